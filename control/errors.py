@@ -1,0 +1,5 @@
+"""Exceptions raised by control."""
+
+
+class ControlError(ValueError):
+    """Invalid input to a control function (a ValueError subclass)."""

@@ -1,0 +1,1 @@
+"""Computational backends for gpmsa (numpy reference, torch, pyro)."""

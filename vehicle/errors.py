@@ -1,0 +1,9 @@
+"""Exceptions raised by vehicle."""
+
+
+class VehicleError(ValueError):
+    """Invalid input to a vehicle function (a ValueError subclass)."""
+
+
+class SimulationDivergedError(RuntimeError):
+    """A simulation left its numerically valid range (NaN/inf or runaway states)."""
