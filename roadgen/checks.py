@@ -1,0 +1,69 @@
+"""Input checks shared by roadgen's functions; each raises RoadgenError naming the argument."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from roadgen.errors import RoadgenError
+
+
+def positive(name: str, value: float) -> float:
+    """Return ``value`` as a float, or raise if it is not a finite number > 0."""
+    v = _finite(name, value)
+    if v <= 0.0:
+        raise RoadgenError(f"{name}={value!r} is out of range: allowed (0, inf)")
+    return v
+
+
+def non_negative(name: str, value: float) -> float:
+    """Return ``value`` as a float, or raise if it is not a finite number >= 0."""
+    v = _finite(name, value)
+    if v < 0.0:
+        raise RoadgenError(f"{name}={value!r} is out of range: allowed [0, inf)")
+    return v
+
+
+def choice(name: str, value: str, allowed: tuple[str, ...]) -> str:
+    """Return ``value`` if it is one of ``allowed``, else raise."""
+    if value not in allowed:
+        raise RoadgenError(f"{name}={value!r} is not allowed: choose one of {allowed}")
+    return value
+
+
+def band(name: str, value: tuple[float, float], nyquist: float) -> tuple[float, float]:
+    """Check a band (n_min, n_max) in cycles/m: 0 < n_min < n_max <= nyquist."""
+    try:
+        lo, hi = (float(b) for b in value)
+    except (TypeError, ValueError) as exc:
+        raise RoadgenError(f"{name}={value!r} must be a pair (n_min, n_max) in cycles/m") from exc
+    if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi <= nyquist):
+        raise RoadgenError(
+            f"{name}={value!r} is out of range: need 0 < n_min < n_max <= {nyquist:.6g} "
+            "cycles/m (the Nyquist frequency 1/(2 dx_m) of the grid)"
+        )
+    return lo, hi
+
+
+def positions(name: str, s: np.ndarray | float, length_m: float) -> np.ndarray:
+    """Return ``s`` as a float array, or raise if any position is NaN or outside [0, length_m]."""
+    arr = np.asarray(s, dtype=float)
+    tol = 1e-9 * max(length_m, 1.0)
+    bad = ~np.isfinite(arr) | (arr < -tol) | (arr > length_m + tol)
+    if np.any(bad):
+        first = arr[bad].flat[0]
+        raise RoadgenError(
+            f"{name} contains {first!r}: allowed positions are [0, {length_m:.6g}] m"
+        )
+    return np.clip(arr, 0.0, length_m)
+
+
+def _finite(name: str, value: float) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError) as exc:
+        raise RoadgenError(f"{name}={value!r} must be a real number") from exc
+    if not math.isfinite(v):
+        raise RoadgenError(f"{name}={value!r} must be finite")
+    return v

@@ -1,0 +1,49 @@
+"""ISO 8608 facts: the reference frequency, the displacement PSD model and the road classes.
+
+ISO 8608 describes a road by the one-sided PSD of its vertical displacement,
+``Gd(n) = Gd(n0) (n / n0)^-w`` with ``n`` the spatial frequency (cycles/m), ``n0 = 0.1``
+cycles/m and waviness ``w = 2``. Following the paper, ``GD = Gd(n0) * 1e6`` (units 1e-6 m^3).
+"""
+
+from __future__ import annotations
+
+import bisect
+
+import numpy as np
+
+from roadgen import checks
+
+N0 = 0.1
+"""Reference spatial frequency n0 of ISO 8608, cycles/m."""
+
+GD_SCALE = 1e-6
+"""Gd(n0) in m^3 per unit of GD."""
+
+CLASS_LOWER_BOUNDS: tuple[tuple[str, float], ...] = (
+    ("A", 0.0),
+    ("B", 32.0),
+    ("C", 128.0),
+    ("D", 512.0),
+    ("E", 2048.0),
+    ("F", 8192.0),
+    ("G", 32768.0),
+    ("H", 131072.0),
+)
+"""ISO 8608 road classes and the lower GD bound of each (each class spans a factor of 4)."""
+
+
+def gd_spectrum(n: np.ndarray, gd: float, waviness: float = 2.0) -> np.ndarray:
+    """One-sided displacement PSD Gd(n) in m^3 for spatial frequencies ``n`` (cycles/m, > 0)."""
+    return gd * GD_SCALE * (np.asarray(n, dtype=float) / N0) ** (-waviness)
+
+
+def road_class(gd: float) -> str:
+    """ISO 8608 road class ("A".."H") of a road with the given GD (units 1e-6 m^3, > 0).
+
+    Classes (lower bound inclusive): A < 32, B 32-128, C 128-512, D 512-2048, E 2048-8192,
+    F 8192-32768, G 32768-131072, H >= 131072. The paper's Table 1 prints B's upper limit as 28;
+    that is a typo for 128 (the bounds grow by a factor of 4 per class).
+    """
+    g = checks.positive("gd", gd)
+    bounds = [b for _, b in CLASS_LOWER_BOUNDS]
+    return CLASS_LOWER_BOUNDS[bisect.bisect_right(bounds, g) - 1][0]

@@ -1,0 +1,165 @@
+"""ISO 8608 road profiles synthesised from random-phase harmonics (one inverse FFT)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from roadgen import checks
+from roadgen.errors import RoadgenError
+from roadgen.iso8608 import gd_spectrum
+from roadgen.road import Road
+
+AMPLITUDE_MODES = ("deterministic", "rayleigh")
+
+
+@dataclass(frozen=True)
+class ProfileSettings:
+    """How a profile was made.
+
+    band: (n_min, n_max) cycles/m, the spatial frequencies that carry content (as resolved).
+    amplitudes: "deterministic" (each harmonic carries exactly Gd(n_k) dn) or "rayleigh"
+        (Rayleigh-distributed amplitudes, i.e. a Gaussian process with that mean PSD).
+    waviness: w in Gd(n) = Gd(n0) (n/n0)^-w (ISO 8608: 2).
+    seed: the integer seed, or None when a Generator or fresh entropy was used.
+    lead_in_m: length of the raised-cosine taper from z = 0 at the start, m (0: none).
+    """
+
+    band: tuple[float, float]
+    amplitudes: str
+    waviness: float
+    seed: int | None
+    lead_in_m: float
+
+
+@dataclass(frozen=True, eq=False)
+class Profile(Road):
+    """A road of one prescribed GD: x (N,) m, z (N,) m, dx_m, gd (1e-6 m^3), settings."""
+
+    gd: float
+    settings: ProfileSettings
+
+    def gd_at(self, s: np.ndarray | float) -> np.ndarray | float:
+        """Prescribed GD at positions ``s`` (m): the constant ``gd``, shaped like ``s``."""
+        arr = checks.positions("s", s, self.length_m)
+        out = np.full(arr.shape, self.gd)
+        return float(out) if out.ndim == 0 else out
+
+
+def iso8608_profile(
+    length_m: float,
+    gd: float,
+    dx_m: float = 0.006,
+    seed: int | np.random.Generator | None = None,
+    band: tuple[float, float] | None = None,
+    amplitudes: str = "deterministic",
+    waviness: float = 2.0,
+    lead_in_m: float = 0.0,
+) -> Profile:
+    """A random road profile whose one-sided displacement PSD is Gd(n) = GD 1e-6 (n/0.1)^-w m^3.
+
+    Grid: ``N = round(length_m / dx_m) + 1`` points x = 0, dx_m, ..., length_m (the length is
+    rounded to whole steps). The profile is one period, of length ``P = N dx_m``, of a sum of
+    cosines at the periodogram's frequencies n_k = k / P with random phases and amplitudes
+    ``A_k = sqrt(2 Gd(n_k) / P)`` (times a unit-power Rayleigh factor for
+    ``amplitudes="rayleigh"``), so the boxcar periodogram of ``z`` returns Gd(n_k) exactly at
+    every harmonic in the band (deterministic amplitudes). It is computed by one inverse real FFT.
+
+    band: (n_min, n_max) cycles/m with ``1/P <= n_min < n_max <= 1/(2 dx_m)``. Default: every
+        harmonic the grid holds, from the fundamental 1/P to the Nyquist limit 1/(2 dx_m)
+        (83.3 cycles/m at 6 mm). The upper limit matters: a vehicle at 0.5 m/s sees 10 cycles/m
+        as 5 Hz, so a band that stops there would hide the road from its ~10 Hz tyre modes.
+        The Nyquist harmonic itself is never used (it has no phase).
+    lead_in_m: if > 0, z is multiplied by 0.5 (1 - cos(pi x / lead_in_m)) on [0, lead_in_m], so the
+        road starts at z = 0 with zero slope (the vehicle's rest height).
+    seed: int or numpy Generator; the same seed gives the same profile. The phases (and Rayleigh
+        factors) do not depend on GD, so one seed gives the same shape scaled by sqrt(GD) for
+        every GD: use different seeds for independent roads.
+
+    Raises RoadgenError for a non-positive or non-finite length, GD, dx or waviness, a band outside
+    (0, Nyquist], a length shorter than 1/n_min, or a band without harmonics.
+    """
+    length = checks.positive("length_m", length_m)
+    gd_val = checks.positive("gd", gd)
+    dx = checks.positive("dx_m", dx_m)
+    lead = checks.non_negative("lead_in_m", lead_in_m)
+    n_points = grid_points(length, dx)
+    if lead > (n_points - 1) * dx:
+        raise RoadgenError(
+            f"lead_in_m={lead_in_m!r} is out of range: allowed [0, {(n_points - 1) * dx:.6g}] m"
+        )
+    unit, settings = unit_road(n_points, dx, seed, band, amplitudes, waviness, lead)
+    z = np.sqrt(gd_val) * unit * lead_in_taper(np.arange(n_points) * dx, lead)
+    return Profile(x=np.arange(n_points) * dx, z=z, dx_m=dx, gd=gd_val, settings=settings)
+
+
+def unit_road(
+    n_points: int,
+    dx_m: float,
+    seed: int | np.random.Generator | None,
+    band: tuple[float, float] | None,
+    amplitudes: str,
+    waviness: float,
+    lead_in_m: float,
+) -> tuple[np.ndarray, ProfileSettings]:
+    """Heights (n_points,) m of a GD = 1 profile on the grid, and the resolved settings."""
+    checks.choice("amplitudes", amplitudes, AMPLITUDE_MODES)
+    w = checks.positive("waviness", waviness)
+    period = n_points * dx_m
+    nyquist = 0.5 / dx_m
+    dn = 1.0 / period
+    if band is None:
+        lo, hi = dn, nyquist
+    else:
+        lo, hi = checks.band("band", band, nyquist)
+        if lo < dn * (1.0 - 1e-9):
+            raise RoadgenError(
+                f"length_m={(n_points - 1) * dx_m:.6g} is too short for band={band!r}: the band's "
+                f"n_min={lo:.6g} cycles/m needs length_m >= {1.0 / lo - dx_m:.6g} m "
+                f"(or use n_min >= {dn:.6g} cycles/m)"
+            )
+    k = np.arange(n_points // 2 + 1)
+    n = k * dn
+    keep = (k >= 1) & (2 * k < n_points) & (n >= lo * (1 - 1e-9)) & (n <= hi * (1 + 1e-9))
+    if not np.any(keep):
+        raise RoadgenError(
+            f"band={band!r} holds no harmonic of the profile (spacing {dn:.6g} cycles/m): widen it "
+            f"or lengthen the profile"
+        )
+    rng = np.random.default_rng(seed)
+    n_keep = int(np.count_nonzero(keep))
+    phase = rng.uniform(0.0, 2.0 * np.pi, n_keep)
+    amp = np.sqrt(2.0 * gd_spectrum(n[keep], 1.0, w) * dn)
+    if amplitudes == "rayleigh":
+        amp = amp * rng.rayleigh(scale=np.sqrt(0.5), size=n_keep)
+    spectrum = np.zeros(k.size, dtype=complex)
+    spectrum[keep] = 0.5 * n_points * amp * np.exp(1j * phase)
+    unit = np.fft.irfft(spectrum, n=n_points)
+    seed_int = None if seed is None or isinstance(seed, np.random.Generator) else int(seed)
+    settings = ProfileSettings(
+        band=(float(n[keep][0]) if band is None else lo, hi),
+        amplitudes=amplitudes,
+        waviness=w,
+        seed=seed_int,
+        lead_in_m=lead_in_m,
+    )
+    return unit, settings
+
+
+def lead_in_taper(x: np.ndarray, lead_in_m: float) -> np.ndarray:
+    """Raised-cosine ramp (N,): 0 at x = 0 up to 1 at x >= lead_in_m (all ones if lead_in_m = 0)."""
+    if lead_in_m == 0.0:
+        return np.ones_like(x)
+    t = np.clip(x / lead_in_m, 0.0, 1.0)
+    return 0.5 * (1.0 - np.cos(np.pi * t))
+
+
+def grid_points(length_m: float, dx_m: float) -> int:
+    """Number of grid points for a length rounded to whole steps; at least 2 steps."""
+    steps = round(length_m / dx_m)
+    if steps < 2:
+        raise RoadgenError(
+            f"dx_m={dx_m!r} is out of range for length_m={length_m!r}: allowed (0, length_m / 2]"
+        )
+    return steps + 1

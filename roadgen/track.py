@@ -1,0 +1,124 @@
+"""Tracks: consecutive segments of prescribed GD, joined without steps."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from roadgen import checks
+from roadgen.errors import RoadgenError
+from roadgen.profile import ProfileSettings, grid_points, lead_in_taper, unit_road
+from roadgen.road import Road
+
+
+@dataclass(frozen=True, eq=False)
+class Track(Road):
+    """A road made of segments: x (N,) m, z (N,) m, dx_m and what it was made from.
+
+    segments: ((length_m, gd), ...) in driving order; boundaries_m: start position of each segment
+    (the first is 0); lead_in_m: length of the start taper; blend_m: length of each amplitude
+    cross-fade, centred on a boundary; settings: synthesis settings of the underlying road.
+    """
+
+    segments: tuple[tuple[float, float], ...]
+    boundaries_m: tuple[float, ...]
+    lead_in_m: float
+    blend_m: float
+    settings: ProfileSettings
+
+    def gd_at(self, s: np.ndarray | float) -> np.ndarray | float:
+        """Prescribed GD at positions ``s`` (m): that of the segment holding each position.
+
+        This is the step function the paper scores against; the realised roughness changes over
+        ``blend_m`` around each boundary and is tapered over the lead-in.
+        """
+        arr = checks.positions("s", s, self.length_m)
+        idx = np.searchsorted(np.asarray(self.boundaries_m), arr, side="right") - 1
+        gds = np.array([g for _, g in self.segments])
+        out = gds[np.clip(idx, 0, len(gds) - 1)]
+        return float(out) if out.ndim == 0 else out
+
+
+def track(
+    segments: Sequence[tuple[float, float]],
+    seed: int | np.random.Generator | None = None,
+    dx_m: float = 0.006,
+    band: tuple[float, float] | None = None,
+    amplitudes: str = "deterministic",
+    waviness: float = 2.0,
+    lead_in_m: float = 1.0,
+    blend_m: float = 1.0,
+) -> Track:
+    """A track of segments [(length_m, gd), ...]; the paper's is [(50, 300), (50, 500), (50, 300)].
+
+    One GD = 1 road is synthesised over the whole length (see ``iso8608_profile``: same band,
+    amplitudes, waviness and seed rules) and multiplied by an amplitude a(x) = sqrt(GD(x)) that is
+    constant in each segment and cross-fades with a raised cosine over ``blend_m`` (default 1 m)
+    centred on each boundary. Heights are therefore continuous at the joins and each segment has
+    exactly its prescribed PSD away from them. A raised-cosine lead-in over ``lead_in_m``
+    (default 1 m) makes the track start at z = 0 with zero slope. x = 0 is the start of the first
+    segment; the length is rounded to whole dx_m steps.
+
+    Raises RoadgenError for an empty or malformed segment list, non-positive lengths or GDs,
+    blend_m < 2 dx_m or longer than the shortest segment, a lead-in that reaches into the first
+    blend, and the band errors of ``iso8608_profile``.
+    """
+    segs = _check_segments(segments)
+    dx = checks.positive("dx_m", dx_m)
+    lead = checks.non_negative("lead_in_m", lead_in_m)
+    blend = checks.positive("blend_m", blend_m)
+    lengths = np.array([length for length, _ in segs])
+    if not 2 * dx <= blend <= lengths.min():
+        raise RoadgenError(
+            f"blend_m={blend_m!r} is out of range: allowed [{2 * dx:.6g}, {lengths.min():.6g}] m "
+            "(two grid steps to the shortest segment)"
+        )
+    lead_max = lengths[0] - (0.5 * blend if len(segs) > 1 else 0.0)
+    if lead > lead_max:
+        raise RoadgenError(
+            f"lead_in_m={lead_in_m!r} is out of range: allowed [0, {lead_max:.6g}] m"
+        )
+    n_points = grid_points(float(lengths.sum()), dx)
+    unit, settings = unit_road(n_points, dx, seed, band, amplitudes, waviness, lead)
+    x = np.arange(n_points) * dx
+    starts = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
+    amp = _amplitude(x, starts, np.sqrt([g for _, g in segs]), blend)
+    return Track(
+        x=x,
+        z=amp * lead_in_taper(x, lead) * unit,
+        dx_m=dx,
+        segments=segs,
+        boundaries_m=tuple(float(b) for b in starts),
+        lead_in_m=lead,
+        blend_m=blend,
+        settings=settings,
+    )
+
+
+def _amplitude(x: np.ndarray, starts: np.ndarray, amps: np.ndarray, blend: float) -> np.ndarray:
+    """sqrt(GD) along x (N,): amps[0], then a raised-cosine step amps[i] - amps[i-1] per start."""
+    out = np.full_like(x, amps[0])
+    for start, step in zip(starts[1:], np.diff(amps), strict=True):
+        t = np.clip((x - start) / blend + 0.5, 0.0, 1.0)
+        out += step * 0.5 * (1.0 - np.cos(np.pi * t))
+    return out
+
+
+def _check_segments(segments: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+    try:
+        pairs = [tuple(seg) for seg in segments]
+    except TypeError as exc:
+        raise RoadgenError(f"segments={segments!r} must be a sequence of (length_m, gd)") from exc
+    if not pairs or any(len(p) != 2 for p in pairs):
+        raise RoadgenError(
+            f"segments={segments!r} must be a non-empty sequence of (length_m, gd) pairs"
+        )
+    return tuple(
+        (
+            checks.positive(f"segments[{i}] length_m", length),
+            checks.positive(f"segments[{i}] gd", g),
+        )
+        for i, (length, g) in enumerate(pairs)
+    )

@@ -1,0 +1,106 @@
+"""PSD estimates, the GD fit, Welch, and ISO 8608 road classes."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import roadgen
+
+
+@pytest.mark.parametrize(
+    ("gd", "cls"),
+    [
+        (1.0, "A"),
+        (31.99, "A"),
+        (32.0, "B"),
+        (100.0, "B"),
+        (127.99, "B"),
+        (128.0, "C"),
+        (300.0, "C"),
+        (511.9, "C"),
+        (512.0, "D"),
+        (2047.0, "D"),
+        (2048.0, "E"),
+        (8192.0, "F"),
+        (32767.0, "F"),
+        (32768.0, "G"),
+        (131071.0, "G"),
+        (131072.0, "H"),
+        (1e9, "H"),
+    ],
+)
+def test_road_class_bounds(gd, cls):
+    assert roadgen.road_class(gd) == cls
+
+
+@given(st.floats(1e-3, 1e7))
+def test_road_class_grows_by_a_factor_of_4(gd):
+    letters = "ABCDEFGH"
+    a, b = letters.index(roadgen.road_class(gd)), letters.index(roadgen.road_class(4.0 * gd))
+    assert b == min(a + 1, 7) or (a == 0 and b <= 1)
+
+
+@pytest.mark.parametrize("gd", [0.0, -5.0, np.nan, np.inf, None])
+def test_road_class_rejects_bad_gd(gd):
+    with pytest.raises(roadgen.RoadgenError, match="gd="):
+        roadgen.road_class(gd)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_welch_and_fit_agree_on_long_profiles(seed):
+    road = roadgen.iso8608_profile(600.0, 400.0, seed=seed, amplitudes="rayleigh")
+    band = (0.05, 5.0)
+    fit = roadgen.estimate_gd(road, band=band)
+    welch = roadgen.estimate_gd(road, method="welch", band=band)
+    assert welch == pytest.approx(fit, rel=0.05)
+    assert fit == pytest.approx(400.0, rel=0.1)
+
+
+def test_welch_psd_follows_the_prescribed_line():
+    road = roadgen.iso8608_profile(600.0, 400.0, seed=3)
+    n, gd = roadgen.profile_psd(road, method="welch")
+    assert n[0] == pytest.approx(1.0 / (road.x.size // 4 * road.dx_m))
+    mid = (n > 0.5) & (n < 20.0)
+    ratio = gd[mid] / roadgen.gd_spectrum(n[mid], 400.0)
+    assert np.mean(ratio) == pytest.approx(1.0, rel=0.05)
+
+
+def test_estimates_scale_with_gd_and_use_the_roads_waviness():
+    road = roadgen.iso8608_profile(150.0, 100.0, seed=0, waviness=3.0)
+    assert roadgen.estimate_gd(road) == pytest.approx(100.0, rel=0.01)
+    assert roadgen.estimate_gd(road, waviness=2.0) != pytest.approx(100.0, rel=0.1)
+    plain = SimpleNamespace(z=road.z * 2.0, dx_m=road.dx_m)  # no settings: w defaults to 2
+    assert roadgen.estimate_gd(plain, waviness=3.0) == pytest.approx(400.0, rel=0.01)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"method": "median"}, "method='median'"),
+        ({"band": (0.5, 0.1)}, r"band=\(0.5, 0.1\).*n_min < n_max"),
+        ({"band": (0.0, 1.0)}, "band="),
+        ({"band": (0.1, 100.0)}, r"83.33"),
+        ({"band": (0.1, np.nan)}, "band="),
+        ({"band": "wide"}, "band="),
+        ({"waviness": -1.0}, "waviness"),
+    ],
+)
+def test_bad_estimate_arguments_raise(kwargs, match):
+    road = roadgen.iso8608_profile(30.0, 300.0, seed=0)
+    with pytest.raises(roadgen.RoadgenError, match=match):
+        roadgen.estimate_gd(road, **kwargs)
+
+
+def test_too_short_a_road_for_the_band_raises():
+    road = roadgen.iso8608_profile(12.0, 300.0, seed=0)
+    with pytest.raises(roadgen.RoadgenError, match="too short for band"):
+        roadgen.estimate_gd(road, band=(0.05, 0.08))
+    with pytest.raises(roadgen.RoadgenError, match="too short for band.*'welch'"):
+        roadgen.estimate_gd(road, method="welch")
+    with pytest.raises(roadgen.RoadgenError, match="nperseg=4"):
+        roadgen.profile_psd(road, method="welch", nperseg=4)
+    with pytest.raises(roadgen.RoadgenError, match="method='fft'"):
+        roadgen.profile_psd(road, method="fft")
