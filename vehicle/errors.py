@@ -7,3 +7,7 @@ class VehicleError(ValueError):
 
 class SimulationDivergedError(RuntimeError):
     """A simulation left its numerically valid range (NaN/inf or runaway states)."""
+
+
+class CampaignFileError(VehicleError):
+    """A campaign file (or a cached run) is missing, damaged or of an unknown format."""

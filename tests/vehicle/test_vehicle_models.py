@@ -1,0 +1,56 @@
+"""Model parameter sets: description, derived quantities, bad parameters."""
+
+import json
+import math
+
+import pytest
+
+import vehicle
+from vehicle.models import GRAVITY
+
+
+@pytest.mark.parametrize("model", [vehicle.Jackal(), vehicle.HalfCar()])
+def test_describe_is_json_and_names_every_parameter(model):
+    d = model.describe()
+    back = json.loads(json.dumps(d))
+    assert back["model"] == type(model).__name__
+    for name in model.__dataclass_fields__:
+        assert back[name] == getattr(model, name)
+
+
+def test_describe_distinguishes_tyre_parameters():
+    assert vehicle.Jackal().describe() != vehicle.Jackal(tyre_stiffness_n_per_m=10e3).describe()
+
+
+def test_jackal_static_loads_carry_the_weight_and_balance_the_moment():
+    m = vehicle.Jackal()
+    f1, f2 = m.static_tyre_loads_n
+    assert math.isclose(f1 + f2, m.mass_kg * GRAVITY)
+    assert math.isclose(f1 * m.b1_m, f2 * m.b2_m)
+    assert math.isclose(m.wheelbase_m, 0.262)
+
+
+def test_halfcar_static_loads_include_unsprung_masses():
+    m = vehicle.HalfCar()
+    total = m.sprung_mass_kg + m.unsprung_mass_front_kg + m.unsprung_mass_rear_kg
+    assert math.isclose(sum(m.static_tyre_loads_n), total * GRAVITY)
+
+
+@pytest.mark.parametrize(
+    ("cls", "field", "value"),
+    [
+        (vehicle.Jackal, "mass_kg", -1.0),
+        (vehicle.Jackal, "tyre_stiffness_n_per_m", float("nan")),
+        (vehicle.Jackal, "tyre_damping_ns_per_m", -3.0),
+        (vehicle.HalfCar, "b1_m", 0.0),
+        (vehicle.HalfCar, "suspension_damping_front_ns_per_m", float("inf")),
+    ],
+)
+def test_bad_parameters_raise(cls, field, value):
+    with pytest.raises(vehicle.VehicleError, match=field):
+        cls(**{field: value})
+
+
+def test_models_are_frozen():
+    with pytest.raises(AttributeError):
+        vehicle.Jackal().mass_kg = 3.0

@@ -1,0 +1,142 @@
+"""simulate(): the trace, the sensor, speed schedules, lift-off, bad input."""
+
+import numpy as np
+import pytest
+
+import roadgen
+import vehicle
+
+
+@pytest.fixture(scope="module")
+def jackal_trace(rough_road):
+    return vehicle.simulate(vehicle.Jackal(), rough_road, 1.5, noise_std=1.0, seed=4)
+
+
+def test_trace_samples_on_the_120_hz_grid_up_to_the_road_end(jackal_trace, rough_road):
+    tr = jackal_trace
+    k = np.arange(1, len(tr) + 1)
+    np.testing.assert_allclose(tr.t, k / 120.0, atol=1e-12)
+    wb = vehicle.Jackal().wheelbase_m
+    np.testing.assert_allclose(tr.position, wb + 1.5 * tr.t, atol=1e-9)
+    assert tr.position[-1] <= rough_road.length_m
+    assert tr.position[-1] + 1.5 / 120 > rough_road.length_m
+    np.testing.assert_allclose(tr.speed, 1.5)
+    for name in ("accel_rear", "accel_front_measured", "heave", "pitch", "contact_front"):
+        assert getattr(tr, name).shape == tr.t.shape
+
+
+def test_noise_is_standard_normal_and_seeded(jackal_trace, rough_road):
+    tr = jackal_trace
+    noise = tr.accel_front_measured - tr.accel_front
+    assert abs(np.std(noise) - 1.0) < 4 * (1 / np.sqrt(2 * noise.size))
+    assert abs(np.mean(noise)) < 4 / np.sqrt(noise.size)
+    again = vehicle.simulate(vehicle.Jackal(), rough_road, 1.5, noise_std=1.0, seed=4)
+    np.testing.assert_array_equal(again.accel_front_measured, tr.accel_front_measured)
+    other = vehicle.simulate(vehicle.Jackal(), rough_road, 1.5, noise_std=1.0, seed=5)
+    assert not np.array_equal(other.accel_front_measured, tr.accel_front_measured)
+    np.testing.assert_array_equal(other.accel_front, tr.accel_front)
+
+
+def test_no_noise_means_measured_equals_true(rough_road):
+    tr = vehicle.simulate(vehicle.Jackal(), rough_road, 1.0)
+    np.testing.assert_array_equal(tr.accel_front_measured, tr.accel_front)
+
+
+def test_flat_road_gives_no_acceleration(flat_road):
+    tr = vehicle.simulate(vehicle.Jackal(), flat_road, 2.0)
+    assert np.max(np.abs(tr.accel_front)) < 1e-5
+    assert tr.contact_front.all() and tr.contact_rear.all()
+
+
+def test_rougher_and_faster_shake_more(rough_road):
+    slow = vehicle.simulate(vehicle.Jackal(), rough_road, 0.6)
+    fast = vehicle.simulate(vehicle.Jackal(), rough_road, 1.8)
+    assert np.var(fast.accel_front) > 1.5 * np.var(slow.accel_front)
+    smooth = roadgen.iso8608_profile(12.0, gd=100, seed=3, lead_in_m=1.0)
+    tr = vehicle.simulate(vehicle.Jackal(), smooth, 0.6)
+    # same seed, same shape: heights scale with sqrt(GD), so bilateral f would scale with GD
+    assert np.var(tr.accel_front) < 0.5 * np.var(slow.accel_front)
+
+
+def test_lift_off_caps_the_tyre_force_and_changes_the_response():
+    road = roadgen.iso8608_profile(8.0, gd=600, seed=1, lead_in_m=0.5)
+    uni = vehicle.simulate(vehicle.Jackal(), road, 2.0)
+    bi = vehicle.simulate(vehicle.Jackal(lift_off=False), road, 2.0)
+    assert 0.02 < 1 - uni.contact_front.mean() < 0.8  # the wheel leaves the ground sometimes
+    assert 1 - bi.contact_front.mean() > 0.02  # a bilateral tyre would have pulled there
+    assert np.var(uni.accel_front) < 0.9 * np.var(bi.accel_front)
+
+
+def test_envelope_lowers_the_response(rough_road):
+    """The wheel bridges short bumps; bilateral, so lift-off cannot blur the comparison."""
+    model = vehicle.Jackal(lift_off=False)
+    env = vehicle.simulate(model, rough_road, 1.5)
+    raw = vehicle.simulate(model, rough_road, 1.5, envelope=False)
+    assert np.var(env.accel_front) < np.var(raw.accel_front)
+
+
+def test_speed_schedules_of_time_position_and_arrays_agree(rough_road):
+    wb = vehicle.Jackal().wheelbase_m
+    by_time = vehicle.simulate(vehicle.Jackal(), rough_road, lambda t: 0.8 + 0.1 * t)
+    arrays = vehicle.simulate(vehicle.Jackal(), rough_road, ([0.0, 100.0], [0.8, 10.8]))
+    np.testing.assert_allclose(by_time.speed, 0.8 + 0.1 * by_time.t, rtol=1e-9)
+    np.testing.assert_allclose(by_time.position, wb + 0.8 * by_time.t + 0.05 * by_time.t**2)
+    np.testing.assert_allclose(arrays.accel_front, by_time.accel_front, atol=1e-6)
+    # a schedule of position: v(s) = 1 + 0.05 (s - wb) passes each point at the analytic time
+    by_pos = vehicle.simulate(
+        vehicle.Jackal(), rough_road, lambda s: 1.0 + 0.05 * (s - wb), speed_of="position"
+    )
+    t_exact = np.log(1 + 0.05 * (by_pos.position - wb)) / 0.05
+    np.testing.assert_allclose(by_pos.t, t_exact, atol=1e-4)
+    np.testing.assert_allclose(by_pos.speed, 1.0 + 0.05 * (by_pos.position - wb), atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"speed": 0.0}, "speed=0.0"),
+        ({"speed": -1.0}, "speed=-1.0"),
+        ({"speed": float("nan")}, "speed=nan"),
+        ({"speed": 2.5}, r"allowed \(0, 2\] m/s"),
+        ({"speed": lambda t: 1.0 - t}, "speed="),
+        ({"speed": 1.0, "rate_hz": 0.0}, "rate_hz=0.0"),
+        ({"speed": 1.0, "rate_hz": -120.0}, "rate_hz=-120.0"),
+        ({"speed": 1.0, "noise_std": -1.0}, "noise_std=-1.0"),
+        ({"speed": 1.0, "start_m": -0.1}, "start_m=-0.1"),
+        ({"speed": 1.0, "end_m": 99.0}, "end_m=99.0"),
+        ({"speed": 1.0, "speed_of": "distance"}, "speed_of='distance'"),
+    ],
+)
+def test_bad_input_raises(rough_road, kwargs, match):
+    with pytest.raises(vehicle.VehicleError, match=match):
+        vehicle.simulate(vehicle.Jackal(), rough_road, **kwargs)
+
+
+def test_road_shorter_than_wheelbase_raises():
+    road = roadgen.iso8608_profile(0.2, gd=300, seed=0)
+    with pytest.raises(vehicle.VehicleError, match="shorter than the wheelbase|not longer"):
+        vehicle.simulate(vehicle.Jackal(), road, 1.0)
+
+
+def test_road_without_heights_raises():
+    with pytest.raises(vehicle.VehicleError, match="road="):
+        vehicle.simulate(vehicle.Jackal(), [0.0, 1.0], 1.0, envelope=False)
+
+
+def test_a_diverging_run_raises():
+    road = roadgen.iso8608_profile(5.0, gd=1e9, seed=0, lead_in_m=0.5)  # ~20 m bumps
+    with pytest.raises(vehicle.SimulationDivergedError, match="out of range"):
+        vehicle.simulate(vehicle.Jackal(), road, 2.0)
+
+
+def test_halfcar_lift_off_option():
+    road = roadgen.iso8608_profile(30.0, gd=5000, seed=1, lead_in_m=2.0)
+    uni = vehicle.simulate(vehicle.HalfCar(lift_off=True), road, 30.0)
+    bi = vehicle.simulate(vehicle.HalfCar(), road, 30.0)
+    assert 1 - bi.contact_front.mean() > 0.05
+    assert np.var(uni.accel_front) < 0.8 * np.var(bi.accel_front)
+
+
+def test_unknown_model_raises(rough_road):
+    with pytest.raises(vehicle.VehicleError, match="model='car'"):
+        vehicle.simulate("car", rough_road, 1.0)

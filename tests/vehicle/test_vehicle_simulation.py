@@ -1,0 +1,95 @@
+"""Simulation: the steppable drive of the closed loop."""
+
+import numpy as np
+import pytest
+
+import roadgen
+import vehicle
+
+
+@pytest.fixture(scope="module")
+def track():
+    return roadgen.track([(4, 300), (4, 500)], seed=2)
+
+
+def _drive(track, chunks, speed=1.5, model=None, **kwargs):
+    sim = vehicle.Simulation(model or vehicle.Jackal(), track, **kwargs)
+    out = []
+    i = 0
+    while not sim.finished:
+        out.append(sim.advance(chunks[i % len(chunks)], speed))
+        i += 1
+    cat = {n: np.concatenate([getattr(s, n) for s in out]) for n in ("t", "position", "speed")}
+    cat["accel"] = np.concatenate([s.accel_front_true for s in out])
+    cat["measured"] = np.concatenate([s.accel_front for s in out])
+    return sim, cat
+
+
+def _rel_rms(a, b):
+    return np.sqrt(np.mean((a - b) ** 2)) / np.sqrt(np.mean(b**2))
+
+
+@pytest.mark.parametrize(("lift_off", "tol"), [(False, 1e-4), (True, 1e-2)])
+def test_chunks_continue_the_integration(track, lift_off, tol):
+    """Many short advances give the samples of long ones: the state carries over (a restart only
+    recomputes the integrator's acceleration variable; with lift-off, small differences grow a
+    little at the non-smooth contact events, still far below the step-size sensitivity)."""
+    model = vehicle.Jackal(lift_off=lift_off)
+    _, a = _drive(track, [0.1, 0.37, 1.0], model=model)
+    _, b = _drive(track, [2.5], model=model)
+    np.testing.assert_allclose(a["t"], b["t"], atol=1e-12)
+    np.testing.assert_allclose(np.diff(a["t"]), 1 / 120, atol=1e-12)
+    assert _rel_rms(a["accel"], b["accel"]) < tol
+    assert abs(np.var(a["accel"]) / np.var(b["accel"]) - 1) < tol
+
+
+def test_speed_ramps_at_the_acceleration_limit_and_stops_at_the_end(track):
+    sim, a = _drive(track, [0.3], speed=2.0)
+    limit = vehicle.Jackal().max_accel_mps2
+    accel = np.diff(np.concatenate([[0.0], a["speed"]])) * 120
+    assert np.max(accel) <= limit * (1 + 1e-9)
+    assert np.isclose(a["speed"][0], limit / 120)  # from rest, one sample period at the limit
+    assert np.isclose(a["speed"][-1], 2.0)
+    assert a["position"][-1] <= track.length_m
+    assert sim.finished and sim.position == a["position"][-1]
+    assert len(sim.advance(0.5, 1.0)) == 0
+
+
+def test_samples_report_noisy_and_true_acceleration(track):
+    _, a = _drive(track, [0.5], noise_std=1.0, seed=3)
+    noise = a["measured"] - a["accel"]
+    assert abs(np.std(noise) - 1.0) < 0.1
+    _, b = _drive(track, [0.5], noise_std=1.0, seed=3)
+    np.testing.assert_array_equal(a["measured"], b["measured"])
+
+
+def test_slowing_down_respects_the_limit(track):
+    sim = vehicle.Simulation(vehicle.Jackal(), track, start_m=0.5)
+    sim.advance(0.5, 2.0)
+    s = sim.advance(0.05, 0.5)
+    assert np.all(np.diff(np.concatenate([[2.0], s.speed])) * 120 >= -20.0 * (1 + 1e-9))
+    assert sim.speed == pytest.approx(2.0 - 20.0 * 6 / 120)
+
+
+@pytest.mark.parametrize(
+    ("dt", "speed", "match"),
+    [
+        (0.5, 0.0, "speed=0.0"),
+        (0.5, -1.0, "speed=-1.0"),
+        (0.5, float("nan"), "speed=nan"),
+        (0.5, 2.1, r"speed=2.1 m/s is out of range"),
+        (0.0, 1.0, "dt=0.0"),
+        (float("nan"), 1.0, "dt=nan"),
+    ],
+)
+def test_bad_advance_raises(track, dt, speed, match):
+    sim = vehicle.Simulation(vehicle.Jackal(), track)
+    with pytest.raises(vehicle.VehicleError, match=match):
+        sim.advance(dt, speed)
+
+
+def test_bad_construction_raises(track):
+    with pytest.raises(vehicle.VehicleError, match="rate_hz=0"):
+        vehicle.Simulation(vehicle.Jackal(), track, rate_hz=0)
+    with pytest.raises(vehicle.VehicleError, match="start_m=9"):
+        vehicle.Simulation(vehicle.Jackal(), track, start_m=9.0)

@@ -1,0 +1,296 @@
+"""The training campaign: one fresh road and one drive per design point, f per run.
+
+f is the variance of the front-axle vertical acceleration normalised by T (``np.var``, ddof=0),
+the paper's eq. 5, computed over two spans of each drive:
+
+* ``f_full``: every sample after the start-up transient, i.e. once the rear axle has passed the
+  road's lead-in taper (front-axle position >= lead_in_m + wheelbase), up to the road's end;
+* ``f_window``: the last ``window`` (1,000) samples of the drive, i.e. the window that ends when
+  the front axle reaches the road's end (as far from the start as possible);
+
+each noise-free and with N(0, noise_std^2) accelerometer noise (``*_noisy``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm.auto import tqdm
+
+import roadgen
+from vehicle.design import check_design, lhs_design
+from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
+from vehicle.models import Jackal, Model, check_model
+from vehicle.simulate import SUBSTEPS, simulate
+
+FORMAT = "vehicle.campaign/1"
+_F_NAMES = ("f_full", "f_window", "f_full_noisy", "f_window_noisy")
+_ARRAYS = ("v", "gd", "seed", *_F_NAMES, "status")
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Everything one run needs (picklable, so any Executor can ship it)."""
+
+    model: Model
+    v: float
+    gd: float
+    seed: int
+    road_length_m: float
+    dx_m: float
+    lead_in_m: float
+    band: tuple[float, float] | None
+    rate_hz: float
+    noise_std: float
+    window: int
+    substeps: int
+
+    def key(self) -> str:
+        """Hash of the run's settings: its cache file name."""
+        text = json.dumps(
+            {**_spec_settings(self), "v": self.v, "gd": self.gd, "seed": self.seed},
+            sort_keys=True,
+        )
+        return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+@dataclass(frozen=True)
+class Campaign:
+    """The campaign's table; arrays (n,) in design order.
+
+    v: speed, m/s. gd: GD, 1e-6 m^3. seed: the run's road seed (its noise seed is [seed, 1]).
+    f_full, f_window, f_full_noisy, f_window_noisy: (m/s^2)^2, NaN for a failed run (see the
+    module docstring for the spans). status: "ok" or the failure message. settings: dict of the
+    campaign's settings (model description, road, sensor, window, solver, seed).
+    """
+
+    v: np.ndarray
+    gd: np.ndarray
+    seed: np.ndarray
+    f_full: np.ndarray
+    f_window: np.ndarray
+    f_full_noisy: np.ndarray
+    f_window_noisy: np.ndarray
+    status: np.ndarray
+    settings: dict
+
+    @property
+    def ok(self) -> np.ndarray:
+        """Boolean mask (n,) of the runs that finished."""
+        return self.status == "ok"
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write a plain ``.npz`` (no pickle): the arrays and the settings as JSON."""
+        arrays = {name: np.asarray(getattr(self, name)) for name in _ARRAYS}
+        arrays["status"] = np.asarray(self.status, dtype=str)
+        arrays["settings"] = np.asarray(json.dumps({"format": FORMAT, **self.settings}))
+        with open(path, "wb") as fh:
+            np.savez(fh, **arrays)
+
+
+def load_campaign(path: str | os.PathLike) -> Campaign:
+    """Read a file written by ``Campaign.save``; CampaignFileError if missing or damaged."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {name: data[name] for name in (*_ARRAYS, "settings")}
+    except FileNotFoundError as exc:
+        raise CampaignFileError(f"campaign file {str(path)!r} does not exist") from exc
+    except (OSError, ValueError, KeyError, EOFError) as exc:
+        raise CampaignFileError(
+            f"campaign file {str(path)!r} is damaged or not a campaign: {exc}"
+        ) from exc
+    try:
+        settings = json.loads(str(arrays.pop("settings")))
+    except json.JSONDecodeError as exc:
+        raise CampaignFileError(f"campaign file {str(path)!r}: settings are not JSON") from exc
+    if not isinstance(settings, dict) or settings.pop("format", None) != FORMAT:
+        raise CampaignFileError(f"campaign file {str(path)!r}: unknown format, need {FORMAT!r}")
+    n = arrays["v"].shape
+    if len(n) != 1 or any(a.shape != n for a in arrays.values()):
+        shapes = {k: a.shape for k, a in arrays.items()}
+        raise CampaignFileError(f"campaign file {str(path)!r}: arrays of unequal shapes {shapes}")
+    return Campaign(**arrays, settings=settings)
+
+
+def run_campaign(
+    design: np.ndarray | None = None,
+    model: Model | None = None,
+    road_length_m: float = 21.0,
+    *,
+    dx_m: float = 0.006,
+    lead_in_m: float = 1.0,
+    band: tuple[float, float] | None = None,
+    rate_hz: float = 120.0,
+    noise_std: float = 1.0,
+    window: int = 1000,
+    substeps: int = SUBSTEPS,
+    executor: Executor | None = None,
+    progress: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    seed: int = 0,
+) -> Campaign:
+    """Run one drive per design point and tabulate f (see the module docstring).
+
+    Each run gets a fresh road: ``roadgen.iso8608_profile(road_length_m, gd, dx_m, seed=...,
+    band=band, lead_in_m=lead_in_m)``, which the tyres follow enveloped by the model's wheel
+    radius (``simulate``'s default); the vehicle drives it at constant speed v from rest, front axle
+    starting a wheelbase in (rear axle at the road's start), to the road's end.
+
+    Args:
+        design: (n, 2) array [v (m/s), GD]; default ``lhs_design(198, seed=seed)``.
+        model: default ``Jackal()``. band: road content band (cycles/m), default the full grid.
+        noise_std: accelerometer noise std for the ``*_noisy`` columns (paper: 1 m/s^2).
+        window: samples in the ``f_window`` span.
+        executor: any ``concurrent.futures.Executor`` (e.g. a dask ``Client.get_executor()``);
+            default a process pool over all cores, shut down at the end.
+        cache_dir: finished runs are stored there, one ``.npz`` per run named by a hash of its
+            settings, and reused: an interrupted campaign loses no finished run.
+        seed: the campaign's seed; run i gets road seed ``SeedSequence(seed).generate_state(n)[i]``.
+    Returns:
+        Campaign. A run that fails (diverges) is recorded with NaN f and its message.
+    """
+    model = Jackal() if model is None else check_model(model)
+    design = lhs_design(198, seed=seed) if design is None else design
+    points = check_design(design, model)
+    if not (isinstance(window, (int, np.integer)) and window >= 2):
+        raise VehicleError(f"window={window!r} is out of range: allowed integers >= 2")
+    usable_m = float(road_length_m) - lead_in_m - 2 * model.wheelbase_m
+    need_m = window * float(np.max(points[:, 0])) / rate_hz
+    if not usable_m >= need_m:
+        raise VehicleError(
+            f"road_length_m={road_length_m!r} is too short: a {window}-sample window at "
+            f"{np.max(points[:, 0]):.4g} m/s after the lead-in ({lead_in_m} m) needs "
+            f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
+        )
+    seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
+    specs = [
+        RunSpec(model, float(v), float(gd), int(s), float(road_length_m), float(dx_m),
+                float(lead_in_m), None if band is None else tuple(map(float, band)),
+                float(rate_hz), float(noise_std), int(window), int(substeps))
+        for (v, gd), s in zip(points, seeds, strict=True)
+    ]  # fmt: skip
+    cache = None if cache_dir is None else Path(cache_dir)
+    if cache is not None:
+        cache.mkdir(parents=True, exist_ok=True)
+    results: list[tuple[np.ndarray, str] | None] = [None] * len(specs)
+    todo = []
+    for i, spec in enumerate(specs):
+        cached = None if cache is None else _read_cached(cache / f"run-{spec.key()}.npz")
+        if cached is None:
+            todo.append(i)
+        else:
+            results[i] = cached
+    bar = tqdm(total=len(specs), initial=len(specs) - len(todo), disable=not progress,
+               desc=f"campaign {model.name}", unit="run")  # fmt: skip
+    own = executor is None and len(todo) > 0
+    pool = ProcessPoolExecutor(max_workers=min(os.cpu_count() or 1, len(todo))) if own else executor
+    try:
+        futures: dict[Future, int] = {
+            pool.submit(run_one, specs[i], None if cache is None else str(cache)): i for i in todo
+        }
+        for fut in as_completed(futures):
+            results[futures[fut]] = fut.result()
+            bar.update()
+    finally:
+        bar.close()
+        if own:
+            pool.shutdown()
+    f = np.array([r[0] for r in results])
+    settings = {
+        **_spec_settings(specs[0]),
+        "seed": int(seed),
+        "f_full": "var(accel_front) over front-axle position >= lead_in_m + wheelbase",
+        "f_window": f"var(accel_front) over the last {window} samples (ending at the road's end)",
+    }
+    return Campaign(
+        v=points[:, 0].copy(),
+        gd=points[:, 1].copy(),
+        seed=seeds,
+        **{name: f[:, j] for j, name in enumerate(_F_NAMES)},
+        status=np.array([r[1] for r in results], dtype=str),
+        settings=settings,
+    )
+
+
+def run_one(spec: RunSpec, cache_dir: str | None = None) -> tuple[np.ndarray, str]:
+    """One run: f values (4,) in ``_F_NAMES`` order and "ok" or the failure message.
+
+    Writes the result to ``cache_dir`` (if given) before returning.
+    """
+    try:
+        f = _drive(spec)
+        status = "ok"
+    except (VehicleError, SimulationDivergedError, roadgen.RoadgenError) as exc:
+        f, status = np.full(len(_F_NAMES), np.nan), f"{type(exc).__name__}: {exc}"
+    if cache_dir is not None:
+        _write_cached(Path(cache_dir) / f"run-{spec.key()}.npz", f, status, spec)
+    return f, status
+
+
+def _drive(spec: RunSpec) -> np.ndarray:
+    profile = roadgen.iso8608_profile(
+        spec.road_length_m, spec.gd, dx_m=spec.dx_m, seed=spec.seed, band=spec.band,
+        lead_in_m=spec.lead_in_m,
+    )  # fmt: skip
+    trace = simulate(
+        spec.model, profile, spec.v, rate_hz=spec.rate_hz, noise_std=spec.noise_std,
+        seed=np.random.default_rng([spec.seed, 1]), substeps=spec.substeps,
+    )  # fmt: skip
+    full = trace.position >= spec.lead_in_m + spec.model.wheelbase_m
+    if np.count_nonzero(full) < spec.window:
+        raise VehicleError(
+            f"run v={spec.v:.4g} m/s has {np.count_nonzero(full)} samples after the lead-in: "
+            f"need >= window={spec.window}"
+        )
+    win = slice(len(trace) - spec.window, None)
+    return np.array(
+        [
+            np.var(trace.accel_front[full]),
+            np.var(trace.accel_front[win]),
+            np.var(trace.accel_front_measured[full]),
+            np.var(trace.accel_front_measured[win]),
+        ]
+    )
+
+
+def _spec_settings(spec: RunSpec) -> dict:
+    return {
+        "model": spec.model.describe(),
+        "road_length_m": spec.road_length_m,
+        "dx_m": spec.dx_m,
+        "lead_in_m": spec.lead_in_m,
+        "band": None if spec.band is None else list(spec.band),
+        "wheel_envelope_radius_m": spec.model.wheel_radius_m,
+        "rate_hz": spec.rate_hz,
+        "noise_std": spec.noise_std,
+        "window": spec.window,
+        "substeps": spec.substeps,
+        "solver": "exudyn generalised-alpha, spectral radius 0.9",
+    }
+
+
+def _write_cached(path: Path, f: np.ndarray, status: str, spec: RunSpec) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "wb") as fh:
+        np.savez(fh, f=f, status=np.asarray(status), key=np.asarray(spec.key()))
+    os.replace(tmp, path)  # atomic: a crash never leaves a half-written cache file
+
+
+def _read_cached(path: Path) -> tuple[np.ndarray, str] | None:
+    if not path.exists():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            f, status, key = data["f"], str(data["status"]), str(data["key"])
+    except (OSError, ValueError, KeyError, EOFError):
+        return None  # a damaged cache entry is recomputed
+    if f.shape != (len(_F_NAMES),) or key != path.stem.removeprefix("run-"):
+        return None
+    return f, status

@@ -1,0 +1,149 @@
+"""Longitudinal motion of the front axle: position s(t) and speed v(t) on a uniform time grid.
+
+The vehicle body stays at x = 0 in the Exudyn model; the tyres read the road at s(t) (front) and
+s(t) - wheelbase (rear). ``Drive`` holds that grid; the Exudyn models tabulate the road under
+each tyre on it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+
+from vehicle.errors import VehicleError
+
+SpeedSchedule = float | Callable | tuple
+"""A constant speed (m/s); a callable of time (s) or of position (m); or a pair of arrays
+(points, speeds) interpolated linearly and held constant beyond the ends."""
+
+
+class Drive:
+    """Front-axle position and speed on the grid t0 + k h (k = 0..N), linearly interpolated."""
+
+    def __init__(self, t0: float, h: float, s: np.ndarray, v: np.ndarray) -> None:
+        self.set(t0, h, s, v)
+
+    def set(self, t0: float, h: float, s: np.ndarray, v: np.ndarray) -> None:
+        """Replace the grid: ``s``, ``v`` of shape (N + 1,) at times t0 + k h."""
+        self.t0 = float(t0)
+        self.h = float(h)
+        self.s = np.asarray(s, dtype=float)
+        self.v = np.asarray(v, dtype=float)
+
+    def positions(self, t: np.ndarray) -> np.ndarray:
+        """Positions (m) at times ``t`` (s), vectorised."""
+        return np.interp(t, self.t0 + self.h * np.arange(self.s.size), self.s)
+
+    def speeds(self, t: np.ndarray) -> np.ndarray:
+        """Speeds (m/s) at times ``t`` (s), vectorised."""
+        return np.interp(t, self.t0 + self.h * np.arange(self.v.size), self.v)
+
+
+def check_speed(name: str, v: np.ndarray | float, max_speed: float) -> np.ndarray:
+    """Return speeds as an array or raise VehicleError unless all are finite and in (0, max]."""
+    arr = np.asarray(v, dtype=float)
+    bad = ~np.isfinite(arr) | (arr <= 0.0) | (arr > max_speed * (1 + 1e-12))
+    if np.any(bad):
+        raise VehicleError(
+            f"{name}={float(arr[bad].flat[0])!r} m/s is out of range: allowed "
+            f"(0, {max_speed:g}] m/s (finite, positive, at most the model's max_speed_mps)"
+        )
+    return arr
+
+
+def _as_function(speed: SpeedSchedule) -> Callable[[np.ndarray], np.ndarray]:
+    if callable(speed):
+
+        def evaluate(x: np.ndarray) -> np.ndarray:
+            out = np.asarray(speed(x), dtype=float)
+            if out.shape != x.shape:
+                out = np.array([float(speed(xi)) for xi in x])
+            return out
+
+        return evaluate
+    if isinstance(speed, tuple):
+        if len(speed) != 2:
+            raise VehicleError(f"speed is a tuple of {len(speed)} items: need (points, speeds)")
+        pts, vals = (np.asarray(a, dtype=float) for a in speed)
+        if pts.ndim != 1 or pts.shape != vals.shape or pts.size < 1:
+            raise VehicleError(
+                f"speed=(points {pts.shape}, speeds {vals.shape}): need two (K,) arrays, K >= 1"
+            )
+        if not (np.all(np.isfinite(pts)) and np.all(np.diff(pts) > 0)):
+            raise VehicleError("speed points must be finite and strictly increasing")
+        return lambda x: np.interp(x, pts, vals)
+    try:
+        value = float(speed)
+    except (TypeError, ValueError) as exc:
+        raise VehicleError(
+            f"speed={speed!r} must be a number (m/s), a callable or a (points, speeds) pair"
+        ) from exc
+    return lambda x: np.full(np.shape(x), value)
+
+
+def schedule_grid(
+    speed: SpeedSchedule,
+    speed_of: str,
+    start_m: float,
+    end_m: float,
+    h: float,
+    max_speed: float,
+    max_duration_s: float = 3600.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Front-axle (s, v) at t = k h from s = start_m until s reaches end_m (inclusive).
+
+    Args:
+        speed: see ``SpeedSchedule``; a callable/array is read as a function of time when
+            ``speed_of="time"`` and of the front-axle position when ``speed_of="position"``.
+        h: grid step, s. max_duration_s: give up (VehicleError) if the drive would be longer.
+    Returns:
+        s, v: arrays (N + 1,) with s[-1] >= end_m.
+    """
+    if speed_of not in ("time", "position"):
+        raise VehicleError(f"speed_of={speed_of!r} is not allowed: choose 'time' or 'position'")
+    fun = _as_function(speed)
+    if speed_of == "position":
+        n_s = max(2, math.ceil((end_m - start_m) / 1e-3) + 1)
+        s_grid = np.linspace(start_m, end_m, n_s)
+        v_grid = check_speed("speed", fun(s_grid), max_speed)
+        t_of_s = cumulative_trapezoid(1.0 / v_grid, s_grid, initial=0.0)
+        if t_of_s[-1] > max_duration_s:
+            raise VehicleError(f"the drive takes {t_of_s[-1]:.4g} s: allowed <= {max_duration_s} s")
+        n = math.ceil(t_of_s[-1] / h)
+        t = h * np.arange(n + 1)
+        s = np.interp(t, t_of_s, s_grid)
+        return s, fun(s)
+    s_parts, v_parts, s_now, k0 = [], [], start_m, 0
+    block = 4096
+    while True:
+        t = h * np.arange(k0, k0 + block + 1)
+        v = fun(t)
+        s = s_now + cumulative_trapezoid(v, t, initial=0.0)
+        done = np.nonzero(s >= end_m)[0]
+        stop = int(done[0]) if done.size else block
+        check_speed("speed", v[: stop + 1], max_speed)  # only the part actually driven
+        s_parts.append(s[: stop + 1] if not s_parts else s[1 : stop + 1])
+        v_parts.append(v[: stop + 1] if not v_parts else v[1 : stop + 1])
+        if done.size:
+            return np.concatenate(s_parts), np.concatenate(v_parts)
+        s_now, k0 = float(s[-1]), k0 + block
+        if k0 * h > max_duration_s:
+            raise VehicleError(f"the drive takes more than {max_duration_s} s: allowed less")
+
+
+def ramp_grid(
+    s0: float, v0: float, v_set: float, max_accel: float, h: float, n_steps: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """(s, v) at t = k h, k = 0..n_steps, for a speed ramping from v0 to v_set at <= max_accel."""
+    t = h * np.arange(n_steps + 1)
+    dv = v_set - v0
+    t_ramp = abs(dv) / max_accel
+    a = math.copysign(max_accel, dv) if dv else 0.0
+    v = np.where(t < t_ramp, v0 + a * t, v_set)
+    s_ramp = v0 * t + 0.5 * a * t * t
+    s_after = v0 * t_ramp + 0.5 * a * t_ramp * t_ramp + v_set * (t - t_ramp)
+    s = s0 + np.where(t < t_ramp, s_ramp, s_after)
+    return s, v

@@ -1,0 +1,148 @@
+"""Independent reference: the linear (bilateral-contact) models solved as state-space systems.
+
+Written from the equations of motion, not from the Exudyn models, to validate them. Generalised
+coordinates: HalfCar q = [y1, y2, y3, phi3] (front axle, rear axle, body heave, body pitch);
+Jackal q = [y, phi] (heave, pitch). All vertical motions are deviations from static equilibrium;
+``phi`` is positive when the front rises. The model is ``M q'' + C q' + K q = Kt u + Ct u'``
+with the road heights ``u = [u1, u2]`` under the front and rear tyre.
+
+The paper's eq. 1 prints the suspension terms of the axle equations (and the rear-suspension
+moment in the pitch equation) with a flipped sign, which would make the suspension push the wheel
+away from equilibrium; the physically consistent signs are used here (symmetric, positive-definite
+stiffness matrix), and they agree with eq. 1 everywhere else.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import signal
+
+from vehicle.models import HalfCar, Jackal, Model
+from vehicle.road_input import RoadInput
+
+
+@dataclass(frozen=True)
+class LinearModel:
+    """Matrices of ``M q'' + C q' + K q = Kt u + Ct u'`` and the front/rear axle selectors.
+
+    mass, damping, stiffness: (d, d). tyre_stiffness, tyre_damping: (d, 2), the road inputs'
+    force gains. front, rear: (d,) rows giving the axle displacement from q.
+    """
+
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    tyre_stiffness: np.ndarray
+    tyre_damping: np.ndarray
+    front: np.ndarray
+    rear: np.ndarray
+
+
+def linear_model(model: Model) -> LinearModel:
+    """The linearised equations of motion of ``model`` (bilateral tyre contact)."""
+    b1, b2 = model.b1_m, model.b2_m
+    if isinstance(model, Jackal):
+        kt, ct = model.axle_stiffness_n_per_m, model.axle_damping_ns_per_m
+        front, rear = np.array([1.0, b1]), np.array([1.0, -b2])
+        arms = np.stack([front, rear], axis=1)  # (2, 2): generalised force of each tyre
+        return LinearModel(
+            mass=np.diag([model.mass_kg, model.pitch_inertia_kgm2]),
+            damping=ct * arms @ arms.T,
+            stiffness=kt * arms @ arms.T,
+            tyre_stiffness=kt * arms,
+            tyre_damping=ct * arms,
+            front=front,
+            rear=rear,
+        )
+    assert isinstance(model, HalfCar)
+    k1, k2 = model.suspension_stiffness_front_n_per_m, model.suspension_stiffness_rear_n_per_m
+    c1, c2 = model.suspension_damping_front_ns_per_m, model.suspension_damping_rear_ns_per_m
+    kt, ct = model.tyre_stiffness_n_per_m, model.tyre_damping_ns_per_m
+    # suspension deflections: d1 = y3 + b1 phi - y1, d2 = y3 - b2 phi - y2
+    d1 = np.array([-1.0, 0.0, 1.0, b1])
+    d2 = np.array([0.0, -1.0, 1.0, -b2])
+    tyre1 = np.array([1.0, 0.0, 0.0, 0.0])
+    tyre2 = np.array([0.0, 1.0, 0.0, 0.0])
+    tyres = np.stack([tyre1, tyre2], axis=1)
+    stiffness = k1 * np.outer(d1, d1) + k2 * np.outer(d2, d2) + kt * tyres @ tyres.T
+    damping = c1 * np.outer(d1, d1) + c2 * np.outer(d2, d2) + ct * tyres @ tyres.T
+    return LinearModel(
+        mass=np.diag(
+            [
+                model.unsprung_mass_front_kg,
+                model.unsprung_mass_rear_kg,
+                model.sprung_mass_kg,
+                model.pitch_inertia_kgm2,
+            ]
+        ),
+        damping=damping,
+        stiffness=stiffness,
+        tyre_stiffness=kt * tyres,
+        tyre_damping=ct * tyres,
+        front=tyre1,
+        rear=tyre2,
+    )
+
+
+def state_space(lm: LinearModel) -> signal.StateSpace:
+    """State x = [q, q'], input [u1, u2, u1', u2'], output [a_front, a_rear, q (d)]."""
+    d = lm.mass.shape[0]
+    acc_x = np.linalg.solve(lm.mass, np.hstack([-lm.stiffness, -lm.damping]))  # (d, 2d)
+    acc_u = np.linalg.solve(lm.mass, np.hstack([lm.tyre_stiffness, lm.tyre_damping]))  # (d, 4)
+    a = np.block([[np.zeros((d, d)), np.eye(d)], [acc_x]])
+    b = np.vstack([np.zeros((d, 4)), acc_u])
+    axles = np.stack([lm.front, lm.rear])
+    c = np.vstack([axles @ acc_x, np.hstack([np.eye(d), np.zeros((d, d))])])
+    dd = np.vstack([axles @ acc_u, np.zeros((d, 4))])
+    return signal.StateSpace(a, b, c, dd)
+
+
+@dataclass(frozen=True)
+class LinearTrace:
+    """Linear reference at t = k / rate_hz, k = 1..n: accel_front, accel_rear (m/s^2), q (n, d)."""
+
+    t: np.ndarray
+    accel_front: np.ndarray
+    accel_rear: np.ndarray
+    q: np.ndarray
+
+
+def linear_response(
+    model: Model,
+    road,
+    speed: float,
+    n_samples: int,
+    rate_hz: float = 120.0,
+    start_m: float | None = None,
+    oversample: int = 20,
+    envelope: bool = True,
+) -> LinearTrace:
+    """Response of the linear model at constant ``speed`` (m/s), from rest on the road.
+
+    The front axle starts at ``start_m`` (default: wheelbase). The road input is evaluated on a
+    grid ``oversample`` times finer than the samples and interpolated linearly by ``lsim``;
+    ``envelope`` as in ``simulate``.
+    """
+    road_in = RoadInput(road, model.wheel_radius_m if envelope else None)
+    lm = linear_model(model)
+    wb = model.wheelbase_m
+    s0 = wb if start_m is None else float(start_m)
+    t = np.arange(n_samples * oversample + 1) / (rate_hz * oversample)
+    s = s0 + speed * t
+    u = np.stack(
+        [
+            road_in.heights(s),
+            road_in.heights(s - wb),
+            speed * road_in.slopes(s),
+            speed * road_in.slopes(s - wb),
+        ],
+        axis=1,
+    )
+    # at rest on the road: static deflection solves K q0 = Kt u(0)
+    q0 = np.linalg.solve(lm.stiffness, lm.tyre_stiffness @ u[0, :2])
+    x0 = np.concatenate([q0, np.zeros_like(q0)])
+    _, y, _ = signal.lsim(state_space(lm), u, t, X0=x0)
+    keep = slice(oversample, None, oversample)
+    return LinearTrace(t=t[keep], accel_front=y[keep, 0], accel_rear=y[keep, 1], q=y[keep, 2:])

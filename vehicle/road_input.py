@@ -1,0 +1,61 @@
+"""The road as the tyres see it: height u(s) and slope du/ds, linearly interpolated."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import roadgen
+from vehicle.errors import VehicleError
+
+
+class RoadInput:
+    """Height and slope of a uniformly sampled road (a roadgen Profile or Track).
+
+    Beyond its ends the road continues flat at its first / last height (so a vehicle may start
+    with its rear axle behind the road's start). The slope du/ds is computed once by central
+    finite differences (``numpy.gradient``).
+
+    Args:
+        road: object with ``z`` (N,) heights in m on a uniform grid of spacing ``dx_m`` from 0.
+        wheel_radius_m: if given, the road is first enveloped by a rigid wheel of this radius
+            (``roadgen.wheel_envelope``): what the tyre's contact point follows.
+    """
+
+    def __init__(self, road, wheel_radius_m: float | None = None) -> None:
+        if wheel_radius_m is not None:
+            try:
+                road = roadgen.wheel_envelope(road, wheel_radius_m)
+            except (AttributeError, TypeError) as exc:
+                raise VehicleError(
+                    f"road={type(road).__name__} cannot be enveloped: need a roadgen Profile or "
+                    "Track (or envelope=False)"
+                ) from exc
+        try:
+            z = np.asarray(road.z, dtype=float)
+            dx = float(road.dx_m)
+        except (AttributeError, TypeError, ValueError) as exc:
+            raise VehicleError(
+                f"road={type(road).__name__} must have z (N,) heights and dx_m (a roadgen "
+                "Profile or Track)"
+            ) from exc
+        if z.ndim != 1 or z.size < 3:
+            raise VehicleError(f"road.z has shape {z.shape}: need (N,) with N >= 3")
+        if not np.all(np.isfinite(z)):
+            raise VehicleError("road.z contains NaN or inf: allowed finite heights in m")
+        if not (math.isfinite(dx) and dx > 0):
+            raise VehicleError(f"road.dx_m={dx!r} is out of range: allowed (0, inf)")
+        self.dx_m = dx
+        self.length_m = dx * (z.size - 1)
+        self._z = z
+        self._x = dx * np.arange(z.size)
+        self._slope = np.gradient(z, dx)
+
+    def heights(self, s: np.ndarray) -> np.ndarray:
+        """Heights (m) at positions ``s`` (m), any shape; flat beyond the ends."""
+        return np.interp(s, self._x, self._z)
+
+    def slopes(self, s: np.ndarray) -> np.ndarray:
+        """Slopes du/ds (-) at positions ``s`` (m), any shape; 0 beyond the ends."""
+        return np.interp(s, self._x, self._slope, left=0.0, right=0.0)

@@ -1,0 +1,64 @@
+"""What the vehicle's sensors report: the noisy accelerometer and the tyre contact flags."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vehicle.errors import VehicleError
+from vehicle.models import Model
+from vehicle.road_input import RoadInput
+
+
+def check_rate(rate_hz: float) -> float:
+    """Return the sample rate as a float, or raise VehicleError unless finite and > 0."""
+    try:
+        r = float(rate_hz)
+    except (TypeError, ValueError) as exc:
+        raise VehicleError(f"rate_hz={rate_hz!r} must be a number in (0, inf) Hz") from exc
+    if not (math.isfinite(r) and r > 0):
+        raise VehicleError(f"rate_hz={rate_hz!r} is out of range: allowed (0, inf) Hz")
+    return r
+
+
+def check_noise(noise_std: float) -> float:
+    """Return the noise standard deviation, or raise VehicleError unless finite and >= 0."""
+    try:
+        s = float(noise_std)
+    except (TypeError, ValueError) as exc:
+        raise VehicleError(f"noise_std={noise_std!r} must be a number in [0, inf) m/s^2") from exc
+    if not (math.isfinite(s) and s >= 0):
+        raise VehicleError(f"noise_std={noise_std!r} is out of range: allowed [0, inf) m/s^2")
+    return s
+
+
+def add_noise(accel: np.ndarray, noise_std: float, rng: np.random.Generator) -> np.ndarray:
+    """Measured acceleration: ``accel`` plus N(0, noise_std^2) white noise (a copy if std is 0)."""
+    if noise_std == 0.0:
+        return accel.copy()
+    return accel + rng.normal(0.0, noise_std, size=accel.shape)
+
+
+def contact_flags(
+    model: Model,
+    road: RoadInput,
+    s_axle: np.ndarray,
+    speed: np.ndarray,
+    z: np.ndarray,
+    zt: np.ndarray,
+    axle: int,
+) -> np.ndarray:
+    """True where the tyre of ``axle`` (0 front, 1 rear) presses on the road (total force > 0).
+
+    Args (each (n,)): s_axle: the axle's road position, m; speed, m/s; z, zt: the axle's vertical
+    displacement (m) and velocity (m/s). With bilateral contact (``lift_off=False``) a False flag
+    marks where a real tyre would have lost contact.
+    """
+    if hasattr(model, "axle_stiffness_n_per_m"):
+        k, c = model.axle_stiffness_n_per_m, model.axle_damping_ns_per_m
+    else:
+        k, c = model.tyre_stiffness_n_per_m, model.tyre_damping_ns_per_m
+    u, du = road.heights(s_axle), road.slopes(s_axle)
+    deviation = -k * (z - u) - c * (zt - speed * du)
+    return model.static_tyre_loads_n[axle] + deviation > 0.0

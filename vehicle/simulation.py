@@ -1,0 +1,129 @@
+"""A steppable drive for the closed loop: ``Simulation.advance(dt, speed)`` continues in time."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from vehicle.errors import VehicleError
+from vehicle.exudyn_models import ExudynVehicle
+from vehicle.kinematics import Drive, check_speed, ramp_grid
+from vehicle.models import Model, check_model
+from vehicle.road_input import RoadInput
+from vehicle.sensor import add_noise, check_noise, check_rate, contact_flags
+from vehicle.simulate import SUBSTEPS, check_span
+
+
+@dataclass(frozen=True)
+class Samples:
+    """The samples of one ``advance`` call, arrays (n,) (n = 0 once the road has ended).
+
+    t: s. position: front-axle road position, m. accel_front: measured front-axle vertical
+    acceleration (noisy if noise_std > 0), m/s^2; accel_front_true: noise-free, m/s^2.
+    speed: actual speed, m/s. contact: front tyre presses on the road.
+    """
+
+    t: np.ndarray
+    position: np.ndarray
+    accel_front: np.ndarray
+    accel_front_true: np.ndarray
+    speed: np.ndarray
+    contact: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+
+class Simulation:
+    """A vehicle driving along a track, integrated on demand (the Exudyn model is built once).
+
+    The vehicle starts at rest on the road with its front axle at ``start_m`` (the rear axle,
+    a wheelbase behind, reads a flat extension at the road's first height while it is before 0).
+    The commanded speed of ``advance`` is a set-point: the actual speed ramps towards it at the
+    model's ``max_accel_mps2`` and it must lie in (0, max_speed_mps].
+
+    Args:
+        model: HalfCar or Jackal. track: roadgen Track or Profile. rate_hz: accelerometer rate, Hz.
+        noise_std: accelerometer noise std, m/s^2. seed: seed or Generator of the noise.
+        start_m: initial front-axle position, m, in [0, track length).
+        substeps: solver steps per sample period.
+        envelope: the tyres follow the track enveloped by the model's wheel radius (as in the
+            campaign); False: the raw heights.
+
+    Attributes: time (s), position (front axle, m), speed (m/s), finished (no further sample
+    fits before the end of the track at the current speed), end_m (the track's length, m).
+    """
+
+    def __init__(
+        self,
+        model: Model,
+        track,
+        rate_hz: float = 120.0,
+        noise_std: float = 0.0,
+        seed: int | np.random.Generator | None = None,
+        start_m: float = 0.0,
+        *,
+        substeps: int = SUBSTEPS,
+        envelope: bool = True,
+    ) -> None:
+        self.model = check_model(model)
+        self.rate_hz = check_rate(rate_hz)
+        self.noise_std = check_noise(noise_std)
+        if not (isinstance(substeps, int) and substeps >= 1):
+            raise VehicleError(f"substeps={substeps!r} is out of range: allowed integers >= 1")
+        self._rng = np.random.default_rng(seed)
+        self._road = RoadInput(track, model.wheel_radius_m if envelope else None)
+        self.end_m = self._road.length_m
+        check_span(model, self._road, float(start_m), self.end_m)
+        self._substeps = substeps
+        self._h = 1.0 / (self.rate_hz * substeps)
+        self.time = 0.0
+        self.position = float(start_m)
+        self.speed = 0.0
+        self._drive = Drive(0.0, self._h, np.full(2, self.position), np.zeros(2))
+        self._vehicle = ExudynVehicle(model, self._road, self._drive, self.rate_hz, substeps)
+
+    @property
+    def finished(self) -> bool:
+        """True once the front axle cannot advance another sample period before the end."""
+        return self.position + self.speed / self.rate_hz > self.end_m
+
+    def advance(self, dt: float, speed: float) -> Samples:
+        """Drive for ``dt`` seconds (rounded to whole sample periods, at least one) towards the
+        commanded ``speed`` (m/s) and return the new samples; fewer (or none) at the track's end.
+        """
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise VehicleError(f"dt={dt!r} is out of range: allowed (0, inf) s")
+        v_set = float(check_speed("speed", speed, self.model.max_speed_mps))
+        n = max(1, round(dt * self.rate_hz))
+        sub = self._substeps
+        s, v = ramp_grid(
+            self.position, self.speed, v_set, self.model.max_accel_mps2, self._h, n * sub
+        )
+        n_fit = int(np.count_nonzero(s[sub::sub] <= self.end_m + 1e-9))
+        if n_fit == 0:
+            return _empty()
+        self._drive.set(self.time, self._h, s[: n_fit * sub + 1], v[: n_fit * sub + 1])
+        states = self._vehicle.integrate(self.time, n_fit)
+        k = np.arange(1, n_fit + 1) * sub
+        position, spd = s[k], v[k]
+        self.time = float(states.t[-1])
+        self.position = float(position[-1])
+        self.speed = float(spd[-1])
+        return Samples(
+            t=states.t,
+            position=position,
+            accel_front=add_noise(states.accel_front, self.noise_std, self._rng),
+            accel_front_true=states.accel_front,
+            speed=spd,
+            contact=contact_flags(
+                self.model, self._road, position, spd, states.z_front, states.zt_front, 0
+            ),
+        )
+
+
+def _empty() -> Samples:
+    e = np.zeros(0)
+    return Samples(e, e, e, e, e, np.zeros(0, dtype=bool))
