@@ -1,0 +1,140 @@
+"""Online calibration speed on the 198-run road case (emulator fixed at SEPIA's values).
+
+Prints, single-threaded (BLAS limited to one thread; --pin also pins the process to one CPU):
+- ``Calibrator.update`` latency over >= 1,000 updates with varying (v, f): median, p90, p99, max,
+  also with the posterior's mean and P(GD > 350) read (what a control loop does);
+- ``Calibrator.log_likelihood_grid`` latency (the sequential-filter hook);
+- ``gpmsa.calibrate`` with the paper's settings (tuning 50 x 20, 5,000 draws, 1,000 burned), the
+  fast sampler and the generic numpy backend;
+- memory: the Calibrator's cached arrays and the peak Python allocation of preparing and of an
+  update (tracemalloc).
+SEPIA's figures are from tests/data/reference_posteriors.json (same case, this machine class).
+
+Usage: python benchmarks/calibrate_speed.py [--updates 2000] [--runs 10] [--pin]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+import gpmsa
+from gpmsa.emulator import Emulator
+
+DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
+
+
+def road_emulator() -> tuple[Emulator, dict]:
+    case = dict(np.load(DATA / "case.npz", allow_pickle=False))
+    ref = json.loads((DATA / "reference_posteriors.json").read_text())
+    sim = gpmsa.SimData(
+        x=case["v"][:, None], t=case["GD"][:, None], y=case["f"][:, None],
+        x_names=["v"], t_names=["GD"], y_names=["f"],
+    )  # fmt: skip
+    params = ref["sepia_calibration_only"]["fixed_emulator_params_unit_scale"]
+    return Emulator.from_params(sim, params), ref
+
+
+def observations(emu: Emulator, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """n windows: v uniform on the domain, f from the road case's formula with 5% noise."""
+    rng = np.random.default_rng(seed)
+    lo, hi = emu.domain["v"]
+    v = rng.uniform(lo, hi, n)
+    gd = rng.uniform(*emu.domain["GD"], n)
+    f = 0.02 * gd * v**1.6 * (1 + 0.05 * rng.standard_normal(n))
+    return v, f
+
+
+def latencies(fn, v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Wall-clock and thread CPU seconds per call of fn([[v]], [[f]]) for each window (after 50
+    warm-up calls). On a loaded machine the wall clock includes time the process waited for a
+    CPU (scheduler ticks of ~4 ms); the CPU time does not."""
+    for i in range(50):
+        fn([[v[i]]], [[f[i]]])
+    wall, cpu = np.empty(v.size), np.empty(v.size)
+    for i in range(v.size):
+        t0, c0 = time.perf_counter(), time.thread_time()
+        fn([[v[i]]], [[f[i]]])
+        wall[i], cpu[i] = time.perf_counter() - t0, time.thread_time() - c0
+    return wall, cpu
+
+
+def row(name: str, ms: np.ndarray, sepia: str = "") -> str:
+    q = np.percentile(ms, [50, 90, 99])
+    return (f"{name:50s} {q[0]:9.3f} {q[1]:9.3f} {q[2]:9.3f} {ms.max():9.3f} {ms.size:7d}"
+            f"  {sepia}")  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--updates", type=int, default=2000)
+    parser.add_argument("--runs", type=int, default=10)
+    parser.add_argument("--pin", action="store_true", help="pin the process to one CPU")
+    args = parser.parse_args()
+    if args.pin and hasattr(os, "sched_setaffinity"):
+        os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
+    emu, ref = road_emulator()
+    sepia = ref["timings_this_machine_1_blas_thread_s"][
+        "sepia_calibration_only_tuning_plus_5000_draws"
+    ]
+    t0 = time.perf_counter()
+    cal = gpmsa.Calibrator(emu, seed=0)
+    prep_s = time.perf_counter() - t0
+    v, f = observations(emu, args.updates + 50)
+
+    def update_and_read(x, y):
+        post = cal.update(x, y)
+        return post.mean("GD"), post.prob_above("GD", 350.0)
+
+    print(f"road case: m = {emu.m} runs, grid of {cal.theta_grid.size} GD nodes; "
+          f"Calibrator prepared in {1e3 * prep_s:.1f} ms")  # fmt: skip
+    print(f"{'latency, ms':50s} {'median':>9s} {'p90':>9s} {'p99':>9s} {'max':>9s} {'calls':>7s}"
+          "  SEPIA")  # fmt: skip
+    for name, fn in (
+        ("Calibrator.update", cal.update),
+        ("Calibrator.update + mean + P(GD > 350)", update_and_read),
+        ("Calibrator.log_likelihood_grid", cal.log_likelihood_grid),
+    ):
+        wall, cpu = latencies(fn, v, f)
+        print(row(name + " (wall)", 1e3 * wall, f"~{1e3 * sepia:.0f}"))
+        print(row(name + " (CPU)", 1e3 * cpu))
+    x_obs, y_obs = [[float(ref_v)] for ref_v in [1.25]], [[12.09696044]]
+    runs = []
+    for seed in range(args.runs):
+        t0 = time.perf_counter()
+        gpmsa.calibrate(emu, x_obs, y_obs, seed=seed)
+        runs.append(time.perf_counter() - t0)
+    print(
+        row("calibrate, paper settings (fast sampler)", 1e3 * np.array(runs), f"{1e3 * sepia:.0f}")
+    )
+    runs = []
+    for seed in range(max(2, args.runs // 5)):
+        t0 = time.perf_counter()
+        gpmsa.calibrate(emu, x_obs, y_obs, seed=seed, fast=False)
+        runs.append(time.perf_counter() - t0)
+    print(
+        row("calibrate, paper settings (numpy backend)", 1e3 * np.array(runs), f"{1e3 * sepia:.0f}")
+    )
+    cached = sum(a.nbytes for p in cal._predictors for a in [p.rt_alpha, *(p.H or [])])
+    cached += sum(g.chol.nbytes + g.alpha.nbytes for g in cal._gps)
+    tracemalloc.start()
+    gpmsa.Calibrator(emu)
+    prep_peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.reset_peak()
+    cal.update([[1.25]], [[12.1]]).mean("GD")
+    upd_peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    print(
+        f"memory: Calibrator cached arrays {cached / 2**20:.2f} MiB; peak allocation while "
+        f"preparing {prep_peak / 2**20:.2f} MiB, per update {upd_peak / 2**20:.3f} MiB"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,64 @@
+"""Milliseconds per GPM/SA sweep on the road case (198 runs, scalar output), numpy backend.
+
+Prints the median over repeats for the sim-only and the sim+obs model and the extrapolated time
+of a 30,000-sweep fit (plus 1,000 tuning sweeps). Usage: python benchmarks/fit_speed.py [repeats]
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+import gpmsa
+from gpmsa.mcmc import ChainState, elements, sample
+from gpmsa.problem import prepare
+
+CASE = Path(__file__).parents[1] / "tests" / "data" / "case.npz"
+
+
+def sweep_ms(problem, repeats: int, n_sweeps: int = 200) -> tuple[float, float, float]:
+    """ms per sweep: median wall clock, median and best process CPU time over ``repeats``.
+
+    Step widths come from a short tuning run. On a shared machine the CPU time is the steadier
+    figure (it excludes time spent waiting for a core); the best repeat is the least disturbed.
+    """
+    tuned = sample(problem, n_iter=10, seed=0, tune_rounds=10)
+    widths = {k: v[0] for k, v in tuned.step_widths.items()}
+    start = problem.with_init({k: v[0, -1] for k, v in tuned.draws.items()})
+    state = ChainState(start, start.init, np.random.default_rng(1))
+    w = np.array([widths[n][i] for n, i in elements(start)])
+    acc = np.zeros(len(w))
+    wall, cpu = [], []
+    with threadpool_limits(1):
+        for _ in range(repeats):
+            t0, c0 = time.perf_counter(), time.process_time()
+            for _ in range(n_sweeps):
+                state.sweep(w, False, acc)
+            wall.append((time.perf_counter() - t0) / n_sweeps * 1e3)
+            cpu.append((time.process_time() - c0) / n_sweeps * 1e3)
+    return float(np.median(wall)), float(np.median(cpu)), float(np.min(cpu))
+
+
+def main(repeats: int = 15) -> None:
+    d = np.load(CASE)
+    sim = gpmsa.SimData(x=d["v"], t=d["GD"], y=d["f"])
+    obs = gpmsa.ObsData(x=d["v_obs"][:, None], y=d["f_obs"][:, None])
+    print(f"road case: m={sim.m}, scalar output; load average {os.getloadavg()[0]:.2f} "
+          f"on {os.cpu_count()} cores; 1 BLAS thread")  # fmt: skip
+    for label, prob in (("sim-only", prepare(sim).problem), ("sim+obs", prepare(sim, obs).problem)):
+        wall, cpu, best = sweep_ms(prob, repeats)
+        print(
+            f"{label:9s} {wall:6.3f} ms/sweep wall, {cpu:6.3f} ms CPU (medians of {repeats}), "
+            f"best {best:.3f} ms CPU; 30,000 sweeps + 1,000 tuning ~ {31 * wall:5.1f} s wall, "
+            f"{31 * cpu:5.1f} s CPU"
+        )
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 15)

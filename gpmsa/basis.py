@@ -1,0 +1,84 @@
+"""Output bases: the PCA emulator basis K and the discrepancy basis D (GPM/SA conventions)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+
+VARIANCE_FRACTION = 0.995
+
+
+def pca_basis(
+    y_std: np.ndarray, n_pc: int | None = None, fraction: float = VARIANCE_FRACTION
+) -> np.ndarray:
+    """PCA basis K (l_sim, p_u) of standardised outputs y_std (m, l_sim): K = U S / sqrt(m).
+
+    p_u = ``n_pc`` if given, else the fewest components reaching ``fraction`` of the variance.
+    A scalar output (l_sim = 1) gives K = [[1]].
+    """
+    m, l_sim = y_std.shape
+    if l_sim == 1:
+        if n_pc not in (None, 1):
+            raise GPMSAError(f"n_pc must be 1 for a scalar output, got {n_pc}")
+        return np.ones((1, 1))
+    u, s, _ = np.linalg.svd(y_std.T, full_matrices=False)
+    if n_pc is None:
+        if not 0 < fraction <= 1:
+            raise GPMSAError(f"fraction must be in (0, 1], got {fraction}")
+        share = np.cumsum(s**2) / np.sum(s**2)
+        n_pc = int(np.searchsorted(share, fraction - 1e-12) + 1)
+    if not 1 <= n_pc <= min(m, l_sim):
+        raise GPMSAError(f"n_pc must be in [1, {min(m, l_sim)}], got {n_pc}")
+    return u[:, :n_pc] * s[:n_pc] / np.sqrt(m)
+
+
+def basis_weights(y_std: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """Weights w (m, p_u) = y_std K^+^T (least-squares projection on the basis)."""
+    return y_std @ np.linalg.pinv(K).T
+
+
+def interpolate_basis(K: np.ndarray, grid: np.ndarray, new_grid: np.ndarray | None) -> np.ndarray:
+    """Basis columns interpolated linearly from ``grid`` onto ``new_grid`` (None: unchanged)."""
+    if new_grid is None or (new_grid.shape == grid.shape and np.array_equal(new_grid, grid)):
+        return K
+    if K.shape[0] == 1:
+        return np.repeat(K, new_grid.size, axis=0)
+    lo, hi = grid.min(), grid.max()
+    if new_grid.min() < lo or new_grid.max() > hi:
+        raise GPMSAError(
+            f"observation index must lie within the simulation grid [{lo}, {hi}], "
+            f"got [{new_grid.min()}, {new_grid.max()}]"
+        )
+    return np.column_stack([np.interp(new_grid, grid, K[:, j]) for j in range(K.shape[1])])
+
+
+def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
+    """Discrepancy basis D (l_obs, p_v) on ``grid`` (l_obs,), normalised so max diag(D D^T) = 1.
+
+    ``kind``: None (no discrepancy), "constant", "linear" (1 and the index), or a given
+    (l_obs, p_v) array.
+    """
+    if kind is None:
+        return None
+    if isinstance(kind, str):
+        if kind == "constant":
+            D = np.ones((grid.size, 1))
+        elif kind == "linear":
+            D = np.column_stack([np.ones(grid.size), grid])
+        else:
+            raise GPMSAError(
+                f"discrepancy must be None, 'constant', 'linear' or an array, got {kind!r}"
+            )
+    else:
+        D = np.array(kind, dtype=np.float64)
+        if D.ndim == 1:
+            D = D[:, None]
+        if D.ndim != 2 or D.shape[0] != grid.size:
+            raise GPMSAError(f"discrepancy basis must be ({grid.size}, p_v), got {D.shape}")
+        if not np.all(np.isfinite(D)):
+            raise GPMSAError("discrepancy basis must be finite")
+    scale = np.max(np.sum(D**2, axis=1))
+    if not scale > 0:
+        raise GPMSAError("discrepancy basis is all zeros")
+    return D / np.sqrt(scale)

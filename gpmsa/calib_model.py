@@ -1,0 +1,373 @@
+"""The calibration-only GPM/SA model: the emulator's GP with its parameters held fixed.
+
+With the emulator parameters fixed, the first likelihood term N(w; 0, Sigma_W) is constant in theta
+and the calibration needs only the second: the predictive of the observation's basis weights u at
+(x_obs, theta) given the simulation weights w,
+
+    u | w, theta ~ N(mu(theta), S(theta) + Sigma_obs / lamOs),
+    mu(theta) = Sigma_UW Sigma_W^-1 w,   S(theta) = Sigma_U - Sigma_UW Sigma_W^-1 Sigma_UW^T,
+
+block-diagonal over the p_u basis components (Higdon et al. 2008; GPM/SA's no-discrepancy model).
+Everything here works on plain arrays in unit (x, theta) and standardised (u) units; the Cholesky of
+Sigma_W and alpha = Sigma_W^-1 w are computed once.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numpy.polynomial import chebyshev as cheb
+from scipy.linalg import cho_solve, cholesky, solve_triangular
+from scipy.special import gammainc, gammainccinv, gammaln
+
+_LOG_2PI = float(np.log(2.0 * np.pi))
+_LOG_2 = float(np.log(2.0))
+COARSE_STRIDE = 8
+TRUNCATED_REFINE = 8
+
+
+def weighted_sqdist(a: np.ndarray, b: np.ndarray, beta: np.ndarray) -> np.ndarray:
+    """sum_k beta_k (a_k - b_k)^2 for all pairs; a (N, k), b (M, k), beta (k,) -> (N, M)."""
+    diff = a[:, None, :] - b[None, :, :]
+    return (diff * diff) @ beta
+
+
+class FixedGP:
+    """The emulator's GP over (x, t) with fixed betaU, lamUz, lamWs, lamWOs.
+
+    Args (unit/standardised units):
+        x_sim: (m, p) known inputs of the simulation design on [0, 1].
+        t_sim: (m, q) calibration parameters of the design on [0, 1].
+        w: (m, p_u) simulation basis weights.
+        lam_sim: (p_u,) diag(K^T K).
+        betaU: (p + q, p_u) correlation parameters (x rows first).
+        lamUz: (p_u,) GP precisions; lamWs: (p_u,) nugget precisions; lamWOs: scalar.
+    """
+
+    def __init__(
+        self,
+        x_sim: np.ndarray,
+        t_sim: np.ndarray,
+        w: np.ndarray,
+        lam_sim: np.ndarray,
+        betaU: np.ndarray,
+        lamUz: np.ndarray,
+        lamWs: np.ndarray,
+        lamWOs: float,
+    ) -> None:
+        self.x_sim = np.asarray(x_sim, dtype=float)
+        self.t_sim = np.asarray(t_sim, dtype=float)
+        self.p = self.x_sim.shape[1]
+        self.q = self.t_sim.shape[1]
+        self.m = self.x_sim.shape[0]
+        w = np.asarray(w, dtype=float).reshape(self.m, -1)
+        self.p_u = w.shape[1]
+        self.betaU = np.asarray(betaU, dtype=float).reshape(self.p + self.q, self.p_u)
+        self.lamUz = np.asarray(lamUz, dtype=float).ravel()
+        self.lamWs = np.asarray(lamWs, dtype=float).ravel()
+        lam_sim = np.asarray(lam_sim, dtype=float).ravel()
+        lamWOs = float(np.asarray(lamWOs).ravel()[0])
+        z = np.hstack([self.x_sim, self.t_sim])
+        chol = np.empty((self.p_u, self.m, self.m))
+        alpha = np.empty((self.p_u, self.m))
+        for c in range(self.p_u):
+            sigma = np.exp(-weighted_sqdist(z, z, self.betaU[:, c])) / self.lamUz[c]
+            sigma[np.diag_indices_from(sigma)] += 1.0 / (lam_sim[c] * lamWOs) + 1.0 / self.lamWs[c]
+            chol[c] = cholesky(sigma, lower=True)
+            alpha[c] = cho_solve((chol[c], True), w[:, c])
+        self.chol = chol
+        self.alpha = alpha
+
+    def corr_x(self, x: np.ndarray, c: int) -> np.ndarray:
+        """R over the x part between points x (n, p) and the design: (n, m)."""
+        return np.exp(-weighted_sqdist(x, self.x_sim, self.betaU[: self.p, c]))
+
+    def corr_t(self, theta: np.ndarray, c: int) -> np.ndarray:
+        """R over the t part between points theta (G, q) and the design: (G, m)."""
+        return np.exp(-weighted_sqdist(theta, self.t_sim, self.betaU[self.p :, c]))
+
+    def prior_cov(self, x: np.ndarray, c: int) -> np.ndarray:
+        """Sigma_U for component c among obs points at one theta (n, n), nugget included."""
+        r = np.exp(-weighted_sqdist(x, x, self.betaU[: self.p, c])) / self.lamUz[c]
+        return r + np.eye(x.shape[0]) / self.lamWs[c]
+
+    def predict(self, x: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Predictive of u at (x_j, theta_g) given w, by dense solves.
+
+        Args:
+            x: (n, p) unit-scale known inputs of the n observations.
+            theta: (G, q) unit-scale calibration parameters.
+
+        Returns:
+            mean (G, p_u, n) and covariance (G, p_u, n, n) in standardised weight units.
+        """
+        n, G = x.shape[0], theta.shape[0]
+        mean = np.empty((G, self.p_u, n))
+        cov = np.empty((G, self.p_u, n, n))
+        for c in range(self.p_u):
+            rx = self.corr_x(x, c)
+            rt = self.corr_t(theta, c)
+            r = (rt[:, None, :] * rx[None, :, :]).reshape(G * n, self.m) / self.lamUz[c]
+            mean[:, c, :] = (r @ self.alpha[c]).reshape(G, n)
+            v = solve_triangular(self.chol[c], r.T, lower=True).T.reshape(G, n, self.m)
+            cov[:, c] = self.prior_cov(x, c)[None] - np.einsum("gim,gjm->gij", v, v)
+        return mean, cov
+
+
+def _cheb_coefficients(gp: FixedGP, c: int, tol: float, max_deg: int) -> np.ndarray | None:
+    """Chebyshev coefficients (deg + 1, m) of x -> R_x(x, x_i) on x in [0, 1] (p == 1)."""
+    beta = gp.betaU[0, c]
+    test = np.linspace(0.0, 1.0, 401)
+    exact = np.exp(-beta * (test[:, None] - gp.x_sim[None, :, 0]) ** 2)
+    deg = 8
+    while deg <= max_deg:
+        nodes = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+        vals = np.exp(-beta * ((nodes[:, None] + 1.0) / 2.0 - gp.x_sim[None, :, 0]) ** 2)
+        coef = cheb.chebfit(nodes, vals, deg)
+        if np.max(np.abs(cheb.chebval(2.0 * test - 1.0, coef).T - exact)) <= tol:
+            return coef
+        deg *= 2
+    return None
+
+
+class GridPredictor:
+    """Predictive of u on a fixed theta grid for any x_obs, with a per-update cost of O(G m n).
+
+    Precomputes, per grid node g and component c, R_t(theta_g) and (for p == 1) the matrix
+    H_g = E_g^T Sigma_W^-1 E_g of a Chebyshev expansion of R_x(x, x_i) in x (accurate to `tol`,
+    checked at set-up), so that Sigma_UW Sigma_W^-1 Sigma_UW^T = T(x) H_g T(x)^T needs no solve per
+    update. Falls back to dense solves (`FixedGP.predict`) for p > 1, for x outside [0, 1], or
+    when the expansion does not reach `tol` within `max_deg`.
+    """
+
+    def __init__(
+        self, gp: FixedGP, theta: np.ndarray, tol: float = 1e-14, max_deg: int = 128
+    ) -> None:
+        self.gp = gp
+        self.theta = np.asarray(theta, dtype=float)
+        G = self.theta.shape[0]
+        self.rt_alpha = np.empty((gp.p_u, G, gp.m))
+        coefs = (
+            [_cheb_coefficients(gp, c, tol, max_deg) for c in range(gp.p_u)] if gp.p == 1 else []
+        )
+        usable = len(coefs) == gp.p_u and all(cf is not None for cf in coefs)
+        self.H: list[np.ndarray] | None = [] if usable else None
+        for c in range(gp.p_u):
+            rt = gp.corr_t(self.theta, c) / gp.lamUz[c]
+            self.rt_alpha[c] = rt * gp.alpha[c][None, :]
+            if self.H is None:
+                continue
+            coef = coefs[c]
+            na = coef.shape[0]
+            e = rt[:, :, None] * coef.T[None, :, :]  # (G, m, na)
+            v = solve_triangular(gp.chol[c], e.transpose(1, 0, 2).reshape(gp.m, G * na), lower=True)
+            v = v.reshape(gp.m, G, na)
+            self.H.append(np.einsum("mga,mgb->gab", v, v))
+
+    def predict(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """mean (G, p_u, n) and covariance (G, p_u, n, n) of u at (x, theta_g); x (n, p) unit."""
+        gp = self.gp
+        inside = bool(np.all((x >= 0.0) & (x <= 1.0)))
+        if self.H is None or not inside:
+            return gp.predict(x, self.theta)
+        n, G = x.shape[0], self.theta.shape[0]
+        mean = np.empty((G, gp.p_u, n))
+        cov = np.empty((G, gp.p_u, n, n))
+        s = 2.0 * x[:, 0] - 1.0
+        for c in range(gp.p_u):
+            mean[:, c, :] = self.rt_alpha[c] @ gp.corr_x(x, c).T
+            H = self.H[c]
+            na = H.shape[1]
+            T = _cheb_vander(s, na)  # (n, na)
+            HT = (H.reshape(G * na, na) @ T.T).reshape(G, na, n)
+            cov[:, c] = gp.prior_cov(x, c)[None] - np.matmul(T[None], HT)
+        return mean, cov
+
+
+def _cheb_vander(s: np.ndarray, size: int) -> np.ndarray:
+    """Chebyshev polynomials T_k(s) = cos(k arccos s), k < size, at s (n,) in [-1, 1]: (n, size)."""
+    return np.cos(np.outer(np.arccos(np.clip(s, -1.0, 1.0)), np.arange(size)))
+
+
+@dataclass(frozen=True)
+class LamOsPrior:
+    """Gamma(shape, rate) prior of the observation precision lamOs, truncated to (lower, upper)."""
+
+    shape: float
+    rate: float
+    lower: float = 0.0
+    upper: float = np.inf
+
+    def log_norm(self) -> float:
+        """log P(lower < lamOs < upper) under the untruncated Gamma."""
+        mass = gammainc(self.shape, self.rate * self.upper) - gammainc(
+            self.shape, self.rate * self.lower
+        )
+        return float(np.log(mass))
+
+    def upper_quantile(self, tail: float) -> float:
+        """The value above which the (untruncated) prior has mass `tail`."""
+        return float(gammainccinv(self.shape, tail) / self.rate)
+
+
+@dataclass(frozen=True, eq=False)
+class LamOsMarginal:
+    """log p(u | theta_g) with lamOs integrated out, and the conditional of log(lamOs) per node.
+
+    Attributes:
+        loglik: (G,) log marginal density of the reduced data u at each theta node.
+        log_lam: (S,) equally spaced nodes of s = log(lamOs), shared by all theta nodes.
+    """
+
+    loglik: np.ndarray
+    log_lam: np.ndarray
+    _weights: np.ndarray  # (G, S) trapezoid terms, scaled per row
+    _sums: np.ndarray  # (G,) their row sums
+
+    def log_cond(self, nodes: np.ndarray) -> np.ndarray:
+        """(k, S) log trapezoid weights of the s nodes under p(s | u, theta) at theta ``nodes``
+        (indices); each row's exponentials sum to one."""
+        with np.errstate(divide="ignore"):
+            return np.log(self._weights[nodes]) - np.log(self._sums[nodes, None])
+
+
+def _whiten(
+    mean: np.ndarray, cov: np.ndarray, u: np.ndarray, obs_chol: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Eigenvalues e (G, d) of L^-1 S L^-T and rotated residuals y (G, d) (Sigma_obs = L L^T)."""
+    G, d = mean.shape
+    if d == 1:
+        s = obs_chol[0, 0]
+        return cov[:, 0, :] / (s * s), (u[None, :] - mean) / s
+    z = solve_triangular(obs_chol, (u[None, :] - mean).T, lower=True)  # (d, G)
+    a = solve_triangular(obs_chol, cov.transpose(1, 0, 2).reshape(d, G * d), lower=True)
+    a = a.reshape(d, G, d).transpose(1, 2, 0)  # rows of (L^-1 S)^T per g
+    b = solve_triangular(obs_chol, a.transpose(1, 0, 2).reshape(d, G * d), lower=True)
+    b = b.reshape(d, G, d).transpose(1, 0, 2)
+    e, vecs = np.linalg.eigh(0.5 * (b + b.transpose(0, 2, 1)))
+    return e, np.einsum("gdk,dg->gk", vecs, z)
+
+
+def _log_integrand(
+    s: np.ndarray, e: np.ndarray, y2: np.ndarray, prior: LamOsPrior, const: float
+) -> np.ndarray:
+    """log p(u | theta, lamOs) p(lamOs) lamOs at s = log lamOs; s (S,), e, y2 (G, d) -> (G, S)."""
+    lam = np.exp(s)
+    tail = prior.shape * s - prior.rate * lam + const
+    if e.shape[1] == 1:
+        var = e + 1.0 / lam
+        return tail - 0.5 * (np.log(var) + y2 / var)
+    var = e[:, None, :] + 1.0 / lam[None, :, None]  # (G, S, d)
+    return tail - 0.5 * np.sum(np.log(var) + y2[:, None, :] / var, axis=2)
+
+
+def lamos_marginal(
+    mean: np.ndarray,
+    cov: np.ndarray,
+    u: np.ndarray,
+    obs_chol: np.ndarray,
+    prior: LamOsPrior,
+    cutoff: float = 25.0,
+    max_step: float = 0.45,
+) -> LamOsMarginal:
+    """Integrate lamOs out of N(u; mean_g, cov_g + Sigma_obs / lamOs) against its prior.
+
+    The integral runs over s = log(lamOs) with the trapezoidal rule, which converges geometrically
+    for this smooth integrand that decays at both ends (error in loglik about 1e-8 at the default
+    step, checked against adaptive quadrature in the tests). A coarse pass (step 2 in s, on every
+    COARSE_STRIDE-th theta node and the nodes of largest residual and smallest variance) finds
+    where the integrand is within exp(-cutoff) of a node's peak (widened by one coarse step each
+    side); a fine pass (step <= max_step, and <= the posterior sd of s, about
+    sqrt(2 / (2 shape + d))) integrates over that window on nodes shared by all theta. Where the
+    window reaches a finite prior bound the integrand is cut off, the rule is only second order,
+    and the step is divided by TRUNCATED_REFINE.
+
+    Args:
+        mean: (G, d) predictive means of u (d = n p_u); cov: (G, d, d) predictive covariances.
+        u: (d,) reduced observation data; obs_chol: (d, d) lower Cholesky factor of Sigma_obs.
+        prior: the lamOs prior.
+
+    Returns:
+        LamOsMarginal with loglik = log p(u | theta_g) (all normalising constants included).
+    """
+    d = mean.shape[1]
+    e, y = _whiten(mean, cov, u, obs_chol)
+    e = np.maximum(e, 0.0)
+    y2 = y * y
+    const, coarse = _prior_terms(prior, d)
+    const -= float(np.sum(np.log(np.diag(obs_chol))))
+    G = e.shape[0]
+    y2_sum = y2.sum(axis=1)
+    ends = [G - 1, int(np.argmax(y2_sum)), int(np.argmin(y2_sum)), int(np.argmin(e[:, 0]))]
+    probe = np.concatenate([np.arange(0, G, COARSE_STRIDE), ends])
+    phi = _log_integrand(coarse, e[probe], y2[probe], prior, const)
+    keep = (phi >= phi.max(axis=1, keepdims=True) - cutoff).any(axis=0)
+    inside = np.flatnonzero(keep)
+    lo = coarse[max(inside[0] - 1, 0)]
+    hi = coarse[min(inside[-1] + 1, coarse.size - 1)]
+    step = min(max_step, np.sqrt(2.0 / (2.0 * prior.shape + d)))
+    if (prior.lower > 0.0 and lo <= coarse[0]) or (np.isfinite(prior.upper) and hi >= coarse[-1]):
+        step /= TRUNCATED_REFINE  # the integrand is cut off at a bound: the rule is O(step^2)
+    n_nodes = int(np.ceil((hi - lo) / step)) + 1
+    step = (hi - lo) / (n_nodes - 1)
+    s = lo + step * np.arange(n_nodes)
+    if d == 1:
+        return _fine_pass_scalar(s, step, e[:, 0], y2[:, 0], prior, const)
+    phi = _log_integrand(s, e, y2, prior, const)
+    phi[:, 0] -= _LOG_2
+    phi[:, -1] -= _LOG_2
+    peak = phi.max(axis=1)
+    w = np.exp(phi - peak[:, None])
+    sums = w.sum(axis=1)
+    return LamOsMarginal(np.log(sums) + peak + np.log(step), s, w, sums)
+
+
+def _fine_pass_scalar(
+    s: np.ndarray, step: float, e: np.ndarray, y2: np.ndarray, prior: LamOsPrior, const: float
+) -> LamOsMarginal:
+    """The fine pass for d = 1 in linear space: one exp and one sqrt per node instead of a log
+    and an exp. Each row is scaled by an upper bound of its integrand, exp(B_g) with
+    B_g = max_s tail(s) + max_v (-log(v) / 2 - y2 / (2 v)) over v >= e; rows that underflow
+    (a bound more than ~700 above the peak) are recomputed in log space."""
+    lam = np.exp(s)
+    tail = prior.shape * s - prior.rate * lam + const
+    tail_max = float(tail.max())
+    v_star = np.maximum(y2, e)
+    lik_max = -0.5 * (np.log(v_star) + y2 / v_star)
+    r = 1.0 / (e[:, None] + 1.0 / lam[None, :])  # 1 / var, (G, S)
+    w = np.sqrt(v_star[:, None] * r) * np.exp(-0.5 * y2[:, None] * (r - 1.0 / v_star[:, None]))
+    w *= np.exp(tail - tail_max)[None, :]
+    w[:, 0] *= 0.5
+    w[:, -1] *= 0.5
+    sums = w.sum(axis=1)
+    loglik = np.log(sums) + tail_max + lik_max + np.log(step)
+    low = ~(sums > 1e-250)
+    if low.any():  # the scaling overshot: redo those rows in log space
+        phi = _log_integrand(s, e[low, None], y2[low, None], prior, const)
+        phi[:, 0] -= _LOG_2
+        phi[:, -1] -= _LOG_2
+        peak = phi.max(axis=1)
+        w[low] = np.exp(phi - peak[:, None])
+        sums[low] = w[low].sum(axis=1)
+        loglik[low] = np.log(sums[low]) + peak + np.log(step)
+    return LamOsMarginal(loglik, s, w, sums)
+
+
+@lru_cache(maxsize=64)
+def _prior_terms(prior: LamOsPrior, d: int) -> tuple[float, np.ndarray]:
+    """Normalising constant of the integrand and the coarse s grid, per prior and data size."""
+    const = (
+        prior.shape * np.log(prior.rate)
+        - gammaln(prior.shape)
+        - prior.log_norm()
+        - 0.5 * d * _LOG_2PI
+    )
+    s_hi = float(np.log(min(prior.upper, prior.upper_quantile(1e-17))))
+    s_lo = s_hi - 80.0
+    if prior.lower > 0.0:
+        s_lo = max(s_lo, float(np.log(prior.lower)))
+    coarse = np.linspace(s_lo, s_hi, int(np.ceil((s_hi - s_lo) / 2.0)) + 1)
+    coarse.flags.writeable = False
+    return float(const), coarse

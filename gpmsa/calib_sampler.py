@@ -1,0 +1,357 @@
+"""A fast Metropolis-within-Gibbs sampler of (theta, lamOs) with the emulator fixed.
+
+The same algorithm as the numpy backend (gpmsa.mcmc: GPM/SA's sweep order, proposals, bounds and
+step-size tuning via gpmsa.tuning), specialised to the calibration-only model of
+``gpmsa.calib_model``: a theta proposal needs only the predictive of u at the new theta. For one
+calibration parameter that predictive (mean and covariance of u as functions of theta, for the given
+x_obs) is expanded once in Chebyshev polynomials to round-off accuracy (checked against dense solves
+at set-up), so a proposal costs O(degree) instead of O(m^2); otherwise each theta proposal does
+dense solves. The emulator parameters may be one set (its point estimate) or several (its retained
+draws): then an index over the sets is a further Gibbs element with a uniform prior, updated by
+a Metropolis step proposing a uniformly chosen set, so that the chain targets the posterior with
+the likelihood averaged over the sets.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.polynomial import chebyshev as cheb
+from scipy.linalg import solve_triangular
+
+from gpmsa import tuning
+from gpmsa.calib_model import FixedGP
+from gpmsa.calib_obs import Observations
+from gpmsa.priors import Priors
+
+THETA_WIDTH = 0.2
+CHEB_DEGREES = (16, 32, 64, 128, 256)
+
+
+def _clenshaw2(pairs: tuple[tuple[float, float], ...], x: float) -> tuple[float, float]:
+    """Two Chebyshev series at a scalar x in [-1, 1] in one pure-Python loop (no array overhead).
+
+    ``pairs``: ((a_n, b_n), ..., (a_1, b_1)) in reverse order; the constant terms a_0, b_0 are
+    added by the caller. Returns (sum_{k>=1} a_k T_k(x) + ..., same for b) without the constants.
+    """
+    a1 = a2 = b1 = b2 = 0.0
+    x2 = x + x
+    for ak, bk in pairs:
+        t = ak + x2 * a1 - a2
+        a2 = a1
+        a1 = t
+        t = bk + x2 * b1 - b2
+        b2 = b1
+        b1 = t
+    return x * a1 - a2, x * b1 - b2
+
+
+def _trim(*coefs: np.ndarray) -> tuple[tuple[float, ...], ...]:
+    """Drop trailing coefficients below round-off (relative 1e-17), keeping a common length."""
+    n = 2
+    for c in coefs:
+        keep = np.flatnonzero(np.abs(c) > 1e-17 * np.max(np.abs(c)))
+        n = max(n, int(keep[-1]) + 1 if keep.size else 1)
+    return tuple(tuple(float(v) for v in c[:n]) for c in coefs)
+
+
+class ThetaPredictive:
+    """Whitened predictive (e, y) of the reduced data at theta for fixed x_obs.
+
+    ``at(theta)`` returns (e, y2): the eigenvalues of L^-1 S(theta) L^-T (d,) and the squared
+    rotated residuals (d,), with Sigma_obs = L L^T, so that
+    log p(u | theta, lamOs) = -0.5 sum(log(e + 1/lamOs) + y2 / (e + 1/lamOs)) + const.
+    For d == 1 both are floats. With one calibration parameter, the mean (d,) and covariance
+    (d, d) of u are Chebyshev series in theta (``cheb``), accurate to ``tol`` relative to their
+    scale (checked at 257 points against dense solves); with two and d == 1, 2-D series
+    (``cheb2``, checked on a 33 x 33 grid); otherwise each call does dense solves.
+    """
+
+    def __init__(self, gp: FixedGP, data: Observations, tol: float = 1e-12) -> None:
+        self.gp = gp
+        self.x = data.x
+        self.z = data.z
+        self.d = data.z.size
+        self.L = data.obs_chol
+        self._sig = float(data.obs_chol[0, 0])
+        self.cheb: tuple[np.ndarray, np.ndarray] | None = None
+        self.cheb2: tuple[np.ndarray, np.ndarray] | None = None
+        if gp.q == 1:
+            self.cheb = self._expand(tol)
+        elif gp.q == 2 and self.d == 1:
+            self.cheb2 = self._expand2(tol)
+        if self.cheb is not None and self.d == 1:
+            cm, cv = _trim(self.cheb[0][:, 0], self.cheb[1][:, 0, 0])
+            self._const = (cm[0], cv[0])
+            self._pairs = tuple(zip(cm[:0:-1], cv[:0:-1], strict=True))
+        elif self.cheb is not None:  # whiten the coefficients once: L^-1 mean_k, L^-1 C_k L^-T
+            cm, cv = self.cheb
+            k, d = cm.shape
+            self._zw = solve_triangular(self.L, self.z, lower=True)
+            self._cmw = solve_triangular(self.L, cm.T, lower=True).T
+            a = solve_triangular(self.L, cv.transpose(1, 0, 2).reshape(d, k * d), lower=True)
+            a = a.reshape(d, k, d).transpose(1, 2, 0)  # (k, d, d): (L^-1 C_k)^T
+            b = solve_triangular(self.L, a.transpose(1, 0, 2).reshape(d, k * d), lower=True)
+            self._cvw = b.reshape(d, k, d).transpose(1, 0, 2)
+            self._orders = np.arange(k)
+
+    def _dense(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """mean (G, d) and covariance (G, d, d) of u at unit-scale theta (G, q)."""
+        mean, cov = self.gp.predict(self.x, theta)
+        G = theta.shape[0]
+        out = np.zeros((G, self.d, self.d))
+        n = self.x.shape[0]
+        for c in range(self.gp.p_u):
+            out[:, c * n : (c + 1) * n, c * n : (c + 1) * n] = cov[:, c]
+        return mean.reshape(G, self.d), out
+
+    def _expand(self, tol: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """Chebyshev coefficients (deg + 1, d) and (deg + 1, d, d) on theta in [0, 1], or None."""
+        s_test = np.linspace(-1.0, 1.0, 257)
+        m_ex, v_ex = self._dense(((s_test + 1.0) / 2.0)[:, None])
+        d = self.d
+        scale_m = max(1.0, float(np.max(np.abs(m_ex))))
+        scale_v = np.sqrt(np.einsum("gii,gjj->gij", v_ex, v_ex))  # |cov_ij| <= sqrt(v_ii v_jj)
+        for deg in CHEB_DEGREES:
+            nodes = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+            m, v = self._dense(((nodes + 1.0) / 2.0)[:, None])
+            cm = cheb.chebfit(nodes, m, deg)
+            cv = cheb.chebfit(nodes, v.reshape(-1, d * d), deg)
+            err_m = np.max(np.abs(cheb.chebval(s_test, cm).T - m_ex)) / scale_m
+            err_v = np.max(np.abs(cheb.chebval(s_test, cv).T.reshape(-1, d, d) - v_ex) / scale_v)
+            if err_m <= tol and err_v <= 10 * tol:
+                return cm, cv.reshape(deg + 1, d, d)
+        return None
+
+    def _expand2(self, tol: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """2-D Chebyshev coefficients (deg + 1, deg + 1) of the mean and variance of u (d = 1)
+        on theta in [0, 1]^2 (q = 2), or None."""
+        s_test = np.linspace(-1.0, 1.0, 33)
+        test = np.column_stack([g.ravel() for g in np.meshgrid(s_test, s_test, indexing="ij")])
+        m_ex, v_ex = self._dense((test + 1.0) / 2.0)
+        m_ex, v_ex = m_ex[:, 0], v_ex[:, 0, 0]
+        scale_m = max(1.0, float(np.max(np.abs(m_ex))))
+        for deg in CHEB_DEGREES[:3]:
+            nodes = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
+            grid = np.column_stack([g.ravel() for g in np.meshgrid(nodes, nodes, indexing="ij")])
+            m, v = self._dense((grid + 1.0) / 2.0)
+            coefs = []
+            for vals in (m[:, 0], v[:, 0, 0]):
+                c = cheb.chebfit(nodes, vals.reshape(deg + 1, deg + 1), deg)  # along theta_1
+                coefs.append(cheb.chebfit(nodes, c.T, deg).T)  # then along theta_2
+            cm, cv = coefs
+            err_m = np.max(np.abs(cheb.chebval2d(test[:, 0], test[:, 1], cm) - m_ex)) / scale_m
+            err_v = np.max(np.abs(cheb.chebval2d(test[:, 0], test[:, 1], cv) - v_ex) / v_ex)
+            if err_m <= tol and err_v <= 10 * tol:
+                return cm, cv
+        return None
+
+    def at(self, theta):
+        """(e, y2) at unit-scale theta (a sequence of q floats)."""
+        if self.cheb2 is not None:
+            cm, cv = self.cheb2
+            k = np.arange(cm.shape[0])
+            t1 = np.cos(k * math.acos(min(1.0, max(-1.0, 2.0 * theta[0] - 1.0))))
+            t2 = np.cos(k * math.acos(min(1.0, max(-1.0, 2.0 * theta[1] - 1.0))))
+            r = (float(self.z[0]) - float(t1 @ cm @ t2)) / self._sig
+            return float(t1 @ cv @ t2) / (self._sig * self._sig), r * r
+        if self.cheb is not None and self.d == 1:
+            mean, var = _clenshaw2(self._pairs, 2.0 * theta[0] - 1.0)
+            r = (float(self.z[0]) - mean - self._const[0]) / self._sig
+            return (var + self._const[1]) / (self._sig * self._sig), r * r
+        if self.cheb is not None:
+            t = np.cos(self._orders * math.acos(min(1.0, max(-1.0, 2.0 * theta[0] - 1.0))))
+            zw = self._zw - t @ self._cmw
+            b = np.tensordot(t, self._cvw, 1)
+        else:
+            mean, cov = self._dense(np.asarray(theta, dtype=float)[None, :])
+            if self.d == 1:
+                r = (float(self.z[0]) - float(mean[0, 0])) / self._sig
+                return float(cov[0, 0, 0]) / (self._sig * self._sig), r * r
+            zw = solve_triangular(self.L, self.z - mean[0], lower=True)
+            a = solve_triangular(self.L, cov[0], lower=True)
+            b = solve_triangular(self.L, a.T, lower=True)
+        e, vecs = np.linalg.eigh(0.5 * (b + b.T))
+        y = vecs.T @ zw
+        return np.maximum(e, 0.0), y * y
+
+
+def _loglik(ey, lam: float) -> float:
+    """log p(u | theta, lamOs) up to a constant, from the whitened (e, y2)."""
+    e, y2 = ey
+    if isinstance(e, float):
+        v = e + 1.0 / lam
+        return -0.5 * (math.log(v) + y2 / v)
+    v = e + 1.0 / lam
+    return float(-0.5 * np.sum(np.log(v) + y2 / v))
+
+
+@dataclass(frozen=True)
+class ChainResult:
+    """Draws of one chain: theta (n, q) unit scale, lamOs (n,), emulator-set index (n,),
+    log posterior (n,) up to a constant, acceptance rate and step width per element."""
+
+    theta: np.ndarray
+    lamOs: np.ndarray
+    index: np.ndarray
+    log_post: np.ndarray
+    accept_rate: np.ndarray
+    widths: np.ndarray
+
+
+class CalibrationSampler:
+    """Metropolis-within-Gibbs over theta (q,), lamOs and (for several emulator parameter sets)
+    the set index.
+
+    Args:
+        gps: the emulator's GP at one or more parameter sets.
+        data: the reduced observations.
+        priors: the emulator's priors (theta prior); the lamOs prior is ``data.lamos``.
+        log_prior: optional extra log prior of unit-scale theta (q,) -> float.
+    """
+
+    def __init__(
+        self,
+        gps: list[FixedGP],
+        data: Observations,
+        priors: Priors,
+        log_prior: Callable[[np.ndarray], float] | None = None,
+    ) -> None:
+        self.preds = [ThetaPredictive(gp, data) for gp in gps]
+        self.q = gps[0].q
+        self.priors = priors
+        self.lamos = data.lamos
+        self.extra = log_prior
+        lo = data.lamos
+        self.init_lamos = max(20.0, lo.shape / lo.rate)
+
+    def _log_prior_theta(self, theta: list[float]) -> float:
+        """Truncated-normal prior of unit-scale theta (plus the extra prior), pure Python."""
+        pri = self.priors
+        lp = 0.0
+        for t in theta:
+            if not 0.0 < t < 1.0:
+                return -math.inf
+            z = (t - pri.theta_mean) / pri.theta_sd
+            lp -= 0.5 * z * z
+        if self.extra is not None:
+            lp += float(self.extra(np.array(theta)))
+        return lp
+
+    def _log_prior_lamos(self, lam: float) -> float:
+        p = self.lamos
+        if not p.lower < lam < p.upper:
+            return -math.inf
+        return (p.shape - 1.0) * math.log(lam) - p.rate * lam
+
+    def run(
+        self,
+        n_iter: int,
+        rng: np.random.Generator,
+        *,
+        tune: bool = True,
+        tune_rounds: int = tuning.N_BURN,
+        tune_levels: int = tuning.N_LEVELS,
+        widths: np.ndarray | None = None,
+        progress: bool = False,
+    ) -> ChainResult:
+        """Tune (optionally, GPM/SA's stepsize), then ``n_iter`` sweeps from GPM/SA's initials."""
+        from tqdm import tqdm
+
+        q = self.q
+        names = ["theta"] * q + ["lamOs"]
+        w = np.array([THETA_WIDTH] * q + [self.init_lamos / 2.0]) if widths is None else widths
+        state = _State(self, [0.5] * q, self.init_lamos, 0)
+        n_tune = tune_rounds * tune_levels if tune else 0
+        with tqdm(total=n_iter + n_tune, desc="calibrate", disable=not progress) as bar:
+            if tune:
+                cands = tuning.level_widths(names, w, tune_levels)
+                acc = np.zeros((tune_levels, q + 1))
+                levels = [c.tolist() for c in cands]
+                for _ in range(tune_rounds):
+                    u = rng.random((tune_levels, 2 * (q + 2))).tolist()
+                    for lev in range(tune_levels):
+                        state.sweep(levels[lev], False, acc[lev], u[lev])
+                    bar.update(tune_levels)
+                w = tuning.choose_widths(w, cands, acc, tune_rounds)
+            widths_l = w.tolist()
+            out = []
+            accepted = np.zeros(q + 1)
+            block = 1000
+            for start in range(0, n_iter, block):
+                u = rng.random((min(block, n_iter - start), 2 * (q + 2))).tolist()
+                for row in u:
+                    state.sweep(widths_l, not tune, accepted, row)
+                    out.append((*state.theta, state.lam, state.k, state.log_post()))
+                bar.update(len(u))
+        arr = np.array(out)
+        return ChainResult(
+            theta=arr[:, :q], lamOs=arr[:, q], index=arr[:, q + 1].astype(np.int64),
+            log_post=arr[:, q + 2], accept_rate=accepted / max(n_iter, 1), widths=w,
+        )  # fmt: skip
+
+
+class _State:
+    """The current (theta, lamOs, set index) of one chain and its sweep (Python floats)."""
+
+    def __init__(self, s: CalibrationSampler, theta: list[float], lam: float, k: int) -> None:
+        self.s = s
+        self.theta = list(theta)
+        self.lam = lam
+        self.k = k
+        self.ey = s.preds[k].at(self.theta)
+        self.ll = _loglik(self.ey, lam)
+        self.lp_theta = s._log_prior_theta(self.theta)
+        self.lp_lam = s._log_prior_lamos(lam)
+
+    def log_post(self) -> float:
+        """Log posterior up to a constant."""
+        return self.ll + self.lp_theta + self.lp_lam
+
+    def sweep(self, widths: list[float], prop_mh: bool, accepted, u: list[float]) -> None:
+        """One sweep: each theta element, lamOs, then (several sets) the set index.
+
+        ``u``: 2 (q + 2) uniform numbers (a step and an acceptance draw per element).
+        """
+        s = self.s
+        q = s.q
+        pred = s.preds[self.k]
+        for i in range(q):
+            cand = list(self.theta)
+            cand[i] += widths[i] * (u[2 * i] - 0.5)
+            lp_new = s._log_prior_theta(cand)
+            if lp_new == -math.inf:
+                continue
+            ey = pred.at(cand)
+            ll = _loglik(ey, self.lam)
+            if math.log(u[2 * i + 1]) < ll - self.ll + lp_new - self.lp_theta:
+                self.theta, self.ey, self.ll, self.lp_theta = cand, ey, ll, lp_new
+                accepted[i] += 1
+        x = self.lam
+        step = u[2 * q] - 0.5
+        corr = 0.0
+        if prop_mh:  # GPM/SA's proportional step for an untuned precision, with its correction
+            w0 = max(1.0, x / 3.0)
+            cand_l = x + w0 * 2.0 * step
+            w1 = max(1.0, cand_l / 3.0)
+            if x > cand_l + w1:
+                cand_l = -1.0
+            else:
+                corr = math.log(w0 / w1)
+        else:
+            cand_l = x + widths[q] * step
+        lp_new = s._log_prior_lamos(cand_l) if cand_l > 0.0 else -math.inf
+        if lp_new != -math.inf:
+            ll = _loglik(self.ey, cand_l)
+            if math.log(u[2 * q + 1]) < ll - self.ll + lp_new - self.lp_lam + corr:
+                self.lam, self.ll, self.lp_lam = cand_l, ll, lp_new
+                accepted[q] += 1
+        if len(s.preds) > 1:
+            k = int(u[2 * q + 2] * len(s.preds))
+            ey = s.preds[k].at(self.theta)
+            ll = _loglik(ey, self.lam)
+            if math.log(u[2 * q + 3]) < ll - self.ll:
+                self.k, self.ey, self.ll = k, ey, ll

@@ -1,0 +1,213 @@
+"""``gpmsa.calibrate``: MCMC calibration with the emulator fixed (the paper's online step).
+
+With the emulator's parameters fixed (its point estimate, or integrated over its retained draws),
+the calibration samples theta and the observation precision lamOs (and, with a discrepancy basis,
+the discrepancy parameters betaV and lamVz). Defaults are the paper's: GPM/SA step-size tuning of
+50 rounds x 20 levels (1,000 sweeps), then 5,000 sweeps of which the first 1,000 are burned.
+
+Engines: the calibration-only problem is a ``gpmsa.Problem`` whose emulator parameters are in
+``fixed``; any backend's ``sample`` runs it. For backend="numpy" without discrepancy the default is
+a specialised sampler of the same algorithm (``gpmsa.calib_sampler``) that evaluates only the
+predictive at each proposed theta; ``fast=False`` uses the generic numpy backend instead.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from gpmsa import backends, tuning
+from gpmsa.calib_obs import (
+    EMULATOR_PARAMS,
+    blas_controller,
+    check_emulator,
+    check_x,
+    emulator_param_sets,
+    fixed_gp,
+    reduce,
+)
+from gpmsa.calib_sampler import CalibrationSampler
+from gpmsa.data import ObsData
+from gpmsa.errors import GPMSAError
+from gpmsa.posterior import Posterior
+from gpmsa.problem import Problem, default_init, reduce_obs
+
+
+def calibration_problem(emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False) -> Problem:
+    """The calibration-only Problem: the emulator's parameters at its point estimate in ``fixed``.
+
+    Sampled: theta, lamOs (and betaV, lamVz with a discrepancy basis, "constant" for a scalar
+    output; "constant", "linear" or a matrix for a vector output).
+    """
+    check_emulator(emulator)
+    if discrepancy is None:
+        data = reduce(emulator, x_obs, y_obs, extrapolate)
+        obs, corr = data.obs, data.os_corr
+    else:
+        x, _ = check_x(emulator, x_obs, extrapolate)
+        y = np.asarray(y_obs, dtype=float)
+        if emulator.K.shape[0] == 1 and y.size == x.shape[0]:
+            y = y.reshape(-1, 1)
+        obs, corr = reduce_obs(
+            ObsData(x, y), emulator.standardizer, emulator.K, discrepancy, emulator.x_names
+        )
+    pri = emulator.priors
+    lo = pri.lamOs
+    priors = replace(pri, lamOs=replace(lo, a=lo.a + corr[0], b=lo.b + corr[1]))
+    p, q, p_u = emulator.x_unit.shape[1], emulator.t_unit.shape[1], emulator.K.shape[1]
+    init = default_init(p, q, p_u, priors, obs)
+    for k in EMULATOR_PARAMS:
+        init[k] = np.array(emulator.params[k], dtype=float).reshape(init[k].shape)
+    return Problem(
+        emulator.x_unit, emulator.t_unit, emulator.w, emulator.lam_sim, priors, init,
+        frozenset(EMULATOR_PARAMS), obs,
+    )  # fmt: skip
+
+
+def calibrate(
+    emulator,
+    x_obs,
+    y_obs,
+    n_samples: int = 5000,
+    n_burn: int = 1000,
+    tune: bool = True,
+    seed=None,
+    backend: str = "numpy",
+    *,
+    emulator_params: str = "point",
+    n_emulator_draws: int = 20,
+    discrepancy=None,
+    n_chains: int = 1,
+    tune_rounds: int = tuning.N_BURN,
+    tune_levels: int = tuning.N_LEVELS,
+    extrapolate: bool = False,
+    fast: bool | None = None,
+    log_prior=None,
+    progress: bool = False,
+) -> Posterior:
+    """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
+
+    Args:
+        emulator: a gpmsa.Emulator.
+        x_obs: (n, p) known inputs of the observations, native units.
+        y_obs: (n, l_sim) observed outputs, native units (a scalar output also takes (n,)).
+        n_samples: sweeps per chain after tuning; n_burn: of these, burned (kept: the rest).
+        tune: GPM/SA step-size tuning first (tune_rounds x tune_levels sweeps).
+        seed: seed of the random numbers (same seed, same draws).
+        backend: "numpy" (default), "torch" or "pyro" (``gpmsa.backends.available()``).
+        emulator_params: "point" (the emulator's point estimate) or "draws" (the likelihood
+            averaged over ``n_emulator_draws`` of its retained draws; numpy fast path only).
+        discrepancy: None (no discrepancy, the default) or a discrepancy basis (generic backends).
+        n_chains: independent chains (their kept draws are pooled in ``samples``).
+        extrapolate: allow x_obs outside the emulator's x domain (with a warning).
+        fast: None (auto: the specialised sampler when it applies), True, or False (the backend).
+        log_prior: optional extra log prior of theta, a vectorised callable of native theta as
+            ``Calibrator.update`` takes it ((k,) values for one parameter, (k, q) for more ->
+            (k,) log densities; called with k = 1); fast path only.
+        progress: show a tqdm bar.
+
+    Returns:
+        Posterior with draws of each calibration parameter (named as the emulator's t_names,
+        native units), "lamOs" (and "betaV", "lamVz" with a discrepancy), and chains per name.
+    """
+    check_emulator(emulator)
+    for name, val, low in (("n_samples", n_samples, 2), ("n_chains", n_chains, 1)):
+        if not (isinstance(val, int | np.integer) and val >= low):
+            raise GPMSAError(f"{name} must be an integer >= {low}, got {val}")
+    if not (isinstance(n_burn, int | np.integer) and 0 <= n_burn < n_samples - 1):
+        raise GPMSAError(f"n_burn must be an integer in [0, n_samples - 1), got {n_burn}")
+    sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
+    can_fast = backend == "numpy" and discrepancy is None
+    if fast is None:
+        fast = can_fast
+    if fast and not can_fast:
+        raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
+    if not fast and (emulator_params != "point" or log_prior is not None):
+        raise GPMSAError("emulator_params='draws' and log_prior need the fast numpy path")
+    t0 = time.perf_counter()
+    with blas_controller().limit(limits=1, user_api="blas"):
+        if fast:
+            draws, info = _run_fast(
+                emulator, x_obs, y_obs, sets, n_samples, n_chains, tune, tune_rounds,
+                tune_levels, seed, extrapolate, log_prior, progress,
+            )  # fmt: skip
+        else:
+            draws, info = _run_backend(
+                emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
+                tune_rounds, tune_levels, seed, extrapolate, progress,
+            )  # fmt: skip
+    chains = {k: v[:, n_burn:] for k, v in draws.items()}
+    samples = {k: v.reshape(-1) for k, v in chains.items()}
+    info.update(
+        method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
+        emulator_params=emulator_params, seconds=time.perf_counter() - t0,
+    )  # fmt: skip
+    return Posterior(samples, chains=chains, info=info)
+
+
+def _run_fast(
+    emulator, x_obs, y_obs, sets, n_samples, n_chains, tune, tune_rounds, tune_levels, seed,
+    extrapolate, log_prior, progress,
+):  # fmt: skip
+    data = reduce(emulator, x_obs, y_obs, extrapolate)
+    std = emulator.standardizer
+    extra = None
+    if log_prior is not None:
+        if not callable(log_prior):
+            raise GPMSAError("log_prior must be a callable of native theta for MCMC")
+
+        def extra(theta_unit: np.ndarray) -> float:
+            native = std.t_from_unit(theta_unit[None, :])
+            return float(np.ravel(log_prior(native[:, 0] if native.shape[1] == 1 else native))[0])
+
+    sampler = CalibrationSampler(
+        [fixed_gp(emulator, s) for s in sets], data, emulator.priors, extra
+    )
+    seeds = np.random.SeedSequence(seed).spawn(n_chains)
+    runs = [
+        sampler.run(n_samples, np.random.default_rng(s), tune=tune, tune_rounds=tune_rounds,
+                    tune_levels=tune_levels, progress=progress)
+        for s in seeds
+    ]  # fmt: skip
+    theta = std.t_from_unit(np.stack([r.theta for r in runs]))  # (chains, n, q)
+    draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
+    draws["lamOs"] = np.stack([r.lamOs for r in runs])
+    info = {
+        "engine": "fast",
+        "backend": "numpy",
+        "accept_rate": np.stack([r.accept_rate for r in runs]).tolist(),
+        "step_widths": np.stack([r.widths for r in runs]).tolist(),
+        "chebyshev": all(p.cheb is not None or p.cheb2 is not None for p in sampler.preds),
+    }
+    return draws, info
+
+
+def _run_backend(
+    emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tune_rounds,
+    tune_levels, seed, extrapolate, progress,
+):  # fmt: skip
+    problem = calibration_problem(
+        emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate
+    )
+    module = backends.get(backend)
+    opts = {"tune_rounds": tune_rounds, "tune_levels": tune_levels} if backend == "numpy" else {}
+    chains = module.sample(
+        problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed, progress=progress,
+        **opts,
+    )  # fmt: skip
+    std = emulator.standardizer
+    theta = std.t_from_unit(np.asarray(chains.draws["theta"]))
+    draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
+    draws["lamOs"] = np.asarray(chains.draws["lamOs"])[:, :, 0]
+    for name in ("betaV", "lamVz"):
+        if name in chains.draws:
+            draws[name] = np.asarray(chains.draws[name]).reshape(n_chains, n_samples, -1)[..., 0]
+    info = {
+        "engine": "backend",
+        "backend": backend,
+        "accept_rate": {k: np.asarray(v).tolist() for k, v in chains.accept_rate.items()},
+        "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
+    }
+    return draws, info

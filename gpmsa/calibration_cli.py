@@ -1,0 +1,92 @@
+"""``gpmsa calibrate FILE --x v=1.25 --y f=12.1``: print the posterior of one observation."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+
+
+def add_parser(sub) -> None:
+    """Add the ``calibrate`` subcommand to an argparse subparsers object."""
+    p = sub.add_parser(
+        "calibrate",
+        help="calibrate an emulator file on one observation and print the posterior summary",
+    )
+    p.add_argument("file", help="path to a .gpmsa file")
+    p.add_argument("--x", action="append", default=[], metavar="NAME=VALUE",
+                   help="a known input, native units (repeat for each x name)")  # fmt: skip
+    p.add_argument("--y", action="append", default=[], metavar="NAME=VALUE",
+                   help="an observed output, native units (repeat for each y name)")  # fmt: skip
+    p.add_argument("--method", choices=("auto", "grid", "mcmc"), default="auto",
+                   help="exact grid (1-2 parameters) or MCMC (default: auto)")  # fmt: skip
+    p.add_argument("--level", type=float, default=0.9, help="central interval level (0.9)")
+    p.add_argument("--seed", type=int, default=None, help="seed of the draws / MCMC")
+    p.add_argument("--extrapolate", action="store_true", help="allow x outside the domain")
+    p.add_argument("--json", action="store_true", help="print JSON for programs")
+    p.set_defaults(func=run)
+
+
+def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
+    """Values ordered as ``names`` from NAME=VALUE strings."""
+    given = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep:
+            raise GPMSAError(f"--{what} expects NAME=VALUE, got {item!r}")
+        try:
+            given[name.strip()] = float(value)
+        except ValueError as exc:
+            raise GPMSAError(f"--{what} {name}: {value!r} is not a number") from exc
+    unknown = sorted(set(given) - set(names))
+    missing = [n for n in names if n not in given]
+    if unknown or missing:
+        raise GPMSAError(
+            f"--{what} needs exactly the names {list(names)}; unknown {unknown}, missing {missing}"
+        )
+    return np.array([[given[n] for n in names]])
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the subcommand; exit status 0, or 2 with a message on stderr for bad input."""
+    from gpmsa.calibrator import Calibrator
+    from gpmsa.fileformat import load
+
+    try:
+        emu = load(args.file)
+        x = _pairs(args.x, tuple(emu.x_names), "x")
+        y = _pairs(args.y, tuple(emu.y_names), "y")
+        cal = Calibrator(emu, method=args.method, extrapolate=args.extrapolate, seed=args.seed)
+        t0 = time.perf_counter()
+        post = cal.update(x, y)
+        summary = post.summary(args.level)
+        seconds = time.perf_counter() - t0
+    except GPMSAError as exc:
+        print(f"gpmsa calibrate: {exc}", file=sys.stderr)
+        return 2
+    if args.json:
+        out = {
+            "file": args.file,
+            "x": dict(zip(emu.x_names, x[0].tolist(), strict=True)),
+            "y": dict(zip(emu.y_names, y[0].tolist(), strict=True)),
+            "method": post.info.get("method"),
+            "level": args.level,
+            "seconds": seconds,
+            "posterior": summary,
+        }
+        print(json.dumps(out, indent=1))
+        return 0
+    lo_key, hi_key = (f"q{100 * (1 - args.level) / 2:g}", f"q{100 * (1 + args.level) / 2:g}")
+    print(f"posterior ({post.info.get('method')}, {1e3 * seconds:.2f} ms) given "
+          + ", ".join(f"{n}={v:g}" for n, v in zip(emu.x_names, x[0], strict=True)) + "; "
+          + ", ".join(f"{n}={v:g}" for n, v in zip(emu.y_names, y[0], strict=True)))  # fmt: skip
+    print(f"{'name':>10s} {'mean':>12s} {'sd':>12s} {lo_key:>12s} {'median':>12s} {hi_key:>12s}")
+    for name, s in summary.items():
+        print(f"{name:>10s} {s['mean']:12.5g} {s['sd']:12.5g} {s[lo_key]:12.5g} "
+              f"{s['median']:12.5g} {s[hi_key]:12.5g}")  # fmt: skip
+    return 0

@@ -1,0 +1,375 @@
+"""Online calibration with a fixed emulator: prepared once, then ``update`` per observation window.
+
+For one or two calibration parameters the posterior is computed exactly on a grid (no sampling):
+with the emulator parameters fixed, the observation's reduced data u given the simulation weights w
+is Gaussian at every theta (``gpmsa.calib_model``), lamOs is integrated out per theta node by
+quadrature, and the posterior is the prior times that likelihood on the grid, refined where the
+mass is when the grid does not resolve it. More parameters use the MCMC of ``gpmsa.calibrate``.
+
+The fixed grid (``Calibrator.theta_grid``): ``n_grid`` equally spaced nodes per calibration
+parameter spanning the emulator's training range [t_min, t_max] of that parameter, end points
+included (default 129 for one parameter, 65 x 65 for two, in 'ij' order, first parameter slowest).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+from scipy.special import ndtr
+
+from gpmsa.calib_model import GridPredictor, LamOsMarginal, lamos_marginal
+from gpmsa.calib_obs import (
+    EMULATOR_PARAM_MODES,
+    Observations,
+    blas_controller,
+    check_emulator,
+    emulator_param_sets,
+    fixed_gp,
+    reduce,
+)
+from gpmsa.errors import GPMSAError
+from gpmsa.posterior import GridMarginal, Posterior, trapezoid_weights
+
+METHODS = ("auto", "grid", "mcmc")
+RESOLVE_SD = 4.0
+"""The grid resolves a posterior whose sd spans at least this many node spacings; otherwise the
+posterior is recomputed on a finer grid over the region holding its mass."""
+MASS_CUTOFF = 1e-14
+"""Nodes whose posterior density is below this fraction of the peak carry no mass."""
+N_REFINE = 129
+N_REFINE_2D = 49
+MAX_REFINE = 4
+
+
+class Calibrator:
+    """Calibration of ``emulator`` for a stream of observations, prepared once.
+
+    Args:
+        emulator: a gpmsa.Emulator (no discrepancy model is used).
+        method: "grid" (exact, q <= 2), "mcmc" (``gpmsa.calibrate``), or "auto" (grid for q <= 2).
+        n_grid: nodes per calibration parameter of the fixed grid (default 129 for q = 1, 65 for 2).
+        emulator_params: "point" (the emulator's point estimate) or "draws" (average the
+            likelihood over up to ``n_emulator_draws`` of its retained draws, evenly spaced).
+        extrapolate: allow x_obs outside the emulator's x domain (with a warning).
+        n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``.
+        seed: seed of those draws (and of the MCMC), for reproducibility.
+        mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC.
+    """
+
+    def __init__(
+        self,
+        emulator,
+        *,
+        method: str = "auto",
+        n_grid: int | None = None,
+        emulator_params: str = "point",
+        n_emulator_draws: int = 20,
+        extrapolate: bool = False,
+        n_draws: int = 4000,
+        seed=None,
+        mcmc_options: dict | None = None,
+    ) -> None:
+        check_emulator(emulator)
+        if method not in METHODS:
+            raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
+        if emulator_params not in EMULATOR_PARAM_MODES:
+            raise GPMSAError(
+                f"emulator_params must be one of {EMULATOR_PARAM_MODES}, got {emulator_params!r}"
+            )
+        q = emulator.t_unit.shape[1]
+        if method == "grid" and q > 2:
+            raise GPMSAError(f"method='grid' handles 1 or 2 calibration parameters, got q={q}")
+        self.emulator = emulator
+        self.method = ("grid" if q <= 2 else "mcmc") if method == "auto" else method
+        self.q = q
+        self.extrapolate = extrapolate
+        if not (isinstance(n_draws, int | np.integer) and n_draws >= 1):
+            raise GPMSAError(f"n_draws must be an integer >= 1, got {n_draws}")
+        self.n_draws = int(n_draws)
+        self._n_emulator_draws = n_emulator_draws
+        self.emulator_params = emulator_params
+        self._entropy = np.random.SeedSequence(seed).entropy
+        self._count = 0
+        self.mcmc_options = dict(mcmc_options or {})
+        if n_grid is None:
+            n_grid = 129 if q == 1 else 65
+        if not (isinstance(n_grid, int | np.integer) and n_grid >= 3):
+            raise GPMSAError(f"n_grid must be an integer >= 3, got {n_grid}")
+        self.n_grid = int(n_grid)
+        if self.method == "mcmc":
+            return
+        axes = [np.linspace(0.0, 1.0, self.n_grid)] * q
+        mesh = np.meshgrid(*axes, indexing="ij")
+        self._theta_unit = np.column_stack([g.ravel() for g in mesh])
+        std = emulator.standardizer
+        self.theta_grid = std.t_from_unit(self._theta_unit)
+        if q == 1:
+            self.theta_grid = self.theta_grid[:, 0]
+        with blas_controller().limit(limits=1, user_api="blas"):
+            sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
+            self._gps = [fixed_gp(emulator, prm) for prm in sets]
+            self._predictors = [GridPredictor(gp, self._theta_unit) for gp in self._gps]
+        pri = emulator.priors
+        self._log_prior_theta = -0.5 * np.sum(
+            ((self._theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1
+        )
+        self._weights = trapezoid_weights(self.theta_grid) if q == 1 else None
+        z = (1.0 - pri.theta_mean) / pri.theta_sd, (0.0 - pri.theta_mean) / pri.theta_sd
+        self._log_prior_norm = float(
+            np.log(pri.theta_sd * np.sqrt(2 * np.pi) * (ndtr(z[0]) - ndtr(z[1])))
+        )
+
+    # --- the exact likelihood on a grid ---------------------------------------------------------
+    def _marginals(self, data: Observations, theta_unit: np.ndarray | None) -> list[LamOsMarginal]:
+        """lamOs-marginal likelihoods per emulator parameter set on the fixed grid (None) or on
+        the given unit-scale nodes (dense solves)."""
+        out = []
+        d = data.z.size
+        for gp, pred in zip(self._gps, self._predictors, strict=True):
+            if theta_unit is None:
+                mean, cov = pred.predict(data.x)
+            else:
+                mean, cov = gp.predict(data.x, theta_unit)
+            G = mean.shape[0]
+            out.append(
+                lamos_marginal(
+                    mean.reshape(G, d), _block_diag(cov), data.z, data.obs_chol, data.lamos
+                )
+            )
+        return out
+
+    @staticmethod
+    def _combine(marginals: list[LamOsMarginal]) -> np.ndarray:
+        """log of the likelihood averaged over the emulator parameter sets (G,)."""
+        if len(marginals) == 1:
+            return marginals[0].loglik
+        ll = np.stack([m.loglik for m in marginals])
+        peak = ll.max(axis=0)
+        return peak + np.log(np.mean(np.exp(ll - peak), axis=0))
+
+    def _check_grid_method(self) -> None:
+        if self.method != "grid":
+            raise GPMSAError(
+                "this Calibrator uses MCMC (q > 2 or method='mcmc'); no grid likelihood"
+            )
+
+    def log_likelihood_grid(self, x_obs, y_obs) -> tuple[np.ndarray, np.ndarray]:
+        """Exact log-likelihood of theta on the fixed grid, lamOs integrated out.
+
+        Returns (theta_grid, loglik): theta_grid native units, (G,) for one calibration parameter
+        or (G, 2) for two (``Calibrator.theta_grid``); loglik (G,) = log p(u_obs | theta) with
+        all normalising constants (the density of the reduced observation data u, standardised
+        units), lamOs integrated against its prior (each window has its own lamOs). Successive
+        independent windows multiply: add their logliks. Raises GPMSAError for invalid input.
+        """
+        self._check_grid_method()
+        data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
+        with blas_controller().limit(limits=1, user_api="blas"):
+            ll = self._combine(self._marginals(data, None))
+        if np.any(np.isnan(ll)):
+            raise GPMSAError("the likelihood could not be evaluated for this observation")
+        return self.theta_grid, ll
+
+    # --- posterior ------------------------------------------------------------------------------
+    def _prior_values(self, prior, theta_unit: np.ndarray, on_grid: bool) -> np.ndarray:
+        """User log prior at unit-scale nodes (callable of native theta, or values on the grid)."""
+        if prior is None:
+            return np.zeros(theta_unit.shape[0])
+        if callable(prior):
+            native = self.emulator.standardizer.t_from_unit(theta_unit)
+            vals = np.asarray(prior(native[:, 0] if self.q == 1 else native), dtype=float)
+            vals = vals.reshape(-1)
+            if vals.size != theta_unit.shape[0]:
+                raise GPMSAError(
+                    f"prior(theta) must return one log density per node ({theta_unit.shape[0]}),"
+                    f" got {vals.size}"
+                )
+        else:
+            vals = np.asarray(prior, dtype=float).reshape(-1)
+            if vals.size != self._theta_unit.shape[0]:
+                raise GPMSAError(
+                    f"prior must be log densities on the Calibrator's grid "
+                    f"({self._theta_unit.shape[0]} values), got {vals.size}"
+                )
+            if not on_grid and self.q == 1:
+                vals = np.interp(theta_unit[:, 0], self._theta_unit[:, 0], vals)
+            elif not on_grid:
+                axis = np.linspace(0.0, 1.0, self.n_grid)
+                table = vals.reshape(self.n_grid, self.n_grid)
+                vals = RegularGridInterpolator((axis, axis), table)(theta_unit)
+        if np.any(np.isnan(vals)) or np.any(vals == np.inf):
+            raise GPMSAError("prior log densities must not be NaN or +inf")
+        return vals
+
+    def update(self, x_obs, y_obs, prior=None, seed=None) -> Posterior:
+        """Posterior of the calibration parameters (and lamOs) given one observation window.
+
+        Args:
+            x_obs: (n, p) known inputs, native units (e.g. [[v]]).
+            y_obs: (n, l_sim) observed outputs, native units (e.g. [[f]]).
+            prior: optional extra log prior of theta: log-density values on ``theta_grid`` (G,)
+                (interpolated linearly, bilinearly for two parameters, where the grid is
+                refined), or a callable of native theta ((k,) for one parameter, (k, 2) for two)
+                returning (k,). It multiplies the emulator's theta prior (effectively uniform on
+                the domain).
+            seed: seed of the lazily drawn samples (default: derived from the Calibrator's seed
+                and a per-update counter).
+
+        Returns:
+            Posterior; for the grid method its summaries of theta are exact (grid) and
+            ``info["log_evidence"]`` holds log p(u_obs) under the emulator's (normalised) theta
+            prior times the given prior (as given, unnormalised), for one parameter.
+        """
+        self._count += 1
+        if self.method == "mcmc":
+            from gpmsa.calibration import calibrate
+
+            opts = dict(self.mcmc_options)
+            auto = int(_seed_sequence((self._entropy, self._count)).generate_state(1)[0])
+            opts.setdefault("seed", seed if seed is not None else auto)
+            opts.setdefault("emulator_params", self.emulator_params)
+            opts.setdefault("n_emulator_draws", self._n_emulator_draws)
+            return calibrate(
+                self.emulator, x_obs, y_obs, extrapolate=self.extrapolate, log_prior=prior, **opts
+            )
+        data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
+        with blas_controller().limit(limits=1, user_api="blas"):
+            theta = self._theta_unit
+            margs = self._marginals(data, None)
+            logp = self._combine(margs) + self._log_prior_theta
+            if prior is not None:
+                logp = logp + self._prior_values(prior, theta, True)
+            if np.any(np.isnan(logp)) or not np.any(np.isfinite(logp)):
+                raise GPMSAError("the posterior has no mass on the grid (prior zero everywhere?)")
+            spacing = np.full(self.q, 1.0 / (self.n_grid - 1))
+            for _ in range(MAX_REFINE):
+                finer = _unresolved_region(theta, logp, spacing, self.q)
+                if finer is None:
+                    break
+                theta, spacing = finer
+                margs = self._marginals(data, theta)
+                logp = self._combine(margs) + self._theta_prior_at(theta, prior)
+        key = seed if seed is not None else (self._entropy, self._count)
+        return self._posterior(theta, logp, margs, key)
+
+    def _theta_prior_at(self, theta_unit: np.ndarray, prior) -> np.ndarray:
+        """The emulator's theta prior plus the user's at refined unit-scale nodes."""
+        pri = self.emulator.priors
+        base = -0.5 * np.sum(((theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1)
+        return base if prior is None else base + self._prior_values(prior, theta_unit, False)
+
+    def _posterior(self, theta, logp, margs: list[LamOsMarginal], key) -> Posterior:
+        std = self.emulator.standardizer
+        names = tuple(self.emulator.t_names)
+        native = std.t_from_unit(theta)
+        if self.q == 1:
+            on_base = theta is self._theta_unit
+            gm = GridMarginal.from_log_density(
+                native[:, 0], logp, self._weights if on_base else None
+            )
+            grids = {names[0]: gm}
+            log_evidence = float(np.log(np.sum(gm.weights * np.exp(logp - logp.max()))))
+            log_evidence += float(logp.max()) - float(np.log(std.t_max[0] - std.t_min[0]))
+            log_evidence -= self._log_prior_norm
+        else:
+            axes = [np.unique(native[:, k]) for k in range(2)]
+            dens = np.exp(logp - logp.max()).reshape(axes[0].size, axes[1].size)
+            w = [trapezoid_weights(a) for a in axes]
+            with np.errstate(divide="ignore"):
+                grids = {
+                    names[0]: GridMarginal.from_log_density(axes[0], np.log(dens @ w[1])),
+                    names[1]: GridMarginal.from_log_density(axes[1], np.log(w[0] @ dens)),
+                }
+            log_evidence = None
+        n_draws, q = self.n_draws, self.q
+
+        def draw() -> dict[str, np.ndarray]:
+            rng = np.random.default_rng(_seed_sequence(key))
+            out = {}
+            if q == 1:
+                th = grids[names[0]].sample(rng, n_draws)
+                out[names[0]] = th
+                step = native[1, 0] - native[0, 0]
+                node = np.clip(
+                    np.rint((th - native[0, 0]) / step).astype(int), 0, theta.shape[0] - 1
+                )
+            else:
+                p = np.exp(logp - logp.max())
+                node = rng.choice(p.size, size=n_draws, p=p / p.sum())
+                cell = np.array([a[1] - a[0] for a in axes])
+                jitter = (rng.random((n_draws, 2)) - 0.5) * cell
+                lo, hi = native.min(axis=0), native.max(axis=0)
+                vals = np.clip(native[node] + jitter, lo, hi)
+                for k, name in enumerate(names):
+                    out[name] = vals[:, k]
+            out["lamOs"] = _draw_lamos(margs, node, rng)
+            return out
+
+        info = {
+            "method": "grid",
+            "names": names + ("lamOs",),
+            "n_nodes": int(theta.shape[0]),
+            "refined": theta is not self._theta_unit,
+            "log_evidence": log_evidence,
+            "emulator_params": self.emulator_params,
+        }
+        return Posterior(grids=grids, draw=draw, info=info)
+
+
+def _seed_sequence(key) -> np.random.SeedSequence:
+    """A SeedSequence from a seed or an (entropy, counter) pair."""
+    if isinstance(key, tuple) and len(key) == 2 and isinstance(key[1], int):
+        return np.random.SeedSequence(key[0], spawn_key=(key[1],))
+    return np.random.SeedSequence(key)
+
+
+def _block_diag(cov: np.ndarray) -> np.ndarray:
+    """(G, p_u, n, n) per-component covariances -> (G, d, d) block-diagonal, d = p_u n."""
+    G, p_u, n, _ = cov.shape
+    if p_u == 1:
+        return cov[:, 0]
+    out = np.zeros((G, p_u * n, p_u * n))
+    for c in range(p_u):
+        out[:, c * n : (c + 1) * n, c * n : (c + 1) * n] = cov[:, c]
+    return out
+
+
+def _unresolved_region(theta: np.ndarray, logp: np.ndarray, spacing: np.ndarray, q: int):
+    """(finer nodes, their spacing) over the region holding the mass when the grid does not
+    resolve the posterior (its sd spans fewer than RESOLVE_SD node spacings along a parameter);
+    None when it does."""
+    f = np.exp(logp - np.max(logp))
+    f /= f.sum()
+    mean = f @ theta
+    sd = np.sqrt(f @ (theta - mean) ** 2)
+    if np.all(sd >= RESOLVE_SD * spacing):
+        return None
+    live = theta[f >= MASS_CUTOFF * f.max()]
+    lo = np.clip(live.min(axis=0) - spacing, 0.0, 1.0)
+    hi = np.clip(live.max(axis=0) + spacing, 0.0, 1.0)
+    n = N_REFINE if q == 1 else N_REFINE_2D
+    axes = [np.linspace(lo[k], hi[k], n) for k in range(q)]
+    mesh = np.meshgrid(*axes, indexing="ij")
+    return np.column_stack([g.ravel() for g in mesh]), (hi - lo) / (n - 1)
+
+
+def _draw_lamos(
+    margs: list[LamOsMarginal], node: np.ndarray, rng: np.random.Generator
+) -> np.ndarray:
+    """lamOs draws from its conditional at the given theta nodes (log-grid cell jitter); with
+    several emulator parameter sets, each draw's set is chosen by its likelihood at the node."""
+    k = np.zeros(node.size, dtype=int)
+    if len(margs) > 1:
+        ll = np.stack([m.loglik[node] for m in margs], axis=1)  # (n, J)
+        p = np.exp(ll - ll.max(axis=1, keepdims=True))
+        cum = np.cumsum(p, axis=1)
+        k = (cum < rng.random(node.size)[:, None] * cum[:, -1:]).sum(axis=1)
+    out = np.empty(node.size)
+    for j in np.unique(k):
+        sel = k == j
+        s = margs[j].log_lam
+        cum = np.cumsum(np.exp(margs[j].log_cond(node[sel])), axis=1)
+        u = rng.random(int(sel.sum())) * cum[:, -1]
+        idx = np.minimum((cum < u[:, None]).sum(axis=1), s.size - 1)
+        out[sel] = np.exp(s[idx] + (rng.random(idx.size) - 0.5) * (s[1] - s[0]))
+    return out

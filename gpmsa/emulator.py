@@ -1,0 +1,348 @@
+"""The fitted GPM/SA emulator: training data, transforms, basis, posterior draws, predictions."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.linalg import cho_solve, solve_triangular
+
+from gpmsa.data import SimData, as_matrix
+from gpmsa.errors import GPMSAError
+from gpmsa.gp import correlation
+from gpmsa.likelihood import lower_cholesky
+from gpmsa.priors import Priors
+from gpmsa.transforms import Standardizer
+
+EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+DOMAIN_MARGIN = 0.1
+"""predict() warns outside the training domain and refuses beyond this margin (unit scale)."""
+
+
+@dataclass(frozen=True)
+class LooResult:
+    """Exact leave-one-out predictions of the simulation runs (native units).
+
+    mean, var (m, l_sim): predictive mean and variance of run i given all others; z (m, l_sim):
+    standardised residuals (y - mean) / sqrt(var); rmse (l_sim,); coverage95: share of |z| < 1.96.
+    """
+
+    mean: np.ndarray
+    var: np.ndarray
+    z: np.ndarray
+    rmse: np.ndarray
+    coverage95: float
+
+
+def _param_shapes(p: int, q: int, p_u: int) -> dict[str, tuple[int, ...]]:
+    return {"betaU": (p + q, p_u), "lamUz": (p_u,), "lamWs": (p_u,), "lamWOs": (1,)}
+
+
+def _check_params(params: dict, shapes: dict) -> dict[str, np.ndarray]:
+    out = {}
+    for name, shape in shapes.items():
+        if name not in params:
+            raise GPMSAError(f"params needs {name!r} (shape {shape}); got keys {sorted(params)}")
+        val = np.array(params[name], dtype=np.float64)
+        if val.size != int(np.prod(shape)):
+            raise GPMSAError(f"params[{name!r}] must have shape {shape}, got {val.shape}")
+        val = val.reshape(shape)
+        if not np.all(np.isfinite(val)) or np.any(val <= 0):
+            raise GPMSAError(f"params[{name!r}] must be finite and > 0, got {val.ravel()}")
+        out[name] = val
+    return out
+
+
+class Emulator:
+    """A GPM/SA emulator (unit-scale inputs, standardised outputs inside; native units outside).
+
+    Attributes: standardizer, x_unit (m, p), t_unit (m, q), y (m, l_sim) native, K (l_sim, p_u),
+    w (m, p_u), lam_sim (p_u,), index (l_sim,) or None, params (point estimate: betaU (p+q, p_u),
+    lamUz, lamWs (p_u,), lamWOs (1,)), draws (name -> (n_draws, *shape), retained posterior
+    draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected), x_names,
+    t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
+    settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
+    lamOs draws of a joint sim+obs fit, else None).
+    """
+
+    def __init__(
+        self,
+        *,
+        standardizer: Standardizer,
+        x_unit: np.ndarray,
+        t_unit: np.ndarray,
+        y: np.ndarray,
+        K: np.ndarray,
+        w: np.ndarray,
+        index: np.ndarray | None,
+        params: dict[str, np.ndarray],
+        priors: Priors,
+        names: dict[str, tuple[str, ...]],
+        units: dict[str, tuple[str, ...]],
+        draws: dict[str, np.ndarray] | None = None,
+        log_post: np.ndarray | None = None,
+        metadata: dict | None = None,
+        settings: dict | None = None,
+        diagnostics: dict | None = None,
+        calibration: dict[str, np.ndarray] | None = None,
+    ):
+        self.standardizer = standardizer
+        self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
+        self.lam_sim = np.sum(K**2, axis=0)
+        self.index = index
+        self.params = _check_params(params, _param_shapes(self.p, self.q, self.p_u))
+        self.priors = priors
+        self.x_names, self.t_names, self.y_names = names["x"], names["t"], names["y"]
+        self.x_units, self.t_units, self.y_units = units["x"], units["t"], units["y"]
+        self.draws = draws if draws is not None else {}
+        self.log_post = log_post if log_post is not None else np.zeros(0)
+        self.metadata = dict(metadata or {})
+        self.settings = dict(settings or {})
+        self.diagnostics = dict(diagnostics or {})
+        self.calibration = calibration
+        self._factors: dict[int, list] = {}
+
+    # --- construction -------------------------------------------------------------------------
+    @classmethod
+    def from_params(
+        cls,
+        sim_data: SimData,
+        params: dict,
+        priors: Priors | None = None,
+        metadata: dict | None = None,
+        *,
+        n_pc: int | None = None,
+    ) -> Emulator:
+        """An emulator at given unit-scale parameter values (no MCMC).
+
+        ``params``: betaU (p+q, p_u), lamUz (p_u,), lamWs (p_u,), lamWOs (1,); arrays of the
+        same sizes in other shapes (e.g. (1, p_u) as SEPIA stores them) are accepted.
+        """
+        from gpmsa.problem import prepare
+
+        prep = prepare(sim_data, priors=priors, n_pc=n_pc)
+        return cls._from_prepared(sim_data, prep, params, metadata=metadata,
+                                  settings={"source": "from_params"})  # fmt: skip
+
+    @classmethod
+    def _from_prepared(cls, sim: SimData, prep, params, **kw) -> Emulator:
+        prob = prep.problem
+        return cls(
+            standardizer=prep.standardizer, x_unit=prob.x_sim, t_unit=prob.t_sim, y=sim.y,
+            K=prep.K, w=prob.w, index=sim.index, params=params, priors=prob.priors,
+            names={"x": sim.x_names, "t": sim.t_names, "y": sim.y_names},
+            units={"x": sim.x_units, "t": sim.t_units, "y": sim.y_units}, **kw,
+        )  # fmt: skip
+
+    # --- shapes and domain --------------------------------------------------------------------
+    @property
+    def m(self) -> int:
+        """Number of simulation runs."""
+        return self.x_unit.shape[0]
+
+    @property
+    def p(self) -> int:
+        """Number of known inputs."""
+        return self.x_unit.shape[1]
+
+    @property
+    def q(self) -> int:
+        """Number of calibration parameters."""
+        return self.t_unit.shape[1]
+
+    @property
+    def p_u(self) -> int:
+        """Number of basis vectors."""
+        return self.K.shape[1]
+
+    @property
+    def l_sim(self) -> int:
+        """Length of one output."""
+        return self.K.shape[0]
+
+    @property
+    def zt(self) -> np.ndarray:
+        """Unit-scale design (m, p + q)."""
+        return np.hstack([self.x_unit, self.t_unit])
+
+    @property
+    def domain(self) -> dict[str, tuple[float, float]]:
+        """Training range of every input, native units: name -> (lo, hi)."""
+        s = self.standardizer
+        out = {
+            n: (float(a), float(b)) for n, a, b in zip(self.x_names, s.x_min, s.x_max, strict=True)
+        }
+        out.update(
+            {
+                n: (float(a), float(b))
+                for n, a, b in zip(self.t_names, s.t_min, s.t_max, strict=True)
+            }
+        )
+        return out
+
+    @property
+    def n_draws(self) -> int:
+        """Number of retained posterior draws."""
+        return self.log_post.shape[0]
+
+    # --- prediction ---------------------------------------------------------------------------
+    def _factor(self, params: dict[str, np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Per component: (Cholesky factor of Sigma_W_j, Sigma_W_j^-1 w_j)."""
+        out = []
+        zt = self.zt
+        for j in range(self.p_u):
+            S = correlation(zt, None, params["betaU"][:, j]) / params["lamUz"][j]
+            nug = 1.0 / (self.lam_sim[j] * params["lamWOs"][0]) + 1.0 / params["lamWs"][j]
+            S[np.diag_indices(self.m)] += nug
+            L = lower_cholesky(S)
+            if L is None:
+                raise GPMSAError("Sigma_W is not positive definite at these parameters")
+            L = np.tril(L)
+            out.append((L, cho_solve((L, True), self.w[:, j])))
+        return out
+
+    def _point_factor(self):
+        if -1 not in self._factors:
+            self._factors[-1] = self._factor(self.params)
+        return self._factors[-1]
+
+    def _inputs(self, x, t) -> np.ndarray:
+        x = as_matrix(x, "x", ncols=self.p) if np.ndim(x) != 1 or self.p != 1 else as_matrix(x, "x")
+        t = as_matrix(t, "t", ncols=self.q) if np.ndim(t) != 1 or self.q != 1 else as_matrix(t, "t")
+        if x.shape[0] != t.shape[0]:
+            if x.shape[0] == 1:
+                x = np.repeat(x, t.shape[0], axis=0)
+            elif t.shape[0] == 1:
+                t = np.repeat(t, x.shape[0], axis=0)
+            else:
+                raise GPMSAError(
+                    f"x and t need the same number of rows, got {x.shape} and {t.shape}"
+                )
+        z = np.hstack([self.standardizer.x_to_unit(x), self.standardizer.t_to_unit(t)])
+        names = self.x_names + self.t_names
+        lo, hi = z.min(axis=0), z.max(axis=0)
+        far = (lo < -DOMAIN_MARGIN) | (hi > 1 + DOMAIN_MARGIN)
+        if far.any():
+            k = int(np.flatnonzero(far)[0])
+            col = np.hstack([x, t])[:, k]
+            a, b = self.domain[names[k]]
+            raise GPMSAError(
+                f"{names[k]} reaches [{col.min():.6g}, {col.max():.6g}], outside the emulator's "
+                f"domain [{a:.6g}, {b:.6g}] by more than {DOMAIN_MARGIN:.0%} of its width"
+            )
+        if (lo < 0).any() or (hi > 1).any():
+            warnings.warn("predict() extrapolates beyond the training domain", stacklevel=3)
+        return z
+
+    def _predict_std(self, z: np.ndarray, params, factors, resid: bool):
+        mean = np.zeros((z.shape[0], self.l_sim))
+        var = np.zeros((z.shape[0], self.l_sim))
+        for j, (L, a) in enumerate(factors):
+            r = correlation(z, self.zt, params["betaU"][:, j]) / params["lamUz"][j]
+            mw = r @ a
+            v = solve_triangular(L, r.T, lower=True)
+            vw = 1.0 / params["lamUz"][j] - np.sum(v**2, axis=0)
+            if resid:
+                vw = vw + 1.0 / params["lamWs"][j]
+            mean += np.outer(mw, self.K[:, j])
+            var += np.outer(vw, self.K[:, j] ** 2)
+        if resid:
+            var += 1.0 / params["lamWOs"][0]
+        return mean, var
+
+    def predict(
+        self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Predictive mean and variance (N, l_sim) of the simulator output in native units.
+
+        x (N, p) known inputs and t (N, q) parameters, native units (a single row broadcasts).
+        ``draws=False``: at the point estimate ``params``; ``draws=True``: averaged over the
+        retained posterior draws (the first ``n_draws`` of them evenly spaced), combining the
+        variances by the law of total variance. ``resid`` adds the nugget 1/lamWs and the residual
+        variance 1/lamWOs (the spread of a new simulation run about the smooth emulator).
+        """
+        z = self._inputs(x, t)
+        s = self.standardizer
+        if not draws:
+            m, v = self._predict_std(z, self.params, self._point_factor(), resid)
+            return s.y_from_std(m), s.var_from_std(v)
+        if not self.draws:
+            raise GPMSAError("this emulator has no posterior draws (built by from_params)")
+        idx = np.arange(self.n_draws)
+        if n_draws is not None:
+            idx = np.unique(np.linspace(0, self.n_draws - 1, max(1, n_draws)).astype(int))
+        means, vars_ = [], []
+        for i in idx:
+            prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
+            m, v = self._predict_std(z, prm, self._factor(prm), resid)
+            means.append(m)
+            vars_.append(v)
+        means, vars_ = np.array(means), np.array(vars_)
+        mean = means.mean(axis=0)
+        var = vars_.mean(axis=0) + means.var(axis=0)
+        return s.y_from_std(mean), s.var_from_std(var)
+
+    # --- checks -------------------------------------------------------------------------------
+    def loo(self) -> LooResult:
+        """Exact leave-one-out cross-validation at the point estimate (Cholesky of Sigma_W).
+
+        For component j: mean_i = w_i - [S^-1 w]_i / [S^-1]_ii, var_i = 1 / [S^-1]_ii (the
+        nugget included); outputs through K, plus the residual 1/lamWOs for l_sim > 1.
+        """
+        mean_w = np.zeros((self.m, self.p_u))
+        var_w = np.zeros((self.m, self.p_u))
+        for j, (L, a) in enumerate(self._point_factor()):
+            Linv = solve_triangular(L, np.eye(self.m), lower=True)
+            d = np.sum(Linv**2, axis=0)
+            mean_w[:, j] = self.w[:, j] - a / d
+            var_w[:, j] = 1.0 / d
+        mean = mean_w @ self.K.T
+        var = var_w @ (self.K**2).T
+        if self.l_sim > 1:
+            var = var + 1.0 / self.params["lamWOs"][0]
+        s = self.standardizer
+        mean, var = s.y_from_std(mean), s.var_from_std(var)
+        z = (self.y - mean) / np.sqrt(var)
+        rmse = np.sqrt(np.mean((self.y - mean) ** 2, axis=0))
+        return LooResult(mean, var, z, rmse, float(np.mean(np.abs(z) < 1.959964)))
+
+    def to_arviz(self):
+        """ArviZ InferenceData of the retained draws (chains as fitted)."""
+        from gpmsa.diagnostics import to_inference_data
+
+        n_ch = int(self.settings.get("n_chains", 1)) or 1
+        if self.n_draws == 0:
+            raise GPMSAError("this emulator has no posterior draws (built by from_params)")
+        per = self.n_draws // n_ch
+        draws = {k: v[: per * n_ch].reshape(n_ch, per, *v.shape[1:]) for k, v in self.draws.items()}
+        if self.calibration:
+            for k, v in self.calibration.items():
+                draws[k] = v[: per * n_ch].reshape(n_ch, per, *v.shape[1:])
+        return to_inference_data(draws, self.log_post[: per * n_ch].reshape(n_ch, per))
+
+    def theta_summary(self) -> dict[str, dict[str, float]]:
+        """Posterior of the calibration parameters (native units) from a joint sim+obs fit."""
+        if not self.calibration:
+            raise GPMSAError("no calibration draws: fit was run without obs=")
+        th = self.calibration["theta_native"]
+        out = {}
+        for k, name in enumerate(self.t_names):
+            col = th[:, k]
+            q = np.quantile(col, [0.025, 0.5, 0.975])
+            out[name] = {"mean": float(col.mean()), "sd": float(col.std(ddof=1)),
+                         "q2.5": float(q[0]), "q50": float(q[1]), "q97.5": float(q[2])}  # fmt: skip
+        return out
+
+    def save(self, path: str | Path) -> Path:
+        """Write the emulator file (see docs/emulator-file.md); returns the path."""
+        from gpmsa.fileformat import save
+
+        return save(self, path)
+
+    def __repr__(self) -> str:
+        return (
+            f"Emulator(m={self.m}, x={list(self.x_names)}, t={list(self.t_names)}, "
+            f"y={self.l_sim} outputs, p_u={self.p_u}, draws={self.n_draws})"
+        )

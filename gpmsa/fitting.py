@@ -1,0 +1,108 @@
+"""``gpmsa.fit``: fit the GPM/SA emulator (optionally jointly with observations) by MCMC."""
+
+from __future__ import annotations
+
+import math
+from datetime import datetime, timezone
+
+import numpy as np
+
+from gpmsa import backends
+from gpmsa.data import ObsData, SimData
+from gpmsa.diagnostics import summarize
+from gpmsa.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.errors import GPMSAError
+from gpmsa.priors import Priors
+from gpmsa.problem import prepare
+
+N_KEEP = 1000
+"""Default number of retained draws (all chains together) after burn-in and thinning."""
+
+
+def _seed(seed):
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(2**63))
+    if seed is not None and not isinstance(seed, (int, np.integer)):
+        raise GPMSAError(f"seed must be an int, a numpy Generator or None, got {seed!r}")
+    return None if seed is None else int(seed)
+
+
+def fit(
+    data: SimData,
+    obs: ObsData | None = None,
+    n_iter: int = 30_000,
+    tune: bool = True,
+    n_chains: int = 1,
+    backend: str = "numpy",
+    seed=None,
+    progress: bool = False,
+    priors: Priors | None = None,
+    *,
+    n_burn: int | None = None,
+    n_keep: int = N_KEEP,
+    point: str = "mean",
+    n_pc: int | None = None,
+    discrepancy=None,
+    step_widths: dict | None = None,
+    metadata: dict | None = None,
+    **options,
+) -> Emulator:
+    """Fit the emulator by GPM/SA's Metropolis-within-Gibbs; returns an ``Emulator``.
+
+    data: the simulation runs. obs: field data for GPM/SA's classic joint calibration (theta and
+    lamOs are sampled together with the emulator; the draws land in ``Emulator.calibration``).
+    n_iter: sweeps per chain after step-size tuning (``tune``: 50 rounds x 20 levels).
+    n_burn: sweeps discarded per chain (default n_iter // 5). n_keep: retained draws in all
+    (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
+    posterior) for ``Emulator.params``. n_pc: basis size (default: 99.5% of the variance).
+    discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. options: passed to the
+    backend's ``sample``.
+    """
+    if not isinstance(n_iter, (int, np.integer)) or n_iter < 2:
+        raise GPMSAError(f"n_iter must be an integer >= 2, got {n_iter!r}")
+    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
+        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    n_burn = n_iter // 5 if n_burn is None else int(n_burn)
+    if not 0 <= n_burn < n_iter:
+        raise GPMSAError(f"n_burn must be in [0, n_iter) = [0, {n_iter}), got {n_burn}")
+    if point not in ("mean", "map"):
+        raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
+    if n_keep < 1:
+        raise GPMSAError(f"n_keep must be >= 1, got {n_keep}")
+    seed = _seed(seed)
+    prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
+    module = backends.get(backend)
+    chains = module.sample(
+        prep.problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
+        step_widths=step_widths, seed=seed, progress=progress, **options,
+    )  # fmt: skip
+    kept = n_iter - n_burn
+    thin = max(1, math.ceil(n_chains * kept / n_keep))
+    post = {k: v[:, n_burn:] for k, v in chains.draws.items()}
+    lp = chains.log_post[:, n_burn:]
+    retained = {k: v[:, ::thin].reshape(-1, *v.shape[2:]) for k, v in post.items()}
+    lp_kept = lp[:, ::thin].reshape(-1)
+    if point == "mean":
+        params = {k: retained[k].mean(axis=0) for k in EMULATOR_PARAMS}
+    else:
+        best = int(np.argmax(lp_kept))
+        params = {k: retained[k][best].copy() for k in EMULATOR_PARAMS}
+    calibration = None
+    if obs is not None:
+        calibration = {k: v for k, v in retained.items() if k not in EMULATOR_PARAMS}
+        calibration["theta_native"] = prep.standardizer.t_from_unit(calibration["theta"])
+    settings = {
+        "n_iter": int(n_iter), "n_burn": n_burn, "thin": thin, "n_chains": int(n_chains),
+        "tune": bool(tune), "backend": backend, "seed": seed, "point": point,
+        "n_pc": int(prep.K.shape[1]), "joint_obs": obs is not None,
+        "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
+        else "given",
+        "step_widths": {k: v.tolist() for k, v in chains.step_widths.items()},
+        "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+    }  # fmt: skip
+    return Emulator._from_prepared(
+        data, prep, params,
+        draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,
+        metadata=metadata, settings=settings,
+        diagnostics=summarize(post, chains.accept_rate), calibration=calibration,
+    )  # fmt: skip

@@ -1,0 +1,248 @@
+"""Posterior draws (``Chains``) and the numpy Metropolis-within-Gibbs sampler in GPM/SA's order.
+
+Each sweep updates every scalar element of the sampled parameters once, in the order theta,
+betaV, betaU, lamVz, lamUz, lamWs, lamWOs, lamOs (betaU element order: input index fastest, as
+GPM/SA's column-major loop). Proposals: uniform random walk (theta; beta on the rho = exp(-beta/4)
+scale; precisions). Untuned precisions use GPM/SA's proportional step (width max(1, x/3)) with its
+Hastings correction. A proposal outside the prior bounds is rejected without a likelihood call.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from gpmsa import tuning
+from gpmsa.likelihood import IncrementalLikelihood
+from gpmsa.problem import Problem
+
+DEFAULT_WIDTHS = {"theta": 0.2, "betaU": 0.1, "betaV": 0.1, "lamVz": 10.0, "lamUz": 5.0,
+                  "lamWs": 100.0, "lamWOs": 100.0}  # fmt: skip
+"""GPM/SA's initial step widths; lamOs starts at half its initial value."""
+
+RHO_PARAMS = ("betaU", "betaV")
+PRECISION_PARAMS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
+
+
+@dataclass
+class Chains:
+    """Posterior draws of several chains.
+
+    draws: name -> (n_chains, n_draws, *shape); log_post (n_chains, n_draws); accept_rate:
+    name -> (n_chains, *shape) fraction of accepted proposals after tuning; step_widths:
+    name -> (n_chains, *shape) the widths used (tuned, or given); info: free-form settings.
+    """
+
+    draws: dict[str, np.ndarray]
+    log_post: np.ndarray
+    accept_rate: dict[str, np.ndarray]
+    step_widths: dict[str, np.ndarray]
+    info: dict = field(default_factory=dict)
+
+    @property
+    def n_chains(self) -> int:
+        """Number of chains."""
+        return self.log_post.shape[0]
+
+    @property
+    def n_draws(self) -> int:
+        """Draws per chain."""
+        return self.log_post.shape[1]
+
+    def to_arviz(self):
+        """ArviZ ``InferenceData`` of the draws (arviz imported lazily)."""
+        from gpmsa.diagnostics import to_inference_data
+
+        return to_inference_data(self.draws, self.log_post)
+
+
+def default_widths(problem: Problem) -> dict[str, np.ndarray]:
+    """GPM/SA's default step widths, one per element."""
+    out = {}
+    for name in problem.names:
+        shape = problem.init[name].shape
+        if name == "lamOs":
+            out[name] = np.full(shape, problem.init["lamOs"][0] / 2.0)
+        else:
+            out[name] = np.full(shape, DEFAULT_WIDTHS[name])
+    return out
+
+
+def elements(problem: Problem) -> list[tuple[str, tuple[int, ...]]]:
+    """(name, index) of every sampled scalar element, in sweep order."""
+    out = []
+    for name in problem.sampled:
+        shape = problem.init[name].shape
+        if len(shape) == 2:  # column-major, as GPM/SA
+            out += [(name, (k, j)) for j in range(shape[1]) for k in range(shape[0])]
+        else:
+            out += [(name, (k,)) for k in range(shape[0])]
+    return out
+
+
+class ChainState:
+    """One chain: current parameters, incremental likelihood, and the sweep.
+
+    ``els`` restricts the sweep to some (name, index) elements (default: every sampled one).
+    """
+
+    def __init__(
+        self,
+        problem: Problem,
+        params: dict[str, np.ndarray],
+        rng: np.random.Generator,
+        els: list[tuple[str, tuple[int, ...]]] | None = None,
+    ):
+        self.problem = problem
+        self.rng = rng
+        self.lik = IncrementalLikelihood(problem, params)
+        self.els = elements(problem) if els is None else list(els)
+        self.kinds = [
+            1 if n in RHO_PARAMS else 2 if n in PRECISION_PARAMS else 0 for n, _ in self.els
+        ]
+        self.prior = problem.priors.log_prior
+        self.el_prior = [problem.priors.scalar_log_prior(n) for n, _ in self.els]
+        self.log_prior = sum(self.prior(n, self.lik.params[n]) for n in problem.sampled)
+
+    @property
+    def params(self) -> dict[str, np.ndarray]:
+        """Current parameter values."""
+        return self.lik.params
+
+    def log_post(self) -> float:
+        """Current log posterior (likelihood + priors of the sampled parameters)."""
+        return self.lik.loglik + self.log_prior
+
+    def sweep(self, widths: np.ndarray, prop_mh: bool, accepted: np.ndarray) -> None:
+        """One Metropolis-within-Gibbs sweep; adds 1 to ``accepted[i]`` per accepted element."""
+        lik = self.lik
+        u = self.rng.random((len(self.els), 2))
+        for i, (name, idx) in enumerate(self.els):
+            kind = self.kinds[i]
+            x = float(lik.params[name][idx])
+            corr = 0.0
+            step = u[i, 0] - 0.5
+            if kind == 1:
+                r = math.exp(-0.25 * x) + widths[i] * step
+                if r <= 0.0:
+                    continue
+                cand = -4.0 * math.log(r)
+            elif kind == 2 and prop_mh:
+                w0 = max(1.0, x / 3.0)
+                cand = x + w0 * 2.0 * step
+                w1 = max(1.0, cand / 3.0)
+                if x > cand + w1:
+                    continue
+                corr = math.log(w0 / w1)
+            else:
+                cand = x + widths[i] * step
+            prior = self.el_prior[i]
+            lp_new = prior(cand)
+            if lp_new == -math.inf:
+                continue
+            ll_old = lik.loglik
+            ll_new = lik.propose(name, idx, cand)
+            if ll_new == -math.inf:
+                continue
+            lp_old = prior(x)
+            if math.log(u[i, 1]) < ll_new - ll_old + lp_new - lp_old + corr:
+                lik.accept()
+                self.log_prior += lp_new - lp_old
+                accepted[i] += 1
+
+
+def _flat_widths(problem: Problem, els, widths: dict[str, np.ndarray]) -> np.ndarray:
+    return np.array([float(widths[n][idx]) for n, idx in els])
+
+
+def run_chain(
+    problem: Problem,
+    n_iter: int,
+    *,
+    tune: bool,
+    widths: dict[str, np.ndarray],
+    rng: np.random.Generator,
+    tune_rounds: int = tuning.N_BURN,
+    tune_levels: int = tuning.N_LEVELS,
+    progress: bool = False,
+    desc: str = "MCMC",
+) -> tuple[dict[str, np.ndarray], np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Tune (optionally), then ``n_iter`` sweeps. Returns draws, log_post, accept rates, widths."""
+    from tqdm.auto import tqdm
+
+    state = ChainState(problem, problem.init, rng)
+    els = state.els
+    w = _flat_widths(problem, els, widths)
+    total = n_iter + (tune_rounds * tune_levels if tune else 0)
+    bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    with threadpool_limits(1):
+        if tune and els:
+            names = [n for n, _ in els]
+            cands = tuning.level_widths(names, w, tune_levels)
+            acc = np.zeros((tune_levels, len(els)))
+            for _ in range(tune_rounds):
+                for lev in range(tune_levels):
+                    state.sweep(cands[lev], False, acc[lev])
+                bar.update(tune_levels)
+            w = tuning.choose_widths(w, cands, acc, tune_rounds)
+        draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
+        log_post = np.empty(n_iter)
+        accepted = np.zeros(len(els))
+        prop_mh = not tune
+        names = problem.names
+        for it in range(n_iter):
+            state.sweep(w, prop_mh, accepted)
+            prm = state.params
+            for n in names:
+                draws[n][it] = prm[n]
+            log_post[it] = state.log_post()
+            if it % 100 == 99:
+                bar.update(100)
+        bar.update(n_iter % 100)
+    bar.close()
+    rate = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
+    wid = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
+    for i, (n, idx) in enumerate(els):
+        rate[n][idx] = accepted[i] / max(n_iter, 1)
+        wid[n][idx] = w[i]
+    return draws, log_post, rate, wid
+
+
+def sample(
+    problem: Problem,
+    *,
+    n_iter: int,
+    n_chains: int = 1,
+    tune: bool = True,
+    step_widths: dict[str, np.ndarray] | None = None,
+    seed=None,
+    progress: bool = False,
+    tune_rounds: int = tuning.N_BURN,
+    tune_levels: int = tuning.N_LEVELS,
+) -> Chains:
+    """Run ``n_chains`` independent chains (sequentially) of ``n_iter`` sweeps after tuning."""
+    widths = default_widths(problem)
+    if step_widths:
+        for name, val in step_widths.items():
+            widths[name] = np.broadcast_to(np.asarray(val, dtype=np.float64), widths[name].shape)
+    seeds = np.random.SeedSequence(seed).spawn(n_chains)
+    runs = [
+        run_chain(
+            problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(s),
+            tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress,
+            desc=f"chain {c + 1}/{n_chains}",
+        )
+        for c, s in enumerate(seeds)
+    ]  # fmt: skip
+    names = problem.names
+    return Chains(
+        draws={n: np.stack([r[0][n] for r in runs]) for n in names},
+        log_post=np.stack([r[1] for r in runs]),
+        accept_rate={n: np.stack([r[2][n] for r in runs]) for n in names},
+        step_widths={n: np.stack([r[3][n] for r in runs]) for n in names},
+        info={"n_iter": n_iter, "n_chains": n_chains, "tune": tune, "tune_rounds": tune_rounds,
+              "tune_levels": tune_levels, "seed": seed, "backend": "numpy"},
+    )  # fmt: skip

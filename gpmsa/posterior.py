@@ -1,0 +1,240 @@
+"""The result of a calibration: named posterior draws, and (fast path) an exact grid density."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+
+
+def trapezoid_weights(nodes: np.ndarray) -> np.ndarray:
+    """Trapezoid-rule weights (k,) of sorted nodes (k,)."""
+    h = np.diff(nodes)
+    w = np.zeros(nodes.size)
+    w[:-1] += 0.5 * h
+    w[1:] += 0.5 * h
+    return w
+
+
+@dataclass(frozen=True, eq=False)
+class GridMarginal:
+    """A 1-D posterior density known at the nodes of a sorted grid (native units).
+
+    Moments are trapezoid sums over the nodes (geometrically accurate for a smooth density that
+    is resolved by the grid); the CDF, quantiles and draws use the piecewise-linear interpolant of
+    the density, normalised by the same trapezoid sum.
+
+    Attributes:
+        nodes: (k,) strictly increasing parameter values.
+        density: (k,) density values (native units), trapezoid integral 1.
+        weights: (k,) trapezoid weights of the nodes.
+    """
+
+    nodes: np.ndarray
+    density: np.ndarray
+    weights: np.ndarray
+
+    @classmethod
+    def from_log_density(
+        cls, nodes: np.ndarray, log_density: np.ndarray, weights: np.ndarray | None = None
+    ) -> GridMarginal:
+        """Normalise exp(log_density) on ``nodes`` (any additive constant); ``weights``: the
+        grid's trapezoid weights when already known."""
+        nodes = np.asarray(nodes, dtype=float)
+        w = trapezoid_weights(nodes) if weights is None else weights
+        f = np.exp(log_density - np.max(log_density))
+        return cls(nodes, f / float(w @ f), w)
+
+    def _cell_mass(self) -> np.ndarray:
+        return 0.5 * np.diff(self.nodes) * (self.density[:-1] + self.density[1:])
+
+    def mean(self) -> float:
+        """Posterior mean."""
+        return float((self.weights * self.density) @ self.nodes)
+
+    def sd(self) -> float:
+        """Posterior standard deviation."""
+        d = self.nodes - self.mean()
+        return float(np.sqrt((self.weights * self.density) @ (d * d)))
+
+    def cdf(self, value: np.ndarray | float) -> np.ndarray:
+        """P(X <= value) under the piecewise-linear density."""
+        x = np.asarray(value, dtype=float)
+        cum = np.concatenate([[0.0], np.cumsum(self._cell_mass())])
+        k = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.nodes.size - 2)
+        a, h = self.nodes[k], np.diff(self.nodes)[k]
+        f0, f1 = self.density[k], self.density[k + 1]
+        t = np.clip(x - a, 0.0, h)
+        out = cum[k] + f0 * t + 0.5 * (f1 - f0) * t * t / h
+        return np.clip(out / cum[-1], 0.0, 1.0)
+
+    def ppf(self, q: np.ndarray | float) -> np.ndarray:
+        """Quantile function: the inverse of ``cdf`` (exact for the piecewise-linear density)."""
+        q = np.asarray(q, dtype=float)
+        mass = self._cell_mass()
+        cum = np.concatenate([[0.0], np.cumsum(mass)])
+        target = q * cum[-1]
+        k = np.clip(np.searchsorted(cum, target, side="right") - 1, 0, mass.size - 1)
+        a, h = self.nodes[k], np.diff(self.nodes)[k]
+        f0, f1 = self.density[k], self.density[k + 1]
+        r = target - cum[k]  # solve f0 t + (f1 - f0) t^2 / (2h) = r for t in [0, h]
+        slope = (f1 - f0) / h
+        denom = f0 + np.sqrt(np.maximum(f0 * f0 + 2.0 * slope * r, 0.0))
+        t = 2.0 * r / np.where(denom > 0.0, denom, 1.0)
+        return a + np.clip(t, 0.0, h)
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        """Independent draws from the piecewise-linear density."""
+        return self.ppf(rng.random(size))
+
+
+class Posterior:
+    """Posterior of a calibration, native units.
+
+    Args:
+        samples: name -> draws (n_draws,) for scalar parameters, or None when ``draw`` gives them.
+        grids: name -> GridMarginal, the exact grid representation of a parameter's marginal (the
+            fast path); summaries of that name come from it, not from draws.
+        draw: a callable returning the samples dict, called once on first access of ``samples``
+            (the fast path draws lazily so that an update costs nothing it does not need).
+        chains: name -> (n_chains, n_draws) the MCMC draws per chain (for ``to_arviz`` and traces).
+        info: how the posterior was computed (method, settings, timings).
+    """
+
+    def __init__(
+        self,
+        samples: dict[str, np.ndarray] | None = None,
+        *,
+        grids: dict[str, GridMarginal] | None = None,
+        draw: Callable[[], dict[str, np.ndarray]] | None = None,
+        chains: dict[str, np.ndarray] | None = None,
+        info: dict | None = None,
+    ) -> None:
+        if samples is None and draw is None:
+            raise GPMSAError("a Posterior needs samples or a draw callable")
+        self._samples = samples
+        self._draw = draw
+        self.grids = dict(grids or {})
+        self.chains = chains
+        self.info = dict(info or {})
+
+    @property
+    def samples(self) -> dict[str, np.ndarray]:
+        """Named draws, native units: name -> (n_draws,)."""
+        if self._samples is None:
+            self._samples = self._draw()
+        return self._samples
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Parameter names (calibration parameters first, then lamOs and others)."""
+        if self._samples is None and self.info.get("names"):
+            return tuple(self.info["names"])
+        return tuple(self.samples)
+
+    def _check(self, name: str) -> None:
+        if name not in self.grids and name not in self.names:
+            raise GPMSAError(f"unknown parameter {name!r}; this posterior has {self.names}")
+
+    def mean(self, name: str) -> float:
+        """Posterior mean of ``name``."""
+        self._check(name)
+        if name in self.grids:
+            return self.grids[name].mean()
+        return float(np.mean(self.samples[name]))
+
+    def sd(self, name: str) -> float:
+        """Posterior standard deviation of ``name``."""
+        self._check(name)
+        if name in self.grids:
+            return self.grids[name].sd()
+        return float(np.std(self.samples[name], ddof=1))
+
+    def quantile(self, name: str, q: float | np.ndarray) -> float | np.ndarray:
+        """Posterior quantile(s) of ``name`` at probability q in [0, 1]."""
+        self._check(name)
+        q_arr = np.asarray(q, dtype=float)
+        if np.any(~np.isfinite(q_arr)) or np.any((q_arr < 0) | (q_arr > 1)):
+            raise GPMSAError(f"q must lie in [0, 1], got {q}")
+        out = (
+            self.grids[name].ppf(q_arr)
+            if name in self.grids
+            else np.quantile(self.samples[name], q_arr)
+        )
+        return float(out) if np.ndim(out) == 0 else out
+
+    def interval(self, name: str, level: float = 0.9) -> tuple[float, float]:
+        """Central credible interval of ``name`` with probability ``level`` in (0, 1)."""
+        if not 0 < level < 1:
+            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        lo, hi = self.quantile(name, [(1 - level) / 2, (1 + level) / 2])
+        return float(lo), float(hi)
+
+    def prob_above(self, name: str, value: float) -> float:
+        """P(name > value) under the posterior (e.g. P(GD > GDmax) for a risk posture)."""
+        self._check(name)
+        if not np.isfinite(value):
+            raise GPMSAError(f"value must be finite, got {value}")
+        if name in self.grids:
+            return float(1.0 - self.grids[name].cdf(value))
+        return float(np.mean(self.samples[name] > value))
+
+    def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
+        """name -> {mean, sd, q_lo, median, q_hi, n_draws, exact_grid} (the interval at
+        ``level``; MCMC posteriors add the bulk ESS)."""
+        out = {}
+        for name in self.names:
+            lo, hi = self.interval(name, level)
+            out[name] = {
+                "mean": self.mean(name),
+                "sd": self.sd(name),
+                f"q{100 * (1 - level) / 2:g}": lo,
+                "median": float(self.quantile(name, 0.5)),
+                f"q{100 * (1 + level) / 2:g}": hi,
+                "n_draws": int(np.size(self.samples[name])),
+                "exact_grid": name in self.grids,
+            }
+            if self.chains is not None:
+                from gpmsa.diagnostics import ess
+
+                out[name]["ess"] = ess(np.atleast_2d(self.chains[name]))
+        return out
+
+    def to_arviz(self):
+        """ArviZ InferenceData of the draws (arviz imported lazily)."""
+        from gpmsa.diagnostics import to_inference_data
+
+        if self.chains is not None:
+            return to_inference_data({k: np.asarray(v) for k, v in self.chains.items()})
+        return to_inference_data({k: np.asarray(v)[None, :] for k, v in self.samples.items()})
+
+    def plot(self, name: str, bins: int = 50):
+        """Histogram (with the grid density when there is one) and trace of ``name``: a Figure."""
+        from matplotlib.figure import Figure
+
+        self._check(name)
+        fig = Figure(figsize=(9.0, 3.5))
+        ax_h, ax_t = fig.subplots(1, 2)
+        draws = np.asarray(self.samples[name])
+        ax_h.hist(draws, bins=bins, density=True, color="0.75", label="draws")
+        if name in self.grids:
+            g = self.grids[name]
+            ax_h.plot(g.nodes, g.density, color="C0", label="exact (grid)")
+        ax_h.axvline(self.mean(name), color="C3", lw=1, label="mean")
+        ax_h.set_xlabel(name)
+        ax_h.set_ylabel("density")
+        ax_h.legend(fontsize="small")
+        chains = self.chains[name] if self.chains is not None else draws[None, :]
+        for c, chain in enumerate(np.atleast_2d(chains)):
+            ax_t.plot(chain, lw=0.5, color=f"C{c}")
+        ax_t.set_xlabel("draw")
+        ax_t.set_ylabel(name)
+        fig.tight_layout()
+        return fig
+
+    def __repr__(self) -> str:
+        parts = [f"{n}={self.mean(n):.4g}±{self.sd(n):.3g}" for n in self.names[:3]]
+        return f"Posterior({', '.join(parts)}, method={self.info.get('method', '?')})"

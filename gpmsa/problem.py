@@ -1,0 +1,280 @@
+"""The sampling problem: everything a backend needs, in unit/standardised units."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve
+
+from gpmsa.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
+from gpmsa.data import ObsData, SimData
+from gpmsa.errors import GPMSAError
+from gpmsa.priors import Priors
+from gpmsa.transforms import Standardizer
+
+ORDER = ("theta", "betaV", "betaU", "lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
+"""GPM/SA's sweep order; absent or fixed parameters are skipped."""
+
+X_OBS_MARGIN = 0.1
+"""Observations may lie this far (unit scale) outside the design's x range (warning); beyond it
+they are refused."""
+
+GLS_RIDGE = 1e-6
+SIGOBS_RIDGE = 1e-8
+
+
+@dataclass(frozen=True, eq=False)
+class ObsProblem:
+    """Observation side of the model, in unit/standardised units.
+
+    x (n, p) unit inputs; u (n, p_u) and v (n, p_v) the reduced data (GLS of y_obs on [D, K]);
+    sig_obs (N, N) the covariance of the stacked reduced data per unit lamOs (N = n (p_v + p_u),
+    or n for a scalar output, where u and v share one block). p_v: number of discrepancy basis
+    vectors (0: no discrepancy; a scalar output has v empty and p_v 0 or 1).
+    The stacked order is GPM/SA's:
+    v component 0 over all experiments, v component 1, ..., then u components likewise.
+    K, D: per-experiment bases on the observation grids (D None without discrepancy).
+    """
+
+    x: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    sig_obs: np.ndarray
+    scalar_out: bool
+    K: tuple[np.ndarray, ...]
+    D: tuple[np.ndarray, ...] | None
+    p_v: int = 0
+    y_std: tuple[np.ndarray, ...] = field(repr=False, default=())
+
+    def __post_init__(self) -> None:
+        if not self.scalar_out and self.p_v != self.v.shape[1]:
+            raise GPMSAError(f"p_v = {self.p_v} but v has {self.v.shape[1]} columns")
+
+    @property
+    def n(self) -> int:
+        """Number of experiments."""
+        return self.x.shape[0]
+
+    @property
+    def z(self) -> np.ndarray:
+        """Stacked reduced data (N,): [v comps; u comps], or u for a scalar output."""
+        if self.scalar_out:
+            return self.u[:, 0].copy()
+        return np.concatenate([self.v.T.reshape(-1), self.u.T.reshape(-1)])
+
+
+@dataclass(frozen=True, eq=False)
+class Problem:
+    """What every sampler works on (unit scale inputs, standardised outputs).
+
+    x_sim (m, p), t_sim (m, q) on [0, 1]; w (m, p_u) basis weights; lam_sim (p_u,) = diag(K^T K);
+    priors (with data corrections); init: initial value of every parameter; fixed: names held
+    at their init value; obs: the observation side (None: the sim-only emulator model).
+    """
+
+    x_sim: np.ndarray
+    t_sim: np.ndarray
+    w: np.ndarray
+    lam_sim: np.ndarray
+    priors: Priors
+    init: dict[str, np.ndarray]
+    fixed: frozenset[str] = frozenset()
+    obs: ObsProblem | None = None
+
+    @property
+    def m(self) -> int:
+        """Number of simulation runs."""
+        return self.x_sim.shape[0]
+
+    @property
+    def p(self) -> int:
+        """Number of known inputs."""
+        return self.x_sim.shape[1]
+
+    @property
+    def q(self) -> int:
+        """Number of calibration parameters."""
+        return self.t_sim.shape[1]
+
+    @property
+    def p_u(self) -> int:
+        """Number of emulator basis vectors."""
+        return self.w.shape[1]
+
+    @property
+    def zt(self) -> np.ndarray:
+        """Simulation design (m, p + q) = [x_sim, t_sim]."""
+        return np.hstack([self.x_sim, self.t_sim])
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Parameters of this model in sweep order (fixed ones included)."""
+        return tuple(n for n in ORDER if n in self.init)
+
+    @property
+    def sampled(self) -> tuple[str, ...]:
+        """Parameters updated by the sampler, in sweep order."""
+        return tuple(n for n in self.names if n not in self.fixed)
+
+    def with_init(self, values: dict[str, np.ndarray], fixed: frozenset[str] | None = None):
+        """A copy with some initial values replaced (and optionally a new fixed set)."""
+        init = dict(self.init)
+        for name, val in values.items():
+            if name not in init:
+                raise GPMSAError(f"unknown parameter {name!r}; this model has {self.names}")
+            val = np.array(val, dtype=np.float64).reshape(init[name].shape)
+            init[name] = val
+        return Problem(
+            self.x_sim, self.t_sim, self.w, self.lam_sim, self.priors, init,
+            self.fixed if fixed is None else frozenset(fixed), self.obs,
+        )  # fmt: skip
+
+
+def default_init(p: int, q: int, p_u: int, priors: Priors, obs: ObsProblem | None) -> dict:
+    """GPM/SA's initial values (the table in docs/internals.md)."""
+    lw = priors.lamWOs
+    init = {
+        "betaU": np.full((p + q, p_u), 0.1),
+        "lamUz": np.ones(p_u),
+        "lamWs": np.full(p_u, 1000.0),
+        "lamWOs": np.array([min(max(100.0, lw.a / lw.b), 1e5 - 1.0)]),
+    }
+    if obs is not None:
+        lo = priors.lamOs
+        init["theta"] = np.full(q, 0.5)
+        init["lamOs"] = np.array([max(20.0, lo.a / lo.b)])
+        if obs.p_v > 0:
+            init["betaV"] = np.full((p, 1), 0.1)
+            init["lamVz"] = np.array([20.0])
+    return init
+
+
+def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
+    """Warn when observations lie outside the design range; refuse beyond ``X_OBS_MARGIN``."""
+    lo, hi = x_unit.min(axis=0), x_unit.max(axis=0)
+    far = (lo < -X_OBS_MARGIN) | (hi > 1 + X_OBS_MARGIN)
+    if far.any():
+        k = int(np.flatnonzero(far)[0])
+        raise GPMSAError(
+            f"x_obs column {names[k]} reaches {lo[k]:.3g}..{hi[k]:.3g} on the unit scale of the "
+            f"design; allowed [{-X_OBS_MARGIN}, {1 + X_OBS_MARGIN}] (the emulator cannot "
+            "extrapolate that far)"
+        )
+    if (lo < 0).any() or (hi > 1).any():
+        warnings.warn(
+            "x_obs lies outside the simulation design's range; the emulator extrapolates there",
+            stacklevel=3,
+        )
+
+
+def reduce_obs(
+    obs: ObsData, std: Standardizer, K: np.ndarray, discrepancy, x_names: tuple[str, ...]
+) -> tuple[ObsProblem, tuple[float, float]]:
+    """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db)."""
+    x = std.x_to_unit(obs.x)
+    if x.shape[1] != std.x_min.size:
+        raise GPMSAError(f"x_obs must have {std.x_min.size} columns, got {obs.x.shape[1]}")
+    check_x_obs(x, x_names)
+    n, p_u = obs.n, K.shape[1]
+    scalar = K.shape[0] == 1
+    for j, (e, g) in enumerate(zip(obs.experiments, obs.grids, strict=True)):
+        if not scalar and g is None and e.size != K.shape[0]:
+            raise GPMSAError(
+                f"experiment {j} has {e.size} values but the simulation output has {K.shape[0]}; "
+                "give ObsData an index grid"
+            )
+    ys = [std.y_to_std(e, g) for e, g in zip(obs.experiments, obs.grids, strict=True)]
+    lamy = [np.eye(e.size) for e in ys]
+    if obs.precisions is not None:
+        lamy = [lam * std.y_sd**2 for lam in obs.precisions]
+    if scalar:
+        if any(e.size != 1 for e in ys):
+            raise GPMSAError("a scalar simulation output needs one value per experiment in y_obs")
+        u = np.array([e[0] for e in ys])[:, None]
+        p_v = 0 if discrepancy is None else 1
+        if p_v and not (isinstance(discrepancy, str) and discrepancy == "constant"):
+            raise GPMSAError("a scalar output supports discrepancy=None or 'constant' only")
+        sig = np.diag([1.0 / (lam[0, 0] + SIGOBS_RIDGE) for lam in lamy])
+        Ks = tuple(np.ones((1, 1)) for _ in ys)
+        Ds = tuple(np.ones((1, 1)) for _ in ys) if p_v else None
+        v = np.zeros((n, 0))
+        obs_p = ObsProblem(x, u, v, sig, True, Ks, Ds, p_v, tuple(ys))
+        return obs_p, (0.0, 0.0)
+    Ks, Ds, vs, us, blocks = [], [], [], [], []
+    rank, total, ss = 0, 0, 0.0
+    for e, g, lam in zip(ys, obs.grids, lamy, strict=True):
+        Kj = interpolate_basis(K, std.grid, g)
+        Dj = discrepancy_basis(discrepancy, std.grid if g is None else g)
+        DK = Kj if Dj is None else np.hstack([Dj, Kj])
+        A = DK.T @ lam @ DK
+        ridge = A + GLS_RIDGE * np.eye(A.shape[0])
+        vu = cho_solve(cho_factor(ridge), DK.T @ lam @ e)
+        resid = e - DK @ vu
+        ss += float(resid @ lam @ resid)
+        rank += int(np.linalg.matrix_rank(A, hermitian=True))
+        total += e.size
+        blocks.append(
+            cho_solve(cho_factor(ridge + SIGOBS_RIDGE * np.eye(A.shape[0])), np.eye(A.shape[0]))
+        )
+        p_v = 0 if Dj is None else Dj.shape[1]
+        vs.append(vu[:p_v])
+        us.append(vu[p_v:])
+        Ks.append(Kj)
+        Ds.append(Dj)
+    p_v = vs[0].size
+    if any(v.size != p_v for v in vs):
+        raise GPMSAError("every experiment needs the same number of discrepancy basis vectors")
+    n_c = p_v + p_u
+    sig = np.zeros((n * n_c, n * n_c))
+    for e, blk in enumerate(blocks):
+        idx = np.arange(n_c) * n + e
+        sig[np.ix_(idx, idx)] = blk
+    obs_p = ObsProblem(
+        x, np.array(us), np.array(vs).reshape(n, p_v), sig, False,
+        tuple(Ks), None if p_v == 0 else tuple(Ds), p_v, tuple(ys),
+    )  # fmt: skip
+    return obs_p, (0.5 * (total - rank), 0.5 * ss)
+
+
+@dataclass(frozen=True, eq=False)
+class Prepared:
+    """A problem with the transforms and basis that produced it."""
+
+    problem: Problem
+    standardizer: Standardizer
+    K: np.ndarray
+
+
+def prepare(
+    sim: SimData,
+    obs: ObsData | None = None,
+    *,
+    priors: Priors | None = None,
+    n_pc: int | None = None,
+    discrepancy=None,
+) -> Prepared:
+    """Standardise, build the PCA basis and weights, reduce observations, set priors and inits."""
+    if not isinstance(sim, SimData):
+        raise GPMSAError(f"data must be a gpmsa.SimData, got {type(sim).__name__}")
+    if obs is not None and not isinstance(obs, ObsData):
+        raise GPMSAError(f"obs must be a gpmsa.ObsData or None, got {type(obs).__name__}")
+    std = Standardizer.from_sim(sim)
+    y_std = std.y_to_std(sim.y)
+    K = pca_basis(y_std, n_pc)
+    w = basis_weights(y_std, K)
+    lam_sim = np.sum(K**2, axis=0)
+    m, p_u = w.shape
+    wos = (0.5 * (sim.l_sim - p_u) * m, 0.5 * float(np.sum((y_std - w @ K.T) ** 2)))
+    if sim.l_sim == 1:
+        wos = (0.0, 0.0)
+    obs_p, os_corr = (None, (0.0, 0.0))
+    if obs is not None:
+        obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names)
+    priors = (priors or Priors()).with_data(wos, os_corr)
+    init = default_init(sim.p, sim.q, p_u, priors, obs_p)
+    prob = Problem(
+        std.x_to_unit(sim.x), std.t_to_unit(sim.t), w, lam_sim, priors, init, frozenset(), obs_p
+    )
+    return Prepared(prob, std, K)

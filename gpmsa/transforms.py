@@ -1,0 +1,80 @@
+"""Maps between native units and GPM/SA's unit-cube inputs and standardised outputs."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from gpmsa.data import SimData
+from gpmsa.errors import GPMSAError
+
+
+@dataclass(frozen=True, eq=False)
+class Standardizer:
+    """x, t -> [0, 1] by the design's min/max; y -> (y - mean) / sd with one scalar sd.
+
+    Attributes (native units): ``x_min``, ``x_max`` (p,), ``t_min``, ``t_max`` (q,),
+    ``y_mean`` (l_sim,) on the simulation grid ``grid`` (l_sim,), ``y_sd`` (scalar, ddof=1).
+    """
+
+    x_min: np.ndarray
+    x_max: np.ndarray
+    t_min: np.ndarray
+    t_max: np.ndarray
+    y_mean: np.ndarray
+    y_sd: float
+    grid: np.ndarray
+
+    @classmethod
+    def from_sim(cls, sim: SimData) -> Standardizer:
+        """GPM/SA's default transforms fitted to the simulation design and outputs."""
+        centred = sim.y - sim.y.mean(axis=0)
+        sd = float(np.std(centred, ddof=1))
+        if not sd > 0:
+            raise GPMSAError("the simulation outputs have zero spread after centring")
+        return cls(
+            x_min=sim.x.min(axis=0),
+            x_max=sim.x.max(axis=0),
+            t_min=sim.t.min(axis=0),
+            t_max=sim.t.max(axis=0),
+            y_mean=sim.y.mean(axis=0),
+            y_sd=sd,
+            grid=sim.grid.copy(),
+        )
+
+    def x_to_unit(self, x: np.ndarray) -> np.ndarray:
+        """Known inputs (n, p) native -> unit scale."""
+        return (np.asarray(x, dtype=np.float64) - self.x_min) / (self.x_max - self.x_min)
+
+    def x_from_unit(self, x: np.ndarray) -> np.ndarray:
+        """Known inputs (n, p) unit scale -> native."""
+        return np.asarray(x) * (self.x_max - self.x_min) + self.x_min
+
+    def t_to_unit(self, t: np.ndarray) -> np.ndarray:
+        """Parameters (n, q) native -> unit scale."""
+        return (np.asarray(t, dtype=np.float64) - self.t_min) / (self.t_max - self.t_min)
+
+    def t_from_unit(self, t: np.ndarray) -> np.ndarray:
+        """Parameters (n, q) unit scale -> native: theta * (t_max - t_min) + t_min."""
+        return np.asarray(t) * (self.t_max - self.t_min) + self.t_min
+
+    def mean_on(self, grid: np.ndarray | None) -> np.ndarray:
+        """The simulation mean interpolated onto ``grid`` (None: the simulation grid)."""
+        if grid is None or (grid.shape == self.grid.shape and np.array_equal(grid, self.grid)):
+            return self.y_mean
+        if self.y_mean.size == 1:
+            return np.full(grid.shape, self.y_mean[0])
+        return np.interp(grid, self.grid, self.y_mean)
+
+    def y_to_std(self, y: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:
+        """Outputs (..., l) native -> standardised, on ``grid`` (None: the simulation grid)."""
+        return (np.asarray(y, dtype=np.float64) - self.mean_on(grid)) / self.y_sd
+
+    def y_from_std(self, y: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:
+        """Outputs (..., l) standardised -> native."""
+        return np.asarray(y) * self.y_sd + self.mean_on(grid)
+
+    def var_from_std(self, var: np.ndarray) -> np.ndarray:
+        """Variances in standardised units -> native units^2."""
+        return np.asarray(var) * self.y_sd**2

@@ -1,0 +1,80 @@
+"""GPM/SA step-size tuning (``stepsize``, after Graves 2011): a binomial GLM per element.
+
+Candidate widths step0 * base^e, e = -(L-1)/2 .. (L-1)/2; ``n_burn`` rounds each run one sweep
+at every level; per element, a logistic regression of acceptance on log(width) picks the width
+with acceptance 1/e.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+TARGET = 1.0 / np.e
+N_BURN = 50
+N_LEVELS = 20
+
+
+def level_bases(name: str, n_levels: int) -> tuple[float, float]:
+    """(base for e <= 0, base for e > 0) of parameter ``name``, as in GPM/SA."""
+    up = 2.0
+    if n_levels > 1:
+        if name == "theta":
+            up = 20.0 ** (2.0 / (n_levels - 1))
+        elif name in ("betaU", "betaV"):
+            up = 10.0 ** (2.0 / (n_levels - 1))
+        elif name in ("lamUz", "lamOs"):
+            up = 100.0 ** (2.0 / (n_levels - 1))
+    return 2.0, up
+
+
+def level_widths(names: list[str], widths: np.ndarray, n_levels: int) -> np.ndarray:
+    """Candidate widths (n_levels, n_elements) for elements of parameters ``names``."""
+    ex = np.linspace(-(n_levels - 1) / 2, (n_levels - 1) / 2, n_levels)
+    out = np.empty((n_levels, len(names)))
+    for i, name in enumerate(names):
+        down, up = level_bases(name, n_levels)
+        base = np.where(ex <= 0, down, up)
+        out[:, i] = widths[i] * base**ex
+    return out
+
+
+def fit_logistic(x: np.ndarray, k: np.ndarray, n: int, ridge: float = 1e-6) -> np.ndarray | None:
+    """Binomial GLM (logit link) of k successes in n trials on x: returns (b0, b1) or None.
+
+    Newton-Raphson (IRLS) with a tiny ridge so that fully separated data still give a finite fit.
+    """
+    X = np.column_stack([np.ones_like(x), x])
+    b = np.zeros(2)
+    for _ in range(100):
+        eta = X @ b
+        p = 1.0 / (1.0 + np.exp(-eta))
+        grad = X.T @ (k - n * p) - ridge * b
+        H = (X * (n * p * (1 - p))[:, None]).T @ X + ridge * np.eye(2)
+        try:
+            step = np.linalg.solve(H, grad)
+        except np.linalg.LinAlgError:
+            return None
+        b = b + step
+        if np.max(np.abs(step)) < 1e-10 * (1 + np.max(np.abs(b))):
+            break
+    return b if np.all(np.isfinite(b)) else None
+
+
+def choose_widths(
+    widths: np.ndarray, candidates: np.ndarray, accepted: np.ndarray, n_burn: int
+) -> np.ndarray:
+    """Tuned width per element: where the fitted acceptance equals 1/e.
+
+    ``candidates`` (n_levels, n_el) widths, ``accepted`` (n_levels, n_el) acceptance counts out of
+    ``n_burn``. An element whose fit fails (or gives acceptance rising with width) keeps ``widths``.
+    """
+    logit = np.log(TARGET / (1 - TARGET))
+    out = widths.copy()
+    for i in range(widths.size):
+        b = fit_logistic(np.log(candidates[:, i]), accepted[:, i], n_burn)
+        if b is None or not b[1] < 0:
+            continue
+        w = np.exp((logit - b[0]) / b[1])
+        if np.isfinite(w) and w > 0:
+            out[i] = w
+    return out

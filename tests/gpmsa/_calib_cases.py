@@ -1,0 +1,87 @@
+"""Shared cases for the calibration tests: the road case and small synthetic emulators."""
+
+from __future__ import annotations
+
+import json
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+import gpmsa
+from gpmsa.emulator import Emulator
+
+DATA = Path(__file__).parent.parent / "data"
+
+
+@cache
+def road_case() -> dict:
+    """case.npz as a dict of arrays, plus the SEPIA calibration-only reference."""
+    case = dict(np.load(DATA / "case.npz", allow_pickle=False))
+    ref = json.loads((DATA / "reference_posteriors.json").read_text())
+    case["sepia_calibration_only"] = ref["sepia_calibration_only"]
+    return case
+
+
+@cache
+def road_emulator() -> Emulator:
+    """The road case's emulator at SEPIA's fixed (calibration-only) parameter values."""
+    case = road_case()
+    sim = gpmsa.SimData(
+        x=case["v"][:, None], t=case["GD"][:, None], y=case["f"][:, None],
+        x_names=["v"], t_names=["GD"], y_names=["f"],
+    )  # fmt: skip
+    params = case["sepia_calibration_only"]["fixed_emulator_params_unit_scale"]
+    return Emulator.from_params(sim, params)
+
+
+def road_obs() -> tuple[list[list[float]], list[list[float]]]:
+    """The road case's single observation (x_obs, y_obs), native units."""
+    case = road_case()
+    return [[float(case["v_obs"][0])]], [[float(case["f_obs"][0])]]
+
+
+@cache
+def two_param_emulator() -> Emulator:
+    """A scalar-output emulator with one x and two calibration parameters (q = 2)."""
+    rng = np.random.default_rng(7)
+    m = 60
+    x = rng.uniform(0, 1, m)
+    t = rng.uniform(0, 1, (m, 2))
+    y = np.sin(2.0 * x + 1.5 * t[:, 0]) + 0.8 * t[:, 1] * x
+    sim = gpmsa.SimData(x=x[:, None], t=t, y=y[:, None], x_names=["x"], t_names=["a", "b"])
+    params = {"betaU": [[1.0], [1.5], [0.8]], "lamUz": [1.0], "lamWs": [5000.0],
+              "lamWOs": [5000.0]}  # fmt: skip
+    return Emulator.from_params(sim, params)
+
+
+@cache
+def vector_emulator() -> Emulator:
+    """A vector-output emulator (l_sim = 8 on a grid, p_u = 2) with one x and one parameter."""
+    rng = np.random.default_rng(11)
+    m = 40
+    x = rng.uniform(0, 1, m)
+    t = rng.uniform(0, 1, m)
+    grid = np.linspace(0, 1, 8)
+    y = (1.0 + t[:, None]) * np.sin(np.pi * grid[None, :] * (0.5 + x[:, None])) + 0.3 * t[:, None]
+    sim = gpmsa.SimData(x=x[:, None], t=t[:, None], y=y, index=grid, x_names=["x"], t_names=["t"])
+    params = {"betaU": [[1.0, 1.0], [1.0, 1.0]], "lamUz": [1.0, 1.0], "lamWs": [5000.0, 5000.0],
+              "lamWOs": [5000.0]}  # fmt: skip
+    return Emulator.from_params(sim, params, n_pc=2)
+
+
+def with_draws(emu: Emulator, n: int = 5, seed: int = 3) -> Emulator:
+    """A copy of ``emu`` with ``n`` retained draws: its parameters perturbed by 10 % (lognormal)."""
+    rng = np.random.default_rng(seed)
+    draws = {
+        k: np.stack([v * np.exp(0.1 * rng.standard_normal(v.shape)) for _ in range(n)])
+        for k, v in emu.params.items()
+    }
+    out = Emulator(
+        standardizer=emu.standardizer, x_unit=emu.x_unit, t_unit=emu.t_unit, y=emu.y, K=emu.K,
+        w=emu.w, index=emu.index, params=emu.params, priors=emu.priors,
+        names={"x": emu.x_names, "t": emu.t_names, "y": emu.y_names},
+        units={"x": emu.x_units, "t": emu.t_units, "y": emu.y_units},
+        draws=draws, log_post=np.zeros(n),
+    )  # fmt: skip
+    return out

@@ -1,0 +1,95 @@
+"""``gpmsa calibrate`` and calibrated prediction."""
+
+import json
+import re
+
+import numpy as np
+import pytest
+from _calib_cases import road_emulator, road_obs
+
+from gpmsa import Calibrator, GPMSAError, Posterior, calibrate
+from gpmsa.cli import main
+from gpmsa.predictive import calibrated_predict
+
+
+@pytest.fixture(scope="module")
+def emu_file(tmp_path_factory):
+    return road_emulator().save(tmp_path_factory.mktemp("emu") / "road.gpmsa")
+
+
+def test_cli_prints_summary(emu_file, capsys):
+    assert main(["calibrate", str(emu_file), "--x", "v=1.25", "--y", "f=12.1"]) == 0
+    out = capsys.readouterr().out
+    assert "posterior (grid" in out and "GD" in out and "lamOs" in out
+    row = next(line for line in out.splitlines() if line.split()[0] == "GD").split()
+    post = Calibrator(road_emulator()).update([[1.25]], [[12.1]])
+    assert float(row[1]) == pytest.approx(post.mean("GD"), rel=1e-4)
+
+
+def test_cli_json(emu_file, capsys):
+    args = [
+        "calibrate",
+        str(emu_file),
+        "--x",
+        "v=1.25",
+        "--y",
+        "f=12.1",
+        "--json",
+        "--level",
+        "0.8",
+    ]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    gd = out["posterior"]["GD"]
+    assert out["method"] == "grid" and out["x"] == {"v": 1.25} and gd["exact_grid"]
+    assert gd["q10"] < gd["median"] < gd["q90"]
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (["--x", "w=1.25", "--y", "f=12.1"], r"--x needs exactly the names \['v'\]"),
+        (["--x", "v=fast", "--y", "f=12.1"], "is not a number"),
+        (["--x", "v=1.25", "--y", "f"], "expects NAME=VALUE"),
+        (["--x", "v=9", "--y", "f=12.1"], "outside the emulator's domain"),
+    ],
+)
+def test_cli_bad_input(emu_file, capsys, extra, match):
+    assert main(["calibrate", str(emu_file), *extra]) == 2
+    assert re.search(match, capsys.readouterr().err)
+
+
+def test_calibrated_prediction_grid_and_draws_agree():
+    emu = road_emulator()
+    x, y = road_obs()
+    post = Calibrator(emu, n_draws=20_000).update(x, y)
+    x_new = [[0.8], [1.25], [1.9]]
+    grid = calibrated_predict(emu, post, x_new)
+    draws = calibrated_predict(emu, Posterior(post.samples), x_new, n_theta=4000)
+    assert grid.weights.size > 50 and draws.weights.size == 4000
+    np.testing.assert_allclose(grid.mean, draws.mean, rtol=0.01)
+    np.testing.assert_allclose(np.sqrt(grid.var), np.sqrt(draws.var), rtol=0.05)
+    # at the observed speed the prediction reproduces the observation within its spread
+    assert abs(grid.mean[1, 0] - y[0][0]) < 2 * grid.sd[1, 0]
+
+
+def test_calibrated_prediction_quantiles_and_noise():
+    emu = road_emulator()
+    x, y = road_obs()
+    post = Calibrator(emu).update(x, y)
+    pred = calibrated_predict(emu, post, [[1.5]])
+    for q in (0.05, 0.5, 0.95):
+        assert pred.cdf(pred.quantile(q))[0, 0] == pytest.approx(q, abs=1e-9)
+    lo, hi = pred.interval(0.9)
+    assert lo[0, 0] < pred.mean[0, 0] < hi[0, 0]
+    noisy = calibrated_predict(emu, post, [[1.5]], noise=True)
+    assert noisy.var[0, 0] > pred.var[0, 0]
+    mc = calibrate(emu, x, y, seed=1)
+    via_mcmc = calibrated_predict(emu, mc, [[1.5]])
+    assert via_mcmc.mean[0, 0] == pytest.approx(pred.mean[0, 0], abs=0.5 * pred.sd[0, 0])
+    with pytest.raises(GPMSAError, match="q must lie in"):
+        pred.quantile(1.0)
+    with pytest.raises(GPMSAError, match="outside the emulator's domain"):
+        calibrated_predict(emu, post, [[5.0]])
+    with pytest.raises(GPMSAError, match="n_theta must be an integer >= 1"):
+        calibrated_predict(emu, post, [[1.5]], n_theta=0)

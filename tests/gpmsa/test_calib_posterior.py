@@ -1,0 +1,98 @@
+"""Posterior and its exact grid representation."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+from scipy.stats import norm
+
+from gpmsa import GPMSAError, Posterior
+from gpmsa.posterior import GridMarginal
+
+
+def gaussian_grid(mu=3.0, sd=0.7, n=201):
+    nodes = np.linspace(mu - 9 * sd, mu + 9 * sd, n)
+    return GridMarginal.from_log_density(nodes, norm.logpdf(nodes, mu, sd) + 17.0)
+
+
+def test_grid_moments_of_a_resolved_gaussian():
+    g = gaussian_grid()
+    assert g.mean() == pytest.approx(3.0, abs=1e-12)
+    assert g.sd() == pytest.approx(0.7, rel=1e-10)
+    assert float(np.sum(g.weights * g.density)) == pytest.approx(1.0, rel=1e-13)
+
+
+def test_grid_cdf_ppf_are_inverse_and_close_to_the_gaussian():
+    g = gaussian_grid()
+    q = np.array([0.001, 0.05, 0.3, 0.5, 0.9, 0.999])
+    x = g.ppf(q)
+    np.testing.assert_allclose(g.cdf(x), q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(x, norm.ppf(q, 3.0, 0.7), atol=2e-3)  # O(h^2) interpolation
+    assert g.cdf(-100.0) == 0.0 and g.cdf(100.0) == 1.0
+
+
+def test_grid_draws_follow_the_density():
+    g = gaussian_grid()
+    draws = g.sample(np.random.default_rng(0), 40_000)
+    se = 0.7 / np.sqrt(draws.size)
+    assert abs(draws.mean() - 3.0) < 4 * se
+    assert abs(draws.std() - 0.7) < 4 * 0.7 / np.sqrt(2 * draws.size) + 1e-3
+
+
+def test_posterior_from_samples():
+    rng = np.random.default_rng(1)
+    s = {"GD": rng.normal(400, 20, 20_000), "lamOs": rng.gamma(2.0, 500.0, 20_000)}
+    post = Posterior(s, info={"method": "mcmc"})
+    assert post.mean("GD") == pytest.approx(s["GD"].mean())
+    assert post.sd("GD") == pytest.approx(s["GD"].std(ddof=1))
+    lo, hi = post.interval("GD", 0.9)
+    assert lo == pytest.approx(np.quantile(s["GD"], 0.05))
+    assert hi == pytest.approx(np.quantile(s["GD"], 0.95))
+    assert post.prob_above("GD", 420) == pytest.approx(np.mean(s["GD"] > 420))
+    summ = post.summary()
+    assert set(summ) == {"GD", "lamOs"} and summ["GD"]["n_draws"] == 20_000
+    assert not summ["GD"]["exact_grid"]
+
+
+def test_posterior_grid_summaries_come_from_the_grid():
+    g = gaussian_grid(400.0, 20.0)
+    calls = []
+
+    def draw():
+        calls.append(1)
+        return {"GD": g.sample(np.random.default_rng(2), 1000)}
+
+    post = Posterior(grids={"GD": g}, draw=draw, info={"names": ("GD",)})
+    assert post.mean("GD") == pytest.approx(400.0, abs=1e-9)
+    assert post.prob_above("GD", 400.0) == pytest.approx(0.5, abs=1e-9)
+    assert post.quantile("GD", 0.95) == pytest.approx(norm.ppf(0.95, 400, 20), abs=0.1)
+    assert not calls  # draws are lazy
+    assert post.samples["GD"].shape == (1000,) and len(calls) == 1
+    assert post.samples["GD"].shape == (1000,) and len(calls) == 1  # drawn once
+
+
+def test_posterior_arviz_and_plot():
+    rng = np.random.default_rng(3)
+    chains = {"GD": rng.normal(400, 20, (2, 500)), "lamOs": rng.gamma(2.0, 500.0, (2, 500))}
+    post = Posterior({k: v.reshape(-1) for k, v in chains.items()}, chains=chains)
+    idata = post.to_arviz()
+    assert idata.posterior["GD"].shape == (2, 500)
+    fig = post.plot("GD")
+    assert isinstance(fig, Figure) and len(fig.axes) == 2
+
+
+def test_posterior_bad_arguments():
+    post = Posterior({"GD": np.arange(10.0)})
+    with pytest.raises(GPMSAError, match="unknown parameter 'gd'"):
+        post.mean("gd")
+    with pytest.raises(GPMSAError, match=r"q must lie in \[0, 1\], got 1.5"):
+        post.quantile("GD", 1.5)
+    with pytest.raises(GPMSAError, match=r"level must lie in \(0, 1\), got 1.0"):
+        post.interval("GD", 1.0)
+    with pytest.raises(GPMSAError, match="value must be finite"):
+        post.prob_above("GD", np.nan)
+    with pytest.raises(GPMSAError, match="needs samples or a draw"):
+        Posterior()

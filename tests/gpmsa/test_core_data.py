@@ -1,0 +1,200 @@
+"""Data validation, transforms and bases; bad input raises GPMSAError naming the problem."""
+
+import subprocess
+import sys
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+import gpmsa
+from gpmsa.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
+from gpmsa.problem import prepare
+from gpmsa.transforms import Standardizer
+
+
+def sim(m=20, p=1, q=1, l=1, seed=0, **kw):
+    rng = np.random.default_rng(seed)
+    x, t = rng.random((m, p)), rng.random((m, q))
+    y = np.sin(3 * x.sum(1, keepdims=True) + np.linspace(0, 1, l)) * (1 + t.sum(1, keepdims=True))
+    return gpmsa.SimData(x=x, t=t, y=y, **kw)
+
+
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"x": [[0.1], [np.nan]] * 10}, r"x must be finite, got nan at index \(1, 0\)"),
+        ({"y": np.r_[np.ones(19), np.inf]}, "y must be finite, got inf"),
+        ({"t": np.ones((21, 1))}, "same number of rows"),
+        (
+            {"x": np.c_[np.linspace(0, 1, 20), np.full(20, 3.0)]},
+            r"design column x\[:, 1\] is constant",
+        ),
+        ({"y": np.ones(20)}, "y is constant"),
+        ({"x": "abc"}, "x must be a numeric array"),
+        ({"x_names": ["a", "b"]}, "x_names must have 1 entries"),
+        ({"t_names": ["GD"], "t": np.ones((20, 1))}, "design column GD is constant"),
+        ({"index": [1, 2]}, "index must have 1 entries"),
+    ],
+)
+def test_simdata_bad_input(kw, match):
+    rng = np.random.default_rng(0)
+    base = {"x": rng.random((20, 1)), "t": rng.random((20, 1)), "y": rng.random(20)}
+    base.update(kw)
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        gpmsa.SimData(**base)
+
+
+def test_fewer_runs_than_parameters_refused():
+    rng = np.random.default_rng(0)
+    with pytest.raises(
+        gpmsa.GPMSAError, match=r"at least p \+ q \+ 2 = 6 simulation runs .* got 5"
+    ):
+        gpmsa.SimData(x=rng.random((5, 2)), t=rng.random((5, 2)), y=rng.random(5))
+    assert issubclass(gpmsa.GPMSAError, ValueError)
+
+
+def test_obsdata_bad_input_and_ragged():
+    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs\[0\] must be finite"):
+        gpmsa.ObsData(x=[[0.5]], y=[[np.nan]])
+    with pytest.raises(gpmsa.GPMSAError, match="one row per x_obs row"):
+        gpmsa.ObsData(x=[[0.5], [0.6]], y=[[1.0, 2.0, 3.0]])
+    with pytest.raises(gpmsa.GPMSAError, match="precision must have one entry per experiment"):
+        gpmsa.ObsData(x=[[0.5]], y=[[1.0]], precision=[1.0, 2.0])
+    with pytest.raises(gpmsa.GPMSAError, match="symmetric positive definite"):
+        gpmsa.ObsData(x=[[0.5]], y=[[1.0, 2.0]], precision=[[[1.0, 2.0], [2.0, 1.0]]])
+    ragged = gpmsa.ObsData(x=[[0.2], [0.4]], y=[np.ones(3), np.ones(5)],
+                           index=[np.linspace(0, 1, 3), np.linspace(0, 1, 5)])  # fmt: skip
+    assert isinstance(ragged.y, list) and [len(e) for e in ragged.experiments] == [3, 5]
+
+
+def test_observations_outside_design_warn_then_refused():
+    s = sim()
+    lo, hi = s.x.min(), s.x.max()
+    with pytest.warns(UserWarning, match="outside the simulation design"):
+        prepare(s, gpmsa.ObsData(x=[[hi + 0.05 * (hi - lo)]], y=[[1.0]]))
+    with pytest.raises(gpmsa.GPMSAError, match=r"x_obs column x0 reaches .* allowed \[-0.1, 1.1\]"):
+        prepare(s, gpmsa.ObsData(x=[[hi + 0.5 * (hi - lo)]], y=[[1.0]]))
+    with pytest.raises(gpmsa.GPMSAError, match="one value per experiment"):
+        prepare(s, gpmsa.ObsData(x=[[0.5]], y=[[1.0, 2.0]]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        prepare(s, gpmsa.ObsData(x=[[0.5 * (lo + hi)]], y=[[1.0]]))
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    data=arrays(np.float64, (12, 3), elements=st.floats(-1e6, 1e6, allow_nan=False)),
+    shift=st.floats(-1e3, 1e3),
+)
+def test_standardizer_round_trip(data, shift):
+    spread = np.ptp(data, axis=0)
+    if np.any(spread < 1e-3 * (1 + np.abs(data).max(axis=0))):
+        return
+    s = gpmsa.SimData(x=data[:, :1], t=data[:, 1:2] + shift, y=data[:, 2:])
+    std = Standardizer.from_sim(s)
+    xu = std.x_to_unit(s.x)
+    assert xu.min() == pytest.approx(0.0, abs=1e-12) and xu.max() == pytest.approx(1.0, abs=1e-12)
+    assert np.allclose(std.x_from_unit(xu), s.x, rtol=1e-9, atol=1e-9 * np.abs(s.x).max())
+    assert np.allclose(std.t_from_unit(std.t_to_unit(s.t)), s.t, rtol=1e-9, atol=1e-6)
+    ys = std.y_to_std(s.y)
+    assert ys.mean() == pytest.approx(0, abs=1e-9) and ys.std(ddof=1) == pytest.approx(1)
+    assert np.allclose(std.y_from_std(ys), s.y, rtol=1e-9, atol=1e-9 * np.abs(s.y).max())
+
+
+def test_pca_basis_variance_fraction_and_weights():
+    s = sim(m=30, l=40)
+    std = Standardizer.from_sim(s)
+    ys = std.y_to_std(s.y)
+    K = pca_basis(ys)
+    sv = np.linalg.svd(ys, compute_uv=False)
+    share = np.cumsum(sv**2) / np.sum(sv**2)
+    assert share[K.shape[1] - 1] >= 0.995 and (K.shape[1] == 1 or share[K.shape[1] - 2] < 0.995)
+    assert np.allclose(K.T @ K, np.diag(sv[: K.shape[1]] ** 2 / 30))  # U S / sqrt(m)
+    w = basis_weights(ys, K)
+    assert np.allclose(w @ K.T, ys, atol=0.1)
+    assert pca_basis(ys, n_pc=4).shape == (40, 4)
+    assert np.array_equal(pca_basis(ys[:, :1]), [[1.0]])
+    with pytest.raises(gpmsa.GPMSAError, match=r"n_pc must be in \[1, 30\], got 31"):
+        pca_basis(ys, n_pc=31)
+    grid = np.linspace(0, 1, 40)
+    Ki = interpolate_basis(K, grid, grid[::3])
+    assert np.allclose(Ki, K[::3])
+    with pytest.raises(gpmsa.GPMSAError, match="within the simulation grid"):
+        interpolate_basis(K, grid, np.array([1.5]))
+
+
+def test_discrepancy_basis_normalised():
+    grid = np.linspace(0, 2, 11)
+    for kind in ("constant", "linear", np.c_[np.ones(11), grid**2]):
+        D = discrepancy_basis(kind, grid)
+        assert np.max(np.diag(D @ D.T)) == pytest.approx(1.0)
+    assert discrepancy_basis(None, grid) is None
+    assert discrepancy_basis("linear", grid).shape == (11, 2)
+    with pytest.raises(gpmsa.GPMSAError, match="discrepancy must be None, 'constant'"):
+        discrepancy_basis("quadratic", grid)
+
+
+def test_prepare_gpmsa_priors_and_inits_multivariate():
+    s = sim(m=25, l=30, seed=2)
+    prep = prepare(s, gpmsa.ObsData(x=[[0.3], [0.6]], y=s.y[:2] + 0.1), discrepancy="linear")
+    prob = prep.problem
+    ys = prep.standardizer.y_to_std(s.y)
+    p_u = prob.p_u
+    resid = np.sum((ys - prob.w @ prep.K.T) ** 2)
+    assert prob.priors.lamWOs.a == pytest.approx(5 + (30 - p_u) * 25 / 2)
+    assert prob.priors.lamWOs.b == pytest.approx(0.005 + resid / 2)
+    assert prob.init["lamWOs"][0] == min(
+        max(100, prob.priors.lamWOs.a / prob.priors.lamWOs.b), 1e5 - 1
+    )
+    assert prob.obs.p_v == 2 and prob.obs.u.shape == (2, p_u) and prob.init["betaV"].shape == (1, 1)
+    assert prob.names == ("theta", "betaV", "betaU", "lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
+    assert prob.obs.sig_obs.shape == (2 * (2 + p_u),) * 2
+    # GLS of y on [D, K] reproduces y up to the residual
+    e = prob.obs.y_std[0]
+    DK = np.hstack([prob.obs.D[0], prob.obs.K[0]])
+    fit = DK @ np.r_[prob.obs.v[0], prob.obs.u[0]]
+    assert np.linalg.norm(e - fit) < np.linalg.norm(e)
+    assert prob.priors.lamOs.a == pytest.approx(1 + 0.5 * (2 * 30 - 2 * (2 + p_u)))
+
+
+def test_backend_registry_and_lazy_torch():
+    assert "numpy" in gpmsa.backends.available()
+    assert gpmsa.backends.get("numpy").sample is not None
+    with pytest.raises(gpmsa.GPMSAError, match=r"unknown backend 'stan'; registered: \('numpy'"):
+        gpmsa.backends.get("stan")
+    code = "import sys, gpmsa; gpmsa.load; sys.exit('torch' in sys.modules)"
+    assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
+
+
+def test_observation_precision_and_ragged_grids():
+    s = sim(m=25, l=30, seed=4, index=np.linspace(0, 1, 30))
+    with pytest.raises(gpmsa.GPMSAError, match="experiment 0 has 1 values .* has 30; give ObsData"):
+        prepare(s, gpmsa.ObsData(x=[[0.3], [0.6]], y=[[1.0], [2.0]]))
+    s1 = sim(m=25, seed=4)
+    p1 = prepare(s1, gpmsa.ObsData(x=[[0.3], [0.6]], y=[[1.0], [2.0]], precision=[4.0, 9.0]))
+    sd1 = p1.standardizer.y_sd
+    assert np.allclose(
+        np.diag(p1.problem.obs.sig_obs), 1 / (np.array([4.0, 9.0]) * sd1**2), rtol=1e-6
+    )
+    full = prepare(s, gpmsa.ObsData(x=[[0.3]], y=s.y[:1], precision=[np.eye(30) * 4.0]))
+    sd = full.standardizer.y_sd
+    # GLS with a scalar precision: sig_obs = (K^T K lam + ridge)^-1, lam = 4 sd^2
+    K = full.K
+    expected = np.linalg.inv(
+        K.T @ K * 4 * sd**2 + 1e-6 * np.eye(K.shape[1]) + 1e-8 * np.eye(K.shape[1])
+    )
+    assert np.allclose(full.problem.obs.sig_obs, expected, rtol=1e-6)
+    grids = [np.linspace(0, 1, 12), np.linspace(0.2, 0.9, 7)]
+    ys = [np.interp(g, s.grid, s.y[0]) for g in grids]
+    rag = prepare(s, gpmsa.ObsData(x=[[0.3], [0.6]], y=ys, index=grids), discrepancy="constant")
+    obs = rag.problem.obs
+    p_u = rag.problem.p_u
+    assert obs.u.shape == (2, p_u) and obs.v.shape == (2, 1)
+    assert [k.shape for k in obs.K] == [(12, p_u), (7, p_u)]
+    assert obs.sig_obs.shape == (2 * (1 + p_u),) * 2
+    # the lamOs correction counts every observed element: 19 in all
+    assert rag.problem.priors.lamOs.a == pytest.approx(1 + 0.5 * (19 - 2 * (1 + p_u)))

@@ -1,0 +1,89 @@
+"""gpmsa.fit end to end: sim-only, several chains, multivariate output with discrepancy."""
+
+import numpy as np
+import pytest
+
+import gpmsa
+
+
+def lhs(rng, m, d):
+    return (np.argsort(rng.random((m, d)), axis=0) + rng.random((m, d))) / m
+
+
+@pytest.fixture(scope="module")
+def small_sim():
+    rng = np.random.default_rng(1)
+    z = lhs(rng, 30, 2)
+    x, t = 1 + 2 * z[:, :1], 10 + 5 * z[:, 1:]
+    y = np.sin(2 * x) * t / 10 + 0.01 * rng.standard_normal((30, 1))
+    return gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["k"], x_units=["m"])
+
+
+def test_sim_only_fit_gives_emulator_with_draws_and_diagnostics(small_sim):
+    emu = gpmsa.fit(small_sim, n_iter=400, n_chains=2, seed=3, tune=False, n_keep=100)
+    assert emu.settings["thin"] == 7  # ceil(2 chains * 320 kept / 100)
+    assert emu.n_draws == 2 * len(range(0, 320, 7)) <= 100
+    assert set(emu.draws) == {"betaU", "lamUz", "lamWs", "lamWOs"}
+    assert emu.draws["betaU"].shape == (92, 2, 1) and emu.calibration is None
+    for k, v in emu.params.items():
+        assert np.allclose(v, emu.draws[k].mean(axis=0))
+    d = emu.diagnostics["betaU"]
+    assert (
+        len(d["ess"]) == 2 and all(e > 0 for e in d["ess"]) and all(0 < a < 1 for a in d["accept"])
+    )
+    assert np.isfinite(d["rhat"]).all()
+    idata = emu.to_arviz()
+    assert idata.posterior["betaU"].shape[:2] == (2, 46)
+    mean, var = emu.predict(small_sim.x[:5], small_sim.t[:5])
+    assert np.all(np.abs(mean - small_sim.y[:5]) < 4 * np.sqrt(var))
+    m2, v2 = emu.predict(small_sim.x[:5], small_sim.t[:5], draws=True, n_draws=20)
+    assert np.allclose(m2, mean, atol=0.05) and np.all(v2 > 0)
+
+
+def test_same_seed_same_numbers_and_map_point(small_sim):
+    a = gpmsa.fit(small_sim, n_iter=60, seed=11, tune=False)
+    b = gpmsa.fit(small_sim, n_iter=60, seed=11, tune=False, point="map")
+    assert np.array_equal(a.draws["betaU"], b.draws["betaU"])
+    best = int(np.argmax(b.log_post))
+    assert np.array_equal(b.params["lamUz"], b.draws["lamUz"][best])
+    c = gpmsa.fit(small_sim, n_iter=60, seed=12, tune=False)
+    assert not np.array_equal(a.draws["betaU"], c.draws["betaU"])
+
+
+def test_fit_argument_errors(small_sim):
+    with pytest.raises(gpmsa.GPMSAError, match="n_iter must be"):
+        gpmsa.fit(small_sim, n_iter=1)
+    with pytest.raises(gpmsa.GPMSAError, match=r"n_burn must be in \[0, n_iter\)"):
+        gpmsa.fit(small_sim, n_iter=10, n_burn=10)
+    with pytest.raises(gpmsa.GPMSAError, match="point must be"):
+        gpmsa.fit(small_sim, n_iter=10, point="median")
+    with pytest.raises(gpmsa.GPMSAError, match="unknown backend 'jax'"):
+        gpmsa.fit(small_sim, n_iter=10, backend="jax")
+    with pytest.raises(gpmsa.GPMSAError, match="data must be a gpmsa.SimData"):
+        gpmsa.fit({"x": 1}, n_iter=10)
+
+
+def test_multivariate_output_with_discrepancy_recovers_true_theta():
+    """p_u > 1, constant discrepancy, three experiments; theta_true = 0.6 (native 1.6)."""
+    rng = np.random.default_rng(5)
+    s = np.linspace(0, 1, 25)
+
+    def sim_fn(x, t):
+        return t[:, None] * np.sin(2 * np.pi * s[None, :] + x[:, None]) + x[:, None] * s[None, :]
+
+    z = lhs(rng, 40, 2)
+    x, t = z[:, 0], 1 + z[:, 1]
+    sim = gpmsa.SimData(x=x, t=t, y=sim_fn(x, t), index=s, t_names=["amp"])
+    xo = np.array([0.2, 0.5, 0.8])
+    yo = sim_fn(xo, np.full(3, 1.6)) + 0.1 + 0.01 * rng.standard_normal((3, 25))
+    obs = gpmsa.ObsData(x=xo[:, None], y=yo, index=s)
+    emu = gpmsa.fit(sim, obs=obs, n_iter=800, seed=1, discrepancy="constant")
+    assert emu.p_u >= 2 and emu.K.shape == (25, emu.p_u)
+    assert {"theta", "lamOs", "betaV", "lamVz", "theta_native"} <= set(emu.calibration)
+    summary = emu.theta_summary()["amp"]
+    assert abs(summary["mean"] - 1.6) < 3 * summary["sd"] + 0.02, summary
+    assert summary["sd"] < 0.15
+    mean, var = emu.predict(xo[:, None], np.full((3, 1), 1.6))
+    assert mean.shape == (3, 25) and np.all(var > 0)
+    truth = sim_fn(xo, np.full(3, 1.6))
+    assert np.sqrt(np.mean((mean - truth) ** 2)) < 0.1
