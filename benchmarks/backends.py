@@ -1,0 +1,126 @@
+"""Effective samples per second of each gpmsa backend on the road case (fit and calibrate).
+
+ESS: arviz bulk ESS, the minimum over every sampled scalar parameter, of the draws kept after
+burn-in (n_iter // 5 per chain, as ``gpmsa.fit``); per second of wall time of the whole run
+(tuning or warm-up included). Fit: the simulation-only emulator (198 runs, scalar output;
+betaU, lamUz, lamWs, lamWOs sampled). Calibrate: ``gpmsa.calibrate`` at the SEPIA full-joint
+posterior means (theta and lamOs sampled). Prints one line per configuration, medians over
+``--repeats`` runs. Usage: python benchmarks/backends.py [--repeats 3] [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+import gpmsa
+from gpmsa import backends
+from gpmsa.diagnostics import ess, rhat
+from gpmsa.problem import prepare
+
+ROOT = Path(__file__).resolve().parents[1]
+CASE = ROOT / "tests" / "data" / "case.npz"
+REF = ROOT / "tests" / "data" / "reference_posteriors.json"
+
+
+def road() -> tuple[gpmsa.SimData, np.ndarray, np.ndarray]:
+    """The road case: simulation data, x_obs (1, 1), y_obs (1, 1)."""
+    d = np.load(CASE)
+    sim = gpmsa.SimData(x=d["v"][:, None], t=d["GD"][:, None], y=d["f"][:, None],
+                        x_names=["v"], t_names=["GD"])  # fmt: skip
+    return sim, d["v_obs"][:, None], d["f_obs"][:, None]
+
+
+def ess_rhat(draws: dict[str, np.ndarray], names) -> tuple[float, float]:
+    """(min bulk ESS, max R-hat) over every scalar element of ``names`` in draws (chains, n, ...).
+
+    R-hat needs two chains or more (NaN for one chain).
+    """
+    e, r = [], []
+    for name in names:
+        d = draws[name]
+        flat = d.reshape(d.shape[0], d.shape[1], -1)
+        e += [ess(flat[:, :, i]) for i in range(flat.shape[2])]
+        if d.shape[0] > 1:
+            r += [rhat(flat[:, :, i]) for i in range(flat.shape[2])]
+    return float(np.nanmin(e)), float(np.nanmax(r)) if r else float("nan")
+
+
+def bench_fit(backend: str, n_iter: int, n_chains: int, options: dict, seed: int) -> tuple:
+    """(wall s, min ESS, max R-hat) of one simulation-only fit."""
+    sim, _, _ = road()
+    problem = prepare(sim).problem
+    t0 = time.perf_counter()
+    chains = backends.get(backend).sample(
+        problem, n_iter=n_iter, n_chains=n_chains, seed=seed, **options
+    )
+    wall = time.perf_counter() - t0
+    burn = n_iter // 5
+    kept = {k: v[:, burn:] for k, v in chains.draws.items()}
+    return (wall, *ess_rhat(kept, problem.sampled))
+
+
+def bench_calibrate(backend: str, n_samples: int, n_chains: int, fast: bool, seed: int) -> tuple:
+    """(wall s, min ESS, max R-hat over GD and lamOs) of one gpmsa.calibrate."""
+    sim, x_obs, y_obs = road()
+    ref = json.loads(REF.read_text())["sepia_calibration_only"]["fixed_emulator_params_unit_scale"]
+    emu = gpmsa.Emulator.from_params(sim, {k: np.asarray(v) for k, v in ref.items()})
+    t0 = time.perf_counter()
+    post = gpmsa.calibrate(
+        emu, x_obs, y_obs, n_samples=n_samples, n_burn=n_samples // 5, seed=seed,
+        backend=backend, n_chains=n_chains, fast=fast,
+    )  # fmt: skip
+    wall = time.perf_counter() - t0
+    return (wall, *ess_rhat(post.chains, ("GD", "lamOs")))
+
+
+def main(argv=None) -> None:
+    """Run every configuration and print wall time, min ESS and ESS/s (medians)."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--quick", action="store_true", help="shorter runs (noisier figures)")
+    args = ap.parse_args(argv)
+    s = 0.25 if args.quick else 1.0
+    fits = [
+        ("numpy", 1, int(3000 * s), {}),
+        ("torch", 1, int(1500 * s), {}),
+        ("torch", 8, int(1000 * s), {}),
+        ("torch", 64, int(400 * s), {}),
+        ("pyro", 2, int(200 * s), {"n_warmup": int(150 * s)}),
+    ]
+    cals = [
+        ("numpy", 1, int(5000 * s), True),
+        ("numpy", 1, int(5000 * s), False),
+        ("torch", 1, int(3000 * s), False),
+        ("torch", 8, int(1500 * s), False),
+        ("torch", 64, int(500 * s), False),
+        ("pyro", 2, int(500 * s), False),
+    ]
+    print(f"# load average at start: {os.getloadavg()}; {os.cpu_count()} CPUs; torch threads 1")
+    print(f"{'task':9} {'backend':14} {'chains':>6} {'draws':>6} {'wall s':>8} {'min ESS':>8} "
+          f"{'ESS/s':>8} {'R-hat':>6}")  # fmt: skip
+    for task, configs in (("fit", fits), ("calibrate", cals)):
+        for backend, chains, n, extra in configs:
+            runs = []
+            for r in range(args.repeats):
+                if task == "fit":
+                    runs.append(bench_fit(backend, n, chains, extra, seed=r))
+                else:
+                    runs.append(bench_calibrate(backend, n, chains, extra, seed=r))
+            wall = statistics.median(w for w, _, _ in runs)
+            n_eff = statistics.median(e for _, e, _ in runs)
+            rate = statistics.median(e / w for w, e, _ in runs)
+            r_hat = max(r for _, _, r in runs)
+            label = backend + (" (fast)" if task == "calibrate" and extra else "")
+            print(f"{task:9} {label:14} {chains:6d} {n:6d} {wall:8.2f} {n_eff:8.0f} {rate:8.1f} "
+                  f"{r_hat:6.3f}", flush=True)  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,52 @@
+"""The BCR's output: one GD estimate, or the reason there is none."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.grid_posterior import GridPosterior
+
+#: Status values. Only "ok" carries numbers; every other status says why there is no estimate.
+STATUSES = ("ok", "filling", "out_of_domain", "sensor_fault", "calibration_failed", "stale")
+
+
+@dataclass(frozen=True, eq=False)
+class Estimate:
+    """A posterior of GD at one instant, or why there is none.
+
+    Attributes:
+        time: s, time of the newest sample the BCR has seen.
+        position: m, front-axle position at that time.
+        status: one of STATUSES; "ok" means gd_mean etc. are valid.
+        reason: a sentence for a person ("" when ok).
+        gd_mean: posterior mean of GD (1e-6 m^3); NaN unless ok.
+        gd_sd: posterior standard deviation; NaN unless ok.
+        interval: central credible interval (lo, hi) at the BCR's level; NaNs unless ok.
+        posterior: the GD posterior on a grid (quantiles, P(GD > x)); None unless ok.
+        latency_s: wall-clock time of the computation that produced this estimate, s.
+        speed: m/s, mean measured speed over the window used (NaN if none).
+        feature: the window's observation y (e.g. log of the acceleration variance; NaN if none).
+    """
+
+    time: float
+    position: float
+    status: str
+    reason: str = ""
+    gd_mean: float = np.nan
+    gd_sd: float = np.nan
+    interval: tuple[float, float] = (np.nan, np.nan)
+    posterior: GridPosterior | None = None
+    latency_s: float = 0.0
+    speed: float = np.nan
+    feature: float = np.nan
+
+    @property
+    def ok(self) -> bool:
+        """True when the estimate carries a usable posterior."""
+        return self.status == "ok"
+
+    def prob_above(self, value: float) -> float:
+        """P(GD > value); NaN unless ok."""
+        return self.posterior.prob_above(value) if self.posterior is not None else np.nan

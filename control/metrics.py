@@ -1,0 +1,114 @@
+"""Scores of a closed-loop run: RMSE of the GD estimate, detection delays, speed on rough ground."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.errors import ControlError
+
+
+@dataclass(frozen=True)
+class GDError:
+    """Squared-error sums of the GD estimate over the parts of a track with one prescribed GD.
+
+    Attributes:
+        gd: the prescribed GD of those parts.
+        sse: sum of squared errors of the estimates (posterior means) there.
+        n: number of estimates there.
+    """
+
+    gd: float
+    sse: float
+    n: int
+
+    @property
+    def rmse(self) -> float:
+        """Root mean squared error (NaN without estimates)."""
+        return float(np.sqrt(self.sse / self.n)) if self.n else np.nan
+
+
+def segment_index(track, position: np.ndarray) -> np.ndarray:
+    """Index of the track segment holding each position (clipped to the first/last segment)."""
+    starts = np.asarray(track.boundaries_m, dtype=float)
+    idx = np.searchsorted(starts, np.asarray(position, dtype=float), side="right") - 1
+    return np.clip(idx, 0, len(track.segments) - 1)
+
+
+def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDError, ...]:
+    """Errors of the estimates against the prescribed GD at each estimate's position, as the paper.
+
+    Args:
+        track: a roadgen Track (segments, boundaries_m).
+        position: (n,) positions of the estimates (front axle when the estimate was made), m.
+        gd_estimate: (n,) posterior means; NaN entries (no estimate) are left out.
+
+    Returns:
+        One `GDError` per distinct prescribed GD, in increasing GD.
+    """
+    position = np.asarray(position, dtype=float)
+    gd_estimate = np.asarray(gd_estimate, dtype=float)
+    if position.shape != gd_estimate.shape:
+        raise ControlError(
+            f"position and gd_estimate must match, got {position.shape} and {gd_estimate.shape}"
+        )
+    seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
+    truth = seg_gd[segment_index(track, position)]
+    ok = np.isfinite(gd_estimate)
+    out = []
+    for gd in np.unique(seg_gd):
+        sel = ok & (truth == gd)
+        out.append(GDError(float(gd), float(np.sum((gd_estimate[sel] - gd) ** 2)), int(sel.sum())))
+    return tuple(out)
+
+
+def pooled_rmse(errors: Sequence[Sequence[GDError]], gd: float) -> float:
+    """RMSE at prescribed GD `gd` pooled over several runs (all their estimates together)."""
+    sse = sum(e.sse for run in errors for e in run if e.gd == gd)
+    n = sum(e.n for run in errors for e in run if e.gd == gd)
+    if n == 0:
+        raise ControlError(f"no estimates on parts with prescribed GD {gd}")
+    return float(np.sqrt(sse / n))
+
+
+def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[float, ...]:
+    """Distance past each GD change until the estimate first crosses the midpoint of the two GDs, m.
+
+    One value per boundary between segments of different GD; NaN if the estimate never crosses
+    before the next boundary (or the end of the data).
+    """
+    position = np.asarray(position, dtype=float)
+    gd_estimate = np.asarray(gd_estimate, dtype=float)
+    starts = np.asarray(track.boundaries_m, dtype=float)
+    ends = np.append(starts[1:], np.inf)
+    delays = []
+    for k in range(1, len(track.segments)):
+        before, after = track.segments[k - 1][1], track.segments[k][1]
+        if before == after:
+            continue
+        mid = (before + after) / 2
+        crossed = (gd_estimate > mid) if after > before else (gd_estimate < mid)
+        sel = np.flatnonzero((position >= starts[k]) & (position < ends[k]) & crossed)
+        delays.append(float(position[sel[0]] - starts[k]) if sel.size else np.nan)
+    return tuple(delays)
+
+
+def fast_on_rough_m(
+    track, position: np.ndarray, speed: np.ndarray, gd_max: float, v_safe: float, tol: float = 0.02
+) -> float:
+    """Distance driven faster than v_safe + tol (m/s) where the prescribed GD exceeds gd_max, m.
+
+    Args:
+        position, speed: (n,) the vehicle's samples (front axle), m and m/s.
+    """
+    position = np.asarray(position, dtype=float)
+    speed = np.asarray(speed, dtype=float)
+    if position.size < 2:
+        return 0.0
+    seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
+    mid = 0.5 * (position[1:] + position[:-1])
+    rough = seg_gd[segment_index(track, mid)] > gd_max
+    fast = 0.5 * (speed[1:] + speed[:-1]) > v_safe + tol
+    return float(np.sum(np.diff(position)[rough & fast]))

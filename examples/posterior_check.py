@@ -1,0 +1,123 @@
+"""The paper's Table 2 and Appendix A: percent error of the posterior-mean GD on fresh roads.
+
+    python examples/posterior_check.py                 # case A, 5 roads per cell, ./out
+    python examples/posterior_check.py --case B --roads 10 --out DIR
+
+For v in {0.75, 1.25, 1.75} m/s and GD in {250, 300, ..., 550}: a fresh 21 m road per cell, made
+as the training roads are (roadgen.iso8608_profile with a 1 m lead-in, wheel-enveloped), one Jackal
+drive at constant v, one observation from the last 1,000 samples (the emulator's window), and the
+posterior of GD from ``gpmsa.Calibrator.update`` (uniform prior on [200, 600], the paper's eq. 3).
+The table's first block is road 1 of each cell (one window per cell, as the paper); the second is
+the mean absolute percent error over ``--roads`` roads per cell, a steadier figure. The histograms
+(Appendix A) are of road 1's posterior draws.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+
+import control  # noqa: E402
+import gpmsa  # noqa: E402
+import roadgen  # noqa: E402
+import vehicle  # noqa: E402
+from control.feature import window_feature  # noqa: E402
+from control.plotting import plot_posterior_grid  # noqa: E402
+
+SPEEDS = (0.75, 1.25, 1.75)
+GDS = (250, 300, 350, 400, 450, 500, 550)
+PAPER_TABLE2 = {  # percent error, rows GD, columns v (Lewis et al. 2025, Table 2)
+    250: (78.2, 12.3, 46.8),
+    300: (33.6, 23.6, 7.2),
+    350: (24.2, 0.2, 14.2),
+    400: (2.2, 4.0, 30.9),
+    450: (4.9, 16.1, 1.5),
+    500: (18.5, 3.1, 5.7),
+    550: (22.1, 7.4, 19.2),
+}
+
+
+def cell_posterior(calibrator, model, v: float, gd: float, seed: int, noise_std: float, meta: dict):
+    """Posterior of GD from one window on one fresh road driven at v."""
+    feat = meta["feature"]
+    road = roadgen.iso8608_profile(
+        meta["road"]["length_m"], gd, seed=seed, lead_in_m=meta["road"]["lead_in_m"]
+    )
+    trace = vehicle.simulate(
+        model, road, v, rate_hz=feat["rate_hz"], noise_std=noise_std, seed=seed
+    )
+    y = window_feature(trace.accel_front_measured[-feat["window_samples"] :], feat["name"])
+    return calibrator.update([[v]], [[y]])
+
+
+def main(argv: list[str] | None = None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--case", default="A", choices=["A", "B"])
+    parser.add_argument("--roads", type=int, default=5, help="fresh roads per cell")
+    parser.add_argument("--seed", type=int, default=2025)
+    parser.add_argument("--out", default="out")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    emu = control.shipped_emulator(args.case)
+    calibrator = gpmsa.Calibrator(emu, seed=args.seed)
+    model = vehicle.Jackal()
+    noise = float(emu.metadata["noise_std"])
+
+    errors = np.zeros((len(GDS), len(SPEEDS), args.roads))
+    cells = []
+    seeds = np.random.SeedSequence(args.seed).generate_state(errors.size).reshape(errors.shape)
+    for i, gd in enumerate(GDS):
+        for j, v in enumerate(SPEEDS):
+            for k in range(args.roads):
+                post = cell_posterior(
+                    calibrator, model, v, gd, int(seeds[i, j, k]), noise, emu.metadata
+                )
+                errors[i, j, k] = 100 * abs(post.mean("GD") - gd) / gd
+                if k == 0:
+                    cells.append((v, gd, post.samples["GD"]))
+
+    print(f"Table 2, case {args.case}: percent error of the posterior-mean GD (paper | ours)")
+    print(
+        f"{'GD':>5} " + "".join(f"{'v=' + str(v):>18}" for v in SPEEDS) + f"{'mean of roads':>30}"
+    )
+    for i, gd in enumerate(GDS):
+        row = "".join(f"{PAPER_TABLE2[gd][j]:9.1f}{errors[i, j, 0]:8.1f} " for j in range(3))
+        avg = "".join(f"{errors[i, j].mean():9.1f}" for j in range(3))
+        print(f"{gd:>5} {row}  {avg}")
+    paper = np.array(list(PAPER_TABLE2.values()))
+    summary = {
+        "paper": {"max": float(paper.max()), "mean": float(paper.mean())},
+        "one_road": {"max": float(errors[:, :, 0].max()), "mean": float(errors[:, :, 0].mean())},
+        "all_roads": {
+            "max_cell_mean": float(errors.mean(axis=2).max()),
+            "mean": float(errors.mean()),
+            "roads_per_cell": args.roads,
+        },
+    }
+    print(
+        f"max / mean percent error: paper {summary['paper']['max']:.1f} / "
+        f"{summary['paper']['mean']:.1f}; ours, one road per cell "
+        f"{summary['one_road']['max']:.1f} / {summary['one_road']['mean']:.1f}; "
+        f"ours, mean over {args.roads} roads: worst cell "
+        f"{summary['all_roads']['max_cell_mean']:.1f} / {summary['all_roads']['mean']:.1f}"
+    )
+    title = f"Posterior GD, case {args.case}, one window per cell"
+    plot_posterior_grid(cells, title=title).savefig(
+        out / f"posterior_grid_{args.case}.png", dpi=120
+    )
+    (out / f"table2_{args.case}.json").write_text(
+        json.dumps({"summary": summary, "percent_error": errors.tolist()}, indent=1)
+    )
+    return summary
+
+
+if __name__ == "__main__":
+    main()

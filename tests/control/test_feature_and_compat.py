@@ -1,0 +1,94 @@
+"""Window feature, emulator-compatibility checks and plotting helpers (no simulation)."""
+
+from types import SimpleNamespace
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+import vehicle  # noqa: E402
+from control import (  # noqa: E402
+    BCRSettings,
+    ControlError,
+    ControlWarning,
+    EmulatorMismatchError,
+    bcr_settings_for,
+    check_emulator,
+    window_feature,
+)
+from control.plotting import plot_design, plot_gd_trace, plot_posterior_grid, plot_speed  # noqa: E402
+
+
+def fake_emulator(**meta):
+    return SimpleNamespace(
+        domain={"v": (0.5, 2.0), "GD": (200.0, 600.0)}, x_names=["v"], t_names=["GD"], metadata=meta
+    )
+
+
+def test_feature_is_the_papers_variance_normalised_by_t():
+    a = np.array([1.0, -1.0, 3.0, -3.0])
+    assert window_feature(a, "var") == pytest.approx(5.0)  # sum of squares / T, not T - 1
+    assert window_feature(a, "log_var") == pytest.approx(np.log(5.0))
+    assert np.isnan(window_feature(np.ones(10), "log_var"))
+    with pytest.raises(ControlError, match="feature must be one of"):
+        window_feature(a, "rms")
+    with pytest.raises(ControlError, match="accel must be 1-D"):
+        window_feature(np.ones((2, 2)))
+
+
+def test_bcr_settings_follow_the_emulators_feature():
+    emu = fake_emulator(feature={"name": "var", "window_samples": 600, "rate_hz": 100.0})
+    s = bcr_settings_for(emu, method="window")
+    assert (s.feature, s.buffer, s.rate_hz, s.method) == ("var", 600, 100.0, "window")
+    assert bcr_settings_for(fake_emulator()) == BCRSettings()
+
+
+def test_check_emulator_errors_and_warnings():
+    jackal = vehicle.Jackal()
+    emu = fake_emulator(
+        vehicle=jackal.describe(),
+        noise_std=0.0,
+        feature={"name": "log_var", "window_samples": 1000, "rate_hz": 120.0},
+    )
+    check_emulator(emu, model=jackal, noise_std=0.0, bcr=BCRSettings())  # all agree: silent
+    with pytest.raises(EmulatorMismatchError, match="made for vehicle"):
+        check_emulator(emu, model=vehicle.HalfCar())
+    with pytest.raises(
+        EmulatorMismatchError,
+        match="BCR feature = 'var' but the emulator's feature has name = 'log_var'",
+    ):
+        check_emulator(emu, bcr=BCRSettings(feature="var"))
+    with pytest.raises(EmulatorMismatchError, match="BCR rate_hz = 100.0"):
+        check_emulator(emu, bcr=BCRSettings(rate_hz=100.0))
+    with pytest.warns(ControlWarning, match="no 'vehicle'"):
+        check_emulator(fake_emulator(), model=jackal)
+    with pytest.warns(ControlWarning, match="noise_std = 0.5"):
+        check_emulator(emu, noise_std=0.5)
+    track = SimpleNamespace(segments=((10.0, 150.0), (10.0, 300.0)))
+    with pytest.raises(EmulatorMismatchError, match=r"track GD \[150.0\]"):
+        check_emulator(emu, track=track)
+
+
+def test_plots_return_figures_with_one_line_per_run():
+    track = SimpleNamespace(
+        segments=((50.0, 300.0), (50.0, 500.0)), boundaries_m=(0.0, 50.0), length_m=100.0
+    )
+    pos = np.linspace(10, 100, 50)
+    run = SimpleNamespace(
+        position=pos,
+        gd_mean=np.full(50, 350.0),
+        gd_lo=np.full(50, 300.0),
+        gd_hi=np.full(50, 400.0),
+        sample_position=pos,
+        sample_speed=np.full(50, 1.5),
+    )
+    fig = plot_gd_trace([run, run], track)
+    assert isinstance(fig, Figure) and len(fig.axes[0].lines) >= 3  # prescribed + 2 runs
+    assert isinstance(plot_speed([run], track), Figure)
+    assert isinstance(plot_design(np.array([1.0, 2.0]), np.array([300.0, 400.0])), Figure)
+    cells = [(v, gd, np.full(10, gd)) for v in (1.0, 2.0) for gd in (300.0, 500.0)]
+    assert len(plot_posterior_grid(cells).axes) == 4

@@ -1,0 +1,46 @@
+"""Metrics: RMSE per prescribed GD, detection delay, distance fast on rough ground."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from control import detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
+
+TRACK = SimpleNamespace(
+    segments=((50.0, 300.0), (50.0, 500.0), (50.0, 300.0)),
+    boundaries_m=(0.0, 50.0, 100.0),
+    length_m=150.0,
+)
+
+
+def test_rmse_is_taken_against_the_gd_at_each_estimate_position():
+    pos = np.array([10, 20, 60, 70, 120, 140, 145.0])
+    est = np.array([310, 290, 480, 520, 330, np.nan, 300.0])
+    errs = {e.gd: e for e in gd_errors(TRACK, pos, est)}
+    assert errs[300].n == 4 and errs[500].n == 2  # the NaN (no estimate) is left out
+    assert errs[300].rmse == pytest.approx(np.sqrt((100 + 100 + 900 + 0) / 4))
+    assert errs[500].rmse == pytest.approx(20.0)
+    # Pooling two runs weighs every estimate equally.
+    other = gd_errors(TRACK, np.array([70.0]), np.array([440.0]))
+    assert pooled_rmse([tuple(errs.values()), other], 500) == pytest.approx(
+        np.sqrt((400 + 400 + 3600) / 3)
+    )
+
+
+def test_detection_delay_is_the_distance_to_the_midpoint_crossing():
+    pos = np.arange(0, 150, 2.0)
+    est = np.where(pos < 57, 300.0, 500.0)
+    est[pos >= 110] = 300.0
+    assert detection_delays(TRACK, pos, est) == pytest.approx((8.0, 10.0))
+    never = np.full(pos.shape, 300.0)
+    assert np.isnan(detection_delays(TRACK, pos, never)[0])
+
+
+def test_fast_on_rough_counts_only_rough_ground_above_v_safe():
+    pos = np.linspace(0, 150, 15001)
+    speed = np.where(pos < 58, 2.0, 1.0)
+    assert fast_on_rough_m(TRACK, pos, speed, gd_max=350, v_safe=1.0) == pytest.approx(
+        8.0, abs=0.02
+    )
+    assert fast_on_rough_m(TRACK, pos, np.full(pos.size, 1.0), 350, 1.0) == 0.0

@@ -1,0 +1,97 @@
+"""Simplex controller: the paper's band, the default continuous law, risk posture, faults."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy import stats
+
+from control import ControlError, Estimate, GridPosterior, Simplex
+
+
+def gaussian_estimate(mean: float, sd: float) -> Estimate:
+    grid = np.linspace(200, 600, 801)
+    post = GridPosterior(grid, stats.norm.pdf(grid, mean, sd))
+    return Estimate(
+        time=10.0,
+        position=20.0,
+        status="ok",
+        gd_mean=post.mean(),
+        gd_sd=post.sd(),
+        interval=post.interval(0.9),
+        posterior=post,
+    )
+
+
+def test_linear_law_matches_the_band_and_is_continuous_at_gd_max():
+    s = Simplex()
+    assert s.gain == pytest.approx(0.01)
+    assert s.performance_speed(200) == pytest.approx(2.0)
+    assert s.performance_speed(250) == pytest.approx(2.0)
+    assert s.performance_speed(300) == pytest.approx(1.5)
+    assert s.performance_speed(350 - 1e-9) == pytest.approx(s.v_safe)
+    # The command steps neither up nor down where safety mode takes over.
+    below, above = s.command(gaussian_estimate(349.9, 2)), s.command(gaussian_estimate(350.1, 2))
+    assert below.mode == "performance" and above.mode == "safety"
+    assert abs(below.speed - above.speed) < 0.01
+
+
+def test_speed_never_increases_with_gd():
+    s = Simplex()
+    speeds = [s.command(gaussian_estimate(gd, 3)).speed for gd in np.linspace(210, 590, 60)]
+    assert np.all(np.diff(speeds) <= 1e-12)
+    assert min(speeds) == pytest.approx(s.v_safe) and max(speeds) == pytest.approx(s.v_max)
+
+
+def test_paper_law_as_written_stops_the_robot_mid_band():
+    s = Simplex(law="paper")
+    assert s.performance_speed(250) == pytest.approx(2.0)
+    assert s.performance_speed(300) == pytest.approx(0.0)  # eq. 8 literally
+    assert s.performance_speed(340) == 0.0  # negative speeds are clipped
+    assert s.command(gaussian_estimate(400, 2)).speed == pytest.approx(1.0)
+
+
+def test_switch_law_is_two_speeds():
+    s = Simplex(law="switch")
+    assert s.command(gaussian_estimate(340, 2)).speed == 2.0
+    assert s.command(gaussian_estimate(360, 2)).speed == 1.0
+
+
+def test_any_fault_means_safety_mode():
+    s = Simplex()
+    for status in ("filling", "sensor_fault", "out_of_domain", "stale", "calibration_failed"):
+        cmd = s.command(Estimate(time=1.0, position=1.0, status=status, reason="x"))
+        assert cmd.mode == "safety" and cmd.speed == s.v_safe and status in cmd.reason
+
+
+def test_risk_posture_is_more_cautious_than_the_mean():
+    est = gaussian_estimate(330, 30)  # mean inside the band, P(GD > 350) ~ 0.25
+    assert Simplex().command(est).mode == "performance"
+    assert Simplex(risk=0.1).command(est).mode == "safety"
+    assert Simplex(risk=0.4).command(est).mode == "performance"
+
+
+@given(mean=st.floats(260, 440), sd=st.floats(2, 60), alpha=st.floats(0.02, 0.5))
+def test_risk_switches_exactly_when_prob_above_max_exceeds_alpha(mean, sd, alpha):
+    est = gaussian_estimate(mean, sd)
+    p = est.prob_above(350)
+    if abs(p - alpha) < 1e-9:  # a tie: either mode is right
+        return
+    cmd = Simplex(risk=alpha).command(est)
+    assert (cmd.mode == "safety") == (p > alpha)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"gd_min": 400}, "gd_min must be < gd_max"),
+        ({"v_safe": 3.0}, "v_safe must be <= v_max"),
+        ({"risk": 1.5}, "risk must be None or lie in"),
+        ({"kp": -1}, "kp must be finite"),
+        ({"law": "pid"}, "law must be one of"),
+        ({"v_max": float("nan")}, "v_max must be finite"),
+    ],
+)
+def test_bad_settings_raise(kwargs, match):
+    with pytest.raises(ControlError, match=match):
+        Simplex(**kwargs)

@@ -1,0 +1,71 @@
+"""GDTracker: combining window likelihoods, forgetting after a change."""
+
+import numpy as np
+import pytest
+
+from control import ControlError, GDTracker, TrackerSettings
+
+GRID = np.linspace(200, 600, 401)
+
+
+def gauss_loglik(center: float, sd: float) -> np.ndarray:
+    return -0.5 * ((GRID - center) / sd) ** 2
+
+
+def test_memoryless_tracker_returns_the_one_window_posterior():
+    tr = GDTracker((200, 600), TrackerSettings(mean_segment_m=0.0))
+    for center in (300.0, 480.0):
+        tr.predict(5.0)
+        tr.update(GRID, gauss_loglik(center, 20))
+        post = tr.posterior()
+        # Uniform prior on GD times a Gaussian likelihood far from the bounds: that Gaussian.
+        assert post.mean() == pytest.approx(center, abs=0.5)
+        assert post.sd() == pytest.approx(20, rel=0.02)
+
+
+def test_consistent_windows_sharpen_the_posterior():
+    tr = GDTracker((200, 600), TrackerSettings(mean_segment_m=1e9, drift_per_sqrt_m=0.0))
+    for _ in range(9):
+        tr.predict(10.0)
+        tr.update(GRID, gauss_loglik(400, 30))
+    assert tr.posterior().sd() == pytest.approx(10, rel=0.05)  # 30 / sqrt(9)
+
+
+def test_change_point_lets_the_estimate_follow_a_jump():
+    tr = GDTracker((200, 600), TrackerSettings(mean_segment_m=25.0))
+    for _ in range(6):
+        tr.predict(12.0)
+        tr.update(GRID, gauss_loglik(300, 40))
+    assert tr.posterior().mean() == pytest.approx(300, abs=15)
+    means = []
+    for _ in range(3):
+        tr.predict(12.0)
+        tr.update(GRID, gauss_loglik(500, 40))
+        means.append(tr.posterior().mean())
+    assert means[0] > 400  # one window at the new roughness moves it most of the way
+    assert means[-1] == pytest.approx(500, abs=20)
+    # Without change points (and no drift) the old evidence holds it back.
+    rigid = GDTracker((200, 600), TrackerSettings(mean_segment_m=1e9, drift_per_sqrt_m=0.0))
+    for center in [300] * 6 + [500]:
+        rigid.predict(12.0)
+        rigid.update(GRID, gauss_loglik(center, 40))
+    assert rigid.posterior().mean() < 340
+
+
+def test_prediction_keeps_the_mass():
+    tr = GDTracker((200, 600))
+    tr.update(GRID, gauss_loglik(590, 5))  # near the upper bound: reflection keeps the mass
+    tr.predict(400.0)
+    assert np.exp(tr.log_mass).sum() == pytest.approx(1.0, abs=1e-9)
+
+
+def test_bad_input_raises():
+    with pytest.raises(ControlError, match="domain must satisfy"):
+        GDTracker((600, 200))
+    with pytest.raises(ControlError, match="mean_segment_m"):
+        TrackerSettings(mean_segment_m=-1)
+    tr = GDTracker((200, 600))
+    with pytest.raises(ControlError, match="ds_m must be >= 0"):
+        tr.predict(-1.0)
+    with pytest.raises(ControlError, match="loglik must be finite"):
+        tr.update(GRID, np.full(GRID.size, np.nan))

@@ -1,0 +1,50 @@
+"""examples/train_emulator.py end to end on a small design: a file the closed loop accepts."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import control
+import roadgen
+import vehicle
+
+SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "train_emulator.py"
+
+
+def load_script():
+    spec = importlib.util.spec_from_file_location("train_emulator", SCRIPT)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_stretched_design_spans_the_domain_and_stays_latin():
+    design = load_script().stretched_design(40, seed=3)
+    original = vehicle.lhs_design(40, seed=3)
+    assert design[:, 0].min() == pytest.approx(0.5) and design[:, 0].max() == pytest.approx(2.0)
+    assert design[:, 1].min() == pytest.approx(200) and design[:, 1].max() == pytest.approx(600)
+    for col, width in ((0, 1.5), (1, 400.0)):
+        # An affine map keeps the order, and neighbours stay within about two strata.
+        assert np.array_equal(np.argsort(design[:, col]), np.argsort(original[:, col]))
+        assert np.max(np.diff(np.sort(design[:, col]))) <= 2.2 * width / 40
+
+
+def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path):
+    load_script().main(
+        ["--out", str(tmp_path), "--n-runs", "24", "--n-iter", "400", "--emulator-dir",
+         str(tmp_path)]
+    )  # fmt: skip
+    import gpmsa
+
+    for case, noise in (("A", 0.0), ("B", 1.0)):
+        emu = gpmsa.load(tmp_path / f"jackal_{case}.gpmsa")
+        assert emu.metadata["noise_std"] == noise
+        assert emu.domain["v"] == pytest.approx((0.5, 2.0))
+        control.check_emulator(emu, model=vehicle.Jackal(), noise_std=noise)
+    assert (tmp_path / "lhs_design.png").is_file()
+    track = roadgen.track([(15, 300)], seed=1)
+    emu = gpmsa.load(tmp_path / "jackal_A.gpmsa")
+    r = control.run_closed_loop(track, emu, seed=1)
+    assert (r.status == "ok").any()
