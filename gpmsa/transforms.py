@@ -9,6 +9,17 @@ import numpy as np
 from gpmsa.data import SimData
 from gpmsa.errors import GPMSAError
 
+UNIT_TOL = 1e-9
+"""Unit-scale values within this distance outside [0, 1] are rounding of the design's edges (a
+design stretched onto [0.5, 2.0] may store 1.9999999999999998): they are snapped onto the edge, so
+that an input at the domain's end never reads as outside it."""
+
+
+def _snap_to_unit(u: np.ndarray) -> np.ndarray:
+    """``u`` with values within ``UNIT_TOL`` below 0 or above 1 moved onto the edge."""
+    u = np.where((u < 0.0) & (u > -UNIT_TOL), 0.0, u)
+    return np.where((u > 1.0) & (u < 1.0 + UNIT_TOL), 1.0, u)
+
 
 @dataclass(frozen=True, eq=False)
 class Standardizer:
@@ -45,7 +56,8 @@ class Standardizer:
 
     def x_to_unit(self, x: np.ndarray) -> np.ndarray:
         """Known inputs (n, p) native -> unit scale."""
-        return (np.asarray(x, dtype=np.float64) - self.x_min) / (self.x_max - self.x_min)
+        u = (np.asarray(x, dtype=np.float64) - self.x_min) / (self.x_max - self.x_min)
+        return _snap_to_unit(u)
 
     def x_from_unit(self, x: np.ndarray) -> np.ndarray:
         """Known inputs (n, p) unit scale -> native."""
@@ -53,7 +65,8 @@ class Standardizer:
 
     def t_to_unit(self, t: np.ndarray) -> np.ndarray:
         """Parameters (n, q) native -> unit scale."""
-        return (np.asarray(t, dtype=np.float64) - self.t_min) / (self.t_max - self.t_min)
+        u = (np.asarray(t, dtype=np.float64) - self.t_min) / (self.t_max - self.t_min)
+        return _snap_to_unit(u)
 
     def t_from_unit(self, t: np.ndarray) -> np.ndarray:
         """Parameters (n, q) unit scale -> native: theta * (t_max - t_min) + t_min."""

@@ -12,7 +12,7 @@ from hypothesis.extra.numpy import arrays
 
 import gpmsa
 from gpmsa.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
-from gpmsa.problem import prepare
+from gpmsa.problem import check_x_obs, prepare
 from gpmsa.transforms import Standardizer
 
 
@@ -198,3 +198,18 @@ def test_observation_precision_and_ragged_grids():
     assert obs.sig_obs.shape == (2 * (1 + p_u),) * 2
     # the lamOs correction counts every observed element: 19 in all
     assert rag.problem.priors.lamOs.a == pytest.approx(1 + 0.5 * (19 - 2 * (1 + p_u)))
+
+
+def test_inputs_at_a_rounded_domain_edge_count_as_inside():
+    """A design whose top edge is stored as 2 - 2e-16 still accepts v = 2.0 without a warning."""
+    rng = np.random.default_rng(3)
+    v = np.linspace(0.5, 2.0, 30)
+    v[-1] = 1.9999999999999998
+    gd = rng.uniform(200, 600, 30)
+    std = Standardizer.from_sim(gpmsa.SimData(x=v, t=gd, y=0.02 * gd * v**1.6))
+    unit = std.x_to_unit(np.array([[2.0], [0.5]]))
+    assert np.array_equal(unit, [[1.0], [0.0]])
+    assert std.x_to_unit(np.array([[2.1]]))[0, 0] > 1.0  # beyond rounding: still outside
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_x_obs(std.x_to_unit(np.array([[2.0]])), ("v",))
