@@ -307,6 +307,7 @@ class Calibrator:
 
         info = {
             "method": "grid",
+            "expected_inv_lamOs": _expected_inverse_lamos(margs) if self.q == 1 else None,
             "names": names + ("lamOs",),
             "n_nodes": int(theta.shape[0]),
             "refined": theta is not self._theta_unit,
@@ -351,6 +352,23 @@ def _unresolved_region(theta: np.ndarray, logp: np.ndarray, spacing: np.ndarray,
     axes = [np.linspace(lo[k], hi[k], n) for k in range(q)]
     mesh = np.meshgrid(*axes, indexing="ij")
     return np.column_stack([g.ravel() for g in mesh]), (hi - lo) / (n - 1)
+
+
+def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
+    """(G,) E[1/lamOs | data, theta node]: the observation-error variance (standardised units)
+    expected at each theta node; several emulator parameter sets are weighted by their
+    likelihood at the node."""
+    per_set = np.stack(
+        [
+            np.exp(m.log_cond(np.arange(m.loglik.size)) - m.log_lam[None, :]).sum(axis=1)
+            for m in margs
+        ]
+    )  # (J, G)
+    if len(margs) == 1:
+        return per_set[0]
+    ll = np.stack([m.loglik for m in margs])  # (J, G)
+    p = np.exp(ll - ll.max(axis=0, keepdims=True))
+    return (p * per_set).sum(axis=0) / p.sum(axis=0)
 
 
 def _draw_lamos(

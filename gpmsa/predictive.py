@@ -83,8 +83,9 @@ def calibrated_predict(
         emulator: the gpmsa.Emulator the posterior was computed with.
         posterior: a Posterior from ``calibrate`` or ``Calibrator.update``.
         x_new: (N, p) known inputs, native units.
-        noise: add the observation error 1/lamOs (standardised units) of each draw: the predictive
-            of a new observation rather than of the simulator output (uses draws).
+        noise: add the observation error 1/lamOs (standardised units): the predictive of a new
+            observation rather than of the simulator output. On a one-parameter grid posterior
+            each node adds the exact E[1/lamOs | data, theta]; otherwise each draw its own lamOs.
         resid: include the emulator's nugget and residual variance (see ``Emulator.predict``).
         n_theta: at most this many posterior draws when draws are used.
         extrapolate: allow x_new outside the emulator's x domain (with a warning).
@@ -100,12 +101,15 @@ def calibrated_predict(
     if not (isinstance(n_theta, int | np.integer) and n_theta >= 1):
         raise GPMSAError(f"n_theta must be an integer >= 1, got {n_theta}")
     lam = None
-    if len(names) == 1 and names[0] in posterior.grids and not noise:
+    inv_lam = posterior.info.get("expected_inv_lamOs")
+    if len(names) == 1 and names[0] in posterior.grids and (inv_lam is not None or not noise):
         g = posterior.grids[names[0]]
         w = g.weights * g.density
         live = w > 1e-12 * w.max()
         theta = g.nodes[live][:, None]
         weights = w[live] / w[live].sum()
+        if noise:  # exact: E[1/lamOs | data, theta] at each node
+            lam = 1.0 / np.asarray(inv_lam)[live]
     else:
         n = np.size(posterior.samples[names[0]])
         idx = np.unique(np.linspace(0, n - 1, min(n_theta, n)).astype(int))

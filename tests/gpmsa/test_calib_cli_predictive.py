@@ -73,6 +73,30 @@ def test_calibrated_prediction_grid_and_draws_agree():
     assert abs(grid.mean[1, 0] - y[0][0]) < 2 * grid.sd[1, 0]
 
 
+def test_noisy_prediction_on_the_grid_is_exact_and_matches_draws():
+    """noise=True on a grid posterior stays on the grid (deterministic, never below the noise-free
+    variance) and agrees with the draw-based mixture of per-draw lamOs."""
+    emu = road_emulator()
+    x, y = road_obs()
+    post = Calibrator(emu, n_draws=40_000).update(x, y, seed=3)
+    clean = calibrated_predict(emu, post, [[1.5]])
+    noisy = calibrated_predict(emu, post, [[1.5]], noise=True)
+    again = calibrated_predict(emu, post, [[1.5]], noise=True)
+    assert noisy.weights.size == clean.weights.size > 50
+    np.testing.assert_array_equal(noisy.var, again.var)
+    np.testing.assert_allclose(noisy.mean, clean.mean)
+    assert noisy.var[0, 0] > clean.var[0, 0]
+    via_draws = calibrated_predict(
+        emu, Posterior(post.samples), [[1.5]], noise=True, n_theta=40_000
+    )
+    extra = noisy.var[0, 0] - clean.var[0, 0]
+    extra_draws = (
+        via_draws.var[0, 0]
+        - calibrated_predict(emu, Posterior(post.samples), [[1.5]], n_theta=40_000).var[0, 0]
+    )
+    assert extra == pytest.approx(extra_draws, rel=0.05)
+
+
 def test_calibrated_prediction_quantiles_and_noise():
     emu = road_emulator()
     x, y = road_obs()
