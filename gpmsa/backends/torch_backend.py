@@ -1,0 +1,462 @@
+"""torch backend: GPM/SA's log-posterior and Metropolis-within-Gibbs with many chains batched.
+
+Every tensor carries a leading chain axis C; one scalar Metropolis update moves that element in all
+chains at once (batched Cholesky of Sigma_W over (C, m, m) with ``torch.linalg.cholesky_ex``).
+Proposals, bounds, sweep order and step-size tuning are those of the numpy reference
+(``gpmsa.mcmc``, ``gpmsa.tuning``); chains share one set of tuned widths, fitted on the acceptance
+counts pooled over chains. Float64 by default; ``device="cuda"`` runs on a GPU when present.
+
+The correlation R = exp(-sum_k beta_k d_k^2) is GPyTorch's ARD ``RBFKernel`` with lengthscale
+l_k = 1/sqrt(2 beta_k) (tested equal); the sampler computes it from squared differences
+precomputed once, as one matrix product and one in-place exp per proposal, instead of calling the
+kernel module, whose lengthscale would have to be reset through its constraint transform at
+every proposal. See docs/performance.md for measured speeds.
+"""
+
+from __future__ import annotations
+
+import math
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from tqdm.auto import tqdm
+
+from gpmsa import tuning
+from gpmsa.errors import GPMSAError
+from gpmsa.mcmc import PRECISION_PARAMS, RHO_PARAMS, Chains, default_widths, elements
+from gpmsa.priors import Priors
+from gpmsa.problem import Problem
+
+Tensor = torch.Tensor
+SIM_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+"""Parameters that change Sigma_W (their proposals refactor it)."""
+
+
+@dataclass(frozen=True)
+class ModelTensors:
+    """The fixed data of one problem as tensors (unit / standardised units).
+
+    ``d_sim`` (p+q, m, m): squared differences of the simulation inputs [x, t] per column;
+    ``t_sim`` (m, q); ``w`` (p_u, m) weights, one row per basis component; ``lam_sim`` (p_u,).
+    Observation side (None for the simulation-only model): ``d_obs`` (p, n, n) and ``d_cross``
+    (p, n, m) squared differences of the known inputs (obs-obs, obs-sim); ``z`` (N,) the stacked
+    reduced data, N = n * n_blocks; ``sig_obs`` (N, N) its covariance per unit lamOs;
+    ``u_blocks`` the n-block of each basis component, ``v_blocks`` the n-blocks that receive the
+    discrepancy covariance (GPM/SA's order, see ``gpmsa.problem.ObsProblem``).
+    """
+
+    p: int
+    q: int
+    d_sim: Tensor
+    t_sim: Tensor
+    w: Tensor
+    lam_sim: Tensor
+    d_obs: Tensor | None = None
+    d_cross: Tensor | None = None
+    z: Tensor | None = None
+    sig_obs: Tensor | None = None
+    u_blocks: tuple[int, ...] = ()
+    v_blocks: tuple[int, ...] = ()
+
+    @property
+    def has_obs(self) -> bool:
+        """Whether the observation-side term enters the likelihood."""
+        return self.z is not None
+
+    @classmethod
+    def from_problem(cls, problem: Problem, dtype: torch.dtype, device) -> ModelTensors:
+        """Tensors of ``problem`` on ``device``."""
+
+        def t(a: np.ndarray) -> Tensor:
+            return torch.as_tensor(np.ascontiguousarray(a), dtype=dtype, device=device)
+
+        zt = problem.zt
+        kw = {}
+        obs = problem.obs
+        if obs is not None:
+            u_blocks = (0,) if obs.scalar_out else tuple(obs.p_v + j for j in range(problem.p_u))
+            n_v = 1 if (obs.scalar_out and obs.p_v) else obs.p_v
+            kw = {
+                "d_obs": t(pairwise_sq(obs.x, obs.x)),
+                "d_cross": t(pairwise_sq(obs.x, problem.x_sim)),
+                "z": t(obs.z),
+                "sig_obs": t(obs.sig_obs),
+                "u_blocks": u_blocks,
+                "v_blocks": tuple(range(n_v)) if "betaV" in problem.init else (),
+            }
+        return cls(
+            p=problem.p, q=problem.q, d_sim=t(pairwise_sq(zt, zt)), t_sim=t(problem.t_sim),
+            w=t(problem.w.T), lam_sim=t(problem.lam_sim), **kw,
+        )  # fmt: skip
+
+
+def pairwise_sq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Squared differences per column: a (na, k), b (nb, k) -> (k, na, nb)."""
+    return (a.T[:, :, None] - b.T[:, None, :]) ** 2
+
+
+def scaled_correlation(beta: Tensor, d: Tensor, lam: Tensor) -> Tensor:
+    """R / lam = exp(-sum_k beta_k d_k - log lam) in one matrix product and one in-place exp.
+
+    beta (C, k, J), d (k, a, b), lam (C, J) -> (C, J, a, b).
+    """
+    c, k, j = beta.shape
+    bias = -torch.log(lam).reshape(c * j, 1)
+    expo = torch.addmm(bias, beta.transpose(1, 2).reshape(c * j, k), d.reshape(k, -1), alpha=-1.0)
+    return expo.exp_().reshape(c, j, *d.shape[1:])
+
+
+def _add_diagonal(mat: Tensor, values: Tensor) -> Tensor:
+    """mat + diag(values) over the last two axes; in place unless autograd is recording (pyro)."""
+    if torch.is_grad_enabled():
+        return mat + torch.diag_embed(values.expand(mat.shape[:-1]))
+    mat.diagonal(dim1=-2, dim2=-1).add_(values)
+    return mat
+
+
+def _gaussian_loglik(chol: Tensor, info: Tensor, resid: Tensor) -> tuple[Tensor, Tensor]:
+    """-sum log diag(chol) - |chol^-1 r|^2 / 2 over the last axes; -inf where info != 0.
+
+    chol (..., k, k), info (...), resid (..., k) -> (loglik (...), chol^-1 r (..., k)).
+    """
+    alpha = torch.linalg.solve_triangular(chol, resid.unsqueeze(-1), upper=False).squeeze(-1)
+    logdet = torch.log(torch.diagonal(chol, dim1=-2, dim2=-1)).sum(-1)
+    ll = -logdet - 0.5 * (alpha**2).sum(-1)
+    bad = (info != 0) | ~torch.isfinite(ll)
+    return torch.where(bad, torch.full_like(ll, -torch.inf), ll), alpha
+
+
+def sim_factor(
+    d_sim: Tensor, w: Tensor, lam_sim: Tensor, betaU: Tensor, lamUz: Tensor, lamWs: Tensor,
+    lamWOs: Tensor,
+) -> tuple[Tensor, Tensor, Tensor]:  # fmt: skip
+    """Sigma_W_j = R_j / lamUz_j + (1/(LamSim_j lamWOs) + 1/lamWs_j) I for components j.
+
+    d_sim (p+q, m, m), w (J, m), lam_sim (J,), betaU (C, p+q, J), lamUz, lamWs (C, J), lamWOs
+    (C, 1). Returns chol (C, J, m, m), alpha = chol^-1 w_j (C, J, m) and the per-component
+    log N(w_j; 0, Sigma_W_j) without constants (C, J), -inf where not positive definite.
+    """
+    sig = scaled_correlation(betaU, d_sim, lamUz)
+    nugget = 1.0 / (lam_sim * lamWOs) + 1.0 / lamWs
+    sig = _add_diagonal(sig, nugget.unsqueeze(-1))
+    chol, info = torch.linalg.cholesky_ex(sig)
+    ll, alpha = _gaussian_loglik(chol, info, w.expand(chol.shape[:-1]))
+    return chol, alpha, ll
+
+
+def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, Tensor]) -> Tensor:
+    """log N(z; [0; S_UW S_W^-1 w], blockdiag(S_V, S_U - S_UW S_W^-1 S_WU) + S_obs / lamOs).
+
+    chol (C, p_u, m, m), alpha (C, p_u, m) from ``sim_factor`` (a leading 1 instead of C: one
+    Sigma_W shared by all chains); prm: theta (C, q), betaU (C, p+q, p_u), lamUz, lamWs (C, p_u),
+    lamOs (C, 1), and betaV (C, p, 1), lamVz (C, 1) when there is a discrepancy. Returns (C,).
+    """
+    p, n = data.p, data.d_obs.shape[-1]
+    betaU, lamUz = prm["betaU"], prm["lamUz"]
+    b_x, b_t = betaU[:, :p], betaU[:, p:]
+    dt = (prm["theta"].unsqueeze(-1) - data.t_sim.T) ** 2  # (C, q, m)
+    expo = torch.einsum("ckj,kab->cjab", b_x, data.d_cross)
+    expo = expo + torch.einsum("ckj,ckm->cjm", b_t, dt).unsqueeze(-2)
+    s_uw = torch.exp(-expo) / lamUz[..., None, None]  # (C, p_u, n, m)
+    c, p_u, _, m = s_uw.shape
+    if chol.shape[0] == 1 and c > 1:  # one Sigma_W for all chains: one solve, C n right sides
+        rhs = s_uw.permute(1, 3, 0, 2).reshape(p_u, m, c * n)
+        a = torch.linalg.solve_triangular(chol[0], rhs, upper=False)
+        a = a.reshape(p_u, m, c, n).permute(2, 0, 1, 3)
+    else:
+        a = torch.linalg.solve_triangular(chol, s_uw.transpose(-1, -2), upper=False)
+    mean_u = (a * alpha.unsqueeze(-1)).sum(-2)  # (C, p_u, n)
+    cond = scaled_correlation(b_x, data.d_obs, lamUz) - a.transpose(-1, -2) @ a
+    cond = _add_diagonal(cond, (1.0 / prm["lamWs"]).unsqueeze(-1))
+    full = data.sig_obs / prm["lamOs"][..., None]  # (C, N, N)
+    mean = torch.zeros_like(full[..., 0])
+    for j, blk in enumerate(data.u_blocks):
+        sl = slice(blk * n, (blk + 1) * n)
+        full[:, sl, sl] += cond[:, j]
+        mean[:, sl] = mean_u[:, j]
+    if data.v_blocks:
+        s_v = scaled_correlation(prm["betaV"], data.d_obs, prm["lamVz"])[:, 0]
+        for blk in data.v_blocks:
+            full[:, blk * n : (blk + 1) * n, blk * n : (blk + 1) * n] += s_v
+    chol_z, info = torch.linalg.cholesky_ex(full)
+    ll, _ = _gaussian_loglik(chol_z, info, data.z - mean)
+    return ll
+
+
+def log_prior_elements(priors: Priors, name: str, x: Tensor) -> Tensor:
+    """GPM/SA log prior of each element of ``x`` (any shape); -inf outside the bounds."""
+    inf = torch.full_like(x, -torch.inf)
+    if name == "theta":
+        val = -0.5 * ((x - priors.theta_mean) / priors.theta_sd) ** 2
+        ok = (x > 0.0) & (x < 1.0)
+    elif name in RHO_PARAMS:
+        rho = torch.clamp(torch.exp(-0.25 * x), max=priors.rho_cap)
+        val = (priors.rho_a - 1.0) * torch.log(rho) + (priors.rho_b - 1.0) * torch.log1p(-rho)
+        ok = (x > 0.0) & torch.isfinite(x)
+    elif name in PRECISION_PARAMS:
+        g = getattr(priors, name)
+        val = (g.a - 1.0) * torch.log(x) - g.b * x
+        ok = (x > g.lower) & (x < g.upper)
+    else:
+        raise GPMSAError(f"unknown parameter name {name!r}")
+    return torch.where(ok, val, inf)
+
+
+def _seed_generator(seed, device) -> torch.Generator:
+    """A torch Generator seeded from ``seed`` (int or None) via numpy's SeedSequence."""
+    if seed is not None and not isinstance(seed, (int, np.integer)):
+        raise GPMSAError(f"seed must be an int or None, got {seed!r}")
+    state = int(np.random.SeedSequence(seed).generate_state(1, dtype=np.uint64)[0])
+    return torch.Generator(device=device).manual_seed(state & (2**63 - 1))
+
+
+class BatchState:
+    """C chains of one problem: parameters, cached Sigma_W factors and the batched sweep."""
+
+    def __init__(self, problem: Problem, n_chains: int, dtype: torch.dtype, device):
+        self.problem = problem
+        self.data = ModelTensors.from_problem(problem, dtype, device)
+        self.priors = problem.priors
+        self.els = elements(problem)
+        self.n_chains = n_chains
+        self.reset({
+            k: torch.as_tensor(v, dtype=dtype, device=device).expand(n_chains, *v.shape).clone()
+            for k, v in problem.init.items()
+        })  # fmt: skip
+        if not torch.isfinite(self.loglik).all():
+            raise GPMSAError("the initial values give a log-likelihood of -inf (Sigma not PD)")
+
+    def reset(self, params: dict[str, Tensor]) -> None:
+        """Set every chain's parameters (name -> (C, *shape)) and recompute all cached terms."""
+        self.params = params
+        d = self.data
+        shared = all(k in self.problem.fixed for k in SIM_PARAMS)  # calibration: one Sigma_W
+        self.chol, self.alpha, self.ll_w = sim_factor(
+            d.d_sim, d.w, d.lam_sim, *(params[k][:1] if shared else params[k] for k in SIM_PARAMS)
+        )
+        if shared:
+            self.ll_w = self.ll_w.expand(self.n_chains, -1).clone()
+        if not d.has_obs:
+            self.chol = self.alpha = None  # not needed by the simulation-only likelihood
+        self.ll_obs = self._obs(params, self.chol, self.alpha)
+
+    @property
+    def loglik(self) -> Tensor:
+        """Current log-likelihood (C,)."""
+        return self.ll_w.sum(-1) + self.ll_obs
+
+    def log_post(self) -> Tensor:
+        """Current log posterior (C,): likelihood + priors of the sampled parameters."""
+        lp = self.loglik
+        for name in self.problem.sampled:
+            x = self.params[name]
+            lp = lp + log_prior_elements(self.priors, name, x).reshape(x.shape[0], -1).sum(-1)
+        return lp
+
+    def _obs(self, prm: dict[str, Tensor], chol: Tensor | None, alpha: Tensor | None) -> Tensor:
+        """Observation term (C',) at ``prm`` given the Sigma_W factors (zeros without obs)."""
+        if not self.data.has_obs:
+            return self.ll_w.new_zeros(prm["betaU"].shape[0])
+        return obs_loglik(self.data, chol, alpha, prm)
+
+    def update(self, name: str, idx: tuple[int, ...], width: float, kind: int, prop_mh: bool,
+               u: Tensor) -> Tensor:  # fmt: skip
+        """One Metropolis step of element ``idx`` of ``name`` in every chain; u (2, C) uniforms.
+
+        Returns the accepted mask (C,).
+        """
+        cur = self.params[name]
+        x = cur[(slice(None), *idx)]
+        step = u[0] - 0.5
+        corr = torch.zeros_like(x)
+        valid = torch.ones_like(x, dtype=torch.bool)
+        if kind == 1:  # beta on the rho scale
+            r = torch.exp(-0.25 * x) + width * step
+            valid = r > 0.0
+            cand = -4.0 * torch.log(torch.where(valid, r, torch.ones_like(r)))
+        elif kind == 2 and prop_mh:  # GPM/SA's untuned proportional step
+            w0 = torch.clamp(x / 3.0, min=1.0)
+            cand = x + w0 * 2.0 * step
+            w1 = torch.clamp(cand / 3.0, min=1.0)
+            valid = ~(x > cand + w1)
+            corr = torch.log(w0 / w1)
+        else:
+            cand = x + width * step
+        lp_new = log_prior_elements(self.priors, name, cand)
+        valid &= torch.isfinite(lp_new)
+        accepted = torch.zeros_like(valid)
+        if not valid.any():
+            return accepted
+        cand = torch.where(valid, cand, x)
+        # Sigma_W proposals: factor only the chains whose candidate is inside the bounds.
+        # Others: every chain (no gathers of the cached factors), invalid ones masked below.
+        rows = torch.nonzero(valid).squeeze(-1) if name in SIM_PARAMS else None
+        sub = (lambda t: t) if rows is None else (lambda t: t[rows])  # noqa: E731
+        prm = {k: sub(v) for k, v in self.params.items()}
+        prm[name] = prm[name].clone()
+        prm[name][(slice(None), *idx)] = sub(cand)
+        d = self.data
+        chol, alpha, ll_w = self.chol, self.alpha, self.ll_w
+        if rows is not None:
+            whole = name == "lamWOs" or d.w.shape[0] == 1
+            comps = slice(None) if whole else slice(idx[-1], idx[-1] + 1)
+            chol_c, alpha_c, ll_c = sim_factor(
+                d.d_sim, d.w[comps], d.lam_sim[comps], prm["betaU"][:, :, comps],
+                prm["lamUz"][:, comps], prm["lamWs"][:, comps], prm["lamWOs"],
+            )  # fmt: skip
+            ll_w, chol, alpha = ll_c, chol_c, alpha_c
+            if not whole:
+                ll_w = self.ll_w[rows]  # advanced indexing copies
+                ll_w[:, comps] = ll_c
+                if d.has_obs:
+                    chol, alpha = self.chol[rows], self.alpha[rows]
+                    chol[:, comps], alpha[:, comps] = chol_c, alpha_c
+        ll_obs = self._obs(prm, chol, alpha)
+        ll_new = ll_w.sum(-1) + ll_obs
+        ratio = (
+            ll_new
+            - sub(self.loglik)
+            + sub(lp_new - log_prior_elements(self.priors, name, x) + corr)
+        )
+        acc = (torch.log(sub(u[1])) < ratio) & sub(valid)
+        take = torch.nonzero(acc).squeeze(-1) if rows is None else rows[acc]
+        accepted[take] = True
+        cur[(take, *idx)] = cand[take]
+        self.ll_obs[take] = ll_obs[acc]
+        if rows is not None:
+            self.ll_w[take] = ll_w[acc]
+            if d.has_obs:
+                self.chol[take] = chol[acc]
+                self.alpha[take] = alpha[acc]
+        return accepted
+
+    def sweep(self, widths: np.ndarray, prop_mh: bool, gen: torch.Generator) -> Tensor:
+        """One Metropolis-within-Gibbs sweep in GPM/SA's order; returns accepted (n_el, C)."""
+        c = self.ll_w.shape[0]
+        u = torch.rand((len(self.els), 2, c), generator=gen, dtype=self.ll_w.dtype,
+                       device=self.ll_w.device)  # fmt: skip
+        out = torch.zeros((len(self.els), c), dtype=torch.bool, device=self.ll_w.device)
+        for i, (name, idx) in enumerate(self.els):
+            kind = 1 if name in RHO_PARAMS else 2 if name in PRECISION_PARAMS else 0
+            out[i] = self.update(name, idx, float(widths[i]), kind, prop_mh, u[i])
+        return out
+
+
+@contextmanager
+def torch_threads(num_threads: int | None):
+    """Set torch's CPU thread count inside the block (None: unchanged); restored afterwards."""
+    previous = torch.get_num_threads()
+    if num_threads is not None:
+        torch.set_num_threads(int(num_threads))
+    try:
+        yield
+    finally:
+        torch.set_num_threads(previous)
+
+
+def _dtype(dtype) -> torch.dtype:
+    if isinstance(dtype, torch.dtype):
+        return dtype
+    if dtype in ("float64", "float32"):
+        return getattr(torch, dtype)
+    raise GPMSAError(f"dtype must be 'float64' or 'float32', got {dtype!r}")
+
+
+def _device(device) -> torch.device:
+    dev = torch.device(device)
+    if dev.type == "cuda" and not torch.cuda.is_available():
+        raise GPMSAError(f"device={device!r} was asked for but torch sees no CUDA device")
+    return dev
+
+
+def sample(
+    problem: Problem,
+    *,
+    n_iter: int,
+    n_chains: int = 1,
+    tune: bool = True,
+    step_widths: dict[str, np.ndarray] | None = None,
+    seed=None,
+    progress: bool = False,
+    tune_rounds: int | None = None,
+    tune_levels: int = tuning.N_LEVELS,
+    device="cpu",
+    dtype="float64",
+    num_threads: int | None = 1,
+) -> Chains:
+    """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
+
+    Tuning (``tune=True``) is GPM/SA's: ``tune_levels`` candidate widths per element, each
+    level swept ``tune_rounds`` times by every chain; the acceptance counts are pooled over the
+    chains, so the default ``tune_rounds`` = ceil(50 / n_chains) gives each level at least
+    GPM/SA's 50 trials per element. All chains start at ``problem.init`` and share the tuned
+    widths. ``step_widths`` replace GPM/SA's initial widths. Draws hold every sweep (no burn-in
+    removed). ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
+    ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
+    busy machine more threads made every small tensor op wait for the thread pool); None keeps
+    torch's setting.
+    """
+    if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
+        raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
+    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
+        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    with torch_threads(num_threads):
+        return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
+                       tune_rounds, tune_levels, device, dtype)  # fmt: skip
+
+
+def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
+            tune_levels, device, dtype) -> Chains:  # fmt: skip
+    """``sample`` without the thread setting."""
+    dev, dt = _device(device), _dtype(dtype)
+    if tune_rounds is None:
+        tune_rounds = math.ceil(tuning.N_BURN / n_chains)
+    if tune_rounds < 1 or tune_levels < 2:
+        raise GPMSAError(
+            f"tune_rounds must be >= 1 and tune_levels >= 2, got {tune_rounds}, {tune_levels}"
+        )
+    widths = default_widths(problem)
+    for name, val in (step_widths or {}).items():
+        widths[name] = np.broadcast_to(np.asarray(val, dtype=np.float64), widths[name].shape)
+    gen = _seed_generator(seed, dev)
+    state = BatchState(problem, int(n_chains), dt, dev)
+    els = state.els
+    w = np.array([float(widths[n][idx]) for n, idx in els])
+    total = n_iter + (tune_rounds * tune_levels if tune else 0)
+    names = problem.names
+    draws = {n: torch.empty((n_iter, n_chains, *problem.init[n].shape), dtype=dt, device=dev)
+             for n in names}  # fmt: skip
+    log_post = torch.empty((n_iter, n_chains), dtype=dt, device=dev)
+    accepted = torch.zeros((len(els), n_chains), dtype=torch.long, device=dev)
+    with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
+        if tune and els:
+            cands = tuning.level_widths([n for n, _ in els], w, tune_levels)
+            acc = torch.zeros((tune_levels, len(els)), dtype=torch.long, device=dev)
+            for _ in range(tune_rounds):
+                for lev in range(tune_levels):
+                    acc[lev] += state.sweep(cands[lev], False, gen).sum(-1)
+                bar.update(tune_levels)
+            w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
+        for it in range(n_iter):
+            accepted += state.sweep(w, not tune, gen)
+            for n in names:
+                draws[n][it] = state.params[n]
+            log_post[it] = state.log_post()
+            bar.update(1)
+    rate = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
+    wid = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
+    acc_np = accepted.cpu().numpy() / n_iter
+    for i, (n, idx) in enumerate(els):
+        rate[n][(slice(None), *idx)] = acc_np[i]
+        wid[n][(slice(None), *idx)] = w[i]
+    return Chains(
+        draws={n: np.moveaxis(v.cpu().numpy(), 0, 1) for n, v in draws.items()},
+        log_post=log_post.cpu().numpy().T,
+        accept_rate=rate,
+        step_widths=wid,
+        info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": tune,
+              "tune_rounds": tune_rounds, "tune_levels": tune_levels, "seed": seed,
+              "backend": "torch", "device": str(dev), "dtype": str(dt).replace("torch.", "")},
+    )  # fmt: skip

@@ -1,0 +1,104 @@
+"""Backend registry, missing packages, lazy imports, seeds and bad options."""
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import gpmsa
+from gpmsa import backends
+from gpmsa.errors import BackendUnavailableError, GPMSAError
+
+
+def _road_calibration_problem():
+    from _backend_cases import road_problem
+
+    prob = road_problem(True).problem
+    fixed = {"betaU": [[0.92], [0.35]], "lamUz": [0.45], "lamWs": [165.0], "lamWOs": [837.0]}
+    return prob.with_init(fixed, fixed=frozenset(fixed))
+
+
+def test_available_lists_all_three_backends():
+    assert set(backends.available()) == {"numpy", "torch", "pyro"}
+
+
+def test_unknown_backend_lists_the_available_ones():
+    with pytest.raises(GPMSAError, match=r"unknown backend 'jax'.*numpy.*torch.*pyro"):
+        backends.get("jax")
+    from _backend_cases import road_data
+
+    sim, _ = road_data()
+    with pytest.raises(GPMSAError, match="unknown backend 'stan'"):
+        gpmsa.fit(sim, n_iter=10, backend="stan")
+
+
+@pytest.mark.parametrize(("name", "package"), [("torch", "torch"), ("pyro", "pyro")])
+def test_missing_packages_name_the_extra(monkeypatch, name, package):
+    for mod in list(sys.modules):
+        if mod.startswith("gpmsa.backends.") and mod != "gpmsa.backends.numpy_backend":
+            monkeypatch.delitem(sys.modules, mod)
+    monkeypatch.setitem(sys.modules, package, None)  # makes `import <package>` fail
+    with pytest.raises(BackendUnavailableError, match=r'pip install "terrain-gpmsa\[torch\]"'):
+        backends.get(name)
+    assert name not in backends.available()
+    assert "numpy" in backends.available()
+
+
+def test_importing_gpmsa_never_imports_torch():
+    code = (
+        "import sys, gpmsa, gpmsa.backends, gpmsa.fitting, gpmsa.calibration;"
+        "gpmsa.backends.get('numpy');"
+        "assert 'torch' not in sys.modules and 'pyro' not in sys.modules, 'torch imported'"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_torch_bad_options_raise():
+    tb = backends.get("torch")
+    prob = _road_calibration_problem()
+    with pytest.raises(GPMSAError, match="dtype must be 'float64' or 'float32', got 'float16'"):
+        tb.sample(prob, n_iter=2, dtype="float16")
+    with pytest.raises(GPMSAError, match="n_chains must be an integer >= 1, got 0"):
+        tb.sample(prob, n_iter=2, n_chains=0)
+    with pytest.raises(GPMSAError, match="tune_rounds must be >= 1 and tune_levels >= 2, got 0"):
+        tb.sample(prob, n_iter=2, tune_rounds=0)
+    with pytest.raises(GPMSAError, match="seed must be an int or None"):
+        tb.sample(prob, n_iter=2, seed="abc")
+    import torch
+
+    if not torch.cuda.is_available():
+        with pytest.raises(GPMSAError, match="device='cuda'.*no CUDA device"):
+            tb.sample(prob, n_iter=2, device="cuda")
+
+
+def test_pyro_rejects_step_widths():
+    pb = backends.get("pyro")
+    with pytest.raises(GPMSAError, match="takes no step_widths"):
+        pb.sample(_road_calibration_problem(), n_iter=2, step_widths={"theta": 0.1})
+
+
+def test_torch_same_seed_same_numbers_and_fixed_params_stay():
+    tb = backends.get("torch")
+    prob = _road_calibration_problem()
+    a = tb.sample(prob, n_iter=30, n_chains=3, seed=11, tune_rounds=1, tune_levels=4)
+    b = tb.sample(prob, n_iter=30, n_chains=3, seed=11, tune_rounds=1, tune_levels=4)
+    c = tb.sample(prob, n_iter=30, n_chains=3, seed=12, tune_rounds=1, tune_levels=4)
+    np.testing.assert_array_equal(a.draws["theta"], b.draws["theta"])
+    assert not np.array_equal(a.draws["theta"], c.draws["theta"])
+    assert a.draws["theta"].shape == (3, 30, 1) and a.log_post.shape == (3, 30)
+    np.testing.assert_array_equal(a.draws["lamUz"], np.full((3, 30, 1), 0.45))
+    assert np.all(np.isnan(a.step_widths["lamUz"])) and np.all(a.step_widths["theta"] > 0)
+    # draws differ between chains (independent random numbers per chain)
+    assert not np.array_equal(a.draws["theta"][0], a.draws["theta"][1])
+
+
+def test_pyro_same_seed_same_numbers():
+    pb = backends.get("pyro")
+    prob = _road_calibration_problem()
+    kw = {"n_iter": 15, "n_warmup": 15, "jit": False}
+    a = pb.sample(prob, seed=3, **kw)
+    b = pb.sample(prob, seed=3, **kw)
+    np.testing.assert_array_equal(a.draws["theta"], b.draws["theta"])
+    np.testing.assert_array_equal(a.draws["lamWs"], np.full((1, 15, 1), 165.0))
+    assert np.all(np.isfinite(a.log_post))
