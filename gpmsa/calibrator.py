@@ -17,6 +17,7 @@ import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 from scipy.special import ndtr
 
+from gpmsa import backends
 from gpmsa.calib_model import GridPredictor, LamOsMarginal, lamos_marginal
 from gpmsa.calib_obs import (
     EMULATOR_PARAM_MODES,
@@ -54,6 +55,9 @@ class Calibrator:
         n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``.
         seed: seed of those draws (and of the MCMC), for reproducibility.
         mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC.
+        backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
+            ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
+            "auto" choose MCMC.
     """
 
     def __init__(
@@ -68,10 +72,17 @@ class Calibrator:
         n_draws: int = 4000,
         seed=None,
         mcmc_options: dict | None = None,
+        backend: str = "numpy",
     ) -> None:
         check_emulator(emulator)
         if method not in METHODS:
             raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
+        backends.get(backend)  # unknown or not installed: a clear error now, not at update()
+        if backend != "numpy" and method == "grid":
+            raise GPMSAError(
+                "method='grid' runs on numpy; use method='mcmc' (or 'auto') with "
+                f"backend={backend!r}"
+            )
         if emulator_params not in EMULATOR_PARAM_MODES:
             raise GPMSAError(
                 f"emulator_params must be one of {EMULATOR_PARAM_MODES}, got {emulator_params!r}"
@@ -80,7 +91,9 @@ class Calibrator:
         if method == "grid" and q > 2:
             raise GPMSAError(f"method='grid' handles 1 or 2 calibration parameters, got q={q}")
         self.emulator = emulator
-        self.method = ("grid" if q <= 2 else "mcmc") if method == "auto" else method
+        grid_ok = q <= 2 and backend == "numpy"
+        self.method = ("grid" if grid_ok else "mcmc") if method == "auto" else method
+        self.backend = backend
         self.q = q
         self.extrapolate = extrapolate
         if not (isinstance(n_draws, int | np.integer) and n_draws >= 1):
@@ -229,6 +242,7 @@ class Calibrator:
             opts.setdefault("seed", seed if seed is not None else auto)
             opts.setdefault("emulator_params", self.emulator_params)
             opts.setdefault("n_emulator_draws", self._n_emulator_draws)
+            opts.setdefault("backend", self.backend)
             return calibrate(
                 self.emulator, x_obs, y_obs, extrapolate=self.extrapolate, log_prior=prior, **opts
             )
