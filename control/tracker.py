@@ -5,9 +5,13 @@ The state is the posterior of the current GD as masses on a grid uniform in log(
 1. predict over the distance ``ds`` travelled since the last step: a Gaussian random walk in
    log(GD) with standard deviation ``drift_per_sqrt_m * sqrt(ds)`` (slow drift of the roughness),
    then a change point with probability ``1 - exp(-ds / mean_segment_m)``, after which GD is
-   redrawn from the prior (uniform on the emulator's domain, the paper's eq. 3);
-2. update: multiply by the new window's likelihood of GD (windows fed to one tracker must not
-   overlap, so that their likelihoods are independent; `control.bcr` sees to that).
+   redrawn from the prior (``TrackerSettings.prior``: uniform on the emulator's domain, the
+   paper's eq. 3, or log-uniform);
+2. update: multiply by the new window's likelihood of GD raised to a power in (0, 1]. Windows that
+   share samples are not independent: the BCR either feeds one tracker only disjoint windows at
+   full power (``method="filter"``), or feeds it every overlapping window with its likelihood
+   tempered by the fraction of samples that are new since the tracker's last update
+   (``method="tempered"``), so each sample's evidence counts about once (`control.bcr`).
 
 ``mean_segment_m = 0`` turns the filter into the paper's one-window estimator: every step starts
 from the prior.
@@ -24,6 +28,8 @@ from scipy.special import logsumexp
 from control.errors import ControlError
 from control.grid_posterior import GridPosterior
 
+PRIORS = ("uniform", "log_uniform")
+
 
 @dataclass(frozen=True)
 class TrackerSettings:
@@ -34,11 +40,15 @@ class TrackerSettings:
             1/mean_segment_m per metre). 0 means no memory: each estimate uses its window only.
         drift_per_sqrt_m: random-walk standard deviation of log(GD) per sqrt(metre).
         n_grid: grid points, uniform in log(GD) over the domain.
+        prior: the prior of GD on the domain, also the law GD is redrawn from at a change point:
+            "uniform" (the paper's eq. 3) or "log_uniform" (uniform in log GD: the scale-invariant
+            prior of a scale parameter).
     """
 
     mean_segment_m: float = 25.0
     drift_per_sqrt_m: float = 0.01
     n_grid: int = 400
+    prior: str = "uniform"
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.mean_segment_m) and self.mean_segment_m >= 0):
@@ -47,6 +57,8 @@ class TrackerSettings:
             raise ControlError(
                 f"drift_per_sqrt_m must be finite and >= 0, got {self.drift_per_sqrt_m}"
             )
+        if self.prior not in PRIORS:
+            raise ControlError(f"prior must be one of {PRIORS}, got {self.prior!r}")
         if self.n_grid < 16:
             raise ControlError(f"n_grid must be >= 16, got {self.n_grid}")
 
@@ -61,8 +73,9 @@ class GDTracker:
         self.settings = settings or TrackerSettings()
         self.log_grid = np.linspace(np.log(lo), np.log(hi), self.settings.n_grid)
         self.grid = np.exp(self.log_grid)
-        # Uniform prior on GD: mass of a log-grid cell is proportional to GD.
-        self.log_prior = np.log(self.grid) - logsumexp(np.log(self.grid))
+        # Uniform prior on GD: mass of a log-grid cell is proportional to GD; log-uniform: equal.
+        log_density = self.log_grid if self.settings.prior == "uniform" else 0.0 * self.log_grid
+        self.log_prior = log_density - logsumexp(log_density)
         self.reset()
 
     def reset(self) -> None:
@@ -86,20 +99,24 @@ class GDTracker:
         mass = (1 - hazard) * mass + hazard * np.exp(self.log_prior)
         self.log_mass = np.log(np.maximum(mass, 1e-300))
 
-    def update(self, grid: np.ndarray, loglik: np.ndarray) -> None:
+    def update(self, grid: np.ndarray, loglik: np.ndarray, power: float = 1.0) -> None:
         """Multiply in a likelihood given on any sorted grid of native GD (interpolated in log GD).
 
         Args:
             grid: (k,) sorted GD values where loglik is known (e.g. the Calibrator's grid).
             loglik: (k,) log-likelihood values (any additive constant).
+            power: tempering exponent in (0, 1]: the likelihood enters as likelihood**power
+                (the fraction of the window's samples that are new to this tracker).
         """
+        if not 0 < power <= 1:
+            raise ControlError(f"power must lie in (0, 1], got {power}")
         grid = np.asarray(grid, dtype=float)
         loglik = np.asarray(loglik, dtype=float)
         if grid.ndim != 1 or grid.shape != loglik.shape or grid.size < 2:
             raise ControlError(f"grid/loglik must be 1-D of equal length, got {grid.shape}")
         if not np.all(np.isfinite(loglik)):
             raise ControlError("loglik must be finite")
-        ll = np.interp(self.log_grid, np.log(grid), loglik - loglik.max())
+        ll = power * np.interp(self.log_grid, np.log(grid), loglik - loglik.max())
         log_mass = self.log_mass + ll
         self.log_mass = log_mass - logsumexp(log_mass)
 

@@ -72,7 +72,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out", help="folder for metrics.json and the figures")
     parser.add_argument("--runs", type=int, default=3)
-    parser.add_argument("--method", default="filter", choices=["filter", "window"])
+    parser.add_argument("--method", default="filter", choices=list(control.bcr.METHODS))
     parser.add_argument("--risk", type=float, default=None, help="alpha of the risk posture")
     parser.add_argument("--law", default="linear", choices=["linear", "paper", "switch"])
     args = parser.parse_args(argv)

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import FakeCalibrator, stream
+from conftest import FakeCalibrator, log_f, stream
 
 from control import BCR, ControlError
 
@@ -31,7 +31,7 @@ def test_no_number_until_the_buffer_is_full(fake_calibrator):
 
 
 def test_estimates_cover_the_truth_and_filtering_beats_one_window():
-    errors = {"filter": [], "window": []}
+    errors = {"filter": [], "tempered": [], "window": []}
     inside = 0
     for seed in range(4):
         t, p, a, v = stream(const(420), 1.2, 120, seed=seed)
@@ -46,6 +46,7 @@ def test_estimates_cover_the_truth_and_filtering_beats_one_window():
                 inside += sum(e.interval[0] <= 420 <= e.interval[1] for e in ests[::8])
     rmse = {k: np.sqrt(np.mean(np.square(e))) for k, e in errors.items()}
     assert rmse["filter"] < 0.7 * rmse["window"]
+    assert rmse["tempered"] < 0.7 * rmse["window"]
     n_checked = 4 * len(range(0, 105, 8))
     assert inside >= 0.75 * n_checked  # a 90% interval: allow for the few windows checked
 
@@ -54,7 +55,7 @@ def test_filter_follows_a_step_as_fast_as_one_window():
     gd = lambda s: np.where(s < 60, 300.0, 500.0)  # noqa: E731
     t, p, a, v = stream(gd, 1.5, 100, seed=3)
     res = {}
-    for method in ("filter", "window"):
+    for method in ("filter", "tempered", "window"):
         ests = [
             e
             for e in feed(BCR(FakeCalibrator(), feature="log_var", method=method), t, p, a, v)
@@ -64,6 +65,8 @@ def test_filter_follows_a_step_as_fast_as_one_window():
         mean = np.array([e.gd_mean for e in ests])
         res[method] = pos[np.argmax((pos > 60) & (mean > 400))] - 60
     assert res["filter"] <= res["window"] + 2.0  # within about one update (1.6 m)
+    # the tempered filter weighs the windows straddling the step: later, but within a window
+    assert res["window"] < res["tempered"] < res["window"] + 12.5
     assert res["window"] < 12.5  # less than one window length at 1.5 m/s
 
 
@@ -112,11 +115,13 @@ def test_calibrator_errors_become_a_status():
     assert ests[-1].status == "calibration_failed" and "outside" in ests[-1].reason
 
 
-def test_windows_in_one_filter_do_not_overlap(fake_calibrator):
-    bcr = BCR(fake_calibrator, feature="log_var", buffer=1000, update_every=125)
+def test_windows_in_one_interleaved_filter_do_not_overlap(fake_calibrator):
+    kw = {"feature": "log_var", "method": "filter"}
+    bcr = BCR(fake_calibrator, buffer=1000, update_every=125, **kw)
     assert len(bcr.trackers) == 8
-    bcr3 = BCR(FakeCalibrator(), feature="log_var", buffer=1000, update_every=300)
+    bcr3 = BCR(FakeCalibrator(), buffer=1000, update_every=300, **kw)
     assert len(bcr3.trackers) == 4  # windows 1,200 samples apart
+    assert len(BCR(FakeCalibrator(), feature="log_var", method="tempered").trackers) == 1
     assert len(BCR(FakeCalibrator(), feature="log_var", method="window").trackers) == 1
 
 
@@ -132,3 +137,94 @@ def test_bad_input_raises(fake_calibrator):
         bcr.update(np.arange(3.0), np.arange(3.0), np.arange(2.0), np.ones(3))
     with pytest.raises(ControlError, match="t and position must be finite"):
         bcr.update(np.array([0.0, np.nan]), np.zeros(2), np.zeros(2), np.ones(2))
+
+
+def square_wave(duration_s, speed=1.5, gd=400.0, rate_hz=120.0):
+    """Accelerations +-a (f = a^2 as for GD `gd`): every window has the same f and likelihood."""
+    amp = np.exp(0.5 * log_f(speed, gd))
+    n = int(round(duration_s * rate_hz))
+    t = np.arange(1, n + 1) / rate_hz
+    return t, speed * t, amp * np.where(np.arange(n) % 2, 1.0, -1.0), np.full(n, speed)
+
+
+def rigid_tracker():
+    from control import TrackerSettings
+
+    return TrackerSettings(mean_segment_m=1e9, drift_per_sqrt_m=0.0)
+
+
+def test_tempered_updates_count_each_sample_once(fake_calibrator):
+    """With nothing changing, 1,000 new samples in 8 tempered updates weigh one full window."""
+    from control import GDTracker
+
+    t, p, a, v = square_wave(8000 / 120)  # 8 windows' worth: 57 updates with an estimate
+    ests = [
+        e
+        for e in feed(
+            BCR(FakeCalibrator(), feature="log_var", method="tempered", tracker=rigid_tracker()),
+            t,
+            p,
+            a,
+            v,
+        )
+        if e.ok
+    ]
+    one = [
+        e
+        for e in feed(BCR(FakeCalibrator(), feature="log_var", method="window"), t, p, a, v)
+        if e.ok
+    ]
+    assert ests[0].gd_sd == pytest.approx(one[0].gd_sd, rel=1e-9)  # the first window: power 1
+    grid, loglik = fake_calibrator.log_likelihood_grid([[1.5]], [[ests[0].feature]])
+    for k_windows in (2, 4, 8):
+        ref = GDTracker((200.0, 600.0), rigid_tracker())
+        for _ in range(k_windows):
+            ref.update(grid, loglik)
+        est = ests[8 * (k_windows - 1)]  # 1,000 (k - 1) samples after the first window
+        assert est.gd_sd == pytest.approx(ref.posterior().sd(), rel=1e-6)
+        assert est.gd_mean == pytest.approx(ref.posterior().mean(), rel=1e-9)
+    # Double counting (power 1 for every overlapping window) would shrink the sd by sqrt(8).
+    assert ests[8].gd_sd > 0.9 * one[0].gd_sd / np.sqrt(2)
+
+
+def test_a_restarted_buffer_enters_at_full_power(fake_calibrator, monkeypatch):
+    bcr = BCR(fake_calibrator, feature="log_var", method="tempered")
+    powers = []
+    update = bcr.trackers[0].update
+    monkeypatch.setattr(
+        bcr.trackers[0],
+        "update",
+        lambda g, ll, power=1.0: (powers.append(power), update(g, ll, power)),
+    )
+    t, p, a, v = stream(const(400), 1.5, 30, seed=4)
+    a = a.copy()
+    a[2000:2005] = np.nan
+    feed(bcr, t, p, a, v)
+    # first window, 7 tempered updates, (fault), refilled window, tempered updates
+    n_before = 2000 // 125 - 7
+    assert powers[0] == 1.0 and set(powers[1:n_before]) == {0.125}
+    assert powers[n_before] == pytest.approx(1.0, abs=0.01)
+    assert set(powers[n_before + 1 :]) == {0.125}
+
+
+def test_the_speed_domain_edge_is_inside():
+    cal = FakeCalibrator()
+    cal.emulator.domain["v"] = (0.5, float(np.nextafter(2.0, 0.0)))  # 1.9999999999999998
+    ests = feed(BCR(cal, feature="log_var"), *stream(const(400), 2.0, 10, seed=1))
+    assert ests[-1].ok and ests[-1].speed == 2.0
+    ests = feed(BCR(cal, feature="log_var"), *stream(const(400), 2.001, 10, seed=1))
+    assert ests[-1].status == "out_of_domain"
+
+
+def test_the_window_method_keeps_the_prior_setting(fake_calibrator):
+    from control import TrackerSettings
+
+    bcr = BCR(
+        fake_calibrator,
+        feature="log_var",
+        method="window",
+        tracker=TrackerSettings(prior="log_uniform", n_grid=200),
+    )
+    (tracker,) = bcr.trackers
+    assert tracker.settings.mean_segment_m == 0.0
+    assert (tracker.settings.prior, tracker.settings.n_grid) == ("log_uniform", 200)

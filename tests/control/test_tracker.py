@@ -52,6 +52,39 @@ def test_change_point_lets_the_estimate_follow_a_jump():
     assert rigid.posterior().mean() < 340
 
 
+def test_tempered_updates_add_up_to_one_full_update():
+    """k updates at power 1/k give exactly the posterior of one update at power 1."""
+    rigid = TrackerSettings(mean_segment_m=1e9, drift_per_sqrt_m=0.0)
+    full, tempered = GDTracker((200, 600), rigid), GDTracker((200, 600), rigid)
+    full.update(GRID, gauss_loglik(350, 25))
+    for _ in range(8):
+        tempered.update(GRID, gauss_loglik(350, 25), power=0.125)
+    np.testing.assert_allclose(np.exp(tempered.log_mass), np.exp(full.log_mass), atol=1e-12)
+    # a tempered update is wider than a full one: sd grows by sqrt(1 / power)
+    weak = GDTracker((200, 600), rigid)
+    weak.update(GRID, gauss_loglik(400, 20), power=0.25)
+    assert weak.posterior().sd() == pytest.approx(40, rel=0.02)
+    with pytest.raises(ControlError, match="power must lie in"):
+        weak.update(GRID, gauss_loglik(400, 20), power=0.0)
+
+
+def test_log_uniform_prior_removes_the_upward_tilt():
+    """A likelihood Gaussian in log GD: log-uniform prior -> posterior median at its centre."""
+    log_grid = np.linspace(np.log(200), np.log(600), 2001)
+    loglik = -0.5 * ((log_grid - np.log(300)) / 0.15) ** 2
+    medians = {}
+    for prior in ("uniform", "log_uniform"):
+        tr = GDTracker((200, 600), TrackerSettings(prior=prior))
+        assert np.exp(tr.log_prior).sum() == pytest.approx(1.0)
+        tr.update(np.exp(log_grid), loglik)
+        medians[prior] = tr.posterior().quantile(0.5)
+    assert medians["log_uniform"] == pytest.approx(300, rel=0.01)
+    # uniform in GD = density proportional to GD in log GD: the median moves up by ~sigma^2
+    assert medians["uniform"] == pytest.approx(300 * np.exp(0.15**2), rel=0.01)
+    with pytest.raises(ControlError, match="prior must be one of"):
+        TrackerSettings(prior="jeffreys")
+
+
 def test_prediction_keeps_the_mass():
     tr = GDTracker((200, 600))
     tr.update(GRID, gauss_loglik(590, 5))  # near the upper bound: reflection keeps the mass
