@@ -117,3 +117,22 @@ def test_calibrated_prediction_quantiles_and_noise():
         calibrated_predict(emu, post, [[5.0]])
     with pytest.raises(GPMSAError, match="n_theta must be an integer >= 1"):
         calibrated_predict(emu, post, [[1.5]], n_theta=0)
+
+
+def test_cli_output_piped_into_a_closed_reader_exits_cleanly(tmp_path):
+    """`gpmsa info FILE | head -1`: the reader leaves early; no traceback, exit status 0."""
+    import subprocess
+    import sys
+
+    path = tmp_path / "road.gpmsa"
+    road_emulator().save(path)
+    code = "import sys; from gpmsa.cli import main; sys.exit(main(sys.argv[1:]))"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code, "info", str(path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()  # nobody reads: the first write raises BrokenPipeError
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 0, err
+    assert "Traceback" not in err
