@@ -15,7 +15,6 @@ from control.compat import bcr_settings_for, check_emulator
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError
 from control.estimate import STATUSES, Estimate
 from control.feature import window_feature
-from control.grid_posterior import GridPosterior
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
 from control.shipped import shipped_emulator, shipped_emulator_path
 from control.simplex import Command, Simplex
@@ -33,7 +32,6 @@ __all__ = [
     "Estimate",
     "GDError",
     "GDTracker",
-    "GridPosterior",
     "LoopMetrics",
     "SensorFault",
     "Simplex",

@@ -112,6 +112,7 @@ class BCR:
         )
         self.calibrator = calibrator
         self.speed_range, self.gd_range = emulator_domain(calibrator)
+        self.gd_name = calibrator.emulator.t_names[0]
         tracker = self.settings.tracker
         n_chains = 1
         if self.settings.method == "filter":
@@ -265,14 +266,15 @@ class BCR:
         tracker.update(np.ravel(grid), np.ravel(loglik), power=power)
         self._fresh = 0
         self._tracked_at[chain] = pos_now
-        post = tracker.posterior()
+        name = self.gd_name
+        post = tracker.posterior(name)
         return Estimate(
             t_now,
             pos_now,
             "ok",
-            gd_mean=post.mean(),
-            gd_sd=post.sd(),
-            interval=post.interval(s.interval_level),
+            gd_mean=post.mean(name),
+            gd_sd=post.sd(name),
+            interval=post.interval(name, s.interval_level),
             posterior=post,
             latency_s=_time.perf_counter() - tic,
             speed=v,

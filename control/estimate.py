@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.grid_posterior import GridPosterior
+from gpmsa import Posterior
 
 #: Status values. Only "ok" carries numbers; every other status says why there is no estimate.
 STATUSES = ("ok", "filling", "out_of_domain", "sensor_fault", "calibration_failed", "stale")
@@ -37,7 +37,7 @@ class Estimate:
     gd_mean: float = np.nan
     gd_sd: float = np.nan
     interval: tuple[float, float] = (np.nan, np.nan)
-    posterior: GridPosterior | None = None
+    posterior: Posterior | None = None
     latency_s: float = 0.0
     speed: float = np.nan
     feature: float = np.nan
@@ -49,4 +49,12 @@ class Estimate:
 
     def prob_above(self, value: float) -> float:
         """P(GD > value); NaN unless ok."""
-        return self.posterior.prob_above(value) if self.posterior is not None else np.nan
+        if self.posterior is None:
+            return np.nan
+        return self.posterior.prob_above(self.posterior.names[0], value)
+
+    def quantile(self, q: float) -> float:
+        """The GD quantile at probability q; NaN unless ok."""
+        if self.posterior is None:
+            return np.nan
+        return float(self.posterior.quantile(self.posterior.names[0], q))

@@ -116,7 +116,7 @@ class Simplex:
         if self.risk is None:
             gd = estimate.gd_mean
         elif estimate.posterior is not None:
-            gd = float(estimate.posterior.quantile(1 - self.risk))
+            gd = estimate.quantile(1 - self.risk)
         else:
             return Command(self.v_safe, "safety", np.nan, "risk posture needs the posterior")
         if gd > self.gd_max:

@@ -26,7 +26,7 @@ from scipy.ndimage import gaussian_filter1d
 from scipy.special import logsumexp
 
 from control.errors import ControlError
-from control.grid_posterior import GridPosterior
+from gpmsa.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("uniform", "log_uniform")
 
@@ -120,6 +120,17 @@ class GDTracker:
         log_mass = self.log_mass + ll
         self.log_mass = log_mass - logsumexp(log_mass)
 
-    def posterior(self) -> GridPosterior:
-        """The current posterior of GD."""
-        return GridPosterior(self.grid, np.exp(self.log_mass - self.log_mass.max()))
+    def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
+        """The current posterior of GD as a gpmsa Posterior holding the exact grid marginal.
+
+        The node masses become a density through the grid's trapezoid weights, so the mean and
+        sd are the mass-weighted sums; ``samples`` (for histograms) are ``n_draws`` inverse-CDF
+        draws with a fixed seed, made only when read.
+        """
+        w = trapezoid_weights(self.grid)
+        marginal = GridMarginal.from_log_density(self.grid, self.log_mass - np.log(w), w)
+        return Posterior(
+            grids={name: marginal},
+            draw=lambda: {name: marginal.sample(np.random.default_rng(0), n_draws)},
+            info={"method": "filter", "names": (name,)},
+        )

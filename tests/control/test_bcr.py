@@ -181,8 +181,8 @@ def test_tempered_updates_count_each_sample_once(fake_calibrator):
         for _ in range(k_windows):
             ref.update(grid, loglik)
         est = ests[8 * (k_windows - 1)]  # 1,000 (k - 1) samples after the first window
-        assert est.gd_sd == pytest.approx(ref.posterior().sd(), rel=1e-6)
-        assert est.gd_mean == pytest.approx(ref.posterior().mean(), rel=1e-9)
+        assert est.gd_sd == pytest.approx(ref.posterior().sd("GD"), rel=1e-6)
+        assert est.gd_mean == pytest.approx(ref.posterior().mean("GD"), rel=1e-9)
     # Double counting (power 1 for every overlapping window) would shrink the sd by sqrt(8).
     assert ests[8].gd_sd > 0.9 * one[0].gd_sd / np.sqrt(2)
 

@@ -6,19 +6,22 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy import stats
 
-from control import ControlError, Estimate, GridPosterior, Simplex
+from control import ControlError, Estimate, Simplex
+from gpmsa import Posterior
+from gpmsa.posterior import GridMarginal
 
 
 def gaussian_estimate(mean: float, sd: float) -> Estimate:
     grid = np.linspace(200, 600, 801)
-    post = GridPosterior(grid, stats.norm.pdf(grid, mean, sd))
+    marginal = GridMarginal.from_log_density(grid, stats.norm.logpdf(grid, mean, sd))
+    post = Posterior(grids={"GD": marginal}, draw=lambda: {}, info={"names": ("GD",)})
     return Estimate(
         time=10.0,
         position=20.0,
         status="ok",
-        gd_mean=post.mean(),
-        gd_sd=post.sd(),
-        interval=post.interval(0.9),
+        gd_mean=post.mean("GD"),
+        gd_sd=post.sd("GD"),
+        interval=post.interval("GD", 0.9),
         posterior=post,
     )
 

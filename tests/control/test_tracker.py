@@ -19,8 +19,8 @@ def test_memoryless_tracker_returns_the_one_window_posterior():
         tr.update(GRID, gauss_loglik(center, 20))
         post = tr.posterior()
         # Uniform prior on GD times a Gaussian likelihood far from the bounds: that Gaussian.
-        assert post.mean() == pytest.approx(center, abs=0.5)
-        assert post.sd() == pytest.approx(20, rel=0.02)
+        assert post.mean("GD") == pytest.approx(center, abs=0.5)
+        assert post.sd("GD") == pytest.approx(20, rel=0.02)
 
 
 def test_consistent_windows_sharpen_the_posterior():
@@ -28,7 +28,7 @@ def test_consistent_windows_sharpen_the_posterior():
     for _ in range(9):
         tr.predict(10.0)
         tr.update(GRID, gauss_loglik(400, 30))
-    assert tr.posterior().sd() == pytest.approx(10, rel=0.05)  # 30 / sqrt(9)
+    assert tr.posterior().sd("GD") == pytest.approx(10, rel=0.05)  # 30 / sqrt(9)
 
 
 def test_change_point_lets_the_estimate_follow_a_jump():
@@ -36,12 +36,12 @@ def test_change_point_lets_the_estimate_follow_a_jump():
     for _ in range(6):
         tr.predict(12.0)
         tr.update(GRID, gauss_loglik(300, 40))
-    assert tr.posterior().mean() == pytest.approx(300, abs=15)
+    assert tr.posterior().mean("GD") == pytest.approx(300, abs=15)
     means = []
     for _ in range(3):
         tr.predict(12.0)
         tr.update(GRID, gauss_loglik(500, 40))
-        means.append(tr.posterior().mean())
+        means.append(tr.posterior().mean("GD"))
     assert means[0] > 400  # one window at the new roughness moves it most of the way
     assert means[-1] == pytest.approx(500, abs=20)
     # Without change points (and no drift) the old evidence holds it back.
@@ -49,7 +49,7 @@ def test_change_point_lets_the_estimate_follow_a_jump():
     for center in [300] * 6 + [500]:
         rigid.predict(12.0)
         rigid.update(GRID, gauss_loglik(center, 40))
-    assert rigid.posterior().mean() < 340
+    assert rigid.posterior().mean("GD") < 340
 
 
 def test_tempered_updates_add_up_to_one_full_update():
@@ -63,7 +63,7 @@ def test_tempered_updates_add_up_to_one_full_update():
     # a tempered update is wider than a full one: sd grows by sqrt(1 / power)
     weak = GDTracker((200, 600), rigid)
     weak.update(GRID, gauss_loglik(400, 20), power=0.25)
-    assert weak.posterior().sd() == pytest.approx(40, rel=0.02)
+    assert weak.posterior().sd("GD") == pytest.approx(40, rel=0.02)
     with pytest.raises(ControlError, match="power must lie in"):
         weak.update(GRID, gauss_loglik(400, 20), power=0.0)
 
@@ -77,7 +77,7 @@ def test_log_uniform_prior_removes_the_upward_tilt():
         tr = GDTracker((200, 600), TrackerSettings(prior=prior))
         assert np.exp(tr.log_prior).sum() == pytest.approx(1.0)
         tr.update(np.exp(log_grid), loglik)
-        medians[prior] = tr.posterior().quantile(0.5)
+        medians[prior] = tr.posterior().quantile("GD", 0.5)
     assert medians["log_uniform"] == pytest.approx(300, rel=0.01)
     # uniform in GD = density proportional to GD in log GD: the median moves up by ~sigma^2
     assert medians["uniform"] == pytest.approx(300 * np.exp(0.15**2), rel=0.01)
