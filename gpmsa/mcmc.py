@@ -223,7 +223,13 @@ def sample(
     tune_rounds: int = tuning.N_BURN,
     tune_levels: int = tuning.N_LEVELS,
 ) -> Chains:
-    """Run ``n_chains`` independent chains (sequentially) of ``n_iter`` sweeps after tuning."""
+    """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
+
+    The numpy backend's ``sample``. ``tune_rounds`` x ``tune_levels`` tuning sweeps (default
+    50 x 20 = 1,000) precede the draws; ``step_widths`` (name -> widths) replace GPM/SA's initial
+    widths. Draws hold every sweep (no burn-in removed). The ``n_chains`` independent chains run
+    one after another, each from ``problem.init``.
+    """
     widths = default_widths(problem)
     if step_widths:
         for name, val in step_widths.items():
