@@ -14,11 +14,9 @@ from gpmsa.errors import GPMSAError
 from gpmsa.gp import correlation
 from gpmsa.likelihood import lower_cholesky
 from gpmsa.priors import Priors
-from gpmsa.transforms import Standardizer
+from gpmsa.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
-DOMAIN_MARGIN = 0.1
-"""predict() warns outside the training domain and refuses beyond this margin (unit scale)."""
 
 
 @dataclass(frozen=True)
@@ -223,14 +221,14 @@ class Emulator:
         z = np.hstack([self.standardizer.x_to_unit(x), self.standardizer.t_to_unit(t)])
         names = self.x_names + self.t_names
         lo, hi = z.min(axis=0), z.max(axis=0)
-        far = (lo < -DOMAIN_MARGIN) | (hi > 1 + DOMAIN_MARGIN)
+        far = (lo < -EXTRAPOLATION_MARGIN) | (hi > 1 + EXTRAPOLATION_MARGIN)
         if far.any():
             k = int(np.flatnonzero(far)[0])
             col = np.hstack([x, t])[:, k]
             a, b = self.domain[names[k]]
             raise GPMSAError(
                 f"{names[k]} reaches [{col.min():.6g}, {col.max():.6g}], outside the emulator's "
-                f"domain [{a:.6g}, {b:.6g}] by more than {DOMAIN_MARGIN:.0%} of its width"
+                f"domain [{a:.6g}, {b:.6g}] by more than {EXTRAPOLATION_MARGIN:.0%} of its width"
             )
         if (lo < 0).any() or (hi > 1).any():
             warnings.warn("predict() extrapolates beyond the training domain", stacklevel=3)

@@ -12,14 +12,10 @@ from gpmsa.basis import basis_weights, discrepancy_basis, interpolate_basis, pca
 from gpmsa.data import ObsData, SimData
 from gpmsa.errors import GPMSAError
 from gpmsa.priors import Priors
-from gpmsa.transforms import Standardizer
+from gpmsa.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
 ORDER = ("theta", "betaV", "betaU", "lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
 """GPM/SA's sweep order; absent or fixed parameters are skipped."""
-
-X_OBS_MARGIN = 0.1
-"""Observations may lie this far (unit scale) outside the design's x range (warning); beyond it
-they are refused."""
 
 GLS_RIDGE = 1e-6
 SIGOBS_RIDGE = 1e-8
@@ -152,15 +148,16 @@ def default_init(p: int, q: int, p_u: int, priors: Priors, obs: ObsProblem | Non
 
 
 def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
-    """Warn when observations lie outside the design range; refuse beyond ``X_OBS_MARGIN``."""
+    """Warn when observations lie outside the design range; refuse beyond
+    ``EXTRAPOLATION_MARGIN``."""
     lo, hi = x_unit.min(axis=0), x_unit.max(axis=0)
-    far = (lo < -X_OBS_MARGIN) | (hi > 1 + X_OBS_MARGIN)
+    far = (lo < -EXTRAPOLATION_MARGIN) | (hi > 1 + EXTRAPOLATION_MARGIN)
     if far.any():
         k = int(np.flatnonzero(far)[0])
         raise GPMSAError(
             f"x_obs column {names[k]} reaches {lo[k]:.3g}..{hi[k]:.3g} on the unit scale of the "
-            f"design; allowed [{-X_OBS_MARGIN}, {1 + X_OBS_MARGIN}] (the emulator cannot "
-            "extrapolate that far)"
+            f"design; allowed [{-EXTRAPOLATION_MARGIN}, {1 + EXTRAPOLATION_MARGIN}] (the emulator "
+            "cannot extrapolate that far)"
         )
     if (lo < 0).any() or (hi > 1).any():
         warnings.warn(

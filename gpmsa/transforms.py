@@ -15,6 +15,11 @@ design stretched onto [0.5, 2.0] may store 1.9999999999999998): they are snapped
 that an input at the domain's end never reads as outside it."""
 
 
+EXTRAPOLATION_MARGIN = 0.1
+"""How far (unit scale) inputs may lie outside the design's range, for predictions and
+observations alike: outside the range a warning, beyond the margin a refusal."""
+
+
 def _snap_to_unit(u: np.ndarray) -> np.ndarray:
     """``u`` with values within ``UNIT_TOL`` below 0 or above 1 moved onto the edge."""
     u = np.where((u < 0.0) & (u > -UNIT_TOL), 0.0, u)
