@@ -242,8 +242,9 @@ class BCR:
         tic = _time.perf_counter()
         v = float(np.mean(self._spd))
         lo, hi = self.speed_range
-        tol = 1e-9 * (hi - lo)  # the domain's ends are floats: 2.0 must not fall outside 2.0
-        if not lo - tol <= v <= hi + tol:
+        # the emulator's own rule (it snaps float rounding at the ends onto the domain)
+        unit = float(self.calibrator.emulator.standardizer.x_to_unit([[v]])[0, 0])
+        if not 0.0 <= unit <= 1.0:
             return Estimate(
                 t_now,
                 pos_now,

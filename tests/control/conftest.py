@@ -5,6 +5,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from gpmsa.transforms import Standardizer
+
 C = 0.05  # f = C * GD * v**1.3 (m/s^2)^2, a made-up but realistic-looking law
 SIGMA = 0.06  # spread of log f for one 1,000-sample window of white noise (sqrt(2/1000) ~ 0.045)
 
@@ -16,9 +18,18 @@ def log_f(v, gd):
 class FakeCalibrator:
     """Gaussian likelihood of y = log f on a grid: the part of gpmsa.Calibrator the BCR uses."""
 
-    def __init__(self, metadata=None):
+    def __init__(self, metadata=None, v_range=(0.5, 2.0)):
         self.emulator = SimpleNamespace(
-            domain={"v": (0.5, 2.0), "GD": (200.0, 600.0)},
+            domain={"v": tuple(v_range), "GD": (200.0, 600.0)},
+            standardizer=Standardizer(
+                x_min=np.array([v_range[0]]),
+                x_max=np.array([v_range[1]]),
+                t_min=np.array([200.0]),
+                t_max=np.array([600.0]),
+                y_mean=np.zeros(1),
+                y_sd=1.0,
+                grid=np.zeros(1),
+            ),
             x_names=["v"],
             t_names=["GD"],
             metadata=metadata or {},

@@ -208,8 +208,7 @@ def test_a_restarted_buffer_enters_at_full_power(fake_calibrator, monkeypatch):
 
 
 def test_the_speed_domain_edge_is_inside():
-    cal = FakeCalibrator()
-    cal.emulator.domain["v"] = (0.5, float(np.nextafter(2.0, 0.0)))  # 1.9999999999999998
+    cal = FakeCalibrator(v_range=(0.5, float(np.nextafter(2.0, 0.0))))  # 1.9999999999999998
     ests = feed(BCR(cal, feature="log_var"), *stream(const(400), 2.0, 10, seed=1))
     assert ests[-1].ok and ests[-1].speed == 2.0
     ests = feed(BCR(cal, feature="log_var"), *stream(const(400), 2.001, 10, seed=1))
