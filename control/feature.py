@@ -27,12 +27,22 @@ def window_feature(accel: np.ndarray, feature: str = "log_var") -> float:
     Returns:
         y; NaN for "log_var" of a window with zero variance.
     """
-    if feature not in FEATURES:
-        raise ControlError(f"feature must be one of {FEATURES}, got {feature!r}")
     accel = np.asarray(accel, dtype=float)
     if accel.ndim != 1 or accel.size < 2:
         raise ControlError(f"accel must be 1-D with >= 2 samples, got shape {accel.shape}")
-    f = float(np.var(accel))  # normalised by T, as the paper's eq. 5
-    if feature == "log_var":
-        return float(np.log(f)) if f > 0 else np.nan
-    return f
+    return float(feature_of_variance(np.var(accel), feature))  # var: normalised by T (eq. 5)
+
+
+def feature_of_variance(f: np.ndarray | float, feature: str = "log_var") -> np.ndarray | float:
+    """The observation y of windows whose variance (normalised by T) is ``f``, (m/s^2)^2.
+
+    The one map from f to y, shared by the BCR (``window_feature``) and emulator training, so
+    that both see the same quantity. "log_var" of f <= 0 is NaN.
+    """
+    if feature not in FEATURES:
+        raise ControlError(f"feature must be one of {FEATURES}, got {feature!r}")
+    f = np.asarray(f, dtype=float)
+    if feature == "var":
+        return f[()]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(f > 0, np.log(np.where(f > 0, f, 1.0)), np.nan)[()]

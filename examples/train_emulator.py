@@ -31,11 +31,13 @@ import numpy as np  # noqa: E402
 
 import gpmsa  # noqa: E402
 import vehicle  # noqa: E402
+from control.feature import feature_of_variance  # noqa: E402
 from control.plotting import plot_design  # noqa: E402
 from control.shipped import CASES, EMULATOR_DIR  # noqa: E402
 
 V_RANGE = (0.5, 2.0)
 GD_RANGE = (200.0, 600.0)
+FEATURE = "log_var"  # y = log f (control.feature)
 WINDOW = 1000
 RATE_HZ = 120.0
 ROAD_LENGTH_M = 21.0
@@ -59,7 +61,7 @@ def metadata(case: str, model, campaign, seed: int, n_iter: int, gd_range) -> di
         "vehicle": model.describe(),
         "noise_std": NOISE_STD[case],
         "feature": {
-            "name": "log_var",
+            "name": FEATURE,
             "window_samples": WINDOW,
             "rate_hz": RATE_HZ,
             "span": "last window_samples samples of each drive (ending at the road's end)",
@@ -123,7 +125,7 @@ def main(argv: list[str] | None = None) -> None:
         data = gpmsa.SimData(
             x=campaign.v[ok, None],
             t=campaign.gd[ok, None],
-            y=np.log(f[ok])[:, None],  # control.feature.window_feature(..., "log_var")
+            y=feature_of_variance(f[ok], FEATURE)[:, None],
             x_names=["v"],
             t_names=["GD"],
             y_names=["log_f"],

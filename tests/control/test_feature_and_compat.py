@@ -92,3 +92,14 @@ def test_plots_return_figures_with_one_line_per_run():
     assert isinstance(plot_design(np.array([1.0, 2.0]), np.array([300.0, 400.0])), Figure)
     cells = [(v, gd, np.full(10, gd)) for v in (1.0, 2.0) for gd in (300.0, 500.0)]
     assert len(plot_posterior_grid(cells).axes) == 4
+
+
+def test_training_and_the_bcr_map_a_variance_to_the_same_observation():
+    from control.feature import feature_of_variance, window_feature
+
+    accel = np.random.default_rng(4).standard_normal(1000) * 3.0
+    f = np.var(accel)
+    for feature in ("var", "log_var"):
+        assert feature_of_variance(f, feature) == window_feature(accel, feature)
+    ys = feature_of_variance(np.array([4.0, 0.0, 9.0]), "log_var")
+    np.testing.assert_allclose(ys, [np.log(4.0), np.nan, np.log(9.0)])
