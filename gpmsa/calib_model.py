@@ -22,16 +22,12 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.special import gammainc, gammainccinv, gammaln
 
+from gpmsa.gp import correlation
+
 _LOG_2PI = float(np.log(2.0 * np.pi))
 _LOG_2 = float(np.log(2.0))
 COARSE_STRIDE = 8
 TRUNCATED_REFINE = 8
-
-
-def weighted_sqdist(a: np.ndarray, b: np.ndarray, beta: np.ndarray) -> np.ndarray:
-    """sum_k beta_k (a_k - b_k)^2 for all pairs; a (N, k), b (M, k), beta (k,) -> (N, M)."""
-    diff = a[:, None, :] - b[None, :, :]
-    return (diff * diff) @ beta
 
 
 class FixedGP:
@@ -73,7 +69,7 @@ class FixedGP:
         chol = np.empty((self.p_u, self.m, self.m))
         alpha = np.empty((self.p_u, self.m))
         for c in range(self.p_u):
-            sigma = np.exp(-weighted_sqdist(z, z, self.betaU[:, c])) / self.lamUz[c]
+            sigma = correlation(z, None, self.betaU[:, c]) / self.lamUz[c]
             sigma[np.diag_indices_from(sigma)] += 1.0 / (lam_sim[c] * lamWOs) + 1.0 / self.lamWs[c]
             chol[c] = cholesky(sigma, lower=True)
             alpha[c] = cho_solve((chol[c], True), w[:, c])
@@ -82,15 +78,15 @@ class FixedGP:
 
     def corr_x(self, x: np.ndarray, c: int) -> np.ndarray:
         """R over the x part between points x (n, p) and the design: (n, m)."""
-        return np.exp(-weighted_sqdist(x, self.x_sim, self.betaU[: self.p, c]))
+        return correlation(x, self.x_sim, self.betaU[: self.p, c])
 
     def corr_t(self, theta: np.ndarray, c: int) -> np.ndarray:
         """R over the t part between points theta (G, q) and the design: (G, m)."""
-        return np.exp(-weighted_sqdist(theta, self.t_sim, self.betaU[self.p :, c]))
+        return correlation(theta, self.t_sim, self.betaU[self.p :, c])
 
     def prior_cov(self, x: np.ndarray, c: int) -> np.ndarray:
         """Sigma_U for component c among obs points at one theta (n, n), nugget included."""
-        r = np.exp(-weighted_sqdist(x, x, self.betaU[: self.p, c])) / self.lamUz[c]
+        r = correlation(x, None, self.betaU[: self.p, c]) / self.lamUz[c]
         return r + np.eye(x.shape[0]) / self.lamWs[c]
 
     def predict(self, x: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -12,8 +12,20 @@ def sq_diffs(a: np.ndarray, b: np.ndarray | None = None) -> np.ndarray:
 
 
 def correlation(a: np.ndarray, b: np.ndarray | None, beta: np.ndarray) -> np.ndarray:
-    """R (n_a, n_b) between points a (n_a, d) and b (n_b, d) (b=None: a with itself); beta (d,)."""
-    return np.exp(-np.tensordot(np.asarray(beta, dtype=np.float64), sq_diffs(a, b), axes=1))
+    """R (n_a, n_b) between points a (n_a, d) and b (n_b, d) (b=None: a with itself); beta (d,).
+
+    Accumulated one input dimension at a time in one (n_a, n_b) buffer: no (d, n_a, n_b)
+    temporary, and little fixed cost for the one-row calls of online calibration.
+    """
+    b = a if b is None else b
+    beta = np.asarray(beta, dtype=np.float64)
+    exponent = np.zeros((a.shape[0], b.shape[0]))
+    for k in range(beta.size):
+        diff = a[:, k, None] - b[None, :, k]
+        diff *= diff
+        diff *= beta[k]
+        exponent -= diff
+    return np.exp(exponent, out=exponent)
 
 
 def beta_to_rho(beta: np.ndarray) -> np.ndarray:
