@@ -94,6 +94,9 @@ def main(argv=None) -> None:
         help="run one task/backend pair only, e.g. fit:pyro or calibrate:torch",
     )
     args = ap.parse_args(argv)
+    pairs = {f"{t}:{b}" for t in ("fit", "calibrate") for b in ("numpy", "torch", "pyro")}
+    if args.only is not None and args.only not in pairs:
+        ap.error(f"--only must be one of {sorted(pairs)}, got {args.only!r}")
     s = 0.25 if args.quick else 1.0
     fits = [
         ("numpy", 1, int(3000 * s), {}),
