@@ -10,6 +10,8 @@ from __future__ import annotations
 import importlib
 from types import ModuleType
 
+import numpy as np
+
 from gpmsa.errors import BackendUnavailableError, GPMSAError
 
 _REGISTRY: dict[str, tuple[str, str]] = {
@@ -53,3 +55,13 @@ def get(name: str) -> ModuleType:
         raise BackendUnavailableError(
             f'backend {name!r} needs {exc.name}: pip install "terrain-gpmsa[{extra}]"'
         ) from exc
+
+
+def check_sample_args(n_iter, n_chains, seed) -> None:
+    """The checks every backend's ``sample`` makes on its run arguments (GPMSAError naming it)."""
+    if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
+        raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
+    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
+        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    if seed is not None and not isinstance(seed, (int, np.integer)):
+        raise GPMSAError(f"seed must be an int or None, got {seed!r}")

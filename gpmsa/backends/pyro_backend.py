@@ -20,6 +20,7 @@ from pyro.distributions import constraints
 from pyro.infer import MCMC, NUTS
 from pyro.infer.autoguide import init_to_value
 
+from gpmsa.backends import check_sample_args
 from gpmsa.backends.torch_backend import (
     SIM_PARAMS,
     ModelTensors,
@@ -124,8 +125,6 @@ class PyroModel:
 
 
 def _chain_seeds(seed, n_chains: int) -> list[int]:
-    if seed is not None and not isinstance(seed, (int, np.integer)):
-        raise GPMSAError(f"seed must be an int or None, got {seed!r}")
     return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(n_chains)]
 
 
@@ -162,10 +161,7 @@ def sample(
     """
     if step_widths:
         raise GPMSAError("the pyro backend (NUTS) takes no step_widths; leave step_widths=None")
-    if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
-        raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
-    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
-        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    check_sample_args(n_iter, n_chains, seed)
     if not 0.0 < target_accept < 1.0:
         raise GPMSAError(f"target_accept must be in (0, 1), got {target_accept}")
     model = PyroModel(problem)

@@ -24,6 +24,7 @@ import torch
 from tqdm.auto import tqdm
 
 from gpmsa import tuning
+from gpmsa.backends import check_sample_args
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import PRECISION_PARAMS, RHO_PARAMS, Chains, default_widths, elements
 from gpmsa.priors import Priors
@@ -206,8 +207,6 @@ def log_prior_elements(priors: Priors, name: str, x: Tensor) -> Tensor:
 
 def _seed_generator(seed, device) -> torch.Generator:
     """A torch Generator seeded from ``seed`` (int or None) via numpy's SeedSequence."""
-    if seed is not None and not isinstance(seed, (int, np.integer)):
-        raise GPMSAError(f"seed must be an int or None, got {seed!r}")
     state = int(np.random.SeedSequence(seed).generate_state(1, dtype=np.uint64)[0])
     return torch.Generator(device=device).manual_seed(state & (2**63 - 1))
 
@@ -398,10 +397,7 @@ def sample(
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
     torch's setting.
     """
-    if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
-        raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
-    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
-        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    check_sample_args(n_iter, n_chains, seed)
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype)  # fmt: skip
