@@ -23,8 +23,8 @@ import numpy as np
 
 import gpmsa
 from gpmsa import backends
-from gpmsa.diagnostics import ess, rhat
-from gpmsa.problem import prepare
+from gpmsa.mcmc.diagnostics import ess, rhat
+from gpmsa.model.problem import prepare
 
 ROOT = Path(__file__).resolve().parents[1]
 CASE = ROOT / "tests" / "data" / "case.npz"

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 import gpmsa
-from gpmsa.emulator import Emulator
+from gpmsa.fitting.emulator import Emulator
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
 

@@ -15,8 +15,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 import gpmsa
-from gpmsa.mcmc import ChainState, elements, sample
-from gpmsa.problem import prepare
+from gpmsa.mcmc.sampler import ChainState, elements, sample
+from gpmsa.model.problem import prepare
 
 CASE = Path(__file__).parents[1] / "tests" / "data" / "case.npz"
 

@@ -26,7 +26,7 @@ from scipy.ndimage import gaussian_filter1d
 from scipy.special import logsumexp
 
 from control.errors import ControlError
-from gpmsa.posterior import GridMarginal, Posterior, trapezoid_weights
+from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("uniform", "log_uniform")
 

@@ -4,17 +4,17 @@ An emulator fitted offline by MCMC, shared as a file, calibrated online.
 """
 
 from gpmsa import backends, predictive
-from gpmsa.calibration import calibrate
-from gpmsa.calibrator import Calibrator
-from gpmsa.data import ObsData, SimData
-from gpmsa.emulator import Emulator, LooResult
+from gpmsa.calibration.calibrate import calibrate
+from gpmsa.calibration.calibrator import Calibrator
+from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import BackendUnavailableError, EmulatorFileError, GPMSAError
-from gpmsa.fileformat import load
-from gpmsa.fitting import fit
-from gpmsa.mcmc import Chains
-from gpmsa.posterior import Posterior
-from gpmsa.priors import GammaPrior, Priors
-from gpmsa.problem import ObsProblem, Problem, prepare
+from gpmsa.fitting.emulator import Emulator, LooResult
+from gpmsa.fitting.fit import fit
+from gpmsa.io.container import load
+from gpmsa.mcmc.sampler import Chains
+from gpmsa.model.data import ObsData, SimData
+from gpmsa.model.priors import GammaPrior, Priors
+from gpmsa.model.problem import ObsProblem, Problem, prepare
 
 __version__ = "0.1.0"
 

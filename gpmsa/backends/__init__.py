@@ -1,8 +1,8 @@
 """Computational backends for gpmsa: a registry of modules implementing ``sample``.
 
 A backend module exposes ``sample(problem, *, n_iter, n_chains=1, tune=True, step_widths=None,
-seed=None, progress=False, **options) -> gpmsa.mcmc.Chains``. Modules are imported lazily, so
-importing gpmsa never imports torch.
+seed=None, progress=False, **options) -> gpmsa.mcmc.sampler.Chains``. Modules are imported
+lazily, so importing gpmsa never imports torch.
 """
 
 from __future__ import annotations

@@ -30,8 +30,8 @@ from gpmsa.backends.torch_backend import (
     torch_threads,
 )
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import RHO_PARAMS, Chains
-from gpmsa.problem import Problem
+from gpmsa.mcmc.sampler import RHO_PARAMS, Chains
+from gpmsa.model.problem import Problem
 
 N_WARMUP = 500
 """Default NUTS warm-up (step size and mass-matrix adaptation) iterations per chain."""

@@ -3,8 +3,9 @@
 Every tensor carries a leading chain axis C; one scalar Metropolis update moves that element in all
 chains at once (batched Cholesky of Sigma_W over (C, m, m) with ``torch.linalg.cholesky_ex``).
 Proposals, bounds, sweep order and step-size tuning are those of the numpy reference
-(``gpmsa.mcmc``, ``gpmsa.tuning``); chains share one set of tuned widths, fitted on the acceptance
-counts pooled over chains. Float64 by default; ``device="cuda"`` runs on a GPU when present.
+(``gpmsa.mcmc.sampler``, ``gpmsa.mcmc.tuning``); chains share one set of tuned widths, fitted on the
+acceptance counts pooled over chains. Float64 by default; ``device="cuda"`` runs on a GPU when
+present.
 
 The correlation R = exp(-sum_k beta_k d_k^2) is GPyTorch's ARD ``RBFKernel`` with lengthscale
 l_k = 1/sqrt(2 beta_k) (tested equal); the sampler computes it from squared differences
@@ -23,12 +24,12 @@ import numpy as np
 import torch
 from tqdm.auto import tqdm
 
-from gpmsa import tuning
 from gpmsa.backends import check_sample_args
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import PRECISION_PARAMS, RHO_PARAMS, Chains, default_widths, elements
-from gpmsa.priors import Priors
-from gpmsa.problem import Problem
+from gpmsa.mcmc import tuning
+from gpmsa.mcmc.sampler import PRECISION_PARAMS, RHO_PARAMS, Chains, default_widths, elements
+from gpmsa.model.priors import Priors
+from gpmsa.model.problem import Problem
 
 Tensor = torch.Tensor
 SIM_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -45,7 +46,7 @@ class ModelTensors:
     (p, n, m) squared differences of the known inputs (obs-obs, obs-sim); ``z`` (N,) the stacked
     reduced data, N = n * n_blocks; ``sig_obs`` (N, N) its covariance per unit lamOs;
     ``u_blocks`` the n-block of each basis component, ``v_blocks`` the n-blocks that receive the
-    discrepancy covariance (GPM/SA's order, see ``gpmsa.problem.ObsProblem``).
+    discrepancy covariance (GPM/SA's order, see ``gpmsa.model.problem.ObsProblem``).
     """
 
     p: int

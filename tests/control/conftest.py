@@ -5,7 +5,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from gpmsa.transforms import Standardizer
+from gpmsa.model.transforms import Standardizer
 
 C = 0.05  # f = C * GD * v**1.3 (m/s^2)^2, a made-up but realistic-looking law
 SIGMA = 0.06  # spread of log f for one 1,000-sample window of white noise (sqrt(2/1000) ~ 0.045)

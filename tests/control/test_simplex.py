@@ -8,7 +8,7 @@ from scipy import stats
 
 from control import ControlError, Estimate, Simplex
 from gpmsa import Posterior
-from gpmsa.posterior import GridMarginal
+from gpmsa.calibration.posterior import GridMarginal
 
 
 def gaussian_estimate(mean: float, sd: float) -> Estimate:

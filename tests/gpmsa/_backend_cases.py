@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 
 import gpmsa
-from gpmsa.problem import Prepared, prepare
+from gpmsa.model.problem import Prepared, prepare
 
 DATA = Path(__file__).parents[1] / "data" / "case.npz"
 

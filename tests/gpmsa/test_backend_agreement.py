@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from gpmsa import backends
-from gpmsa.diagnostics import ess, rhat
+from gpmsa.mcmc.diagnostics import ess, rhat
 
 Z = 4.0
 
@@ -76,7 +76,7 @@ def test_road_calibration_agrees_with_numpy(
 def multi_sim_problem():
     from _backend_cases import multi_data
 
-    from gpmsa.problem import prepare
+    from gpmsa.model.problem import prepare
 
     sim, _ = multi_data()
     return prepare(sim).problem

@@ -12,7 +12,7 @@ pb = pytest.importorskip("gpmsa.backends.pyro_backend")
 def test_model_log_density_equals_numpy_log_posterior(case):
     from _backend_cases import multi_problem, road_problem
 
-    from gpmsa.likelihood import log_posterior
+    from gpmsa.model.likelihood import log_posterior
 
     if case == "multi-discrepancy":
         prob = multi_problem("constant").problem

@@ -39,7 +39,7 @@ def test_fit_save_load_calibrate_across_backends(road, tmp_path, fit_with, calib
 
 
 def test_files_from_both_backends_have_the_same_layout(road, tmp_path):
-    from gpmsa.fileformat import read_raw
+    from gpmsa.io.container import read_raw
 
     sim, _ = road
     paths = []

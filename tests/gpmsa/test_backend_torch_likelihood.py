@@ -178,7 +178,7 @@ def _perturbed(problem, n_chains: int, rng: np.random.Generator) -> dict:
 
 
 def _numpy_log_post(problem, params: dict, c: int) -> float:
-    from gpmsa.likelihood import log_posterior
+    from gpmsa.model.likelihood import log_posterior
 
     return log_posterior(problem, {k: v[c].numpy() for k, v in params.items()})
 

@@ -13,9 +13,9 @@ from _calib_cases import (
     with_draws,
 )
 
-import gpmsa
 from gpmsa import Calibrator, GPMSAError, calibrate
-from gpmsa.diagnostics import ess
+from gpmsa.calibration.posterior import trapezoid_weights
+from gpmsa.mcmc.diagnostics import ess
 
 
 def kurtosis(post, name):
@@ -110,7 +110,7 @@ def test_log_likelihood_grid_is_fixed_documented_and_additive():
     assert post_seq.mean("GD") == pytest.approx(post_cb.mean("GD"), rel=1e-9)
     w = np.exp(ll + ll2 - np.max(ll + ll2))
     w *= np.exp(-0.5 * ((cal._theta_unit[:, 0] - 0.5) / 10) ** 2)
-    wt = gpmsa.posterior.trapezoid_weights(grid) * w
+    wt = trapezoid_weights(grid) * w
     assert post_seq.mean("GD") == pytest.approx(float(wt @ grid / wt.sum()), rel=1e-9)
 
 

@@ -8,8 +8,8 @@ import pytest
 from _calib_cases import road_emulator, road_obs
 
 from gpmsa import Calibrator, GPMSAError, Posterior, calibrate
-from gpmsa.cli import main
-from gpmsa.predictive import calibrated_predict
+from gpmsa.cli.main import main
+from gpmsa.predictive.calibrated import calibrated_predict
 
 
 @pytest.fixture(scope="module")
@@ -126,7 +126,7 @@ def test_cli_output_piped_into_a_closed_reader_exits_cleanly(tmp_path):
 
     path = tmp_path / "road.gpmsa"
     road_emulator().save(path)
-    code = "import sys; from gpmsa.cli import main; sys.exit(main(sys.argv[1:]))"
+    code = "import sys; from gpmsa.cli.main import main; sys.exit(main(sys.argv[1:]))"
     proc = subprocess.Popen(
         [sys.executable, "-c", code, "info", str(path)],
         stdout=subprocess.PIPE,

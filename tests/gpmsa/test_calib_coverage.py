@@ -4,7 +4,7 @@ import numpy as np
 from _calib_cases import road_emulator
 
 from gpmsa import Calibrator
-from gpmsa.calib_obs import fixed_gp
+from gpmsa.calibration.observations import fixed_gp
 
 N_OBS = 300
 

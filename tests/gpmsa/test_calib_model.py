@@ -6,11 +6,11 @@ from _calib_cases import road_emulator, road_obs, two_param_emulator, vector_emu
 from scipy.integrate import quad
 from scipy.stats import gamma, multivariate_normal, norm
 
-from gpmsa.calib_model import GridPredictor, LamOsPrior, lamos_marginal
-from gpmsa.calib_obs import fixed_gp, reduce
-from gpmsa.calib_sampler import ThetaPredictive
-from gpmsa.calibration import calibration_problem
-from gpmsa.likelihood import log_likelihood
+from gpmsa.calibration.calibrate import calibration_problem
+from gpmsa.calibration.model import GridPredictor, LamOsPrior, lamos_marginal
+from gpmsa.calibration.observations import fixed_gp, reduce
+from gpmsa.calibration.sampler import ThetaPredictive
+from gpmsa.model.likelihood import log_likelihood
 
 
 def dense_conditional(emu, x_unit, theta_unit, c=0):

@@ -10,7 +10,7 @@ from matplotlib.figure import Figure
 from scipy.stats import norm
 
 from gpmsa import GPMSAError, Posterior
-from gpmsa.posterior import GridMarginal
+from gpmsa.calibration.posterior import GridMarginal
 
 
 def gaussian_grid(mu=3.0, sd=0.7, n=201):

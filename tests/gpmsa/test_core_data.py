@@ -11,9 +11,9 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 import gpmsa
-from gpmsa.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
-from gpmsa.problem import check_x_obs, prepare
-from gpmsa.transforms import Standardizer
+from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
+from gpmsa.model.problem import check_x_obs, prepare
+from gpmsa.model.transforms import Standardizer
 
 
 def sim(m=20, p=1, q=1, l=1, seed=0, **kw):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import gpmsa
-from gpmsa.gp import correlation
+from gpmsa.model.correlation import correlation
 
 PARAMS = {"betaU": [[2.0], [0.5]], "lamUz": [1.2], "lamWs": [2000.0], "lamWOs": [5000.0]}
 

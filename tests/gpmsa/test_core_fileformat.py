@@ -10,8 +10,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import gpmsa
-from gpmsa import fileformat
-from gpmsa.cli import main
+from gpmsa.cli.main import main
+from gpmsa.io import container
 
 
 @pytest.fixture(scope="module")
@@ -72,7 +72,7 @@ def rewrite(src, dst, *, manifest=None, rehash=True, extra=None, drop=()):
         for name, raw in (extra or {}).items():
             if name.endswith(".npy"):
                 arrays[name[7:-4]] = np.load(io.BytesIO(raw), allow_pickle=True)
-        man["content_sha256"] = fileformat.content_hash(arrays, man)
+        man["content_sha256"] = container.content_hash(arrays, man)
     members["manifest.json"] = json.dumps(man).encode()
     members.update(extra or {})
     with zipfile.ZipFile(dst, "w") as zf:

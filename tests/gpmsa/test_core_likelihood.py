@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from gpmsa.gp import correlation
-from gpmsa.likelihood import IncrementalLikelihood, log_likelihood, log_posterior, log_prior
-from gpmsa.mcmc import elements
-from gpmsa.priors import Priors
-from gpmsa.problem import ObsProblem, Problem
+from gpmsa.mcmc.sampler import elements
+from gpmsa.model.correlation import correlation
+from gpmsa.model.likelihood import IncrementalLikelihood, log_likelihood, log_posterior, log_prior
+from gpmsa.model.priors import Priors
+from gpmsa.model.problem import ObsProblem, Problem
 
 
 def random_problem(seed: int, p: int, q: int, p_u: int, n: int, p_v: int, scalar: bool):

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from threadpoolctl import threadpool_limits
 
-from gpmsa.data import ObsData, SimData
-from gpmsa.likelihood import log_likelihood
-from gpmsa.mcmc import ChainState, default_widths, elements
-from gpmsa.problem import prepare
-from gpmsa.tuning import choose_widths, fit_logistic, level_widths
+from gpmsa.mcmc.sampler import ChainState, default_widths, elements
+from gpmsa.mcmc.tuning import choose_widths, fit_logistic, level_widths
+from gpmsa.model.data import ObsData, SimData
+from gpmsa.model.likelihood import log_likelihood
+from gpmsa.model.problem import prepare
 from tests.gpmsa.test_core_likelihood import random_problem
 
 N_UPDATES = 8_000

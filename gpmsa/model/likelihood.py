@@ -11,8 +11,8 @@ import math
 import numpy as np
 from scipy.linalg import lapack
 
-from gpmsa.gp import correlation, sq_diffs
-from gpmsa.problem import Problem
+from gpmsa.model.correlation import correlation, sq_diffs
+from gpmsa.model.problem import Problem
 
 
 def lower_cholesky(S: np.ndarray) -> np.ndarray | None:

@@ -1,15 +1,15 @@
 """A fast Metropolis-within-Gibbs sampler of (theta, lamOs) with the emulator fixed.
 
-The same algorithm as the numpy backend (gpmsa.mcmc: GPM/SA's sweep order, proposals, bounds and
-step-size tuning via gpmsa.tuning), specialised to the calibration-only model of
-``gpmsa.calib_model``: a theta proposal needs only the predictive of u at the new theta. For one
-calibration parameter that predictive (mean and covariance of u as functions of theta, for the given
-x_obs) is expanded once in Chebyshev polynomials to round-off accuracy (checked against dense solves
-at set-up), so a proposal costs O(degree) instead of O(m^2); otherwise each theta proposal does
-dense solves. The emulator parameters may be one set (its point estimate) or several (its retained
-draws): then an index over the sets is a further Gibbs element with a uniform prior, updated by
-a Metropolis step proposing a uniformly chosen set, so that the chain targets the posterior with
-the likelihood averaged over the sets.
+The same algorithm as the numpy backend (gpmsa.mcmc.sampler: GPM/SA's sweep order, proposals, bounds
+and step-size tuning via gpmsa.mcmc.tuning), specialised to the calibration-only model of
+``gpmsa.calibration.model``: a theta proposal needs only the predictive of u at the new theta. For
+one calibration parameter that predictive (mean and covariance of u as functions of theta, for the
+given x_obs) is expanded once in Chebyshev polynomials to round-off accuracy (checked against dense
+solves at set-up), so a proposal costs O(degree) instead of O(m^2); otherwise each theta proposal
+does dense solves. The emulator parameters may be one set (its point estimate) or several (its
+retained draws): then an index over the sets is a further Gibbs element with a uniform prior,
+updated by a Metropolis step proposing a uniformly chosen set, so that the chain targets the
+posterior with the likelihood averaged over the sets.
 """
 
 from __future__ import annotations
@@ -22,10 +22,10 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 from scipy.linalg import solve_triangular
 
-from gpmsa import tuning
-from gpmsa.calib_model import FixedGP
-from gpmsa.calib_obs import Observations
-from gpmsa.priors import Priors
+from gpmsa.calibration.model import FixedGP
+from gpmsa.calibration.observations import Observations
+from gpmsa.mcmc import tuning
+from gpmsa.model.priors import Priors
 
 THETA_WIDTH = 0.2
 CHEB_DEGREES = (16, 32, 64, 128, 256)

@@ -11,7 +11,7 @@ from gpmsa.errors import EmulatorFileError
 
 
 def _info(args: argparse.Namespace) -> int:
-    from gpmsa.fileformat import read_raw
+    from gpmsa.io.container import read_raw
 
     try:
         manifest, arrays = read_raw(args.file)
@@ -65,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("file", help="path to a .gpmsa file")
     info.add_argument("--json", action="store_true", help="print the raw manifest as JSON")
     info.set_defaults(func=_info)
-    from gpmsa.calibration_cli import add_parser as add_calibrate
+    from gpmsa.cli.calibrate import add_parser as add_calibrate
 
     add_calibrate(sub)
     return parser

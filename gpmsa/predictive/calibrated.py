@@ -7,9 +7,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
-from gpmsa.calib_obs import check_x
+from gpmsa.calibration.observations import check_x
+from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
-from gpmsa.posterior import Posterior
 
 
 @dataclass(frozen=True, eq=False)

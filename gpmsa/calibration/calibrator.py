@@ -2,7 +2,7 @@
 
 For one or two calibration parameters the posterior is computed exactly on a grid (no sampling):
 with the emulator parameters fixed, the observation's reduced data u given the simulation weights w
-is Gaussian at every theta (``gpmsa.calib_model``), lamOs is integrated out per theta node by
+is Gaussian at every theta (``gpmsa.calibration.model``), lamOs is integrated out per theta node by
 quadrature, and the posterior is the prior times that likelihood on the grid, refined where the
 mass is when the grid does not resolve it. More parameters use the MCMC of ``gpmsa.calibrate``.
 
@@ -18,8 +18,8 @@ from scipy.interpolate import RegularGridInterpolator
 from scipy.special import ndtr
 
 from gpmsa import backends
-from gpmsa.calib_model import GridPredictor, LamOsMarginal, lamos_marginal
-from gpmsa.calib_obs import (
+from gpmsa.calibration.model import GridPredictor, LamOsMarginal, lamos_marginal
+from gpmsa.calibration.observations import (
     EMULATOR_PARAM_MODES,
     Observations,
     blas_controller,
@@ -28,8 +28,8 @@ from gpmsa.calib_obs import (
     fixed_gp,
     reduce,
 )
+from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 from gpmsa.errors import GPMSAError
-from gpmsa.posterior import GridMarginal, Posterior, trapezoid_weights
 
 METHODS = ("auto", "grid", "mcmc")
 RESOLVE_SD = 4.0
@@ -235,7 +235,7 @@ class Calibrator:
         """
         self._count += 1
         if self.method == "mcmc":
-            from gpmsa.calibration import calibrate
+            from gpmsa.calibration.calibrate import calibrate
 
             opts = dict(self.mcmc_options)
             auto = int(_seed_sequence((self._entropy, self._count)).generate_state(1)[0])

@@ -54,8 +54,8 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
 
 def run(args: argparse.Namespace) -> int:
     """Run the subcommand; exit status 0, or 2 with a message on stderr for bad input."""
-    from gpmsa.calibrator import Calibrator
-    from gpmsa.fileformat import load
+    from gpmsa.calibration.calibrator import Calibrator
+    from gpmsa.io.container import load
 
     try:
         emu = load(args.file)

@@ -8,12 +8,12 @@ from datetime import datetime, timezone
 import numpy as np
 
 from gpmsa import backends
-from gpmsa.data import ObsData, SimData
-from gpmsa.diagnostics import summarize
-from gpmsa.emulator import EMULATOR_PARAMS, Emulator
 from gpmsa.errors import GPMSAError
-from gpmsa.priors import Priors
-from gpmsa.problem import prepare
+from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.mcmc.diagnostics import summarize
+from gpmsa.model.data import ObsData, SimData
+from gpmsa.model.priors import Priors
+from gpmsa.model.problem import prepare
 
 N_KEEP = 1000
 """Default number of retained draws (all chains together) after burn-in and thinning."""

@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from gpmsa.emulator import EMULATOR_PARAMS, Emulator
 from gpmsa.errors import EmulatorFileError, GPMSAError
-from gpmsa.priors import Priors
-from gpmsa.transforms import Standardizer
+from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.model.priors import Priors
+from gpmsa.model.transforms import Standardizer
 
 FORMAT = "gpmsa-emulator"
 SCHEMA_VERSION = 1

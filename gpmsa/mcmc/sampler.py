@@ -15,9 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from gpmsa import tuning
-from gpmsa.likelihood import IncrementalLikelihood
-from gpmsa.problem import Problem
+from gpmsa.mcmc import tuning
+from gpmsa.model.likelihood import IncrementalLikelihood
+from gpmsa.model.problem import Problem
 
 DEFAULT_WIDTHS = {"theta": 0.2, "betaU": 0.1, "betaV": 0.1, "lamVz": 10.0, "lamUz": 5.0,
                   "lamWs": 100.0, "lamWOs": 100.0}  # fmt: skip
@@ -54,7 +54,7 @@ class Chains:
 
     def to_arviz(self):
         """ArviZ ``InferenceData`` of the draws (arviz imported lazily)."""
-        from gpmsa.diagnostics import to_inference_data
+        from gpmsa.mcmc.diagnostics import to_inference_data
 
         return to_inference_data(self.draws, self.log_post)
 

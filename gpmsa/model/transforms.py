@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.data import SimData
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import SimData
 
 UNIT_TOL = 1e-9
 """Unit-scale values within this distance outside [0, 1] are rounding of the design's edges (a

@@ -9,10 +9,10 @@ from functools import cache
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
-from gpmsa.calib_model import FixedGP, LamOsPrior
-from gpmsa.data import ObsData, check_finite
+from gpmsa.calibration.model import FixedGP, LamOsPrior
 from gpmsa.errors import GPMSAError
-from gpmsa.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
+from gpmsa.model.data import ObsData, check_finite
+from gpmsa.model.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
 
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -129,7 +129,7 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     if y.shape[0] != n:
         raise GPMSAError(f"y_obs must have one row per x_obs row ({n}), got {y.shape[0]}")
     base = emulator.priors.lamOs
-    if l_sim == 1:  # GPM/SA's scalar-output reduction, as gpmsa.problem.reduce_obs
+    if l_sim == 1:  # GPM/SA's scalar-output reduction, as gpmsa.model.problem.reduce_obs
         u = (y - std.y_mean) / std.y_sd
         sig = np.eye(n) / (1.0 + SIGOBS_RIDGE)
         obs = ObsProblem(xu, u, np.zeros((n, 0)), sig, True, (np.ones((1, 1)),) * n, None)

@@ -7,7 +7,7 @@ the discrepancy parameters betaV and lamVz). Defaults are the paper's: GPM/SA st
 
 Engines: the calibration-only problem is a ``gpmsa.Problem`` whose emulator parameters are in
 ``fixed``; any backend's ``sample`` runs it. For backend="numpy" without discrepancy the default is
-a specialised sampler of the same algorithm (``gpmsa.calib_sampler``) that evaluates only the
+a specialised sampler of the same algorithm (``gpmsa.calibration.sampler``) that evaluates only the
 predictive at each proposed theta; ``fast=False`` uses the generic numpy backend instead.
 """
 
@@ -18,8 +18,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from gpmsa import backends, tuning
-from gpmsa.calib_obs import (
+from gpmsa import backends
+from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
     blas_controller,
     check_emulator,
@@ -28,11 +28,12 @@ from gpmsa.calib_obs import (
     fixed_gp,
     reduce,
 )
-from gpmsa.calib_sampler import CalibrationSampler
-from gpmsa.data import ObsData
+from gpmsa.calibration.posterior import Posterior
+from gpmsa.calibration.sampler import CalibrationSampler
 from gpmsa.errors import GPMSAError
-from gpmsa.posterior import Posterior
-from gpmsa.problem import Problem, default_init, reduce_obs
+from gpmsa.mcmc import tuning
+from gpmsa.model.data import ObsData
+from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
 def calibration_problem(emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False) -> Problem:

@@ -9,12 +9,12 @@ from pathlib import Path
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
-from gpmsa.data import SimData, as_matrix
 from gpmsa.errors import GPMSAError
-from gpmsa.gp import correlation
-from gpmsa.likelihood import lower_cholesky
-from gpmsa.priors import Priors
-from gpmsa.transforms import EXTRAPOLATION_MARGIN, Standardizer
+from gpmsa.model.correlation import correlation
+from gpmsa.model.data import SimData, as_matrix
+from gpmsa.model.likelihood import lower_cholesky
+from gpmsa.model.priors import Priors
+from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 
@@ -118,7 +118,7 @@ class Emulator:
         ``params``: betaU (p+q, p_u), lamUz (p_u,), lamWs (p_u,), lamWOs (1,); arrays of the
         same sizes in other shapes (e.g. (1, p_u) as SEPIA stores them) are accepted.
         """
-        from gpmsa.problem import prepare
+        from gpmsa.model.problem import prepare
 
         prep = prepare(sim_data, priors=priors, n_pc=n_pc)
         return cls._from_prepared(sim_data, prep, params, metadata=metadata,
@@ -308,7 +308,7 @@ class Emulator:
 
     def to_arviz(self):
         """ArviZ InferenceData of the retained draws (chains as fitted)."""
-        from gpmsa.diagnostics import to_inference_data
+        from gpmsa.mcmc.diagnostics import to_inference_data
 
         n_ch = int(self.settings.get("n_chains", 1)) or 1
         if self.n_draws == 0:
@@ -335,7 +335,7 @@ class Emulator:
 
     def save(self, path: str | Path) -> Path:
         """Write the emulator file (see docs/emulator-file.md); returns the path."""
-        from gpmsa.fileformat import save
+        from gpmsa.io.container import save
 
         return save(self, path)
 

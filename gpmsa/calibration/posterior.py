@@ -198,14 +198,14 @@ class Posterior:
                 "exact_grid": name in self.grids,
             }
             if self.chains is not None:
-                from gpmsa.diagnostics import ess
+                from gpmsa.mcmc.diagnostics import ess
 
                 out[name]["ess"] = ess(np.atleast_2d(self.chains[name]))
         return out
 
     def to_arviz(self):
         """ArviZ InferenceData of the draws (arviz imported lazily)."""
-        from gpmsa.diagnostics import to_inference_data
+        from gpmsa.mcmc.diagnostics import to_inference_data
 
         if self.chains is not None:
             return to_inference_data({k: np.asarray(v) for k, v in self.chains.items()})

@@ -8,11 +8,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from gpmsa.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
-from gpmsa.data import ObsData, SimData
 from gpmsa.errors import GPMSAError
-from gpmsa.priors import Priors
-from gpmsa.transforms import EXTRAPOLATION_MARGIN, Standardizer
+from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
+from gpmsa.model.data import ObsData, SimData
+from gpmsa.model.priors import Priors
+from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
 ORDER = ("theta", "betaV", "betaU", "lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
 """GPM/SA's sweep order; absent or fixed parameters are skipped."""

@@ -22,7 +22,7 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.special import gammainc, gammainccinv, gammaln
 
-from gpmsa.gp import correlation
+from gpmsa.model.correlation import correlation
 
 _LOG_2PI = float(np.log(2.0 * np.pi))
 _LOG_2 = float(np.log(2.0))

@@ -1,0 +1,1 @@
+"""The ``gpmsa`` console command (``gpmsa info FILE``, ``gpmsa calibrate FILE ...``)."""
