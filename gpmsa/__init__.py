@@ -4,19 +4,17 @@ An emulator fitted offline by MCMC, shared as a file, calibrated online.
 """
 
 from gpmsa import backends, predictive
+from gpmsa._version import __version__ as __version__
 from gpmsa.calibration.calibrate import calibrate
 from gpmsa.calibration.calibrator import Calibrator
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import BackendUnavailableError, EmulatorFileError, GPMSAError
-from gpmsa.fitting.emulator import Emulator, LooResult
+from gpmsa.fitting.emulator import Emulator, LooResult, load
 from gpmsa.fitting.fit import fit
-from gpmsa.io.container import load
 from gpmsa.mcmc.sampler import Chains
 from gpmsa.model.data import ObsData, SimData
 from gpmsa.model.priors import GammaPrior, Priors
 from gpmsa.model.problem import ObsProblem, Problem, prepare
-
-__version__ = "0.1.0"
 
 __all__ = [
     "BackendUnavailableError",

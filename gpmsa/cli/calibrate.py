@@ -55,7 +55,7 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
 def run(args: argparse.Namespace) -> int:
     """Run the subcommand; exit status 0, or 2 with a message on stderr for bad input."""
     from gpmsa.calibration.calibrator import Calibrator
-    from gpmsa.io.container import load
+    from gpmsa.fitting.emulator import load
 
     try:
         emu = load(args.file)

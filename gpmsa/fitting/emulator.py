@@ -1,7 +1,13 @@
-"""The fitted GPM/SA emulator: training data, transforms, basis, posterior draws, predictions."""
+"""The fitted GPM/SA emulator: training data, transforms, basis, posterior draws, predictions.
+
+Its file record lives here too: ``Emulator.to_record``/``from_record`` map the emulator to and
+from the (manifest, arrays) pair that the file container (``gpmsa.io.container``) writes and
+reads; ``Emulator.save`` and ``load`` join the two.
+"""
 
 from __future__ import annotations
 
+import json
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -9,7 +15,8 @@ from pathlib import Path
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.io.container import jsonable, read_raw, write_raw
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import SimData, as_matrix
 from gpmsa.model.likelihood import lower_cholesky
@@ -17,6 +24,12 @@ from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+STD_FIELDS = ("x_min", "x_max", "t_min", "t_max", "y_mean", "grid")
+"""Arrays of the file that hold the Standardizer (with ``y_sd``)."""
+REQUIRED = ("x_unit", "t_unit", "y", "K", "w", "log_post", "y_sd", *STD_FIELDS) + tuple(
+    f"param_{k}" for k in EMULATOR_PARAMS
+)
+"""Arrays every emulator file holds."""
 
 
 @dataclass(frozen=True)
@@ -333,14 +346,131 @@ class Emulator:
                          "q2.5": float(q[0]), "q50": float(q[1]), "q97.5": float(q[2])}  # fmt: skip
         return out
 
+    # --- the file record ----------------------------------------------------------------------
+    def to_record(self) -> tuple[dict, dict[str, np.ndarray]]:
+        """The emulator as the file's content: (manifest fields, arrays); docs/emulator-file.md.
+
+        The manifest holds names, units, domain, model, priors, settings, metadata and
+        diagnostics, JSON-able (non-finite floats become null); the arrays are float64.
+        Raises GPMSAError when ``metadata`` is not JSON-able.
+        """
+        s = self.standardizer
+        arrays = {
+            "x_unit": self.x_unit, "t_unit": self.t_unit, "y": self.y, "K": self.K, "w": self.w,
+            "x_min": s.x_min, "x_max": s.x_max, "t_min": s.t_min, "t_max": s.t_max,
+            "y_mean": s.y_mean, "y_sd": np.array([s.y_sd]), "grid": s.grid,
+            "log_post": self.log_post,
+        }  # fmt: skip
+        if self.index is not None:
+            arrays["index"] = self.index
+        for k, v in self.params.items():
+            arrays[f"param_{k}"] = v
+        for k, v in self.draws.items():
+            arrays[f"draw_{k}"] = v
+        for k, v in (self.calibration or {}).items():
+            arrays[f"cal_{k}"] = v
+        arrays = {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
+        manifest = {
+            "names": {"x": list(self.x_names), "t": list(self.t_names), "y": list(self.y_names)},
+            "units": {"x": list(self.x_units), "t": list(self.t_units), "y": list(self.y_units)},
+            "domain": {k: list(v) for k, v in self.domain.items()},
+            "model": {
+                "m": self.m,
+                "p": self.p,
+                "q": self.q,
+                "p_u": self.p_u,
+                "l_sim": self.l_sim,
+                "correlation": "R(a,b) = exp(-sum_k beta_k (a_k - b_k)^2) on unit-scale inputs",
+                "noise": "w_j ~ GP(0, R/lamUz_j) + nugget 1/lamWs_j; residual outside the basis "
+                "has precision lamWOs * lam_sim_j; outputs standardised by y_mean, y_sd",
+                "point_estimate": self.settings.get("point", "given"),
+            },  # fmt: skip
+            "priors": self.priors.to_dict(),
+            "settings": self.settings,
+            "metadata": self.metadata,
+            "diagnostics": self.diagnostics,
+        }
+        manifest = jsonable(manifest)
+        try:
+            json.dumps(manifest["metadata"], allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise GPMSAError(
+                f"Emulator.metadata must be JSON-able (str, numbers, lists, dicts): {exc}"
+            ) from exc
+        return manifest, arrays
+
+    @classmethod
+    def from_record(cls, manifest: dict, arrays: dict[str, np.ndarray]) -> Emulator:
+        """The emulator of a file's (manifest, arrays), as ``read_raw`` returns them.
+
+        Raises EmulatorFileError naming what is missing or inconsistent (shapes, priors, domain).
+        """
+        missing = [k for k in REQUIRED if k not in arrays]
+        if missing:
+            raise EmulatorFileError(f"required arrays missing: {missing}")
+        try:
+            std = Standardizer(**{k: arrays[k] for k in STD_FIELDS}, y_sd=float(arrays["y_sd"][0]))
+            names = {k: tuple(manifest["names"][k]) for k in ("x", "t", "y")}
+            units = {k: tuple(manifest["units"][k]) for k in ("x", "t", "y")}
+            draws = {k[5:]: v for k, v in arrays.items() if k.startswith("draw_")}
+            cal = {k[4:]: v for k, v in arrays.items() if k.startswith("cal_")} or None
+            emu = cls(
+                standardizer=std, x_unit=arrays["x_unit"], t_unit=arrays["t_unit"],
+                y=arrays["y"], K=arrays["K"], w=arrays["w"], index=arrays.get("index"),
+                params={k: arrays[f"param_{k}"] for k in EMULATOR_PARAMS},
+                priors=Priors.from_dict(manifest["priors"]), names=names, units=units,
+                draws=draws, log_post=arrays["log_post"], metadata=manifest["metadata"],
+                settings=manifest["settings"], diagnostics=manifest["diagnostics"],
+                calibration=cal,
+            )  # fmt: skip
+            _check_consistent(emu)
+            domain = {k: list(v) for k, v in emu.domain.items()}
+            if manifest.get("domain") != domain:
+                raise ValueError(
+                    f"manifest domain {manifest.get('domain')} differs from the arrays' {domain}"
+                )
+        except EmulatorFileError:
+            raise
+        except (GPMSAError, KeyError, TypeError, ValueError, IndexError) as exc:
+            raise EmulatorFileError(f"inconsistent content ({type(exc).__name__}: {exc})") from exc
+        return emu
+
     def save(self, path: str | Path) -> Path:
         """Write the emulator file (see docs/emulator-file.md); returns the path."""
-        from gpmsa.io.container import save
-
-        return save(self, path)
+        manifest, arrays = self.to_record()
+        return write_raw(path, manifest, arrays)
 
     def __repr__(self) -> str:
         return (
             f"Emulator(m={self.m}, x={list(self.x_names)}, t={list(self.t_names)}, "
             f"y={self.l_sim} outputs, p_u={self.p_u}, draws={self.n_draws})"
         )
+
+
+def load(path: str | Path) -> Emulator:
+    """Read an emulator file written by ``Emulator.save`` (any older schema; never unpickles).
+
+    Raises EmulatorFileError naming the problem for a damaged, edited, foreign or newer file.
+    """
+    manifest, arrays = read_raw(path)
+    try:
+        return Emulator.from_record(manifest, arrays)
+    except EmulatorFileError as exc:
+        raise EmulatorFileError(f"{path}: {exc}") from exc
+
+
+def _check_consistent(emu: Emulator) -> None:
+    m, p, q, l_sim, p_u = emu.m, emu.p, emu.q, emu.l_sim, emu.p_u
+    checks = {
+        "t_unit": (emu.t_unit.shape, (m, q)), "y": (emu.y.shape, (m, l_sim)),
+        "w": (emu.w.shape, (m, p_u)), "x_min": (emu.standardizer.x_min.shape, (p,)),
+        "t_min": (emu.standardizer.t_min.shape, (q,)),
+        "y_mean": (emu.standardizer.y_mean.shape, (l_sim,)),
+        "names.x": ((len(emu.x_names),), (p,)), "names.t": ((len(emu.t_names),), (q,)),
+    }  # fmt: skip
+    for what, (got, want) in checks.items():
+        if tuple(got) != tuple(want):
+            raise ValueError(f"{what} has shape {got}, expected {want}")
+    for k, v in emu.draws.items():
+        if v.shape[1:] != emu.params[k].shape or v.shape[0] != emu.n_draws:
+            raise ValueError(f"draws of {k} have shape {v.shape}")

@@ -1,4 +1,9 @@
-"""The emulator file (``*.gpmsa``): a zip of .npy arrays plus ``manifest.json``.
+"""The emulator file container (``*.gpmsa``): a zip of .npy arrays plus ``manifest.json``.
+
+It knows nothing of the Emulator: ``write_raw`` and ``read_raw`` move a (manifest dict, arrays
+dict) pair; what goes into them is the Emulator's record (``gpmsa.fitting.emulator``). The container
+owns the envelope: the format name, the schema version (and the upgrade of older ones), the
+library version and time of writing, the arrays' shapes and dtypes, and the content hash.
 
 Safe to read from an untrusted source: arrays load with allow_pickle=False and only float64,
 int64 or bool dtypes; member names, counts and sizes are checked before anything is decompressed
@@ -20,10 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
+from gpmsa._version import __version__
 from gpmsa.errors import EmulatorFileError, GPMSAError
-from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
-from gpmsa.model.priors import Priors
-from gpmsa.model.transforms import Standardizer
 
 FORMAT = "gpmsa-emulator"
 SCHEMA_VERSION = 1
@@ -38,28 +41,25 @@ MAX_MANIFEST_BYTES = 16 * 1024**2
 MAX_RATIO = 200
 """Largest allowed uncompressed/compressed size ratio of a member (zip-bomb guard)."""
 
-STD_FIELDS = ("x_min", "x_max", "t_min", "t_max", "y_mean", "grid")
-REQUIRED = ("x_unit", "t_unit", "y", "K", "w", "log_post", "y_sd", *STD_FIELDS) + tuple(
-    f"param_{k}" for k in EMULATOR_PARAMS
-)
+ENVELOPE = ("format", "schema_version", "library_version", "created_utc", "arrays",
+            "content_sha256")  # fmt: skip
+"""Manifest fields the container writes itself (``write_raw`` refuses them from its caller)."""
+FIELDS = (("arrays", dict), ("names", dict), ("units", dict), ("priors", dict),
+          ("settings", dict), ("metadata", dict), ("diagnostics", dict),
+          ("content_sha256", str))  # fmt: skip
+"""Schema 1: manifest fields every file has, and their JSON types."""
 
 
-def _library_version() -> str:
-    from gpmsa import __version__
-
-    return __version__
-
-
-def _jsonable(obj):
+def jsonable(obj):
     """Replace non-finite floats (not valid JSON) by None, recursively; tuples become lists."""
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
     if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
+        return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
+        return [jsonable(v) for v in obj]
     if isinstance(obj, np.generic):
-        return _jsonable(obj.item())
+        return jsonable(obj.item())
     return obj
 
 
@@ -79,65 +79,32 @@ def content_hash(arrays: dict[str, np.ndarray], manifest: dict) -> str:
     return h.hexdigest()
 
 
-def _arrays_of(emu: Emulator) -> dict[str, np.ndarray]:
-    s = emu.standardizer
-    arrays = {
-        "x_unit": emu.x_unit, "t_unit": emu.t_unit, "y": emu.y, "K": emu.K, "w": emu.w,
-        "x_min": s.x_min, "x_max": s.x_max, "t_min": s.t_min, "t_max": s.t_max,
-        "y_mean": s.y_mean, "y_sd": np.array([s.y_sd]), "grid": s.grid, "log_post": emu.log_post,
-    }  # fmt: skip
-    if emu.index is not None:
-        arrays["index"] = emu.index
-    for k, v in emu.params.items():
-        arrays[f"param_{k}"] = v
-    for k, v in emu.draws.items():
-        arrays[f"draw_{k}"] = v
-    for k, v in (emu.calibration or {}).items():
-        arrays[f"cal_{k}"] = v
-    return {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
+def write_raw(path: str | Path, manifest: dict, arrays: dict[str, np.ndarray]) -> Path:
+    """Write ``manifest`` and ``arrays`` to ``path`` (a zip: manifest.json + arrays/NAME.npy).
 
-
-def build_manifest(emu: Emulator, arrays: dict[str, np.ndarray]) -> dict:
-    """The manifest dict of ``emu`` (without checking JSON-ability)."""
+    manifest: the content fields, JSON-able (see ``jsonable``); the envelope fields (``ENVELOPE``)
+    are added here. arrays: name -> array; names match ``NAME_RE``, dtypes are float64, int64 or
+    bool, as the reader accepts. The zip is written beside ``path`` and then moved over it.
+    Returns the path.
+    """
+    path = Path(path)
+    reserved = sorted(set(manifest) & set(ENVELOPE))
+    if reserved:
+        raise GPMSAError(f"manifest fields {reserved} are written by the container itself")
+    for name, arr in arrays.items():
+        if not NAME_RE.match(name) or arr.dtype.str not in ALLOWED_DTYPES:
+            raise GPMSAError(
+                f"array {name!r} ({arr.dtype.str}): names must match {NAME_RE.pattern} and "
+                f"dtypes be one of {sorted(ALLOWED_DTYPES)}"
+            )
     manifest = {
+        **manifest,
         "format": FORMAT,
         "schema_version": SCHEMA_VERSION,
-        "library_version": _library_version(),
+        "library_version": __version__,
         "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "names": {"x": list(emu.x_names), "t": list(emu.t_names), "y": list(emu.y_names)},
-        "units": {"x": list(emu.x_units), "t": list(emu.t_units), "y": list(emu.y_units)},
-        "domain": {k: list(v) for k, v in emu.domain.items()},
-        "model": {
-            "m": emu.m,
-            "p": emu.p,
-            "q": emu.q,
-            "p_u": emu.p_u,
-            "l_sim": emu.l_sim,
-            "correlation": "R(a,b) = exp(-sum_k beta_k (a_k - b_k)^2) on unit-scale inputs",
-            "noise": "w_j ~ GP(0, R/lamUz_j) + nugget 1/lamWs_j; residual outside the basis "
-            "has precision lamWOs * lam_sim_j; outputs standardised by y_mean, y_sd",
-            "point_estimate": emu.settings.get("point", "given"),
-        },  # fmt: skip
-        "priors": emu.priors.to_dict(),
-        "settings": emu.settings,
-        "metadata": emu.metadata,
-        "diagnostics": emu.diagnostics,
         "arrays": {k: {"shape": list(v.shape), "dtype": v.dtype.str} for k, v in arrays.items()},
     }
-    return _jsonable(manifest)
-
-
-def save(emu: Emulator, path: str | Path) -> Path:
-    """Write ``emu`` to ``path`` (a zip: manifest.json + arrays/NAME.npy). Returns the path."""
-    path = Path(path)
-    arrays = _arrays_of(emu)
-    manifest = build_manifest(emu, arrays)
-    try:
-        json.dumps(manifest["metadata"], allow_nan=False)
-    except (TypeError, ValueError) as exc:
-        raise GPMSAError(
-            f"Emulator.metadata must be JSON-able (str, numbers, lists, dicts): {exc}"
-        ) from exc
     manifest["content_sha256"] = content_hash(arrays, manifest)
     tmp = path.with_name(path.name + ".part")
     with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
@@ -228,9 +195,7 @@ def _parse_manifest(raw: bytes, path) -> dict:
             f"schema_version {version} is newer than this library reads ({SCHEMA_VERSION}); "
             f"upgrade gpmsa (file written by gpmsa {manifest.get('library_version')!r})",
         )
-    for key, kind in (("arrays", dict), ("names", dict), ("units", dict), ("priors", dict),
-                      ("settings", dict), ("metadata", dict), ("diagnostics", dict),
-                      ("content_sha256", str)):  # fmt: skip
+    for key, kind in FIELDS:
         if not isinstance(manifest.get(key), kind):
             raise _fail(path, f"manifest field {key!r} missing or not a {kind.__name__}")
     return _upgrade(manifest)
@@ -304,56 +269,3 @@ def read_raw(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
             path, "content hash mismatch: the file was edited or damaged after it was written"
         )
     return manifest, arrays
-
-
-def load(path: str | Path) -> Emulator:
-    """Read an emulator file written by ``Emulator.save`` (any older schema; never unpickles).
-
-    Raises EmulatorFileError naming the problem for a damaged, edited, foreign or newer file.
-    """
-    manifest, arrays = read_raw(path)
-    missing = [k for k in REQUIRED if k not in arrays]
-    if missing:
-        raise _fail(path, f"required arrays missing: {missing}")
-    try:
-        std = Standardizer(**{k: arrays[k] for k in STD_FIELDS}, y_sd=float(arrays["y_sd"][0]))
-        names = {k: tuple(manifest["names"][k]) for k in ("x", "t", "y")}
-        units = {k: tuple(manifest["units"][k]) for k in ("x", "t", "y")}
-        draws = {k[5:]: v for k, v in arrays.items() if k.startswith("draw_")}
-        cal = {k[4:]: v for k, v in arrays.items() if k.startswith("cal_")} or None
-        emu = Emulator(
-            standardizer=std, x_unit=arrays["x_unit"], t_unit=arrays["t_unit"], y=arrays["y"],
-            K=arrays["K"], w=arrays["w"], index=arrays.get("index"),
-            params={k: arrays[f"param_{k}"] for k in EMULATOR_PARAMS},
-            priors=Priors.from_dict(manifest["priors"]), names=names, units=units,
-            draws=draws, log_post=arrays["log_post"], metadata=manifest["metadata"],
-            settings=manifest["settings"], diagnostics=manifest["diagnostics"], calibration=cal,
-        )  # fmt: skip
-        _check_consistent(emu)
-        domain = {k: list(v) for k, v in emu.domain.items()}
-        if manifest.get("domain") != domain:
-            raise ValueError(
-                f"manifest domain {manifest.get('domain')} differs from the arrays' {domain}"
-            )
-    except EmulatorFileError:
-        raise
-    except (GPMSAError, KeyError, TypeError, ValueError, IndexError) as exc:
-        raise _fail(path, f"inconsistent content ({type(exc).__name__}: {exc})") from exc
-    return emu
-
-
-def _check_consistent(emu: Emulator) -> None:
-    m, p, q, l_sim, p_u = emu.m, emu.p, emu.q, emu.l_sim, emu.p_u
-    checks = {
-        "t_unit": (emu.t_unit.shape, (m, q)), "y": (emu.y.shape, (m, l_sim)),
-        "w": (emu.w.shape, (m, p_u)), "x_min": (emu.standardizer.x_min.shape, (p,)),
-        "t_min": (emu.standardizer.t_min.shape, (q,)),
-        "y_mean": (emu.standardizer.y_mean.shape, (l_sim,)),
-        "names.x": ((len(emu.x_names),), (p,)), "names.t": ((len(emu.t_names),), (q,)),
-    }  # fmt: skip
-    for what, (got, want) in checks.items():
-        if tuple(got) != tuple(want):
-            raise ValueError(f"{what} has shape {got}, expected {want}")
-    for k, v in emu.draws.items():
-        if v.shape[1:] != emu.params[k].shape or v.shape[0] != emu.n_draws:
-            raise ValueError(f"draws of {k} have shape {v.shape}")

@@ -57,6 +57,27 @@ def test_manifest_contents(saved):
     assert manifest["arrays"]["x_unit"] == {"shape": [25, 1], "dtype": "<f8"}
     assert manifest["domain"]["GD"][0] >= 200 and len(manifest["content_sha256"]) == 64
     assert manifest["priors"]["lamWs"]["lower"] == 60.0
+    assert sorted(manifest) == sorted(
+        ["format", "schema_version", "library_version", "created_utc", "names", "units", "domain",
+         "model", "priors", "settings", "metadata", "diagnostics", "arrays", "content_sha256"]
+    )  # fmt: skip
+
+
+def test_record_round_trip_through_the_container(emu, tmp_path):
+    """The container moves the Emulator's record untouched and adds only its envelope."""
+    manifest, arrays = emu.to_record()
+    path = container.write_raw(tmp_path / "raw.gpmsa", manifest, arrays)
+    back_manifest, back_arrays = container.read_raw(path)
+    assert set(back_manifest) == set(manifest) | set(container.ENVELOPE)
+    assert {k: back_manifest[k] for k in manifest} == manifest
+    assert sorted(back_arrays) == sorted(arrays)
+    back = gpmsa.Emulator.from_record(back_manifest, back_arrays)
+    x, t = np.array([[1.0]]), np.array([[400.0]])
+    assert np.array_equal(back.predict(x, t)[0], emu.predict(x, t)[0])
+    with pytest.raises(gpmsa.GPMSAError, match=r"\['format'\] are written by the container"):
+        container.write_raw(tmp_path / "bad.gpmsa", {**manifest, "format": "x"}, arrays)
+    with pytest.raises(gpmsa.GPMSAError, match="array 'a b'"):
+        container.write_raw(tmp_path / "bad.gpmsa", manifest, {"a b": np.zeros(1)})
 
 
 def rewrite(src, dst, *, manifest=None, rehash=True, extra=None, drop=()):
