@@ -15,6 +15,13 @@ from gpmsa.mcmc.sampler import Chains
 from gpmsa.model.data import ObsData, SimData
 from gpmsa.model.priors import GammaPrior, Priors
 from gpmsa.model.problem import ObsProblem, Problem, prepare
+from gpmsa.predictive import (
+    calibration_posterior,
+    cross_validate,
+    emulator_prediction,
+    full_prediction,
+    sensitivity,
+)
 
 __all__ = [
     "BackendUnavailableError",
@@ -33,8 +40,13 @@ __all__ = [
     "SimData",
     "backends",
     "calibrate",
+    "calibration_posterior",
+    "cross_validate",
+    "emulator_prediction",
     "fit",
+    "full_prediction",
     "load",
     "predictive",
     "prepare",
+    "sensitivity",
 ]

@@ -40,7 +40,9 @@ LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 PUBLIC = [
     "BackendUnavailableError", "Calibrator", "Chains", "Emulator", "EmulatorFileError",
     "GPMSAError", "GammaPrior", "LooResult", "ObsData", "ObsProblem", "Posterior", "Priors",
-    "Problem", "SimData", "backends", "calibrate", "fit", "load", "predictive", "prepare",
+    "Problem", "SimData", "backends", "calibrate", "calibration_posterior", "cross_validate",
+    "emulator_prediction", "fit", "full_prediction", "load", "predictive", "prepare",
+    "sensitivity",
 ]  # fmt: skip
 
 

@@ -1,0 +1,147 @@
+"""What the draw-based predictions share: input checks, parameter sets, the GP of the weights.
+
+Everything here works on GPM/SA's scales (unit inputs, standardised outputs); the public modules
+(``emulator_draws``, ``full``, ``sobol``, ``crossval``) convert at their edges.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+from scipy.linalg import cho_solve, solve_triangular
+
+from gpmsa.errors import GPMSAError
+from gpmsa.model.correlation import correlation
+from gpmsa.model.data import as_matrix
+from gpmsa.model.likelihood import lower_cholesky
+from gpmsa.model.transforms import EXTRAPOLATION_MARGIN
+
+EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+
+
+def check_count(value, name: str, low: int = 1) -> int:
+    """``value`` as an int >= ``low``; GPMSAError naming ``name`` otherwise."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        raise GPMSAError(f"{name} must be an integer >= {low}, got {value!r}")
+    return int(value)
+
+
+def rng_of(seed) -> np.random.Generator:
+    """A Generator from an int, a Generator or None."""
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int | np.integer)):
+        raise GPMSAError(f"seed must be an int, a numpy Generator or None, got {seed!r}")
+    return np.random.default_rng(seed)
+
+
+def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """Native rows (N, d) -> (native, unit scale), with the library's extrapolation rule.
+
+    A 1-D array is one column when d = 1 and one row otherwise. Inside the design range: silent;
+    up to ``EXTRAPOLATION_MARGIN`` of the range outside it: a warning; beyond: GPMSAError naming
+    the input, the values and the domain.
+    """
+    d = len(names)
+    if d > 1 and np.ndim(values) == 1 and np.size(values) == d:
+        values = [values]
+    native = as_matrix(values, what, ncols=d)
+    lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
+    unit = (native - lo) / (hi - lo)
+    unit = np.where((unit < 0) & (unit > -1e-9), 0.0, unit)
+    unit = np.where((unit > 1) & (unit < 1 + 1e-9), 1.0, unit)
+    below, above = unit.min(axis=0), unit.max(axis=0)
+    far = (below < -EXTRAPOLATION_MARGIN) | (above > 1 + EXTRAPOLATION_MARGIN)
+    if far.any():
+        k = int(np.flatnonzero(far)[0])
+        raise GPMSAError(
+            f"{what}: {names[k]} reaches [{native[:, k].min():.6g}, {native[:, k].max():.6g}], "
+            f"outside the emulator's domain [{lo[k]:.6g}, {hi[k]:.6g}] by more than "
+            f"{EXTRAPOLATION_MARGIN:.0%} of its width"
+        )
+    outside = (below < 0) | (above > 1)
+    if outside.any():
+        k = int(np.flatnonzero(outside)[0])
+        warnings.warn(
+            f"{what}: {names[k]} lies outside the emulator's domain [{lo[k]:.6g}, {hi[k]:.6g}]; "
+            "the emulator extrapolates there",
+            stacklevel=3,
+        )
+    return native, unit
+
+
+def param_sets(emulator, draws: bool, n_draws: int | None, what: str):
+    """(indices, list of parameter dicts) the prediction averages over.
+
+    ``draws=False``: the point estimate only (index -1). ``draws=True``: the retained posterior
+    draws, or ``n_draws`` of them evenly spaced; GPMSAError when the emulator kept none.
+    """
+    if not draws:
+        return np.array([-1]), [emulator.params]
+    n = emulator.n_draws if emulator.draws else 0
+    if n == 0:
+        raise GPMSAError(
+            f"{what} with draws=True needs the emulator's retained posterior draws, but this "
+            "emulator kept none (built by Emulator.from_params, or read from a file without "
+            "draws); pass draws=False to use its point estimate"
+        )
+    idx = np.arange(n)
+    if n_draws is not None:
+        k = check_count(n_draws, "n_draws")
+        idx = np.unique(np.linspace(0, n - 1, min(k, n)).round().astype(int))
+    sets = [{k: np.asarray(emulator.draws[k][i]) for k in EMULATOR_PARAMS} for i in idx]
+    return idx, sets
+
+
+def factors(emulator, prm: dict) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per basis component j: (lower Cholesky factor of Sigma_W_j, Sigma_W_j^-1 w_j).
+
+    Sigma_W_j = R(zt; betaU_j) / lamUz_j + (1 / (lam_sim_j lamWOs) + 1 / lamWs_j) I.
+    """
+    zt = emulator.zt
+    out = []
+    for j in range(emulator.p_u):
+        S = correlation(zt, None, prm["betaU"][:, j]) / prm["lamUz"][j]
+        S[np.diag_indices(emulator.m)] += (
+            1.0 / (emulator.lam_sim[j] * prm["lamWOs"][0]) + 1.0 / prm["lamWs"][j]
+        )
+        L = lower_cholesky(S)
+        if L is None:
+            raise GPMSAError("Sigma_W is not positive definite at these emulator parameters")
+        L = np.tril(L)
+        out.append((L, cho_solve((L, True), emulator.w[:, j])))
+    return out
+
+
+def w_conditional(emulator, prm: dict, fac, z: np.ndarray, joint: bool):
+    """The smooth GP of the weights at unit-scale points z (N, p + q), given the runs' w.
+
+    Returns mean (N, p_u) and, per component, the variance (N, p_u) or (joint) the covariance
+    (p_u, N, N); no nugget 1/lamWs and no residual 1/lamWOs.
+    """
+    N, p_u = z.shape[0], emulator.p_u
+    mean = np.empty((N, p_u))
+    spread = np.empty((p_u, N, N)) if joint else np.empty((N, p_u))
+    for j, (L, alpha) in enumerate(fac):
+        lam = prm["lamUz"][j]
+        r = correlation(z, emulator.zt, prm["betaU"][:, j]) / lam
+        mean[:, j] = r @ alpha
+        B = solve_triangular(L, r.T, lower=True)
+        if joint:
+            spread[j] = correlation(z, None, prm["betaU"][:, j]) / lam - B.T @ B
+        else:
+            spread[:, j] = np.maximum(1.0 / lam - np.sum(B * B, axis=0), 0.0)
+    return mean, spread
+
+
+def mvn_factor(cov: np.ndarray) -> np.ndarray:
+    """A matrix A with A A^T = cov (Cholesky with a tiny jitter; eigenvalues clipped at 0)."""
+    scale = max(float(np.mean(np.diag(cov))), 1e-300)
+    for jitter in (1e-12, 1e-10, 1e-8):
+        try:
+            return np.linalg.cholesky(cov + jitter * scale * np.eye(cov.shape[0]))
+        except np.linalg.LinAlgError:
+            continue
+    vals, vecs = np.linalg.eigh(0.5 * (cov + cov.T))
+    return vecs * np.sqrt(np.clip(vals, 0.0, None))

@@ -1,0 +1,398 @@
+"""The full calibrated prediction at new x: simulator eta, discrepancy delta, observation y.
+
+This is SEPIA's ``SepiaFullPrediction`` (GPM/SA's ``gPredict`` in 'uvpred' mode). GPM/SA's
+observation model (Higdon et al. 2008) on the standardised scale is
+
+    y(x) = K u(x, theta) + D v(x) + e,   e ~ N(0, I / lamOs),
+
+with u_j ~ GP(0, R(.; betaU_j) / lamUz_j) plus the nugget 1/lamWs_j (the emulator's GP, which also
+produced the simulation runs' weights w) and v_k ~ GP(0, R(x; betaV) / lamVz) independently per
+discrepancy basis vector. For each posterior draw of (theta, lamOs, betaV, lamVz and the emulator
+parameters) the weights (v, u) at the new x are Gaussian given everything observed: the runs'
+weights w and the observations' reduced data (the GLS weights of y_obs on [D, K], with covariance
+Sigma_obs / lamOs). Conditioning is done in two steps, on w (per component, the emulator's
+Cholesky factor) and then on the reduced observations (dense, small). Realizations give
+
+    eta = y_mean + y_sd K u          the simulator at the posterior theta,
+    delta = y_sd D v                 the discrepancy,
+    zeta = eta + delta               the real process,
+    y = zeta + y_sd e                a new observation (its noise, GPM/SA's default I / lamOs),
+
+on the native scale and on one output grid; ``u`` and ``v`` are the basis-space values.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import solve_triangular
+from threadpoolctl import threadpool_limits
+
+from gpmsa.calibration.posterior import Posterior
+from gpmsa.errors import GPMSAError
+from gpmsa.model.basis import discrepancy_basis, interpolate_basis
+from gpmsa.model.correlation import correlation
+from gpmsa.model.data import ObsData, check_finite
+from gpmsa.model.problem import reduce_obs
+from gpmsa.predictive._common import (
+    EMULATOR_PARAMS,
+    check_count,
+    factors,
+    mvn_factor,
+    rng_of,
+    unit_inputs,
+)
+
+AS_FITTED = "as fitted"
+"""``discrepancy`` default of ``full_prediction``: the basis the joint fit recorded."""
+
+QUANTITIES = ("eta", "delta", "zeta", "y")
+
+
+@dataclass(frozen=True, eq=False)
+class FullPrediction:
+    """Draws of the calibrated prediction at new x (SEPIA's full prediction).
+
+    Attributes:
+        x: (N, p) the inputs, native units; grid: (l,) the output grid of eta, delta, zeta, y.
+        draw_index: (S,) the posterior draws used, in order.
+        theta: (S, q) their calibration parameters, native; lamOs: (S,) their noise precisions.
+        mu: (S, N, p_v + p_u) per draw, the conditional mean of the basis weights (v then u,
+            standardised scale); cov: (S, N, p_v + p_u, p_v + p_u) their covariance at each point.
+        u: (S * n_rlz, N, p_u), v: (S * n_rlz, N, p_v) realizations of the weights (row
+            s * n_rlz + r: realization r of draw s).
+        eta, delta, y: (S * n_rlz, N, l) the realizations on the native scale (see the module
+            docstring); ``zeta`` = eta + delta.
+        K: (l, p_u) and D: (l, p_v) the bases on ``grid``; y_mean: (l,), y_sd: the
+            standardisation.
+    """
+
+    x: np.ndarray
+    grid: np.ndarray
+    draw_index: np.ndarray
+    theta: np.ndarray
+    lamOs: np.ndarray
+    mu: np.ndarray
+    cov: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    eta: np.ndarray
+    delta: np.ndarray
+    y: np.ndarray
+    K: np.ndarray
+    D: np.ndarray
+    y_mean: np.ndarray
+    y_sd: float
+
+    @property
+    def zeta(self) -> np.ndarray:
+        """(S * n_rlz, N, l) realizations of the real process eta + delta (no noise)."""
+        return self.eta + self.delta
+
+    @property
+    def p_v(self) -> int:
+        """Number of discrepancy basis vectors (0: no discrepancy)."""
+        return self.D.shape[1]
+
+    def _check(self, what: str) -> None:
+        if what not in QUANTITIES:
+            raise GPMSAError(f"what must be one of {QUANTITIES}, got {what!r}")
+
+    def _moments_std(self, what: str) -> tuple[np.ndarray, np.ndarray]:
+        """Per draw mean and variance (S, N, l), standardised scale, of one quantity."""
+        p_v, l = self.p_v, self.grid.size
+        if what == "eta":
+            B = np.hstack([np.zeros((l, p_v)), self.K])
+        elif what == "delta":
+            B = np.hstack([self.D, np.zeros((l, self.K.shape[1]))])
+        else:
+            B = np.hstack([self.D, self.K])
+        mean = self.mu @ B.T
+        var = np.einsum("lc,sncd,ld->snl", B, self.cov, B, optimize=True)
+        if what == "y":
+            var = var + (1.0 / self.lamOs)[:, None, None]
+        return mean, var
+
+    def mean(self, what: str = "y") -> np.ndarray:
+        """(N, l) predictive mean of ``what`` ("eta", "delta", "zeta" or "y"), native units."""
+        self._check(what)
+        m, _ = self._moments_std(what)
+        offset = 0.0 if what == "delta" else self.y_mean
+        return m.mean(axis=0) * self.y_sd + offset
+
+    def var(self, what: str = "y") -> np.ndarray:
+        """(N, l) predictive variance of ``what``, native units^2 (law of total variance)."""
+        self._check(what)
+        m, v = self._moments_std(what)
+        return (v.mean(axis=0) + m.var(axis=0)) * self.y_sd**2
+
+    def interval(self, what: str = "y", level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
+        """Central interval (N, l) of probability ``level`` from the realizations' quantiles."""
+        self._check(what)
+        if not 0.0 < level < 1.0:
+            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        lo, hi = np.quantile(getattr(self, what), [(1 - level) / 2, (1 + level) / 2], axis=0)
+        return lo, hi
+
+
+def _posterior_sets(emulator, posterior, n_draws):
+    """Indices and per-draw parameter dicts (unit theta) from a joint fit or a Posterior."""
+    if posterior is None:
+        cal = getattr(emulator, "calibration", None)
+        if not cal:
+            raise GPMSAError(
+                "full_prediction needs calibration draws: fit jointly (gpmsa.fit(data, obs, "
+                "discrepancy=...)) or pass posterior= from gpmsa.calibrate"
+            )
+        if not emulator.draws:
+            raise GPMSAError("the emulator kept no posterior draws of its own parameters")
+        n = cal["theta"].shape[0]
+
+        def get(i):
+            prm = {k: np.asarray(emulator.draws[k][i]) for k in EMULATOR_PARAMS}
+            prm["theta"] = np.asarray(cal["theta"][i], dtype=float).reshape(-1)
+            prm["lamOs"] = float(np.ravel(cal["lamOs"][i])[0])
+            if "betaV" in cal:
+                prm["betaV"] = np.asarray(cal["betaV"][i], dtype=float).reshape(-1)
+                prm["lamVz"] = float(np.ravel(cal["lamVz"][i])[0])
+            return prm
+
+    else:
+        if not isinstance(posterior, Posterior):
+            raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
+        names = tuple(emulator.t_names)
+        samples = posterior.samples
+        missing = [k for k in (*names, "lamOs") if k not in samples]
+        if missing:
+            raise GPMSAError(f"posterior lacks {missing}; it has {tuple(samples)}")
+        theta = emulator.standardizer.t_to_unit(
+            np.column_stack([np.asarray(samples[k], dtype=float) for k in names])
+        )
+        n = theta.shape[0]
+        p = emulator.p
+        bnames = ["betaV"] if "betaV" in samples else [f"betaV[{k}]" for k in range(p)]
+        has_v = all(k in samples for k in bnames) and "lamVz" in samples
+        if has_v and len(bnames) != p:
+            raise GPMSAError(f"posterior has one betaV but the emulator has p = {p} known inputs")
+
+        def get(i):
+            prm = {k: emulator.params[k] for k in EMULATOR_PARAMS}
+            prm["theta"] = theta[i]
+            prm["lamOs"] = float(samples["lamOs"][i])
+            if has_v:
+                prm["betaV"] = np.array([float(samples[k][i]) for k in bnames])
+                prm["lamVz"] = float(samples["lamVz"][i])
+            return prm
+
+    idx = np.arange(n)
+    if n_draws is not None:
+        k = check_count(n_draws, "n_draws")
+        idx = np.unique(np.linspace(0, n - 1, min(k, n)).round().astype(int))
+    return idx, [get(i) for i in idx]
+
+
+def _pred_grid(emulator, obs: ObsData, grid):
+    """The output grid of the prediction: ``grid``, else the observations' common grid."""
+    std = emulator.standardizer
+    if emulator.l_sim == 1:
+        if grid is not None:
+            raise GPMSAError("a scalar output has no output grid; leave grid=None")
+        return std.grid
+    if grid is not None:
+        g = np.asarray(grid, dtype=float).reshape(-1)
+        check_finite(g, "grid")
+        lo, hi = std.grid.min(), std.grid.max()
+        if g.size == 0 or g.min() < lo or g.max() > hi:
+            raise GPMSAError(f"grid must be non-empty and lie within the simulation grid "
+                             f"[{lo:.6g}, {hi:.6g}]")  # fmt: skip
+        return g
+    grids = [std.grid if g is None else g for g in obs.grids]
+    same = all(g.shape == grids[0].shape and np.array_equal(g, grids[0]) for g in grids)
+    return grids[0] if same else std.grid
+
+
+def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool):
+    """D (l, p_v) on the prediction grid with the normalisation the fit used for the data."""
+    if kind is None:
+        return np.zeros((grid.size, 0))
+    if scalar:
+        return np.ones((1, 1))
+    obs_grids = [std.grid if g is None else g for g in obs.grids]
+    if not isinstance(kind, str):
+        if not all(g.shape == grid.shape and np.array_equal(g, grid) for g in obs_grids):
+            raise GPMSAError(
+                "a discrepancy basis given as an array is known on the observations' grid only: "
+                "every experiment must share that grid, and grid= must be it (or None)"
+            )
+        return discrepancy_basis(kind, grid)
+    # "constant"/"linear": the first column is 1 before normalisation; keep the data's scale.
+    scales = {round(float(discrepancy_basis(kind, g)[0, 0]), 12) for g in obs_grids}
+    if len(scales) > 1:
+        raise GPMSAError(
+            f"the experiments' grids give the {kind!r} discrepancy basis different scales; "
+            "full_prediction needs them to share one"
+        )
+    D = discrepancy_basis(kind, grid)
+    return D * (scales.pop() / D[0, 0])
+
+
+def full_prediction(
+    emulator,
+    obs: ObsData,
+    x,
+    *,
+    posterior: Posterior | None = None,
+    discrepancy=AS_FITTED,
+    n_draws: int | None = None,
+    n_rlz: int = 1,
+    grid=None,
+    seed=None,
+) -> FullPrediction:
+    """The calibrated prediction at new x: eta(x, theta), delta(x) and y(x), draw by draw.
+
+    Args:
+        emulator: a gpmsa.Emulator; from a joint fit (``gpmsa.fit(data, obs, ...)``) its
+            calibration draws are used, paired with its emulator-parameter draws.
+        obs: the ObsData the calibration used (the prediction conditions on it).
+        x: (N, p) new known inputs, native units. Outside the training range: a warning; more
+            than ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError.
+        posterior: instead of the joint fit's draws, a Posterior of gpmsa.calibrate (theta,
+            lamOs, and betaV, lamVz with a discrepancy) with the emulator at its point estimate.
+        discrepancy: the discrepancy basis of the calibration: None, "constant", "linear" or an
+            (l_obs, p_v) array; the default takes the joint fit's recorded choice (an array must
+            be passed again).
+        n_draws: at most this many posterior draws, evenly spaced (None: all).
+        n_rlz: realizations per draw.
+        grid: output grid of the prediction within the simulation grid (default: the
+            observations' grid when all experiments share one, else the simulation grid).
+        seed: int, numpy Generator or None.
+
+    Returns:
+        FullPrediction (native units; ``u``, ``v``, ``mu``, ``cov`` in the basis space).
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
+        >>> data = gpmsa.SimData(x=x, t=t, y=x + t, x_names=["x"], t_names=["t"])
+        >>> obs = gpmsa.ObsData(x=[[0.2], [0.5], [0.8]], y=[[0.7], [1.1], [1.3]])
+        >>> emu = gpmsa.fit(data, obs, n_iter=50, tune=False, seed=0, discrepancy="constant")
+        >>> pred = gpmsa.full_prediction(emu, obs, [[0.3], [0.6]], seed=1)
+        >>> pred.eta.shape, pred.delta.shape, pred.y.shape   # (draws, points, outputs)
+        ((40, 2, 1), (40, 2, 1), (40, 2, 1))
+        >>> bool(np.all(pred.var("y") > pred.var("zeta")))
+        True
+    """
+    if not isinstance(obs, ObsData):
+        raise GPMSAError(f"obs must be the gpmsa.ObsData of the calibration, got "
+                         f"{type(obs).__name__}")  # fmt: skip
+    n_rlz = check_count(n_rlz, "n_rlz")
+    rng = rng_of(seed)
+    std, K = emulator.standardizer, emulator.K
+    scalar = emulator.l_sim == 1
+    if isinstance(discrepancy, str) and discrepancy == AS_FITTED:
+        if posterior is not None:
+            raise GPMSAError("with posterior= pass the discrepancy basis the calibration used "
+                             "(None, 'constant', 'linear' or the array)")  # fmt: skip
+        discrepancy = emulator.settings.get("discrepancy")
+        if isinstance(discrepancy, str) and discrepancy == "given":
+            raise GPMSAError(
+                "the joint fit used a discrepancy basis given as an array; pass it again as "
+                "discrepancy="
+            )
+    x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
+    idx, sets = _posterior_sets(emulator, posterior, n_draws)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the calibration already warned about its x_obs
+        ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names)
+    p_v = ob.p_v
+    if ("betaV" in sets[0]) != (p_v > 0):
+        raise GPMSAError(
+            f"the draws {'have' if 'betaV' in sets[0] else 'lack'} discrepancy parameters but "
+            f"discrepancy={discrepancy!r} gives {p_v} discrepancy basis vectors"
+        )
+    g = _pred_grid(emulator, obs, grid)
+    K_pred = interpolate_basis(K, std.grid, g) if not scalar else K
+    D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar)
+    N, p_u = xu.shape[0], emulator.p_u
+    n_c = p_v + p_u
+    S = len(sets)
+    mu = np.empty((S, N, n_c))
+    cov_pt = np.empty((S, N, n_c, n_c))
+    lat = np.empty((S, n_rlz, N, n_c))
+    with threadpool_limits(limits=1, user_api="blas"):
+        for i, prm in enumerate(sets):
+            m_i, C_i = _conditional(emulator, ob, prm, xu, p_v, scalar)
+            blocks = C_i.reshape(n_c, N, n_c, N)
+            cov_pt[i] = np.einsum("cidi->icd", blocks)
+            mu[i] = m_i.reshape(n_c, N).T
+            A = mvn_factor(C_i)
+            r = m_i + rng.standard_normal((n_rlz, n_c * N)) @ A.T
+            lat[i] = r.reshape(n_rlz, n_c, N).transpose(0, 2, 1)
+    lat = lat.reshape(S * n_rlz, N, n_c)
+    v, u = lat[:, :, :p_v], lat[:, :, p_v:]
+    lamOs = np.array([prm["lamOs"] for prm in sets])
+    eta = (u @ K_pred.T) * std.y_sd + std.mean_on(g)
+    delta = (v @ D_pred.T) * std.y_sd
+    noise = rng.standard_normal(eta.shape) / np.sqrt(np.repeat(lamOs, n_rlz))[:, None, None]
+    y = eta + delta + noise * std.y_sd
+    theta = std.t_from_unit(np.array([prm["theta"] for prm in sets]))
+    return FullPrediction(
+        x=x_nat, grid=g, draw_index=idx, theta=theta, lamOs=lamOs, mu=mu, cov=cov_pt,
+        u=u, v=v, eta=eta, delta=delta, y=y, K=K_pred, D=D_pred, y_mean=std.mean_on(g),
+        y_sd=std.y_sd,
+    )  # fmt: skip
+
+
+def _conditional(emulator, ob, prm, xu_new, p_v, scalar):
+    """Mean (n_c N,) and covariance of the weights [v comps; u comps] at the new x (comp-major).
+
+    Prior (per component, over the n observed and N new points): v_k ~ GP(0, R(x; betaV)/lamVz);
+    u_j | w ~ the emulator GP given the runs (nugget 1/lamWs_j on every point); then condition
+    on the observations' reduced data z = H [v_obs; u_obs] + N(0, Sigma_obs / lamOs), H the
+    identity (vector output) or the sum of the blocks (scalar output: z = u + v + e).
+    """
+    n, N, p_u = ob.n, xu_new.shape[0], emulator.p_u
+    n_c = p_v + p_u
+    P = n + N
+    x_all = np.vstack([ob.x, xu_new])
+    theta = np.tile(prm["theta"], (P, 1))
+    xt_all = np.hstack([x_all, theta])
+    means = np.zeros((n_c, P))
+    covs = np.empty((n_c, P, P))
+    if p_v:
+        cv = correlation(x_all, None, prm["betaV"]) / prm["lamVz"]
+        covs[:p_v] = cv
+    for j, (L, alpha) in enumerate(factors(emulator, prm)):
+        lam = prm["lamUz"][j]
+        beta = prm["betaU"][:, j]
+        r = correlation(xt_all, emulator.zt, beta) / lam
+        B = solve_triangular(L, r.T, lower=True)
+        c = correlation(xt_all, None, beta) / lam - B.T @ B
+        c[np.diag_indices(P)] += 1.0 / prm["lamWs"][j]
+        covs[p_v + j] = c
+        means[p_v + j] = r @ alpha
+    o, s = slice(0, n), slice(n, P)
+    # H maps the stacked observed latents (n_c n) to the data z.
+    if scalar:
+        C = sum(covs[c][o, o] for c in range(n_c)) + ob.sig_obs / prm["lamOs"]
+        z_res = ob.z - sum(means[c][o] for c in range(n_c))
+        cross = np.vstack([covs[c][s, o] for c in range(n_c)])  # (n_c N, n)
+    else:
+        d = n_c * n
+        C = ob.sig_obs / prm["lamOs"]
+        cross = np.zeros((n_c * N, d))
+        for c in range(n_c):
+            C[c * n : (c + 1) * n, c * n : (c + 1) * n] += covs[c][o, o]
+            cross[c * N : (c + 1) * N, c * n : (c + 1) * n] = covs[c][s, o]
+        z_res = ob.z - means[:, o].reshape(-1)
+    L = np.linalg.cholesky(C)
+    G = solve_triangular(L, cross.T, lower=True)  # L^-1 cross^T
+    a = solve_triangular(L, z_res, lower=True)
+    mean = means[:, s].reshape(-1) + G.T @ a
+    prior = np.zeros((n_c * N, n_c * N))
+    for c in range(n_c):
+        prior[c * N : (c + 1) * N, c * N : (c + 1) * N] = covs[c][s, s]
+    return mean, prior - G.T @ G

@@ -1,0 +1,63 @@
+"""A joint fit's calibration draws as a ``gpmsa.Posterior`` (no wrapping by hand)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gpmsa.calibration.posterior import Posterior
+from gpmsa.errors import GPMSAError
+
+
+def calibration_posterior(emulator) -> Posterior:
+    """The calibration draws of a joint fit (``gpmsa.fit(data, obs, ...)``) as a Posterior.
+
+    Samples (native units): each calibration parameter under its name in ``emulator.t_names``,
+    ``lamOs``, and with a discrepancy ``lamVz`` and ``betaV`` (``betaV[k]`` per known input when
+    p > 1). ``chains`` splits the retained draws into the fit's chains, so ``to_arviz()``,
+    ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
+        >>> data = gpmsa.SimData(x=x, t=t, y=x + t, x_names=["x"], t_names=["t"])
+        >>> obs = gpmsa.ObsData(x=[[0.2], [0.8]], y=[[0.5], [1.1]])
+        >>> emu = gpmsa.fit(data, obs, n_iter=50, tune=False, seed=0)
+        >>> post = gpmsa.calibration_posterior(emu)
+        >>> post.names
+        ('t', 'lamOs')
+        >>> 0.0 <= post.mean("t") <= 1.0
+        True
+    """
+    cal = getattr(emulator, "calibration", None)
+    if not cal:
+        raise GPMSAError(
+            "this emulator has no calibration draws: it was fitted without observations "
+            "(gpmsa.fit(data, obs, ...) samples theta jointly); calibrate it with "
+            "gpmsa.calibrate or gpmsa.Calibrator instead"
+        )
+    theta = np.asarray(cal["theta_native"], dtype=float)
+    samples = {name: theta[:, k].copy() for k, name in enumerate(emulator.t_names)}
+    samples["lamOs"] = np.asarray(cal["lamOs"], dtype=float).reshape(theta.shape[0], -1)[:, 0]
+    if "lamVz" in cal:
+        samples["lamVz"] = np.asarray(cal["lamVz"], dtype=float).reshape(theta.shape[0], -1)[:, 0]
+    if "betaV" in cal:
+        bv = np.asarray(cal["betaV"], dtype=float).reshape(theta.shape[0], -1)
+        if bv.shape[1] == 1:
+            samples["betaV"] = bv[:, 0].copy()
+        else:
+            samples.update({f"betaV[{k}]": bv[:, k].copy() for k in range(bv.shape[1])})
+    n_chains = int(emulator.settings.get("n_chains", 1) or 1)
+    n = theta.shape[0]
+    per = n // n_chains
+    chains = None
+    if per >= 2 and per * n_chains == n:
+        chains = {k: v.reshape(n_chains, per) for k, v in samples.items()}
+    info = {
+        "method": "joint fit",
+        "names": list(samples),
+        "n_chains": n_chains,
+        **{k: emulator.settings[k] for k in ("n_iter", "n_burn", "thin", "seed", "backend",
+                                              "discrepancy") if k in emulator.settings},
+    }  # fmt: skip
+    return Posterior(samples, chains=chains, info=info)
