@@ -3,7 +3,7 @@
 An emulator fitted offline by MCMC, shared as a file, calibrated online.
 """
 
-from gpmsa import backends, predictive
+from gpmsa import backends, plots, predictive
 from gpmsa._version import __version__ as __version__
 from gpmsa.calibration.calibrate import calibrate
 from gpmsa.calibration.calibrator import Calibrator
@@ -46,6 +46,7 @@ __all__ = [
     "fit",
     "full_prediction",
     "load",
+    "plots",
     "predictive",
     "prepare",
     "sensitivity",

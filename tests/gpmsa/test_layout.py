@@ -29,19 +29,19 @@ LAYERS = (
     ("backends",),
     ("fitting", "calibration"),
     ("predictive",),
-    ("cli",),
+    ("cli", "plots"),
 )
 """The parts of gpmsa from the bottom up. A part may import itself and the parts of LOWER layers
 only (never a part of its own layer, never one above): errors, _version <- model, io <- mcmc <-
-backends <- fitting, calibration <- predictive <- cli; the file container (io) knows nothing of the
-Emulator, whose record lives in fitting and imports io."""
+backends <- fitting, calibration <- predictive <- cli, plots; the file container (io) knows
+nothing of the Emulator, whose record lives in fitting and imports io."""
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 
 PUBLIC = [
     "BackendUnavailableError", "Calibrator", "Chains", "Emulator", "EmulatorFileError",
     "GPMSAError", "GammaPrior", "LooResult", "ObsData", "ObsProblem", "Posterior", "Priors",
     "Problem", "SimData", "backends", "calibrate", "calibration_posterior", "cross_validate",
-    "emulator_prediction", "fit", "full_prediction", "load", "predictive", "prepare",
+    "emulator_prediction", "fit", "full_prediction", "load", "plots", "predictive", "prepare",
     "sensitivity",
 ]  # fmt: skip
 

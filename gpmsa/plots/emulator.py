@@ -1,0 +1,132 @@
+"""The emulator's PC basis and weights, and its fit against held-out runs."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.special import ndtri
+
+from gpmsa.errors import GPMSAError
+from gpmsa.model.data import SimData
+from gpmsa.plots._figure import figure
+from gpmsa.predictive.crossval import CrossValidation
+
+
+def pc_basis(emulator, *, max_pc: int = 6):
+    """The basis vectors (native units, y_sd K_j over the output grid) and the runs' weights
+    w_j against each input, one row per component (at most ``max_pc``): a Figure.
+
+    The title of each basis panel gives the share of the standardised runs' variance the
+    component carries. A scalar output (K = [[1]]) shows the weights only.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t, s = rng.uniform(size=(20, 1)), rng.uniform(size=(20, 1)), np.linspace(0, 1, 8)
+        >>> data = gpmsa.SimData(x=x, t=t, y=np.outer(x, s) + np.outer(t, s**2), index=s)
+        >>> emu = gpmsa.Emulator.from_params(data, {"betaU": [[1, 1], [1, 1]], "lamUz": [1, 1],
+        ...                                         "lamWs": [1e3, 1e3], "lamWOs": [1e3]})
+        >>> fig = gpmsa.plots.pc_basis(emu)
+        >>> len(fig.axes)     # 2 components x (basis + 2 inputs)
+        6
+    """
+    std = emulator.standardizer
+    p_u = min(emulator.p_u, int(max_pc))
+    scalar = emulator.l_sim == 1
+    inputs = [(n, emulator.x_unit[:, k] * (std.x_max[k] - std.x_min[k]) + std.x_min[k])
+              for k, n in enumerate(emulator.x_names)]  # fmt: skip
+    inputs += [(n, emulator.t_unit[:, k] * (std.t_max[k] - std.t_min[k]) + std.t_min[k])
+               for k, n in enumerate(emulator.t_names)]  # fmt: skip
+    y_std = std.y_to_std(emulator.y)
+    total = float(np.sum(y_std**2))
+    share = emulator.lam_sim * np.sum(emulator.w**2, axis=0) / total if total > 0 else None
+    n_col = len(inputs) + (0 if scalar else 1)
+    fig = figure(2.6 * n_col + 0.4, 2.2 * p_u + 0.4)
+    axes = fig.subplots(p_u, n_col, squeeze=False)
+    for j in range(p_u):
+        row = list(axes[j])
+        if not scalar:
+            ax = row.pop(0)
+            ax.plot(std.grid, std.y_sd * emulator.K[:, j], color=f"C{j}")
+            ax.axhline(0.0, color="0.7", lw=0.6)
+            pct = f" ({100 * share[j]:.1f} % of variance)" if share is not None else ""
+            ax.set_title(f"PC {j + 1}{pct}", fontsize="small")
+            ax.set_xlabel("output index")
+        for ax, (name, values) in zip(row, inputs, strict=True):
+            ax.plot(values, emulator.w[:, j], ".", ms=3, color=f"C{j}")
+            ax.set_xlabel(name)
+            if ax is row[0]:
+                ax.set_ylabel(f"w{j + 1}")
+    return fig
+
+
+def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
+                 draws: bool = True):  # fmt: skip
+    """Emulator predictions against held-out runs (or a cross-validation): a Figure.
+
+    Left: predicted mean against the run's value for every output element, with central
+    intervals of probability ``level``, and the share of values they cover. Right (a functional
+    output): up to ``max_runs`` runs over the output grid, their value and the predicted band.
+
+    Args:
+        emulator: the gpmsa.Emulator.
+        held_out: a SimData of runs not used in the fit (predicted by ``Emulator.predict``, over
+            the retained draws when ``draws``), or a CrossValidation from ``cross_validate``.
+        level: probability of the intervals.
+        max_runs: runs drawn on the right.
+        draws: average the prediction of held-out runs over the posterior draws.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t = rng.uniform(size=(30, 1)), rng.uniform(size=(30, 1))
+        >>> data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t, x_names=["x"], t_names=["t"])
+        >>> emu = gpmsa.Emulator.from_params(data, {"betaU": [[2], [1]], "lamUz": [1],
+        ...                                         "lamWs": [1e4], "lamWOs": [1e4]})
+        >>> fig = gpmsa.plots.emulator_fit(emu, gpmsa.cross_validate(emu, draws=False))
+        >>> len(fig.axes)
+        1
+    """
+    if not 0.0 < level < 1.0:
+        raise GPMSAError(f"level must lie in (0, 1), got {level}")
+    if isinstance(held_out, CrossValidation):
+        mean, var, actual = held_out.mean, held_out.var, held_out.y
+        what = "cross-validation"
+    elif isinstance(held_out, SimData):
+        if held_out.l_sim != emulator.l_sim:
+            raise GPMSAError(f"held-out runs have {held_out.l_sim} outputs, the emulator "
+                             f"{emulator.l_sim}")  # fmt: skip
+        mean, var = emulator.predict(held_out.x, held_out.t, draws=draws and emulator.n_draws > 0)
+        actual = held_out.y
+        what = f"{held_out.m} held-out runs"
+    else:
+        raise GPMSAError(
+            f"held_out must be a SimData of held-out runs or a CrossValidation, got "
+            f"{type(held_out).__name__}"
+        )
+    half = ndtri(0.5 + level / 2) * np.sqrt(var)
+    inside = float(np.mean(np.abs(actual - mean) <= half))
+    functional = actual.shape[1] > 1
+    fig = figure(10.0 if functional else 5.0, 4.2)
+    axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]
+    ax = axes[0]
+    ax.errorbar(actual.ravel(), mean.ravel(), yerr=half.ravel(), fmt=".", ms=3, lw=0.6,
+                color="C0", ecolor="0.6")  # fmt: skip
+    lims = [min(actual.min(), mean.min()), max(actual.max(), mean.max())]
+    ax.plot(lims, lims, color="C3", lw=1)
+    ax.set_xlabel("run value")
+    ax.set_ylabel("predicted")
+    ax.set_title(f"{what}: {100 * inside:.0f} % inside the {100 * level:.0f} % intervals",
+                 fontsize="small")  # fmt: skip
+    if functional:
+        grid = emulator.standardizer.grid
+        rows = np.unique(np.linspace(0, actual.shape[0] - 1, min(max_runs, actual.shape[0]))
+                         .round().astype(int))  # fmt: skip
+        for c, i in enumerate(rows):
+            col = f"C{c % 10}"
+            axes[1].fill_between(grid, mean[i] - half[i], mean[i] + half[i], color=col, alpha=0.2)
+            axes[1].plot(grid, mean[i], color=col, lw=1)
+            axes[1].plot(grid, actual[i], "o", color=col, ms=3)
+        axes[1].set_xlabel("output index")
+        axes[1].set_ylabel("output")
+        axes[1].set_title("runs (dots) and predicted bands", fontsize="small")
+    return fig

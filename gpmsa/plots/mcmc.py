@@ -1,0 +1,159 @@
+"""MCMC traces and the pair plot of the calibration parameters."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gpmsa.calibration.posterior import Posterior
+from gpmsa.errors import GPMSAError
+from gpmsa.mcmc.sampler import Chains
+from gpmsa.plots._figure import figure
+from gpmsa.predictive.joint import calibration_posterior
+
+NUISANCE = ("lamOs", "lamVz")
+"""Posterior names that are not calibration parameters (with ``betaV`` and ``betaV[k]``)."""
+
+
+def _scalar_series(name: str, arr: np.ndarray) -> dict[str, np.ndarray]:
+    """name -> (n_chains, n_draws) per element of arr (n_chains, n_draws, *shape)."""
+    flat = arr.reshape(arr.shape[0], arr.shape[1], -1)
+    if flat.shape[2] == 1:
+        return {name: flat[:, :, 0]}
+    shape = arr.shape[2:]
+    return {f"{name}[{','.join(map(str, np.unravel_index(i, shape)))}]": flat[:, :, i]
+            for i in range(flat.shape[2])}  # fmt: skip
+
+
+def _series(source) -> dict[str, np.ndarray]:
+    """Every scalar parameter of an Emulator, Posterior or Chains: name -> (chains, draws)."""
+    out: dict[str, np.ndarray] = {}
+    if isinstance(source, Chains):
+        for k, v in source.draws.items():
+            out.update(_scalar_series(k, np.asarray(v)))
+        return out
+    if isinstance(source, Posterior):
+        if source.chains is not None:
+            return {k: np.atleast_2d(np.asarray(v)) for k, v in source.chains.items()}
+        return {k: np.asarray(v)[None, :] for k, v in source.samples.items()}
+    if hasattr(source, "draws") and hasattr(source, "settings"):
+        n = source.n_draws
+        if n == 0:
+            raise GPMSAError("this emulator kept no posterior draws to trace")
+        n_ch = int(source.settings.get("n_chains", 1) or 1)
+        per = n // n_ch if n % n_ch == 0 else n
+        n_ch = n // per
+        if source.calibration:
+            post = calibration_posterior(source)
+            for k, v in post.samples.items():
+                out[k] = np.asarray(v).reshape(n_ch, per)
+        for k, v in source.draws.items():
+            out.update(_scalar_series(k, np.asarray(v).reshape(n_ch, per, *v.shape[1:])))
+        return out
+    raise GPMSAError(
+        f"source must be a gpmsa.Emulator, Posterior or Chains, got {type(source).__name__}"
+    )
+
+
+def _pick(series: dict, names, max_params: int) -> list[str]:
+    if names is None:
+        return list(series)[:max_params]
+    names = [names] if isinstance(names, str) else list(names)
+    picked = []
+    for n in names:
+        hits = [k for k in series if k == n or k.startswith(f"{n}[")]
+        if not hits:
+            raise GPMSAError(f"unknown parameter {n!r}; available: {list(series)}")
+        picked.extend(hits)
+    return picked
+
+
+def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
+    """Trace (per chain) and histogram of each scalar parameter: a Figure.
+
+    Args:
+        source: a gpmsa.Emulator (its retained draws; a joint fit's calibration draws first), a
+            Posterior (its chains) or a Chains.
+        names: parameters to show (a name selects all its elements, e.g. "betaU"); default: the
+            first ``max_params`` scalars.
+        max_params: rows at most when ``names`` is None.
+        bins: histogram bins.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> post = gpmsa.Posterior({"t": np.random.default_rng(0).normal(size=200)})
+        >>> fig = gpmsa.plots.traces(post)
+        >>> len(fig.axes)
+        2
+    """
+    series = _series(source)
+    picked = _pick(series, names, max_params)
+    fig = figure(9.0, 1.6 * len(picked) + 0.6)
+    axes = np.atleast_2d(fig.subplots(len(picked), 2, width_ratios=[3, 1], squeeze=False))
+    for row, name in zip(axes, picked, strict=True):
+        chains = series[name]
+        for c, ch in enumerate(chains):
+            row[0].plot(ch, lw=0.6, color=f"C{c}", label=f"chain {c}" if len(chains) > 1 else None)
+        row[0].set_ylabel(name)
+        row[1].hist(chains.reshape(-1), bins=bins, orientation="horizontal", color="0.6")
+        row[1].set_yticklabels([])
+    axes[-1, 0].set_xlabel("retained draw")
+    axes[-1, 1].set_xlabel("count")
+    if len(series[picked[0]]) > 1:
+        axes[0, 0].legend(fontsize="small", loc="upper right")
+    return fig
+
+
+def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30):
+    """Pair plot of the calibration parameters: histograms on the diagonal, draws below it.
+
+    Args:
+        source: a Posterior, or an Emulator from a joint fit (its calibration draws).
+        names: the parameters (default: every calibration parameter, i.e. not lamOs, lamVz,
+            betaV).
+        truth: name -> value to mark (e.g. the value a synthetic case was made with).
+        bins: histogram bins.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> post = gpmsa.Posterior({"a": rng.normal(size=300), "b": rng.normal(size=300)})
+        >>> fig = gpmsa.plots.theta_pairs(post, truth={"a": 0.0})
+        >>> len(fig.axes)
+        4
+    """
+    post = source if isinstance(source, Posterior) else None
+    if post is None:
+        if not getattr(source, "calibration", None):
+            raise GPMSAError("theta_pairs needs a Posterior or an Emulator from a joint fit")
+        post = calibration_posterior(source)
+    if names is None:
+        names = [n for n in post.names if n not in NUISANCE and not n.startswith("betaV")]
+    names = [names] if isinstance(names, str) else list(names)
+    unknown = [n for n in names if n not in post.names]
+    if unknown or not names:
+        raise GPMSAError(f"unknown parameters {unknown}; the posterior has {post.names}")
+    truth = dict(truth or {})
+    k = len(names)
+    fig = figure(2.4 * k + 0.6, 2.4 * k + 0.4)
+    axes = fig.subplots(k, k, squeeze=False)
+    draws = {n: np.asarray(post.samples[n], dtype=float) for n in names}
+    for i, ni in enumerate(names):
+        for j, nj in enumerate(names):
+            ax = axes[i, j]
+            if j > i:
+                ax.set_axis_off()
+                continue
+            if i == j:
+                ax.hist(draws[ni], bins=bins, color="0.6", density=True)
+                if ni in truth:
+                    ax.axvline(truth[ni], color="C3", lw=1.2)
+                ax.set_yticks([])
+            else:
+                ax.plot(draws[nj], draws[ni], ".", ms=2, alpha=0.3, color="C0")
+                if ni in truth and nj in truth:
+                    ax.plot(truth[nj], truth[ni], "x", color="C3", ms=8, mew=2)
+            if i == k - 1:
+                ax.set_xlabel(nj)
+            if j == 0 and i > 0:
+                ax.set_ylabel(ni)
+    return fig

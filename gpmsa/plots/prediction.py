@@ -1,0 +1,108 @@
+"""Calibrated prediction bands (simulator, simulator + discrepancy, observation) against data."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+from gpmsa.plots._figure import figure
+from gpmsa.predictive.full import FullPrediction
+
+BANDS = (("y", "new observation y", "0.8"), ("zeta", "eta + delta", "C1"),
+         ("eta", "simulator eta", "C0"))  # fmt: skip
+
+
+def prediction_bands(
+    pred: FullPrediction,
+    observed=None,
+    *,
+    level: float = 0.9,
+    max_panels: int = 6,
+    x_column: int = 0,
+):
+    """Bands of a full prediction and the observations at its x: a Figure.
+
+    A functional output gets one column per new x (at most ``max_panels``, evenly chosen): on
+    top the central bands of probability ``level`` of a new observation y, of the real process
+    eta + delta and of the simulator eta over the output grid, with the observed values; below,
+    the discrepancy delta. A scalar output gets the same bands against the known input
+    ``x_column``.
+
+    Args:
+        pred: a FullPrediction from ``full_prediction``.
+        observed: (N, l) observed values at ``pred.x`` (e.g. held-out observations), or None.
+        level: probability of the bands.
+        max_panels: columns at most (functional output).
+        x_column: the known input on the horizontal axis (scalar output).
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
+        >>> data = gpmsa.SimData(x=x, t=t, y=x + t, x_names=["x"], t_names=["t"])
+        >>> obs = gpmsa.ObsData(x=[[0.2], [0.5], [0.8]], y=[[0.7], [1.1], [1.3]])
+        >>> emu = gpmsa.fit(data, obs, n_iter=50, tune=False, seed=0, discrepancy="constant")
+        >>> pred = gpmsa.full_prediction(emu, obs, np.linspace(0.1, 0.9, 5)[:, None], seed=1)
+        >>> fig = gpmsa.plots.prediction_bands(pred)
+        >>> len(fig.axes)
+        2
+    """
+    if not isinstance(pred, FullPrediction):
+        raise GPMSAError(f"pred must be a FullPrediction, got {type(pred).__name__}")
+    if not 0.0 < level < 1.0:
+        raise GPMSAError(f"level must lie in (0, 1), got {level}")
+    N, l = pred.x.shape[0], pred.grid.size
+    if observed is not None:
+        observed = np.asarray(observed, dtype=float)
+        if observed.ndim == 1 and l == 1:
+            observed = observed[:, None]
+        if observed.shape != (N, l):
+            raise GPMSAError(f"observed must have shape ({N}, {l}) (one row per predicted x), "
+                             f"got {observed.shape}")  # fmt: skip
+    bands = {w: pred.interval(w, level) for w in ("y", "zeta", "eta", "delta")}
+    pct = f"{100 * level:.0f} %"
+    if l == 1:
+        if not 0 <= x_column < pred.x.shape[1]:
+            raise GPMSAError(f"x_column must be in [0, {pred.x.shape[1]}), got {x_column}")
+        order = np.argsort(pred.x[:, x_column])
+        xs = pred.x[order, x_column]
+        fig = figure(6.0, 6.0)
+        top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2, 1])
+        for what, label, color in BANDS:
+            lo, hi = bands[what]
+            top.fill_between(xs, lo[order, 0], hi[order, 0], color=color, alpha=0.35,
+                             label=f"{label} ({pct})")  # fmt: skip
+        top.plot(xs, pred.mean("eta")[order, 0], color="C0", lw=1)
+        if observed is not None:
+            top.plot(xs, observed[order, 0], "o", color="k", ms=3, label="observed")
+        lo, hi = bands["delta"]
+        bottom.fill_between(xs, lo[order, 0], hi[order, 0], color="C2", alpha=0.4)
+        bottom.plot(xs, pred.mean("delta")[order, 0], color="C2", lw=1)
+        bottom.axhline(0.0, color="0.6", lw=0.6)
+        bottom.set_xlabel(f"x[{x_column}]")
+        bottom.set_ylabel("discrepancy delta")
+        top.set_ylabel("output")
+        top.legend(fontsize="small")
+        return fig
+    cols = np.unique(np.linspace(0, N - 1, min(int(max_panels), N)).round().astype(int))
+    fig = figure(2.8 * cols.size + 0.6, 5.6)
+    axes = fig.subplots(2, cols.size, squeeze=False, sharex=True, height_ratios=[2, 1])
+    for c, i in enumerate(cols):
+        top, bottom = axes[0, c], axes[1, c]
+        for what, label, color in BANDS:
+            lo, hi = bands[what]
+            top.fill_between(pred.grid, lo[i], hi[i], color=color, alpha=0.35,
+                             label=f"{label} ({pct})")  # fmt: skip
+        if observed is not None:
+            top.plot(pred.grid, observed[i], "o", color="k", ms=3, label="observed")
+        lo, hi = bands["delta"]
+        bottom.fill_between(pred.grid, lo[i], hi[i], color="C2", alpha=0.4)
+        bottom.plot(pred.grid, pred.mean("delta")[i], color="C2", lw=1)
+        bottom.axhline(0.0, color="0.6", lw=0.6)
+        bottom.set_xlabel("output index")
+        xs = ", ".join(f"{v:.3g}" for v in pred.x[i])
+        top.set_title(f"x = ({xs})", fontsize="small")
+    axes[0, 0].set_ylabel("output")
+    axes[1, 0].set_ylabel("discrepancy delta")
+    axes[0, 0].legend(fontsize="x-small")
+    return fig

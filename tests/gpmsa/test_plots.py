@@ -1,0 +1,146 @@
+"""The figures: each a matplotlib Figure with the content it promises; nothing shown; matplotlib
+not imported by ``import gpmsa``."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _calib_cases import two_param_emulator
+from _predict_cases import known_truth_case, vector_fit
+from matplotlib.figure import Figure
+
+import gpmsa
+from gpmsa import GPMSAError, plots
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def test_import_gpmsa_does_not_import_matplotlib():
+    code = "import sys, gpmsa, gpmsa.plots; print('matplotlib' in sys.modules)"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                          timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"
+
+
+def test_traces_of_an_emulator_joint_fit_and_a_selection():
+    emu, *_ = known_truth_case()
+    fig = plots.traces(emu)
+    assert isinstance(fig, Figure)
+    labels = [ax.get_ylabel() for ax in fig.axes[::2]]
+    n_scalars = 4 + 2 * emu.p_u + 2 * emu.p_u + 1  # t lamOs lamVz betaV, betaU, lamUz lamWs, lamWOs
+    assert labels[:4] == ["t", "lamOs", "lamVz", "betaV"] and len(labels) == min(12, n_scalars)
+    line = fig.axes[0].lines[0]
+    np.testing.assert_array_equal(line.get_ydata(), emu.calibration["theta_native"][:, 0])
+    fig = plots.traces(emu, names=["betaU"])
+    assert [ax.get_ylabel() for ax in fig.axes[::2]] == [
+        f"betaU[{i},{j}]" for i in range(2) for j in range(emu.p_u)
+    ]
+    with pytest.raises(GPMSAError, match="unknown parameter 'beta'"):
+        plots.traces(emu, names="beta")
+    with pytest.raises(GPMSAError, match="kept no posterior draws"):
+        plots.traces(two_param_emulator())
+    with pytest.raises(GPMSAError, match="source must be"):
+        plots.traces({"t": [1, 2]})
+
+
+def test_traces_of_chains_show_each_chain():
+    chains = gpmsa.Chains(
+        draws={"theta": np.random.default_rng(0).normal(size=(3, 50, 1))},
+        log_post=np.zeros((3, 50)), accept_rate={}, step_widths={}, info={},
+    )  # fmt: skip
+    fig = plots.traces(chains)
+    assert len(fig.axes[0].lines) == 3 and fig.axes[0].get_legend() is not None
+
+
+def test_theta_pairs_marks_the_truth():
+    rng = np.random.default_rng(0)
+    post = gpmsa.Posterior({"a": rng.normal(size=100), "b": rng.normal(size=100),
+                            "lamOs": rng.gamma(2.0, size=100)})  # fmt: skip
+    fig = plots.theta_pairs(post, truth={"a": 0.5, "b": -0.5})
+    assert len(fig.axes) == 4  # lamOs is not a calibration parameter
+    scatter = fig.axes[2]
+    assert scatter.get_xlabel() == "a" and scatter.get_ylabel() == "b"
+    np.testing.assert_array_equal(scatter.lines[0].get_xdata(), post.samples["a"])
+    assert tuple(scatter.lines[1].get_xydata()[0]) == (0.5, -0.5)
+    emu, *_ = known_truth_case()
+    assert len(plots.theta_pairs(emu).axes) == 1
+    with pytest.raises(GPMSAError, match="unknown parameters"):
+        plots.theta_pairs(post, names=["c"])
+    with pytest.raises(GPMSAError, match="joint fit"):
+        plots.theta_pairs(vector_fit())
+
+
+def test_pc_basis_draws_the_basis_and_weights():
+    emu = vector_fit()
+    fig = plots.pc_basis(emu)
+    assert len(fig.axes) == emu.p_u * 3
+    std = emu.standardizer
+    np.testing.assert_allclose(fig.axes[0].lines[0].get_ydata(), std.y_sd * emu.K[:, 0])
+    np.testing.assert_allclose(fig.axes[1].lines[0].get_ydata(), emu.w[:, 0])
+    shares = [float(ax.get_title().split("(")[1].split(" %")[0]) for ax in fig.axes[::3]]
+    assert shares[0] > shares[1] and 99.0 < sum(shares) <= 100.0
+    assert len(plots.pc_basis(two_param_emulator()).axes) == 3  # scalar: weights only
+
+
+def test_emulator_fit_against_held_out_runs_and_cross_validation():
+    emu = vector_fit()
+    rng = np.random.default_rng(1)
+    x, t = rng.uniform(0.1, 1.9, (8, 1)), rng.uniform(-0.9, 0.9, (8, 1))
+    s = np.linspace(0.0, 1.0, 10)
+    y = np.sin(2.0 * x) * (1.0 + s) + np.outer(t[:, 0] ** 2 + 0.3 * t[:, 0], s**2)
+    test = gpmsa.SimData(x=x, t=t, y=y, index=s)
+    fig = plots.emulator_fit(emu, test)
+    assert len(fig.axes) == 2 and "8 held-out runs" in fig.axes[0].get_title()
+    cv = gpmsa.cross_validate(emu, n_draws=5)
+    fig = plots.emulator_fit(emu, cv, level=0.5)
+    assert "cross-validation" in fig.axes[0].get_title()
+    with pytest.raises(GPMSAError, match="held_out must be"):
+        plots.emulator_fit(emu, (x, t, y))
+
+
+def test_prediction_bands_functional_and_scalar():
+    emu, obs, x_new, y_new = known_truth_case()
+    pred = gpmsa.full_prediction(emu, obs, x_new[::10], n_draws=50, seed=0)
+    fig = plots.prediction_bands(pred, observed=y_new[::10])
+    assert len(fig.axes) == 12  # 6 x values, bands and discrepancy
+    top = fig.axes[0]
+    assert len(top.collections) == 3
+    np.testing.assert_array_equal(top.lines[0].get_ydata(), y_new[0])
+    with pytest.raises(GPMSAError, match=r"observed must have shape \(6, 12\)"):
+        plots.prediction_bands(pred, observed=y_new)
+    rng = np.random.default_rng(0)
+    x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
+    data = gpmsa.SimData(x=x, t=t, y=x + t, x_names=["x"], t_names=["t"])
+    obs1 = gpmsa.ObsData(x=[[0.2], [0.5], [0.8]], y=[[0.7], [1.1], [1.3]])
+    emu1 = gpmsa.fit(data, obs1, n_iter=50, tune=False, seed=0, discrepancy="constant")
+    pred1 = gpmsa.full_prediction(emu1, obs1, [[0.7], [0.3]], seed=1)
+    fig = plots.prediction_bands(pred1, observed=[1.2, 0.8])
+    assert len(fig.axes) == 2
+    np.testing.assert_array_equal(fig.axes[0].lines[-1].get_xdata(), [0.3, 0.7])  # sorted by x
+
+
+def test_sensitivity_bars():
+    emu = vector_fit()
+    sens = gpmsa.sensitivity(emu, n_draws=10)
+    fig = plots.sensitivity_bars(sens)
+    assert len(fig.axes) == 2
+    heights = [p.get_height() for p in fig.axes[0].patches]
+    np.testing.assert_allclose(heights[:2], sens.main_aggregated.mean(axis=0))
+    np.testing.assert_allclose(heights[2:], sens.total_aggregated.mean(axis=0))
+    with pytest.raises(GPMSAError, match="sens must be a Sensitivity"):
+        plots.sensitivity_bars({"x": 1})
+
+
+def test_no_pyplot_figure_is_left_open():
+    import matplotlib.pyplot as plt
+
+    before = plt.get_fignums()
+    plots.sensitivity_bars(gpmsa.sensitivity(vector_fit(), n_draws=3)).savefig(
+        os.devnull, format="png"
+    )
+    assert plt.get_fignums() == before
