@@ -60,7 +60,7 @@ def pc_basis(emulator, *, max_pc: int = 6):
 
 
 def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
-                 draws: bool = True):  # fmt: skip
+                 draws: bool = True, n_draws: int | None = 100):  # fmt: skip
     """Emulator predictions against held-out runs (or a cross-validation): a Figure.
 
     Left: predicted mean against the run's value for every output element, with central
@@ -73,7 +73,8 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
             the retained draws when ``draws``), or a CrossValidation from ``cross_validate``.
         level: probability of the intervals.
         max_runs: runs drawn on the right.
-        draws: average the prediction of held-out runs over the posterior draws.
+        draws: average the prediction of held-out runs over the posterior draws (at most
+            ``n_draws`` of them, evenly spaced; None: all).
 
     Example:
         >>> import numpy as np, gpmsa
@@ -95,7 +96,8 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
         if held_out.l_sim != emulator.l_sim:
             raise GPMSAError(f"held-out runs have {held_out.l_sim} outputs, the emulator "
                              f"{emulator.l_sim}")  # fmt: skip
-        mean, var = emulator.predict(held_out.x, held_out.t, draws=draws and emulator.n_draws > 0)
+        use = draws and emulator.n_draws > 0
+        mean, var = emulator.predict(held_out.x, held_out.t, draws=use, n_draws=n_draws)
         actual = held_out.y
         what = f"{held_out.m} held-out runs"
     else:

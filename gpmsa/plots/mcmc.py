@@ -94,8 +94,9 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
         for c, ch in enumerate(chains):
             row[0].plot(ch, lw=0.6, color=f"C{c}", label=f"chain {c}" if len(chains) > 1 else None)
         row[0].set_ylabel(name)
+        row[1].sharey(row[0])
         row[1].hist(chains.reshape(-1), bins=bins, orientation="horizontal", color="0.6")
-        row[1].set_yticklabels([])
+        row[1].tick_params(labelleft=False)
     axes[-1, 0].set_xlabel("retained draw")
     axes[-1, 1].set_xlabel("count")
     if len(series[picked[0]]) > 1:

@@ -19,6 +19,7 @@ def prediction_bands(
     level: float = 0.9,
     max_panels: int = 6,
     x_column: int = 0,
+    relative: bool = False,
 ):
     """Bands of a full prediction and the observations at its x: a Figure.
 
@@ -26,7 +27,8 @@ def prediction_bands(
     top the central bands of probability ``level`` of a new observation y, of the real process
     eta + delta and of the simulator eta over the output grid, with the observed values; below,
     the discrepancy delta. A scalar output gets the same bands against the known input
-    ``x_column``.
+    ``x_column``. With ``relative`` the top panels show everything minus the predicted mean of
+    y, so that narrow bands on a large output (say 0.05 s on 4 s) can be seen.
 
     Args:
         pred: a FullPrediction from ``full_prediction``.
@@ -34,6 +36,7 @@ def prediction_bands(
         level: probability of the bands.
         max_panels: columns at most (functional output).
         x_column: the known input on the horizontal axis (scalar output).
+        relative: subtract the predicted mean of y in the top panels.
 
     Example:
         >>> import numpy as np, gpmsa
@@ -60,6 +63,13 @@ def prediction_bands(
             raise GPMSAError(f"observed must have shape ({N}, {l}) (one row per predicted x), "
                              f"got {observed.shape}")  # fmt: skip
     bands = {w: pred.interval(w, level) for w in ("y", "zeta", "eta", "delta")}
+    eta_mean = pred.mean("eta")
+    if relative:
+        ref = pred.mean("y")
+        bands.update({w: (bands[w][0] - ref, bands[w][1] - ref) for w in ("y", "zeta", "eta")})
+        eta_mean = eta_mean - ref
+        observed = None if observed is None else observed - ref
+    ylabel = "output minus predicted mean of y" if relative else "output"
     pct = f"{100 * level:.0f} %"
     if l == 1:
         if not 0 <= x_column < pred.x.shape[1]:
@@ -72,7 +82,7 @@ def prediction_bands(
             lo, hi = bands[what]
             top.fill_between(xs, lo[order, 0], hi[order, 0], color=color, alpha=0.35,
                              label=f"{label} ({pct})")  # fmt: skip
-        top.plot(xs, pred.mean("eta")[order, 0], color="C0", lw=1)
+        top.plot(xs, eta_mean[order, 0], color="C0", lw=1)
         if observed is not None:
             top.plot(xs, observed[order, 0], "o", color="k", ms=3, label="observed")
         lo, hi = bands["delta"]
@@ -81,7 +91,7 @@ def prediction_bands(
         bottom.axhline(0.0, color="0.6", lw=0.6)
         bottom.set_xlabel(f"x[{x_column}]")
         bottom.set_ylabel("discrepancy delta")
-        top.set_ylabel("output")
+        top.set_ylabel(ylabel)
         top.legend(fontsize="small")
         return fig
     cols = np.unique(np.linspace(0, N - 1, min(int(max_panels), N)).round().astype(int))
@@ -93,6 +103,7 @@ def prediction_bands(
             lo, hi = bands[what]
             top.fill_between(pred.grid, lo[i], hi[i], color=color, alpha=0.35,
                              label=f"{label} ({pct})")  # fmt: skip
+        top.plot(pred.grid, eta_mean[i], color="C0", lw=1)
         if observed is not None:
             top.plot(pred.grid, observed[i], "o", color="k", ms=3, label="observed")
         lo, hi = bands["delta"]
@@ -102,7 +113,7 @@ def prediction_bands(
         bottom.set_xlabel("output index")
         xs = ", ".join(f"{v:.3g}" for v in pred.x[i])
         top.set_title(f"x = ({xs})", fontsize="small")
-    axes[0, 0].set_ylabel("output")
+    axes[0, 0].set_ylabel(ylabel)
     axes[1, 0].set_ylabel("discrepancy delta")
     axes[0, 0].legend(fontsize="x-small")
     return fig

@@ -110,7 +110,11 @@ def test_prediction_bands_functional_and_scalar():
     assert len(fig.axes) == 12  # 6 x values, bands and discrepancy
     top = fig.axes[0]
     assert len(top.collections) == 3
-    np.testing.assert_array_equal(top.lines[0].get_ydata(), y_new[0])
+    np.testing.assert_allclose(top.lines[0].get_ydata(), pred.mean("eta")[0])
+    np.testing.assert_array_equal(top.lines[1].get_ydata(), y_new[0])
+    rel = plots.prediction_bands(pred, observed=y_new[::10], relative=True).axes[0]
+    np.testing.assert_allclose(rel.lines[1].get_ydata(), y_new[0] - pred.mean("y")[0])
+    assert "minus predicted mean" in rel.get_ylabel()
     with pytest.raises(GPMSAError, match=r"observed must have shape \(6, 12\)"):
         plots.prediction_bands(pred, observed=y_new)
     rng = np.random.default_rng(0)
