@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_solve
 from scipy.special import ndtr
-from threadpoolctl import threadpool_limits
 
+from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.predictive._common import factors, param_sets, rng_of
 
@@ -135,7 +135,7 @@ def cross_validate(
     S = len(sets)
     acc = {k: np.zeros((m, l_sim)) for k in ("m", "m2", "v", "pit")}
     acc_w = {k: np.zeros((m, p_u)) for k in ("m", "m2", "v")}
-    with threadpool_limits(limits=1, user_api="blas"):
+    with blas_controller().limit(limits=1, user_api="blas"):
         for prm in sets:
             mw = np.empty((m, p_u))
             vw = np.empty((m, p_u))

@@ -17,8 +17,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.predictive._common import (
     check_count,
@@ -163,7 +163,7 @@ def emulator_prediction(
     mu = np.empty((S, N, p_u))
     var = np.empty((S, N, p_u))
     w = np.empty((S, n_rlz, N, p_u))
-    with threadpool_limits(limits=1, user_api="blas"):
+    with blas_controller().limit(limits=1, user_api="blas"):
         for i, prm in enumerate(sets):
             m_i, spread = w_conditional(emulator, prm, factors(emulator, prm), z, joint)
             nugget = 1.0 / prm["lamWs"] if resid else np.zeros(p_u)

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import solve_triangular
-from threadpoolctl import threadpool_limits
 
+from gpmsa.calibration.observations import blas_controller
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.model.basis import discrepancy_basis, interpolate_basis
@@ -322,9 +322,11 @@ def full_prediction(
     mu = np.empty((S, N, n_c))
     cov_pt = np.empty((S, N, n_c, n_c))
     lat = np.empty((S, n_rlz, N, n_c))
-    with threadpool_limits(limits=1, user_api="blas"):
+    with blas_controller().limit(limits=1, user_api="blas"):
+        point = factors(emulator, emulator.params) if posterior is not None else None
         for i, prm in enumerate(sets):
-            m_i, C_i = _conditional(emulator, ob, prm, xu, p_v, scalar)
+            fac = point if point is not None else factors(emulator, prm)
+            m_i, C_i = _conditional(emulator, ob, prm, fac, xu, p_v, scalar)
             blocks = C_i.reshape(n_c, N, n_c, N)
             cov_pt[i] = np.einsum("cidi->icd", blocks)
             mu[i] = m_i.reshape(n_c, N).T
@@ -346,11 +348,12 @@ def full_prediction(
     )  # fmt: skip
 
 
-def _conditional(emulator, ob, prm, xu_new, p_v, scalar):
+def _conditional(emulator, ob, prm, fac, xu_new, p_v, scalar):
     """Mean (n_c N,) and covariance of the weights [v comps; u comps] at the new x (comp-major).
 
     Prior (per component, over the n observed and N new points): v_k ~ GP(0, R(x; betaV)/lamVz);
-    u_j | w ~ the emulator GP given the runs (nugget 1/lamWs_j on every point); then condition
+    u_j | w ~ the emulator GP given the runs (nugget 1/lamWs_j on every point; ``fac``: per
+    component the Cholesky factor of Sigma_W_j and Sigma_W_j^-1 w_j); then condition
     on the observations' reduced data z = H [v_obs; u_obs] + N(0, Sigma_obs / lamOs), H the
     identity (vector output) or the sum of the blocks (scalar output: z = u + v + e).
     """
@@ -365,7 +368,7 @@ def _conditional(emulator, ob, prm, xu_new, p_v, scalar):
     if p_v:
         cv = correlation(x_all, None, prm["betaV"]) / prm["lamVz"]
         covs[:p_v] = cv
-    for j, (L, alpha) in enumerate(factors(emulator, prm)):
+    for j, (L, alpha) in enumerate(fac):
         lam = prm["lamUz"][j]
         beta = prm["betaU"][:, j]
         r = correlation(xt_all, emulator.zt, beta) / lam

@@ -28,8 +28,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.special import erf
-from threadpoolctl import threadpool_limits
 
+from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.predictive._common import factors, param_sets, unit_inputs
 
@@ -232,7 +232,7 @@ def sensitivity(
     out_agg = {k: np.empty((S, d)) for k in ("main", "total")}
     variance = np.empty((S, l_sim))
     mean = np.empty((S, l_sim))
-    with threadpool_limits(limits=1, user_api="blas"):
+    with blas_controller().limit(limits=1, user_api="blas"):
         for i, prm in enumerate(sets):
             beta = prm["betaU"]
             coef = np.array([alpha / prm["lamUz"][j] for j, (_, alpha) in

@@ -20,6 +20,7 @@ from gpmsa import GPMSAError
 from gpmsa.model.correlation import correlation as R
 from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive import full_prediction
+from gpmsa.predictive._common import factors
 from gpmsa.predictive.full import _conditional
 
 
@@ -73,7 +74,7 @@ def test_conditional_equals_the_dense_joint_gaussian():
     xn = np.array([[0.1], [0.45], [0.9]])
     for i in (0, emu.n_draws // 2, emu.n_draws - 1):
         prm = _draw(emu, i)
-        mean, cov = _conditional(emu, ob, prm, xn, ob.p_v, False)
+        mean, cov = _conditional(emu, ob, prm, factors(emu, prm), xn, ob.p_v, False)
         ref_mean, ref_cov = _dense_reference(emu, ob, prm, xn)
         np.testing.assert_allclose(mean, ref_mean, atol=1e-10 * np.abs(ref_mean).max())
         np.testing.assert_allclose(cov, ref_cov, atol=1e-10 * np.abs(ref_cov).max())
