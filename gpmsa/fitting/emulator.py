@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
+from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.io.container import jsonable, read_raw, write_raw
@@ -285,11 +286,12 @@ class Emulator:
         if n_draws is not None:
             idx = np.unique(np.linspace(0, self.n_draws - 1, max(1, n_draws)).astype(int))
         means, vars_ = [], []
-        for i in idx:
-            prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
-            m, v = self._predict_std(z, prm, self._factor(prm), resid)
-            means.append(m)
-            vars_.append(v)
+        with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
+            for i in idx:
+                prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
+                m, v = self._predict_std(z, prm, self._factor(prm), resid)
+                means.append(m)
+                vars_.append(v)
         means, vars_ = np.array(means), np.array(vars_)
         mean = means.mean(axis=0)
         var = vars_.mean(axis=0) + means.var(axis=0)
