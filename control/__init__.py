@@ -1,6 +1,6 @@
 """Bayesian Calibration Routine (BCR), Simplex speed controller and the closed loop.
 
->>> import control
+>>> import control, roadgen
 >>> emu = control.shipped_emulator("A")                     # doctest: +SKIP
 >>> track = roadgen.track([(50, 300), (50, 500), (50, 300)], seed=1)   # doctest: +SKIP
 >>> result = control.run_closed_loop(track, emu, seed=1)    # doctest: +SKIP
@@ -9,13 +9,17 @@
 Note: the import name ``control`` is also python-control's; do not install both in one environment.
 """
 
-from control.bcr import BCR, BCRSettings
-from control.closed_loop import ClosedLoopResult, LoopMetrics, SensorFault, run_closed_loop
-from control.compat import bcr_settings_for, check_emulator
+from control.bcr import BCR, METHODS, PAPER_WINDOW, BCRSettings
+from control.changepoint import ChangePointFilter, ChangePointSettings
+from control.closed_loop import ClosedLoopResult, LoopMetrics, run_closed_loop
+from control.compat import bcr_settings_for, check_emulator, emulator_feature
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError
 from control.estimate import STATUSES, Estimate
-from control.feature import window_feature
+from control.faults import FAULT_KINDS, SensorFault
+from control.feature import FeatureSpec, block_features, window_feature
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
+from control.observation_model import BlockScatter, ObservationModel
+from control.sensor_checks import SensorLimits
 from control.shipped import shipped_emulator, shipped_emulator_path
 from control.simplex import Command, Simplex
 from control.tracker import GDTracker, TrackerSettings
@@ -23,22 +27,33 @@ from control.tracker import GDTracker, TrackerSettings
 __all__ = [
     "BCR",
     "BCRSettings",
+    "FAULT_KINDS",
+    "METHODS",
+    "PAPER_WINDOW",
     "STATUSES",
+    "BlockScatter",
+    "ChangePointFilter",
+    "ChangePointSettings",
     "ClosedLoopResult",
     "Command",
     "ControlError",
     "ControlWarning",
     "EmulatorMismatchError",
     "Estimate",
+    "FeatureSpec",
     "GDError",
     "GDTracker",
     "LoopMetrics",
+    "ObservationModel",
     "SensorFault",
+    "SensorLimits",
     "Simplex",
     "TrackerSettings",
     "bcr_settings_for",
+    "block_features",
     "check_emulator",
     "detection_delays",
+    "emulator_feature",
     "fast_on_rough_m",
     "gd_errors",
     "pooled_rmse",

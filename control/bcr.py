@@ -1,30 +1,29 @@
 """The Bayesian Calibration Routine (BCR): streaming accelerations in, GD posteriors out.
 
-The paper's BCR keeps a moving buffer of the last 1,000 front-axle accelerations (120 Hz), computes
-f = var(buffer) (eq. 5, normalised by T) and calibrates the GPM/SA emulator on (v, f) to get a GD
-posterior. This class does the same through ``gpmsa.Calibrator.log_likelihood_grid`` (exact, on
-a grid) and, by default (``method="filter"``), combines successive windows in a sequential Bayes
-filter (`control.tracker`): one window's f has a 15-25% spread across road realisations, so more
-than one window is needed to beat one window's accuracy. ``method="window"`` is the paper's
-estimator: each estimate uses its own window only.
+Methods (``BCRSettings.method``):
 
-Windows that overlap share samples and must not be multiplied together as if independent. Two
-ways to respect that:
+- ``"changepoint"`` (default): the samples are cut into disjoint blocks (125 samples, ~1 s at
+  120 Hz); each block's feature vector (log band powers, `control.feature`) has a likelihood of
+  GD from the emulator with the block scatter as known observation noise
+  (`control.observation_model`), and a change-point filter (`control.changepoint`) pools every
+  block since the last change of roughness and forgets within a few blocks after one.
+- ``"window"``: the paper's estimator: the moving buffer of the last 1,000 samples, its log
+  variance, the posterior of that window alone under the emulator's prior (paper eqs. 3, 5).
+- ``"filter"`` / ``"tempered"``: the previous default: the paper's windows combined by a grid
+  filter with a change-point / random-walk prior (`control.tracker`), with disjoint interleaved
+  windows or tempered overlapping ones.
 
-- ``method="filter"`` (default): K = ceil(buffer / update_every) interleaved filters, filter k
-  taking the disjoint windows that end at updates k, k + K, ... at full power; each estimate is
-  the posterior of the filter whose window just ended, so it reacts to its newest window as fast
-  as the one-window estimator, and adds the earlier, disjoint windows that the change-point /
-  random-walk prior still deems relevant.
-- ``method="tempered"``: one filter, updated at every estimate with the newest window's
-  likelihood raised to the power n_new / buffer, where n_new is the number of samples that
-  entered the buffer since the filter's last update (125 / 1,000 in steady state; 1 after a
-  restart). Over a stretch of constant roughness the tempered likelihoods add up to one full
-  window likelihood per ``buffer`` new samples, so no sample is counted twice. After a change,
-  though, the windows that straddle it enter with weight too, so the estimate moves later than
-  with the interleaved filters (about 10 m against 6 m for a 300 -> 500 step at 1.5 m/s with
-  the test double of tests/control); in closed loop it is better where the roughness is steady
-  and worse after changes, no better overall (docs/closed-loop.md).
+A block next to a fault may hold part of it (a fault rarely starts or ends on a block boundary):
+when a block is a fault or implausible, the change-point filter also undoes the block before it,
+and skips the block after it.
+
+Every update returns an `Estimate` whose status says why there is no number: ``filling`` (not
+enough contiguous samples yet), ``sensor_fault`` (non-finite values, dropped, repeated or
+backwards time stamps, a stuck, quantised or clipped signal), ``implausible`` (no GD in the
+emulator's domain explains the observation), ``out_of_domain`` (speed outside the emulator's
+range and no earlier estimate), ``calibration_failed``, ``stale`` (no new information for
+``max_age_s``). While the speed is outside the emulator's range (e.g. standing) there is no new
+information: the change-point estimate is carried on (its reason says so) until it turns stale.
 """
 
 from __future__ import annotations
@@ -34,241 +33,392 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from control.changepoint import ChangePointFilter, ChangePointSettings
 from control.errors import ControlError
 from control.estimate import Estimate
-from control.feature import FEATURES, window_feature
+from control.feature import FeatureSpec, block_features, window_feature
+from control.sensor_checks import SensorLimits, signal_fault, stream_fault
 from control.tracker import GDTracker, TrackerSettings
 
-METHODS = ("filter", "tempered", "window")
+METHODS = ("changepoint", "window", "filter", "tempered")
+MAX_SPEED_CHANGE = 0.5
+"""A block whose lowest speed is below this fraction of its highest (starting, stopping) carries
+no information for the change-point method: the emulator knows constant speeds only."""
+PAPER_WINDOW = FeatureSpec(name="log_var", block_samples=1000)
+"""The paper's observation: log of the variance of the last 1,000 samples at 120 Hz."""
 
 
 @dataclass(frozen=True)
 class BCRSettings:
-    """Settings of a BCR (see `BCR`); the closed loop builds its BCR from these."""
+    """Settings of a BCR.
 
-    buffer: int = 1000
-    rate_hz: float = 120.0
-    update_every: int = 125
-    feature: str = "log_var"
-    method: str = "filter"
+    Attributes:
+        feature: the observation (block feature for "changepoint"; the window for the others).
+        method: one of METHODS (see the module docstring).
+        update_every: new samples between estimates (None: the block length for "changepoint",
+            125 for the window methods: about one estimate a second at 120 Hz).
+        changepoint: settings of the change-point filter.
+        tracker: settings of the window methods' filter.
+        max_age_s: an estimate older than this (sample time since its newest information)
+            turns "stale".
+        interval_level: level of the reported central credible interval.
+        plausibility_p: an observation whose upper-tail probability under the emulator is below
+            this for every GD in the domain is "implausible".
+        sensor: thresholds of the signal checks (stuck, quantised, clipped).
+        recent_change_m: the distance of ``Estimate.prob_change``, m.
+    """
+
+    feature: FeatureSpec = field(default_factory=FeatureSpec)
+    method: str = "changepoint"
+    update_every: int | None = None
+    changepoint: ChangePointSettings = field(default_factory=ChangePointSettings)
     tracker: TrackerSettings = field(default_factory=TrackerSettings)
     max_age_s: float = 5.0
     interval_level: float = 0.9
+    plausibility_p: float = 1e-6
+    sensor: SensorLimits = field(default_factory=SensorLimits)
+    recent_change_m: float = 5.0
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.buffer, int | np.integer) and self.buffer >= 10):
-            raise ControlError(f"buffer must be an integer >= 10 samples, got {self.buffer}")
-        if not (np.isfinite(self.rate_hz) and self.rate_hz > 0):
-            raise ControlError(f"rate_hz must be > 0, got {self.rate_hz}")
-        if not (isinstance(self.update_every, int | np.integer) and self.update_every >= 1):
-            raise ControlError(f"update_every must be an integer >= 1, got {self.update_every}")
-        if self.feature not in FEATURES:
-            raise ControlError(f"feature must be one of {FEATURES}, got {self.feature!r}")
         if self.method not in METHODS:
             raise ControlError(f"method must be one of {METHODS}, got {self.method!r}")
+        block = self.feature.name == "log_band_power"
+        if (self.method == "changepoint") != block:
+            raise ControlError(
+                f"method {self.method!r} needs the "
+                f"{'log_band_power' if self.method == 'changepoint' else 'log_var or var'} "
+                f"feature, got {self.feature.name!r}"
+            )
+        every = self.samples_per_update
+        if not (isinstance(every, int | np.integer) and every >= 1):
+            raise ControlError(f"update_every must be an integer >= 1, got {every}")
+        if block and every != self.feature.block_samples:
+            raise ControlError(
+                f"the change-point method updates once per block: update_every must equal "
+                f"block_samples = {self.feature.block_samples}, got {every}"
+            )
+        if not block and every > self.feature.block_samples:
+            raise ControlError(
+                f"update_every ({every}) must not exceed the window ({self.feature.block_samples})"
+            )
         if not (np.isfinite(self.max_age_s) and self.max_age_s > 0):
             raise ControlError(f"max_age_s must be > 0, got {self.max_age_s}")
         if not 0 < self.interval_level < 1:
             raise ControlError(f"interval_level must lie in (0, 1), got {self.interval_level}")
+        if not 0 <= self.plausibility_p < 1:
+            raise ControlError(f"plausibility_p must lie in [0, 1), got {self.plausibility_p}")
+        if not (np.isfinite(self.recent_change_m) and self.recent_change_m >= 0):
+            raise ControlError(f"recent_change_m must be >= 0, got {self.recent_change_m}")
+
+    @property
+    def samples_per_update(self) -> int:
+        """New samples between estimates (``update_every`` or its default)."""
+        if self.update_every is not None:
+            return self.update_every
+        block = self.feature.block_samples
+        return block if self.method == "changepoint" else min(125, block)
+
+    @property
+    def rate_hz(self) -> float:
+        """Accelerometer rate, Hz."""
+        return self.feature.rate_hz
 
 
-def emulator_domain(calibrator) -> tuple[tuple[float, float], tuple[float, float]]:
-    """(speed range, GD range) of the calibrator's emulator, native units."""
-    emu = calibrator.emulator
-    dom = emu.domain
-    return tuple(map(float, dom[emu.x_names[0]])), tuple(map(float, dom[emu.t_names[0]]))
+def emulator_domain(emulator) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(speed range, GD range) of an emulator, native units."""
+    dom = emulator.domain
+    return tuple(map(float, dom[emulator.x_names[0]])), tuple(map(float, dom[emulator.t_names[0]]))
 
 
 class BCR:
-    """Streaming GD estimator around a `gpmsa.Calibrator`.
+    """Streaming GD estimator (see the module docstring).
 
     Args:
-        calibrator: a prepared `gpmsa.Calibrator` (anything with ``log_likelihood_grid(x_obs, y_obs)
-            -> (theta_native_grid, loglik)`` and ``emulator.domain``) whose emulator maps speed v
-            (m/s) and GD to the window observation y.
-        buffer: window length, samples (the paper: 1,000).
-        rate_hz: accelerometer rate, Hz (the paper: 120).
-        update_every: new samples between estimates (125: about one estimate a second at 120 Hz;
-            with ``method="filter"``, 1,000 / 125 = 8 interleaved filters of disjoint windows).
-        **settings: the other `BCRSettings` fields (feature, method, tracker, max_age_s,
-            interval_level).
-
-    Guards: the output is an `Estimate` whose status says why there is no number while the buffer
-    fills, when the window's speed is outside the emulator's domain, after NaN or dropped samples
-    (the buffer restarts: windows are contiguous), when the calibrator refuses, and when the newest
-    estimate is older than ``max_age_s``.
+        model: for "changepoint", a `control.ObservationModel` (anything with ``gd``,
+            ``speed_range``, ``loglik(y, v)`` and ``plausibility(y, v)``); for the window
+            methods, a `gpmsa.Calibrator` (anything with ``log_likelihood_grid(x_obs, y_obs)``
+            and ``emulator``). `BCR.from_emulator` builds the right one.
+        settings: `BCRSettings` (default: the change-point method); ``overrides`` replace fields.
     """
 
-    def __init__(
-        self,
-        calibrator,
-        buffer: int = 1000,
-        rate_hz: float = 120.0,
-        update_every: int = 125,
-        **settings,
-    ):
-        self.settings = BCRSettings(
-            buffer=buffer, rate_hz=rate_hz, update_every=update_every, **settings
-        )
-        self.calibrator = calibrator
-        self.speed_range, self.gd_range = emulator_domain(calibrator)
-        self.gd_name = calibrator.emulator.t_names[0]
-        tracker = self.settings.tracker
-        n_chains = 1
-        if self.settings.method == "filter":
-            n_chains = -(-self.settings.buffer // self.settings.update_every)
-        elif self.settings.method == "window":
-            tracker, n_chains = replace(tracker, mean_segment_m=0.0), 1
-        self.trackers = [GDTracker(self.gd_range, tracker) for _ in range(n_chains)]
+    def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
+        self.settings = s = replace(settings or BCRSettings(), **overrides)
+        self.model = model
+        if s.method == "changepoint":
+            if not hasattr(model, "loglik"):
+                raise ControlError("method 'changepoint' needs an ObservationModel")
+            self.speed_range = tuple(model.speed_range)
+            self.gd_range = (float(model.gd[0]), float(model.gd[-1]))
+            self.gd_name = model.emulator.t_names[0]
+            self.filter = ChangePointFilter(model.gd, s.changepoint)
+        else:
+            if not hasattr(model, "log_likelihood_grid"):
+                raise ControlError(f"method {s.method!r} needs a gpmsa.Calibrator")
+            self.speed_range, self.gd_range = emulator_domain(model.emulator)
+            self.gd_name = model.emulator.t_names[0]
+            tracker, n = s.tracker, 1
+            if s.method == "filter":
+                n = -(-s.feature.block_samples // s.samples_per_update)
+            elif s.method == "window":
+                tracker = replace(tracker, mean_segment_m=0.0)
+            self.trackers = [GDTracker(self.gd_range, tracker) for _ in range(n)]
         self.reset()
 
     @classmethod
-    def from_settings(cls, calibrator, settings: BCRSettings) -> BCR:
-        """A BCR with the given settings."""
-        s = settings
-        return cls(
-            calibrator,
-            s.buffer,
-            s.rate_hz,
-            s.update_every,
-            feature=s.feature,
-            method=s.method,
-            tracker=s.tracker,
-            max_age_s=s.max_age_s,
-            interval_level=s.interval_level,
-        )
+    def from_emulator(cls, emulator, settings: BCRSettings | None = None, **overrides) -> BCR:
+        """A BCR for ``emulator``: the settings default to its recorded feature
+        (`control.bcr_settings_for`), and the likelihood model is built from it."""
+        import gpmsa
+        from control.compat import bcr_settings_for, check_feature
+        from control.observation_model import ObservationModel
+
+        s = replace(settings, **overrides) if settings else bcr_settings_for(emulator, **overrides)
+        check_feature(emulator, s)
+        if s.method == "changepoint":
+            return cls(ObservationModel(emulator), s)
+        return cls(gpmsa.Calibrator(emulator), s)
+
+    @property
+    def buffer(self) -> int:
+        """Samples per block (change-point) or per window."""
+        return self.settings.feature.block_samples
 
     def reset(self) -> None:
-        """Empty the buffer and forget the GD state."""
-        self._t = np.empty(0)
-        self._pos = np.empty(0)
-        self._acc = np.empty(0)
+        """Empty the buffers and forget the GD state."""
+        self._acc = np.empty(0)  # contiguous clean samples (block or window)
         self._spd = np.empty(0)
-        self._since_update = 0
-        self._n_updates = 0
+        self._fresh = 0  # samples in the window the tempered filter has not seen
+        self._received = 0  # samples received since the last estimate
         self._fault = ""
-        self._fresh = 0  # samples in the buffer the tempered filter has not seen
-        self._tracked_at: list[float | None] = [None] * len(self.trackers)
-        for tracker in self.trackers:
-            tracker.reset()
+        self._t_last = np.nan  # time and position of the newest finite sample
+        self._pos_last = np.nan
+        self._pos_block = np.nan  # position at the end of the last block the filter saw
+        self._n_updates = 0
+        self._data_time = np.nan
+        self._undo = None  # (filter state, data time, distance) before the newest block
+        self._guard = False  # skip the next block: it may hold the end of a fault
+        self._tracked_at: list[float | None] = [None] * len(getattr(self, "trackers", ()))
+        if self.settings.method == "changepoint":
+            self.filter.reset()
+        else:
+            for tracker in self.trackers:
+                tracker.reset()
         self.last = Estimate(time=0.0, position=0.0, status="filling", reason="no samples yet")
 
-    def update(
-        self, t: np.ndarray, position: np.ndarray, accel: np.ndarray, speed: np.ndarray
-    ) -> Estimate:
+    def update(self, t, position, accel, speed) -> Estimate:
         """Take new samples; return the newest estimate (or why there is none).
 
         Args:
-            t: (n,) sample times, s, increasing by 1/rate_hz (a larger step means dropped samples).
+            t: (n,) sample times, s, increasing by 1 / rate_hz (a larger step means dropped
+                samples, a smaller or negative one repeated or misordered samples).
             position: (n,) front-axle positions, m.
-            accel: (n,) measured vertical front-axle accelerations, m/s^2 (NaN = sensor fault).
+            accel: (n,) measured vertical front-axle accelerations, m/s^2.
             speed: (n,) measured speeds, m/s.
+            Non-finite values are sensor faults, never errors.
         """
         arrays = [np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, position, accel, speed)]
         n = arrays[0].size
         for name, a in zip(("t", "position", "accel", "speed"), arrays, strict=True):
             if a.ndim != 1 or a.size != n:
                 raise ControlError(f"{name} must be 1-D of length {n} (as t), got shape {a.shape}")
-        t, position, accel, speed = arrays
         if n == 0:
             return self._check_age(self.last)
-        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(position))):
-            raise ControlError("t and position must be finite (they come from the clock/odometry)")
+        t, position, accel, speed = arrays
+        drop, restart, reason = stream_fault(
+            t, position, accel, speed, self._t_last, self.settings.rate_hz
+        )
+        every = self.settings.samples_per_update
         start = 0
         while start < n:
-            room = self.settings.update_every - self._since_update
-            stop = min(n, start + room)
-            self._append(t[start:stop], position[start:stop], accel[start:stop], speed[start:stop])
-            self._since_update += stop - start
+            stop = min(n, start + every - self._received)
+            part = slice(start, stop)
+            self._take(t[part], position[part], accel[part], speed[part], drop[part],
+                       restart[part], reason)  # fmt: skip
+            self._received += stop - start
             start = stop
-            if self._since_update >= self.settings.update_every:
-                self.last = self._estimate(self._n_updates % len(self.trackers))
-                self._since_update = 0
+            if self._received == every:
+                self.last = self._estimate()
+                self._received = 0
                 self._n_updates += 1
         return self._check_age(self.last)
 
     # --- internals -------------------------------------------------------------------------------
 
-    def _append(self, t, pos, acc, spd) -> None:
-        """Append samples; a non-finite value or a time gap restarts the buffer after it."""
-        dt_nom = 1.0 / self.settings.rate_hz
-        prev_t = self._t[-1:] if self._t.size else t[:1] - dt_nom
-        steps = np.diff(np.concatenate([prev_t, t]))
-        bad_value = ~(np.isfinite(acc) & np.isfinite(spd))
-        gap = (steps > 1.5 * dt_nom) | (steps <= 0.5 * dt_nom)
-        restart = np.flatnonzero(bad_value | gap)
-        if restart.size:
-            k = restart[-1]
-            n_bad = int(bad_value.sum())
-            n_gap = int(gap.sum())
-            what = []
-            if n_bad:
-                what.append(f"{n_bad} non-finite sample(s)")
-            if n_gap:
-                missing = int(np.round(np.max(steps[gap]) / dt_nom)) - 1
-                what.append(f"a time step {np.max(steps[gap]):.4g} s (about {missing} dropped)")
-            self._fault = f"{' and '.join(what)} near t = {t[k]:.2f} s; buffer restarted"
-            keep = slice(k + 1, None) if bad_value[k] else slice(k, None)
-            parts = [a[keep] for a in (t, pos, acc, spd)]
-            self._fresh = parts[0].size
-        else:
-            held = (self._t, self._pos, self._acc, self._spd)
-            parts = [np.concatenate(pair) for pair in zip(held, (t, pos, acc, spd), strict=True)]
-            self._fresh += t.size
-        b = self.settings.buffer
-        self._fresh = min(self._fresh, b)
-        self._t, self._pos, self._acc, self._spd = (a[-b:] for a in parts)
+    def _take(self, t, pos, acc, spd, drop, restart, reason) -> None:
+        """Append samples; a dropped sample or a gap restarts the contiguous buffer."""
+        good = np.isfinite(t) & np.isfinite(pos) & ~drop
+        if good.any():
+            k = int(np.flatnonzero(good)[-1])
+            self._t_last, self._pos_last = float(t[k]), float(pos[k])
+        broken = np.flatnonzero(drop | restart)
+        if broken.size:
+            self._fault = reason
+            k = int(broken[-1])
+            keep = slice(k + 1, None) if drop[k] else slice(k, None)
+            self._acc, self._spd = acc[keep], spd[keep]
+            self._fresh = self._acc.size
+            return
+        self._acc = np.concatenate([self._acc, acc])[-self.buffer :]
+        self._spd = np.concatenate([self._spd, spd])[-self.buffer :]
+        self._fresh = min(self._fresh + acc.size, self.buffer)
 
     def _now(self) -> tuple[float, float]:
-        return (
-            (float(self._t[-1]), float(self._pos[-1]))
-            if self._t.size
-            else (
-                float(self.last.time),
-                float(self.last.position),
+        if np.isfinite(self._t_last):
+            return self._t_last, self._pos_last
+        return float(self.last.time), float(self.last.position)
+
+    def _block_distance(self) -> float:
+        """Metres since the end of the last block the filter saw (0 before any)."""
+        _, pos = self._now()
+        ds = pos - self._pos_block if np.isfinite(self._pos_block) else 0.0
+        self._pos_block = pos
+        return max(float(ds), 0.0)
+
+    def _estimate(self) -> Estimate:
+        if self.settings.method == "changepoint":
+            return self._estimate_changepoint()
+        return self._estimate_window()
+
+    def _no_estimate(self, status: str, reason: str, **kw) -> Estimate:
+        t_now, pos_now = self._now()
+        return Estimate(t_now, pos_now, status, reason, data_time=self._data_time, **kw)
+
+    def _signal_reason(self, accel: np.ndarray) -> str:
+        return signal_fault(accel[-self.settings.samples_per_update :], self.settings.sensor)
+
+    # --- the change-point method -----------------------------------------------------------------
+
+    def _skip_block(self, ds: float, status: str, reason: str, **kw) -> Estimate:
+        """No information from this block; a fault or an implausible block also undoes the
+        block before it and makes the next one skipped (they may hold part of it)."""
+        if self._undo is not None:
+            state, data_time, ds_before = self._undo
+            self.filter.restore(state)
+            self._data_time = data_time
+            ds += ds_before
+            reason += "; the block before it is undone"
+        self._undo = None
+        self._guard = True
+        self.filter.predict(ds)
+        return self._no_estimate(status, reason, **kw)
+
+    def _estimate_changepoint(self) -> Estimate:
+        s = self.settings
+        ds = self._block_distance()
+        acc, spd = self._acc, self._spd
+        self._acc, self._spd = np.empty(0), np.empty(0)
+        if self._fault or acc.size < s.feature.block_samples:
+            reason, self._fault = self._fault or "incomplete block", ""
+            return self._skip_block(ds, "sensor_fault", reason + "; block skipped")
+        tic = _time.perf_counter()
+        v = float(np.mean(spd))
+        lo, hi = self.speed_range
+        tol = 1e-9 * (hi - lo)
+        why = ""
+        if not lo - tol <= v <= hi + tol:
+            why = f"speed {v:.3g} m/s outside the emulator's [{lo:g}, {hi:g}]"
+        elif np.min(spd) < MAX_SPEED_CHANGE * np.max(spd):
+            why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"
+        if why:  # the emulator knows constant speeds in its range only
+            self._undo = None
+            self.filter.predict(ds)
+            if not np.isfinite(self._data_time):
+                return self._no_estimate("out_of_domain", why, speed=v)
+            return self._posterior_estimate("no new information: " + why, tic, v, None)
+        bad_signal = self._signal_reason(acc)
+        if bad_signal:
+            return self._skip_block(ds, "sensor_fault", bad_signal, speed=v)
+        y = block_features(acc, s.feature)[0]
+        if not np.all(np.isfinite(y)):
+            return self._skip_block(ds, "sensor_fault", "a band of the block has no power", speed=v)
+        d2, p = self.model.plausibility(y, v)
+        if p < s.plausibility_p:
+            why = (
+                f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the block at "
+                f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = {p:.2g} < "
+                f"{s.plausibility_p:g})"
             )
+            return self._skip_block(ds, "implausible", why, speed=v, feature=y)
+        if self._guard:
+            self._guard = False
+            self._undo = None
+            self.filter.predict(ds)
+            return self._no_estimate(
+                "sensor_fault", "first block after a fault: skipped (it may hold its end)", speed=v
+            )
+        self._undo = (self.filter.state(), self._data_time, ds)
+        self.filter.update(self.model.loglik(y, v), ds)
+        self._data_time = self._now()[0]
+        return self._posterior_estimate("", tic, v, y)
+
+    def _posterior_estimate(self, reason: str, tic: float, v: float, y) -> Estimate:
+        t_now, pos_now = self._now()
+        post = self.filter.posterior(self.gd_name)
+        name = self.gd_name
+        return Estimate(
+            t_now,
+            pos_now,
+            "ok",
+            reason,
+            gd_mean=post.mean(name),
+            gd_sd=post.sd(name),
+            interval=post.interval(name, self.settings.interval_level),
+            posterior=post,
+            latency_s=_time.perf_counter() - tic,
+            speed=v,
+            feature=y,
+            prob_change=self.filter.prob_change_within(self.settings.recent_change_m),
+            data_time=self._data_time,
         )
 
-    def _estimate(self, chain: int) -> Estimate:
-        t_now, pos_now = self._now()
+    # --- the window methods (the paper's, and the previous filters) -----------------------------
+
+    def _estimate_window(self) -> Estimate:
         s = self.settings
         if self._fault:
             reason, self._fault = self._fault, ""
-            return Estimate(t_now, pos_now, "sensor_fault", reason)
-        if self._acc.size < s.buffer:
-            return Estimate(
-                t_now, pos_now, "filling", f"buffer holds {self._acc.size} of {s.buffer} samples"
+            return self._no_estimate("sensor_fault", reason + "; buffer restarted")
+        if self._acc.size < self.buffer:
+            return self._no_estimate(
+                "filling", f"buffer holds {self._acc.size} of {self.buffer} samples"
             )
         tic = _time.perf_counter()
+        bad_signal = self._signal_reason(self._acc)
+        if bad_signal:
+            self._acc, self._spd, self._fresh = np.empty(0), np.empty(0), 0
+            return self._no_estimate("sensor_fault", bad_signal + "; buffer restarted")
         v = float(np.mean(self._spd))
         lo, hi = self.speed_range
-        # the emulator's own rule (it snaps float rounding at the ends onto the domain)
-        unit = float(self.calibrator.emulator.standardizer.x_to_unit([[v]])[0, 0])
-        if not 0.0 <= unit <= 1.0:
-            return Estimate(
-                t_now,
-                pos_now,
-                "out_of_domain",
-                f"window speed {v:.3g} m/s outside the emulator's range [{lo:g}, {hi:g}] m/s",
-                speed=v,
-            )
-        y = window_feature(self._acc, s.feature)
+        unit = float(self.model.emulator.standardizer.x_to_unit([[v]])[0, 0])
+        if not 0.0 <= unit <= 1.0:  # the emulator's own rule (snaps rounding at the ends)
+            why = f"window speed {v:.3g} m/s outside the emulator's range [{lo:g}, {hi:g}] m/s"
+            if self.last.ok:
+                return replace(self.last, time=self._now()[0], position=self._now()[1],
+                               reason="no new information: " + why)  # fmt: skip
+            return self._no_estimate("out_of_domain", why, speed=v)
+        y = window_feature(self._acc, s.feature.name)
         if not np.isfinite(y):
-            return Estimate(
-                t_now, pos_now, "sensor_fault", "window feature undefined (zero variance?)", speed=v
+            return self._no_estimate(
+                "sensor_fault", "window feature undefined (zero variance?)", speed=v
             )
+        why = self._window_implausible(v, y)
+        if why:
+            return self._no_estimate("implausible", why, speed=v, feature=np.array([y]))
         try:
-            grid, loglik = self.calibrator.log_likelihood_grid([[v]], [[y]])
+            grid, loglik = self.model.log_likelihood_grid([[v]], [[y]])
         except ValueError as exc:  # the gpmsa errors are ValueError subclasses
-            return Estimate(t_now, pos_now, "calibration_failed", str(exc), speed=v, feature=y)
+            return self._no_estimate("calibration_failed", str(exc), speed=v)
+        chain = self._n_updates % len(self.trackers)
         tracker, last_pos = self.trackers[chain], self._tracked_at[chain]
+        t_now, pos_now = self._now()
         tracker.predict(0.0 if last_pos is None else max(pos_now - last_pos, 0.0))
-        power = self._fresh / s.buffer if s.method == "tempered" else 1.0
+        power = self._fresh / self.buffer if s.method == "tempered" else 1.0
         tracker.update(np.ravel(grid), np.ravel(loglik), power=power)
         self._fresh = 0
         self._tracked_at[chain] = pos_now
+        self._data_time = t_now
+        post = tracker.posterior(self.gd_name)
         name = self.gd_name
-        post = tracker.posterior(name)
         return Estimate(
             t_now,
             pos_now,
@@ -279,18 +429,39 @@ class BCR:
             posterior=post,
             latency_s=_time.perf_counter() - tic,
             speed=v,
-            feature=y,
+            feature=np.array([y]),
+            data_time=t_now,
+        )
+
+    def _window_implausible(self, v: float, y: float) -> str:
+        """Why no GD in the domain explains the window's y (scalar predictive check), or ""."""
+        emulator = self.model.emulator
+        if not hasattr(emulator, "predict"):
+            return ""
+        gd = np.linspace(*self.gd_range, 65)
+        mean, var = emulator.predict(np.full(gd.size, v), gd)
+        z2 = float(np.min((y - mean[:, 0]) ** 2 / var[:, 0]))
+        from scipy.stats import chi2
+
+        p = float(chi2.sf(z2, 1))
+        if p >= self.settings.plausibility_p:
+            return ""
+        return (
+            f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the window at "
+            f"{v:.3g} m/s: y is {np.sqrt(z2):.3g} predictive sds from the nearest "
+            f"(p = {p:.2g} < {self.settings.plausibility_p:g})"
         )
 
     def _check_age(self, est: Estimate) -> Estimate:
-        """Replace an estimate older than max_age_s (by sample time) with a 'stale' status."""
+        """Replace an estimate whose newest information is older than max_age_s by 'stale'."""
         t_now, pos_now = self._now()
-        age = t_now - est.time
+        age = t_now - est.data_time
         if est.ok and age > self.settings.max_age_s:
             return Estimate(
                 t_now,
                 pos_now,
                 "stale",
-                f"newest estimate is {age:.2f} s old (max_age_s = {self.settings.max_age_s:g})",
+                f"newest information is {age:.2f} s old (max_age_s = {self.settings.max_age_s:g})",
+                data_time=est.data_time,
             )
         return est

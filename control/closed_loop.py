@@ -9,37 +9,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm.auto import tqdm
 
-import gpmsa
 import vehicle
 from control.bcr import BCR, BCRSettings
 from control.compat import bcr_settings_for, check_emulator
 from control.errors import ControlError
 from control.estimate import Estimate
+from control.faults import SensorFault, apply_faults
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, segment_index
 from control.simplex import Simplex
-
-
-@dataclass(frozen=True)
-class SensorFault:
-    """An injected accelerometer fault.
-
-    Attributes:
-        start_s: time the fault begins, s.
-        duration_s: how long it lasts, s.
-        kind: "nan" (the samples read NaN) or "drop" (the samples never arrive).
-    """
-
-    start_s: float
-    duration_s: float
-    kind: str = "nan"
-
-    def __post_init__(self) -> None:
-        if not (np.isfinite(self.start_s) and self.start_s >= 0):
-            raise ControlError(f"start_s must be >= 0, got {self.start_s}")
-        if not (np.isfinite(self.duration_s) and self.duration_s > 0):
-            raise ControlError(f"duration_s must be > 0, got {self.duration_s}")
-        if self.kind not in ("nan", "drop"):
-            raise ControlError(f"kind must be 'nan' or 'drop', got {self.kind!r}")
 
 
 @dataclass(frozen=True)
@@ -54,6 +31,7 @@ class LoopMetrics:
         wall_time_s: wall-clock time of the whole loop, s.
         latency_median_s, latency_max_s: BCR compute latency over its estimates, s.
         ok_fraction: fraction of BCR updates that produced an estimate.
+        coverage: fraction of the estimates whose credible interval holds the prescribed GD.
     """
 
     gd_errors: tuple[GDError, ...]
@@ -64,6 +42,7 @@ class LoopMetrics:
     latency_median_s: float
     latency_max_s: float
     ok_fraction: float
+    coverage: float = np.nan
 
     @property
     def real_time_factor(self) -> float:
@@ -90,6 +69,7 @@ class LoopMetrics:
             "latency_median_s": self.latency_median_s,
             "latency_max_s": self.latency_max_s,
             "ok_fraction": self.ok_fraction,
+            "coverage": self.coverage,
         }
 
 
@@ -99,7 +79,8 @@ class ClosedLoopResult:
 
     Per BCR update (length k): ``time`` s, ``position`` m, ``gd_mean``, ``gd_lo``, ``gd_hi`` (the
     credible interval; NaN when there is no estimate), ``gd_true`` (prescribed GD at the position),
-    ``status`` (str), ``command`` (m/s), ``mode`` ("performance"/"safety"), ``latency_s``.
+    ``status`` (str), ``reason`` (str), ``prob_change`` (P(a change within the BCR's
+    recent_change_m)), ``command`` (m/s), ``mode`` ("performance"/"safety"), ``latency_s``.
     Per sensor sample (length n): ``sample_time``, ``sample_position``, ``sample_speed``.
     """
 
@@ -110,6 +91,8 @@ class ClosedLoopResult:
     gd_hi: np.ndarray
     gd_true: np.ndarray
     status: np.ndarray
+    reason: np.ndarray
+    prob_change: np.ndarray
     command: np.ndarray
     mode: np.ndarray
     latency_s: np.ndarray
@@ -120,20 +103,11 @@ class ClosedLoopResult:
     settings: dict = field(default_factory=dict)
 
 
-def _apply_faults(samples, faults: Sequence[SensorFault]):
-    """(t, position, accel, speed) of a sample batch with the faults applied."""
-    t = np.asarray(samples.t, dtype=float)
-    pos = np.asarray(samples.position, dtype=float)
-    acc = np.array(samples.accel_front, dtype=float)
-    spd = np.asarray(samples.speed, dtype=float)
-    keep = np.ones(t.size, dtype=bool)
-    for fault in faults:
-        hit = (t >= fault.start_s) & (t < fault.start_s + fault.duration_s)
-        if fault.kind == "nan":
-            acc[hit] = np.nan
-        else:
-            keep &= ~hit
-    return t[keep], pos[keep], acc[keep], spd[keep]
+def _check_seed(seed) -> None:
+    if seed is None:
+        return
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ControlError(f"seed must be None or an integer >= 0, got {seed!r}")
 
 
 def run_closed_loop(
@@ -146,38 +120,54 @@ def run_closed_loop(
     simplex: Simplex | None = None,
     progress: bool = False,
     *,
-    calibrator=None,
+    likelihood=None,
     faults: Sequence[SensorFault] = (),
     check: bool = True,
+    max_time_s: float | None = None,
 ) -> ClosedLoopResult:
     """Drive `model` over `track` with the BCR estimating GD and the Simplex setting the speed.
 
     Args:
         track: a roadgen Track (prescribed GD per segment).
-        emulator: a gpmsa Emulator mapping (v, GD) to the window observation (see
+        emulator: a gpmsa Emulator mapping (v, GD) to the BCR's observation (see
             `control.shipped_emulator`).
         model: vehicle model (default `vehicle.Jackal()`); must match the emulator's metadata.
         noise_std: accelerometer noise standard deviation, m/s^2 (Test Case B: 1.0).
-        seed: seed of the measurement noise.
-        bcr: BCR settings (default: matching the emulator's recorded feature).
-        simplex: the controller (default `Simplex()`, the paper's band and speeds).
+        seed: seed (integer >= 0) of the measurement noise and of the injected faults.
+        bcr: BCR settings (default: `bcr_settings_for(emulator)`, the emulator's feature).
+        simplex: the controller (default `Simplex()`, the paper's band and speeds); its top and
+            safe speeds must be within the vehicle's.
         progress: show a tqdm bar over the track length.
-        calibrator: a prepared `gpmsa.Calibrator` for `emulator` (saves preparing one per run).
-        faults: injected sensor faults (NaN or dropped samples).
+        likelihood: the BCR's prepared likelihood model for `emulator` (an `ObservationModel`
+            for the change-point method, a `gpmsa.Calibrator` for the window methods), to save
+            preparing one per run.
+        faults: injected sensor faults (`SensorFault`).
         check: check the emulator against model, noise, feature and track (`check_emulator`).
+        max_time_s: simulated time after which a vehicle that has not reached the end is an
+            error (default: 20 times the track length at the safe speed).
 
     Returns:
         `ClosedLoopResult` with traces and `LoopMetrics`.
     """
     model = vehicle.Jackal() if model is None else model
     simplex = Simplex() if simplex is None else simplex
+    _check_seed(seed)
+    top = float(model.max_speed_mps)
+    if simplex.v_max > top * (1 + 1e-12):
+        raise ControlError(
+            f"Simplex v_max = {simplex.v_max:g} m/s exceeds the vehicle's top speed {top:g} m/s"
+        )
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     if check:
         check_emulator(emulator, model=model, noise_std=noise_std, bcr=bcr, track=track)
-    calibrator = gpmsa.Calibrator(emulator) if calibrator is None else calibrator
-    estimator = BCR.from_settings(calibrator, bcr)
-    sim = vehicle.Simulation(model, track, rate_hz=bcr.rate_hz, noise_std=noise_std, seed=seed)
-    dt = bcr.update_every / bcr.rate_hz
+    estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
+    rng = np.random.default_rng(seed)
+    noise_seed, fault_rng = rng.integers(2**63), np.random.default_rng(rng.integers(2**63))
+    sim = vehicle.Simulation(
+        model, track, rate_hz=bcr.rate_hz, noise_std=noise_std, seed=int(noise_seed)
+    )
+    dt = bcr.samples_per_update / bcr.rate_hz
+    limit = 20.0 * float(track.length_m) / simplex.v_safe if max_time_s is None else max_time_s
 
     rows: list[tuple[Estimate, object]] = []
     s_t, s_pos, s_spd = [], [], []
@@ -185,25 +175,41 @@ def run_closed_loop(
     command = simplex.command(estimator.last)
     bar = tqdm(total=round(float(track.length_m)), unit="m", disable=not progress, leave=False)
     while not sim.finished:
+        if sim.time > limit:
+            raise ControlError(
+                f"the vehicle stood or crawled: {sim.position:.1f} of {track.length_m:.1f} m "
+                f"after {sim.time:.0f} s (max_time_s = {limit:g})"
+            )
         samples = sim.advance(dt, command.speed)
+        if len(samples) == 0:
+            break
         s_t.append(np.asarray(samples.t, dtype=float))
         s_pos.append(np.asarray(samples.position, dtype=float))
         s_spd.append(np.asarray(samples.speed, dtype=float))
-        estimate = estimator.update(*_apply_faults(samples, faults))
+        observed = apply_faults(
+            samples.t, samples.position, samples.accel_front, samples.speed, faults, fault_rng
+        )
+        estimate = estimator.update(*observed)
         command = simplex.command(estimate)
         rows.append((estimate, command))
-        if s_pos[-1].size:
-            bar.update(max(0, round(float(s_pos[-1][-1])) - bar.n))
+        bar.update(max(0, round(float(s_pos[-1][-1])) - bar.n))
     bar.close()
     wall = _time.perf_counter() - tic
 
     ests = [e for e, _ in rows]
-    position = np.array([e.position for e in ests])
+    # the position of each update is the vehicle's (an estimate may carry a stale position
+    # when its samples were faulty)
+    position = np.array([p[-1] for p in s_pos])
     gd_mean = np.array([e.gd_mean for e in ests])
+    gd_lo = np.array([e.interval[0] for e in ests])
+    gd_hi = np.array([e.interval[1] for e in ests])
     sample_time = np.concatenate(s_t) if s_t else np.empty(0)
     sample_position = np.concatenate(s_pos) if s_pos else np.empty(0)
     sample_speed = np.concatenate(s_spd) if s_spd else np.empty(0)
     latencies = np.array([e.latency_s for e in ests if e.ok])
+    seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
+    gd_true = seg_gd[segment_index(track, position)]
+    ok = np.isfinite(gd_mean)
     metrics = LoopMetrics(
         gd_errors=gd_errors(track, position, gd_mean),
         detection_delay_m=detection_delays(track, position, gd_mean),
@@ -214,17 +220,21 @@ def run_closed_loop(
         wall_time_s=wall,
         latency_median_s=float(np.median(latencies)) if latencies.size else np.nan,
         latency_max_s=float(np.max(latencies)) if latencies.size else np.nan,
-        ok_fraction=float(np.mean([e.ok for e in ests])) if ests else 0.0,
+        ok_fraction=float(np.mean(ok)) if ests else 0.0,
+        coverage=float(np.mean((gd_lo[ok] <= gd_true[ok]) & (gd_true[ok] <= gd_hi[ok])))
+        if ok.any()
+        else np.nan,
     )
-    seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
     return ClosedLoopResult(
-        time=np.array([e.time for e in ests]),
+        time=np.array([t[-1] for t in s_t]),
         position=position,
         gd_mean=gd_mean,
-        gd_lo=np.array([e.interval[0] for e in ests]),
-        gd_hi=np.array([e.interval[1] for e in ests]),
-        gd_true=seg_gd[segment_index(track, position)],
+        gd_lo=gd_lo,
+        gd_hi=gd_hi,
+        gd_true=gd_true,
         status=np.array([e.status for e in ests]),
+        reason=np.array([e.reason for e in ests], dtype=object),
+        prob_change=np.array([e.prob_change for e in ests]),
         command=np.array([c.speed for _, c in rows]),
         mode=np.array([c.mode for _, c in rows]),
         latency_s=np.array([e.latency_s for e in ests]),

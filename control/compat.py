@@ -1,23 +1,53 @@
 """Checks that an emulator suits the loop it is asked to serve (vehicle, noise, feature, domain).
 
-The training script records in ``emulator.metadata``: ``vehicle`` (``model.describe()``),
-``noise_std`` (m/s^2), ``feature`` (``{"name": ..., "window_samples": ..., "rate_hz": ...}``, see
-`control.feature`) and ``road`` (the campaign's road settings).
+The training script (examples/train_emulator.py) records in ``emulator.metadata``: ``vehicle``
+(``model.describe()``), ``noise_std`` (m/s^2), ``feature`` (`control.FeatureSpec.to_dict`),
+``block_scatter`` for the block feature (`control.BlockScatter`) and the campaign's ``road``
+settings.
 """
 
 from __future__ import annotations
 
 import json
 import warnings
+from dataclasses import replace
 
 import numpy as np
 
 from control.bcr import BCRSettings
 from control.errors import ControlWarning, EmulatorMismatchError
+from control.feature import FeatureSpec
 
 
 def _canon(obj) -> str:
     return json.dumps(obj, sort_keys=True, default=str)
+
+
+def emulator_feature(emulator) -> FeatureSpec:
+    """The feature the emulator was trained on (its metadata's ``feature``)."""
+    meta = dict(getattr(emulator, "metadata", None) or {})
+    if "feature" not in meta:
+        raise EmulatorMismatchError(
+            "the emulator's metadata has no 'feature': it does not say what observation it "
+            "was trained on (examples/train_emulator.py records it)"
+        )
+    try:
+        return FeatureSpec.from_dict(meta["feature"])
+    except (TypeError, ValueError) as exc:
+        raise EmulatorMismatchError(f"the emulator's feature is malformed: {exc}") from exc
+
+
+def check_feature(emulator, bcr: BCRSettings) -> None:
+    """Raise `EmulatorMismatchError` naming each field in which the BCR's feature differs from
+    the one the emulator was trained on."""
+    trained = emulator_feature(emulator)
+    diff = trained.same_as(bcr.feature)
+    if diff:
+        pairs = ", ".join(
+            f"{k}: BCR {getattr(bcr.feature, k)!r} vs emulator {getattr(trained, k)!r}"
+            for k in diff
+        )
+        raise EmulatorMismatchError(f"the BCR's feature differs from the emulator's ({pairs})")
 
 
 def check_emulator(
@@ -30,10 +60,11 @@ def check_emulator(
 ) -> None:
     """Raise `EmulatorMismatchError` or warn (`ControlWarning`) where the emulator does not fit.
 
-    Errors: another vehicle model; another feature (name, window length, rate); a track whose
-    prescribed GD lies outside the emulator's GD domain. Warnings: a different noise level (the
-    paper's Test Cases pair the noise-free emulator with noise-free data and the noisy one with
-    noisy data; a mismatch biases GD, but a robustness study may want it); metadata missing.
+    Errors: another vehicle model; another feature (name, block or window length, rate, bands,
+    tapers); a track whose prescribed GD lies outside the emulator's GD domain. Warnings: a
+    different noise level (the paper's Test Cases pair the noise-free emulator with noise-free
+    data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
+    want it); vehicle or noise metadata missing.
     """
     meta = dict(getattr(emulator, "metadata", None) or {})
     if model is not None:
@@ -59,21 +90,8 @@ def check_emulator(
                 ControlWarning,
                 stacklevel=3,
             )
-    if bcr is not None and "feature" in meta:
-        feat = meta["feature"]
-        expected = {  # emulator metadata key: (BCR setting, its value)
-            "window_samples": ("buffer", bcr.buffer),
-            "rate_hz": ("rate_hz", bcr.rate_hz),
-            "name": ("feature", bcr.feature),
-        }
-        for key, (setting, value) in expected.items():
-            if key not in feat or feat[key] == value:
-                continue
-            if not isinstance(value, str) and np.isclose(float(feat[key]), float(value)):
-                continue
-            raise EmulatorMismatchError(
-                f"BCR {setting} = {value!r} but the emulator's feature has {key} = {feat[key]!r}"
-            )
+    if bcr is not None:
+        check_feature(emulator, bcr)
     if track is not None:
         lo, hi = emulator.domain[emulator.t_names[0]]
         gds = [gd for _, gd in track.segments]
@@ -85,14 +103,11 @@ def check_emulator(
 
 
 def bcr_settings_for(emulator, **overrides) -> BCRSettings:
-    """BCR settings matching the emulator's recorded feature (name, window, rate)."""
-    feat = dict((getattr(emulator, "metadata", None) or {}).get("feature", {}))
-    kwargs = {}
-    if "window_samples" in feat:
-        kwargs["buffer"] = int(feat["window_samples"])
-    if "rate_hz" in feat:
-        kwargs["rate_hz"] = float(feat["rate_hz"])
-    if "name" in feat:
-        kwargs["feature"] = str(feat["name"])
-    kwargs.update(overrides)
-    return BCRSettings(**kwargs)
+    """BCR settings for the emulator's recorded feature: the change-point method for the block
+    feature, the paper's one-window estimator's filter for a window feature (``method=`` and
+    any other `BCRSettings` field may be overridden)."""
+    feature = overrides.pop("feature", None) or emulator_feature(emulator)
+    method = overrides.pop("method", None)
+    if method is None:
+        method = "changepoint" if feature.name == "log_band_power" else "filter"
+    return replace(BCRSettings(feature=feature, method=method), **overrides)

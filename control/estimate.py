@@ -9,7 +9,15 @@ import numpy as np
 from gpmsa import Posterior
 
 #: Status values. Only "ok" carries numbers; every other status says why there is no estimate.
-STATUSES = ("ok", "filling", "out_of_domain", "sensor_fault", "calibration_failed", "stale")
+STATUSES = (
+    "ok",
+    "filling",
+    "out_of_domain",
+    "sensor_fault",
+    "implausible",
+    "calibration_failed",
+    "stale",
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -20,14 +28,19 @@ class Estimate:
         time: s, time of the newest sample the BCR has seen.
         position: m, front-axle position at that time.
         status: one of STATUSES; "ok" means gd_mean etc. are valid.
-        reason: a sentence for a person ("" when ok).
+        reason: a sentence for a person ("" when an ok estimate used new data; an ok estimate
+            made without new data, e.g. while standing, says so).
         gd_mean: posterior mean of GD (1e-6 m^3); NaN unless ok.
         gd_sd: posterior standard deviation; NaN unless ok.
         interval: central credible interval (lo, hi) at the BCR's level; NaNs unless ok.
         posterior: the GD posterior on a grid (quantiles, P(GD > x)); None unless ok.
         latency_s: wall-clock time of the computation that produced this estimate, s.
-        speed: m/s, mean measured speed over the window used (NaN if none).
-        feature: the window's observation y (e.g. log of the acceleration variance; NaN if none).
+        speed: m/s, mean measured speed over the samples used (NaN if none).
+        feature: the newest observation (the block's feature vector, or the window's log f);
+            None if none.
+        prob_change: P(the roughness changed within the BCR's ``recent_change_m``) (change-point
+            method; NaN otherwise).
+        data_time: s, time of the newest sample whose information the estimate holds.
     """
 
     time: float
@@ -40,7 +53,9 @@ class Estimate:
     posterior: Posterior | None = None
     latency_s: float = 0.0
     speed: float = np.nan
-    feature: float = np.nan
+    feature: np.ndarray | None = None
+    prob_change: float = np.nan
+    data_time: float = np.nan
 
     @property
     def ok(self) -> bool:

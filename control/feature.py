@@ -1,28 +1,189 @@
-"""The observation y the BCR gives the calibrator, computed from one window of accelerations.
+"""The observation the BCR makes of a block of front-axle accelerations.
 
-Features (the emulator records which one it was trained on; training and BCR agree through it):
+Two features (the emulator records which one it was trained on; training and BCR agree through
+`FeatureSpec`):
 
-- ``"var"``: f = var(a) normalised by T (the paper's eq. 5);
-- ``"log_var"``: log f (default). The window-to-window scatter of f across road realisations is
-  multiplicative (a CV of ~15-25%), so log f has a near-constant spread that the GP nugget can
-  describe, and the likelihood of GD is closer to Gaussian.
+- ``"log_band_power"`` (default): log band powers of one short block (125 samples, ~1 s at
+  120 Hz): a multitaper (DPSS, NW = 2, 3 tapers) power spectrum summed over 8 bands between 1.5
+  and 60 Hz. The vector carries 2.5-3x the information about GD per second of driving of the
+  paper's log f (docs/closed-loop.md, `benchmarks/feature_information.py`): the spectrum's shape
+  changes with GD (the 2-7 Hz bands grow faster than GD, the 7-10 Hz resonance band saturates),
+  which one variance cannot see.
+- ``"log_var"``: y = log f, f = var(a) normalised by T over a 1,000-sample window (the paper's
+  eq. 5; the log makes the multiplicative window scatter additive). ``"var"``: f itself.
 """
 
 from __future__ import annotations
 
+from dataclasses import asdict, dataclass
+from functools import lru_cache
+
 import numpy as np
+from scipy.signal.windows import dpss
 
 from control.errors import ControlError
 
-FEATURES = ("var", "log_var")
+FEATURES = ("log_band_power", "log_var", "var")
+SCALAR_FEATURES = ("log_var", "var")
+BAND_EDGES_HZ = (1.5, 4.5, 7.0, 10.0, 14.0, 20.0, 30.0, 45.0, 60.0)
+
+
+@dataclass(frozen=True)
+class FeatureSpec:
+    """What the BCR computes from a block of samples (recorded in the emulator's metadata).
+
+    Attributes:
+        name: one of FEATURES.
+        block_samples: samples per block (the paper's window: 1,000; the band feature: 125).
+        rate_hz: accelerometer rate, Hz.
+        bands_hz: band edges, Hz (``log_band_power`` only): K + 1 increasing values <= rate / 2.
+        taper_nw: time-bandwidth product of the DPSS tapers.
+        n_tapers: number of DPSS tapers (<= 2 NW - 1).
+    """
+
+    name: str = "log_band_power"
+    block_samples: int = 125
+    rate_hz: float = 120.0
+    bands_hz: tuple[float, ...] = BAND_EDGES_HZ
+    taper_nw: float = 2.0
+    n_tapers: int = 3
+
+    def __post_init__(self) -> None:
+        if self.name not in FEATURES:
+            raise ControlError(f"feature name must be one of {FEATURES}, got {self.name!r}")
+        if not (isinstance(self.block_samples, int | np.integer) and self.block_samples >= 16):
+            raise ControlError(f"block_samples must be an integer >= 16, got {self.block_samples}")
+        if not (np.isfinite(self.rate_hz) and self.rate_hz > 0):
+            raise ControlError(f"rate_hz must be > 0, got {self.rate_hz}")
+        object.__setattr__(self, "bands_hz", tuple(float(b) for b in self.bands_hz))
+        if self.name == "log_band_power":
+            edges = np.asarray(self.bands_hz)
+            nyquist = self.rate_hz / 2
+            if edges.size < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
+                raise ControlError(f"bands_hz must be >= 2 increasing edges >= 0, got {edges}")
+            if edges[-1] > nyquist + 1e-9:
+                raise ControlError(
+                    f"bands_hz reach {edges[-1]:g} Hz, above the Nyquist frequency {nyquist:g} Hz"
+                )
+            counts = _band_matrix(self.block_samples, float(self.rate_hz), self.bands_hz).sum(0)
+            for lo, hi, count in zip(edges[:-1], edges[1:], counts, strict=True):
+                if count == 0:
+                    raise ControlError(
+                        f"band [{lo:g}, {hi:g}) Hz holds no frequency bin of a "
+                        f"{self.block_samples}-sample block at {self.rate_hz:g} Hz "
+                        f"(bin spacing {self.rate_hz / self.block_samples:.3g} Hz)"
+                    )
+            if not (0 < self.taper_nw < self.block_samples / 2):
+                raise ControlError(
+                    f"taper_nw must lie in (0, block_samples / 2), got {self.taper_nw}"
+                )
+            if not (1 <= self.n_tapers <= max(1, int(2 * self.taper_nw) - 1)):
+                raise ControlError(
+                    f"n_tapers must lie in [1, 2 NW - 1] = [1, {int(2 * self.taper_nw) - 1}], "
+                    f"got {self.n_tapers}"
+                )
+
+    @property
+    def dim(self) -> int:
+        """Length K of the feature vector."""
+        return len(self.bands_hz) - 1 if self.name == "log_band_power" else 1
+
+    @property
+    def block_s(self) -> float:
+        """Duration of a block, s."""
+        return self.block_samples / self.rate_hz
+
+    def names(self) -> list[str]:
+        """Output names for the emulator (``y_names``)."""
+        if self.name != "log_band_power":
+            return [self.name]
+        e = self.bands_hz
+        return [f"logP_{e[k]:g}_{e[k + 1]:g}Hz".replace(".", "p") for k in range(self.dim)]
+
+    def to_dict(self) -> dict:
+        """JSON-able form (the emulator metadata's ``feature``)."""
+        return {**asdict(self), "bands_hz": list(self.bands_hz)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> FeatureSpec:
+        """Inverse of `to_dict`; also reads the older metadata form (name, window_samples)."""
+        d = dict(d)
+        if "window_samples" in d and "block_samples" not in d:
+            d["block_samples"] = d.pop("window_samples")
+        known = {k: d[k] for k in cls.__dataclass_fields__ if k in d}
+        if "bands_hz" in known:
+            known["bands_hz"] = tuple(known["bands_hz"])
+        return cls(**known)
+
+    def same_as(self, other: FeatureSpec) -> list[str]:
+        """Names of the fields in which ``other`` differs (empty when they agree)."""
+        diff = []
+        for key in ("name", "block_samples", "rate_hz"):
+            a, b = getattr(self, key), getattr(other, key)
+            if a != b and not (isinstance(a, float) and np.isclose(a, b)):
+                diff.append(key)
+        if self.name == other.name == "log_band_power":
+            for key in ("bands_hz", "taper_nw", "n_tapers"):
+                if not np.allclose(np.ravel(getattr(self, key)), np.ravel(getattr(other, key))):
+                    diff.append(key)
+        return diff
+
+
+@lru_cache(maxsize=8)
+def _tapers(n: int, nw: float, k: int) -> np.ndarray:
+    return np.atleast_2d(dpss(n, nw, k))
+
+
+@lru_cache(maxsize=8)
+def _band_matrix(n: int, rate: float, edges: tuple[float, ...]) -> np.ndarray:
+    """(n_bins, K) 0/1 matrix summing the one-sided spectrum's bins into the bands."""
+    f = np.fft.rfftfreq(n, 1.0 / rate)
+    e = np.asarray(edges)
+    last = np.zeros(f.size, dtype=bool)
+    last[f == e[-1]] = True
+    cols = [(f >= lo) & (f < hi) for lo, hi in zip(e[:-1], e[1:], strict=True)]
+    cols[-1] = cols[-1] | last
+    return np.stack(cols, axis=1).astype(float)
+
+
+def block_features(accel: np.ndarray, spec: FeatureSpec) -> np.ndarray:
+    """The feature of each block.
+
+    Args:
+        accel: (n, B) blocks (or one block (B,)) of vertical front-axle acceleration, m/s^2,
+            B = ``spec.block_samples``.
+        spec: the feature.
+
+    Returns:
+        (n, K) features (K = ``spec.dim``); ``log_band_power`` in log((m/s^2)^2) (band power =
+        the multitaper PSD integrated over the band); a block with zero power in a band gives
+        -inf there (the BCR treats it as a sensor fault).
+    """
+    a = np.atleast_2d(np.asarray(accel, dtype=float))
+    if a.ndim != 2 or a.shape[1] != spec.block_samples:
+        raise ControlError(
+            f"accel must have shape (n, {spec.block_samples}) or ({spec.block_samples},), "
+            f"got {np.shape(accel)}"
+        )
+    if spec.name != "log_band_power":
+        return np.asarray(feature_of_variance(np.var(a, axis=1), spec.name))[:, None]
+    x = a - a.mean(axis=1, keepdims=True)
+    w = _tapers(spec.block_samples, spec.taper_nw, spec.n_tapers)  # (k, B), unit energy each
+    spectra = np.abs(np.fft.rfft(x[:, None, :] * w[None], axis=2)) ** 2  # (n, k, bins)
+    power = spectra.mean(axis=1) / spec.rate_hz  # PSD (m/s^2)^2/Hz, two-sided scaling
+    last = power.shape[1] if spec.block_samples % 2 else -1  # no Nyquist bin for odd B
+    power[:, 1:last] *= 2.0  # one-sided
+    band = power @ _band_matrix(spec.block_samples, spec.rate_hz, spec.bands_hz)
+    with np.errstate(divide="ignore"):
+        return np.log(band * (spec.rate_hz / spec.block_samples))
 
 
 def window_feature(accel: np.ndarray, feature: str = "log_var") -> float:
-    """The observation y of one window.
+    """The paper's observation y of one window: "var" (f, eq. 5) or "log_var" (log f).
 
     Args:
         accel: (T,) vertical front-axle accelerations, m/s^2.
-        feature: "var" or "log_var" (see the module docstring).
+        feature: "var" or "log_var".
 
     Returns:
         y; NaN for "log_var" of a window with zero variance.
@@ -39,8 +200,8 @@ def feature_of_variance(f: np.ndarray | float, feature: str = "log_var") -> np.n
     The one map from f to y, shared by the BCR (``window_feature``) and emulator training, so
     that both see the same quantity. "log_var" of f <= 0 is NaN.
     """
-    if feature not in FEATURES:
-        raise ControlError(f"feature must be one of {FEATURES}, got {feature!r}")
+    if feature not in SCALAR_FEATURES:
+        raise ControlError(f"feature must be one of {SCALAR_FEATURES}, got {feature!r}")
     f = np.asarray(f, dtype=float)
     if feature == "var":
         return f[()]

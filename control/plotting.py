@@ -14,47 +14,74 @@ def _track_steps(track) -> tuple[np.ndarray, np.ndarray]:
     return x, gd
 
 
-def _boundaries(ax, track) -> None:
-    for b in track.boundaries_m[1:]:
-        ax.axvline(b, color="tab:blue", lw=0.8, ls=":")
+def _mark_track(ax, track, gd_max: float | None) -> None:
+    """Segment changes (dotted verticals) and the parts rougher than gd_max (shaded)."""
+    for i, b in enumerate(track.boundaries_m[1:]):
+        ax.axvline(b, color="0.4", lw=0.8, ls=":", label="segment change" if i == 0 else None)
+    if gd_max is None:
+        return
+    ends = list(track.boundaries_m[1:]) + [float(track.length_m)]
+    first = True
+    for start, end, (_, gd) in zip(track.boundaries_m, ends, track.segments, strict=True):
+        if gd > gd_max:
+            ax.axvspan(start, end, color="tab:red", alpha=0.08, lw=0,
+                       label=f"prescribed GD > GD_max = {gd_max:g}" if first else None)  # fmt: skip
+            first = False
 
 
-def plot_gd_trace(results: Sequence, track, title: str = "") -> Figure:
-    """GD estimate (posterior mean and credible band) against position, one line per run.
+def plot_gd_trace(
+    results: Sequence, track, title: str = "", gd_max: float | None = 350.0, level: float = 0.9
+) -> Figure:
+    """GD estimate (posterior mean, and the credible interval as thin lines) against position.
 
     Args:
         results: `ClosedLoopResult`s driven over `track` (or tracks with the same segments).
         track: the track whose prescribed GD is drawn as a black step line.
+        gd_max: the Simplex's GD_max: the parts rougher than it are shaded (None: no shading).
+        level: the level of the BCR's interval (for the legend).
     """
-    fig = Figure(figsize=(7, 3.6), constrained_layout=True)
+    fig = Figure(figsize=(7.5, 3.8), constrained_layout=True)
     ax = fig.add_subplot()
+    _mark_track(ax, track, gd_max)
     x, gd = _track_steps(track)
     ax.step(x, gd, where="post", color="k", lw=1.5, label="prescribed GD")
     for i, r in enumerate(results):
-        line = ax.plot(r.position, r.gd_mean, lw=1.2, label=f"run {i + 1}")[0]
-        ax.fill_between(r.position, r.gd_lo, r.gd_hi, color=line.get_color(), alpha=0.15, lw=0)
-    _boundaries(ax, track)
-    ax.set_xlabel("position (m)")
+        line = ax.plot(r.position, r.gd_mean, lw=1.3, label=f"run {i + 1}: posterior mean")[0]
+        label = f"run {i + 1}: {level:.0%} interval"
+        for edge in (r.gd_lo, r.gd_hi):
+            ax.plot(r.position, edge, lw=0.6, alpha=0.7, color=line.get_color(), ls="--",
+                    label=label)  # fmt: skip
+            label = None
+    ax.set_xlabel("position of the front axle (m)")
     ax.set_ylabel("GD (1e-6 m$^3$)")
     ax.set_xlim(0, float(track.length_m))
-    ax.set_title(title or "BCR estimate of GD (mean and 90% interval)")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.set_title(title or "BCR estimate of GD")
+    ax.legend(loc="upper left", fontsize=7, ncol=2, framealpha=0.8)
     return fig
 
 
-def plot_speed(results: Sequence, track, title: str = "") -> Figure:
-    """Vehicle speed against position, one line per run, with the track's GD changes marked."""
-    fig = Figure(figsize=(7, 3.0), constrained_layout=True)
+def plot_speed(
+    results: Sequence, track, title: str = "", gd_max: float | None = 350.0,
+    v_safe: float | None = 1.0,
+) -> Figure:  # fmt: skip
+    """Vehicle speed against position, one line per run, with the track's GD changes marked.
+
+    The start (the vehicle ramps up from rest within a few centimetres) is left out.
+    """
+    fig = Figure(figsize=(7.5, 3.0), constrained_layout=True)
     ax = fig.add_subplot()
+    _mark_track(ax, track, gd_max)
     for i, r in enumerate(results):
-        ax.plot(r.sample_position, r.sample_speed, lw=1.0, label=f"run {i + 1}")
-    _boundaries(ax, track)
-    ax.set_xlabel("position (m)")
+        moving = r.sample_position > r.sample_position[0] + 0.1
+        ax.plot(r.sample_position[moving], r.sample_speed[moving], lw=1.0, label=f"run {i + 1}")
+    if v_safe is not None:
+        ax.axhline(v_safe, color="0.3", lw=0.8, ls="--", label=f"safe speed {v_safe:g} m/s")
+    ax.set_xlabel("position of the front axle (m)")
     ax.set_ylabel("speed v (m/s)")
     ax.set_xlim(0, float(track.length_m))
     ax.set_ylim(0, None)
     ax.set_title(title or "Speed set by the Simplex controller")
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="lower right", fontsize=7, framealpha=0.8)
     return fig
 
 
@@ -91,7 +118,7 @@ def plot_posterior_grid(
         if v == speeds[0]:
             ax.set_ylabel(f"GD {gd:g}", fontsize=9)
     for ax in axes[-1]:
-        ax.set_xlabel("GD")
+        ax.set_xlabel("GD (1e-6 m$^3$)")
     if title:
         fig.suptitle(title)
     return fig

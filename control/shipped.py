@@ -9,28 +9,41 @@ from control.errors import ControlError
 EMULATOR_DIR = Path(__file__).parent / "emulators"
 
 #: Test Case A: trained on noise-free accelerations; B: on accelerations with N(0, 1) noise.
-CASES = {"A": "jackal_A.gpmsa", "B": "jackal_B.gpmsa"}
+CASES = ("A", "B")
+#: "band": the block feature of the change-point BCR; "window": the paper's log f of a window.
+KINDS = ("band", "window")
 
 
-def shipped_emulator_path(case: str = "A") -> Path:
-    """Path of the shipped emulator of Test Case "A" (noise-free) or "B" (noise std 1 m/s^2)."""
+def emulator_file_name(case: str, kind: str = "band") -> str:
+    """File name of the emulator of a case and feature kind."""
     if case not in CASES:
-        raise ControlError(f"case must be one of {sorted(CASES)}, got {case!r}")
-    path = EMULATOR_DIR / CASES[case]
+        raise ControlError(f"case must be one of {CASES}, got {case!r}")
+    if kind not in KINDS:
+        raise ControlError(f"kind must be one of {KINDS}, got {kind!r}")
+    return f"jackal_{case}.gpmsa" if kind == "band" else f"jackal_{case}_window.gpmsa"
+
+
+def shipped_emulator_path(case: str = "A", kind: str = "band") -> Path:
+    """Path of the shipped emulator of Test Case "A" (noise-free) or "B" (noise std 1 m/s^2),
+    for the block feature ("band", the default BCR) or the paper's window feature ("window")."""
+    path = EMULATOR_DIR / emulator_file_name(case, kind)
     if not path.is_file():
         raise ControlError(
-            f"shipped emulator {path} is missing; make it with `python examples/train_emulator.py`"
+            f"shipped emulator {path} is missing; make it with "
+            "`python examples/train_emulator.py --ship`"
         )
     return path
 
 
-def shipped_emulator(case: str = "A"):
+def shipped_emulator(case: str = "A", kind: str = "band"):
     """The shipped Jackal emulator of Test Case "A" or "B" as a `gpmsa.Emulator`.
 
-    Its ``metadata`` records the vehicle (``vehicle``), the noise level (``noise_std``), the window
-    feature (``feature``) and the campaign's road settings (``road``); `control.run_closed_loop`
-    checks them against the loop.
+    ``kind="band"``: the block-feature emulator of the change-point BCR (metadata:
+    ``block_scatter``); ``kind="window"``: the paper's feature (log f of a 1,000-sample
+    window). Its ``metadata`` records the vehicle (``vehicle``), the noise level
+    (``noise_std``), the feature (``feature``), the road settings (``road``) and the versions
+    that made it; `control.run_closed_loop` checks them against the loop.
     """
     import gpmsa
 
-    return gpmsa.load(shipped_emulator_path(case))
+    return gpmsa.load(shipped_emulator_path(case, kind))

@@ -1,26 +1,38 @@
-"""Train the emulators the closed loop uses (paper Test Cases A and B) and ship them in the package.
+"""Train the emulators the closed loop uses (paper Test Cases A and B).
 
-    python examples/train_emulator.py                 # 198-run campaign, 30,000-iteration fits
-    python examples/train_emulator.py --out out --n-iter 30000 --seed 0
+    python examples/train_emulator.py                  # campaign + fits -> out/emulators/
+    python examples/train_emulator.py --ship           # ... and replace the package's shipped files
+    python examples/train_emulator.py --n-iter 5000 --out out_quick   # a quicker try
 
-Steps: a 198-point Latin hypercube over v in [0.5, 2.0] m/s and GD in [200, 600] (paper eqs. 3-4,
-Fig. 5), stretched so that its extreme points lie on the bounds (the emulator's domain is the
-design's range, and the robot drives at exactly 2.0 m/s); one fresh 21 m road and one Jackal drive
-per point (``vehicle.run_campaign``); the observation y = log f, f = variance (ddof 0) of the last
-1,000 front-axle accelerations of the drive (the BCR's window; see docs/closed-loop.md for why the
-window and why the log); ``gpmsa.fit`` with 30,000 iterations; the emulator files
-control/emulators/jackal_A.gpmsa (noise-free accelerations) and jackal_B.gpmsa (N(0, 1) noise).
+Steps (docs/closed-loop.md):
 
-The GP nugget must be free to describe the window-to-window scatter of log f (~0.1-0.2 across road
-realisations), so the prior of lamWs is relaxed from GPM/SA's default lower bound of 60 (a nugget
-sd of ~0.13 standardised units, meant for deterministic simulators) to 1.
+1. a 198-point Latin hypercube over v in [0.5, 2.0] m/s and GD in [200, 600] (paper eqs. 3-4,
+   Fig. 5), stretched so that its extreme points lie on the bounds (the emulator's domain is the
+   design's range, and the robot drives at exactly 2.0 m/s);
+2. one fresh road and one Jackal drive per point (``vehicle.run_campaign``), keeping the last
+   ``--keep-s`` (60) seconds of front-axle accelerations, noise-free and with N(0, 1) noise;
+3. the block-feature emulators ``jackal_{A,B}.gpmsa`` (the change-point BCR's): per run, the
+   mean log band-power vector of its 125-sample blocks (`control.training`), fitted by
+   ``gpmsa.fit`` through its PCA basis; the block-to-block covariance Sigma(v) and the
+   Student-t dof, stored in the file's metadata (``block_scatter``) as the known observation
+   noise of one block;
+4. the paper-feature emulators ``jackal_{A,B}_window.gpmsa`` (the paper's estimator and the
+   window filters): y = log f of the last 1,000 samples of each drive, with the GP nugget
+   describing the window scatter (its lamWs prior relaxed from GPM/SA's lower bound of 60 to 1).
+
+The files go to ``--emulator-dir`` (default ``OUT/emulators``); ``--ship`` writes them into the
+package (control/emulators/) instead, replacing the shipped ones. Each file's metadata records the
+vehicle, the noise level, the feature, the road settings, the design, the fit settings and the
+versions of Python, numpy, scipy, exudyn and gpmsa that made it.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import platform
 import time
+from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import matplotlib
@@ -31,19 +43,19 @@ import numpy as np  # noqa: E402
 
 import gpmsa  # noqa: E402
 import vehicle  # noqa: E402
+from control import PAPER_WINDOW, FeatureSpec  # noqa: E402
 from control.feature import feature_of_variance  # noqa: E402
 from control.plotting import plot_design  # noqa: E402
-from control.shipped import CASES, EMULATOR_DIR  # noqa: E402
+from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
+from control.training import block_scatter, block_statistics  # noqa: E402
 
 V_RANGE = (0.5, 2.0)
 GD_RANGE = (200.0, 600.0)
-FEATURE = "log_var"  # y = log f (control.feature)
-WINDOW = 1000
 RATE_HZ = 120.0
-ROAD_LENGTH_M = 21.0
 LEAD_IN_M = 1.0
 NOISE_STD = {"A": 0.0, "B": 1.0}
-PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(1.0, 1e-3, 1.0, 1e5))
+BAND_FEATURE = FeatureSpec()
+WINDOW_PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(1.0, 1e-3, 1.0, 1e5))
 
 
 def stretched_design(n: int, seed: int, gd_range: tuple[float, float] = GD_RANGE) -> np.ndarray:
@@ -54,96 +66,131 @@ def stretched_design(n: int, seed: int, gd_range: tuple[float, float] = GD_RANGE
     return target_lo + (design - lo) * (target_hi - target_lo) / (hi - lo)
 
 
-def metadata(case: str, model, campaign, seed: int, n_iter: int, gd_range) -> dict:
-    """What the loop checks: vehicle, noise, feature definition, road settings."""
+def versions() -> dict:
+    """Versions of what made the training data and the fit."""
+    out = {"python": platform.python_version()}
+    for pkg in ("numpy", "scipy", "exudyn", "terrain-gpmsa"):
+        try:
+            out[pkg] = version(pkg)
+        except PackageNotFoundError:
+            out[pkg] = "unknown"
+    return out
+
+
+def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict) -> dict:
+    """What the loop checks and what a reader of the file wants to know."""
     return {
         "case": case,
         "vehicle": model.describe(),
         "noise_std": NOISE_STD[case],
-        "feature": {
-            "name": FEATURE,
-            "window_samples": WINDOW,
-            "rate_hz": RATE_HZ,
-            "span": "last window_samples samples of each drive (ending at the road's end)",
-        },
+        "feature": feature.to_dict(),
         "road": {
             "generator": "roadgen.iso8608_profile",
-            "length_m": ROAD_LENGTH_M,
             "lead_in_m": LEAD_IN_M,
             "dx_m": 0.006,
             "band": None,
             "wheel_envelope": True,
+            "drive_s": args.keep_s,
         },
         "design": {
             "n": int(campaign.v.size),
-            "seed": seed,
+            "seed": args.seed,
             "v_range": V_RANGE,
-            "gd_range": tuple(gd_range),
+            "gd_range": GD_RANGE,
         },
-        "fit": {"n_iter": n_iter, "lamWs_prior": [1.0, 1e-3, 1.0, 1e5]},
+        "versions": versions(),
         "made_by": "examples/train_emulator.py",
+        **extra,
     }
+
+
+def fit_band(case: str, campaign, model, args):
+    """The block-feature emulator of one case, with its block scatter in the metadata."""
+    accel = campaign.accel if case == "A" else campaign.accel_measured
+    ok = campaign.ok & np.all(np.isfinite(accel), axis=1)
+    stats_ = block_statistics(accel[ok], BAND_FEATURE)
+    scatter = block_scatter(campaign.v[ok], stats_, nodes=np.linspace(*V_RANGE, 16))
+    data = gpmsa.SimData(
+        x=campaign.v[ok, None], t=campaign.gd[ok, None], y=stats_.mean,
+        x_names=["v"], t_names=["GD"], y_names=BAND_FEATURE.names(),
+        x_units=["m/s"], t_units=["1e-6 m^3"], y_units=["log((m/s^2)^2)"] * BAND_FEATURE.dim,
+    )  # fmt: skip
+    extra = {
+        "block_scatter": scatter.to_dict(),
+        "fit": {"n_iter": args.n_iter, "priors": "GPM/SA defaults"},
+        "training_target": "mean feature of the run's blocks (expected feature)",
+    }
+    return gpmsa.fit(
+        data, n_iter=args.n_iter, seed=args.seed, progress=True,
+        metadata=metadata(case, BAND_FEATURE, model, campaign, args, extra),
+    )  # fmt: skip
+
+
+def fit_window(case: str, campaign, model, args):
+    """The paper-feature emulator of one case: log f of the last 1,000 samples of each drive."""
+    f = campaign.f_window if case == "A" else campaign.f_window_noisy
+    ok = np.isfinite(f) & (f > 0)
+    data = gpmsa.SimData(
+        x=campaign.v[ok, None], t=campaign.gd[ok, None],
+        y=feature_of_variance(f[ok], "log_var")[:, None],
+        x_names=["v"], t_names=["GD"], y_names=["log_f"],
+    )  # fmt: skip
+    extra = {"fit": {"n_iter": args.n_iter, "lamWs_prior": [1.0, 1e-3, 1.0, 1e5]}}
+    return gpmsa.fit(
+        data, n_iter=args.n_iter, seed=args.seed, progress=True, priors=WINDOW_PRIORS,
+        metadata=metadata(case, PAPER_WINDOW, model, campaign, args, extra),
+    )  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out", help="folder for the figure and the campaign")
-    parser.add_argument("--n-runs", type=int, default=198)
-    parser.add_argument("--n-iter", type=int, default=30_000)
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--emulator-dir", default=str(EMULATOR_DIR))
-    parser.add_argument("--cases", nargs="+", default=sorted(CASES), choices=sorted(CASES))
-    parser.add_argument("--gd-range", nargs=2, type=float, default=GD_RANGE, metavar=("LO", "HI"))
+    parser.add_argument("--out", default="out", help="folder for the campaign and the figure")
+    parser.add_argument("--n-runs", type=int, default=198, help="design points (paper: 198)")
+    parser.add_argument("--keep-s", type=float, default=60.0, help="seconds of driving per run")
+    parser.add_argument("--n-iter", type=int, default=30_000, help="MCMC sweeps per fit")
+    parser.add_argument("--seed", type=int, default=0, help="seed of design, roads and fits")
+    parser.add_argument("--emulator-dir", default=None, help="default: OUT/emulators")
+    parser.add_argument(
+        "--ship", action="store_true", help=f"write the emulators into {EMULATOR_DIR}"
+    )
+    parser.add_argument("--cases", nargs="+", default=["A", "B"], choices=["A", "B"])
+    parser.add_argument(
+        "--features", nargs="+", default=["band", "window"], choices=["band", "window"]
+    )
     args = parser.parse_args(argv)
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed}")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.ship and args.emulator_dir is not None:
+        parser.error("--ship and --emulator-dir exclude each other")
+    emu_dir = EMULATOR_DIR if args.ship else Path(args.emulator_dir or out / "emulators")
+    emu_dir.mkdir(parents=True, exist_ok=True)
     model = vehicle.Jackal()
 
-    design = stretched_design(args.n_runs, args.seed, tuple(args.gd_range))
+    design = stretched_design(args.n_runs, args.seed)
     plot_design(design[:, 0], design[:, 1]).savefig(out / "lhs_design.png", dpi=150)
     tic = time.perf_counter()
     campaign = vehicle.run_campaign(
-        design,
-        model,
-        road_length_m=ROAD_LENGTH_M,
-        lead_in_m=LEAD_IN_M,
-        rate_hz=RATE_HZ,
-        noise_std=NOISE_STD["B"],
-        window=WINDOW,
-        cache_dir=out / "campaign_cache",
-        progress=True,
-        seed=args.seed,
-    )
+        design, model, lead_in_m=LEAD_IN_M, rate_hz=RATE_HZ, noise_std=NOISE_STD["B"],
+        window=PAPER_WINDOW.block_samples, cache_dir=out / "campaign_cache", progress=True,
+        seed=args.seed, keep_s=args.keep_s,
+    )  # fmt: skip
     print(f"campaign: {campaign.v.size} runs in {time.perf_counter() - tic:.0f} s")
+    if not campaign.ok.all():
+        print(f"  {np.count_nonzero(~campaign.ok)} failed runs are left out")
     campaign.save(out / "campaign.npz")
 
+    fitters = {"band": fit_band, "window": fit_window}
     for case in args.cases:
-        f = campaign.f_window if case == "A" else campaign.f_window_noisy
-        ok = np.isfinite(f) & (f > 0)
-        if not ok.all():
-            print(f"case {case}: {np.count_nonzero(~ok)} failed runs left out")
-        data = gpmsa.SimData(
-            x=campaign.v[ok, None],
-            t=campaign.gd[ok, None],
-            y=feature_of_variance(f[ok], FEATURE)[:, None],
-            x_names=["v"],
-            t_names=["GD"],
-            y_names=["log_f"],
-        )
-        tic = time.perf_counter()
-        emu = gpmsa.fit(
-            data,
-            n_iter=args.n_iter,
-            seed=args.seed,
-            progress=True,
-            priors=PRIORS,
-            metadata=metadata(case, model, campaign, args.seed, args.n_iter, args.gd_range),
-        )
-        path = Path(args.emulator_dir) / CASES[case]
-        emu.save(path)
-        params = {k: np.round(np.ravel(v), 4).tolist() for k, v in emu.params.items()}
-        print(f"case {case}: fitted in {time.perf_counter() - tic:.0f} s -> {path}")
-        print(f"  point estimate: {json.dumps(params)}")
+        for kind in args.features:
+            tic = time.perf_counter()
+            emu = fitters[kind](case, campaign, model, args)
+            path = emu_dir / emulator_file_name(case, kind)
+            emu.save(path)
+            params = {k: np.round(np.ravel(v), 3).tolist() for k, v in emu.params.items()}
+            print(f"case {case}, {kind}: fitted in {time.perf_counter() - tic:.0f} s -> {path}")
+            print(f"  point estimate: {json.dumps(params)}")
     print(f"design figure: {out / 'lhs_design.png'}")
 
 

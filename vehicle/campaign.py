@@ -8,7 +8,10 @@ the paper's eq. 5, computed over two spans of each drive:
 * ``f_window``: the last ``window`` (1,000) samples of the drive, i.e. the window that ends when
   the front axle reaches the road's end (as far from the start as possible);
 
-each noise-free and with N(0, noise_std^2) accelerometer noise (``*_noisy``).
+each noise-free and with N(0, noise_std^2) accelerometer noise (``*_noisy``). With ``keep_s > 0``
+the campaign also keeps the last ``keep_s`` seconds of each drive's accelerations (``accel`` and
+``accel_measured``), lengthening each road so that they follow the start-up span: training data
+for features of many short blocks per run.
 """
 
 from __future__ import annotations
@@ -31,6 +34,8 @@ from vehicle.models import Jackal, Model, check_model
 from vehicle.simulate import SUBSTEPS, simulate
 
 FORMAT = "vehicle.campaign/1"
+MAX_TRACE_BYTES = 4 * 2**30
+"""Largest memory the kept traces (``keep_s``) of a campaign may take, bytes."""
 _F_NAMES = ("f_full", "f_window", "f_full_noisy", "f_window_noisy")
 _ARRAYS = ("v", "gd", "seed", *_F_NAMES, "status")
 
@@ -51,6 +56,7 @@ class RunSpec:
     noise_std: float
     window: int
     substeps: int
+    keep_samples: int = 0
 
     def key(self) -> str:
         """Hash of the run's settings: its cache file name."""
@@ -68,7 +74,9 @@ class Campaign:
     v: speed, m/s. gd: GD, 1e-6 m^3. seed: the run's road seed (its noise seed is [seed, 1]).
     f_full, f_window, f_full_noisy, f_window_noisy: (m/s^2)^2, NaN for a failed run (see the
     module docstring for the spans). status: "ok" or the failure message. settings: dict of the
-    campaign's settings (model description, road, sensor, window, solver, seed).
+    campaign's settings (model description, road, sensor, window, solver, seed). accel,
+    accel_measured: (n, keep) the last ``keep_s`` seconds of each drive's noise-free and
+    measured front-axle accelerations, m/s^2 (NaN rows for failed runs); None unless kept.
     """
 
     v: np.ndarray
@@ -80,6 +88,8 @@ class Campaign:
     f_window_noisy: np.ndarray
     status: np.ndarray
     settings: dict
+    accel: np.ndarray | None = None
+    accel_measured: np.ndarray | None = None
 
     @property
     def ok(self) -> np.ndarray:
@@ -91,6 +101,8 @@ class Campaign:
         arrays = {name: np.asarray(getattr(self, name)) for name in _ARRAYS}
         arrays["status"] = np.asarray(self.status, dtype=str)
         arrays["settings"] = np.asarray(json.dumps({"format": FORMAT, **self.settings}))
+        if self.accel is not None:
+            arrays["accel"], arrays["accel_measured"] = self.accel, self.accel_measured
         with open(path, "wb") as fh:
             np.savez(fh, **arrays)
 
@@ -100,6 +112,7 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {name: data[name] for name in (*_ARRAYS, "settings")}
+            traces = {k: data[k] for k in ("accel", "accel_measured") if k in data.files}
     except FileNotFoundError as exc:
         raise CampaignFileError(f"campaign file {str(path)!r} does not exist") from exc
     except (OSError, ValueError, KeyError, EOFError) as exc:
@@ -116,7 +129,9 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
     if len(n) != 1 or any(a.shape != n for a in arrays.values()):
         shapes = {k: a.shape for k, a in arrays.items()}
         raise CampaignFileError(f"campaign file {str(path)!r}: arrays of unequal shapes {shapes}")
-    return Campaign(**arrays, settings=settings)
+    if traces and any(a.shape[:1] != n for a in traces.values()):
+        raise CampaignFileError(f"campaign file {str(path)!r}: traces do not match the runs")
+    return Campaign(**arrays, settings=settings, **traces)
 
 
 def run_campaign(
@@ -135,6 +150,7 @@ def run_campaign(
     progress: bool = True,
     cache_dir: str | os.PathLike | None = None,
     seed: int = 0,
+    keep_s: float = 0.0,
 ) -> Campaign:
     """Run one drive per design point and tabulate f (see the module docstring).
 
@@ -153,6 +169,9 @@ def run_campaign(
         cache_dir: finished runs are stored there, one ``.npz`` per run named by a hash of its
             settings, and reused: an interrupted campaign loses no finished run.
         seed: the campaign's seed; run i gets road seed ``SeedSequence(seed).generate_state(n)[i]``.
+        keep_s: keep the last keep_s seconds of each drive's accelerations (``Campaign.accel``);
+            each road is lengthened (beyond ``road_length_m`` where needed) so that they begin
+            at least 1 s after the front axle has passed the lead-in.
     Returns:
         Campaign. A run that fails (diverges) is recorded with NaN f and its message.
     """
@@ -169,17 +188,31 @@ def run_campaign(
             f"{np.max(points[:, 0]):.4g} m/s after the lead-in ({lead_in_m} m) needs "
             f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
         )
+    if not (np.isfinite(keep_s) and keep_s >= 0):
+        raise VehicleError(f"keep_s={keep_s!r} is out of range: allowed [0, inf) s")
+    keep = int(round(keep_s * rate_hz))
+    if keep * points.shape[0] * 16 > MAX_TRACE_BYTES:
+        raise VehicleError(
+            f"keep_s={keep_s!r} s for {points.shape[0]} runs would hold "
+            f"{keep * points.shape[0] * 16 / 2**30:.3g} GiB of traces; the limit is "
+            f"vehicle.campaign.MAX_TRACE_BYTES = {MAX_TRACE_BYTES / 2**30:g} GiB"
+        )
+
+    def length(v: float) -> float:
+        need = lead_in_m + model.wheelbase_m + v * (keep_s + 1.0) if keep else 0.0
+        return float(max(road_length_m, need))
+
     seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
     specs = [
-        RunSpec(model, float(v), float(gd), int(s), float(road_length_m), float(dx_m),
+        RunSpec(model, float(v), float(gd), int(s), length(float(v)), float(dx_m),
                 float(lead_in_m), None if band is None else tuple(map(float, band)),
-                float(rate_hz), float(noise_std), int(window), int(substeps))
+                float(rate_hz), float(noise_std), int(window), int(substeps), keep)
         for (v, gd), s in zip(points, seeds, strict=True)
     ]  # fmt: skip
     cache = None if cache_dir is None else Path(cache_dir)
     if cache is not None:
         cache.mkdir(parents=True, exist_ok=True)
-    results: list[tuple[np.ndarray, str] | None] = [None] * len(specs)
+    results: list[RunResult | None] = [None] * len(specs)
     todo = []
     for i, spec in enumerate(specs):
         cached = None if cache is None else _read_cached(cache / f"run-{spec.key()}.npz")
@@ -203,8 +236,18 @@ def run_campaign(
         if own:
             pool.shutdown()
     f = np.array([r[0] for r in results])
+    traces = {}
+    if keep:
+        traces = {
+            "accel": np.stack([r[2] if r[2].size else np.full(keep, np.nan) for r in results]),
+            "accel_measured": np.stack(
+                [r[3] if r[3].size else np.full(keep, np.nan) for r in results]
+            ),
+        }
     settings = {
         **_spec_settings(specs[0]),
+        "road_length_m": float(road_length_m),
+        "keep_s": float(keep_s),
         "seed": int(seed),
         "f_full": "var(accel_front) over front-axle position >= lead_in_m + wheelbase",
         "f_window": f"var(accel_front) over the last {window} samples (ending at the road's end)",
@@ -216,25 +259,32 @@ def run_campaign(
         **{name: f[:, j] for j, name in enumerate(_F_NAMES)},
         status=np.array([r[1] for r in results], dtype=str),
         settings=settings,
+        **traces,
     )
 
 
-def run_one(spec: RunSpec, cache_dir: str | None = None) -> tuple[np.ndarray, str]:
-    """One run: f values (4,) in ``_F_NAMES`` order and "ok" or the failure message.
+RunResult = tuple[np.ndarray, str, np.ndarray, np.ndarray]
+"""f values (4,), "ok" or the failure message, kept noise-free and measured accelerations."""
 
-    Writes the result to ``cache_dir`` (if given) before returning.
+
+def run_one(spec: RunSpec, cache_dir: str | None = None) -> RunResult:
+    """One run: f values (4,) in ``_F_NAMES`` order, "ok" or the failure message, and the last
+    ``spec.keep_samples`` noise-free and measured accelerations (empty when none are kept or
+    the run failed). Writes the result to ``cache_dir`` (if given) before returning.
     """
+    empty = np.zeros(0)
     try:
-        f = _drive(spec)
+        f, acc, measured = _drive(spec)
         status = "ok"
     except (VehicleError, SimulationDivergedError, roadgen.RoadgenError) as exc:
         f, status = np.full(len(_F_NAMES), np.nan), f"{type(exc).__name__}: {exc}"
+        acc = measured = empty
     if cache_dir is not None:
-        _write_cached(Path(cache_dir) / f"run-{spec.key()}.npz", f, status, spec)
-    return f, status
+        _write_cached(Path(cache_dir) / f"run-{spec.key()}.npz", (f, status, acc, measured), spec)
+    return f, status, acc, measured
 
 
-def _drive(spec: RunSpec) -> np.ndarray:
+def _drive(spec: RunSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     profile = roadgen.iso8608_profile(
         spec.road_length_m, spec.gd, dx_m=spec.dx_m, seed=spec.seed, band=spec.band,
         lead_in_m=spec.lead_in_m,
@@ -244,13 +294,15 @@ def _drive(spec: RunSpec) -> np.ndarray:
         seed=np.random.default_rng([spec.seed, 1]), substeps=spec.substeps,
     )  # fmt: skip
     full = trace.position >= spec.lead_in_m + spec.model.wheelbase_m
-    if np.count_nonzero(full) < spec.window:
+    need = max(spec.window, spec.keep_samples)
+    if np.count_nonzero(full) < need:
         raise VehicleError(
             f"run v={spec.v:.4g} m/s has {np.count_nonzero(full)} samples after the lead-in: "
-            f"need >= window={spec.window}"
+            f"need >= {need} (window={spec.window}, keep={spec.keep_samples})"
         )
     win = slice(len(trace) - spec.window, None)
-    return np.array(
+    kept = slice(len(trace) - spec.keep_samples, None) if spec.keep_samples else slice(0, 0)
+    f = np.array(
         [
             np.var(trace.accel_front[full]),
             np.var(trace.accel_front[win]),
@@ -258,6 +310,7 @@ def _drive(spec: RunSpec) -> np.ndarray:
             np.var(trace.accel_front_measured[win]),
         ]
     )
+    return f, trace.accel_front[kept].copy(), trace.accel_front_measured[kept].copy()
 
 
 def _spec_settings(spec: RunSpec) -> dict:
@@ -271,26 +324,32 @@ def _spec_settings(spec: RunSpec) -> dict:
         "rate_hz": spec.rate_hz,
         "noise_std": spec.noise_std,
         "window": spec.window,
+        "keep_samples": spec.keep_samples,
         "substeps": spec.substeps,
         "solver": "exudyn generalised-alpha, spectral radius 0.9",
     }
 
 
-def _write_cached(path: Path, f: np.ndarray, status: str, spec: RunSpec) -> None:
+def _write_cached(path: Path, result: RunResult, spec: RunSpec) -> None:
+    f, status, acc, measured = result
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
     with os.fdopen(fd, "wb") as fh:
-        np.savez(fh, f=f, status=np.asarray(status), key=np.asarray(spec.key()))
+        np.savez(
+            fh, f=f, status=np.asarray(status), key=np.asarray(spec.key()), accel=acc,
+            accel_measured=measured,
+        )  # fmt: skip
     os.replace(tmp, path)  # atomic: a crash never leaves a half-written cache file
 
 
-def _read_cached(path: Path) -> tuple[np.ndarray, str] | None:
+def _read_cached(path: Path) -> RunResult | None:
     if not path.exists():
         return None
     try:
         with np.load(path, allow_pickle=False) as data:
             f, status, key = data["f"], str(data["status"]), str(data["key"])
+            acc, measured = data["accel"], data["accel_measured"]
     except (OSError, ValueError, KeyError, EOFError):
-        return None  # a damaged cache entry is recomputed
+        return None  # a damaged (or older) cache entry is recomputed
     if f.shape != (len(_F_NAMES),) or key != path.stem.removeprefix("run-"):
         return None
-    return f, status
+    return f, status, acc, measured

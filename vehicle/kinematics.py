@@ -42,14 +42,19 @@ class Drive:
         return np.interp(t, self.t0 + self.h * np.arange(self.v.size), self.v)
 
 
-def check_speed(name: str, v: np.ndarray | float, max_speed: float) -> np.ndarray:
-    """Return speeds as an array or raise VehicleError unless all are finite and in (0, max]."""
+def check_speed(
+    name: str, v: np.ndarray | float, max_speed: float, allow_stop: bool = False
+) -> np.ndarray:
+    """Return speeds as an array or raise VehicleError unless all are finite and in (0, max]
+    ([0, max] with ``allow_stop``: a commanded standstill)."""
     arr = np.asarray(v, dtype=float)
-    bad = ~np.isfinite(arr) | (arr <= 0.0) | (arr > max_speed * (1 + 1e-12))
+    low = (arr < 0.0) if allow_stop else (arr <= 0.0)
+    bad = ~np.isfinite(arr) | low | (arr > max_speed * (1 + 1e-12))
     if np.any(bad):
+        bracket = "[0" if allow_stop else "(0"
         raise VehicleError(
             f"{name}={float(arr[bad].flat[0])!r} m/s is out of range: allowed "
-            f"(0, {max_speed:g}] m/s (finite, positive, at most the model's max_speed_mps)"
+            f"{bracket}, {max_speed:g}] m/s (finite, at most the model's max_speed_mps)"
         )
     return arr
 

@@ -42,7 +42,8 @@ class Simulation:
     The vehicle starts at rest on the road with its front axle at ``start_m`` (the rear axle,
     a wheelbase behind, reads a flat extension at the road's first height while it is before 0).
     The commanded speed of ``advance`` is a set-point: the actual speed ramps towards it at the
-    model's ``max_accel_mps2`` and it must lie in (0, max_speed_mps].
+    model's ``max_accel_mps2`` and it must lie in [0, max_speed_mps]: 0 stops the vehicle, which
+    then stands (samples keep coming, the position does not change) until a speed is commanded.
 
     Args:
         model: HalfCar or Jackal. track: roadgen Track or Profile. rate_hz: accelerometer rate, Hz.
@@ -87,8 +88,9 @@ class Simulation:
 
     @property
     def finished(self) -> bool:
-        """True once the front axle cannot advance another sample period before the end."""
-        return self.position + self.speed / self.rate_hz > self.end_m
+        """True once the front axle cannot advance another sample period before the end (a
+        vehicle standing short of the end is not finished)."""
+        return self.speed > 0 and self.position + self.speed / self.rate_hz > self.end_m
 
     def advance(self, dt: float, speed: float) -> Samples:
         """Drive for ``dt`` seconds (rounded to whole sample periods, at least one) towards the
@@ -96,7 +98,7 @@ class Simulation:
         """
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise VehicleError(f"dt={dt!r} is out of range: allowed (0, inf) s")
-        v_set = float(check_speed("speed", speed, self.model.max_speed_mps))
+        v_set = float(check_speed("speed", speed, self.model.max_speed_mps, allow_stop=True))
         n = max(1, round(dt * self.rate_hz))
         sub = self._substeps
         s, v = ramp_grid(

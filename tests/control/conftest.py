@@ -1,60 +1,14 @@
-"""Test doubles for control: a calibrator with a known likelihood and a synthetic sensor stream."""
+"""Fixtures of the control tests (the doubles live in control_doubles.py)."""
 
-from types import SimpleNamespace
-
-import numpy as np
 import pytest
-
-from gpmsa.model.transforms import Standardizer
-
-C = 0.05  # f = C * GD * v**1.3 (m/s^2)^2, a made-up but realistic-looking law
-SIGMA = 0.06  # spread of log f for one 1,000-sample window of white noise (sqrt(2/1000) ~ 0.045)
-
-
-def log_f(v, gd):
-    return np.log(C) + np.log(gd) + 1.3 * np.log(v)
-
-
-class FakeCalibrator:
-    """Gaussian likelihood of y = log f on a grid: the part of gpmsa.Calibrator the BCR uses."""
-
-    def __init__(self, metadata=None, v_range=(0.5, 2.0)):
-        self.emulator = SimpleNamespace(
-            domain={"v": tuple(v_range), "GD": (200.0, 600.0)},
-            standardizer=Standardizer(
-                x_min=np.array([v_range[0]]),
-                x_max=np.array([v_range[1]]),
-                t_min=np.array([200.0]),
-                t_max=np.array([600.0]),
-                y_mean=np.zeros(1),
-                y_sd=1.0,
-                grid=np.zeros(1),
-            ),
-            x_names=["v"],
-            t_names=["GD"],
-            metadata=metadata or {},
-        )
-        self.grid = np.linspace(200.0, 600.0, 401)
-        self.calls = 0
-
-    def log_likelihood_grid(self, x_obs, y_obs):
-        self.calls += 1
-        v = float(np.asarray(x_obs).ravel()[0])
-        y = float(np.asarray(y_obs).ravel()[0])
-        return self.grid, -0.5 * ((y - log_f(v, self.grid)) / SIGMA) ** 2
-
-
-def stream(gd_of_position, speed, duration_s, rate_hz=120.0, seed=0, t0=0.0, s0=0.0):
-    """White-noise accelerations whose variance follows f = C GD v^1.3 at constant speed."""
-    rng = np.random.default_rng(seed)
-    n = int(round(duration_s * rate_hz))
-    t = t0 + np.arange(1, n + 1) / rate_hz
-    pos = s0 + speed * (t - t0)
-    f = np.exp(log_f(speed, gd_of_position(pos)))
-    acc = rng.standard_normal(n) * np.sqrt(f)
-    return t, pos, acc, np.full(n, float(speed))
+from control_doubles import FakeBlockModel, FakeCalibrator
 
 
 @pytest.fixture
 def fake_calibrator():
     return FakeCalibrator()
+
+
+@pytest.fixture
+def block_model():
+    return FakeBlockModel()

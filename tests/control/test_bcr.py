@@ -1,109 +1,263 @@
-"""BCR with a test-double calibrator: buffering, guards, filtering of disjoint windows."""
+"""BCR with test doubles: the change-point method on blocks, the window methods, the guards."""
 
 import numpy as np
 import pytest
-from conftest import FakeCalibrator, log_f, stream
+from control_doubles import FakeBlockModel, FakeCalibrator, log_f, stream
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from control import BCR, ControlError
+from control import BCR, PAPER_WINDOW, STATUSES, BCRSettings, ControlError, SensorFault
+from control.faults import apply_faults
+
+WINDOW = {"feature": PAPER_WINDOW}
 
 
 def feed(bcr, t, p, a, v, chunk=125):
-    out = []
-    for k in range(0, t.size, chunk):
-        out.append(
-            bcr.update(t[k : k + chunk], p[k : k + chunk], a[k : k + chunk], v[k : k + chunk])
-        )
-    return out
+    return [
+        bcr.update(t[k : k + chunk], p[k : k + chunk], a[k : k + chunk], v[k : k + chunk])
+        for k in range(0, t.size, chunk)
+    ]
 
 
 def const(gd):
     return lambda s: np.full_like(s, gd)
 
 
-def test_no_number_until_the_buffer_is_full(fake_calibrator):
-    bcr = BCR(fake_calibrator, feature="log_var")
-    ests = feed(bcr, *stream(const(400), 1.5, 12.5, seed=1))  # 12 updates
-    # Windows of 1,000 samples: the first 7 updates (875 samples) have no estimate.
+# --- the change-point method ----------------------------------------------------------------------
+
+
+def test_every_block_gives_an_estimate_that_pools_on_steady_ground(block_model):
+    ests = feed(BCR(block_model), *stream(const(400), 1.5, 60, seed=1))
+    assert all(e.ok for e in ests) and len(ests) == 58  # 7,200 samples fed in 58 chunks
+    assert block_model.calls == 57  # one per complete 125-sample block, none filling
+    # pooling: the estimates beat what one block alone says about GD
+    one = [block_model.gd[np.argmax(block_model.loglik(e.feature, 1.5))] for e in ests[20:]]
+    pooled = [e.gd_mean for e in ests[20:]]
+    assert np.sqrt(np.mean((np.array(pooled) - 400) ** 2)) < 0.6 * np.sqrt(
+        np.mean((np.array(one) - 400) ** 2)
+    )
+    assert abs(np.mean(pooled) - 400) < 25
+    assert ests[-1].prob_change < 0.2 and ests[-1].latency_s > 0
+    assert ests[-1].feature.shape == (8,) and ests[-1].data_time == pytest.approx(ests[-1].time)
+
+
+def test_intervals_cover_the_truth_at_about_their_level():
+    inside, total = 0, 0
+    for seed in range(6):
+        ests = feed(BCR(FakeBlockModel()), *stream(const(350), 1.2, 60, seed=seed))
+        checked = ests[10::10]  # spaced, so that the checks are nearly independent
+        inside += sum(e.interval[0] <= 350 <= e.interval[1] for e in checked)
+        total += len(checked)
+    assert 0.75 <= inside / total <= 1.0
+
+
+def test_a_step_is_followed_within_a_few_blocks(block_model):
+    gd = lambda s: np.where(s < 45, 300.0, 500.0)  # noqa: E731
+    ests = feed(BCR(block_model), *stream(gd, 1.5, 60, seed=3))
+    pos = np.array([e.position for e in ests])
+    mean = np.array([e.gd_mean for e in ests])
+    delay = pos[np.argmax((pos > 45) & (mean > 400))] - 45
+    assert 0 < delay < 8.0  # metres: a few 1.56 m blocks
+    change = np.array([e.prob_change for e in ests])
+    assert change[(pos > 45) & (pos < 45 + delay + 3)].max() > 0.5
+    assert abs(mean[-5:].mean() - 500) < 50
+
+
+def test_a_fault_skips_its_block_and_keeps_the_run_length_posterior(block_model):
+    t, p, a, v = stream(const(400), 1.5, 40, seed=2)
+    a = a.copy()
+    a[2510:2520] = np.nan
+    bcr = BCR(block_model)
+    k = 2510 // 125
+    ests = feed(bcr, t[: (k + 2) * 125], p[: (k + 2) * 125], a[: (k + 2) * 125], v[: (k + 2) * 125])
+    # the run-length posterior is that of the clean blocks before the undone one, carried over
+    # the distance of the three blocks without data: unharmed, not reset
+    from control import ChangePointFilter
+    from control.feature import block_features
+
+    ref = ChangePointFilter(block_model.gd, bcr.settings.changepoint)
+    step = 1.5 * 125 / 120
+    for j in range(k - 1):
+        y = block_features(a[j * 125 : (j + 1) * 125], bcr.settings.feature)[0]
+        ref.update(block_model.loglik(y, 1.5), 0.0 if j == 0 else step)
+    ref.predict(2 * step)  # the undone block and the faulty one
+    ref.predict(step)  # the block after it
+    np.testing.assert_allclose(bcr.filter.gd_mass, ref.gd_mass, rtol=1e-9, atol=1e-15)
+    ests += feed(
+        bcr, t[(k + 2) * 125 :], p[(k + 2) * 125 :], a[(k + 2) * 125 :], v[(k + 2) * 125 :]
+    )
+    # the faulty block, and the block after it (it may hold the fault's end), are skipped; the
+    # block before it is undone (it may hold the fault's start)
+    assert [e.status for e in ests[k - 1 : k + 3]] == ["ok", "sensor_fault", "sensor_fault", "ok"]
+    assert "10 sample(s) with non-finite accel" in ests[k].reason and np.isnan(ests[k].gd_mean)
+    assert "block before it is undone" in ests[k].reason
+    assert "first block after a fault" in ests[k + 1].reason
+    assert ests[k + 2].ok
+
+
+@pytest.mark.parametrize(
+    ("kind", "magnitude", "status", "words"),
+    [
+        ("nan", 1.0, "sensor_fault", "non-finite accel"),
+        ("time_nan", 1.0, "sensor_fault", "non-finite t"),
+        ("position_nan", 1.0, "sensor_fault", "non-finite position"),
+        ("drop", 1.0, "sensor_fault", "gap"),
+        ("stuck", 1.0, "sensor_fault", "stuck sensor"),
+        ("quantize", 5.0, "sensor_fault", "quantised"),
+        ("clip", 0.05, "sensor_fault", "clipped"),
+        ("spike", 10.0, "sensor_fault", "clipped"),  # the spikes read +-1e6: saturation
+        ("scale", 1e-3, "implausible", "no GD in"),
+        ("noise", 100.0, "implausible", "no GD in"),
+    ],
+)
+def test_each_fault_kind_gives_no_estimate_and_the_bcr_recovers(
+    block_model, kind, magnitude, status, words
+):
+    t, p, a, v = stream(const(400), 1.5, 30, seed=5)
+    fault = SensorFault(10.0, 2.0, kind, magnitude)
+    obs = apply_faults(t, p, a, v, [fault], np.random.default_rng(0))
+    ests = feed(BCR(block_model), *obs)
+    hit = [e for e in ests if 10.0 <= e.time < 12.0 + 125 / 120]
+    assert hit and all(not e.ok for e in hit[1:-1])
+    assert any(e.status == status and words in e.reason for e in hit)
+    assert ests[-1].ok and abs(ests[-1].gd_mean - 400) < 60
+
+
+FAULT_SIZES = {  # fault-like magnitudes: a mild miscalibration (a gain of 0.7, say) looks like
+    # another roughness to any check of the signal alone, and is not a sensor fault here
+    "spike": (1.0, 60.0),  # one spike every 1 to 60 samples
+    "noise": (5.0, 1e4),  # m/s^2, above the signal's own ~6 m/s^2
+    "scale": (1e-4, 0.05),
+    "quantize": (2.0, 1e3),  # m/s^2 steps
+    "clip": (1e-3, 2.0),  # m/s^2
+}
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    kind=st.sampled_from(
+        [
+            "nan",
+            "drop",
+            "spike",
+            "noise",
+            "scale",
+            "quantize",
+            "stuck",
+            "clip",
+            "time_nan",
+            "position_nan",
+        ]
+    ),  # fmt: skip
+    start=st.floats(0.0, 20.0),
+    duration=st.floats(0.01, 8.0),
+    size=st.floats(0.0, 1.0),
+)
+def test_no_fault_crashes_the_bcr_or_makes_it_confidently_too_low(kind, start, duration, size):
+    t, p, a, v = stream(const(400), 1.5, 25, seed=7)
+    lo, hi = FAULT_SIZES.get(kind, (1.0, 1.0))
+    magnitude = float(np.exp(np.log(lo) + size * (np.log(hi) - np.log(lo))))
+    fault = SensorFault(start, duration, kind, magnitude)
+    ests = feed(BCR(FakeBlockModel()), *apply_faults(t, p, a, v, [fault], np.random.default_rng(1)))
+    assert all(e.status in STATUSES for e in ests)
+    for e in ests:  # an accepted estimate is never far below the truth (a faster robot)
+        if e.ok:
+            assert e.interval[1] + (e.interval[1] - e.interval[0]) >= 400
+
+
+def test_standing_still_keeps_the_estimate_until_it_turns_stale(block_model):
+    bcr = BCR(block_model, max_age_s=3.0)
+    t, p, a, v = stream(const(400), 1.5, 10, seed=1)
+    assert feed(bcr, t, p, a, v)[-1].ok
+    n = 125 * 5
+    ts = t[-1] + np.arange(1, n + 1) / 120
+    ests = feed(bcr, ts, np.full(n, p[-1]), 0.01 * np.random.default_rng(2).standard_normal(n),
+                np.zeros(n))  # fmt: skip
+    assert ests[1].ok and "no new information" in ests[1].reason  # ests[0] ends a moving block
+    assert ests[1].gd_mean == pytest.approx(ests[0].gd_mean, rel=0.05)
+    assert ests[-1].status == "stale" and "s old" in ests[-1].reason
+
+
+def test_speed_outside_the_domain_before_any_estimate(block_model):
+    ests = feed(BCR(block_model), *stream(const(400), 0.3, 3, seed=1))
+    assert ests[-1].status == "out_of_domain" and "0.3 m/s" in ests[-1].reason
+
+
+def test_changepoint_settings_are_checked(block_model):
+    with pytest.raises(ControlError, match="needs the log_band_power feature"):
+        BCR(block_model, method="changepoint", feature=PAPER_WINDOW)
+    with pytest.raises(ControlError, match="update_every must equal block_samples"):
+        BCR(block_model, update_every=100)
+    with pytest.raises(ControlError, match="needs an ObservationModel"):
+        BCR(FakeCalibrator())
+    bcr = BCR(block_model)
+    with pytest.raises(ControlError, match="accel must be 1-D of length 3"):
+        bcr.update(np.arange(3.0), np.arange(3.0), np.arange(2.0), np.ones(3))
+
+
+def test_backwards_and_repeated_time_stamps_are_faults(block_model):
+    t, p, a, v = stream(const(400), 1.5, 10, seed=1)
+    t = t.copy()
+    t[300] = t[299]  # repeated
+    t[400] = t[398]  # backwards
+    ests = feed(BCR(block_model), t, p, a, v)
+    assert [e.status for e in ests[2:4]] == ["sensor_fault", "sensor_fault"]
+    assert "repeated or backwards" in ests[2].reason
+    assert ests[-1].ok
+
+
+# --- the window methods (the paper's and the earlier filters) ------------------------------------
+
+
+def test_window_methods_need_a_full_window(fake_calibrator):
+    bcr = BCR(fake_calibrator, method="filter", **WINDOW)
+    ests = feed(bcr, *stream(const(400), 1.5, 12.5, seed=1))
     assert [e.status for e in ests[:7]] == ["filling"] * 7
     assert all(np.isnan(e.gd_mean) and "buffer holds" in e.reason for e in ests[:7])
     assert ests[7].ok and np.isfinite(ests[7].gd_mean) and ests[7].latency_s > 0
     assert fake_calibrator.calls == len(ests) - 7
 
 
-def test_estimates_cover_the_truth_and_filtering_beats_one_window():
+def test_filters_beat_one_window_on_steady_ground():
     errors = {"filter": [], "tempered": [], "window": []}
-    inside = 0
     for seed in range(4):
         t, p, a, v = stream(const(420), 1.2, 120, seed=seed)
         for method in errors:
-            ests = [
-                e
-                for e in feed(BCR(FakeCalibrator(), feature="log_var", method=method), t, p, a, v)
-                if e.ok
-            ]
-            errors[method] += [e.gd_mean - 420 for e in ests]
-            if method == "filter":
-                inside += sum(e.interval[0] <= 420 <= e.interval[1] for e in ests[::8])
+            ests = feed(BCR(FakeCalibrator(), method=method, **WINDOW), t, p, a, v)
+            errors[method] += [e.gd_mean - 420 for e in ests if e.ok]
     rmse = {k: np.sqrt(np.mean(np.square(e))) for k, e in errors.items()}
     assert rmse["filter"] < 0.7 * rmse["window"]
     assert rmse["tempered"] < 0.7 * rmse["window"]
-    n_checked = 4 * len(range(0, 105, 8))
-    assert inside >= 0.75 * n_checked  # a 90% interval: allow for the few windows checked
 
 
-def test_filter_follows_a_step_as_fast_as_one_window():
-    gd = lambda s: np.where(s < 60, 300.0, 500.0)  # noqa: E731
-    t, p, a, v = stream(gd, 1.5, 100, seed=3)
-    res = {}
-    for method in ("filter", "tempered", "window"):
-        ests = [
-            e
-            for e in feed(BCR(FakeCalibrator(), feature="log_var", method=method), t, p, a, v)
-            if e.ok
-        ]
-        pos = np.array([e.position for e in ests])
-        mean = np.array([e.gd_mean for e in ests])
-        res[method] = pos[np.argmax((pos > 60) & (mean > 400))] - 60
-    assert res["filter"] <= res["window"] + 2.0  # within about one update (1.6 m)
-    # the tempered filter weighs the windows straddling the step: later, but within a window
-    assert res["window"] < res["tempered"] < res["window"] + 12.5
-    assert res["window"] < 12.5  # less than one window length at 1.5 m/s
-
-
-def test_nan_samples_give_a_fault_then_recovery(fake_calibrator):
+def test_window_faults_restart_the_buffer(fake_calibrator):
     t, p, a, v = stream(const(400), 1.5, 40, seed=2)
     a = a.copy()
     a[2000:2010] = np.nan
-    ests = feed(BCR(fake_calibrator, feature="log_var"), t, p, a, v)
+    ests = feed(BCR(fake_calibrator, method="filter", **WINDOW), t, p, a, v)
     status = [e.status for e in ests]
     k = 2000 // 125
-    assert status[k - 1] == "ok"
-    assert status[k] == "sensor_fault" and "10 non-finite" in ests[k].reason
-    assert set(status[k + 1 : k + 8]) == {"filling"}  # the window restarts after the fault
-    assert status[k + 9 :] and set(status[k + 9 :]) == {"ok"}
+    assert status[k - 1] == "ok" and status[k] == "sensor_fault"
+    assert set(status[k + 1 : k + 8]) == {"filling"}
+    assert set(status[k + 9 :]) == {"ok"}
 
 
-def test_dropped_samples_are_detected(fake_calibrator):
-    t, p, a, v = stream(const(400), 1.5, 20, seed=2)
-    keep = np.ones(t.size, bool)
-    keep[1500:1530] = False
-    ests = feed(BCR(fake_calibrator, feature="log_var"), t[keep], p[keep], a[keep], v[keep])
-    faults = [e for e in ests if e.status == "sensor_fault"]
-    assert len(faults) == 1 and "30 dropped" in faults[0].reason
+def test_window_interleaved_filters_and_settings(fake_calibrator):
+    assert len(BCR(fake_calibrator, method="filter", **WINDOW).trackers) == 8
+    assert len(BCR(fake_calibrator, method="filter", update_every=300, **WINDOW).trackers) == 4
+    assert len(BCR(fake_calibrator, method="window", **WINDOW).trackers) == 1
+    with pytest.raises(ControlError, match="method must be one of"):
+        BCRSettings(method="kalman")
+    with pytest.raises(ControlError, match="must not exceed the window"):
+        BCRSettings(method="window", feature=PAPER_WINDOW, update_every=2000)
 
 
-def test_speed_outside_the_emulator_domain(fake_calibrator):
-    ests = feed(BCR(fake_calibrator, feature="log_var"), *stream(const(400), 0.3, 12, seed=1))
-    assert ests[-1].status == "out_of_domain" and "0.3 m/s" in ests[-1].reason
-    assert np.isnan(ests[-1].gd_mean)
-
-
-def test_an_old_estimate_turns_stale(fake_calibrator):
-    bcr = BCR(fake_calibrator, feature="log_var", update_every=1000, max_age_s=1.0)
-    t, p, a, v = stream(const(400), 1.5, 13, seed=1)
-    assert bcr.update(t[:1000], p[:1000], a[:1000], v[:1000]).ok
-    late = bcr.update(t[1000:1500], p[1000:1500], a[1000:1500], v[1000:1500])
-    assert late.status == "stale" and "s old" in late.reason and np.isnan(late.gd_mean)
+def test_the_speed_domain_edge_is_inside():
+    cal = FakeCalibrator(v_range=(0.5, float(np.nextafter(2.0, 0.0))))  # 1.9999999999999998
+    ests = feed(BCR(cal, method="window", **WINDOW), *stream(const(400), 2.0, 10, seed=1))
+    assert ests[-1].ok and ests[-1].speed == 2.0
+    ests = feed(BCR(cal, method="window", **WINDOW), *stream(const(400), 2.001, 10, seed=1))
+    assert ests[-1].status == "out_of_domain"
 
 
 def test_calibrator_errors_become_a_status():
@@ -111,119 +265,20 @@ def test_calibrator_errors_become_a_status():
         def log_likelihood_grid(self, x_obs, y_obs):
             raise ValueError("x_obs outside the domain")
 
-    ests = feed(BCR(Refusing(), feature="log_var"), *stream(const(400), 1.5, 10, seed=1))
+    ests = feed(BCR(Refusing(), method="window", **WINDOW), *stream(const(400), 1.5, 10, seed=1))
     assert ests[-1].status == "calibration_failed" and "outside" in ests[-1].reason
 
 
-def test_windows_in_one_interleaved_filter_do_not_overlap(fake_calibrator):
-    kw = {"feature": "log_var", "method": "filter"}
-    bcr = BCR(fake_calibrator, buffer=1000, update_every=125, **kw)
-    assert len(bcr.trackers) == 8
-    bcr3 = BCR(FakeCalibrator(), buffer=1000, update_every=300, **kw)
-    assert len(bcr3.trackers) == 4  # windows 1,200 samples apart
-    assert len(BCR(FakeCalibrator(), feature="log_var", method="tempered").trackers) == 1
-    assert len(BCR(FakeCalibrator(), feature="log_var", method="window").trackers) == 1
+def test_an_old_window_estimate_turns_stale(fake_calibrator):
+    bcr = BCR(fake_calibrator, method="window", update_every=1000, max_age_s=1.0, **WINDOW)
+    t, p, a, v = stream(const(400), 1.5, 13, seed=1)
+    assert bcr.update(t[:1000], p[:1000], a[:1000], v[:1000]).ok
+    late = bcr.update(t[1000:1500], p[1000:1500], a[1000:1500], v[1000:1500])
+    assert late.status == "stale" and "s old" in late.reason and np.isnan(late.gd_mean)
 
 
-def test_bad_input_raises(fake_calibrator):
-    with pytest.raises(ControlError, match="buffer must be an integer >= 10"):
-        BCR(fake_calibrator, feature="log_var", buffer=5)
-    with pytest.raises(ControlError, match="method must be one of"):
-        BCR(fake_calibrator, feature="log_var", method="kalman")
-    with pytest.raises(ControlError, match="rate_hz must be > 0"):
-        BCR(fake_calibrator, feature="log_var", rate_hz=0)
-    bcr = BCR(fake_calibrator, feature="log_var")
-    with pytest.raises(ControlError, match="accel must be 1-D of length 3"):
-        bcr.update(np.arange(3.0), np.arange(3.0), np.arange(2.0), np.ones(3))
-    with pytest.raises(ControlError, match="t and position must be finite"):
-        bcr.update(np.array([0.0, np.nan]), np.zeros(2), np.zeros(2), np.ones(2))
-
-
-def square_wave(duration_s, speed=1.5, gd=400.0, rate_hz=120.0):
-    """Accelerations +-a (f = a^2 as for GD `gd`): every window has the same f and likelihood."""
-    amp = np.exp(0.5 * log_f(speed, gd))
-    n = int(round(duration_s * rate_hz))
-    t = np.arange(1, n + 1) / rate_hz
-    return t, speed * t, amp * np.where(np.arange(n) % 2, 1.0, -1.0), np.full(n, speed)
-
-
-def rigid_tracker():
-    from control import TrackerSettings
-
-    return TrackerSettings(mean_segment_m=1e9, drift_per_sqrt_m=0.0)
-
-
-def test_tempered_updates_count_each_sample_once(fake_calibrator):
-    """With nothing changing, 1,000 new samples in 8 tempered updates weigh one full window."""
-    from control import GDTracker
-
-    t, p, a, v = square_wave(8000 / 120)  # 8 windows' worth: 57 updates with an estimate
-    ests = [
-        e
-        for e in feed(
-            BCR(FakeCalibrator(), feature="log_var", method="tempered", tracker=rigid_tracker()),
-            t,
-            p,
-            a,
-            v,
-        )
-        if e.ok
-    ]
-    one = [
-        e
-        for e in feed(BCR(FakeCalibrator(), feature="log_var", method="window"), t, p, a, v)
-        if e.ok
-    ]
-    assert ests[0].gd_sd == pytest.approx(one[0].gd_sd, rel=1e-9)  # the first window: power 1
-    grid, loglik = fake_calibrator.log_likelihood_grid([[1.5]], [[ests[0].feature]])
-    for k_windows in (2, 4, 8):
-        ref = GDTracker((200.0, 600.0), rigid_tracker())
-        for _ in range(k_windows):
-            ref.update(grid, loglik)
-        est = ests[8 * (k_windows - 1)]  # 1,000 (k - 1) samples after the first window
-        assert est.gd_sd == pytest.approx(ref.posterior().sd("GD"), rel=1e-6)
-        assert est.gd_mean == pytest.approx(ref.posterior().mean("GD"), rel=1e-9)
-    # Double counting (power 1 for every overlapping window) would shrink the sd by sqrt(8).
-    assert ests[8].gd_sd > 0.9 * one[0].gd_sd / np.sqrt(2)
-
-
-def test_a_restarted_buffer_enters_at_full_power(fake_calibrator, monkeypatch):
-    bcr = BCR(fake_calibrator, feature="log_var", method="tempered")
-    powers = []
-    update = bcr.trackers[0].update
-    monkeypatch.setattr(
-        bcr.trackers[0],
-        "update",
-        lambda g, ll, power=1.0: (powers.append(power), update(g, ll, power)),
-    )
-    t, p, a, v = stream(const(400), 1.5, 30, seed=4)
-    a = a.copy()
-    a[2000:2005] = np.nan
-    feed(bcr, t, p, a, v)
-    # first window, 7 tempered updates, (fault), refilled window, tempered updates
-    n_before = 2000 // 125 - 7
-    assert powers[0] == 1.0 and set(powers[1:n_before]) == {0.125}
-    assert powers[n_before] == pytest.approx(1.0, abs=0.01)
-    assert set(powers[n_before + 1 :]) == {0.125}
-
-
-def test_the_speed_domain_edge_is_inside():
-    cal = FakeCalibrator(v_range=(0.5, float(np.nextafter(2.0, 0.0))))  # 1.9999999999999998
-    ests = feed(BCR(cal, feature="log_var"), *stream(const(400), 2.0, 10, seed=1))
-    assert ests[-1].ok and ests[-1].speed == 2.0
-    ests = feed(BCR(cal, feature="log_var"), *stream(const(400), 2.001, 10, seed=1))
-    assert ests[-1].status == "out_of_domain"
-
-
-def test_the_window_method_keeps_the_prior_setting(fake_calibrator):
-    from control import TrackerSettings
-
-    bcr = BCR(
-        fake_calibrator,
-        feature="log_var",
-        method="window",
-        tracker=TrackerSettings(prior="log_uniform", n_grid=200),
-    )
-    (tracker,) = bcr.trackers
-    assert tracker.settings.mean_segment_m == 0.0
-    assert (tracker.settings.prior, tracker.settings.n_grid) == ("log_uniform", 200)
+def test_the_window_feature_of_the_paper(fake_calibrator):
+    t, p, a, v = stream(const(400), 1.5, 9, seed=1)
+    est = feed(BCR(fake_calibrator, method="window", **WINDOW), t, p, a, v)[-1]
+    assert est.feature[0] == pytest.approx(np.log(np.var(a[:1000])))  # 1,080 samples fed
+    assert est.feature[0] == pytest.approx(log_f(1.5, 400), abs=0.3)

@@ -12,11 +12,14 @@ from matplotlib.figure import Figure  # noqa: E402
 
 import vehicle  # noqa: E402
 from control import (  # noqa: E402
+    PAPER_WINDOW,
     BCRSettings,
     ControlError,
     ControlWarning,
     EmulatorMismatchError,
+    FeatureSpec,
     bcr_settings_for,
+    block_features,
     check_emulator,
     window_feature,
 )
@@ -43,8 +46,17 @@ def test_feature_is_the_papers_variance_normalised_by_t():
 def test_bcr_settings_follow_the_emulators_feature():
     emu = fake_emulator(feature={"name": "var", "window_samples": 600, "rate_hz": 100.0})
     s = bcr_settings_for(emu, method="window")
-    assert (s.feature, s.buffer, s.rate_hz, s.method) == ("var", 600, 100.0, "window")
-    assert bcr_settings_for(fake_emulator()) == BCRSettings()
+    assert (s.feature.name, s.feature.block_samples, s.rate_hz, s.method) == (
+        "var",
+        600,
+        100.0,
+        "window",
+    )
+    assert bcr_settings_for(emu).method == "filter"  # a window feature: the window filter
+    band = fake_emulator(feature=FeatureSpec().to_dict())
+    assert bcr_settings_for(band) == BCRSettings()  # the block feature: the change-point BCR
+    with pytest.raises(EmulatorMismatchError, match="has no 'feature'"):
+        bcr_settings_for(fake_emulator())
 
 
 def test_check_emulator_errors_and_warnings():
@@ -54,16 +66,16 @@ def test_check_emulator_errors_and_warnings():
         noise_std=0.0,
         feature={"name": "log_var", "window_samples": 1000, "rate_hz": 120.0},
     )
-    check_emulator(emu, model=jackal, noise_std=0.0, bcr=BCRSettings())  # all agree: silent
+    window = BCRSettings(feature=PAPER_WINDOW, method="window")
+    check_emulator(emu, model=jackal, noise_std=0.0, bcr=window)  # all agree: silent
     with pytest.raises(EmulatorMismatchError, match="made for vehicle"):
         check_emulator(emu, model=vehicle.HalfCar())
-    with pytest.raises(
-        EmulatorMismatchError,
-        match="BCR feature = 'var' but the emulator's feature has name = 'log_var'",
-    ):
-        check_emulator(emu, bcr=BCRSettings(feature="var"))
-    with pytest.raises(EmulatorMismatchError, match="BCR rate_hz = 100.0"):
-        check_emulator(emu, bcr=BCRSettings(rate_hz=100.0))
+    var = BCRSettings(feature=FeatureSpec("var", 1000), method="window")
+    with pytest.raises(EmulatorMismatchError, match="name: BCR 'var' vs emulator 'log_var'"):
+        check_emulator(emu, bcr=var)
+    fast = BCRSettings(feature=FeatureSpec("log_var", 1000, rate_hz=100.0), method="window")
+    with pytest.raises(EmulatorMismatchError, match="rate_hz: BCR 100.0 vs emulator 120.0"):
+        check_emulator(emu, bcr=fast)
     with pytest.warns(ControlWarning, match="no 'vehicle'"):
         check_emulator(fake_emulator(), model=jackal)
     with pytest.warns(ControlWarning, match="noise_std = 0.5"):
@@ -71,6 +83,32 @@ def test_check_emulator_errors_and_warnings():
     track = SimpleNamespace(segments=((10.0, 150.0), (10.0, 300.0)))
     with pytest.raises(EmulatorMismatchError, match=r"track GD \[150.0\]"):
         check_emulator(emu, track=track)
+
+
+def test_feature_spec_checks_and_round_trips():
+    spec = FeatureSpec()
+    assert spec.dim == 8 and len(spec.names()) == 8 and spec.block_s == pytest.approx(125 / 120)
+    assert FeatureSpec.from_dict(spec.to_dict()) == spec
+    assert spec.same_as(FeatureSpec(taper_nw=3.0, n_tapers=5)) == ["taper_nw", "n_tapers"]
+    with pytest.raises(ControlError, match="holds no frequency bin"):
+        FeatureSpec(block_samples=16, bands_hz=(1.0, 2.0, 60.0))
+    with pytest.raises(ControlError, match="above the Nyquist frequency"):
+        FeatureSpec(bands_hz=(1.0, 70.0))
+    with pytest.raises(ControlError, match="n_tapers must lie in"):
+        FeatureSpec(n_tapers=4)
+    with pytest.raises(ControlError, match="feature name must be one of"):
+        FeatureSpec(name="rms")
+
+
+def test_band_powers_add_up_to_the_variance_of_white_noise():
+    """The bands tile (1.5, 60) Hz: for white noise their powers sum to that share of the
+    variance (the multitaper estimate is unbiased for a flat spectrum)."""
+    rng = np.random.default_rng(3)
+    a = rng.standard_normal((4000, 125)) * 2.0
+    power = np.exp(block_features(a, FeatureSpec())).sum(axis=1).mean()
+    assert power == pytest.approx(4.0 * (60 - 1.5) / 60, rel=0.03)
+    with pytest.raises(ControlError, match=r"accel must have shape \(n, 125\)"):
+        block_features(np.ones((2, 100)), FeatureSpec())
 
 
 def test_plots_return_figures_with_one_line_per_run():

@@ -31,20 +31,32 @@ def test_stretched_design_spans_the_domain_and_stays_latin():
         assert np.max(np.diff(np.sort(design[:, col]))) <= 2.2 * width / 40
 
 
-def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path):
-    load_script().main(
-        ["--out", str(tmp_path), "--n-runs", "24", "--n-iter", "400", "--emulator-dir",
-         str(tmp_path)]
+def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypatch):
+    script = load_script()
+    shipped = {p: p.stat().st_mtime_ns for p in script.EMULATOR_DIR.glob("*.gpmsa")}
+    script.main(
+        ["--out", str(tmp_path), "--n-runs", "24", "--n-iter", "300", "--keep-s", "18"]
     )  # fmt: skip
     import gpmsa
 
+    # without --ship the package's emulators are left alone
+    assert {p: p.stat().st_mtime_ns for p in script.EMULATOR_DIR.glob("*.gpmsa")} == shipped
+    folder = tmp_path / "emulators"
     for case, noise in (("A", 0.0), ("B", 1.0)):
-        emu = gpmsa.load(tmp_path / f"jackal_{case}.gpmsa")
-        assert emu.metadata["noise_std"] == noise
-        assert emu.domain["v"] == pytest.approx((0.5, 2.0))
-        control.check_emulator(emu, model=vehicle.Jackal(), noise_std=noise)
+        for kind in ("band", "window"):
+            emu = gpmsa.load(folder / control.shipped.emulator_file_name(case, kind))
+            assert emu.metadata["noise_std"] == noise
+            assert emu.domain["v"] == pytest.approx((0.5, 2.0))
+            assert set(emu.metadata["versions"]) >= {"numpy", "scipy", "exudyn", "python"}
+            control.check_emulator(emu, model=vehicle.Jackal(), noise_std=noise)
+    band = gpmsa.load(folder / "jackal_A.gpmsa")
+    assert band.l_sim == 8 and "block_scatter" in band.metadata
     assert (tmp_path / "lhs_design.png").is_file()
     track = roadgen.track([(15, 300)], seed=1)
-    emu = gpmsa.load(tmp_path / "jackal_A.gpmsa")
-    r = control.run_closed_loop(track, emu, seed=1)
-    assert (r.status == "ok").any()
+    r = control.run_closed_loop(track, band, seed=1)
+    assert (r.status == "ok").mean() > 0.8
+
+
+def test_ship_and_emulator_dir_exclude_each_other(tmp_path):
+    with pytest.raises(SystemExit):
+        load_script().main(["--out", str(tmp_path), "--ship", "--emulator-dir", str(tmp_path)])

@@ -1,0 +1,182 @@
+"""Bayesian online change-point filter over GD: a posterior on (run length, GD) on a grid.
+
+Adams and MacKay (2007) track the run length r since the last change point; here the joint state
+P(r, GD | blocks so far) is kept exactly on a grid (run lengths in blocks, each with the distance
+it spans; GD uniform in log GD), so that the filter can use a segment-length law with memory and
+a jump law that depends on the GD before the change. One step per block, ds metres long:
+
+1. predict: a run of d metres ends within the next ds metres with the hazard
+   h(d) = 1 - S(d + ds) / S(d) of a gamma segment-length law (shape k, mean L; k = 1 is the
+   memoryless 1 - exp(-ds / L)); the mass that ends moves to run length 0 with GD redrawn by the
+   jump law T(GD -> GD'): the prior on GD' (log-uniform on the domain by default), times a
+   log-normal factor of the ratio GD'/GD (sd ``jump_sd``; None: no factor), and zero for
+   |log(GD'/GD)| < ``min_jump`` (a change smaller than that is not a change);
+2. update: every run length's GD posterior is multiplied by the block's likelihood.
+
+On steady ground the long run holds the mass and pools every block since the change; after a
+change the short runs take over within a few blocks. The marginal over r is the GD posterior; the
+run-length posterior gives the probability of a recent change.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import gammaincc
+
+from control.errors import ControlError
+from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
+
+PRIORS = ("log_uniform", "uniform")
+
+
+@dataclass(frozen=True)
+class ChangePointSettings:
+    """Settings of the change-point filter (see the module docstring).
+
+    Attributes:
+        mean_segment_m: expected distance between roughness changes L, m.
+        segment_shape: gamma shape k of the segment length (1: memoryless; 2: short segments
+            less likely, hazard rising from 0 to k / L).
+        min_jump: smallest |log(GD_new / GD_old)| counted as a change.
+        jump_sd: sd of log(GD_new / GD_old) at a change (None: GD_new from the prior alone).
+        prior: law of GD at the start and the base of the jump law: "log_uniform" (the
+            scale-invariant prior of a scale parameter) or "uniform" (the paper's eq. 3).
+        max_runs: run lengths kept (older ones are merged into the last).
+    """
+
+    mean_segment_m: float = 40.0
+    segment_shape: float = 2.0
+    min_jump: float = 0.15
+    jump_sd: float | None = 0.5
+    prior: str = "log_uniform"
+    max_runs: int = 300
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.mean_segment_m) and self.mean_segment_m > 0):
+            raise ControlError(f"mean_segment_m must be finite and > 0, got {self.mean_segment_m}")
+        if not (np.isfinite(self.segment_shape) and self.segment_shape > 0):
+            raise ControlError(f"segment_shape must be finite and > 0, got {self.segment_shape}")
+        if not (np.isfinite(self.min_jump) and self.min_jump >= 0):
+            raise ControlError(f"min_jump must be finite and >= 0, got {self.min_jump}")
+        if self.jump_sd is not None and not (np.isfinite(self.jump_sd) and self.jump_sd > 0):
+            raise ControlError(f"jump_sd must be None or finite and > 0, got {self.jump_sd}")
+        if self.prior not in PRIORS:
+            raise ControlError(f"prior must be one of {PRIORS}, got {self.prior!r}")
+        if not (isinstance(self.max_runs, int | np.integer) and self.max_runs >= 2):
+            raise ControlError(f"max_runs must be an integer >= 2, got {self.max_runs}")
+
+
+class ChangePointFilter:
+    """The filter on a fixed GD grid (native units, increasing, positive); see the module doc."""
+
+    def __init__(self, gd: np.ndarray, settings: ChangePointSettings | None = None) -> None:
+        gd = np.asarray(gd, dtype=float)
+        if gd.ndim != 1 or gd.size < 3 or np.any(np.diff(gd) <= 0) or gd[0] <= 0:
+            raise ControlError("gd must be an increasing 1-D grid of >= 3 positive values")
+        self.settings = s = settings or ChangePointSettings()
+        self.gd = gd
+        self._weights = trapezoid_weights(gd)
+        # prior mass per node: density (1/GD for log-uniform, 1 for uniform) times node weight
+        density = 1.0 / gd if s.prior == "log_uniform" else np.ones_like(gd)
+        prior = density * self._weights
+        self.prior = prior / prior.sum()
+        lg = np.log(gd)
+        jump = lg[None, :] - lg[:, None]
+        T = self.prior[None, :] * (np.abs(jump) >= s.min_jump)
+        if s.jump_sd is not None:
+            T = T * np.exp(-0.5 * (jump / s.jump_sd) ** 2)
+        rows = T.sum(axis=1, keepdims=True)
+        if np.any(rows <= 0):
+            raise ControlError(
+                f"min_jump = {s.min_jump} leaves no GD to jump to from some node of the domain "
+                f"[{gd[0]:g}, {gd[-1]:g}]"
+            )
+        self._jump = T / rows
+        self._scale = s.mean_segment_m / s.segment_shape
+        self.reset()
+
+    def reset(self) -> None:
+        """Back to the prior: no data, run length 0."""
+        self._mass = self.prior[None, :].copy()  # (R, G) joint P(r, GD)
+        self._dist = np.zeros(1)  # metres spanned by each run length
+        self._has_data = False
+
+    def _hazard(self, ds: float) -> np.ndarray:
+        """P(a run of d metres ends within the next ds metres), per run length (R,)."""
+        k, theta = self.settings.segment_shape, self._scale
+        if k == 1.0:
+            return np.full(self._dist.size, -np.expm1(-ds / theta))
+        s0 = gammaincc(k, self._dist / theta)
+        s1 = gammaincc(k, (self._dist + ds) / theta)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            h = 1.0 - s1 / s0
+        tail = -np.expm1(-ds / theta)  # the hazard's limit for long runs
+        return np.clip(np.where(s0 > 1e-250, h, tail), 0.0, 1.0)
+
+    def predict(self, ds_m: float) -> None:
+        """Propagate over ds_m metres (change points; GD unchanged within a run)."""
+        if not (np.isfinite(ds_m) and ds_m >= 0):
+            raise ControlError(f"ds_m must be finite and >= 0, got {ds_m}")
+        if not self._has_data:  # before any block the prior already is "a new segment"
+            self._dist = self._dist + ds_m
+            return
+        h = self._hazard(ds_m)
+        ended = (h[:, None] * self._mass).sum(axis=0)
+        mass = np.vstack([(ended @ self._jump)[None, :], self._mass * (1.0 - h)[:, None]])
+        dist = np.concatenate([[0.0], self._dist + ds_m])
+        R = self.settings.max_runs
+        if mass.shape[0] > R:
+            mass[R - 1] += mass[R:].sum(axis=0)
+            mass, dist = mass[:R], dist[:R]
+        self._mass, self._dist = mass / mass.sum(), dist
+
+    def update(self, loglik: np.ndarray, ds_m: float) -> None:
+        """One block ds_m metres long with log-likelihood ``loglik`` on the grid (G,)."""
+        loglik = np.asarray(loglik, dtype=float)
+        if loglik.shape != self.gd.shape or not np.all(np.isfinite(loglik)):
+            raise ControlError(f"loglik must hold {self.gd.size} finite values")
+        self.predict(ds_m)
+        mass = self._mass * np.exp(loglik - loglik.max())[None, :]
+        total = mass.sum()
+        if not total > 0:
+            raise ControlError("the block's likelihood has no mass on the grid")
+        self._mass = mass / total
+        self._has_data = True
+
+    def state(self) -> tuple:
+        """A copy of the filter's state (for `restore`)."""
+        return self._mass.copy(), self._dist.copy(), self._has_data
+
+    def restore(self, state: tuple) -> None:
+        """Return to a state taken by `state` (e.g. to undo a block found suspect later)."""
+        mass, dist, has_data = state
+        self._mass, self._dist, self._has_data = mass.copy(), dist.copy(), has_data
+
+    @property
+    def gd_mass(self) -> np.ndarray:
+        """Posterior mass of GD per grid node (G,)."""
+        return self._mass.sum(axis=0)
+
+    def prob_change_within(self, distance_m: float) -> float:
+        """P(the current segment began within the last ``distance_m`` metres)."""
+        if not self._has_data:
+            return float("nan")
+        return float(min(1.0, self._mass[self._dist <= distance_m].sum()))
+
+    def expected_run_m(self) -> float:
+        """Posterior mean of the distance since the last change, m."""
+        return float(self._mass.sum(axis=1) @ self._dist)
+
+    def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
+        """The GD posterior as a gpmsa Posterior holding the grid marginal (draws made lazily)."""
+        mass = self.gd_mass
+        with np.errstate(divide="ignore"):
+            log_density = np.log(mass) - np.log(self._weights)
+        marginal = GridMarginal.from_log_density(self.gd, log_density, self._weights)
+        return Posterior(
+            grids={name: marginal},
+            draw=lambda: {name: marginal.sample(np.random.default_rng(0), n_draws)},
+            info={"method": "changepoint", "names": (name,)},
+        )

@@ -1,0 +1,90 @@
+"""Injected sensor faults: what a failing accelerometer, clock or odometer does to the samples."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from control.errors import ControlError
+
+FAULT_KINDS = (
+    "nan",  # the accelerometer reads NaN
+    "drop",  # the samples never arrive
+    "spike",  # every `magnitude`-th sample is replaced by +-1e6 m/s^2 (magnitude: spacing >= 1)
+    "noise",  # N(0, magnitude^2) m/s^2 added
+    "scale",  # the acceleration multiplied by magnitude
+    "quantize",  # rounded to steps of magnitude m/s^2
+    "stuck",  # the last good value repeated
+    "clip",  # clipped to +-magnitude m/s^2
+    "time_nan",  # the time stamps read NaN
+    "position_nan",  # the odometry reads NaN
+)
+
+
+@dataclass(frozen=True)
+class SensorFault:
+    """An injected fault over [start_s, start_s + duration_s) of sample time.
+
+    Attributes:
+        start_s: time the fault begins, s.
+        duration_s: how long it lasts, s.
+        kind: one of FAULT_KINDS (see there for what ``magnitude`` means).
+        magnitude: the fault's size (kind-dependent; ignored by nan, drop, stuck, time_nan,
+            position_nan).
+    """
+
+    start_s: float
+    duration_s: float
+    kind: str = "nan"
+    magnitude: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.start_s) and self.start_s >= 0):
+            raise ControlError(f"start_s must be >= 0, got {self.start_s}")
+        if not (np.isfinite(self.duration_s) and self.duration_s > 0):
+            raise ControlError(f"duration_s must be > 0, got {self.duration_s}")
+        if self.kind not in FAULT_KINDS:
+            raise ControlError(f"kind must be one of {FAULT_KINDS}, got {self.kind!r}")
+        if not (np.isfinite(self.magnitude) and self.magnitude > 0):
+            raise ControlError(f"magnitude must be finite and > 0, got {self.magnitude}")
+        if self.kind == "spike" and self.magnitude < 1:
+            raise ControlError(f"a spike fault's magnitude is a spacing >= 1, got {self.magnitude}")
+
+
+def apply_faults(t, position, accel, speed, faults, rng: np.random.Generator):
+    """(t, position, accel, speed) of a sample batch with the faults applied (copies)."""
+    t = np.array(t, dtype=float)
+    pos = np.array(position, dtype=float)
+    acc = np.array(accel, dtype=float)
+    spd = np.array(speed, dtype=float)
+    keep = np.ones(t.size, dtype=bool)
+    clock = t.copy()
+    for fault in faults:
+        hit = (clock >= fault.start_s) & (clock < fault.start_s + fault.duration_s)
+        if not hit.any():
+            continue
+        k, m = fault.kind, fault.magnitude
+        if k == "nan":
+            acc[hit] = np.nan
+        elif k == "drop":
+            keep &= ~hit
+        elif k == "spike":
+            idx = np.flatnonzero(hit)[:: max(1, int(m))]
+            acc[idx] = 1e6 * np.where(np.arange(idx.size) % 2, 1.0, -1.0)
+        elif k == "noise":
+            acc[hit] += rng.normal(0.0, m, int(hit.sum()))
+        elif k == "scale":
+            acc[hit] *= m
+        elif k == "quantize":
+            acc[hit] = np.round(acc[hit] / m) * m
+        elif k == "stuck":
+            first = int(np.flatnonzero(hit)[0])  # held within each batch of samples
+            acc[hit] = acc[max(first - 1, 0)]
+        elif k == "clip":
+            acc[hit] = np.clip(acc[hit], -m, m)
+        elif k == "time_nan":
+            t[hit] = np.nan
+        elif k == "position_nan":
+            pos[hit] = np.nan
+    return t[keep], pos[keep], acc[keep], spd[keep]

@@ -1,0 +1,202 @@
+"""The emulator's likelihood of one block's feature vector, and the plausibility of the block.
+
+The emulator (a gpmsa multivariate emulator, trained on the *expected* feature of a block: the
+mean over many blocks of each training run) gives the mean mu(v, GD) of the feature; the
+block-to-block scatter about it is a known observation covariance Sigma(v) learned from the same
+campaign (`BlockScatter`). One block y at speed v has the likelihood
+
+    p(y | GD) = t_nu(y; mu(v, GD), Sigma(v))   (a multivariate Student t; nu = inf: Gaussian)
+
+evaluated on a grid of GD (uniform in log GD over the emulator's domain). mu is tabulated once on
+(speed, GD) nodes from the emulator's point estimate and interpolated linearly in speed;
+Sigma(v) likewise. Blocks are disjoint and their features nearly independent (lag-1 correlation
+0.0-0.15; Sigma is the long-run covariance, so that pooled blocks are not over-counted).
+
+Plausibility: the squared Mahalanobis distance of y from the nearest mu(v, GD) over the whole GD
+domain; under the model d2 / K follows an F(K, nu) law (chi-square for nu = inf), so a block that
+no GD in the domain explains has a tiny upper-tail probability.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+from scipy import stats
+from scipy.linalg import cholesky, solve_triangular
+from threadpoolctl import ThreadpoolController
+
+from control.errors import ControlError, EmulatorMismatchError
+
+
+@dataclass(frozen=True, eq=False)
+class BlockScatter:
+    """Covariance of one block's feature about its expected value, as a function of speed.
+
+    Attributes:
+        speed: (n,) speed nodes, m/s, increasing.
+        cov: (n, K, K) covariance of the feature at each node (long-run: batch means of
+            consecutive blocks, so that correlation between neighbouring blocks is included).
+        dof: degrees of freedom nu of the Student-t block law (inf: Gaussian).
+    """
+
+    speed: np.ndarray
+    cov: np.ndarray
+    dof: float = np.inf
+
+    def __post_init__(self) -> None:
+        s = np.asarray(self.speed, dtype=float)
+        c = np.asarray(self.cov, dtype=float)
+        if s.ndim != 1 or s.size < 2 or np.any(np.diff(s) <= 0) or not np.all(np.isfinite(s)):
+            raise ControlError(f"speed must be >= 2 increasing finite nodes, got {s}")
+        if c.ndim != 3 or c.shape[0] != s.size or c.shape[1] != c.shape[2]:
+            raise ControlError(f"cov must have shape ({s.size}, K, K), got {c.shape}")
+        if not np.all(np.isfinite(c)) or np.any(np.linalg.eigvalsh(c)[:, 0] <= 0):
+            raise ControlError("cov must hold finite, positive-definite matrices")
+        if not (self.dof > 2):
+            raise ControlError(f"dof must be > 2 (or inf), got {self.dof}")
+        object.__setattr__(self, "speed", s)
+        object.__setattr__(self, "cov", c)
+        object.__setattr__(self, "dof", float(self.dof))
+
+    def to_dict(self) -> dict:
+        """JSON-able form (stored in the emulator's metadata as ``block_scatter``)."""
+        return {
+            "speed_mps": self.speed.tolist(),
+            "cov": self.cov.tolist(),
+            "dof": None if np.isinf(self.dof) else self.dof,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict) -> BlockScatter:
+        """Inverse of `to_dict`."""
+        try:
+            dof = np.inf if d.get("dof") is None else float(d["dof"])
+            return cls(np.asarray(d["speed_mps"], float), np.asarray(d["cov"], float), dof)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise EmulatorMismatchError(
+                f"the emulator's block_scatter is malformed: {exc}"
+            ) from exc
+
+
+class ObservationModel:
+    """Likelihood of GD on a grid for one block feature (see the module docstring).
+
+    Args:
+        emulator: a gpmsa Emulator with one known input (speed, m/s), one calibration parameter
+            (GD) and K outputs (the feature), whose ``metadata["block_scatter"]`` holds the
+            `BlockScatter` (or pass ``scatter``).
+        scatter: the block scatter (default: from the emulator's metadata).
+        n_grid: GD nodes, uniform in log GD over the emulator's GD domain.
+        n_speed: speed nodes of the mean table over the emulator's speed domain.
+    """
+
+    def __init__(
+        self, emulator, scatter: BlockScatter | None = None, n_grid: int = 121, n_speed: int = 31
+    ) -> None:
+        if emulator.p != 1 or emulator.q != 1:
+            raise EmulatorMismatchError(
+                f"the block likelihood needs one known input (speed) and one calibration "
+                f"parameter (GD); the emulator has p = {emulator.p}, q = {emulator.q}"
+            )
+        if scatter is None:
+            meta = getattr(emulator, "metadata", None) or {}
+            if "block_scatter" not in meta:
+                raise EmulatorMismatchError(
+                    "the emulator's metadata has no 'block_scatter' (the per-block observation "
+                    "covariance): it was not trained for the block feature "
+                    "(examples/train_emulator.py writes it)"
+                )
+            scatter = BlockScatter.from_dict(meta["block_scatter"])
+        if scatter.cov.shape[1] != emulator.l_sim:
+            raise EmulatorMismatchError(
+                f"block_scatter is {scatter.cov.shape[1]}-dimensional but the emulator has "
+                f"{emulator.l_sim} outputs"
+            )
+        if not (isinstance(n_grid, int | np.integer) and n_grid >= 16):
+            raise ControlError(f"n_grid must be an integer >= 16, got {n_grid}")
+        if not (isinstance(n_speed, int | np.integer) and n_speed >= 2):
+            raise ControlError(f"n_speed must be an integer >= 2, got {n_speed}")
+        self.emulator = emulator
+        self.scatter = scatter
+        (v_lo, v_hi) = emulator.domain[emulator.x_names[0]]
+        (g_lo, g_hi) = emulator.domain[emulator.t_names[0]]
+        self.speed_range = (float(v_lo), float(v_hi))
+        self.gd = np.geomspace(g_lo, g_hi, int(n_grid))
+        self.speed = np.linspace(v_lo, v_hi, int(n_speed))
+        V, G = np.meshgrid(self.speed, self.gd, indexing="ij")
+        mean, _ = emulator.predict(V.ravel(), G.ravel(), resid=False)
+        self._mean = mean.reshape(self.speed.size, self.gd.size, -1)  # (S, G, K)
+        self.dim = self._mean.shape[2]
+        self._last = None
+        nu, K = scatter.dof, self.dim
+        self._log_norm = (
+            -0.5 * K * np.log(2 * np.pi)
+            if np.isinf(nu)
+            else float(stats.multivariate_t.logpdf(np.zeros(K), np.zeros(K), np.eye(K), df=nu))
+        )
+
+    def _at(self, v: float) -> tuple[np.ndarray, np.ndarray]:
+        """(mean (G, K), lower Cholesky factor of Sigma (K, K)) at speed v (linear in v)."""
+        lo, hi = self.speed_range
+        if not lo - 1e-9 * (hi - lo) <= v <= hi + 1e-9 * (hi - lo):
+            raise ControlError(f"speed {v:.4g} m/s outside the emulator's range [{lo:g}, {hi:g}]")
+        x = np.clip((v - lo) / (hi - lo) * (self.speed.size - 1), 0, self.speed.size - 1)
+        i = min(int(x), self.speed.size - 2)
+        a = x - i
+        mean = (1 - a) * self._mean[i] + a * self._mean[i + 1]
+        chol = cholesky(_interp_cov(self.scatter, v), lower=True)
+        return mean, chol
+
+    def _mahalanobis(self, y: np.ndarray, v: float) -> tuple[np.ndarray, float]:
+        """Squared Mahalanobis distances of y from the mean at every GD node (G,), and half the
+        log-determinant of Sigma(v). The last call is remembered (the BCR asks twice)."""
+        y = np.asarray(y, dtype=float).reshape(-1)
+        if y.size != self.dim or not np.all(np.isfinite(y)):
+            raise ControlError(f"y must hold {self.dim} finite values, got {y}")
+        key = (y.tobytes(), float(v))
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        mean, chol = self._at(float(v))
+        with _blas().limit(limits=1, user_api="blas"):  # tiny solves: threads only cost
+            r = solve_triangular(chol, (y[None, :] - mean).T, lower=True)  # (K, G)
+        out = np.sum(r**2, axis=0), float(np.sum(np.log(np.diag(chol))))
+        self._last = (key, out)
+        return out
+
+    def loglik(self, y: np.ndarray, v: float) -> np.ndarray:
+        """log p(y | GD) on ``self.gd`` (G,), all constants included.
+
+        Args:
+            y: (K,) the block's feature. v: the block's mean speed, m/s.
+        """
+        d2, half_logdet = self._mahalanobis(y, v)
+        K, nu = self.dim, self.scatter.dof
+        kernel = -0.5 * d2 if np.isinf(nu) else -0.5 * (nu + K) * np.log1p(d2 / nu)
+        return self._log_norm + kernel - half_logdet
+
+    def plausibility(self, y: np.ndarray, v: float) -> tuple[float, float]:
+        """(d2, p): the smallest squared Mahalanobis distance of y over the GD domain and its
+        upper-tail probability under the block law (F(K, nu) of d2 / K; chi-square(K) for a
+        Gaussian). A small p means that no GD in the domain explains the block."""
+        d2, _ = self._mahalanobis(y, v)
+        d2_min = float(np.min(d2))
+        K, nu = self.dim, self.scatter.dof
+        p = stats.chi2.sf(d2_min, K) if np.isinf(nu) else stats.f.sf(d2_min / K, K, nu)
+        return d2_min, float(p)
+
+
+@cache
+def _blas() -> ThreadpoolController:
+    """The process's BLAS libraries, scanned once."""
+    return ThreadpoolController()
+
+
+def _interp_cov(scatter: BlockScatter, v: float) -> np.ndarray:
+    """Sigma(v): linear interpolation between the scatter's speed nodes (constant beyond)."""
+    s = scatter.speed
+    x = float(np.clip(v, s[0], s[-1]))
+    i = min(int(np.searchsorted(s, x, side="right")) - 1, s.size - 2)
+    a = (x - s[i]) / (s[i + 1] - s[i])
+    return (1 - a) * scatter.cov[i] + a * scatter.cov[i + 1]

@@ -1,0 +1,113 @@
+"""Training data for the block feature: expected features and the block scatter from a campaign.
+
+Each campaign run drives one fresh road at one (v, GD) for ``keep_s`` seconds
+(`vehicle.run_campaign(..., keep_s=...)`). Its blocks give
+
+- the run's mean feature: an estimate of the expected feature at (v, GD) with a Monte-Carlo error
+  of about sd / sqrt(blocks); the emulator is fitted to these means, so its nugget describes that
+  small error instead of one block's scatter;
+- the run's block-to-block covariance about its mean, as a long-run covariance (batch means of
+  ``batch`` consecutive blocks, times ``batch``), so that correlation between neighbouring
+  blocks is counted when the filter pools them. Pooled over runs and smoothed in speed, it is
+  the known observation covariance Sigma(v) of one block (`BlockScatter`), with the Student-t
+  degrees of freedom that fit the blocks' squared Mahalanobis distances.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize, stats
+
+from control.errors import ControlError
+from control.feature import FeatureSpec, block_features
+from control.observation_model import BlockScatter
+
+
+@dataclass(frozen=True, eq=False)
+class BlockStatistics:
+    """Per-run block statistics of a campaign.
+
+    Attributes:
+        mean: (m, K) mean feature of each run.
+        cov: (m, K, K) long-run block covariance of each run.
+        features: (m, n_blocks, K) every block's feature.
+    """
+
+    mean: np.ndarray
+    cov: np.ndarray
+    features: np.ndarray
+
+
+def block_statistics(accel: np.ndarray, spec: FeatureSpec, batch: int = 8) -> BlockStatistics:
+    """Block features of each run's accelerations and their mean and long-run covariance.
+
+    Args:
+        accel: (m, n) accelerations of m runs, m/s^2 (e.g. ``Campaign.accel_measured``).
+        spec: the block feature.
+        batch: blocks per batch of the long-run covariance.
+    """
+    accel = np.asarray(accel, dtype=float)
+    B = spec.block_samples
+    if accel.ndim != 2 or accel.shape[1] < 2 * batch * B:
+        raise ControlError(
+            f"accel must be (runs, samples) with >= {2 * batch * B} samples per run (two batches "
+            f"of {batch} blocks of {B}), got shape {accel.shape}"
+        )
+    if not np.all(np.isfinite(accel)):
+        raise ControlError("accel holds non-finite values (failed runs?): leave those runs out")
+    n_blocks = accel.shape[1] // B
+    blocks = accel[:, : n_blocks * B].reshape(-1, B)
+    feats = block_features(blocks, spec).reshape(accel.shape[0], n_blocks, spec.dim)
+    if not np.all(np.isfinite(feats)):
+        raise ControlError("a block of the campaign has no power in a band")
+    mean = feats.mean(axis=1)
+    dev = feats - mean[:, None, :]
+    n_batch = n_blocks // batch
+    batches = dev[:, : n_batch * batch].reshape(accel.shape[0], n_batch, batch, -1).mean(axis=2)
+    cov = np.einsum("rbi,rbj->rij", batches, batches) / (n_batch - 1) * batch
+    return BlockStatistics(mean=mean, cov=cov, features=feats)
+
+
+def block_scatter(
+    speed: np.ndarray,
+    stats_: BlockStatistics,
+    nodes: np.ndarray | None = None,
+    bandwidth: float = 0.15,
+) -> BlockScatter:
+    """Sigma(v) at speed nodes: the runs' long-run covariances averaged with Gaussian kernel
+    weights in speed (``bandwidth``, m/s), and the Student-t dof fitted to the blocks.
+
+    Args:
+        speed: (m,) the runs' speeds, m/s.
+        stats_: their `block_statistics`.
+        nodes: speed nodes (default 16 over the runs' range).
+    """
+    speed = np.asarray(speed, dtype=float)
+    if speed.shape != (stats_.mean.shape[0],):
+        raise ControlError(f"speed must have one value per run ({stats_.mean.shape[0]})")
+    nodes = np.linspace(speed.min(), speed.max(), 16) if nodes is None else np.asarray(nodes)
+    w = np.exp(-0.5 * ((nodes[:, None] - speed[None, :]) / bandwidth) ** 2)
+    w /= w.sum(axis=1, keepdims=True)
+    cov = np.einsum("sr,rij->sij", w, stats_.cov)
+    return BlockScatter(nodes, cov, _fit_dof(speed, stats_, nodes, cov))
+
+
+def _fit_dof(speed, stats_: BlockStatistics, nodes, cov) -> float:
+    """Student-t dof by maximum likelihood of the blocks' squared Mahalanobis distances about
+    their run means (d2 / K ~ F(K, nu)); inf when the Gaussian fits as well."""
+    K = stats_.mean.shape[1]
+    d2 = []
+    for r in range(speed.size):
+        c = cov[int(np.argmin(np.abs(nodes - speed[r])))]
+        dev = stats_.features[r] - stats_.mean[r]
+        d2.append(np.einsum("bi,ij,bj->b", dev, np.linalg.inv(c), dev))
+    x = np.concatenate(d2) / K
+
+    def nll(log_nu: float) -> float:
+        return -float(np.sum(stats.f.logpdf(x, K, np.exp(log_nu))))
+
+    res = optimize.minimize_scalar(nll, bounds=(np.log(2.5), np.log(1000.0)), method="bounded")
+    gauss = -float(np.sum(stats.chi2.logpdf(x * K, K) + np.log(K)))
+    return float(np.exp(res.x)) if res.fun < gauss - 1.0 else np.inf

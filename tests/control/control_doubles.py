@@ -1,0 +1,93 @@
+"""Test doubles for control: a calibrator and a block model with known likelihoods, and a
+synthetic sensor stream."""
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from gpmsa.model.transforms import Standardizer
+
+C = 0.05  # f = C * GD * v**1.3 (m/s^2)^2, a made-up but realistic-looking law
+SIGMA = 0.06  # spread of log f for one 1,000-sample window of white noise (sqrt(2/1000) ~ 0.045)
+
+
+def log_f(v, gd):
+    return np.log(C) + np.log(gd) + 1.3 * np.log(v)
+
+
+class FakeCalibrator:
+    """Gaussian likelihood of y = log f on a grid: the part of gpmsa.Calibrator the BCR uses."""
+
+    def __init__(self, metadata=None, v_range=(0.5, 2.0)):
+        self.emulator = SimpleNamespace(
+            domain={"v": tuple(v_range), "GD": (200.0, 600.0)},
+            standardizer=Standardizer(
+                x_min=np.array([v_range[0]]),
+                x_max=np.array([v_range[1]]),
+                t_min=np.array([200.0]),
+                t_max=np.array([600.0]),
+                y_mean=np.zeros(1),
+                y_sd=1.0,
+                grid=np.zeros(1),
+            ),
+            x_names=["v"],
+            t_names=["GD"],
+            metadata=metadata or {},
+        )
+        self.grid = np.linspace(200.0, 600.0, 401)
+        self.calls = 0
+
+    def log_likelihood_grid(self, x_obs, y_obs):
+        self.calls += 1
+        v = float(np.asarray(x_obs).ravel()[0])
+        y = float(np.asarray(y_obs).ravel()[0])
+        return self.grid, -0.5 * ((y - log_f(v, self.grid)) / SIGMA) ** 2
+
+
+def stream(gd_of_position, speed, duration_s, rate_hz=120.0, seed=0, t0=0.0, s0=0.0):
+    """White-noise accelerations whose variance follows f = C GD v^1.3 at constant speed."""
+    rng = np.random.default_rng(seed)
+    n = int(round(duration_s * rate_hz))
+    t = t0 + np.arange(1, n + 1) / rate_hz
+    pos = s0 + speed * (t - t0)
+    f = np.exp(log_f(speed, gd_of_position(pos)))
+    acc = rng.standard_normal(n) * np.sqrt(f)
+    return t, pos, acc, np.full(n, float(speed))
+
+
+class FakeBlockModel:
+    """The part of control.ObservationModel the BCR uses, for white-noise blocks of `stream`.
+
+    The band feature of a white-noise block is log f + m (m fixed by the bands and tapers), with
+    a fixed covariance: both are estimated once from unit-variance noise, so the likelihood of
+    GD for a `stream` block is exactly Gaussian in the feature.
+    """
+
+    def __init__(self, spec=None, v_range=(0.5, 2.0)):
+        from control.feature import FeatureSpec, block_features
+
+        self.spec = spec or FeatureSpec()
+        unit = np.random.default_rng(123).standard_normal((8000, self.spec.block_samples))
+        feats = block_features(unit, self.spec)
+        self.offset = feats.mean(axis=0)
+        self.chol = np.linalg.cholesky(np.cov(feats.T))
+        self.dim = feats.shape[1]
+        self.gd = np.geomspace(200.0, 600.0, 121)
+        self.speed_range = tuple(v_range)
+        self.emulator = SimpleNamespace(t_names=["GD"], x_names=["v"])
+        self.calls = 0
+
+    def _d2(self, y, v):
+        mean = log_f(v, self.gd)[:, None] + self.offset[None, :]
+        r = np.linalg.solve(self.chol, (np.asarray(y)[None, :] - mean).T)
+        return np.sum(r**2, axis=0)
+
+    def loglik(self, y, v):
+        self.calls += 1
+        return -0.5 * self._d2(y, v)
+
+    def plausibility(self, y, v):
+        from scipy.stats import chi2
+
+        d2 = float(np.min(self._d2(y, v)))
+        return d2, float(chi2.sf(d2, self.dim))

@@ -1,0 +1,91 @@
+"""The change-point filter on (run length, GD): mass, hazard, pooling, detection, state."""
+
+import numpy as np
+import pytest
+
+from control import ChangePointFilter, ChangePointSettings, ControlError
+
+GD = np.geomspace(200.0, 600.0, 121)
+
+
+def gauss_loglik(gd_true, sd_log=0.3):
+    return -0.5 * ((np.log(GD) - np.log(gd_true)) / sd_log) ** 2
+
+
+def test_the_prior_is_log_uniform_or_uniform():
+    log_u = ChangePointFilter(GD).posterior()
+    # log-uniform on [200, 600]: median at sqrt(200 * 600)
+    assert log_u.quantile("GD", 0.5) == pytest.approx(np.sqrt(200 * 600), rel=0.01)
+    uni = ChangePointFilter(GD, ChangePointSettings(prior="uniform")).posterior()
+    assert uni.mean("GD") == pytest.approx(400.0, rel=0.01)
+
+
+def test_steady_blocks_pool_and_the_mass_stays_normalised():
+    f = ChangePointFilter(GD)
+    sds = []
+    for _ in range(60):
+        f.update(gauss_loglik(300.0), 1.5)
+        assert f.gd_mass.sum() == pytest.approx(1.0)
+        sds.append(f.posterior().sd("GD"))
+    assert sds[-1] < 0.4 * sds[0]  # the change hypotheses keep it wider than 1 / sqrt(n)
+    assert f.posterior().mean("GD") == pytest.approx(300.0, rel=0.03)
+    assert f.prob_change_within(5.0) < 0.15 and f.expected_run_m() > 40
+
+
+def test_a_step_is_detected_and_the_old_blocks_forgotten():
+    f = ChangePointFilter(GD)
+    for _ in range(40):
+        f.update(gauss_loglik(300.0), 1.5)
+    means, changes = [], []
+    for _ in range(10):
+        f.update(gauss_loglik(500.0), 1.5)
+        means.append(f.posterior().mean("GD"))
+        changes.append(f.prob_change_within(10.0))
+    assert means[-1] == pytest.approx(500.0, rel=0.05)
+    assert max(changes[:4]) > 0.5
+    assert np.argmax(np.array(means) > 400) <= 4  # within a few 1.5 m blocks
+
+
+def test_the_hazard_of_a_gamma_segment_length():
+    s = ChangePointSettings(mean_segment_m=40.0, segment_shape=1.0)
+    f = ChangePointFilter(GD, s)
+    f.update(gauss_loglik(300.0), 0.0)
+    f.predict(10.0)  # memoryless: P(change within 10 m) = 1 - exp(-10 / 40)
+    assert f.prob_change_within(0.0) == pytest.approx(1 - np.exp(-0.25), rel=1e-9)
+    g = ChangePointFilter(GD, ChangePointSettings(mean_segment_m=40.0, segment_shape=2.0))
+    g.update(gauss_loglik(300.0), 0.0)
+    g.predict(10.0)  # shape 2: a new segment rarely ends in its first metres
+    assert g.prob_change_within(0.0) < f.prob_change_within(0.0)
+
+
+def test_the_jump_law_excludes_small_changes():
+    f = ChangePointFilter(GD, ChangePointSettings(min_jump=0.3, jump_sd=None))
+    row = f._jump[np.argmin(np.abs(GD - 350.0))]
+    near = np.abs(np.log(GD / 350.0)) < 0.3
+    assert row[near].sum() == 0 and row.sum() == pytest.approx(1.0)
+
+
+def test_state_and_restore_undo_a_block():
+    f = ChangePointFilter(GD)
+    f.update(gauss_loglik(300.0), 1.0)
+    saved = f.state()
+    before = f.gd_mass.copy()
+    f.update(gauss_loglik(550.0), 1.0)
+    f.restore(saved)
+    np.testing.assert_array_equal(f.gd_mass, before)
+
+
+def test_bad_settings_and_inputs():
+    with pytest.raises(ControlError, match="mean_segment_m must be finite and > 0"):
+        ChangePointSettings(mean_segment_m=0.0)
+    with pytest.raises(ControlError, match="prior must be one of"):
+        ChangePointSettings(prior="jeffreys")
+    with pytest.raises(ControlError, match="leaves no GD to jump to"):
+        ChangePointFilter(GD, ChangePointSettings(min_jump=5.0))
+    f = ChangePointFilter(GD)
+    with pytest.raises(ControlError, match="loglik must hold 121 finite values"):
+        f.update(np.full(121, np.nan), 1.0)
+    with pytest.raises(ControlError, match="ds_m must be finite and >= 0"):
+        f.predict(-1.0)
+    with pytest.raises(ControlError, match="increasing 1-D grid"):
+        ChangePointFilter(np.array([3.0, 2.0, 1.0]))

@@ -1,0 +1,85 @@
+"""The block likelihood from the shipped emulator, the block scatter and the training helpers."""
+
+import numpy as np
+import pytest
+
+import control
+from control import BlockScatter, ControlError, EmulatorMismatchError, ObservationModel
+from control.sensor_checks import SensorLimits, level_jump, longest_repeat, signal_fault
+from control.training import block_scatter, block_statistics
+
+
+@pytest.fixture(scope="module")
+def model():
+    return ObservationModel(control.shipped_emulator("A"))
+
+
+def test_the_likelihood_peaks_where_the_emulator_says_the_feature_is(model):
+    for v, gd in ((1.0, 300.0), (1.6, 450.0)):
+        mean, _ = model.emulator.predict([[v]], [[gd]], resid=False)
+        ll = model.loglik(mean[0], v)
+        assert ll.shape == model.gd.shape and np.all(np.isfinite(ll))
+        assert model.gd[np.argmax(ll)] == pytest.approx(gd, rel=0.02)
+        d2, p = model.plausibility(mean[0], v)
+        assert d2 < 1e-3 and p > 0.99
+
+
+def test_blocks_that_no_gd_explains_are_implausible(model):
+    mean, _ = model.emulator.predict([[1.5]], [[300.0]], resid=False)
+    for shift in (-7.0, 7.0):  # the signal scaled by ~1/30 or ~30
+        _, p = model.plausibility(mean[0] + shift, 1.5)
+        assert p < 1e-12
+    shape = mean[0] + np.linspace(-3, 3, 8)  # a spectrum no road makes
+    assert model.plausibility(shape, 1.5)[1] < 1e-6
+
+
+def test_bad_inputs_to_the_model(model):
+    with pytest.raises(ControlError, match="y must hold 8 finite values"):
+        model.loglik(np.ones(7), 1.0)
+    with pytest.raises(ControlError, match="outside the emulator's range"):
+        model.loglik(np.ones(8), 3.0)
+    with pytest.raises(EmulatorMismatchError, match="no 'block_scatter'"):
+        ObservationModel(control.shipped_emulator("A", "window"))
+
+
+def test_block_statistics_and_scatter_of_white_noise():
+    rng = np.random.default_rng(0)
+    spec = control.FeatureSpec()
+    accel = rng.standard_normal((12, 125 * 40)) * np.linspace(1.0, 3.0, 12)[:, None]
+    stats_ = block_statistics(accel, spec)
+    assert stats_.mean.shape == (12, 8) and stats_.cov.shape == (12, 8, 8)
+    # a scale of the signal shifts every band by 2 log(scale)
+    np.testing.assert_allclose(stats_.mean[-1] - stats_.mean[0], 2 * np.log(3.0), atol=0.25)
+    speed = np.linspace(0.5, 2.0, 12)
+    scatter = block_scatter(speed, stats_, nodes=np.linspace(0.5, 2.0, 4))
+    assert scatter.cov.shape == (4, 8, 8) and scatter.dof > 2
+    again = BlockScatter.from_dict(scatter.to_dict())
+    np.testing.assert_array_equal(again.cov, scatter.cov)
+    with pytest.raises(ControlError, match="non-finite values"):
+        block_statistics(np.full((2, 125 * 40), np.nan), spec)
+    with pytest.raises(ControlError, match="samples per run"):
+        block_statistics(np.ones((2, 100)), spec)
+    with pytest.raises(ControlError, match="positive-definite"):
+        BlockScatter(np.array([1.0, 2.0]), np.zeros((2, 8, 8)))
+
+
+def test_signal_checks_name_what_a_healthy_sensor_never_does():
+    rng = np.random.default_rng(1)
+    a = rng.standard_normal(125) * 3
+    limits = SensorLimits()
+    assert signal_fault(a, limits) == ""
+    stuck = a.copy()
+    stuck[40:60] = stuck[40]
+    assert "stuck sensor: 20 identical" in signal_fault(stuck, limits)
+    assert "quantised" in signal_fault(np.round(a / 4) * 4, limits)
+    assert "clipped signal" in signal_fault(np.clip(a, -1.5, 1.5), limits)
+    plateau = a.copy()
+    plateau[a < -2] = -9.81  # a wheel in the air: one end only, not clipping
+    assert signal_fault(plateau, limits) == ""
+    drop = a.copy()
+    drop[70:] *= 0.01
+    assert "level jumps" in signal_fault(drop, limits)
+    assert longest_repeat(np.array([1.0, 1.0, 2.0, 2.0, 2.0])) == 3
+    assert level_jump(a)[0] < 10
+    with pytest.raises(ControlError, match="max_repeats must be an integer >= 1"):
+        SensorLimits(max_repeats=0)
