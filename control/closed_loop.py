@@ -81,7 +81,8 @@ class ClosedLoopResult:
     credible interval; NaN when there is no estimate), ``gd_true`` (prescribed GD at the position),
     ``status`` (str), ``reason`` (str), ``prob_change`` (P(a change within the BCR's
     recent_change_m)), ``command`` (m/s), ``mode`` ("performance"/"safety"), ``latency_s``.
-    Per sensor sample (length n): ``sample_time``, ``sample_position``, ``sample_speed``.
+    Per sensor sample (length n): ``sample_time``, ``sample_position``, ``sample_speed``,
+    ``sample_accel`` (the measured front-axle acceleration, m/s^2, before injected faults).
     """
 
     time: np.ndarray
@@ -99,6 +100,7 @@ class ClosedLoopResult:
     sample_time: np.ndarray
     sample_position: np.ndarray
     sample_speed: np.ndarray
+    sample_accel: np.ndarray
     metrics: LoopMetrics
     settings: dict = field(default_factory=dict)
 
@@ -170,7 +172,7 @@ def run_closed_loop(
     limit = 20.0 * float(track.length_m) / simplex.v_safe if max_time_s is None else max_time_s
 
     rows: list[tuple[Estimate, object]] = []
-    s_t, s_pos, s_spd = [], [], []
+    s_t, s_pos, s_spd, s_acc = [], [], [], []
     tic = _time.perf_counter()
     command = simplex.command(estimator.last)
     bar = tqdm(total=round(float(track.length_m)), unit="m", disable=not progress, leave=False)
@@ -186,6 +188,7 @@ def run_closed_loop(
         s_t.append(np.asarray(samples.t, dtype=float))
         s_pos.append(np.asarray(samples.position, dtype=float))
         s_spd.append(np.asarray(samples.speed, dtype=float))
+        s_acc.append(np.asarray(samples.accel_front, dtype=float))
         observed = apply_faults(
             samples.t, samples.position, samples.accel_front, samples.speed, faults, fault_rng
         )
@@ -206,6 +209,7 @@ def run_closed_loop(
     sample_time = np.concatenate(s_t) if s_t else np.empty(0)
     sample_position = np.concatenate(s_pos) if s_pos else np.empty(0)
     sample_speed = np.concatenate(s_spd) if s_spd else np.empty(0)
+    sample_accel = np.concatenate(s_acc) if s_acc else np.empty(0)
     latencies = np.array([e.latency_s for e in ests if e.ok])
     seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
     gd_true = seg_gd[segment_index(track, position)]
@@ -241,6 +245,7 @@ def run_closed_loop(
         sample_time=sample_time,
         sample_position=sample_position,
         sample_speed=sample_speed,
+        sample_accel=sample_accel,
         metrics=metrics,
         settings={
             "noise_std": noise_std,
