@@ -283,6 +283,11 @@ class Emulator:
         variances by the law of total variance. ``resid`` adds the nugget 1/lamWs and the residual
         variance 1/lamWOs (the spread of a new simulation run about the smooth emulator).
         """
+        n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
+        check_memory(
+            8.0 * n * (4.0 * self.m + 6.0 * self.l_sim + 4.0 * (self.p + self.q)),
+            f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs)",
+        )
         z = self._inputs(x, t)
         s = self.standardizer
         if not draws:
