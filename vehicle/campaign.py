@@ -25,6 +25,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import roadgen
+from vehicle import checks
 from vehicle.design import check_design, lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
 from vehicle.models import Jackal, Model, check_model
@@ -157,6 +158,7 @@ def run_campaign(
         Campaign. A run that fails (diverges) is recorded with NaN f and its message.
     """
     model = Jackal() if model is None else check_model(model)
+    seed = checks.seed("seed", seed, generator=False)
     design = lhs_design(198, seed=seed) if design is None else design
     points = check_design(design, model)
     if not (isinstance(window, (int, np.integer)) and window >= 2):
@@ -169,6 +171,7 @@ def run_campaign(
             f"{np.max(points[:, 0]):.4g} m/s after the lead-in ({lead_in_m} m) needs "
             f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
         )
+    roadgen.profile.grid_points(float(road_length_m), float(dx_m))  # one road fits in memory
     seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
     specs = [
         RunSpec(model, float(v), float(gd), int(s), float(road_length_m), float(dx_m),
@@ -208,6 +211,7 @@ def run_campaign(
         "seed": int(seed),
         "f_full": "var(accel_front) over front-axle position >= lead_in_m + wheelbase",
         "f_window": f"var(accel_front) over the last {window} samples (ending at the road's end)",
+        "versions": package_versions(),
     }
     return Campaign(
         v=points[:, 0].copy(),
@@ -217,6 +221,40 @@ def run_campaign(
         status=np.array([r[1] for r in results], dtype=str),
         settings=settings,
     )
+
+
+def package_versions() -> dict[str, str]:
+    """Versions of what computes a campaign's f: Python, numpy, scipy, exudyn, this project,
+    the machine and its BLAS (see docs/vehicle-models.md, "Reproducibility": f of a run depends
+    on the floating-point details of the machine, so a campaign records where it was made)."""
+    import platform
+    from importlib import metadata
+
+    import exudyn
+    import scipy
+
+    out = {
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "exudyn": str(getattr(exudyn, "__version__", None) or metadata.version("exudyn")),
+        "machine": f"{platform.system()} {platform.machine()}",
+    }
+    try:
+        out["terrain-gpmsa"] = metadata.version("terrain-gpmsa")
+    except metadata.PackageNotFoundError:
+        out["terrain-gpmsa"] = "not installed"
+    try:
+        from threadpoolctl import threadpool_info
+
+        out["blas"] = "; ".join(
+            f"{i.get('internal_api')} {i.get('version')} ({i.get('architecture')})"
+            for i in threadpool_info()
+            if i.get("user_api") == "blas"
+        )
+    except Exception:  # informative only
+        out["blas"] = "unknown"
+    return out
 
 
 def run_one(spec: RunSpec, cache_dir: str | None = None) -> tuple[np.ndarray, str]:
