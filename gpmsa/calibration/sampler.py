@@ -271,7 +271,7 @@ class CalibrationSampler:
         n_tune = tune_rounds * tune_levels if tune else 0
         with tqdm(total=n_iter + n_tune, desc="calibrate", disable=not progress) as bar:
             if tune:
-                bar.set_description("calibrate: tuning step widths", refresh=False)
+                bar.set_description("calibrate: tuning step widths")
                 cands = tuning.level_widths(names, w, tune_levels)
                 acc = np.zeros((tune_levels, q + 1))
                 levels = [c.tolist() for c in cands]
@@ -281,7 +281,7 @@ class CalibrationSampler:
                         state.sweep(levels[lev], False, acc[lev], u[lev])
                     bar.update(tune_levels)
                 w = tuning.choose_widths(w, cands, acc, tune_rounds)
-            bar.set_description("calibrate: sampling", refresh=False)
+            bar.set_description("calibrate: sampling")
             widths_l = w.tolist()
             out = []
             accepted = np.zeros(q + 1)
