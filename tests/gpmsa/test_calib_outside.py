@@ -248,6 +248,10 @@ def test_oversized_requests_are_refused_before_allocating(monkeypatch):
     with pytest.raises(gpmsa.ResourceLimitError, match="MAX_MEMORY_BYTES = 10000 bytes"):
         Calibrator(emu)
     monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", 4 * 1024**3)
-    monkeypatch.setattr(gpmsa.limits, "MAX_OBS_VALUES", 400)
-    post = Calibrator(emu).update(rows[0][:300], rows[1][:300])
+    monkeypatch.setattr(gpmsa.limits, "MAX_OBS_VALUES", 2)
+    three = np.array([[0.8], [1.2], [1.6]]), np.array([[6.0], [11.0], [17.0]])
+    with pytest.raises(gpmsa.ResourceLimitError, match=r"3 reduced values.*MAX_OBS_VALUES = 2"):
+        Calibrator(emu).update(*three)
+    monkeypatch.setattr(gpmsa.limits, "MAX_OBS_VALUES", 3)
+    post = Calibrator(emu).update(*three)
     assert np.isfinite(post.mean("GD"))
