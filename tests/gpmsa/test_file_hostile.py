@@ -487,3 +487,25 @@ def test_safe_escapes_every_non_printable_character():
         assert chr(code) not in safe(f"a{chr(code)}b")
     assert safe("GD [1e-6 m^3] é ü 語") == "GD [1e-6 m^3] é ü 語"
     assert safe("x" * 500, 10) == "xxxxxxxxxx... (500 characters)"
+
+
+def test_info_shows_the_recorded_versions(emu, tmp_path, capsys):
+    """fit records the versions that computed the emulator (issue 15, section 5); a campaign's
+    versions copied into the metadata are shown too."""
+    import platform
+
+    import scipy
+
+    v = emu.settings["versions"]
+    assert v["numpy"] == np.__version__ and v["scipy"] == scipy.__version__
+    assert v["python"] == platform.python_version() and v["gpmsa"] == gpmsa.__version__
+    assert "blas" in v and "machine" in v
+    copy = gpmsa.load(emu.save(tmp_path / "a.gpmsa"))
+    copy.metadata["versions"] = {"exudyn": "1.13.6", "numpy": "2.4.6"}
+    path = copy.save(tmp_path / "b.gpmsa")
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    line = next(x for x in out.splitlines() if x.startswith("versions (settings): "))
+    assert f"python {platform.python_version()}" in line and f"numpy {np.__version__}" in line
+    assert f"gpmsa {gpmsa.__version__}" in line and "blas " in line
+    assert "versions (metadata): exudyn 1.13.6, numpy 2.4.6" in out
