@@ -65,6 +65,20 @@ def test_issue_examples_both_paths_warn_and_agree(f):
         assert mc.quantile("GD", 0.99) < hi - 3.0  # not piled up at the bound
 
 
+def test_generic_backend_agrees_far_out():
+    """The generic numpy backend (fast=False) starts lamOs where the fast sampler does."""
+    emu = road_emulator()
+    with pytest.warns(OutsideEmulatorWarning):
+        grid = Calibrator(emu, seed=0).update(road_obs()[0], [[1e5]])
+    with pytest.warns(OutsideEmulatorWarning):
+        mc = calibrate(emu, road_obs()[0], [[1e5]], n_samples=4000, n_burn=500, seed=4,
+                       fast=False)  # fmt: skip
+    assert mc.info["engine"] == "backend"
+    _agree(grid, mc, "GD")
+    lam_g, lam_m = np.median(grid.samples["lamOs"]), np.median(mc.samples["lamOs"])
+    assert lam_m == pytest.approx(lam_g, rel=0.15)
+
+
 def test_grid_likelihood_is_exact_for_far_out_observations():
     """The grid's lamOs-marginal likelihood against adaptive quadrature, up to u ~ 6e5 sds."""
     emu = road_emulator()
