@@ -3,12 +3,18 @@
 An emulator fitted offline by MCMC, shared as a file, calibrated online.
 """
 
-from gpmsa import backends, plots, predictive
+from gpmsa import backends, limits, plots, predictive
 from gpmsa._version import __version__ as __version__
 from gpmsa.calibration.calibrate import calibrate
 from gpmsa.calibration.calibrator import Calibrator
 from gpmsa.calibration.posterior import Posterior
-from gpmsa.errors import BackendUnavailableError, EmulatorFileError, GPMSAError
+from gpmsa.errors import (
+    BackendUnavailableError,
+    EmulatorFileError,
+    GPMSAError,
+    OutsideEmulatorWarning,
+    ResourceLimitError,
+)
 from gpmsa.fitting.emulator import Emulator, LooResult, load
 from gpmsa.fitting.fit import fit
 from gpmsa.mcmc.sampler import Chains
@@ -34,9 +40,11 @@ __all__ = [
     "LooResult",
     "ObsData",
     "ObsProblem",
+    "OutsideEmulatorWarning",
     "Posterior",
     "Priors",
     "Problem",
+    "ResourceLimitError",
     "SimData",
     "backends",
     "calibrate",
@@ -45,6 +53,7 @@ __all__ = [
     "emulator_prediction",
     "fit",
     "full_prediction",
+    "limits",
     "load",
     "plots",
     "predictive",

@@ -9,5 +9,14 @@ class EmulatorFileError(GPMSAError):
     """An emulator file is damaged, foreign, of a newer schema, or unsafe to read."""
 
 
+class ResourceLimitError(GPMSAError):
+    """A call would need more memory (or time) than ``gpmsa.limits`` allows; the message gives
+    the estimate, the limit and how to change it."""
+
+
 class BackendUnavailableError(ImportError):
     """A backend's optional packages are not installed; the message names the extra to install."""
+
+
+class OutsideEmulatorWarning(UserWarning):
+    """An observation lies outside what the emulator has seen (far from all its predictions)."""

@@ -429,6 +429,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     accepted = torch.zeros((len(els), n_chains), dtype=torch.long, device=dev)
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
         if tune and els:
+            bar.set_description("torch MCMC: tuning step widths")
             cands = tuning.level_widths([n for n, _ in els], w, tune_levels)
             acc = torch.zeros((tune_levels, len(els)), dtype=torch.long, device=dev)
             for _ in range(tune_rounds):
@@ -436,6 +437,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                     acc[lev] += state.sweep(cands[lev], False, gen).sum(-1)
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
+        bar.set_description("torch MCMC: sampling")
         for it in range(n_iter):
             accepted += state.sweep(w, not tune, gen)
             for n in names:

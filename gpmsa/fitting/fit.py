@@ -8,10 +8,12 @@ from datetime import datetime, timezone
 import numpy as np
 
 from gpmsa import backends
+from gpmsa._version import library_versions
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import summarize
-from gpmsa.model.data import ObsData, SimData
+from gpmsa.model.data import ObsData, SimData, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
 
@@ -20,11 +22,21 @@ N_KEEP = 1000
 
 
 def _seed(seed):
+    seed = check_seed(seed, generator=True)
     if isinstance(seed, np.random.Generator):
         return int(seed.integers(2**63))
-    if seed is not None and not isinstance(seed, (int, np.integer)):
-        raise GPMSAError(f"seed must be an int, a numpy Generator or None, got {seed!r}")
-    return None if seed is None else int(seed)
+    return seed
+
+
+def _check_fit_memory(problem, n_iter: int, n_chains: int) -> None:
+    """Refuse (before sampling) a fit whose draws or factorisations exceed the memory limit:
+    every sweep of every chain is stored (n_chains x n_iter x parameter elements, kept twice
+    while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats."""
+    n_el = sum(int(np.size(v)) for v in problem.init.values()) + 1
+    m, d, p_u = problem.m, problem.p + problem.q, problem.p_u
+    nbytes = 8.0 * (2.0 * n_chains * n_iter * n_el + m * m * (d + 4 * p_u + 2))
+    check_memory(nbytes, f"fit(n_iter={n_iter}, n_chains={n_chains}) of {m} runs x {n_el - 1} "
+                 "parameter elements")  # fmt: skip
 
 
 def fit(
@@ -71,6 +83,7 @@ def fit(
         raise GPMSAError(f"n_keep must be >= 1, got {n_keep}")
     seed = _seed(seed)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
+    _check_fit_memory(prep.problem, int(n_iter), int(n_chains))
     module = backends.get(backend)
     chains = module.sample(
         prep.problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
@@ -99,6 +112,7 @@ def fit(
         else "given",
         "step_widths": {k: v.tolist() for k, v in chains.step_widths.items()},
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "versions": library_versions(backend),
     }  # fmt: skip
     return Emulator._from_prepared(
         data, prep, params,

@@ -180,6 +180,7 @@ def run_chain(
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
     with threadpool_limits(1):
         if tune and els:
+            bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases
             names = [n for n, _ in els]
             cands = tuning.level_widths(names, w, tune_levels)
             acc = np.zeros((tune_levels, len(els)))
@@ -188,6 +189,7 @@ def run_chain(
                     state.sweep(cands[lev], False, acc[lev])
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc, tune_rounds)
+        bar.set_description(f"{desc}: sampling")
         draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
         log_post = np.empty(n_iter)
         accepted = np.zeros(len(els))

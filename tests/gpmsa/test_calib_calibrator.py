@@ -248,6 +248,7 @@ def test_bad_settings_and_emulators():
         cal.update(*road_obs())  # valid input: no warning
 
 
+@pytest.mark.filterwarnings("ignore::gpmsa.errors.OutsideEmulatorWarning")  # f spans far out
 def test_evidence_is_a_normalised_density_of_the_observation():
     """exp(log_evidence) as a function of f_obs integrates to one: every normalising constant
     (theta prior, lamOs prior and its integral, the Gaussian) is accounted for."""
