@@ -23,16 +23,15 @@ Steps (docs/closed-loop.md):
 The files go to ``--emulator-dir`` (default ``OUT/emulators``); ``--ship`` writes them into the
 package (control/emulators/) instead, replacing the shipped ones. Each file's metadata records the
 vehicle, the noise level, the feature, the road settings, the design, the fit settings and the
-versions of Python, numpy, scipy, exudyn and gpmsa that made it.
+versions of Python, numpy, scipy, exudyn and BLAS that made the training data (`gpmsa info`
+shows them, with those of the fit).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import platform
 import time
-from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
 import matplotlib
@@ -66,17 +65,6 @@ def stretched_design(n: int, seed: int, gd_range: tuple[float, float] = GD_RANGE
     return target_lo + (design - lo) * (target_hi - target_lo) / (hi - lo)
 
 
-def versions() -> dict:
-    """Versions of what made the training data and the fit."""
-    out = {"python": platform.python_version()}
-    for pkg in ("numpy", "scipy", "exudyn", "terrain-gpmsa"):
-        try:
-            out[pkg] = version(pkg)
-        except PackageNotFoundError:
-            out[pkg] = "unknown"
-    return out
-
-
 def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict) -> dict:
     """What the loop checks and what a reader of the file wants to know."""
     return {
@@ -98,7 +86,7 @@ def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict
             "v_range": V_RANGE,
             "gd_range": GD_RANGE,
         },
-        "versions": versions(),
+        "versions": campaign.settings.get("versions", {}),  # what made the training data
         "made_by": "examples/train_emulator.py",
         **extra,
     }
