@@ -8,7 +8,13 @@ from gpmsa._version import __version__ as __version__
 from gpmsa.calibration.calibrate import calibrate
 from gpmsa.calibration.calibrator import Calibrator
 from gpmsa.calibration.posterior import Posterior
-from gpmsa.errors import BackendUnavailableError, EmulatorFileError, GPMSAError
+from gpmsa.errors import (
+    BackendUnavailableError,
+    ChainError,
+    ConvergenceWarning,
+    EmulatorFileError,
+    GPMSAError,
+)
 from gpmsa.fitting.emulator import Emulator, LooResult, load
 from gpmsa.fitting.fit import fit
 from gpmsa.mcmc.sampler import Chains
@@ -19,7 +25,9 @@ from gpmsa.model.problem import ObsProblem, Problem, prepare
 __all__ = [
     "BackendUnavailableError",
     "Calibrator",
+    "ChainError",
     "Chains",
+    "ConvergenceWarning",
     "Emulator",
     "EmulatorFileError",
     "GPMSAError",

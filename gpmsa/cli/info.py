@@ -58,8 +58,26 @@ def run(args: argparse.Namespace) -> int:
     for name, d in manifest["diagnostics"].items():
         mean = ", ".join(f"{v:.4g}" for v in d.get("mean", []) if v is not None)
         ess = ", ".join(f"{v:.0f}" for v in d.get("ess", []) if v is not None)
-        lines.append(f"posterior {name}: mean [{mean}] ESS [{ess}]")
+        rhat = ", ".join(f"{v:.3f}" for v in d.get("rhat", []) if v is not None)
+        lines.append(f"posterior {name}: mean [{mean}] ESS [{ess}] R-hat [{rhat}]")
+    lines.append(_convergence_line(manifest.get("convergence")))
     n_arr = sum(int(a.size) for a in arrays.values())
     lines.append(f"arrays:          {len(arrays)} ({n_arr} values)")
     print("\n".join(lines))
     return 0
+
+
+def _convergence_line(rec: dict | None) -> str:
+    """One line on the chains' convergence (files of one chain or older ones have no record)."""
+    if not rec:
+        return "convergence:     not checked (one chain, or a file from before the check)"
+    (r_el, r_val), (e_el, e_val) = rec["max_rhat"], rec["min_ess"]
+    if r_val is None or e_val is None:
+        worst = "R-hat and ESS undefined (constant draws)"
+    else:
+        worst = f"max R-hat {r_val:.3f} ({r_el}), min bulk ESS {e_val:.0f} ({e_el})"
+    head = f"convergence:     {rec['n_chains']} chains x {rec['n_draws']} draws; {worst}; "
+    flagged = rec.get("flagged") or {}
+    if not flagged:
+        return head + f"converged (R-hat <= {rec['rhat_max']}, ESS >= {rec['ess_min']:.0f})"
+    return head + "NOT converged: " + "; ".join(f"{k}: {v}" for k, v in flagged.items())

@@ -75,7 +75,9 @@ class Emulator:
     draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected), x_names,
     t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
     settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
-    lamOs draws of a joint sim+obs fit, else None).
+    lamOs draws of a joint sim+obs fit, else None), convergence (several chains: R-hat and bulk
+    ESS of every sampled parameter and the elements flagged, see
+    ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files).
     """
 
     def __init__(
@@ -98,6 +100,7 @@ class Emulator:
         settings: dict | None = None,
         diagnostics: dict | None = None,
         calibration: dict[str, np.ndarray] | None = None,
+        convergence: dict | None = None,
     ):
         self.standardizer = standardizer
         self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
@@ -113,6 +116,7 @@ class Emulator:
         self.settings = dict(settings or {})
         self.diagnostics = dict(diagnostics or {})
         self.calibration = calibration
+        self.convergence = convergence
         self._factors: dict[int, list] = {}
 
     # --- construction -------------------------------------------------------------------------
@@ -390,6 +394,8 @@ class Emulator:
             "metadata": self.metadata,
             "diagnostics": self.diagnostics,
         }
+        if self.convergence is not None:
+            manifest["convergence"] = self.convergence
         manifest = jsonable(manifest)
         try:
             json.dumps(manifest["metadata"], allow_nan=False)
@@ -421,7 +427,7 @@ class Emulator:
                 priors=Priors.from_dict(manifest["priors"]), names=names, units=units,
                 draws=draws, log_post=arrays["log_post"], metadata=manifest["metadata"],
                 settings=manifest["settings"], diagnostics=manifest["diagnostics"],
-                calibration=cal,
+                calibration=cal, convergence=_convergence(manifest),
             )  # fmt: skip
             _check_consistent(emu)
             domain = {k: list(v) for k, v in emu.domain.items()}
@@ -457,6 +463,14 @@ def load(path: str | Path) -> Emulator:
         return Emulator.from_record(manifest, arrays)
     except EmulatorFileError as exc:
         raise EmulatorFileError(f"{path}: {exc}") from exc
+
+
+def _convergence(manifest: dict) -> dict | None:
+    """The optional convergence record (files before it existed have none)."""
+    rec = manifest.get("convergence")
+    if rec is not None and not isinstance(rec, dict):
+        raise ValueError(f"convergence must be a JSON object, got {type(rec).__name__}")
+    return rec
 
 
 def _check_consistent(emu: Emulator) -> None:

@@ -38,7 +38,8 @@ Emulator, whose record lives in fitting and imports io."""
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 
 PUBLIC = [
-    "BackendUnavailableError", "Calibrator", "Chains", "Emulator", "EmulatorFileError",
+    "BackendUnavailableError", "Calibrator", "ChainError", "Chains", "ConvergenceWarning",
+    "Emulator", "EmulatorFileError",
     "GPMSAError", "GammaPrior", "LooResult", "ObsData", "ObsProblem", "Posterior", "Priors",
     "Problem", "SimData", "backends", "calibrate", "fit", "load", "predictive", "prepare",
 ]  # fmt: skip
