@@ -22,17 +22,31 @@ from dataclasses import dataclass
 
 import numpy as np
 import torch
+from scipy.linalg import lapack
+from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
 from gpmsa.backends import check_sample_args
-from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import tuning
-from gpmsa.mcmc.sampler import PRECISION_PARAMS, RHO_PARAMS, Chains, default_widths, elements
+from gpmsa.errors import ChainError, GPMSAError
+from gpmsa.mcmc import ridge, starts, tuning
+from gpmsa.mcmc.sampler import (
+    PRECISION_PARAMS,
+    RHO_PARAMS,
+    Chains,
+    check_ridge,
+    default_widths,
+    elements,
+)
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem
 
 Tensor = torch.Tensor
+_POTRF = {torch.float64: lapack.dpotrf, torch.float32: lapack.spotrf}
 SIM_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+WARMUP = 100
+"""Default sweeps before each pooled step-size tuning (not recorded)."""
+TUNE_STAGES = 3
+"""Default number of (warm-up, pooled tuning) stages: each tunes where the last one led."""
 """Parameters that change Sigma_W (their proposals refactor it)."""
 
 
@@ -110,6 +124,10 @@ def scaled_correlation(beta: Tensor, d: Tensor, lam: Tensor) -> Tensor:
     return expo.exp_().reshape(c, j, *d.shape[1:])
 
 
+def _ONE(prm: dict[str, Tensor]) -> Tensor:  # noqa: N802
+    return torch.ones_like(prm["lamUz"])
+
+
 def _add_diagonal(mat: Tensor, values: Tensor) -> Tensor:
     """mat + diag(values) over the last two axes; in place unless autograd is recording (pyro)."""
     if torch.is_grad_enabled():
@@ -130,6 +148,27 @@ def _gaussian_loglik(chol: Tensor, info: Tensor, resid: Tensor) -> tuple[Tensor,
     return torch.where(bad, torch.full_like(ll, -torch.inf), ll), alpha
 
 
+def factor_(sig: Tensor) -> tuple[Tensor, Tensor]:
+    """Lower Cholesky factors of the matrices sig (..., m, m): (factor, info (...), 0 = success).
+
+    On the CPU, in place through LAPACK ``potrf``, one call per matrix on a zero-copy view: the
+    factor overwrites sig's lower triangle and the upper triangle keeps Sigma (every later use
+    reads the lower triangle only). torch's batched ``cholesky_ex`` costs 1.8x as much here
+    (it copies each matrix and zeroes its upper triangle; docs/performance.md). Elsewhere (a
+    GPU), or under autograd, ``torch.linalg.cholesky_ex``.
+    """
+    if sig.device.type != "cpu" or sig.requires_grad or sig.dtype not in _POTRF:
+        return torch.linalg.cholesky_ex(sig)
+    sig = sig.contiguous()
+    m = sig.shape[-1]
+    mats = sig.view(-1, m, m).numpy()
+    potrf = _POTRF[sig.dtype]
+    info = np.zeros(mats.shape[0], dtype=np.int32)
+    for i, a in enumerate(mats):  # a.T is a's upper triangle in Fortran order: no copy
+        info[i] = potrf(a.T, lower=0, clean=0, overwrite_a=1)[1]
+    return sig, torch.from_numpy(info).view(sig.shape[:-2])
+
+
 def sim_factor(
     d_sim: Tensor, w: Tensor, lam_sim: Tensor, betaU: Tensor, lamUz: Tensor, lamWs: Tensor,
     lamWOs: Tensor,
@@ -141,9 +180,48 @@ def sim_factor(
     log N(w_j; 0, Sigma_W_j) without constants (C, J), -inf where not positive definite.
     """
     sig = scaled_correlation(betaU, d_sim, lamUz)
+    return _factor_sigma(sig, w, lam_sim, lamWs, lamWOs)
+
+
+_FUSED = True
+
+
+def _factor_scaled(
+    corr: Tensor, scale: Tensor, w: Tensor, lam_sim: Tensor, lamWs: Tensor, lamWOs: Tensor
+) -> tuple[Tensor, Tensor, Tensor]:
+    """``sim_factor`` from the unscaled correlation corr (C, J, m, m) and scale = 1/lamUz (C, J)."""
+    if not _FUSED or corr.device.type != "cpu" or corr.dtype not in _POTRF:
+        return _factor_sigma(corr * scale[..., None, None], w, lam_sim, lamWs, lamWOs)
+    nugget = (1.0 / (lam_sim * lamWOs) + 1.0 / lamWs).numpy()
+    corr = corr.contiguous()
+    c_n, j_n, m, _ = corr.shape
+    out = torch.empty_like(corr)
+    o, cr, sc, wn = out.numpy(), corr.numpy(), scale.numpy(), w.numpy()
+    potrf = _POTRF[corr.dtype]
+    trtrs = lapack.dtrtrs if corr.dtype == torch.float64 else lapack.strtrs
+    alpha = np.zeros((c_n, j_n, m), dtype=o.dtype)
+    ll = np.full((c_n, j_n), -np.inf)
+    for c in range(c_n):
+        for j in range(j_n):
+            a = o[c, j]
+            np.multiply(cr[c, j], sc[c, j], out=a)
+            diag = a.reshape(-1)[:: m + 1]
+            diag += nugget[c, j]
+            if potrf(a.T, lower=0, clean=0, overwrite_a=1)[1] != 0:
+                continue
+            v, _ = trtrs(a.T, wn[j], lower=0, trans=1)
+            alpha[c, j] = v
+            ll[c, j] = -np.log(diag).sum() - 0.5 * (v @ v)
+    return out, torch.from_numpy(alpha), torch.from_numpy(ll).to(out.dtype)
+
+
+def _factor_sigma(
+    sig: Tensor, w: Tensor, lam_sim: Tensor, lamWs: Tensor, lamWOs: Tensor
+) -> tuple[Tensor, Tensor, Tensor]:
+    """``sim_factor`` from sig = R_j / lamUz_j (C, J, m, m; overwritten on the CPU)."""
     nugget = 1.0 / (lam_sim * lamWOs) + 1.0 / lamWs
     sig = _add_diagonal(sig, nugget.unsqueeze(-1))
-    chol, info = torch.linalg.cholesky_ex(sig)
+    chol, info = factor_(sig)
     ll, alpha = _gaussian_loglik(chol, info, w.expand(chol.shape[:-1]))
     return chol, alpha, ll
 
@@ -215,26 +293,39 @@ def _seed_generator(seed, device) -> torch.Generator:
 class BatchState:
     """C chains of one problem: parameters, cached Sigma_W factors and the batched sweep."""
 
-    def __init__(self, problem: Problem, n_chains: int, dtype: torch.dtype, device):
+    def __init__(self, problem: Problem, n_chains: int, dtype: torch.dtype, device,
+                 start: dict[str, np.ndarray] | None = None, ridge_moves: int = 0):  # fmt: skip
+        """``start``: name -> (C, *shape) starting values (default: ``problem.init`` for all);
+        ``ridge_moves``: moves along the nugget ridge per sweep where they apply."""
         self.problem = problem
+        self.ridge_moves = int(ridge_moves) if ridge.applies(problem) else 0
         self.data = ModelTensors.from_problem(problem, dtype, device)
         self.priors = problem.priors
         self.els = elements(problem)
         self.n_chains = n_chains
+        if start is None:
+            start = {k: np.broadcast_to(v, (n_chains, *v.shape)) for k, v in problem.init.items()}
         self.reset({
-            k: torch.as_tensor(v, dtype=dtype, device=device).expand(n_chains, *v.shape).clone()
-            for k, v in problem.init.items()
+            k: torch.as_tensor(np.array(v), dtype=dtype, device=device) for k, v in start.items()
         })  # fmt: skip
-        if not torch.isfinite(self.loglik).all():
-            raise GPMSAError("the initial values give a log-likelihood of -inf (Sigma not PD)")
+        bad = torch.nonzero(~torch.isfinite(self.loglik)).squeeze(-1).tolist()
+        if bad:
+            raise ChainError(
+                f"the starting values of chain(s) {bad} give a log-likelihood of "
+                f"{self.loglik[bad[0]].item()} (Sigma not positive definite, or NaN data)", bad,
+            )  # fmt: skip
 
     def reset(self, params: dict[str, Tensor]) -> None:
         """Set every chain's parameters (name -> (C, *shape)) and recompute all cached terms."""
         self.params = params
         d = self.data
         shared = all(k in self.problem.fixed for k in SIM_PARAMS)  # calibration: one Sigma_W
-        self.chol, self.alpha, self.ll_w = sim_factor(
-            d.d_sim, d.w, d.lam_sim, *(params[k][:1] if shared else params[k] for k in SIM_PARAMS)
+        prm = {k: params[k][:1] if shared else params[k] for k in SIM_PARAMS}
+        # R_j = exp(-sum_k beta_kj d_k) per chain, cached: a precision proposal only rescales it
+        self.corr = None if shared else scaled_correlation(prm["betaU"], d.d_sim, _ONE(prm))
+        sig = scaled_correlation(prm["betaU"], d.d_sim, prm["lamUz"])
+        self.chol, self.alpha, self.ll_w = _factor_sigma(
+            sig, d.w, d.lam_sim, prm["lamWs"], prm["lamWOs"]
         )
         if shared:
             self.ll_w = self.ll_w.expand(self.n_chains, -1).clone()
@@ -290,68 +381,97 @@ class BatchState:
         if not valid.any():
             return accepted
         cand = torch.where(valid, cand, x)
-        # Sigma_W proposals: factor only the chains whose candidate is inside the bounds.
-        # Others: every chain (no gathers of the cached factors), invalid ones masked below.
-        rows = torch.nonzero(valid).squeeze(-1) if name in SIM_PARAMS else None
-        sub = (lambda t: t) if rows is None else (lambda t: t[rows])  # noqa: E731
-        prm = {k: sub(v) for k, v in self.params.items()}
-        prm[name] = prm[name].clone()
-        prm[name][(slice(None), *idx)] = sub(cand)
+        # Every chain is evaluated (no gathers of cached matrices); invalid ones are masked.
+        prm = dict(self.params)
+        prm[name] = cur.clone()
+        prm[name][(slice(None), *idx)] = cand
         d = self.data
         chol, alpha, ll_w = self.chol, self.alpha, self.ll_w
-        if rows is not None:
+        if name in SIM_PARAMS:
             whole = name == "lamWOs" or d.w.shape[0] == 1
             comps = slice(None) if whole else slice(idx[-1], idx[-1] + 1)
-            chol_c, alpha_c, ll_c = sim_factor(
-                d.d_sim, d.w[comps], d.lam_sim[comps], prm["betaU"][:, :, comps],
-                prm["lamUz"][:, comps], prm["lamWs"][:, comps], prm["lamWOs"],
+            if name == "betaU":  # a new correlation matrix
+                corr_c = scaled_correlation(prm["betaU"][:, :, comps], d.d_sim,
+                                            _ONE(prm)[:, comps])  # fmt: skip
+            else:  # the cached one, rescaled
+                corr_c = self.corr[:, comps]
+            chol_c, alpha_c, ll_c = _factor_scaled(
+                corr_c, 1.0 / prm["lamUz"][:, comps], d.w[comps], d.lam_sim[comps],
+                prm["lamWs"][:, comps], prm["lamWOs"],
             )  # fmt: skip
             ll_w, chol, alpha = ll_c, chol_c, alpha_c
             if not whole:
-                ll_w = self.ll_w[rows]  # advanced indexing copies
+                ll_w = self.ll_w.clone()
                 ll_w[:, comps] = ll_c
                 if d.has_obs:
-                    chol, alpha = self.chol[rows], self.alpha[rows]
+                    chol, alpha = self.chol.clone(), self.alpha.clone()
                     chol[:, comps], alpha[:, comps] = chol_c, alpha_c
         ll_obs = self._obs(prm, chol, alpha)
         ll_new = ll_w.sum(-1) + ll_obs
-        ratio = (
-            ll_new
-            - sub(self.loglik)
-            + sub(lp_new - log_prior_elements(self.priors, name, x) + corr)
-        )
-        acc = (torch.log(sub(u[1])) < ratio) & sub(valid)
-        take = torch.nonzero(acc).squeeze(-1) if rows is None else rows[acc]
+        ratio = ll_new - self.loglik + lp_new - log_prior_elements(self.priors, name, x) + corr
+        acc = (torch.log(u[1]) < ratio) & valid
+        take = torch.nonzero(acc).squeeze(-1)
         accepted[take] = True
         cur[(take, *idx)] = cand[take]
-        self.ll_obs[take] = ll_obs[acc]
-        if rows is not None:
-            self.ll_w[take] = ll_w[acc]
+        self.ll_obs[take] = ll_obs[take]
+        if name in SIM_PARAMS:
+            self.ll_w[take] = ll_w[take]
+            if name == "betaU":
+                self.corr[take, comps] = corr_c[take]
             if d.has_obs:
-                self.chol[take] = chol[acc]
-                self.alpha[take] = alpha[acc]
+                self.chol[take, comps] = chol_c[take]
+                self.alpha[take, comps] = alpha_c[take]
         return accepted
 
     def sweep(self, widths: np.ndarray, prop_mh: bool, gen: torch.Generator) -> Tensor:
-        """One Metropolis-within-Gibbs sweep in GPM/SA's order; returns accepted (n_el, C)."""
+        """One Metropolis-within-Gibbs sweep in GPM/SA's order, then ``ridge_moves`` moves along
+        the nugget ridge (``gpmsa.mcmc.ridge``); returns accepted (n_el, C) of the sweep."""
         c = self.ll_w.shape[0]
-        u = torch.rand((len(self.els), 2, c), generator=gen, dtype=self.ll_w.dtype,
+        n_el = len(self.els)
+        u = torch.rand((n_el + self.ridge_moves, 2, c), generator=gen, dtype=self.ll_w.dtype,
                        device=self.ll_w.device)  # fmt: skip
-        out = torch.zeros((len(self.els), c), dtype=torch.bool, device=self.ll_w.device)
+        out = torch.zeros((n_el, c), dtype=torch.bool, device=self.ll_w.device)
         for i, (name, idx) in enumerate(self.els):
             kind = 1 if name in RHO_PARAMS else 2 if name in PRECISION_PARAMS else 0
             out[i] = self.update(name, idx, float(widths[i]), kind, prop_mh, u[i])
+        if self.ridge_moves:
+            self.ridge_sweep(u[n_el:])
         return out
+
+    def ridge_sweep(self, u: Tensor) -> None:
+        """Moves along the nugget ridge in every chain, one per u[k] (2, C) (likelihood unchanged;
+        the same move as the numpy sampler's ``ChainState.ridge_sweep``)."""
+        pri, lam_sim = self.priors, self.data.lam_sim[0]
+        ws, wos = self.params["lamWs"], self.params["lamWOs"]
+        s, t = ws[:, 0].clone(), wos[:, 0].clone()
+        lp_old = log_prior_elements(pri, "lamWs", s) + log_prior_elements(pri, "lamWOs", t)
+        for k in range(u.shape[0]):
+            n = 1.0 / (lam_sim * t) + 1.0 / s
+            s2 = s * torch.exp(ridge.WIDTH * (u[k, 0] - 0.5))
+            r = n - 1.0 / s2
+            ok = r > 0.0
+            t2 = 1.0 / (lam_sim * torch.where(ok, r, torch.ones_like(r)))
+            lp_new = log_prior_elements(pri, "lamWs", s2) + log_prior_elements(pri, "lamWOs", t2)
+            ok &= torch.isfinite(lp_new)
+            ratio = lp_new - lp_old + 2.0 * torch.log(t2 / t) + torch.log(s2 / s)
+            acc = ok & (torch.log(u[k, 1]) < ratio)
+            s, t = torch.where(acc, s2, s), torch.where(acc, t2, t)
+            lp_old = torch.where(acc, lp_new, lp_old)
+        ws[:, 0], wos[:, 0] = s, t
 
 
 @contextmanager
 def torch_threads(num_threads: int | None):
-    """Set torch's CPU thread count inside the block (None: unchanged); restored afterwards."""
+    """Set torch's CPU thread count, and the BLAS libraries' (scipy's LAPACK factors on the CPU),
+    inside the block (None: unchanged); restored afterwards."""
     previous = torch.get_num_threads()
-    if num_threads is not None:
-        torch.set_num_threads(int(num_threads))
-    try:
+    if num_threads is None:
         yield
+        return
+    torch.set_num_threads(int(num_threads))
+    try:
+        with threadpool_limits(int(num_threads), user_api="blas"):  # scipy's LAPACK (factor_)
+            yield
     finally:
         torch.set_num_threads(previous)
 
@@ -385,6 +505,10 @@ def sample(
     device="cpu",
     dtype="float64",
     num_threads: int | None = 1,
+    init: str = "auto",
+    warmup: int | None = None,
+    tune_stages: int = TUNE_STAGES,
+    ridge_moves: int | None = None,
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
@@ -401,13 +525,19 @@ def sample(
     check_sample_args(n_iter, n_chains, seed)
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
-                       tune_rounds, tune_levels, device, dtype)  # fmt: skip
+                       tune_rounds, tune_levels, device, dtype, init, warmup,
+                       tune_stages, check_ridge(ridge_moves, problem))  # fmt: skip
 
 
 def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
-            tune_levels, device, dtype) -> Chains:  # fmt: skip
+            tune_levels, device, dtype, init, warmup, tune_stages, n_ridge) -> Chains:  # fmt: skip
     """``sample`` without the thread setting."""
     dev, dt = _device(device), _dtype(dtype)
+    how = starts.check_init(init, n_chains)
+    if warmup is None:
+        warmup = WARMUP if tune else 0
+    if not isinstance(warmup, (int, np.integer)) or warmup < 0:
+        raise GPMSAError(f"warmup must be an integer >= 0, got {warmup!r}")
     if tune_rounds is None:
         tune_rounds = math.ceil(tuning.N_BURN / n_chains)
     if tune_rounds < 1 or tune_levels < 2:
@@ -418,17 +548,28 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     for name, val in (step_widths or {}).items():
         widths[name] = np.broadcast_to(np.asarray(val, dtype=np.float64), widths[name].shape)
     gen = _seed_generator(seed, dev)
-    state = BatchState(problem, int(n_chains), dt, dev)
+    seeds = np.random.SeedSequence(seed).spawn(n_chains)  # chain c starts as the numpy chain c
+    firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seeds]
+    start = {k: np.stack([f[k] for f in firsts]) for k in problem.init}
+    state = BatchState(problem, int(n_chains), dt, dev, start, n_ridge)
     els = state.els
     w = np.array([float(widths[n][idx]) for n, idx in els])
-    total = n_iter + (tune_rounds * tune_levels if tune else 0)
+    if not isinstance(tune_stages, (int, np.integer)) or tune_stages < 1:
+        raise GPMSAError(f"tune_stages must be an integer >= 1, got {tune_stages!r}")
+    n_stages = tune_stages if tune else 1
+    total = n_iter + n_stages * (warmup + (tune_rounds * tune_levels if tune else 0))
     names = problem.names
     draws = {n: torch.empty((n_iter, n_chains, *problem.init[n].shape), dtype=dt, device=dev)
              for n in names}  # fmt: skip
     log_post = torch.empty((n_iter, n_chains), dtype=dt, device=dev)
     accepted = torch.zeros((len(els), n_chains), dtype=torch.long, device=dev)
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
-        if tune and els:
+        for _stage in range(n_stages):
+            for _ in range(warmup):  # leave the starts (then the last widths' region) first
+                state.sweep(w, not tune, gen)
+                bar.update(1)
+            if not (tune and els):
+                break
             cands = tuning.level_widths([n for n, _ in els], w, tune_levels)
             acc = torch.zeros((tune_levels, len(els)), dtype=torch.long, device=dev)
             for _ in range(tune_rounds):
@@ -455,5 +596,8 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
         step_widths=wid,
         info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": tune,
               "tune_rounds": tune_rounds, "tune_levels": tune_levels, "seed": seed,
-              "backend": "torch", "device": str(dev), "dtype": str(dt).replace("torch.", "")},
+              "init": how, "warmup": int(warmup), "tune_stages": n_stages, "starts": start,
+              "ridge_moves": state.ridge_moves,
+              "backend": "torch",
+              "device": str(dev), "dtype": str(dt).replace("torch.", "")},
     )  # fmt: skip

@@ -16,7 +16,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import ChainError, GPMSAError
-from gpmsa.mcmc import starts, tuning
+from gpmsa.mcmc import ridge, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.likelihood import IncrementalLikelihood
 from gpmsa.model.problem import Problem
@@ -113,6 +113,8 @@ class ChainState:
     """One chain: current parameters, incremental likelihood, and the sweep.
 
     ``els`` restricts the sweep to some (name, index) elements (default: every sampled one).
+    ``ridge_moves``: moves along the nugget ridge after each sweep (``gpmsa.mcmc.ridge``; only
+    where the move applies, else none).
     """
 
     def __init__(
@@ -121,9 +123,14 @@ class ChainState:
         params: dict[str, np.ndarray],
         rng: np.random.Generator,
         els: list[tuple[str, tuple[int, ...]]] | None = None,
+        ridge_moves: int = 0,
     ):
         self.problem = problem
         self.rng = rng
+        self.ridge_moves = int(ridge_moves) if ridge.applies(problem) else 0
+        self.ridge_accepted = 0
+        pri = problem.priors
+        self._ridge_priors = (pri.scalar_log_prior("lamWs"), pri.scalar_log_prior("lamWOs"))
         self.lik = IncrementalLikelihood(problem, params)
         self.els = elements(problem) if els is None else list(els)
         self.kinds = [
@@ -178,6 +185,28 @@ class ChainState:
                 lik.accept()
                 self.log_prior += lp_new - lp_old
                 accepted[i] += 1
+        if self.ridge_moves:
+            self.ridge_sweep(self.rng.random((self.ridge_moves, 2)))
+
+    def ridge_sweep(self, u: np.ndarray) -> None:
+        """Moves along the nugget ridge (likelihood unchanged), one per row of uniforms u (k, 2)."""
+        lik = self.lik
+        g_s, g_t = self._ridge_priors
+        lam_sim = float(self.problem.lam_sim[0])
+        for u0, u1 in u:
+            s, t = float(lik.params["lamWs"][0]), float(lik.params["lamWOs"][0])
+            prop = ridge.proposal(s, t, lam_sim, u0)
+            if prop is None:
+                continue
+            s2, t2 = prop
+            lp_new = g_s(s2) + g_t(t2)
+            if lp_new == -math.inf:
+                continue
+            lp_old = g_s(s) + g_t(t)
+            if math.log(u1) < lp_new - lp_old + ridge.log_jacobian_ratio(s, t, s2, t2):
+                lik.params = {**lik.params, "lamWs": np.array([s2]), "lamWOs": np.array([t2])}
+                self.log_prior += lp_new - lp_old
+                self.ridge_accepted += 1
 
 
 def check_sample_args(n_iter, n_chains, seed) -> None:
@@ -188,6 +217,18 @@ def check_sample_args(n_iter, n_chains, seed) -> None:
         raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
     if seed is not None and not isinstance(seed, (int, np.integer)):
         raise GPMSAError(f"seed must be an int or None, got {seed!r}")
+
+
+def check_ridge(ridge_moves, problem: Problem) -> int:
+    """Moves along the nugget ridge per sweep: ``ridge_moves`` (None: the default where the move
+    applies), 0 where it does not apply; GPMSAError for a negative or non-integer value."""
+    if ridge_moves is None:
+        ridge_moves = ridge.N_MOVES
+    if isinstance(ridge_moves, bool) or not isinstance(ridge_moves, (int, np.integer)):
+        raise GPMSAError(f"ridge_moves must be None or an integer >= 0, got {ridge_moves!r}")
+    if ridge_moves < 0:
+        raise GPMSAError(f"ridge_moves must be None or an integer >= 0, got {ridge_moves!r}")
+    return int(ridge_moves) if ridge.applies(problem) else 0
 
 
 def _flat_widths(problem: Problem, els, widths: dict[str, np.ndarray]) -> np.ndarray:
@@ -206,6 +247,7 @@ def run_chain(
     progress: bool = False,
     desc: str = "MCMC",
     start: dict[str, np.ndarray] | None = None,
+    ridge_moves: int = 0,
 ) -> tuple[dict[str, np.ndarray], np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Tune (optionally), then ``n_iter`` sweeps from ``start`` (default ``problem.init``).
 
@@ -214,7 +256,8 @@ def run_chain(
     """
     from tqdm.auto import tqdm
 
-    state = ChainState(problem, problem.init if start is None else start, rng)
+    state = ChainState(problem, problem.init if start is None else start, rng,
+                       ridge_moves=ridge_moves)  # fmt: skip
     if math.isnan(state.log_post()):
         raise GPMSAError(
             f"the starting values give a log posterior of NaN (log-likelihood "
@@ -260,7 +303,7 @@ def run_chain(
 def _chain_task(
     problem: Problem, n_iter: int, tune: bool, widths: dict[str, np.ndarray],
     seed: np.random.SeedSequence, init: str, tune_rounds: int, tune_levels: int,
-    progress: bool = False, desc: str = "MCMC",
+    ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
 ):  # fmt: skip
     """One chain from plain data (run in a worker process): its start, then ``run_chain``."""
     start = starts.draw_start(problem, init, starts.start_generator(seed))
@@ -268,7 +311,7 @@ def _chain_task(
         out = run_chain(
             problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
             tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress, desc=desc,
-            start=start,
+            start=start, ridge_moves=ridge_moves,
         )  # fmt: skip
     return (*out, start)
 
@@ -287,6 +330,7 @@ def sample(
     init: str = "auto",
     n_jobs: int | None = None,
     executor=None,
+    ridge_moves: int | None = None,
 ) -> Chains:
     """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
 
@@ -299,11 +343,14 @@ def sample(
     ``n_jobs`` workers (None: every CPU, never more than the chains) or any
     ``concurrent.futures.Executor`` / dask ``Client`` given as ``executor``. ``init``: the
     chains' starts (``gpmsa.mcmc.starts``: "auto" is GPM/SA's initial values for one chain,
-    dispersed ones for several). Raises ChainError naming a chain that failed or whose draws
-    are not finite.
+    dispersed ones for several). ``ridge_moves``: moves along the lamWs/lamWOs nugget ridge per
+    sweep (``gpmsa.mcmc.ridge``; None: ``ridge.N_MOVES`` where the move applies, a simulation-only
+    problem with one basis component; 0: GPM/SA's sweep alone). Raises ChainError naming a
+    chain that failed or whose draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
     how = starts.check_init(init, int(n_chains))
+    n_ridge = check_ridge(ridge_moves, problem)
     widths = default_widths(problem)
     if step_widths:
         for name, val in step_widths.items():
@@ -311,7 +358,8 @@ def sample(
     seq = np.random.SeedSequence(seed)
     tasks = [
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": widths, "seed": s,
-         "init": how, "tune_rounds": tune_rounds, "tune_levels": tune_levels}
+         "init": how, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
+         "ridge_moves": n_ridge}
         for s in seq.spawn(int(n_chains))
     ]  # fmt: skip
     runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
@@ -324,7 +372,8 @@ def sample(
         step_widths={n: np.stack([r[3][n] for r in runs]) for n in names},
         info={"n_iter": n_iter, "n_chains": n_chains, "tune": tune, "tune_rounds": tune_rounds,
               "tune_levels": tune_levels, "seed": seed, "seed_entropy": str(seq.entropy),
-              "init": how, "starts": {n: np.stack([r[4][n] for r in runs]) for n in names},
+              "init": how, "ridge_moves": n_ridge,
+              "starts": {n: np.stack([r[4][n] for r in runs]) for n in names},
               "backend": "numpy"},
     )  # fmt: skip
     chains.check_finite()
