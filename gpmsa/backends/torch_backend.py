@@ -61,6 +61,9 @@ class ModelTensors:
     reduced data, N = n * n_blocks; ``sig_obs`` (N, N) its covariance per unit lamOs;
     ``u_blocks`` the n-block of each basis component, ``v_blocks`` the n-blocks that receive the
     discrepancy covariance (GPM/SA's order, see ``gpmsa.model.problem.ObsProblem``).
+    Packed lower triangle (a factorisation reads only that): ``rows`` the row blocks (a, b)
+    (rows a..b-1, columns 0..b-1), ``d_packed`` (p+q, P) d_sim over them, ``packed_index`` (P,)
+    their flat positions in an m x m matrix.
     """
 
     p: int
@@ -75,6 +78,9 @@ class ModelTensors:
     sig_obs: Tensor | None = None
     u_blocks: tuple[int, ...] = ()
     v_blocks: tuple[int, ...] = ()
+    rows: tuple[tuple[int, int], ...] = ()
+    d_packed: Tensor | None = None
+    packed_index: Tensor | None = None
 
     @property
     def has_obs(self) -> bool:
@@ -102,10 +108,27 @@ class ModelTensors:
                 "u_blocks": u_blocks,
                 "v_blocks": tuple(range(n_v)) if "betaV" in problem.init else (),
             }
+        d_sim = pairwise_sq(zt, zt)
+        rows = row_blocks(problem.m)
+        index = np.concatenate([(np.arange(a, b)[:, None] * problem.m + np.arange(b)).ravel()
+                                for a, b in rows])  # fmt: skip
         return cls(
-            p=problem.p, q=problem.q, d_sim=t(pairwise_sq(zt, zt)), t_sim=t(problem.t_sim),
-            w=t(problem.w.T), lam_sim=t(problem.lam_sim), **kw,
+            p=problem.p, q=problem.q, d_sim=t(d_sim), t_sim=t(problem.t_sim),
+            w=t(problem.w.T), lam_sim=t(problem.lam_sim), rows=rows,
+            d_packed=t(np.concatenate([d_sim[:, a:b, :b].reshape(d_sim.shape[0], -1)
+                                       for a, b in rows], axis=1)),
+            packed_index=torch.as_tensor(index, device=device), **kw,
         )  # fmt: skip
+
+
+N_BLOCKS = 12
+"""Row blocks of the packed lower triangle (12: 54 % of the matrix for m = 198)."""
+
+
+def row_blocks(m: int, n_blocks: int = N_BLOCKS) -> tuple[tuple[int, int], ...]:
+    """Row blocks (a, b) covering rows 0..m-1 evenly; block (a, b) keeps columns 0..b-1."""
+    edges = np.unique(np.linspace(0, m, min(n_blocks, m) + 1).round().astype(int))
+    return tuple((int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True))
 
 
 def pairwise_sq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -122,10 +145,6 @@ def scaled_correlation(beta: Tensor, d: Tensor, lam: Tensor) -> Tensor:
     bias = -torch.log(lam).reshape(c * j, 1)
     expo = torch.addmm(bias, beta.transpose(1, 2).reshape(c * j, k), d.reshape(k, -1), alpha=-1.0)
     return expo.exp_().reshape(c, j, *d.shape[1:])
-
-
-def _ONE(prm: dict[str, Tensor]) -> Tensor:  # noqa: N802
-    return torch.ones_like(prm["lamUz"])
 
 
 def _add_diagonal(mat: Tensor, values: Tensor) -> Tensor:
@@ -183,36 +202,76 @@ def sim_factor(
     return _factor_sigma(sig, w, lam_sim, lamWs, lamWOs)
 
 
-_FUSED = True
+def _on_lapack(t: Tensor) -> bool:
+    """Whether the per-chain LAPACK path applies (a CPU tensor of float64/float32, no autograd)."""
+    return t.device.type == "cpu" and t.dtype in _POTRF and not t.requires_grad
+
+
+def correlation_packed(beta: Tensor, data: ModelTensors, out: Tensor) -> Tensor:
+    """R = exp(-sum_k beta_k d_k) on the packed lower triangle, written into ``out`` (C, J, P,
+    contiguous): one matrix product and one in-place exp; beta (C, k, J)."""
+    c, k, j = beta.shape
+    flat = out.view(c * j, -1)
+    torch.mm(-beta.transpose(1, 2).reshape(c * j, k), data.d_packed, out=flat)
+    return flat.exp_().view(out.shape)
+
+
+def unpack(packed: Tensor, data: ModelTensors) -> Tensor:
+    """The (..., m, m) matrices whose lower triangle is ``packed`` (..., P); upper part zero."""
+    m = data.d_sim.shape[-1]
+    full = packed.new_zeros((*packed.shape[:-1], m * m))
+    full[..., data.packed_index] = packed
+    return full.view(*packed.shape[:-1], m, m)
 
 
 def _factor_scaled(
-    corr: Tensor, scale: Tensor, w: Tensor, lam_sim: Tensor, lamWs: Tensor, lamWOs: Tensor
-) -> tuple[Tensor, Tensor, Tensor]:
-    """``sim_factor`` from the unscaled correlation corr (C, J, m, m) and scale = 1/lamUz (C, J)."""
-    if not _FUSED or corr.device.type != "cpu" or corr.dtype not in _POTRF:
-        return _factor_sigma(corr * scale[..., None, None], w, lam_sim, lamWs, lamWOs)
+    corr: Tensor, scale: Tensor, data: ModelTensors, comps: slice, lamWs: Tensor,
+    lamWOs: Tensor, out: Tensor | None = None, scratch: np.ndarray | None = None,
+) -> tuple[Tensor | None, Tensor, Tensor]:  # fmt: skip
+    """``sim_factor`` of components ``comps`` from their packed correlation corr (C, J, P) and
+    scale = 1/lamUz (C, J).
+
+    On the CPU, chain by chain and component by component: Sigma = corr * scale + nugget I is
+    built (lower triangle) in one m x m buffer, factored there by LAPACK and solved against w
+    while it is in cache (a batch of 64 chains x 198 x 198 is 20 MB: whole-batch passes each go
+    through memory). The factors go to ``out`` (C, J, m, m) when given, else only the ``scratch``
+    buffer is used and no factor is returned (None). Elsewhere (a GPU): batched torch ops.
+    """
+    w, lam_sim = data.w[comps], data.lam_sim[comps]
+    if not _on_lapack(corr):
+        sig = unpack(corr * scale[..., None], data)
+        chol, alpha, ll = _factor_sigma(sig, w, lam_sim, lamWs, lamWOs)
+        if out is not None:
+            out.copy_(chol)
+        return chol, alpha, ll
     nugget = (1.0 / (lam_sim * lamWOs) + 1.0 / lamWs).numpy()
-    corr = corr.contiguous()
-    c_n, j_n, m, _ = corr.shape
-    out = torch.empty_like(corr)
-    o, cr, sc, wn = out.numpy(), corr.numpy(), scale.numpy(), w.numpy()
+    c_n, j_n, _ = corr.shape
+    m = data.d_sim.shape[-1]
+    cr, sc, wn = corr.contiguous().numpy(), scale.numpy(), w.numpy()
+    o = None if out is None else out.numpy()
+    if o is None and (scratch is None or scratch.shape != (m, m) or scratch.dtype != cr.dtype):
+        scratch = np.empty((m, m), dtype=cr.dtype)
+    offsets = np.cumsum([0] + [(b - a) * b for a, b in data.rows]).tolist()
+    blocks = [(a, b, o0, o1) for (a, b), o0, o1 in zip(data.rows, offsets[:-1], offsets[1:],
+                                                         strict=True)]  # fmt: skip
     potrf = _POTRF[corr.dtype]
     trtrs = lapack.dtrtrs if corr.dtype == torch.float64 else lapack.strtrs
-    alpha = np.zeros((c_n, j_n, m), dtype=o.dtype)
+    alpha = np.zeros((c_n, j_n, m), dtype=cr.dtype)
     ll = np.full((c_n, j_n), -np.inf)
     for c in range(c_n):
         for j in range(j_n):
-            a = o[c, j]
-            np.multiply(cr[c, j], sc[c, j], out=a)
-            diag = a.reshape(-1)[:: m + 1]
+            a_ = scratch if o is None else o[c, j]
+            src, f = cr[c, j], sc[c, j]
+            for a, b, o0, o1 in blocks:
+                np.multiply(src[o0:o1].reshape(b - a, b), f, out=a_[a:b, :b])
+            diag = a_.reshape(-1)[:: m + 1]
             diag += nugget[c, j]
-            if potrf(a.T, lower=0, clean=0, overwrite_a=1)[1] != 0:
+            if potrf(a_.T, lower=0, clean=0, overwrite_a=1)[1] != 0:
                 continue
-            v, _ = trtrs(a.T, wn[j], lower=0, trans=1)
+            v, _ = trtrs(a_.T, wn[j], lower=0, trans=1)
             alpha[c, j] = v
             ll[c, j] = -np.log(diag).sum() - 0.5 * (v @ v)
-    return out, torch.from_numpy(alpha), torch.from_numpy(ll).to(out.dtype)
+    return out, torch.from_numpy(alpha), torch.from_numpy(ll).to(corr.dtype)
 
 
 def _factor_sigma(
@@ -290,6 +349,16 @@ def _seed_generator(seed, device) -> torch.Generator:
     return torch.Generator(device=device).manual_seed(state & (2**63 - 1))
 
 
+def _copy_rows(dst: Tensor, src: Tensor, rows: Tensor) -> None:
+    """dst[rows] = src[rows] along the chain axis (per chain on the CPU: no gathered copy)."""
+    if dst.device.type == "cpu":
+        d, s_ = dst.numpy(), src.numpy()
+        for r in rows.tolist():
+            d[r] = s_[r]
+    else:
+        dst[rows] = src[rows]
+
+
 class BatchState:
     """C chains of one problem: parameters, cached Sigma_W factors and the batched sweep."""
 
@@ -299,6 +368,9 @@ class BatchState:
         ``ridge_moves``: moves along the nugget ridge per sweep where they apply."""
         self.problem = problem
         self.ridge_moves = int(ridge_moves) if ridge.applies(problem) else 0
+        self._buffers: dict[tuple[str, int], Tensor] = {}
+        m = problem.m
+        self._scratch = torch.empty((m, m), dtype=dtype).numpy()  # factors not kept (CPU)
         self.data = ModelTensors.from_problem(problem, dtype, device)
         self.priors = problem.priors
         self.els = elements(problem)
@@ -315,18 +387,37 @@ class BatchState:
                 f"{self.loglik[bad[0]].item()} (Sigma not positive definite, or NaN data)", bad,
             )  # fmt: skip
 
+    def _buffer(self, what: str, n_comp: int) -> Tensor:
+        """A reused work tensor, (C, n_comp, P) packed correlations ("corr") or (C, n_comp, m, m)
+        factors ("chol"): a fresh 20 MB tensor per proposal costs page faults."""
+        key = (what, n_comp)
+        if key not in self._buffers:
+            m = self.data.d_sim.shape[-1]
+            tail = (self.data.d_packed.shape[-1],) if what == "corr" else (m, m)
+            self._buffers[key] = self.ll_w.new_empty((self.n_chains, n_comp, *tail))
+        return self._buffers[key]
+
     def reset(self, params: dict[str, Tensor]) -> None:
         """Set every chain's parameters (name -> (C, *shape)) and recompute all cached terms."""
         self.params = params
         d = self.data
         shared = all(k in self.problem.fixed for k in SIM_PARAMS)  # calibration: one Sigma_W
         prm = {k: params[k][:1] if shared else params[k] for k in SIM_PARAMS}
-        # R_j = exp(-sum_k beta_kj d_k) per chain, cached: a precision proposal only rescales it
-        self.corr = None if shared else scaled_correlation(prm["betaU"], d.d_sim, _ONE(prm))
-        sig = scaled_correlation(prm["betaU"], d.d_sim, prm["lamUz"])
-        self.chol, self.alpha, self.ll_w = _factor_sigma(
-            sig, d.w, d.lam_sim, prm["lamWs"], prm["lamWOs"]
-        )
+        if shared:  # one Sigma_W, factored once
+            self.corr = None
+            sig = scaled_correlation(prm["betaU"], d.d_sim, prm["lamUz"])
+            self.chol, self.alpha, self.ll_w = _factor_sigma(
+                sig, d.w, d.lam_sim, prm["lamWs"], prm["lamWOs"]
+            )
+        else:  # R_j per chain, packed and cached: a precision proposal only rescales it
+            n, p_u, m = self.n_chains, d.w.shape[0], d.d_sim.shape[-1]
+            corr = prm["betaU"].new_empty((n, p_u, d.d_packed.shape[-1]))
+            self.corr = correlation_packed(prm["betaU"], d, corr)
+            chol = prm["betaU"].new_empty((n, p_u, m, m)) if d.has_obs else None
+            self.chol, self.alpha, self.ll_w = _factor_scaled(
+                self.corr, 1.0 / prm["lamUz"], d, slice(None), prm["lamWs"], prm["lamWOs"],
+                out=chol, scratch=self._scratch,
+            )  # fmt: skip
         if shared:
             self.ll_w = self.ll_w.expand(self.n_chains, -1).clone()
         if not d.has_obs:
@@ -390,14 +481,16 @@ class BatchState:
         if name in SIM_PARAMS:
             whole = name == "lamWOs" or d.w.shape[0] == 1
             comps = slice(None) if whole else slice(idx[-1], idx[-1] + 1)
-            if name == "betaU":  # a new correlation matrix
-                corr_c = scaled_correlation(prm["betaU"][:, :, comps], d.d_sim,
-                                            _ONE(prm)[:, comps])  # fmt: skip
+            j_c = d.w.shape[0] if whole else 1
+            if name == "betaU":  # a new correlation matrix, into a reused buffer
+                corr_c = correlation_packed(prm["betaU"][:, :, comps], d,
+                                            self._buffer("corr", j_c))  # fmt: skip
             else:  # the cached one, rescaled
                 corr_c = self.corr[:, comps]
             chol_c, alpha_c, ll_c = _factor_scaled(
-                corr_c, 1.0 / prm["lamUz"][:, comps], d.w[comps], d.lam_sim[comps],
-                prm["lamWs"][:, comps], prm["lamWOs"],
+                corr_c, 1.0 / prm["lamUz"][:, comps], d, comps, prm["lamWs"][:, comps],
+                prm["lamWOs"], out=self._buffer("chol", j_c) if d.has_obs else None,
+                scratch=self._scratch,
             )  # fmt: skip
             ll_w, chol, alpha = ll_c, chol_c, alpha_c
             if not whole:
@@ -417,9 +510,9 @@ class BatchState:
         if name in SIM_PARAMS:
             self.ll_w[take] = ll_w[take]
             if name == "betaU":
-                self.corr[take, comps] = corr_c[take]
+                _copy_rows(self.corr[:, comps], corr_c, take)
             if d.has_obs:
-                self.chol[take, comps] = chol_c[take]
+                _copy_rows(self.chol[:, comps], chol_c, take)
                 self.alpha[take, comps] = alpha_c[take]
         return accepted
 

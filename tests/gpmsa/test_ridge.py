@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 import torch
+from threadpoolctl import threadpool_limits
 
 import gpmsa
 from gpmsa import backends
@@ -10,6 +11,12 @@ from gpmsa.mcmc import ridge
 from gpmsa.mcmc.diagnostics import ess
 from gpmsa.mcmc.sampler import ChainState
 
+
+@pytest.fixture(autouse=True)
+def one_blas_thread():
+    """BatchState and ChainState used directly: LAPACK on one thread, as the samplers run it."""
+    with threadpool_limits(1):
+        yield
 
 @pytest.fixture(scope="module")
 def scalar_problem():
