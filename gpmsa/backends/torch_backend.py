@@ -1,10 +1,15 @@
 """torch backend: GPM/SA's log-posterior and Metropolis-within-Gibbs with many chains batched.
 
 Every tensor carries a leading chain axis C; one scalar Metropolis update moves that element in all
-chains at once (batched Cholesky of Sigma_W over (C, m, m) with ``torch.linalg.cholesky_ex``).
-Proposals, bounds, sweep order and step-size tuning are those of the numpy reference
-(``gpmsa.mcmc.sampler``, ``gpmsa.mcmc.tuning``); chains share one set of tuned widths, fitted on the
-acceptance counts pooled over chains. Float64 by default; ``device="cuda"`` runs on a GPU when
+chains at once. Proposals, bounds, sweep order, the nugget-ridge moves and step-size tuning are
+those of the numpy reference (``gpmsa.mcmc.sampler``, ``gpmsa.mcmc.ridge``,
+``gpmsa.mcmc.tuning``); chain c starts where the numpy chain c would (``gpmsa.mcmc.starts``:
+dispersed for several chains), and the chains share one set of widths, tuned on acceptance
+counts pooled over chains in ``tune_stages`` stages, each after ``warmup`` sweeps from where the
+last stage left the chains.
+Each chain caches its correlation matrices (packed lower triangle). Sigma_W is factored per chain
+by LAPACK on the CPU (in cache, no copies; ``factor_``, ``_factor_scaled``) and by batched
+``torch.linalg.cholesky_ex`` elsewhere. Float64 by default; ``device="cuda"`` runs on a GPU when
 present.
 
 The correlation R = exp(-sum_k beta_k d_k^2) is GPyTorch's ARD ``RBFKernel`` with lengthscale
@@ -605,12 +610,17 @@ def sample(
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
-    Tuning (``tune=True``) is GPM/SA's: ``tune_levels`` candidate widths per element, each
-    level swept ``tune_rounds`` times by every chain; the acceptance counts are pooled over the
-    chains, so the default ``tune_rounds`` = ceil(50 / n_chains) gives each level at least
-    GPM/SA's 50 trials per element. All chains start at ``problem.init`` and share the tuned
-    widths. ``step_widths`` replace GPM/SA's initial widths. Draws hold every sweep (no burn-in
-    removed). ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
+    Starts: ``init`` ("auto": GPM/SA's initial values for one chain, dispersed ones for several,
+    chain c as the numpy backend's chain c; see ``gpmsa.mcmc.starts``). Warm-up and tuning
+    (``tune=True``): ``tune_stages`` (3) stages of ``warmup`` (100) sweeps followed by GPM/SA's
+    tuning: ``tune_levels`` candidate widths per element, each level swept ``tune_rounds`` times
+    by every chain, the acceptance counts pooled over the chains (the default ``tune_rounds`` =
+    ceil(50 / n_chains) gives each level at least GPM/SA's 50 trials per element); each stage
+    starts from the last one's widths, where the chains then are (tuned once from dispersed
+    starts, the widths fit the transient, not the posterior). All chains share the widths.
+    ``step_widths`` replace GPM/SA's initial widths. ``ridge_moves``: nugget-ridge moves per
+    sweep (``gpmsa.mcmc.ridge``). Draws hold every sweep after the warm-up (no burn-in removed).
+    ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
     ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
     torch's setting.

@@ -5,6 +5,9 @@ betaV, betaU, lamVz, lamUz, lamWs, lamWOs, lamOs (betaU element order: input ind
 GPM/SA's column-major loop). Proposals: uniform random walk (theta; beta on the rho = exp(-beta/4)
 scale; precisions). Untuned precisions use GPM/SA's proportional step (width max(1, x/3)) with its
 Hastings correction. A proposal outside the prior bounds is rejected without a likelihood call.
+Where it applies (one basis component, no observations) each sweep ends with moves along the
+lamWs/lamWOs nugget ridge (``gpmsa.mcmc.ridge``; not in GPM/SA, ``ridge_moves=0`` turns them off).
+Several chains run as parallel tasks (``gpmsa.mcmc.parallel``), each on its own seed.
 """
 
 from __future__ import annotations
