@@ -278,3 +278,11 @@ def test_dispersed_starts_are_inside_the_prior_and_differ(problem):
     chains = backends.get("numpy").sample(problem, n_chains=3, seed=4, **SHORT)
     first = chains.info["starts"]["lamUz"][:, 0]
     assert len(set(first.tolist())) == 3
+
+
+def test_progress_with_parallel_chains_is_one_bar_over_the_chains(problem, capsys):
+    chains = backends.get("numpy").sample(
+        problem, n_chains=2, seed=5, n_jobs=2, progress=True, **SHORT
+    )
+    err = capsys.readouterr().err
+    assert "chain: 100%" in err and "2/2" in err and chains.n_chains == 2
