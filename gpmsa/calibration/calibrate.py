@@ -34,7 +34,7 @@ from gpmsa.calibration.sampler import CalibrationSampler
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
-from gpmsa.mcmc.parallel import run_chains
+from gpmsa.mcmc.parallel import n_workers, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model.data import ObsData
 from gpmsa.model.problem import Problem, default_init, reduce_obs
@@ -201,6 +201,7 @@ def _run_fast(
     if extra is not None:  # a callable of this process: the chains run here
         if where["executor"] is not None:
             raise GPMSAError("log_prior is a callable of this process: it cannot go to executor=")
+        n_workers(where["n_jobs"], n_chains)  # still refuse a bad n_jobs
         where = {"n_jobs": 1, "executor": None}
     tasks = [
         {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune,

@@ -286,3 +286,22 @@ def test_progress_with_parallel_chains_is_one_bar_over_the_chains(problem, capsy
     )
     err = capsys.readouterr().err
     assert "chain: 100%" in err and "2/2" in err and chains.n_chains == 2
+
+
+def test_calibrate_refuses_bad_placement():
+    from _backend_cases import road_data
+
+    emu = gpmsa.Emulator.from_params(
+        road_data()[0],
+        {"betaU": [[0.924], [0.354]], "lamUz": [0.453], "lamWs": [164.6], "lamWOs": [837.1]},
+    )
+    x, y = [[1.25]], [[12.1]]
+    cpus = parallel.available_cpus()
+    with pytest.raises(gpmsa.GPMSAError, match=f"n_jobs={cpus + 1} is more than"):
+        gpmsa.calibrate(emu, x, y, n_chains=2, n_jobs=cpus + 1)
+    with pytest.raises(gpmsa.GPMSAError, match=f"n_jobs={cpus + 1} is more than"):
+        gpmsa.calibrate(emu, x, y, n_chains=2, n_jobs=cpus + 1, log_prior=lambda t: 0.0 * t)
+    with ThreadPoolExecutor(1) as ex, pytest.raises(gpmsa.GPMSAError, match="cannot go to exec"):
+        gpmsa.calibrate(emu, x, y, n_chains=2, executor=ex, log_prior=lambda t: 0.0 * t)
+    with pytest.raises(gpmsa.GPMSAError, match="backend 'torch' runs its chains in one process"):
+        gpmsa.calibrate(emu, x, y, n_chains=2, backend="torch", n_jobs=1)
