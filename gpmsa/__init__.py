@@ -10,6 +10,8 @@ from gpmsa.calibration.calibrator import Calibrator
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import (
     BackendUnavailableError,
+    ChainError,
+    ConvergenceWarning,
     EmulatorFileError,
     GPMSAError,
     OutsideEmulatorWarning,
@@ -32,7 +34,9 @@ from gpmsa.predictive import (
 __all__ = [
     "BackendUnavailableError",
     "Calibrator",
+    "ChainError",
     "Chains",
+    "ConvergenceWarning",
     "Emulator",
     "EmulatorFileError",
     "GPMSAError",

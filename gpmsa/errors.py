@@ -20,3 +20,18 @@ class BackendUnavailableError(ImportError):
 
 class OutsideEmulatorWarning(UserWarning):
     """An observation lies outside what the emulator has seen (far from all its predictions)."""
+
+
+class ChainError(GPMSAError):
+    """A chain failed (its task raised, its worker died, or its draws are not finite).
+
+    ``chains`` lists the indices (0-based) of the chains concerned; the message names them.
+    """
+
+    def __init__(self, message: str, chains: tuple[int, ...] = ()):
+        super().__init__(message)
+        self.chains = tuple(chains)
+
+
+class ConvergenceWarning(UserWarning):
+    """Several chains disagree (R-hat above its limit) or give too few effective draws."""

@@ -17,6 +17,7 @@ import time
 from dataclasses import replace
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from gpmsa import backends
 from gpmsa.calibration.observations import (
@@ -39,6 +40,9 @@ from gpmsa.calibration.sampler import CalibrationSampler
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
+from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
+from gpmsa.mcmc.parallel import n_workers, run_chains
+from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model.data import ObsData, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
@@ -99,6 +103,8 @@ def calibrate(
     fast: bool | None = None,
     log_prior=None,
     progress: bool = False,
+    n_jobs: int | None = None,
+    executor=None,
 ) -> Posterior:
     """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
 
@@ -120,6 +126,15 @@ def calibrate(
             ``Calibrator.update`` takes it ((k,) values for one parameter, (k, q) for more ->
             (k,) log densities; called with k = 1); fast path only.
         progress: show a tqdm bar.
+        n_jobs, executor: where several chains run (numpy backend): ``n_jobs`` worker processes
+            (None: every CPU, never more than the chains) or any ``concurrent.futures.Executor``
+            / dask ``Client``; each chain has its own seed, so the draws do not depend on it.
+            With ``log_prior`` (a callable, not shipped to workers) the chains run here.
+
+    With more than one chain, ``info["diagnostics"]`` holds each parameter's rank-normalised
+    R-hat and bulk ESS (and mean, sd), ``info["convergence"]`` the verdict, and a
+    ``gpmsa.ConvergenceWarning`` names each parameter with R-hat > 1.01 or ESS < 100. A chain
+    that fails or produces non-finite draws raises ``gpmsa.ChainError`` naming it.
 
     Returns:
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
@@ -143,19 +158,21 @@ def calibrate(
     _check_calibrate_memory(emulator, n_samples, n_chains, fast)
     t0 = time.perf_counter()
     with blas_controller().limit(limits=1, user_api="blas"):
+        where = {"n_jobs": n_jobs, "executor": executor}
         data = reduce(emulator, x_obs, y_obs, extrapolate)
         fit = _probe(emulator, data, sets)
         warn_if_outside(fit)
         if fast:
             draws, info = _run_fast(
                 emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds,
-                tune_levels, seed, log_prior, progress,
+                tune_levels, seed, log_prior, progress, where,
             )  # fmt: skip
         else:
             draws, info = _run_backend(
                 emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
-                tune_rounds, tune_levels, seed, extrapolate, progress,
+                tune_rounds, tune_levels, seed, extrapolate, progress, where,
             )  # fmt: skip
+    require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
     samples = {k: v.reshape(-1) for k, v in chains.items()}
     info.update(
@@ -163,6 +180,11 @@ def calibrate(
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds,
     )  # fmt: skip
+    if n_chains > 1:
+        info["diagnostics"] = summarize(chains)
+        shapes = {k: v.shape[2:] for k, v in chains.items()}
+        info["convergence"] = convergence(info["diagnostics"], shapes, n_chains, n_samples - n_burn)
+        warn_unconverged(info["convergence"], f"gpmsa.calibrate (backend {backend!r})")
     return Posterior(samples, chains=chains, info=info)
 
 
@@ -186,9 +208,19 @@ def _check_calibrate_memory(emulator, n_samples: int, n_chains: int, fast: bool)
     )
 
 
+def _fast_chain(
+    sampler: CalibrationSampler, n_samples: int, seed: np.random.SeedSequence, tune: bool,
+    tune_rounds: int, tune_levels: int, progress: bool = False, desc: str = "calibrate",
+):  # fmt: skip
+    """One chain of the fast sampler (a worker process runs it from plain data)."""
+    with threadpool_limits(1):
+        return sampler.run(n_samples, np.random.default_rng(seed), tune=tune,
+                           tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress)
+
+
 def _run_fast(
     emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds, tune_levels, seed,
-    log_prior, progress,
+    log_prior, progress, where,
 ):  # fmt: skip
     std = emulator.standardizer
     extra = None
@@ -206,12 +238,17 @@ def _run_fast(
         [fixed_gp(emulator, s) for s in sets], data, emulator.priors, extra,
         init_lamos=lamos_start(fit, data.lamos),
     )  # fmt: skip
-    seeds = np.random.SeedSequence(seed).spawn(n_chains)
-    runs = [
-        sampler.run(n_samples, np.random.default_rng(s), tune=tune, tune_rounds=tune_rounds,
-                    tune_levels=tune_levels, progress=progress)
-        for s in seeds
+    if extra is not None:  # a callable of this process: the chains run here
+        if where["executor"] is not None:
+            raise GPMSAError("log_prior is a callable of this process: it cannot go to executor=")
+        n_workers(where["n_jobs"], n_chains)  # still refuse a bad n_jobs
+        where = {"n_jobs": 1, "executor": None}
+    tasks = [
+        {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune,
+         "tune_rounds": tune_rounds, "tune_levels": tune_levels}
+        for s in np.random.SeedSequence(seed).spawn(n_chains)
     ]  # fmt: skip
+    runs = run_chains(_fast_chain, tasks, progress=progress, desc="calibrate chain", **where)
     if any(not np.isfinite(r.log_post[-1]) for r in runs):
         raise GPMSAError(
             "the posterior has no mass where the sampler looked: log_prior is -inf there "
@@ -232,13 +269,14 @@ def _run_fast(
 
 def _run_backend(
     emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tune_rounds,
-    tune_levels, seed, extrapolate, progress,
+    tune_levels, seed, extrapolate, progress, where,
 ):  # fmt: skip
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate
     )
     module = backends.get(backend)
     opts = {"tune_rounds": tune_rounds, "tune_levels": tune_levels} if backend == "numpy" else {}
+    opts.update(backends.placement(backend, **where))
     chains = module.sample(
         problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed, progress=progress,
         **opts,

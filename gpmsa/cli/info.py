@@ -81,15 +81,48 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
             lines.append(f"metadata {safe(k, 60)}: {value(v)}")
     for name, d in manifest["diagnostics"].items():
         if isinstance(d, dict) and isinstance(d.get("mean"), list):
-            mean = ", ".join(number(v) for v in d["mean"] if v is not None)
-            ess = d.get("ess", [])
-            ess = ", ".join(number(v, ".0f") for v in ess if v is not None) if isinstance(
-                ess, list
-            ) else value(ess)  # fmt: skip
-            lines.append(f"posterior {safe(name, 60)}: mean [{safe(mean, 300)}] ESS "
-                         f"[{safe(ess, 300)}]")  # fmt: skip
+            cells = {}
+            for key, fmt in (("mean", ".4g"), ("ess", ".0f"), ("rhat", ".3f")):
+                vals = d.get(key, [])
+                cells[key] = (
+                    ", ".join(number(v, fmt) for v in vals if v is not None)
+                    if isinstance(vals, list) else value(vals)
+                )  # fmt: skip
+            lines.append(
+                f"posterior {safe(name, 60)}: mean [{safe(cells['mean'], 300)}] ESS "
+                f"[{safe(cells['ess'], 300)}] R-hat [{safe(cells['rhat'], 300)}]"
+            )
         else:
             lines.append(f"diagnostics {safe(name, 60)}: {value(d)}")
+    lines.append(_convergence_line(manifest.get("convergence")))
     n_arr = sum(int(a.size) for a in arrays.values())
     lines.append(f"arrays:          {len(arrays)} ({n_arr} values)")
     return lines
+
+
+def _convergence_line(rec: object) -> str:
+    """One line on the chains' convergence (files of one chain or older ones have no record)."""
+    if not rec:
+        return "convergence:     not checked (one chain, or a file from before the check)"
+    if not isinstance(rec, dict):
+        return f"convergence:     {value(rec)}"
+    try:
+        (r_el, r_val), (e_el, e_val) = rec["max_rhat"], rec["min_ess"]
+    except (KeyError, TypeError, ValueError):
+        return f"convergence:     {value(rec)}"
+    if r_val is None or e_val is None:
+        worst = "R-hat and ESS undefined (constant draws)"
+    else:
+        worst = (f"max R-hat {number(r_val, '.3f')} ({safe(r_el, 60)}), min bulk ESS "
+                 f"{number(e_val, '.0f')} ({safe(e_el, 60)})")  # fmt: skip
+    head = (f"convergence:     {plain(rec.get('n_chains'))} chains x "
+            f"{plain(rec.get('n_draws'))} draws; {worst}; ")  # fmt: skip
+    flagged = rec.get("flagged") or {}
+    if not flagged:
+        return head + (f"converged (R-hat <= {plain(rec.get('rhat_max'))}, ESS >= "
+                       f"{number(rec.get('ess_min'), '.0f')})")  # fmt: skip
+    if not isinstance(flagged, dict):
+        return head + "NOT converged: " + value(flagged)
+    return head + "NOT converged: " + "; ".join(
+        f"{safe(k, 60)}: {plain(v)}" for k, v in flagged.items()
+    )

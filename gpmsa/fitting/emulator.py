@@ -78,7 +78,9 @@ class Emulator:
     draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected), x_names,
     t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
     settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
-    lamOs draws of a joint sim+obs fit, else None).
+    lamOs draws of a joint sim+obs fit, else None), convergence (several chains: R-hat and bulk
+    ESS of every sampled parameter and the elements flagged, see
+    ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files).
     """
 
     def __init__(
@@ -101,6 +103,7 @@ class Emulator:
         settings: dict | None = None,
         diagnostics: dict | None = None,
         calibration: dict[str, np.ndarray] | None = None,
+        convergence: dict | None = None,
     ):
         self.standardizer = standardizer
         self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
@@ -116,6 +119,7 @@ class Emulator:
         self.settings = dict(settings or {})
         self.diagnostics = dict(diagnostics or {})
         self.calibration = calibration
+        self.convergence = convergence
         self._factors: dict[int, list] = {}
 
     # --- construction -------------------------------------------------------------------------
@@ -407,6 +411,8 @@ class Emulator:
             "diagnostics": self.diagnostics,
         }
         _check_metadata(self.metadata, "metadata")
+        if self.convergence is not None:
+            manifest["convergence"] = self.convergence
         manifest = jsonable(manifest)
         try:
             json.dumps(manifest["metadata"], allow_nan=False)
@@ -439,7 +445,7 @@ class Emulator:
                 priors=Priors.from_dict(manifest["priors"]), names=names, units=units,
                 draws=draws, log_post=arrays["log_post"], metadata=manifest["metadata"],
                 settings=manifest["settings"], diagnostics=manifest["diagnostics"],
-                calibration=cal,
+                calibration=cal, convergence=manifest.get("convergence"),  # check_fields checked it
             )  # fmt: skip
             _check_consistent(emu)
             domain = {k: list(v) for k, v in emu.domain.items()}

@@ -199,6 +199,8 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
     for key in ("metadata", "diagnostics"):
         if not isinstance(manifest.get(key), dict):
             raise _fail(key, f"must be an object, got {_short(manifest.get(key))}")
+    if manifest.get("convergence") is not None and not isinstance(manifest["convergence"], dict):
+        raise _fail("convergence", f"must be an object, got {_short(manifest['convergence'])}")
 
 
 def check_manifest(manifest: dict) -> None:

@@ -40,8 +40,9 @@ limits, read at call time) sits just above the leaves."""
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 
 PUBLIC = [
-    "BackendUnavailableError", "Calibrator", "Chains", "Emulator", "EmulatorFileError",
-    "GPMSAError", "GammaPrior", "LooResult", "ObsData", "ObsProblem", "OutsideEmulatorWarning",
+    "BackendUnavailableError", "Calibrator", "ChainError", "Chains", "ConvergenceWarning",
+    "Emulator", "EmulatorFileError", "GPMSAError", "GammaPrior", "LooResult", "ObsData",
+    "ObsProblem", "OutsideEmulatorWarning",
     "Posterior", "Priors", "Problem", "ResourceLimitError", "SimData", "backends", "calibrate",
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
     "limits", "load", "plots", "predictive", "prepare", "sensitivity",
