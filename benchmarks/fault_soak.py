@@ -26,13 +26,22 @@ coarse quantisation over the whole rough part, a partly stuck sensor, NaN time s
 positions; and one extra example (not the issue's): all samples dropped for 20 s from 3 s
 before the rough part.
 
+The loop is chaotic: a perturbation of the samples far below anything a check could see (a gain
+of 1 + 1e-9 over the fault's time, the "null" run, made for every random scenario) already
+changes later estimates, speeds and so the fast-on-rough distance by metres either way. The
+faults are therefore also compared with the null runs, per scenario (paired).
+
 Printed (with the load average): scenarios run, crashes (with their exceptions), per fault kind
 the scenarios whose faulted run drove farther too fast on rough ground than the clean one (how
 many, the worst excess and its scenario) and the distribution of the difference (faulted minus
 clean, m: the loop is chaotic, a fault that changes one estimate changes later speeds, so a
-fault can also make a run safer), the statuses the faults produced, the examples' table, and
-for the ``--explain`` worst scenarios the updates around the fault (faulted and clean) with the
-call that reproduces them. Exits with status 1 if any run crashed.
+fault can also make a run safer), the same against the null runs, the statuses the faults
+produced, the examples' table, and for the ``--explain`` worst scenarios (faster while the fault
+lasts; faster over the whole run) the updates around the fault (faulted and clean), the
+fast-on-rough distance per rough segment (clean, faulted, null) and the call that reproduces
+them (with one BLAS thread: the soak's workers run with one, and a different thread count
+changes the emulator's factors in the last bits, which the chaotic loop amplifies). Exits with
+status 1 if any run crashed.
 """
 
 from __future__ import annotations
@@ -47,6 +56,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import stats
 
 import control
 import roadgen
@@ -61,6 +71,7 @@ MAGNITUDE = {  # log-uniform ranges of the fault-like magnitudes
     "clip": ((1e-3, 2.0),),
 }
 DURATION_S = (0.05, 20.0)
+NULL_GAIN = 1.0 + 1e-9  # the null perturbation: a gain error no check can see
 ROUGH_PART_S = 50.0  # the paper track's rough part lasts at most 50 m / v_safe = 50 s
 EXAMPLES = (  # (name, kind, start after entering the rough part s, duration s, magnitude)
     ("spikes 1e6 every sample", "spike", 0.0, ROUGH_PART_S, 1.0),
@@ -128,8 +139,12 @@ class Outcome:
     fast_fault: float = np.nan
     during_clean: float = np.nan
     during_fault: float = np.nan
+    fast_null: float = np.nan
+    during_null: float = np.nan
     statuses: Counter = field(default_factory=Counter)
     excerpt: list = field(default_factory=list)
+    segments: list = field(default_factory=list)
+    fault_span_m: tuple = (np.nan, np.nan)
 
     @property
     def diff(self) -> float:
@@ -138,6 +153,14 @@ class Outcome:
     @property
     def during_diff(self) -> float:
         return self.during_fault - self.during_clean
+
+    @property
+    def null_diff(self) -> float:
+        return self.fast_null - self.fast_clean
+
+    @property
+    def null_during_diff(self) -> float:
+        return self.during_null - self.during_clean
 
 
 def fast_between(result, track, t0: float, t1: float) -> float:
@@ -217,8 +240,26 @@ def _crash(exc: BaseException, which: str) -> str:
     return f"{which} run: {type(exc).__name__}: {exc}\n" + "".join(tail)
 
 
-def run_scenario(sc: Scenario, keep_excerpt: bool = False) -> Outcome:
-    """Clean and faulted loop of one scenario."""
+def rough_segments(track, runs, gd_max: float) -> list:
+    """Per segment with GD > gd_max: (start m, end m, GD, fast-on-rough m of each run there)."""
+    edges = [*track.boundaries_m, track.length_m]
+    out = []
+    for k, (_, gd) in enumerate(track.segments):
+        if gd <= gd_max:
+            continue
+        fast = []
+        for r in runs:
+            sel = (r.sample_position >= edges[k]) & (r.sample_position < edges[k + 1])
+            fast.append(control.fast_on_rough_m(
+                track, r.sample_position[sel], r.sample_speed[sel], gd_max,
+                r.settings["simplex"].v_safe,
+            ))  # fmt: skip
+        out.append((edges[k], edges[k + 1], gd, *fast))
+    return out
+
+
+def run_scenario(sc: Scenario, keep_excerpt: bool = False, null: bool = True) -> Outcome:
+    """Clean, faulted and (``null``) imperceptibly perturbed loop of one scenario."""
     out = Outcome(sc)
     try:
         track = roadgen.track(sc.segments, seed=sc.track_seed)
@@ -239,9 +280,30 @@ def run_scenario(sc: Scenario, keep_excerpt: bool = False) -> Outcome:
     out.during_fault = fast_between(faulted, track, fault.start_s, end)
     during = (faulted.time >= fault.start_s) & (faulted.time <= end)
     out.statuses = Counter(faulted.status[during].tolist())
+    runs = [clean, faulted]
+    if null:
+        try:
+            perturbed = _loop(sc, track, (control.SensorFault(
+                fault.start_s, fault.duration_s, "scale", NULL_GAIN),))  # fmt: skip
+        except Exception as exc:  # noqa: BLE001
+            out.crash = _crash(exc, "null")
+            return out
+        out.fast_null = perturbed.metrics.fast_on_rough_m
+        out.during_null = fast_between(perturbed, track, fault.start_s, end)
+        runs.append(perturbed)
     if keep_excerpt or out.diff > 0 or out.during_diff > 0:
         out.excerpt = excerpt(clean, faulted, fault)
+        out.segments = rough_segments(track, runs, clean.settings["simplex"].gd_max)
+        out.fault_span_m = tuple(
+            float(np.interp(t, faulted.sample_time, faulted.sample_position))
+            for t in (fault.start_s, fault.start_s + fault.duration_s)
+        )
     return out
+
+
+def _job(job: tuple[Scenario, bool]) -> Outcome:
+    sc, null = job
+    return run_scenario(sc, null=null)
 
 
 def excerpt(clean, faulted, fault, before_s: float = 3.0, after_s: float = 12.0) -> list:
@@ -269,7 +331,17 @@ def print_excerpt(o: Outcome) -> None:
         f"for {f.duration_s:.3g} s; track {list(sc.segments)}; fast on rough: clean "
         f"{o.fast_clean:.2f} m, faulted {o.fast_fault:.2f} m"
     )
-    print(f"  reproduce: {sc.reproduce(f)}")
+    print(f"  reproduce (with one BLAS thread, as the soak's workers): {sc.reproduce(f)}")
+    names = ("clean", "faulted", "null")
+    print(
+        f"  fault from {o.fault_span_m[0]:.1f} to {o.fault_span_m[1]:.1f} m; fast on rough per "
+        "segment with GD > GD_max: "
+        + "; ".join(
+            f"[{a:.0f}-{b:.0f} m, GD {gd:.0f}] "
+            + " ".join(f"{n} {x:.1f}" for n, x in zip(names, fast, strict=False))
+            for a, b, gd, *fast in o.segments
+        )
+    )
     print(
         f"  {'t s':>7}{'pos m':>8}{'GD':>5} {'status':<12}{'GD est':>7}{'cmd':>6} | "
         f"{'clean GD':>8}{'cmd':>6}{'pos m':>8}  reason (faulted)"
@@ -321,6 +393,35 @@ def summarise(outcomes: list[Outcome]) -> None:
                 f"{sum(o.fast_clean for o in mine):.1f} m, faulted "
                 f"{sum(o.fast_fault for o in mine):.1f} m"
             )
+    with_null = [o for o in done if np.isfinite(o.fast_null)]
+    if not with_null:
+        return
+    print(
+        f"\nthe faults against the chaos of the loop ({load()}): 'null' reruns each scenario with "
+        f"the fault replaced by a gain of 1 + 1e-9 over the same time (no check can see it); "
+        "the loop is chaotic, so the null run also drives differently from the clean one. "
+        "p: one-sided Wilcoxon signed-rank test that the faulted run is faster on rough ground "
+        "than the null run (pairs per scenario)"
+    )
+    print(
+        f"{'kind':<13}{'n':>4}{'worse: fault':>13}{'null':>6}{'mean diff: fault':>17}{'null':>7}"
+        f"{'p95: fault':>11}{'null':>7}{'p':>8} | during: {'fault worse':>11}{'null worse':>11}"
+    )
+    for kind in (*control.FAULT_KINDS, "all"):
+        sel = [o for o in with_null if kind == "all" or o.scenario.kind == kind]
+        if not sel:
+            continue
+        d = np.array([o.diff for o in sel])
+        d0 = np.array([o.null_diff for o in sel])
+        paired = d - d0
+        p = stats.wilcoxon(paired, alternative="greater").pvalue if np.any(paired != 0) else np.nan
+        print(
+            f"{kind:<13}{len(sel):4d}{int(np.sum(d > 0)):13d}{int(np.sum(d0 > 0)):6d}"
+            f"{d.mean():+17.2f}{d0.mean():+7.2f}{np.percentile(d, 95):11.2f}"
+            f"{np.percentile(d0, 95):7.2f}{p:8.3f} | {'':8}"
+            f"{sum(o.during_diff > 0 for o in sel):11d}"
+            f"{sum(o.null_during_diff > 0 for o in sel):11d}"
+        )
     print("\nstatuses of the updates during the faults (to their end + 2 blocks), per kind")
     for kind in control.FAULT_KINDS:
         total = sum((o.statuses for o in done if o.scenario.kind == kind), Counter())
@@ -357,6 +458,11 @@ def main(argv: list[str] | None = None) -> int:
         help="print the updates around the fault of this many worst scenarios",
     )
     parser.add_argument(
+        "--no-null",
+        action="store_true",
+        help="skip the null runs (the fault replaced by an invisible 1e-9 gain error)",
+    )
+    parser.add_argument(
         "--only",
         type=int,
         default=None,
@@ -364,6 +470,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)  # fmt: skip
     if args.only is not None:
+        _init_worker()  # one BLAS thread, as in the soak: the loop is chaotic to the last bit
         o = run_scenario(random_scenario(args.seed, args.only), keep_excerpt=True)
         if o.crash:
             print(o.crash)
@@ -378,14 +485,16 @@ def main(argv: list[str] | None = None) -> int:
 
     tic = time.perf_counter()
     with ProcessPoolExecutor(max_workers=args.workers, initializer=_init_worker) as pool:
-        outcomes = list(pool.map(run_scenario, scenarios + examples, chunksize=1))
+        jobs = [(sc, not args.no_null) for sc in scenarios] + [(sc, False) for sc in examples]
+        outcomes = list(pool.map(_job, jobs, chunksize=1))
     wall = time.perf_counter() - tic
     random_out, example_out = outcomes[:n], outcomes[n:]
     crashes = [o for o in outcomes if o.crash]
     print(
         f"fault soak: {n} random scenarios ({sum(s.case == 'A' for s in scenarios)} case A, "
         f"{sum(s.case == 'B' for s in scenarios)} case B; seed {args.seed}) + {len(examples)} "
-        f"examples, {2 * len(outcomes)} loop runs in {wall:.0f} s on {args.workers} workers; "
+        f"examples, {2 * len(outcomes) + (0 if args.no_null else n)} loop runs in {wall:.0f} s "
+        f"on {args.workers} workers; "
         f"{load()}"
     )
     print(f"crashes: {len(crashes)}")
@@ -411,12 +520,20 @@ def main(argv: list[str] | None = None) -> int:
                 f"{o.fast_fault:9.2f}{o.diff:+7.2f}{o.during_diff:+7.2f}  {st}"
             )
 
-    worse = sorted((o for o in outcomes if not o.crash and o.diff > 0), key=lambda o: -o.diff)
-    if worse and args.explain:
-        print(f"\nthe {min(args.explain, len(worse))} scenarios with the largest excess: updates "
-              "around the fault ('!': faster than v_safe on GD > 350)")  # fmt: skip
-        for o in worse[: args.explain]:
-            print_excerpt(o)
+    ok = [o for o in outcomes if not o.crash]
+    during = sorted((o for o in ok if o.during_diff > 0), key=lambda o: -o.during_diff)
+    worse = sorted((o for o in ok[:n] if o.diff > 0), key=lambda o: -o.diff)
+    for title, chosen in (
+        ("faster on rough ground than the clean run while the fault lasts", during),
+        ("random scenarios with the largest excess over the whole run", worse),
+    ):
+        if chosen and args.explain:
+            print(
+                f"\n{title}: {len(chosen)}; the first {min(args.explain, len(chosen))}, with the "
+                "updates around the fault ('!': faster than v_safe on GD > GD_max)"
+            )
+            for o in chosen[: args.explain]:
+                print_excerpt(o)
     print(f"\ntotal {time.perf_counter() - tic:.0f} s; {load()}")
     return 1 if crashes else 0
 
