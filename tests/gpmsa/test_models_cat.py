@@ -233,3 +233,13 @@ def test_other_backends_and_predictions_refuse_the_extensions(cat_emulator):
     pytest.importorskip("torch")
     with pytest.raises(gpmsa.GPMSAError, match="torch backend does not support categorical"):
         gpmsa.fit(cat_data(), n_iter=5, backend="torch")
+
+
+def test_info_shows_categorical_and_mean_basis(cat_emulator, tmp_path, capsys):
+    from gpmsa.cli.main import main
+
+    path = cat_emulator.save(tmp_path / "cat.gpmsa")
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "categorical:     kind levels [0, 1, 2]" in out
+    assert "mean basis:      zero (GPM/SA)" in out
