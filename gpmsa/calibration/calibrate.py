@@ -205,6 +205,7 @@ def calibrate(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds,
+        units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
     )  # fmt: skip
     if n_chains > 1:
         info["diagnostics"] = summarize(chains)

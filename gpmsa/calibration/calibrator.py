@@ -372,6 +372,7 @@ class Calibrator:
             "refined": theta is not self._theta_unit,
             "log_evidence": log_evidence,
             "emulator_params": self.emulator_params,
+            "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
         return Posterior(grids=grids, draw=draw, info=info)
 
