@@ -185,6 +185,27 @@ def test_standing_still_keeps_the_estimate_until_it_turns_stale(block_model):
     assert ests[-1].status == "stale" and "s old" in ests[-1].reason
 
 
+def test_a_silent_sensor_is_a_fault_when_the_caller_gives_its_clock(block_model):
+    bcr = BCR(block_model)
+    t, p, a, v = stream(const(400), 1.5, 10, seed=1)
+    assert feed(bcr, t, p, a, v)[-1].ok
+    empty = np.empty(0)
+    assert bcr.update(empty, empty, empty, empty, now=t[-1] + 0.4).ok  # within max_silence_s
+    est = bcr.update(empty, empty, empty, empty, now=t[-1] + 0.8)
+    assert est.status == "sensor_fault" and "no samples for 0.80 s" in est.reason
+    assert est.time == pytest.approx(t[-1] + 0.8)
+    assert bcr.update(empty, empty, empty, empty).status == "sensor_fault"  # still silent
+    t2, p2, a2, v2 = stream(const(400), 1.5, 20, seed=1)
+    later = t2 > t[-1] + 1.0  # samples again (after a gap: the stream restarts)
+    ests = feed(bcr, t2[later], p2[later], a2[later], v2[later])
+    assert ests[-1].ok
+    with pytest.raises(ControlError, match="now must be a finite time"):
+        bcr.update(empty, empty, empty, empty, now=np.nan)
+    quiet = BCR(block_model)  # without the clock a silent sensor keeps the last estimate
+    assert feed(quiet, t, p, a, v)[-1].ok
+    assert quiet.update(empty, empty, empty, empty).ok
+
+
 def test_speed_outside_the_domain_before_any_estimate(block_model):
     ests = feed(BCR(block_model), *stream(const(400), 0.3, 3, seed=1))
     assert ests[-1].status == "out_of_domain" and "0.3 m/s" in ests[-1].reason
