@@ -28,8 +28,15 @@ PARAMS = {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1000.0], "lamWOs": 
 
 @cache
 def emulator(priors: gpmsa.Priors | None = None, t_lo: float = 0.0, t_hi: float = 1.0,
-             t_name: str = "t") -> gpmsa.Emulator:  # fmt: skip
-    return gpmsa.Emulator.from_params(sim_data(t_lo, t_hi, t_name), PARAMS, priors)
+             t_name: str = "t", lam_w: float = 1000.0) -> gpmsa.Emulator:  # fmt: skip
+    """The emulator at fixed parameters; ``lam_w``: its lamWs and lamWOs (1e5 - 1: a nugget so
+    small that the emulator is in effect the simulator, for checks of interval coverage)."""
+    params = {**PARAMS, "lamWs": [lam_w], "lamWOs": [lam_w]}
+    return gpmsa.Emulator.from_params(sim_data(t_lo, t_hi, t_name), params, priors)
+
+
+EXACT = 1e5 - 1.0
+"""``lam_w`` of an emulator whose nugget is negligible."""
 
 
 def observations(theta: float, n: int, sd: float, rng: np.random.Generator):
