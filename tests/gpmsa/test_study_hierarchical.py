@@ -19,8 +19,8 @@ def _synthetic(rng, n_models: int, mu: float, sd: float, n_obs: int = 3, noise: 
     return truth, [d[0] for d in data], [d[1] for d in data]
 
 
-def _run(rng, n_models, mu, sd, seed, n_samples=4000, n_burn=1000):
-    truth, xs, ys = _synthetic(rng, n_models, mu, sd)
+def _run(rng, n_models, mu, sd, seed, n_samples=4000, n_burn=1000, n_obs=3):
+    truth, xs, ys = _synthetic(rng, n_models, mu, sd, n_obs)
     emu = emulator(None, lam_w=EXACT)  # the emulator's own error would widen every interval
     study = gpmsa.calibrate_study([emu] * n_models, xs, ys, hierarchical=["t"],
                                   n_samples=n_samples, n_burn=n_burn, seed=seed)  # fmt: skip
@@ -74,13 +74,15 @@ def test_bad_hyperpriors_are_named():
 
 @pytest.mark.slow
 def test_hierarchical_intervals_cover_at_the_nominal_rate():
-    """Over 20 synthetic data sets of 6 experiments each (mu ~ U(0.35, 0.65), sd 0.12), the 90%
+    """Over 20 synthetic data sets of 6 experiments each (mu ~ U(0.35, 0.65), sd 0.12; 6
+    observations per experiment, so that each lamOs is learnt), the 90%
     intervals of the experiments' theta_i and of mu cover the truth about 90% of the time."""
     rng = np.random.default_rng(2024)
     hit_theta, hit_mu, n_sets = [], [], 20
     for r in range(n_sets):
         mu = rng.uniform(0.35, 0.65)
-        truth, study = _run(rng, 6, mu, 0.12, seed=100 + r, n_samples=2500, n_burn=500)
+        truth, study = _run(rng, 6, mu, 0.12, seed=100 + r, n_samples=2500, n_burn=500,
+                            n_obs=6)
         post = study.posterior
         for i, th in enumerate(truth):
             lo, hi = post.interval(f"t[model{i}]", 0.9)
