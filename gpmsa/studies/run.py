@@ -45,13 +45,13 @@ def _same_count(**lists) -> int:
     return n
 
 
-def _check_run(n_iter, n_burn, n_chains, seed, hyper) -> HyperPriors:
-    for name, val, low in (("n_samples", n_iter, 2), ("n_chains", n_chains, 1)):
+def _check_run(n_iter, n_burn, n_chains, seed, hyper, what: str = "n_samples") -> HyperPriors:
+    for name, val, low in ((what, n_iter, 2), ("n_chains", n_chains, 1)):
         if isinstance(val, bool) or not (isinstance(val, (int, np.integer)) and val >= low):
             raise GPMSAError(f"{name} must be an integer >= {low}, got {val!r}")
     if isinstance(n_burn, bool) or not (isinstance(n_burn, (int, np.integer))
                                         and 0 <= n_burn < n_iter - 1):  # fmt: skip
-        raise GPMSAError(f"n_burn must be an integer in [0, n_samples - 1), got {n_burn!r}")
+        raise GPMSAError(f"n_burn must be an integer in [0, {what} - 1), got {n_burn!r}")
     check_seed(seed)
     if hyper is None:
         return HyperPriors()
@@ -188,7 +188,7 @@ def fit_study(
         if not isinstance(o, ObsData):
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
     n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int) else n_burn
-    hyper = _check_run(n_iter, n_burn, n_chains, seed, hyper)
+    hyper = _check_run(n_iter, n_burn, n_chains, seed, hyper, "n_iter")
     if point not in ("mean", "map"):
         raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
     if isinstance(n_keep, bool) or not isinstance(n_keep, (int, np.integer)) or n_keep < 1:
