@@ -30,6 +30,9 @@ from gpmsa.predictive import (
     full_prediction,
     sensitivity,
 )
+from gpmsa.studies.layout import HyperPriors
+from gpmsa.studies.run import calibrate_study, fit_study
+from gpmsa.studies.study import Study, load_study
 
 __all__ = [
     "BackendUnavailableError",
@@ -41,6 +44,7 @@ __all__ = [
     "EmulatorFileError",
     "GPMSAError",
     "GammaPrior",
+    "HyperPriors",
     "LooResult",
     "ObsData",
     "ObsProblem",
@@ -50,15 +54,19 @@ __all__ = [
     "Problem",
     "ResourceLimitError",
     "SimData",
+    "Study",
     "backends",
     "calibrate",
+    "calibrate_study",
     "calibration_posterior",
     "cross_validate",
     "emulator_prediction",
     "fit",
+    "fit_study",
     "full_prediction",
     "limits",
     "load",
+    "load_study",
     "plots",
     "predictive",
     "prepare",

@@ -12,8 +12,9 @@ from gpmsa.errors import EmulatorFileError
 
 def add_parser(sub) -> None:
     """Add the ``info`` subcommand to an argparse subparsers object."""
-    p = sub.add_parser("info", help="print an emulator file's manifest (verifies it first)")
-    p.add_argument("file", help="path to a .gpmsa file")
+    p = sub.add_parser("info", help="print an emulator or study file's manifest (verifies it "
+                       "first)")  # fmt: skip
+    p.add_argument("file", help="path to a .gpmsa file (an emulator or a study)")
     p.add_argument("--json", action="store_true", help="print the raw manifest as JSON")
     p.set_defaults(func=run)
 
@@ -23,21 +24,37 @@ def run(args: argparse.Namespace) -> int:
 
     The file is verified as ``gpmsa.load`` verifies it (hash and every field of the content)
     before anything is printed; every string from it is printed escaped (``gpmsa.cli.text``).
+    A study file (``gpmsa.load_study``) is verified with every model file it lists.
     """
+    from gpmsa.cli.study_info import study_lines
     from gpmsa.fitting.emulator import Emulator
     from gpmsa.fitting.validation import check_manifest
-    from gpmsa.io.container import read_raw
+    from gpmsa.io.container import FORMAT, STUDY_FORMAT, read_raw
+    from gpmsa.studies.record import check_study_manifest
+    from gpmsa.studies.study import load_study
+
+    def check(manifest: dict) -> None:
+        is_study = manifest["format"] == STUDY_FORMAT
+        (check_study_manifest if is_study else check_manifest)(manifest)
 
     try:
-        manifest, arrays = read_raw(args.file, check_manifest)
-        Emulator.from_record(manifest, arrays)
+        manifest, arrays = read_raw(args.file, check, formats=(FORMAT, STUDY_FORMAT))
+        if manifest["format"] == STUDY_FORMAT:
+            study = load_study(args.file)
+        else:
+            Emulator.from_record(manifest, arrays)
     except EmulatorFileError as exc:
         print(f"gpmsa info: {safe(exc)}", file=sys.stderr)
         return 2
     if args.json:  # ensure_ascii: control characters come out as \u001b escapes
         print(json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True))
         return 0
-    print("\n".join(_lines(args.file, manifest, arrays)))
+    if manifest["format"] == STUDY_FORMAT:
+        lines = study_lines(args.file, manifest, study)
+        lines.append(_convergence_line(manifest.get("convergence")))
+    else:
+        lines = _lines(args.file, manifest, arrays)
+    print("\n".join(lines))
     return 0
 
 

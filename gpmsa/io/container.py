@@ -35,6 +35,8 @@ from gpmsa._version import __version__
 from gpmsa.errors import EmulatorFileError, GPMSAError
 
 FORMAT = "gpmsa-emulator"
+STUDY_FORMAT = "gpmsa-study"
+"""The format of a study file (several models' shared draws; gpmsa.studies, docs/models.md)."""
 SCHEMA_VERSION = 1
 MANIFEST = "manifest.json"
 ARRAY_DIR = "arrays/"
@@ -154,7 +156,9 @@ def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
     return raw
 
 
-def write_raw(path: str | Path, manifest: dict, arrays: dict[str, np.ndarray]) -> Path:
+def write_raw(
+    path: str | Path, manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT
+) -> Path:
     """Write ``manifest`` and ``arrays`` to ``path`` (a zip: manifest.json + arrays/NAME.npy).
 
     manifest: the content fields, JSON-able (see ``jsonable``); the envelope fields (``ENVELOPE``)
@@ -165,7 +169,8 @@ def write_raw(path: str | Path, manifest: dict, arrays: dict[str, np.ndarray]) -
     structure, flushed to disk and then moved over ``path`` in one step: a failure at any point
     leaves an existing ``path`` untouched and no temporary file behind. A member that deflates
     beyond ``limits.MAX_RATIO`` (e.g. zero padding) is stored uncompressed. An existing ``path``
-    that is not a regular file (a directory, device, FIFO) is refused. Returns the path.
+    that is not a regular file (a directory, device, FIFO) is refused. ``fmt``: the format
+    name written (``FORMAT``, or ``STUDY_FORMAT`` for a study). Returns the path.
     """
     path = Path(path)
     reserved = sorted(set(manifest) & set(ENVELOPE))
@@ -173,7 +178,7 @@ def write_raw(path: str | Path, manifest: dict, arrays: dict[str, np.ndarray]) -
         raise GPMSAError(f"manifest fields {reserved} are written by the container itself")
     manifest = {
         **manifest,
-        "format": FORMAT,
+        "format": fmt,
         "schema_version": SCHEMA_VERSION,
         "library_version": __version__,
         "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
@@ -355,7 +360,7 @@ def _check_members(zf: zipfile.ZipFile, path) -> dict[str, zipfile.ZipInfo]:
     return members
 
 
-def _parse_manifest(raw: bytes, path) -> dict:
+def _parse_manifest(raw: bytes, path, formats: tuple[str, ...] = (FORMAT,)) -> dict:
     def reject_constant(token):
         raise ValueError(f"non-standard JSON constant {token}")
 
@@ -365,9 +370,10 @@ def _parse_manifest(raw: bytes, path) -> dict:
         raise _fail(path, f"manifest.json is not valid JSON ({exc})") from exc
     if not isinstance(manifest, dict):
         raise _fail(path, "manifest.json must hold a JSON object")
-    if manifest.get("format") != FORMAT:
+    if manifest.get("format") not in formats:
+        want = " or ".join(repr(f) for f in formats)
         raise _fail(
-            path, f"format is {_short(manifest.get('format'))}, expected {FORMAT!r} (foreign file)"
+            path, f"format is {_short(manifest.get('format'))}, expected {want} (foreign file)"
         )
     version = manifest.get("schema_version")
     if not isinstance(version, int) or isinstance(version, bool) or version < 1:
@@ -457,7 +463,10 @@ def _load_array(raw: bytearray, name: str, spec: dict, path) -> np.ndarray:
 
 
 def read_raw(
-    path: str | Path, check: Callable[[dict], None] | None = None
+    path: str | Path,
+    check: Callable[[dict], None] | None = None,
+    *,
+    formats: tuple[str, ...] = (FORMAT,),
 ) -> tuple[dict, dict[str, np.ndarray]]:
     """Validated manifest and arrays of an emulator file (no Emulator built).
 
@@ -465,7 +474,8 @@ def read_raw(
     directory (members, names, compression, ratios, declared sizes against gpmsa.limits), the
     manifest, and each array's declared shape and dtype against its member's size; then
     ``check(manifest)`` (the caller's test of the declared content, e.g. consistent shapes).
-    Raises EmulatorFileError naming the problem.
+    ``formats``: the format names accepted (default: an emulator file). Raises
+    EmulatorFileError naming the problem.
     """
     path = Path(path)
     fh, size = _open_regular(path)
@@ -478,7 +488,8 @@ def read_raw(
             raise _fail(path, f"not a gpmsa emulator file (not a readable zip: {exc})") from exc
         with zf:
             members = _check_members(zf, path)
-            manifest = _parse_manifest(bytes(_read_member(zf, members[MANIFEST], path)), path)
+            raw = bytes(_read_member(zf, members[MANIFEST], path))
+            manifest = _parse_manifest(raw, path, formats)
             specs = manifest["arrays"]
             npy = {n[len(ARRAY_DIR) : -4]: info for n, info in members.items() if n != MANIFEST}
             _check_specs(specs, npy, path)

@@ -20,6 +20,8 @@ MODULES = [
     "gpmsa.model.categorical",
     "gpmsa.model.mean_basis",
     "gpmsa.model.constraints",
+    "gpmsa.studies.run",
+    "gpmsa.studies.study",
 ]
 
 
@@ -47,3 +49,11 @@ def test_every_public_function_has_an_example():
         doc = getattr(package, n).__doc__ or ""
         assert ">>> " in doc, f"{package.__name__}.{n} has no example"
         assert getattr(package, n).__module__ in MODULES
+
+
+def test_the_study_functions_have_examples():
+    import gpmsa
+
+    for fn in (gpmsa.calibrate_study, gpmsa.fit_study, gpmsa.load_study):
+        assert ">>> " in (fn.__doc__ or ""), fn.__name__
+        assert fn.__module__ in MODULES

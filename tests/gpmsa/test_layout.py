@@ -29,12 +29,14 @@ LAYERS = (
     ("mcmc",),
     ("backends",),
     ("fitting", "calibration"),
-    ("predictive",),
+    ("predictive", "studies"),
     ("cli", "plots"),
 )
 """The parts of gpmsa from the bottom up. A part may import itself and the parts of LOWER layers
 only (never a part of its own layer, never one above): errors, _version <- model, io <- mcmc <-
-backends <- fitting, calibration <- predictive <- cli, plots; the file container (io) knows
+backends <- fitting, calibration <- predictive, studies <- cli, plots (studies: several models
+at once, built on fitting's Emulator and calibration's problem; cli describes study files); the
+file container (io) knows
 nothing of the Emulator, whose record lives in fitting and imports io. ``limits`` (resource
 limits, read at call time) sits just above the leaves."""
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
@@ -46,6 +48,7 @@ PUBLIC = [
     "Posterior", "Priors", "Problem", "ResourceLimitError", "SimData", "backends", "calibrate",
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
     "limits", "load", "plots", "predictive", "prepare", "sensitivity",
+    "HyperPriors", "Study", "calibrate_study", "fit_study", "load_study",
 ]  # fmt: skip
 
 

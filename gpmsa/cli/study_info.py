@@ -1,0 +1,49 @@
+"""``gpmsa info STUDY`` for a study file (gpmsa.studies): its models, elements and posterior."""
+
+from __future__ import annotations
+
+from gpmsa.cli.text import number, plain, safe, value
+
+
+def study_lines(file: str, manifest: dict, study) -> list[str]:
+    """A verified study (``gpmsa.load_study``) and its manifest for a person; every string
+    from the file printed escaped."""
+    st = manifest["study"]
+    lines = [
+        f"file:            {safe(file)}",
+        f"format:          {safe(manifest['format'])} schema {manifest['schema_version']} "
+        f"(gpmsa {plain(manifest.get('library_version'))}, written "
+        f"{plain(manifest.get('created_utc'))})",
+        f"content sha256:  {safe(manifest['content_sha256'])} (verified)",
+        f"study:           {safe(st['kind'])} of {len(st['models'])} models; shared "
+        f"[{', '.join(safe(n, 60) for n in st['shared'])}], hierarchical "
+        f"[{', '.join(safe(n, 60) for n in st['hierarchical'])}]",
+    ]
+    for mod, emu in zip(st["models"], study.members, strict=True):
+        params = ", ".join(
+            f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''} in "
+            f"[{emu.domain[n][0]:.6g}, {emu.domain[n][1]:.6g}]"
+            for n, u in zip(emu.t_names, emu.t_units, strict=True)
+        )
+        lines.append(f"model {safe(mod['label'], 60)}: file {safe(mod['file'], 160)} sha256 "
+                     f"{safe(mod['sha256'], 64)} (verified); m={emu.m}, p={emu.p}, "
+                     f"l_sim={emu.l_sim}; parameters {params}")  # fmt: skip
+    if st["hierarchical"]:
+        hp = manifest["priors"]["hyper"]
+        lines.append("hyperpriors:     mu ~ Normal({}, {}) on (0, 1); lam ~ Gamma({}, {}) "
+                     "(unit scale)".format(*(number(hp[k]) for k in
+                                             ("mu_mean", "mu_sd", "lam_a", "lam_b"))))  # fmt: skip
+    flat = [f"{safe(k, 60)}={plain(v)}" for k, v in manifest["settings"].items()
+            if not isinstance(v, (list, dict))]  # fmt: skip
+    lines.append("settings:        " + ", ".join(flat))
+    for k, v in manifest["metadata"].items():
+        lines.append(f"metadata {safe(k, 60)}: {value(v)}")
+    post = study.posterior
+    for name in post.names:
+        lo, hi = post.interval(name, 0.9)
+        d = study.diagnostics.get(name, {})
+        e, r = (d.get(k, [None])[0] for k in ("ess", "rhat"))
+        lines.append(f"posterior {safe(name, 80)}: mean {post.mean(name):.6g} sd "
+                     f"{post.sd(name):.4g} 90% [{lo:.6g}, {hi:.6g}] ESS {number(e, '.0f')} "
+                     f"R-hat {number(r, '.3f')}")  # fmt: skip
+    return lines

@@ -1,0 +1,4 @@
+"""Several GPM/SA models at once: shared and hierarchical calibration parameters.
+
+See docs/models.md.
+"""

@@ -1,0 +1,193 @@
+"""The study's calibration parameters: which theta element of which model is which study element.
+
+A study of M models has one vector of study elements g (unit scale). Model i's theta (q_i,) is
+``g[layout.index[i]]``. An element used by several models is *shared* (one value, one prior);
+an element of a *hierarchical* group belongs to one model and has the prior
+theta ~ Normal(mu, 1/lam) truncated to (0, 1), with mu and lam (the group's precision) sampled
+too; every other element is the model's own, with the model's theta prior. docs/models.md.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+
+LABEL_RE = re.compile(r"^[A-Za-z0-9_-]{1,48}$")
+"""A model's label: letters, digits, _ and -, at most 48 (it names the model's file)."""
+
+
+@dataclass(frozen=True)
+class HyperPriors:
+    """Hyperpriors of a hierarchical group (unit scale), SEPIA's defaults.
+
+    mu ~ Normal(mu_mean, mu_sd) truncated to (0, 1); the precision lam ~ Gamma(lam_a, lam_b)
+    (shape, rate) on (0, inf). lam_start: the precision a chain starts from (sd 1/sqrt(lam)).
+    """
+
+    mu_mean: float = 0.5
+    mu_sd: float = 10.0
+    lam_a: float = 1.0
+    lam_b: float = 1e-3
+    lam_start: float = 5.0
+
+    def __post_init__(self) -> None:
+        for name in ("mu_mean", "mu_sd", "lam_a", "lam_b", "lam_start"):
+            val = getattr(self, name)
+            if isinstance(val, bool) or not isinstance(val, (int, float, np.floating, np.integer)):
+                raise GPMSAError(f"HyperPriors.{name} must be a number, got {val!r}")
+            if not np.isfinite(val) or (name != "mu_mean" and not val > 0):
+                need = "finite" if name == "mu_mean" else "finite and > 0"
+                raise GPMSAError(f"HyperPriors.{name} must be {need}, got {val!r}")
+
+    def to_dict(self) -> dict[str, float]:
+        """JSON-able dict."""
+        return {k: float(getattr(self, k)) for k in ("mu_mean", "mu_sd", "lam_a", "lam_b",
+                                                      "lam_start")}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Element:
+    """One study element: its display name, the parameter's name, the (model, theta index) pairs
+    that use it, its hierarchical group (-1: none) and the theta prior (mean, sd) of its models."""
+
+    name: str
+    param: str
+    uses: tuple[tuple[int, int], ...]
+    group: int
+    prior: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Layout:
+    """The study's elements and how the models use them.
+
+    labels: the models' labels; elements: the study elements in order; index: per model, the
+    study element of each of its theta elements; groups: hierarchical parameter names (group g
+    holds the elements with ``group == g``); bounds: native (lo, hi) of each element.
+    """
+
+    labels: tuple[str, ...]
+    elements: tuple[Element, ...]
+    index: tuple[tuple[int, ...], ...]
+    groups: tuple[str, ...]
+    bounds: tuple[tuple[float, float], ...]
+    shared: tuple[str, ...]
+
+    @property
+    def n_elements(self) -> int:
+        """Number of study elements."""
+        return len(self.elements)
+
+    def members_of(self, g: int) -> list[int]:
+        """Study elements of hierarchical group g."""
+        return [e for e, el in enumerate(self.elements) if el.group == g]
+
+
+def _names(arg, what: str) -> tuple[str, ...]:
+    if isinstance(arg, str):
+        arg = (arg,)
+    try:
+        out = tuple(arg)
+    except TypeError as exc:
+        raise GPMSAError(f"{what} must be a sequence of parameter names, got {arg!r}") from exc
+    for n in out:
+        if not isinstance(n, str):
+            raise GPMSAError(f"{what} must hold parameter names (str), got {n!r}")
+    if len(set(out)) != len(out):
+        raise GPMSAError(f"{what} names a parameter twice: {list(out)}")
+    return out
+
+
+def check_labels(labels, n_models: int) -> tuple[str, ...]:
+    """The models' labels (default model0, model1, ...); GPMSAError for a bad or repeated one."""
+    if labels is None:
+        return tuple(f"model{i}" for i in range(n_models))
+    labels = tuple(labels)
+    if len(labels) != n_models:
+        raise GPMSAError(f"got {len(labels)} labels for {n_models} models")
+    for lab in labels:
+        if not isinstance(lab, str) or not LABEL_RE.match(lab):
+            raise GPMSAError(
+                f"model label {lab!r}: use 1-48 letters, digits, '_' or '-' (it names a file)"
+            )
+    if len(set(labels)) != len(labels):
+        raise GPMSAError(f"model labels must differ, got {list(labels)}")
+    return labels
+
+
+def build_layout(
+    labels: tuple[str, ...],
+    t_names: list[tuple[str, ...]],
+    t_bounds: list[tuple[np.ndarray, np.ndarray]],
+    theta_priors: list[tuple[float, float]],
+    shared=(),
+    hierarchical=(),
+) -> Layout:
+    """The study's layout from each model's parameter names, native (t_min, t_max) and theta
+    prior (mean, sd).
+
+    Raises GPMSAError naming the problem: a shared or hierarchical name no model has or only one
+    model has, a name both shared and hierarchical, models whose ranges (t_min, t_max) of a
+    shared or hierarchical parameter differ (the unit scale would mean different things), a
+    shared parameter whose models' theta priors differ.
+    """
+    shared = _names(shared, "shared")
+    hier = _names(hierarchical, "hierarchical")
+    both = sorted(set(shared) & set(hier))
+    if both:
+        raise GPMSAError(f"parameters {both} are both shared and hierarchical; choose one")
+    if len(t_names) != len(labels) or len(t_bounds) != len(labels):
+        raise GPMSAError(f"got {len(t_names)} models' parameter names for {len(labels)} labels")
+    for what, names in (("shared", shared), ("hierarchical", hier)):
+        for n in names:
+            have = [labels[i] for i, ts in enumerate(t_names) if n in ts]
+            if not have:
+                known = sorted({t for ts in t_names for t in ts})
+                raise GPMSAError(f"{what} parameter {n!r} is unknown: no model has it "
+                                 f"(the models' parameters: {known})")  # fmt: skip
+            if len(have) < 2:
+                raise GPMSAError(f"{what} parameter {n!r} is in one model only ({have[0]}); "
+                                 "it needs two or more")  # fmt: skip
+            ranges = {labels[i]: (float(lo[ts.index(n)]), float(hi[ts.index(n)]))
+                      for i, (ts, (lo, hi)) in enumerate(zip(t_names, t_bounds, strict=True))
+                      if n in ts}  # fmt: skip
+            first = next(iter(ranges.values()))
+            if any(not np.allclose(r, first, rtol=1e-12, atol=0.0) for r in ranges.values()):
+                raise GPMSAError(
+                    f"{what} parameter {n!r} has different bounds in the models' designs "
+                    f"(t ranges {ranges}); give the models one range for it (the unit scale "
+                    "must mean the same value in every model)"
+                )
+    elements: list[Element] = []
+    bounds: list[tuple[float, float]] = []
+    index: list[list[int]] = []
+    by_shared: dict[str, int] = {}
+    for i, ts in enumerate(t_names):
+        row = []
+        lo, hi = t_bounds[i]
+        for k, n in enumerate(ts):
+            if n in by_shared:
+                e = by_shared[n]
+                el = elements[e]
+                if el.prior != tuple(theta_priors[i]):
+                    raise GPMSAError(
+                        f"shared parameter {n!r}: the models' theta priors differ "
+                        f"({labels[el.uses[0][0]]}: {el.prior}, {labels[i]}: {theta_priors[i]})"
+                    )
+                elements[e] = Element(el.name, n, (*el.uses, (i, k)), -1, el.prior)
+            else:
+                e = len(elements)
+                if n in shared:
+                    by_shared[n] = e
+                name = n if n in shared else f"{n}[{labels[i]}]"
+                group = hier.index(n) if n in hier else -1
+                elements.append(Element(name, n, ((i, k),), group, tuple(theta_priors[i])))
+                bounds.append((float(lo[k]), float(hi[k])))
+            row.append(e)
+        index.append(row)
+    return Layout(tuple(labels), tuple(elements), tuple(tuple(r) for r in index), hier,
+                  tuple(bounds), shared)  # fmt: skip

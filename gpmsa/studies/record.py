@@ -1,0 +1,121 @@
+"""Checks of a study file's record (manifest + arrays); each failure an EmulatorFileError naming
+the field ("study.models[1].sha256", "arrays/theta", ...). docs/models.md describes the layout."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+from gpmsa.errors import EmulatorFileError
+from gpmsa.studies.layout import LABEL_RE, Layout
+
+KINDS = ("calibration", "fit")
+"""How a study's draws were made: calibration with the emulators fixed, or a joint fit."""
+ARRAYS = ("theta", "mu", "lam", "lamOs", "log_post")
+"""The arrays of a study file: (C, N, G), (C, N, H), (C, N, H), (C, N, M), (C, N)."""
+FILE_RE = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,150}\.gpmsa$")
+"""A model's file name: beside the study file, no folder, no leading dot."""
+SHA_RE = re.compile(r"^[0-9a-f]{64}$")
+
+
+def _fail(field: str, problem: str) -> EmulatorFileError:
+    return EmulatorFileError(f"{field}: {problem}")
+
+
+def _short(value, n: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+def _names(value, field: str) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise _fail(field, f"must be a list of strings, got {_short(value)}")
+    return value
+
+
+def check_study_manifest(manifest: dict) -> None:
+    """The study fields of a manifest (before any array is decompressed)."""
+    study = manifest.get("study")
+    if not isinstance(study, dict):
+        raise _fail("study", f"must be an object, got {_short(study)}")
+    if study.get("kind") not in KINDS:
+        raise _fail("study.kind", f"must be one of {KINDS}, got {_short(study.get('kind'))}")
+    _names(study.get("shared"), "study.shared")
+    _names(study.get("hierarchical"), "study.hierarchical")
+    models = study.get("models")
+    if not isinstance(models, list) or not models:
+        raise _fail("study.models", f"must be a non-empty list, got {_short(models)}")
+    labels, files = [], []
+    for j, mod in enumerate(models):
+        where = f"study.models[{j}]"
+        if not isinstance(mod, dict):
+            raise _fail(where, f"must be an object, got {_short(mod)}")
+        lab, file, sha = mod.get("label"), mod.get("file"), mod.get("sha256")
+        if not isinstance(lab, str) or not LABEL_RE.match(lab):
+            raise _fail(f"{where}.label", f"must be 1-48 letters, digits, _ or -: {_short(lab)}")
+        if not isinstance(file, str) or not FILE_RE.match(file):
+            raise _fail(f"{where}.file", f"must be a .gpmsa file name beside the study file (no "
+                                         f"folder), got {_short(file)}")  # fmt: skip
+        if not isinstance(sha, str) or not SHA_RE.match(sha):
+            raise _fail(f"{where}.sha256", f"must be 64 lowercase hex digits, got {_short(sha)}")
+        labels.append(lab)
+        files.append(file)
+    if len(set(labels)) != len(labels):
+        raise _fail("study.models", f"labels repeat: {labels}")
+    if len(set(files)) != len(files):
+        raise _fail("study.models", f"files repeat: {files}")
+    hyper = manifest["priors"].get("hyper")
+    if not isinstance(hyper, dict):
+        raise _fail("priors.hyper", f"must be an object, got {_short(hyper)}")
+    for key in ("mu_mean", "mu_sd", "lam_a", "lam_b", "lam_start"):
+        val = hyper.get(key)
+        ok = isinstance(val, (int, float)) and not isinstance(val, bool) and math.isfinite(val)
+        if not ok or (key != "mu_mean" and not val > 0):
+            need = "a finite number" if key == "mu_mean" else "a finite number > 0"
+            raise _fail(f"priors.hyper.{key}", f"must be {need}, got {_short(val)}")
+    specs = manifest["arrays"]
+    if set(specs) != set(ARRAYS):
+        raise _fail("arrays", f"a study holds exactly {list(ARRAYS)}, got {sorted(specs)[:10]}")
+    for name, spec in specs.items():
+        if spec["dtype"] != "<f8":
+            raise _fail(f"arrays/{name}", f"dtype {spec['dtype']}: must be <f8 (float64)")
+    shape = {k: tuple(specs[k]["shape"]) for k in ARRAYS}
+    if len(shape["log_post"]) != 2:
+        raise _fail("arrays/log_post", f"must be (chains, draws), got {shape['log_post']}")
+    cn = shape["log_post"]
+    for k in ("theta", "mu", "lam", "lamOs"):
+        if len(shape[k]) != 3 or shape[k][:2] != cn:
+            raise _fail(f"arrays/{k}", f"must be (chains, draws, k) with (chains, draws) = {cn}, "
+                                       f"got {shape[k]}")  # fmt: skip
+    if shape["lamOs"][2] != len(models):
+        raise _fail("arrays/lamOs", f"has {shape['lamOs'][2]} columns for {len(models)} models")
+    n_h = len(study["hierarchical"])
+    if shape["mu"] != shape["lam"] or shape["mu"][2] != n_h:
+        raise _fail("arrays/mu", f"mu {shape['mu']} and lam {shape['lam']} need one column per "
+                                 f"hierarchical parameter ({n_h})")  # fmt: skip
+
+
+def check_study_arrays(manifest: dict, arrays: dict[str, np.ndarray], layout: Layout) -> None:
+    """The arrays against the models' layout: shapes, finiteness and ranges."""
+    names = manifest.get("names", {}).get("elements")
+    want = [el.name for el in layout.elements]
+    if names != want:
+        raise _fail("names.elements", f"{_short(names, 200)} differ from the models' study "
+                                      f"elements {want}")  # fmt: skip
+    if arrays["theta"].shape[2] != layout.n_elements:
+        raise _fail("arrays/theta", f"has {arrays['theta'].shape[2]} columns for "
+                                    f"{layout.n_elements} study elements")  # fmt: skip
+    for name in ARRAYS:
+        if not np.all(np.isfinite(arrays[name])):
+            raise _fail(f"arrays/{name}", "holds NaN or inf")
+    for name in ("theta", "mu"):
+        a = arrays[name]
+        if a.size and not (a.min() > 0.0 and a.max() < 1.0):
+            raise _fail(f"arrays/{name}", f"must lie in (0, 1) (unit scale), got "
+                                          f"{a.min():.6g}..{a.max():.6g}")  # fmt: skip
+    for name in ("lam", "lamOs"):
+        a = arrays[name]
+        if a.size and not a.min() > 0.0:
+            raise _fail(f"arrays/{name}", f"precisions must be > 0, got min {a.min():.6g}")

@@ -1,0 +1,244 @@
+"""``calibrate_study`` (the emulators fixed) and ``fit_study`` (emulators and calibration
+jointly): several models whose calibration parameters are shared or hierarchical."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from datetime import datetime, timezone
+
+import numpy as np
+
+from gpmsa._version import library_versions
+from gpmsa.calibration.calibrate import calibration_problem
+from gpmsa.calibration.observations import check_emulator
+from gpmsa.errors import GPMSAError
+from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.limits import check_memory
+from gpmsa.mcmc import tuning
+from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
+from gpmsa.model.data import ObsData, SimData, check_seed
+from gpmsa.model.priors import Priors
+from gpmsa.model.problem import prepare
+from gpmsa.studies.layout import HyperPriors, build_layout, check_labels
+from gpmsa.studies.sampler import StudyChains, sample_study
+from gpmsa.studies.study import Study, layout_of
+
+
+def _sequence(value, what: str) -> list:
+    if isinstance(value, (str, bytes, np.ndarray, Emulator, SimData, ObsData)) or not isinstance(
+        value, Sequence
+    ):
+        raise GPMSAError(f"{what} must be a list with one entry per model, got "
+                         f"{type(value).__name__}")  # fmt: skip
+    return list(value)
+
+
+def _same_count(**lists) -> int:
+    counts = {k: len(v) for k, v in lists.items()}
+    if len(set(counts.values())) != 1:
+        raise GPMSAError(f"mismatched numbers of models: {counts}")
+    n = next(iter(counts.values()))
+    if n < 1:
+        raise GPMSAError("a study needs at least one model")
+    return n
+
+
+def _check_run(n_iter, n_burn, n_chains, seed, hyper, what: str = "n_samples") -> HyperPriors:
+    for name, val, low in ((what, n_iter, 2), ("n_chains", n_chains, 1)):
+        if isinstance(val, bool) or not (isinstance(val, (int, np.integer)) and val >= low):
+            raise GPMSAError(f"{name} must be an integer >= {low}, got {val!r}")
+    if isinstance(n_burn, bool) or not (isinstance(n_burn, (int, np.integer))
+                                        and 0 <= n_burn < n_iter - 1):  # fmt: skip
+        raise GPMSAError(f"n_burn must be an integer in [0, {what} - 1), got {n_burn!r}")
+    check_seed(seed)
+    if hyper is None:
+        return HyperPriors()
+    if not isinstance(hyper, HyperPriors):
+        raise GPMSAError(f"hyper must be a gpmsa.HyperPriors, got {type(hyper).__name__}")
+    return hyper
+
+
+def _check_memory(problems, n_iter: int, n_chains: int, what: str) -> None:
+    per_sweep = sum(sum(int(np.size(p.init[n])) for n in p.sampled) for p in problems) + 4
+    check_memory(8.0 * 2.0 * per_sweep * n_iter * n_chains, what)
+
+
+def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
+    rate = chains.accept_rate.mean(axis=0)
+    return {**chains.info, "n_burn": int(n_burn), **extra,
+            "accept_rate": {n: float(r) for n, r in zip(chains.names, rate, strict=True)},
+            "step_widths": {n: float(w) for n, w in zip(chains.names, chains.widths[0],
+                                                        strict=True)},
+            "seconds": time.perf_counter() - t0,
+            "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+            "versions": library_versions("numpy")}  # fmt: skip
+
+
+def _study_draws(chains: StudyChains, keep: slice) -> dict[str, np.ndarray]:
+    lam_os = np.stack([m["lamOs"][:, keep, 0] for m in chains.members], axis=2)
+    return {"theta": chains.theta[:, keep], "mu": chains.mu[:, keep], "lam": chains.lam[:, keep],
+            "lamOs": lam_os, "log_post": chains.log_post[:, keep]}  # fmt: skip
+
+
+def calibrate_study(
+    emulators, x_obs, y_obs, *, labels=None, shared=(), hierarchical=(),
+    hyper: HyperPriors | None = None, n_samples: int = 5000, n_burn: int = 1000,
+    tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
+    tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
+    extrapolate: bool = False, progress: bool = False, n_jobs: int | None = None,
+    executor=None, metadata: dict | None = None,
+) -> Study:  # fmt: skip
+    """Calibrate several fitted emulators at once, their emulator parameters fixed (as
+    ``gpmsa.calibrate`` does for one), with shared and/or hierarchical calibration parameters.
+
+    Args:
+        emulators: one ``gpmsa.Emulator`` per model; x_obs, y_obs: per model, its observations
+            as ``gpmsa.calibrate`` takes them.
+        labels: the models' labels (default model0, model1, ...).
+        shared: parameter names (emulator t_names) that take one value in every model that has
+            them. hierarchical: names whose per-model values are draws of
+            Normal(mu, 1/lam) truncated to the parameter's range, mu and lam sampled too
+            (``hyper``: their priors, SEPIA's defaults). Every other parameter is its model's.
+        n_samples, n_burn, tune, seed, n_chains, init, tune_rounds, tune_levels, extrapolate,
+            progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep).
+        metadata: a JSON-able dict saved with the study.
+
+    Returns a ``Study``; ``study.posterior`` names each shared parameter by its name, every
+    other by "NAME[LABEL]", each model's "lamOs[LABEL]" and each hierarchical group's "NAME.mu",
+    "NAME.sd" (native units) and "NAME.lam" (unit-scale precision). GPMSAError names a bad
+    input: mismatched numbers of models, an unknown shared name, a shared or hierarchical
+    parameter whose range differs between the models.
+
+    >>> import numpy as np, gpmsa
+    >>> t = np.linspace(0.1, 0.9, 12)[:, None]; x = np.tile([[0.0], [1.0]], (6, 1))
+    >>> sim = gpmsa.SimData(x=x, t=t, y=(x + 2 * t), t_names=["E"])
+    >>> prm = {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e4], "lamWOs": [1e4]}
+    >>> emu = gpmsa.Emulator.from_params(sim, prm)
+    >>> study = gpmsa.calibrate_study([emu, emu], [[[0.5]], [[0.2]]], [[1.5], [1.2]],
+    ...                               shared=["E"], n_samples=400, n_burn=100, seed=1)
+    >>> study.posterior.names[:3]
+    ('E', 'lamOs[model0]', 'lamOs[model1]')
+    >>> 0.3 < study.posterior.mean("E") < 0.7
+    True
+    """
+    emulators = _sequence(emulators, "emulators")
+    x_obs, y_obs = _sequence(x_obs, "x_obs"), _sequence(y_obs, "y_obs")
+    n = _same_count(emulators=emulators, x_obs=x_obs, y_obs=y_obs)
+    for e in emulators:
+        check_emulator(e)
+    hyper = _check_run(n_samples, n_burn, n_chains, seed, hyper)
+    labels = check_labels(labels, n)
+    layout = layout_of(emulators, labels, shared, hierarchical)
+    t0 = time.perf_counter()
+    problems = [calibration_problem(e, x, y, extrapolate=extrapolate)
+                for e, x, y in zip(emulators, x_obs, y_obs, strict=True)]  # fmt: skip
+    _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
+                  f"n_chains={n_chains})")  # fmt: skip
+    chains = sample_study(
+        problems, layout, hyper, n_iter=int(n_samples), n_chains=int(n_chains), tune=tune,
+        seed=seed, init=init, tune_rounds=tune_rounds, tune_levels=tune_levels,
+        progress=progress, n_jobs=n_jobs, executor=executor,
+    )  # fmt: skip
+    settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
+    study = Study("calibration", emulators, layout, hyper,
+                  _study_draws(chains, slice(int(n_burn), None)), settings, metadata)  # fmt: skip
+    if study.convergence is not None:
+        warn_unconverged(study.convergence, "gpmsa.calibrate_study")
+    return study
+
+
+def fit_study(
+    sims, obs, *, labels=None, shared=(), hierarchical=(), hyper: HyperPriors | None = None,
+    n_iter: int = 30_000, n_burn: int | None = None, n_keep: int = 1000, point: str = "mean",
+    tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
+    priors: Priors | None = None, n_pc: int | None = None, discrepancy=None,
+    tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
+    progress: bool = False, n_jobs: int | None = None, executor=None,
+    metadata: dict | None = None,
+) -> Study:  # fmt: skip
+    """Fit several GPM/SA models jointly (each its emulator and observations, as ``gpmsa.fit``
+    with ``obs``) whose calibration parameters are shared and/or hierarchical (SEPIA's shared
+    and hierarchical theta models). Each model's own parameters are updated within it; a study
+    theta element is accepted on the sum of its models' log posteriors.
+
+    Args:
+        sims, obs: per model, its ``gpmsa.SimData`` and ``gpmsa.ObsData``.
+        labels, shared, hierarchical, hyper: as ``calibrate_study``.
+        n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, priors, n_pc, discrepancy:
+            as ``gpmsa.fit`` (priors, n_pc, discrepancy: the same for every model).
+        metadata: a JSON-able dict saved with the study.
+
+    Returns a ``Study`` of kind "fit": ``study.members`` are the models' fitted emulators (their
+    ``calibration`` holds the model's theta draws), ``study.posterior`` as ``calibrate_study``.
+
+    >>> import numpy as np, gpmsa
+    >>> t = np.linspace(0.1, 0.9, 12)[:, None]; x = np.tile([[0.0], [1.0]], (6, 1))
+    >>> sim = gpmsa.SimData(x=x, t=t, y=(x + 2 * t), t_names=["E"])
+    >>> obs = [gpmsa.ObsData(x=[[0.5]], y=[[1.5]]), gpmsa.ObsData(x=[[0.2]], y=[[1.2]])]
+    >>> study = gpmsa.fit_study([sim, sim], obs, shared=["E"], n_iter=300, seed=2,
+    ...                         tune_rounds=5)
+    >>> [e.calibration["theta"].shape for e in study.members]
+    [(240, 1), (240, 1)]
+    """
+    sims, obs = _sequence(sims, "sims"), _sequence(obs, "obs")
+    n = _same_count(sims=sims, obs=obs)
+    for o in obs:
+        if not isinstance(o, ObsData):
+            raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
+    n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int) else n_burn
+    hyper = _check_run(n_iter, n_burn, n_chains, seed, hyper, "n_iter")
+    if point not in ("mean", "map"):
+        raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
+    if isinstance(n_keep, bool) or not isinstance(n_keep, (int, np.integer)) or n_keep < 1:
+        raise GPMSAError(f"n_keep must be an integer >= 1, got {n_keep!r}")
+    labels = check_labels(labels, n)
+    preps = [prepare(s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
+             for s, o in zip(sims, obs, strict=True)]  # fmt: skip
+    layout = build_layout(
+        labels, [tuple(s.t_names) for s in sims],
+        [(p.standardizer.t_min, p.standardizer.t_max) for p in preps],
+        [(p.problem.priors.theta_mean, p.problem.priors.theta_sd) for p in preps],
+        shared, hierarchical,
+    )  # fmt: skip
+    problems = [p.problem for p in preps]
+    _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})")
+    t0 = time.perf_counter()
+    chains = sample_study(
+        problems, layout, hyper, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
+        seed=seed, init=init, tune_rounds=tune_rounds, tune_levels=tune_levels,
+        progress=progress, n_jobs=n_jobs, executor=executor,
+    )  # fmt: skip
+    thin = max(1, math.ceil(n_chains * (n_iter - n_burn) / n_keep))
+    keep = slice(int(n_burn), None, thin)
+    settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point)
+    draws = _study_draws(chains, keep)
+    lp = draws["log_post"].reshape(-1)
+    members = []
+    for i, (sim, prep) in enumerate(zip(sims, preps, strict=True)):
+        post = {k: v[:, keep] for k, v in chains.members[i].items()}
+        flat = {k: v.reshape(-1, *v.shape[2:]) for k, v in post.items()}
+        theta = draws["theta"][:, :, list(layout.index[i])]
+        flat["theta"] = theta.reshape(-1, theta.shape[2])
+        if point == "mean":
+            params = {k: flat[k].mean(axis=0) for k in EMULATOR_PARAMS}
+        else:
+            params = {k: flat[k][int(np.argmax(lp))].copy() for k in EMULATOR_PARAMS}
+        cal = {k: v for k, v in flat.items() if k not in EMULATOR_PARAMS}
+        cal["theta_native"] = prep.standardizer.t_from_unit(cal["theta"])
+        emu_settings = {"n_iter": int(n_iter), "n_burn": int(n_burn), "thin": thin,
+                        "n_chains": int(n_chains), "tune": bool(tune), "backend": "numpy",
+                        "seed": seed, "point": point, "n_pc": int(prep.K.shape[1]),
+                        "joint_obs": True, "study": {"label": labels[i], "shared": list(shared),
+                                                     "hierarchical": list(hierarchical)},
+                        "versions": settings["versions"]}  # fmt: skip
+        members.append(Emulator._from_prepared(
+            sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,
+            settings=emu_settings, diagnostics=summarize({**post, "theta": theta}),
+            calibration=cal,
+        ))  # fmt: skip
+    study = Study("fit", members, layout, hyper, draws, settings, metadata)
+    if study.convergence is not None:
+        warn_unconverged(study.convergence, "gpmsa.fit_study")
+    return study

@@ -1,0 +1,284 @@
+"""Metropolis-within-Gibbs over several GPM/SA models whose theta share study elements.
+
+One sweep: each study theta element (a uniform walk on the unit scale, accepted on the sum over
+the models that use it of their log-likelihood change, plus its prior: the models' theta prior
+or its hierarchical group's truncated normal), then each model's own parameters by that model's
+``gpmsa.mcmc.sampler.ChainState`` sweep (its theta held by the study), then each hierarchical
+group's mean mu (uniform walk) and precision lam (walk on log lam, with its Hastings factor).
+Step widths are tuned as GPM/SA tunes them (``gpmsa.mcmc.tuning``) over every element at once.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from gpmsa.errors import GPMSAError
+from gpmsa.mcmc import starts, tuning
+from gpmsa.mcmc.parallel import run_chains
+from gpmsa.mcmc.sampler import DEFAULT_WIDTHS, ChainState, default_widths, require_finite
+from gpmsa.model.problem import Problem
+from gpmsa.studies.layout import HyperPriors, Layout
+
+MU_WIDTH = 0.2
+"""Initial step width of a group mean mu (unit scale), as SEPIA's."""
+LOG_LAM_WIDTH = 1.0
+"""Initial step width of a group precision on the log scale."""
+_SQRT_HALF = math.sqrt(0.5)
+
+
+def log_mass01(mu: float, lam: float) -> float:
+    """log P(0 < X < 1) for X ~ Normal(mu, 1/lam), mu in (0, 1) (accurate in both tails)."""
+    s = math.sqrt(lam) * _SQRT_HALF
+    return math.log1p(-0.5 * (math.erfc(mu * s) + math.erfc((1.0 - mu) * s)))
+
+
+@dataclass(frozen=True)
+class StudyChains:
+    """Draws of a study's chains (unit scale).
+
+    theta (C, N, G): study elements; mu, lam (C, N, H): hierarchical groups' mean and
+    precision; log_post (C, N): the joint log posterior up to a constant; members: per model,
+    name -> (C, N, *shape) of its own sampled parameters; accept_rate, widths (C, n_el): per
+    element in sweep order (``names``).
+    """
+
+    theta: np.ndarray
+    mu: np.ndarray
+    lam: np.ndarray
+    log_post: np.ndarray
+    members: tuple[dict[str, np.ndarray], ...]
+    accept_rate: np.ndarray
+    widths: np.ndarray
+    names: tuple[str, ...]
+    info: dict
+
+
+class StudyState:
+    """The current state of one study chain: the models' ``ChainState``s (theta held), the study
+    elements g, and the groups' (mu, lam)."""
+
+    def __init__(
+        self, problems: list[Problem], layout: Layout, hyper: HyperPriors,
+        start: list[dict[str, np.ndarray]], g: np.ndarray, mu: np.ndarray, lam: np.ndarray,
+        rng: np.random.Generator,
+    ):  # fmt: skip
+        self.layout, self.hyper, self.rng = layout, hyper, rng
+        self.g, self.mu, self.lam = g.copy(), mu.copy(), lam.copy()
+        self.states = []
+        for i, prob in enumerate(problems):
+            held = prob.with_init({}, fixed=prob.fixed | {"theta"})
+            init = {**start[i], "theta": self.g[list(layout.index[i])]}
+            self.states.append(ChainState(held, init, rng))
+        self.group_els = [layout.members_of(h) for h in range(len(layout.groups))]
+        self.sizes = [len(s.els) for s in self.states]
+
+    # --- priors -------------------------------------------------------------------------------
+    def _theta_lp(self, e: int, x: float) -> float:
+        """Log prior of study element e at x, up to terms that do not depend on x."""
+        if not 0.0 < x < 1.0:
+            return -math.inf
+        el = self.layout.elements[e]
+        if el.group < 0:
+            m, sd = el.prior
+            return -0.5 * ((x - m) / sd) ** 2
+        d = x - self.mu[el.group]
+        return -0.5 * self.lam[el.group] * d * d
+
+    def _group_lp(self, h: int, mu: float, lam: float) -> float:
+        """Log density of group h's (mu, lam): hyperpriors and the elements' truncated normals."""
+        hp = self.hyper
+        if not (0.0 < mu < 1.0 and lam > 0.0):
+            return -math.inf
+        els = self.group_els[h]
+        ss = sum((self.g[e] - mu) ** 2 for e in els)
+        lp = -0.5 * ((mu - hp.mu_mean) / hp.mu_sd) ** 2 + (hp.lam_a - 1.0) * math.log(lam)
+        lp -= hp.lam_b * lam
+        return lp + len(els) * (0.5 * math.log(lam) - log_mass01(mu, lam)) - 0.5 * lam * ss
+
+    def log_post(self) -> float:
+        """The joint log posterior (up to a constant)."""
+        lp = sum(s.log_post() for s in self.states)
+        for e, el in enumerate(self.layout.elements):
+            if el.group < 0:
+                lp += self._theta_lp(e, float(self.g[e]))
+        for h in range(len(self.group_els)):
+            lp += self._group_lp(h, float(self.mu[h]), float(self.lam[h]))
+        return lp
+
+    # --- the sweep ----------------------------------------------------------------------------
+    def sweep(self, widths: np.ndarray, prop_mh: bool, accepted: np.ndarray) -> None:
+        """One sweep (theta elements, each model's own parameters, the groups' mu and lam);
+        adds 1 to ``accepted[i]`` per accepted element (order as ``element_names``)."""
+        G, H = self.layout.n_elements, len(self.group_els)
+        u = self.rng.random((G + 2 * H, 2))
+        for e, el in enumerate(self.layout.elements):
+            x = float(self.g[e])
+            cand = x + widths[e] * (u[e, 0] - 0.5)
+            lp_new = self._theta_lp(e, cand)
+            if lp_new == -math.inf:
+                continue
+            dll = 0.0
+            for i, k in el.uses:
+                lik = self.states[i].lik
+                ll = lik.propose("theta", (k,), cand)
+                if ll == -math.inf:
+                    dll = -math.inf
+                    break
+                dll += ll - lik.loglik
+            if dll == -math.inf:
+                continue
+            if math.log(u[e, 1]) < dll + lp_new - self._theta_lp(e, x):
+                for i, _ in el.uses:
+                    self.states[i].lik.accept()
+                self.g[e] = cand
+                accepted[e] += 1
+        o = G
+        for s, n in zip(self.states, self.sizes, strict=True):
+            s.sweep(widths[o : o + n], prop_mh, accepted[o : o + n])
+            o += n
+        for h in range(H):
+            mu, lam = float(self.mu[h]), float(self.lam[h])
+            cur = self._group_lp(h, mu, lam)
+            cand = mu + widths[o] * (u[G + 2 * h, 0] - 0.5)
+            new = self._group_lp(h, cand, lam)
+            if math.log(u[G + 2 * h, 1]) < new - cur:
+                self.mu[h], mu, cur = cand, cand, new
+                accepted[o] += 1
+            step = widths[o + 1] * (u[G + 2 * h + 1, 0] - 0.5)
+            cand = lam * math.exp(step)
+            new = self._group_lp(h, mu, cand)
+            if math.log(u[G + 2 * h + 1, 1]) < new - cur + step:  # step = log(lam'/lam): Hastings
+                self.lam[h] = cand
+                accepted[o + 1] += 1
+            o += 2
+
+
+def element_names(states: list[ChainState], layout: Layout) -> list[str]:
+    """Names of the sweep's elements ("E[beam]", "beam.lamOs[0]", "E.mu", "E.lam", ...)."""
+    names = [el.name for el in layout.elements]
+    for lab, s in zip(layout.labels, states, strict=True):
+        names += [f"{lab}.{n}{list(idx)}" for n, idx in s.els]
+    for g in layout.groups:
+        names += [f"{g}.mu", f"{g}.lam"]
+    return names
+
+
+def _tuning_kinds(states: list[ChainState], layout: Layout) -> list[str]:
+    """The parameter kind of each element for GPM/SA's tuning levels."""
+    kinds = ["theta"] * layout.n_elements
+    for s in states:
+        kinds += [n for n, _ in s.els]
+    return kinds + ["theta", "lamOs"] * len(layout.groups)
+
+
+def _start(problems, layout, hyper, how, rng):
+    """Each model's start, the study elements' and the groups' (mu, lam)."""
+    start = [starts.draw_start(p, how, rng) for p in problems]
+    g = np.array([start[el.uses[0][0]]["theta"][el.uses[0][1]] for el in layout.elements])
+    H = len(layout.groups)
+    if how == "gpmsa":
+        mu, lam = np.full(H, 0.5), np.full(H, hyper.lam_start)
+    else:
+        mu = np.array([np.mean(g[layout.members_of(h)]) for h in range(H)])
+        lam = hyper.lam_start * np.exp(rng.uniform(-np.log(10.0), np.log(10.0), H))
+    return start, g, mu, lam
+
+
+def run_study_chain(
+    problems: list[Problem], layout: Layout, hyper: HyperPriors, n_iter: int, *, tune: bool,
+    seed: np.random.SeedSequence, init: str = "gpmsa", tune_rounds: int = tuning.N_BURN,
+    tune_levels: int = tuning.N_LEVELS, progress: bool = False, desc: str = "study",
+) -> dict:  # fmt: skip
+    """One chain: its start (``gpmsa.mcmc.starts`` rule ``init``), tuning, ``n_iter`` sweeps.
+
+    Returns plain arrays: theta (N, G), mu, lam (N, H), log_post (N,), members (per model,
+    name -> (N, *shape)), accept_rate and widths per element.
+    """
+    from tqdm.auto import tqdm
+
+    rng = np.random.default_rng(seed)
+    start, g, mu, lam = _start(problems, layout, hyper, init, starts.start_generator(seed))
+    state = StudyState(problems, layout, hyper, start, g, mu, lam, rng)
+    if math.isnan(state.log_post()):
+        raise GPMSAError("the starting values give a log posterior of NaN; check the data")
+    w = [np.full(layout.n_elements, DEFAULT_WIDTHS["theta"])]
+    for s in state.states:
+        dw = default_widths(s.problem)
+        w.append(np.array([float(dw[n][idx]) for n, idx in s.els]))
+    w.append(np.tile([MU_WIDTH, LOG_LAM_WIDTH], len(layout.groups)))
+    w = np.concatenate(w)
+    total = n_iter + (tune_rounds * tune_levels if tune else 0)
+    own = [s.problem.sampled for s in state.states]
+    bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    with threadpool_limits(1):
+        if tune:
+            bar.set_description(f"{desc}: tuning step widths")
+            cands = tuning.level_widths(_tuning_kinds(state.states, layout), w, tune_levels)
+            acc = np.zeros((tune_levels, w.size))
+            for _ in range(tune_rounds):
+                for lev in range(tune_levels):
+                    state.sweep(cands[lev], False, acc[lev])
+                bar.update(tune_levels)
+            w = tuning.choose_widths(w, cands, acc, tune_rounds)
+        bar.set_description(f"{desc}: sampling")
+        out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
+               "mu": np.empty((n_iter, len(layout.groups))),
+               "lam": np.empty((n_iter, len(layout.groups)))}  # fmt: skip
+        members = [{n: np.empty((n_iter, *s.params[n].shape)) for n in names}
+                   for s, names in zip(state.states, own, strict=True)]  # fmt: skip
+        accepted = np.zeros(w.size)
+        for it in range(n_iter):
+            state.sweep(w, not tune, accepted)
+            out["theta"][it], out["mu"][it], out["lam"][it] = state.g, state.mu, state.lam
+            for s, names, rec in zip(state.states, own, members, strict=True):
+                for n in names:
+                    rec[n][it] = s.params[n]
+            out["log_post"][it] = state.log_post()
+            if it % 100 == 99:
+                bar.update(100)
+        bar.update(n_iter % 100)
+    bar.close()
+    out.update(members=members, accept_rate=accepted / max(n_iter, 1), widths=w,
+               names=element_names(state.states, layout))  # fmt: skip
+    return out
+
+
+def sample_study(
+    problems: list[Problem], layout: Layout, hyper: HyperPriors, *, n_iter: int,
+    n_chains: int = 1, tune: bool = True, seed=None, init: str = "auto",
+    tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
+    progress: bool = False, n_jobs: int | None = None, executor=None,
+) -> StudyChains:  # fmt: skip
+    """``n_chains`` study chains, chain c on ``SeedSequence(seed).spawn(n_chains)[c]`` (its draws
+    do not depend on where it runs: ``n_jobs`` processes or ``executor``, as
+    ``gpmsa.mcmc.parallel.run_chains``). ChainError names a chain that failed or whose draws are
+    not finite."""
+    how = starts.check_init(init, int(n_chains))
+    seq = np.random.SeedSequence(seed)
+    tasks = [
+        {"problems": problems, "layout": layout, "hyper": hyper, "n_iter": int(n_iter),
+         "tune": tune, "seed": s, "init": how, "tune_rounds": tune_rounds,
+         "tune_levels": tune_levels}
+        for s in seq.spawn(int(n_chains))
+    ]  # fmt: skip
+    runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
+                      progress=progress, desc="study chain")  # fmt: skip
+    members = tuple(
+        {n: np.stack([r["members"][i][n] for r in runs]) for n in runs[0]["members"][i]}
+        for i in range(len(problems))
+    )
+    out = StudyChains(
+        theta=np.stack([r["theta"] for r in runs]), mu=np.stack([r["mu"] for r in runs]),
+        lam=np.stack([r["lam"] for r in runs]), log_post=np.stack([r["log_post"] for r in runs]),
+        members=members, accept_rate=np.stack([r["accept_rate"] for r in runs]),
+        widths=np.stack([r["widths"] for r in runs]), names=tuple(runs[0]["names"]),
+        info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": bool(tune),
+              "tune_rounds": tune_rounds, "tune_levels": tune_levels, "seed": seed,
+              "seed_entropy": str(seq.entropy), "init": how},
+    )  # fmt: skip
+    require_finite({"theta": out.theta, "mu": out.mu, "lam": out.lam}, out.log_post)
+    return out

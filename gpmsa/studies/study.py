@@ -1,0 +1,190 @@
+"""``Study``: several models' emulators and their joint calibration draws; its files.
+
+A study is saved as a set of files in one folder: the study file (``STUDY.gpmsa``, the
+container of ``gpmsa.io.container`` with format "gpmsa-study": the draws and a manifest listing
+each model's emulator file with its content sha256) and one emulator file per model
+(``STUDY.LABEL.gpmsa``, an ordinary emulator file). ``load_study`` reads the models' files
+through ``gpmsa.load`` with the listed sha256, so an edited model file is refused.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from gpmsa.calibration.posterior import Posterior
+from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.fitting.emulator import _check_metadata, load
+from gpmsa.io.container import STUDY_FORMAT, jsonable, read_raw, write_raw
+from gpmsa.mcmc.diagnostics import convergence, summarize
+from gpmsa.studies.layout import HyperPriors, Layout, build_layout
+from gpmsa.studies.record import check_study_arrays, check_study_manifest
+
+
+def layout_of(emulators, labels, shared, hierarchical) -> Layout:
+    """The study layout of fitted emulators (their t names, t ranges and theta priors)."""
+    return build_layout(
+        tuple(labels), [tuple(e.t_names) for e in emulators],
+        [(e.standardizer.t_min, e.standardizer.t_max) for e in emulators],
+        [(e.priors.theta_mean, e.priors.theta_sd) for e in emulators], shared, hierarchical,
+    )  # fmt: skip
+
+
+def native_chains(layout: Layout, draws: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Named (C, N) chains in native units from the unit-scale draws: each study element, each
+    model's lamOs ("lamOs[LABEL]"), each group's mean "NAME.mu" and sd "NAME.sd" (native: the
+    unit-scale 1/sqrt(lam) times the parameter's range) and precision "NAME.lam" (unit scale)."""
+    out = {}
+    for e, el in enumerate(layout.elements):
+        lo, hi = layout.bounds[e]
+        out[el.name] = lo + draws["theta"][:, :, e] * (hi - lo)
+    for i, lab in enumerate(layout.labels):
+        out[f"lamOs[{lab}]"] = draws["lamOs"][:, :, i]
+    for h, name in enumerate(layout.groups):
+        e = layout.members_of(h)[0]
+        lo, hi = layout.bounds[e]
+        out[f"{name}.mu"] = lo + draws["mu"][:, :, h] * (hi - lo)
+        out[f"{name}.sd"] = (hi - lo) / np.sqrt(draws["lam"][:, :, h])
+        out[f"{name}.lam"] = draws["lam"][:, :, h]
+    return out
+
+
+class Study:
+    """Several models calibrated together (shared and hierarchical theta); docs/models.md.
+
+    Attributes:
+        kind: "calibration" (the emulators fixed, ``calibrate_study``) or "fit" (emulators and
+            calibration fitted jointly, ``fit_study``).
+        members: the models' ``gpmsa.Emulator``s, in order; labels: their labels.
+        layout: the study elements (``gpmsa.studies.layout.Layout``); hyper: the hyperpriors.
+        draws: unit-scale kept draws: theta (C, N, G), mu and lam (C, N, H), lamOs (C, N, M),
+            log_post (C, N).
+        posterior: ``gpmsa.Posterior`` in native units (names: ``native_chains``).
+        settings, metadata: how it was run; the user's JSON-able dict (saved).
+    """
+
+    def __init__(self, kind: str, members, layout: Layout, hyper: HyperPriors,
+                 draws: dict[str, np.ndarray], settings: dict | None = None,
+                 metadata: dict | None = None):  # fmt: skip
+        self.kind = kind
+        self.members = tuple(members)
+        self.layout = layout
+        self.hyper = hyper
+        self.draws = {k: np.asarray(v, dtype=np.float64) for k, v in draws.items()}
+        self.settings = dict(settings or {})
+        self.metadata = dict(metadata or {})
+        chains = native_chains(layout, self.draws)
+        samples = {k: v.reshape(-1) for k, v in chains.items()}
+        self.diagnostics = summarize(chains)
+        n_chains, n_draws = self.draws["log_post"].shape
+        info = {"method": f"study {kind}", "diagnostics": self.diagnostics, **self.settings}
+        self.convergence = None
+        if n_chains > 1:
+            shapes = {k: () for k in chains}
+            self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws)
+            info["convergence"] = self.convergence
+        self.posterior = Posterior(samples, chains=chains, info=info)
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """The models' labels."""
+        return self.layout.labels
+
+    def _member(self, model: int | str) -> int:
+        if isinstance(model, str):
+            if model not in self.labels:
+                raise GPMSAError(f"unknown model {model!r}; this study has {list(self.labels)}")
+            return self.labels.index(model)
+        if not 0 <= int(model) < len(self.members):
+            raise GPMSAError(f"model index {model} outside 0..{len(self.members) - 1}")
+        return int(model)
+
+    def member_posterior(self, model: int | str) -> Posterior:
+        """One model's calibration as a ``gpmsa.Posterior`` named as its emulator's t_names and
+        "lamOs" (native units), e.g. for ``gpmsa.predictive.calibrated_predict``."""
+        i = self._member(model)
+        chains = self.posterior.chains
+        out = {}
+        for k, name in enumerate(self.members[i].t_names):
+            out[name] = chains[self.layout.elements[self.layout.index[i][k]].name]
+        out["lamOs"] = chains[f"lamOs[{self.labels[i]}]"]
+        return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out,
+                         info={"method": f"study {self.kind}", "model": self.labels[i]})
+
+    def to_record(self, files: list[str], hashes: list[str]) -> tuple[dict, dict]:
+        """The study file's (manifest, arrays), its models' files and sha256 given."""
+        _check_metadata(self.metadata, "metadata")
+        models = [{"label": lab, "file": f, "sha256": h}
+                  for lab, f, h in zip(self.labels, files, hashes, strict=True)]  # fmt: skip
+        manifest = {
+            "names": {"models": list(self.labels),
+                      "elements": [el.name for el in self.layout.elements],
+                      "t": {lab: list(e.t_names) for lab, e in zip(self.labels, self.members,
+                                                                   strict=True)}},
+            "units": {lab: list(e.t_units) for lab, e in zip(self.labels, self.members,
+                                                             strict=True)},
+            "priors": {"hyper": self.hyper.to_dict()},
+            "settings": self.settings,
+            "metadata": self.metadata,
+            "diagnostics": self.diagnostics,
+            "study": {"kind": self.kind, "shared": list(self.layout.shared),
+                      "hierarchical": list(self.layout.groups), "models": models},
+        }  # fmt: skip
+        if self.convergence is not None:
+            manifest["convergence"] = self.convergence
+        return jsonable(manifest), {k: np.ascontiguousarray(v) for k, v in self.draws.items()}
+
+    def save(self, path: str | Path) -> Path:
+        """Write the study file ``path`` and beside it each model's emulator file
+        ``<stem>.<label>.gpmsa``; returns ``path``. Each file is written atomically (the models'
+        first, the study file last, so a study file never lists a file not yet written)."""
+        path = Path(path)
+        files, hashes = [], []
+        for lab, emu in zip(self.labels, self.members, strict=True):
+            file = f"{path.stem}.{lab}.gpmsa"
+            member = emu.save(path.with_name(file))
+            files.append(file)
+            hashes.append(read_raw(member)[0]["content_sha256"])
+        manifest, arrays = self.to_record(files, hashes)
+        return write_raw(path, manifest, arrays, fmt=STUDY_FORMAT)
+
+    def __repr__(self) -> str:
+        c, n = self.draws["log_post"].shape
+        return (f"Study({self.kind}, models={list(self.labels)}, shared={list(self.layout.shared)}"
+                f", hierarchical={list(self.layout.groups)}, {c} chains x {n} draws)")  # fmt: skip
+
+
+def load_study(path: str | Path) -> Study:
+    """Read a study written by ``Study.save``: the study file and each model's file beside it.
+
+    Every model file is read by ``gpmsa.load`` with the sha256 the study lists (an edited or
+    replaced model file is refused); the study's fields and draws are validated against the
+    models. Raises EmulatorFileError naming the file and the field.
+
+    >>> import gpmsa
+    >>> gpmsa.load_study("no-such-study.gpmsa")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    gpmsa.errors.EmulatorFileError: ...no-such-study.gpmsa...
+    """
+    path = Path(path)
+    manifest, arrays = read_raw(path, check_study_manifest, formats=(STUDY_FORMAT,))
+    study = manifest["study"]
+    members = []
+    for j, mod in enumerate(study["models"]):
+        try:
+            members.append(load(path.with_name(mod["file"]), sha256=mod["sha256"]))
+        except EmulatorFileError as exc:
+            raise EmulatorFileError(f"{path}: study.models[{j}] ({mod['label']}): {exc}") from exc
+    labels = [mod["label"] for mod in study["models"]]
+    try:
+        layout = layout_of(members, labels, study["shared"], study["hierarchical"])
+        check_study_arrays(manifest, arrays, layout)
+        hyper = HyperPriors(**manifest["priors"]["hyper"])
+        return Study(study["kind"], members, layout, hyper, arrays, manifest["settings"],
+                     manifest["metadata"])  # fmt: skip
+    except EmulatorFileError as exc:
+        raise EmulatorFileError(f"{path}: {exc}") from exc
+    except GPMSAError as exc:
+        raise EmulatorFileError(f"{path}: study: {exc}") from exc

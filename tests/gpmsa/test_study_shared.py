@@ -1,0 +1,144 @@
+"""Shared calibration parameters across models (gpmsa.calibrate_study, gpmsa.fit_study)."""
+
+import numpy as np
+import pytest
+
+import gpmsa
+from gpmsa.mcmc.diagnostics import ess
+from tests.gpmsa._study_cases import emulator, observations
+
+TIGHT = gpmsa.Priors(lamOs=gpmsa.GammaPrior(1e6, 1e6 / 400.0))
+"""A lamOs prior so tight (mean 400, relative sd 1e-3) that lamOs is in effect known: then a
+study whose models each have their own lamOs is the same model as one with all the data."""
+
+
+def _within(a: np.ndarray, b: np.ndarray, ess_a: float, ess_b: float, k: float = 4.0):
+    """Means and sds agree within k Monte-Carlo standard errors (sd of the mean: sd/sqrt(ESS);
+    of the sd, for a near-normal posterior: sd/sqrt(2 ESS))."""
+    sd = max(a.std(), b.std())
+    se_mean = sd * np.sqrt(1.0 / ess_a + 1.0 / ess_b)
+    se_sd = sd * np.sqrt(1.0 / (2 * ess_a) + 1.0 / (2 * ess_b))
+    assert abs(a.mean() - b.mean()) < k * se_mean, (a.mean(), b.mean(), se_mean)
+    assert abs(a.std() - b.std()) < k * se_sd, (a.std(), b.std(), se_sd)
+
+
+def test_two_halves_sharing_theta_equal_one_model_with_all_the_data():
+    emu = emulator(TIGHT)
+    x, y = observations(0.4, 8, 0.05, np.random.default_rng(3))
+    study = gpmsa.calibrate_study([emu, emu], [x[::2], x[1::2]], [y[::2], y[1::2]],
+                                  shared=["t"], n_samples=6000, n_burn=1000, seed=11)  # fmt: skip
+    one = gpmsa.calibrate(emu, x, y, n_samples=6000, n_burn=1000, seed=12)
+    exact = gpmsa.Calibrator(emu, method="grid").update(x, y)
+    a, b = study.posterior.chains["t"], one.chains["t"]
+    ess_a, ess_b = ess(a), ess(b)
+    assert ess_a > 400 and ess_b > 400
+    _within(a.ravel(), b.ravel(), ess_a, ess_b)
+    # and against the exact grid posterior (no Monte-Carlo error on that side)
+    sd = exact.sd("t")
+    assert abs(a.mean() - exact.mean("t")) < 4 * sd / np.sqrt(ess_a)
+    assert abs(a.std() - sd) < 4 * sd / np.sqrt(2 * ess_a)
+    assert abs(a.mean() - 0.4) < 3 * sd  # and the truth
+    # the per-model view: the same draws under the emulator's names
+    mp = study.member_posterior("model1")
+    assert mp.names == ("t", "lamOs") and np.array_equal(mp.samples["t"], a.ravel())
+
+
+def test_own_parameters_stay_separate_and_match_single_calibrations():
+    """Nothing shared: the study is two independent calibrations."""
+    emu = emulator(TIGHT)
+    rng = np.random.default_rng(5)
+    (x1, y1), (x2, y2) = observations(0.3, 4, 0.05, rng), observations(0.7, 4, 0.05, rng)
+    study = gpmsa.calibrate_study([emu, emu], [x1, x2], [y1, y2], labels=["a", "b"],
+                                  n_samples=4000, n_burn=500, seed=1)  # fmt: skip
+    assert set(study.posterior.names) == {"t[a]", "t[b]", "lamOs[a]", "lamOs[b]"}
+    for name, (x, y) in (("t[a]", (x1, y1)), ("t[b]", (x2, y2))):
+        exact = gpmsa.Calibrator(emu, method="grid").update(x, y)
+        draws = study.posterior.chains[name]
+        assert abs(draws.mean() - exact.mean("t")) < 4 * exact.sd("t") / np.sqrt(ess(draws))
+
+
+def test_shared_and_own_parameters_mix():
+    """Two models with two parameters each, one shared: the study has three elements."""
+    e1 = emulator(None, 0.0, 1.0, "t")
+    e2 = emulator(None, 0.0, 1.0, "s")
+    x, y = observations(0.4, 3, 0.05, np.random.default_rng(2))
+    study = gpmsa.calibrate_study([e1, e2, e1], [x, x, x], [y, y, y], shared=["t"],
+                                  n_samples=300, n_burn=50, seed=3, tune=False)  # fmt: skip
+    assert study.layout.index == ((0,), (1,), (0,))
+    assert [el.name for el in study.layout.elements] == ["t", "s[model1]"]
+
+
+def test_several_chains_do_not_depend_on_the_workers():
+    emu = emulator(None)
+    x, y = observations(0.4, 3, 0.05, np.random.default_rng(2))
+    kw = dict(shared=["t"], n_samples=200, n_burn=50, seed=4, n_chains=2, tune_rounds=5)
+    with pytest.warns(gpmsa.ConvergenceWarning):
+        one = gpmsa.calibrate_study([emu, emu], [x, x], [y, y], n_jobs=1, **kw)
+    with pytest.warns(gpmsa.ConvergenceWarning):
+        two = gpmsa.calibrate_study([emu, emu], [x, x], [y, y], n_jobs=2, **kw)
+    assert np.array_equal(one.draws["theta"], two.draws["theta"])
+    assert one.posterior.info["convergence"]["n_chains"] == 2
+
+
+def test_joint_fit_shares_theta_and_recovers_it():
+    """fit_study: two models (their own emulator parameters) share t; truth 0.4."""
+    rng = np.random.default_rng(8)
+    from tests.gpmsa._study_cases import sim_data
+
+    sim = sim_data()
+    obs = []
+    for lo in (0.1, 0.5):
+        x = np.linspace(lo, lo + 0.4, 4)[:, None]
+        obs.append(gpmsa.ObsData(x=x, y=x * np.exp(1.5 * 0.4) + 0.03 * rng.standard_normal(
+            (4, 1))))  # fmt: skip
+    study = gpmsa.fit_study([sim, sim], obs, labels=["left", "right"], shared=["t"],
+                            n_iter=1500, seed=5, tune_rounds=20)  # fmt: skip
+    assert study.kind == "fit"
+    post = study.posterior
+    assert abs(post.mean("t") - 0.4) < max(3 * post.sd("t"), 0.03)
+    for emu in study.members:  # each member's own calibration draws are the shared ones
+        assert np.allclose(emu.calibration["theta_native"][:, 0], post.samples["t"])
+        assert emu.params["lamUz"].shape == (1,)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"shared": ["E"]}, "shared parameter 'E' is unknown"),
+        ({"hierarchical": ["E"]}, "hierarchical parameter 'E' is unknown"),
+        ({"shared": ["t"], "hierarchical": ["t"]}, "both shared and hierarchical"),
+        ({"labels": ["a", "a"]}, "labels must differ"),
+        ({"labels": ["a/b", "c"]}, "model label 'a/b'"),
+        ({"labels": ["a"]}, "got 1 labels for 2 models"),
+        ({"hyper": {"mu_mean": 0.5}}, "hyper must be a gpmsa.HyperPriors"),
+        ({"n_burn": 500}, "n_burn must be"),
+    ],
+)
+def test_bad_study_input_is_named(kwargs, message):
+    emu = emulator(None)
+    x, y = observations(0.4, 2, 0.05, np.random.default_rng(0))
+    with pytest.raises(gpmsa.GPMSAError, match=message.replace("[", r"\[")):
+        gpmsa.calibrate_study([emu, emu], [x, x], [y, y], **{"n_samples": 100, "n_burn": 10,
+                                                              **kwargs})
+
+
+def test_different_bounds_of_a_shared_parameter_are_refused():
+    narrow = emulator(None, 0.0, 0.8)
+    x, y = observations(0.4, 2, 0.05, np.random.default_rng(0))
+    for kw in ({"shared": ["t"]}, {"hierarchical": ["t"]}):
+        with pytest.raises(gpmsa.GPMSAError, match="'t' has different bounds"):
+            gpmsa.calibrate_study([emulator(None), narrow], [x, x], [y, y], n_samples=100,
+                                  n_burn=10, **kw)  # fmt: skip
+
+
+def test_mismatched_numbers_are_refused():
+    emu = emulator(None)
+    x, y = observations(0.4, 2, 0.05, np.random.default_rng(0))
+    with pytest.raises(gpmsa.GPMSAError, match="mismatched numbers of models"):
+        gpmsa.calibrate_study([emu, emu], [x, x, x], [y, y], shared=["t"])
+    with pytest.raises(gpmsa.GPMSAError, match="one entry per model"):
+        gpmsa.calibrate_study(emu, x, y)
+    with pytest.raises(gpmsa.GPMSAError, match="in one model only"):
+        gpmsa.calibrate_study([emu], [x], [y], shared=["t"])
+    with pytest.raises(gpmsa.GPMSAError, match="mismatched numbers of models"):
+        gpmsa.fit_study([emu], [], shared=["t"])
