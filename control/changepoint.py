@@ -20,6 +20,7 @@ run-length posterior gives the probability of a recent change.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,7 +43,9 @@ class ChangePointSettings:
         min_jump: smallest |log(GD_new / GD_old)| counted as a change.
         jump_sd: sd of log(GD_new / GD_old) at a change (None: GD_new from the prior alone).
         prior: law of GD at the start and the base of the jump law: "log_uniform" (the
-            scale-invariant prior of a scale parameter) or "uniform" (the paper's eq. 3).
+            scale-invariant prior of a scale parameter), "uniform" (the paper's eq. 3), or a
+            function of GD (an array of grid values) returning the log prior density there (any
+            additive constant; finite where the prior has mass, -inf outside).
         max_runs: run lengths kept (older ones are merged into the last).
     """
 
@@ -50,7 +53,7 @@ class ChangePointSettings:
     segment_shape: float = 2.0
     min_jump: float = 0.15
     jump_sd: float | None = 0.5
-    prior: str = "log_uniform"
+    prior: str | Callable[[np.ndarray], np.ndarray] = "log_uniform"
     max_runs: int = 300
 
     def __post_init__(self) -> None:
@@ -62,8 +65,8 @@ class ChangePointSettings:
             raise ControlError(f"min_jump must be finite and >= 0, got {self.min_jump}")
         if self.jump_sd is not None and not (np.isfinite(self.jump_sd) and self.jump_sd > 0):
             raise ControlError(f"jump_sd must be None or finite and > 0, got {self.jump_sd}")
-        if self.prior not in PRIORS:
-            raise ControlError(f"prior must be one of {PRIORS}, got {self.prior!r}")
+        if not callable(self.prior) and self.prior not in PRIORS:
+            raise ControlError(f"prior must be one of {PRIORS} or a function, got {self.prior!r}")
         if not (isinstance(self.max_runs, int | np.integer) and self.max_runs >= 2):
             raise ControlError(f"max_runs must be an integer >= 2, got {self.max_runs}")
 
@@ -78,10 +81,7 @@ class ChangePointFilter:
         self.settings = s = settings or ChangePointSettings()
         self.gd = gd
         self._weights = trapezoid_weights(gd)
-        # prior mass per node: density (1/GD for log-uniform, 1 for uniform) times node weight
-        density = 1.0 / gd if s.prior == "log_uniform" else np.ones_like(gd)
-        prior = density * self._weights
-        self.prior = prior / prior.sum()
+        self.prior = _prior_mass(gd, self._weights, s.prior)
         lg = np.log(gd)
         jump = lg[None, :] - lg[:, None]
         T = self.prior[None, :] * (np.abs(jump) >= s.min_jump)
@@ -180,3 +180,22 @@ class ChangePointFilter:
             draw=lambda: {name: marginal.sample(np.random.default_rng(0), n_draws)},
             info={"method": "changepoint", "names": (name,)},
         )
+
+
+def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:
+    """Prior mass per grid node: the density (1/GD for log-uniform, 1 for uniform, or exp of
+    the user's log density) times the node's trapezoid weight, normalised."""
+    if callable(prior):
+        log_density = np.asarray(prior(gd.copy()), dtype=float)
+        if log_density.shape != gd.shape or np.any(np.isnan(log_density)):
+            raise ControlError(
+                f"prior(gd) must return {gd.size} log densities (no NaN), got shape "
+                f"{log_density.shape}"
+            )
+        if np.any(log_density == np.inf) or not np.any(np.isfinite(log_density)):
+            raise ControlError("prior(gd) must be finite somewhere and never +inf")
+        density = np.exp(log_density - np.max(log_density[np.isfinite(log_density)]))
+    else:
+        density = 1.0 / gd if prior == "log_uniform" else np.ones_like(gd)
+    mass = density * weights
+    return mass / mass.sum()

@@ -40,7 +40,7 @@ def plot_gd_trace(
         gd_max: the Simplex's GD_max: the parts rougher than it are shaded (None: no shading).
         level: the level of the BCR's interval (for the legend).
     """
-    fig = Figure(figsize=(7.5, 3.8), constrained_layout=True)
+    fig = Figure(figsize=(7.5, 4.6), layout="constrained")
     ax = fig.add_subplot()
     _mark_track(ax, track, gd_max)
     x, gd = _track_steps(track)
@@ -56,7 +56,7 @@ def plot_gd_trace(
     ax.set_ylabel("GD (1e-6 m$^3$)")
     ax.set_xlim(0, float(track.length_m))
     ax.set_title(title or "BCR estimate of GD")
-    ax.legend(loc="upper left", fontsize=7, ncol=2, framealpha=0.8)
+    fig.legend(loc="outside lower center", fontsize=7, ncol=4, frameon=False)
     return fig
 
 

@@ -3,12 +3,20 @@
 An emulator fitted offline by MCMC, shared as a file, calibrated online.
 """
 
-from gpmsa import backends, plots, predictive
+from gpmsa import backends, limits, plots, predictive
 from gpmsa._version import __version__ as __version__
 from gpmsa.calibration.calibrate import calibrate
 from gpmsa.calibration.calibrator import Calibrator
 from gpmsa.calibration.posterior import Posterior
-from gpmsa.errors import BackendUnavailableError, EmulatorFileError, GPMSAError
+from gpmsa.errors import (
+    BackendUnavailableError,
+    ChainError,
+    ConvergenceWarning,
+    EmulatorFileError,
+    GPMSAError,
+    OutsideEmulatorWarning,
+    ResourceLimitError,
+)
 from gpmsa.fitting.emulator import Emulator, LooResult, load
 from gpmsa.fitting.fit import fit
 from gpmsa.mcmc.sampler import Chains
@@ -26,7 +34,9 @@ from gpmsa.predictive import (
 __all__ = [
     "BackendUnavailableError",
     "Calibrator",
+    "ChainError",
     "Chains",
+    "ConvergenceWarning",
     "Emulator",
     "EmulatorFileError",
     "GPMSAError",
@@ -34,9 +44,11 @@ __all__ = [
     "LooResult",
     "ObsData",
     "ObsProblem",
+    "OutsideEmulatorWarning",
     "Posterior",
     "Priors",
     "Problem",
+    "ResourceLimitError",
     "SimData",
     "backends",
     "calibrate",
@@ -45,6 +57,7 @@ __all__ = [
     "emulator_prediction",
     "fit",
     "full_prediction",
+    "limits",
     "load",
     "plots",
     "predictive",

@@ -9,5 +9,29 @@ class EmulatorFileError(GPMSAError):
     """An emulator file is damaged, foreign, of a newer schema, or unsafe to read."""
 
 
+class ResourceLimitError(GPMSAError):
+    """A call would need more memory (or time) than ``gpmsa.limits`` allows; the message gives
+    the estimate, the limit and how to change it."""
+
+
 class BackendUnavailableError(ImportError):
     """A backend's optional packages are not installed; the message names the extra to install."""
+
+
+class OutsideEmulatorWarning(UserWarning):
+    """An observation lies outside what the emulator has seen (far from all its predictions)."""
+
+
+class ChainError(GPMSAError):
+    """A chain failed (its task raised, its worker died, or its draws are not finite).
+
+    ``chains`` lists the indices (0-based) of the chains concerned; the message names them.
+    """
+
+    def __init__(self, message: str, chains: tuple[int, ...] = ()):
+        super().__init__(message)
+        self.chains = tuple(chains)
+
+
+class ConvergenceWarning(UserWarning):
+    """Several chains disagree (R-hat above its limit) or give too few effective draws."""

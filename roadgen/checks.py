@@ -1,4 +1,10 @@
-"""Input checks shared by roadgen's functions; each raises RoadgenError naming the argument."""
+"""Input checks shared by roadgen's functions; each raises RoadgenError naming the argument.
+
+Resource limit: ``MAX_MEMORY_BYTES`` (module attribute, read at call time). A road is made only
+when the memory its synthesis needs (about ``BYTES_PER_POINT`` per grid point) is below it;
+otherwise RoadgenError states the estimate and the limit. A program that has the memory raises
+it: ``roadgen.checks.MAX_MEMORY_BYTES = 16 * 1024**3``.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +13,40 @@ import math
 import numpy as np
 
 from roadgen.errors import RoadgenError
+
+MAX_MEMORY_BYTES = 4 * 1024**3
+"""Largest memory (bytes) one call may need; change it by assignment."""
+BYTES_PER_POINT = 96
+"""Memory a road's synthesis needs per grid point: x, z and the unit road (8 bytes each), the
+half-length complex spectrum with its phases and amplitudes, the inverse FFT's work space, the
+taper and the amplitude profile."""
+MAX_SEED = 2**128
+
+
+def memory(nbytes: float, what: str) -> None:
+    """Raise RoadgenError when ``nbytes`` (an estimate) exceeds ``MAX_MEMORY_BYTES``."""
+    if nbytes > MAX_MEMORY_BYTES:
+        raise RoadgenError(
+            f"{what} needs about {nbytes / 1024**3:.3g} GiB of memory, above the limit "
+            f"roadgen.checks.MAX_MEMORY_BYTES = {MAX_MEMORY_BYTES / 1024**3:.3g} GiB; use a "
+            "shorter road or a coarser dx_m, or raise the limit (roadgen.checks.MAX_MEMORY_BYTES "
+            "= ...) if the machine has the memory"
+        )
+
+
+def seed(name: str, value):
+    """Return ``value`` if it is None, a numpy Generator or an integer in [0, 2**128); else
+    raise (numpy refuses a negative seed only deep inside SeedSequence)."""
+    if value is None or isinstance(value, np.random.Generator):
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise RoadgenError(
+            f"{name}={value!r} must be None, an integer or a numpy Generator "
+            f"(got {type(value).__name__})"
+        )
+    if not 0 <= int(value) < MAX_SEED:
+        raise RoadgenError(f"{name}={int(value)} is out of range: allowed integers in [0, 2**128)")
+    return int(value)
 
 
 def positive(name: str, value: float) -> float:

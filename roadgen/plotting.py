@@ -15,7 +15,10 @@ def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None 
 
     The PSD panel shows the prescribed line(s) Gd(n) = GD 1e-6 (n/n0)^-w for each distinct GD of the
     road (``gd`` of a Profile, the segments' GDs of a Track), n0 = 0.1 cycles/m, and the GD that
-    ``estimate_gd`` recovers. ``method`` is that of ``profile_psd``.
+    ``estimate_gd`` recovers. ``method`` is that of ``profile_psd``. The prescribed lines are
+    drawn wide and translucent underneath, the road's PSD as a thin line with a dot per ordinate
+    on top: with deterministic amplitudes the periodogram lies exactly on its line and stays
+    visible there.
     """
     fig = Figure(figsize=(7.0, 6.5), layout="constrained")
     ax_z, ax_p = fig.subplots(2, 1)
@@ -24,9 +27,10 @@ def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None 
     ax_z.set_ylabel("height z (mm)")
     n, gd = profile_psd(road, method)
     waviness = road.settings.waviness
-    ax_p.loglog(n, gd, lw=0.5, color="0.5", label=f"{method} of z")
-    for g in _prescribed_gds(road):
-        ax_p.loglog(n, gd_spectrum(n, g, waviness), "--", label=f"prescribed GD {g:g}")
+    for k, g in enumerate(_prescribed_gds(road)):
+        ax_p.loglog(n, gd_spectrum(n, g, waviness), lw=5.0, alpha=0.35, color=f"C{k + 1}",
+                    solid_capstyle="butt", zorder=1, label=f"prescribed GD {g:g}")  # fmt: skip
+    ax_p.loglog(n, gd, lw=0.6, color="C0", marker=".", ms=2.0, zorder=3, label=f"{method} of z")
     recovered = estimate_gd(road)
     ax_p.loglog([N0], [recovered * 1e-6], "o", color="k", label=f"recovered GD {recovered:.1f}")
     ax_p.set_xlabel("spatial frequency n (cycles/m)")

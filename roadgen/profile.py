@@ -127,7 +127,7 @@ def unit_road(
             f"band={band!r} holds no harmonic of the profile (spacing {dn:.6g} cycles/m): widen it "
             f"or lengthen the profile"
         )
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(checks.seed("seed", seed))
     n_keep = int(np.count_nonzero(keep))
     phase = rng.uniform(0.0, 2.0 * np.pi, n_keep)
     amp = np.sqrt(2.0 * gd_spectrum(n[keep], 1.0, w) * dn)
@@ -156,8 +156,17 @@ def lead_in_taper(x: np.ndarray, lead_in_m: float) -> np.ndarray:
 
 
 def grid_points(length_m: float, dx_m: float) -> int:
-    """Number of grid points for a length rounded to whole steps; at least 2 steps."""
-    steps = round(length_m / dx_m)
+    """Number of grid points for a length rounded to whole steps; at least 2 steps.
+
+    Raises RoadgenError when the road's synthesis would need more than
+    ``checks.MAX_MEMORY_BYTES`` (before anything is allocated).
+    """
+    steps_f = length_m / dx_m
+    checks.memory(
+        checks.BYTES_PER_POINT * (steps_f + 1),
+        f"a road of length_m={length_m:.6g} at dx_m={dx_m:.6g} ({steps_f + 1:.4g} points)",
+    )
+    steps = round(steps_f)
     if steps < 2:
         raise RoadgenError(
             f"dx_m={dx_m!r} is out of range for length_m={length_m!r}: allowed (0, length_m / 2]"

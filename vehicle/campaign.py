@@ -28,14 +28,13 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import roadgen
+from vehicle import checks
 from vehicle.design import check_design, lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
 from vehicle.models import Jackal, Model, check_model
 from vehicle.simulate import SUBSTEPS, simulate
 
 FORMAT = "vehicle.campaign/1"
-MAX_TRACE_BYTES = 4 * 2**30
-"""Largest memory the kept traces (``keep_s``) of a campaign may take, bytes."""
 _F_NAMES = ("f_full", "f_window", "f_full_noisy", "f_window_noisy")
 _ARRAYS = ("v", "gd", "seed", *_F_NAMES, "status")
 
@@ -176,6 +175,7 @@ def run_campaign(
         Campaign. A run that fails (diverges) is recorded with NaN f and its message.
     """
     model = Jackal() if model is None else check_model(model)
+    seed = checks.seed("seed", seed, generator=False)
     design = lhs_design(198, seed=seed) if design is None else design
     points = check_design(design, model)
     if not (isinstance(window, (int, np.integer)) and window >= 2):
@@ -188,15 +188,13 @@ def run_campaign(
             f"{np.max(points[:, 0]):.4g} m/s after the lead-in ({lead_in_m} m) needs "
             f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
         )
+    roadgen.profile.grid_points(float(road_length_m), float(dx_m))  # one road fits in memory
     if not (np.isfinite(keep_s) and keep_s >= 0):
         raise VehicleError(f"keep_s={keep_s!r} is out of range: allowed [0, inf) s")
     keep = int(round(keep_s * rate_hz))
-    if keep * points.shape[0] * 16 > MAX_TRACE_BYTES:
-        raise VehicleError(
-            f"keep_s={keep_s!r} s for {points.shape[0]} runs would hold "
-            f"{keep * points.shape[0] * 16 / 2**30:.3g} GiB of traces; the limit is "
-            f"vehicle.campaign.MAX_TRACE_BYTES = {MAX_TRACE_BYTES / 2**30:g} GiB"
-        )
+    checks.memory(
+        16.0 * keep * points.shape[0], f"keep_s={keep_s!r} s of traces for {points.shape[0]} runs"
+    )
 
     def length(v: float) -> float:
         need = lead_in_m + model.wheelbase_m + v * (keep_s + 1.0) if keep else 0.0
@@ -251,6 +249,7 @@ def run_campaign(
         "seed": int(seed),
         "f_full": "var(accel_front) over front-axle position >= lead_in_m + wheelbase",
         "f_window": f"var(accel_front) over the last {window} samples (ending at the road's end)",
+        "versions": package_versions(),
     }
     return Campaign(
         v=points[:, 0].copy(),
@@ -261,6 +260,40 @@ def run_campaign(
         settings=settings,
         **traces,
     )
+
+
+def package_versions() -> dict[str, str]:
+    """Versions of what computes a campaign's f: Python, numpy, scipy, exudyn, this project,
+    the machine and its BLAS (see docs/vehicle-models.md, "Reproducibility": f of a run depends
+    on the floating-point details of the machine, so a campaign records where it was made)."""
+    import platform
+    from importlib import metadata
+
+    import exudyn
+    import scipy
+
+    out = {
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "exudyn": str(getattr(exudyn, "__version__", None) or metadata.version("exudyn")),
+        "machine": f"{platform.system()} {platform.machine()}",
+    }
+    try:
+        out["terrain-gpmsa"] = metadata.version("terrain-gpmsa")
+    except metadata.PackageNotFoundError:
+        out["terrain-gpmsa"] = "not installed"
+    try:
+        from threadpoolctl import threadpool_info
+
+        out["blas"] = "; ".join(
+            f"{i.get('internal_api')} {i.get('version')} ({i.get('architecture')})"
+            for i in threadpool_info()
+            if i.get("user_api") == "blas"
+        )
+    except Exception:  # informative only
+        out["blas"] = "unknown"
+    return out
 
 
 RunResult = tuple[np.ndarray, str, np.ndarray, np.ndarray]

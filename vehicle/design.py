@@ -7,6 +7,7 @@ import math
 import numpy as np
 from scipy.stats import qmc
 
+from vehicle import checks
 from vehicle.errors import VehicleError
 from vehicle.models import Model
 
@@ -32,8 +33,10 @@ def lhs_design(
     Returns an array (n, 2): column 0 speed v (m/s) uniform on ``v_range``, column 1 GD
     (1e-6 m^3) uniform on ``gd_range`` (the paper's priors, eqs. 3-4).
     """
-    if not (isinstance(n, (int, np.integer)) and n >= 1):
+    if isinstance(n, bool) or not (isinstance(n, (int, np.integer)) and n >= 1):
         raise VehicleError(f"n={n!r} is out of range: allowed integers >= 1")
+    checks.memory(64.0 * int(n), f"a design of n={n} points")
+    seed = checks.seed("seed", seed)
     lo_v, hi_v = _range("v_range", v_range)
     lo_g, hi_g = _range("gd_range", gd_range)
     unit = qmc.LatinHypercube(d=2, rng=np.random.default_rng(seed)).random(int(n))

@@ -13,6 +13,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
+from vehicle import checks
 from vehicle.errors import VehicleError
 
 SpeedSchedule = float | Callable | tuple
@@ -118,12 +119,18 @@ def schedule_grid(
         if t_of_s[-1] > max_duration_s:
             raise VehicleError(f"the drive takes {t_of_s[-1]:.4g} s: allowed <= {max_duration_s} s")
         n = math.ceil(t_of_s[-1] / h)
+        checks.memory(checks.BYTES_PER_STEP * (n + 1), f"a drive of {n + 1} solver steps")
         t = h * np.arange(n + 1)
         s = np.interp(t, t_of_s, s_grid)
         return s, fun(s)
+    if not (callable(speed) or isinstance(speed, tuple)):  # a constant: the length is known
+        v0 = float(check_speed("speed", float(speed), max_speed))
+        n_est = (end_m - start_m) / (v0 * h) + 1
+        checks.memory(checks.BYTES_PER_STEP * n_est, f"a drive of {n_est:.4g} solver steps")
     s_parts, v_parts, s_now, k0 = [], [], start_m, 0
     block = 4096
     while True:
+        checks.memory(checks.BYTES_PER_STEP * (k0 + block), f"a drive of over {k0} solver steps")
         t = h * np.arange(k0, k0 + block + 1)
         v = fun(t)
         s = s_now + cumulative_trapezoid(v, t, initial=0.0)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vehicle import checks
 from vehicle.errors import VehicleError
 from vehicle.exudyn_models import ExudynVehicle
 from vehicle.kinematics import Drive, SpeedSchedule, schedule_grid
@@ -111,7 +112,7 @@ def simulate(
     noise = check_noise(noise_std)
     if not (isinstance(substeps, int) and substeps >= 1):
         raise VehicleError(f"substeps={substeps!r} is out of range: allowed integers >= 1")
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(checks.seed("seed", seed))
     road_in = RoadInput(road, model.wheel_radius_m if envelope else None)
     start = model.wheelbase_m if start_m is None else float(start_m)
     end = road_in.length_m if end_m is None else float(end_m)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vehicle import checks
 from vehicle.errors import VehicleError
 from vehicle.exudyn_models import ExudynVehicle
 from vehicle.kinematics import Drive, check_speed, ramp_grid
@@ -74,7 +75,7 @@ class Simulation:
         self.noise_std = check_noise(noise_std)
         if not (isinstance(substeps, int) and substeps >= 1):
             raise VehicleError(f"substeps={substeps!r} is out of range: allowed integers >= 1")
-        self._rng = np.random.default_rng(seed)
+        self._rng = np.random.default_rng(checks.seed("seed", seed))
         self._road = RoadInput(track, model.wheel_radius_m if envelope else None)
         self.end_m = self._road.length_m
         check_span(model, self._road, float(start_m), self.end_m)
@@ -99,8 +100,14 @@ class Simulation:
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise VehicleError(f"dt={dt!r} is out of range: allowed (0, inf) s")
         v_set = float(check_speed("speed", speed, self.model.max_speed_mps, allow_stop=True))
-        n = max(1, round(dt * self.rate_hz))
+        # no sample lies past the end: cap the grid at the time the end is surely reached
+        # (a vehicle told to stop never reaches it: dt stands, within the memory limit)
+        t_end = abs(v_set - self.speed) / self.model.max_accel_mps2 + (
+            max(self.end_m - self.position, 0.0) / v_set if v_set > 0 else np.inf
+        )
+        n = max(1, round(min(dt, t_end + 2.0 / self.rate_hz) * self.rate_hz))
         sub = self._substeps
+        checks.memory(checks.BYTES_PER_STEP * n * sub, f"advance(dt={dt:g}) ({n * sub} steps)")
         s, v = ramp_grid(
             self.position, self.speed, v_set, self.model.max_accel_mps2, self._h, n * sub
         )

@@ -8,11 +8,13 @@ lazily, so importing gpmsa never imports torch.
 from __future__ import annotations
 
 import importlib
+import inspect
 from types import ModuleType
 
-import numpy as np
-
 from gpmsa.errors import BackendUnavailableError, GPMSAError
+from gpmsa.mcmc.sampler import check_sample_args
+
+__all__ = ["available", "check_sample_args", "get", "names", "placement"]
 
 _REGISTRY: dict[str, tuple[str, str]] = {
     # name: (module path, pip extra that provides its packages)
@@ -57,11 +59,16 @@ def get(name: str) -> ModuleType:
         ) from exc
 
 
-def check_sample_args(n_iter, n_chains, seed) -> None:
-    """The checks every backend's ``sample`` makes on its run arguments (GPMSAError naming it)."""
-    if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
-        raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
-    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
-        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
-    if seed is not None and not isinstance(seed, (int, np.integer)):
-        raise GPMSAError(f"seed must be an int or None, got {seed!r}")
+def placement(backend: str, n_jobs=None, executor=None) -> dict:
+    """The ``n_jobs``/``executor`` options to pass to backend ``backend``'s ``sample`` (those
+    given). GPMSAError when given to a backend that runs its chains in one process (torch)."""
+    sample = get(backend).sample
+    out = {}
+    for key, val in (("n_jobs", n_jobs), ("executor", executor)):
+        if val is not None:
+            if key not in inspect.signature(sample).parameters:
+                raise GPMSAError(
+                    f"backend {backend!r} runs its chains in one process: it takes no {key}="
+                )
+            out[key] = val
+    return out

@@ -1,10 +1,15 @@
 """torch backend: GPM/SA's log-posterior and Metropolis-within-Gibbs with many chains batched.
 
 Every tensor carries a leading chain axis C; one scalar Metropolis update moves that element in all
-chains at once (batched Cholesky of Sigma_W over (C, m, m) with ``torch.linalg.cholesky_ex``).
-Proposals, bounds, sweep order and step-size tuning are those of the numpy reference
-(``gpmsa.mcmc.sampler``, ``gpmsa.mcmc.tuning``); chains share one set of tuned widths, fitted on the
-acceptance counts pooled over chains. Float64 by default; ``device="cuda"`` runs on a GPU when
+chains at once. Proposals, bounds, sweep order, the nugget-ridge moves and step-size tuning are
+those of the numpy reference (``gpmsa.mcmc.sampler``, ``gpmsa.mcmc.ridge``,
+``gpmsa.mcmc.tuning``); chain c starts where the numpy chain c would (``gpmsa.mcmc.starts``:
+dispersed for several chains), and the chains share one set of widths, tuned on acceptance
+counts pooled over chains in ``tune_stages`` stages, each after ``warmup`` sweeps from where the
+last stage left the chains.
+Each chain caches its correlation matrices (packed lower triangle). Sigma_W is factored per chain
+by LAPACK on the CPU (in cache, no copies; ``factor_``, ``_factor_scaled``) and by batched
+``torch.linalg.cholesky_ex`` elsewhere. Float64 by default; ``device="cuda"`` runs on a GPU when
 present.
 
 The correlation R = exp(-sum_k beta_k d_k^2) is GPyTorch's ARD ``RBFKernel`` with lengthscale
@@ -22,17 +27,31 @@ from dataclasses import dataclass
 
 import numpy as np
 import torch
+from scipy.linalg import lapack
+from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
 from gpmsa.backends import check_sample_args
-from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import tuning
-from gpmsa.mcmc.sampler import PRECISION_PARAMS, RHO_PARAMS, Chains, default_widths, elements
+from gpmsa.errors import ChainError, GPMSAError
+from gpmsa.mcmc import ridge, starts, tuning
+from gpmsa.mcmc.sampler import (
+    PRECISION_PARAMS,
+    RHO_PARAMS,
+    Chains,
+    check_ridge,
+    default_widths,
+    elements,
+)
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem
 
 Tensor = torch.Tensor
+_POTRF = {torch.float64: lapack.dpotrf, torch.float32: lapack.spotrf}
 SIM_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+WARMUP = 100
+"""Default sweeps before each pooled step-size tuning (not recorded)."""
+TUNE_STAGES = 3
+"""Default number of (warm-up, pooled tuning) stages: each tunes where the last one led."""
 """Parameters that change Sigma_W (their proposals refactor it)."""
 
 
@@ -47,6 +66,9 @@ class ModelTensors:
     reduced data, N = n * n_blocks; ``sig_obs`` (N, N) its covariance per unit lamOs;
     ``u_blocks`` the n-block of each basis component, ``v_blocks`` the n-blocks that receive the
     discrepancy covariance (GPM/SA's order, see ``gpmsa.model.problem.ObsProblem``).
+    Packed lower triangle (a factorisation reads only that): ``rows`` the row blocks (a, b)
+    (rows a..b-1, columns 0..b-1), ``d_packed`` (p+q, P) d_sim over them, ``packed_index`` (P,)
+    their flat positions in an m x m matrix.
     """
 
     p: int
@@ -61,6 +83,9 @@ class ModelTensors:
     sig_obs: Tensor | None = None
     u_blocks: tuple[int, ...] = ()
     v_blocks: tuple[int, ...] = ()
+    rows: tuple[tuple[int, int], ...] = ()
+    d_packed: Tensor | None = None
+    packed_index: Tensor | None = None
 
     @property
     def has_obs(self) -> bool:
@@ -88,10 +113,27 @@ class ModelTensors:
                 "u_blocks": u_blocks,
                 "v_blocks": tuple(range(n_v)) if "betaV" in problem.init else (),
             }
+        d_sim = pairwise_sq(zt, zt)
+        rows = row_blocks(problem.m)
+        index = np.concatenate([(np.arange(a, b)[:, None] * problem.m + np.arange(b)).ravel()
+                                for a, b in rows])  # fmt: skip
         return cls(
-            p=problem.p, q=problem.q, d_sim=t(pairwise_sq(zt, zt)), t_sim=t(problem.t_sim),
-            w=t(problem.w.T), lam_sim=t(problem.lam_sim), **kw,
+            p=problem.p, q=problem.q, d_sim=t(d_sim), t_sim=t(problem.t_sim),
+            w=t(problem.w.T), lam_sim=t(problem.lam_sim), rows=rows,
+            d_packed=t(np.concatenate([d_sim[:, a:b, :b].reshape(d_sim.shape[0], -1)
+                                       for a, b in rows], axis=1)),
+            packed_index=torch.as_tensor(index, device=device), **kw,
         )  # fmt: skip
+
+
+N_BLOCKS = 12
+"""Row blocks of the packed lower triangle (12: 54 % of the matrix for m = 198)."""
+
+
+def row_blocks(m: int, n_blocks: int = N_BLOCKS) -> tuple[tuple[int, int], ...]:
+    """Row blocks (a, b) covering rows 0..m-1 evenly; block (a, b) keeps columns 0..b-1."""
+    edges = np.unique(np.linspace(0, m, min(n_blocks, m) + 1).round().astype(int))
+    return tuple((int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True))
 
 
 def pairwise_sq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -130,6 +172,27 @@ def _gaussian_loglik(chol: Tensor, info: Tensor, resid: Tensor) -> tuple[Tensor,
     return torch.where(bad, torch.full_like(ll, -torch.inf), ll), alpha
 
 
+def factor_(sig: Tensor) -> tuple[Tensor, Tensor]:
+    """Lower Cholesky factors of the matrices sig (..., m, m): (factor, info (...), 0 = success).
+
+    On the CPU, in place through LAPACK ``potrf``, one call per matrix on a zero-copy view: the
+    factor overwrites sig's lower triangle and the upper triangle keeps Sigma (every later use
+    reads the lower triangle only). torch's batched ``cholesky_ex`` costs 1.8x as much here
+    (it copies each matrix and zeroes its upper triangle; docs/performance.md). Elsewhere (a
+    GPU), or under autograd, ``torch.linalg.cholesky_ex``.
+    """
+    if sig.device.type != "cpu" or sig.requires_grad or sig.dtype not in _POTRF:
+        return torch.linalg.cholesky_ex(sig)
+    sig = sig.contiguous()
+    m = sig.shape[-1]
+    mats = sig.view(-1, m, m).numpy()
+    potrf = _POTRF[sig.dtype]
+    info = np.zeros(mats.shape[0], dtype=np.int32)
+    for i, a in enumerate(mats):  # a.T is a's upper triangle in Fortran order: no copy
+        info[i] = potrf(a.T, lower=0, clean=0, overwrite_a=1)[1]
+    return sig, torch.from_numpy(info).view(sig.shape[:-2])
+
+
 def sim_factor(
     d_sim: Tensor, w: Tensor, lam_sim: Tensor, betaU: Tensor, lamUz: Tensor, lamWs: Tensor,
     lamWOs: Tensor,
@@ -141,9 +204,88 @@ def sim_factor(
     log N(w_j; 0, Sigma_W_j) without constants (C, J), -inf where not positive definite.
     """
     sig = scaled_correlation(betaU, d_sim, lamUz)
+    return _factor_sigma(sig, w, lam_sim, lamWs, lamWOs)
+
+
+def _on_lapack(t: Tensor) -> bool:
+    """Whether the per-chain LAPACK path applies (a CPU tensor of float64/float32, no autograd)."""
+    return t.device.type == "cpu" and t.dtype in _POTRF and not t.requires_grad
+
+
+def correlation_packed(beta: Tensor, data: ModelTensors, out: Tensor) -> Tensor:
+    """R = exp(-sum_k beta_k d_k) on the packed lower triangle, written into ``out`` (C, J, P,
+    contiguous): one matrix product and one in-place exp; beta (C, k, J)."""
+    c, k, j = beta.shape
+    flat = out.view(c * j, -1)
+    torch.mm(-beta.transpose(1, 2).reshape(c * j, k), data.d_packed, out=flat)
+    return flat.exp_().view(out.shape)
+
+
+def unpack(packed: Tensor, data: ModelTensors) -> Tensor:
+    """The (..., m, m) matrices whose lower triangle is ``packed`` (..., P); upper part zero."""
+    m = data.d_sim.shape[-1]
+    full = packed.new_zeros((*packed.shape[:-1], m * m))
+    full[..., data.packed_index] = packed
+    return full.view(*packed.shape[:-1], m, m)
+
+
+def _factor_scaled(
+    corr: Tensor, scale: Tensor, data: ModelTensors, comps: slice, lamWs: Tensor,
+    lamWOs: Tensor, out: Tensor | None = None, scratch: np.ndarray | None = None,
+) -> tuple[Tensor | None, Tensor, Tensor]:  # fmt: skip
+    """``sim_factor`` of components ``comps`` from their packed correlation corr (C, J, P) and
+    scale = 1/lamUz (C, J).
+
+    On the CPU, chain by chain and component by component: Sigma = corr * scale + nugget I is
+    built (lower triangle) in one m x m buffer, factored there by LAPACK and solved against w
+    while it is in cache (a batch of 64 chains x 198 x 198 is 20 MB: whole-batch passes each go
+    through memory). The factors go to ``out`` (C, J, m, m) when given, else only the ``scratch``
+    buffer is used and no factor is returned (None). Elsewhere (a GPU): batched torch ops.
+    """
+    w, lam_sim = data.w[comps], data.lam_sim[comps]
+    if not _on_lapack(corr):
+        sig = unpack(corr * scale[..., None], data)
+        chol, alpha, ll = _factor_sigma(sig, w, lam_sim, lamWs, lamWOs)
+        if out is not None:
+            out.copy_(chol)
+        return chol, alpha, ll
+    nugget = (1.0 / (lam_sim * lamWOs) + 1.0 / lamWs).numpy()
+    c_n, j_n, _ = corr.shape
+    m = data.d_sim.shape[-1]
+    cr, sc, wn = corr.contiguous().numpy(), scale.numpy(), w.numpy()
+    o = None if out is None else out.numpy()
+    if o is None and (scratch is None or scratch.shape != (m, m) or scratch.dtype != cr.dtype):
+        scratch = np.empty((m, m), dtype=cr.dtype)
+    offsets = np.cumsum([0] + [(b - a) * b for a, b in data.rows]).tolist()
+    blocks = [(a, b, o0, o1) for (a, b), o0, o1 in zip(data.rows, offsets[:-1], offsets[1:],
+                                                         strict=True)]  # fmt: skip
+    potrf = _POTRF[corr.dtype]
+    trtrs = lapack.dtrtrs if corr.dtype == torch.float64 else lapack.strtrs
+    alpha = np.zeros((c_n, j_n, m), dtype=cr.dtype)
+    ll = np.full((c_n, j_n), -np.inf)
+    for c in range(c_n):
+        for j in range(j_n):
+            a_ = scratch if o is None else o[c, j]
+            src, f = cr[c, j], sc[c, j]
+            for a, b, o0, o1 in blocks:
+                np.multiply(src[o0:o1].reshape(b - a, b), f, out=a_[a:b, :b])
+            diag = a_.reshape(-1)[:: m + 1]
+            diag += nugget[c, j]
+            if potrf(a_.T, lower=0, clean=0, overwrite_a=1)[1] != 0:
+                continue
+            v, _ = trtrs(a_.T, wn[j], lower=0, trans=1)
+            alpha[c, j] = v
+            ll[c, j] = -np.log(diag).sum() - 0.5 * (v @ v)
+    return out, torch.from_numpy(alpha), torch.from_numpy(ll).to(corr.dtype)
+
+
+def _factor_sigma(
+    sig: Tensor, w: Tensor, lam_sim: Tensor, lamWs: Tensor, lamWOs: Tensor
+) -> tuple[Tensor, Tensor, Tensor]:
+    """``sim_factor`` from sig = R_j / lamUz_j (C, J, m, m; overwritten on the CPU)."""
     nugget = 1.0 / (lam_sim * lamWOs) + 1.0 / lamWs
     sig = _add_diagonal(sig, nugget.unsqueeze(-1))
-    chol, info = torch.linalg.cholesky_ex(sig)
+    chol, info = factor_(sig)
     ll, alpha = _gaussian_loglik(chol, info, w.expand(chol.shape[:-1]))
     return chol, alpha, ll
 
@@ -212,30 +354,75 @@ def _seed_generator(seed, device) -> torch.Generator:
     return torch.Generator(device=device).manual_seed(state & (2**63 - 1))
 
 
+def _copy_rows(dst: Tensor, src: Tensor, rows: Tensor) -> None:
+    """dst[rows] = src[rows] along the chain axis (per chain on the CPU: no gathered copy)."""
+    if dst.device.type == "cpu":
+        d, s_ = dst.numpy(), src.numpy()
+        for r in rows.tolist():
+            d[r] = s_[r]
+    else:
+        dst[rows] = src[rows]
+
+
 class BatchState:
     """C chains of one problem: parameters, cached Sigma_W factors and the batched sweep."""
 
-    def __init__(self, problem: Problem, n_chains: int, dtype: torch.dtype, device):
+    def __init__(self, problem: Problem, n_chains: int, dtype: torch.dtype, device,
+                 start: dict[str, np.ndarray] | None = None, ridge_moves: int = 0):  # fmt: skip
+        """``start``: name -> (C, *shape) starting values (default: ``problem.init`` for all);
+        ``ridge_moves``: moves along the nugget ridge per sweep where they apply."""
         self.problem = problem
+        self.ridge_moves = int(ridge_moves) if ridge.applies(problem) else 0
+        self._buffers: dict[tuple[str, int], Tensor] = {}
+        m = problem.m
+        self._scratch = torch.empty((m, m), dtype=dtype).numpy()  # factors not kept (CPU)
         self.data = ModelTensors.from_problem(problem, dtype, device)
         self.priors = problem.priors
         self.els = elements(problem)
         self.n_chains = n_chains
+        if start is None:
+            start = {k: np.broadcast_to(v, (n_chains, *v.shape)) for k, v in problem.init.items()}
         self.reset({
-            k: torch.as_tensor(v, dtype=dtype, device=device).expand(n_chains, *v.shape).clone()
-            for k, v in problem.init.items()
+            k: torch.as_tensor(np.array(v), dtype=dtype, device=device) for k, v in start.items()
         })  # fmt: skip
-        if not torch.isfinite(self.loglik).all():
-            raise GPMSAError("the initial values give a log-likelihood of -inf (Sigma not PD)")
+        bad = torch.nonzero(~torch.isfinite(self.loglik)).squeeze(-1).tolist()
+        if bad:
+            raise ChainError(
+                f"the starting values of chain(s) {bad} give a log-likelihood of "
+                f"{self.loglik[bad[0]].item()} (Sigma not positive definite, or NaN data)", bad,
+            )  # fmt: skip
+
+    def _buffer(self, what: str, n_comp: int) -> Tensor:
+        """A reused work tensor, (C, n_comp, P) packed correlations ("corr") or (C, n_comp, m, m)
+        factors ("chol"): a fresh 20 MB tensor per proposal costs page faults."""
+        key = (what, n_comp)
+        if key not in self._buffers:
+            m = self.data.d_sim.shape[-1]
+            tail = (self.data.d_packed.shape[-1],) if what == "corr" else (m, m)
+            self._buffers[key] = self.ll_w.new_empty((self.n_chains, n_comp, *tail))
+        return self._buffers[key]
 
     def reset(self, params: dict[str, Tensor]) -> None:
         """Set every chain's parameters (name -> (C, *shape)) and recompute all cached terms."""
         self.params = params
         d = self.data
         shared = all(k in self.problem.fixed for k in SIM_PARAMS)  # calibration: one Sigma_W
-        self.chol, self.alpha, self.ll_w = sim_factor(
-            d.d_sim, d.w, d.lam_sim, *(params[k][:1] if shared else params[k] for k in SIM_PARAMS)
-        )
+        prm = {k: params[k][:1] if shared else params[k] for k in SIM_PARAMS}
+        if shared:  # one Sigma_W, factored once
+            self.corr = None
+            sig = scaled_correlation(prm["betaU"], d.d_sim, prm["lamUz"])
+            self.chol, self.alpha, self.ll_w = _factor_sigma(
+                sig, d.w, d.lam_sim, prm["lamWs"], prm["lamWOs"]
+            )
+        else:  # R_j per chain, packed and cached: a precision proposal only rescales it
+            n, p_u, m = self.n_chains, d.w.shape[0], d.d_sim.shape[-1]
+            corr = prm["betaU"].new_empty((n, p_u, d.d_packed.shape[-1]))
+            self.corr = correlation_packed(prm["betaU"], d, corr)
+            chol = prm["betaU"].new_empty((n, p_u, m, m)) if d.has_obs else None
+            self.chol, self.alpha, self.ll_w = _factor_scaled(
+                self.corr, 1.0 / prm["lamUz"], d, slice(None), prm["lamWs"], prm["lamWOs"],
+                out=chol, scratch=self._scratch,
+            )  # fmt: skip
         if shared:
             self.ll_w = self.ll_w.expand(self.n_chains, -1).clone()
         if not d.has_obs:
@@ -290,68 +477,99 @@ class BatchState:
         if not valid.any():
             return accepted
         cand = torch.where(valid, cand, x)
-        # Sigma_W proposals: factor only the chains whose candidate is inside the bounds.
-        # Others: every chain (no gathers of the cached factors), invalid ones masked below.
-        rows = torch.nonzero(valid).squeeze(-1) if name in SIM_PARAMS else None
-        sub = (lambda t: t) if rows is None else (lambda t: t[rows])  # noqa: E731
-        prm = {k: sub(v) for k, v in self.params.items()}
-        prm[name] = prm[name].clone()
-        prm[name][(slice(None), *idx)] = sub(cand)
+        # Every chain is evaluated (no gathers of cached matrices); invalid ones are masked.
+        prm = dict(self.params)
+        prm[name] = cur.clone()
+        prm[name][(slice(None), *idx)] = cand
         d = self.data
         chol, alpha, ll_w = self.chol, self.alpha, self.ll_w
-        if rows is not None:
+        if name in SIM_PARAMS:
             whole = name == "lamWOs" or d.w.shape[0] == 1
             comps = slice(None) if whole else slice(idx[-1], idx[-1] + 1)
-            chol_c, alpha_c, ll_c = sim_factor(
-                d.d_sim, d.w[comps], d.lam_sim[comps], prm["betaU"][:, :, comps],
-                prm["lamUz"][:, comps], prm["lamWs"][:, comps], prm["lamWOs"],
+            j_c = d.w.shape[0] if whole else 1
+            if name == "betaU":  # a new correlation matrix, into a reused buffer
+                corr_c = correlation_packed(prm["betaU"][:, :, comps], d,
+                                            self._buffer("corr", j_c))  # fmt: skip
+            else:  # the cached one, rescaled
+                corr_c = self.corr[:, comps]
+            chol_c, alpha_c, ll_c = _factor_scaled(
+                corr_c, 1.0 / prm["lamUz"][:, comps], d, comps, prm["lamWs"][:, comps],
+                prm["lamWOs"], out=self._buffer("chol", j_c) if d.has_obs else None,
+                scratch=self._scratch,
             )  # fmt: skip
             ll_w, chol, alpha = ll_c, chol_c, alpha_c
             if not whole:
-                ll_w = self.ll_w[rows]  # advanced indexing copies
+                ll_w = self.ll_w.clone()
                 ll_w[:, comps] = ll_c
                 if d.has_obs:
-                    chol, alpha = self.chol[rows], self.alpha[rows]
+                    chol, alpha = self.chol.clone(), self.alpha.clone()
                     chol[:, comps], alpha[:, comps] = chol_c, alpha_c
         ll_obs = self._obs(prm, chol, alpha)
         ll_new = ll_w.sum(-1) + ll_obs
-        ratio = (
-            ll_new
-            - sub(self.loglik)
-            + sub(lp_new - log_prior_elements(self.priors, name, x) + corr)
-        )
-        acc = (torch.log(sub(u[1])) < ratio) & sub(valid)
-        take = torch.nonzero(acc).squeeze(-1) if rows is None else rows[acc]
+        ratio = ll_new - self.loglik + lp_new - log_prior_elements(self.priors, name, x) + corr
+        acc = (torch.log(u[1]) < ratio) & valid
+        take = torch.nonzero(acc).squeeze(-1)
         accepted[take] = True
         cur[(take, *idx)] = cand[take]
-        self.ll_obs[take] = ll_obs[acc]
-        if rows is not None:
-            self.ll_w[take] = ll_w[acc]
+        self.ll_obs[take] = ll_obs[take]
+        if name in SIM_PARAMS:
+            self.ll_w[take] = ll_w[take]
+            if name == "betaU":
+                _copy_rows(self.corr[:, comps], corr_c, take)
             if d.has_obs:
-                self.chol[take] = chol[acc]
-                self.alpha[take] = alpha[acc]
+                _copy_rows(self.chol[:, comps], chol_c, take)
+                self.alpha[take, comps] = alpha_c[take]
         return accepted
 
     def sweep(self, widths: np.ndarray, prop_mh: bool, gen: torch.Generator) -> Tensor:
-        """One Metropolis-within-Gibbs sweep in GPM/SA's order; returns accepted (n_el, C)."""
+        """One Metropolis-within-Gibbs sweep in GPM/SA's order, then ``ridge_moves`` moves along
+        the nugget ridge (``gpmsa.mcmc.ridge``); returns accepted (n_el, C) of the sweep."""
         c = self.ll_w.shape[0]
-        u = torch.rand((len(self.els), 2, c), generator=gen, dtype=self.ll_w.dtype,
+        n_el = len(self.els)
+        u = torch.rand((n_el + self.ridge_moves, 2, c), generator=gen, dtype=self.ll_w.dtype,
                        device=self.ll_w.device)  # fmt: skip
-        out = torch.zeros((len(self.els), c), dtype=torch.bool, device=self.ll_w.device)
+        out = torch.zeros((n_el, c), dtype=torch.bool, device=self.ll_w.device)
         for i, (name, idx) in enumerate(self.els):
             kind = 1 if name in RHO_PARAMS else 2 if name in PRECISION_PARAMS else 0
             out[i] = self.update(name, idx, float(widths[i]), kind, prop_mh, u[i])
+        if self.ridge_moves:
+            self.ridge_sweep(u[n_el:])
         return out
+
+    def ridge_sweep(self, u: Tensor) -> None:
+        """Moves along the nugget ridge in every chain, one per u[k] (2, C) (likelihood unchanged;
+        the same move as the numpy sampler's ``ChainState.ridge_sweep``)."""
+        pri, lam_sim = self.priors, self.data.lam_sim[0]
+        ws, wos = self.params["lamWs"], self.params["lamWOs"]
+        s, t = ws[:, 0].clone(), wos[:, 0].clone()
+        lp_old = log_prior_elements(pri, "lamWs", s) + log_prior_elements(pri, "lamWOs", t)
+        for k in range(u.shape[0]):
+            n = 1.0 / (lam_sim * t) + 1.0 / s
+            s2 = s * torch.exp(ridge.WIDTH * (u[k, 0] - 0.5))
+            r = n - 1.0 / s2
+            ok = r > 0.0
+            t2 = 1.0 / (lam_sim * torch.where(ok, r, torch.ones_like(r)))
+            lp_new = log_prior_elements(pri, "lamWs", s2) + log_prior_elements(pri, "lamWOs", t2)
+            ok &= torch.isfinite(lp_new)
+            ratio = lp_new - lp_old + 2.0 * torch.log(t2 / t) + torch.log(s2 / s)
+            acc = ok & (torch.log(u[k, 1]) < ratio)
+            s, t = torch.where(acc, s2, s), torch.where(acc, t2, t)
+            lp_old = torch.where(acc, lp_new, lp_old)
+        ws[:, 0], wos[:, 0] = s, t
 
 
 @contextmanager
 def torch_threads(num_threads: int | None):
-    """Set torch's CPU thread count inside the block (None: unchanged); restored afterwards."""
+    """Set torch's CPU thread count, and the BLAS libraries' (scipy's LAPACK factors on the CPU),
+    inside the block (None: unchanged); restored afterwards."""
     previous = torch.get_num_threads()
-    if num_threads is not None:
-        torch.set_num_threads(int(num_threads))
-    try:
+    if num_threads is None:
         yield
+        return
+    torch.set_num_threads(int(num_threads))
+    try:
+        with threadpool_limits(int(num_threads), user_api="blas"):  # scipy's LAPACK (factor_)
+            yield
     finally:
         torch.set_num_threads(previous)
 
@@ -385,15 +603,24 @@ def sample(
     device="cpu",
     dtype="float64",
     num_threads: int | None = 1,
+    init: str = "auto",
+    warmup: int | None = None,
+    tune_stages: int = TUNE_STAGES,
+    ridge_moves: int | None = None,
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
-    Tuning (``tune=True``) is GPM/SA's: ``tune_levels`` candidate widths per element, each
-    level swept ``tune_rounds`` times by every chain; the acceptance counts are pooled over the
-    chains, so the default ``tune_rounds`` = ceil(50 / n_chains) gives each level at least
-    GPM/SA's 50 trials per element. All chains start at ``problem.init`` and share the tuned
-    widths. ``step_widths`` replace GPM/SA's initial widths. Draws hold every sweep (no burn-in
-    removed). ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
+    Starts: ``init`` ("auto": GPM/SA's initial values for one chain, dispersed ones for several,
+    chain c as the numpy backend's chain c; see ``gpmsa.mcmc.starts``). Warm-up and tuning
+    (``tune=True``): ``tune_stages`` (3) stages of ``warmup`` (100) sweeps followed by GPM/SA's
+    tuning: ``tune_levels`` candidate widths per element, each level swept ``tune_rounds`` times
+    by every chain, the acceptance counts pooled over the chains (the default ``tune_rounds`` =
+    ceil(50 / n_chains) gives each level at least GPM/SA's 50 trials per element); each stage
+    starts from the last one's widths, where the chains then are (tuned once from dispersed
+    starts, the widths fit the transient, not the posterior). All chains share the widths.
+    ``step_widths`` replace GPM/SA's initial widths. ``ridge_moves``: nugget-ridge moves per
+    sweep (``gpmsa.mcmc.ridge``). Draws hold every sweep after the warm-up (no burn-in removed).
+    ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
     ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
     torch's setting.
@@ -401,13 +628,19 @@ def sample(
     check_sample_args(n_iter, n_chains, seed)
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
-                       tune_rounds, tune_levels, device, dtype)  # fmt: skip
+                       tune_rounds, tune_levels, device, dtype, init, warmup,
+                       tune_stages, check_ridge(ridge_moves, problem))  # fmt: skip
 
 
 def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
-            tune_levels, device, dtype) -> Chains:  # fmt: skip
+            tune_levels, device, dtype, init, warmup, tune_stages, n_ridge) -> Chains:  # fmt: skip
     """``sample`` without the thread setting."""
     dev, dt = _device(device), _dtype(dtype)
+    how = starts.check_init(init, n_chains)
+    if warmup is None:
+        warmup = WARMUP if tune else 0
+    if not isinstance(warmup, (int, np.integer)) or warmup < 0:
+        raise GPMSAError(f"warmup must be an integer >= 0, got {warmup!r}")
     if tune_rounds is None:
         tune_rounds = math.ceil(tuning.N_BURN / n_chains)
     if tune_rounds < 1 or tune_levels < 2:
@@ -418,17 +651,29 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     for name, val in (step_widths or {}).items():
         widths[name] = np.broadcast_to(np.asarray(val, dtype=np.float64), widths[name].shape)
     gen = _seed_generator(seed, dev)
-    state = BatchState(problem, int(n_chains), dt, dev)
+    seeds = np.random.SeedSequence(seed).spawn(n_chains)  # chain c starts as the numpy chain c
+    firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seeds]
+    start = {k: np.stack([f[k] for f in firsts]) for k in problem.init}
+    state = BatchState(problem, int(n_chains), dt, dev, start, n_ridge)
     els = state.els
     w = np.array([float(widths[n][idx]) for n, idx in els])
-    total = n_iter + (tune_rounds * tune_levels if tune else 0)
+    if not isinstance(tune_stages, (int, np.integer)) or tune_stages < 1:
+        raise GPMSAError(f"tune_stages must be an integer >= 1, got {tune_stages!r}")
+    n_stages = tune_stages if tune else 1
+    total = n_iter + n_stages * (warmup + (tune_rounds * tune_levels if tune else 0))
     names = problem.names
     draws = {n: torch.empty((n_iter, n_chains, *problem.init[n].shape), dtype=dt, device=dev)
              for n in names}  # fmt: skip
     log_post = torch.empty((n_iter, n_chains), dtype=dt, device=dev)
     accepted = torch.zeros((len(els), n_chains), dtype=torch.long, device=dev)
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
-        if tune and els:
+        for _stage in range(n_stages):
+            bar.set_description("torch MCMC: warm-up and tuning" if tune else "torch MCMC: warm-up")
+            for _ in range(warmup):  # leave the starts (then the last widths' region) first
+                state.sweep(w, not tune, gen)
+                bar.update(1)
+            if not (tune and els):
+                break
             cands = tuning.level_widths([n for n, _ in els], w, tune_levels)
             acc = torch.zeros((tune_levels, len(els)), dtype=torch.long, device=dev)
             for _ in range(tune_rounds):
@@ -436,6 +681,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                     acc[lev] += state.sweep(cands[lev], False, gen).sum(-1)
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
+        bar.set_description("torch MCMC: sampling")
         for it in range(n_iter):
             accepted += state.sweep(w, not tune, gen)
             for n in names:
@@ -455,5 +701,8 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
         step_widths=wid,
         info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": tune,
               "tune_rounds": tune_rounds, "tune_levels": tune_levels, "seed": seed,
-              "backend": "torch", "device": str(dev), "dtype": str(dt).replace("torch.", "")},
+              "init": how, "warmup": int(warmup), "tune_stages": n_stages, "starts": start,
+              "ridge_moves": state.ridge_moves,
+              "backend": "torch",
+              "device": str(dev), "dtype": str(dt).replace("torch.", "")},
     )  # fmt: skip

@@ -17,22 +17,33 @@ import time
 from dataclasses import replace
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from gpmsa import backends
 from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
+    Fit,
     blas_controller,
     check_emulator,
+    check_log_prior,
     check_x,
     emulator_param_sets,
+    fit_of,
     fixed_gp,
+    lamos_start,
     reduce,
+    theta_probe,
+    warn_if_outside,
 )
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.calibration.sampler import CalibrationSampler
 from gpmsa.errors import GPMSAError
+from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
-from gpmsa.model.data import ObsData
+from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
+from gpmsa.mcmc.parallel import n_workers, run_chains
+from gpmsa.mcmc.sampler import require_finite
+from gpmsa.model.data import ObsData, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
@@ -43,9 +54,12 @@ def calibration_problem(emulator, x_obs, y_obs, *, discrepancy=None, extrapolate
     output; "constant", "linear" or a matrix for a vector output).
     """
     check_emulator(emulator)
+    start = None
     if discrepancy is None:
         data = reduce(emulator, x_obs, y_obs, extrapolate)
         obs, corr = data.obs, data.os_corr
+        fit = _probe(emulator, data, [emulator.params])
+        start = lamos_start(fit, data.lamos)
     else:
         x, _ = check_x(emulator, x_obs, extrapolate)
         y = np.asarray(y_obs, dtype=float)
@@ -61,6 +75,8 @@ def calibration_problem(emulator, x_obs, y_obs, *, discrepancy=None, extrapolate
     init = default_init(p, q, p_u, priors, obs)
     for k in EMULATOR_PARAMS:
         init[k] = np.array(emulator.params[k], dtype=float).reshape(init[k].shape)
+    if start is not None:
+        init["lamOs"] = np.array([start])
     return Problem(
         emulator.x_unit, emulator.t_unit, emulator.w, emulator.lam_sim, priors, init,
         frozenset(EMULATOR_PARAMS), obs,
@@ -87,6 +103,8 @@ def calibrate(
     fast: bool | None = None,
     log_prior=None,
     progress: bool = False,
+    n_jobs: int | None = None,
+    executor=None,
 ) -> Posterior:
     """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
 
@@ -108,12 +126,22 @@ def calibrate(
             ``Calibrator.update`` takes it ((k,) values for one parameter, (k, q) for more ->
             (k,) log densities; called with k = 1); fast path only.
         progress: show a tqdm bar.
+        n_jobs, executor: where several chains run (numpy backend): ``n_jobs`` worker processes
+            (None: every CPU, never more than the chains) or any ``concurrent.futures.Executor``
+            / dask ``Client``; each chain has its own seed, so the draws do not depend on it.
+            With ``log_prior`` (a callable, not shipped to workers) the chains run here.
+
+    With more than one chain, ``info["diagnostics"]`` holds each parameter's rank-normalised
+    R-hat and bulk ESS (and mean, sd), ``info["convergence"]`` the verdict, and a
+    ``gpmsa.ConvergenceWarning`` names each parameter with R-hat > 1.01 or ESS < 100. A chain
+    that fails or produces non-finite draws raises ``gpmsa.ChainError`` naming it.
 
     Returns:
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
         native units), "lamOs" (and "betaV", "lamVz" with a discrepancy), and chains per name.
     """
     check_emulator(emulator)
+    seed = check_seed(seed)
     for name, val, low in (("n_samples", n_samples, 2), ("n_chains", n_chains, 1)):
         if not (isinstance(val, int | np.integer) and val >= low):
             raise GPMSAError(f"{name} must be an integer >= {low}, got {val}")
@@ -127,51 +155,105 @@ def calibrate(
         raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
     if not fast and (emulator_params != "point" or log_prior is not None):
         raise GPMSAError("emulator_params='draws' and log_prior need the fast numpy path")
+    _check_calibrate_memory(emulator, n_samples, n_chains, fast)
     t0 = time.perf_counter()
     with blas_controller().limit(limits=1, user_api="blas"):
+        where = {"n_jobs": n_jobs, "executor": executor}
+        data = reduce(emulator, x_obs, y_obs, extrapolate)
+        fit = _probe(emulator, data, sets)
+        warn_if_outside(fit)
         if fast:
             draws, info = _run_fast(
-                emulator, x_obs, y_obs, sets, n_samples, n_chains, tune, tune_rounds,
-                tune_levels, seed, extrapolate, log_prior, progress,
+                emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds,
+                tune_levels, seed, log_prior, progress, where,
             )  # fmt: skip
         else:
             draws, info = _run_backend(
                 emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
-                tune_rounds, tune_levels, seed, extrapolate, progress,
+                tune_rounds, tune_levels, seed, extrapolate, progress, where,
             )  # fmt: skip
+    require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
     samples = {k: v.reshape(-1) for k, v in chains.items()}
     info.update(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
+        outside_sds=fit.outside_sds,
     )  # fmt: skip
+    if n_chains > 1:
+        info["diagnostics"] = summarize(chains)
+        shapes = {k: v.shape[2:] for k, v in chains.items()}
+        info["convergence"] = convergence(info["diagnostics"], shapes, n_chains, n_samples - n_burn)
+        warn_unconverged(info["convergence"], f"gpmsa.calibrate (backend {backend!r})")
     return Posterior(samples, chains=chains, info=info)
 
 
-def _run_fast(
-    emulator, x_obs, y_obs, sets, n_samples, n_chains, tune, tune_rounds, tune_levels, seed,
-    extrapolate, log_prior, progress,
+def _probe(emulator, data, sets) -> Fit:
+    """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets)."""
+    theta = theta_probe(emulator.t_unit.shape[1])
+    fits = [fit_of(*fixed_gp(emulator, s).predict(data.x, theta), data) for s in sets]
+    return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
+
+
+def _check_calibrate_memory(emulator, n_samples: int, n_chains: int, fast: bool) -> None:
+    """Refuse before sampling a run whose stored sweeps exceed gpmsa.limits.MAX_MEMORY_BYTES."""
+    p, q, p_u = emulator.x_unit.shape[1], emulator.t_unit.shape[1], emulator.K.shape[1]
+    if fast:  # a tuple of q + 3 Python floats per sweep, then an array
+        per_sweep = 64.0 + 56.0 * (q + 3)
+    else:  # every parameter (the fixed emulator ones too) per sweep, stacked over chains
+        per_sweep = 16.0 * (q + 4 + (p + q) * p_u + 2 * p_u + 1 + p)
+    check_memory(
+        per_sweep * n_samples * n_chains,
+        f"calibrate(n_samples={n_samples}, n_chains={n_chains})",
+    )
+
+
+def _fast_chain(
+    sampler: CalibrationSampler, n_samples: int, seed: np.random.SeedSequence, tune: bool,
+    tune_rounds: int, tune_levels: int, progress: bool = False, desc: str = "calibrate",
 ):  # fmt: skip
-    data = reduce(emulator, x_obs, y_obs, extrapolate)
+    """One chain of the fast sampler (a worker process runs it from plain data)."""
+    with threadpool_limits(1):
+        return sampler.run(n_samples, np.random.default_rng(seed), tune=tune,
+                           tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress)
+
+
+def _run_fast(
+    emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds, tune_levels, seed,
+    log_prior, progress, where,
+):  # fmt: skip
     std = emulator.standardizer
     extra = None
     if log_prior is not None:
         if not callable(log_prior):
             raise GPMSAError("log_prior must be a callable of native theta for MCMC")
+        names = tuple(emulator.t_names)
 
         def extra(theta_unit: np.ndarray) -> float:
             native = std.t_from_unit(theta_unit[None, :])
-            return float(np.ravel(log_prior(native[:, 0] if native.shape[1] == 1 else native))[0])
+            val = np.ravel(log_prior(native[:, 0] if native.shape[1] == 1 else native))
+            return check_log_prior(val, names, native[0])
 
     sampler = CalibrationSampler(
-        [fixed_gp(emulator, s) for s in sets], data, emulator.priors, extra
-    )
-    seeds = np.random.SeedSequence(seed).spawn(n_chains)
-    runs = [
-        sampler.run(n_samples, np.random.default_rng(s), tune=tune, tune_rounds=tune_rounds,
-                    tune_levels=tune_levels, progress=progress)
-        for s in seeds
+        [fixed_gp(emulator, s) for s in sets], data, emulator.priors, extra,
+        init_lamos=lamos_start(fit, data.lamos),
+    )  # fmt: skip
+    if extra is not None:  # a callable of this process: the chains run here
+        if where["executor"] is not None:
+            raise GPMSAError("log_prior is a callable of this process: it cannot go to executor=")
+        n_workers(where["n_jobs"], n_chains)  # still refuse a bad n_jobs
+        where = {"n_jobs": 1, "executor": None}
+    tasks = [
+        {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune,
+         "tune_rounds": tune_rounds, "tune_levels": tune_levels}
+        for s in np.random.SeedSequence(seed).spawn(n_chains)
     ]  # fmt: skip
+    runs = run_chains(_fast_chain, tasks, progress=progress, desc="calibrate chain", **where)
+    if any(not np.isfinite(r.log_post[-1]) for r in runs):
+        raise GPMSAError(
+            "the posterior has no mass where the sampler looked: log_prior is -inf there "
+            "(zero prior density everywhere?)"
+        )
     theta = std.t_from_unit(np.stack([r.theta for r in runs]))  # (chains, n, q)
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.stack([r.lamOs for r in runs])
@@ -187,13 +269,14 @@ def _run_fast(
 
 def _run_backend(
     emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tune_rounds,
-    tune_levels, seed, extrapolate, progress,
+    tune_levels, seed, extrapolate, progress, where,
 ):  # fmt: skip
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate
     )
     module = backends.get(backend)
     opts = {"tune_rounds": tune_rounds, "tune_levels": tune_levels} if backend == "numpy" else {}
+    opts.update(backends.placement(backend, **where))
     chains = module.sample(
         problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed, progress=progress,
         **opts,

@@ -21,15 +21,20 @@ from gpmsa import backends
 from gpmsa.calibration.model import GridPredictor, LamOsMarginal, lamos_marginal
 from gpmsa.calibration.observations import (
     EMULATOR_PARAM_MODES,
+    Fit,
     Observations,
     blas_controller,
     check_emulator,
     emulator_param_sets,
+    fit_of,
     fixed_gp,
     reduce,
+    warn_if_outside,
 )
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 from gpmsa.errors import GPMSAError
+from gpmsa.limits import check_memory
+from gpmsa.model.data import check_seed
 
 METHODS = ("auto", "grid", "mcmc")
 RESOLVE_SD = 4.0
@@ -101,7 +106,7 @@ class Calibrator:
         self.n_draws = int(n_draws)
         self._n_emulator_draws = n_emulator_draws
         self.emulator_params = emulator_params
-        self._entropy = np.random.SeedSequence(seed).entropy
+        self._entropy = np.random.SeedSequence(check_seed(seed)).entropy
         self._count = 0
         self.mcmc_options = dict(mcmc_options or {})
         if n_grid is None:
@@ -111,6 +116,17 @@ class Calibrator:
         self.n_grid = int(n_grid)
         if self.method == "mcmc":
             return
+        m, p_u = emulator.x_unit.shape[0], emulator.K.shape[1]
+        n_sets = 1 if emulator_params == "point" else max(1, int(n_emulator_draws))
+        G = self.n_grid**q
+        # per parameter set: R_t on the grid and its product with alpha (G x m per component)
+        # and Sigma_W's factor (GridPredictor checks its Chebyshev products once sized)
+        per_set = 8.0 * p_u * (2.0 * G * m + 2.0 * m * m)
+        check_memory(
+            n_sets * per_set + 8.0 * 8 * G,
+            f"Calibrator(n_grid={self.n_grid}): {G} grid nodes x {m} runs x {p_u} components "
+            f"x {n_sets} emulator parameter set(s)",
+        )
         axes = [np.linspace(0.0, 1.0, self.n_grid)] * q
         mesh = np.meshgrid(*axes, indexing="ij")
         self._theta_unit = np.column_stack([g.ravel() for g in mesh])
@@ -133,9 +149,11 @@ class Calibrator:
         )
 
     # --- the exact likelihood on a grid ---------------------------------------------------------
-    def _marginals(self, data: Observations, theta_unit: np.ndarray | None) -> list[LamOsMarginal]:
+    def _marginals(
+        self, data: Observations, theta_unit: np.ndarray | None, fits: list | None = None
+    ) -> list[LamOsMarginal]:
         """lamOs-marginal likelihoods per emulator parameter set on the fixed grid (None) or on
-        the given unit-scale nodes (dense solves)."""
+        the given unit-scale nodes (dense solves); ``fits`` collects each set's ``Fit``."""
         out = []
         d = data.z.size
         for gp, pred in zip(self._gps, self._predictors, strict=True):
@@ -143,6 +161,8 @@ class Calibrator:
                 mean, cov = pred.predict(data.x)
             else:
                 mean, cov = gp.predict(data.x, theta_unit)
+            if fits is not None:
+                fits.append(fit_of(mean, cov, data))
             G = mean.shape[0]
             out.append(
                 lamos_marginal(
@@ -177,8 +197,10 @@ class Calibrator:
         """
         self._check_grid_method()
         data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
+        fits: list[Fit] = []
         with blas_controller().limit(limits=1, user_api="blas"):
-            ll = self._combine(self._marginals(data, None))
+            ll = self._combine(self._marginals(data, None, fits))
+        warn_if_outside(Fit(min(f.outside_sds for f in fits), 0.0))
         if np.any(np.isnan(ll)):
             raise GPMSAError("the likelihood could not be evaluated for this observation")
         return self.theta_grid, ll
@@ -239,7 +261,7 @@ class Calibrator:
 
             opts = dict(self.mcmc_options)
             auto = int(_seed_sequence((self._entropy, self._count)).generate_state(1)[0])
-            opts.setdefault("seed", seed if seed is not None else auto)
+            opts.setdefault("seed", check_seed(seed) if seed is not None else auto)
             opts.setdefault("emulator_params", self.emulator_params)
             opts.setdefault("n_emulator_draws", self._n_emulator_draws)
             opts.setdefault("backend", self.backend)
@@ -247,9 +269,12 @@ class Calibrator:
                 self.emulator, x_obs, y_obs, extrapolate=self.extrapolate, log_prior=prior, **opts
             )
         data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
+        fits: list[Fit] = []
         with blas_controller().limit(limits=1, user_api="blas"):
             theta = self._theta_unit
-            margs = self._marginals(data, None)
+            margs = self._marginals(data, None, fits)
+            outside = min(f.outside_sds for f in fits)
+            warn_if_outside(Fit(outside, 0.0))
             logp = self._combine(margs) + self._log_prior_theta
             if prior is not None:
                 logp = logp + self._prior_values(prior, theta, True)
@@ -263,8 +288,10 @@ class Calibrator:
                 theta, spacing = finer
                 margs = self._marginals(data, theta)
                 logp = self._combine(margs) + self._theta_prior_at(theta, prior)
-        key = seed if seed is not None else (self._entropy, self._count)
-        return self._posterior(theta, logp, margs, key)
+        key = check_seed(seed) if seed is not None else (self._entropy, self._count)
+        post = self._posterior(theta, logp, margs, key)
+        post.info["outside_sds"] = outside
+        return post
 
     def _theta_prior_at(self, theta_unit: np.ndarray, prior) -> np.ndarray:
         """The emulator's theta prior plus the user's at refined unit-scale nodes."""

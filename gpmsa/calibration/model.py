@@ -22,6 +22,8 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.linalg import cho_solve, cholesky, solve_triangular
 from scipy.special import gammainc, gammainccinv, gammaln
 
+from gpmsa.errors import GPMSAError
+from gpmsa.limits import check_memory
 from gpmsa.model.correlation import correlation
 
 _LOG_2PI = float(np.log(2.0 * np.pi))
@@ -66,12 +68,22 @@ class FixedGP:
         lam_sim = np.asarray(lam_sim, dtype=float).ravel()
         lamWOs = float(np.asarray(lamWOs).ravel()[0])
         z = np.hstack([self.x_sim, self.t_sim])
+        check_memory(
+            8.0 * self.m * self.m * (self.p_u + 2 + self.p + self.q),
+            f"the emulator's GP ({self.m} runs, {self.p_u} components: an m x m factor each)",
+        )
         chol = np.empty((self.p_u, self.m, self.m))
         alpha = np.empty((self.p_u, self.m))
         for c in range(self.p_u):
             sigma = correlation(z, None, self.betaU[:, c]) / self.lamUz[c]
             sigma[np.diag_indices_from(sigma)] += 1.0 / (lam_sim[c] * lamWOs) + 1.0 / self.lamWs[c]
-            chol[c] = cholesky(sigma, lower=True)
+            try:
+                chol[c] = cholesky(sigma, lower=True)
+            except (np.linalg.LinAlgError, ValueError) as exc:
+                raise GPMSAError(
+                    f"Sigma_W of component {c} is not positive definite at these emulator "
+                    f"parameters ({exc})"
+                ) from exc
             alpha[c] = cho_solve((chol[c], True), w[:, c])
         self.chol = chol
         self.alpha = alpha
@@ -100,6 +112,10 @@ class FixedGP:
             mean (G, p_u, n) and covariance (G, p_u, n, n) in standardised weight units.
         """
         n, G = x.shape[0], theta.shape[0]
+        check_memory(
+            8.0 * G * n * (3.0 * self.m + 2.0 * self.p_u * n),
+            f"the emulator's predictive at {G} theta values x {n} observation rows ({self.m} runs)",
+        )
         mean = np.empty((G, self.p_u, n))
         cov = np.empty((G, self.p_u, n, n))
         for c in range(self.p_u):
@@ -149,6 +165,13 @@ class GridPredictor:
             [_cheb_coefficients(gp, c, tol, max_deg) for c in range(gp.p_u)] if gp.p == 1 else []
         )
         usable = len(coefs) == gp.p_u and all(cf is not None for cf in coefs)
+        na = max((cf.shape[0] for cf in coefs if cf is not None), default=0) if usable else 0
+        check_memory(
+            8.0 * gp.p_u * G * (2.0 * gp.m + na * na) + 8.0 * G * gp.m * 3 * na,
+            f"the calibration grid's predictor ({G} nodes x {gp.m} runs x {gp.p_u} components"
+            + (f", Chebyshev degree {na - 1}" if na else "")
+            + ")",
+        )
         self.H: list[np.ndarray] | None = [] if usable else None
         for c in range(gp.p_u):
             rt = gp.corr_t(self.theta, c) / gp.lamUz[c]
@@ -289,6 +312,10 @@ def lamos_marginal(
         LamOsMarginal with loglik = log p(u | theta_g) (all normalising constants included).
     """
     d = mean.shape[1]
+    check_memory(
+        8.0 * mean.shape[0] * d * (4.0 * d + 4.0),
+        f"the exact likelihood at {mean.shape[0]} theta values of {d} reduced observations",
+    )
     e, y = _whiten(mean, cov, u, obs_chol)
     e = np.maximum(e, 0.0)
     y2 = y * y
@@ -306,7 +333,13 @@ def lamos_marginal(
     step = min(max_step, np.sqrt(2.0 / (2.0 * prior.shape + d)))
     if (prior.lower > 0.0 and lo <= coarse[0]) or (np.isfinite(prior.upper) and hi >= coarse[-1]):
         step /= TRUNCATED_REFINE  # the integrand is cut off at a bound: the rule is O(step^2)
-    n_nodes = int(np.ceil((hi - lo) / step)) + 1
+    n_float = np.ceil((hi - lo) / step) + 1
+    check_memory(
+        8.0 * G * n_float * (4.0 if d == 1 else 2.0 + d),
+        f"the lamOs quadrature ({G} theta nodes x {n_float:.3g} log-lamOs nodes; the lamOs "
+        f"prior's shape a = {prior.shape:.6g} sets the step)",
+    )
+    n_nodes = int(n_float)
     step = (hi - lo) / (n_nodes - 1)
     s = lo + step * np.arange(n_nodes)
     if d == 1:

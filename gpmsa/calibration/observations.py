@@ -9,8 +9,9 @@ from functools import cache
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
+from gpmsa import limits
 from gpmsa.calibration.model import FixedGP, LamOsPrior
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, OutsideEmulatorWarning, ResourceLimitError
 from gpmsa.model.data import ObsData, check_finite
 from gpmsa.model.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
 
@@ -19,6 +20,10 @@ EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 EMULATOR_PARAM_MODES = ("point", "draws")
 MAX_STD_OBS = 1e6
 """Reduced observations farther than this from the simulation mean (in its sds) are refused."""
+OUTSIDE_SDS = 5.0
+"""An observation farther than this many predictive sds from every emulator prediction at its
+x (over the whole theta domain) lies outside what the emulator has seen: a warning
+(``OutsideEmulatorWarning``), and ``Posterior.info["outside_sds"]`` holds the distance."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,6 +133,15 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     )
     if y.shape[0] != n:
         raise GPMSAError(f"y_obs must have one row per x_obs row ({n}), got {y.shape[0]}")
+    d = n * K.shape[1]
+    if d > limits.MAX_OBS_VALUES:
+        raise ResourceLimitError(
+            f"x_obs/y_obs have {n} rows x {K.shape[1]} basis components = {d} reduced values, "
+            f"above gpmsa.limits.MAX_OBS_VALUES = {limits.MAX_OBS_VALUES}: the exact likelihood "
+            f"costs a {d} x {d} eigendecomposition per theta value (time ~ d^3); split the rows "
+            "into windows and add their Calibrator.log_likelihood_grid (or pass one window's as "
+            "the next one's prior=), or raise gpmsa.limits.MAX_OBS_VALUES"
+        )
     base = emulator.priors.lamOs
     if l_sim == 1:  # GPM/SA's scalar-output reduction, as gpmsa.model.problem.reduce_obs
         u = (y - std.y_mean) / std.y_sd
@@ -149,3 +163,111 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     sig = obs.sig_obs
     chol = np.sqrt(sig) if sig.shape == (1, 1) else np.linalg.cholesky(sig)
     return Observations(xu, z, chol, lamos, obs, corr)
+
+
+@dataclass(frozen=True)
+class Fit:
+    """How well the emulator can explain an observation, over a set of theta values.
+
+    outside_sds: the smallest over theta of the largest |z_i - mean_i| / sd_i over the reduced
+        data's elements (sd_i: the emulator's predictive sd, nugget included): how many
+        predictive sds the observation lies from the nearest emulator prediction at its x.
+    excess_var: the smallest over theta of max(0, (||L^-1 (z - mean)||^2 - tr(L^-1 S L^-T)) / d)
+        (Sigma_obs = L L^T): the observation-error variance per unit lamOs that the misfit beyond
+        the emulator's own predictive variance needs (0 when some theta explains the data).
+    """
+
+    outside_sds: float
+    excess_var: float
+
+
+def theta_probe(q: int) -> np.ndarray:
+    """Unit-scale theta values (k, q) at which ``fit_of`` looks: 129 equally spaced for one
+    parameter, a 33 x 33 grid for two, else the 3^q corners, edge midpoints and centre plus 256
+    points of an unscrambled Sobol sequence."""
+    if q == 1:
+        return np.linspace(0.0, 1.0, 129)[:, None]
+    if q == 2:
+        axis = np.linspace(0.0, 1.0, 33)
+        return np.column_stack([g.ravel() for g in np.meshgrid(axis, axis, indexing="ij")])
+    from scipy.stats import qmc
+
+    lattice = np.stack(np.meshgrid(*[[0.0, 0.5, 1.0]] * min(q, 6), indexing="ij"), -1)
+    lattice = lattice.reshape(-1, min(q, 6))
+    lattice = np.hstack([lattice, np.full((lattice.shape[0], q - lattice.shape[1]), 0.5)])
+    sobol = qmc.Sobol(d=q, scramble=False).random(256)
+    return np.vstack([lattice, sobol])
+
+
+def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
+    """``Fit`` of the observation from the emulator's predictive on some theta values:
+    mean (G, p_u, n), cov (G, p_u, n, n) (``FixedGP.predict`` / ``GridPredictor.predict``)."""
+    G, p_u, n = mean.shape
+    m = mean.reshape(G, p_u * n)
+    var = np.maximum(np.diagonal(cov, axis1=2, axis2=3).reshape(G, p_u * n), 1e-300)
+    resid = data.z[None, :] - m
+    with np.errstate(over="ignore"):
+        sds = np.max(np.abs(resid) / np.sqrt(var), axis=1)
+    L = data.obs_chol
+    d = data.z.size
+    if d == 1:
+        s2 = float(L[0, 0]) ** 2
+        y2, tr = resid[:, 0] ** 2 / s2, var[:, 0] / s2
+    else:
+        from scipy.linalg import solve_triangular
+
+        y2 = np.sum(solve_triangular(L, resid.T, lower=True) ** 2, axis=0)
+        Linv = solve_triangular(L, np.eye(d), lower=True)
+        tr = np.zeros(G)
+        for c in range(p_u):  # tr(L^-1 S L^-T), S block-diagonal over components
+            blk = Linv[:, c * n : (c + 1) * n]
+            tr += np.einsum("ai,gij,aj->g", blk, cov[:, c], blk)
+    excess = np.maximum(0.0, (y2 - tr) / d)
+    return Fit(float(np.min(sds)), float(np.min(excess)))
+
+
+def warn_if_outside(fit: Fit, stacklevel: int = 3) -> None:
+    """Warn (``OutsideEmulatorWarning``) when the observation lies more than ``OUTSIDE_SDS``
+    predictive sds from every emulator prediction at its x."""
+    if fit.outside_sds > OUTSIDE_SDS:
+        warnings.warn(
+            f"y_obs lies {fit.outside_sds:.3g} predictive sds from the nearest emulator "
+            f"prediction at x_obs over the whole theta domain (more than {OUTSIDE_SDS:g}): the "
+            "observation is outside what the emulator has seen. The posterior then explains it "
+            "by a large observation error (small lamOs) and theta falls back towards its prior; "
+            "check the units, the feature and the emulator's domain",
+            OutsideEmulatorWarning,
+            stacklevel=stacklevel,
+        )
+
+
+def lamos_start(fit: Fit, prior: LamOsPrior) -> float:
+    """A start of lamOs for the samplers: GPM/SA's max(20, a/b), lowered to 1/excess_var when
+    the observation needs a larger observation error than that (else an additive random walk
+    started there never reaches the posterior, decades below, and theta sticks at a bound)."""
+    start = max(20.0, prior.shape / prior.rate)
+    if fit.excess_var > 0.0:
+        start = min(start, 1.0 / fit.excess_var)
+    if prior.lower > 0.0:
+        start = max(start, 1.01 * prior.lower)
+    return start
+
+
+def check_log_prior(values: np.ndarray, names: tuple[str, ...], theta) -> float:
+    """One log prior density from a user's ``log_prior`` (a 1-element array): a float, or
+    -inf; NaN, +inf or a wrong size raise GPMSAError (a NaN is an error, not a zero density)."""
+    if np.size(values) != 1:
+        raise GPMSAError(
+            f"log_prior must return one log density per theta row, got {np.size(values)} values"
+        )
+    try:
+        val = float(np.asarray(values, dtype=float).reshape(-1)[0])
+    except (TypeError, ValueError) as exc:
+        raise GPMSAError(f"log_prior must return numbers, got {values!r}") from exc
+    if np.isnan(val) or val == np.inf:
+        at = ", ".join(f"{n}={float(v):.6g}" for n, v in zip(names, np.ravel(theta), strict=False))
+        raise GPMSAError(
+            f"log_prior returned {val} at {at}: it must return a log density (a finite number, "
+            "or -inf where the prior density is zero)"
+        )
+    return val

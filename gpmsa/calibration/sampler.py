@@ -211,6 +211,8 @@ class CalibrationSampler:
         data: the reduced observations.
         priors: the emulator's priors (theta prior); the lamOs prior is ``data.lamos``.
         log_prior: optional extra log prior of unit-scale theta (q,) -> float.
+        init_lamos: start of lamOs (default GPM/SA's max(20, a/b) of its prior); see
+            ``gpmsa.calibration.observations.lamos_start``.
     """
 
     def __init__(
@@ -219,6 +221,7 @@ class CalibrationSampler:
         data: Observations,
         priors: Priors,
         log_prior: Callable[[np.ndarray], float] | None = None,
+        init_lamos: float | None = None,
     ) -> None:
         self.preds = [ThetaPredictive(gp, data) for gp in gps]
         self.q = gps[0].q
@@ -226,7 +229,7 @@ class CalibrationSampler:
         self.lamos = data.lamos
         self.extra = log_prior
         lo = data.lamos
-        self.init_lamos = max(20.0, lo.shape / lo.rate)
+        self.init_lamos = max(20.0, lo.shape / lo.rate) if init_lamos is None else init_lamos
 
     def _log_prior_theta(self, theta: list[float]) -> float:
         """Truncated-normal prior of unit-scale theta (plus the extra prior), pure Python."""
@@ -268,6 +271,7 @@ class CalibrationSampler:
         n_tune = tune_rounds * tune_levels if tune else 0
         with tqdm(total=n_iter + n_tune, desc="calibrate", disable=not progress) as bar:
             if tune:
+                bar.set_description("calibrate: tuning step widths")
                 cands = tuning.level_widths(names, w, tune_levels)
                 acc = np.zeros((tune_levels, q + 1))
                 levels = [c.tolist() for c in cands]
@@ -277,6 +281,7 @@ class CalibrationSampler:
                         state.sweep(levels[lev], False, acc[lev], u[lev])
                     bar.update(tune_levels)
                 w = tuning.choose_widths(w, cands, acc, tune_rounds)
+            bar.set_description("calibrate: sampling")
             widths_l = w.tolist()
             out = []
             accepted = np.zeros(q + 1)

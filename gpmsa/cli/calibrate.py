@@ -6,9 +6,11 @@ import argparse
 import json
 import sys
 import time
+import warnings
 
 import numpy as np
 
+from gpmsa.cli.text import safe
 from gpmsa.errors import GPMSAError
 
 
@@ -57,6 +59,15 @@ def run(args: argparse.Namespace) -> int:
     from gpmsa.calibration.calibrator import Calibrator
     from gpmsa.fitting.emulator import load
 
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UserWarning)
+        code = _run(args, load, Calibrator)
+    for w in caught:  # their messages quote names from the file: printed escaped
+        print(f"gpmsa calibrate: {w.category.__name__}: {safe(w.message)}", file=sys.stderr)
+    return code
+
+
+def _run(args: argparse.Namespace, load, Calibrator) -> int:
     try:
         emu = load(args.file)
         x = _pairs(args.x, tuple(emu.x_names), "x")
@@ -67,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
         summary = post.summary(args.level)
         seconds = time.perf_counter() - t0
     except GPMSAError as exc:
-        print(f"gpmsa calibrate: {exc}", file=sys.stderr)
+        print(f"gpmsa calibrate: {safe(exc)}", file=sys.stderr)
         return 2
     if args.json:
         out = {
@@ -83,10 +94,12 @@ def run(args: argparse.Namespace) -> int:
         return 0
     lo_key, hi_key = (f"q{100 * (1 - args.level) / 2:g}", f"q{100 * (1 + args.level) / 2:g}")
     print(f"posterior ({post.info.get('method')}, {1e3 * seconds:.2f} ms) given "
-          + ", ".join(f"{n}={v:g}" for n, v in zip(emu.x_names, x[0], strict=True)) + "; "
-          + ", ".join(f"{n}={v:g}" for n, v in zip(emu.y_names, y[0], strict=True)))  # fmt: skip
+          + ", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(emu.x_names, x[0], strict=True))
+          + "; "
+          + ", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(emu.y_names, y[0], strict=True))
+          )  # fmt: skip
     print(f"{'name':>10s} {'mean':>12s} {'sd':>12s} {lo_key:>12s} {'median':>12s} {hi_key:>12s}")
     for name, s in summary.items():
-        print(f"{name:>10s} {s['mean']:12.5g} {s['sd']:12.5g} {s[lo_key]:12.5g} "
+        print(f"{safe(name, 60):>10s} {s['mean']:12.5g} {s['sd']:12.5g} {s[lo_key]:12.5g} "
               f"{s['median']:12.5g} {s[hi_key]:12.5g}")  # fmt: skip
     return 0

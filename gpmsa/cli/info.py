@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 
+from gpmsa.cli.text import number, plain, safe, value
 from gpmsa.errors import EmulatorFileError
 
 
@@ -18,23 +19,37 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the subcommand; exit status 0, or 2 with a message on stderr for a bad file."""
+    """Run the subcommand; exit status 0, or 2 with a message on stderr for a bad file.
+
+    The file is verified as ``gpmsa.load`` verifies it (hash and every field of the content)
+    before anything is printed; every string from it is printed escaped (``gpmsa.cli.text``).
+    """
+    from gpmsa.fitting.emulator import Emulator
+    from gpmsa.fitting.validation import check_manifest
     from gpmsa.io.container import read_raw
 
     try:
-        manifest, arrays = read_raw(args.file)
+        manifest, arrays = read_raw(args.file, check_manifest)
+        Emulator.from_record(manifest, arrays)
     except EmulatorFileError as exc:
-        print(f"gpmsa info: {exc}", file=sys.stderr)
+        print(f"gpmsa info: {safe(exc)}", file=sys.stderr)
         return 2
-    if args.json:
-        print(json.dumps(manifest, indent=1, sort_keys=True))
+    if args.json:  # ensure_ascii: control characters come out as \u001b escapes
+        print(json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True))
         return 0
+    print("\n".join(_lines(args.file, manifest, arrays)))
+    return 0
+
+
+def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
+    """The manifest for a person (the content already validated: names, units, domain, model)."""
     model = manifest.get("model", {})
     lines = [
-        f"file:            {args.file}",
+        f"file:            {safe(file)}",
         f"format:          {manifest['format']} schema {manifest['schema_version']} "
-        f"(gpmsa {manifest.get('library_version')}, written {manifest.get('created_utc')})",
-        f"content sha256:  {manifest['content_sha256']} (verified)",
+        f"(gpmsa {plain(manifest.get('library_version'))}, written "
+        f"{plain(manifest.get('created_utc'))})",
+        f"content sha256:  {safe(manifest['content_sha256'])} (verified)",
         f"model:           m={model.get('m')} runs, p={model.get('p')}, q={model.get('q')}, "
         f"l_sim={model.get('l_sim')}, p_u={model.get('p_u')}",
     ]
@@ -42,24 +57,72 @@ def run(args: argparse.Namespace) -> int:
     for kind, label in (("x", "known inputs"), ("t", "parameters"), ("y", "outputs")):
         names = manifest["names"][kind]
         if kind == "y" and len(names) > 8:
-            lines.append(f"{label + ':':17s}{len(names)} ({names[0]} .. {names[-1]})")
+            lines.append(f"{label + ':':17s}{len(names)} ({safe(names[0], 60)} .. "
+                         f"{safe(names[-1], 60)})")  # fmt: skip
             continue
         parts = []
-        for n, u in zip(names, units[kind], strict=False):
-            dom = manifest.get("domain", {}).get(n)
+        for n, u in zip(names, units[kind], strict=True):
+            dom = manifest["domain"].get(n) if kind != "y" else None
             rng = f" in [{dom[0]:.6g}, {dom[1]:.6g}]" if dom else ""
-            parts.append(f"{n}{' [' + u + ']' if u else ''}{rng}")
+            parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
         lines.append(f"{label + ':':17s}{', '.join(parts)}")
     s = manifest["settings"]
-    plain = [f"{k}={v}" for k, v in s.items() if not isinstance(v, (list, dict))]
-    lines.append("settings:        " + ", ".join(plain))
+    flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
+    lines.append("settings:        " + ", ".join(flat))
+    for source in ("settings", "metadata"):
+        versions = manifest[source].get("versions")
+        if isinstance(versions, dict):
+            lines.append(
+                f"versions ({source}): "
+                + ", ".join(f"{safe(k, 40)} {plain(v)}" for k, v in versions.items())
+            )
     for k, v in manifest["metadata"].items():
-        lines.append(f"metadata {k}: {json.dumps(v)}")
+        if k != "versions" or not isinstance(v, dict):
+            lines.append(f"metadata {safe(k, 60)}: {value(v)}")
     for name, d in manifest["diagnostics"].items():
-        mean = ", ".join(f"{v:.4g}" for v in d.get("mean", []) if v is not None)
-        ess = ", ".join(f"{v:.0f}" for v in d.get("ess", []) if v is not None)
-        lines.append(f"posterior {name}: mean [{mean}] ESS [{ess}]")
+        if isinstance(d, dict) and isinstance(d.get("mean"), list):
+            cells = {}
+            for key, fmt in (("mean", ".4g"), ("ess", ".0f"), ("rhat", ".3f")):
+                vals = d.get(key, [])
+                cells[key] = (
+                    ", ".join(number(v, fmt) for v in vals if v is not None)
+                    if isinstance(vals, list) else value(vals)
+                )  # fmt: skip
+            lines.append(
+                f"posterior {safe(name, 60)}: mean [{safe(cells['mean'], 300)}] ESS "
+                f"[{safe(cells['ess'], 300)}] R-hat [{safe(cells['rhat'], 300)}]"
+            )
+        else:
+            lines.append(f"diagnostics {safe(name, 60)}: {value(d)}")
+    lines.append(_convergence_line(manifest.get("convergence")))
     n_arr = sum(int(a.size) for a in arrays.values())
     lines.append(f"arrays:          {len(arrays)} ({n_arr} values)")
-    print("\n".join(lines))
-    return 0
+    return lines
+
+
+def _convergence_line(rec: object) -> str:
+    """One line on the chains' convergence (files of one chain or older ones have no record)."""
+    if not rec:
+        return "convergence:     not checked (one chain, or a file from before the check)"
+    if not isinstance(rec, dict):
+        return f"convergence:     {value(rec)}"
+    try:
+        (r_el, r_val), (e_el, e_val) = rec["max_rhat"], rec["min_ess"]
+    except (KeyError, TypeError, ValueError):
+        return f"convergence:     {value(rec)}"
+    if r_val is None or e_val is None:
+        worst = "R-hat and ESS undefined (constant draws)"
+    else:
+        worst = (f"max R-hat {number(r_val, '.3f')} ({safe(r_el, 60)}), min bulk ESS "
+                 f"{number(e_val, '.0f')} ({safe(e_el, 60)})")  # fmt: skip
+    head = (f"convergence:     {plain(rec.get('n_chains'))} chains x "
+            f"{plain(rec.get('n_draws'))} draws; {worst}; ")  # fmt: skip
+    flagged = rec.get("flagged") or {}
+    if not flagged:
+        return head + (f"converged (R-hat <= {plain(rec.get('rhat_max'))}, ESS >= "
+                       f"{number(rec.get('ess_min'), '.0f')})")  # fmt: skip
+    if not isinstance(flagged, dict):
+        return head + "NOT converged: " + value(flagged)
+    return head + "NOT converged: " + "; ".join(
+        f"{safe(k, 60)}: {plain(v)}" for k, v in flagged.items()
+    )

@@ -17,20 +17,22 @@ from scipy.linalg import cho_solve, solve_triangular
 from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.fitting.validation import (
+    EMULATOR_PARAMS,
+    REQUIRED,
+    STD_FIELDS,
+    check_manifest,
+    check_record,
+)
 from gpmsa.io.container import jsonable, read_raw, write_raw
+from gpmsa.limits import check_memory
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import SimData, as_matrix
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
-EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
-STD_FIELDS = ("x_min", "x_max", "t_min", "t_max", "y_mean", "grid")
-"""Arrays of the file that hold the Standardizer (with ``y_sd``)."""
-REQUIRED = ("x_unit", "t_unit", "y", "K", "w", "log_post", "y_sd", *STD_FIELDS) + tuple(
-    f"param_{k}" for k in EMULATOR_PARAMS
-)
-"""Arrays every emulator file holds."""
+__all__ = ["EMULATOR_PARAMS", "REQUIRED", "STD_FIELDS", "Emulator", "LooResult", "load"]
 
 
 @dataclass(frozen=True)
@@ -76,7 +78,9 @@ class Emulator:
     draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected), x_names,
     t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
     settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
-    lamOs draws of a joint sim+obs fit, else None).
+    lamOs draws of a joint sim+obs fit, else None), convergence (several chains: R-hat and bulk
+    ESS of every sampled parameter and the elements flagged, see
+    ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files).
     """
 
     def __init__(
@@ -99,6 +103,7 @@ class Emulator:
         settings: dict | None = None,
         diagnostics: dict | None = None,
         calibration: dict[str, np.ndarray] | None = None,
+        convergence: dict | None = None,
     ):
         self.standardizer = standardizer
         self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
@@ -114,6 +119,7 @@ class Emulator:
         self.settings = dict(settings or {})
         self.diagnostics = dict(diagnostics or {})
         self.calibration = calibration
+        self.convergence = convergence
         self._factors: dict[int, list] = {}
 
     # --- construction -------------------------------------------------------------------------
@@ -204,15 +210,22 @@ class Emulator:
         """Per component: (Cholesky factor of Sigma_W_j, Sigma_W_j^-1 w_j)."""
         out = []
         zt = self.zt
+        check_memory(
+            8.0 * self.m * self.m * (2 * self.p_u + self.p + self.q + 2),
+            f"the emulator's factorisation ({self.m} runs x {self.p_u} components)",
+        )
         for j in range(self.p_u):
             S = correlation(zt, None, params["betaU"][:, j]) / params["lamUz"][j]
             nug = 1.0 / (self.lam_sim[j] * params["lamWOs"][0]) + 1.0 / params["lamWs"][j]
             S[np.diag_indices(self.m)] += nug
-            L = lower_cholesky(S)
+            L = lower_cholesky(S) if np.all(np.isfinite(S)) else None
             if L is None:
                 raise GPMSAError("Sigma_W is not positive definite at these parameters")
             L = np.tril(L)
-            out.append((L, cho_solve((L, True), self.w[:, j])))
+            alpha = cho_solve((L, True), self.w[:, j])
+            if not np.all(np.isfinite(alpha)):
+                raise GPMSAError("Sigma_W is numerically singular at these parameters")
+            out.append((L, alpha))
         return out
 
     def _point_factor(self):
@@ -275,6 +288,11 @@ class Emulator:
         variances by the law of total variance. ``resid`` adds the nugget 1/lamWs and the residual
         variance 1/lamWOs (the spread of a new simulation run about the smooth emulator).
         """
+        n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
+        check_memory(
+            8.0 * n * (4.0 * self.m + 6.0 * self.l_sim + 4.0 * (self.p + self.q)),
+            f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs)",
+        )
         z = self._inputs(x, t)
         s = self.standardizer
         if not draws:
@@ -392,10 +410,13 @@ class Emulator:
             "metadata": self.metadata,
             "diagnostics": self.diagnostics,
         }
+        _check_metadata(self.metadata, "metadata")
+        if self.convergence is not None:
+            manifest["convergence"] = self.convergence
         manifest = jsonable(manifest)
         try:
             json.dumps(manifest["metadata"], allow_nan=False)
-        except (TypeError, ValueError) as exc:
+        except (TypeError, ValueError, RecursionError) as exc:
             raise GPMSAError(
                 f"Emulator.metadata must be JSON-able (str, numbers, lists, dicts): {exc}"
             ) from exc
@@ -407,9 +428,10 @@ class Emulator:
 
         Raises EmulatorFileError naming what is missing or inconsistent (shapes, priors, domain).
         """
-        missing = [k for k in REQUIRED if k not in arrays]
-        if missing:
-            raise EmulatorFileError(f"required arrays missing: {missing}")
+        try:
+            check_record(manifest, arrays)
+        except GPMSAError as exc:
+            raise EmulatorFileError(str(exc)) from exc
         try:
             std = Standardizer(**{k: arrays[k] for k in STD_FIELDS}, y_sd=float(arrays["y_sd"][0]))
             names = {k: tuple(manifest["names"][k]) for k in ("x", "t", "y")}
@@ -423,13 +445,14 @@ class Emulator:
                 priors=Priors.from_dict(manifest["priors"]), names=names, units=units,
                 draws=draws, log_post=arrays["log_post"], metadata=manifest["metadata"],
                 settings=manifest["settings"], diagnostics=manifest["diagnostics"],
-                calibration=cal,
+                calibration=cal, convergence=manifest.get("convergence"),  # check_fields checked it
             )  # fmt: skip
             _check_consistent(emu)
             domain = {k: list(v) for k, v in emu.domain.items()}
             if manifest.get("domain") != domain:
                 raise ValueError(
-                    f"manifest domain {manifest.get('domain')} differs from the arrays' {domain}"
+                    f"domain: {str(manifest.get('domain'))[:200]} differs from the arrays' "
+                    f"{domain}"
                 )
         except EmulatorFileError:
             raise
@@ -438,8 +461,17 @@ class Emulator:
         return emu
 
     def save(self, path: str | Path) -> Path:
-        """Write the emulator file (see docs/emulator-file.md); returns the path."""
+        """Write the emulator file (see docs/emulator-file.md); returns the path.
+
+        Refuses (GPMSAError, before writing anything) an emulator that ``load`` would refuse:
+        invalid content, non-finite metadata, or sizes beyond ``gpmsa.limits``. The file is
+        replaced in one step, never left half-written.
+        """
         manifest, arrays = self.to_record()
+        try:
+            check_record(manifest, arrays)
+        except EmulatorFileError as exc:
+            raise GPMSAError(f"refusing to write {path}, it could not be read back: {exc}") from exc
         return write_raw(path, manifest, arrays)
 
     def __repr__(self) -> str:
@@ -449,12 +481,23 @@ class Emulator:
         )
 
 
-def load(path: str | Path) -> Emulator:
+def load(path: str | Path, *, sha256: str | None = None) -> Emulator:
     """Read an emulator file written by ``Emulator.save`` (any older schema; never unpickles).
 
-    Raises EmulatorFileError naming the problem for a damaged, edited, foreign or newer file.
+    Only regular files are read; sizes are checked before anything is decompressed and every
+    field of the content is validated (``gpmsa.fitting.validation``). ``sha256``: the expected
+    ``content_sha256`` (``gpmsa info`` prints it), received from the file's author over a
+    trusted channel; a file whose content differs is refused.
+
+    Raises EmulatorFileError naming the problem (and the field) for a damaged, edited,
+    inconsistent, foreign or newer file.
     """
-    manifest, arrays = read_raw(path)
+    manifest, arrays = read_raw(path, check_manifest)
+    if sha256 is not None and manifest["content_sha256"] != str(sha256).strip().lower():
+        raise EmulatorFileError(
+            f"{path}: content sha256 {manifest['content_sha256']} differs from the expected "
+            f"{str(sha256)[:80]!r}"
+        )
     try:
         return Emulator.from_record(manifest, arrays)
     except EmulatorFileError as exc:
@@ -476,3 +519,33 @@ def _check_consistent(emu: Emulator) -> None:
     for k, v in emu.draws.items():
         if v.shape[1:] != emu.params[k].shape or v.shape[0] != emu.n_draws:
             raise ValueError(f"draws of {k} have shape {v.shape}")
+
+
+def _check_metadata(value, where: str, depth: int = 0) -> None:
+    """Metadata that survive the file unchanged: dicts with string keys, lists, strings, bools,
+    integers, finite floats and None (NaN would come back as null, a tuple as a list)."""
+    if depth > 64:
+        raise GPMSAError(f"{where}: nests deeper than 64 levels")
+    if value is None or isinstance(value, (str, bool, int, np.integer, np.bool_)):
+        return
+    if isinstance(value, (float, np.floating)):
+        if not np.isfinite(value):
+            raise GPMSAError(
+                f"{where} = {value}: metadata must be finite (NaN and inf are not JSON and would "
+                "not come back)"
+            )
+        return
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise GPMSAError(f"{where}: keys must be strings, got {k!r}")
+            _check_metadata(v, f"{where}[{k!r}]", depth + 1)
+        return
+    if isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            _check_metadata(v, f"{where}[{i}]", depth + 1)
+        return
+    raise GPMSAError(
+        f"{where}: Emulator.metadata must be JSON-able (str, numbers, lists, dicts), got "
+        f"{type(value).__name__}"
+    )

@@ -8,10 +8,12 @@ from datetime import datetime, timezone
 import numpy as np
 
 from gpmsa import backends
+from gpmsa._version import library_versions
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
-from gpmsa.mcmc.diagnostics import summarize
-from gpmsa.model.data import ObsData, SimData
+from gpmsa.limits import check_memory
+from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
+from gpmsa.model.data import ObsData, SimData, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
 
@@ -20,11 +22,21 @@ N_KEEP = 1000
 
 
 def _seed(seed):
+    seed = check_seed(seed, generator=True)
     if isinstance(seed, np.random.Generator):
         return int(seed.integers(2**63))
-    if seed is not None and not isinstance(seed, (int, np.integer)):
-        raise GPMSAError(f"seed must be an int, a numpy Generator or None, got {seed!r}")
-    return None if seed is None else int(seed)
+    return seed
+
+
+def _check_fit_memory(problem, n_iter: int, n_chains: int) -> None:
+    """Refuse (before sampling) a fit whose draws or factorisations exceed the memory limit:
+    every sweep of every chain is stored (n_chains x n_iter x parameter elements, kept twice
+    while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats."""
+    n_el = sum(int(np.size(v)) for v in problem.init.values()) + 1
+    m, d, p_u = problem.m, problem.p + problem.q, problem.p_u
+    nbytes = 8.0 * (2.0 * n_chains * n_iter * n_el + m * m * (d + 4 * p_u + 2))
+    check_memory(nbytes, f"fit(n_iter={n_iter}, n_chains={n_chains}) of {m} runs x {n_el - 1} "
+                 "parameter elements")  # fmt: skip
 
 
 def fit(
@@ -45,6 +57,8 @@ def fit(
     discrepancy=None,
     step_widths: dict | None = None,
     metadata: dict | None = None,
+    n_jobs: int | None = None,
+    executor=None,
     **options,
 ) -> Emulator:
     """Fit the emulator by GPM/SA's Metropolis-within-Gibbs; returns an ``Emulator``.
@@ -55,8 +69,15 @@ def fit(
     n_burn: sweeps discarded per chain (default n_iter // 5). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
     posterior) for ``Emulator.params``. n_pc: basis size (default: 99.5% of the variance).
-    discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. options: passed to the
-    backend's ``sample``.
+    discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. n_jobs, executor: where
+    the chains run (numpy backend: ``n_jobs`` worker processes, None = every CPU but never more
+    than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws are the
+    same wherever they run. options: passed to the backend's ``sample`` (e.g. ``init``).
+
+    With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
+    are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
+    names each parameter with R-hat > 1.01 or ESS < 100. A chain that fails or produces
+    non-finite draws raises ``gpmsa.ChainError`` naming it.
     """
     if not isinstance(n_iter, (int, np.integer)) or n_iter < 2:
         raise GPMSAError(f"n_iter must be an integer >= 2, got {n_iter!r}")
@@ -71,11 +92,14 @@ def fit(
         raise GPMSAError(f"n_keep must be >= 1, got {n_keep}")
     seed = _seed(seed)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
+    _check_fit_memory(prep.problem, int(n_iter), int(n_chains))
     module = backends.get(backend)
+    options.update(backends.placement(backend, n_jobs, executor))
     chains = module.sample(
         prep.problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,
     )  # fmt: skip
+    chains.check_finite()
     kept = n_iter - n_burn
     thin = max(1, math.ceil(n_chains * kept / n_keep))
     post = {k: v[:, n_burn:] for k, v in chains.draws.items()}
@@ -97,12 +121,20 @@ def fit(
         "n_pc": int(prep.K.shape[1]), "joint_obs": obs is not None,
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
+        "init": chains.info.get("init", "gpmsa"),
         "step_widths": {k: v.tolist() for k, v in chains.step_widths.items()},
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "versions": library_versions(backend),
     }  # fmt: skip
+    summary = summarize(post, chains.accept_rate)
+    record = None
+    if n_chains > 1:
+        shapes = {k: prep.problem.init[k].shape for k in prep.problem.sampled}
+        record = convergence(summary, shapes, n_chains, kept)
+        warn_unconverged(record, f"gpmsa.fit (backend {backend!r})")
     return Emulator._from_prepared(
         data, prep, params,
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,
         metadata=metadata, settings=settings,
-        diagnostics=summarize(post, chains.accept_rate), calibration=calibration,
+        diagnostics=summary, calibration=calibration, convergence=record,
     )  # fmt: skip

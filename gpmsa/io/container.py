@@ -19,12 +19,18 @@ import json
 import math
 import os
 import re
+import secrets
+import stat
+import struct
 import zipfile
+import zlib
+from collections.abc import Callable
 from datetime import datetime, timezone
 from pathlib import Path
 
 import numpy as np
 
+from gpmsa import limits
 from gpmsa._version import __version__
 from gpmsa.errors import EmulatorFileError, GPMSAError
 
@@ -34,12 +40,16 @@ MANIFEST = "manifest.json"
 ARRAY_DIR = "arrays/"
 NAME_RE = re.compile(r"^[A-Za-z0-9_]{1,64}$")
 ALLOWED_DTYPES = {"<f8", "<i8", "|b1"}
-MAX_FILE_BYTES = 2 * 1024**3
-MAX_TOTAL_BYTES = 4 * 1024**3
-MAX_MEMBERS = 512
-MAX_MANIFEST_BYTES = 16 * 1024**2
-MAX_RATIO = 200
-"""Largest allowed uncompressed/compressed size ratio of a member (zip-bomb guard)."""
+MAX_NDIM = 8
+"""Most dimensions of an array of the file."""
+NPY_HEADER_MAX = 65536 + 16
+"""Longest .npy preamble (magic, header length, header) a member may carry before its data."""
+READ_CHUNK = 8 * 1024**2
+"""Bytes decompressed per step when a member is read."""
+CENTRAL_ENTRY_MAX = 1024
+"""Bytes of the zip's central directory allowed per member (names are at most 75 characters)."""
+# The size limits live in gpmsa.limits (MAX_FILE_BYTES, MAX_ARRAY_BYTES, MAX_MANIFEST_BYTES,
+# MAX_MEMBERS, MAX_RATIO) and are read when a file is read or written.
 
 ENVELOPE = ("format", "schema_version", "library_version", "created_utc", "arrays",
             "content_sha256")  # fmt: skip
@@ -74,9 +84,74 @@ def content_hash(arrays: dict[str, np.ndarray], manifest: dict) -> str:
     for name in sorted(arrays):
         a = np.ascontiguousarray(arrays[name])
         h.update(f"{name}\0{a.dtype.str}\0{a.shape}\0".encode())
-        h.update(a.tobytes())
+        if a.dtype.hasobject or not a.size:
+            h.update(a.tobytes())
+        else:
+            h.update(a.reshape(-1).view(np.uint8))  # the data's bytes, without a copy
     h.update(_canonical(manifest))
     return h.hexdigest()
+
+
+# --- writing ------------------------------------------------------------------------------------
+def _npy_bytes(arr: np.ndarray) -> bytes:
+    buf = io.BytesIO()
+    np.save(buf, arr, allow_pickle=False)
+    return buf.getvalue()
+
+
+def _deflated_size(data: bytes) -> int:
+    """Size of ``data`` deflated as zipfile does it (raw deflate, default level)."""
+    c = zlib.compressobj(zlib.Z_DEFAULT_COMPRESSION, zlib.DEFLATED, -15)
+    return len(c.compress(data)) + len(c.flush())
+
+
+def _too_compressible(file_size: int, compress_size: int) -> bool:
+    """The reader's zip-bomb test of one member."""
+    return file_size > limits.MAX_RATIO * max(compress_size, 1) + 1024
+
+
+def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
+    """Apply the reader's limits to a record about to be written; returns the manifest's JSON.
+
+    Raises GPMSAError naming what exceeds which limit (member count, array bytes, manifest
+    bytes, names, dtypes, dimensions), so that ``write_raw`` never writes a file ``read_raw``
+    refuses.
+    """
+    for name, arr in arrays.items():
+        if not NAME_RE.match(name) or arr.dtype.str not in ALLOWED_DTYPES:
+            raise GPMSAError(
+                f"array {name!r} ({arr.dtype.str}): names must match {NAME_RE.pattern} and "
+                f"dtypes be one of {sorted(ALLOWED_DTYPES)}"
+            )
+        if arr.ndim > MAX_NDIM:
+            raise GPMSAError(f"array {name!r} has {arr.ndim} dimensions (limit {MAX_NDIM})")
+    if len(arrays) + 1 > limits.MAX_MEMBERS:
+        raise GPMSAError(
+            f"{len(arrays)} arrays: a file holds at most gpmsa.limits.MAX_MEMBERS - 1 = "
+            f"{limits.MAX_MEMBERS - 1}"
+        )
+    total = sum(int(a.nbytes) + NPY_HEADER_MAX for a in arrays.values())
+    if total > limits.MAX_ARRAY_BYTES:
+        big = max(arrays, key=lambda k: arrays[k].nbytes)
+        raise GPMSAError(
+            f"the arrays take {total} bytes (the largest, {big!r} {list(arrays[big].shape)}: "
+            f"{arrays[big].nbytes}), above gpmsa.limits.MAX_ARRAY_BYTES = "
+            f"{limits.MAX_ARRAY_BYTES} that readers accept; keep fewer draws or outputs, or raise "
+            "the limit (on every reader's machine too)"
+        )
+    try:
+        raw = json.dumps(manifest, indent=1, sort_keys=True, allow_nan=False).encode()
+    except (TypeError, ValueError) as exc:
+        raise GPMSAError(f"the manifest is not JSON-able ({exc})") from exc
+    if len(raw) > limits.MAX_MANIFEST_BYTES:
+        sizes = {k: len(json.dumps(v, allow_nan=False)) for k, v in manifest.items()}
+        big = max(sizes, key=sizes.get)
+        raise GPMSAError(
+            f"the manifest takes {len(raw)} bytes (field {big!r}: {sizes[big]}), above "
+            f"gpmsa.limits.MAX_MANIFEST_BYTES = {limits.MAX_MANIFEST_BYTES} that readers accept; "
+            "store less in metadata (large data belong in arrays or beside the file)"
+        )
+    return raw
 
 
 def write_raw(path: str | Path, manifest: dict, arrays: dict[str, np.ndarray]) -> Path:
@@ -84,19 +159,18 @@ def write_raw(path: str | Path, manifest: dict, arrays: dict[str, np.ndarray]) -
 
     manifest: the content fields, JSON-able (see ``jsonable``); the envelope fields (``ENVELOPE``)
     are added here. arrays: name -> array; names match ``NAME_RE``, dtypes are float64, int64 or
-    bool, as the reader accepts. The zip is written beside ``path`` and then moved over it.
-    Returns the path.
+    bool, as the reader accepts. Everything the reader checks is checked first
+    (``check_writable``): a record it would refuse raises GPMSAError and nothing is written. The
+    zip is written to a new temporary file beside ``path``, checked as the reader checks a zip's
+    structure, flushed to disk and then moved over ``path`` in one step: a failure at any point
+    leaves an existing ``path`` untouched and no temporary file behind. A member that deflates
+    beyond ``limits.MAX_RATIO`` (e.g. zero padding) is stored uncompressed. An existing ``path``
+    that is not a regular file (a directory, device, FIFO) is refused. Returns the path.
     """
     path = Path(path)
     reserved = sorted(set(manifest) & set(ENVELOPE))
     if reserved:
         raise GPMSAError(f"manifest fields {reserved} are written by the container itself")
-    for name, arr in arrays.items():
-        if not NAME_RE.match(name) or arr.dtype.str not in ALLOWED_DTYPES:
-            raise GPMSAError(
-                f"array {name!r} ({arr.dtype.str}): names must match {NAME_RE.pattern} and "
-                f"dtypes be one of {sorted(ALLOWED_DTYPES)}"
-            )
     manifest = {
         **manifest,
         "format": FORMAT,
@@ -106,15 +180,48 @@ def write_raw(path: str | Path, manifest: dict, arrays: dict[str, np.ndarray]) -
         "arrays": {k: {"shape": list(v.shape), "dtype": v.dtype.str} for k, v in arrays.items()},
     }
     manifest["content_sha256"] = content_hash(arrays, manifest)
-    tmp = path.with_name(path.name + ".part")
-    with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-        zf.writestr(MANIFEST, json.dumps(manifest, indent=1, sort_keys=True, allow_nan=False))
-        for name, arr in arrays.items():
-            buf = io.BytesIO()
-            np.save(buf, arr, allow_pickle=False)
-            zf.writestr(ARRAY_DIR + name + ".npy", buf.getvalue())
-    os.replace(tmp, path)
+    raw_manifest = check_writable(manifest, arrays)
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise GPMSAError(f"{path}: cannot write ({exc.strerror})") from exc
+    if mode is not None and not stat.S_ISREG(mode):
+        raise GPMSAError(f"{path} exists and is not a regular file: refusing to replace it")
+    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.part")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+                _write_member(zf, MANIFEST, raw_manifest)
+                for name, arr in arrays.items():
+                    _write_member(zf, ARRAY_DIR + name + ".npy", _npy_bytes(arr))
+            fh.flush()
+            os.fsync(fh.fileno())
+        with open(tmp, "rb") as fh:  # the reader's structural checks, before the file is seen
+            fh.seek(0, os.SEEK_END)
+            _check_directory(fh, fh.tell(), tmp)
+            fh.seek(0)
+            with zipfile.ZipFile(fh) as zf:
+                _check_members(zf, tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
     return path
+
+
+def _write_member(zf: zipfile.ZipFile, name: str, data: bytes) -> None:
+    info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+    info.compress_type = zipfile.ZIP_DEFLATED
+    if _too_compressible(len(data), _deflated_size(data)):
+        info.compress_type = zipfile.ZIP_STORED  # the reader would take it for a zip bomb
+    info.external_attr = 0o644 << 16
+    zf.writestr(info, data)
 
 
 # --- reading ------------------------------------------------------------------------------------
@@ -122,25 +229,90 @@ def _fail(path, what: str) -> EmulatorFileError:
     return EmulatorFileError(f"{path}: {what}")
 
 
-def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path, limit: int) -> bytes:
-    if info.file_size > limit:
+def _open_regular(path: Path):
+    """Open ``path`` for reading if it is a regular file within the size limit; never opens a
+    device, FIFO or directory (``/dev/zero`` would grow memory without end, a FIFO block)."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError) as exc:
+        raise EmulatorFileError(f"{path}: cannot read ({getattr(exc, 'strerror', exc)})") from exc
+    if not stat.S_ISREG(mode):
+        kind = "a directory" if stat.S_ISDIR(mode) else "a device, FIFO or socket"
+        raise _fail(path, f"not a regular file ({kind}): gpmsa reads emulator files only")
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(path, flags)
+    except OSError as exc:
+        raise EmulatorFileError(f"{path}: cannot read ({exc.strerror})") from exc
+    fh = os.fdopen(fd, "rb")
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):  # replaced between the stat and the open
+        fh.close()
+        raise _fail(path, "not a regular file: gpmsa reads emulator files only")
+    if st.st_size > limits.MAX_FILE_BYTES:
+        fh.close()
         raise _fail(
-            path, f"member {info.filename!r} declares {info.file_size} bytes (limit {limit})"
-        )
+            path, f"file is {st.st_size} bytes (limit gpmsa.limits.MAX_FILE_BYTES = "
+                  f"{limits.MAX_FILE_BYTES})"
+        )  # fmt: skip
+    return fh, st.st_size
+
+
+def _check_directory(fh, size: int, path) -> None:
+    """Read the zip's end-of-central-directory record and refuse, before zipfile parses the
+    directory, more entries or a larger directory than a gpmsa file has."""
+    tail_len = min(size, 22 + 65535)
+    fh.seek(size - tail_len)
+    tail = fh.read(tail_len)
+    at = tail.rfind(b"PK\x05\x06")
+    if at < 0 or len(tail) - at < 22:
+        raise _fail(path, "not a gpmsa emulator file (not a readable zip: no end record)")
+    entries, cd_size = struct.unpack("<xxxxxxxxxxHI", tail[at : at + 16])
+    if entries == 0xFFFF or cd_size == 0xFFFFFFFF:  # a zip64 record: read that one
+        loc = tail[at - 20 : at] if at >= 20 else b""
+        if len(loc) != 20 or loc[:4] != b"PK\x06\x07":
+            raise _fail(path, "damaged zip64 end record")
+        (offset,) = struct.unpack("<Q", loc[8:16])
+        if offset > size - 56:
+            raise _fail(path, "damaged zip64 end record")
+        fh.seek(offset)
+        rec = fh.read(56)
+        if rec[:4] != b"PK\x06\x06":
+            raise _fail(path, "damaged zip64 end record")
+        entries, cd_size = struct.unpack("<QQ", rec[32:48])
+    if entries > limits.MAX_MEMBERS:
+        raise _fail(path, f"{entries} members (limit gpmsa.limits.MAX_MEMBERS = "
+                          f"{limits.MAX_MEMBERS})")  # fmt: skip
+    if cd_size > CENTRAL_ENTRY_MAX * max(entries, 1):
+        raise _fail(path, f"zip directory of {cd_size} bytes for {entries} members")
+
+
+def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path) -> bytearray:
+    """A member's bytes (exactly its declared size, CRC checked), in a writable buffer that the
+    loaded array then shares (no second copy of a large array)."""
+    data = bytearray(info.file_size)
+    view = memoryview(data)
+    got = 0
     try:
         with zf.open(info) as fh:
-            data = fh.read(limit + 1)
+            while got < info.file_size:  # in chunks: zipfile's read(n) would join a second copy
+                chunk = fh.read(min(READ_CHUNK, info.file_size - got))
+                if not chunk:
+                    break
+                view[got : got + len(chunk)] = chunk
+                got += len(chunk)
+            rest = fh.read(1)  # reaching the end checks the CRC
     except Exception as exc:  # zipfile/zlib raise many types on hostile bytes
         raise _fail(path, f"member {info.filename!r} is damaged ({exc})") from exc
-    if len(data) != info.file_size:
+    if got != info.file_size or rest:
         raise _fail(path, f"member {info.filename!r} size differs from its zip header")
     return data
 
 
 def _check_members(zf: zipfile.ZipFile, path) -> dict[str, zipfile.ZipInfo]:
     infos = zf.infolist()
-    if len(infos) > MAX_MEMBERS:
-        raise _fail(path, f"{len(infos)} members (limit {MAX_MEMBERS})")
+    if len(infos) > limits.MAX_MEMBERS:
+        raise _fail(path, f"{len(infos)} members (limit {limits.MAX_MEMBERS})")
     members: dict[str, zipfile.ZipInfo] = {}
     total = 0
     for info in infos:
@@ -159,14 +331,25 @@ def _check_members(zf: zipfile.ZipFile, path) -> dict[str, zipfile.ZipInfo]:
                 )
         if info.flag_bits & 0x1:
             raise _fail(path, f"member {name!r} is encrypted")
-        if info.file_size > MAX_RATIO * max(info.compress_size, 1) + 1024:
+        if info.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
+            raise _fail(path, f"member {name!r} uses compression method {info.compress_type} "
+                              "(only stored or deflated)")  # fmt: skip
+        if info.compress_type == zipfile.ZIP_STORED and info.file_size != info.compress_size:
+            raise _fail(path, f"stored member {name!r} has unequal sizes in its zip header")
+        if _too_compressible(info.file_size, info.compress_size):
             raise _fail(
                 path, f"member {name!r} expands {info.file_size}/{info.compress_size}x (zip bomb?)"
             )
-        total += info.file_size
+        if name == MANIFEST and info.file_size > limits.MAX_MANIFEST_BYTES:
+            limit = limits.MAX_MANIFEST_BYTES
+            raise _fail(path, f"{MANIFEST} declares {info.file_size} bytes (limit "
+                              f"gpmsa.limits.MAX_MANIFEST_BYTES = {limit})")  # fmt: skip
+        if name != MANIFEST:
+            total += info.file_size
         members[name] = info
-    if total > MAX_TOTAL_BYTES:
-        raise _fail(path, f"uncompressed size {total} exceeds {MAX_TOTAL_BYTES} bytes")
+    if total > limits.MAX_ARRAY_BYTES:
+        raise _fail(path, f"arrays of {total} bytes once decompressed exceed "
+                          f"gpmsa.limits.MAX_ARRAY_BYTES = {limits.MAX_ARRAY_BYTES}")  # fmt: skip
     if MANIFEST not in members:
         raise _fail(path, f"no {MANIFEST}: not a gpmsa emulator file")
     return members
@@ -184,16 +367,16 @@ def _parse_manifest(raw: bytes, path) -> dict:
         raise _fail(path, "manifest.json must hold a JSON object")
     if manifest.get("format") != FORMAT:
         raise _fail(
-            path, f"format is {manifest.get('format')!r}, expected {FORMAT!r} (foreign file)"
+            path, f"format is {_short(manifest.get('format'))}, expected {FORMAT!r} (foreign file)"
         )
     version = manifest.get("schema_version")
     if not isinstance(version, int) or isinstance(version, bool) or version < 1:
-        raise _fail(path, f"schema_version must be a positive integer, got {version!r}")
+        raise _fail(path, f"schema_version must be a positive integer, got {_short(version)}")
     if version > SCHEMA_VERSION:
         raise _fail(
             path,
             f"schema_version {version} is newer than this library reads ({SCHEMA_VERSION}); "
-            f"upgrade gpmsa (file written by gpmsa {manifest.get('library_version')!r})",
+            f"upgrade gpmsa (file written by gpmsa {_short(manifest.get('library_version'))})",
         )
     for key, kind in FIELDS:
         if not isinstance(manifest.get(key), kind):
@@ -201,15 +384,51 @@ def _parse_manifest(raw: bytes, path) -> dict:
     return _upgrade(manifest)
 
 
+def _short(value, n: int = 60) -> str:
+    """repr of a value from a file, cut to ``n`` characters (messages stay readable)."""
+    text = repr(value)
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
 def _upgrade(manifest: dict) -> dict:
     """Bring an older schema's manifest to the current one (schema 1 is the first)."""
     return manifest
 
 
-def _load_array(raw: bytes, name: str, spec, path) -> np.ndarray:
-    if not isinstance(spec, dict) or not isinstance(spec.get("shape"), list):
-        raise _fail(path, f"manifest entry of array {name!r} is malformed")
-    buf = io.BytesIO(raw)
+def _check_specs(specs: dict, npy: dict[str, zipfile.ZipInfo], path) -> None:
+    """Each listed array's declared shape and dtype, and its member's size, agree (checked
+    before anything is decompressed)."""
+    if set(specs) != set(npy):
+        missing = sorted(set(specs) - set(npy))
+        extra = sorted(set(npy) - set(specs))
+        raise _fail(path, f"arrays do not match the manifest (missing {missing[:10]}, unlisted "
+                          f"{extra[:10]})")  # fmt: skip
+    for name, spec in specs.items():
+        shape = spec.get("shape") if isinstance(spec, dict) else None
+        dtype = spec.get("dtype") if isinstance(spec, dict) else None
+        if dtype not in ALLOWED_DTYPES:
+            allowed = sorted(ALLOWED_DTYPES)
+            shown = dtype if isinstance(dtype, str) and len(dtype) < 20 else _short(dtype)
+            raise _fail(path, f"array {name!r} has dtype {shown} (allowed {allowed}; "
+                              "object/pickled arrays are refused)")  # fmt: skip
+        if (
+            not isinstance(shape, list)
+            or len(shape) > MAX_NDIM
+            or not all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in shape)
+        ):
+            raise _fail(path, f"manifest entry of array {name!r} is malformed: {_short(spec)}")
+        nbytes = math.prod(shape) * np.dtype(dtype).itemsize
+        extra = npy[name].file_size - nbytes
+        if not 10 <= extra <= NPY_HEADER_MAX:
+            raise _fail(
+                path,
+                f"array {name!r}: its member holds {npy[name].file_size} bytes, not a .npy of "
+                f"shape {shape} {dtype} ({nbytes} bytes of data)",
+            )
+
+
+def _load_array(raw: bytearray, name: str, spec: dict, path) -> np.ndarray:
+    buf = io.BytesIO(bytes(raw[:NPY_HEADER_MAX]))  # the header only: BytesIO copies
     try:
         major, minor = np.lib.format.read_magic(buf)
         if (major, minor) == (1, 0):
@@ -227,43 +446,51 @@ def _load_array(raw: bytes, name: str, spec, path) -> np.ndarray:
     if list(shape) != spec["shape"] or dtype.str != spec.get("dtype"):
         raise _fail(path, f"array {name!r} is {dtype.str}{list(shape)}, manifest says "
                           f"{spec.get('dtype')}{spec['shape']}")  # fmt: skip
-    try:
-        arr = np.load(io.BytesIO(raw), allow_pickle=False)
-    except Exception as exc:  # np.load on damaged bytes raises many types
-        raise _fail(path, f"array {name!r} is truncated or damaged ({exc})") from exc
-    return arr
+    offset = buf.tell()
+    count = math.prod(shape)
+    if len(raw) - offset != count * dtype.itemsize:
+        need = count * dtype.itemsize
+        raise _fail(path, f"array {name!r} is truncated or damaged (its data are "
+                          f"{len(raw) - offset} bytes, its shape needs {need})")  # fmt: skip
+    flat = np.frombuffer(raw, dtype=dtype, count=count, offset=offset)  # shares raw's memory
+    return np.ascontiguousarray(flat.reshape(shape, order="F" if fortran else "C"))
 
 
-def read_raw(path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
-    """Validated manifest and arrays of an emulator file (no Emulator built)."""
+def read_raw(
+    path: str | Path, check: Callable[[dict], None] | None = None
+) -> tuple[dict, dict[str, np.ndarray]]:
+    """Validated manifest and arrays of an emulator file (no Emulator built).
+
+    Only regular files are read. Before anything is decompressed: the file's size, the zip's
+    directory (members, names, compression, ratios, declared sizes against gpmsa.limits), the
+    manifest, and each array's declared shape and dtype against its member's size; then
+    ``check(manifest)`` (the caller's test of the declared content, e.g. consistent shapes).
+    Raises EmulatorFileError naming the problem.
+    """
     path = Path(path)
-    try:
-        size = path.stat().st_size
-    except OSError as exc:
-        raise EmulatorFileError(f"{path}: cannot read ({exc.strerror})") from exc
-    if size > MAX_FILE_BYTES:
-        raise _fail(path, f"file is {size} bytes (limit {MAX_FILE_BYTES})")
-    try:
-        zf = zipfile.ZipFile(path)
-    except Exception as exc:  # zipfile raises many types on hostile bytes
-        raise _fail(path, f"not a gpmsa emulator file (not a readable zip: {exc})") from exc
-    with zf:
-        members = _check_members(zf, path)
-        manifest = _parse_manifest(
-            _read_member(zf, members[MANIFEST], path, MAX_MANIFEST_BYTES), path
-        )
-        specs = manifest["arrays"]
-        npy = {n[len(ARRAY_DIR) : -4]: info for n, info in members.items() if n != MANIFEST}
-        if set(specs) != set(npy):
-            missing = sorted(set(specs) - set(npy))
-            extra = sorted(set(npy) - set(specs))
-            raise _fail(
-                path, f"arrays do not match the manifest (missing {missing}, unlisted {extra})"
-            )
-        arrays = {
-            name: _load_array(_read_member(zf, info, path, MAX_FILE_BYTES), name, specs[name], path)
-            for name, info in npy.items()
-        }
+    fh, size = _open_regular(path)
+    with fh:
+        _check_directory(fh, size, path)
+        fh.seek(0)
+        try:
+            zf = zipfile.ZipFile(fh)
+        except Exception as exc:  # zipfile raises many types on hostile bytes
+            raise _fail(path, f"not a gpmsa emulator file (not a readable zip: {exc})") from exc
+        with zf:
+            members = _check_members(zf, path)
+            manifest = _parse_manifest(bytes(_read_member(zf, members[MANIFEST], path)), path)
+            specs = manifest["arrays"]
+            npy = {n[len(ARRAY_DIR) : -4]: info for n, info in members.items() if n != MANIFEST}
+            _check_specs(specs, npy, path)
+            if check is not None:
+                try:
+                    check(manifest)
+                except EmulatorFileError as exc:
+                    raise _fail(path, str(exc)) from exc
+            arrays = {
+                name: _load_array(_read_member(zf, info, path), name, specs[name], path)
+                for name, info in npy.items()
+            }
     if content_hash(arrays, manifest) != manifest["content_sha256"]:
         raise _fail(
             path, "content hash mismatch: the file was edited or damaged after it was written"

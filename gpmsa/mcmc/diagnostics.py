@@ -69,3 +69,84 @@ def summarize(
             entry["accept"] = [float(v) for v in accept_rate[name].reshape(d.shape[0], -1).mean(0)]
         out[name] = entry
     return out
+
+
+RHAT_MAX = 1.01
+"""Largest R-hat (rank-normalised, split) of a converged parameter (Vehtari et al. 2021)."""
+ESS_MIN = 100.0
+"""Smallest bulk effective sample size of a converged parameter (all chains together)."""
+
+
+def element_names(name: str, shape: tuple[int, ...]) -> list[str]:
+    """Names of the elements of parameter ``name`` in C order: "lamUz[0]", "betaU[1,0]"; a
+    scalar (shape ()) is its name."""
+    if len(shape) == 0:
+        return [name]
+    if len(shape) == 1:
+        return [f"{name}[{i}]" for i in range(int(np.prod(shape)))]
+    return [f"{name}[{','.join(map(str, ix))}]" for ix in np.ndindex(*shape)]
+
+
+def convergence(
+    summary: dict[str, dict[str, list[float]]],
+    shapes: dict[str, tuple[int, ...]],
+    n_chains: int,
+    n_draws: int,
+) -> dict:
+    """The convergence record of sampled parameters from ``summarize`` output (JSON-able).
+
+    ``shapes``: name -> element shape of every sampled parameter to judge. Returns n_chains,
+    n_draws (per chain), the limits, per parameter ``rhat`` and ``ess`` (bulk) lists (C order),
+    the worst element of each kind, and ``flagged``: element -> reason, for every element with
+    R-hat > RHAT_MAX, ESS < ESS_MIN, or no movement at all (constant draws: NaN R-hat and ESS).
+    """
+    rhat_of, ess_of, flagged = {}, {}, {}
+    worst_r, worst_e = ("", -np.inf), ("", np.inf)
+    for name, shape in shapes.items():
+        rs, es = summary[name]["rhat"], summary[name]["ess"]
+        rhat_of[name], ess_of[name] = list(rs), list(es)
+        for el, r, e in zip(element_names(name, shape), rs, es, strict=True):
+            r = float("nan") if r is None else float(r)
+            e = float("nan") if e is None else float(e)
+            if not (np.isfinite(r) or np.isfinite(e)):
+                flagged[el] = "constant draws (no proposal accepted)"
+                continue
+            why = []
+            if r > RHAT_MAX:
+                why.append(f"R-hat {r:.3f}")
+            if e < ESS_MIN:
+                why.append(f"ESS {e:.0f}")
+            if why:
+                flagged[el] = ", ".join(why)
+            if np.isfinite(r) and r > worst_r[1]:
+                worst_r = (el, r)
+            if np.isfinite(e) and e < worst_e[1]:
+                worst_e = (el, e)
+    return {
+        "n_chains": int(n_chains),
+        "n_draws": int(n_draws),
+        "rhat_max": RHAT_MAX,
+        "ess_min": ESS_MIN,
+        "rhat": rhat_of,
+        "ess": ess_of,
+        "max_rhat": [worst_r[0], worst_r[1] if np.isfinite(worst_r[1]) else None],
+        "min_ess": [worst_e[0], worst_e[1] if np.isfinite(worst_e[1]) else None],
+        "flagged": flagged,
+        "converged": not flagged,
+    }
+
+
+def warn_unconverged(record: dict, what: str, stacklevel: int = 3) -> None:
+    """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record."""
+    from gpmsa.errors import ConvergenceWarning
+
+    flagged = record.get("flagged") or {}
+    if not flagged:
+        return
+    items = "; ".join(f"{el}: {why}" for el, why in flagged.items())
+    warnings.warn(
+        f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "
+        f"chains x {record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
+        f"{record['ess_min']:.0f}): {items}. Run longer chains (n_iter) or more of them.",
+        ConvergenceWarning, stacklevel=stacklevel,
+    )  # fmt: skip

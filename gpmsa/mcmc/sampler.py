@@ -5,6 +5,9 @@ betaV, betaU, lamVz, lamUz, lamWs, lamWOs, lamOs (betaU element order: input ind
 GPM/SA's column-major loop). Proposals: uniform random walk (theta; beta on the rho = exp(-beta/4)
 scale; precisions). Untuned precisions use GPM/SA's proportional step (width max(1, x/3)) with its
 Hastings correction. A proposal outside the prior bounds is rejected without a likelihood call.
+Where it applies (one basis component, no observations) each sweep ends with moves along the
+lamWs/lamWOs nugget ridge (``gpmsa.mcmc.ridge``; not in GPM/SA, ``ridge_moves=0`` turns them off).
+Several chains run as parallel tasks (``gpmsa.mcmc.parallel``), each on its own seed.
 """
 
 from __future__ import annotations
@@ -15,7 +18,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from gpmsa.mcmc import tuning
+from gpmsa.errors import ChainError, GPMSAError
+from gpmsa.mcmc import ridge, starts, tuning
+from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.likelihood import IncrementalLikelihood
 from gpmsa.model.problem import Problem
 
@@ -58,6 +63,30 @@ class Chains:
 
         return to_inference_data(self.draws, self.log_post)
 
+    def check_finite(self) -> None:
+        """Raise ChainError naming every chain whose draws or log posterior are not finite."""
+        require_finite(self.draws, self.log_post)
+
+
+def require_finite(draws: dict[str, np.ndarray], log_post: np.ndarray | None = None) -> None:
+    """Raise ChainError naming every chain (and its first bad draw) with a NaN or inf in
+    ``draws`` (name -> (n_chains, n_draws, ...)) or ``log_post`` (n_chains, n_draws)."""
+    arrays = list(draws.values()) + ([] if log_post is None else [log_post])
+    n_chains = arrays[0].shape[0]
+    bad = {}
+    for c in range(n_chains):
+        ok = np.ones(arrays[0].shape[1], dtype=bool)
+        for v in arrays:
+            ok &= np.isfinite(v[c].reshape(v.shape[1], -1)).all(axis=1)
+        if not ok.all():
+            bad[c] = int(np.argmin(ok))
+    if bad:
+        where = ", ".join(f"chain {c} (from draw {i})" for c, i in bad.items())
+        raise ChainError(
+            f"{len(bad)} of {n_chains} chains produced non-finite values (NaN or inf) in their "
+            f"draws or log posterior: {where}", tuple(bad),
+        )  # fmt: skip
+
 
 def default_widths(problem: Problem) -> dict[str, np.ndarray]:
     """GPM/SA's default step widths, one per element."""
@@ -87,6 +116,8 @@ class ChainState:
     """One chain: current parameters, incremental likelihood, and the sweep.
 
     ``els`` restricts the sweep to some (name, index) elements (default: every sampled one).
+    ``ridge_moves``: moves along the nugget ridge after each sweep (``gpmsa.mcmc.ridge``; only
+    where the move applies, else none).
     """
 
     def __init__(
@@ -95,9 +126,14 @@ class ChainState:
         params: dict[str, np.ndarray],
         rng: np.random.Generator,
         els: list[tuple[str, tuple[int, ...]]] | None = None,
+        ridge_moves: int = 0,
     ):
         self.problem = problem
         self.rng = rng
+        self.ridge_moves = int(ridge_moves) if ridge.applies(problem) else 0
+        self.ridge_accepted = 0
+        pri = problem.priors
+        self._ridge_priors = (pri.scalar_log_prior("lamWs"), pri.scalar_log_prior("lamWOs"))
         self.lik = IncrementalLikelihood(problem, params)
         self.els = elements(problem) if els is None else list(els)
         self.kinds = [
@@ -152,6 +188,50 @@ class ChainState:
                 lik.accept()
                 self.log_prior += lp_new - lp_old
                 accepted[i] += 1
+        if self.ridge_moves:
+            self.ridge_sweep(self.rng.random((self.ridge_moves, 2)))
+
+    def ridge_sweep(self, u: np.ndarray) -> None:
+        """Moves along the nugget ridge (likelihood unchanged), one per row of uniforms u (k, 2)."""
+        lik = self.lik
+        g_s, g_t = self._ridge_priors
+        lam_sim = float(self.problem.lam_sim[0])
+        for u0, u1 in u:
+            s, t = float(lik.params["lamWs"][0]), float(lik.params["lamWOs"][0])
+            prop = ridge.proposal(s, t, lam_sim, u0)
+            if prop is None:
+                continue
+            s2, t2 = prop
+            lp_new = g_s(s2) + g_t(t2)
+            if lp_new == -math.inf:
+                continue
+            lp_old = g_s(s) + g_t(t)
+            if math.log(u1) < lp_new - lp_old + ridge.log_jacobian_ratio(s, t, s2, t2):
+                lik.params = {**lik.params, "lamWs": np.array([s2]), "lamWOs": np.array([t2])}
+                self.log_prior += lp_new - lp_old
+                self.ridge_accepted += 1
+
+
+def check_sample_args(n_iter, n_chains, seed) -> None:
+    """The checks every backend's ``sample`` makes on its run arguments (GPMSAError naming it)."""
+    if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
+        raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
+    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
+        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    if seed is not None and not isinstance(seed, (int, np.integer)):
+        raise GPMSAError(f"seed must be an int or None, got {seed!r}")
+
+
+def check_ridge(ridge_moves, problem: Problem) -> int:
+    """Moves along the nugget ridge per sweep: ``ridge_moves`` (None: the default where the move
+    applies), 0 where it does not apply; GPMSAError for a negative or non-integer value."""
+    if ridge_moves is None:
+        ridge_moves = ridge.N_MOVES
+    if isinstance(ridge_moves, bool) or not isinstance(ridge_moves, (int, np.integer)):
+        raise GPMSAError(f"ridge_moves must be None or an integer >= 0, got {ridge_moves!r}")
+    if ridge_moves < 0:
+        raise GPMSAError(f"ridge_moves must be None or an integer >= 0, got {ridge_moves!r}")
+    return int(ridge_moves) if ridge.applies(problem) else 0
 
 
 def _flat_widths(problem: Problem, els, widths: dict[str, np.ndarray]) -> np.ndarray:
@@ -169,17 +249,30 @@ def run_chain(
     tune_levels: int = tuning.N_LEVELS,
     progress: bool = False,
     desc: str = "MCMC",
+    start: dict[str, np.ndarray] | None = None,
+    ridge_moves: int = 0,
 ) -> tuple[dict[str, np.ndarray], np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """Tune (optionally), then ``n_iter`` sweeps. Returns draws, log_post, accept rates, widths."""
+    """Tune (optionally), then ``n_iter`` sweeps from ``start`` (default ``problem.init``).
+
+    Returns draws, log_post, accept rates, widths. GPMSAError when the start's log posterior is
+    NaN (no proposal could ever be accepted).
+    """
     from tqdm.auto import tqdm
 
-    state = ChainState(problem, problem.init, rng)
+    state = ChainState(problem, problem.init if start is None else start, rng,
+                       ridge_moves=ridge_moves)  # fmt: skip
+    if math.isnan(state.log_post()):
+        raise GPMSAError(
+            f"the starting values give a log posterior of NaN (log-likelihood "
+            f"{state.lik.loglik}); check the data and the starting values"
+        )
     els = state.els
     w = _flat_widths(problem, els, widths)
     total = n_iter + (tune_rounds * tune_levels if tune else 0)
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
     with threadpool_limits(1):
         if tune and els:
+            bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases
             names = [n for n, _ in els]
             cands = tuning.level_widths(names, w, tune_levels)
             acc = np.zeros((tune_levels, len(els)))
@@ -188,6 +281,7 @@ def run_chain(
                     state.sweep(cands[lev], False, acc[lev])
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc, tune_rounds)
+        bar.set_description(f"{desc}: sampling")
         draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
         log_post = np.empty(n_iter)
         accepted = np.zeros(len(els))
@@ -211,6 +305,22 @@ def run_chain(
     return draws, log_post, rate, wid
 
 
+def _chain_task(
+    problem: Problem, n_iter: int, tune: bool, widths: dict[str, np.ndarray],
+    seed: np.random.SeedSequence, init: str, tune_rounds: int, tune_levels: int,
+    ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
+):  # fmt: skip
+    """One chain from plain data (run in a worker process): its start, then ``run_chain``."""
+    start = starts.draw_start(problem, init, starts.start_generator(seed))
+    with threadpool_limits(1):
+        out = run_chain(
+            problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
+            tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress, desc=desc,
+            start=start, ridge_moves=ridge_moves,
+        )  # fmt: skip
+    return (*out, start)
+
+
 def sample(
     problem: Problem,
     *,
@@ -222,33 +332,54 @@ def sample(
     progress: bool = False,
     tune_rounds: int = tuning.N_BURN,
     tune_levels: int = tuning.N_LEVELS,
+    init: str = "auto",
+    n_jobs: int | None = None,
+    executor=None,
+    ridge_moves: int | None = None,
 ) -> Chains:
     """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
 
     The numpy backend's ``sample``. ``tune_rounds`` x ``tune_levels`` tuning sweeps (default
-    50 x 20 = 1,000) precede the draws; ``step_widths`` (name -> widths) replace GPM/SA's initial
-    widths. Draws hold every sweep (no burn-in removed). The ``n_chains`` independent chains run
-    one after another, each from ``problem.init``.
+    50 x 20 = 1,000) precede the draws of each chain; ``step_widths`` (name -> widths) replace
+    GPM/SA's initial widths. Draws hold every sweep (no burn-in removed).
+
+    Chains: chain c runs on ``SeedSequence(seed).spawn(n_chains)[c]``, so its draws do not
+    depend on where it runs; they run in parallel processes (``gpmsa.mcmc.parallel``):
+    ``n_jobs`` workers (None: every CPU, never more than the chains) or any
+    ``concurrent.futures.Executor`` / dask ``Client`` given as ``executor``. ``init``: the
+    chains' starts (``gpmsa.mcmc.starts``: "auto" is GPM/SA's initial values for one chain,
+    dispersed ones for several). ``ridge_moves``: moves along the lamWs/lamWOs nugget ridge per
+    sweep (``gpmsa.mcmc.ridge``; None: ``ridge.N_MOVES`` where the move applies, a simulation-only
+    problem with one basis component; 0: GPM/SA's sweep alone). Raises ChainError naming a
+    chain that failed or whose draws are not finite.
     """
+    check_sample_args(n_iter, n_chains, seed)
+    how = starts.check_init(init, int(n_chains))
+    n_ridge = check_ridge(ridge_moves, problem)
     widths = default_widths(problem)
     if step_widths:
         for name, val in step_widths.items():
             widths[name] = np.broadcast_to(np.asarray(val, dtype=np.float64), widths[name].shape)
-    seeds = np.random.SeedSequence(seed).spawn(n_chains)
-    runs = [
-        run_chain(
-            problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(s),
-            tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress,
-            desc=f"chain {c + 1}/{n_chains}",
-        )
-        for c, s in enumerate(seeds)
+    seq = np.random.SeedSequence(seed)
+    tasks = [
+        {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": widths, "seed": s,
+         "init": how, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
+         "ridge_moves": n_ridge}
+        for s in seq.spawn(int(n_chains))
     ]  # fmt: skip
+    runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
+                      desc="chain")  # fmt: skip
     names = problem.names
-    return Chains(
+    chains = Chains(
         draws={n: np.stack([r[0][n] for r in runs]) for n in names},
         log_post=np.stack([r[1] for r in runs]),
         accept_rate={n: np.stack([r[2][n] for r in runs]) for n in names},
         step_widths={n: np.stack([r[3][n] for r in runs]) for n in names},
         info={"n_iter": n_iter, "n_chains": n_chains, "tune": tune, "tune_rounds": tune_rounds,
-              "tune_levels": tune_levels, "seed": seed, "backend": "numpy"},
+              "tune_levels": tune_levels, "seed": seed, "seed_entropy": str(seq.entropy),
+              "init": how, "ridge_moves": n_ridge,
+              "starts": {n: np.stack([r[4][n] for r in runs]) for n in names},
+              "backend": "numpy"},
     )  # fmt: skip
+    chains.check_finite()
+    return chains

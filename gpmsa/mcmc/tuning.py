@@ -74,7 +74,8 @@ def choose_widths(
         b = fit_logistic(np.log(candidates[:, i]), accepted[:, i], n_burn)
         if b is None or not b[1] < 0:
             continue
-        w = np.exp((logit - b[0]) / b[1])
+        with np.errstate(over="ignore"):  # an overflow gives inf: refused just below
+            w = np.exp((logit - b[0]) / b[1])
         if np.isfinite(w) and w > 0:
             out[i] = w
     return out

@@ -39,6 +39,26 @@ def check_finite(arr: np.ndarray, name: str) -> None:
         raise GPMSAError(f"{name} must be finite, got {arr[pos]} at index {pos}")
 
 
+MAX_SEED = 2**128
+"""Seeds are integers in [0, MAX_SEED) (numpy's SeedSequence takes non-negative integers)."""
+
+
+def check_seed(seed, name: str = "seed", *, generator: bool = False):
+    """Return ``seed`` if it is None or an integer in [0, 2**128) (or, with ``generator=True``,
+    a ``numpy.random.Generator``); else raise GPMSAError naming the argument and the range.
+
+    numpy itself refuses a negative seed deep inside SeedSequence; this says so up front.
+    """
+    if seed is None or (generator and isinstance(seed, np.random.Generator)):
+        return seed
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        kinds = "None, an integer or a numpy Generator" if generator else "None or an integer"
+        raise GPMSAError(f"{name} must be {kinds}, got {seed!r} ({type(seed).__name__})")
+    if not 0 <= int(seed) < MAX_SEED:
+        raise GPMSAError(f"{name}={int(seed)} is out of range: allowed integers in [0, 2**128)")
+    return int(seed)
+
+
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
     if names is None:
         return tuple(f"{prefix}{i}" for i in range(n))

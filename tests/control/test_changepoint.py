@@ -20,6 +20,18 @@ def test_the_prior_is_log_uniform_or_uniform():
     assert uni.mean("GD") == pytest.approx(400.0, rel=0.01)
 
 
+def test_a_prior_of_the_users_own():
+    def log_prior(gd):  # a normal belief around 300, nothing above 450
+        return np.where(gd <= 450, -0.5 * ((gd - 300) / 40) ** 2, -np.inf)
+
+    post = ChangePointFilter(GD, ChangePointSettings(prior=log_prior)).posterior()
+    assert post.mean("GD") == pytest.approx(300, abs=10) and post.prob_above("GD", 460) == 0
+    with pytest.raises(ControlError, match="must return 121 log densities"):
+        ChangePointFilter(GD, ChangePointSettings(prior=lambda gd: 0.0))
+    with pytest.raises(ControlError, match="finite somewhere"):
+        ChangePointFilter(GD, ChangePointSettings(prior=lambda gd: np.full(gd.size, -np.inf)))
+
+
 def test_steady_blocks_pool_and_the_mass_stays_normalised():
     f = ChangePointFilter(GD)
     sds = []

@@ -13,6 +13,7 @@ def road():
     return road_data()
 
 
+@pytest.mark.filterwarnings("ignore::gpmsa.ConvergenceWarning")  # short chains on purpose
 @pytest.mark.parametrize(("fit_with", "calibrate_with"), [("torch", "numpy"), ("numpy", "torch")])
 def test_fit_save_load_calibrate_across_backends(road, tmp_path, fit_with, calibrate_with):
     sim, obs = road

@@ -248,6 +248,7 @@ def test_bad_settings_and_emulators():
         cal.update(*road_obs())  # valid input: no warning
 
 
+@pytest.mark.filterwarnings("ignore::gpmsa.errors.OutsideEmulatorWarning")  # f spans far out
 def test_evidence_is_a_normalised_density_of_the_observation():
     """exp(log_evidence) as a function of f_obs integrates to one: every normalising constant
     (theta prior, lamOs prior and its integral, the Gaussian) is accounted for."""
@@ -273,6 +274,7 @@ def test_mcmc_with_extra_prior_matches_grid():
     assert abs(mc.sd("GD") - grid.sd("GD")) < tol_sd
 
 
+@pytest.mark.filterwarnings("ignore::gpmsa.ConvergenceWarning")  # 2 x 500 draws: R-hat ~1.01
 def test_discrepancy_runs_on_the_backend_and_chains_pool():
     emu = road_emulator()
     x, y = [[1.0], [1.25], [1.5]], [[7.5], [12.1], [16.0]]

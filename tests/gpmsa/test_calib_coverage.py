@@ -1,6 +1,7 @@
 """Calibration of the uncertainty: 90% intervals cover the truth 85-95% of the time."""
 
 import numpy as np
+import pytest
 from _calib_cases import road_emulator
 
 from gpmsa import Calibrator
@@ -9,6 +10,7 @@ from gpmsa.calibration.observations import fixed_gp
 N_OBS = 300
 
 
+@pytest.mark.filterwarnings("ignore::gpmsa.errors.OutsideEmulatorWarning")  # 1 in 300 draws
 def test_intervals_cover_truth_drawn_from_the_model():
     """Truth (GD, lamOs) from the priors, the observation from the emulator's own predictive."""
     emu = road_emulator()

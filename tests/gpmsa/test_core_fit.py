@@ -20,7 +20,9 @@ def small_sim():
 
 
 def test_sim_only_fit_gives_emulator_with_draws_and_diagnostics(small_sim):
-    emu = gpmsa.fit(small_sim, n_iter=400, n_chains=2, seed=3, tune=False, n_keep=100)
+    with pytest.warns(gpmsa.ConvergenceWarning, match="2 chains x 320 draws"):  # short chains
+        emu = gpmsa.fit(small_sim, n_iter=400, n_chains=2, seed=3, tune=False, n_keep=100)
+    assert emu.convergence["n_chains"] == 2 and not emu.convergence["converged"]
     assert emu.settings["thin"] == 7  # ceil(2 chains * 320 kept / 100)
     assert emu.n_draws == 2 * len(range(0, 320, 7)) <= 100
     assert set(emu.draws) == {"betaU", "lamUz", "lamWs", "lamWOs"}

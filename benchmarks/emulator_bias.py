@@ -1,0 +1,329 @@
+"""Does the shipped band emulator have a bias anywhere in its domain, edges included?
+
+    PYTHONPATH=. python benchmarks/emulator_bias.py             # 63 cells x 3 roads x 60 s
+    PYTHONPATH=. python benchmarks/emulator_bias.py --quick     # 63 cells x 1 road x 60 s
+    PYTHONPATH=. python benchmarks/emulator_bias.py --help
+
+On held-aside roads (a campaign seed whose road seeds are not among the training campaign's,
+checked), the Jackal drives k roads (``--roads``) for ``--keep-s`` seconds at constant speed in
+each cell of the grid v in {0.5, 0.75, ..., 2.0} m/s x GD in {200, 250, ..., 600}, through the
+training pipeline itself (`vehicle.run_campaign`: `roadgen.iso8608_profile` roads with the same
+lead-in and `vehicle.simulate`; case A: noise-free accelerations, case B: with N(0, 1) noise).
+
+Band emulator (``control.shipped_emulator(case, "band")``, the change-point BCR's): every
+125-sample block's log band-power vector (`control.block_features`); per cell
+
+- ``z``: per band, (mean over the cell's blocks - ``emu.predict(v, GD, resid=False)``) in units
+  of its Monte-Carlo standard error (the cell's long-run block variance, batch means of 8
+  blocks as `control.training`, over the number of blocks);
+- ``chi2``: d' (Sigma(v) / n)^-1 d over the 8 bands with the emulator's own block scatter Sigma(v)
+  (its metadata), and its chi-square(8) upper-tail probability ``p``; ``var`` is the cell's
+  long-run block variance over Sigma(v)'s, averaged over bands (1 when the scatter the
+  likelihood assumes is right);
+- ``GD bias``: the maximum-likelihood GD of all the cell's blocks pooled
+  (`control.ObservationModel.loglik` summed over the blocks, on an 801-node log grid refined by a
+  parabola) relative to the truth, %, with its Monte-Carlo standard error from a block bootstrap
+  (400 resamples of batches of 8 consecutive blocks);
+- ``lin``: the same bias linearised at the truth, exp(g' S^-1 d / g' S^-1 g) - 1 with
+  g = d mu / d log GD of the emulator and S = Sigma(v), with its standard error from the cell's
+  long-run covariance: not truncated by the domain's edges (the ML at GD 200 and 600 is).
+
+Window emulator (``shipped_emulator(case, "window")``, the paper's): log f of disjoint 1,000-sample
+windows (7 per minute of driving); ``z`` of the mean against ``emu.predict(v, GD)``'s mean in
+units of its standard error (window sd / sqrt(n)), ``sd``: the windows' sd over the emulator's
+predictive sd (nugget included; 1 when the paper's likelihood has the right width), the GD
+bias: the maximum-likelihood GD of all the cell's windows under the Gaussian likelihood
+N(mean(v, GD), var(v, GD)) of ``emu.predict`` with its nugget, with a bootstrap over windows,
+and its linearised form (d / slope).
+
+Printed (with the load average): per case and emulator, a line per cell, then a table (rows GD,
+columns v) of the relative GD bias in %, marked ``*`` where it exceeds twice its Monte-Carlo
+standard error (about 3 of 63 cells by chance alone) and ``|`` where the maximum lies on the
+domain's edge (200 or 600: a truncated, one-sided estimate), the same for the linearised bias,
+and RMS figures (a bias beyond Monte-Carlo noise shows as an RMS bias above the RMS se).
+Campaign runs are cached under ``--cache-dir``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+import control
+import vehicle
+from control.training import block_statistics
+
+SPEEDS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0)
+GDS = (200.0, 250.0, 300.0, 350.0, 400.0, 450.0, 500.0, 550.0, 600.0)
+RATE_HZ = 120.0
+WINDOW = 1000
+BATCH = 8  # blocks per batch of the long-run covariance and of the block bootstrap
+N_GRID = 801
+N_BOOT = 400
+
+
+def load() -> str:
+    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+
+
+def training_seeds(emu) -> np.ndarray:
+    """Road seeds of the campaign the shipped emulators were trained on (its metadata's seed)."""
+    design = emu.metadata["design"]
+    return np.random.SeedSequence(int(design["seed"])).generate_state(int(design["n"]))
+
+
+def drive(roads: int, keep_s: float, seed: int, workers: int, cache_dir: str | None):
+    """The campaign: every grid cell driven on `roads` fresh roads."""
+    design = np.array([(v, gd) for v in SPEEDS for gd in GDS for _ in range(roads)])
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        return vehicle.run_campaign(
+            design, seed=seed, keep_s=keep_s, executor=pool, progress=False, cache_dir=cache_dir
+        )
+
+
+def scatter_at(scatter: control.BlockScatter, v: float) -> np.ndarray:
+    """Sigma(v) (K, K): the block scatter interpolated linearly in speed, as the likelihood does."""
+    flat = scatter.cov.reshape(scatter.speed.size, -1)
+    cols = [np.interp(v, scatter.speed, flat[:, k]) for k in range(flat.shape[1])]
+    return np.array(cols).reshape(scatter.cov.shape[1:])
+
+
+def max_likelihood(loglik: np.ndarray, log_gd: np.ndarray) -> tuple[float, bool]:
+    """(GD at the maximum of loglik on the grid, refined by a parabola; at the grid's edge?)."""
+    i = int(np.argmax(loglik))
+    if i == 0 or i == log_gd.size - 1:
+        return float(np.exp(log_gd[i])), True
+    a, b, c = loglik[i - 1 : i + 2]
+    den = a - 2 * b + c
+    step = 0.5 * (a - c) / den if den < 0 else 0.0
+    return float(np.exp(log_gd[i] + step * (log_gd[1] - log_gd[0]))), False
+
+
+def ml_with_bootstrap(parts: np.ndarray, log_gd, rng) -> tuple[float, float, bool]:
+    """(relative-to-1 GD at the ML of the summed parts, bootstrap SE of it, at the edge) where
+    ``parts`` (n, G) are log-likelihoods of resampling units (batches of blocks, windows)."""
+    gd_ml, edge = max_likelihood(parts.sum(axis=0), log_gd)
+    boot = [
+        max_likelihood(parts[rng.integers(0, len(parts), len(parts))].sum(axis=0), log_gd)[0]
+        for _ in range(N_BOOT)
+    ]
+    return gd_ml, float(np.std(boot)), edge
+
+
+@dataclass
+class Cell:
+    """One cell's result (``z``: per output; bias and se relative, e.g. 0.05 = 5%)."""
+
+    v: float
+    gd: float
+    z: np.ndarray
+    chi2: float
+    p: float
+    spread: float  # var ratio (band) or sd ratio (window)
+    bias: float
+    se: float
+    edge: bool
+    lin: float
+    lin_se: float
+
+    @property
+    def mark(self) -> str:
+        return ("*" if abs(self.bias) > 2 * self.se else " ") + ("|" if self.edge else " ")
+
+    @property
+    def lin_mark(self) -> str:
+        return "*" if abs(self.lin) > 2 * self.lin_se else " "
+
+
+def slope(emu, v: float, gd: float, h: float = 0.02) -> np.ndarray:
+    """d mean / d log GD (K,) of ``emu.predict`` at (v, GD), central within the domain."""
+    lo, hi = emu.domain["GD"]
+    a, b = max(gd * np.exp(-h), lo), min(gd * np.exp(h), hi)
+    mean, _ = emu.predict([v, v], [a, b], resid=False)
+    return (mean[1] - mean[0]) / np.log(b / a)
+
+
+def linearised(d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray):
+    """(relative GD bias, its se) of the weighted least-squares step g' W d / (g' W g) in
+    log GD, W = the likelihood's inverse covariance, cov_d the covariance of d."""
+    wg = w @ g
+    den = float(g @ wg)
+    step = float(wg @ d) / den
+    return float(np.expm1(step)), float(np.sqrt(wg @ cov_d @ wg) / den * np.exp(step))
+
+
+def band_cells(case: str, c, rng) -> list[Cell]:
+    emu = control.shipped_emulator(case, "band")
+    om = control.ObservationModel(emu, n_grid=N_GRID)
+    v_hi = om.speed_range[1]
+    log_gd = np.log(om.gd)
+    accel = c.accel if case == "A" else c.accel_measured
+    spec = control.FeatureSpec()
+    out = []
+    for v in SPEEDS:
+        sigma = scatter_at(om.scatter, v)
+        for gd in GDS:
+            runs = np.flatnonzero(c.ok & (c.v == v) & (c.gd == gd))
+            st = block_statistics(accel[runs], spec, batch=BATCH)
+            n_batch = st.features.shape[1] // BATCH
+            feats = st.features[:, : n_batch * BATCH].reshape(-1, spec.dim)
+            n = feats.shape[0]
+            mu, _ = emu.predict([min(v, v_hi)], [gd], resid=False)
+            d = feats.mean(axis=0) - mu[0]
+            cell_cov = st.cov.mean(axis=0)
+            z = d / np.sqrt(np.diag(cell_cov) / n)
+            chi2 = float(d @ np.linalg.solve(sigma / n, d))
+            loglik = np.array([om.loglik(y, v) for y in feats])  # (n, G)
+            parts = loglik.reshape(-1, BATCH, loglik.shape[1]).sum(axis=1)
+            gd_ml, se, edge = ml_with_bootstrap(parts, log_gd, rng)
+            g = slope(emu, min(v, v_hi), gd)
+            lin = linearised(d, g, np.linalg.inv(sigma), cell_cov / n)
+            out.append(
+                Cell(v, gd, z, chi2, float(stats.chi2.sf(chi2, spec.dim)),
+                     float(np.mean(np.diag(cell_cov) / np.diag(sigma))), gd_ml / gd - 1,
+                     se / gd, edge, *lin)
+            )  # fmt: skip
+    return out
+
+
+def window_cells(case: str, c, rng) -> list[Cell]:
+    emu = control.shipped_emulator(case, "window")
+    v_hi, (g_lo, g_hi) = emu.domain["v"][1], emu.domain["GD"]
+    gd_grid = np.geomspace(g_lo, g_hi, N_GRID)
+    log_gd = np.log(gd_grid)
+    accel = c.accel if case == "A" else c.accel_measured
+    out = []
+    for v in SPEEDS:
+        v_in = min(v, v_hi)
+        mean_g, var_g = emu.predict(np.full(N_GRID, v_in), gd_grid)  # nugget included
+        for gd in GDS:
+            runs = np.flatnonzero(c.ok & (c.v == v) & (c.gd == gd))
+            n_win = accel.shape[1] // WINDOW
+            windows = accel[runs, : n_win * WINDOW].reshape(-1, WINDOW)
+            y = np.array([control.window_feature(w, "log_var") for w in windows])
+            mu, var = emu.predict([v_in], [gd])
+            z = (y.mean() - mu[0, 0]) / (y.std(ddof=1) / np.sqrt(y.size))
+            loglik = -0.5 * (y[:, None] - mean_g[None, :, 0]) ** 2 / var_g[
+                None, :, 0
+            ] - 0.5 * np.log(var_g[None, :, 0])
+            gd_ml, se, edge = ml_with_bootstrap(loglik, log_gd, rng)
+            lin = linearised(
+                np.array([y.mean() - mu[0, 0]]), slope(emu, v_in, gd), np.eye(1),
+                np.array([[y.var(ddof=1) / y.size]]),
+            )  # fmt: skip
+            out.append(
+                Cell(v, gd, np.array([z]), float(z**2), float(stats.chi2.sf(z**2, 1)),
+                     float(y.std(ddof=1) / np.sqrt(var[0, 0])), gd_ml / gd - 1, se / gd, edge,
+                     *lin)
+            )  # fmt: skip
+    return out
+
+
+def print_cells(title: str, cells: list[Cell], band: bool) -> None:
+    print(f"\n{title} ({load()})")
+    if band:
+        zs = "".join(f"{'z' + str(k + 1):>6}" for k in range(cells[0].z.size))
+        head = f"{'v':>5}{'GD':>5} {zs} {'chi2':>7}{'p':>8}{'var':>6}"
+    else:
+        head = f"{'v':>5}{'GD':>5} {'z':>6} {'p':>8}{'sd':>6}"
+    print(head + f" {'GD bias %':>10}{'se %':>6} {'lin %':>7}{'se %':>6}")
+    for cell in cells:
+        zs = "".join(f"{z:6.1f}" for z in cell.z)
+        mid = f" {cell.chi2:7.1f}{cell.p:8.1e}" if band else f"{cell.p:9.1e}"
+        print(
+            f"{cell.v:5.2f}{cell.gd:5.0f} {zs}{mid}{cell.spread:6.2f} "
+            f"{100 * cell.bias:+9.1f}{cell.mark}{100 * cell.se:5.1f} "
+            f"{100 * cell.lin:+6.1f}{cell.lin_mark}{100 * cell.lin_se:5.1f}"
+        )
+    print("\nrelative GD bias, % (* > 2 se; | maximum on the domain's edge); rows GD, columns v")
+    print(f"{'GD':>5} " + "".join(f"{v:>9.2f}" for v in SPEEDS))
+    for gd in GDS:
+        row = [c for c in cells if c.gd == gd]
+        print(f"{gd:5.0f} " + "".join(f"{100 * c.bias:+7.1f}{c.mark}" for c in row))
+    print("linearised (not truncated at the edges), % (* > 2 se)")
+    for gd in GDS:
+        row = [c for c in cells if c.gd == gd]
+        print(f"{gd:5.0f} " + "".join(f"{100 * c.lin:+7.1f}{c.lin_mark} " for c in row))
+    flagged = sum(abs(c.bias) > 2 * c.se for c in cells)
+    flagged_lin = sum(abs(c.lin) > 2 * c.lin_se for c in cells)
+    inner = [c for c in cells if 200 < c.gd < 600]
+
+    def rms(x) -> float:
+        return 100 * float(np.sqrt(np.mean(np.square(x))))
+
+    print(
+        f"ML: {flagged} of {len(cells)} cells beyond 2 se (about {0.0455 * len(cells):.0f} by "
+        f"chance); over GD 250-550, RMS bias {rms([c.bias for c in inner]):.1f}% against RMS se "
+        f"{rms([c.se for c in inner]):.1f}%"
+    )
+    print(
+        f"linearised: {flagged_lin} of {len(cells)} cells beyond 2 se; RMS bias "
+        f"{rms([c.lin for c in cells]):.1f}% against RMS se {rms([c.lin_se for c in cells]):.1f}%"
+        f" (all cells); per speed "
+        + ", ".join(f"{v:g}: {rms([c.lin for c in cells if c.v == v]):.1f}%" for v in SPEEDS)
+    )
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--quick", action="store_true", help="one road per cell instead of --roads (63 drives)"
+    )
+    parser.add_argument("--roads", type=int, default=3, help="roads driven per cell (full run)")
+    parser.add_argument("--keep-s", type=float, default=60.0, help="seconds of driving per road")
+    parser.add_argument(
+        "--seed", type=int, default=31337,
+        help="campaign seed of the held-aside roads (their seeds are checked against training)",
+    )  # fmt: skip
+    parser.add_argument("--boot-seed", type=int, default=0, help="seed of the bootstraps")
+    parser.add_argument(
+        "--workers", type=int, default=2, help="worker processes of the drives (at most 2 here)"
+    )
+    parser.add_argument(
+        "--cache-dir", default="out/bench_campaigns",
+        help="folder caching the drives ('' for none)",
+    )  # fmt: skip
+    args = parser.parse_args(argv)
+    roads = 1 if args.quick else args.roads
+    if roads < 1 or args.keep_s < 2 * BATCH * 125 / RATE_HZ:
+        parser.error("need --roads >= 1 and --keep-s long enough for two batches of 8 blocks")
+
+    tic = time.perf_counter()
+    c = drive(roads, args.keep_s, args.seed, args.workers, args.cache_dir or None)
+    train = training_seeds(control.shipped_emulator("A", "band"))
+    overlap = np.intersect1d(c.seed, train)
+    if overlap.size:
+        raise SystemExit(f"road seeds {overlap} were in the training campaign: use another --seed")
+    print(
+        f"{c.v.size} drives ({len(SPEEDS)} x {len(GDS)} cells x {roads} roads x {args.keep_s:g} s, "
+        f"campaign seed {args.seed}; none of the {train.size} training road seeds) in "
+        f"{time.perf_counter() - tic:.0f} s; {int(np.sum(~c.ok))} failed; {load()}"
+    )
+    if not c.ok.all():
+        for v, gd, s in zip(c.v[~c.ok], c.gd[~c.ok], c.status[~c.ok], strict=True):
+            print(f"  failed: v={v:g} GD={gd:g}: {s}")
+    rng = np.random.default_rng(args.boot_seed)
+    for case in ("A", "B"):
+        noise = "noise-free" if case == "A" else "N(0, 1) noise"
+        print_cells(
+            f"band emulator, case {case} ({noise}): per cell, z per band (bands 1.5-4.5, 4.5-7, "
+            "7-10, 10-14, 14-20, 20-30, 30-45, 45-60 Hz)",
+            band_cells(case, c, rng),
+            band=True,
+        )
+        print_cells(
+            f"window emulator (paper's log f of 1,000 samples), case {case} ({noise})",
+            window_cells(case, c, rng),
+            band=False,
+        )
+    print(f"\ntotal {time.perf_counter() - tic:.0f} s; {load()}")
+
+
+if __name__ == "__main__":
+    main()

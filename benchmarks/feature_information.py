@@ -1,0 +1,491 @@
+"""Which observation of a block of accelerations carries the most information about GD per second.
+
+    PYTHONPATH=. python benchmarks/feature_information.py             # 2 x 198 runs x 60 s
+    PYTHONPATH=. python benchmarks/feature_information.py --quick     # 2 x 60 runs x 30 s
+    PYTHONPATH=. python benchmarks/feature_information.py --help
+
+Features of one block of B samples of front-axle vertical acceleration (120 Hz), B in
+{125, 250, 500, 1000}, with and without N(0, 1) sensor noise:
+
+- ``log_var``: log f, f = var of the block (the paper's feature, eq. 5; B = 1000 is the paper's);
+- ``log_pgram``: the mean log periodogram (Hann window) over the bins in [1.5, 60] Hz;
+- ``whittle``: log c_hat, c_hat = mean_j I(f_j) / S_ref(f_j; v), the maximum-likelihood (Whittle)
+  scale of a reference spectrum S_ref: the average periodogram of the training runs near speed v,
+  each rescaled to GD_ref = 400 (Gaussian kernel weights in speed, bandwidth 0.15 m/s, and in
+  log GD about GD_ref, bandwidth 0.3; a training run's own blocks are left out of its reference);
+- ``bands``: the log band-power vector of `control.block_features` with
+  ``FeatureSpec(block_samples=B)`` (8 bands 1.5-60 Hz, DPSS NW = 2, 3 tapers), multivariate.
+
+Method (held out): two independent campaigns (`vehicle.run_campaign`, Latin hypercube over v in
+[0.5, 2] m/s and GD in [200, 600], other seeds), one for training and one for testing. On the
+training campaign, per feature and B, the mean of each output is a cubic polynomial in
+(log v, log GD) fitted by least squares to the runs' mean features, and the block-to-block
+covariance Sigma(v) is the long-run covariance (batch means over 1,000 samples, as
+`control.training`) averaged with Gaussian kernel weights in speed (bandwidth 0.15 m/s). On each
+test run with GD in [250, 550] (the prior truncates estimates near the domain's edges; the
+tables use only runs away from them) the blocks of T seconds of driving (T = 500, 1,000 and 2,000
+samples: 4.2, 8.3, 16.7 s; disjoint stretches, as many as the run holds) are pooled into a
+Gaussian likelihood on a grid of log GD with a flat prior on [log 200, log 600].
+
+Printed (with the load average): per noise case, feature and B, for each T the information per
+second J = 1 / (RMSE^2 T) of the posterior-mean log GD (with its bootstrap standard error over
+test runs), the RMSE in log GD and the coverage of the central 90% interval; J_fit, the
+information per second the fitted model itself claims (Fisher information of the cubic mean under
+Sigma(v), averaged over the test runs as 1 / mean(1 / I)); the ratio of each J to that of log f at
+B = 1000 (the paper's); lack of fit (mean over training runs of the squared standardised
+residual of the run mean about the cubic, per output; 1 when the cubic and Sigma explain the run
+means); per speed band (v < 1, 1-1.5, > 1.5 m/s) J at T = 8.3 s. The prior alone (posterior mean
+= prior mean) has the RMSE printed as ``prior-only``: a J near 1 / (that^2 T) is the prior's, not
+the feature's.
+
+Campaign runs are cached under ``--cache-dir`` (keyed by their settings), so a second call only
+recomputes the features (a few seconds).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve
+from scipy.signal.windows import hann
+
+import vehicle
+from control import FeatureSpec, block_features
+
+RATE_HZ = 120.0
+V_RANGE = (0.5, 2.0)
+GD_RANGE = (200.0, 600.0)
+BLOCKS = (125, 250, 500, 1000)
+FEATURES = ("log_var", "log_pgram", "whittle", "bands")
+SPANS = (500, 1000, 2000)  # samples of driving pooled per estimate
+PAPER = ("log_var", 1000)
+BAND_HZ = (1.5, 60.0)
+GD_REF = 400.0
+SPEED_BW = 0.15  # m/s, kernel bandwidth of Sigma(v) and S_ref
+LOG_GD_BW = 0.3  # kernel bandwidth of S_ref in log GD
+BATCH_SAMPLES = 1000  # samples per batch of the long-run covariance
+SPEED_BANDS = ((0.0, 1.0, "v<1"), (1.0, 1.5, "1-1.5"), (1.5, 9.9, "v>1.5"))
+N_GRID = 401
+
+
+def lhs(n: int, seed: int) -> np.ndarray:
+    """(n, 2) Latin-hypercube design [v, GD] over the paper's domain."""
+    return vehicle.lhs_design(n, V_RANGE, GD_RANGE, seed=seed)
+
+
+def campaign(n: int, keep_s: float, seed: int, workers: int, cache_dir: str | None):
+    """A campaign of n runs keeping keep_s seconds of accelerations (failed runs left out)."""
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        c = vehicle.run_campaign(
+            lhs(n, seed), seed=seed, keep_s=keep_s, executor=pool, progress=False,
+            cache_dir=cache_dir,
+        )  # fmt: skip
+    ok = c.ok & np.all(np.isfinite(c.accel_measured), axis=1)
+    return c.v[ok], c.gd[ok], {"A": c.accel[ok], "B": c.accel_measured[ok]}
+
+
+# --- features ------------------------------------------------------------------------------------
+
+
+def blocks_of(accel: np.ndarray, B: int) -> np.ndarray:
+    """(runs, n_blocks, B) disjoint blocks of each run."""
+    n = accel.shape[1] // B
+    return accel[:, : n * B].reshape(accel.shape[0], n, B)
+
+
+def periodogram(blocks: np.ndarray) -> np.ndarray:
+    """Hann-windowed one-sided periodogram (.., bins in BAND_HZ), (m/s^2)^2/Hz."""
+    B = blocks.shape[-1]
+    w = hann(B, sym=False)
+    x = (blocks - blocks.mean(axis=-1, keepdims=True)) * w
+    f = np.fft.rfftfreq(B, 1.0 / RATE_HZ)
+    sel = (f >= BAND_HZ[0]) & (f <= BAND_HZ[1])
+    return 2.0 * np.abs(np.fft.rfft(x, axis=-1)[..., sel]) ** 2 / (RATE_HZ * np.sum(w**2))
+
+
+def kernel(v_eval: np.ndarray, v_runs: np.ndarray) -> np.ndarray:
+    """(n_eval, n_runs) Gaussian weights in speed (rows unnormalised)."""
+    return np.exp(-0.5 * ((v_eval[:, None] - v_runs[None, :]) / SPEED_BW) ** 2)
+
+
+def reference_spectrum(v_eval, v_train, gd_train, mean_pgram, leave_out: bool) -> np.ndarray:
+    """S_ref(f; v) (n_eval, bins): training runs' mean periodograms rescaled to GD_REF, kernel
+    weighted in speed and in log GD about GD_REF (the evaluated run itself left out)."""
+    w = kernel(v_eval, v_train) * np.exp(-0.5 * (np.log(gd_train / GD_REF) / LOG_GD_BW) ** 2)
+    if leave_out:
+        np.fill_diagonal(w, 0.0)
+    scaled = mean_pgram * (GD_REF / gd_train)[:, None]
+    return (w @ scaled) / w.sum(axis=1, keepdims=True)
+
+
+def features(blocks: np.ndarray, B: int, pgram: np.ndarray, s_ref: np.ndarray | None):
+    """{name: (runs, n_blocks, K)} of every feature."""
+    out = {
+        "log_var": np.log(np.var(blocks, axis=-1))[..., None],
+        "log_pgram": np.mean(np.log(pgram), axis=-1)[..., None],
+        "bands": block_features(blocks.reshape(-1, B), FeatureSpec(block_samples=B)).reshape(
+            *blocks.shape[:2], -1
+        ),
+    }
+    if s_ref is not None:
+        out["whittle"] = np.log(np.mean(pgram / s_ref[:, None, :], axis=-1))[..., None]
+    return out
+
+
+# --- the model: cubic mean, kernel-weighted long-run covariance -----------------------------------
+
+
+def poly(log_v: np.ndarray, log_gd: np.ndarray) -> np.ndarray:
+    """(n, 10) cubic monomials of (log v, log GD), centred and scaled to [-1, 1]."""
+    a = (log_v - np.log(1.0)) / np.log(2.0)
+    b = (log_gd - np.log(346.4)) / np.log(3.0) * 2
+    return np.stack([a**i * b**j for i in range(4) for j in range(4 - i)], axis=-1)
+
+
+def dpoly_dlog_gd(log_v: np.ndarray, log_gd: np.ndarray) -> np.ndarray:
+    """(n, 10) derivative of `poly` with respect to log GD."""
+    a = (log_v - np.log(1.0)) / np.log(2.0)
+    b = (log_gd - np.log(346.4)) / np.log(3.0) * 2
+    s = 2 / np.log(3.0)
+    cols = [
+        (j * a**i * b ** max(j - 1, 0) * s) if j else np.zeros_like(a)
+        for i in range(4)
+        for j in range(4 - i)
+    ]
+    return np.stack(cols, axis=-1)
+
+
+def long_run_cov(feats: np.ndarray, batch: int) -> np.ndarray:
+    """(runs, K, K) long-run covariance per run: batch means of `batch` consecutive blocks."""
+    dev = feats - feats.mean(axis=1, keepdims=True)
+    n_batch = feats.shape[1] // batch
+    means = dev[:, : n_batch * batch].reshape(feats.shape[0], n_batch, batch, -1).mean(axis=2)
+    return np.einsum("rbi,rbj->rij", means, means) / (n_batch - 1) * batch
+
+
+@dataclass
+class Model:
+    """Fitted mean (cubic coefficients (10, K)) and per-run covariances for Sigma(v)."""
+
+    coef: np.ndarray
+    v_train: np.ndarray
+    cov_train: np.ndarray
+    lack_of_fit: float
+
+    def sigma(self, v: np.ndarray) -> np.ndarray:
+        """(n, K, K) kernel-weighted long-run covariance at speeds v."""
+        w = kernel(np.atleast_1d(v), self.v_train)
+        w /= w.sum(axis=1, keepdims=True)
+        return np.einsum("sr,rij->sij", w, self.cov_train)
+
+    def mean(self, v: float, log_gd: np.ndarray) -> np.ndarray:
+        """(G, K) mean feature at speed v on the log-GD grid."""
+        return poly(np.full(log_gd.size, np.log(v)), log_gd) @ self.coef
+
+
+def fit(v: np.ndarray, gd: np.ndarray, feats: np.ndarray, batch: int) -> Model:
+    """Least-squares cubic mean of the runs' mean features; per-run long-run covariances."""
+    X = poly(np.log(v), np.log(gd))
+    run_mean = feats.mean(axis=1)
+    coef, *_ = np.linalg.lstsq(X, run_mean, rcond=None)
+    cov = long_run_cov(feats, batch)
+    model = Model(coef, v, cov, np.nan)
+    resid = run_mean - X @ coef
+    sig = model.sigma(v) / feats.shape[1]
+    d2 = [r @ np.linalg.solve(s, r) for r, s in zip(resid, sig, strict=True)]
+    dof = 1.0 - X.shape[1] / v.size  # residuals of a least-squares fit are smaller
+    model.lack_of_fit = float(np.mean(d2) / feats.shape[2] / dof)
+    return model
+
+
+# --- held-out estimates ---------------------------------------------------------------------------
+
+
+@dataclass
+class Scores:
+    """Per estimate (one stretch of T seconds): error of the posterior-mean log GD, interval
+    covered, error of the linearised estimate (see `estimates`), run index, speed."""
+
+    err: np.ndarray
+    covered: np.ndarray
+    err_lin: np.ndarray
+    run: np.ndarray
+    speed: np.ndarray
+
+    def subset(self, sel: np.ndarray) -> Scores:
+        return Scores(*(getattr(self, k)[sel] for k in self.__dataclass_fields__))
+
+
+def estimates(model: Model, v, gd, feats: np.ndarray, per: int, log_grid) -> Scores:
+    """Estimates of log GD from each stretch of ``per`` blocks of each run.
+
+    The posterior (flat prior on ``log_grid``) gives the posterior mean and the 90% interval.
+    The linearised estimate is the generalised-least-squares step from the truth,
+    g' S^-1 (y_bar - mu(log GD_true)) / (g' S^-1 g), g = d mu / d log GD: no prior and no grid
+    bounds, so its error measures the information the feature holds (and the fit's bias), not
+    the prior's.
+    """
+    err, cov, lin, run, spd = [], [], [], [], []
+    n_seg = feats.shape[1] // per
+    for r in range(v.size):
+        mu = model.mean(float(v[r]), log_grid)  # (G, K)
+        chol = cho_factor(model.sigma(v[r])[0], lower=True)
+        y = feats[r, : n_seg * per]  # (n, K)
+        dev = y[:, None, :] - mu[None, :, :]  # (n, G, K)
+        white = cho_solve(chol, dev.reshape(-1, dev.shape[2]).T).T.reshape(dev.shape)
+        d2 = np.einsum("ngk,ngk->ng", dev, white)
+        loglik = -0.5 * d2.reshape(n_seg, per, -1).sum(axis=1)  # (n_seg, G)
+        post = np.exp(loglik - loglik.max(axis=1, keepdims=True))
+        post /= post.sum(axis=1, keepdims=True)
+        mean = post @ log_grid
+        cdf = np.cumsum(post, axis=1)
+        lo = log_grid[np.argmax(cdf >= 0.05, axis=1)]
+        hi = log_grid[np.argmax(cdf >= 0.95, axis=1)]
+        truth = np.log(gd[r])
+        g = dpoly_dlog_gd(np.log(v[r : r + 1]), np.array([truth]))[0] @ model.coef  # (K,)
+        s_g = cho_solve(chol, g)
+        ybar = y.reshape(n_seg, per, -1).mean(axis=1)
+        mu_true = poly(np.log(v[r : r + 1]), np.array([truth]))[0] @ model.coef
+        err.append(mean - truth)
+        cov.append((lo <= truth) & (truth <= hi))
+        lin.append((ybar - mu_true) @ s_g / (g @ s_g))
+        run.append(np.full(n_seg, r))
+        spd.append(np.full(n_seg, v[r]))
+    return Scores(*(np.concatenate(a) for a in (err, cov, lin, run, spd)))
+
+
+def fisher_j(model: Model, v, gd, B: int) -> float:
+    """Information per second about log GD the fitted model claims, g' Sigma^-1 g / block
+    duration, median over the runs (v, GD)."""
+    g = dpoly_dlog_gd(np.log(v), np.log(gd)) @ model.coef  # (n, K)
+    sig = model.sigma(v)
+    info = np.array([d @ np.linalg.solve(s, d) for d, s in zip(g, sig, strict=True)])
+    return float(np.median(info * RATE_HZ / B))
+
+
+MEDIAN_CHI2_1 = 0.4549364  # median of a chi-square(1) variable
+
+
+def info_per_s(s: Scores, t_s: float, rng: np.random.Generator, n_boot: int = 300) -> dict:
+    """J (1/(RMSE^2 T)) with its bootstrap SE over test runs, RMSE, coverage, and J_lin: the
+    information per second of the linearised estimate, robust (from the median squared error,
+    so that a few runs where a feature's slope vanishes do not dominate), with its SE."""
+
+    def j_of(e):
+        return 1.0 / (np.mean(e**2) * t_s)
+
+    def jlin_of(e):
+        return MEDIAN_CHI2_1 / (np.median(e**2) * t_s)
+
+    runs = np.unique(s.run)
+    idx = [np.flatnonzero(s.run == r) for r in runs]
+    boot = []
+    for _ in range(n_boot):
+        pick = np.concatenate([idx[i] for i in rng.integers(0, runs.size, runs.size)])
+        boot.append((j_of(s.err[pick]), jlin_of(s.err_lin[pick])))
+    boot = np.array(boot)
+    return {
+        "J": j_of(s.err),
+        "se": float(np.std(boot[:, 0])),
+        "rmse": float(np.sqrt(np.mean(s.err**2))),
+        "cov": float(np.mean(s.covered)),
+        "Jlin": jlin_of(s.err_lin),
+        "se_lin": float(np.std(boot[:, 1])),
+    }
+
+
+def load() -> str:
+    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="small campaigns (60 runs x 30 s each) for a first look",
+    )
+    parser.add_argument(
+        "--n-runs", type=int, default=None, help="runs per campaign (default 198; --quick: 60)"
+    )
+    parser.add_argument(
+        "--keep-s",
+        type=float,
+        default=None,
+        help="seconds of driving kept per run (default 60; --quick: 30)",
+    )
+    parser.add_argument(
+        "--train-seed",
+        type=int,
+        default=101,
+        help="seed of the training campaign's design, roads and noise",
+    )
+    parser.add_argument(
+        "--test-seed",
+        type=int,
+        default=202,
+        help="seed of the test campaign (must differ from --train-seed)",
+    )
+    parser.add_argument(
+        "--gd-band",
+        type=float,
+        nargs=2,
+        default=(250.0, 550.0),
+        help="test runs scored: GD in this range (away from the prior's edges)",
+    )
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=2,
+        help="worker processes of the campaigns (at most 2 on a shared machine)",
+    )
+    parser.add_argument(
+        "--cache-dir",
+        default="out/bench_campaigns",
+        help="folder caching the campaign runs ('' for none)",
+    )
+    parser.add_argument("--seed", type=int, default=0, help="seed of the bootstrap")
+    args = parser.parse_args(argv)
+    if args.train_seed == args.test_seed:
+        parser.error("--train-seed and --test-seed must differ (held-out test)")
+    n_runs = args.n_runs or (60 if args.quick else 198)
+    keep_s = args.keep_s or (30.0 if args.quick else 60.0)
+    cache = args.cache_dir or None
+
+    tic = time.perf_counter()
+    v_tr, gd_tr, acc_tr = campaign(n_runs, keep_s, args.train_seed, args.workers, cache)
+    v_te, gd_te, acc_te = campaign(n_runs, keep_s, args.test_seed, args.workers, cache)
+    print(f"campaigns: {v_tr.size} training + {v_te.size} test runs of {keep_s:g} s "
+          f"(seeds {args.train_seed}, {args.test_seed}) in {time.perf_counter() - tic:.0f} s; "
+          f"{load()}")  # fmt: skip
+    scored = (gd_te >= args.gd_band[0]) & (gd_te <= args.gd_band[1])
+    v_s, gd_s = v_te[scored], gd_te[scored]
+    log_grid = np.linspace(np.log(GD_RANGE[0]), np.log(GD_RANGE[1]), N_GRID)
+    prior_rmse = float(np.sqrt(np.mean((log_grid.mean() - np.log(gd_s)) ** 2)))
+    print(f"scored test runs: {scored.sum()} with GD in [{args.gd_band[0]:g}, "
+          f"{args.gd_band[1]:g}]; prior-only RMSE of log GD: {prior_rmse:.3f}")  # fmt: skip
+    for B in BLOCKS:
+        counts = FeatureSpec(block_samples=B)  # raises if a band holds no frequency bin
+        f = np.fft.rfftfreq(B, 1 / RATE_HZ)
+        e = counts.bands_hz
+        n_bins = [int(np.sum((f >= lo) & (f < hi))) for lo, hi in zip(e[:-1], e[1:], strict=True)]
+        n_bins[-1] += int(np.sum(f == e[-1]))
+        print(f"  B = {B:4d}: frequency bins per band {n_bins}")
+
+    rng = np.random.default_rng(args.seed)
+    table: dict = {}
+    lack: dict = {}
+    jfit: dict = {}
+    band_j: dict = {}
+    for case in ("A", "B"):
+        for B in BLOCKS:
+            bl_tr, bl_te = blocks_of(acc_tr[case], B), blocks_of(acc_te[case], B)[scored]
+            pg_tr, pg_te = periodogram(bl_tr), periodogram(bl_te)
+            mean_pg = pg_tr.mean(axis=1)
+            s_tr = reference_spectrum(v_tr, v_tr, gd_tr, mean_pg, leave_out=True)
+            s_te = reference_spectrum(v_s, v_tr, gd_tr, mean_pg, leave_out=False)
+            f_tr = features(bl_tr, B, pg_tr, s_tr)
+            f_te = features(bl_te, B, pg_te, s_te)
+            batch = max(1, BATCH_SAMPLES // B)
+            for name in FEATURES:
+                model = fit(v_tr, gd_tr, f_tr[name], batch)
+                lack[case, name, B] = model.lack_of_fit
+                jfit[case, name, B] = fisher_j(model, v_s, gd_s, B)
+                for span in SPANS:
+                    if span < B:
+                        continue
+                    sc = estimates(model, v_s, gd_s, f_te[name], span // B, log_grid)
+                    table[case, name, B, span] = info_per_s(sc, span / RATE_HZ, rng)
+                    if span == 1000:
+                        for lo, hi, label in SPEED_BANDS:
+                            sel = (sc.speed >= lo) & (sc.speed < hi)
+                            sub = sc.subset(sel)
+                            band_j[case, name, B, label] = info_per_s(sub, span / RATE_HZ, rng)
+
+    def reference(case: str, span: int) -> tuple:
+        """log f of the paper's 1,000-sample window, or of the longest block within T."""
+        return (case, PAPER[0], min(PAPER[1], max(b for b in BLOCKS if b <= span)), span)
+
+    def ratio(d: dict, key: tuple, ref_key: tuple, field: str) -> float:
+        return d[key][field] / d[ref_key][field] if ref_key in d else np.nan
+
+    print(f"\n1. Held-out GD estimates from T seconds of driving ({load()})")
+    print("J = 1/(RMSE^2 T) [1/s] +- bootstrap SE over test runs; RMSE of the posterior-mean log")
+    print("GD (flat prior on [log 200, log 600]); cov: coverage of the 90% interval; ratio: J /")
+    print("J(log_var, B=1000) at the same T (at T = 4.2 s: log_var, B=500). Prior-only RMSE")
+    print(f"{prior_rmse:.3f}: where RMSE is not far below it, the prior bounds the error and J")
+    print("measures the prior as much as the feature (section 2 leaves the prior out).")
+    head = "".join(f"| T={s / RATE_HZ:4.1f} s: J +- se    RMSE  cov ratio " for s in SPANS)
+    for case in ("A", "B"):
+        print(f"\ncase {case} ({'noise-free' if case == 'A' else 'N(0, 1) noise'})")
+        print(f"{'feature':<10}{'B':>5} {head}")
+        for name in FEATURES:
+            for B in BLOCKS:
+                row = f"{name:<10}{B:5d} "
+                for span in SPANS:
+                    key = (case, name, B, span)
+                    if key not in table:
+                        row += f"| {'(block longer than T)':<38}"
+                        continue
+                    t = table[key]
+                    r = ratio(table, key, reference(case, span), "J")
+                    row += f"| {t['J']:6.2f} +- {t['se']:5.2f} {t['rmse']:6.3f} "
+                    row += f"{t['cov']:4.2f} {r:5.2f} "
+                print(row)
+
+    print(f"\n2. Information per second without the prior ({load()})")
+    print(
+        "J_lin [1/s] +- bootstrap SE: held out, from the linearised (GLS-from-the-truth) estimate"
+    )
+    print("of each stretch: 0.455 / (median squared error x T) (a robust 1 / (MSE T)); ratio: to")
+    print(
+        "log_var B=1000 at T = 8.3 s. J_fit: the fitted model's own Fisher information per second"
+    )
+    print("(median over test runs). lof: lack of fit of the training runs' means about the cubic")
+    print("(mean squared standardised residual per output; 1: the cubic and Sigma explain them).")
+    head = "".join(f"| T={s / RATE_HZ:4.1f} s: J_lin +- se " for s in SPANS)
+    for case in ("A", "B"):
+        print(f"\ncase {case} ({'noise-free' if case == 'A' else 'N(0, 1) noise'})")
+        print(f"{'feature':<10}{'B':>5} {'J_fit':>6} {'lof':>5} {head}| ratio@8.3s")
+        for name in FEATURES:
+            for B in BLOCKS:
+                row = f"{name:<10}{B:5d} {jfit[case, name, B]:6.2f} {lack[case, name, B]:5.2f} "
+                for span in SPANS:
+                    key = (case, name, B, span)
+                    if key not in table:
+                        row += f"| {'(B > T)':<22}"
+                        continue
+                    t = table[key]
+                    row += f"| {t['Jlin']:12.2f} +- {t['se_lin']:5.2f} "
+                r = ratio(table, (case, name, B, 1000), (case, *PAPER, 1000), "Jlin")
+                print(row + f"| {r:6.2f}")
+
+    n_band = ", ".join(f"{lab}: {np.sum((v_s >= lo) & (v_s < hi))}" for lo, hi, lab in SPEED_BANDS)
+    print(f"\n3. Per speed band at T = 8.3 s (test runs {n_band}); ({load()})")
+    print("J from the posterior-mean RMSE and J_lin (no prior), [1/s], ratio to log_var B=1000")
+    cols = "".join(f"{lab + ': J (ratio)':>17}{'J_lin (ratio)':>16}" for *_, lab in SPEED_BANDS)
+    for case in ("A", "B"):
+        print(f"\ncase {case}")
+        print(f"{'feature':<10}{'B':>5} {cols}")
+        for name in FEATURES:
+            for B in BLOCKS:
+                row = f"{name:<10}{B:5d} "
+                for *_, lab in SPEED_BANDS:
+                    t, key, ref = (
+                        band_j[case, name, B, lab],
+                        (case, name, B, lab),
+                        (case, *PAPER, lab),
+                    )
+                    row += f"{t['J']:10.2f} ({ratio(band_j, key, ref, 'J'):4.2f})"
+                    row += f"{t['Jlin']:9.2f} ({ratio(band_j, key, ref, 'Jlin'):4.2f})"
+                print(row)
+    print(f"\ntotal {time.perf_counter() - tic:.0f} s; {load()}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,57 @@
+"""Text from a file, made safe to print: control and format characters escaped, long values cut.
+
+An emulator file comes from people the reader need not trust; its names, units, metadata and
+even its member names (quoted in error messages) may hold terminal escape sequences (ESC [ ...),
+carriage returns or bidirectional overrides that would rewrite the terminal or disguise text.
+Everything the CLI prints from a file goes through ``safe``.
+"""
+
+from __future__ import annotations
+
+import json
+
+MAX_VALUE_CHARS = 300
+"""Longest value printed whole; longer ones are cut and their length stated."""
+
+
+def safe(text: object, limit: int | None = None) -> str:
+    """``str(text)`` with every non-printable character (C0/C1 controls, DEL, format and
+    separator characters other than the space) written as a Python escape (``\\x1b``,
+    ``\\u202e``), cut to ``limit`` characters if given."""
+    s = str(text)
+    cut = ""
+    if limit is not None and len(s) > limit:
+        cut = f"... ({len(s)} characters)"
+        s = s[:limit]
+    out = []
+    for ch in s:
+        if ch.isprintable() or ch == " ":
+            out.append(ch)
+        elif ord(ch) < 0x100:
+            out.append(f"\\x{ord(ch):02x}")
+        elif ord(ch) < 0x10000:
+            out.append(f"\\u{ord(ch):04x}")
+        else:
+            out.append(f"\\U{ord(ch):08x}")
+    return "".join(out) + cut
+
+
+def value(obj: object) -> str:
+    """A JSON value for a person: compact JSON (ASCII escapes), cut at MAX_VALUE_CHARS."""
+    try:
+        text = json.dumps(obj, ensure_ascii=True, allow_nan=True)
+    except (TypeError, ValueError, RecursionError):
+        text = repr(obj)
+    return safe(text, MAX_VALUE_CHARS)
+
+
+def plain(obj: object) -> str:
+    """A string as itself (escaped, cut), any other JSON value as ``value`` shows it."""
+    return safe(obj, MAX_VALUE_CHARS) if isinstance(obj, str) else value(obj)
+
+
+def number(obj: object, fmt: str = ".4g") -> str:
+    """A number formatted with ``fmt``, or the value as ``value`` shows it if it is none."""
+    if isinstance(obj, (int, float)) and not isinstance(obj, bool):
+        return format(obj, fmt)
+    return value(obj)

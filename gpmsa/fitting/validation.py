@@ -1,0 +1,329 @@
+"""Checks of an emulator file's record (manifest + arrays) before an Emulator is built from it.
+
+The content hash shows only that a file is as its writer left it: whoever can edit a file can
+recompute the hash. So the reader checks every field itself: shapes (first from the manifest's
+declarations, before anything is decompressed, then from the arrays), finiteness, ranges and
+positive scales, the priors, names and settings the code relies on, and the redundancies a
+consistent file has (the output mean and sd are those of the training outputs, the basis
+weights are the outputs' projection on the basis, the design spans the unit cube, the point
+estimate lies within its posterior draws). Each failure raises EmulatorFileError naming the
+field ("arrays/K", "priors.lamOs.a", "names.x", ...). ``Emulator.save`` applies the same checks
+before writing, so that it never writes a file ``gpmsa.load`` refuses.
+
+A file that passes is an internally consistent, numerically valid emulator; it is not
+necessarily the emulator its sender fitted (a consistent rewrite with a recomputed hash passes):
+compare ``content_sha256`` with a value received over a trusted channel (``gpmsa.load(path,
+sha256=...)``) for that.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gpmsa.errors import EmulatorFileError
+from gpmsa.model.transforms import UNIT_TOL
+
+EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+STD_FIELDS = ("x_min", "x_max", "t_min", "t_max", "y_mean", "grid")
+REQUIRED = ("x_unit", "t_unit", "y", "K", "w", "log_post", "y_sd", *STD_FIELDS) + tuple(
+    f"param_{k}" for k in EMULATOR_PARAMS
+)
+"""Arrays every emulator file holds."""
+CALIBRATION_ARRAYS = ("theta", "theta_native", "lamOs", "betaV", "lamVz")
+PRECISIONS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
+PRIOR_SCALARS = ("theta_mean", "theta_sd", "rho_a", "rho_b", "rho_cap")
+MAX_PRIOR_SHAPE = 1e12
+"""Largest Gamma shape a of a prior in a file (the data corrections give (l_sim - p_u) m / 2;
+a shape of 1e30 would make the lamOs quadrature ask for petabytes)."""
+REL_TOL = 1e-9
+"""Relative tolerance of the recomputed redundancies (y_mean, y_sd)."""
+W_TOL = 1e-7
+"""Tolerance of the recomputed basis weights, relative to their largest magnitude (plus 1)."""
+
+
+def _fail(field: str, problem: str) -> EmulatorFileError:
+    return EmulatorFileError(f"{field}: {problem}")
+
+
+def _short(value, n: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= n else text[: n - 3] + "..."
+
+
+# --- shapes (from declarations or arrays) -------------------------------------------------------
+def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
+    """Sizes (m, p, q, l_sim, p_u, n_draws) of a record whose arrays have these shapes."""
+    missing = [k for k in REQUIRED if k not in shapes]
+    if missing:
+        raise EmulatorFileError(f"arrays: required arrays missing: {missing}")
+
+    def two(name: str) -> tuple[int, int]:
+        s = shapes[name]
+        if len(s) != 2:
+            raise _fail(f"arrays/{name}", f"must be 2-D, has shape {list(s)}")
+        return s
+
+    m, p = two("x_unit")
+    _, q = two("t_unit")
+    l_sim, p_u = two("K")
+    if p < 1 or q < 1:
+        raise _fail(
+            "arrays/x_unit", f"needs p >= 1 known inputs and q >= 1 parameters, got {p}, {q}"
+        )
+    if m < p + q + 2:
+        raise _fail("arrays/x_unit", f"{m} runs: at least p + q + 2 = {p + q + 2} are needed")
+    if l_sim < 1 or not 1 <= p_u <= min(m, l_sim):
+        raise _fail("arrays/K", f"shape {[l_sim, p_u]}: need l_sim >= 1, 1 <= p_u <= min(m, l_sim)")
+    n = shapes["log_post"][0] if len(shapes["log_post"]) == 1 else -1
+    if n < 0:
+        raise _fail("arrays/log_post", f"must be 1-D, has shape {list(shapes['log_post'])}")
+    pshape = {"betaU": (p + q, p_u), "lamUz": (p_u,), "lamWs": (p_u,), "lamWOs": (1,)}
+    want = {
+        "t_unit": (m, q), "y": (m, l_sim), "w": (m, p_u), "x_min": (p,), "x_max": (p,),
+        "t_min": (q,), "t_max": (q,), "y_mean": (l_sim,), "grid": (l_sim,), "y_sd": (1,),
+        **{f"param_{k}": v for k, v in pshape.items()},
+    }  # fmt: skip
+    if "index" in shapes:
+        want["index"] = (l_sim,)
+    for name in shapes:
+        if name.startswith("draw_"):
+            key = name[5:]
+            if key not in pshape:
+                raise _fail(
+                    f"arrays/{name}", f"unknown emulator parameter (have {EMULATOR_PARAMS})"
+                )
+            want[name] = (n, *pshape[key])
+        elif name.startswith("cal_"):
+            if name[4:] not in CALIBRATION_ARRAYS:
+                raise _fail(f"arrays/{name}", f"unknown calibration array ({CALIBRATION_ARRAYS})")
+            if not shapes[name] or shapes[name][0] != n:
+                raise _fail(f"arrays/{name}", f"shape {list(shapes[name])}: needs {n} draws first")
+            if name[4:] in ("theta", "theta_native"):
+                want[name] = (n, q)
+        elif name.startswith("param_") and name[6:] not in pshape:
+            raise _fail(f"arrays/{name}", f"unknown emulator parameter (have {EMULATOR_PARAMS})")
+    for name, shape in want.items():
+        if tuple(shapes[name]) != tuple(shape):
+            raise _fail(f"arrays/{name}", f"has shape {list(shapes[name])}, expected {list(shape)}")
+    return {"m": m, "p": p, "q": q, "l_sim": l_sim, "p_u": p_u, "n_draws": n}
+
+
+# --- manifest fields ----------------------------------------------------------------------------
+def _number(value, field: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise _fail(field, f"must be a number, got {_short(value)}")
+    v = float(value)
+    if math.isnan(v):
+        raise _fail(field, "must be a number, got NaN")
+    return v
+
+
+def _strings(value, n: int, field: str) -> list[str]:
+    if not isinstance(value, list) or not all(isinstance(s, str) for s in value):
+        raise _fail(field, f"must be a list of strings, got {_short(value)}")
+    if len(value) != n:
+        raise _fail(field, f"must have {n} entries (one per column), got {len(value)}")
+    return value
+
+
+def check_priors(priors) -> None:
+    """The priors as ``Priors.to_dict`` writes them, with valid values."""
+    if not isinstance(priors, dict):
+        raise _fail("priors", f"must be an object, got {_short(priors)}")
+    expected = {*PRIOR_SCALARS, *PRECISIONS, "corrected"}
+    if set(priors) != expected:
+        raise _fail(
+            "priors", f"fields {sorted(priors)} differ from the expected {sorted(expected)}"
+        )
+    for name in PRIOR_SCALARS:
+        v = _number(priors[name], f"priors.{name}")
+        ok = {
+            "theta_mean": math.isfinite(v),
+            "theta_sd": math.isfinite(v) and v > 0,
+            "rho_a": math.isfinite(v) and v > 0,
+            "rho_b": math.isfinite(v) and v > 0,
+            "rho_cap": 0 < v < 1,
+        }[name]
+        if not ok:
+            allowed = {"theta_mean": "finite", "rho_cap": "(0, 1)"}.get(name, "(0, inf), finite")
+            raise _fail(f"priors.{name}", f"{v!r} is out of range: allowed {allowed}")
+    if not isinstance(priors["corrected"], bool):
+        raise _fail("priors.corrected", f"must be true or false, got {_short(priors['corrected'])}")
+    for name in PRECISIONS:
+        g = priors[name]
+        field = f"priors.{name}"
+        if not isinstance(g, dict) or set(g) != {"a", "b", "lower", "upper"}:
+            raise _fail(field, f"must be an object {{a, b, lower, upper}}, got {_short(g)}")
+        a, b = _number(g["a"], f"{field}.a"), _number(g["b"], f"{field}.b")
+        if not 0 < a <= MAX_PRIOR_SHAPE:
+            raise _fail(f"{field}.a", f"{a!r} is out of range: allowed (0, {MAX_PRIOR_SHAPE:g}]")
+        if not (0 < b and math.isfinite(b)):
+            raise _fail(f"{field}.b", f"{b!r} is out of range: allowed (0, inf), finite")
+        lo = _number(g["lower"], f"{field}.lower")
+        hi = math.inf if g["upper"] == "inf" else _number(g["upper"], f"{field}.upper")
+        if not (math.isfinite(lo) and 0 <= lo < hi):
+            raise _fail(f"{field}.lower", f"bounds ({lo!r}, {hi!r}): need 0 <= lower < upper")
+
+
+def check_fields(manifest: dict, dims: dict[str, int]) -> None:
+    """Names, units, priors, the model sizes and the settings the code reads."""
+    p, q, l_sim = dims["p"], dims["q"], dims["l_sim"]
+    names, units = manifest.get("names"), manifest.get("units")
+    for field, value in (("names", names), ("units", units)):
+        if not isinstance(value, dict) or set(value) != {"x", "t", "y"}:
+            raise _fail(field, f"must be an object with x, t and y lists, got {_short(value)}")
+    for kind, n in (("x", p), ("t", q), ("y", l_sim)):
+        _strings(names[kind], n, f"names.{kind}")
+        _strings(units[kind], n, f"units.{kind}")
+    inputs = names["x"] + names["t"]
+    if len(set(inputs)) != len(inputs):
+        raise _fail("names", f"input names must be unique, got {_short(inputs)}")
+    if len(set(names["y"])) != len(names["y"]):
+        raise _fail("names.y", "output names must be unique")
+    check_priors(manifest.get("priors"))
+    model = manifest.get("model", {})
+    if not isinstance(model, dict):
+        raise _fail("model", f"must be an object, got {_short(model)}")
+    for key in ("m", "p", "q", "l_sim", "p_u"):
+        if key in model and model[key] != dims[key]:
+            raise _fail(f"model.{key}", f"{_short(model[key])}, but the arrays give {dims[key]}")
+    settings = manifest.get("settings")
+    if not isinstance(settings, dict):
+        raise _fail("settings", f"must be an object, got {_short(settings)}")
+    if "n_chains" in settings:
+        n_ch = settings["n_chains"]
+        if isinstance(n_ch, bool) or not isinstance(n_ch, int) or n_ch < 1:
+            raise _fail("settings.n_chains", f"must be an integer >= 1, got {_short(n_ch)}")
+    for key in ("metadata", "diagnostics"):
+        if not isinstance(manifest.get(key), dict):
+            raise _fail(key, f"must be an object, got {_short(manifest.get(key))}")
+    if manifest.get("convergence") is not None and not isinstance(manifest["convergence"], dict):
+        raise _fail("convergence", f"must be an object, got {_short(manifest['convergence'])}")
+
+
+def check_manifest(manifest: dict) -> None:
+    """The declared content of a file, before its arrays are decompressed (``read_raw``'s
+    ``check``): the shapes the manifest lists and every other field."""
+    specs = manifest["arrays"]
+    dims = check_shapes({k: tuple(v["shape"]) for k, v in specs.items()})
+    for name in specs:
+        if _known(name) and specs[name]["dtype"] != "<f8":
+            raise _fail(f"arrays/{name}", f"dtype {specs[name]['dtype']}: must be <f8 (float64)")
+    check_fields(manifest, dims)
+
+
+def _known(name: str) -> bool:
+    return name in REQUIRED or name == "index" or name.startswith(("draw_", "cal_", "param_"))
+
+
+# --- values ------------------------------------------------------------------------------------
+def _finite(arrays: dict[str, np.ndarray], name: str) -> np.ndarray:
+    a = arrays[name]
+    if a.dtype != np.float64:
+        raise _fail(f"arrays/{name}", f"dtype {a.dtype.str}: must be <f8 (float64)")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        pos = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise _fail(f"arrays/{name}", f"must be finite, holds {a[pos]} at index {list(pos)}")
+    return a
+
+
+def _positive(arrays: dict[str, np.ndarray], name: str) -> np.ndarray:
+    a = _finite(arrays, name)
+    if a.size and not np.all(a > 0):
+        pos = tuple(int(i) for i in np.argwhere(~(a > 0))[0])
+        raise _fail(f"arrays/{name}", f"must be > 0, holds {a[pos]} at index {list(pos)}")
+    return a
+
+
+def _in_unit(arrays: dict[str, np.ndarray], name: str, span: bool) -> None:
+    a = _finite(arrays, name)
+    if a.size and (a.min() < -UNIT_TOL or a.max() > 1 + UNIT_TOL):
+        raise _fail(f"arrays/{name}", f"must lie in [0, 1], spans [{a.min():.6g}, {a.max():.6g}]")
+    if span and a.size:
+        lo, hi = a.min(axis=0), a.max(axis=0)
+        k = np.flatnonzero((lo > UNIT_TOL) | (hi < 1 - UNIT_TOL))
+        if k.size:
+            j = int(k[0])
+            raise _fail(
+                f"arrays/{name}",
+                f"column {j} spans [{lo[j]:.6g}, {hi[j]:.6g}]: a design maps its own range "
+                "onto [0, 1] exactly",
+            )
+
+
+def check_values(arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
+    """Finite values, ranges, positive scales and the file's internal redundancies."""
+    _in_unit(arrays, "x_unit", span=True)
+    _in_unit(arrays, "t_unit", span=True)
+    for lo_name, hi_name in (("x_min", "x_max"), ("t_min", "t_max")):
+        lo, hi = _finite(arrays, lo_name), _finite(arrays, hi_name)
+        bad = np.flatnonzero(~(lo < hi))
+        if bad.size:
+            j = int(bad[0])
+            raise _fail(
+                f"arrays/{lo_name}",
+                f"[{j}] = {lo[j]!r} must be below {hi_name}[{j}] = {hi[j]!r} (a design column "
+                "with no spread)",
+            )
+    for name in ("y", "K", "w", "y_mean", "grid", "log_post"):
+        _finite(arrays, name)
+    if "index" in arrays:
+        _finite(arrays, "index")
+    y_sd = float(_positive(arrays, "y_sd")[0])
+    y, y_mean = arrays["y"], arrays["y_mean"]
+    mean = y.mean(axis=0)
+    tol = REL_TOL * (y_sd + np.abs(mean))
+    if np.any(np.abs(mean - y_mean) > tol):
+        raise _fail("arrays/y_mean", "differs from the mean of the training outputs arrays/y")
+    sd = float(np.std(y - mean, ddof=1))
+    if abs(sd - y_sd) > REL_TOL * sd:
+        raise _fail("arrays/y_sd", f"{y_sd!r}, but the training outputs' sd is {sd!r}")
+    K = arrays["K"]
+    lam = np.sum(K**2, axis=0)
+    if not np.all(lam > 0):
+        raise _fail("arrays/K", "has a basis vector of zero length")
+    if dims["l_sim"] == 1:
+        if K[0, 0] != 1.0:
+            raise _fail("arrays/K", f"{K.tolist()}: a scalar output's basis is [[1.0]]")
+    else:
+        gram = K.T @ K
+        off = np.abs(gram - np.diag(np.diag(gram)))
+        if off.max() > 1e-8 * lam.max():
+            raise _fail("arrays/K", "basis vectors are not orthogonal (not a PCA basis)")
+    w = arrays["w"]
+    w_ref = ((y - y_mean) / y_sd) @ np.linalg.pinv(K).T
+    if np.max(np.abs(w - w_ref)) > W_TOL * (1.0 + np.max(np.abs(w_ref))):
+        raise _fail("arrays/w", "differs from the projection of the training outputs on arrays/K")
+    for k in EMULATOR_PARAMS:
+        prm = _positive(arrays, f"param_{k}")
+        if f"draw_{k}" in arrays:
+            draws = _positive(arrays, f"draw_{k}")
+            if draws.shape[0]:
+                lo, hi = draws.min(axis=0), draws.max(axis=0)
+                slack = 1e-9 * np.maximum(np.abs(lo), np.abs(hi))
+                if np.any(prm < lo - slack) or np.any(prm > hi + slack):
+                    raise _fail(
+                        f"arrays/param_{k}", "lies outside the range of its posterior draws"
+                    )
+    for name in arrays:
+        if name.startswith("cal_"):
+            if name[4:] == "theta":
+                _in_unit(arrays, name, span=False)
+            elif name[4:] == "theta_native":
+                _finite(arrays, name)
+            else:
+                _positive(arrays, name)
+
+
+def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int]:
+    """Every check of a record (shapes, fields, values); returns its sizes."""
+    for name, arr in arrays.items():
+        if not isinstance(arr, np.ndarray):
+            raise _fail(f"arrays/{name}", f"must be an array, got {type(arr).__name__}")
+    dims = check_shapes({k: v.shape for k, v in arrays.items()})
+    check_fields(manifest, dims)
+    check_values(arrays, dims)
+    return dims

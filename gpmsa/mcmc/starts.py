@@ -1,0 +1,103 @@
+"""Starting values of chains: GPM/SA's, dispersed around them, or drawn from the prior.
+
+R-hat can only reveal chains that have not forgotten where they started when the starts are
+spread wider than the posterior (Gelman and Rubin 1992; Vehtari et al. 2021), so several chains
+start from dispersed values by default (``init="auto"``); one chain starts at GPM/SA's initial
+values, as GPM/SA does.
+
+- ``"gpmsa"``: ``problem.init`` (theta 0.5, betaU 0.1, lamUz 1, lamWs 1000, ...).
+- ``"jitter"``: around GPM/SA's start: theta ~ U(0.1, 0.9); beta through rho = exp(-beta/4)
+  ~ U(RHO_JITTER); each precision log-uniform on [x0 / f, x0 f] (x0 its GPM/SA start, f =
+  ``PRECISION_JITTER``) cut to its prior's bounds.
+- ``"prior"``: from the (data-corrected) prior: theta from the truncated normal, rho from
+  Beta(rho_a, rho_b) capped at rho_cap, precisions from their truncated Gammas.
+
+Fixed parameters keep ``problem.init``. Each chain draws its start from its own generator
+(``start_generator``), separate from the stream of its sweeps.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+from gpmsa.model.priors import GammaPrior
+from gpmsa.model.problem import Problem
+
+CHOICES = ("auto", "gpmsa", "jitter", "prior")
+RHO_JITTER = (0.5, 0.99)
+"""Range of the uniform start of rho = exp(-beta/4) under ``"jitter"`` (GPM/SA's: 0.975)."""
+PRECISION_JITTER = 10.0
+"""Factor f of the log-uniform start of a precision under ``"jitter"``."""
+
+
+def check_init(init, n_chains: int) -> str:
+    """The init rule for ``n_chains`` chains ("auto" resolved); GPMSAError for an unknown one."""
+    if not isinstance(init, str) or init not in CHOICES:
+        raise GPMSAError(f"init must be one of {CHOICES}, got {init!r}")
+    if init == "auto":
+        return "gpmsa" if n_chains == 1 else "jitter"
+    return init
+
+
+def start_generator(seed: np.random.SeedSequence) -> np.random.Generator:
+    """The generator of a chain's start: a child of its SeedSequence (not its sweep stream)."""
+    child = np.random.SeedSequence(seed.entropy, spawn_key=(*seed.spawn_key, 0x5EED))
+    return np.random.default_rng(child)
+
+
+def _gamma(g: GammaPrior, size: int, rng: np.random.Generator) -> np.ndarray:
+    out = rng.gamma(g.a, 1.0 / g.b, size)
+    for _ in range(1000):
+        bad = (out <= g.lower) | (out >= g.upper)
+        if not bad.any():
+            return out
+        out[bad] = rng.gamma(g.a, 1.0 / g.b, int(bad.sum()))
+    # a prior with little mass inside its bounds: the bounds' geometric middle
+    hi = g.upper if np.isfinite(g.upper) else 10.0 * max(g.lower, g.a / g.b)
+    out[bad] = np.sqrt(max(g.lower, 1e-12) * hi)
+    return out
+
+
+def _truncnorm01(mean: float, sd: float, size: int, rng: np.random.Generator) -> np.ndarray:
+    out = rng.normal(mean, sd, size)
+    for _ in range(1000):
+        bad = (out <= 0.0) | (out >= 1.0)
+        if not bad.any():
+            return out
+        out[bad] = rng.normal(mean, sd, int(bad.sum()))
+    out[bad] = rng.uniform(0.01, 0.99, int(bad.sum()))
+    return out
+
+
+def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str, np.ndarray]:
+    """One chain's starting values (name -> array of the init's shape) under rule ``how``."""
+    if how == "gpmsa":
+        return {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+    pri = problem.priors
+    out = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+    for name in problem.sampled:
+        x0 = out[name]
+        size = x0.size
+        if name == "theta":
+            if how == "jitter":
+                val = rng.uniform(0.1, 0.9, size)
+            else:
+                val = _truncnorm01(pri.theta_mean, pri.theta_sd, size, rng)
+        elif name in ("betaU", "betaV"):
+            if how == "jitter":
+                rho = rng.uniform(*RHO_JITTER, size)
+            else:
+                rho = np.minimum(rng.beta(pri.rho_a, pri.rho_b, size), pri.rho_cap)
+            val = -4.0 * np.log(rho)
+        else:
+            g = getattr(pri, name)
+            if how == "jitter":  # log-uniform on [x0 / f, x0 f] cut to the bounds
+                x = x0.ravel()
+                lo = np.maximum(x / PRECISION_JITTER, g.lower * (1.0 + 1e-3) + 1e-12)
+                hi = np.minimum(x * PRECISION_JITTER, g.upper * (1.0 - 1e-3))
+                val = np.exp(rng.uniform(np.log(lo), np.log(hi)))
+            else:
+                val = _gamma(g, size, rng)
+        out[name] = np.asarray(val, dtype=np.float64).reshape(x0.shape)
+    return out

@@ -1,0 +1,129 @@
+"""Batched torch chains: CPU and GPU code paths agree, 64 chains converge, CUDA where present."""
+
+import numpy as np
+import pytest
+import torch
+from threadpoolctl import threadpool_limits
+
+import gpmsa
+from gpmsa import backends
+from gpmsa.backends import torch_backend as tb
+from gpmsa.mcmc.diagnostics import rhat
+from gpmsa.model.likelihood import log_posterior
+
+
+@pytest.fixture(autouse=True)
+def one_blas_thread():
+    """BatchState and ChainState used directly: LAPACK on one thread, as the samplers run it."""
+    with threadpool_limits(1):
+        yield
+
+
+def _cases():
+    from _backend_cases import multi_problem, road_problem
+
+    return {
+        "road-sim": road_problem(False).problem,
+        "road-joint": road_problem(True).problem,
+        "multi-discrepancy": multi_problem("constant").problem,
+    }
+
+
+@pytest.mark.parametrize("case", ["road-sim", "road-joint", "multi-discrepancy"])
+def test_batched_path_for_gpus_equals_the_lapack_path(case, monkeypatch):
+    """The batched torch ops that a GPU runs (forced here on the CPU) and the per-chain LAPACK
+    path give the same cached state after the same sweeps, and both the numpy log posterior."""
+    problem = _cases()[case]
+    widths = np.array([0.1] * len(gpmsa.mcmc.sampler.elements(problem)))
+    states = {}
+    for path in ("lapack", "batched"):
+        if path == "batched":
+            monkeypatch.setattr(tb, "_on_lapack", lambda t: False)
+        state = tb.BatchState(problem, 3, torch.float64, "cpu", ridge_moves=2)
+        gen = torch.Generator().manual_seed(0)
+        for _ in range(6):
+            state.sweep(widths, True, gen)
+        states[path] = state
+    a, b = states["lapack"], states["batched"]
+    for name, val in a.params.items():
+        np.testing.assert_allclose(b.params[name].numpy(), val.numpy(), rtol=1e-9, err_msg=name)
+    want = [log_posterior(problem, {k: v[c].numpy() for k, v in a.params.items()})
+            for c in range(3)]  # fmt: skip
+    np.testing.assert_allclose(a.log_post().numpy(), want, rtol=1e-9, atol=1e-7)
+    np.testing.assert_allclose(b.log_post().numpy(), want, rtol=1e-9, atol=1e-7)
+
+
+def test_same_starts_as_the_numpy_chains_and_nan_starts_named():
+    from _backend_cases import multi_data
+
+    problem = gpmsa.prepare(multi_data()[0]).problem
+    got = backends.get("torch").sample(problem, n_iter=3, n_chains=4, seed=9, tune=False)
+    ref = backends.get("numpy").sample(problem, n_iter=3, n_chains=4, seed=9, tune=False)
+    assert got.info["init"] == "jitter" and got.info["tune_stages"] == 1
+    for name, val in ref.info["starts"].items():
+        np.testing.assert_allclose(got.info["starts"][name], val, rtol=1e-15)
+    w = problem.w.copy()
+    w[0, 1] = np.nan
+    import dataclasses
+
+    bad = dataclasses.replace(problem, w=w)
+    with pytest.raises(gpmsa.ChainError, match=r"chain\(s\) \[0, 1\] give a log-likelihood"):
+        backends.get("torch").sample(bad, n_iter=3, n_chains=2, seed=1)
+
+
+def _max_rhat(chains, burn: float = 0.2) -> tuple[float, str]:
+    worst = (0.0, "")
+    for name, d in chains.draws.items():
+        if np.ptp(d) == 0:
+            continue
+        d = d[:, int(burn * d.shape[1]) :]
+        flat = d.reshape(d.shape[0], d.shape[1], -1)
+        for i in range(flat.shape[2]):
+            worst = max(worst, (rhat(flat[:, :, i]), f"{name}[{i}]"))
+    return worst
+
+
+@pytest.mark.slow
+def test_64_chains_converge_on_a_multivariate_case_with_the_defaults():
+    """64 chains from dispersed starts, default warm-up and tuning: R-hat < 1.01 everywhere."""
+    from _backend_cases import multi_data
+
+    problem = gpmsa.prepare(multi_data()[0]).problem
+    chains = backends.get("torch").sample(problem, n_iter=2500, n_chains=64, seed=11)
+    r, where = _max_rhat(chains)
+    assert r < 1.01, f"max R-hat {r:.4f} at {where}"
+
+
+@pytest.mark.slow
+def test_64_chains_converge_on_the_road_case_with_the_defaults():
+    from _backend_cases import road_problem
+
+    problem = road_problem(False).problem
+    chains = backends.get("torch").sample(problem, n_iter=2000, n_chains=64, seed=12)
+    r, where = _max_rhat(chains)
+    assert r < 1.01, f"max R-hat {r:.4f} at {where}"
+
+
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="no CUDA device")
+def test_cuda_chains_agree_with_the_cpu_and_numpy():
+    """The GPU path: float64 chains on CUDA give the posterior of the numpy backend."""
+    from _backend_cases import multi_data
+    from test_backend_agreement import _elements, assert_agree
+
+    problem = gpmsa.prepare(multi_data()[0]).problem
+    got = backends.get("torch").sample(problem, n_iter=600, n_chains=64, seed=4, device="cuda")
+    assert got.info["device"].startswith("cuda")
+    ref = backends.get("numpy").sample(problem, n_iter=4000, seed=3)
+    for name in ("betaU", "lamUz", "lamWs", "lamWOs"):
+        for k, (a, b) in enumerate(zip(_elements(got, name), _elements(ref, name), strict=True)):
+            assert_agree(a, b, f"cuda {name}[{k}]")
+
+
+def test_cuda_request_without_a_device_is_refused():
+    if torch.cuda.is_available():
+        pytest.skip("a CUDA device exists")
+    from _backend_cases import multi_data
+
+    problem = gpmsa.prepare(multi_data()[0]).problem
+    with pytest.raises(gpmsa.GPMSAError, match="torch sees no CUDA device"):
+        backends.get("torch").sample(problem, n_iter=2, device="cuda")
