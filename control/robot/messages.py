@@ -18,6 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from control.errors import ControlError
 from control.robot.extra import require
 
 IMU_TYPE = "sensor_msgs/msg/Imu"
@@ -133,7 +134,15 @@ def decode_odometry(raws: Sequence[bytes]) -> tuple[np.ndarray, np.ndarray, np.n
     return stamp, position, velocity
 
 
+#: The latest stamp a ROS 2 ``builtin_interfaces/msg/Time`` holds (int32 seconds), ns.
+MAX_STAMP_NS = (2**31 - 1) * 1_000_000_000 + 999_999_999
+
+
 def _cdr_header(stamp_ns: int, frame_id: str) -> bytes:
+    if not 0 <= int(stamp_ns) <= MAX_STAMP_NS:
+        raise ControlError(
+            f"stamp {stamp_ns} ns lies outside a ROS 2 time stamp's range [0, {MAX_STAMP_NS}] ns"
+        )
     sec, nsec = divmod(int(stamp_ns), 1_000_000_000)
     name = frame_id.encode() + b"\x00"
     return _CDR_LE + struct.pack("<iII", sec, nsec, len(name)) + name

@@ -23,7 +23,7 @@ RATE = 120.0
 def test_stream_check_counts_each_kind_of_stamp_fault():
     t = np.arange(100) / RATE
     t = np.insert(t, 40, t[40])  # a repeated stamp
-    t[60] = t[58]  # one stamp before an earlier one
+    t[[60, 61]] = t[[61, 60]]  # two messages swapped: one stamp before an earlier one
     t = np.delete(t, range(80, 85))  # a gap of 5 lost samples
     report = condition.check_stream("/imu", t, np.isfinite(t), "header")
     assert report.rate_hz == pytest.approx(RATE)
@@ -80,7 +80,7 @@ def test_the_two_filters_differ_where_they_should_above_the_output_nyquist():
     _, a_s, _ = condition.to_rate(t, a, RATE, method="sample")
     _, a_l, _ = condition.to_rate(t, a, RATE, method="lowpass")
     assert np.std(a_s) * np.sqrt(2) == pytest.approx(1.0, abs=0.02)
-    assert np.std(a_l) * np.sqrt(2) < 0.8
+    assert np.std(a_l) * np.sqrt(2) < 0.9
 
 
 def test_resampling_turns_stamp_faults_into_faults_the_bcr_reports():
@@ -139,10 +139,11 @@ def test_odometry_interpolates_and_leaves_gaps_empty():
 
 frames = st.text(st.characters(codec="ascii", exclude_characters="\x00"), max_size=24)
 finite = st.floats(-1e6, 1e6)
+stamps = st.integers(0, msgs.MAX_STAMP_NS)
 
 
 @settings(max_examples=80, deadline=None)
-@given(frames, st.integers(0, 2**62), st.lists(finite, min_size=3, max_size=3))
+@given(frames, stamps, st.lists(finite, min_size=3, max_size=3))
 def test_imu_codec_round_trips(frame, stamp, accel):
     raw = msgs.encode_imu(stamp, accel, frame)
     got_stamp, got_accel = msgs.decode_imu([raw, msgs.encode_imu(1, [0, 0, 1], "imu")])
@@ -151,7 +152,7 @@ def test_imu_codec_round_trips(frame, stamp, accel):
 
 
 @settings(max_examples=80, deadline=None)
-@given(frames, frames, st.integers(0, 2**62), st.lists(finite, min_size=6, max_size=6))
+@given(frames, frames, stamps, st.lists(finite, min_size=6, max_size=6))
 def test_odometry_codec_round_trips(frame, child, stamp, values):
     raw = msgs.encode_odometry(stamp, values[:3], values[3:], frame, child)
     got = msgs.decode_odometry([raw, msgs.encode_odometry(5, [1, 2, 3], [4, 5, 6], "o", "")])
@@ -160,6 +161,8 @@ def test_odometry_codec_round_trips(frame, child, stamp, values):
 
 
 def test_codec_refuses_what_it_does_not_know():
+    with pytest.raises(ControlError, match="ROS 2 time stamp"):
+        msgs.encode_imu(msgs.MAX_STAMP_NS + 1, [0, 0, 1])
     with pytest.raises(msgs.CdrLayoutError):
         msgs.decode_imu([b"\x00\x00\x00\x00" + bytes(400)])  # big-endian: the generic path
     with pytest.raises(msgs.CdrLayoutError):
