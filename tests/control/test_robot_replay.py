@@ -261,3 +261,28 @@ def test_recording_without_the_extra_fails_before_the_drive(emulator_a, tmp_path
     with pytest.raises(MissingExtraError, match="robot"):
         control.run_closed_loop(track, emulator_a, record=tmp_path / "x.mcap")
     assert not (tmp_path / "x.mcap").exists()
+
+
+def test_every_path_of_the_foxglove_layout_is_in_the_recorded_file(loop_run):
+    import re
+    from pathlib import Path
+
+    from mcap.reader import make_reader
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    layout = Path(__file__).resolve().parents[2] / "examples" / "foxglove_layout.json"
+    text = layout.read_text()
+    json.loads(text)
+    paths = set(re.findall(r'"(/[\w/]+)((?:\.\w+)*)"', text))
+    _, recorded = loop_run
+    store, first = get_typestore(Stores.EMPTY), {}
+    with recorded.open("rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages():
+            if channel.topic not in first:
+                store.register(get_types_from_msg(schema.data.decode(), schema.name))
+                first[channel.topic] = store.deserialize_cdr(message.data, schema.name)
+    assert {topic for topic, _ in paths} <= set(first)
+    for topic, fields in paths:
+        value = first[topic]
+        for name in filter(None, fields.split(".")):
+            value = getattr(value, name)  # AttributeError names a field the file lacks
