@@ -28,7 +28,7 @@ from __future__ import annotations
 import csv
 import os
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -131,7 +131,8 @@ class ReplayResult:
     ``sample_speed``, ``sample_accel`` (m/s^2).
     ``imu``, ``odometry``: `StreamReport` of each topic; ``resampling``: what was done to the
     IMU's rate; ``notes``: what else was left out. ``read_s``, ``condition_s``, ``bcr_s``:
-    wall-clock times of the three stages, s; ``t0_ns``: stamp of time 0.
+    wall-clock times of the three stages, s; ``t0_ns``: stamp of time 0; ``settings``, ``bcr``,
+    ``simplex``: what ran; ``source``: the recording read.
     """
 
     stamp_ns: np.ndarray
@@ -165,7 +166,6 @@ class ReplayResult:
     bcr: BCRSettings
     simplex: Simplex
     source: str = ""
-    extra: dict = field(default_factory=dict)
 
     @property
     def duration_s(self) -> float:
