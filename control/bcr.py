@@ -61,6 +61,8 @@ class BCRSettings:
         tracker: settings of the window methods' filter.
         max_age_s: an estimate older than this (sample time since its newest information)
             turns "stale".
+        max_silence_s: with the caller's clock (``update(..., now=)``), no sample for longer
+            than this is a "sensor_fault" (a silent sensor or a broken link), s.
         interval_level: level of the reported central credible interval.
         plausibility_p: an observation whose upper-tail probability under the emulator is below
             this for every GD in the domain is "implausible".
@@ -74,6 +76,7 @@ class BCRSettings:
     changepoint: ChangePointSettings = field(default_factory=ChangePointSettings)
     tracker: TrackerSettings = field(default_factory=TrackerSettings)
     max_age_s: float = 5.0
+    max_silence_s: float = 0.5
     interval_level: float = 0.9
     plausibility_p: float = 1e-6
     sensor: SensorLimits = field(default_factory=SensorLimits)
@@ -101,8 +104,10 @@ class BCRSettings:
             raise ControlError(
                 f"update_every ({every}) must not exceed the window ({self.feature.block_samples})"
             )
-        if not (np.isfinite(self.max_age_s) and self.max_age_s > 0):
-            raise ControlError(f"max_age_s must be > 0, got {self.max_age_s}")
+        for name in ("max_age_s", "max_silence_s"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise ControlError(f"{name} must be finite and > 0, got {value}")
         if not 0 < self.interval_level < 1:
             raise ControlError(f"interval_level must lie in (0, 1), got {self.interval_level}")
         if not 0 <= self.plausibility_p < 1:
@@ -192,6 +197,8 @@ class BCR:
         self._fault = ""
         self._t_last = np.nan  # time and position of the newest finite sample
         self._pos_last = np.nan
+        self._clock = np.nan  # the caller's clock (update's now=), newest value
+        self._clock_start = np.nan  # its first value (silence before any sample)
         self._pos_block = np.nan  # position at the end of the last block the filter saw
         self._n_updates = 0
         self._data_time = np.nan
@@ -205,7 +212,7 @@ class BCR:
                 tracker.reset()
         self.last = Estimate(time=0.0, position=0.0, status="filling", reason="no samples yet")
 
-    def update(self, t, position, accel, speed) -> Estimate:
+    def update(self, t, position, accel, speed, *, now: float | None = None) -> Estimate:
         """Take new samples; return the newest estimate (or why there is none).
 
         Args:
@@ -214,15 +221,26 @@ class BCR:
             position: (n,) front-axle positions, m.
             accel: (n,) measured vertical front-axle accelerations, m/s^2.
             speed: (n,) measured speeds, m/s.
+            now: the caller's clock, s, on the time base of ``t`` (None: the newest sample's
+                time). With it, the BCR knows time passes while no samples arrive: the estimate
+                ages, and silence longer than ``max_silence_s`` is a "sensor_fault". A control
+                loop should pass it: without it a silent sensor keeps the last estimate.
             Non-finite values are sensor faults, never errors.
         """
+        if now is not None:
+            now = float(now)
+            if not np.isfinite(now):
+                raise ControlError(f"now must be a finite time, s, got {now}")
+            if not np.isfinite(self._clock):
+                self._clock_start = now
+            self._clock = max(self._clock, now) if np.isfinite(self._clock) else now
         arrays = [np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, position, accel, speed)]
         n = arrays[0].size
         for name, a in zip(("t", "position", "accel", "speed"), arrays, strict=True):
             if a.ndim != 1 or a.size != n:
                 raise ControlError(f"{name} must be 1-D of length {n} (as t), got shape {a.shape}")
         if n == 0:
-            return self._check_age(self.last)
+            return self._check_silence(self._check_age(self.last))
         t, position, accel, speed = arrays
         drop, restart, reason = stream_fault(
             t, position, accel, speed, self._t_last, self.settings.rate_hz
@@ -240,7 +258,7 @@ class BCR:
                 self.last = self._estimate()
                 self._received = 0
                 self._n_updates += 1
-        return self._check_age(self.last)
+        return self._check_silence(self._check_age(self.last))
 
     # --- internals -------------------------------------------------------------------------------
 
@@ -263,9 +281,27 @@ class BCR:
         self._fresh = min(self._fresh + acc.size, self.buffer)
 
     def _now(self) -> tuple[float, float]:
+        """(time, position) now: the newest sample's, or the caller's clock when it is later."""
         if np.isfinite(self._t_last):
-            return self._t_last, self._pos_last
+            t = max(self._t_last, self._clock) if np.isfinite(self._clock) else self._t_last
+            return t, self._pos_last
         return float(self.last.time), float(self.last.position)
+
+    def _check_silence(self, est: Estimate) -> Estimate:
+        """'sensor_fault' when the caller's clock is more than max_silence_s past the newest
+        sample (or, before any sample, past the first call)."""
+        if not np.isfinite(self._clock):
+            return est
+        last = self._t_last if np.isfinite(self._t_last) else self._clock_start
+        silence = self._clock - last
+        if silence <= self.settings.max_silence_s:
+            return est
+        t_now, pos_now = self._now()
+        return Estimate(
+            t_now, pos_now, "sensor_fault",
+            f"no samples for {silence:.2f} s (max_silence_s = {self.settings.max_silence_s:g})",
+            data_time=est.data_time,
+        )  # fmt: skip
 
     def _block_distance(self) -> float:
         """Metres since the end of the last block the filter saw (0 before any)."""

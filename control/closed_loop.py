@@ -201,7 +201,7 @@ def run_closed_loop(
         observed = apply_faults(
             samples.t, samples.position, samples.accel_front, samples.speed, faults, fault_rng
         )
-        estimate = estimator.update(*observed)
+        estimate = estimator.update(*observed, now=float(samples.t[-1]))
         command = simplex.command(estimate)
         rows.append((estimate, command))
         bar.update(max(0, round(float(s_pos[-1][-1])) - bar.n))

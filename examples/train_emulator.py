@@ -153,6 +153,7 @@ def fit_window(case: str, campaign, model, args):
         x=campaign.v[ok, None], t=campaign.gd[ok, None],
         y=feature_of_variance(f[ok], "log_var")[:, None],
         x_names=["v"], t_names=["GD"], y_names=["log_f"],
+        x_units=["m/s"], t_units=["1e-6 m^3"], y_units=["log((m/s^2)^2)"],
     )  # fmt: skip
     extra = {"fit": {"n_iter": args.n_iter, "lamWs_prior": [1.0, 1e-3, 1.0, 1e5]}}
     return gpmsa.fit(

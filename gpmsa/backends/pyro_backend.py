@@ -162,6 +162,11 @@ def sample(
     if step_widths:
         raise GPMSAError("the pyro backend (NUTS) takes no step_widths; leave step_widths=None")
     check_sample_args(n_iter, n_chains, seed)
+    if problem.extensions:
+        raise GPMSAError(
+            f"the pyro backend does not support {', '.join(problem.extensions)}; use "
+            "backend='numpy'"
+        )
     if not 0.0 < target_accept < 1.0:
         raise GPMSAError(f"target_accept must be in (0, 1), got {target_accept}")
     model = PyroModel(problem)

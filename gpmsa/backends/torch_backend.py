@@ -626,6 +626,11 @@ def sample(
     torch's setting.
     """
     check_sample_args(n_iter, n_chains, seed)
+    if problem.extensions:
+        raise GPMSAError(
+            f"the torch backend does not support {', '.join(problem.extensions)}; use "
+            "backend='numpy'"
+        )
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,

@@ -43,15 +43,20 @@ from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import n_workers, run_chains
 from gpmsa.mcmc.sampler import require_finite
+from gpmsa.model import constraints
 from gpmsa.model.data import ObsData, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
-def calibration_problem(emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False) -> Problem:
+def calibration_problem(
+    emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False, constraint=None,
+    theta_init=None,
+) -> Problem:  # fmt: skip
     """The calibration-only Problem: the emulator's parameters at its point estimate in ``fixed``.
 
     Sampled: theta, lamOs (and betaV, lamVz with a discrepancy basis, "constant" for a scalar
-    output; "constant", "linear" or a matrix for a vector output).
+    output; "constant", "linear" or a matrix for a vector output). ``constraint`` and
+    ``theta_init`` as ``calibrate``'s.
     """
     check_emulator(emulator)
     start = None
@@ -66,7 +71,8 @@ def calibration_problem(emulator, x_obs, y_obs, *, discrepancy=None, extrapolate
         if emulator.K.shape[0] == 1 and y.size == x.shape[0]:
             y = y.reshape(-1, 1)
         obs, corr = reduce_obs(
-            ObsData(x, y), emulator.standardizer, emulator.K, discrepancy, emulator.x_names
+            ObsData(x, y), emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
+            getattr(emulator, "levels", None),
         )
     pri = emulator.priors
     lo = pri.lamOs
@@ -77,10 +83,22 @@ def calibration_problem(emulator, x_obs, y_obs, *, discrepancy=None, extrapolate
         init[k] = np.array(emulator.params[k], dtype=float).reshape(init[k].shape)
     if start is not None:
         init["lamOs"] = np.array([start])
+    con, theta0 = _theta_options(emulator, constraint, theta_init)
+    if theta0 is not None:
+        init["theta"] = theta0
     return Problem(
         emulator.x_unit, emulator.t_unit, emulator.w, emulator.lam_sim, priors, init,
-        frozenset(EMULATOR_PARAMS), obs,
+        frozenset(EMULATOR_PARAMS), obs, getattr(emulator, "categorical_mask", None),
+        getattr(emulator, "mean_basis", None), con,
     )  # fmt: skip
+
+
+def _theta_options(emulator, constraint, theta_init):
+    """The ``ThetaConstraint`` (or None) and the unit-scale start of theta (or None)."""
+    std = emulator.standardizer
+    names = tuple(emulator.t_names)
+    con = constraints.make(constraint, std.t_min, std.t_max, names)
+    return con, constraints.theta_init_unit(theta_init, std.t_min, std.t_max, names)
 
 
 def calibrate(
@@ -105,6 +123,8 @@ def calibrate(
     progress: bool = False,
     n_jobs: int | None = None,
     executor=None,
+    constraint=None,
+    theta_init=None,
 ) -> Posterior:
     """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
 
@@ -130,6 +150,10 @@ def calibrate(
             (None: every CPU, never more than the chains) or any ``concurrent.futures.Executor``
             / dask ``Client``; each chain has its own seed, so the draws do not depend on it.
             With ``log_prior`` (a callable, not shipped to workers) the chains run here.
+        constraint: optional callable of native theta (q,) -> bool, False where theta is not
+            allowed: zero prior mass there (no draw inside the forbidden region); a constraint
+            that rejects the start is a GPMSAError. Chains run in this process.
+        theta_init: start of theta (native, (q,); default the centre of the design's range).
 
     With more than one chain, ``info["diagnostics"]`` holds each parameter's rank-normalised
     R-hat and bulk ESS (and mean, sd), ``info["convergence"]`` the verdict, and a
@@ -156,6 +180,8 @@ def calibrate(
     if not fast and (emulator_params != "point" or log_prior is not None):
         raise GPMSAError("emulator_params='draws' and log_prior need the fast numpy path")
     _check_calibrate_memory(emulator, n_samples, n_chains, fast)
+    _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
+    theta_opts = {"constraint": constraint, "theta_init": theta_init}
     t0 = time.perf_counter()
     with blas_controller().limit(limits=1, user_api="blas"):
         where = {"n_jobs": n_jobs, "executor": executor}
@@ -165,12 +191,12 @@ def calibrate(
         if fast:
             draws, info = _run_fast(
                 emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds,
-                tune_levels, seed, log_prior, progress, where,
+                tune_levels, seed, log_prior, progress, where, theta_opts,
             )  # fmt: skip
         else:
             draws, info = _run_backend(
                 emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
-                tune_rounds, tune_levels, seed, extrapolate, progress, where,
+                tune_rounds, tune_levels, seed, extrapolate, progress, where, theta_opts,
             )  # fmt: skip
     require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
@@ -179,6 +205,7 @@ def calibrate(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds,
+        units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
     )  # fmt: skip
     if n_chains > 1:
         info["diagnostics"] = summarize(chains)
@@ -220,9 +247,10 @@ def _fast_chain(
 
 def _run_fast(
     emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds, tune_levels, seed,
-    log_prior, progress, where,
+    log_prior, progress, where, theta_opts,
 ):  # fmt: skip
     std = emulator.standardizer
+    con, theta0 = _theta_options(emulator, **theta_opts)
     extra = None
     if log_prior is not None:
         if not callable(log_prior):
@@ -236,11 +264,14 @@ def _run_fast(
 
     sampler = CalibrationSampler(
         [fixed_gp(emulator, s) for s in sets], data, emulator.priors, extra,
-        init_lamos=lamos_start(fit, data.lamos),
+        init_lamos=lamos_start(fit, data.lamos), constraint=con, init_theta=theta0,
     )  # fmt: skip
-    if extra is not None:  # a callable of this process: the chains run here
+    if extra is not None or con is not None:  # a callable of this process: chains run here
         if where["executor"] is not None:
-            raise GPMSAError("log_prior is a callable of this process: it cannot go to executor=")
+            raise GPMSAError(
+                "log_prior and constraint are callables of this process: they cannot go to "
+                "executor="
+            )
         n_workers(where["n_jobs"], n_chains)  # still refuse a bad n_jobs
         where = {"n_jobs": 1, "executor": None}
     tasks = [
@@ -269,12 +300,14 @@ def _run_fast(
 
 def _run_backend(
     emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tune_rounds,
-    tune_levels, seed, extrapolate, progress, where,
+    tune_levels, seed, extrapolate, progress, where, theta_opts,
 ):  # fmt: skip
     problem = calibration_problem(
-        emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate
+        emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate, **theta_opts
     )
     module = backends.get(backend)
+    if problem.constraint is not None:  # a callable of this process: the chains run here
+        where = {"n_jobs": 1, "executor": None}
     opts = {"tune_rounds": tune_rounds, "tune_levels": tune_levels} if backend == "numpy" else {}
     opts.update(backends.placement(backend, **where))
     chains = module.sample(

@@ -34,6 +34,7 @@ from gpmsa.calibration.observations import (
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
+from gpmsa.model import constraints
 from gpmsa.model.data import check_seed
 
 METHODS = ("auto", "grid", "mcmc")
@@ -63,6 +64,9 @@ class Calibrator:
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
             ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
             "auto" choose MCMC.
+        constraint: optional callable of native theta (q,) -> bool, False where theta is not
+            allowed: zero prior mass there (grid nodes get weight 0; MCMC passes it to
+            ``gpmsa.calibrate``).
     """
 
     def __init__(
@@ -78,8 +82,12 @@ class Calibrator:
         seed=None,
         mcmc_options: dict | None = None,
         backend: str = "numpy",
+        constraint=None,
     ) -> None:
         check_emulator(emulator)
+        std = emulator.standardizer
+        self.constraint = constraints.make(constraint, std.t_min, std.t_max,
+                                           tuple(emulator.t_names))  # fmt: skip
         if method not in METHODS:
             raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
         backends.get(backend)  # unknown or not installed: a clear error now, not at update()
@@ -109,6 +117,8 @@ class Calibrator:
         self._entropy = np.random.SeedSequence(check_seed(seed)).entropy
         self._count = 0
         self.mcmc_options = dict(mcmc_options or {})
+        if constraint is not None:
+            self.mcmc_options.setdefault("constraint", constraint)
         if n_grid is None:
             n_grid = 129 if q == 1 else 65
         if not (isinstance(n_grid, int | np.integer) and n_grid >= 3):
@@ -275,7 +285,7 @@ class Calibrator:
             margs = self._marginals(data, None, fits)
             outside = min(f.outside_sds for f in fits)
             warn_if_outside(Fit(outside, 0.0))
-            logp = self._combine(margs) + self._log_prior_theta
+            logp = self._combine(margs) + self._log_prior_theta + self._allowed(theta)
             if prior is not None:
                 logp = logp + self._prior_values(prior, theta, True)
             if np.any(np.isnan(logp)) or not np.any(np.isfinite(logp)):
@@ -293,10 +303,18 @@ class Calibrator:
         post.info["outside_sds"] = outside
         return post
 
+    def _allowed(self, theta_unit: np.ndarray) -> np.ndarray:
+        """0 at unit-scale nodes (G, q) the constraint allows, -inf elsewhere."""
+        if self.constraint is None:
+            return np.zeros(theta_unit.shape[0])
+        ok = np.array([self.constraint(t) for t in theta_unit])
+        return np.where(ok, 0.0, -np.inf)
+
     def _theta_prior_at(self, theta_unit: np.ndarray, prior) -> np.ndarray:
         """The emulator's theta prior plus the user's at refined unit-scale nodes."""
         pri = self.emulator.priors
         base = -0.5 * np.sum(((theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1)
+        base = base + self._allowed(theta_unit)
         return base if prior is None else base + self._prior_values(prior, theta_unit, False)
 
     def _posterior(self, theta, logp, margs: list[LamOsMarginal], key) -> Posterior:
@@ -354,6 +372,7 @@ class Calibrator:
             "refined": theta is not self._theta_unit,
             "log_evidence": log_evidence,
             "emulator_params": self.emulator_params,
+            "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
         return Posterior(grids=grids, draw=draw, info=info)
 

@@ -25,6 +25,7 @@ from scipy.special import gammainc, gammainccinv, gammaln
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.correlation import correlation
+from gpmsa.model.mean_basis import GLS, MeanBasis
 
 _LOG_2PI = float(np.log(2.0 * np.pi))
 _LOG_2 = float(np.log(2.0))
@@ -42,6 +43,9 @@ class FixedGP:
         lam_sim: (p_u,) diag(K^T K).
         betaU: (p + q, p_u) correlation parameters (x rows first).
         lamUz: (p_u,) GP precisions; lamWs: (p_u,) nugget precisions; lamWOs: scalar.
+        categorical: boolean mask (p + q,) of categorical inputs (None: none).
+        mean_basis: the weights' mean basis (None: zero mean); its coefficients are the GLS
+            estimates at these parameters (``coef`` (p_u, k)), ``alpha`` = Sigma_W^-1 (w - H c).
     """
 
     def __init__(
@@ -54,6 +58,8 @@ class FixedGP:
         lamUz: np.ndarray,
         lamWs: np.ndarray,
         lamWOs: float,
+        categorical: np.ndarray | None = None,
+        mean_basis: MeanBasis | None = None,
     ) -> None:
         self.x_sim = np.asarray(x_sim, dtype=float)
         self.t_sim = np.asarray(t_sim, dtype=float)
@@ -68,6 +74,12 @@ class FixedGP:
         lam_sim = np.asarray(lam_sim, dtype=float).ravel()
         lamWOs = float(np.asarray(lamWOs).ravel()[0])
         z = np.hstack([self.x_sim, self.t_sim])
+        self.cat = categorical
+        self.cat_x = None if categorical is None else categorical[: self.p]
+        self.cat_t = None if categorical is None else categorical[self.p :]
+        self.mean_basis = mean_basis
+        H = None if mean_basis is None else mean_basis.matrix(z)
+        self.coef = None
         check_memory(
             8.0 * self.m * self.m * (self.p_u + 2 + self.p + self.q),
             f"the emulator's GP ({self.m} runs, {self.p_u} components: an m x m factor each)",
@@ -75,7 +87,7 @@ class FixedGP:
         chol = np.empty((self.p_u, self.m, self.m))
         alpha = np.empty((self.p_u, self.m))
         for c in range(self.p_u):
-            sigma = correlation(z, None, self.betaU[:, c]) / self.lamUz[c]
+            sigma = correlation(z, None, self.betaU[:, c], categorical) / self.lamUz[c]
             sigma[np.diag_indices_from(sigma)] += 1.0 / (lam_sim[c] * lamWOs) + 1.0 / self.lamWs[c]
             try:
                 chol[c] = cholesky(sigma, lower=True)
@@ -84,21 +96,27 @@ class FixedGP:
                     f"Sigma_W of component {c} is not positive definite at these emulator "
                     f"parameters ({exc})"
                 ) from exc
-            alpha[c] = cho_solve((chol[c], True), w[:, c])
+            if H is None:
+                alpha[c] = cho_solve((chol[c], True), w[:, c])
+                continue
+            gls = GLS.of(chol[c], w[:, c], H)
+            alpha[c] = gls.alpha
+            self.coef = np.zeros((self.p_u, H.shape[1])) if self.coef is None else self.coef
+            self.coef[c] = gls.coef
         self.chol = chol
         self.alpha = alpha
 
     def corr_x(self, x: np.ndarray, c: int) -> np.ndarray:
         """R over the x part between points x (n, p) and the design: (n, m)."""
-        return correlation(x, self.x_sim, self.betaU[: self.p, c])
+        return correlation(x, self.x_sim, self.betaU[: self.p, c], self.cat_x)
 
     def corr_t(self, theta: np.ndarray, c: int) -> np.ndarray:
         """R over the t part between points theta (G, q) and the design: (G, m)."""
-        return correlation(theta, self.t_sim, self.betaU[self.p :, c])
+        return correlation(theta, self.t_sim, self.betaU[self.p :, c], self.cat_t)
 
     def prior_cov(self, x: np.ndarray, c: int) -> np.ndarray:
         """Sigma_U for component c among obs points at one theta (n, n), nugget included."""
-        r = correlation(x, None, self.betaU[: self.p, c]) / self.lamUz[c]
+        r = correlation(x, None, self.betaU[: self.p, c], self.cat_x) / self.lamUz[c]
         return r + np.eye(x.shape[0]) / self.lamWs[c]
 
     def predict(self, x: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -118,11 +136,16 @@ class FixedGP:
         )
         mean = np.empty((G, self.p_u, n))
         cov = np.empty((G, self.p_u, n, n))
+        h = None
+        if self.coef is not None:  # the GLS mean at every (theta_g, x_j): (G * n, k)
+            h = self.mean_basis.matrix(np.hstack([np.tile(x, (G, 1)), np.repeat(theta, n, 0)]))
         for c in range(self.p_u):
             rx = self.corr_x(x, c)
             rt = self.corr_t(theta, c)
             r = (rt[:, None, :] * rx[None, :, :]).reshape(G * n, self.m) / self.lamUz[c]
             mean[:, c, :] = (r @ self.alpha[c]).reshape(G, n)
+            if h is not None:
+                mean[:, c, :] += (h @ self.coef[c]).reshape(G, n)
             v = solve_triangular(self.chol[c], r.T, lower=True).T.reshape(G, n, self.m)
             cov[:, c] = self.prior_cov(x, c)[None] - np.einsum("gim,gjm->gij", v, v)
         return mean, cov
@@ -161,9 +184,8 @@ class GridPredictor:
         self.theta = np.asarray(theta, dtype=float)
         G = self.theta.shape[0]
         self.rt_alpha = np.empty((gp.p_u, G, gp.m))
-        coefs = (
-            [_cheb_coefficients(gp, c, tol, max_deg) for c in range(gp.p_u)] if gp.p == 1 else []
-        )
+        plain = gp.p == 1 and gp.cat is None and gp.mean_basis is None  # else: dense solves
+        coefs = [_cheb_coefficients(gp, c, tol, max_deg) for c in range(gp.p_u)] if plain else []
         usable = len(coefs) == gp.p_u and all(cf is not None for cf in coefs)
         na = max((cf.shape[0] for cf in coefs if cf is not None), default=0) if usable else 0
         check_memory(

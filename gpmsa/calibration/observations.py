@@ -12,6 +12,7 @@ from threadpoolctl import ThreadpoolController
 from gpmsa import limits
 from gpmsa.calibration.model import FixedGP, LamOsPrior
 from gpmsa.errors import GPMSAError, OutsideEmulatorWarning, ResourceLimitError
+from gpmsa.model import categorical
 from gpmsa.model.data import ObsData, check_finite
 from gpmsa.model.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
 
@@ -51,6 +52,11 @@ def check_emulator(emulator) -> None:
         raise GPMSAError(f"emulator.params lacks {absent}; it needs {EMULATOR_PARAMS}")
     if emulator.t_unit.shape[1] < 1:
         raise GPMSAError("the emulator has no calibration parameter (t has 0 columns)")
+    levels = getattr(emulator, "levels", None)
+    if levels is not None:
+        categorical.refuse_categorical_theta(
+            levels, emulator.x_unit.shape[1], emulator.x_names + emulator.t_names, "calibration"
+        )
 
 
 def emulator_param_sets(emulator, mode: str, n_sets: int) -> list[dict]:
@@ -81,6 +87,7 @@ def fixed_gp(emulator, params: dict | None = None) -> FixedGP:
     return FixedGP(
         emulator.x_unit, emulator.t_unit, emulator.w, emulator.lam_sim,
         prm["betaU"], prm["lamUz"], prm["lamWs"], prm["lamWOs"],
+        getattr(emulator, "categorical_mask", None), getattr(emulator, "mean_basis", None),
     )  # fmt: skip
 
 
@@ -104,6 +111,9 @@ def check_x(emulator, x_obs, extrapolate: bool) -> tuple[np.ndarray, np.ndarray]
     ``extrapolate=True`` a warning."""
     p = emulator.x_unit.shape[1]
     x = _as_rows(x_obs, "x_obs", p)
+    levels = getattr(emulator, "levels", None)
+    if levels is not None:
+        categorical.check_levels(x, levels[:p], emulator.x_names, "x_obs")
     xu = emulator.standardizer.x_to_unit(x)
     out = (xu < 0.0) | (xu > 1.0)
     if out.any():

@@ -211,11 +211,17 @@ class Posterior:
             return to_inference_data({k: np.asarray(v) for k, v in self.chains.items()})
         return to_inference_data({k: np.asarray(v)[None, :] for k, v in self.samples.items()})
 
-    def plot(self, name: str, bins: int = 50):
-        """Histogram (with the grid density when there is one) and trace of ``name``: a Figure."""
+    def plot(self, name: str, bins: int = 50, unit: str | None = None):
+        """Histogram (with the grid density when there is one) and trace of ``name``: a Figure.
+
+        ``unit`` labels the axes (None: ``info["units"][name]`` where calibrate or Calibrator
+        recorded the emulator's units)."""
         from matplotlib.figure import Figure
 
         self._check(name)
+        if unit is None:
+            unit = (self.info.get("units") or {}).get(name, "")
+        label = f"{name} ({unit})" if unit else name
         fig = Figure(figsize=(9.0, 3.5))
         ax_h, ax_t = fig.subplots(1, 2)
         draws = np.asarray(self.samples[name])
@@ -224,14 +230,14 @@ class Posterior:
             g = self.grids[name]
             ax_h.plot(g.nodes, g.density, color="C0", label="exact (grid)")
         ax_h.axvline(self.mean(name), color="C3", lw=1, label="mean")
-        ax_h.set_xlabel(name)
-        ax_h.set_ylabel("density")
+        ax_h.set_xlabel(label)
+        ax_h.set_ylabel(f"density (1/{unit})" if unit else "density")
         ax_h.legend(fontsize="small")
         chains = self.chains[name] if self.chains is not None else draws[None, :]
         for c, chain in enumerate(np.atleast_2d(chains)):
             ax_t.plot(chain, lw=0.5, color=f"C{c}")
         ax_t.set_xlabel("draw")
-        ax_t.set_ylabel(name)
+        ax_t.set_ylabel(label)
         fig.tight_layout()
         return fig
 

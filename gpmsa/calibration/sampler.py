@@ -25,6 +25,7 @@ from scipy.linalg import solve_triangular
 from gpmsa.calibration.model import FixedGP
 from gpmsa.calibration.observations import Observations
 from gpmsa.mcmc import tuning
+from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.priors import Priors
 
 THETA_WIDTH = 0.2
@@ -213,6 +214,8 @@ class CalibrationSampler:
         log_prior: optional extra log prior of unit-scale theta (q,) -> float.
         init_lamos: start of lamOs (default GPM/SA's max(20, a/b) of its prior); see
             ``gpmsa.calibration.observations.lamos_start``.
+        constraint: allowed region of unit-scale theta (zero prior mass outside; None: all).
+        init_theta: start of unit-scale theta (q,) (default GPM/SA's 0.5).
     """
 
     def __init__(
@@ -222,6 +225,8 @@ class CalibrationSampler:
         priors: Priors,
         log_prior: Callable[[np.ndarray], float] | None = None,
         init_lamos: float | None = None,
+        constraint: ThetaConstraint | None = None,
+        init_theta: np.ndarray | None = None,
     ) -> None:
         self.preds = [ThetaPredictive(gp, data) for gp in gps]
         self.q = gps[0].q
@@ -230,6 +235,10 @@ class CalibrationSampler:
         self.extra = log_prior
         lo = data.lamos
         self.init_lamos = max(20.0, lo.shape / lo.rate) if init_lamos is None else init_lamos
+        self.constraint = constraint
+        self.init_theta = [0.5] * self.q if init_theta is None else [float(v) for v in init_theta]
+        if constraint is not None:
+            constraint.check_start(np.array(self.init_theta), "calibrate")
 
     def _log_prior_theta(self, theta: list[float]) -> float:
         """Truncated-normal prior of unit-scale theta (plus the extra prior), pure Python."""
@@ -240,6 +249,8 @@ class CalibrationSampler:
                 return -math.inf
             z = (t - pri.theta_mean) / pri.theta_sd
             lp -= 0.5 * z * z
+        if self.constraint is not None and not self.constraint(np.array(theta)):
+            return -math.inf
         if self.extra is not None:
             lp += float(self.extra(np.array(theta)))
         return lp
@@ -267,7 +278,7 @@ class CalibrationSampler:
         q = self.q
         names = ["theta"] * q + ["lamOs"]
         w = np.array([THETA_WIDTH] * q + [self.init_lamos / 2.0]) if widths is None else widths
-        state = _State(self, [0.5] * q, self.init_lamos, 0)
+        state = _State(self, self.init_theta, self.init_lamos, 0)
         n_tune = tune_rounds * tune_levels if tune else 0
         with tqdm(total=n_iter + n_tune, desc="calibrate", disable=not progress) as bar:
             if tune:

@@ -77,8 +77,9 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
         post = cal.update(x, y)
         summary = post.summary(args.level)
         seconds = time.perf_counter() - t0
-    except GPMSAError as exc:
-        print(f"gpmsa calibrate: {safe(exc)}", file=sys.stderr)
+    except GPMSAError as exc:  # the library's advice, in this command's words
+        advice = str(exc).replace("pass extrapolate=True", "pass --extrapolate")
+        print(f"gpmsa calibrate: {safe(advice)}", file=sys.stderr)
         return 2
     if args.json:
         out = {

@@ -66,6 +66,17 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
             rng = f" in [{dom[0]:.6g}, {dom[1]:.6g}]" if dom else ""
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
         lines.append(f"{label + ':':17s}{', '.join(parts)}")
+    cat = model.get("categorical") or {}
+    if cat:
+        lines.append("categorical:     " + ", ".join(
+            f"{safe(n, 60)} levels [{safe(', '.join(str(v) for v in lv), 300)}]"
+            for n, lv in cat.items()))  # fmt: skip
+    mean = model.get("mean_basis")
+    lines.append(f"mean basis:      {'zero (GPM/SA)' if mean is None else safe(mean, 60)}")
+    fixed = manifest["settings"].get("fixed")
+    if isinstance(fixed, dict) and fixed:
+        lines.append("fixed:           " + ", ".join(
+            f"{safe(k, 60)}={plain(v)}" for k, v in fixed.items()))  # fmt: skip
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))

@@ -26,9 +26,12 @@ from gpmsa.fitting.validation import (
 )
 from gpmsa.io.container import jsonable, read_raw, write_raw
 from gpmsa.limits import check_memory
+from gpmsa.model import categorical as categorical_mod
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import SimData, as_matrix
 from gpmsa.model.likelihood import lower_cholesky
+from gpmsa.model.mean_basis import GLS, MeanBasis
+from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
@@ -80,7 +83,9 @@ class Emulator:
     settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
     lamOs draws of a joint sim+obs fit, else None), convergence (several chains: R-hat and bulk
     ESS of every sampled parameter and the elements flagged, see
-    ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files).
+    ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files), levels
+    (per column of [x, t]: a categorical input's training levels, else None), mean_basis (the
+    weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md.
     """
 
     def __init__(
@@ -104,6 +109,8 @@ class Emulator:
         diagnostics: dict | None = None,
         calibration: dict[str, np.ndarray] | None = None,
         convergence: dict | None = None,
+        levels: categorical_mod.Levels | None = None,
+        mean_basis: MeanBasis | None = None,
     ):
         self.standardizer = standardizer
         self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
@@ -120,6 +127,8 @@ class Emulator:
         self.diagnostics = dict(diagnostics or {})
         self.calibration = calibration
         self.convergence = convergence
+        self.levels = (None,) * (self.p + self.q) if levels is None else tuple(levels)
+        self.mean_basis = mean_basis
         self._factors: dict[int, list] = {}
 
     # --- construction -------------------------------------------------------------------------
@@ -132,15 +141,17 @@ class Emulator:
         metadata: dict | None = None,
         *,
         n_pc: int | None = None,
+        mean_basis=None,
     ) -> Emulator:
         """An emulator at given unit-scale parameter values (no MCMC).
 
         ``params``: betaU (p+q, p_u), lamUz (p_u,), lamWs (p_u,), lamWOs (1,); arrays of the
         same sizes in other shapes (e.g. (1, p_u) as SEPIA stores them) are accepted.
+        ``mean_basis``: as ``gpmsa.fit``'s.
         """
         from gpmsa.model.problem import prepare
 
-        prep = prepare(sim_data, priors=priors, n_pc=n_pc)
+        prep = prepare(sim_data, priors=priors, n_pc=n_pc, mean_basis=mean_basis)
         return cls._from_prepared(sim_data, prep, params, metadata=metadata,
                                   settings={"source": "from_params"})  # fmt: skip
 
@@ -151,7 +162,8 @@ class Emulator:
             standardizer=prep.standardizer, x_unit=prob.x_sim, t_unit=prob.t_sim, y=sim.y,
             K=prep.K, w=prob.w, index=sim.index, params=params, priors=prob.priors,
             names={"x": sim.x_names, "t": sim.t_names, "y": sim.y_names},
-            units={"x": sim.x_units, "t": sim.t_units, "y": sim.y_units}, **kw,
+            units={"x": sim.x_units, "t": sim.t_units, "y": sim.y_units},
+            levels=sim.levels, mean_basis=prob.mean_basis, **kw,
         )  # fmt: skip
 
     # --- shapes and domain --------------------------------------------------------------------
@@ -201,31 +213,46 @@ class Emulator:
         return out
 
     @property
+    def categorical(self) -> dict[str, tuple[int, ...]]:
+        """The categorical inputs: name -> training levels (native integer codes)."""
+        names = self.x_names + self.t_names
+        return {n: lv for n, lv in zip(names, self.levels, strict=True) if lv is not None}
+
+    @property
+    def categorical_mask(self) -> np.ndarray | None:
+        """Boolean mask (p + q,) of the categorical inputs, None when there are none."""
+        return categorical_mod.mask(self.levels)
+
+    @property
     def n_draws(self) -> int:
         """Number of retained posterior draws."""
         return self.log_post.shape[0]
 
     # --- prediction ---------------------------------------------------------------------------
-    def _factor(self, params: dict[str, np.ndarray]) -> list[tuple[np.ndarray, np.ndarray]]:
-        """Per component: (Cholesky factor of Sigma_W_j, Sigma_W_j^-1 w_j)."""
+    def _factor(self, params: dict[str, np.ndarray]) -> list[tuple]:
+        """Per component: (Cholesky factor of Sigma_W_j, Sigma_W_j^-1 w_j, None), or with a
+        mean basis (L, Sigma_W_j^-1 (w_j - H c_j), the ``GLS`` fit c_j)."""
         out = []
         zt = self.zt
+        cat = self.categorical_mask
+        H = None if self.mean_basis is None else self.mean_basis.matrix(zt)
         check_memory(
             8.0 * self.m * self.m * (2 * self.p_u + self.p + self.q + 2),
             f"the emulator's factorisation ({self.m} runs x {self.p_u} components)",
         )
         for j in range(self.p_u):
-            S = correlation(zt, None, params["betaU"][:, j]) / params["lamUz"][j]
+            S = correlation(zt, None, params["betaU"][:, j], cat) / params["lamUz"][j]
             nug = 1.0 / (self.lam_sim[j] * params["lamWOs"][0]) + 1.0 / params["lamWs"][j]
             S[np.diag_indices(self.m)] += nug
             L = lower_cholesky(S) if np.all(np.isfinite(S)) else None
             if L is None:
                 raise GPMSAError("Sigma_W is not positive definite at these parameters")
             L = np.tril(L)
-            alpha = cho_solve((L, True), self.w[:, j])
+            gls = None if H is None else GLS.of(L, self.w[:, j], H)
+            alpha = cho_solve((L, True), self.w[:, j]) if gls is None else gls.alpha
             if not np.all(np.isfinite(alpha)):
                 raise GPMSAError("Sigma_W is numerically singular at these parameters")
-            out.append((L, alpha))
+            out.append((L, alpha, gls))
         return out
 
     def _point_factor(self):
@@ -245,8 +272,9 @@ class Emulator:
                 raise GPMSAError(
                     f"x and t need the same number of rows, got {x.shape} and {t.shape}"
                 )
-        z = np.hstack([self.standardizer.x_to_unit(x), self.standardizer.t_to_unit(t)])
         names = self.x_names + self.t_names
+        categorical_mod.check_levels(np.hstack([x, t]), self.levels, names, "predict()")
+        z = np.hstack([self.standardizer.x_to_unit(x), self.standardizer.t_to_unit(t)])
         lo, hi = z.min(axis=0), z.max(axis=0)
         far = (lo < -EXTRAPOLATION_MARGIN) | (hi > 1 + EXTRAPOLATION_MARGIN)
         if far.any():
@@ -264,11 +292,16 @@ class Emulator:
     def _predict_std(self, z: np.ndarray, params, factors, resid: bool):
         mean = np.zeros((z.shape[0], self.l_sim))
         var = np.zeros((z.shape[0], self.l_sim))
-        for j, (L, a) in enumerate(factors):
-            r = correlation(z, self.zt, params["betaU"][:, j]) / params["lamUz"][j]
+        cat = self.categorical_mask
+        h = None if self.mean_basis is None else self.mean_basis.matrix(z)
+        for j, (L, a, gls) in enumerate(factors):
+            r = correlation(z, self.zt, params["betaU"][:, j], cat) / params["lamUz"][j]
             mw = r @ a
             v = solve_triangular(L, r.T, lower=True)
             vw = 1.0 / params["lamUz"][j] - np.sum(v**2, axis=0)
+            if gls is not None:  # the GLS mean and its coefficients' variance
+                mw = mw + h @ gls.coef
+                vw = vw + gls.variance(h, v)
             if resid:
                 vw = vw + 1.0 / params["lamWs"][j]
             mean += np.outer(mw, self.K[:, j])
@@ -324,7 +357,7 @@ class Emulator:
         """
         mean_w = np.zeros((self.m, self.p_u))
         var_w = np.zeros((self.m, self.p_u))
-        for j, (L, a) in enumerate(self._point_factor()):
+        for j, (L, a, _) in enumerate(self._point_factor()):
             Linv = solve_triangular(L, np.eye(self.m), lower=True)
             d = np.sum(Linv**2, axis=0)
             mean_w[:, j] = self.w[:, j] - a / d
@@ -374,6 +407,11 @@ class Emulator:
         diagnostics, JSON-able (non-finite floats become null); the arrays are float64.
         Raises GPMSAError when ``metadata`` is not JSON-able.
         """
+        if self.mean_basis is not None and self.mean_basis.kind not in MEAN_BASIS_KINDS:
+            raise GPMSAError(
+                "an emulator with a callable mean_basis cannot be saved (a file holds no code); "
+                f"fit with one of the named mean bases {MEAN_BASIS_KINDS} to save it"
+            )
         s = self.standardizer
         arrays = {
             "x_unit": self.x_unit, "t_unit": self.t_unit, "y": self.y, "K": self.K, "w": self.w,
@@ -400,10 +438,13 @@ class Emulator:
                 "q": self.q,
                 "p_u": self.p_u,
                 "l_sim": self.l_sim,
-                "correlation": "R(a,b) = exp(-sum_k beta_k (a_k - b_k)^2) on unit-scale inputs",
+                "correlation": "R(a,b) = exp(-sum_k beta_k d_k(a_k, b_k)) on unit-scale inputs, "
+                "d_k = (a_k - b_k)^2, or 1/4 * 1[a_k != b_k] for a categorical input",
                 "noise": "w_j ~ GP(0, R/lamUz_j) + nugget 1/lamWs_j; residual outside the basis "
                 "has precision lamWOs * lam_sim_j; outputs standardised by y_mean, y_sd",
                 "point_estimate": self.settings.get("point", "given"),
+                "categorical": {k: list(v) for k, v in self.categorical.items()},
+                "mean_basis": None if self.mean_basis is None else self.mean_basis.kind,
             },  # fmt: skip
             "priors": self.priors.to_dict(),
             "settings": self.settings,
@@ -446,6 +487,7 @@ class Emulator:
                 draws=draws, log_post=arrays["log_post"], metadata=manifest["metadata"],
                 settings=manifest["settings"], diagnostics=manifest["diagnostics"],
                 calibration=cal, convergence=manifest.get("convergence"),  # check_fields checked it
+                levels=_levels(manifest, names), mean_basis=_mean_basis(manifest, names),
             )  # fmt: skip
             _check_consistent(emu)
             domain = {k: list(v) for k, v in emu.domain.items()}
@@ -502,6 +544,17 @@ def load(path: str | Path, *, sha256: str | None = None) -> Emulator:
         return Emulator.from_record(manifest, arrays)
     except EmulatorFileError as exc:
         raise EmulatorFileError(f"{path}: {exc}") from exc
+
+
+def _levels(manifest: dict, names: dict) -> categorical_mod.Levels:
+    """Per input column, the levels the file declares (None: continuous)."""
+    cat = manifest["model"].get("categorical", {})
+    return tuple(tuple(cat[n]) if n in cat else None for n in names["x"] + names["t"])
+
+
+def _mean_basis(manifest: dict, names: dict) -> MeanBasis | None:
+    kind = manifest["model"].get("mean_basis")
+    return None if kind is None else MeanBasis(kind, len(names["x"]) + len(names["t"]))
 
 
 def _check_consistent(emu: Emulator) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from datetime import datetime, timezone
 
 import numpy as np
@@ -13,9 +14,10 @@ from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
+from gpmsa.model import constraints
 from gpmsa.model.data import ObsData, SimData, check_seed
 from gpmsa.model.priors import Priors
-from gpmsa.model.problem import prepare
+from gpmsa.model.problem import Problem, prepare
 
 N_KEEP = 1000
 """Default number of retained draws (all chains together) after burn-in and thinning."""
@@ -59,6 +61,10 @@ def fit(
     metadata: dict | None = None,
     n_jobs: int | None = None,
     executor=None,
+    mean_basis=None,
+    fixed: dict | None = None,
+    constraint=None,
+    theta_init=None,
     **options,
 ) -> Emulator:
     """Fit the emulator by GPM/SA's Metropolis-within-Gibbs; returns an ``Emulator``.
@@ -73,6 +79,14 @@ def fit(
     the chains run (numpy backend: ``n_jobs`` worker processes, None = every CPU but never more
     than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws are the
     same wherever they run. options: passed to the backend's ``sample`` (e.g. ``init``).
+
+    Beyond GPM/SA's model (numpy backend; docs/categorical-and-constraints.md): categorical
+    inputs are declared in ``SimData``. mean_basis: None (zero mean, GPM/SA), "constant",
+    "linear" or a callable of unit-scale [x, t] (n, p + q) -> (n, k); its coefficients are
+    integrated out (flat prior). fixed: name -> value held fixed (model scales as
+    ``Emulator.params``; theta in native units), e.g. ``{"lamWOs": 1e5 - 1}``. constraint (joint
+    fit only): a callable of native theta (q,) -> bool, False where theta is not allowed (zero
+    prior mass there). theta_init: the chains' start of theta (native, (q,); default the centre).
 
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
@@ -91,12 +105,14 @@ def fit(
     if n_keep < 1:
         raise GPMSAError(f"n_keep must be >= 1, got {n_keep}")
     seed = _seed(seed)
-    prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
-    _check_fit_memory(prep.problem, int(n_iter), int(n_chains))
+    prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
+                   mean_basis=mean_basis)  # fmt: skip
+    problem = _model_options(prep, data, fixed, constraint, theta_init)
+    _check_fit_memory(problem, int(n_iter), int(n_chains))
     module = backends.get(backend)
     options.update(backends.placement(backend, n_jobs, executor))
     chains = module.sample(
-        prep.problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
+        problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,
     )  # fmt: skip
     chains.check_finite()
@@ -122,6 +138,9 @@ def fit(
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),
+        "mean_basis": None if problem.mean_basis is None else problem.mean_basis.kind,
+        "fixed": {k: problem.init[k].tolist() for k in sorted(problem.fixed)},
+        "constraint": constraint is not None,
         "step_widths": {k: v.tolist() for k, v in chains.step_widths.items()},
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "versions": library_versions(backend),
@@ -129,7 +148,7 @@ def fit(
     summary = summarize(post, chains.accept_rate)
     record = None
     if n_chains > 1:
-        shapes = {k: prep.problem.init[k].shape for k in prep.problem.sampled}
+        shapes = {k: problem.init[k].shape for k in problem.sampled}
         record = convergence(summary, shapes, n_chains, kept)
         warn_unconverged(record, f"gpmsa.fit (backend {backend!r})")
     return Emulator._from_prepared(
@@ -138,3 +157,24 @@ def fit(
         metadata=metadata, settings=settings,
         diagnostics=summary, calibration=calibration, convergence=record,
     )  # fmt: skip
+
+
+def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Problem:
+    """``prep.problem`` with the theta constraint, theta's start and the fixed parameters."""
+    problem = prep.problem
+    std = prep.standardizer
+    if (constraint is not None or theta_init is not None) and problem.obs is None:
+        raise GPMSAError("constraint= and theta_init= apply to theta: they need obs= (a joint fit)")
+    if constraint is not None:
+        problem = replace(problem, constraint=constraints.make(
+            constraint, std.t_min, std.t_max, data.t_names))  # fmt: skip
+    start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, data.t_names)
+    if start is not None:
+        problem = problem.with_init({"theta": start})
+    if fixed:
+        fixed = dict(fixed)
+        if "theta" in fixed and problem.obs is not None:
+            fixed["theta"] = constraints.theta_init_unit(
+                fixed["theta"], std.t_min, std.t_max, data.t_names)  # fmt: skip
+        problem = problem.with_fixed(fixed)
+    return problem

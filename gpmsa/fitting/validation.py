@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError
+from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.transforms import UNIT_TOL
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -201,6 +202,49 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
             raise _fail(key, f"must be an object, got {_short(manifest.get(key))}")
     if manifest.get("convergence") is not None and not isinstance(manifest["convergence"], dict):
         raise _fail("convergence", f"must be an object, got {_short(manifest['convergence'])}")
+    _check_model_options(model, inputs)
+
+
+def _check_model_options(model: dict, inputs: list[str]) -> None:
+    """The declared categorical inputs (model.categorical: name -> sorted integer levels, at
+    least two) and the mean basis (model.mean_basis: null or a named kind); absent in files
+    written before they existed."""
+    cat = model.get("categorical", {})
+    if not isinstance(cat, dict):
+        raise _fail("model.categorical", f"must be an object name -> levels, got {_short(cat)}")
+    for name, levels in cat.items():
+        field = f"model.categorical.{name}"
+        if name not in inputs:
+            raise _fail(field, f"is not an input (inputs {_short(inputs)})")
+        ok = isinstance(levels, list) and len(levels) >= 2 and all(
+            isinstance(v, int) and not isinstance(v, bool) for v in levels)  # fmt: skip
+        if not ok or levels != sorted(set(levels)):
+            raise _fail(field, f"must be a sorted list of >= 2 distinct integers, got "
+                        f"{_short(levels)}")  # fmt: skip
+    kind = model.get("mean_basis")
+    if kind is not None and kind not in MEAN_BASIS_KINDS:
+        raise _fail("model.mean_basis",
+                    f"must be null or one of {MEAN_BASIS_KINDS}, got {_short(kind)}")  # fmt: skip
+
+
+def check_categorical(manifest: dict, arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
+    """Each declared categorical input's levels are exactly the integer values its design
+    column takes (native units, from the unit design and its min/max)."""
+    cat = manifest.get("model", {}).get("categorical", {})
+    names = manifest["names"]["x"] + manifest["names"]["t"]
+    design = np.hstack([
+        arrays["x_unit"] * (arrays["x_max"] - arrays["x_min"]) + arrays["x_min"],
+        arrays["t_unit"] * (arrays["t_max"] - arrays["t_min"]) + arrays["t_min"],
+    ])  # fmt: skip
+    for name, levels in cat.items():
+        col = design[:, names.index(name)]
+        codes = np.round(col)
+        if np.any(np.abs(col - codes) > 1e-6 * np.maximum(1.0, np.abs(codes))):
+            raise _fail(f"model.categorical.{name}", "its design column holds non-integer values")
+        found = [int(v) for v in np.unique(codes)]
+        if found != levels:
+            raise _fail(f"model.categorical.{name}",
+                        f"declares levels {_short(levels)} but the design has {_short(found)}")
 
 
 def check_manifest(manifest: dict) -> None:
@@ -326,4 +370,5 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     dims = check_shapes({k: v.shape for k, v in arrays.items()})
     check_fields(manifest, dims)
     check_values(arrays, dims)
+    check_categorical(manifest, arrays, dims)
     return dims

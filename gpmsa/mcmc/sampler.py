@@ -142,6 +142,9 @@ class ChainState:
         self.prior = problem.priors.log_prior
         self.el_prior = [problem.priors.scalar_log_prior(n) for n, _ in self.els]
         self.log_prior = sum(self.prior(n, self.lik.params[n]) for n in problem.sampled)
+        self.constraint = problem.constraint if "theta" in problem.sampled else None
+        if self.constraint is not None:
+            self.constraint.check_start(self.lik.params["theta"], "the chain's start")
 
     @property
     def params(self) -> dict[str, np.ndarray]:
@@ -179,6 +182,11 @@ class ChainState:
             lp_new = prior(cand)
             if lp_new == -math.inf:
                 continue
+            if name == "theta" and self.constraint is not None:
+                theta = lik.params["theta"].copy()
+                theta[idx] = cand
+                if not self.constraint(theta):  # zero prior mass outside the constraint
+                    continue
             ll_old = lik.loglik
             ll_new = lik.propose(name, idx, cand)
             if ll_new == -math.inf:

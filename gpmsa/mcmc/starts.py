@@ -12,7 +12,9 @@ values, as GPM/SA does.
 - ``"prior"``: from the (data-corrected) prior: theta from the truncated normal, rho from
   Beta(rho_a, rho_b) capped at rho_cap, precisions from their truncated Gammas.
 
-Fixed parameters keep ``problem.init``. Each chain draws its start from its own generator
+Fixed parameters keep ``problem.init``. With a theta constraint (``problem.constraint``),
+dispersed and prior starts of theta are redrawn until the constraint holds (``MAX_REDRAWS``).
+Each chain draws its start from its own generator
 (``start_generator``), separate from the stream of its sweeps.
 """
 
@@ -27,6 +29,8 @@ from gpmsa.model.problem import Problem
 CHOICES = ("auto", "gpmsa", "jitter", "prior")
 RHO_JITTER = (0.5, 0.99)
 """Range of the uniform start of rho = exp(-beta/4) under ``"jitter"`` (GPM/SA's: 0.975)."""
+MAX_REDRAWS = 1000
+"""Draws of a dispersed or prior theta start tried against a theta constraint."""
 PRECISION_JITTER = 10.0
 """Factor f of the log-uniform start of a precision under ``"jitter"``."""
 
@@ -80,10 +84,7 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
         x0 = out[name]
         size = x0.size
         if name == "theta":
-            if how == "jitter":
-                val = rng.uniform(0.1, 0.9, size)
-            else:
-                val = _truncnorm01(pri.theta_mean, pri.theta_sd, size, rng)
+            val = _theta_start(problem, how, size, rng)
         elif name in ("betaU", "betaV"):
             if how == "jitter":
                 rho = rng.uniform(*RHO_JITTER, size)
@@ -101,3 +102,19 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
                 val = _gamma(g, size, rng)
         out[name] = np.asarray(val, dtype=np.float64).reshape(x0.shape)
     return out
+
+
+def _theta_start(problem: Problem, how: str, size: int, rng: np.random.Generator) -> np.ndarray:
+    """A dispersed ("jitter") or prior theta start inside the theta constraint (if any)."""
+    pri = problem.priors
+    for _ in range(MAX_REDRAWS):
+        if how == "jitter":
+            val = rng.uniform(0.1, 0.9, size)
+        else:
+            val = _truncnorm01(pri.theta_mean, pri.theta_sd, size, rng)
+        if problem.constraint is None or problem.constraint(val):
+            return val
+    raise GPMSAError(
+        f"no {how!r} start of theta inside the theta constraint in {MAX_REDRAWS} draws; pass "
+        "init='gpmsa' with theta_init= inside the allowed region"
+    )

@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model import categorical
 
 
 def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
@@ -95,6 +96,8 @@ class SimData:
 
     ``index`` (l_sim,) is the output grid of a multivariate output (None: 0..l_sim-1).
     Names default to x0.., t0.., y0..; units to "". A 1-D ``x``, ``t`` or ``y`` is one column.
+    ``x_categorical``, ``t_categorical``: the categorical inputs (column indices or names; None:
+    none), whose values are integer level codes; see docs/categorical-and-constraints.md.
     """
 
     x: np.ndarray
@@ -107,6 +110,8 @@ class SimData:
     x_units: tuple[str, ...] | None = None
     t_units: tuple[str, ...] | None = None
     y_units: tuple[str, ...] | None = None
+    x_categorical: Sequence[int | str] | None = None
+    t_categorical: Sequence[int | str] | None = None
 
     def __post_init__(self) -> None:
         x = as_matrix(self.x, "x")
@@ -144,6 +149,11 @@ class SimData:
         object.__setattr__(self, "x_units", _units(self.x_units, p, "x_units"))
         object.__setattr__(self, "t_units", _units(self.t_units, q, "t_units"))
         object.__setattr__(self, "y_units", _units(self.y_units, y.shape[1], "y_units"))
+        for arr, attr, names in ((x, "x_categorical", self.x_names),
+                                 (t, "t_categorical", self.t_names)):  # fmt: skip
+            cols = categorical.columns(getattr(self, attr), names, attr)
+            categorical.check_integer_levels(arr, cols, names, attr[0])
+            object.__setattr__(self, attr, cols)
 
     @property
     def m(self) -> int:
@@ -169,6 +179,11 @@ class SimData:
     def grid(self) -> np.ndarray:
         """Output index grid (l_sim,): ``index`` or 0..l_sim-1."""
         return self.index if self.index is not None else np.arange(self.l_sim, dtype=np.float64)
+
+    @property
+    def levels(self) -> categorical.Levels:
+        """Per column of [x, t]: the training levels of a categorical input, None otherwise."""
+        return categorical.levels_of(self.x, self.t, self.x_categorical, self.t_categorical)
 
 
 @dataclass(frozen=True, eq=False)

@@ -9,9 +9,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.linalg import lapack
+from scipy.linalg import cho_solve, lapack
 
 from gpmsa.model.correlation import correlation, sq_diffs
+from gpmsa.model.mean_basis import GLS
 from gpmsa.model.problem import Problem
 
 
@@ -44,33 +45,46 @@ def log_likelihood(problem: Problem, params: dict[str, np.ndarray]) -> float:
     zt, w = problem.zt, problem.w
     m = problem.m
     bu, luz, lws, lwos = (params[k] for k in ("betaU", "lamUz", "lamWs", "lamWOs"))
+    cat, mb = problem.categorical, problem.mean_basis
+    H = None if mb is None else mb.matrix(zt)
     ll = 0.0
-    chols, alphas = [], []
+    chols, alphas, coefs = [], [], []
     for j in range(problem.p_u):
-        S = correlation(zt, None, bu[:, j]) / luz[j]
+        S = correlation(zt, None, bu[:, j], cat) / luz[j]
         S[np.diag_indices(m)] += 1.0 / (problem.lam_sim[j] * lwos[0]) + 1.0 / lws[j]
         L = lower_cholesky(S)
         if L is None:
             return -np.inf
         a = _tri_solve(L, w[:, j])
+        coef = None
+        if H is not None:  # restricted likelihood: the mean coefficients integrated out
+            g = GLS.of(np.tril(L), w[:, j], H)
+            coef = g.coef
+            a = a - g.A @ coef
+            ll -= float(np.sum(np.log(np.diagonal(g.Q[0]))))
         ll += -_logdet_half(L) - 0.5 * float(a @ a)
         chols.append(L)
         alphas.append(a)
+        coefs.append(coef)
     obs = problem.obs
     if obs is None:
         return ll
     n, p_v = obs.n, obs.p_v
     xt = np.hstack([obs.x, np.tile(params["theta"], (n, 1))])
+    h_obs = None if mb is None else mb.matrix(xt)
     C = obs.sig_obs / params["lamOs"][0]
     mu = np.zeros(C.shape[0])
     for j in range(problem.p_u):
-        sig_u = correlation(xt, None, bu[:, j]) / luz[j] + np.eye(n) / lws[j]
-        B = _tri_solve(chols[j], correlation(xt, zt, bu[:, j]).T / luz[j])
+        sig_u = correlation(xt, None, bu[:, j], cat) / luz[j] + np.eye(n) / lws[j]
+        B = _tri_solve(chols[j], correlation(xt, zt, bu[:, j], cat).T / luz[j])
         o = 0 if obs.scalar_out else n * (p_v + j)
         C[o : o + n, o : o + n] += sig_u - B.T @ B
         mu[o : o + n] = B.T @ alphas[j]
+        if h_obs is not None:
+            mu[o : o + n] += h_obs @ coefs[j]
     if p_v:
-        sig_v = correlation(obs.x, None, params["betaV"][:, 0]) / params["lamVz"][0]
+        x_cat = None if cat is None else cat[: problem.p]
+        sig_v = correlation(obs.x, None, params["betaV"][:, 0], x_cat) / params["lamVz"][0]
         for i in range(1 if obs.scalar_out else p_v):
             C[i * n : (i + 1) * n, i * n : (i + 1) * n] += sig_v
     L = lower_cholesky(C)
@@ -130,7 +144,7 @@ class _Component:
         self.ri = 0
         self.si = 0
         self.ok = True
-        self.L = self.alpha = self.llw = self.B = self.mu = self.cond = None
+        self.L = self.alpha = self.llw = self.B = self.mu = self.cond = self.coef = None
         self.cxz = self.cxo = None
 
 
@@ -151,8 +165,13 @@ class IncrementalLikelihood:
         self.params = {k: np.array(v, dtype=np.float64) for k, v in params.items()}
         m = problem.m
         self.packed = _Packed(m, self.N_BLOCKS)
-        D = sq_diffs(problem.zt)
+        cat = problem.categorical
+        x_cat = None if cat is None else cat[: problem.p]
+        D = sq_diffs(problem.zt, None, cat)
         self.D = [self.packed.pack(d) for d in D]
+        mb = problem.mean_basis
+        self.mean_basis = mb
+        self.H = None if mb is None else np.asfortranarray(mb.matrix(problem.zt))
         self.tmp = np.empty(self.packed.size)
         self.tmp_views = self.packed.views(self.tmp)
         self.w_cols = [np.ascontiguousarray(problem.w[:, j]) for j in range(problem.p_u)]
@@ -161,8 +180,8 @@ class IncrementalLikelihood:
         if obs is not None:
             self.p = problem.p
             n = obs.n
-            self.Dxo = sq_diffs(obs.x).reshape(self.p, n * n)
-            self.Dxz_x = sq_diffs(obs.x, problem.x_sim).reshape(self.p, n * problem.m)
+            self.Dxo = sq_diffs(obs.x, None, x_cat).reshape(self.p, n * n)
+            self.Dxz_x = sq_diffs(obs.x, problem.x_sim, x_cat).reshape(self.p, n * problem.m)
             self.shape_nm = (n, problem.m)
             self.shape_nn = (n, n)
             self.t_sim_T = problem.t_sim.T.copy()
@@ -186,7 +205,9 @@ class IncrementalLikelihood:
 
     # --- pieces -------------------------------------------------------------------------------
     def _factor(self, c: _Component, j: int, ri: int, si: int, prm: dict) -> tuple:
-        """Factor Sigma_W_j from R buffer ``ri`` into S buffer ``si``: (ri, si, alpha, llw, L)."""
+        """Factor Sigma_W_j from R buffer ``ri`` into S buffer ``si``: (ri, si, alpha, llw, L,
+        coef); with a mean basis alpha = L^-1 (w - H coef) and coef the GLS coefficients (else
+        alpha = L^-1 w, coef None)."""
         scale = 1.0 / prm["lamUz"][j]
         nug = 1.0 / (self.problem.lam_sim[j] * prm["lamWOs"][0]) + 1.0 / prm["lamWs"][j]
         np.multiply(c.r[ri], scale, out=self.tmp)
@@ -197,10 +218,20 @@ class IncrementalLikelihood:
         # S holds Sigma_W in its lower triangle (C order) = the upper triangle of S.T (F order).
         L, info = lapack.dpotrf(c.S[si].T, lower=0, clean=0, overwrite_a=1)
         if info != 0:
-            return (ri, si, None, -np.inf, None)
+            return (ri, si, None, -np.inf, None, None)
         alpha, _ = lapack.dtrtrs(L, self.w_cols[j], lower=0, trans=1)
-        llw = -float(np.sum(np.log(diag))) - 0.5 * float(alpha @ alpha)
-        return (ri, si, alpha, llw, L)
+        llw = -float(np.sum(np.log(diag)))
+        coef = None
+        if self.H is not None:  # restricted likelihood: the mean coefficients integrated out
+            A, _ = lapack.dtrtrs(L, self.H, lower=0, trans=1)
+            Lq = lower_cholesky(A.T @ A)
+            if Lq is None:
+                return (ri, si, None, -np.inf, None, None)
+            coef = cho_solve((Lq, True), A.T @ alpha)
+            alpha = alpha - A @ coef
+            llw -= float(np.sum(np.log(np.diagonal(Lq))))
+        llw -= 0.5 * float(alpha @ alpha)
+        return (ri, si, alpha, llw, L, coef)
 
     def _theta_dists(self, theta: np.ndarray) -> np.ndarray:
         return np.square(theta[:, None] - self.t_sim_T)  # (q, m), same for every obs row
@@ -216,7 +247,7 @@ class IncrementalLikelihood:
 
     def _obs_part(self, fac: tuple, j: int, prm: dict, cxz: np.ndarray, cxo: np.ndarray) -> tuple:
         """Cross terms (B, mu, cond, cxz, cxo) of component j given its factor tuple."""
-        _, _, alpha, _, L = fac
+        _, _, alpha, _, L, coef = fac
         if L is None:
             return (None, None, None, cxz, cxo)
         scale = 1.0 / prm["lamUz"][j]
@@ -224,14 +255,19 @@ class IncrementalLikelihood:
         Bt = B.T
         cond = cxo * scale - Bt @ B
         cond += self.eye_n * (1.0 / prm["lamWs"][j])
-        return (B, Bt @ alpha, cond, cxz, cxo)
+        mu = Bt @ alpha
+        if coef is not None:  # the GLS mean at [x_obs, theta]
+            obs = self.problem.obs
+            xt = np.hstack([obs.x, np.tile(prm["theta"], (obs.n, 1))])
+            mu = mu + self.mean_basis.matrix(xt) @ coef
+        return (B, mu, cond, cxz, cxo)
 
     @staticmethod
     def _commit(c: _Component, out: tuple) -> None:
-        c.ri, c.si, c.alpha, c.llw, c.L = out[:5]
+        c.ri, c.si, c.alpha, c.llw, c.L, c.coef = out[:6]
         c.ok = c.L is not None
-        if len(out) > 5:
-            c.B, c.mu, c.cond, c.cxz, c.cxo = out[5:]
+        if len(out) > 6:
+            c.B, c.mu, c.cond, c.cxz, c.cxo = out[6:]
 
     def _obs_terms(self) -> list[tuple]:
         return [(c.mu, c.cond) if c.ok else (None, None) for c in self.comps]
@@ -300,7 +336,7 @@ class IncrementalLikelihood:
             dxz_t = self._theta_dists(arr)
             beta = prm["betaU"]
             for j, c in enumerate(self.comps):
-                changed[j] = (c.ri, c.si, c.alpha, c.llw, c.L)
+                changed[j] = (c.ri, c.si, c.alpha, c.llw, c.L, c.coef)
                 cross[j] = (self._cross_z(beta[:, j], dxz_t), c.cxo)
         elif name in ("betaV", "lamVz"):
             sig_v = self._sig_v(prm)
@@ -310,7 +346,7 @@ class IncrementalLikelihood:
                 changed[j] = fac + self._obs_part(fac, j, prm, *cj)
             terms = self._obs_terms()
             for j, out in changed.items():
-                terms[j] = (out[6], out[7]) if out[4] is not None else (None, None)
+                terms[j] = (out[7], out[8]) if out[4] is not None else (None, None)
             ll_vu = self._vu(terms, sig_v, prm)
         else:
             ll_vu = 0.0

@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model import categorical
+from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
+from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.data import ObsData, SimData
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
@@ -68,6 +71,9 @@ class Problem:
     x_sim (m, p), t_sim (m, q) on [0, 1]; w (m, p_u) basis weights; lam_sim (p_u,) = diag(K^T K);
     priors (with data corrections); init: initial value of every parameter; fixed: names held
     at their init value; obs: the observation side (None: the sim-only emulator model).
+    categorical: boolean mask (p + q,) of the categorical inputs (None: none); mean_basis: the
+    weights' GP mean basis (None: zero mean); constraint: allowed region of unit-scale theta
+    (None: all of it). See docs/categorical-and-constraints.md.
     """
 
     x_sim: np.ndarray
@@ -78,6 +84,9 @@ class Problem:
     init: dict[str, np.ndarray]
     fixed: frozenset[str] = frozenset()
     obs: ObsProblem | None = None
+    categorical: np.ndarray | None = None
+    mean_basis: mean_basis_mod.MeanBasis | None = None
+    constraint: ThetaConstraint | None = None
 
     @property
     def m(self) -> int:
@@ -110,6 +119,15 @@ class Problem:
         return tuple(n for n in ORDER if n in self.init)
 
     @property
+    def extensions(self) -> tuple[str, ...]:
+        """The features beyond GPM/SA's model this problem uses (categorical inputs, a mean
+        basis, a theta constraint): only the numpy backend samples them."""
+        used = (("categorical inputs", self.categorical is not None),
+                ("mean_basis", self.mean_basis is not None),
+                ("theta constraint", self.constraint is not None))  # fmt: skip
+        return tuple(name for name, on in used if on)
+
+    @property
     def sampled(self) -> tuple[str, ...]:
         """Parameters updated by the sampler, in sweep order."""
         return tuple(n for n in self.names if n not in self.fixed)
@@ -122,10 +140,43 @@ class Problem:
                 raise GPMSAError(f"unknown parameter {name!r}; this model has {self.names}")
             val = np.array(val, dtype=np.float64).reshape(init[name].shape)
             init[name] = val
-        return Problem(
-            self.x_sim, self.t_sim, self.w, self.lam_sim, self.priors, init,
-            self.fixed if fixed is None else frozenset(fixed), self.obs,
-        )  # fmt: skip
+        return replace(self, init=init, fixed=self.fixed if fixed is None else frozenset(fixed))
+
+    def with_fixed(self, values: dict) -> Problem:
+        """A copy holding the parameters in ``values`` (name -> value on the model's scales,
+        scalar or the parameter's shape) at those values; GPMSAError naming an unknown
+        parameter, a wrong shape, a non-finite value or one outside its prior's bounds."""
+        if not isinstance(values, dict):
+            raise GPMSAError(f"fixed must be a dict name -> value, got {type(values).__name__}")
+        out = {}
+        for name, val in values.items():
+            if name not in self.init:
+                raise GPMSAError(
+                    f"fixed: unknown parameter {name!r}; this model has {self.names}"
+                )
+            shape = self.init[name].shape
+            try:
+                arr = np.array(val, dtype=np.float64)
+            except (TypeError, ValueError) as exc:
+                raise GPMSAError(f"fixed[{name!r}] must be numeric, got {val!r}") from exc
+            if arr.size == 1:
+                arr = np.full(shape, float(arr.reshape(-1)[0]))
+            elif arr.size != int(np.prod(shape)):
+                raise GPMSAError(
+                    f"fixed[{name!r}] must be a scalar or have shape {shape}, got {arr.shape}"
+                )
+            arr = arr.reshape(shape)
+            if not np.all(np.isfinite(arr)):
+                raise GPMSAError(f"fixed[{name!r}] must be finite, got {arr.ravel()}")
+            if self.priors.log_prior(name, arr) == -np.inf:
+                raise GPMSAError(
+                    f"fixed[{name!r}] = {arr.ravel()} lies outside its prior's bounds (zero prior "
+                    "density)"
+                )
+            out[name] = arr
+        if "theta" in out and self.constraint is not None:
+            self.constraint.check_start(out["theta"], "fixed theta")
+        return self.with_init(out, self.fixed | frozenset(out))
 
 
 def default_init(p: int, q: int, p_u: int, priors: Priors, obs: ObsProblem | None) -> dict:
@@ -167,12 +218,18 @@ def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
 
 
 def reduce_obs(
-    obs: ObsData, std: Standardizer, K: np.ndarray, discrepancy, x_names: tuple[str, ...]
+    obs: ObsData, std: Standardizer, K: np.ndarray, discrepancy, x_names: tuple[str, ...],
+    levels: categorical.Levels | None = None,
 ) -> tuple[ObsProblem, tuple[float, float]]:
-    """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db)."""
+    """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db).
+
+    ``levels``: the x columns' training levels (``SimData.levels``); an unseen level is refused.
+    """
     x = std.x_to_unit(obs.x)
     if x.shape[1] != std.x_min.size:
         raise GPMSAError(f"x_obs must have {std.x_min.size} columns, got {obs.x.shape[1]}")
+    if levels is not None:
+        categorical.check_levels(obs.x, levels[: x.shape[1]], x_names, "x_obs")
     check_x_obs(x, x_names)
     n, p_u = obs.n, K.shape[1]
     scalar = K.shape[0] == 1
@@ -251,8 +308,13 @@ def prepare(
     priors: Priors | None = None,
     n_pc: int | None = None,
     discrepancy=None,
+    mean_basis=None,
 ) -> Prepared:
-    """Standardise, build the PCA basis and weights, reduce observations, set priors and inits."""
+    """Standardise, build the PCA basis and weights, reduce observations, set priors and inits.
+
+    ``mean_basis``: None (zero mean), "constant", "linear" or a callable of unit-scale [x, t]
+    (n, p + q) -> (n, k) (``gpmsa.model.mean_basis``). Categorical inputs come from ``sim``.
+    """
     if not isinstance(sim, SimData):
         raise GPMSAError(f"data must be a gpmsa.SimData, got {type(sim).__name__}")
     if obs is not None and not isinstance(obs, ObsData):
@@ -267,11 +329,15 @@ def prepare(
     if sim.l_sim == 1:
         wos = (0.0, 0.0)
     obs_p, os_corr = (None, (0.0, 0.0))
+    levels = sim.levels
     if obs is not None:
-        obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names)
+        categorical.refuse_categorical_theta(levels, sim.p, sim.x_names + sim.t_names,
+                                             "fit with obs")  # fmt: skip
+        obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels)
     priors = (priors or Priors()).with_data(wos, os_corr)
     init = default_init(sim.p, sim.q, p_u, priors, obs_p)
     prob = Problem(
-        std.x_to_unit(sim.x), std.t_to_unit(sim.t), w, lam_sim, priors, init, frozenset(), obs_p
-    )
+        std.x_to_unit(sim.x), std.t_to_unit(sim.t), w, lam_sim, priors, init, frozenset(), obs_p,
+        categorical.mask(levels), mean_basis_mod.make(mean_basis, sim.p + sim.q, sim.m),
+    )  # fmt: skip
     return Prepared(prob, std, K)

@@ -71,6 +71,21 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
     return native, unit
 
 
+def gpmsa_model_only(emulator, what: str) -> None:
+    """GPMSAError when ``emulator`` uses categorical inputs or a mean basis, which ``what`` does
+    not support (``Emulator.predict``, ``gpmsa.calibrate`` and ``gpmsa.Calibrator`` do)."""
+    used = []
+    if any(lv is not None for lv in getattr(emulator, "levels", ())):
+        used.append("categorical inputs")
+    if getattr(emulator, "mean_basis", None) is not None:
+        used.append("a mean basis")
+    if used:
+        raise GPMSAError(
+            f"{what} does not support an emulator with {' and '.join(used)}; use "
+            "Emulator.predict, gpmsa.calibrate or gpmsa.Calibrator"
+        )
+
+
 def param_sets(emulator, draws: bool, n_draws: int | None, what: str):
     """(indices, list of parameter dicts) the prediction averages over.
 

@@ -26,7 +26,7 @@ from scipy.special import ndtr
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
-from gpmsa.predictive._common import factors, param_sets, rng_of
+from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, rng_of
 
 
 @dataclass(frozen=True, eq=False)
@@ -125,6 +125,7 @@ def cross_validate(
         >>> bool(np.allclose(gpmsa.cross_validate(emu, draws=False).mean, emu.loo().mean))
         True
     """
+    gpmsa_model_only(emulator, "cross_validate")
     m, p_u, l_sim = emulator.m, emulator.p_u, emulator.l_sim
     labels = _fold_labels(folds, m, seed)
     groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1)]

@@ -23,6 +23,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.predictive._common import (
     check_count,
     factors,
+    gpmsa_model_only,
     mvn_factor,
     param_sets,
     rng_of,
@@ -142,6 +143,7 @@ def emulator_prediction(
         >>> bool(np.allclose(pred.mean(), emu.predict(x_new, t_new, draws=True)[0]))
         True
     """
+    gpmsa_model_only(emulator, "emulator_prediction")
     n_rlz = check_count(n_rlz, "n_rlz")
     rng = rng_of(seed)
     s = emulator.standardizer

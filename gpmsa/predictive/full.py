@@ -40,6 +40,7 @@ from gpmsa.predictive._common import (
     EMULATOR_PARAMS,
     check_count,
     factors,
+    gpmsa_model_only,
     mvn_factor,
     rng_of,
     unit_inputs,
@@ -285,6 +286,7 @@ def full_prediction(
         >>> bool(np.all(pred.var("y") > pred.var("zeta")))
         True
     """
+    gpmsa_model_only(emulator, "full_prediction")
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be the gpmsa.ObsData of the calibration, got "
                          f"{type(obs).__name__}")  # fmt: skip

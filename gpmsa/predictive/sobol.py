@@ -31,7 +31,7 @@ from scipy.special import erf
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
-from gpmsa.predictive._common import factors, param_sets, unit_inputs
+from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, unit_inputs
 
 _SQRT_PI_2 = 0.5 * np.sqrt(np.pi)
 ZERO_VARIANCE = 1e-12
@@ -184,6 +184,7 @@ def sensitivity(
         >>> s["x"]["main"] > 0.8 and s["b"]["total"] < 0.05
         True
     """
+    gpmsa_model_only(emulator, "sensitivity")
     std = emulator.standardizer
     names = tuple(emulator.x_names) + tuple(emulator.t_names)
     lo_all = np.concatenate([std.x_min, std.t_min])

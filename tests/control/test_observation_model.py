@@ -79,6 +79,16 @@ def test_signal_checks_name_what_a_healthy_sensor_never_does():
     drop = a.copy()
     drop[70:] *= 0.01
     assert "level jumps" in signal_fault(drop, limits)
+    middle = a.copy()  # a gain that drops for a stretch inside the block, clean on both sides
+    middle[60:120] *= 1e-4
+    assert signal_fault(middle, limits) != ""
+    assert level_jump(middle)[1] == (60, 120) and level_jump(middle)[0] > 1e6
+    part = a.copy()  # clipped for a stretch only: the block's extremes are not the clip values
+    part[50:90] = np.clip(part[50:90], -1.0, 1.0)
+    assert "clipped signal" in signal_fault(part, limits)
+    flights = a.copy()  # two flights of one block: -g up to the solver's residual
+    flights[a < -2] = -9.81 + 1e-8 * (np.arange(125)[a < -2] > 60)
+    assert signal_fault(flights, limits) == ""
     assert longest_repeat(np.array([1.0, 1.0, 2.0, 2.0, 2.0])) == 3
     assert level_jump(a)[0] < 10
     with pytest.raises(ControlError, match="max_repeats must be an integer >= 1"):

@@ -51,7 +51,7 @@ def test_cli_json(emu_file, capsys):
         (["--x", "w=1.25", "--y", "f=12.1"], r"--x needs exactly the names \['v'\]"),
         (["--x", "v=fast", "--y", "f=12.1"], "is not a number"),
         (["--x", "v=1.25", "--y", "f"], "expects NAME=VALUE"),
-        (["--x", "v=9", "--y", "f=12.1"], "outside the emulator's domain"),
+        (["--x", "v=9", "--y", "f=12.1"], "outside the emulator's domain .*; pass --extrapolate"),
     ],
 )
 def test_cli_bad_input(emu_file, capsys, extra, match):

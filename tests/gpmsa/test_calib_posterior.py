@@ -82,6 +82,10 @@ def test_posterior_arviz_and_plot():
     assert idata.posterior["GD"].shape == (2, 500)
     fig = post.plot("GD")
     assert isinstance(fig, Figure) and len(fig.axes) == 2
+    assert fig.axes[0].get_xlabel() == "GD"
+    post = Posterior(post.samples, chains=chains, info={"units": {"GD": "1e-6 m^3"}})
+    assert post.plot("GD").axes[0].get_xlabel() == "GD (1e-6 m^3)"  # calibrate's units
+    assert post.plot("GD", unit="um^3").axes[1].get_ylabel() == "GD (um^3)"
 
 
 def test_posterior_bad_arguments():

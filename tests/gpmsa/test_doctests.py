@@ -17,6 +17,9 @@ MODULES = [
     "gpmsa.plots.emulator",
     "gpmsa.plots.prediction",
     "gpmsa.plots.sensitivity",
+    "gpmsa.model.categorical",
+    "gpmsa.model.mean_basis",
+    "gpmsa.model.constraints",
 ]
 
 

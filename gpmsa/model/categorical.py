@@ -1,0 +1,96 @@
+"""Categorical inputs: which columns of [x, t] are categorical, their levels, and level checks.
+
+A categorical input takes integer levels (native units; map labels to integers first). The
+standardiser maps it like any input, (level - min) / (max - min): distinct levels stay distinct
+and equal levels stay exactly equal, which is all the categorical correlation
+(``gpmsa.model.correlation``) looks at. Levels never seen in the simulation design are refused.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+
+Levels = tuple[tuple[int, ...] | None, ...]
+"""Per input column of [x, t]: the sorted training levels of a categorical input, None for a
+continuous one."""
+
+
+def columns(spec: Sequence | None, names: tuple[str, ...], what: str) -> tuple[int, ...]:
+    """Sorted column indices from ``spec``: column indices or names (None: none).
+
+    >>> columns(["b", 0], ("a", "b", "c"), "x_categorical")
+    (0, 1)
+    """
+    if spec is None:
+        return ()
+    if isinstance(spec, (str, int, np.integer)):
+        spec = [spec]
+    out = set()
+    for item in spec:
+        if isinstance(item, str):
+            if item not in names:
+                raise GPMSAError(f"{what}: {item!r} is not an input; the inputs are {names}")
+            out.add(names.index(item))
+        elif isinstance(item, (int, np.integer)) and not isinstance(item, bool):
+            if not 0 <= int(item) < len(names):
+                raise GPMSAError(f"{what}: column {item} out of range [0, {len(names)})")
+            out.add(int(item))
+        else:
+            raise GPMSAError(f"{what} must hold column indices or names, got {item!r}")
+    return tuple(sorted(out))
+
+
+def check_integer_levels(arr: np.ndarray, cols: tuple[int, ...], names, what: str) -> None:
+    """GPMSAError naming the input unless every value of the categorical columns is an integer."""
+    for k in cols:
+        col = arr[:, k]
+        bad = col != np.round(col)
+        if bad.any():
+            raise GPMSAError(
+                f"{what} {names[k]} is categorical: its levels must be integers, got "
+                f"{col[bad][0]!r} (map labels to integer codes first)"
+            )
+
+
+def levels_of(x: np.ndarray, t: np.ndarray, x_cols, t_cols) -> Levels:
+    """The training levels of every column of [x, t] (None for continuous columns)."""
+    out: list[tuple[int, ...] | None] = []
+    for arr, cols in ((x, x_cols), (t, t_cols)):
+        for k in range(arr.shape[1]):
+            out.append(tuple(int(v) for v in np.unique(arr[:, k])) if k in cols else None)
+    return tuple(out)
+
+
+def mask(levels: Levels) -> np.ndarray | None:
+    """Boolean mask (p + q,) of the categorical columns, or None when there are none."""
+    m = np.array([lv is not None for lv in levels], dtype=bool)
+    return m if m.any() else None
+
+
+def check_levels(values: np.ndarray, levels: Levels, names: Sequence[str], what: str) -> None:
+    """GPMSAError naming the input and the level when a categorical column of ``values`` (N, d,
+    native, the columns of ``levels``/``names``) holds a level not seen in training."""
+    for k, lv in enumerate(levels):
+        if lv is None:
+            continue
+        new = np.setdiff1d(values[:, k], np.asarray(lv, dtype=np.float64))
+        if new.size:
+            raise GPMSAError(
+                f"{what}: categorical input {names[k]} has level {new[0]:g}, never seen in "
+                f"training (levels {list(lv)})"
+            )
+
+
+def refuse_categorical_theta(levels: Levels, p: int, names: Sequence[str], what: str) -> None:
+    """GPMSAError for calibrating a categorical calibration parameter (not supported)."""
+    for k, lv in enumerate(levels[p:]):
+        if lv is not None:
+            raise GPMSAError(
+                f"{what}: calibration parameter {names[p + k]} is categorical; calibrating a "
+                "categorical theta is not supported (docs/categorical-and-constraints.md): "
+                "calibrate at each level separately, or make it a known input x"
+            )

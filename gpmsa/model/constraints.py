@@ -1,0 +1,95 @@
+"""Constraints on the calibration parameters: a function of native theta that is False outside
+the allowed region, which then has zero prior mass (every sampler rejects a proposal there
+before computing its likelihood; the Calibrator's grid gives it zero weight)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+
+
+@dataclass(frozen=True, eq=False)
+class ThetaConstraint:
+    """``fn(theta)`` of native theta (q,) -> bool, applied to unit-scale theta.
+
+    t_min, t_max (q,): the native range of the design (unit 0 and 1); names: theta's names.
+
+    >>> c = ThetaConstraint(lambda th: th[0] < th[1], np.zeros(2), np.full(2, 10.0), ("a", "b"))
+    >>> c(np.array([0.1, 0.2])), c(np.array([0.3, 0.2]))
+    (True, False)
+    """
+
+    fn: Callable[[np.ndarray], bool]
+    t_min: np.ndarray
+    t_max: np.ndarray
+    names: tuple[str, ...]
+
+    def native(self, theta_unit: np.ndarray) -> np.ndarray:
+        """Unit-scale theta (q,) -> native (q,)."""
+        return np.asarray(theta_unit, dtype=np.float64) * (self.t_max - self.t_min) + self.t_min
+
+    def __call__(self, theta_unit: np.ndarray) -> bool:
+        """Whether unit-scale theta (q,) is allowed; GPMSAError if ``fn`` fails or is not bool."""
+        native = self.native(theta_unit)
+        try:
+            ok = self.fn(native.copy())
+        except Exception as exc:
+            at = self.describe(native)
+            raise GPMSAError(f"the theta constraint failed at {at}: {exc}") from exc
+        if not isinstance(ok, (bool, np.bool_)):
+            raise GPMSAError(
+                f"the theta constraint must return True or False, got {ok!r} at "
+                f"{self.describe(native)}"
+            )
+        return bool(ok)
+
+    def describe(self, native: np.ndarray) -> str:
+        """``name=value, ...`` of native theta."""
+        return ", ".join(f"{n}={float(v):.6g}" for n, v in zip(self.names, native, strict=True))
+
+    def check_start(self, theta_unit: np.ndarray, what: str) -> None:
+        """GPMSAError naming the constraint and theta when the start ``theta_unit`` is refused."""
+        if not self(theta_unit):
+            raise GPMSAError(
+                f"{what}: the theta constraint rejects the initial value "
+                f"{self.describe(self.native(theta_unit))}; pass theta_init= (native units) inside "
+                "the allowed region"
+            )
+
+
+def make(constraint, t_min, t_max, names) -> ThetaConstraint | None:
+    """A ``ThetaConstraint`` from the user's ``constraint`` (None: no constraint)."""
+    if constraint is None:
+        return None
+    if not callable(constraint):
+        raise GPMSAError(
+            f"constraint must be a callable of native theta (q,) -> bool, got {constraint!r}"
+        )
+    return ThetaConstraint(constraint, np.asarray(t_min, dtype=np.float64),
+                           np.asarray(t_max, dtype=np.float64), tuple(names))  # fmt: skip
+
+
+def theta_init_unit(theta_init, t_min, t_max, names) -> np.ndarray | None:
+    """The user's ``theta_init`` (native, (q,)) on the unit scale; GPMSAError outside (0, 1)."""
+    if theta_init is None:
+        return None
+    q = len(names)
+    try:
+        arr = np.array(theta_init, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError) as exc:
+        raise GPMSAError(f"theta_init must be {q} numbers, got {theta_init!r}") from exc
+    if arr.size != q:
+        raise GPMSAError(f"theta_init must have {q} values ({names}), got {arr.size}")
+    unit = (arr - np.asarray(t_min)) / (np.asarray(t_max) - np.asarray(t_min))
+    bad = ~((unit > 0.0) & (unit < 1.0))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise GPMSAError(
+            f"theta_init {names[k]}={arr[k]:.6g} lies outside the open range "
+            f"({float(t_min[k]):.6g}, {float(t_max[k]):.6g}) of the design"
+        )
+    return unit

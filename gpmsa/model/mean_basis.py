@@ -1,0 +1,114 @@
+"""A user-set mean basis for the GP of each basis weight: w_j(z) ~ GP(h(z)^T c_j, Sigma_j).
+
+GPM/SA's default is a zero mean. With a mean basis h (``"constant"``: h(z) = 1; ``"linear"``:
+h(z) = [1, z_1, ..., z_d] on the unit-scale inputs z = [x, t]; or a callable of unit-scale
+z (n, d) -> (n, k)), the coefficients c_j have a flat prior and are integrated out (as SEPIA's
+``mean_basis``, Higdon et al. 2008 section 2):
+
+- the fit samples the restricted (marginal) likelihood of w_j:
+  -1/2 log|Sigma| - 1/2 log|H^T Sigma^-1 H| - 1/2 (w - H c^)^T Sigma^-1 (w - H c^),
+  with c^ = (H^T Sigma^-1 H)^-1 H^T Sigma^-1 w the GLS estimate (H = h(design), (m, k));
+- a prediction at z has mean h(z)^T c^ + r^T Sigma^-1 (w - H c^) and adds to the variance
+  g^T (H^T Sigma^-1 H)^-1 g, g = h(z) - H^T Sigma^-1 r (the coefficients' uncertainty);
+- the observation term of a joint fit and calibration use the GLS mean h([x_obs, theta]) c^ at
+  the current emulator parameters (without the coefficients' variance).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.linalg import cho_factor, cho_solve, solve_triangular
+
+from gpmsa.errors import GPMSAError
+
+KINDS = ("constant", "linear")
+"""The named mean bases (they can be saved in an emulator file; a callable cannot)."""
+
+
+@dataclass(frozen=True, eq=False)
+class MeanBasis:
+    """A mean basis: ``kind`` "constant", "linear" or "callable" (then ``fn``), over d inputs.
+
+    >>> MeanBasis("linear", 2).matrix(np.array([[0.5, 1.0]]))
+    array([[1. , 0.5, 1. ]])
+    """
+
+    kind: str
+    d: int
+    fn: Callable[[np.ndarray], np.ndarray] | None = None
+
+    def matrix(self, z: np.ndarray) -> np.ndarray:
+        """h at unit-scale points z (n, d): (n, k)."""
+        z = np.asarray(z, dtype=np.float64)
+        n = z.shape[0]
+        if self.kind == "constant":
+            return np.ones((n, 1))
+        if self.kind == "linear":
+            return np.hstack([np.ones((n, 1)), z])
+        try:
+            h = np.asarray(self.fn(z), dtype=np.float64)
+        except GPMSAError:
+            raise
+        except Exception as exc:
+            raise GPMSAError(f"mean_basis callable failed on unit inputs {z.shape}: {exc}") from exc
+        if h.ndim == 1:
+            h = h[:, None]
+        if h.ndim != 2 or h.shape[0] != n or not np.all(np.isfinite(h)):
+            raise GPMSAError(
+                f"mean_basis must return a finite (n, k) matrix for n = {n} points, got "
+                f"shape {h.shape}"
+            )
+        return h
+
+
+def make(spec, d: int, m: int | None = None) -> MeanBasis | None:
+    """A ``MeanBasis`` from the user's ``mean_basis``: None (zero mean), "constant", "linear" or
+    a callable of unit-scale inputs (n, d) -> (n, k); ``m`` runs (k < m needed)."""
+    if spec is None:
+        return None
+    if isinstance(spec, MeanBasis):
+        basis = spec
+    elif isinstance(spec, str):
+        if spec not in KINDS:
+            raise GPMSAError(f"mean_basis must be None, one of {KINDS} or a callable, got {spec!r}")
+        basis = MeanBasis(spec, d)
+    elif callable(spec):
+        basis = MeanBasis("callable", d, spec)
+    else:
+        raise GPMSAError(f"mean_basis must be None, one of {KINDS} or a callable, got {spec!r}")
+    k = basis.matrix(np.full((2, d), 0.5)).shape[1]
+    if m is not None and k >= m:
+        raise GPMSAError(f"mean_basis has {k} columns; it needs fewer than the {m} runs")
+    return basis
+
+
+@dataclass(frozen=True, eq=False)
+class GLS:
+    """The GLS fit of one weight vector: coefficients ``coef`` (k,), ``alpha`` =
+    Sigma^-1 (w - H coef) (m,), ``A`` = L^-1 H (m, k), ``Q`` = cho_factor(H^T Sigma^-1 H)."""
+
+    coef: np.ndarray
+    alpha: np.ndarray
+    A: np.ndarray
+    Q: tuple
+
+    @classmethod
+    def of(cls, L: np.ndarray, w: np.ndarray, H: np.ndarray) -> GLS:
+        """From the lower Cholesky factor L of Sigma, the weights w (m,) and H (m, k)."""
+        A = solve_triangular(L, H, lower=True)
+        a = solve_triangular(L, w, lower=True)
+        try:
+            Q = cho_factor(A.T @ A, lower=True)
+        except np.linalg.LinAlgError as exc:
+            raise GPMSAError("the mean basis is collinear on the simulation design") from exc
+        coef = cho_solve(Q, A.T @ a)
+        alpha = solve_triangular(L, a - A @ coef, lower=True, trans="T")
+        return cls(coef, alpha, A, Q)
+
+    def variance(self, h: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Added predictive variance (N,) at points with h (N, k) and v = L^-1 r^T (m, N)."""
+        g = h.T - self.A.T @ v
+        return np.sum(g * cho_solve(self.Q, g), axis=0)
