@@ -13,8 +13,9 @@ The pipeline (`replay_bag`):
    integral of the speed) and speed (the planar norm of ``twist.twist.linear``), interpolated
    linearly at the IMU's sample times; IMU samples before the first or after the last odometry
    message are left out, those inside an odometry gap get NaN (the BCR reports a sensor fault);
-4. the BCR fed in time order, one update's worth of samples (one block) at a time, and the
-   Simplex's command for each estimate.
+4. the BCR fed in time order, one update's worth of samples (one block) at a time with the
+   newest sample's time as its clock (``now=``), the call `control.run_closed_loop` makes, and
+   the Simplex's command for each estimate.
 
 Faults in the recording are reported, never raised: repeated or backwards stamps and gaps reach
 the BCR, which gives ``sensor_fault`` with the reason for the blocks they touch (status and
@@ -369,13 +370,13 @@ def replay_recording(
     ests, cmds, ends = [], [], []
     for k in tqdm(range(n_full), disable=not progress, unit="block", leave=False):
         part = slice(k * every, (k + 1) * every)
-        est = estimator.update(t[part], pos[part], a[part], spd[part])
+        est = estimator.update(t[part], pos[part], a[part], spd[part], now=t[part.stop - 1])
         ests.append(est)
         cmds.append(simplex.command(est))
         ends.append(part.stop - 1)
     if t.size > n_full * every:
         tail = slice(n_full * every, None)
-        estimator.update(t[tail], pos[tail], a[tail], spd[tail])
+        estimator.update(t[tail], pos[tail], a[tail], spd[tail], now=t[-1])
         notes.append(f"the last {t.size - n_full * every} samples did not fill a block")
     bcr_s = time.perf_counter() - tic
 
