@@ -13,12 +13,19 @@ from control.bcr import BCR, METHODS, PAPER_WINDOW, BCRSettings
 from control.changepoint import ChangePointFilter, ChangePointSettings
 from control.closed_loop import ClosedLoopResult, LoopMetrics, run_closed_loop
 from control.compat import bcr_settings_for, check_emulator, emulator_feature
-from control.errors import ControlError, ControlWarning, EmulatorMismatchError
+from control.errors import (
+    BagError,
+    ControlError,
+    ControlWarning,
+    EmulatorMismatchError,
+    MissingExtraError,
+)
 from control.estimate import STATUSES, Estimate
 from control.faults import FAULT_KINDS, SensorFault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
 from control.observation_model import BlockScatter, ObservationModel
+from control.robot import ReplayResult, ReplaySettings, record_run, replay_bag
 from control.sensor_checks import SensorLimits
 from control.shipped import shipped_emulator, shipped_emulator_path
 from control.simplex import Command, Simplex
@@ -27,6 +34,7 @@ from control.tracker import GDTracker, TrackerSettings
 __all__ = [
     "BCR",
     "BCRSettings",
+    "BagError",
     "FAULT_KINDS",
     "METHODS",
     "PAPER_WINDOW",
@@ -44,7 +52,10 @@ __all__ = [
     "GDError",
     "GDTracker",
     "LoopMetrics",
+    "MissingExtraError",
     "ObservationModel",
+    "ReplayResult",
+    "ReplaySettings",
     "SensorFault",
     "SensorLimits",
     "Simplex",
@@ -57,6 +68,8 @@ __all__ = [
     "fast_on_rough_m",
     "gd_errors",
     "pooled_rmse",
+    "record_run",
+    "replay_bag",
     "run_closed_loop",
     "shipped_emulator",
     "shipped_emulator_path",

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import time as _time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -126,6 +127,7 @@ def run_closed_loop(
     faults: Sequence[SensorFault] = (),
     check: bool = True,
     max_time_s: float | None = None,
+    record: str | os.PathLike | None = None,
 ) -> ClosedLoopResult:
     """Drive `model` over `track` with the BCR estimating GD and the Simplex setting the speed.
 
@@ -147,6 +149,9 @@ def run_closed_loop(
         check: check the emulator against model, noise, feature and track (`check_emulator`).
         max_time_s: simulated time after which a vehicle that has not reached the end is an
             error (default: 20 times the track length at the safe speed).
+        record: write the run to this MCAP file for Foxglove (`control.record_run`: the
+            accelerations, speed command and actual speed, the GD estimate with its interval,
+            the mode and the true GD; needs the ``robot`` extra).
 
     Returns:
         `ClosedLoopResult` with traces and `LoopMetrics`.
@@ -154,6 +159,10 @@ def run_closed_loop(
     model = vehicle.Jackal() if model is None else model
     simplex = Simplex() if simplex is None else simplex
     _check_seed(seed)
+    if record is not None:  # without the robot extra, fail before the drive, not after it
+        from control.robot.record import check_can_record, record_run
+
+        check_can_record()
     top = float(model.max_speed_mps)
     if simplex.v_max > top * (1 + 1e-12):
         raise ControlError(
@@ -229,7 +238,7 @@ def run_closed_loop(
         if ok.any()
         else np.nan,
     )
-    return ClosedLoopResult(
+    result = ClosedLoopResult(
         time=np.array([t[-1] for t in s_t]),
         position=position,
         gd_mean=gd_mean,
@@ -255,3 +264,6 @@ def run_closed_loop(
             "faults": tuple(faults),
         },
     )
+    if record is not None:
+        record_run(result, record)
+    return result

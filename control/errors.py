@@ -11,3 +11,13 @@ class EmulatorMismatchError(ControlError):
 
 class ControlWarning(UserWarning):
     """A setting that works but is probably not what the user meant (e.g. mismatched noise)."""
+
+
+class BagError(ControlError):
+    """A robot recording that cannot be replayed: a missing or mistyped topic, no messages, an
+    IMU slower than the emulator's rate (the message names the topic or the setting)."""
+
+
+class MissingExtraError(ControlError, ImportError):
+    """An optional package of the ``robot`` extra is not installed (the message says how to
+    install it)."""

@@ -2,6 +2,7 @@
 
     python examples/closed_loop.py                # writes ./out/metrics.json and the figures
     python examples/closed_loop.py --out DIR --runs 3 --method changepoint --law linear
+    python examples/closed_loop.py --record runs/   # also one MCAP per run, for Foxglove
 
 Track: 50 m at GD 300, 50 m at GD 500, 50 m at GD 300 (roadgen.track). Test Case A: noise-free
 accelerations and the noise-free emulators; Test Case B: N(0, 1) accelerometer noise and the
@@ -38,8 +39,11 @@ PAPER_RMSE = {
 }
 
 
-def run_case(case: str, runs: int, method: str, simplex: control.Simplex) -> list:
-    """The closed-loop results of one test case and estimator (one per run)."""
+def run_case(
+    case: str, runs: int, method: str, simplex: control.Simplex, record: Path | None = None
+) -> list:
+    """The closed-loop results of one test case and estimator (one per run); with ``record``,
+    each run is also written there as ``case{A,B}_{method}_run{k}.mcap`` (control.record_run)."""
     kind = "band" if method == "changepoint" else "window"
     emu = control.shipped_emulator(case, kind)
     bcr = control.bcr_settings_for(emu, method=method)
@@ -53,6 +57,7 @@ def run_case(case: str, runs: int, method: str, simplex: control.Simplex) -> lis
             bcr=bcr,
             simplex=simplex,
             likelihood=likelihood,
+            record=record / f"case{case}_{method}_run{k}.mcap" if record else None,
         )  # fmt: skip
         for k in range(1, runs + 1)
     ]
@@ -91,6 +96,11 @@ def main(argv: list[str] | None = None) -> dict:
         "--law", default="linear", choices=list(control.simplex.LAWS),
         help="Simplex performance law: linear (default), paper (eq. 8 literally), switch",
     )  # fmt: skip
+    parser.add_argument(
+        "--record", default=None, metavar="DIR",
+        help="write each run as an MCAP file in DIR, to watch in Foxglove with "
+        "examples/foxglove_layout.json (needs the robot extra)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
@@ -103,7 +113,8 @@ def main(argv: list[str] | None = None) -> dict:
     for case in ("A", "B"):
         title = f"Test Case {case} ({'noise-free' if case == 'A' else 'N(0, 1) noise'})"
         for key, method in (("ours", args.method), ("paper_method", "window")):
-            results = run_case(case, args.runs, method, simplex)
+            record = Path(args.record) if args.record else None
+            results = run_case(case, args.runs, method, simplex, record)
             metrics[key][case] = summarise(results)
             label = "ours" if key == "ours" else "paper's method"
             plot_gd_trace(results, track, title=f"{title}, {label}: GD").savefig(
@@ -138,6 +149,9 @@ def main(argv: list[str] | None = None) -> dict:
             )
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
     print(f"\nwrote {out / 'metrics.json'} and the figures gd_trace_*.png, speed_*.png")
+    if args.record:
+        print(f"wrote one MCAP per run in {args.record} (open in Foxglove with "
+              "examples/foxglove_layout.json)")  # fmt: skip
     return metrics
 
 

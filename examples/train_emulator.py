@@ -3,6 +3,8 @@
     python examples/train_emulator.py                  # campaign + fits -> out/emulators/
     python examples/train_emulator.py --ship           # ... and replace the package's shipped files
     python examples/train_emulator.py --n-iter 5000 --out out_quick   # a quicker try
+    python examples/train_emulator.py --cases B --noise-std 0.3 \
+        --vehicle mass_kg=21.5 tyre_stiffness_n_per_m=26000            # your robot (docs/robot.md)
 
 Steps (docs/closed-loop.md):
 
@@ -30,6 +32,7 @@ shows them, with those of the fit).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import time
 from pathlib import Path
@@ -69,12 +72,36 @@ def stretched_design(n: int, seed: int, gd_range: tuple[float, float] = GD_RANGE
     return target_lo + (design - lo) * (target_hi - target_lo) / (hi - lo)
 
 
+def noise_std(case: str, args) -> float:
+    """Accelerometer noise sd of a case, m/s^2: none for A, ``--noise-std`` for B."""
+    return NOISE_STD["A"] if case == "A" else float(args.noise_std)
+
+
+def vehicle_model(overrides: list[str]) -> vehicle.Jackal:
+    """A Jackal with the ``NAME=VALUE`` overrides of ``--vehicle`` (its attributes, SI units)."""
+    fields = {f.name for f in dataclasses.fields(vehicle.Jackal)}
+    kw: dict[str, object] = {}
+    for item in overrides:
+        name, sep, value = item.partition("=")
+        if not sep or name not in fields:
+            raise ValueError(
+                f"--vehicle {item!r}: expected NAME=VALUE with NAME one of {sorted(fields)}"
+            )
+        if name == "lift_off":
+            kw[name] = value.lower() in ("1", "true", "yes", "on")
+        elif name == "wheels_per_axle":
+            kw[name] = int(value)
+        else:
+            kw[name] = float(value)
+    return vehicle.Jackal(**kw)
+
+
 def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict) -> dict:
     """What the loop checks and what a reader of the file wants to know."""
     return {
         "case": case,
         "vehicle": model.describe(),
-        "noise_std": NOISE_STD[case],
+        "noise_std": noise_std(case, args),
         "feature": feature.to_dict(),
         "road": {
             "generator": "roadgen.iso8608_profile",
@@ -152,6 +179,15 @@ def main(argv: list[str] | None = None) -> None:
     )  # fmt: skip
     parser.add_argument("--cases", nargs="+", default=["A", "B"], choices=["A", "B"])
     parser.add_argument(
+        "--noise-std", type=float, default=NOISE_STD["B"],
+        help="accelerometer noise sd of case B, m/s^2 (your IMU's; default 1.0, the paper's)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--vehicle", nargs="+", default=[], metavar="NAME=VALUE",
+        help="Jackal parameters to change, e.g. mass_kg=21.5 tyre_stiffness_n_per_m=26000 "
+        "(vehicle.Jackal's attributes, SI units)",
+    )  # fmt: skip
+    parser.add_argument(
         "--features", nargs="+", default=["band", "window"], choices=["band", "window"]
     )
     args = parser.parse_args(argv)
@@ -163,13 +199,18 @@ def main(argv: list[str] | None = None) -> None:
         parser.error("--ship and --emulator-dir exclude each other")
     emu_dir = EMULATOR_DIR if args.ship else Path(args.emulator_dir or out / "emulators")
     emu_dir.mkdir(parents=True, exist_ok=True)
-    model = vehicle.Jackal()
+    if not (np.isfinite(args.noise_std) and args.noise_std >= 0):
+        parser.error(f"--noise-std must be >= 0, got {args.noise_std}")
+    try:
+        model = vehicle_model(args.vehicle)
+    except (ValueError, TypeError) as exc:
+        parser.error(str(exc))
 
     design = stretched_design(args.n_runs, args.seed, tuple(args.gd_range))
     plot_design(design[:, 0], design[:, 1]).savefig(out / "lhs_design.png", dpi=150)
     tic = time.perf_counter()
     campaign = vehicle.run_campaign(
-        design, model, lead_in_m=LEAD_IN_M, rate_hz=RATE_HZ, noise_std=NOISE_STD["B"],
+        design, model, lead_in_m=LEAD_IN_M, rate_hz=RATE_HZ, noise_std=args.noise_std,
         window=PAPER_WINDOW.block_samples, cache_dir=out / "campaign_cache", progress=True,
         seed=args.seed, keep_s=args.keep_s,
     )  # fmt: skip

@@ -60,3 +60,12 @@ def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypat
 def test_ship_and_emulator_dir_exclude_each_other(tmp_path):
     with pytest.raises(SystemExit):
         load_script().main(["--out", str(tmp_path), "--ship", "--emulator-dir", str(tmp_path)])
+
+
+def test_vehicle_overrides_make_the_users_robot():
+    script = load_script()
+    model = script.vehicle_model(["mass_kg=21.5", "tyre_stiffness_n_per_m=26000", "lift_off=no"])
+    assert (model.mass_kg, model.tyre_stiffness_n_per_m, model.lift_off) == (21.5, 26000.0, False)
+    assert model.b1_m == vehicle.Jackal().b1_m
+    with pytest.raises(ValueError, match="mass_kg"):
+        script.vehicle_model(["weight=20"])

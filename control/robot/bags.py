@@ -1,0 +1,489 @@
+"""Reading and writing robot recordings: ROS 2 bags (MCAP or sqlite3), ROS 1 bags, MCAP files.
+
+What is read, as arrays: the IMU's header stamps, receive (log) times and linear accelerations,
+and the odometry's stamps, receive times, positions and linear velocities. Any of these opens:
+
+- a ROS 2 bag folder (``metadata.yaml`` beside ``*.mcap`` or ``*.db3`` files; ROS 2's default
+  storage is MCAP, older bags are sqlite3), read with rosbags;
+- a ``*.db3`` or ``*.mcap`` file inside such a folder (the folder is read);
+- a ROS 1 ``*.bag`` file (rosbags);
+- a bare ``*.mcap`` file with ROS 2 (CDR) messages, e.g. one `control.record_run` wrote or
+  Foxglove recorded (the ``mcap`` package).
+
+rosbags and mcap are the ``robot`` extra; they are imported when a function needs them.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path, PurePath
+
+import numpy as np
+
+from control.errors import BagError, ControlError
+from control.robot import messages as msgs
+from control.robot import storage as storage_mod
+from control.robot.extra import require
+
+STORAGES = ("mcap", "sqlite3")
+
+
+@dataclass(frozen=True)
+class ImuMessages:
+    """The messages of an IMU topic, in the recording's order.
+
+    Attributes:
+        topic: the topic name.
+        log_ns: (n,) receive times, int ns.
+        stamp_ns: (n,) header stamps, int ns.
+        accel: (n, 3) ``linear_acceleration`` (x, y, z), m/s^2, in the IMU's frame.
+    """
+
+    topic: str
+    log_ns: np.ndarray
+    stamp_ns: np.ndarray
+    accel: np.ndarray
+
+
+@dataclass(frozen=True)
+class OdometryMessages:
+    """The messages of an odometry topic, in the recording's order.
+
+    Attributes:
+        topic: the topic name.
+        log_ns, stamp_ns: (n,) receive times and header stamps, int ns.
+        position: (n, 3) ``pose.pose.position``, m, in the odometry frame.
+        velocity: (n, 3) ``twist.twist.linear``, m/s, in the child (body) frame.
+    """
+
+    topic: str
+    log_ns: np.ndarray
+    stamp_ns: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+
+
+@dataclass(frozen=True)
+class Recording:
+    """What `read_recording` found.
+
+    Attributes:
+        path: the recording.
+        kind: "rosbag2" (with ``storage``), "ros1" or "mcap".
+        storage: "mcap" or "sqlite3" for a ROS 2 bag folder; "" otherwise.
+        topics: every topic of the recording and its message type.
+        imu, odometry: the messages of the two topics asked for.
+        read_s: wall-clock time of the reading, s.
+    """
+
+    path: Path
+    kind: str
+    storage: str
+    topics: dict[str, str]
+    imu: ImuMessages
+    odometry: OdometryMessages
+    read_s: float
+
+
+def _normalise(msgtype: str) -> str:
+    """``pkg/msg/Name`` for ``pkg/Name`` (ROS 1 and some MCAP writers leave out ``msg``)."""
+    parts = msgtype.split("/")
+    return f"{parts[0]}/msg/{parts[1]}" if len(parts) == 2 else msgtype
+
+
+def _topic_error(path: Path, topic: str, role: str, topics: dict[str, str], option: str) -> str:
+    listing = ", ".join(f"{t} ({ty})" for t, ty in sorted(topics.items())) or "none"
+    return (
+        f"the {role} topic {topic!r} is not in {path}; its topics: {listing} "
+        f"(choose another with {option})"
+    )
+
+
+def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic: str) -> None:
+    for topic, role, want, option in (
+        (imu_topic, "IMU", msgs.IMU_TYPE, "imu_topic / --imu-topic"),
+        (odom_topic, "odometry", msgs.ODOMETRY_TYPE, "odom_topic / --odom-topic"),
+    ):
+        if topic not in topics:
+            raise BagError(_topic_error(path, topic, role, topics, option))
+        if _normalise(topics[topic]) != want:
+            raise BagError(
+                f"the {role} topic {topic!r} in {path} holds {topics[topic]}, expected {want}"
+            )
+
+
+def _resolve(path: Path) -> tuple[Path, str]:
+    """(what to open, its kind) for a path the user gave."""
+    if not path.exists():
+        raise BagError(f"no recording at {path}")
+    if path.is_dir():
+        if not (path / "metadata.yaml").is_file():
+            raise BagError(
+                f"{path} is a folder without metadata.yaml: not a ROS 2 bag (give the bag's "
+                "folder, a *.mcap file or a ROS 1 *.bag file)"
+            )
+        return path, "rosbag2"
+    if path.suffix in (".mcap", ".db3") and (path.parent / "metadata.yaml").is_file():
+        return path.parent, "rosbag2"
+    if path.suffix == ".mcap":
+        return path, "mcap"
+    if path.suffix == ".bag":
+        return path, "ros1"
+    if path.suffix == ".db3":
+        raise BagError(f"{path} is a sqlite3 bag file without its folder's metadata.yaml")
+    raise BagError(
+        f"{path}: not a recording this reader knows (a ROS 2 bag folder, *.mcap, *.db3 in its "
+        "bag folder, or a ROS 1 *.bag)"
+    )
+
+
+def read_recording(
+    path: str | os.PathLike, imu_topic: str = "/imu/data", odom_topic: str = "/odometry/filtered"
+) -> Recording:
+    """Read the IMU and odometry messages of a recording (see the module docstring for what
+    opens), each topic in receive-time order. Raises `BagError` naming the topic when a topic is
+    missing, holds another message type or has no messages; `MissingExtraError` when the
+    ``robot`` extra is not installed."""
+    tic = time.perf_counter()
+    require("rosbags.typesys", "reading a robot recording")
+    target, kind = _resolve(Path(path))
+    if kind == "mcap":
+        require("mcap.reader", "reading an MCAP file")
+    wanted = [imu_topic, odom_topic]
+    raw, storage = None, ""
+    if kind == "rosbag2":
+        files, storage, simple = _bag_files(target)
+        if simple and storage == "mcap":
+            raw = storage_mod.mcap_messages(files, wanted)
+        elif simple and storage == "sqlite3":
+            raw = storage_mod.sqlite_messages(files, wanted)
+    elif kind == "mcap":
+        raw = storage_mod.mcap_messages([target], wanted)
+    if raw is not None:
+        topics, imu, odom = _from_raw(target, raw, imu_topic, odom_topic)
+    elif kind == "mcap":
+        topics, imu, odom = _read_mcap(target, imu_topic, odom_topic)
+    else:
+        topics, imu, odom = _read_rosbags(target, kind, imu_topic, odom_topic)
+    for topic, got in ((imu_topic, imu), (odom_topic, odom)):
+        if got.stamp_ns.size == 0:
+            raise BagError(f"the topic {topic!r} in {target} has no messages")
+    return Recording(target, kind, storage, topics, imu, odom, time.perf_counter() - tic)
+
+
+def _bag_files(folder: Path) -> tuple[list[Path], str, bool]:
+    """(storage files, storage id, whether the fast readers can take them) of a bag folder."""
+    yaml = require("ruamel.yaml", "reading a ROS 2 bag")
+    try:
+        meta = yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_text())
+        info = meta["rosbag2_bagfile_information"]
+        files = [folder / PurePath(x).name for x in info["relative_file_paths"]]
+        storage = str(info["storage_identifier"])
+        compression = str(info.get("compression_mode", "") or "").lower()
+    except Exception:  # rosbags reads (and reports on) whatever this does not understand
+        return [], "", False
+    simple = compression in ("", "none") and all(f.is_file() for f in files) and bool(files)
+    return files, storage, simple
+
+
+def _from_raw(path: Path, raw, imu_topic: str, odom_topic: str):
+    """(topics, IMU, odometry) from raw messages read by `control.robot.storage`."""
+    _check_topics(path, raw.types, imu_topic, odom_topic)
+    store = None
+
+    def decoder(topic: str):
+        def decode(data: bytes):
+            nonlocal store
+            if store is None:
+                store = _typestore_for(raw.types, raw.definitions)
+            return store.deserialize_cdr(data, _normalise(raw.types[topic]))
+
+        return decode
+
+    out = []
+    for topic, make in ((imu_topic, _imu), (odom_topic, _odometry)):
+        if raw.encodings.get(topic, "cdr") != "cdr":
+            raise BagError(
+                f"the topic {topic!r} in {path} is encoded as {raw.encodings[topic]!r}; the "
+                "replay reads ROS 2 (cdr) messages"
+            )
+        log = np.asarray(raw.log_ns[topic], dtype=np.int64)
+        order = np.argsort(log, kind="stable")
+        data = raw.data[topic]
+        if np.any(np.diff(order) != 1):
+            data = [data[i] for i in order]
+        out.append(make(topic, log[order], data, decoder(topic)))
+    return raw.types, out[0], out[1]
+
+
+def _typestore_for(types: dict[str, str], definitions: dict[str, tuple[str, str]]):
+    """A typestore knowing ROS 2's standard messages and the definitions a file carries."""
+    stores = require("rosbags.typesys", "reading a ROS bag")
+    store = stores.get_typestore(stores.Stores.ROS2_HUMBLE)
+    for topic, (encoding, text) in definitions.items():
+        try:
+            if encoding == "ros2idl":
+                store.register(stores.get_types_from_idl(text))
+            elif encoding == "ros2msg":
+                store.register(stores.get_types_from_msg(text, _normalise(types[topic])))
+        except Exception:  # a definition that clashes with the standard one: that one serves
+            continue
+    return store
+
+
+def _imu(topic: str, log_ns: list[int], raws: list, decode, cdr: bool = True) -> ImuMessages:
+    log = np.asarray(log_ns, dtype=np.int64)
+    try:
+        if not cdr:
+            raise msgs.CdrLayoutError("not CDR")
+        stamp, accel = msgs.decode_imu(raws)
+    except msgs.CdrLayoutError:
+        fields = [decode(raw) for raw in raws]
+        stamp = np.array([_stamp(m) for m in fields], dtype=np.int64)
+        accel = np.array([_xyz(m.linear_acceleration) for m in fields]).reshape(-1, 3)
+    return ImuMessages(topic, log, stamp, accel)
+
+
+def _odometry(
+    topic: str, log_ns: list[int], raws: list, decode, cdr: bool = True
+) -> OdometryMessages:
+    log = np.asarray(log_ns, dtype=np.int64)
+    try:
+        if not cdr:
+            raise msgs.CdrLayoutError("not CDR")
+        stamp, position, velocity = msgs.decode_odometry(raws)
+    except msgs.CdrLayoutError:
+        fields = [decode(raw) for raw in raws]
+        stamp = np.array([_stamp(m) for m in fields], dtype=np.int64)
+        position = np.array([_xyz(m.pose.pose.position) for m in fields]).reshape(-1, 3)
+        velocity = np.array([_xyz(m.twist.twist.linear) for m in fields]).reshape(-1, 3)
+    return OdometryMessages(topic, log, stamp, position, velocity)
+
+
+def _stamp(msg) -> int:
+    stamp = msg.header.stamp
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+def _xyz(v) -> tuple[float, float, float]:
+    return float(v.x), float(v.y), float(v.z)
+
+
+def _read_rosbags(path: Path, kind: str, imu_topic: str, odom_topic: str):
+    highlevel = require("rosbags.highlevel", "reading a ROS bag")
+    stores = require("rosbags.typesys", "reading a ROS bag")
+    default = stores.get_typestore(
+        stores.Stores.ROS1_NOETIC if kind == "ros1" else stores.Stores.ROS2_HUMBLE
+    )
+    try:
+        reader = highlevel.AnyReader([path], default_typestore=default)
+        reader.open()
+    except Exception as exc:  # rosbags raises its own errors for damaged or unknown bags
+        raise BagError(f"cannot open {path} as a ROS bag: {exc}") from exc
+    try:
+        topics = {t: info.msgtype for t, info in reader.topics.items()}
+        _check_topics(path, topics, imu_topic, odom_topic)
+        out = []
+        for topic, make in ((imu_topic, _imu), (odom_topic, _odometry)):
+            conns = [c for c in reader.connections if c.topic == topic]
+            log, raws = [], []
+            for _, stamp, raw in reader.messages(connections=conns):
+                log.append(stamp)
+                raws.append(raw)
+            msgtype = conns[0].msgtype
+
+            def decode(raw, msgtype=msgtype):
+                return reader.deserialize(raw, msgtype)
+
+            out.append(make(topic, log, raws, decode, cdr=reader.is2))
+        return topics, out[0], out[1]
+    finally:
+        reader.close()
+
+
+def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
+    reader_mod = require("mcap.reader", "reading an MCAP file")
+    stores = require("rosbags.typesys", "reading an MCAP file")
+    with open(path, "rb") as f:
+        try:
+            reader = reader_mod.make_reader(f)
+            summary = reader.get_summary()
+        except Exception as exc:  # the mcap package raises its own errors for damaged files
+            raise BagError(f"cannot read {path} as an MCAP file: {exc}") from exc
+        if summary is not None:
+            topics = {
+                ch.topic: summary.schemas[ch.schema_id].name if ch.schema_id else ""
+                for ch in summary.channels.values()
+            }
+            _check_topics(path, topics, imu_topic, odom_topic)
+            wanted = [imu_topic, odom_topic]
+        else:  # an unindexed (e.g. truncated) file: find the topics by reading it all
+            topics, wanted = {}, None
+        collected: dict[str, tuple[list, list]] = {imu_topic: ([], []), odom_topic: ([], [])}
+        schemas: dict[str, object] = {}
+        try:
+            for schema, channel, message in reader.iter_messages(topics=wanted):
+                topics.setdefault(channel.topic, schema.name if schema else "")
+                if channel.topic not in collected:
+                    continue
+                if channel.message_encoding != "cdr":
+                    raise BagError(
+                        f"the topic {channel.topic!r} in {path} is encoded as "
+                        f"{channel.message_encoding!r}; the replay reads ROS 2 (cdr) messages"
+                    )
+                schemas[channel.topic] = schema
+                collected[channel.topic][0].append(message.log_time)
+                collected[channel.topic][1].append(message.data)
+        except BagError:
+            raise
+        except Exception as exc:
+            raise BagError(f"cannot read the messages of {path}: {exc}") from exc
+    if summary is None:
+        _check_topics(path, topics, imu_topic, odom_topic)
+    store = stores.get_typestore(stores.Stores.EMPTY)
+    for topic, schema in schemas.items():
+        if schema is None:
+            raise BagError(f"the topic {topic!r} in {path} has no schema")
+        text = schema.data.decode()
+        if schema.encoding == "ros2idl":
+            store.register(stores.get_types_from_idl(text))
+        else:
+            store.register(stores.get_types_from_msg(text, _normalise(schema.name)))
+
+    def decoder(topic: str):
+        name = _normalise(topics[topic])
+        return lambda raw: store.deserialize_cdr(raw, name)
+
+    imu = _imu(imu_topic, *collected[imu_topic], decoder(imu_topic))
+    odom = _odometry(odom_topic, *collected[odom_topic], decoder(odom_topic))
+    return topics, imu, odom
+
+
+# --- writing ------------------------------------------------------------------------------------
+
+
+def _check_storage(storage: str) -> None:
+    if storage not in STORAGES:
+        raise ControlError(f"storage must be one of {STORAGES}, got {storage!r}")
+
+
+def to_ns(t) -> np.ndarray:
+    """Times in seconds as int nanoseconds (rounded to the nearest)."""
+    return np.rint(np.asarray(t, dtype=float) * 1e9).astype(np.int64)
+
+
+def _vectors(name: str, a, n: int, axis: str = "x") -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if a.ndim == 1:
+        if a.size != n:
+            raise ControlError(f"{name} must have length {n}, got {a.size}")
+        out = np.zeros((n, 3))
+        out[:, "xyz".index(axis)] = a
+        return out
+    if a.shape != (n, 3):
+        raise ControlError(f"{name} must have shape ({n},) or ({n}, 3), got {a.shape}")
+    return a
+
+
+def open_bag_writer(path: str | os.PathLike, storage: str = "mcap"):
+    """A rosbags ROS 2 bag writer (format version 9) for a new folder ``path``."""
+    _check_storage(storage)
+    rosbag2 = require("rosbags.rosbag2", "writing a ROS 2 bag")
+    path = Path(path)
+    if path.exists():
+        raise ControlError(f"{path} exists already; a bag is written to a new folder")
+    plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
+    return rosbag2.Writer(path, version=9, storage_plugin=plugin)
+
+
+def merge_in_time(streams: Sequence[tuple[object, np.ndarray, Sequence[bytes]]]) -> Iterator:
+    """(channel, time ns, data) of several streams in time order (stable: ties keep the order
+    of the streams)."""
+    chans = [c for c, t, _ in streams for _ in range(len(t))]
+    times = np.concatenate([np.asarray(t, dtype=np.int64) for _, t, _ in streams])
+    data = [d for _, _, ds in streams for d in ds]
+    for i in np.argsort(times, kind="stable"):
+        yield chans[i], int(times[i]), data[i]
+
+
+def sensor_messages(
+    imu_time, accel, odom_time, position, speed, *, axis: str = "z",
+    imu_frame: str = "imu_link", odom_frame: str = "odom", base_frame: str = "base_link",
+) -> tuple[np.ndarray, list[bytes], np.ndarray, list[bytes]]:  # fmt: skip
+    """(IMU stamps ns, CDR Imu messages, odometry stamps ns, CDR Odometry messages) of sampled
+    signals (see `write_sensor_bag` for the arguments)."""
+    if axis not in ("x", "y", "z"):
+        raise ControlError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
+    t_imu = to_ns(np.atleast_1d(imu_time))
+    t_odom = to_ns(np.atleast_1d(odom_time))
+    acc = _vectors("accel", accel, t_imu.size, axis)
+    pos = _vectors("position", position, t_odom.size)
+    vel = _vectors("speed", speed, t_odom.size)
+    imu = [msgs.encode_imu(s, a, imu_frame) for s, a in zip(t_imu.tolist(), acc.tolist(),
+                                                             strict=True)]  # fmt: skip
+    odom = [
+        msgs.encode_odometry(s, p, v, odom_frame, base_frame)
+        for s, p, v in zip(t_odom.tolist(), pos.tolist(), vel.tolist(), strict=True)
+    ]
+    return t_imu, imu, t_odom, odom
+
+
+def write_sensor_bag(
+    path: str | os.PathLike,
+    imu_time,
+    accel,
+    odom_time,
+    position,
+    speed,
+    *,
+    storage: str = "mcap",
+    imu_topic: str = "/imu/data",
+    odom_topic: str = "/odometry/filtered",
+    axis: str = "z",
+    log_time=None,
+) -> Path:
+    """Write sampled signals as a ROS 2 bag of standard messages (``sensor_msgs/msg/Imu``,
+    ``nav_msgs/msg/Odometry``), e.g. a simulated drive to try the replay on.
+
+    Args:
+        path: the new bag folder.
+        imu_time: (n,) IMU header stamps, s (rounded to ns).
+        accel: (n,) accelerations along ``axis`` (m/s^2), or (n, 3).
+        odom_time: (m,) odometry stamps, s.
+        position: (m,) positions along the odometry frame's x axis (m), or (m, 3).
+        speed: (m,) forward speeds (twist.linear.x, m/s), or (m, 3) linear velocities.
+        storage: "mcap" (ROS 2's default) or "sqlite3".
+        imu_topic, odom_topic: topic names.
+        axis: the IMU axis that holds ``accel`` when it is 1-D.
+        log_time: (n + m,) receive times in s, IMU messages first (default: the stamps).
+
+    Returns:
+        the bag folder.
+    """
+    t_imu, imu, t_odom, odom = sensor_messages(
+        imu_time, accel, odom_time, position, speed, axis=axis
+    )
+    log = np.concatenate([t_imu, t_odom]) if log_time is None else to_ns(log_time)
+    if log.size != t_imu.size + t_odom.size:
+        raise ControlError(f"log_time must have length {t_imu.size + t_odom.size}, got {log.size}")
+    store = msgs.typestore()
+    with open_bag_writer(path, storage) as writer:
+        c_imu = writer.add_connection(imu_topic, msgs.IMU_TYPE, typestore=store)
+        c_odom = writer.add_connection(odom_topic, msgs.ODOMETRY_TYPE, typestore=store)
+        streams = [(c_imu, log[: t_imu.size], imu), (c_odom, log[t_imu.size :], odom)]
+        for conn, stamp, data in merge_in_time(streams):
+            writer.write(conn, stamp, data)
+    return Path(path)
+
+
+def write_run_bag(result, path: str | os.PathLike, **kw) -> Path:
+    """Write the samples of a `control.ClosedLoopResult` (front-axle acceleration on the IMU's
+    z axis, position and speed as odometry along x, both at the loop's rate) as a ROS 2 bag;
+    keyword arguments as `write_sensor_bag`."""
+    t = result.sample_time
+    return write_sensor_bag(
+        path, t, result.sample_accel, t, result.sample_position, result.sample_speed, **kw
+    )

@@ -1,0 +1,131 @@
+"""A closed-loop run as an MCAP file to watch in Foxglove (examples/foxglove_layout.json).
+
+The file holds ROS 2 messages (CDR, with their ``ros2msg`` definitions inside), on the topics a
+real Jackal's recording and the replay use, so one Foxglove layout serves a simulated run, a
+robot's bag and the replay's output, and `control.replay_bag` reads the file back:
+
+| topic | type | rate | holds |
+|---|---|---|---|
+| ``/imu/data`` | ``sensor_msgs/msg/Imu`` | the loop's (120 Hz) | ``linear_acceleration.z``: the measured front-axle acceleration, m/s^2 |
+| ``/odometry/filtered`` | ``nav_msgs/msg/Odometry`` | the loop's | ``pose.pose.position.x``: position along the track, m; ``twist.twist.linear.x``: actual speed, m/s |
+| ``/bcr/estimate`` | ``terrain_gpmsa_msgs/msg/GDEstimate`` | one per BCR update | status, reason, GD mean and credible interval, P(change), the speed command and mode |
+| ``/sim/gd_true`` | ``std_msgs/msg/Float64`` | one per BCR update | the GD prescribed at the vehicle's position |
+
+The loop's result keeps no posterior sd nor P(GD > GD_max): those fields are NaN here (the
+replay fills them).
+"""  # noqa: E501
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from control.errors import ControlError
+from control.robot import messages as msgs
+from control.robot.bags import merge_in_time, sensor_messages, to_ns
+from control.robot.extra import require
+
+TOPICS = {
+    "imu": "/imu/data",
+    "odometry": "/odometry/filtered",
+    "estimate": "/bcr/estimate",
+    "gd_true": "/sim/gd_true",
+}
+
+
+def _estimate_rows(result) -> list[dict]:
+    n = result.time.size
+    return [
+        {
+            "stamp_ns": 0,
+            "status": str(result.status[i]),
+            "reason": str(result.reason[i]),
+            "position_m": float(result.position[i]),
+            "speed_mps": float(_speed_at(result, result.time[i])),
+            "gd_mean": float(result.gd_mean[i]),
+            "gd_sd": np.nan,
+            "gd_lo": float(result.gd_lo[i]),
+            "gd_hi": float(result.gd_hi[i]),
+            "prob_gd_above_max": np.nan,
+            "prob_change": float(result.prob_change[i]),
+            "command_mps": float(result.command[i]),
+            "mode": str(result.mode[i]),
+        }
+        for i in range(n)
+    ]
+
+
+def _speed_at(result, t: float) -> float:
+    if result.sample_time.size == 0:
+        return np.nan
+    return float(np.interp(t, result.sample_time, result.sample_speed))
+
+
+def check_can_record() -> None:
+    """Raise `MissingExtraError` unless the packages `record_run` needs are installed."""
+    require("mcap.writer", "recording a run as MCAP")
+    require("rosbags.typesys", "recording a run as MCAP")
+
+
+def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
+    """Write a `control.ClosedLoopResult` as an MCAP file for Foxglove (topics in the module
+    docstring).
+
+    Args:
+        result: the closed loop's result (`control.run_closed_loop`).
+        path: the ``*.mcap`` file to write (replaced if it exists; its folder is made).
+        start_ns: the time stamp of the run's time 0, ns (0: the epoch; Foxglove shows
+            seconds from the start either way).
+
+    Returns:
+        the path written. Raises `MissingExtraError` without the ``robot`` extra.
+    """
+    from control.robot.replay import estimate_message
+
+    writer_mod = require("mcap.writer", "recording a run as MCAP")
+    if not isinstance(start_ns, int | np.integer) or start_ns < 0:
+        raise ControlError(f"start_ns must be an integer >= 0, got {start_ns!r}")
+    store = msgs.typestore()
+    t = result.sample_time
+    t_imu, imu, t_odom, odom = sensor_messages(
+        t, result.sample_accel, t, result.sample_position, result.sample_speed
+    )
+    stamps = to_ns(result.time)
+    rows = _estimate_rows(result)
+    settings = getattr(result, "settings", None) or {}
+    level = getattr(settings.get("bcr"), "interval_level", np.nan)
+    gd_max = getattr(settings.get("simplex"), "gd_max", np.nan)
+    estimates = []
+    for row, stamp in zip(rows, stamps.tolist(), strict=True):
+        row["stamp_ns"] = stamp + start_ns
+        estimates.append(estimate_message(store, row, level, gd_max))
+    f64 = store.types[msgs.FLOAT64_TYPE]
+    truth = [bytes(store.serialize_cdr(f64(data=float(g)), msgs.FLOAT64_TYPE))
+             for g in result.gd_true]  # fmt: skip
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("wb") as f:
+        writer = writer_mod.Writer(f)
+        writer.start(profile="ros2", library="terrain-gpmsa")
+        channels = {}
+        for key, msgtype in (
+            ("imu", msgs.IMU_TYPE), ("odometry", msgs.ODOMETRY_TYPE),
+            ("estimate", msgs.GD_ESTIMATE_TYPE), ("gd_true", msgs.FLOAT64_TYPE),
+        ):  # fmt: skip
+            definition, _ = store.generate_msgdef(msgtype, ros_version=2)
+            schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
+            channels[key] = writer.register_channel(TOPICS[key], "cdr", schema)
+        streams = [
+            (channels["imu"], t_imu + start_ns, imu),
+            (channels["odometry"], t_odom + start_ns, odom),
+            (channels["estimate"], stamps + start_ns, estimates),
+            (channels["gd_true"], stamps + start_ns, truth),
+        ]
+        for seq, (channel, stamp, data) in enumerate(merge_in_time(streams)):
+            writer.add_message(channel, log_time=stamp, data=data, publish_time=stamp,
+                               sequence=seq)  # fmt: skip
+        writer.finish()
+    return path

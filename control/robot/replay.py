@@ -1,0 +1,476 @@
+"""Replay a robot recording through the BCR and the Simplex: estimates as a table, CSV and bag.
+
+The pipeline (`replay_bag`):
+
+1. read the IMU and odometry topics (`control.robot.bags.read_recording`);
+2. the IMU's acceleration along ``imu_axis`` times ``imu_sign``, on the time base chosen
+   (header stamps, or receive times); its stamps checked (`condition.check_stream`); brought to
+   the emulator's rate (`condition.to_rate`: as recorded when the rates agree, else resampled);
+   optionally high-passed (``gravity="highpass"``; by default gravity's static part is kept: the
+   BCR removes each block's mean before its feature, so a constant offset changes nothing);
+3. the odometry's position along the path (``position="path"``: the length of the pose
+   trajectory from the odometry frame's origin, `condition.path_length`; ``"speed"``: the
+   integral of the speed) and speed (the planar norm of ``twist.twist.linear``), interpolated
+   linearly at the IMU's sample times; IMU samples before the first or after the last odometry
+   message are left out, those inside an odometry gap get NaN (the BCR reports a sensor fault);
+4. the BCR fed in time order, one update's worth of samples (one block) at a time with the
+   newest sample's time as its clock (``now=``), the call `control.run_closed_loop` makes, and
+   the Simplex's command for each estimate.
+
+Faults in the recording are reported, never raised: repeated or backwards stamps and gaps reach
+the BCR, which gives ``sensor_fault`` with the reason for the blocks they touch (status and
+reason columns of the CSV), and the per-topic `StreamReport` counts them. A missing topic, a
+topic of another type, no messages or an IMU slower than the emulator's rate raise `BagError`
+naming the topic.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from control.bcr import BCR, BCRSettings
+from control.compat import bcr_settings_for
+from control.errors import BagError, ControlError
+from control.estimate import Estimate
+from control.robot import condition
+from control.robot import messages as msgs
+from control.robot.bags import STORAGES, Recording, merge_in_time, open_bag_writer, read_recording
+from control.simplex import Simplex
+
+TIME_BASES = ("header", "log")
+POSITIONS = ("path", "speed")
+GRAVITY = ("keep", "highpass")
+CSV_COLUMNS = (
+    "stamp_ns", "time_s", "position_m", "speed_mps", "status", "reason", "gd_mean", "gd_sd",
+    "gd_lo", "gd_hi", "prob_gd_above_max", "prob_change", "command_mps", "mode",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class ReplaySettings:
+    """What to read from a recording and how (see the module docstring).
+
+    Attributes:
+        imu_topic: topic of ``sensor_msgs/msg/Imu`` messages.
+        odom_topic: topic of ``nav_msgs/msg/Odometry`` messages.
+        imu_axis: "x", "y" or "z": the IMU axis that points up (along the front axle's
+            vertical) when the robot stands level.
+        imu_sign: +1 or -1: -1 when that axis points down.
+        time_base: "header" (the messages' header stamps; the receive times when every header
+            stamp is zero) or "log" (the receive times the recorder wrote).
+        position: "path" (length of the odometry's pose trajectory) or "speed" (integral of
+            the odometry's speed).
+        gravity: "keep" (the BCR demeans each block) or "highpass" (a zero-phase 2nd-order
+            Butterworth high-pass at ``highpass_hz`` first).
+        highpass_hz: cut-off of the high-pass, Hz.
+        rate_tolerance: an IMU whose nominal rate is within this relative difference of the
+            emulator's is used as recorded; a faster one is resampled.
+        resample: how a faster IMU is resampled: "sample" (band-limited interpolation: samples
+            at the emulator's rate, the simulator's sensor model) or "lowpass" (an
+            anti-aliasing low-pass at the emulator's Nyquist frequency first);
+            `control.robot.condition`.
+        max_odometry_gap_s: IMU samples inside a longer odometry gap get no position or speed
+            (a sensor fault), s.
+        estimate_topic: the output bag's topic of the estimates.
+        storage: the output bag's storage, "mcap" or "sqlite3".
+    """
+
+    imu_topic: str = "/imu/data"
+    odom_topic: str = "/odometry/filtered"
+    imu_axis: str = "z"
+    imu_sign: float = 1.0
+    time_base: str = "header"
+    position: str = "path"
+    gravity: str = "keep"
+    highpass_hz: float = 0.5
+    rate_tolerance: float = 0.02
+    resample: str = "sample"
+    max_odometry_gap_s: float = 0.25
+    estimate_topic: str = "/bcr/estimate"
+    storage: str = "mcap"
+
+    def __post_init__(self) -> None:
+        if self.imu_axis not in ("x", "y", "z"):
+            raise ControlError(f"imu_axis must be 'x', 'y' or 'z', got {self.imu_axis!r}")
+        if self.imu_sign not in (1, -1):
+            raise ControlError(f"imu_sign must be +1 or -1, got {self.imu_sign!r}")
+        for name, allowed in (
+            ("time_base", TIME_BASES), ("position", POSITIONS), ("gravity", GRAVITY),
+            ("storage", STORAGES), ("resample", condition.METHODS),
+        ):  # fmt: skip
+            if getattr(self, name) not in allowed:
+                raise ControlError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
+        if not (np.isfinite(self.highpass_hz) and self.highpass_hz > 0):
+            raise ControlError(f"highpass_hz must be > 0, got {self.highpass_hz}")
+        if not 0 <= self.rate_tolerance < 0.5:
+            raise ControlError(f"rate_tolerance must lie in [0, 0.5), got {self.rate_tolerance}")
+        if not (np.isfinite(self.max_odometry_gap_s) and self.max_odometry_gap_s > 0):
+            raise ControlError(f"max_odometry_gap_s must be > 0, got {self.max_odometry_gap_s}")
+        for name in ("imu_topic", "odom_topic", "estimate_topic"):
+            if not str(getattr(self, name)).startswith("/"):
+                raise ControlError(f"{name} must start with '/', got {getattr(self, name)!r}")
+
+
+@dataclass(frozen=True, eq=False)
+class ReplayResult:
+    """The estimates of a replay and how they were made.
+
+    Per estimate (length k; one per BCR update, i.e. per block): ``stamp_ns`` (int, bag time of
+    the newest sample), ``time`` (s since the first IMU sample used), ``position`` (m along the
+    path), ``speed`` (m/s, the odometry's at that sample), ``status``, ``reason``, ``gd_mean``,
+    ``gd_sd``, ``gd_lo``, ``gd_hi`` (the credible interval at the BCR's ``interval_level``),
+    ``prob_above`` (P(GD > the Simplex's GD_max)), ``prob_change``, ``command`` (m/s), ``mode``;
+    ``estimates``: the `Estimate` objects (with their posteriors).
+    Per sample fed to the BCR (length n): ``sample_time`` (s, as ``time``), ``sample_position``,
+    ``sample_speed``, ``sample_accel`` (m/s^2).
+    ``imu``, ``odometry``: `StreamReport` of each topic; ``resampling``: what was done to the
+    IMU's rate; ``notes``: what else was left out. ``read_s``, ``condition_s``, ``bcr_s``:
+    wall-clock times of the three stages, s; ``t0_ns``: stamp of time 0; ``settings``, ``bcr``,
+    ``simplex``: what ran; ``source``: the recording read.
+    """
+
+    stamp_ns: np.ndarray
+    time: np.ndarray
+    position: np.ndarray
+    speed: np.ndarray
+    status: np.ndarray
+    reason: np.ndarray
+    gd_mean: np.ndarray
+    gd_sd: np.ndarray
+    gd_lo: np.ndarray
+    gd_hi: np.ndarray
+    prob_above: np.ndarray
+    prob_change: np.ndarray
+    command: np.ndarray
+    mode: np.ndarray
+    estimates: tuple[Estimate, ...]
+    sample_time: np.ndarray
+    sample_position: np.ndarray
+    sample_speed: np.ndarray
+    sample_accel: np.ndarray
+    imu: condition.StreamReport
+    odometry: condition.StreamReport
+    resampling: condition.Resampling
+    notes: tuple[str, ...]
+    read_s: float
+    condition_s: float
+    bcr_s: float
+    t0_ns: int
+    settings: ReplaySettings
+    bcr: BCRSettings
+    simplex: Simplex
+    source: str = ""
+
+    @property
+    def duration_s(self) -> float:
+        """Span of the samples fed to the BCR, s."""
+        return float(self.sample_time[-1] - self.sample_time[0]) if self.sample_time.size else 0.0
+
+    @property
+    def wall_s(self) -> float:
+        """Wall-clock time of reading, conditioning and estimating, s."""
+        return self.read_s + self.condition_s + self.bcr_s
+
+    @property
+    def real_time_factor(self) -> float:
+        """Recorded seconds replayed per wall-clock second."""
+        return self.duration_s / self.wall_s if self.wall_s > 0 else np.nan
+
+    def status_counts(self) -> dict[str, int]:
+        """Number of estimates of each status."""
+        names, counts = np.unique(self.status, return_counts=True)
+        return {str(k): int(c) for k, c in zip(names, counts, strict=True)}
+
+    def rows(self) -> list[dict]:
+        """One dict per estimate, keyed by CSV_COLUMNS."""
+        cols = (
+            self.stamp_ns, self.time, self.position, self.speed, self.status, self.reason,
+            self.gd_mean, self.gd_sd, self.gd_lo, self.gd_hi, self.prob_above, self.prob_change,
+            self.command, self.mode,
+        )  # fmt: skip
+        return [dict(zip(CSV_COLUMNS, vals, strict=True)) for vals in zip(*cols, strict=True)]
+
+    def to_csv(self, path: str | os.PathLike) -> Path:
+        """Write the estimates as CSV (columns CSV_COLUMNS; floats in full precision, "nan"
+        where there is no number)."""
+        path = Path(path)
+        with path.open("w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(CSV_COLUMNS)
+            for row in self.rows():
+                writer.writerow(
+                    [repr(float(v)) if isinstance(v, float | np.floating) else v
+                     for v in row.values()]
+                )  # fmt: skip
+        return path
+
+    def write_bag(self, path: str | os.PathLike, storage: str | None = None) -> Path:
+        """Write the estimates as a ROS 2 bag (topic ``settings.estimate_topic``, type
+        ``terrain_gpmsa_msgs/msg/GDEstimate``, stamped with ``stamp_ns``)."""
+        storage = storage or self.settings.storage
+        store = msgs.typestore()
+        level, gd_max = self.bcr.interval_level, self.simplex.gd_max
+        datas = [estimate_message(store, row, level, gd_max) for row in self.rows()]
+        with open_bag_writer(path, storage) as writer:
+            conn = writer.add_connection(
+                self.settings.estimate_topic, msgs.GD_ESTIMATE_TYPE, typestore=store
+            )
+            for c, stamp, data in merge_in_time([(conn, self.stamp_ns, datas)]):
+                writer.write(c, stamp, data)
+        return Path(path)
+
+    def describe(self) -> str:
+        """A few lines for a person: the topics, the resampling, the statuses, the timing."""
+        counts = ", ".join(f"{k} {v}" for k, v in sorted(self.status_counts().items()))
+        ok = self.status == "ok"
+        lines = [
+            self.imu.describe(),
+            self.odometry.describe(),
+            f"resampling: {self.resampling.filter}",
+            *self.notes,
+            f"{self.status.size} estimates over {self.duration_s:.1f} s: {counts}",
+        ]
+        if ok.any():
+            lines.append(
+                f"GD posterior mean {np.min(self.gd_mean[ok]):.0f} to "
+                f"{np.max(self.gd_mean[ok]):.0f}; safety mode "
+                f"{np.mean(self.mode == 'safety'):.0%} of the time"
+            )
+        lines.append(
+            f"replayed at {self.real_time_factor:.0f}x real time (read {self.read_s:.3f} s, "
+            f"resample {self.condition_s:.3f} s, BCR {self.bcr_s:.3f} s)"
+        )
+        return "\n".join(lines)
+
+
+def estimate_message(store, row: dict, interval_level: float, gd_max: float) -> bytes:
+    """One row (keys CSV_COLUMNS) as a CDR ``GD_ESTIMATE_TYPE`` message."""
+    types = store.types
+    sec, nsec = divmod(int(row["stamp_ns"]), 1_000_000_000)
+    header = types["std_msgs/msg/Header"](
+        stamp=types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nsec), frame_id="base_link"
+    )
+    msg = types[msgs.GD_ESTIMATE_TYPE](
+        header=header,
+        status=str(row["status"]),
+        reason=str(row["reason"]),
+        position=float(row["position_m"]),
+        speed=float(row["speed_mps"]),
+        gd_mean=float(row["gd_mean"]),
+        gd_sd=float(row["gd_sd"]),
+        gd_lo=float(row["gd_lo"]),
+        gd_hi=float(row["gd_hi"]),
+        interval_level=float(interval_level),
+        gd_max=float(gd_max),
+        prob_above_gd_max=float(row["prob_gd_above_max"]),
+        prob_change=float(row["prob_change"]),
+        command_speed=float(row["command_mps"]),
+        mode=str(row["mode"]),
+        safety=row["mode"] == "safety",
+    )
+    return bytes(store.serialize_cdr(msg, msgs.GD_ESTIMATE_TYPE))
+
+
+def _load_emulator(emulator):
+    if isinstance(emulator, str | os.PathLike):
+        import gpmsa
+
+        return gpmsa.load(emulator)
+    return emulator
+
+
+def _times(topic_msgs, time_base: str) -> tuple[np.ndarray, str, str]:
+    """(times ns, the base used, a note)."""
+    if time_base == "log":
+        return topic_msgs.log_ns, "log", ""
+    if np.all(topic_msgs.stamp_ns == 0):
+        return topic_msgs.log_ns, "log", "every header stamp is zero: receive times used"
+    return topic_msgs.stamp_ns, "header", ""
+
+
+def replay_bag(
+    bag: str | os.PathLike,
+    emulator,
+    settings: ReplaySettings | None = None,
+    *,
+    bcr: BCRSettings | None = None,
+    simplex: Simplex | None = None,
+    likelihood=None,
+    csv: str | os.PathLike | None = None,
+    out_bag: str | os.PathLike | None = None,
+    progress: bool = False,
+    **overrides,
+) -> ReplayResult:
+    """Run the BCR and the Simplex over a robot recording.
+
+    Args:
+        bag: a ROS 2 bag folder (MCAP or sqlite3 storage), a ``*.mcap`` file, or a ROS 1
+            ``*.bag`` (see `control.robot.bags`).
+        emulator: a `gpmsa.Emulator` or the path of a ``*.gpmsa`` file, trained for this
+            vehicle, sensor and rate (`control.shipped_emulator`, examples/train_emulator.py).
+        settings: `ReplaySettings` (topics, IMU axis and sign, time base, ...); ``overrides``
+            replace its fields (e.g. ``imu_topic="/imu"``).
+        bcr: BCR settings (default: `control.bcr_settings_for(emulator)`).
+        simplex: the controller (default `Simplex()`).
+        likelihood: the BCR's prepared likelihood model for ``emulator`` (as in
+            `control.run_closed_loop`), to save preparing it per replay.
+        csv: write the estimates here as CSV (`ReplayResult.to_csv`).
+        out_bag: write the estimates here as a ROS 2 bag folder (`ReplayResult.write_bag`).
+        progress: show a tqdm bar over the blocks.
+
+    Returns:
+        `ReplayResult`. Raises `BagError` (a topic missing, mistyped or empty; an IMU slower
+        than the emulator's rate) and `MissingExtraError` (the ``robot`` extra not installed).
+    """
+    s = replace(settings or ReplaySettings(), **overrides)
+    emulator = _load_emulator(emulator)
+    bcr = bcr_settings_for(emulator) if bcr is None else bcr
+    simplex = Simplex() if simplex is None else simplex
+    rec = read_recording(bag, s.imu_topic, s.odom_topic)
+    result = replay_recording(
+        rec, emulator, s, bcr=bcr, simplex=simplex, likelihood=likelihood, progress=progress
+    )
+    if csv is not None:
+        result.to_csv(csv)
+    if out_bag is not None:
+        result.write_bag(out_bag)
+    return result
+
+
+def replay_recording(
+    rec: Recording,
+    emulator,
+    settings: ReplaySettings | None = None,
+    *,
+    bcr: BCRSettings | None = None,
+    simplex: Simplex | None = None,
+    likelihood=None,
+    progress: bool = False,
+) -> ReplayResult:
+    """`replay_bag` on a recording already read (`control.robot.bags.read_recording`)."""
+    s = settings or ReplaySettings()
+    emulator = _load_emulator(emulator)
+    bcr = bcr_settings_for(emulator) if bcr is None else bcr
+    simplex = Simplex() if simplex is None else simplex
+    estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
+    tic = time.perf_counter()
+    t, a, pos, spd, reports, resampling, notes, t0 = _condition(rec, s, bcr.rate_hz)
+    condition_s = time.perf_counter() - tic
+
+    tic = time.perf_counter()
+    every = bcr.samples_per_update
+    n_full = t.size // every
+    ests, cmds, ends = [], [], []
+    for k in tqdm(range(n_full), disable=not progress, unit="block", leave=False):
+        part = slice(k * every, (k + 1) * every)
+        est = estimator.update(t[part], pos[part], a[part], spd[part], now=t[part.stop - 1])
+        ests.append(est)
+        cmds.append(simplex.command(est))
+        ends.append(part.stop - 1)
+    if t.size > n_full * every:
+        tail = slice(n_full * every, None)
+        estimator.update(t[tail], pos[tail], a[tail], spd[tail], now=t[-1])
+        notes.append(f"the last {t.size - n_full * every} samples did not fill a block")
+    bcr_s = time.perf_counter() - tic
+
+    ends = np.asarray(ends, dtype=int)
+    return ReplayResult(
+        stamp_ns=t0 + np.rint(t[ends] * 1e9).astype(np.int64),
+        time=t[ends],
+        position=pos[ends],
+        speed=spd[ends],
+        status=np.array([e.status for e in ests], dtype=object).astype(str),
+        reason=np.array([e.reason for e in ests], dtype=object),
+        gd_mean=np.array([e.gd_mean for e in ests]),
+        gd_sd=np.array([e.gd_sd for e in ests]),
+        gd_lo=np.array([e.interval[0] for e in ests]),
+        gd_hi=np.array([e.interval[1] for e in ests]),
+        prob_above=np.array([e.prob_above(simplex.gd_max) for e in ests]),
+        prob_change=np.array([e.prob_change for e in ests]),
+        command=np.array([c.speed for c in cmds]),
+        mode=np.array([c.mode for c in cmds], dtype=object).astype(str),
+        estimates=tuple(ests),
+        sample_time=t,
+        sample_position=pos,
+        sample_speed=spd,
+        sample_accel=a,
+        imu=reports[0],
+        odometry=reports[1],
+        resampling=resampling,
+        notes=tuple(notes),
+        read_s=rec.read_s,
+        condition_s=condition_s,
+        bcr_s=bcr_s,
+        t0_ns=int(t0),
+        settings=s,
+        bcr=bcr,
+        simplex=simplex,
+        source=str(rec.path),
+    )
+
+
+def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
+    """The BCR's samples (t s from t0, accel, position, speed), the reports and t0 (ns)."""
+    notes: list[str] = []
+    imu_ns, imu_base, imu_note = _times(rec.imu, s.time_base)
+    odom_ns, odom_base, odom_note = _times(rec.odometry, s.time_base)
+    accel = s.imu_sign * rec.imu.accel[:, "xyz".index(s.imu_axis)]
+    t0 = int(imu_ns[0])
+    t_imu = (imu_ns - t0) / 1e9
+    t_odom = (odom_ns - t0) / 1e9
+    odom_finite = np.all(np.isfinite(rec.odometry.position), axis=1) & np.all(
+        np.isfinite(rec.odometry.velocity), axis=1
+    )
+    reports = (
+        condition.check_stream(rec.imu.topic, t_imu, np.isfinite(accel), imu_base, imu_note),
+        condition.check_stream(rec.odometry.topic, t_odom, odom_finite, odom_base, odom_note),
+    )
+    t, a, resampling = condition.to_rate(t_imu, accel, rate_hz, s.rate_tolerance, s.resample)
+    if s.gravity == "highpass":
+        a = condition.highpass(t, a, rate_hz, s.highpass_hz)
+
+    keep = condition.increasing(t_odom) & odom_finite
+    if not keep.any():
+        raise BagError(f"the odometry topic {rec.odometry.topic!r} has no usable message")
+    if not keep.all():
+        notes.append(
+            f"{np.count_nonzero(~keep)} odometry messages left out (repeated or backwards "
+            "stamps, non-finite values)"
+        )
+    to, po, vo = t_odom[keep], rec.odometry.position[keep], rec.odometry.velocity[keep]
+    speed = np.hypot(vo[:, 0], vo[:, 1])
+    if s.position == "path":
+        along = condition.path_length(po)
+    else:
+        along = condition.integrated_speed(to, speed)
+    # samples outside the odometry's span are left out (a bag often starts the IMU first)
+    finite_t = np.isfinite(t)
+    inside = ~finite_t | ((t >= to[0]) & (t <= to[-1]))
+    first = int(np.argmax(inside)) if inside.any() else t.size
+    last = t.size - int(np.argmax(inside[::-1])) if inside.any() else t.size
+    if first or last < t.size:
+        notes.append(
+            f"{first} IMU samples before the first and {t.size - last} after the last "
+            "odometry message left out"
+        )
+    t, a = t[first:last], a[first:last]
+    pos, spd = condition.odometry_at(t, to, along, speed, s.max_odometry_gap_s)
+    in_gap = finite_t[first:last] & ~np.isfinite(pos)
+    if in_gap.any():
+        notes.append(
+            f"{np.count_nonzero(in_gap)} IMU samples fell in odometry gaps longer than "
+            f"{s.max_odometry_gap_s:g} s (no position or speed: sensor faults)"
+        )
+    if t.size == 0:
+        raise BagError(
+            f"the IMU topic {rec.imu.topic!r} and the odometry topic {rec.odometry.topic!r} do "
+            "not overlap in time"
+        )
+    return t, a, pos, spd, reports, resampling, notes, t0

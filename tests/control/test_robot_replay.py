@@ -1,0 +1,339 @@
+"""Replay of robot recordings and recording of closed-loop runs (needs the robot extra).
+
+The round trip is the test of the replay: a simulated run written as a ROS 2 bag of standard
+messages and replayed gives, to the last bit, the estimates the BCR made in the loop.
+"""
+
+import csv
+import json
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip("rosbags")
+pytest.importorskip("mcap")
+
+import control  # noqa: E402
+import roadgen  # noqa: E402
+import vehicle  # noqa: E402
+from control.errors import BagError, MissingExtraError  # noqa: E402
+from control.robot import (  # noqa: E402
+    cli,
+    read_recording,
+    replay_bag,
+    write_run_bag,
+    write_sensor_bag,
+)
+
+#: what the closed loop's result and the replay's both carry, per estimate
+SHARED = ("gd_mean", "gd_lo", "gd_hi", "status", "reason", "prob_change", "command", "mode")
+
+
+@pytest.fixture(scope="module")
+def emulator_a():
+    return control.shipped_emulator("A")
+
+
+@pytest.fixture(scope="module")
+def likelihood_a(emulator_a):
+    return control.ObservationModel(emulator_a)
+
+
+@pytest.fixture(scope="module")
+def loop_run(emulator_a, likelihood_a, tmp_path_factory):
+    """A short closed-loop run, recorded as MCAP on the way."""
+    track = roadgen.track([(25, 300), (25, 500)], seed=3)
+    path = tmp_path_factory.mktemp("record") / "run.mcap"
+    result = control.run_closed_loop(
+        track, emulator_a, seed=3, likelihood=likelihood_a, record=path
+    )
+    return result, path
+
+
+def _assert_replay_is_the_loop(replayed, result, every=125):
+    n = result.sample_time.size // every  # the loop's last update may hold a part block only
+    assert replayed.gd_mean.size == n and n >= 40
+    for name in SHARED:
+        got, want = getattr(replayed, name), getattr(result, name)[:n]
+        if want.dtype.kind == "f":
+            assert np.array_equal(got, want, equal_nan=True), name
+        else:
+            assert got.tolist() == want.tolist(), name
+    for name in ("sample_accel", "sample_position", "sample_speed"):
+        assert np.array_equal(getattr(replayed, name), getattr(result, name)), name
+    assert (replayed.status == "ok").sum() >= n - 2
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_a_run_written_as_a_ros2_bag_replays_to_the_last_bit(
+    storage, loop_run, emulator_a, likelihood_a, tmp_path
+):
+    result, _ = loop_run
+    bag = write_run_bag(result, tmp_path / "run", storage=storage)
+    rec = read_recording(bag)
+    assert (rec.kind, rec.storage) == ("rosbag2", storage)
+    assert rec.topics == {"/imu/data": "sensor_msgs/msg/Imu",
+                          "/odometry/filtered": "nav_msgs/msg/Odometry"}  # fmt: skip
+    replayed = replay_bag(bag, emulator_a, likelihood=likelihood_a)
+    _assert_replay_is_the_loop(replayed, result)
+    assert replayed.imu.clean and replayed.odometry.clean
+    assert not replayed.resampling.resampled and "none" in replayed.resampling.filter
+
+
+def test_the_recorded_mcap_holds_the_run_and_replays_to_the_last_bit(
+    loop_run, emulator_a, likelihood_a
+):
+    from mcap.reader import make_reader
+
+    result, path = loop_run
+    with path.open("rb") as f:
+        summary = make_reader(f).get_summary()
+    counts = summary.statistics.channel_message_counts
+    by_topic = {ch.topic: counts[cid] for cid, ch in summary.channels.items()}
+    n = result.time.size
+    assert by_topic == {"/imu/data": result.sample_time.size,
+                        "/odometry/filtered": result.sample_time.size,
+                        "/bcr/estimate": n, "/sim/gd_true": n}  # fmt: skip
+    schemas = {summary.schemas[ch.schema_id].name for ch in summary.channels.values()}
+    assert "terrain_gpmsa_msgs/msg/GDEstimate" in schemas
+
+    replayed = replay_bag(path, emulator_a, likelihood=likelihood_a)
+    assert read_recording(path).kind == "mcap"
+    _assert_replay_is_the_loop(replayed, result)
+
+
+def test_the_recorded_estimates_decode_with_the_definition_inside_the_file(loop_run):
+    from mcap.reader import make_reader
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    result, path = loop_run
+    store = get_typestore(Stores.EMPTY)
+    got = {"/bcr/estimate": [], "/sim/gd_true": []}
+    with path.open("rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages(topics=list(got)):
+            if not got[channel.topic]:  # the file's own definition, as Foxglove reads it
+                store.register(get_types_from_msg(schema.data.decode(), schema.name))
+            got[channel.topic].append(store.deserialize_cdr(message.data, schema.name))
+    est = got["/bcr/estimate"]
+    assert [m.status for m in est] == result.status.tolist()
+    assert np.array_equal([m.gd_mean for m in est], result.gd_mean, equal_nan=True)
+    assert np.array_equal([m.gd_hi for m in est], result.gd_hi, equal_nan=True)
+    assert [m.command_speed for m in est] == result.command.tolist()
+    assert [m.safety for m in est] == (result.mode == "safety").tolist()
+    assert [m.data for m in got["/sim/gd_true"]] == result.gd_true.tolist()
+
+
+def _drive(track, rate_hz, speed=1.0):
+    """Samples of a drive at a constant commanded speed with the accelerometer at rate_hz."""
+    sim = vehicle.Simulation(vehicle.Jackal(), track, rate_hz=rate_hz, seed=1)
+    parts = []
+    while not sim.finished:
+        s = sim.advance(1.0, speed)
+        if len(s) == 0:
+            break
+        parts.append((s.t, s.position, s.speed, s.accel_front))
+    return [np.concatenate(x) for x in zip(*parts, strict=True)]
+
+
+def test_a_faster_imu_resampled_gives_the_120_hz_estimates_within_their_error(
+    emulator_a, likelihood_a, tmp_path
+):
+    track = roadgen.track([(30, 300), (30, 500)], seed=5)
+    runs = {}
+    for rate in (120.0, 200.0, 400.0):
+        t, pos, spd, acc = _drive(track, rate)
+        cruise = t >= 2.0  # the recording starts at the cruising speed, as at every rate
+        t, pos, spd, acc = t[cruise], pos[cruise], spd[cruise], acc[cruise]
+        odom = slice(None, None, int(rate // 40))  # odometry at 40 Hz
+        bag = write_sensor_bag(tmp_path / f"r{rate:.0f}", t, acc, t[odom], pos[odom], spd[odom])
+        runs[rate] = replay_bag(bag, emulator_a, likelihood=likelihood_a)
+    base = runs[120.0]
+    assert not base.resampling.resampled
+    for rate in (200.0, 400.0):
+        r = runs[rate]
+        assert r.resampling.resampled and r.resampling.rate_out_hz == 120.0
+        assert "resample_poly" in r.resampling.filter and "Kaiser" in r.resampling.filter
+        n = min(r.gd_mean.size, base.gd_mean.size)
+        ok = (r.status[:n] == "ok") & (base.status[:n] == "ok")
+        assert ok.sum() >= n - 3
+        z = (r.gd_mean[:n] - base.gd_mean[:n])[ok] / base.gd_sd[:n][ok]
+        assert np.max(np.abs(z)) < 1.0 and np.mean(np.abs(z)) < 0.4, (rate, z)
+
+
+def test_faults_in_the_recording_become_sensor_faults_not_crashes(
+    loop_run, emulator_a, likelihood_a, tmp_path
+):
+    result, _ = loop_run
+    t, a = result.sample_time.copy(), result.sample_accel.copy()
+    pos, spd = result.sample_position, result.sample_speed
+    t_imu = t.copy()
+    t_imu[[1000, 1001]] = t_imu[[1001, 1000]]  # two messages misordered
+    dup = np.r_[np.arange(2500), 2499, np.arange(2500, t.size)]  # a duplicated message
+    t_imu, a_imu, received = t_imu[dup], a[dup], t[dup]
+    keep = np.ones(t_imu.size, bool)
+    keep[4000:4060] = False  # half a second of IMU lost
+    log = np.concatenate([received[keep], t])  # received in order, stamped out of order
+    bag = write_sensor_bag(
+        tmp_path / "faulty", t_imu[keep], a_imu[keep], t, pos, spd, log_time=log
+    )
+    r = replay_bag(bag, emulator_a, likelihood=likelihood_a)
+    assert (r.imu.repeated, r.imu.backwards, r.imu.gaps) == (1, 1, 1)
+    assert r.imu.largest_gap_s == pytest.approx(61 / 120)
+    faults = r.reason[r.status == "sensor_fault"]
+    text = " ".join(faults)
+    assert "repeated or backwards" in text and "gap" in text
+    assert (r.status == "ok").sum() >= r.status.size - 10
+
+
+def test_a_missing_or_mistyped_topic_is_an_error_naming_it(loop_run, emulator_a, tmp_path):
+    result, path = loop_run
+    with pytest.raises(BagError, match=r"'/imu' is not in .*/imu/data \(sensor_msgs/msg/Imu\)"):
+        replay_bag(path, emulator_a, imu_topic="/imu")
+    with pytest.raises(BagError, match=r"odometry topic '/bcr/estimate' .* holds"):
+        replay_bag(path, emulator_a, odom_topic="/bcr/estimate")
+    empty = write_sensor_bag(tmp_path / "empty", [], [], result.sample_time[:10],
+                             result.sample_position[:10], result.sample_speed[:10])  # fmt: skip
+    with pytest.raises(BagError, match="'/imu/data' .* has no messages"):
+        replay_bag(empty, emulator_a)
+    with pytest.raises(BagError, match="no recording at"):
+        replay_bag(tmp_path / "nothing", emulator_a)
+
+
+def test_an_imu_slower_than_the_emulator_is_an_error(loop_run, emulator_a, tmp_path):
+    result, _ = loop_run
+    t, every = result.sample_time, slice(None, None, 2)
+    bag = write_sensor_bag(tmp_path / "slow", t[every], result.sample_accel[every], t,
+                           result.sample_position, result.sample_speed)  # fmt: skip
+    with pytest.raises(BagError, match="60 Hz, slower than the emulator's 120 Hz"):
+        replay_bag(bag, emulator_a)
+
+
+def test_the_imu_axis_and_sign_are_options(loop_run, emulator_a, likelihood_a, tmp_path):
+    result, _ = loop_run
+    t = result.sample_time
+    bag = write_sensor_bag(tmp_path / "flipped", t, -result.sample_accel, t,
+                           result.sample_position, result.sample_speed, axis="y")  # fmt: skip
+    r = replay_bag(bag, emulator_a, likelihood=likelihood_a, imu_axis="y", imu_sign=-1)
+    _assert_replay_is_the_loop(r, result)
+
+
+def test_the_command_writes_csv_bag_and_report(loop_run, tmp_path, capsys):
+    result, path = loop_run
+    out = tmp_path / "out"
+    assert cli.main([str(path), "--emulator", "A", "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert "real time" in printed and "estimates.csv" in printed
+    with (out / "estimates.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert list(rows[0]) == list(control.robot.CSV_COLUMNS)
+    n = len(rows)
+    assert [r["status"] for r in rows] == result.status[:n].tolist()
+    mean = np.array([float(r["gd_mean"]) for r in rows])
+    assert np.array_equal(mean, result.gd_mean[:n], equal_nan=True)  # repr: every bit
+    report = json.loads((out / "replay.json").read_text())
+    assert report["settings"]["imu_topic"] == "/imu/data" and report["real_time_factor"] > 0
+
+    from rosbags.highlevel import AnyReader
+
+    with AnyReader([out / "estimates"]) as reader:
+        conns = [c for c in reader.connections if c.topic == "/bcr/estimate"]
+        msgs = [reader.deserialize(raw, c.msgtype) for c, _, raw in reader.messages(conns)]
+    assert np.array_equal([m.gd_mean for m in msgs], mean, equal_nan=True)
+    assert [m.status for m in msgs] == [r["status"] for r in rows]
+
+
+def test_the_command_reports_a_bad_topic_and_a_missing_extra(
+    loop_run, tmp_path, capsys, monkeypatch
+):
+    _, path = loop_run
+    code = cli.main([str(path), "--emulator", "A", "--out", str(tmp_path / "o"),
+                     "--imu-topic", "/imu"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "'/imu' is not in" in err and "--imu-topic" in err
+    monkeypatch.setitem(sys.modules, "rosbags.typesys", None)
+    code = cli.main([str(path), "--emulator", "A", "--out", str(tmp_path / "p")])
+    err = capsys.readouterr().err
+    assert code == 2 and "'robot' extra" in err and 'pip install -e ".[robot]"' in err
+
+
+def test_recording_without_the_extra_fails_before_the_drive(emulator_a, tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "mcap.writer", None)
+    track = roadgen.track([(5, 300)], seed=1)
+    with pytest.raises(MissingExtraError, match="robot"):
+        control.run_closed_loop(track, emulator_a, record=tmp_path / "x.mcap")
+    assert not (tmp_path / "x.mcap").exists()
+
+
+def test_every_path_of_the_foxglove_layout_is_in_the_recorded_file(loop_run):
+    import re
+    from pathlib import Path
+
+    from mcap.reader import make_reader
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    layout = Path(__file__).resolve().parents[2] / "examples" / "foxglove_layout.json"
+    text = layout.read_text()
+    json.loads(text)
+    paths = set(re.findall(r'"(/[\w/]+)((?:\.\w+)*)"', text))
+    _, recorded = loop_run
+    store, first = get_typestore(Stores.EMPTY), {}
+    with recorded.open("rb") as f:
+        for schema, channel, message in make_reader(f).iter_messages():
+            if channel.topic not in first:
+                store.register(get_types_from_msg(schema.data.decode(), schema.name))
+                first[channel.topic] = store.deserialize_cdr(message.data, schema.name)
+    assert {topic for topic, _ in paths} <= set(first)
+    for topic, fields in paths:
+        value = first[topic]
+        for name in filter(None, fields.split(".")):
+            value = getattr(value, name)  # AttributeError names a field the file lacks
+
+
+def _write_ros1_bag(result, path):
+    """The run's samples as a ROS 1 bag (rosbags' generic serialiser, Noetic's messages)."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    T = store.types
+    vec, zeros9, zeros36 = T["geometry_msgs/msg/Vector3"], np.zeros(9), np.zeros(36)
+    quat = T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)
+    still = vec(x=0.0, y=0.0, z=0.0)
+
+    def header(ns, frame):
+        stamp = T["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
+        return T["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id=frame)
+
+    stamps = np.rint(result.sample_time * 1e9).astype(np.int64).tolist()
+    with Writer(path) as writer:
+        c_imu = writer.add_connection("/imu/data", "sensor_msgs/msg/Imu", typestore=store)
+        c_odom = writer.add_connection("/odometry/filtered", "nav_msgs/msg/Odometry",
+                                       typestore=store)  # fmt: skip
+        for k, ns in enumerate(stamps):
+            imu = T["sensor_msgs/msg/Imu"](
+                header=header(ns, "imu_link"), orientation=quat, orientation_covariance=zeros9,
+                angular_velocity=still, angular_velocity_covariance=zeros9,
+                linear_acceleration=vec(x=0.0, y=0.0, z=float(result.sample_accel[k])),
+                linear_acceleration_covariance=zeros9,
+            )  # fmt: skip
+            writer.write(c_imu, ns, store.serialize_ros1(imu, "sensor_msgs/msg/Imu"))
+            point = T["geometry_msgs/msg/Point"](x=float(result.sample_position[k]), y=0.0, z=0.0)
+            pose = T["geometry_msgs/msg/Pose"](position=point, orientation=quat)
+            twist = T["geometry_msgs/msg/Twist"](
+                linear=vec(x=float(result.sample_speed[k]), y=0.0, z=0.0), angular=still
+            )
+            odom = T["nav_msgs/msg/Odometry"](
+                header=header(ns, "odom"), child_frame_id="base_link",
+                pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros36),
+                twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros36),
+            )  # fmt: skip
+            writer.write(c_odom, ns, store.serialize_ros1(odom, "nav_msgs/msg/Odometry"))
+    return path
+
+
+def test_a_ros1_bag_replays_to_the_last_bit(loop_run, emulator_a, likelihood_a, tmp_path):
+    result, _ = loop_run
+    bag = _write_ros1_bag(result, tmp_path / "run.bag")
+    assert read_recording(bag).kind == "ros1"
+    _assert_replay_is_the_loop(replay_bag(bag, emulator_a, likelihood=likelihood_a), result)
