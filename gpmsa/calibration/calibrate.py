@@ -32,6 +32,7 @@ from gpmsa.calibration.observations import (
     fixed_gp,
     lamos_start,
     reduce,
+    theta_levels,
     theta_probe,
     warn_if_outside,
 )
@@ -164,7 +165,7 @@ def calibrate(
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
         native units), "lamOs" (and "betaV", "lamVz" with a discrepancy), and chains per name.
     """
-    check_emulator(emulator)
+    check_emulator(emulator, categorical_theta=True)
     seed = check_seed(seed)
     for name, val, low in (("n_samples", n_samples, 2), ("n_chains", n_chains, 1)):
         if not (isinstance(val, int | np.integer) and val >= low):
@@ -179,6 +180,8 @@ def calibrate(
         raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
     if not fast and (emulator_params != "point" or log_prior is not None):
         raise GPMSAError("emulator_params='draws' and log_prior need the fast numpy path")
+    if not fast:  # a categorical theta: the fast sampler only
+        check_emulator(emulator)
     _check_calibrate_memory(emulator, n_samples, n_chains, fast)
     _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}
@@ -265,6 +268,7 @@ def _run_fast(
     sampler = CalibrationSampler(
         [fixed_gp(emulator, s) for s in sets], data, emulator.priors, extra,
         init_lamos=lamos_start(fit, data.lamos), constraint=con, init_theta=theta0,
+        theta_levels=theta_levels(emulator),
     )  # fmt: skip
     if extra is not None or con is not None:  # a callable of this process: chains run here
         if where["executor"] is not None:
@@ -286,6 +290,9 @@ def _run_fast(
             "(zero prior density everywhere?)"
         )
     theta = std.t_from_unit(np.stack([r.theta for r in runs]))  # (chains, n, q)
+    for k, lv in enumerate(sampler.levels):  # categorical draws: exactly the level codes
+        if lv is not None:
+            theta[:, :, k] = np.round(theta[:, :, k])
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.stack([r.lamOs for r in runs])
     info = {

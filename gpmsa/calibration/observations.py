@@ -42,8 +42,9 @@ class Observations:
     os_corr: tuple[float, float]
 
 
-def check_emulator(emulator) -> None:
-    """Raise GPMSAError unless ``emulator`` has what calibration needs."""
+def check_emulator(emulator, categorical_theta: bool = False) -> None:
+    """Raise GPMSAError unless ``emulator`` has what calibration needs (a categorical
+    calibration parameter only where ``categorical_theta``: the fast sampler)."""
     missing = [a for a in EMULATOR_ATTRS if not hasattr(emulator, a)]
     if missing:
         raise GPMSAError(f"emulator lacks {missing}: calibration needs a gpmsa.Emulator")
@@ -53,7 +54,7 @@ def check_emulator(emulator) -> None:
     if emulator.t_unit.shape[1] < 1:
         raise GPMSAError("the emulator has no calibration parameter (t has 0 columns)")
     levels = getattr(emulator, "levels", None)
-    if levels is not None:
+    if levels is not None and not categorical_theta:
         categorical.refuse_categorical_theta(
             levels, emulator.x_unit.shape[1], emulator.x_names + emulator.t_names, "calibration"
         )
@@ -281,3 +282,22 @@ def check_log_prior(values: np.ndarray, names: tuple[str, ...], theta) -> float:
             "or -inf where the prior density is zero)"
         )
     return val
+
+
+def theta_levels(emulator) -> list[tuple[float, ...] | None] | None:
+    """Per calibration parameter, its training levels on the unit scale (None: continuous);
+    None when no calibration parameter is categorical."""
+    levels = getattr(emulator, "levels", None)
+    p = emulator.x_unit.shape[1]
+    if levels is None or all(lv is None for lv in levels[p:]):
+        return None
+    std = emulator.standardizer
+    out: list[tuple[float, ...] | None] = []
+    for k, lv in enumerate(levels[p:]):
+        if lv is None:
+            out.append(None)
+            continue
+        native = np.tile(std.t_min, (len(lv), 1))
+        native[:, k] = lv
+        out.append(tuple(float(v) for v in std.t_to_unit(native)[:, k]))
+    return out

@@ -24,6 +24,7 @@ from scipy.linalg import solve_triangular
 
 from gpmsa.calibration.model import FixedGP
 from gpmsa.calibration.observations import Observations
+from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.priors import Priors
@@ -71,7 +72,9 @@ class ThetaPredictive:
     (``cheb2``, checked on a 33 x 33 grid); otherwise each call does dense solves.
     """
 
-    def __init__(self, gp: FixedGP, data: Observations, tol: float = 1e-12) -> None:
+    def __init__(
+        self, gp: FixedGP, data: Observations, tol: float = 1e-12, expand: bool = True
+    ) -> None:
         self.gp = gp
         self.x = data.x
         self.z = data.z
@@ -80,7 +83,9 @@ class ThetaPredictive:
         self._sig = float(data.obs_chol[0, 0])
         self.cheb: tuple[np.ndarray, np.ndarray] | None = None
         self.cheb2: tuple[np.ndarray, np.ndarray] | None = None
-        if gp.q == 1:
+        if not expand:  # a categorical theta: no smooth series, dense solves at each level
+            pass
+        elif gp.q == 1:
             self.cheb = self._expand(tol)
         elif gp.q == 2 and self.d == 1:
             self.cheb2 = self._expand2(tol)
@@ -216,6 +221,9 @@ class CalibrationSampler:
             ``gpmsa.calibration.observations.lamos_start``.
         constraint: allowed region of unit-scale theta (zero prior mass outside; None: all).
         init_theta: start of unit-scale theta (q,) (default GPM/SA's 0.5).
+        theta_levels: per calibration parameter, its levels on the unit scale if categorical
+            (uniform prior over them, proposals to another level drawn uniformly), else None;
+            None: every parameter continuous.
     """
 
     def __init__(
@@ -227,9 +235,14 @@ class CalibrationSampler:
         init_lamos: float | None = None,
         constraint: ThetaConstraint | None = None,
         init_theta: np.ndarray | None = None,
+        theta_levels: list[tuple[float, ...] | None] | None = None,
     ) -> None:
-        self.preds = [ThetaPredictive(gp, data) for gp in gps]
         self.q = gps[0].q
+        self.levels = [None] * self.q if theta_levels is None else list(theta_levels)
+        if len(self.levels) != self.q:
+            raise GPMSAError(f"theta_levels has {len(self.levels)} entries for q = {self.q}")
+        smooth = all(lv is None for lv in self.levels)
+        self.preds = [ThetaPredictive(gp, data, expand=smooth) for gp in gps]
         self.priors = priors
         self.lamos = data.lamos
         self.extra = log_prior
@@ -237,6 +250,9 @@ class CalibrationSampler:
         self.init_lamos = max(20.0, lo.shape / lo.rate) if init_lamos is None else init_lamos
         self.constraint = constraint
         self.init_theta = [0.5] * self.q if init_theta is None else [float(v) for v in init_theta]
+        for i, lv in enumerate(self.levels):  # a categorical start: the level nearest it
+            if lv is not None:
+                self.init_theta[i] = min(lv, key=lambda v, t=self.init_theta[i]: abs(v - t))
         if constraint is not None:
             constraint.check_start(np.array(self.init_theta), "calibrate")
 
@@ -244,7 +260,11 @@ class CalibrationSampler:
         """Truncated-normal prior of unit-scale theta (plus the extra prior), pure Python."""
         pri = self.priors
         lp = 0.0
-        for t in theta:
+        for t, lv in zip(theta, self.levels, strict=True):
+            if lv is not None:  # uniform over the levels
+                if t not in lv:
+                    return -math.inf
+                continue
             if not 0.0 < t < 1.0:
                 return -math.inf
             z = (t - pri.theta_mean) / pri.theta_sd
@@ -337,7 +357,14 @@ class _State:
         pred = s.preds[self.k]
         for i in range(q):
             cand = list(self.theta)
-            cand[i] += widths[i] * (u[2 * i] - 0.5)
+            levels = s.levels[i]
+            if levels is None:
+                cand[i] += widths[i] * (u[2 * i] - 0.5)
+            elif len(levels) < 2:
+                continue
+            else:  # another level, uniformly: a symmetric proposal
+                others = [v for v in levels if v != cand[i]]
+                cand[i] = others[min(int(u[2 * i] * len(others)), len(others) - 1)]
             lp_new = s._log_prior_theta(cand)
             if lp_new == -math.inf:
                 continue

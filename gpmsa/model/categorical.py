@@ -90,7 +90,7 @@ def refuse_categorical_theta(levels: Levels, p: int, names: Sequence[str], what:
     for k, lv in enumerate(levels[p:]):
         if lv is not None:
             raise GPMSAError(
-                f"{what}: calibration parameter {names[p + k]} is categorical; calibrating a "
-                "categorical theta is not supported (docs/categorical-and-constraints.md): "
-                "calibrate at each level separately, or make it a known input x"
+                f"{what}: calibration parameter {names[p + k]} is categorical; a categorical "
+                "theta is calibrated by gpmsa.calibrate on the numpy backend (its fast path, "
+                "no discrepancy) only (docs/categorical-and-constraints.md)"
             )

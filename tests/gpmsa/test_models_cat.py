@@ -99,17 +99,34 @@ def test_calibrate_continuous_theta_with_categorical_x(cat_emulator):
     assert np.median(back.samples["k"]) == pytest.approx(0.7, abs=0.15)
 
 
-def test_categorical_theta_calibration_refused():
+def test_categorical_theta_is_calibrated_by_the_fast_sampler_only():
     rng = np.random.default_rng(0)
-    x, t = rng.random(20), np.arange(20) % 2
-    sim = gpmsa.SimData(x, t, x + t, t_categorical=[0])
+    x, t = rng.random(30), np.arange(30) % 3
+    shift = np.array([0.0, 1.0, -0.7])
+    sim = gpmsa.SimData(x, t, x + shift[t], t_categorical=[0])
     emu = gpmsa.Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0],
                                            "lamWs": [1e3], "lamWOs": [1e3]})  # fmt: skip
     assert emu.predict([[0.5]], [[1]])[0].shape == (1, 1)
-    with pytest.raises(gpmsa.GPMSAError, match="t0 is categorical"):
-        gpmsa.calibrate(emu, [[0.5]], [1.0])
-    with pytest.raises(gpmsa.GPMSAError, match="t0 is categorical"):
-        gpmsa.fit(sim, gpmsa.ObsData([[0.5]], [1.0]), n_iter=5)
+    x_obs = np.linspace(0.1, 0.9, 5)[:, None]
+    y_obs = x_obs[:, 0] + shift[2] + 0.02 * rng.standard_normal(5)  # level 2
+    post = gpmsa.calibrate(emu, x_obs, y_obs, n_samples=1500, n_burn=300, seed=1)
+    draws = post.samples["t0"]
+    assert set(np.unique(draws)) <= {0.0, 1.0, 2.0}  # only the levels, exactly
+    assert np.mean(draws == 2.0) > 0.95
+    # every level reachable: with data between levels 0 and 1 both are visited
+    y_mid = x_obs[:, 0] + 0.5
+    post = gpmsa.calibrate(emu, x_obs, y_mid, n_samples=1500, n_burn=300, seed=2)
+    assert {0.0, 1.0} <= set(np.unique(post.samples["t0"]))
+    post = gpmsa.calibrate(emu, x_obs, y_obs, n_samples=600, n_burn=100, seed=1,
+                           constraint=lambda th: th[0] != 2)  # fmt: skip
+    assert not np.any(post.samples["t0"] == 2.0)  # the constraint removes the level
+    for call in (
+        lambda: gpmsa.Calibrator(emu),
+        lambda: gpmsa.calibrate(emu, x_obs, y_obs, fast=False),
+        lambda: gpmsa.fit(sim, gpmsa.ObsData([[0.5]], [1.0]), n_iter=5),
+    ):
+        with pytest.raises(gpmsa.GPMSAError, match="t0 is categorical.*gpmsa.calibrate"):
+            call()
 
 
 def test_file_round_trip_and_edited_declaration(cat_emulator, tmp_path):
