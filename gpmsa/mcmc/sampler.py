@@ -282,13 +282,7 @@ def run_chain(
         if tune and els:
             bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases
             names = [n for n, _ in els]
-            cands = tuning.level_widths(names, w, tune_levels)
-            acc = np.zeros((tune_levels, len(els)))
-            for _ in range(tune_rounds):
-                for lev in range(tune_levels):
-                    state.sweep(cands[lev], False, acc[lev])
-                bar.update(tune_levels)
-            w = tuning.choose_widths(w, cands, acc, tune_rounds)
+            w = tuning.tune_widths(state.sweep, names, w, tune_rounds, tune_levels, bar.update)
         bar.set_description(f"{desc}: sampling")
         draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
         log_post = np.empty(n_iter)

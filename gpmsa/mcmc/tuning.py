@@ -7,6 +7,8 @@ with acceptance 1/e.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 TARGET = 1.0 / np.e
@@ -79,3 +81,28 @@ def choose_widths(
         if np.isfinite(w) and w > 0:
             out[i] = w
     return out
+
+
+def tune_widths(
+    sweep: Callable[[np.ndarray, bool, np.ndarray], None],
+    names: list[str],
+    widths: np.ndarray,
+    n_rounds: int,
+    n_levels: int,
+    on_round: Callable[[int], None] | None = None,
+) -> np.ndarray:
+    """GPM/SA's tuning run: ``n_rounds`` rounds of one sweep at each candidate level, then the
+    width per element where the fitted acceptance is 1/e.
+
+    ``sweep(widths, prop_mh, accepted)`` is a chain's Metropolis-within-Gibbs sweep (adding its
+    acceptances to ``accepted``); ``on_round(n_levels)`` is called after each round (a progress
+    bar's ``update``).
+    """
+    cands = level_widths(names, widths, n_levels)
+    acc = np.zeros((n_levels, widths.size))
+    for _ in range(n_rounds):
+        for lev in range(n_levels):
+            sweep(cands[lev], False, acc[lev])
+        if on_round is not None:
+            on_round(n_levels)
+    return choose_widths(widths, cands, acc, n_rounds)

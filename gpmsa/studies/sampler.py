@@ -217,13 +217,8 @@ def run_study_chain(
     with threadpool_limits(1):
         if tune:
             bar.set_description(f"{desc}: tuning step widths")
-            cands = tuning.level_widths(_tuning_kinds(state.states, layout), w, tune_levels)
-            acc = np.zeros((tune_levels, w.size))
-            for _ in range(tune_rounds):
-                for lev in range(tune_levels):
-                    state.sweep(cands[lev], False, acc[lev])
-                bar.update(tune_levels)
-            w = tuning.choose_widths(w, cands, acc, tune_rounds)
+            kinds = _tuning_kinds(state.states, layout)
+            w = tuning.tune_widths(state.sweep, kinds, w, tune_rounds, tune_levels, bar.update)
         bar.set_description(f"{desc}: sampling")
         out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
                "mu": np.empty((n_iter, len(layout.groups))),

@@ -3,6 +3,8 @@
 import pytest
 from control_doubles import FakeBlockModel, FakeCalibrator
 
+import control
+
 
 @pytest.fixture
 def fake_calibrator():
@@ -12,3 +14,15 @@ def fake_calibrator():
 @pytest.fixture
 def block_model():
     return FakeBlockModel()
+
+
+@pytest.fixture(scope="session")
+def emulator_a():
+    """The shipped band emulator of case A (noise-free)."""
+    return control.shipped_emulator("A")
+
+
+@pytest.fixture(scope="session")
+def likelihood_a(emulator_a):
+    """Its block likelihood, prepared once for the session."""
+    return control.ObservationModel(emulator_a)

@@ -22,16 +22,6 @@ from control import (
 
 
 @pytest.fixture(scope="module")
-def emulator_a():
-    return control.shipped_emulator("A")
-
-
-@pytest.fixture(scope="module")
-def likelihood_a(emulator_a):
-    return control.ObservationModel(emulator_a)
-
-
-@pytest.fixture(scope="module")
 def short_run(emulator_a, likelihood_a):
     track = roadgen.track([(25, 300), (25, 500)], seed=3)
     return track, run_closed_loop(track, emulator_a, seed=3, likelihood=likelihood_a)

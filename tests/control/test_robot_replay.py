@@ -31,16 +31,6 @@ SHARED = ("gd_mean", "gd_lo", "gd_hi", "status", "reason", "prob_change", "comma
 
 
 @pytest.fixture(scope="module")
-def emulator_a():
-    return control.shipped_emulator("A")
-
-
-@pytest.fixture(scope="module")
-def likelihood_a(emulator_a):
-    return control.ObservationModel(emulator_a)
-
-
-@pytest.fixture(scope="module")
 def loop_run(emulator_a, likelihood_a, tmp_path_factory):
     """A short closed-loop run, recorded as MCAP on the way."""
     track = roadgen.track([(25, 300), (25, 500)], seed=3)
