@@ -25,27 +25,38 @@ MAX_SEED = 2**128
 
 def memory(nbytes: float, what: str) -> None:
     """Raise RoadgenError when ``nbytes`` (an estimate) exceeds ``MAX_MEMORY_BYTES``."""
-    if nbytes > MAX_MEMORY_BYTES:
-        raise RoadgenError(
+    memory_limit(
+        nbytes, what, MAX_MEMORY_BYTES, "roadgen.checks.MAX_MEMORY_BYTES",
+        "use a shorter road or a coarser dx_m", RoadgenError,
+    )  # fmt: skip
+
+
+def memory_limit(
+    nbytes: float, what: str, limit: float, setting: str, advice: str, error: type[Exception]
+) -> None:
+    """Raise ``error`` when ``nbytes`` (an estimate) exceeds ``limit``, naming the ``setting``
+    that holds the limit and the ``advice`` (shared with ``vehicle.checks``)."""
+    if nbytes > limit:
+        raise error(
             f"{what} needs about {nbytes / 1024**3:.3g} GiB of memory, above the limit "
-            f"roadgen.checks.MAX_MEMORY_BYTES = {MAX_MEMORY_BYTES / 1024**3:.3g} GiB; use a "
-            "shorter road or a coarser dx_m, or raise the limit (roadgen.checks.MAX_MEMORY_BYTES "
+            f"{setting} = {limit / 1024**3:.3g} GiB; {advice}, or raise the limit ({setting} "
             "= ...) if the machine has the memory"
         )
 
 
-def seed(name: str, value):
-    """Return ``value`` if it is None, a numpy Generator or an integer in [0, 2**128); else
-    raise (numpy refuses a negative seed only deep inside SeedSequence)."""
-    if value is None or isinstance(value, np.random.Generator):
+def seed(
+    name: str, value, generator: bool = True, error: type[Exception] = RoadgenError
+):  # fmt: skip
+    """Return ``value`` if it is None, an integer in [0, 2**128) or (``generator``) a numpy
+    Generator; else raise ``error`` (numpy refuses a negative seed only deep inside
+    SeedSequence). ``vehicle.checks`` calls it with its own error class."""
+    if value is None or (generator and isinstance(value, np.random.Generator)):
         return value
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise RoadgenError(
-            f"{name}={value!r} must be None, an integer or a numpy Generator "
-            f"(got {type(value).__name__})"
-        )
+        kinds = "None, an integer or a numpy Generator" if generator else "None or an integer"
+        raise error(f"{name}={value!r} must be {kinds} (got {type(value).__name__})")
     if not 0 <= int(value) < MAX_SEED:
-        raise RoadgenError(f"{name}={int(value)} is out of range: allowed integers in [0, 2**128)")
+        raise error(f"{name}={int(value)} is out of range: allowed integers in [0, 2**128)")
     return int(value)
 
 

@@ -20,7 +20,7 @@ EXTRAPOLATION_MARGIN = 0.1
 observations alike: outside the range a warning, beyond the margin a refusal."""
 
 
-def _snap_to_unit(u: np.ndarray) -> np.ndarray:
+def snap_to_unit(u: np.ndarray) -> np.ndarray:
     """``u`` with values within ``UNIT_TOL`` below 0 or above 1 moved onto the edge."""
     u = np.where((u < 0.0) & (u > -UNIT_TOL), 0.0, u)
     return np.where((u > 1.0) & (u < 1.0 + UNIT_TOL), 1.0, u)
@@ -62,7 +62,7 @@ class Standardizer:
     def x_to_unit(self, x: np.ndarray) -> np.ndarray:
         """Known inputs (n, p) native -> unit scale."""
         u = (np.asarray(x, dtype=np.float64) - self.x_min) / (self.x_max - self.x_min)
-        return _snap_to_unit(u)
+        return snap_to_unit(u)
 
     def x_from_unit(self, x: np.ndarray) -> np.ndarray:
         """Known inputs (n, p) unit scale -> native."""
@@ -71,7 +71,7 @@ class Standardizer:
     def t_to_unit(self, t: np.ndarray) -> np.ndarray:
         """Parameters (n, q) native -> unit scale."""
         u = (np.asarray(t, dtype=np.float64) - self.t_min) / (self.t_max - self.t_min)
-        return _snap_to_unit(u)
+        return snap_to_unit(u)
 
     def t_from_unit(self, t: np.ndarray) -> np.ndarray:
         """Parameters (n, q) unit scale -> native: theta * (t_max - t_min) + t_min."""

@@ -15,7 +15,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import as_matrix
 from gpmsa.model.likelihood import lower_cholesky
-from gpmsa.model.transforms import EXTRAPOLATION_MARGIN
+from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 
@@ -48,9 +48,7 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
         values = [values]
     native = as_matrix(values, what, ncols=d)
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
-    unit = (native - lo) / (hi - lo)
-    unit = np.where((unit < 0) & (unit > -1e-9), 0.0, unit)
-    unit = np.where((unit > 1) & (unit < 1 + 1e-9), 1.0, unit)
+    unit = snap_to_unit((native - lo) / (hi - lo))
     below, above = unit.min(axis=0), unit.max(axis=0)
     far = (below < -EXTRAPOLATION_MARGIN) | (above > 1 + EXTRAPOLATION_MARGIN)
     if far.any():
