@@ -30,9 +30,12 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
                      f"l_sim={emu.l_sim}; parameters {params}")  # fmt: skip
     if st["hierarchical"]:
         hp = manifest["priors"]["hyper"]
-        lines.append("hyperpriors:     mu ~ Normal({}, {}) on (0, 1); lam ~ Gamma({}, {}) "
-                     "(unit scale)".format(*(number(hp[k]) for k in
-                                             ("mu_mean", "mu_sd", "lam_a", "lam_b"))))  # fmt: skip
+        if hp.get("sd_prior", "gamma") == "uniform":
+            spread = f"sd = 1/sqrt(lam) ~ Uniform(0, {number(hp['sd_max'])})"
+        else:
+            spread = f"lam ~ Gamma({number(hp['lam_a'])}, {number(hp['lam_b'])}) (SEPIA's)"
+        lines.append(f"hyperpriors:     mu ~ Normal({number(hp['mu_mean'])}, "
+                     f"{number(hp['mu_sd'])}) on (0, 1); {spread} (unit scale)")  # fmt: skip
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in manifest["settings"].items()
             if not isinstance(v, (list, dict))]  # fmt: skip
     lines.append("settings:        " + ", ".join(flat))

@@ -9,6 +9,7 @@ too; every other element is the model's own, with the model's theta prior. docs/
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 
@@ -20,33 +21,69 @@ LABEL_RE = re.compile(r"^[A-Za-z0-9_-]{1,48}$")
 """A model's label: letters, digits, _ and -, at most 48 (it names the model's file)."""
 
 
+SD_PRIORS = ("uniform", "gamma")
+"""The group-spread priors: a uniform sd (the default) or SEPIA's Gamma on the precision."""
+
+
 @dataclass(frozen=True)
 class HyperPriors:
-    """Hyperpriors of a hierarchical group (unit scale), SEPIA's defaults.
+    """Hyperpriors of a hierarchical group (unit scale).
 
-    mu ~ Normal(mu_mean, mu_sd) truncated to (0, 1); the precision lam ~ Gamma(lam_a, lam_b)
-    (shape, rate) on (0, inf). lam_start: the precision a chain starts from (sd 1/sqrt(lam)).
+    mu ~ Normal(mu_mean, mu_sd) truncated to (0, 1). The group's spread: with ``sd_prior =
+    "uniform"`` (default) its sd = 1/sqrt(lam) ~ Uniform(0, sd_max) (Gelman 2006's choice for
+    few groups); with ``"gamma"`` the precision lam ~ Gamma(lam_a, lam_b) (shape, rate), SEPIA's
+    prior (``HyperPriors.sepia()``). lam_start: the precision a chain starts from.
     """
 
     mu_mean: float = 0.5
     mu_sd: float = 10.0
+    sd_prior: str = "uniform"
+    sd_max: float = 1.0
     lam_a: float = 1.0
     lam_b: float = 1e-3
     lam_start: float = 5.0
 
     def __post_init__(self) -> None:
-        for name in ("mu_mean", "mu_sd", "lam_a", "lam_b", "lam_start"):
+        for name in NUMBERS:
             val = getattr(self, name)
             if isinstance(val, bool) or not isinstance(val, (int, float, np.floating, np.integer)):
                 raise GPMSAError(f"HyperPriors.{name} must be a number, got {val!r}")
             if not np.isfinite(val) or (name != "mu_mean" and not val > 0):
                 need = "finite" if name == "mu_mean" else "finite and > 0"
                 raise GPMSAError(f"HyperPriors.{name} must be {need}, got {val!r}")
+        if self.sd_prior not in SD_PRIORS:
+            raise GPMSAError(f"HyperPriors.sd_prior must be one of {SD_PRIORS}, got "
+                             f"{self.sd_prior!r}")  # fmt: skip
+        if self.sd_prior == "uniform" and self.lam_start * self.sd_max**2 <= 1.0:
+            raise GPMSAError(f"HyperPriors.lam_start={self.lam_start!r} gives a start sd "
+                             f"{self.lam_start**-0.5:.3g} outside the uniform sd prior's "
+                             f"(0, sd_max={self.sd_max!r})")  # fmt: skip
 
-    def to_dict(self) -> dict[str, float]:
+    @classmethod
+    def sepia(cls) -> HyperPriors:
+        """SEPIA's hyperpriors: mu ~ Normal(0.5, 10), lam ~ Gamma(1, 1e-3), start lam = 5."""
+        return cls(sd_prior="gamma")
+
+    @property
+    def lam_min(self) -> float:
+        """The smallest precision the spread prior allows (0 for the Gamma prior)."""
+        return self.sd_max**-2 if self.sd_prior == "uniform" else 0.0
+
+    def log_prior_lam(self, lam: float) -> float:
+        """Log prior density of the precision lam, up to a constant (-inf outside its support)."""
+        if not lam > self.lam_min:
+            return -math.inf
+        if self.sd_prior == "uniform":  # p(sd) = 1/sd_max: p(lam) = p(sd) |d sd / d lam|
+            return -1.5 * math.log(lam)
+        return (self.lam_a - 1.0) * math.log(lam) - self.lam_b * lam
+
+    def to_dict(self) -> dict[str, float | str]:
         """JSON-able dict."""
-        return {k: float(getattr(self, k)) for k in ("mu_mean", "mu_sd", "lam_a", "lam_b",
-                                                      "lam_start")}  # fmt: skip
+        return {"sd_prior": self.sd_prior, **{k: float(getattr(self, k)) for k in NUMBERS}}
+
+
+NUMBERS = ("mu_mean", "mu_sd", "sd_max", "lam_a", "lam_b", "lam_start")
+"""HyperPriors' numeric fields."""
 
 
 @dataclass(frozen=True)

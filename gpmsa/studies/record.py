@@ -9,7 +9,7 @@ import re
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError
-from gpmsa.studies.layout import LABEL_RE, Layout
+from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout
 
 KINDS = ("calibration", "fit")
 """How a study's draws were made: calibration with the emulators fixed, or a joint fit."""
@@ -69,7 +69,15 @@ def check_study_manifest(manifest: dict) -> None:
     hyper = manifest["priors"].get("hyper")
     if not isinstance(hyper, dict):
         raise _fail("priors.hyper", f"must be an object, got {_short(hyper)}")
-    for key in ("mu_mean", "mu_sd", "lam_a", "lam_b", "lam_start"):
+    unknown = set(hyper) - {"sd_prior", *NUMBERS}
+    if unknown:
+        raise _fail("priors.hyper", f"unknown keys {_short(sorted(unknown))}")
+    if hyper.get("sd_prior", "gamma") not in SD_PRIORS:  # files before the key had SEPIA's
+        raise _fail("priors.hyper.sd_prior", f"must be one of {SD_PRIORS}, got "
+                                             f"{_short(hyper.get('sd_prior'))}")  # fmt: skip
+    for key in NUMBERS:
+        if key == "sd_max" and key not in hyper:
+            continue
         val = hyper.get(key)
         ok = isinstance(val, (int, float)) and not isinstance(val, bool) and math.isfinite(val)
         if not ok or (key != "mu_mean" and not val > 0):

@@ -100,7 +100,8 @@ def calibrate_study(
         shared: parameter names (emulator t_names) that take one value in every model that has
             them. hierarchical: names whose per-model values are draws of
             Normal(mu, 1/lam) truncated to the parameter's range, mu and lam sampled too
-            (``hyper``: their priors, SEPIA's defaults). Every other parameter is its model's.
+            (``hyper``: their priors, ``gpmsa.HyperPriors()``: a uniform group sd; SEPIA's:
+            ``HyperPriors.sepia()``). Every other parameter is its model's.
         n_samples, n_burn, tune, seed, n_chains, init, tune_rounds, tune_levels, extrapolate,
             progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep).
         metadata: a JSON-able dict saved with the study.

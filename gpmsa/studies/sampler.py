@@ -95,8 +95,9 @@ class StudyState:
             return -math.inf
         els = self.group_els[h]
         ss = sum((self.g[e] - mu) ** 2 for e in els)
-        lp = -0.5 * ((mu - hp.mu_mean) / hp.mu_sd) ** 2 + (hp.lam_a - 1.0) * math.log(lam)
-        lp -= hp.lam_b * lam
+        lp = -0.5 * ((mu - hp.mu_mean) / hp.mu_sd) ** 2 + hp.log_prior_lam(lam)
+        if lp == -math.inf:
+            return lp
         return lp + len(els) * (0.5 * math.log(lam) - log_mass01(mu, lam)) - 0.5 * lam * ss
 
     def log_post(self) -> float:
@@ -184,7 +185,8 @@ def _start(problems, layout, hyper, how, rng):
         mu, lam = np.full(H, 0.5), np.full(H, hyper.lam_start)
     else:
         mu = np.array([np.mean(g[layout.members_of(h)]) for h in range(H)])
-        lam = hyper.lam_start * np.exp(rng.uniform(-np.log(10.0), np.log(10.0), H))
+        lo = max(hyper.lam_start / 10.0, hyper.lam_min * (1.0 + 1e-9))  # inside the prior
+        lam = np.exp(rng.uniform(np.log(lo), np.log(hyper.lam_start * 10.0), H))
     return start, g, mu, lam
 
 

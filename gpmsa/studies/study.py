@@ -181,7 +181,8 @@ def load_study(path: str | Path) -> Study:
     try:
         layout = layout_of(members, labels, study["shared"], study["hierarchical"])
         check_study_arrays(manifest, arrays, layout)
-        hyper = HyperPriors(**manifest["priors"]["hyper"])
+        saved = manifest["priors"]["hyper"]
+        hyper = HyperPriors(**{"sd_prior": "gamma", **saved})  # no sd_prior: SEPIA's, as before
         return Study(study["kind"], members, layout, hyper, arrays, manifest["settings"],
                      manifest["metadata"])  # fmt: skip
     except EmulatorFileError as exc:

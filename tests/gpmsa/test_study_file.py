@@ -102,6 +102,9 @@ FILE0 = r"study.models\[0\].file"
         (lambda m: m["study"].update(shared=["t"], hierarchical=[]), "arrays/mu"),
         (lambda m: m["names"].update(elements=["x", "y", "z"]), "names.elements"),
         (lambda m: m["priors"]["hyper"].update(lam_b=-1), "priors.hyper.lam_b"),
+        (lambda m: m["priors"]["hyper"].update(sd_prior="flat"), "priors.hyper.sd_prior"),
+        (lambda m: m["priors"]["hyper"].update(sd_max=0.1), "HyperPriors.lam_start"),
+        (lambda m: m["priors"]["hyper"].update(__class__=1), "priors.hyper: unknown keys"),
         (lambda m: m.pop("study"), "study: must be an object"),
     ],
 )
@@ -110,6 +113,13 @@ def test_an_edited_study_manifest_is_refused_naming_the_field(tmp_path, edit, fi
     _rewrite(path, edit)
     with pytest.raises(gpmsa.EmulatorFileError, match=field):
         gpmsa.load_study(path)
+
+
+def test_a_study_saved_before_the_spread_prior_key_reads_as_sepias(tmp_path):
+    """Study files written before ``sd_prior`` existed had SEPIA's Gamma prior on lam."""
+    path = _study().save(tmp_path / "run.gpmsa")
+    _rewrite(path, lambda m: [m["priors"]["hyper"].pop(k) for k in ("sd_prior", "sd_max")])
+    assert gpmsa.load_study(path).hyper == gpmsa.HyperPriors.sepia()
 
 
 def test_edited_bytes_are_refused(tmp_path):
@@ -128,7 +138,7 @@ def test_gpmsa_info_describes_a_study(tmp_path, capsys):
     assert "study:           calibration of 3 models; shared [], hierarchical [t]" in out
     assert "model b: file run.b.gpmsa sha256" in out and "(verified)" in out
     assert "posterior t.mu: mean" in out and "posterior lamOs[c]" in out
-    assert "hyperpriors:" in out and "\x1b" not in out and "\\u001b[31m" in out
+    assert "sd = 1/sqrt(lam) ~ Uniform(0, 1)" in out and "\x1b" not in out and "\\u001b[31m" in out
     assert main(["info", "--json", str(path)]) == 0
     assert '"gpmsa-study"' in capsys.readouterr().out
     emulator(None).save(tmp_path / "run.a.gpmsa")  # not the file the study lists

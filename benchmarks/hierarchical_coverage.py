@@ -1,0 +1,64 @@
+"""Coverage of a hierarchical study's 90% intervals: the default uniform group-sd prior against
+SEPIA's Gamma(1, 1e-3) on the precision, on synthetic data sets with known truth.
+
+The slow test (tests/gpmsa/test_study_hierarchical.py) checks 6 groups of spread 0.12; this runs
+other group counts and spreads on other seeds (the held-out check of the default's choice). Each
+data set: mu ~ U(0.35, 0.65), the groups' theta_i from Normal(mu, sd) truncated to (0, 1), 6
+noisy observations per group of y = x exp(1.5 t), an emulator with a negligible nugget (the
+study case of the tests). Prints, per (groups, sd) and prior, the fraction of 90% intervals that
+cover theta_i, mu and the group sd. Usage: python benchmarks/hierarchical_coverage.py [--sets 12]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the tests' study case
+import gpmsa  # noqa: E402
+from tests.gpmsa.test_study_hierarchical import _run  # noqa: E402
+
+CONFIGS = ((4, 0.06), (4, 0.25), (10, 0.06), (10, 0.25))
+"""(groups, group sd) of each row."""
+
+
+def coverage(n_groups: int, sd: float, hyper, n_sets: int) -> tuple[float, float, float, int]:
+    """Fractions of 90% intervals covering theta_i, mu and sd over ``n_sets`` data sets, and the
+    number of theta_i intervals."""
+    rng = np.random.default_rng(777)  # the same data sets for both priors
+    hit_theta, hit_mu, hit_sd = [], [], []
+    for r in range(n_sets):
+        mu = rng.uniform(0.35, 0.65)
+        truth, study = _run(rng, n_groups, mu, sd, seed=900 + r, n_samples=2500, n_burn=500,
+                            n_obs=6, hyper=hyper)  # fmt: skip
+        post = study.posterior
+        for i, th in enumerate(truth):
+            lo, hi = post.interval(f"t[model{i}]", 0.9)
+            hit_theta.append(lo < th < hi)
+        lo, hi = post.interval("t.mu", 0.9)
+        hit_mu.append(lo < mu < hi)
+        lo, hi = post.interval("t.sd", 0.9)
+        hit_sd.append(lo < sd < hi)
+    return np.mean(hit_theta), np.mean(hit_mu), np.mean(hit_sd), len(hit_theta)
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sets", type=int, default=12, help="data sets per row (default 12)")
+    args = ap.parse_args(argv)
+    print(f"# 90% interval coverage, {args.sets} data sets a row; load "
+          f"{os.getloadavg()[0]:.2f}")  # fmt: skip
+    print("groups  sd    prior     theta_i (n)    mu     group sd")
+    for n_groups, sd in CONFIGS:
+        for name, hyper in (("uniform", gpmsa.HyperPriors()), ("sepia", gpmsa.HyperPriors.sepia())):
+            th, mu, s, n = coverage(n_groups, sd, hyper, args.sets)
+            print(f"{n_groups:6d}  {sd:.2f}  {name:8s}  {th:.3f} ({n:3d})  {mu:.3f}  {s:.3f}",
+                  flush=True)  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()
