@@ -21,6 +21,7 @@ from threadpoolctl import threadpool_limits
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.mcmc import ridge, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
+from gpmsa.model.data import check_seed
 from gpmsa.model.likelihood import IncrementalLikelihood
 from gpmsa.model.problem import Problem
 
@@ -226,8 +227,7 @@ def check_sample_args(n_iter, n_chains, seed) -> None:
         raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
     if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
         raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
-    if seed is not None and not isinstance(seed, (int, np.integer)):
-        raise GPMSAError(f"seed must be an int or None, got {seed!r}")
+    check_seed(seed)
 
 
 def check_ridge(ridge_moves, problem: Problem) -> int:

@@ -13,7 +13,7 @@ from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import as_matrix
+from gpmsa.model.data import as_matrix, check_seed
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
 
@@ -28,12 +28,9 @@ def check_count(value, name: str, low: int = 1) -> int:
 
 
 def rng_of(seed) -> np.random.Generator:
-    """A Generator from an int, a Generator or None."""
-    if isinstance(seed, np.random.Generator):
-        return seed
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int | np.integer)):
-        raise GPMSAError(f"seed must be an int, a numpy Generator or None, got {seed!r}")
-    return np.random.default_rng(seed)
+    """A Generator from an integer in [0, 2**128), a Generator or None (``check_seed``)."""
+    seed = check_seed(seed, generator=True)
+    return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
 
 def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarray]:

@@ -124,7 +124,8 @@ def test_draws_of_an_emulator_file_that_kept_none_are_refused(tmp_path):
 @pytest.mark.parametrize(
     ("kw", "match"),
     [({"n_rlz": 0}, "n_rlz must be an integer >= 1"), ({"n_draws": 0}, "n_draws must be"),
-     ({"seed": "x"}, "seed must be an int")],
+     ({"seed": "x"}, "seed must be None, an integer or a numpy Generator"),
+     ({"seed": -1}, r"seed=-1 is out of range")],
 )  # fmt: skip
 def test_bad_settings(kw, match):
     with pytest.raises(GPMSAError, match=match):
