@@ -32,7 +32,8 @@ class HyperPriors:
     mu ~ Normal(mu_mean, mu_sd) truncated to (0, 1). The group's spread: with ``sd_prior =
     "uniform"`` (default) its sd = 1/sqrt(lam) ~ Uniform(0, sd_max) (Gelman 2006's choice for
     few groups); with ``"gamma"`` the precision lam ~ Gamma(lam_a, lam_b) (shape, rate), SEPIA's
-    prior (``HyperPriors.sepia()``). lam_start: the precision a chain starts from.
+    prior (``HyperPriors.sepia()``). lam_start: the precision a chain starts from (None: SEPIA's
+    5, or 4 / sd_max^2, an sd of sd_max / 2, where the uniform sd prior excludes 5).
     """
 
     mu_mean: float = 0.5
@@ -41,9 +42,14 @@ class HyperPriors:
     sd_max: float = 1.0
     lam_a: float = 1.0
     lam_b: float = 1e-3
-    lam_start: float = 5.0
+    lam_start: float | None = None
 
     def __post_init__(self) -> None:
+        if self.lam_start is None:
+            ok = isinstance(self.sd_max, (int, float, np.floating, np.integer))
+            sd_max = float(self.sd_max) if ok and 0 < self.sd_max < np.inf else 1.0  # else: below
+            inside = self.sd_prior != "uniform" or 5.0 * sd_max**2 > 1.0
+            object.__setattr__(self, "lam_start", 5.0 if inside else 4.0 / sd_max**2)
         for name in NUMBERS:
             val = getattr(self, name)
             if isinstance(val, bool) or not isinstance(val, (int, float, np.floating, np.integer)):

@@ -89,6 +89,7 @@ def test_bad_hyperpriors_are_named():
         gpmsa.HyperPriors(sd_prior="half-cauchy")
     with pytest.raises(gpmsa.GPMSAError, match="HyperPriors.lam_start"):
         gpmsa.HyperPriors(sd_max=0.3, lam_start=5.0)  # start sd 0.45 > sd_max
+    assert gpmsa.HyperPriors(sd_max=0.3).lam_start == pytest.approx(4 / 0.09)  # sd 0.15
 
 
 @pytest.mark.slow
