@@ -5,7 +5,8 @@ Prints, each with the load average (the machine is shared: compare rows of one r
    and their ratio (target >= 1.8 on 2 cores), medians over ``--repeats`` alternating runs;
 2. torch, 64 batched chains with the default warm-up (dispersed starts, 3 stages of warm-up and
    pooled tuning): max R-hat (target < 1.01), min bulk ESS, ESS/s and its ratio to the numpy
-   single chain's of part 1 (target >= 1 on this CPU);
+   single chain's of part 1 (target >= 1 on this CPU), as one batch (one core) and as
+   ``chain_groups`` = the CPU count (one process per group after the tuning);
 3. the cost of one chain-sweep: torch x64 against a numpy sweep (CPU time, alternating).
 
 Fit: the simulation-only emulator (198 runs, scalar output; betaU, lamUz, lamWs, lamWOs), run
@@ -31,6 +32,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from backends import ess_rhat, road  # noqa: E402
 
 from gpmsa import backends  # noqa: E402
+from gpmsa.mcmc.parallel import available_cpus  # noqa: E402
 from gpmsa.model.problem import prepare  # noqa: E402
 
 
@@ -78,17 +80,25 @@ def numpy_parallel(n_iter: int, repeats: int) -> float:
 
 
 def torch_batched(n_iter: int, n_chains: int, numpy_rate: float | None) -> None:
-    """Part 2."""
+    """Part 2: one batch (one core), then ``chain_groups`` = every CPU (one process each)."""
     print(f"\n# torch, {n_chains} batched chains x {n_iter} draws, default warm-up; {load()}")
-    wall, cpu, n_eff, r_hat, chains = run_fit("torch", n_iter, n_chains, seed=0)
-    worst = _worst_rhat(chains, n_iter // 5)
-    line = (
-        f"torch x{n_chains}: wall {wall:7.1f} s, min ESS {n_eff:7.0f}, ESS/s {n_eff / wall:6.1f}, "
-        f"max R-hat {r_hat:.4f} ({worst}; target < 1.01), CPU {cpu:.1f} s"
-    )
-    if numpy_rate:
-        line += f", ESS/s vs numpy 1 chain {n_eff / wall / numpy_rate:.2f} (target >= 1)"
-    print(line + f"; {load()}", flush=True)
+    cpus = available_cpus()
+    rates = {}
+    for groups in (1, cpus) if cpus > 1 else (1,):
+        wall, cpu, n_eff, r_hat, chains = run_fit("torch", n_iter, n_chains, seed=0,
+                                                  chain_groups=groups)  # fmt: skip
+        worst = _worst_rhat(chains, n_iter // 5)
+        rates[groups] = n_eff / wall
+        line = (
+            f"torch x{n_chains}, chain_groups={groups}: wall {wall:7.1f} s, min ESS {n_eff:7.0f}, "
+            f"ESS/s {n_eff / wall:6.1f}, max R-hat {r_hat:.4f} ({worst}; target < 1.01), CPU "
+            f"{cpu:.1f} s"
+        )
+        if numpy_rate:
+            line += f", ESS/s vs numpy 1 chain {n_eff / wall / numpy_rate:.2f} (target >= 1)"
+        print(line + f"; {load()}", flush=True)
+    if len(rates) == 2:
+        print(f"torch ESS/s, {cpus} groups vs one batch: {rates[cpus] / rates[1]:.2f}x; {load()}")
 
 
 def _worst_rhat(chains, burn: int) -> str:

@@ -34,6 +34,7 @@ from tqdm.auto import tqdm
 from gpmsa.backends import check_sample_args
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.mcmc import ridge, starts, tuning
+from gpmsa.mcmc.parallel import n_workers, run_chains
 from gpmsa.mcmc.sampler import (
     PRECISION_PARAMS,
     RHO_PARAMS,
@@ -607,6 +608,9 @@ def sample(
     warmup: int | None = None,
     tune_stages: int = TUNE_STAGES,
     ridge_moves: int | None = None,
+    chain_groups: int = 1,
+    n_jobs: int | None = None,
+    executor=None,
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
@@ -624,6 +628,15 @@ def sample(
     ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
     torch's setting.
+
+    Several cores, or a cluster, on the CPU: ``chain_groups`` > 1 splits the chains, after the
+    (pooled) tuning, into that many batches of consecutive chains, each sampled in a worker
+    process with its own random stream (a child of ``seed``'s SeedSequence after the chains'):
+    ``n_jobs`` processes (None: every CPU, never more than the groups) or any
+    ``concurrent.futures.Executor`` / dask ``Client`` as ``executor``. The draws depend on
+    ``chain_groups`` and ``seed``, never on ``n_jobs`` or where the groups ran; each worker
+    runs one thread (``num_threads`` must be 1); a failed group is retried as the numpy
+    backend's chains are (``gpmsa.mcmc.parallel``), then ``ChainError`` names its chains.
     """
     check_sample_args(n_iter, n_chains, seed)
     if problem.extensions:
@@ -631,14 +644,44 @@ def sample(
             f"the torch backend does not support {', '.join(problem.extensions)}; use "
             "backend='numpy'"
         )
+    where = _check_groups(chain_groups, n_jobs, executor, int(n_chains), device, num_threads)
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,
-                       tune_stages, check_ridge(ridge_moves, problem))  # fmt: skip
+                       tune_stages, check_ridge(ridge_moves, problem), where)  # fmt: skip
+
+
+def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_threads) -> dict:
+    """``sample``'s placement of the sampling phase: {"groups", "n_jobs", "executor"}."""
+    if isinstance(chain_groups, bool) or not isinstance(chain_groups, (int, np.integer)) or not (
+        1 <= chain_groups <= n_chains
+    ):
+        raise GPMSAError(
+            f"chain_groups must be an integer in [1, n_chains={n_chains}], got {chain_groups!r}"
+        )
+    remote = chain_groups > 1 or executor is not None
+    if remote and torch.device(device).type != "cpu":
+        raise GPMSAError(
+            f"chain_groups > 1 and executor= run CPU worker processes; device={device!r} samples "
+            "all chains in one batch (give chain_groups=1 and no executor)"
+        )
+    if remote and num_threads != 1:
+        raise GPMSAError(
+            f"with chain_groups > 1 or an executor each group's process runs one thread: give "
+            f"num_threads=1 (got {num_threads!r}); use more groups for more cores"
+        )
+    n_workers(n_jobs, int(chain_groups))  # refuse a bad n_jobs up front
+    if chain_groups == 1 and n_jobs is not None and n_jobs > 1:
+        raise GPMSAError(
+            f"n_jobs={n_jobs} with chain_groups=1: the torch backend samples its chains as one "
+            f"batch; give chain_groups={n_jobs} (or more) to sample in {n_jobs} processes"
+        )
+    return {"groups": int(chain_groups), "n_jobs": n_jobs, "executor": executor}
 
 
 def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
-            tune_levels, device, dtype, init, warmup, tune_stages, n_ridge) -> Chains:  # fmt: skip
+            tune_levels, device, dtype, init, warmup, tune_stages, n_ridge,
+            where) -> Chains:  # fmt: skip
     """``sample`` without the thread setting."""
     dev, dt = _device(device), _dtype(dtype)
     how = starts.check_init(init, n_chains)
@@ -667,10 +710,9 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     n_stages = tune_stages if tune else 1
     total = n_iter + n_stages * (warmup + (tune_rounds * tune_levels if tune else 0))
     names = problem.names
-    draws = {n: torch.empty((n_iter, n_chains, *problem.init[n].shape), dtype=dt, device=dev)
-             for n in names}  # fmt: skip
-    log_post = torch.empty((n_iter, n_chains), dtype=dt, device=dev)
-    accepted = torch.zeros((len(els), n_chains), dtype=torch.long, device=dev)
+    in_process = where["groups"] == 1 and where["executor"] is None
+    if not in_process:
+        total -= n_iter  # the groups' sweeps: counted by run_chains' bar over the groups
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
         for _stage in range(n_stages):
             bar.set_description("torch MCMC: warm-up and tuning" if tune else "torch MCMC: warm-up")
@@ -686,28 +728,90 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                     acc[lev] += state.sweep(cands[lev], False, gen).sum(-1)
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
-        bar.set_description("torch MCMC: sampling")
-        for it in range(n_iter):
-            accepted += state.sweep(w, not tune, gen)
-            for n in names:
-                draws[n][it] = state.params[n]
-            log_post[it] = state.log_post()
-            bar.update(1)
+        if in_process:
+            bar.set_description("torch MCMC: sampling")
+            draws, log_post, accepted = _sweeps(state, w, n_iter, not tune, gen, bar)
+    if not in_process:
+        draws, log_post, accepted = _grouped_sweeps(state, w, n_iter, not tune, seeds[0], where,
+                                                    dtype=str(dt).replace("torch.", ""),
+                                                    progress=progress)  # fmt: skip
     rate = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
     wid = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
-    acc_np = accepted.cpu().numpy() / n_iter
+    acc_np = accepted / n_iter
     for i, (n, idx) in enumerate(els):
         rate[n][(slice(None), *idx)] = acc_np[i]
         wid[n][(slice(None), *idx)] = w[i]
     return Chains(
-        draws={n: np.moveaxis(v.cpu().numpy(), 0, 1) for n, v in draws.items()},
-        log_post=log_post.cpu().numpy().T,
+        draws=draws,
+        log_post=log_post,
         accept_rate=rate,
         step_widths=wid,
         info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": tune,
               "tune_rounds": tune_rounds, "tune_levels": tune_levels, "seed": seed,
               "init": how, "warmup": int(warmup), "tune_stages": n_stages, "starts": start,
-              "ridge_moves": state.ridge_moves,
+              "ridge_moves": state.ridge_moves, "chain_groups": where["groups"],
               "backend": "torch",
               "device": str(dev), "dtype": str(dt).replace("torch.", "")},
     )  # fmt: skip
+
+
+def _sweeps(
+    state: BatchState, widths: np.ndarray, n_iter: int, prop_mh: bool, gen: torch.Generator, bar
+) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]:
+    """``n_iter`` recorded sweeps of every chain of ``state``: draws name -> (C, n_iter, *shape),
+    log posterior (C, n_iter) and accepted counts (n_el, C), as numpy arrays."""
+    problem, c = state.problem, state.n_chains
+    dt, dev = state.ll_w.dtype, state.ll_w.device
+    draws = {n: torch.empty((n_iter, c, *problem.init[n].shape), dtype=dt, device=dev)
+             for n in problem.names}  # fmt: skip
+    log_post = torch.empty((n_iter, c), dtype=dt, device=dev)
+    accepted = torch.zeros((len(state.els), c), dtype=torch.long, device=dev)
+    for it in range(n_iter):
+        accepted += state.sweep(widths, prop_mh, gen)
+        for n in problem.names:
+            draws[n][it] = state.params[n]
+        log_post[it] = state.log_post()
+        bar.update(1)
+    return ({n: np.moveaxis(v.cpu().numpy(), 0, 1) for n, v in draws.items()},
+            log_post.cpu().numpy().T, accepted.cpu().numpy())  # fmt: skip
+
+
+def _group_task(problem: Problem, start: dict[str, np.ndarray], widths: np.ndarray, n_iter: int,
+                prop_mh: bool, stream: int, dtype: str, ridge_moves: int, progress: bool = False,
+                desc: str = "torch chains") -> tuple:  # fmt: skip
+    """One chain group's sweeps from plain data (run in a worker process, one thread)."""
+    with torch_threads(1), torch.no_grad():
+        n_chains = len(next(iter(start.values())))
+        state = BatchState(problem, n_chains, _dtype(dtype), "cpu", start, ridge_moves)
+        gen = torch.Generator().manual_seed(stream)
+        with tqdm(total=n_iter, desc=desc, disable=not progress) as bar:
+            return _sweeps(state, widths, n_iter, prop_mh, gen, bar)
+
+
+def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh: bool,
+                    first: np.random.SeedSequence, where: dict, *, dtype: str,
+                    progress: bool) -> tuple:  # fmt: skip
+    """``_sweeps`` of consecutive chain groups in worker processes (``gpmsa.mcmc.parallel``);
+    group g's stream is child n_chains + g of the seed's SeedSequence (``first`` is child 0)."""
+    c, k = state.n_chains, where["groups"]
+    bounds = np.linspace(0, c, k + 1).round().astype(int)
+    tasks = []
+    for g in range(k):
+        lo, hi = int(bounds[g]), int(bounds[g + 1])
+        seq = np.random.SeedSequence(first.entropy, spawn_key=(c + g,))
+        tasks.append({
+            "problem": state.problem, "widths": np.asarray(widths), "n_iter": int(n_iter),
+            "start": {n: v[lo:hi].cpu().numpy().copy() for n, v in state.params.items()},
+            "prop_mh": bool(prop_mh), "dtype": dtype, "ridge_moves": state.ridge_moves,
+            "stream": int(seq.generate_state(1, dtype=np.uint64)[0]) & (2**63 - 1),
+        })  # fmt: skip
+    try:
+        runs = run_chains(_group_task, tasks, n_jobs=where["n_jobs"], executor=where["executor"],
+                          progress=progress, desc="torch chain groups",
+                          what="chain group")  # fmt: skip
+    except ChainError as exc:
+        g = exc.chains[0] if exc.chains else 0
+        chains = tuple(range(int(bounds[g]), int(bounds[g + 1])))
+        raise ChainError(f"chains {chains[0]}-{chains[-1]}: {exc}", chains) from exc
+    draws = {n: np.concatenate([r[0][n] for r in runs]) for n in runs[0][0]}
+    return draws, np.concatenate([r[1] for r in runs]), np.concatenate([r[2] for r in runs], 1)

@@ -138,6 +138,9 @@ def fit(
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),
+        "backend_options": {k: v for k, v in sorted(options.items())  # not where they ran
+                            if k not in ("n_jobs", "executor")
+                            and (v is None or isinstance(v, (bool, int, float, str)))},
         "mean_basis": None if problem.mean_basis is None else problem.mean_basis.kind,
         "fixed": {k: problem.init[k].tolist() for k in sorted(problem.fixed)},
         "constraint": constraint is not None,

@@ -88,6 +88,7 @@ def run_chains(
     progress: bool = False,
     desc: str = "chains",
     retries: int = RETRIES,
+    what: str = "chain",
 ) -> list:
     """``[fn(**task, progress=..., desc=...) for task in tasks]``, the tasks run in parallel.
 
@@ -97,7 +98,7 @@ def run_chains(
     ``concurrent.futures.Executor`` or a dask ``Client`` instead (``n_jobs`` must then be None).
     ``progress``: in this process, each chain's own bar; in parallel, one bar over the chains.
     Returns the results in chain order. Raises ChainError naming the failed chain (see the
-    module docstring for retries).
+    module docstring for retries); ``what`` is what a task is called there ("chain").
     """
     n = len(tasks)
     if executor is not None and n_jobs is not None:
@@ -107,18 +108,18 @@ def run_chains(
         raise GPMSAError(f"retries must be an integer >= 0, got {retries!r}")
     workers = 1 if executor is not None else n_workers(n_jobs, n)
     if executor is None and workers == 1:
-        return [_in_process(fn, task, i, n, progress, desc) for i, task in enumerate(tasks)]
-    return _parallel(fn, tasks, executor, workers, progress, desc, retries)
+        return [_in_process(fn, task, i, n, progress, desc, what) for i, task in enumerate(tasks)]
+    return _parallel(fn, tasks, executor, workers, progress, desc, retries, what)
 
 
-def _in_process(fn, task, i, n, progress, desc):
+def _in_process(fn, task, i, n, progress, desc, what):
     try:
         return fn(**task, progress=progress, desc=f"{desc} {i + 1}/{n}")
     except Exception as exc:
-        raise ChainError(f"chain {i} of {n} failed: {_describe(exc)}", (i,)) from exc
+        raise ChainError(f"{what} {i} of {n} failed: {_describe(exc)}", (i,)) from exc
 
 
-def _parallel(fn, tasks, executor, workers, progress, desc, retries):
+def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
     from tqdm.auto import tqdm
 
     n = len(tasks)
@@ -127,7 +128,7 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries):
     results: list = [None] * n
     attempts = [0] * n
     running: dict[Future, int] = {}
-    bar = tqdm(total=n, desc=desc, unit="chain", disable=not progress)
+    bar = tqdm(total=n, desc=desc, unit=what, disable=not progress)
 
     def submit(i: int) -> None:
         attempts[i] += 1
@@ -137,9 +138,9 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries):
         nonlocal pool
         if isinstance(exc, GPMSAError) or attempts[i] > retries:
             tries = f" after {attempts[i]} attempts" if attempts[i] > 1 else ""
-            raise ChainError(f"chain {i} of {n} failed{tries}: {_describe(exc)}", (i,)) from exc
+            raise ChainError(f"{what} {i} of {n} failed{tries}: {_describe(exc)}", (i,)) from exc
         warnings.warn(
-            f"chain {i} of {n} failed ({_describe(exc)}); running it again (same seed, same "
+            f"{what} {i} of {n} failed ({_describe(exc)}); running it again (same seed, same "
             f"draws)", RuntimeWarning, stacklevel=2,
         )  # fmt: skip
         if own and isinstance(exc, BrokenExecutor):  # a dead worker breaks the whole pool

@@ -127,3 +127,75 @@ def test_cuda_request_without_a_device_is_refused():
     problem = gpmsa.prepare(multi_data()[0]).problem
     with pytest.raises(gpmsa.GPMSAError, match="torch sees no CUDA device"):
         backends.get("torch").sample(problem, n_iter=2, device="cuda")
+
+
+# --- chain groups: the sampling phase in worker processes -----------------------------------
+def _grouped(problem, **kw):
+    return backends.get("torch").sample(problem, n_iter=12, n_chains=6, seed=21, warmup=4,
+                                        tune_stages=1, tune_rounds=1, chain_groups=3,
+                                        **kw)  # fmt: skip
+
+
+def test_chain_groups_give_the_same_draws_with_any_number_of_workers():
+    """Groups of consecutive chains, each in a worker process with its own stream: the draws
+    depend on chain_groups and seed only; every chain's draws and log posterior stay together."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from _backend_cases import multi_data
+
+    problem = gpmsa.prepare(multi_data()[0]).problem
+    runs = [_grouped(problem, n_jobs=1)]
+    if gpmsa.mcmc.parallel.available_cpus() >= 2:
+        runs.append(_grouped(problem, n_jobs=2))
+    with ThreadPoolExecutor(2) as ex:
+        runs.append(_grouped(problem, executor=ex))
+    first = runs[0]
+    assert first.info["chain_groups"] == 3 and first.draws["betaU"].shape[:2] == (6, 12)
+    for other in runs[1:]:
+        for name, val in first.draws.items():
+            assert np.array_equal(other.draws[name], val), name
+        assert np.array_equal(other.log_post, first.log_post)
+    for c in range(6):  # each group's state (caches included) is its chains' own
+        params = {k: v[c, -1] for k, v in first.draws.items()}
+        assert np.isclose(first.log_post[c, -1], log_posterior(problem, params), rtol=1e-9)
+    assert np.isfinite(first.accept_rate["betaU"]).all()
+    one_batch = backends.get("torch").sample(problem, n_iter=12, n_chains=6, seed=21, warmup=4,
+                                             tune_stages=1, tune_rounds=1)  # fmt: skip
+    assert one_batch.info["chain_groups"] == 1
+    assert not np.array_equal(one_batch.log_post, first.log_post)  # other streams
+
+
+@pytest.mark.filterwarnings("ignore::gpmsa.ConvergenceWarning")  # 4 chains x 8 draws
+def test_fit_takes_chain_groups_and_n_jobs_for_torch():
+    """gpmsa.fit passes n_jobs and the torch options on, and records the options it used."""
+    from _backend_cases import multi_data
+
+    emu = gpmsa.fit(multi_data()[0], n_iter=10, n_chains=4, backend="torch", seed=2, n_jobs=2,
+                    chain_groups=2, warmup=2, tune_stages=1, tune_rounds=1)  # fmt: skip
+    assert emu.settings["backend_options"] == {"chain_groups": 2, "tune_rounds": 1,
+                                               "tune_stages": 1, "warmup": 2}  # fmt: skip
+
+
+def test_bad_chain_groups_are_named():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from _backend_cases import multi_data
+    from test_chains import RefusingExecutor
+
+    problem = gpmsa.prepare(multi_data()[0]).problem
+    for bad in (0, 7, True, 2.0):
+        with pytest.raises(gpmsa.GPMSAError, match=r"chain_groups must be an integer in \[1, "):
+            backends.get("torch").sample(problem, n_iter=2, n_chains=6, chain_groups=bad)
+    with pytest.raises(gpmsa.GPMSAError, match="run CPU worker processes; device='cuda'"):
+        _grouped(problem, device="cuda")
+    with pytest.raises(gpmsa.GPMSAError, match="runs one thread: give num_threads=1"):
+        _grouped(problem, num_threads=2)
+    with pytest.raises(gpmsa.GPMSAError, match="n_jobs=4096 is more than"):
+        _grouped(problem, n_jobs=4096)
+    with ThreadPoolExecutor(1) as ex, pytest.raises(gpmsa.GPMSAError, match="not both"):
+        _grouped(problem, n_jobs=1, executor=ex)
+    with RefusingExecutor(1) as ex, pytest.warns(RuntimeWarning, match="running it again"):
+        with pytest.raises(gpmsa.ChainError, match=r"chains 0-1: chain group 0 of 3 failed "
+                                                   r"after 2 attempts") as info:  # fmt: skip
+            _grouped(problem, executor=ex)
+    assert info.value.chains == (0, 1)
