@@ -20,30 +20,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the tests' study case
 import gpmsa  # noqa: E402
-from tests.gpmsa.test_study_hierarchical import _run  # noqa: E402
+from tests.gpmsa.test_study_hierarchical import coverage  # noqa: E402
 
 CONFIGS = ((4, 0.06), (4, 0.25), (10, 0.06), (10, 0.25))
 """(groups, group sd) of each row."""
-
-
-def coverage(n_groups: int, sd: float, hyper, n_sets: int) -> tuple[float, float, float, int]:
-    """Fractions of 90% intervals covering theta_i, mu and sd over ``n_sets`` data sets, and the
-    number of theta_i intervals."""
-    rng = np.random.default_rng(777)  # the same data sets for both priors
-    hit_theta, hit_mu, hit_sd = [], [], []
-    for r in range(n_sets):
-        mu = rng.uniform(0.35, 0.65)
-        truth, study = _run(rng, n_groups, mu, sd, seed=900 + r, n_samples=2500, n_burn=500,
-                            n_obs=6, hyper=hyper)  # fmt: skip
-        post = study.posterior
-        for i, th in enumerate(truth):
-            lo, hi = post.interval(f"t[model{i}]", 0.9)
-            hit_theta.append(lo < th < hi)
-        lo, hi = post.interval("t.mu", 0.9)
-        hit_mu.append(lo < mu < hi)
-        lo, hi = post.interval("t.sd", 0.9)
-        hit_sd.append(lo < sd < hi)
-    return np.mean(hit_theta), np.mean(hit_mu), np.mean(hit_sd), len(hit_theta)
 
 
 def main(argv=None) -> None:
@@ -55,9 +35,10 @@ def main(argv=None) -> None:
     print("groups  sd    prior     theta_i (n)    mu     group sd")
     for n_groups, sd in CONFIGS:
         for name, hyper in (("uniform", gpmsa.HyperPriors()), ("sepia", gpmsa.HyperPriors.sepia())):
-            th, mu, s, n = coverage(n_groups, sd, hyper, args.sets)
-            print(f"{n_groups:6d}  {sd:.2f}  {name:8s}  {th:.3f} ({n:3d})  {mu:.3f}  {s:.3f}",
-                  flush=True)  # fmt: skip
+            rng = np.random.default_rng(777)  # the same data sets for both priors
+            th, mu, s = coverage(rng, n_groups, sd, args.sets, hyper, 900)
+            print(f"{n_groups:6d}  {sd:.2f}  {name:8s}  {np.mean(th):.3f} ({len(th):3d})  "
+                  f"{np.mean(mu):.3f}  {np.mean(s):.3f}", flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -27,6 +27,25 @@ def _run(rng, n_models, mu, sd, seed, n_samples=4000, n_burn=1000, n_obs=3, hype
     return truth, study
 
 
+def coverage(rng, n_groups: int, sd: float, n_sets: int, hyper, seed0: int) -> tuple:
+    """Whether each 90% interval covers the truth over ``n_sets`` synthetic studies (mu ~
+    U(0.35, 0.65), group sd ``sd``, 6 observations a group): (theta_i hits, mu hits, sd hits)."""
+    hit_theta, hit_mu, hit_sd = [], [], []
+    for r in range(n_sets):
+        mu = rng.uniform(0.35, 0.65)
+        truth, study = _run(rng, n_groups, mu, sd, seed=seed0 + r, n_samples=2500, n_burn=500,
+                            n_obs=6, hyper=hyper)  # fmt: skip
+        post = study.posterior
+        for i, th in enumerate(truth):
+            lo, hi = post.interval(f"t[model{i}]", 0.9)
+            hit_theta.append(lo < th < hi)
+        lo, hi = post.interval("t.mu", 0.9)
+        hit_mu.append(lo < mu < hi)
+        lo, hi = post.interval("t.sd", 0.9)
+        hit_sd.append(lo < sd < hi)
+    return hit_theta, hit_mu, hit_sd
+
+
 def test_truncated_normal_mass():
     for mu, lam in ((0.5, 4.0), (0.05, 1e4), (0.97, 30.0), (0.3, 1e-3)):
         sd = 1 / math.sqrt(lam)
@@ -104,18 +123,8 @@ def test_hierarchical_intervals_cover_at_the_nominal_rate(hyper, mu_floor):
     intervals of the experiments' theta_i and of mu cover the truth about 90% of the time with
     the default uniform prior on the group sd; SEPIA's Gamma(1, 1e-3) on lam (p(sd) ~ sd^-3)
     favours a small group sd and under-covers mu (0.75 measured; docs/models.md)."""
-    rng = np.random.default_rng(2024)
-    hit_theta, hit_mu, n_sets = [], [], 20
-    for r in range(n_sets):
-        mu = rng.uniform(0.35, 0.65)
-        truth, study = _run(rng, 6, mu, 0.12, seed=100 + r, n_samples=2500, n_burn=500,
-                            n_obs=6, hyper=hyper)
-        post = study.posterior
-        for i, th in enumerate(truth):
-            lo, hi = post.interval(f"t[model{i}]", 0.9)
-            hit_theta.append(lo < th < hi)
-        lo, hi = post.interval("t.mu", 0.9)
-        hit_mu.append(lo < mu < hi)
+    n_sets = 20
+    hit_theta, hit_mu, _ = coverage(np.random.default_rng(2024), 6, 0.12, n_sets, hyper, 100)
     rate_theta, rate_mu = np.mean(hit_theta), np.mean(hit_mu)
     print(f"coverage of 90% intervals: theta_i {rate_theta:.3f} ({len(hit_theta)}), "
           f"mu {rate_mu:.3f} ({n_sets})")
