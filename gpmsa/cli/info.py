@@ -97,6 +97,10 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))
+    options = s.get("backend_options")
+    if isinstance(options, dict) and options:
+        lines.append("backend options: " + ", ".join(
+            f"{safe(k, 60)}={plain(v)}" for k, v in options.items()))  # fmt: skip
     for source in ("settings", "metadata"):
         versions = manifest[source].get("versions")
         if isinstance(versions, dict):

@@ -166,7 +166,7 @@ def test_chain_groups_give_the_same_draws_with_any_number_of_workers():
 
 
 @pytest.mark.filterwarnings("ignore::gpmsa.ConvergenceWarning")  # 4 chains x 8 draws
-def test_fit_takes_chain_groups_and_n_jobs_for_torch():
+def test_fit_takes_chain_groups_and_n_jobs_for_torch(tmp_path, capsys):
     """gpmsa.fit passes n_jobs and the torch options on, and records the options it used."""
     from _backend_cases import multi_data
 
@@ -174,6 +174,12 @@ def test_fit_takes_chain_groups_and_n_jobs_for_torch():
                     chain_groups=2, warmup=2, tune_stages=1, tune_rounds=1)  # fmt: skip
     assert emu.settings["backend_options"] == {"chain_groups": 2, "tune_rounds": 1,
                                                "tune_stages": 1, "warmup": 2}  # fmt: skip
+    from gpmsa.cli.main import main
+
+    path = emu.save(tmp_path / "torch.gpmsa")
+    assert gpmsa.load(path).settings["backend_options"] == emu.settings["backend_options"]
+    assert main(["info", str(path)]) == 0
+    assert "backend options: chain_groups=2, tune_rounds=1" in capsys.readouterr().out
 
 
 def test_bad_chain_groups_are_named():
