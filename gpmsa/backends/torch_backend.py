@@ -6,7 +6,8 @@ those of the numpy reference (``gpmsa.mcmc.sampler``, ``gpmsa.mcmc.ridge``,
 ``gpmsa.mcmc.tuning``); chain c starts where the numpy chain c would (``gpmsa.mcmc.starts``:
 dispersed for several chains), and the chains share one set of widths, tuned on acceptance
 counts pooled over chains in ``tune_stages`` stages, each after ``warmup`` sweeps from where the
-last stage left the chains.
+last stage left the chains. ``chain_groups`` > 1 then samples the chains in batches of consecutive
+chains in worker processes (``gpmsa.mcmc.parallel``), to use every CPU core or a cluster.
 Each chain caches its correlation matrices (packed lower triangle). Sigma_W is factored per chain
 by LAPACK on the CPU (in cache, no copies; ``factor_``, ``_factor_scaled``) and by batched
 ``torch.linalg.cholesky_ex`` elsewhere. Float64 by default; ``device="cuda"`` runs on a GPU when
