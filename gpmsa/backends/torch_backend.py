@@ -234,6 +234,7 @@ def unpack(packed: Tensor, data: ModelTensors) -> Tensor:
 def _factor_scaled(
     corr: Tensor, scale: Tensor, data: ModelTensors, comps: slice, lamWs: Tensor,
     lamWOs: Tensor, out: Tensor | None = None, scratch: np.ndarray | None = None,
+    only: Tensor | None = None,
 ) -> tuple[Tensor | None, Tensor, Tensor]:  # fmt: skip
     """``sim_factor`` of components ``comps`` from their packed correlation corr (C, J, P) and
     scale = 1/lamUz (C, J).
@@ -242,7 +243,9 @@ def _factor_scaled(
     built (lower triangle) in one m x m buffer, factored there by LAPACK and solved against w
     while it is in cache (a batch of 64 chains x 198 x 198 is 20 MB: whole-batch passes each go
     through memory). The factors go to ``out`` (C, J, m, m) when given, else only the ``scratch``
-    buffer is used and no factor is returned (None). Elsewhere (a GPU): batched torch ops.
+    buffer is used and no factor is returned (None); then ``only`` (C,) bool, when given, limits
+    the work to those chains (the others get -inf: proposals the prior refuses). Elsewhere (a
+    GPU): batched torch ops.
     """
     w, lam_sim = data.w[comps], data.lam_sim[comps]
     if not _on_lapack(corr):
@@ -259,23 +262,29 @@ def _factor_scaled(
     if o is None and (scratch is None or scratch.shape != (m, m) or scratch.dtype != cr.dtype):
         scratch = np.empty((m, m), dtype=cr.dtype)
     offsets = np.cumsum([0] + [(b - a) * b for a, b in data.rows]).tolist()
-    blocks = [(a, b, o0, o1) for (a, b), o0, o1 in zip(data.rows, offsets[:-1], offsets[1:],
-                                                         strict=True)]  # fmt: skip
+    tmp = np.empty(cr.shape[-1], dtype=cr.dtype)  # the scaled packed rows: one contiguous pass
+    blocks = [(a, b, tmp[o0:o1].reshape(b - a, b)) for (a, b), o0, o1 in
+              zip(data.rows, offsets[:-1], offsets[1:], strict=True)]  # fmt: skip
     potrf = _POTRF[corr.dtype]
     trtrs = lapack.dtrtrs if corr.dtype == torch.float64 else lapack.strtrs
     alpha = np.zeros((c_n, j_n, m), dtype=cr.dtype)
     ll = np.full((c_n, j_n), -np.inf)
-    for c in range(c_n):
+    def views(a_: np.ndarray) -> tuple[np.ndarray, list, np.ndarray]:
+        """a_'s transpose (LAPACK's view), its row blocks and its diagonal."""
+        return a_.T, [(a_[a:b, :b], rows) for a, b, rows in blocks], a_.reshape(-1)[:: m + 1]
+
+    fixed = None if o is not None else views(scratch)  # one buffer: views made once
+    todo = range(c_n) if only is None or o is not None else torch.nonzero(only).flatten().tolist()
+    for c in todo:
         for j in range(j_n):
-            a_ = scratch if o is None else o[c, j]
-            src, f = cr[c, j], sc[c, j]
-            for a, b, o0, o1 in blocks:
-                np.multiply(src[o0:o1].reshape(b - a, b), f, out=a_[a:b, :b])
-            diag = a_.reshape(-1)[:: m + 1]
+            lapack_view, dst, diag = fixed or views(o[c, j])
+            np.multiply(cr[c, j], sc[c, j], out=tmp)  # half the time of 12 strided multiplies
+            for d, rows in dst:
+                d[...] = rows
             diag += nugget[c, j]
-            if potrf(a_.T, lower=0, clean=0, overwrite_a=1)[1] != 0:
+            if potrf(lapack_view, lower=0, clean=0, overwrite_a=1)[1] != 0:
                 continue
-            v, _ = trtrs(a_.T, wn[j], lower=0, trans=1)
+            v, _ = trtrs(lapack_view, wn[j], lower=0, trans=1)
             alpha[c, j] = v
             ll[c, j] = -np.log(diag).sum() - 0.5 * (v @ v)
     return out, torch.from_numpy(alpha), torch.from_numpy(ll).to(corr.dtype)
@@ -497,7 +506,7 @@ class BatchState:
             chol_c, alpha_c, ll_c = _factor_scaled(
                 corr_c, 1.0 / prm["lamUz"][:, comps], d, comps, prm["lamWs"][:, comps],
                 prm["lamWOs"], out=self._buffer("chol", j_c) if d.has_obs else None,
-                scratch=self._scratch,
+                scratch=self._scratch, only=valid,
             )  # fmt: skip
             ll_w, chol, alpha = ll_c, chol_c, alpha_c
             if not whole:
