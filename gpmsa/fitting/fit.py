@@ -81,12 +81,14 @@ def fit(
     same wherever they run. options: passed to the backend's ``sample`` (e.g. ``init``).
 
     Beyond GPM/SA's model (numpy backend; docs/categorical-and-constraints.md): categorical
-    inputs are declared in ``SimData``. mean_basis: None (zero mean, GPM/SA), "constant",
+    inputs are declared in ``SimData`` (a categorical theta of a joint fit is sampled over its
+    levels, uniform prior). mean_basis: None (zero mean, GPM/SA), "constant",
     "linear" or a callable of unit-scale [x, t] (n, p + q) -> (n, k); its coefficients are
     integrated out (flat prior). fixed: name -> value held fixed (model scales as
     ``Emulator.params``; theta in native units), e.g. ``{"lamWOs": 1e5 - 1}``. constraint (joint
     fit only): a callable of native theta (q,) -> bool, False where theta is not allowed (zero
-    prior mass there). theta_init: the chains' start of theta (native, (q,); default the centre).
+    prior mass there). theta_init: the chains' start of theta (native, (q,); default the centre;
+    a categorical element: one of its levels).
 
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
@@ -130,7 +132,11 @@ def fit(
     calibration = None
     if obs is not None:
         calibration = {k: v for k, v in retained.items() if k not in EMULATOR_PARAMS}
-        calibration["theta_native"] = prep.standardizer.t_from_unit(calibration["theta"])
+        native = prep.standardizer.t_from_unit(calibration["theta"])
+        for k, lv in enumerate(problem.theta_levels or ()):
+            if lv is not None:  # categorical draws: exactly the level codes
+                native[..., k] = np.round(native[..., k])
+        calibration["theta_native"] = native
     settings = {
         "n_iter": int(n_iter), "n_burn": n_burn, "thin": thin, "n_chains": int(n_chains),
         "tune": bool(tune), "backend": backend, "seed": seed, "point": point,
@@ -162,6 +168,14 @@ def fit(
     )  # fmt: skip
 
 
+def _check_levels(problem: Problem, theta_unit: np.ndarray, names, what: str) -> None:
+    """GPMSAError when a categorical element of ``theta_unit`` is not one of its levels."""
+    for k, lv in enumerate(problem.theta_levels or ()):
+        if lv is not None and not np.any(np.isclose(lv, theta_unit[k], rtol=0, atol=1e-12)):
+            raise GPMSAError(f"{what}: categorical calibration parameter {names[k]} must be one "
+                             "of its training levels")  # fmt: skip
+
+
 def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Problem:
     """``prep.problem`` with the theta constraint, theta's start and the fixed parameters."""
     problem = prep.problem
@@ -171,13 +185,17 @@ def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Proble
     if constraint is not None:
         problem = replace(problem, constraint=constraints.make(
             constraint, std.t_min, std.t_max, data.t_names))  # fmt: skip
-    start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, data.t_names)
+    levels = problem.theta_levels
+    closed = None if levels is None else [lv is not None for lv in levels]
+    start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, data.t_names, closed)
     if start is not None:
+        _check_levels(problem, start, data.t_names, "theta_init")
         problem = problem.with_init({"theta": start})
     if fixed:
         fixed = dict(fixed)
         if "theta" in fixed and problem.obs is not None:
             fixed["theta"] = constraints.theta_init_unit(
-                fixed["theta"], std.t_min, std.t_max, data.t_names)  # fmt: skip
+                fixed["theta"], std.t_min, std.t_max, data.t_names, closed)  # fmt: skip
+            _check_levels(problem, fixed["theta"], data.t_names, "fixed theta")
         problem = problem.with_fixed(fixed)
     return problem

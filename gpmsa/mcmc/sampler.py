@@ -22,7 +22,7 @@ from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.mcmc import ridge, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.data import check_seed
-from gpmsa.model.likelihood import IncrementalLikelihood
+from gpmsa.model.likelihood import IncrementalLikelihood, log_prior
 from gpmsa.model.problem import Problem
 
 DEFAULT_WIDTHS = {"theta": 0.2, "betaU": 0.1, "betaV": 0.1, "lamVz": 10.0, "lamUz": 5.0,
@@ -113,6 +113,11 @@ def elements(problem: Problem) -> list[tuple[str, tuple[int, ...]]]:
     return out
 
 
+def _uniform_over_levels(x: float) -> float:
+    """The log prior of a categorical theta element at a level (its sweep proposes levels)."""
+    return 0.0
+
+
 class ChainState:
     """One chain: current parameters, incremental likelihood, and the sweep.
 
@@ -140,9 +145,14 @@ class ChainState:
         self.kinds = [
             1 if n in RHO_PARAMS else 2 if n in PRECISION_PARAMS else 0 for n, _ in self.els
         ]
-        self.prior = problem.priors.log_prior
         self.el_prior = [problem.priors.scalar_log_prior(n) for n, _ in self.els]
-        self.log_prior = sum(self.prior(n, self.lik.params[n]) for n in problem.sampled)
+        levels = problem.theta_levels or []
+        self.levels: list[np.ndarray | None] = [None] * len(self.els)
+        for i, (n, idx) in enumerate(self.els):  # a categorical theta: a move to another level
+            if n == "theta" and levels and levels[idx[0]] is not None:
+                self.kinds[i], self.levels[i] = 3, levels[idx[0]]
+                self.el_prior[i] = _uniform_over_levels
+        self.log_prior = log_prior(problem, self.lik.params)
         self.constraint = problem.constraint if "theta" in problem.sampled else None
         if self.constraint is not None:
             self.constraint.check_start(self.lik.params["theta"], "the chain's start")
@@ -170,6 +180,11 @@ class ChainState:
                 if r <= 0.0:
                     continue
                 cand = -4.0 * math.log(r)
+            elif kind == 3:  # another level, uniformly (symmetric; the prior is uniform)
+                others = self.levels[i][self.levels[i] != x]
+                if others.size == 0:
+                    continue
+                cand = float(others[int(u[i, 0] * others.size)])
             elif kind == 2 and prop_mh:
                 w0 = max(1.0, x / 3.0)
                 cand = x + w0 * 2.0 * step

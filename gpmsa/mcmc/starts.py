@@ -112,6 +112,8 @@ def _theta_start(problem: Problem, how: str, size: int, rng: np.random.Generator
             val = rng.uniform(0.1, 0.9, size)
         else:
             val = _truncnorm01(pri.theta_mean, pri.theta_sd, size, rng)
+        if problem.theta_levels is not None:  # a categorical element starts at its nearest level
+            val = problem.snap_theta(val)
         if problem.constraint is None or problem.constraint(val):
             return val
     raise GPMSAError(

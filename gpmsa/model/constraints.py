@@ -73,8 +73,9 @@ def make(constraint, t_min, t_max, names) -> ThetaConstraint | None:
                            np.asarray(t_max, dtype=np.float64), tuple(names))  # fmt: skip
 
 
-def theta_init_unit(theta_init, t_min, t_max, names) -> np.ndarray | None:
-    """The user's ``theta_init`` (native, (q,)) on the unit scale; GPMSAError outside (0, 1)."""
+def theta_init_unit(theta_init, t_min, t_max, names, closed=None) -> np.ndarray | None:
+    """The user's ``theta_init`` (native, (q,)) on the unit scale; GPMSAError outside (0, 1)
+    (outside [0, 1] for the elements that ``closed`` (q,) bool marks: categorical levels)."""
     if theta_init is None:
         return None
     q = len(names)
@@ -85,11 +86,13 @@ def theta_init_unit(theta_init, t_min, t_max, names) -> np.ndarray | None:
     if arr.size != q:
         raise GPMSAError(f"theta_init must have {q} values ({names}), got {arr.size}")
     unit = (arr - np.asarray(t_min)) / (np.asarray(t_max) - np.asarray(t_min))
-    bad = ~((unit > 0.0) & (unit < 1.0))
+    closed = np.zeros(q, dtype=bool) if closed is None else np.asarray(closed, dtype=bool)
+    bad = ~np.where(closed, (unit >= 0.0) & (unit <= 1.0), (unit > 0.0) & (unit < 1.0))
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
+        kind = "closed range [" if closed[k] else "open range ("
         raise GPMSAError(
-            f"theta_init {names[k]}={arr[k]:.6g} lies outside the open range "
-            f"({float(t_min[k]):.6g}, {float(t_max[k]):.6g}) of the design"
+            f"theta_init {names[k]}={arr[k]:.6g} lies outside the {kind}{float(t_min[k]):.6g}, "
+            f"{float(t_max[k]):.6g}{']' if closed[k] else ')'} of the design"
         )
     return unit

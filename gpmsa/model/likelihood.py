@@ -11,7 +11,7 @@ import math
 import numpy as np
 from scipy.linalg import cho_solve, lapack
 
-from gpmsa.model.correlation import correlation, sq_diffs
+from gpmsa.model.correlation import CATEGORICAL_DISTANCE, correlation, sq_diffs
 from gpmsa.model.mean_basis import GLS
 from gpmsa.model.problem import Problem
 
@@ -36,8 +36,10 @@ def _logdet_half(L: np.ndarray) -> float:
 
 
 def log_prior(problem: Problem, params: dict[str, np.ndarray]) -> float:
-    """Sum of the log priors of the sampled (non-fixed) parameters."""
-    return sum(problem.priors.log_prior(n, params[n]) for n in problem.sampled)
+    """Sum of the log priors of the sampled (non-fixed) parameters (a categorical theta element:
+    uniform over its levels, ``Problem.theta_log_prior``)."""
+    return sum(problem.theta_log_prior(params[n]) if n == "theta"
+               else problem.priors.log_prior(n, params[n]) for n in problem.sampled)  # fmt: skip
 
 
 def log_likelihood(problem: Problem, params: dict[str, np.ndarray]) -> float:
@@ -185,6 +187,8 @@ class IncrementalLikelihood:
             self.shape_nm = (n, problem.m)
             self.shape_nn = (n, n)
             self.t_sim_T = problem.t_sim.T.copy()
+            t_cat = None if cat is None else cat[problem.p :]
+            self.theta_cat = None if t_cat is None or not t_cat.any() else np.flatnonzero(t_cat)
             self.z = obs.z
             self.eye_n = np.eye(obs.n)
             self.Dxz_t = self._theta_dists(self.params["theta"])
@@ -234,7 +238,13 @@ class IncrementalLikelihood:
         return (ri, si, alpha, llw, L, coef)
 
     def _theta_dists(self, theta: np.ndarray) -> np.ndarray:
-        return np.square(theta[:, None] - self.t_sim_T)  # (q, m), same for every obs row
+        """(q, m) squared differences (categorical: 1/4 between levels) of theta from the design
+        (the same for every observation row)."""
+        d = np.square(theta[:, None] - self.t_sim_T)
+        if self.theta_cat is not None:
+            k = self.theta_cat
+            d[k] = CATEGORICAL_DISTANCE * (theta[k, None] != self.t_sim_T[k])
+        return d
 
     def _cross_z(self, beta: np.ndarray, dxz_t: np.ndarray) -> np.ndarray:
         """Unscaled correlation (n, m) of [x_obs, theta] with the design."""

@@ -128,6 +128,35 @@ class Problem:
         return tuple(name for name, on in used if on)
 
     @property
+    def theta_levels(self) -> list[np.ndarray | None] | None:
+        """Per calibration parameter, its levels on the unit scale if categorical (the design's
+        values), else None; None when no calibration parameter is categorical."""
+        if self.categorical is None or not self.categorical[self.p :].any():
+            return None
+        cat = self.categorical[self.p :]
+        return [np.unique(self.t_sim[:, k]) if cat[k] else None for k in range(self.q)]
+
+    def theta_log_prior(self, theta: np.ndarray) -> float:
+        """Log prior of unit-scale theta (q,): the priors' truncated normal for the continuous
+        elements; uniform over its levels (-inf off them) for a categorical one."""
+        levels = self.theta_levels
+        if levels is None:
+            return self.priors.log_prior("theta", theta)
+        theta = np.asarray(theta, dtype=np.float64).reshape(-1)
+        if any(lv is not None and not np.any(lv == v) for lv, v in zip(levels, theta, strict=True)):
+            return -np.inf
+        cont = [k for k, lv in enumerate(levels) if lv is None]
+        return self.priors.log_prior("theta", theta[cont]) if cont else 0.0
+
+    def snap_theta(self, theta: np.ndarray) -> np.ndarray:
+        """``theta`` (unit scale, (q,)) with each categorical element moved to its nearest level."""
+        out = np.array(theta, dtype=np.float64)
+        for k, lv in enumerate(self.theta_levels or ()):
+            if lv is not None:
+                out[k] = lv[np.argmin(np.abs(lv - out[k]))]
+        return out
+
+    @property
     def sampled(self) -> tuple[str, ...]:
         """Parameters updated by the sampler, in sweep order."""
         return tuple(n for n in self.names if n not in self.fixed)
@@ -168,7 +197,9 @@ class Problem:
             arr = arr.reshape(shape)
             if not np.all(np.isfinite(arr)):
                 raise GPMSAError(f"fixed[{name!r}] must be finite, got {arr.ravel()}")
-            if self.priors.log_prior(name, arr) == -np.inf:
+            is_theta = name == "theta"
+            lp = self.theta_log_prior(arr) if is_theta else self.priors.log_prior(name, arr)
+            if lp == -np.inf:
                 raise GPMSAError(
                     f"fixed[{name!r}] = {arr.ravel()} lies outside its prior's bounds (zero prior "
                     "density)"
@@ -331,8 +362,6 @@ def prepare(
     obs_p, os_corr = (None, (0.0, 0.0))
     levels = sim.levels
     if obs is not None:
-        categorical.refuse_categorical_theta(levels, sim.p, sim.x_names + sim.t_names,
-                                             "fit with obs")  # fmt: skip
         obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels)
     priors = (priors or Priors()).with_data(wos, os_corr)
     init = default_init(sim.p, sim.q, p_u, priors, obs_p)
@@ -340,4 +369,6 @@ def prepare(
         std.x_to_unit(sim.x), std.t_to_unit(sim.t), w, lam_sim, priors, init, frozenset(), obs_p,
         categorical.mask(levels), mean_basis_mod.make(mean_basis, sim.p + sim.q, sim.m),
     )  # fmt: skip
+    if obs is not None and prob.theta_levels is not None:  # a categorical theta starts at a level
+        prob = prob.with_init({"theta": prob.snap_theta(init["theta"])})
     return Prepared(prob, std, K)

@@ -18,6 +18,7 @@ from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
+from gpmsa.model import categorical
 from gpmsa.model.data import ObsData, SimData, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
@@ -197,6 +198,9 @@ def fit_study(
     labels = check_labels(labels, n)
     preps = [prepare(s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
              for s, o in zip(sims, obs, strict=True)]  # fmt: skip
+    for lab, sim in zip(labels, sims, strict=True):  # the study's theta moves are continuous
+        categorical.refuse_categorical_theta(sim.levels, sim.p, sim.x_names + sim.t_names,
+                                             f"fit_study (model {lab})")  # fmt: skip
     layout = build_layout(
         labels, [tuple(s.t_names) for s in sims],
         [(p.standardizer.t_min, p.standardizer.t_max) for p in preps],

@@ -99,7 +99,7 @@ def test_calibrate_continuous_theta_with_categorical_x(cat_emulator):
     assert np.median(back.samples["k"]) == pytest.approx(0.7, abs=0.15)
 
 
-def test_categorical_theta_is_calibrated_by_the_fast_sampler_only():
+def test_categorical_theta_is_calibrated_by_the_fast_sampler():
     rng = np.random.default_rng(0)
     x, t = rng.random(30), np.arange(30) % 3
     shift = np.array([0.0, 1.0, -0.7])
@@ -123,10 +123,52 @@ def test_categorical_theta_is_calibrated_by_the_fast_sampler_only():
     for call in (
         lambda: gpmsa.Calibrator(emu),
         lambda: gpmsa.calibrate(emu, x_obs, y_obs, fast=False),
-        lambda: gpmsa.fit(sim, gpmsa.ObsData([[0.5]], [1.0]), n_iter=5),
     ):
         with pytest.raises(gpmsa.GPMSAError, match="t0 is categorical.*gpmsa.calibrate"):
             call()
+
+
+def _level_case():
+    rng = np.random.default_rng(0)
+    x, t = rng.random(30), np.arange(30) % 3
+    shift = np.array([0.0, 1.0, -0.7])
+    sim = gpmsa.SimData(x, t, x + shift[t], t_categorical=[0])
+    x_obs = np.linspace(0.1, 0.9, 5)[:, None]
+    return sim, x_obs, x_obs[:, 0] + 0.5  # between levels 0 (+0) and 1 (+1)
+
+
+def test_categorical_theta_in_a_joint_fit_agrees_with_calibrate():
+    """fit(obs=) samples a categorical theta by moves between its levels (uniform prior): the
+    level probabilities match gpmsa.calibrate's fast sampler at the fitted emulator."""
+    sim, x_obs, y_mid = _level_case()
+    pr = prepare(sim, gpmsa.ObsData(x_obs, y_mid)).problem
+    params = {k: v.copy() for k, v in pr.init.items()}
+    assert params["theta"][0] in (0.0, 0.5, 1.0)  # starts at a level
+    inc = IncrementalLikelihood(pr, params)
+    for val in (1.0, 0.0):  # the incremental likelihood's categorical theta distance
+        ll = inc.propose("theta", (0,), val)
+        inc.accept()
+        params["theta"][0] = val
+        assert ll == pytest.approx(log_likelihood(pr, params), rel=1e-10)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
+        emu = gpmsa.fit(sim, gpmsa.ObsData(x_obs, y_mid), n_iter=3000, seed=1, n_chains=2)
+    th = emu.calibration["theta_native"]
+    assert set(np.unique(th)) <= {0.0, 1.0, 2.0}  # only the levels, exactly
+    p_fit = np.mean(th == 1.0)
+    post = gpmsa.calibrate(emu, x_obs, y_mid, n_samples=3000, n_burn=500, seed=2)
+    p_cal = np.mean(post.samples["t0"] == 1.0)
+    assert 0.3 < p_fit < 0.7 and abs(p_fit - p_cal) < 0.1, (p_fit, p_cal)  # measured .526/.518
+    with pytest.raises(gpmsa.GPMSAError, match="theta_init: categorical calibration parameter"):
+        gpmsa.fit(sim, gpmsa.ObsData(x_obs, y_mid), n_iter=5, theta_init=[0.5])
+    with pytest.raises(gpmsa.GPMSAError, match="fixed theta: categorical"):
+        gpmsa.fit(sim, gpmsa.ObsData(x_obs, y_mid), n_iter=5, fixed={"theta": [1.5]})
+    fixed = gpmsa.fit(sim, gpmsa.ObsData(x_obs, y_mid), n_iter=20, fixed={"theta": [2]}, seed=0)
+    assert np.all(fixed.calibration["theta_native"] == 2.0)
+    obs = gpmsa.ObsData(x_obs, y_mid)  # a study's theta moves are continuous: refused
+    with pytest.raises(gpmsa.GPMSAError, match=r"fit_study \(model model0\): calibration "
+                                               r"parameter t0 is categorical"):  # fmt: skip
+        gpmsa.fit_study([sim, sim], [obs, obs], shared=["t0"], n_iter=5)
 
 
 def test_file_round_trip_and_edited_declaration(cat_emulator, tmp_path):
