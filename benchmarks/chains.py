@@ -13,8 +13,10 @@ Fit: the simulation-only emulator (198 runs, scalar output; betaU, lamUz, lamWs,
 through the backend's ``sample`` with its defaults (tuning, the nugget-ridge moves); ESS: arviz
 bulk ESS of the draws after burn-in (n_iter // 5 per chain, as ``gpmsa.fit``), the minimum over
 every sampled scalar; per second of wall time of the whole run (tuning, warm-up, process start
-included). Usage: python benchmarks/chains.py [--repeats 3] [--numpy-iter 6000]
-[--torch-iter 2000] [--torch-chains 64] [--only numpy|torch|sweep]
+included). The torch chains draw as many sweeps as the numpy chain (``--torch-iter`` defaults
+to ``--numpy-iter``): the ESS/s of chains of equal length (at 2,000 draws a chain 64 chains each
+pay the warm-up: docs/performance.md). Usage: python benchmarks/chains.py [--repeats 3]
+[--numpy-iter 6000] [--torch-iter N] [--torch-chains 64] [--only numpy|torch|sweep]
 """
 
 from __future__ import annotations
@@ -152,7 +154,7 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--numpy-iter", type=int, default=6000)
-    ap.add_argument("--torch-iter", type=int, default=2000)
+    ap.add_argument("--torch-iter", type=int, default=None, help="default: --numpy-iter")
     ap.add_argument("--torch-chains", type=int, default=64)
     ap.add_argument("--only", choices=("numpy", "torch", "sweep"), default=None)
     args = ap.parse_args(argv)
@@ -161,7 +163,7 @@ def main(argv=None) -> None:
     if args.only in (None, "numpy"):
         rate = numpy_parallel(args.numpy_iter, args.repeats)
     if args.only in (None, "torch"):
-        torch_batched(args.torch_iter, args.torch_chains, rate)
+        torch_batched(args.torch_iter or args.numpy_iter, args.torch_chains, rate)
     if args.only in (None, "sweep"):
         sweep_cost(args.torch_chains)
 
