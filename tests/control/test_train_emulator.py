@@ -1,7 +1,5 @@
 """examples/train_emulator.py end to end on a small design: a file the closed loop accepts."""
 
-import importlib.util
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,15 +7,11 @@ import pytest
 import control
 import roadgen
 import vehicle
-
-SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "train_emulator.py"
+from tests._examples import load_example
 
 
 def load_script():
-    spec = importlib.util.spec_from_file_location("train_emulator", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_example("train_emulator")
 
 
 def test_stretched_design_spans_the_domain_and_stays_latin():

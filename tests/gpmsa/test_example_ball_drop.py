@@ -1,23 +1,19 @@
 """examples/ball_drop.py: its physics, and the worked example end to end (every figure saved)."""
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "ball_drop.py"
+from tests._examples import load_example
+
 FIGURES = ["emulator_held_out.png", "emulator_loo.png", "pc_basis.png", "prediction.png",
            "sensitivity.png", "theta_pairs.png", "traces.png"]  # fmt: skip
 
 
 def load_script():
-    spec = importlib.util.spec_from_file_location("ball_drop", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_example("ball_drop")
 
 
 def test_simulator_is_the_closed_form_of_quadratic_drag():

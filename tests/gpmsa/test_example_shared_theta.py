@@ -1,19 +1,14 @@
 """examples/shared_theta.py: its physics, and the worked example end to end."""
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 
-SCRIPT = Path(__file__).resolve().parents[2] / "examples" / "shared_theta.py"
+from tests._examples import load_example
 
 
 def load_script():
-    spec = importlib.util.spec_from_file_location("shared_theta", SCRIPT)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_example("shared_theta")
 
 
 def test_physics():

@@ -1,8 +1,5 @@
 """The profile/PSD figure and the example script that repeats the paper's check."""
 
-import importlib.util
-from pathlib import Path
-
 import matplotlib
 
 matplotlib.use("Agg")
@@ -11,8 +8,7 @@ import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 import roadgen  # noqa: E402
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests._examples import load_example  # noqa: E402
 
 
 def test_plot_profile_psd_shows_profile_psd_and_prescribed_lines(tmp_path):
@@ -49,11 +45,7 @@ def test_the_periodogram_stays_visible_on_its_prescribed_line(tmp_path):
 
 
 def test_example_prints_the_check_and_saves_figures(tmp_path, capsys):
-    spec = importlib.util.spec_from_file_location(
-        "roadgen_psd_check", ROOT / "examples" / "roadgen_psd_check.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+    module = load_example("roadgen_psd_check")
     module.main(["--out", str(tmp_path)])
     out = capsys.readouterr().out
     assert "periodogram at 0.1 cycles/m gives 450.0" in out
