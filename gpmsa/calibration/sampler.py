@@ -26,6 +26,7 @@ from gpmsa.calibration.model import FixedGP
 from gpmsa.calibration.observations import Observations
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
+from gpmsa.model.categorical import snap_to_levels
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.priors import Priors
 
@@ -249,10 +250,8 @@ class CalibrationSampler:
         lo = data.lamos
         self.init_lamos = max(20.0, lo.shape / lo.rate) if init_lamos is None else init_lamos
         self.constraint = constraint
-        self.init_theta = [0.5] * self.q if init_theta is None else [float(v) for v in init_theta]
-        for i, lv in enumerate(self.levels):  # a categorical start: the level nearest it
-            if lv is not None:
-                self.init_theta[i] = min(lv, key=lambda v, t=self.init_theta[i]: abs(v - t))
+        start = [0.5] * self.q if init_theta is None else [float(v) for v in init_theta]
+        self.init_theta = snap_to_levels(start, self.levels).tolist()  # categorical: nearest level
         if constraint is not None:
             constraint.check_start(np.array(self.init_theta), "calibrate")
 

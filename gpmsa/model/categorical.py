@@ -85,6 +85,17 @@ def check_levels(values: np.ndarray, levels: Levels, names: Sequence[str], what:
             )
 
 
+def snap_to_levels(values, levels: Sequence) -> np.ndarray:
+    """``values`` (q,) with each element that has levels (a sequence; None: continuous) moved to
+    its nearest level (the first of two equally near)."""
+    out = np.array(values, dtype=np.float64).reshape(-1)
+    for k, lv in enumerate(levels):
+        if lv is not None:
+            lv = np.asarray(lv, dtype=np.float64)
+            out[k] = lv[np.argmin(np.abs(lv - out[k]))]
+    return out
+
+
 def refuse_categorical_theta(levels: Levels, p: int, names: Sequence[str], what: str) -> None:
     """GPMSAError for calibrating a categorical calibration parameter (not supported)."""
     for k, lv in enumerate(levels[p:]):

@@ -150,11 +150,7 @@ class Problem:
 
     def snap_theta(self, theta: np.ndarray) -> np.ndarray:
         """``theta`` (unit scale, (q,)) with each categorical element moved to its nearest level."""
-        out = np.array(theta, dtype=np.float64)
-        for k, lv in enumerate(self.theta_levels or ()):
-            if lv is not None:
-                out[k] = lv[np.argmin(np.abs(lv - out[k]))]
-        return out
+        return categorical.snap_to_levels(theta, self.theta_levels or ())
 
     @property
     def sampled(self) -> tuple[str, ...]:
