@@ -145,6 +145,8 @@ class Outcome:
     excerpt: list = field(default_factory=list)
     segments: list = field(default_factory=list)
     fault_span_m: tuple = (np.nan, np.nan)
+    latched: bool = False
+    clean_latched: bool = False
 
     @property
     def diff(self) -> float:
@@ -224,14 +226,14 @@ def _init_worker() -> None:
     threadpool_limits(1)  # two workers on two cores: no BLAS threads on top
 
 
-def _loop(sc: Scenario, track, faults=()):
+def _loop(sc: Scenario, track, faults=(), after_fault: str = "latch"):
     if sc.case not in _LIKELIHOOD:
         emu = control.shipped_emulator(sc.case)
         _LIKELIHOOD[sc.case] = (emu, control.ObservationModel(emu))
     emu, lik = _LIKELIHOOD[sc.case]
     return control.run_closed_loop(
         track, emu, noise_std=NOISE_STD[sc.case], seed=sc.noise_seed, likelihood=lik,
-        faults=faults,
+        faults=faults, simplex=control.Simplex(after_fault=after_fault),
     )  # fmt: skip
 
 
@@ -258,23 +260,27 @@ def rough_segments(track, runs, gd_max: float) -> list:
     return out
 
 
-def run_scenario(sc: Scenario, keep_excerpt: bool = False, null: bool = True) -> Outcome:
+def run_scenario(
+    sc: Scenario, keep_excerpt: bool = False, null: bool = True, after_fault: str = "latch"
+) -> Outcome:
     """Clean, faulted and (``null``) imperceptibly perturbed loop of one scenario."""
     out = Outcome(sc)
     try:
         track = roadgen.track(sc.segments, seed=sc.track_seed)
-        clean = _loop(sc, track)
+        clean = _loop(sc, track, after_fault=after_fault)
     except Exception as exc:  # noqa: BLE001 - a crash is what the soak counts
         out.crash = _crash(exc, "clean")
         return out
     out.fault = fault = sc.fault(clean)
     out.fast_clean = clean.metrics.fast_on_rough_m
     try:
-        faulted = _loop(sc, track, (fault,))
+        faulted = _loop(sc, track, (fault,), after_fault)
     except Exception as exc:  # noqa: BLE001
         out.crash = _crash(exc, "faulted")
         return out
     out.fast_fault = faulted.metrics.fast_on_rough_m
+    out.latched = bool(np.isfinite(faulted.metrics.latched_at_s))
+    out.clean_latched = bool(np.isfinite(clean.metrics.latched_at_s))
     end = fault.start_s + fault.duration_s + 2 * 125 / 120.0
     out.during_clean = fast_between(clean, track, fault.start_s, end)
     out.during_fault = fast_between(faulted, track, fault.start_s, end)
@@ -284,7 +290,7 @@ def run_scenario(sc: Scenario, keep_excerpt: bool = False, null: bool = True) ->
     if null:
         try:
             perturbed = _loop(sc, track, (control.SensorFault(
-                fault.start_s, fault.duration_s, "scale", NULL_GAIN),))  # fmt: skip
+                fault.start_s, fault.duration_s, "scale", NULL_GAIN),), after_fault)  # fmt: skip
         except Exception as exc:  # noqa: BLE001
             out.crash = _crash(exc, "null")
             return out
@@ -301,9 +307,9 @@ def run_scenario(sc: Scenario, keep_excerpt: bool = False, null: bool = True) ->
     return out
 
 
-def _job(job: tuple[Scenario, bool]) -> Outcome:
-    sc, null = job
-    return run_scenario(sc, null=null)
+def _job(job: tuple[Scenario, bool, str]) -> Outcome:
+    sc, null, after_fault = job
+    return run_scenario(sc, null=null, after_fault=after_fault)
 
 
 def excerpt(clean, faulted, fault, before_s: float = 3.0, after_s: float = 12.0) -> list:
@@ -383,6 +389,13 @@ def summarise(outcomes: list[Outcome]) -> None:
             + f" | {len(worse_in):5d}{(worst_in.during_diff if worst_in else 0.0):9.2f} "
             f"{(worst_in.scenario.name if worst_in else '-'):<11}"
         )
+    missed = [o for o in done if not o.latched]
+    print(
+        f"faulted runs latched in safety mode: {sum(o.latched for o in done)} of {len(done)}; "
+        f"faults never detected: {len(missed)} (worse than clean among them: "
+        f"{sum(o.diff > 0 for o in missed)}); clean runs latched (false alarms): "
+        f"{sum(o.clean_latched for o in done)}"
+    )
     for case in ("A", "B"):
         mine = [o for o in done if o.scenario.case == case]
         d = np.array([o.diff for o in mine])
@@ -463,6 +476,12 @@ def main(argv: list[str] | None = None) -> int:
         help="skip the null runs (the fault replaced by an invisible 1e-9 gain error)",
     )
     parser.add_argument(
+        "--after-fault",
+        choices=["latch", "resume"],
+        default="latch",
+        help="the Simplex's policy after a fault (default: latch, the library's default)",
+    )
+    parser.add_argument(
         "--only",
         type=int,
         default=None,
@@ -471,7 +490,9 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)  # fmt: skip
     if args.only is not None:
         _init_worker()  # one BLAS thread, as in the soak: the loop is chaotic to the last bit
-        o = run_scenario(random_scenario(args.seed, args.only), keep_excerpt=True)
+        o = run_scenario(
+            random_scenario(args.seed, args.only), keep_excerpt=True, after_fault=args.after_fault
+        )
         if o.crash:
             print(o.crash)
             return 1
@@ -485,7 +506,9 @@ def main(argv: list[str] | None = None) -> int:
 
     tic = time.perf_counter()
     with ProcessPoolExecutor(max_workers=args.workers, initializer=_init_worker) as pool:
-        jobs = [(sc, not args.no_null) for sc in scenarios] + [(sc, False) for sc in examples]
+        jobs = [(sc, not args.no_null, args.after_fault) for sc in scenarios] + [
+            (sc, False, args.after_fault) for sc in examples
+        ]
         outcomes = list(pool.map(_job, jobs, chunksize=1))
     wall = time.perf_counter() - tic
     random_out, example_out = outcomes[:n], outcomes[n:]
@@ -494,7 +517,7 @@ def main(argv: list[str] | None = None) -> int:
         f"fault soak: {n} random scenarios ({sum(s.case == 'A' for s in scenarios)} case A, "
         f"{sum(s.case == 'B' for s in scenarios)} case B; seed {args.seed}) + {len(examples)} "
         f"examples, {2 * len(outcomes) + (0 if args.no_null else n)} loop runs in {wall:.0f} s "
-        f"on {args.workers} workers; "
+        f"on {args.workers} workers; after_fault={args.after_fault!r}; "
         f"{load()}"
     )
     print(f"crashes: {len(crashes)}")

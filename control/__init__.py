@@ -28,7 +28,7 @@ from control.observation_model import BlockScatter, ObservationModel
 from control.robot import ReplayResult, ReplaySettings, record_run, replay_bag
 from control.sensor_checks import SensorLimits
 from control.shipped import shipped_emulator, shipped_emulator_path
-from control.simplex import Command, Simplex
+from control.simplex import FAULT_STATUSES, Command, Simplex, SimplexRun
 from control.tracker import GDTracker, TrackerSettings
 
 __all__ = [
@@ -36,6 +36,7 @@ __all__ = [
     "BCRSettings",
     "BagError",
     "FAULT_KINDS",
+    "FAULT_STATUSES",
     "METHODS",
     "PAPER_WINDOW",
     "STATUSES",
@@ -59,6 +60,7 @@ __all__ = [
     "SensorFault",
     "SensorLimits",
     "Simplex",
+    "SimplexRun",
     "TrackerSettings",
     "bcr_settings_for",
     "block_features",

@@ -18,8 +18,9 @@ when a block is a fault or implausible, the change-point filter also undoes the 
 and skips the block after it.
 
 Every update returns an `Estimate` whose status says why there is no number: ``filling`` (not
-enough contiguous samples yet), ``sensor_fault`` (non-finite values, dropped, repeated or
-backwards time stamps, a stuck, quantised or clipped signal), ``implausible`` (no GD in the
+enough contiguous samples yet, or the first block after a fault), ``sensor_fault`` (non-finite
+values, dropped, repeated or backwards time stamps, a stuck, quantised, clipped or dead signal),
+``implausible`` (no GD in the
 emulator's domain explains the observation), ``out_of_domain`` (speed outside the emulator's
 range and no earlier estimate), ``calibration_failed``, ``stale`` (no new information for
 ``max_age_s``). While the speed is outside the emulator's range (e.g. standing) there is no new
@@ -374,13 +375,15 @@ class BCR:
                 f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = {p:.2g} < "
                 f"{s.plausibility_p:g})"
             )
-            return self._skip_block(ds, "implausible", why, speed=v, feature=y)
+            return self._skip_block(
+                ds, "implausible", why, speed=v, feature=y, plausibility_p=p
+            )
         if self._guard:
             self._guard = False
             self._undo = None
             self.filter.predict(ds)
             return self._no_estimate(
-                "sensor_fault", "first block after a fault: skipped (it may hold its end)", speed=v
+                "filling", "first block after a fault: skipped (it may hold its end)", speed=v
             )
         self._undo = (self.filter.state(), self._data_time, ds)
         self.filter.update(self.model.loglik(y, v), ds)
@@ -437,9 +440,11 @@ class BCR:
             return self._no_estimate(
                 "sensor_fault", "window feature undefined (zero variance?)", speed=v
             )
-        why = self._window_implausible(v, y)
+        why, p = self._window_implausible(v, y)
         if why:
-            return self._no_estimate("implausible", why, speed=v, feature=np.array([y]))
+            return self._no_estimate(
+                "implausible", why, speed=v, feature=np.array([y]), plausibility_p=p
+            )
         try:
             grid, loglik = self.model.log_likelihood_grid([[v]], [[y]])
         except ValueError as exc:  # the gpmsa errors are ValueError subclasses
@@ -469,11 +474,12 @@ class BCR:
             data_time=t_now,
         )
 
-    def _window_implausible(self, v: float, y: float) -> str:
-        """Why no GD in the domain explains the window's y (scalar predictive check), or ""."""
+    def _window_implausible(self, v: float, y: float) -> tuple[str, float]:
+        """(why no GD in the domain explains the window's y, or ""; the check's p) by a scalar
+        predictive check."""
         emulator = self.model.emulator
         if not hasattr(emulator, "predict"):
-            return ""
+            return "", np.nan
         gd = np.linspace(*self.gd_range, 65)
         mean, var = emulator.predict(np.full(gd.size, v), gd)
         z2 = float(np.min((y - mean[:, 0]) ** 2 / var[:, 0]))
@@ -481,12 +487,12 @@ class BCR:
 
         p = float(chi2.sf(z2, 1))
         if p >= self.settings.plausibility_p:
-            return ""
+            return "", p
         return (
             f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the window at "
             f"{v:.3g} m/s: y is {np.sqrt(z2):.3g} predictive sds from the nearest "
             f"(p = {p:.2g} < {self.settings.plausibility_p:g})"
-        )
+        ), p
 
     def _check_age(self, est: Estimate) -> Estimate:
         """Replace an estimate whose newest information is older than max_age_s by 'stale'."""

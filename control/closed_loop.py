@@ -33,6 +33,8 @@ class LoopMetrics:
         latency_median_s, latency_max_s: BCR compute latency over its estimates, s.
         ok_fraction: fraction of BCR updates that produced an estimate.
         coverage: fraction of the estimates whose credible interval holds the prescribed GD.
+        latched_at_s: time of the estimate whose fault latched safety mode (the Simplex's
+            ``after_fault="latch"``), s; NaN if none did.
     """
 
     gd_errors: tuple[GDError, ...]
@@ -44,6 +46,7 @@ class LoopMetrics:
     latency_max_s: float
     ok_fraction: float
     coverage: float = np.nan
+    latched_at_s: float = np.nan
 
     @property
     def real_time_factor(self) -> float:
@@ -71,6 +74,7 @@ class LoopMetrics:
             "latency_max_s": self.latency_max_s,
             "ok_fraction": self.ok_fraction,
             "coverage": self.coverage,
+            "latched_at_s": self.latched_at_s,
         }
 
 
@@ -183,7 +187,8 @@ def run_closed_loop(
     rows: list[tuple[Estimate, object]] = []
     s_t, s_pos, s_spd, s_acc = [], [], [], []
     tic = _time.perf_counter()
-    command = simplex.command(estimator.last)
+    controller = simplex.start()
+    command = controller.command(estimator.last)
     bar = tqdm(total=round(float(track.length_m)), unit="m", disable=not progress, leave=False)
     while not sim.finished:
         if sim.time > limit:
@@ -202,7 +207,7 @@ def run_closed_loop(
             samples.t, samples.position, samples.accel_front, samples.speed, faults, fault_rng
         )
         estimate = estimator.update(*observed, now=float(samples.t[-1]))
-        command = simplex.command(estimate)
+        command = controller.command(estimate)
         rows.append((estimate, command))
         bar.update(max(0, round(float(s_pos[-1][-1])) - bar.n))
     bar.close()
@@ -237,6 +242,7 @@ def run_closed_loop(
         coverage=float(np.mean((gd_lo[ok] <= gd_true[ok]) & (gd_true[ok] <= gd_hi[ok])))
         if ok.any()
         else np.nan,
+        latched_at_s=controller.latched_by.time if controller.latched else np.nan,
     )
     result = ClosedLoopResult(
         time=np.array([t[-1] for t in s_t]),

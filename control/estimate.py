@@ -11,7 +11,7 @@ from gpmsa import Posterior
 #: Status values. Only "ok" carries numbers; every other status says why there is no estimate.
 STATUSES = (
     "ok",
-    "filling",
+    "filling",  # not enough contiguous samples yet (start, after a gap), or the block after a fault
     "out_of_domain",
     "sensor_fault",
     "implausible",
@@ -41,6 +41,9 @@ class Estimate:
         prob_change: P(the roughness changed within the BCR's ``recent_change_m``) (change-point
             method; NaN otherwise).
         data_time: s, time of the newest sample whose information the estimate holds.
+        plausibility_p: for an "implausible" estimate, the upper-tail probability of the
+            newest observation under the emulator's law at the GD that explains it best (the
+            smaller, the less any GD explains it); NaN otherwise.
     """
 
     time: float
@@ -56,6 +59,7 @@ class Estimate:
     feature: np.ndarray | None = None
     prob_change: float = np.nan
     data_time: float = np.nan
+    plausibility_p: float = np.nan
 
     @property
     def ok(self) -> bool:

@@ -368,11 +368,12 @@ def replay_recording(
     every = bcr.samples_per_update
     n_full = t.size // every
     ests, cmds, ends = [], [], []
+    controller = simplex.start()
     for k in tqdm(range(n_full), disable=not progress, unit="block", leave=False):
         part = slice(k * every, (k + 1) * every)
         est = estimator.update(t[part], pos[part], a[part], spd[part], now=t[part.stop - 1])
         ests.append(est)
-        cmds.append(simplex.command(est))
+        cmds.append(controller.command(est))
         ends.append(part.stop - 1)
     if t.size > n_full * every:
         tail = slice(n_full * every, None)

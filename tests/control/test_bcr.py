@@ -89,7 +89,7 @@ def test_a_fault_skips_its_block_and_keeps_the_run_length_posterior(block_model)
     )
     # the faulty block, and the block after it (it may hold the fault's end), are skipped; the
     # block before it is undone (it may hold the fault's start)
-    assert [e.status for e in ests[k - 1 : k + 3]] == ["ok", "sensor_fault", "sensor_fault", "ok"]
+    assert [e.status for e in ests[k - 1 : k + 3]] == ["ok", "sensor_fault", "filling", "ok"]
     assert "10 sample(s) with non-finite accel" in ests[k].reason and np.isnan(ests[k].gd_mean)
     assert "block before it is undone" in ests[k].reason
     assert "first block after a fault" in ests[k + 1].reason

@@ -59,19 +59,33 @@ def test_safety_mode_whenever_the_estimate_exceeds_gd_max(short_run):
 @pytest.mark.parametrize(
     ("kind", "magnitude"), [("nan", 1.0), ("drop", 1.0), ("time_nan", 1.0), ("spike", 5.0)]
 )
-def test_a_sensor_fault_means_safety_mode_and_the_loop_recovers(
+def test_a_sensor_fault_means_safety_mode_and_the_bcr_recovers(
     emulator_a, likelihood_a, kind, magnitude
 ):
     track = roadgen.track([(40, 300)], seed=5)
     fault = SensorFault(start_s=14.0, duration_s=0.5, kind=kind, magnitude=magnitude)
-    r = run_closed_loop(track, emulator_a, seed=5, likelihood=likelihood_a, faults=[fault])
-    hit = (r.time >= 14.0) & (r.time < 14.5 + 3 * 125 / 120)
-    # while samples are missing the last estimate stands; every block with the fault in it, and
-    # the one after it, give no estimate, and the robot slows to the safe speed
-    faulty = hit & (r.status != "ok")
-    assert faulty.sum() >= 2 and np.all(r.mode[faulty] == "safety")
-    assert np.all(r.command[faulty] == 1.0)
-    assert np.all(r.status[r.time > 17.0] == "ok")  # clean blocks: estimates again
+    runs = {
+        after: run_closed_loop(
+            track, emulator_a, seed=5, likelihood=likelihood_a, faults=[fault],
+            simplex=Simplex(after_fault=after),
+        )
+        for after in ("latch", "resume")
+    }  # fmt: skip
+    for after, r in runs.items():
+        hit = (r.time >= 14.0) & (r.time < 14.5 + 3 * 125 / 120)
+        # while samples are missing the last estimate stands; every block with the fault in
+        # it, and the one after it, give no estimate, and the robot slows to the safe speed
+        faulty = hit & (r.status != "ok")
+        assert faulty.sum() >= 2 and np.all(r.mode[faulty] == "safety")
+        assert np.all(r.command[faulty] == 1.0)
+        assert np.all(r.status[r.time > 17.0] == "ok")  # clean blocks: estimates again
+        later = r.time > 17.0
+        if after == "latch":  # the robot stays at the safe speed for the rest of the run
+            assert 14.0 <= r.metrics.latched_at_s < 14.5 + 2 * 125 / 120
+            assert np.all(r.command[later] == 1.0) and np.all(r.mode[later] == "safety")
+        else:
+            assert np.isnan(r.metrics.latched_at_s)
+            assert np.any(r.mode[later] == "performance")
 
 
 def test_the_papers_window_method_runs_with_its_emulator():

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import control
 from control import BlockScatter, ControlError, EmulatorMismatchError, ObservationModel
@@ -89,7 +91,36 @@ def test_signal_checks_name_what_a_healthy_sensor_never_does():
     flights = a.copy()  # two flights of one block: -g up to the solver's residual
     flights[a < -2] = -9.81 + 1e-8 * (np.arange(125)[a < -2] > 60)
     assert signal_fault(flights, limits) == ""
+    dead = a.copy()  # a dead sensor for 6 samples (0.05 s): too short for the level check
+    dead[30:36] = 1e-4 * a[30:36]
+    assert "dead sensor: samples 30-35" in signal_fault(dead, limits)
     assert longest_repeat(np.array([1.0, 1.0, 2.0, 2.0, 2.0])) == 3
     assert level_jump(a)[0] < 10
     with pytest.raises(ControlError, match="max_repeats must be an integer >= 1"):
         SensorLimits(max_repeats=0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    start=st.integers(0, 119),
+    length=st.integers(6, 125),
+    kind=st.sampled_from(["scale", "stuck", "clip", "quantize"]),
+    seed=st.integers(0, 2**16),
+)
+def test_a_dead_stretch_of_six_samples_or_more_is_a_fault_wherever_it_lies(
+    start, length, kind, seed
+):
+    """Property: a sensor that goes dead (a gain of 1e-4, stuck, clipped at 1e-3 m/s^2,
+    quantised in steps of 1e3 m/s^2) for >= 6 samples anywhere in a block is a fault."""
+    a = 3 * np.random.default_rng(seed).standard_normal(125)
+    stop = min(start + length, 125)
+    if stop - start < 6:
+        start = stop - 6
+    part = a[start:stop]
+    a[start:stop] = {
+        "scale": 1e-4 * part,
+        "stuck": np.full(part.size, part[0]),
+        "clip": np.clip(part, -1e-3, 1e-3),
+        "quantize": np.round(part / 1e3) * 1e3,
+    }[kind]
+    assert signal_fault(a, SensorLimits()) != ""

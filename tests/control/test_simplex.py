@@ -6,7 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy import stats
 
-from control import ControlError, Estimate, Simplex
+from control import FAULT_STATUSES, STATUSES, ControlError, Estimate, Simplex
 from gpmsa import Posterior
 from gpmsa.calibration.posterior import GridMarginal
 
@@ -92,9 +92,73 @@ def test_risk_switches_exactly_when_prob_above_max_exceeds_alpha(mean, sd, alpha
         ({"risk": 1.5}, "risk must be None or lie in"),
         ({"kp": -1}, "kp must be finite"),
         ({"law": "pid"}, "law must be one of"),
+        ({"after_fault": "ignore"}, "after_fault must be one of"),
+        ({"latch_p": 0.0}, "latch_p must lie in"),
         ({"v_max": float("nan")}, "v_max must be finite"),
     ],
 )
 def test_bad_settings_raise(kwargs, match):
     with pytest.raises(ControlError, match=match):
         Simplex(**kwargs)
+
+
+def bare_estimate(status: str, time: float = 1.0) -> Estimate:
+    return Estimate(time=time, position=1.0, status=status, reason=f"why {status}")
+
+
+def test_a_fault_latches_safety_mode_until_reset():
+    run = Simplex().start()
+    assert run.command(gaussian_estimate(260, 5)).mode == "performance"
+    assert run.command(bare_estimate("sensor_fault", time=3.5)).speed == 1.0
+    cmd = run.command(gaussian_estimate(260, 5))  # clean data again: the BCR is ok, the robot not
+    assert run.latched and cmd.mode == "safety" and cmd.speed == 1.0
+    assert "latched by a sensor_fault at 3.50 s (why sensor_fault)" in cmd.reason
+    run.reset()
+    assert not run.latched and run.command(gaussian_estimate(260, 5)).mode == "performance"
+
+
+def test_an_implausible_block_latches_only_below_latch_p():
+    def implausible(p: float) -> Estimate:
+        return Estimate(time=1.0, position=1.0, status="implausible", plausibility_p=p)
+
+    for p, latches in ((1e-9, False), (1e-13, True), (float("nan"), True)):
+        run = Simplex().start()
+        assert run.command(implausible(p)).mode == "safety"  # this block: safety mode anyway
+        assert run.latched == latches
+        assert (run.command(gaussian_estimate(260, 5)).mode == "safety") == latches
+
+
+def test_resume_returns_to_the_law_at_the_next_ok_estimate():
+    run = Simplex(after_fault="resume").start()
+    assert run.command(bare_estimate("implausible")).mode == "safety"
+    assert not run.latched and run.command(gaussian_estimate(260, 5)).mode == "performance"
+
+
+@pytest.mark.parametrize("status", sorted(set(STATUSES) - set(FAULT_STATUSES) - {"ok"}))
+def test_statuses_that_are_not_sensor_faults_do_not_latch(status):
+    run = Simplex().start()
+    assert run.command(bare_estimate(status)).mode == "safety"
+    assert not run.latched and run.command(gaussian_estimate(260, 5)).mode == "performance"
+
+
+@given(
+    steps=st.lists(
+        st.one_of(st.floats(210, 590), st.sampled_from(sorted(set(STATUSES) - {"ok"}))),
+        min_size=1,
+        max_size=30,
+    ),
+    after_fault=st.sampled_from(["latch", "resume"]),
+)
+def test_a_run_never_commands_more_than_the_memoryless_law(steps, after_fault):
+    """Property: the run's command never exceeds Simplex.command's for the same estimate, and
+    with the latch it is the safe speed at and after the first fault, whatever follows."""
+    simplex = Simplex(after_fault=after_fault)
+    run = simplex.start()
+    faulted = False
+    for step in steps:
+        est = gaussian_estimate(step, 5) if isinstance(step, float) else bare_estimate(step)
+        faulted |= est.status in FAULT_STATUSES
+        cmd = run.command(est)
+        assert cmd.speed <= simplex.command(est).speed
+        if after_fault == "latch" and faulted:
+            assert cmd.speed == simplex.v_safe and cmd.mode == "safety"
