@@ -20,11 +20,11 @@ and skips the block after it.
 Every update returns an `Estimate` whose status says why there is no number: ``filling`` (not
 enough contiguous samples yet, or the first block after a fault), ``sensor_fault`` (non-finite
 values, dropped, repeated or backwards time stamps, a stuck, quantised, clipped or dead signal),
-``implausible`` (no GD in the
-emulator's domain explains the observation), ``out_of_domain`` (speed outside the emulator's
-range and no earlier estimate), ``calibration_failed``, ``stale`` (no new information for
-``max_age_s``). While the speed is outside the emulator's range (e.g. standing) there is no new
-information: the change-point estimate is carried on (its reason says so) until it turns stale.
+``implausible`` (no GD in the emulator's domain explains the observation), ``out_of_domain``
+(speed outside the emulator's range and no earlier estimate), ``calibration_failed``, ``stale``
+(no new information for ``max_age_s``). While the speed is outside the emulator's range (e.g.
+standing) there is no new information: the change-point estimate is carried on (its reason says
+so) until it turns stale.
 """
 
 from __future__ import annotations

@@ -13,13 +13,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
+from vehicle.models import GRAVITY
 
 MIN_SEGMENT = 32
 """Shortest stretch (samples, 0.27 s at 120 Hz) whose variance the level check compares with the
 rest of the block: shorter stretches of a healthy signal scatter too much (free flight)."""
 DEAD_STRETCH = 6
 """Shortest stretch (samples, 0.05 s at 120 Hz) that the dead-sensor check looks at."""
-FREE_FALL_MPS2 = -9.81
+FREE_FALL_MPS2 = -GRAVITY
 """What the vertical acceleration reads while a wheel is in the air (the simulator's -g), m/s^2."""
 
 
