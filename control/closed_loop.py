@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import time as _time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -18,6 +18,11 @@ from control.estimate import Estimate
 from control.faults import SensorFault, apply_faults
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, segment_index
 from control.simplex import Simplex
+
+EXACT_CLOCK_SILENCE = 0.5
+"""The simulated sensor's clock is exact, so any sample missing at an update is silence: the
+loop's BCR uses ``max_silence_s`` no longer than this many sample periods (a real link's jitter
+is what the BCR's own default of 0.5 s allows for)."""
 
 
 @dataclass(frozen=True)
@@ -142,7 +147,10 @@ def run_closed_loop(
         model: vehicle model (default `vehicle.Jackal()`); must match the emulator's metadata.
         noise_std: accelerometer noise standard deviation, m/s^2 (Test Case B: 1.0).
         seed: seed (integer >= 0) of the measurement noise and of the injected faults.
-        bcr: BCR settings (default: `bcr_settings_for(emulator)`, the emulator's feature).
+        bcr: BCR settings (default: `bcr_settings_for(emulator)`, the emulator's feature); the
+            loop shortens ``max_silence_s`` to `EXACT_CLOCK_SILENCE` sample periods, since the
+            simulation's clock is exact (a dropped sample at the end of an update is a fault
+            at that update, not half a second later).
         simplex: the controller (default `Simplex()`, the paper's band and speeds); its top and
             safe speeds must be within the vehicle's.
         progress: show a tqdm bar over the track length.
@@ -173,6 +181,9 @@ def run_closed_loop(
             f"Simplex v_max = {simplex.v_max:g} m/s exceeds the vehicle's top speed {top:g} m/s"
         )
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
+    bcr = replace(
+        bcr, max_silence_s=min(bcr.max_silence_s, EXACT_CLOCK_SILENCE / bcr.rate_hz)
+    )
     if check:
         check_emulator(emulator, model=model, noise_std=noise_std, bcr=bcr, track=track)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)

@@ -88,6 +88,22 @@ def test_a_sensor_fault_means_safety_mode_and_the_bcr_recovers(
             assert np.any(r.mode[later] == "performance")
 
 
+def test_samples_missing_at_the_end_of_an_update_are_a_fault_at_that_update(
+    emulator_a, likelihood_a
+):
+    """The simulation's clock is exact: a drop that starts one sample before an update's end
+    is silence at that update (the robot must not keep its speed for another block)."""
+    track = roadgen.track([(30, 300)], seed=6)
+    clean = run_closed_loop(track, emulator_a, seed=6, likelihood=likelihood_a)
+    j = int(np.flatnonzero(clean.time > 8.0)[0])
+    fault = SensorFault(start_s=clean.time[j] - 0.5 / 120, duration_s=0.5, kind="drop")
+    r = run_closed_loop(track, emulator_a, seed=6, likelihood=likelihood_a, faults=[fault])
+    np.testing.assert_array_equal(r.status[:j], clean.status[:j])
+    assert r.status[j] == "sensor_fault" and "no samples" in r.reason[j]
+    assert r.metrics.latched_at_s == pytest.approx(clean.time[j])
+    assert r.settings["bcr"].max_silence_s < 1 / 120
+
+
 def test_the_papers_window_method_runs_with_its_emulator():
     emu = control.shipped_emulator("A", "window")
     track = roadgen.track([(20, 300)], seed=2)
