@@ -206,6 +206,22 @@ def test_a_silent_sensor_is_a_fault_when_the_caller_gives_its_clock(block_model)
     assert quiet.update(empty, empty, empty, empty).ok
 
 
+@settings(max_examples=25, deadline=None)
+@given(missing=st.integers(1, 124))
+def test_with_an_exact_clock_any_missing_trailing_sample_is_a_fault(missing):
+    """The closed loop's setting (max_silence_s below one sample period): samples missing at
+    the end of an update are a fault at that update, however few."""
+    bcr = BCR(FakeBlockModel(), max_silence_s=0.5 / 120)
+    t, p, a, v = stream(const(400), 1.5, 10, seed=1)
+    n = 125 * 8
+    for k in range(0, n, 125):  # on time, every sample: estimates
+        assert bcr.update(t[k : k + 125], p[k : k + 125], a[k : k + 125], v[k : k + 125],
+                          now=t[k + 124]).ok  # fmt: skip
+    keep = slice(n, n + 125 - missing)
+    est = bcr.update(t[keep], p[keep], a[keep], v[keep], now=t[n + 124])
+    assert est.status == "sensor_fault" and "no samples for" in est.reason
+
+
 def test_speed_outside_the_domain_before_any_estimate(block_model):
     ests = feed(BCR(block_model), *stream(const(400), 0.3, 3, seed=1))
     assert ests[-1].status == "out_of_domain" and "0.3 m/s" in ests[-1].reason
