@@ -389,11 +389,15 @@ def summarise(outcomes: list[Outcome]) -> None:
             + f" | {len(worse_in):5d}{(worst_in.during_diff if worst_in else 0.0):9.2f} "
             f"{(worst_in.scenario.name if worst_in else '-'):<11}"
         )
-    missed = [o for o in done if not o.latched]
+    unlatched = [o for o in done if not o.latched]
+    seen = [any(o.statuses[s] for s in control.FAULT_STATUSES) for o in unlatched]
+    flagged = [o for o, f in zip(unlatched, seen, strict=True) if f]
+    unseen = [o for o, f in zip(unlatched, seen, strict=True) if not f]
     print(
         f"faulted runs latched in safety mode: {sum(o.latched for o in done)} of {len(done)}; "
-        f"faults never detected: {len(missed)} (worse than clean among them: "
-        f"{sum(o.diff > 0 for o in missed)}); clean runs latched (false alarms): "
+        f"not latched: {len(flagged)} flagged during the fault (p above latch_p), worse than "
+        f"clean {sum(o.diff > 0 for o in flagged)}; {len(unseen)} never flagged, worse "
+        f"{sum(o.diff > 0 for o in unseen)}; clean runs latched (false alarms): "
         f"{sum(o.clean_latched for o in done)}"
     )
     for case in ("A", "B"):
