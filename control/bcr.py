@@ -67,7 +67,8 @@ class BCRSettings:
         interval_level: level of the reported central credible interval.
         plausibility_p: an observation whose upper-tail probability under the emulator is below
             this for every GD in the domain is "implausible".
-        sensor: thresholds of the signal checks (stuck, quantised, clipped).
+        sensor: thresholds of the signal checks (stuck, quantised, clipped, dead, below the
+            noise floor, a level jump).
         recent_change_m: the distance of ``Estimate.prob_change``, m.
     """
 

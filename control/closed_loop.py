@@ -17,6 +17,7 @@ from control.errors import ControlError
 from control.estimate import Estimate
 from control.faults import SensorFault, apply_faults
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, segment_index
+from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 
 EXACT_CLOCK_SILENCE = 0.5
@@ -122,6 +123,14 @@ def _check_seed(seed) -> None:
         raise ControlError(f"seed must be None or an integer >= 0, got {seed!r}")
 
 
+def _within_simulated_noise(sensor: SensorLimits, noise_std: float) -> SensorLimits:
+    """The sensor checks with a noise sd no larger than the simulated sensor's (None if 0)."""
+    assumed = sensor.noise_sd_mps2
+    if assumed is None or noise_std >= assumed:
+        return sensor
+    return replace(sensor, noise_sd_mps2=float(noise_std) if noise_std > 0 else None)
+
+
 def run_closed_loop(
     track,
     emulator,
@@ -150,7 +159,9 @@ def run_closed_loop(
         bcr: BCR settings (default: `bcr_settings_for(emulator)`, the emulator's feature); the
             loop shortens ``max_silence_s`` to `EXACT_CLOCK_SILENCE` sample periods, since the
             simulation's clock is exact (a dropped sample at the end of an update is a fault
-            at that update, not half a second later).
+            at that update, not half a second later), and lowers the sensor checks' noise sd
+            to the simulated ``noise_std`` where that is lower (a noise-free run with a noisy
+            emulator has no noise floor to check).
         simplex: the controller (default `Simplex()`, the paper's band and speeds); its top and
             safe speeds must be within the vehicle's.
         progress: show a tqdm bar over the track length.
@@ -171,6 +182,7 @@ def run_closed_loop(
     model = vehicle.Jackal() if model is None else model
     simplex = Simplex() if simplex is None else simplex
     _check_seed(seed)
+    noise_std = vehicle.sensor.check_noise(noise_std)
     if record is not None:  # without the robot extra, fail before the drive, not after it
         from control.robot.record import check_can_record, record_run
 
@@ -182,7 +194,9 @@ def run_closed_loop(
         )
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     bcr = replace(
-        bcr, max_silence_s=min(bcr.max_silence_s, EXACT_CLOCK_SILENCE / bcr.rate_hz)
+        bcr,
+        max_silence_s=min(bcr.max_silence_s, EXACT_CLOCK_SILENCE / bcr.rate_hz),
+        sensor=_within_simulated_noise(bcr.sensor, noise_std),
     )
     if check:
         check_emulator(emulator, model=model, noise_std=noise_std, bcr=bcr, track=track)

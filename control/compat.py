@@ -17,6 +17,7 @@ import numpy as np
 from control.bcr import BCRSettings
 from control.errors import ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
+from control.sensor_checks import SensorLimits
 
 
 def _canon(obj) -> str:
@@ -102,12 +103,28 @@ def check_emulator(
             )
 
 
+def emulator_noise_std(emulator) -> float | None:
+    """The accelerometer noise sd the emulator was trained with (metadata ``noise_std``), m/s^2;
+    None when it is missing, not a positive number, or 0 (noise-free training data)."""
+    meta = dict(getattr(emulator, "metadata", None) or {})
+    try:
+        value = float(meta.get("noise_std", 0.0))
+    except (TypeError, ValueError):
+        return None
+    return value if np.isfinite(value) and value > 0 else None
+
+
 def bcr_settings_for(emulator, **overrides) -> BCRSettings:
     """BCR settings for the emulator's recorded feature: the change-point method for the block
-    feature, the paper's one-window estimator's filter for a window feature (``method=`` and
-    any other `BCRSettings` field may be overridden)."""
+    feature, the paper's one-window estimator's filter for a window feature; the sensor checks
+    know the sensor's noise sd from the emulator's training noise (`emulator_noise_std`: the
+    noise-floor check). ``method=``, ``sensor=`` and any other `BCRSettings` field may be
+    overridden."""
     feature = overrides.pop("feature", None) or emulator_feature(emulator)
     method = overrides.pop("method", None)
     if method is None:
         method = "changepoint" if feature.name == "log_band_power" else "filter"
-    return replace(BCRSettings(feature=feature, method=method), **overrides)
+    sensor = overrides.pop("sensor", None) or SensorLimits(
+        noise_sd_mps2=emulator_noise_std(emulator)
+    )
+    return replace(BCRSettings(feature=feature, method=method, sensor=sensor), **overrides)

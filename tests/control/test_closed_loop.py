@@ -104,6 +104,26 @@ def test_samples_missing_at_the_end_of_an_update_are_a_fault_at_that_update(
     assert r.settings["bcr"].max_silence_s < 1 / 120
 
 
+def test_a_gain_drop_late_in_a_noisy_block_is_a_fault_at_that_update():
+    """Case B: a gain of 0.04 over the last 0.4 s of an update reads quieter than the sensor's
+    own N(0, 1) noise, so that update is already a fault; noise-free data with the noisy
+    emulator has no noise floor (the loop lowers it to the simulated noise)."""
+    emu_b = control.shipped_emulator("B")
+    track = roadgen.track([(25, 500)], seed=7)
+    clean = run_closed_loop(track, emu_b, noise_std=1.0, seed=7)
+    assert clean.settings["bcr"].sensor.noise_sd_mps2 == 1.0
+    assert not np.any(clean.status == "sensor_fault")
+    j = int(np.flatnonzero(clean.time > 6.0)[0])
+    fault = SensorFault(start_s=clean.time[j] - 0.4, duration_s=3.0, kind="scale", magnitude=0.04)
+    r = run_closed_loop(track, emu_b, noise_std=1.0, seed=7, faults=[fault])
+    np.testing.assert_array_equal(r.status[:j], clean.status[:j])
+    assert r.status[j] == "sensor_fault" and "attenuated signal" in r.reason[j]
+    assert r.metrics.latched_at_s == pytest.approx(clean.time[j])
+    with pytest.warns(ControlWarning, match="noise_std = 0 m/s\\^2 in the data"):
+        quiet = run_closed_loop(roadgen.track([(8, 300)], seed=7), emu_b, noise_std=0.0, seed=7)
+    assert quiet.settings["bcr"].sensor.noise_sd_mps2 is None
+
+
 def test_the_papers_window_method_runs_with_its_emulator():
     emu = control.shipped_emulator("A", "window")
     track = roadgen.track([(20, 300)], seed=2)

@@ -18,6 +18,7 @@ from control import (  # noqa: E402
     ControlWarning,
     EmulatorMismatchError,
     FeatureSpec,
+    SensorLimits,
     bcr_settings_for,
     block_features,
     check_emulator,
@@ -55,6 +56,14 @@ def test_bcr_settings_follow_the_emulators_feature():
     assert bcr_settings_for(emu).method == "filter"  # a window feature: the window filter
     band = fake_emulator(feature=FeatureSpec().to_dict())
     assert bcr_settings_for(band) == BCRSettings()  # the block feature: the change-point BCR
+    # the sensor checks know the training noise (the noise-floor check); none if noise-free
+    noisy = fake_emulator(feature=FeatureSpec().to_dict(), noise_std=0.7)
+    assert bcr_settings_for(noisy).sensor == SensorLimits(noise_sd_mps2=0.7)
+    for value in (0.0, "loud", float("nan")):
+        bare = fake_emulator(feature=FeatureSpec().to_dict(), noise_std=value)
+        assert bcr_settings_for(bare).sensor.noise_sd_mps2 is None
+    mine = SensorLimits(max_repeats=3)
+    assert bcr_settings_for(noisy, sensor=mine).sensor == mine
     with pytest.raises(EmulatorMismatchError, match="has no 'feature'"):
         bcr_settings_for(fake_emulator())
 

@@ -7,7 +7,13 @@ from hypothesis import strategies as st
 
 import control
 from control import BlockScatter, ControlError, EmulatorMismatchError, ObservationModel
-from control.sensor_checks import SensorLimits, level_jump, longest_repeat, signal_fault
+from control.sensor_checks import (
+    SensorLimits,
+    level_jump,
+    longest_repeat,
+    quietest_stretch,
+    signal_fault,
+)
 from control.training import block_scatter, block_statistics
 
 
@@ -98,6 +104,48 @@ def test_signal_checks_name_what_a_healthy_sensor_never_does():
     assert level_jump(a)[0] < 10
     with pytest.raises(ControlError, match="max_repeats must be an integer >= 1"):
         SensorLimits(max_repeats=0)
+
+
+def test_a_signal_quieter_than_the_sensors_noise_is_attenuated():
+    rng = np.random.default_rng(3)
+    limits = SensorLimits(noise_sd_mps2=1.0)
+    # pure noise (the quietest a healthy sensor can read, at rest or in flight) passes
+    assert all(signal_fault(rng.standard_normal(125), limits) == "" for _ in range(2000))
+    flight = np.full(125, -9.81) + rng.standard_normal(125)
+    assert signal_fault(flight, limits) == ""
+    a = rng.standard_normal(125) + rng.standard_normal(125)  # signal and noise, variance 2
+    a[85:] *= 0.2  # variance 0.08 over the last 40 samples: a level change of only 25x
+    assert signal_fault(a, SensorLimits()) == ""  # without the noise sd nothing can tell
+    reason = signal_fault(a, limits)
+    assert reason.startswith("attenuated signal: samples 8") and "below 0.1 of" in reason
+    variance, start = quietest_stretch(a)
+    assert start >= 85 - 5 and variance < 0.1
+    assert quietest_stretch(a[:31]) == (float("inf"), -1)
+    for bad in ({"noise_sd_mps2": 0.0}, {"noise_sd_mps2": np.nan}, {"noise_floor": 1.0}):
+        with pytest.raises(ControlError, match=next(iter(bad))):
+            SensorLimits(**bad)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    start=st.integers(0, 93),
+    left=st.floats(1e-6, 0.02),
+    signal_sd=st.floats(0.0, 3.0),
+    noise_sd=st.floats(0.1, 2.0),
+    seed=st.integers(0, 2**16),
+)
+def test_a_gain_drop_over_32_samples_or_more_is_found_below_the_noise_floor(
+    start, left, signal_sd, noise_sd, seed
+):
+    """Property: a noisy sensor whose gain drops, for the rest of the block from any sample
+    that leaves >= 32 of them, so far that the reading's variance is ``left`` <= 2% of the noise
+    variance, is a fault; the same block without the drop has no stretch below the floor."""
+    rng = np.random.default_rng(seed)
+    a = signal_sd * rng.standard_normal(125) + noise_sd * rng.standard_normal(125)
+    limits = SensorLimits(noise_sd_mps2=noise_sd)
+    assert quietest_stretch(a)[0] >= limits.noise_floor * noise_sd**2
+    a[start:] *= np.sqrt(left * noise_sd**2 / (signal_sd**2 + noise_sd**2))
+    assert signal_fault(a, limits) != ""
 
 
 @settings(max_examples=60, deadline=None)
