@@ -376,9 +376,7 @@ class BCR:
                 f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = {p:.2g} < "
                 f"{s.plausibility_p:g})"
             )
-            return self._skip_block(
-                ds, "implausible", why, speed=v, feature=y, plausibility_p=p
-            )
+            return self._skip_block(ds, "implausible", why, speed=v, feature=y, plausibility_p=p)
         if self._guard:
             self._guard = False
             self._undo = None
