@@ -5,6 +5,7 @@ were not used to choose the estimator's settings.
     python benchmarks/closed_loop_accuracy.py --sets paper,heldout --workers 2
     python benchmarks/closed_loop_accuracy.py --sets dev       # the development set
     python benchmarks/closed_loop_accuracy.py --mean-segment 60 --min-jump 0.1   # other settings
+    python benchmarks/closed_loop_accuracy.py --sets dev,steady-dev --emulator-dir DIR  # others
 
 Sets (run k drives a track synthesised with seed k, and noise seed k):
 
@@ -17,7 +18,11 @@ Sets (run k drives a track synthesised with seed k, and noise seed k):
 - ``steady``: single-GD roads of 100 m (GD 250-550, seeds 501-503) driven at a constant 1.0, 1.5
   or 2.0 m/s; the estimates made after the first 25 m: relative bias and RMSE per GD and speed;
 - ``dev``: the development set the settings were chosen on (paper track seeds 101-132, random
-  tracks seeds 201-232); it shares no seed with the others.
+  tracks seeds 201-232), and ``steady-dev``: the steady roads with seeds 601-603; they share no
+  seed with the others.
+
+``--emulator-dir DIR`` takes the band emulators ``DIR/jackal_{A,B}.gpmsa`` (as written by
+``examples/train_emulator.py --emulator-dir DIR``) instead of the shipped ones.
 
 Targets (issue 12): paper track, seeds 1-3 and 11-20, cases A and B: RMSE <= 35 on the GD-300
 parts and <= 60 on the GD-500 part; steady roads: |bias| <= 5% and RMSE <= 10% of GD at every
@@ -35,6 +40,7 @@ from dataclasses import replace
 import numpy as np
 
 import control
+import gpmsa
 import roadgen
 
 PAPER_TRACK = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
@@ -48,6 +54,7 @@ SETS = {
     "random": range(401, 441),
     "steady": range(501, 504),
     "dev": range(101, 133),
+    "steady-dev": range(601, 604),
 }
 _MODELS: dict = {}
 
@@ -61,11 +68,14 @@ def random_segments(seed: int) -> tuple[tuple[float, float], ...]:
     )
 
 
-def _model(case: str, method: str):
+def _model(case: str, method: str, emulator_dir: str | None):
     """(emulator, BCR settings, prepared likelihood) per worker process."""
-    key = (case, method)
+    key = (case, method, emulator_dir)
     if key not in _MODELS:
-        emu = control.shipped_emulator(case, "band" if method == "changepoint" else "window")
+        if method == "changepoint" and emulator_dir:
+            emu = gpmsa.load(os.path.join(emulator_dir, f"jackal_{case}.gpmsa"))
+        else:
+            emu = control.shipped_emulator(case, "band" if method == "changepoint" else "window")
         bcr = control.bcr_settings_for(emu, method=method)
         _MODELS[key] = (emu, bcr, control.BCR.from_emulator(emu, bcr).model)
     return _MODELS[key]
@@ -73,8 +83,8 @@ def _model(case: str, method: str):
 
 def _run(job: tuple) -> dict:
     """One closed-loop run; returns its per-update traces and metrics."""
-    case, kind, seed, method, cp, extra = job
-    emu, bcr, likelihood = _model(case, method)
+    case, kind, seed, method, cp, extra, emulator_dir = job
+    emu, bcr, likelihood = _model(case, method, emulator_dir)
     if method == "changepoint":
         bcr = replace(bcr, changepoint=cp)
     simplex = control.Simplex()
@@ -100,7 +110,7 @@ def _run(job: tuple) -> dict:
     }  # fmt: skip
 
 
-def jobs_for(name: str, cases, cp) -> list[tuple]:
+def jobs_for(name: str, cases, cp, emulator_dir: str | None = None) -> list[tuple]:
     out = []
     for case in cases:
         seeds = SETS[name]
@@ -110,7 +120,7 @@ def jobs_for(name: str, cases, cp) -> list[tuple]:
             ]
         elif name == "random":
             out += [(case, "random", s, "changepoint", cp, None) for s in seeds]
-        elif name == "steady":
+        elif name in ("steady", "steady-dev"):
             out += [
                 (case, "steady", s, "changepoint", cp, (gd, v))
                 for gd in STEADY_GD for v in STEADY_SPEEDS for s in seeds
@@ -118,7 +128,7 @@ def jobs_for(name: str, cases, cp) -> list[tuple]:
         else:  # dev
             out += [(case, "paper", s, "changepoint", cp, None) for s in seeds]
             out += [(case, "random", s + 100, "changepoint", cp, None) for s in seeds]
-    return out
+    return [(*job, emulator_dir) for job in out]
 
 
 def coverage(runs) -> float:
@@ -201,12 +211,25 @@ def main() -> None:
                         help="sd of the log GD ratio at a change")  # fmt: skip
     parser.add_argument("--prior", default=defaults.prior, choices=["log_uniform", "uniform"],
                         help="prior of GD")  # fmt: skip
+    parser.add_argument(
+        "--emulator-dir",
+        default=None,
+        help="band emulators DIR/jackal_{A,B}.gpmsa instead of the shipped ones",
+    )
     args = parser.parse_args()
     names = [n for n in args.sets.split(",") if n]
     unknown = set(names) - set(SETS)
     if unknown:
         parser.error(f"unknown sets {sorted(unknown)}; choose from {list(SETS)}")
     cases = [c for c in args.cases.split(",") if c]
+    if args.emulator_dir:
+        missing = [
+            c
+            for c in cases
+            if not os.path.isfile(os.path.join(args.emulator_dir, f"jackal_{c}.gpmsa"))
+        ]
+        if missing:
+            parser.error(f"--emulator-dir {args.emulator_dir}: no jackal_{missing[0]}.gpmsa")
     cp = control.ChangePointSettings(
         mean_segment_m=args.mean_segment, segment_shape=args.shape, min_jump=args.min_jump,
         jump_sd=args.jump_sd, prior=args.prior,
@@ -214,7 +237,7 @@ def main() -> None:
     tic = time.perf_counter()
     out = []
     for name in names:
-        jobs = jobs_for(name, cases, cp)
+        jobs = jobs_for(name, cases, cp, args.emulator_dir)
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             results = list(pool.map(_run, jobs))
         for case in cases:
@@ -222,9 +245,11 @@ def main() -> None:
                 out += report_paper(results, name, case)
             if name in ("random", "dev"):
                 out.append(report_random(results, case))
-            if name == "steady":
+            if name in ("steady", "steady-dev"):
                 out += report_steady(results, case)
     print(f"closed-loop accuracy, change-point settings: {cp}")
+    if args.emulator_dir:
+        print(f"band emulators from {args.emulator_dir}")
     print("\n".join(out))
     load = os.getloadavg()
     print(f"\n{time.perf_counter() - tic:.0f} s on {args.workers} worker(s), load average "

@@ -36,7 +36,9 @@ B = 1000 (the paper's); lack of fit (mean over training runs of the squared stan
 residual of the run mean about the cubic, per output; 1 when the cubic and Sigma explain the run
 means); per speed band (v < 1, 1-1.5, > 1.5 m/s) J at T = 8.3 s. The prior alone (posterior mean
 = prior mean) has the RMSE printed as ``prior-only``: a J near 1 / (that^2 T) is the prior's, not
-the feature's.
+the feature's. Last, variants of the band vector (`BAND_VARIANTS`: narrower bands, a lower
+first band, other tapers, shorter blocks, the vector plus the block's skewness or log kurtosis),
+J and J_lin at T ~ 8.3 s: is there information the shipped vector leaves out?
 
 Campaign runs are cached under ``--cache-dir`` (keyed by their settings), so a second call only
 recomputes the features (a few seconds).
@@ -71,6 +73,19 @@ LOG_GD_BW = 0.3  # kernel bandwidth of S_ref in log GD
 BATCH_SAMPLES = 1000  # samples per batch of the long-run covariance
 SPEED_BANDS = ((0.0, 1.0, "v<1"), (1.0, 1.5, "1-1.5"), (1.5, 9.9, "v>1.5"))
 N_GRID = 401
+NARROW_BANDS_HZ = (1.5, 3, 4.5, 6, 7, 8.5, 10, 12, 14, 17, 20, 25, 30, 37, 45, 52, 60)
+BAND_VARIANTS = {  # name: (block samples, FeatureSpec fields, extra moment or None)
+    "8 bands (shipped)": (125, {}, None),
+    "16 narrower bands": (125, {"bands_hz": NARROW_BANDS_HZ}, None),
+    "first band from 0.9 Hz": (125, {"bands_hz": (0.9, 2.5, 4.5, 7, 10, 14, 20, 30, 45, 60)}, None),
+    "NW 3, 5 tapers": (125, {"taper_nw": 3.0, "n_tapers": 5}, None),
+    "NW 1.5, 2 tapers": (125, {"taper_nw": 1.5, "n_tapers": 2}, None),
+    "+ skewness": (125, {}, "skewness"),
+    "+ log kurtosis": (125, {}, "log_kurtosis"),
+    "100-sample blocks": (100, {}, None),
+    "80-sample blocks": (80, {}, None),
+    "64-sample blocks": (64, {}, None),
+}
 
 
 def lhs(n: int, seed: int) -> np.ndarray:
@@ -135,6 +150,25 @@ def features(blocks: np.ndarray, B: int, pgram: np.ndarray, s_ref: np.ndarray | 
     if s_ref is not None:
         out["whittle"] = np.log(np.mean(pgram / s_ref[:, None, :], axis=-1))[..., None]
     return out
+
+
+def moment(blocks: np.ndarray, name: str) -> np.ndarray:
+    """(runs, n_blocks, 1) skewness or log kurtosis of each block (lift-off makes the
+    acceleration non-Gaussian: what a spectrum cannot see)."""
+    d = blocks - blocks.mean(axis=-1, keepdims=True)
+    var = np.mean(d**2, axis=-1)
+    if name == "skewness":
+        return (np.mean(d**3, axis=-1) / var**1.5)[..., None]
+    return np.log(np.mean(d**4, axis=-1) / var**2)[..., None]
+
+
+def band_variant(accel: np.ndarray, B: int, fields: dict, extra: str | None) -> np.ndarray:
+    """(runs, n_blocks, K) a variant of the band vector: other bands, tapers or block length,
+    or the shipped vector plus one moment."""
+    blocks = blocks_of(accel, B)
+    out = block_features(blocks.reshape(-1, B), FeatureSpec(block_samples=B, **fields))
+    out = out.reshape(*blocks.shape[:2], -1)
+    return out if extra is None else np.concatenate([out, moment(blocks, extra)], axis=-1)
 
 
 # --- the model: cubic mean, kernel-weighted long-run covariance -----------------------------------
@@ -297,6 +331,25 @@ def info_per_s(s: Scores, t_s: float, rng: np.random.Generator, n_boot: int = 30
         "Jlin": jlin_of(s.err_lin),
         "se_lin": float(np.std(boot[:, 1])),
     }
+
+
+def paired_j_ratio(
+    s: Scores, base: Scores, span: int, rng: np.random.Generator, n_boot: int = 1000
+) -> tuple[float, float]:
+    """J of ``s`` over J of ``base`` (each from the posterior-mean errors of stretches of
+    ``span`` and 1000 samples respectively), with its paired bootstrap SE: the same test runs
+    are resampled for both."""
+    runs = np.unique(base.run)
+    mine = [np.flatnonzero(s.run == r) for r in runs]
+    theirs = [np.flatnonzero(base.run == r) for r in runs]
+
+    def ratio(picks: np.ndarray) -> float:
+        a = np.concatenate([mine[i] for i in picks])
+        b = np.concatenate([theirs[i] for i in picks])
+        return float(np.mean(base.err[b] ** 2) * 1000 / (np.mean(s.err[a] ** 2) * span))
+
+    boot = [ratio(rng.integers(0, runs.size, runs.size)) for _ in range(n_boot)]
+    return ratio(np.arange(runs.size)), float(np.std(boot))
 
 
 def load() -> str:
@@ -484,6 +537,29 @@ def main(argv: list[str] | None = None) -> None:
                     row += f"{t['J']:10.2f} ({ratio(band_j, key, ref, 'J'):4.2f})"
                     row += f"{t['Jlin']:9.2f} ({ratio(band_j, key, ref, 'Jlin'):4.2f})"
                 print(row)
+
+    print(f"\n4. Variants of the band vector at T ~ 8.3 s (1,000 samples; {load()})")
+    print("J and J_lin [1/s] +- bootstrap SE as in sections 1 and 2; K: outputs per block;")
+    print("J / shipped: J over the shipped vector's J, +- a paired bootstrap SE over test runs")
+    print("(same runs, same stretches: block-length variants differ in stretch ends, still paired)")
+    for case in ("A", "B"):
+        print(f"\ncase {case}")
+        print(f"{'variant':<24}{'B':>5}{'K':>4} {'J +- se':>15} {'J_lin +- se':>15} {'cov':>5}"
+              f" {'J / shipped':>15}")  # fmt: skip
+        shipped = None
+        for name, (B, fields, extra) in BAND_VARIANTS.items():
+            f_tr = band_variant(acc_tr[case], B, fields, extra)
+            f_te = band_variant(acc_te[case], B, fields, extra)[scored]
+            per = 1000 // B
+            model = fit(v_tr, gd_tr, f_tr, max(1, BATCH_SAMPLES // B))
+            sc = estimates(model, v_s, gd_s, f_te, per, log_grid)
+            if shipped is None:  # the first variant is the shipped vector
+                shipped = sc
+            t = info_per_s(sc, per * B / RATE_HZ, rng)
+            r, r_se = paired_j_ratio(sc, shipped, per * B, rng)
+            print(f"{name:<24}{B:5d}{f_tr.shape[2]:4d} {t['J']:7.2f} +- {t['se']:4.2f} "
+                  f"{t['Jlin']:7.2f} +- {t['se_lin']:4.2f} {t['cov']:5.2f} "
+                  f"{r:7.3f} +- {r_se:5.3f}")  # fmt: skip
     print(f"\ntotal {time.perf_counter() - tic:.0f} s; {load()}")
 
 

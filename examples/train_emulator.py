@@ -14,10 +14,10 @@ Steps (docs/closed-loop.md):
 2. one fresh road and one Jackal drive per point (``vehicle.run_campaign``), keeping the last
    ``--keep-s`` (120) seconds of front-axle accelerations, noise-free and with N(0, 1) noise;
 3. the block-feature emulators ``jackal_{A,B}.gpmsa`` (the change-point BCR's): per run, the
-   mean log band-power vector of its 125-sample blocks (`control.training`), fitted by
-   ``gpmsa.fit`` through its PCA basis; the block-to-block covariance Sigma(v) and the
-   Student-t dof, stored in the file's metadata (``block_scatter``) as the known observation
-   noise of one block;
+   mean log band-power vector of its 125-sample blocks (``--block-samples``; `control.training`),
+   fitted by ``gpmsa.fit`` through its PCA basis; the block-to-block covariance Sigma(v) and
+   the Student-t dof, stored in the file's metadata (``block_scatter``) as the known
+   observation noise of one block;
 4. the paper-feature emulators ``jackal_{A,B}_window.gpmsa`` (the paper's estimator and the
    window filters): y = log f of the last 1,000 samples of each drive, with the GP nugget
    describing the window scatter (its lamWs prior relaxed from GPM/SA's lower bound of 60 to 1).
@@ -125,14 +125,15 @@ def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict
 
 def fit_band(case: str, campaign, model, args):
     """The block-feature emulator of one case, with its block scatter in the metadata."""
+    feature = dataclasses.replace(BAND_FEATURE, block_samples=args.block_samples)
     accel = campaign.accel if case == "A" else campaign.accel_measured
     ok = campaign.ok & np.all(np.isfinite(accel), axis=1)
-    stats_ = block_statistics(accel[ok], BAND_FEATURE)
+    stats_ = block_statistics(accel[ok], feature)
     scatter = block_scatter(campaign.v[ok], stats_, nodes=np.linspace(*V_RANGE, 16))
     data = gpmsa.SimData(
         x=campaign.v[ok, None], t=campaign.gd[ok, None], y=stats_.mean,
-        x_names=["v"], t_names=["GD"], y_names=BAND_FEATURE.names(),
-        x_units=["m/s"], t_units=["1e-6 m^3"], y_units=["log((m/s^2)^2)"] * BAND_FEATURE.dim,
+        x_names=["v"], t_names=["GD"], y_names=feature.names(),
+        x_units=["m/s"], t_units=["1e-6 m^3"], y_units=["log((m/s^2)^2)"] * feature.dim,
     )  # fmt: skip
     extra = {
         "block_scatter": scatter.to_dict(),
@@ -141,7 +142,7 @@ def fit_band(case: str, campaign, model, args):
     }
     return gpmsa.fit(
         data, n_iter=args.n_iter, seed=args.seed, progress=True, n_pc=BAND_PCS,
-        metadata=metadata(case, BAND_FEATURE, model, campaign, args, extra),
+        metadata=metadata(case, feature, model, campaign, args, extra),
     )  # fmt: skip
 
 
@@ -190,9 +191,19 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--features", nargs="+", default=["band", "window"], choices=["band", "window"]
     )
+    parser.add_argument(
+        "--block-samples", type=int, default=BAND_FEATURE.block_samples,
+        help="samples per block of the band emulators (the change-point BCR updates once a "
+        "block and takes the length from the emulator file; the default 125 is the length the "
+        "BCR's settings and sensor checks were chosen for: docs/closed-loop.md)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
+    try:
+        dataclasses.replace(BAND_FEATURE, block_samples=args.block_samples)
+    except ValueError as exc:  # ControlError: too short for the bands
+        parser.error(f"--block-samples: {exc}")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     if args.ship and args.emulator_dir is not None:

@@ -1,6 +1,5 @@
 """examples/train_emulator.py end to end on a small design: a file the closed loop accepts."""
 
-
 import numpy as np
 import pytest
 
@@ -63,3 +62,26 @@ def test_vehicle_overrides_make_the_users_robot():
     assert model.b1_m == vehicle.Jackal().b1_m
     with pytest.raises(ValueError, match="mass_kg"):
         script.vehicle_model(["weight=20"])
+
+
+def test_block_samples_option_sets_the_bcrs_block(tmp_path):
+    import gpmsa
+
+    load_script().main(
+        ["--out", str(tmp_path), "--n-runs", "16", "--n-iter", "200", "--keep-s", "12",
+         "--cases", "A", "--features", "band", "--block-samples", "80"]
+    )  # fmt: skip
+    emu = gpmsa.load(tmp_path / "emulators" / "jackal_A.gpmsa")
+    assert control.FeatureSpec.from_dict(emu.metadata["feature"]).block_samples == 80
+    settings = control.bcr_settings_for(emu)
+    assert settings.feature.block_samples == settings.samples_per_update == 80
+    r = control.run_closed_loop(roadgen.track([(10, 300)], seed=2), emu, seed=2)
+    assert np.median(np.diff(r.time)) == pytest.approx(80 / 120)  # one update per block
+    assert (r.status == "ok").mean() > 0.7
+
+
+@pytest.mark.parametrize("block", ["10", "20"])
+def test_block_samples_too_short_for_the_bands_is_refused(tmp_path, block, capsys):
+    with pytest.raises(SystemExit):
+        load_script().main(["--out", str(tmp_path), "--block-samples", block])
+    assert "--block-samples" in capsys.readouterr().err
