@@ -334,11 +334,16 @@ def info_per_s(s: Scores, t_s: float, rng: np.random.Generator, n_boot: int = 30
 
 
 def paired_j_ratio(
-    s: Scores, base: Scores, span: int, rng: np.random.Generator, n_boot: int = 1000
+    s: Scores,
+    span: int,
+    base: Scores,
+    base_span: int,
+    rng: np.random.Generator,
+    n_boot: int = 1000,
 ) -> tuple[float, float]:
-    """J of ``s`` over J of ``base`` (each from the posterior-mean errors of stretches of
-    ``span`` and 1000 samples respectively), with its paired bootstrap SE: the same test runs
-    are resampled for both."""
+    """J of ``s`` over J of ``base`` (from the posterior-mean errors of their stretches of
+    ``span`` and ``base_span`` samples), with its paired bootstrap SE: the same test runs are
+    resampled for both."""
     runs = np.unique(base.run)
     mine = [np.flatnonzero(s.run == r) for r in runs]
     theirs = [np.flatnonzero(base.run == r) for r in runs]
@@ -346,7 +351,7 @@ def paired_j_ratio(
     def ratio(picks: np.ndarray) -> float:
         a = np.concatenate([mine[i] for i in picks])
         b = np.concatenate([theirs[i] for i in picks])
-        return float(np.mean(base.err[b] ** 2) * 1000 / (np.mean(s.err[a] ** 2) * span))
+        return float(np.mean(base.err[b] ** 2) * base_span / (np.mean(s.err[a] ** 2) * span))
 
     boot = [ratio(rng.integers(0, runs.size, runs.size)) for _ in range(n_boot)]
     return ratio(np.arange(runs.size)), float(np.std(boot))
@@ -554,9 +559,9 @@ def main(argv: list[str] | None = None) -> None:
             model = fit(v_tr, gd_tr, f_tr, max(1, BATCH_SAMPLES // B))
             sc = estimates(model, v_s, gd_s, f_te, per, log_grid)
             if shipped is None:  # the first variant is the shipped vector
-                shipped = sc
+                shipped = sc, per * B
             t = info_per_s(sc, per * B / RATE_HZ, rng)
-            r, r_se = paired_j_ratio(sc, shipped, per * B, rng)
+            r, r_se = paired_j_ratio(sc, per * B, *shipped, rng)
             print(f"{name:<24}{B:5d}{f_tr.shape[2]:4d} {t['J']:7.2f} +- {t['se']:4.2f} "
                   f"{t['Jlin']:7.2f} +- {t['se_lin']:4.2f} {t['cov']:5.2f} "
                   f"{r:7.3f} +- {r_se:5.3f}")  # fmt: skip
