@@ -143,9 +143,7 @@ def features(blocks: np.ndarray, B: int, pgram: np.ndarray, s_ref: np.ndarray | 
     out = {
         "log_var": np.log(np.var(blocks, axis=-1))[..., None],
         "log_pgram": np.mean(np.log(pgram), axis=-1)[..., None],
-        "bands": block_features(blocks.reshape(-1, B), FeatureSpec(block_samples=B)).reshape(
-            *blocks.shape[:2], -1
-        ),
+        "bands": band_vector(blocks, FeatureSpec(block_samples=B)),
     }
     if s_ref is not None:
         out["whittle"] = np.log(np.mean(pgram / s_ref[:, None, :], axis=-1))[..., None]
@@ -162,12 +160,16 @@ def moment(blocks: np.ndarray, name: str) -> np.ndarray:
     return np.log(np.mean(d**4, axis=-1) / var**2)[..., None]
 
 
+def band_vector(blocks: np.ndarray, spec: FeatureSpec) -> np.ndarray:
+    """(runs, n_blocks, K) `control.block_features` of every block."""
+    return block_features(blocks.reshape(-1, blocks.shape[-1]), spec).reshape(*blocks.shape[:2], -1)
+
+
 def band_variant(accel: np.ndarray, B: int, fields: dict, extra: str | None) -> np.ndarray:
     """(runs, n_blocks, K) a variant of the band vector: other bands, tapers or block length,
     or the shipped vector plus one moment."""
     blocks = blocks_of(accel, B)
-    out = block_features(blocks.reshape(-1, B), FeatureSpec(block_samples=B, **fields))
-    out = out.reshape(*blocks.shape[:2], -1)
+    out = band_vector(blocks, FeatureSpec(block_samples=B, **fields))
     return out if extra is None else np.concatenate([out, moment(blocks, extra)], axis=-1)
 
 
