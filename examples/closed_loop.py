@@ -3,16 +3,20 @@
     python examples/closed_loop.py                # writes ./out/metrics.json and the figures
     python examples/closed_loop.py --out DIR --runs 3 --method changepoint --law linear
     python examples/closed_loop.py --record runs/   # also one MCAP per run, for Foxglove
+    python examples/closed_loop.py --track 40:250,30:450,60:350 --first-seed 21   # another track
 
-Track: 50 m at GD 300, 50 m at GD 500, 50 m at GD 300 (roadgen.track). Test Case A: noise-free
+Track: 50 m at GD 300, 50 m at GD 500, 50 m at GD 300 (roadgen.track), or ``--track`` (segments
+``LENGTH_M:GD``, GD within the emulators' domain, 200-600). Test Case A: noise-free
 accelerations and the noise-free emulators; Test Case B: N(0, 1) accelerometer noise and the
-emulators trained with it. Run k drives a track synthesised with seed k (and noise seed k).
+emulators trained with it. Run k drives a track synthesised with seed k (and noise seed k), for
+k = FIRST_SEED .. FIRST_SEED + RUNS - 1.
 
 Each case is run twice: with our estimator (default: the change-point BCR on log band powers of
 1 s blocks, `control.bcr`) and with the paper's method run here (one 1,000-sample window, its
 log variance, the paper's uniform prior: ``method="window"``). The RMSE is that of the
 posterior-mean GD at each estimate's position against the GD prescribed there, pooled over the
-runs; the table prints the paper's figures, the paper's method run here, and ours.
+runs, for each prescribed GD of the track; the table prints the paper's figures (on the paper's
+track), the paper's method run here, and ours.
 """
 
 from __future__ import annotations
@@ -31,26 +35,48 @@ import control  # noqa: E402
 import roadgen  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
 
-SEGMENTS = [(50.0, 300.0), (50.0, 500.0), (50.0, 300.0)]
+PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 NOISE_STD = {"A": 0.0, "B": 1.0}
-PAPER_RMSE = {
-    "A": {"rmse_gd300": 42.58, "rmse_gd500": 94.42},
-    "B": {"rmse_gd300": 50.19, "rmse_gd500": 96.23},
-}
+PAPER_RMSE = {"A": {"300": 42.58, "500": 94.42}, "B": {"300": 50.19, "500": 96.23}}
+
+
+def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
+    """``"50:300,50:500,50:300"`` -> ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0)): length in m, GD.
+
+    Raises ValueError naming the segment that is not ``LENGTH:GD`` with two finite positive
+    numbers.
+    """
+    segments = []
+    for part in text.split(","):
+        fields = part.strip().split(":")
+        try:
+            length, gd = (float(f) for f in fields)
+        except ValueError:
+            raise ValueError(f"segment {part.strip()!r} is not LENGTH_M:GD (e.g. 50:300)") from None
+        if not (np.isfinite(length) and np.isfinite(gd) and length > 0 and gd > 0):
+            raise ValueError(f"segment {part.strip()!r}: length and GD must be finite and > 0")
+        segments.append((length, gd))
+    return tuple(segments)
 
 
 def run_case(
-    case: str, runs: int, method: str, simplex: control.Simplex, record: Path | None = None
+    case: str,
+    seeds: range,
+    method: str,
+    simplex: control.Simplex,
+    segments=PAPER_SEGMENTS,
+    record: Path | None = None,
 ) -> list:
-    """The closed-loop results of one test case and estimator (one per run); with ``record``,
-    each run is also written there as ``case{A,B}_{method}_run{k}.mcap`` (control.record_run)."""
+    """The closed-loop results of one test case and estimator, one per seed (track and noise);
+    with ``record``, each run is also written there as ``case{A,B}_{method}_run{k}.mcap``
+    (control.record_run)."""
     kind = "band" if method == "changepoint" else "window"
     emu = control.shipped_emulator(case, kind)
     bcr = control.bcr_settings_for(emu, method=method)
     likelihood = control.BCR.from_emulator(emu, bcr).model  # prepared once for all runs
     return [
         control.run_closed_loop(
-            roadgen.track(SEGMENTS, seed=k),
+            roadgen.track(segments, seed=k),
             emu,
             noise_std=NOISE_STD[case],
             seed=k,
@@ -59,20 +85,20 @@ def run_case(
             likelihood=likelihood,
             record=record / f"case{case}_{method}_run{k}.mcap" if record else None,
         )  # fmt: skip
-        for k in range(1, runs + 1)
+        for k in seeds
     ]
 
 
-def summarise(results) -> dict:
-    """Pooled RMSE per prescribed GD, pooled interval coverage and the per-run metrics."""
+def summarise(results, gds: list[float]) -> dict:
+    """Pooled RMSE per prescribed GD (keys ``str(int(gd))``), pooled interval coverage and the
+    per-run metrics."""
     errors = [r.metrics.gd_errors for r in results]
     ok = np.concatenate([np.isfinite(r.gd_mean) for r in results])
     lo, hi, true = (
         np.concatenate([getattr(r, k) for r in results]) for k in ("gd_lo", "gd_hi", "gd_true")
     )
     return {
-        "rmse_gd300": control.pooled_rmse(errors, 300.0),
-        "rmse_gd500": control.pooled_rmse(errors, 500.0),
+        "rmse": {f"{gd:g}": control.pooled_rmse(errors, gd) for gd in gds},
         "coverage": float(np.mean((lo[ok] <= true[ok]) & (true[ok] <= hi[ok]))),
         "runs": [r.metrics.as_dict() for r in results],
     }
@@ -81,9 +107,15 @@ def summarise(results) -> dict:
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out", help="folder for metrics.json and the figures")
+    parser.add_argument("--runs", type=int, default=3, help="runs per test case")
     parser.add_argument(
-        "--runs", type=int, default=3, help="runs per test case (track and noise seeds 1..RUNS)"
-    )
+        "--first-seed", type=int, default=1,
+        help="run k drives track and noise seed k, k = FIRST_SEED .. FIRST_SEED + RUNS - 1",
+    )  # fmt: skip
+    parser.add_argument(
+        "--track", default=None, metavar="L:GD,...",
+        help="segments LENGTH_M:GD, e.g. 50:300,50:500,50:300 (the paper's track, the default)",
+    )  # fmt: skip
     parser.add_argument(
         "--method", default="changepoint", choices=list(control.METHODS),
         help="our estimator: changepoint (default), or the window methods for comparison",
@@ -104,18 +136,30 @@ def main(argv: list[str] | None = None) -> dict:
     args = parser.parse_args(argv)
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
+    if args.first_seed < 0:
+        parser.error(f"--first-seed must be >= 0, got {args.first_seed}")
+    try:
+        segments = PAPER_SEGMENTS if args.track is None else parse_segments(args.track)
+        track = roadgen.track(segments, seed=args.first_seed)
+    except ValueError as err:  # RoadgenError is a ValueError
+        parser.error(f"--track: {err}")
+    seeds = range(args.first_seed, args.first_seed + args.runs)
+    gds = sorted({gd for _, gd in segments})
+    paper_track = tuple(segments) == PAPER_SEGMENTS
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     simplex = control.Simplex(risk=args.risk, law=args.law)
+    record = Path(args.record) if args.record else None
 
     metrics: dict = {"ours": {}, "paper_method": {}}
-    track = roadgen.track(SEGMENTS, seed=1)
     for case in ("A", "B"):
         title = f"Test Case {case} ({'noise-free' if case == 'A' else 'N(0, 1) noise'})"
         for key, method in (("ours", args.method), ("paper_method", "window")):
-            record = Path(args.record) if args.record else None
-            results = run_case(case, args.runs, method, simplex, record)
-            metrics[key][case] = summarise(results)
+            try:
+                results = run_case(case, seeds, method, simplex, segments, record)
+            except control.EmulatorMismatchError as err:  # e.g. a GD outside the domain
+                parser.error(f"--track: {err}")
+            metrics[key][case] = summarise(results, gds)
             label = "ours" if key == "ours" else "paper's method"
             plot_gd_trace(results, track, title=f"{title}, {label}: GD").savefig(
                 out / f"gd_trace_{case}_{key}.png", dpi=150
@@ -123,29 +167,35 @@ def main(argv: list[str] | None = None) -> dict:
             plot_speed(results, track, title=f"{title}, {label}: speed").savefig(
                 out / f"speed_{case}_{key}.png", dpi=150
             )
-    metrics["paper"] = PAPER_RMSE
-    metrics["settings"] = vars(args)
+    if paper_track:
+        metrics["paper"] = PAPER_RMSE
+    metrics["settings"] = {**vars(args), "segments": segments, "seeds": list(seeds)}
 
-    print(f"RMSE of the GD estimate, pooled over {args.runs} runs (paper: Lewis et al. 2025)")
+    source = "paper: Lewis et al. 2025" if paper_track else "no paper figures for this track"
+    which = f"seed {seeds.start}" if len(seeds) == 1 else f"seeds {seeds.start}-{seeds[-1]} pooled"
+    print(f"RMSE of the GD estimate, {which} ({source})")
     print(f"{'case':<6}{'part':<9}{'paper':>8}{'paper method':>14}{'ours':>8}   ours per run")
     for case in ("A", "B"):
-        for gd in (300, 500):
-            key = f"rmse_gd{gd}"
-            ours = metrics["ours"][case]
-            per_run = " ".join(f"{r['rmse'][str(gd)]:6.1f}" for r in ours["runs"])
+        ours = metrics["ours"][case]
+        for gd in ours["rmse"]:
+            per_run = " ".join(f"{r['rmse'][gd]:6.1f}" for r in ours["runs"])
+            paper = PAPER_RMSE[case].get(gd) if paper_track else None
             print(
-                f"{case:<6}{'GD ' + str(gd):<9}{PAPER_RMSE[case][key]:8.1f}"
-                f"{metrics['paper_method'][case][key]:14.1f}{ours[key]:8.1f}   {per_run}"
+                f"{case:<6}{'GD ' + gd:<9}{'-' if paper is None else f'{paper:.1f}':>8}"
+                f"{metrics['paper_method'][case]['rmse'][gd]:14.1f}{ours['rmse'][gd]:8.1f}"
+                f"   {per_run}"
             )
     print()
-    head = ("delay up (m)", "delay down", "fast on GD>350", "90% cover", "time (s)", "x real time")
-    print(f"{'case':<6}{'run':<5}" + "".join(f"{h:>{len(h) + 2}}" for h in head))
+    head = ("fast on GD>350", "90% cover", "time (s)", "x real time")
+    print(f"{'case':<6}{'seed':<6}" + "".join(f"{h:>{len(h) + 2}}" for h in head)
+          + "   delay at each change (m)")  # fmt: skip
     for case in ("A", "B"):
-        for k, r in enumerate(metrics["ours"][case]["runs"], start=1):
-            up, down = (r["detection_delay_m"] + [np.nan, np.nan])[:2]
+        for k, r in zip(seeds, metrics["ours"][case]["runs"], strict=True):
+            delays = " ".join(f"{d:.1f}" for d in r["detection_delay_m"])
             print(
-                f"{case:<6}{k:<5}{up:14.1f}{down:12.1f}{r['fast_on_rough_m']:14.1f} m"
+                f"{case:<6}{k:<6}{r['fast_on_rough_m']:14.1f} m"
                 f"{r['coverage']:11.2f}{r['traversal_time_s']:10.1f}{r['real_time_factor']:13.0f}"
+                f"   {delays}"
             )
     (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
     print(f"\nwrote {out / 'metrics.json'} and the figures gd_trace_*.png, speed_*.png")

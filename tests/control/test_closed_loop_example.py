@@ -1,0 +1,64 @@
+"""examples/closed_loop.py (the README's main job): other tracks and seeds, and its input errors."""
+
+import json
+
+import pytest
+
+from tests._examples import load_example
+
+
+def load_script():
+    return load_example("closed_loop")
+
+
+def test_segments_parse_and_bad_ones_are_named():
+    parse = load_script().parse_segments
+    assert parse("50:300, 50:500,50:300") == ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
+    assert parse("12.5:250") == ((12.5, 250.0),)
+    bad = {"50:300,30": "'30'", "50:300:1": "'50:300:1'", "a:b": "'a:b'", "50:-300": "'50:-300'",
+           "nan:300": "'nan:300'", "": "''"}  # fmt: skip
+    for text, named in bad.items():
+        with pytest.raises(ValueError, match=named):
+            parse(text)
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--track", "40:250,30:700"], "outside the emulator's GD domain"),
+        (["--track", "40:250,30"], "not LENGTH_M:GD"),
+        (["--first-seed", "-2"], "--first-seed must be >= 0"),
+        (["--runs", "0"], "--runs must be >= 1"),
+    ],
+)
+def test_bad_arguments_are_a_usage_error_naming_the_option(tmp_path, capsys, argv, message):
+    with pytest.raises(SystemExit) as exit_info:
+        load_script().main(["--out", str(tmp_path), *argv])
+    assert exit_info.value.code == 2
+    assert message in capsys.readouterr().err
+
+
+def test_another_track_and_seed_give_one_rmse_per_prescribed_gd(tmp_path, capsys):
+    argv = ["--out", str(tmp_path), "--runs", "1", "--first-seed", "7", "--track", "15:250,15:450"]
+    metrics = load_script().main(argv)
+    assert "paper" not in metrics  # the paper's figures belong to the paper's track only
+    assert metrics["settings"]["seeds"] == [7]
+    for key in ("ours", "paper_method"):
+        for case in ("A", "B"):
+            rmse = metrics[key][case]["rmse"]
+            assert set(rmse) == {"250", "450"}
+            assert all(0 < value < 400 for value in rmse.values())
+            (run,) = metrics[key][case]["runs"]
+            assert len(run["detection_delay_m"]) == 1  # one change on this track
+    assert (
+        json.loads((tmp_path / "metrics.json").read_text())["settings"]["track"] == "15:250,15:450"
+    )
+    assert {p.name for p in tmp_path.glob("*.png")} == {
+        f"{kind}_{case}_{key}.png"
+        for kind in ("gd_trace", "speed")
+        for case in ("A", "B")
+        for key in ("ours", "paper_method")
+    }
+    printed = capsys.readouterr().out
+    assert "seed 7 (no paper figures for this track)" in printed
+    assert "GD 250" in printed and "GD 450" in printed
