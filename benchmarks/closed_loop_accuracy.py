@@ -83,10 +83,10 @@ def _model(case: str, method: str, emulator_dir: str | None):
 
 def _run(job: tuple) -> dict:
     """One closed-loop run; returns its per-update traces and metrics."""
-    case, kind, seed, method, cp, extra, emulator_dir = job
+    case, kind, seed, method, cp, extra, emulator_dir, update_every = job
     emu, bcr, likelihood = _model(case, method, emulator_dir)
     if method == "changepoint":
-        bcr = replace(bcr, changepoint=cp)
+        bcr = replace(bcr, changepoint=cp, update_every=update_every)
     simplex = control.Simplex()
     if kind == "steady":
         gd, speed = extra
@@ -110,7 +110,9 @@ def _run(job: tuple) -> dict:
     }  # fmt: skip
 
 
-def jobs_for(name: str, cases, cp, emulator_dir: str | None = None) -> list[tuple]:
+def jobs_for(
+    name: str, cases, cp, emulator_dir: str | None = None, update_every: int | None = None
+) -> list[tuple]:
     out = []
     for case in cases:
         seeds = SETS[name]
@@ -128,7 +130,7 @@ def jobs_for(name: str, cases, cp, emulator_dir: str | None = None) -> list[tupl
         else:  # dev
             out += [(case, "paper", s, "changepoint", cp, None) for s in seeds]
             out += [(case, "random", s + 100, "changepoint", cp, None) for s in seeds]
-    return [(*job, emulator_dir) for job in out]
+    return [(*job, emulator_dir, update_every) for job in out]
 
 
 def coverage(runs) -> float:
@@ -216,6 +218,11 @@ def main() -> None:
         default=None,
         help="band emulators DIR/jackal_{A,B}.gpmsa instead of the shipped ones",
     )
+    parser.add_argument(
+        "--update-every", type=int, default=None,
+        help="samples between estimates of ours (default: one block; less runs interleaved "
+        "change-point filters, control.BCRSettings)",
+    )  # fmt: skip
     args = parser.parse_args()
     names = [n for n in args.sets.split(",") if n]
     unknown = set(names) - set(SETS)
@@ -237,7 +244,7 @@ def main() -> None:
     tic = time.perf_counter()
     out = []
     for name in names:
-        jobs = jobs_for(name, cases, cp, args.emulator_dir)
+        jobs = jobs_for(name, cases, cp, args.emulator_dir, args.update_every)
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             results = list(pool.map(_run, jobs))
         for case in cases:
@@ -248,6 +255,8 @@ def main() -> None:
             if name in ("steady", "steady-dev"):
                 out += report_steady(results, case)
     print(f"closed-loop accuracy, change-point settings: {cp}")
+    if args.update_every:
+        print(f"our estimates every {args.update_every} samples")
     if args.emulator_dir:
         print(f"band emulators from {args.emulator_dir}")
     print("\n".join(out))

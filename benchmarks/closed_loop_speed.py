@@ -1,6 +1,7 @@
 """Speed of the closed loop (vehicle + BCR + Simplex) against real time, and the BCR's latency.
 
     python benchmarks/closed_loop_speed.py [--repeats 3] [--case A] [--method changepoint]
+    python benchmarks/closed_loop_speed.py --update-every 125   # one change-point filter
 
 Prints, for the paper's 150 m track: simulated time, wall time and real-time factor of the whole
 loop (median over repeats), the BCR's share (the time spent in BCR.update, measured separately by
@@ -31,10 +32,16 @@ def main() -> None:
     parser.add_argument(
         "--method", default="changepoint", choices=list(control.METHODS), help="the estimator"
     )
+    parser.add_argument(
+        "--update-every", type=int, default=None,
+        help="samples between estimates (default: the BCR's; 125 = one change-point filter)",
+    )  # fmt: skip
     args = parser.parse_args()
     emu = control.shipped_emulator(args.case, "band" if args.method == "changepoint" else "window")
     noise = float(emu.metadata["noise_std"])
-    settings = control.bcr_settings_for(emu, method=args.method)
+    settings = control.bcr_settings_for(
+        emu, method=args.method, update_every=args.update_every
+    )  # fmt: skip
     tic = time.perf_counter()
     likelihood = control.BCR.from_emulator(emu, settings).model
     prep = time.perf_counter() - tic

@@ -20,7 +20,7 @@ from control.errors import (
     EmulatorMismatchError,
     MissingExtraError,
 )
-from control.estimate import STATUSES, Estimate
+from control.estimate import FAULT_STATUSES, STATUSES, Estimate
 from control.faults import FAULT_KINDS, SensorFault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
@@ -28,7 +28,7 @@ from control.observation_model import BlockScatter, ObservationModel
 from control.robot import ReplayResult, ReplaySettings, record_run, replay_bag
 from control.sensor_checks import SensorLimits
 from control.shipped import shipped_emulator, shipped_emulator_path
-from control.simplex import FAULT_STATUSES, Command, Simplex, SimplexRun
+from control.simplex import Command, Simplex, SimplexRun
 from control.tracker import GDTracker, TrackerSettings
 
 __all__ = [

@@ -6,7 +6,12 @@ Methods (``BCRSettings.method``):
   120 Hz); each block's feature vector (log band powers, `control.feature`) has a likelihood of
   GD from the emulator with the block scatter as known observation noise
   (`control.observation_model`), and a change-point filter (`control.changepoint`) pools every
-  block since the last change of roughness and forgets within a few blocks after one.
+  block since the last change of roughness and forgets within a few blocks after one. With
+  ``update_every`` below the block length, K = ceil(block / update_every) such filters run
+  interleaved ("phases"), each on its own disjoint blocks, which end K * update_every samples
+  apart; every update feeds the block that just ended (the newest block_samples samples) to its
+  phase and reports that phase's posterior: the freshest one (an estimate every update_every
+  samples, at most update_every samples old).
 - ``"window"``: the paper's estimator: the moving buffer of the last 1,000 samples, its log
   variance, the posterior of that window alone under the emulator's prior (paper eqs. 3, 5).
 - ``"filter"`` / ``"tempered"``: the previous default: the paper's windows combined by a grid
@@ -15,7 +20,8 @@ Methods (``BCRSettings.method``):
 
 A block next to a fault may hold part of it (a fault rarely starts or ends on a block boundary):
 when a block is a fault or implausible, the change-point filter also undoes the block before it,
-and skips the block after it.
+and skips the block after it (with phases: every phase undoes its newest block and skips its
+next one, as those overlap the fault's block or the block before or after it).
 
 Every update returns an `Estimate` whose status says why there is no number: ``filling`` (not
 enough contiguous samples yet, or the first block after a fault), ``sensor_fault`` (non-finite
@@ -36,12 +42,19 @@ import numpy as np
 
 from control.changepoint import ChangePointFilter, ChangePointSettings
 from control.errors import ControlError
-from control.estimate import Estimate
+from control.estimate import Estimate, graver_fault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.sensor_checks import SensorLimits, signal_fault, stream_fault
 from control.tracker import GDTracker, TrackerSettings
 
 METHODS = ("changepoint", "window", "filter", "tempered")
+DEFAULT_PHASES = 2
+"""Interleaved change-point filters by default: an estimate every half block (0.53 s at 120 Hz).
+Chosen on the development set of benchmarks/closed_loop_accuracy.py against one filter: the
+paper track's rises are seen 1.2-1.5 m sooner and its GD-500 part is 4-6 units better; 3 or 4
+phases gave no further gain beyond the run-to-run scatter (docs/closed-loop.md)."""
+MAX_PHASES = 8
+"""Most interleaved change-point filters (``block_samples / update_every``) a BCR runs."""
 MAX_SPEED_CHANGE = 0.5
 """A block whose lowest speed is below this fraction of its highest (starting, stopping) carries
 no information for the change-point method: the emulator knows constant speeds only."""
@@ -56,8 +69,11 @@ class BCRSettings:
     Attributes:
         feature: the observation (block feature for "changepoint"; the window for the others).
         method: one of METHODS (see the module docstring).
-        update_every: new samples between estimates (None: the block length for "changepoint",
-            125 for the window methods: about one estimate a second at 120 Hz).
+        update_every: new samples between estimates (None: half a block for "changepoint",
+            DEFAULT_PHASES interleaved filters; 125 for the window methods: about one estimate
+            a second at 120 Hz). For "changepoint", ceil(block / update_every) interleaved
+            filters run (at most MAX_PHASES; see the module docstring); the block length is
+            one filter.
         changepoint: settings of the change-point filter.
         tracker: settings of the window methods' filter.
         max_age_s: an estimate older than this (sample time since its newest information)
@@ -97,10 +113,16 @@ class BCRSettings:
         every = self.samples_per_update
         if not (isinstance(every, int | np.integer) and every >= 1):
             raise ControlError(f"update_every must be an integer >= 1, got {every}")
-        if block and every != self.feature.block_samples:
+        if (
+            block
+            and not self.feature.block_samples / MAX_PHASES <= every <= self.feature.block_samples
+        ):
             raise ControlError(
-                f"the change-point method updates once per block: update_every must equal "
-                f"block_samples = {self.feature.block_samples}, got {every}"
+                f"the change-point method updates at most once per block and runs at most "
+                f"{MAX_PHASES} interleaved filters: update_every must lie in "
+                f"[block_samples / {MAX_PHASES}, block_samples] = "
+                f"[{self.feature.block_samples / MAX_PHASES:g}, {self.feature.block_samples}], "
+                f"got {every}"
             )
         if not block and every > self.feature.block_samples:
             raise ControlError(
@@ -123,12 +145,36 @@ class BCRSettings:
         if self.update_every is not None:
             return self.update_every
         block = self.feature.block_samples
-        return block if self.method == "changepoint" else min(125, block)
+        return -(-block // DEFAULT_PHASES) if self.method == "changepoint" else min(125, block)
+
+    @property
+    def phases(self) -> int:
+        """Interleaved change-point filters: ceil(block_samples / update_every) (1 otherwise)."""
+        if self.method != "changepoint":
+            return 1
+        return -(-self.feature.block_samples // self.samples_per_update)
 
     @property
     def rate_hz(self) -> float:
         """Accelerometer rate, Hz."""
         return self.feature.rate_hz
+
+
+@dataclass
+class _Phase:
+    """One interleaved change-point filter and what the BCR remembers of its blocks."""
+
+    filter: ChangePointFilter
+    pos_block: float = np.nan  # position at the end of its newest block, m
+    pending_m: float = 0.0  # distance of undone blocks, not yet propagated, m
+    data_time: float = np.nan  # sample time of its newest information, s
+    undo: tuple | None = None  # (filter state, data time, distance) before its newest block
+    guard: bool = False  # skip its next block: it may hold the end of a fault
+
+    def reset(self) -> None:
+        self.filter.reset()
+        self.pos_block, self.pending_m, self.data_time = np.nan, 0.0, np.nan
+        self.undo, self.guard = None, False
 
 
 def emulator_domain(emulator) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -157,7 +203,8 @@ class BCR:
             self.speed_range = tuple(model.speed_range)
             self.gd_range = (float(model.gd[0]), float(model.gd[-1]))
             self.gd_name = model.emulator.t_names[0]
-            self.filter = ChangePointFilter(model.gd, s.changepoint)
+            self._phases = [_Phase(ChangePointFilter(model.gd, s.changepoint))
+                            for _ in range(s.phases)]  # fmt: skip
         else:
             if not hasattr(model, "log_likelihood_grid"):
                 raise ControlError(f"method {s.method!r} needs a gpmsa.Calibrator")
@@ -190,6 +237,11 @@ class BCR:
         """Samples per block (change-point) or per window."""
         return self.settings.feature.block_samples
 
+    @property
+    def filter(self) -> ChangePointFilter:
+        """The change-point filter of the newest estimate (the only one without phases)."""
+        return self._phases[self._phase].filter
+
     def reset(self) -> None:
         """Empty the buffers and forget the GD state."""
         self._acc = np.empty(0)  # contiguous clean samples (block or window)
@@ -201,21 +253,22 @@ class BCR:
         self._pos_last = np.nan
         self._clock = np.nan  # the caller's clock (update's now=), newest value
         self._clock_start = np.nan  # its first value (silence before any sample)
-        self._pos_block = np.nan  # position at the end of the last block the filter saw
         self._n_updates = 0
         self._data_time = np.nan
-        self._undo = None  # (filter state, data time, distance) before the newest block
-        self._guard = False  # skip the next block: it may hold the end of a fault
+        self._phase = 0  # the change-point phase of the newest update
         self._tracked_at: list[float | None] = [None] * len(getattr(self, "trackers", ()))
         if self.settings.method == "changepoint":
-            self.filter.reset()
+            for phase in self._phases:
+                phase.reset()
         else:
             for tracker in self.trackers:
                 tracker.reset()
         self.last = Estimate(time=0.0, position=0.0, status="filling", reason="no samples yet")
 
     def update(self, t, position, accel, speed, *, now: float | None = None) -> Estimate:
-        """Take new samples; return the newest estimate (or why there is none).
+        """Take new samples; return the newest estimate (or why there is none), or the gravest
+        fault (``FAULT_STATUSES``) that this call's samples gave, if any: a caller that feeds
+        more than ``update_every`` samples at once still sees every fault.
 
         Args:
             t: (n,) sample times, s, increasing by 1 / rate_hz (a larger step means dropped
@@ -249,6 +302,7 @@ class BCR:
         )
         every = self.settings.samples_per_update
         start = 0
+        fault = None  # the gravest fault found by this call's updates
         while start < n:
             stop = min(n, start + every - self._received)
             part = slice(start, stop)
@@ -258,9 +312,10 @@ class BCR:
             start = stop
             if self._received == every:
                 self.last = self._estimate()
+                fault = graver_fault(fault, self.last)
                 self._received = 0
                 self._n_updates += 1
-        return self._check_silence(self._check_age(self.last))
+        return self._check_silence(self._check_age(fault or self.last))
 
     # --- internals -------------------------------------------------------------------------------
 
@@ -305,12 +360,15 @@ class BCR:
             data_time=est.data_time,
         )  # fmt: skip
 
-    def _block_distance(self) -> float:
-        """Metres since the end of the last block the filter saw (0 before any)."""
+    def _block_distance(self, phase: _Phase) -> float:
+        """Metres since the end of the last block ``phase`` saw (0 before any), with the
+        distance of its undone blocks."""
         _, pos = self._now()
-        ds = pos - self._pos_block if np.isfinite(self._pos_block) else 0.0
-        self._pos_block = pos
-        return max(float(ds), 0.0)
+        ds = pos - phase.pos_block if np.isfinite(phase.pos_block) else 0.0
+        phase.pos_block = pos
+        ds = max(float(ds), 0.0) + phase.pending_m
+        phase.pending_m = 0.0
+        return ds
 
     def _estimate(self) -> Estimate:
         if self.settings.method == "changepoint":
@@ -322,32 +380,60 @@ class BCR:
         return Estimate(t_now, pos_now, status, reason, data_time=self._data_time, **kw)
 
     def _signal_reason(self, accel: np.ndarray) -> str:
-        return signal_fault(accel[-self.settings.samples_per_update :], self.settings.sensor)
+        """The signal checks on the new samples of a window, or on a whole block."""
+        if self.settings.method != "changepoint":
+            accel = accel[-self.settings.samples_per_update :]
+        return signal_fault(accel, self.settings.sensor)
 
     # --- the change-point method -----------------------------------------------------------------
 
-    def _skip_block(self, ds: float, status: str, reason: str, **kw) -> Estimate:
-        """No information from this block; a fault or an implausible block also undoes the
-        block before it and makes the next one skipped (they may hold part of it)."""
-        if self._undo is not None:
-            state, data_time, ds_before = self._undo
-            self.filter.restore(state)
-            self._data_time = data_time
-            ds += ds_before
+    def _skip_block(self, phase: _Phase, ds: float, status: str, reason: str, **kw) -> Estimate:
+        """No information from this block; a fault or an implausible block also undoes every
+        phase's newest block (the block before it, and those overlapping it) and makes every
+        phase skip its next block (they may hold part of it)."""
+        undone = False
+        for other in self._phases:
+            if other.undo is not None:
+                state, data_time, ds_before = other.undo
+                other.filter.restore(state)
+                other.data_time = data_time
+                if other is phase:
+                    ds += ds_before
+                else:
+                    other.pending_m += ds_before
+                undone = True
+            other.undo = None
+            other.guard = True
+        if undone:
             reason += "; the block before it is undone"
-        self._undo = None
-        self._guard = True
-        self.filter.predict(ds)
+        self._data_time = self._newest_data_time()
+        phase.filter.predict(ds)
         return self._no_estimate(status, reason, **kw)
+
+    def _newest_data_time(self) -> float:
+        times = [p.data_time for p in self._phases if np.isfinite(p.data_time)]
+        return max(times) if times else np.nan
 
     def _estimate_changepoint(self) -> Estimate:
         s = self.settings
-        ds = self._block_distance()
+        self._phase = self._n_updates % len(self._phases)
+        phase = self._phases[self._phase]
+        ds = self._block_distance(phase)
         acc, spd = self._acc, self._spd
-        self._acc, self._spd = np.empty(0), np.empty(0)
-        if self._fault or acc.size < s.feature.block_samples:
-            reason, self._fault = self._fault or "incomplete block", ""
-            return self._skip_block(ds, "sensor_fault", reason + "; block skipped")
+        if len(self._phases) == 1:
+            self._acc, self._spd = np.empty(0), np.empty(0)
+        if self._fault:
+            reason, self._fault = self._fault, ""
+            return self._skip_block(phase, ds, "sensor_fault", reason + "; block skipped")
+        if acc.size < s.feature.block_samples:  # (re)starting, with phases
+            phase.undo = None
+            if np.isfinite(phase.data_time):
+                phase.filter.predict(ds)
+            else:  # its first block starts its run, as the first block without phases does
+                phase.pos_block = np.nan
+            return self._no_estimate(
+                "filling", f"block holds {acc.size} of {s.feature.block_samples} samples"
+            )
         tic = _time.perf_counter()
         v = float(np.mean(spd))
         lo, hi = self.speed_range
@@ -358,17 +444,19 @@ class BCR:
         elif np.min(spd) < MAX_SPEED_CHANGE * np.max(spd):
             why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"
         if why:  # the emulator knows constant speeds in its range only
-            self._undo = None
-            self.filter.predict(ds)
-            if not np.isfinite(self._data_time):
+            phase.undo = None
+            phase.filter.predict(ds)
+            if not np.isfinite(phase.data_time):
                 return self._no_estimate("out_of_domain", why, speed=v)
-            return self._posterior_estimate("no new information: " + why, tic, v, None)
+            return self._posterior_estimate(phase, "no new information: " + why, tic, v, None)
         bad_signal = self._signal_reason(acc)
         if bad_signal:
-            return self._skip_block(ds, "sensor_fault", bad_signal, speed=v)
+            return self._skip_block(phase, ds, "sensor_fault", bad_signal, speed=v)
         y = block_features(acc, s.feature)[0]
         if not np.all(np.isfinite(y)):
-            return self._skip_block(ds, "sensor_fault", "a band of the block has no power", speed=v)
+            return self._skip_block(
+                phase, ds, "sensor_fault", "a band of the block has no power", speed=v
+            )
         d2, p = self.model.plausibility(y, v)
         if p < s.plausibility_p:
             why = (
@@ -376,22 +464,24 @@ class BCR:
                 f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = {p:.2g} < "
                 f"{s.plausibility_p:g})"
             )
-            return self._skip_block(ds, "implausible", why, speed=v, feature=y, plausibility_p=p)
-        if self._guard:
-            self._guard = False
-            self._undo = None
-            self.filter.predict(ds)
+            return self._skip_block(
+                phase, ds, "implausible", why, speed=v, feature=y, plausibility_p=p
+            )
+        if phase.guard:
+            phase.guard = False
+            phase.undo = None
+            phase.filter.predict(ds)
             return self._no_estimate(
                 "filling", "first block after a fault: skipped (it may hold its end)", speed=v
             )
-        self._undo = (self.filter.state(), self._data_time, ds)
-        self.filter.update(self.model.loglik(y, v), ds)
-        self._data_time = self._now()[0]
-        return self._posterior_estimate("", tic, v, y)
+        phase.undo = (phase.filter.state(), phase.data_time, ds)
+        phase.filter.update(self.model.loglik(y, v), ds)
+        phase.data_time = self._data_time = self._now()[0]
+        return self._posterior_estimate(phase, "", tic, v, y)
 
-    def _posterior_estimate(self, reason: str, tic: float, v: float, y) -> Estimate:
+    def _posterior_estimate(self, phase: _Phase, reason: str, tic: float, v: float, y) -> Estimate:
         t_now, pos_now = self._now()
-        post = self.filter.posterior(self.gd_name)
+        post = phase.filter.posterior(self.gd_name)
         name = self.gd_name
         return Estimate(
             t_now,
@@ -405,8 +495,8 @@ class BCR:
             latency_s=_time.perf_counter() - tic,
             speed=v,
             feature=y,
-            prob_change=self.filter.prob_change_within(self.settings.recent_change_m),
-            data_time=self._data_time,
+            prob_change=phase.filter.prob_change_within(self.settings.recent_change_m),
+            data_time=phase.data_time,
         )
 
     # --- the window methods (the paper's, and the previous filters) -----------------------------

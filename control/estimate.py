@@ -18,6 +18,23 @@ STATUSES = (
     "calibration_failed",
     "stale",
 )
+#: The statuses that say the sensor or its signal failed (the Simplex latches on them).
+FAULT_STATUSES = ("sensor_fault", "implausible")
+
+
+def graver_fault(first: Estimate | None, second: Estimate) -> Estimate | None:
+    """The graver of two estimates as faults (None if neither is one): a sensor fault before an
+    implausible block (the earlier of two sensor faults), else the less plausible block."""
+    if second.status not in FAULT_STATUSES:
+        return first
+    if first is None:
+        return second
+    if second.status == "sensor_fault" and first.status != "sensor_fault":
+        return second
+    both_implausible = first.status == second.status == "implausible"
+    if both_implausible and second.plausibility_p < first.plausibility_p:
+        return second
+    return first
 
 
 @dataclass(frozen=True, eq=False)

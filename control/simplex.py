@@ -40,12 +40,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
-from control.estimate import Estimate
+from control.estimate import FAULT_STATUSES, Estimate
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
 #: Estimate statuses that mean the sensor, not the ground, is wrong.
-FAULT_STATUSES = ("sensor_fault", "implausible")
 
 
 @dataclass(frozen=True)

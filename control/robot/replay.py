@@ -369,7 +369,7 @@ def replay_recording(
     n_full = t.size // every
     ests, cmds, ends = [], [], []
     controller = simplex.start()
-    for k in tqdm(range(n_full), disable=not progress, unit="block", leave=False):
+    for k in tqdm(range(n_full), disable=not progress, unit="update", leave=False):
         part = slice(k * every, (k + 1) * every)
         est = estimator.update(t[part], pos[part], a[part], spd[part], now=t[part.stop - 1])
         ests.append(est)
@@ -378,7 +378,7 @@ def replay_recording(
     if t.size > n_full * every:
         tail = slice(n_full * every, None)
         estimator.update(t[tail], pos[tail], a[tail], spd[tail], now=t[-1])
-        notes.append(f"the last {t.size - n_full * every} samples did not fill a block")
+        notes.append(f"the last {t.size - n_full * every} samples did not fill an update")
     bcr_s = time.perf_counter() - tic
 
     ends = np.asarray(ends, dtype=int)

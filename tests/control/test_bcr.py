@@ -6,11 +6,21 @@ from control_doubles import FakeBlockModel, FakeCalibrator, log_f, stream
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from control import BCR, PAPER_WINDOW, STATUSES, BCRSettings, ControlError, SensorFault
+from control import (
+    BCR,
+    PAPER_WINDOW,
+    STATUSES,
+    BCRSettings,
+    ControlError,
+    Estimate,
+    SensorFault,
+)
 from control.faults import apply_faults
 from control.sensor_checks import MIN_SEGMENT
 
 WINDOW = {"feature": PAPER_WINDOW}
+ONE_FILTER = {"update_every": 125}  # one change-point filter: an estimate per 125-sample block
+EVERY = BCRSettings().samples_per_update  # the default: two interleaved filters
 
 
 def feed(bcr, t, p, a, v, chunk=125):
@@ -28,7 +38,7 @@ def const(gd):
 
 
 def test_every_block_gives_an_estimate_that_pools_on_steady_ground(block_model):
-    ests = feed(BCR(block_model), *stream(const(400), 1.5, 60, seed=1))
+    ests = feed(BCR(block_model, **ONE_FILTER), *stream(const(400), 1.5, 60, seed=1))
     assert all(e.ok for e in ests) and len(ests) == 58  # 7,200 samples fed in 58 chunks
     assert block_model.calls == 57  # one per complete 125-sample block, none filling
     # pooling: the estimates beat what one block alone says about GD
@@ -68,7 +78,7 @@ def test_a_fault_skips_its_block_and_keeps_the_run_length_posterior(block_model)
     t, p, a, v = stream(const(400), 1.5, 40, seed=2)
     a = a.copy()
     a[2510:2520] = np.nan
-    bcr = BCR(block_model)
+    bcr = BCR(block_model, **ONE_FILTER)
     k = 2510 // 125
     ests = feed(bcr, t[: (k + 2) * 125], p[: (k + 2) * 125], a[: (k + 2) * 125], v[: (k + 2) * 125])
     # the run-length posterior is that of the clean blocks before the undone one, carried over
@@ -96,6 +106,66 @@ def test_a_fault_skips_its_block_and_keeps_the_run_length_posterior(block_model)
     assert ests[k + 2].ok
 
 
+def test_interleaved_phases_each_pool_their_own_disjoint_blocks(block_model):
+    """update_every = 63 of 125: two filters, each on blocks ending 126 samples apart; every
+    update reports the filter whose block just ended."""
+    from control import ChangePointFilter
+    from control.feature import block_features
+
+    t, p, a, v = stream(const(400), 1.5, 30, seed=4)
+    bcr = BCR(block_model, update_every=63)
+    ests = feed(bcr, t, p, a, v, chunk=63)
+    assert ests[0].status == "filling" and "63 of 125" in ests[0].reason
+    assert all(e.ok for e in ests[1:])
+    # one likelihood per update after the first: each block is the newest 125 samples
+    n_updates = t.size // 63
+    assert block_model.calls == n_updates - 1
+    step = 1.5 * 126 / 120  # metres between the ends of one phase's blocks
+    for last in (n_updates - 1, n_updates - 2):  # the newest update of each phase
+        ends = [63 * (u + 1) for u in range(last % 2, last + 1, 2) if u >= 1]
+        ref = ChangePointFilter(block_model.gd, bcr.settings.changepoint)
+        for j, end in enumerate(ends):
+            y = block_features(a[end - 125 : end], bcr.settings.feature)[0]
+            ref.update(block_model.loglik(y, 1.5), 0.0 if j == 0 else step)
+        np.testing.assert_allclose(
+            ests[last].posterior.grids["GD"].density, ref.posterior().grids["GD"].density,
+            rtol=1e-9,
+        )  # fmt: skip
+    # each estimate as well pooled as those of one filter
+    one = feed(BCR(block_model), t, p, a, v)
+    assert ests[-1].gd_sd == pytest.approx(one[-1].gd_sd, rel=0.15)
+
+
+def test_with_phases_a_fault_undoes_and_skips_the_blocks_around_it_in_every_phase(block_model):
+    t, p, a, v = stream(const(400), 1.5, 40, seed=2)
+    a = a.copy()
+    a[2510:2520] = np.nan  # in the update ending at sample 2520 (63 * 40)
+    bcr = BCR(block_model, update_every=63)
+    ests = []
+    for start in range(0, t.size, 63):
+        part = slice(start, start + 63)
+        ests.append(bcr.update(t[part], p[part], a[part], v[part]))
+        if start + 63 == 2331:  # update 36, phase 0's block before its newest one at the fault
+            kept = bcr._phases[0].filter.state()
+        if start + 63 == 2520:
+            at_fault = bcr._phases[0].filter.state(), bcr._phases[0].pending_m
+    k = 2520 // 63 - 1  # that update; the gap after the NaN samples is seen at the next one
+    assert [e.status for e in ests[k - 1 : k + 5]] == [
+        "ok", "sensor_fault", "sensor_fault", "filling", "filling", "ok"
+    ]  # fmt: skip
+    assert "non-finite accel" in ests[k].reason and "block before it is undone" in ests[k].reason
+    assert "gap" in ests[k + 1].reason
+    # the first complete block after the restart, in each phase, may hold the fault's end
+    assert all("first block after a fault" in e.reason for e in ests[k + 2 : k + 4])
+    assert all(e.ok for e in ests[k + 4 :]) and abs(ests[-1].gd_mean - 400) < 60
+    # the other phase's newest block (update 38, overlapping the faulty block) was taken back:
+    # its filter is as after update 36, and that block's distance waits for its next update
+    (mass, dist, has_data), pending = at_fault
+    np.testing.assert_array_equal(mass, kept[0])
+    np.testing.assert_array_equal(dist, kept[1])
+    assert has_data and pending == pytest.approx(1.5 * 126 / 120)
+
+
 @pytest.mark.parametrize(
     ("kind", "magnitude", "status", "words"),
     [
@@ -117,11 +187,42 @@ def test_each_fault_kind_gives_no_estimate_and_the_bcr_recovers(
     t, p, a, v = stream(const(400), 1.5, 30, seed=5)
     fault = SensorFault(10.0, 2.0, kind, magnitude)
     obs = apply_faults(t, p, a, v, [fault], np.random.default_rng(0))
-    ests = feed(BCR(block_model), *obs)
-    hit = [e for e in ests if 10.0 <= e.time < 12.0 + 125 / 120]
+    bcr = BCR(block_model)
+    every = bcr.settings.samples_per_update  # one update per call, as in the closed loop
+    ests = feed(bcr, *obs, chunk=every)
+    ends = t[every - 1 :: every]  # the time of each call's last sample
+    hit = [e for e, end in zip(ests, ends, strict=False) if 10.0 <= end < 12.0 + 125 / 120]
     assert hit and all(not e.ok for e in hit[1:-1])
     assert any(e.status == status and words in e.reason for e in hit)
     assert ests[-1].ok and abs(ests[-1].gd_mean - 400) < 60
+
+
+def test_a_call_with_many_updates_returns_its_gravest_fault_not_only_the_newest(block_model):
+    t, p, a, v = stream(const(400), 1.5, 30, seed=5)
+    a = a.copy()
+    a[1200:1210] = np.nan  # a fault 10 s into a 30 s call: later updates are "ok" again
+    bcr = BCR(block_model)
+    est = bcr.update(t, p, a, v)
+    assert est.status == "sensor_fault" and "non-finite accel" in est.reason
+    assert bcr.last.ok  # the newest estimate, which the next call starts from
+    nxt = bcr.update(t[-1] + np.arange(1, EVERY + 1) / 120, p[-1] + 1.5 * np.arange(1, EVERY + 1)
+                     / 120, a[:EVERY], v[:EVERY])  # fmt: skip
+    assert nxt.ok
+
+
+def test_the_gravest_fault_is_a_sensor_fault_else_the_least_plausible_block():
+    from control.estimate import graver_fault
+
+    def est(status, p=np.nan, tag=""):
+        return Estimate(0.0, 0.0, status, tag, plausibility_p=p)
+
+    ok, filling = est("ok"), est("filling")
+    low, high = est("implausible", 1e-9, "low"), est("implausible", 1e-7, "high")
+    first, second = est("sensor_fault", tag="first"), est("sensor_fault", tag="second")
+    assert graver_fault(None, ok) is None and graver_fault(high, filling) is high
+    assert graver_fault(None, high) is high and graver_fault(high, low) is low
+    assert graver_fault(low, high) is low and graver_fault(low, first) is first
+    assert graver_fault(first, low) is first and graver_fault(first, second) is first
 
 
 SHAPE_FAULTS = ("scale", "quantize", "clip", "stuck")
@@ -207,18 +308,19 @@ def test_a_silent_sensor_is_a_fault_when_the_caller_gives_its_clock(block_model)
 
 
 @settings(max_examples=25, deadline=None)
-@given(missing=st.integers(1, 124))
+@given(missing=st.integers(1, EVERY - 1))
 def test_with_an_exact_clock_any_missing_trailing_sample_is_a_fault(missing):
     """The closed loop's setting (max_silence_s below one sample period): samples missing at
     the end of an update are a fault at that update, however few."""
     bcr = BCR(FakeBlockModel(), max_silence_s=0.5 / 120)
     t, p, a, v = stream(const(400), 1.5, 10, seed=1)
-    n = 125 * 8
-    for k in range(0, n, 125):  # on time, every sample: estimates
-        assert bcr.update(t[k : k + 125], p[k : k + 125], a[k : k + 125], v[k : k + 125],
-                          now=t[k + 124]).ok  # fmt: skip
-    keep = slice(n, n + 125 - missing)
-    est = bcr.update(t[keep], p[keep], a[keep], v[keep], now=t[n + 124])
+    n = EVERY * 16
+    for k in range(0, n, EVERY):  # on time, every sample: estimates (after the first block)
+        est = bcr.update(t[k : k + EVERY], p[k : k + EVERY], a[k : k + EVERY], v[k : k + EVERY],
+                         now=t[k + EVERY - 1])  # fmt: skip
+        assert est.ok or k + EVERY < 125
+    keep = slice(n, n + EVERY - missing)
+    est = bcr.update(t[keep], p[keep], a[keep], v[keep], now=t[n + EVERY - 1])
     assert est.status == "sensor_fault" and "no samples for" in est.reason
 
 
@@ -230,8 +332,12 @@ def test_speed_outside_the_domain_before_any_estimate(block_model):
 def test_changepoint_settings_are_checked(block_model):
     with pytest.raises(ControlError, match="needs the log_band_power feature"):
         BCR(block_model, method="changepoint", feature=PAPER_WINDOW)
-    with pytest.raises(ControlError, match="update_every must equal block_samples"):
-        BCR(block_model, update_every=100)
+    for every in (126, 15):  # more than a block; more than 8 phases
+        with pytest.raises(ControlError, match=r"update_every must lie in .* = \[15.625, 125\]"):
+            BCR(block_model, update_every=every)
+    with pytest.raises(ControlError, match="update_every must be an integer >= 1"):
+        BCR(block_model, update_every=0)
+    assert BCRSettings(update_every=63).phases == 2 and BCRSettings(update_every=16).phases == 8
     with pytest.raises(ControlError, match="needs an ObservationModel"):
         BCR(FakeCalibrator())
     bcr = BCR(block_model)

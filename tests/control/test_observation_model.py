@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 import control
@@ -162,11 +162,14 @@ def test_a_dead_stretch_of_six_samples_or_more_is_a_fault_wherever_it_lies(
     start, length, kind, seed
 ):
     """Property: a sensor that goes dead (a gain of 1e-4, stuck, clipped at 1e-3 m/s^2,
-    quantised in steps of 1e3 m/s^2) for >= 6 samples anywhere in a block is a fault."""
+    quantised in steps of 1e3 m/s^2) for >= 6 samples anywhere in a block is a fault. (A gain
+    over the whole block is no dead stretch: to the signal checks it is a quieter road, and the
+    plausibility check refuses it: test_bcr.)"""
     a = 3 * np.random.default_rng(seed).standard_normal(125)
     stop = min(start + length, 125)
     if stop - start < 6:
         start = stop - 6
+    assume(not (kind == "scale" and stop - start == 125))
     part = a[start:stop]
     a[start:stop] = {
         "scale": 1e-4 * part,

@@ -74,9 +74,9 @@ def test_block_samples_option_sets_the_bcrs_block(tmp_path):
     emu = gpmsa.load(tmp_path / "emulators" / "jackal_A.gpmsa")
     assert control.FeatureSpec.from_dict(emu.metadata["feature"]).block_samples == 80
     settings = control.bcr_settings_for(emu)
-    assert settings.feature.block_samples == settings.samples_per_update == 80
+    assert settings.feature.block_samples == 80 and settings.samples_per_update == 40
     r = control.run_closed_loop(roadgen.track([(10, 300)], seed=2), emu, seed=2)
-    assert np.median(np.diff(r.time)) == pytest.approx(80 / 120)  # one update per block
+    assert np.median(np.diff(r.time)) == pytest.approx(40 / 120)  # two phases of 80-sample blocks
     assert (r.status == "ok").mean() > 0.7
 
 
