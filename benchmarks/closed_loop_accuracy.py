@@ -21,6 +21,10 @@ Sets (run k drives a track synthesised with seed k, and noise seed k):
   tracks seeds 201-232), and ``steady-dev``: the steady roads with seeds 601-603; they share no
   seed with the others.
 
+On the paper's track the report also gives the speed steps: updates on steady ground (15 m or
+more past the start of a segment) whose speed command moved by more than 0.2 m/s from the update
+before, per run: how much the estimate's scatter shakes the robot.
+
 ``--emulator-dir DIR`` takes the band emulators ``DIR/jackal_{A,B}.gpmsa`` (as written by
 ``examples/train_emulator.py --emulator-dir DIR``) instead of the shipped ones.
 
@@ -107,7 +111,20 @@ def _run(job: tuple) -> dict:
         "position": r.position, "mean": r.gd_mean, "lo": r.gd_lo, "hi": r.gd_hi,
         "true": r.gd_true, "errors": r.metrics.gd_errors, "delays": r.metrics.detection_delay_m,
         "steps": [s for s in steps if s[0] != s[1]], "wall": r.metrics.wall_time_s,
+        "speed_steps": speed_steps(r.position, r.command, segments),
     }  # fmt: skip
+
+
+def speed_steps(position, command, segments, margin_m: float = 15.0, step_mps: float = 0.2) -> int:
+    """Updates whose speed command moved by more than ``step_mps`` from the update before, on
+    steady ground: farther than ``margin_m`` past the start of a segment (the first segment
+    included) and within it."""
+    starts = np.cumsum([0.0] + [length for length, _ in segments])
+    steady = np.zeros(position.size, bool)
+    for a, b in zip(starts[:-1], starts[1:], strict=True):
+        steady |= (position > a + margin_m) & (position < b)
+    moved = np.abs(np.diff(command)) > step_mps
+    return int(np.sum(moved & steady[1:] & steady[:-1]))
 
 
 def jobs_for(
@@ -154,10 +171,12 @@ def report_paper(results, name: str, case: str) -> list[str]:
         if method == "changepoint" and name != "dev":
             ok = "  target " + ("met" if rmse[300.0] <= 35 and rmse[500.0] <= 60 else "NOT met")
         paper = f"(paper {PAPER_RMSE[(case, 300.0)]:.1f} / {PAPER_RMSE[(case, 500.0)]:.1f})"
+        steps = np.mean([r["speed_steps"] for r in runs])
         lines.append(
             f"{case:<3}{name:<9}{label:<16}{len(runs):>4} runs  RMSE GD-300 {rmse[300.0]:6.1f}  "
             f"GD-500 {rmse[500.0]:6.1f} {paper}  cover {coverage(runs):.2f}  "
-            f"median rise delay {np.median(rises) if rises else np.nan:4.1f} m{ok}"
+            f"median rise delay {np.median(rises) if rises else np.nan:4.1f} m  "
+            f"speed steps {steps:4.1f} a run{ok}"
         )
     return lines
 

@@ -10,8 +10,8 @@ Methods (``BCRSettings.method``):
   ``update_every`` below the block length, K = ceil(block / update_every) such filters run
   interleaved ("phases"), each on its own disjoint blocks, which end K * update_every samples
   apart; every update feeds the block that just ended (the newest block_samples samples) to its
-  phase and reports that phase's posterior: the freshest one (an estimate every update_every
-  samples, at most update_every samples old).
+  phase and reports the phases' posteriors pooled, the phase whose block ended j updates ago
+  weighing K - j (an estimate every update_every samples; the default is two phases).
 - ``"window"``: the paper's estimator: the moving buffer of the last 1,000 samples, its log
   variance, the posterior of that window alone under the emulator's prior (paper eqs. 3, 5).
 - ``"filter"`` / ``"tempered"``: the previous default: the paper's windows combined by a grid
@@ -40,19 +40,21 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from control.changepoint import ChangePointFilter, ChangePointSettings
+from control.changepoint import ChangePointFilter, ChangePointSettings, mixture_posterior
 from control.errors import ControlError
 from control.estimate import Estimate, graver_fault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.sensor_checks import SensorLimits, signal_fault, stream_fault
 from control.tracker import GDTracker, TrackerSettings
+from gpmsa import Posterior
 
 METHODS = ("changepoint", "window", "filter", "tempered")
 DEFAULT_PHASES = 2
 """Interleaved change-point filters by default: an estimate every half block (0.53 s at 120 Hz).
 Chosen on the development set of benchmarks/closed_loop_accuracy.py against one filter: the
-paper track's rises are seen 1.2-1.5 m sooner and its GD-500 part is 4-6 units better; 3 or 4
-phases gave no further gain beyond the run-to-run scatter (docs/closed-loop.md)."""
+paper track's rises are seen ~1 m sooner, its GD-500 part is 1-4 units better and the speed
+command moves half as often; 3 or 4 phases gave no further gain beyond the run-to-run scatter
+(docs/closed-loop.md, "How often to estimate")."""
 MAX_PHASES = 8
 """Most interleaved change-point filters (``block_samples / update_every``) a BCR runs."""
 MAX_SPEED_CHANGE = 0.5
@@ -481,7 +483,7 @@ class BCR:
 
     def _posterior_estimate(self, phase: _Phase, reason: str, tic: float, v: float, y) -> Estimate:
         t_now, pos_now = self._now()
-        post = phase.filter.posterior(self.gd_name)
+        post, prob_change = self._pooled_posterior()
         name = self.gd_name
         return Estimate(
             t_now,
@@ -495,8 +497,28 @@ class BCR:
             latency_s=_time.perf_counter() - tic,
             speed=v,
             feature=y,
-            prob_change=phase.filter.prob_change_within(self.settings.recent_change_m),
+            prob_change=prob_change,
             data_time=phase.data_time,
+        )
+
+    def _pooled_posterior(self) -> tuple[Posterior, float]:
+        """(GD posterior, P(a change within recent_change_m)) of the phases pooled: a mixture in
+        which the phase whose block ended j updates ago weighs K - j, the share of the newest
+        block's worth of samples it has seen (one phase: its own posterior)."""
+        K, newest, recent = len(self._phases), self._phase, self.settings.recent_change_m
+        if K == 1:
+            only = self._phases[0].filter
+            return only.posterior(self.gd_name), only.prob_change_within(recent)
+        used = [
+            (ph.filter, K - (newest - j) % K)
+            for j, ph in enumerate(self._phases)
+            if ph.filter.has_data
+        ]  # fmt: skip
+        filters, weights = [f for f, _ in used], np.array([w for _, w in used], dtype=float)
+        change = np.array([f.prob_change_within(recent) for f in filters])
+        return (
+            mixture_posterior(filters, weights, self.gd_name),
+            float(weights @ change / weights.sum()),
         )
 
     # --- the window methods (the paper's, and the previous filters) -----------------------------

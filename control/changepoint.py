@@ -155,6 +155,11 @@ class ChangePointFilter:
         self._mass, self._dist, self._has_data = mass.copy(), dist.copy(), has_data
 
     @property
+    def has_data(self) -> bool:
+        """Whether any block has updated the filter since its reset."""
+        return self._has_data
+
+    @property
     def gd_mass(self) -> np.ndarray:
         """Posterior mass of GD per grid node (G,)."""
         return self._mass.sum(axis=0)
@@ -171,15 +176,34 @@ class ChangePointFilter:
 
     def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
         """The GD posterior as a gpmsa Posterior holding the grid marginal (draws made lazily)."""
-        mass = self.gd_mass
-        with np.errstate(divide="ignore"):
-            log_density = np.log(mass) - np.log(self._weights)
-        marginal = GridMarginal.from_log_density(self.gd, log_density, self._weights)
-        return Posterior(
-            grids={name: marginal},
-            draw=lambda: {name: marginal.sample(np.random.default_rng(0), n_draws)},
-            info={"method": "changepoint", "names": (name,)},
+        return _grid_posterior(self.gd, self._weights, self.gd_mass, name, n_draws)
+
+
+def mixture_posterior(
+    filters: list[ChangePointFilter], weights, name: str = "GD", n_draws: int = 4000
+) -> Posterior:
+    """The mixture of the GD posteriors of filters on one GD grid, with (positive) weights."""
+    w = np.asarray(weights, dtype=float)
+    if not filters or w.shape != (len(filters),) or not np.all(np.isfinite(w) & (w > 0)):
+        raise ControlError(
+            f"mixture_posterior needs one finite positive weight per filter: {len(filters)} "
+            f"filter(s), weights {w.tolist()}"
         )
+    if any(not np.array_equal(f.gd, filters[0].gd) for f in filters[1:]):
+        raise ControlError("mixture_posterior needs filters on one GD grid")
+    mass = (w[:, None] * np.array([f.gd_mass for f in filters])).sum(axis=0) / w.sum()
+    return _grid_posterior(filters[0].gd, filters[0]._weights, mass, name, n_draws)
+
+
+def _grid_posterior(gd, weights, mass, name: str, n_draws: int) -> Posterior:
+    with np.errstate(divide="ignore"):
+        log_density = np.log(mass) - np.log(weights)
+    marginal = GridMarginal.from_log_density(gd, log_density, weights)
+    return Posterior(
+        grids={name: marginal},
+        draw=lambda: {name: marginal.sample(np.random.default_rng(0), n_draws)},
+        info={"method": "changepoint", "names": (name,)},
+    )
 
 
 def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:

@@ -108,8 +108,9 @@ def test_a_fault_skips_its_block_and_keeps_the_run_length_posterior(block_model)
 
 def test_interleaved_phases_each_pool_their_own_disjoint_blocks(block_model):
     """update_every = 63 of 125: two filters, each on blocks ending 126 samples apart; every
-    update reports the filter whose block just ended."""
+    update reports their mixture, the phase whose block just ended weighing 2, the other 1."""
     from control import ChangePointFilter
+    from control.changepoint import mixture_posterior
     from control.feature import block_features
 
     t, p, a, v = stream(const(400), 1.5, 30, seed=4)
@@ -121,18 +122,21 @@ def test_interleaved_phases_each_pool_their_own_disjoint_blocks(block_model):
     n_updates = t.size // 63
     assert block_model.calls == n_updates - 1
     step = 1.5 * 126 / 120  # metres between the ends of one phase's blocks
+    refs = {}
     for last in (n_updates - 1, n_updates - 2):  # the newest update of each phase
         ends = [63 * (u + 1) for u in range(last % 2, last + 1, 2) if u >= 1]
-        ref = ChangePointFilter(block_model.gd, bcr.settings.changepoint)
+        ref = refs[last] = ChangePointFilter(block_model.gd, bcr.settings.changepoint)
         for j, end in enumerate(ends):
             y = block_features(a[end - 125 : end], bcr.settings.feature)[0]
             ref.update(block_model.loglik(y, 1.5), 0.0 if j == 0 else step)
-        np.testing.assert_allclose(
-            ests[last].posterior.grids["GD"].density, ref.posterior().grids["GD"].density,
-            rtol=1e-9,
-        )  # fmt: skip
-    # each estimate as well pooled as those of one filter
-    one = feed(BCR(block_model), t, p, a, v)
+        phase = bcr._phases[last % 2].filter
+        np.testing.assert_allclose(phase.gd_mass, ref.gd_mass, rtol=1e-9, atol=1e-300)
+    pooled = mixture_posterior([refs[n_updates - 1], refs[n_updates - 2]], [2.0, 1.0])
+    np.testing.assert_allclose(
+        ests[-1].posterior.grids["GD"].density, pooled.grids["GD"].density, rtol=1e-9
+    )
+    # each estimate at least as well pooled as those of one filter
+    one = feed(BCR(block_model, **ONE_FILTER), t, p, a, v)
     assert ests[-1].gd_sd == pytest.approx(one[-1].gd_sd, rel=0.15)
 
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from control import ChangePointFilter, ChangePointSettings, ControlError
+from gpmsa.calibration.posterior import trapezoid_weights
 
 GD = np.geomspace(200.0, 600.0, 121)
 
@@ -101,3 +102,20 @@ def test_bad_settings_and_inputs():
         f.predict(-1.0)
     with pytest.raises(ControlError, match="increasing 1-D grid"):
         ChangePointFilter(np.array([3.0, 2.0, 1.0]))
+
+
+def test_a_mixture_of_filters_needs_one_grid_and_positive_weights():
+    from control.changepoint import mixture_posterior
+
+    gd = np.geomspace(200, 600, 41)
+    a, b = ChangePointFilter(gd), ChangePointFilter(gd)
+    a.update(-0.5 * ((np.log(gd) - np.log(300)) / 0.1) ** 2, 0.0)
+    b.update(-0.5 * ((np.log(gd) - np.log(500)) / 0.1) ** 2, 0.0)
+    mix = mixture_posterior([a, b], [2.0, 1.0]).grids["GD"]
+    expected = (2 * a.gd_mass + b.gd_mass) / 3
+    np.testing.assert_allclose(mix.density * trapezoid_weights(gd), expected, rtol=1e-9)
+    for weights in ([1.0], [1.0, 0.0], [1.0, np.nan]):
+        with pytest.raises(ControlError, match="one finite positive weight per filter"):
+            mixture_posterior([a, b], weights)
+    with pytest.raises(ControlError, match="one GD grid"):
+        mixture_posterior([a, ChangePointFilter(np.geomspace(200, 600, 21))], [1.0, 1.0])
