@@ -10,8 +10,9 @@ Methods (``BCRSettings.method``):
   ``update_every`` below the block length, K = ceil(block / update_every) such filters run
   interleaved ("phases"), each on its own disjoint blocks, which end K * update_every samples
   apart; every update feeds the block that just ended (the newest block_samples samples) to its
-  phase and reports the phases' posteriors pooled, the phase whose block ended j updates ago
-  weighing K - j (an estimate every update_every samples; the default is two phases).
+  phase and reports the phases' posteriors pooled, the phase with the newest information
+  weighing K, the next K - 1, ... (an estimate every update_every samples; the default is two
+  phases).
 - ``"window"``: the paper's estimator: the moving buffer of the last 1,000 samples, its log
   variance, the posterior of that window alone under the emulator's prior (paper eqs. 3, 5).
 - ``"filter"`` / ``"tempered"``: the previous default: the paper's windows combined by a grid
@@ -448,9 +449,9 @@ class BCR:
         if why:  # the emulator knows constant speeds in its range only
             phase.undo = None
             phase.filter.predict(ds)
-            if not np.isfinite(phase.data_time):
+            if not np.isfinite(self._newest_data_time()):
                 return self._no_estimate("out_of_domain", why, speed=v)
-            return self._posterior_estimate(phase, "no new information: " + why, tic, v, None)
+            return self._posterior_estimate("no new information: " + why, tic, v, None)
         bad_signal = self._signal_reason(acc)
         if bad_signal:
             return self._skip_block(phase, ds, "sensor_fault", bad_signal, speed=v)
@@ -479,9 +480,9 @@ class BCR:
         phase.undo = (phase.filter.state(), phase.data_time, ds)
         phase.filter.update(self.model.loglik(y, v), ds)
         phase.data_time = self._data_time = self._now()[0]
-        return self._posterior_estimate(phase, "", tic, v, y)
+        return self._posterior_estimate("", tic, v, y)
 
-    def _posterior_estimate(self, phase: _Phase, reason: str, tic: float, v: float, y) -> Estimate:
+    def _posterior_estimate(self, reason: str, tic: float, v: float, y) -> Estimate:
         t_now, pos_now = self._now()
         post, prob_change = self._pooled_posterior()
         name = self.gd_name
@@ -498,23 +499,24 @@ class BCR:
             speed=v,
             feature=y,
             prob_change=prob_change,
-            data_time=phase.data_time,
+            data_time=self._newest_data_time(),
         )
 
     def _pooled_posterior(self) -> tuple[Posterior, float]:
         """(GD posterior, P(a change within recent_change_m)) of the phases pooled: a mixture in
-        which the phase whose block ended j updates ago weighs K - j, the share of the newest
-        block's worth of samples it has seen (one phase: its own posterior)."""
-        K, newest, recent = len(self._phases), self._phase, self.settings.recent_change_m
-        if K == 1:
+        which the phase with the newest information weighs K, the next K - 1, and so on (in
+        steady driving: the share of the newest block's worth of samples each has seen; while
+        no information comes, the weights stay). One phase: its own posterior."""
+        recent = self.settings.recent_change_m
+        if len(self._phases) == 1:
             only = self._phases[0].filter
             return only.posterior(self.gd_name), only.prob_change_within(recent)
-        used = [
-            (ph.filter, K - (newest - j) % K)
-            for j, ph in enumerate(self._phases)
-            if ph.filter.has_data
-        ]  # fmt: skip
-        filters, weights = [f for f, _ in used], np.array([w for _, w in used], dtype=float)
+        # at least one phase has data: an estimate is made only then
+        used = sorted(
+            (ph for ph in self._phases if ph.filter.has_data), key=lambda ph: -ph.data_time
+        )
+        filters = [ph.filter for ph in used]
+        weights = np.arange(len(self._phases), len(self._phases) - len(used), -1, dtype=float)
         change = np.array([f.prob_change_within(recent) for f in filters])
         return (
             mixture_posterior(filters, weights, self.gd_name),
