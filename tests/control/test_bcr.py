@@ -140,6 +140,21 @@ def test_interleaved_phases_each_pool_their_own_disjoint_blocks(block_model):
     assert ests[-1].gd_sd == pytest.approx(one[-1].gd_sd, rel=0.15)
 
 
+def test_with_phases_the_estimate_holds_still_while_no_information_comes(block_model):
+    """Crawling (speed below the emulator's range): no phase learns anything, so the pooled
+    estimate must not alternate with the phase that happens to update; it only drifts as the
+    chance of a change grows with the distance crawled."""
+    t, p, a, v = stream(const(400), 1.5, 12, seed=6)
+    t2, p2, a2, v2 = stream(const(400), 0.2, 3, seed=7, t0=t[-1], s0=p[-1])
+    bcr = BCR(block_model)
+    feed(bcr, t, p, a, v, chunk=EVERY)
+    still = feed(bcr, t2, p2, a2, v2, chunk=EVERY)[2:]  # the first blocks straddle the stop
+    assert len(still) >= 3 and all(e.ok and "no new information" in e.reason for e in still)
+    steps = np.diff([e.gd_mean for e in still])
+    assert np.all(steps < 0) or np.all(steps > 0)  # one way, not back and forth
+    assert np.max(np.abs(steps)) < 0.5 and len({e.data_time for e in still}) == 1
+
+
 def test_with_phases_a_fault_undoes_and_skips_the_blocks_around_it_in_every_phase(block_model):
     t, p, a, v = stream(const(400), 1.5, 40, seed=2)
     a = a.copy()
