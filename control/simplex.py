@@ -44,7 +44,6 @@ from control.estimate import FAULT_STATUSES, Estimate
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
-#: Estimate statuses that mean the sensor, not the ground, is wrong.
 
 
 @dataclass(frozen=True)
