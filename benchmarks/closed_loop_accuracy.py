@@ -239,8 +239,8 @@ def main() -> None:
     )
     parser.add_argument(
         "--update-every", type=int, default=None,
-        help="samples between estimates of ours (default: one block; less runs interleaved "
-        "change-point filters, control.BCRSettings)",
+        help="samples between estimates of ours (default: the BCR's, half a block: two "
+        "interleaved change-point filters; 125 = one filter; control.BCRSettings)",
     )  # fmt: skip
     args = parser.parse_args()
     names = [n for n in args.sets.split(",") if n]

@@ -257,7 +257,7 @@ class BCR:
         self._clock = np.nan  # the caller's clock (update's now=), newest value
         self._clock_start = np.nan  # its first value (silence before any sample)
         self._n_updates = 0
-        self._data_time = np.nan
+        self._data_time = np.nan  # newest information of the window methods (phases keep theirs)
         self._phase = 0  # the change-point phase of the newest update
         self._tracked_at: list[float | None] = [None] * len(getattr(self, "trackers", ()))
         if self.settings.method == "changepoint":
@@ -380,7 +380,7 @@ class BCR:
 
     def _no_estimate(self, status: str, reason: str, **kw) -> Estimate:
         t_now, pos_now = self._now()
-        return Estimate(t_now, pos_now, status, reason, data_time=self._data_time, **kw)
+        return Estimate(t_now, pos_now, status, reason, data_time=self._newest_data_time(), **kw)
 
     def _signal_reason(self, accel: np.ndarray) -> str:
         """The signal checks on the new samples of a window, or on a whole block."""
@@ -409,11 +409,13 @@ class BCR:
             other.guard = True
         if undone:
             reason += "; the block before it is undone"
-        self._data_time = self._newest_data_time()
         phase.filter.predict(ds)
         return self._no_estimate(status, reason, **kw)
 
     def _newest_data_time(self) -> float:
+        """Sample time of the newest information any estimate rests on, s (NaN before any)."""
+        if self.settings.method != "changepoint":
+            return self._data_time
         times = [p.data_time for p in self._phases if np.isfinite(p.data_time)]
         return max(times) if times else np.nan
 
@@ -422,9 +424,7 @@ class BCR:
         self._phase = self._n_updates % len(self._phases)
         phase = self._phases[self._phase]
         ds = self._block_distance(phase)
-        acc, spd = self._acc, self._spd
-        if len(self._phases) == 1:
-            self._acc, self._spd = np.empty(0), np.empty(0)
+        acc, spd = self._acc, self._spd  # the newest block_samples contiguous samples
         if self._fault:
             reason, self._fault = self._fault, ""
             return self._skip_block(phase, ds, "sensor_fault", reason + "; block skipped")
@@ -479,7 +479,7 @@ class BCR:
             )
         phase.undo = (phase.filter.state(), phase.data_time, ds)
         phase.filter.update(self.model.loglik(y, v), ds)
-        phase.data_time = self._data_time = self._now()[0]
+        phase.data_time = self._now()[0]
         return self._posterior_estimate("", tic, v, y)
 
     def _posterior_estimate(self, reason: str, tic: float, v: float, y) -> Estimate:

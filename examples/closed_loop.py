@@ -90,8 +90,8 @@ def run_case(
 
 
 def summarise(results, gds: list[float]) -> dict:
-    """Pooled RMSE per prescribed GD (keys ``str(int(gd))``), pooled interval coverage and the
-    per-run metrics."""
+    """Pooled RMSE per prescribed GD (keys ``f"{gd:g}"``, as the per-run metrics'), pooled
+    interval coverage and the per-run metrics."""
     errors = [r.metrics.gd_errors for r in results]
     ok = np.concatenate([np.isfinite(r.gd_mean) for r in results])
     lo, hi, true = (

@@ -193,8 +193,8 @@ def main(argv: list[str] | None = None) -> None:
     )
     parser.add_argument(
         "--block-samples", type=int, default=BAND_FEATURE.block_samples,
-        help="samples per block of the band emulators (the change-point BCR updates once a "
-        "block and takes the length from the emulator file; the default 125 is the length the "
+        help="samples per block of the band emulators (the change-point BCR takes the length "
+        "from the emulator file and updates twice a block; the default 125 is the length the "
         "BCR's settings and sensor checks were chosen for: docs/closed-loop.md)",
     )  # fmt: skip
     args = parser.parse_args(argv)
