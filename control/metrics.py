@@ -65,12 +65,14 @@ def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDE
 
 
 def pooled_rmse(errors: Sequence[Sequence[GDError]], gd: float) -> float:
-    """RMSE at prescribed GD `gd` pooled over several runs (all their estimates together)."""
+    """RMSE at prescribed GD `gd` pooled over several runs (all their estimates together).
+
+    NaN when no run made an estimate there (a part shorter than the first block), as
+    `GDError.rmse` for one run.
+    """
     sse = sum(e.sse for run in errors for e in run if e.gd == gd)
     n = sum(e.n for run in errors for e in run if e.gd == gd)
-    if n == 0:
-        raise ControlError(f"no estimates on parts with prescribed GD {gd}")
-    return float(np.sqrt(sse / n))
+    return float(np.sqrt(sse / n)) if n else float("nan")
 
 
 def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[float, ...]:

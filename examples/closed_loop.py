@@ -16,7 +16,8 @@ Each case is run twice: with our estimator (default: the change-point BCR on log
 log variance, the paper's uniform prior: ``method="window"``). The RMSE is that of the
 posterior-mean GD at each estimate's position against the GD prescribed there, pooled over the
 runs, for each prescribed GD of the track; the table prints the paper's figures (on the paper's
-track), the paper's method run here, and ours.
+track), the paper's method run here, and ours. A "-" in the tables (null in metrics.json): no
+estimate on that part (shorter than the first block), or a change the estimate never crossed.
 """
 
 from __future__ import annotations
@@ -59,6 +60,22 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
     return tuple(segments)
 
 
+def figure(value: float, spec: str) -> str:
+    """`value` formatted with `spec`, or "-" when it is NaN (no estimate, a change never seen)."""
+    return "-" if np.isnan(value) else format(value, spec)
+
+
+def json_safe(value):
+    """`value` with every NaN replaced by None, so that metrics.json is strict JSON (null)."""
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_safe(v) for v in value]
+    if isinstance(value, float) and np.isnan(value):
+        return None
+    return value
+
+
 def run_case(
     case: str,
     seeds: range,
@@ -91,15 +108,16 @@ def run_case(
 
 def summarise(results, gds: list[float]) -> dict:
     """Pooled RMSE per prescribed GD (keys ``f"{gd:g}"``, as the per-run metrics'), pooled
-    interval coverage and the per-run metrics."""
+    interval coverage and the per-run metrics; NaN where a part has no estimate."""
     errors = [r.metrics.gd_errors for r in results]
     ok = np.concatenate([np.isfinite(r.gd_mean) for r in results])
     lo, hi, true = (
         np.concatenate([getattr(r, k) for r in results]) for k in ("gd_lo", "gd_hi", "gd_true")
     )
+    covered = (lo[ok] <= true[ok]) & (true[ok] <= hi[ok])
     return {
         "rmse": {f"{gd:g}": control.pooled_rmse(errors, gd) for gd in gds},
-        "coverage": float(np.mean((lo[ok] <= true[ok]) & (true[ok] <= hi[ok]))),
+        "coverage": float(np.mean(covered)) if covered.size else float("nan"),
         "runs": [r.metrics.as_dict() for r in results],
     }
 
@@ -178,12 +196,12 @@ def main(argv: list[str] | None = None) -> dict:
     for case in ("A", "B"):
         ours = metrics["ours"][case]
         for gd in ours["rmse"]:
-            per_run = " ".join(f"{r['rmse'][gd]:6.1f}" for r in ours["runs"])
-            paper = PAPER_RMSE[case].get(gd) if paper_track else None
+            per_run = " ".join(f"{figure(r['rmse'][gd], '.1f'):>6}" for r in ours["runs"])
+            paper = PAPER_RMSE[case].get(gd, np.nan) if paper_track else np.nan
             print(
-                f"{case:<6}{'GD ' + gd:<9}{'-' if paper is None else f'{paper:.1f}':>8}"
-                f"{metrics['paper_method'][case]['rmse'][gd]:14.1f}{ours['rmse'][gd]:8.1f}"
-                f"   {per_run}"
+                f"{case:<6}{'GD ' + gd:<9}{figure(paper, '.1f'):>8}"
+                f"{figure(metrics['paper_method'][case]['rmse'][gd], '.1f'):>14}"
+                f"{figure(ours['rmse'][gd], '.1f'):>8}   {per_run}"
             )
     print()
     head = ("fast on GD>350", "90% cover", "time (s)", "x real time")
@@ -191,13 +209,14 @@ def main(argv: list[str] | None = None) -> dict:
           + "   delay at each change (m)")  # fmt: skip
     for case in ("A", "B"):
         for k, r in zip(seeds, metrics["ours"][case]["runs"], strict=True):
-            delays = " ".join(f"{d:.1f}" for d in r["detection_delay_m"])
+            delays = " ".join(figure(d, ".1f") for d in r["detection_delay_m"])
             print(
                 f"{case:<6}{k:<6}{r['fast_on_rough_m']:14.1f} m"
-                f"{r['coverage']:11.2f}{r['traversal_time_s']:10.1f}{r['real_time_factor']:13.0f}"
-                f"   {delays}"
+                f"{figure(r['coverage'], '.2f'):>11}{r['traversal_time_s']:10.1f}"
+                f"{r['real_time_factor']:13.0f}   {delays}"
             )
-    (out / "metrics.json").write_text(json.dumps(metrics, indent=2, default=float))
+    metrics_json = json.dumps(json_safe(metrics), indent=2, default=float, allow_nan=False)
+    (out / "metrics.json").write_text(metrics_json)
     print(f"\nwrote {out / 'metrics.json'} and the figures gd_trace_*.png, speed_*.png")
     if args.record:
         print(f"wrote one MCAP per run in {args.record} (open in Foxglove with "

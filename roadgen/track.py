@@ -77,8 +77,11 @@ def track(
         )
     lead_max = lengths[0] - (0.5 * blend if len(segs) > 1 else 0.0)
     if lead > lead_max:
+        reach = f", less half of blend_m={blend:g} m" if len(segs) > 1 else ""
         raise RoadgenError(
-            f"lead_in_m={lead_in_m!r} is out of range: allowed [0, {lead_max:.6g}] m"
+            f"lead_in_m={lead_in_m!r} is out of range: allowed [0, {lead_max:.6g}] m "
+            f"(the first segment, {lengths[0]:g} m{reach}); lengthen the first segment or "
+            "shorten lead_in_m"
         )
     n_points = grid_points(float(lengths.sum()), dx)
     unit, settings = unit_road(n_points, dx, seed, band, amplitudes, waviness, lead)

@@ -1,6 +1,7 @@
 """examples/closed_loop.py (the README's main job): other tracks and seeds, and its input errors."""
 
 import json
+import math
 
 import pytest
 
@@ -62,3 +63,14 @@ def test_another_track_and_seed_give_one_rmse_per_prescribed_gd(tmp_path, capsys
     printed = capsys.readouterr().out
     assert "seed 7 (no paper figures for this track)" in printed
     assert "GD 250" in printed and "GD 450" in printed
+
+
+def test_a_part_too_short_for_an_estimate_prints_a_dash_and_writes_null(tmp_path, capsys):
+    # 2 m at <= 2 m/s ends before the paper's method fills its 1,000-sample window.
+    metrics = load_script().main(["--out", str(tmp_path), "--runs", "1", "--track", "2:300"])
+    assert all(math.isnan(metrics["paper_method"][case]["rmse"]["300"]) for case in ("A", "B"))
+    written = json.loads((tmp_path / "metrics.json").read_text())  # strict JSON: no NaN token
+    assert written["paper_method"]["A"]["rmse"]["300"] is None
+    assert "NaN" not in (tmp_path / "metrics.json").read_text()
+    rows = [line.split() for line in capsys.readouterr().out.splitlines() if "GD 300" in line]
+    assert len(rows) == 2 and all(row[3:5] == ["-", "-"] for row in rows)  # paper, paper method

@@ -26,6 +26,9 @@ def test_rmse_is_taken_against_the_gd_at_each_estimate_position():
     assert pooled_rmse([tuple(errs.values()), other], 500) == pytest.approx(
         np.sqrt((400 + 400 + 3600) / 3)
     )
+    # A part without estimates in any run has no RMSE (NaN, as one run's), not an error.
+    no_estimates = gd_errors(TRACK, np.array([10.0]), np.array([np.nan]))
+    assert np.isnan(pooled_rmse([no_estimates], 300)) and np.isnan(no_estimates[0].rmse)
 
 
 def test_detection_delay_is_the_distance_to_the_midpoint_crossing():
