@@ -24,6 +24,18 @@ def _canon(obj) -> str:
     return json.dumps(obj, sort_keys=True, default=str)
 
 
+def _vehicle_diff(trained, model) -> str:
+    """The fields in which the vehicle the emulator was made for differs from ``model``'s."""
+    if not isinstance(trained, dict):
+        return f"emulator {_canon(trained)} vs model {_canon(model.describe())}"
+    used = model.describe()
+    return ", ".join(
+        f"{k}: model {_canon(used.get(k, '(none)'))} vs emulator {_canon(trained.get(k, '(none)'))}"
+        for k in sorted(set(trained) | set(used), key=lambda k: (k != "model", k))  # model first
+        if _canon(trained.get(k)) != _canon(used.get(k))
+    )
+
+
 def emulator_feature(emulator) -> FeatureSpec:
     """The feature the emulator was trained on (its metadata's ``feature``)."""
     meta = dict(getattr(emulator, "metadata", None) or {})
@@ -78,8 +90,7 @@ def check_emulator(
             )
         elif _canon(meta["vehicle"]) != _canon(model.describe()):
             raise EmulatorMismatchError(
-                f"emulator was made for vehicle {_canon(meta['vehicle'])}, "
-                f"not for model {_canon(model.describe())}"
+                f"emulator was made for another vehicle ({_vehicle_diff(meta['vehicle'], model)})"
             )
     if noise_std is not None:
         if "noise_std" not in meta:

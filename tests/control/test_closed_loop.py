@@ -153,7 +153,10 @@ def test_set_up_is_checked_before_the_run(emulator_a):
     with pytest.raises(ControlError, match="seed must be None or an integer >= 0, got -1"):
         run_closed_loop(track, emulator_a, seed=-1)
     stiffer = vehicle.Jackal(tyre_stiffness_n_per_m=30_000.0)
-    with pytest.raises(EmulatorMismatchError, match="made for vehicle"):
+    with pytest.raises(
+        EmulatorMismatchError,
+        match=r"another vehicle \(tyre_stiffness_n_per_m: model 30000.0 vs emulator 20000.0\)",
+    ):
         run_closed_loop(track, emulator_a, model=stiffer)
     far = roadgen.track([(20, 300), (20, 800)], seed=1)
     with pytest.raises(EmulatorMismatchError, match=r"track GD \[800.0\] outside .* \[200, 600\]"):

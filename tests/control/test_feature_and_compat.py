@@ -77,7 +77,7 @@ def test_check_emulator_errors_and_warnings():
     )
     window = BCRSettings(feature=PAPER_WINDOW, method="window")
     check_emulator(emu, model=jackal, noise_std=0.0, bcr=window)  # all agree: silent
-    with pytest.raises(EmulatorMismatchError, match="made for vehicle"):
+    with pytest.raises(EmulatorMismatchError, match=r"another vehicle \(.*model: model \"HalfCar"):
         check_emulator(emu, model=vehicle.HalfCar())
     var = BCRSettings(feature=FeatureSpec("var", 1000), method="window")
     with pytest.raises(EmulatorMismatchError, match="name: BCR 'var' vs emulator 'log_var'"):
