@@ -180,6 +180,21 @@ class _Phase:
         self.undo, self.guard = None, False
 
 
+def _samples(name: str, values) -> np.ndarray:
+    """``values`` as a 1-D float array; ControlError naming ``name`` for anything but real
+    numbers in one dimension (NaN and None are missing samples: sensor faults, not errors)."""
+    a = np.atleast_1d(np.asarray(values))
+    if a.dtype.kind not in "biufO":
+        raise ControlError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    try:
+        a = a.astype(float)
+    except (TypeError, ValueError) as exc:
+        raise ControlError(f"{name} must hold real numbers: {exc}") from None
+    if a.ndim != 1:
+        raise ControlError(f"{name} must be 1-D, got shape {a.shape}")
+    return a
+
+
 def emulator_domain(emulator) -> tuple[tuple[float, float], tuple[float, float]]:
     """(speed range, GD range) of an emulator, native units."""
     dom = emulator.domain
@@ -292,11 +307,14 @@ class BCR:
             if not np.isfinite(self._clock):
                 self._clock_start = now
             self._clock = max(self._clock, now) if np.isfinite(self._clock) else now
-        arrays = [np.atleast_1d(np.asarray(a, dtype=float)) for a in (t, position, accel, speed)]
+        names = ("t", "position", "accel", "speed")
+        arrays = [
+            _samples(name, a) for name, a in zip(names, (t, position, accel, speed), strict=True)
+        ]
         n = arrays[0].size
-        for name, a in zip(("t", "position", "accel", "speed"), arrays, strict=True):
-            if a.ndim != 1 or a.size != n:
-                raise ControlError(f"{name} must be 1-D of length {n} (as t), got shape {a.shape}")
+        for name, a in zip(names, arrays, strict=True):
+            if a.size != n:
+                raise ControlError(f"{name} must have t's length {n}, got {a.size}")
         if n == 0:
             return self._check_silence(self._check_age(self.last))
         t, position, accel, speed = arrays

@@ -267,5 +267,5 @@ def stream_fault(
         what.append(f"{int(backwards.sum())} repeated or backwards time stamp(s)")
     if gap.any():
         worst = float(np.max(step[gap]))
-        what.append(f"a gap of {worst:.4g} s (about {round(worst / dt) - 1} dropped samples)")
+        what.append(f"a gap of {worst:.4g} s (about {round(worst / dt) - 1:.4g} dropped samples)")
     return bad_value | backwards, gap & ~bad_value, " and ".join(what)

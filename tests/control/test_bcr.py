@@ -360,8 +360,15 @@ def test_changepoint_settings_are_checked(block_model):
     with pytest.raises(ControlError, match="needs an ObservationModel"):
         BCR(FakeCalibrator())
     bcr = BCR(block_model)
-    with pytest.raises(ControlError, match="accel must be 1-D of length 3"):
+    with pytest.raises(ControlError, match="accel must have t's length 3, got 2"):
         bcr.update(np.arange(3.0), np.arange(3.0), np.arange(2.0), np.ones(3))
+    with pytest.raises(ControlError, match=r"t must be 1-D, got shape \(2, 2\)"):
+        bcr.update(np.zeros((2, 2)), np.zeros(4), np.zeros(4), np.ones(4))
+    for junk in (["a", "b", "c"], np.ones(3, complex), np.array([b"x"] * 3)):
+        with pytest.raises(ControlError, match="speed must hold real numbers"):
+            bcr.update(np.arange(3.0), np.arange(3.0), np.arange(3.0), junk)
+    with pytest.raises(ControlError, match="position must hold real numbers"):
+        bcr.update(np.arange(3.0), np.array([1.0, "x", 2.0], dtype=object), np.ones(3), np.ones(3))
 
 
 def test_backwards_and_repeated_time_stamps_are_faults(block_model):
