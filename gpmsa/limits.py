@@ -24,6 +24,10 @@ MIB = 1024**2
 MAX_MEMORY_BYTES = 4 * GIB
 """Largest estimated working memory of one call (fit, calibrate, Calibrator, predict, ...)."""
 
+BYTES_PER_HISTOGRAM_BIN = 10_000
+"""matplotlib's memory per histogram bar (one Rectangle patch, about 9 KB measured): what a
+plot's ``bins=`` is charged against ``MAX_MEMORY_BYTES``."""
+
 MAX_OBS_VALUES = 128
 """Largest size d = n_rows * p_u of an observation's reduced data in one calibration. The exact
 likelihood needs a d x d eigendecomposition per theta node (grid) or per proposal (MCMC), so its
@@ -58,7 +62,13 @@ def check_memory(nbytes: float, what: str) -> None:
     ``what`` says what needs the memory and why (e.g. "Calibrator: a 10000000-node grid x 198
     runs"); the message adds the estimate, the limit and how to raise it.
     """
-    if nbytes > MAX_MEMORY_BYTES:
+    limit = MAX_MEMORY_BYTES
+    if isinstance(limit, bool) or not isinstance(limit, int | float) or not limit > 0:
+        raise ResourceLimitError(
+            f"gpmsa.limits.MAX_MEMORY_BYTES must be a number of bytes > 0 (inf: no limit), got "
+            f"{limit!r}"
+        )
+    if nbytes > limit:
         raise ResourceLimitError(
             f"{what} needs about {_size(nbytes)} of memory, above the limit "
             f"gpmsa.limits.MAX_MEMORY_BYTES = {_size(MAX_MEMORY_BYTES)}; use smaller settings, "

@@ -41,7 +41,7 @@ from gpmsa.mcmc.sampler import (
     RHO_PARAMS,
     Chains,
     check_ridge,
-    default_widths,
+    check_step_widths,
     elements,
 )
 from gpmsa.model.priors import Priors
@@ -701,13 +701,8 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
         raise GPMSAError(f"warmup must be an integer >= 0, got {warmup!r}")
     if tune_rounds is None:
         tune_rounds = math.ceil(tuning.N_BURN / n_chains)
-    if tune_rounds < 1 or tune_levels < 2:
-        raise GPMSAError(
-            f"tune_rounds must be >= 1 and tune_levels >= 2, got {tune_rounds}, {tune_levels}"
-        )
-    widths = default_widths(problem)
-    for name, val in (step_widths or {}).items():
-        widths[name] = np.broadcast_to(np.asarray(val, dtype=np.float64), widths[name].shape)
+    tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
+    widths = check_step_widths(step_widths, problem)
     gen = _seed_generator(seed, dev)
     seeds = np.random.SeedSequence(seed).spawn(n_chains)  # chain c starts as the numpy chain c
     firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seeds]

@@ -172,6 +172,7 @@ def calibrate(
             raise GPMSAError(f"{name} must be an integer >= {low}, got {val}")
     if not (isinstance(n_burn, int | np.integer) and 0 <= n_burn < n_samples - 1):
         raise GPMSAError(f"n_burn must be an integer in [0, n_samples - 1), got {n_burn}")
+    tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
     can_fast = backend == "numpy" and discrepancy is None
     if fast is None:

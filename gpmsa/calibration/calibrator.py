@@ -35,7 +35,7 @@ from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weigh
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
-from gpmsa.model.data import check_seed
+from gpmsa.model.data import as_float, check_seed
 
 METHODS = ("auto", "grid", "mcmc")
 RESOLVE_SD = 4.0
@@ -112,6 +112,10 @@ class Calibrator:
         if not (isinstance(n_draws, int | np.integer) and n_draws >= 1):
             raise GPMSAError(f"n_draws must be an integer >= 1, got {n_draws}")
         self.n_draws = int(n_draws)
+        check_memory(  # the draws of theta and lamOs and their grid cells, made lazily
+            8.0 * 3 * self.n_draws * (q + 1),
+            f"Calibrator(n_draws={self.n_draws}): the posterior's draws of {q + 1} parameters",
+        )
         self._n_emulator_draws = n_emulator_draws
         self.emulator_params = emulator_params
         self._entropy = np.random.SeedSequence(check_seed(seed)).entropy
@@ -222,7 +226,7 @@ class Calibrator:
             return np.zeros(theta_unit.shape[0])
         if callable(prior):
             native = self.emulator.standardizer.t_from_unit(theta_unit)
-            vals = np.asarray(prior(native[:, 0] if self.q == 1 else native), dtype=float)
+            vals = as_float(prior(native[:, 0] if self.q == 1 else native), "prior(theta)")
             vals = vals.reshape(-1)
             if vals.size != theta_unit.shape[0]:
                 raise GPMSAError(
@@ -230,7 +234,7 @@ class Calibrator:
                     f" got {vals.size}"
                 )
         else:
-            vals = np.asarray(prior, dtype=float).reshape(-1)
+            vals = as_float(prior, "prior").reshape(-1)
             if vals.size != self._theta_unit.shape[0]:
                 raise GPMSAError(
                     f"prior must be log densities on the Calibrator's grid "

@@ -13,7 +13,7 @@ from gpmsa import limits
 from gpmsa.calibration.model import FixedGP, LamOsPrior
 from gpmsa.errors import GPMSAError, OutsideEmulatorWarning, ResourceLimitError
 from gpmsa.model import categorical
-from gpmsa.model.data import ObsData, check_finite
+from gpmsa.model.data import ObsData, as_float, check_finite
 from gpmsa.model.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
 
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
@@ -93,10 +93,7 @@ def fixed_gp(emulator, params: dict | None = None) -> FixedGP:
 
 
 def _as_rows(value, name: str, ncols: int) -> np.ndarray:
-    try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise GPMSAError(f"{name} must be numeric, got {type(value).__name__}") from exc
+    arr = as_float(value, name)
     if arr.ndim == 0 or (arr.ndim == 1 and arr.size == ncols):
         arr = arr.reshape(1, -1)
     elif arr.ndim == 1 and ncols == 1:
@@ -137,15 +134,14 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     n = x.shape[0]
     std, K = emulator.standardizer, emulator.K
     l_sim = K.shape[0]
-    y = (
-        _as_rows(y_obs, "y_obs", l_sim)
-        if not (l_sim == 1 and np.size(y_obs) == n)
-        else (_as_rows(np.reshape(y_obs, (n, 1)), "y_obs", 1))
-    )
+    y = as_float(y_obs, "y_obs")
+    if l_sim == 1 and y.ndim == 2 and y.size == n:  # a scalar output as one row (1, n)
+        y = y.reshape(n, 1)
+    y = _as_rows(y, "y_obs", l_sim)
     if y.shape[0] != n:
         raise GPMSAError(f"y_obs must have one row per x_obs row ({n}), got {y.shape[0]}")
     d = n * K.shape[1]
-    if d > limits.MAX_OBS_VALUES:
+    if not d <= limits.MAX_OBS_VALUES:  # a NaN limit refuses too
         raise ResourceLimitError(
             f"x_obs/y_obs have {n} rows x {K.shape[1]} basis components = {d} reduced values, "
             f"above gpmsa.limits.MAX_OBS_VALUES = {limits.MAX_OBS_VALUES}: the exact likelihood "

@@ -8,6 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.limits import BYTES_PER_HISTOGRAM_BIN, check_memory
+from gpmsa.model.data import as_float, check_count, check_finite, check_level
 
 
 def trapezoid_weights(nodes: np.ndarray) -> np.ndarray:
@@ -91,6 +93,25 @@ class GridMarginal:
         return self.ppf(rng.random(size))
 
 
+def _checked_samples(samples) -> dict[str, np.ndarray]:
+    """``samples`` as name -> float draws (n_draws, ...); GPMSAError for anything but a dict of
+    string names to non-empty arrays of finite real numbers."""
+    if not isinstance(samples, dict):
+        raise GPMSAError(f"samples must be a dict name -> draws, got {type(samples).__name__}")
+    out = {}
+    for name, draws in samples.items():
+        if not isinstance(name, str):
+            raise GPMSAError(f"samples: parameter names must be strings, got {name!r}")
+        arr = as_float(draws, f"samples[{name!r}]")
+        if arr.ndim == 0 or arr.shape[0] == 0:
+            raise GPMSAError(
+                f"samples[{name!r}] must hold at least one draw, got shape {arr.shape}"
+            )
+        check_finite(arr, f"samples[{name!r}]")
+        out[name] = arr
+    return out
+
+
 class Posterior:
     """Posterior of a calibration, native units.
 
@@ -115,7 +136,7 @@ class Posterior:
     ) -> None:
         if samples is None and draw is None:
             raise GPMSAError("a Posterior needs samples or a draw callable")
-        self._samples = samples
+        self._samples = None if samples is None else _checked_samples(samples)
         self._draw = draw
         self.grids = dict(grids or {})
         self.chains = chains
@@ -151,7 +172,10 @@ class Posterior:
         self._check(name)
         if name in self.grids:
             return self.grids[name].sd()
-        return float(np.std(self.samples[name], ddof=1))
+        draws = self.samples[name]
+        if len(draws) < 2:
+            raise GPMSAError(f"the sd of {name!r} needs at least 2 draws, the posterior has 1")
+        return float(np.std(draws, ddof=1))
 
     def quantile(self, name: str, q: float | np.ndarray) -> float | np.ndarray:
         """Posterior quantile(s) of ``name`` at probability q in [0, 1]."""
@@ -168,8 +192,7 @@ class Posterior:
 
     def interval(self, name: str, level: float = 0.9) -> tuple[float, float]:
         """Central credible interval of ``name`` with probability ``level`` in (0, 1)."""
-        if not 0 < level < 1:
-            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        level = check_level(level)
         lo, hi = self.quantile(name, [(1 - level) / 2, (1 + level) / 2])
         return float(lo), float(hi)
 
@@ -219,6 +242,8 @@ class Posterior:
         from matplotlib.figure import Figure
 
         self._check(name)
+        bins = check_count(bins, "bins")
+        check_memory(BYTES_PER_HISTOGRAM_BIN * bins, f"Posterior.plot: a histogram of {bins} bins")
         if unit is None:
             unit = (self.info.get("units") or {}).get(name, "")
         label = f"{name} ({unit})" if unit else name

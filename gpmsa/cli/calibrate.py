@@ -41,6 +41,8 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
         name, sep, value = item.partition("=")
         if not sep:
             raise GPMSAError(f"--{what} expects NAME=VALUE, got {item!r}")
+        if name.strip() in given:  # the later one silently won
+            raise GPMSAError(f"--{what} {name.strip()} is given twice; give each name once")
         try:
             given[name.strip()] = float(value)
         except ValueError as exc:

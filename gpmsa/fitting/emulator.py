@@ -28,7 +28,7 @@ from gpmsa.io.container import jsonable, read_raw, write_raw
 from gpmsa.limits import check_memory
 from gpmsa.model import categorical as categorical_mod
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import SimData, as_matrix
+from gpmsa.model.data import SimData, as_float, as_matrix, check_count
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
@@ -62,7 +62,7 @@ def _check_params(params: dict, shapes: dict) -> dict[str, np.ndarray]:
     for name, shape in shapes.items():
         if name not in params:
             raise GPMSAError(f"params needs {name!r} (shape {shape}); got keys {sorted(params)}")
-        val = np.array(params[name], dtype=np.float64)
+        val = as_float(params[name], f"params[{name!r}]")
         if val.size != int(np.prod(shape)):
             raise GPMSAError(f"params[{name!r}] must have shape {shape}, got {val.shape}")
         val = val.reshape(shape)
@@ -335,7 +335,8 @@ class Emulator:
             raise GPMSAError("this emulator has no posterior draws (built by from_params)")
         idx = np.arange(self.n_draws)
         if n_draws is not None:
-            idx = np.unique(np.linspace(0, self.n_draws - 1, max(1, n_draws)).astype(int))
+            k = min(check_count(n_draws, "n_draws"), self.n_draws)
+            idx = np.unique(np.linspace(0, self.n_draws - 1, k).astype(int))
         means, vars_ = [], []
         with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
             for i in idx:

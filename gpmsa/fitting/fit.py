@@ -141,6 +141,7 @@ def fit(
         "n_iter": int(n_iter), "n_burn": n_burn, "thin": thin, "n_chains": int(n_chains),
         "tune": bool(tune), "backend": backend, "seed": seed, "point": point,
         "n_pc": int(prep.K.shape[1]), "joint_obs": obs is not None,
+        "obs_lengths": None if obs is None else [int(e.size) for e in obs.experiments],
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),

@@ -24,6 +24,7 @@ import numpy as np
 
 from gpmsa.errors import EmulatorFileError
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
+from gpmsa.model.priors import MAX_PRIOR_SHAPE
 from gpmsa.model.transforms import UNIT_TOL
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -35,9 +36,6 @@ REQUIRED = ("x_unit", "t_unit", "y", "K", "w", "log_post", "y_sd", *STD_FIELDS) 
 CALIBRATION_ARRAYS = ("theta", "theta_native", "lamOs", "betaV", "lamVz")
 PRECISIONS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
 PRIOR_SCALARS = ("theta_mean", "theta_sd", "rho_a", "rho_b", "rho_cap")
-MAX_PRIOR_SHAPE = 1e12
-"""Largest Gamma shape a of a prior in a file (the data corrections give (l_sim - p_u) m / 2;
-a shape of 1e30 would make the lamOs quadrature ask for petabytes)."""
 REL_TOL = 1e-9
 """Relative tolerance of the recomputed redundancies (y_mean, y_sd)."""
 W_TOL = 1e-7

@@ -172,6 +172,8 @@ def write_raw(
     that is not a regular file (a directory, device, FIFO) is refused. ``fmt``: the format
     name written (``FORMAT``, or ``STUDY_FORMAT`` for a study). Returns the path.
     """
+    if not isinstance(path, str | os.PathLike) or not str(path):
+        raise GPMSAError(f"path must be a file name (str or path-like), got {path!r}")
     path = Path(path)
     reserved = sorted(set(manifest) & set(ENVELOPE))
     if reserved:
@@ -195,7 +197,10 @@ def write_raw(
     if mode is not None and not stat.S_ISREG(mode):
         raise GPMSAError(f"{path} exists and is not a regular file: refusing to replace it")
     tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.part")
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    except OSError as exc:  # e.g. a missing folder or one without write permission
+        raise GPMSAError(f"{path}: cannot write ({exc.strerror})") from exc
     try:
         with os.fdopen(fd, "wb") as fh:
             with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED) as zf:

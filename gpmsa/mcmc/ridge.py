@@ -26,6 +26,8 @@ WIDTH = 2.0
 """h: the width of the uniform walk on log lamWs (a factor of e^-1 to e^1)."""
 N_MOVES = 5
 """Default moves per sweep where the move applies (each costs a few microseconds)."""
+MAX_MOVES = 1000
+"""Most moves per sweep (``ridge_moves``): beyond, the moves, not the sweep, take the time."""
 
 
 def applies(problem: Problem) -> bool:

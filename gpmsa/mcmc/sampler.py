@@ -21,7 +21,7 @@ from threadpoolctl import threadpool_limits
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.mcmc import ridge, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
-from gpmsa.model.data import check_seed
+from gpmsa.model.data import as_float, check_count, check_seed
 from gpmsa.model.likelihood import IncrementalLikelihood, log_prior
 from gpmsa.model.problem import Problem
 
@@ -247,14 +247,39 @@ def check_sample_args(n_iter, n_chains, seed) -> None:
 
 def check_ridge(ridge_moves, problem: Problem) -> int:
     """Moves along the nugget ridge per sweep: ``ridge_moves`` (None: the default where the move
-    applies), 0 where it does not apply; GPMSAError for a negative or non-integer value."""
+    applies), 0 where it does not apply; GPMSAError for a value that is not an integer in
+    [0, ``ridge.MAX_MOVES``]."""
     if ridge_moves is None:
         ridge_moves = ridge.N_MOVES
-    if isinstance(ridge_moves, bool) or not isinstance(ridge_moves, (int, np.integer)):
-        raise GPMSAError(f"ridge_moves must be None or an integer >= 0, got {ridge_moves!r}")
-    if ridge_moves < 0:
-        raise GPMSAError(f"ridge_moves must be None or an integer >= 0, got {ridge_moves!r}")
-    return int(ridge_moves) if ridge.applies(problem) else 0
+    n = check_count(ridge_moves, "ridge_moves", 0, ridge.MAX_MOVES)
+    return n if ridge.applies(problem) else 0
+
+
+def check_step_widths(step_widths, problem: Problem) -> dict[str, np.ndarray]:
+    """GPM/SA's initial step widths with ``step_widths`` (None, or a dict name -> a scalar or
+    the parameter's shape) in place; GPMSAError naming an unknown parameter, a wrong shape or a
+    width that is not finite and > 0 (a chain would never move)."""
+    widths = default_widths(problem)
+    if step_widths is None:
+        return widths
+    if not isinstance(step_widths, dict):
+        raise GPMSAError(
+            f"step_widths must be None or a dict name -> widths, got {type(step_widths).__name__}"
+        )
+    for name, val in step_widths.items():
+        if name not in widths:
+            raise GPMSAError(f"step_widths: unknown parameter {name!r}; this model has "
+                             f"{problem.names}")  # fmt: skip
+        shape = widths[name].shape
+        arr = as_float(val, f"step_widths[{name!r}]")
+        if arr.size != 1 and arr.shape != shape:
+            raise GPMSAError(
+                f"step_widths[{name!r}] must be a scalar or have shape {shape}, got {arr.shape}"
+            )
+        if not np.all(np.isfinite(arr) & (arr > 0)):
+            raise GPMSAError(f"step_widths[{name!r}] must be finite and > 0, got {arr.ravel()}")
+        widths[name] = arr.reshape(shape) if arr.size > 1 else np.full(shape, arr.item())
+    return widths
 
 
 def _flat_widths(problem: Problem, els, widths: dict[str, np.ndarray]) -> np.ndarray:
@@ -371,12 +396,10 @@ def sample(
     chain that failed or whose draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
+    tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     how = starts.check_init(init, int(n_chains))
     n_ridge = check_ridge(ridge_moves, problem)
-    widths = default_widths(problem)
-    if step_widths:
-        for name, val in step_widths.items():
-            widths[name] = np.broadcast_to(np.asarray(val, dtype=np.float64), widths[name].shape)
+    widths = check_step_widths(step_widths, problem)
     seq = np.random.SeedSequence(seed)
     tasks = [
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": widths, "seed": s,

@@ -11,9 +11,29 @@ from collections.abc import Callable
 
 import numpy as np
 
+from gpmsa.errors import GPMSAError
+from gpmsa.model.data import check_count
+
 TARGET = 1.0 / np.e
 N_BURN = 50
 N_LEVELS = 20
+MAX_LEVELS = 1000
+"""Most candidate widths per element (``tune_levels``)."""
+MAX_SWEEPS = 1_000_000
+"""Most tuning sweeps per chain (``tune_rounds`` x ``tune_levels``): 1,000 times GPM/SA's."""
+
+
+def check_tuning(tune_rounds, tune_levels) -> tuple[int, int]:
+    """(tune_rounds, tune_levels) as ints: rounds >= 1, levels in [2, MAX_LEVELS], at most
+    ``MAX_SWEEPS`` sweeps in all; GPMSAError naming the argument otherwise."""
+    rounds = check_count(tune_rounds, "tune_rounds", 1, MAX_SWEEPS)
+    levels = check_count(tune_levels, "tune_levels", 2, MAX_LEVELS)
+    if rounds * levels > MAX_SWEEPS:
+        raise GPMSAError(
+            f"tune_rounds x tune_levels = {rounds} x {levels} tuning sweeps per chain, above the "
+            f"most allowed ({MAX_SWEEPS}; GPM/SA's tuning is {N_BURN} x {N_LEVELS})"
+        )
+    return rounds, levels
 
 
 def level_bases(name: str, n_levels: int) -> tuple[float, float]:

@@ -11,15 +11,27 @@ from gpmsa.errors import GPMSAError
 from gpmsa.model import categorical
 
 
+def as_float(value, name: str) -> np.ndarray:
+    """Return ``value`` as a float64 array (a copy); GPMSAError naming ``name`` when it is not
+    real numbers (strings, objects, ragged lists; complex values, which are never cast to their
+    real part)."""
+    try:
+        is_complex = np.iscomplexobj(value)
+        arr = None if is_complex else np.array(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise GPMSAError(f"{name} must be a numeric array, got {type(value).__name__}") from exc
+    if arr is None:
+        raise GPMSAError(f"{name} must hold real numbers, got complex values")
+    return arr
+
+
 def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
     """Return ``value`` as a finite float64 2-D array; a 1-D array becomes one column.
 
-    Raises GPMSAError naming ``name`` for a wrong shape or non-finite entries.
+    Raises GPMSAError naming ``name`` for non-numeric or complex values, a wrong shape or
+    non-finite entries.
     """
-    try:
-        arr = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise GPMSAError(f"{name} must be a numeric array, got {type(value).__name__}") from exc
+    arr = as_float(value, name)
     if arr.ndim == 1:
         arr = arr[:, None]
     if arr.ndim != 2 or arr.shape[0] == 0 or arr.shape[1] == 0:
@@ -40,6 +52,25 @@ def check_finite(arr: np.ndarray, name: str) -> None:
         raise GPMSAError(f"{name} must be finite, got {arr[pos]} at index {pos}")
 
 
+def check_count(value, name: str, low: int = 1, high: int | None = None) -> int:
+    """``value`` as an int >= ``low`` (and <= ``high`` if given); GPMSAError naming ``name``
+    otherwise (a bool, a float, a string or NaN is not a count)."""
+    ok = not isinstance(value, bool) and isinstance(value, int | np.integer)
+    if not ok or value < low or (high is not None and value > high):
+        allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+        raise GPMSAError(f"{name} must be an integer {allowed}, got {value!r}")
+    return int(value)
+
+
+def check_level(level) -> float:
+    """A probability ``level`` of a credible or prediction interval as a float in (0, 1);
+    GPMSAError otherwise (a string, a bool or an array is not a level)."""
+    real = not isinstance(level, bool) and isinstance(level, int | float | np.integer | np.floating)
+    if not (real and 0.0 < level < 1.0):
+        raise GPMSAError(f"level must be a number in (0, 1), got {level!r}")
+    return float(level)
+
+
 MAX_SEED = 2**128
 """Seeds are integers in [0, MAX_SEED) (numpy's SeedSequence takes non-negative integers)."""
 
@@ -58,6 +89,22 @@ def check_seed(seed, name: str = "seed", *, generator: bool = False):
     if not 0 <= int(seed) < MAX_SEED:
         raise GPMSAError(f"{name}={int(seed)} is out of range: allowed integers in [0, 2**128)")
     return int(seed)
+
+
+def output_scale(y: np.ndarray) -> float:
+    """GPM/SA's output scale of simulation outputs ``y`` (m, l): the sd (ddof=1) of all values
+    after centring each column; GPMSAError naming ``y`` when it is zero or not finite (values so
+    large that their squares overflow)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        sd = float(np.std(y - y.mean(axis=0), ddof=1))
+    if not np.isfinite(sd):
+        raise GPMSAError(
+            f"y is too large to standardise: its spread overflows float64 (largest |y| = "
+            f"{np.abs(y).max():.3g}); rescale y (e.g. other units)"
+        )
+    if not sd > 0:
+        raise GPMSAError("y has zero spread after centring each column; the output must vary")
+    return sd
 
 
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
@@ -83,7 +130,7 @@ def _units(units: Sequence[str] | None, n: int, what: str) -> tuple[str, ...]:
 def _index(index, n: int, name: str) -> np.ndarray | None:
     if index is None:
         return None
-    arr = np.array(index, dtype=np.float64).reshape(-1)
+    arr = as_float(index, name).reshape(-1)
     if arr.size != n:
         raise GPMSAError(f"{name} must have {n} entries (one per output column), got {arr.size}")
     check_finite(arr, name)
@@ -139,12 +186,18 @@ class SimData:
                 )
         if np.ptp(y) == 0.0:
             raise GPMSAError(f"y is constant ({y[0, 0]}); the simulation output must vary")
+        output_scale(y)
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "index", _index(self.index, y.shape[1], "index"))
         object.__setattr__(self, "x_names", _names(self.x_names, p, "x", "x_names"))
         object.__setattr__(self, "t_names", _names(self.t_names, q, "t", "t_names"))
+        if shared := sorted(set(self.x_names) & set(self.t_names)):
+            raise GPMSAError(
+                f"x_names and t_names must not share a name (an input is either known or "
+                f"calibrated), got {shared} in both"
+            )
         object.__setattr__(self, "y_names", _names(self.y_names, y.shape[1], "y", "y_names"))
         object.__setattr__(self, "x_units", _units(self.x_units, p, "x_units"))
         object.__setattr__(self, "t_units", _units(self.t_units, q, "t_units"))
@@ -219,9 +272,9 @@ class ObsData:
     @staticmethod
     def _experiments(y, n: int) -> list[np.ndarray]:
         if isinstance(y, (list, tuple)) and any(np.ndim(e) == 1 and np.size(e) > 1 for e in y):
-            ys = [np.array(e, dtype=np.float64).reshape(-1) for e in y]
+            ys = [as_float(e, f"y_obs[{j}]").reshape(-1) for j, e in enumerate(y)]
         else:
-            arr = np.array(y, dtype=np.float64)
+            arr = as_float(y, "y_obs")
             if arr.ndim == 1:
                 arr = arr[:, None] if arr.size == n else arr[None, :]
             if arr.ndim != 2:
@@ -242,9 +295,9 @@ class ObsData:
         if index is None:
             return [None] * len(ys)
         if isinstance(index, (list, tuple)) and len(index) == len(ys) and np.ndim(index[0]) == 1:
-            grids = [np.array(g, dtype=np.float64).reshape(-1) for g in index]
+            grids = [as_float(g, f"index_obs[{j}]").reshape(-1) for j, g in enumerate(index)]
         else:
-            g = np.array(index, dtype=np.float64).reshape(-1)
+            g = as_float(index, "index_obs").reshape(-1)
             grids = [g] * len(ys)
         for j, (g, e) in enumerate(zip(grids, ys, strict=True)):
             if g.size != e.size:
@@ -260,7 +313,7 @@ class ObsData:
             raise GPMSAError(f"precision must have one entry per experiment ({len(ys)})")
         out = []
         for j, (lam, e) in enumerate(zip(precision, ys, strict=True)):
-            lam = np.array(lam, dtype=np.float64)
+            lam = as_float(lam, f"precision[{j}]")
             if lam.ndim == 0:
                 lam = lam * np.eye(e.size)
             if lam.shape != (e.size, e.size):

@@ -10,11 +10,29 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 
 PRECISIONS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
+MAX_PRIOR_SHAPE = 1e12
+"""Largest Gamma shape a of a prior (the data corrections give (l_sim - p_u) m / 2; a shape of
+1e30 would make the lamOs quadrature ask for petabytes); emulator files are held to it too."""
+
+
+def _real(obj, name: str) -> float:
+    """Field ``name`` of ``obj`` as a float, stored back; GPMSAError unless a real number."""
+    value = getattr(obj, name)
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise GPMSAError(
+            f"{type(obj).__name__}.{name} must be a real number, got {value!r} "
+            f"({type(value).__name__})"
+        )
+    object.__setattr__(obj, name, float(value))
+    return float(value)
 
 
 @dataclass(frozen=True)
 class GammaPrior:
-    """Gamma(shape a, rate b) prior on a precision, with open bounds (lower, upper)."""
+    """Gamma(shape a, rate b) prior on a precision, with open bounds (lower, upper).
+
+    Allowed: 0 < a <= ``MAX_PRIOR_SHAPE``, 0 < b finite, 0 <= lower < upper, lower finite.
+    """
 
     a: float
     b: float
@@ -22,12 +40,13 @@ class GammaPrior:
     upper: float = float("inf")
 
     def __post_init__(self) -> None:
-        if not (self.a > 0 and self.b > 0):
-            raise GPMSAError(f"Gamma prior needs a > 0 and b > 0, got a={self.a}, b={self.b}")
-        if not (0 <= self.lower < self.upper):
+        a, b, lower, upper = (_real(self, k) for k in ("a", "b", "lower", "upper"))
+        if not (0 < a <= MAX_PRIOR_SHAPE and 0 < b < math.inf):
             raise GPMSAError(
-                f"Gamma bounds need 0 <= lower < upper, got {self.lower}, {self.upper}"
+                f"Gamma prior needs 0 < a <= {MAX_PRIOR_SHAPE:g} and b > 0 finite, got a={a}, b={b}"
             )
+        if not (0 <= lower < upper and lower < math.inf):
+            raise GPMSAError(f"Gamma bounds need 0 <= lower < upper, got {lower}, {upper}")
 
     def log_density(self, x: np.ndarray) -> float:
         """Unnormalised log density summed over elements; -inf outside the open bounds."""
@@ -58,6 +77,27 @@ class Priors:
     lamWOs: GammaPrior = field(default_factory=lambda: GammaPrior(5.0, 5e-3, 60.0, 1e5))
     lamOs: GammaPrior = field(default_factory=lambda: GammaPrior(1.0, 1e-3))
     corrected: bool = False
+
+    def __post_init__(self) -> None:
+        allowed = {
+            "theta_mean": "finite",
+            "theta_sd": "finite and > 0",
+            "rho_a": "finite and > 0",
+            "rho_b": "finite and > 0",
+            "rho_cap": "in (0, 1)",
+        }
+        for name, rule in allowed.items():
+            v = _real(self, name)
+            ok = 0 < v < 1 if name == "rho_cap" else math.isfinite(v) and (
+                name == "theta_mean" or v > 0)  # fmt: skip
+            if not ok:
+                raise GPMSAError(f"Priors.{name} must be {rule}, got {v}")
+        for name in PRECISIONS:
+            if not isinstance(getattr(self, name), GammaPrior):
+                raise GPMSAError(f"Priors.{name} must be a gpmsa.GammaPrior, got "
+                                 f"{getattr(self, name)!r}")  # fmt: skip
+        if not isinstance(self.corrected, bool):
+            raise GPMSAError(f"Priors.corrected must be True or False, got {self.corrected!r}")
 
     def with_data(self, wos: tuple[float, float], os: tuple[float, float] = (0.0, 0.0)) -> Priors:
         """Add GPM/SA's data corrections (delta a, delta b) to the lamWOs and lamOs priors.

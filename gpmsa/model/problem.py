@@ -13,7 +13,7 @@ from gpmsa.model import categorical
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
 from gpmsa.model.constraints import ThetaConstraint
-from gpmsa.model.data import ObsData, SimData
+from gpmsa.model.data import ObsData, SimData, check_finite
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
@@ -266,7 +266,10 @@ def reduce_obs(
                 f"experiment {j} has {e.size} values but the simulation output has {K.shape[0]}; "
                 "give ObsData an index grid"
             )
-    ys = [std.y_to_std(e, g) for e, g in zip(obs.experiments, obs.grids, strict=True)]
+    with np.errstate(over="ignore"):  # an overflow gives inf: refused just below
+        ys = [std.y_to_std(e, g) for e, g in zip(obs.experiments, obs.grids, strict=True)]
+    for j, e in enumerate(ys):
+        check_finite(e, f"y_obs[{j}] in standardised units")
     lamy = [np.eye(e.size) for e in ys]
     if obs.precisions is not None:
         lamy = [lam * std.y_sd**2 for lam in obs.precisions]

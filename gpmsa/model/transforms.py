@@ -6,8 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.errors import GPMSAError
-from gpmsa.model.data import SimData
+from gpmsa.model.data import SimData, output_scale
 
 UNIT_TOL = 1e-9
 """Unit-scale values within this distance outside [0, 1] are rounding of the design's edges (a
@@ -45,17 +44,13 @@ class Standardizer:
     @classmethod
     def from_sim(cls, sim: SimData) -> Standardizer:
         """GPM/SA's default transforms fitted to the simulation design and outputs."""
-        centred = sim.y - sim.y.mean(axis=0)
-        sd = float(np.std(centred, ddof=1))
-        if not sd > 0:
-            raise GPMSAError("the simulation outputs have zero spread after centring")
         return cls(
             x_min=sim.x.min(axis=0),
             x_max=sim.x.max(axis=0),
             t_min=sim.t.min(axis=0),
             t_max=sim.t.max(axis=0),
             y_mean=sim.y.mean(axis=0),
-            y_sd=sd,
+            y_sd=output_scale(sim.y),
             grid=sim.grid.copy(),
         )
 

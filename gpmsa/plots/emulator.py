@@ -6,7 +6,7 @@ import numpy as np
 from scipy.special import ndtri
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import SimData
+from gpmsa.model.data import SimData, check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.crossval import CrossValidation
 
@@ -87,8 +87,7 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
         >>> len(fig.axes)
         1
     """
-    if not 0.0 < level < 1.0:
-        raise GPMSAError(f"level must lie in (0, 1), got {level}")
+    level = check_level(level)
     if isinstance(held_out, CrossValidation):
         mean, var, actual = held_out.mean, held_out.var, held_out.y
         what = "cross-validation"

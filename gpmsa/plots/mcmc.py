@@ -7,7 +7,7 @@ import numpy as np
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc.sampler import Chains
-from gpmsa.plots._figure import figure
+from gpmsa.plots._figure import check_bins, figure
 from gpmsa.predictive.joint import calibration_posterior
 
 NUISANCE = ("lamOs", "lamVz")
@@ -87,6 +87,7 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
     """
     series = _series(source)
     picked = _pick(series, names, max_params)
+    bins = check_bins(bins, len(picked), "plots.traces")
     fig = figure(9.0, 1.6 * len(picked) + 0.6)
     axes = np.atleast_2d(fig.subplots(len(picked), 2, width_ratios=[3, 1], squeeze=False))
     for row, name in zip(axes, picked, strict=True):
@@ -135,6 +136,7 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
         raise GPMSAError(f"unknown parameters {unknown}; the posterior has {post.names}")
     truth = dict(truth or {})
     k = len(names)
+    bins = check_bins(bins, k, "plots.theta_pairs")
     fig = figure(2.4 * k + 0.6, 2.4 * k + 0.4)
     axes = fig.subplots(k, k, squeeze=False)
     draws = {n: np.asarray(post.samples[n], dtype=float) for n in names}

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.full import FullPrediction
 
@@ -52,8 +53,7 @@ def prediction_bands(
     """
     if not isinstance(pred, FullPrediction):
         raise GPMSAError(f"pred must be a FullPrediction, got {type(pred).__name__}")
-    if not 0.0 < level < 1.0:
-        raise GPMSAError(f"level must lie in (0, 1), got {level}")
+    level = check_level(level)
     N, l = pred.x.shape[0], pred.grid.size
     if observed is not None:
         observed = np.asarray(observed, dtype=float)

@@ -7,6 +7,7 @@ import warnings
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.sobol import Sensitivity
 
@@ -31,8 +32,7 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
     """
     if not isinstance(sens, Sensitivity):
         raise GPMSAError(f"sens must be a Sensitivity, got {type(sens).__name__}")
-    if not 0.0 < level < 1.0:
-        raise GPMSAError(f"level must lie in (0, 1), got {level}")
+    level = check_level(level)
     q = [(1 - level) / 2, (1 + level) / 2]
     functional = sens.grid.size > 1
     fig = figure(11.0 if functional else 5.5, 4.0)

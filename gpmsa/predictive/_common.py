@@ -12,19 +12,13 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa.errors import GPMSAError
+from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import as_matrix, check_seed
+from gpmsa.model.data import as_matrix, check_count, check_seed
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
-
-
-def check_count(value, name: str, low: int = 1) -> int:
-    """``value`` as an int >= ``low``; GPMSAError naming ``name`` otherwise."""
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
-        raise GPMSAError(f"{name} must be an integer >= {low}, got {value!r}")
-    return int(value)
 
 
 def rng_of(seed) -> np.random.Generator:
@@ -67,8 +61,11 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
 
 
 def gpmsa_model_only(emulator, what: str) -> None:
-    """GPMSAError when ``emulator`` uses categorical inputs or a mean basis, which ``what`` does
-    not support (``Emulator.predict``, ``gpmsa.calibrate`` and ``gpmsa.Calibrator`` do)."""
+    """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or uses categorical inputs or a mean
+    basis, which ``what`` does not support (``Emulator.predict``, ``gpmsa.calibrate`` and
+    ``gpmsa.Calibrator`` do)."""
+    if not isinstance(emulator, Emulator):
+        raise GPMSAError(f"{what} needs a gpmsa.Emulator, got {type(emulator).__name__}")
     used = []
     if any(lv is not None for lv in getattr(emulator, "levels", ())):
         used.append("categorical inputs")

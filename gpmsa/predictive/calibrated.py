@@ -10,6 +10,7 @@ from scipy.special import ndtr
 from gpmsa.calibration.observations import check_x
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import as_float, check_finite, check_level
 
 
 @dataclass(frozen=True, eq=False)
@@ -38,7 +39,9 @@ class CalibratedPrediction:
 
     def cdf(self, y: np.ndarray) -> np.ndarray:
         """P(Y <= y) per point, y (N, l_sim) (or broadcastable)."""
-        z = (np.asarray(y, dtype=float)[None] - self.comp_mean) / np.sqrt(self.comp_var)
+        y = as_float(y, "y")
+        check_finite(y, "y")
+        z = (y[None] - self.comp_mean) / np.sqrt(self.comp_var)
         return np.tensordot(self.weights, ndtr(z), axes=1)
 
     def quantile(self, q: float) -> np.ndarray:
@@ -57,8 +60,7 @@ class CalibratedPrediction:
 
     def interval(self, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central predictive interval of probability ``level``: (lower, upper), (N, l_sim) each."""
-        if not 0.0 < level < 1.0:
-            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        level = check_level(level)
         return self.quantile((1.0 - level) / 2.0), self.quantile((1.0 + level) / 2.0)
 
 

@@ -26,6 +26,7 @@ from scipy.special import ndtr
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import check_level
 from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, rng_of
 
 
@@ -65,8 +66,7 @@ class CrossValidation:
 
     def coverage(self, level: float = 0.9) -> float:
         """Share of held-out values inside their central predictive interval of ``level``."""
-        if not 0.0 < level < 1.0:
-            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        level = check_level(level)
         return float(np.mean(np.abs(self.pit - 0.5) <= level / 2))
 
 

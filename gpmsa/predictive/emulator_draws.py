@@ -20,8 +20,9 @@ import numpy as np
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
+from gpmsa.limits import check_memory
+from gpmsa.model.data import check_count, check_level
 from gpmsa.predictive._common import (
-    check_count,
     factors,
     gpmsa_model_only,
     mvn_factor,
@@ -92,8 +93,7 @@ class EmulatorPrediction:
 
     def interval(self, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval (N, l_sim) of probability ``level`` from the realizations' quantiles."""
-        if not 0.0 < level < 1.0:
-            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        level = check_level(level)
         lo, hi = np.quantile(self.y, [(1 - level) / 2, (1 + level) / 2], axis=0)
         return lo, hi
 
@@ -162,6 +162,11 @@ def emulator_prediction(
     z = np.hstack([xu, tu])
     idx, sets = param_sets(emulator, draws, n_draws, "emulator_prediction")
     S, N, p_u, l_sim = len(sets), z.shape[0], emulator.p_u, emulator.l_sim
+    check_memory(  # the realizations (w, y and its noise), and per set the GP's matrices
+        8.0 * (S * n_rlz * N * (p_u + 3 * l_sim) + 3 * N * emulator.m
+               + (4.0 * p_u * N * N if joint else 0.0)),
+        f"emulator_prediction(n_rlz={n_rlz}, joint={joint}) at {N} points x {S} draws",
+    )  # fmt: skip
     mu = np.empty((S, N, p_u))
     var = np.empty((S, N, p_u))
     w = np.empty((S, n_rlz, N, p_u))

@@ -32,13 +32,13 @@ from scipy.linalg import solve_triangular
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
+from gpmsa.limits import check_memory
 from gpmsa.model.basis import discrepancy_basis, interpolate_basis
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import ObsData, check_finite
+from gpmsa.model.data import ObsData, as_float, check_count, check_finite, check_level
 from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive._common import (
     EMULATOR_PARAMS,
-    check_count,
     factors,
     gpmsa_model_only,
     mvn_factor,
@@ -132,8 +132,7 @@ class FullPrediction:
     def interval(self, what: str = "y", level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval (N, l) of probability ``level`` from the realizations' quantiles."""
         self._check(what)
-        if not 0.0 < level < 1.0:
-            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        level = check_level(level)
         lo, hi = np.quantile(getattr(self, what), [(1 - level) / 2, (1 + level) / 2], axis=0)
         return lo, hi
 
@@ -202,7 +201,7 @@ def _pred_grid(emulator, obs: ObsData, grid):
             raise GPMSAError("a scalar output has no output grid; leave grid=None")
         return std.grid
     if grid is not None:
-        g = np.asarray(grid, dtype=float).reshape(-1)
+        g = as_float(grid, "grid").reshape(-1)
         check_finite(g, "grid")
         lo, hi = std.grid.min(), std.grid.max()
         if g.size == 0 or g.min() < lo or g.max() > hi:
@@ -237,6 +236,37 @@ def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool):
         )
     D = discrepancy_basis(kind, grid)
     return D * (scales.pop() / D[0, 0])
+
+
+def _check_fitted_discrepancy(emulator, discrepancy) -> None:
+    """GPMSAError when ``discrepancy`` is not the basis the joint fit recorded (its settings'
+    "discrepancy": None, "constant", "linear", or "given" for an array, which cannot be compared
+    further)."""
+    settings = getattr(emulator, "settings", None) or {}
+    if "discrepancy" not in settings:
+        return
+    fitted = settings["discrepancy"]
+    as_array = not (discrepancy is None or isinstance(discrepancy, str))
+    if as_array != (fitted == "given") or (not as_array and discrepancy != fitted):
+        given = "an array" if as_array else repr(discrepancy)
+        was = "an array" if fitted == "given" else repr(fitted)
+        raise GPMSAError(
+            f"discrepancy={given} differs from the joint fit's discrepancy ({was}); the draws "
+            "belong to that basis: leave discrepancy= at its default"
+            + (" (or pass the fit's array again)" if fitted == "given" else "")
+        )
+
+
+def _check_fitted_obs(emulator, obs: ObsData) -> None:
+    """GPMSAError when ``obs`` has other experiments (their count or lengths) than the joint
+    fit's, where the fit recorded them (settings "obs_lengths")."""
+    fitted = (getattr(emulator, "settings", None) or {}).get("obs_lengths")
+    lengths = [int(e.size) for e in obs.experiments]
+    if fitted is not None and lengths != list(fitted):
+        raise GPMSAError(
+            f"obs has {len(lengths)} experiment(s) of lengths {lengths}, but the joint fit's had "
+            f"{len(fitted)} of lengths {list(fitted)}: pass the ObsData the fit used"
+        )
 
 
 def full_prediction(
@@ -304,6 +334,10 @@ def full_prediction(
                 "the joint fit used a discrepancy basis given as an array; pass it again as "
                 "discrepancy="
             )
+    elif posterior is None:
+        _check_fitted_discrepancy(emulator, discrepancy)
+    if posterior is None:
+        _check_fitted_obs(emulator, obs)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
     with warnings.catch_warnings():
@@ -321,6 +355,10 @@ def full_prediction(
     N, p_u = xu.shape[0], emulator.p_u
     n_c = p_v + p_u
     S = len(sets)
+    check_memory(  # the draws (latents, eta, delta, y, noise) and per draw the joint covariance
+        8.0 * S * (n_rlz * N * (n_c + 4 * g.size) + N * n_c * n_c) + 8.0 * 4 * (n_c * N) ** 2,
+        f"full_prediction(n_rlz={n_rlz}) at {N} points x {S} draws x {g.size} outputs",
+    )
     mu = np.empty((S, N, n_c))
     cov_pt = np.empty((S, N, n_c, n_c))
     lat = np.empty((S, n_rlz, N, n_c))

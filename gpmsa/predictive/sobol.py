@@ -31,6 +31,7 @@ from scipy.special import erf
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import check_level
 from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, unit_inputs
 
 _SQRT_PI_2 = 0.5 * np.sqrt(np.pi)
@@ -72,8 +73,7 @@ class Sensitivity:
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
         """Per input: the aggregated main and total indices, their mean, sd and central
         interval of probability ``level`` over the draws."""
-        if not 0.0 < level < 1.0:
-            raise GPMSAError(f"level must lie in (0, 1), got {level}")
+        level = check_level(level)
         q = [(1 - level) / 2, (1 + level) / 2]
         out = {}
         for k, name in enumerate(self.names):

@@ -254,6 +254,7 @@ def sample_study(
     do not depend on where it runs: ``n_jobs`` processes or ``executor``, as
     ``gpmsa.mcmc.parallel.run_chains``). ChainError names a chain that failed or whose draws are
     not finite."""
+    tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     how = starts.check_init(init, int(n_chains))
     seq = np.random.SeedSequence(seed)
     tasks = [

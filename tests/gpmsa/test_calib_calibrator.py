@@ -13,6 +13,7 @@ from _calib_cases import (
     with_draws,
 )
 
+import gpmsa
 from gpmsa import Calibrator, GPMSAError, calibrate
 from gpmsa.calibration.posterior import trapezoid_weights
 from gpmsa.mcmc.diagnostics import ess
@@ -201,7 +202,7 @@ def test_mcmc_method_and_auto():
         ([[1.25]], [[12.0, 1.0]], r"y_obs must have shape \(n, 1\)"),
         ([[1.25], [1.5]], [[12.0], [1.0], [3.0]], "y_obs must have one row per x_obs row"),
         ([[3.0]], [[12.0]], r"x_obs v=3 lies outside the emulator's domain \[0.50"),
-        ("fast", [[12.0]], "x_obs must be numeric"),
+        ("fast", [[12.0]], "x_obs must be a numeric array, got str"),
         (
             [[1.25]],
             [[1e200]],
@@ -217,6 +218,56 @@ def test_bad_input_raises(x, y, match):
         cal.log_likelihood_grid(x, y)
     with pytest.raises(GPMSAError, match=match):
         calibrate(road_emulator(), x, y)
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "match"),
+    [(np.array([[1.25 + 0j]]), [[12.0]], "x_obs must hold real numbers, got complex values"),
+     ([[1.25]], np.array([[12.0 + 1j]]), "y_obs must hold real numbers"),
+     ([[1.25]], [[[12.0]]], r"y_obs must have shape \(n, 1\), got \(1, 1, 1\)"),
+     ([[1.25], [1.5]], np.ones((2, 1, 1)), r"y_obs must have shape \(n, 1\)")],
+)  # fmt: skip
+def test_complex_or_3d_observations_are_refused(x, y, match):
+    """A complex array was cast to its real part; a (1, 1, 1) y_obs was read as one value."""
+    cal = Calibrator(road_emulator())
+    with pytest.raises(GPMSAError, match=match):
+        cal.update(x, y)
+    with pytest.raises(GPMSAError, match=match):
+        calibrate(road_emulator(), x, y, n_samples=10, n_burn=1)
+
+
+def test_complex_prior_is_refused_on_the_grid():
+    cal = Calibrator(road_emulator())
+    with pytest.raises(GPMSAError, match="prior must hold real numbers"):
+        cal.update(*road_obs(), prior=np.zeros(129, dtype=complex))
+    with pytest.raises(GPMSAError, match=r"prior\(theta\) must hold real numbers"):
+        cal.update(*road_obs(), prior=lambda gd: np.zeros(np.shape(gd), dtype=complex))
+
+
+def test_huge_n_draws_is_refused_before_allocating():
+    with pytest.raises(
+        gpmsa.ResourceLimitError,
+        match=r"Calibrator\(n_draws=1000000000000\).*gpmsa.limits.MAX_MEMORY_BYTES",
+    ):
+        Calibrator(road_emulator(), n_draws=10**12)
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [({"tune_rounds": 0}, r"tune_rounds must be an integer in \[1, 1000000\], got 0"),
+     ({"tune_rounds": -1}, "tune_rounds must be an integer"),
+     ({"tune_levels": 0}, r"tune_levels must be an integer in \[2, 1000\], got 0"),
+     ({"tune_levels": 1}, "tune_levels must be an integer"),
+     ({"tune_levels": 10**9}, "tune_levels must be an integer"),
+     ({"tune_rounds": 10**9}, "tune_rounds must be an integer"),
+     ({"tune_rounds": 1.5}, "tune_rounds must be an integer"),
+     ({"tune_rounds": 10**4, "tune_levels": 1000}, "tuning sweeps per chain, above the most")],
+)  # fmt: skip
+def test_calibrate_tuning_options_are_bounded_counts(kw, match):
+    """tune_rounds=10**9 hung; 0 rounds or levels left the widths untuned without a word."""
+    for backend in ("numpy", "torch") if "torch" in gpmsa.backends.available() else ("numpy",):
+        with pytest.raises(GPMSAError, match=match):
+            calibrate(road_emulator(), *road_obs(), n_samples=50, n_burn=5, backend=backend, **kw)
 
 
 def test_extrapolation_warns_when_allowed():

@@ -51,6 +51,7 @@ def test_cli_json(emu_file, capsys):
         (["--x", "w=1.25", "--y", "f=12.1"], r"--x needs exactly the names \['v'\]"),
         (["--x", "v=fast", "--y", "f=12.1"], "is not a number"),
         (["--x", "v=1.25", "--y", "f"], "expects NAME=VALUE"),
+        (["--x", "v=1.25", "--x", "v=1.5", "--y", "f=12.1"], "--x v is given twice"),
         (["--x", "v=9", "--y", "f=12.1"], "outside the emulator's domain .*; pass --extrapolate"),
     ],
 )
@@ -104,6 +105,10 @@ def test_calibrated_prediction_quantiles_and_noise():
     pred = calibrated_predict(emu, post, [[1.5]])
     for q in (0.05, 0.5, 0.95):
         assert pred.cdf(pred.quantile(q))[0, 0] == pytest.approx(q, abs=1e-9)
+    with pytest.raises(GPMSAError, match=r"y must be finite, got nan at index \(\)"):
+        pred.cdf(np.nan)  # was a silent NaN probability
+    with pytest.raises(GPMSAError, match="y must hold real numbers"):
+        pred.cdf(1.0 + 0j)
     lo, hi = pred.interval(0.9)
     assert lo[0, 0] < pred.mean[0, 0] < hi[0, 0]
     noisy = calibrated_predict(emu, post, [[1.5]], noise=True)

@@ -261,7 +261,17 @@ def test_oversized_requests_are_refused_before_allocating(monkeypatch):
     monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", 10_000)
     with pytest.raises(gpmsa.ResourceLimitError, match="MAX_MEMORY_BYTES = 10000 bytes"):
         Calibrator(emu)
+    for bad in (float("nan"), -1, "big"):  # NaN compared False: it lifted every limit
+        monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", bad)
+        with pytest.raises(
+            gpmsa.ResourceLimitError,
+            match=r"gpmsa.limits.MAX_MEMORY_BYTES must be a number of bytes > 0",
+        ):
+            Calibrator(emu)
     monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", 4 * 1024**3)
+    monkeypatch.setattr(gpmsa.limits, "MAX_OBS_VALUES", float("nan"))
+    with pytest.raises(gpmsa.ResourceLimitError, match=r"MAX_OBS_VALUES = nan"):
+        Calibrator(emu).update(*road_obs())
     monkeypatch.setattr(gpmsa.limits, "MAX_OBS_VALUES", 2)
     three = np.array([[0.8], [1.2], [1.6]]), np.array([[6.0], [11.0], [17.0]])
     with pytest.raises(gpmsa.ResourceLimitError, match=r"3 reduced values.*MAX_OBS_VALUES = 2"):

@@ -9,7 +9,7 @@ import pytest
 from matplotlib.figure import Figure
 from scipy.stats import norm
 
-from gpmsa import GPMSAError, Posterior
+from gpmsa import GPMSAError, Posterior, ResourceLimitError
 from gpmsa.calibration.posterior import GridMarginal
 
 
@@ -94,9 +94,38 @@ def test_posterior_bad_arguments():
         post.mean("gd")
     with pytest.raises(GPMSAError, match=r"q must lie in \[0, 1\], got 1.5"):
         post.quantile("GD", 1.5)
-    with pytest.raises(GPMSAError, match=r"level must lie in \(0, 1\), got 1.0"):
-        post.interval("GD", 1.0)
+    for level in (1.0, "0.9", True, [0.9], np.nan):
+        with pytest.raises(GPMSAError, match=r"level must be a number in \(0, 1\), got"):
+            post.interval("GD", level)
     with pytest.raises(GPMSAError, match="value must be finite"):
         post.prob_above("GD", np.nan)
     with pytest.raises(GPMSAError, match="needs samples or a draw"):
         Posterior()
+    with pytest.raises(
+        ResourceLimitError, match=r"Posterior.plot: a histogram of 1000000000 bins needs about"
+    ):
+        post.plot("GD", bins=10**9)
+    for bins in (0, 2.5, "auto"):
+        with pytest.raises(GPMSAError, match="bins must be an integer >= 1"):
+            post.plot("GD", bins=bins)
+
+
+@pytest.mark.parametrize(
+    ("samples", "match"),
+    [
+        ([1.0, 2.0], "samples must be a dict"),
+        ({"a": []}, r"samples\['a'\] must hold at least one draw"),
+        ({"a": [np.nan, 1.0]}, r"samples\['a'\] must be finite"),
+        ({"a": ["x", "y"]}, r"samples\['a'\] must be a numeric array"),
+        ({"a": np.ones(3, complex)}, r"samples\['a'\] must hold real numbers"),
+        ({1: [1.0]}, "parameter names must be strings"),
+    ],
+)
+def test_posterior_samples_are_checked_on_construction(samples, match):
+    with pytest.raises(GPMSAError, match=match):
+        Posterior(samples)
+
+
+def test_the_sd_of_one_draw_is_an_error_not_nan():
+    with pytest.raises(GPMSAError, match="needs at least 2 draws"):
+        Posterior({"a": [1.0]}).sd("a")

@@ -213,3 +213,117 @@ def test_inputs_at_a_rounded_domain_edge_count_as_inside():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_x_obs(std.x_to_unit(np.array([[2.0]])), ("v",))
+
+
+@settings(max_examples=30, deadline=None)
+@given(exponent=st.integers(155, 307), sign=st.sampled_from([-1.0, 1.0]))
+def test_outputs_too_large_to_standardise_are_refused(exponent, sign):
+    """y of order 1e155 and beyond: the sd's squares overflow, which gave y_sd = inf and NaN
+    predictions; now SimData refuses y (and so does the Standardizer)."""
+    rng = np.random.default_rng(0)
+    x, t = rng.random((20, 1)), rng.random((20, 1))
+    y = sign * 10.0**exponent * np.sin(3 * x + t)
+    with pytest.raises(gpmsa.GPMSAError, match="y is too large to standardise"):
+        gpmsa.SimData(x=x, t=t, y=y)
+
+
+def test_large_but_standardisable_outputs_and_far_observations():
+    s = sim(l=3)
+    big = gpmsa.SimData(x=s.x, t=s.t, y=s.y * 1e150)
+    std = Standardizer.from_sim(big)
+    assert np.isfinite(std.y_sd) and np.all(np.isfinite(std.y_to_std(big.y)))
+    far = gpmsa.ObsData(x=[[0.5]], y=[[1e308, -1e308, 1e308]])
+    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs\[0\] in standardised units must be finite"):
+        prepare(gpmsa.SimData(x=s.x, t=s.t, y=s.y * 1e-100), far)
+
+
+def test_an_input_cannot_be_both_known_and_calibrated():
+    with pytest.raises(gpmsa.GPMSAError, match=r"x_names and t_names must not share a name.*'a'"):
+        sim(p=2, q=1, x_names=["a", "b"], t_names=["a"])
+
+
+COMPLEX = np.array([[0.5 + 1j]] * 20)
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [({"x": COMPLEX}, "x must hold real numbers, got complex values"),
+     ({"t": COMPLEX + 0j}, "t must hold real numbers"),
+     ({"y": np.sin(np.arange(20.0)) + 0j}, "y must hold real numbers"),  # zero imaginary part
+     ({"x": [[complex(v, 1)] for v in range(20)]}, "x must hold real numbers"),  # a list too
+     ({"index": [1j]}, "index must hold real numbers")],
+)  # fmt: skip
+def test_complex_data_are_refused_not_cast(kw, match):
+    rng = np.random.default_rng(0)
+    base = {"x": rng.random((20, 1)), "t": rng.random((20, 1)), "y": rng.random(20)}
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        gpmsa.SimData(**{**base, **kw})
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [({"y": np.array([[0.3 + 1j]])}, "y_obs must hold real numbers"),
+     ({"y": [np.ones(3) + 0j, np.ones(2)]}, r"y_obs\[0\] must hold real numbers"),
+     ({"x": np.array([[0.5 + 0j]])}, "x_obs must hold real numbers"),
+     ({"index": np.array([1j])}, "index_obs must hold real numbers"),
+     ({"precision": [2 + 1j]}, r"precision\[0\] must hold real numbers"),
+     ({"y": [["a"]]}, "y_obs must be a numeric array")],
+)  # fmt: skip
+def test_complex_observations_are_refused_not_cast(kw, match):
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        gpmsa.ObsData(**{"x": [[0.5]], "y": [[0.3]], **kw})
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [({"theta_sd": 0}, r"Priors.theta_sd must be finite and > 0, got 0.0"),
+     ({"theta_sd": -1.0}, "Priors.theta_sd must be finite and > 0"),
+     ({"theta_mean": float("nan")}, "Priors.theta_mean must be finite, got nan"),
+     ({"rho_a": 0}, "Priors.rho_a must be finite and > 0"),
+     ({"rho_b": float("inf")}, "Priors.rho_b must be finite and > 0"),
+     ({"rho_cap": 2}, r"Priors.rho_cap must be in \(0, 1\), got 2.0"),
+     ({"rho_cap": float("nan")}, r"Priors.rho_cap must be in \(0, 1\)"),
+     ({"rho_a": "a"}, r"Priors.rho_a must be a real number, got 'a' \(str\)"),
+     ({"theta_sd": 1 + 1j}, r"Priors.theta_sd must be a real number, got \(1\+1j\)"),
+     ({"lamUz": {"a": 1}}, "Priors.lamUz must be a gpmsa.GammaPrior"),
+     ({"lamUz": (1, 1)}, "Priors.lamUz must be a gpmsa.GammaPrior"),
+     ({"corrected": "no"}, "Priors.corrected must be True or False")],
+)  # fmt: skip
+def test_priors_are_validated_at_construction(kw, match):
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        gpmsa.Priors(**kw)
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [((float("nan"), 1.0), "Gamma prior needs 0 < a <= 1e\\+12 and b > 0 finite"),
+     ((1.0, float("inf")), "Gamma prior needs"),
+     ((1e13, 1.0), "Gamma prior needs 0 < a <= 1e\\+12"),
+     ((1.0, 1.0, float("nan")), "Gamma bounds need 0 <= lower < upper"),
+     ((1.0, 1.0, 0.0, float("nan")), "Gamma bounds need 0 <= lower < upper"),
+     ((1.0, 1.0, float("inf"), float("inf")), "Gamma bounds need"),
+     (("a", 1.0), r"GammaPrior.a must be a real number, got 'a' \(str\)"),
+     ((1 + 1j, 1.0), "GammaPrior.a must be a real number"),
+     (([1, 2], 1.0), r"GammaPrior.a must be a real number, got \[1, 2\] \(list\)")],
+)  # fmt: skip
+def test_gamma_priors_are_validated_at_construction(args, match):
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        gpmsa.GammaPrior(*args)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    theta_mean=st.floats(-1e3, 1e3),
+    theta_sd=st.floats(1e-3, 1e3),
+    rho_cap=st.floats(0.01, 0.99),
+    a=st.floats(1e-3, 1e12),
+    b=st.floats(1e-12, 1e6),
+)
+def test_valid_priors_round_trip_through_the_file_checks(theta_mean, theta_sd, rho_cap, a, b):
+    """Every Priors the constructor accepts is one the emulator file's validator accepts."""
+    from gpmsa.fitting.validation import check_priors
+
+    pri = gpmsa.Priors(theta_mean=theta_mean, theta_sd=theta_sd, rho_cap=rho_cap,
+                       lamUz=gpmsa.GammaPrior(a, b, 0.3))  # fmt: skip
+    check_priors(pri.to_dict())
+    assert gpmsa.Priors.from_dict(pri.to_dict()) == pri

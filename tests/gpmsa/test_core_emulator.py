@@ -91,3 +91,35 @@ def test_from_params_shape_errors(emu):
         gpmsa.Emulator.from_params(sim, {**PARAMS, "betaU": [1.0, 2.0, 3.0]})
     with pytest.raises(gpmsa.GPMSAError, match=r"params\['lamUz'\] must be finite and > 0"):
         gpmsa.Emulator.from_params(sim, {**PARAMS, "lamUz": [-1.0]})
+    with pytest.raises(gpmsa.GPMSAError, match=r"params\['lamUz'\] must hold real numbers"):
+        gpmsa.Emulator.from_params(sim, {**PARAMS, "lamUz": np.array([1.2 + 0j])})
+
+
+def test_complex_prediction_inputs_are_refused_not_cast(emu):
+    with pytest.raises(gpmsa.GPMSAError, match="x must hold real numbers, got complex values"):
+        emu.predict(np.array([[1.0 + 1j]]), [[0.5]])
+    with pytest.raises(gpmsa.GPMSAError, match="t must hold real numbers"):
+        emu.predict([[1.0]], np.array([[0.5 + 0j]]))
+
+
+@pytest.mark.parametrize(
+    ("n_draws", "match"),
+    [(0, "n_draws must be an integer >= 1, got 0"), (-5, "got -5"), (2.5, "got 2.5"),
+     (float("nan"), "got nan"), ("3", "got '3'"), (True, "got True")],
+)  # fmt: skip
+def test_predict_n_draws_is_a_count(n_draws, match):
+    from _predict_cases import vector_fit
+
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        vector_fit().predict([[0.5]], [[0.5]], draws=True, n_draws=n_draws)
+
+
+def test_predict_with_more_draws_than_kept_uses_all_of_them():
+    """A huge n_draws (10**18 allocated an index array of 8 EB) means every retained draw."""
+    from _predict_cases import vector_fit
+
+    emu = vector_fit()
+    every = emu.predict([[0.5]], [[0.5]], draws=True)
+    for n in (emu.n_draws, 10**18):
+        np.testing.assert_array_equal(emu.predict([[0.5]], [[0.5]], draws=True, n_draws=n)[0],
+                                      every[0])  # fmt: skip

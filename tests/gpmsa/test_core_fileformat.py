@@ -31,6 +31,16 @@ def saved(emu, tmp_path_factory):
     return path
 
 
+def test_save_into_a_missing_folder_or_to_no_path_names_the_problem(emu, tmp_path):
+    target = tmp_path / "missing" / "model.gpmsa"
+    with pytest.raises(gpmsa.GPMSAError, match=r"model.gpmsa: cannot write \(No such file"):
+        emu.save(target)
+    assert not target.parent.exists()
+    for bad in (None, 5, ""):
+        with pytest.raises(gpmsa.GPMSAError, match="path must be a file name"):
+            emu.save(bad)
+
+
 def test_round_trip_is_exact(emu, saved):
     back = gpmsa.load(saved)
     x, t = np.array([[0.3], [1.1], [1.9]]), np.array([[250.0], [420.0], [590.0]])

@@ -65,6 +65,50 @@ def test_fit_argument_errors(small_sim):
         gpmsa.fit({"x": 1}, n_iter=10)
 
 
+@pytest.mark.parametrize(
+    ("widths", "match"),
+    [({"lamWOs": np.nan}, r"step_widths\['lamWOs'\] must be finite and > 0, got \[nan\]"),
+     ({"lamWOs": 0.0}, r"step_widths\['lamWOs'\] must be finite and > 0"),
+     ({"betaU": -5.0}, r"step_widths\['betaU'\] must be finite and > 0"),
+     ({"betaU": [[0.1], [np.inf]]}, r"step_widths\['betaU'\] must be finite and > 0"),
+     ({"betaU": [0.1, 0.1, 0.1]}, r"\['betaU'\] must be a scalar or have shape \(2, 1\)"),
+     ({"lamOs": 1.0}, r"step_widths: unknown parameter 'lamOs'; this model has"),
+     ({"lamWOs": "wide"}, r"step_widths\['lamWOs'\] must be a numeric array"),
+     ({"lamWOs": 1 + 1j}, r"step_widths\['lamWOs'\] must hold real numbers"),
+     ([("lamWOs", 1.0)], "step_widths must be None or a dict name -> widths, got list"),
+     ("lamWOs", "step_widths must be None or a dict name -> widths, got str")],
+)  # fmt: skip
+def test_fit_step_widths_are_checked(small_sim, widths, match):
+    """A zero, negative or NaN width froze the chain silently; others raised deep inside."""
+    for tune in (False, True):
+        with pytest.raises(gpmsa.GPMSAError, match=match):
+            gpmsa.fit(small_sim, n_iter=10, tune=tune, step_widths=widths)
+
+
+def test_fit_step_widths_in_the_parameters_shape_are_used(small_sim):
+    emu = gpmsa.fit(small_sim, n_iter=10, tune=False, seed=0,
+                    step_widths={"betaU": [[0.2], [0.3]], "lamWOs": [50.0]})  # fmt: skip
+    assert emu.settings["step_widths"]["betaU"] == [[[0.2], [0.3]]]
+    assert emu.settings["step_widths"]["lamWOs"] == [[50.0]]
+
+
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [({"tune_rounds": 0}, r"tune_rounds must be an integer in \[1, 1000000\], got 0"),
+     ({"tune_rounds": 2.5}, "tune_rounds must be an integer"),
+     ({"tune_rounds": "5"}, "tune_rounds must be an integer"),
+     ({"tune_levels": 1}, r"tune_levels must be an integer in \[2, 1000\], got 1"),
+     ({"tune_levels": -2}, "tune_levels must be an integer"),
+     ({"tune_levels": 10**9}, r"tune_levels must be an integer in \[2, 1000\]"),
+     ({"tune_rounds": 10**7}, "tune_rounds must be an integer in"),
+     ({"tune_rounds": 10**5, "tune_levels": 20}, r"100000 x 20 tuning sweeps per chain, above")],
+)  # fmt: skip
+def test_fit_tuning_options_are_bounded_counts(small_sim, kw, match):
+    """tune_rounds=10**7 ran for hours; 0 or 1 level gave a silent GLM on nothing."""
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        gpmsa.fit(small_sim, n_iter=10, **kw)
+
+
 def test_multivariate_output_with_discrepancy_recovers_true_theta():
     """p_u > 1, constant discrepancy, three experiments; theta_true = 0.6 (native 1.6)."""
     rng = np.random.default_rng(5)

@@ -57,6 +57,18 @@ def test_traces_of_chains_show_each_chain():
     assert len(fig.axes[0].lines) == 3 and fig.axes[0].get_legend() is not None
 
 
+def test_huge_bin_counts_are_refused_before_drawing():
+    """bins=10**9 asked matplotlib for ~10 TB of Rectangle patches."""
+    post = gpmsa.Posterior({"a": np.arange(10.0), "b": np.arange(10.0)})
+    with pytest.raises(gpmsa.ResourceLimitError, match=r"plots.traces: 2 histogram\(s\) of "
+                       r"1000000000 bins .*gpmsa.limits.MAX_MEMORY_BYTES"):  # fmt: skip
+        plots.traces(post, bins=10**9)
+    with pytest.raises(gpmsa.ResourceLimitError, match=r"plots.theta_pairs: 2 histogram"):
+        plots.theta_pairs(post, bins=10**9)
+    with pytest.raises(GPMSAError, match="bins must be an integer >= 1, got 0"):
+        plots.traces(post, bins=0)
+
+
 def test_theta_pairs_marks_the_truth():
     rng = np.random.default_rng(0)
     post = gpmsa.Posterior({"a": rng.normal(size=100), "b": rng.normal(size=100),

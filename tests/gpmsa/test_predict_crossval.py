@@ -115,5 +115,5 @@ def test_bad_input(kw, match):
 def test_no_draws_kept():
     with pytest.raises(GPMSAError, match="kept none"):
         cross_validate(two_param_emulator())
-    with pytest.raises(GPMSAError, match="level must lie in"):
+    with pytest.raises(GPMSAError, match=r"level must be a number in \(0, 1\)"):
         cross_validate(two_param_emulator(), draws=False).coverage(1.0)

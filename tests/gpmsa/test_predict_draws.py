@@ -132,6 +132,24 @@ def test_bad_settings(kw, match):
         emulator_prediction(vector_fit(), X_NEW, T_NEW, **kw)
 
 
+@pytest.mark.parametrize(
+    ("kw", "match"),
+    [({"n_rlz": 10**9}, r"emulator_prediction\(n_rlz=1000000000, joint=False\) at 3 points"),
+     ({"x": np.full((10**5, 1), 1.0), "t": [[0.1]], "joint": True},
+      r"emulator_prediction\(n_rlz=1, joint=True\) at 100000 points")],
+)  # fmt: skip
+def test_huge_requests_are_refused_before_allocating(kw, match):
+    """n_rlz=10**9 or 10**5 points drawn jointly asked numpy for terabytes (MemoryError)."""
+    args = {"x": X_NEW, "t": T_NEW, **kw}
+    with pytest.raises(gpmsa.ResourceLimitError, match=match + ".*gpmsa.limits.MAX_MEMORY_BYTES"):
+        emulator_prediction(vector_fit(), seed=0, **args)
+
+
+def test_complex_inputs_are_refused_not_cast():
+    with pytest.raises(GPMSAError, match="x must hold real numbers, got complex values"):
+        emulator_prediction(vector_fit(), np.array(X_NEW) + 0j, T_NEW)
+
+
 # --- a joint fit's calibration draws as a Posterior --------------------------------------------
 def test_calibration_posterior_of_a_joint_fit():
     emu, *_ = known_truth_case()
@@ -152,3 +170,14 @@ def test_calibration_posterior_of_a_joint_fit():
 def test_calibration_posterior_needs_a_joint_fit():
     with pytest.raises(GPMSAError, match="fitted without observations"):
         gpmsa.calibration_posterior(vector_fit())
+
+
+@pytest.mark.parametrize("not_an_emulator", [{}, None, gpmsa.Posterior({"a": [1.0, 2.0]})])
+def test_the_predictive_functions_name_a_missing_emulator(not_an_emulator):
+    for what, call in {
+        "emulator_prediction": lambda e: gpmsa.emulator_prediction(e, [[0.5]], [[0.5]]),
+        "sensitivity": gpmsa.sensitivity,
+        "cross_validate": gpmsa.cross_validate,
+    }.items():
+        with pytest.raises(GPMSAError, match=f"{what} needs a gpmsa.Emulator, got"):
+            call(not_an_emulator)

@@ -181,7 +181,7 @@ def test_bad_input_names_the_problem():
         full_prediction(vector_fit(), obs, [[0.5]])
     with pytest.raises(GPMSAError, match="obs must be the gpmsa.ObsData"):
         full_prediction(emu, (obs.x, obs.y), [[0.5]])
-    with pytest.raises(GPMSAError, match="discrepancy parameters but discrepancy=None"):
+    with pytest.raises(GPMSAError, match=r"discrepancy=None differs from the joint fit's"):
         full_prediction(emu, obs, [[0.5]], discrepancy=None)
     with pytest.raises(GPMSAError, match=r"x reaches .* by more than 10%"):
         full_prediction(emu, obs, [[1.5]])
@@ -195,6 +195,36 @@ def test_bad_input_names_the_problem():
         full_prediction(emu, obs, [[0.5]], n_draws=2).mean("ysim")
     with pytest.raises(GPMSAError, match="posterior must be a gpmsa.Posterior"):
         full_prediction(emu, obs, [[0.5]], posterior={"t": [1.0]}, discrepancy="linear")
+
+
+def test_discrepancy_and_obs_must_be_the_joint_fits():
+    """docs/prediction.md: a discrepancy other than the fit's is an error; so is other data."""
+    emu, obs, *_ = known_truth_case()
+    assert emu.settings["discrepancy"] == "linear" and emu.settings["obs_lengths"] == [12] * 12
+    with pytest.raises(GPMSAError, match=r"discrepancy='constant' differs from the joint fit's "
+                                         r"discrepancy \('linear'\)"):  # fmt: skip
+        full_prediction(emu, obs, [[0.5]], discrepancy="constant")
+    with pytest.raises(GPMSAError, match=r"discrepancy=an array differs from the joint fit's"):
+        full_prediction(emu, obs, [[0.5]], discrepancy=np.ones((GRID.size, 1)))
+    fewer = gpmsa.ObsData(x=obs.x[:3], y=obs.y[:3], index=GRID)
+    with pytest.raises(GPMSAError, match=r"obs has 3 experiment\(s\) of lengths \[12, 12, 12\], "
+                                         r"but the joint fit's had 12"):  # fmt: skip
+        full_prediction(emu, fewer, [[0.5]])
+    shorter = gpmsa.ObsData(x=obs.x, y=obs.y[:, ::2], index=GRID[::2])
+    with pytest.raises(GPMSAError, match="pass the ObsData the fit used"):
+        full_prediction(emu, shorter, [[0.5]])
+    same = full_prediction(emu, obs, [[0.5]], discrepancy="linear", n_draws=2, seed=0)
+    default = full_prediction(emu, obs, [[0.5]], n_draws=2, seed=0)
+    np.testing.assert_array_equal(same.y, default.y)
+
+
+def test_huge_realization_counts_are_refused_before_allocating():
+    emu, obs, *_ = known_truth_case()
+    with pytest.raises(gpmsa.ResourceLimitError, match=r"full_prediction\(n_rlz=1000000000\) "
+                       r"at 1 points .*gpmsa.limits.MAX_MEMORY_BYTES"):  # fmt: skip
+        full_prediction(emu, obs, [[0.5]], n_rlz=10**9)
+    with pytest.raises(GPMSAError, match="grid must be a numeric array"):
+        full_prediction(emu, obs, [[0.5]], grid=["a"])
 
 
 def test_an_array_discrepancy_basis_must_be_given_again():

@@ -109,8 +109,9 @@ def test_ridge_applies_only_where_the_likelihood_is_unchanged():
     fixed = road_problem(False).problem
     fixed = fixed.with_init({}, fixed=frozenset({"lamWOs"}))
     assert not ridge.applies(fixed)
-    with pytest.raises(gpmsa.GPMSAError, match="ridge_moves must be None or an integer >= 0"):
-        backends.get("numpy").sample(fixed, n_iter=5, ridge_moves=-1)
+    for bad in (-1, 2.5, "5", 10**6):  # a million moves per sweep: the fit would never end
+        with pytest.raises(gpmsa.GPMSAError, match=r"ridge_moves must be an integer in \[0, 10"):
+            backends.get("numpy").sample(fixed, n_iter=5, ridge_moves=bad)
 
 
 def test_ridge_moves_mix_lamws_and_lamwos_on_the_road_case():

@@ -112,6 +112,9 @@ def test_joint_fit_shares_theta_and_recovers_it():
         ({"labels": ["a"]}, "got 1 labels for 2 models"),
         ({"hyper": {"mu_mean": 0.5}}, "hyper must be a gpmsa.HyperPriors"),
         ({"n_burn": 500}, "n_burn must be"),
+        ({"tune_rounds": 0}, "tune_rounds must be an integer in [1, 1000000], got 0"),
+        ({"tune_levels": 1}, "tune_levels must be an integer in [2, 1000], got 1"),
+        ({"tune_rounds": 10**9}, "tune_rounds must be an integer in"),
     ],
 )
 def test_bad_study_input_is_named(kwargs, message):
