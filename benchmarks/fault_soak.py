@@ -220,20 +220,23 @@ def example_scenarios(seeds) -> list[Scenario]:
 _LIKELIHOOD: dict = {}
 
 
+DEFAULT_SIMPLEX = control.Simplex()
+
+
 def _init_worker() -> None:
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(1)  # two workers on two cores: no BLAS threads on top
 
 
-def _loop(sc: Scenario, track, faults=(), after_fault: str = "latch"):
+def _loop(sc: Scenario, track, faults=(), simplex: control.Simplex = DEFAULT_SIMPLEX):
     if sc.case not in _LIKELIHOOD:
         emu = control.shipped_emulator(sc.case)
         _LIKELIHOOD[sc.case] = (emu, control.ObservationModel(emu))
     emu, lik = _LIKELIHOOD[sc.case]
     return control.run_closed_loop(
         track, emu, noise_std=NOISE_STD[sc.case], seed=sc.noise_seed, likelihood=lik,
-        faults=faults, simplex=control.Simplex(after_fault=after_fault),
+        faults=faults, simplex=simplex,
     )  # fmt: skip
 
 
@@ -261,20 +264,23 @@ def rough_segments(track, runs, gd_max: float) -> list:
 
 
 def run_scenario(
-    sc: Scenario, keep_excerpt: bool = False, null: bool = True, after_fault: str = "latch"
+    sc: Scenario,
+    keep_excerpt: bool = False,
+    null: bool = True,
+    simplex: control.Simplex = DEFAULT_SIMPLEX,
 ) -> Outcome:
     """Clean, faulted and (``null``) imperceptibly perturbed loop of one scenario."""
     out = Outcome(sc)
     try:
         track = roadgen.track(sc.segments, seed=sc.track_seed)
-        clean = _loop(sc, track, after_fault=after_fault)
+        clean = _loop(sc, track, simplex=simplex)
     except Exception as exc:  # noqa: BLE001 - a crash is what the soak counts
         out.crash = _crash(exc, "clean")
         return out
     out.fault = fault = sc.fault(clean)
     out.fast_clean = clean.metrics.fast_on_rough_m
     try:
-        faulted = _loop(sc, track, (fault,), after_fault)
+        faulted = _loop(sc, track, (fault,), simplex)
     except Exception as exc:  # noqa: BLE001
         out.crash = _crash(exc, "faulted")
         return out
@@ -290,7 +296,7 @@ def run_scenario(
     if null:
         try:
             perturbed = _loop(sc, track, (control.SensorFault(
-                fault.start_s, fault.duration_s, "scale", NULL_GAIN),), after_fault)  # fmt: skip
+                fault.start_s, fault.duration_s, "scale", NULL_GAIN),), simplex)  # fmt: skip
         except Exception as exc:  # noqa: BLE001
             out.crash = _crash(exc, "null")
             return out
@@ -307,9 +313,9 @@ def run_scenario(
     return out
 
 
-def _job(job: tuple[Scenario, bool, str]) -> Outcome:
-    sc, null, after_fault = job
-    return run_scenario(sc, null=null, after_fault=after_fault)
+def _job(job: tuple[Scenario, bool, control.Simplex]) -> Outcome:
+    sc, null, simplex = job
+    return run_scenario(sc, null=null, simplex=simplex)
 
 
 def excerpt(clean, faulted, fault, before_s: float = 3.0, after_s: float = 12.0) -> list:
@@ -491,12 +497,18 @@ def main(argv: list[str] | None = None) -> int:
         default=None,
         help="run the random scenario of this index only, with its trace",
     )
+    parser.add_argument(
+        "--speed-step",
+        type=float,
+        default=control.Simplex().speed_step_mps,
+        help="the Simplex's speed grid, m/s (control.Simplex.speed_step_mps; default: the "
+        "library's)",
+    )
     args = parser.parse_args(argv)  # fmt: skip
+    simplex = control.Simplex(after_fault=args.after_fault, speed_step_mps=args.speed_step)
     if args.only is not None:
         _init_worker()  # one BLAS thread, as in the soak: the loop is chaotic to the last bit
-        o = run_scenario(
-            random_scenario(args.seed, args.only), keep_excerpt=True, after_fault=args.after_fault
-        )
+        o = run_scenario(random_scenario(args.seed, args.only), keep_excerpt=True, simplex=simplex)
         if o.crash:
             print(o.crash)
             return 1
@@ -510,8 +522,8 @@ def main(argv: list[str] | None = None) -> int:
 
     tic = time.perf_counter()
     with ProcessPoolExecutor(max_workers=args.workers, initializer=_init_worker) as pool:
-        jobs = [(sc, not args.no_null, args.after_fault) for sc in scenarios] + [
-            (sc, False, args.after_fault) for sc in examples
+        jobs = [(sc, not args.no_null, simplex) for sc in scenarios] + [
+            (sc, False, simplex) for sc in examples
         ]
         outcomes = list(pool.map(_job, jobs, chunksize=1))
     wall = time.perf_counter() - tic
@@ -521,7 +533,8 @@ def main(argv: list[str] | None = None) -> int:
         f"fault soak: {n} random scenarios ({sum(s.case == 'A' for s in scenarios)} case A, "
         f"{sum(s.case == 'B' for s in scenarios)} case B; seed {args.seed}) + {len(examples)} "
         f"examples, {2 * len(outcomes) + (0 if args.no_null else n)} loop runs in {wall:.0f} s "
-        f"on {args.workers} workers; after_fault={args.after_fault!r}; "
+        f"on {args.workers} workers; after_fault={args.after_fault!r}, "
+        f"speed step {args.speed_step:g} m/s; "
         f"{load()}"
     )
     print(f"crashes: {len(crashes)}")

@@ -15,6 +15,13 @@ paper's robot did (it drove at up to 2.0 m/s on GD 300). Laws offered here:
   v_max / ((GD_max - GD_min) / 2), which gives v_max at GD_min). It stops the robot mid-band;
 - ``"switch"``: v_max in performance mode, v_safe in safety mode.
 
+Speed grid: in performance mode the law's speed is rounded down to v_safe + k ``speed_step_mps``
+(default 0.1 m/s; v_max and 0 are on the grid), so a change of the estimate far below its
+resolution changes no command. The closed loop is chaotic (wheel lift-off): on the continuous
+law a 1e-9 gain error of the accelerometer, which no check can see, moved the command by
+~1e-7 m/s and later positions by metres. On the grid the command moves only when the law
+crosses a grid point, and it is never above the law. ``speed_step_mps=0``: the continuous law.
+
 Risk posture: ``risk=None`` feeds the posterior mean of GD to the law (the paper). ``risk=alpha``
 feeds the (1 - alpha) posterior quantile instead, so safety mode starts as soon as
 P(GD > GD_max) > alpha. Any estimate that is not "ok" (buffer filling, fault, out of domain,
@@ -82,6 +89,8 @@ class Simplex:
             tails are lighter than the road's), the smallest at 3.4e-10; a fault that no check
             of the signal sees and no GD explains lies far beyond (90% of such blocks of added
             noise below 1e-15).
+        speed_step_mps: the performance-mode speed is rounded down to v_safe + k times this,
+            m/s (0: the continuous law; see the module docstring).
     """
 
     gd_min: float = 250.0
@@ -93,6 +102,7 @@ class Simplex:
     law: str = "linear"
     after_fault: str = "latch"
     latch_p: float = 1e-12
+    speed_step_mps: float = 0.1
 
     def __post_init__(self) -> None:
         for name in ("gd_min", "gd_max", "v_max", "v_safe"):
@@ -109,6 +119,11 @@ class Simplex:
             raise ControlError(f"risk must be None or lie in (0, 1), got {self.risk}")
         if self.law not in LAWS:
             raise ControlError(f"law must be one of {LAWS}, got {self.law!r}")
+        if not (np.isfinite(self.speed_step_mps) and 0 <= self.speed_step_mps <= self.v_max):
+            raise ControlError(
+                f"speed_step_mps must lie in [0, v_max] = [0, {self.v_max:g}], "
+                f"got {self.speed_step_mps}"
+            )
         if not 0 < self.latch_p <= 1:
             raise ControlError(f"latch_p must lie in (0, 1], got {self.latch_p}")
         if self.after_fault not in AFTER_FAULT:
@@ -154,7 +169,16 @@ class Simplex:
             return Command(self.v_safe, "safety", np.nan, "risk posture needs the posterior")
         if gd > self.gd_max:
             return Command(self.v_safe, "safety", gd, f"GD {gd:.0f} > GD_max {self.gd_max:g}")
-        return Command(self.performance_speed(gd), "performance", gd)
+        return Command(self.on_speed_grid(self.performance_speed(gd)), "performance", gd)
+
+    def on_speed_grid(self, speed: float) -> float:
+        """``speed`` rounded down to the grid v_safe + k ``speed_step_mps`` (k any integer; v_max
+        and 0 are on it too), m/s; unchanged when the step is 0. Never above ``speed``."""
+        step = self.speed_step_mps
+        if step == 0 or speed >= self.v_max:
+            return speed
+        k = np.floor((speed - self.v_safe) / step + 1e-9)  # 1e-9: grid points stay put
+        return float(max(self.v_safe + k * step, 0.0))
 
 
 class SimplexRun:

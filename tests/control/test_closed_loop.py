@@ -56,6 +56,28 @@ def test_safety_mode_whenever_the_estimate_exceeds_gd_max(short_run):
     assert np.all(r.mode[~ok] == "safety")
 
 
+def test_an_invisible_change_of_the_signal_leaves_the_run_as_it_was(short_run, likelihood_a):
+    """The speed grid (Simplex.speed_step_mps) keeps a gain error of 1e-9, which no check can
+    see, from setting off the loop's chaos: every command and position stays the same. On a
+    continuous law the same error moves later positions (docs/closed-loop.md, "Faults")."""
+    track, clean = short_run
+    emu = control.shipped_emulator("A")
+    invisible = (SensorFault(start_s=5.0, duration_s=3.0, kind="scale", magnitude=1 + 1e-9),)
+
+    def run(step: float, faults=()):
+        simplex = Simplex(speed_step_mps=step)
+        return run_closed_loop(
+            track, emu, seed=3, likelihood=likelihood_a, faults=faults, simplex=simplex
+        )
+
+    on_grid = run(0.1, invisible)
+    assert np.array_equal(on_grid.command, clean.command)
+    assert np.array_equal(on_grid.sample_position, clean.sample_position)
+    ok = np.isfinite(clean.gd_mean)
+    assert not np.array_equal(on_grid.gd_mean[ok], clean.gd_mean[ok])  # the estimates moved
+    assert not np.array_equal(run(0.0, invisible).command, run(0.0).command)
+
+
 @pytest.mark.parametrize(
     ("kind", "magnitude"), [("nan", 1.0), ("drop", 1.0), ("time_nan", 1.0), ("spike", 5.0)]
 )

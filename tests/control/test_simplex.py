@@ -95,6 +95,8 @@ def test_risk_switches_exactly_when_prob_above_max_exceeds_alpha(mean, sd, alpha
         ({"after_fault": "ignore"}, "after_fault must be one of"),
         ({"latch_p": 0.0}, "latch_p must lie in"),
         ({"v_max": float("nan")}, "v_max must be finite"),
+        ({"speed_step_mps": -0.1}, r"speed_step_mps must lie in \[0, v_max\]"),
+        ({"speed_step_mps": float("inf")}, "speed_step_mps must lie in"),
     ],
 )
 def test_bad_settings_raise(kwargs, match):
@@ -162,3 +164,33 @@ def test_a_run_never_commands_more_than_the_memoryless_law(steps, after_fault):
         assert cmd.speed <= simplex.command(est).speed
         if after_fault == "latch" and faulted:
             assert cmd.speed == simplex.v_safe and cmd.mode == "safety"
+
+
+@given(gd=st.floats(200, 600), law=st.sampled_from(["linear", "paper"]))
+def test_the_speed_grid_rounds_the_law_down_onto_its_steps(gd, law):
+    """Property: the command is the law's speed or the grid point below it, within one step."""
+    plain, grid = Simplex(law=law, speed_step_mps=0), Simplex(law=law)  # default grid: 0.1 m/s
+    est = gaussian_estimate(gd, 3)
+    law_speed, speed = plain.command(est).speed, grid.command(est).speed
+    assert law_speed - 0.1 - 1e-9 < speed <= law_speed
+    steps_above_safe = (speed - grid.v_safe) / 0.1
+    assert speed == grid.v_max or abs(steps_above_safe - round(steps_above_safe)) < 1e-9
+
+
+def test_the_speed_grid_keeps_its_end_points_and_stops():
+    s = Simplex(speed_step_mps=0.1)
+    assert s.on_speed_grid(2.0) == 2.0 and s.on_speed_grid(1.0) == 1.0
+    assert s.on_speed_grid(1.3) == pytest.approx(1.3)  # a grid point stays put
+    assert s.on_speed_grid(1.2999) == pytest.approx(1.2)
+    assert Simplex(law="paper", speed_step_mps=0.3).on_speed_grid(0.05) == 0.0  # not negative
+    assert Simplex(v_max=1.95, speed_step_mps=0.1).on_speed_grid(1.95) == 1.95  # v_max is on it
+    assert Simplex(speed_step_mps=0).on_speed_grid(1.2345) == 1.2345  # no grid: the law as is
+
+
+def test_on_the_speed_grid_an_invisible_change_of_the_estimate_changes_no_command():
+    s = Simplex(speed_step_mps=0.1)
+    gds = np.linspace(251, 349, 200)
+    speeds = [s.command(gaussian_estimate(gd, 3)).speed for gd in gds]
+    nudged = [s.command(gaussian_estimate(gd * (1 + 1e-9), 3)).speed for gd in gds]
+    assert speeds == nudged
+    assert len(set(speeds)) == 10  # 1.0, 1.1, ..., 1.9: one command per step of the law
