@@ -6,7 +6,7 @@ import numpy as np
 from scipy.special import ndtri
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import SimData, check_level
+from gpmsa.model.data import SimData, check_count, check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.crossval import CrossValidation
 
@@ -30,7 +30,7 @@ def pc_basis(emulator, *, max_pc: int = 6):
         6
     """
     std = emulator.standardizer
-    p_u = min(emulator.p_u, int(max_pc))
+    p_u = min(emulator.p_u, check_count(max_pc, "max_pc"))
     scalar = emulator.l_sim == 1
     inputs = [(n, emulator.x_unit[:, k] * (std.x_max[k] - std.x_min[k]) + std.x_min[k])
               for k, n in enumerate(emulator.x_names)]  # fmt: skip

@@ -7,6 +7,7 @@ import numpy as np
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc.sampler import Chains
+from gpmsa.model.data import check_count
 from gpmsa.plots._figure import check_bins, figure
 from gpmsa.predictive.joint import calibration_posterior
 
@@ -55,9 +56,12 @@ def _series(source) -> dict[str, np.ndarray]:
 
 
 def _pick(series: dict, names, max_params: int) -> list[str]:
+    max_params = check_count(max_params, "max_params")
     if names is None:
         return list(series)[:max_params]
     names = [names] if isinstance(names, str) else list(names)
+    if not names:
+        raise GPMSAError(f"names is empty; available: {list(series)}")
     picked = []
     for n in names:
         hits = [k for k in series if k == n or k.startswith(f"{n}[")]

@@ -69,6 +69,17 @@ def test_huge_bin_counts_are_refused_before_drawing():
         plots.traces(post, bins=0)
 
 
+def test_empty_or_uncountable_selections_are_named():
+    post = gpmsa.Posterior({"a": np.arange(10.0), "b": np.arange(10.0)})
+    with pytest.raises(GPMSAError, match="names is empty; available"):
+        plots.traces(post, names=[])
+    for bad in (0, -1, 2.5, "3"):
+        with pytest.raises(GPMSAError, match="max_params must be an integer >= 1"):
+            plots.traces(post, max_params=bad)
+        with pytest.raises(GPMSAError, match="max_pc must be an integer >= 1"):
+            plots.pc_basis(two_param_emulator(), max_pc=bad)
+
+
 def test_theta_pairs_marks_the_truth():
     rng = np.random.default_rng(0)
     post = gpmsa.Posterior({"a": rng.normal(size=100), "b": rng.normal(size=100),
