@@ -41,6 +41,14 @@ class CalibratedPrediction:
         """P(Y <= y) per point, y (N, l_sim) (or broadcastable)."""
         y = as_float(y, "y")
         check_finite(y, "y")
+        shape = self.comp_mean.shape[1:]
+        try:
+            fits = np.broadcast_shapes(y.shape, shape) == shape
+        except ValueError:
+            fits = False
+        if not fits:
+            raise GPMSAError(f"y must have shape {shape} (N points x l_sim), or broadcast to it, "
+                             f"got {y.shape}")  # fmt: skip
         z = (y[None] - self.comp_mean) / np.sqrt(self.comp_var)
         return np.tensordot(self.weights, ndtr(z), axes=1)
 

@@ -18,6 +18,7 @@ from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, load
 from gpmsa.io.container import STUDY_FORMAT, jsonable, read_raw, write_raw
 from gpmsa.mcmc.diagnostics import convergence, summarize
+from gpmsa.model.data import check_count
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
 from gpmsa.studies.record import check_study_arrays, check_study_manifest
 
@@ -96,9 +97,7 @@ class Study:
             if model not in self.labels:
                 raise GPMSAError(f"unknown model {model!r}; this study has {list(self.labels)}")
             return self.labels.index(model)
-        if not 0 <= int(model) < len(self.members):
-            raise GPMSAError(f"model index {model} outside 0..{len(self.members) - 1}")
-        return int(model)
+        return check_count(model, "model index", 0, len(self.members) - 1)
 
     def member_posterior(self, model: int | str) -> Posterior:
         """One model's calibration as a ``gpmsa.Posterior`` named as its emulator's t_names and
@@ -109,8 +108,11 @@ class Study:
         for k, name in enumerate(self.members[i].t_names):
             out[name] = chains[self.layout.elements[self.layout.index[i][k]].name]
         out["lamOs"] = chains[f"lamOs[{self.labels[i]}]"]
-        return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out,
-                         info={"method": f"study {self.kind}", "model": self.labels[i]})
+        return Posterior(
+            {k: v.reshape(-1) for k, v in out.items()},
+            chains=out,
+            info={"method": f"study {self.kind}", "model": self.labels[i]},
+        )
 
     def to_record(self, files: list[str], hashes: list[str]) -> tuple[dict, dict]:
         """The study file's (manifest, arrays), its models' files and sha256 given."""

@@ -109,6 +109,8 @@ def test_calibrated_prediction_quantiles_and_noise():
         pred.cdf(np.nan)  # was a silent NaN probability
     with pytest.raises(GPMSAError, match="y must hold real numbers"):
         pred.cdf(1.0 + 0j)
+    with pytest.raises(GPMSAError, match=r"y must have shape \(1, 1\) .* got \(3, 4\)"):
+        pred.cdf(np.ones((3, 4)))  # was broadcast into a (3, 4) answer for one point
     lo, hi = pred.interval(0.9)
     assert lo[0, 0] < pred.mean[0, 0] < hi[0, 0]
     noisy = calibrated_predict(emu, post, [[1.5]], noise=True)

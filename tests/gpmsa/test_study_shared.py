@@ -41,6 +41,9 @@ def test_two_halves_sharing_theta_equal_one_model_with_all_the_data():
     # the per-model view: the same draws under the emulator's names
     mp = study.member_posterior("model1")
     assert mp.names == ("t", "lamOs") and np.array_equal(mp.samples["t"], a.ravel())
+    for bad in (True, 1.0, 2, -1, [0]):  # not a model index (a bool was taken as 1)
+        with pytest.raises(gpmsa.GPMSAError, match=r"model index must be an integer in \[0, 1\]"):
+            study.member_posterior(bad)
 
 
 def test_own_parameters_stay_separate_and_match_single_calibrations():
@@ -121,8 +124,9 @@ def test_bad_study_input_is_named(kwargs, message):
     emu = emulator(None)
     x, y = observations(0.4, 2, 0.05, np.random.default_rng(0))
     with pytest.raises(gpmsa.GPMSAError, match=message.replace("[", r"\[")):
-        gpmsa.calibrate_study([emu, emu], [x, x], [y, y], **{"n_samples": 100, "n_burn": 10,
-                                                              **kwargs})
+        gpmsa.calibrate_study(
+            [emu, emu], [x, x], [y, y], **{"n_samples": 100, "n_burn": 10, **kwargs}
+        )
 
 
 def test_different_bounds_of_a_shared_parameter_are_refused():
