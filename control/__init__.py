@@ -12,7 +12,13 @@ Note: the import name ``control`` is also python-control's; do not install both 
 from control.bcr import BCR, METHODS, PAPER_WINDOW, BCRSettings
 from control.changepoint import ChangePointFilter, ChangePointSettings
 from control.closed_loop import ClosedLoopResult, LoopMetrics, run_closed_loop
-from control.compat import bcr_settings_for, check_emulator, emulator_feature
+from control.compat import (
+    bcr_settings_for,
+    check_emulator,
+    emulator_feature,
+    emulator_noise_std,
+    emulator_vehicle,
+)
 from control.errors import (
     BagError,
     ControlError,
@@ -67,6 +73,8 @@ __all__ = [
     "check_emulator",
     "detection_delays",
     "emulator_feature",
+    "emulator_noise_std",
+    "emulator_vehicle",
     "fast_on_rough_m",
     "gd_errors",
     "pooled_rmse",

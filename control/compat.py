@@ -14,6 +14,7 @@ from dataclasses import replace
 
 import numpy as np
 
+import vehicle
 from control.bcr import BCRSettings
 from control.errors import ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
@@ -112,6 +113,22 @@ def check_emulator(
             raise EmulatorMismatchError(
                 f"track GD {outside} outside the emulator's GD domain [{lo:g}, {hi:g}]"
             )
+
+
+def emulator_vehicle(emulator):
+    """The vehicle model the emulator was trained for (its metadata's ``vehicle``, as
+    ``model.describe()`` recorded it), e.g. to run the closed loop with a user's emulator;
+    EmulatorMismatchError when the record is missing or malformed."""
+    meta = dict(getattr(emulator, "metadata", None) or {})
+    if "vehicle" not in meta:
+        raise EmulatorMismatchError(
+            "the emulator's metadata has no 'vehicle': it does not say which vehicle it was "
+            "trained for (examples/train_emulator.py records it)"
+        )
+    try:
+        return vehicle.from_description(meta["vehicle"])
+    except (vehicle.VehicleError, TypeError) as exc:
+        raise EmulatorMismatchError(f"the emulator's vehicle record is malformed: {exc}") from exc
 
 
 def emulator_noise_std(emulator) -> float | None:

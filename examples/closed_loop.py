@@ -4,12 +4,15 @@
     python examples/closed_loop.py --out DIR --runs 3 --method changepoint --law linear
     python examples/closed_loop.py --record runs/   # also one MCAP per run, for Foxglove
     python examples/closed_loop.py --track 40:250,30:450,60:350 --first-seed 21   # another track
+    python examples/closed_loop.py --emulator-dir mine/emulators   # your emulators (and robot)
 
 Track: 50 m at GD 300, 50 m at GD 500, 50 m at GD 300 (roadgen.track), or ``--track`` (segments
 ``LENGTH_M:GD``, GD within the emulators' domain, 200-600). Test Case A: noise-free
 accelerations and the noise-free emulators; Test Case B: N(0, 1) accelerometer noise and the
 emulators trained with it. Run k drives a track synthesised with seed k (and noise seed k), for
-k = FIRST_SEED .. FIRST_SEED + RUNS - 1.
+k = FIRST_SEED .. FIRST_SEED + RUNS - 1. ``--emulator-dir DIR`` takes the four emulators that
+``examples/train_emulator.py --emulator-dir DIR`` writes instead of the shipped ones; the loop then
+drives the vehicle they were trained for, with their noise level.
 
 Each case is run twice: with our estimator (default: the change-point BCR on log band powers of
 1 s blocks, `control.bcr`) and with the paper's method run here (one 1,000-sample window, its
@@ -33,11 +36,11 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 
 import control  # noqa: E402
+import gpmsa  # noqa: E402
 import roadgen  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
 
 PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
-NOISE_STD = {"A": 0.0, "B": 1.0}
 PAPER_RMSE = {"A": {"300": 42.58, "500": 94.42}, "B": {"300": 50.19, "500": 96.23}}
 
 
@@ -76,6 +79,21 @@ def json_safe(value):
     return value
 
 
+def load_emulator(case: str, kind: str, emulator_dir: Path | None):
+    """The shipped emulator of a case and kind, or the one in ``emulator_dir`` (FileNotFoundError
+    naming a missing file and how to make it)."""
+    if emulator_dir is None:
+        return control.shipped_emulator(case, kind)
+    path = emulator_dir / control.shipped.emulator_file_name(case, kind)
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"{path} is missing; make it with `python examples/train_emulator.py "
+            f"--emulator-dir {emulator_dir} --cases {case} --features band window`, or leave "
+            f"case {case} out (--cases)"
+        )
+    return gpmsa.load(path)
+
+
 def run_case(
     case: str,
     seeds: range,
@@ -83,19 +101,20 @@ def run_case(
     simplex: control.Simplex,
     segments=PAPER_SEGMENTS,
     record: Path | None = None,
+    emulator_dir: Path | None = None,
 ) -> list:
-    """The closed-loop results of one test case and estimator, one per seed (track and noise);
-    with ``record``, each run is also written there as ``case{A,B}_{method}_run{k}.mcap``
-    (control.record_run)."""
-    kind = "band" if method == "changepoint" else "window"
-    emu = control.shipped_emulator(case, kind)
+    """The closed-loop results of one test case and estimator, one per seed (track and noise),
+    on the vehicle and at the noise level the emulator was trained for; with ``record``, each
+    run is also written there as ``case{A,B}_{method}_run{k}.mcap`` (control.record_run)."""
+    emu = load_emulator(case, "band" if method == "changepoint" else "window", emulator_dir)
     bcr = control.bcr_settings_for(emu, method=method)
     likelihood = control.BCR.from_emulator(emu, bcr).model  # prepared once for all runs
     return [
         control.run_closed_loop(
             roadgen.track(segments, seed=k),
             emu,
-            noise_std=NOISE_STD[case],
+            model=control.emulator_vehicle(emu),
+            noise_std=control.emulator_noise_std(emu) or 0.0,
             seed=k,
             bcr=bcr,
             simplex=simplex,
@@ -151,6 +170,20 @@ def main(argv: list[str] | None = None) -> dict:
         help="write each run as an MCAP file in DIR, to watch in Foxglove with "
         "examples/foxglove_layout.json (needs the robot extra)",
     )  # fmt: skip
+    parser.add_argument(
+        "--speed-step", type=float, default=control.Simplex.speed_step_mps, metavar="M_PER_S",
+        help="the Simplex rounds its speed down to this grid, m/s (0: the continuous law; "
+        "docs/closed-loop.md)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--cases", nargs="+", choices=["A", "B"], default=["A", "B"],
+        help="test cases: A (noise-free), B (with the noise the case-B emulators were trained on)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--emulator-dir", default=None, metavar="DIR",
+        help="the emulators DIR/jackal_{A,B}[_window].gpmsa made by examples/train_emulator.py "
+        "--emulator-dir DIR, instead of the shipped ones",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
@@ -166,17 +199,27 @@ def main(argv: list[str] | None = None) -> dict:
     paper_track = tuple(segments) == PAPER_SEGMENTS
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    simplex = control.Simplex(risk=args.risk, law=args.law)
+    try:
+        simplex = control.Simplex(risk=args.risk, law=args.law, speed_step_mps=args.speed_step)
+    except control.ControlError as err:
+        parser.error(str(err))
+    emulator_dir = Path(args.emulator_dir) if args.emulator_dir else None
+    for case in args.cases if emulator_dir else ():  # every file before the first run
+        for kind in ("band", "window"):
+            try:
+                load_emulator(case, kind, emulator_dir)
+            except (FileNotFoundError, gpmsa.EmulatorFileError) as err:
+                parser.error(f"--emulator-dir: {err}")
     record = Path(args.record) if args.record else None
 
     metrics: dict = {"ours": {}, "paper_method": {}}
-    for case in ("A", "B"):
+    for case in args.cases:
         title = f"Test Case {case} ({'noise-free' if case == 'A' else 'N(0, 1) noise'})"
         for key, method in (("ours", args.method), ("paper_method", "window")):
             try:
-                results = run_case(case, seeds, method, simplex, segments, record)
+                results = run_case(case, seeds, method, simplex, segments, record, emulator_dir)
             except control.EmulatorMismatchError as err:  # e.g. a GD outside the domain
-                parser.error(f"--track: {err}")
+                parser.error(f"--track: {err}" if "track GD" in str(err) else str(err))
             metrics[key][case] = summarise(results, gds)
             label = "ours" if key == "ours" else "paper's method"
             plot_gd_trace(results, track, title=f"{title}, {label}: GD").savefig(
@@ -193,7 +236,7 @@ def main(argv: list[str] | None = None) -> dict:
     which = f"seed {seeds.start}" if len(seeds) == 1 else f"seeds {seeds.start}-{seeds[-1]} pooled"
     print(f"RMSE of the GD estimate, {which} ({source})")
     print(f"{'case':<6}{'part':<9}{'paper':>8}{'paper method':>14}{'ours':>8}   ours per run")
-    for case in ("A", "B"):
+    for case in args.cases:
         ours = metrics["ours"][case]
         for gd in ours["rmse"]:
             per_run = " ".join(f"{figure(r['rmse'][gd], '.1f'):>6}" for r in ours["runs"])
@@ -207,7 +250,7 @@ def main(argv: list[str] | None = None) -> dict:
     head = ("fast on GD>350", "90% cover", "time (s)", "x real time")
     print(f"{'case':<6}{'seed':<6}" + "".join(f"{h:>{len(h) + 2}}" for h in head)
           + "   delay at each change (m)")  # fmt: skip
-    for case in ("A", "B"):
+    for case in args.cases:
         for k, r in zip(seeds, metrics["ours"][case]["runs"], strict=True):
             delays = " ".join(figure(d, ".1f") for d in r["detection_delay_m"])
             print(

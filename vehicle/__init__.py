@@ -11,7 +11,7 @@ from vehicle.campaign import Campaign, load_campaign, run_campaign
 from vehicle.design import lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
 from vehicle.linear import linear_model, linear_response
-from vehicle.models import HalfCar, Jackal
+from vehicle.models import HalfCar, Jackal, from_description
 from vehicle.simulate import Trace, simulate
 from vehicle.simulation import Samples, Simulation
 
@@ -25,6 +25,7 @@ __all__ = [
     "Simulation",
     "Trace",
     "VehicleError",
+    "from_description",
     "lhs_design",
     "linear_model",
     "linear_response",

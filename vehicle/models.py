@@ -195,6 +195,26 @@ Model = HalfCar | Jackal
 """Either vehicle model."""
 
 
+def from_description(description: dict) -> Model:
+    """The model that ``describe()`` recorded (e.g. an emulator's metadata "vehicle"): its
+    "model" name and parameters; a parameter it lacks takes the default. VehicleError for an
+    unknown model or parameter."""
+    if not isinstance(description, dict):
+        raise VehicleError(f"a vehicle description is a dict, got {type(description).__name__}")
+    kinds = {"HalfCar": HalfCar, "Jackal": Jackal}
+    params = dict(description)
+    name = params.pop("model", None)
+    if name not in kinds:
+        raise VehicleError(
+            f"vehicle description: model must be one of {sorted(kinds)}, got {name!r}"
+        )
+    fields = {f.name for f in dataclasses.fields(kinds[name])}
+    unknown = sorted(set(params) - fields)
+    if unknown:
+        raise VehicleError(f"vehicle description: {name} has no parameter(s) {unknown}")
+    return kinds[name](**params)
+
+
 def check_model(model: object) -> Model:
     """Return ``model`` or raise VehicleError unless it is a HalfCar or a Jackal."""
     if not isinstance(model, (HalfCar, Jackal)):

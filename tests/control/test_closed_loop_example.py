@@ -30,6 +30,11 @@ def test_segments_parse_and_bad_ones_are_named():
         (["--track", "40:250,30"], "not LENGTH_M:GD"),
         (["--first-seed", "-2"], "--first-seed must be >= 0"),
         (["--runs", "0"], "--runs must be >= 1"),
+        (["--speed-step", "-0.1"], "speed_step_mps must lie in"),
+        (
+            ["--emulator-dir", "no/such/dir", "--cases", "B"],
+            "no/such/dir/jackal_B.gpmsa is missing",
+        ),
     ],
 )
 def test_bad_arguments_are_a_usage_error_naming_the_option(tmp_path, capsys, argv, message):

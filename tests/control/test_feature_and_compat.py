@@ -22,6 +22,7 @@ from control import (  # noqa: E402
     bcr_settings_for,
     block_features,
     check_emulator,
+    emulator_vehicle,
     window_feature,
 )
 from control.plotting import plot_design, plot_gd_trace, plot_posterior_grid, plot_speed  # noqa: E402
@@ -150,3 +151,12 @@ def test_training_and_the_bcr_map_a_variance_to_the_same_observation():
         assert feature_of_variance(f, feature) == window_feature(accel, feature)
     ys = feature_of_variance(np.array([4.0, 0.0, 9.0]), "log_var")
     np.testing.assert_allclose(ys, [np.log(4.0), np.nan, np.log(9.0)])
+
+
+def test_the_emulators_vehicle_is_rebuilt_from_its_record():
+    mine = vehicle.Jackal(mass_kg=21.5)
+    assert emulator_vehicle(fake_emulator(vehicle=mine.describe())) == mine
+    with pytest.raises(EmulatorMismatchError, match="has no 'vehicle'"):
+        emulator_vehicle(fake_emulator())
+    with pytest.raises(EmulatorMismatchError, match="vehicle record is malformed: .*no parameter"):
+        emulator_vehicle(fake_emulator(vehicle={"model": "Jackal", "wings": 2}))

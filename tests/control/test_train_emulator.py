@@ -48,6 +48,14 @@ def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypat
     track = roadgen.track([(15, 300)], seed=1)
     r = control.run_closed_loop(track, band, seed=1)
     assert (r.status == "ok").mean() > 0.8
+    # the main command runs on these emulators instead of the shipped ones
+    argv = ["--out", str(tmp_path / "loop"), "--runs", "1", "--track", "12:300,12:450",
+            "--emulator-dir", str(folder)]  # fmt: skip
+    metrics = load_example("closed_loop").main(argv)
+    assert metrics["settings"]["emulator_dir"] == str(folder)
+    for case in ("A", "B"):
+        rmse = metrics["ours"][case]["rmse"]
+        assert set(rmse) == {"300", "450"} and all(0 < v < 400 for v in rmse.values())
 
 
 def test_ship_and_emulator_dir_exclude_each_other(tmp_path):

@@ -54,3 +54,17 @@ def test_bad_parameters_raise(cls, field, value):
 def test_models_are_frozen():
     with pytest.raises(AttributeError):
         vehicle.Jackal().mass_kg = 3.0
+
+
+def test_a_description_makes_the_model_it_describes():
+    for model in (vehicle.Jackal(mass_kg=21.5, lift_off=False), vehicle.HalfCar()):
+        assert vehicle.from_description(model.describe()) == model
+    assert vehicle.from_description({"model": "Jackal"}) == vehicle.Jackal()  # defaults
+    for bad, match in (
+        ({"model": "Tank"}, "model must be one of"),
+        ({"model": "Jackal", "wings": 2}, r"Jackal has no parameter\(s\) \['wings'\]"),
+        ([("model", "Jackal")], "a vehicle description is a dict"),
+        ({"model": "Jackal", "mass_kg": -1.0}, "mass_kg"),
+    ):
+        with pytest.raises(vehicle.VehicleError, match=match):
+            vehicle.from_description(bad)
