@@ -178,7 +178,7 @@ class Simplex:
         if step == 0 or speed >= self.v_max:
             return speed
         k = np.floor((speed - self.v_safe) / step + 1e-9)  # 1e-9: grid points stay put
-        return float(max(self.v_safe + k * step, 0.0))
+        return float(min(max(self.v_safe + k * step, 0.0), speed))  # min: round-off of k * step
 
 
 class SimplexRun:
