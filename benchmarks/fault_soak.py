@@ -47,6 +47,7 @@ status 1 if any run crashed.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import sys
 import time
@@ -117,14 +118,23 @@ class Scenario:
             start = float(clean.sample_time[min(k, clean.sample_time.size - 1)]) + self.offset_s
         return control.SensorFault(start, self.duration_s, self.kind, self.magnitude)
 
-    def reproduce(self, fault: control.SensorFault) -> str:
-        """Python that reruns the faulted loop."""
+    def reproduce(self, fault: control.SensorFault, simplex: control.Simplex) -> str:
+        """Python that reruns the faulted loop (with ``simplex``'s settings that are not the
+        defaults)."""
+        changed = {
+            f.name: getattr(simplex, f.name)
+            for f in dataclasses.fields(simplex)
+            if getattr(simplex, f.name) != getattr(DEFAULT_SIMPLEX, f.name)
+        }
+        settings = ", ".join(f"{k}={v!r}" for k, v in changed.items())
         return (
             f"control.run_closed_loop(roadgen.track({list(self.segments)}, "
             f"seed={self.track_seed}), control.shipped_emulator({self.case!r}), "
             f"noise_std={NOISE_STD[self.case]}, seed={self.noise_seed}, "
             f"faults=[control.SensorFault({fault.start_s!r}, {fault.duration_s!r}, "
-            f"{fault.kind!r}, {fault.magnitude!r})])"
+            f"{fault.kind!r}, {fault.magnitude!r})]"
+            + (f", simplex=control.Simplex({settings})" if changed else "")
+            + ")"
         )
 
 
@@ -147,6 +157,7 @@ class Outcome:
     fault_span_m: tuple = (np.nan, np.nan)
     latched: bool = False
     clean_latched: bool = False
+    simplex: control.Simplex = field(default_factory=control.Simplex)
 
     @property
     def diff(self) -> float:
@@ -270,7 +281,7 @@ def run_scenario(
     simplex: control.Simplex = DEFAULT_SIMPLEX,
 ) -> Outcome:
     """Clean, faulted and (``null``) imperceptibly perturbed loop of one scenario."""
-    out = Outcome(sc)
+    out = Outcome(sc, simplex=simplex)
     try:
         track = roadgen.track(sc.segments, seed=sc.track_seed)
         clean = _loop(sc, track, simplex=simplex)
@@ -343,7 +354,9 @@ def print_excerpt(o: Outcome) -> None:
         f"for {f.duration_s:.3g} s; track {list(sc.segments)}; fast on rough: clean "
         f"{o.fast_clean:.2f} m, faulted {o.fast_fault:.2f} m"
     )
-    print(f"  reproduce (with one BLAS thread, as the soak's workers): {sc.reproduce(f)}")
+    print(
+        f"  reproduce (with one BLAS thread, as the soak's workers): {sc.reproduce(f, o.simplex)}"
+    )
     names = ("clean", "faulted", "null")
     print(
         f"  fault from {o.fault_span_m[0]:.1f} to {o.fault_span_m[1]:.1f} m; fast on rough per "
