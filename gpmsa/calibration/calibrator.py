@@ -13,6 +13,8 @@ included (default 129 for one parameter, 65 x 65 for two, in 'ij' order, first p
 
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 from scipy.special import ndtr
@@ -46,6 +48,26 @@ MASS_CUTOFF = 1e-14
 N_REFINE = 129
 N_REFINE_2D = 49
 MAX_REFINE = 4
+
+
+def _check_mcmc_options(options) -> dict:
+    """``options`` (None or a dict of ``gpmsa.calibrate`` keywords) as a dict; GPMSAError naming
+    what is not a keyword the Calibrator may pass on (it gives the data, ``extrapolate`` and
+    the prior itself)."""
+    from gpmsa.calibration.calibrate import calibrate  # calibrate imports this module
+
+    if options is None:
+        return {}
+    if not isinstance(options, dict):
+        raise GPMSAError(f"mcmc_options must be None or a dict, got {type(options).__name__}")
+    own = {"emulator", "x_obs", "y_obs", "extrapolate", "log_prior"}
+    allowed = sorted(set(inspect.signature(calibrate).parameters) - own)
+    unknown = sorted(set(options) - set(allowed), key=str)
+    if unknown:
+        raise GPMSAError(
+            f"mcmc_options: unknown keyword(s) {unknown}; gpmsa.calibrate takes {allowed}"
+        )
+    return dict(options)
 
 
 class Calibrator:
@@ -120,7 +142,7 @@ class Calibrator:
         self.emulator_params = emulator_params
         self._entropy = np.random.SeedSequence(check_seed(seed)).entropy
         self._count = 0
-        self.mcmc_options = dict(mcmc_options or {})
+        self.mcmc_options = _check_mcmc_options(mcmc_options)
         if constraint is not None:
             self.mcmc_options.setdefault("constraint", constraint)
         if n_grid is None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import math
 from dataclasses import replace
 from datetime import datetime, timezone
@@ -112,6 +113,15 @@ def fit(
     problem = _model_options(prep, data, fixed, constraint, theta_init)
     _check_fit_memory(problem, int(n_iter), int(n_chains))
     module = backends.get(backend)
+    accepted = inspect.signature(module.sample).parameters
+    open_ended = any(a.kind is inspect.Parameter.VAR_KEYWORD for a in accepted.values())
+    unknown = [] if open_ended else sorted(set(options) - set(accepted))
+    if unknown:
+        offered = sorted(set(accepted) - {"problem", "n_iter", "n_chains", "tune", "step_widths",
+                                          "seed", "progress", "n_jobs", "executor"})  # fmt: skip
+        raise GPMSAError(
+            f"fit: unknown option(s) {unknown} for the {backend!r} backend; it takes {offered}"
+        )
     options.update(backends.placement(backend, n_jobs, executor))
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,

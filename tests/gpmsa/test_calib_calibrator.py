@@ -356,3 +356,14 @@ def test_two_parameter_gridded_prior_survives_refinement():
     assert gridded.info["refined"] and gridded.mean("a") < flat.mean("a") - flat.sd("a")
     assert gridded.mean("a") == pytest.approx(call.mean("a"), abs=0.1 * call.sd("a"))
     assert gridded.sd("a") == pytest.approx(call.sd("a"), rel=0.05)
+
+
+def test_mcmc_options_are_checked_when_the_calibrator_is_made():
+    """An unknown keyword used to fail only at the first update, as calibrate's TypeError."""
+    emu = two_param_emulator()
+    with pytest.raises(GPMSAError, match=r"mcmc_options: unknown keyword\(s\) \['n_sample'\]"):
+        Calibrator(emu, method="mcmc", mcmc_options={"n_sample": 500})
+    with pytest.raises(GPMSAError, match=r"unknown keyword\(s\) \['log_prior'\]"):
+        Calibrator(emu, mcmc_options={"log_prior": None})  # the Calibrator passes its prior itself
+    with pytest.raises(GPMSAError, match="mcmc_options must be None or a dict, got list"):
+        Calibrator(emu, mcmc_options=[("n_samples", 500)])

@@ -133,3 +133,10 @@ def test_multivariate_output_with_discrepancy_recovers_true_theta():
     assert mean.shape == (3, 25) and np.all(var > 0)
     truth = sim_fn(xo, np.full(3, 1.6))
     assert np.sqrt(np.mean((mean - truth) ** 2)) < 0.1
+
+
+def test_an_unknown_fit_option_is_named_with_the_backends_options():
+    sim = gpmsa.SimData(x=np.linspace(0, 1, 8)[:, None], t=np.linspace(1, 0, 8)[:, None],
+                        y=np.linspace(0, 1, 8) ** 2)  # fmt: skip
+    with pytest.raises(gpmsa.GPMSAError, match=r"unknown option\(s\) \['tune_round'\] .* takes \["):
+        gpmsa.fit(sim, n_iter=5, tune_round=3)
