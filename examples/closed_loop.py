@@ -214,7 +214,8 @@ def main(argv: list[str] | None = None) -> dict:
 
     metrics: dict = {"ours": {}, "paper_method": {}}
     for case in args.cases:
-        title = f"Test Case {case} ({'noise-free' if case == 'A' else 'N(0, 1) noise'})"
+        noise = control.emulator_noise_std(load_emulator(case, "band", emulator_dir))
+        title = f"Test Case {case} ({f'N(0, {noise**2:g}) noise' if noise else 'noise-free'})"
         for key, method in (("ours", args.method), ("paper_method", "window")):
             try:
                 results = run_case(case, seeds, method, simplex, segments, record, emulator_dir)
