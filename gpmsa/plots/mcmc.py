@@ -7,7 +7,7 @@ import numpy as np
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc.sampler import Chains
-from gpmsa.model.data import check_count
+from gpmsa.model.data import as_float, check_count
 from gpmsa.plots._figure import check_bins, figure
 from gpmsa.predictive.joint import calibration_posterior
 
@@ -109,6 +109,26 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
     return fig
 
 
+def _check_truth(truth, names) -> dict[str, float]:
+    """``truth`` (None or name -> finite value) of parameters among ``names`` (the
+    posterior's); GPMSAError naming an unknown parameter or a value that is not a finite
+    number."""
+    if truth is None:
+        return {}
+    if not isinstance(truth, dict):
+        raise GPMSAError(f"truth must be a dict name -> value, got {type(truth).__name__}")
+    unknown = sorted(set(truth) - set(names), key=str)
+    if unknown:
+        raise GPMSAError(f"truth: unknown parameter(s) {unknown}; the posterior has {list(names)}")
+    out = {}
+    for name, value in truth.items():
+        arr = as_float(value, f"truth[{name!r}]")
+        if arr.ndim != 0 or not np.isfinite(arr):
+            raise GPMSAError(f"truth[{name!r}] must be one finite number, got {value!r}")
+        out[name] = float(arr)
+    return out
+
+
 def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30):
     """Pair plot of the calibration parameters: histograms on the diagonal, draws below it.
 
@@ -138,7 +158,7 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
     unknown = [n for n in names if n not in post.names]
     if unknown or not names:
         raise GPMSAError(f"unknown parameters {unknown}; the posterior has {post.names}")
-    truth = dict(truth or {})
+    truth = _check_truth(truth, post.names)
     k = len(names)
     bins = check_bins(bins, k, "plots.theta_pairs")
     fig = figure(2.4 * k + 0.6, 2.4 * k + 0.4)

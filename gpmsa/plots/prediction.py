@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import check_level
+from gpmsa.model.data import as_float, check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.full import FullPrediction
 
@@ -56,7 +56,7 @@ def prediction_bands(
     level = check_level(level)
     N, l = pred.x.shape[0], pred.grid.size
     if observed is not None:
-        observed = np.asarray(observed, dtype=float)
+        observed = as_float(observed, "observed")
         if observed.ndim == 1 and l == 1:
             observed = observed[:, None]
         if observed.shape != (N, l):

@@ -140,6 +140,9 @@ def test_prediction_bands_functional_and_scalar():
     assert "minus predicted mean" in rel.get_ylabel()
     with pytest.raises(GPMSAError, match=r"observed must have shape \(6, 12\)"):
         plots.prediction_bands(pred, observed=y_new)
+    for junk in ("x", {"y": 1.0}):  # were raw numpy errors
+        with pytest.raises(GPMSAError, match="observed must be a numeric array"):
+            plots.prediction_bands(pred, observed=junk)
     rng = np.random.default_rng(0)
     x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
     data = gpmsa.SimData(x=x, t=t, y=x + t, x_names=["x"], t_names=["t"])
@@ -171,3 +174,17 @@ def test_no_pyplot_figure_is_left_open():
         os.devnull, format="png"
     )
     assert plt.get_fignums() == before
+
+
+def test_theta_pairs_truth_and_prediction_observations_are_checked():
+    post = gpmsa.Posterior({"a": np.arange(10.0), "b": np.arange(10.0)})
+    plots.theta_pairs(post, names=["a"], truth={"a": 1.0, "b": 2.0})  # b: not shown, not a typo
+    for truth, match in (
+        ({"c": 1.0}, r"truth: unknown parameter\(s\) \['c'\]"),
+        ({"a": np.nan}, r"truth\['a'\] must be one finite number"),
+        ({"a": "x"}, r"truth\['a'\] must be a numeric array"),
+        ({"a": [1.0, 2.0]}, r"truth\['a'\] must be one finite number"),
+        ([1.0], "truth must be a dict"),
+    ):
+        with pytest.raises(GPMSAError, match=match):
+            plots.theta_pairs(post, truth=truth)
