@@ -16,7 +16,7 @@ from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.model import constraints
-from gpmsa.model.data import ObsData, SimData, check_seed
+from gpmsa.model.data import ObsData, SimData, check_count, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, prepare
 
@@ -100,13 +100,16 @@ def fit(
         raise GPMSAError(f"n_iter must be an integer >= 2, got {n_iter!r}")
     if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
         raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
-    n_burn = n_iter // 5 if n_burn is None else int(n_burn)
-    if not 0 <= n_burn < n_iter:
-        raise GPMSAError(f"n_burn must be in [0, n_iter) = [0, {n_iter}), got {n_burn}")
+    n_burn = n_iter // 5 if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     if point not in ("mean", "map"):
         raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
-    if n_keep < 1:
-        raise GPMSAError(f"n_keep must be >= 1, got {n_keep}")
+    n_keep = check_count(n_keep, "n_keep")
+    if obs is None and discrepancy is not None:
+        given = repr(discrepancy) if isinstance(discrepancy, str) else "an array"
+        raise GPMSAError(
+            f"discrepancy={given} needs observations (obs=): a discrepancy is fitted with the "
+            "field data, and a simulator-only fit has none"
+        )
     seed = _seed(seed)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
                    mean_basis=mean_basis)  # fmt: skip

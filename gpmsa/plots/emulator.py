@@ -120,7 +120,8 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
                  fontsize="small")  # fmt: skip
     if functional:
         grid = emulator.standardizer.grid
-        rows = np.unique(np.linspace(0, actual.shape[0] - 1, min(max_runs, actual.shape[0]))
+        n_rows = min(check_count(max_runs, "max_runs"), actual.shape[0])
+        rows = np.unique(np.linspace(0, actual.shape[0] - 1, n_rows)
                          .round().astype(int))  # fmt: skip
         for c, i in enumerate(rows):
             col = f"C{c % 10}"

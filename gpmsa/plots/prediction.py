@@ -62,6 +62,8 @@ def prediction_bands(
         if observed.shape != (N, l):
             raise GPMSAError(f"observed must have shape ({N}, {l}) (one row per predicted x), "
                              f"got {observed.shape}")  # fmt: skip
+    if not isinstance(relative, bool | np.bool_):
+        raise GPMSAError(f"relative must be True or False, got {relative!r}")
     bands = {w: pred.interval(w, level) for w in ("y", "zeta", "eta", "delta")}
     eta_mean = pred.mean("eta")
     if relative:

@@ -201,7 +201,10 @@ def _pred_grid(emulator, obs: ObsData, grid):
             raise GPMSAError("a scalar output has no output grid; leave grid=None")
         return std.grid
     if grid is not None:
-        g = as_float(grid, "grid").reshape(-1)
+        g = as_float(grid, "grid")
+        if g.ndim > 1 and sum(n > 1 for n in g.shape) > 1:
+            raise GPMSAError(f"grid must be one row of output-grid points, got shape {g.shape}")
+        g = g.reshape(-1)
         check_finite(g, "grid")
         lo, hi = std.grid.min(), std.grid.max()
         if g.size == 0 or g.min() < lo or g.max() > hi:

@@ -55,8 +55,13 @@ def test_same_seed_same_numbers_and_map_point(small_sim):
 def test_fit_argument_errors(small_sim):
     with pytest.raises(gpmsa.GPMSAError, match="n_iter must be"):
         gpmsa.fit(small_sim, n_iter=1)
-    with pytest.raises(gpmsa.GPMSAError, match=r"n_burn must be in \[0, n_iter\)"):
-        gpmsa.fit(small_sim, n_iter=10, n_burn=10)
+    for n_burn in (10, -1, 2.5, "2"):  # a float was truncated, a string a raw ValueError
+        with pytest.raises(gpmsa.GPMSAError, match=r"n_burn must be an integer in \[0, 9\]"):
+            gpmsa.fit(small_sim, n_iter=10, n_burn=n_burn)
+    with pytest.raises(gpmsa.GPMSAError, match="n_keep must be an integer >= 1"):
+        gpmsa.fit(small_sim, n_iter=10, n_keep=float("nan"))
+    with pytest.raises(gpmsa.GPMSAError, match="discrepancy='constant' needs observations"):
+        gpmsa.fit(small_sim, n_iter=10, discrepancy="constant")  # was silently ignored
     with pytest.raises(gpmsa.GPMSAError, match="point must be"):
         gpmsa.fit(small_sim, n_iter=10, point="median")
     with pytest.raises(gpmsa.GPMSAError, match="unknown backend 'jax'"):

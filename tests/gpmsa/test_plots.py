@@ -124,6 +124,9 @@ def test_emulator_fit_against_held_out_runs_and_cross_validation():
     assert "cross-validation" in fig.axes[0].get_title()
     with pytest.raises(GPMSAError, match="held_out must be"):
         plots.emulator_fit(emu, (x, t, y))
+    for bad in (0, -1, 2.5):  # 0 and -1 drew nothing, silently
+        with pytest.raises(GPMSAError, match="max_runs must be an integer >= 1"):
+            plots.emulator_fit(emu, test, max_runs=bad)
 
 
 def test_prediction_bands_functional_and_scalar():
@@ -143,6 +146,8 @@ def test_prediction_bands_functional_and_scalar():
     for junk in ("x", {"y": 1.0}):  # were raw numpy errors
         with pytest.raises(GPMSAError, match="observed must be a numeric array"):
             plots.prediction_bands(pred, observed=junk)
+    with pytest.raises(GPMSAError, match="relative must be True or False, got 'yes'"):
+        plots.prediction_bands(pred, relative="yes")
     rng = np.random.default_rng(0)
     x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
     data = gpmsa.SimData(x=x, t=t, y=x + t, x_names=["x"], t_names=["t"])

@@ -191,6 +191,8 @@ def test_bad_input_names_the_problem():
         full_prediction(emu, obs, [[0.5, 0.5]])
     with pytest.raises(GPMSAError, match="grid must be non-empty and lie within"):
         full_prediction(emu, obs, [[0.5]], grid=[-1.0, 0.5])
+    with pytest.raises(GPMSAError, match=r"grid must be one row of output-grid points, got shape"):
+        full_prediction(emu, obs, [[0.5]], grid=[[0.1, 0.2], [0.3, 0.4]])  # was flattened
     with pytest.raises(GPMSAError, match="what must be one of"):
         full_prediction(emu, obs, [[0.5]], n_draws=2).mean("ysim")
     with pytest.raises(GPMSAError, match="posterior must be a gpmsa.Posterior"):
