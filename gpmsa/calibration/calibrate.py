@@ -45,7 +45,7 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import n_workers, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
-from gpmsa.model.data import ObsData, check_seed
+from gpmsa.model.data import ObsData, check_count, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
@@ -167,9 +167,8 @@ def calibrate(
     """
     check_emulator(emulator, categorical_theta=True)
     seed = check_seed(seed)
-    for name, val, low in (("n_samples", n_samples, 2), ("n_chains", n_chains, 1)):
-        if not (isinstance(val, int | np.integer) and val >= low):
-            raise GPMSAError(f"{name} must be an integer >= {low}, got {val}")
+    n_samples = check_count(n_samples, "n_samples", 2)
+    n_chains = check_count(n_chains, "n_chains")
     if not (isinstance(n_burn, int | np.integer) and 0 <= n_burn < n_samples - 1):
         raise GPMSAError(f"n_burn must be an integer in [0, n_samples - 1), got {n_burn}")
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)

@@ -37,7 +37,7 @@ from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weigh
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
-from gpmsa.model.data import as_float, check_seed
+from gpmsa.model.data import as_float, check_count, check_seed
 
 METHODS = ("auto", "grid", "mcmc")
 RESOLVE_SD = 4.0
@@ -131,9 +131,7 @@ class Calibrator:
         self.backend = backend
         self.q = q
         self.extrapolate = extrapolate
-        if not (isinstance(n_draws, int | np.integer) and n_draws >= 1):
-            raise GPMSAError(f"n_draws must be an integer >= 1, got {n_draws}")
-        self.n_draws = int(n_draws)
+        self.n_draws = check_count(n_draws, "n_draws")
         check_memory(  # the draws of theta and lamOs and their grid cells, made lazily
             8.0 * 3 * self.n_draws * (q + 1),
             f"Calibrator(n_draws={self.n_draws}): the posterior's draws of {q + 1} parameters",
@@ -147,9 +145,7 @@ class Calibrator:
             self.mcmc_options.setdefault("constraint", constraint)
         if n_grid is None:
             n_grid = 129 if q == 1 else 65
-        if not (isinstance(n_grid, int | np.integer) and n_grid >= 3):
-            raise GPMSAError(f"n_grid must be an integer >= 3, got {n_grid}")
-        self.n_grid = int(n_grid)
+        self.n_grid = check_count(n_grid, "n_grid", 3)
         if self.method == "mcmc":
             return
         m, p_u = emulator.x_unit.shape[0], emulator.K.shape[1]

@@ -96,10 +96,7 @@ def fit(
     names each parameter with R-hat > 1.01 or ESS < 100. A chain that fails or produces
     non-finite draws raises ``gpmsa.ChainError`` naming it.
     """
-    if not isinstance(n_iter, (int, np.integer)) or n_iter < 2:
-        raise GPMSAError(f"n_iter must be an integer >= 2, got {n_iter!r}")
-    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
-        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
     n_burn = n_iter // 5 if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     if point not in ("mean", "map"):
         raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
