@@ -37,16 +37,23 @@ def _vehicle_diff(trained, model) -> str:
     )
 
 
+def _recorded(emulator, key: str, what: str):
+    """The emulator's metadata ``key``; EmulatorMismatchError saying it does not say ``what``
+    when the record is missing."""
+    meta = dict(getattr(emulator, "metadata", None) or {})
+    if key not in meta:
+        raise EmulatorMismatchError(
+            f"the emulator's metadata has no {key!r}: it does not say {what} "
+            "(examples/train_emulator.py records it)"
+        )
+    return meta[key]
+
+
 def emulator_feature(emulator) -> FeatureSpec:
     """The feature the emulator was trained on (its metadata's ``feature``)."""
-    meta = dict(getattr(emulator, "metadata", None) or {})
-    if "feature" not in meta:
-        raise EmulatorMismatchError(
-            "the emulator's metadata has no 'feature': it does not say what observation it "
-            "was trained on (examples/train_emulator.py records it)"
-        )
+    record = _recorded(emulator, "feature", "what observation it was trained on")
     try:
-        return FeatureSpec.from_dict(meta["feature"])
+        return FeatureSpec.from_dict(record)
     except (TypeError, ValueError) as exc:
         raise EmulatorMismatchError(f"the emulator's feature is malformed: {exc}") from exc
 
@@ -119,14 +126,9 @@ def emulator_vehicle(emulator):
     """The vehicle model the emulator was trained for (its metadata's ``vehicle``, as
     ``model.describe()`` recorded it), e.g. to run the closed loop with a user's emulator;
     EmulatorMismatchError when the record is missing or malformed."""
-    meta = dict(getattr(emulator, "metadata", None) or {})
-    if "vehicle" not in meta:
-        raise EmulatorMismatchError(
-            "the emulator's metadata has no 'vehicle': it does not say which vehicle it was "
-            "trained for (examples/train_emulator.py records it)"
-        )
+    record = _recorded(emulator, "vehicle", "which vehicle it was trained for")
     try:
-        return vehicle.from_description(meta["vehicle"])
+        return vehicle.from_description(record)
     except (vehicle.VehicleError, TypeError) as exc:
         raise EmulatorMismatchError(f"the emulator's vehicle record is malformed: {exc}") from exc
 

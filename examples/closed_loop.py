@@ -96,17 +96,17 @@ def load_emulator(case: str, kind: str, emulator_dir: Path | None):
 
 def run_case(
     case: str,
+    emu,
     seeds: range,
     method: str,
     simplex: control.Simplex,
     segments=PAPER_SEGMENTS,
     record: Path | None = None,
-    emulator_dir: Path | None = None,
 ) -> list:
-    """The closed-loop results of one test case and estimator, one per seed (track and noise),
-    on the vehicle and at the noise level the emulator was trained for; with ``record``, each
-    run is also written there as ``case{A,B}_{method}_run{k}.mcap`` (control.record_run)."""
-    emu = load_emulator(case, "band" if method == "changepoint" else "window", emulator_dir)
+    """The closed-loop results of one test case and estimator on emulator ``emu``, one per seed
+    (track and noise), on the vehicle and at the noise level the emulator was trained for; with
+    ``record``, each run is also written there as ``case{A,B}_{method}_run{k}.mcap``
+    (control.record_run)."""
     bcr = control.bcr_settings_for(emu, method=method)
     likelihood = control.BCR.from_emulator(emu, bcr).model  # prepared once for all runs
     return [
@@ -204,21 +204,24 @@ def main(argv: list[str] | None = None) -> dict:
     except control.ControlError as err:
         parser.error(str(err))
     emulator_dir = Path(args.emulator_dir) if args.emulator_dir else None
-    for case in args.cases if emulator_dir else ():  # every file before the first run
-        for kind in ("band", "window"):
-            try:
-                load_emulator(case, kind, emulator_dir)
-            except (FileNotFoundError, gpmsa.EmulatorFileError) as err:
-                parser.error(f"--emulator-dir: {err}")
+    try:  # every file before the first run
+        emulators = {
+            (case, kind): load_emulator(case, kind, emulator_dir)
+            for case in args.cases
+            for kind in ("band", "window")
+        }
+    except (FileNotFoundError, gpmsa.EmulatorFileError) as err:
+        parser.error(f"--emulator-dir: {err}")
     record = Path(args.record) if args.record else None
 
     metrics: dict = {"ours": {}, "paper_method": {}}
     for case in args.cases:
-        noise = control.emulator_noise_std(load_emulator(case, "band", emulator_dir))
+        noise = control.emulator_noise_std(emulators[case, "band"])
         title = f"Test Case {case} ({f'N(0, {noise**2:g}) noise' if noise else 'noise-free'})"
         for key, method in (("ours", args.method), ("paper_method", "window")):
             try:
-                results = run_case(case, seeds, method, simplex, segments, record, emulator_dir)
+                emu = emulators[case, "band" if method == "changepoint" else "window"]
+                results = run_case(case, emu, seeds, method, simplex, segments, record)
             except control.EmulatorMismatchError as err:  # e.g. a GD outside the domain
                 parser.error(f"--track: {err}" if "track GD" in str(err) else str(err))
             metrics[key][case] = summarise(results, gds)
