@@ -14,7 +14,8 @@ Sets (run k drives a track synthesised with seed k, and noise seed k):
   (one 1,000-sample window, log f, the paper's prior: ``method="window"``);
 - ``heldout``: the paper's track, seeds 11-20, both estimators;
 - ``random``: random tracks (3-5 segments of 20-60 m, GD uniform in [220, 580]), seeds 401-440
-  (``--random-tracks N``: 401 to 400 + N): coverage of the 90% intervals and the detection delay
+  (``--random-tracks N``: 401 to 400 + N; ``--random-first-seed S``: S to S + N - 1, a fresh
+  set none of the settings has seen): coverage of the 90% intervals and the detection delay
   of rises of at least 150 GD units, its median with a 90% bootstrap interval (one rise's delay
   swings by metres with the loop's chaos, so the median of 18 rises moves by 1-2 m);
 - ``steady``: single-GD roads of 100 m (GD 250-550, seeds 501-503) driven at a constant 1.0, 1.5
@@ -139,6 +140,7 @@ def jobs_for(
     update_every: int | None = None,
     speed_step: float = control.Simplex.speed_step_mps,
     random_tracks: int = len(SETS["random"]),
+    random_first_seed: int = SETS["random"].start,
 ) -> list[tuple]:
     out = []
     for case in cases:
@@ -149,7 +151,7 @@ def jobs_for(
             ]
         elif name in ("random", "random-dev"):
             if name == "random":
-                seeds = range(seeds.start, seeds.start + random_tracks)
+                seeds = range(random_first_seed, random_first_seed + random_tracks)
             out += [(case, "random", s, "changepoint", cp, None) for s in seeds]
         elif name in ("steady", "steady-dev"):
             out += [
@@ -254,8 +256,9 @@ def main() -> None:
     )
     parser.add_argument(
         "--update-every", type=int, default=None,
-        help="samples between estimates of ours (default: the BCR's, half a block: two "
-        "interleaved change-point filters; 125 = one filter; control.BCRSettings)",
+        help="samples between estimates of ours (default: the BCR's, a third of a block: "
+        "three interleaved change-point filters; 63 = two; 125 = one filter; "
+        "control.BCRSettings)",
     )  # fmt: skip
     parser.add_argument(
         "--speed-step", type=float, default=control.Simplex.speed_step_mps,
@@ -265,9 +268,15 @@ def main() -> None:
         "--random-tracks", type=int, default=len(SETS["random"]),
         help=f"random tracks of the random set, seeds 401 on (default {len(SETS['random'])})",
     )  # fmt: skip
+    parser.add_argument(
+        "--random-first-seed", type=int, default=SETS["random"].start,
+        help="first seed of the random set (another seed draws another held-out set)",
+    )  # fmt: skip
     args = parser.parse_args()
     if args.random_tracks < 1:
         parser.error(f"--random-tracks must be >= 1, got {args.random_tracks}")
+    if args.random_first_seed < 0:
+        parser.error(f"--random-first-seed must be >= 0, got {args.random_first_seed}")
     names = [n for n in args.sets.split(",") if n]
     unknown = set(names) - set(SETS)
     if unknown:
@@ -290,7 +299,7 @@ def main() -> None:
     for name in names:
         jobs = jobs_for(
             name, cases, cp, args.emulator_dir, args.update_every, args.speed_step,
-            args.random_tracks,
+            args.random_tracks, args.random_first_seed,
         )  # fmt: skip
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             results = list(pool.map(_run, jobs))
@@ -307,6 +316,9 @@ def main() -> None:
     print(f"Simplex speed step {args.speed_step:g} m/s")
     if args.emulator_dir:
         print(f"band emulators from {args.emulator_dir}")
+    if "random" in names:
+        last = args.random_first_seed + args.random_tracks - 1
+        print(f"random set: seeds {args.random_first_seed}-{last}")
     print("\n".join(out))
     load = os.getloadavg()
     print(f"\n{time.perf_counter() - tic:.0f} s on {args.workers} worker(s), load average "

@@ -11,7 +11,7 @@ Methods (``BCRSettings.method``):
   interleaved ("phases"), each on its own disjoint blocks, which end K * update_every samples
   apart; every update feeds the block that just ended (the newest block_samples samples) to its
   phase and reports the phases' posteriors pooled, the phase with the newest information
-  weighing K, the next K - 1, ... (an estimate every update_every samples; the default is two
+  weighing K, the next K - 1, ... (an estimate every update_every samples; the default is three
   phases).
 - ``"window"``: the paper's estimator: the moving buffer of the last 1,000 samples, its log
   variance, the posterior of that window alone under the emulator's prior (paper eqs. 3, 5).
@@ -50,12 +50,13 @@ from control.tracker import GDTracker, TrackerSettings
 from gpmsa import Posterior
 
 METHODS = ("changepoint", "window", "filter", "tempered")
-DEFAULT_PHASES = 2
-"""Interleaved change-point filters by default: an estimate every half block (0.53 s at 120 Hz).
-Chosen on the development set of benchmarks/closed_loop_accuracy.py against one filter: the
-paper track's rises are seen ~1 m sooner, its GD-500 part is 1-4 units better and the speed
-command moves half as often; 3 or 4 phases gave no further gain beyond the run-to-run scatter
-(docs/closed-loop.md, "How often to estimate")."""
+DEFAULT_PHASES = 3
+"""Interleaved change-point filters by default: an estimate every third of a block (42 samples,
+0.35 s at 120 Hz). Chosen on the development set of benchmarks/closed_loop_accuracy.py, with the
+Simplex's speed grid, against two phases and four: the speed command moves about half as often
+as with two phases (held out as well), the RMSE and coverage stay within the run-to-run scatter,
+and the rise delay over 120 development tracks was 0.5 m shorter (on the held-out sets it moved
+within its scatter; docs/closed-loop.md, "How often to estimate")."""
 MAX_PHASES = 8
 """Most interleaved change-point filters (``block_samples / update_every``) a BCR runs."""
 MAX_SPEED_CHANGE = 0.5
@@ -72,11 +73,11 @@ class BCRSettings:
     Attributes:
         feature: the observation (block feature for "changepoint"; the window for the others).
         method: one of METHODS (see the module docstring).
-        update_every: new samples between estimates (None: half a block for "changepoint",
-            DEFAULT_PHASES interleaved filters; 125 for the window methods: about one estimate
-            a second at 120 Hz). For "changepoint", ceil(block / update_every) interleaved
-            filters run (at most MAX_PHASES; see the module docstring); the block length is
-            one filter.
+        update_every: new samples between estimates (None: a third of a block for
+            "changepoint", DEFAULT_PHASES interleaved filters; 125 for the window methods:
+            about one estimate a second at 120 Hz). For "changepoint", ceil(block /
+            update_every) interleaved filters run (at most MAX_PHASES; see the module
+            docstring); the block length is one filter.
         changepoint: settings of the change-point filter.
         tracker: settings of the window methods' filter.
         max_age_s: an estimate older than this (sample time since its newest information)

@@ -20,7 +20,7 @@ from control.sensor_checks import MIN_SEGMENT
 
 WINDOW = {"feature": PAPER_WINDOW}
 ONE_FILTER = {"update_every": 125}  # one change-point filter: an estimate per 125-sample block
-EVERY = BCRSettings().samples_per_update  # the default: two interleaved filters
+EVERY = BCRSettings().samples_per_update  # the default: three interleaved filters
 
 
 def feed(bcr, t, p, a, v, chunk=125):
@@ -106,32 +106,39 @@ def test_a_fault_skips_its_block_and_keeps_the_run_length_posterior(block_model)
     assert ests[k + 2].ok
 
 
-def test_interleaved_phases_each_pool_their_own_disjoint_blocks(block_model):
-    """update_every = 63 of 125: two filters, each on blocks ending 126 samples apart; every
-    update reports their mixture, the phase whose block just ended weighing 2, the other 1."""
+@pytest.mark.parametrize("every", [63, 42])
+def test_interleaved_phases_each_pool_their_own_disjoint_blocks(block_model, every):
+    """update_every = 63 (42) of 125: two (three) filters, each on blocks ending 126 samples
+    apart; every update reports their mixture, the phase whose block just ended weighing K, the
+    one before it K - 1, and so on."""
     from control import ChangePointFilter
     from control.changepoint import mixture_posterior
     from control.feature import block_features
 
     t, p, a, v = stream(const(400), 1.5, 30, seed=4)
-    bcr = BCR(block_model, update_every=63)
-    ests = feed(bcr, t, p, a, v, chunk=63)
-    assert ests[0].status == "filling" and "63 of 125" in ests[0].reason
-    assert all(e.ok for e in ests[1:])
-    # one likelihood per update after the first: each block is the newest 125 samples
-    n_updates = t.size // 63
-    assert block_model.calls == n_updates - 1
-    step = 1.5 * 126 / 120  # metres between the ends of one phase's blocks
-    refs = {}
-    for last in (n_updates - 1, n_updates - 2):  # the newest update of each phase
-        ends = [63 * (u + 1) for u in range(last % 2, last + 1, 2) if u >= 1]
-        ref = refs[last] = ChangePointFilter(block_model.gd, bcr.settings.changepoint)
+    bcr = BCR(block_model, update_every=every)
+    k = bcr.settings.phases
+    assert k == -(-125 // every)
+    ests = feed(bcr, t, p, a, v, chunk=every)
+    n_filling = -(-125 // every) - 1  # updates before the first whole block
+    assert all(e.status == "filling" for e in ests[:n_filling])
+    assert f"{every} of 125" in ests[0].reason
+    assert all(e.ok for e in ests[n_filling:])
+    # one likelihood per update after filling: each block is the newest 125 samples
+    n_updates = t.size // every
+    assert block_model.calls == n_updates - n_filling
+    step = 1.5 * k * every / 120  # metres between the ends of one phase's blocks
+    refs = []
+    for last in range(n_updates - 1, n_updates - 1 - k, -1):  # the newest update of each phase
+        ends = [every * (u + 1) for u in range(last % k, last + 1, k) if u >= n_filling]
+        ref = ChangePointFilter(block_model.gd, bcr.settings.changepoint)
         for j, end in enumerate(ends):
             y = block_features(a[end - 125 : end], bcr.settings.feature)[0]
             ref.update(block_model.loglik(y, 1.5), 0.0 if j == 0 else step)
-        phase = bcr._phases[last % 2].filter
+        phase = bcr._phases[last % k].filter
         np.testing.assert_allclose(phase.gd_mass, ref.gd_mass, rtol=1e-9, atol=1e-300)
-    pooled = mixture_posterior([refs[n_updates - 1], refs[n_updates - 2]], [2.0, 1.0])
+        refs.append(ref)
+    pooled = mixture_posterior(refs, np.arange(k, 0, -1.0))
     np.testing.assert_allclose(
         ests[-1].posterior.grids["GD"].density, pooled.grids["GD"].density, rtol=1e-9
     )
@@ -149,6 +156,7 @@ def test_with_phases_the_estimate_holds_still_while_no_information_comes(block_m
     bcr = BCR(block_model)
     feed(bcr, t, p, a, v, chunk=EVERY)
     still = feed(bcr, t2, p2, a2, v2, chunk=EVERY)[2:]  # the first blocks straddle the stop
+    still = list({e.time: e for e in still}.values())  # a short last chunk repeats the last
     assert len(still) >= 3 and all(e.ok and "no new information" in e.reason for e in still)
     steps = np.diff([e.gd_mean for e in still])
     assert np.all(steps < 0) or np.all(steps > 0)  # one way, not back and forth
@@ -209,7 +217,7 @@ def test_each_fault_kind_gives_no_estimate_and_the_bcr_recovers(
     bcr = BCR(block_model)
     every = bcr.settings.samples_per_update  # one update per call, as in the closed loop
     ests = feed(bcr, *obs, chunk=every)
-    ends = t[every - 1 :: every]  # the time of each call's last sample
+    ends = obs[0][every - 1 :: every]  # the time of each call's last sample (after any drop)
     hit = [e for e, end in zip(ests, ends, strict=False) if 10.0 <= end < 12.0 + 125 / 120]
     assert hit and all(not e.ok for e in hit[1:-1])
     assert any(e.status == status and words in e.reason for e in hit)
@@ -357,6 +365,7 @@ def test_changepoint_settings_are_checked(block_model):
     with pytest.raises(ControlError, match="update_every must be an integer >= 1"):
         BCR(block_model, update_every=0)
     assert BCRSettings(update_every=63).phases == 2 and BCRSettings(update_every=16).phases == 8
+    assert BCRSettings().phases == 3 and BCRSettings().samples_per_update == 42  # the default
     with pytest.raises(ControlError, match="needs an ObservationModel"):
         BCR(FakeCalibrator())
     bcr = BCR(block_model)

@@ -6,6 +6,7 @@ import pytest
 import control
 import roadgen
 import vehicle
+from control.bcr import DEFAULT_PHASES
 from tests._examples import load_example
 
 
@@ -82,9 +83,10 @@ def test_block_samples_option_sets_the_bcrs_block(tmp_path):
     emu = gpmsa.load(tmp_path / "emulators" / "jackal_A.gpmsa")
     assert control.FeatureSpec.from_dict(emu.metadata["feature"]).block_samples == 80
     settings = control.bcr_settings_for(emu)
-    assert settings.feature.block_samples == 80 and settings.samples_per_update == 40
+    every = -(-80 // DEFAULT_PHASES)  # the default's interleaved phases of 80-sample blocks
+    assert settings.feature.block_samples == 80 and settings.samples_per_update == every
     r = control.run_closed_loop(roadgen.track([(10, 300)], seed=2), emu, seed=2)
-    assert np.median(np.diff(r.time)) == pytest.approx(40 / 120)  # two phases of 80-sample blocks
+    assert np.median(np.diff(r.time)) == pytest.approx(every / 120)
     assert (r.status == "ok").mean() > 0.7
 
 
