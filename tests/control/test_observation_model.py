@@ -153,6 +153,46 @@ def test_a_gain_drop_over_32_samples_or_more_is_found_below_the_noise_floor(
 
 @settings(max_examples=60, deadline=None)
 @given(
+    start=st.integers(0, 117),
+    length=st.integers(8, 31),
+    left=st.floats(1e-9, 1e-5),
+    signal_sd=st.floats(0.0, 3.0),
+    noise_sd=st.floats(0.1, 2.0),
+    seed=st.integers(0, 2**16),
+)
+def test_a_short_gain_drop_of_8_to_31_samples_is_found_below_the_noise_floor(
+    start, length, left, signal_sd, noise_sd, seed
+):
+    """Property: a noisy sensor whose gain drops for 8-31 samples (too short for the 32-sample
+    floor: soak seed 21, #369, a gain of 1e-3 for 25 samples) so far that the reading's variance
+    is ``left`` <= 1e-5 of the noise variance is a fault; the same block without it is not."""
+    rng = np.random.default_rng(seed)
+    a = signal_sd * rng.standard_normal(125) + noise_sd * rng.standard_normal(125)
+    limits = SensorLimits(
+        noise_sd_mps2=noise_sd, max_same=125, dead_fraction=0.0, max_level_jump=1e300
+    )
+    assert signal_fault(a, limits) == ""
+    stop = min(start + length, 125)
+    start = min(start, stop - 8)
+    a[start:stop] *= np.sqrt(left * noise_sd**2 / (signal_sd**2 + noise_sd**2))
+    reason = signal_fault(a, limits)
+    assert reason.startswith("attenuated signal") and "vary less than" in reason
+
+
+def test_the_shorter_noise_floors_are_as_rare_for_pure_noise_as_the_32_sample_floor():
+    from scipy.stats import chi2
+
+    from control.sensor_checks import NOISE_STRETCH, noise_floors
+
+    floors = noise_floors(0.1)
+    assert floors[0] == (NOISE_STRETCH, 0.1) and [n for n, _ in floors] == [32, 16, 8]
+    p = [chi2.cdf(f * (n - 1), n - 1) for n, f in floors]
+    np.testing.assert_allclose(p, p[0], rtol=1e-9)
+    assert p[0] < 1e-10 and floors[1][1] == pytest.approx(0.0199, abs=1e-4)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
     start=st.integers(0, 119),
     length=st.integers(6, 125),
     kind=st.sampled_from(["scale", "stuck", "clip", "quantize"]),
