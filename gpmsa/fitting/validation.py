@@ -22,7 +22,8 @@ import math
 
 import numpy as np
 
-from gpmsa.errors import EmulatorFileError
+from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.model.data import output_scale
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import MAX_PRIOR_SHAPE
 from gpmsa.model.transforms import UNIT_TOL
@@ -320,7 +321,10 @@ def check_values(arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
     tol = REL_TOL * (y_sd + np.abs(mean))
     if np.any(np.abs(mean - y_mean) > tol):
         raise _fail("arrays/y_mean", "differs from the mean of the training outputs arrays/y")
-    sd = float(np.std(y - mean, ddof=1))
+    try:  # the writer's definition of the output scale (Standardizer.from_sim)
+        sd = output_scale(y)
+    except GPMSAError as exc:  # zero spread, or a spread that overflows
+        raise _fail("arrays/y", str(exc)) from None
     if abs(sd - y_sd) > REL_TOL * sd:
         raise _fail("arrays/y_sd", f"{y_sd!r}, but the training outputs' sd is {sd!r}")
     K = arrays["K"]
