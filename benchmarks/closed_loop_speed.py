@@ -2,6 +2,7 @@
 
     python benchmarks/closed_loop_speed.py [--repeats 3] [--case A] [--method changepoint]
     python benchmarks/closed_loop_speed.py --update-every 125   # one change-point filter
+    python benchmarks/closed_loop_speed.py --lattice-p 0        # without the lattice check
 
 Prints, for the paper's 150 m track: simulated time, wall time and real-time factor of the whole
 loop (median over repeats), the BCR's share (the time spent in BCR.update, measured separately by
@@ -13,6 +14,7 @@ included; BCR.update p99 <= 2 ms.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import time
 
@@ -36,12 +38,19 @@ def main() -> None:
         "--update-every", type=int, default=None,
         help="samples between estimates (default: the BCR's; 125 = one change-point filter)",
     )  # fmt: skip
+    parser.add_argument(
+        "--lattice-p", type=float, default=None,
+        help="SensorLimits.lattice_p of the sensor checks (default: its default; 0: off)",
+    )  # fmt: skip
     args = parser.parse_args()
     emu = control.shipped_emulator(args.case, "band" if args.method == "changepoint" else "window")
     noise = float(emu.metadata["noise_std"])
     settings = control.bcr_settings_for(
         emu, method=args.method, update_every=args.update_every
     )  # fmt: skip
+    if args.lattice_p is not None:
+        sensor = dataclasses.replace(settings.sensor, lattice_p=args.lattice_p)
+        settings = dataclasses.replace(settings, sensor=sensor)
     tic = time.perf_counter()
     likelihood = control.BCR.from_emulator(emu, settings).model
     prep = time.perf_counter() - tic
@@ -74,7 +83,8 @@ def main() -> None:
     load = os.getloadavg()
     print(
         f"closed loop, case {args.case}, {args.method}, paper track, {args.repeats} runs "
-        f"(medians); load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}"
+        f"(medians), lattice_p {settings.sensor.lattice_p:g}; "
+        f"load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}"
     )
     print(f"  likelihood preparation      {prep * 1e3:8.1f} ms (once)")
     print(f"  simulated time              {np.median(sims):8.1f} s")

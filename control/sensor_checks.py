@@ -1,8 +1,9 @@
 """Checks of raw sensor samples before the BCR uses them: what a healthy accelerometer never does.
 
 A real accelerometer on a moving vehicle gives values that change from sample to sample, take
-many distinct values, never sit at the ends of the sensor's range and never read quieter than
-its own noise. Each check returns a reason (a sentence for a person) or "" when the samples pass.
+many distinct values, never line up on a lattice coarser than its resolution, never sit at the
+ends of the sensor's range and never read quieter than its own noise. Each check returns a
+reason (a sentence for a person) or "" when the samples pass.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.special import bdtrc
 from scipy.stats import chi2
 
 from control.errors import ControlError
@@ -28,6 +30,9 @@ SHORT_NOISE_STRETCHES = (8, 16)
 """Shorter stretches the noise-floor check also looks at, each against the fraction of the noise
 variance that pure noise reads as rarely as ``NOISE_STRETCH`` samples read ``noise_floor``
 (`noise_floors`): a gain that drops for 8-31 samples (0.07-0.26 s)."""
+LATTICE_STRETCHES = (6, 8)
+"""Stretches (samples, 0.05 and 0.07 s at 120 Hz) the lattice check looks at: a coarse
+quantisation as short as 6 samples (`lattice_stretch`)."""
 FREE_FALL_MPS2 = -GRAVITY
 """What the vertical acceleration reads while a wheel is in the air (the simulator's -g), m/s^2."""
 
@@ -73,6 +78,14 @@ class SensorLimits:
             held to the floors pure noise falls below as rarely (0.020 and 6.2e-4 at the
             default; `noise_floors`); in a campaign of 198 clean noisy drives (2.9 million
             stretches, seed 7) the quietest read 0.345 and 0.018.
+        lattice_p: a stretch of 6 or 8 samples whose values sit on a lattice (an offset plus
+            multiples of a step far above the block's resolution) as often as a healthy sensor
+            does with a probability below this (`lattice_stretch`, Bonferroni over the steps
+            tried and the two stretch lengths) is a quantised signal: the short quantisations
+            that ``min_distinct`` cannot see. Of 45,540 clean blocks of 125 samples (198 drives
+            of 120 s, seed 7, with and without noise, also rounded to ADC resolutions of
+            0.001-0.1 m/s^2) the most lattice-like scored 1.3e-6 (`benchmarks/sensor_checks.py`).
+            0 switches the check off.
     """
 
     max_repeats: int = 8
@@ -84,6 +97,7 @@ class SensorLimits:
     free_fall_mps2: float | None = FREE_FALL_MPS2
     noise_sd_mps2: float | None = None
     noise_floor: float = 0.1
+    lattice_p: float = 1e-10
 
     def __post_init__(self) -> None:
         for name in ("max_repeats", "min_distinct", "max_same"):
@@ -108,6 +122,8 @@ class SensorLimits:
             )
         if not (np.isfinite(self.noise_floor) and 0 < self.noise_floor < 1):
             raise ControlError(f"noise_floor must lie in (0, 1), got {self.noise_floor}")
+        if not (np.isfinite(self.lattice_p) and 0 <= self.lattice_p < 1):
+            raise ControlError(f"lattice_p must lie in [0, 1), got {self.lattice_p}")
 
 
 def longest_repeat(a: np.ndarray) -> int:
@@ -149,6 +165,16 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits) -> str:
             f"dead sensor: samples {start}-{start + DEAD_STRETCH - 1} span less than "
             f"{limits.dead_fraction:g} of the block's standard deviation"
         )
+    if limits.lattice_p > 0:
+        tries = len(LATTICE_STRETCHES)
+        for stretch in LATTICE_STRETCHES:
+            p, start, step = lattice_stretch(a, stretch, limits.free_fall_mps2)
+            if tries * p < limits.lattice_p:
+                return (
+                    f"quantised signal: samples {start}-{start + stretch - 1} sit on a lattice of "
+                    f"step {step:.4g} m/s^2 (probability {tries * p:.2g} for a healthy sensor, "
+                    f"allowed {limits.lattice_p:g})"
+                )
     if limits.noise_sd_mps2 is not None:
         noise_var = limits.noise_sd_mps2**2
         for stretch, fraction in noise_floors(limits.noise_floor):
@@ -186,6 +212,56 @@ def dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None) -> int
         dead &= np.abs(total / DEAD_STRETCH - free_fall) > 0.05 * abs(free_fall)
     hit = np.flatnonzero(dead)
     return int(hit[0]) if hit.size else -1
+
+
+def lattice_stretch(
+    a: np.ndarray, stretch: int, free_fall: float | None = FREE_FALL_MPS2
+) -> tuple[float, int, float]:
+    """How lattice-like the most lattice-like ``stretch`` consecutive samples of ``a`` are:
+    (probability, the stretch's start, the step in m/s^2); (1, -1, nan) if no stretch is.
+
+    For each stretch and each step ``g`` between two of its values that are neighbours in
+    value, counts the stretch's other values that lie within r/2 of the lattice through those
+    two (r: the block's resolution, its smallest gap between distinct values, at least the
+    sensor's). A healthy sensor puts a value there with probability at most ``2 r / g``, so the
+    binomial tail of the count, times the number of steps tried (Bonferroni), bounds the chance
+    of that many hits; a signal rounded to a coarse step puts every value there. Values within
+    5% of ``free_fall`` (a wheel in the air reads it) neither count nor make a step.
+    """
+    gaps = np.diff(np.sort(a))
+    gaps = gaps[gaps > 0]
+    if gaps.size == 0 or a.size < stretch:
+        return 1.0, -1, float("nan")
+    resolution = float(gaps.min())
+    w = a[_window_index(a.size, stretch)]  # (stretch, stretches)
+    low = np.sort(w, axis=0)
+    step = np.diff(low, axis=0)  # (stretch - 1 steps, stretches): neighbours in value
+    low = low[:-1]
+    usable = step > resolution
+    flight = np.zeros(w.shape, dtype=bool)
+    if free_fall is not None:
+        flight = np.abs(w - free_fall) <= 0.05 * abs(free_fall)
+        usable &= np.abs(low - free_fall) > 0.05 * abs(free_fall)
+        usable &= np.abs(low + step - free_fall) > 0.05 * abs(free_fall)
+    if not usable.any():
+        return 1.0, -1, float("nan")
+    g = np.where(usable, step, 1.0)
+    x = (w[None] - low[:, None]) / g[:, None]  # (steps, stretch, stretches)
+    on = (np.abs(x - np.rint(x)) * g[:, None] <= 0.5 * resolution) & ~flight[None]
+    hits = on.sum(axis=1) - 2  # the two values that make the step are on it
+    row, col = np.nonzero(usable & (hits > 0))
+    if row.size == 0:
+        return 1.0, -1, float("nan")
+    chance = np.minimum(1.0, 2.0 * resolution / g[row, col])
+    p = bdtrc(hits[row, col] - 1, stretch - 2, chance)  # P(hits or more)
+    k = int(np.argmin(p))
+    return float(p[k] * (stretch - 1)), int(col[k]), float(step[row[k], col[k]])
+
+
+@functools.lru_cache(maxsize=16)
+def _window_index(n: int, stretch: int) -> np.ndarray:
+    """Indices (stretch, n - stretch + 1) of every ``stretch`` consecutive of n samples."""
+    return np.arange(stretch)[:, None] + np.arange(n - stretch + 1)
 
 
 @functools.lru_cache(maxsize=8)

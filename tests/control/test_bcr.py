@@ -224,6 +224,21 @@ def test_each_fault_kind_gives_no_estimate_and_the_bcr_recovers(
     assert ests[-1].ok and abs(ests[-1].gd_mean - 400) < 60
 
 
+def test_a_quantisation_of_seven_samples_is_a_sensor_fault(block_model):
+    """Soak seed 19, #131: steps of 2.6 m/s^2 for 0.06 s, unflagged before the lattice check,
+    drove 3.5 m too fast on rough ground."""
+    t, p, a, v = stream(const(400), 1.5, 20, seed=5)
+    fault = SensorFault(10.001, 0.058, "quantize", 2.6)
+    obs = apply_faults(t, p, a, v, [fault], np.random.default_rng(0))
+    assert np.sum(obs[2] != a) == 7
+    bcr = BCR(block_model)
+    ests = feed(bcr, *obs, chunk=bcr.settings.samples_per_update)
+    hit = [e for e in ests if e.status == "sensor_fault"]
+    assert hit and all("quantised signal" in e.reason for e in hit)
+    assert all(10.0 <= e.time < 10.06 + 2 * 125 / 120 for e in hit)
+    assert ests[-1].ok
+
+
 def test_a_call_with_many_updates_returns_its_gravest_fault_not_only_the_newest(block_model):
     t, p, a, v = stream(const(400), 1.5, 30, seed=5)
     a = a.copy()

@@ -9,6 +9,7 @@ import control
 from control import BlockScatter, ControlError, EmulatorMismatchError, ObservationModel
 from control.sensor_checks import (
     SensorLimits,
+    lattice_stretch,
     level_jump,
     longest_repeat,
     quietest_stretch,
@@ -189,6 +190,70 @@ def test_the_shorter_noise_floors_are_as_rare_for_pure_noise_as_the_32_sample_fl
     p = [chi2.cdf(f * (n - 1), n - 1) for n, f in floors]
     np.testing.assert_allclose(p, p[0], rtol=1e-9)
     assert p[0] < 1e-10 and floors[1][1] == pytest.approx(0.0199, abs=1e-4)
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    start=st.integers(0, 117),
+    length=st.integers(8, 60),
+    step=st.floats(0.3, 3.0),
+    offset=st.floats(0.0, 1.0),
+    signal_sd=st.floats(0.5, 3.0),
+    noise_sd=st.sampled_from([0.0, 1.0]),
+    seed=st.integers(0, 2**16),
+)
+def test_a_short_coarse_quantisation_is_a_quantised_signal(
+    start, length, step, offset, signal_sd, noise_sd, seed
+):
+    """Property: a signal rounded to a step (0.3-3x its sd) for 8-60 samples, too few for
+    ``min_distinct`` (soak seed 19, #131: steps of 2.6 m/s^2 for 7 samples), is a fault and the
+    lattice check finds it, wherever its first 8 samples take two neighbouring levels and the
+    rest of the block is finer than 1/200 of the step; the same block unrounded is no fault."""
+    rng = np.random.default_rng(seed)
+    a = signal_sd * rng.standard_normal(125) + noise_sd * rng.standard_normal(125)
+    limits = SensorLimits(noise_sd_mps2=noise_sd or None)
+    assert signal_fault(a, limits) == ""
+    stop = min(start + length, 125)
+    start = min(start, stop - 8)
+    q = step * np.std(a)
+    level = np.round(a[start:stop] / q - offset)
+    a[start:stop] = q * (level + offset)
+    assume(np.min(np.diff(np.unique(a))) < 0.005 * q)
+    assume(np.any(np.diff(np.unique(level[:8])) == 1))
+    assume(np.all(np.abs(a[start:stop] + 9.81) > 0.05 * 9.81))  # no value reads as a flight
+    assert 2 * min(lattice_stretch(a, n)[0] for n in (6, 8)) < limits.lattice_p
+    assert signal_fault(a, limits) != ""
+
+
+def test_healthy_sensors_of_any_resolution_are_no_lattice():
+    """Noise-free and noisy signals, in float and rounded to ADC resolutions of 0.001-0.1
+    m/s^2, and a wheel in the air (-g to the solver's residual) are no quantisation fault; the
+    same signals with 6 samples rounded to 2.6 m/s^2 are (most of the time: 6 values on few
+    levels)."""
+    rng = np.random.default_rng(11)
+    flight = rng.standard_normal(125) * 2.0
+    flight[40:70] = -9.81 + 1e-9 * rng.standard_normal(30)  # a flight, noise-free (solver)
+    found = 0
+    for k in range(300):
+        a = 2.0 * rng.standard_normal(125) + (k % 2) * rng.standard_normal(125)
+        for resolution in (0.0, 0.001, 0.0048, 0.02, 0.1):
+            b = np.round(a / resolution) * resolution if resolution else a
+            p = min(lattice_stretch(b, n)[0] for n in (6, 8))
+            assert p > 1e-6, (k, resolution, p)
+        a[50:56] = np.round(a[50:56] / 2.6) * 2.6
+        found += lattice_stretch(a, 6)[0] < 1e-10 / 2
+    assert found > 0.7 * 300
+    assert lattice_stretch(flight, 6)[0] > 1e-6 and lattice_stretch(flight, 8)[0] > 1e-6
+    flight[80:90] = np.round(flight[80:90] / 0.5) * 0.5
+    p, start, step = lattice_stretch(flight, 8)
+    assert p < 1e-10 and 80 <= start <= 82 and step == pytest.approx(0.5)
+    assert signal_fault(flight, SensorLimits()).startswith("quantised signal: samples 8")
+    assert signal_fault(flight, SensorLimits(lattice_p=0.0)) == ""  # switched off
+    p, start, step = lattice_stretch(np.ones(10), 6)
+    assert (p, start) == (1.0, -1) and np.isnan(step)
+    for bad in (-1e-3, 1.0, np.nan):
+        with pytest.raises(ControlError, match="lattice_p"):
+            SensorLimits(lattice_p=bad)
 
 
 @settings(max_examples=60, deadline=None)

@@ -1,0 +1,85 @@
+"""False alarms and power of the sensor checks (`control.sensor_checks`) on clean campaign drives.
+
+    PYTHONPATH=. python benchmarks/sensor_checks.py [--seed 7] [--keep-s 120] [--workers 2]
+
+Runs the training campaign's design (198 drives of ``--keep-s`` s, campaign ``--seed``) without
+and with N(0, 1) sensor noise, cuts each drive into blocks of 125 samples and prints, per case:
+- the blocks that `signal_fault` flags (every check, with the sensor's noise sd where it has
+  noise): the false alarms, which should be none;
+- the most lattice-like stretch of the lattice check (`lattice_stretch`, 6 and 8 samples, with
+  its Bonferroni factor; flagged below ``SensorLimits.lattice_p``) on the blocks as floats and
+  rounded to ADC resolutions of 0.001-0.1 m/s^2 (every fourth block), as a real IMU's would be;
+- the share of blocks in which the lattice check finds 6, 7 or 10 samples rounded to steps of
+  1-8 m/s^2 at a random place (1,000 blocks per cell).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+import vehicle
+from control.sensor_checks import LATTICE_STRETCHES, SensorLimits, lattice_stretch, signal_fault
+
+BLOCK = 125
+RESOLUTIONS = (0.001, 0.0048, 0.02, 0.05, 0.1)  # m/s^2; 0.0048: a 16-bit part at +-16 g
+STEPS = (1.0, 2.0, 2.6, 4.0, 8.0)  # m/s^2; 2.6: soak seed 19, #131
+LENGTHS = (6, 7, 10)  # samples
+
+
+def lattice_score(block: np.ndarray) -> float:
+    """What the lattice check compares with ``lattice_p``: the smallest probability over both
+    stretch lengths, times their number."""
+    return len(LATTICE_STRETCHES) * min(lattice_stretch(block, n)[0] for n in LATTICE_STRETCHES)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seed", type=int, default=7, help="campaign seed")
+    parser.add_argument("--keep-s", type=float, default=120.0, help="seconds kept per drive")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+    tic = time.perf_counter()
+    limit = SensorLimits().lattice_p
+    rng = np.random.default_rng(args.seed)
+    print(f"campaign seed {args.seed}, {args.keep_s:g} s a drive, lattice_p {limit:g}")
+    for case, noise in (("A", 0.0), ("B", 1.0)):
+        with ProcessPoolExecutor(args.workers) as pool:
+            camp = vehicle.run_campaign(
+                seed=args.seed, keep_s=args.keep_s, noise_std=noise, executor=pool, progress=False
+            )
+        acc = camp.accel_measured[camp.ok]
+        per_drive = acc.shape[1] // BLOCK
+        blocks = acc[:, : per_drive * BLOCK].reshape(-1, BLOCK)
+        limits = SensorLimits(noise_sd_mps2=noise or None)
+        flagged = [b for b in blocks if signal_fault(b, limits)]
+        floats = min(lattice_score(b) for b in blocks)
+        print(f"{case} (noise sd {noise:g}): {blocks.shape[0]:,} clean blocks of {BLOCK}, "
+              f"flagged by any check: {len(flagged)}; most lattice-like: {floats:.2g}")  # fmt: skip
+        for r in RESOLUTIONS:
+            rounded = np.round(blocks[::4] / r) * r
+            worst = min(lattice_score(b) for b in rounded)
+            print(f"   rounded to {r:g} m/s^2 ({rounded.shape[0]:,} blocks): most lattice-like "
+                  f"{worst:.2g}")  # fmt: skip
+        for step in STEPS:
+            found = []
+            for length in LENGTHS:
+                picks = blocks[rng.choice(blocks.shape[0], 1000, replace=False)].copy()
+                hits = 0
+                for b in picks:
+                    start = rng.integers(0, BLOCK - length)
+                    part = b[start : start + length]
+                    b[start : start + length] = np.round(part / step) * step
+                    hits += lattice_score(b) < limit
+                found.append(f"{length} samples {hits / 10:5.1f}%")
+            print(f"   rounded to {step:g} m/s^2 steps for " + ", ".join(found))
+    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    print(f"{time.perf_counter() - tic:.0f} s; load average {load}")
+
+
+if __name__ == "__main__":
+    main()
