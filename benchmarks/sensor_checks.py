@@ -23,18 +23,12 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 import vehicle
-from control.sensor_checks import LATTICE_STRETCHES, SensorLimits, lattice_stretch, signal_fault
+from control.sensor_checks import SensorLimits, most_lattice_like, signal_fault
 
 BLOCK = 125
 RESOLUTIONS = (0.001, 0.0048, 0.02, 0.05, 0.1)  # m/s^2; 0.0048: a 16-bit part at +-16 g
 STEPS = (1.0, 2.0, 2.6, 4.0, 8.0)  # m/s^2; 2.6: soak seed 19, #131
 LENGTHS = (6, 7, 10)  # samples
-
-
-def lattice_score(block: np.ndarray) -> float:
-    """What the lattice check compares with ``lattice_p``: the smallest probability over both
-    stretch lengths, times their number."""
-    return len(LATTICE_STRETCHES) * min(lattice_stretch(block, n)[0] for n in LATTICE_STRETCHES)
 
 
 def main() -> None:
@@ -57,12 +51,12 @@ def main() -> None:
         blocks = acc[:, : per_drive * BLOCK].reshape(-1, BLOCK)
         limits = SensorLimits(noise_sd_mps2=noise or None)
         flagged = [b for b in blocks if signal_fault(b, limits)]
-        floats = min(lattice_score(b) for b in blocks)
+        floats = min(most_lattice_like(b)[0] for b in blocks)
         print(f"{case} (noise sd {noise:g}): {blocks.shape[0]:,} clean blocks of {BLOCK}, "
               f"flagged by any check: {len(flagged)}; most lattice-like: {floats:.2g}")  # fmt: skip
         for r in RESOLUTIONS:
             rounded = np.round(blocks[::4] / r) * r
-            worst = min(lattice_score(b) for b in rounded)
+            worst = min(most_lattice_like(b)[0] for b in rounded)
             print(f"   rounded to {r:g} m/s^2 ({rounded.shape[0]:,} blocks): most lattice-like "
                   f"{worst:.2g}")  # fmt: skip
         for step in STEPS:
@@ -74,7 +68,7 @@ def main() -> None:
                     start = rng.integers(0, BLOCK - length)
                     part = b[start : start + length]
                     b[start : start + length] = np.round(part / step) * step
-                    hits += lattice_score(b) < limit
+                    hits += most_lattice_like(b)[0] < limit
                 found.append(f"{length} samples {hits / 10:5.1f}%")
             print(f"   rounded to {step:g} m/s^2 steps for " + ", ".join(found))
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())

@@ -166,15 +166,13 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits) -> str:
             f"{limits.dead_fraction:g} of the block's standard deviation"
         )
     if limits.lattice_p > 0:
-        tries = len(LATTICE_STRETCHES)
-        for stretch in LATTICE_STRETCHES:
-            p, start, step = lattice_stretch(a, stretch, limits.free_fall_mps2)
-            if tries * p < limits.lattice_p:
-                return (
-                    f"quantised signal: samples {start}-{start + stretch - 1} sit on a lattice of "
-                    f"step {step:.4g} m/s^2 (probability {tries * p:.2g} for a healthy sensor, "
-                    f"allowed {limits.lattice_p:g})"
-                )
+        p, start, stretch, step = most_lattice_like(a, limits.free_fall_mps2)
+        if p < limits.lattice_p:
+            return (
+                f"quantised signal: samples {start}-{start + stretch - 1} sit on a lattice of "
+                f"step {step:.4g} m/s^2 (probability {p:.2g} for a healthy sensor, "
+                f"allowed {limits.lattice_p:g})"
+            )
     if limits.noise_sd_mps2 is not None:
         noise_var = limits.noise_sd_mps2**2
         for stretch, fraction in noise_floors(limits.noise_floor):
@@ -209,9 +207,25 @@ def dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None) -> int
         total += part
     dead = hi - lo < fraction * np.std(a)
     if free_fall is not None:
-        dead &= np.abs(total / DEAD_STRETCH - free_fall) > 0.05 * abs(free_fall)
+        dead &= ~_in_flight(total / DEAD_STRETCH, free_fall)
     hit = np.flatnonzero(dead)
     return int(hit[0]) if hit.size else -1
+
+
+def _in_flight(x: np.ndarray, free_fall: float) -> np.ndarray:
+    """Where ``x`` lies within 5% of ``free_fall``: what a wheel in the air reads."""
+    return np.abs(x - free_fall) <= 0.05 * abs(free_fall)
+
+
+def most_lattice_like(
+    a: np.ndarray, free_fall: float | None = FREE_FALL_MPS2
+) -> tuple[float, int, int, float]:
+    """What the lattice check compares with ``SensorLimits.lattice_p``: (the smallest
+    `lattice_stretch` probability over ``LATTICE_STRETCHES`` times their number (Bonferroni),
+    that stretch's start, its length, its step in m/s^2)."""
+    found = [(*lattice_stretch(a, n, free_fall), n) for n in LATTICE_STRETCHES]
+    p, start, step, stretch = min(found, key=lambda f: f[0])
+    return p * len(LATTICE_STRETCHES), start, stretch, step
 
 
 def lattice_stretch(
@@ -234,15 +248,15 @@ def lattice_stretch(
         return 1.0, -1, float("nan")
     resolution = float(gaps.min())
     w = a[_window_index(a.size, stretch)]  # (stretch, stretches)
-    low = np.sort(w, axis=0)
-    step = np.diff(low, axis=0)  # (stretch - 1 steps, stretches): neighbours in value
-    low = low[:-1]
+    ordered = np.sort(w, axis=0)
+    step = np.diff(ordered, axis=0)  # (stretch - 1 steps, stretches): neighbours in value
+    low = ordered[:-1]
     usable = step > resolution
     flight = np.zeros(w.shape, dtype=bool)
     if free_fall is not None:
-        flight = np.abs(w - free_fall) <= 0.05 * abs(free_fall)
-        usable &= np.abs(low - free_fall) > 0.05 * abs(free_fall)
-        usable &= np.abs(low + step - free_fall) > 0.05 * abs(free_fall)
+        flight = _in_flight(w, free_fall)
+        flying = _in_flight(ordered, free_fall)
+        usable &= ~(flying[:-1] | flying[1:])
     if not usable.any():
         return 1.0, -1, float("nan")
     g = np.where(usable, step, 1.0)
