@@ -2,6 +2,7 @@
 
     PYTHONPATH=. python benchmarks/emulator_bias.py             # 63 cells x 3 roads x 60 s
     PYTHONPATH=. python benchmarks/emulator_bias.py --quick     # 63 cells x 1 road x 60 s
+    PYTHONPATH=. python benchmarks/emulator_bias.py --emulator-dir DIR --features band  # yours
     PYTHONPATH=. python benchmarks/emulator_bias.py --help
 
 On held-aside roads (a campaign seed whose road seeds are not among the training campaign's,
@@ -9,6 +10,9 @@ checked), the Jackal drives k roads (``--roads``) for ``--keep-s`` seconds at co
 each cell of the grid v in {0.5, 0.75, ..., 2.0} m/s x GD in {200, 250, ..., 600}, through the
 training pipeline itself (`vehicle.run_campaign`: `roadgen.iso8608_profile` roads with the same
 lead-in and `vehicle.simulate`; case A: noise-free accelerations, case B: with N(0, 1) noise).
+``--emulator-dir`` scores the emulators in a folder (`examples/train_emulator.py
+--emulator-dir`) instead of the shipped ones: the roads are driven by the vehicle their metadata
+records, case B with their noise level, and emulators that disagree on either stop the run.
 
 Band emulator (``control.shipped_emulator(case, "band")``, the change-point BCR's): every
 125-sample block's log band-power vector (`control.block_features`); per cell
@@ -49,14 +53,18 @@ from __future__ import annotations
 import argparse
 import os
 import time
+import warnings
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy import stats
 
 import control
+import gpmsa
 import vehicle
+from control.shipped import emulator_file_name
 from control.training import block_statistics
 
 SPEEDS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0)
@@ -72,19 +80,50 @@ def load() -> str:
     return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
 
 
+def load_emulator(case: str, kind: str, emulator_dir: str | None):
+    """The shipped emulator of a case and kind, or the one of that name in ``emulator_dir``
+    (`examples/train_emulator.py --emulator-dir`)."""
+    if emulator_dir is None:
+        return control.shipped_emulator(case, kind)
+    return gpmsa.load(Path(emulator_dir) / emulator_file_name(case, kind))
+
+
 def training_seeds(emu) -> np.ndarray:
-    """Road seeds of the campaign the shipped emulators were trained on (its metadata's seed)."""
+    """Road seeds of the campaign an emulator was trained on (its metadata's design)."""
     design = emu.metadata["design"]
     return np.random.SeedSequence(int(design["seed"])).generate_state(int(design["n"]))
 
 
-def drive(roads: int, keep_s: float, seed: int, workers: int, cache_dir: str | None):
-    """The campaign: every grid cell driven on `roads` fresh roads."""
+def drive(roads: int, keep_s: float, seed: int, workers: int, cache_dir: str | None,
+          model, noise_std: float):  # fmt: skip
+    """The campaign: every grid cell driven on `roads` fresh roads by ``model``, its noisy
+    accelerations with N(0, noise_std^2) noise."""
     design = np.array([(v, gd) for v in SPEEDS for gd in GDS for _ in range(roads)])
     with ProcessPoolExecutor(max_workers=workers) as pool:
         return vehicle.run_campaign(
-            design, seed=seed, keep_s=keep_s, executor=pool, progress=False, cache_dir=cache_dir
-        )
+            design, model, seed=seed, keep_s=keep_s, executor=pool, progress=False,
+            cache_dir=cache_dir, noise_std=noise_std,
+        )  # fmt: skip
+
+
+def emulators_to_score(args) -> tuple[dict, object, float]:
+    """({(case, kind): emulator}, the vehicle they were trained for, the noise sd of the drives'
+    noisy accelerations: case B's, or the paper's 1 m/s^2 when B is not scored): what the
+    held-aside drives must match; exits naming any emulator that does not."""
+    emus = {(case, kind): load_emulator(case, kind, args.emulator_dir)
+            for case in args.cases for kind in args.features}  # fmt: skip
+    model = control.emulator_vehicle(next(iter(emus.values())))
+    noise = {case: 0.0 for case in args.cases}
+    if "B" in noise:
+        noise["B"] = control.emulator_noise_std(emus[("B", args.features[0])]) or 0.0
+    for (case, kind), emu in emus.items():
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error", control.ControlWarning)
+                control.check_emulator(emu, model=model, noise_std=noise[case])
+        except (control.EmulatorMismatchError, control.ControlWarning) as exc:
+            raise SystemExit(f"emulator {case}/{kind} does not match the others: {exc}") from exc
+    return emus, model, noise.get("B", 1.0)
 
 
 def scatter_at(scatter: control.BlockScatter, v: float) -> np.ndarray:
@@ -158,8 +197,7 @@ def linearised(d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray):
     return float(np.expm1(step)), float(np.sqrt(wg @ cov_d @ wg) / den * np.exp(step))
 
 
-def band_cells(case: str, c, rng) -> list[Cell]:
-    emu = control.shipped_emulator(case, "band")
+def band_cells(case: str, emu, c, rng) -> list[Cell]:
     om = control.ObservationModel(emu, n_grid=N_GRID)
     v_hi = om.speed_range[1]
     log_gd = np.log(om.gd)
@@ -192,8 +230,7 @@ def band_cells(case: str, c, rng) -> list[Cell]:
     return out
 
 
-def window_cells(case: str, c, rng) -> list[Cell]:
-    emu = control.shipped_emulator(case, "window")
+def window_cells(case: str, emu, c, rng) -> list[Cell]:
     v_hi, (g_lo, g_hi) = emu.domain["v"][1], emu.domain["GD"]
     gd_grid = np.geomspace(g_lo, g_hi, N_GRID)
     log_gd = np.log(gd_grid)
@@ -289,14 +326,28 @@ def main(argv: list[str] | None = None) -> None:
         "--cache-dir", default="out/bench_campaigns",
         help="folder caching the drives ('' for none)",
     )  # fmt: skip
+    parser.add_argument(
+        "--emulator-dir", default=None,
+        help="score the emulators in this folder (train_emulator.py --emulator-dir) instead of "
+        "the shipped ones",
+    )  # fmt: skip
+    parser.add_argument(
+        "--cases", nargs="+", default=["A", "B"], choices=["A", "B"], help="cases to score"
+    )
+    parser.add_argument(
+        "--features", nargs="+", default=["band", "window"], choices=["band", "window"],
+        help="emulators to score",
+    )  # fmt: skip
     args = parser.parse_args(argv)
     roads = 1 if args.quick else args.roads
     if roads < 1 or args.keep_s < 2 * BATCH * 125 / RATE_HZ:
         parser.error("need --roads >= 1 and --keep-s long enough for two batches of 8 blocks")
 
     tic = time.perf_counter()
-    c = drive(roads, args.keep_s, args.seed, args.workers, args.cache_dir or None)
-    train = training_seeds(control.shipped_emulator("A", "band"))
+    emus, model, noise_std = emulators_to_score(args)
+    c = drive(roads, args.keep_s, args.seed, args.workers, args.cache_dir or None, model,
+              noise_std)  # fmt: skip
+    train = training_seeds(next(iter(emus.values())))
     overlap = np.intersect1d(c.seed, train)
     if overlap.size:
         raise SystemExit(f"road seeds {overlap} were in the training campaign: use another --seed")
@@ -309,19 +360,21 @@ def main(argv: list[str] | None = None) -> None:
         for v, gd, s in zip(c.v[~c.ok], c.gd[~c.ok], c.status[~c.ok], strict=True):
             print(f"  failed: v={v:g} GD={gd:g}: {s}")
     rng = np.random.default_rng(args.boot_seed)
-    for case in ("A", "B"):
+    for case in args.cases:
         noise = "noise-free" if case == "A" else "N(0, 1) noise"
-        print_cells(
-            f"band emulator, case {case} ({noise}): per cell, z per band (bands 1.5-4.5, 4.5-7, "
-            "7-10, 10-14, 14-20, 20-30, 30-45, 45-60 Hz)",
-            band_cells(case, c, rng),
-            band=True,
-        )
-        print_cells(
-            f"window emulator (paper's log f of 1,000 samples), case {case} ({noise})",
-            window_cells(case, c, rng),
-            band=False,
-        )
+        if "band" in args.features:
+            print_cells(
+                f"band emulator, case {case} ({noise}): per cell, z per band (bands 1.5-4.5, "
+                "4.5-7, 7-10, 10-14, 14-20, 20-30, 30-45, 45-60 Hz)",
+                band_cells(case, emus[(case, "band")], c, rng),
+                band=True,
+            )
+        if "window" in args.features:
+            print_cells(
+                f"window emulator (paper's log f of 1,000 samples), case {case} ({noise})",
+                window_cells(case, emus[(case, "window")], c, rng),
+                band=False,
+            )
     print(f"\ntotal {time.perf_counter() - tic:.0f} s; {load()}")
 
 

@@ -15,9 +15,9 @@ Steps (docs/closed-loop.md):
    ``--keep-s`` (120) seconds of front-axle accelerations, noise-free and with N(0, 1) noise;
 3. the block-feature emulators ``jackal_{A,B}.gpmsa`` (the change-point BCR's): per run, the
    mean log band-power vector of its 125-sample blocks (``--block-samples``; `control.training`),
-   fitted by ``gpmsa.fit`` through its PCA basis; the block-to-block covariance Sigma(v) and
-   the Student-t dof, stored in the file's metadata (``block_scatter``) as the known
-   observation noise of one block;
+   fitted by ``gpmsa.fit`` through its PCA basis (5 components, ``--n-pc``); the block-to-block
+   covariance Sigma(v) and the Student-t dof, stored in the file's metadata (``block_scatter``)
+   as the known observation noise of one block;
 4. the paper-feature emulators ``jackal_{A,B}_window.gpmsa`` (the paper's estimator and the
    window filters): y = log f of the last 1,000 samples of each drive, with the GP nugget
    describing the window scatter (its lamWs prior relaxed from GPM/SA's lower bound of 60 to 1).
@@ -58,9 +58,10 @@ LEAD_IN_M = 1.0
 NOISE_STD = {"A": 0.0, "B": 1.0}
 BAND_FEATURE = FeatureSpec()
 BAND_PCS = 5
-"""Basis size of the band emulators: 99.9% of the variance of the runs' mean features (GPM/SA's
-default 99.5% keeps 3-4 and drops GD-dependent shape: held-out RMSE of log GD over 8.3 s of
-driving 0.116 with 3, 0.110 with 5, 0.109 with all 8)."""
+"""Basis size of the band emulators (``--n-pc``): 99.9% of the variance of the runs' mean
+features (GPM/SA's default 99.5% keeps 3-4 and drops GD-dependent shape: held-out RMSE of log
+GD over 8.3 s of driving 0.116 with 3, 0.110 with 5, 0.109 with all 8). All 8 fitted alike:
+neither their GD bias nor the closed loop moved beyond Monte-Carlo error (docs/closed-loop.md)."""
 WINDOW_PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(1.0, 1e-3, 1.0, 1e5))
 
 
@@ -137,11 +138,11 @@ def fit_band(case: str, campaign, model, args):
     )  # fmt: skip
     extra = {
         "block_scatter": scatter.to_dict(),
-        "fit": {"n_iter": args.n_iter, "priors": "GPM/SA defaults", "n_pc": BAND_PCS},
+        "fit": {"n_iter": args.n_iter, "priors": "GPM/SA defaults", "n_pc": args.n_pc},
         "training_target": "mean feature of the run's blocks (expected feature)",
     }
     return gpmsa.fit(
-        data, n_iter=args.n_iter, seed=args.seed, progress=True, n_pc=BAND_PCS,
+        data, n_iter=args.n_iter, seed=args.seed, progress=True, n_pc=args.n_pc,
         metadata=metadata(case, feature, model, campaign, args, extra),
     )  # fmt: skip
 
@@ -197,7 +198,13 @@ def main(argv: list[str] | None = None) -> None:
         "from the emulator file and updates twice a block; the default 125 is the length the "
         "BCR's settings and sensor checks were chosen for: docs/closed-loop.md)",
     )  # fmt: skip
+    parser.add_argument(
+        "--n-pc", type=int, default=BAND_PCS,
+        help="principal components of the band emulators (1 to the number of bands)",
+    )  # fmt: skip
     args = parser.parse_args(argv)
+    if not 1 <= args.n_pc <= BAND_FEATURE.dim:
+        parser.error(f"--n-pc must be in [1, {BAND_FEATURE.dim}], got {args.n_pc}")
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
     try:

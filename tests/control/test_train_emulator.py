@@ -73,14 +73,15 @@ def test_vehicle_overrides_make_the_users_robot():
         script.vehicle_model(["weight=20"])
 
 
-def test_block_samples_option_sets_the_bcrs_block(tmp_path):
+def test_block_samples_and_n_pc_options_set_the_bcrs_block_and_the_basis(tmp_path):
     import gpmsa
 
     load_script().main(
         ["--out", str(tmp_path), "--n-runs", "16", "--n-iter", "200", "--keep-s", "12",
-         "--cases", "A", "--features", "band", "--block-samples", "80"]
+         "--cases", "A", "--features", "band", "--block-samples", "80", "--n-pc", "8"]
     )  # fmt: skip
     emu = gpmsa.load(tmp_path / "emulators" / "jackal_A.gpmsa")
+    assert emu.p_u == 8 and emu.metadata["fit"]["n_pc"] == 8
     assert control.FeatureSpec.from_dict(emu.metadata["feature"]).block_samples == 80
     settings = control.bcr_settings_for(emu)
     every = -(-80 // DEFAULT_PHASES)  # the default's interleaved phases of 80-sample blocks
@@ -95,3 +96,10 @@ def test_block_samples_too_short_for_the_bands_is_refused(tmp_path, block, capsy
     with pytest.raises(SystemExit):
         load_script().main(["--out", str(tmp_path), "--block-samples", block])
     assert "--block-samples" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("n_pc", ["0", "9"])
+def test_n_pc_outside_the_bands_is_refused(tmp_path, n_pc, capsys):
+    with pytest.raises(SystemExit):
+        load_script().main(["--out", str(tmp_path), "--n-pc", n_pc])
+    assert "--n-pc must be in [1, 8]" in capsys.readouterr().err
