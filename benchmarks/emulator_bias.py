@@ -85,7 +85,10 @@ def load_emulator(case: str, kind: str, emulator_dir: str | None):
     (`examples/train_emulator.py --emulator-dir`)."""
     if emulator_dir is None:
         return control.shipped_emulator(case, kind)
-    return gpmsa.load(Path(emulator_dir) / emulator_file_name(case, kind))
+    path = Path(emulator_dir) / emulator_file_name(case, kind)
+    if not path.is_file():
+        raise SystemExit(f"--emulator-dir {emulator_dir}: no {path.name} (drop the case or kind)")
+    return gpmsa.load(path)
 
 
 def training_seeds(emu) -> np.ndarray:
@@ -202,7 +205,7 @@ def band_cells(case: str, emu, c, rng) -> list[Cell]:
     v_hi = om.speed_range[1]
     log_gd = np.log(om.gd)
     accel = c.accel if case == "A" else c.accel_measured
-    spec = control.FeatureSpec()
+    spec = control.emulator_feature(emu)
     out = []
     for v in SPEEDS:
         sigma = scatter_at(om.scatter, v)
@@ -361,7 +364,7 @@ def main(argv: list[str] | None = None) -> None:
             print(f"  failed: v={v:g} GD={gd:g}: {s}")
     rng = np.random.default_rng(args.boot_seed)
     for case in args.cases:
-        noise = "noise-free" if case == "A" else "N(0, 1) noise"
+        noise = "noise-free" if case == "A" else f"N(0, {noise_std:g}^2) noise"
         if "band" in args.features:
             print_cells(
                 f"band emulator, case {case} ({noise}): per cell, z per band (bands 1.5-4.5, "
