@@ -48,7 +48,6 @@ from dataclasses import replace
 import numpy as np
 
 import control
-import gpmsa
 import roadgen
 
 PAPER_TRACK = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
@@ -82,7 +81,7 @@ def _model(case: str, method: str, emulator_dir: str | None):
     key = (case, method, emulator_dir)
     if key not in _MODELS:
         if method == "changepoint" and emulator_dir:
-            emu = gpmsa.load(os.path.join(emulator_dir, f"jackal_{case}.gpmsa"))
+            emu = control.shipped_emulator(case, "band", emulator_dir)
         else:
             emu = control.shipped_emulator(case, "band" if method == "changepoint" else "window")
         bcr = control.bcr_settings_for(emu, method=method)
@@ -283,13 +282,11 @@ def main() -> None:
         parser.error(f"unknown sets {sorted(unknown)}; choose from {list(SETS)}")
     cases = [c for c in args.cases.split(",") if c]
     if args.emulator_dir:
-        missing = [
-            c
-            for c in cases
-            if not os.path.isfile(os.path.join(args.emulator_dir, f"jackal_{c}.gpmsa"))
-        ]
-        if missing:
-            parser.error(f"--emulator-dir {args.emulator_dir}: no jackal_{missing[0]}.gpmsa")
+        try:
+            for c in cases:
+                control.shipped_emulator_path(c, "band", args.emulator_dir)
+        except control.ControlError as exc:
+            parser.error(f"--emulator-dir: {exc}")
     cp = control.ChangePointSettings(
         mean_segment_m=args.mean_segment, segment_shape=args.shape, min_jump=args.min_jump,
         jump_sd=args.jump_sd, prior=args.prior,

@@ -56,15 +56,12 @@ import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from scipy import stats
 
 import control
-import gpmsa
 import vehicle
-from control.shipped import emulator_file_name
 from control.training import block_statistics
 
 SPEEDS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0)
@@ -78,17 +75,6 @@ N_BOOT = 400
 
 def load() -> str:
     return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
-
-
-def load_emulator(case: str, kind: str, emulator_dir: str | None):
-    """The shipped emulator of a case and kind, or the one of that name in ``emulator_dir``
-    (`examples/train_emulator.py --emulator-dir`)."""
-    if emulator_dir is None:
-        return control.shipped_emulator(case, kind)
-    path = Path(emulator_dir) / emulator_file_name(case, kind)
-    if not path.is_file():
-        raise SystemExit(f"--emulator-dir {emulator_dir}: no {path.name} (drop the case or kind)")
-    return gpmsa.load(path)
 
 
 def training_seeds(emu) -> np.ndarray:
@@ -113,8 +99,11 @@ def emulators_to_score(args) -> tuple[dict, object, float]:
     """({(case, kind): emulator}, the vehicle they were trained for, the noise sd of the drives'
     noisy accelerations: case B's, or the paper's 1 m/s^2 when B is not scored): what the
     held-aside drives must match; exits naming any emulator that does not."""
-    emus = {(case, kind): load_emulator(case, kind, args.emulator_dir)
-            for case in args.cases for kind in args.features}  # fmt: skip
+    try:
+        emus = {(case, kind): control.shipped_emulator(case, kind, args.emulator_dir)
+                for case in args.cases for kind in args.features}  # fmt: skip
+    except control.ControlError as exc:
+        raise SystemExit(f"{exc} (or drop that case or kind: --cases, --features)") from exc
     model = control.emulator_vehicle(next(iter(emus.values())))
     noise = {case: 0.0 for case in args.cases}
     if "B" in noise:

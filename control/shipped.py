@@ -23,20 +23,28 @@ def emulator_file_name(case: str, kind: str = "band") -> str:
     return f"jackal_{case}.gpmsa" if kind == "band" else f"jackal_{case}_window.gpmsa"
 
 
-def shipped_emulator_path(case: str = "A", kind: str = "band") -> Path:
+def shipped_emulator_path(case: str = "A", kind: str = "band", folder=None) -> Path:
     """Path of the shipped emulator of Test Case "A" (noise-free) or "B" (noise std 1 m/s^2),
-    for the block feature ("band", the default BCR) or the paper's window feature ("window")."""
-    path = EMULATOR_DIR / emulator_file_name(case, kind)
-    if not path.is_file():
-        raise ControlError(
-            f"shipped emulator {path} is missing; make it with "
-            "`python examples/train_emulator.py --ship`"
+    for the block feature ("band", the default BCR) or the paper's window feature ("window");
+    with ``folder``, the file of that name there (`examples/train_emulator.py --emulator-dir`).
+    ControlError naming a missing file and the command that makes it."""
+    name = emulator_file_name(case, kind)
+    if folder is None:
+        path, make = EMULATOR_DIR / name, "`python examples/train_emulator.py --ship`"
+    else:
+        path = Path(folder) / name
+        make = (
+            f"`python examples/train_emulator.py --emulator-dir {folder} --cases {case} "
+            f"--features {kind}`"
         )
+    if not path.is_file():
+        raise ControlError(f"emulator {path} is missing; make it with {make}")
     return path
 
 
-def shipped_emulator(case: str = "A", kind: str = "band"):
-    """The shipped Jackal emulator of Test Case "A" or "B" as a `gpmsa.Emulator`.
+def shipped_emulator(case: str = "A", kind: str = "band", folder=None):
+    """The shipped Jackal emulator of Test Case "A" or "B" as a `gpmsa.Emulator` (with
+    ``folder``: the one of that name there, e.g. trained for your robot).
 
     ``kind="band"``: the block-feature emulator of the change-point BCR (metadata:
     ``block_scatter``); ``kind="window"``: the paper's feature (log f of a 1,000-sample
@@ -46,4 +54,4 @@ def shipped_emulator(case: str = "A", kind: str = "band"):
     """
     import gpmsa
 
-    return gpmsa.load(shipped_emulator_path(case, kind))
+    return gpmsa.load(shipped_emulator_path(case, kind, folder))

@@ -79,21 +79,6 @@ def json_safe(value):
     return value
 
 
-def load_emulator(case: str, kind: str, emulator_dir: Path | None):
-    """The shipped emulator of a case and kind, or the one in ``emulator_dir`` (FileNotFoundError
-    naming a missing file and how to make it)."""
-    if emulator_dir is None:
-        return control.shipped_emulator(case, kind)
-    path = emulator_dir / control.shipped.emulator_file_name(case, kind)
-    if not path.is_file():
-        raise FileNotFoundError(
-            f"{path} is missing; make it with `python examples/train_emulator.py "
-            f"--emulator-dir {emulator_dir} --cases {case} --features band window`, or leave "
-            f"case {case} out (--cases)"
-        )
-    return gpmsa.load(path)
-
-
 def run_case(
     case: str,
     emu,
@@ -206,12 +191,12 @@ def main(argv: list[str] | None = None) -> dict:
     emulator_dir = Path(args.emulator_dir) if args.emulator_dir else None
     try:  # every file before the first run
         emulators = {
-            (case, kind): load_emulator(case, kind, emulator_dir)
+            (case, kind): control.shipped_emulator(case, kind, emulator_dir)
             for case in args.cases
             for kind in ("band", "window")
         }
-    except (FileNotFoundError, gpmsa.EmulatorFileError) as err:
-        parser.error(f"--emulator-dir: {err}")
+    except (control.ControlError, gpmsa.EmulatorFileError) as err:
+        parser.error(f"--emulator-dir: {err} (or leave that case out: --cases)")
     record = Path(args.record) if args.record else None
 
     metrics: dict = {"ours": {}, "paper_method": {}}

@@ -1,5 +1,6 @@
 """The closed loop with the shipped emulators: traces, metrics, faults, set-up guards."""
 
+import shutil
 import warnings
 
 import numpy as np
@@ -212,6 +213,16 @@ def test_shipped_emulators_record_what_the_loop_checks():
         control.shipped_emulator("C")
     with pytest.raises(ControlError, match="kind must be one of"):
         control.shipped_emulator("A", "psd")
+
+
+def test_an_emulator_folder_gives_its_file_or_names_the_missing_one(tmp_path):
+    shutil.copy(control.shipped_emulator_path("B"), tmp_path / "jackal_B.gpmsa")
+    emu = control.shipped_emulator("B", "band", tmp_path)
+    assert emu.metadata == control.shipped_emulator("B").metadata
+    with pytest.raises(ControlError, match=r"jackal_B_window.gpmsa is missing; make it with "
+                       r"`python examples/train_emulator.py --emulator-dir .* --cases B "
+                       r"--features window`"):  # fmt: skip
+        control.shipped_emulator("B", "window", tmp_path)
 
 
 def test_bad_fault_settings_raise():
