@@ -1,13 +1,15 @@
 """Milliseconds per GPM/SA sweep on the road case (198 runs, scalar output), numpy backend.
 
 Prints the median over repeats for the sim-only and the sim+obs model and the extrapolated time
-of a 30,000-sweep fit (plus 1,000 tuning sweeps). Usage: python benchmarks/fit_speed.py [repeats]
+of a 30,000-sweep fit (plus 1,000 tuning sweeps).
+
+    PYTHONPATH=. python benchmarks/fit_speed.py [REPEATS]    # default 15 repeats of 200 sweeps
 """
 
 from __future__ import annotations
 
+import argparse
 import os
-import sys
 import time
 from pathlib import Path
 
@@ -60,5 +62,17 @@ def main(repeats: int = 15) -> None:
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
+def repeats_arg(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"repeats must be >= 1, got {value}")
+    return value
+
+
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 15)
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "repeats", nargs="?", type=repeats_arg, default=15, help="repeats of 200 sweeps each"
+    )
+    main(parser.parse_args().repeats)
