@@ -62,17 +62,10 @@ def main(repeats: int = 15) -> None:
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
-def repeats_arg(text: str) -> int:
-    """argparse type: an integer >= 1."""
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"repeats must be >= 1, got {value}")
-    return value
-
-
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument(
-        "repeats", nargs="?", type=repeats_arg, default=15, help="repeats of 200 sweeps each"
-    )
-    main(parser.parse_args().repeats)
+    parser.add_argument("repeats", nargs="?", type=int, default=15, help="repeats of 200 sweeps")
+    args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"repeats must be >= 1, got {args.repeats}")
+    main(args.repeats)
