@@ -15,6 +15,7 @@ from control.closed_loop import ClosedLoopResult, LoopMetrics, run_closed_loop
 from control.compat import (
     bcr_settings_for,
     check_emulator,
+    check_likelihood,
     emulator_feature,
     emulator_noise_std,
     emulator_vehicle,
@@ -71,6 +72,7 @@ __all__ = [
     "bcr_settings_for",
     "block_features",
     "check_emulator",
+    "check_likelihood",
     "detection_delays",
     "emulator_feature",
     "emulator_noise_std",

@@ -47,6 +47,7 @@ from control.estimate import Estimate, graver_fault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.sensor_checks import SensorLimits, signal_fault, stream_fault
 from control.tracker import GDTracker, TrackerSettings
+from control.validation import is_real, require_instance, require_reals
 from gpmsa import Posterior
 
 METHODS = ("changepoint", "window", "filter", "tempered")
@@ -105,6 +106,17 @@ class BCRSettings:
     recent_change_m: float = 5.0
 
     def __post_init__(self) -> None:
+        for name, cls in (
+            ("feature", FeatureSpec),
+            ("changepoint", ChangePointSettings),
+            ("tracker", TrackerSettings),
+            ("sensor", SensorLimits),
+        ):
+            require_instance(self, name, cls)
+        require_reals(
+            self,
+            ("max_age_s", "max_silence_s", "interval_level", "plausibility_p", "recent_change_m"),
+        )
         if self.method not in METHODS:
             raise ControlError(f"method must be one of {METHODS}, got {self.method!r}")
         block = self.feature.name == "log_band_power"
@@ -209,13 +221,20 @@ class BCR:
         model: for "changepoint", a `control.ObservationModel` (anything with ``gd``,
             ``speed_range``, ``loglik(y, v)`` and ``plausibility(y, v)``); for the window
             methods, a `gpmsa.Calibrator` (anything with ``log_likelihood_grid(x_obs, y_obs)``
-            and ``emulator``). `BCR.from_emulator` builds the right one.
+            and ``emulator``). `BCR.from_emulator` builds the right one. When the model's
+            emulator records its feature, the settings' feature must match it
+            (`EmulatorMismatchError` otherwise).
         settings: `BCRSettings` (default: the change-point method); ``overrides`` replace fields.
     """
 
     def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
+        from control.compat import check_feature
+
         self.settings = s = replace(settings or BCRSettings(), **overrides)
         self.model = model
+        emulator = getattr(model, "emulator", None)
+        if "feature" in (getattr(emulator, "metadata", None) or {}):
+            check_feature(emulator, s)  # an emulator that records its feature must match
         if s.method == "changepoint":
             if not hasattr(model, "loglik"):
                 raise ControlError("method 'changepoint' needs an ObservationModel")
@@ -302,9 +321,9 @@ class BCR:
             Non-finite values are sensor faults, never errors.
         """
         if now is not None:
+            if not (is_real(now) and np.isfinite(now)):
+                raise ControlError(f"now must be a finite time, s, got {now!r}")
             now = float(now)
-            if not np.isfinite(now):
-                raise ControlError(f"now must be a finite time, s, got {now}")
             if not np.isfinite(self._clock):
                 self._clock_start = now
             self._clock = max(self._clock, now) if np.isfinite(self._clock) else now

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.special import gammaincc
 
 from control.errors import ControlError
+from control.validation import check_n_draws, float_array, is_real, require_integers, require_reals
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("log_uniform", "uniform")
@@ -57,6 +58,10 @@ class ChangePointSettings:
     max_runs: int = 300
 
     def __post_init__(self) -> None:
+        require_reals(
+            self, ("mean_segment_m", "segment_shape", "min_jump", "jump_sd"), optional=("jump_sd",)
+        )
+        require_integers(self, ("max_runs",))
         if not (np.isfinite(self.mean_segment_m) and self.mean_segment_m > 0):
             raise ControlError(f"mean_segment_m must be finite and > 0, got {self.mean_segment_m}")
         if not (np.isfinite(self.segment_shape) and self.segment_shape > 0):
@@ -75,9 +80,14 @@ class ChangePointFilter:
     """The filter on a fixed GD grid (native units, increasing, positive); see the module doc."""
 
     def __init__(self, gd: np.ndarray, settings: ChangePointSettings | None = None) -> None:
-        gd = np.asarray(gd, dtype=float)
-        if gd.ndim != 1 or gd.size < 3 or np.any(np.diff(gd) <= 0) or gd[0] <= 0:
-            raise ControlError("gd must be an increasing 1-D grid of >= 3 positive values")
+        gd = float_array(gd, "gd")
+        if not (
+            gd.ndim == 1 and gd.size >= 3 and np.all(np.isfinite(gd)) and gd[0] > 0
+            and np.all(np.diff(gd) > 0)
+        ):  # fmt: skip
+            raise ControlError(
+                f"gd must be an increasing 1-D grid of >= 3 positive, finite values, got {gd}"
+            )
         self.settings = s = settings or ChangePointSettings()
         self.gd = gd
         self._weights = trapezoid_weights(gd)
@@ -117,8 +127,8 @@ class ChangePointFilter:
 
     def predict(self, ds_m: float) -> None:
         """Propagate over ds_m metres (change points; GD unchanged within a run)."""
-        if not (np.isfinite(ds_m) and ds_m >= 0):
-            raise ControlError(f"ds_m must be finite and >= 0, got {ds_m}")
+        if not (is_real(ds_m) and np.isfinite(ds_m) and ds_m >= 0):
+            raise ControlError(f"ds_m must be finite and >= 0, got {ds_m!r}")
         if not self._has_data:  # before any block the prior already is "a new segment"
             self._dist = self._dist + ds_m
             return
@@ -196,6 +206,7 @@ def mixture_posterior(
 
 
 def _grid_posterior(gd, weights, mass, name: str, n_draws: int) -> Posterior:
+    check_n_draws(n_draws)
     with np.errstate(divide="ignore"):
         log_density = np.log(mass) - np.log(weights)
     marginal = GridMarginal.from_log_density(gd, log_density, weights)

@@ -6,19 +6,21 @@ import os
 import time as _time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 from tqdm.auto import tqdm
 
 import vehicle
 from control.bcr import BCR, BCRSettings
-from control.compat import bcr_settings_for, check_emulator
+from control.compat import bcr_settings_for, check_emulator, check_likelihood
 from control.errors import ControlError
 from control.estimate import Estimate
-from control.faults import SensorFault, apply_faults
+from control.faults import FaultInjector, SensorFault
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, segment_index
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
+from control.validation import is_real
 
 EXACT_CLOCK_SILENCE = 0.5
 """The simulated sensor's clock is exact, so any sample missing at an update is silence: the
@@ -123,6 +125,30 @@ def _check_seed(seed) -> None:
         raise ControlError(f"seed must be None or an integer >= 0, got {seed!r}")
 
 
+def _check_faults(faults) -> tuple[SensorFault, ...]:
+    """The injected faults as a tuple; ControlError unless a sequence of `SensorFault`."""
+    if isinstance(faults, SensorFault):
+        raise ControlError("faults must be a sequence of SensorFault: pass [fault]")
+    try:
+        faults = tuple(faults)
+    except TypeError as exc:
+        raise ControlError(f"faults must be a sequence of SensorFault, got {faults!r}") from exc
+    wrong = [f for f in faults if not isinstance(f, SensorFault)]
+    if wrong:
+        raise ControlError(f"faults must hold SensorFault objects, got {wrong[0]!r}")
+    return faults
+
+
+def _check_record_path(record) -> None:
+    """ControlError before the drive when ``record`` names a folder or has no writable folder."""
+    path = Path(record)
+    if path.is_dir():
+        raise ControlError(f"record={str(record)!r} is a folder; name the .mcap file to write")
+    folder = next((p for p in path.absolute().parents if p.exists()), None)
+    if folder is None or not folder.is_dir() or not os.access(folder, os.W_OK):
+        raise ControlError(f"record={str(record)!r}: cannot write under {folder}")
+
+
 def _within_simulated_noise(sensor: SensorLimits, noise_std: float) -> SensorLimits:
     """The sensor checks with a noise sd no larger than the simulated sensor's (None if 0)."""
     assumed = sensor.noise_sd_mps2
@@ -167,7 +193,8 @@ def run_closed_loop(
         progress: show a tqdm bar over the track length.
         likelihood: the BCR's prepared likelihood model for `emulator` (an `ObservationModel`
             for the change-point method, a `gpmsa.Calibrator` for the window methods), to save
-            preparing one per run.
+            preparing one per run; one prepared for another emulator is refused
+            (`check_likelihood`).
         faults: injected sensor faults (`SensorFault`).
         check: check the emulator against model, noise, feature and track (`check_emulator`).
         max_time_s: simulated time after which a vehicle that has not reached the end is an
@@ -179,14 +206,20 @@ def run_closed_loop(
     Returns:
         `ClosedLoopResult` with traces and `LoopMetrics`.
     """
-    model = vehicle.Jackal() if model is None else model
+    model = vehicle.Jackal() if model is None else vehicle.models.check_model(model)
     simplex = Simplex() if simplex is None else simplex
+    if not isinstance(simplex, Simplex):
+        raise ControlError(f"simplex must be a control.Simplex, got {type(simplex).__name__}")
     _check_seed(seed)
     noise_std = vehicle.sensor.check_noise(noise_std)
+    faults = _check_faults(faults)
+    if max_time_s is not None and not (is_real(max_time_s) and max_time_s > 0):
+        raise ControlError(f"max_time_s must be None or a number > 0, s, got {max_time_s!r}")
     if record is not None:  # without the robot extra, fail before the drive, not after it
         from control.robot.record import check_can_record, record_run
 
         check_can_record()
+        _check_record_path(record)
     top = float(model.max_speed_mps)
     if simplex.v_max > top * (1 + 1e-12):
         raise ControlError(
@@ -200,9 +233,12 @@ def run_closed_loop(
     )
     if check:
         check_emulator(emulator, model=model, noise_std=noise_std, bcr=bcr, track=track)
+    if likelihood is not None:
+        check_likelihood(emulator, likelihood)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     rng = np.random.default_rng(seed)
     noise_seed, fault_rng = rng.integers(2**63), np.random.default_rng(rng.integers(2**63))
+    inject = FaultInjector(faults, fault_rng)
     sim = vehicle.Simulation(
         model, track, rate_hz=bcr.rate_hz, noise_std=noise_std, seed=int(noise_seed)
     )
@@ -228,9 +264,7 @@ def run_closed_loop(
         s_pos.append(np.asarray(samples.position, dtype=float))
         s_spd.append(np.asarray(samples.speed, dtype=float))
         s_acc.append(np.asarray(samples.accel_front, dtype=float))
-        observed = apply_faults(
-            samples.t, samples.position, samples.accel_front, samples.speed, faults, fault_rng
-        )
+        observed = inject(samples.t, samples.position, samples.accel_front, samples.speed)
         estimate = estimator.update(*observed, now=float(samples.t[-1]))
         command = controller.command(estimate)
         rows.append((estimate, command))

@@ -122,6 +122,44 @@ def check_emulator(
             )
 
 
+def check_likelihood(emulator, likelihood) -> None:
+    """Raise `EmulatorMismatchError` unless ``likelihood`` (an `ObservationModel` or a
+    `gpmsa.Calibrator`, prepared to save the work per run) was prepared for ``emulator``: the
+    same object, or one with the same metadata, domain and predictions (at the domain's corners
+    and centre)."""
+    prepared = getattr(likelihood, "emulator", None)
+    if prepared is None:
+        raise EmulatorMismatchError(
+            f"likelihood must be an ObservationModel or a gpmsa.Calibrator made from the "
+            f"emulator, got {type(likelihood).__name__}"
+        )
+    if prepared is emulator:
+        return
+    meta, other = (dict(getattr(e, "metadata", None) or {}) for e in (emulator, prepared))
+    differ = sorted(
+        k for k in set(meta) | set(other) if _canon(meta.get(k)) != _canon(other.get(k))
+    )
+    if differ:
+        raise EmulatorMismatchError(
+            f"the likelihood was prepared for another emulator (metadata differ in {differ})"
+        )
+    if _canon(emulator.domain) != _canon(prepared.domain) or not np.allclose(
+        _probe(emulator), _probe(prepared), rtol=1e-12, atol=0.0
+    ):
+        raise EmulatorMismatchError(
+            "the likelihood was prepared for another emulator (domains or predictions differ)"
+        )
+
+
+def _probe(emulator) -> np.ndarray:
+    """The emulator's mean predictions at the corners and centre of its (speed, GD) domain."""
+    (v_lo, v_hi), (g_lo, g_hi) = (emulator.domain[n] for n in emulator.x_names + emulator.t_names)
+    v = np.array([v_lo, v_lo, v_hi, v_hi, (v_lo + v_hi) / 2])
+    gd = np.array([g_lo, g_hi, g_lo, g_hi, (g_lo + g_hi) / 2])
+    mean, _ = emulator.predict(v, gd, resid=False)
+    return np.asarray(mean, dtype=float)
+
+
 def emulator_vehicle(emulator):
     """The vehicle model the emulator was trained for (its metadata's ``vehicle``, as
     ``model.describe()`` recorded it), e.g. to run the closed loop with a user's emulator;

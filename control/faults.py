@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
+from control.validation import require_reals
 
 FAULT_KINDS = (
     "nan",  # the accelerometer reads NaN
@@ -15,7 +16,7 @@ FAULT_KINDS = (
     "noise",  # N(0, magnitude^2) m/s^2 added
     "scale",  # the acceleration multiplied by magnitude
     "quantize",  # rounded to steps of magnitude m/s^2
-    "stuck",  # the last good value repeated
+    "stuck",  # the last good value repeated (held across batches by `FaultInjector`)
     "clip",  # clipped to +-magnitude m/s^2
     "time_nan",  # the time stamps read NaN
     "position_nan",  # the odometry reads NaN
@@ -40,6 +41,7 @@ class SensorFault:
     magnitude: float = 1.0
 
     def __post_init__(self) -> None:
+        require_reals(self, ("start_s", "duration_s", "magnitude"))
         if not (np.isfinite(self.start_s) and self.start_s >= 0):
             raise ControlError(f"start_s must be >= 0, got {self.start_s}")
         if not (np.isfinite(self.duration_s) and self.duration_s > 0):
@@ -52,39 +54,61 @@ class SensorFault:
             raise ControlError(f"a spike fault's magnitude is a spacing >= 1, got {self.magnitude}")
 
 
-def apply_faults(t, position, accel, speed, faults, rng: np.random.Generator):
-    """(t, position, accel, speed) of a sample batch with the faults applied (copies)."""
-    t = np.array(t, dtype=float)
-    pos = np.array(position, dtype=float)
-    acc = np.array(accel, dtype=float)
-    spd = np.array(speed, dtype=float)
-    keep = np.ones(t.size, dtype=bool)
-    clock = t.copy()
-    for fault in faults:
-        hit = (clock >= fault.start_s) & (clock < fault.start_s + fault.duration_s)
-        if not hit.any():
-            continue
-        k, m = fault.kind, fault.magnitude
-        if k == "nan":
-            acc[hit] = np.nan
-        elif k == "drop":
-            keep &= ~hit
-        elif k == "spike":
-            idx = np.flatnonzero(hit)[:: max(1, int(m))]
-            acc[idx] = 1e6 * np.where(np.arange(idx.size) % 2, 1.0, -1.0)
-        elif k == "noise":
-            acc[hit] += rng.normal(0.0, m, int(hit.sum()))
-        elif k == "scale":
-            acc[hit] *= m
-        elif k == "quantize":
-            acc[hit] = np.round(acc[hit] / m) * m
-        elif k == "stuck":
-            first = int(np.flatnonzero(hit)[0])  # held within each batch of samples
-            acc[hit] = acc[max(first - 1, 0)]
-        elif k == "clip":
-            acc[hit] = np.clip(acc[hit], -m, m)
-        elif k == "time_nan":
-            t[hit] = np.nan
-        elif k == "position_nan":
-            pos[hit] = np.nan
-    return t[keep], pos[keep], acc[keep], spd[keep]
+class FaultInjector:
+    """The faults applied to a stream of sample batches, one batch after another (a stuck sensor
+    holds the value it read before the fault through every batch the fault spans).
+
+    Args:
+        faults: the `SensorFault`s.
+        rng: the generator of the random faults ("noise").
+    """
+
+    def __init__(self, faults, rng: np.random.Generator) -> None:
+        self.faults = tuple(faults)
+        self.rng = rng
+        self._last = np.nan  # the newest reading of the batches before
+        self._held: dict[int, float] = {}  # per stuck fault, the value it holds
+
+    def __call__(self, t, position, accel, speed):
+        """(t, position, accel, speed) of the next batch with the faults applied (copies)."""
+        t = np.array(t, dtype=float)
+        pos = np.array(position, dtype=float)
+        acc = np.array(accel, dtype=float)
+        spd = np.array(speed, dtype=float)
+        keep = np.ones(t.size, dtype=bool)
+        clock = t.copy()
+        for i, fault in enumerate(self.faults):
+            hit = (clock >= fault.start_s) & (clock < fault.start_s + fault.duration_s)
+            if not hit.any():
+                continue
+            k, m = fault.kind, fault.magnitude
+            if k == "nan":
+                acc[hit] = np.nan
+            elif k == "drop":
+                keep &= ~hit
+            elif k == "spike":
+                idx = np.flatnonzero(hit)[:: max(1, int(m))]
+                acc[idx] = 1e6 * np.where(np.arange(idx.size) % 2, 1.0, -1.0)
+            elif k == "noise":
+                acc[hit] += self.rng.normal(0.0, m, int(hit.sum()))
+            elif k == "scale":
+                acc[hit] *= m
+            elif k == "quantize":
+                acc[hit] = np.round(acc[hit] / m) * m
+            elif k == "stuck":
+                acc[hit] = self._held.setdefault(i, self._before(acc, int(np.flatnonzero(hit)[0])))
+            elif k == "clip":
+                acc[hit] = np.clip(acc[hit], -m, m)
+            elif k == "time_nan":
+                t[hit] = np.nan
+            elif k == "position_nan":
+                pos[hit] = np.nan
+        if keep.any():
+            self._last = float(acc[keep][-1])
+        return t[keep], pos[keep], acc[keep], spd[keep]
+
+    def _before(self, acc: np.ndarray, first: int) -> float:
+        """The reading before sample ``first`` of this batch (the first one if none came)."""
+        if first > 0:
+            return float(acc[first - 1])
+        return self._last if np.isfinite(self._last) else float(acc[0])

@@ -22,10 +22,15 @@ import numpy as np
 from scipy.signal.windows import dpss
 
 from control.errors import ControlError
+from control.validation import float_array, require_integers, require_reals
 
 FEATURES = ("log_band_power", "log_var", "var")
 SCALAR_FEATURES = ("log_var", "var")
 BAND_EDGES_HZ = (1.5, 4.5, 7.0, 10.0, 14.0, 20.0, 30.0, 45.0, 60.0)
+MAX_BLOCK_SAMPLES = 4096
+"""Longest block or window (34 s at 120 Hz, 4 s at 1 kHz). The sensor checks' level check
+compares every segment of a block with the rest, so its cost grows as the square of the block:
+~0.25 s a block at this length, 0.1 ms at the default 125 samples."""
 
 
 @dataclass(frozen=True)
@@ -51,13 +56,21 @@ class FeatureSpec:
     def __post_init__(self) -> None:
         if self.name not in FEATURES:
             raise ControlError(f"feature name must be one of {FEATURES}, got {self.name!r}")
-        if not (isinstance(self.block_samples, int | np.integer) and self.block_samples >= 16):
-            raise ControlError(f"block_samples must be an integer >= 16, got {self.block_samples}")
+        require_integers(self, ("block_samples", "n_tapers"))
+        require_reals(self, ("rate_hz", "taper_nw"))
+        if not 16 <= self.block_samples <= MAX_BLOCK_SAMPLES:
+            raise ControlError(
+                f"block_samples must lie in [16, {MAX_BLOCK_SAMPLES}], got {self.block_samples}"
+            )
         if not (np.isfinite(self.rate_hz) and self.rate_hz > 0):
             raise ControlError(f"rate_hz must be > 0, got {self.rate_hz}")
-        object.__setattr__(self, "bands_hz", tuple(float(b) for b in self.bands_hz))
+        edges = float_array(self.bands_hz, "bands_hz")
+        if edges.ndim != 1 or not np.all(np.isfinite(edges)):
+            raise ControlError(
+                f"bands_hz must be a sequence of finite edges, Hz, got {self.bands_hz!r}"
+            )
+        object.__setattr__(self, "bands_hz", tuple(float(b) for b in edges))
         if self.name == "log_band_power":
-            edges = np.asarray(self.bands_hz)
             nyquist = self.rate_hz / 2
             if edges.size < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
                 raise ControlError(f"bands_hz must be >= 2 increasing edges >= 0, got {edges}")

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
+from control.validation import float_array
 
 
 @dataclass(frozen=True)
@@ -37,26 +38,34 @@ def segment_index(track, position: np.ndarray) -> np.ndarray:
     return np.clip(idx, 0, len(track.segments) - 1)
 
 
+def _traces(position, values, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """(position, values) as 1-D float arrays of one length; ControlError naming the problem."""
+    position = float_array(position, "position")
+    values = float_array(values, name)
+    if position.ndim != 1 or position.shape != values.shape:
+        raise ControlError(
+            f"position and {name} must be 1-D of one length, got shapes {position.shape} and "
+            f"{values.shape}"
+        )
+    return position, values
+
+
 def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDError, ...]:
     """Errors of the estimates against the prescribed GD at each estimate's position, as the paper.
 
     Args:
         track: a roadgen Track (segments, boundaries_m).
         position: (n,) positions of the estimates (front axle when the estimate was made), m.
-        gd_estimate: (n,) posterior means; NaN entries (no estimate) are left out.
+        gd_estimate: (n,) posterior means; NaN entries (no estimate), and estimates without a
+            finite position, are left out.
 
     Returns:
         One `GDError` per distinct prescribed GD, in increasing GD.
     """
-    position = np.asarray(position, dtype=float)
-    gd_estimate = np.asarray(gd_estimate, dtype=float)
-    if position.shape != gd_estimate.shape:
-        raise ControlError(
-            f"position and gd_estimate must match, got {position.shape} and {gd_estimate.shape}"
-        )
+    position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
     seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
     truth = seg_gd[segment_index(track, position)]
-    ok = np.isfinite(gd_estimate)
+    ok = np.isfinite(gd_estimate) & np.isfinite(position)
     out = []
     for gd in np.unique(seg_gd):
         sel = ok & (truth == gd)
@@ -69,7 +78,15 @@ def pooled_rmse(errors: Sequence[Sequence[GDError]], gd: float) -> float:
 
     NaN when no run made an estimate there (a part shorter than the first block), as
     `GDError.rmse` for one run.
+
+    Args:
+        errors: per run, its `GDError`s (``[r.metrics.gd_errors for r in results]``).
     """
+    if any(isinstance(run, GDError) for run in errors):
+        raise ControlError(
+            "errors must hold one sequence of GDError per run; for one run's errors pass "
+            "[metrics.gd_errors]"
+        )
     sse = sum(e.sse for run in errors for e in run if e.gd == gd)
     n = sum(e.n for run in errors for e in run if e.gd == gd)
     return float(np.sqrt(sse / n)) if n else float("nan")
@@ -81,8 +98,7 @@ def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tu
     One value per boundary between segments of different GD; NaN if the estimate never crosses
     before the next boundary (or the end of the data).
     """
-    position = np.asarray(position, dtype=float)
-    gd_estimate = np.asarray(gd_estimate, dtype=float)
+    position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
     starts = np.asarray(track.boundaries_m, dtype=float)
     ends = np.append(starts[1:], np.inf)
     delays = []
@@ -103,10 +119,12 @@ def fast_on_rough_m(
     """Distance driven faster than v_safe + tol (m/s) where the prescribed GD exceeds gd_max, m.
 
     Args:
-        position, speed: (n,) the vehicle's samples (front axle), m and m/s.
+        position, speed: (n,) the vehicle's samples (front axle), m (finite, non-decreasing)
+            and m/s.
     """
-    position = np.asarray(position, dtype=float)
-    speed = np.asarray(speed, dtype=float)
+    position, speed = _traces(position, speed, "speed")
+    if not (np.all(np.isfinite(position)) and np.all(np.diff(position) >= 0)):
+        raise ControlError("position must hold finite, non-decreasing samples, m")
     if position.size < 2:
         return 0.0
     seg_gd = np.array([gd for _, gd in track.segments], dtype=float)

@@ -26,6 +26,7 @@ from scipy import special, stats
 from scipy.linalg import cholesky
 
 from control.errors import ControlError, EmulatorMismatchError
+from control.validation import float_array, require_reals
 
 
 @dataclass(frozen=True, eq=False)
@@ -44,8 +45,9 @@ class BlockScatter:
     dof: float = np.inf
 
     def __post_init__(self) -> None:
-        s = np.asarray(self.speed, dtype=float)
-        c = np.asarray(self.cov, dtype=float)
+        require_reals(self, ("dof",))
+        s = float_array(self.speed, "speed")
+        c = float_array(self.cov, "cov")
         if s.ndim != 1 or s.size < 2 or np.any(np.diff(s) <= 0) or not np.all(np.isfinite(s)):
             raise ControlError(f"speed must be >= 2 increasing finite nodes, got {s}")
         if c.ndim != 3 or c.shape[0] != s.size or c.shape[1] != c.shape[2]:

@@ -16,6 +16,7 @@ from scipy.special import bdtrc
 from scipy.stats import chi2
 
 from control.errors import ControlError
+from control.validation import require_reals
 from vehicle.models import GRAVITY
 
 MIN_SEGMENT = 32
@@ -100,6 +101,12 @@ class SensorLimits:
     lattice_p: float = 1e-10
 
     def __post_init__(self) -> None:
+        require_reals(
+            self,
+            ("range_mps2", "max_level_jump", "dead_fraction", "free_fall_mps2", "noise_sd_mps2",
+             "noise_floor", "lattice_p"),
+            optional=("range_mps2", "free_fall_mps2", "noise_sd_mps2"),
+        )  # fmt: skip
         for name in ("max_repeats", "min_distinct", "max_same"):
             value = getattr(self, name)
             if not (isinstance(value, int | np.integer) and value >= 1):
@@ -322,17 +329,23 @@ def level_jump(a: np.ndarray, min_segment: int = MIN_SEGMENT) -> tuple[float, tu
     if n < 2 * min_segment:
         return 1.0, (0, 0)
     s1, s2 = _running_sums(a)
-    start, stop = _segments(n, min_segment)
-    n_in = stop - start
-    n_out = n - n_in
-    sum_in, sq_in = s1[stop] - s1[start], s2[stop] - s2[start]
-    var_in = np.maximum((sq_in - sum_in**2 / n_in) / (n_in - 1), 0.0)
-    var_out = np.maximum(((s2[-1] - sq_in) - (s1[-1] - sum_in) ** 2 / n_out) / (n_out - 1), 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.maximum(var_in / var_out, var_out / var_in)
-    ratio = np.where(np.isnan(ratio), 1.0, ratio)
-    i = int(np.argmax(ratio))
-    return float(ratio[i]), (int(start[i]), int(stop[i]))
+    best = (1.0, (0, 0))
+    for first in range(0, n + 1, _starts_per_chunk(n)):
+        start, stop = _segments(n, min_segment, first, _starts_per_chunk(n))
+        if start.size == 0:
+            continue
+        n_in = stop - start
+        n_out = n - n_in
+        sum_in, sq_in = s1[stop] - s1[start], s2[stop] - s2[start]
+        var_in = np.maximum((sq_in - sum_in**2 / n_in) / (n_in - 1), 0.0)
+        var_out = np.maximum(((s2[-1] - sq_in) - (s1[-1] - sum_in) ** 2 / n_out) / (n_out - 1), 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.maximum(var_in / var_out, var_out / var_in)
+        ratio = np.where(np.isnan(ratio), 1.0, ratio)
+        i = int(np.argmax(ratio))
+        if ratio[i] > best[0]:
+            best = (float(ratio[i]), (int(start[i]), int(stop[i])))
+    return best
 
 
 def _running_sums(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -342,10 +355,22 @@ def _running_sums(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([[0.0], np.cumsum(x)]), np.concatenate([[0.0], np.cumsum(x * x)])
 
 
+SEGMENT_PAIRS_PER_CHUNK = 1 << 16
+"""The level check compares every segment of a block with the rest, O(n^2) pairs; it takes them
+in chunks of about this many, so that its memory stays bounded for long blocks."""
+
+
+def _starts_per_chunk(n: int) -> int:
+    return max(1, SEGMENT_PAIRS_PER_CHUNK // (n + 1))
+
+
 @functools.lru_cache(maxsize=8)
-def _segments(n: int, min_segment: int) -> tuple[np.ndarray, np.ndarray]:
-    """(start, stop) of every segment of n samples with >= min_segment samples in and out."""
-    start, stop = np.meshgrid(np.arange(n + 1), np.arange(n + 1), indexing="ij")
+def _segments(n: int, min_segment: int, first: int, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """(start, stop) of every segment of n samples with >= min_segment samples in and out whose
+    start lies in [first, first + count)."""
+    start, stop = np.meshgrid(
+        np.arange(first, min(first + count, n + 1)), np.arange(n + 1), indexing="ij"
+    )
     keep = (stop - start >= min_segment) & (n - (stop - start) >= min_segment)
     return start[keep], stop[keep]
 
@@ -363,10 +388,11 @@ def stream_fault(
     """
     bad_value = ~(np.isfinite(t) & np.isfinite(position) & np.isfinite(accel) & np.isfinite(speed))
     dt = 1.0 / rate_hz
-    step = t - np.concatenate([[t_prev], t[:-1]])
+    step = t - _previous_finite(t, t_prev)
+    finite_step = np.isfinite(step)  # a non-finite time stamp is a bad value, not a step
     with np.errstate(invalid="ignore"):
-        backwards = step < 0.5 * dt
-        gap = step > 1.5 * dt
+        backwards = finite_step & (step < 0.5 * dt)
+        gap = finite_step & (step > 1.5 * dt)
     what = []
     if bad_value.any():
         names = [
@@ -381,3 +407,11 @@ def stream_fault(
         worst = float(np.max(step[gap]))
         what.append(f"a gap of {worst:.4g} s (about {round(worst / dt) - 1:.4g} dropped samples)")
     return bad_value | backwards, gap & ~bad_value, " and ".join(what)
+
+
+def _previous_finite(t: np.ndarray, t_prev: float) -> np.ndarray:
+    """Per sample, the newest finite time stamp before it (``t_prev`` before the first; NaN
+    if there is none)."""
+    before = np.concatenate([[t_prev], t[:-1]])
+    index = np.where(np.isfinite(before), np.arange(before.size), 0)
+    return before[np.maximum.accumulate(index)]

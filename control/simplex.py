@@ -25,7 +25,7 @@ crosses a grid point, and it is never above the law. ``speed_step_mps=0``: the c
 Risk posture: ``risk=None`` feeds the posterior mean of GD to the law (the paper). ``risk=alpha``
 feeds the (1 - alpha) posterior quantile instead, so safety mode starts as soon as
 P(GD > GD_max) > alpha. Any estimate that is not "ok" (buffer filling, fault, out of domain,
-stale) means safety mode.
+stale), or an "ok" one whose GD is not finite, means safety mode.
 
 After a fault (``after_fault``): a sensor that has failed once is not trusted again within the
 run. With ``"latch"`` (default), the first estimate whose status is a fault (``FAULT_STATUSES``:
@@ -48,6 +48,7 @@ import numpy as np
 
 from control.errors import ControlError
 from control.estimate import FAULT_STATUSES, Estimate
+from control.validation import require_reals
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
@@ -105,6 +106,11 @@ class Simplex:
     speed_step_mps: float = 0.1
 
     def __post_init__(self) -> None:
+        require_reals(
+            self,
+            ("gd_min", "gd_max", "v_max", "v_safe", "kp", "risk", "latch_p", "speed_step_mps"),
+            optional=("kp", "risk"),
+        )
         for name in ("gd_min", "gd_max", "v_max", "v_safe"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
@@ -167,6 +173,8 @@ class Simplex:
             gd = estimate.quantile(1 - self.risk)
         else:
             return Command(self.v_safe, "safety", np.nan, "risk posture needs the posterior")
+        if not np.isfinite(gd):
+            return Command(self.v_safe, "safety", np.nan, f"the estimate's GD is {gd}")
         if gd > self.gd_max:
             return Command(self.v_safe, "safety", gd, f"GD {gd:.0f} > GD_max {self.gd_max:g}")
         return Command(self.on_speed_grid(self.performance_speed(gd)), "performance", gd)

@@ -26,6 +26,7 @@ from scipy.ndimage import gaussian_filter1d
 from scipy.special import logsumexp
 
 from control.errors import ControlError
+from control.validation import check_n_draws, float_array, require_integers, require_reals
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("uniform", "log_uniform")
@@ -51,6 +52,8 @@ class TrackerSettings:
     prior: str = "uniform"
 
     def __post_init__(self) -> None:
+        require_reals(self, ("mean_segment_m", "drift_per_sqrt_m"))
+        require_integers(self, ("n_grid",))
         if not (np.isfinite(self.mean_segment_m) and self.mean_segment_m >= 0):
             raise ControlError(f"mean_segment_m must be finite and >= 0, got {self.mean_segment_m}")
         if not (np.isfinite(self.drift_per_sqrt_m) and self.drift_per_sqrt_m >= 0):
@@ -103,17 +106,19 @@ class GDTracker:
         """Multiply in a likelihood given on any sorted grid of native GD (interpolated in log GD).
 
         Args:
-            grid: (k,) sorted GD values where loglik is known (e.g. the Calibrator's grid).
+            grid: (k,) increasing GD values where loglik is known (e.g. the Calibrator's grid).
             loglik: (k,) log-likelihood values (any additive constant).
             power: tempering exponent in (0, 1]: the likelihood enters as likelihood**power
                 (the fraction of the window's samples that are new to this tracker).
         """
         if not 0 < power <= 1:
             raise ControlError(f"power must lie in (0, 1], got {power}")
-        grid = np.asarray(grid, dtype=float)
-        loglik = np.asarray(loglik, dtype=float)
+        grid = float_array(grid, "grid")
+        loglik = float_array(loglik, "loglik")
         if grid.ndim != 1 or grid.shape != loglik.shape or grid.size < 2:
             raise ControlError(f"grid/loglik must be 1-D of equal length, got {grid.shape}")
+        if not (np.all(np.isfinite(grid)) and grid[0] > 0 and np.all(np.diff(grid) > 0)):
+            raise ControlError(f"grid must hold increasing, finite, positive GD values, got {grid}")
         if not np.all(np.isfinite(loglik)):
             raise ControlError("loglik must be finite")
         ll = power * np.interp(self.log_grid, np.log(grid), loglik - loglik.max())
@@ -127,6 +132,7 @@ class GDTracker:
         sd are the mass-weighted sums; ``samples`` (for histograms) are ``n_draws`` inverse-CDF
         draws with a fixed seed, made only when read.
         """
+        check_n_draws(n_draws)
         w = trapezoid_weights(self.grid)
         marginal = GridMarginal.from_log_density(self.grid, self.log_mass - np.log(w), w)
         return Posterior(

@@ -12,10 +12,12 @@ from control import (
     STATUSES,
     BCRSettings,
     ControlError,
+    EmulatorMismatchError,
     Estimate,
+    FeatureSpec,
     SensorFault,
 )
-from control.faults import apply_faults
+from control.faults import FaultInjector
 from control.sensor_checks import MIN_SEGMENT
 
 WINDOW = {"feature": PAPER_WINDOW}
@@ -213,7 +215,7 @@ def test_each_fault_kind_gives_no_estimate_and_the_bcr_recovers(
 ):
     t, p, a, v = stream(const(400), 1.5, 30, seed=5)
     fault = SensorFault(10.0, 2.0, kind, magnitude)
-    obs = apply_faults(t, p, a, v, [fault], np.random.default_rng(0))
+    obs = FaultInjector([fault], np.random.default_rng(0))(t, p, a, v)
     bcr = BCR(block_model)
     every = bcr.settings.samples_per_update  # one update per call, as in the closed loop
     ests = feed(bcr, *obs, chunk=every)
@@ -229,7 +231,7 @@ def test_a_quantisation_of_seven_samples_is_a_sensor_fault(block_model):
     drove 3.5 m too fast on rough ground."""
     t, p, a, v = stream(const(400), 1.5, 20, seed=5)
     fault = SensorFault(10.001, 0.058, "quantize", 2.6)
-    obs = apply_faults(t, p, a, v, [fault], np.random.default_rng(0))
+    obs = FaultInjector([fault], np.random.default_rng(0))(t, p, a, v)
     assert np.sum(obs[2] != a) == 7
     bcr = BCR(block_model)
     ests = feed(bcr, *obs, chunk=bcr.settings.samples_per_update)
@@ -308,7 +310,9 @@ def test_no_fault_crashes_the_bcr_or_makes_it_confidently_too_low(kind, start, d
     lo, hi = FAULT_SIZES.get(kind, (1.0, 1.0))
     magnitude = float(np.exp(np.log(lo) + size * (np.log(hi) - np.log(lo))))
     fault = SensorFault(start, duration, kind, magnitude)
-    ests = feed(BCR(FakeBlockModel()), *apply_faults(t, p, a, v, [fault], np.random.default_rng(1)))
+    ests = feed(
+        BCR(FakeBlockModel()), *FaultInjector([fault], np.random.default_rng(1))(t, p, a, v)
+    )
     assert all(e.status in STATUSES for e in ests)
     for e in ests:  # an accepted estimate is never far below the truth (a faster robot)
         if e.ok:
@@ -393,6 +397,36 @@ def test_changepoint_settings_are_checked(block_model):
             bcr.update(np.arange(3.0), np.arange(3.0), np.arange(3.0), junk)
     with pytest.raises(ControlError, match="position must hold real numbers"):
         bcr.update(np.arange(3.0), np.array([1.0, "x", 2.0], dtype=object), np.ones(3), np.ones(3))
+
+
+def test_settings_of_the_wrong_type_are_named(block_model):
+    for field in ("feature", "changepoint", "tracker", "sensor"):
+        with pytest.raises(ControlError, match=f"BCRSettings.{field} must be a"):
+            BCRSettings(**{field: None})
+    with pytest.raises(ControlError, match="BCRSettings.max_age_s must be a real number"):
+        BCRSettings(max_age_s="5")
+    with pytest.raises(ControlError, match="now must be a finite time"):
+        BCR(block_model).update(np.arange(3.0), np.arange(3.0), np.ones(3), np.ones(3), now="x")
+
+
+def test_a_feature_other_than_the_models_emulators_is_refused():
+    model = FakeBlockModel()
+    model.emulator.metadata = {"feature": FeatureSpec().to_dict()}
+    BCR(model)  # the same feature
+    for other in (FeatureSpec(block_samples=250), FeatureSpec(taper_nw=3.0, n_tapers=5)):
+        with pytest.raises(EmulatorMismatchError, match="the BCR's feature differs"):
+            BCR(model, feature=other)
+
+
+@pytest.mark.parametrize("bad", [np.inf, -np.inf, np.nan])
+def test_a_non_finite_time_stamp_is_a_sensor_fault_not_an_error(block_model, bad):
+    t, p, a, v = stream(const(400), 1.5, 6, seed=1)
+    t = t.copy()
+    t[300] = bad
+    ests = feed(BCR(block_model), t, p, a, v, chunk=42)
+    faults = [e for e in ests if e.status == "sensor_fault"]
+    assert faults and "non-finite t" in faults[0].reason
+    assert ests[-1].ok
 
 
 def test_backwards_and_repeated_time_stamps_are_faults(block_model):
@@ -482,3 +516,15 @@ def test_the_window_feature_of_the_paper(fake_calibrator):
     est = feed(BCR(fake_calibrator, method="window", **WINDOW), t, p, a, v)[-1]
     assert est.feature[0] == pytest.approx(np.log(np.var(a[:1000])))  # 1,080 samples fed
     assert est.feature[0] == pytest.approx(log_f(1.5, 400), abs=0.3)
+
+
+def test_a_stuck_sensor_holds_its_last_good_value_across_batches():
+    t = np.arange(240) / 120.0
+    a = np.arange(240, dtype=float)
+    inject = FaultInjector([SensorFault(0.5, 1.0, "stuck")], np.random.default_rng(0))
+    read = np.concatenate(
+        [inject(t[k : k + 42], t[k : k + 42], a[k : k + 42], np.ones(42)[: t[k : k + 42].size])[2]
+         for k in range(0, 240, 42)]
+    )  # fmt: skip
+    stuck = (t >= 0.5) & (t < 1.5)
+    assert np.all(read[stuck] == a[59]) and np.array_equal(read[~stuck], a[~stuck])

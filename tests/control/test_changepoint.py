@@ -102,6 +102,15 @@ def test_bad_settings_and_inputs():
         f.predict(-1.0)
     with pytest.raises(ControlError, match="increasing 1-D grid"):
         ChangePointFilter(np.array([3.0, 2.0, 1.0]))
+    for grid in ([1.0, np.nan, 3.0], [100.0, 200.0, 300.0, np.inf]):
+        with pytest.raises(ControlError, match="positive, finite values"):
+            ChangePointFilter(np.array(grid))
+    with pytest.raises(ControlError, match="ChangePointSettings.mean_segment_m must be a real"):
+        ChangePointSettings(mean_segment_m="40")
+    with pytest.raises(ControlError, match="ChangePointSettings.max_runs must be an integer"):
+        ChangePointSettings(max_runs=300.0)
+    with pytest.raises(ControlError, match="n_draws must be an integer >= 1"):
+        f.posterior(n_draws=0)
 
 
 def test_a_mixture_of_filters_needs_one_grid_and_positive_weights():

@@ -190,6 +190,34 @@ def test_set_up_is_checked_before_the_run(emulator_a):
         run_closed_loop(track, emulator_a, bcr=BCRSettings(feature=PAPER_WINDOW, method="window"))
 
 
+def test_arguments_are_checked_before_the_drive(emulator_a, likelihood_a, tmp_path):
+    track = roadgen.track([(20, 300)], seed=1)
+    for kwargs, match in (
+        (
+            {"faults": SensorFault(1.0, 1.0)},
+            r"faults must be a sequence of SensorFault: pass \[fault\]",
+        ),
+        ({"faults": [("nan", 1, 2)]}, "faults must hold SensorFault objects"),
+        ({"max_time_s": float("nan")}, "max_time_s must be None or a number > 0"),
+        ({"max_time_s": 0.0}, "max_time_s must be None or a number > 0"),
+        ({"simplex": "fast"}, "simplex must be a control.Simplex"),
+        ({"record": tmp_path}, "is a folder; name the .mcap file"),
+    ):
+        with pytest.raises(ControlError, match=match):
+            run_closed_loop(track, emulator_a, likelihood=likelihood_a, **kwargs)
+    with pytest.raises(vehicle.VehicleError, match="model='jackal' is not allowed"):
+        run_closed_loop(track, emulator_a, model="jackal")
+
+
+def test_a_likelihood_prepared_for_another_emulator_is_refused(emulator_a):
+    track = roadgen.track([(20, 300)], seed=1)
+    emulator_b = control.shipped_emulator("B")
+    with pytest.raises(EmulatorMismatchError, match=r"metadata differ in \[.*'noise_std'\]"):
+        run_closed_loop(track, emulator_a, likelihood=control.ObservationModel(emulator_b))
+    # the same file loaded twice is the same emulator
+    control.check_likelihood(emulator_a, control.ObservationModel(control.shipped_emulator("A")))
+
+
 def test_a_noise_mismatch_warns():
     emu = control.shipped_emulator("A")
     with pytest.warns(ControlWarning, match="noise_std = 1 m/s\\^2 in the data"):

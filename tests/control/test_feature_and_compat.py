@@ -108,6 +108,17 @@ def test_feature_spec_checks_and_round_trips():
         FeatureSpec(n_tapers=4)
     with pytest.raises(ControlError, match="feature name must be one of"):
         FeatureSpec(name="rms")
+    with pytest.raises(ControlError, match=r"block_samples must lie in \[16, 4096\]"):
+        FeatureSpec(block_samples=10**9)  # refused before any table of that size is made
+    for kwargs, match in (
+        ({"rate_hz": "120"}, "FeatureSpec.rate_hz must be a real number"),
+        ({"n_tapers": 2.5}, "FeatureSpec.n_tapers must be an integer"),
+        ({"block_samples": 125.0}, "FeatureSpec.block_samples must be an integer"),
+        ({"bands_hz": None}, "bands_hz must be a sequence of finite edges"),
+        ({"bands_hz": (1.0, "a")}, "bands_hz must hold numbers"),
+    ):
+        with pytest.raises(ControlError, match=match):
+            FeatureSpec(**kwargs)
 
 
 def test_band_powers_add_up_to_the_variance_of_white_noise():

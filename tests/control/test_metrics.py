@@ -5,7 +5,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from control import detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
+from control import ControlError, detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
 
 TRACK = SimpleNamespace(
     segments=((50.0, 300.0), (50.0, 500.0), (50.0, 300.0)),
@@ -47,3 +47,34 @@ def test_fast_on_rough_counts_only_rough_ground_above_v_safe():
         8.0, abs=0.02
     )
     assert fast_on_rough_m(TRACK, pos, np.full(pos.size, 1.0), 350, 1.0) == 0.0
+
+
+def test_an_estimate_without_a_position_is_left_out_not_charged_to_the_last_part():
+    errs = {e.gd: e for e in gd_errors(TRACK, [np.nan, 5.0], [300.0, 300.0])}
+    assert errs[500].n == 0 and errs[300].n == 1 and errs[300].sse == 0.0
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: gd_errors(TRACK, [1.0, 2.0, 3.0], [300.0, 300.0]),
+        lambda: detection_delays(TRACK, [1.0, 12.0, 13.0], [300.0, 500.0]),
+        lambda: fast_on_rough_m(TRACK, [1.0, 12.0, 13.0], [2.0, 2.0], 350.0, 1.0),
+        lambda: gd_errors(TRACK, ["a", "b"], [300.0, 300.0]),
+    ],
+)
+def test_traces_of_different_lengths_or_not_numbers_are_refused(call):
+    with pytest.raises(ControlError, match="position"):
+        call()
+
+
+def test_fast_on_rough_refuses_positions_that_go_backwards():
+    with pytest.raises(ControlError, match="non-decreasing"):
+        fast_on_rough_m(TRACK, [69.0, 62.0], [2.0, 2.0], 350.0, 1.0)
+
+
+def test_pooled_rmse_names_the_one_run_mistake():
+    errs = gd_errors(TRACK, [10.0], [310.0])
+    with pytest.raises(ControlError, match=r"\[metrics.gd_errors\]"):
+        pooled_rmse(errs, 300.0)
+    assert pooled_rmse([errs], 300.0) == pytest.approx(10.0)

@@ -284,3 +284,22 @@ def test_a_dead_stretch_of_six_samples_or_more_is_a_fault_wherever_it_lies(
         "quantize": np.round(part / 1e3) * 1e3,
     }[kind]
     assert signal_fault(a, SensorLimits()) != ""
+
+
+def test_the_level_check_in_chunks_finds_the_same_segment_as_every_pair_at_once(monkeypatch):
+    from control import sensor_checks
+
+    rng = np.random.default_rng(3)
+    a = rng.standard_normal(200)
+    a[70:150] *= 1e-3
+    n, m = a.size, sensor_checks.MIN_SEGMENT
+    best = max(
+        (max(np.var(a[i:j], ddof=1) / np.var(np.r_[a[:i], a[j:]], ddof=1),
+             np.var(np.r_[a[:i], a[j:]], ddof=1) / np.var(a[i:j], ddof=1)), (i, j))
+        for i in range(n + 1) for j in range(i + m, n + 1) if n - (j - i) >= m
+    )  # fmt: skip
+    whole = level_jump(a)
+    monkeypatch.setattr(sensor_checks, "SEGMENT_PAIRS_PER_CHUNK", 500)  # 2 starts a chunk
+    chunked = level_jump(a)
+    assert whole[1] == chunked[1] == best[1] and 70 <= best[1][0] < best[1][1] <= 150
+    assert whole[0] == pytest.approx(best[0], rel=1e-6) and chunked[0] == whole[0]

@@ -97,6 +97,9 @@ def test_risk_switches_exactly_when_prob_above_max_exceeds_alpha(mean, sd, alpha
         ({"v_max": float("nan")}, "v_max must be finite"),
         ({"speed_step_mps": -0.1}, r"speed_step_mps must lie in \[0, v_max\]"),
         ({"speed_step_mps": float("inf")}, "speed_step_mps must lie in"),
+        ({"gd_min": "250"}, "Simplex.gd_min must be a real number"),
+        ({"risk": "0.1"}, "Simplex.risk must be a real number or None"),
+        ({"kp": True}, "Simplex.kp must be a real number or None"),
     ],
 )
 def test_bad_settings_raise(kwargs, match):
@@ -194,3 +197,13 @@ def test_on_the_speed_grid_an_invisible_change_of_the_estimate_changes_no_comman
     nudged = [s.command(gaussian_estimate(gd * (1 + 1e-9), 3)).speed for gd in gds]
     assert speeds == nudged
     assert len(set(speeds)) == 10  # 1.0, 1.1, ..., 1.9: one command per step of the law
+
+
+@pytest.mark.parametrize("law", ["linear", "paper", "switch"])
+@pytest.mark.parametrize("gd", [float("nan"), float("inf")])
+def test_an_ok_estimate_without_a_finite_gd_means_safety_mode(gd, law):
+    estimate = Estimate(time=1.0, position=1.0, status="ok", gd_mean=gd)
+    for controller in (Simplex(law=law), Simplex(law=law, speed_step_mps=0.0)):
+        command = controller.command(estimate)
+        assert (command.mode, command.speed) == ("safety", controller.v_safe)
+        assert controller.start().command(estimate).speed == controller.v_safe

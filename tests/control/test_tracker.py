@@ -102,3 +102,15 @@ def test_bad_input_raises():
         tr.predict(-1.0)
     with pytest.raises(ControlError, match="loglik must be finite"):
         tr.update(GRID, np.full(GRID.size, np.nan))
+    with pytest.raises(ControlError, match="TrackerSettings.n_grid must be an integer"):
+        TrackerSettings(n_grid=400.5)
+    with pytest.raises(ControlError, match="n_draws must be an integer >= 1"):
+        tr.posterior(n_draws=-1)
+
+
+@pytest.mark.parametrize(
+    "grid", [[600.0, 200.0, 400.0], [200.0, np.nan, 600.0], [-1.0, 200.0, 600.0]]
+)
+def test_a_grid_that_is_not_increasing_finite_and_positive_is_refused(grid):
+    with pytest.raises(ControlError, match="grid must hold increasing, finite, positive"):
+        GDTracker((200, 600)).update(grid, [-10.0, -10.0, 0.0])

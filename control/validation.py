@@ -1,0 +1,66 @@
+"""Type checks of the settings' fields: a string or None where a number belongs is named in a
+`ControlError`, before any numpy comparison fails on it with a message about ufuncs."""
+
+from __future__ import annotations
+
+from numbers import Integral, Real
+
+import numpy as np
+
+from control.errors import ControlError
+
+
+def is_real(value) -> bool:
+    """Whether ``value`` is a real number (a bool is not)."""
+    return isinstance(value, Real) and not isinstance(value, bool)
+
+
+def float_array(values, name: str) -> np.ndarray:
+    """``values`` as a float array; ControlError naming ``name`` when they are not numbers."""
+    try:
+        return np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ControlError(f"{name} must hold numbers: {exc}") from exc
+
+
+def check_n_draws(n_draws) -> None:
+    """ControlError unless ``n_draws`` (posterior draws made for histograms) is an integer >= 1."""
+    if not (isinstance(n_draws, Integral) and not isinstance(n_draws, bool) and n_draws >= 1):
+        raise ControlError(f"n_draws must be an integer >= 1, got {n_draws!r}")
+
+
+def require_reals(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:
+    """ControlError naming the first of ``names`` whose value in ``obj`` is not a real number
+    (bools are not); the fields in ``optional`` may also be None."""
+    for name in names:
+        value = getattr(obj, name)
+        if not (is_real(value) or (value is None and name in optional)):
+            allowed = "a real number or None" if name in optional else "a real number"
+            raise ControlError(
+                f"{type(obj).__name__}.{name} must be {allowed}, got {value!r} "
+                f"({type(value).__name__})"
+            )
+
+
+def require_integers(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:
+    """ControlError naming the first of ``names`` whose value in ``obj`` is not an integer
+    (bools are not; 3.0 is not); the fields in ``optional`` may also be None."""
+    for name in names:
+        value = getattr(obj, name)
+        integer = isinstance(value, Integral) and not isinstance(value, bool)
+        if not (integer or (value is None and name in optional)):
+            allowed = "an integer or None" if name in optional else "an integer"
+            raise ControlError(
+                f"{type(obj).__name__}.{name} must be {allowed}, got {value!r} "
+                f"({type(value).__name__})"
+            )
+
+
+def require_instance(obj, name: str, cls: type) -> None:
+    """ControlError naming ``name`` when its value in ``obj`` is not a ``cls``."""
+    value = getattr(obj, name)
+    if not isinstance(value, cls):
+        raise ControlError(
+            f"{type(obj).__name__}.{name} must be a {cls.__name__}, got {value!r} "
+            f"({type(value).__name__})"
+        )
