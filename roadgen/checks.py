@@ -1,4 +1,6 @@
-"""Input checks shared by roadgen's functions; each raises RoadgenError naming the argument.
+"""Input checks shared by roadgen's functions; each raises RoadgenError naming the argument
+(those with an ``error`` parameter raise that class instead: ``vehicle.checks`` reuses them
+with VehicleError).
 
 Resource limit: ``MAX_MEMORY_BYTES`` (module attribute, read at call time). A road is made only
 when the memory its synthesis needs (about ``BYTES_PER_POINT`` per grid point) is below it;
@@ -9,6 +11,7 @@ it: ``roadgen.checks.MAX_MEMORY_BYTES = 16 * 1024**3``.
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -60,37 +63,93 @@ def seed(
     return int(value)
 
 
-def positive(name: str, value: float) -> float:
-    """Return ``value`` as a float, or raise if it is not a finite number > 0."""
-    v = _finite(name, value)
+def real(name: str, value: object, error: type[Exception] = RoadgenError) -> float:
+    """Return ``value`` as a float if it is a real number: a Python or numpy int or float (or a
+    0-d array of one), not a bool, a string or a complex number; else raise ``error``. NaN and
+    inf pass."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise error(f"{name}={value!r} must be a real number (got {type(value).__name__})")
+    return float(value)
+
+
+def integer(name: str, value: object, minimum: int, error: type[Exception] = RoadgenError) -> int:
+    """Return ``value`` as an int if it is a Python or numpy integer (or a 0-d array of one), not
+    a bool, and >= ``minimum``; else raise ``error``."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iu":
+        value = value.item()
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise error(
+            f"{name}={value!r} must be an integer >= {minimum} (got {type(value).__name__})"
+        )
+    if value < minimum:
+        raise error(f"{name}={int(value)} is out of range: allowed integers >= {minimum}")
+    return int(value)
+
+
+def flag(name: str, value: object, error: type[Exception] = RoadgenError) -> bool:
+    """Return ``value`` as a bool if it is True or False (Python or numpy); else raise ``error``
+    (a string such as "no" or a number is not read as a truth value)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise error(f"{name}={value!r} must be True or False (got {type(value).__name__})")
+    return bool(value)
+
+
+def real_array(name: str, value: object, error: type[Exception] = RoadgenError) -> np.ndarray:
+    """Return ``value`` as a new float array if it holds real numbers (ints or floats, not
+    bools, strings, complex numbers or objects); else raise ``error``. NaN and inf pass."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:  # e.g. ragged nested lists
+        raise error(f"{name} must be an array of real numbers: {exc}") from exc
+    if arr.dtype.kind not in "iuf":
+        raise error(f"{name} must be an array of real numbers, got dtype {arr.dtype}")
+    return arr.astype(float)
+
+
+def positive(
+    name: str, value: object, error: type[Exception] = RoadgenError, unit: str = ""
+) -> float:
+    """Return ``value`` as a float, or raise ``error`` if it is not a finite real number > 0
+    (``unit`` ends the range in the message)."""
+    v = _finite(name, value, error)
     if v <= 0.0:
-        raise RoadgenError(f"{name}={value!r} is out of range: allowed (0, inf)")
+        raise error(f"{name}={value!r} is out of range: allowed (0, inf){_unit(unit)}")
     return v
 
 
-def non_negative(name: str, value: float) -> float:
-    """Return ``value`` as a float, or raise if it is not a finite number >= 0."""
-    v = _finite(name, value)
+def non_negative(
+    name: str, value: object, error: type[Exception] = RoadgenError, unit: str = ""
+) -> float:
+    """Return ``value`` as a float, or raise ``error`` if it is not a finite real number >= 0
+    (``unit`` ends the range in the message)."""
+    v = _finite(name, value, error)
     if v < 0.0:
-        raise RoadgenError(f"{name}={value!r} is out of range: allowed [0, inf)")
+        raise error(f"{name}={value!r} is out of range: allowed [0, inf){_unit(unit)}")
     return v
 
 
-def choice(name: str, value: str, allowed: tuple[str, ...]) -> str:
-    """Return ``value`` if it is one of ``allowed``, else raise."""
-    if value not in allowed:
-        raise RoadgenError(f"{name}={value!r} is not allowed: choose one of {allowed}")
+def choice(
+    name: str, value: object, allowed: tuple[str, ...], error: type[Exception] = RoadgenError
+) -> str:
+    """Return ``value`` if it is one of the strings ``allowed``, else raise ``error``."""
+    if not isinstance(value, str) or value not in allowed:
+        raise error(f"{name}={value!r} is not allowed: choose one of {allowed}")
     return value
 
 
-def band(name: str, value: tuple[float, float], nyquist: float) -> tuple[float, float]:
-    """Check a band (n_min, n_max) in cycles/m: 0 < n_min < n_max <= nyquist."""
-    try:
-        lo, hi = (float(b) for b in value)
-    except (TypeError, ValueError) as exc:
-        raise RoadgenError(f"{name}={value!r} must be a pair (n_min, n_max) in cycles/m") from exc
+def band(
+    name: str, value: tuple[float, float], nyquist: float, error: type[Exception] = RoadgenError
+) -> tuple[float, float]:
+    """Return a band (n_min, n_max) in cycles/m as floats, or raise ``error`` unless it is a
+    pair of real numbers with 0 < n_min < n_max <= nyquist."""
+    pair = tuple(value) if isinstance(value, (tuple, list, np.ndarray)) else ()
+    if len(pair) != 2:
+        raise error(f"{name}={value!r} must be a pair (n_min, n_max) in cycles/m")
+    lo, hi = (real(f"{name}[{i}]", b, error) for i, b in enumerate(pair))
     if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi <= nyquist):
-        raise RoadgenError(
+        raise error(
             f"{name}={value!r} is out of range: need 0 < n_min < n_max <= {nyquist:.6g} "
             "cycles/m (the Nyquist frequency 1/(2 dx_m) of the grid)"
         )
@@ -99,22 +158,42 @@ def band(name: str, value: tuple[float, float], nyquist: float) -> tuple[float, 
 
 def positions(name: str, s: np.ndarray | float, length_m: float) -> np.ndarray:
     """Return ``s`` as a float array, or raise if any position is NaN or outside [0, length_m]."""
-    arr = np.asarray(s, dtype=float)
+    arr = real_array(name, s)
     tol = 1e-9 * max(length_m, 1.0)
     bad = ~np.isfinite(arr) | (arr < -tol) | (arr > length_m + tol)
     if np.any(bad):
-        first = arr[bad].flat[0]
+        first = float(arr[bad].flat[0])
         raise RoadgenError(
             f"{name} contains {first!r}: allowed positions are [0, {length_m:.6g}] m"
         )
     return np.clip(arr, 0.0, length_m)
 
 
-def _finite(name: str, value: float) -> float:
+def heights(name: str, road: object) -> tuple[np.ndarray, float]:
+    """Return the heights z (N,) m and grid step dx_m of ``road`` (anything with ``z`` and
+    ``dx_m``: a Profile, a Track), or raise unless z is a finite real (N,) array, N >= 2, and
+    dx_m a finite real > 0."""
     try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise RoadgenError(f"{name}={value!r} must be a real number") from exc
+        z, dx = road.z, road.dx_m
+    except AttributeError:
+        raise RoadgenError(
+            f"{name}={type(road).__name__} must have heights z (N,) m and a grid step dx_m "
+            "(a roadgen Profile or Track)"
+        ) from None
+    arr = real_array(f"{name}.z", z)
+    if arr.ndim != 1 or arr.size < 2:
+        raise RoadgenError(f"{name}.z has shape {arr.shape}: need (N,) heights with N >= 2")
+    if not np.all(np.isfinite(arr)):
+        raise RoadgenError(f"{name}.z contains NaN or inf: allowed finite heights in m")
+    return arr, positive(f"{name}.dx_m", dx)
+
+
+def _finite(name: str, value: object, error: type[Exception]) -> float:
+    v = real(name, value, error)
     if not math.isfinite(v):
-        raise RoadgenError(f"{name}={value!r} must be finite")
+        raise error(f"{name}={value!r} must be finite")
     return v
+
+
+def _unit(unit: str) -> str:
+    return f" {unit}" if unit else ""

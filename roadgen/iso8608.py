@@ -12,6 +12,7 @@ import bisect
 import numpy as np
 
 from roadgen import checks
+from roadgen.errors import RoadgenError
 
 N0 = 0.1
 """Reference spatial frequency n0 of ISO 8608, cycles/m."""
@@ -33,8 +34,19 @@ CLASS_LOWER_BOUNDS: tuple[tuple[str, float], ...] = (
 
 
 def gd_spectrum(n: np.ndarray, gd: float, waviness: float = 2.0) -> np.ndarray:
-    """One-sided displacement PSD Gd(n) in m^3 for spatial frequencies ``n`` (cycles/m, > 0)."""
-    return gd * GD_SCALE * (np.asarray(n, dtype=float) / N0) ** (-waviness)
+    """One-sided displacement PSD Gd(n) in m^3 for spatial frequencies ``n`` (cycles/m, > 0, any
+    shape), a road of ``gd`` (> 0, units 1e-6 m^3) and ``waviness`` w (> 0).
+
+    Raises RoadgenError for a frequency that is not finite and > 0, or a bad gd or waviness.
+    """
+    arr = checks.real_array("n", n)
+    bad = ~np.isfinite(arr) | (arr <= 0.0)
+    if np.any(bad):
+        first = float(arr[bad].flat[0])
+        raise RoadgenError(f"n contains {first!r}: allowed frequencies in (0, inf) cycles/m")
+    g = checks.positive("gd", gd)
+    w = checks.positive("waviness", waviness)
+    return g * GD_SCALE * (arr / N0) ** (-w)
 
 
 def road_class(gd: float) -> str:

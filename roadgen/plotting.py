@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from roadgen.errors import RoadgenError
 from roadgen.iso8608 import N0, gd_spectrum
 from roadgen.psd import estimate_gd, profile_psd
 from roadgen.road import Road
@@ -18,15 +19,22 @@ def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None 
     ``estimate_gd`` recovers. ``method`` is that of ``profile_psd``. The prescribed lines are
     drawn wide and translucent underneath, the road's PSD as a thin line with a dot per ordinate
     on top: with deterministic amplitudes the periodogram lies exactly on its line and stays
-    visible there.
+    visible there. A plain Road (no GD of its own) shows no prescribed line and is fitted with
+    waviness 2.
+
+    Raises RoadgenError unless ``road`` is a roadgen Road, and for the errors of ``profile_psd``.
     """
+    if not isinstance(road, Road):
+        raise RoadgenError(
+            f"road={type(road).__name__} is not allowed: need a roadgen Road (a Profile or Track)"
+        )
+    n, gd = profile_psd(road, method)
     fig = Figure(figsize=(7.0, 6.5), layout="constrained")
     ax_z, ax_p = fig.subplots(2, 1)
     ax_z.plot(road.x, 1e3 * road.z, lw=0.6)
     ax_z.set_xlabel("distance x (m)")
     ax_z.set_ylabel("height z (mm)")
-    n, gd = profile_psd(road, method)
-    waviness = road.settings.waviness
+    waviness = getattr(getattr(road, "settings", None), "waviness", 2.0)
     for k, g in enumerate(_prescribed_gds(road)):
         ax_p.loglog(n, gd_spectrum(n, g, waviness), lw=5.0, alpha=0.35, color=f"C{k + 1}",
                     solid_capstyle="butt", zorder=1, label=f"prescribed GD {g:g}")  # fmt: skip
@@ -46,4 +54,5 @@ def _prescribed_gds(road: Road) -> list[float]:
     segments = getattr(road, "segments", None)
     if segments is not None:
         return sorted({g for _, g in segments})
-    return [road.gd]
+    gd = getattr(road, "gd", None)
+    return [] if gd is None else [gd]

@@ -40,6 +40,10 @@ class Profile(Road):
     gd: float
     settings: ProfileSettings
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        object.__setattr__(self, "gd", checks.positive("gd", self.gd))
+
     def gd_at(self, s: np.ndarray | float) -> np.ndarray | float:
         """Prescribed GD at positions ``s`` (m): the constant ``gd``, shaped like ``s``."""
         arr = checks.positions("s", s, self.length_m)

@@ -47,15 +47,20 @@ def profile_psd(
         the mean. It removes the step that a non-periodic road (a track, a window cut from a
         road, a measured profile) has at the wrap-around, whose leakage falls like n^-2, as
         steeply as the road's own PSD; on periodic profiles it costs ~0.1% (150 m) to ~1% (21 m).
+
+    Raises RoadgenError for an unknown method, a road without finite heights z (N,) and a grid
+    step dx_m > 0, an nperseg that is not an integer in [8, N], or an end_match that is not a
+    bool.
     """
     checks.choice("method", method, PSD_METHODS)
-    z = np.asarray(road.z, dtype=float)
-    fs = 1.0 / road.dx_m
+    z, dx = checks.heights("road", road)
+    end_match = checks.flag("end_match", end_match)
+    seg = z.size // 4 if nperseg is None else checks.integer("nperseg", nperseg, 8)
+    fs = 1.0 / dx
     if method == "periodogram":
         detrend = _end_match if end_match else "constant"
         n, gd = scipy.signal.periodogram(z, fs=fs, window="boxcar", detrend=detrend)
     else:
-        seg = z.size // 4 if nperseg is None else int(nperseg)
         if not 8 <= seg <= z.size:
             raise RoadgenError(f"nperseg={nperseg!r} is out of range: allowed [8, {z.size}]")
         n, gd = scipy.signal.welch(z, fs=fs, window="hann", nperseg=seg, detrend="constant")
@@ -88,8 +93,9 @@ def estimate_gd(
     the band.
     """
     checks.choice("method", method, GD_METHODS)
+    z, dx = checks.heights("road", road)
     w = _waviness(road, waviness)
-    nyquist = 0.5 / road.dx_m
+    nyquist = 0.5 / dx
     lo, hi = checks.band("band", FIT_BAND if band is None else band, nyquist)
     if method == "periodogram":
         n, gd = profile_psd(road, "periodogram")
@@ -105,7 +111,7 @@ def estimate_gd(
         keep &= k >= WELCH_MIN_BIN
         gd = gd / (1.0 + w * (w + 1.0) / (6.0 * k**2))
     if not np.any(keep):
-        length = road.dx_m * np.asarray(road.z).size
+        length = dx * z.size
         raise RoadgenError(
             f"the road (length {length:.6g} m) is too short for band=({lo:.6g}, {hi:.6g}) cycles/m "
             f"with method={method!r}: its PSD has no bin there (spacing {n[0]:.6g} cycles/m)"
@@ -115,7 +121,8 @@ def estimate_gd(
 
 def psd_slope(road: HasHeights, band: tuple[float, float] | None = None) -> float:
     """Least-squares slope of log Gd on log n over ``band`` (default FIT_BAND); ISO 8608: -2."""
-    lo, hi = checks.band("band", FIT_BAND if band is None else band, 0.5 / road.dx_m)
+    _, dx = checks.heights("road", road)
+    lo, hi = checks.band("band", FIT_BAND if band is None else band, 0.5 / dx)
     n, gd = profile_psd(road, "periodogram", end_match=True)
     keep = (n >= lo) & (n <= hi) & (gd > 0)
     if np.count_nonzero(keep) < 2:

@@ -23,8 +23,8 @@ class Road:
 
     def __post_init__(self) -> None:
         dx = checks.positive("dx_m", self.dx_m)
-        x = np.array(self.x, dtype=float)
-        z = np.array(self.z, dtype=float)
+        x = checks.real_array("x", self.x)
+        z = checks.real_array("z", self.z)
         if x.ndim != 1 or z.shape != x.shape or x.size < 2:
             raise RoadgenError(
                 f"x and z must be 1-D arrays of the same length >= 2, got shapes {x.shape} "

@@ -28,6 +28,22 @@ class Track(Road):
     blend_m: float
     settings: ProfileSettings
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        segs = _check_segments(self.segments)
+        starts = checks.real_array("boundaries_m", self.boundaries_m)
+        if starts.shape != (len(segs),) or not (
+            np.all(np.isfinite(starts)) and np.all(np.diff(starts) > 0)
+        ):
+            raise RoadgenError(
+                f"boundaries_m={self.boundaries_m!r} must hold one finite start position per "
+                f"segment ({len(segs)}), increasing"
+            )
+        object.__setattr__(self, "segments", segs)
+        object.__setattr__(self, "boundaries_m", tuple(float(b) for b in starts))
+        object.__setattr__(self, "lead_in_m", checks.non_negative("lead_in_m", self.lead_in_m))
+        object.__setattr__(self, "blend_m", checks.positive("blend_m", self.blend_m))
+
     def gd_at(self, s: np.ndarray | float) -> np.ndarray | float:
         """Prescribed GD at positions ``s`` (m): that of the segment holding each position.
 

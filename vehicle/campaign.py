@@ -32,6 +32,7 @@ from vehicle import checks
 from vehicle.design import check_design, lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
 from vehicle.models import Jackal, Model, check_model
+from vehicle.sensor import check_noise, check_rate
 from vehicle.simulate import SUBSTEPS, simulate
 
 FORMAT = "vehicle.campaign/1"
@@ -97,6 +98,7 @@ class Campaign:
 
     def save(self, path: str | os.PathLike) -> None:
         """Write a plain ``.npz`` (no pickle): the arrays and the settings as JSON."""
+        _check_path(path)
         arrays = {name: np.asarray(getattr(self, name)) for name in _ARRAYS}
         arrays["status"] = np.asarray(self.status, dtype=str)
         arrays["settings"] = np.asarray(json.dumps({"format": FORMAT, **self.settings}))
@@ -107,7 +109,9 @@ class Campaign:
 
 
 def load_campaign(path: str | os.PathLike) -> Campaign:
-    """Read a file written by ``Campaign.save``; CampaignFileError if missing or damaged."""
+    """Read a file written by ``Campaign.save``; CampaignFileError if missing or damaged,
+    VehicleError if ``path`` is not a path."""
+    _check_path(path)
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {name: data[name] for name in (*_ARRAYS, "settings")}
@@ -131,6 +135,15 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
     if traces and any(a.shape[:1] != n for a in traces.values()):
         raise CampaignFileError(f"campaign file {str(path)!r}: traces do not match the runs")
     return Campaign(**arrays, settings=settings, **traces)
+
+
+def _check_path(path: object) -> None:
+    """Raise VehicleError unless ``path`` is a str or os.PathLike (an int would be taken for an
+    open file descriptor)."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise VehicleError(
+            f"path={path!r} must be a file path, str or os.PathLike (got {type(path).__name__})"
+        )
 
 
 def run_campaign(
@@ -173,14 +186,32 @@ def run_campaign(
             at least 1 s after the front axle has passed the lead-in.
     Returns:
         Campaign. A run that fails (diverges) is recorded with NaN f and its message.
+
+    Raises VehicleError for bad input (checked before any run: each argument's type and range,
+    a road too short for the window, traces beyond ``vehicle.checks.MAX_MEMORY_BYTES``), and
+    RoadgenError for road settings that no road can have (too long for
+    ``roadgen.checks.MAX_MEMORY_BYTES``, a band its length cannot hold).
     """
     model = Jackal() if model is None else check_model(model)
     seed = checks.seed("seed", seed, generator=False)
     design = lhs_design(198, seed=seed) if design is None else design
     points = check_design(design, model)
-    if not (isinstance(window, (int, np.integer)) and window >= 2):
-        raise VehicleError(f"window={window!r} is out of range: allowed integers >= 2")
-    usable_m = float(road_length_m) - lead_in_m - 2 * model.wheelbase_m
+    road_length_m = checks.positive("road_length_m", road_length_m, unit="m")
+    dx_m = checks.positive("dx_m", dx_m, unit="m")
+    lead_in_m = checks.non_negative("lead_in_m", lead_in_m, unit="m")
+    band = None if band is None else checks.band("band", band, 0.5 / dx_m)
+    rate_hz = check_rate(rate_hz)
+    noise_std = check_noise(noise_std)
+    window = checks.integer("window", window, 2)
+    substeps = checks.integer("substeps", substeps, 1)
+    progress = checks.flag("progress", progress)
+    keep_s = checks.non_negative("keep_s", keep_s, unit="s")
+    if cache_dir is not None and not isinstance(cache_dir, (str, os.PathLike)):
+        raise VehicleError(
+            f"cache_dir={cache_dir!r} must be a folder path, str or os.PathLike (got "
+            f"{type(cache_dir).__name__})"
+        )
+    usable_m = road_length_m - lead_in_m - 2 * model.wheelbase_m
     need_m = window * float(np.max(points[:, 0])) / rate_hz
     if not usable_m >= need_m:
         raise VehicleError(
@@ -188,9 +219,9 @@ def run_campaign(
             f"{np.max(points[:, 0]):.4g} m/s after the lead-in ({lead_in_m} m) needs "
             f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
         )
-    roadgen.profile.grid_points(float(road_length_m), float(dx_m))  # one road fits in memory
-    if not (np.isfinite(keep_s) and keep_s >= 0):
-        raise VehicleError(f"keep_s={keep_s!r} is out of range: allowed [0, inf) s")
+    roadgen.profile.grid_points(road_length_m, dx_m)  # one road fits in memory
+    if band is not None:  # and holds the band: roadgen's check, on the shortest road
+        roadgen.iso8608_profile(road_length_m, 1.0, dx_m, seed=0, band=band, lead_in_m=lead_in_m)
     keep = int(round(keep_s * rate_hz))
     checks.memory(
         16.0 * keep * points.shape[0], f"keep_s={keep_s!r} s of traces for {points.shape[0]} runs"
@@ -202,9 +233,8 @@ def run_campaign(
 
     seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
     specs = [
-        RunSpec(model, float(v), float(gd), int(s), length(float(v)), float(dx_m),
-                float(lead_in_m), None if band is None else tuple(map(float, band)),
-                float(rate_hz), float(noise_std), int(window), int(substeps), keep)
+        RunSpec(model, float(v), float(gd), int(s), length(float(v)), dx_m, lead_in_m, band,
+                rate_hz, noise_std, window, substeps, keep)
         for (v, gd), s in zip(points, seeds, strict=True)
     ]  # fmt: skip
     cache = None if cache_dir is None else Path(cache_dir)

@@ -1,4 +1,5 @@
-"""Checks shared by vehicle's functions: seeds and the memory limit.
+"""Checks shared by vehicle's functions: roadgen's checks (``roadgen.checks``) raising VehicleError
+(numbers, integers, flags, arrays, choices, bands, seeds) and the memory limit.
 
 Resource limit: ``MAX_MEMORY_BYTES`` (module attribute, read at call time). A drive is
 integrated only when the memory of its time grid (about ``BYTES_PER_STEP`` per solver step) and
@@ -8,6 +9,8 @@ limit. A program that has the memory raises it: ``vehicle.checks.MAX_MEMORY_BYTE
 """
 
 from __future__ import annotations
+
+import numpy as np
 
 from roadgen import checks as roadgen_checks
 from vehicle.errors import VehicleError
@@ -31,3 +34,45 @@ def seed(name: str, value, generator: bool = True):
     """Return ``value`` if it is None, an integer in [0, 2**128) or (``generator``) a numpy
     Generator; else raise VehicleError (roadgen's check with vehicle's error)."""
     return roadgen_checks.seed(name, value, generator, VehicleError)
+
+
+def real(name: str, value: object) -> float:
+    """``value`` as a float if it is a real number (not a bool, string or complex), else
+    VehicleError; NaN and inf pass."""
+    return roadgen_checks.real(name, value, VehicleError)
+
+
+def integer(name: str, value: object, minimum: int) -> int:
+    """``value`` as an int if it is a Python or numpy integer (not a bool) >= ``minimum``, else
+    VehicleError."""
+    return roadgen_checks.integer(name, value, minimum, VehicleError)
+
+
+def flag(name: str, value: object) -> bool:
+    """``value`` as a bool if it is True or False, else VehicleError."""
+    return roadgen_checks.flag(name, value, VehicleError)
+
+
+def real_array(name: str, value: object) -> np.ndarray:
+    """``value`` as a new float array if it holds real numbers, else VehicleError."""
+    return roadgen_checks.real_array(name, value, VehicleError)
+
+
+def positive(name: str, value: object, unit: str = "") -> float:
+    """``value`` as a float if it is a finite real number > 0, else VehicleError."""
+    return roadgen_checks.positive(name, value, VehicleError, unit)
+
+
+def non_negative(name: str, value: object, unit: str = "") -> float:
+    """``value`` as a float if it is a finite real number >= 0, else VehicleError."""
+    return roadgen_checks.non_negative(name, value, VehicleError, unit)
+
+
+def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
+    """``value`` if it is one of the strings ``allowed``, else VehicleError."""
+    return roadgen_checks.choice(name, value, allowed, VehicleError)
+
+
+def band(name: str, value: object, nyquist: float) -> tuple[float, float]:
+    """A band (n_min, n_max) cycles/m with 0 < n_min < n_max <= nyquist, else VehicleError."""
+    return roadgen_checks.band(name, value, nyquist, VehicleError)

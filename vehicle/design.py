@@ -13,10 +13,10 @@ from vehicle.models import Model
 
 
 def _range(name: str, value: tuple[float, float]) -> tuple[float, float]:
-    try:
-        lo, hi = (float(b) for b in value)
-    except (TypeError, ValueError) as exc:
-        raise VehicleError(f"{name}={value!r} must be a pair (low, high)") from exc
+    pair = tuple(value) if isinstance(value, (tuple, list, np.ndarray)) else ()
+    if len(pair) != 2:
+        raise VehicleError(f"{name}={value!r} must be a pair (low, high)")
+    lo, hi = (checks.real(f"{name}[{i}]", b) for i, b in enumerate(pair))
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
         raise VehicleError(f"{name}={value!r} is out of range: need 0 < low < high, finite")
     return lo, hi
@@ -32,21 +32,23 @@ def lhs_design(
 
     Returns an array (n, 2): column 0 speed v (m/s) uniform on ``v_range``, column 1 GD
     (1e-6 m^3) uniform on ``gd_range`` (the paper's priors, eqs. 3-4).
+
+    Raises VehicleError for an n that is not an integer >= 1, a range that is not a pair of real
+    numbers 0 < low < high, or a bad seed.
     """
-    if isinstance(n, bool) or not (isinstance(n, (int, np.integer)) and n >= 1):
-        raise VehicleError(f"n={n!r} is out of range: allowed integers >= 1")
-    checks.memory(64.0 * int(n), f"a design of n={n} points")
+    n = checks.integer("n", n, 1)
+    checks.memory(64.0 * n, f"a design of n={n} points")
     seed = checks.seed("seed", seed)
     lo_v, hi_v = _range("v_range", v_range)
     lo_g, hi_g = _range("gd_range", gd_range)
-    unit = qmc.LatinHypercube(d=2, rng=np.random.default_rng(seed)).random(int(n))
+    unit = qmc.LatinHypercube(d=2, rng=np.random.default_rng(seed)).random(n)
     return qmc.scale(unit, [lo_v, lo_g], [hi_v, hi_g])
 
 
 def check_design(design: np.ndarray, model: Model) -> np.ndarray:
     """Return ``design`` as a float (n, 2) array [v, GD], or raise VehicleError if a point lies
     outside the model's validity: v in (0, max_speed_mps], GD > 0, all finite."""
-    arr = np.asarray(design, dtype=float)
+    arr = checks.real_array("design", design)
     if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 1:
         raise VehicleError(f"design has shape {arr.shape}: need (n, 2) columns [v, GD], n >= 1")
     v, gd = arr[:, 0], arr[:, 1]

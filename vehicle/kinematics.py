@@ -64,16 +64,20 @@ def _as_function(speed: SpeedSchedule) -> Callable[[np.ndarray], np.ndarray]:
     if callable(speed):
 
         def evaluate(x: np.ndarray) -> np.ndarray:
-            out = np.asarray(speed(x), dtype=float)
-            if out.shape != x.shape:
-                out = np.array([float(speed(xi)) for xi in x])
+            try:
+                out = checks.real_array("speed(...)", speed(x))
+            except (TypeError, ValueError):  # a scalar function (VehicleError is a ValueError)
+                out = None
+            if out is None or out.shape != x.shape:
+                out = np.array([checks.real(f"speed({xi:.6g})", speed(xi)) for xi in x])
             return out
 
         return evaluate
     if isinstance(speed, tuple):
         if len(speed) != 2:
             raise VehicleError(f"speed is a tuple of {len(speed)} items: need (points, speeds)")
-        pts, vals = (np.asarray(a, dtype=float) for a in speed)
+        pts = checks.real_array("speed points", speed[0])
+        vals = checks.real_array("speed values", speed[1])
         if pts.ndim != 1 or pts.shape != vals.shape or pts.size < 1:
             raise VehicleError(
                 f"speed=(points {pts.shape}, speeds {vals.shape}): need two (K,) arrays, K >= 1"
@@ -82,11 +86,12 @@ def _as_function(speed: SpeedSchedule) -> Callable[[np.ndarray], np.ndarray]:
             raise VehicleError("speed points must be finite and strictly increasing")
         return lambda x: np.interp(x, pts, vals)
     try:
-        value = float(speed)
-    except (TypeError, ValueError) as exc:
+        value = checks.real("speed", speed)
+    except VehicleError:
         raise VehicleError(
-            f"speed={speed!r} must be a number (m/s), a callable or a (points, speeds) pair"
-        ) from exc
+            f"speed={speed!r} must be a number (m/s), a callable or a (points, speeds) pair "
+            f"(got {type(speed).__name__})"
+        ) from None
     return lambda x: np.full(np.shape(x), value)
 
 
@@ -108,8 +113,7 @@ def schedule_grid(
     Returns:
         s, v: arrays (N + 1,) with s[-1] >= end_m.
     """
-    if speed_of not in ("time", "position"):
-        raise VehicleError(f"speed_of={speed_of!r} is not allowed: choose 'time' or 'position'")
+    checks.choice("speed_of", speed_of, ("time", "position"))
     fun = _as_function(speed)
     if speed_of == "position":
         n_s = max(2, math.ceil((end_m - start_m) / 1e-3) + 1)
@@ -124,7 +128,7 @@ def schedule_grid(
         s = np.interp(t, t_of_s, s_grid)
         return s, fun(s)
     if not (callable(speed) or isinstance(speed, tuple)):  # a constant: the length is known
-        v0 = float(check_speed("speed", float(speed), max_speed))
+        v0 = float(check_speed("speed", fun(0.0), max_speed))
         n_est = (end_m - start_m) / (v0 * h) + 1
         checks.memory(checks.BYTES_PER_STEP * n_est, f"a drive of {n_est:.4g} solver steps")
     s_parts, v_parts, s_now, k0 = [], [], start_m, 0

@@ -2,30 +2,42 @@
 
 Both are frozen dataclasses in SI units. Vertical motions are measured from the static equilibrium
 (gravity only enters through the static tyre loads that bound the unilateral contact force).
+A field that is not a finite real number in range (an integer for ``wheels_per_axle``, True or
+False for ``lift_off``) raises VehicleError naming it; numpy numbers are stored as Python ones.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
 
+from vehicle import checks
 from vehicle.errors import VehicleError
 
 GRAVITY = 9.81
 """Gravitational acceleration, m/s^2."""
 
 
-def _check_positive(model: str, **values: float) -> None:
-    for name, value in values.items():
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-            raise VehicleError(f"{model}.{name}={value!r} is out of range: allowed (0, inf)")
-
-
-def _check_non_negative(model: str, **values: float) -> None:
-    for name, value in values.items():
-        if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
-            raise VehicleError(f"{model}.{name}={value!r} is out of range: allowed [0, inf)")
+def _check_fields(
+    model: object,
+    positive: tuple[str, ...],
+    non_negative: tuple[str, ...] = (),
+    counts: tuple[str, ...] = (),
+) -> None:
+    """Check a model's fields and store them as Python floats (``counts`` as ints, ``lift_off``
+    as a bool), so that ``describe()`` is JSON-able whatever numbers were given: VehicleError
+    naming ``Model.field`` for a value that is not a finite real number > 0 (``positive``) or
+    >= 0 (``non_negative``), an integer >= 1 (``counts``) or, for lift_off, a bool."""
+    cls = type(model).__name__
+    for name in positive:
+        value = checks.positive(f"{cls}.{name}", getattr(model, name))
+        object.__setattr__(model, name, value)
+    for name in non_negative:
+        value = checks.non_negative(f"{cls}.{name}", getattr(model, name))
+        object.__setattr__(model, name, value)
+    for name in counts:
+        object.__setattr__(model, name, checks.integer(f"{cls}.{name}", getattr(model, name), 1))
+    object.__setattr__(model, "lift_off", checks.flag(f"{cls}.lift_off", model.lift_off))
 
 
 @dataclass(frozen=True)
@@ -64,27 +76,19 @@ class HalfCar:
     lift_off: bool = False
 
     def __post_init__(self) -> None:
-        _check_positive(
-            "HalfCar",
-            sprung_mass_kg=self.sprung_mass_kg,
-            pitch_inertia_kgm2=self.pitch_inertia_kgm2,
-            b1_m=self.b1_m,
-            b2_m=self.b2_m,
-            unsprung_mass_front_kg=self.unsprung_mass_front_kg,
-            unsprung_mass_rear_kg=self.unsprung_mass_rear_kg,
-            suspension_stiffness_front_n_per_m=self.suspension_stiffness_front_n_per_m,
-            suspension_stiffness_rear_n_per_m=self.suspension_stiffness_rear_n_per_m,
-            tyre_stiffness_n_per_m=self.tyre_stiffness_n_per_m,
-            wheel_radius_m=self.wheel_radius_m,
-            max_speed_mps=self.max_speed_mps,
-            max_accel_mps2=self.max_accel_mps2,
-        )
-        _check_non_negative(
-            "HalfCar",
-            suspension_damping_front_ns_per_m=self.suspension_damping_front_ns_per_m,
-            suspension_damping_rear_ns_per_m=self.suspension_damping_rear_ns_per_m,
-            tyre_damping_ns_per_m=self.tyre_damping_ns_per_m,
-        )
+        _check_fields(
+            self,
+            positive=(
+                "sprung_mass_kg", "pitch_inertia_kgm2", "b1_m", "b2_m", "unsprung_mass_front_kg",
+                "unsprung_mass_rear_kg", "suspension_stiffness_front_n_per_m",
+                "suspension_stiffness_rear_n_per_m", "tyre_stiffness_n_per_m", "wheel_radius_m",
+                "max_speed_mps", "max_accel_mps2",
+            ),
+            non_negative=(
+                "suspension_damping_front_ns_per_m", "suspension_damping_rear_ns_per_m",
+                "tyre_damping_ns_per_m",
+            ),
+        )  # fmt: skip
 
     @property
     def name(self) -> str:
@@ -147,19 +151,15 @@ class Jackal:
     lift_off: bool = True
 
     def __post_init__(self) -> None:
-        _check_positive(
-            "Jackal",
-            mass_kg=self.mass_kg,
-            pitch_inertia_kgm2=self.pitch_inertia_kgm2,
-            b1_m=self.b1_m,
-            b2_m=self.b2_m,
-            tyre_stiffness_n_per_m=self.tyre_stiffness_n_per_m,
-            wheels_per_axle=self.wheels_per_axle,
-            wheel_radius_m=self.wheel_radius_m,
-            max_speed_mps=self.max_speed_mps,
-            max_accel_mps2=self.max_accel_mps2,
-        )
-        _check_non_negative("Jackal", tyre_damping_ns_per_m=self.tyre_damping_ns_per_m)
+        _check_fields(
+            self,
+            positive=(
+                "mass_kg", "pitch_inertia_kgm2", "b1_m", "b2_m", "tyre_stiffness_n_per_m",
+                "wheel_radius_m", "max_speed_mps", "max_accel_mps2",
+            ),
+            non_negative=("tyre_damping_ns_per_m",),
+            counts=("wheels_per_axle",),
+        )  # fmt: skip
 
     @property
     def name(self) -> str:
@@ -204,7 +204,7 @@ def from_description(description: dict) -> Model:
     kinds = {"HalfCar": HalfCar, "Jackal": Jackal}
     params = dict(description)
     name = params.pop("model", None)
-    if name not in kinds:
+    if not isinstance(name, str) or name not in kinds:
         raise VehicleError(
             f"vehicle description: model must be one of {sorted(kinds)}, got {name!r}"
         )

@@ -2,11 +2,10 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 import roadgen
+from vehicle import checks
 from vehicle.errors import VehicleError
 
 
@@ -25,27 +24,25 @@ class RoadInput:
 
     def __init__(self, road, wheel_radius_m: float | None = None) -> None:
         if wheel_radius_m is not None:
-            try:
-                road = roadgen.wheel_envelope(road, wheel_radius_m)
-            except (AttributeError, TypeError) as exc:
+            if not isinstance(road, roadgen.Road):
                 raise VehicleError(
                     f"road={type(road).__name__} cannot be enveloped: need a roadgen Profile or "
                     "Track (or envelope=False)"
-                ) from exc
+                )
+            road = roadgen.wheel_envelope(road, wheel_radius_m)
         try:
-            z = np.asarray(road.z, dtype=float)
-            dx = float(road.dx_m)
-        except (AttributeError, TypeError, ValueError) as exc:
+            z, dx = road.z, road.dx_m
+        except AttributeError:
             raise VehicleError(
                 f"road={type(road).__name__} must have z (N,) heights and dx_m (a roadgen "
                 "Profile or Track)"
-            ) from exc
+            ) from None
+        z = checks.real_array("road.z", z)
         if z.ndim != 1 or z.size < 3:
             raise VehicleError(f"road.z has shape {z.shape}: need (N,) with N >= 3")
         if not np.all(np.isfinite(z)):
             raise VehicleError("road.z contains NaN or inf: allowed finite heights in m")
-        if not (math.isfinite(dx) and dx > 0):
-            raise VehicleError(f"road.dx_m={dx!r} is out of range: allowed (0, inf)")
+        dx = checks.positive("road.dx_m", dx)
         self.dx_m = dx
         self.length_m = dx * (z.size - 1)
         self._z = z

@@ -2,35 +2,22 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from vehicle.errors import VehicleError
+from vehicle import checks
 from vehicle.models import Model
 from vehicle.road_input import RoadInput
 
 
 def check_rate(rate_hz: float) -> float:
-    """Return the sample rate as a float, or raise VehicleError unless finite and > 0."""
-    try:
-        r = float(rate_hz)
-    except (TypeError, ValueError) as exc:
-        raise VehicleError(f"rate_hz={rate_hz!r} must be a number in (0, inf) Hz") from exc
-    if not (math.isfinite(r) and r > 0):
-        raise VehicleError(f"rate_hz={rate_hz!r} is out of range: allowed (0, inf) Hz")
-    return r
+    """Return the sample rate as a float, or raise VehicleError unless a finite real > 0."""
+    return checks.positive("rate_hz", rate_hz, unit="Hz")
 
 
 def check_noise(noise_std: float) -> float:
-    """Return the noise standard deviation, or raise VehicleError unless finite and >= 0."""
-    try:
-        s = float(noise_std)
-    except (TypeError, ValueError) as exc:
-        raise VehicleError(f"noise_std={noise_std!r} must be a number in [0, inf) m/s^2") from exc
-    if not (math.isfinite(s) and s >= 0):
-        raise VehicleError(f"noise_std={noise_std!r} is out of range: allowed [0, inf) m/s^2")
-    return s
+    """Return the noise standard deviation as a float, or raise VehicleError unless a finite
+    real >= 0."""
+    return checks.non_negative("noise_std", noise_std, unit="m/s^2")
 
 
 def add_noise(accel: np.ndarray, noise_std: float, rng: np.random.Generator) -> np.ndarray:

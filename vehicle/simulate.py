@@ -110,12 +110,13 @@ def simulate(
     check_model(model)
     rate = check_rate(rate_hz)
     noise = check_noise(noise_std)
-    if not (isinstance(substeps, int) and substeps >= 1):
-        raise VehicleError(f"substeps={substeps!r} is out of range: allowed integers >= 1")
+    substeps = checks.integer("substeps", substeps, 1)
     rng = np.random.default_rng(checks.seed("seed", seed))
+    envelope = checks.flag("envelope", envelope)
+    start = model.wheelbase_m if start_m is None else checks.real("start_m", start_m)
+    end = None if end_m is None else checks.real("end_m", end_m)
     road_in = RoadInput(road, model.wheel_radius_m if envelope else None)
-    start = model.wheelbase_m if start_m is None else float(start_m)
-    end = road_in.length_m if end_m is None else float(end_m)
+    end = road_in.length_m if end is None else end
     check_span(model, road_in, start, end)
     h = 1.0 / (rate * substeps)
     s, v = schedule_grid(speed, speed_of, start, end, h, model.max_speed_mps)

@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from vehicle import checks
-from vehicle.errors import VehicleError
 from vehicle.exudyn_models import ExudynVehicle
 from vehicle.kinematics import Drive, check_speed, ramp_grid
 from vehicle.models import Model, check_model
@@ -73,16 +71,17 @@ class Simulation:
         self.model = check_model(model)
         self.rate_hz = check_rate(rate_hz)
         self.noise_std = check_noise(noise_std)
-        if not (isinstance(substeps, int) and substeps >= 1):
-            raise VehicleError(f"substeps={substeps!r} is out of range: allowed integers >= 1")
+        substeps = checks.integer("substeps", substeps, 1)
         self._rng = np.random.default_rng(checks.seed("seed", seed))
+        start = checks.real("start_m", start_m)
+        envelope = checks.flag("envelope", envelope)
         self._road = RoadInput(track, model.wheel_radius_m if envelope else None)
         self.end_m = self._road.length_m
-        check_span(model, self._road, float(start_m), self.end_m)
+        check_span(model, self._road, start, self.end_m)
         self._substeps = substeps
         self._h = 1.0 / (self.rate_hz * substeps)
         self.time = 0.0
-        self.position = float(start_m)
+        self.position = start
         self.speed = 0.0
         self._drive = Drive(0.0, self._h, np.full(2, self.position), np.zeros(2))
         self._vehicle = ExudynVehicle(model, self._road, self._drive, self.rate_hz, substeps)
@@ -97,9 +96,9 @@ class Simulation:
         """Drive for ``dt`` seconds (rounded to whole sample periods, at least one) towards the
         commanded ``speed`` (m/s) and return the new samples; fewer (or none) at the track's end.
         """
-        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
-            raise VehicleError(f"dt={dt!r} is out of range: allowed (0, inf) s")
-        v_set = float(check_speed("speed", speed, self.model.max_speed_mps, allow_stop=True))
+        dt = checks.positive("dt", dt, unit="s")
+        v_set = checks.real("speed", speed)
+        check_speed("speed", v_set, self.model.max_speed_mps, allow_stop=True)
         # no sample lies past the end: cap the grid at the time the end is surely reached
         # (a vehicle told to stop never reaches it: dt stands, within the memory limit)
         t_end = abs(v_set - self.speed) / self.model.max_accel_mps2 + (
