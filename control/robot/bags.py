@@ -11,11 +11,15 @@ and the odometry's stamps, receive times, positions and linear velocities. Any o
   Foxglove recorded (the ``mcap`` package).
 
 rosbags and mcap are the ``robot`` extra; they are imported when a function needs them.
+A recording whose bytes are damaged (truncated, corrupted) raises `BagError` naming the file
+and what is wrong, whichever library found it.
 """
 
 from __future__ import annotations
 
 import os
+import struct
+import sys
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -145,8 +149,8 @@ def read_recording(
 ) -> Recording:
     """Read the IMU and odometry messages of a recording (see the module docstring for what
     opens), each topic in receive-time order. Raises `BagError` naming the topic when a topic is
-    missing, holds another message type or has no messages; `MissingExtraError` when the
-    ``robot`` extra is not installed."""
+    missing, holds another message type or has no messages, and naming the file when it is
+    damaged; `MissingExtraError` when the ``robot`` extra is not installed."""
     tic = time.perf_counter()
     require("rosbags.typesys", "reading a robot recording")
     target, kind = _resolve(Path(path))
@@ -210,12 +214,12 @@ def _from_raw(path: Path, raw, imu_topic: str, odom_topic: str):
                 f"the topic {topic!r} in {path} is encoded as {raw.encodings[topic]!r}; the "
                 "replay reads ROS 2 (cdr) messages"
             )
-        log = np.asarray(raw.log_ns[topic], dtype=np.int64)
+        log = _receive_times(path, topic, raw.log_ns[topic])
         order = np.argsort(log, kind="stable")
         data = raw.data[topic]
         if np.any(np.diff(order) != 1):
             data = [data[i] for i in order]
-        out.append(make(topic, log[order], data, decoder(topic)))
+        out.append(make(path, topic, log[order], data, decoder(topic)))
     return raw.types, out[0], out[1]
 
 
@@ -234,29 +238,83 @@ def _typestore_for(types: dict[str, str], definitions: dict[str, tuple[str, str]
     return store
 
 
-def _imu(topic: str, log_ns: list[int], raws: list, decode, cdr: bool = True) -> ImuMessages:
-    log = np.asarray(log_ns, dtype=np.int64)
+def _damage_errors() -> tuple[type[BaseException], ...]:
+    """What rosbags raises on a recording's damaged bytes, opening, reading or deserialising
+    them: its own errors, apsw's (a sqlite3 bag), the zstd module's (a compressed ROS 2 bag)
+    and (found by corrupting bags byte by byte) Python's for a garbled length or offset (a
+    read of more memory than there is, a seek outside the file), index, text or number, a
+    failed assertion on the format, or a sqlite3 value of another type than the column's
+    (passed on to the decompressor)."""
+    purpose = "reading a ROS bag"
+    zstd = "compression.zstd" if sys.version_info >= (3, 14) else "backports.zstd"  # as rosbags
+    return (
+        require("rosbags.serde", purpose).SerdeError,
+        require("rosbags.highlevel", purpose).AnyReaderError,
+        require("rosbags.rosbag1", purpose).ReaderError,
+        require("rosbags.rosbag2", purpose).ReaderError,
+        require("apsw", purpose).Error,
+        require(zstd, purpose).ZstdError,
+        AssertionError, EOFError, LookupError, ValueError, ArithmeticError, MemoryError,
+        OSError, TypeError, struct.error,
+    )  # fmt: skip
+
+
+def _why(exc: BaseException) -> str:
+    """An exception's type and message (some carry none), for a `BagError`'s message."""
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def _receive_times(path: Path, topic: str, log_ns) -> np.ndarray:
+    """Receive times as int64 ns; `BagError` for one outside int64's range or not a number (a
+    damaged file)."""
+    try:
+        return np.asarray(log_ns, dtype=np.int64)
+    except (OverflowError, TypeError, ValueError) as exc:
+        raise BagError(
+            f"{path} is damaged: a receive time of the topic {topic!r} is not an int64 ns "
+            f"({_why(exc)})"
+        ) from exc
+
+
+def _decoded(path: Path, topic: str, raws: list, decode) -> list:
+    """The messages deserialised one by one by ``decode`` (a generic deserialiser)."""
+    errors = _damage_errors()
+    out = []
+    for k, raw in enumerate(raws):
+        try:
+            out.append(decode(raw))
+        except errors as exc:
+            raise BagError(
+                f"{path} is damaged: message {k} of the topic {topic!r} does not deserialise "
+                f"({_why(exc)})"
+            ) from exc
+    return out
+
+
+def _imu(path: Path, topic: str, log_ns, raws: list, decode, cdr: bool = True) -> ImuMessages:
+    log = _receive_times(path, topic, log_ns)
     try:
         if not cdr:
             raise msgs.CdrLayoutError("not CDR")
         stamp, accel = msgs.decode_imu(raws)
     except msgs.CdrLayoutError:
-        fields = [decode(raw) for raw in raws]
+        fields = _decoded(path, topic, raws, decode)
         stamp = np.array([_stamp(m) for m in fields], dtype=np.int64)
         accel = np.array([_xyz(m.linear_acceleration) for m in fields]).reshape(-1, 3)
     return ImuMessages(topic, log, stamp, accel)
 
 
 def _odometry(
-    topic: str, log_ns: list[int], raws: list, decode, cdr: bool = True
+    path: Path, topic: str, log_ns, raws: list, decode, cdr: bool = True
 ) -> OdometryMessages:
-    log = np.asarray(log_ns, dtype=np.int64)
+    log = _receive_times(path, topic, log_ns)
     try:
         if not cdr:
             raise msgs.CdrLayoutError("not CDR")
         stamp, position, velocity = msgs.decode_odometry(raws)
     except msgs.CdrLayoutError:
-        fields = [decode(raw) for raw in raws]
+        fields = _decoded(path, topic, raws, decode)
         stamp = np.array([_stamp(m) for m in fields], dtype=np.int64)
         position = np.array([_xyz(m.pose.pose.position) for m in fields]).reshape(-1, 3)
         velocity = np.array([_xyz(m.twist.twist.linear) for m in fields]).reshape(-1, 3)
@@ -281,27 +339,38 @@ def _read_rosbags(path: Path, kind: str, imu_topic: str, odom_topic: str):
     try:
         reader = highlevel.AnyReader([path], default_typestore=default)
         reader.open()
-    except Exception as exc:  # rosbags raises its own errors for damaged or unknown bags
-        raise BagError(f"cannot open {path} as a ROS bag: {exc}") from exc
+    except _damage_errors() as exc:
+        raise BagError(f"cannot open {path} as a ROS bag: {_why(exc)}") from exc
     try:
         topics = {t: info.msgtype for t, info in reader.topics.items()}
         _check_topics(path, topics, imu_topic, odom_topic)
         out = []
         for topic, make in ((imu_topic, _imu), (odom_topic, _odometry)):
             conns = [c for c in reader.connections if c.topic == topic]
-            log, raws = [], []
-            for _, stamp, raw in reader.messages(connections=conns):
-                log.append(stamp)
-                raws.append(raw)
+            log, raws = _messages(reader, conns, path, topic)
             msgtype = conns[0].msgtype
 
             def decode(raw, msgtype=msgtype):
                 return reader.deserialize(raw, msgtype)
 
-            out.append(make(topic, log, raws, decode, cdr=reader.is2))
+            out.append(make(path, topic, log, raws, decode, cdr=reader.is2))
         return topics, out[0], out[1]
     finally:
         reader.close()
+
+
+def _messages(reader, conns: list, path: Path, topic: str) -> tuple[list[int], list[bytes]]:
+    """(receive times, raw data) of a topic's connections, read by a rosbags reader."""
+    log, raws = [], []
+    try:
+        for _, stamp, raw in reader.messages(connections=conns):
+            log.append(stamp)
+            raws.append(raw)
+    except _damage_errors() as exc:
+        raise BagError(
+            f"{path} is damaged: reading the topic {topic!r} failed ({_why(exc)})"
+        ) from exc
+    return log, raws
 
 
 def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
@@ -309,10 +378,10 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
     stores = require("rosbags.typesys", "reading an MCAP file")
     with open(path, "rb") as f:
         try:
-            reader = reader_mod.make_reader(f)
+            reader = reader_mod.make_reader(f, validate_crcs=True)
             summary = reader.get_summary()
         except Exception as exc:  # the mcap package raises its own errors for damaged files
-            raise BagError(f"cannot read {path} as an MCAP file: {exc}") from exc
+            raise BagError(f"cannot read {path} as an MCAP file: {_why(exc)}") from exc
         if summary is not None:
             topics = {
                 ch.topic: summary.schemas[ch.schema_id].name if ch.schema_id else ""
@@ -340,26 +409,54 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
         except BagError:
             raise
         except Exception as exc:
-            raise BagError(f"cannot read the messages of {path}: {exc}") from exc
+            raise BagError(f"cannot read the messages of {path}: {_why(exc)}") from exc
     if summary is None:
         _check_topics(path, topics, imu_topic, odom_topic)
+    elif summary.statistics is not None:
+        _check_counts(path, summary, {t: len(log) for t, (log, _) in collected.items()})
     store = stores.get_typestore(stores.Stores.EMPTY)
     for topic, schema in schemas.items():
         if schema is None:
             raise BagError(f"the topic {topic!r} in {path} has no schema")
-        text = schema.data.decode()
-        if schema.encoding == "ros2idl":
-            store.register(stores.get_types_from_idl(text))
-        else:
-            store.register(stores.get_types_from_msg(text, _normalise(schema.name)))
+        _register(store, path, topic, schema)
 
     def decoder(topic: str):
         name = _normalise(topics[topic])
         return lambda raw: store.deserialize_cdr(raw, name)
 
-    imu = _imu(imu_topic, *collected[imu_topic], decoder(imu_topic))
-    odom = _odometry(odom_topic, *collected[odom_topic], decoder(odom_topic))
+    imu = _imu(path, imu_topic, *collected[imu_topic], decoder(imu_topic))
+    odom = _odometry(path, odom_topic, *collected[odom_topic], decoder(odom_topic))
     return topics, imu, odom
+
+
+def _check_counts(path: Path, summary, found: dict[str, int]) -> None:
+    """`BagError` where the messages read of a topic are not as many as the MCAP file's
+    statistics count: the mcap package passes over a chunk whose index is damaged, and over
+    messages outside chunks, without a word."""
+    counts = summary.statistics.channel_message_counts
+    for topic, n in found.items():
+        want = sum(counts.get(c, 0) for c, ch in summary.channels.items() if ch.topic == topic)
+        if want != n:
+            raise BagError(
+                f"{path} is damaged: its statistics count {want} messages of the topic "
+                f"{topic!r}, its indexed chunks hold {n} (a damaged chunk index, or messages "
+                "outside chunks, which the mcap package does not read)"
+            )
+
+
+def _register(store, path: Path, topic: str, schema) -> None:
+    """Register the message definition an MCAP schema carries (ros2idl or ros2msg text)."""
+    stores = require("rosbags.typesys", "reading an MCAP file")
+    try:
+        text = schema.data.decode()
+        if schema.encoding == "ros2idl":
+            store.register(stores.get_types_from_idl(text))
+        else:
+            store.register(stores.get_types_from_msg(text, _normalise(schema.name)))
+    except (UnicodeDecodeError, stores.TypesysError) as exc:
+        raise BagError(
+            f"{path} is damaged: the schema of the topic {topic!r} does not parse ({_why(exc)})"
+        ) from exc
 
 
 # --- writing ------------------------------------------------------------------------------------

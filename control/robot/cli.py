@@ -6,8 +6,9 @@
 BAG: a ROS 2 bag folder (MCAP or sqlite3), a ``*.mcap`` file or a ROS 1 ``*.bag``. Writes
 ``DIR/estimates.csv``, ``DIR/estimates/`` (a ROS 2 bag with the topic ``/bcr/estimate``) and
 ``DIR/replay.json`` (settings, what was found in the recording, timing), and prints a summary.
-Exit status 0 on success, 2 on a usage error, a recording that cannot be replayed or a missing
-extra (the message says which extra to install).
+Exit status 0 on success, 2 with a one-line message on a usage error, an emulator file that
+cannot be loaded, a recording that cannot be replayed (a missing topic, a damaged file, ...) or a
+missing extra (the message says which extra to install).
 """
 
 from __future__ import annotations
@@ -31,7 +32,8 @@ DEFAULTS = ReplaySettings()
 
 
 def _emulator(text: str):
-    """A shipped emulator for "A" or "B", else the file at ``text``."""
+    """A shipped emulator for "A" or "B", else the file at ``text``; `ControlError` naming
+    ``--emulator`` for a file gpmsa cannot load."""
     import control
 
     if text in ("A", "B"):
@@ -41,7 +43,15 @@ def _emulator(text: str):
         raise ControlError(f"--emulator {text!r}: no such file (or give A or B: the shipped ones)")
     import gpmsa
 
-    return gpmsa.load(path), str(path)
+    try:
+        return gpmsa.load(path), str(path)
+    except gpmsa.GPMSAError as exc:  # a damaged, foreign or too large emulator file
+        raise ControlError(f"--emulator {text!r}: {exc}") from exc
+
+
+def _one_line(exc: Exception) -> str:
+    """The message of ``exc`` on one line (a library's message may hold line breaks)."""
+    return " ".join(str(exc).split())
 
 
 def parser() -> argparse.ArgumentParser:
@@ -117,10 +127,10 @@ def main(argv: list[str] | None = None) -> int:
             progress=args.progress,
         )  # fmt: skip
     except MissingExtraError as exc:
-        print(f"terrain-replay: {exc}", file=sys.stderr)
+        print(f"terrain-replay: {_one_line(exc)}", file=sys.stderr)
         return 2
     except (ControlError, OSError) as exc:
-        print(f"terrain-replay: error: {exc}", file=sys.stderr)
+        print(f"terrain-replay: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     report = {
         "bag": str(bag),

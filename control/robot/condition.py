@@ -169,7 +169,10 @@ def increasing(t: np.ndarray) -> np.ndarray:
 
 
 def _ratio(rate_in: float, rate_out: float) -> tuple[int, int]:
-    frac = Fraction(rate_out / rate_in).limit_denominator(100)
+    """(up, down), up / down nearest rate_out / rate_in (< 1) with down at most 100, or at
+    most the whole number above rate_in / rate_out where that is more (never up = 0)."""
+    most = max(100, math.ceil(rate_in / rate_out))
+    frac = Fraction(rate_out / rate_in).limit_denominator(most)
     return frac.numerator, frac.denominator
 
 

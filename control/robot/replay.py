@@ -36,7 +36,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from control.bcr import BCR, BCRSettings
-from control.compat import bcr_settings_for
+from control.compat import bcr_settings_for, check_likelihood
 from control.errors import BagError, ControlError
 from control.estimate import Estimate
 from control.robot import condition
@@ -320,19 +320,23 @@ def replay_bag(
         bcr: BCR settings (default: `control.bcr_settings_for(emulator)`).
         simplex: the controller (default `Simplex()`).
         likelihood: the BCR's prepared likelihood model for ``emulator`` (as in
-            `control.run_closed_loop`), to save preparing it per replay.
+            `control.run_closed_loop`), to save preparing it per replay; one prepared for
+            another emulator is refused (`control.check_likelihood`).
         csv: write the estimates here as CSV (`ReplayResult.to_csv`).
         out_bag: write the estimates here as a ROS 2 bag folder (`ReplayResult.write_bag`).
         progress: show a tqdm bar over the blocks.
 
     Returns:
         `ReplayResult`. Raises `BagError` (a topic missing, mistyped or empty; an IMU slower
-        than the emulator's rate) and `MissingExtraError` (the ``robot`` extra not installed).
+        than the emulator's rate; a damaged file), `ControlError` (a setting that does not
+        fit the emulator, a likelihood prepared for another one; before the recording is read)
+        and `MissingExtraError` (the ``robot`` extra not installed).
     """
     s = replace(settings or ReplaySettings(), **overrides)
     emulator = _load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex
+    _check_fit(s, bcr, emulator, likelihood)
     rec = read_recording(bag, s.imu_topic, s.odom_topic)
     result = replay_recording(
         rec, emulator, s, bcr=bcr, simplex=simplex, likelihood=likelihood, progress=progress
@@ -359,6 +363,7 @@ def replay_recording(
     emulator = _load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex
+    _check_fit(s, bcr, emulator, likelihood)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     tic = time.perf_counter()
     t, a, pos, spd, reports, resampling, notes, t0 = _condition(rec, s, bcr.rate_hz)
@@ -417,6 +422,20 @@ def replay_recording(
     )
 
 
+def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood) -> None:
+    """`ControlError` for settings that do not fit the BCR's rate (a high-pass cut-off at or
+    above its Nyquist frequency), `EmulatorMismatchError` for a likelihood prepared for
+    another emulator."""
+    nyquist = bcr.rate_hz / 2
+    if s.gravity == "highpass" and s.highpass_hz >= nyquist:
+        raise ControlError(
+            f"highpass_hz = {s.highpass_hz:g} Hz must lie below {nyquist:g} Hz, the Nyquist "
+            f"frequency of the emulator's rate ({bcr.rate_hz:g} Hz)"
+        )
+    if likelihood is not None:
+        check_likelihood(emulator, likelihood)
+
+
 def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
     """The BCR's samples (t s from t0, accel, position, speed), the reports and t0 (ns)."""
     notes: list[str] = []
@@ -434,6 +453,14 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
         condition.check_stream(rec.odometry.topic, t_odom, odom_finite, odom_base, odom_note),
     )
     t, a, resampling = condition.to_rate(t_imu, accel, rate_hz, s.rate_tolerance, s.resample)
+    if t.size == 0:  # resampled: every run too short for the filter's start-up at both ends
+        raise BagError(
+            f"the IMU topic {rec.imu.topic!r} gives no sample at {rate_hz:g} Hz: resampling "
+            f"its {resampling.rate_in_hz:.4g} Hz needs runs of increasing stamps and finite "
+            f"values longer than {2 * resampling.trimmed_per_edge / rate_hz:.3g} s, and "
+            f"{resampling.dropped} of its {t_imu.size} messages (repeated or backwards stamps, "
+            "non-finite values) cut it into shorter ones"
+        )
     if s.gravity == "highpass":
         a = condition.highpass(t, a, rate_hz, s.highpass_hz)
 

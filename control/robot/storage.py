@@ -4,19 +4,24 @@ rosbags and the mcap package build a Python object per record (10-25 us a messag
 project's machine), which alone would hold a replay of a 120 Hz IMU below 200x real time. Here
 an MCAP file's chunks are found through its summary (the mcap package reads it) and their
 records walked with `struct` (~1 us a message); a sqlite3 file is one query per topic. Each
-function returns None where the file is not the simple, common case (no summary or chunk
-index, messages outside chunks, an unknown chunk compression, a schema it does not know): the
-caller then reads with rosbags or the mcap package.
+`mcap_messages` returns None where the file is not the simple, common case (no summary, chunk
+index or statistics; messages outside chunks): the caller then reads with rosbags or the mcap
+package. A file whose bytes contradict its own structure (a truncated or corrupted chunk, a CRC
+that does not match, a chunk compression MCAP does not define, a truncated or damaged sqlite3
+database) raises `BagError` naming the file and what is wrong.
 """
 
 from __future__ import annotations
 
+import os
 import sqlite3
 import struct
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from control.errors import BagError
 from control.robot.extra import require
 
 _RECORD = struct.Struct("<BQ")  # opcode, length
@@ -24,6 +29,11 @@ _MESSAGE = struct.Struct("<HIQ")  # channel id, sequence, log time (publish time
 _MESSAGE_DATA = 9 + 2 + 4 + 8 + 8  # offset of a Message record's data from the record's start
 _CHUNK = struct.Struct("<QQQI")  # start and end time, uncompressed size, crc
 OP_MESSAGE, OP_CHUNK = 0x05, 0x06
+_PIECE = 1 << 22  # bytes decompressed at a time (the chunk's declared size bounds the total)
+
+
+class _Damaged(Exception):
+    """Bytes that contradict the structure around them (the caller names the file)."""
 
 
 @dataclass
@@ -45,29 +55,85 @@ class RawTopics:
     encodings: dict[str, str] = field(default_factory=dict)
 
 
-def _decompress(data: bytes, compression: str, size: int) -> bytes | None:
+def _read_at_most(read, limit: int) -> bytes:
+    """Up to ``limit`` bytes of a decompressor, ``read(n)`` giving at most n bytes more (b"" at
+    the end), taken ``_PIECE`` at a time: memory follows the data, not a declared size."""
+    parts, got = [], 0
+    while got < limit and (piece := read(min(_PIECE, limit - got))):
+        parts.append(piece)
+        got += len(piece)
+    return b"".join(parts)
+
+
+def _unzstd(data: bytes, size: int) -> bytes:
+    """A zstd frame decompressed to at most ``size + 1`` bytes, whatever the frame declares."""
+    zstandard = require("zstandard", "reading a zstd-compressed MCAP file")
+    try:
+        declared = zstandard.frame_content_size(data)
+        if declared not in (-1, size):  # -1: the frame does not say
+            raise _Damaged(f"its zstd frame declares {declared} bytes, its header {size}")
+        with zstandard.ZstdDecompressor().stream_reader(data) as reader:
+            return _read_at_most(reader.read, size + 1)
+    except zstandard.ZstdError as exc:
+        raise _Damaged(f"zstd: {exc}") from exc
+
+
+def _unlz4(data: bytes, size: int) -> bytes:
+    """An lz4 frame decompressed to at most ``size + 1`` bytes."""
+    lz4 = require("lz4.frame", "reading an lz4-compressed MCAP file")
+    decompressor, pending = lz4.LZ4FrameDecompressor(), [data]
+
+    def read(n: int) -> bytes:  # the data first, then what the decompressor holds back
+        return decompressor.decompress(pending.pop() if pending else b"", max_length=n)
+
+    try:
+        return _read_at_most(read, size + 1)
+    except RuntimeError as exc:  # lz4's error for a damaged frame
+        raise _Damaged(f"lz4: {exc}") from exc
+
+
+def _decompress(data: bytes, compression: str, size: int) -> bytes:
+    """The records of a chunk, ``size`` bytes declared."""
     if compression == "":
-        return data
-    if compression == "zstd":
-        zstandard = require("zstandard", "reading a zstd-compressed MCAP file")
-        return zstandard.ZstdDecompressor().decompress(data, max_output_size=size)
-    if compression == "lz4":
-        return require("lz4.frame", "reading an lz4-compressed MCAP file").decompress(data)
-    return None
+        out = data
+    elif compression == "zstd":
+        out = _unzstd(data, size)
+    elif compression == "lz4":
+        out = _unlz4(data, size)
+    else:  # the mcap package would take such a chunk as uncompressed: garbage, or none
+        raise _Damaged(f"its compression {compression!r} is none of MCAP's ('', zstd, lz4)")
+    if len(out) != size:
+        got = "more than" if len(out) > size else f"{len(out)} bytes, not"
+        raise _Damaged(f"its records hold {got} the {size} bytes its header declares")
+    return out
 
 
-def _chunk_records(raw: bytes) -> bytes | None:
-    """The (decompressed) records of a Chunk record, or None if it is not one we know."""
+def _chunk_records(raw: bytes) -> bytes:
+    """The (decompressed) records of a Chunk record, checked against its sizes and CRC."""
     op, _length = _RECORD.unpack_from(raw, 0)
     if op != OP_CHUNK:
-        return None
-    _start, _end, size, _crc = _CHUNK.unpack_from(raw, 9)
+        raise _Damaged(f"the summary's chunk index points at a record of opcode {op:#x}")
+    _start, _end, size, crc = _CHUNK.unpack_from(raw, 9)
     pos = 9 + _CHUNK.size
     (n_comp,) = struct.unpack_from("<I", raw, pos)
-    compression = raw[pos + 4 : pos + 4 + n_comp].decode()
+    compression = _text(raw[pos + 4 : pos + 4 + n_comp], "its compression's name")
     pos += 4 + n_comp
     (n_rec,) = struct.unpack_from("<Q", raw, pos)
-    return _decompress(raw[pos + 8 : pos + 8 + n_rec], compression, size)
+    data = raw[pos + 8 : pos + 8 + n_rec]
+    if len(data) != n_rec:
+        raise _Damaged(f"it is cut short: {len(data)} of its {n_rec} bytes of records")
+    records = _decompress(data, compression, size)
+    if crc and zlib.crc32(records) != crc:  # crc 0: not computed
+        raise _Damaged("its records do not match their CRC")
+    return records
+
+
+def _text(data: bytes, what: str) -> str:
+    """``data`` as UTF-8 text; `_Damaged` naming ``what`` where it is not."""
+    try:
+        return data.decode()
+    except UnicodeDecodeError as exc:
+        raise _Damaged(f"{what} is not UTF-8 text") from exc
 
 
 def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
@@ -77,78 +143,139 @@ def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
     while pos < end:
         op, length = head(records, pos)
         if op == OP_MESSAGE:
+            if length < _MESSAGE_DATA - 9:
+                raise _Damaged(f"a message record at byte {pos} of its records is too short")
             channel, _seq, log = message(records, pos + 9)
             topic = wanted.get(channel)
             if topic is not None:
                 out.log_ns[topic].append(log)
                 out.data[topic].append(records[pos + _MESSAGE_DATA : pos + 9 + length])
         pos += 9 + length
+    if pos != end:
+        raise _Damaged("its last record runs past its end")
 
 
 def mcap_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics | None:
-    """The messages of ``topics`` in MCAP files (None where a file is not the simple case)."""
-    reader_mod = require("mcap.reader", "reading an MCAP file")
+    """The messages of ``topics`` in MCAP files (None where a file is not the simple case).
+    Raises `BagError` for a file whose chunks, chunk index or schemas are damaged."""
     out = RawTopics()
     for topic in topics:
         out.log_ns[topic], out.data[topic] = [], []
     for path in paths:
         with open(path, "rb") as f:
             try:
-                summary = reader_mod.make_reader(f).get_summary()
-            except Exception:  # a damaged or unindexed file: the generic reader reports it
-                return None
-            if summary is None or not summary.chunk_indexes or summary.statistics is None:
-                return None
-            wanted = {}
-            for cid, channel in summary.channels.items():
-                schema = summary.schemas.get(channel.schema_id)
-                name = schema.name if schema is not None else ""
-                out.types.setdefault(channel.topic, name)
-                if channel.topic in out.log_ns:
-                    wanted[cid] = channel.topic
-                    out.encodings[channel.topic] = channel.message_encoding
-                    if schema is not None:
-                        out.definitions[channel.topic] = (schema.encoding, schema.data.decode())
-            before = {t: len(v) for t, v in out.log_ns.items()}
-            for index in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
-                if not set(index.message_index_offsets) & set(wanted):
-                    continue
-                f.seek(index.chunk_start_offset)
-                records = _chunk_records(f.read(index.chunk_length))
-                if records is None:
-                    return None
-                _walk(records, wanted, out)
-            counts = summary.statistics.channel_message_counts
-            for cid, topic in wanted.items():
-                found = len(out.log_ns[topic]) - before[topic]
-                if counts.get(cid, found) != found:  # messages outside chunks
-                    return None
+                simple = _mcap_file(f, out)
+            except _Damaged as exc:
+                raise BagError(f"{path} is damaged: {exc}") from exc
+        if not simple:
+            return None
     return out
 
 
+def _mcap_file(f, out: RawTopics) -> bool:
+    """Append the messages of ``out``'s topics in one MCAP file; False where it is not the
+    simple case."""
+    reader_mod = require("mcap.reader", "reading an MCAP file")
+    try:
+        summary = reader_mod.make_reader(f).get_summary()
+    except Exception:  # a damaged or unindexed file: the generic reader reports it
+        return False
+    if summary is None or not summary.chunk_indexes or summary.statistics is None:
+        return False
+    wanted = {}
+    for cid, channel in summary.channels.items():
+        schema = summary.schemas.get(channel.schema_id)
+        name = schema.name if schema is not None else ""
+        out.types.setdefault(channel.topic, name)
+        if channel.topic in out.log_ns:
+            wanted[cid] = channel.topic
+            out.encodings[channel.topic] = channel.message_encoding
+            if schema is not None:
+                text = _text(schema.data, f"the schema of {channel.topic!r}")
+                out.definitions[channel.topic] = (schema.encoding, text)
+    before = {t: len(v) for t, v in out.log_ns.items()}
+    size = os.fstat(f.fileno()).st_size
+    for index in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
+        if not set(index.message_index_offsets) & set(wanted):
+            continue
+        start = index.chunk_start_offset
+        try:
+            if start + index.chunk_length > size:
+                raise _Damaged(f"its {index.chunk_length} bytes run past the file's {size}")
+            f.seek(start)
+            _walk(_chunk_records(f.read(index.chunk_length)), wanted, out)
+        except struct.error as exc:
+            raise _Damaged(f"the chunk at byte {start}: a record is cut short ({exc})") from exc
+        except _Damaged as exc:
+            raise _Damaged(f"the chunk at byte {start}: {exc}") from exc
+    counts = summary.statistics.channel_message_counts
+    for cid, topic in wanted.items():
+        found = len(out.log_ns[topic]) - before[topic]
+        if counts.get(cid, found) != found:  # messages outside chunks
+            return False
+    return True
+
+
 def sqlite_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics:
-    """The messages of ``topics`` in rosbag2 sqlite3 files, by receive time."""
+    """The messages of ``topics`` in rosbag2 sqlite3 files, by receive time. Raises `BagError`
+    for a file sqlite3 cannot read, a truncated one, or one whose topics are not UTF-8 text
+    (or NULL) or whose messages are not (int, bytes)."""
     out = RawTopics()
     for topic in topics:
         out.log_ns[topic], out.data[topic] = [], []
     for path in paths:
-        con = sqlite3.connect(f"file:{Path(path).resolve()}?mode=ro", uri=True)
         try:
-            rows = con.execute("SELECT id, name, type, serialization_format FROM topics")
-            ids = {}
-            for tid, name, msgtype, encoding in rows.fetchall():
-                out.types.setdefault(name, msgtype)
-                if name in out.log_ns:
-                    ids[tid] = name
-                    out.encodings[name] = encoding
-            for tid, name in ids.items():
-                rows = con.execute(
-                    "SELECT timestamp, data FROM messages WHERE topic_id = ? "
-                    "ORDER BY timestamp, id",
-                    (tid,),
-                ).fetchall()
-                out.log_ns[name].extend(r[0] for r in rows)
-                out.data[name].extend(r[1] for r in rows)
-        finally:
-            con.close()
+            _sqlite_file(Path(path), out)
+        except sqlite3.Error as exc:
+            raise BagError(f"{path} is not a readable rosbag2 sqlite3 file: {exc}") from exc
+        except UnicodeDecodeError as exc:  # sqlite3's for a TEXT value that is not UTF-8
+            raise BagError(f"{path} is damaged: a topic's name or type is not text") from exc
     return out
+
+
+def _sqlite_file(path: Path, out: RawTopics) -> None:
+    """Append the messages of ``out``'s topics in one rosbag2 sqlite3 file."""
+    con = sqlite3.connect(f"file:{path.resolve()}?mode=ro", uri=True)
+    try:
+        _check_complete(con, path)
+        rows = con.execute("SELECT id, name, type, serialization_format FROM topics")
+        ids = {}
+        for tid, name, msgtype, encoding in rows.fetchall():
+            if not all(type(v) is str for v in (name, msgtype, encoding)):
+                raise BagError(
+                    f"{path} is damaged: the topic of id {tid!r} lacks its name, type or "
+                    "serialisation format"
+                )
+            out.types.setdefault(name, msgtype)
+            if name in out.log_ns:
+                ids[tid] = name
+                out.encodings[name] = encoding
+        for tid, name in ids.items():
+            rows = con.execute(
+                "SELECT timestamp, data FROM messages WHERE topic_id = ? ORDER BY timestamp, id",
+                (tid,),
+            ).fetchall()
+            if not all(type(stamp) is int and type(data) is bytes for stamp, data in rows):
+                raise BagError(
+                    f"{path} is damaged: a message of the topic {name!r} lacks an integer "
+                    "time stamp or its data"
+                )
+            out.log_ns[name].extend(r[0] for r in rows)
+            out.data[name].extend(r[1] for r in rows)
+    finally:
+        con.close()
+
+
+def _check_complete(con: sqlite3.Connection, path: Path) -> None:
+    """`BagError` for a database file shorter than its header says (sqlite3 reads the missing
+    pages as zeros: a truncated bag would lose the end of its last messages unnoticed). A file
+    with a write-ahead log beside it is not checked (the log holds pages the file lacks)."""
+    if Path(f"{path}-wal").exists():
+        return
+    ((page,),) = con.execute("PRAGMA page_size").fetchall()
+    ((pages,),) = con.execute("PRAGMA page_count").fetchall()
+    size = path.stat().st_size
+    if size % page or size < page * pages:
+        raise BagError(
+            f"{path} is truncated: {size} bytes, its header declares {pages} pages of {page}"
+        )

@@ -83,6 +83,17 @@ def test_the_two_filters_differ_where_they_should_above_the_output_nyquist():
     assert np.std(a_l) * np.sqrt(2) < 0.9
 
 
+@pytest.mark.parametrize("rate_in", [24_000.0, 30_000.0, 100_000.0])
+def test_an_imu_hundreds_of_times_faster_than_the_emulator_is_resampled(rate_in):
+    # the resampling ratio 120 / rate_in was once rounded to 0 / 1 (ZeroDivisionError)
+    t, a = _tone(rate_in, 7.0, 2.0)
+    for method in condition.METHODS:
+        t2, a2, info = condition.to_rate(t, a, RATE, method=method)
+        assert info.up >= 1 and info.up / info.down == pytest.approx(RATE / rate_in, rel=1e-3)
+        assert t2.size > 150 and np.allclose(np.diff(t2), 1 / RATE, rtol=0, atol=1e-9)
+        assert np.max(np.abs(a2 - np.sin(2 * np.pi * 7.0 * t2))) < 2e-3
+
+
 def test_resampling_turns_stamp_faults_into_faults_the_bcr_reports():
     from control.sensor_checks import stream_fault
 

@@ -17,7 +17,12 @@ pytest.importorskip("mcap")
 import control  # noqa: E402
 import roadgen  # noqa: E402
 import vehicle  # noqa: E402
-from control.errors import BagError, MissingExtraError  # noqa: E402
+from control.errors import (  # noqa: E402
+    BagError,
+    ControlError,
+    EmulatorMismatchError,
+    MissingExtraError,
+)
 from control.robot import (  # noqa: E402
     cli,
     read_recording,
@@ -25,6 +30,7 @@ from control.robot import (  # noqa: E402
     write_run_bag,
     write_sensor_bag,
 )
+from control.robot.replay import replay_recording  # noqa: E402
 
 #: what the closed loop's result and the replay's both carry, per estimate
 SHARED = ("gd_mean", "gd_lo", "gd_hi", "status", "reason", "prob_change", "command", "mode")
@@ -203,6 +209,44 @@ def test_an_imu_slower_than_the_emulator_is_an_error(loop_run, emulator_a, tmp_p
                            result.sample_position, result.sample_speed)  # fmt: skip
     with pytest.raises(BagError, match="60 Hz, slower than the emulator's 120 Hz"):
         replay_bag(bag, emulator_a)
+
+
+def test_an_imu_whose_every_message_is_doubled_is_an_error_saying_why(emulator_a, tmp_path):
+    # each repeated stamp ends a run of the resampler: nothing was left, and the replay said
+    # that the IMU and the odometry "do not overlap in time"
+    t = 1.0 + np.arange(1600) / 400.0
+    odom = t[::10]
+    bag = write_sensor_bag(tmp_path / "doubled", np.repeat(t, 2), np.repeat(np.sin(t), 2), odom,
+                           0.5 * (odom - 1.0), np.full(odom.size, 0.5))  # fmt: skip
+    with pytest.raises(BagError, match=r"'/imu/data' gives no sample at 120 Hz: .* 1600 of its "
+                                       r"3200 messages \(repeated"):  # fmt: skip
+        replay_bag(bag, emulator_a)
+
+
+@pytest.fixture(scope="module")
+def likelihood_b():
+    """The block likelihood of case B's emulator (not case A's)."""
+    return control.ObservationModel(control.shipped_emulator("B"))
+
+
+def test_settings_that_do_not_fit_the_emulator_are_refused_before_reading(
+    emulator_a, likelihood_b, tmp_path
+):
+    nothing = tmp_path / "not_read.mcap"  # BagError ("no recording") if it were read first
+    with pytest.raises(ControlError, match=r"highpass_hz = 60 Hz must lie below 60 Hz"):
+        replay_bag(nothing, emulator_a, gravity="highpass", highpass_hz=60.0)
+    with pytest.raises(BagError, match="no recording"):  # no high-pass: its cut-off unused
+        replay_bag(nothing, emulator_a, gravity="keep", highpass_hz=60.0)
+    with pytest.raises(EmulatorMismatchError, match="prepared for another emulator"):
+        replay_bag(nothing, emulator_a, likelihood=likelihood_b)
+
+
+def test_a_likelihood_for_another_emulator_is_refused_by_replay_recording(
+    loop_run, emulator_a, likelihood_b
+):
+    _, path = loop_run
+    with pytest.raises(EmulatorMismatchError, match=r"metadata differ in .*'noise_std'"):
+        replay_recording(read_recording(path), emulator_a, likelihood=likelihood_b)
 
 
 def test_the_imu_axis_and_sign_are_options(loop_run, emulator_a, likelihood_a, tmp_path):
