@@ -94,6 +94,8 @@ def main(argv=None) -> None:
         help="run one task/backend pair only, e.g. fit:pyro or calibrate:torch",
     )
     args = ap.parse_args(argv)
+    if args.repeats < 1:
+        ap.error(f"--repeats must be >= 1, got {args.repeats}")
     pairs = {f"{t}:{b}" for t in ("fit", "calibrate") for b in ("numpy", "torch", "pyro")}
     if args.only is not None and args.only not in pairs:
         ap.error(f"--only must be one of {sorted(pairs)}, got {args.only!r}")

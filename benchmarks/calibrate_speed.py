@@ -1,7 +1,8 @@
 """Online calibration speed on the 198-run road case (emulator fixed at SEPIA's values).
 
 Prints, single-threaded (BLAS limited to one thread; --pin also pins the process to one CPU):
-- ``Calibrator.update`` latency over >= 1,000 updates with varying (v, f): median, p90, p99, max,
+- ``Calibrator.update`` latency over ``--updates`` (>= 1,000, for a p99) updates with varying
+  (v, f), after 50 warm-up calls: median, p90, p99, max,
   also with the posterior's mean and P(GD > 350) read (what a control loop does);
 - ``Calibrator.log_likelihood_grid`` latency (the sequential-filter hook);
 - ``gpmsa.calibrate`` with the paper's settings (tuning 50 x 20, 5,000 draws, 1,000 burned), the
@@ -28,6 +29,8 @@ import gpmsa
 from gpmsa.fitting.emulator import Emulator
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
+MIN_UPDATES = 1000
+WARM_UP = 50
 
 
 def road_emulator() -> tuple[Emulator, dict]:
@@ -52,11 +55,12 @@ def observations(emu: Emulator, n: int, seed: int = 0) -> tuple[np.ndarray, np.n
 
 
 def latencies(fn, v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Wall-clock and thread CPU seconds per call of fn([[v]], [[f]]) for each window (after 50
-    warm-up calls). On a loaded machine the wall clock includes time the process waited for a
-    CPU (scheduler ticks of ~4 ms); the CPU time does not."""
-    for i in range(50):
+    """Wall-clock and thread CPU seconds per call of fn([[v]], [[f]]) for each (v, f) pair after
+    the first WARM_UP (warm-up calls, not timed). On a loaded machine the wall clock includes
+    time the process waited for a CPU (scheduler ticks of ~4 ms); the CPU time does not."""
+    for i in range(WARM_UP):
         fn([[v[i]]], [[f[i]]])
+    v, f = v[WARM_UP:], f[WARM_UP:]
     wall, cpu = np.empty(v.size), np.empty(v.size)
     for i in range(v.size):
         t0, c0 = time.perf_counter(), time.thread_time()
@@ -77,6 +81,10 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=10)
     parser.add_argument("--pin", action="store_true", help="pin the process to one CPU")
     args = parser.parse_args()
+    if args.updates < MIN_UPDATES:
+        parser.error(f"--updates must be >= {MIN_UPDATES} (for a p99), got {args.updates}")
+    if args.runs < 1:
+        parser.error(f"--runs must be >= 1, got {args.runs}")
     if args.pin and hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {sorted(os.sched_getaffinity(0))[0]})
     emu, ref = road_emulator()
@@ -86,7 +94,7 @@ def main() -> None:
     t0 = time.perf_counter()
     cal = gpmsa.Calibrator(emu, seed=0)
     prep_s = time.perf_counter() - t0
-    v, f = observations(emu, args.updates + 50)
+    v, f = observations(emu, args.updates + WARM_UP)
 
     def update_and_read(x, y):
         post = cal.update(x, y)

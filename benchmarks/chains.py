@@ -37,6 +37,10 @@ from gpmsa import backends  # noqa: E402
 from gpmsa.mcmc.parallel import available_cpus  # noqa: E402
 from gpmsa.model.problem import prepare  # noqa: E402
 
+MIN_ITER = 5
+"""Fewest sweeps a chain (``--numpy-iter``, ``--torch-iter``): the bulk ESS needs 4 draws after
+the burn-in of n_iter // 5."""
+
 
 def load() -> str:
     """The 1-minute load average, printed with every figure."""
@@ -82,9 +86,10 @@ def numpy_parallel(n_iter: int, repeats: int) -> float:
 
 
 def torch_batched(n_iter: int, n_chains: int, numpy_rate: float | None) -> None:
-    """Part 2: one batch (one core), then ``chain_groups`` = every CPU (one process each)."""
+    """Part 2: one batch (one core), then ``chain_groups`` = every CPU (one process each; at
+    most one group a chain)."""
     print(f"\n# torch, {n_chains} batched chains x {n_iter} draws, default warm-up; {load()}")
-    cpus = available_cpus()
+    cpus = min(available_cpus(), n_chains)
     rates = {}
     for groups in (1, cpus) if cpus > 1 else (1,):
         wall, cpu, n_eff, r_hat, chains = run_fit("torch", n_iter, n_chains, seed=0,
@@ -158,12 +163,21 @@ def main(argv=None) -> None:
     ap.add_argument("--torch-chains", type=int, default=64)
     ap.add_argument("--only", choices=("numpy", "torch", "sweep"), default=None)
     args = ap.parse_args(argv)
+    if args.repeats < 1:
+        ap.error(f"--repeats must be >= 1, got {args.repeats}")
+    for option, n_iter in (("--numpy-iter", args.numpy_iter), ("--torch-iter", args.torch_iter)):
+        if n_iter is not None and n_iter < MIN_ITER:
+            ap.error(f"{option} must be >= {MIN_ITER} (the ESS's 4 draws after burn-in), "
+                     f"got {n_iter}")  # fmt: skip
+    if args.torch_chains < 1:
+        ap.error(f"--torch-chains must be >= 1, got {args.torch_chains}")
     print(f"# {os.cpu_count()} CPUs; {load()}; one BLAS / torch thread per chain or batch")
     rate = None
     if args.only in (None, "numpy"):
         rate = numpy_parallel(args.numpy_iter, args.repeats)
     if args.only in (None, "torch"):
-        torch_batched(args.torch_iter or args.numpy_iter, args.torch_chains, rate)
+        n_iter = args.numpy_iter if args.torch_iter is None else args.torch_iter
+        torch_batched(n_iter, args.torch_chains, rate)
     if args.only in (None, "sweep"):
         sweep_cost(args.torch_chains)
 

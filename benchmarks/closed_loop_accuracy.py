@@ -276,21 +276,45 @@ def main() -> None:
         parser.error(f"--random-tracks must be >= 1, got {args.random_tracks}")
     if args.random_first_seed < 0:
         parser.error(f"--random-first-seed must be >= 0, got {args.random_first_seed}")
+    if args.workers < 1:
+        parser.error(f"--workers must be >= 1, got {args.workers}")
     names = [n for n in args.sets.split(",") if n]
     unknown = set(names) - set(SETS)
+    if not names:
+        parser.error(f"--sets names no set, got {args.sets!r}; choose from {list(SETS)}")
     if unknown:
-        parser.error(f"unknown sets {sorted(unknown)}; choose from {list(SETS)}")
+        parser.error(f"--sets: unknown sets {sorted(unknown)}; choose from {list(SETS)}")
     cases = [c for c in args.cases.split(",") if c]
+    if not cases or not set(cases) <= set(NOISE_STD):
+        parser.error(f"--cases must be among {list(NOISE_STD)}, got {args.cases!r}")
     if args.emulator_dir:
         try:
             for c in cases:
                 control.shipped_emulator_path(c, "band", args.emulator_dir)
         except control.ControlError as exc:
             parser.error(f"--emulator-dir: {exc}")
-    cp = control.ChangePointSettings(
-        mean_segment_m=args.mean_segment, segment_shape=args.shape, min_jump=args.min_jump,
-        jump_sd=args.jump_sd, prior=args.prior,
-    )  # fmt: skip
+    numbers = {"--mean-segment": ("mean_segment_m", args.mean_segment),
+               "--shape": ("segment_shape", args.shape),
+               "--min-jump": ("min_jump", args.min_jump),
+               "--jump-sd": ("jump_sd", args.jump_sd)}  # fmt: skip
+    for option, (field, value) in numbers.items():
+        try:
+            replace(defaults, **{field: value})
+        except control.ControlError as exc:
+            parser.error(f"{option}: {exc}")
+    # each checked alone above (the settings check none against another); --prior: its choices
+    cp = control.ChangePointSettings(prior=args.prior, **dict(numbers.values()))
+    try:
+        control.Simplex(speed_step_mps=args.speed_step)
+    except control.ControlError as exc:
+        parser.error(f"--speed-step: {exc}")
+    if args.update_every is not None:  # the runs' own check, on each case's band emulator
+        for c in cases:
+            emu = control.shipped_emulator(c, "band", args.emulator_dir)
+            try:
+                control.bcr_settings_for(emu, changepoint=cp, update_every=args.update_every)
+            except control.ControlError as exc:
+                parser.error(f"--update-every: {exc}")
     tic = time.perf_counter()
     out = []
     for name in names:

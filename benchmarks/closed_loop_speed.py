@@ -43,14 +43,22 @@ def main() -> None:
         help="SensorLimits.lattice_p of the sensor checks (default: its default; 0: off)",
     )  # fmt: skip
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"--repeats must be >= 1, got {args.repeats}")
     emu = control.shipped_emulator(args.case, "band" if args.method == "changepoint" else "window")
     noise = float(emu.metadata["noise_std"])
-    settings = control.bcr_settings_for(
-        emu, method=args.method, update_every=args.update_every
-    )  # fmt: skip
+    try:
+        settings = control.bcr_settings_for(
+            emu, method=args.method, update_every=args.update_every
+        )  # fmt: skip
+    except control.ControlError as exc:
+        parser.error(f"--update-every: {exc}")
     if args.lattice_p is not None:
-        sensor = dataclasses.replace(settings.sensor, lattice_p=args.lattice_p)
-        settings = dataclasses.replace(settings, sensor=sensor)
+        try:
+            sensor = dataclasses.replace(settings.sensor, lattice_p=args.lattice_p)
+            settings = dataclasses.replace(settings, sensor=sensor)
+        except control.ControlError as exc:
+            parser.error(f"--lattice-p: {exc}")
     tic = time.perf_counter()
     likelihood = control.BCR.from_emulator(emu, settings).model
     prep = time.perf_counter() - tic

@@ -30,6 +30,8 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sets", type=int, default=12, help="data sets per row (default 12)")
     args = ap.parse_args(argv)
+    if args.sets < 1:
+        ap.error(f"--sets must be >= 1, got {args.sets}")
     print(f"# 90% interval coverage, {args.sets} data sets a row; load "
           f"{os.getloadavg()[0]:.2f}")  # fmt: skip
     print("groups  sd    prior     theta_i (n)    mu     group sd")

@@ -47,6 +47,8 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3, help="runs (track seeds 1..N)")
     parser.add_argument("--case", default="A", choices=["A", "B"], help="test case")
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"--repeats must be >= 1, got {args.repeats}")
     emu = control.shipped_emulator(args.case)
     noise = float(emu.metadata["noise_std"])
     likelihood = control.ObservationModel(emu)

@@ -29,6 +29,7 @@ import roadgen
 import vehicle
 from vehicle.simulate import simulate
 
+CAMPAIGN_RUNS = 198  # the default campaign's design (vehicle.run_campaign)
 ENV_SETTINGS = {
     "OpenBLAS kernel Sandybridge": {"OPENBLAS_CORETYPE": "Sandybridge"},
     "OpenBLAS kernel Prescott (SSE3)": {"OPENBLAS_CORETYPE": "Prescott"},
@@ -41,8 +42,8 @@ ENV_SETTINGS = {
 def campaign_f(n: int, lift_off: bool = True, ulp: bool = False) -> np.ndarray:
     """Noise-free f_window of the first n runs of the default campaign (seed 0)."""
     model = vehicle.Jackal(lift_off=lift_off)
-    design = vehicle.lhs_design(198, seed=0)[:n]
-    seeds = np.random.SeedSequence(0).generate_state(198).astype(np.int64)[:n]
+    design = vehicle.lhs_design(CAMPAIGN_RUNS, seed=0)[:n]
+    seeds = np.random.SeedSequence(0).generate_state(CAMPAIGN_RUNS).astype(np.int64)[:n]
     out = []
     for (v, gd), s in zip(design, seeds, strict=True):
         road = roadgen.iso8608_profile(21.0, gd, dx_m=0.006, seed=int(s), lead_in_m=1.0)
@@ -69,6 +70,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--env", action="store_true", help="also the machine settings (part 2)")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if not 1 <= args.runs <= CAMPAIGN_RUNS:
+        parser.error(f"--runs must be in [1, {CAMPAIGN_RUNS}] (the default campaign's runs), "
+                     f"got {args.runs}")  # fmt: skip
     if args.child:  # part 2's worker: print a hash of f
         f = campaign_f(args.runs)
         print(hashlib.sha256(f.tobytes()).hexdigest())

@@ -27,6 +27,8 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=21)
     args = parser.parse_args(argv)
+    if args.repeats < 1:
+        parser.error(f"--repeats must be >= 1, got {args.repeats}")
     segments = [(50, 300), (50, 500), (50, 300)]
     road = roadgen.iso8608_profile(150.0, 450.0, seed=0)
     trk = roadgen.track(segments, seed=0)

@@ -38,6 +38,10 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=198)
     parser.add_argument("--skip-campaign", action="store_true")
     args = parser.parse_args()
+    if args.repeats < 1:
+        parser.error(f"--repeats must be >= 1, got {args.repeats}")
+    if args.runs < 1:
+        parser.error(f"--runs must be >= 1, got {args.runs}")
 
     print(f"cores: {os.cpu_count()}, load average at start: {os.getloadavg()}")
     road = roadgen.iso8608_profile(151.0, gd=400, seed=0, lead_in_m=1.0)

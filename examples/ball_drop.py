@@ -28,13 +28,13 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+from _cli import output_folder  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 from scipy.stats import qmc  # noqa: E402
 
@@ -47,6 +47,10 @@ RANGES = {"R": (0.04, 0.20), "Cd": (0.2, 1.2), "g": (8.4, 10.8)}  # m, -, m/s^2
 WORLD = {"Cd": 0.5, "g": 9.81, "linear_drag": 0.08, "delay": 0.04, "noise_sd": 0.02}
 OBSERVED_R = (0.05, 0.08, 0.10, 0.13, 0.16, 0.19)
 HELD_OUT_R = (0.065, 0.115, 0.175)
+MIN_RUNS = 12
+"""Fewest simulator runs (``--runs``): the emulator extrapolates at most 10% of its design's
+range, and a Latin hypercube of m runs may leave up to 1/m of each range uncovered at either
+end; from 12 runs on, the 12 held-out test runs and every ball lie within reach for any seed."""
 
 
 def simulator(R: np.ndarray, Cd: np.ndarray, g: np.ndarray) -> np.ndarray:
@@ -96,8 +100,13 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--runs", type=int, default=60, help="simulator runs")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    if args.runs < MIN_RUNS:
+        parser.error(f"--runs must be >= {MIN_RUNS} (the emulator's design), got {args.runs}")
+    if args.n_iter < 2:
+        parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed}")
+    out = output_folder(parser, "--out", args.out)
     rng = np.random.default_rng(args.seed)
     t0 = time.perf_counter()
 

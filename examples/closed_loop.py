@@ -34,6 +34,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+from _cli import output_folder  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -182,12 +183,14 @@ def main(argv: list[str] | None = None) -> dict:
     seeds = range(args.first_seed, args.first_seed + args.runs)
     gds = sorted({gd for _, gd in segments})
     paper_track = tuple(segments) == PAPER_SEGMENTS
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    try:
-        simplex = control.Simplex(risk=args.risk, law=args.law, speed_step_mps=args.speed_step)
-    except control.ControlError as err:
-        parser.error(str(err))
+    for option, field, value in (("--risk", "risk", args.risk),
+                                 ("--speed-step", "speed_step_mps", args.speed_step)):  # fmt: skip
+        try:
+            control.Simplex(**{field: value})
+        except control.ControlError as err:
+            parser.error(f"{option}: {err}")
+    # each checked alone above (the Simplex checks none against another); --law: its choices
+    simplex = control.Simplex(risk=args.risk, law=args.law, speed_step_mps=args.speed_step)
     emulator_dir = Path(args.emulator_dir) if args.emulator_dir else None
     try:  # every file before the first run
         emulators = {
@@ -197,18 +200,33 @@ def main(argv: list[str] | None = None) -> dict:
         }
     except (control.ControlError, gpmsa.EmulatorFileError) as err:
         parser.error(f"--emulator-dir: {err} (or leave that case out: --cases)")
-    record = Path(args.record) if args.record else None
+    for emu in emulators.values():  # the runs' checks of the files, before the first run
+        try:
+            bcr = control.bcr_settings_for(emu)
+            control.check_emulator(emu, model=control.emulator_vehicle(emu), bcr=bcr)
+        except control.ControlError as err:  # a user's file without or with garbled records
+            parser.error(f"--emulator-dir: {err}")
+        try:
+            control.check_emulator(emu, track=track)
+        except control.EmulatorMismatchError as err:  # a GD outside the emulator's domain
+            parser.error(f"--track: {err}")
+    if args.record:
+        from control.robot.record import check_can_record
+
+        try:
+            check_can_record()
+        except control.ControlError as err:  # MissingExtraError: the robot extra
+            parser.error(f"--record: {err}")
+    out = output_folder(parser, "--out", args.out)
+    record = output_folder(parser, "--record", args.record) if args.record else None
 
     metrics: dict = {"ours": {}, "paper_method": {}}
     for case in args.cases:
         noise = control.emulator_noise_std(emulators[case, "band"])
         title = f"Test Case {case} ({f'N(0, {noise**2:g}) noise' if noise else 'noise-free'})"
         for key, method in (("ours", args.method), ("paper_method", "window")):
-            try:
-                emu = emulators[case, "band" if method == "changepoint" else "window"]
-                results = run_case(case, emu, seeds, method, simplex, segments, record)
-            except control.EmulatorMismatchError as err:  # e.g. a GD outside the domain
-                parser.error(f"--track: {err}" if "track GD" in str(err) else str(err))
+            emu = emulators[case, "band" if method == "changepoint" else "window"]
+            results = run_case(case, emu, seeds, method, simplex, segments, record)
             metrics[key][case] = summarise(results, gds)
             label = "ours" if key == "ours" else "paper's method"
             plot_gd_trace(results, track, title=f"{title}, {label}: GD").savefig(

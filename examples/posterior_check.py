@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+from _cli import output_folder  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -64,8 +64,11 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--seed", type=int, default=2025)
     parser.add_argument("--out", default="out")
     args = parser.parse_args(argv)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    if args.roads < 1:
+        parser.error(f"--roads must be >= 1, got {args.roads}")
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed}")
+    out = output_folder(parser, "--out", args.out)
     emu = control.shipped_emulator(args.case)
     calibrator = gpmsa.Calibrator(emu, seed=args.seed)
     model = vehicle.Jackal()

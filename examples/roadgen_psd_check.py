@@ -15,6 +15,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 
+from _cli import output_folder  # noqa: E402
+
 import roadgen  # noqa: E402
 
 GDS = (200.0, 300.0, 450.0, 600.0)
@@ -26,7 +28,7 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("out"), help="folder for the figure")
     args = parser.parse_args(argv)
-    args.out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(parser, "--out", args.out)
 
     road = roadgen.iso8608_profile(150.0, 450.0, seed=0)
     print(
@@ -49,10 +51,10 @@ def main(argv: list[str] | None = None) -> None:
                         f"{roadgen.estimate_gd(p):8.1f} {welch:8.1f} {roadgen.psd_slope(p):6.2f}"
                     )
     fig = roadgen.plot_profile_psd(road, title="ISO 8608 profile, prescribed GD 450")
-    path = args.out / "roadgen_psd_gd450.png"
+    path = out / "roadgen_psd_gd450.png"
     fig.savefig(path, dpi=120)
     track = roadgen.track([(50, 300), (50, 500), (50, 300)], seed=0)
-    track_path = args.out / "roadgen_track.png"
+    track_path = out / "roadgen_track.png"
     roadgen.plot_profile_psd(track, title="the paper's track: GD 300 / 500 / 300").savefig(
         track_path, dpi=120
     )

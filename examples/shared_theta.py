@@ -28,9 +28,9 @@ from __future__ import annotations
 import argparse
 import json
 import warnings
-from pathlib import Path
 
 import numpy as np
+from _cli import output_folder
 from matplotlib.figure import Figure
 from scipy.stats import qmc
 
@@ -107,8 +107,11 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--n-iter", type=int, default=2000, help="MCMC sweeps after tuning")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    if args.n_iter < 2:
+        parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed}")
+    out = output_folder(parser, "--out", args.out)
     rng = np.random.default_rng(args.seed)
     static, modal = simulations(24, 40, args.seed)
     data = experiments(rng)

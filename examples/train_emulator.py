@@ -35,13 +35,13 @@ import argparse
 import dataclasses
 import json
 import time
-from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+from _cli import output_folder  # noqa: E402
 
 import gpmsa  # noqa: E402
 import vehicle  # noqa: E402
@@ -63,6 +63,14 @@ features (GPM/SA's default 99.5% keeps 3-4 and drops GD-dependent shape: held-ou
 GD over 8.3 s of driving 0.116 with 3, 0.110 with 5, 0.109 with all 8). All 8 fitted alike:
 neither their GD bias nor the closed loop moved beyond Monte-Carlo error (docs/closed-loop.md)."""
 WINDOW_PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(1.0, 1e-3, 1.0, 1e5))
+MIN_RUNS = 4
+"""Fewest design points (``--n-runs``): gpmsa.SimData needs p + q + 2 = 4 runs for v and GD
+(and the band emulators at least ``--n-pc``)."""
+BATCH = 8
+"""Blocks per batch of the band emulators' block scatter (`control.training.block_statistics`,
+which needs two batches per run: ``--keep-s`` >= 2 * BATCH * ``--block-samples`` / RATE_HZ)."""
+BOOLEANS = {"1": True, "true": True, "yes": True, "on": True,
+            "0": False, "false": False, "no": False, "off": False}  # fmt: skip
 
 
 def stretched_design(n: int, seed: int, gd_range: tuple[float, float] = GD_RANGE) -> np.ndarray:
@@ -79,7 +87,13 @@ def noise_std(case: str, args) -> float:
 
 
 def vehicle_model(overrides: list[str]) -> vehicle.Jackal:
-    """A Jackal with the ``NAME=VALUE`` overrides of ``--vehicle`` (its attributes, SI units)."""
+    """A Jackal with the ``NAME=VALUE`` overrides of ``--vehicle`` (its attributes, SI units).
+
+    Raises ValueError, its message starting ``--vehicle``, naming the item that is not
+    ``NAME=VALUE`` with a known NAME and a value of its type (lift_off: true/false, yes/no,
+    on/off or 1/0; wheels_per_axle: an integer; the others: a number), or the value the Jackal
+    refuses (`vehicle.VehicleError`: out of its range).
+    """
     fields = {f.name for f in dataclasses.fields(vehicle.Jackal)}
     kw: dict[str, object] = {}
     for item in overrides:
@@ -88,13 +102,22 @@ def vehicle_model(overrides: list[str]) -> vehicle.Jackal:
             raise ValueError(
                 f"--vehicle {item!r}: expected NAME=VALUE with NAME one of {sorted(fields)}"
             )
-        if name == "lift_off":
-            kw[name] = value.lower() in ("1", "true", "yes", "on")
-        elif name == "wheels_per_axle":
-            kw[name] = int(value)
-        else:
-            kw[name] = float(value)
-    return vehicle.Jackal(**kw)
+        try:
+            if name == "lift_off":
+                kw[name] = BOOLEANS[value.lower()]
+            elif name == "wheels_per_axle":
+                kw[name] = int(value)
+            else:
+                kw[name] = float(value)
+        except (KeyError, ValueError):
+            kind = {"lift_off": f"one of {sorted(BOOLEANS)}", "wheels_per_axle": "an integer"}
+            raise ValueError(
+                f"--vehicle {item!r}: {name} must be {kind.get(name, 'a number')}"
+            ) from None
+    try:
+        return vehicle.Jackal(**kw)
+    except vehicle.VehicleError as exc:
+        raise ValueError(f"--vehicle: {exc}") from None
 
 
 def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict) -> dict:
@@ -129,7 +152,7 @@ def fit_band(case: str, campaign, model, args):
     feature = dataclasses.replace(BAND_FEATURE, block_samples=args.block_samples)
     accel = campaign.accel if case == "A" else campaign.accel_measured
     ok = campaign.ok & np.all(np.isfinite(accel), axis=1)
-    stats_ = block_statistics(accel[ok], feature)
+    stats_ = block_statistics(accel[ok], feature, batch=BATCH)
     scatter = block_scatter(campaign.v[ok], stats_, nodes=np.linspace(*V_RANGE, 16))
     data = gpmsa.SimData(
         x=campaign.v[ok, None], t=campaign.gd[ok, None], y=stats_.mean,
@@ -211,18 +234,35 @@ def main(argv: list[str] | None = None) -> None:
         dataclasses.replace(BAND_FEATURE, block_samples=args.block_samples)
     except ValueError as exc:  # ControlError: too short for the bands
         parser.error(f"--block-samples: {exc}")
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    band = "band" in args.features
+    min_runs = max(MIN_RUNS, args.n_pc) if band else MIN_RUNS
+    if args.n_runs < min_runs:
+        why = "gpmsa.SimData's minimum and --n-pc" if band else "gpmsa.SimData's minimum"
+        parser.error(f"--n-runs must be >= {min_runs} ({why}), got {args.n_runs}")
+    min_keep_s = 2 * BATCH * args.block_samples / RATE_HZ if band else 0.0
+    if not (np.isfinite(args.keep_s) and args.keep_s >= min_keep_s):
+        why = f" (band emulators: two batches of {BATCH} blocks of --block-samples)" if band else ""
+        parser.error(f"--keep-s must be >= {min_keep_s:.4g} s{why}, got {args.keep_s}")
+    if args.n_iter < 2:
+        parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
+    lo, hi = args.gd_range
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
+        parser.error(f"--gd-range must be finite with 0 < LO < HI, got {lo} {hi}")
     if args.ship and args.emulator_dir is not None:
         parser.error("--ship and --emulator-dir exclude each other")
-    emu_dir = EMULATOR_DIR if args.ship else Path(args.emulator_dir or out / "emulators")
-    emu_dir.mkdir(parents=True, exist_ok=True)
     if not (np.isfinite(args.noise_std) and args.noise_std >= 0):
         parser.error(f"--noise-std must be >= 0, got {args.noise_std}")
     try:
         model = vehicle_model(args.vehicle)
-    except (ValueError, TypeError) as exc:
+    except ValueError as exc:
         parser.error(str(exc))
+    out = output_folder(parser, "--out", args.out)
+    if args.ship:
+        emu_dir = output_folder(parser, "--ship", EMULATOR_DIR)
+    elif args.emulator_dir:
+        emu_dir = output_folder(parser, "--emulator-dir", args.emulator_dir)
+    else:
+        emu_dir = output_folder(parser, "--out", out / "emulators")
 
     design = stretched_design(args.n_runs, args.seed, tuple(args.gd_range))
     plot_design(design[:, 0], design[:, 1]).savefig(out / "lhs_design.png", dpi=150)

@@ -1,6 +1,7 @@
 """Load a script of examples/ as a module (its functions tested without running main)."""
 
 import importlib.util
+import sys
 from pathlib import Path
 from types import ModuleType
 
@@ -8,7 +9,10 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def load_example(name: str) -> ModuleType:
-    """examples/<name>.py imported as module ``name``."""
+    """examples/<name>.py imported as module ``name``, with examples/ on sys.path as when the
+    script runs (its helpers: ``from _cli import ...``)."""
+    if str(EXAMPLES) not in sys.path:
+        sys.path.append(str(EXAMPLES))
     spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

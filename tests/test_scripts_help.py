@@ -8,7 +8,12 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-SCRIPTS = sorted((ROOT / "benchmarks").glob("*.py")) + sorted((ROOT / "examples").glob("*.py"))
+SCRIPTS = [
+    path
+    for folder in ("benchmarks", "examples")
+    for path in sorted((ROOT / folder).glob("*.py"))
+    if not path.name.startswith("_")  # a helper the scripts import (examples/_cli.py)
+]
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: f"{p.parent.name}/{p.name}")

@@ -1,0 +1,71 @@
+"""Bad command-line arguments of the benchmark and example scripts are usage errors: exit status
+2 and a one-line message naming the option and the value, before any long work (no traceback
+from deep inside a library)."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+FILE = "{file}"
+"""In argv: an existing regular file where the script wants a folder; in the message: its path
+as the script prints it (repr)."""
+NOT_A_FOLDER = FILE + ": cannot make that folder"
+
+CASES = [
+    ("benchmarks/backends.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
+    ("benchmarks/calibrate_speed.py", ["--updates", "10"], "--updates must be >= 1000"),
+    ("benchmarks/chains.py", ["--numpy-iter", "4"], "--numpy-iter must be >= 5"),
+    ("benchmarks/closed_loop_accuracy.py", ["--sets", ""], "--sets names no set, got ''"),
+    ("benchmarks/closed_loop_accuracy.py", ["--cases", "X"], "--cases must be among"),
+    (
+        "benchmarks/closed_loop_accuracy.py",
+        ["--mean-segment", "-1"],
+        "--mean-segment: mean_segment_m must be finite and > 0, got -1",
+    ),
+    ("benchmarks/closed_loop_speed.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
+    ("benchmarks/hierarchical_coverage.py", ["--sets", "0"], "--sets must be >= 1, got 0"),
+    ("benchmarks/replay_speed.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
+    ("benchmarks/reproducibility.py", ["--runs", "199"], "--runs must be in [1, 198]"),
+    ("benchmarks/roadgen_speed.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
+    ("benchmarks/vehicle_speed.py", ["--runs", "0"], "--runs must be >= 1, got 0"),
+    ("examples/ball_drop.py", ["--runs", "11"], "--runs must be >= 12"),
+    ("examples/ball_drop.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+    ("examples/closed_loop.py", ["--risk", "1.5"], "--risk: risk must be None or lie in (0, 1)"),
+    ("examples/closed_loop.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+    ("examples/posterior_check.py", ["--seed", "-1"], "--seed must be >= 0, got -1"),
+    ("examples/posterior_check.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+    ("examples/roadgen_psd_check.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+    ("examples/shared_theta.py", ["--n-iter", "1"], "--n-iter must be >= 2"),
+    ("examples/shared_theta.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+    (
+        "examples/train_emulator.py",
+        ["--vehicle", "mass_kg=abc"],
+        "--vehicle 'mass_kg=abc': mass_kg must be a number",
+    ),
+    ("examples/train_emulator.py", ["--gd-range", "5", "1"], "--gd-range must be finite"),
+    ("examples/train_emulator.py", ["--keep-s", "0"], "--keep-s must be >= 16.67 s"),
+    ("examples/train_emulator.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+]
+
+
+@pytest.mark.parametrize(
+    "script, argv, message", CASES, ids=[f"{Path(s).name} {' '.join(a)}" for s, a, _ in CASES]
+)
+def test_bad_argument_is_a_usage_error_naming_it(tmp_path, script, argv, message) -> None:
+    a_file = tmp_path / "a_file"
+    a_file.write_text("kept")
+    argv = [str(a_file) if arg == FILE else arg for arg in argv]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    done = subprocess.run(
+        [sys.executable, str(ROOT / script), *argv],
+        capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert "Traceback" not in done.stderr, done.stderr[-2000:]
+    (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
+    assert message.replace(FILE, repr(str(a_file))) in error
+    assert a_file.read_text() == "kept"
