@@ -17,6 +17,7 @@ and what is wrong, whichever library found it.
 
 from __future__ import annotations
 
+import importlib
 import os
 import struct
 import sys
@@ -247,16 +248,28 @@ def _damage_errors() -> tuple[type[BaseException], ...]:
     (passed on to the decompressor)."""
     purpose = "reading a ROS bag"
     zstd = "compression.zstd" if sys.version_info >= (3, 14) else "backports.zstd"  # as rosbags
+    backends = tuple(  # rosbags' own dependencies, absent from its older releases
+        getattr(module, error)
+        for name, error in (("apsw", "Error"), (zstd, "ZstdError"))
+        if (module := _imported(name)) is not None
+    )
     return (
         require("rosbags.serde", purpose).SerdeError,
         require("rosbags.highlevel", purpose).AnyReaderError,
         require("rosbags.rosbag1", purpose).ReaderError,
         require("rosbags.rosbag2", purpose).ReaderError,
-        require("apsw", purpose).Error,
-        require(zstd, purpose).ZstdError,
+        *backends,
         AssertionError, EOFError, LookupError, ValueError, ArithmeticError, MemoryError,
         OSError, TypeError, struct.error,
     )  # fmt: skip
+
+
+def _imported(name: str):
+    """The module ``name``, or None where it is not installed."""
+    try:
+        return importlib.import_module(name)
+    except ImportError:
+        return None
 
 
 def _why(exc: BaseException) -> str:
