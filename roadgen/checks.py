@@ -139,15 +139,24 @@ def choice(
     return value
 
 
+def pair(
+    name: str, value: object, what: str, error: type[Exception] = RoadgenError
+) -> tuple[float, float]:
+    """Return ``value`` as two floats if it is a tuple, list or array of two real numbers (NaN
+    and inf pass); else raise ``error`` saying it must be a pair ``what``."""
+    items = tuple(value) if isinstance(value, (tuple, list, np.ndarray)) else ()
+    if len(items) != 2:
+        raise error(f"{name}={value!r} must be a pair {what}")
+    lo, hi = (real(f"{name}[{i}]", b, error) for i, b in enumerate(items))
+    return lo, hi
+
+
 def band(
     name: str, value: tuple[float, float], nyquist: float, error: type[Exception] = RoadgenError
 ) -> tuple[float, float]:
     """Return a band (n_min, n_max) in cycles/m as floats, or raise ``error`` unless it is a
     pair of real numbers with 0 < n_min < n_max <= nyquist."""
-    pair = tuple(value) if isinstance(value, (tuple, list, np.ndarray)) else ()
-    if len(pair) != 2:
-        raise error(f"{name}={value!r} must be a pair (n_min, n_max) in cycles/m")
-    lo, hi = (real(f"{name}[{i}]", b, error) for i, b in enumerate(pair))
+    lo, hi = pair(name, value, "(n_min, n_max) in cycles/m", error)
     if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi <= nyquist):
         raise error(
             f"{name}={value!r} is out of range: need 0 < n_min < n_max <= {nyquist:.6g} "

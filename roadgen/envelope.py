@@ -8,8 +8,7 @@ from typing import TypeVar
 import numpy as np
 
 from roadgen import checks
-from roadgen.errors import RoadgenError
-from roadgen.road import Road
+from roadgen.road import Road, check_road
 
 R = TypeVar("R", bound=Road)
 
@@ -24,10 +23,7 @@ def wheel_envelope(road: R, radius_m: float) -> R:
     the road is not known and gives no support. Cost O(N r / dx): one vectorised max per
     neighbour offset.
     """
-    if not isinstance(road, Road):
-        raise RoadgenError(
-            f"road={type(road).__name__} is not allowed: need a roadgen Road (a Profile or Track)"
-        )
+    check_road("road", road)
     r = checks.positive("radius_m", radius_m)
     z = road.z
     n = z.size

@@ -5,10 +5,9 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from roadgen.errors import RoadgenError
 from roadgen.iso8608 import N0, gd_spectrum
 from roadgen.psd import estimate_gd, profile_psd
-from roadgen.road import Road
+from roadgen.road import Road, check_road
 
 
 def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None = None) -> Figure:
@@ -24,10 +23,7 @@ def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None 
 
     Raises RoadgenError unless ``road`` is a roadgen Road, and for the errors of ``profile_psd``.
     """
-    if not isinstance(road, Road):
-        raise RoadgenError(
-            f"road={type(road).__name__} is not allowed: need a roadgen Road (a Profile or Track)"
-        )
+    check_road("road", road)
     n, gd = profile_psd(road, method)
     fig = Figure(figsize=(7.0, 6.5), layout="constrained")
     ax_z, ax_p = fig.subplots(2, 1)

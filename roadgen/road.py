@@ -55,3 +55,13 @@ class Road:
         arr = checks.positions("s", s, self.length_m)
         out = np.interp(arr, self.x, self.z)
         return float(out) if out.ndim == 0 else out
+
+
+def check_road(name: str, value: object) -> Road:
+    """Return ``value`` if it is a roadgen Road (a Profile, a Track), else raise RoadgenError."""
+    if not isinstance(value, Road):
+        raise RoadgenError(
+            f"{name}={type(value).__name__} is not allowed: need a roadgen Road (a Profile or "
+            "Track)"
+        )
+    return value

@@ -73,6 +73,11 @@ def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
     return roadgen_checks.choice(name, value, allowed, VehicleError)
 
 
+def pair(name: str, value: object, what: str) -> tuple[float, float]:
+    """``value`` as two floats if it is a pair of real numbers, else VehicleError."""
+    return roadgen_checks.pair(name, value, what, VehicleError)
+
+
 def band(name: str, value: object, nyquist: float) -> tuple[float, float]:
     """A band (n_min, n_max) cycles/m with 0 < n_min < n_max <= nyquist, else VehicleError."""
     return roadgen_checks.band(name, value, nyquist, VehicleError)

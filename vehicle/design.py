@@ -13,10 +13,7 @@ from vehicle.models import Model
 
 
 def _range(name: str, value: tuple[float, float]) -> tuple[float, float]:
-    pair = tuple(value) if isinstance(value, (tuple, list, np.ndarray)) else ()
-    if len(pair) != 2:
-        raise VehicleError(f"{name}={value!r} must be a pair (low, high)")
-    lo, hi = (checks.real(f"{name}[{i}]", b) for i, b in enumerate(pair))
+    lo, hi = checks.pair(name, value, "(low, high)")
     if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo < hi):
         raise VehicleError(f"{name}={value!r} is out of range: need 0 < low < high, finite")
     return lo, hi
