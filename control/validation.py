@@ -8,19 +8,20 @@ from numbers import Integral, Real
 import numpy as np
 
 from control.errors import ControlError
+from roadgen import checks
 
 
 def is_real(value) -> bool:
-    """Whether ``value`` is a real number (a bool is not)."""
-    return isinstance(value, Real) and not isinstance(value, bool)
+    """Whether ``value`` is a real number (a bool is not; the predicate form of
+    ``roadgen.checks.real``)."""
+    return isinstance(value, Real) and not isinstance(value, (bool, np.bool_))
 
 
 def float_array(values, name: str) -> np.ndarray:
-    """``values`` as a float array; ControlError naming ``name`` when they are not numbers."""
-    try:
-        return np.asarray(values, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ControlError(f"{name} must hold numbers: {exc}") from exc
+    """``values`` as a new float array; ControlError naming ``name`` unless they are real
+    numbers (ints or floats: not bools, strings such as "1.5", complex numbers or objects;
+    ``roadgen.checks.real_array`` with control's error). NaN and inf pass."""
+    return checks.real_array(name, values, ControlError)
 
 
 def check_n_draws(n_draws) -> None:

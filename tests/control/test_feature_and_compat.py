@@ -114,8 +114,9 @@ def test_feature_spec_checks_and_round_trips():
         ({"rate_hz": "120"}, "FeatureSpec.rate_hz must be a real number"),
         ({"n_tapers": 2.5}, "FeatureSpec.n_tapers must be an integer"),
         ({"block_samples": 125.0}, "FeatureSpec.block_samples must be an integer"),
-        ({"bands_hz": None}, "bands_hz must be a sequence of finite edges"),
-        ({"bands_hz": (1.0, "a")}, "bands_hz must hold numbers"),
+        ({"bands_hz": None}, "bands_hz must be an array of real numbers"),
+        ({"bands_hz": 5.0}, "bands_hz must be a sequence of finite edges"),
+        ({"bands_hz": (1.0, "a")}, "bands_hz must be an array of real numbers"),
     ):
         with pytest.raises(ControlError, match=match):
             FeatureSpec(**kwargs)

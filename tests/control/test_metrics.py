@@ -61,6 +61,9 @@ def test_an_estimate_without_a_position_is_left_out_not_charged_to_the_last_part
         lambda: detection_delays(TRACK, [1.0, 12.0, 13.0], [300.0, 500.0]),
         lambda: fast_on_rough_m(TRACK, [1.0, 12.0, 13.0], [2.0, 2.0], 350.0, 1.0),
         lambda: gd_errors(TRACK, ["a", "b"], [300.0, 300.0]),
+        lambda: gd_errors(TRACK, ["1.5", "2.5"], [300.0, 300.0]),
+        lambda: gd_errors(TRACK, [True, False], [300.0, 300.0]),
+        lambda: gd_errors(TRACK, [1.0 + 2j, 2.0], [300.0, 300.0]),
     ],
 )
 def test_traces_of_different_lengths_or_not_numbers_are_refused(call):
