@@ -332,8 +332,18 @@ def main(argv: list[str] | None = None) -> None:
     )  # fmt: skip
     args = parser.parse_args(argv)
     roads = 1 if args.quick else args.roads
-    if roads < 1 or args.keep_s < 2 * BATCH * 125 / RATE_HZ:
-        parser.error("need --roads >= 1 and --keep-s long enough for two batches of 8 blocks")
+    min_keep_s = 2 * BATCH * 125 / RATE_HZ
+    if roads < 1:
+        parser.error(f"--roads must be >= 1, got {roads}")
+    if not args.keep_s >= min_keep_s:  # NaN fails too
+        parser.error(
+            f"--keep-s must be >= {min_keep_s:.2f} s (two batches of 8 blocks), got {args.keep_s}"
+        )
+    for option, value in (("--seed", args.seed), ("--boot-seed", args.boot_seed)):
+        if value < 0:
+            parser.error(f"{option} must be >= 0, got {value}")
+    if args.workers < 1:
+        parser.error(f"--workers must be >= 1, got {args.workers}")
 
     tic = time.perf_counter()
     emus, model, noise_std = emulators_to_score(args)

@@ -473,7 +473,7 @@ def main(argv: list[str] | None = None) -> int:
         "--scenarios",
         type=int,
         default=400,
-        help="random scenarios, half per noise case (full run; >= 200)",
+        help="random scenarios, half per noise case (full run; the documented figures use 400)",
     )
     parser.add_argument("--seed", type=int, default=15, help="master seed of the scenarios")
     parser.add_argument(
@@ -518,7 +518,18 @@ def main(argv: list[str] | None = None) -> int:
         "library's)",
     )
     args = parser.parse_args(argv)  # fmt: skip
-    simplex = control.Simplex(after_fault=args.after_fault, speed_step_mps=args.speed_step)
+    for option, value, minimum in (
+        ("--scenarios", args.scenarios, 1), ("--seed", args.seed, 0),
+        ("--workers", args.workers, 1), ("--explain", args.explain, 0),
+        ("--only", 0 if args.only is None else args.only, 0),
+        *(("--example-seeds", seed, 0) for seed in args.example_seeds),
+    ):  # fmt: skip
+        if value < minimum:
+            parser.error(f"{option} must be >= {minimum}, got {value}")
+    try:
+        simplex = control.Simplex(after_fault=args.after_fault, speed_step_mps=args.speed_step)
+    except control.ControlError as exc:
+        parser.error(f"--speed-step: {exc}")
     if args.only is not None:
         _init_worker()  # one BLAS thread, as in the soak: the loop is chaotic to the last bit
         o = run_scenario(random_scenario(args.seed, args.only), keep_excerpt=True, simplex=simplex)

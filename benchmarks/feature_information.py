@@ -413,8 +413,25 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.train_seed == args.test_seed:
         parser.error("--train-seed and --test-seed must differ (held-out test)")
-    n_runs = args.n_runs or (60 if args.quick else 198)
-    keep_s = args.keep_s or (30.0 if args.quick else 60.0)
+    n_runs = (60 if args.quick else 198) if args.n_runs is None else args.n_runs
+    keep_s = (30.0 if args.quick else 60.0) if args.keep_s is None else args.keep_s
+    min_keep_s = max(SPANS) / RATE_HZ
+    if n_runs < 10:
+        parser.error(f"--n-runs must be >= 10 (a cubic mean per output), got {n_runs}")
+    if not keep_s >= min_keep_s:  # NaN fails too
+        parser.error(
+            f"--keep-s must be >= {min_keep_s:.2f} s (the longest stretch pooled), got {keep_s}"
+        )
+    for option, value in (
+        ("--train-seed", args.train_seed), ("--test-seed", args.test_seed), ("--seed", args.seed)
+    ):  # fmt: skip
+        if value < 0:
+            parser.error(f"{option} must be >= 0, got {value}")
+    lo, hi = args.gd_band
+    if not GD_RANGE[0] <= lo < hi <= GD_RANGE[1]:
+        parser.error(f"--gd-band must lie in {list(GD_RANGE)} with low < high, got {lo:g} {hi:g}")
+    if args.workers < 1:
+        parser.error(f"--workers must be >= 1, got {args.workers}")
     cache = args.cache_dir or None
 
     tic = time.perf_counter()

@@ -37,6 +37,12 @@ def main() -> None:
     parser.add_argument("--keep-s", type=float, default=120.0, help="seconds kept per drive")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args()
+    if args.seed < 0:
+        parser.error(f"--seed must be >= 0, got {args.seed}")
+    if not args.keep_s >= BLOCK / 120.0:  # NaN fails too
+        parser.error(f"--keep-s must be >= {BLOCK / 120.0:.2f} s (one block), got {args.keep_s}")
+    if args.workers < 1:
+        parser.error(f"--workers must be >= 1, got {args.workers}")
     tic = time.perf_counter()
     limit = SensorLimits().lattice_p
     rng = np.random.default_rng(args.seed)
