@@ -1,0 +1,187 @@
+"""Would a second sensor add information about GD? And how much does the road itself hold?
+
+    PYTHONPATH=. python benchmarks/second_channel.py            # 7 GDs x 3 speeds x 8 roads x 120 s
+    PYTHONPATH=. python benchmarks/second_channel.py --quick    # 4 roads x 60 s
+    PYTHONPATH=. python benchmarks/second_channel.py --help
+
+The estimator observes one accelerometer over the Jackal's front axle. Its chassis is a rigid
+body (heave, pitch), so a second accelerometer over the rear axle (or, equivalently for the
+information, a pitch-rate gyro: the pitch acceleration is (a_front - a_rear) / wheelbase) sees
+the same road through another response. Per steady road (GD 250-550, 1.0 / 1.5 / 2.0 m/s), each
+channel is cut into the shipped blocks (125 samples, ``control.block_features``: 8 log band
+powers) and scored as a linear estimator of log GD:
+
+- on the training roads (half of the road seeds; every GD level uses the same seeds, so the
+  levels differ by their roughness, not by their road shapes), the mean feature is quadratic
+  in log GD (least squares) and the block-to-block covariance Sigma is the long-run covariance
+  (batch means of 8 blocks, as ``control.training``); the estimator weights are
+  w = Sigma^-1 d, d the mean's slope;
+- on the held-out roads (the other half of the seeds; then the halves swap), the information
+  per block about log GD is J = (w' d_test)^2 / (w' Sigma_test w), d_test and Sigma_test
+  measured there (1 / J is the variance of one block's log GD estimate).
+
+Channels: the front accelerometer (shipped), the rear one, both (16 outputs), each without and
+with independent N(0, 1) m/s^2 noise. For reference, the same 8-band feature of the road itself
+as the tyre sees it (``roadgen.wheel_envelope``, noise-free), in position blocks as long as a
+block's drive and in the spatial band the 120 Hz sensor resolves at that speed (up to 60 / v
+cycles/m): what an ideal road sensor with this feature would give. Printed: J per block (mean
+over the 7 GD levels and both folds), the ratio to the front channel, and the two folds' J
+(their difference shows the scatter); then the elapsed time and the load average.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+from scipy.signal.windows import dpss
+
+import roadgen
+import vehicle
+from control import FeatureSpec, block_features
+
+GDS = (250.0, 300.0, 350.0, 400.0, 450.0, 500.0, 550.0)
+SPEEDS = (1.0, 1.5, 2.0)
+SPEC = FeatureSpec()
+BATCH = 8  # blocks per batch mean (as control.training)
+SETTLE_S = 2.0  # start-up transient dropped, s
+GD_CENTRE = 400.0
+
+
+def drive(job: tuple[float, float, int, float]) -> dict[str, np.ndarray]:
+    """Block features of one steady road: front, rear (noise-free and noisy) and the road."""
+    speed, gd, seed, duration_s = job
+    road = roadgen.iso8608_profile(speed * (duration_s + SETTLE_S) + 1.0, gd, seed=seed)
+    model = vehicle.Jackal()
+    trace = vehicle.simulate(model, road, speed)
+    start = int(SETTLE_S * trace.rate_hz)
+    n = (trace.t.size - start) // SPEC.block_samples * SPEC.block_samples
+    noise = np.random.default_rng([seed, int(gd), int(100 * speed)]).standard_normal((2, n))
+    out = {}
+    for name, accel, eps in (
+        ("front", trace.accel_front, noise[0]),
+        ("rear", trace.accel_rear, noise[1]),
+    ):
+        blocks = accel[start : start + n]
+        out[name] = block_features(blocks.reshape(-1, SPEC.block_samples), SPEC)
+        noisy = (blocks + eps).reshape(-1, SPEC.block_samples)
+        out[name + "_noisy"] = block_features(noisy, SPEC)
+    out["road"] = road_features(road, model.wheel_radius_m, speed)
+    return out
+
+
+def road_features(road, wheel_radius_m: float, speed: float) -> np.ndarray:
+    """8 log band powers of the enveloped road in blocks of one block's drive (m), bands
+    log-spaced over the spatial frequencies the sensor resolves at ``speed`` (1.5 / v to
+    60 / v cycles/m), multitaper as the shipped feature (NW 2, 3 tapers)."""
+    z = roadgen.wheel_envelope(road, wheel_radius_m).z[int(SETTLE_S * speed / road.dx_m) :]
+    n = int(round(speed * SPEC.block_s / road.dx_m))
+    blocks = z[: z.size // n * n].reshape(-1, n)
+    blocks = blocks - blocks.mean(axis=1, keepdims=True)
+    tapers = dpss(n, SPEC.taper_nw, SPEC.n_tapers)
+    power = (np.abs(np.fft.rfft(blocks[:, None] * tapers[None], axis=2)) ** 2).mean(axis=1)
+    freq = np.fft.rfftfreq(n, road.dx_m)
+    edges = np.geomspace(1.5 / speed, 60.0 / speed, 9)
+    bands = [(freq >= lo) & (freq < hi) for lo, hi in zip(edges[:-1], edges[1:], strict=True)]
+    return np.log(np.column_stack([power[:, b].sum(axis=1) for b in bands]))
+
+
+def long_run_cov(runs: list[np.ndarray]) -> np.ndarray:
+    """Long-run covariance of blocks about each run's mean (batch means of BATCH blocks)."""
+    devs = []
+    for x in runs:
+        m = x.shape[0] // BATCH
+        centred = x[: m * BATCH] - x.mean(axis=0)
+        devs.append(centred.reshape(m, BATCH, -1).mean(axis=1) * np.sqrt(BATCH))
+    d = np.concatenate(devs)
+    return d.T @ d / d.shape[0]
+
+
+def slope(runs: list[tuple[float, np.ndarray]], log_gd: float) -> np.ndarray:
+    """d(mean feature)/d(log GD) at ``log_gd`` from a quadratic fit over (gd, blocks) runs."""
+    x = np.concatenate([np.full(b.shape[0], np.log(gd / GD_CENTRE)) for gd, b in runs])
+    y = np.vstack([b for _, b in runs])
+    coef, *_ = np.linalg.lstsq(np.column_stack([np.ones_like(x), x, x * x]), y, rcond=None)
+    return coef[1] + 2.0 * coef[2] * (log_gd - np.log(GD_CENTRE))
+
+
+def held_out_information(train, test) -> float:
+    """Mean over GD levels of the held-out J per block (see the module docstring)."""
+    sigma = long_run_cov([b for _, b in train])
+    out = []
+    for gd in GDS:
+        weights = np.linalg.solve(sigma, slope(train, np.log(gd)))
+        gain = weights @ slope(test, np.log(gd))
+        spread = weights @ long_run_cov([b for g, b in test if g == gd]) @ weights
+        out.append(gain**2 / spread)
+    return float(np.mean(out))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--roads", type=int, default=8, help="roads per (speed, GD), even")
+    parser.add_argument("--duration-s", type=float, default=120.0, help="seconds per road")
+    parser.add_argument("--workers", type=int, default=2, help="worker processes")
+    parser.add_argument("--quick", action="store_true", help="4 roads x 60 s")
+    args = parser.parse_args()
+    if args.quick:
+        args.roads, args.duration_s = 4, 60.0
+    if args.roads < 4 or args.roads % 2:
+        parser.error(f"--roads must be an even integer >= 4, got {args.roads}")
+    if not args.duration_s >= 30.0:  # NaN fails too
+        parser.error(f"--duration-s must be >= 30 (two batches per road), got {args.duration_s}")
+    if args.workers < 1:
+        parser.error(f"--workers must be >= 1, got {args.workers}")
+
+    tic = time.perf_counter()
+    jobs = [
+        (v, gd, seed, args.duration_s)
+        for v in SPEEDS
+        for gd in GDS
+        for seed in range(1, args.roads + 1)
+    ]
+    with ProcessPoolExecutor(args.workers) as pool:
+        results = list(pool.map(drive, jobs))
+    channels = {
+        "front (shipped)": ["front"],
+        "rear": ["rear"],
+        "front + rear": ["front", "rear"],
+    }
+    print(
+        f"{args.roads} roads x {args.duration_s:g} s per (speed, GD); J per block of "
+        f"{SPEC.block_samples} samples ({SPEC.block_s:.2f} s), held out; fold 1 / fold 2"
+    )
+    for speed in SPEEDS:
+        rows = [(job, res) for job, res in zip(jobs, results, strict=True) if job[0] == speed]
+        print(f"\nv = {speed} m/s")
+        lines = [
+            (f"{name}{tag}", [k + suffix for k in keys])
+            for suffix, tag in (("", ""), ("_noisy", ", N(0,1) noise"))
+            for name, keys in channels.items()
+        ]
+        lines.append(("enveloped road, sensor's band (ideal road sensor)", ["road"]))
+        base = {}
+        for label, keys in lines:
+            folds = []
+            for parity in (0, 1):
+                sets = [
+                    [
+                        (job[1], np.hstack([res[k] for k in keys]))
+                        for job, res in rows
+                        if job[2] % 2 == p
+                    ]
+                    for p in (parity, 1 - parity)
+                ]
+                folds.append(held_out_information(*sets))
+            j = float(np.mean(folds))
+            ref = base.setdefault("noisy" if "noise" in label else "clean", j)
+            print(f"  {label:52s} J {j:6.2f}  x{j / ref:4.2f}  ({folds[0]:.2f} / {folds[1]:.2f})")
+    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    print(f"\n{time.perf_counter() - tic:.0f} s; load average {load}")
+
+
+if __name__ == "__main__":
+    main()
