@@ -178,23 +178,26 @@ def positions(name: str, s: np.ndarray | float, length_m: float) -> np.ndarray:
     return np.clip(arr, 0.0, length_m)
 
 
-def heights(name: str, road: object) -> tuple[np.ndarray, float]:
+def heights(
+    name: str, road: object, error: type[Exception] = RoadgenError, min_points: int = 2
+) -> tuple[np.ndarray, float]:
     """Return the heights z (N,) m and grid step dx_m of ``road`` (anything with ``z`` and
-    ``dx_m``: a Profile, a Track), or raise unless z is a finite real (N,) array, N >= 2, and
-    dx_m a finite real > 0."""
+    ``dx_m``: a Profile, a Track), or raise ``error`` unless z is a finite real (N,) array,
+    N >= ``min_points``, and dx_m a finite real > 0 (``vehicle``'s road input uses it with
+    VehicleError and 3 points)."""
     try:
         z, dx = road.z, road.dx_m
     except AttributeError:
-        raise RoadgenError(
+        raise error(
             f"{name}={type(road).__name__} must have heights z (N,) m and a grid step dx_m "
             "(a roadgen Profile or Track)"
         ) from None
-    arr = real_array(f"{name}.z", z)
-    if arr.ndim != 1 or arr.size < 2:
-        raise RoadgenError(f"{name}.z has shape {arr.shape}: need (N,) heights with N >= 2")
+    arr = real_array(f"{name}.z", z, error)
+    if arr.ndim != 1 or arr.size < min_points:
+        raise error(f"{name}.z has shape {arr.shape}: need (N,) heights with N >= {min_points}")
     if not np.all(np.isfinite(arr)):
-        raise RoadgenError(f"{name}.z contains NaN or inf: allowed finite heights in m")
-    return arr, positive(f"{name}.dx_m", dx)
+        raise error(f"{name}.z contains NaN or inf: allowed finite heights in m")
+    return arr, positive(f"{name}.dx_m", dx, error)
 
 
 def _finite(name: str, value: object, error: type[Exception]) -> float:

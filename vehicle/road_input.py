@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import roadgen
-from vehicle import checks
+from roadgen import checks as roadgen_checks
 from vehicle.errors import VehicleError
 
 
@@ -30,19 +30,7 @@ class RoadInput:
                     "Track (or envelope=False)"
                 )
             road = roadgen.wheel_envelope(road, wheel_radius_m)
-        try:
-            z, dx = road.z, road.dx_m
-        except AttributeError:
-            raise VehicleError(
-                f"road={type(road).__name__} must have z (N,) heights and dx_m (a roadgen "
-                "Profile or Track)"
-            ) from None
-        z = checks.real_array("road.z", z)
-        if z.ndim != 1 or z.size < 3:
-            raise VehicleError(f"road.z has shape {z.shape}: need (N,) with N >= 3")
-        if not np.all(np.isfinite(z)):
-            raise VehicleError("road.z contains NaN or inf: allowed finite heights in m")
-        dx = checks.positive("road.dx_m", dx)
+        z, dx = roadgen_checks.heights("road", road, VehicleError, min_points=3)
         self.dx_m = dx
         self.length_m = dx * (z.size - 1)
         self._z = z

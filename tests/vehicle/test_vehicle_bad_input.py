@@ -140,7 +140,9 @@ def test_a_scalar_speed_function_is_read_point_by_point(road):
         (Heights([[0.0], [1.0, 2.0]], 1.0), r"^road.z must be an array of real numbers: "),
         (Heights(np.zeros(9), "1"), r"^road.dx_m='1' must be a real number \(got str\)"),
         (Heights(np.zeros(9), True), r"^road.dx_m=True must be a real number \(got bool\)"),
-        (None, r"^road=NoneType must have z"),
+        (Heights(np.zeros(2), 1.0), r"^road.z has shape \(2,\): need \(N,\) heights with N >= 3"),
+        (Heights(np.array([0.0, np.nan, 0.0]), 1.0), r"^road.z contains NaN or inf"),
+        (None, r"^road=NoneType must have heights z"),
     ],
 )
 def test_road_like_objects_with_bad_fields_raise(road_like, match):
