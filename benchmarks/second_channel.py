@@ -5,11 +5,10 @@
     PYTHONPATH=. python benchmarks/second_channel.py --help
 
 The estimator observes one accelerometer over the Jackal's front axle. Its chassis is a rigid
-body (heave, pitch), so a second accelerometer over the rear axle (or, equivalently for the
-information, a pitch-rate gyro: the pitch acceleration is (a_front - a_rear) / wheelbase) sees
-the same road through another response. Per steady road (GD 250-550, 1.0 / 1.5 / 2.0 m/s), each
-channel is cut into the shipped blocks (125 samples, ``control.block_features``: 8 log band
-powers) and scored as a linear estimator of log GD:
+body (heave, pitch), so a second sensor (an accelerometer over the rear axle, or a pitch-rate
+gyro) sees the same road through another response. Per steady road (GD 250-550, 1.0 / 1.5 /
+2.0 m/s), each channel is cut into the shipped blocks (125 samples, ``control.block_features``:
+8 log band powers) and scored as a linear estimator of log GD:
 
 - on the training roads (half of the road seeds; every GD level uses the same seeds, so the
   levels differ by their roughness, not by their road shapes), the mean feature is quadratic
@@ -20,11 +19,14 @@ powers) and scored as a linear estimator of log GD:
   per block about log GD is J = (w' d_test)^2 / (w' Sigma_test w), d_test and Sigma_test
   measured there (1 / J is the variance of one block's log GD estimate).
 
-Channels: the front accelerometer (shipped), the rear one, both (16 outputs), each without and
-with independent N(0, 1) m/s^2 noise. For reference, the same 8-band feature of the road itself
-as the tyre sees it (``roadgen.wheel_envelope``, noise-free), in position blocks as long as a
-block's drive and in the spatial band the 120 Hz sensor resolves at that speed (up to 60 / v
-cycles/m): what an ideal road sensor with this feature would give. Printed: J per block (mean
+Channels: the front accelerometer (shipped), the rear one, both (16 outputs), and the front
+one with a pitch-rate gyro (the central differences of the sampled pitch; the 8 bands of its
+rate), each without and with independent noise: N(0, 1) m/s^2 on an accelerometer, N(0, 0.01^2)
+rad/s on the gyro (an assumed MEMS figure; the pitch rate's rms is 0.5-1.4 rad/s on these
+roads). For reference, the same 8-band feature of the road itself as the tyre sees it
+(``roadgen.wheel_envelope``, noise-free), in position blocks as long as a block's drive and in
+the spatial band the 120 Hz sensor resolves at that speed (up to 60 / v cycles/m): what an ideal
+road sensor with this feature would give. Printed: J per block (mean
 over the 7 GD levels and both folds), the ratio to the front channel, and the two folds' J
 (their difference shows the scatter); then the elapsed time and the load average.
 """
@@ -49,23 +51,26 @@ SPEC = FeatureSpec()
 BATCH = 8  # blocks per batch mean (as control.training)
 SETTLE_S = 2.0  # start-up transient dropped, s
 GD_CENTRE = 400.0
+GYRO_NOISE_RAD_S = 0.01  # an assumed MEMS gyro's white noise at 120 Hz, sd; the signal: 0.5-1.4
 
 
 def drive(job: tuple[float, float, int, float]) -> dict[str, np.ndarray]:
-    """Block features of one steady road: front, rear (noise-free and noisy) and the road."""
+    """Block features of one steady road: front, rear, gyro (noise-free and noisy), the road."""
     speed, gd, seed, duration_s = job
     road = roadgen.iso8608_profile(speed * (duration_s + SETTLE_S) + 1.0, gd, seed=seed)
     model = vehicle.Jackal()
     trace = vehicle.simulate(model, road, speed)
     start = int(SETTLE_S * trace.rate_hz)
     n = (trace.t.size - start) // SPEC.block_samples * SPEC.block_samples
-    noise = np.random.default_rng([seed, int(gd), int(100 * speed)]).standard_normal((2, n))
+    noise = np.random.default_rng([seed, int(gd), int(100 * speed)]).standard_normal((3, n))
+    pitch_rate = np.gradient(trace.pitch, 1.0 / trace.rate_hz)  # rad/s
     out = {}
-    for name, accel, eps in (
+    for name, signal, eps in (
         ("front", trace.accel_front, noise[0]),
         ("rear", trace.accel_rear, noise[1]),
+        ("gyro", pitch_rate, GYRO_NOISE_RAD_S * noise[2]),
     ):
-        blocks = accel[start : start + n]
+        blocks = signal[start : start + n]
         out[name] = block_features(blocks.reshape(-1, SPEC.block_samples), SPEC)
         noisy = (blocks + eps).reshape(-1, SPEC.block_samples)
         out[name + "_noisy"] = block_features(noisy, SPEC)
@@ -149,6 +154,7 @@ def main() -> None:
         "front (shipped)": ["front"],
         "rear": ["rear"],
         "front + rear": ["front", "rear"],
+        "front + pitch-rate gyro": ["front", "gyro"],
     }
     print(
         f"{args.roads} roads x {args.duration_s:g} s per (speed, GD); J per block of "
