@@ -12,8 +12,7 @@ from roadgen import checks
 
 
 def is_real(value) -> bool:
-    """Whether ``value`` is a real number (a bool is not; the predicate form of
-    ``roadgen.checks.real``)."""
+    """Whether ``value`` is a real number (a bool, Python's or numpy's, is not)."""
     return isinstance(value, Real) and not isinstance(value, (bool, np.bool_))
 
 
