@@ -103,6 +103,11 @@ def _bag_error(target) -> BagError | None:
     return None
 
 
+def _write_flipped(file, data: bytes, at: int, mask: int) -> None:
+    """Write ``data`` to ``file`` with the byte at ``at`` XORed with ``mask``."""
+    file.write_bytes(data[:at] + bytes([data[at] ^ mask]) + data[at + 1 :])
+
+
 def _chunks(path):
     """(start, length) of the chunks of an MCAP file, from its summary."""
     from mcap.reader import make_reader
@@ -145,9 +150,7 @@ def test_a_flipped_byte_in_a_chunk_is_a_bag_error_naming_the_chunk(
     for start, _ in _chunks(file)[:4]:
         at, length = _records_at(data, start)
         for k in (0, length // 2, length - 1):
-            damaged = bytearray(data)
-            damaged[at + k] ^= 0x5A
-            file.write_bytes(bytes(damaged))
+            _write_flipped(file, data, at + k, 0x5A)
             with pytest.raises(BagError, match=f"{file} is damaged: the chunk at byte {start}"):
                 read_recording(target)
 
@@ -162,13 +165,10 @@ def test_damage_to_bytes_the_replay_does_not_read_leaves_the_result(recordings, 
     at = data.find(first)
     assert at > 0 and data.find(first, at + 1) < 0
     orientation = at + len(first) - 8 * (4 + 9 + 3 + 9 + 3 + 9)
-    damaged = bytearray(data)
-    damaged[orientation + 3] ^= 0x40
-    file.write_bytes(bytes(damaged))
+    _write_flipped(file, data, orientation + 3, 0x40)
     assert _same(read_recording(target), read_recording(recordings["rosbag2-mcap"][0]))
-    damaged = bytearray(data)
-    damaged[at - 30] ^= 0x40  # the length of the Message record holding it (at its byte 1)
-    file.write_bytes(bytes(damaged))
+    # the length of the Message record holding it (at its byte 1)
+    _write_flipped(file, data, at - 30, 0x40)
     assert "is damaged" in str(_bag_error(target))
 
 
@@ -178,9 +178,7 @@ def test_a_chunk_whose_size_disagrees_with_its_zstd_frame_is_refused(recordings,
     start, _ = _chunks(file)[0]
     size_at = start + 9 + 16
     size = int.from_bytes(data[size_at : size_at + 8], "little")
-    damaged = bytearray(data)
-    damaged[size_at : size_at + 8] = (size + 1).to_bytes(8, "little")
-    file.write_bytes(bytes(damaged))
+    file.write_bytes(data[:size_at] + (size + 1).to_bytes(8, "little") + data[size_at + 8 :])
     with pytest.raises(BagError, match=f"zstd frame declares {size} bytes, its header {size + 1}"):
         read_recording(target)
 
@@ -216,9 +214,7 @@ def test_a_corrupted_sqlite3_bag_is_a_bag_error(recordings, tmp_path):
     # the type of each page (byte 0 of its header; page 1's follows the file's header)
     errors = 0
     for at in [100, *range(4096, len(data), 4096)]:
-        damaged = bytearray(data)
-        damaged[at] ^= 0xFF
-        file.write_bytes(bytes(damaged))
+        _write_flipped(file, data, at, 0xFF)
         errors += _bag_error(target) is not None
     assert errors >= 10  # of 19 pages (unused ones may take a flip unnoticed)
 
@@ -252,9 +248,7 @@ def test_flipping_bytes_all_over_a_recording_never_crashes(kind, recordings, tmp
     step = len(data) // 400 + 1
     errors = 0
     for at in range(int(rng.integers(step)), len(data), step):
-        damaged = bytearray(data)
-        damaged[at] ^= int(rng.integers(1, 256))
-        file.write_bytes(bytes(damaged))
+        _write_flipped(file, data, at, int(rng.integers(1, 256)))
         errors += _bag_error(target) is not None
     assert errors >= 10  # the rest: flipped values (rosbags writes no CRC) or unread bytes
 
