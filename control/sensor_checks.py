@@ -16,7 +16,7 @@ from scipy.special import bdtrc
 from scipy.stats import chi2
 
 from control.errors import ControlError
-from control.validation import require_reals
+from control.validation import require_integers, require_reals
 from vehicle.models import GRAVITY
 
 MIN_SEGMENT = 32
@@ -107,9 +107,11 @@ class SensorLimits:
              "noise_floor", "lattice_p"),
             optional=("range_mps2", "free_fall_mps2", "noise_sd_mps2"),
         )  # fmt: skip
-        for name in ("max_repeats", "min_distinct", "max_same"):
+        counts = ("max_repeats", "min_distinct", "max_same")
+        require_integers(self, counts)
+        for name in counts:
             value = getattr(self, name)
-            if not (isinstance(value, int | np.integer) and value >= 1):
+            if value < 1:
                 raise ControlError(f"{name} must be an integer >= 1, got {value}")
         if not (np.isfinite(self.max_level_jump) and self.max_level_jump > 1):
             raise ControlError(f"max_level_jump must be finite and > 1, got {self.max_level_jump}")
@@ -330,8 +332,9 @@ def level_jump(a: np.ndarray, min_segment: int = MIN_SEGMENT) -> tuple[float, tu
         return 1.0, (0, 0)
     s1, s2 = _running_sums(a)
     best = (1.0, (0, 0))
-    for first in range(0, n + 1, _starts_per_chunk(n)):
-        start, stop = _segments(n, min_segment, first, _starts_per_chunk(n))
+    per_chunk = _starts_per_chunk(n)
+    for first in range(0, n + 1, per_chunk):
+        start, stop = _segments(n, min_segment, first, per_chunk)
         if start.size == 0:
             continue
         n_in = stop - start

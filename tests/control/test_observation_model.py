@@ -106,6 +106,8 @@ def test_signal_checks_name_what_a_healthy_sensor_never_does():
     assert level_jump(a)[0] < 10
     with pytest.raises(ControlError, match="max_repeats must be an integer >= 1"):
         SensorLimits(max_repeats=0)
+    with pytest.raises(ControlError, match="SensorLimits.max_same must be an integer, got True"):
+        SensorLimits(max_same=True)
 
 
 def test_a_signal_quieter_than_the_sensors_noise_is_attenuated():
