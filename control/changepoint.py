@@ -72,7 +72,7 @@ class ChangePointSettings:
             raise ControlError(f"jump_sd must be None or finite and > 0, got {self.jump_sd}")
         if not callable(self.prior) and self.prior not in PRIORS:
             raise ControlError(f"prior must be one of {PRIORS} or a function, got {self.prior!r}")
-        if not (isinstance(self.max_runs, int | np.integer) and self.max_runs >= 2):
+        if self.max_runs < 2:  # an integer: require_integers above
             raise ControlError(f"max_runs must be an integer >= 2, got {self.max_runs}")
 
 
