@@ -137,12 +137,12 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
     return Campaign(**arrays, settings=settings, **traces)
 
 
-def _check_path(path: object) -> None:
-    """Raise VehicleError unless ``path`` is a str or os.PathLike (an int would be taken for an
-    open file descriptor)."""
+def _check_path(path: object, name: str = "path", what: str = "file") -> None:
+    """Raise VehicleError unless ``path`` (the argument ``name``, a ``what`` path) is a str or
+    os.PathLike (an int would be taken for an open file descriptor)."""
     if not isinstance(path, (str, os.PathLike)):
         raise VehicleError(
-            f"path={path!r} must be a file path, str or os.PathLike (got {type(path).__name__})"
+            f"{name}={path!r} must be a {what} path, str or os.PathLike (got {type(path).__name__})"
         )
 
 
@@ -206,11 +206,8 @@ def run_campaign(
     substeps = checks.integer("substeps", substeps, 1)
     progress = checks.flag("progress", progress)
     keep_s = checks.non_negative("keep_s", keep_s, unit="s")
-    if cache_dir is not None and not isinstance(cache_dir, (str, os.PathLike)):
-        raise VehicleError(
-            f"cache_dir={cache_dir!r} must be a folder path, str or os.PathLike (got "
-            f"{type(cache_dir).__name__})"
-        )
+    if cache_dir is not None:
+        _check_path(cache_dir, "cache_dir", "folder")
     usable_m = road_length_m - lead_in_m - 2 * model.wheelbase_m
     need_m = window * float(np.max(points[:, 0])) / rate_hz
     if not usable_m >= need_m:
