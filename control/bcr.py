@@ -47,7 +47,7 @@ from control.estimate import Estimate, graver_fault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.sensor_checks import SensorLimits, signal_fault, stream_fault
 from control.tracker import GDTracker, TrackerSettings
-from control.validation import is_real, require_instance, require_reals
+from control.validation import is_integer, is_real, require_instance, require_reals
 from gpmsa import Posterior
 
 METHODS = ("changepoint", "window", "filter", "tempered")
@@ -127,7 +127,7 @@ class BCRSettings:
                 f"feature, got {self.feature.name!r}"
             )
         every = self.samples_per_update
-        if not (isinstance(every, int | np.integer) and every >= 1):
+        if not (is_integer(every) and every >= 1):
             raise ControlError(f"update_every must be an integer >= 1, got {every}")
         if (
             block

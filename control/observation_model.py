@@ -26,7 +26,7 @@ from scipy import special, stats
 from scipy.linalg import cholesky
 
 from control.errors import ControlError, EmulatorMismatchError
-from control.validation import float_array, require_reals
+from control.validation import float_array, is_integer, require_reals
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,9 +114,9 @@ class ObservationModel:
                 f"block_scatter is {scatter.cov.shape[1]}-dimensional but the emulator has "
                 f"{emulator.l_sim} outputs"
             )
-        if not (isinstance(n_grid, int | np.integer) and n_grid >= 16):
+        if not (is_integer(n_grid) and n_grid >= 16):
             raise ControlError(f"n_grid must be an integer >= 16, got {n_grid}")
-        if not (isinstance(n_speed, int | np.integer) and n_speed >= 2):
+        if not (is_integer(n_speed) and n_speed >= 2):
             raise ControlError(f"n_speed must be an integer >= 2, got {n_speed}")
         self.emulator = emulator
         self.scatter = scatter

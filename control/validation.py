@@ -16,6 +16,11 @@ def is_real(value) -> bool:
     return isinstance(value, Real) and not isinstance(value, (bool, np.bool_))
 
 
+def is_integer(value) -> bool:
+    """Whether ``value`` is an integer (a bool, Python's or numpy's, is not; 3.0 is not)."""
+    return isinstance(value, Integral) and not isinstance(value, (bool, np.bool_))
+
+
 def float_array(values, name: str) -> np.ndarray:
     """``values`` as a new float array; ControlError naming ``name`` unless they are real
     numbers (ints or floats: not bools, strings such as "1.5", complex numbers or objects;
@@ -25,7 +30,7 @@ def float_array(values, name: str) -> np.ndarray:
 
 def check_n_draws(n_draws) -> None:
     """ControlError unless ``n_draws`` (posterior draws made for histograms) is an integer >= 1."""
-    if not (isinstance(n_draws, Integral) and not isinstance(n_draws, bool) and n_draws >= 1):
+    if not (is_integer(n_draws) and n_draws >= 1):
         raise ControlError(f"n_draws must be an integer >= 1, got {n_draws!r}")
 
 
@@ -47,8 +52,7 @@ def require_integers(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()
     (bools are not; 3.0 is not); the fields in ``optional`` may also be None."""
     for name in names:
         value = getattr(obj, name)
-        integer = isinstance(value, Integral) and not isinstance(value, bool)
-        if not (integer or (value is None and name in optional)):
+        if not (is_integer(value) or (value is None and name in optional)):
             allowed = "an integer or None" if name in optional else "an integer"
             raise ControlError(
                 f"{type(obj).__name__}.{name} must be {allowed}, got {value!r} "

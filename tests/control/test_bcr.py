@@ -381,8 +381,9 @@ def test_changepoint_settings_are_checked(block_model):
     for every in (126, 15):  # more than a block; more than 8 phases
         with pytest.raises(ControlError, match=r"update_every must lie in .* = \[15.625, 125\]"):
             BCR(block_model, update_every=every)
-    with pytest.raises(ControlError, match="update_every must be an integer >= 1"):
-        BCR(block_model, update_every=0)
+    for every in (0, True, 42.0):
+        with pytest.raises(ControlError, match="update_every must be an integer >= 1"):
+            BCR(block_model, update_every=every)
     assert BCRSettings(update_every=63).phases == 2 and BCRSettings(update_every=16).phases == 8
     assert BCRSettings().phases == 3 and BCRSettings().samples_per_update == 42  # the default
     with pytest.raises(ControlError, match="needs an ObservationModel"):

@@ -50,6 +50,13 @@ def test_bad_inputs_to_the_model(model):
         model.loglik(np.ones(8), 3.0)
     with pytest.raises(EmulatorMismatchError, match="no 'block_scatter'"):
         ObservationModel(control.shipped_emulator("A", "window"))
+    for kwargs, message in (
+        ({"n_grid": True}, "n_grid must be an integer >= 16, got True"),
+        ({"n_grid": 64.0}, "n_grid must be an integer >= 16, got 64.0"),
+        ({"n_speed": np.bool_(True)}, "n_speed must be an integer >= 2, got True"),
+    ):
+        with pytest.raises(ControlError, match=message):
+            ObservationModel(model.emulator, **kwargs)
 
 
 def test_block_statistics_and_scatter_of_white_noise():
