@@ -7,12 +7,14 @@
 
 On held-aside roads (a campaign seed whose road seeds are not among the training campaign's,
 checked), the Jackal drives k roads (``--roads``) for ``--keep-s`` seconds at constant speed in
-each cell of the grid v in {0.5, 0.75, ..., 2.0} m/s x GD in {200, 250, ..., 600}, through the
+each cell of a 7 x 9 grid spanning the emulators' domain evenly, both ends included (the shipped
+ones: v in {0.5, 0.75, ..., 2.0} m/s x GD in {200, 250, ..., 600}), through the
 training pipeline itself (`vehicle.run_campaign`: `roadgen.iso8608_profile` roads with the same
 lead-in and `vehicle.simulate`; case A: noise-free accelerations, case B: with N(0, 1) noise).
 ``--emulator-dir`` scores the emulators in a folder (`examples/train_emulator.py
 --emulator-dir`) instead of the shipped ones: the roads are driven by the vehicle their metadata
-records, case B with their noise level, and emulators that disagree on either stop the run.
+records, case B with their noise level, and emulators that disagree on either, or on their
+domain, stop the run.
 
 Band emulator (``control.shipped_emulator(case, "band")``, the change-point BCR's): every
 125-sample block's log band-power vector (`control.block_features`); per cell
@@ -64,8 +66,8 @@ import control
 import vehicle
 from control.training import block_statistics
 
-SPEEDS = (0.5, 0.75, 1.0, 1.25, 1.5, 1.75, 2.0)
-GDS = (200.0, 250.0, 300.0, 350.0, 400.0, 450.0, 500.0, 550.0, 600.0)
+N_SPEEDS = 7
+N_GDS = 9
 RATE_HZ = 120.0
 WINDOW = 1000
 BATCH = 8  # blocks per batch of the long-run covariance and of the block bootstrap
@@ -83,11 +85,27 @@ def training_seeds(emu) -> np.ndarray:
     return np.random.SeedSequence(int(design["seed"])).generate_state(int(design["n"]))
 
 
-def drive(roads: int, keep_s: float, seed: int, workers: int, cache_dir: str | None,
-          model, noise_std: float):  # fmt: skip
+@dataclass(frozen=True)
+class Grid:
+    """The cells: speeds (m/s) x GDs (1e-6 m^3), each spanning the emulator's domain evenly."""
+
+    speeds: tuple[float, ...]
+    gds: tuple[float, ...]
+
+    @classmethod
+    def over(cls, emu) -> Grid:
+        (v_lo, v_hi), (g_lo, g_hi) = emu.domain["v"], emu.domain["GD"]
+        return cls(
+            tuple(np.linspace(v_lo, v_hi, N_SPEEDS).tolist()),
+            tuple(np.linspace(g_lo, g_hi, N_GDS).tolist()),
+        )
+
+
+def drive(grid: Grid, roads: int, keep_s: float, seed: int, workers: int,
+          cache_dir: str | None, model, noise_std: float):  # fmt: skip
     """The campaign: every grid cell driven on `roads` fresh roads by ``model``, its noisy
     accelerations with N(0, noise_std^2) noise."""
-    design = np.array([(v, gd) for v in SPEEDS for gd in GDS for _ in range(roads)])
+    design = np.array([(v, gd) for v in grid.speeds for gd in grid.gds for _ in range(roads)])
     with ProcessPoolExecutor(max_workers=workers) as pool:
         return vehicle.run_campaign(
             design, model, seed=seed, keep_s=keep_s, executor=pool, progress=False,
@@ -95,16 +113,19 @@ def drive(roads: int, keep_s: float, seed: int, workers: int, cache_dir: str | N
         )  # fmt: skip
 
 
-def emulators_to_score(args) -> tuple[dict, object, float]:
+def emulators_to_score(args) -> tuple[dict, object, float, Grid]:
     """({(case, kind): emulator}, the vehicle they were trained for, the noise sd of the drives'
-    noisy accelerations: case B's, or the paper's 1 m/s^2 when B is not scored): what the
-    held-aside drives must match; exits naming any emulator that does not."""
+    noisy accelerations: case B's, or the paper's 1 m/s^2 when B is not scored, the cells over
+    their domain): what the held-aside drives must match; exits naming any emulator that does
+    not."""
     try:
         emus = {(case, kind): control.shipped_emulator(case, kind, args.emulator_dir)
                 for case in args.cases for kind in args.features}  # fmt: skip
     except control.ControlError as exc:
         raise SystemExit(f"{exc} (or drop that case or kind: --cases, --features)") from exc
-    model = control.emulator_vehicle(next(iter(emus.values())))
+    first = next(iter(emus.values()))
+    model = control.emulator_vehicle(first)
+    grid = Grid.over(first)
     noise = {case: 0.0 for case in args.cases}
     if "B" in noise:
         noise["B"] = control.emulator_noise_std(emus[("B", args.features[0])]) or 0.0
@@ -115,7 +136,12 @@ def emulators_to_score(args) -> tuple[dict, object, float]:
                 control.check_emulator(emu, model=model, noise_std=noise[case])
         except (control.EmulatorMismatchError, control.ControlWarning) as exc:
             raise SystemExit(f"emulator {case}/{kind} does not match the others: {exc}") from exc
-    return emus, model, noise.get("B", 1.0)
+        if Grid.over(emu) != grid:
+            raise SystemExit(
+                f"emulator {case}/{kind} does not match the others: its domain {emu.domain} "
+                f"differs from {first.domain}"
+            )
+    return emus, model, noise.get("B", 1.0), grid
 
 
 def scatter_at(scatter: control.BlockScatter, v: float) -> np.ndarray:
@@ -189,16 +215,16 @@ def linearised(d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray):
     return float(np.expm1(step)), float(np.sqrt(wg @ cov_d @ wg) / den * np.exp(step))
 
 
-def band_cells(case: str, emu, c, rng) -> list[Cell]:
+def band_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
     om = control.ObservationModel(emu, n_grid=N_GRID)
     v_hi = om.speed_range[1]
     log_gd = np.log(om.gd)
     accel = c.accel if case == "A" else c.accel_measured
     spec = control.emulator_feature(emu)
     out = []
-    for v in SPEEDS:
+    for v in grid.speeds:
         sigma = scatter_at(om.scatter, v)
-        for gd in GDS:
+        for gd in grid.gds:
             runs = np.flatnonzero(c.ok & (c.v == v) & (c.gd == gd))
             st = block_statistics(accel[runs], spec, batch=BATCH)
             n_batch = st.features.shape[1] // BATCH
@@ -222,16 +248,16 @@ def band_cells(case: str, emu, c, rng) -> list[Cell]:
     return out
 
 
-def window_cells(case: str, emu, c, rng) -> list[Cell]:
+def window_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
     v_hi, (g_lo, g_hi) = emu.domain["v"][1], emu.domain["GD"]
     gd_grid = np.geomspace(g_lo, g_hi, N_GRID)
     log_gd = np.log(gd_grid)
     accel = c.accel if case == "A" else c.accel_measured
     out = []
-    for v in SPEEDS:
+    for v in grid.speeds:
         v_in = min(v, v_hi)
         mean_g, var_g = emu.predict(np.full(N_GRID, v_in), gd_grid)  # nugget included
-        for gd in GDS:
+        for gd in grid.gds:
             runs = np.flatnonzero(c.ok & (c.v == v) & (c.gd == gd))
             n_win = accel.shape[1] // WINDOW
             windows = accel[runs, : n_win * WINDOW].reshape(-1, WINDOW)
@@ -254,7 +280,7 @@ def window_cells(case: str, emu, c, rng) -> list[Cell]:
     return out
 
 
-def print_cells(title: str, cells: list[Cell], band: bool) -> None:
+def print_cells(title: str, cells: list[Cell], grid: Grid, band: bool) -> None:
     print(f"\n{title} ({load()})")
     if band:
         zs = "".join(f"{'z' + str(k + 1):>6}" for k in range(cells[0].z.size))
@@ -271,31 +297,31 @@ def print_cells(title: str, cells: list[Cell], band: bool) -> None:
             f"{100 * cell.lin:+6.1f}{cell.lin_mark}{100 * cell.lin_se:5.1f}"
         )
     print("\nrelative GD bias, % (* > 2 se; | maximum on the domain's edge); rows GD, columns v")
-    print(f"{'GD':>5} " + "".join(f"{v:>9.2f}" for v in SPEEDS))
-    for gd in GDS:
+    print(f"{'GD':>5} " + "".join(f"{v:>9.2f}" for v in grid.speeds))
+    for gd in grid.gds:
         row = [c for c in cells if c.gd == gd]
         print(f"{gd:5.0f} " + "".join(f"{100 * c.bias:+7.1f}{c.mark}" for c in row))
     print("linearised (not truncated at the edges), % (* > 2 se)")
-    for gd in GDS:
+    for gd in grid.gds:
         row = [c for c in cells if c.gd == gd]
         print(f"{gd:5.0f} " + "".join(f"{100 * c.lin:+7.1f}{c.lin_mark} " for c in row))
     flagged = sum(abs(c.bias) > 2 * c.se for c in cells)
     flagged_lin = sum(abs(c.lin) > 2 * c.lin_se for c in cells)
-    inner = [c for c in cells if 200 < c.gd < 600]
+    inner = [c for c in cells if grid.gds[0] < c.gd < grid.gds[-1]]
 
     def rms(x) -> float:
         return 100 * float(np.sqrt(np.mean(np.square(x))))
 
     print(
         f"ML: {flagged} of {len(cells)} cells beyond 2 se (about {0.0455 * len(cells):.0f} by "
-        f"chance); over GD 250-550, RMS bias {rms([c.bias for c in inner]):.1f}% against RMS se "
-        f"{rms([c.se for c in inner]):.1f}%"
+        f"chance); over GD {grid.gds[1]:g}-{grid.gds[-2]:g}, RMS bias "
+        f"{rms([c.bias for c in inner]):.1f}% against RMS se {rms([c.se for c in inner]):.1f}%"
     )
     print(
         f"linearised: {flagged_lin} of {len(cells)} cells beyond 2 se; RMS bias "
         f"{rms([c.lin for c in cells]):.1f}% against RMS se {rms([c.lin_se for c in cells]):.1f}%"
         f" (all cells); per speed "
-        + ", ".join(f"{v:g}: {rms([c.lin for c in cells if c.v == v]):.1f}%" for v in SPEEDS)
+        + ", ".join(f"{v:.3g}: {rms([c.lin for c in cells if c.v == v]):.1f}%" for v in grid.speeds)
     )
 
 
@@ -346,17 +372,17 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"--workers must be >= 1, got {args.workers}")
 
     tic = time.perf_counter()
-    emus, model, noise_std = emulators_to_score(args)
-    c = drive(roads, args.keep_s, args.seed, args.workers, args.cache_dir or None, model,
+    emus, model, noise_std, grid = emulators_to_score(args)
+    c = drive(grid, roads, args.keep_s, args.seed, args.workers, args.cache_dir or None, model,
               noise_std)  # fmt: skip
     train = training_seeds(next(iter(emus.values())))
     overlap = np.intersect1d(c.seed, train)
     if overlap.size:
         raise SystemExit(f"road seeds {overlap} were in the training campaign: use another --seed")
     print(
-        f"{c.v.size} drives ({len(SPEEDS)} x {len(GDS)} cells x {roads} roads x {args.keep_s:g} s, "
-        f"campaign seed {args.seed}; none of the {train.size} training road seeds) in "
-        f"{time.perf_counter() - tic:.0f} s; {int(np.sum(~c.ok))} failed; {load()}"
+        f"{c.v.size} drives ({len(grid.speeds)} x {len(grid.gds)} cells x {roads} roads x "
+        f"{args.keep_s:g} s, campaign seed {args.seed}; none of the {train.size} training road "
+        f"seeds) in {time.perf_counter() - tic:.0f} s; {int(np.sum(~c.ok))} failed; {load()}"
     )
     if not c.ok.all():
         for v, gd, s in zip(c.v[~c.ok], c.gd[~c.ok], c.status[~c.ok], strict=True):
@@ -368,13 +394,15 @@ def main(argv: list[str] | None = None) -> None:
             print_cells(
                 f"band emulator, case {case} ({noise}): per cell, z per band (bands 1.5-4.5, "
                 "4.5-7, 7-10, 10-14, 14-20, 20-30, 30-45, 45-60 Hz)",
-                band_cells(case, emus[(case, "band")], c, rng),
+                band_cells(case, emus[(case, "band")], c, grid, rng),
+                grid,
                 band=True,
             )
         if "window" in args.features:
             print_cells(
                 f"window emulator (paper's log f of 1,000 samples), case {case} ({noise})",
-                window_cells(case, emus[(case, "window")], c, rng),
+                window_cells(case, emus[(case, "window")], c, grid, rng),
+                grid,
                 band=False,
             )
     print(f"\ntotal {time.perf_counter() - tic:.0f} s; {load()}")
