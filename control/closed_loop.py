@@ -196,7 +196,8 @@ def run_closed_loop(
             preparing one per run; one prepared for another emulator is refused
             (`check_likelihood`).
         faults: injected sensor faults (`SensorFault`).
-        check: check the emulator against model, noise, feature and track (`check_emulator`).
+        check: check the emulator against model, noise, feature, track and the Simplex's
+            speeds (`check_emulator`).
         max_time_s: simulated time after which a vehicle that has not reached the end is an
             error (default: 20 times the track length at the safe speed).
         record: write the run to this MCAP file for Foxglove (`control.record_run`: the
@@ -232,7 +233,9 @@ def run_closed_loop(
         sensor=_within_simulated_noise(bcr.sensor, noise_std),
     )
     if check:
-        check_emulator(emulator, model=model, noise_std=noise_std, bcr=bcr, track=track)
+        check_emulator(
+            emulator, model=model, noise_std=noise_std, bcr=bcr, track=track, simplex=simplex
+        )
     if likelihood is not None:
         check_likelihood(emulator, likelihood)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)

@@ -19,6 +19,7 @@ from control.bcr import BCRSettings
 from control.errors import ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
+from control.simplex import Simplex
 
 
 def _canon(obj) -> str:
@@ -78,11 +79,14 @@ def check_emulator(
     noise_std: float | None = None,
     bcr: BCRSettings | None = None,
     track=None,
+    simplex: Simplex | None = None,
 ) -> None:
     """Raise `EmulatorMismatchError` or warn (`ControlWarning`) where the emulator does not fit.
 
     Errors: another vehicle model; another feature (name, block or window length, rate, bands,
-    tapers); a track whose prescribed GD lies outside the emulator's GD domain. Warnings: a
+    tapers); a track whose prescribed GD lies outside the emulator's GD domain; a Simplex whose
+    top or safe speed lies outside the emulator's speed domain (the BCR learns nothing at such
+    a speed: the robot would drive on an estimate that only ages). Warnings: a
     different noise level (the paper's Test Cases pair the noise-free emulator with noise-free
     data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
     want it); vehicle or noise metadata missing.
@@ -120,6 +124,28 @@ def check_emulator(
             raise EmulatorMismatchError(
                 f"track GD {outside} outside the emulator's GD domain [{lo:g}, {hi:g}]"
             )
+    if simplex is not None:
+        _check_speeds(emulator, simplex)
+
+
+def _check_speeds(emulator, simplex: Simplex) -> None:
+    """EmulatorMismatchError naming the Simplex's speeds outside the emulator's speed domain."""
+    lo, hi = (float(b) for b in emulator.domain[emulator.x_names[0]])
+    tol = 1e-9 * (hi - lo)
+    outside = [
+        f"{name} = {speed:g} m/s"
+        for name, speed in (("v_safe", simplex.v_safe), ("v_max", simplex.v_max))
+        if not lo - tol <= speed <= hi + tol
+    ]
+    if outside:
+        raise EmulatorMismatchError(
+            f"the Simplex's {' and '.join(outside)} {'lies' if len(outside) == 1 else 'lie'} "
+            f"outside the emulator's speed domain "
+            f"[{lo:g}, {hi:g}] m/s: the BCR learns nothing at such a speed, so the robot would "
+            f"drive on an estimate that only ages; use a Simplex whose speeds lie in the domain "
+            f"(control.Simplex(v_max=..., v_safe=...)) or an emulator trained over them "
+            f"(examples/train_emulator.py --speed-range)"
+        )
 
 
 def check_likelihood(emulator, likelihood) -> None:

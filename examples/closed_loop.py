@@ -5,6 +5,7 @@
     python examples/closed_loop.py --record runs/   # also one MCAP per run, for Foxglove
     python examples/closed_loop.py --track 40:250,30:450,60:350 --first-seed 21   # another track
     python examples/closed_loop.py --emulator-dir mine/emulators   # your emulators (and robot)
+    python examples/closed_loop.py --emulator-dir mine/emulators --v-max 1.5   # a slower robot
 
 Track: 50 m at GD 300, 50 m at GD 500, 50 m at GD 300 (roadgen.track), or ``--track`` (segments
 ``LENGTH_M:GD``, GD within the emulators' domain, 200-600). Test Case A: noise-free
@@ -12,7 +13,8 @@ accelerations and the noise-free emulators; Test Case B: N(0, 1) accelerometer n
 emulators trained with it. Run k drives a track synthesised with seed k (and noise seed k), for
 k = FIRST_SEED .. FIRST_SEED + RUNS - 1. ``--emulator-dir DIR`` takes the four emulators that
 ``examples/train_emulator.py --emulator-dir DIR`` writes instead of the shipped ones; the loop then
-drives the vehicle they were trained for, with their noise level.
+drives the vehicle they were trained for, with their noise level. The Simplex's speeds
+(``--v-safe``, ``--v-max``; the paper's 1.0 and 2.0 m/s) must lie in the emulators' speed range.
 
 Each case is run twice: with our estimator (default: the change-point BCR on log band powers of
 1 s blocks, `control.bcr`) and with the paper's method run here (one 1,000-sample window, its
@@ -162,6 +164,15 @@ def main(argv: list[str] | None = None) -> dict:
         "docs/closed-loop.md)",
     )  # fmt: skip
     parser.add_argument(
+        "--v-max", type=float, default=control.Simplex.v_max, metavar="M_PER_S",
+        help="the Simplex's top speed, m/s (default 2.0, the paper's; within the emulators' "
+        "speed range and the vehicle's top speed)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--v-safe", type=float, default=control.Simplex.v_safe, metavar="M_PER_S",
+        help="the Simplex's safety-mode speed, m/s (default 1.0, the paper's)",
+    )  # fmt: skip
+    parser.add_argument(
         "--cases", nargs="+", choices=["A", "B"], default=["A", "B"],
         help="test cases: A (noise-free), B (with the noise the case-B emulators were trained on)",
     )  # fmt: skip
@@ -184,13 +195,20 @@ def main(argv: list[str] | None = None) -> dict:
     gds = sorted({gd for _, gd in segments})
     paper_track = tuple(segments) == PAPER_SEGMENTS
     for option, field, value in (("--risk", "risk", args.risk),
-                                 ("--speed-step", "speed_step_mps", args.speed_step)):  # fmt: skip
+                                 ("--speed-step", "speed_step_mps", args.speed_step),
+                                 ("--v-max", "v_max", args.v_max),
+                                 ("--v-safe", "v_safe", args.v_safe)):  # fmt: skip
         try:
             control.Simplex(**{field: value})
         except control.ControlError as err:
             parser.error(f"{option}: {err}")
-    # each checked alone above (the Simplex checks none against another); --law: its choices
-    simplex = control.Simplex(risk=args.risk, law=args.law, speed_step_mps=args.speed_step)
+    try:  # each checked alone above, then against each other; --law: its choices
+        simplex = control.Simplex(
+            risk=args.risk, law=args.law, speed_step_mps=args.speed_step,
+            v_max=args.v_max, v_safe=args.v_safe,
+        )  # fmt: skip
+    except control.ControlError as err:
+        parser.error(f"--v-safe, --v-max, --speed-step: {err}")
     emulator_dir = Path(args.emulator_dir) if args.emulator_dir else None
     try:  # every file before the first run
         emulators = {
@@ -210,6 +228,10 @@ def main(argv: list[str] | None = None) -> dict:
             control.check_emulator(emu, track=track)
         except control.EmulatorMismatchError as err:  # a GD outside the emulator's domain
             parser.error(f"--track: {err}")
+        try:
+            control.check_emulator(emu, simplex=simplex)
+        except control.EmulatorMismatchError as err:  # speeds outside the emulator's domain
+            parser.error(f"--v-safe / --v-max: {err}")
     if args.record:
         from control.robot.record import check_can_record
 

@@ -8,9 +8,11 @@
 
 Steps (docs/closed-loop.md):
 
-1. a 198-point Latin hypercube over v in [0.5, 2.0] m/s and GD in [200, 600] (paper eqs. 3-4,
-   Fig. 5), stretched so that its extreme points lie on the bounds (the emulator's domain is the
-   design's range, and the robot drives at exactly 2.0 m/s);
+1. a 198-point Latin hypercube over v in [0.5, 2.0] m/s (``--speed-range``) and GD in [200, 600]
+   (``--gd-range``; paper eqs. 3-4, Fig. 5), stretched so that its extreme points lie on the
+   bounds (the emulator's domain is the design's range, and the robot drives at exactly 2.0 m/s;
+   a robot with another top speed trains to it, and drives with ``Simplex(v_max=...)`` inside
+   the range: `control.check_emulator` refuses a Simplex whose speeds lie outside);
 2. one fresh road and one Jackal drive per point (``vehicle.run_campaign``), keeping the last
    ``--keep-s`` (120) seconds of front-axle accelerations, noise-free and with N(0, 1) noise;
 3. the block-feature emulators ``jackal_{A,B}.gpmsa`` (the change-point BCR's): per run, the
@@ -73,11 +75,17 @@ BOOLEANS = {"1": True, "true": True, "yes": True, "on": True,
             "0": False, "false": False, "no": False, "off": False}  # fmt: skip
 
 
-def stretched_design(n: int, seed: int, gd_range: tuple[float, float] = GD_RANGE) -> np.ndarray:
-    """An LHS (vehicle.lhs_design) mapped affinely so each column spans its range exactly."""
-    design = vehicle.lhs_design(n, V_RANGE, gd_range, seed=seed)
+def stretched_design(
+    n: int,
+    seed: int,
+    gd_range: tuple[float, float] = GD_RANGE,
+    v_range: tuple[float, float] = V_RANGE,
+) -> np.ndarray:
+    """An LHS (vehicle.lhs_design) mapped affinely so each column spans its range exactly
+    (speed in m/s, GD in 1e-6 m^3)."""
+    design = vehicle.lhs_design(n, v_range, gd_range, seed=seed)
     lo, hi = design.min(axis=0), design.max(axis=0)
-    target_lo, target_hi = np.array([V_RANGE[0], gd_range[0]]), np.array([V_RANGE[1], gd_range[1]])
+    target_lo, target_hi = np.array([v_range[0], gd_range[0]]), np.array([v_range[1], gd_range[1]])
     return target_lo + (design - lo) * (target_hi - target_lo) / (hi - lo)
 
 
@@ -138,7 +146,7 @@ def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict
         "design": {
             "n": int(campaign.v.size),
             "seed": args.seed,
-            "v_range": V_RANGE,
+            "v_range": list(args.speed_range),
             "gd_range": list(args.gd_range),
         },
         "versions": campaign.settings.get("versions", {}),  # what made the training data
@@ -153,7 +161,7 @@ def fit_band(case: str, campaign, model, args):
     accel = campaign.accel if case == "A" else campaign.accel_measured
     ok = campaign.ok & np.all(np.isfinite(accel), axis=1)
     stats_ = block_statistics(accel[ok], feature, batch=BATCH)
-    scatter = block_scatter(campaign.v[ok], stats_, nodes=np.linspace(*V_RANGE, 16))
+    scatter = block_scatter(campaign.v[ok], stats_, nodes=np.linspace(*args.speed_range, 16))
     data = gpmsa.SimData(
         x=campaign.v[ok, None], t=campaign.gd[ok, None], y=stats_.mean,
         x_names=["v"], t_names=["GD"], y_names=feature.names(),
@@ -202,6 +210,11 @@ def main(argv: list[str] | None = None) -> None:
         "--gd-range", nargs=2, type=float, default=GD_RANGE, metavar=("LO", "HI"),
         help="GD range of the design (the emulators' domain and the BCR's prior)",
     )  # fmt: skip
+    parser.add_argument(
+        "--speed-range", nargs=2, type=float, default=V_RANGE, metavar=("LO", "HI"),
+        help="speed range of the design, m/s (the emulators' domain: the Simplex's v_safe and "
+        "v_max must lie in it; HI at most the vehicle's top speed)",
+    )  # fmt: skip
     parser.add_argument("--cases", nargs="+", default=["A", "B"], choices=["A", "B"])
     parser.add_argument(
         "--noise-std", type=float, default=NOISE_STD["B"],
@@ -248,6 +261,9 @@ def main(argv: list[str] | None = None) -> None:
     lo, hi = args.gd_range
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
         parser.error(f"--gd-range must be finite with 0 < LO < HI, got {lo} {hi}")
+    v_lo, v_hi = args.speed_range
+    if not (np.isfinite(v_lo) and np.isfinite(v_hi) and 0 < v_lo < v_hi):
+        parser.error(f"--speed-range must be finite with 0 < LO < HI, m/s, got {v_lo} {v_hi}")
     if args.ship and args.emulator_dir is not None:
         parser.error("--ship and --emulator-dir exclude each other")
     if not (np.isfinite(args.noise_std) and args.noise_std >= 0):
@@ -256,6 +272,11 @@ def main(argv: list[str] | None = None) -> None:
         model = vehicle_model(args.vehicle)
     except ValueError as exc:
         parser.error(str(exc))
+    if v_hi > model.max_speed_mps:
+        parser.error(
+            f"--speed-range HI = {v_hi:g} m/s exceeds the vehicle's top speed "
+            f"{model.max_speed_mps:g} m/s"
+        )
     out = output_folder(parser, "--out", args.out)
     if args.ship:
         emu_dir = output_folder(parser, "--ship", EMULATOR_DIR)
@@ -264,7 +285,7 @@ def main(argv: list[str] | None = None) -> None:
     else:
         emu_dir = output_folder(parser, "--out", out / "emulators")
 
-    design = stretched_design(args.n_runs, args.seed, tuple(args.gd_range))
+    design = stretched_design(args.n_runs, args.seed, tuple(args.gd_range), tuple(args.speed_range))
     plot_design(design[:, 0], design[:, 1]).savefig(out / "lhs_design.png", dpi=150)
     tic = time.perf_counter()
     campaign = vehicle.run_campaign(

@@ -55,6 +55,16 @@ CASES = [
     ("examples/ball_drop.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
     ("examples/closed_loop.py", ["--risk", "1.5"], "--risk: risk must be None or lie in (0, 1)"),
     ("examples/closed_loop.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+    (
+        "examples/closed_loop.py",
+        ["--v-max", "2.5"],
+        "--v-safe / --v-max: the Simplex's v_max = 2.5 m/s lies outside the emulator's speed",
+    ),
+    (
+        "examples/closed_loop.py",
+        ["--v-safe", "1.5", "--v-max", "1.2"],
+        "--v-safe, --v-max, --speed-step: v_safe must be <= v_max, got 1.5 and 1.2",
+    ),
     ("examples/posterior_check.py", ["--seed", "-1"], "--seed must be >= 0, got -1"),
     ("examples/posterior_check.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
     ("examples/roadgen_psd_check.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
@@ -67,6 +77,16 @@ CASES = [
     ),
     ("examples/train_emulator.py", ["--gd-range", "5", "1"], "--gd-range must be finite"),
     ("examples/train_emulator.py", ["--keep-s", "0"], "--keep-s must be >= 16.67 s"),
+    (
+        "examples/train_emulator.py",
+        ["--speed-range", "1.5", "0.5"],
+        "--speed-range must be finite with 0 < LO < HI, m/s, got 1.5 0.5",
+    ),
+    (
+        "examples/train_emulator.py",
+        ["--speed-range", "0.5", "2.5"],
+        "--speed-range HI = 2.5 m/s exceeds the vehicle's top speed 2 m/s",
+    ),
     ("examples/train_emulator.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
 ]
 

@@ -19,6 +19,7 @@ from control import (  # noqa: E402
     EmulatorMismatchError,
     FeatureSpec,
     SensorLimits,
+    Simplex,
     bcr_settings_for,
     block_features,
     check_emulator,
@@ -93,6 +94,22 @@ def test_check_emulator_errors_and_warnings():
     track = SimpleNamespace(segments=((10.0, 150.0), (10.0, 300.0)))
     with pytest.raises(EmulatorMismatchError, match=r"track GD \[150.0\]"):
         check_emulator(emu, track=track)
+
+
+def test_check_emulator_refuses_a_simplex_driving_outside_the_speed_domain():
+    emu = fake_emulator()
+    check_emulator(emu, simplex=Simplex())  # the paper's 1.0 and 2.0 m/s in [0.5, 2.0]
+    check_emulator(emu, simplex=Simplex(v_safe=0.5, v_max=0.5))  # the domain's edge is inside
+    slow = SimpleNamespace(**{**vars(emu), "domain": {"v": (0.5, 1.5), "GD": (200.0, 600.0)}})
+    with pytest.raises(EmulatorMismatchError, match=r"v_max = 2 m/s lies outside .* \[0.5, 1.5\]"):
+        check_emulator(slow, simplex=Simplex())
+    check_emulator(slow, simplex=Simplex(v_max=1.5))
+    fast = SimpleNamespace(**{**vars(emu), "domain": {"v": (1.2, 2.0), "GD": (200.0, 600.0)}})
+    with pytest.raises(EmulatorMismatchError, match=r"v_safe = 1 m/s lies outside .*--speed-range"):
+        check_emulator(fast, simplex=Simplex())
+    narrow = SimpleNamespace(**{**vars(emu), "domain": {"v": (1.2, 1.8), "GD": (200.0, 600.0)}})
+    with pytest.raises(EmulatorMismatchError, match="v_safe = 1 m/s and v_max = 2 m/s lie outside"):
+        check_emulator(narrow, simplex=Simplex())
 
 
 def test_feature_spec_checks_and_round_trips():

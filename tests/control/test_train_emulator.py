@@ -103,3 +103,30 @@ def test_n_pc_outside_the_bands_is_refused(tmp_path, n_pc, capsys):
     with pytest.raises(SystemExit):
         load_script().main(["--out", str(tmp_path), "--n-pc", n_pc])
     assert "--n-pc must be in [1, 8]" in capsys.readouterr().err
+
+
+def test_a_slower_robots_emulators_and_a_simplex_within_their_speeds(tmp_path, capsys):
+    import gpmsa
+
+    load_script().main(
+        ["--out", str(tmp_path), "--n-runs", "16", "--n-iter", "200", "--keep-s", "18",
+         "--cases", "A", "--speed-range", "0.5", "1.5"]
+    )  # fmt: skip
+    folder = tmp_path / "emulators"
+    band = gpmsa.load(folder / "jackal_A.gpmsa")
+    assert band.domain["v"] == pytest.approx((0.5, 1.5))
+    assert band.metadata["design"]["v_range"] == [0.5, 1.5]
+    assert band.metadata["block_scatter"]["speed_mps"][-1] == pytest.approx(1.5)
+    track = roadgen.track([(8, 300)], seed=3)
+    with pytest.raises(control.EmulatorMismatchError, match="v_max = 2 m/s lies outside"):
+        control.run_closed_loop(track, band, seed=3)  # the paper's Simplex would drive blind
+    r = control.run_closed_loop(track, band, seed=3, simplex=control.Simplex(v_max=1.5))
+    assert (r.status == "ok").mean() > 0.7 and r.command.max() <= 1.5
+    loop = load_example("closed_loop")
+    argv = ["--out", str(tmp_path / "loop"), "--runs", "1", "--track", "10:300", "--cases", "A",
+            "--emulator-dir", str(folder)]  # fmt: skip
+    with pytest.raises(SystemExit):
+        loop.main(argv)
+    assert "--v-safe / --v-max: the Simplex's v_max = 2 m/s" in capsys.readouterr().err
+    metrics = loop.main([*argv, "--v-max", "1.5"])
+    assert 0 < metrics["ours"]["A"]["rmse"]["300"] < 400
