@@ -20,15 +20,20 @@ gyro) sees the same road through another response. Per steady road (GD 250-550, 
   measured there (1 / J is the variance of one block's log GD estimate).
 
 Channels: the front accelerometer (shipped), the rear one, both (16 outputs), and the front
-one with a pitch-rate gyro (the central differences of the sampled pitch; the 8 bands of its
-rate), each without and with independent noise: N(0, 1) m/s^2 on an accelerometer, N(0, 0.01^2)
-rad/s on the gyro (an assumed MEMS figure; the pitch rate's rms is 0.5-1.4 rad/s on these
-roads). For reference, the same 8-band feature of the road itself as the tyre sees it
-(``roadgen.wheel_envelope``, noise-free), in position blocks as long as a block's drive and in
-the spatial band the 120 Hz sensor resolves at that speed (up to 60 / v cycles/m): what an ideal
-road sensor with this feature would give. Printed: J per block (mean
-over the 7 GD levels and both folds), the ratio to the front channel, and the two folds' J
-(their difference shows the scatter); then the elapsed time and the load average.
+one with a pitch-rate gyro (the sampled pitch differentiated through the FFT; the 8 bands of
+its rate); the front one with a rear axle synthesised from it and the gyro (the chassis is
+rigid: a_rear = a_front - wheelbase x d(pitch rate)/dt, so without noise it is the rear axle;
+with noise it carries the front's noise and the gyro noise's derivative); and the front-rear
+and front-gyro pairs with their cross-spectra as well (per band, the real and imaginary parts
+of the multitaper cross-spectrum over the square root of the two band powers: the relative
+phase that separate band powers miss; 32 outputs), each without and with independent noise:
+N(0, 1) m/s^2 on an accelerometer, N(0, 0.01^2) rad/s on the gyro (an assumed MEMS figure; the
+pitch rate's rms is 0.5-1.4 rad/s on these roads). For reference, the same 8-band feature of the
+road itself as the tyre sees it (``roadgen.wheel_envelope``, noise-free), in position blocks as
+long as a block's drive and in the spatial band the 120 Hz sensor resolves at that speed (up to
+60 / v cycles/m): what an ideal road sensor with this feature would give. Printed: J per block
+(mean over the 7 GD levels and both folds), the ratio to the front channel, and the two folds'
+J (their difference shows the scatter); then the elapsed time and the load average.
 """
 
 from __future__ import annotations
@@ -52,6 +57,18 @@ BATCH = 8  # blocks per batch mean (as control.training)
 SETTLE_S = 2.0  # start-up transient dropped, s
 GD_CENTRE = 400.0
 GYRO_NOISE_RAD_S = 0.01  # an assumed MEMS gyro's white noise at 120 Hz, sd; the signal: 0.5-1.4
+END_TRIM_S = 1.0  # dropped at the end: the spectral derivative's wrap-around, s
+
+
+def spectral_derivative(x: np.ndarray, dt: float) -> np.ndarray:
+    """d x / d t of a sampled signal through the FFT (exact within the band, unlike central
+    differences, which fall to 0 at the Nyquist frequency), after removing the straight line
+    through its ends; the ends' wrap-around leaves an error near them (END_TRIM_S)."""
+    n = x.size
+    trend = np.linspace(x[0], x[-1], n)
+    freq = np.fft.rfftfreq(n, dt)
+    rate = np.fft.irfft(2j * np.pi * freq * np.fft.rfft(x - trend), n)
+    return rate + (x[-1] - x[0]) / ((n - 1) * dt)
 
 
 def drive(job: tuple[float, float, int, float]) -> dict[str, np.ndarray]:
@@ -60,22 +77,57 @@ def drive(job: tuple[float, float, int, float]) -> dict[str, np.ndarray]:
     road = roadgen.iso8608_profile(speed * (duration_s + SETTLE_S) + 1.0, gd, seed=seed)
     model = vehicle.Jackal()
     trace = vehicle.simulate(model, road, speed)
+    dt = 1.0 / trace.rate_hz
     start = int(SETTLE_S * trace.rate_hz)
-    n = (trace.t.size - start) // SPEC.block_samples * SPEC.block_samples
+    n = (trace.t.size - start - int(END_TRIM_S * trace.rate_hz)) // SPEC.block_samples
+    n *= SPEC.block_samples
     noise = np.random.default_rng([seed, int(gd), int(100 * speed)]).standard_normal((3, n))
-    pitch_rate = np.gradient(trace.pitch, 1.0 / trace.rate_hz)  # rad/s
-    out = {}
+    gyro_noise = GYRO_NOISE_RAD_S * noise[2]
+    # the rigid chassis: a_rear = a_front - wheelbase * d(pitch rate)/dt, so the rear axle
+    # synthesised from the front accelerometer and the gyro is the rear axle plus the front's
+    # noise and the wheelbase times the gyro noise's derivative
+    synthesised_noise = noise[0] - model.wheelbase_m * spectral_derivative(gyro_noise, dt)
+    out, blocks = {}, {}
     for name, signal, eps in (
         ("front", trace.accel_front, noise[0]),
         ("rear", trace.accel_rear, noise[1]),
-        ("gyro", pitch_rate, GYRO_NOISE_RAD_S * noise[2]),
+        ("gyro", spectral_derivative(trace.pitch, dt), gyro_noise),
+        ("synthesised_rear", trace.accel_rear, synthesised_noise),
     ):
-        blocks = signal[start : start + n]
-        out[name] = block_features(blocks.reshape(-1, SPEC.block_samples), SPEC)
-        noisy = (blocks + eps).reshape(-1, SPEC.block_samples)
-        out[name + "_noisy"] = block_features(noisy, SPEC)
+        clean = signal[start : start + n]
+        for suffix, x in (("", clean), ("_noisy", clean + eps)):
+            blocks[name + suffix] = x.reshape(-1, SPEC.block_samples)
+            out[name + suffix] = block_features(blocks[name + suffix], SPEC)
+    for other in ("rear", "gyro"):
+        for suffix in ("", "_noisy"):
+            out[f"cross_{other}{suffix}"] = cross_features(
+                blocks["front" + suffix], blocks[other + suffix]
+            )
     out["road"] = road_features(road, model.wheel_radius_m, speed)
     return out
+
+
+def cross_features(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """(n, 16): per band of SPEC, Re and Im of the multitaper cross-spectrum of blocks x and y
+    (n, B) summed over the band, over sqrt(band power of x * band power of y) (a coherency in
+    [-1, 1]; same tapers and bands as the shipped feature)."""
+    tapers = dpss(SPEC.block_samples, SPEC.taper_nw, SPEC.n_tapers)
+    fx, fy = (
+        np.fft.rfft((b - b.mean(axis=1, keepdims=True))[:, None] * tapers[None], axis=2)
+        for b in (x, y)
+    )
+    freq = np.fft.rfftfreq(SPEC.block_samples, 1.0 / SPEC.rate_hz)
+    edges = np.asarray(SPEC.bands_hz)
+    bands = [(freq >= lo) & (freq < hi) for lo, hi in zip(edges[:-1], edges[1:], strict=True)]
+
+    def band_sum(spec: np.ndarray) -> np.ndarray:
+        return np.column_stack([spec[:, b].sum(axis=1) for b in bands])
+
+    cross = band_sum((fx * fy.conj()).mean(axis=1))
+    scale = np.sqrt(
+        band_sum((np.abs(fx) ** 2).mean(axis=1)) * band_sum((np.abs(fy) ** 2).mean(axis=1))
+    )
+    return np.hstack([cross.real / scale, cross.imag / scale])
 
 
 def road_features(road, wheel_radius_m: float, speed: float) -> np.ndarray:
@@ -155,6 +207,11 @@ def main() -> None:
         "rear": ["rear"],
         "front + rear": ["front", "rear"],
         "front + pitch-rate gyro": ["front", "gyro"],
+        "front + rear, with cross-spectra": ["front", "rear", "cross_rear"],
+        "front + gyro, with cross-spectra": ["front", "gyro", "cross_gyro"],
+        "front + rear synthesised from the gyro": ["front", "synthesised_rear"],
+        "front-rear cross-spectra alone": ["cross_rear"],
+        "front-gyro cross-spectra alone": ["cross_gyro"],
     }
     print(
         f"{args.roads} roads x {args.duration_s:g} s per (speed, GD); J per block of "
