@@ -19,6 +19,7 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
+from control.compat import check_emulator
 from control.errors import ControlError, MissingExtraError
 from control.robot.replay import (
     GRAVITY,
@@ -27,6 +28,7 @@ from control.robot.replay import (
     ReplaySettings,
     replay_bag,
 )
+from control.simplex import Simplex
 
 DEFAULTS = ReplaySettings()
 
@@ -98,6 +100,15 @@ def parser() -> argparse.ArgumentParser:
         "--storage", default=DEFAULTS.storage, choices=["mcap", "sqlite3"],
         help="storage of the output bag",
     )  # fmt: skip
+    p.add_argument(
+        "--v-max", type=float, default=Simplex.v_max, metavar="M_PER_S",
+        help="the Simplex's top speed, m/s, for the commands it would have ordered (default "
+        "2.0, the paper's; within the emulator's speed range)",
+    )  # fmt: skip
+    p.add_argument(
+        "--v-safe", type=float, default=Simplex.v_safe, metavar="M_PER_S",
+        help="the Simplex's safety-mode speed, m/s (default 1.0, the paper's)",
+    )  # fmt: skip
     p.add_argument("--progress", action="store_true", help="show a progress bar")
     return p
 
@@ -118,13 +129,15 @@ def main(argv: list[str] | None = None) -> int:
             resample=args.resample,
             storage=args.storage,
         )
+        simplex = Simplex(v_max=args.v_max, v_safe=args.v_safe)
         if (out / "estimates").exists():
             raise ControlError(f"{out / 'estimates'} exists already: choose another --out")
         emulator, source = _emulator(args.emulator)
+        check_emulator(emulator, simplex=simplex)  # before the output folder is made
         out.mkdir(parents=True, exist_ok=True)
         result = replay_bag(
-            bag, emulator, settings, csv=out / "estimates.csv", out_bag=out / "estimates",
-            progress=args.progress,
+            bag, emulator, settings, simplex=simplex, csv=out / "estimates.csv",
+            out_bag=out / "estimates", progress=args.progress,
         )  # fmt: skip
     except MissingExtraError as exc:
         print(f"terrain-replay: {_one_line(exc)}", file=sys.stderr)

@@ -36,7 +36,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from control.bcr import BCR, BCRSettings
-from control.compat import bcr_settings_for, check_likelihood
+from control.compat import bcr_settings_for, check_emulator, check_likelihood
 from control.errors import BagError, ControlError
 from control.estimate import Estimate
 from control.robot import condition
@@ -318,7 +318,8 @@ def replay_bag(
         settings: `ReplaySettings` (topics, IMU axis and sign, time base, ...); ``overrides``
             replace its fields (e.g. ``imu_topic="/imu"``).
         bcr: BCR settings (default: `control.bcr_settings_for(emulator)`).
-        simplex: the controller (default `Simplex()`).
+        simplex: the controller (default `Simplex()`); its commands are what it would have
+            ordered. Its v_safe and v_max must lie in the emulator's speed domain.
         likelihood: the BCR's prepared likelihood model for ``emulator`` (as in
             `control.run_closed_loop`), to save preparing it per replay; one prepared for
             another emulator is refused (`control.check_likelihood`).
@@ -329,14 +330,15 @@ def replay_bag(
     Returns:
         `ReplayResult`. Raises `BagError` (a topic missing, mistyped or empty; an IMU slower
         than the emulator's rate; a damaged file), `ControlError` (a setting that does not
-        fit the emulator, a likelihood prepared for another one; before the recording is read)
+        fit the emulator, a likelihood prepared for another one, a Simplex outside its speeds;
+        before the recording is read)
         and `MissingExtraError` (the ``robot`` extra not installed).
     """
     s = replace(settings or ReplaySettings(), **overrides)
     emulator = _load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex
-    _check_fit(s, bcr, emulator, likelihood)
+    _check_fit(s, bcr, emulator, likelihood, simplex)
     rec = read_recording(bag, s.imu_topic, s.odom_topic)
     result = replay_recording(
         rec, emulator, s, bcr=bcr, simplex=simplex, likelihood=likelihood, progress=progress
@@ -363,7 +365,7 @@ def replay_recording(
     emulator = _load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex
-    _check_fit(s, bcr, emulator, likelihood)
+    _check_fit(s, bcr, emulator, likelihood, simplex)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     tic = time.perf_counter()
     t, a, pos, spd, reports, resampling, notes, t0 = _condition(rec, s, bcr.rate_hz)
@@ -422,10 +424,15 @@ def replay_recording(
     )
 
 
-def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood) -> None:
+def _check_fit(
+    s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simplex: Simplex
+) -> None:
     """`ControlError` for settings that do not fit the BCR's rate (a high-pass cut-off at or
     above its Nyquist frequency), `EmulatorMismatchError` for a likelihood prepared for
-    another emulator."""
+    another emulator or a Simplex whose speeds lie outside the emulator's speed domain."""
+    if not isinstance(simplex, Simplex):
+        raise ControlError(f"simplex must be a control.Simplex, got {type(simplex).__name__}")
+    check_emulator(emulator, simplex=simplex)
     nyquist = bcr.rate_hz / 2
     if s.gravity == "highpass" and s.highpass_hz >= nyquist:
         raise ControlError(

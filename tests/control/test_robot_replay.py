@@ -239,6 +239,10 @@ def test_settings_that_do_not_fit_the_emulator_are_refused_before_reading(
         replay_bag(nothing, emulator_a, gravity="keep", highpass_hz=60.0)
     with pytest.raises(EmulatorMismatchError, match="prepared for another emulator"):
         replay_bag(nothing, emulator_a, likelihood=likelihood_b)
+    with pytest.raises(EmulatorMismatchError, match="v_max = 2.5 m/s lies outside"):
+        replay_bag(nothing, emulator_a, simplex=control.Simplex(v_max=2.5))
+    with pytest.raises(ControlError, match="simplex must be a control.Simplex, got dict"):
+        replay_bag(nothing, emulator_a, simplex={"v_max": 1.5})
 
 
 def test_a_likelihood_for_another_emulator_is_refused_by_replay_recording(
@@ -291,6 +295,11 @@ def test_the_command_reports_a_bad_topic_and_a_missing_extra(
                      "--imu-topic", "/imu"])  # fmt: skip
     err = capsys.readouterr().err
     assert code == 2 and "'/imu' is not in" in err and "--imu-topic" in err
+    code = cli.main([str(path), "--emulator", "A", "--out", str(tmp_path / "q"),
+                     "--v-max", "2.5"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "v_max = 2.5 m/s lies outside the emulator's speed domain" in err
+    assert not (tmp_path / "q").exists()
     monkeypatch.setitem(sys.modules, "rosbags.typesys", None)
     code = cli.main([str(path), "--emulator", "A", "--out", str(tmp_path / "p")])
     err = capsys.readouterr().err
