@@ -194,15 +194,11 @@ def main(argv: list[str] | None = None) -> dict:
     seeds = range(args.first_seed, args.first_seed + args.runs)
     gds = sorted({gd for _, gd in segments})
     paper_track = tuple(segments) == PAPER_SEGMENTS
-    for option, field, value in (("--risk", "risk", args.risk),
-                                 ("--speed-step", "speed_step_mps", args.speed_step),
-                                 ("--v-max", "v_max", args.v_max),
-                                 ("--v-safe", "v_safe", args.v_safe)):  # fmt: skip
-        try:
-            control.Simplex(**{field: value})
-        except control.ControlError as err:
-            parser.error(f"{option}: {err}")
-    try:  # each checked alone above, then against each other; --law: its choices
+    try:
+        control.Simplex(risk=args.risk)
+    except control.ControlError as err:
+        parser.error(f"--risk: {err}")
+    try:  # the speeds are checked together (v_safe <= v_max, the step <= v_max); --law: choices
         simplex = control.Simplex(
             risk=args.risk, law=args.law, speed_step_mps=args.speed_step,
             v_max=args.v_max, v_safe=args.v_safe,

@@ -62,6 +62,11 @@ CASES = [
     ),
     (
         "examples/closed_loop.py",
+        ["--speed-step", "-0.1"],
+        "--v-safe, --v-max, --speed-step: speed_step_mps must lie in [0, v_max] = [0, 2]",
+    ),
+    (
+        "examples/closed_loop.py",
         ["--v-safe", "1.5", "--v-max", "1.2"],
         "--v-safe, --v-max, --speed-step: v_safe must be <= v_max, got 1.5 and 1.2",
     ),

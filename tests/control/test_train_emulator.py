@@ -128,5 +128,5 @@ def test_a_slower_robots_emulators_and_a_simplex_within_their_speeds(tmp_path, c
     with pytest.raises(SystemExit):
         loop.main(argv)
     assert "--v-safe / --v-max: the Simplex's v_max = 2 m/s" in capsys.readouterr().err
-    metrics = loop.main([*argv, "--v-max", "1.5"])
+    metrics = loop.main([*argv, "--v-max", "0.9", "--v-safe", "0.6"])  # both below the default
     assert 0 < metrics["ours"]["A"]["rmse"]["300"] < 400
