@@ -47,7 +47,7 @@ from control.estimate import Estimate, graver_fault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.sensor_checks import SensorLimits, signal_fault, stream_fault
 from control.tracker import GDTracker, TrackerSettings
-from control.validation import is_integer, is_real, require_instance, require_reals
+from control.validation import is_integer, is_real, require_instance, require_reals, within
 from gpmsa import Posterior
 
 METHODS = ("changepoint", "window", "filter", "tempered")
@@ -478,9 +478,8 @@ class BCR:
         tic = _time.perf_counter()
         v = float(np.mean(spd))
         lo, hi = self.speed_range
-        tol = 1e-9 * (hi - lo)
         why = ""
-        if not lo - tol <= v <= hi + tol:
+        if not within(v, lo, hi):
             why = f"speed {v:.3g} m/s outside the emulator's [{lo:g}, {hi:g}]"
         elif np.min(spd) < MAX_SPEED_CHANGE * np.max(spd):
             why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"

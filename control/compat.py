@@ -20,6 +20,7 @@ from control.errors import ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
+from control.validation import within
 
 
 def _canon(obj) -> str:
@@ -131,11 +132,10 @@ def check_emulator(
 def _check_speeds(emulator, simplex: Simplex) -> None:
     """EmulatorMismatchError naming the Simplex's speeds outside the emulator's speed domain."""
     lo, hi = (float(b) for b in emulator.domain[emulator.x_names[0]])
-    tol = 1e-9 * (hi - lo)
     outside = [
         f"{name} = {speed:g} m/s"
         for name, speed in (("v_safe", simplex.v_safe), ("v_max", simplex.v_max))
-        if not lo - tol <= speed <= hi + tol
+        if not within(speed, lo, hi)
     ]
     if outside:
         raise EmulatorMismatchError(

@@ -26,7 +26,7 @@ from scipy import special, stats
 from scipy.linalg import cholesky
 
 from control.errors import ControlError, EmulatorMismatchError
-from control.validation import float_array, is_integer, require_reals
+from control.validation import float_array, is_integer, require_reals, within
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,7 +140,7 @@ class ObservationModel:
     def _at(self, v: float) -> tuple[np.ndarray, np.ndarray]:
         """(mean (G, K), lower Cholesky factor of Sigma (K, K)) at speed v (linear in v)."""
         lo, hi = self.speed_range
-        if not lo - 1e-9 * (hi - lo) <= v <= hi + 1e-9 * (hi - lo):
+        if not within(v, lo, hi):
             raise ControlError(f"speed {v:.4g} m/s outside the emulator's range [{lo:g}, {hi:g}]")
         x = np.clip((v - lo) / (hi - lo) * (self.speed.size - 1), 0, self.speed.size - 1)
         i = min(int(x), self.speed.size - 2)

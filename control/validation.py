@@ -21,6 +21,13 @@ def is_integer(value) -> bool:
     return isinstance(value, Integral) and not isinstance(value, (bool, np.bool_))
 
 
+def within(value: float, lo: float, hi: float) -> bool:
+    """Whether ``value`` lies in [lo, hi], its ends widened by 1e-9 of the width (rounding of a
+    speed at the emulator's domain edge is inside)."""
+    tol = 1e-9 * (hi - lo)
+    return lo - tol <= value <= hi + tol
+
+
 def float_array(values, name: str) -> np.ndarray:
     """``values`` as a new float array; ControlError naming ``name`` unless they are real
     numbers (ints or floats: not bools, strings such as "1.5", complex numbers or objects;
