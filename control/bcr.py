@@ -420,6 +420,10 @@ class BCR:
         t_now, pos_now = self._now()
         return Estimate(t_now, pos_now, status, reason, data_time=self._newest_data_time(), **kw)
 
+    def _block_feature(self, block: np.ndarray) -> np.ndarray:
+        """The feature vector (K,) of the newest block of clean samples."""
+        return block_features(block, self.settings.feature)[0]
+
     def _signal_reason(self, accel: np.ndarray) -> str:
         """The signal checks on the new samples of a window, or on a whole block."""
         if self.settings.method != "changepoint":
@@ -492,7 +496,7 @@ class BCR:
         bad_signal = self._signal_reason(acc)
         if bad_signal:
             return self._skip_block(phase, ds, "sensor_fault", bad_signal, speed=v)
-        y = block_features(acc, s.feature)[0]
+        y = self._block_feature(acc)
         if not np.all(np.isfinite(y)):
             return self._skip_block(
                 phase, ds, "sensor_fault", "a band of the block has no power", speed=v

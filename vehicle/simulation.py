@@ -21,7 +21,9 @@ class Samples:
 
     t: s. position: front-axle road position, m. accel_front: measured front-axle vertical
     acceleration (noisy if noise_std > 0), m/s^2; accel_front_true: noise-free, m/s^2.
-    speed: actual speed, m/s. contact: front tyre presses on the road.
+    speed: actual speed, m/s. contact: front tyre presses on the road. accel_rear,
+    accel_rear_true: the same over the rear axle (a second accelerometer; its noise is
+    independent of the front one's), m/s^2.
     """
 
     t: np.ndarray
@@ -30,6 +32,8 @@ class Samples:
     accel_front_true: np.ndarray
     speed: np.ndarray
     contact: np.ndarray
+    accel_rear: np.ndarray
+    accel_rear_true: np.ndarray
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -46,7 +50,9 @@ class Simulation:
 
     Args:
         model: HalfCar or Jackal. track: roadgen Track or Profile. rate_hz: accelerometer rate, Hz.
-        noise_std: accelerometer noise std, m/s^2. seed: seed or Generator of the noise.
+        noise_std: accelerometer noise std, m/s^2. seed: seed or Generator of the noise (the
+            rear accelerometer's noise comes from a generator spawned from it, so the front
+            one's noise does not depend on whether the rear is read).
         start_m: initial front-axle position, m, in [0, track length).
         substeps: solver steps per sample period.
         envelope: the tyres follow the track enveloped by the model's wheel radius (as in the
@@ -73,6 +79,7 @@ class Simulation:
         self.noise_std = check_noise(noise_std)
         substeps = checks.integer("substeps", substeps, 1)
         self._rng = np.random.default_rng(checks.seed("seed", seed))
+        self._rear_rng = self._rng.spawn(1)[0]  # draws nothing from the front's stream
         start = checks.real("start_m", start_m)
         envelope = checks.flag("envelope", envelope)
         self._road = RoadInput(track, model.wheel_radius_m if envelope else None)
@@ -129,9 +136,11 @@ class Simulation:
             contact=contact_flags(
                 self.model, self._road, position, spd, states.z_front, states.zt_front, 0
             ),
+            accel_rear=add_noise(states.accel_rear, self.noise_std, self._rear_rng),
+            accel_rear_true=states.accel_rear,
         )
 
 
 def _empty() -> Samples:
     e = np.zeros(0)
-    return Samples(e, e, e, e, e, np.zeros(0, dtype=bool))
+    return Samples(e, e, e, e, e, np.zeros(0, dtype=bool), e, e)

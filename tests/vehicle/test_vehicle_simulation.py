@@ -63,6 +63,28 @@ def test_samples_report_noisy_and_true_acceleration(track):
     np.testing.assert_array_equal(a["measured"], b["measured"])
 
 
+def test_samples_report_the_rear_axle_with_its_own_noise(track):
+    """The rear accelerometer: its noise-free value does not depend on the noise; its noise is
+    N(0, 1), independent of the front one's and drawn from its own stream (the front's noise is
+    that of seed 3 alone, as before the rear was read)."""
+    got = {
+        std: [vehicle.Simulation(vehicle.Jackal(), track, noise_std=std, seed=3).advance(3.0, 1.0)]
+        for std in (0.0, 1.0)
+    }
+    clean, noisy = got[0.0][0], got[1.0][0]
+    np.testing.assert_array_equal(noisy.accel_rear_true, clean.accel_rear_true)
+    np.testing.assert_array_equal(clean.accel_rear, clean.accel_rear_true)
+    assert np.std(noisy.accel_rear_true) > 0.1
+    assert not np.allclose(noisy.accel_rear_true, noisy.accel_front_true)
+    front_noise = noisy.accel_front - noisy.accel_front_true
+    rear_noise = noisy.accel_rear - noisy.accel_rear_true
+    np.testing.assert_allclose(
+        front_noise, np.random.default_rng(3).normal(0.0, 1.0, front_noise.size), atol=1e-12
+    )
+    assert abs(np.std(rear_noise) - 1.0) < 0.1
+    assert abs(np.corrcoef(rear_noise, front_noise)[0, 1]) < 0.15
+
+
 def test_slowing_down_respects_the_limit(track):
     sim = vehicle.Simulation(vehicle.Jackal(), track, start_m=0.5)
     sim.advance(0.5, 2.0)
