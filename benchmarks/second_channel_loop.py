@@ -118,13 +118,16 @@ def joint_statistics(signals: list[np.ndarray]) -> BlockStatistics:
     return BlockStatistics(mean=mean, cov=cov, features=feats)
 
 
-def fit(design: np.ndarray, acc: np.ndarray, case: str, channels: str, n_iter: int):
-    """The block-feature emulator of a channel set, its block scatter in the metadata."""
+def fit(
+    design: np.ndarray, acc: np.ndarray, case: str, channels: str, n_iter: int, pcs: int | None
+):
+    """The block-feature emulator of a channel set, its block scatter in the metadata; ``pcs``
+    principal components for two channels (None: TWO_CHANNEL_VARIANCE of the variance)."""
     stats_ = joint_statistics(channel_signals(acc, case, channels))
     y = stats_.mean
     z = (y - y.mean(axis=0)) / y.std()
     share = np.cumsum(np.linalg.svd(z, compute_uv=False) ** 2)
-    n_pc = int(np.searchsorted(share / share[-1], TWO_CHANNEL_VARIANCE)) + 1
+    n_pc = int(np.searchsorted(share / share[-1], TWO_CHANNEL_VARIANCE)) + 1 if pcs is None else pcs
     n_pc = BAND_PCS if channels == "front" else n_pc
     scatter = block_scatter(design[:, 0], stats_, nodes=np.linspace(0.5, 2.0, 16))
     data = gpmsa.SimData(
@@ -207,12 +210,12 @@ def two_channel_loop(track, likelihood, bcr, simplex, noise_std: float, seed: in
 
 def drive(job: tuple) -> dict:
     """One closed-loop run of closed_loop_accuracy's kinds, with one channel set."""
-    channels, case, kind, seed, extra, emulator_dir = job
-    key = (channels, case)
-    if key not in _MODELS:
-        emu = gpmsa.load(Path(emulator_dir) / f"{channels}_{case}.gpmsa")
-        _MODELS[key] = (emu, control.ObservationModel(emu))
-    emu, likelihood = _MODELS[key]
+    channels, case, kind, seed, extra, emulator_dir, pcs = job
+    path = emulator_path(Path(emulator_dir), channels, case, pcs)
+    if path not in _MODELS:
+        emu = gpmsa.load(path)
+        _MODELS[path] = (emu, control.ObservationModel(emu))
+    emu, likelihood = _MODELS[path]
     bcr = control.BCRSettings()
     simplex = control.Simplex()
     if kind == "steady":
@@ -246,7 +249,13 @@ def drive(job: tuple) -> dict:
     }  # fmt: skip
 
 
-def jobs_for(name: str, channels: str, cases, emulator_dir: str, random_tracks: int) -> list:
+def emulator_path(folder: Path, channels: str, case: str, pcs: int | None) -> Path:
+    """Where the benchmark keeps the emulator of a channel set, case and basis size."""
+    basis = f"_{pcs}pc" if pcs is not None and channels != "front" else ""
+    return folder / f"{channels}_{case}{basis}.gpmsa"
+
+
+def jobs_for(name: str, channels: str, cases, emulator_dir: str, random_tracks: int, pcs) -> list:
     out = []
     for case in cases:
         if name == "dev":
@@ -260,7 +269,7 @@ def jobs_for(name: str, channels: str, cases, emulator_dir: str, random_tracks: 
         else:  # steady, steady-dev
             out += [(channels, case, "steady", s, (gd, v)) for gd in cla.STEADY_GD
                     for v in cla.STEADY_SPEEDS for s in cla.SETS[name]]  # fmt: skip
-    return [(*job, emulator_dir) for job in out]
+    return [(*job, emulator_dir, pcs) for job in out]
 
 
 def main() -> None:
@@ -269,6 +278,11 @@ def main() -> None:
     parser.add_argument("--sets", default="dev,steady-dev", help=f"comma-separated, among {sets}")
     parser.add_argument("--channels", default=",".join(CHANNELS), help=f"among {CHANNELS}")
     parser.add_argument("--n-iter", type=int, default=6000, help="MCMC sweeps per fit")
+    parser.add_argument(
+        "--two-channel-pcs", type=int, default=None,
+        help=f"principal components of the two-channel emulators, 1 to {2 * SPEC.dim} (default: "
+        f"those that hold {TWO_CHANNEL_VARIANCE:.1%} of the variance)",
+    )  # fmt: skip
     parser.add_argument("--random-tracks", type=int, default=40, help="random set: seeds 401 on")
     parser.add_argument("--workers", type=int, default=2, help="worker processes")
     parser.add_argument("--out", default="out/second_channel_loop", help="campaign and emulators")
@@ -279,6 +293,9 @@ def main() -> None:
         parser.error(f"--sets must name sets among {sets}, got {args.sets!r}")
     if not channel_sets or not set(channel_sets) <= set(CHANNELS):
         parser.error(f"--channels must be among {CHANNELS}, got {args.channels!r}")
+    pcs = args.two_channel_pcs
+    if pcs is not None and not 1 <= pcs <= 2 * SPEC.dim:
+        parser.error(f"--two-channel-pcs must be in [1, {2 * SPEC.dim}], got {pcs}")
     if args.n_iter < 2:
         parser.error(f"--n-iter must be >= 2, got {args.n_iter}")
     if args.random_tracks < 1:
@@ -289,7 +306,7 @@ def main() -> None:
     cases = tuple(cla.NOISE_STD)
     tic = time.perf_counter()
     design = stretched_design(198, 0)
-    emulators = [out / f"{c}_{case}.gpmsa" for c in channel_sets for case in cases]
+    emulators = [emulator_path(out, c, case, pcs) for c in channel_sets for case in cases]
     if all(p.exists() for p in emulators):
         print(f"emulators from {out} (delete them to refit)")
     else:
@@ -301,13 +318,13 @@ def main() -> None:
         for channels in channel_sets:
             for case in cases:
                 t0 = time.perf_counter()
-                emu, n_pc = fit(design, acc, case, channels, args.n_iter)
-                emu.save(out / f"{channels}_{case}.gpmsa")
+                emu, n_pc = fit(design, acc, case, channels, args.n_iter, pcs)
+                emu.save(emulator_path(out, channels, case, pcs))
                 print(f"fit {channels} {case}: {n_pc} PCs, {time.perf_counter() - t0:.0f} s")
     for channels in channel_sets:
         print(f"\n=== {channels}" + ("" if channels == "front" else " + front"))
         for name in names:
-            jobs = jobs_for(name, channels, cases, str(out), args.random_tracks)
+            jobs = jobs_for(name, channels, cases, str(out), args.random_tracks, pcs)
             with ProcessPoolExecutor(args.workers) as pool:
                 results = list(pool.map(drive, jobs, chunksize=2))
             for case in cases:
