@@ -62,10 +62,30 @@ def block_statistics(accel: np.ndarray, spec: FeatureSpec, batch: int = 8) -> Bl
     feats = block_features(blocks, spec).reshape(accel.shape[0], n_blocks, spec.dim)
     if not np.all(np.isfinite(feats)):
         raise ControlError("a block of the campaign has no power in a band")
+    return feature_statistics(feats, batch)
+
+
+def feature_statistics(features: np.ndarray, batch: int = 8) -> BlockStatistics:
+    """Each run's mean feature and long-run block covariance (batch means of ``batch``
+    consecutive blocks, times ``batch``), from the features of its blocks.
+
+    Args:
+        features: (m, n_blocks, K) feature of every block of m runs (e.g. several channels'
+            `block_statistics` features side by side), n_blocks >= 2 batch.
+        batch: blocks per batch.
+    """
+    feats = np.asarray(features, dtype=float)
+    if feats.ndim != 3 or feats.shape[1] < 2 * batch:
+        raise ControlError(
+            f"features must be (runs, blocks, K) with >= {2 * batch} blocks per run (two batches "
+            f"of {batch}), got shape {feats.shape}"
+        )
+    if not np.all(np.isfinite(feats)):
+        raise ControlError("features hold non-finite values")
     mean = feats.mean(axis=1)
     dev = feats - mean[:, None, :]
-    n_batch = n_blocks // batch
-    batches = dev[:, : n_batch * batch].reshape(accel.shape[0], n_batch, batch, -1).mean(axis=2)
+    n_batch = feats.shape[1] // batch
+    batches = dev[:, : n_batch * batch].reshape(feats.shape[0], n_batch, batch, -1).mean(axis=2)
     cov = np.einsum("rbi,rbj->rij", batches, batches) / (n_batch - 1) * batch
     return BlockStatistics(mean=mean, cov=cov, features=feats)
 
