@@ -275,7 +275,7 @@ def main() -> None:
     parser.add_argument(
         "--two-channel-pcs", type=int, default=None,
         help=f"principal components of the two-channel emulators, 1 to {2 * SPEC.dim} (default: "
-        f"those that hold {TWO_CHANNEL_VARIANCE:.1%} of the variance)",
+        f"those that hold {100 * TWO_CHANNEL_VARIANCE:g}%% of the variance)",
     )  # fmt: skip
     parser.add_argument("--random-tracks", type=int, default=40, help="random set: seeds 401 on")
     parser.add_argument("--workers", type=int, default=2, help="worker processes")
