@@ -41,7 +41,6 @@ import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -50,7 +49,7 @@ import control
 import gpmsa
 import roadgen
 import vehicle
-from control.closed_loop import EXACT_CLOCK_SILENCE, _within_simulated_noise
+from control.closed_loop import simulated_sensor_settings
 from control.metrics import detection_delays, gd_errors, segment_index
 from control.sensor_checks import signal_fault
 from control.training import block_scatter, block_statistics, feature_statistics
@@ -117,10 +116,14 @@ def fit(
         np.concatenate([block_statistics(x, SPEC, BATCH).features for x in signals], axis=2), BATCH
     )
     y = stats_.mean
-    z = (y - y.mean(axis=0)) / y.std()
-    share = np.cumsum(np.linalg.svd(z, compute_uv=False) ** 2)
-    n_pc = int(np.searchsorted(share / share[-1], TWO_CHANNEL_VARIANCE)) + 1 if pcs is None else pcs
-    n_pc = BAND_PCS if channels == "front" else n_pc
+    if channels == "front":
+        n_pc = BAND_PCS
+    elif pcs is None:
+        z = (y - y.mean(axis=0)) / y.std()
+        share = np.cumsum(np.linalg.svd(z, compute_uv=False) ** 2)
+        n_pc = int(np.searchsorted(share / share[-1], TWO_CHANNEL_VARIANCE)) + 1
+    else:
+        n_pc = pcs
     scatter = block_scatter(design[:, 0], stats_, nodes=np.linspace(0.5, 2.0, 16))
     data = gpmsa.SimData(
         x=design[:, :1], t=design[:, 1:], y=y, x_names=["v"], t_names=["GD"],
@@ -165,11 +168,7 @@ def two_channel_loop(track, likelihood, bcr, simplex, noise_std: float, seed: in
     """`control.run_closed_loop` (same noise draws, BCR settings and Simplex) with the second
     channel; returns (position, mean, lo, hi, command) per update."""
     model = vehicle.Jackal()
-    bcr = replace(
-        bcr,
-        max_silence_s=min(bcr.max_silence_s, EXACT_CLOCK_SILENCE / bcr.rate_hz),
-        sensor=_within_simulated_noise(bcr.sensor, noise_std),
-    )
+    bcr = simulated_sensor_settings(bcr, noise_std)
     estimator = TwoChannelBCR(likelihood, bcr)
     noise_seed = np.random.default_rng(seed).integers(2**63)
     sim = vehicle.Simulation(

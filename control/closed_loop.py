@@ -157,6 +157,17 @@ def _within_simulated_noise(sensor: SensorLimits, noise_std: float) -> SensorLim
     return replace(sensor, noise_sd_mps2=float(noise_std) if noise_std > 0 else None)
 
 
+def simulated_sensor_settings(bcr: BCRSettings, noise_std: float) -> BCRSettings:
+    """The BCR settings a loop over the simulated sensor uses: ``max_silence_s`` no longer than
+    `EXACT_CLOCK_SILENCE` sample periods (the simulation's clock is exact) and the sensor checks'
+    noise sd no larger than the simulated ``noise_std`` (m/s^2)."""
+    return replace(
+        bcr,
+        max_silence_s=min(bcr.max_silence_s, EXACT_CLOCK_SILENCE / bcr.rate_hz),
+        sensor=_within_simulated_noise(bcr.sensor, noise_std),
+    )
+
+
 def run_closed_loop(
     track,
     emulator,
@@ -226,12 +237,7 @@ def run_closed_loop(
         raise ControlError(
             f"Simplex v_max = {simplex.v_max:g} m/s exceeds the vehicle's top speed {top:g} m/s"
         )
-    bcr = bcr_settings_for(emulator) if bcr is None else bcr
-    bcr = replace(
-        bcr,
-        max_silence_s=min(bcr.max_silence_s, EXACT_CLOCK_SILENCE / bcr.rate_hz),
-        sensor=_within_simulated_noise(bcr.sensor, noise_std),
-    )
+    bcr = simulated_sensor_settings(bcr_settings_for(emulator) if bcr is None else bcr, noise_std)
     if check:
         check_emulator(
             emulator, model=model, noise_std=noise_std, bcr=bcr, track=track, simplex=simplex
