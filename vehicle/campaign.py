@@ -19,7 +19,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
+import secrets
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -91,21 +91,30 @@ class Campaign:
     accel: np.ndarray | None = None
     accel_measured: np.ndarray | None = None
 
+    def __post_init__(self) -> None:
+        """Check the table (VehicleError naming the field) and hold its arrays as numpy arrays
+        (float v, gd, f and traces; int seed; str status), so that what is saved can be read."""
+        for name, array in _checked_table(self).items():
+            object.__setattr__(self, name, array)
+
     @property
     def ok(self) -> np.ndarray:
         """Boolean mask (n,) of the runs that finished."""
         return self.status == "ok"
 
     def save(self, path: str | os.PathLike) -> None:
-        """Write a plain ``.npz`` (no pickle): the arrays and the settings as JSON."""
+        """Write a plain ``.npz`` (no pickle): the arrays and the settings as JSON. The file is
+        replaced in one step (a failure leaves an existing file whole); CampaignFileError if it
+        cannot be written."""
         _check_path(path)
-        arrays = {name: np.asarray(getattr(self, name)) for name in _ARRAYS}
-        arrays["status"] = np.asarray(self.status, dtype=str)
+        arrays = {name: getattr(self, name) for name in _ARRAYS}
         arrays["settings"] = np.asarray(json.dumps({"format": FORMAT, **self.settings}))
         if self.accel is not None:
             arrays["accel"], arrays["accel_measured"] = self.accel, self.accel_measured
-        with open(path, "wb") as fh:
-            np.savez(fh, **arrays)
+        try:
+            _save_npz(Path(path), arrays)
+        except OSError as exc:
+            raise CampaignFileError(f"cannot write campaign file {str(path)!r}: {exc}") from exc
 
 
 def load_campaign(path: str | os.PathLike) -> Campaign:
@@ -128,13 +137,78 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
         raise CampaignFileError(f"campaign file {str(path)!r}: settings are not JSON") from exc
     if not isinstance(settings, dict) or settings.pop("format", None) != FORMAT:
         raise CampaignFileError(f"campaign file {str(path)!r}: unknown format, need {FORMAT!r}")
-    n = arrays["v"].shape
-    if len(n) != 1 or any(a.shape != n for a in arrays.values()):
-        shapes = {k: a.shape for k, a in arrays.items()}
-        raise CampaignFileError(f"campaign file {str(path)!r}: arrays of unequal shapes {shapes}")
-    if traces and any(a.shape[:1] != n for a in traces.values()):
-        raise CampaignFileError(f"campaign file {str(path)!r}: traces do not match the runs")
-    return Campaign(**arrays, settings=settings, **traces)
+    try:
+        return Campaign(**arrays, settings=settings, **traces)
+    except VehicleError as exc:
+        raise CampaignFileError(
+            f"campaign file {str(path)!r} is not a valid campaign: {exc}"
+        ) from exc
+
+
+def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
+    """The campaign's arrays, checked and converted (see ``Campaign.__post_init__``)."""
+    out: dict[str, np.ndarray | None] = {}
+    for name in ("v", "gd", *_F_NAMES):
+        out[name] = checks.real_array(f"Campaign.{name}", getattr(c, name))
+    try:
+        seed = np.asarray(c.seed)
+        status = np.asarray(c.status)
+    except (TypeError, ValueError) as exc:
+        raise VehicleError(f"Campaign.seed and .status must be arrays: {exc}") from exc
+    if seed.size == 0 and status.size == 0:  # an empty table: any dtype will do
+        seed, status = seed.astype(np.int64), status.astype(str)
+    if seed.dtype.kind not in "iu":
+        raise VehicleError(f"Campaign.seed must hold integers, got dtype {seed.dtype}")
+    if status.dtype.kind != "U":
+        raise VehicleError(f"Campaign.status must hold strings, got dtype {status.dtype}")
+    out["seed"], out["status"] = seed, status
+    n = out["v"].shape
+    if len(n) != 1 or any(out[k].shape != n for k in _ARRAYS):
+        shapes = {k: out[k].shape for k in _ARRAYS}
+        raise VehicleError(f"Campaign arrays must be 1-D of one length, got shapes {shapes}")
+    for name in ("v", "gd"):
+        if not np.all(np.isfinite(out[name]) & (out[name] > 0)):
+            raise VehicleError(f"Campaign.{name} must be finite and > 0 in every run")
+    for name in _F_NAMES:
+        if np.any(out[name] < 0) or np.any(np.isinf(out[name])):
+            raise VehicleError(f"Campaign.{name} must be >= 0 and finite, or NaN for a failed run")
+    if not isinstance(c.settings, dict) or "format" in c.settings:
+        raise VehicleError("Campaign.settings must be a dict without the key 'format' (the file's)")
+    try:
+        json.dumps(c.settings)
+    except (TypeError, ValueError) as exc:
+        raise VehicleError(f"Campaign.settings must be JSON-able: {exc}") from exc
+    if (c.accel is None) != (c.accel_measured is None):
+        raise VehicleError("Campaign.accel and .accel_measured are both given or both None")
+    for name in ("accel", "accel_measured"):
+        out[name] = (
+            None if c.accel is None else checks.real_array(f"Campaign.{name}", getattr(c, name))
+        )
+    if c.accel is not None and not (
+        out["accel"].ndim == 2 and out["accel"].shape[0] == n[0]
+        and out["accel"].shape == out["accel_measured"].shape
+    ):  # fmt: skip
+        raise VehicleError(
+            f"Campaign.accel and .accel_measured must be ({n[0]}, samples) arrays of one shape, "
+            f"got {out['accel'].shape} and {out['accel_measured'].shape}"
+        )
+    return out
+
+
+def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """``np.savez`` to a new temporary file beside ``path``, moved over it in one step: a crash
+    or an error never leaves a half-written file, and an existing one stays whole."""
+    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.part")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez(fh, **arrays)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
 
 
 def _check_path(path: object, name: str = "path", what: str = "file") -> None:
@@ -392,13 +466,8 @@ def _spec_settings(spec: RunSpec) -> dict:
 
 def _write_cached(path: Path, result: RunResult, spec: RunSpec) -> None:
     f, status, acc, measured = result
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    with os.fdopen(fd, "wb") as fh:
-        np.savez(
-            fh, f=f, status=np.asarray(status), key=np.asarray(spec.key()), accel=acc,
-            accel_measured=measured,
-        )  # fmt: skip
-    os.replace(tmp, path)  # atomic: a crash never leaves a half-written cache file
+    _save_npz(path, {"f": f, "status": np.asarray(status), "key": np.asarray(spec.key()),
+                     "accel": acc, "accel_measured": measured})  # fmt: skip
 
 
 def _read_cached(path: Path) -> RunResult | None:

@@ -29,6 +29,7 @@ from control.robot.replay import (
     replay_bag,
 )
 from control.simplex import Simplex
+from gpmsa.io.atomic import atomic_write
 
 DEFAULTS = ReplaySettings()
 
@@ -158,7 +159,8 @@ def main(argv: list[str] | None = None) -> int:
         "duration_s": result.duration_s,
         "real_time_factor": result.real_time_factor,
     }
-    (out / "replay.json").write_text(json.dumps(report, indent=2, default=float))
+    with atomic_write(out / "replay.json", text=True, error=ControlError) as fh:
+        fh.write(json.dumps(report, indent=2, default=float))
     print(result.describe())
     print(f"wrote {out / 'estimates.csv'}, {out / 'estimates'} (topic "
           f"{settings.estimate_topic}) and {out / 'replay.json'}")  # fmt: skip

@@ -26,6 +26,7 @@ from control.errors import ControlError
 from control.robot import messages as msgs
 from control.robot.bags import merge_in_time, sensor_messages, to_ns
 from control.robot.extra import require
+from gpmsa.io.atomic import atomic_write
 
 TOPICS = {
     "imu": "/imu/data",
@@ -107,7 +108,7 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with path.open("wb") as f:
+    with atomic_write(path, error=ControlError) as f:
         writer = writer_mod.Writer(f)
         writer.start(profile="ros2", library="terrain-gpmsa")
         channels = {}

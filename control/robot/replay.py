@@ -43,6 +43,7 @@ from control.robot import condition
 from control.robot import messages as msgs
 from control.robot.bags import STORAGES, Recording, merge_in_time, open_bag_writer, read_recording
 from control.simplex import Simplex
+from gpmsa.io.atomic import atomic_write
 
 TIME_BASES = ("header", "log")
 POSITIONS = ("path", "speed")
@@ -201,7 +202,7 @@ class ReplayResult:
         """Write the estimates as CSV (columns CSV_COLUMNS; floats in full precision, "nan"
         where there is no number)."""
         path = Path(path)
-        with path.open("w", newline="") as f:
+        with atomic_write(path, text=True, error=ControlError) as f:
             writer = csv.writer(f)
             writer.writerow(CSV_COLUMNS)
             for row in self.rows():

@@ -19,7 +19,6 @@ import json
 import math
 import os
 import re
-import secrets
 import stat
 import struct
 import zipfile
@@ -33,6 +32,7 @@ import numpy as np
 from gpmsa import limits
 from gpmsa._version import __version__
 from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.io.atomic import atomic_write
 
 FORMAT = "gpmsa-emulator"
 STUDY_FORMAT = "gpmsa-study"
@@ -188,40 +188,16 @@ def write_raw(
     }
     manifest["content_sha256"] = content_hash(arrays, manifest)
     raw_manifest = check_writable(manifest, arrays)
-    try:
-        mode = os.stat(path).st_mode
-    except FileNotFoundError:
-        mode = None
-    except OSError as exc:
-        raise GPMSAError(f"{path}: cannot write ({exc.strerror})") from exc
-    if mode is not None and not stat.S_ISREG(mode):
-        raise GPMSAError(f"{path} exists and is not a regular file: refusing to replace it")
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.part")
-    try:
-        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
-    except OSError as exc:  # e.g. a missing folder or one without write permission
-        raise GPMSAError(f"{path}: cannot write ({exc.strerror})") from exc
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-                _write_member(zf, MANIFEST, raw_manifest)
-                for name, arr in arrays.items():
-                    _write_member(zf, ARRAY_DIR + name + ".npy", _npy_bytes(arr))
-            fh.flush()
-            os.fsync(fh.fileno())
-        with open(tmp, "rb") as fh:  # the reader's structural checks, before the file is seen
-            fh.seek(0, os.SEEK_END)
-            _check_directory(fh, fh.tell(), tmp)
-            fh.seek(0)
-            with zipfile.ZipFile(fh) as zf:
-                _check_members(zf, tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    with atomic_write(path) as fh:
+        with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+            _write_member(zf, MANIFEST, raw_manifest)
+            for name, arr in arrays.items():
+                _write_member(zf, ARRAY_DIR + name + ".npy", _npy_bytes(arr))
+        fh.seek(0, os.SEEK_END)  # the reader's structural checks, before the file is seen
+        _check_directory(fh, fh.tell(), path)
+        fh.seek(0)
+        with zipfile.ZipFile(fh) as zf:
+            _check_members(zf, path)
     return path
 
 

@@ -386,3 +386,22 @@ def test_a_ros1_bag_replays_to_the_last_bit(loop_run, emulator_a, likelihood_a, 
     bag = _write_ros1_bag(result, tmp_path / "run.bag")
     assert read_recording(bag).kind == "ros1"
     _assert_replay_is_the_loop(replay_bag(bag, emulator_a, likelihood=likelihood_a), result)
+
+
+def test_a_recording_that_fails_midway_leaves_the_earlier_file_whole(loop_run, tmp_path,
+                                                                     monkeypatch):
+    from control.robot import record
+
+    result, path = loop_run
+    target = tmp_path / "run.mcap"
+    target.write_bytes(path.read_bytes())
+
+    def failing_merge(streams):
+        raise OSError("disk full")
+        yield  # a generator, as the one it replaces
+
+    monkeypatch.setattr(record, "merge_in_time", failing_merge)
+    with pytest.raises(OSError, match="disk full"):
+        control.record_run(result, target)
+    assert target.read_bytes() == path.read_bytes()
+    assert [p.name for p in tmp_path.iterdir()] == ["run.mcap"]

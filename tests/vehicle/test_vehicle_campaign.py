@@ -129,3 +129,70 @@ def test_dask_executor_gives_the_same_table(table):
         got = vehicle.run_campaign(DESIGN[:2], executor=client.get_executor(), **SHORT)
     np.testing.assert_array_equal(got.f_full, camp.f_full[:2])
     np.testing.assert_array_equal(got.f_window_noisy, camp.f_window_noisy[:2])
+
+
+def _fields(camp, **change):
+    names = ("v", "gd", "seed", "f_full", "f_window", "f_full_noisy", "f_window_noisy", "status",
+             "settings", "accel", "accel_measured")  # fmt: skip
+    return {**{k: getattr(camp, k) for k in names}, **change}
+
+
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        ({"v": np.array([0.7, 1.6])}, "one length"),
+        ({"gd": np.array([250.0, np.nan, 400.0])}, "Campaign.gd must be finite"),
+        ({"f_full": np.array([1.0, -1.0, 2.0])}, "Campaign.f_full must be >= 0"),
+        ({"seed": np.array([1.0, 2.0, 3.0])}, "seed must hold integers"),
+        ({"status": np.array([1, 2, 3])}, "status must hold strings"),
+        ({"settings": {"format": "mine"}}, "without the key 'format'"),
+        ({"settings": {"road": object()}}, "JSON-able"),
+        ({"accel": np.zeros((3, 4))}, "both given or both None"),
+        ({"accel": np.zeros((3, 4)), "accel_measured": np.zeros((3, 5))}, r"\(3, samples\)"),
+    ],
+)
+def test_a_campaign_that_could_not_be_saved_and_read_back_is_refused(table, change, match):
+    camp, _ = table
+    with pytest.raises(vehicle.VehicleError, match=match):
+        vehicle.Campaign(**_fields(camp, **change))
+
+
+def test_a_campaign_built_from_lists_is_held_as_arrays_and_round_trips(table, tmp_path):
+    camp, _ = table
+    lists = {k: getattr(camp, k).tolist() for k in ("v", "gd", "seed", "status")}
+    built = vehicle.Campaign(**_fields(camp, **lists))
+    assert built.ok.tolist() == [True, True, True]  # a list status would give one False
+    built.save(tmp_path / "c.npz")
+    back = vehicle.load_campaign(tmp_path / "c.npz")
+    np.testing.assert_array_equal(back.gd, camp.gd)
+    assert back.status.tolist() == camp.status.tolist()
+
+
+def test_a_save_that_fails_leaves_the_earlier_file_whole(table, tmp_path, monkeypatch):
+    camp, _ = table
+    path = tmp_path / "campaign.npz"
+    camp.save(path)
+    before = path.read_bytes()
+
+    def full_disk(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(np, "savez", full_disk)
+    with pytest.raises(vehicle.CampaignFileError, match="No space left"):
+        camp.save(path)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["campaign.npz"]
+    with pytest.raises(vehicle.CampaignFileError, match="cannot write"):
+        camp.save(tmp_path / "missing-folder" / "c.npz")
+
+
+def test_a_file_whose_table_is_invalid_is_a_campaign_file_error(table, tmp_path):
+    camp, _ = table
+    path = tmp_path / "c.npz"
+    camp.save(path)
+    with np.load(path) as data:
+        arrays = dict(data)
+    arrays["gd"] = np.array([250.0, -1.0, 400.0])
+    np.savez(path, **arrays)
+    with pytest.raises(vehicle.CampaignFileError, match="not a valid campaign.*gd"):
+        vehicle.load_campaign(path)

@@ -1,0 +1,61 @@
+"""Replace a file in one step: readers see the old file or the whole new one, never a part."""
+
+from __future__ import annotations
+
+import os
+import secrets
+import stat
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import IO
+
+from gpmsa.errors import GPMSAError
+
+
+@contextmanager
+def atomic_write(
+    path: str | os.PathLike, *, text: bool = False, error: type[Exception] = GPMSAError
+) -> Iterator[IO]:
+    """Open a new temporary file beside ``path`` for writing (and reading back); on a clean exit
+    flush it to disk and move it over ``path``; on any exception remove it, leaving an existing
+    ``path`` untouched.
+
+    Args:
+        path: the file to write (its folder must exist); an existing ``path`` that is not a
+            regular file (a directory, device, FIFO) is refused.
+        text: a text handle (UTF-8, newlines written as given) instead of a binary one.
+        error: the exception type raised when the file cannot be written.
+
+    Yields:
+        the open handle, positioned at 0 (opened "w+", so a writer may check what it wrote).
+        The file gets the permissions of a newly created file (0o666 less the umask).
+    """
+    path = Path(path)
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise error(f"{path}: cannot write ({exc.strerror})") from exc
+    if mode is not None and not stat.S_ISREG(mode):
+        raise error(f"{path} exists and is not a regular file: refusing to replace it")
+    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.part")
+    flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(tmp, flags, 0o666)
+    except OSError as exc:  # e.g. a missing folder or one without write permission
+        raise error(f"{path}: cannot write ({exc.strerror})") from exc
+    try:
+        kw = {"encoding": "utf-8", "newline": ""} if text else {}
+        with os.fdopen(fd, "w+" if text else "w+b", **kw) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
