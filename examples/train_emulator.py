@@ -25,7 +25,9 @@ Steps (docs/closed-loop.md):
    describing the window scatter (its lamWs prior relaxed from GPM/SA's lower bound of 60 to 1).
 
 The files go to ``--emulator-dir`` (default ``OUT/emulators``); ``--ship`` writes them into the
-package (control/emulators/) instead, replacing the shipped ones. Each file's metadata records the
+package (control/emulators/) instead, replacing the shipped ones; it refuses, before the
+campaign, speed or GD ranges that would not cover the default Simplex's speeds (1-2 m/s) and the
+paper's track (GD 300-500), which the README's main command needs. Each file's metadata records the
 vehicle, the noise level, the feature, the road settings, the design, the fit settings and the
 versions of Python, numpy, scipy, exudyn and BLAS that made the training data (`gpmsa info`
 shows them, with those of the fit).
@@ -44,7 +46,9 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 from _cli import output_folder  # noqa: E402
+from closed_loop import PAPER_SEGMENTS  # noqa: E402
 
+import control  # noqa: E402
 import gpmsa  # noqa: E402
 import vehicle  # noqa: E402
 from control import PAPER_WINDOW, FeatureSpec  # noqa: E402
@@ -153,6 +157,24 @@ def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict
         "made_by": "examples/train_emulator.py",
         **extra,
     }
+
+
+def check_shippable(parser: argparse.ArgumentParser, args) -> None:
+    """Refuse --ship with ranges that the main command (closed_loop.py with the shipped files,
+    the paper's track and the default Simplex) would refuse, before the campaign runs."""
+    need_v = (control.Simplex.v_safe, control.Simplex.v_max)
+    need_gd = (min(gd for _, gd in PAPER_SEGMENTS), max(gd for _, gd in PAPER_SEGMENTS))
+    for flag, (lo, hi), (need_lo, need_hi), unit in (
+        ("--speed-range", args.speed_range, need_v, "m/s (the default Simplex's speeds)"),
+        ("--gd-range", args.gd_range, need_gd, "(the paper's track)"),
+    ):
+        if not lo <= need_lo <= need_hi <= hi:
+            parser.error(
+                f"--ship with {flag} {lo:g} {hi:g}: the shipped files must cover "
+                f"[{need_lo:g}, {need_hi:g}] {unit}, or `python examples/closed_loop.py` would "
+                "refuse them; write these emulators elsewhere with --emulator-dir DIR and run "
+                "closed_loop.py --emulator-dir DIR"
+            )
 
 
 def fit_band(case: str, campaign, model, args):
@@ -277,6 +299,8 @@ def main(argv: list[str] | None = None) -> None:
             f"--speed-range HI = {v_hi:g} m/s exceeds the vehicle's top speed "
             f"{model.max_speed_mps:g} m/s"
         )
+    if args.ship:
+        check_shippable(parser, args)
     out = output_folder(parser, "--out", args.out)
     if args.ship:
         emu_dir = output_folder(parser, "--ship", EMULATOR_DIR)

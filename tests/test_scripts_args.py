@@ -96,6 +96,16 @@ CASES = [
         "--speed-range HI = 2.5 m/s exceeds the vehicle's top speed 2 m/s",
     ),
     ("examples/train_emulator.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
+    (
+        "examples/train_emulator.py",
+        ["--ship", "--speed-range", "0.5", "1.5"],
+        "--ship with --speed-range 0.5 1.5: the shipped files must cover [1, 2] m/s",
+    ),
+    (
+        "examples/train_emulator.py",
+        ["--ship", "--gd-range", "350", "600"],
+        "--ship with --gd-range 350 600: the shipped files must cover [300, 500]",
+    ),
 ]
 
 
