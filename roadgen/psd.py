@@ -56,14 +56,22 @@ def profile_psd(
     z, dx = checks.heights("road", road)
     end_match = checks.flag("end_match", end_match)
     seg = z.size // 4 if nperseg is None else checks.integer("nperseg", nperseg, 8)
-    fs = 1.0 / dx
+    if method == "welch" and not 8 <= seg <= z.size:
+        raise RoadgenError(f"nperseg={nperseg!r} is out of range: allowed [8, {z.size}]")
+    return _psd(z, dx, method, seg, end_match)
+
+
+def _psd(
+    z: np.ndarray, dx: float, method: str, nperseg: int, end_match: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """``profile_psd`` of checked heights z (N,) m on a step dx m (n = 0 dropped)."""
     if method == "periodogram":
         detrend = _end_match if end_match else "constant"
-        n, gd = scipy.signal.periodogram(z, fs=fs, window="boxcar", detrend=detrend)
+        n, gd = scipy.signal.periodogram(z, fs=1.0 / dx, window="boxcar", detrend=detrend)
     else:
-        if not 8 <= seg <= z.size:
-            raise RoadgenError(f"nperseg={nperseg!r} is out of range: allowed [8, {z.size}]")
-        n, gd = scipy.signal.welch(z, fs=fs, window="hann", nperseg=seg, detrend="constant")
+        n, gd = scipy.signal.welch(
+            z, fs=1.0 / dx, window="hann", nperseg=nperseg, detrend="constant"
+        )
     return n[1:], gd[1:]
 
 
@@ -98,13 +106,15 @@ def estimate_gd(
     nyquist = 0.5 / dx
     lo, hi = checks.band("band", FIT_BAND if band is None else band, nyquist)
     if method == "periodogram":
-        n, gd = profile_psd(road, "periodogram")
+        n, gd = _psd(z, dx, "periodogram", z.size, end_match=False)
         k = int(np.argmin(np.abs(np.log(n / N0))))
         return float(gd[k] * (n[k] / N0) ** w / GD_SCALE)
     if method == "fit":
-        n, gd = profile_psd(road, "periodogram", end_match=True)
+        n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
     else:
-        n, gd = profile_psd(road, "welch")
+        if z.size < 32:  # profile_psd's default Welch segment, N // 4, must hold 8 points
+            raise RoadgenError(f"method='welch' needs a road of >= 32 heights, got {z.size}")
+        n, gd = _psd(z, dx, "welch", z.size // 4, end_match=False)
     keep = (n >= lo) & (n <= hi)
     if method == "welch":
         k = n / n[0]
@@ -121,9 +131,9 @@ def estimate_gd(
 
 def psd_slope(road: HasHeights, band: tuple[float, float] | None = None) -> float:
     """Least-squares slope of log Gd on log n over ``band`` (default FIT_BAND); ISO 8608: -2."""
-    _, dx = checks.heights("road", road)
+    z, dx = checks.heights("road", road)
     lo, hi = checks.band("band", FIT_BAND if band is None else band, 0.5 / dx)
-    n, gd = profile_psd(road, "periodogram", end_match=True)
+    n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
     keep = (n >= lo) & (n <= hi) & (gd > 0)
     if np.count_nonzero(keep) < 2:
         raise RoadgenError(f"band=({lo:.6g}, {hi:.6g}) holds fewer than 2 PSD bins of this road")

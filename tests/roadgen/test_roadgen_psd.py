@@ -102,5 +102,8 @@ def test_too_short_a_road_for_the_band_raises():
         roadgen.estimate_gd(road, method="welch")
     with pytest.raises(roadgen.RoadgenError, match="nperseg=4"):
         roadgen.profile_psd(road, method="welch", nperseg=4)
+    few = SimpleNamespace(z=road.z[:20], dx_m=road.dx_m)  # Welch's default segment < 8 points
+    with pytest.raises(roadgen.RoadgenError, match="method='welch' needs a road of >= 32 heights"):
+        roadgen.estimate_gd(few, method="welch", band=(10.0, 80.0))
     with pytest.raises(roadgen.RoadgenError, match="method='fft'"):
         roadgen.profile_psd(road, method="fft")
