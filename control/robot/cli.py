@@ -159,8 +159,12 @@ def main(argv: list[str] | None = None) -> int:
         "duration_s": result.duration_s,
         "real_time_factor": result.real_time_factor,
     }
-    with atomic_write(out / "replay.json", text=True, error=ControlError) as fh:
-        fh.write(json.dumps(report, indent=2, default=float))
+    try:
+        with atomic_write(out / "replay.json", text=True, error=ControlError) as fh:
+            fh.write(json.dumps(report, indent=2, default=float))
+    except (ControlError, OSError) as exc:  # e.g. a full disk
+        print(f"terrain-replay: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
     print(result.describe())
     print(f"wrote {out / 'estimates.csv'}, {out / 'estimates'} (topic "
           f"{settings.estimate_topic}) and {out / 'replay.json'}")  # fmt: skip
