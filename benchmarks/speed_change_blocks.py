@@ -241,8 +241,8 @@ def main() -> None:
     ap.add_argument("--first-seed", type=int, default=101, help="first seed of either part")
     ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     args = ap.parse_args()
-    if args.roads < 2 or args.runs < 1 or args.workers < 1:
-        ap.error("--roads must be >= 2, --runs and --workers >= 1")
+    if args.roads < 2 or args.runs < 2 or args.workers < 1 or args.first_seed < 0:
+        ap.error("--roads and --runs must be >= 2, --workers >= 1, --first-seed >= 0")
     tic = time.perf_counter()
     print(load())
     if args.part in ("open", "both"):
