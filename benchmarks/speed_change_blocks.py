@@ -39,6 +39,7 @@ import argparse
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
+from functools import cache
 
 import numpy as np
 from scipy.signal.windows import dpss
@@ -46,6 +47,7 @@ from scipy.signal.windows import dpss
 import control
 import roadgen
 import vehicle
+from control.bcr import MAX_SPEED_CHANGE
 from control.shipped import shipped_emulator
 
 RATE_HZ = 120.0
@@ -83,13 +85,10 @@ class _BlockReader:
         return float(np.log(self.model.gd[np.argmax(self.model.loglik(y, speed))] / gd))
 
 
-_READERS: dict[str, _BlockReader] = {}
-
-
+@cache
 def _reader(case: str) -> _BlockReader:
-    if case not in _READERS:
-        _READERS[case] = _BlockReader(case)
-    return _READERS[case]
+    """One reader per case and worker process."""
+    return _BlockReader(case)
 
 
 def _open_run(job: tuple[str, int, float, float, float]) -> list[tuple[int, float, float]]:
@@ -127,7 +126,7 @@ def _blocks(r: _BlockReader, track, accel, speed, position) -> list[tuple[float,
         for i in range(n):
             v = float(s[i].mean())
             gd = track.gd_at(p[i, 0])
-            if not (1.0 <= v <= 2.0) or s[i].min() < 0.5 * s[i].max():
+            if not (1.0 <= v <= 2.0) or s[i].min() < MAX_SPEED_CHANGE * s[i].max():
                 continue
             if track.gd_at(p[i, -1]) != gd or p[i, 0] < 5.0:
                 continue
