@@ -32,7 +32,12 @@ Band emulator (``control.shipped_emulator(case, "band")``, the change-point BCR'
   (400 resamples of batches of 8 consecutive blocks);
 - ``lin``: the same bias linearised at the truth, exp(g' S^-1 d / g' S^-1 g) - 1 with
   g = d mu / d log GD of the emulator and S = Sigma(v), with its standard error from the cell's
-  long-run covariance: not truncated by the domain's edges (the ML at GD 200 and 600 is).
+  long-run covariance: not truncated by the domain's edges (the ML at GD 200 and 600 is);
+- ``emu``: the emulator's own sd of its mean at the cell (each component's GP variance at the
+  point estimate, no nugget, through the basis: `gpmsa.emulator_prediction`), as a linearised GD
+  error like ``lin``. A bias within it is the uncertainty the emulator states; a cell marked
+  ``+`` in its table lies beyond 2 x the root of se^2 + emu^2, an error the emulator does not
+  claim (a misfit, not too few runs).
 
 Window emulator (``shipped_emulator(case, "window")``, the paper's): log f of disjoint 1,000-sample
 windows (7 per minute of driving); ``z`` of the mean against ``emu.predict(v, GD)``'s mean in
@@ -63,6 +68,7 @@ import numpy as np
 from scipy import stats
 
 import control
+import gpmsa
 import vehicle
 from control.training import block_statistics
 
@@ -188,6 +194,7 @@ class Cell:
     edge: bool
     lin: float
     lin_se: float
+    emu_sd: float  # the emulator's own sd of its mean at the cell, as a linearised GD error
 
     @property
     def mark(self) -> str:
@@ -197,6 +204,12 @@ class Cell:
     def lin_mark(self) -> str:
         return "*" if abs(self.lin) > 2 * self.lin_se else " "
 
+    @property
+    def beyond_emulator(self) -> bool:
+        """Whether the linearised bias exceeds twice its Monte-Carlo se and the emulator's own
+        sd combined: an error the emulator does not claim (misfit rather than uncertainty)."""
+        return abs(self.lin) > 2 * np.hypot(self.lin_se, self.emu_sd)
+
 
 def slope(emu, v: float, gd: float, h: float = 0.02) -> np.ndarray:
     """d mean / d log GD (K,) of ``emu.predict`` at (v, GD), central within the domain."""
@@ -204,6 +217,15 @@ def slope(emu, v: float, gd: float, h: float = 0.02) -> np.ndarray:
     a, b = max(gd * np.exp(-h), lo), min(gd * np.exp(h), hi)
     mean, _ = emu.predict([v, v], [a, b], resid=False)
     return (mean[1] - mean[0]) / np.log(b / a)
+
+
+def mean_cov(emu, v: float, gd: float) -> np.ndarray:
+    """The emulator's own predictive covariance (K, K) of its mean at (v, GD), native units: the
+    GP's variance of each principal component's weight at the point estimate (no nugget)
+    through the basis, y_sd^2 K diag(var_w) K'."""
+    pred = gpmsa.emulator_prediction(emu, [[v]], [[gd]], draws=False, resid=False, seed=0)
+    basis = pred.K * pred.y_sd
+    return basis @ np.diag(pred.var_w[0, 0]) @ basis.T
 
 
 def linearised(d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray):
@@ -240,10 +262,11 @@ def band_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
             gd_ml, se, edge = ml_with_bootstrap(parts, log_gd, rng)
             g = slope(emu, min(v, v_hi), gd)
             lin = linearised(d, g, np.linalg.inv(sigma), cell_cov / n)
+            emu_sd = linearised(d, g, np.linalg.inv(sigma), mean_cov(emu, min(v, v_hi), gd))[1]
             out.append(
                 Cell(v, gd, z, chi2, float(stats.chi2.sf(chi2, spec.dim)),
                      float(np.mean(np.diag(cell_cov) / np.diag(sigma))), gd_ml / gd - 1,
-                     se / gd, edge, *lin)
+                     se / gd, edge, *lin, emu_sd)
             )  # fmt: skip
     return out
 
@@ -268,14 +291,13 @@ def window_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
                 None, :, 0
             ] - 0.5 * np.log(var_g[None, :, 0])
             gd_ml, se, edge = ml_with_bootstrap(loglik, log_gd, rng)
-            lin = linearised(
-                np.array([y.mean() - mu[0, 0]]), slope(emu, v_in, gd), np.eye(1),
-                np.array([[y.var(ddof=1) / y.size]]),
-            )  # fmt: skip
+            d, g = np.array([y.mean() - mu[0, 0]]), slope(emu, v_in, gd)
+            lin = linearised(d, g, np.eye(1), np.array([[y.var(ddof=1) / y.size]]))
+            emu_sd = linearised(d, g, np.eye(1), mean_cov(emu, v_in, gd))[1]
             out.append(
                 Cell(v, gd, np.array([z]), float(z**2), float(stats.chi2.sf(z**2, 1)),
                      float(y.std(ddof=1) / np.sqrt(var[0, 0])), gd_ml / gd - 1, se / gd, edge,
-                     *lin)
+                     *lin, emu_sd)
             )  # fmt: skip
     return out
 
@@ -287,7 +309,7 @@ def print_cells(title: str, cells: list[Cell], grid: Grid, band: bool) -> None:
         head = f"{'v':>5}{'GD':>5} {zs} {'chi2':>7}{'p':>8}{'var':>6}"
     else:
         head = f"{'v':>5}{'GD':>5} {'z':>6} {'p':>8}{'sd':>6}"
-    print(head + f" {'GD bias %':>10}{'se %':>6} {'lin %':>7}{'se %':>6}")
+    print(head + f" {'GD bias %':>10}{'se %':>6} {'lin %':>7}{'se %':>6}{'emu %':>6}")
     for cell in cells:
         zs = "".join(f"{z:6.1f}" for z in cell.z)
         mid = f" {cell.chi2:7.1f}{cell.p:8.1e}" if band else f"{cell.p:9.1e}"
@@ -295,6 +317,7 @@ def print_cells(title: str, cells: list[Cell], grid: Grid, band: bool) -> None:
             f"{cell.v:5.2f}{cell.gd:5.0f} {zs}{mid}{cell.spread:6.2f} "
             f"{100 * cell.bias:+9.1f}{cell.mark}{100 * cell.se:5.1f} "
             f"{100 * cell.lin:+6.1f}{cell.lin_mark}{100 * cell.lin_se:5.1f}"
+            f"{100 * cell.emu_sd:6.1f}"
         )
     print("\nrelative GD bias, % (* > 2 se; | maximum on the domain's edge); rows GD, columns v")
     print(f"{'GD':>5} " + "".join(f"{v:>9.2f}" for v in grid.speeds))
@@ -322,6 +345,20 @@ def print_cells(title: str, cells: list[Cell], grid: Grid, band: bool) -> None:
         f"{rms([c.lin for c in cells]):.1f}% against RMS se {rms([c.lin_se for c in cells]):.1f}%"
         f" (all cells); per speed "
         + ", ".join(f"{v:.3g}: {rms([c.lin for c in cells if c.v == v]):.1f}%" for v in grid.speeds)
+    )
+    print("the emulator's own sd of its mean, as a linearised GD error, % (+ where the linearised "
+          "bias exceeds 2 x the root of its se^2 + this^2)")  # fmt: skip
+    for gd in grid.gds:
+        row = [c for c in cells if c.gd == gd]
+        marks = "".join(f"{100 * c.emu_sd:7.1f}{'+' if c.beyond_emulator else ' '} " for c in row)
+        print(f"{gd:5.0f} " + marks)
+    print(
+        f"{sum(c.beyond_emulator for c in cells)} of {len(cells)} cells beyond what the emulator "
+        f"claims (about {0.0455 * len(cells):.0f} by chance); RMS emulator sd "
+        f"{rms([c.emu_sd for c in cells]):.1f}%, per speed "
+        + ", ".join(
+            f"{v:.3g}: {rms([c.emu_sd for c in cells if c.v == v]):.1f}%" for v in grid.speeds
+        )
     )
 
 

@@ -26,6 +26,16 @@ CASES = [
         ["--mean-segment", "-1"],
         "--mean-segment: mean_segment_m must be finite and > 0, got -1",
     ),
+    (
+        "benchmarks/closed_loop_accuracy.py",
+        ["--steady-roads", "1"],
+        "--steady-roads must be >= 2 (a standard error needs two), got 1",
+    ),
+    (
+        "benchmarks/closed_loop_accuracy.py",
+        ["--steady-first-seed", "-1"],
+        "--steady-first-seed must be >= 0, got -1",
+    ),
     ("benchmarks/closed_loop_speed.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
     (
         "benchmarks/emulator_bias.py",

@@ -25,6 +25,24 @@ def test_stretched_design_spans_the_domain_and_stays_latin():
         assert np.max(np.diff(np.sort(design[:, col]))) <= 2.2 * width / 40
 
 
+def test_arcsine_speed_spacing_keeps_the_latin_order_and_crowds_the_ends():
+    script = load_script()
+    uniform = script.stretched_design(200, seed=4)
+    arcsine = script.stretched_design(200, seed=4, speed_spacing="arcsine")
+    assert np.array_equal(arcsine[:, 1], uniform[:, 1])  # GD untouched
+    assert np.array_equal(np.argsort(arcsine[:, 0]), np.argsort(uniform[:, 0]))
+    assert arcsine[:, 0].min() == pytest.approx(0.5) and arcsine[:, 0].max() == pytest.approx(2.0)
+
+    def share_near_ends(v):  # within 5% of the range of either end
+        return np.mean((v < 0.575) | (v > 1.925))
+
+    # the arcsine law puts 2 acos(0.9) / pi = 29% there, uniform spacing 10%
+    assert share_near_ends(uniform[:, 0]) == pytest.approx(0.10, abs=0.02)
+    assert share_near_ends(arcsine[:, 0]) == pytest.approx(0.287, abs=0.03)
+    with pytest.raises(ValueError, match="speed_spacing must be one of"):
+        script.stretched_design(10, seed=0, speed_spacing="chebyshev")
+
+
 def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypatch):
     script = load_script()
     shipped = {p: p.stat().st_mtime_ns for p in script.EMULATOR_DIR.glob("*.gpmsa")}
@@ -40,6 +58,7 @@ def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypat
         for kind in ("band", "window"):
             emu = gpmsa.load(folder / control.shipped.emulator_file_name(case, kind))
             assert emu.metadata["noise_std"] == noise
+            assert emu.metadata["design"]["speed_spacing"] == "uniform"
             assert emu.domain["v"] == pytest.approx((0.5, 2.0))
             assert set(emu.metadata["versions"]) >= {"numpy", "scipy", "exudyn", "python"}
             control.check_emulator(emu, model=vehicle.Jackal(), noise_std=noise)
