@@ -246,6 +246,7 @@ def report_steady(results, case: str) -> list[str]:
         for v in STEADY_SPEEDS:
             rel = [r["mean"][r["position"] > 25.0] / gd - 1 for r in runs if r["extra"] == (gd, v)]
             rel = [x[np.isfinite(x)] for x in rel]
+            rel = [x for x in rel if x.size]  # a road with no estimate after 25 m has no mean
             bias, bias_se = clustered_mean(rel)
             mse, mse_se = clustered_mean([x**2 for x in rel])
             rmse = np.sqrt(mse)
