@@ -246,6 +246,7 @@ def band_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
     out = []
     for v in grid.speeds:
         sigma = scatter_at(om.scatter, v)
+        weight = np.linalg.inv(sigma)  # the likelihood's, for the linearised bias
         for gd in grid.gds:
             runs = np.flatnonzero(c.ok & (c.v == v) & (c.gd == gd))
             st = block_statistics(accel[runs], spec, batch=BATCH)
@@ -261,8 +262,8 @@ def band_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
             parts = loglik.reshape(-1, BATCH, loglik.shape[1]).sum(axis=1)
             gd_ml, se, edge = ml_with_bootstrap(parts, log_gd, rng)
             g = slope(emu, min(v, v_hi), gd)
-            lin = linearised(d, g, np.linalg.inv(sigma), cell_cov / n)
-            emu_sd = linearised(d, g, np.linalg.inv(sigma), mean_cov(emu, min(v, v_hi), gd))[1]
+            lin = linearised(d, g, weight, cell_cov / n)
+            emu_sd = linearised(d, g, weight, mean_cov(emu, min(v, v_hi), gd))[1]
             out.append(
                 Cell(v, gd, z, chi2, float(stats.chi2.sf(chi2, spec.dim)),
                      float(np.mean(np.diag(cell_cov) / np.diag(sigma))), gd_ml / gd - 1,
