@@ -43,7 +43,7 @@ import numpy as np
 
 from control.changepoint import ChangePointFilter, ChangePointSettings, mixture_posterior
 from control.errors import ControlError
-from control.estimate import Estimate, graver_fault
+from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.sensor_checks import SensorLimits, signal_fault, stream_fault
 from control.tracker import GDTracker, TrackerSettings
@@ -527,11 +527,12 @@ class BCR:
         t_now, pos_now = self._now()
         post, prob_change = self._pooled_posterior()
         name = self.gd_name
+        edge, note = self._edge_note(post, self._phases[0].filter.prior)
         return Estimate(
             t_now,
             pos_now,
             "ok",
-            reason,
+            "; ".join(filter(None, (reason, note))),
             gd_mean=post.mean(name),
             gd_sd=post.sd(name),
             interval=post.interval(name, self.settings.interval_level),
@@ -541,6 +542,24 @@ class BCR:
             feature=y,
             prob_change=prob_change,
             data_time=self._newest_data_time(),
+            domain_edge=edge,
+        )
+
+    def _edge_note(self, post: Posterior, prior_mass: np.ndarray) -> tuple[str, str]:
+        """(`favoured_edge` of a grid posterior with the given prior masses on its nodes, a
+        sentence for the estimate's reason or "")."""
+        marginal = post.grids[self.gd_name]
+        edge = favoured_edge(marginal.nodes, marginal.density * marginal.weights, prior_mass)
+        if not edge:
+            return "", ""
+        lo, hi = self.gd_range
+        at, side, bound = (hi, "rougher", f"<= {hi:g}") if edge == "upper" else (
+            lo, "smoother", f">= {lo:g}")  # fmt: skip
+        return edge, (
+            f"the data favour GD {at:g}, the emulator's {edge} edge, over every GD "
+            f"{EDGE_MARGIN:.0%} or more inside its domain by a Bayes factor > "
+            f"{EDGE_BAYES_FACTOR:g}: the road may be {side} than any the emulator knows (the "
+            f"posterior assumes GD {bound})"
         )
 
     def _pooled_posterior(self) -> tuple[Posterior, float]:
@@ -586,8 +605,10 @@ class BCR:
         if not 0.0 <= unit <= 1.0:  # the emulator's own rule (snaps rounding at the ends)
             why = f"window speed {v:.3g} m/s outside the emulator's range [{lo:g}, {hi:g}] m/s"
             if self.last.ok:
+                note = self._edge_note(self.last.posterior, np.exp(self.trackers[0].log_prior))[1]
+                reason = "; ".join(filter(None, ("no new information: " + why, note)))
                 return replace(self.last, time=self._now()[0], position=self._now()[1],
-                               reason="no new information: " + why)  # fmt: skip
+                               reason=reason)  # fmt: skip
             return self._no_estimate("out_of_domain", why, speed=v)
         y = window_feature(self._acc, s.feature.name)
         if not np.isfinite(y):
@@ -614,10 +635,12 @@ class BCR:
         self._data_time = t_now
         post = tracker.posterior(self.gd_name)
         name = self.gd_name
+        edge, note = self._edge_note(post, np.exp(tracker.log_prior))
         return Estimate(
             t_now,
             pos_now,
             "ok",
+            note,
             gd_mean=post.mean(name),
             gd_sd=post.sd(name),
             interval=post.interval(name, s.interval_level),
@@ -626,6 +649,7 @@ class BCR:
             speed=v,
             feature=np.array([y]),
             data_time=t_now,
+            domain_edge=edge,
         )
 
     def _window_implausible(self, v: float, y: float) -> tuple[str, float]:

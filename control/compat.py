@@ -87,7 +87,9 @@ def check_emulator(
     Errors: another vehicle model; another feature (name, block or window length, rate, bands,
     tapers); a track whose prescribed GD lies outside the emulator's GD domain; a Simplex whose
     top or safe speed lies outside the emulator's speed domain (the BCR learns nothing at such
-    a speed: the robot would drive on an estimate that only ages). Warnings: a
+    a speed: the robot would drive on an estimate that only ages), or whose GD_max is not below
+    the emulator's highest GD (the posterior never exceeds that, so the estimate could never
+    call for safety mode). Warnings: a
     different noise level (the paper's Test Cases pair the noise-free emulator with noise-free
     data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
     want it); vehicle or noise metadata missing.
@@ -127,6 +129,12 @@ def check_emulator(
             )
     if simplex is not None:
         _check_speeds(emulator, simplex)
+        hi = float(emulator.domain[emulator.t_names[0]][1])
+        if not simplex.gd_max < hi:
+            raise EmulatorMismatchError(
+                f"Simplex gd_max = {simplex.gd_max:g} is not below the emulator's highest GD "
+                f"{hi:g}: no GD estimate could exceed it, so safety mode would never start"
+            )
 
 
 def _check_speeds(emulator, simplex: Simplex) -> None:

@@ -37,6 +37,29 @@ def graver_fault(first: Estimate | None, second: Estimate) -> Estimate | None:
     return first
 
 
+#: `favoured_edge`: the evidence (posterior-to-prior ratio, a Bayes factor) that marks an edge
+#: of the GD domain as favoured, against every GD at least EDGE_MARGIN (relative) inside it:
+#: 20 is "strong" evidence on Kass and Raftery's (1995) scale.
+EDGE_BAYES_FACTOR = 20.0
+EDGE_MARGIN = 0.05
+
+
+def favoured_edge(nodes: np.ndarray, posterior_mass: np.ndarray, prior_mass: np.ndarray) -> str:
+    """The edge "upper" ("lower") when the data favour the last (first) of the increasing GD
+    ``nodes`` by a Bayes factor above EDGE_BAYES_FACTOR over every node at least EDGE_MARGIN
+    inside it (the posterior-to-prior mass ratio there is that much higher); "" otherwise."""
+    with np.errstate(divide="ignore", invalid="ignore"):  # no prior mass: no evidence there
+        log_ratio = np.where(prior_mass > 0, np.log(posterior_mass) - np.log(prior_mass), -np.inf)
+    threshold = np.log(EDGE_BAYES_FACTOR)
+    inside_top = nodes <= nodes[-1] * (1.0 - EDGE_MARGIN)
+    inside_bottom = nodes >= nodes[0] * (1.0 + EDGE_MARGIN)
+    if log_ratio[-1] - log_ratio[inside_top].max() > threshold:
+        return "upper"
+    if log_ratio[0] - log_ratio[inside_bottom].max() > threshold:
+        return "lower"
+    return ""
+
+
 @dataclass(frozen=True, eq=False)
 class Estimate:
     """A posterior of GD at one instant, or why there is none.
@@ -61,6 +84,10 @@ class Estimate:
         plausibility_p: for an "implausible" estimate, the upper-tail probability of the
             newest observation under the emulator's law at the GD that explains it best (the
             smaller, the less any GD explains it); NaN otherwise.
+        domain_edge: "upper" ("lower") when the data strongly favour the emulator's highest
+            (lowest) GD over every GD inside its domain (`favoured_edge`): the road may be
+            rougher (smoother) than any the emulator knows, and the posterior, which assumes GD
+            within the domain, then understates (overstates) it; "" otherwise and unless ok.
     """
 
     time: float
@@ -77,6 +104,7 @@ class Estimate:
     prob_change: float = np.nan
     data_time: float = np.nan
     plausibility_p: float = np.nan
+    domain_edge: str = ""
 
     @property
     def ok(self) -> bool:

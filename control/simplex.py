@@ -25,7 +25,9 @@ crosses a grid point, and it is never above the law. ``speed_step_mps=0``: the c
 Risk posture: ``risk=None`` feeds the posterior mean of GD to the law (the paper). ``risk=alpha``
 feeds the (1 - alpha) posterior quantile instead, so safety mode starts as soon as
 P(GD > GD_max) > alpha. Any estimate that is not "ok" (buffer filling, fault, out of domain,
-stale), or an "ok" one whose GD is not finite, means safety mode.
+stale), an "ok" one whose GD is not finite, or one whose data favour the emulator's upper GD edge
+(``Estimate.domain_edge == "upper"``: the road may be rougher than any the emulator knows, and the
+posterior, bounded by that edge, cannot say how much) means safety mode.
 
 After a fault (``after_fault``): a sensor that has failed once is not trusted again within the
 run. With ``"latch"`` (default), the first estimate whose status is a fault (``FAULT_STATUSES``:
@@ -175,6 +177,10 @@ class Simplex:
             return Command(self.v_safe, "safety", np.nan, "risk posture needs the posterior")
         if not np.isfinite(gd):
             return Command(self.v_safe, "safety", np.nan, f"the estimate's GD is {gd}")
+        if estimate.domain_edge == "upper":
+            return Command(
+                self.v_safe, "safety", gd, "the road reads at or above the emulator's roughest GD"
+            )
         if gd > self.gd_max:
             return Command(self.v_safe, "safety", gd, f"GD {gd:.0f} > GD_max {self.gd_max:g}")
         return Command(self.on_speed_grid(self.performance_speed(gd)), "performance", gd)

@@ -32,7 +32,7 @@ GD_ESTIMATE_MSG = """\
 # One estimate of the BCR (terrain roughness GD, 1e-6 m^3) and the Simplex's speed command.
 std_msgs/Header header   # stamp: time of the newest IMU sample the estimate has seen
 string status            # ok, filling, out_of_domain, sensor_fault, implausible, ...
-string reason            # why there is no estimate (or "" when status is ok)
+string reason            # why there is no estimate (on an ok one: a note, or "")
 float64 position         # m along the path (odometry)
 float64 speed            # m/s, mean measured speed over the block
 float64 gd_mean          # posterior mean of GD

@@ -16,7 +16,9 @@ from control import (
     Estimate,
     FeatureSpec,
     SensorFault,
+    Simplex,
 )
+from control.estimate import favoured_edge
 from control.faults import FaultInjector
 from control.sensor_checks import MIN_SEGMENT
 
@@ -74,6 +76,66 @@ def test_a_step_is_followed_within_a_few_blocks(block_model):
     change = np.array([e.prob_change for e in ests])
     assert change[(pos > 45) & (pos < 45 + delay + 3)].max() > 0.5
     assert abs(mean[-5:].mean() - 500) < 50
+
+
+@pytest.mark.parametrize(
+    ("gd", "edge", "side", "mode"),
+    [(750.0, "upper", "rougher", "safety"), (150.0, "lower", "smoother", "performance")],
+)
+@pytest.mark.parametrize("method", ["changepoint", "filter", "window"])
+def test_a_road_beyond_the_domain_is_named_and_a_rougher_one_means_safety(
+    block_model, fake_calibrator, method, gd, edge, side, mode
+):
+    if method == "changepoint":
+        bcr, lo, hi = BCR(block_model), block_model.gd[0], block_model.gd[-1]
+    else:
+        bcr, lo, hi = BCR(fake_calibrator, method=method, **WINDOW), 200.0, 600.0
+    ests = feed(bcr, *stream(const(gd), 1.5, 120, seed=0))
+    late = [e for e in ests if e.ok][-10:]
+    assert len(late) == 10 and all(e.domain_edge == edge and side in e.reason for e in late)
+    # the posterior cannot leave the domain: the note is what says the road lies beyond it
+    assert all(lo <= e.interval[0] <= e.interval[1] <= hi for e in late)
+    # GD_max above the domain (check_emulator refuses it): here only the edge can mean safety
+    simplex = Simplex(gd_min=100.0, gd_max=650.0)
+    assert all(simplex.command(e).mode == mode for e in late)
+    if method == "changepoint":  # standing: the carried estimate keeps its note
+        t, p = 120.0 + np.arange(1, 251) / 120, np.full(250, 180.0)
+        noise = 0.01 * np.random.default_rng(2).standard_normal(250)
+        still = feed(bcr, t, p, noise, np.zeros(250))[-1]
+        assert still.ok and "no new information" in still.reason and side in still.reason
+
+
+@pytest.mark.parametrize("method", ["changepoint", "filter"])
+def test_inside_the_domain_no_edge_is_named(block_model, fake_calibrator, method):
+    for gd in (230.0, 400.0, 550.0):
+        if method == "changepoint":
+            bcr = BCR(block_model)
+        else:
+            bcr = BCR(fake_calibrator, method=method, **WINDOW)
+        ests = feed(bcr, *stream(const(gd), 1.5, 60, seed=0))
+        assert all(e.domain_edge == "" and e.reason == "" for e in ests if e.ok)
+
+
+def test_favoured_edge_needs_strong_evidence_beyond_the_margin():
+    nodes = np.geomspace(200.0, 600.0, 121)
+    prior = np.full(nodes.size, 1.0 / nodes.size)
+
+    def post(log_lik):
+        mass = prior * np.exp(log_lik - log_lik.max())
+        return mass / mass.sum()
+
+    rising = 100.0 * np.log(nodes)  # the likelihood still rises at 600: its peak lies beyond
+    assert favoured_edge(nodes, post(rising), prior) == "upper"
+    assert favoured_edge(nodes, post(-rising), prior) == "lower"
+    peak = lambda centre, sd: -0.5 * (np.log(nodes / centre) / sd) ** 2  # noqa: E731
+    assert favoured_edge(nodes, post(peak(400.0, 0.05)), prior) == ""
+    assert favoured_edge(nodes, post(np.zeros(nodes.size)), prior) == ""  # no information
+    # a peak at the edge itself counts only with a Bayes factor > 20 against 5% inside
+    assert favoured_edge(nodes, post(peak(600.0, 0.02)), prior) == "upper"
+    assert favoured_edge(nodes, post(peak(600.0, 0.05)), prior) == ""
+    # nodes the prior excludes carry no evidence
+    fenced = np.where(nodes > 550.0, 0.0, prior)
+    assert favoured_edge(nodes, post(rising) * (nodes <= 550.0), fenced) == ""
 
 
 def test_a_fault_skips_its_block_and_keeps_the_run_length_posterior(block_model):

@@ -112,6 +112,14 @@ def test_check_emulator_refuses_a_simplex_driving_outside_the_speed_domain():
         check_emulator(narrow, simplex=Simplex())
 
 
+def test_check_emulator_refuses_a_gd_max_that_no_estimate_can_exceed():
+    emu = fake_emulator()  # GD domain [200, 600]
+    check_emulator(emu, simplex=Simplex(gd_min=400, gd_max=590))
+    for gd_max in (600, 650):
+        with pytest.raises(EmulatorMismatchError, match=rf"gd_max = {gd_max} is not below .* 600"):
+            check_emulator(emu, simplex=Simplex(gd_min=400, gd_max=gd_max))
+
+
 def test_feature_spec_checks_and_round_trips():
     spec = FeatureSpec()
     assert spec.dim == 8 and len(spec.names()) == 8 and spec.block_s == pytest.approx(125 / 120)

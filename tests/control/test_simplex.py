@@ -207,3 +207,16 @@ def test_an_ok_estimate_without_a_finite_gd_means_safety_mode(gd, law):
         command = controller.command(estimate)
         assert (command.mode, command.speed) == ("safety", controller.v_safe)
         assert controller.start().command(estimate).speed == controller.v_safe
+
+
+@pytest.mark.parametrize("risk", [None, 0.1])
+def test_an_estimate_at_the_emulators_upper_edge_means_safety(risk):
+    from dataclasses import replace
+
+    s = Simplex(risk=risk)
+    low = gaussian_estimate(300, 20)
+    assert s.command(low).mode == "performance"
+    beyond = s.command(replace(low, domain_edge="upper"))
+    assert beyond.mode == "safety" and beyond.speed == s.v_safe
+    assert "roughest GD" in beyond.reason
+    assert s.command(replace(low, domain_edge="lower")).mode == "performance"
