@@ -97,8 +97,9 @@ def _model(case: str, method: str, emulator_dir: str | None):
 
 def _run(job: tuple) -> dict:
     """One closed-loop run; returns its per-update traces and metrics."""
-    case, kind, seed, method, cp, extra, emulator_dir, update_every, speed_step = job
+    case, kind, seed, method, cp, extra, emulator_dir, update_every, speed_step, interval = job
     emu, bcr, likelihood = _model(case, method, emulator_dir)
+    bcr = replace(bcr, interval_kind=interval)
     if method == "changepoint":
         bcr = replace(bcr, changepoint=cp, update_every=update_every)
     simplex = control.Simplex(speed_step_mps=speed_step)
@@ -148,6 +149,7 @@ def jobs_for(
     random_first_seed: int = SETS["random"].start,
     steady_roads: int = len(SETS["steady"]),
     steady_first_seed: int = SETS["steady"].start,
+    interval: str = control.BCRSettings.interval_kind,
 ) -> list[tuple]:
     out = []
     for case in cases:
@@ -170,7 +172,7 @@ def jobs_for(
         else:  # dev
             out += [(case, "paper", s, "changepoint", cp, None) for s in seeds]
             out += [(case, "random", s + 100, "changepoint", cp, None) for s in seeds]
-    return [(*job, emulator_dir, update_every, speed_step) for job in out]
+    return [(*job, emulator_dir, update_every, speed_step, interval) for job in out]
 
 
 def coverage(runs) -> float:
@@ -300,6 +302,10 @@ def main() -> None:
         help="the Simplex's speed grid, m/s (control.Simplex.speed_step_mps)",
     )  # fmt: skip
     parser.add_argument(
+        "--interval", default=control.BCRSettings.interval_kind, choices=control.INTERVAL_KINDS,
+        help="the credible interval whose coverage is scored (control.BCRSettings.interval_kind)",
+    )  # fmt: skip
+    parser.add_argument(
         "--random-tracks", type=int, default=len(SETS["random"]),
         help=f"random tracks of the random set, seeds 401 on (default {len(SETS['random'])})",
     )  # fmt: skip
@@ -371,6 +377,7 @@ def main() -> None:
         jobs = jobs_for(
             name, cases, cp, args.emulator_dir, args.update_every, args.speed_step,
             args.random_tracks, args.random_first_seed, args.steady_roads, args.steady_first_seed,
+            args.interval,
         )  # fmt: skip
         with ProcessPoolExecutor(max_workers=args.workers) as pool:
             results = list(pool.map(_run, jobs))
@@ -384,7 +391,7 @@ def main() -> None:
     print(f"closed-loop accuracy, change-point settings: {cp}")
     if args.update_every:
         print(f"our estimates every {args.update_every} samples")
-    print(f"Simplex speed step {args.speed_step:g} m/s")
+    print(f"Simplex speed step {args.speed_step:g} m/s; {args.interval} credible intervals")
     if args.emulator_dir:
         print(f"band emulators from {args.emulator_dir}")
     if "random" in names:

@@ -9,7 +9,7 @@
 Note: the import name ``control`` is also python-control's; do not install both in one environment.
 """
 
-from control.bcr import BCR, METHODS, PAPER_WINDOW, BCRSettings
+from control.bcr import BCR, INTERVAL_KINDS, METHODS, PAPER_WINDOW, BCRSettings
 from control.changepoint import ChangePointFilter, ChangePointSettings
 from control.closed_loop import ClosedLoopResult, LoopMetrics, run_closed_loop
 from control.compat import (
@@ -44,6 +44,7 @@ __all__ = [
     "BagError",
     "FAULT_KINDS",
     "FAULT_STATUSES",
+    "INTERVAL_KINDS",
     "METHODS",
     "PAPER_WINDOW",
     "STATUSES",

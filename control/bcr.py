@@ -51,6 +51,7 @@ from control.validation import is_integer, is_real, require_instance, require_re
 from gpmsa import Posterior
 
 METHODS = ("changepoint", "window", "filter", "tempered")
+INTERVAL_KINDS = ("hdi", "central")
 DEFAULT_PHASES = 3
 """Interleaved change-point filters by default: an estimate every third of a block (42 samples,
 0.35 s at 120 Hz). Chosen on the development set of benchmarks/closed_loop_accuracy.py, with the
@@ -85,7 +86,9 @@ class BCRSettings:
             turns "stale".
         max_silence_s: with the caller's clock (``update(..., now=)``), no sample for longer
             than this is a "sensor_fault" (a silent sensor or a broken link), s.
-        interval_level: level of the reported central credible interval.
+        interval_level: probability of the reported credible interval.
+        interval_kind: "hdi" (the shortest interval: it reaches the emulator's GD bound where the
+            posterior piles up there) or "central" (equal tails, which never holds a bound).
         plausibility_p: an observation whose upper-tail probability under the emulator is below
             this for every GD in the domain is "implausible".
         sensor: thresholds of the signal checks (stuck, quantised, clipped, dead, below the
@@ -101,6 +104,7 @@ class BCRSettings:
     max_age_s: float = 5.0
     max_silence_s: float = 0.5
     interval_level: float = 0.9
+    interval_kind: str = "hdi"
     plausibility_p: float = 1e-6
     sensor: SensorLimits = field(default_factory=SensorLimits)
     recent_change_m: float = 5.0
@@ -150,6 +154,10 @@ class BCRSettings:
                 raise ControlError(f"{name} must be finite and > 0, got {value}")
         if not 0 < self.interval_level < 1:
             raise ControlError(f"interval_level must lie in (0, 1), got {self.interval_level}")
+        if self.interval_kind not in INTERVAL_KINDS:
+            raise ControlError(
+                f"interval_kind must be one of {INTERVAL_KINDS}, got {self.interval_kind!r}"
+            )
         if not 0 <= self.plausibility_p < 1:
             raise ControlError(f"plausibility_p must lie in [0, 1), got {self.plausibility_p}")
         if not (np.isfinite(self.recent_change_m) and self.recent_change_m >= 0):
@@ -535,7 +543,7 @@ class BCR:
             "; ".join(filter(None, (reason, note))),
             gd_mean=post.mean(name),
             gd_sd=post.sd(name),
-            interval=post.interval(name, self.settings.interval_level),
+            interval=self._interval(post),
             posterior=post,
             latency_s=_time.perf_counter() - tic,
             speed=v,
@@ -544,6 +552,12 @@ class BCR:
             data_time=self._newest_data_time(),
             domain_edge=edge,
         )
+
+    def _interval(self, post: Posterior) -> tuple[float, float]:
+        """The credible interval of GD of the settings' kind and level."""
+        s = self.settings
+        interval = post.hdi if s.interval_kind == "hdi" else post.interval
+        return interval(self.gd_name, s.interval_level)
 
     def _edge_note(self, post: Posterior, prior_mass: np.ndarray) -> tuple[str, str]:
         """(`favoured_edge` of a grid posterior with the given prior masses on its nodes, a
@@ -643,7 +657,7 @@ class BCR:
             note,
             gd_mean=post.mean(name),
             gd_sd=post.sd(name),
-            interval=post.interval(name, s.interval_level),
+            interval=self._interval(post),
             posterior=post,
             latency_s=_time.perf_counter() - tic,
             speed=v,

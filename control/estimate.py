@@ -72,7 +72,8 @@ class Estimate:
             made without new data, e.g. while standing, says so).
         gd_mean: posterior mean of GD (1e-6 m^3); NaN unless ok.
         gd_sd: posterior standard deviation; NaN unless ok.
-        interval: central credible interval (lo, hi) at the BCR's level; NaNs unless ok.
+        interval: credible interval (lo, hi) of the BCR's kind and level (the highest-density
+            interval by default); NaNs unless ok.
         posterior: the GD posterior on a grid (quantiles, P(GD > x)); None unless ok.
         latency_s: wall-clock time of the computation that produced this estimate, s.
         speed: m/s, mean measured speed over the samples used (NaN if none).

@@ -37,8 +37,8 @@ float64 position         # m along the path (odometry)
 float64 speed            # m/s, mean measured speed over the block
 float64 gd_mean          # posterior mean of GD
 float64 gd_sd            # posterior standard deviation of GD
-float64 gd_lo            # central credible interval of GD, lower end
-float64 gd_hi            # central credible interval of GD, upper end
+float64 gd_lo            # credible interval of GD (the BCR's interval_kind), lower end
+float64 gd_hi            # credible interval of GD, upper end
 float64 interval_level   # level of [gd_lo, gd_hi], e.g. 0.9
 float64 gd_max           # the Simplex's GD_max
 float64 prob_above_gd_max  # P(GD > GD_max)

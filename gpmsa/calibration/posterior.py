@@ -9,7 +9,11 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import BYTES_PER_HISTOGRAM_BIN, check_memory
+from gpmsa.mcmc import diagnostics
 from gpmsa.model.data import as_float, check_count, check_finite, check_level
+
+#: Lower tail probabilities tried by `GridMarginal.hdi`.
+HDI_STEPS = 201
 
 
 def trapezoid_weights(nodes: np.ndarray) -> np.ndarray:
@@ -87,6 +91,15 @@ class GridMarginal:
         denom = f0 + np.sqrt(np.maximum(f0 * f0 + 2.0 * slope * r, 0.0))
         t = 2.0 * r / np.where(denom > 0.0, denom, 1.0)
         return a + np.clip(t, 0.0, h)
+
+    def hdi(self, level: float) -> tuple[float, float]:
+        """The shortest interval holding probability ``level`` (the highest-density interval of a
+        unimodal density; it reaches a grid end where the density piles up there), its lower
+        tail probability resolved to (1 - level) / (HDI_STEPS - 1)."""
+        p = np.linspace(0.0, 1.0 - level, HDI_STEPS)
+        lo, hi = np.split(self.ppf(np.concatenate([p, p + level])), 2)
+        k = int(np.argmin(hi - lo))
+        return float(lo[k]), float(hi[k])
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """Independent draws from the piecewise-linear density."""
@@ -195,6 +208,20 @@ class Posterior:
         level = check_level(level)
         lo, hi = self.quantile(name, [(1 - level) / 2, (1 + level) / 2])
         return float(lo), float(hi)
+
+    def hdi(self, name: str, level: float = 0.9) -> tuple[float, float]:
+        """Highest-density interval of ``name`` with probability ``level`` in (0, 1): the
+        shortest interval holding it (`GridMarginal.hdi` on a grid, ``arviz.hdi`` on draws).
+        Unlike the central interval it reaches a bound of the domain where the mass piles up
+        there."""
+        level = check_level(level)
+        self._check(name)
+        if name in self.grids:
+            return self.grids[name].hdi(level)
+        draws = self.samples[name]
+        if draws.ndim != 1:
+            raise GPMSAError(f"hdi needs a scalar parameter; {name!r} has draws {draws.shape}")
+        return diagnostics.hdi(draws, level)
 
     def prob_above(self, name: str, value: float) -> float:
         """P(name > value) under the posterior (e.g. P(GD > GDmax) for a risk posture)."""

@@ -35,6 +35,13 @@ def ess(x: np.ndarray) -> float:
         return float(_arviz().ess(np.atleast_2d(x)))
 
 
+def hdi(x: np.ndarray, level: float) -> tuple[float, float]:
+    """Highest-density interval (ArviZ's: the shortest one) of 1-D draws x with probability
+    ``level``."""
+    lo, hi = _arviz().hdi(np.asarray(x, dtype=np.float64), hdi_prob=level)
+    return float(lo), float(hi)
+
+
 def rhat(x: np.ndarray) -> float:
     """Rank-normalised split R-hat of x (n_chains, n_draws); one chain is split in two."""
     x = np.atleast_2d(np.asarray(x, dtype=np.float64))

@@ -94,7 +94,7 @@ def test_a_road_beyond_the_domain_is_named_and_a_rougher_one_means_safety(
     late = [e for e in ests if e.ok][-10:]
     assert len(late) == 10 and all(e.domain_edge == edge and side in e.reason for e in late)
     # the posterior cannot leave the domain: the note is what says the road lies beyond it
-    assert all(lo <= e.interval[0] <= e.interval[1] <= hi for e in late)
+    assert all(lo * (1 - 1e-12) <= e.interval[0] <= e.interval[1] <= hi * (1 + 1e-12) for e in late)
     # GD_max above the domain (check_emulator refuses it): here only the edge can mean safety
     simplex = Simplex(gd_min=100.0, gd_max=650.0)
     assert all(simplex.command(e).mode == mode for e in late)
@@ -114,6 +114,20 @@ def test_inside_the_domain_no_edge_is_named(block_model, fake_calibrator, method
             bcr = BCR(fake_calibrator, method=method, **WINDOW)
         ests = feed(bcr, *stream(const(gd), 1.5, 60, seed=0))
         assert all(e.domain_edge == "" and e.reason == "" for e in ests if e.ok)
+
+
+def test_the_default_hdi_holds_a_gd_at_the_domains_edge_and_the_central_one_cannot(block_model):
+    t, p, a, v = stream(const(200.0), 1.5, 60, seed=0)
+    late = {}
+    for kind in ("hdi", "central"):
+        ests = feed(BCR(block_model, interval_kind=kind), t, p, a, v)
+        late[kind] = [e for e in ests if e.ok][-30:]
+    assert all(e.interval[0] == 200.0 for e in late["hdi"])
+    assert all(e.interval[0] > 200.0 for e in late["central"])
+    # the same posterior: only the interval differs
+    assert [e.gd_mean for e in late["hdi"]] == [e.gd_mean for e in late["central"]]
+    with pytest.raises(ControlError, match="interval_kind must be one of"):
+        BCRSettings(interval_kind="equal_tails")
 
 
 def test_favoured_edge_needs_strong_evidence_beyond_the_margin():

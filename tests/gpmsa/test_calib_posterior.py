@@ -129,3 +129,31 @@ def test_posterior_samples_are_checked_on_construction(samples, match):
 def test_the_sd_of_one_draw_is_an_error_not_nan():
     with pytest.raises(GPMSAError, match="needs at least 2 draws"):
         Posterior({"a": [1.0]}).sd("a")
+
+
+def test_the_hdi_is_the_shortest_interval_and_reaches_a_bound_where_mass_piles_up():
+    g = gaussian_grid()
+    lo, hi = g.hdi(0.9)  # symmetric: the HDI is the central interval
+    assert (lo, hi) == pytest.approx(tuple(norm.ppf([0.05, 0.95], 3.0, 0.7)), abs=2e-3)
+    # skewed: exponential density on [0, 5]; its HDI starts at 0 and holds the level
+    nodes = np.linspace(0.0, 5.0, 2001)
+    expo = GridMarginal.from_log_density(nodes, -nodes)
+    lo, hi = expo.hdi(0.9)
+    assert lo == 0.0 and float(expo.cdf(hi) - expo.cdf(lo)) == pytest.approx(0.9, abs=1e-9)
+    central = expo.ppf(np.array([0.05, 0.95]))
+    assert hi - lo < central[1] - central[0] and central[0] > 0
+    post = Posterior(grids={"x": expo}, draw=lambda: {}, info={"names": ("x",)})
+    assert post.hdi("x", 0.9) == (lo, hi)
+
+
+def test_the_hdi_of_draws_is_arviz_and_bad_arguments_are_named():
+    draws = np.random.default_rng(4).exponential(size=20_000)
+    post = Posterior(samples={"x": draws, "v": np.ones((20_000, 2))})
+    lo, hi = post.hdi("x", 0.9)
+    assert lo == pytest.approx(0.0, abs=0.01) and hi == pytest.approx(-np.log(0.1), rel=0.03)
+    with pytest.raises(GPMSAError, match="scalar parameter"):
+        post.hdi("v")
+    with pytest.raises(GPMSAError, match="unknown parameter"):
+        post.hdi("y")
+    with pytest.raises(GPMSAError, match="level"):
+        post.hdi("x", 1.5)
