@@ -47,12 +47,15 @@ EDGE_MARGIN = 0.05
 def favoured_edge(nodes: np.ndarray, posterior_mass: np.ndarray, prior_mass: np.ndarray) -> str:
     """The edge "upper" ("lower") when the data favour the last (first) of the increasing GD
     ``nodes`` by a Bayes factor above EDGE_BAYES_FACTOR over every node at least EDGE_MARGIN
-    inside it (the posterior-to-prior mass ratio there is that much higher); "" otherwise."""
+    inside it (the posterior-to-prior mass ratio there is that much higher); "" otherwise, and
+    on a grid too narrow to hold a node that far inside."""
     with np.errstate(divide="ignore", invalid="ignore"):  # no prior mass: no evidence there
         log_ratio = np.where(prior_mass > 0, np.log(posterior_mass) - np.log(prior_mass), -np.inf)
     threshold = np.log(EDGE_BAYES_FACTOR)
     inside_top = nodes <= nodes[-1] * (1.0 - EDGE_MARGIN)
     inside_bottom = nodes >= nodes[0] * (1.0 + EDGE_MARGIN)
+    if not (inside_top.any() and inside_bottom.any()):
+        return ""
     if log_ratio[-1] - log_ratio[inside_top].max() > threshold:
         return "upper"
     if log_ratio[0] - log_ratio[inside_bottom].max() > threshold:

@@ -147,6 +147,8 @@ def test_favoured_edge_needs_strong_evidence_beyond_the_margin():
     # a peak at the edge itself counts only with a Bayes factor > 20 against 5% inside
     assert favoured_edge(nodes, post(peak(600.0, 0.02)), prior) == "upper"
     assert favoured_edge(nodes, post(peak(600.0, 0.05)), prior) == ""
+    narrow = np.linspace(590.0, 600.0, 11)  # no node 5% inside: no edge can be named
+    assert favoured_edge(narrow, post(rising)[-11:], prior[-11:]) == ""
     # nodes the prior excludes carry no evidence
     fenced = np.where(nodes > 550.0, 0.0, prior)
     assert favoured_edge(nodes, post(rising) * (nodes <= 550.0), fenced) == ""
