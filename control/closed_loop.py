@@ -92,8 +92,10 @@ class ClosedLoopResult:
 
     Per BCR update (length k): ``time`` s, ``position`` m, ``gd_mean``, ``gd_lo``, ``gd_hi`` (the
     credible interval; NaN when there is no estimate), ``gd_true`` (prescribed GD at the position),
-    ``status`` (str), ``reason`` (str), ``prob_change`` (P(a change within the BCR's
-    recent_change_m)), ``command`` (m/s), ``mode`` ("performance"/"safety"), ``latency_s``.
+    ``status`` (str), ``reason`` (str), ``domain_edge`` (str: the edge of the emulator's GD
+    domain the data favour, "" for none; `Estimate.domain_edge`), ``prob_change`` (P(a change
+    within the BCR's recent_change_m)), ``command`` (m/s), ``mode`` ("performance"/"safety"),
+    ``latency_s``.
     Per sensor sample (length n): ``sample_time``, ``sample_position``, ``sample_speed``,
     ``sample_accel`` (the measured front-axle acceleration, m/s^2, before injected faults).
     """
@@ -106,6 +108,7 @@ class ClosedLoopResult:
     gd_true: np.ndarray
     status: np.ndarray
     reason: np.ndarray
+    domain_edge: np.ndarray
     prob_change: np.ndarray
     command: np.ndarray
     mode: np.ndarray
@@ -321,6 +324,7 @@ def run_closed_loop(
         gd_true=gd_true,
         status=np.array([e.status for e in ests]),
         reason=np.array([e.reason for e in ests], dtype=object),
+        domain_edge=np.array([e.domain_edge for e in ests], dtype=object),
         prob_change=np.array([e.prob_change for e in ests]),
         command=np.array([c.speed for _, c in rows]),
         mode=np.array([c.mode for _, c in rows]),

@@ -57,6 +57,19 @@ def test_safety_mode_whenever_the_estimate_exceeds_gd_max(short_run):
     assert np.all(r.mode[~ok] == "safety")
 
 
+def test_a_road_rougher_than_the_emulator_knows_is_named_and_driven_in_safety_mode(
+    emulator_a, likelihood_a
+):
+    track = roadgen.track([(20, 300), (40, 900)], seed=2)  # GD 900: beyond the domain's 600
+    r = run_closed_loop(track, emulator_a, seed=2, likelihood=likelihood_a, check=False)
+    named = r.domain_edge == "upper"
+    assert named[r.position > 20].mean() > 0.1 and not named[r.position < 20].any()
+    assert np.all(r.mode[named] == "safety") and not np.any(r.domain_edge == "lower")
+    assert all("rougher than any the emulator knows" in why for why in r.reason[named])
+    assert np.all(r.gd_hi[r.status == "ok"] <= 600.0)  # the posterior stays in the domain
+    assert r.domain_edge.shape == r.status.shape and np.all(r.domain_edge[r.status != "ok"] == "")
+
+
 def test_an_invisible_change_of_the_signal_leaves_the_run_as_it_was(short_run, likelihood_a):
     """The speed grid (Simplex.speed_step_mps) keeps a gain error of 1e-9, which no check can
     see, from setting off the loop's chaos: every command and position stays the same. On a
