@@ -560,16 +560,20 @@ class BCR:
         return interval(self.gd_name, s.interval_level)
 
     def _edge_note(self, post: Posterior, prior_mass: np.ndarray) -> tuple[str, str]:
-        """(`favoured_edge` of a grid posterior with the given prior masses on its nodes, a
-        sentence for the estimate's reason or "")."""
+        """(`favoured_edge` of a grid posterior with the given prior masses on its nodes, its
+        `_edge_sentence`)."""
         marginal = post.grids[self.gd_name]
         edge = favoured_edge(marginal.nodes, marginal.density * marginal.weights, prior_mass)
+        return edge, self._edge_sentence(edge)
+
+    def _edge_sentence(self, edge: str) -> str:
+        """The estimate's note on a favoured edge of the GD domain ("" for none)."""
         if not edge:
-            return "", ""
+            return ""
         lo, hi = self.gd_range
         at, side, bound = (hi, "rougher", f"<= {hi:g}") if edge == "upper" else (
             lo, "smoother", f">= {lo:g}")  # fmt: skip
-        return edge, (
+        return (
             f"the data favour GD {at:g}, the emulator's {edge} edge, over every GD "
             f"{EDGE_MARGIN:.0%} or more inside its domain by a Bayes factor > "
             f"{EDGE_BAYES_FACTOR:g}: the road may be {side} than any the emulator knows (the "
@@ -619,7 +623,7 @@ class BCR:
         if not 0.0 <= unit <= 1.0:  # the emulator's own rule (snaps rounding at the ends)
             why = f"window speed {v:.3g} m/s outside the emulator's range [{lo:g}, {hi:g}] m/s"
             if self.last.ok:
-                note = self._edge_note(self.last.posterior, np.exp(self.trackers[0].log_prior))[1]
+                note = self._edge_sentence(self.last.domain_edge)
                 reason = "; ".join(filter(None, ("no new information: " + why, note)))
                 return replace(self.last, time=self._now()[0], position=self._now()[1],
                                reason=reason)  # fmt: skip

@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 import vehicle
-from control.bcr import BCRSettings
+from control.bcr import BCRSettings, emulator_domain
 from control.errors import ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
@@ -129,7 +129,7 @@ def check_emulator(
             )
     if simplex is not None:
         _check_speeds(emulator, simplex)
-        hi = float(emulator.domain[emulator.t_names[0]][1])
+        hi = emulator_domain(emulator)[1][1]
         if not simplex.gd_max < hi:
             raise EmulatorMismatchError(
                 f"Simplex gd_max = {simplex.gd_max:g} is not below the emulator's highest GD "
