@@ -33,6 +33,8 @@ GD_ESTIMATE_MSG = """\
 std_msgs/Header header   # stamp: time of the newest IMU sample the estimate has seen
 string status            # ok, filling, out_of_domain, sensor_fault, implausible, ...
 string reason            # why there is no estimate (on an ok one: a note, or "")
+string domain_edge       # upper, lower: the data favour that edge of the emulator's GD domain
+                         # (the road may lie beyond it); "" for none
 float64 position         # m along the path (odometry)
 float64 speed            # m/s, mean measured speed over the block
 float64 gd_mean          # posterior mean of GD

@@ -8,7 +8,7 @@ robot's bag and the replay's output, and `control.replay_bag` reads the file bac
 |---|---|---|---|
 | ``/imu/data`` | ``sensor_msgs/msg/Imu`` | the loop's (120 Hz) | ``linear_acceleration.z``: the measured front-axle acceleration, m/s^2 |
 | ``/odometry/filtered`` | ``nav_msgs/msg/Odometry`` | the loop's | ``pose.pose.position.x``: position along the track, m; ``twist.twist.linear.x``: actual speed, m/s |
-| ``/bcr/estimate`` | ``terrain_gpmsa_msgs/msg/GDEstimate`` | one per BCR update | status, reason, GD mean and credible interval, P(change), the speed command and mode |
+| ``/bcr/estimate`` | ``terrain_gpmsa_msgs/msg/GDEstimate`` | one per BCR update | status, reason, the GD domain's edge the data favour, GD mean and credible interval, P(change), the speed command and mode |
 | ``/sim/gd_true`` | ``std_msgs/msg/Float64`` | one per BCR update | the GD prescribed at the vehicle's position |
 
 The loop's result keeps no posterior sd nor P(GD > GD_max): those fields are NaN here (the
@@ -43,6 +43,7 @@ def _estimate_rows(result) -> list[dict]:
             "stamp_ns": 0,
             "status": str(result.status[i]),
             "reason": str(result.reason[i]),
+            "domain_edge": str(result.domain_edge[i]),
             "position_m": float(result.position[i]),
             "speed_mps": float(_speed_at(result, result.time[i])),
             "gd_mean": float(result.gd_mean[i]),

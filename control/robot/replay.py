@@ -49,8 +49,9 @@ TIME_BASES = ("header", "log")
 POSITIONS = ("path", "speed")
 GRAVITY = ("keep", "highpass")
 CSV_COLUMNS = (
-    "stamp_ns", "time_s", "position_m", "speed_mps", "status", "reason", "gd_mean", "gd_sd",
-    "gd_lo", "gd_hi", "prob_gd_above_max", "prob_change", "command_mps", "mode",
+    "stamp_ns", "time_s", "position_m", "speed_mps", "status", "reason", "domain_edge",
+    "gd_mean", "gd_sd", "gd_lo", "gd_hi", "prob_gd_above_max", "prob_change", "command_mps",
+    "mode",
 )  # fmt: skip
 
 
@@ -125,7 +126,8 @@ class ReplayResult:
 
     Per estimate (length k; one per BCR update, i.e. per block): ``stamp_ns`` (int, bag time of
     the newest sample), ``time`` (s since the first IMU sample used), ``position`` (m along the
-    path), ``speed`` (m/s, the odometry's at that sample), ``status``, ``reason``, ``gd_mean``,
+    path), ``speed`` (m/s, the odometry's at that sample), ``status``, ``reason``,
+    ``domain_edge`` (`Estimate.domain_edge`: "upper", "lower" or ""), ``gd_mean``,
     ``gd_sd``, ``gd_lo``, ``gd_hi`` (the credible interval at the BCR's ``interval_level``),
     ``prob_above`` (P(GD > the Simplex's GD_max)), ``prob_change``, ``command`` (m/s), ``mode``;
     ``estimates``: the `Estimate` objects (with their posteriors).
@@ -143,6 +145,7 @@ class ReplayResult:
     speed: np.ndarray
     status: np.ndarray
     reason: np.ndarray
+    domain_edge: np.ndarray
     gd_mean: np.ndarray
     gd_sd: np.ndarray
     gd_lo: np.ndarray
@@ -193,8 +196,8 @@ class ReplayResult:
         """One dict per estimate, keyed by CSV_COLUMNS."""
         cols = (
             self.stamp_ns, self.time, self.position, self.speed, self.status, self.reason,
-            self.gd_mean, self.gd_sd, self.gd_lo, self.gd_hi, self.prob_above, self.prob_change,
-            self.command, self.mode,
+            self.domain_edge, self.gd_mean, self.gd_sd, self.gd_lo, self.gd_hi, self.prob_above,
+            self.prob_change, self.command, self.mode,
         )  # fmt: skip
         return [dict(zip(CSV_COLUMNS, vals, strict=True)) for vals in zip(*cols, strict=True)]
 
@@ -244,6 +247,13 @@ class ReplayResult:
                 f"{np.max(self.gd_mean[ok]):.0f}; safety mode "
                 f"{np.mean(self.mode == 'safety'):.0%} of the time"
             )
+        for edge, beyond in (("upper", "rougher"), ("lower", "smoother")):
+            named = int(np.sum(self.domain_edge == edge))
+            if named:
+                lines.append(
+                    f"{named} estimates favour the {edge} edge of the emulator's GD domain: the "
+                    f"road may be {beyond} than any it was trained on"
+                )
         lines.append(
             f"replayed at {self.real_time_factor:.0f}x real time (read {self.read_s:.3f} s, "
             f"resample {self.condition_s:.3f} s, BCR {self.bcr_s:.3f} s)"
@@ -262,6 +272,7 @@ def estimate_message(store, row: dict, interval_level: float, gd_max: float) -> 
         header=header,
         status=str(row["status"]),
         reason=str(row["reason"]),
+        domain_edge=str(row["domain_edge"]),
         position=float(row["position_m"]),
         speed=float(row["speed_mps"]),
         gd_mean=float(row["gd_mean"]),
@@ -397,6 +408,7 @@ def replay_recording(
         speed=spd[ends],
         status=np.array([e.status for e in ests], dtype=object).astype(str),
         reason=np.array([e.reason for e in ests], dtype=object),
+        domain_edge=np.array([e.domain_edge for e in ests], dtype=object).astype(str),
         gd_mean=np.array([e.gd_mean for e in ests]),
         gd_sd=np.array([e.gd_sd for e in ests]),
         gd_lo=np.array([e.interval[0] for e in ests]),

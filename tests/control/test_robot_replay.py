@@ -33,7 +33,10 @@ from control.robot import (  # noqa: E402
 from control.robot.replay import replay_recording  # noqa: E402
 
 #: what the closed loop's result and the replay's both carry, per estimate
-SHARED = ("gd_mean", "gd_lo", "gd_hi", "status", "reason", "prob_change", "command", "mode")
+SHARED = (
+    "gd_mean", "gd_lo", "gd_hi", "status", "reason", "domain_edge", "prob_change", "command",
+    "mode",
+)  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -101,18 +104,25 @@ def test_the_recorded_mcap_holds_the_run_and_replays_to_the_last_bit(
     _assert_replay_is_the_loop(replayed, result)
 
 
-def test_the_recorded_estimates_decode_with_the_definition_inside_the_file(loop_run):
+def _decoded(path) -> dict[str, list]:
+    """The messages of /bcr/estimate and /sim/gd_true, decoded with the definition inside the
+    file, as Foxglove reads them."""
     from mcap.reader import make_reader
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-    result, path = loop_run
     store = get_typestore(Stores.EMPTY)
     got = {"/bcr/estimate": [], "/sim/gd_true": []}
     with path.open("rb") as f:
         for schema, channel, message in make_reader(f).iter_messages(topics=list(got)):
-            if not got[channel.topic]:  # the file's own definition, as Foxglove reads it
+            if not got[channel.topic]:
                 store.register(get_types_from_msg(schema.data.decode(), schema.name))
             got[channel.topic].append(store.deserialize_cdr(message.data, schema.name))
+    return got
+
+
+def test_the_recorded_estimates_decode_with_the_definition_inside_the_file(loop_run):
+    result, path = loop_run
+    got = _decoded(path)
     est = got["/bcr/estimate"]
     assert [m.status for m in est] == result.status.tolist()
     assert np.array_equal([m.gd_mean for m in est], result.gd_mean, equal_nan=True)
@@ -120,6 +130,31 @@ def test_the_recorded_estimates_decode_with_the_definition_inside_the_file(loop_
     assert [m.command_speed for m in est] == result.command.tolist()
     assert [m.safety for m in est] == (result.mode == "safety").tolist()
     assert [m.data for m in got["/sim/gd_true"]] == result.gd_true.tolist()
+    assert [m.domain_edge for m in est] == result.domain_edge.tolist()
+
+
+def test_a_road_beyond_the_domain_is_named_in_the_recording_and_its_replay(
+    emulator_a, likelihood_a, tmp_path
+):
+    track = roadgen.track([(15, 300), (30, 900)], seed=2)  # GD 900: beyond the domain's 600
+    path = tmp_path / "rough.mcap"
+    result = control.run_closed_loop(
+        track, emulator_a, seed=2, likelihood=likelihood_a, check=False, record=path
+    )
+    assert "upper" in result.domain_edge.tolist()
+    est = _decoded(path)["/bcr/estimate"]
+    assert [m.domain_edge for m in est] == result.domain_edge.tolist()
+    assert all(m.safety for m in est if m.domain_edge == "upper")
+
+    table = tmp_path / "estimates.csv"
+    replayed = replay_bag(path, emulator_a, likelihood=likelihood_a, csv=table)
+    n = replayed.domain_edge.size
+    assert replayed.domain_edge.tolist() == result.domain_edge[:n].tolist()
+    with table.open() as f:
+        column = [row["domain_edge"] for row in csv.DictReader(f)]
+    assert column == replayed.domain_edge.tolist()
+    named = int(np.sum(replayed.domain_edge == "upper"))
+    assert f"{named} estimates favour the upper edge" in replayed.describe()
 
 
 def _drive(track, rate_hz, speed=1.0):
@@ -268,6 +303,7 @@ def test_the_command_writes_csv_bag_and_report(loop_run, tmp_path, capsys):
     assert cli.main([str(path), "--emulator", "A", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "real time" in printed and "estimates.csv" in printed
+    assert "edge of the emulator's GD domain" not in printed  # an in-domain road
     with (out / "estimates.csv").open() as f:
         rows = list(csv.DictReader(f))
     assert list(rows[0]) == list(control.robot.CSV_COLUMNS)
