@@ -224,16 +224,6 @@ def report_random(results, case: str, kind: str = "random") -> str:
     )
 
 
-def clustered_mean(per_road: list[np.ndarray]) -> tuple[float, float]:
-    """Mean of every value pooled over roads, and its standard error clustered by road (a
-    road's values share its realised roughness, so they are not independent)."""
-    n = np.array([x.size for x in per_road], float)
-    means = np.array([x.mean() for x in per_road])
-    mean = float(np.sum(n * means) / n.sum())
-    se = float(np.sqrt(np.sum((n * (means - mean)) ** 2)) / n.sum())
-    return mean, se * np.sqrt(n.size / (n.size - 1))
-
-
 def report_steady(results, case: str) -> list[str]:
     runs = [r for r in results if r["kind"] == "steady" and r["case"] == case]
     roads = len({r["seed"] for r in runs})
@@ -247,10 +237,9 @@ def report_steady(results, case: str) -> list[str]:
         cells = []
         for v in STEADY_SPEEDS:
             rel = [r["mean"][r["position"] > 25.0] / gd - 1 for r in runs if r["extra"] == (gd, v)]
-            rel = [x[np.isfinite(x)] for x in rel]
-            rel = [x for x in rel if x.size]  # a road with no estimate after 25 m has no mean
-            bias, bias_se = clustered_mean(rel)
-            mse, mse_se = clustered_mean([x**2 for x in rel])
+            rel = [x[np.isfinite(x)] for x in rel]  # a road with none after 25 m is left out
+            bias, bias_se = control.clustered_mean(rel)
+            mse, mse_se = control.clustered_mean([x**2 for x in rel])
             rmse = np.sqrt(mse)
             rmse_se = mse_se / (2 * rmse)  # the delta method
             worst_bias = max(worst_bias, (abs(bias), bias_se))

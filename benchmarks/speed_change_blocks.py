@@ -165,13 +165,8 @@ def _mean_se(x: np.ndarray) -> str:
 def _clustered(per_run: list[np.ndarray]) -> str:
     """Mean of all runs' values with its standard error clustered by run (a run's blocks at the
     three phases' offsets overlap, so they are not independent)."""
-    n = np.array([x.size for x in per_run], dtype=float)
-    total = n.sum()
-    if total < 2 or np.count_nonzero(n) < 2:
-        return "-"
-    mean = sum(float(x.sum()) for x in per_run) / total
-    resid = np.array([float(x.sum()) - mean * k for x, k in zip(per_run, n, strict=True)])
-    return f"{mean:+.3f} ({np.sqrt(np.sum(resid**2)) / total:.3f})"
+    mean, se = control.clustered_mean(per_run)
+    return "-" if np.isnan(se) else f"{mean:+.3f} ({se:.3f})"
 
 
 def open_part(case: str, roads: int, first_seed: int, workers: int) -> None:

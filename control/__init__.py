@@ -30,7 +30,14 @@ from control.errors import (
 from control.estimate import FAULT_STATUSES, STATUSES, Estimate
 from control.faults import FAULT_KINDS, SensorFault
 from control.feature import FeatureSpec, block_features, window_feature
-from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
+from control.metrics import (
+    GDError,
+    clustered_mean,
+    detection_delays,
+    fast_on_rough_m,
+    gd_errors,
+    pooled_rmse,
+)
 from control.observation_model import BlockScatter, ObservationModel
 from control.robot import ReplayResult, ReplaySettings, record_run, replay_bag
 from control.sensor_checks import SensorLimits
@@ -74,6 +81,7 @@ __all__ = [
     "block_features",
     "check_emulator",
     "check_likelihood",
+    "clustered_mean",
     "detection_delays",
     "emulator_feature",
     "emulator_noise_std",

@@ -1,4 +1,5 @@
-"""Scores of a closed-loop run: RMSE of the GD estimate, detection delays, speed on rough ground."""
+"""Scores of a closed-loop run: RMSE of the GD estimate, detection delays, speed on rough ground;
+means over many runs with their clustered standard errors."""
 
 from __future__ import annotations
 
@@ -90,6 +91,40 @@ def pooled_rmse(errors: Sequence[Sequence[GDError]], gd: float) -> float:
     sse = sum(e.sse for run in errors for e in run if e.gd == gd)
     n = sum(e.n for run in errors for e in run if e.gd == gd)
     return float(np.sqrt(sse / n)) if n else float("nan")
+
+
+def clustered_mean(per_run: Sequence) -> tuple[float, float]:
+    """Mean of values pooled over runs, and its standard error clustered by run.
+
+    The estimates of one run share its road and its filter's excursions, so they are not
+    independent; the standard error treats each run as one draw (the cluster-robust sandwich
+    with the small-sample factor G / (G - 1), G runs with values).
+
+    Args:
+        per_run: per run, a 1-D sequence of finite values (e.g. one run's relative errors);
+            runs with no values are left out.
+
+    Returns:
+        (mean, standard error); NaN for the mean without values and for the standard error
+        with fewer than two runs that have values.
+    """
+    runs = [float_array(x, f"per_run[{k}]") for k, x in enumerate(per_run)]
+    for k, x in enumerate(runs):
+        if x.ndim != 1 or not np.all(np.isfinite(x)):
+            raise ControlError(
+                f"per_run[{k}] must be a 1-D sequence of finite values (one run's); for one "
+                "run's values pass [values]"
+            )
+    runs = [x for x in runs if x.size]
+    if not runs:
+        return float("nan"), float("nan")
+    n = np.array([x.size for x in runs], dtype=float)
+    sums = np.array([x.sum() for x in runs])
+    mean = float(sums.sum() / n.sum())
+    if len(runs) < 2:
+        return mean, float("nan")
+    scatter = np.sqrt(np.sum((sums - mean * n) ** 2)) / n.sum()
+    return mean, float(scatter * np.sqrt(len(runs) / (len(runs) - 1)))
 
 
 def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[float, ...]:

@@ -1,11 +1,18 @@
-"""Metrics: RMSE per prescribed GD, detection delay, distance fast on rough ground."""
+"""Metrics: RMSE per GD, detection delay, distance fast on rough ground, clustered means."""
 
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from control import ControlError, detection_delays, fast_on_rough_m, gd_errors, pooled_rmse
+from control import (
+    ControlError,
+    clustered_mean,
+    detection_delays,
+    fast_on_rough_m,
+    gd_errors,
+    pooled_rmse,
+)
 
 TRACK = SimpleNamespace(
     segments=((50.0, 300.0), (50.0, 500.0), (50.0, 300.0)),
@@ -81,3 +88,29 @@ def test_pooled_rmse_names_the_one_run_mistake():
     with pytest.raises(ControlError, match=r"\[metrics.gd_errors\]"):
         pooled_rmse(errs, 300.0)
     assert pooled_rmse([errs], 300.0) == pytest.approx(10.0)
+
+
+def test_clustered_mean_treats_each_run_as_one_draw():
+    rng = np.random.default_rng(5)
+    runs = [rng.normal(loc, 1.0, size=20) for loc in rng.normal(0.0, 2.0, size=8)]
+    mean, se = clustered_mean(runs)
+    means = np.array([r.mean() for r in runs])
+    assert mean == pytest.approx(means.mean())  # equal sizes: the mean of the run means
+    assert se == pytest.approx(means.std(ddof=1) / np.sqrt(means.size))
+    # a run's values are not independent draws: the naive se is far smaller here
+    assert se > 2 * np.concatenate(runs).std(ddof=1) / np.sqrt(160)
+
+
+def test_clustered_mean_weighs_runs_by_their_values_and_leaves_empty_runs_out():
+    mean, se = clustered_mean([[1.0, 1.0, 1.0], [4.0], []])
+    assert mean == pytest.approx(7.0 / 4)
+    # runs' sums minus mean x size: -2.25 and +2.25; sqrt(2 x 2.25^2) / 4 x sqrt(2 / 1)
+    assert se == pytest.approx(np.sqrt(2 * 2.25**2) / 4 * np.sqrt(2))
+    assert clustered_mean([[2.0, 3.0]]) == (2.5, pytest.approx(np.nan, nan_ok=True))
+    assert all(np.isnan(clustered_mean([[], []])))
+
+
+@pytest.mark.parametrize("bad", [[[1.0, np.nan], [2.0]], [[[1.0]], [2.0]], [1.0, 2.0], [["a"]]])
+def test_clustered_mean_refuses_what_is_not_runs_of_finite_values(bad):
+    with pytest.raises(ControlError, match=r"per_run\[0\]"):
+        clustered_mean(bad)
