@@ -26,7 +26,7 @@ def test_segments_parse_and_bad_ones_are_named():
 @pytest.mark.parametrize(
     "argv, message",
     [
-        (["--track", "40:250,30:700"], "outside the emulator's GD domain"),
+        (["--track", "40:250,30:700"], "outside the emulator's GD domain [200, 600] (--beyond"),
         (["--track", "40:250,30"], "not LENGTH_M:GD"),
         (["--first-seed", "-2"], "--first-seed must be >= 0"),
         (["--runs", "0"], "--runs must be >= 1"),
@@ -68,6 +68,7 @@ def test_another_track_and_seed_give_one_rmse_per_prescribed_gd(tmp_path, capsys
     printed = capsys.readouterr().out
     assert "seed 7 (no paper figures for this track)" in printed
     assert "GD 250" in printed and "GD 450" in printed
+    assert "edge of the emulator's GD domain" not in printed  # inside the domain: none named
 
 
 def test_a_part_too_short_for_an_estimate_prints_a_dash_and_writes_null(tmp_path, capsys):
@@ -79,3 +80,15 @@ def test_a_part_too_short_for_an_estimate_prints_a_dash_and_writes_null(tmp_path
     assert "NaN" not in (tmp_path / "metrics.json").read_text()
     rows = [line.split() for line in capsys.readouterr().out.splitlines() if "GD 300" in line]
     assert len(rows) == 2 and all(row[3:5] == ["-", "-"] for row in rows)  # paper, paper method
+
+
+def test_beyond_domain_drives_a_track_outside_the_emulators_domain_and_counts_named_edges(
+    tmp_path, capsys
+):
+    argv = ["--out", str(tmp_path), "--runs", "1", "--first-seed", "1", "--cases", "B",
+            "--track", "20:300,40:900", "--beyond-domain"]  # fmt: skip
+    metrics = load_script().main(argv)
+    (run,) = metrics["ours"]["B"]["runs"]
+    assert run["domain_edge"]["upper"] > 0 and run["domain_edge"]["lower"] == 0
+    printed = capsys.readouterr().out
+    assert f"B seed 1: {run['domain_edge']['upper']} upper" in printed
