@@ -19,10 +19,13 @@ from __future__ import annotations
 
 import importlib
 import os
+import shutil
 import struct
 import sys
+import tempfile
 import time
 from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path, PurePath
 
@@ -498,15 +501,33 @@ def _vectors(name: str, a, n: int, axis: str = "x") -> np.ndarray:
     return a
 
 
-def open_bag_writer(path: str | os.PathLike, storage: str = "mcap"):
-    """A rosbags ROS 2 bag writer (format version 9) for a new folder ``path``."""
+@contextmanager
+def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
+    """A rosbags ROS 2 bag writer (format version 9), open, for a new folder ``path``.
+
+    The bag is written in a hidden folder beside ``path`` and moved to ``path`` once closed, so
+    an interrupted write (an exception, a killed process) never leaves a bag without its
+    metadata at ``path``; on an exception the hidden folder is removed."""
     _check_storage(storage)
     rosbag2 = require("rosbags.rosbag2", "writing a ROS 2 bag")
     path = Path(path)
     if path.exists():
         raise ControlError(f"{path} exists already; a bag is written to a new folder")
     plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
-    return rosbag2.Writer(path, version=9, storage_plugin=plugin)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        work = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent))
+    except OSError as exc:
+        raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
+    try:
+        with rosbag2.Writer(work / path.name, version=9, storage_plugin=plugin) as writer:
+            yield writer
+        try:
+            os.rename(work / path.name, path)  # the bag's files are named after its folder
+        except OSError as exc:  # e.g. path made meanwhile by another writer
+            raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
 
 
 def merge_in_time(streams: Sequence[tuple[object, np.ndarray, Sequence[bytes]]]) -> Iterator:

@@ -16,7 +16,7 @@ pytest.importorskip("mcap")
 
 from test_robot_replay import _write_ros1_bag  # noqa: E402
 
-from control.errors import BagError  # noqa: E402
+from control.errors import BagError, ControlError  # noqa: E402
 from control.robot import cli, read_recording, write_sensor_bag  # noqa: E402
 from control.robot import messages as msgs  # noqa: E402
 from control.robot.bags import merge_in_time, sensor_messages  # noqa: E402
@@ -274,3 +274,35 @@ def test_the_command_reports_a_damaged_emulator_file_in_one_line(
     assert code == 2 and err.count("\n") == 1
     assert err.startswith(f"terrain-replay: error: --emulator {str(emulator)!r}: ")
     assert "not a gpmsa emulator file" in err
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_an_interrupted_bag_write_leaves_nothing_and_the_next_one_succeeds(
+    tmp_path, monkeypatch, storage
+):
+    import control.robot.bags as bags
+
+    path = tmp_path / "sub" / "drive"
+    seen_during_write = []
+    real_merge = bags.merge_in_time
+
+    def failing_merge(streams):
+        for k, item in enumerate(real_merge(streams)):
+            if k == N // 2:  # half the messages written
+                seen_during_write.append(path.exists())
+                raise KeyboardInterrupt
+            yield item
+
+    monkeypatch.setattr(bags, "merge_in_time", failing_merge)
+    with pytest.raises(KeyboardInterrupt):
+        write_sensor_bag(path, *_signals(), storage=storage)
+    assert seen_during_write == [False]  # a killed writer leaves no half bag at path either
+    assert not path.exists() and list(path.parent.iterdir()) == []  # the hidden folder went
+
+    monkeypatch.setattr(bags, "merge_in_time", real_merge)
+    write_sensor_bag(path, *_signals(), storage=storage)
+    rec = read_recording(path)
+    assert rec.storage == storage and rec.imu.stamp_ns.size == rec.odometry.stamp_ns.size == N
+    assert [p.name for p in tmp_path.joinpath("sub").iterdir()] == ["drive"]
+    with pytest.raises(ControlError, match="exists already"):
+        write_sensor_bag(path, *_signals(), storage=storage)
