@@ -155,6 +155,7 @@ def main(argv: list[str] | None = None) -> int:
         "resampling": asdict(result.resampling),
         "notes": list(result.notes),
         "status_counts": result.status_counts(),
+        "domain_edge_counts": {e: int(sum(result.domain_edge == e)) for e in ("upper", "lower")},
         "timing_s": {"read": result.read_s, "resample": result.condition_s, "bcr": result.bcr_s},
         "duration_s": result.duration_s,
         "real_time_factor": result.real_time_factor,

@@ -313,6 +313,7 @@ def test_the_command_writes_csv_bag_and_report(loop_run, tmp_path, capsys):
     assert np.array_equal(mean, result.gd_mean[:n], equal_nan=True)  # repr: every bit
     report = json.loads((out / "replay.json").read_text())
     assert report["settings"]["imu_topic"] == "/imu/data" and report["real_time_factor"] > 0
+    assert report["domain_edge_counts"] == {"upper": 0, "lower": 0}  # an in-domain road
 
     from rosbags.highlevel import AnyReader
 
