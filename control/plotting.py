@@ -32,7 +32,9 @@ def _mark_track(ax, track, gd_max: float | None) -> None:
 def plot_gd_trace(
     results: Sequence, track, title: str = "", gd_max: float | None = 350.0, level: float = 0.9
 ) -> Figure:
-    """GD estimate (posterior mean, and the credible interval as thin lines) against position.
+    """GD estimate (posterior mean, and the credible interval as thin lines) against position;
+    estimates that name an edge of the emulator's GD domain (``domain_edge``) are marked with a
+    triangle pointing beyond it.
 
     Args:
         results: `ClosedLoopResult`s driven over `track` (or tracks with the same segments).
@@ -52,6 +54,13 @@ def plot_gd_trace(
             ax.plot(r.position, edge, lw=0.6, alpha=0.7, color=line.get_color(), ls="--",
                     label=label)  # fmt: skip
             label = None
+        edges = getattr(r, "domain_edge", None)
+        for edge, marker in (("upper", "^"), ("lower", "v")):
+            named = np.asarray(edges) == edge if edges is not None else np.zeros(0, bool)
+            if named.any():
+                ax.plot(r.position[named], r.gd_mean[named], ls="none", marker=marker, ms=4,
+                        color=line.get_color(),
+                        label=f"run {i + 1}: {edge} edge of the GD domain")  # fmt: skip
     ax.set_xlabel("position of the front axle (m)")
     ax.set_ylabel("GD (1e-6 m$^3$)")
     ax.set_xlim(0, float(track.length_m))

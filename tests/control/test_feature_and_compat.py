@@ -174,6 +174,11 @@ def test_plots_return_figures_with_one_line_per_run():
     fig = plot_gd_trace([run, run], track)
     assert isinstance(fig, Figure) and len(fig.axes[0].lines) >= 3  # prescribed + 2 runs
     assert isinstance(plot_speed([run], track), Figure)
+    edged = SimpleNamespace(**vars(run), domain_edge=np.where(pos > 90, "upper", ""))
+    fig = plot_gd_trace([run, edged], track)
+    (marks,) = [ln for ln in fig.axes[0].lines if ln.get_marker() == "^"]
+    assert marks.get_label() == "run 2: upper edge of the GD domain"
+    np.testing.assert_array_equal(marks.get_xdata(), pos[pos > 90])
     assert isinstance(plot_design(np.array([1.0, 2.0]), np.array([300.0, 400.0])), Figure)
     cells = [(v, gd, np.full(10, gd)) for v in (1.0, 2.0) for gd in (300.0, 500.0)]
     assert len(plot_posterior_grid(cells).axes) == 4
