@@ -228,19 +228,26 @@ def mean_cov(emu, v: float, gd: float) -> np.ndarray:
     return basis @ np.diag(pred.var_w[0, 0]) @ basis.T
 
 
-def linearised(d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray):
+def linearised(d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray, width: float):
     """(relative GD bias, its se) of the weighted least-squares step g' W d / (g' W g) in
-    log GD, W = the likelihood's inverse covariance, cov_d the covariance of d."""
+    log GD, W = the likelihood's inverse covariance, cov_d the covariance of d; (NaN, NaN)
+    where the emulator is too flat in GD to linearise: a step or se beyond ``width``, the
+    domain's width in log GD (the window feature saturates at high GD)."""
     wg = w @ g
     den = float(g @ wg)
-    step = float(wg @ d) / den
-    return float(np.expm1(step)), float(np.sqrt(wg @ cov_d @ wg) / den * np.exp(step))
+    if not den > 0:
+        return np.nan, np.nan
+    step, step_se = float(wg @ d) / den, float(np.sqrt(wg @ cov_d @ wg)) / den
+    if not (abs(step) <= width and step_se <= width):
+        return np.nan, np.nan
+    return float(np.expm1(step)), step_se * float(np.exp(step))
 
 
 def band_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
     om = control.ObservationModel(emu, n_grid=N_GRID)
     v_hi = om.speed_range[1]
     log_gd = np.log(om.gd)
+    width = float(log_gd[-1] - log_gd[0])
     accel = c.accel if case == "A" else c.accel_measured
     spec = control.emulator_feature(emu)
     out = []
@@ -262,8 +269,8 @@ def band_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
             parts = loglik.reshape(-1, BATCH, loglik.shape[1]).sum(axis=1)
             gd_ml, se, edge = ml_with_bootstrap(parts, log_gd, rng)
             g = slope(emu, min(v, v_hi), gd)
-            lin = linearised(d, g, weight, cell_cov / n)
-            emu_sd = linearised(d, g, weight, mean_cov(emu, min(v, v_hi), gd))[1]
+            lin = linearised(d, g, weight, cell_cov / n, width)
+            emu_sd = linearised(d, g, weight, mean_cov(emu, min(v, v_hi), gd), width)[1]
             out.append(
                 Cell(v, gd, z, chi2, float(stats.chi2.sf(chi2, spec.dim)),
                      float(np.mean(np.diag(cell_cov) / np.diag(sigma))), gd_ml / gd - 1,
@@ -276,6 +283,7 @@ def window_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
     v_hi, (g_lo, g_hi) = emu.domain["v"][1], emu.domain["GD"]
     gd_grid = np.geomspace(g_lo, g_hi, N_GRID)
     log_gd = np.log(gd_grid)
+    width = float(log_gd[-1] - log_gd[0])
     accel = c.accel if case == "A" else c.accel_measured
     out = []
     for v in grid.speeds:
@@ -293,8 +301,8 @@ def window_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
             ] - 0.5 * np.log(var_g[None, :, 0])
             gd_ml, se, edge = ml_with_bootstrap(loglik, log_gd, rng)
             d, g = np.array([y.mean() - mu[0, 0]]), slope(emu, v_in, gd)
-            lin = linearised(d, g, np.eye(1), np.array([[y.var(ddof=1) / y.size]]))
-            emu_sd = linearised(d, g, np.eye(1), mean_cov(emu, v_in, gd))[1]
+            lin = linearised(d, g, np.eye(1), np.array([[y.var(ddof=1) / y.size]]), width)
+            emu_sd = linearised(d, g, np.eye(1), mean_cov(emu, v_in, gd), width)[1]
             out.append(
                 Cell(v, gd, np.array([z]), float(z**2), float(stats.chi2.sf(z**2, 1)),
                      float(y.std(ddof=1) / np.sqrt(var[0, 0])), gd_ml / gd - 1, se / gd, edge,
@@ -325,7 +333,8 @@ def print_cells(title: str, cells: list[Cell], grid: Grid, band: bool) -> None:
     for gd in grid.gds:
         row = [c for c in cells if c.gd == gd]
         print(f"{gd:5.0f} " + "".join(f"{100 * c.bias:+7.1f}{c.mark}" for c in row))
-    print("linearised (not truncated at the edges), % (* > 2 se)")
+    print("linearised (not truncated at the edges), % (* > 2 se; nan: the emulator is too flat "
+          "in GD there to linearise, its step beyond the domain's width)")  # fmt: skip
     for gd in grid.gds:
         row = [c for c in cells if c.gd == gd]
         print(f"{gd:5.0f} " + "".join(f"{100 * c.lin:+7.1f}{c.lin_mark} " for c in row))
@@ -333,16 +342,20 @@ def print_cells(title: str, cells: list[Cell], grid: Grid, band: bool) -> None:
     flagged_lin = sum(abs(c.lin) > 2 * c.lin_se for c in cells)
     inner = [c for c in cells if grid.gds[0] < c.gd < grid.gds[-1]]
 
-    def rms(x) -> float:
-        return 100 * float(np.sqrt(np.mean(np.square(x))))
+    def rms(x) -> float:  # over the cells that have a value (NaN: too flat to linearise)
+        x = np.asarray(x, dtype=float)
+        return 100 * float(np.sqrt(np.mean(np.square(x[np.isfinite(x)]))))
 
     print(
         f"ML: {flagged} of {len(cells)} cells beyond 2 se (about {0.0455 * len(cells):.0f} by "
         f"chance); over GD {grid.gds[1]:g}-{grid.gds[-2]:g}, RMS bias "
         f"{rms([c.bias for c in inner]):.1f}% against RMS se {rms([c.se for c in inner]):.1f}%"
     )
+    flat = sum(not np.isfinite(c.lin) for c in cells)
     print(
-        f"linearised: {flagged_lin} of {len(cells)} cells beyond 2 se; RMS bias "
+        f"linearised: {flagged_lin} of {len(cells)} cells beyond 2 se"
+        + (f" ({flat} too flat to linearise, left out of the RMS)" if flat else "")
+        + "; RMS bias "
         f"{rms([c.lin for c in cells]):.1f}% against RMS se {rms([c.lin_se for c in cells]):.1f}%"
         f" (all cells); per speed "
         + ", ".join(f"{v:.3g}: {rms([c.lin for c in cells if c.v == v]):.1f}%" for v in grid.speeds)
