@@ -65,8 +65,11 @@ class SensorLimits:
             stretch), however short the fault (from 6 samples). Of 41,904 clean blocks of
             125 samples (GD 200-600, 0.5-2 m/s, with and without noise) the smallest such range
             was 0.0077 of the block's sd.
-        free_fall_mps2: the reading of a wheel in the air (exempt from the dead-sensor check:
-            a flight holds one value), m/s^2; None: no exemption.
+        free_fall_mps2: the reading of a wheel in the air, m/s^2: without sensor noise a
+            flight holds this one value, so it is exempt from the dead-sensor and lattice
+            checks; None: no exemption. Where ``noise_sd_mps2`` is set every reading carries
+            noise, flights too, and the exemption is dropped: it would hide a quantisation or a
+            dead stretch that falls in a flight (`flight_reading`).
         noise_sd_mps2: the sensor's own white-noise standard deviation, m/s^2 (every reading
             carries it, in flight and at rest too); None: unknown, no noise-floor check.
             `control.bcr_settings_for` takes it from the emulator's training noise.
@@ -168,14 +171,15 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits) -> str:
             f"clipped signal: {counts[lo]} samples at {values[lo]:.4g} m/s^2 and {counts[hi]} at "
             f"{values[hi]:.4g} m/s^2 (allowed {limits.max_same} at two values)"
         )
-    start = dead_stretch(a, limits.dead_fraction, limits.free_fall_mps2)
+    flight = flight_reading(limits)
+    start = dead_stretch(a, limits.dead_fraction, flight)
     if start >= 0:
         return (
             f"dead sensor: samples {start}-{start + DEAD_STRETCH - 1} span less than "
             f"{limits.dead_fraction:g} of the block's standard deviation"
         )
     if limits.lattice_p > 0:
-        p, start, stretch, step = most_lattice_like(a, limits.free_fall_mps2)
+        p, start, stretch, step = most_lattice_like(a, flight)
         if p < limits.lattice_p:
             return (
                 f"quantised signal: samples {start}-{start + stretch - 1} sit on a lattice of "
@@ -199,6 +203,13 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits) -> str:
             f"differs from the rest's by a factor {ratio:.3g} (allowed {limits.max_level_jump:g})"
         )
     return ""
+
+
+def flight_reading(limits: SensorLimits) -> float | None:
+    """The reading the dead-sensor and lattice checks exempt as a wheel in the air: the limits'
+    ``free_fall_mps2`` for a sensor without known noise, None (no exemption) for one with it (a
+    noisy flight neither holds one value nor sits on a lattice)."""
+    return limits.free_fall_mps2 if limits.noise_sd_mps2 is None else None
 
 
 def dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None) -> int:

@@ -9,6 +9,7 @@ import control
 from control import BlockScatter, ControlError, EmulatorMismatchError, ObservationModel
 from control.sensor_checks import (
     SensorLimits,
+    flight_reading,
     lattice_stretch,
     level_jump,
     longest_repeat,
@@ -256,6 +257,23 @@ def test_a_short_coarse_quantisation_is_a_quantised_signal(
     assume(np.all(np.abs(a[start:stop] + 9.81) > 0.05 * 9.81))  # no value reads as a flight
     assert most_lattice_like(a)[0] < limits.lattice_p
     assert signal_fault(a, limits) != ""
+
+
+def test_a_quantisation_inside_a_noisy_flight_is_found_where_the_noise_is_known():
+    """Soak seed 24, #271: 8 samples rounded to steps of 4.9 m/s^2 while the wheel was in the
+    air; half of them read -9.79, within 5% of -g, and the flight exemption hid them. A sensor
+    with known noise carries it in flight too, so its flights are not exempt."""
+    rng = np.random.default_rng(271)
+    a = 2.0 * rng.standard_normal(125) + rng.standard_normal(125)
+    a[40:70] = -9.81 + rng.standard_normal(30)  # a flight, read through the sensor's noise
+    noisy = SensorLimits(noise_sd_mps2=1.0)
+    assert signal_fault(a, noisy) == "" and flight_reading(noisy) is None
+    assert flight_reading(SensorLimits()) == SensorLimits().free_fall_mps2
+    q = a.copy()
+    q[36:44] = np.round(q[36:44] / 4.9) * 4.9  # into the flight: -4.9, -9.8, -9.8, ...
+    assert np.sum(np.abs(q[36:44] + 9.81) <= 0.05 * 9.81) >= 4
+    assert signal_fault(q, noisy).startswith("quantised signal: samples 3")
+    assert signal_fault(q, SensorLimits()) == ""  # noise unknown: the flight stays exempt
 
 
 def test_healthy_sensors_of_any_resolution_are_no_lattice():
