@@ -270,7 +270,7 @@ def test_a_quantisation_inside_a_noisy_flight_is_found_where_the_noise_is_known(
     assert signal_fault(a, noisy) == "" and flight_reading(noisy) is None
     assert flight_reading(SensorLimits()) == SensorLimits().free_fall_mps2
     q = a.copy()
-    q[36:44] = np.round(q[36:44] / 4.9) * 4.9  # into the flight: -4.9, -9.8, -9.8, ...
+    q[36:44] = np.round(q[36:44] / 4.9) * 4.9  # into the flight: levels 4.9, 0 and -9.8
     assert np.sum(np.abs(q[36:44] + 9.81) <= 0.05 * 9.81) >= 4
     assert signal_fault(q, noisy).startswith("quantised signal: samples 3")
     assert signal_fault(q, SensorLimits()) == ""  # noise unknown: the flight stays exempt
