@@ -27,7 +27,7 @@ from control.errors import (
     EmulatorMismatchError,
     MissingExtraError,
 )
-from control.estimate import FAULT_STATUSES, STATUSES, Estimate
+from control.estimate import DOMAIN_EDGES, FAULT_STATUSES, STATUSES, Estimate, edge_counts
 from control.faults import FAULT_KINDS, SensorFault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.metrics import (
@@ -49,6 +49,7 @@ __all__ = [
     "BCR",
     "BCRSettings",
     "BagError",
+    "DOMAIN_EDGES",
     "FAULT_KINDS",
     "FAULT_STATUSES",
     "INTERVAL_KINDS",
@@ -83,6 +84,7 @@ __all__ = [
     "check_likelihood",
     "clustered_mean",
     "detection_delays",
+    "edge_counts",
     "emulator_feature",
     "emulator_noise_std",
     "emulator_vehicle",

@@ -37,6 +37,17 @@ def graver_fault(first: Estimate | None, second: Estimate) -> Estimate | None:
     return first
 
 
+#: The values of a named `Estimate.domain_edge` ("" names none).
+DOMAIN_EDGES = ("upper", "lower")
+
+
+def edge_counts(domain_edge) -> dict[str, int]:
+    """How many estimates name each edge of the GD domain, from their ``domain_edge`` values
+    (e.g. `ClosedLoopResult.domain_edge`), keyed by DOMAIN_EDGES."""
+    edges = np.asarray(domain_edge, dtype=object)
+    return {edge: int(np.sum(edges == edge)) for edge in DOMAIN_EDGES}
+
+
 #: `favoured_edge`: the evidence (posterior-to-prior ratio, a Bayes factor) that marks an edge
 #: of the GD domain as favoured, against every GD at least EDGE_MARGIN (relative) inside it:
 #: 20 is "strong" evidence on Kass and Raftery's (1995) scale.

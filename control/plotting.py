@@ -54,9 +54,9 @@ def plot_gd_trace(
             ax.plot(r.position, edge, lw=0.6, alpha=0.7, color=line.get_color(), ls="--",
                     label=label)  # fmt: skip
             label = None
-        edges = getattr(r, "domain_edge", None)
+        edges = np.asarray(getattr(r, "domain_edge", np.full(r.position.shape, "")), dtype=object)
         for edge, marker in (("upper", "^"), ("lower", "v")):
-            named = np.asarray(edges) == edge if edges is not None else np.zeros(0, bool)
+            named = edges == edge
             if named.any():
                 ax.plot(r.position[named], r.gd_mean[named], ls="none", marker=marker, ms=4,
                         color=line.get_color(),

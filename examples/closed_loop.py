@@ -130,10 +130,9 @@ def summarise(results, gds: list[float]) -> dict:
         "rmse": {f"{gd:g}": control.pooled_rmse(errors, gd) for gd in gds},
         "coverage": float(np.mean(covered)) if covered.size else float("nan"),
         "runs": [
-            {**r.metrics.as_dict(),
-             "domain_edge": {e: int(np.sum(r.domain_edge == e)) for e in ("upper", "lower")}}
+            {**r.metrics.as_dict(), "domain_edge": control.edge_counts(r.domain_edge)}
             for r in results
-        ],  # fmt: skip
+        ],
     }
 
 

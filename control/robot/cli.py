@@ -21,6 +21,7 @@ from pathlib import Path
 
 from control.compat import check_emulator
 from control.errors import ControlError, MissingExtraError
+from control.estimate import edge_counts
 from control.robot.replay import (
     GRAVITY,
     POSITIONS,
@@ -155,7 +156,7 @@ def main(argv: list[str] | None = None) -> int:
         "resampling": asdict(result.resampling),
         "notes": list(result.notes),
         "status_counts": result.status_counts(),
-        "domain_edge_counts": {e: int(sum(result.domain_edge == e)) for e in ("upper", "lower")},
+        "domain_edge_counts": edge_counts(result.domain_edge),
         "timing_s": {"read": result.read_s, "resample": result.condition_s, "bcr": result.bcr_s},
         "duration_s": result.duration_s,
         "real_time_factor": result.real_time_factor,

@@ -38,7 +38,7 @@ from tqdm.auto import tqdm
 from control.bcr import BCR, BCRSettings
 from control.compat import bcr_settings_for, check_emulator, check_likelihood
 from control.errors import BagError, ControlError
-from control.estimate import Estimate
+from control.estimate import Estimate, edge_counts
 from control.robot import condition
 from control.robot import messages as msgs
 from control.robot.bags import STORAGES, Recording, merge_in_time, open_bag_writer, read_recording
@@ -247,12 +247,12 @@ class ReplayResult:
                 f"{np.max(self.gd_mean[ok]):.0f}; safety mode "
                 f"{np.mean(self.mode == 'safety'):.0%} of the time"
             )
-        for edge, beyond in (("upper", "rougher"), ("lower", "smoother")):
-            named = int(np.sum(self.domain_edge == edge))
+        beyond = {"upper": "rougher", "lower": "smoother"}
+        for edge, named in edge_counts(self.domain_edge).items():
             if named:
                 lines.append(
                     f"{named} estimates favour the {edge} edge of the emulator's GD domain: the "
-                    f"road may be {beyond} than any it was trained on"
+                    f"road may be {beyond[edge]} than any it was trained on"
                 )
         lines.append(
             f"replayed at {self.real_time_factor:.0f}x real time (read {self.read_s:.3f} s, "

@@ -65,6 +65,7 @@ def test_a_road_rougher_than_the_emulator_knows_is_named_and_driven_in_safety_mo
     named = r.domain_edge == "upper"
     assert named[r.position > 20].mean() > 0.1 and not named[r.position < 20].any()
     assert np.all(r.mode[named] == "safety") and not np.any(r.domain_edge == "lower")
+    assert control.edge_counts(r.domain_edge) == {"upper": int(named.sum()), "lower": 0}
     assert all("rougher than any the emulator knows" in why for why in r.reason[named])
     assert np.all(r.gd_hi[r.status == "ok"] <= 600.0)  # the posterior stays in the domain
     assert r.domain_edge.shape == r.status.shape and np.all(r.domain_edge[r.status != "ok"] == "")
