@@ -1,11 +1,17 @@
-"""Command-line checks the example scripts share (imported as ``_cli``: a script's folder is the
-first entry of sys.path when it runs)."""
+"""Command-line checks and file writes the example scripts share (imported as ``_cli``: a
+script's folder is the first entry of sys.path when it runs)."""
 
 from __future__ import annotations
 
 import argparse
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+from gpmsa.io.atomic import atomic_write
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 def output_folder(parser: argparse.ArgumentParser, option: str, folder: str | Path) -> Path:
@@ -24,3 +30,16 @@ def output_folder(parser: argparse.ArgumentParser, option: str, folder: str | Pa
     if not os.access(folder, os.W_OK | os.X_OK):
         parser.error(f"{option} {str(folder)!r}: the folder is not writable")
     return folder
+
+
+def write_text(path: Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` in one step: a script stopped while writing leaves the
+    previous file or none, never a part of one."""
+    with atomic_write(path, text=True) as fh:
+        fh.write(text)
+
+
+def save_figure(fig: Figure, path: Path, dpi: int = 120) -> None:
+    """``fig.savefig`` to ``path`` in one step (the format from its suffix), as `write_text`."""
+    with atomic_write(path) as fh:
+        fig.savefig(fh, format=path.suffix.lstrip("."), dpi=dpi)

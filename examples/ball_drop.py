@@ -34,7 +34,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder  # noqa: E402
+from _cli import output_folder, save_figure, write_text  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 from scipy.stats import qmc  # noqa: E402
 
@@ -154,7 +154,7 @@ def main(argv: list[str] | None = None) -> dict:
     figs["sensitivity"] = gpmsa.plots.sensitivity_bars(sens)
 
     for name, fig in figs.items():
-        fig.savefig(out / f"{name}.png", dpi=120)
+        save_figure(fig, out / f"{name}.png")
     summary = {
         "posterior": post.summary(0.9),
         "world": WORLD,
@@ -173,7 +173,7 @@ def main(argv: list[str] | None = None) -> dict:
         "seconds": time.perf_counter() - t0,
         "figures": sorted(f"{name}.png" for name in figs),
     }  # fmt: skip
-    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    write_text(out / "summary.json", json.dumps(summary, indent=2))
     p = summary["prediction_held_out_balls"]
     print(
         f"Cd = {post.mean('Cd'):.3f} +- {post.sd('Cd'):.3f}, g = {post.mean('g'):.3f} +- "

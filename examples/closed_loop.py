@@ -36,7 +36,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder  # noqa: E402
+from _cli import output_folder, save_figure, write_text  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -262,12 +262,10 @@ def main(argv: list[str] | None = None) -> dict:
             )
             metrics[key][case] = summarise(results, gds)
             label = "ours" if key == "ours" else "paper's method"
-            plot_gd_trace(results, track, title=f"{title}, {label}: GD").savefig(
-                out / f"gd_trace_{case}_{key}.png", dpi=150
-            )
-            plot_speed(results, track, title=f"{title}, {label}: speed").savefig(
-                out / f"speed_{case}_{key}.png", dpi=150
-            )
+            gd_figure = plot_gd_trace(results, track, title=f"{title}, {label}: GD")
+            save_figure(gd_figure, out / f"gd_trace_{case}_{key}.png", dpi=150)
+            speed_figure = plot_speed(results, track, title=f"{title}, {label}: speed")
+            save_figure(speed_figure, out / f"speed_{case}_{key}.png", dpi=150)
     if paper_track:
         metrics["paper"] = PAPER_RMSE
     metrics["settings"] = {**vars(args), "segments": segments, "seeds": list(seeds)}
@@ -308,7 +306,7 @@ def main(argv: list[str] | None = None) -> dict:
         print("\nestimates naming an edge of the emulator's GD domain (the road may lie beyond):")
         print("\n".join(f"  {line}" for line in named))
     metrics_json = json.dumps(json_safe(metrics), indent=2, default=float, allow_nan=False)
-    (out / "metrics.json").write_text(metrics_json)
+    write_text(out / "metrics.json", metrics_json)
     print(f"\nwrote {out / 'metrics.json'} and the figures gd_trace_*.png, speed_*.png")
     if args.record:
         print(f"wrote one MCAP per run in {args.record} (open in Foxglove with "

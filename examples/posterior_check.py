@@ -22,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder  # noqa: E402
+from _cli import output_folder, save_figure, write_text  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -113,11 +113,10 @@ def main(argv: list[str] | None = None) -> dict:
         f"{summary['all_roads']['max_cell_mean']:.1f} / {summary['all_roads']['mean']:.1f}"
     )
     title = f"Posterior GD, case {args.case}, one window per cell"
-    plot_posterior_grid(cells, title=title).savefig(
-        out / f"posterior_grid_{args.case}.png", dpi=120
-    )
-    (out / f"table2_{args.case}.json").write_text(
-        json.dumps({"summary": summary, "percent_error": errors.tolist()}, indent=1)
+    save_figure(plot_posterior_grid(cells, title=title), out / f"posterior_grid_{args.case}.png")
+    write_text(
+        out / f"table2_{args.case}.json",
+        json.dumps({"summary": summary, "percent_error": errors.tolist()}, indent=1),
     )
     return summary
 

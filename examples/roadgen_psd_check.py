@@ -15,7 +15,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-from _cli import output_folder  # noqa: E402
+from _cli import output_folder, save_figure  # noqa: E402
 
 import roadgen  # noqa: E402
 
@@ -52,11 +52,11 @@ def main(argv: list[str] | None = None) -> None:
                     )
     fig = roadgen.plot_profile_psd(road, title="ISO 8608 profile, prescribed GD 450")
     path = out / "roadgen_psd_gd450.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     track = roadgen.track([(50, 300), (50, 500), (50, 300)], seed=0)
     track_path = out / "roadgen_track.png"
-    roadgen.plot_profile_psd(track, title="the paper's track: GD 300 / 500 / 300").savefig(
-        track_path, dpi=120
+    save_figure(
+        roadgen.plot_profile_psd(track, title="the paper's track: GD 300 / 500 / 300"), track_path
     )
     print(f"\nsaved {path} and {track_path}")
 

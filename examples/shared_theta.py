@@ -30,7 +30,7 @@ import json
 import warnings
 
 import numpy as np
-from _cli import output_folder
+from _cli import output_folder, save_figure, write_text
 from matplotlib.figure import Figure
 from scipy.stats import qmc
 
@@ -167,7 +167,7 @@ def main(argv: list[str] | None = None) -> dict:
           "rho [kg/m^3]")  # fmt: skip
     fig.suptitle("Posterior of the shared modulus E and the modal test's density")
     fig.tight_layout()
-    fig.savefig(out / "posterior_E_rho.png", dpi=120)
+    save_figure(fig, out / "posterior_E_rho.png")
     fig = Figure(figsize=(5, 4.5))
     ax = fig.subplots()
     for label in ("modal alone", "shared (emulators fixed)"):
@@ -178,7 +178,7 @@ def main(argv: list[str] | None = None) -> dict:
     ax.legend(fontsize=8)
     ax.set_title("The modal test alone pins E / rho; sharing E pins both")
     fig.tight_layout()
-    fig.savefig(out / "pairs_E_rho.png", dpi=120)
+    save_figure(fig, out / "pairs_E_rho.png")
     fig = Figure(figsize=(8, 3))
     ax = fig.subplots()
     for name in ("E", "rho[modal]"):
@@ -188,8 +188,8 @@ def main(argv: list[str] | None = None) -> dict:
     ax.set_ylabel("standardised draw")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "traces.png", dpi=120)
-    (out / "summary.json").write_text(json.dumps(summary, indent=1))
+    save_figure(fig, out / "traces.png")
+    write_text(out / "summary.json", json.dumps(summary, indent=1))
     return summary
 
 

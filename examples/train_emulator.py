@@ -46,7 +46,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder  # noqa: E402
+from _cli import output_folder, save_figure  # noqa: E402
 from closed_loop import PAPER_SEGMENTS  # noqa: E402
 
 import control  # noqa: E402
@@ -333,7 +333,7 @@ def main(argv: list[str] | None = None) -> None:
     design = stretched_design(
         args.n_runs, args.seed, tuple(args.gd_range), tuple(args.speed_range), args.speed_spacing
     )
-    plot_design(design[:, 0], design[:, 1]).savefig(out / "lhs_design.png", dpi=150)
+    save_figure(plot_design(design[:, 0], design[:, 1]), out / "lhs_design.png", dpi=150)
     tic = time.perf_counter()
     campaign = vehicle.run_campaign(
         design, model, lead_in_m=LEAD_IN_M, rate_hz=RATE_HZ, noise_std=args.noise_std,
