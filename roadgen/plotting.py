@@ -5,12 +5,18 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from roadgen.errors import RoadgenError
 from roadgen.iso8608 import N0, gd_spectrum
-from roadgen.psd import estimate_gd, profile_psd
+from roadgen.psd import FIT_BAND, estimate_gd, profile_psd
 from roadgen.road import Road, check_road
 
 
-def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None = None) -> Figure:
+def plot_profile_psd(
+    road: Road,
+    method: str = "periodogram",
+    title: str | None = None,
+    band: tuple[float, float] | None = None,
+) -> Figure:
     """Figure with the profile z(x) in mm (top) and its PSD (bottom, log-log, m^3 against cycles/m).
 
     The PSD panel shows the prescribed line(s) Gd(n) = GD 1e-6 (n/n0)^-w for each distinct GD of the
@@ -19,12 +25,21 @@ def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None 
     drawn wide and translucent underneath, the road's PSD as a thin line with a dot per ordinate
     on top: with deterministic amplitudes the periodogram lies exactly on its line and stays
     visible there. A plain Road (no GD of its own) shows no prescribed line and is fitted with
-    waviness 2.
+    waviness 2. ``band`` (cycles/m) is that of the GD fit (``estimate_gd``); default FIT_BAND,
+    its n_max lowered to the grid's Nyquist frequency 0.5 / dx_m on grids coarser than 0.5 m.
 
-    Raises RoadgenError unless ``road`` is a roadgen Road, and for the errors of ``profile_psd``.
+    Raises RoadgenError unless ``road`` is a roadgen Road, for a flat road (no PSD to draw), a grid
+    too coarse for the default band (dx_m >= 10 m), and for the errors of ``profile_psd`` and
+    ``estimate_gd``.
     """
     check_road("road", road)
     n, gd = profile_psd(road, method)
+    if not np.any(gd > 0.0):
+        raise RoadgenError(
+            f"road is flat: its {method} is zero at every frequency, so there is no PSD to draw "
+            "on log axes"
+        )
+    recovered = estimate_gd(road, band=_fit_band(road.dx_m) if band is None else band)
     fig = Figure(figsize=(7.0, 6.5), layout="constrained")
     ax_z, ax_p = fig.subplots(2, 1)
     ax_z.plot(road.x, 1e3 * road.z, lw=0.6)
@@ -35,7 +50,6 @@ def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None 
         ax_p.loglog(n, gd_spectrum(n, g, waviness), lw=5.0, alpha=0.35, color=f"C{k + 1}",
                     solid_capstyle="butt", zorder=1, label=f"prescribed GD {g:g}")  # fmt: skip
     ax_p.loglog(n, gd, lw=0.6, color="C0", marker=".", ms=2.0, zorder=3, label=f"{method} of z")
-    recovered = estimate_gd(road)
     ax_p.loglog([N0], [recovered * 1e-6], "o", color="k", label=f"recovered GD {recovered:.1f}")
     ax_p.set_xlabel("spatial frequency n (cycles/m)")
     ax_p.set_ylabel("Gd(n) (m$^3$)")
@@ -44,6 +58,18 @@ def plot_profile_psd(road: Road, method: str = "periodogram", title: str | None 
     if title is not None:
         fig.suptitle(title)
     return fig
+
+
+def _fit_band(dx_m: float) -> tuple[float, float]:
+    """FIT_BAND (cycles/m) with n_max lowered to the Nyquist frequency 0.5 / dx_m of the grid."""
+    nyquist = 0.5 / dx_m
+    if FIT_BAND[0] >= nyquist:
+        raise RoadgenError(
+            f"the grid dx_m={dx_m:.6g} m (Nyquist frequency {nyquist:.6g} cycles/m) is too coarse "
+            f"for the GD fit band FIT_BAND={FIT_BAND} cycles/m: pass a band inside "
+            f"(0, {nyquist:.6g}] cycles/m, or use dx_m < {0.5 / FIT_BAND[0]:g} m"
+        )
+    return FIT_BAND[0], min(FIT_BAND[1], nyquist)
 
 
 def _prescribed_gds(road: Road) -> list[float]:

@@ -8,7 +8,7 @@ import numpy as np
 
 from roadgen import checks
 from roadgen.errors import RoadgenError
-from roadgen.iso8608 import gd_spectrum
+from roadgen.iso8608 import check_waviness, gd_spectrum
 from roadgen.road import Road
 
 AMPLITUDE_MODES = ("deterministic", "rayleigh")
@@ -21,7 +21,7 @@ class ProfileSettings:
     band: (n_min, n_max) cycles/m, the spatial frequencies that carry content (as resolved).
     amplitudes: "deterministic" (each harmonic carries exactly Gd(n_k) dn) or "rayleigh"
         (Rayleigh-distributed amplitudes, i.e. a Gaussian process with that mean PSD).
-    waviness: w in Gd(n) = Gd(n0) (n/n0)^-w (ISO 8608: 2).
+    waviness: w in Gd(n) = Gd(n0) (n/n0)^-w, in (0, MAX_WAVINESS = 5] (ISO 8608: 2).
     seed: the integer seed, or None when a Generator or fresh entropy was used.
     lead_in_m: length of the raised-cosine taper from z = 0 at the start, m (0: none).
     """
@@ -74,15 +74,19 @@ def iso8608_profile(
         harmonic the grid holds, from the fundamental 1/P to the Nyquist limit 1/(2 dx_m)
         (83.3 cycles/m at 6 mm). The upper limit matters: a vehicle at 0.5 m/s sees 10 cycles/m
         as 5 Hz, so a band that stops there would hide the road from its ~10 Hz tyre modes.
-        The Nyquist harmonic itself is never used (it has no phase).
+        The Nyquist harmonic itself is never used (it has no phase). The edges are inclusive,
+        n_min within a relative 1/N (see ``band_edges``): band=(0.1, ...) on a 150 m road keeps
+        the harmonic k = 15 at 15 / 150.006 m = 0.099996 cycles/m, the paper's n0.
+    waviness: w, in (0, MAX_WAVINESS = 5] (ISO 8608: 2).
     lead_in_m: if > 0, z is multiplied by 0.5 (1 - cos(pi x / lead_in_m)) on [0, lead_in_m], so the
         road starts at z = 0 with zero slope (the vehicle's rest height).
     seed: int or numpy Generator; the same seed gives the same profile. The phases (and Rayleigh
         factors) do not depend on GD, so one seed gives the same shape scaled by sqrt(GD) for
         every GD: use different seeds for independent roads.
 
-    Raises RoadgenError for a non-positive or non-finite length, GD, dx or waviness, a band outside
-    (0, Nyquist], a length shorter than 1/n_min, or a band without harmonics.
+    Raises RoadgenError for a non-positive or non-finite length, GD or dx, a waviness outside
+    (0, 5], a band outside (0, Nyquist], a length shorter than 1/n_min, or a band without
+    harmonics.
     """
     length = checks.positive("length_m", length_m)
     gd_val = checks.positive("gd", gd)
@@ -109,7 +113,7 @@ def unit_road(
 ) -> tuple[np.ndarray, ProfileSettings]:
     """Heights (n_points,) m of a GD = 1 profile on the grid, and the resolved settings."""
     checks.choice("amplitudes", amplitudes, AMPLITUDE_MODES)
-    w = checks.positive("waviness", waviness)
+    w = check_waviness("waviness", waviness)
     period = n_points * dx_m
     nyquist = 0.5 / dx_m
     dn = 1.0 / period
@@ -125,7 +129,8 @@ def unit_road(
             )
     k = np.arange(n_points // 2 + 1)
     n = k * dn
-    keep = (k >= 1) & (2 * k < n_points) & (n >= lo * (1 - 1e-9)) & (n <= hi * (1 + 1e-9))
+    edge_lo, edge_hi = band_edges((lo, hi), n_points)
+    keep = (k >= 1) & (2 * k < n_points) & (n >= edge_lo) & (n <= edge_hi)
     if not np.any(keep):
         raise RoadgenError(
             f"band={band!r} holds no harmonic of the profile (spacing {dn:.6g} cycles/m): widen it "
@@ -149,6 +154,18 @@ def unit_road(
         lead_in_m=lead_in_m,
     )
     return unit, settings
+
+
+def band_edges(band: tuple[float, float], n_points: int) -> tuple[float, float]:
+    """Lowest and highest frequency (cycles/m) that a harmonic of an ``n_points`` grid may have to
+    count as inside ``band``: n_min less a relative 1/n_points, n_max plus rounding.
+
+    Harmonic k lies at k / (n_points dx), the road's period, just below k / ((n_points - 1) dx)
+    over its length: on a 150 m road at 6 mm the harmonic with 15 cycles over the road is at
+    0.099996 cycles/m, and a band from 0.1 keeps it.
+    """
+    lo, hi = band
+    return lo * (1.0 - 1.0 / n_points) * (1.0 - 1e-9), hi * (1.0 + 1e-9)
 
 
 def lead_in_taper(x: np.ndarray, lead_in_m: float) -> np.ndarray:

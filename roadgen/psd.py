@@ -9,7 +9,8 @@ import scipy.signal
 
 from roadgen import checks
 from roadgen.errors import RoadgenError
-from roadgen.iso8608 import GD_SCALE, N0
+from roadgen.iso8608 import GD_SCALE, N0, check_waviness
+from roadgen.profile import band_edges
 
 FIT_BAND = (0.05, 1.0)
 """Default band of the GD fit, cycles/m: an octave below n0 to a decade above (20 m to 1 m
@@ -95,44 +96,111 @@ def estimate_gd(
       "periodogram": the paper's check, the periodogram at the harmonic nearest n0 = 0.1 cycles/m,
           scaled to n0 along the slope (one ordinate, mean removed: exact for deterministic
           amplitudes, noisy for random ones).
+    A road that records the band of its content (``settings.band`` of a Profile or Track) is
+    fitted only inside it (edges as ``profile.band_edges``; Welch bins also keep 2 bins, the Hann
+    window's main lobe, clear of its edges), and "periodogram" needs content at its harmonic.
     waviness: w of the fit; default the road's ``settings.waviness`` if it has one, else 2.
 
-    Raises RoadgenError for an unknown method, a bad band, or a road too short to hold a PSD bin in
-    the band.
+    Raises RoadgenError for an unknown method, a bad band or waviness (or settings.band or
+    settings.waviness), a band outside the road's content band, a road too short to hold a PSD
+    bin in the band, and for "periodogram" a road without content at the harmonic nearest n0.
     """
     checks.choice("method", method, GD_METHODS)
     z, dx = checks.heights("road", road)
     w = _waviness(road, waviness)
-    nyquist = 0.5 / dx
-    lo, hi = checks.band("band", FIT_BAND if band is None else band, nyquist)
+    lo, hi = _fit_band(band, dx)
+    content = _content_band(road, dx)
     if method == "periodogram":
-        n, gd = _psd(z, dx, "periodogram", z.size, end_match=False)
-        k = int(np.argmin(np.abs(np.log(n / N0))))
-        return float(gd[k] * (n[k] / N0) ** w / GD_SCALE)
+        return _periodogram_gd(z, dx, w, content)
     if method == "fit":
         n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
+        keep = _fit_bins(n, (lo, hi), content, z.size, dx, method)
     else:
         if z.size < 32:  # profile_psd's default Welch segment, N // 4, must hold 8 points
             raise RoadgenError(f"method='welch' needs a road of >= 32 heights, got {z.size}")
         n, gd = _psd(z, dx, "welch", z.size // 4, end_match=False)
-    keep = (n >= lo) & (n <= hi)
-    if method == "welch":
+        keep = _fit_bins(n, (lo, hi), content, z.size, dx, method)
         k = n / n[0]
+        if not np.any(keep & (k >= WELCH_MIN_BIN)):
+            raise _welch_too_short((lo, hi), float(n[keep][-1]), z.size, dx)
         keep &= k >= WELCH_MIN_BIN
         gd = gd / (1.0 + w * (w + 1.0) / (6.0 * k**2))
-    if not np.any(keep):
-        length = dx * z.size
-        raise RoadgenError(
-            f"the road (length {length:.6g} m) is too short for band=({lo:.6g}, {hi:.6g}) cycles/m "
-            f"with method={method!r}: its PSD has no bin there (spacing {n[0]:.6g} cycles/m)"
-        )
     return float(np.mean(gd[keep] * (n[keep] / N0) ** w) / GD_SCALE)
+
+
+def _periodogram_gd(
+    z: np.ndarray, dx: float, w: float, content: tuple[float, float] | None
+) -> float:
+    """GD from the periodogram ordinate of z (N,) m nearest n0, scaled to n0 along slope -w."""
+    n, gd = _psd(z, dx, "periodogram", z.size, end_match=False)
+    k = int(np.argmin(np.abs(np.log(n / N0))))
+    if content is not None:
+        edge_lo, edge_hi = band_edges(content, z.size)
+        if not edge_lo <= n[k] <= edge_hi:
+            raise RoadgenError(
+                f"method='periodogram' reads the harmonic nearest n0 = {N0} cycles/m, "
+                f"{n[k]:.6g} cycles/m, but the road has no content there: its settings.band="
+                f"({content[0]:.6g}, {content[1]:.6g}) cycles/m; use method='fit' with a band "
+                "inside settings.band, or make the road with a band that holds n0"
+            )
+    return float(gd[k] * (n[k] / N0) ** w / GD_SCALE)
+
+
+def _fit_bins(
+    n: np.ndarray,
+    band: tuple[float, float],
+    content: tuple[float, float] | None,
+    n_points: int,
+    dx: float,
+    method: str,
+) -> np.ndarray:
+    """Mask of the PSD bins n (M,) cycles/m of a road of ``n_points`` heights on a step ``dx`` m
+    that lie in ``band`` and, if known, in its ``content`` band (for "welch" 2 bins inside its
+    edges); raises RoadgenError if none does, naming the cause."""
+    lo, hi = band
+    in_band = (n >= lo) & (n <= hi)
+    if not np.any(in_band):
+        raise RoadgenError(
+            f"the road (length {n_points * dx:.6g} m) is too short for band=({lo:.6g}, {hi:.6g}) "
+            f"cycles/m with method={method!r}: its PSD has no bin there (spacing {n[0]:.6g} "
+            "cycles/m)"
+        )
+    if content is None:
+        return in_band
+    margin = 2.0 * n[0] if method == "welch" else 0.0
+    edge_lo, edge_hi = band_edges(content, n_points)
+    keep = in_band & (n >= edge_lo + margin) & (n <= edge_hi - margin)
+    if not np.any(keep):
+        clear = f" less 2 Welch bins ({margin:.6g} cycles/m) at each edge" if margin else ""
+        raise RoadgenError(
+            f"band=({lo:.6g}, {hi:.6g}) cycles/m holds no PSD bin of the road inside its content "
+            f"band settings.band=({content[0]:.6g}, {content[1]:.6g}) cycles/m{clear}, with "
+            f"method={method!r}: the road has no content there; pass a band inside settings.band"
+        )
+    return keep
+
+
+def _welch_too_short(
+    band: tuple[float, float], top: float, n_points: int, dx: float
+) -> RoadgenError:
+    """The error for a road whose Welch bins in ``band``, up to ``top`` cycles/m, all lie below
+    WELCH_MIN_BIN."""
+    seg = n_points // 4
+    n_first = WELCH_MIN_BIN / (seg * dx)
+    return RoadgenError(
+        f"the road (length {n_points * dx:.6g} m) is too short for band=({band[0]:.6g}, "
+        f"{band[1]:.6g}) cycles/m with method='welch': it fits only Welch bins from index "
+        f"WELCH_MIN_BIN={WELCH_MIN_BIN} of its segments of N // 4 = {seg} heights "
+        f"({seg * dx:.6g} m), n >= {n_first:.6g} cycles/m, and its bins in the band reach only "
+        f"{top:.6g} cycles/m; use a road longer than {4 * WELCH_MIN_BIN / top:.3g} m, a band "
+        f"reaching above {n_first:.6g} cycles/m, or method='fit'"
+    )
 
 
 def psd_slope(road: HasHeights, band: tuple[float, float] | None = None) -> float:
     """Least-squares slope of log Gd on log n over ``band`` (default FIT_BAND); ISO 8608: -2."""
     z, dx = checks.heights("road", road)
-    lo, hi = checks.band("band", FIT_BAND if band is None else band, 0.5 / dx)
+    lo, hi = _fit_band(band, dx)
     n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
     keep = (n >= lo) & (n <= hi) & (gd > 0)
     if np.count_nonzero(keep) < 2:
@@ -145,8 +213,31 @@ def _end_match(z: np.ndarray) -> np.ndarray:
     return z - np.linspace(z[0], z[-1], z.size)
 
 
+def _fit_band(band: tuple[float, float] | None, dx: float) -> tuple[float, float]:
+    """The fit band (cycles/m): ``band`` checked against the Nyquist frequency 0.5 / dx, or
+    FIT_BAND if None (RoadgenError naming the grid if it reaches above that frequency)."""
+    nyquist = 0.5 / dx
+    if band is not None:
+        return checks.band("band", band, nyquist)
+    if FIT_BAND[1] > nyquist:
+        raise RoadgenError(
+            f"the grid dx_m={dx:.6g} m (Nyquist frequency {nyquist:.6g} cycles/m) is too coarse "
+            f"for the default fit band FIT_BAND={FIT_BAND} cycles/m: pass a band inside "
+            f"(0, {nyquist:.6g}] cycles/m, or use dx_m <= {0.5 / FIT_BAND[1]:g} m"
+        )
+    return FIT_BAND
+
+
 def _waviness(road: HasHeights, waviness: float | None) -> float:
+    """w of the fit: ``waviness``, else the road's ``settings.waviness`` (checked), else 2."""
     if waviness is not None:
-        return checks.positive("waviness", waviness)
-    settings = getattr(road, "settings", None)
-    return float(getattr(settings, "waviness", 2.0))
+        return check_waviness("waviness", waviness)
+    value = getattr(getattr(road, "settings", None), "waviness", None)
+    return 2.0 if value is None else check_waviness("road.settings.waviness", value)
+
+
+def _content_band(road: HasHeights, dx: float) -> tuple[float, float] | None:
+    """The road's ``settings.band`` (cycles/m, checked against the Nyquist frequency 0.5 / dx),
+    or None if it records none."""
+    value = getattr(getattr(road, "settings", None), "band", None)
+    return None if value is None else checks.band("road.settings.band", value, 0.5 / dx)

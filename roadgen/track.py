@@ -17,9 +17,11 @@ from roadgen.road import Road
 class Track(Road):
     """A road made of segments: x (N,) m, z (N,) m, dx_m and what it was made from.
 
-    segments: ((length_m, gd), ...) in driving order; boundaries_m: start position of each segment
-    (the first is 0); lead_in_m: length of the start taper; blend_m: length of each amplitude
-    cross-fade, centred on a boundary; settings: synthesis settings of the underlying road.
+    segments: ((length_m, gd), ...) in driving order, their lengths summing to the road's length
+    within dx_m / 2; boundaries_m: start position of each segment (0 and the running sums of the
+    lengths, to 1e-9 relative); lead_in_m: length of the start taper; blend_m: length of each
+    amplitude cross-fade, centred on a boundary; settings: synthesis settings of the underlying
+    road.
     """
 
     segments: tuple[tuple[float, float], ...]
@@ -31,14 +33,8 @@ class Track(Road):
     def __post_init__(self) -> None:
         super().__post_init__()
         segs = _check_segments(self.segments)
-        starts = checks.real_array("boundaries_m", self.boundaries_m)
-        if starts.shape != (len(segs),) or not (
-            np.all(np.isfinite(starts)) and np.all(np.diff(starts) > 0)
-        ):
-            raise RoadgenError(
-                f"boundaries_m={self.boundaries_m!r} must hold one finite start position per "
-                f"segment ({len(segs)}), increasing"
-            )
+        starts = _check_boundaries(self.boundaries_m, segs)
+        _check_total_length(segs, self.length_m, self.dx_m)
         object.__setattr__(self, "segments", segs)
         object.__setattr__(self, "boundaries_m", tuple(float(b) for b in starts))
         object.__setattr__(self, "lead_in_m", checks.non_negative("lead_in_m", self.lead_in_m))
@@ -123,6 +119,42 @@ def _amplitude(x: np.ndarray, starts: np.ndarray, amps: np.ndarray, blend: float
         t = np.clip((x - start) / blend + 0.5, 0.0, 1.0)
         out += step * 0.5 * (1.0 - np.cos(np.pi * t))
     return out
+
+
+def _check_boundaries(
+    boundaries: tuple[float, ...], segs: tuple[tuple[float, float], ...]
+) -> np.ndarray:
+    """``boundaries`` (m) as an array, or raise unless they are the segments' start positions: 0
+    and the running sums of their lengths, within 1e-9 of the total length."""
+    starts = checks.real_array("boundaries_m", boundaries)
+    if starts.shape != (len(segs),) or not (
+        np.all(np.isfinite(starts)) and np.all(np.diff(starts) > 0)
+    ):
+        raise RoadgenError(
+            f"boundaries_m={boundaries!r} must hold one finite start position per segment "
+            f"({len(segs)}), increasing"
+        )
+    lengths = np.array([length for length, _ in segs])
+    expected = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
+    if np.max(np.abs(starts - expected)) > 1e-9 * lengths.sum():
+        raise RoadgenError(
+            f"boundaries_m={boundaries!r} do not match segments: a segment starts where the "
+            f"previous one ends, at ({', '.join(f'{b:g}' for b in expected)}) m"
+        )
+    return starts
+
+
+def _check_total_length(
+    segs: tuple[tuple[float, float], ...], length_m: float, dx_m: float
+) -> None:
+    """Raise unless the segments' lengths sum to ``length_m`` within dx_m / 2 (the rounding of a
+    track's length to whole grid steps)."""
+    total = sum(length for length, _ in segs)
+    if abs(total - length_m) > 0.5 * dx_m + 1e-9 * total:
+        raise RoadgenError(
+            f"segments span {total:g} m but the road (x) is {length_m:.6g} m long: they must "
+            f"agree within dx_m / 2 = {0.5 * dx_m:g} m"
+        )
 
 
 def _check_segments(segments: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:

@@ -30,6 +30,7 @@ def test_roadgen_error_is_a_value_error():
         ),
         ({"waviness": 0.0}, "waviness=0.0"),
         ({"waviness": np.nan}, "waviness=nan"),
+        ({"waviness": 1000.0}, r"^waviness=1000.0 is out of range: allowed \(0, 5\]"),
         ({"amplitudes": "gaussian"}, "amplitudes='gaussian'.*deterministic"),
         ({"band": (0.0, 10.0)}, r"band=\(0.0, 10.0\) is out of range: need 0 < n_min"),
         ({"band": (1.0, 90.0)}, r"band=\(1.0, 90.0\).*<= 83.33"),
@@ -60,3 +61,16 @@ def test_road_classes_validate_their_arrays():
         roadgen.Profile(x=road.x**2, z=road.z, **fields)
     with pytest.raises(roadgen.RoadgenError, match="dx_m=0"):
         roadgen.Profile(x=road.x, z=road.z, dx_m=0, gd=300.0, settings=road.settings)
+
+
+def test_waviness_is_bounded_and_gd_spectrum_refuses_an_overflow():
+    road = roadgen.iso8608_profile(21.0, 300.0, seed=0, waviness=5.0)  # the largest allowed
+    assert roadgen.estimate_gd(road) == pytest.approx(300.0, rel=0.01)
+    with pytest.raises(roadgen.RoadgenError, match=r"^waviness=5.5 is out of range"):
+        roadgen.estimate_gd(road, waviness=5.5)
+    with pytest.raises(roadgen.RoadgenError, match=r"^waviness=6 is out of range"):
+        roadgen.gd_spectrum([1.0], 300.0, 6)
+    assert np.isfinite(roadgen.gd_spectrum([1e-150], 450.0))
+    with pytest.raises(roadgen.RoadgenError, match=r"^n contains 1e-200: Gd\(n\) overflows.*"
+                       r"above about 1.58e-157 cycles/m"):  # fmt: skip
+        roadgen.gd_spectrum([1.0, 1e-200], 450.0)

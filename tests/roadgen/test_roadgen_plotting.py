@@ -5,6 +5,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
+import pytest  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 import roadgen  # noqa: E402
@@ -51,3 +52,30 @@ def test_example_prints_the_check_and_saves_figures(tmp_path, capsys):
     assert "periodogram at 0.1 cycles/m gives 450.0" in out
     assert (tmp_path / "roadgen_psd_gd450.png").exists()
     assert (tmp_path / "roadgen_track.png").exists()
+
+
+def test_a_flat_road_has_no_psd_to_draw():
+    x = np.arange(0.0, 30.0, 0.006)
+    flat = roadgen.Road(x=x, z=np.full_like(x, 0.01), dx_m=0.006)
+    with pytest.raises(roadgen.RoadgenError, match="road is flat: its periodogram is zero"):
+        roadgen.plot_profile_psd(flat)
+
+
+def _recovered(fig: Figure) -> float:
+    """The GD in the figure's "recovered GD ..." legend label."""
+    labels = [line.get_label() for line in fig.axes[1].get_lines()]
+    return float(next(lb for lb in labels if lb.startswith("recovered GD")).split()[-1])
+
+
+def test_the_fit_band_follows_a_coarse_grid_and_the_profiles_band():
+    coarse = roadgen.iso8608_profile(150.0, 450.0, dx_m=1.0, seed=0)  # Nyquist 0.5 cycles/m
+    assert _recovered(roadgen.plot_profile_psd(coarse)) == pytest.approx(450.0, rel=0.01)
+    too_coarse = roadgen.iso8608_profile(400.0, 450.0, dx_m=10.0, seed=0)
+    with pytest.raises(roadgen.RoadgenError, match=r"dx_m=10 m \(Nyquist frequency 0.05 "
+                       r"cycles/m\) is too coarse for the GD fit band FIT_BAND"):  # fmt: skip
+        roadgen.plot_profile_psd(too_coarse)
+    high = roadgen.iso8608_profile(60.0, 450.0, seed=0, band=(2.0, 10.0))
+    with pytest.raises(roadgen.RoadgenError, match=r"settings.band=\(2, 10\)"):
+        roadgen.plot_profile_psd(high)  # the default band holds none of its content
+    fig = roadgen.plot_profile_psd(high, band=(2.0, 10.0))
+    assert _recovered(fig) == pytest.approx(450.0, rel=0.01)

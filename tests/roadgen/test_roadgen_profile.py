@@ -51,7 +51,9 @@ def test_explicit_band_has_no_content_outside():
     road = roadgen.iso8608_profile(50.0, 300.0, seed=0, band=(0.5, 10.0))
     n, gd = roadgen.profile_psd(road)
     total = gd.sum()
-    outside = (n < 0.5 * (1 - 1e-9)) | (n > 10.0 * (1 + 1e-9))
+    # n_min holds within a relative 1/N (profile.band_edges): the harmonic with 25 cycles over the
+    # road's 49.998 m lies at 25 / 50.004 m = 0.49996 cycles/m and is inside
+    outside = (n < 0.5 * (1 - 1 / road.x.size) * (1 - 1e-9)) | (n > 10.0 * (1 + 1e-9))
     assert gd[outside].sum() < 1e-20 * total
     inside = ~outside
     np.testing.assert_allclose(gd[inside], gd_spectrum(n[inside], 300.0), rtol=1e-8)
@@ -154,3 +156,15 @@ def test_fit_is_unbiased_on_windows_cut_from_a_longer_road():
         window = SimpleNamespace(z=road.z[10000:26667], dx_m=road.dx_m)
         estimates.append(roadgen.estimate_gd(window))
     assert np.mean(estimates) == pytest.approx(300.0, rel=0.08)
+
+
+def test_band_starting_at_n0_keeps_the_harmonic_at_n0():
+    """On 150 m at 6 mm the period is 150.006 m: 15 cycles over the road lie at 0.099996
+    cycles/m, just below the band's n_min = 0.1, and are kept (they were dropped)."""
+    road = roadgen.iso8608_profile(150.0, 450.0, seed=0, band=(0.1, 83.3))
+    assert road.settings.band == (0.1, 83.3)
+    n, gd = roadgen.profile_psd(road)
+    k = int(np.argmin(np.abs(n - 0.1)))
+    assert n[k] == pytest.approx(15 / 150.006) and n[k] < 0.1
+    assert gd[k] == pytest.approx(gd_spectrum(n[k], 450.0), rel=1e-8)
+    assert np.all(gd[: k - 1] < 1e-30)  # nothing below it

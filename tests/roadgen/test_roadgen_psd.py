@@ -107,3 +107,58 @@ def test_too_short_a_road_for_the_band_raises():
         roadgen.estimate_gd(few, method="welch", band=(10.0, 80.0))
     with pytest.raises(roadgen.RoadgenError, match="method='fft'"):
         roadgen.profile_psd(road, method="fft")
+
+
+def test_estimate_gd_fits_only_inside_the_profiles_band():
+    """A band-limited profile is fitted where it has content (settings.band); the paper's check
+    at n0 works from a band that starts there and is refused where n0 has no content."""
+    from_n0 = roadgen.iso8608_profile(150.0, 450.0, seed=0, band=(0.1, 83.3))
+    assert roadgen.estimate_gd(from_n0) == pytest.approx(450.0, rel=1e-3)  # was 424.8
+    assert roadgen.estimate_gd(from_n0, method="periodogram") == pytest.approx(450.0, rel=1e-9)
+    narrow = roadgen.iso8608_profile(150.0, 450.0, seed=0, band=(0.05, 0.5))
+    assert roadgen.estimate_gd(narrow) == pytest.approx(450.0, rel=1e-3)  # was 214
+    mid = roadgen.iso8608_profile(150.0, 450.0, seed=0, band=(0.5, 10.0))
+    assert roadgen.estimate_gd(mid, method="welch") == pytest.approx(450.0, rel=0.02)
+    with pytest.raises(roadgen.RoadgenError, match="n0 = 0.1 cycles/m.*no content there"):
+        roadgen.estimate_gd(mid, method="periodogram")
+    high = roadgen.iso8608_profile(150.0, 450.0, seed=0, band=(2.0, 10.0))
+    for method in ("fit", "welch"):  # was 0.01
+        with pytest.raises(roadgen.RoadgenError, match=r"content band settings.band=\(2, 10\)"):
+            roadgen.estimate_gd(high, method=method)
+    assert roadgen.estimate_gd(high, band=(2.0, 10.0)) == pytest.approx(450.0, rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    ("settings", "match"),
+    [
+        ({"waviness": "abc"}, r"^road.settings.waviness='abc' must be a real number"),
+        ({"waviness": np.nan}, r"^road.settings.waviness=nan must be finite"),
+        ({"waviness": -2.0}, r"^road.settings.waviness=-2.0 is out of range"),
+        ({"waviness": 2.0, "band": "wide"}, r"^road.settings.band='wide' must be a pair"),
+        ({"waviness": 2.0, "band": (0.1, np.nan)}, r"^road.settings.band=\(0.1, nan\)"),
+    ],
+)
+def test_estimate_gd_checks_the_settings_it_reads(settings, match):
+    road = roadgen.iso8608_profile(30.0, 300.0, seed=0)
+    like = SimpleNamespace(z=road.z, dx_m=road.dx_m, settings=SimpleNamespace(**settings))
+    with pytest.raises(roadgen.RoadgenError, match=match):
+        roadgen.estimate_gd(like)
+
+
+def test_welch_on_a_short_road_names_the_welch_min_bin_rule():
+    road = roadgen.iso8608_profile(21.0, 450.0, seed=0)
+    with pytest.raises(roadgen.RoadgenError, match=r"WELCH_MIN_BIN=6 .*n >= 1.14286 cycles/m, "
+                       r"and its bins in the band reach only 0.952\d* cycles/m; use a road "
+                       r"longer than 25.2 m"):  # fmt: skip
+        roadgen.estimate_gd(road, method="welch")
+    assert roadgen.estimate_gd(road, method="welch", band=(0.05, 5.0)) == pytest.approx(
+        450.0, rel=0.1
+    )
+
+
+def test_default_band_on_a_coarse_grid_names_the_grid():
+    road = roadgen.iso8608_profile(150.0, 450.0, dx_m=1.0, seed=0)
+    with pytest.raises(roadgen.RoadgenError, match=r"dx_m=1 m .*too coarse for the default fit "
+                       r"band FIT_BAND=\(0.05, 1.0\)"):  # fmt: skip
+        roadgen.estimate_gd(road)
+    assert roadgen.estimate_gd(road, band=(0.05, 0.5)) == pytest.approx(450.0, rel=0.01)

@@ -108,3 +108,23 @@ def test_enveloped_track_still_starts_at_rest_height():
     t = roadgen.track(PAPER, seed=0)
     env = roadgen.wheel_envelope(t, 0.098)
     assert abs(env.z[0]) < 1e-5
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        ({"boundaries_m": (0.0, 100.0, 120.0)}, r"do not match segments.*at \(0, 50, 100\) m"),
+        ({"boundaries_m": (10.0, 50.0, 100.0)}, "do not match segments"),
+        ({"boundaries_m": (0.0, 500.0, 1000.0)}, "do not match segments"),
+        ({"boundaries_m": (0.0, 50.0, 100.0 + 1e-6)}, "do not match segments"),
+        ({"segments": ((50, 300), (50, 500), (150, 300))}, r"segments span 250 m but the road"),
+        ({"segments": ((50, 300), (50, 500), (49.9, 300))}, r"within dx_m / 2 = 0.003 m"),
+    ],
+)
+def test_track_built_directly_checks_boundaries_against_segments(change, match):
+    t = roadgen.track(PAPER, seed=0)
+    fields = {name: getattr(t, name) for name in t.__dataclass_fields__}
+    with pytest.raises(roadgen.RoadgenError, match=match):
+        roadgen.Track(**(fields | change))
+    same = roadgen.Track(**(fields | {"boundaries_m": (0, 50, 100)}))
+    assert same.gd_at(75.0) == 500.0 and same.boundaries_m == (0.0, 50.0, 100.0)
