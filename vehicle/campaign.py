@@ -18,8 +18,12 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import secrets
+import stat
+import zipfile
+import zlib
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,6 +42,15 @@ from vehicle.simulate import SUBSTEPS, simulate
 FORMAT = "vehicle.campaign/1"
 _F_NAMES = ("f_full", "f_window", "f_full_noisy", "f_window_noisy")
 _ARRAYS = ("v", "gd", "seed", *_F_NAMES, "status")
+_TRACES = ("accel", "accel_measured")
+_MAX_DEFLATE_RATIO = 1032
+"""Most bytes that one deflated byte expands to: what a compressed member can hold."""
+_READ_ERRORS = (
+    OSError, EOFError, ValueError, KeyError, RuntimeError, NotImplementedError,
+    zipfile.BadZipFile, zlib.error,
+)  # fmt: skip
+"""What reading a damaged or hostile ``.npz`` raises (zipfile: RuntimeError for an encrypted
+member, NotImplementedError for an unknown method; zlib; numpy's .npy parser: ValueError)."""
 
 
 @dataclass(frozen=True)
@@ -71,12 +84,13 @@ class RunSpec:
 class Campaign:
     """The campaign's table; arrays (n,) in design order.
 
-    v: speed, m/s. gd: GD, 1e-6 m^3. seed: the run's road seed (its noise seed is [seed, 1]).
-    f_full, f_window, f_full_noisy, f_window_noisy: (m/s^2)^2, NaN for a failed run (see the
-    module docstring for the spans). status: "ok" or the failure message. settings: dict of the
-    campaign's settings (model description, road, sensor, window, solver, seed). accel,
-    accel_measured: (n, keep) the last ``keep_s`` seconds of each drive's noise-free and
-    measured front-axle accelerations, m/s^2 (NaN rows for failed runs); None unless kept.
+    v: speed, m/s. gd: GD, 1e-6 m^3. seed: the run's road seed, in [0, 2**128) (its noise seed
+    is [seed, 1]). f_full, f_window, f_full_noisy, f_window_noisy: (m/s^2)^2, finite where the
+    status is "ok", NaN for a failed run (see the module docstring for the spans). status: "ok"
+    or the failure message. settings: dict of the campaign's settings (model description, road,
+    sensor, window, solver, seed). accel, accel_measured: (n, keep) the last ``keep_s`` seconds
+    of each drive's noise-free and measured front-axle accelerations, m/s^2 (NaN rows for failed
+    runs); None unless kept.
     """
 
     v: np.ndarray
@@ -103,46 +117,106 @@ class Campaign:
         return self.status == "ok"
 
     def save(self, path: str | os.PathLike) -> None:
-        """Write a plain ``.npz`` (no pickle): the arrays and the settings as JSON. The file is
-        replaced in one step (a failure leaves an existing file whole); CampaignFileError if it
+        """Write a plain ``.npz`` (no pickle): the arrays and the settings as JSON. The table is
+        checked again first (its arrays may have been changed in place since construction);
+        VehicleError if it is invalid or ``path`` names no file. The file is replaced in one
+        step (a refusal or a failure leaves an existing file whole); CampaignFileError if it
         cannot be written."""
         _check_path(path)
-        arrays = {name: getattr(self, name) for name in _ARRAYS}
+        target = Path(path)
+        if target.name in ("", ".."):
+            raise VehicleError(f"path={str(path)!r} names no file: need a file name, e.g. 'c.npz'")
+        table = _checked_table(self)
+        arrays = {name: table[name] for name in _ARRAYS}
         arrays["settings"] = np.asarray(json.dumps({"format": FORMAT, **self.settings}))
-        if self.accel is not None:
-            arrays["accel"], arrays["accel_measured"] = self.accel, self.accel_measured
+        if table["accel"] is not None:
+            arrays.update({name: table[name] for name in _TRACES})
         try:
-            _save_npz(Path(path), arrays)
+            _save_npz(target, arrays)
         except OSError as exc:
             raise CampaignFileError(f"cannot write campaign file {str(path)!r}: {exc}") from exc
 
 
 def load_campaign(path: str | os.PathLike) -> Campaign:
-    """Read a file written by ``Campaign.save``; CampaignFileError if missing or damaged,
-    VehicleError if ``path`` is not a path."""
+    """Read a file written by ``Campaign.save``; CampaignFileError if missing, not a regular
+    file, damaged or invalid, VehicleError if ``path`` is not a path."""
     _check_path(path)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {name: data[name] for name in (*_ARRAYS, "settings")}
-            traces = {k: data[k] for k in ("accel", "accel_measured") if k in data.files}
-    except FileNotFoundError as exc:
-        raise CampaignFileError(f"campaign file {str(path)!r} does not exist") from exc
-    except (OSError, ValueError, KeyError, EOFError) as exc:
+    arrays = _read_npz(Path(path), (*_ARRAYS, "settings"), _TRACES)
+    settings = arrays.pop("settings")
+    if settings.dtype.kind != "U" or settings.ndim != 0:
         raise CampaignFileError(
-            f"campaign file {str(path)!r} is damaged or not a campaign: {exc}"
-        ) from exc
+            f"campaign file {str(path)!r}: settings must be one JSON string, got a "
+            f"{settings.dtype} array of shape {settings.shape}"
+        )
     try:
-        settings = json.loads(str(arrays.pop("settings")))
-    except json.JSONDecodeError as exc:
-        raise CampaignFileError(f"campaign file {str(path)!r}: settings are not JSON") from exc
+        settings = json.loads(str(settings))
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise CampaignFileError(
+            f"campaign file {str(path)!r}: settings are not JSON (or nested too deep): {exc}"
+        ) from exc
     if not isinstance(settings, dict) or settings.pop("format", None) != FORMAT:
         raise CampaignFileError(f"campaign file {str(path)!r}: unknown format, need {FORMAT!r}")
     try:
-        return Campaign(**arrays, settings=settings, **traces)
+        return Campaign(**arrays, settings=settings)
     except VehicleError as exc:
         raise CampaignFileError(
             f"campaign file {str(path)!r} is not a valid campaign: {exc}"
         ) from exc
+
+
+def _read_npz(
+    path: Path, names: tuple[str, ...], optional: tuple[str, ...] = ()
+) -> dict[str, np.ndarray]:
+    """The arrays ``names`` and those of ``optional`` that are present in the ``.npz`` file at
+    ``path``, read without pickle; CampaignFileError naming the problem if the file is missing,
+    not a regular file (a FIFO would block), or damaged (each member's size is checked against
+    what its bytes can hold before any array is allocated)."""
+    try:
+        info = os.stat(path)
+    except FileNotFoundError as exc:
+        raise CampaignFileError(f"campaign file {str(path)!r} does not exist") from exc
+    except (OSError, ValueError) as exc:
+        raise CampaignFileError(f"cannot read campaign file {str(path)!r}: {exc}") from exc
+    if not stat.S_ISREG(info.st_mode):
+        raise CampaignFileError(f"campaign file {str(path)!r} is not a regular file")
+    try:
+        with zipfile.ZipFile(path) as zf:
+            present = {n.removesuffix(".npy") for n in zf.namelist()}
+            wanted = (*names, *(n for n in optional if n in present))
+            return {name: _read_member(zf, name, info.st_size) for name in wanted}
+    except _READ_ERRORS as exc:
+        raise CampaignFileError(
+            f"campaign file {str(path)!r} is damaged or not a campaign: {exc}"
+        ) from exc
+
+
+def _read_member(zf: zipfile.ZipFile, name: str, file_bytes: int) -> np.ndarray:
+    """The array of member ``name``.npy; ValueError unless it is a plain .npy (version 1 or 2,
+    no objects) whose declared size fits in its bytes (``file_bytes``: the whole file's size)."""
+    member = zf.getinfo(f"{name}.npy")
+    if member.compress_type not in (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED):
+        raise ValueError(f"member {name}.npy is compressed with method {member.compress_type}")
+    ratio = 1 if member.compress_type == zipfile.ZIP_STORED else _MAX_DEFLATE_RATIO
+    capacity = min(member.file_size, ratio * min(member.compress_size, file_bytes))
+    with zf.open(member) as fh:
+        version = np.lib.format.read_magic(fh)
+        if version not in ((1, 0), (2, 0)):
+            raise ValueError(f"member {name}.npy has .npy version {version}: need 1.0 or 2.0")
+        read_header = getattr(np.lib.format, f"read_array_header_{version[0]}_0")
+        shape, _, dtype = read_header(fh)
+        nbytes = math.prod(shape) * max(dtype.itemsize, 1)  # an element takes >= 1 byte
+        if dtype.hasobject:
+            raise ValueError(f"member {name}.npy holds Python objects (dtype {dtype}): no pickle")
+        if nbytes > capacity:
+            raise ValueError(
+                f"member {name}.npy declares a {dtype} array of shape {shape} ({nbytes} bytes), "
+                f"more than its {capacity} bytes in the file can hold"
+            )
+        fh.seek(0)
+        array = np.lib.format.read_array(fh, allow_pickle=False)
+        if fh.read(1):  # reading to the end also checks the member's CRC
+            raise ValueError(f"member {name}.npy has data after its array")
+    return array
 
 
 def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
@@ -166,17 +240,26 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
     if len(n) != 1 or any(out[k].shape != n for k in _ARRAYS):
         shapes = {k: out[k].shape for k in _ARRAYS}
         raise VehicleError(f"Campaign arrays must be 1-D of one length, got shapes {shapes}")
+    if np.any(seed < 0):  # an integer dtype holds nothing at or above 2**128
+        i = int(np.argmax(seed < 0))
+        raise VehicleError(
+            f"Campaign.seed[{i}]={int(seed[i])} is out of range: allowed integers in [0, 2**128)"
+        )
     for name in ("v", "gd"):
         if not np.all(np.isfinite(out[name]) & (out[name] > 0)):
             raise VehicleError(f"Campaign.{name} must be finite and > 0 in every run")
     for name in _F_NAMES:
         if np.any(out[name] < 0) or np.any(np.isinf(out[name])):
             raise VehicleError(f"Campaign.{name} must be >= 0 and finite, or NaN for a failed run")
+        unfinished = np.isnan(out[name]) & (status == "ok")
+        if np.any(unfinished):
+            i = int(np.argmax(unfinished))
+            raise VehicleError(f"Campaign.{name}[{i}] is NaN but status[{i}] is 'ok'")
     if not isinstance(c.settings, dict) or "format" in c.settings:
         raise VehicleError("Campaign.settings must be a dict without the key 'format' (the file's)")
     try:
         json.dumps(c.settings)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, RecursionError) as exc:
         raise VehicleError(f"Campaign.settings must be JSON-able: {exc}") from exc
     if (c.accel is None) != (c.accel_measured is None):
         raise VehicleError("Campaign.accel and .accel_measured are both given or both None")
@@ -198,7 +281,9 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
 def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
     """``np.savez`` to a new temporary file beside ``path``, moved over it in one step: a crash
     or an error never leaves a half-written file, and an existing one stays whole."""
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.part")
+    # the name's start (at most 32 characters) keeps the temporary name within the 255 bytes
+    # a file name may have
+    tmp = path.with_name(f".{path.name[:32]}.{secrets.token_hex(6)}.part")
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -213,11 +298,17 @@ def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
 
 def _check_path(path: object, name: str = "path", what: str = "file") -> None:
     """Raise VehicleError unless ``path`` (the argument ``name``, a ``what`` path) is a str or
-    os.PathLike (an int would be taken for an open file descriptor)."""
+    os.PathLike (an int would be taken for an open file descriptor) without a NUL byte."""
     if not isinstance(path, (str, os.PathLike)):
         raise VehicleError(
             f"{name}={path!r} must be a {what} path, str or os.PathLike (got {type(path).__name__})"
         )
+    try:
+        text = os.fsdecode(path)
+    except TypeError as exc:  # a PathLike whose __fspath__ returns neither str nor bytes
+        raise VehicleError(f"{name}={path!r} must be a {what} path: {exc}") from exc
+    if "\0" in text:
+        raise VehicleError(f"{name}={text!r} must be a {what} path: it contains a NUL byte")
 
 
 def run_campaign(
@@ -253,7 +344,9 @@ def run_campaign(
         executor: any ``concurrent.futures.Executor`` (e.g. a dask ``Client.get_executor()``);
             default a process pool over all cores, shut down at the end.
         cache_dir: finished runs are stored there, one ``.npz`` per run named by a hash of its
-            settings, and reused: an interrupted campaign loses no finished run.
+            settings, and reused: an interrupted campaign loses no finished run. Failed runs are
+            not stored (they run again next time), and a damaged entry is recomputed; an entry
+            that reads as a finished run of the same settings is trusted as the user's own.
         seed: the campaign's seed; run i gets road seed ``SeedSequence(seed).generate_state(n)[i]``.
         keep_s: keep the last keep_s seconds of each drive's accelerations (``Campaign.accel``);
             each road is lengthened (beyond ``road_length_m`` where needed) so that they begin
@@ -262,7 +355,8 @@ def run_campaign(
         Campaign. A run that fails (diverges) is recorded with NaN f and its message.
 
     Raises VehicleError for bad input (checked before any run: each argument's type and range,
-    a road too short for the window, traces beyond ``vehicle.checks.MAX_MEMORY_BYTES``), and
+    a road too short for the window, traces beyond ``vehicle.checks.MAX_MEMORY_BYTES``, a
+    ``keep_s`` that keeps no sample, a ``cache_dir`` that cannot be a folder), and
     RoadgenError for road settings that no road can have (too long for
     ``roadgen.checks.MAX_MEMORY_BYTES``, a band its length cannot hold).
     """
@@ -280,6 +374,11 @@ def run_campaign(
     substeps = checks.integer("substeps", substeps, 1)
     progress = checks.flag("progress", progress)
     keep_s = checks.non_negative("keep_s", keep_s, unit="s")
+    if executor is not None and not callable(getattr(executor, "submit", None)):
+        raise VehicleError(
+            f"executor={executor!r} must be None or an Executor (an object with a callable "
+            f"submit), got {type(executor).__name__}"
+        )
     if cache_dir is not None:
         _check_path(cache_dir, "cache_dir", "folder")
     usable_m = road_length_m - lead_in_m - 2 * model.wheelbase_m
@@ -294,6 +393,11 @@ def run_campaign(
     if band is not None:  # and holds the band: roadgen's check, on the shortest road
         roadgen.iso8608_profile(road_length_m, 1.0, dx_m, seed=0, band=band, lead_in_m=lead_in_m)
     keep = int(round(keep_s * rate_hz))
+    if keep_s > 0 and keep == 0:
+        raise VehicleError(
+            f"keep_s={keep_s!r} s keeps 0 samples at rate_hz={rate_hz:g} Hz: use 0 or at least "
+            f"{1 / rate_hz:.4g} s (one sample)"
+        )
     checks.memory(
         16.0 * keep * points.shape[0], f"keep_s={keep_s!r} s of traces for {points.shape[0]} runs"
     )
@@ -308,13 +412,11 @@ def run_campaign(
                 rate_hz, noise_std, window, substeps, keep)
         for (v, gd), s in zip(points, seeds, strict=True)
     ]  # fmt: skip
-    cache = None if cache_dir is None else Path(cache_dir)
-    if cache is not None:
-        cache.mkdir(parents=True, exist_ok=True)
+    cache = None if cache_dir is None else _cache_folder(cache_dir)
     results: list[RunResult | None] = [None] * len(specs)
     todo = []
     for i, spec in enumerate(specs):
-        cached = None if cache is None else _read_cached(cache / f"run-{spec.key()}.npz")
+        cached = None if cache is None else _read_cached(cache / f"run-{spec.key()}.npz", spec)
         if cached is None:
             todo.append(i)
         else:
@@ -323,17 +425,19 @@ def run_campaign(
                desc=f"campaign {model.name}", unit="run")  # fmt: skip
     own = executor is None and len(todo) > 0
     pool = ProcessPoolExecutor(max_workers=min(os.cpu_count() or 1, len(todo))) if own else executor
+    futures: dict[Future, int] = {}
     try:
-        futures: dict[Future, int] = {
-            pool.submit(run_one, specs[i], None if cache is None else str(cache)): i for i in todo
-        }
+        for i in todo:
+            futures[pool.submit(run_one, specs[i], None if cache is None else str(cache))] = i
         for fut in as_completed(futures):
             results[futures[fut]] = fut.result()
             bar.update()
-    finally:
+    finally:  # after an error or Ctrl-C, the runs not yet started are cancelled, not waited for
         bar.close()
+        for fut in futures:
+            fut.cancel()
         if own:
-            pool.shutdown()
+            pool.shutdown(cancel_futures=True)
     f = np.array([r[0] for r in results])
     traces = {}
     if keep:
@@ -404,7 +508,8 @@ RunResult = tuple[np.ndarray, str, np.ndarray, np.ndarray]
 def run_one(spec: RunSpec, cache_dir: str | None = None) -> RunResult:
     """One run: f values (4,) in ``_F_NAMES`` order, "ok" or the failure message, and the last
     ``spec.keep_samples`` noise-free and measured accelerations (empty when none are kept or
-    the run failed). Writes the result to ``cache_dir`` (if given) before returning.
+    the run failed). Writes a finished run to ``cache_dir`` (if given) before returning; a
+    failed one is not stored (its cause, e.g. a memory limit, may be gone next time).
     """
     empty = np.zeros(0)
     try:
@@ -413,7 +518,7 @@ def run_one(spec: RunSpec, cache_dir: str | None = None) -> RunResult:
     except (VehicleError, SimulationDivergedError, roadgen.RoadgenError) as exc:
         f, status = np.full(len(_F_NAMES), np.nan), f"{type(exc).__name__}: {exc}"
         acc = measured = empty
-    if cache_dir is not None:
+    if cache_dir is not None and status == "ok":
         _write_cached(Path(cache_dir) / f"run-{spec.key()}.npz", (f, status, acc, measured), spec)
     return f, status, acc, measured
 
@@ -470,15 +575,38 @@ def _write_cached(path: Path, result: RunResult, spec: RunSpec) -> None:
                      "accel": acc, "accel_measured": measured})  # fmt: skip
 
 
-def _read_cached(path: Path) -> RunResult | None:
+def _cache_folder(cache_dir: str | os.PathLike) -> Path:
+    """``cache_dir`` as a Path, made if missing; VehicleError naming it if it cannot be a folder
+    (a file, below a file, not writable)."""
+    cache = Path(cache_dir)
+    try:
+        cache.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise VehicleError(
+            f"cache_dir={str(cache_dir)!r} cannot be used as a folder: {exc}"
+        ) from exc
+    return cache
+
+
+def _read_cached(path: Path, spec: RunSpec) -> RunResult | None:
+    """The finished run of ``spec`` stored at ``path``, or None if there is none or the entry is
+    damaged or not a finished run of ``spec`` (it is recomputed); CampaignFileError if the entry
+    is not a regular file (a run could not replace it)."""
     if not path.exists():
         return None
+    if not path.is_file():
+        raise CampaignFileError(f"cache entry {str(path)!r} is not a regular file: remove it")
     try:
-        with np.load(path, allow_pickle=False) as data:
-            f, status, key = data["f"], str(data["status"]), str(data["key"])
-            acc, measured = data["accel"], data["accel_measured"]
-    except (OSError, ValueError, KeyError, EOFError):
-        return None  # a damaged (or older) cache entry is recomputed
-    if f.shape != (len(_F_NAMES),) or key != path.stem.removeprefix("run-"):
+        data = _read_npz(path, ("f", "status", "key", *_TRACES))
+    except CampaignFileError:
         return None
-    return f, status, acc, measured
+    f, status, key = data["f"], data["status"], data["key"]
+    traces = [data[name] for name in _TRACES]
+    finished = (
+        status.shape == () and str(status) == "ok"
+        and key.shape == () and str(key) == spec.key()
+        and f.shape == (len(_F_NAMES),) and f.dtype.kind == "f"
+        and bool(np.all(np.isfinite(f) & (f >= 0)))
+        and all(a.shape == (spec.keep_samples,) and a.dtype.kind == "f" for a in traces)
+    )  # fmt: skip
+    return (f, "ok", *traces) if finished else None

@@ -47,7 +47,8 @@ _OUT = exu.OutputVariableType
 _MAX_ACCEL = 1e4
 """|acceleration| (m/s^2) above which a run counts as diverged."""
 _MAX_DISPLACEMENT = 1.0
-"""|heave| or |axle displacement| (m) above which a run counts as diverged."""
+"""|heave| or |axle displacement| (m) from the static equilibrium on the road under the wheels
+above which a run counts as diverged (so a road's offset or grade is no divergence)."""
 
 
 @dataclass(frozen=True)
@@ -326,6 +327,9 @@ class ExudynVehicle:
             )
         states = States(t=t_start + k[keep] / self.rate_hz, **{n: a[keep] for n, a in out.items()})
         _check_finite(states)
+        s = self.drive.positions(states.t)
+        u = self.road.heights(np.stack([s, s - self.model.wheelbase_m]))
+        _check_range(states, self.model, u[0], u[1])
         return states
 
 
@@ -349,15 +353,26 @@ def _tyre_function(table: _TyreInput, axle: int, k: float, c: float, f_static: f
 
 
 def _check_finite(st: States) -> None:
-    accel = np.concatenate([st.accel_front, st.accel_rear])
-    disp = np.concatenate([st.heave, st.z_front, st.z_rear])
-    if not (np.all(np.isfinite(accel)) and np.all(np.isfinite(disp))):
+    """Raise SimulationDivergedError if an acceleration or a displacement is NaN or inf."""
+    states = np.concatenate([st.accel_front, st.accel_rear, st.heave, st.z_front, st.z_rear])
+    if not np.all(np.isfinite(states)):
         raise SimulationDivergedError(
             f"NaN/inf states between t={st.t[0]:.4g} and {st.t[-1]:.4g} s"
         )
+
+
+def _check_range(st: States, model: Model, u_front: np.ndarray, u_rear: np.ndarray) -> None:
+    """Raise SimulationDivergedError if an |acceleration| exceeds ``_MAX_ACCEL`` or the body or
+    an axle lies more than ``_MAX_DISPLACEMENT`` from its static equilibrium, which follows the
+    road heights under the axles (``u_front``, ``u_rear``, m; the body's at its centre of mass).
+    """
+    u_body = (model.b2_m * u_front + model.b1_m * u_rear) / model.wheelbase_m
+    accel = np.concatenate([st.accel_front, st.accel_rear])
+    disp = np.concatenate([st.heave - u_body, st.z_front - u_front, st.z_rear - u_rear])
     if np.max(np.abs(accel)) > _MAX_ACCEL or np.max(np.abs(disp)) > _MAX_DISPLACEMENT:
         raise SimulationDivergedError(
             f"states out of range between t={st.t[0]:.4g} and {st.t[-1]:.4g} s: "
             f"max |accel| {np.max(np.abs(accel)):.3g} m/s^2 (limit {_MAX_ACCEL:g}), "
-            f"max |displacement| {np.max(np.abs(disp)):.3g} m (limit {_MAX_DISPLACEMENT:g})"
+            f"max |displacement| from the road {np.max(np.abs(disp)):.3g} m "
+            f"(limit {_MAX_DISPLACEMENT:g})"
         )

@@ -59,7 +59,8 @@ class Simulation:
             campaign); False: the raw heights.
 
     Attributes: time (s), position (front axle, m), speed (m/s), finished (no further sample
-    fits before the end of the track at the current speed), end_m (the track's length, m).
+    fits before the end of the track: at the current speed, or at the speed last commanded, whose
+    ``advance`` returned no samples), end_m (the track's length, m).
     """
 
     def __init__(
@@ -90,14 +91,19 @@ class Simulation:
         self.time = 0.0
         self.position = start
         self.speed = 0.0
+        self._at_end = False  # the last advance found no sample before the end
         self._drive = Drive(0.0, self._h, np.full(2, self.position), np.zeros(2))
         self._vehicle = ExudynVehicle(model, self._road, self._drive, self.rate_hz, substeps)
 
     @property
     def finished(self) -> bool:
-        """True once the front axle cannot advance another sample period before the end (a
-        vehicle standing short of the end is not finished)."""
-        return self.speed > 0 and self.position + self.speed / self.rate_hz > self.end_m
+        """True once the front axle cannot advance another sample period before the end: at the
+        current speed, or as last commanded (that ``advance`` returned no samples), so that
+        ``while not sim.finished: sim.advance(dt, speed)`` ends. A vehicle standing short of
+        the end is finished only if the speed last commanded takes it past the end within one
+        sample period."""
+        moving_past = self.speed > 0 and self.position + self.speed / self.rate_hz > self.end_m
+        return self._at_end or moving_past
 
     def advance(self, dt: float, speed: float) -> Samples:
         """Drive for ``dt`` seconds (rounded to whole sample periods, at least one) towards the
@@ -118,6 +124,7 @@ class Simulation:
             self.position, self.speed, v_set, self.model.max_accel_mps2, self._h, n * sub
         )
         n_fit = int(np.count_nonzero(s[sub::sub] <= self.end_m + 1e-9))
+        self._at_end = n_fit == 0
         if n_fit == 0:
             return _empty()
         self._drive.set(self.time, self._h, s[: n_fit * sub + 1], v[: n_fit * sub + 1])

@@ -247,6 +247,12 @@ def test_design_sizes_and_ranges_take_numpy_numbers():
         ({"keep_s": "1"}, vehicle.VehicleError, r"^keep_s='1' must be a real number"),
         ({"progress": "no"}, vehicle.VehicleError, r"^progress='no' must be True or False"),
         ({"cache_dir": 5}, vehicle.VehicleError, r"^cache_dir=5 must be a folder path"),
+        ({"cache_dir": "a\0b"}, vehicle.VehicleError, r"^cache_dir='a\\x00b' .* a NUL byte"),
+        ({"executor": 5}, vehicle.VehicleError, r"^executor=5 must be None or an Executor"),
+        ({"executor": "pool"}, vehicle.VehicleError, r"^executor='pool' must be None or an"),
+        ({"design": [[True, 300.0]]}, vehicle.VehicleError, r"^design must be .*, got a bool"),
+        ({"design": np.array([[True, True]])}, vehicle.VehicleError, r"^design .* dtype bool"),
+        ({"keep_s": 0.004}, vehicle.VehicleError, r"^keep_s=0.004 s keeps 0 samples at rate_hz"),
     ],
 )
 def test_bad_campaign_arguments_raise_before_any_run(kwargs, error, match):

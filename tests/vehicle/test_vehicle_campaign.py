@@ -1,11 +1,18 @@
 """run_campaign: f per run, executors, the cache, failures, the file."""
 
+import io
+import json
+import os
+import threading
+import time
+import zipfile
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
 
 import vehicle
+from vehicle import campaign
 
 DESIGN = np.array([[0.7, 250.0], [1.6, 550.0], [1.1, 400.0]])
 SHORT = {"road_length_m": 6.0, "window": 300, "lead_in_m": 0.5, "progress": False, "seed": 1}
@@ -149,6 +156,11 @@ def _fields(camp, **change):
         ({"settings": {"road": object()}}, "JSON-able"),
         ({"accel": np.zeros((3, 4))}, "both given or both None"),
         ({"accel": np.zeros((3, 4)), "accel_measured": np.zeros((3, 5))}, r"\(3, samples\)"),
+        (
+            {"f_window": np.array([np.nan, 1.0, 2.0])},
+            r"f_window\[0\] is NaN but status\[0\] is 'ok'",
+        ),
+        ({"seed": np.array([1, -2, 3])}, r"seed\[1\]=-2 is out of range: allowed integers in \[0"),
     ],
 )
 def test_a_campaign_that_could_not_be_saved_and_read_back_is_refused(table, change, match):
@@ -196,3 +208,246 @@ def test_a_file_whose_table_is_invalid_is_a_campaign_file_error(table, tmp_path)
     np.savez(path, **arrays)
     with pytest.raises(vehicle.CampaignFileError, match="not a valid campaign.*gd"):
         vehicle.load_campaign(path)
+
+
+def test_a_file_with_an_unfinished_ok_run_or_a_negative_seed_is_refused(table, tmp_path):
+    camp, _ = table
+    path = tmp_path / "c.npz"
+    camp.save(path)
+    with np.load(path) as data:
+        good = dict(data)
+    for change, match in (
+        ({"f_full": np.array([1.0, np.nan, 2.0])}, r"f_full\[1\] is NaN but status\[1\] is 'ok'"),
+        ({"seed": np.array([-1, 2, 3])}, r"seed\[0\]=-1 is out of range"),
+    ):
+        np.savez(path, **(good | change))
+        with pytest.raises(vehicle.CampaignFileError, match="not a valid campaign.*" + match):
+            vehicle.load_campaign(path)
+
+
+@pytest.mark.parametrize(
+    "spoil",
+    [
+        lambda c: c.f_full.__setitem__(0, -1.0),
+        lambda c: c.f_window.__setitem__(1, np.nan),
+        lambda c: c.seed.__setitem__(2, -5),
+        lambda c: c.settings.__setitem__("format", "mine"),
+        lambda c: c.settings.__setitem__("road", object()),
+    ],
+    ids=["negative f", "NaN f of an ok run", "negative seed", "format key", "not JSON"],
+)
+def test_save_checks_the_table_again_and_keeps_the_earlier_file(table, tmp_path, spoil):
+    """In-place changes after construction are caught before anything is written."""
+    camp, _ = table
+    mine = vehicle.Campaign(**_fields(camp, seed=camp.seed.copy(), settings=dict(camp.settings)))
+    path = tmp_path / "campaign.npz"
+    mine.save(path)
+    before = path.read_bytes()
+    spoil(mine)
+    with pytest.raises(vehicle.VehicleError, match="^Campaign"):
+        mine.save(path)
+    assert path.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["campaign.npz"]
+
+
+@pytest.mark.parametrize(
+    ("path", "match"),
+    [("", "names no file"), (".", "names no file"), ("..", "names no file"), ("a\0b.npz", "NUL")],
+)
+def test_save_refuses_a_path_that_names_no_file(table, path, match):
+    camp, _ = table
+    with pytest.raises(vehicle.VehicleError, match=r"^path=.*" + match):
+        camp.save(path)
+
+
+def test_save_takes_the_longest_file_name(table, tmp_path):
+    """A 255-character name (the file system's limit) is written: the temporary name is short."""
+    camp, _ = table
+    path = tmp_path / ("c" * 251 + ".npz")
+    camp.save(path)
+    camp.save(path)  # and replaced
+    np.testing.assert_array_equal(vehicle.load_campaign(path).f_full, camp.f_full)
+    assert list(tmp_path.iterdir()) == [path]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this system")
+def test_loading_a_fifo_is_refused_without_blocking(tmp_path):
+    fifo = tmp_path / "c.npz"
+    os.mkfifo(fifo)
+    errors = []
+
+    def load():
+        try:
+            vehicle.load_campaign(fifo)
+        except vehicle.CampaignFileError as exc:
+            errors.append(str(exc))
+
+    thread = threading.Thread(target=load, daemon=True)
+    thread.start()
+    thread.join(5.0)
+    if thread.is_alive():  # blocked in open(): release it before failing
+        os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+    assert errors and errors[0].endswith("c.npz' is not a regular file")
+
+
+def _npz_bytes(members: dict[str, np.ndarray | bytes]) -> bytes:
+    """An npz file's bytes: arrays as .npy members, bytes as they are."""
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w") as zf:
+        for name, value in members.items():
+            if isinstance(value, np.ndarray):
+                npy = io.BytesIO()
+                np.lib.format.write_array(npy, value)
+                value = npy.getvalue()
+            zf.writestr(f"{name}.npy", value)
+    return out.getvalue()
+
+
+def _flip_last_byte_of(raw: bytes, member: str) -> bytes:
+    info = zipfile.ZipFile(io.BytesIO(raw)).getinfo(member)
+    start = info.header_offset + 30 + len(info.filename) + len(info.extra)
+    out = bytearray(raw)
+    out[start + info.compress_size - 1] ^= 0x01
+    return bytes(out)
+
+
+def _huge_v(raw: bytes) -> bytes:
+    """v.npy's header claims 1e10 float64 values (80 GB) over 64 bytes."""
+    with np.load(io.BytesIO(raw)) as data:
+        members = dict(data)
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        header, {"descr": "<f8", "fortran_order": False, "shape": (10**10,)}
+    )
+    return _npz_bytes(members | {"v": header.getvalue() + bytes(64)})
+
+
+def _deep_settings(raw: bytes) -> bytes:
+    with np.load(io.BytesIO(raw)) as data:
+        members = dict(data)
+    deep = json.dumps({"format": campaign.FORMAT})[:-1] + ', "x": ' + "[" * 10**5 + "]" * 10**5
+    return _npz_bytes(members | {"settings": np.array(deep + "}")})
+
+
+def _plain_npy(raw: bytes) -> bytes:
+    out = io.BytesIO()
+    np.save(out, np.arange(3.0))
+    return out.getvalue()
+
+
+@pytest.mark.parametrize(
+    ("damage", "match"),
+    [
+        (lambda raw: raw[: len(raw) // 2], "damaged or not a campaign"),
+        (lambda raw: _flip_last_byte_of(raw, "f_full.npy"), "damaged.*Bad CRC-32"),
+        (_plain_npy, "damaged or not a campaign: File is not a zip file"),
+        (_huge_v, r"v.npy declares a float64 array of shape \(10000000000,\)"),
+        (_deep_settings, "settings are not JSON"),
+    ],
+    ids=["truncated", "bad CRC", "plain npy", "huge shape", "deep settings"],
+)
+def test_damaged_or_hostile_files_are_campaign_file_errors(table, tmp_path, damage, match):
+    camp, _ = table
+    path = tmp_path / "c.npz"
+    camp.save(path)
+    path.write_bytes(damage(path.read_bytes()))
+    with pytest.raises(vehicle.CampaignFileError, match=match):
+        vehicle.load_campaign(path)
+
+
+def _fake_drive(calls: list):
+    """A stand-in for one drive (no simulation): f = v, traces of ones; records each run."""
+
+    def drive(spec):
+        calls.append(spec.seed)
+        keep = spec.keep_samples
+        return np.full(4, spec.v), np.ones(keep), np.ones(keep)
+
+    return drive
+
+
+def _run(cache, **kwargs):
+    with ThreadPoolExecutor(1) as ex:
+        return vehicle.run_campaign(DESIGN, cache_dir=cache, executor=ex, **(SHORT | kwargs))
+
+
+def test_failed_runs_are_not_cached_and_run_again(tmp_path, monkeypatch):
+    def out_of_memory(spec):
+        raise vehicle.VehicleError("a drive needs about 5 GiB of memory")
+
+    monkeypatch.setattr(campaign, "_drive", out_of_memory)
+    failed = _run(tmp_path)
+    assert not failed.ok.any() and list(tmp_path.iterdir()) == []
+    calls = []
+    monkeypatch.setattr(campaign, "_drive", _fake_drive(calls))
+    again = _run(tmp_path)
+    assert again.ok.all() and len(calls) == len(DESIGN)
+    np.testing.assert_array_equal(again.f_full, DESIGN[:, 0])
+
+
+def test_damaged_or_failed_cache_entries_are_run_again(tmp_path, monkeypatch):
+    calls = []
+    monkeypatch.setattr(campaign, "_drive", _fake_drive(calls))
+    first = _run(tmp_path, keep_s=0.05)
+    entries = sorted(tmp_path.glob("run-*.npz"))
+    assert len(calls) == len(entries) == 3 and first.accel.shape == (3, 6)
+    raw = entries[0].read_bytes()
+    entries[0].write_bytes(raw[: len(raw) // 2])  # truncated
+    with np.load(entries[1]) as data:
+        members = dict(data)
+    np.savez(entries[1], **(members | {"accel": np.ones(7)}))  # traces of the wrong length
+    nan = np.full(4, np.nan)
+    np.savez(entries[2], **(members | {"f": nan, "status": np.array("VehicleError: memory")}))
+    again = _run(tmp_path, keep_s=0.05)
+    assert len(calls) == 6 and again.ok.all()
+    np.testing.assert_array_equal(again.accel, first.accel)
+    np.testing.assert_array_equal(again.f_window, first.f_window)
+
+
+def test_a_cache_entry_that_is_a_folder_is_a_clear_error_before_any_run(tmp_path, monkeypatch):
+    calls = []
+    monkeypatch.setattr(campaign, "_drive", _fake_drive(calls))
+    _run(tmp_path)
+    entry = sorted(tmp_path.glob("run-*.npz"))[0]
+    entry.unlink()
+    entry.mkdir()
+    with pytest.raises(
+        vehicle.CampaignFileError, match=f"cache entry .*{entry.name}.* not a regular"
+    ):
+        _run(tmp_path)
+    assert len(calls) == 3
+
+
+def test_a_cache_dir_that_cannot_be_a_folder_is_refused(tmp_path):
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    for cache in (afile, afile / "sub"):
+        with pytest.raises(vehicle.VehicleError, match=r"^cache_dir=.*afile.* cannot be used"):
+            _run(cache)
+    assert afile.read_text() == "x"
+
+
+@pytest.mark.parametrize("own_pool", [True, False], ids=["own pool", "given executor"])
+def test_an_error_cancels_the_queued_runs(monkeypatch, own_pool):
+    """A run that raises (not a failure the campaign records) ends the campaign at once: the
+    runs still queued are cancelled, not waited for (in the campaign's own pool, a thread pool
+    here so that the stand-in drive reaches it, or in a given executor)."""
+
+    class Boom(Exception):
+        pass
+
+    calls = []
+
+    def drive(spec):
+        calls.append(spec.seed)
+        if len(calls) == 1:
+            raise Boom("worker lost")
+        time.sleep(0.2)
+        return np.ones(4), np.zeros(0), np.zeros(0)
+
+    monkeypatch.setattr(campaign, "_drive", drive)
+    monkeypatch.setattr(campaign, "ProcessPoolExecutor", lambda max_workers: ThreadPoolExecutor(1))
+    design = np.column_stack([np.linspace(0.5, 1.5, 8), np.full(8, 300.0)])
+    with ThreadPoolExecutor(1) as ex, pytest.raises(Boom):
+        vehicle.run_campaign(design, executor=None if own_pool else ex, **SHORT)
+    assert len(calls) <= 2

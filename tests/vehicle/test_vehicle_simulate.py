@@ -140,3 +140,24 @@ def test_halfcar_lift_off_option():
 def test_unknown_model_raises(rough_road):
     with pytest.raises(vehicle.VehicleError, match="model='car'"):
         vehicle.simulate("car", rough_road, 1.0)
+
+
+@pytest.mark.parametrize(
+    ("model", "speed"),
+    [(vehicle.Jackal(), 2.0), (vehicle.HalfCar(), 10.0)],
+    ids=["Jackal", "HalfCar"],
+)
+@pytest.mark.parametrize(
+    ("length", "height"),
+    [(3.0, lambda x: np.full_like(x, 1.5)), (60.0, lambda x: 0.03 * x)],
+    ids=["1.5 m offset", "3% grade"],
+)
+def test_a_road_far_above_zero_is_no_divergence(model, speed, length, height):
+    """The divergence bound is on the displacement from the road under the wheels, not from 0:
+    the body follows a road 1.5 m up, or 1.8 m up a 60 m grade, to its static equilibrium."""
+    x = np.arange(0.0, length + 0.003, 0.006)
+    road = roadgen.Road(x=x, z=height(x), dx_m=0.006)
+    tr = vehicle.simulate(model, road, speed)
+    assert tr.position[-1] > length - speed / 120
+    under_body = height(tr.position - model.b1_m)
+    assert np.max(np.abs(tr.heave - under_body)[len(tr) // 2 :]) < 0.02

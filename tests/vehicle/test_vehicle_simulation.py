@@ -128,3 +128,23 @@ def test_a_commanded_standstill_stops_the_vehicle_where_it_is(track):
     stood = sim.position
     sim.advance(1.0, 1.0)
     assert sim.position > stood + 0.9  # and drives on
+
+
+@pytest.mark.parametrize(
+    ("short_of_end_m", "warm_up"),
+    [(0.0087 + 0.975, True), (0.0005, False)],
+    ids=["at speed", "from rest"],
+)
+def test_the_drive_loop_ends_when_no_sample_fits_before_the_end(short_of_end_m, warm_up):
+    """Close to the end, the commanded speed's first sample may pass it although the current
+    speed's would not: advance returns nothing, and finished turns True so the loop ends."""
+    road = roadgen.track([(5, 400)], seed=0)
+    sim = vehicle.Simulation(vehicle.Jackal(), road, start_m=road.length_m - short_of_end_m)
+    if warm_up:
+        assert len(sim.advance(1.0, 1.0)) == 120 and not sim.finished
+    calls = 0
+    while not sim.finished and calls < 10:
+        sim.advance(0.5, 2.0)
+        calls += 1
+    assert sim.finished and calls == 1
+    assert len(sim.advance(0.5, 2.0)) == 0 and sim.finished
