@@ -46,7 +46,7 @@ def get(name: str) -> ModuleType:
 
     Raises GPMSAError for an unknown name and BackendUnavailableError when its packages are missing.
     """
-    if name not in _REGISTRY:
+    if not isinstance(name, str) or name not in _REGISTRY:
         raise GPMSAError(f"unknown backend {name!r}; registered: {names()}")
     path, extra = _REGISTRY[name]
     try:

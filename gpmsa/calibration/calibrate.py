@@ -45,7 +45,7 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import n_workers, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
-from gpmsa.model.data import ObsData, check_count, check_seed
+from gpmsa.model.data import ObsData, as_float, check_count, check_flag, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
@@ -68,11 +68,15 @@ def calibration_problem(
         start = lamos_start(fit, data.lamos)
     else:
         x, _ = check_x(emulator, x_obs, extrapolate)
-        y = np.asarray(y_obs, dtype=float)
+        y = as_float(y_obs, "y_obs")
         if emulator.K.shape[0] == 1 and y.size == x.shape[0]:
             y = y.reshape(-1, 1)
         obs, corr = reduce_obs(
-            ObsData(x, y), emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
+            ObsData(x, y),
+            emulator.standardizer,
+            emulator.K,
+            discrepancy,
+            emulator.x_names,
             getattr(emulator, "levels", None),
         )
     pri = emulator.priors
@@ -116,8 +120,8 @@ def calibrate(
     n_emulator_draws: int = 20,
     discrepancy=None,
     n_chains: int = 1,
-    tune_rounds: int = tuning.N_BURN,
-    tune_levels: int = tuning.N_LEVELS,
+    tune_rounds: int | None = None,
+    tune_levels: int | None = None,
     extrapolate: bool = False,
     fast: bool | None = None,
     log_prior=None,
@@ -135,6 +139,9 @@ def calibrate(
         y_obs: (n, l_sim) observed outputs, native units (a scalar output also takes (n,)).
         n_samples: sweeps per chain after tuning; n_burn: of these, burned (kept: the rest).
         tune: GPM/SA step-size tuning first (tune_rounds x tune_levels sweeps).
+        tune_rounds, tune_levels: the tuning's rounds and candidate widths per element (None:
+            the backend's default; numpy 50 x 20; torch ceil(50 / n_chains) x 20). The pyro
+            backend (NUTS) has no such tuning: giving either to it is a GPMSAError.
         seed: seed of the random numbers (same seed, same draws).
         backend: "numpy" (default), "torch" or "pyro" (``gpmsa.backends.available()``).
         emulator_params: "point" (the emulator's point estimate) or "draws" (the likelihood
@@ -169,13 +176,18 @@ def calibrate(
     seed = check_seed(seed)
     n_samples = check_count(n_samples, "n_samples", 2)
     n_chains = check_count(n_chains, "n_chains")
-    if not (isinstance(n_burn, int | np.integer) and 0 <= n_burn < n_samples - 1):
-        raise GPMSAError(f"n_burn must be an integer in [0, n_samples - 1), got {n_burn}")
-    tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
+    ok = not isinstance(n_burn, bool) and isinstance(n_burn, int | np.integer)
+    if not (ok and 0 <= n_burn < n_samples - 1):
+        raise GPMSAError(f"n_burn must be an integer in [0, n_samples - 1), got {n_burn!r}")
+    tune, extrapolate = check_flag(tune, "tune"), check_flag(extrapolate, "extrapolate")
+    progress = check_flag(progress, "progress")
+    backends.get(backend)  # unknown or not installed: a clear error before any work
+    tuning_opts = _tuning_options(backend, tune_rounds, tune_levels)
     sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
     can_fast = backend == "numpy" and discrepancy is None
     if fast is None:
         fast = can_fast
+    fast = check_flag(fast, "fast")
     if fast and not can_fast:
         raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
     if not fast and (emulator_params != "point" or log_prior is not None):
@@ -193,13 +205,13 @@ def calibrate(
         warn_if_outside(fit)
         if fast:
             draws, info = _run_fast(
-                emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds,
-                tune_levels, seed, log_prior, progress, where, theta_opts,
+                emulator, data, fit, sets, n_samples, n_chains, tune, tuning_opts, seed,
+                log_prior, progress, where, theta_opts,
             )  # fmt: skip
         else:
             draws, info = _run_backend(
                 emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
-                tune_rounds, tune_levels, seed, extrapolate, progress, where, theta_opts,
+                tuning_opts, seed, extrapolate, progress, where, theta_opts,
             )  # fmt: skip
     require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
@@ -216,6 +228,25 @@ def calibrate(
         info["convergence"] = convergence(info["diagnostics"], shapes, n_chains, n_samples - n_burn)
         warn_unconverged(info["convergence"], f"gpmsa.calibrate (backend {backend!r})")
     return Posterior(samples, chains=chains, info=info)
+
+
+def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:
+    """The tuning keywords for ``backend``'s sampler: those given (checked), with numpy's
+    defaults for the numpy samplers; GPMSAError when given to pyro, which does not tune so."""
+    given = {k: v for k, v in (("tune_rounds", tune_rounds), ("tune_levels", tune_levels))
+             if v is not None}  # fmt: skip
+    if backend == "pyro":
+        if given:
+            raise GPMSAError(f"backend 'pyro' (NUTS) has no GPM/SA step-size tuning: it takes no "
+                             f"{' or '.join(given)}= (its adaptation is n_warmup)")  # fmt: skip
+        return {}
+    if backend == "numpy":
+        given = {"tune_rounds": tuning.N_BURN, "tune_levels": tuning.N_LEVELS, **given}
+    # torch's default rounds, ceil(50 / n_chains), are at most numpy's
+    rounds, levels = tuning.check_tuning(given.get("tune_rounds", tuning.N_BURN),
+                                         given.get("tune_levels", tuning.N_LEVELS))  # fmt: skip
+    checked = {"tune_rounds": rounds, "tune_levels": levels}
+    return {k: checked[k] for k in given}
 
 
 def _probe(emulator, data, sets) -> Fit:
@@ -244,13 +275,19 @@ def _fast_chain(
 ):  # fmt: skip
     """One chain of the fast sampler (a worker process runs it from plain data)."""
     with threadpool_limits(1):
-        return sampler.run(n_samples, np.random.default_rng(seed), tune=tune,
-                           tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress)
+        return sampler.run(
+            n_samples,
+            np.random.default_rng(seed),
+            tune=tune,
+            tune_rounds=tune_rounds,
+            tune_levels=tune_levels,
+            progress=progress,
+        )
 
 
 def _run_fast(
-    emulator, data, fit, sets, n_samples, n_chains, tune, tune_rounds, tune_levels, seed,
-    log_prior, progress, where, theta_opts,
+    emulator, data, fit, sets, n_samples, n_chains, tune, tuning_opts, seed, log_prior,
+    progress, where, theta_opts,
 ):  # fmt: skip
     std = emulator.standardizer
     con, theta0 = _theta_options(emulator, **theta_opts)
@@ -279,8 +316,7 @@ def _run_fast(
         n_workers(where["n_jobs"], n_chains)  # still refuse a bad n_jobs
         where = {"n_jobs": 1, "executor": None}
     tasks = [
-        {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune,
-         "tune_rounds": tune_rounds, "tune_levels": tune_levels}
+        {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune, **tuning_opts}
         for s in np.random.SeedSequence(seed).spawn(n_chains)
     ]  # fmt: skip
     runs = run_chains(_fast_chain, tasks, progress=progress, desc="calibrate chain", **where)
@@ -306,8 +342,8 @@ def _run_fast(
 
 
 def _run_backend(
-    emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tune_rounds,
-    tune_levels, seed, extrapolate, progress, where, theta_opts,
+    emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tuning_opts, seed,
+    extrapolate, progress, where, theta_opts,
 ):  # fmt: skip
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate, **theta_opts
@@ -315,8 +351,7 @@ def _run_backend(
     module = backends.get(backend)
     if problem.constraint is not None:  # a callable of this process: the chains run here
         where = {"n_jobs": 1, "executor": None}
-    opts = {"tune_rounds": tune_rounds, "tune_levels": tune_levels} if backend == "numpy" else {}
-    opts.update(backends.placement(backend, **where))
+    opts = {**tuning_opts, **backends.placement(backend, **where)}
     chains = module.sample(
         problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed, progress=progress,
         **opts,

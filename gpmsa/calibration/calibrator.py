@@ -37,7 +37,7 @@ from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weigh
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
-from gpmsa.model.data import as_float, check_count, check_seed
+from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 
 METHODS = ("auto", "grid", "mcmc")
 RESOLVE_SD = 4.0
@@ -130,13 +130,13 @@ class Calibrator:
         self.method = ("grid" if grid_ok else "mcmc") if method == "auto" else method
         self.backend = backend
         self.q = q
-        self.extrapolate = extrapolate
+        self.extrapolate = check_flag(extrapolate, "extrapolate")
         self.n_draws = check_count(n_draws, "n_draws")
         check_memory(  # the draws of theta and lamOs and their grid cells, made lazily
             8.0 * 3 * self.n_draws * (q + 1),
             f"Calibrator(n_draws={self.n_draws}): the posterior's draws of {q + 1} parameters",
         )
-        self._n_emulator_draws = n_emulator_draws
+        self._n_emulator_draws = check_count(n_emulator_draws, "n_emulator_draws")
         self.emulator_params = emulator_params
         self._entropy = np.random.SeedSequence(check_seed(seed)).entropy
         self._count = 0
@@ -149,7 +149,7 @@ class Calibrator:
         if self.method == "mcmc":
             return
         m, p_u = emulator.x_unit.shape[0], emulator.K.shape[1]
-        n_sets = 1 if emulator_params == "point" else max(1, int(n_emulator_draws))
+        n_sets = 1 if emulator_params == "point" else self._n_emulator_draws
         G = self.n_grid**q
         # per parameter set: R_t on the grid and its product with alpha (G x m per component)
         # and Sigma_W's factor (GridPredictor checks its Chebyshev products once sized)

@@ -13,7 +13,13 @@ from gpmsa import limits
 from gpmsa.calibration.model import FixedGP, LamOsPrior
 from gpmsa.errors import GPMSAError, OutsideEmulatorWarning, ResourceLimitError
 from gpmsa.model import categorical
-from gpmsa.model.data import ObsData, as_float, check_finite
+from gpmsa.model.data import (
+    ObsData,
+    as_float,
+    check_count,
+    check_finite,
+    check_parameter_names,
+)
 from gpmsa.model.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
 
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
@@ -53,6 +59,7 @@ def check_emulator(emulator, categorical_theta: bool = False) -> None:
         raise GPMSAError(f"emulator.params lacks {absent}; it needs {EMULATOR_PARAMS}")
     if emulator.t_unit.shape[1] < 1:
         raise GPMSAError("the emulator has no calibration parameter (t has 0 columns)")
+    check_parameter_names(emulator.t_names, "the emulator's t_names")
     levels = getattr(emulator, "levels", None)
     if levels is not None and not categorical_theta:
         categorical.refuse_categorical_theta(
@@ -70,9 +77,8 @@ def emulator_param_sets(emulator, mode: str, n_sets: int) -> list[dict]:
     n = len(next(iter(draws.values()))) if draws else 0
     if n == 0:
         raise GPMSAError("emulator_params='draws' needs retained draws; this emulator has none")
-    if not (isinstance(n_sets, int | np.integer) and n_sets >= 1):
-        raise GPMSAError(f"n_emulator_draws must be an integer >= 1, got {n_sets}")
-    idx = np.unique(np.linspace(0, n - 1, min(int(n_sets), n)).astype(int))
+    n_sets = check_count(n_sets, "n_emulator_draws")
+    idx = np.unique(np.linspace(0, n - 1, min(n_sets, n)).astype(int))
     return [{k: np.asarray(draws[k][i]) for k in EMULATOR_PARAMS} for i in idx]
 
 
@@ -104,21 +110,23 @@ def _as_rows(value, name: str, ncols: int) -> np.ndarray:
     return arr
 
 
-def check_x(emulator, x_obs, extrapolate: bool) -> tuple[np.ndarray, np.ndarray]:
+def check_x(
+    emulator, x_obs, extrapolate: bool, what: str = "x_obs"
+) -> tuple[np.ndarray, np.ndarray]:
     """x_obs native (n, p) and unit scale; outside the emulator's x domain: GPMSAError, or with
-    ``extrapolate=True`` a warning."""
+    ``extrapolate=True`` a warning. ``what``: the argument's name in messages."""
     p = emulator.x_unit.shape[1]
-    x = _as_rows(x_obs, "x_obs", p)
+    x = _as_rows(x_obs, what, p)
     levels = getattr(emulator, "levels", None)
     if levels is not None:
-        categorical.check_levels(x, levels[:p], emulator.x_names, "x_obs")
+        categorical.check_levels(x, levels[:p], emulator.x_names, what)
     xu = emulator.standardizer.x_to_unit(x)
     out = (xu < 0.0) | (xu > 1.0)
     if out.any():
         j, k = (int(i) for i in np.argwhere(out)[0])
         name = emulator.x_names[k]
         lo, hi = emulator.domain[name]
-        msg = f"x_obs {name}={x[j, k]:.6g} lies outside the emulator's domain [{lo:.6g}, {hi:.6g}]"
+        msg = f"{what} {name}={x[j, k]:.6g} lies outside the emulator's domain [{lo:.6g}, {hi:.6g}]"
         if not extrapolate:
             raise GPMSAError(msg + "; pass extrapolate=True to allow it")
         warnings.warn(msg + "; the emulator extrapolates", stacklevel=3)

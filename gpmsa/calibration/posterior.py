@@ -10,7 +10,7 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import BYTES_PER_HISTOGRAM_BIN, check_memory
 from gpmsa.mcmc import diagnostics
-from gpmsa.model.data import as_float, check_count, check_finite, check_level
+from gpmsa.model.data import as_float, as_real, check_count, check_finite, check_level
 
 #: Lower tail probabilities tried by `GridMarginal.hdi`.
 HDI_STEPS = 201
@@ -170,6 +170,9 @@ class Posterior:
         return tuple(self.samples)
 
     def _check(self, name: str) -> None:
+        if not isinstance(name, str):
+            raise GPMSAError(f"name must be a parameter name (str), got {name!r}; this posterior "
+                             f"has {self.names}")  # fmt: skip
         if name not in self.grids and name not in self.names:
             raise GPMSAError(f"unknown parameter {name!r}; this posterior has {self.names}")
 
@@ -191,11 +194,12 @@ class Posterior:
         return float(np.std(draws, ddof=1))
 
     def quantile(self, name: str, q: float | np.ndarray) -> float | np.ndarray:
-        """Posterior quantile(s) of ``name`` at probability q in [0, 1]."""
+        """Posterior quantile(s) of ``name`` at probability q in [0, 1]: a number, or an array
+        of them (vectorised: an array of quantiles of the same shape)."""
         self._check(name)
-        q_arr = np.asarray(q, dtype=float)
-        if np.any(~np.isfinite(q_arr)) or np.any((q_arr < 0) | (q_arr > 1)):
-            raise GPMSAError(f"q must lie in [0, 1], got {q}")
+        q_arr = as_float(q, "q")
+        if q_arr.size == 0 or np.any(~np.isfinite(q_arr)) or np.any((q_arr < 0) | (q_arr > 1)):
+            raise GPMSAError(f"q must lie in [0, 1], got {q!r}")
         out = (
             self.grids[name].ppf(q_arr)
             if name in self.grids
@@ -224,8 +228,10 @@ class Posterior:
         return diagnostics.hdi(draws, level)
 
     def prob_above(self, name: str, value: float) -> float:
-        """P(name > value) under the posterior (e.g. P(GD > GDmax) for a risk posture)."""
+        """P(name > value) under the posterior (e.g. P(GD > GDmax) for a risk posture);
+        ``value``: one finite number (a list or an array of several is refused)."""
         self._check(name)
+        value = as_real(value, "value")
         if not np.isfinite(value):
             raise GPMSAError(f"value must be finite, got {value}")
         if name in self.grids:
@@ -294,5 +300,16 @@ class Posterior:
         return fig
 
     def __repr__(self) -> str:
-        parts = [f"{n}={self.mean(n):.4g}±{self.sd(n):.3g}" for n in self.names[:3]]
+        try:
+            parts = [self._describe(n) for n in self.names[:3]]
+        except Exception:  # a repr never raises (e.g. a failing draw callable)
+            parts = ["?"]
         return f"Posterior({', '.join(parts)}, method={self.info.get('method', '?')})"
+
+    def _describe(self, name: str) -> str:
+        """``name=mean±sd`` (the mean alone where the sd is undefined: one draw)."""
+        text = f"{name}={self.mean(name):.4g}"
+        try:
+            return f"{text}±{self.sd(name):.3g}"
+        except GPMSAError:
+            return text

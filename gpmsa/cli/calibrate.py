@@ -35,10 +35,11 @@ def add_parser(sub) -> None:
 
 
 def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
-    """Values ordered as ``names`` from NAME=VALUE strings."""
+    """Values ordered as ``names`` from NAME=VALUE strings (split at the last "=": a name may
+    hold "=", a number never does)."""
     given = {}
     for item in items:
-        name, sep, value = item.partition("=")
+        name, sep, value = item.rpartition("=")
         if not sep:
             raise GPMSAError(f"--{what} expects NAME=VALUE, got {item!r}")
         if name.strip() in given:  # the later one silently won

@@ -24,11 +24,11 @@ from gpmsa.fitting.validation import (
     check_manifest,
     check_record,
 )
-from gpmsa.io.container import jsonable, read_raw, write_raw
+from gpmsa.io.container import check_path, jsonable, read_raw, write_raw
 from gpmsa.limits import check_memory
 from gpmsa.model import categorical as categorical_mod
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import SimData, as_float, as_matrix, check_count
+from gpmsa.model.data import SimData, as_float, as_matrix, check_count, check_flag
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
@@ -122,6 +122,8 @@ class Emulator:
         self.x_units, self.t_units, self.y_units = units["x"], units["t"], units["y"]
         self.draws = draws if draws is not None else {}
         self.log_post = log_post if log_post is not None else np.zeros(0)
+        if metadata is not None and not isinstance(metadata, dict):
+            raise GPMSAError(f"metadata must be None or a dict, got {type(metadata).__name__}")
         self.metadata = dict(metadata or {})
         self.settings = dict(settings or {})
         self.diagnostics = dict(diagnostics or {})
@@ -151,6 +153,7 @@ class Emulator:
         """
         from gpmsa.model.problem import prepare
 
+        metadata = check_metadata(metadata)
         prep = prepare(sim_data, priors=priors, n_pc=n_pc, mean_basis=mean_basis)
         return cls._from_prepared(sim_data, prep, params, metadata=metadata,
                                   settings={"source": "from_params"})  # fmt: skip
@@ -321,6 +324,7 @@ class Emulator:
         variances by the law of total variance. ``resid`` adds the nugget 1/lamWs and the residual
         variance 1/lamWOs (the spread of a new simulation run about the smooth emulator).
         """
+        draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
         n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
         check_memory(
             8.0 * n * (4.0 * self.m + 6.0 * self.l_sim + 4.0 * (self.p + self.q)),
@@ -494,8 +498,7 @@ class Emulator:
             domain = {k: list(v) for k, v in emu.domain.items()}
             if manifest.get("domain") != domain:
                 raise ValueError(
-                    f"domain: {str(manifest.get('domain'))[:200]} differs from the arrays' "
-                    f"{domain}"
+                    f"domain: {str(manifest.get('domain'))[:200]} differs from the arrays' {domain}"
                 )
         except EmulatorFileError:
             raise
@@ -510,12 +513,19 @@ class Emulator:
         invalid content, non-finite metadata, or sizes beyond ``gpmsa.limits``. The file is
         replaced in one step, never left half-written.
         """
+        path = check_path(path)
+        manifest, arrays = self.checked_record(path)
+        return write_raw(path, manifest, arrays)
+
+    def checked_record(self, path: str | Path) -> tuple[dict, dict[str, np.ndarray]]:
+        """``to_record`` checked as ``load`` checks a file; GPMSAError (refusing to write
+        ``path``) for a record that ``load`` would refuse."""
         manifest, arrays = self.to_record()
         try:
             check_record(manifest, arrays)
         except EmulatorFileError as exc:
             raise GPMSAError(f"refusing to write {path}, it could not be read back: {exc}") from exc
-        return write_raw(path, manifest, arrays)
+        return manifest, arrays
 
     def __repr__(self) -> str:
         return (
@@ -575,9 +585,21 @@ def _check_consistent(emu: Emulator) -> None:
             raise ValueError(f"draws of {k} have shape {v.shape}")
 
 
+def check_metadata(metadata) -> dict:
+    """``metadata`` (None or a dict) as a dict; GPMSAError unless a file can hold it
+    (``_check_metadata``)."""
+    if metadata is None:
+        return {}
+    if not isinstance(metadata, dict):
+        raise GPMSAError(f"metadata must be None or a dict, got {type(metadata).__name__}")
+    _check_metadata(metadata, "metadata")
+    return dict(metadata)
+
+
 def _check_metadata(value, where: str, depth: int = 0) -> None:
-    """Metadata that survive the file unchanged: dicts with string keys, lists, strings, bools,
-    integers, finite floats and None (NaN would come back as null, a tuple as a list)."""
+    """Metadata a file can hold: dicts with string keys, lists, tuples, strings, bools, integers,
+    finite floats and None (NaN would come back as null). JSON has no tuple: a tuple comes back
+    as a list (numpy scalars as Python numbers)."""
     if depth > 64:
         raise GPMSAError(f"{where}: nests deeper than 64 levels")
     if value is None or isinstance(value, (str, bool, int, np.integer, np.bool_)):

@@ -12,11 +12,11 @@ import numpy as np
 from gpmsa import backends
 from gpmsa._version import library_versions
 from gpmsa.errors import GPMSAError
-from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.model import constraints
-from gpmsa.model.data import ObsData, SimData, check_count, check_seed
+from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, prepare
 
@@ -98,9 +98,10 @@ def fit(
     """
     n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
     n_burn = n_iter // 5 if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
-    if point not in ("mean", "map"):
-        raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
+    check_point(point)
     n_keep = check_count(n_keep, "n_keep")
+    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    metadata = check_metadata(metadata)
     if obs is None and discrepancy is not None:
         given = repr(discrepancy) if isinstance(discrepancy, str) else "an array"
         raise GPMSAError(
@@ -108,11 +109,11 @@ def fit(
             "field data, and a simulator-only fit has none"
         )
     seed = _seed(seed)
+    module = backends.get(backend)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
                    mean_basis=mean_basis)  # fmt: skip
     problem = _model_options(prep, data, fixed, constraint, theta_init)
     _check_fit_memory(problem, int(n_iter), int(n_chains))
-    module = backends.get(backend)
     accepted = inspect.signature(module.sample).parameters
     open_ended = any(a.kind is inspect.Parameter.VAR_KEYWORD for a in accepted.values())
     unknown = [] if open_ended else sorted(set(options) - set(accepted))
@@ -179,6 +180,12 @@ def fit(
     )  # fmt: skip
 
 
+def check_point(point) -> None:
+    """GPMSAError unless ``point`` is "mean" or "map" (the point estimate of ``fit``)."""
+    if not (isinstance(point, str) and point in ("mean", "map")):
+        raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
+
+
 def _check_levels(problem: Problem, theta_unit: np.ndarray, names, what: str) -> None:
     """GPMSAError when a categorical element of ``theta_unit`` is not one of its levels."""
     for k, lv in enumerate(problem.theta_levels or ()):
@@ -202,11 +209,14 @@ def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Proble
     if start is not None:
         _check_levels(problem, start, data.t_names, "theta_init")
         problem = problem.with_init({"theta": start})
-    if fixed:
+    if fixed is not None:
+        if not isinstance(fixed, dict):
+            raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
         fixed = dict(fixed)
         if "theta" in fixed and problem.obs is not None:
             fixed["theta"] = constraints.theta_init_unit(
-                fixed["theta"], std.t_min, std.t_max, data.t_names, closed)  # fmt: skip
+                fixed["theta"], std.t_min, std.t_max, data.t_names, closed, "fixed['theta']"
+            )
             _check_levels(problem, fixed["theta"], data.t_names, "fixed theta")
         problem = problem.with_fixed(fixed)
     return problem

@@ -242,8 +242,10 @@ def check_categorical(manifest: dict, arrays: dict[str, np.ndarray], dims: dict[
             raise _fail(f"model.categorical.{name}", "its design column holds non-integer values")
         found = [int(v) for v in np.unique(codes)]
         if found != levels:
-            raise _fail(f"model.categorical.{name}",
-                        f"declares levels {_short(levels)} but the design has {_short(found)}")
+            raise _fail(
+                f"model.categorical.{name}",
+                f"declares levels {_short(levels)} but the design has {_short(found)}",
+            )
 
 
 def check_manifest(manifest: dict) -> None:
@@ -315,6 +317,10 @@ def check_values(arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
         _finite(arrays, name)
     if "index" in arrays:
         _finite(arrays, "index")
+    for name in ("grid", "index"):  # the basis and the mean are interpolated along it
+        g = arrays.get(name)
+        if g is not None and np.any(np.diff(g) <= 0):
+            raise _fail(f"arrays/{name}", "must be strictly increasing (the output grid)")
     y_sd = float(_positive(arrays, "y_sd")[0])
     y, y_mean = arrays["y"], arrays["y_mean"]
     mean = y.mean(axis=0)

@@ -1,11 +1,12 @@
-"""Replace a file in one step: readers see the old file or the whole new one, never a part."""
+"""Replace a file in one step (or several files together): readers see the old file or the whole
+new one, never a part."""
 
 from __future__ import annotations
 
 import os
 import secrets
 import stat
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO
@@ -31,7 +32,51 @@ def atomic_write(
         the open handle, positioned at 0 (opened "w+", so a writer may check what it wrote).
         The file gets the permissions of a newly created file (0o666 less the umask).
     """
-    path = Path(path)
+    with atomic_group(error=error) as stage, stage(path, text=text) as fh:
+        yield fh
+
+
+@contextmanager
+def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
+    """Replace several files together: each is written whole to a temporary file first, and
+    none is moved over its path until every one is written.
+
+    Yields ``stage``: ``with stage(path, text=False) as fh:`` gives the handle of a new temporary
+    file beside ``path`` (as ``atomic_write``'s), flushed to disk when its block ends. When the
+    group's block ends without an exception the temporary files are moved over their paths in
+    the order staged; on any exception (while writing any of them) every temporary file is
+    removed and no path is touched. Only an OS failure during the final moves (each one step)
+    can leave some paths replaced and others not.
+    """
+    staged: list[tuple[Path, Path]] = []
+
+    @contextmanager
+    def stage(path: str | os.PathLike, *, text: bool = False) -> Iterator[IO]:
+        path = Path(path)
+        tmp, fd = _new_temporary(path, error)
+        staged.append((tmp, path))
+        kw = {"encoding": "utf-8", "newline": ""} if text else {}
+        with os.fdopen(fd, "w+" if text else "w+b", **kw) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+
+    try:
+        yield stage
+        for tmp, path in staged:
+            os.replace(tmp, path)
+    except BaseException:
+        for tmp, _ in staged:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+        raise
+
+
+def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
+    """A new empty file beside ``path`` (created exclusively) and its open descriptor; ``error``
+    when ``path`` exists and is not a regular file, or the folder cannot be written."""
     try:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
@@ -46,16 +91,4 @@ def atomic_write(
         fd = os.open(tmp, flags, 0o666)
     except OSError as exc:  # e.g. a missing folder or one without write permission
         raise error(f"{path}: cannot write ({exc.strerror})") from exc
-    try:
-        kw = {"encoding": "utf-8", "newline": ""} if text else {}
-        with os.fdopen(fd, "w+" if text else "w+b", **kw) as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+    return tmp, fd

@@ -156,25 +156,18 @@ def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
     return raw
 
 
-def write_raw(
-    path: str | Path, manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT
-) -> Path:
-    """Write ``manifest`` and ``arrays`` to ``path`` (a zip: manifest.json + arrays/NAME.npy).
-
-    manifest: the content fields, JSON-able (see ``jsonable``); the envelope fields (``ENVELOPE``)
-    are added here. arrays: name -> array; names match ``NAME_RE``, dtypes are float64, int64 or
-    bool, as the reader accepts. Everything the reader checks is checked first
-    (``check_writable``): a record it would refuse raises GPMSAError and nothing is written. The
-    zip is written to a new temporary file beside ``path``, checked as the reader checks a zip's
-    structure, flushed to disk and then moved over ``path`` in one step: a failure at any point
-    leaves an existing ``path`` untouched and no temporary file behind. A member that deflates
-    beyond ``limits.MAX_RATIO`` (e.g. zero padding) is stored uncompressed. An existing ``path``
-    that is not a regular file (a directory, device, FIFO) is refused. ``fmt``: the format
-    name written (``FORMAT``, or ``STUDY_FORMAT`` for a study). Returns the path.
-    """
+def check_path(path) -> Path:
+    """``path`` as a Path; GPMSAError unless it is a non-empty str or path-like (bytes, numbers
+    and None are not file names here)."""
     if not isinstance(path, str | os.PathLike) or not str(path):
         raise GPMSAError(f"path must be a file name (str or path-like), got {path!r}")
-    path = Path(path)
+    return Path(path)
+
+
+def seal(manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT) -> tuple[dict, bytes]:
+    """``manifest`` with the container's envelope (``ENVELOPE``: format ``fmt``, schema and
+    library versions, time, the arrays' shapes and dtypes, the content sha256) and its JSON as
+    written. Raises GPMSAError for a record the reader would refuse (``check_writable``)."""
     reserved = sorted(set(manifest) & set(ENVELOPE))
     if reserved:
         raise GPMSAError(f"manifest fields {reserved} are written by the container itself")
@@ -187,8 +180,41 @@ def write_raw(
         "arrays": {k: {"shape": list(v.shape), "dtype": v.dtype.str} for k, v in arrays.items()},
     }
     manifest["content_sha256"] = content_hash(arrays, manifest)
-    raw_manifest = check_writable(manifest, arrays)
-    with atomic_write(path) as fh:
+    return manifest, check_writable(manifest, arrays)
+
+
+def write_raw(
+    path: str | Path, manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT
+) -> Path:
+    """Write ``manifest`` and ``arrays`` to ``path`` (a zip: manifest.json + arrays/NAME.npy).
+
+    manifest: the content fields, JSON-able (see ``jsonable``); the envelope fields (``ENVELOPE``)
+    are added here (``seal``). arrays: name -> array; names match ``NAME_RE``, dtypes are float64,
+    int64 or bool, as the reader accepts. Everything the reader checks is checked first
+    (``check_writable``): a record it would refuse raises GPMSAError and nothing is written. The
+    zip is written as ``write_sealed`` writes it. ``fmt``: the format name written (``FORMAT``,
+    or ``STUDY_FORMAT`` for a study). Returns the path.
+    """
+    path = check_path(path)
+    _, raw = seal(manifest, arrays, fmt=fmt)
+    return write_sealed(path, raw, arrays)
+
+
+def write_sealed(
+    path: str | Path, raw_manifest: bytes, arrays: dict[str, np.ndarray], stage=None
+) -> Path:
+    """Write a sealed record (``seal``'s JSON and the arrays) to ``path``.
+
+    The zip is written to a new temporary file beside ``path``, checked as the reader checks a
+    zip's structure, flushed to disk and then moved over ``path`` in one step: a failure at any
+    point leaves an existing ``path`` untouched and no temporary file behind. ``stage``: an
+    ``atomic_group``'s stage, to defer the move to the end of that group (several files replaced
+    together); None: moved at once. A member that deflates beyond ``limits.MAX_RATIO`` (e.g.
+    zero padding) is stored uncompressed. An existing ``path`` that is not a regular file (a
+    directory, device, FIFO) is refused. Returns the path.
+    """
+    path = check_path(path)
+    with (atomic_write if stage is None else stage)(path) as fh:
         with zipfile.ZipFile(fh, "w", compression=zipfile.ZIP_DEFLATED) as zf:
             _write_member(zf, MANIFEST, raw_manifest)
             for name, arr in arrays.items():
@@ -458,7 +484,7 @@ def read_raw(
     ``formats``: the format names accepted (default: an emulator file). Raises
     EmulatorFileError naming the problem.
     """
-    path = Path(path)
+    path = check_path(path)
     fh, size = _open_regular(path)
     with fh:
         _check_directory(fh, size, path)

@@ -398,6 +398,8 @@ def sample(
     check_sample_args(n_iter, n_chains, seed)
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     how = starts.check_init(init, int(n_chains))
+    if how == "gpmsa":  # here, not in a worker: a plain GPMSAError naming the prior
+        starts.check_start(problem, problem.init, how)
     n_ridge = check_ridge(ridge_moves, problem)
     widths = check_step_widths(step_widths, problem)
     seq = np.random.SeedSequence(seed)

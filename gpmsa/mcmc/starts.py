@@ -74,10 +74,33 @@ def _truncnorm01(mean: float, sd: float, size: int, rng: np.random.Generator) ->
     return out
 
 
+def check_start(problem: Problem, start: dict[str, np.ndarray], how: str) -> None:
+    """GPMSAError naming the parameter and its prior when a start lies where that prior has no
+    density (e.g. GPM/SA's start lamUz = 1 outside a prior's bounds (0.3, 0.31)): no chain could
+    have a finite log posterior there."""
+    pri = problem.priors
+    for name in problem.sampled:
+        value = start[name]
+        lp = problem.theta_log_prior(value) if name == "theta" else pri.log_prior(name, value)
+        if lp == -np.inf:
+            prior = getattr(pri, name, None)
+            where = f"the support of the {name} prior"
+            if isinstance(prior, GammaPrior):
+                where = f"the bounds ({prior.lower:g}, {prior.upper:g}) of Priors.{name}"
+            raise GPMSAError(
+                f"the chains' start {name} = {np.ravel(value).tolist()} ({how!r} start) lies "
+                f"outside {where}: zero prior density. Widen the prior's bounds, or start inside "
+                "them (init='prior', or a fixed= value)"
+            )
+
+
 def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str, np.ndarray]:
-    """One chain's starting values (name -> array of the init's shape) under rule ``how``."""
+    """One chain's starting values (name -> array of the init's shape) under rule ``how``;
+    GPMSAError (``check_start``) for one where a prior has no density."""
     if how == "gpmsa":
-        return {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+        start = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+        check_start(problem, start, how)
+        return start
     pri = problem.priors
     out = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
     for name in problem.sampled:
@@ -101,6 +124,7 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
             else:
                 val = _gamma(g, size, rng)
         out[name] = np.asarray(val, dtype=np.float64).reshape(x0.shape)
+    check_start(problem, out, how)
     return out
 
 

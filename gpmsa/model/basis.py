@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import as_float, check_count, check_increasing
 
 VARIANCE_FRACTION = 0.995
 
@@ -18,9 +19,11 @@ def pca_basis(
     A scalar output (l_sim = 1) gives K = [[1]].
     """
     m, l_sim = y_std.shape
+    if n_pc is not None:
+        n_pc = check_count(n_pc, "n_pc")
     if l_sim == 1:
         if n_pc not in (None, 1):
-            raise GPMSAError(f"n_pc must be 1 for a scalar output, got {n_pc}")
+            raise GPMSAError(f"n_pc must be 1 for a scalar output, got {n_pc!r}")
         return np.ones((1, 1))
     u, s, _ = np.linalg.svd(y_std.T, full_matrices=False)
     if n_pc is None:
@@ -29,7 +32,7 @@ def pca_basis(
         share = np.cumsum(s**2) / np.sum(s**2)
         n_pc = int(np.searchsorted(share, fraction - 1e-12) + 1)
     if not 1 <= n_pc <= min(m, l_sim):
-        raise GPMSAError(f"n_pc must be in [1, {min(m, l_sim)}], got {n_pc}")
+        raise GPMSAError(f"n_pc must be in [1, {min(m, l_sim)}], got {n_pc!r}")
     return u[:, :n_pc] * s[:n_pc] / np.sqrt(m)
 
 
@@ -39,11 +42,13 @@ def basis_weights(y_std: np.ndarray, K: np.ndarray) -> np.ndarray:
 
 
 def interpolate_basis(K: np.ndarray, grid: np.ndarray, new_grid: np.ndarray | None) -> np.ndarray:
-    """Basis columns interpolated linearly from ``grid`` onto ``new_grid`` (None: unchanged)."""
+    """Basis columns interpolated linearly from ``grid`` (strictly increasing) onto ``new_grid``
+    (any order; None: unchanged)."""
     if new_grid is None or (new_grid.shape == grid.shape and np.array_equal(new_grid, grid)):
         return K
     if K.shape[0] == 1:
         return np.repeat(K, new_grid.size, axis=0)
+    check_increasing(grid, "the simulation grid")
     lo, hi = grid.min(), grid.max()
     if new_grid.min() < lo or new_grid.max() > hi:
         raise GPMSAError(
@@ -71,7 +76,7 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
                 f"discrepancy must be None, 'constant', 'linear' or an array, got {kind!r}"
             )
     else:
-        D = np.array(kind, dtype=np.float64)
+        D = as_float(kind, "discrepancy basis")
         if D.ndim == 1:
             D = D[:, None]
         if D.ndim != 2 or D.shape[0] != grid.size:

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import as_float, check_finite
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,18 +74,19 @@ def make(constraint, t_min, t_max, names) -> ThetaConstraint | None:
                            np.asarray(t_max, dtype=np.float64), tuple(names))  # fmt: skip
 
 
-def theta_init_unit(theta_init, t_min, t_max, names, closed=None) -> np.ndarray | None:
-    """The user's ``theta_init`` (native, (q,)) on the unit scale; GPMSAError outside (0, 1)
-    (outside [0, 1] for the elements that ``closed`` (q,) bool marks: categorical levels)."""
+def theta_init_unit(
+    theta_init, t_min, t_max, names, closed=None, what: str = "theta_init"
+) -> np.ndarray | None:
+    """The user's ``theta_init`` (native, (q,)) on the unit scale; GPMSAError naming ``what``
+    outside (0, 1) (outside [0, 1] for the elements that ``closed`` (q,) bool marks: categorical
+    levels)."""
     if theta_init is None:
         return None
     q = len(names)
-    try:
-        arr = np.array(theta_init, dtype=np.float64).reshape(-1)
-    except (TypeError, ValueError) as exc:
-        raise GPMSAError(f"theta_init must be {q} numbers, got {theta_init!r}") from exc
+    arr = as_float(theta_init, what).reshape(-1)
     if arr.size != q:
-        raise GPMSAError(f"theta_init must have {q} values ({names}), got {arr.size}")
+        raise GPMSAError(f"{what} must have {q} values ({names}), got {arr.size}")
+    check_finite(arr, what)
     unit = (arr - np.asarray(t_min)) / (np.asarray(t_max) - np.asarray(t_min))
     closed = np.zeros(q, dtype=bool) if closed is None else np.asarray(closed, dtype=bool)
     bad = ~np.where(closed, (unit >= 0.0) & (unit <= 1.0), (unit > 0.0) & (unit < 1.0))
@@ -92,7 +94,7 @@ def theta_init_unit(theta_init, t_min, t_max, names, closed=None) -> np.ndarray 
         k = int(np.flatnonzero(bad)[0])
         kind = "closed range [" if closed[k] else "open range ("
         raise GPMSAError(
-            f"theta_init {names[k]}={arr[k]:.6g} lies outside the {kind}{float(t_min[k]):.6g}, "
+            f"{what} {names[k]}={arr[k]:.6g} lies outside the {kind}{float(t_min[k]):.6g}, "
             f"{float(t_max[k]):.6g}{']' if closed[k] else ')'} of the design"
         )
     return unit

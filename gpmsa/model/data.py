@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -11,10 +12,49 @@ from gpmsa.errors import GPMSAError
 from gpmsa.model import categorical
 
 
+def _first_non_number(value) -> str | None:
+    """The first entry of ``value`` that is not a real number, described ("str '1.5'",
+    "bool True", "None"): numpy would read "1.5" as 1.5, True as 1 and None as NaN. None when
+    every entry is a number (numpy's integer and float scalars are)."""
+    stack, seen = [value], set()
+    while stack:
+        v = stack.pop()
+        if v is None:
+            return "None"
+        if isinstance(v, (str, bytes, bool, np.bool_)):
+            item = v.item() if isinstance(v, np.generic) else v
+            return f"{type(item).__name__} {item!r}"
+        if isinstance(v, (list, tuple)):
+            if id(v) not in seen:  # a list that holds itself is walked once
+                seen.add(id(v))
+                stack.extend(reversed(v))
+            continue
+        if isinstance(v, (int, float, complex, np.number)):
+            continue
+        try:
+            arr = v if isinstance(v, np.ndarray) else np.asarray(v)
+        except (TypeError, ValueError):
+            continue  # the conversion fails later with its own message
+        if arr.dtype.kind in "bUS":
+            if not arr.size:
+                return f"{arr.dtype.name} values"
+            item = arr.reshape(-1)[0].item()
+            return f"{type(item).__name__} {item!r}"
+        if arr.dtype.kind == "O":
+            stack.extend(x for x in reversed(arr.reshape(-1).tolist()) if x is not v)
+    return None
+
+
 def as_float(value, name: str) -> np.ndarray:
     """Return ``value`` as a float64 array (a copy); GPMSAError naming ``name`` when it is not
-    real numbers (strings, objects, ragged lists; complex values, which are never cast to their
-    real part)."""
+    real numbers (strings, even numeric ones, bools, None, objects, ragged lists; complex
+    values, which are never cast to their real part). numpy integer and float scalars are
+    numbers."""
+    bad = _first_non_number(value)
+    if bad is not None:
+        raise GPMSAError(
+            f"{name} must be a numeric array, got {bad} (text, bools and None are not converted)"
+        )
     try:
         is_complex = np.iscomplexobj(value)
         arr = None if is_complex else np.array(value, dtype=np.float64)
@@ -23,6 +63,25 @@ def as_float(value, name: str) -> np.ndarray:
     if arr is None:
         raise GPMSAError(f"{name} must hold real numbers, got complex values")
     return arr
+
+
+def as_real(value, name: str) -> float:
+    """``value`` as a float: a real number (a Python or numpy scalar, or a 0-d array); GPMSAError
+    naming ``name`` for a string, a bool, None, a list or a larger array."""
+    bad = _first_non_number(value)
+    if bad is not None:
+        raise GPMSAError(f"{name} must be a number, got {bad}")
+    if isinstance(value, (list, tuple)) or np.ndim(value) != 0:
+        raise GPMSAError(f"{name} must be a single number, got {value!r}")
+    return float(as_float(value, name))
+
+
+def check_flag(value, name: str) -> bool:
+    """``value`` as a bool; GPMSAError naming ``name`` unless it is True or False (a string such
+    as "no" is not read as a flag)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise GPMSAError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
 
 
 def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
@@ -93,18 +152,43 @@ def check_seed(seed, name: str = "seed", *, generator: bool = False):
 
 def output_scale(y: np.ndarray) -> float:
     """GPM/SA's output scale of simulation outputs ``y`` (m, l): the sd (ddof=1) of all values
-    after centring each column; GPMSAError naming ``y`` when it is zero or not finite (values so
-    large that their squares overflow)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        sd = float(np.std(y - y.mean(axis=0), ddof=1))
-    if not np.isfinite(sd):
+    after centring each column; GPMSAError naming ``y`` when it is zero, or when its square
+    overflows (values too large) or underflows (a spread too small) float64."""
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+        centred = y - y.mean(axis=0)
+        big = float(np.max(np.abs(centred)))
+        sd = big * float(np.std(centred / big, ddof=1)) if 0.0 < big < np.inf else big
+        square = sd * sd
+    if not (np.isfinite(sd) and np.isfinite(square)):
         raise GPMSAError(
             f"y is too large to standardise: its spread overflows float64 (largest |y| = "
             f"{np.abs(y).max():.3g}); rescale y (e.g. other units)"
         )
     if not sd > 0:
         raise GPMSAError("y has zero spread after centring each column; the output must vary")
+    if not square >= np.finfo(np.float64).tiny:
+        raise GPMSAError(
+            f"y's spread (sd {sd:.3g} after centring each column) is too small to standardise: "
+            "its square underflows float64; rescale y (e.g. other units)"
+        )
     return sd
+
+
+RESERVED_NAMES = ("lamOs", "lamVz", "betaV")
+"""Names a calibration posterior gives its other parameters (with "betaV[k]", k = 0, 1, ...):
+no calibration parameter (t_names) may take them."""
+
+
+def check_parameter_names(names, what: str = "t_names") -> None:
+    """GPMSAError when a calibration parameter name is reserved (``RESERVED_NAMES`` or
+    betaV[k]): its draws would overwrite, or be confused with, those of that parameter."""
+    for name in names:
+        if name in RESERVED_NAMES or re.fullmatch(r"betaV\[\d+\]", name):
+            raise GPMSAError(
+                f"{what}: {name!r} is a reserved name: a calibration posterior names its other "
+                f"parameters {', '.join(RESERVED_NAMES)} and betaV[k] (k = 0, 1, ...); rename the "
+                "calibration parameter"
+            )
 
 
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
@@ -128,21 +212,55 @@ def _units(units: Sequence[str] | None, n: int, what: str) -> tuple[str, ...]:
 
 
 def _index(index, n: int, name: str) -> np.ndarray | None:
+    """The simulation output grid: finite and strictly increasing (the basis and the mean are
+    interpolated along it)."""
     if index is None:
         return None
     arr = as_float(index, name).reshape(-1)
     if arr.size != n:
         raise GPMSAError(f"{name} must have {n} entries (one per output column), got {arr.size}")
     check_finite(arr, name)
+    check_increasing(arr, name)
     return arr
+
+
+def check_increasing(grid: np.ndarray, name: str) -> None:
+    """GPMSAError unless the output grid ``grid`` (l,) is strictly increasing (np.interp, which
+    maps the basis and the mean onto other grids, silently misreads any other order)."""
+    step = np.flatnonzero(~(np.diff(grid) > 0))
+    if step.size:
+        k = int(step[0])
+        a, b = float(grid[k]), float(grid[k + 1])
+        raise GPMSAError(
+            f"{name} must be strictly increasing, got {a!r} then {b!r} at positions {k}, {k + 1};"
+            " sort the output columns (the index and the columns of y together)"
+        )
+
+
+def _check_spans(arr: np.ndarray, name: str, names) -> None:
+    """GPMSAError naming a design column that is constant or whose range overflows float64."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        span = arr.max(axis=0) - arr.min(axis=0)
+    for j in range(arr.shape[1]):
+        label = names[j] if names is not None and len(names) > j else f"{name}[:, {j}]"
+        col = arr[:, j]
+        if not np.isfinite(span[j]):
+            raise GPMSAError(f"design column {label} spans [{col.min()}, {col.max()}]: its width "
+                             "overflows float64; rescale it (e.g. other units)")  # fmt: skip
+        if span[j] <= 1e-12 * max(1.0, float(np.abs(col).max())):
+            raise GPMSAError(f"design column {label} is constant ({col[0]}); every input must vary")
 
 
 @dataclass(frozen=True, eq=False)
 class SimData:
     """Simulation runs: inputs ``x`` (m, p), parameters ``t`` (m, q), outputs ``y`` (m, l_sim).
 
-    ``index`` (l_sim,) is the output grid of a multivariate output (None: 0..l_sim-1).
-    Names default to x0.., t0.., y0..; units to "". A 1-D ``x``, ``t`` or ``y`` is one column.
+    ``index`` (l_sim,) is the output grid of a multivariate output (None: 0..l_sim-1); it must
+    be strictly increasing (a descending or unsorted grid is refused: sort the index and the
+    columns of ``y`` together). Names default to x0.., t0.., y0..; units to "". ``t_names`` may
+    not be a reserved name (lamOs, lamVz, betaV, betaV[k]: the other parameters of a calibration
+    posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every entry must be a real number
+    (strings, bools and None are refused, never converted).
     ``x_categorical``, ``t_categorical``: the categorical inputs (column indices or names; None:
     none), whose values are integer level codes; see docs/categorical-and-constraints.md.
     """
@@ -175,15 +293,8 @@ class SimData:
             raise GPMSAError(
                 f"need at least p + q + 2 = {p + q + 2} simulation runs for {p + q} inputs, got {m}"
             )
-        for arr, name, names in ((x, "x", self.x_names), (t, "t", self.t_names)):
-            span = arr.max(axis=0) - arr.min(axis=0)
-            const = np.flatnonzero(span <= 1e-12 * np.maximum(1.0, np.abs(arr).max(axis=0)))
-            if const.size:
-                j = int(const[0])
-                label = names[j] if names is not None and len(names) > j else f"{name}[:, {j}]"
-                raise GPMSAError(
-                    f"design column {label} is constant ({arr[0, j]}); every input must vary"
-                )
+        _check_spans(x, "x", self.x_names)
+        _check_spans(t, "t", self.t_names)
         if np.ptp(y) == 0.0:
             raise GPMSAError(f"y is constant ({y[0, 0]}); the simulation output must vary")
         output_scale(y)
@@ -193,6 +304,7 @@ class SimData:
         object.__setattr__(self, "index", _index(self.index, y.shape[1], "index"))
         object.__setattr__(self, "x_names", _names(self.x_names, p, "x", "x_names"))
         object.__setattr__(self, "t_names", _names(self.t_names, q, "t", "t_names"))
+        check_parameter_names(self.t_names)
         if shared := sorted(set(self.x_names) & set(self.t_names)):
             raise GPMSAError(
                 f"x_names and t_names must not share a name (an input is either known or "
@@ -245,9 +357,13 @@ class ObsData:
 
     ``y`` is (n, l_obs), or a list of n 1-D arrays of differing lengths ("ragged"), each with its
     ``index`` grid (a list of arrays; a single array applies to every experiment; None means the
-    simulation grid). ``precision`` is the observation-error precision in native units
-    (1/unit^2): None (identity in standardised units, GPM/SA's default), or per experiment a
-    scalar or an (l_j, l_j) matrix (a list, or an array of shape (n,) or (n, l, l)).
+    simulation grid). An observation grid may be in any order (each point is interpolated on the
+    simulation grid, which is increasing), but must lie within the simulation grid; the columns
+    of ``y`` follow its order. ``precision`` is the observation-error precision in native units
+    (1/unit^2): None (identity in standardised units, GPM/SA's default), a scalar (the same for
+    every experiment), or per experiment a scalar or an (l_j, l_j) matrix (a list, or an array
+    of shape (n,) or (n, l, l)). Every entry must be a real number (strings, bools and None are
+    refused, never converted).
     """
 
     x: np.ndarray
@@ -309,6 +425,8 @@ class ObsData:
     def _precisions(precision, ys: list[np.ndarray]) -> list[np.ndarray] | None:
         if precision is None:
             return None
+        if not isinstance(precision, (list, tuple)) and np.ndim(precision) == 0:
+            precision = [precision] * len(ys)  # one scalar for every experiment
         if len(precision) != len(ys):
             raise GPMSAError(f"precision must have one entry per experiment ({len(ys)})")
         out = []

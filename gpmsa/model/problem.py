@@ -13,7 +13,7 @@ from gpmsa.model import categorical
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
 from gpmsa.model.constraints import ThetaConstraint
-from gpmsa.model.data import ObsData, SimData, check_finite
+from gpmsa.model.data import ObsData, SimData, as_float, check_finite
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
@@ -176,14 +176,9 @@ class Problem:
         out = {}
         for name, val in values.items():
             if name not in self.init:
-                raise GPMSAError(
-                    f"fixed: unknown parameter {name!r}; this model has {self.names}"
-                )
+                raise GPMSAError(f"fixed: unknown parameter {name!r}; this model has {self.names}")
             shape = self.init[name].shape
-            try:
-                arr = np.array(val, dtype=np.float64)
-            except (TypeError, ValueError) as exc:
-                raise GPMSAError(f"fixed[{name!r}] must be numeric, got {val!r}") from exc
+            arr = as_float(val, f"fixed[{name!r}]")
             if arr.size == 1:
                 arr = np.full(shape, float(arr.reshape(-1)[0]))
             elif arr.size != int(np.prod(shape)):
@@ -245,7 +240,11 @@ def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
 
 
 def reduce_obs(
-    obs: ObsData, std: Standardizer, K: np.ndarray, discrepancy, x_names: tuple[str, ...],
+    obs: ObsData,
+    std: Standardizer,
+    K: np.ndarray,
+    discrepancy,
+    x_names: tuple[str, ...],
     levels: categorical.Levels | None = None,
 ) -> tuple[ObsProblem, tuple[float, float]]:
     """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db).
@@ -349,6 +348,8 @@ def prepare(
         raise GPMSAError(f"data must be a gpmsa.SimData, got {type(sim).__name__}")
     if obs is not None and not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be a gpmsa.ObsData or None, got {type(obs).__name__}")
+    if priors is not None and not isinstance(priors, Priors):
+        raise GPMSAError(f"priors must be a gpmsa.Priors or None, got {priors!r}")
     std = Standardizer.from_sim(sim)
     y_std = std.y_to_std(sim.y)
     K = pca_basis(y_std, n_pc)
@@ -362,7 +363,7 @@ def prepare(
     levels = sim.levels
     if obs is not None:
         obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels)
-    priors = (priors or Priors()).with_data(wos, os_corr)
+    priors = (Priors() if priors is None else priors).with_data(wos, os_corr)
     init = default_init(sim.p, sim.q, p_u, priors, obs_p)
     prob = Problem(
         std.x_to_unit(sim.x), std.t_to_unit(sim.t), w, lam_sim, priors, init, frozenset(), obs_p,

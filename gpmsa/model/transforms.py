@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.model.data import SimData, output_scale
+from gpmsa.model.data import SimData, check_increasing, output_scale
 
 UNIT_TOL = 1e-9
 """Unit-scale values within this distance outside [0, 1] are rounding of the design's edges (a
@@ -73,11 +73,13 @@ class Standardizer:
         return np.asarray(t) * (self.t_max - self.t_min) + self.t_min
 
     def mean_on(self, grid: np.ndarray | None) -> np.ndarray:
-        """The simulation mean interpolated onto ``grid`` (None: the simulation grid)."""
+        """The simulation mean interpolated onto ``grid`` (any order; None: the simulation
+        grid, which is strictly increasing)."""
         if grid is None or (grid.shape == self.grid.shape and np.array_equal(grid, self.grid)):
             return self.y_mean
         if self.y_mean.size == 1:
             return np.full(grid.shape, self.y_mean[0])
+        check_increasing(self.grid, "the simulation grid")
         return np.interp(grid, self.grid, self.y_mean)
 
     def y_to_std(self, y: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:

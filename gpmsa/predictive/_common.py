@@ -60,6 +60,29 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
     return native, unit
 
 
+def posterior_theta(emulator, theta: np.ndarray) -> np.ndarray:
+    """Unit-scale theta (k, q) of native posterior draws (k, q), under the rule of
+    ``Emulator.predict``: outside the emulator's t domain a warning, beyond it by more than
+    ``EXTRAPOLATION_MARGIN`` a GPMSAError naming the parameter."""
+    s = emulator.standardizer
+    return unit_inputs(theta, emulator.t_names, s.t_min, s.t_max, "posterior theta")[1]
+
+
+def posterior_lamos(posterior, idx: np.ndarray | None = None) -> np.ndarray:
+    """The posterior's lamOs draws (those at ``idx``; None: all); GPMSAError when it has none
+    or one is not a finite precision > 0 (1/lamOs is the observation-error variance)."""
+    if "lamOs" not in posterior.names:
+        raise GPMSAError(f"the posterior lacks lamOs (the observation precision); it has "
+                         f"{posterior.names}")  # fmt: skip
+    lam = np.asarray(posterior.samples["lamOs"], dtype=np.float64).reshape(-1)
+    lam = lam if idx is None else lam[idx]
+    bad = np.flatnonzero(~(np.isfinite(lam) & (lam > 0)))
+    if bad.size:
+        raise GPMSAError(f"the posterior's lamOs draws must be finite and > 0 (a precision), got "
+                         f"{float(lam[bad[0]])!r}")  # fmt: skip
+    return lam
+
+
 def gpmsa_model_only(emulator, what: str) -> None:
     """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or uses categorical inputs or a mean
     basis, which ``what`` does not support (``Emulator.predict``, ``gpmsa.calibrate`` and

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,7 +11,8 @@ from scipy.special import ndtr
 from gpmsa.calibration.observations import check_x
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import as_float, check_finite, check_level
+from gpmsa.model.data import as_float, as_real, check_count, check_finite, check_flag, check_level
+from gpmsa.predictive._common import posterior_lamos, posterior_theta
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,7 +55,9 @@ class CalibratedPrediction:
         return np.tensordot(self.weights, ndtr(z), axes=1)
 
     def quantile(self, q: float) -> np.ndarray:
-        """Predictive quantile (N, l_sim) at probability q in (0, 1) (bisection on the CDF)."""
+        """Predictive quantile (N, l_sim) at one probability q in (0, 1) (bisection on the CDF;
+        a list or an array of several q is refused: call once per q)."""
+        q = as_real(q, "q")
         if not 0.0 < q < 1.0:
             raise GPMSAError(f"q must lie in (0, 1), got {q}")
         sd = np.sqrt(self.comp_var)
@@ -103,13 +107,15 @@ def calibrated_predict(
     Returns:
         CalibratedPrediction (native units).
     """
-    x, _ = check_x(emulator, x_new, extrapolate)
+    noise, resid = check_flag(noise, "noise"), check_flag(resid, "resid")
+    x, _ = check_x(emulator, x_new, check_flag(extrapolate, "extrapolate"), "x_new")
+    if not isinstance(posterior, Posterior):
+        raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
     names = tuple(emulator.t_names)
     missing = [n for n in names if n not in posterior.names]
     if missing:
         raise GPMSAError(f"posterior lacks {missing}; it has {posterior.names}")
-    if not (isinstance(n_theta, int | np.integer) and n_theta >= 1):
-        raise GPMSAError(f"n_theta must be an integer >= 1, got {n_theta}")
+    n_theta = check_count(n_theta, "n_theta")
     lam = None
     inv_lam = posterior.info.get("expected_inv_lamOs")
     if len(names) == 1 and names[0] in posterior.grids and (inv_lam is not None or not noise):
@@ -126,11 +132,14 @@ def calibrated_predict(
         theta = np.column_stack([np.asarray(posterior.samples[k])[idx] for k in names])
         weights = np.full(idx.size, 1.0 / idx.size)
         if noise:
-            lam = np.asarray(posterior.samples["lamOs"])[idx]
+            lam = posterior_lamos(posterior, idx)
+    posterior_theta(emulator, theta)
     K, N = theta.shape[0], x.shape[0]
     xs = np.tile(x, (K, 1))
     ts = np.repeat(theta, N, axis=0)
-    mean, var = emulator.predict(xs, ts, resid=resid)
+    with warnings.catch_warnings():  # x_new and theta were checked (and warned about) above
+        warnings.simplefilter("ignore")
+        mean, var = emulator.predict(xs, ts, resid=resid)
     l_sim = mean.shape[1]
     mean = mean.reshape(K, N, l_sim)
     var = var.reshape(K, N, l_sim)

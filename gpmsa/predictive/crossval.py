@@ -26,7 +26,7 @@ from scipy.special import ndtr
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import check_level
+from gpmsa.model.data import check_flag, check_level
 from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, rng_of
 
 
@@ -84,7 +84,17 @@ def _fold_labels(folds, m: int, seed) -> np.ndarray:
             f"folds must be None (leave-one-out), an integer k or one label per run (shape "
             f"({m},)), got shape {labels.shape}"
         )
-    _, inv = np.unique(labels, return_inverse=True)
+    bad = [v for v in labels.tolist() if v is None or (isinstance(v, float) and v != v)]
+    if bad:
+        raise GPMSAError(f"folds: every run needs a label (None and NaN are not labels), got "
+                         f"{bad[0]!r}")  # fmt: skip
+    try:
+        _, inv = np.unique(labels, return_inverse=True)
+    except TypeError as exc:  # labels numpy cannot order (e.g. numbers mixed with strings)
+        raise GPMSAError(
+            f"folds: the labels must be of one kind (all numbers or all strings), "
+            f"got {sorted({type(v).__name__ for v in labels.tolist()})}"
+        ) from exc
     if inv.max() == 0:
         raise GPMSAError("folds must hold at least two different labels")
     return inv.reshape(m)
@@ -126,6 +136,7 @@ def cross_validate(
         True
     """
     gpmsa_model_only(emulator, "cross_validate")
+    draws = check_flag(draws, "draws")
     m, p_u, l_sim = emulator.m, emulator.p_u, emulator.l_sim
     labels = _fold_labels(folds, m, seed)
     groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1)]

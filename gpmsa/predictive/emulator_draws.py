@@ -21,7 +21,7 @@ import numpy as np
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.model.data import check_count, check_level
+from gpmsa.model.data import check_count, check_flag, check_level
 from gpmsa.predictive._common import (
     factors,
     gpmsa_model_only,
@@ -144,6 +144,8 @@ def emulator_prediction(
         True
     """
     gpmsa_model_only(emulator, "emulator_prediction")
+    draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
+    joint = check_flag(joint, "joint")
     n_rlz = check_count(n_rlz, "n_rlz")
     rng = rng_of(seed)
     s = emulator.standardizer

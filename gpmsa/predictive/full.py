@@ -42,6 +42,8 @@ from gpmsa.predictive._common import (
     factors,
     gpmsa_model_only,
     mvn_factor,
+    posterior_lamos,
+    posterior_theta,
     rng_of,
     unit_inputs,
 )
@@ -167,20 +169,24 @@ def _posterior_sets(emulator, posterior, n_draws):
         missing = [k for k in (*names, "lamOs") if k not in samples]
         if missing:
             raise GPMSAError(f"posterior lacks {missing}; it has {tuple(samples)}")
-        theta = emulator.standardizer.t_to_unit(
-            np.column_stack([np.asarray(samples[k], dtype=float) for k in names])
+        theta = posterior_theta(
+            emulator, np.column_stack([np.asarray(samples[k], dtype=float) for k in names])
         )
+        lam_os = posterior_lamos(posterior)
         n = theta.shape[0]
         p = emulator.p
         bnames = ["betaV"] if "betaV" in samples else [f"betaV[{k}]" for k in range(p)]
         has_v = all(k in samples for k in bnames) and "lamVz" in samples
         if has_v and len(bnames) != p:
             raise GPMSAError(f"posterior has one betaV but the emulator has p = {p} known inputs")
+        for k in (*bnames, "lamVz") if has_v else ():
+            if not np.all(np.asarray(samples[k]) > 0):
+                raise GPMSAError(f"the posterior's {k} draws must be > 0")
 
         def get(i):
             prm = {k: emulator.params[k] for k in EMULATOR_PARAMS}
             prm["theta"] = theta[i]
-            prm["lamOs"] = float(samples["lamOs"][i])
+            prm["lamOs"] = float(lam_os[i])
             if has_v:
                 prm["betaV"] = np.array([float(samples[k][i]) for k in bnames])
                 prm["lamVz"] = float(samples["lamVz"][i])
@@ -299,8 +305,8 @@ def full_prediction(
             be passed again).
         n_draws: at most this many posterior draws, evenly spaced (None: all).
         n_rlz: realizations per draw.
-        grid: output grid of the prediction within the simulation grid (default: the
-            observations' grid when all experiments share one, else the simulation grid).
+        grid: output grid of the prediction within the simulation grid, in any order (default:
+            the observations' grid when all experiments share one, else the simulation grid).
         seed: int, numpy Generator or None.
 
     Returns:

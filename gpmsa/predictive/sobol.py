@@ -20,6 +20,12 @@ The same is reported per basis component (V^u_jj) and for the variance summed ov
 (trace(K^T K V^u), the aggregated index of a functional output, GPM/SA's multivariate gSens).
 The spread over draws shows how well the emulator pins the indices down. An output element whose
 variance over the box is below 1e-12 of the largest has undefined indices (NaN).
+
+Numerics: each one-dimensional integral over a narrow range (a box of width 1e-6 of the
+domain, say) is computed by Gauss-Legendre quadrature rather than as a difference of error
+functions, which would cancel and give indices wrong by percents; the variances are differences
+of second moments, whose rounding (about 1e-11 of the variance) could still put an index of 0
+or 1 just outside [0, 1], so the indices are clipped to [0, 1].
 """
 
 from __future__ import annotations
@@ -27,15 +33,18 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.special import erf
+from scipy.special import erf, erfc
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import check_level
+from gpmsa.model.data import as_real, check_flag, check_level
 from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, unit_inputs
 
 _SQRT_PI_2 = 0.5 * np.sqrt(np.pi)
 ZERO_VARIANCE = 1e-12
+NARROW = 0.5
+"""sqrt(gamma) (b - a) below which a Gaussian integral is done by quadrature (``_mean_gauss``)."""
+_GL_NODES, _GL_WEIGHTS = np.polynomial.legendre.leggauss(12)
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,10 +97,25 @@ class Sensitivity:
         return out
 
 
-def _mean_gauss(gamma: np.ndarray, c: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Mean of exp(-gamma (z - c)^2) over z ~ U[a, b] (broadcast)."""
+def _mean_gauss(gamma: float, c: np.ndarray, a: float, b: float) -> np.ndarray:
+    """Mean of exp(-gamma (z - c)^2) over z ~ U[a, b] (a < b), elementwise over c.
+
+    By the error functions, their difference taken in the tail where both arguments lie
+    (erfc) so that it keeps its relative accuracy; on a narrow interval (sqrt(gamma) (b - a) <
+    ``NARROW``), where that difference would cancel (the interval's width is lost in the
+    rounding of erf), by Gauss-Legendre quadrature, exact to rounding there.
+    """
     s = np.sqrt(gamma)
-    return _SQRT_PI_2 * (erf(s * (b - c)) - erf(s * (a - c))) / (s * (b - a))
+    if s * (b - a) < NARROW:
+        mid, half = 0.5 * (a + b), 0.5 * (b - a)
+        out = np.zeros(np.shape(c))
+        for node, weight in zip(_GL_NODES, _GL_WEIGHTS, strict=True):
+            out += 0.5 * weight * np.exp(-gamma * (mid + half * node - c) ** 2)
+        return out
+    lo, hi = s * (a - c), s * (b - c)
+    diff = np.where(lo > 0, erfc(lo) - erfc(hi), np.where(hi < 0, erfc(-hi) - erfc(-lo),
+                                                           erf(hi) - erf(lo)))  # fmt: skip
+    return _SQRT_PI_2 * diff / (s * (b - a))
 
 
 def _pair_integral(al: float, be: float, p: np.ndarray, q: np.ndarray, a: float, b: float):
@@ -142,8 +166,20 @@ def _component_moments(zt, coef, beta, varied, lo, hi):
 
 
 def _ratio(num: np.ndarray, den: np.ndarray, scale: float) -> np.ndarray:
+    """The variance share num / den clipped to [0, 1] (the rounding left in the differences
+    of second moments, about 1e-11 of the variance, can put a share of 0 or 1 just outside);
+    NaN where den is below ``ZERO_VARIANCE`` * scale (an index is undefined there)."""
     ok = den > ZERO_VARIANCE * scale
-    return np.where(ok, num / np.where(ok, den, 1.0), np.nan)
+    return np.where(ok, np.clip(num / np.where(ok, den, 1.0), 0.0, 1.0), np.nan)
+
+
+def _name_dict(value, what: str) -> dict:
+    """``value`` (None or a dict keyed by input names) as a dict; GPMSAError otherwise."""
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise GPMSAError(f"{what} must be None or a dict input name -> value, got {value!r}")
+    return dict(value)
 
 
 def sensitivity(
@@ -189,9 +225,10 @@ def sensitivity(
     names = tuple(emulator.x_names) + tuple(emulator.t_names)
     lo_all = np.concatenate([std.x_min, std.t_min])
     hi_all = np.concatenate([std.x_max, std.t_max])
-    bounds, fixed = dict(bounds or {}), dict(fixed or {})
+    draws = check_flag(draws, "draws")
+    bounds, fixed = _name_dict(bounds, "bounds"), _name_dict(fixed, "fixed")
     for what, given in (("bounds", bounds), ("fixed", fixed)):
-        unknown = sorted(set(given) - set(names))
+        unknown = sorted(set(given) - set(names), key=str)
         if unknown:
             raise GPMSAError(f"{what} names unknown inputs {unknown}; the inputs are {names}")
     both = sorted(set(bounds) & set(fixed))
@@ -204,10 +241,9 @@ def sensitivity(
     for k in varied:
         name = names[k]
         pair = bounds.get(name, (lo_all[k], hi_all[k]))
-        try:
-            a, b = (float(v) for v in pair)
-        except (TypeError, ValueError) as exc:
-            raise GPMSAError(f"bounds[{name!r}] must be (lo, hi), got {pair!r}") from exc
+        if not isinstance(pair, (list, tuple, np.ndarray)) or len(pair) != 2:
+            raise GPMSAError(f"bounds[{name!r}] must be (lo, hi), got {pair!r}")
+        a, b = (as_real(v, f"bounds[{name!r}]") for v in pair)
         if not (np.isfinite(a) and np.isfinite(b) and a < b):
             raise GPMSAError(f"bounds[{name!r}] must be finite with lo < hi, got ({a}, {b})")
         lo_n.append(a)
@@ -218,10 +254,9 @@ def sensitivity(
     lo_u, hi_u = ends[0], ends[1]
     zt = emulator.zt.copy()
     fix_u = {}
+    fixed = {name: as_real(value, f"fixed[{name!r}]") for name, value in fixed.items()}
     for name, value in fixed.items():
         k = names.index(name)
-        if not isinstance(value, int | float | np.integer | np.floating):
-            raise GPMSAError(f"fixed[{name!r}] must be a number, got {value!r}")
         _, u = unit_inputs([[value]], [name], lo_all[k : k + 1], hi_all[k : k + 1], "fixed")
         fix_u[k] = float(u[0, 0])
     idx, sets = param_sets(emulator, draws, n_draws, "sensitivity")
@@ -254,8 +289,10 @@ def sensitivity(
             out_pc["total"][i] = 1.0 - _ratio(np.diagonal(Vcomp, axis1=1, axis2=2).T,
                                               v_pc[:, None], scale_pc)  # fmt: skip
             v_sum = float(np.sum(KtK * Vall))
-            out_agg["main"][i] = np.einsum("jk,njk->n", KtK, Vmain) / v_sum
-            out_agg["total"][i] = 1.0 - np.einsum("jk,njk->n", KtK, Vcomp) / v_sum
+            scale_sum = max(v_sum, 1e-300)
+            out_agg["main"][i] = _ratio(np.einsum("jk,njk->n", KtK, Vmain), v_sum, scale_sum)
+            out_agg["total"][i] = 1.0 - _ratio(np.einsum("jk,njk->n", KtK, Vcomp), v_sum,
+                                               scale_sum)  # fmt: skip
             variance[i] = v_l * std.y_sd**2
             mean[i] = K @ mu * std.y_sd + std.y_mean
     return Sensitivity(

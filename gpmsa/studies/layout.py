@@ -234,3 +234,31 @@ def build_layout(
         index.append(row)
     return Layout(tuple(labels), tuple(elements), tuple(tuple(r) for r in index), hier,
                   tuple(bounds), shared)  # fmt: skip
+
+
+def posterior_names(layout: Layout) -> list[str]:
+    """The names of a study's posterior (``gpmsa.studies.study.native_chains``), in order."""
+    return ([el.name for el in layout.elements] + [f"lamOs[{lab}]" for lab in layout.labels]
+            + [f"{g}.{k}" for g in layout.groups for k in ("mu", "sd", "lam")])  # fmt: skip
+
+
+def check_study_names(layout: Layout) -> None:
+    """GPMSAError when a study's posterior names could be confused: a calibration parameter
+    whose name holds "[" or "]" (the study names a model's own parameter NAME[LABEL] and its
+    lamOs lamOs[LABEL]), or two posterior names alike (e.g. a shared parameter "E.mu" and the
+    mean "E.mu" of a hierarchical E), whose draws would overwrite each other."""
+    for el in layout.elements:
+        if "[" in el.param or "]" in el.param:
+            raise GPMSAError(
+                f"calibration parameter {el.param!r}: a study's parameter names may not hold '[' "
+                "or ']' (the study names a model's own parameter NAME[LABEL] and its lamOs "
+                "lamOs[LABEL]); rename it"
+            )
+    names = posterior_names(layout)
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise GPMSAError(
+            f"the study's posterior would name several quantities {twice} (a hierarchical "
+            "group's NAME.mu, NAME.sd and NAME.lam, a model's NAME[LABEL] and lamOs[LABEL]); "
+            "rename the calibration parameter"
+        )

@@ -14,15 +14,16 @@ from gpmsa._version import library_versions
 from gpmsa.calibration.calibrate import calibration_problem
 from gpmsa.calibration.observations import check_emulator
 from gpmsa.errors import GPMSAError
-from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
+from gpmsa.fitting.fit import check_point
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
-from gpmsa.model.data import ObsData, SimData, check_seed
+from gpmsa.model.data import ObsData, SimData, check_flag, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
-from gpmsa.studies.layout import HyperPriors, build_layout, check_labels
+from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
 from gpmsa.studies.sampler import StudyChains, sample_study
 from gpmsa.studies.study import Study, layout_of
 
@@ -131,8 +132,12 @@ def calibrate_study(
     for e in emulators:
         check_emulator(e)
     hyper = _check_run(n_samples, n_burn, n_chains, seed, hyper)
+    metadata = check_metadata(metadata)
+    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    extrapolate = check_flag(extrapolate, "extrapolate")
     labels = check_labels(labels, n)
     layout = layout_of(emulators, labels, shared, hierarchical)
+    check_study_names(layout)
     t0 = time.perf_counter()
     problems = [calibration_problem(e, x, y, extrapolate=extrapolate)
                 for e, x, y in zip(emulators, x_obs, y_obs, strict=True)]  # fmt: skip
@@ -191,10 +196,11 @@ def fit_study(
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
     n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int) else n_burn
     hyper = _check_run(n_iter, n_burn, n_chains, seed, hyper, "n_iter")
-    if point not in ("mean", "map"):
-        raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
+    check_point(point)
     if isinstance(n_keep, bool) or not isinstance(n_keep, (int, np.integer)) or n_keep < 1:
         raise GPMSAError(f"n_keep must be an integer >= 1, got {n_keep!r}")
+    metadata = check_metadata(metadata)
+    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
     preps = [prepare(s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
              for s, o in zip(sims, obs, strict=True)]  # fmt: skip
@@ -207,6 +213,7 @@ def fit_study(
         [(p.problem.priors.theta_mean, p.problem.priors.theta_sd) for p in preps],
         shared, hierarchical,
     )  # fmt: skip
+    check_study_names(layout)
     problems = [p.problem for p in preps]
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})")
     t0 = time.perf_counter()

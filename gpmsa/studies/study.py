@@ -16,7 +16,8 @@ import numpy as np
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, load
-from gpmsa.io.container import STUDY_FORMAT, jsonable, read_raw, write_raw
+from gpmsa.io.atomic import atomic_group
+from gpmsa.io.container import STUDY_FORMAT, check_path, jsonable, read_raw, seal, write_sealed
 from gpmsa.mcmc.diagnostics import convergence, summarize
 from gpmsa.model.data import check_count
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
@@ -139,17 +140,35 @@ class Study:
 
     def save(self, path: str | Path) -> Path:
         """Write the study file ``path`` and beside it each model's emulator file
-        ``<stem>.<label>.gpmsa``; returns ``path``. Each file is written atomically (the models'
-        first, the study file last, so a study file never lists a file not yet written)."""
-        path = Path(path)
-        files, hashes = [], []
+        ``<stem>.<label>.gpmsa``; returns ``path``.
+
+        Every record (each model's and the study's) is built and checked as ``load_study``
+        checks it before anything is written: a refused save (GPMSAError) writes nothing. The
+        files are then written whole to temporary files and moved over their paths together
+        (``gpmsa.io.atomic.atomic_group``), so a save that fails leaves an existing study at
+        ``path`` as it was (only an OS failure during the final moves could mix the two).
+        """
+        path = check_path(path)
+        files, hashes, sealed = [], [], []
         for lab, emu in zip(self.labels, self.members, strict=True):
             file = f"{path.stem}.{lab}.gpmsa"
-            member = emu.save(path.with_name(file))
+            manifest, arrays = emu.checked_record(path.with_name(file))
+            head, raw = seal(manifest, arrays)
             files.append(file)
-            hashes.append(read_raw(member)[0]["content_sha256"])
+            hashes.append(head["content_sha256"])
+            sealed.append((path.with_name(file), raw, arrays))
         manifest, arrays = self.to_record(files, hashes)
-        return write_raw(path, manifest, arrays, fmt=STUDY_FORMAT)
+        head, raw = seal(manifest, arrays, fmt=STUDY_FORMAT)
+        try:
+            check_study_manifest(head)
+            check_study_arrays(head, arrays, self.layout)
+        except EmulatorFileError as exc:
+            raise GPMSAError(f"refusing to write {path}, it could not be read back: {exc}") from exc
+        sealed.append((path, raw, arrays))
+        with atomic_group() as stage:
+            for target, raw_manifest, member_arrays in sealed:
+                write_sealed(target, raw_manifest, member_arrays, stage)
+        return path
 
     def __repr__(self) -> str:
         c, n = self.draws["log_post"].shape
@@ -170,7 +189,7 @@ def load_study(path: str | Path) -> Study:
     ...
     gpmsa.errors.EmulatorFileError: ...no-such-study.gpmsa...
     """
-    path = Path(path)
+    path = check_path(path)
     manifest, arrays = read_raw(path, check_study_manifest, formats=(STUDY_FORMAT,))
     study = manifest["study"]
     members = []

@@ -1,11 +1,11 @@
-"""gpmsa.io.atomic.atomic_write: a file is replaced whole or not at all."""
+"""gpmsa.io.atomic: a file (or a group of files) is replaced whole or not at all."""
 
 import os
 
 import pytest
 
 from gpmsa.errors import GPMSAError
-from gpmsa.io.atomic import atomic_write
+from gpmsa.io.atomic import atomic_group, atomic_write
 
 
 class Boom(Exception):
@@ -62,3 +62,24 @@ def test_a_directory_or_a_missing_folder_raises_the_callers_error(tmp_path):
         with atomic_write(tmp_path / "no" / "f"):
             pass
     assert sorted(os.listdir(tmp_path)) == ["d"]
+
+
+def test_a_group_replaces_every_file_at_its_end_or_none(tmp_path):
+    a, b = tmp_path / "a.bin", tmp_path / "b.bin"
+    a.write_bytes(b"old a")
+    b.write_bytes(b"old b")
+    with pytest.raises(Boom), atomic_group() as stage:
+        with stage(a) as fh:
+            fh.write(b"new a")
+        assert a.read_bytes() == b"old a"  # written, not moved yet
+        with stage(b) as fh:
+            fh.write(b"half of new b")
+            raise Boom
+    assert (a.read_bytes(), b.read_bytes()) == (b"old a", b"old b")
+    assert sorted(os.listdir(tmp_path)) == ["a.bin", "b.bin"]
+    with atomic_group() as stage:
+        for path in (a, b):
+            with stage(path) as fh:
+                fh.write(b"new " + path.name.encode())
+    assert (a.read_bytes(), b.read_bytes()) == (b"new a.bin", b"new b.bin")
+    assert sorted(os.listdir(tmp_path)) == ["a.bin", "b.bin"]
