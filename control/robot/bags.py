@@ -148,16 +148,29 @@ def _resolve(path: Path) -> tuple[Path, str]:
     )
 
 
+def recording_path(value, name: str = "path") -> Path:
+    """``value`` (a str or `os.PathLike`, not empty) as a Path; `ControlError` naming the
+    argument ``name`` for anything else (None, a number, ...)."""
+    if not isinstance(value, str | os.PathLike) or not str(value):
+        raise ControlError(
+            f"{name} must be the path (a str or os.PathLike) of a ROS 2 bag folder, a *.mcap "
+            f"file or a ROS 1 *.bag, got {value!r} ({type(value).__name__})"
+        )
+    return Path(value)
+
+
 def read_recording(
     path: str | os.PathLike, imu_topic: str = "/imu/data", odom_topic: str = "/odometry/filtered"
 ) -> Recording:
     """Read the IMU and odometry messages of a recording (see the module docstring for what
     opens), each topic in receive-time order. Raises `BagError` naming the topic when a topic is
     missing, holds another message type or has no messages, and naming the file when it is
-    damaged; `MissingExtraError` when the ``robot`` extra is not installed."""
+    damaged; `ControlError` when ``path`` is not a path; `MissingExtraError` when the ``robot``
+    extra is not installed."""
     tic = time.perf_counter()
+    path = recording_path(path)
     require("rosbags.typesys", "reading a robot recording")
-    target, kind = _resolve(Path(path))
+    target, kind = _resolve(path)
     if kind == "mcap":
         require("mcap.reader", "reading an MCAP file")
     wanted = [imu_topic, odom_topic]
@@ -507,7 +520,9 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
 
     The bag is written in a hidden folder beside ``path`` and moved to ``path`` once closed, so
     an interrupted write (an exception, a killed process) never leaves a bag without its
-    metadata at ``path``; on an exception the hidden folder is removed."""
+    metadata at ``path``; on an exception the hidden folder is removed. Each chunk of an MCAP
+    bag is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves
+    it 0), so that a reader refuses a chunk whose bytes changed."""
     _check_storage(storage)
     rosbag2 = require("rosbags.rosbag2", "writing a ROS 2 bag")
     path = Path(path)
@@ -522,6 +537,8 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
     try:
         with rosbag2.Writer(work / path.name, version=9, storage_plugin=plugin) as writer:
             yield writer
+        for file in (work / path.name).glob("*.mcap"):  # rosbags writes chunks without CRCs
+            storage_mod.write_chunk_crcs(file)
         try:
             os.rename(work / path.name, path)  # the bag's files are named after its folder
         except OSError as exc:  # e.g. path made meanwhile by another writer

@@ -5,19 +5,28 @@
 
 BAG: a ROS 2 bag folder (MCAP or sqlite3), a ``*.mcap`` file or a ROS 1 ``*.bag``. Writes
 ``DIR/estimates.csv``, ``DIR/estimates/`` (a ROS 2 bag with the topic ``/bcr/estimate``) and
-``DIR/replay.json`` (settings, what was found in the recording, timing), and prints a summary.
-Exit status 0 on success, 2 with a one-line message on a usage error, an emulator file that
-cannot be loaded, a recording that cannot be replayed (a missing topic, a damaged file, ...) or a
-missing extra (the message says which extra to install).
+``DIR/replay.json`` (settings, what was found in the recording, timing; strict JSON: a number
+that is not finite, such as the rate of a topic with one message, is ``null``), and prints a
+summary. DIR is made only once the replay has run, and removed again (with the parents this
+made) if writing into it fails; a folder that was there before is never removed.
+Exit status 0 on success, also for a recording too short for one estimate (the summary then
+says "no estimate" and why); 2 with a one-line message on a usage error (``--out`` a file, a
+setting out of range), an emulator file that is missing or cannot be loaded, a recording that
+cannot be replayed (a missing topic, a damaged file, ...) or a missing extra (the message says
+which extra to install).
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
+import shutil
 import sys
 from dataclasses import asdict
 from pathlib import Path
+
+import numpy as np
 
 from control.compat import check_emulator
 from control.errors import ControlError, MissingExtraError
@@ -25,8 +34,11 @@ from control.estimate import edge_counts
 from control.robot.replay import (
     GRAVITY,
     POSITIONS,
+    SHIPPED,
     TIME_BASES,
+    ReplayResult,
     ReplaySettings,
+    load_emulator,
     replay_bag,
 )
 from control.simplex import Simplex
@@ -35,27 +47,73 @@ from gpmsa.io.atomic import atomic_write
 DEFAULTS = ReplaySettings()
 
 
-def _emulator(text: str):
-    """A shipped emulator for "A" or "B", else the file at ``text``; `ControlError` naming
-    ``--emulator`` for a file gpmsa cannot load."""
-    import control
-
-    if text in ("A", "B"):
-        return control.shipped_emulator(text), f"shipped emulator {text}"
-    path = Path(text)
-    if not path.is_file():
-        raise ControlError(f"--emulator {text!r}: no such file (or give A or B: the shipped ones)")
-    import gpmsa
-
-    try:
-        return gpmsa.load(path), str(path)
-    except gpmsa.GPMSAError as exc:  # a damaged, foreign or too large emulator file
-        raise ControlError(f"--emulator {text!r}: {exc}") from exc
-
-
 def _one_line(exc: Exception) -> str:
     """The message of ``exc`` on one line (a library's message may hold line breaks)."""
     return " ".join(str(exc).split())
+
+
+def _strict_json(value):
+    """``value`` (dicts, lists, tuples, numbers, strings) with numpy scalars as Python's and
+    floats that are not finite (NaN, inf) as None, for ``json.dumps(allow_nan=False)``."""
+    if isinstance(value, dict):
+        return {str(k): _strict_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_strict_json(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def _check_out(out: Path) -> None:
+    """`ControlError` where ``out``, or its nearest existing parent, is not a folder, or where
+    ``out`` holds ``estimates`` already (checked before the replay runs)."""
+    there = next((p for p in (out, *out.parents) if p.exists()), None)
+    if there == out and not out.is_dir():
+        raise ControlError(f"--out {str(out)!r} exists and is not a folder")
+    if there is not None and not there.is_dir():
+        raise ControlError(f"--out {str(out)!r}: {str(there)!r} exists and is not a folder")
+    if (out / "estimates").exists():
+        raise ControlError(f"{out / 'estimates'} exists already: choose another --out")
+
+
+def _report(bag: Path, source: str, settings: ReplaySettings, result: ReplayResult) -> dict:
+    """The content of ``replay.json``."""
+    return {
+        "bag": str(bag),
+        "emulator": source,
+        "settings": asdict(settings),
+        "imu": asdict(result.imu),
+        "odometry": asdict(result.odometry),
+        "resampling": asdict(result.resampling),
+        "notes": list(result.notes),
+        "status_counts": result.status_counts(),
+        "domain_edge_counts": edge_counts(result.domain_edge),
+        "timing_s": {"read": result.read_s, "resample": result.condition_s, "bcr": result.bcr_s},
+        "duration_s": result.duration_s,
+        "real_time_factor": result.real_time_factor,
+    }
+
+
+def _write(out: Path, result: ReplayResult, report: dict) -> None:
+    """Write the estimates (CSV, ROS 2 bag) and the report (strict JSON) into ``out``, made
+    here where it is missing; on a failure the folders made here are removed again."""
+    missing = [p for p in (out, *out.parents) if not p.exists()]  # the last made first
+    try:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ControlError(f"--out {str(out)!r}: cannot make it ({exc.strerror})") from exc
+        result.to_csv(out / "estimates.csv")
+        result.write_bag(out / "estimates")
+        text = json.dumps(_strict_json(report), indent=2, allow_nan=False)
+        with atomic_write(out / "replay.json", text=True, error=ControlError) as fh:
+            fh.write(text)
+    except BaseException:
+        if missing:
+            shutil.rmtree(missing[-1], ignore_errors=True)
+        raise
 
 
 def parser() -> argparse.ArgumentParser:
@@ -91,7 +149,8 @@ def parser() -> argparse.ArgumentParser:
     )  # fmt: skip
     p.add_argument(
         "--gravity", default=DEFAULTS.gravity, choices=list(GRAVITY),
-        help="keep (each block is demeaned) or highpass (0.5 Hz, zero-phase) the acceleration",
+        help="keep (each block is demeaned) or highpass (0.5 Hz, zero-phase) the acceleration; "
+        "highpass an IMU that reads gravity with an emulator trained without noise (A)",
     )  # fmt: skip
     p.add_argument(
         "--resample", default=DEFAULTS.resample, choices=["sample", "lowpass"],
@@ -132,39 +191,16 @@ def main(argv: list[str] | None = None) -> int:
             storage=args.storage,
         )
         simplex = Simplex(v_max=args.v_max, v_safe=args.v_safe)
-        if (out / "estimates").exists():
-            raise ControlError(f"{out / 'estimates'} exists already: choose another --out")
-        emulator, source = _emulator(args.emulator)
-        check_emulator(emulator, simplex=simplex)  # before the output folder is made
-        out.mkdir(parents=True, exist_ok=True)
-        result = replay_bag(
-            bag, emulator, settings, simplex=simplex, csv=out / "estimates.csv",
-            out_bag=out / "estimates", progress=args.progress,
-        )  # fmt: skip
+        _check_out(out)
+        emulator = load_emulator(args.emulator, "--emulator")
+        check_emulator(emulator, simplex=simplex)
+        result = replay_bag(bag, emulator, settings, simplex=simplex, progress=args.progress)
+        source = f"shipped emulator {args.emulator}" if args.emulator in SHIPPED else args.emulator
+        _write(out, result, _report(bag, source, settings, result))
     except MissingExtraError as exc:
         print(f"terrain-replay: {_one_line(exc)}", file=sys.stderr)
         return 2
-    except (ControlError, OSError) as exc:
-        print(f"terrain-replay: error: {_one_line(exc)}", file=sys.stderr)
-        return 2
-    report = {
-        "bag": str(bag),
-        "emulator": source,
-        "settings": asdict(settings),
-        "imu": asdict(result.imu),
-        "odometry": asdict(result.odometry),
-        "resampling": asdict(result.resampling),
-        "notes": list(result.notes),
-        "status_counts": result.status_counts(),
-        "domain_edge_counts": edge_counts(result.domain_edge),
-        "timing_s": {"read": result.read_s, "resample": result.condition_s, "bcr": result.bcr_s},
-        "duration_s": result.duration_s,
-        "real_time_factor": result.real_time_factor,
-    }
-    try:
-        with atomic_write(out / "replay.json", text=True, error=ControlError) as fh:
-            fh.write(json.dumps(report, indent=2, default=float))
-    except (ControlError, OSError) as exc:  # e.g. a full disk
+    except (ControlError, OSError) as exc:  # OSError: e.g. a full disk
         print(f"terrain-replay: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     print(result.describe())

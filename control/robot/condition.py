@@ -49,7 +49,8 @@ class StreamReport:
         topic: the topic.
         time_base: "header" (the messages' header stamps) or "log" (the receive times).
         messages: number of messages.
-        rate_hz: nominal rate (1 / the median positive step), Hz.
+        rate_hz: nominal rate (1 / the median positive step), Hz; NaN for fewer than two
+            distinct stamps (``null`` in ``replay.json``).
         repeated: stamps equal to the one before.
         backwards: stamps before an earlier one.
         gaps: steps between successive distinct stamps (in time order) longer than 1.5
@@ -87,9 +88,9 @@ class StreamReport:
             )
             if n
         ]
-        text = (
-            f"{self.topic}: {self.messages} messages at {self.rate_hz:.4g} Hz "
-            f"({self.time_base} stamps); " + (", ".join(faults) or "no stamp faults")
+        rate = f"at {self.rate_hz:.4g} Hz" if np.isfinite(self.rate_hz) else "without a rate"
+        text = f"{self.topic}: {self.messages} messages {rate} ({self.time_base} stamps); " + (
+            ", ".join(faults) or "no stamp faults"
         )
         return text + (f"; {self.note}" if self.note else "")
 

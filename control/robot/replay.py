@@ -7,7 +7,10 @@ The pipeline (`replay_bag`):
    (header stamps, or receive times); its stamps checked (`condition.check_stream`); brought to
    the emulator's rate (`condition.to_rate`: as recorded when the rates agree, else resampled);
    optionally high-passed (``gravity="highpass"``; by default gravity's static part is kept: the
-   BCR removes each block's mean before its feature, so a constant offset changes nothing);
+   BCR removes each block's mean before its feature, so a constant offset leaves the estimate
+   alone, but without a noise sd its sensor checks exempt flights only near -9.81 m/s^2, where
+   a gravity-free signal puts them: a noise-free signal with +9.81 in it has its flights
+   flagged as dead or quantised, docs/robot.md);
 3. the odometry's position along the path (``position="path"``: the length of the pose
    trajectory from the odometry frame's origin, `condition.path_length`; ``"speed"``: the
    integral of the speed) and speed (the planar norm of ``twist.twist.linear``), interpolated
@@ -29,25 +32,36 @@ from __future__ import annotations
 import csv
 import os
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
 from tqdm.auto import tqdm
 
+import gpmsa
 from control.bcr import BCR, BCRSettings
 from control.compat import bcr_settings_for, check_emulator, check_likelihood
 from control.errors import BagError, ControlError
 from control.estimate import Estimate, edge_counts
 from control.robot import condition
 from control.robot import messages as msgs
-from control.robot.bags import STORAGES, Recording, merge_in_time, open_bag_writer, read_recording
+from control.robot.bags import (
+    STORAGES,
+    Recording,
+    merge_in_time,
+    open_bag_writer,
+    read_recording,
+    recording_path,
+)
+from control.shipped import shipped_emulator
 from control.simplex import Simplex
+from control.validation import require_instance, require_reals
 from gpmsa.io.atomic import atomic_write
 
 TIME_BASES = ("header", "log")
 POSITIONS = ("path", "speed")
 GRAVITY = ("keep", "highpass")
+SHIPPED = ("A", "B")
 CSV_COLUMNS = (
     "stamp_ns", "time_s", "position_m", "speed_mps", "status", "reason", "domain_edge",
     "gd_mean", "gd_sd", "gd_lo", "gd_hi", "prob_gd_above_max", "prob_change", "command_mps",
@@ -64,13 +78,14 @@ class ReplaySettings:
         odom_topic: topic of ``nav_msgs/msg/Odometry`` messages.
         imu_axis: "x", "y" or "z": the IMU axis that points up (along the front axle's
             vertical) when the robot stands level.
-        imu_sign: +1 or -1: -1 when that axis points down.
+        imu_sign: +1 or -1 (an int or a float; not a bool): -1 when that axis points down.
         time_base: "header" (the messages' header stamps; the receive times when every header
             stamp is zero) or "log" (the receive times the recorder wrote).
         position: "path" (length of the odometry's pose trajectory) or "speed" (integral of
             the odometry's speed).
         gravity: "keep" (the BCR demeans each block) or "highpass" (a zero-phase 2nd-order
-            Butterworth high-pass at ``highpass_hz`` first).
+            Butterworth high-pass at ``highpass_hz`` first: for a signal with gravity in it and
+            an emulator without noise, whose sensor checks expect flights at -9.81 m/s^2).
         highpass_hz: cut-off of the high-pass, Hz.
         rate_tolerance: an IMU whose nominal rate is within this relative difference of the
             emulator's is used as recorded; a faster one is resampled.
@@ -99,6 +114,9 @@ class ReplaySettings:
     storage: str = "mcap"
 
     def __post_init__(self) -> None:
+        for name in ("imu_topic", "odom_topic", "estimate_topic", "imu_axis"):
+            require_instance(self, name, str)
+        require_reals(self, ("imu_sign", "highpass_hz", "rate_tolerance", "max_odometry_gap_s"))
         if self.imu_axis not in ("x", "y", "z"):
             raise ControlError(f"imu_axis must be 'x', 'y' or 'z', got {self.imu_axis!r}")
         if self.imu_sign not in (1, -1):
@@ -116,7 +134,7 @@ class ReplaySettings:
         if not (np.isfinite(self.max_odometry_gap_s) and self.max_odometry_gap_s > 0):
             raise ControlError(f"max_odometry_gap_s must be > 0, got {self.max_odometry_gap_s}")
         for name in ("imu_topic", "odom_topic", "estimate_topic"):
-            if not str(getattr(self, name)).startswith("/"):
+            if not getattr(self, name).startswith("/"):
                 raise ControlError(f"{name} must start with '/', got {getattr(self, name)!r}")
 
 
@@ -230,16 +248,27 @@ class ReplayResult:
                 writer.write(c, stamp, data)
         return Path(path)
 
+    def _count_line(self) -> str:
+        """How many estimates of each status, or why there is none."""
+        if self.status.size:
+            counts = ", ".join(f"{k} {v}" for k, v in sorted(self.status_counts().items()))
+            return f"{self.status.size} estimates over {self.duration_s:.1f} s: {counts}"
+        every = self.bcr.samples_per_update
+        return (
+            f"no estimate: only {self.sample_time.size} IMU sample(s) lie within the "
+            f"odometry's time span ({self.duration_s:.2f} s), fewer than the {every} of one BCR "
+            f"update ({every / self.bcr.rate_hz:.2f} s)"
+        )
+
     def describe(self) -> str:
         """A few lines for a person: the topics, the resampling, the statuses, the timing."""
-        counts = ", ".join(f"{k} {v}" for k, v in sorted(self.status_counts().items()))
         ok = self.status == "ok"
         lines = [
             self.imu.describe(),
             self.odometry.describe(),
             f"resampling: {self.resampling.filter}",
             *self.notes,
-            f"{self.status.size} estimates over {self.duration_s:.1f} s: {counts}",
+            self._count_line(),
         ]
         if ok.any():
             lines.append(
@@ -290,12 +319,54 @@ def estimate_message(store, row: dict, interval_level: float, gd_max: float) -> 
     return bytes(store.serialize_cdr(msg, msgs.GD_ESTIMATE_TYPE))
 
 
-def _load_emulator(emulator):
-    if isinstance(emulator, str | os.PathLike):
-        import gpmsa
+def load_emulator(
+    emulator: gpmsa.Emulator | str | os.PathLike, name: str = "emulator"
+) -> gpmsa.Emulator:
+    """The `gpmsa.Emulator` that ``emulator`` names: an Emulator as it is; "A" or "B": the
+    shipped Jackal one (`control.shipped_emulator`; a file named A or B needs a path such as
+    ./A); a str or path: the ``*.gpmsa`` file there (`gpmsa.load`). `ControlError` naming
+    ``name`` for anything else, a path that is missing or no regular file, or a file gpmsa
+    cannot load (chaining gpmsa's `EmulatorFileError`)."""
+    if isinstance(emulator, gpmsa.Emulator):
+        return emulator
+    if isinstance(emulator, str) and emulator in SHIPPED:
+        return shipped_emulator(emulator)
+    if not isinstance(emulator, str | os.PathLike) or not str(emulator):
+        raise ControlError(
+            f"{name} must be a gpmsa.Emulator, the path of an emulator file (*.gpmsa) or 'A' / "
+            f"'B' (the shipped ones), got {emulator!r} ({type(emulator).__name__})"
+        )
+    path = Path(emulator)
+    if not path.exists():
+        raise ControlError(f"{name} {str(path)!r}: no such file (or give A or B: the shipped ones)")
+    if not path.is_file():
+        kind = "a folder" if path.is_dir() else "not a regular file"
+        raise ControlError(
+            f"{name} {str(path)!r} is {kind}, not an emulator file (*.gpmsa; or give A or B: "
+            "the shipped ones)"
+        )
+    try:
+        return gpmsa.load(path)
+    except gpmsa.GPMSAError as exc:  # a damaged, foreign or too large emulator file
+        raise ControlError(f"{name} {str(path)!r}: {exc}") from exc
+    except OSError as exc:
+        raise ControlError(f"{name} {str(path)!r}: cannot read it ({exc.strerror})") from exc
 
-        return gpmsa.load(emulator)
-    return emulator
+
+def _settings(settings: ReplaySettings | None, overrides: dict) -> ReplaySettings:
+    """``settings`` (default `ReplaySettings()`) with ``overrides`` replacing its fields;
+    `ControlError` for settings of another type or an override that is no field."""
+    s = ReplaySettings() if settings is None else settings
+    if not isinstance(s, ReplaySettings):
+        raise ControlError(f"settings must be a ReplaySettings, got {type(s).__name__}")
+    names = [f.name for f in fields(ReplaySettings)]
+    unknown = [name for name in overrides if name not in names]
+    if unknown:
+        raise ControlError(
+            f"{', '.join(map(repr, unknown))}: no ReplaySettings field (its fields: "
+            f"{', '.join(names)})"
+        )
+    return replace(s, **overrides)
 
 
 def _times(topic_msgs, time_base: str) -> tuple[np.ndarray, str, str]:
@@ -325,8 +396,10 @@ def replay_bag(
     Args:
         bag: a ROS 2 bag folder (MCAP or sqlite3 storage), a ``*.mcap`` file, or a ROS 1
             ``*.bag`` (see `control.robot.bags`).
-        emulator: a `gpmsa.Emulator` or the path of a ``*.gpmsa`` file, trained for this
-            vehicle, sensor and rate (`control.shipped_emulator`, examples/train_emulator.py).
+        emulator: a `gpmsa.Emulator`, the path of a ``*.gpmsa`` file, or "A" / "B" for the
+            shipped Jackal ones (as ``terrain-replay --emulator``; `load_emulator`), trained
+            for this vehicle, sensor and rate (`control.shipped_emulator`,
+            examples/train_emulator.py).
         settings: `ReplaySettings` (topics, IMU axis and sign, time base, ...); ``overrides``
             replace its fields (e.g. ``imu_topic="/imu"``).
         bcr: BCR settings (default: `control.bcr_settings_for(emulator)`).
@@ -341,13 +414,16 @@ def replay_bag(
 
     Returns:
         `ReplayResult`. Raises `BagError` (a topic missing, mistyped or empty; an IMU slower
-        than the emulator's rate; a damaged file), `ControlError` (a setting that does not
-        fit the emulator, a likelihood prepared for another one, a Simplex outside its speeds;
-        before the recording is read)
-        and `MissingExtraError` (the ``robot`` extra not installed).
+        than the emulator's rate; a damaged file), `ControlError` (``bag`` not a path; an
+        override that is no `ReplaySettings` field; ``emulator`` none of the forms above, a
+        missing file or one gpmsa cannot load, its `gpmsa.EmulatorFileError` chained; a
+        setting that does not fit the emulator, a likelihood prepared for another one, a
+        Simplex outside its speeds; all before the recording is read) and
+        `MissingExtraError` (the ``robot`` extra not installed).
     """
-    s = replace(settings or ReplaySettings(), **overrides)
-    emulator = _load_emulator(emulator)
+    bag = recording_path(bag, "bag")
+    s = _settings(settings, overrides)
+    emulator = load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex
     _check_fit(s, bcr, emulator, likelihood, simplex)
@@ -373,8 +449,8 @@ def replay_recording(
     progress: bool = False,
 ) -> ReplayResult:
     """`replay_bag` on a recording already read (`control.robot.bags.read_recording`)."""
-    s = settings or ReplaySettings()
-    emulator = _load_emulator(emulator)
+    s = _settings(settings, {})
+    emulator = load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex
     _check_fit(s, bcr, emulator, likelihood, simplex)
@@ -437,9 +513,7 @@ def replay_recording(
     )
 
 
-def _check_fit(
-    s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simplex: Simplex
-) -> None:
+def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simplex: Simplex) -> None:
     """`ControlError` for settings that do not fit the BCR's rate (a high-pass cut-off at or
     above its Nyquist frequency), `EmulatorMismatchError` for a likelihood prepared for
     another emulator or a Simplex whose speeds lie outside the emulator's speed domain."""

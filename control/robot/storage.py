@@ -8,7 +8,8 @@ records walked with `struct` (~1 us a message); a sqlite3 file is one query per 
 index or statistics; messages outside chunks): the caller then reads with rosbags or the mcap
 package. A file whose bytes contradict its own structure (a truncated or corrupted chunk, a CRC
 that does not match, a chunk compression MCAP does not define, a truncated or damaged sqlite3
-database) raises `BagError` naming the file and what is wrong.
+database) raises `BagError` naming the file and what is wrong. `write_chunk_crcs` gives the
+chunks of an MCAP file written without CRCs (rosbags' writer) theirs.
 """
 
 from __future__ import annotations
@@ -28,7 +29,8 @@ _RECORD = struct.Struct("<BQ")  # opcode, length
 _MESSAGE = struct.Struct("<HIQ")  # channel id, sequence, log time (publish time follows)
 _MESSAGE_DATA = 9 + 2 + 4 + 8 + 8  # offset of a Message record's data from the record's start
 _CHUNK = struct.Struct("<QQQI")  # start and end time, uncompressed size, crc
-OP_MESSAGE, OP_CHUNK = 0x05, 0x06
+OP_MESSAGE, OP_CHUNK, OP_DATA_END = 0x05, 0x06, 0x0F
+MAGIC = b"\x89MCAP0\r\n"
 _PIECE = 1 << 22  # bytes decompressed at a time (the chunk's declared size bounds the total)
 
 
@@ -214,6 +216,32 @@ def _mcap_file(f, out: RawTopics) -> bool:
         if counts.get(cid, found) != found:  # messages outside chunks
             return False
     return True
+
+
+def write_chunk_crcs(path: Path) -> None:
+    """Write into each chunk of an MCAP file whose CRC field is 0 ("not computed"; rosbags'
+    writer leaves it so) the CRC32 of its (decompressed) records, in place, so that this module,
+    rosbags and the mcap package (``validate_crcs``) refuse a chunk whose bytes changed.
+    `BagError` for a file that is not an MCAP file or whose chunks are damaged."""
+    with open(path, "r+b") as f:
+        if f.read(len(MAGIC)) != MAGIC:
+            raise BagError(f"{path} is not an MCAP file (no magic bytes)")
+        pos = len(MAGIC)
+        while len(head := f.read(_RECORD.size)) == _RECORD.size:
+            op, length = _RECORD.unpack(head)
+            if op == OP_DATA_END:
+                break
+            if op == OP_CHUNK:
+                raw = head + f.read(length)
+                try:
+                    records = _chunk_records(raw)
+                except (_Damaged, struct.error) as exc:
+                    raise BagError(f"{path} is damaged: the chunk at byte {pos}: {exc}") from exc
+                if _CHUNK.unpack_from(raw, 9)[3] == 0:
+                    f.seek(pos + 9 + _CHUNK.size - 4)
+                    f.write(struct.pack("<I", zlib.crc32(records)))
+            pos += 9 + length
+            f.seek(pos)
 
 
 def sqlite_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics:

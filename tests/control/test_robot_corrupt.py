@@ -155,21 +155,33 @@ def test_a_flipped_byte_in_a_chunk_is_a_bag_error_naming_the_chunk(
                 read_recording(target)
 
 
-def test_damage_to_bytes_the_replay_does_not_read_leaves_the_result(recordings, tmp_path):
-    # rosbags writes no CRC: a flipped byte of the first IMU message's orientation goes
-    # unnoticed and unused; one of its length prefix (the record's structure) is an error
+def test_a_written_bags_chunks_carry_crcs_that_refuse_any_changed_byte(recordings, tmp_path):
+    # rosbags' writer leaves each chunk's CRC 0 ("not computed"), and a flipped byte of a
+    # message's orientation (unused) or receive time went unnoticed; `open_bag_writer` writes
+    # the CRCs, which this package's reader, rosbags' and the mcap package's then check
+    from mcap.reader import make_reader
+    from mcap.stream_reader import CRCValidationError
+    from rosbags.highlevel import AnyReader
+    from rosbags.rosbag2 import ReaderError
+
     target, file = _copy(recordings, "rosbag2-mcap", tmp_path)
     data = file.read_bytes()
+    starts = [start for start, _ in _chunks(file)]
+    assert starts and all(int.from_bytes(data[s + 33 : s + 37], "little") for s in starts)
     t, accel, *_ = _signals()
     first = msgs.encode_imu(int(round(t[0] * 1e9)), [0.0, 0.0, accel[0]])
     at = data.find(first)
     assert at > 0 and data.find(first, at + 1) < 0
     orientation = at + len(first) - 8 * (4 + 9 + 3 + 9 + 3 + 9)
-    _write_flipped(file, data, orientation + 3, 0x40)
-    assert _same(read_recording(target), read_recording(recordings["rosbag2-mcap"][0]))
-    # the length of the Message record holding it (at its byte 1)
-    _write_flipped(file, data, at - 30, 0x40)
-    assert "is damaged" in str(_bag_error(target))
+    log_time = at - 16  # the Message record's log time precedes its publish time and data
+    for where in (orientation + 3, log_time):
+        _write_flipped(file, data, where, 0x40)
+        with pytest.raises(BagError, match=f"{file} is damaged: .* do not match their CRC"):
+            read_recording(target)
+        with open(file, "rb") as f, pytest.raises(CRCValidationError):
+            list(make_reader(f, validate_crcs=True).iter_messages())
+        with pytest.raises(ReaderError, match="checksum"), AnyReader([target]) as reader:
+            list(reader.messages())
 
 
 def test_a_chunk_whose_size_disagrees_with_its_zstd_frame_is_refused(recordings, tmp_path):
@@ -250,7 +262,7 @@ def test_flipping_bytes_all_over_a_recording_never_crashes(kind, recordings, tmp
     for at in range(int(rng.integers(step)), len(data), step):
         _write_flipped(file, data, at, int(rng.integers(1, 256)))
         errors += _bag_error(target) is not None
-    assert errors >= 10  # the rest: flipped values (rosbags writes no CRC) or unread bytes
+    assert errors >= 10  # the rest: unread bytes (and, without CRCs, flipped values)
 
 
 def test_the_command_reports_a_damaged_bag_in_one_line(recordings, tmp_path, capsys):

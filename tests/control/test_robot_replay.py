@@ -297,6 +297,57 @@ def test_the_imu_axis_and_sign_are_options(loop_run, emulator_a, likelihood_a, t
     _assert_replay_is_the_loop(r, result)
 
 
+def _replay_with(tmp_path, result, accel, speed, emulator, likelihood, **kw):
+    """The replay of the run's samples with ``accel`` and ``speed`` in place of its own (the
+    position integrated from ``speed``: the odometry agrees with itself)."""
+    t = result.sample_time
+    position = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))])
+    bag = write_sensor_bag(tmp_path / f"bag{len(list(tmp_path.iterdir()))}", t, accel, t,
+                           position, speed)  # fmt: skip
+    return replay_bag(bag, emulator, likelihood=likelihood, **kw)
+
+
+def test_gravity_left_in_a_noise_free_signal_flags_its_flights_unless_high_passed(
+    loop_run, emulator_a, likelihood_a, tmp_path
+):
+    # docs/robot.md: without a noise sd (emulator A) the dead-sensor and lattice checks exempt
+    # only readings near -9.81 m/s^2 (a wheel in the air); +9.81 of gravity moves a flight to
+    # 0, a flipped sign to +9.81. The high-pass removes the offset, not the flip.
+    result, _ = loop_run
+    a, v = result.sample_accel, result.sample_speed
+    assert np.sum(np.abs(a + 9.81) < 0.01) > 100  # the run has wheels in the air
+
+    def replay(accel, gravity):
+        return _replay_with(tmp_path, result, accel, v, emulator_a, likelihood_a, gravity=gravity)
+
+    clean = replay(a, "keep").status
+    assert "sensor_fault" not in clean
+    for accel, gravity in ((a + 9.81, "keep"), (-a, "keep"), (-a, "highpass")):
+        r = replay(accel, gravity)
+        faults = r.status == "sensor_fault"
+        assert faults.sum() >= 20 and "dead sensor" in " ".join(r.reason[faults]), gravity
+    assert replay(a + 9.81, "highpass").status.tolist() == clean.tolist()
+
+
+def test_a_speed_outside_the_domain_carries_the_estimate_once_there_is_one(
+    loop_run, emulator_a, likelihood_a, tmp_path
+):
+    # docs/robot.md, docs/closed-loop.md: `out_of_domain` only before the first estimate
+    result, _ = loop_run
+    t = result.sample_time
+    for slow, status, reason in (
+        (slice(2000, 2400), "ok", "no new information: speed 0.3 m/s outside"),
+        (slice(0, 2400), "out_of_domain", "speed 0.3 m/s outside"),
+    ):
+        speed = result.sample_speed.copy()
+        speed[slow] = 0.3
+        r = _replay_with(tmp_path, result, result.sample_accel, speed, emulator_a, likelihood_a)
+        inside = (r.time >= t[slow.start + 125]) & (r.time <= t[slow.stop - 1])
+        assert inside.sum() >= 5
+        assert set(r.status[inside]) == {status}
+        assert all(why.startswith(reason) for why in r.reason[inside])
+
+
 def test_the_command_writes_csv_bag_and_report(loop_run, tmp_path, capsys):
     result, path = loop_run
     out = tmp_path / "out"
@@ -425,8 +476,9 @@ def test_a_ros1_bag_replays_to_the_last_bit(loop_run, emulator_a, likelihood_a, 
     _assert_replay_is_the_loop(replay_bag(bag, emulator_a, likelihood=likelihood_a), result)
 
 
-def test_a_recording_that_fails_midway_leaves_the_earlier_file_whole(loop_run, tmp_path,
-                                                                     monkeypatch):
+def test_a_recording_that_fails_midway_leaves_the_earlier_file_whole(
+    loop_run, tmp_path, monkeypatch
+):
     from control.robot import record
 
     result, path = loop_run

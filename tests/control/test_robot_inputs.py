@@ -1,0 +1,202 @@
+"""What the replay and ``terrain-replay`` take: wrong arguments and settings are a ControlError
+naming them, a failed run leaves no output folder, and the report is strict JSON."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+import gpmsa
+
+pytest.importorskip("rosbags")
+pytest.importorskip("mcap")
+
+from control.errors import ControlError  # noqa: E402
+from control.robot import (  # noqa: E402
+    ReplayResult,
+    ReplaySettings,
+    cli,
+    replay_bag,
+    write_sensor_bag,
+)
+
+
+def _drive(n: int = 400):
+    """(IMU time s, accel, odometry time s, position, speed) of n samples at 120 Hz, 1 m/s."""
+    t = 1.0 + np.arange(n) / 120.0
+    accel = np.random.default_rng(1).normal(size=n)
+    return t, accel, t, t - 1.0, np.ones(n)
+
+
+@pytest.fixture(scope="module")
+def bag(tmp_path_factory):
+    """A short, healthy ROS 2 bag."""
+    return write_sensor_bag(tmp_path_factory.mktemp("bags") / "drive", *_drive())
+
+
+def _run(capsys, *argv) -> tuple[int, str, str]:
+    """(exit status, stdout, stderr) of ``terrain-replay argv``."""
+    code = cli.main([str(a) for a in argv])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def _no_nan(name: str):
+    raise AssertionError(f"{name} in strict JSON")
+
+
+# --- the report is strict JSON; a recording too short for an estimate says so ---------------------
+
+
+def test_a_bag_too_short_for_an_estimate_gives_strict_json_and_says_why(tmp_path, capsys):
+    t, accel, _, _, _ = _drive()
+    one = slice(5, 6)  # one odometry message: its topic has no rate
+    short = write_sensor_bag(tmp_path / "one_odom", t, accel, t[one], t[one] - 1.0, [1.0])
+    out = tmp_path / "out"
+    code, printed, _ = _run(capsys, short, "--emulator", "A", "--out", out)
+    assert code == 0  # the docs: a recording too short for an estimate is no error
+    assert "no estimate: only 1 IMU sample(s) lie within the odometry's time span" in printed
+    assert "fewer than the 42 of one BCR update" in printed
+    assert "without a rate" in printed
+    text = (out / "replay.json").read_text()
+    report = json.loads(text, parse_constant=_no_nan)  # NaN, Infinity: not JSON
+    assert report["odometry"]["rate_hz"] is None and report["status_counts"] == {}
+    assert report["imu"]["rate_hz"] == pytest.approx(120.0)
+
+
+def test_the_report_of_a_healthy_bag_is_strict_json_with_numbers(bag, tmp_path, capsys):
+    out = tmp_path / "out"
+    code, printed, _ = _run(capsys, bag, "--emulator", "A", "--out", out)
+    assert code == 0 and "estimates over" in printed
+    report = json.loads((out / "replay.json").read_text(), parse_constant=_no_nan)
+    assert report["odometry"]["rate_hz"] == pytest.approx(120.0)
+    assert sum(report["status_counts"].values()) == 400 // 42
+
+
+# --- no output folder is left by a failed run -----------------------------------------------------
+
+
+def test_a_failed_replay_leaves_no_output_folder(bag, tmp_path, capsys):
+    (tmp_path / "notabag.mcap").write_text("hello")
+    for case, argv in (
+        ("missing", [tmp_path / "none"]),
+        ("not a bag", [tmp_path / "notabag.mcap"]),
+        ("no topic", [bag, "--imu-topic", "/imu/raw"]),
+    ):
+        out = tmp_path / "made" / "out"
+        code, _, err = _run(capsys, *argv, "--emulator", "A", "--out", out)
+        assert code == 2 and err.startswith("terrain-replay: error: "), case
+        assert not (tmp_path / "made").exists(), case
+    mine = tmp_path / "mine"  # a folder the user had stays, with what it held
+    mine.mkdir()
+    (mine / "notes.txt").write_text("kept")
+    code, _, _ = _run(capsys, tmp_path / "none", "--emulator", "A", "--out", mine)
+    assert code == 2 and [p.name for p in mine.iterdir()] == ["notes.txt"]
+
+
+def test_a_failed_write_removes_the_folder_it_made_only(bag, tmp_path, capsys, monkeypatch):
+    def full_disk(self, path, storage=None):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(ReplayResult, "write_bag", full_disk)
+    out = tmp_path / "made" / "out"
+    code, _, err = _run(capsys, bag, "--emulator", "A", "--out", out)
+    assert code == 2 and "No space left on device" in err
+    assert list(tmp_path.iterdir()) == []
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    code, _, _ = _run(capsys, bag, "--emulator", "A", "--out", mine)
+    assert code == 2 and mine.is_dir()
+
+
+# --- messages about --out and --emulator ----------------------------------------------------------
+
+
+def test_an_out_path_that_is_a_file_is_named_as_such(bag, tmp_path, capsys):
+    file = tmp_path / "file.txt"
+    file.write_text("")
+    for out, there in ((os.devnull, os.devnull), (file, file), (file / "sub", file)):
+        code, _, err = _run(capsys, bag, "--emulator", "A", "--out", out)
+        assert code == 2 and "exists and is not a folder" in err, err
+        assert repr(str(there)) in err and "Errno" not in err
+
+
+def test_an_emulator_path_that_is_no_file_is_named_as_such(bag, tmp_path, capsys):
+    for emulator, what in (
+        (os.devnull, "is not a regular file, not an emulator file"),
+        (tmp_path, "is a folder, not an emulator file"),
+        (tmp_path / "none.gpmsa", "no such file"),
+    ):
+        code, _, err = _run(capsys, bag, "--emulator", emulator, "--out", tmp_path / "o")
+        assert code == 2 and f"--emulator {str(emulator)!r}" in err and what in err, err
+        assert not (tmp_path / "o").exists()
+
+
+# --- settings name the field that is wrong --------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "field, value, message",
+    [
+        ("highpass_hz", "1", r"highpass_hz must be a real number, got '1' \(str\)"),
+        ("max_odometry_gap_s", "1", "max_odometry_gap_s must be a real number"),
+        ("rate_tolerance", "0.1", "rate_tolerance must be a real number"),
+        ("rate_tolerance", None, "rate_tolerance must be a real number"),
+        ("imu_sign", True, r"imu_sign must be a real number, got True \(bool\)"),
+        ("imu_sign", "1", "imu_sign must be a real number"),
+        ("imu_sign", 0.5, r"imu_sign must be \+1 or -1, got 0.5"),
+        ("imu_topic", 3, r"imu_topic must be a .*str, got 3 \(int\)"),
+        ("imu_axis", None, r"imu_axis must be a .*str, got None"),
+    ],
+)
+def test_replay_settings_refuse_a_value_of_the_wrong_type_naming_the_field(field, value, message):
+    with pytest.raises(ControlError, match=message):
+        ReplaySettings(**{field: value})
+
+
+def test_replay_bag_names_an_override_that_is_no_setting(bag, emulator_a):
+    with pytest.raises(ControlError, match="'imu_rate': no ReplaySettings field .* imu_topic"):
+        replay_bag(bag, emulator_a, imu_rate=200)
+    with pytest.raises(ControlError, match="settings must be a ReplaySettings, got dict"):
+        replay_bag(bag, emulator_a, {"imu_topic": "/imu"})
+
+
+def test_replay_settings_take_either_sign_as_int_or_float():
+    assert [ReplaySettings(imu_sign=s).imu_sign for s in (1, -1, 1.0, -1.0)] == [1, -1, 1, -1]
+
+
+# --- the bag and emulator arguments of replay_bag -------------------------------------------------
+
+
+@pytest.mark.parametrize("value", [None, 3, "", b"drive"])
+def test_replay_bag_refuses_a_bag_that_is_not_a_path(value, emulator_a):
+    with pytest.raises(ControlError, match=r"bag must be the path \(a str or os.PathLike\)"):
+        replay_bag(value, emulator_a)
+
+
+@pytest.mark.parametrize("value", [None, 3, ["A"], "C"])
+def test_replay_bag_refuses_an_emulator_of_another_kind(value, bag):
+    match = "no such file" if value == "C" else "emulator must be a gpmsa.Emulator, the path"
+    with pytest.raises(ControlError, match=match):
+        replay_bag(bag, value)
+
+
+def test_replay_bag_takes_the_emulators_forms_the_command_takes(bag, emulator_a, likelihood_a):
+    want = replay_bag(bag, emulator_a, likelihood=likelihood_a)
+    from control.shipped import shipped_emulator_path
+
+    for form in ("A", shipped_emulator_path("A"), str(shipped_emulator_path("A"))):
+        got = replay_bag(bag, form, likelihood=likelihood_a)
+        assert got.status.tolist() == want.status.tolist()
+        assert np.array_equal(got.gd_mean, want.gd_mean, equal_nan=True)
+
+
+def test_a_damaged_emulator_file_is_a_control_error_chaining_gpmsas(bag, tmp_path):
+    damaged = tmp_path / "jackal.gpmsa"
+    damaged.write_bytes(np.random.default_rng(0).bytes(3000))
+    with pytest.raises(ControlError, match=f"emulator {str(damaged)!r}: ") as info:
+        replay_bag(bag, damaged)
+    assert isinstance(info.value.__cause__, gpmsa.EmulatorFileError)
+    with pytest.raises(ControlError, match="emulator 'nofile.gpmsa': no such file"):
+        replay_bag(bag, "nofile.gpmsa")
