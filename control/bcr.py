@@ -45,9 +45,16 @@ from control.changepoint import ChangePointFilter, ChangePointSettings, mixture_
 from control.errors import ControlError
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, block_features, window_feature
-from control.sensor_checks import SensorLimits, signal_fault, stream_fault
+from control.sensor_checks import SensorLimits, signal_fault, stream_fault, timing_fault
 from control.tracker import GDTracker, TrackerSettings
-from control.validation import is_integer, is_real, require_instance, require_reals, within
+from control.validation import (
+    check_instance,
+    is_integer,
+    is_real,
+    require_instance,
+    require_reals,
+    within,
+)
 from gpmsa import Posterior
 
 METHODS = ("changepoint", "window", "filter", "tempered")
@@ -203,17 +210,27 @@ class _Phase:
 
 def _samples(name: str, values) -> np.ndarray:
     """``values`` as a 1-D float array; ControlError naming ``name`` for anything but real
-    numbers in one dimension (NaN and None are missing samples: sensor faults, not errors)."""
-    a = np.atleast_1d(np.asarray(values))
-    if a.dtype.kind not in "biufO":
-        raise ControlError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    numbers in one dimension (bools and strings are not numbers; NaN and None are missing
+    samples: sensor faults, not errors)."""
+    if values is None:
+        raise ControlError(f"{name} must be a 1-D sequence of numbers, got None")
     try:
-        a = a.astype(float)
-    except (TypeError, ValueError) as exc:
-        raise ControlError(f"{name} must hold real numbers: {exc}") from None
+        a = np.atleast_1d(np.asarray(values))
+    except ValueError as exc:  # a ragged list
+        raise ControlError(f"{name} must be a 1-D sequence of numbers: {exc}") from None
     if a.ndim != 1:
         raise ControlError(f"{name} must be 1-D, got shape {a.shape}")
-    return a
+    if a.dtype.kind == "O":
+        wrong = [v for v in a if not (v is None or is_real(v))]
+        if wrong:
+            raise ControlError(
+                f"{name} must hold real numbers (None for a missing sample), got {wrong[0]!r} "
+                f"({type(wrong[0]).__name__})"
+            )
+        return np.array([np.nan if v is None else float(v) for v in a])
+    if a.dtype.kind not in "iuf":
+        raise ControlError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    return a.astype(float)
 
 
 def emulator_domain(emulator) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -238,7 +255,9 @@ class BCR:
     def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
         from control.compat import check_feature
 
-        self.settings = s = replace(settings or BCRSettings(), **overrides)
+        settings = BCRSettings() if settings is None else settings
+        check_instance(settings, "settings", BCRSettings)
+        self.settings = s = replace(settings, **overrides)
         self.model = model
         emulator = getattr(model, "emulator", None)
         if "feature" in (getattr(emulator, "metadata", None) or {}):
@@ -272,7 +291,11 @@ class BCR:
         from control.compat import bcr_settings_for, check_feature
         from control.observation_model import ObservationModel
 
-        s = replace(settings, **overrides) if settings else bcr_settings_for(emulator, **overrides)
+        if settings is None:
+            s = bcr_settings_for(emulator, **overrides)
+        else:
+            check_instance(settings, "settings", BCRSettings)
+            s = replace(settings, **overrides)
         check_feature(emulator, s)
         if s.method == "changepoint":
             return cls(ObservationModel(emulator), s)
@@ -292,6 +315,8 @@ class BCR:
         """Empty the buffers and forget the GD state."""
         self._acc = np.empty(0)  # contiguous clean samples (block or window)
         self._spd = np.empty(0)
+        self._t = np.empty(0)  # their times and positions (the timing and odometry check)
+        self._pos = np.empty(0)
         self._fresh = 0  # samples in the window the tempered filter has not seen
         self._received = 0  # samples received since the last estimate
         self._fault = ""
@@ -379,11 +404,13 @@ class BCR:
             self._fault = reason
             k = int(broken[-1])
             keep = slice(k + 1, None) if drop[k] else slice(k, None)
-            self._acc, self._spd = acc[keep], spd[keep]
+            self._acc, self._spd, self._t, self._pos = acc[keep], spd[keep], t[keep], pos[keep]
             self._fresh = self._acc.size
             return
         self._acc = np.concatenate([self._acc, acc])[-self.buffer :]
         self._spd = np.concatenate([self._spd, spd])[-self.buffer :]
+        self._t = np.concatenate([self._t, t])[-self.buffer :]
+        self._pos = np.concatenate([self._pos, pos])[-self.buffer :]
         self._fresh = min(self._fresh + acc.size, self.buffer)
 
     def _now(self) -> tuple[float, float]:
@@ -433,10 +460,15 @@ class BCR:
         return block_features(block, self.settings.feature)[0]
 
     def _signal_reason(self, accel: np.ndarray) -> str:
-        """The signal checks on the new samples of a window, or on a whole block."""
-        if self.settings.method != "changepoint":
-            accel = accel[-self.settings.samples_per_update :]
-        return signal_fault(accel, self.settings.sensor)
+        """The checks of the buffer's time stamps and odometry (`timing_fault`), then the
+        signal checks on the new samples of a window, or on a whole block."""
+        s = self.settings
+        timing = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
+        if timing:
+            return timing
+        if s.method != "changepoint":
+            accel = accel[-s.samples_per_update :]
+        return signal_fault(accel, s.sensor)
 
     # --- the change-point method -----------------------------------------------------------------
 
@@ -615,7 +647,8 @@ class BCR:
         tic = _time.perf_counter()
         bad_signal = self._signal_reason(self._acc)
         if bad_signal:
-            self._acc, self._spd, self._fresh = np.empty(0), np.empty(0), 0
+            self._acc, self._spd, self._t, self._pos = (np.empty(0),) * 4
+            self._fresh = 0
             return self._no_estimate("sensor_fault", bad_signal + "; buffer restarted")
         v = float(np.mean(self._spd))
         lo, hi = self.speed_range

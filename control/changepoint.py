@@ -27,7 +27,14 @@ import numpy as np
 from scipy.special import gammaincc
 
 from control.errors import ControlError
-from control.validation import check_n_draws, float_array, is_real, require_integers, require_reals
+from control.validation import (
+    check_instance,
+    check_n_draws,
+    float_array,
+    is_real,
+    require_integers,
+    require_reals,
+)
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("log_uniform", "uniform")
@@ -88,7 +95,9 @@ class ChangePointFilter:
             raise ControlError(
                 f"gd must be an increasing 1-D grid of >= 3 positive, finite values, got {gd}"
             )
-        self.settings = s = settings or ChangePointSettings()
+        s = ChangePointSettings() if settings is None else settings
+        check_instance(s, "settings", ChangePointSettings)
+        self.settings = s
         self.gd = gd
         self._weights = trapezoid_weights(gd)
         self.prior = _prior_mass(gd, self._weights, s.prior)
@@ -96,12 +105,13 @@ class ChangePointFilter:
         jump = lg[None, :] - lg[:, None]
         T = self.prior[None, :] * (np.abs(jump) >= s.min_jump)
         if s.jump_sd is not None:
-            T = T * np.exp(-0.5 * (jump / s.jump_sd) ** 2)
+            with np.errstate(over="ignore", under="ignore"):
+                T = T * np.exp(-0.5 * (jump / s.jump_sd) ** 2)
         rows = T.sum(axis=1, keepdims=True)
         if np.any(rows <= 0):
             raise ControlError(
-                f"min_jump = {s.min_jump} leaves no GD to jump to from some node of the domain "
-                f"[{gd[0]:g}, {gd[-1]:g}]"
+                f"min_jump = {s.min_jump} with jump_sd = {s.jump_sd} leaves no GD to jump to "
+                f"from some node of the domain [{gd[0]:g}, {gd[-1]:g}]"
             )
         self._jump = T / rows
         self._scale = s.mean_segment_m / s.segment_shape
@@ -221,7 +231,10 @@ def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:
     """Prior mass per grid node: the density (1/GD for log-uniform, 1 for uniform, or exp of
     the user's log density) times the node's trapezoid weight, normalised."""
     if callable(prior):
-        log_density = np.asarray(prior(gd.copy()), dtype=float)
+        try:
+            log_density = np.asarray(prior(gd.copy()), dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ControlError(f"prior(gd) must return real log densities: {exc}") from None
         if log_density.shape != gd.shape or np.any(np.isnan(log_density)):
             raise ControlError(
                 f"prior(gd) must return {gd.size} log densities (no NaN), got shape "

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
+import roadgen
 import vehicle
 from control.bcr import BCR, BCRSettings
 from control.compat import bcr_settings_for, check_emulator, check_likelihood
@@ -20,7 +21,7 @@ from control.faults import FaultInjector, SensorFault
 from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, segment_index
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
-from control.validation import is_real
+from control.validation import check_instance, is_real
 
 EXACT_CLOCK_SILENCE = 0.5
 """The simulated sensor's clock is exact, so any sample missing at an update is silence: the
@@ -221,10 +222,12 @@ def run_closed_loop(
     Returns:
         `ClosedLoopResult` with traces and `LoopMetrics`.
     """
+    check_instance(track, "track", roadgen.Track)
     model = vehicle.Jackal() if model is None else vehicle.models.check_model(model)
     simplex = Simplex() if simplex is None else simplex
-    if not isinstance(simplex, Simplex):
-        raise ControlError(f"simplex must be a control.Simplex, got {type(simplex).__name__}")
+    check_instance(simplex, "simplex", Simplex)
+    if bcr is not None:
+        check_instance(bcr, "bcr", BCRSettings)
     _check_seed(seed)
     noise_std = vehicle.sensor.check_noise(noise_std)
     faults = _check_faults(faults)

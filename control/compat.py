@@ -222,11 +222,14 @@ def bcr_settings_for(emulator, **overrides) -> BCRSettings:
     know the sensor's noise sd from the emulator's training noise (`emulator_noise_std`: the
     noise-floor check). ``method=``, ``sensor=`` and any other `BCRSettings` field may be
     overridden."""
-    feature = overrides.pop("feature", None) or emulator_feature(emulator)
+    feature = overrides.pop("feature", None)
+    if feature is None:
+        feature = emulator_feature(emulator)
     method = overrides.pop("method", None)
-    if method is None:
-        method = "changepoint" if feature.name == "log_band_power" else "filter"
-    sensor = overrides.pop("sensor", None) or SensorLimits(
-        noise_sd_mps2=emulator_noise_std(emulator)
-    )
+    if method is None:  # (BCRSettings refuses a feature that is not a FeatureSpec)
+        block = getattr(feature, "name", None) == "log_band_power"
+        method = "changepoint" if block else "filter"
+    sensor = overrides.pop("sensor", None)
+    if sensor is None:
+        sensor = SensorLimits(noise_sd_mps2=emulator_noise_std(emulator))
     return replace(BCRSettings(feature=feature, method=method, sensor=sensor), **overrides)

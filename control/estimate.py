@@ -6,6 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from control.errors import ControlError
+from control.validation import is_real
 from gpmsa import Posterior
 
 #: Status values. Only "ok" carries numbers; every other status says why there is no estimate.
@@ -127,13 +129,17 @@ class Estimate:
         return self.status == "ok"
 
     def prob_above(self, value: float) -> float:
-        """P(GD > value); NaN unless ok."""
+        """P(GD > value) for a finite GD ``value``; NaN unless ok."""
+        if not (is_real(value) and np.isfinite(value)):
+            raise ControlError(f"value must be a finite GD, got {value!r}")
         if self.posterior is None:
             return np.nan
-        return self.posterior.prob_above(self.posterior.names[0], value)
+        return float(self.posterior.prob_above(self.posterior.names[0], float(value)))
 
     def quantile(self, q: float) -> float:
-        """The GD quantile at probability q; NaN unless ok."""
+        """The GD quantile at probability q in [0, 1]; NaN unless ok."""
+        if not (is_real(q) and 0 <= q <= 1):
+            raise ControlError(f"q must be a probability in [0, 1], got {q!r}")
         if self.posterior is None:
             return np.nan
-        return float(self.posterior.quantile(self.posterior.names[0], q))
+        return float(self.posterior.quantile(self.posterior.names[0], float(q)))

@@ -34,6 +34,9 @@ variance that pure noise reads as rarely as ``NOISE_STRETCH`` samples read ``noi
 LATTICE_STRETCHES = (6, 8)
 """Stretches (samples, 0.05 and 0.07 s at 120 Hz) the lattice check looks at: a coarse
 quantisation as short as 6 samples (`lattice_stretch`)."""
+MAX_NOISE_SD_MPS2 = 1e4
+"""Largest sensor noise sd the checks take, m/s^2 (about 1,000 g: beyond any accelerometer;
+its square must stay finite)."""
 FREE_FALL_MPS2 = -GRAVITY
 """What the vertical acceleration reads while a wheel is in the air (the simulator's -g), m/s^2."""
 
@@ -46,7 +49,8 @@ class SensorLimits:
         max_repeats: longest run of identical consecutive accelerations allowed (a stuck sensor
             repeats its last value).
         min_distinct: fewest distinct acceleration values allowed in a block (a coarsely
-            quantised or clipped signal takes few).
+            quantised or clipped signal takes few); at most half the block's samples are
+            asked for (62 of a 125-sample block).
         max_same: most samples allowed at each of two values (a clipped signal piles up at both
             ends of its range, also when the clipped stretch is only part of the block; a wheel
             in the air piles up at one value, -g; of 22,770 clean campaign blocks none had a
@@ -90,6 +94,17 @@ class SensorLimits:
             of 120 s, seed 7, with and without noise, also rounded to ADC resolutions of
             0.001-0.1 m/s^2) the most lattice-like scored 1.3e-6 (`benchmarks/sensor_checks.py`).
             0 switches the check off.
+        rate_tolerance: a block whose time stamps span more or less than its samples at the
+            BCR's rate, by more than this fraction, comes at another rate (a 150 Hz stream fed
+            as 120 Hz: its band powers would be read at the wrong frequencies). Single steps
+            within half a period either way are jitter, not a fault (`stream_fault`). Above
+            `control.ReplaySettings.rate_tolerance` (0.02), beyond which a recording is
+            resampled: one kept as recorded is not refused for its rate and its jitter.
+        odometry_tolerance, odometry_slack_m: a block the BCR would use, whose position advances
+            by more than ``odometry_tolerance`` times the distance its speeds give (the
+            trapezoid rule over its time stamps) plus ``odometry_slack_m`` away from it, has
+            broken odometry (a frozen or backwards position, a jump): the change-point filter
+            counts distance with the positions and would stop forgetting.
     """
 
     max_repeats: int = 8
@@ -102,12 +117,16 @@ class SensorLimits:
     noise_sd_mps2: float | None = None
     noise_floor: float = 0.1
     lattice_p: float = 1e-10
+    rate_tolerance: float = 0.03
+    odometry_tolerance: float = 0.25
+    odometry_slack_m: float = 0.1
 
     def __post_init__(self) -> None:
         require_reals(
             self,
             ("range_mps2", "max_level_jump", "dead_fraction", "free_fall_mps2", "noise_sd_mps2",
-             "noise_floor", "lattice_p"),
+             "noise_floor", "lattice_p", "rate_tolerance", "odometry_tolerance",
+             "odometry_slack_m"),
             optional=("range_mps2", "free_fall_mps2", "noise_sd_mps2"),
         )  # fmt: skip
         counts = ("max_repeats", "min_distinct", "max_same")
@@ -126,16 +145,25 @@ class SensorLimits:
             np.isfinite(self.range_mps2) and self.range_mps2 > 0
         ):
             raise ControlError(f"range_mps2 must be None or finite and > 0, got {self.range_mps2}")
-        if self.noise_sd_mps2 is not None and not (
-            np.isfinite(self.noise_sd_mps2) and self.noise_sd_mps2 > 0
-        ):
+        if self.noise_sd_mps2 is not None and not 0 < self.noise_sd_mps2 <= MAX_NOISE_SD_MPS2:
             raise ControlError(
-                f"noise_sd_mps2 must be None or finite and > 0, got {self.noise_sd_mps2}"
+                f"noise_sd_mps2 must be None or lie in (0, {MAX_NOISE_SD_MPS2:g}] m/s^2, got "
+                f"{self.noise_sd_mps2}"
             )
         if not (np.isfinite(self.noise_floor) and 0 < self.noise_floor < 1):
             raise ControlError(f"noise_floor must lie in (0, 1), got {self.noise_floor}")
         if not (np.isfinite(self.lattice_p) and 0 <= self.lattice_p < 1):
             raise ControlError(f"lattice_p must lie in [0, 1), got {self.lattice_p}")
+        if not 0 < self.rate_tolerance < 0.5:
+            raise ControlError(f"rate_tolerance must lie in (0, 0.5), got {self.rate_tolerance}")
+        if not 0 < self.odometry_tolerance < 1:
+            raise ControlError(
+                f"odometry_tolerance must lie in (0, 1), got {self.odometry_tolerance}"
+            )
+        if not (np.isfinite(self.odometry_slack_m) and self.odometry_slack_m >= 0):
+            raise ControlError(
+                f"odometry_slack_m must be finite and >= 0, got {self.odometry_slack_m}"
+            )
 
 
 def longest_repeat(a: np.ndarray) -> int:
@@ -421,6 +449,32 @@ def stream_fault(
         worst = float(np.max(step[gap]))
         what.append(f"a gap of {worst:.4g} s (about {round(worst / dt) - 1:.4g} dropped samples)")
     return bad_value | backwards, gap & ~bad_value, " and ".join(what)
+
+
+def timing_fault(
+    t: np.ndarray, position: np.ndarray, speed: np.ndarray, rate_hz: float, limits: SensorLimits
+) -> str:
+    """Why a block of contiguous samples (finite times s, positions m, speeds m/s) does not
+    come from a stream at ``rate_hz`` with working odometry, or "": its time stamps span
+    another duration than its samples at that rate (beyond ``limits.rate_tolerance``), or its
+    positions advance otherwise than its speeds say (beyond ``limits.odometry_tolerance`` and
+    ``limits.odometry_slack_m``)."""
+    if t.size < 2:
+        return ""
+    span, expected = float(t[-1] - t[0]), (t.size - 1) / rate_hz
+    if abs(span / expected - 1.0) > limits.rate_tolerance:
+        return (
+            f"samples at another rate: the block's {t.size} time stamps span {span:.4g} s "
+            f"({(t.size - 1) / span:.4g} Hz), not the {expected:.4g} s of {rate_hz:g} Hz"
+        )
+    moved = float(position[-1] - position[0])
+    by_speed = float(np.sum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t)))
+    if abs(moved - by_speed) > limits.odometry_tolerance * abs(by_speed) + limits.odometry_slack_m:
+        return (
+            f"odometry disagrees with the speeds: the position moved {moved:.4g} m over the "
+            f"block, its speeds give {by_speed:.4g} m"
+        )
+    return ""
 
 
 def _previous_finite(t: np.ndarray, t_prev: float) -> np.ndarray:

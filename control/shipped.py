@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
-from control.errors import ControlError
+from control.errors import ControlError, EmulatorMismatchError
 
 EMULATOR_DIR = Path(__file__).parent / "emulators"
 
@@ -29,6 +30,10 @@ def shipped_emulator_path(case: str = "A", kind: str = "band", folder=None) -> P
     with ``folder``, the file of that name there (`examples/train_emulator.py --emulator-dir`).
     ControlError naming a missing file and the command that makes it."""
     name = emulator_file_name(case, kind)
+    if folder is not None and not isinstance(folder, str | os.PathLike):
+        raise ControlError(
+            f"folder must be None or a path, got {folder!r} ({type(folder).__name__})"
+        )
     if folder is None:
         path, make = EMULATOR_DIR / name, "`python examples/train_emulator.py --ship`"
     else:
@@ -51,7 +56,18 @@ def shipped_emulator(case: str = "A", kind: str = "band", folder=None):
     window). Its ``metadata`` records the vehicle (``vehicle``), the noise level
     (``noise_std``), the feature (``feature``), the road settings (``road``) and the versions
     that made it; `control.run_closed_loop` checks them against the loop.
+
+    Raises ControlError for a missing file, `gpmsa.EmulatorFileError` for a damaged one and
+    `EmulatorMismatchError` for a file whose recorded feature is not of ``kind``.
     """
     import gpmsa
+    from control.compat import emulator_feature
 
-    return gpmsa.load(shipped_emulator_path(case, kind, folder))
+    path = shipped_emulator_path(case, kind, folder)
+    emulator = gpmsa.load(path)
+    feature = emulator_feature(emulator).name
+    if (feature == "log_band_power") != (kind == "band"):
+        raise EmulatorMismatchError(
+            f"{path} holds an emulator of the feature {feature!r}, not of kind {kind!r}"
+        )
+    return emulator

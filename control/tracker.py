@@ -26,7 +26,13 @@ from scipy.ndimage import gaussian_filter1d
 from scipy.special import logsumexp
 
 from control.errors import ControlError
-from control.validation import check_n_draws, float_array, require_integers, require_reals
+from control.validation import (
+    check_instance,
+    check_n_draws,
+    float_array,
+    require_integers,
+    require_reals,
+)
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("uniform", "log_uniform")
@@ -73,7 +79,8 @@ class GDTracker:
         lo, hi = (float(d) for d in domain)
         if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
             raise ControlError(f"domain must satisfy 0 < lo < hi, got {domain}")
-        self.settings = settings or TrackerSettings()
+        self.settings = TrackerSettings() if settings is None else settings
+        check_instance(self.settings, "settings", TrackerSettings)
         self.log_grid = np.linspace(np.log(lo), np.log(hi), self.settings.n_grid)
         self.grid = np.exp(self.log_grid)
         # Uniform prior on GD: mass of a log-grid cell is proportional to GD; log-uniform: equal.

@@ -69,9 +69,14 @@ def require_integers(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()
 
 def require_instance(obj, name: str, cls: type) -> None:
     """ControlError naming ``name`` when its value in ``obj`` is not a ``cls``."""
-    value = getattr(obj, name)
+    check_instance(getattr(obj, name), f"{type(obj).__name__}.{name}", cls)
+
+
+def check_instance(value, name: str, cls: type) -> None:
+    """ControlError naming the argument ``name`` when ``value`` is not a ``cls`` (named with
+    its package: ``control.Simplex``)."""
     if not isinstance(value, cls):
+        package = cls.__module__.split(".")[0]
         raise ControlError(
-            f"{type(obj).__name__}.{name} must be a {cls.__name__}, got {value!r} "
-            f"({type(value).__name__})"
+            f"{name} must be a {package}.{cls.__name__}, got {value!r} ({type(value).__name__})"
         )
