@@ -1,8 +1,9 @@
 """Scores of a closed-loop run: RMSE of the GD estimate, detection delays, speed on rough ground;
-means over many runs with their clustered standard errors."""
+means over many runs with their clustered standard errors; reports as strict JSON."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -167,3 +168,18 @@ def fast_on_rough_m(
     rough = seg_gd[segment_index(track, mid)] > gd_max
     fast = 0.5 * (speed[1:] + speed[:-1]) > v_safe + tol
     return float(np.sum(np.diff(position)[rough & fast]))
+
+
+def strict_json(value):
+    """``value`` (dicts, lists, tuples, numbers, strings) ready for ``json.dumps(...,
+    allow_nan=False)``: numpy scalars as Python's, floats that are not finite (NaN, inf) as None
+    (JSON's null), tuples as lists, keys as strings."""
+    if isinstance(value, dict):
+        return {str(k): strict_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [strict_json(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value

@@ -468,7 +468,7 @@ def timing_fault(
             f"({(t.size - 1) / span:.4g} Hz), not the {expected:.4g} s of {rate_hz:g} Hz"
         )
     moved = float(position[-1] - position[0])
-    by_speed = float(np.sum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t)))
+    by_speed = float(np.trapezoid(speed, t))
     if abs(moved - by_speed) > limits.odometry_tolerance * abs(by_speed) + limits.odometry_slack_m:
         return (
             f"odometry disagrees with the speeds: the position moved {moved:.4g} m over the "

@@ -41,6 +41,7 @@ from _cli import output_folder, save_figure, write_text  # noqa: E402
 import control  # noqa: E402
 import gpmsa  # noqa: E402
 import roadgen  # noqa: E402
+from control.metrics import strict_json  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
 
 PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
@@ -69,17 +70,6 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
 def figure(value: float, spec: str) -> str:
     """`value` formatted with `spec`, or "-" when it is NaN (no estimate, a change never seen)."""
     return "-" if np.isnan(value) else format(value, spec)
-
-
-def json_safe(value):
-    """`value` with every NaN replaced by None, so that metrics.json is strict JSON (null)."""
-    if isinstance(value, dict):
-        return {k: json_safe(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [json_safe(v) for v in value]
-    if isinstance(value, float) and np.isnan(value):
-        return None
-    return value
 
 
 def run_case(
@@ -305,7 +295,7 @@ def main(argv: list[str] | None = None) -> dict:
     if named:
         print("\nestimates naming an edge of the emulator's GD domain (the road may lie beyond):")
         print("\n".join(f"  {line}" for line in named))
-    metrics_json = json.dumps(json_safe(metrics), indent=2, default=float, allow_nan=False)
+    metrics_json = json.dumps(strict_json(metrics), indent=2, allow_nan=False)
     write_text(out / "metrics.json", metrics_json)
     print(f"\nwrote {out / 'metrics.json'} and the figures gd_trace_*.png, speed_*.png")
     if args.record:

@@ -98,13 +98,18 @@ def flag(name: str, value: object, error: type[Exception] = RoadgenError) -> boo
 
 def real_array(name: str, value: object, error: type[Exception] = RoadgenError) -> np.ndarray:
     """Return ``value`` as a new float array if it holds real numbers (ints or floats, not
-    bools, strings, complex numbers or objects); else raise ``error``. NaN and inf pass."""
+    bools, strings, complex numbers or objects); else raise ``error``. NaN and inf pass. A bool
+    inside a list is refused too (numpy would read ``[[True, 300]]`` as integers)."""
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError) as exc:  # e.g. ragged nested lists
         raise error(f"{name} must be an array of real numbers: {exc}") from exc
     if arr.dtype.kind not in "iuf":
         raise error(f"{name} must be an array of real numbers, got dtype {arr.dtype}")
+    if not isinstance(value, np.ndarray) and any(
+        isinstance(x, bool | np.bool_) for x in np.asarray(value, dtype=object).flat
+    ):
+        raise error(f"{name} must be an array of real numbers, got a bool element")
     return arr.astype(float)
 
 

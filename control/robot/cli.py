@@ -20,17 +20,15 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import shutil
 import sys
 from dataclasses import asdict
 from pathlib import Path
 
-import numpy as np
-
 from control.compat import check_emulator
 from control.errors import ControlError, MissingExtraError
 from control.estimate import edge_counts
+from control.metrics import strict_json
 from control.robot.replay import (
     GRAVITY,
     POSITIONS,
@@ -50,20 +48,6 @@ DEFAULTS = ReplaySettings()
 def _one_line(exc: Exception) -> str:
     """The message of ``exc`` on one line (a library's message may hold line breaks)."""
     return " ".join(str(exc).split())
-
-
-def _strict_json(value):
-    """``value`` (dicts, lists, tuples, numbers, strings) with numpy scalars as Python's and
-    floats that are not finite (NaN, inf) as None, for ``json.dumps(allow_nan=False)``."""
-    if isinstance(value, dict):
-        return {str(k): _strict_json(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_strict_json(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def _check_out(out: Path) -> None:
@@ -107,7 +91,7 @@ def _write(out: Path, result: ReplayResult, report: dict) -> None:
             raise ControlError(f"--out {str(out)!r}: cannot make it ({exc.strerror})") from exc
         result.to_csv(out / "estimates.csv")
         result.write_bag(out / "estimates")
-        text = json.dumps(_strict_json(report), indent=2, allow_nan=False)
+        text = json.dumps(strict_json(report), indent=2, allow_nan=False)
         with atomic_write(out / "replay.json", text=True, error=ControlError) as fh:
             fh.write(text)
     except BaseException:
