@@ -136,7 +136,11 @@ def test_the_recorded_estimates_decode_with_the_definition_inside_the_file(loop_
 def test_a_road_beyond_the_domain_is_named_in_the_recording_and_its_replay(
     emulator_a, likelihood_a, tmp_path
 ):
-    track = roadgen.track([(15, 300), (30, 900)], seed=2)  # GD 900: beyond the domain's 600
+    # GD 1200, twice the domain's 600: every seed names the edge (25-40 of ~86 estimates on
+    # seeds 1-8); at GD 900 a seed may name none (0 to 29 on seeds 1-6), as the loop's chaos
+    # falls (seed 2 named none with numpy 2.4.6 / scipy 1.17.1), so the test would depend on
+    # the library versions that decide the trajectory
+    track = roadgen.track([(15, 300), (30, 1200)], seed=2)
     path = tmp_path / "rough.mcap"
     result = control.run_closed_loop(
         track, emulator_a, seed=2, likelihood=likelihood_a, check=False, record=path
