@@ -14,7 +14,8 @@ Features of one block of B samples of front-axle vertical acceleration (120 Hz),
   each rescaled to GD_ref = 400 (Gaussian kernel weights in speed, bandwidth 0.15 m/s, and in
   log GD about GD_ref, bandwidth 0.3; a training run's own blocks are left out of its reference);
 - ``bands``: the log band-power vector of `control.block_features` with
-  ``FeatureSpec(block_samples=B)`` (8 bands 1.5-60 Hz, DPSS NW = 2, 3 tapers), multivariate.
+  ``FeatureSpec(block_samples=B, quantiles=())`` (8 bands 1.5-60 Hz, DPSS NW = 2, 3 tapers),
+  multivariate (the shipped feature adds two quantiles: section 4).
 
 Method (held out): two independent campaigns (`vehicle.run_campaign`, Latin hypercube over v in
 [0.5, 2] m/s and GD in [200, 600], other seeds), one for training and one for testing. On the
@@ -36,9 +37,10 @@ B = 1000 (the paper's); lack of fit (mean over training runs of the squared stan
 residual of the run mean about the cubic, per output; 1 when the cubic and Sigma explain the run
 means); per speed band (v < 1, 1-1.5, > 1.5 m/s) J at T = 8.3 s. The prior alone (posterior mean
 = prior mean) has the RMSE printed as ``prior-only``: a J near 1 / (that^2 T) is the prior's, not
-the feature's. Last, variants of the band vector (`BAND_VARIANTS`: narrower bands, a lower
-first band, other tapers, shorter blocks, the vector plus the block's skewness or log kurtosis),
-J and J_lin at T ~ 8.3 s: is there information the shipped vector leaves out?
+the feature's. Last, variants of the band vector (`BAND_VARIANTS`: the block's quantiles, of
+which the shipped feature adds the 90% and 98%; narrower bands, a lower first band, other
+tapers, shorter blocks; the vector plus the block's skewness, log kurtosis or flight time),
+J and J_lin at T ~ 8.3 s: is there information the band vector leaves out?
 
 Campaign runs are cached under ``--cache-dir`` (keyed by their settings), so a second call only
 recomputes the features (a few seconds).
@@ -58,6 +60,7 @@ from scipy.signal.windows import hann
 
 import vehicle
 from control import FeatureSpec, block_features
+from control.feature import STANDARD_GRAVITY
 
 RATE_HZ = 120.0
 V_RANGE = (0.5, 2.0)
@@ -74,17 +77,27 @@ BATCH_SAMPLES = 1000  # samples per batch of the long-run covariance
 SPEED_BANDS = ((0.0, 1.0, "v<1"), (1.0, 1.5, "1-1.5"), (1.5, 9.9, "v>1.5"))
 N_GRID = 401
 NARROW_BANDS_HZ = (1.5, 3, 4.5, 6, 7, 8.5, 10, 12, 14, 17, 20, 25, 30, 37, 45, 52, 60)
+BANDS_ONLY = {"quantiles": ()}
 BAND_VARIANTS = {  # name: (block samples, FeatureSpec fields, extra moment or None)
-    "8 bands (shipped)": (125, {}, None),
-    "16 narrower bands": (125, {"bands_hz": NARROW_BANDS_HZ}, None),
-    "first band from 0.9 Hz": (125, {"bands_hz": (0.9, 2.5, 4.5, 7, 10, 14, 20, 30, 45, 60)}, None),
-    "NW 3, 5 tapers": (125, {"taper_nw": 3.0, "n_tapers": 5}, None),
-    "NW 1.5, 2 tapers": (125, {"taper_nw": 1.5, "n_tapers": 2}, None),
-    "+ skewness": (125, {}, "skewness"),
-    "+ log kurtosis": (125, {}, "log_kurtosis"),
-    "100-sample blocks": (100, {}, None),
-    "80-sample blocks": (80, {}, None),
-    "64-sample blocks": (64, {}, None),
+    "8 bands": (125, BANDS_ONLY, None),
+    "+ quantiles 0.9, 0.98 (shipped)": (125, {}, None),
+    "+ quantiles 0.02, 0.1, 0.9, 0.98": (125, {"quantiles": (0.02, 0.1, 0.9, 0.98)}, None),
+    "+ quantiles 0.02, 0.1": (125, {"quantiles": (0.02, 0.1)}, None),
+    "+ quantile 0.5 (median)": (125, {"quantiles": (0.5,)}, None),
+    "16 narrower bands": (125, {**BANDS_ONLY, "bands_hz": NARROW_BANDS_HZ}, None),
+    "first band from 0.9 Hz": (
+        125,
+        {**BANDS_ONLY, "bands_hz": (0.9, 2.5, 4.5, 7, 10, 14, 20, 30, 45, 60)},
+        None,
+    ),
+    "NW 3, 5 tapers": (125, {**BANDS_ONLY, "taper_nw": 3.0, "n_tapers": 5}, None),
+    "NW 1.5, 2 tapers": (125, {**BANDS_ONLY, "taper_nw": 1.5, "n_tapers": 2}, None),
+    "+ skewness": (125, BANDS_ONLY, "skewness"),
+    "+ log kurtosis": (125, BANDS_ONLY, "log_kurtosis"),
+    "+ flight time": (125, BANDS_ONLY, "flight_time"),
+    "100-sample blocks": (100, BANDS_ONLY, None),
+    "80-sample blocks": (80, BANDS_ONLY, None),
+    "64-sample blocks": (64, BANDS_ONLY, None),
 }
 
 
@@ -143,7 +156,7 @@ def features(blocks: np.ndarray, B: int, pgram: np.ndarray, s_ref: np.ndarray | 
     out = {
         "log_var": np.log(np.var(blocks, axis=-1))[..., None],
         "log_pgram": np.mean(np.log(pgram), axis=-1)[..., None],
-        "bands": band_vector(blocks, FeatureSpec(block_samples=B)),
+        "bands": band_vector(blocks, FeatureSpec(block_samples=B, quantiles=())),
     }
     if s_ref is not None:
         out["whittle"] = np.log(np.mean(pgram / s_ref[:, None, :], axis=-1))[..., None]
@@ -151,8 +164,11 @@ def features(blocks: np.ndarray, B: int, pgram: np.ndarray, s_ref: np.ndarray | 
 
 
 def moment(blocks: np.ndarray, name: str) -> np.ndarray:
-    """(runs, n_blocks, 1) skewness or log kurtosis of each block (lift-off makes the
-    acceleration non-Gaussian: what a spectrum cannot see)."""
+    """(runs, n_blocks, 1) skewness, log kurtosis or flight time of each block (lift-off makes
+    the acceleration non-Gaussian: what a spectrum cannot see). The flight time is log(1 + the
+    samples below -0.9 g): a wheel in the air reads -g."""
+    if name == "flight_time":
+        return np.log1p(np.sum(blocks < -0.9 * STANDARD_GRAVITY, axis=-1))[..., None]
     d = blocks - blocks.mean(axis=-1, keepdims=True)
     var = np.mean(d**2, axis=-1)
     if name == "skewness":
@@ -167,7 +183,7 @@ def band_vector(blocks: np.ndarray, spec: FeatureSpec) -> np.ndarray:
 
 def band_variant(accel: np.ndarray, B: int, fields: dict, extra: str | None) -> np.ndarray:
     """(runs, n_blocks, K) a variant of the band vector: other bands, tapers or block length,
-    or the shipped vector plus one moment."""
+    or the band vector plus quantiles or one moment."""
     blocks = blocks_of(accel, B)
     out = band_vector(blocks, FeatureSpec(block_samples=B, **fields))
     return out if extra is None else np.concatenate([out, moment(blocks, extra)], axis=-1)
@@ -447,7 +463,7 @@ def main(argv: list[str] | None = None) -> None:
     print(f"scored test runs: {scored.sum()} with GD in [{args.gd_band[0]:g}, "
           f"{args.gd_band[1]:g}]; prior-only RMSE of log GD: {prior_rmse:.3f}")  # fmt: skip
     for B in BLOCKS:
-        counts = FeatureSpec(block_samples=B)  # raises if a band holds no frequency bin
+        counts = FeatureSpec(block_samples=B, quantiles=())  # raises if a band has no bin
         f = np.fft.rfftfreq(B, 1 / RATE_HZ)
         e = counts.bands_hz
         n_bins = [int(np.sum((f >= lo) & (f < hi))) for lo, hi in zip(e[:-1], e[1:], strict=True)]
@@ -564,23 +580,23 @@ def main(argv: list[str] | None = None) -> None:
 
     print(f"\n4. Variants of the band vector at T ~ 8.3 s (1,000 samples; {load()})")
     print("J and J_lin [1/s] +- bootstrap SE as in sections 1 and 2; K: outputs per block;")
-    print("J / shipped: J over the shipped vector's J, +- a paired bootstrap SE over test runs")
+    print("J / bands: J over the 8-band vector's J, +- a paired bootstrap SE over test runs")
     print("(same runs, same stretches: block-length variants differ in stretch ends, still paired)")
     for case in ("A", "B"):
         print(f"\ncase {case}")
         print(f"{'variant':<24}{'B':>5}{'K':>4} {'J +- se':>15} {'J_lin +- se':>15} {'cov':>5}"
-              f" {'J / shipped':>15}")  # fmt: skip
-        shipped = None
+              f" {'J / bands':>15}")  # fmt: skip
+        bands = None
         for name, (B, fields, extra) in BAND_VARIANTS.items():
             f_tr = band_variant(acc_tr[case], B, fields, extra)
             f_te = band_variant(acc_te[case], B, fields, extra)[scored]
             per = 1000 // B
             model = fit(v_tr, gd_tr, f_tr, max(1, BATCH_SAMPLES // B))
             sc = estimates(model, v_s, gd_s, f_te, per, log_grid)
-            if shipped is None:  # the first variant is the shipped vector
-                shipped = sc, per * B
+            if bands is None:  # the first variant is the 8-band vector
+                bands = sc, per * B
             t = info_per_s(sc, per * B / RATE_HZ, rng)
-            r, r_se = paired_j_ratio(sc, per * B, *shipped, rng)
+            r, r_se = paired_j_ratio(sc, per * B, *bands, rng)
             print(f"{name:<24}{B:5d}{f_tr.shape[2]:4d} {t['J']:7.2f} +- {t['se']:4.2f} "
                   f"{t['Jlin']:7.2f} +- {t['se_lin']:4.2f} {t['cov']:5.2f} "
                   f"{r:7.3f} +- {r_se:5.3f}")  # fmt: skip

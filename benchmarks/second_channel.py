@@ -52,7 +52,7 @@ from control import FeatureSpec, block_features
 
 GDS = (250.0, 300.0, 350.0, 400.0, 450.0, 500.0, 550.0)
 SPEEDS = (1.0, 1.5, 2.0)
-SPEC = FeatureSpec()
+SPEC = FeatureSpec(quantiles=())  # the band powers: the channels' spectra
 BATCH = 8  # blocks per batch mean (as control.training)
 SETTLE_S = 2.0  # start-up transient dropped, s
 GD_CENTRE = 400.0

@@ -60,9 +60,11 @@ sys.path.insert(0, str(HERE.parent / "examples"))
 import closed_loop_accuracy as cla  # noqa: E402
 from _cli import output_folder  # noqa: E402
 from second_channel import GYRO_NOISE_RAD_S, spectral_derivative  # noqa: E402
-from train_emulator import BAND_PCS, BATCH, LEAD_IN_M, stretched_design  # noqa: E402
+from train_emulator import BATCH, LEAD_IN_M, stretched_design  # noqa: E402
 
-SPEC = control.FeatureSpec()
+SPEC = control.FeatureSpec(quantiles=())  # as measured: the band powers alone
+FRONT_PCS = 5
+"""Principal components of the front axle's band-power emulator (as shipped when measured)."""
 CHANNELS = ("front", "rear", "synthesised")
 """Channel sets: the front axle alone (shipped), front + rear accelerometer, front + rear axle
 synthesised from the front accelerometer and the gyro."""
@@ -117,7 +119,7 @@ def fit(
     )
     y = stats_.mean
     if channels == "front":
-        n_pc = BAND_PCS
+        n_pc = FRONT_PCS
     elif pcs is None:
         z = (y - y.mean(axis=0)) / y.std()
         share = np.cumsum(np.linalg.svd(z, compute_uv=False) ** 2)

@@ -8,7 +8,10 @@ Two features (the emulator records which one it was trained on; training and BCR
   and 60 Hz. The vector carries 2.5-3x the information about GD per second of driving of the
   paper's log f (docs/closed-loop.md, `benchmarks/feature_information.py`): the spectrum's shape
   changes with GD (the 2-7 Hz bands grow faster than GD, the 7-10 Hz resonance band saturates),
-  which one variance cannot see.
+  which one variance cannot see. Then the block's 90% and 98% quantiles, each minus the block's
+  mean (in g): the upper tail of the distribution, where a wheel that left the ground lands,
+  which a spectrum cannot see; they add 13-17% to the information per second of the bands
+  (`BAND_QUANTILES`; ``quantiles=()`` is the band vector alone).
 - ``"log_var"``: y = log f, f = var(a) normalised by T over a 1,000-sample window (the paper's
   eq. 5; the log makes the multiplicative window scatter additive). ``"var"``: f itself.
 """
@@ -27,6 +30,13 @@ from control.validation import float_array, require_integers, require_reals
 FEATURES = ("log_band_power", "log_var", "var")
 SCALAR_FEATURES = ("log_var", "var")
 BAND_EDGES_HZ = (1.5, 4.5, 7.0, 10.0, 14.0, 20.0, 30.0, 45.0, 60.0)
+BAND_QUANTILES = (0.9, 0.98)
+"""Levels of the block quantiles the band feature appends by default (`FeatureSpec.quantiles`).
+The upper tail holds what the band powers miss: held out, they add 13-17% to the information
+per second about GD (benchmarks/feature_information.py, section 4), the lower tail and the
+flight time nothing (docs/closed-loop.md, "Which feature")."""
+STANDARD_GRAVITY = 9.80665
+"""g, m/s^2: the unit of the feature's quantiles (of the order of the log band powers' spread)."""
 MAX_BLOCK_SAMPLES = 4096
 """Longest block or window (34 s at 120 Hz, 4 s at 1 kHz). The sensor checks' level check
 compares every segment of a block with the rest, so its cost grows as the square of the block:
@@ -44,6 +54,14 @@ class FeatureSpec:
         bands_hz: band edges, Hz (``log_band_power`` only): K + 1 increasing values <= rate / 2.
         taper_nw: time-bandwidth product of the DPSS tapers.
         n_tapers: number of DPSS tapers (<= 2 NW - 1).
+        quantiles: levels in (0, 1), increasing (``log_band_power`` only): the block's
+            quantiles at these levels, each minus the block's mean and in units of g
+            (`STANDARD_GRAVITY`), appended to the band vector. They see the shape of the
+            acceleration's distribution (the landings of a wheel that left the ground), which a
+            spectrum cannot; the mean taken off makes them blind to an accelerometer's offset,
+            as the band powers are. None (default): `BAND_QUANTILES` for ``log_band_power``,
+            none for the window features; ``()``: the band vector alone (the feature of
+            emulator files written before this field existed).
     """
 
     name: str = "log_band_power"
@@ -52,6 +70,7 @@ class FeatureSpec:
     bands_hz: tuple[float, ...] = BAND_EDGES_HZ
     taper_nw: float = 2.0
     n_tapers: int = 3
+    quantiles: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.name not in FEATURES:
@@ -95,11 +114,30 @@ class FeatureSpec:
                     f"n_tapers must lie in [1, 2 NW - 1] = [1, {int(2 * self.taper_nw) - 1}], "
                     f"got {self.n_tapers}"
                 )
+        if self.quantiles is None:
+            default = BAND_QUANTILES if self.name == "log_band_power" else ()
+            object.__setattr__(self, "quantiles", default)
+        if isinstance(self.quantiles, str):
+            raise ControlError(f"quantiles must be a sequence of levels, got {self.quantiles!r}")
+        levels = float_array(self.quantiles, "quantiles")
+        if levels.ndim != 1 or not np.all((levels > 0) & (levels < 1)):
+            raise ControlError(
+                f"quantiles must be a sequence of levels in (0, 1), got {self.quantiles!r}"
+            )
+        if np.any(np.diff(levels) <= 0):
+            raise ControlError(f"quantiles must be increasing, got {self.quantiles!r}")
+        if levels.size and self.name != "log_band_power":
+            raise ControlError(
+                f"quantiles go with the log_band_power feature only, not {self.name!r}"
+            )
+        object.__setattr__(self, "quantiles", tuple(float(q) for q in levels))
 
     @property
     def dim(self) -> int:
         """Length K of the feature vector."""
-        return len(self.bands_hz) - 1 if self.name == "log_band_power" else 1
+        if self.name != "log_band_power":
+            return 1
+        return len(self.bands_hz) - 1 + len(self.quantiles)
 
     @property
     def block_s(self) -> float:
@@ -111,11 +149,20 @@ class FeatureSpec:
         if self.name != "log_band_power":
             return [self.name]
         e = self.bands_hz
-        return [f"logP_{e[k]:g}_{e[k + 1]:g}Hz".replace(".", "p") for k in range(self.dim)]
+        bands = [f"logP_{e[k]:g}_{e[k + 1]:g}Hz".replace(".", "p") for k in range(len(e) - 1)]
+        return bands + [f"q{100 * q:g}_minus_mean".replace(".", "p") for q in self.quantiles]
+
+    def units(self) -> list[str]:
+        """Output units for the emulator (``y_units``)."""
+        if self.name == "var":
+            return ["(m/s^2)^2"]
+        if self.name == "log_var":
+            return ["log((m/s^2)^2)"]
+        return ["log((m/s^2)^2)"] * (len(self.bands_hz) - 1) + ["g"] * len(self.quantiles)
 
     def to_dict(self) -> dict:
         """JSON-able form (the emulator metadata's ``feature``)."""
-        return {**asdict(self), "bands_hz": list(self.bands_hz)}
+        return {**asdict(self), "bands_hz": list(self.bands_hz), "quantiles": list(self.quantiles)}
 
     @classmethod
     def from_dict(cls, d: dict) -> FeatureSpec:
@@ -124,8 +171,10 @@ class FeatureSpec:
         if "window_samples" in d and "block_samples" not in d:
             d["block_samples"] = d.pop("window_samples")
         known = {k: d[k] for k in cls.__dataclass_fields__ if k in d}
-        if "bands_hz" in known:
-            known["bands_hz"] = tuple(known["bands_hz"])
+        for key in ("bands_hz", "quantiles"):
+            if key in known:
+                known[key] = tuple(known[key])
+        known.setdefault("quantiles", ())  # written before the field existed: bands alone
         return cls(**known)
 
     def same_as(self, other: FeatureSpec) -> list[str]:
@@ -136,8 +185,9 @@ class FeatureSpec:
             if a != b and not (isinstance(a, float) and np.isclose(a, b)):
                 diff.append(key)
         if self.name == other.name == "log_band_power":
-            for key in ("bands_hz", "taper_nw", "n_tapers"):
-                if not np.allclose(np.ravel(getattr(self, key)), np.ravel(getattr(other, key))):
+            for key in ("bands_hz", "taper_nw", "n_tapers", "quantiles"):
+                a, b = np.ravel(getattr(self, key)), np.ravel(getattr(other, key))
+                if a.shape != b.shape or not np.allclose(a, b):
                     diff.append(key)
         return diff
 
@@ -169,8 +219,9 @@ def block_features(accel: np.ndarray, spec: FeatureSpec) -> np.ndarray:
 
     Returns:
         (n, K) features (K = ``spec.dim``); ``log_band_power`` in log((m/s^2)^2) (band power =
-        the multitaper PSD integrated over the band); a block with zero power in a band gives
-        -inf there (the BCR treats it as a sensor fault).
+        the multitaper PSD integrated over the band), then the ``quantiles`` (block quantile
+        minus block mean, g); a block with zero power in a band gives -inf there (the BCR
+        treats it as a sensor fault).
     """
     a = np.atleast_2d(np.asarray(accel, dtype=float))
     if a.ndim != 2 or a.shape[1] != spec.block_samples:
@@ -188,7 +239,11 @@ def block_features(accel: np.ndarray, spec: FeatureSpec) -> np.ndarray:
     power[:, 1:last] *= 2.0  # one-sided
     band = power @ _band_matrix(spec.block_samples, spec.rate_hz, spec.bands_hz)
     with np.errstate(divide="ignore"):
-        return np.log(band * (spec.rate_hz / spec.block_samples))
+        log_power = np.log(band * (spec.rate_hz / spec.block_samples))
+    if not spec.quantiles:
+        return log_power
+    tails = np.quantile(x, spec.quantiles, axis=1).T / STANDARD_GRAVITY  # x: mean taken off
+    return np.concatenate([log_power, tails], axis=1)
 
 
 def window_feature(accel: np.ndarray, feature: str = "log_var") -> float:

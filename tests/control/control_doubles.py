@@ -58,9 +58,11 @@ def stream(gd_of_position, speed, duration_s, rate_hz=120.0, seed=0, t0=0.0, s0=
 class FakeBlockModel:
     """The part of control.ObservationModel the BCR uses, for white-noise blocks of `stream`.
 
-    The band feature of a white-noise block is log f + m (m fixed by the bands and tapers), with
-    a fixed covariance: both are estimated once from unit-variance noise, so the likelihood of
-    GD for a `stream` block is exactly Gaussian in the feature.
+    A white-noise block of variance f has log band powers log f + m and quantiles (less the
+    mean) sqrt(f) u, where m and u have a distribution that does not depend on f; their mean
+    and covariance are estimated once from unit-variance noise, so the likelihood of GD for a
+    `stream` block is Gaussian in (bands - log f, quantiles / sqrt(f)), with the Jacobian
+    f^(-1/2) of each quantile.
     """
 
     def __init__(self, spec=None, v_range=(0.5, 2.0)):
@@ -72,19 +74,24 @@ class FakeBlockModel:
         self.offset = feats.mean(axis=0)
         self.chol = np.linalg.cholesky(np.cov(feats.T))
         self.dim = feats.shape[1]
+        self.n_quantiles = len(self.spec.quantiles)
         self.gd = np.geomspace(200.0, 600.0, 121)
         self.speed_range = tuple(v_range)
         self.emulator = SimpleNamespace(t_names=["GD"], x_names=["v"])
         self.calls = 0
 
     def _d2(self, y, v):
-        mean = log_f(v, self.gd)[:, None] + self.offset[None, :]
-        r = np.linalg.solve(self.chol, (np.asarray(y)[None, :] - mean).T)
+        lf = log_f(v, self.gd)[:, None]  # (G, 1)
+        y = np.asarray(y)[None, :]
+        nb = self.dim - self.n_quantiles
+        unit = np.concatenate([y[:, :nb] - lf, y[:, nb:] / np.exp(0.5 * lf)], axis=1)
+        r = np.linalg.solve(self.chol, (unit - self.offset[None, :]).T)
         return np.sum(r**2, axis=0)
 
     def loglik(self, y, v):
         self.calls += 1
-        return -0.5 * self._d2(y, v)
+        jacobian = -0.5 * self.n_quantiles * log_f(v, self.gd)
+        return -0.5 * self._d2(y, v) + jacobian
 
     def plausibility(self, y, v):
         from scipy.stats import chi2

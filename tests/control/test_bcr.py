@@ -53,7 +53,7 @@ def test_every_block_gives_an_estimate_that_pools_on_steady_ground(block_model):
     )
     assert abs(np.mean(pooled) - 400) < 25
     assert ests[-1].prob_change < 0.2 and ests[-1].latency_s > 0
-    assert ests[-1].feature.shape == (8,) and ests[-1].data_time == pytest.approx(ests[-1].time)
+    assert ests[-1].feature.shape == (10,) and ests[-1].data_time == pytest.approx(ests[-1].time)
 
 
 def test_intervals_cover_the_truth_at_about_their_level():

@@ -248,7 +248,7 @@ def test_shipped_emulators_record_what_the_loop_checks():
         assert band.metadata["noise_std"] == noise
         assert FeatureSpec.from_dict(band.metadata["feature"]) == FeatureSpec()
         scatter = control.BlockScatter.from_dict(band.metadata["block_scatter"])
-        assert scatter.cov.shape[1:] == (8, 8) and scatter.speed[0] == pytest.approx(0.5)
+        assert scatter.cov.shape[1:] == (10, 10) and scatter.speed[0] == pytest.approx(0.5)
         window = control.shipped_emulator(case, "window")
         assert FeatureSpec.from_dict(window.metadata["feature"]) == PAPER_WINDOW
     with pytest.raises(ControlError, match="case must be one of"):

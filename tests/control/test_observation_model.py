@@ -40,15 +40,15 @@ def test_blocks_that_no_gd_explains_are_implausible(model):
     for shift in (-7.0, 7.0):  # the signal scaled by ~1/30 or ~30
         _, p = model.plausibility(mean[0] + shift, 1.5)
         assert p < 1e-12
-    shape = mean[0] + np.linspace(-3, 3, 8)  # a spectrum no road makes
+    shape = mean[0] + np.linspace(-3, 3, model.dim)  # a spectrum no road makes
     assert model.plausibility(shape, 1.5)[1] < 1e-6
 
 
 def test_bad_inputs_to_the_model(model):
-    with pytest.raises(ControlError, match="y must hold 8 finite values"):
+    with pytest.raises(ControlError, match="y must hold 10 finite values"):
         model.loglik(np.ones(7), 1.0)
     with pytest.raises(ControlError, match="outside the emulator's range"):
-        model.loglik(np.ones(8), 3.0)
+        model.loglik(np.ones(10), 3.0)
     with pytest.raises(EmulatorMismatchError, match="no 'block_scatter'"):
         ObservationModel(control.shipped_emulator("A", "window"))
     for kwargs, message in (
@@ -65,12 +65,13 @@ def test_block_statistics_and_scatter_of_white_noise():
     spec = control.FeatureSpec()
     accel = rng.standard_normal((12, 125 * 40)) * np.linspace(1.0, 3.0, 12)[:, None]
     stats_ = block_statistics(accel, spec)
-    assert stats_.mean.shape == (12, 8) and stats_.cov.shape == (12, 8, 8)
-    # a scale of the signal shifts every band by 2 log(scale)
-    np.testing.assert_allclose(stats_.mean[-1] - stats_.mean[0], 2 * np.log(3.0), atol=0.25)
+    assert stats_.mean.shape == (12, 10) and stats_.cov.shape == (12, 10, 10)
+    # a scale of the signal shifts every band by 2 log(scale) and scales each quantile by it
+    np.testing.assert_allclose(stats_.mean[-1, :8] - stats_.mean[0, :8], 2 * np.log(3.0), atol=0.25)
+    np.testing.assert_allclose(stats_.mean[-1, 8:] / stats_.mean[0, 8:], 3.0, rtol=0.1)
     speed = np.linspace(0.5, 2.0, 12)
     scatter = block_scatter(speed, stats_, nodes=np.linspace(0.5, 2.0, 4))
-    assert scatter.cov.shape == (4, 8, 8) and scatter.dof > 2
+    assert scatter.cov.shape == (4, 10, 10) and scatter.dof > 2
     again = BlockScatter.from_dict(scatter.to_dict())
     np.testing.assert_array_equal(again.cov, scatter.cov)
     with pytest.raises(ControlError, match="non-finite values"):
@@ -87,7 +88,7 @@ def test_feature_statistics_of_two_channels_side_by_side():
     12 runs x 16 batches: sd ~0.075, so the largest of 64 lies within ~0.25); a run that is too
     short or not finite is refused."""
     rng = np.random.default_rng(1)
-    spec = control.FeatureSpec()
+    spec = control.FeatureSpec(quantiles=())  # the band powers of each channel
     front, rear = (block_statistics(rng.standard_normal((12, 125 * 128)), spec) for _ in range(2))
     both = feature_statistics(np.concatenate([front.features, rear.features], axis=2))
     assert both.mean.shape == (12, 16) and both.cov.shape == (12, 16, 16)

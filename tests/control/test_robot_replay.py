@@ -63,7 +63,11 @@ def _assert_replay_is_the_loop(replayed, result):
     for name in ("sample_accel", "sample_position", "sample_speed"):
         assert np.array_equal(getattr(replayed, name), getattr(result, name)), name
     first_block = result.settings["bcr"].phases  # updates until a whole block, and its start-up
-    assert (replayed.status[first_block:] == "ok").all()
+    # clean data: estimates throughout, no fault; a block in the block law's far tail may be
+    # `implausible` (1 update in ~48,000 of 64 clean closed-loop runs), and each phase then
+    # skips its next block ("filling")
+    after = replayed.status[first_block:].tolist()
+    assert set(after) <= {"ok", "implausible", "filling"} and after.count("implausible") <= 1
 
 
 @pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
@@ -181,17 +185,21 @@ def test_a_faster_imu_resampled_gives_the_120_hz_estimates_within_their_error(
     # estimates of one filter do not share blocks (the default's three phases are replayed to the
     # last bit by the tests above)
     one_filter = control.bcr_settings_for(emulator_a, update_every=125)
+    # one drive sampled at 1,200 Hz, read by IMUs at 120, 200 and 400 Hz: the recordings differ
+    # by their rate alone (drives simulated at each rate part by the loop's chaos)
+    drive = _drive(track, 1200.0)
     runs = {}
-    for rate in (120.0, 200.0, 400.0):
-        t, pos, spd, acc = _drive(track, rate)
+    for rate in (120, 200, 400):
+        k = 1200 // rate
+        t, pos, spd, acc = (x[k - 1 :: k] for x in drive)
         cruise = t >= 2.0  # the recording starts at the cruising speed, as at every rate
         t, pos, spd, acc = t[cruise], pos[cruise], spd[cruise], acc[cruise]
-        odom = slice(None, None, int(rate // 40))  # odometry at 40 Hz
-        bag = write_sensor_bag(tmp_path / f"r{rate:.0f}", t, acc, t[odom], pos[odom], spd[odom])
+        odom = slice(None, None, rate // 40)  # odometry at 40 Hz
+        bag = write_sensor_bag(tmp_path / f"r{rate}", t, acc, t[odom], pos[odom], spd[odom])
         runs[rate] = replay_bag(bag, emulator_a, bcr=one_filter, likelihood=likelihood_a)
-    base = runs[120.0]
+    base = runs[120]
     assert not base.resampling.resampled
-    for rate in (200.0, 400.0):
+    for rate in (200, 400):
         r = runs[rate]
         assert r.resampling.resampled and r.resampling.rate_out_hz == 120.0
         assert "resample_poly" in r.resampling.filter and "Kaiser" in r.resampling.filter

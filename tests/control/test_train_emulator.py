@@ -63,7 +63,7 @@ def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypat
             assert set(emu.metadata["versions"]) >= {"numpy", "scipy", "exudyn", "python"}
             control.check_emulator(emu, model=vehicle.Jackal(), noise_std=noise)
     band = gpmsa.load(folder / "jackal_A.gpmsa")
-    assert band.l_sim == 8 and "block_scatter" in band.metadata
+    assert band.l_sim == 10 and "block_scatter" in band.metadata  # 8 bands, 2 quantiles
     assert (tmp_path / "lhs_design.png").is_file()
     track = roadgen.track([(15, 300)], seed=1)
     r = control.run_closed_loop(track, band, seed=1)
@@ -92,16 +92,18 @@ def test_vehicle_overrides_make_the_users_robot():
         script.vehicle_model(["weight=20"])
 
 
-def test_block_samples_and_n_pc_options_set_the_bcrs_block_and_the_basis(tmp_path):
+def test_block_samples_quantiles_and_n_pc_options_set_the_bcrs_block_and_the_basis(tmp_path):
     import gpmsa
 
     load_script().main(
         ["--out", str(tmp_path), "--n-runs", "16", "--n-iter", "200", "--keep-s", "12",
-         "--cases", "A", "--features", "band", "--block-samples", "80", "--n-pc", "8"]
+         "--cases", "A", "--features", "band", "--block-samples", "80", "--n-pc", "7",
+         "--quantiles"]
     )  # fmt: skip
     emu = gpmsa.load(tmp_path / "emulators" / "jackal_A.gpmsa")
-    assert emu.p_u == 8 and emu.metadata["fit"]["n_pc"] == 8
-    assert control.FeatureSpec.from_dict(emu.metadata["feature"]).block_samples == 80
+    assert emu.p_u == 7 and emu.metadata["fit"]["n_pc"] == 7 and emu.l_sim == 8
+    feature = control.FeatureSpec.from_dict(emu.metadata["feature"])
+    assert feature.block_samples == 80 and feature.quantiles == ()  # the band powers alone
     settings = control.bcr_settings_for(emu)
     every = -(-80 // DEFAULT_PHASES)  # the default's interleaved phases of 80-sample blocks
     assert settings.feature.block_samples == 80 and settings.samples_per_update == every
@@ -117,11 +119,20 @@ def test_block_samples_too_short_for_the_bands_is_refused(tmp_path, block, capsy
     assert "--block-samples" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("n_pc", ["0", "9"])
-def test_n_pc_outside_the_bands_is_refused(tmp_path, n_pc, capsys):
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--n-pc", "0"], "--n-pc must be in [1, 10]"),
+        (["--n-pc", "11"], "--n-pc must be in [1, 10]"),
+        (["--n-pc", "9", "--quantiles"], "--n-pc must be in [1, 8]"),
+        (["--quantiles", "0.9", "1.5"], "--quantiles: quantiles must be a sequence of levels"),
+        (["--quantiles", "0.98", "0.9"], "--quantiles: quantiles must be increasing"),
+    ],
+)
+def test_n_pc_beyond_the_outputs_and_bad_quantiles_are_refused(tmp_path, args, message, capsys):
     with pytest.raises(SystemExit):
-        load_script().main(["--out", str(tmp_path), "--n-pc", n_pc])
-    assert "--n-pc must be in [1, 8]" in capsys.readouterr().err
+        load_script().main(["--out", str(tmp_path), *args])
+    assert message in capsys.readouterr().err
 
 
 def test_a_slower_robots_emulators_and_a_simplex_within_their_speeds(tmp_path, capsys):
