@@ -17,14 +17,15 @@ records, case B with their noise level, and emulators that disagree on either, o
 domain, stop the run.
 
 Band emulator (``control.shipped_emulator(case, "band")``, the change-point BCR's): every
-125-sample block's log band-power vector (`control.block_features`); per cell
+125-sample block's feature vector (`control.block_features`: the log band powers, then the
+quantiles less the mean); per cell
 
-- ``z``: per band, (mean over the cell's blocks - ``emu.predict(v, GD, resid=False)``) in units
+- ``z``: per output, (mean over the cell's blocks - ``emu.predict(v, GD, resid=False)``) in units
   of its Monte-Carlo standard error (the cell's long-run block variance, batch means of 8
   blocks as `control.training`, over the number of blocks);
-- ``chi2``: d' (Sigma(v) / n)^-1 d over the 8 bands with the emulator's own block scatter Sigma(v)
-  (its metadata), and its chi-square(8) upper-tail probability ``p``; ``var`` is the cell's
-  long-run block variance over Sigma(v)'s, averaged over bands (1 when the scatter the
+- ``chi2``: d' (Sigma(v) / n)^-1 d over the K outputs with the emulator's own block scatter
+  Sigma(v) (its metadata), and its chi-square(K) upper-tail probability ``p``; ``var`` is the
+  cell's long-run block variance over Sigma(v)'s, averaged over outputs (1 when the scatter the
   likelihood assumes is right);
 - ``GD bias``: the maximum-likelihood GD of all the cell's blocks pooled
   (`control.ObservationModel.loglik` summed over the blocks, on an 801-node log grid refined by a
@@ -100,10 +101,12 @@ class Grid:
 
     @classmethod
     def over(cls, emu) -> Grid:
+        """The cells over ``emu``'s domain, rounded to 9 decimals: emulators trained on one
+        design with other library versions may bound it 1 ulp apart (2.0, 1.9999999999999998)."""
         (v_lo, v_hi), (g_lo, g_hi) = emu.domain["v"], emu.domain["GD"]
         return cls(
-            tuple(np.linspace(v_lo, v_hi, N_SPEEDS).tolist()),
-            tuple(np.linspace(g_lo, g_hi, N_GDS).tolist()),
+            tuple(np.round(np.linspace(v_lo, v_hi, N_SPEEDS), 9).tolist()),
+            tuple(np.round(np.linspace(g_lo, g_hi, N_GDS), 9).tolist()),
         )
 
 
@@ -442,9 +445,10 @@ def main(argv: list[str] | None = None) -> None:
     for case in args.cases:
         noise = "noise-free" if case == "A" else f"N(0, {noise_std:g}^2) noise"
         if "band" in args.features:
+            outputs = control.FeatureSpec.from_dict(emus[(case, "band")].metadata["feature"])
             print_cells(
-                f"band emulator, case {case} ({noise}): per cell, z per band (bands 1.5-4.5, "
-                "4.5-7, 7-10, 10-14, 14-20, 20-30, 30-45, 45-60 Hz)",
+                f"band emulator, case {case} ({noise}): per cell, z per output "
+                f"({', '.join(outputs.names())})",
                 band_cells(case, emus[(case, "band")], c, grid, rng),
                 grid,
                 band=True,

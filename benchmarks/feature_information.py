@@ -584,7 +584,7 @@ def main(argv: list[str] | None = None) -> None:
     print("(same runs, same stretches: block-length variants differ in stretch ends, still paired)")
     for case in ("A", "B"):
         print(f"\ncase {case}")
-        print(f"{'variant':<24}{'B':>5}{'K':>4} {'J +- se':>15} {'J_lin +- se':>15} {'cov':>5}"
+        print(f"{'variant':<34}{'B':>5}{'K':>4} {'J +- se':>15} {'J_lin +- se':>15} {'cov':>5}"
               f" {'J / bands':>15}")  # fmt: skip
         bands = None
         for name, (B, fields, extra) in BAND_VARIANTS.items():
@@ -597,7 +597,7 @@ def main(argv: list[str] | None = None) -> None:
                 bands = sc, per * B
             t = info_per_s(sc, per * B / RATE_HZ, rng)
             r, r_se = paired_j_ratio(sc, per * B, *bands, rng)
-            print(f"{name:<24}{B:5d}{f_tr.shape[2]:4d} {t['J']:7.2f} +- {t['se']:4.2f} "
+            print(f"{name:<34}{B:5d}{f_tr.shape[2]:4d} {t['J']:7.2f} +- {t['se']:4.2f} "
                   f"{t['Jlin']:7.2f} +- {t['se_lin']:4.2f} {t['cov']:5.2f} "
                   f"{r:7.3f} +- {r_se:5.3f}")  # fmt: skip
     print(f"\ntotal {time.perf_counter() - tic:.0f} s; {load()}")

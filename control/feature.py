@@ -242,8 +242,20 @@ def block_features(accel: np.ndarray, spec: FeatureSpec) -> np.ndarray:
         log_power = np.log(band * (spec.rate_hz / spec.block_samples))
     if not spec.quantiles:
         return log_power
-    tails = np.quantile(x, spec.quantiles, axis=1).T / STANDARD_GRAVITY  # x: mean taken off
+    tails = _quantiles(x, spec.quantiles) / STANDARD_GRAVITY  # x: the mean taken off
     return np.concatenate([log_power, tails], axis=1)
+
+
+def _quantiles(x: np.ndarray, levels: tuple[float, ...]) -> np.ndarray:
+    """(n, L) quantiles of each row of x (n, B) at ``levels``: numpy's default (linear) method,
+    from a partition around the order statistics it interpolates (a twentieth of np.quantile's
+    time for one block)."""
+    position = np.asarray(levels) * (x.shape[1] - 1)
+    below = np.floor(position).astype(int)
+    above = np.minimum(below + 1, x.shape[1] - 1)
+    ordered = np.partition(x, np.unique(np.concatenate([below, above])), axis=1)
+    weight = position - below
+    return ordered[:, below] + weight * (ordered[:, above] - ordered[:, below])
 
 
 def window_feature(accel: np.ndarray, feature: str = "log_var") -> float:

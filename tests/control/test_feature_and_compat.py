@@ -8,6 +8,8 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from scipy import stats  # noqa: E402
 
@@ -27,6 +29,7 @@ from control import (  # noqa: E402
     emulator_vehicle,
     window_feature,
 )
+from control.feature import _quantiles  # noqa: E402
 from control.plotting import plot_design, plot_gd_trace, plot_posterior_grid, plot_speed  # noqa: E402
 
 
@@ -194,6 +197,20 @@ def test_the_quantiles_are_the_blocks_upper_tail_less_its_mean_in_g():
     assert y[:, 8:].mean(axis=0) == pytest.approx(expected, rel=0.02)
     assert np.array_equal(y[:, :8], block_features(a, FeatureSpec(quantiles=())))
     assert np.allclose(block_features(a + 3.7, spec), y)  # an offset of 3.7 m/s^2
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    n=st.integers(2, 300),
+    levels=st.lists(st.floats(0.001, 0.999), min_size=1, max_size=5, unique=True),
+    seed=st.integers(0, 2**16),
+)
+def test_the_quantiles_are_numpys_linear_quantiles(n, levels, seed):
+    x = np.random.default_rng(seed).standard_normal((3, n)) * 4.0
+    levels = tuple(sorted(levels))
+    np.testing.assert_allclose(
+        _quantiles(x, levels), np.quantile(x, levels, axis=1).T, rtol=0, atol=1e-12
+    )
 
 
 def test_plots_return_figures_with_one_line_per_run():
