@@ -10,7 +10,7 @@ Two features (the emulator records which one it was trained on; training and BCR
   changes with GD (the 2-7 Hz bands grow faster than GD, the 7-10 Hz resonance band saturates),
   which one variance cannot see. Then the block's 90% and 98% quantiles, each minus the block's
   mean (in g): the upper tail of the distribution, where a wheel that left the ground lands,
-  which a spectrum cannot see; they add 13-17% to the information per second of the bands
+  which a spectrum cannot see; they add 14-17% to the information per second of the bands
   (`BAND_QUANTILES`; ``quantiles=()`` is the band vector alone).
 - ``"log_var"``: y = log f, f = var(a) normalised by T over a 1,000-sample window (the paper's
   eq. 5; the log makes the multiplicative window scatter additive). ``"var"``: f itself.
@@ -32,7 +32,7 @@ SCALAR_FEATURES = ("log_var", "var")
 BAND_EDGES_HZ = (1.5, 4.5, 7.0, 10.0, 14.0, 20.0, 30.0, 45.0, 60.0)
 BAND_QUANTILES = (0.9, 0.98)
 """Levels of the block quantiles the band feature appends by default (`FeatureSpec.quantiles`).
-The upper tail holds what the band powers miss: held out, they add 13-17% to the information
+The upper tail holds what the band powers miss: held out, they add 14-17% to the information
 per second about GD (benchmarks/feature_information.py, section 4), the lower tail and the
 flight time nothing (docs/closed-loop.md, "Which feature")."""
 STANDARD_GRAVITY = 9.80665
@@ -173,6 +173,8 @@ class FeatureSpec:
         known = {k: d[k] for k in cls.__dataclass_fields__ if k in d}
         for key in ("bands_hz", "quantiles"):
             if key in known:
+                if not isinstance(known[key], list | tuple):
+                    raise ControlError(f"{key} must be a list of numbers, got {known[key]!r}")
                 known[key] = tuple(known[key])
         known.setdefault("quantiles", ())  # written before the field existed: bands alone
         return cls(**known)

@@ -248,6 +248,17 @@ def test_training_and_the_bcr_map_a_variance_to_the_same_observation():
     np.testing.assert_allclose(ys, [np.log(4.0), np.nan, np.log(9.0)])
 
 
+def test_a_malformed_quantiles_record_is_refused_and_an_old_one_reads_as_bands_alone():
+    from control.compat import emulator_feature
+
+    record = FeatureSpec().to_dict()
+    for bad in (None, "0.9", [0.9, "x"], [1.5]):
+        with pytest.raises(EmulatorMismatchError, match="feature is malformed: .*quantiles"):
+            emulator_feature(fake_emulator(feature={**record, "quantiles": bad}))
+    old = {k: v for k, v in record.items() if k != "quantiles"}
+    assert emulator_feature(fake_emulator(feature=old)).quantiles == ()
+
+
 def test_the_emulators_vehicle_is_rebuilt_from_its_record():
     mine = vehicle.Jackal(mass_kg=21.5)
     assert emulator_vehicle(fake_emulator(vehicle=mine.describe())) == mine
