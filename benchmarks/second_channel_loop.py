@@ -66,8 +66,8 @@ SPEC = control.FeatureSpec(quantiles=())  # as measured: the band powers alone
 FRONT_PCS = 5
 """Principal components of the front axle's band-power emulator (as shipped when measured)."""
 CHANNELS = ("front", "rear", "synthesised")
-"""Channel sets: the front axle alone (shipped), front + rear accelerometer, front + rear axle
-synthesised from the front accelerometer and the gyro."""
+"""Channel sets: the front axle alone (its band powers, as shipped when measured), front + rear
+accelerometer, front + rear axle synthesised from the front accelerometer and the gyro."""
 TWO_CHANNEL_VARIANCE = 0.999  # principal components of the two-channel emulators: this share
 _MODELS: dict = {}
 
