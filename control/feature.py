@@ -36,7 +36,9 @@ The upper tail holds what the band powers miss: held out, they add 14-17% to the
 per second about GD (benchmarks/feature_information.py, section 4), the lower tail and the
 flight time nothing (docs/closed-loop.md, "Which feature")."""
 STANDARD_GRAVITY = 9.80665
-"""g, m/s^2: the unit of the feature's quantiles (of the order of the log band powers' spread)."""
+"""g, m/s^2: the unit of the feature's quantiles (of the order of the log band powers' spread).
+The standard value (a unit, fixed in the emulator files' training data), not the vehicle
+model's gravity (`vehicle.models.GRAVITY`, physics)."""
 MAX_BLOCK_SAMPLES = 4096
 """Longest block or window (34 s at 120 Hz, 4 s at 1 kHz). The sensor checks' level check
 compares every segment of a block with the rest, so its cost grows as the square of the block:
