@@ -445,7 +445,7 @@ def main(argv: list[str] | None = None) -> None:
     for case in args.cases:
         noise = "noise-free" if case == "A" else f"N(0, {noise_std:g}^2) noise"
         if "band" in args.features:
-            outputs = control.FeatureSpec.from_dict(emus[(case, "band")].metadata["feature"])
+            outputs = control.emulator_feature(emus[(case, "band")])
             print_cells(
                 f"band emulator, case {case} ({noise}): per cell, z per output "
                 f"({', '.join(outputs.names())})",

@@ -302,11 +302,15 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
-    try:
-        dim = band_feature(args).dim
-    except ValueError as exc:  # ControlError: too short for the bands, or bad levels
-        option = "--quantiles" if "quantiles" in str(exc) else "--block-samples"
-        parser.error(f"{option}: {exc}")
+    for option, fields in (
+        ("--quantiles", {"quantiles": tuple(args.quantiles)}),
+        ("--block-samples", {"block_samples": args.block_samples}),
+    ):
+        try:
+            dataclasses.replace(BAND_FEATURE, **fields)
+        except ValueError as exc:  # ControlError: bad levels, or too short for the bands
+            parser.error(f"{option}: {exc}")
+    dim = band_feature(args).dim
     if not 1 <= args.n_pc <= dim:
         parser.error(f"--n-pc must be in [1, {dim}] (the feature's outputs), got {args.n_pc}")
     band = "band" in args.features
