@@ -13,7 +13,11 @@ Steps (docs/closed-loop.md):
    bounds (the emulator's domain is the design's range, and the robot drives at exactly 2.0 m/s;
    a robot with another top speed trains to it, and drives with ``Simplex(v_max=...)`` inside
    the range: `control.check_emulator` refuses a Simplex whose speeds lie outside);
-   ``--speed-spacing arcsine`` places the speeds denser towards both ends of the range;
+   ``--speed-spacing arcsine`` places the speeds denser towards both ends of the range; the band
+   emulators' design adds ``--anchor-runs`` (198 // 6 = 33) runs, GD stratified, at each of
+   ``--anchor-speeds`` (default 1.0 and 2.0 m/s, the default Simplex's two speeds: where the
+   loop reads the emulator; for another ``--speed-range``, 1.0 m/s if it lies inside and the
+   range's top);
 2. one fresh road and one Jackal drive per point (``vehicle.run_campaign``), keeping the last
    ``--keep-s`` (120) seconds of front-axle accelerations, noise-free and with N(0, 1) noise;
 3. the block-feature emulators ``jackal_{A,B}.gpmsa`` (the change-point BCR's): per run, the
@@ -23,7 +27,8 @@ Steps (docs/closed-loop.md):
    covariance Sigma(v) and the Student-t dof, stored in the file's metadata (``block_scatter``)
    as the known observation noise of one block;
 4. the paper-feature emulators ``jackal_{A,B}_window.gpmsa`` (the paper's estimator and the
-   window filters): y = log f of the last 1,000 samples of each drive, with the GP nugget
+   window filters): y = log f of the last 1,000 samples of each drive of the Latin hypercube
+   (the paper's design, without the anchor runs), with the GP nugget
    describing the window scatter (its lamWs prior relaxed from GPM/SA's lower bound of 60 to 1).
 
 The files go to ``--emulator-dir`` (default ``OUT/emulators``); ``--ship`` writes them into the
@@ -80,6 +85,23 @@ MIN_RUNS = 4
 BATCH = 8
 """Blocks per batch of the band emulators' block scatter (`control.training.block_statistics`,
 which needs two batches per run: ``--keep-s`` >= 2 * BATCH * ``--block-samples`` / RATE_HZ)."""
+
+
+def default_anchor_speeds(speed_range: tuple[float, float]) -> list[float]:
+    """Default ``--anchor-speeds``, m/s: the default Simplex's safe speed (1.0 m/s) where it lies
+    in ``speed_range``, and the range's top, the speed the robot drives at in performance mode
+    (the default Simplex's v_max, 2.0 m/s, for the default range): where the loop reads the
+    emulator. On held-aside roads (12 a cell, 6,000-sweep fits, docs/closed-loop.md "The
+    emulators") runs on these lines took the band emulators' linearised RMS GD bias at 1.0 m/s
+    from 2.4% / 3.6% (A / B) to 1.3% / 2.0%, at 2.0 m/s from 2.4% / 2.2% to 1.7% / 1.9%, and
+    their own sd at 2.0 m/s from 6.5% / 5.0% to 3.3% / 2.7%."""
+    lo, hi = speed_range
+    v_safe = control.Simplex.v_safe
+    return ([float(v_safe)] if lo <= v_safe < hi else []) + [float(hi)]
+
+
+ANCHOR_SHARE = 6
+"""Default ``--anchor-runs``: ``--n-runs`` // this at each anchor speed (33 for the paper's 198)."""
 SPEED_SPACINGS = ("uniform", "arcsine")
 """Spacing of the design's speeds (``--speed-spacing``). A GP is least sure at the ends of its
 domain, and the loop drives at its top speed: with the same runs, arcsine spacing lowered the
@@ -110,6 +132,23 @@ def stretched_design(
         unit[:, 0] = 0.5 * (1.0 - np.cos(np.pi * unit[:, 0]))
     target_lo, target_hi = np.array([v_range[0], gd_range[0]]), np.array([v_range[1], gd_range[1]])
     return target_lo + unit * (target_hi - target_lo)
+
+
+def anchor_design(
+    speeds: tuple[float, ...], n_per_speed: int, seed: int, gd_range: tuple[float, float]
+) -> np.ndarray:
+    """``n_per_speed`` runs at each of ``speeds`` (m/s), GD stratified over ``gd_range``
+    (1e-6 m^3: one GD drawn uniformly in each of n_per_speed equal strata, a one-dimensional
+    Latin hypercube per speed), as rows [v, GD]. A GP is least sure along the edge of its domain,
+    and the Simplex drives at exactly its two speeds, so runs on those lines pin the emulator
+    where the loop reads it (docs/closed-loop.md, "The emulators")."""
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 1]))  # apart from the LHS's
+    lo, hi = gd_range
+    rows = []
+    for v in speeds:
+        strata = (rng.permutation(n_per_speed) + rng.uniform(size=n_per_speed)) / n_per_speed
+        rows.append(np.column_stack([np.full(n_per_speed, v), lo + strata * (hi - lo)]))
+    return np.concatenate(rows) if rows else np.empty((0, 2))
 
 
 def noise_std(case: str, args) -> float:
@@ -151,8 +190,12 @@ def vehicle_model(overrides: list[str]) -> vehicle.Jackal:
         raise ValueError(f"--vehicle: {exc}") from None
 
 
-def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict) -> dict:
-    """What the loop checks and what a reader of the file wants to know."""
+def metadata(
+    case: str, feature: FeatureSpec, model, campaign, args, extra: dict, anchored: bool = True
+) -> dict:
+    """What the loop checks and what a reader of the file wants to know (``anchored``: the fit
+    used the anchor runs as well as the Latin hypercube's)."""
+    speeds = list(args.anchor_speeds) if anchored else []
     return {
         "case": case,
         "vehicle": model.describe(),
@@ -167,9 +210,11 @@ def metadata(case: str, feature: FeatureSpec, model, campaign, args, extra: dict
             "drive_s": args.keep_s,
         },
         "design": {
-            "n": int(campaign.v.size),
+            "n": int(campaign.v.size) if anchored else args.n_runs,
             "seed": args.seed,
             "speed_spacing": args.speed_spacing,
+            "anchor_speeds": speeds,
+            "anchor_runs": args.anchor_runs if speeds else 0,
             "v_range": list(args.speed_range),
             "gd_range": list(args.gd_range),
         },
@@ -195,6 +240,25 @@ def check_shippable(parser: argparse.ArgumentParser, args) -> None:
                 "refuse them; write these emulators elsewhere with --emulator-dir DIR and run "
                 "closed_loop.py --emulator-dir DIR"
             )
+
+
+def check_anchors(parser: argparse.ArgumentParser, args) -> None:
+    """Refuse anchor speeds outside ``--speed-range`` and fewer than one run a speed; fill the
+    default ``--anchor-runs``; no anchors where no band emulator is fitted."""
+    v_lo, v_hi = args.speed_range
+    if "band" not in args.features:
+        args.anchor_speeds = []
+    elif args.anchor_speeds is None:
+        args.anchor_speeds = default_anchor_speeds((v_lo, v_hi))
+    for v in args.anchor_speeds:
+        if not (np.isfinite(v) and v_lo <= v <= v_hi):
+            parser.error(
+                f"--anchor-speeds {v:g}: must lie in --speed-range [{v_lo:g}, {v_hi:g}] m/s"
+            )
+    if args.anchor_runs is None:
+        args.anchor_runs = max(1, args.n_runs // ANCHOR_SHARE)
+    if args.anchor_speeds and args.anchor_runs < 1:
+        parser.error(f"--anchor-runs must be >= 1, got {args.anchor_runs}")
 
 
 def band_feature(args) -> FeatureSpec:
@@ -228,9 +292,10 @@ def fit_band(case: str, campaign, model, args):
 
 
 def fit_window(case: str, campaign, model, args):
-    """The paper-feature emulator of one case: log f of the last 1,000 samples of each drive."""
+    """The paper-feature emulator of one case: log f of the last 1,000 samples of each drive of
+    the Latin hypercube (the paper's design: the anchor runs are the band emulators')."""
     f = campaign.f_window if case == "A" else campaign.f_window_noisy
-    ok = np.isfinite(f) & (f > 0)
+    ok = np.isfinite(f) & (f > 0) & (np.arange(f.size) < args.n_runs)
     data = gpmsa.SimData(
         x=campaign.v[ok, None], t=campaign.gd[ok, None],
         y=feature_of_variance(f[ok], "log_var")[:, None],
@@ -240,7 +305,7 @@ def fit_window(case: str, campaign, model, args):
     extra = {"fit": {"n_iter": args.n_iter, "lamWs_prior": [1.0, 1e-3, 1.0, 1e5]}}
     return gpmsa.fit(
         data, n_iter=args.n_iter, seed=args.seed, progress=True, priors=WINDOW_PRIORS,
-        metadata=metadata(case, PAPER_WINDOW, model, campaign, args, extra),
+        metadata=metadata(case, PAPER_WINDOW, model, campaign, args, extra, anchored=False),
     )  # fmt: skip
 
 
@@ -268,6 +333,17 @@ def main(argv: list[str] | None = None) -> None:
         "--speed-spacing", default="uniform", choices=SPEED_SPACINGS,
         help="spacing of the design's speeds: uniform (the paper's LHS) or arcsine (denser "
         "towards both ends of --speed-range)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--anchor-speeds", nargs="*", type=float, default=None, metavar="V",
+        help="speeds, m/s, at which --anchor-runs runs are added to the band emulators' design, "
+        "GD stratified: your Simplex's v_safe and v_max, where the loop reads the emulator "
+        "(default: the default Simplex's v_safe, 1.0, if in --speed-range, and the range's top; "
+        "the option alone: none)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--anchor-runs", type=int, default=None,
+        help=f"runs added at each of --anchor-speeds (default: --n-runs // {ANCHOR_SHARE})",
     )  # fmt: skip
     parser.add_argument("--cases", nargs="+", default=["A", "B"], choices=["A", "B"])
     parser.add_argument(
@@ -345,6 +421,7 @@ def main(argv: list[str] | None = None) -> None:
         )
     if args.ship:
         check_shippable(parser, args)
+    check_anchors(parser, args)
     out = output_folder(parser, "--out", args.out)
     if args.ship:
         emu_dir = output_folder(parser, "--ship", EMULATOR_DIR)
@@ -353,9 +430,13 @@ def main(argv: list[str] | None = None) -> None:
     else:
         emu_dir = output_folder(parser, "--out", out / "emulators")
 
-    design = stretched_design(
-        args.n_runs, args.seed, tuple(args.gd_range), tuple(args.speed_range), args.speed_spacing
-    )
+    design = np.concatenate([
+        stretched_design(
+            args.n_runs, args.seed, tuple(args.gd_range), tuple(args.speed_range),
+            args.speed_spacing,
+        ),
+        anchor_design(tuple(args.anchor_speeds), args.anchor_runs, args.seed, tuple(args.gd_range)),
+    ])  # fmt: skip
     save_figure(plot_design(design[:, 0], design[:, 1]), out / "lhs_design.png", dpi=150)
     tic = time.perf_counter()
     campaign = vehicle.run_campaign(

@@ -108,6 +108,16 @@ CASES = [
     ("examples/train_emulator.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
     (
         "examples/train_emulator.py",
+        ["--anchor-speeds", "1.0", "2.5"],
+        "--anchor-speeds 2.5: must lie in --speed-range [0.5, 2] m/s",
+    ),
+    (
+        "examples/train_emulator.py",
+        ["--anchor-speeds", "1.0", "--anchor-runs", "0"],
+        "--anchor-runs must be >= 1, got 0",
+    ),
+    (
+        "examples/train_emulator.py",
         ["--ship", "--speed-range", "0.5", "1.5"],
         "--ship with --speed-range 0.5 1.5: the shipped files must cover [1, 2] m/s",
     ),

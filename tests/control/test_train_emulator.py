@@ -43,6 +43,30 @@ def test_arcsine_speed_spacing_keeps_the_latin_order_and_crowds_the_ends():
         script.stretched_design(10, seed=0, speed_spacing="chebyshev")
 
 
+def test_anchor_runs_lie_on_their_speeds_one_per_gd_stratum():
+    script = load_script()
+    rows = script.anchor_design((1.0, 2.0), 20, seed=5, gd_range=(200.0, 600.0))
+    assert rows.shape == (40, 2)
+    for k, v in enumerate((1.0, 2.0)):
+        line = rows[20 * k : 20 * (k + 1)]
+        assert np.all(line[:, 0] == v)
+        strata = np.floor((line[:, 1] - 200.0) / 20.0).astype(int)
+        assert sorted(strata) == list(range(20))  # one GD in each 20-wide stratum
+    # the two speeds draw their GDs apart, and the seed decides them
+    assert not np.allclose(np.sort(rows[:20, 1]), np.sort(rows[20:, 1]))
+    again = script.anchor_design((1.0, 2.0), 20, seed=5, gd_range=(200.0, 600.0))
+    assert np.array_equal(rows, again)
+    assert script.anchor_design((), 20, seed=5, gd_range=(200.0, 600.0)).shape == (0, 2)
+
+
+@pytest.mark.parametrize(
+    "speed_range, anchors",
+    [((0.5, 2.0), [1.0, 2.0]), ((0.5, 1.5), [1.0, 1.5]), ((0.5, 1.0), [1.0]), ((1.2, 3.0), [3.0])],
+)
+def test_default_anchors_are_the_safe_speed_inside_the_range_and_its_top(speed_range, anchors):
+    assert load_script().default_anchor_speeds(speed_range) == anchors
+
+
 def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypatch):
     script = load_script()
     shipped = {p: p.stat().st_mtime_ns for p in script.EMULATOR_DIR.glob("*.gpmsa")}
@@ -64,6 +88,13 @@ def test_small_training_run_gives_emulators_the_loop_accepts(tmp_path, monkeypat
             control.check_emulator(emu, model=vehicle.Jackal(), noise_std=noise)
     band = gpmsa.load(folder / "jackal_A.gpmsa")
     assert band.l_sim == 10 and "block_scatter" in band.metadata  # 8 bands, 2 quantiles
+    # the band emulators add 24 // 6 runs at each of the default Simplex's speeds; the paper's
+    # window emulators keep the paper's Latin hypercube
+    design = band.metadata["design"]
+    assert (design["n"], design["anchor_speeds"], design["anchor_runs"]) == (32, [1.0, 2.0], 4)
+    assert band.m == 32 and np.sum(band.zt[:, 0] == 1.0) >= 4  # zt: inputs scaled to [0, 1]
+    window = gpmsa.load(folder / "jackal_A_window.gpmsa").metadata["design"]
+    assert (window["n"], window["anchor_speeds"], window["anchor_runs"]) == (24, [], 0)
     assert (tmp_path / "lhs_design.png").is_file()
     track = roadgen.track([(15, 300)], seed=1)
     r = control.run_closed_loop(track, band, seed=1)
@@ -146,6 +177,7 @@ def test_a_slower_robots_emulators_and_a_simplex_within_their_speeds(tmp_path, c
     band = gpmsa.load(folder / "jackal_A.gpmsa")
     assert band.domain["v"] == pytest.approx((0.5, 1.5))
     assert band.metadata["design"]["v_range"] == [0.5, 1.5]
+    assert band.metadata["design"]["anchor_speeds"] == [1.0, 1.5]  # its safe and top speeds
     assert band.metadata["block_scatter"]["speed_mps"][-1] == pytest.approx(1.5)
     track = roadgen.track([(8, 300)], seed=3)
     with pytest.raises(control.EmulatorMismatchError, match="v_max = 2 m/s lies outside"):
