@@ -85,21 +85,6 @@ MIN_RUNS = 4
 BATCH = 8
 """Blocks per batch of the band emulators' block scatter (`control.training.block_statistics`,
 which needs two batches per run: ``--keep-s`` >= 2 * BATCH * ``--block-samples`` / RATE_HZ)."""
-
-
-def default_anchor_speeds(speed_range: tuple[float, float]) -> list[float]:
-    """Default ``--anchor-speeds``, m/s: the default Simplex's safe speed (1.0 m/s) where it lies
-    in ``speed_range``, and the range's top, the speed the robot drives at in performance mode
-    (the default Simplex's v_max, 2.0 m/s, for the default range): where the loop reads the
-    emulator. On held-aside roads (12 a cell, 6,000-sweep fits, docs/closed-loop.md "The
-    emulators") runs on these lines took the band emulators' linearised RMS GD bias at 1.0 m/s
-    from 2.4% / 3.6% (A / B) to 1.3% / 2.0%, at 2.0 m/s from 2.4% / 2.2% to 1.7% / 1.9%, and
-    their own sd at 2.0 m/s from 6.5% / 5.0% to 3.3% / 2.7%."""
-    lo, hi = speed_range
-    v_safe = control.Simplex.v_safe
-    return ([float(v_safe)] if lo <= v_safe < hi else []) + [float(hi)]
-
-
 ANCHOR_SHARE = 6
 """Default ``--anchor-runs``: ``--n-runs`` // this at each anchor speed (33 for the paper's 198)."""
 SPEED_SPACINGS = ("uniform", "arcsine")
@@ -113,6 +98,19 @@ leaves the closed loop where it was, so the shipped emulators keep uniform spaci
 calibrates at any speed of the range may prefer it (docs/closed-loop.md, "The emulators")."""
 BOOLEANS = {"1": True, "true": True, "yes": True, "on": True,
             "0": False, "false": False, "no": False, "off": False}  # fmt: skip
+
+
+def default_anchor_speeds(speed_range: tuple[float, float]) -> list[float]:
+    """Default ``--anchor-speeds``, m/s: the default Simplex's safe speed (1.0 m/s) where it lies
+    in ``speed_range``, and the range's top, the speed the robot drives at in performance mode
+    (the default Simplex's v_max, 2.0 m/s, for the default range): where the loop reads the
+    emulator. On held-aside roads (12 a cell, 6,000-sweep fits, docs/closed-loop.md "The
+    emulators") runs on these lines took the band emulators' linearised RMS GD bias at 1.0 m/s
+    from 2.4% / 3.6% (A / B) to 1.3% / 2.0%, at 2.0 m/s from 2.4% / 2.2% to 1.7% / 1.9%, and
+    their own sd at 2.0 m/s from 6.5% / 5.0% to 3.3% / 2.7%."""
+    lo, hi = speed_range
+    v_safe = control.Simplex.v_safe
+    return ([float(v_safe)] if lo <= v_safe < hi else []) + [float(hi)]
 
 
 def stretched_design(
