@@ -618,20 +618,42 @@ class BCR:
         steady driving: the share of the newest block's worth of samples each has seen; while
         no information comes, the weights stay). One phase: its own posterior."""
         recent = self.settings.recent_change_m
-        if len(self._phases) == 1:
-            only = self._phases[0].filter
-            return only.posterior(self.gd_name), only.prob_change_within(recent)
-        # at least one phase has data: an estimate is made only then
-        used = sorted(
-            (ph for ph in self._phases if ph.filter.has_data), key=lambda ph: -ph.data_time
-        )
-        filters = [ph.filter for ph in used]
-        weights = np.arange(len(self._phases), len(self._phases) - len(used), -1, dtype=float)
+        filters, weights = self._pooled_filters()
+        if len(filters) == 1:
+            return filters[0].posterior(self.gd_name), filters[0].prob_change_within(recent)
         change = np.array([f.prob_change_within(recent) for f in filters])
         return (
             mixture_posterior(filters, weights, self.gd_name),
             float(weights @ change / weights.sum()),
         )
+
+    def _pooled_filters(self) -> tuple[list[ChangePointFilter], np.ndarray]:
+        """The phases' filters that hold data (all of them with one phase), newest information
+        first, and their weights in the pooled estimate (`_pooled_posterior`)."""
+        if len(self._phases) == 1:
+            return [self._phases[0].filter], np.ones(1)
+        used = sorted(
+            (ph for ph in self._phases if ph.filter.has_data), key=lambda ph: -ph.data_time
+        )
+        weights = np.arange(len(self._phases), len(self._phases) - len(used), -1, dtype=float)
+        return [ph.filter for ph in used], weights
+
+    def mass_by_run(self, edges_m) -> np.ndarray:
+        """The pooled GD posterior split by the distance since the last change
+        (`ChangePointFilter.mass_by_run` of each phase, mixed as the estimate mixes them): row i
+        holds the mass of the runs that began more than ``edges_m[i-1]`` and at most
+        ``edges_m[i]`` metres ago (row 0 from 0, the last row beyond ``edges_m[-1]``), per node
+        of ``model.gd``; the rows sum to the posterior mass. It shows how much of an estimate
+        rests on a recent change. Method "changepoint" only, after an estimate."""
+        if self.settings.method != "changepoint":
+            raise ControlError(
+                f"mass_by_run needs method 'changepoint', not {self.settings.method!r}"
+            )
+        filters, weights = self._pooled_filters()
+        if not any(f.has_data for f in filters):
+            raise ControlError("mass_by_run: no block has been used yet")
+        parts = np.array([f.mass_by_run(edges_m) for f in filters])
+        return np.einsum("f,fcg->cg", weights / weights.sum(), parts)
 
     # --- the window methods (the paper's, and the previous filters) -----------------------------
 

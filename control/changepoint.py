@@ -87,14 +87,9 @@ class ChangePointFilter:
     """The filter on a fixed GD grid (native units, increasing, positive); see the module doc."""
 
     def __init__(self, gd: np.ndarray, settings: ChangePointSettings | None = None) -> None:
-        gd = float_array(gd, "gd")
-        if not (
-            gd.ndim == 1 and gd.size >= 3 and np.all(np.isfinite(gd)) and gd[0] > 0
-            and np.all(np.diff(gd) > 0)
-        ):  # fmt: skip
-            raise ControlError(
-                f"gd must be an increasing 1-D grid of >= 3 positive, finite values, got {gd}"
-            )
+        gd = _increasing_positive(
+            gd, "gd", 3, "an increasing 1-D grid of >= 3 positive, finite values"
+        )
         s = ChangePointSettings() if settings is None else settings
         check_instance(s, "settings", ChangePointSettings)
         self.settings = s
@@ -190,6 +185,19 @@ class ChangePointFilter:
             return float("nan")
         return float(min(1.0, self._mass[self._dist <= distance_m].sum()))
 
+    def mass_by_run(self, edges_m) -> np.ndarray:
+        """GD mass per run-length class: row i holds the runs that began more than
+        ``edges_m[i-1]`` and at most ``edges_m[i]`` metres ago (row 0 from 0, so that its mass is
+        `prob_change_within` of ``edges_m[0]``; the last row beyond ``edges_m[-1]``); the rows
+        sum to `gd_mass`. ``edges_m``: increasing, positive, finite, m."""
+        edges = _increasing_positive(
+            edges_m, "edges_m", 1, "increasing, positive, finite distances (m)"
+        )
+        cls = np.searchsorted(edges, self._dist, side="left")  # run length -> class
+        out = np.zeros((edges.size + 1, self.gd.size))
+        np.add.at(out, cls, self._mass)
+        return out
+
     def expected_run_m(self) -> float:
         """Posterior mean of the distance since the last change, m."""
         return float(self._mass.sum(axis=1) @ self._dist)
@@ -225,6 +233,18 @@ def _grid_posterior(gd, weights, mass, name: str, n_draws: int) -> Posterior:
         draw=lambda: {name: marginal.sample(np.random.default_rng(0), n_draws)},
         info={"method": "changepoint", "names": (name,)},
     )
+
+
+def _increasing_positive(values, name: str, min_size: int, what: str) -> np.ndarray:
+    """``values`` as a 1-D float array of >= ``min_size`` increasing, positive, finite values;
+    otherwise a ControlError saying it must be ``what``."""
+    a = float_array(values, name)
+    if not (
+        a.ndim == 1 and a.size >= min_size and np.all(np.isfinite(a)) and a[0] > 0
+        and np.all(np.diff(a) > 0)
+    ):  # fmt: skip
+        raise ControlError(f"{name} must be {what}, got {a}")
+    return a
 
 
 def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:

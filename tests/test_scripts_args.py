@@ -63,6 +63,18 @@ CASES = [
     ("benchmarks/second_channel_loop.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
     ("benchmarks/sensor_checks.py", ["--keep-s", "0.5"], "--keep-s must be >= 1.04 s"),
     ("benchmarks/sensor_checks.py", ["--seed", "-3"], "--seed must be >= 0, got -3"),
+    ("benchmarks/steady_hedge.py", ["--roads", "1"], "--roads must be >= 2 (a standard error"),
+    (
+        "benchmarks/steady_hedge.py",
+        ["--gd", "700"],
+        "--gd 700: outside emulator A's GDs [200, 600]",
+    ),
+    (
+        "benchmarks/steady_hedge.py",
+        ["--speeds", "3"],
+        "--speeds 3: outside A's speeds [0.5, 2] m/s",
+    ),
+    ("benchmarks/steady_hedge.py", ["--cases", "C"], "--cases must be among"),
     ("benchmarks/vehicle_speed.py", ["--runs", "0"], "--runs must be >= 1, got 0"),
     ("examples/ball_drop.py", ["--runs", "11"], "--runs must be >= 12"),
     ("examples/ball_drop.py", ["--out", FILE], "--out " + NOT_A_FOLDER),

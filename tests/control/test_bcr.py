@@ -227,6 +227,21 @@ def test_interleaved_phases_each_pool_their_own_disjoint_blocks(block_model, eve
     assert ests[-1].gd_sd == pytest.approx(one[-1].gd_sd, rel=0.15)
 
 
+def test_the_pooled_mass_by_run_length_is_the_estimates_posterior(block_model, fake_calibrator):
+    t, p, a, v = stream(const(400), 1.5, 30, seed=4)
+    bcr = BCR(block_model)
+    with pytest.raises(ControlError, match="no block has been used yet"):
+        bcr.mass_by_run([5.0])
+    est = feed(bcr, t, p, a, v, chunk=EVERY)[-1]
+    parts = bcr.mass_by_run([5.0, 15.0])
+    marginal = est.posterior.grids["GD"]
+    mass = marginal.density * marginal.weights
+    np.testing.assert_allclose(parts.sum(axis=0), mass / mass.sum(), rtol=1e-9, atol=1e-300)
+    assert parts[0].sum() == pytest.approx(est.prob_change, rel=1e-9)  # 5 m = recent_change_m
+    with pytest.raises(ControlError, match="needs method 'changepoint'"):
+        BCR(fake_calibrator, method="window", **WINDOW).mass_by_run([5.0])
+
+
 def test_with_phases_the_estimate_holds_still_while_no_information_comes(block_model):
     """Crawling (speed below the emulator's range): no phase learns anything, so the pooled
     estimate must not alternate with the phase that happens to update; it only drifts as the

@@ -88,6 +88,28 @@ def test_state_and_restore_undo_a_block():
     np.testing.assert_array_equal(f.gd_mass, before)
 
 
+def test_the_mass_by_run_length_sums_to_the_posterior_and_moves_after_a_step():
+    f = ChangePointFilter(GD)
+    for _ in range(40):
+        f.update(gauss_loglik(300.0), 1.5)
+    parts = f.mass_by_run([5.0, 15.0])
+    assert parts.shape == (3, GD.size)
+    np.testing.assert_allclose(parts.sum(axis=0), f.gd_mass, rtol=1e-12)
+    assert parts[0].sum() == pytest.approx(f.prob_change_within(5.0))
+    assert parts[2].sum() > 0.5  # steady ground: most mass on the long run
+    # the short runs hold the hedge that the roughness just changed: away from the truth
+    short_mean = parts[0] @ GD / parts[0].sum()
+    long_mean = parts[2] @ GD / parts[2].sum()
+    assert abs(short_mean - 300) > abs(long_mean - 300)
+    for _ in range(4):
+        f.update(gauss_loglik(500.0), 1.5)
+    after = f.mass_by_run([5.0, 15.0])
+    assert after[0].sum() + after[1].sum() > 0.5  # a step: the mass moves to recent runs
+    for bad in ([], [0.0, 5.0], [15.0, 5.0], [5.0, np.inf], "5", [[5.0]]):
+        with pytest.raises(ControlError, match="edges_m must be"):
+            f.mass_by_run(bad)
+
+
 def test_bad_settings_and_inputs():
     with pytest.raises(ControlError, match="mean_segment_m must be finite and > 0"):
         ChangePointSettings(mean_segment_m=0.0)
