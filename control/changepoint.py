@@ -189,7 +189,10 @@ class ChangePointFilter:
         """GD mass per run-length class: row i holds the runs that began more than
         ``edges_m[i-1]`` and at most ``edges_m[i]`` metres ago (row 0 from 0, so that its mass is
         `prob_change_within` of ``edges_m[0]``; the last row beyond ``edges_m[-1]``); the rows
-        sum to `gd_mass`. ``edges_m``: increasing, positive, finite, m."""
+        sum to `gd_mass`. ``edges_m``: increasing, positive, finite, m. Needs a block (before
+        any, the filter holds the prior and no run length, as `prob_change_within` says)."""
+        if not self._has_data:
+            raise ControlError("mass_by_run: no block has been used yet")
         edges = _increasing_positive(
             edges_m, "edges_m", 1, "increasing, positive, finite distances (m)"
         )

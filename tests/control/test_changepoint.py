@@ -90,6 +90,8 @@ def test_state_and_restore_undo_a_block():
 
 def test_the_mass_by_run_length_sums_to_the_posterior_and_moves_after_a_step():
     f = ChangePointFilter(GD)
+    with pytest.raises(ControlError, match="no block has been used yet"):
+        f.mass_by_run([5.0])
     for _ in range(40):
         f.update(gauss_loglik(300.0), 1.5)
     parts = f.mass_by_run([5.0, 15.0])
