@@ -61,6 +61,9 @@ NOISE_STD = {"A": 0.0, "B": 1.0}
 PAPER_RMSE = {("A", 300.0): 42.58, ("A", 500.0): 94.42, ("B", 300.0): 50.19, ("B", 500.0): 96.23}
 STEADY_GD = (250.0, 300.0, 350.0, 400.0, 450.0, 500.0, 550.0)
 STEADY_SPEEDS = (1.0, 1.5, 2.0)
+STEADY_ROAD_M = 100.0
+STEADY_SCORED_AFTER_M = 25.0
+"""The steady set: single-GD roads of STEADY_ROAD_M metres, scored after STEADY_SCORED_AFTER_M."""
 SETS = {
     "paper": range(1, 4),
     "heldout": range(11, 21),
@@ -95,6 +98,11 @@ def _model(case: str, method: str, emulator_dir: str | None):
     return _MODELS[key]
 
 
+def steady_simplex(speed: float) -> control.Simplex:
+    """The steady set's controller: a constant ``speed``, m/s (v_max = v_safe)."""
+    return control.Simplex(v_max=speed, v_safe=speed, law="switch")
+
+
 def _run(job: tuple) -> dict:
     """One closed-loop run; returns its per-update traces and metrics."""
     case, kind, seed, method, cp, extra, emulator_dir, update_every, speed_step, interval = job
@@ -105,8 +113,8 @@ def _run(job: tuple) -> dict:
     simplex = control.Simplex(speed_step_mps=speed_step)
     if kind == "steady":
         gd, speed = extra
-        segments = ((100.0, gd),)
-        simplex = control.Simplex(v_max=speed, v_safe=speed, law="switch")
+        segments = ((STEADY_ROAD_M, gd),)
+        simplex = steady_simplex(speed)
     elif kind == "random":
         segments = random_segments(seed)
     else:
@@ -228,7 +236,8 @@ def report_steady(results, case: str) -> list[str]:
     runs = [r for r in results if r["kind"] == "steady" and r["case"] == case]
     roads = len({r["seed"] for r in runs})
     lines = [
-        f"{case}: steady roads ({roads} a cell), estimates after 25 m: relative bias / RMSE "
+        f"{case}: steady roads ({roads} a cell), estimates after {STEADY_SCORED_AFTER_M:g} m: "
+        "relative bias / RMSE "
         "(target 5% / 10%), standard errors over roads in brackets"
     ]
     worst_bias = worst_rmse = (0.0, 0.0)
@@ -236,8 +245,12 @@ def report_steady(results, case: str) -> list[str]:
     for gd in STEADY_GD:
         cells = []
         for v in STEADY_SPEEDS:
-            rel = [r["mean"][r["position"] > 25.0] / gd - 1 for r in runs if r["extra"] == (gd, v)]
-            rel = [x[np.isfinite(x)] for x in rel]  # a road with none after 25 m is left out
+            rel = [
+                r["mean"][r["position"] > STEADY_SCORED_AFTER_M] / gd - 1
+                for r in runs
+                if r["extra"] == (gd, v)
+            ]
+            rel = [x[np.isfinite(x)] for x in rel]  # a road with none scored is left out
             bias, bias_se = control.clustered_mean(rel)
             mse, mse_se = control.clustered_mean([x**2 for x in rel])
             rmse = np.sqrt(mse)

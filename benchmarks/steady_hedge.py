@@ -21,8 +21,10 @@ leans inwards ("Why steady roads miss 5% / 10%" in docs/closed-loop.md).
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
 import numpy as np
 
@@ -30,11 +32,16 @@ import control
 import roadgen
 from control.bcr import emulator_domain
 
-NOISE_STD = {"A": 0.0, "B": 1.0}
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from closed_loop_accuracy import (  # noqa: E402  (the steady set's definition)
+    NOISE_STD,
+    STEADY_ROAD_M,
+    STEADY_SCORED_AFTER_M,
+    steady_simplex,
+)
+
 EDGES_M = (5.0, 15.0)
 CLASSES = ("< 5 m", "5-15 m", ">= 15 m")
-ROAD_M = 100.0
-SCORED_AFTER_M = 25.0
 _EMULATORS: dict[str, object] = {}
 
 
@@ -67,13 +74,13 @@ def replay(result: control.ClosedLoopResult, emulator) -> tuple[np.ndarray, ...]
 def _run(job: tuple[str, float, float, int]) -> dict:
     case, gd, speed, seed = job
     emu = _emulator(case)
-    track = roadgen.track(((ROAD_M, gd),), seed=seed)
-    simplex = control.Simplex(v_max=speed, v_safe=speed, law="switch")
+    track = roadgen.track(((STEADY_ROAD_M, gd),), seed=seed)
+    simplex = steady_simplex(speed)
     r = control.run_closed_loop(track, emu, noise_std=NOISE_STD[case], seed=seed, simplex=simplex)
     means, parts, nodes = replay(r, emu)
     if not np.array_equal(means, r.gd_mean, equal_nan=True):
         raise RuntimeError(f"the replay of {job} did not reproduce the loop's estimates")
-    keep = (r.position > SCORED_AFTER_M) & np.isfinite(means)
+    keep = (r.position > STEADY_SCORED_AFTER_M) & np.isfinite(means)
     mass = parts[keep].sum(axis=2)  # (k, classes)
     with np.errstate(invalid="ignore", divide="ignore"):
         cond = parts[keep] @ nodes / mass  # conditional mean of GD per class
@@ -135,8 +142,9 @@ def main() -> None:
         results = list(pool.map(_run, jobs))
     print(
         f"steady roads {args.first_seed}-{args.first_seed + args.roads - 1} ({args.roads} a cell), "
-        f"estimates after {SCORED_AFTER_M:g} m of {ROAD_M:g}; bias (se clustered by road), and per "
-        f"class of the distance since the last change: mean mass, mean GD, part of the bias"
+        f"estimates after {STEADY_SCORED_AFTER_M:g} m of {STEADY_ROAD_M:g}; bias (se clustered "
+        "by road), and per class of the distance since the last change: mean mass, mean GD, part "
+        "of the bias"
     )
     for case in cases:
         for gd in args.gd:
