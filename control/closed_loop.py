@@ -18,7 +18,14 @@ from control.compat import bcr_settings_for, check_emulator, check_likelihood
 from control.errors import ControlError
 from control.estimate import Estimate
 from control.faults import FaultInjector, SensorFault
-from control.metrics import GDError, detection_delays, fast_on_rough_m, gd_errors, segment_index
+from control.metrics import (
+    GDError,
+    detection_delays,
+    fast_on_rough_m,
+    gd_errors,
+    segment_index,
+    strict_json,
+)
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_instance, is_real
@@ -63,15 +70,21 @@ class LoopMetrics:
         return self.traversal_time_s / self.wall_time_s
 
     def rmse(self, gd: float) -> float:
-        """RMSE of the estimates on the parts with prescribed GD `gd` (NaN if none)."""
+        """RMSE of the estimates on the parts with prescribed GD `gd` (NaN where those parts
+        hold no estimate, e.g. shorter than the first block); ControlError for a `gd` that no
+        part of the track has, or that is not a number."""
+        if not is_real(gd):
+            raise ControlError(f"gd must be a real number, got {gd!r} ({type(gd).__name__})")
         for e in self.gd_errors:
             if e.gd == gd:
                 return e.rmse
-        return np.nan
+        track_gds = ", ".join(f"{e.gd:g}" for e in self.gd_errors)
+        raise ControlError(f"no part of the track has prescribed GD {gd:g}; its GDs: {track_gds}")
 
     def as_dict(self) -> dict:
-        """JSON-able summary."""
-        return {
+        """JSON-able summary (`strict_json`: a value that is not finite, e.g. ``latched_at_s``
+        of a run that never latched or the RMSE of a part without estimates, is None)."""
+        summary = {
             "rmse": {f"{e.gd:g}": e.rmse for e in self.gd_errors},
             "n_estimates": {f"{e.gd:g}": e.n for e in self.gd_errors},
             "detection_delay_m": list(self.detection_delay_m),
@@ -85,6 +98,7 @@ class LoopMetrics:
             "coverage": self.coverage,
             "latched_at_s": self.latched_at_s,
         }
+        return strict_json(summary)
 
 
 @dataclass(frozen=True, eq=False)

@@ -16,7 +16,7 @@ import numpy as np
 
 import vehicle
 from control.bcr import BCRSettings, emulator_domain
-from control.errors import ControlWarning, EmulatorMismatchError
+from control.errors import ControlError, ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
@@ -39,9 +39,21 @@ def _vehicle_diff(trained, model) -> str:
     )
 
 
+def _check_is_emulator(emulator) -> None:
+    """ControlError for an argument that is not an emulator at all (a case name, a path, None),
+    before any message about its records could send the user to retrain it."""
+    if not hasattr(emulator, "metadata"):
+        raise ControlError(
+            f"emulator must be a gpmsa.Emulator (gpmsa.load(path), or "
+            f"control.shipped_emulator(case) for the shipped ones), got {emulator!r:.80} "
+            f"({type(emulator).__name__})"
+        )
+
+
 def _recorded(emulator, key: str, what: str):
     """The emulator's metadata ``key``; EmulatorMismatchError saying it does not say ``what``
     when the record is missing."""
+    _check_is_emulator(emulator)
     meta = dict(getattr(emulator, "metadata", None) or {})
     if key not in meta:
         raise EmulatorMismatchError(
@@ -94,6 +106,7 @@ def check_emulator(
     data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
     want it); vehicle or noise metadata missing.
     """
+    _check_is_emulator(emulator)
     meta = dict(getattr(emulator, "metadata", None) or {})
     if model is not None:
         if "vehicle" not in meta:
@@ -208,6 +221,7 @@ def emulator_vehicle(emulator):
 def emulator_noise_std(emulator) -> float | None:
     """The accelerometer noise sd the emulator was trained with (metadata ``noise_std``), m/s^2;
     None when it is missing, not a positive number, or 0 (noise-free training data)."""
+    _check_is_emulator(emulator)
     meta = dict(getattr(emulator, "metadata", None) or {})
     try:
         value = float(meta.get("noise_std", 0.0))

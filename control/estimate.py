@@ -123,6 +123,14 @@ class Estimate:
     plausibility_p: float = np.nan
     domain_edge: str = ""
 
+    def __post_init__(self) -> None:
+        if self.status not in STATUSES:
+            raise ControlError(f"status must be one of {STATUSES}, got {self.status!r}")
+        if self.domain_edge not in ("", *DOMAIN_EDGES):
+            raise ControlError(
+                f"domain_edge must be '' or one of {DOMAIN_EDGES}, got {self.domain_edge!r}"
+            )
+
     @property
     def ok(self) -> bool:
         """True when the estimate carries a usable posterior."""

@@ -50,7 +50,7 @@ import numpy as np
 
 from control.errors import ControlError
 from control.estimate import FAULT_STATUSES, Estimate
-from control.validation import require_reals
+from control.validation import check_instance, require_reals
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
@@ -167,6 +167,7 @@ class Simplex:
 
     def command(self, estimate: Estimate) -> Command:
         """The speed command for one BCR estimate, memoryless (no latch: see `start`)."""
+        check_instance(estimate, "estimate", Estimate)
         if not estimate.ok:
             return Command(self.v_safe, "safety", np.nan, f"no estimate ({estimate.status})")
         if self.risk is None:
@@ -215,6 +216,7 @@ class SimplexRun:
 
     def command(self, estimate: Estimate) -> Command:
         """The speed command for the next estimate of the run."""
+        check_instance(estimate, "estimate", Estimate)
         s = self.simplex
         if s.after_fault == "latch" and not self.latched and self._latches(estimate):
             self.latched_by = estimate

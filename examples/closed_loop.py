@@ -67,9 +67,10 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
     return tuple(segments)
 
 
-def figure(value: float, spec: str) -> str:
-    """`value` formatted with `spec`, or "-" when it is NaN (no estimate, a change never seen)."""
-    return "-" if np.isnan(value) else format(value, spec)
+def figure(value: float | None, spec: str) -> str:
+    """`value` formatted with `spec`, or "-" when it is NaN or None (no estimate, a change never
+    seen: `LoopMetrics.as_dict` gives None)."""
+    return "-" if value is None or np.isnan(value) else format(value, spec)
 
 
 def run_case(

@@ -26,6 +26,7 @@ from control.errors import ControlError
 from control.robot import messages as msgs
 from control.robot.bags import merge_in_time, sensor_messages, to_ns
 from control.robot.extra import require
+from control.validation import check_instance
 from gpmsa.io.atomic import atomic_write
 
 TOPICS = {
@@ -84,8 +85,10 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     Returns:
         the path written. Raises `MissingExtraError` without the ``robot`` extra.
     """
+    from control.closed_loop import ClosedLoopResult
     from control.robot.replay import estimate_message
 
+    check_instance(result, "result", ClosedLoopResult)
     writer_mod = require("mcap.writer", "recording a run as MCAP")
     if not isinstance(start_ns, int | np.integer) or start_ns < 0:
         raise ControlError(f"start_ns must be an integer >= 0, got {start_ns!r}")

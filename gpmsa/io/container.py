@@ -279,6 +279,10 @@ def _check_directory(fh, size: int, path) -> None:
     at = tail.rfind(b"PK\x05\x06")
     if at < 0 or len(tail) - at < 22:
         raise _fail(path, "not a gpmsa emulator file (not a readable zip: no end record)")
+    (comment_len,) = struct.unpack("<H", tail[at + 20 : at + 22])
+    if (extra := len(tail) - (at + 22 + comment_len)) != 0:
+        what = f"{extra} bytes follow" if extra > 0 else "a truncated comment ends"
+        raise _fail(path, f"damaged zip: {what} the end record (appended to, or cut?)")
     entries, cd_size = struct.unpack("<xxxxxxxxxxHI", tail[at : at + 16])
     if entries == 0xFFFF or cd_size == 0xFFFFFFFF:  # a zip64 record: read that one
         loc = tail[at - 20 : at] if at >= 20 else b""

@@ -238,7 +238,9 @@ def check_increasing(grid: np.ndarray, name: str) -> None:
 
 
 def _check_spans(arr: np.ndarray, name: str, names) -> None:
-    """GPMSAError naming a design column that is constant or whose range overflows float64."""
+    """GPMSAError naming a design column that is constant (its span within 1e-12 of its largest
+    magnitude, so that a column in small units, e.g. a permeability in m^2, still varies) or
+    whose range overflows float64."""
     with np.errstate(over="ignore", invalid="ignore"):
         span = arr.max(axis=0) - arr.min(axis=0)
     for j in range(arr.shape[1]):
@@ -247,7 +249,7 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
         if not np.isfinite(span[j]):
             raise GPMSAError(f"design column {label} spans [{col.min()}, {col.max()}]: its width "
                              "overflows float64; rescale it (e.g. other units)")  # fmt: skip
-        if span[j] <= 1e-12 * max(1.0, float(np.abs(col).max())):
+        if span[j] <= 1e-12 * float(np.abs(col).max()):  # relative: small units are fine
             raise GPMSAError(f"design column {label} is constant ({col[0]}); every input must vary")
 
 

@@ -131,6 +131,36 @@ def test_estimate_quantile_takes_one_probability(q):
         est.quantile(q)
 
 
+def test_an_estimate_names_a_status_or_edge_it_does_not_know():
+    with pytest.raises(ControlError, match=r"status must be one of \('ok', 'filling'.*got 'bogus'"):
+        Estimate(time=0.0, position=0.0, status="bogus")
+    with pytest.raises(ControlError, match="domain_edge must be '' or one of .*got 'top'"):
+        Estimate(time=0.0, position=0.0, status="ok", domain_edge="top")
+
+
+def test_the_simplex_and_the_recorder_name_an_argument_of_the_wrong_kind(tmp_path):
+    for simplex in (Simplex(), Simplex().start()):
+        with pytest.raises(ControlError, match="estimate must be a control.Estimate, got None"):
+            simplex.command(None)
+    with pytest.raises(ControlError, match="result must be a control.ClosedLoopResult, got 'r'"):
+        control.record_run("r", tmp_path / "run.mcap")
+    assert not (tmp_path / "run.mcap").exists()
+
+
+@pytest.mark.parametrize("emulator", ["B", None, control.shipped_emulator_path("B")])
+def test_something_other_than_an_emulator_is_named_not_sent_to_retraining(emulator):
+    track = roadgen.track([(30, 300)], seed=1)
+    why = r"emulator must be a gpmsa.Emulator \(gpmsa.load\(path\), or control.shipped_emulator"
+    for call in (
+        lambda: control.run_closed_loop(track, emulator, seed=1),
+        lambda: BCR.from_emulator(emulator),
+        lambda: control.check_emulator(emulator),
+        lambda: control.emulator_noise_std(emulator),
+    ):
+        with pytest.raises(ControlError, match=why):
+            call()
+
+
 def test_settings_of_the_wrong_kind_are_named(emulator_a):
     with pytest.raises(ControlError, match="settings must be a control.BCRSettings, got {}"):
         BCR.from_emulator(emulator_a, {})

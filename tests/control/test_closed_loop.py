@@ -48,6 +48,22 @@ def test_the_loop_drives_to_the_end_and_scores_itself(short_run):
     assert set(m.as_dict()) >= {"rmse", "detection_delay_m", "fast_on_rough_m", "coverage"}
 
 
+def test_metrics_refuse_a_gd_the_track_lacks_and_dump_as_strict_json(short_run):
+    import json
+
+    m = short_run[1].metrics
+    assert m.rmse(300) == m.rmse(np.float64(300.0)) == m.gd_errors[0].rmse
+    with pytest.raises(ControlError, match="no part of the track has prescribed GD 400; its GDs: "
+                       "300, 500"):  # fmt: skip
+        m.rmse(400)
+    for bad in ("300", None, True):
+        with pytest.raises(ControlError, match="gd must be a real number"):
+            m.rmse(bad)
+    summary = m.as_dict()
+    assert np.isnan(m.latched_at_s) and summary["latched_at_s"] is None  # never latched
+    assert json.loads(json.dumps(summary, allow_nan=False)) == summary
+
+
 def test_safety_mode_whenever_the_estimate_exceeds_gd_max(short_run):
     _, r = short_run
     ok = r.status == "ok"

@@ -327,3 +327,18 @@ def test_valid_priors_round_trip_through_the_file_checks(theta_mean, theta_sd, r
                        lamUz=gpmsa.GammaPrior(a, b, 0.3))  # fmt: skip
     check_priors(pri.to_dict())
     assert gpmsa.Priors.from_dict(pri.to_dict()) == pri
+
+
+def test_a_design_column_in_small_units_varies():
+    """Constancy is judged relative to the column's own size: a parameter in m^2 (1e-15 to 1e-13)
+    is a design column like any other, and the emulator is the same as in scaled units."""
+    rng = np.random.default_rng(0)
+    k, x = 10 ** rng.uniform(-15, -13, (40, 1)), rng.uniform(0, 1, (40, 1))
+    y = np.log10(k) + x
+    small = gpmsa.SimData(x=x, t=k, y=y, t_names=["k"])
+    scaled = gpmsa.SimData(x=x, t=k * 1e14, y=y, t_names=["k"])
+    emus = [gpmsa.fit(d, n_iter=100, seed=0) for d in (small, scaled)]
+    for name in emus[0].params:
+        np.testing.assert_allclose(emus[0].params[name], emus[1].params[name], rtol=1e-9)
+    with pytest.raises(gpmsa.GPMSAError, match=r"design column k is constant \(1e-14\)"):
+        gpmsa.SimData(x=x, t=np.full((40, 1), 1e-14), y=y, t_names=["k"])

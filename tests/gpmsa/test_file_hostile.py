@@ -340,6 +340,21 @@ def test_zip_bomb_member_refused_from_its_header(saved, tmp_path):
         gpmsa.load(path)
 
 
+def test_bytes_after_the_zip_end_record_are_refused(saved, tmp_path):
+    """zip readers skip what follows the end record, so an appended or concatenated file would
+    load as if whole; the reader names it instead, and a zip comment that overruns the file."""
+    raw = saved["scalar"].read_bytes()
+    appended = tmp_path / "appended.gpmsa"
+    appended.write_bytes(raw + b"trailing")
+    with pytest.raises(gpmsa.EmulatorFileError, match="8 bytes follow the end record"):
+        gpmsa.load(appended)
+    overrun = tmp_path / "overrun.gpmsa"
+    overrun.write_bytes(raw[:-2] + (40).to_bytes(2, "little"))  # comment length 40, none there
+    with pytest.raises(gpmsa.EmulatorFileError, match="a truncated comment ends the end record"):
+        gpmsa.load(overrun)
+    assert gpmsa.load(saved["scalar"]).metadata == {"vehicle": "jackal"}
+
+
 # --- the writer ---------------------------------------------------------------------------------
 def test_zero_padded_outputs_save_and_load(tmp_path):
     """The issue's 30 runs x 20,000 outputs padded with zeros: written (the zero members stored
