@@ -36,7 +36,12 @@ more past the start of a segment) whose speed command moved by more than 0.2 m/s
 before, per run: how much the estimate's scatter shakes the robot.
 
 ``--emulator-dir DIR`` takes the band emulators ``DIR/jackal_{A,B}.gpmsa`` (as written by
-``examples/train_emulator.py --emulator-dir DIR``) instead of the shipped ones.
+``examples/train_emulator.py --emulator-dir DIR``) instead of the shipped ones, and the window
+emulators ``DIR/jackal_{A,B}_window.gpmsa`` for the paper's method where DIR holds them (else the
+shipped ones). Every run drives the vehicle and the noise level that the case's band emulator
+records (`control.emulator_vehicle`, `control.emulator_noise_std`), so emulators trained for
+another robot (``train_emulator.py --vehicle ... --noise-std ...``) are scored on that robot; the
+paper's method must then have been trained for it as well (``--features band window``).
 
 Targets (issue 12): paper track, seeds 1-3 and 11-20, cases A and B: RMSE <= 35 on the GD-300
 parts and <= 60 on the GD-500 part; steady roads: |bias| <= 5% and RMSE <= 10% of GD at every
@@ -49,12 +54,13 @@ import argparse
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import replace
+from dataclasses import fields, replace
 
 import numpy as np
 
 import control
 import roadgen
+import vehicle
 
 PAPER_TRACK = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 NOISE_STD = {"A": 0.0, "B": 1.0}
@@ -85,16 +91,41 @@ def random_segments(seed: int) -> tuple[tuple[float, float], ...]:
     )
 
 
+def emulator_for(case: str, method: str, emulator_dir: str | None):
+    """The emulator a run of ``method`` reads: with ``emulator_dir``, the band emulator there
+    and the window emulator there if DIR holds one (else the shipped one); otherwise the
+    shipped ones."""
+    kind = "band" if method == "changepoint" else "window"
+    if emulator_dir and (kind == "band" or window_in(emulator_dir, case)):
+        return control.shipped_emulator(case, kind, emulator_dir)
+    return control.shipped_emulator(case, kind)
+
+
+def window_in(emulator_dir: str, case: str) -> bool:
+    """Whether ``emulator_dir`` holds the case's window emulator (a damaged one still raises
+    when it is read)."""
+    try:
+        control.shipped_emulator_path(case, "window", emulator_dir)
+    except control.ControlError:  # the file is missing
+        return False
+    return True
+
+
+def driven(emulator) -> tuple:
+    """(vehicle, accelerometer noise sd in m/s^2) that ``emulator`` was trained for: what the
+    runs drive, so that a folder of emulators for another robot is scored on its own robot."""
+    return control.emulator_vehicle(emulator), control.emulator_noise_std(emulator) or 0.0
+
+
 def _model(case: str, method: str, emulator_dir: str | None):
-    """(emulator, BCR settings, prepared likelihood) per worker process."""
+    """(emulator, BCR settings, prepared likelihood, (vehicle, noise sd) driven) per worker
+    process; both methods drive the vehicle and noise of the case's band emulator."""
     key = (case, method, emulator_dir)
     if key not in _MODELS:
-        if method == "changepoint" and emulator_dir:
-            emu = control.shipped_emulator(case, "band", emulator_dir)
-        else:
-            emu = control.shipped_emulator(case, "band" if method == "changepoint" else "window")
+        emu = emulator_for(case, method, emulator_dir)
         bcr = control.bcr_settings_for(emu, method=method)
-        _MODELS[key] = (emu, bcr, control.BCR.from_emulator(emu, bcr).model)
+        ground = driven(emulator_for(case, "changepoint", emulator_dir))
+        _MODELS[key] = (emu, bcr, control.BCR.from_emulator(emu, bcr).model, ground)
     return _MODELS[key]
 
 
@@ -106,7 +137,7 @@ def steady_simplex(speed: float) -> control.Simplex:
 def _run(job: tuple) -> dict:
     """One closed-loop run; returns its per-update traces and metrics."""
     case, kind, seed, method, cp, extra, emulator_dir, update_every, speed_step, interval = job
-    emu, bcr, likelihood = _model(case, method, emulator_dir)
+    emu, bcr, likelihood, (model, noise_std) = _model(case, method, emulator_dir)
     bcr = replace(bcr, interval_kind=interval)
     if method == "changepoint":
         bcr = replace(bcr, changepoint=cp, update_every=update_every)
@@ -121,7 +152,7 @@ def _run(job: tuple) -> dict:
         segments = PAPER_TRACK
     track = roadgen.track(segments, seed=seed)
     r = control.run_closed_loop(
-        track, emu, noise_std=NOISE_STD[case], seed=seed, bcr=bcr, simplex=simplex,
+        track, emu, model=model, noise_std=noise_std, seed=seed, bcr=bcr, simplex=simplex,
         likelihood=likelihood,
     )  # fmt: skip
     steps = [(segments[k - 1][1], segments[k][1]) for k in range(1, len(segments))]
@@ -271,6 +302,41 @@ def report_steady(results, case: str) -> list[str]:
     return lines
 
 
+def check_window_ground(parser: argparse.ArgumentParser, cases, emulator_dir: str) -> None:
+    """Refuse a window emulator (the paper's method, sets paper and heldout) made for another
+    vehicle or noise level than the band emulator of the same case in ``emulator_dir``."""
+    for case in cases:
+        model, noise = driven(emulator_for(case, "changepoint", emulator_dir))
+        window = emulator_for(case, "window", emulator_dir)
+        where = "DIR's" if window_in(emulator_dir, case) else "the shipped"
+        try:
+            control.check_emulator(window, model=model)
+            window_noise = control.emulator_noise_std(window) or 0.0
+            if not np.isclose(window_noise, noise):
+                raise control.EmulatorMismatchError(
+                    f"it was trained with noise sd {window_noise:g} m/s^2, the band emulator "
+                    f"with {noise:g}"
+                )
+        except control.EmulatorMismatchError as exc:
+            parser.error(
+                f"--emulator-dir: the sets paper and heldout run the paper's method on {where} "
+                f"window emulator of case {case}, which does not fit the band emulator's robot "
+                f"({exc}); train both for it (examples/train_emulator.py --features band window "
+                f"--emulator-dir {emulator_dir}) or leave those sets out"
+            )
+
+
+def vehicle_changes(model) -> str:
+    """The vehicle's fields that differ from the default `vehicle.Jackal`, as NAME=VALUE."""
+    default = vehicle.Jackal()
+    changed = [
+        f"{f.name}={getattr(model, f.name)!r}"
+        for f in fields(model)
+        if getattr(model, f.name) != getattr(default, f.name)
+    ]
+    return " ".join(changed) or "the default Jackal"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     defaults = control.ChangePointSettings()
@@ -351,6 +417,8 @@ def main() -> None:
                 control.shipped_emulator_path(c, "band", args.emulator_dir)
         except control.ControlError as exc:
             parser.error(f"--emulator-dir: {exc}")
+        if {"paper", "heldout"} & set(names):
+            check_window_ground(parser, cases, args.emulator_dir)
     numbers = {"--mean-segment": ("mean_segment_m", args.mean_segment),
                "--shape": ("segment_shape", args.shape),
                "--min-jump": ("min_jump", args.min_jump),
@@ -395,7 +463,10 @@ def main() -> None:
         print(f"our estimates every {args.update_every} samples")
     print(f"Simplex speed step {args.speed_step:g} m/s; {args.interval} credible intervals")
     if args.emulator_dir:
-        print(f"band emulators from {args.emulator_dir}")
+        print(f"band emulators from {args.emulator_dir}, driving what they were trained for:")
+        for case in cases:
+            model, noise = driven(emulator_for(case, "changepoint", args.emulator_dir))
+            print(f"  case {case}: {vehicle_changes(model)}, noise sd {noise:g} m/s^2")
     if "random" in names:
         last = args.random_first_seed + args.random_tracks - 1
         print(f"random set: seeds {args.random_first_seed}-{last}")

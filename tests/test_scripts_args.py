@@ -1,13 +1,18 @@
 """Bad command-line arguments of the benchmark and example scripts are usage errors: exit status
 2 and a one-line message naming the option and the value, before any long work (no traceback
-from deep inside a library)."""
+from deep inside a library). Also: the accuracy benchmark drives the robot that its emulators
+record."""
 
+import importlib.util
 import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+
+import control
+import vehicle
 
 ROOT = Path(__file__).resolve().parents[1]
 FILE = "{file}"
@@ -158,3 +163,51 @@ def test_bad_argument_is_a_usage_error_naming_it(tmp_path, script, argv, message
     (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
     assert message.replace(FILE, repr(str(a_file))) in error
     assert a_file.read_text() == "kept"
+
+
+def _load_benchmark(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _emulators_for_another_robot(folder: Path, noise_std: float) -> Path:
+    """The shipped band emulator of case A, its record changed to a 21.5 kg Jackal and the
+    given training noise, saved in ``folder``."""
+    emu = control.shipped_emulator("A", "band")
+    emu.metadata["vehicle"] = vehicle.Jackal(mass_kg=21.5).describe()
+    emu.metadata["noise_std"] = noise_std
+    folder.mkdir()
+    emu.save(folder / "jackal_A.gpmsa")
+    return folder
+
+
+def test_accuracy_benchmark_drives_the_robot_its_emulators_record(tmp_path) -> None:
+    bench = _load_benchmark("closed_loop_accuracy")
+    for case in ("A", "B"):  # the shipped emulators: the default Jackal and the cases' noise
+        emu = bench.emulator_for(case, "changepoint", None)
+        assert bench.driven(emu) == (vehicle.Jackal(), bench.NOISE_STD[case])
+    folder = str(_emulators_for_another_robot(tmp_path / "mine", noise_std=0.3))
+    model, noise = bench.driven(bench.emulator_for("A", "changepoint", folder))
+    assert (model, noise) == (vehicle.Jackal(mass_kg=21.5), 0.3)
+    assert bench.vehicle_changes(model) == "mass_kg=21.5"
+    assert bench.vehicle_changes(vehicle.Jackal()) == "the default Jackal"
+    # no window emulator in the folder: the paper's method reads the shipped one
+    window = bench.emulator_for("A", "window", folder)
+    assert window.metadata == control.shipped_emulator("A", "window").metadata
+
+
+def test_accuracy_benchmark_refuses_a_paper_method_for_another_robot(tmp_path) -> None:
+    folder = _emulators_for_another_robot(tmp_path / "mine", noise_std=0.0)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    argv = ["--sets", "paper", "--cases", "A", "--emulator-dir", str(folder)]
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks/closed_loop_accuracy.py"), *argv],
+        capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
+    )  # fmt: skip
+    assert done.returncode == 2, done.stderr[-2000:]
+    (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
+    assert "the shipped window emulator of case A, which does not fit" in error
+    assert "mass_kg: model 21.5 vs emulator" in error
+    assert "--features band window" in error
