@@ -59,6 +59,7 @@ from dataclasses import fields, replace
 import numpy as np
 
 import control
+import gpmsa
 import roadgen
 import vehicle
 
@@ -307,8 +308,11 @@ def check_window_ground(parser: argparse.ArgumentParser, cases, emulator_dir: st
     vehicle or noise level than the band emulator of the same case in ``emulator_dir``."""
     for case in cases:
         model, noise = driven(emulator_for(case, "changepoint", emulator_dir))
-        window = emulator_for(case, "window", emulator_dir)
-        where = "DIR's" if window_in(emulator_dir, case) else "the shipped"
+        try:
+            window = emulator_for(case, "window", emulator_dir)
+        except (control.ControlError, gpmsa.EmulatorFileError) as exc:  # damaged, wrong kind
+            parser.error(f"--emulator-dir: {exc}")
+        where = f"{emulator_dir}'s" if window_in(emulator_dir, case) else "the shipped"
         try:
             control.check_emulator(window, model=model)
             window_noise = control.emulator_noise_std(window) or 0.0
@@ -412,10 +416,10 @@ def main() -> None:
     if not cases or not set(cases) <= set(NOISE_STD):
         parser.error(f"--cases must be among {list(NOISE_STD)}, got {args.cases!r}")
     if args.emulator_dir:
-        try:
+        try:  # each case's band emulator, and the robot it records, before any run
             for c in cases:
-                control.shipped_emulator_path(c, "band", args.emulator_dir)
-        except control.ControlError as exc:
+                driven(emulator_for(c, "changepoint", args.emulator_dir))
+        except (control.ControlError, gpmsa.EmulatorFileError) as exc:
             parser.error(f"--emulator-dir: {exc}")
         if {"paper", "heldout"} & set(names):
             check_window_ground(parser, cases, args.emulator_dir)

@@ -211,3 +211,29 @@ def test_accuracy_benchmark_refuses_a_paper_method_for_another_robot(tmp_path) -
     assert "the shipped window emulator of case A, which does not fit" in error
     assert "mass_kg: model 21.5 vs emulator" in error
     assert "--features band window" in error
+
+
+def test_accuracy_benchmark_refuses_emulators_it_cannot_drive(tmp_path) -> None:
+    """A band emulator without a vehicle record, or a damaged file, is a usage error naming it."""
+    unrecorded = tmp_path / "unrecorded"
+    unrecorded.mkdir()
+    emu = control.shipped_emulator("A", "band")
+    del emu.metadata["vehicle"]
+    emu.save(unrecorded / "jackal_A.gpmsa")
+    damaged = tmp_path / "damaged"
+    damaged.mkdir()
+    (damaged / "jackal_A.gpmsa").write_bytes(b"not a zip")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    for folder, message in (
+        (unrecorded, "the emulator's metadata has no 'vehicle'"),
+        (damaged, "jackal_A.gpmsa: not a gpmsa emulator file"),
+    ):
+        argv = ["--sets", "random", "--cases", "A", "--emulator-dir", str(folder)]
+        done = subprocess.run(
+            [sys.executable, str(ROOT / "benchmarks/closed_loop_accuracy.py"), *argv],
+            capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
+        )  # fmt: skip
+        assert done.returncode == 2, done.stderr[-2000:]
+        assert "Traceback" not in done.stderr
+        (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
+        assert "--emulator-dir: " in error and message in error
