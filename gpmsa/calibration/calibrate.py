@@ -226,7 +226,9 @@ def calibrate(
         info["diagnostics"] = summarize(chains)
         shapes = {k: v.shape[2:] for k, v in chains.items()}
         info["convergence"] = convergence(info["diagnostics"], shapes, n_chains, n_samples - n_burn)
-        warn_unconverged(info["convergence"], f"gpmsa.calibrate (backend {backend!r})")
+        warn_unconverged(
+            info["convergence"], f"gpmsa.calibrate (backend {backend!r})", length="n_samples"
+        )
     return Posterior(samples, chains=chains, info=info)
 
 

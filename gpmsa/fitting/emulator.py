@@ -28,7 +28,14 @@ from gpmsa.io.container import check_path, jsonable, read_raw, write_raw
 from gpmsa.limits import check_memory
 from gpmsa.model import categorical as categorical_mod
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import SimData, as_float, as_matrix, check_count, check_flag
+from gpmsa.model.data import (
+    SimData,
+    as_float,
+    as_matrix,
+    by_column_names,
+    check_count,
+    check_flag,
+)
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
@@ -264,6 +271,8 @@ class Emulator:
         return self._factors[-1]
 
     def _inputs(self, x, t) -> np.ndarray:
+        x = by_column_names(x, self.x_names, "x")
+        t = by_column_names(t, self.t_names, "t")
         x = as_matrix(x, "x", ncols=self.p) if np.ndim(x) != 1 or self.p != 1 else as_matrix(x, "x")
         t = as_matrix(t, "t", ncols=self.q) if np.ndim(t) != 1 or self.q != 1 else as_matrix(t, "t")
         if x.shape[0] != t.shape[0]:

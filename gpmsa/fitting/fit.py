@@ -153,6 +153,7 @@ def fit(
         "tune": bool(tune), "backend": backend, "seed": seed, "point": point,
         "n_pc": int(prep.K.shape[1]), "joint_obs": obs is not None,
         "obs_lengths": None if obs is None else [int(e.size) for e in obs.experiments],
+        "obs_sha256": None if obs is None else obs.digest(),
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),

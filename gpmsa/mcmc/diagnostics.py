@@ -143,8 +143,9 @@ def convergence(
     }
 
 
-def warn_unconverged(record: dict, what: str, stacklevel: int = 3) -> None:
-    """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record."""
+def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str = "n_iter") -> None:
+    """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record
+    and the caller's argument ``length`` that sets the chains' length."""
     from gpmsa.errors import ConvergenceWarning
 
     flagged = record.get("flagged") or {}
@@ -154,6 +155,6 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3) -> None:
     warnings.warn(
         f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "
         f"chains x {record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
-        f"{record['ess_min']:.0f}): {items}. Run longer chains (n_iter) or more of them.",
+        f"{record['ess_min']:.0f}): {items}. Run longer chains ({length}) or more of them.",
         ConvergenceWarning, stacklevel=stacklevel,
     )  # fmt: skip

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -82,6 +83,19 @@ def check_flag(value, name: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
         raise GPMSAError(f"{name} must be True or False, got {value!r}")
     return bool(value)
+
+
+def by_column_names(value, names, name: str):
+    """A table with named columns (a pandas DataFrame: anything with ``columns``) as its columns
+    in the order of ``names``; any other value as it is. GPMSAError naming ``name`` when the
+    table's columns are not ``names`` (in some order): its columns are never read by position."""
+    columns = getattr(value, "columns", None)
+    if columns is None or names is None or isinstance(value, np.ndarray):
+        return value
+    labels, names = [str(c) for c in columns], list(names)
+    if sorted(labels) != sorted(names):
+        raise GPMSAError(f"{name} has the columns {labels}; expected {names} (in any order)")
+    return value[names]
 
 
 def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
@@ -386,6 +400,19 @@ class ObsData:
         object.__setattr__(self, "precisions", self._precisions(self.precision, ys))
         ragged = len({len(e) for e in ys}) > 1
         object.__setattr__(self, "y", ys if ragged else np.stack(ys))
+
+    def digest(self) -> str:
+        """SHA-256 of the observations (x, every experiment's y, grid and precision, as float64):
+        a joint fit records it, so a prediction conditioned on other observations is refused."""
+        h = hashlib.sha256()
+        parts = [self.x, *self.experiments, *(g for g in self.grids if g is not None)]
+        parts += self.precisions or []
+        for k, part in enumerate(parts):
+            arr = np.ascontiguousarray(part, dtype="<f8")
+            h.update(f"{k}:{arr.shape}".encode())
+            h.update(arr.tobytes())
+        h.update(f"grids:{[g is None for g in self.grids]}".encode())
+        return h.hexdigest()
 
     @staticmethod
     def _experiments(y, n: int) -> list[np.ndarray]:

@@ -6,6 +6,7 @@ import numpy as np
 from scipy.special import ndtri
 
 from gpmsa.errors import GPMSAError
+from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.data import SimData, check_count, check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.crossval import CrossValidation
@@ -29,6 +30,8 @@ def pc_basis(emulator, *, max_pc: int = 6):
         >>> len(fig.axes)     # 2 components x (basis + 2 inputs)
         6
     """
+    if not isinstance(emulator, Emulator):
+        raise GPMSAError(f"emulator must be a gpmsa.Emulator, got {type(emulator).__name__}")
     std = emulator.standardizer
     p_u = min(emulator.p_u, check_count(max_pc, "max_pc"))
     scalar = emulator.l_sim == 1
@@ -57,6 +60,31 @@ def pc_basis(emulator, *, max_pc: int = 6):
             if ax is row[0]:
                 ax.set_ylabel(f"w{j + 1}")
     return fig
+
+
+def _held_out_inputs(emulator, held_out: SimData) -> tuple[np.ndarray, np.ndarray]:
+    """The held-out runs' x and t in the emulator's column order; GPMSAError when their outputs
+    or output grid differ from the emulator's, or their named columns are not the emulator's
+    (runs with the default names x0.., t0.. are read by position)."""
+    if held_out.l_sim != emulator.l_sim:
+        raise GPMSAError(f"held-out runs have {held_out.l_sim} outputs, the emulator "
+                         f"{emulator.l_sim}")  # fmt: skip
+    grid, index = emulator.standardizer.grid, held_out.index  # either may be None (scalar)
+    if grid is not None and index is not None and not np.allclose(index, grid):
+        raise GPMSAError("held-out runs lie on another output grid (index) than the emulator's")
+    columns = []
+    sides = ((held_out.x, held_out.x_names, emulator.x_names, "x"),
+             (held_out.t, held_out.t_names, emulator.t_names, "t"))  # fmt: skip
+    for arr, names, mine, prefix in sides:
+        default = tuple(f"{prefix}{i}" for i in range(len(names)))
+        if tuple(names) == default or tuple(names) == tuple(mine):
+            columns.append(arr)
+        elif sorted(names) == sorted(mine):
+            columns.append(arr[:, [list(names).index(n) for n in mine]])
+        else:
+            raise GPMSAError(f"held-out runs name their {prefix} columns {list(names)}, the "
+                             f"emulator {list(mine)}")  # fmt: skip
+    return columns[0], columns[1]
 
 
 def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
@@ -91,12 +119,15 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
     if isinstance(held_out, CrossValidation):
         mean, var, actual = held_out.mean, held_out.var, held_out.y
         what = "cross-validation"
+        if held_out.y.shape != emulator.y.shape or not np.allclose(held_out.y, emulator.y):
+            raise GPMSAError(
+                "held_out is the cross-validation of another emulator (its runs' outputs differ "
+                "from this emulator's)"
+            )
     elif isinstance(held_out, SimData):
-        if held_out.l_sim != emulator.l_sim:
-            raise GPMSAError(f"held-out runs have {held_out.l_sim} outputs, the emulator "
-                             f"{emulator.l_sim}")  # fmt: skip
+        x, t = _held_out_inputs(emulator, held_out)
         use = draws and emulator.n_draws > 0
-        mean, var = emulator.predict(held_out.x, held_out.t, draws=use, n_draws=n_draws)
+        mean, var = emulator.predict(x, t, draws=use, n_draws=n_draws)
         actual = held_out.y
         what = f"{held_out.m} held-out runs"
     else:

@@ -14,11 +14,27 @@ from scipy.linalg import cho_solve, solve_triangular
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import as_matrix, check_count, check_seed
+from gpmsa.model.data import as_matrix, by_column_names, check_count, check_seed
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
+
+
+def realization_interval(samples: np.ndarray, level: float, fix: str) -> tuple[np.ndarray, ...]:
+    """Central interval of probability ``level`` (checked by the caller) from the quantiles of
+    the realizations along axis 0. Fewer than 2 / (1 - level) realizations cannot resolve its
+    tails (one draw gives an interval of width 0): then a warning that it is too narrow, saying
+    how to draw more (``fix``)."""
+    n, need = samples.shape[0], int(np.ceil(2.0 / (1.0 - level) - 1e-9))
+    if n < need:
+        warnings.warn(
+            f"a central {level:g} interval from {n} realization(s) is too narrow: its tails need "
+            f"at least {need}; draw more ({fix})",
+            stacklevel=3,
+        )
+    lo, hi = np.quantile(samples, [(1 - level) / 2, (1 + level) / 2], axis=0)
+    return lo, hi
 
 
 def rng_of(seed) -> np.random.Generator:
@@ -35,6 +51,7 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
     the input, the values and the domain.
     """
     d = len(names)
+    values = by_column_names(values, names, what)
     if d > 1 and np.ndim(values) == 1 and np.size(values) == d:
         values = [values]
     native = as_matrix(values, what, ncols=d)

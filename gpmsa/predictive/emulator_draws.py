@@ -27,6 +27,7 @@ from gpmsa.predictive._common import (
     gpmsa_model_only,
     mvn_factor,
     param_sets,
+    realization_interval,
     rng_of,
     unit_inputs,
     w_conditional,
@@ -92,10 +93,10 @@ class EmulatorPrediction:
         return self._moments_std()[1] * self.y_sd**2
 
     def interval(self, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval (N, l_sim) of probability ``level`` from the realizations' quantiles."""
+        """Central interval (N, l_sim) of probability ``level`` from the realizations' quantiles
+        (a warning when there are too few for its tails: `realization_interval`)."""
         level = check_level(level)
-        lo, hi = np.quantile(self.y, [(1 - level) / 2, (1 + level) / 2], axis=0)
-        return lo, hi
+        return realization_interval(self.y, level, "emulator_prediction's n_draws or n_rlz")
 
 
 def emulator_prediction(

@@ -44,6 +44,7 @@ from gpmsa.predictive._common import (
     mvn_factor,
     posterior_lamos,
     posterior_theta,
+    realization_interval,
     rng_of,
     unit_inputs,
 )
@@ -132,11 +133,12 @@ class FullPrediction:
         return (v.mean(axis=0) + m.var(axis=0)) * self.y_sd**2
 
     def interval(self, what: str = "y", level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval (N, l) of probability ``level`` from the realizations' quantiles."""
+        """Central interval (N, l) of probability ``level`` from the realizations' quantiles
+        (a warning when there are too few for its tails: `realization_interval`)."""
         self._check(what)
         level = check_level(level)
-        lo, hi = np.quantile(getattr(self, what), [(1 - level) / 2, (1 + level) / 2], axis=0)
-        return lo, hi
+        fix = "full_prediction's n_draws or n_rlz"
+        return realization_interval(getattr(self, what), level, fix)
 
 
 def _posterior_sets(emulator, posterior, n_draws):
@@ -267,14 +269,21 @@ def _check_fitted_discrepancy(emulator, discrepancy) -> None:
 
 
 def _check_fitted_obs(emulator, obs: ObsData) -> None:
-    """GPMSAError when ``obs`` has other experiments (their count or lengths) than the joint
-    fit's, where the fit recorded them (settings "obs_lengths")."""
+    """GPMSAError when ``obs`` has other experiments (their count or lengths) or other values
+    than the joint fit's, where the fit recorded them (settings "obs_lengths", "obs_sha256";
+    files written before the digest are checked by their lengths alone)."""
     fitted = (getattr(emulator, "settings", None) or {}).get("obs_lengths")
     lengths = [int(e.size) for e in obs.experiments]
     if fitted is not None and lengths != list(fitted):
         raise GPMSAError(
             f"obs has {len(lengths)} experiment(s) of lengths {lengths}, but the joint fit's had "
             f"{len(fitted)} of lengths {list(fitted)}: pass the ObsData the fit used"
+        )
+    digest = (getattr(emulator, "settings", None) or {}).get("obs_sha256")
+    if digest is not None and obs.digest() != digest:
+        raise GPMSAError(
+            "obs holds other observations (x, y, grids or precisions) than the joint fit's: pass "
+            "the ObsData the fit used"
         )
 
 

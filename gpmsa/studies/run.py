@@ -152,7 +152,7 @@ def calibrate_study(
     study = Study("calibration", emulators, layout, hyper,
                   _study_draws(chains, slice(int(n_burn), None)), settings, metadata)  # fmt: skip
     if study.convergence is not None:
-        warn_unconverged(study.convergence, "gpmsa.calibrate_study")
+        warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
     return study
 
 

@@ -109,6 +109,16 @@ def test_short_chains_warn_naming_parameters_and_the_record_is_kept(multi, tmp_p
     assert main(["info", str(path)]) == 0
 
 
+def test_the_convergence_warning_names_the_argument_that_lengthens_the_chains():
+    from _calib_cases import two_param_emulator
+
+    with pytest.warns(gpmsa.ConvergenceWarning, match=r"Run longer chains \(n_samples\)"):
+        gpmsa.calibrate(
+            two_param_emulator(), x_obs=[[0.5]], y_obs=[[0.7]], n_chains=2, n_samples=20,
+            n_burn=5, seed=0,
+        )  # fmt: skip
+
+
 def test_info_shows_the_verdict(multi, tmp_path, capsys):
     from gpmsa.cli.main import main
 

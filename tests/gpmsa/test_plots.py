@@ -129,6 +129,35 @@ def test_emulator_fit_against_held_out_runs_and_cross_validation():
             plots.emulator_fit(emu, test, max_runs=bad)
 
 
+def test_emulator_fit_reads_held_out_columns_by_name_and_checks_what_it_is_given():
+    """Held-out runs with the emulator's names in another order are read by name (the same
+    figure); other names, another output grid, another emulator's cross-validation and a
+    basis plot of something other than an emulator are refused."""
+    emu = two_param_emulator()
+    rng = np.random.default_rng(2)
+    x, t = rng.uniform(0.1, 0.9, (8, 1)), rng.uniform(0.1, 0.9, (8, 2))
+    y = np.sin(2.0 * x[:, 0] + 1.5 * t[:, 0]) + 0.8 * t[:, 1] * x[:, 0]
+    kept = gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["a", "b"])
+    swapped = gpmsa.SimData(x=x, t=t[:, ::-1], y=y, x_names=["x"], t_names=["b", "a"])
+    unnamed = gpmsa.SimData(x=x, t=t, y=y)  # x0, t0, t1: read by position
+    misread = gpmsa.SimData(x=x, t=t[:, ::-1], y=y)  # what reading "swapped" by position gave
+    titles = [plots.emulator_fit(emu, d, draws=False).axes[0].get_title()
+              for d in (kept, swapped, unnamed, misread)]  # fmt: skip
+    assert titles[0] == titles[1] == titles[2] != titles[3]
+    other = gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["a", "c"])
+    with pytest.raises(GPMSAError, match=r"name their t columns \['a', 'c'\], the emulator"):
+        plots.emulator_fit(emu, other)
+    vec = vector_fit()
+    s = np.linspace(0.0, 1.0, 10)
+    y10 = np.sin(2.0 * x) * (1.0 + s)
+    with pytest.raises(GPMSAError, match="another output grid"):
+        plots.emulator_fit(vec, gpmsa.SimData(x=x, t=t[:, :1], y=y10, index=3 * s))
+    with pytest.raises(GPMSAError, match="cross-validation of another emulator"):
+        plots.emulator_fit(emu, gpmsa.cross_validate(vec, draws=False))
+    with pytest.raises(GPMSAError, match="emulator must be a gpmsa.Emulator, got CrossValidation"):
+        plots.pc_basis(gpmsa.cross_validate(vec, draws=False))
+
+
 def test_prediction_bands_functional_and_scalar():
     emu, obs, x_new, y_new = known_truth_case()
     pred = gpmsa.full_prediction(emu, obs, x_new[::10], n_draws=50, seed=0)

@@ -181,3 +181,34 @@ def test_the_predictive_functions_name_a_missing_emulator(not_an_emulator):
     }.items():
         with pytest.raises(GPMSAError, match=f"{what} needs a gpmsa.Emulator, got"):
             call(not_an_emulator)
+
+
+def test_a_table_of_inputs_is_read_by_its_column_names():
+    """A pandas DataFrame's columns are the emulator's names in any order, never read by
+    position; other names are refused."""
+    pd = pytest.importorskip("pandas")
+    emu = two_param_emulator()
+    ordered = pd.DataFrame({"a": [0.2, 0.6], "b": [0.8, 0.4]})
+    swapped = ordered[["b", "a"]]
+    means = [emu.predict([[0.5]], t)[0] for t in (ordered, swapped)]
+    np.testing.assert_array_equal(*means)
+    draws = [emulator_prediction(emu, [[0.5]], t, draws=False, seed=0).mean() for t in
+             (ordered, swapped)]  # fmt: skip
+    np.testing.assert_array_equal(*draws)
+    for call in (lambda t: emu.predict([[0.5]], t), lambda t: emulator_prediction(emu, [[0.5]], t)):
+        why = r"t has the columns \['a', 'c'\]; expected \['a', 'b'\]"
+        with pytest.raises(GPMSAError, match=why):
+            call(ordered.rename(columns={"b": "c"}))
+
+
+def test_an_interval_from_too_few_realizations_warns_that_it_is_too_narrow():
+    emu = vector_fit()
+    one = emulator_prediction(emu, X_NEW, T_NEW, n_draws=1, seed=0)
+    why = r"central 0.9 interval from 1 realization\(s\) is too narrow: its tails need at least 20"
+    with pytest.warns(UserWarning, match=why):
+        lo, hi = one.interval(0.9)
+    np.testing.assert_array_equal(lo, hi)  # what the warning is about: width 0
+    enough = emulator_prediction(emu, X_NEW, T_NEW, n_draws=5, n_rlz=4, seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        enough.interval(0.9)  # 20 realizations: no warning

@@ -215,6 +215,15 @@ def test_discrepancy_and_obs_must_be_the_joint_fits():
     shorter = gpmsa.ObsData(x=obs.x, y=obs.y[:, ::2], index=GRID[::2])
     with pytest.raises(GPMSAError, match="pass the ObsData the fit used"):
         full_prediction(emu, shorter, [[0.5]])
+    # the same shapes, other values: the fit's digest of its observations tells them apart
+    others = (gpmsa.ObsData(x=obs.x, y=obs.y + 3.0, index=GRID),
+              gpmsa.ObsData(x=obs.x, y=obs.y, index=0.5 * GRID),
+              gpmsa.ObsData(x=obs.x, y=obs.y, index=GRID, precision=4.0))  # fmt: skip
+    for other in others:
+        with pytest.raises(GPMSAError, match="obs holds other observations .* than the joint"):
+            full_prediction(emu, other, [[0.5]])
+    again = gpmsa.ObsData(x=obs.x.copy(), y=np.array(obs.y), index=GRID.copy())
+    assert again.digest() == obs.digest() == emu.settings["obs_sha256"]
     same = full_prediction(emu, obs, [[0.5]], discrepancy="linear", n_draws=2, seed=0)
     default = full_prediction(emu, obs, [[0.5]], n_draws=2, seed=0)
     np.testing.assert_array_equal(same.y, default.y)
