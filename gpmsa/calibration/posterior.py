@@ -107,8 +107,9 @@ class GridMarginal:
 
 
 def _checked_samples(samples) -> dict[str, np.ndarray]:
-    """``samples`` as name -> float draws (n_draws, ...); GPMSAError for anything but a dict of
-    string names to non-empty arrays of finite real numbers."""
+    """``samples`` as name -> float draws (n_draws,) of a scalar parameter; GPMSAError for
+    anything but a dict of string names to non-empty 1-D arrays of finite real numbers (a
+    vector parameter is one name per element, as ``betaV[0]``, ``betaV[1]``)."""
     if not isinstance(samples, dict):
         raise GPMSAError(f"samples must be a dict name -> draws, got {type(samples).__name__}")
     out = {}
@@ -116,12 +117,36 @@ def _checked_samples(samples) -> dict[str, np.ndarray]:
         if not isinstance(name, str):
             raise GPMSAError(f"samples: parameter names must be strings, got {name!r}")
         arr = as_float(draws, f"samples[{name!r}]")
-        if arr.ndim == 0 or arr.shape[0] == 0:
+        if arr.ndim != 1 or arr.shape[0] == 0:
             raise GPMSAError(
-                f"samples[{name!r}] must hold at least one draw, got shape {arr.shape}"
+                f"samples[{name!r}] must be the draws (n_draws,) of one scalar parameter, at "
+                f"least one, got shape {arr.shape} (name each element of a vector: 'b[0]', ...)"
             )
         check_finite(arr, f"samples[{name!r}]")
         out[name] = arr
+    return out
+
+
+def _checked_chains(chains, names: tuple[str, ...] | None) -> dict[str, np.ndarray] | None:
+    """``chains`` as name -> float draws (n_chains, n_draws) for every parameter of the
+    posterior (``names``; None: not known yet), or None; GPMSAError naming what is wrong."""
+    if chains is None:
+        return None
+    if not isinstance(chains, dict):
+        raise GPMSAError(f"chains must be a dict name -> (n_chains, n_draws), got "
+                         f"{type(chains).__name__}")  # fmt: skip
+    out = {}
+    for name, draws in chains.items():
+        if not isinstance(name, str):
+            raise GPMSAError(f"chains: parameter names must be strings, got {name!r}")
+        arr = np.atleast_2d(as_float(draws, f"chains[{name!r}]"))
+        if arr.ndim != 2 or arr.size == 0:
+            raise GPMSAError(f"chains[{name!r}] must be (n_chains, n_draws), got {arr.shape}")
+        check_finite(arr, f"chains[{name!r}]")
+        out[name] = arr
+    missing = sorted(set(names or ()) - set(out))
+    if missing:
+        raise GPMSAError(f"chains lacks {missing}: give the chains of every parameter or none")
     return out
 
 
@@ -152,14 +177,14 @@ class Posterior:
         self._samples = None if samples is None else _checked_samples(samples)
         self._draw = draw
         self.grids = dict(grids or {})
-        self.chains = chains
+        self.chains = _checked_chains(chains, None if samples is None else tuple(self._samples))
         self.info = dict(info or {})
 
     @property
     def samples(self) -> dict[str, np.ndarray]:
         """Named draws, native units: name -> (n_draws,)."""
         if self._samples is None:
-            self._samples = self._draw()
+            self._samples = _checked_samples(self._draw())
         return self._samples
 
     @property
@@ -223,8 +248,6 @@ class Posterior:
         if name in self.grids:
             return self.grids[name].hdi(level)
         draws = self.samples[name]
-        if draws.ndim != 1:
-            raise GPMSAError(f"hdi needs a scalar parameter; {name!r} has draws {draws.shape}")
         return diagnostics.hdi(draws, level)
 
     def prob_above(self, name: str, value: float) -> float:
@@ -244,9 +267,10 @@ class Posterior:
         out = {}
         for name in self.names:
             lo, hi = self.interval(name, level)
+            one_draw = name not in self.grids and np.size(self.samples[name]) < 2
             out[name] = {
                 "mean": self.mean(name),
-                "sd": self.sd(name),
+                "sd": float("nan") if one_draw else self.sd(name),
                 f"q{100 * (1 - level) / 2:g}": lo,
                 "median": float(self.quantile(name, 0.5)),
                 f"q{100 * (1 + level) / 2:g}": hi,

@@ -114,7 +114,12 @@ def test_posterior_bad_arguments():
     ("samples", "match"),
     [
         ([1.0, 2.0], "samples must be a dict"),
-        ({"a": []}, r"samples\['a'\] must hold at least one draw"),
+        (
+            {"a": []},
+            r"samples\['a'\] must be the draws \(n_draws,\) of one scalar parameter, at "
+            r"least one, got shape \(0,\)",
+        ),  # fmt: skip
+        ({"a": np.ones((5, 2))}, r"got shape \(5, 2\) \(name each element of a vector"),
         ({"a": [np.nan, 1.0]}, r"samples\['a'\] must be finite"),
         ({"a": ["x", "y"]}, r"samples\['a'\] must be a numeric array"),
         ({"a": np.ones(3, complex)}, r"samples\['a'\] must hold real numbers"),
@@ -129,6 +134,23 @@ def test_posterior_samples_are_checked_on_construction(samples, match):
 def test_the_sd_of_one_draw_is_an_error_not_nan():
     with pytest.raises(GPMSAError, match="needs at least 2 draws"):
         Posterior({"a": [1.0]}).sd("a")
+    row = Posterior({"a": [1.0]}).summary()["a"]  # the summary says it has no sd
+    assert row["mean"] == row["median"] == 1.0 and np.isnan(row["sd"]) and row["n_draws"] == 1
+
+
+@pytest.mark.parametrize(
+    ("chains", "match"),
+    [
+        ([1.0], "chains must be a dict"),
+        ({"a": "x"}, r"chains\['a'\] must be a numeric array"),
+        ({"a": [[np.nan, 1.0]]}, r"chains\['a'\] must be finite"),
+        ({"a": np.ones((2, 2, 2))}, r"chains\['a'\] must be \(n_chains, n_draws\)"),
+        ({"a": [[1.0, 2.0]]}, r"chains lacks \['b'\]: give the chains of every parameter"),
+    ],
+)
+def test_posterior_chains_are_checked_on_construction(chains, match):
+    with pytest.raises(GPMSAError, match=match):
+        Posterior({"a": [1.0, 2.0], "b": [3.0, 4.0]}, chains=chains)
 
 
 def test_the_hdi_is_the_shortest_interval_and_reaches_a_bound_where_mass_piles_up():
@@ -148,11 +170,12 @@ def test_the_hdi_is_the_shortest_interval_and_reaches_a_bound_where_mass_piles_u
 
 def test_the_hdi_of_draws_is_arviz_and_bad_arguments_are_named():
     draws = np.random.default_rng(4).exponential(size=20_000)
-    post = Posterior(samples={"x": draws, "v": np.ones((20_000, 2))})
+    post = Posterior(samples={"x": draws})
     lo, hi = post.hdi("x", 0.9)
     assert lo == pytest.approx(0.0, abs=0.01) and hi == pytest.approx(-np.log(0.1), rel=0.03)
-    with pytest.raises(GPMSAError, match="scalar parameter"):
-        post.hdi("v")
+    lazy = Posterior(draw=lambda: {"v": np.ones((20_000, 2))})  # checked when first drawn
+    with pytest.raises(GPMSAError, match=r"samples\['v'\] must be the draws \(n_draws,\) of one"):
+        lazy.hdi("v")
     with pytest.raises(GPMSAError, match="unknown parameter"):
         post.hdi("y")
     with pytest.raises(GPMSAError, match="level"):
