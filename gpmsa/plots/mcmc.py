@@ -129,13 +129,22 @@ def _check_truth(truth, names) -> dict[str, float]:
     return out
 
 
+def _is_calibration_parameter(name: str) -> bool:
+    """Whether a posterior name is a calibration parameter (or a study's group mean or sd of
+    one), not a noise or discrepancy parameter (plain or a study's NAME[LABEL]) nor a
+    hierarchical parameter's unit-scale precision NAME.lam."""
+    base = name.split("[", 1)[0]
+    return base not in NUISANCE and not base.startswith("betaV") and not name.endswith(".lam")
+
+
 def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30):
     """Pair plot of the calibration parameters: histograms on the diagonal, draws below it.
 
     Args:
         source: a Posterior, or an Emulator from a joint fit (its calibration draws).
         names: the parameters (default: every calibration parameter, i.e. not lamOs, lamVz,
-            betaV).
+            betaV, nor a study's per-model lamOs[LABEL] or a hierarchical parameter's unit-scale
+            precision NAME.lam; its group mean NAME.mu and sd NAME.sd are shown).
         truth: name -> value to mark (e.g. the value a synthetic case was made with).
         bins: histogram bins.
 
@@ -153,7 +162,7 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
             raise GPMSAError("theta_pairs needs a Posterior or an Emulator from a joint fit")
         post = calibration_posterior(source)
     if names is None:
-        names = [n for n in post.names if n not in NUISANCE and not n.startswith("betaV")]
+        names = [n for n in post.names if _is_calibration_parameter(n)]
     names = [names] if isinstance(names, str) else list(names)
     unknown = [n for n in names if n not in post.names]
     if unknown or not names:

@@ -71,13 +71,14 @@ class CrossValidation:
 
 
 def _fold_labels(folds, m: int, seed) -> np.ndarray:
+    rng = rng_of(seed)  # checked whatever the folds (a bad seed is refused, used or not)
     if folds is None:
         return np.arange(m)
     if isinstance(folds, int | np.integer) and not isinstance(folds, bool):
         k = int(folds)
         if not 2 <= k <= m:
             raise GPMSAError(f"folds must be an integer in [2, m] = [2, {m}], got {k}")
-        return rng_of(seed).permutation(m) % k
+        return rng.permutation(m) % k
     labels = np.asarray(folds)
     if labels.shape != (m,):
         raise GPMSAError(

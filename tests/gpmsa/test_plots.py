@@ -98,6 +98,15 @@ def test_theta_pairs_marks_the_truth():
         plots.theta_pairs(vector_fit())
 
 
+def test_theta_pairs_of_a_study_shows_its_calibration_parameters_only():
+    rng = np.random.default_rng(0)
+    names = ("t[m0]", "t[m1]", "lamOs[m0]", "lamOs[m1]", "t.mu", "t.sd", "t.lam", "betaV[m0]")
+    post = gpmsa.Posterior({n: rng.normal(size=50) for n in names})
+    fig = plots.theta_pairs(post)
+    assert len(fig.axes) == 16  # t[m0], t[m1], t.mu, t.sd: no noise, discrepancy or precision
+    assert [ax.get_xlabel() for ax in fig.axes[-4:]] == ["t[m0]", "t[m1]", "t.mu", "t.sd"]
+
+
 def test_pc_basis_draws_the_basis_and_weights():
     emu = vector_fit()
     fig = plots.pc_basis(emu)

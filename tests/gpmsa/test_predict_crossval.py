@@ -105,6 +105,7 @@ def test_loo_over_draws_is_calibrated_on_a_gp_sample():
         ({"folds": np.zeros(3)}, r"one label per run \(shape \(36,\)\)"),
         ({"folds": np.zeros(36)}, "at least two different labels"),
         ({"n_draws": -1}, "n_draws must be"),
+        ({"seed": "x"}, r"seed must be .* got 'x'"),  # refused even where leave-one-out needs none
     ],
 )
 def test_bad_input(kw, match):
