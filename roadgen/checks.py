@@ -71,7 +71,13 @@ def real(name: str, value: object, error: type[Exception] = RoadgenError) -> flo
         value = value.item()
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise error(f"{name}={value!r} must be a real number (got {type(value).__name__})")
-    return float(value)
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond float64's range
+        bits = int(value).bit_length()  # (str() of a huge int is itself refused by Python)
+        raise error(
+            f"{name}=<an integer of {bits} bits> is out of range: beyond float64's"
+        ) from None
 
 
 def integer(name: str, value: object, minimum: int, error: type[Exception] = RoadgenError) -> int:

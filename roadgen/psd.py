@@ -50,12 +50,20 @@ def profile_psd(
         steeply as the road's own PSD; on periodic profiles it costs ~0.1% (150 m) to ~1% (21 m).
 
     Raises RoadgenError for an unknown method, a road without finite heights z (N,) and a grid
-    step dx_m > 0, an nperseg that is not an integer in [8, N], or an end_match that is not a
+    step dx_m > 0, an nperseg that is not an integer in [8, N] (for "welch": a road of fewer than
+    8 heights, or of fewer than 32 with the default nperseg), or an end_match that is not a
     bool.
     """
     checks.choice("method", method, PSD_METHODS)
     z, dx = checks.heights("road", road)
     end_match = checks.flag("end_match", end_match)
+    if method == "welch" and z.size < 8:
+        raise RoadgenError(f"method='welch' needs a road of >= 8 heights, got {z.size}")
+    if nperseg is None and method == "welch" and z.size < 32:  # the default N // 4 needs 8
+        raise RoadgenError(
+            f"method='welch' with the default nperseg (N // 4) needs a road of >= 32 heights, "
+            f"got {z.size}; give nperseg in [8, {z.size}] or use method='periodogram'"
+        )
     seg = z.size // 4 if nperseg is None else checks.integer("nperseg", nperseg, 8)
     if method == "welch" and not 8 <= seg <= z.size:
         raise RoadgenError(f"nperseg={nperseg!r} is out of range: allowed [8, {z.size}]")
@@ -103,7 +111,8 @@ def estimate_gd(
 
     Raises RoadgenError for an unknown method, a bad band or waviness (or settings.band or
     settings.waviness), a band outside the road's content band, a road too short to hold a PSD
-    bin in the band, and for "periodogram" a road without content at the harmonic nearest n0.
+    bin in the band, and for "periodogram" a road without content at the harmonic nearest n0
+    or whose nearest harmonic lies more than PERIODOGRAM_REACH from n0 (a road under 5 m).
     """
     checks.choice("method", method, GD_METHODS)
     z, dx = checks.heights("road", road)
@@ -128,12 +137,24 @@ def estimate_gd(
     return float(np.mean(gd[keep] * (n[keep] / N0) ** w) / GD_SCALE)
 
 
+PERIODOGRAM_REACH = 2.0
+"""method="periodogram": how far (a factor) the harmonic it reads may lie from n0."""
+
+
 def _periodogram_gd(
     z: np.ndarray, dx: float, w: float, content: tuple[float, float] | None
 ) -> float:
     """GD from the periodogram ordinate of z (N,) m nearest n0, scaled to n0 along slope -w."""
     n, gd = _psd(z, dx, "periodogram", z.size, end_match=False)
     k = int(np.argmin(np.abs(np.log(n / N0))))
+    if abs(np.log(n[k] / N0)) > np.log(PERIODOGRAM_REACH) + 1e-9:
+        raise RoadgenError(
+            f"method='periodogram' reads the harmonic nearest n0 = {N0} cycles/m, but the "
+            f"nearest of this road ({z.size * dx:.6g} m: harmonics every "
+            f"{1.0 / (z.size * dx):.6g} cycles/m) is {n[k]:.6g} cycles/m, more than a factor "
+            f"{PERIODOGRAM_REACH:g} from n0; scaling it to n0 along the slope would extrapolate. "
+            f"Use a road of at least {1.0 / (PERIODOGRAM_REACH * N0):g} m"
+        )
     if content is not None:
         edge_lo, edge_hi = band_edges(content, z.size)
         if not edge_lo <= n[k] <= edge_hi:
@@ -202,9 +223,16 @@ def psd_slope(road: HasHeights, band: tuple[float, float] | None = None) -> floa
     z, dx = checks.heights("road", road)
     lo, hi = _fit_band(band, dx)
     n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
-    keep = (n >= lo) & (n <= hi) & (gd > 0)
+    in_band = (n >= lo) & (n <= hi)
+    keep = in_band & (gd > 0)
     if np.count_nonzero(keep) < 2:
-        raise RoadgenError(f"band=({lo:.6g}, {hi:.6g}) holds fewer than 2 PSD bins of this road")
+        if np.count_nonzero(in_band) < 2:
+            length = z.size * dx
+            why = (f"holds fewer than 2 PSD bins of this road ({length:.6g} m: bins every "
+                   f"{1.0 / length:.6g} cycles/m)")  # fmt: skip
+        else:
+            why = "holds no power: the road is flat there (a constant or a straight ramp)"
+        raise RoadgenError(f"band=({lo:.6g}, {hi:.6g}) {why}; no slope to fit")
     return float(np.polyfit(np.log(n[keep]), np.log(gd[keep]), 1)[0])
 
 

@@ -82,6 +82,12 @@ def track(
     lead = checks.non_negative("lead_in_m", lead_in_m)
     blend = checks.positive("blend_m", blend_m)
     lengths = np.array([length for length, _ in segs])
+    if lengths.min() < 2 * dx:  # no blend fits: name the segment, not an empty range
+        k = int(np.argmin(lengths))
+        raise RoadgenError(
+            f"segment {k} is {lengths[k]:g} m long, too short for any blend: shorter than two "
+            f"grid steps (2 dx_m = {2 * dx:.6g} m); lengthen it or merge it with a neighbour"
+        )
     if not 2 * dx <= blend <= lengths.min():
         raise RoadgenError(
             f"blend_m={blend_m!r} is out of range: allowed [{2 * dx:.6g}, {lengths.min():.6g}] m "

@@ -9,7 +9,12 @@
 
 from vehicle.campaign import Campaign, load_campaign, run_campaign
 from vehicle.design import lhs_design
-from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
+from vehicle.errors import (
+    CampaignFileError,
+    SimulationDivergedError,
+    SolverStepWarning,
+    VehicleError,
+)
 from vehicle.linear import linear_model, linear_response
 from vehicle.models import HalfCar, Jackal, from_description
 from vehicle.simulate import Trace, simulate
@@ -23,6 +28,7 @@ __all__ = [
     "Samples",
     "SimulationDivergedError",
     "Simulation",
+    "SolverStepWarning",
     "Trace",
     "VehicleError",
     "from_description",

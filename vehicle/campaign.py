@@ -35,6 +35,7 @@ import roadgen
 from vehicle import checks
 from vehicle.design import check_design, lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
+from vehicle.linear import warn_if_step_too_coarse
 from vehicle.models import Jackal, Model, check_model
 from vehicle.sensor import check_noise, check_rate
 from vehicle.simulate import SUBSTEPS, simulate
@@ -348,6 +349,8 @@ def run_campaign(
             not stored (they run again next time), and a damaged entry is recomputed; an entry
             that reads as a finished run of the same settings is trusted as the user's own.
         seed: the campaign's seed; run i gets road seed ``SeedSequence(seed).generate_state(n)[i]``.
+            None: a fresh seed from the OS's entropy, recorded in ``settings["seed"]`` like a
+            given one, so that the campaign can be run again.
         keep_s: keep the last keep_s seconds of each drive's accelerations (``Campaign.accel``);
             each road is lengthened (beyond ``road_length_m`` where needed) so that they begin
             at least 1 s after the front axle has passed the lead-in.
@@ -362,6 +365,8 @@ def run_campaign(
     """
     model = Jackal() if model is None else check_model(model)
     seed = checks.seed("seed", seed, generator=False)
+    if seed is None:  # a fresh seed, recorded (SeedSequence entropy: 128 bits, as the range)
+        seed = int(np.random.SeedSequence().entropy)
     design = lhs_design(198, seed=seed) if design is None else design
     points = check_design(design, model)
     road_length_m = checks.positive("road_length_m", road_length_m, unit="m")
@@ -372,6 +377,7 @@ def run_campaign(
     noise_std = check_noise(noise_std)
     window = checks.integer("window", window, 2)
     substeps = checks.integer("substeps", substeps, 1)
+    warn_if_step_too_coarse(model, rate_hz, substeps)  # here: a worker process's warning is lost
     progress = checks.flag("progress", progress)
     keep_s = checks.non_negative("keep_s", keep_s, unit="s")
     if executor is not None and not callable(getattr(executor, "submit", None)):
@@ -381,6 +387,8 @@ def run_campaign(
         )
     if cache_dir is not None:
         _check_path(cache_dir, "cache_dir", "folder")
+        if not os.fsdecode(cache_dir):  # Path("") is the working directory: never by accident
+            raise VehicleError("cache_dir='' must be a folder path, got the empty string")
     usable_m = road_length_m - lead_in_m - 2 * model.wheelbase_m
     need_m = window * float(np.max(points[:, 0])) / rate_hz
     if not usable_m >= need_m:

@@ -11,3 +11,7 @@ class SimulationDivergedError(RuntimeError):
 
 class CampaignFileError(VehicleError):
     """A campaign file (or a cached run) is missing, damaged or of an unknown format."""
+
+
+class SolverStepWarning(UserWarning):
+    """The solver's fixed step is too coarse for the model's stiffest mode (results biased)."""

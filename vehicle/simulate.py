@@ -11,6 +11,7 @@ from vehicle import checks
 from vehicle.errors import VehicleError
 from vehicle.exudyn_models import ExudynVehicle
 from vehicle.kinematics import Drive, SpeedSchedule, schedule_grid
+from vehicle.linear import warn_if_step_too_coarse
 from vehicle.models import Model, check_model
 from vehicle.road_input import RoadInput
 from vehicle.sensor import add_noise, check_noise, check_rate, contact_flags
@@ -128,6 +129,7 @@ def simulate(
             f"the drive from {start:.6g} m to {end:.6g} m is shorter than one sample period "
             f"(1/{rate:g} s): use a longer road or a lower speed"
         )
+    warn_if_step_too_coarse(model, rate, substeps)
     drive = Drive(0.0, h, s, v)
     states = ExudynVehicle(model, road_in, drive, rate, substeps).integrate(0.0, n_samples)
     position, spd = drive.positions(states.t), drive.speeds(states.t)

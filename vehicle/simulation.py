@@ -9,6 +9,7 @@ import numpy as np
 from vehicle import checks
 from vehicle.exudyn_models import ExudynVehicle
 from vehicle.kinematics import Drive, check_speed, ramp_grid
+from vehicle.linear import warn_if_step_too_coarse
 from vehicle.models import Model, check_model
 from vehicle.road_input import RoadInput
 from vehicle.sensor import add_noise, check_noise, check_rate, contact_flags
@@ -86,6 +87,7 @@ class Simulation:
         self._road = RoadInput(track, model.wheel_radius_m if envelope else None)
         self.end_m = self._road.length_m
         check_span(model, self._road, start, self.end_m)
+        warn_if_step_too_coarse(self.model, self.rate_hz, substeps)
         self._substeps = substeps
         self._h = 1.0 / (self.rate_hz * substeps)
         self.time = 0.0

@@ -31,6 +31,7 @@ from gpmsa.backends.torch_backend import (
 )
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc.sampler import RHO_PARAMS, Chains
+from gpmsa.model.data import as_real, check_count, check_flag
 from gpmsa.model.problem import Problem
 
 N_WARMUP = 500
@@ -128,6 +129,28 @@ def _chain_seeds(seed, n_chains: int) -> list[int]:
     return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(n_chains)]
 
 
+MIN_DRAWS = 4
+"""Draws a NUTS chain needs: pyro's diagnostics split it into two halves of two draws."""
+
+
+def _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass, jit,
+                     num_threads) -> int:  # fmt: skip
+    """The NUTS options checked (GPMSAError naming the first bad one); the warm-up steps."""
+    if n_iter < MIN_DRAWS:
+        raise GPMSAError(
+            f"the pyro backend needs at least {MIN_DRAWS} draws a chain (pyro's diagnostics "
+            f"split each chain in two halves), got n_iter = {n_iter}"
+        )
+    for name, flag in (("tune", tune), ("full_mass", full_mass), ("jit", jit)):
+        check_flag(flag, name)
+    if not 0.0 < as_real(target_accept, "target_accept") < 1.0:
+        raise GPMSAError(f"target_accept must be a number in (0, 1), got {target_accept!r}")
+    check_count(max_tree_depth, "max_tree_depth")
+    if num_threads is not None:
+        check_count(num_threads, "num_threads")
+    return check_count(n_warmup, "n_warmup") if tune else 0
+
+
 def sample(
     problem: Problem,
     *,
@@ -147,7 +170,9 @@ def sample(
     """NUTS draws of every sampled parameter: ``n_chains`` chains (one after another) of
     ``n_iter`` draws after ``n_warmup`` adaptation steps, each from GPM/SA's initial values.
 
-    ``tune=False`` skips the adaptation (unit step size and mass matrix, no warm-up).
+    ``tune=False`` skips the adaptation (unit step size and mass matrix, no warm-up); a chain
+    that never leaves its starting point (as then on the road case) is a GPMSAError, not a
+    sample. A chain needs at least ``MIN_DRAWS`` draws.
     ``full_mass``: adapt a dense mass matrix (default) rather than a diagonal one (1.5x less
     wall time per draw on the road case's fit); ``target_accept`` 0.9 (pyro's default: 0.8) takes
     shorter steps along the curved lamWs/lamWOs ridge of a scalar-output emulator. With these
@@ -167,10 +192,9 @@ def sample(
             f"the pyro backend does not support {', '.join(problem.extensions)}; use "
             "backend='numpy'"
         )
-    if not 0.0 < target_accept < 1.0:
-        raise GPMSAError(f"target_accept must be in (0, 1), got {target_accept}")
+    warmup = _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass,
+                              jit, num_threads)  # fmt: skip
     model = PyroModel(problem)
-    warmup = int(n_warmup) if tune else 0
     runs = []
     for seed_c in _chain_seeds(seed, int(n_chains)):
         kernel = NUTS(
@@ -191,6 +215,13 @@ def sample(
                 mcmc.run()
         sites = {k: v.detach() for k, v in mcmc.get_samples().items()}
         accept = mcmc.diagnostics()["acceptance rate"]["chain 0"]
+        if all(bool(torch.all(v == v[:1])) for v in sites.values()):
+            why = ("with tune=False NUTS keeps a unit step size; use tune=True" if not tune
+                   else "raise n_warmup, or lower target_accept")  # fmt: skip
+            raise GPMSAError(
+                f"NUTS never left its starting point in {int(n_iter)} draws (acceptance rate "
+                f"{float(accept):.2g}): the chain is no sample of the posterior; {why}"
+            )
         runs.append((sites, float(accept), float(kernel.step_size)))
     draws, log_post = {}, []
     for sites, _, _ in runs:

@@ -44,6 +44,7 @@ from gpmsa.mcmc.sampler import (
     check_step_widths,
     elements,
 )
+from gpmsa.model.data import check_count
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem
 
@@ -573,6 +574,8 @@ class BatchState:
 def torch_threads(num_threads: int | None):
     """Set torch's CPU thread count, and the BLAS libraries' (scipy's LAPACK factors on the CPU),
     inside the block (None: unchanged); restored afterwards."""
+    if num_threads is not None:
+        check_count(num_threads, "num_threads")
     previous = torch.get_num_threads()
     if num_threads is None:
         yield

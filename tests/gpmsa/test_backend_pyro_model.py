@@ -39,3 +39,37 @@ def test_model_log_density_equals_numpy_log_posterior(case):
         np.testing.assert_allclose(
             float(trace.log_prob_sum()), log_posterior(prob, params), rtol=1e-9, atol=1e-7
         )
+
+
+@pytest.mark.parametrize(
+    ("options", "match"),
+    [
+        ({"n_iter": 3}, r"needs at least 4 draws a chain .* got n_iter = 3"),
+        ({"n_warmup": 2.7}, "n_warmup must be an integer >= 1, got 2.7"),
+        ({"n_warmup": -5}, "n_warmup must be an integer >= 1, got -5"),
+        ({"max_tree_depth": 0}, "max_tree_depth must be an integer >= 1, got 0"),
+        ({"target_accept": "0.5"}, "target_accept must be a number, got str"),
+        ({"target_accept": 1.0}, r"target_accept must be a number in \(0, 1\), got 1.0"),
+        ({"num_threads": 0}, "num_threads must be an integer >= 1, got 0"),
+        ({"jit": "no"}, "jit must be True or False"),
+    ],
+)
+def test_nuts_options_are_checked_before_sampling(options, match):
+    from _backend_cases import road_problem
+
+    from gpmsa import GPMSAError
+
+    with pytest.raises(GPMSAError, match=match):
+        pb.sample(road_problem(True).problem, **{"n_iter": 10, "seed": 0, **options})
+
+
+def test_a_chain_that_never_moves_is_refused_not_returned():
+    """With tune=False NUTS keeps a unit step size; on the road case it accepts no step, and
+    the draws would all be the starting values."""
+    from _backend_cases import road_problem
+
+    from gpmsa import GPMSAError
+
+    with pytest.raises(GPMSAError, match=r"NUTS never left its starting point in 20 draws .* "
+                                         r"use tune=True"):  # fmt: skip
+        pb.sample(road_problem(True).problem, n_iter=20, seed=0, tune=False)

@@ -109,6 +109,32 @@ def test_too_short_a_road_for_the_band_raises():
         roadgen.profile_psd(road, method="fft")
 
 
+def test_the_papers_check_refuses_a_road_too_short_to_have_a_harmonic_near_n0():
+    """method="periodogram" scales one ordinate to n0 along the slope: from a harmonic a decade
+    away (a road under a metre) that was an extrapolation returned as a number."""
+    z = np.random.default_rng(0).normal(scale=0.01, size=16)
+    short = SimpleNamespace(z=z, dx_m=0.05)  # 0.8 m: harmonics every 1.25 cycles/m
+    with pytest.raises(roadgen.RoadgenError, match=r"\(0.8 m: harmonics every 1.25 cycles/m\) is "
+                       r"1.25 cycles/m, more than a factor 2 from n0.*at least 5 m"):  # fmt: skip
+        roadgen.estimate_gd(short, method="periodogram")
+    five = roadgen.iso8608_profile(5.0, 450.0, seed=0)  # its first harmonic, 0.2, is within
+    assert np.isfinite(roadgen.estimate_gd(five, method="periodogram"))
+
+
+def test_short_or_flat_roads_are_named_for_what_they_lack():
+    rng = np.random.default_rng(0)
+    default_too_long = r"with the default nperseg \(N // 4\) needs a road of >= 32 heights"
+    cases = ((5, "method='welch' needs a road of >= 8 heights, got 5"), (16, default_too_long))
+    for n, match in cases:
+        with pytest.raises(roadgen.RoadgenError, match=match):
+            roadgen.profile_psd(SimpleNamespace(z=rng.normal(size=n), dx_m=0.05), method="welch")
+    for flat in (np.zeros(4000), np.linspace(0.0, 1.0, 4000)):  # no power, not too few bins
+        with pytest.raises(roadgen.RoadgenError, match=r"holds no power: the road is flat there"):
+            roadgen.psd_slope(SimpleNamespace(z=flat, dx_m=0.006))
+    with pytest.raises(roadgen.RoadgenError, match=r"fewer than 2 PSD bins of this road \(0.8 m"):
+        roadgen.psd_slope(SimpleNamespace(z=rng.normal(size=16), dx_m=0.05))
+
+
 def test_estimate_gd_fits_only_inside_the_profiles_band():
     """A band-limited profile is fitted where it has content (settings.band); the paper's check
     at n0 works from a band that starts there and is refused where n0 has no content."""

@@ -90,6 +90,11 @@ def test_seed_reproducible_and_settings_recorded():
         ({"segments": PAPER, "lead_in_m": 49.8}, r"lead_in_m=49.8 .*\[0, 49.5\]"),
         ({"segments": PAPER, "lead_in_m": -1.0}, "lead_in_m"),
         ({"segments": PAPER, "band": (0.001, 10.0)}, "too short for band"),
+        (  # no blend fits at all: the segment is named, not an empty range
+            {"segments": [(0.01, 400), (5, 300)], "lead_in_m": 0.0},
+            r"segment 0 is 0.01 m long, too short for any blend: shorter than two grid steps "
+            r"\(2 dx_m = 0.012 m\)",
+        ),
     ],
 )
 def test_bad_track_input_raises(kwargs, match):

@@ -47,6 +47,7 @@ def road() -> roadgen.Profile:
         (vehicle.Jackal, "lift_off", 0, r"must be True or False \(got int\)"),
         (vehicle.HalfCar, "sprung_mass_kg", True, r"must be a real number \(got bool\)"),
         (vehicle.HalfCar, "lift_off", None, r"must be True or False \(got NoneType\)"),
+        (vehicle.Jackal, "mass_kg", 10**400, r"<an integer of 1329 bits> is out of range"),
     ],
 )
 def test_model_fields_of_the_wrong_type_raise(cls, field, value, match):
@@ -154,13 +155,13 @@ def test_road_like_objects_with_bad_fields_raise(road_like, match):
 
 def test_numpy_numbers_drive_like_python_ones(road):
     ref = vehicle.simulate(J, road, 2.0, rate_hz=120.0, noise_std=1.0, seed=1, start_m=0.5,
-                           end_m=4.0, substeps=2, envelope=True)  # fmt: skip
+                           end_m=4.0, substeps=3, envelope=True)  # fmt: skip
     got = vehicle.simulate(J, road, np.float32(2.0), rate_hz=np.int64(120), noise_std=np.array(1.0),
                            seed=np.int64(1), start_m=np.float64(0.5), end_m=np.int64(4),
-                           substeps=np.int64(2), envelope=np.bool_(True))  # fmt: skip
+                           substeps=np.int64(3), envelope=np.bool_(True))  # fmt: skip
     np.testing.assert_array_equal(got.accel_front_measured, ref.accel_front_measured)
     sim = vehicle.Simulation(J, road, rate_hz=np.int64(120), start_m=np.int64(1),
-                             substeps=np.int64(2), envelope=np.bool_(False))  # fmt: skip
+                             substeps=np.int64(3), envelope=np.bool_(False))  # fmt: skip
     assert len(sim.advance(np.int64(1), np.int64(1))) == 120
 
 
@@ -248,6 +249,7 @@ def test_design_sizes_and_ranges_take_numpy_numbers():
         ({"progress": "no"}, vehicle.VehicleError, r"^progress='no' must be True or False"),
         ({"cache_dir": 5}, vehicle.VehicleError, r"^cache_dir=5 must be a folder path"),
         ({"cache_dir": "a\0b"}, vehicle.VehicleError, r"^cache_dir='a\\x00b' .* a NUL byte"),
+        ({"cache_dir": ""}, vehicle.VehicleError, r"^cache_dir='' must be a folder path, got the"),
         ({"executor": 5}, vehicle.VehicleError, r"^executor=5 must be None or an Executor"),
         ({"executor": "pool"}, vehicle.VehicleError, r"^executor='pool' must be None or an"),
         ({"design": [[True, 300.0]]}, vehicle.VehicleError, r"^design must be .*, got a bool"),

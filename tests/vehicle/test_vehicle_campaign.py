@@ -90,6 +90,19 @@ def test_a_diverged_run_is_recorded_and_the_rest_goes_on(table):
     np.testing.assert_array_equal(got.f_full[[0, 2]], camp.f_full[[0, 2]])
 
 
+def test_no_seed_draws_a_fresh_one_and_records_it(tmp_path):
+    """seed=None ran every run and then failed to record None; now the campaign draws a seed,
+    records it, and the recorded seed runs the same campaign again."""
+    kw = {**SHORT, "seed": None}
+    first = vehicle.run_campaign(DESIGN[:2], **kw)
+    seed = first.settings["seed"]
+    assert isinstance(seed, int) and 0 <= seed < 2**128
+    again = vehicle.run_campaign(DESIGN[:2], **{**kw, "seed": seed})
+    np.testing.assert_array_equal(first.f_full, again.f_full)
+    first.save(tmp_path / "c.npz")
+    assert vehicle.load_campaign(tmp_path / "c.npz").settings["seed"] == seed
+
+
 def test_save_and_load_round_trip_without_pickle(table, tmp_path):
     camp, _ = table
     path = tmp_path / "campaign.npz"
