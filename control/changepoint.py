@@ -132,32 +132,47 @@ class ChangePointFilter:
 
     def predict(self, ds_m: float) -> None:
         """Propagate over ds_m metres (change points; GD unchanged within a run)."""
+        self._mass, self._dist = self._predicted(ds_m)
+
+    def _predicted(self, ds_m: float) -> tuple[np.ndarray, np.ndarray]:
+        """(mass, dist) after ds_m metres, the filter unchanged. Runs beyond ``max_runs`` are
+        merged into the last row at their mass-weighted mean distance, which keeps growing."""
         if not (is_real(ds_m) and np.isfinite(ds_m) and ds_m >= 0):
             raise ControlError(f"ds_m must be finite and >= 0, got {ds_m!r}")
         if not self._has_data:  # before any block the prior already is "a new segment"
-            self._dist = self._dist + ds_m
-            return
+            return self._mass, self._dist + ds_m
         h = self._hazard(ds_m)
         ended = (h[:, None] * self._mass).sum(axis=0)
         mass = np.vstack([(ended @ self._jump)[None, :], self._mass * (1.0 - h)[:, None]])
         dist = np.concatenate([[0.0], self._dist + ds_m])
         R = self.settings.max_runs
         if mass.shape[0] > R:
+            tail = mass[R - 1 :].sum(axis=1)
+            if tail.sum() > 0:
+                dist[R - 1] = float(tail @ dist[R - 1 :] / tail.sum())
             mass[R - 1] += mass[R:].sum(axis=0)
             mass, dist = mass[:R], dist[:R]
-        self._mass, self._dist = mass / mass.sum(), dist
+        return mass / mass.sum(), dist
 
     def update(self, loglik: np.ndarray, ds_m: float) -> None:
-        """One block ds_m metres long with log-likelihood ``loglik`` on the grid (G,)."""
-        loglik = np.asarray(loglik, dtype=float)
-        if loglik.shape != self.gd.shape or not np.all(np.isfinite(loglik)):
+        """One block ds_m metres long with log-likelihood ``loglik`` on the grid (G,). All or
+        nothing: a refused block leaves the filter as it was."""
+        loglik = np.asarray(loglik)
+        if loglik.dtype.kind not in "iuf" or loglik.shape != self.gd.shape:
             raise ControlError(f"loglik must hold {self.gd.size} finite values")
-        self.predict(ds_m)
-        mass = self._mass * np.exp(loglik - loglik.max())[None, :]
+        loglik = loglik.astype(float, copy=False)
+        if not np.all(np.isfinite(loglik)):
+            raise ControlError(f"loglik must hold {self.gd.size} finite values")
+        mass, dist = self._predicted(ds_m)
+        mass = mass * np.exp(loglik - loglik.max())[None, :]
         total = mass.sum()
         if not total > 0:
-            raise ControlError("the block's likelihood has no mass on the grid")
-        self._mass = mass / total
+            raise ControlError(
+                "the block's likelihood has no mass where the filter's prediction has: their "
+                "product underflows on every grid node (the block contradicts the prior or the "
+                "estimate so far)"
+            )
+        self._mass, self._dist = mass / total, dist
         self._has_data = True
 
     def state(self) -> tuple:
@@ -181,6 +196,8 @@ class ChangePointFilter:
 
     def prob_change_within(self, distance_m: float) -> float:
         """P(the current segment began within the last ``distance_m`` metres)."""
+        if not (is_real(distance_m) and distance_m >= 0):  # (NaN fails the comparison)
+            raise ControlError(f"distance_m must be a distance >= 0, m, got {distance_m!r}")
         if not self._has_data:
             return float("nan")
         return float(min(1.0, self._mass[self._dist <= distance_m].sum()))
@@ -269,4 +286,11 @@ def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:
     else:
         density = 1.0 / gd if prior == "log_uniform" else np.ones_like(gd)
     mass = density * weights
+    if np.count_nonzero(mass > 0) < 2:  # e.g. -inf but at one node, or a density that underflows
+        node = float(gd[int(np.argmax(mass))])
+        raise ControlError(
+            f"prior(gd) puts all its mass on one grid node (GD {node:g}): a change would have "
+            "nowhere to go; give a log density that is finite on more of the grid and varies "
+            "by far less than 700 across it"
+        )
     return mass / mass.sum()

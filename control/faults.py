@@ -7,12 +7,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
-from control.validation import require_reals
+from control.validation import check_instance, require_reals
 
 FAULT_KINDS = (
     "nan",  # the accelerometer reads NaN
     "drop",  # the samples never arrive
-    "spike",  # every `magnitude`-th sample is replaced by +-1e6 m/s^2 (magnitude: spacing >= 1)
+    "spike",  # every `magnitude`-th sample (rounded) is replaced by +-1e6 m/s^2 (spacing >= 1)
     "noise",  # N(0, magnitude^2) m/s^2 added
     "scale",  # the acceleration multiplied by magnitude
     "quantize",  # rounded to steps of magnitude m/s^2
@@ -65,8 +65,11 @@ class FaultInjector:
 
     def __init__(self, faults, rng: np.random.Generator) -> None:
         self.faults = tuple(faults)
+        for k, fault in enumerate(self.faults):
+            check_instance(fault, f"faults[{k}]", SensorFault)
+        check_instance(rng, "rng", np.random.Generator)
         self.rng = rng
-        self._last = np.nan  # the newest reading of the batches before
+        self._last = np.nan  # the newest finite reading of the batches before
         self._held: dict[int, float] = {}  # per stuck fault, the value it holds
 
     def __call__(self, t, position, accel, speed):
@@ -87,7 +90,7 @@ class FaultInjector:
             elif k == "drop":
                 keep &= ~hit
             elif k == "spike":
-                idx = np.flatnonzero(hit)[:: max(1, int(m))]
+                idx = np.flatnonzero(hit)[:: max(1, round(m))]  # the nearest whole spacing
                 acc[idx] = 1e6 * np.where(np.arange(idx.size) % 2, 1.0, -1.0)
             elif k == "noise":
                 acc[hit] += self.rng.normal(0.0, m, int(hit.sum()))
@@ -103,12 +106,16 @@ class FaultInjector:
                 t[hit] = np.nan
             elif k == "position_nan":
                 pos[hit] = np.nan
-        if keep.any():
-            self._last = float(acc[keep][-1])
+        good = np.isfinite(acc) & keep
+        if good.any():
+            self._last = float(acc[good][-1])
         return t[keep], pos[keep], acc[keep], spd[keep]
 
     def _before(self, acc: np.ndarray, first: int) -> float:
-        """The reading before sample ``first`` of this batch (the first one if none came)."""
-        if first > 0:
-            return float(acc[first - 1])
+        """The last good (finite) reading before sample ``first`` of this batch, or of the
+        batches before; the first one if none came (a stuck fault after a NaN fault holds the
+        value before the NaNs)."""
+        finite = np.flatnonzero(np.isfinite(acc[:first]))
+        if finite.size:
+            return float(acc[finite[-1]])
         return self._last if np.isfinite(self._last) else float(acc[0])

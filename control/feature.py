@@ -79,6 +79,10 @@ class FeatureSpec:
             raise ControlError(f"feature name must be one of {FEATURES}, got {self.name!r}")
         require_integers(self, ("block_samples", "n_tapers"))
         require_reals(self, ("rate_hz", "taper_nw"))
+        # numpy scalars stored as Python numbers: to_dict is JSON-able, same_as symmetric
+        for name, kind in (("block_samples", int), ("n_tapers", int), ("rate_hz", float),
+                           ("taper_nw", float)):  # fmt: skip
+            object.__setattr__(self, name, kind(getattr(self, name)))
         if not 16 <= self.block_samples <= MAX_BLOCK_SAMPLES:
             raise ControlError(
                 f"block_samples must lie in [16, {MAX_BLOCK_SAMPLES}], got {self.block_samples}"

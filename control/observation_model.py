@@ -26,7 +26,7 @@ from scipy import special, stats
 from scipy.linalg import cholesky
 
 from control.errors import ControlError, EmulatorMismatchError
-from control.validation import float_array, is_integer, require_reals, within
+from control.validation import float_array, is_integer, is_real, require_reals, within
 
 
 @dataclass(frozen=True, eq=False)
@@ -141,7 +141,7 @@ class ObservationModel:
         """(mean (G, K), lower Cholesky factor of Sigma (K, K)) at speed v (linear in v)."""
         lo, hi = self.speed_range
         if not within(v, lo, hi):
-            raise ControlError(f"speed {v:.4g} m/s outside the emulator's range [{lo:g}, {hi:g}]")
+            raise ControlError(f"speed {v:.10g} m/s outside the emulator's range [{lo:g}, {hi:g}]")
         x = np.clip((v - lo) / (hi - lo) * (self.speed.size - 1), 0, self.speed.size - 1)
         i = min(int(x), self.speed.size - 2)
         a = x - i
@@ -152,9 +152,12 @@ class ObservationModel:
     def _mahalanobis(self, y: np.ndarray, v: float) -> tuple[np.ndarray, float]:
         """Squared Mahalanobis distances of y from the mean at every GD node (G,), and half the
         log-determinant of Sigma(v). The last call is remembered (the BCR asks twice)."""
-        y = np.asarray(y, dtype=float).reshape(-1)
-        if y.size != self.dim or not np.all(np.isfinite(y)):
-            raise ControlError(f"y must hold {self.dim} finite values, got {y}")
+        y = np.asarray(y)
+        if y.shape != (self.dim,) or y.dtype.kind not in "iuf" or not np.all(np.isfinite(y)):
+            raise ControlError(f"y must be {self.dim} finite numbers (K,), got {y!r}")
+        y = y.astype(float, copy=False)
+        if not (is_real(v) and np.isfinite(v)):
+            raise ControlError(f"v must be a finite speed, m/s, got {v!r}")
         key = (y.tobytes(), float(v))
         if self._last is not None and self._last[0] == key:
             return self._last[1]

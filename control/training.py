@@ -23,6 +23,7 @@ from scipy import optimize, stats
 from control.errors import ControlError
 from control.feature import FeatureSpec, block_features
 from control.observation_model import BlockScatter
+from control.validation import check_instance, float_array, is_integer, is_real
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,6 +41,13 @@ class BlockStatistics:
     features: np.ndarray
 
 
+def _check_batch(batch) -> int:
+    """``batch`` as an int >= 2 (a batch mean of one block is no batch); ControlError else."""
+    if not is_integer(batch) or batch < 2:
+        raise ControlError(f"batch must be an integer >= 2 (blocks per batch), got {batch!r}")
+    return int(batch)
+
+
 def block_statistics(accel: np.ndarray, spec: FeatureSpec, batch: int = 8) -> BlockStatistics:
     """Block features of each run's accelerations and their mean and long-run covariance.
 
@@ -48,7 +56,9 @@ def block_statistics(accel: np.ndarray, spec: FeatureSpec, batch: int = 8) -> Bl
         spec: the block feature.
         batch: blocks per batch of the long-run covariance.
     """
-    accel = np.asarray(accel, dtype=float)
+    check_instance(spec, "spec", FeatureSpec)
+    batch = _check_batch(batch)
+    accel = float_array(accel, "accel")
     B = spec.block_samples
     if accel.ndim != 2 or accel.shape[1] < 2 * batch * B:
         raise ControlError(
@@ -74,8 +84,9 @@ def feature_statistics(features: np.ndarray, batch: int = 8) -> BlockStatistics:
             `block_statistics` features side by side), n_blocks >= 2 batch.
         batch: blocks per batch.
     """
-    feats = np.asarray(features, dtype=float)
-    if feats.ndim != 3 or feats.shape[1] < 2 * batch:
+    batch = _check_batch(batch)
+    feats = float_array(features, "features")
+    if feats.ndim != 3 or feats.shape[0] == 0 or feats.shape[1] < 2 * batch:
         raise ControlError(
             f"features must be (runs, blocks, K) with >= {2 * batch} blocks per run (two batches "
             f"of {batch}), got shape {feats.shape}"
@@ -104,13 +115,32 @@ def block_scatter(
         stats_: their `block_statistics`.
         nodes: speed nodes (default 16 over the runs' range).
     """
-    speed = np.asarray(speed, dtype=float)
-    if speed.shape != (stats_.mean.shape[0],):
-        raise ControlError(f"speed must have one value per run ({stats_.mean.shape[0]})")
-    nodes = np.linspace(speed.min(), speed.max(), 16) if nodes is None else np.asarray(nodes)
-    w = np.exp(-0.5 * ((nodes[:, None] - speed[None, :]) / bandwidth) ** 2)
+    speed = float_array(speed, "speed")
+    if speed.shape != (stats_.mean.shape[0],) or not np.all(np.isfinite(speed)):
+        raise ControlError(f"speed must hold one finite value per run ({stats_.mean.shape[0]})")
+    if not (is_real(bandwidth) and np.isfinite(bandwidth) and bandwidth > 0):
+        raise ControlError(f"bandwidth must be a finite speed > 0, m/s, got {bandwidth!r}")
+    if nodes is None:
+        nodes = np.linspace(speed.min(), speed.max(), 16)
+    nodes = float_array(nodes, "nodes")
+    if nodes.ndim != 1 or nodes.size == 0 or not np.all(np.isfinite(nodes)):
+        raise ControlError(f"nodes must be a non-empty 1-D array of finite speeds, got {nodes!r}")
+    z = (nodes[:, None] - speed[None, :]) / bandwidth
+    far = np.min(np.abs(z), axis=1) > 30.0  # the kernel weights would all underflow
+    if far.any():
+        raise ControlError(
+            f"speed node {nodes[int(np.argmax(far))]:g} m/s lies more than 30 bandwidths "
+            f"({bandwidth:g} m/s) from every run's speed: no run informs its covariance"
+        )
+    w = np.exp(-0.5 * z**2)
     w /= w.sum(axis=1, keepdims=True)
     cov = np.einsum("sr,rij->sij", w, stats_.cov)
+    for node, c in zip(nodes, cov, strict=True):
+        if not np.all(np.linalg.eigvalsh(c) > 1e-12 * max(float(np.trace(c)), 1e-300)):
+            raise ControlError(
+                f"the runs' block covariance at {node:g} m/s is singular: a feature (or a "
+                "combination of them) does not vary from block to block"
+            )
     return BlockScatter(nodes, cov, _fit_dof(speed, stats_, nodes, cov))
 
 

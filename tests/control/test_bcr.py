@@ -622,3 +622,21 @@ def test_a_stuck_sensor_holds_its_last_good_value_across_batches():
     )  # fmt: skip
     stuck = (t >= 0.5) & (t < 1.5)
     assert np.all(read[stuck] == a[59]) and np.array_equal(read[~stuck], a[~stuck])
+    # after a NaN fault it holds the last good value before the NaNs, not NaN
+    faults = [SensorFault(0.4, 0.2, "nan"), SensorFault(0.6, 0.5, "stuck")]
+    inject = FaultInjector(faults, np.random.default_rng(0))
+    read = np.concatenate(
+        [inject(t[k : k + 42], t[k : k + 42], a[k : k + 42], np.ones(42)[: t[k : k + 42].size])[2]
+         for k in range(0, 240, 42)]
+    )  # fmt: skip
+    assert np.all(read[(t >= 0.6) & (t < 1.1)] == a[47])  # 47: the sample before t = 0.4
+
+
+def test_the_fault_injector_names_what_it_cannot_inject():
+    with pytest.raises(ControlError, match=r"faults\[0\] must be a control.SensorFault"):
+        FaultInjector(["nan"], np.random.default_rng(0))
+    with pytest.raises(ControlError, match="rng must be a numpy.Generator"):
+        FaultInjector([SensorFault(0.5, 1.0, "noise", 3.0)], None)
+    t, a = np.arange(120) / 120.0, np.zeros(120)
+    spiked = FaultInjector([SensorFault(0.0, 1.0, "spike", 2.9)], np.random.default_rng(0))
+    assert np.flatnonzero(spiked(t, t, a, np.ones(120))[2])[:3].tolist() == [0, 3, 6]  # not 2

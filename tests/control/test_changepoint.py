@@ -33,6 +33,43 @@ def test_a_prior_of_the_users_own():
         ChangePointFilter(GD, ChangePointSettings(prior=lambda gd: np.full(gd.size, -np.inf)))
 
 
+def test_a_prior_on_one_node_is_named_as_such():
+    for one in (lambda gd: np.where(gd > 599, 0.0, -np.inf), lambda gd: gd * 1e6):
+        with pytest.raises(ControlError, match=r"puts all its mass on one grid node \(GD 600\)"):
+            ChangePointFilter(GD, ChangePointSettings(prior=one))
+
+
+def test_runs_longer_than_max_runs_keep_their_age():
+    """The merged last row kept the distance of run R - 1, so on a long steady road the run
+    length read as about R blocks (45 m for 1,000 m) and every change as recent."""
+    f = ChangePointFilter(GD, ChangePointSettings(max_runs=50))
+    for _ in range(1000):
+        f.update(gauss_loglik(300.0), 1.0)
+    assert f.expected_run_m() > 500.0  # 45.4 before
+    assert f.prob_change_within(60.0) < 0.3  # 1.0 before
+    assert f.mass_by_run([100.0])[1].sum() > 0.7  # 0 before
+    short = ChangePointFilter(GD, ChangePointSettings(max_runs=50))
+    for _ in range(40):  # under max_runs: nothing merged, the distances exact
+        short.update(gauss_loglik(300.0), 1.0)
+    assert short.state()[1].max() == 40.0
+
+
+def test_a_refused_block_leaves_the_filter_as_it_was():
+    f = ChangePointFilter(GD, ChangePointSettings(prior=lambda g: np.where(g <= 300, 0.0, -np.inf)))
+    f.update(gauss_loglik(250.0), 1.0)
+    before = f.state()
+    far = np.where(GD <= 300, -2000.0, 0.0)  # finite, but none where the filter has mass
+    with pytest.raises(ControlError, match="their product underflows on every grid node"):
+        f.update(far, 1.0)
+    after = f.state()
+    assert all(np.array_equal(a, b) for a, b in zip(before[:2], after[:2], strict=True))
+    with pytest.raises(ControlError, match="loglik must hold 121 finite values"):
+        f.update(["0"] * GD.size, 1.0)  # numbers as text are not numbers
+    for bad in (np.nan, True, "5", -1.0):
+        with pytest.raises(ControlError, match="distance_m must be a distance >= 0"):
+            f.prob_change_within(bad)
+
+
 def test_steady_blocks_pool_and_the_mass_stays_normalised():
     f = ChangePointFilter(GD)
     sds = []

@@ -45,10 +45,16 @@ def test_blocks_that_no_gd_explains_are_implausible(model):
 
 
 def test_bad_inputs_to_the_model(model):
-    with pytest.raises(ControlError, match="y must hold 10 finite values"):
-        model.loglik(np.ones(7), 1.0)
+    for y in (np.ones(7), np.ones((2, 5)), ["1"] * 10, np.full(10, np.nan)):  # not flattened
+        with pytest.raises(ControlError, match=r"y must be 10 finite numbers \(K,\)"):
+            model.loglik(y, 1.0)
     with pytest.raises(ControlError, match="outside the emulator's range"):
         model.loglik(np.ones(10), 3.0)
+    with pytest.raises(ControlError, match=r"speed 2.000001 m/s outside the emulator's range"):
+        model.loglik(np.ones(10), 2.000001)  # not rounded to "2" in the message
+    for v in ("1.0", True, None, np.nan):
+        with pytest.raises(ControlError, match="v must be a finite speed"):
+            model.loglik(np.ones(10), v)
     with pytest.raises(EmulatorMismatchError, match="no 'block_scatter'"):
         ObservationModel(control.shipped_emulator("A", "window"))
     for kwargs, message in (
@@ -80,6 +86,44 @@ def test_block_statistics_and_scatter_of_white_noise():
         block_statistics(np.ones((2, 100)), spec)
     with pytest.raises(ControlError, match="positive-definite"):
         BlockScatter(np.array([1.0, 2.0]), np.zeros((2, 8, 8)))
+
+
+def test_the_training_helpers_name_their_bad_arguments():
+    rng = np.random.default_rng(2)
+    spec = control.FeatureSpec()
+    accel = rng.standard_normal((6, 125 * 40))
+    for batch in (0, 1, -1, 1.5, None, True):
+        with pytest.raises(
+            ControlError, match=r"batch must be an integer >= 2 \(blocks per batch\)"
+        ):
+            block_statistics(accel, spec, batch=batch)
+    with pytest.raises(ControlError, match="spec must be a control.FeatureSpec"):
+        block_statistics(accel, None)
+    with pytest.raises(ControlError, match="features must be"):
+        feature_statistics(np.zeros((0, 40, 10)))
+    stats_ = block_statistics(accel, spec)
+    speed = np.linspace(0.5, 2.0, 6)
+    for bandwidth in (-1.0, 0.0, np.nan, "0.15"):
+        with pytest.raises(ControlError, match="bandwidth must be a finite speed > 0"):
+            block_scatter(speed, stats_, bandwidth=bandwidth)
+    with pytest.raises(ControlError, match=r"speed node 1.25 m/s lies more than 30 bandwidths"):
+        block_scatter(speed, stats_, nodes=[1.25], bandwidth=1e-3)
+    flat = control.training.BlockStatistics(
+        mean=stats_.mean, cov=np.zeros_like(stats_.cov), features=stats_.features
+    )
+    with pytest.raises(ControlError, match="block covariance at 0.5 m/s is singular"):
+        block_scatter(speed, flat)
+
+
+def test_a_feature_spec_stores_python_numbers():
+    """numpy scalars are stored as Python numbers: to_dict is JSON, same_as reads both ways."""
+    import json
+
+    spec = control.FeatureSpec(rate_hz=np.float32(120), block_samples=np.int32(125),
+                               n_tapers=np.int64(3))  # fmt: skip
+    assert json.loads(json.dumps(spec.to_dict())) == control.FeatureSpec().to_dict()
+    a, b = control.FeatureSpec(rate_hz=120), control.FeatureSpec(rate_hz=120.0000001)
+    assert a.same_as(b) == b.same_as(a) == []
 
 
 def test_feature_statistics_of_two_channels_side_by_side():
