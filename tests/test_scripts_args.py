@@ -198,16 +198,24 @@ def test_accuracy_benchmark_drives_the_robot_its_emulators_record(tmp_path) -> N
     assert window.metadata == control.shipped_emulator("A", "window").metadata
 
 
-def test_accuracy_benchmark_refuses_a_paper_method_for_another_robot(tmp_path) -> None:
-    folder = _emulators_for_another_robot(tmp_path / "mine", noise_std=0.0)
+def _accuracy_usage_error(argv: list[str]) -> str:
+    """The one-line usage error of ``closed_loop_accuracy.py argv`` (exit status 2, no
+    traceback)."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    argv = ["--sets", "paper", "--cases", "A", "--emulator-dir", str(folder)]
     done = subprocess.run(
         [sys.executable, str(ROOT / "benchmarks/closed_loop_accuracy.py"), *argv],
         capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
     )  # fmt: skip
     assert done.returncode == 2, done.stderr[-2000:]
+    assert "Traceback" not in done.stderr
     (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
+    return error
+
+
+def test_accuracy_benchmark_refuses_a_paper_method_for_another_robot(tmp_path) -> None:
+    folder = _emulators_for_another_robot(tmp_path / "mine", noise_std=0.0)
+    argv = ["--sets", "paper", "--cases", "A", "--emulator-dir", str(folder)]
+    error = _accuracy_usage_error(argv)
     assert "the shipped window emulator of case A, which does not fit" in error
     assert "mass_kg: model 21.5 vs emulator" in error
     assert "--features band window" in error
@@ -223,17 +231,11 @@ def test_accuracy_benchmark_refuses_emulators_it_cannot_drive(tmp_path) -> None:
     damaged = tmp_path / "damaged"
     damaged.mkdir()
     (damaged / "jackal_A.gpmsa").write_bytes(b"not a zip")
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
     for folder, message in (
         (unrecorded, "the emulator's metadata has no 'vehicle'"),
         (damaged, "jackal_A.gpmsa: not a gpmsa emulator file"),
     ):
-        argv = ["--sets", "random", "--cases", "A", "--emulator-dir", str(folder)]
-        done = subprocess.run(
-            [sys.executable, str(ROOT / "benchmarks/closed_loop_accuracy.py"), *argv],
-            capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
-        )  # fmt: skip
-        assert done.returncode == 2, done.stderr[-2000:]
-        assert "Traceback" not in done.stderr
-        (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
+        error = _accuracy_usage_error(
+            ["--sets", "random", "--cases", "A", "--emulator-dir", str(folder)]
+        )
         assert "--emulator-dir: " in error and message in error
