@@ -111,13 +111,15 @@ def _topic_error(path: Path, topic: str, role: str, topics: dict[str, str], opti
 
 
 def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic: str) -> None:
+    if imu_topic == odom_topic:
+        raise BagError(f"imu_topic and odom_topic must differ, both are {imu_topic!r}")
     for topic, role, want, option in (
         (imu_topic, "IMU", msgs.IMU_TYPE, "imu_topic / --imu-topic"),
         (odom_topic, "odometry", msgs.ODOMETRY_TYPE, "odom_topic / --odom-topic"),
     ):
         if topic not in topics:
             raise BagError(_topic_error(path, topic, role, topics, option))
-        if _normalise(topics[topic]) != want:
+        if topics[topic] is None or _normalise(topics[topic]) != want:  # None: several types
             raise BagError(
                 f"the {role} topic {topic!r} in {path} holds {topics[topic]}, expected {want}"
             )
@@ -611,6 +613,8 @@ def write_sensor_bag(
     Returns:
         the bag folder.
     """
+    if imu_topic == odom_topic:  # a topic holds one message type
+        raise ControlError(f"imu_topic and odom_topic must differ, both are {imu_topic!r}")
     t_imu, imu, t_odom, odom = sensor_messages(
         imu_time, accel, odom_time, position, speed, axis=axis
     )

@@ -69,6 +69,11 @@ CSV_COLUMNS = (
 )  # fmt: skip
 
 
+MIN_HIGHPASS_HZ = 1e-4
+"""Lowest ``ReplaySettings.highpass_hz``: a period of ~3 h; far lower cut-offs make the
+Butterworth filter's initial conditions a singular system (1e-9 Hz at 120 Hz did)."""
+
+
 @dataclass(frozen=True)
 class ReplaySettings:
     """What to read from a recording and how (see the module docstring).
@@ -86,7 +91,7 @@ class ReplaySettings:
         gravity: "keep" (the BCR demeans each block) or "highpass" (a zero-phase 2nd-order
             Butterworth high-pass at ``highpass_hz`` first: for a signal with gravity in it and
             an emulator without noise, whose sensor checks expect flights at -9.81 m/s^2).
-        highpass_hz: cut-off of the high-pass, Hz.
+        highpass_hz: cut-off of the high-pass, Hz (at least MIN_HIGHPASS_HZ).
         rate_tolerance: an IMU whose nominal rate is within this relative difference of the
             emulator's is used as recorded; a faster one is resampled.
         resample: how a faster IMU is resampled: "sample" (band-limited interpolation: samples
@@ -127,8 +132,12 @@ class ReplaySettings:
         ):  # fmt: skip
             if getattr(self, name) not in allowed:
                 raise ControlError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
-        if not (np.isfinite(self.highpass_hz) and self.highpass_hz > 0):
-            raise ControlError(f"highpass_hz must be > 0, got {self.highpass_hz}")
+        if not (np.isfinite(self.highpass_hz) and self.highpass_hz >= MIN_HIGHPASS_HZ):
+            raise ControlError(
+                f"highpass_hz must be >= {MIN_HIGHPASS_HZ:g} Hz (a period of hours: below it the "
+                f"filter removes nothing and its coefficients turn singular), got "
+                f"{self.highpass_hz}"
+            )
         if not 0 <= self.rate_tolerance < 0.5:
             raise ControlError(f"rate_tolerance must lie in [0, 0.5), got {self.rate_tolerance}")
         if not (np.isfinite(self.max_odometry_gap_s) and self.max_odometry_gap_s > 0):

@@ -28,6 +28,8 @@ from concurrent.futures import (
     wait,
 )
 
+import numpy as np
+
 from gpmsa.errors import ChainError, GPMSAError
 
 RETRIES = 1
@@ -43,13 +45,15 @@ def available_cpus() -> int:
 
 def n_workers(n_jobs: int | None, n_chains: int) -> int:
     """Worker processes for ``n_chains`` chains: ``n_jobs`` (None: every CPU), never more than the
-    chains. GPMSAError for ``n_jobs`` < 1, not an integer, or above the CPUs available."""
+    chains. GPMSAError for ``n_jobs`` < 1, not an integer, or (counting only the workers that
+    would run, min(n_jobs, n_chains)) above the CPUs available."""
     cpus = available_cpus()
     if n_jobs is None:
         return max(1, min(cpus, n_chains))
-    if isinstance(n_jobs, bool) or not isinstance(n_jobs, int) or n_jobs < 1:
+    if isinstance(n_jobs, bool) or not isinstance(n_jobs, int | np.integer) or n_jobs < 1:
         raise GPMSAError(f"n_jobs must be None (every CPU) or an integer >= 1, got {n_jobs!r}")
-    if n_jobs > cpus:
+    n_jobs = int(n_jobs)
+    if min(n_jobs, n_chains) > cpus:  # only the workers that would run count
         raise GPMSAError(
             f"n_jobs={n_jobs} is more than the {cpus} CPUs this process may use; give "
             f"n_jobs <= {cpus}, or an executor= (e.g. a dask Client's) to run elsewhere"
@@ -161,6 +165,11 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
         try:
             submit(i)
         except Exception as exc:  # the executor refused the task
+            if not own and "shutdown" in str(exc):  # the caller's executor is shut down:
+                raise GPMSAError(  # no retry can help (a transient refusal is retried)
+                    f"the executor refused {what} {i} of {n}: {_describe(exc)}; pass an "
+                    "executor that is running"
+                ) from exc
             retry_or_raise(i, exc)
 
     try:

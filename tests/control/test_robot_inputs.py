@@ -140,6 +140,7 @@ def test_an_emulator_path_that_is_no_file_is_named_as_such(bag, tmp_path, capsys
     "field, value, message",
     [
         ("highpass_hz", "1", r"highpass_hz must be a real number, got '1' \(str\)"),
+        ("highpass_hz", 1e-9, r"highpass_hz must be >= 0.0001 Hz .* got 1e-09"),  # was LinAlgError
         ("max_odometry_gap_s", "1", "max_odometry_gap_s must be a real number"),
         ("rate_tolerance", "0.1", "rate_tolerance must be a real number"),
         ("rate_tolerance", None, "rate_tolerance must be a real number"),
@@ -153,6 +154,20 @@ def test_an_emulator_path_that_is_no_file_is_named_as_such(bag, tmp_path, capsys
 def test_replay_settings_refuse_a_value_of_the_wrong_type_naming_the_field(field, value, message):
     with pytest.raises(ControlError, match=message):
         ReplaySettings(**{field: value})
+
+
+def test_one_topic_cannot_be_both_the_imu_and_the_odometry(bag, emulator_a, tmp_path):
+    """A topic holds one message type: the writer refuses to put both on one, and the reader
+    names it (a bag with two types on a topic had crashed the topic check)."""
+    from control.robot.bags import write_sensor_bag
+
+    t = np.arange(10) / 120.0
+    with pytest.raises(ControlError, match="imu_topic and odom_topic must differ, both are '/x'"):
+        write_sensor_bag(tmp_path / "same", t, np.zeros(10), t, t, np.ones(10), imu_topic="/x",
+                         odom_topic="/x")  # fmt: skip
+    assert not (tmp_path / "same").exists()
+    with pytest.raises(ControlError, match="imu_topic and odom_topic must differ"):
+        replay_bag(bag, emulator_a, imu_topic="/imu/data", odom_topic="/imu/data")
 
 
 def test_replay_bag_names_an_override_that_is_no_setting(bag, emulator_a):

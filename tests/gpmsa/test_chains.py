@@ -168,7 +168,10 @@ def test_bad_chain_arguments_raise_naming_them(multi, problem):
     with pytest.raises(gpmsa.GPMSAError, match="n_chains must be an integer >= 1, got 0"):
         gpmsa.fit(sim, n_iter=10, n_chains=0)
     with pytest.raises(gpmsa.GPMSAError, match=f"n_jobs={cpus + 1} is more than the {cpus} CPUs"):
-        gpmsa.fit(sim, n_iter=10, n_chains=2, n_jobs=cpus + 1)
+        gpmsa.fit(sim, n_iter=10, n_chains=cpus + 1, n_jobs=cpus + 1)
+    # only the workers that would run count, and a numpy integer is an integer
+    assert parallel.n_workers(cpus + 3, 1) == 1
+    assert parallel.n_workers(np.int64(1), 2) == 1
     with pytest.raises(gpmsa.GPMSAError, match="n_jobs must be None"):
         gpmsa.fit(sim, n_iter=10, n_chains=2, n_jobs=0)
     with ThreadPoolExecutor(1) as ex:
@@ -257,6 +260,13 @@ def test_an_executor_that_fails_a_task_is_retried_then_reported():
                 match=r"chain 0 of 3 failed after 2 attempts: RuntimeError: executor refuses",
             ):
                 parallel.run_chains(_double, tasks, executor=ex)
+    shut = ThreadPoolExecutor(1)
+    shut.shutdown()
+    with warnings.catch_warnings():  # a shut-down executor: one clear error, no retry
+        warnings.simplefilter("error", RuntimeWarning)
+        why = r"the executor refused chain 0 of 3: .*shutdown"
+        with pytest.raises(gpmsa.GPMSAError, match=why):
+            parallel.run_chains(_double, tasks, executor=shut)
     with LosesFirstTask() as ex, pytest.raises(gpmsa.ChainError, match="chain 0 of 3 failed"):
         parallel.run_chains(_double, tasks, executor=ex, retries=0)
     # a chain whose input is wrong fails the same everywhere: no retry
@@ -309,10 +319,11 @@ def test_calibrate_refuses_bad_placement():
     )
     x, y = [[1.25]], [[12.1]]
     cpus = parallel.available_cpus()
-    with pytest.raises(gpmsa.GPMSAError, match=f"n_jobs={cpus + 1} is more than"):
-        gpmsa.calibrate(emu, x, y, n_chains=2, n_jobs=cpus + 1)
-    with pytest.raises(gpmsa.GPMSAError, match=f"n_jobs={cpus + 1} is more than"):
-        gpmsa.calibrate(emu, x, y, n_chains=2, n_jobs=cpus + 1, log_prior=lambda t: 0.0 * t)
+    more = cpus + 1  # chains and workers beyond the CPUs
+    with pytest.raises(gpmsa.GPMSAError, match=f"n_jobs={more} is more than"):
+        gpmsa.calibrate(emu, x, y, n_chains=more, n_jobs=more)
+    with pytest.raises(gpmsa.GPMSAError, match=f"n_jobs={more} is more than"):
+        gpmsa.calibrate(emu, x, y, n_chains=more, n_jobs=more, log_prior=lambda t: 0.0 * t)
     with ThreadPoolExecutor(1) as ex, pytest.raises(gpmsa.GPMSAError, match="cannot go to exec"):
         gpmsa.calibrate(emu, x, y, n_chains=2, executor=ex, log_prior=lambda t: 0.0 * t)
     with pytest.raises(gpmsa.GPMSAError, match="backend 'pyro' runs its chains in one process"):
