@@ -303,11 +303,11 @@ def report_steady(results, case: str) -> list[str]:
     return lines
 
 
-def check_window_ground(parser: argparse.ArgumentParser, cases, emulator_dir: str) -> None:
+def check_window_ground(parser: argparse.ArgumentParser, grounds: dict, emulator_dir: str) -> None:
     """Refuse a window emulator (the paper's method, sets paper and heldout) made for another
-    vehicle or noise level than the band emulator of the same case in ``emulator_dir``."""
-    for case in cases:
-        model, noise = driven(emulator_for(case, "changepoint", emulator_dir))
+    vehicle or noise level than ``grounds`` (case -> the (vehicle, noise sd) of the case's
+    band emulator in ``emulator_dir``)."""
+    for case, (model, noise) in grounds.items():
         try:
             window = emulator_for(case, "window", emulator_dir)
         except (control.ControlError, gpmsa.EmulatorFileError) as exc:  # damaged, wrong kind
@@ -417,12 +417,11 @@ def main() -> None:
         parser.error(f"--cases must be among {list(NOISE_STD)}, got {args.cases!r}")
     if args.emulator_dir:
         try:  # each case's band emulator, and the robot it records, before any run
-            for c in cases:
-                driven(emulator_for(c, "changepoint", args.emulator_dir))
+            grounds = {c: driven(emulator_for(c, "changepoint", args.emulator_dir)) for c in cases}
         except (control.ControlError, gpmsa.EmulatorFileError) as exc:
             parser.error(f"--emulator-dir: {exc}")
         if {"paper", "heldout"} & set(names):
-            check_window_ground(parser, cases, args.emulator_dir)
+            check_window_ground(parser, grounds, args.emulator_dir)
     numbers = {"--mean-segment": ("mean_segment_m", args.mean_segment),
                "--shape": ("segment_shape", args.shape),
                "--min-jump": ("min_jump", args.min_jump),
@@ -468,8 +467,7 @@ def main() -> None:
     print(f"Simplex speed step {args.speed_step:g} m/s; {args.interval} credible intervals")
     if args.emulator_dir:
         print(f"band emulators from {args.emulator_dir}, driving what they were trained for:")
-        for case in cases:
-            model, noise = driven(emulator_for(case, "changepoint", args.emulator_dir))
+        for case, (model, noise) in grounds.items():
             print(f"  case {case}: {vehicle_changes(model)}, noise sd {noise:g} m/s^2")
     if "random" in names:
         last = args.random_first_seed + args.random_tracks - 1

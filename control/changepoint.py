@@ -157,12 +157,11 @@ class ChangePointFilter:
     def update(self, loglik: np.ndarray, ds_m: float) -> None:
         """One block ds_m metres long with log-likelihood ``loglik`` on the grid (G,). All or
         nothing: a refused block leaves the filter as it was."""
-        loglik = np.asarray(loglik)
-        if loglik.dtype.kind not in "iuf" or loglik.shape != self.gd.shape:
+        loglik = np.asarray(loglik)  # (numbers only: the dtype is checked before isfinite)
+        if (loglik.dtype.kind not in "iuf" or loglik.shape != self.gd.shape
+                or not np.all(np.isfinite(loglik))):  # fmt: skip
             raise ControlError(f"loglik must hold {self.gd.size} finite values")
         loglik = loglik.astype(float, copy=False)
-        if not np.all(np.isfinite(loglik)):
-            raise ControlError(f"loglik must hold {self.gd.size} finite values")
         mass, dist = self._predicted(ds_m)
         mass = mass * np.exp(loglik - loglik.max())[None, :]
         total = mass.sum()

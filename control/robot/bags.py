@@ -110,9 +110,14 @@ def _topic_error(path: Path, topic: str, role: str, topics: dict[str, str], opti
     )
 
 
-def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic: str) -> None:
+def _check_distinct(imu_topic: str, odom_topic: str, error: type[Exception]) -> None:
+    """``error`` unless the IMU and odometry topics differ (a topic holds one message type)."""
     if imu_topic == odom_topic:
-        raise BagError(f"imu_topic and odom_topic must differ, both are {imu_topic!r}")
+        raise error(f"imu_topic and odom_topic must differ, both are {imu_topic!r}")
+
+
+def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic: str) -> None:
+    _check_distinct(imu_topic, odom_topic, BagError)
     for topic, role, want, option in (
         (imu_topic, "IMU", msgs.IMU_TYPE, "imu_topic / --imu-topic"),
         (odom_topic, "odometry", msgs.ODOMETRY_TYPE, "odom_topic / --odom-topic"),
@@ -613,8 +618,7 @@ def write_sensor_bag(
     Returns:
         the bag folder.
     """
-    if imu_topic == odom_topic:  # a topic holds one message type
-        raise ControlError(f"imu_topic and odom_topic must differ, both are {imu_topic!r}")
+    _check_distinct(imu_topic, odom_topic, ControlError)
     t_imu, imu, t_odom, odom = sensor_messages(
         imu_time, accel, odom_time, position, speed, axis=axis
     )

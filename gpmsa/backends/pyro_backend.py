@@ -133,9 +133,9 @@ MIN_DRAWS = 4
 """Draws a NUTS chain needs: pyro's diagnostics split it into two halves of two draws."""
 
 
-def _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass, jit,
-                     num_threads) -> int:  # fmt: skip
-    """The NUTS options checked (GPMSAError naming the first bad one); the warm-up steps."""
+def _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass, jit) -> int:
+    """The NUTS options checked (GPMSAError naming the first bad one); the warm-up steps
+    (``num_threads`` is checked by `torch_threads`, before any sampling)."""
     if n_iter < MIN_DRAWS:
         raise GPMSAError(
             f"the pyro backend needs at least {MIN_DRAWS} draws a chain (pyro's diagnostics "
@@ -146,8 +146,6 @@ def _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full
     if not 0.0 < as_real(target_accept, "target_accept") < 1.0:
         raise GPMSAError(f"target_accept must be a number in (0, 1), got {target_accept!r}")
     check_count(max_tree_depth, "max_tree_depth")
-    if num_threads is not None:
-        check_count(num_threads, "num_threads")
     return check_count(n_warmup, "n_warmup") if tune else 0
 
 
@@ -193,7 +191,7 @@ def sample(
             "backend='numpy'"
         )
     warmup = _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass,
-                              jit, num_threads)  # fmt: skip
+                              jit)  # fmt: skip
     model = PyroModel(problem)
     runs = []
     for seed_c in _chain_seeds(seed, int(n_chains)):

@@ -106,25 +106,32 @@ class GridMarginal:
         return self.ppf(rng.random(size))
 
 
+def _named_arrays(value, what: str, kind: str, ndim: int, wrong_shape: str) -> dict:
+    """``value`` as name -> finite float arrays of ``ndim`` dimensions, none empty; GPMSAError
+    naming ``what`` (a dict name -> ``kind``) and the entry, ``wrong_shape`` (a template with
+    ``{shape}``) saying what an entry of another shape should have been."""
+    if not isinstance(value, dict):
+        raise GPMSAError(f"{what} must be a dict name -> {kind}, got {type(value).__name__}")
+    out = {}
+    for name, draws in value.items():
+        if not isinstance(name, str):
+            raise GPMSAError(f"{what}: parameter names must be strings, got {name!r}")
+        arr = as_float(draws, f"{what}[{name!r}]")
+        arr = np.atleast_2d(arr) if ndim == 2 else arr
+        if arr.ndim != ndim or arr.size == 0:
+            raise GPMSAError(f"{what}[{name!r}] must be {wrong_shape.format(shape=arr.shape)}")
+        check_finite(arr, f"{what}[{name!r}]")
+        out[name] = arr
+    return out
+
+
 def _checked_samples(samples) -> dict[str, np.ndarray]:
     """``samples`` as name -> float draws (n_draws,) of a scalar parameter; GPMSAError for
     anything but a dict of string names to non-empty 1-D arrays of finite real numbers (a
     vector parameter is one name per element, as ``betaV[0]``, ``betaV[1]``)."""
-    if not isinstance(samples, dict):
-        raise GPMSAError(f"samples must be a dict name -> draws, got {type(samples).__name__}")
-    out = {}
-    for name, draws in samples.items():
-        if not isinstance(name, str):
-            raise GPMSAError(f"samples: parameter names must be strings, got {name!r}")
-        arr = as_float(draws, f"samples[{name!r}]")
-        if arr.ndim != 1 or arr.shape[0] == 0:
-            raise GPMSAError(
-                f"samples[{name!r}] must be the draws (n_draws,) of one scalar parameter, at "
-                f"least one, got shape {arr.shape} (name each element of a vector: 'b[0]', ...)"
-            )
-        check_finite(arr, f"samples[{name!r}]")
-        out[name] = arr
-    return out
+    wrong = ("the draws (n_draws,) of one scalar parameter, at least one, got shape {shape} "
+             "(name each element of a vector: 'b[0]', ...)")  # fmt: skip
+    return _named_arrays(samples, "samples", "draws", 1, wrong)
 
 
 def _checked_chains(chains, names: tuple[str, ...] | None) -> dict[str, np.ndarray] | None:
@@ -132,18 +139,8 @@ def _checked_chains(chains, names: tuple[str, ...] | None) -> dict[str, np.ndarr
     posterior (``names``; None: not known yet), or None; GPMSAError naming what is wrong."""
     if chains is None:
         return None
-    if not isinstance(chains, dict):
-        raise GPMSAError(f"chains must be a dict name -> (n_chains, n_draws), got "
-                         f"{type(chains).__name__}")  # fmt: skip
-    out = {}
-    for name, draws in chains.items():
-        if not isinstance(name, str):
-            raise GPMSAError(f"chains: parameter names must be strings, got {name!r}")
-        arr = np.atleast_2d(as_float(draws, f"chains[{name!r}]"))
-        if arr.ndim != 2 or arr.size == 0:
-            raise GPMSAError(f"chains[{name!r}] must be (n_chains, n_draws), got {arr.shape}")
-        check_finite(arr, f"chains[{name!r}]")
-        out[name] = arr
+    out = _named_arrays(chains, "chains", "(n_chains, n_draws)", 2,
+                        "(n_chains, n_draws), got {shape}")  # fmt: skip
     missing = sorted(set(names or ()) - set(out))
     if missing:
         raise GPMSAError(f"chains lacks {missing}: give the chains of every parameter or none")

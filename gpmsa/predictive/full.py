@@ -272,14 +272,15 @@ def _check_fitted_obs(emulator, obs: ObsData) -> None:
     """GPMSAError when ``obs`` has other experiments (their count or lengths) or other values
     than the joint fit's, where the fit recorded them (settings "obs_lengths", "obs_sha256";
     files written before the digest are checked by their lengths alone)."""
-    fitted = (getattr(emulator, "settings", None) or {}).get("obs_lengths")
+    settings = getattr(emulator, "settings", None) or {}
+    fitted = settings.get("obs_lengths")
     lengths = [int(e.size) for e in obs.experiments]
     if fitted is not None and lengths != list(fitted):
         raise GPMSAError(
             f"obs has {len(lengths)} experiment(s) of lengths {lengths}, but the joint fit's had "
             f"{len(fitted)} of lengths {list(fitted)}: pass the ObsData the fit used"
         )
-    digest = (getattr(emulator, "settings", None) or {}).get("obs_sha256")
+    digest = settings.get("obs_sha256")
     if digest is not None and obs.digest() != digest:
         raise GPMSAError(
             "obs holds other observations (x, y, grids or precisions) than the joint fit's: pass "
