@@ -235,7 +235,8 @@ def bcr_settings_for(emulator, **overrides) -> BCRSettings:
     feature, the paper's one-window estimator's filter for a window feature; the sensor checks
     know the sensor's noise sd from the emulator's training noise (`emulator_noise_std`: the
     noise-floor check). ``method=``, ``sensor=`` and any other `BCRSettings` field may be
-    overridden."""
+    overridden; a ``sensor=`` given replaces the emulator's noise sd too, so set its
+    ``noise_sd_mps2`` (the sensor's own, if lower than the training noise) to keep that check."""
     feature = overrides.pop("feature", None)
     if feature is None:
         feature = emulator_feature(emulator)

@@ -74,14 +74,26 @@ def _psd(
     z: np.ndarray, dx: float, method: str, nperseg: int, end_match: bool
 ) -> tuple[np.ndarray, np.ndarray]:
     """``profile_psd`` of checked heights z (N,) m on a step dx m (n = 0 dropped)."""
-    if method == "periodogram":
-        detrend = _end_match if end_match else "constant"
-        n, gd = scipy.signal.periodogram(z, fs=1.0 / dx, window="boxcar", detrend=detrend)
-    else:
-        n, gd = scipy.signal.welch(
-            z, fs=1.0 / dx, window="hann", nperseg=nperseg, detrend="constant"
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow: _finite_psd names it
+        if method == "periodogram":
+            detrend = _end_match if end_match else "constant"
+            n, gd = scipy.signal.periodogram(z, fs=1.0 / dx, window="boxcar", detrend=detrend)
+        else:
+            n, gd = scipy.signal.welch(
+                z, fs=1.0 / dx, window="hann", nperseg=nperseg, detrend="constant"
+            )
+    return n[1:], _finite_psd(gd[1:], z)
+
+
+def _finite_psd(values: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """``values`` (a PSD, or a GD from it) if all finite; RoadgenError where heights z m so
+    large that their squares overflow float64 made them inf or NaN."""
+    if not np.all(np.isfinite(values)):
+        raise RoadgenError(
+            f"road.z holds heights up to {np.max(np.abs(z)):.3g} m: their PSD overflows "
+            "float64; give heights in m"
         )
-    return n[1:], gd[1:]
+    return values
 
 
 def estimate_gd(
@@ -134,7 +146,7 @@ def estimate_gd(
             raise _welch_too_short((lo, hi), float(n[keep][-1]), z.size, dx)
         keep &= k >= WELCH_MIN_BIN
         gd = gd / (1.0 + w * (w + 1.0) / (6.0 * k**2))
-    return float(np.mean(gd[keep] * (n[keep] / N0) ** w) / GD_SCALE)
+    return float(_finite_psd(np.mean(gd[keep] * (n[keep] / N0) ** w) / GD_SCALE, z))
 
 
 PERIODOGRAM_REACH = 2.0
@@ -164,7 +176,7 @@ def _periodogram_gd(
                 f"({content[0]:.6g}, {content[1]:.6g}) cycles/m; use method='fit' with a band "
                 "inside settings.band, or make the road with a band that holds n0"
             )
-    return float(gd[k] * (n[k] / N0) ** w / GD_SCALE)
+    return float(_finite_psd(gd[k] * (n[k] / N0) ** w / GD_SCALE, z))
 
 
 def _fit_bins(

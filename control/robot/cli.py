@@ -8,7 +8,8 @@ BAG: a ROS 2 bag folder (MCAP or sqlite3), a ``*.mcap`` file or a ROS 1 ``*.bag`
 ``DIR/replay.json`` (settings, what was found in the recording, timing; strict JSON: a number
 that is not finite, such as the rate of a topic with one message, is ``null``), and prints a
 summary. DIR is made only once the replay has run, and removed again (with the parents this
-made) if writing into it fails; a folder that was there before is never removed.
+made) if writing into it fails; a folder that was there before is never removed, none of the
+three outputs may be there already, and a failed write removes those it wrote.
 Exit status 0 on success, also for a recording too short for one estimate (the summary then
 says "no estimate" and why); 2 with a one-line message on a usage error (``--out`` a file, a
 setting out of range), an emulator file that is missing or cannot be loaded, a recording that
@@ -43,6 +44,8 @@ from control.simplex import Simplex
 from gpmsa.io.atomic import atomic_write
 
 DEFAULTS = ReplaySettings()
+OUTPUTS = ("estimates.csv", "estimates", "replay.json")
+"""What the command writes into --out."""
 
 
 def _one_line(exc: Exception) -> str:
@@ -52,14 +55,18 @@ def _one_line(exc: Exception) -> str:
 
 def _check_out(out: Path) -> None:
     """`ControlError` where ``out``, or its nearest existing parent, is not a folder, or where
-    ``out`` holds ``estimates`` already (checked before the replay runs)."""
+    ``out`` holds any of `OUTPUTS` already (checked before the replay runs)."""
     there = next((p for p in (out, *out.parents) if p.exists()), None)
     if there == out and not out.is_dir():
         raise ControlError(f"--out {str(out)!r} exists and is not a folder")
     if there is not None and not there.is_dir():
         raise ControlError(f"--out {str(out)!r}: {str(there)!r} exists and is not a folder")
-    if (out / "estimates").exists():
-        raise ControlError(f"{out / 'estimates'} exists already: choose another --out")
+    there_already = [name for name in OUTPUTS if (out / name).exists()]
+    if there_already:
+        raise ControlError(
+            f"{out / there_already[0]} exists already: choose another --out (this command "
+            f"writes {', '.join(OUTPUTS)} and overwrites none of them)"
+        )
 
 
 def _report(bag: Path, source: str, settings: ReplaySettings, result: ReplayResult) -> dict:
@@ -82,7 +89,8 @@ def _report(bag: Path, source: str, settings: ReplaySettings, result: ReplayResu
 
 def _write(out: Path, result: ReplayResult, report: dict) -> None:
     """Write the estimates (CSV, ROS 2 bag) and the report (strict JSON) into ``out``, made
-    here where it is missing; on a failure the folders made here are removed again."""
+    here where it is missing; on a failure the folders made here are removed again, and in a
+    folder that was there before, the outputs written here (`_check_out` saw none of them)."""
     missing = [p for p in (out, *out.parents) if not p.exists()]  # the last made first
     try:
         try:
@@ -97,6 +105,13 @@ def _write(out: Path, result: ReplayResult, report: dict) -> None:
     except BaseException:
         if missing:
             shutil.rmtree(missing[-1], ignore_errors=True)
+        else:
+            for name in OUTPUTS:
+                path = out / name
+                if path.is_dir():
+                    shutil.rmtree(path, ignore_errors=True)
+                else:
+                    path.unlink(missing_ok=True)
         raise
 
 

@@ -645,7 +645,7 @@ def sample(
     Several cores, or a cluster, on the CPU: ``chain_groups`` > 1 splits the chains, after the
     (pooled) tuning, into that many batches of consecutive chains, each sampled in a worker
     process with its own random stream (a child of ``seed``'s SeedSequence after the chains'):
-    ``n_jobs`` processes (None: every CPU, never more than the groups) or any
+    ``n_jobs`` processes (None or -1: every CPU, never more than the groups) or any
     ``concurrent.futures.Executor`` / dask ``Client`` as ``executor``. The draws depend on
     ``chain_groups`` and ``seed``, never on ``n_jobs`` or where the groups ran; each worker
     runs one thread (``num_threads`` must be 1); a failed group is retried as the numpy

@@ -155,8 +155,9 @@ def calibrate(
             (k,) log densities; called with k = 1); fast path only.
         progress: show a tqdm bar.
         n_jobs, executor: where several chains run (numpy backend): ``n_jobs`` worker processes
-            (None: every CPU, never more than the chains) or any ``concurrent.futures.Executor``
-            / dask ``Client``; each chain has its own seed, so the draws do not depend on it.
+            (None or -1: every CPU, never more than the chains) or any
+            ``concurrent.futures.Executor`` / dask ``Client``; each chain has its own seed, so
+            the draws do not depend on it.
             With ``log_prior`` (a callable, not shipped to workers) the chains run here.
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there (no draw inside the forbidden region); a constraint

@@ -45,6 +45,8 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
         if name.strip() in given:  # the later one silently won
             raise GPMSAError(f"--{what} {name.strip()} is given twice; give each name once")
         try:
+            if "_" in value:  # float() reads "1_0" as 10: a typo for 1.0 must not pass
+                raise ValueError(value)
             given[name.strip()] = float(value)
         except ValueError as exc:
             raise GPMSAError(f"--{what} {name}: {value!r} is not a number") from exc

@@ -77,9 +77,9 @@ def fit(
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
     posterior) for ``Emulator.params``. n_pc: basis size (default: 99.5% of the variance).
     discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. n_jobs, executor: where
-    the chains run (numpy backend: ``n_jobs`` worker processes, None = every CPU but never more
-    than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws are the
-    same wherever they run. options: passed to the backend's ``sample`` (e.g. ``init``).
+    the chains run (numpy backend: ``n_jobs`` worker processes, None or -1 = every CPU but never
+    more than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws
+    are the same wherever they run. options: passed to the backend's ``sample`` (e.g. ``init``).
 
     Beyond GPM/SA's model (numpy backend; docs/categorical-and-constraints.md): categorical
     inputs are declared in ``SimData`` (a categorical theta of a joint fit is sampled over its

@@ -44,14 +44,18 @@ def available_cpus() -> int:
 
 
 def n_workers(n_jobs: int | None, n_chains: int) -> int:
-    """Worker processes for ``n_chains`` chains: ``n_jobs`` (None: every CPU), never more than the
-    chains. GPMSAError for ``n_jobs`` < 1, not an integer, or (counting only the workers that
-    would run, min(n_jobs, n_chains)) above the CPUs available."""
+    """Worker processes for ``n_chains`` chains: ``n_jobs`` (None or -1, joblib's spelling: every
+    CPU), never more than the chains. GPMSAError for ``n_jobs`` 0 or below -1, not an integer,
+    or (counting only the workers that would run, min(n_jobs, n_chains)) above the CPUs
+    available."""
     cpus = available_cpus()
-    if n_jobs is None:
+    integer = not isinstance(n_jobs, bool) and isinstance(n_jobs, int | np.integer)
+    if n_jobs is None or (integer and n_jobs == -1):
         return max(1, min(cpus, n_chains))
-    if isinstance(n_jobs, bool) or not isinstance(n_jobs, int | np.integer) or n_jobs < 1:
-        raise GPMSAError(f"n_jobs must be None (every CPU) or an integer >= 1, got {n_jobs!r}")
+    if not integer or n_jobs < 1:
+        raise GPMSAError(
+            f"n_jobs must be None or -1 (every CPU) or an integer >= 1, got {n_jobs!r}"
+        )
     n_jobs = int(n_jobs)
     if min(n_jobs, n_chains) > cpus:  # only the workers that would run count
         raise GPMSAError(

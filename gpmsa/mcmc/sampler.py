@@ -387,7 +387,7 @@ def sample(
 
     Chains: chain c runs on ``SeedSequence(seed).spawn(n_chains)[c]``, so its draws do not
     depend on where it runs; they run in parallel processes (``gpmsa.mcmc.parallel``):
-    ``n_jobs`` workers (None: every CPU, never more than the chains) or any
+    ``n_jobs`` workers (None or -1: every CPU, never more than the chains) or any
     ``concurrent.futures.Executor`` / dask ``Client`` given as ``executor``. ``init``: the
     chains' starts (``gpmsa.mcmc.starts``: "auto" is GPM/SA's initial values for one chain,
     dispersed ones for several). ``ridge_moves``: moves along the lamWs/lamWOs nugget ridge per

@@ -104,10 +104,22 @@ def test_a_failed_write_removes_the_folder_it_made_only(bag, tmp_path, capsys, m
     code, _, err = _run(capsys, bag, "--emulator", "A", "--out", out)
     assert code == 2 and "No space left on device" in err
     assert list(tmp_path.iterdir()) == []
-    mine = tmp_path / "mine"
+    mine = tmp_path / "mine"  # a folder the user had keeps what it held, and nothing else
     mine.mkdir()
+    (mine / "notes.txt").write_text("kept")
     code, _, _ = _run(capsys, bag, "--emulator", "A", "--out", mine)
-    assert code == 2 and mine.is_dir()
+    assert code == 2 and [p.name for p in mine.iterdir()] == ["notes.txt"]
+
+
+@pytest.mark.parametrize("name", ["estimates.csv", "estimates", "replay.json"])
+def test_no_output_of_an_earlier_run_is_overwritten(bag, tmp_path, capsys, name):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / name).write_text("an earlier run's")
+    code, _, err = _run(capsys, bag, "--emulator", "A", "--out", out)
+    assert code == 2 and f"{out / name} exists already: choose another --out" in err
+    assert [p.name for p in out.iterdir()] == [name]
+    assert (out / name).read_text() == "an earlier run's"
 
 
 # --- messages about --out and --emulator ----------------------------------------------------------

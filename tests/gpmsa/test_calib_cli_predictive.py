@@ -50,6 +50,7 @@ def test_cli_json(emu_file, capsys):
     [
         (["--x", "w=1.25", "--y", "f=12.1"], r"--x needs exactly the names \['v'\]"),
         (["--x", "v=fast", "--y", "f=12.1"], "is not a number"),
+        (["--x", "v=1_0", "--y", "f=12.1"], "'1_0' is not a number"),  # float() reads 10
         (["--x", "v=1.25", "--y", "f"], "expects NAME=VALUE"),
         (["--x", "v=1.25", "--x", "v=1.5", "--y", "f=12.1"], "--x v is given twice"),
         (["--x", "v=9", "--y", "f=12.1"], "outside the emulator's domain .*; pass --extrapolate"),

@@ -172,7 +172,13 @@ def test_bad_chain_arguments_raise_naming_them(multi, problem):
     # only the workers that would run count, and a numpy integer is an integer
     assert parallel.n_workers(cpus + 3, 1) == 1
     assert parallel.n_workers(np.int64(1), 2) == 1
-    with pytest.raises(gpmsa.GPMSAError, match="n_jobs must be None"):
+    # -1 is joblib's "every CPU", as None; other values below 1 are refused
+    assert parallel.n_workers(-1, 5) == parallel.n_workers(None, 5) == min(cpus, 5)
+    assert parallel.n_workers(np.int64(-1), 1) == 1
+    for bad in (0, -2, True, 1.0):
+        with pytest.raises(gpmsa.GPMSAError, match="n_jobs must be None or -1"):
+            parallel.n_workers(bad, 2)
+    with pytest.raises(gpmsa.GPMSAError, match="n_jobs must be None or -1"):
         gpmsa.fit(sim, n_iter=10, n_chains=2, n_jobs=0)
     with ThreadPoolExecutor(1) as ex:
         with pytest.raises(gpmsa.GPMSAError, match="give n_jobs or executor, not both"):

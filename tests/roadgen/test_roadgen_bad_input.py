@@ -193,3 +193,21 @@ def test_a_plain_road_is_plotted_without_a_prescribed_line():
     fig = roadgen.plot_profile_psd(PLAIN)
     labels = [line.get_label() for line in fig.axes[1].get_lines()]
     assert not any(label.startswith("prescribed") for label in labels)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda road: roadgen.estimate_gd(road),
+        lambda road: roadgen.estimate_gd(road, method="welch"),
+        lambda road: roadgen.estimate_gd(road, method="periodogram"),
+        lambda road: roadgen.profile_psd(road),
+        lambda road: roadgen.psd_slope(road),
+    ],
+)
+def test_heights_whose_psd_overflows_are_refused_not_read_as_inf(call):
+    road = roadgen.iso8608_profile(length_m=200.0, gd=300.0, seed=1)
+    huge = Heights(road.z * 1e200, road.dx_m)
+    with pytest.raises(roadgen.RoadgenError, match=r"heights up to .* overflows float64"):
+        call(huge)
+    assert np.isfinite(call(Heights(road.z * 1e150, road.dx_m))).all()  # large, still finite
