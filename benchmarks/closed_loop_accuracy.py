@@ -395,6 +395,8 @@ def main() -> None:
         help="first seed of the steady set (another seed draws another held-out set)",
     )  # fmt: skip
     args = parser.parse_args()
+    if args.emulator_dir is not None and not args.emulator_dir.strip():
+        parser.error("argument --emulator-dir: an empty path: give a folder name")
     if args.steady_roads < 2:
         parser.error(f"--steady-roads must be >= 2 (a standard error needs two), got "
                      f"{args.steady_roads}")  # fmt: skip
@@ -406,13 +408,13 @@ def main() -> None:
         parser.error(f"--random-first-seed must be >= 0, got {args.random_first_seed}")
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
-    names = [n for n in args.sets.split(",") if n]
+    names = list(dict.fromkeys(n for n in args.sets.split(",") if n))  # each set once
     unknown = set(names) - set(SETS)
     if not names:
         parser.error(f"--sets names no set, got {args.sets!r}; choose from {list(SETS)}")
     if unknown:
         parser.error(f"--sets: unknown sets {sorted(unknown)}; choose from {list(SETS)}")
-    cases = [c for c in args.cases.split(",") if c]
+    cases = list(dict.fromkeys(c for c in args.cases.split(",") if c))  # each case once
     if not cases or not set(cases) <= set(NOISE_STD):
         parser.error(f"--cases must be among {list(NOISE_STD)}, got {args.cases!r}")
     if args.emulator_dir:

@@ -411,6 +411,8 @@ def main(argv: list[str] | None = None) -> None:
         help="emulators to score",
     )  # fmt: skip
     args = parser.parse_args(argv)
+    if args.emulator_dir is not None and not args.emulator_dir.strip():
+        parser.error("argument --emulator-dir: an empty path: give a folder name")
     roads = 1 if args.quick else args.roads
     min_keep_s = 2 * BATCH * 125 / RATE_HZ
     if roads < 1:

@@ -58,7 +58,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "examples"))
 import closed_loop_accuracy as cla  # noqa: E402
-from _cli import output_folder  # noqa: E402
+from _cli import output_folder, path_option  # noqa: E402
 from second_channel import GYRO_NOISE_RAD_S, spectral_derivative  # noqa: E402
 from train_emulator import BATCH, LEAD_IN_M, stretched_design  # noqa: E402
 
@@ -280,7 +280,10 @@ def main() -> None:
     )  # fmt: skip
     parser.add_argument("--random-tracks", type=int, default=40, help="random set: seeds 401 on")
     parser.add_argument("--workers", type=int, default=2, help="worker processes")
-    parser.add_argument("--out", default="out/second_channel_loop", help="campaign and emulators")
+    parser.add_argument(
+        "--out", type=path_option, default="out/second_channel_loop",
+        help="campaign and emulators",
+    )  # fmt: skip
     args = parser.parse_args()
     names = [n for n in args.sets.split(",") if n]
     channel_sets = [c for c in args.channels.split(",") if c]

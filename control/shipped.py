@@ -28,7 +28,8 @@ def shipped_emulator_path(case: str = "A", kind: str = "band", folder=None) -> P
     """Path of the shipped emulator of Test Case "A" (noise-free) or "B" (noise std 1 m/s^2),
     for the block feature ("band", the default BCR) or the paper's window feature ("window");
     with ``folder``, the file of that name there (`examples/train_emulator.py --emulator-dir`).
-    ControlError naming a missing file and the command that makes it."""
+    ControlError naming a missing file and the command that makes it, an empty ``folder`` or
+    one that is a file."""
     name = emulator_file_name(case, kind)
     if folder is not None and not isinstance(folder, str | os.PathLike):
         raise ControlError(
@@ -37,6 +38,10 @@ def shipped_emulator_path(case: str = "A", kind: str = "band", folder=None) -> P
     if folder is None:
         path, make = EMULATOR_DIR / name, "`python examples/train_emulator.py --ship`"
     else:
+        if not str(folder).strip():
+            raise ControlError("folder is an empty path: give the folder of the emulators")
+        if Path(folder).exists() and not Path(folder).is_dir():
+            raise ControlError(f"folder {str(folder)!r} is not a folder")
         path = Path(folder) / name
         make = (
             f"`python examples/train_emulator.py --emulator-dir {folder} --cases {case} "

@@ -14,6 +14,28 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 
+def path_option(text: str) -> str:
+    """argparse ``type=`` of an option that names a file or folder: an empty string (which
+    would mean the current folder, or no path at all) is a usage error."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path: give a file or folder name")
+    return text
+
+
+def check_option_memory(parser: argparse.ArgumentParser, nbytes: float, what: str) -> None:
+    """Usage error (before any simulation) where an option's setting would need ``nbytes``
+    (an estimate, a lower bound) beyond ``gpmsa.limits.MAX_MEMORY_BYTES``; ``what`` names the
+    option and what needs the memory. E.g. `gpmsa.fit` keeps every sweep of its parameters
+    (8 bytes an element, twice while its chains are stacked) and would refuse it only when it
+    starts, after the campaign."""
+    import gpmsa
+
+    try:
+        gpmsa.limits.check_memory(nbytes, what)
+    except gpmsa.ResourceLimitError as exc:
+        parser.error(str(exc))
+
+
 def output_folder(parser: argparse.ArgumentParser, option: str, folder: str | Path) -> Path:
     """The folder an option names for a script's output, made (with its parents) if missing.
 

@@ -34,7 +34,13 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder, save_figure, write_text  # noqa: E402
+from _cli import (  # noqa: E402
+    check_option_memory,
+    output_folder,
+    path_option,
+    save_figure,
+    write_text,
+)
 from scipy.integrate import solve_ivp  # noqa: E402
 from scipy.stats import qmc  # noqa: E402
 
@@ -95,7 +101,10 @@ def design(m: int, seed: int) -> np.ndarray:
 
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/ball_drop", help="folder for figures and summary")
+    parser.add_argument(
+        "--out", type=path_option, default="out/ball_drop",
+        help="folder for figures and summary",
+    )  # fmt: skip
     parser.add_argument("--n-iter", type=int, default=3000, help="MCMC sweeps after tuning")
     parser.add_argument("--runs", type=int, default=60, help="simulator runs")
     parser.add_argument("--seed", type=int, default=0)
@@ -104,6 +113,9 @@ def main(argv: list[str] | None = None) -> dict:
         parser.error(f"--runs must be >= {MIN_RUNS} (the emulator's design), got {args.runs}")
     if args.n_iter < 2:
         parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
+    sweep = 8.0 * 2 * 6  # bytes a sweep keeps, at least: theta (2), lamOs, lamVz, betaU (2)
+    check_option_memory(parser, sweep * args.n_iter, f"--n-iter {args.n_iter}: gpmsa.fit's draws")
+    check_option_memory(parser, 8.0 * 4 * args.runs**2, f"--runs {args.runs}: the GP's covariances")
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
     out = output_folder(parser, "--out", args.out)

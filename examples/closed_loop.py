@@ -36,11 +36,12 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder, save_figure, write_text  # noqa: E402
+from _cli import output_folder, path_option, save_figure, write_text  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
 import roadgen  # noqa: E402
+import vehicle  # noqa: E402
 from control.metrics import strict_json  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
 
@@ -48,11 +49,16 @@ PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 PAPER_RMSE = {"A": {"300": 42.58, "500": 94.42}, "B": {"300": 50.19, "500": 96.23}}
 
 
+GD_MAX = 1e6
+"""Largest GD (1e-6 m^3) the scripts take: beyond ISO 8608's roughest class (H, from 131072),
+far beyond what a small robot survives (its drive ends with `vehicle.SimulationDivergedError`)."""
+
+
 def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
     """``"50:300,50:500,50:300"`` -> ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0)): length in m, GD.
 
     Raises ValueError naming the segment that is not ``LENGTH:GD`` with two finite positive
-    numbers.
+    numbers, GD at most `GD_MAX`.
     """
     segments = []
     for part in text.split(","):
@@ -63,6 +69,8 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
             raise ValueError(f"segment {part.strip()!r} is not LENGTH_M:GD (e.g. 50:300)") from None
         if not (np.isfinite(length) and np.isfinite(gd) and length > 0 and gd > 0):
             raise ValueError(f"segment {part.strip()!r}: length and GD must be finite and > 0")
+        if gd > GD_MAX:
+            raise ValueError(f"segment {part.strip()!r}: GD must be at most {GD_MAX:g}")
         segments.append((length, gd))
     return tuple(segments)
 
@@ -129,7 +137,10 @@ def summarise(results, gds: list[float]) -> dict:
 
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out", help="folder for metrics.json and the figures")
+    parser.add_argument(
+        "--out", type=path_option, default="out",
+        help="folder for metrics.json and the figures",
+    )  # fmt: skip
     parser.add_argument("--runs", type=int, default=3, help="runs per test case")
     parser.add_argument(
         "--first-seed", type=int, default=1,
@@ -157,7 +168,7 @@ def main(argv: list[str] | None = None) -> dict:
         help="Simplex performance law: linear (default), paper (eq. 8 literally), switch",
     )  # fmt: skip
     parser.add_argument(
-        "--record", default=None, metavar="DIR",
+        "--record", type=path_option, default=None, metavar="DIR",
         help="write each run as an MCAP file in DIR, to watch in Foxglove with "
         "examples/foxglove_layout.json (needs the robot extra)",
     )  # fmt: skip
@@ -180,11 +191,12 @@ def main(argv: list[str] | None = None) -> dict:
         help="test cases: A (noise-free), B (with the noise the case-B emulators were trained on)",
     )  # fmt: skip
     parser.add_argument(
-        "--emulator-dir", default=None, metavar="DIR",
+        "--emulator-dir", type=path_option, default=None, metavar="DIR",
         help="the emulators DIR/jackal_{A,B}[_window].gpmsa made by examples/train_emulator.py "
         "--emulator-dir DIR, instead of the shipped ones",
     )  # fmt: skip
     args = parser.parse_args(argv)
+    args.cases = list(dict.fromkeys(args.cases))  # each case once
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
     if args.first_seed < 0:
@@ -243,20 +255,27 @@ def main(argv: list[str] | None = None) -> dict:
     record = output_folder(parser, "--record", args.record) if args.record else None
 
     metrics: dict = {"ours": {}, "paper_method": {}}
+    figures = {}  # written once every run has finished: a failed run leaves no partial set
     for case in args.cases:
         noise = control.emulator_noise_std(emulators[case, "band"])
         title = f"Test Case {case} ({f'N(0, {noise**2:g}) noise' if noise else 'noise-free'})"
         for key, method in (("ours", args.method), ("paper_method", "window")):
             emu = emulators[case, "band" if method == "changepoint" else "window"]
-            results = run_case(
-                case, emu, seeds, method, simplex, segments, record, checked=not args.beyond_domain
-            )
+            try:
+                results = run_case(case, emu, seeds, method, simplex, segments, record,
+                                   checked=not args.beyond_domain)  # fmt: skip
+            except vehicle.SimulationDivergedError as err:  # a road far rougher than any known
+                parser.error(f"--track: the vehicle left the road ({err}); lower the track's GD")
             metrics[key][case] = summarise(results, gds)
             label = "ours" if key == "ours" else "paper's method"
-            gd_figure = plot_gd_trace(results, track, title=f"{title}, {label}: GD")
-            save_figure(gd_figure, out / f"gd_trace_{case}_{key}.png", dpi=150)
-            speed_figure = plot_speed(results, track, title=f"{title}, {label}: speed")
-            save_figure(speed_figure, out / f"speed_{case}_{key}.png", dpi=150)
+            figures[f"gd_trace_{case}_{key}.png"] = plot_gd_trace(
+                results, track, title=f"{title}, {label}: GD"
+            )
+            figures[f"speed_{case}_{key}.png"] = plot_speed(
+                results, track, title=f"{title}, {label}: speed"
+            )
+    for name, fig in figures.items():
+        save_figure(fig, out / name, dpi=150)
     if paper_track:
         metrics["paper"] = PAPER_RMSE
     metrics["settings"] = {**vars(args), "segments": segments, "seeds": list(seeds)}

@@ -22,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder, save_figure, write_text  # noqa: E402
+from _cli import output_folder, path_option, save_figure, write_text  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -57,15 +57,19 @@ def cell_posterior(calibrator, model, v: float, gd: float, seed: int, noise_std:
     return calibrator.update([[v]], [[y]])
 
 
+MAX_ROADS = 10_000
+"""Most fresh roads per cell (``--roads``): each is a drive of its own."""
+
+
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--case", default="A", choices=["A", "B"])
     parser.add_argument("--roads", type=int, default=5, help="fresh roads per cell")
     parser.add_argument("--seed", type=int, default=2025)
-    parser.add_argument("--out", default="out")
+    parser.add_argument("--out", type=path_option, default="out")
     args = parser.parse_args(argv)
-    if args.roads < 1:
-        parser.error(f"--roads must be >= 1, got {args.roads}")
+    if not 1 <= args.roads <= MAX_ROADS:
+        parser.error(f"--roads must be in [1, {MAX_ROADS}] (a drive each), got {args.roads}")
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
     out = output_folder(parser, "--out", args.out)

@@ -9,13 +9,12 @@ and saves the profile/PSD figure of the GD 450 road (paper Figs 3-4).
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 
-from _cli import output_folder, save_figure  # noqa: E402
+from _cli import output_folder, path_option, save_figure  # noqa: E402
 
 import roadgen  # noqa: E402
 
@@ -26,7 +25,7 @@ LENGTHS = (150.0, 21.0)
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("out"), help="folder for the figure")
+    parser.add_argument("--out", type=path_option, default="out", help="folder for the figure")
     args = parser.parse_args(argv)
     out = output_folder(parser, "--out", args.out)
 

@@ -30,7 +30,7 @@ import json
 import warnings
 
 import numpy as np
-from _cli import output_folder, save_figure, write_text
+from _cli import check_option_memory, output_folder, path_option, save_figure, write_text
 from matplotlib.figure import Figure
 from scipy.stats import qmc
 
@@ -103,12 +103,17 @@ def _hist(ax, draws: dict[str, np.ndarray], truth: float, label: str) -> None:
 
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out/shared_theta", help="folder for the results")
+    parser.add_argument(
+        "--out", type=path_option, default="out/shared_theta",
+        help="folder for the results",
+    )  # fmt: skip
     parser.add_argument("--n-iter", type=int, default=2000, help="MCMC sweeps after tuning")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
     if args.n_iter < 2:
         parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
+    sweep = 8.0 * 2 * 4  # bytes a sweep keeps, at least: E, lamOs and the emulator's
+    check_option_memory(parser, sweep * args.n_iter, f"--n-iter {args.n_iter}: the draws")
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
     out = output_folder(parser, "--out", args.out)

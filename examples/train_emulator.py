@@ -46,14 +46,15 @@ import argparse
 import dataclasses
 import json
 import time
+from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder, save_figure  # noqa: E402
-from closed_loop import PAPER_SEGMENTS  # noqa: E402
+from _cli import check_option_memory, output_folder, path_option, save_figure  # noqa: E402
+from closed_loop import GD_MAX, PAPER_SEGMENTS  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -173,6 +174,8 @@ def vehicle_model(overrides: list[str]) -> vehicle.Jackal:
             raise ValueError(
                 f"--vehicle {item!r}: expected NAME=VALUE with NAME one of {sorted(fields)}"
             )
+        if name in kw:  # the later one would silently win
+            raise ValueError(f"--vehicle {name} is given twice; give each name once")
         try:
             if name == "lift_off":
                 kw[name] = BOOLEANS[value.lower()]
@@ -258,8 +261,11 @@ def check_anchors(parser: argparse.ArgumentParser, args) -> None:
             )
     if args.anchor_runs is None:
         args.anchor_runs = max(1, args.n_runs // ANCHOR_SHARE)
-    if args.anchor_speeds and args.anchor_runs < 1:
-        parser.error(f"--anchor-runs must be >= 1, got {args.anchor_runs}")
+    if args.anchor_speeds and not 1 <= args.anchor_runs <= args.n_runs:
+        parser.error(
+            f"--anchor-runs must be in [1, --n-runs = {args.n_runs}] (runs at each anchor "
+            f"speed), got {args.anchor_runs}"
+        )
 
 
 def band_feature(args) -> FeatureSpec:
@@ -312,12 +318,18 @@ def fit_window(case: str, campaign, model, args):
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="out", help="folder for the campaign and the figure")
+    parser.add_argument(
+        "--out", type=path_option, default="out",
+        help="folder for the campaign and the figure",
+    )  # fmt: skip
     parser.add_argument("--n-runs", type=int, default=198, help="design points (paper: 198)")
     parser.add_argument("--keep-s", type=float, default=120.0, help="seconds of driving per run")
     parser.add_argument("--n-iter", type=int, default=30_000, help="MCMC sweeps per fit")
     parser.add_argument("--seed", type=int, default=0, help="seed of design, roads and fits")
-    parser.add_argument("--emulator-dir", default=None, help="default: OUT/emulators")
+    parser.add_argument(
+        "--emulator-dir", type=path_option, default=None,
+        help="default: OUT/emulators",
+    )  # fmt: skip
     parser.add_argument(
         "--ship", action="store_true", help=f"write the emulators into {EMULATOR_DIR}"
     )
@@ -377,6 +389,7 @@ def main(argv: list[str] | None = None) -> None:
         help="principal components of the band emulators (1 to the number of bands)",
     )  # fmt: skip
     args = parser.parse_args(argv)
+    args.cases, args.features = list(dict.fromkeys(args.cases)), list(dict.fromkeys(args.features))
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
     for option, fields in (
@@ -395,20 +408,32 @@ def main(argv: list[str] | None = None) -> None:
     if args.n_runs < min_runs:
         why = "gpmsa.SimData's minimum and --n-pc" if band else "gpmsa.SimData's minimum"
         parser.error(f"--n-runs must be >= {min_runs} ({why}), got {args.n_runs}")
-    min_keep_s = 2 * BATCH * args.block_samples / RATE_HZ if band else 0.0
+    needs = [(2 * BATCH * args.block_samples / RATE_HZ,
+              f"band emulators: two batches of {BATCH} blocks of --block-samples")] if band else []
+    if "window" in args.features:
+        needs.append((PAPER_WINDOW.block_samples / RATE_HZ, "the window emulators' window"))
+    min_keep_s, why = max(needs)
     if not (np.isfinite(args.keep_s) and args.keep_s >= min_keep_s):
-        why = f" (band emulators: two batches of {BATCH} blocks of --block-samples)" if band else ""
-        parser.error(f"--keep-s must be >= {min_keep_s:.4g} s{why}, got {args.keep_s}")
+        parser.error(f"--keep-s must be >= {min_keep_s:.4g} s ({why}), got {args.keep_s}")
     if args.n_iter < 2:
         parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
+    sweep = 8.0 * 2 * (4 * args.n_pc + 1)  # bytes a sweep keeps: betaU, lamUz, lamWs, lamWOs
+    check_option_memory(parser, sweep * args.n_iter, f"--n-iter {args.n_iter}: gpmsa.fit's draws")
     lo, hi = args.gd_range
-    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
-        parser.error(f"--gd-range must be finite with 0 < LO < HI, got {lo} {hi}")
+    if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi <= GD_MAX):
+        parser.error(
+            f"--gd-range must be finite with 0 < LO < HI <= {GD_MAX:g} (beyond ISO 8608's "
+            f"roughest class, H, from 131072), got {lo} {hi}"
+        )
     v_lo, v_hi = args.speed_range
     if not (np.isfinite(v_lo) and np.isfinite(v_hi) and 0 < v_lo < v_hi):
         parser.error(f"--speed-range must be finite with 0 < LO < HI, m/s, got {v_lo} {v_hi}")
     if args.ship and args.emulator_dir is not None:
         parser.error("--ship and --emulator-dir exclude each other")
+    shipped_dir = EMULATOR_DIR.resolve()
+    if args.emulator_dir is not None and Path(args.emulator_dir).resolve() == shipped_dir:
+        parser.error(f"--emulator-dir {args.emulator_dir!r} is the shipped emulators' folder: "
+                     "use --ship, which checks the settings first")  # fmt: skip
     if not (np.isfinite(args.noise_std) and args.noise_std >= 0):
         parser.error(f"--noise-std must be >= 0, got {args.noise_std}")
     try:
@@ -438,16 +463,25 @@ def main(argv: list[str] | None = None) -> None:
         ),
         anchor_design(tuple(args.anchor_speeds), args.anchor_runs, args.seed, tuple(args.gd_range)),
     ])  # fmt: skip
-    save_figure(plot_design(design[:, 0], design[:, 1]), out / "lhs_design.png", dpi=150)
     tic = time.perf_counter()
-    campaign = vehicle.run_campaign(
-        design, model, lead_in_m=LEAD_IN_M, rate_hz=RATE_HZ, noise_std=args.noise_std,
-        window=PAPER_WINDOW.block_samples, cache_dir=out / "campaign_cache", progress=True,
-        seed=args.seed, keep_s=args.keep_s,
-    )  # fmt: skip
+    try:  # its memory and settings are checked before the first run
+        campaign = vehicle.run_campaign(
+            design, model, lead_in_m=LEAD_IN_M, rate_hz=RATE_HZ, noise_std=args.noise_std,
+            window=PAPER_WINDOW.block_samples, cache_dir=out / "campaign_cache", progress=True,
+            seed=args.seed, keep_s=args.keep_s,
+        )  # fmt: skip
+    except vehicle.VehicleError as exc:
+        parser.error(f"the campaign (--n-runs, --anchor-runs, --keep-s): {exc}")
+    save_figure(plot_design(design[:, 0], design[:, 1]), out / "lhs_design.png", dpi=150)
     print(f"campaign: {campaign.v.size} runs in {time.perf_counter() - tic:.0f} s")
     if not campaign.ok.all():
         print(f"  {np.count_nonzero(~campaign.ok)} failed runs are left out")
+    if np.count_nonzero(campaign.ok) < min_runs:
+        parser.error(
+            f"only {np.count_nonzero(campaign.ok)} of {campaign.v.size} runs finished (the "
+            f"vehicle left the road in the others), fewer than the {min_runs} a fit needs: "
+            "lower --gd-range HI or --speed-range HI"
+        )
     campaign.save(out / "campaign.npz")
 
     fitters = {"band": fit_band, "window": fit_window}

@@ -111,6 +111,37 @@ CASES = [
         "--vehicle 'mass_kg=abc': mass_kg must be a number",
     ),
     ("examples/train_emulator.py", ["--gd-range", "5", "1"], "--gd-range must be finite"),
+    ("examples/train_emulator.py", ["--gd-range", "200", "1e300"], "HI <= 1e+06"),
+    (
+        "examples/train_emulator.py",
+        ["--keep-s", "1", "--features", "window"],
+        "--keep-s must be >= 8.333 s (the window emulators' window), got 1.0",
+    ),
+    ("examples/train_emulator.py", ["--n-iter", "10" * 10], "gpmsa.fit's draws needs about"),
+    (
+        "examples/train_emulator.py",
+        ["--vehicle", "mass_kg=20", "mass_kg=30"],
+        "--vehicle mass_kg is given twice",
+    ),
+    ("examples/train_emulator.py", ["--out", ""], "argument --out: an empty path"),
+    (
+        "examples/train_emulator.py",
+        ["--emulator-dir", "control/emulators"],
+        "is the shipped emulators' folder: use --ship",
+    ),
+    ("examples/closed_loop.py", ["--out", ""], "argument --out: an empty path"),
+    ("examples/closed_loop.py", ["--record", " "], "argument --record: an empty path"),
+    ("examples/closed_loop.py", ["--track", "50:1e7"], "GD must be at most 1e+06"),
+    ("examples/closed_loop.py", ["--emulator-dir", FILE], "is not a folder"),
+    (
+        "examples/closed_loop.py",
+        ["--runs", "1", "--cases", "A", "--beyond-domain", "--track", "5:300,10:200000"],
+        "--track: the vehicle left the road",
+    ),
+    ("examples/ball_drop.py", ["--runs", "100000000"], "--runs 100000000: the GP's covariances"),
+    ("examples/shared_theta.py", ["--n-iter", "10" * 10], "the draws needs about"),
+    ("examples/posterior_check.py", ["--roads", "10" * 6], "--roads must be in [1, 10000]"),
+    ("benchmarks/closed_loop_accuracy.py", ["--emulator-dir", ""], "an empty path"),
     ("examples/train_emulator.py", ["--keep-s", "0"], "--keep-s must be >= 16.67 s"),
     (
         "examples/train_emulator.py",
@@ -131,7 +162,7 @@ CASES = [
     (
         "examples/train_emulator.py",
         ["--anchor-speeds", "1.0", "--anchor-runs", "0"],
-        "--anchor-runs must be >= 1, got 0",
+        "--anchor-runs must be in [1, --n-runs = 198] (runs at each anchor speed), got 0",
     ),
     (
         "examples/train_emulator.py",

@@ -175,8 +175,14 @@ def parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = parser().parse_args(argv)
+    for name, given in (("BAG", args.bag), ("--out", args.out), ("--emulator", args.emulator)):
+        if given is not None and not given.strip():  # would mean the current folder
+            print(f"terrain-replay: error: {name} is an empty path: give a file or folder name",
+                  file=sys.stderr)  # fmt: skip
+            return 2
     bag = Path(args.bag)
-    out = Path(args.out) if args.out else Path(f"{bag.name.removesuffix(bag.suffix)}_bcr")
+    default_out = Path(f"{bag.name.removesuffix(bag.suffix)}_bcr")
+    out = default_out if args.out is None else Path(args.out)
     try:
         settings = ReplaySettings(
             imu_topic=args.imu_topic,

@@ -171,7 +171,9 @@ def calibrate(
 
     Returns:
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
-        native units), "lamOs" (and "betaV", "lamVz" with a discrepancy), and chains per name.
+        native units), "lamOs" (and "betaV", "lamVz" with a discrepancy), and chains per name;
+        ``info["obs_values_sha256"]`` fingerprints the observations (`ObsData.values_digest`),
+        so that ``gpmsa.full_prediction`` refuses other ones with these draws.
     """
     check_emulator(emulator, categorical_theta=True)
     seed = check_seed(seed)
@@ -220,7 +222,7 @@ def calibrate(
     info.update(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
-        outside_sds=fit.outside_sds,
+        outside_sds=fit.outside_sds, obs_values_sha256=data.values_sha256,
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
     )  # fmt: skip
     if n_chains > 1:

@@ -19,6 +19,7 @@ from gpmsa.model.data import (
     check_count,
     check_finite,
     check_parameter_names,
+    values_digest,
 )
 from gpmsa.model.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
 
@@ -38,7 +39,8 @@ class Observations:
     """One calibration's data, reduced: x (n, p) unit; z (d,) stacked u (component-major,
     d = n p_u);
     obs_chol (d, d) lower Cholesky factor of Sigma_obs; lamos the data-corrected lamOs prior;
-    obs the ObsProblem for the samplers."""
+    obs the ObsProblem for the samplers; values_sha256 the SHA-256 of the native x and y rows
+    (`gpmsa.model.data.values_digest`: an ObsData of the same values has the same)."""
 
     x: np.ndarray
     z: np.ndarray
@@ -46,6 +48,7 @@ class Observations:
     lamos: LamOsPrior
     obs: ObsProblem
     os_corr: tuple[float, float]
+    values_sha256: str
 
 
 def check_emulator(emulator, categorical_theta: bool = False) -> None:
@@ -177,7 +180,7 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     lamos = LamOsPrior(base.a + corr[0], base.b + corr[1], base.lower, base.upper)
     sig = obs.sig_obs
     chol = np.sqrt(sig) if sig.shape == (1, 1) else np.linalg.cholesky(sig)
-    return Observations(xu, z, chol, lamos, obs, corr)
+    return Observations(xu, z, chol, lamos, obs, corr, values_digest(x, list(y)))
 
 
 @dataclass(frozen=True)

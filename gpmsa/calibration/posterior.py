@@ -131,19 +131,38 @@ def _checked_samples(samples) -> dict[str, np.ndarray]:
     vector parameter is one name per element, as ``betaV[0]``, ``betaV[1]``)."""
     wrong = ("the draws (n_draws,) of one scalar parameter, at least one, got shape {shape} "
              "(name each element of a vector: 'b[0]', ...)")  # fmt: skip
-    return _named_arrays(samples, "samples", "draws", 1, wrong)
+    out = _named_arrays(samples, "samples", "draws", 1, wrong)
+    counts = {name: arr.size for name, arr in out.items()}
+    if len(set(counts.values())) > 1:  # draw i of every parameter is one joint draw
+        raise GPMSAError(
+            f"samples must hold the same number of draws of every parameter (draw i of each "
+            f"is one joint draw), got {counts}"
+        )
+    return out
 
 
-def _checked_chains(chains, names: tuple[str, ...] | None) -> dict[str, np.ndarray] | None:
+def _checked_chains(
+    chains, samples: dict[str, np.ndarray] | None
+) -> dict[str, np.ndarray] | None:
     """``chains`` as name -> float draws (n_chains, n_draws) for every parameter of the
-    posterior (``names``; None: not known yet), or None; GPMSAError naming what is wrong."""
+    posterior (the names of ``samples``; None: not known yet), each the samples of that name
+    split into chains, or None; GPMSAError naming what is wrong."""
     if chains is None:
         return None
+    names = None if samples is None else tuple(samples)
     out = _named_arrays(chains, "chains", "(n_chains, n_draws)", 2,
                         "(n_chains, n_draws), got {shape}")  # fmt: skip
     missing = sorted(set(names or ()) - set(out))
     if missing:
         raise GPMSAError(f"chains lacks {missing}: give the chains of every parameter or none")
+    for name, arr in out.items():
+        drawn = None if samples is None else samples.get(name)
+        if drawn is not None and not np.array_equal(arr.reshape(-1), drawn):
+            raise GPMSAError(
+                f"chains[{name!r}] of shape {arr.shape} are not samples[{name!r}] "
+                f"({drawn.size} draws) split into chains: give the chains the samples were "
+                "pooled from (samples = chains.reshape(-1)), or no chains"
+            )
     return out
 
 
@@ -174,7 +193,7 @@ class Posterior:
         self._samples = None if samples is None else _checked_samples(samples)
         self._draw = draw
         self.grids = dict(grids or {})
-        self.chains = _checked_chains(chains, None if samples is None else tuple(self._samples))
+        self.chains = _checked_chains(chains, self._samples)
         self.info = dict(info or {})
 
     @property

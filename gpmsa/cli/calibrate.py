@@ -27,11 +27,33 @@ def add_parser(sub) -> None:
                    help="an observed output, native units (repeat for each y name)")  # fmt: skip
     p.add_argument("--method", choices=("auto", "grid", "mcmc"), default="auto",
                    help="exact grid (1-2 parameters) or MCMC (default: auto)")  # fmt: skip
-    p.add_argument("--level", type=float, default=0.9, help="central interval level (0.9)")
+    p.add_argument("--level", type=_level, default=0.9, help="central interval level (0.9)")
     p.add_argument("--seed", type=int, default=None, help="seed of the draws / MCMC")
     p.add_argument("--extrapolate", action="store_true", help="allow x outside the domain")
     p.add_argument("--json", action="store_true", help="print JSON for programs")
     p.set_defaults(func=run)
+
+
+def _quantile_keys(level: float) -> tuple[str, str]:
+    """The summary's keys of the ends of the central interval of probability ``level``."""
+    return f"q{100 * (1 - level) / 2:g}", f"q{100 * (1 + level) / 2:g}"
+
+
+def _level(text: str) -> float:
+    """argparse type of --level: a number in (0, 1) whose interval ends print apart from the
+    median and from 0 and 100 (checked before any work)."""
+    try:
+        level = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not 0 < level < 1:  # NaN too
+        raise argparse.ArgumentTypeError(f"{text!r} must lie in (0, 1)")
+    if set(_quantile_keys(level)) & {"q0", "q50", "q100"}:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is so near 0 or 1 that its interval's ends print as the median or as "
+            "0 and 100: give a level in [1e-4, 0.9999]"
+        )
+    return level
 
 
 def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
@@ -98,7 +120,7 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
         }
         print(json.dumps(out, indent=1))
         return 0
-    lo_key, hi_key = (f"q{100 * (1 - args.level) / 2:g}", f"q{100 * (1 + args.level) / 2:g}")
+    lo_key, hi_key = _quantile_keys(args.level)
     print(f"posterior ({post.info.get('method')}, {1e3 * seconds:.2f} ms) given "
           + ", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(emu.x_names, x[0], strict=True))
           + "; "

@@ -7,7 +7,7 @@ import json
 import sys
 
 from gpmsa.cli.text import number, plain, safe, value
-from gpmsa.errors import EmulatorFileError
+from gpmsa.errors import GPMSAError
 
 
 def add_parser(sub) -> None:
@@ -20,7 +20,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the subcommand; exit status 0, or 2 with a message on stderr for a bad file.
+    """Run the subcommand; exit status 0, or 2 with a message on stderr for a bad file or path.
 
     The file is verified as ``gpmsa.load`` verifies it (hash and every field of the content)
     before anything is printed; every string from it is printed escaped (``gpmsa.cli.text``).
@@ -43,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
             study = load_study(args.file)
         else:
             Emulator.from_record(manifest, arrays)
-    except EmulatorFileError as exc:
+    except GPMSAError as exc:  # a damaged file (EmulatorFileError), or no file path at all
         print(f"gpmsa info: {safe(exc)}", file=sys.stderr)
         return 2
     if args.json:  # ensure_ascii: control characters come out as \u001b escapes

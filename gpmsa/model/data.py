@@ -367,6 +367,17 @@ class SimData:
         return categorical.levels_of(self.x, self.t, self.x_categorical, self.t_categorical)
 
 
+def values_digest(x, experiments) -> str:
+    """SHA-256 of observations' inputs x (n, p) and outputs (one array per experiment), as
+    float64 with their shapes."""
+    h = hashlib.sha256()
+    for k, part in enumerate([x, *experiments]):
+        arr = np.ascontiguousarray(part, dtype="<f8")
+        h.update(f"{k}:{arr.shape}".encode())
+        h.update(arr.tobytes())
+    return h.hexdigest()
+
+
 @dataclass(frozen=True, eq=False)
 class ObsData:
     """Field observations: known inputs ``x`` (n, p) and outputs ``y`` in native units.
@@ -400,6 +411,11 @@ class ObsData:
         object.__setattr__(self, "precisions", self._precisions(self.precision, ys))
         ragged = len({len(e) for e in ys}) > 1
         object.__setattr__(self, "y", ys if ragged else np.stack(ys))
+
+    def values_digest(self) -> str:
+        """SHA-256 of x and every experiment's y (`values_digest`): what ``gpmsa.calibrate``,
+        which takes no grids or precisions, records of its observations."""
+        return values_digest(self.x, self.experiments)
 
     def digest(self) -> str:
         """SHA-256 of the observations (x, every experiment's y, grid and precision, as float64):

@@ -7,7 +7,7 @@ from scipy.special import ndtri
 
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
-from gpmsa.model.data import SimData, check_count, check_level
+from gpmsa.model.data import SimData, check_count, check_flag, check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.crossval import CrossValidation
 
@@ -116,6 +116,9 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
         1
     """
     level = check_level(level)
+    draws = check_flag(draws, "draws")
+    if n_draws is not None:
+        check_count(n_draws, "n_draws")
     if isinstance(held_out, CrossValidation):
         mean, var, actual = held_out.mean, held_out.var, held_out.y
         what = "cross-validation"

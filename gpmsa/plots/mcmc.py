@@ -76,7 +76,7 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
 
     Args:
         source: a gpmsa.Emulator (its retained draws; a joint fit's calibration draws first), a
-            Posterior (its chains) or a Chains.
+            Posterior (its chains), a Chains, or a study (its pooled posterior's chains).
         names: parameters to show (a name selects all its elements, e.g. "betaU"); default: the
             first ``max_params`` scalars.
         max_params: rows at most when ``names`` is None.
@@ -89,7 +89,7 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
         >>> len(fig.axes)
         2
     """
-    series = _series(source)
+    series = _series(_calibration_source(source))
     picked = _pick(series, names, max_params)
     bins = check_bins(bins, len(picked), "plots.traces")
     fig = figure(9.0, 1.6 * len(picked) + 0.6)
@@ -129,19 +129,33 @@ def _check_truth(truth, names) -> dict[str, float]:
     return out
 
 
-def _is_calibration_parameter(name: str) -> bool:
-    """Whether a posterior name is a calibration parameter (or a study's group mean or sd of
-    one), not a noise or discrepancy parameter (plain or a study's NAME[LABEL]) nor a
-    hierarchical parameter's unit-scale precision NAME.lam."""
-    base = name.split("[", 1)[0]
-    return base not in NUISANCE and not base.startswith("betaV") and not name.endswith(".lam")
+def _is_calibration_parameter(name: str, names) -> bool:
+    """Whether a posterior name (of ``names``, the posterior's) is a calibration parameter (or
+    a study's group mean or sd of one), not a noise or discrepancy parameter (lamOs, lamVz,
+    betaV, plain or with an index or a study's label in brackets) nor a hierarchical
+    parameter's unit-scale precision NAME.lam (beside its NAME.mu); a calibration parameter
+    named, say, "betaVel" or "a.lam" is shown."""
+    if name.split("[", 1)[0] in (*NUISANCE, "betaV"):
+        return False
+    return not (name.endswith(".lam") and f"{name[:-4]}.mu" in names)
+
+
+def _calibration_source(source):
+    """A Study's pooled posterior for a study (a duck type: plots import no study code), else
+    ``source``."""
+    if hasattr(source, "member_posterior") and isinstance(
+        getattr(source, "posterior", None), Posterior
+    ):
+        return source.posterior
+    return source
 
 
 def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30):
     """Pair plot of the calibration parameters: histograms on the diagonal, draws below it.
 
     Args:
-        source: a Posterior, or an Emulator from a joint fit (its calibration draws).
+        source: a Posterior, a study (its pooled posterior), or an Emulator from a joint fit
+            (its calibration draws).
         names: the parameters (default: every calibration parameter, i.e. not lamOs, lamVz,
             betaV, nor a study's per-model lamOs[LABEL] or a hierarchical parameter's unit-scale
             precision NAME.lam; its group mean NAME.mu and sd NAME.sd are shown).
@@ -156,16 +170,23 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
         >>> len(fig.axes)
         4
     """
+    source = _calibration_source(source)
     post = source if isinstance(source, Posterior) else None
     if post is None:
         if not getattr(source, "calibration", None):
-            raise GPMSAError("theta_pairs needs a Posterior or an Emulator from a joint fit")
+            raise GPMSAError(
+                "theta_pairs needs a Posterior, a study, or an Emulator from a joint fit"
+            )
         post = calibration_posterior(source)
     if names is None:
-        names = [n for n in post.names if _is_calibration_parameter(n)]
+        names = [n for n in post.names if _is_calibration_parameter(n, post.names)]
+        if not names:
+            raise GPMSAError(f"the posterior has no calibration parameter to plot: {post.names}")
     names = [names] if isinstance(names, str) else list(names)
+    if not names:
+        raise GPMSAError(f"names is empty: give at least one of {post.names}")
     unknown = [n for n in names if n not in post.names]
-    if unknown or not names:
+    if unknown:
         raise GPMSAError(f"unknown parameters {unknown}; the posterior has {post.names}")
     truth = _check_truth(truth, post.names)
     k = len(names)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import as_float, check_level
+from gpmsa.model.data import as_float, check_count, check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.full import FullPrediction
 
@@ -54,6 +54,8 @@ def prediction_bands(
     if not isinstance(pred, FullPrediction):
         raise GPMSAError(f"pred must be a FullPrediction, got {type(pred).__name__}")
     level = check_level(level)
+    max_panels = check_count(max_panels, "max_panels")
+    x_column = check_count(x_column, "x_column", 0, pred.x.shape[1] - 1)
     N, l = pred.x.shape[0], pred.grid.size
     if observed is not None:
         observed = as_float(observed, "observed")
@@ -74,8 +76,6 @@ def prediction_bands(
     ylabel = "output minus predicted mean of y" if relative else "output"
     pct = f"{100 * level:.0f} %"
     if l == 1:
-        if not 0 <= x_column < pred.x.shape[1]:
-            raise GPMSAError(f"x_column must be in [0, {pred.x.shape[1]}), got {x_column}")
         order = np.argsort(pred.x[:, x_column])
         xs = pred.x[order, x_column]
         fig = figure(6.0, 6.0)
@@ -96,7 +96,7 @@ def prediction_bands(
         top.set_ylabel(ylabel)
         top.legend(fontsize="small")
         return fig
-    cols = np.unique(np.linspace(0, N - 1, min(int(max_panels), N)).round().astype(int))
+    cols = np.unique(np.linspace(0, N - 1, min(max_panels, N)).round().astype(int))
     fig = figure(2.8 * cols.size + 0.6, 5.6)
     axes = fig.subplots(2, cols.size, squeeze=False, sharex=True, height_ratios=[2, 1])
     for c, i in enumerate(cols):

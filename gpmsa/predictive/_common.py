@@ -124,6 +124,8 @@ def param_sets(emulator, draws: bool, n_draws: int | None, what: str):
     ``draws=False``: the point estimate only (index -1). ``draws=True``: the retained posterior
     draws, or ``n_draws`` of them evenly spaced; GPMSAError when the emulator kept none.
     """
+    if n_draws is not None:  # checked also where draws=False leaves it unused
+        n_draws = check_count(n_draws, "n_draws")
     if not draws:
         return np.array([-1]), [emulator.params]
     n = emulator.n_draws if emulator.draws else 0

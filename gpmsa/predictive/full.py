@@ -288,6 +288,18 @@ def _check_fitted_obs(emulator, obs: ObsData) -> None:
         )
 
 
+def _check_calibrated_obs(posterior, obs: ObsData) -> None:
+    """GPMSAError when ``posterior`` recorded the values of its observations (``gpmsa.calibrate``:
+    info "obs_values_sha256") and ``obs`` holds other ones."""
+    info = getattr(posterior, "info", None) or {}
+    digest = info.get("obs_values_sha256")
+    if digest is not None and obs.values_digest() != digest:
+        raise GPMSAError(
+            "obs holds other observations (x or y) than the calibration that drew posterior=: "
+            "pass the x_obs and y_obs given to gpmsa.calibrate as ObsData(x=x_obs, y=y_obs)"
+        )
+
+
 def full_prediction(
     emulator,
     obs: ObsData,
@@ -309,7 +321,9 @@ def full_prediction(
         x: (N, p) new known inputs, native units. Outside the training range: a warning; more
             than ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError.
         posterior: instead of the joint fit's draws, a Posterior of gpmsa.calibrate (theta,
-            lamOs, and betaV, lamVz with a discrepancy) with the emulator at its point estimate.
+            lamOs, and betaV, lamVz with a discrepancy) with the emulator at its point estimate;
+            ``obs`` must then hold the calibration's x_obs and y_obs (where the Posterior
+            recorded them: info "obs_values_sha256").
         discrepancy: the discrepancy basis of the calibration: None, "constant", "linear" or an
             (l_obs, p_v) array; the default takes the joint fit's recorded choice (an array must
             be passed again).
@@ -357,6 +371,8 @@ def full_prediction(
         _check_fitted_discrepancy(emulator, discrepancy)
     if posterior is None:
         _check_fitted_obs(emulator, obs)
+    else:
+        _check_calibrated_obs(posterior, obs)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
     with warnings.catch_warnings():

@@ -257,7 +257,9 @@ def sensitivity(
     fixed = {name: as_real(value, f"fixed[{name!r}]") for name, value in fixed.items()}
     for name, value in fixed.items():
         k = names.index(name)
-        _, u = unit_inputs([[value]], [name], lo_all[k : k + 1], hi_all[k : k + 1], "fixed")
+        _, u = unit_inputs(
+            [[value]], [name], lo_all[k : k + 1], hi_all[k : k + 1], f"fixed[{name!r}]"
+        )
         fix_u[k] = float(u[0, 0])
     idx, sets = param_sets(emulator, draws, n_draws, "sensitivity")
     S, l_sim, p_u, d = len(sets), emulator.l_sim, emulator.p_u, len(varied)

@@ -228,6 +228,8 @@ def fit_study(
     draws = _study_draws(chains, keep)
     lp = draws["log_post"].reshape(-1)
     members = []
+    fitted_discrepancy = (discrepancy if isinstance(discrepancy, str) or discrepancy is None
+                          else "given")  # fmt: skip
     for i, (sim, prep) in enumerate(zip(sims, preps, strict=True)):
         post = {k: v[:, keep] for k, v in chains.members[i].items()}
         flat = {k: v.reshape(-1, *v.shape[2:]) for k, v in post.items()}
@@ -242,7 +244,10 @@ def fit_study(
         emu_settings = {"n_iter": int(n_iter), "n_burn": int(n_burn), "thin": thin,
                         "n_chains": int(n_chains), "tune": bool(tune), "backend": "numpy",
                         "seed": seed, "point": point, "n_pc": int(prep.K.shape[1]),
-                        "joint_obs": True, "study": {"label": labels[i], "shared": list(shared),
+                        "joint_obs": True, "discrepancy": fitted_discrepancy,
+                        "obs_lengths": [int(e.size) for e in obs[i].experiments],
+                        "obs_sha256": obs[i].digest(),
+                        "study": {"label": labels[i], "shared": list(shared),
                                                      "hierarchical": list(hierarchical)},
                         "versions": settings["versions"]}  # fmt: skip
         members.append(Emulator._from_prepared(

@@ -102,13 +102,16 @@ class Study:
 
     def member_posterior(self, model: int | str) -> Posterior:
         """One model's calibration as a ``gpmsa.Posterior`` named as its emulator's t_names and
-        "lamOs" (native units), e.g. for ``gpmsa.predictive.calibrated_predict``."""
+        "lamOs" (native units), and for a study fitted with a discrepancy its "betaV" (one
+        input; "betaV[k]" for several) and "lamVz", e.g. for ``gpmsa.full_prediction``'s
+        ``posterior=`` or ``gpmsa.predictive.calibrated_predict``."""
         i = self._member(model)
         chains = self.posterior.chains
         out = {}
         for k, name in enumerate(self.members[i].t_names):
             out[name] = chains[self.layout.elements[self.layout.index[i][k]].name]
         out["lamOs"] = chains[f"lamOs[{self.labels[i]}]"]
+        out.update(_discrepancy_chains(self.members[i], out["lamOs"].shape))
         return Posterior(
             {k: v.reshape(-1) for k, v in out.items()},
             chains=out,
@@ -210,3 +213,16 @@ def load_study(path: str | Path) -> Study:
         raise EmulatorFileError(f"{path}: {exc}") from exc
     except GPMSAError as exc:
         raise EmulatorFileError(f"{path}: study: {exc}") from exc
+
+
+def _discrepancy_chains(member, shape: tuple[int, int]) -> dict[str, np.ndarray]:
+    """A fitted study model's discrepancy draws as chains of ``shape`` (n_chains, n_draws):
+    "betaV" (one known input) or "betaV[k]", and "lamVz"; none for a model without one."""
+    cal = getattr(member, "calibration", None) or {}
+    if "betaV" not in cal or "lamVz" not in cal:
+        return {}
+    beta = np.asarray(cal["betaV"], dtype=float).reshape(shape[0] * shape[1], -1)
+    names = ["betaV"] if beta.shape[1] == 1 else [f"betaV[{k}]" for k in range(beta.shape[1])]
+    out = {name: beta[:, k].reshape(shape) for k, name in enumerate(names)}
+    out["lamVz"] = np.asarray(cal["lamVz"], dtype=float).reshape(shape)
+    return out

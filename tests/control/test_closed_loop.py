@@ -281,6 +281,10 @@ def test_an_emulator_folder_gives_its_file_or_names_the_missing_one(tmp_path):
                        r"`python examples/train_emulator.py --emulator-dir .* --cases B "
                        r"--features window`"):  # fmt: skip
         control.shipped_emulator("B", "window", tmp_path)
+    with pytest.raises(ControlError, match="folder is an empty path"):  # not the current folder
+        control.shipped_emulator("B", "band", "")
+    with pytest.raises(ControlError, match=r"folder '.*jackal_B.gpmsa' is not a folder"):
+        control.shipped_emulator("B", "band", tmp_path / "jackal_B.gpmsa")
 
 
 def test_bad_fault_settings_raise():

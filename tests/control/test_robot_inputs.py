@@ -134,6 +134,17 @@ def test_an_out_path_that_is_a_file_is_named_as_such(bag, tmp_path, capsys):
         assert repr(str(there)) in err and "Errno" not in err
 
 
+def test_an_empty_path_is_refused_not_read_as_the_current_folder(bag, tmp_path, capsys):
+    for argv, name in (
+        (["", "--emulator", "A"], "BAG"),
+        ([bag, "--emulator", "A", "--out", ""], "--out"),
+        ([bag, "--emulator", " "], "--emulator"),
+    ):
+        code, _, err = _run(capsys, *argv)
+        assert code == 2 and f"error: {name} is an empty path" in err, err
+        assert err.count("\n") == 1
+
+
 def test_an_emulator_path_that_is_no_file_is_named_as_such(bag, tmp_path, capsys):
     for emulator, what in (
         (os.devnull, "is not a regular file, not an emulator file"),

@@ -61,6 +61,19 @@ def test_cli_bad_input(emu_file, capsys, extra, match):
     assert re.search(match, capsys.readouterr().err)
 
 
+@pytest.mark.parametrize(
+    ("level", "match"),
+    [("0", r"'0' must lie in \(0, 1\)"), ("nan", "must lie in"), ("x", "is not a number"),
+     ("1e-300", "print as the median"), ("0.99999999", "print as the median or as 0 and 100")],
+)  # fmt: skip
+def test_cli_level_is_checked_before_any_work(emu_file, capsys, level, match):
+    with pytest.raises(SystemExit) as exit_:
+        main(["calibrate", str(emu_file), "--x", "v=1.25", "--y", "f=12.1", "--level", level])
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2 and "argument --level" in err and re.search(match, err)
+    assert "Warning" not in err  # refused before the calibration
+
+
 def test_calibrated_prediction_grid_and_draws_agree():
     emu = road_emulator()
     x, y = road_obs()

@@ -292,6 +292,7 @@ def test_devices_fifos_and_directories_are_refused_at_once(tmp_path):
             with pytest.raises(gpmsa.EmulatorFileError, match="not a regular file"):
                 gpmsa.load(path)
             assert main(["info", path]) == 2
+    assert main(["info", ""]) == 2  # no path at all: a message, not a traceback
     link = tmp_path / "zero.gpmsa"
     link.symlink_to("/dev/zero")
     with time_limit(5), pytest.raises(gpmsa.EmulatorFileError, match="not a regular file"):

@@ -163,6 +163,13 @@ def test_posterior_path_scalar_output_and_grid_option():
         full_prediction(emu, obs, [[0.2]], posterior=post, discrepancy=None)
     with pytest.raises(GPMSAError, match="no output grid"):
         full_prediction(emu, obs, [[0.2]], posterior=post, discrepancy="constant", grid=[0.5])
+    # the posterior records its observations' values: other ones are refused, the same accepted
+    assert post.info["obs_values_sha256"] == obs.values_digest()
+    for other in (gpmsa.ObsData(x=xo, y=obs.y + 0.5), gpmsa.ObsData(x=xo[:5], y=obs.y[:5])):
+        with pytest.raises(GPMSAError, match="obs holds other observations .* than the calib"):
+            full_prediction(emu, other, [[0.2]], posterior=post, discrepancy="constant")
+    again = gpmsa.ObsData(x=xo.tolist(), y=obs.y[:, 0])  # other containers, the same values
+    full_prediction(emu, again, [[0.2]], posterior=post, discrepancy="constant", n_draws=2)
 
     emu_v, obs_v, *_ = known_truth_case()
     fine = np.linspace(0.0, 1.0, 34)  # every third node is a node of GRID (12 nodes)

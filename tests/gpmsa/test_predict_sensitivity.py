@@ -176,7 +176,7 @@ def test_per_component_indices_and_draw_spread():
         ({"bounds": {"t": 3}}, r"bounds\['t'\] must be \(lo, hi\)"),
         ({"bounds": {"t": (-1.0, 5.0)}}, r"bounds: t reaches .* by more than 10%"),
         ({"fixed": {"x": 1.0, "t": 0.0}}, "every input is fixed"),
-        ({"fixed": {"x": 9.0}}, r"fixed: x reaches"),
+        ({"fixed": {"x": 9.0}}, r"fixed\['x'\]: x reaches"),
         ({"fixed": {"x": "a"}}, r"fixed\['x'\] must be a number"),
         ({"fixed": {"x": 1.0}, "bounds": {"x": (0, 1)}}, "both in bounds and in fixed"),
         ({"n_draws": 0}, "n_draws must be an integer >= 1"),
