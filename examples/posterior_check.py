@@ -44,16 +44,21 @@ PAPER_TABLE2 = {  # percent error, rows GD, columns v (Lewis et al. 2025, Table 
 }
 
 
-def cell_posterior(calibrator, model, v: float, gd: float, seed: int, noise_std: float, meta: dict):
-    """Posterior of GD from one window on one fresh road driven at v."""
-    feat = meta["feature"]
+ROAD_M = 21.0
+"""Length of each fresh road, m (the paper's): long enough for a 1,000-sample window at 1.75 m/s."""
+
+
+def cell_posterior(calibrator, model, v: float, gd: float, seed: int, noise_std: float, emu):
+    """Posterior of GD from one window on one fresh road driven at v (the window emulator's
+    feature, roads made as its training roads were)."""
+    feature = control.emulator_feature(emu)
     road = roadgen.iso8608_profile(
-        meta["road"]["length_m"], gd, seed=seed, lead_in_m=meta["road"]["lead_in_m"]
+        ROAD_M, gd, seed=seed, lead_in_m=emu.metadata["road"]["lead_in_m"]
     )
     trace = vehicle.simulate(
-        model, road, v, rate_hz=feat["rate_hz"], noise_std=noise_std, seed=seed
+        model, road, v, rate_hz=feature.rate_hz, noise_std=noise_std, seed=seed
     )
-    y = window_feature(trace.accel_front_measured[-feat["window_samples"] :], feat["name"])
+    y = window_feature(trace.accel_front_measured[-feature.block_samples :], feature.name)
     return calibrator.update([[v]], [[y]])
 
 
@@ -73,7 +78,7 @@ def main(argv: list[str] | None = None) -> dict:
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
     out = output_folder(parser, "--out", args.out)
-    emu = control.shipped_emulator(args.case)
+    emu = control.shipped_emulator(args.case, "window")  # the paper's feature
     calibrator = gpmsa.Calibrator(emu, seed=args.seed)
     model = vehicle.Jackal()
     noise = float(emu.metadata["noise_std"])
@@ -84,9 +89,7 @@ def main(argv: list[str] | None = None) -> dict:
     for i, gd in enumerate(GDS):
         for j, v in enumerate(SPEEDS):
             for k in range(args.roads):
-                post = cell_posterior(
-                    calibrator, model, v, gd, int(seeds[i, j, k]), noise, emu.metadata
-                )
+                post = cell_posterior(calibrator, model, v, gd, int(seeds[i, j, k]), noise, emu)
                 errors[i, j, k] = 100 * abs(post.mean("GD") - gd) / gd
                 if k == 0:
                     cells.append((v, gd, post.samples["GD"]))

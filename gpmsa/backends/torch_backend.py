@@ -589,7 +589,7 @@ def torch_threads(num_threads: int | None):
 
 
 def _dtype(dtype) -> torch.dtype:
-    if isinstance(dtype, torch.dtype):
+    if dtype in (torch.float64, torch.float32):
         return dtype
     if dtype in ("float64", "float32"):
         return getattr(torch, dtype)
@@ -597,9 +597,27 @@ def _dtype(dtype) -> torch.dtype:
 
 
 def _device(device) -> torch.device:
-    dev = torch.device(device)
+    """``device`` as a torch.device (`_parsed_device`); GPMSAError for CUDA where torch sees
+    none."""
+    dev = _parsed_device(device)
     if dev.type == "cuda" and not torch.cuda.is_available():
         raise GPMSAError(f"device={device!r} was asked for but torch sees no CUDA device")
+    return dev
+
+
+def _parsed_device(device) -> torch.device:
+    """``device`` ("cpu", "cuda", "cuda:N" or such a torch.device) as a torch.device;
+    GPMSAError for anything else."""
+    dev = None
+    if isinstance(device, torch.device):
+        dev = device
+    elif isinstance(device, str):
+        try:
+            dev = torch.device(device)
+        except RuntimeError:
+            dev = None
+    if dev is None or dev.type not in ("cpu", "cuda"):
+        raise GPMSAError(f"device must be 'cpu' or 'cuda' (or 'cuda:N'), got {device!r}")
     return dev
 
 
@@ -673,7 +691,7 @@ def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_thr
             f"chain_groups must be an integer in [1, n_chains={n_chains}], got {chain_groups!r}"
         )
     remote = chain_groups > 1 or executor is not None
-    if remote and torch.device(device).type != "cpu":
+    if remote and _parsed_device(device).type != "cpu":
         raise GPMSAError(
             f"chain_groups > 1 and executor= run CPU worker processes; device={device!r} samples "
             "all chains in one batch (give chain_groups=1 and no executor)"

@@ -194,7 +194,12 @@ def calibrate(
     if fast and not can_fast:
         raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
     if not fast and (emulator_params != "point" or log_prior is not None):
-        raise GPMSAError("emulator_params='draws' and log_prior need the fast numpy path")
+        what = ("emulator_params='draws'" if emulator_params != "point"
+                else "log_prior (a Calibrator update's prior=)")  # fmt: skip
+        raise GPMSAError(
+            f"{what} needs the fast numpy sampler: backend='numpy', no discrepancy and fast "
+            f"not False; got backend={backend!r}, discrepancy={discrepancy!r}, fast={fast}"
+        )
     if not fast:  # a categorical theta: the fast sampler only
         check_emulator(emulator)
     _check_calibrate_memory(emulator, n_samples, n_chains, fast)

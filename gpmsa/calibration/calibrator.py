@@ -143,13 +143,15 @@ class Calibrator:
         self.mcmc_options = _check_mcmc_options(mcmc_options)
         if constraint is not None:
             self.mcmc_options.setdefault("constraint", constraint)
+        self._check_mcmc_path(backend)
         if n_grid is None:
             n_grid = 129 if q == 1 else 65
         self.n_grid = check_count(n_grid, "n_grid", 3)
         if self.method == "mcmc":
             return
         m, p_u = emulator.x_unit.shape[0], emulator.K.shape[1]
-        n_sets = 1 if emulator_params == "point" else self._n_emulator_draws
+        kept = emulator.n_draws if emulator.draws else 0  # at most these draws are used
+        n_sets = 1 if emulator_params == "point" else min(self._n_emulator_draws, max(kept, 1))
         G = self.n_grid**q
         # per parameter set: R_t on the grid and its product with alpha (G x m per component)
         # and Sigma_W's factor (GridPredictor checks its Chebyshev products once sized)
@@ -179,6 +181,23 @@ class Calibrator:
         self._log_prior_norm = float(
             np.log(pri.theta_sd * np.sqrt(2 * np.pi) * (ndtr(z[0]) - ndtr(z[1])))
         )
+
+    def _check_mcmc_path(self, backend: str) -> None:
+        """GPMSAError now, not at every update, for MCMC settings ``gpmsa.calibrate`` refuses:
+        a constraint or the emulator's draws on another backend than numpy, or the draws with
+        ``mcmc_options={"fast": False}`` (only the fast numpy sampler averages over them)."""
+        if self.method != "mcmc":
+            return
+        opts = self.mcmc_options
+        backend = opts.get("backend", backend)
+        if backend != "numpy":
+            for what, given in (("constraint", opts.get("constraint") is not None),
+                                ("emulator_params='draws'", self.emulator_params == "draws")):
+                if given:
+                    raise GPMSAError(f"{what} needs backend='numpy', got backend={backend!r}")
+        if self.emulator_params == "draws" and opts.get("fast") is False:
+            raise GPMSAError("emulator_params='draws' needs the fast numpy sampler: drop "
+                             "mcmc_options['fast'] = False")  # fmt: skip
 
     # --- the exact likelihood on a grid ---------------------------------------------------------
     def _marginals(
@@ -252,12 +271,15 @@ class Calibrator:
                     f" got {vals.size}"
                 )
         else:
-            vals = as_float(prior, "prior").reshape(-1)
-            if vals.size != self._theta_unit.shape[0]:
+            vals = as_float(prior, "prior")
+            G, n = self._theta_unit.shape[0], self.n_grid
+            shapes = [(G,)] + ([(n, n)] if self.q == 2 else [])  # (n, n): [first, second]
+            if vals.shape not in shapes:
                 raise GPMSAError(
-                    f"prior must be log densities on the Calibrator's grid "
-                    f"({self._theta_unit.shape[0]} values), got {vals.size}"
+                    f"prior must be log densities on the Calibrator's grid, of shape "
+                    f"{' or '.join(map(str, shapes))} (theta_grid's order), got {vals.shape}"
                 )
+            vals = vals.reshape(-1)
             if not on_grid and self.q == 1:
                 vals = np.interp(theta_unit[:, 0], self._theta_unit[:, 0], vals)
             elif not on_grid:
@@ -275,12 +297,14 @@ class Calibrator:
             x_obs: (n, p) known inputs, native units (e.g. [[v]]).
             y_obs: (n, l_sim) observed outputs, native units (e.g. [[f]]).
             prior: optional extra log prior of theta: log-density values on ``theta_grid`` (G,)
-                (interpolated linearly, bilinearly for two parameters, where the grid is
+                (for two parameters also (n_grid, n_grid), rows the first parameter;
+                interpolated linearly, bilinearly for two parameters, where the grid is
                 refined), or a callable of native theta ((k,) for one parameter, (k, 2) for two)
-                returning (k,). It multiplies the emulator's theta prior (effectively uniform on
-                the domain).
-            seed: seed of the lazily drawn samples (default: derived from the Calibrator's seed
-                and a per-update counter).
+                returning (k,); on the MCMC path a callable only. It multiplies the emulator's
+                theta prior (effectively uniform on the domain).
+            seed: seed of the lazily drawn samples, or of the MCMC (there it wins over
+                ``mcmc_options["seed"]``; default: derived from the Calibrator's seed and a
+                per-update counter).
 
         Returns:
             Posterior; for the grid method its summaries of theta are exact (grid) and
@@ -291,9 +315,17 @@ class Calibrator:
         if self.method == "mcmc":
             from gpmsa.calibration.calibrate import calibrate
 
+            if prior is not None and not callable(prior):
+                raise GPMSAError(
+                    "prior= on the MCMC path must be a callable of native theta returning log "
+                    "densities (values on a theta grid need method='grid': an MCMC Calibrator "
+                    "has no theta_grid)"
+                )
             opts = dict(self.mcmc_options)
             auto = int(_seed_sequence((self._entropy, self._count)).generate_state(1)[0])
-            opts.setdefault("seed", check_seed(seed) if seed is not None else auto)
+            if seed is not None:  # this update's seed wins over mcmc_options' and the default
+                opts["seed"] = check_seed(seed)
+            opts.setdefault("seed", auto)
             opts.setdefault("emulator_params", self.emulator_params)
             opts.setdefault("n_emulator_draws", self._n_emulator_draws)
             opts.setdefault("backend", self.backend)

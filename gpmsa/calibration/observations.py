@@ -16,6 +16,7 @@ from gpmsa.model import categorical
 from gpmsa.model.data import (
     ObsData,
     as_float,
+    by_column_names,
     check_count,
     check_finite,
     check_parameter_names,
@@ -119,7 +120,7 @@ def check_x(
     """x_obs native (n, p) and unit scale; outside the emulator's x domain: GPMSAError, or with
     ``extrapolate=True`` a warning. ``what``: the argument's name in messages."""
     p = emulator.x_unit.shape[1]
-    x = _as_rows(x_obs, what, p)
+    x = _as_rows(by_column_names(x_obs, emulator.x_names, what), what, p)
     levels = getattr(emulator, "levels", None)
     if levels is not None:
         categorical.check_levels(x, levels[:p], emulator.x_names, what)

@@ -8,6 +8,7 @@ reads; ``Emulator.save`` and ``load`` join the two.
 from __future__ import annotations
 
 import json
+import re
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,12 +66,17 @@ def _param_shapes(p: int, q: int, p_u: int) -> dict[str, tuple[int, ...]]:
 
 
 def _check_params(params: dict, shapes: dict) -> dict[str, np.ndarray]:
+    """``params`` as arrays of ``shapes``; an array of another shape is taken only where it
+    differs by axes of length 1 ((1, p_u) for (p_u,), as SEPIA stores them), never reordered
+    (a transposed betaU is refused)."""
+    if not isinstance(params, dict):
+        raise GPMSAError(f"params must be a dict name -> array, got {type(params).__name__}")
     out = {}
     for name, shape in shapes.items():
         if name not in params:
             raise GPMSAError(f"params needs {name!r} (shape {shape}); got keys {sorted(params)}")
         val = as_float(params[name], f"params[{name!r}]")
-        if val.size != int(np.prod(shape)):
+        if [d for d in val.shape if d != 1] != [d for d in shape if d != 1]:
             raise GPMSAError(f"params[{name!r}] must have shape {shape}, got {val.shape}")
         val = val.reshape(shape)
         if not np.all(np.isfinite(val)) or np.any(val <= 0):
@@ -161,6 +167,11 @@ class Emulator:
         from gpmsa.model.problem import prepare
 
         metadata = check_metadata(metadata)
+        if isinstance(params, dict) and (unknown := sorted(set(params) - set(EMULATOR_PARAMS))):
+            raise GPMSAError(
+                f"params has unknown keys {unknown}: an emulator's parameters are "
+                f"{list(EMULATOR_PARAMS)}"
+            )
         prep = prepare(sim_data, priors=priors, n_pc=n_pc, mean_basis=mean_basis)
         return cls._from_prepared(sim_data, prep, params, metadata=metadata,
                                   settings={"source": "from_params"})  # fmt: skip
@@ -271,8 +282,8 @@ class Emulator:
         return self._factors[-1]
 
     def _inputs(self, x, t) -> np.ndarray:
-        x = by_column_names(x, self.x_names, "x")
-        t = by_column_names(t, self.t_names, "t")
+        x = as_float(by_column_names(x, self.x_names, "x"), "x")  # ragged: named here
+        t = as_float(by_column_names(t, self.t_names, "t"), "t")
         x = as_matrix(x, "x", ncols=self.p) if np.ndim(x) != 1 or self.p != 1 else as_matrix(x, "x")
         t = as_matrix(t, "t", ncols=self.q) if np.ndim(t) != 1 or self.q != 1 else as_matrix(t, "t")
         if x.shape[0] != t.shape[0]:
@@ -334,7 +345,12 @@ class Emulator:
         variance 1/lamWOs (the spread of a new simulation run about the smooth emulator).
         """
         draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
-        n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
+        if n_draws is not None:  # also where draws=False leaves it unused
+            check_count(n_draws, "n_draws")
+        try:  # the size before converting; a ragged input is named by _inputs below
+            n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
+        except ValueError:
+            n = 1
         check_memory(
             8.0 * n * (4.0 * self.m + 6.0 * self.l_sim + 4.0 * (self.p + self.q)),
             f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs)",
@@ -554,8 +570,12 @@ def load(path: str | Path, *, sha256: str | None = None) -> Emulator:
     Raises EmulatorFileError naming the problem (and the field) for a damaged, edited,
     inconsistent, foreign or newer file.
     """
+    if sha256 is not None and not (
+        isinstance(sha256, str) and re.fullmatch(r"[0-9a-fA-F]{64}", sha256.strip())
+    ):
+        raise GPMSAError(f"sha256 must be 64 hexadecimal digits, got {str(sha256)[:80]!r}")
     manifest, arrays = read_raw(path, check_manifest)
-    if sha256 is not None and manifest["content_sha256"] != str(sha256).strip().lower():
+    if sha256 is not None and manifest["content_sha256"] != sha256.strip().lower():
         raise EmulatorFileError(
             f"{path}: content sha256 {manifest['content_sha256']} differs from the expected "
             f"{str(sha256)[:80]!r}"

@@ -131,12 +131,17 @@ def fit(
     chains.check_finite()
     kept = n_iter - n_burn
     thin = max(1, math.ceil(n_chains * kept / n_keep))
-    post = {k: v[:, n_burn:] for k, v in chains.draws.items()}
+    # float64 whatever the backend sampled in (torch float32), a fixed parameter exactly at its
+    # value; a mean within its draws' range (a parameter that never moved: float rounding)
+    post = {k: np.asarray(v[:, n_burn:], dtype=float) for k, v in chains.draws.items()}
+    for k in problem.fixed & set(post):
+        post[k][...] = np.asarray(problem.init[k], dtype=float).reshape(post[k].shape[2:])
     lp = chains.log_post[:, n_burn:]
     retained = {k: v[:, ::thin].reshape(-1, *v.shape[2:]) for k, v in post.items()}
     lp_kept = lp[:, ::thin].reshape(-1)
     if point == "mean":
-        params = {k: retained[k].mean(axis=0) for k in EMULATOR_PARAMS}
+        params = {k: np.clip(retained[k].mean(axis=0), retained[k].min(axis=0),
+                             retained[k].max(axis=0)) for k in EMULATOR_PARAMS}  # fmt: skip
     else:
         best = int(np.argmax(lp_kept))
         params = {k: retained[k][best].copy() for k in EMULATOR_PARAMS}

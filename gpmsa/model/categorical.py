@@ -79,8 +79,9 @@ def check_levels(values: np.ndarray, levels: Levels, names: Sequence[str], what:
             continue
         new = np.setdiff1d(values[:, k], np.asarray(lv, dtype=np.float64))
         if new.size:
+            level = np.format_float_positional(new[0], trim="-")  # every digit: 1.0000000001
             raise GPMSAError(
-                f"{what}: categorical input {names[k]} has level {new[0]:g}, never seen in "
+                f"{what}: categorical input {names[k]} has level {level}, never seen in "
                 f"training (levels {list(lv)})"
             )
 

@@ -85,6 +85,15 @@ def check_flag(value, name: str) -> bool:
     return bool(value)
 
 
+def column_labels(value) -> tuple[str, ...] | None:
+    """The column labels of a table with named columns (a pandas DataFrame: anything with
+    ``columns`` that is not a numpy array), as strings; None for any other value."""
+    columns = getattr(value, "columns", None)
+    if columns is None or isinstance(value, np.ndarray):
+        return None
+    return tuple(str(c) for c in columns)
+
+
 def by_column_names(value, names, name: str):
     """A table with named columns (a pandas DataFrame: anything with ``columns``) as its columns
     in the order of ``names``; any other value as it is. GPMSAError naming ``name`` when the
@@ -295,6 +304,13 @@ class SimData:
     t_categorical: Sequence[int | str] | None = None
 
     def __post_init__(self) -> None:
+        for part in ("x", "t", "y"):  # a table: its columns by name, never by position
+            labels, names = column_labels(getattr(self, part)), getattr(self, f"{part}_names")
+            if labels is not None and names is None:
+                object.__setattr__(self, f"{part}_names", labels)
+            elif labels is not None:
+                value = by_column_names(getattr(self, part), tuple(names), part)
+                object.__setattr__(self, part, value)
         x = as_matrix(self.x, "x")
         t = as_matrix(self.t, "t")
         y = as_matrix(self.y, "y")
@@ -400,8 +416,10 @@ class ObsData:
     experiments: list[np.ndarray] = field(init=False, repr=False)
     grids: list[np.ndarray | None] = field(init=False, repr=False)
     precisions: list[np.ndarray] | None = field(init=False, repr=False)
+    x_columns: tuple[str, ...] | None = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "x_columns", column_labels(self.x))
         x = as_matrix(self.x, "x_obs")
         n = x.shape[0]
         ys = self._experiments(self.y, n)
@@ -411,6 +429,19 @@ class ObsData:
         object.__setattr__(self, "precisions", self._precisions(self.precision, ys))
         ragged = len({len(e) for e in ys}) > 1
         object.__setattr__(self, "y", ys if ragged else np.stack(ys))
+
+    def inputs(self, x_names) -> np.ndarray:
+        """x (n, p) with its columns in the order of ``x_names``: as given, or, for inputs given
+        as a table with named columns (``x_columns``), by name; GPMSAError when those names are
+        not ``x_names``."""
+        if self.x_columns is None:
+            return self.x
+        names = list(x_names)
+        if sorted(self.x_columns) != sorted(names):
+            raise GPMSAError(
+                f"x_obs has the columns {list(self.x_columns)}; expected {names} (in any order)"
+            )
+        return self.x[:, [self.x_columns.index(n) for n in names]]
 
     def values_digest(self) -> str:
         """SHA-256 of x and every experiment's y (`values_digest`): what ``gpmsa.calibrate``,

@@ -56,12 +56,26 @@ class MeanBasis:
             raise GPMSAError(f"mean_basis callable failed on unit inputs {z.shape}: {exc}") from exc
         if h.ndim == 1:
             h = h[:, None]
-        if h.ndim != 2 or h.shape[0] != n or not np.all(np.isfinite(h)):
+        if h.ndim != 2 or h.shape[0] != n:
             raise GPMSAError(
                 f"mean_basis must return a finite (n, k) matrix for n = {n} points, got "
                 f"shape {h.shape}"
             )
+        if not np.all(np.isfinite(h)):
+            raise GPMSAError(f"mean_basis returned NaN or inf for n = {n} unit-scale points")
         return h
+
+
+def check_rank(basis: MeanBasis, z: np.ndarray) -> None:
+    """GPMSAError when ``basis``'s columns are linearly dependent on the design z (m, d): its
+    GLS coefficients would not be identified."""
+    h = basis.matrix(z)
+    rank = np.linalg.matrix_rank(h)
+    if rank < h.shape[1]:
+        raise GPMSAError(
+            f"the mean basis is collinear on the simulation design: its {h.shape[1]} columns "
+            f"have rank {rank}"
+        )
 
 
 def make(spec, d: int, m: int | None = None) -> MeanBasis | None:

@@ -251,11 +251,12 @@ def reduce_obs(
 
     ``levels``: the x columns' training levels (``SimData.levels``); an unseen level is refused.
     """
-    x = std.x_to_unit(obs.x)
+    x_native = obs.inputs(x_names)
+    x = std.x_to_unit(x_native)
     if x.shape[1] != std.x_min.size:
-        raise GPMSAError(f"x_obs must have {std.x_min.size} columns, got {obs.x.shape[1]}")
+        raise GPMSAError(f"x_obs must have {std.x_min.size} columns, got {x_native.shape[1]}")
     if levels is not None:
-        categorical.check_levels(obs.x, levels[: x.shape[1]], x_names, "x_obs")
+        categorical.check_levels(x_native, levels[: x.shape[1]], x_names, "x_obs")
     check_x_obs(x, x_names)
     n, p_u = obs.n, K.shape[1]
     scalar = K.shape[0] == 1
@@ -365,9 +366,13 @@ def prepare(
         obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels)
     priors = (Priors() if priors is None else priors).with_data(wos, os_corr)
     init = default_init(sim.p, sim.q, p_u, priors, obs_p)
+    x_unit, t_unit = std.x_to_unit(sim.x), std.t_to_unit(sim.t)
+    basis = mean_basis_mod.make(mean_basis, sim.p + sim.q, sim.m)
+    if basis is not None:  # refused before sampling, not at the first prediction
+        mean_basis_mod.check_rank(basis, np.hstack([x_unit, t_unit]))
     prob = Problem(
-        std.x_to_unit(sim.x), std.t_to_unit(sim.t), w, lam_sim, priors, init, frozenset(), obs_p,
-        categorical.mask(levels), mean_basis_mod.make(mean_basis, sim.p + sim.q, sim.m),
+        x_unit, t_unit, w, lam_sim, priors, init, frozenset(), obs_p,
+        categorical.mask(levels), basis,
     )  # fmt: skip
     if obs is not None and prob.theta_levels is not None:  # a categorical theta starts at a level
         prob = prob.with_init({"theta": prob.snap_theta(init["theta"])})

@@ -80,6 +80,11 @@ def _fold_labels(folds, m: int, seed) -> np.ndarray:
             raise GPMSAError(f"folds must be an integer in [2, m] = [2, {m}], got {k}")
         return rng.permutation(m) % k
     labels = np.asarray(folds)
+    if labels.ndim == 0:  # a single value that is no integer (2.0, "3", True)
+        raise GPMSAError(
+            f"folds must be None (leave-one-out), an integer k in [2, {m}] or one label per "
+            f"run, got {folds!r}"
+        )
     if labels.shape != (m,):
         raise GPMSAError(
             f"folds must be None (leave-one-out), an integer k or one label per run (shape "

@@ -286,7 +286,9 @@ def test_an_executor_that_fails_a_task_is_retried_then_reported():
 def test_a_worker_that_dies_is_replaced_and_its_chain_rerun(tmp_path):
     marker = str(tmp_path / "died")
     tasks = [{"x": i, "marker": marker} for i in range(4)]
-    with pytest.warns(RuntimeWarning, match="chain 1 of 4 failed .*BrokenProcessPool"):
+    # chain 1's worker dies; the broken pool fails the futures still running, and which of
+    # them the warning names first depends on timing (on a loaded machine chain 3's)
+    with pytest.warns(RuntimeWarning, match="chain [1-3] of 4 failed .*BrokenProcessPool"):
         got = parallel.run_chains(_die_once, tasks, n_jobs=2)
     assert got == [0, 2, 4, 6] and os.path.exists(marker)
 
