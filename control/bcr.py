@@ -214,6 +214,10 @@ def _samples(name: str, values) -> np.ndarray:
     samples: sensor faults, not errors)."""
     if values is None:
         raise ControlError(f"{name} must be a 1-D sequence of numbers, got None")
+    if isinstance(values, np.ma.MaskedArray):  # its mask would be read as data
+        raise ControlError(
+            f"{name} is a masked array: give NaN for missing samples ({name}.filled(np.nan))"
+        )
     try:
         a = np.atleast_1d(np.asarray(values))
     except ValueError as exc:  # a ragged list
@@ -250,6 +254,12 @@ class BCR:
             emulator records its feature, the settings' feature must match it
             (`EmulatorMismatchError` otherwise).
         settings: `BCRSettings` (default: the change-point method); ``overrides`` replace fields.
+
+    A BCR is a stream's state: feed it from one thread (it holds no lock), and copy it with
+    ``copy.deepcopy`` (``copy.copy`` shares its filters). It pickles, and so do its estimates
+    (their posteriors' lazily drawn samples are drawn then). Its estimates do not depend on
+    how the samples are chunked across calls; a call returns the newest estimate, or the
+    gravest fault among those it made.
     """
 
     def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
@@ -321,6 +331,7 @@ class BCR:
         self._received = 0  # samples received since the last estimate
         self._fault = ""
         self._t_last = np.nan  # time and position of the newest finite sample
+        self._t_prev = np.nan  # the newest finite time stamp, kept or dropped
         self._pos_last = np.nan
         self._clock = np.nan  # the caller's clock (update's now=), newest value
         self._clock_start = np.nan  # its first value (silence before any sample)
@@ -353,13 +364,8 @@ class BCR:
                 loop should pass it: without it a silent sensor keeps the last estimate.
             Non-finite values are sensor faults, never errors.
         """
-        if now is not None:
-            if not (is_real(now) and np.isfinite(now)):
-                raise ControlError(f"now must be a finite time, s, got {now!r}")
-            now = float(now)
-            if not np.isfinite(self._clock):
-                self._clock_start = now
-            self._clock = max(self._clock, now) if np.isfinite(self._clock) else now
+        if now is not None and not (is_real(now) and np.isfinite(now)):
+            raise ControlError(f"now must be a finite time, s, got {now!r}")
         names = ("t", "position", "accel", "speed")
         arrays = [
             _samples(name, a) for name, a in zip(names, (t, position, accel, speed), strict=True)
@@ -368,12 +374,19 @@ class BCR:
         for name, a in zip(names, arrays, strict=True):
             if a.size != n:
                 raise ControlError(f"{name} must have t's length {n}, got {a.size}")
+        if now is not None:  # a refused call above leaves the clock as it was
+            if not np.isfinite(self._clock):
+                self._clock_start = float(now)
+            self._clock = float(now)  # the latest: one wild value is forgotten at the next call
         if n == 0:
             return self._check_silence(self._check_age(self.last))
         t, position, accel, speed = arrays
         drop, restart, reason = stream_fault(
-            t, position, accel, speed, self._t_last, self.settings.rate_hz
+            t, position, accel, speed, self._t_prev, self.settings.rate_hz
         )
+        stamped = np.flatnonzero(np.isfinite(t))
+        if stamped.size:  # steps run from the previous stamp, kept or dropped, in any chunking
+            self._t_prev = float(t[stamped[-1]])
         every = self.settings.samples_per_update
         start = 0
         fault = None  # the gravest fault found by this call's updates
@@ -400,8 +413,9 @@ class BCR:
             k = int(np.flatnonzero(good)[-1])
             self._t_last, self._pos_last = float(t[k]), float(pos[k])
         broken = np.flatnonzero(drop | restart)
-        if broken.size:
-            self._fault = reason
+        if broken.size:  # every cause until a block reports them, whatever the chunking
+            if reason not in self._fault:
+                self._fault = f"{self._fault} and {reason}" if self._fault else reason
             k = int(broken[-1])
             keep = slice(k + 1, None) if drop[k] else slice(k, None)
             self._acc, self._spd, self._t, self._pos = acc[keep], spd[keep], t[keep], pos[keep]
@@ -528,6 +542,9 @@ class BCR:
         elif np.min(spd) < MAX_SPEED_CHANGE * np.max(spd):
             why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"
         if why:  # the emulator knows constant speeds in its range only
+            timing = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
+            if timing:  # odometry that disagrees with the speeds (a sign flip, a wild speed)
+                return self._skip_block(phase, ds, "sensor_fault", timing, speed=v)
             phase.undo = None
             phase.filter.predict(ds)
             if not np.isfinite(self._newest_data_time()):

@@ -76,6 +76,11 @@ def favoured_edge(nodes: np.ndarray, posterior_mass: np.ndarray, prior_mass: np.
     return ""
 
 
+NUMBERS = ("time", "position", "gd_mean", "gd_sd", "latency_s", "speed", "prob_change",
+           "data_time", "plausibility_p")  # fmt: skip
+"""The `Estimate` fields that hold one real number (NaN: none)."""
+
+
 @dataclass(frozen=True, eq=False)
 class Estimate:
     """A posterior of GD at one instant, or why there is none.
@@ -126,6 +131,10 @@ class Estimate:
     def __post_init__(self) -> None:
         if self.status not in STATUSES:
             raise ControlError(f"status must be one of {STATUSES}, got {self.status!r}")
+        for name in NUMBERS:  # NaN where there is none; never a string, a bool or an array
+            value = getattr(self, name)
+            if not is_real(value):
+                raise ControlError(f"{name} must be a real number (NaN: none), got {value!r}")
         if self.domain_edge not in ("", *DOMAIN_EDGES):
             raise ControlError(
                 f"domain_edge must be '' or one of {DOMAIN_EDGES}, got {self.domain_edge!r}"

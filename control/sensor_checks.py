@@ -34,6 +34,9 @@ variance that pure noise reads as rarely as ``NOISE_STRETCH`` samples read ``noi
 LATTICE_STRETCHES = (6, 8)
 """Stretches (samples, 0.05 and 0.07 s at 120 Hz) the lattice check looks at: a coarse
 quantisation as short as 6 samples (`lattice_stretch`)."""
+MAX_ACCEL_MPS2 = 1e5
+"""Largest |acceleration| the signal checks take as a reading, m/s^2 (about 10,000 g: beyond any
+accelerometer's range; larger values are a fault, and their squares could overflow)."""
 MAX_NOISE_SD_MPS2 = 1e4
 """Largest sensor noise sd the checks take, m/s^2 (about 1,000 g: beyond any accelerometer;
 its square must stay finite)."""
@@ -182,6 +185,9 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits) -> str:
     a = np.asarray(accel, dtype=float)
     if a.size < 2:
         return ""
+    peak = float(np.max(np.abs(a)))
+    if peak > MAX_ACCEL_MPS2:  # before any check squares them (and overflows)
+        return f"out of range: |a| reaches {peak:.3g} m/s^2, beyond any accelerometer's range"
     run = longest_repeat(a)
     if run > limits.max_repeats:
         return f"stuck sensor: {run} identical consecutive samples (allowed {limits.max_repeats})"

@@ -176,14 +176,14 @@ class Simplex:
             gd = estimate.quantile(1 - self.risk)
         else:
             return Command(self.v_safe, "safety", np.nan, "risk posture needs the posterior")
-        if not np.isfinite(gd):
+        if not (np.isfinite(gd) and gd > 0):  # no roughness reads below 0
             return Command(self.v_safe, "safety", np.nan, f"the estimate's GD is {gd}")
         if estimate.domain_edge == "upper":
             return Command(
                 self.v_safe, "safety", gd, "the road reads at or above the emulator's roughest GD"
             )
         if gd > self.gd_max:
-            return Command(self.v_safe, "safety", gd, f"GD {gd:.0f} > GD_max {self.gd_max:g}")
+            return Command(self.v_safe, "safety", gd, f"GD {gd:.4g} > GD_max {self.gd_max:g}")
         return Command(self.on_speed_grid(self.performance_speed(gd)), "performance", gd)
 
     def on_speed_grid(self, speed: float) -> float:

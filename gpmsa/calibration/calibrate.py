@@ -99,11 +99,25 @@ def calibration_problem(
 
 
 def _theta_options(emulator, constraint, theta_init):
-    """The ``ThetaConstraint`` (or None) and the unit-scale start of theta (or None)."""
+    """The ``ThetaConstraint`` (or None) and the unit-scale start of theta (or None); a
+    categorical element of ``theta_init`` must be one of its training levels (the end levels
+    included), as ``gpmsa.fit`` asks."""
     std = emulator.standardizer
     names = tuple(emulator.t_names)
     con = constraints.make(constraint, std.t_min, std.t_max, names)
-    return con, constraints.theta_init_unit(theta_init, std.t_min, std.t_max, names)
+    levels = getattr(emulator, "levels", None)
+    levels = None if levels is None else levels[emulator.x_unit.shape[1] :]
+    closed = None if levels is None else [lv is not None for lv in levels]
+    start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, names, closed)
+    if start is not None and levels is not None:
+        native = np.asarray(theta_init, dtype=float).reshape(-1)
+        for k, lv in enumerate(levels):
+            if lv is not None and not np.any(np.isclose(lv, native[k], rtol=0, atol=1e-9)):
+                raise GPMSAError(
+                    f"theta_init: categorical calibration parameter {names[k]} must be one of "
+                    f"its training levels {list(lv)}, got {native[k]:g}"
+                )
+    return con, start
 
 
 def calibrate(

@@ -196,6 +196,14 @@ class Posterior:
         self.chains = _checked_chains(chains, self._samples)
         self.info = dict(info or {})
 
+    def __getstate__(self) -> dict:
+        """For pickle (a Posterior sent to another process): lazily drawn samples are drawn
+        now, so that the draw callable (often a closure) is not pickled."""
+        state = self.__dict__.copy()
+        if state.get("_draw") is not None:
+            state["_samples"], state["_draw"] = self.samples, None
+        return state
+
     @property
     def samples(self) -> dict[str, np.ndarray]:
         """Named draws, native units: name -> (n_draws,)."""

@@ -55,10 +55,15 @@ class ThetaConstraint:
     def check_start(self, theta_unit: np.ndarray, what: str) -> None:
         """GPMSAError naming the constraint and theta when the start ``theta_unit`` is refused."""
         if not self(theta_unit):
+            value = self.describe(self.native(theta_unit))
+            if what == "fixed theta":  # theta_init cannot move a fixed value
+                raise GPMSAError(
+                    f"fixed theta: the theta constraint rejects the fixed value {value}; fix theta "
+                    "inside the allowed region, or drop the constraint"
+                )
             raise GPMSAError(
-                f"{what}: the theta constraint rejects the initial value "
-                f"{self.describe(self.native(theta_unit))}; pass theta_init= (native units) inside "
-                "the allowed region"
+                f"{what}: the theta constraint rejects the initial value {value}; pass "
+                "theta_init= (native units) inside the allowed region"
             )
 
 

@@ -17,7 +17,7 @@ z (n, d) -> (n, k)), the coefficients c_j have a flat prior and are integrated o
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve, solve_triangular
@@ -39,6 +39,7 @@ class MeanBasis:
     kind: str
     d: int
     fn: Callable[[np.ndarray], np.ndarray] | None = None
+    k: int | None = None  # a callable's column count on the design (None: not known yet)
 
     def matrix(self, z: np.ndarray) -> np.ndarray:
         """h at unit-scale points z (n, d): (n, k)."""
@@ -49,21 +50,36 @@ class MeanBasis:
         if self.kind == "linear":
             return np.hstack([np.ones((n, 1)), z])
         try:
-            h = np.asarray(self.fn(z), dtype=np.float64)
+            raw = np.asarray(self.fn(z.copy()))  # a copy: the callable cannot edit the design
         except GPMSAError:
             raise
         except Exception as exc:
             raise GPMSAError(f"mean_basis callable failed on unit inputs {z.shape}: {exc}") from exc
+        if raw.dtype.kind not in "biuf":
+            raise GPMSAError(f"mean_basis must return real numbers, got dtype {raw.dtype}")
+        h = raw.astype(np.float64)
         if h.ndim == 1:
             h = h[:, None]
-        if h.ndim != 2 or h.shape[0] != n:
+        if h.ndim != 2 or h.shape[0] != n or h.shape[1] == 0:
             raise GPMSAError(
-                f"mean_basis must return a finite (n, k) matrix for n = {n} points, got "
-                f"shape {h.shape}"
+                f"mean_basis must return a finite (n, k) matrix, k >= 1, for n = {n} points, "
+                f"got shape {h.shape}"
             )
-        if not np.all(np.isfinite(h)):
-            raise GPMSAError(f"mean_basis returned NaN or inf for n = {n} unit-scale points")
+        if self.k is not None and h.shape[1] != self.k:
+            raise GPMSAError(
+                f"mean_basis returned {h.shape[1]} columns for n = {n} points, but {self.k} on "
+                "the simulation design: it must give the same columns at any point"
+            )
+        if not np.all(np.isfinite(h)) or np.max(np.abs(h)) > MAX_ABS:
+            raise GPMSAError(
+                f"mean_basis returned NaN, inf or values beyond {MAX_ABS:g} for n = {n} "
+                "unit-scale points (scale its columns)"
+            )
         return h
+
+
+MAX_ABS = 1e100
+"""Largest |value| a mean basis may return: its GLS products square them."""
 
 
 def check_rank(basis: MeanBasis, z: np.ndarray) -> None:
@@ -96,7 +112,7 @@ def make(spec, d: int, m: int | None = None) -> MeanBasis | None:
     k = basis.matrix(np.full((2, d), 0.5)).shape[1]
     if m is not None and k >= m:
         raise GPMSAError(f"mean_basis has {k} columns; it needs fewer than the {m} runs")
-    return basis
+    return basis if basis.kind != "callable" else replace(basis, k=k)
 
 
 @dataclass(frozen=True, eq=False)

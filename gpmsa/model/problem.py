@@ -181,7 +181,8 @@ class Problem:
             arr = as_float(val, f"fixed[{name!r}]")
             if arr.size == 1:
                 arr = np.full(shape, float(arr.reshape(-1)[0]))
-            elif arr.size != int(np.prod(shape)):
+            elif [d for d in arr.shape if d != 1] != [d for d in shape if d != 1]:
+                # another layout (a transposed betaU) would be reshuffled, not read
                 raise GPMSAError(
                     f"fixed[{name!r}] must be a scalar or have shape {shape}, got {arr.shape}"
                 )

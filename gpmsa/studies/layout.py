@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import math
 import re
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from gpmsa.errors import GPMSAError
 
-LABEL_RE = re.compile(r"^[A-Za-z0-9_-]{1,48}$")
+LABEL_RE = re.compile(r"\A[A-Za-z0-9_-]{1,48}\Z")  # \Z: "$" also matches before a final "\n"
 """A model's label: letters, digits, _ and -, at most 48 (it names the model's file)."""
 
 
@@ -60,6 +61,12 @@ class HyperPriors:
         if self.sd_prior not in SD_PRIORS:
             raise GPMSAError(f"HyperPriors.sd_prior must be one of {SD_PRIORS}, got "
                              f"{self.sd_prior!r}")  # fmt: skip
+        if self.sd_prior == "uniform" and (self.lam_a, self.lam_b) != (1.0, 1e-3):
+            warnings.warn(
+                f"HyperPriors: lam_a={self.lam_a!r} and lam_b={self.lam_b!r} set the gamma "
+                "prior of the precision, which sd_prior='uniform' does not use; give "
+                "sd_prior='gamma' (SEPIA's: HyperPriors.sepia())", UserWarning, stacklevel=3,
+            )  # fmt: skip
         if self.sd_prior == "uniform" and self.lam_start * self.sd_max**2 <= 1.0:
             raise GPMSAError(f"HyperPriors.lam_start={self.lam_start!r} gives a start sd "
                              f"{self.lam_start**-0.5:.3g} outside the uniform sd prior's "
@@ -149,6 +156,8 @@ def check_labels(labels, n_models: int) -> tuple[str, ...]:
     """The models' labels (default model0, model1, ...); GPMSAError for a bad or repeated one."""
     if labels is None:
         return tuple(f"model{i}" for i in range(n_models))
+    if isinstance(labels, str):  # tuple("ab") would be ("a", "b")
+        raise GPMSAError(f"labels must be a sequence of {n_models} strings, got {labels!r}")
     labels = tuple(labels)
     if len(labels) != n_models:
         raise GPMSAError(f"got {len(labels)} labels for {n_models} models")
@@ -157,8 +166,8 @@ def check_labels(labels, n_models: int) -> tuple[str, ...]:
             raise GPMSAError(
                 f"model label {lab!r}: use 1-48 letters, digits, '_' or '-' (it names a file)"
             )
-    if len(set(labels)) != len(labels):
-        raise GPMSAError(f"model labels must differ, got {list(labels)}")
+    if len({lab.lower() for lab in labels}) != len(labels):  # files differ on any file system
+        raise GPMSAError(f"model labels must differ, also in more than case, got {list(labels)}")
     return labels
 
 

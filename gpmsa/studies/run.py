@@ -139,8 +139,8 @@ def calibrate_study(
     layout = layout_of(emulators, labels, shared, hierarchical)
     check_study_names(layout)
     t0 = time.perf_counter()
-    problems = [calibration_problem(e, x, y, extrapolate=extrapolate)
-                for e, x, y in zip(emulators, x_obs, y_obs, strict=True)]  # fmt: skip
+    problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate)
+                for lab, e, x, y in zip(labels, emulators, x_obs, y_obs, strict=True)]  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})")  # fmt: skip
     chains = sample_study(
@@ -154,6 +154,18 @@ def calibrate_study(
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
     return study
+
+
+def _per_model(label: str, make, *args, **kwargs):
+    """``make(*args, **kwargs)`` for the model ``label``; its GPMSAError names that model."""
+    try:
+        return make(*args, **kwargs)
+    except GPMSAError as exc:
+        try:
+            named = type(exc)(f"model {label!r}: {exc}")  # the same class, where it can be
+        except TypeError:
+            named = GPMSAError(f"model {label!r}: {exc}")
+        raise named from exc
 
 
 def fit_study(
@@ -202,8 +214,8 @@ def fit_study(
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
-    preps = [prepare(s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
-             for s, o in zip(sims, obs, strict=True)]  # fmt: skip
+    preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
+             for lab, s, o in zip(labels, sims, obs, strict=True)]  # fmt: skip
     for lab, sim in zip(labels, sims, strict=True):  # the study's theta moves are continuous
         categorical.refuse_categorical_theta(sim.levels, sim.p, sim.x_names + sim.t_names,
                                              f"fit_study (model {lab})")  # fmt: skip

@@ -282,6 +282,8 @@ def test_constraint_rejecting_the_start():
         gpmsa.calibrate(emu, [[0.5]], [2.0], n_samples=10, n_burn=0, constraint=above)
     with pytest.raises(gpmsa.GPMSAError, match="need obs="):
         gpmsa.fit(sim, n_iter=5, constraint=above)
+    with pytest.raises(gpmsa.GPMSAError, match="rejects the fixed value t0=0.5; fix theta inside"):
+        gpmsa.fit(sim, obs, n_iter=5, constraint=above, fixed={"theta": 0.5})
 
 
 def test_other_backends_and_predictions_refuse_the_extensions(cat_emulator):

@@ -115,7 +115,7 @@ def test_a_collinear_mean_basis_and_a_non_finite_one_are_refused_by_fit():
     with pytest.raises(GPMSAError, match="collinear on the simulation design: its 2 columns have "
                                          "rank 1"):  # fmt: skip
         gpmsa.fit(sim, n_iter=20, mean_basis=lambda z: np.ones((len(z), 2)))
-    with pytest.raises(GPMSAError, match="mean_basis returned NaN or inf"):
+    with pytest.raises(GPMSAError, match="mean_basis returned NaN, inf or values beyond"):
         gpmsa.fit(sim, n_iter=20, mean_basis=lambda z: np.full((len(z), 1), np.nan))
 
 
@@ -143,3 +143,96 @@ def test_a_malformed_expected_hash_is_named(tmp_path):
         gpmsa.load(path, sha256="xyz")
     with pytest.raises(GPMSAError, match="folds must be None .* got 2.0"):
         gpmsa.cross_validate(emu, folds=2.0, draws=False)
+
+
+def _vector_sim():
+    rng = np.random.default_rng(0)
+    x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
+    s = np.linspace(0, 1, 8)
+    return gpmsa.SimData(x=x, t=t, y=np.outer(x[:, 0], 1 + s) + np.outer(t[:, 0], s**2), index=s)
+
+
+def test_a_fixed_matrix_in_another_layout_is_refused_not_reshuffled():
+    sim, betaU = _vector_sim(), np.array([[0.1, 0.2, 0.3], [1.0, 2.0, 3.0]])
+    with pytest.raises(GPMSAError, match=r"fixed\['betaU'\] must be a scalar or have shape "
+                                         r"\(2, 3\), got \(3, 2\)"):  # fmt: skip
+        gpmsa.fit(sim, n_iter=20, n_pc=3, fixed={"betaU": betaU.T})
+    emu = gpmsa.fit(sim, n_iter=20, n_pc=3, fixed={"betaU": betaU})
+    np.testing.assert_array_equal(emu.params["betaU"], betaU)
+
+
+def test_mean_basis_callables_get_a_copy_and_must_be_consistent():
+    sim = _vector_sim()
+
+    def zeroes_its_input(z):
+        z *= 0.0
+        return np.ones((len(z), 1))
+
+    edited = gpmsa.fit(sim, n_iter=30, tune=False, seed=0, mean_basis=zeroes_its_input)
+    plain = gpmsa.fit(sim, n_iter=30, tune=False, seed=0, mean_basis="constant")
+    np.testing.assert_allclose(edited.predict([[0.3]], [[0.7]])[0],
+                               plain.predict([[0.3]], [[0.7]])[0])  # fmt: skip
+
+    def more_columns_for_one_point(z):
+        return np.column_stack([np.ones(len(z))] + ([z[:, 0]] if len(z) == 1 else []))
+
+    emu = gpmsa.fit(sim, n_iter=20, mean_basis=more_columns_for_one_point)
+    with pytest.raises(GPMSAError, match="returned 2 columns for n = 1 points, but 1 on the"):
+        emu.predict([[0.5]], [[0.5]])
+    for basis, match in (
+        (lambda z: 1e200 * np.ones((len(z), 1)), "values beyond 1e"),
+        (lambda z: np.ones((len(z), 0)), r"k >= 1, for n = 2 points, got shape \(2, 0\)"),
+        (lambda z: np.ones((len(z), 1)) * (1 + 1j), "must return real numbers"),
+    ):
+        with pytest.raises(GPMSAError, match=match):
+            gpmsa.fit(sim, n_iter=20, mean_basis=basis)
+
+
+def test_callables_keep_several_chains_in_this_process():
+    rng = np.random.default_rng(0)
+    x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 2))
+    sim = gpmsa.SimData(x=x, t=t, y=x + t[:, :1] + t[:, 1:])
+    obs = gpmsa.ObsData(x=[[0.2], [0.5]], y=[[0.9], [1.1]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a short fit: not converged
+        emu = gpmsa.fit(sim, obs, n_iter=20, n_chains=2, seed=0,
+                        constraint=lambda th: bool(th[0] + th[1] < 1.2))  # a lambda: no pickle
+    assert np.all(emu.calibration["theta_native"].sum(axis=1) < 1.2)
+    with pytest.raises(GPMSAError, match="callables of this process: they cannot go to executor"):
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(1) as ex:
+            gpmsa.fit(sim, n_iter=20, n_chains=2, mean_basis=lambda z: np.ones(len(z)),
+                      executor=ex)  # fmt: skip
+
+
+def test_a_categorical_theta_start_is_a_level_the_end_levels_included():
+    rng = np.random.default_rng(0)
+    x = rng.uniform(size=(30, 1))
+    level = (np.arange(30) % 2).astype(float)[:, None]
+    emu = gpmsa.fit(gpmsa.SimData(x=x, t=level, y=x + level, t_categorical=[0]), n_iter=40,
+                    tune=False, seed=0)  # fmt: skip
+    xo, yo, not_zero = [[0.3], [0.6]], [[1.3], [1.6]], (lambda th: th[0] != 0)
+    post = gpmsa.calibrate(emu, xo, yo, constraint=not_zero, theta_init=[1], n_samples=60,
+                           n_burn=10, seed=0)  # fmt: skip
+    assert set(np.unique(post.samples["t0"])) == {1.0}
+    with pytest.raises(GPMSAError, match=r"t0 must be one of its training levels \[0, 1\], got"):
+        gpmsa.calibrate(emu, xo, yo, constraint=not_zero, theta_init=[0.9], n_samples=60,
+                        n_burn=10)
+
+
+def test_study_labels_and_per_model_errors_name_the_model():
+    from tests.gpmsa._study_cases import emulator, observations
+
+    emu = emulator()
+    x, y = observations(0.4, 3, 0.05, np.random.default_rng(0))
+    for labels, match in ((["a\n", "b"], "model label 'a\\\\n'"), ("ab", "labels must be a seq"),
+                          (["A", "a"], "also in more than case")):  # fmt: skip
+        with pytest.raises(GPMSAError, match=match):
+            gpmsa.calibrate_study([emu, emu], [x, x], [y, y], labels=labels, shared=["t"],
+                                  n_samples=20, n_burn=5)  # fmt: skip
+    with pytest.raises(GPMSAError, match=r"model 'second': y_obs must have one row per x_obs"):
+        gpmsa.calibrate_study([emu, emu], [x, x], [y, y[:2]], labels=["first", "second"],
+                              shared=["t"], n_samples=20, n_burn=5)  # fmt: skip
+    with pytest.warns(UserWarning, match="lam_a=2.0 and lam_b=0.001 set the gamma prior"):
+        gpmsa.HyperPriors(lam_a=2.0)
