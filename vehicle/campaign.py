@@ -157,6 +157,12 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
         ) from exc
     if not isinstance(settings, dict) or settings.pop("format", None) != FORMAT:
         raise CampaignFileError(f"campaign file {str(path)!r}: unknown format, need {FORMAT!r}")
+    keep_s = settings.get("keep_s", 0.0)
+    if isinstance(keep_s, int | float) and keep_s > 0 and "accel" not in arrays:
+        raise CampaignFileError(
+            f"campaign file {str(path)!r} is damaged: its settings keep {keep_s:g} s of traces "
+            "per run, but it holds no traces"
+        )
     try:
         return Campaign(**arrays, settings=settings)
     except VehicleError as exc:
@@ -276,6 +282,12 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
             f"Campaign.accel and .accel_measured must be ({n[0]}, samples) arrays of one shape, "
             f"got {out['accel'].shape} and {out['accel_measured'].shape}"
         )
+    for name in ("accel", "accel_measured"):  # a failed run's traces are NaN, a finished one's not
+        if out[name] is not None:
+            broken = (status == "ok") & ~np.all(np.isfinite(out[name]), axis=1)
+            if np.any(broken):
+                i = int(np.argmax(broken))
+                raise VehicleError(f"Campaign.{name}[{i}] is not finite but status[{i}] is 'ok'")
     return out
 
 
@@ -310,6 +322,8 @@ def _check_path(path: object, name: str = "path", what: str = "file") -> None:
         raise VehicleError(f"{name}={path!r} must be a {what} path: {exc}") from exc
     if "\0" in text:
         raise VehicleError(f"{name}={text!r} must be a {what} path: it contains a NUL byte")
+    if what == "file" and text.endswith(("/", os.sep)):  # "out/" names a folder, not a file
+        raise VehicleError(f"{name}={text!r} names a folder (it ends in a separator), not a file")
 
 
 def run_campaign(
@@ -589,6 +603,9 @@ def _cache_folder(cache_dir: str | os.PathLike) -> Path:
     cache = Path(cache_dir)
     try:
         cache.mkdir(parents=True, exist_ok=True)
+        probe = cache / f".write-test-{os.getpid()}"  # an existing folder may not be writable
+        probe.write_bytes(b"")
+        probe.unlink()
     except OSError as exc:
         raise VehicleError(
             f"cache_dir={str(cache_dir)!r} cannot be used as a folder: {exc}"

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from vehicle import checks
+from vehicle.errors import SimulationDivergedError
 from vehicle.exudyn_models import ExudynVehicle
 from vehicle.kinematics import Drive, check_speed, ramp_grid
 from vehicle.linear import warn_if_step_too_coarse
@@ -42,6 +43,8 @@ class Samples:
 
 class Simulation:
     """A vehicle driving along a track, integrated on demand (the Exudyn model is built once).
+    After a `SimulationDivergedError` it refuses every further ``advance`` (its solver state is
+    no longer valid): make a new one.
 
     The vehicle starts at rest on the road with its front axle at ``start_m`` (the rear axle,
     a wheelbase behind, reads a flat extension at the road's first height while it is before 0).
@@ -94,6 +97,7 @@ class Simulation:
         self.position = start
         self.speed = 0.0
         self._at_end = False  # the last advance found no sample before the end
+        self._diverged = ""  # why an advance diverged: the solver's state is then no longer valid
         self._drive = Drive(0.0, self._h, np.full(2, self.position), np.zeros(2))
         self._vehicle = ExudynVehicle(model, self._road, self._drive, self.rate_hz, substeps)
 
@@ -111,6 +115,11 @@ class Simulation:
         """Drive for ``dt`` seconds (rounded to whole sample periods, at least one) towards the
         commanded ``speed`` (m/s) and return the new samples; fewer (or none) at the track's end.
         """
+        if self._diverged:  # the solver moved on inside the failed call: its state is invalid
+            raise SimulationDivergedError(
+                f"this Simulation diverged at t = {self.time:.4g} s ({self._diverged}); make a "
+                "new one"
+            )
         dt = checks.positive("dt", dt, unit="s")
         v_set = checks.real("speed", speed)
         check_speed("speed", v_set, self.model.max_speed_mps, allow_stop=True)
@@ -130,7 +139,11 @@ class Simulation:
         if n_fit == 0:
             return _empty()
         self._drive.set(self.time, self._h, s[: n_fit * sub + 1], v[: n_fit * sub + 1])
-        states = self._vehicle.integrate(self.time, n_fit)
+        try:
+            states = self._vehicle.integrate(self.time, n_fit)
+        except SimulationDivergedError as exc:
+            self._diverged = str(exc)
+            raise
         k = np.arange(1, n_fit + 1) * sub
         position, spd = s[k], v[k]
         self.time = float(states.t[-1])

@@ -313,6 +313,17 @@ def check_values(arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
                 f"[{j}] = {lo[j]!r} must be below {hi_name}[{j}] = {hi[j]!r} (a design column "
                 "with no spread)",
             )
+        with np.errstate(over="ignore"):
+            width = hi - lo
+        tiny = np.finfo(float).tiny * np.maximum(1.0, np.maximum(np.abs(lo), np.abs(hi)))
+        bad = np.flatnonzero(~(np.isfinite(width) & (width > tiny)))
+        if bad.size:  # the unit scale divides by it: overflow, or nothing left of the spread
+            j = int(bad[0])
+            raise _fail(
+                f"arrays/{lo_name}",
+                f"[{j}] = {lo[j]!r} to {hi_name}[{j}] = {hi[j]!r}: the width {width[j]!r} is not "
+                "a finite, normal number",
+            )
     for name in ("y", "K", "w", "y_mean", "grid", "log_post"):
         _finite(arrays, name)
     if "index" in arrays:

@@ -30,7 +30,9 @@ def atomic_write(
 
     Yields:
         the open handle, positioned at 0 (opened "w+", so a writer may check what it wrote).
-        The file gets the permissions of a newly created file (0o666 less the umask).
+        A new file gets the permissions of a newly created file (0o666 less the umask); a file
+        replaced keeps its permissions, and a symbolic link is written through (its target is
+        replaced, as ``open`` would write it).
     """
     with atomic_group(error=error) as stage, stage(path, text=text) as fh:
         yield fh
@@ -52,7 +54,11 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
 
     @contextmanager
     def stage(path: str | os.PathLike, *, text: bool = False) -> Iterator[IO]:
+        if "\0" in os.fsdecode(path):
+            raise error(f"{os.fsdecode(path)!r}: cannot write (a path holds no NUL byte)")
         path = Path(path)
+        if path.is_symlink():  # write through the link, as open() would, not over it
+            path = Path(os.path.realpath(path))
         tmp, fd = _new_temporary(path, error)
         staged.append((tmp, path))
         kw = {"encoding": "utf-8", "newline": ""} if text else {}
@@ -85,10 +91,13 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
         raise error(f"{path}: cannot write ({exc.strerror})") from exc
     if mode is not None and not stat.S_ISREG(mode):
         raise error(f"{path} exists and is not a regular file: refusing to replace it")
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.part")
+    # the name's start only: a 255-byte name plus the suffix would exceed the file system's limit
+    tmp = path.with_name(f".{path.name[:32]}.{secrets.token_hex(6)}.part")
     flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
     try:
         fd = os.open(tmp, flags, 0o666)
     except OSError as exc:  # e.g. a missing folder or one without write permission
         raise error(f"{path}: cannot write ({exc.strerror})") from exc
+    if mode is not None:  # a file replaced keeps its permissions (a private one stays so)
+        os.chmod(tmp, stat.S_IMODE(mode))
     return tmp, fd

@@ -40,7 +40,7 @@ STUDY_FORMAT = "gpmsa-study"
 SCHEMA_VERSION = 1
 MANIFEST = "manifest.json"
 ARRAY_DIR = "arrays/"
-NAME_RE = re.compile(r"^[A-Za-z0-9_]{1,64}$")
+NAME_RE = re.compile(r"\A[A-Za-z0-9_]{1,64}\Z")  # \Z: "$" also matches before a final "\n"
 ALLOWED_DTYPES = {"<f8", "<i8", "|b1"}
 MAX_NDIM = 8
 """Most dimensions of an array of the file."""
@@ -371,16 +371,44 @@ def _check_members(zf: zipfile.ZipFile, path) -> dict[str, zipfile.ZipInfo]:
     return members
 
 
+MAX_MANIFEST_DEPTH = 72
+"""Deepest nesting a manifest may have: a writer's metadata nests at most 64 levels, a few
+more hold it; deeper JSON cannot be re-encoded within Python's recursion limit."""
+
+
+def _nesting(value) -> int:
+    """How deep JSON ``value`` nests (iteratively: no recursion on hostile input)."""
+    deepest, stack = 0, [(value, 1)]
+    while stack:
+        item, depth = stack.pop()
+        deepest = max(deepest, depth)
+        if isinstance(item, dict):
+            stack.extend((v, depth + 1) for v in item.values())
+        elif isinstance(item, list):
+            stack.extend((v, depth + 1) for v in item)
+    return deepest
+
+
 def _parse_manifest(raw: bytes, path, formats: tuple[str, ...] = (FORMAT,)) -> dict:
     def reject_constant(token):
         raise ValueError(f"non-standard JSON constant {token}")
 
+    def finite_float(token):
+        value = float(token)
+        if not math.isfinite(value):  # 1e999 parses as inf
+            raise ValueError(f"number {token[:40]} is beyond float64")
+        return value
+
     try:
-        manifest = json.loads(raw.decode("utf-8"), parse_constant=reject_constant)
+        manifest = json.loads(
+            raw.decode("utf-8"), parse_constant=reject_constant, parse_float=finite_float
+        )
     except (UnicodeDecodeError, ValueError, RecursionError) as exc:
         raise _fail(path, f"manifest.json is not valid JSON ({exc})") from exc
     if not isinstance(manifest, dict):
         raise _fail(path, "manifest.json must hold a JSON object")
+    if _nesting(manifest) > MAX_MANIFEST_DEPTH:
+        raise _fail(path, f"manifest.json nests deeper than {MAX_MANIFEST_DEPTH} levels")
     if manifest.get("format") not in formats:
         want = " or ".join(repr(f) for f in formats)
         raise _fail(

@@ -289,15 +289,22 @@ def reduce_obs(
         return obs_p, (0.0, 0.0)
     Ks, Ds, vs, us, blocks = [], [], [], [], []
     rank, total, ss = 0, 0, 0.0
-    for e, g, lam in zip(ys, obs.grids, lamy, strict=True):
+    for j, (e, g, lam) in enumerate(zip(ys, obs.grids, lamy, strict=True)):
         Kj = interpolate_basis(K, std.grid, g)
         Dj = discrepancy_basis(discrepancy, std.grid if g is None else g)
         DK = Kj if Dj is None else np.hstack([Dj, Kj])
         A = DK.T @ lam @ DK
         ridge = A + GLS_RIDGE * np.eye(A.shape[0])
-        vu = cho_solve(cho_factor(ridge), DK.T @ lam @ e)
-        resid = e - DK @ vu
-        ss += float(resid @ lam @ resid)
+        with np.errstate(over="ignore", invalid="ignore"):
+            rhs = DK.T @ lam @ e
+            vu = cho_solve(cho_factor(ridge), rhs) if np.all(np.isfinite(rhs)) else rhs
+            resid = e - DK @ vu
+            ss += float(resid @ lam @ resid)
+        if not (np.all(np.isfinite(vu)) and np.isfinite(ss)):
+            raise GPMSAError(
+                f"y_obs[{j}] is too large for the emulator's basis: its projection overflows "
+                "float64 (wrong units?)"
+            )
         rank += int(np.linalg.matrix_rank(A, hermitian=True))
         total += e.size
         blocks.append(

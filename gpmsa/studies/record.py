@@ -15,7 +15,7 @@ KINDS = ("calibration", "fit")
 """How a study's draws were made: calibration with the emulators fixed, or a joint fit."""
 ARRAYS = ("theta", "mu", "lam", "lamOs", "log_post")
 """The arrays of a study file: (C, N, G), (C, N, H), (C, N, H), (C, N, M), (C, N)."""
-FILE_RE = re.compile(r"^[A-Za-z0-9_-][A-Za-z0-9_.-]{0,150}\.gpmsa$")
+FILE_RE = re.compile(r"\A[A-Za-z0-9_-][A-Za-z0-9_.-]{0,150}\.gpmsa\Z")
 """A model's file name: beside the study file, no folder, no leading dot."""
 SHA_RE = re.compile(r"^[0-9a-f]{64}$")
 

@@ -12,6 +12,7 @@ import json
 import os
 import re
 import signal
+import stat
 import sys
 import warnings
 import zipfile
@@ -525,3 +526,62 @@ def test_info_shows_the_recorded_versions(emu, tmp_path, capsys):
     assert f"python {platform.python_version()}" in line and f"numpy {np.__version__}" in line
     assert f"gpmsa {gpmsa.__version__}" in line and "blas " in line
     assert "versions (metadata): exudyn 1.13.6, numpy 2.4.6" in out
+
+
+def test_a_manifest_number_beyond_float64_or_nested_too_deep_is_a_file_error(saved, tmp_path):
+    manifest, arrays = read_members(saved["scalar"])
+    huge = write_members(tmp_path / "huge.gpmsa", manifest, arrays)
+    raw = zipfile.ZipFile(huge).read("manifest.json").decode()
+    edited = raw.replace('"metadata": {', '"metadata": {"big": 1e999, ', 1)
+    with zipfile.ZipFile(huge, "w") as zf:  # the hash cannot even be computed: refused first
+        zf.writestr("manifest.json", edited)
+        for name, arr in arrays.items():
+            buf = io.BytesIO()
+            np.save(buf, arr)
+            zf.writestr(f"arrays/{name}.npy", buf.getvalue())
+    with pytest.raises(gpmsa.EmulatorFileError, match="beyond float64"):
+        gpmsa.load(huge)
+    assert main(["info", str(huge)]) == 2
+    deep: dict = {}
+    for _ in range(200):
+        deep = {"a": deep}
+    nested = write_members(tmp_path / "deep.gpmsa", {**manifest, "metadata": deep}, arrays)
+    with pytest.raises(gpmsa.EmulatorFileError, match="nests deeper than 72 levels"):
+        gpmsa.load(nested)
+
+
+def test_a_design_width_beyond_float64_and_array_names_with_a_newline_are_refused(
+    saved, tmp_path
+):
+    manifest, arrays = read_members(saved["scalar"])
+    wide = {**arrays, "t_min": np.array([-1e308]), "t_max": np.array([1e308])}
+    path = write_members(tmp_path / "wide.gpmsa", manifest, wide)
+    with pytest.raises(gpmsa.EmulatorFileError, match=r"t_min.*not a finite, normal number"):
+        gpmsa.load(path)
+    assert not container.NAME_RE.match("x_unit\n") and container.NAME_RE.match("x_unit")
+
+
+def test_saving_keeps_permissions_writes_through_links_and_takes_long_names(emu, tmp_path):
+    path = emu.save(tmp_path / "private.gpmsa")
+    os.chmod(path, 0o600)
+    emu.save(path)
+    assert stat.S_IMODE(os.stat(path).st_mode) == 0o600
+    link = tmp_path / "link.gpmsa"
+    link.symlink_to(path)
+    emu.save(link)
+    assert link.is_symlink() and gpmsa.load(link).settings == emu.settings
+    long = tmp_path / ("a" * 249 + ".gpmsa")  # a 255-byte name
+    assert emu.save(long).exists()
+    with pytest.raises(gpmsa.GPMSAError, match="holds no NUL byte"):
+        emu.save(tmp_path / "a\0b.gpmsa")
+
+
+def test_an_observation_too_large_for_the_basis_is_named_and_cli_json_is_strict(vec_emu):
+    y = np.full((1, 6), 0.5)
+    y[0, 0] = 1e308  # finite, but its projection on the basis overflows
+    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs\[0\] is too large for the emulator's"):
+        gpmsa.Calibrator(vec_emu).update([[0.5]], y)
+    from gpmsa.cli.calibrate import _strict
+
+    out = _strict({"sd": float("inf"), "q": [np.float64("nan"), 1.0], "n": 3})
+    assert json.loads(json.dumps(out, allow_nan=False)) == {"sd": None, "q": [None, 1.0], "n": 3}

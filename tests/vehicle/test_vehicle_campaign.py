@@ -1,5 +1,6 @@
 """run_campaign: f per run, executors, the cache, failures, the file."""
 
+import dataclasses
 import io
 import json
 import os
@@ -7,6 +8,7 @@ import threading
 import time
 import zipfile
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -453,3 +455,31 @@ def test_an_error_cancels_the_queued_runs(monkeypatch, own_pool):
     with ThreadPoolExecutor(1) as ex, pytest.raises(Boom):
         vehicle.run_campaign(design, executor=None if own_pool else ex, **SHORT)
     assert len(calls) <= 2
+
+
+def test_cache_write_failures_traces_and_folder_paths_are_named(tmp_path):
+    design = vehicle.lhs_design(3, seed=1)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    os.chmod(locked, 0o500)
+    try:
+        if os.access(locked, os.W_OK):  # root writes anywhere: a folder no one may write
+            locked = Path("/proc/self")
+        with pytest.raises(vehicle.VehicleError, match="cannot be used as a folder"):
+            vehicle.run_campaign(design, progress=False, cache_dir=locked)
+    finally:
+        os.chmod(tmp_path / "locked", 0o700)
+    campaign = vehicle.run_campaign(design, progress=False, keep_s=0.5)
+    with pytest.raises(vehicle.VehicleError, match="names a folder .* not a file"):
+        campaign.save(str(tmp_path) + "/")
+    broken = campaign.accel.copy()
+    broken[0, 0] = np.nan  # a finished run's trace
+    with pytest.raises(vehicle.VehicleError, match=r"Campaign.accel\[0\] is not finite but"):
+        dataclasses.replace(campaign, accel=broken)
+    path = tmp_path / "c.npz"
+    campaign.save(path)
+    arrays = dict(np.load(path, allow_pickle=False))
+    del arrays["accel"], arrays["accel_measured"]  # traces lost, settings say they were kept
+    np.savez(tmp_path / "lost.npz", **arrays)
+    with pytest.raises(vehicle.CampaignFileError, match="keep 0.5 s of traces .* holds no"):
+        vehicle.load_campaign(tmp_path / "lost.npz")

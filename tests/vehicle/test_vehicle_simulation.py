@@ -148,3 +148,17 @@ def test_the_drive_loop_ends_when_no_sample_fits_before_the_end(short_of_end_m, 
         calls += 1
     assert sim.finished and calls == 1
     assert len(sim.advance(0.5, 2.0)) == 0 and sim.finished
+
+
+def test_a_diverged_simulation_refuses_to_go_on():
+    rough = roadgen.track([(2, 300), (3, 3e7), (5, 300)], seed=0, lead_in_m=0.5)
+    sim = vehicle.Simulation(vehicle.Jackal(), rough, seed=0)
+    for _ in range(3):
+        sim.advance(0.5, 1.0)
+    with pytest.raises(vehicle.SimulationDivergedError, match="states out of range"):
+        sim.advance(0.5, 1.0)
+    time, position = sim.time, sim.position
+    for speed in (1.0, 0.0):  # the solver's state moved on inside the failed call: no samples
+        with pytest.raises(vehicle.SimulationDivergedError, match="diverged at t = 1.5 s .*new"):
+            sim.advance(1.0 / 120, speed)
+    assert (sim.time, sim.position) == (time, position)
