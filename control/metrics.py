@@ -3,7 +3,6 @@ means over many runs with their clustered standard errors; reports as strict JSO
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -11,6 +10,7 @@ import numpy as np
 
 from control.errors import ControlError
 from control.validation import float_array
+from gpmsa.io.container import jsonable
 
 
 @dataclass(frozen=True)
@@ -173,13 +173,6 @@ def fast_on_rough_m(
 def strict_json(value):
     """``value`` (dicts, lists, tuples, numbers, strings) ready for ``json.dumps(...,
     allow_nan=False)``: numpy scalars as Python's, floats that are not finite (NaN, inf) as None
-    (JSON's null), tuples as lists, keys as strings."""
-    if isinstance(value, dict):
-        return {str(k): strict_json(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [strict_json(v) for v in value]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
+    (JSON's null), tuples as lists, keys as strings (``gpmsa.io.container.jsonable``, which the
+    emulator files use)."""
+    return jsonable(value)

@@ -42,7 +42,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
-from gpmsa.mcmc.parallel import n_workers, run_chains
+from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
 from gpmsa.model.data import ObsData, as_float, check_count, check_flag, check_seed
@@ -331,14 +331,10 @@ def _run_fast(
         init_lamos=lamos_start(fit, data.lamos), constraint=con, init_theta=theta0,
         theta_levels=theta_levels(emulator),
     )  # fmt: skip
-    if extra is not None or con is not None:  # a callable of this process: chains run here
-        if where["executor"] is not None:
-            raise GPMSAError(
-                "log_prior and constraint are callables of this process: they cannot go to "
-                "executor="
-            )
-        n_workers(where["n_jobs"], n_chains)  # still refuse a bad n_jobs
-        where = {"n_jobs": 1, "executor": None}
+    callables = [name for name, on in (("log_prior", extra is not None),
+                                       ("constraint", con is not None)) if on]  # fmt: skip
+    n_jobs, executor = in_this_process(callables, where["n_jobs"], where["executor"], n_chains)
+    where = {"n_jobs": n_jobs, "executor": executor}
     tasks = [
         {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune, **tuning_opts}
         for s in np.random.SeedSequence(seed).spawn(n_chains)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import time
 import warnings
@@ -13,6 +12,7 @@ import numpy as np
 
 from gpmsa.cli.text import safe
 from gpmsa.errors import GPMSAError
+from gpmsa.io.container import jsonable
 
 
 def add_parser(sub) -> None:
@@ -33,17 +33,6 @@ def add_parser(sub) -> None:
     p.add_argument("--extrapolate", action="store_true", help="allow x outside the domain")
     p.add_argument("--json", action="store_true", help="print JSON for programs")
     p.set_defaults(func=run)
-
-
-def _strict(value):
-    """``value`` with every non-finite float as None (null): strict JSON for any parser."""
-    if isinstance(value, dict):
-        return {k: _strict(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_strict(v) for v in value]
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
 
 
 def _quantile_keys(level: float) -> tuple[str, str]:
@@ -130,7 +119,7 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
             "seconds": seconds,
             "posterior": summary,
         }
-        print(json.dumps(_strict(out), indent=1, allow_nan=False))  # RFC 8259: no NaN
+        print(json.dumps(jsonable(out), indent=1, allow_nan=False))  # RFC 8259: no NaN
         return 0
     lo_key, hi_key = _quantile_keys(args.level)
     print(f"posterior ({post.info.get('method')}, {1e3 * seconds:.2f} ms) given "

@@ -15,7 +15,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
-from gpmsa.mcmc.parallel import n_workers
+from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.model import constraints
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
 from gpmsa.model.priors import Priors
@@ -125,7 +125,12 @@ def fit(
             f"fit: unknown option(s) {unknown} for the {backend!r} backend; it takes {offered}"
         )
     if backend == "numpy":  # (the others refuse these extensions)
-        n_jobs, executor = _in_process_if_callables(problem, n_jobs, executor, int(n_chains))
+        basis = problem.mean_basis
+        callables = [name for name, on in (
+            ("constraint", problem.constraint is not None),
+            ("mean_basis", basis is not None and basis.kind == "callable"),
+        ) if on]  # fmt: skip
+        n_jobs, executor = in_this_process(callables, n_jobs, executor, int(n_chains))
     options.update(backends.placement(backend, n_jobs, executor))
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
@@ -193,26 +198,6 @@ def check_point(point) -> None:
     """GPMSAError unless ``point`` is "mean" or "map" (the point estimate of ``fit``)."""
     if not (isinstance(point, str) and point in ("mean", "map")):
         raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
-
-
-def _in_process_if_callables(problem: Problem, n_jobs, executor, n_chains: int):
-    """(n_jobs, executor) for the chains: a theta constraint or a mean basis given as a
-    callable is this process's (a lambda cannot be pickled), so its chains run here, one after
-    another; an executor= is then a GPMSAError, a bad n_jobs still one."""
-    basis = problem.mean_basis
-    callables = [name for name, on in (
-        ("constraint", problem.constraint is not None),
-        ("mean_basis", basis is not None and basis.kind == "callable"),
-    ) if on]  # fmt: skip
-    if not callables:
-        return n_jobs, executor
-    if executor is not None:
-        raise GPMSAError(
-            f"{' and '.join(callables)} are callables of this process: they cannot go to "
-            "executor= (the chains run here)"
-        )
-    n_workers(n_jobs, n_chains)  # still refuse a bad n_jobs
-    return 1, None
 
 
 def _check_levels(problem: Problem, theta_unit: np.ndarray, names, what: str) -> None:

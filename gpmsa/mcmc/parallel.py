@@ -65,6 +65,22 @@ def n_workers(n_jobs: int | None, n_chains: int) -> int:
     return min(n_jobs, n_chains)
 
 
+def in_this_process(callables: list[str], n_jobs, executor, n_chains: int):
+    """(n_jobs, executor) for chains that hold ``callables`` of this process (names of a
+    constraint, a log prior, a mean basis: a lambda cannot be pickled), run here one after
+    another: (1, None); GPMSAError for an executor=, and still for a bad n_jobs. Unchanged
+    where there are none."""
+    if not callables:
+        return n_jobs, executor
+    if executor is not None:
+        raise GPMSAError(
+            f"{' and '.join(callables)} are callables of this process: they cannot go to "
+            "executor= (the chains run here)"
+        )
+    n_workers(n_jobs, n_chains)
+    return 1, None
+
+
 def as_executor(executor) -> Executor | None:
     """``executor`` as a ``concurrent.futures.Executor`` (a dask ``Client`` gives its own)."""
     if executor is None or isinstance(executor, Executor):

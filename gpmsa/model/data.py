@@ -94,17 +94,24 @@ def column_labels(value) -> tuple[str, ...] | None:
     return tuple(str(c) for c in columns)
 
 
-def by_column_names(value, names, name: str):
-    """A table with named columns (a pandas DataFrame: anything with ``columns``) as its columns
-    in the order of ``names``; any other value as it is. GPMSAError naming ``name`` when the
-    table's columns are not ``names`` (in some order): its columns are never read by position."""
-    columns = getattr(value, "columns", None)
-    if columns is None or names is None or isinstance(value, np.ndarray):
-        return value
-    labels, names = [str(c) for c in columns], list(names)
+def column_order(labels, names, name: str) -> list[int]:
+    """The positions of ``names`` among a table's column ``labels``; GPMSAError naming ``name``
+    when the labels are not ``names`` (in some order)."""
+    labels, names = list(labels), list(names)
     if sorted(labels) != sorted(names):
         raise GPMSAError(f"{name} has the columns {labels}; expected {names} (in any order)")
-    return value[names]
+    return [labels.index(n) for n in names]
+
+
+def by_column_names(value, names, name: str):
+    """A table with named columns (`column_labels`) as its columns in the order of ``names``;
+    any other value as it is. GPMSAError naming ``name`` when the table's columns are not
+    ``names`` (in some order): its columns are never read by position."""
+    labels = column_labels(value)
+    if labels is None or names is None:
+        return value
+    column_order(labels, names, name)
+    return value[list(names)]
 
 
 def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
@@ -386,11 +393,18 @@ class SimData:
 def values_digest(x, experiments) -> str:
     """SHA-256 of observations' inputs x (n, p) and outputs (one array per experiment), as
     float64 with their shapes."""
+    return _arrays_digest([x, *experiments])
+
+
+def _arrays_digest(parts, tail: str = "") -> str:
+    """SHA-256 of arrays (each numbered, with its shape, as little-endian float64), then
+    ``tail``."""
     h = hashlib.sha256()
-    for k, part in enumerate([x, *experiments]):
+    for k, part in enumerate(parts):
         arr = np.ascontiguousarray(part, dtype="<f8")
         h.update(f"{k}:{arr.shape}".encode())
         h.update(arr.tobytes())
+    h.update(tail.encode())
     return h.hexdigest()
 
 
@@ -436,12 +450,7 @@ class ObsData:
         not ``x_names``."""
         if self.x_columns is None:
             return self.x
-        names = list(x_names)
-        if sorted(self.x_columns) != sorted(names):
-            raise GPMSAError(
-                f"x_obs has the columns {list(self.x_columns)}; expected {names} (in any order)"
-            )
-        return self.x[:, [self.x_columns.index(n) for n in names]]
+        return self.x[:, column_order(self.x_columns, x_names, "x_obs")]
 
     def values_digest(self) -> str:
         """SHA-256 of x and every experiment's y (`values_digest`): what ``gpmsa.calibrate``,
@@ -451,15 +460,9 @@ class ObsData:
     def digest(self) -> str:
         """SHA-256 of the observations (x, every experiment's y, grid and precision, as float64):
         a joint fit records it, so a prediction conditioned on other observations is refused."""
-        h = hashlib.sha256()
         parts = [self.x, *self.experiments, *(g for g in self.grids if g is not None)]
         parts += self.precisions or []
-        for k, part in enumerate(parts):
-            arr = np.ascontiguousarray(part, dtype="<f8")
-            h.update(f"{k}:{arr.shape}".encode())
-            h.update(arr.tobytes())
-        h.update(f"grids:{[g is None for g in self.grids]}".encode())
-        return h.hexdigest()
+        return _arrays_digest(parts, f"grids:{[g is None for g in self.grids]}")
 
     @staticmethod
     def _experiments(y, n: int) -> list[np.ndarray]:

@@ -7,7 +7,7 @@ from scipy.special import ndtri
 
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
-from gpmsa.model.data import SimData, check_count, check_flag, check_level
+from gpmsa.model.data import SimData, check_count, check_flag, check_level, column_order
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.crossval import CrossValidation
 
@@ -80,7 +80,7 @@ def _held_out_inputs(emulator, held_out: SimData) -> tuple[np.ndarray, np.ndarra
         if tuple(names) == default or tuple(names) == tuple(mine):
             columns.append(arr)
         elif sorted(names) == sorted(mine):
-            columns.append(arr[:, [list(names).index(n) for n in mine]])
+            columns.append(arr[:, column_order(names, mine, f"held-out runs' {prefix}")])
         else:
             raise GPMSAError(f"held-out runs name their {prefix} columns {list(names)}, the "
                              f"emulator {list(mine)}")  # fmt: skip

@@ -581,7 +581,5 @@ def test_an_observation_too_large_for_the_basis_is_named_and_cli_json_is_strict(
     y[0, 0] = 1e308  # finite, but its projection on the basis overflows
     with pytest.raises(gpmsa.GPMSAError, match=r"y_obs\[0\] is too large for the emulator's"):
         gpmsa.Calibrator(vec_emu).update([[0.5]], y)
-    from gpmsa.cli.calibrate import _strict
-
-    out = _strict({"sd": float("inf"), "q": [np.float64("nan"), 1.0], "n": 3})
+    out = container.jsonable({"sd": float("inf"), "q": [np.float64("nan"), 1.0], "n": 3})
     assert json.loads(json.dumps(out, allow_nan=False)) == {"sd": None, "q": [None, 1.0], "n": 3}
