@@ -16,6 +16,7 @@ for features of many short blocks per run.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -73,11 +74,13 @@ class RunSpec:
     keep_samples: int = 0
 
     def key(self) -> str:
-        """Hash of the run's settings: its cache file name."""
+        """Hash of the run's settings and of the code that computes it (``code_fingerprint``):
+        its cache file name."""
         text = json.dumps(
-            {**_spec_settings(self), "v": self.v, "gd": self.gd, "seed": self.seed},
+            {**_spec_settings(self), "v": self.v, "gd": self.gd, "seed": self.seed,
+             "code": code_fingerprint()},
             sort_keys=True,
-        )
+        )  # fmt: skip
         return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
@@ -359,7 +362,9 @@ def run_campaign(
         executor: any ``concurrent.futures.Executor`` (e.g. a dask ``Client.get_executor()``);
             default a process pool over all cores, shut down at the end.
         cache_dir: finished runs are stored there, one ``.npz`` per run named by a hash of its
-            settings, and reused: an interrupted campaign loses no finished run. Failed runs are
+            settings and of the code that computes it (``code_fingerprint``: the roadgen and
+            vehicle source, numpy, scipy and exudyn), and reused: an interrupted campaign loses
+            no finished run, and an entry of other code is not reused. Failed runs are
             not stored (they run again next time), and a damaged entry is recomputed; an entry
             that reads as a finished run of the same settings is trusted as the user's own.
         seed: the campaign's seed; run i gets road seed ``SeedSequence(seed).generate_state(n)[i]``.
@@ -572,6 +577,29 @@ def _drive(spec: RunSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         ]
     )
     return f, trace.accel_front[kept].copy(), trace.accel_front_measured[kept].copy()
+
+
+@functools.cache
+def code_fingerprint() -> str:
+    """SHA-256 of what computes a run: the source of ``roadgen`` and ``vehicle`` and the versions
+    of numpy, scipy and exudyn. Part of every cache key, so that a cache written by other code
+    (a road drawn differently, another solver) is never taken for this code's runs."""
+    from importlib import metadata
+
+    import scipy
+
+    digest = hashlib.sha256()
+    for folder in (Path(roadgen.__file__).parent, Path(__file__).parent):
+        for source in sorted(folder.glob("*.py")):
+            digest.update(f"{folder.name}/{source.name}\0".encode())
+            digest.update(source.read_bytes())
+    try:
+        exudyn_version = metadata.version("exudyn")
+    except metadata.PackageNotFoundError:
+        exudyn_version = "not installed"
+    versions = {"numpy": np.__version__, "scipy": scipy.__version__, "exudyn": exudyn_version}
+    digest.update(json.dumps(versions, sort_keys=True).encode())
+    return digest.hexdigest()
 
 
 def _spec_settings(spec: RunSpec) -> dict:

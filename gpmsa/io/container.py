@@ -399,10 +399,19 @@ def _parse_manifest(raw: bytes, path, formats: tuple[str, ...] = (FORMAT,)) -> d
             raise ValueError(f"number {token[:40]} is beyond float64")
         return value
 
+    def unique_keys(pairs):  # a repeated key would silently take its last value
+        obj = dict(pairs)
+        if len(obj) != len(pairs):
+            seen = set()
+            twice = next(k for k, _ in pairs if k in seen or seen.add(k))
+            raise ValueError(f"key {_short(twice)} appears twice in one object")
+        return obj
+
     try:
         manifest = json.loads(
-            raw.decode("utf-8"), parse_constant=reject_constant, parse_float=finite_float
-        )
+            raw.decode("utf-8"), parse_constant=reject_constant, parse_float=finite_float,
+            object_pairs_hook=unique_keys,
+        )  # fmt: skip
     except (UnicodeDecodeError, ValueError, RecursionError) as exc:
         raise _fail(path, f"manifest.json is not valid JSON ({exc})") from exc
     if not isinstance(manifest, dict):
@@ -499,6 +508,26 @@ def _load_array(raw: bytearray, name: str, spec: dict, path) -> np.ndarray:
                           f"{len(raw) - offset} bytes, its shape needs {need})")  # fmt: skip
     flat = np.frombuffer(raw, dtype=dtype, count=count, offset=offset)  # shares raw's memory
     return np.ascontiguousarray(flat.reshape(shape, order="F" if fortran else "C"))
+
+
+def stored_format(path: str | Path) -> str | None:
+    """The format name (``FORMAT`` or ``STUDY_FORMAT``) of the gpmsa file at ``path``; None when
+    there is none (no file, another kind of file, or one too damaged to tell). Reads the
+    manifest only, with ``read_raw``'s checks; its content is not verified."""
+    path = check_path(path)
+    if not path.exists():
+        return None
+    try:
+        fh, size = _open_regular(path)
+        with fh:
+            _check_directory(fh, size, path)
+            fh.seek(0)
+            with zipfile.ZipFile(fh) as zf:
+                members = _check_members(zf, path)
+                raw = bytes(_read_member(zf, members[MANIFEST], path))
+        return _parse_manifest(raw, path, (FORMAT, STUDY_FORMAT))["format"]
+    except Exception:  # any damage: not a gpmsa file that can be told apart
+        return None
 
 
 def read_raw(

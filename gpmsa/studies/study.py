@@ -17,7 +17,16 @@ from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, load
 from gpmsa.io.atomic import atomic_group
-from gpmsa.io.container import STUDY_FORMAT, check_path, jsonable, read_raw, seal, write_sealed
+from gpmsa.io.container import (
+    FORMAT,
+    STUDY_FORMAT,
+    check_path,
+    jsonable,
+    read_raw,
+    seal,
+    stored_format,
+    write_sealed,
+)
 from gpmsa.mcmc.diagnostics import convergence, summarize
 from gpmsa.model.data import check_count
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
@@ -149,12 +158,16 @@ class Study:
         checks it before anything is written: a refused save (GPMSAError) writes nothing. The
         files are then written whole to temporary files and moved over their paths together
         (``gpmsa.io.atomic.atomic_group``), so a save that fails leaves an existing study at
-        ``path`` as it was (only an OS failure during the final moves could mix the two).
+        ``path`` as it was (only an OS failure during the final moves could mix the two). A study
+        is not written over an emulator file, nor a model file over a study file (GPMSAError):
+        such a file belongs to another study, which would no longer load.
         """
         path = check_path(path)
+        _refuse_to_replace(path, STUDY_FORMAT)
         files, hashes, sealed = [], [], []
         for lab, emu in zip(self.labels, self.members, strict=True):
             file = f"{path.stem}.{lab}.gpmsa"
+            _refuse_to_replace(path.with_name(file), FORMAT)
             manifest, arrays = emu.checked_record(path.with_name(file))
             head, raw = seal(manifest, arrays)
             files.append(file)
@@ -213,6 +226,22 @@ def load_study(path: str | Path) -> Study:
         raise EmulatorFileError(f"{path}: {exc}") from exc
     except GPMSAError as exc:
         raise EmulatorFileError(f"{path}: study: {exc}") from exc
+
+
+def _refuse_to_replace(target: Path, fmt: str) -> None:
+    """GPMSAError if ``target`` holds a gpmsa file of the other kind than ``fmt``: a study
+    written over an emulator file (another study's model, say) or a model file written over a
+    study would leave that file's owner unreadable."""
+    found = stored_format(target)
+    if found is not None and found != fmt:
+        if found == STUDY_FORMAT:
+            held, wanted = "a study file", "a model's emulator file"
+        else:
+            held, wanted = "an emulator file (another study's model?)", "a study file"
+        raise GPMSAError(
+            f"refusing to write {target}: it holds {held}, which {wanted} would replace; "
+            "choose another path or remove it first"
+        )
 
 
 def _discrepancy_chains(member, shape: tuple[int, int]) -> dict[str, np.ndarray]:

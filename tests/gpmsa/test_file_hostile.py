@@ -550,6 +550,25 @@ def test_a_manifest_number_beyond_float64_or_nested_too_deep_is_a_file_error(sav
         gpmsa.load(nested)
 
 
+def test_a_manifest_key_given_twice_is_a_file_error(saved, tmp_path):
+    """JSON parsers differ on a repeated key (Python's takes the last): a file that reads one
+    way here and another way elsewhere is refused, however its hash was made."""
+    manifest, arrays = read_members(saved["scalar"])
+    path = write_members(tmp_path / "twice.gpmsa", manifest, arrays)
+    raw = zipfile.ZipFile(path).read("manifest.json").decode()
+    edited = raw.replace('"metadata": {', '"metadata": {"note": "a", "note": "b", ', 1)
+    assert edited != raw
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("manifest.json", edited)
+        for name, arr in arrays.items():
+            buf = io.BytesIO()
+            np.save(buf, arr)
+            zf.writestr(f"arrays/{name}.npy", buf.getvalue())
+    with pytest.raises(gpmsa.EmulatorFileError, match="key 'note' appears twice in one object"):
+        gpmsa.load(path)
+    assert main(["info", str(path)]) == 2
+
+
 def test_a_design_width_beyond_float64_and_array_names_with_a_newline_are_refused(
     saved, tmp_path
 ):

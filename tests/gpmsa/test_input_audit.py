@@ -122,6 +122,34 @@ def test_a_study_save_failing_part_way_leaves_the_existing_study_loadable(tmp_pa
     assert gpmsa.load_study(path).members[1].params["lamUz"][0] == 2.0
 
 
+def test_a_study_is_not_saved_over_another_studys_model_file(tmp_path):
+    """A study saved to the path of another study's model file (or whose model files would
+    replace a study file) overwrote it, and the other study no longer loaded."""
+    first = tmp_path / "beam.gpmsa"
+    _study(1.0).save(first)
+    names = sorted(os.listdir(tmp_path))
+    label = gpmsa.load_study(first).labels[0]
+    member = tmp_path / f"beam.{label}.gpmsa"
+    assert member.exists()
+    with pytest.raises(GPMSAError, match=rf"refusing to write .*beam\.{label}\.gpmsa: it holds an "
+                                         r"emulator file \(another study's model\?\)"):
+        _study(2.0).save(member)
+    # a study file at "x.m0.gpmsa" would be replaced by model m0 of a study saved at "x.gpmsa"
+    other = tmp_path / "plate.gpmsa"
+    _study(1.0).save(tmp_path / f"plate.{label}.gpmsa")
+    with pytest.raises(GPMSAError, match=rf"plate\.{label}\.gpmsa: it holds a study file"):
+        _study(2.0).save(other)
+    assert not other.exists()
+    assert gpmsa.load_study(first).members[0].params["lamUz"][0] == 1.0
+    assert gpmsa.load_study(tmp_path / f"plate.{label}.gpmsa").members[0].params["lamUz"][0] == 1.0
+    assert set(names) <= set(os.listdir(tmp_path))
+    # saving over a study of its own kind, and over files that are no gpmsa file, goes on
+    _study(2.0).save(first)
+    (tmp_path / "notes.gpmsa").write_text("not a zip")
+    _study(2.0).save(tmp_path / "notes.gpmsa")
+    assert gpmsa.load_study(first).members[0].params["lamUz"][0] == 2.0
+
+
 # --- 3: reserved and colliding parameter names ----------------------------------------------------
 @pytest.mark.parametrize("name", ["lamOs", "lamVz", "betaV", "betaV[0]", "betaV[12]"])
 def test_a_calibration_parameter_with_a_reserved_name_is_refused(name):

@@ -389,6 +389,34 @@ def test_failed_runs_are_not_cached_and_run_again(tmp_path, monkeypatch):
     np.testing.assert_array_equal(again.f_full, DESIGN[:, 0])
 
 
+def test_a_cache_written_by_other_code_is_not_reused(tmp_path, monkeypatch):
+    """A cache entry's name covers the code that computed it: entries from another version of
+    roadgen, vehicle, numpy, scipy or exudyn (a road drawn differently) run again."""
+    calls = []
+    monkeypatch.setattr(campaign, "_drive", _fake_drive(calls))
+    _run(tmp_path)
+    _run(tmp_path)
+    assert len(calls) == len(DESIGN)  # the same code: every run taken from the cache
+    monkeypatch.setattr(campaign, "code_fingerprint", lambda: "another version of the code")
+    _run(tmp_path)
+    assert len(calls) == 2 * len(DESIGN)
+    assert len(list(tmp_path.glob("run-*.npz"))) == 2 * len(DESIGN)
+
+
+def test_the_code_fingerprint_follows_the_versions(monkeypatch):
+    fp = campaign.code_fingerprint()
+    campaign.code_fingerprint.cache_clear()
+    assert len(fp) == 64 and campaign.code_fingerprint() == fp  # the same files: the same
+    monkeypatch.setattr(np, "__version__", "0.0.1")
+    campaign.code_fingerprint.cache_clear()
+    try:
+        assert campaign.code_fingerprint() != fp
+    finally:
+        monkeypatch.undo()
+        campaign.code_fingerprint.cache_clear()
+    assert campaign.code_fingerprint() == fp
+
+
 def test_damaged_or_failed_cache_entries_are_run_again(tmp_path, monkeypatch):
     calls = []
     monkeypatch.setattr(campaign, "_drive", _fake_drive(calls))
