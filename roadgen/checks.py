@@ -24,6 +24,10 @@ BYTES_PER_POINT = 96
 half-length complex spectrum with its phases and amplitudes, the inverse FFT's work space, the
 taper and the amplitude profile."""
 MAX_SEED = 2**128
+MIN_DX_M, MAX_DX_M = 1e-9, 1e6
+"""Grid steps allowed, m: beyond them a road's spatial frequencies under- or overflow."""
+MIN_GD = 1e-12
+"""Smallest GD allowed (1e-6 m^3): below it the PSD and the heights' squares underflow."""
 
 
 def memory(nbytes: float, what: str) -> None:
@@ -130,6 +134,30 @@ def positive(
     return v
 
 
+def grid_step(name: str, value: object, error: type[Exception] = RoadgenError) -> float:
+    """Return ``value`` as a float, or raise ``error`` unless it is a grid step in
+    [MIN_DX_M, MAX_DX_M] m."""
+    v = _finite(name, value, error)
+    if not MIN_DX_M <= v <= MAX_DX_M:
+        raise error(
+            f"{name}={value!r} is out of range: allowed [{MIN_DX_M:g}, {MAX_DX_M:g}] m (a road's "
+            "grid step)"
+        )
+    return v
+
+
+def gd(name: str, value: object, error: type[Exception] = RoadgenError) -> float:
+    """Return ``value`` as a float, or raise ``error`` unless it is a finite GD >= MIN_GD
+    (units 1e-6 m^3)."""
+    v = _finite(name, value, error)
+    if v < MIN_GD:
+        raise error(
+            f"{name}={value!r} is out of range: allowed [{MIN_GD:g}, inf) in 1e-6 m^3 (ISO 8608's "
+            "smoothest class A lies below 32)"
+        )
+    return v
+
+
 def non_negative(
     name: str, value: object, error: type[Exception] = RoadgenError, unit: str = ""
 ) -> float:
@@ -194,8 +222,8 @@ def heights(
 ) -> tuple[np.ndarray, float]:
     """Return the heights z (N,) m and grid step dx_m of ``road`` (anything with ``z`` and
     ``dx_m``: a Profile, a Track), or raise ``error`` unless z is a finite real (N,) array,
-    N >= ``min_points``, and dx_m a finite real > 0 (``vehicle``'s road input uses it with
-    VehicleError and 3 points)."""
+    N >= ``min_points``, and dx_m a grid step in [MIN_DX_M, MAX_DX_M] m (``vehicle``'s road
+    input uses it with VehicleError and 3 points)."""
     try:
         z, dx = road.z, road.dx_m
     except AttributeError:
@@ -208,7 +236,7 @@ def heights(
         raise error(f"{name}.z has shape {arr.shape}: need (N,) heights with N >= {min_points}")
     if not np.all(np.isfinite(arr)):
         raise error(f"{name}.z contains NaN or inf: allowed finite heights in m")
-    return arr, positive(f"{name}.dx_m", dx, error)
+    return arr, grid_step(f"{name}.dx_m", dx, error)
 
 
 def _finite(name: str, value: object, error: type[Exception]) -> float:

@@ -8,9 +8,14 @@ from typing import TypeVar
 import numpy as np
 
 from roadgen import checks
+from roadgen.errors import RoadgenError
 from roadgen.road import Road, check_road
 
 R = TypeVar("R", bound=Road)
+
+
+MAX_ENVELOPE_WORK = 2e10
+"""Most (grid point, neighbour) pairs one ``wheel_envelope`` call visits (~10 s)."""
 
 
 def wheel_envelope(road: R, radius_m: float) -> R:
@@ -22,16 +27,30 @@ def wheel_envelope(road: R, radius_m: float) -> R:
     bridged; it grows with r and tends to z as r -> 0 (r < dx_m gives z back). Beyond the ends
     the road is not known and gives no support. Cost O(N r / dx): one vectorised max per
     neighbour offset.
+
+    Raises RoadgenError for a radius that is not finite and > 0, larger than the road's length,
+    or whose cost, N x r / dx_m neighbours, exceeds MAX_ENVELOPE_WORK.
     """
     check_road("road", road)
     r = checks.positive("radius_m", radius_m)
+    if r > road.length_m:
+        raise RoadgenError(
+            f"radius_m={radius_m!r} is out of range: allowed (0, {road.length_m:.6g}] m (the "
+            "road's length; a wheel in m, not mm?)"
+        )
     z = road.z
     n = z.size
     reach = min(int(np.floor(r / road.dx_m * (1.0 + 1e-12))), n - 1)
+    if float(reach) * n > MAX_ENVELOPE_WORK:
+        raise RoadgenError(
+            f"radius_m={radius_m!r} reaches {reach} grid steps on each side of {n} points: "
+            f"{float(reach) * n:.3g} comparisons, above MAX_ENVELOPE_WORK = "
+            f"{MAX_ENVELOPE_WORK:.3g}; use a shorter road or a coarser grid"
+        )
     env = z.copy()
     for m in range(1, reach + 1):
         d = m * road.dx_m
-        sag = r - np.sqrt(max(r * r - d * d, 0.0))
+        sag = r - np.sqrt(max(r * r - d * d, 0.0))  # r <= length_m: r * r cannot overflow
         np.maximum(env[:-m], z[m:] - sag, out=env[:-m])
         np.maximum(env[m:], z[:-m] - sag, out=env[m:])
     return dataclasses.replace(road, z=env)

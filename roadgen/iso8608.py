@@ -43,19 +43,24 @@ def gd_spectrum(n: np.ndarray, gd: float, waviness: float = 2.0) -> np.ndarray:
     """One-sided displacement PSD Gd(n) in m^3 for spatial frequencies ``n`` (cycles/m, > 0, any
     shape), a road of ``gd`` (> 0, units 1e-6 m^3) and ``waviness`` w in (0, MAX_WAVINESS].
 
-    Raises RoadgenError for a frequency that is not finite and > 0 or so low that Gd(n)
-    overflows the float range (below 1.6e-157 cycles/m for GD 450, w = 2), or a bad gd or
-    waviness.
+    Raises RoadgenError for a frequency that is not finite and > 0, so low that Gd(n)
+    overflows the float range (below 1.6e-157 cycles/m for GD 450, w = 2) or so high that it
+    underflows, a gd below ``checks.MIN_GD`` or a bad waviness.
     """
     arr = checks.real_array("n", n)
     bad = ~np.isfinite(arr) | (arr <= 0.0)
     if np.any(bad):
         first = float(arr[bad].flat[0])
         raise RoadgenError(f"n contains {first!r}: allowed frequencies in (0, inf) cycles/m")
-    g = checks.positive("gd", gd)
+    g = checks.gd("gd", gd)
     w = check_waviness("waviness", waviness)
-    with np.errstate(over="ignore", divide="ignore"):
+    with np.errstate(over="ignore", divide="ignore", under="ignore"):
         out = g * GD_SCALE * (arr / N0) ** (-w)
+    if np.any(out < np.finfo(float).tiny):
+        raise RoadgenError(
+            f"n contains {float(np.max(arr))!r}: Gd(n) underflows for gd={g:g}, waviness={w:g}; "
+            "allowed frequencies where Gd(n) > 2.2e-308 m^3"
+        )
     if not np.all(np.isfinite(out)):
         n_min = N0 * (g * GD_SCALE / np.finfo(float).max) ** (1.0 / w)
         raise RoadgenError(

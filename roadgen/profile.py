@@ -42,7 +42,8 @@ class Profile(Road):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        object.__setattr__(self, "gd", checks.positive("gd", self.gd))
+        object.__setattr__(self, "gd", checks.gd("gd", self.gd))
+        check_settings(self.settings, self.dx_m, self.length_m)
 
     def gd_at(self, s: np.ndarray | float) -> np.ndarray | float:
         """Prescribed GD at positions ``s`` (m): the constant ``gd``, shaped like ``s``."""
@@ -84,13 +85,14 @@ def iso8608_profile(
         factors) do not depend on GD, so one seed gives the same shape scaled by sqrt(GD) for
         every GD: use different seeds for independent roads.
 
-    Raises RoadgenError for a non-positive or non-finite length, GD or dx, a waviness outside
-    (0, 5], a band outside (0, Nyquist], a length shorter than 1/n_min, or a band without
-    harmonics.
+    Raises RoadgenError for a non-positive or non-finite length, a GD below ``checks.MIN_GD`` or
+    not finite, a dx outside [``checks.MIN_DX_M``, ``checks.MAX_DX_M``] or above length_m / 1.5
+    (fewer than 2 steps), a waviness outside (0, 5], a band outside (0, Nyquist], a length
+    shorter than 1/n_min, or a band without harmonics.
     """
     length = checks.positive("length_m", length_m)
-    gd_val = checks.positive("gd", gd)
-    dx = checks.positive("dx_m", dx_m)
+    gd_val = checks.gd("gd", gd)
+    dx = checks.grid_step("dx_m", dx_m)
     lead = checks.non_negative("lead_in_m", lead_in_m)
     n_points = grid_points(length, dx)
     if lead > (n_points - 1) * dx:
@@ -156,6 +158,26 @@ def unit_road(
     return unit, settings
 
 
+def check_settings(settings: object, dx_m: float, length_m: float) -> None:
+    """Raise RoadgenError unless ``settings`` is a ProfileSettings that a road of grid step
+    ``dx_m`` and length ``length_m`` (m) can have been made with (the PSD estimates read its band
+    and waviness)."""
+    if not isinstance(settings, ProfileSettings):
+        raise RoadgenError(
+            f"settings={type(settings).__name__} is not allowed: need a roadgen ProfileSettings"
+        )
+    checks.band("settings.band", settings.band, 0.5 / dx_m)
+    checks.choice("settings.amplitudes", settings.amplitudes, AMPLITUDE_MODES)
+    check_waviness("settings.waviness", settings.waviness)
+    checks.seed("settings.seed", settings.seed, generator=False)
+    lead = checks.non_negative("settings.lead_in_m", settings.lead_in_m)
+    if lead > length_m:
+        raise RoadgenError(
+            f"settings.lead_in_m={settings.lead_in_m!r} is out of range: allowed [0, "
+            f"{length_m:.6g}] m (the road's length)"
+        )
+
+
 def band_edges(band: tuple[float, float], n_points: int) -> tuple[float, float]:
     """Lowest and highest frequency (cycles/m) that a harmonic of an ``n_points`` grid may have to
     count as inside ``band``: n_min less a relative 1/n_points, n_max plus rounding.
@@ -190,6 +212,7 @@ def grid_points(length_m: float, dx_m: float) -> int:
     steps = round(steps_f)
     if steps < 2:
         raise RoadgenError(
-            f"dx_m={dx_m!r} is out of range for length_m={length_m!r}: allowed (0, length_m / 2]"
+            f"dx_m={dx_m!r} is out of range for length_m={length_m!r}: allowed (0, length_m / "
+            "1.5] (the length, rounded to whole steps, must hold at least 2)"
         )
     return steps + 1

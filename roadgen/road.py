@@ -22,7 +22,7 @@ class Road:
     dx_m: float
 
     def __post_init__(self) -> None:
-        dx = checks.positive("dx_m", self.dx_m)
+        dx = checks.grid_step("dx_m", self.dx_m)
         x = checks.real_array("x", self.x)
         z = checks.real_array("z", self.z)
         if x.ndim != 1 or z.shape != x.shape or x.size < 2:

@@ -17,7 +17,7 @@ def test_roadgen_error_is_a_value_error():
         ({"length_m": -3.0}, "length_m=-3.0"),
         ({"length_m": np.nan}, "length_m=nan must be finite"),
         ({"length_m": np.inf}, "length_m=inf must be finite"),
-        ({"gd": 0.0}, r"gd=0.0 is out of range: allowed \(0, inf\)"),
+        ({"gd": 0.0}, r"gd=0.0 is out of range: allowed \[1e-12, inf\)"),
         ({"gd": -1.0}, "gd=-1.0"),
         ({"gd": np.nan}, "gd=nan"),
         ({"gd": "rough"}, "gd='rough' must be a real number"),
@@ -26,7 +26,7 @@ def test_roadgen_error_is_a_value_error():
         ({"dx_m": np.inf}, "dx_m=inf"),
         (
             {"dx_m": 20.0},
-            r"dx_m=20.0 is out of range for length_m=21.0: allowed \(0, length_m / 2\]",
+            r"dx_m=20.0 is out of range for length_m=21.0: allowed \(0, length_m / 1.5\]",
         ),
         ({"waviness": 0.0}, "waviness=0.0"),
         ({"waviness": np.nan}, "waviness=nan"),

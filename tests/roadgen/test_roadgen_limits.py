@@ -17,7 +17,7 @@ from roadgen import checks
         lambda: roadgen.track([(1e7, 300)]),
         lambda: roadgen.iso8608_profile(21.0, 300.0, dx_m=1e-7),
         lambda: roadgen.track([(50, 300), (50, 500)], dx_m=1e-7),
-        lambda: roadgen.iso8608_profile(21.0, 300.0, dx_m=1e-300),
+        lambda: roadgen.iso8608_profile(21.0, 300.0, dx_m=1e-9),  # the finest grid allowed
     ],
 )
 def test_oversized_roads_are_refused_before_allocating(make):
