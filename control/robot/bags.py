@@ -124,7 +124,12 @@ def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic
     ):
         if topic not in topics:
             raise BagError(_topic_error(path, topic, role, topics, option))
-        if topics[topic] is None or _normalise(topics[topic]) != want:  # None: several types
+        if topics[topic] is None:
+            raise BagError(
+                f"the {role} topic {topic!r} in {path} holds several message types; the replay "
+                f"reads one, {want}, per topic"
+            )
+        if _normalise(topics[topic]) != want:
             raise BagError(
                 f"the {role} topic {topic!r} in {path} holds {topics[topic]}, expected {want}"
             )
@@ -134,6 +139,8 @@ def _resolve(path: Path) -> tuple[Path, str]:
     """(what to open, its kind) for a path the user gave."""
     if not path.exists():
         raise BagError(f"no recording at {path}")
+    if not (path.is_dir() or path.is_file()):  # a FIFO would block the reader for ever
+        raise BagError(f"{path} is not a regular file nor a folder (a FIFO, device or socket)")
     if path.is_dir():
         if not (path / "metadata.yaml").is_file():
             raise BagError(
@@ -213,6 +220,9 @@ def _bag_files(folder: Path) -> tuple[list[Path], str, bool]:
         compression = str(info.get("compression_mode", "") or "").lower()
     except Exception:  # rosbags reads (and reports on) whatever this does not understand
         return [], "", False
+    odd = [f for f in files if f.exists() and not f.is_file()]
+    if odd:  # a FIFO would block the reader for ever
+        raise BagError(f"{odd[0]}, a file of the bag {folder}, is not a regular file")
     simple = compression in ("", "none") and all(f.is_file() for f in files) and bool(files)
     return files, storage, simple
 
@@ -503,13 +513,50 @@ def _check_storage(storage: str) -> None:
         raise ControlError(f"storage must be one of {STORAGES}, got {storage!r}")
 
 
+MAX_STAMP_NS = 2**31 * 10**9
+"""A ROS 2 header stamp's seconds are an int32: stamps lie in [0, 2**31) s."""
+MAX_LOG_NS = 2**63
+"""A bag's receive times are int64 ns."""
+
+
 def to_ns(t) -> np.ndarray:
     """Times in seconds as int nanoseconds (rounded to the nearest)."""
     return np.rint(np.asarray(t, dtype=float) * 1e9).astype(np.int64)
 
 
+def stamps_ns(name: str, t, limit: int = MAX_STAMP_NS, offset_ns: int = 0) -> np.ndarray:
+    """Times ``t`` (s, 1-D) as int64 ns plus ``offset_ns``; `ControlError` naming ``name``
+    unless every one is a finite number that lands in [0, ``limit``) ns."""
+    arr = _floats(name, np.atleast_1d(t) if t is not None else t)
+    if arr.ndim != 1:
+        raise ControlError(f"{name} must be 1-D (times in s), got shape {arr.shape}")
+    with np.errstate(invalid="ignore", over="ignore"):
+        ns = np.rint(arr * 1e9)
+    bad = ~np.isfinite(ns) | (ns + offset_ns < 0) | (ns + offset_ns >= limit)
+    if np.any(bad):
+        first = float(arr[bad][0])
+        raise ControlError(
+            f"{name} holds {first!r} s: allowed finite times that, with an offset of "
+            f"{offset_ns} ns, lie in [0, {limit / 1e9:.6g}) s"
+        )
+    return ns.astype(np.int64) + np.int64(offset_ns)
+
+
+def _floats(name: str, value) -> np.ndarray:
+    """``value`` as a float array; `ControlError` naming ``name`` for what is not numbers."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ControlError(f"{name} must hold real numbers, got {_brief(value)}") from exc
+
+
+def _brief(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 def _vectors(name: str, a, n: int, axis: str = "x") -> np.ndarray:
-    a = np.asarray(a, dtype=float)
+    a = _floats(name, a)
     if a.ndim == 1:
         if a.size != n:
             raise ControlError(f"{name} must have length {n}, got {a.size}")
@@ -567,13 +614,15 @@ def merge_in_time(streams: Sequence[tuple[object, np.ndarray, Sequence[bytes]]])
 def sensor_messages(
     imu_time, accel, odom_time, position, speed, *, axis: str = "z",
     imu_frame: str = "imu_link", odom_frame: str = "odom", base_frame: str = "base_link",
+    offset_ns: int = 0,
 ) -> tuple[np.ndarray, list[bytes], np.ndarray, list[bytes]]:  # fmt: skip
     """(IMU stamps ns, CDR Imu messages, odometry stamps ns, CDR Odometry messages) of sampled
-    signals (see `write_sensor_bag` for the arguments)."""
+    signals (see `write_sensor_bag` for the arguments), every stamp ``offset_ns`` later;
+    `ControlError` for a stamp outside a ROS 2 header's [0, 2**31) s."""
     if axis not in ("x", "y", "z"):
         raise ControlError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
-    t_imu = to_ns(np.atleast_1d(imu_time))
-    t_odom = to_ns(np.atleast_1d(odom_time))
+    t_imu = stamps_ns("imu_time", imu_time, offset_ns=offset_ns)
+    t_odom = stamps_ns("odom_time", odom_time, offset_ns=offset_ns)
     acc = _vectors("accel", accel, t_imu.size, axis)
     pos = _vectors("position", position, t_odom.size)
     vel = _vectors("speed", speed, t_odom.size)
@@ -605,7 +654,7 @@ def write_sensor_bag(
 
     Args:
         path: the new bag folder.
-        imu_time: (n,) IMU header stamps, s (rounded to ns).
+        imu_time: (n,) IMU header stamps, s (rounded to ns; in [0, 2**31) s, a ROS 2 stamp).
         accel: (n,) accelerations along ``axis`` (m/s^2), or (n, 3).
         odom_time: (m,) odometry stamps, s.
         position: (m,) positions along the odometry frame's x axis (m), or (m, 3).
@@ -613,7 +662,8 @@ def write_sensor_bag(
         storage: "mcap" (ROS 2's default) or "sqlite3".
         imu_topic, odom_topic: topic names.
         axis: the IMU axis that holds ``accel`` when it is 1-D.
-        log_time: (n + m,) receive times in s, IMU messages first (default: the stamps).
+        log_time: (n + m,) receive times in s, IMU messages first (default: the stamps); in
+            [0, 2**63) ns.
 
     Returns:
         the bag folder.
@@ -622,7 +672,10 @@ def write_sensor_bag(
     t_imu, imu, t_odom, odom = sensor_messages(
         imu_time, accel, odom_time, position, speed, axis=axis
     )
-    log = np.concatenate([t_imu, t_odom]) if log_time is None else to_ns(log_time)
+    if log_time is None:
+        log = np.concatenate([t_imu, t_odom])
+    else:
+        log = stamps_ns("log_time", log_time, limit=MAX_LOG_NS)
     if log.size != t_imu.size + t_odom.size:
         raise ControlError(f"log_time must have length {t_imu.size + t_odom.size}, got {log.size}")
     store = msgs.typestore()

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import shutil
 import sys
 from dataclasses import asdict
@@ -55,13 +56,14 @@ def _one_line(exc: Exception) -> str:
 
 def _check_out(out: Path) -> None:
     """`ControlError` where ``out``, or its nearest existing parent, is not a folder, or where
-    ``out`` holds any of `OUTPUTS` already (checked before the replay runs)."""
+    ``out`` holds any of `OUTPUTS` already, a dangling link included (checked before the replay
+    runs)."""
     there = next((p for p in (out, *out.parents) if p.exists()), None)
     if there == out and not out.is_dir():
         raise ControlError(f"--out {str(out)!r} exists and is not a folder")
     if there is not None and not there.is_dir():
         raise ControlError(f"--out {str(out)!r}: {str(there)!r} exists and is not a folder")
-    there_already = [name for name in OUTPUTS if (out / name).exists()]
+    there_already = [name for name in OUTPUTS if os.path.lexists(out / name)]  # links too
     if there_already:
         raise ControlError(
             f"{out / there_already[0]} exists already: choose another --out (this command "

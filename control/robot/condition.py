@@ -39,6 +39,9 @@ from control.errors import BagError, ControlError
 
 GAP_PERIODS = 1.5  # a step above this many periods is a gap (as control.sensor_checks)
 METHODS = ("sample", "lowpass")
+MAX_LOWPASS_TAPS = 200_001
+"""Longest "lowpass" filter made (an input up to ~1 MHz at 120 Hz out); stamps far closer than
+any IMU's would ask for millions of taps and gigabytes."""
 
 
 @dataclass(frozen=True)
@@ -188,6 +191,12 @@ def resampling_filter(rate_in: float, rate_out: float, method: str) -> tuple[int
     fs = rate_out * down  # = (rate_out * down / up) * up
     if method == "lowpass":
         half_len = 10 * max(up, down)
+        if 2 * half_len + 1 > MAX_LOWPASS_TAPS:
+            raise BagError(
+                f"the IMU's stamps say {rate_in:.4g} Hz: resampling that to {rate_out:g} Hz with "
+                f"'lowpass' needs a filter of {2 * half_len + 1} taps, above MAX_LOWPASS_TAPS = "
+                f"{MAX_LOWPASS_TAPS}; check the IMU's time stamps (or use resample 'sample')"
+            )
         return up, down, firwin(2 * half_len + 1, 1.0 / max(up, down), window=("kaiser", 5.0))
     grid = fs / up
     taps, beta = kaiserord(60.0, 0.1 * grid / (fs / 2))

@@ -24,7 +24,7 @@ import numpy as np
 
 from control.errors import ControlError
 from control.robot import messages as msgs
-from control.robot.bags import merge_in_time, sensor_messages, to_ns
+from control.robot.bags import MAX_STAMP_NS, merge_in_time, sensor_messages, stamps_ns
 from control.robot.extra import require
 from control.validation import check_instance
 from gpmsa.io.atomic import atomic_write
@@ -79,8 +79,9 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     Args:
         result: the closed loop's result (`control.run_closed_loop`).
         path: the ``*.mcap`` file to write (replaced if it exists; its folder is made).
-        start_ns: the time stamp of the run's time 0, ns (0: the epoch; Foxglove shows
-            seconds from the start either way).
+        start_ns: the time stamp of the run's time 0, ns, in [0, 2**31 s) (0: the epoch;
+            Foxglove shows seconds from the start either way); every header stamp and receive
+            time is that much later.
 
     Returns:
         the path written. Raises `MissingExtraError` without the ``robot`` extra.
@@ -90,21 +91,26 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
 
     check_instance(result, "result", ClosedLoopResult)
     writer_mod = require("mcap.writer", "recording a run as MCAP")
-    if not isinstance(start_ns, int | np.integer) or start_ns < 0:
-        raise ControlError(f"start_ns must be an integer >= 0, got {start_ns!r}")
+    if (isinstance(start_ns, bool) or not isinstance(start_ns, int | np.integer)
+            or not 0 <= start_ns < MAX_STAMP_NS):  # fmt: skip
+        raise ControlError(
+            f"start_ns must be an integer in [0, 2**31 s) (a ROS 2 stamp), got {start_ns!r}"
+        )
+    start_ns = int(start_ns)
     store = msgs.typestore()
     t = result.sample_time
     t_imu, imu, t_odom, odom = sensor_messages(
-        t, result.sample_accel, t, result.sample_position, result.sample_speed
-    )
-    stamps = to_ns(result.time)
+        t, result.sample_accel, t, result.sample_position, result.sample_speed,
+        offset_ns=start_ns,
+    )  # fmt: skip
+    stamps = stamps_ns("the run's update times", result.time, offset_ns=start_ns)
     rows = _estimate_rows(result)
     settings = getattr(result, "settings", None) or {}
     level = getattr(settings.get("bcr"), "interval_level", np.nan)
     gd_max = getattr(settings.get("simplex"), "gd_max", np.nan)
     estimates = []
     for row, stamp in zip(rows, stamps.tolist(), strict=True):
-        row["stamp_ns"] = stamp + start_ns
+        row["stamp_ns"] = stamp
         estimates.append(estimate_message(store, row, level, gd_max))
     f64 = store.types[msgs.FLOAT64_TYPE]
     truth = [bytes(store.serialize_cdr(f64(data=float(g)), msgs.FLOAT64_TYPE))
@@ -124,10 +130,10 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
             schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
             channels[key] = writer.register_channel(TOPICS[key], "cdr", schema)
         streams = [
-            (channels["imu"], t_imu + start_ns, imu),
-            (channels["odometry"], t_odom + start_ns, odom),
-            (channels["estimate"], stamps + start_ns, estimates),
-            (channels["gd_true"], stamps + start_ns, truth),
+            (channels["imu"], t_imu, imu),
+            (channels["odometry"], t_odom, odom),
+            (channels["estimate"], stamps, estimates),
+            (channels["gd_true"], stamps, truth),
         ]
         for seq, (channel, stamp, data) in enumerate(merge_in_time(streams)):
             writer.add_message(channel, log_time=stamp, data=data, publish_time=stamp,

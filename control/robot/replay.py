@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import csv
 import os
+import shutil
 import time
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
@@ -84,8 +85,9 @@ class ReplaySettings:
         imu_axis: "x", "y" or "z": the IMU axis that points up (along the front axle's
             vertical) when the robot stands level.
         imu_sign: +1 or -1 (an int or a float; not a bool): -1 when that axis points down.
-        time_base: "header" (the messages' header stamps; the receive times when every header
-            stamp is zero) or "log" (the receive times the recorder wrote).
+        time_base: "header" (the messages' header stamps; the receive times of both topics
+            when every header stamp of either is zero) or "log" (the receive times the
+            recorder wrote).
         position: "path" (length of the odometry's pose trajectory) or "speed" (integral of
             the odometry's speed).
         gravity: "keep" (the BCR demeans each block) or "highpass" (a zero-phase 2nd-order
@@ -152,8 +154,8 @@ class ReplayResult:
     """The estimates of a replay and how they were made.
 
     Per estimate (length k; one per BCR update, i.e. per block): ``stamp_ns`` (int, bag time of
-    the newest sample), ``time`` (s since the first IMU sample used), ``position`` (m along the
-    path), ``speed`` (m/s, the odometry's at that sample), ``status``, ``reason``,
+    the newest sample), ``time`` (s since the first IMU message's stamp), ``position`` (m along
+    the path), ``speed`` (m/s, the odometry's at that sample), ``status``, ``reason``,
     ``domain_edge`` (`Estimate.domain_edge`: "upper", "lower" or ""), ``gd_mean``,
     ``gd_sd``, ``gd_lo``, ``gd_hi`` (the credible interval at the BCR's ``interval_level``),
     ``prob_above`` (P(GD > the Simplex's GD_max)), ``prob_change``, ``command`` (m/s), ``mode``;
@@ -378,13 +380,21 @@ def _settings(settings: ReplaySettings | None, overrides: dict) -> ReplaySetting
     return replace(s, **overrides)
 
 
-def _times(topic_msgs, time_base: str) -> tuple[np.ndarray, str, str]:
-    """(times ns, the base used, a note)."""
+def _time_base(rec: Recording, time_base: str) -> tuple[str, str]:
+    """(the base both topics are read on, a note): "log" when asked, or when either topic's
+    header stamps are all zero (then neither's can be trusted to share the other's clock)."""
     if time_base == "log":
-        return topic_msgs.log_ns, "log", ""
-    if np.all(topic_msgs.stamp_ns == 0):
-        return topic_msgs.log_ns, "log", "every header stamp is zero: receive times used"
-    return topic_msgs.stamp_ns, "header", ""
+        return "log", ""
+    zero = [m.topic for m in (rec.imu, rec.odometry) if np.all(m.stamp_ns == 0)]
+    if zero:
+        return "log", (f"every header stamp of {' and '.join(map(repr, zero))} is zero: "
+                       "receive times used for both topics")  # fmt: skip
+    return "header", ""
+
+
+def _times(topic_msgs, base: str) -> np.ndarray:
+    """A topic's times, ns, on ``base``."""
+    return topic_msgs.log_ns if base == "log" else topic_msgs.stamp_ns
 
 
 def replay_bag(
@@ -431,6 +441,7 @@ def replay_bag(
         `MissingExtraError` (the ``robot`` extra not installed).
     """
     bag = recording_path(bag, "bag")
+    csv, out_bag = _check_outputs(bag, csv, out_bag)
     s = _settings(settings, overrides)
     emulator = load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
@@ -440,11 +451,43 @@ def replay_bag(
     result = replay_recording(
         rec, emulator, s, bcr=bcr, simplex=simplex, likelihood=likelihood, progress=progress
     )
-    if csv is not None:
-        result.to_csv(csv)
-    if out_bag is not None:
+    if out_bag is not None:  # a new folder, written whole or not at all
         result.write_bag(out_bag)
+    if csv is not None:
+        try:
+            result.to_csv(csv)
+        except BaseException:
+            if out_bag is not None:
+                shutil.rmtree(out_bag, ignore_errors=True)
+            raise
     return result
+
+
+def _check_outputs(bag: Path, csv, out_bag) -> tuple[Path | None, Path | None]:
+    """``csv`` and ``out_bag`` as Paths, checked before the replay: `ControlError` where one is
+    not a path, lies in or on the recording ``bag``, both are the same, ``out_bag`` exists
+    (even as a dangling link) or ``csv`` is a folder."""
+    paths = []
+    for name, value in (("csv", csv), ("out_bag", out_bag)):
+        if value is None:
+            paths.append(None)
+            continue
+        if not isinstance(value, str | os.PathLike) or not str(value):
+            raise ControlError(f"{name} must be a path (a str or os.PathLike), got {value!r}")
+        path = Path(value)
+        target, source = path.resolve(), bag.resolve()
+        if target == source or source in target.parents:
+            raise ControlError(f"{name}={str(path)!r} would overwrite the recording {str(bag)!r}")
+        paths.append(path)
+    csv, out_bag = paths
+    if csv is not None and out_bag is not None and csv.resolve() == out_bag.resolve():
+        raise ControlError(f"csv and out_bag are the same path, {str(csv)!r}")
+    if out_bag is not None and os.path.lexists(out_bag):
+        raise ControlError(f"out_bag={str(out_bag)!r} exists already; a bag is written to a new "
+                           "folder")  # fmt: skip
+    if csv is not None and csv.is_dir():
+        raise ControlError(f"csv={str(csv)!r} is a folder; give the CSV file's path")
+    return csv, out_bag
 
 
 def replay_recording(
@@ -542,8 +585,8 @@ def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simple
 def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
     """The BCR's samples (t s from t0, accel, position, speed), the reports and t0 (ns)."""
     notes: list[str] = []
-    imu_ns, imu_base, imu_note = _times(rec.imu, s.time_base)
-    odom_ns, odom_base, odom_note = _times(rec.odometry, s.time_base)
+    base, note = _time_base(rec, s.time_base)
+    imu_ns, odom_ns = _times(rec.imu, base), _times(rec.odometry, base)
     accel = s.imu_sign * rec.imu.accel[:, "xyz".index(s.imu_axis)]
     t0 = int(imu_ns[0])
     t_imu = (imu_ns - t0) / 1e9
@@ -552,8 +595,8 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
         np.isfinite(rec.odometry.velocity), axis=1
     )
     reports = (
-        condition.check_stream(rec.imu.topic, t_imu, np.isfinite(accel), imu_base, imu_note),
-        condition.check_stream(rec.odometry.topic, t_odom, odom_finite, odom_base, odom_note),
+        condition.check_stream(rec.imu.topic, t_imu, np.isfinite(accel), base, note),
+        condition.check_stream(rec.odometry.topic, t_odom, odom_finite, base, note),
     )
     t, a, resampling = condition.to_rate(t_imu, accel, rate_hz, s.rate_tolerance, s.resample)
     if t.size == 0:  # resampled: every run too short for the filter's start-up at both ends

@@ -43,14 +43,14 @@ class RawTopics:
     """Messages of some topics, each in the order read.
 
     Attributes:
-        types: every topic of the files and its message type.
+        types: every topic of the files and its message type (None: several types).
         log_ns: topic -> receive times (int ns).
         data: topic -> serialised messages (bytes).
         definitions: topic -> (schema encoding, schema text) where the file has one.
         encodings: topic -> message encoding ("cdr" for ROS 2).
     """
 
-    types: dict[str, str] = field(default_factory=dict)
+    types: dict[str, str | None] = field(default_factory=dict)
     log_ns: dict[str, list[int]] = field(default_factory=dict)
     data: dict[str, list[bytes]] = field(default_factory=dict)
     definitions: dict[str, tuple[str, str]] = field(default_factory=dict)
@@ -174,6 +174,12 @@ def mcap_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics | N
     return out
 
 
+def note_type(types: dict[str, str | None], topic: str, msgtype: str) -> None:
+    """Record that ``topic`` holds ``msgtype``: None once it holds several types."""
+    if types.setdefault(topic, msgtype) != msgtype:
+        types[topic] = None
+
+
 def _mcap_file(f, out: RawTopics) -> bool:
     """Append the messages of ``out``'s topics in one MCAP file; False where it is not the
     simple case."""
@@ -188,7 +194,7 @@ def _mcap_file(f, out: RawTopics) -> bool:
     for cid, channel in summary.channels.items():
         schema = summary.schemas.get(channel.schema_id)
         name = schema.name if schema is not None else ""
-        out.types.setdefault(channel.topic, name)
+        note_type(out.types, channel.topic, name)
         if channel.topic in out.log_ns:
             wanted[cid] = channel.topic
             out.encodings[channel.topic] = channel.message_encoding
@@ -274,7 +280,7 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
                     f"{path} is damaged: the topic of id {tid!r} lacks its name, type or "
                     "serialisation format"
                 )
-            out.types.setdefault(name, msgtype)
+            note_type(out.types, name, msgtype)
             if name in out.log_ns:
                 ids[tid] = name
                 out.encodings[name] = encoding

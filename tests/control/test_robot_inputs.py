@@ -238,3 +238,123 @@ def test_a_damaged_emulator_file_is_a_control_error_chaining_gpmsas(bag, tmp_pat
     assert isinstance(info.value.__cause__, gpmsa.EmulatorFileError)
     with pytest.raises(ControlError, match="emulator 'nofile.gpmsa': no such file"):
         replay_bag(bag, "nofile.gpmsa")
+
+
+# --- from a probe of the robot I/O: outputs, clocks, stamps, odd files ---------------------------
+
+
+def test_replay_bag_checks_its_outputs_before_the_replay(bag, tmp_path):
+    mcap = next(bag.glob("*.mcap"))
+    before = mcap.read_bytes()
+    for kwargs in ({"csv": mcap}, {"csv": bag}, {"out_bag": bag / "estimates"}):
+        with pytest.raises(ControlError, match="would overwrite the recording"):
+            replay_bag(bag, "A", **kwargs)
+    assert mcap.read_bytes() == before
+    (tmp_path / "taken").mkdir()
+    csv = tmp_path / "x.csv"
+    with pytest.raises(ControlError, match="out_bag=.*taken.* exists already"):
+        replay_bag(bag, "A", csv=csv, out_bag=tmp_path / "taken")
+    assert not csv.exists()  # refused before anything was written
+    os.symlink(tmp_path / "nowhere", tmp_path / "dangling")
+    with pytest.raises(ControlError, match="out_bag=.*dangling.* exists already"):
+        replay_bag(bag, "A", out_bag=tmp_path / "dangling")
+    with pytest.raises(ControlError, match="csv and out_bag are the same path"):
+        replay_bag(bag, "A", csv=tmp_path / "same", out_bag=tmp_path / "same")
+    with pytest.raises(ControlError, match="csv=.*taken.* is a folder"):
+        replay_bag(bag, "A", csv=tmp_path / "taken")
+    result = replay_bag(bag, "A", csv=csv, out_bag=tmp_path / "fresh")
+    assert csv.is_file() and (tmp_path / "fresh" / "metadata.yaml").is_file()
+    assert len(csv.read_text().splitlines()) == result.gd_mean.size + 1
+
+
+def test_a_topic_without_header_stamps_puts_both_topics_on_the_receive_clock(tmp_path):
+    """The fall-back to receive times was decided per topic: an IMU on receive times and
+    odometry on header stamps 0.5 s apart paired every sample with the odometry of 0.5 s
+    before."""
+    t, accel, _, pos, spd = _drive()
+    log = np.concatenate([t + 0.5, t + 0.5])
+    path = write_sensor_bag(tmp_path / "zero", 0.0 * t, accel, t - 1.0 + 1.0, pos, spd,
+                            log_time=log)  # fmt: skip
+    result = replay_bag(path, "A")
+    assert result.imu.time_base == result.odometry.time_base == "log"
+    assert "receive times used for both topics" in result.imu.note
+    assert result.sample_position[0] == pytest.approx(0.0, abs=1e-9)  # 0.5 before
+    np.testing.assert_allclose(result.sample_position, result.sample_time, atol=1e-6)
+
+
+def test_written_stamps_are_checked_and_offset(tmp_path):
+    t, accel, _, pos, spd = _drive()
+    for value, name in ((np.full(800, np.nan), "log_time"), (np.full(800, -1.0), "log_time"),
+                        (np.full(800, 1e12), "log_time")):  # fmt: skip
+        with pytest.raises(ControlError, match=rf"{name} holds .* allowed finite times"):
+            write_sensor_bag(tmp_path / "b", t, accel, t, pos, spd, log_time=value)
+    with pytest.raises(ControlError, match=r"imu_time holds nan s"):
+        write_sensor_bag(tmp_path / "b", np.where(t > 2, np.nan, t), accel, t, pos, spd)
+    with pytest.raises(ControlError, match=r"imu_time holds 300000000[01].0 s"):
+        write_sensor_bag(tmp_path / "b", t + 3e9, accel, t, pos, spd)
+    with pytest.raises(ControlError, match=r"accel must hold real numbers"):
+        write_sensor_bag(tmp_path / "b", t, ["a"] * t.size, t, pos, spd)
+    assert not (tmp_path / "b").exists()
+
+
+def test_a_recording_that_is_a_fifo_is_refused_not_waited_on(bag, tmp_path):
+    fifo = tmp_path / "f.mcap"
+    os.mkfifo(fifo)
+    with pytest.raises(Exception, match="not a regular file"):
+        replay_bag(fifo, "A")
+    folder = tmp_path / "bag"
+    folder.mkdir()
+    for item in bag.iterdir():
+        if item.suffix == ".mcap":
+            os.mkfifo(folder / item.name)
+        else:
+            (folder / item.name).write_bytes(item.read_bytes())
+    with pytest.raises(Exception, match="is not a regular file"):
+        replay_bag(folder, "A")
+
+
+def test_terrain_replay_refuses_a_dangling_link_among_its_outputs(bag, tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    elsewhere = tmp_path / "elsewhere.json"
+    os.symlink(elsewhere, out / "replay.json")
+    code, _, err = _run(capsys, bag, "--emulator", "A", "--out", out)
+    assert code == 2 and "replay.json exists already" in err
+    assert os.path.islink(out / "replay.json") and not elsewhere.exists()
+
+
+@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
+def test_a_topic_with_two_message_types_is_named_as_such(tmp_path, storage):
+    from control.robot import messages as msgs
+    from control.robot.bags import merge_in_time, open_bag_writer, sensor_messages
+
+    t, accel, _, pos, spd = _drive()
+    t_imu, imu, t_odom, odom = sensor_messages(t, accel, t, pos, spd)
+    store = msgs.typestore()
+    field = store.types["sensor_msgs/msg/MagneticField"]
+    header, vec = store.types["std_msgs/msg/Header"], store.types["geometry_msgs/msg/Vector3"]
+    stamp = store.types["builtin_interfaces/msg/Time"](sec=1, nanosec=0)
+    mag = field(header=header(stamp=stamp, frame_id="imu"), magnetic_field=vec(x=0.0, y=0.0, z=1.0),
+                magnetic_field_covariance=np.zeros(9))  # fmt: skip
+    path = tmp_path / f"two_{storage}"
+    with open_bag_writer(path, storage) as writer:
+        c_imu = writer.add_connection("/imu/data", msgs.IMU_TYPE, typestore=store)
+        c_mag = writer.add_connection("/imu/data", "sensor_msgs/msg/MagneticField", typestore=store)
+        c_odom = writer.add_connection("/odometry/filtered", msgs.ODOMETRY_TYPE, typestore=store)
+        data = [bytes(store.serialize_cdr(mag, "sensor_msgs/msg/MagneticField"))]
+        streams = [(c_imu, t_imu, imu), (c_mag, t_imu[:1], data), (c_odom, t_odom, odom)]
+        for conn, ns, raw in merge_in_time(streams):
+            writer.write(conn, ns, raw)
+    with pytest.raises(Exception, match=r"'/imu/data' in .* holds several message types"):
+        replay_bag(path, "A")
+
+
+def test_stamps_a_nanosecond_apart_are_refused_before_a_huge_lowpass(tmp_path):
+    """400 IMU stamps 1 ns apart asked 'lowpass' for a filter of ~1.7e8 taps: 36 s and 8 GB
+    before a BagError."""
+    from control.errors import BagError
+
+    t, accel, _, pos, spd = _drive()
+    path = write_sensor_bag(tmp_path / "ns", 1.0 + np.arange(t.size) * 1e-9, accel, t, pos, spd)
+    with pytest.raises(BagError, match=r"needs a filter of \d+ taps, above MAX_LOWPASS_TAPS"):
+        replay_bag(path, "A", resample="lowpass")

@@ -506,3 +506,21 @@ def test_a_recording_that_fails_midway_leaves_the_earlier_file_whole(
         control.record_run(result, target)
     assert target.read_bytes() == path.read_bytes()
     assert [p.name for p in tmp_path.iterdir()] == ["run.mcap"]
+
+
+def test_start_ns_moves_every_stamp_and_a_stamp_beyond_ros2_is_refused(loop_run, tmp_path):
+    """start_ns moved the receive times and the estimates' stamps but left the IMU's and the
+    odometry's header stamps at 0 s: a header-stamp replay read 1970 beside the 2023 estimates."""
+    result, _ = loop_run
+    start = 1_700_000_000_123_456_789
+    path = control.record_run(result, tmp_path / "late.mcap", start_ns=start)
+    rec = read_recording(path)
+    first = int(np.rint(result.sample_time[0] * 1e9)) + start
+    assert rec.imu.stamp_ns[0] == rec.odometry.stamp_ns[0] == rec.imu.log_ns[0] == first
+    estimates = _decoded(path)["/bcr/estimate"]
+    stamp = estimates[0].header.stamp
+    assert stamp.sec * 10**9 + stamp.nanosec == int(np.rint(result.time[0] * 1e9)) + start
+    for bad in (3 * 10**18, 2**63, -1, True, 1.5):
+        with pytest.raises(ControlError, match=r"start_ns must be an integer in \[0, 2\*\*31 s\)"):
+            control.record_run(result, tmp_path / "bad.mcap", start_ns=bad)
+    assert not (tmp_path / "bad.mcap").exists()
