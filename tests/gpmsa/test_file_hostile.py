@@ -528,17 +528,26 @@ def test_info_shows_the_recorded_versions(emu, tmp_path, capsys):
     assert "versions (metadata): exudyn 1.13.6, numpy 2.4.6" in out
 
 
-def test_a_manifest_number_beyond_float64_or_nested_too_deep_is_a_file_error(saved, tmp_path):
-    manifest, arrays = read_members(saved["scalar"])
-    huge = write_members(tmp_path / "huge.gpmsa", manifest, arrays)
-    raw = zipfile.ZipFile(huge).read("manifest.json").decode()
-    edited = raw.replace('"metadata": {', '"metadata": {"big": 1e999, ', 1)
-    with zipfile.ZipFile(huge, "w") as zf:  # the hash cannot even be computed: refused first
+def _with_raw_metadata(path, manifest, arrays, text: str):
+    """An emulator file at ``path`` whose manifest JSON gets ``text`` written at the start of
+    its metadata object, as raw JSON (what json.dumps cannot write), the rest unchanged."""
+    write_members(path, manifest, arrays)
+    raw = zipfile.ZipFile(path).read("manifest.json").decode()
+    edited = raw.replace('"metadata": {', '"metadata": {' + text, 1)
+    assert edited != raw
+    with zipfile.ZipFile(path, "w") as zf:
         zf.writestr("manifest.json", edited)
         for name, arr in arrays.items():
             buf = io.BytesIO()
             np.save(buf, arr)
             zf.writestr(f"arrays/{name}.npy", buf.getvalue())
+    return path
+
+
+def test_a_manifest_number_beyond_float64_or_nested_too_deep_is_a_file_error(saved, tmp_path):
+    manifest, arrays = read_members(saved["scalar"])
+    # the hash cannot even be computed: refused first
+    huge = _with_raw_metadata(tmp_path / "huge.gpmsa", manifest, arrays, '"big": 1e999, ')
     with pytest.raises(gpmsa.EmulatorFileError, match="beyond float64"):
         gpmsa.load(huge)
     assert main(["info", str(huge)]) == 2
@@ -554,16 +563,8 @@ def test_a_manifest_key_given_twice_is_a_file_error(saved, tmp_path):
     """JSON parsers differ on a repeated key (Python's takes the last): a file that reads one
     way here and another way elsewhere is refused, however its hash was made."""
     manifest, arrays = read_members(saved["scalar"])
-    path = write_members(tmp_path / "twice.gpmsa", manifest, arrays)
-    raw = zipfile.ZipFile(path).read("manifest.json").decode()
-    edited = raw.replace('"metadata": {', '"metadata": {"note": "a", "note": "b", ', 1)
-    assert edited != raw
-    with zipfile.ZipFile(path, "w") as zf:
-        zf.writestr("manifest.json", edited)
-        for name, arr in arrays.items():
-            buf = io.BytesIO()
-            np.save(buf, arr)
-            zf.writestr(f"arrays/{name}.npy", buf.getvalue())
+    twice = '"note": "a", "note": "b", '
+    path = _with_raw_metadata(tmp_path / "twice.gpmsa", manifest, arrays, twice)
     with pytest.raises(gpmsa.EmulatorFileError, match="key 'note' appears twice in one object"):
         gpmsa.load(path)
     assert main(["info", str(path)]) == 2
