@@ -44,7 +44,7 @@ import numpy as np
 from control.changepoint import ChangePointFilter, ChangePointSettings, mixture_posterior
 from control.errors import ControlError
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
-from control.feature import FeatureSpec, block_features, window_feature
+from control.feature import FeatureSpec, feature_of_variance, features_of_blocks
 from control.sensor_checks import SensorLimits, signal_fault, stream_fault, timing_fault
 from control.tracker import GDTracker, TrackerSettings
 from control.validation import (
@@ -471,7 +471,7 @@ class BCR:
 
     def _block_feature(self, block: np.ndarray) -> np.ndarray:
         """The feature vector (K,) of the newest block of clean samples."""
-        return block_features(block, self.settings.feature)[0]
+        return features_of_blocks(block[None, :], self.settings.feature)[0]
 
     def _signal_reason(self, accel: np.ndarray) -> str:
         """The checks of the buffer's time stamps and odometry (`timing_fault`), then the
@@ -700,7 +700,7 @@ class BCR:
                 return replace(self.last, time=self._now()[0], position=self._now()[1],
                                reason=reason)  # fmt: skip
             return self._no_estimate("out_of_domain", why, speed=v)
-        y = window_feature(self._acc, s.feature.name)
+        y = float(feature_of_variance(np.var(self._acc), s.feature.name))  # clean samples
         if not np.isfinite(y):
             return self._no_estimate(
                 "sensor_fault", "window feature undefined (zero variance?)", speed=v

@@ -20,7 +20,7 @@ from control.errors import ControlError, ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
-from control.validation import within
+from control.validation import check_instance, is_real, within
 
 
 def _canon(obj) -> str:
@@ -107,6 +107,20 @@ def check_emulator(
     want it); vehicle or noise metadata missing.
     """
     _check_is_emulator(emulator)
+    if model is not None and not callable(getattr(model, "describe", None)):
+        raise ControlError(
+            f"model must be a vehicle model (e.g. vehicle.Jackal()), got {model!r:.60}"
+        )
+    if noise_std is not None and not (is_real(noise_std) and 0 <= noise_std < np.inf):
+        raise ControlError(
+            f"noise_std must be a finite real number >= 0, m/s^2, got {noise_std!r}"
+        )
+    if bcr is not None:
+        check_instance(bcr, "bcr", BCRSettings)
+    if track is not None and not hasattr(track, "segments"):
+        raise ControlError(f"track must be a roadgen Track, got {track!r:.60}")
+    if simplex is not None:
+        check_instance(simplex, "simplex", Simplex)
     meta = dict(getattr(emulator, "metadata", None) or {})
     if model is not None:
         if "vehicle" not in meta:
@@ -121,7 +135,7 @@ def check_emulator(
                 f"emulator was made for another vehicle ({_vehicle_diff(meta['vehicle'], model)})"
             )
     if noise_std is not None:
-        if "noise_std" not in meta:
+        if not is_real(meta.get("noise_std")):
             warnings.warn("emulator metadata has no 'noise_std'", ControlWarning, stacklevel=3)
         elif not np.isclose(float(meta["noise_std"]), float(noise_std)):
             warnings.warn(

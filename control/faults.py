@@ -71,13 +71,17 @@ class FaultInjector:
         self.rng = rng
         self._last = np.nan  # the newest finite reading of the batches before
         self._held: dict[int, float] = {}  # per stuck fault, the value it holds
+        self._spiked: dict[int, int] = {}  # per spike fault, the samples it has covered so far
 
     def __call__(self, t, position, accel, speed):
         """(t, position, accel, speed) of the next batch with the faults applied (copies)."""
-        t = np.array(t, dtype=float)
-        pos = np.array(position, dtype=float)
-        acc = np.array(accel, dtype=float)
-        spd = np.array(speed, dtype=float)
+        t, pos = _batch("t", t), _batch("position", position)
+        acc, spd = _batch("accel", accel), _batch("speed", speed)
+        if not t.size == pos.size == acc.size == spd.size:
+            raise ControlError(
+                f"t, position, accel and speed must have one length, got {t.size}, {pos.size}, "
+                f"{acc.size} and {spd.size}"
+            )
         keep = np.ones(t.size, dtype=bool)
         clock = t.copy()
         for i, fault in enumerate(self.faults):
@@ -90,8 +94,12 @@ class FaultInjector:
             elif k == "drop":
                 keep &= ~hit
             elif k == "spike":
-                idx = np.flatnonzero(hit)[:: max(1, round(m))]  # the nearest whole spacing
-                acc[idx] = 1e6 * np.where(np.arange(idx.size) % 2, 1.0, -1.0)
+                # counted over the fault's whole span, not per batch: the nearest whole spacing
+                every, seen = max(1, round(m)), self._spiked.get(i, 0)
+                covered = seen + np.arange(int(hit.sum()))
+                on = covered % every == 0
+                acc[np.flatnonzero(hit)[on]] = 1e6 * np.where((covered[on] // every) % 2, 1.0, -1.0)
+                self._spiked[i] = seen + int(hit.sum())
             elif k == "noise":
                 acc[hit] += self.rng.normal(0.0, m, int(hit.sum()))
             elif k == "scale":
@@ -119,3 +127,17 @@ class FaultInjector:
         if finite.size:
             return float(acc[finite[-1]])
         return self._last if np.isfinite(self._last) else float(acc[0])
+
+
+def _batch(name: str, value) -> np.ndarray:
+    """A batch's ``value`` as a 1-D float array (a copy); `ControlError` naming ``name`` for
+    what is not a sequence of real numbers."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ControlError(
+            f"{name} must be a 1-D sequence of real numbers, got {value!r:.60}"
+        ) from exc
+    if arr.ndim != 1:
+        raise ControlError(f"{name} must be 1-D, got shape {arr.shape}")
+    return arr

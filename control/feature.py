@@ -25,7 +25,7 @@ import numpy as np
 from scipy.signal.windows import dpss
 
 from control.errors import ControlError
-from control.validation import float_array, require_integers, require_reals
+from control.validation import check_instance, float_array, require_integers, require_reals
 
 FEATURES = ("log_band_power", "log_var", "var")
 SCALAR_FEATURES = ("log_var", "var")
@@ -231,12 +231,19 @@ def block_features(accel: np.ndarray, spec: FeatureSpec) -> np.ndarray:
         minus block mean, g); a block with zero power in a band gives -inf there (the BCR
         treats it as a sensor fault).
     """
-    a = np.atleast_2d(np.asarray(accel, dtype=float))
+    check_instance(spec, "spec", FeatureSpec)
+    a = np.atleast_2d(_samples(accel))
     if a.ndim != 2 or a.shape[1] != spec.block_samples:
         raise ControlError(
             f"accel must have shape (n, {spec.block_samples}) or ({spec.block_samples},), "
             f"got {np.shape(accel)}"
         )
+    return features_of_blocks(a, spec)
+
+
+def features_of_blocks(a: np.ndarray, spec: FeatureSpec) -> np.ndarray:
+    """`block_features` of blocks ``a`` (n, B) float whose samples the caller checked (the
+    BCR, in its loop)."""
     if spec.name != "log_band_power":
         return np.asarray(feature_of_variance(np.var(a, axis=1), spec.name))[:, None]
     x = a - a.mean(axis=1, keepdims=True)
@@ -252,6 +259,18 @@ def block_features(accel: np.ndarray, spec: FeatureSpec) -> np.ndarray:
         return log_power
     tails = _quantiles(x, spec.quantiles) / STANDARD_GRAVITY  # x: the mean taken off
     return np.concatenate([log_power, tails], axis=1)
+
+
+def _samples(accel) -> np.ndarray:
+    """``accel`` as a float array; ControlError unless it holds finite real numbers (no strings,
+    bools, complex numbers, masked arrays, NaN or inf: the BCR's sample checks, for the public
+    feature functions)."""
+    if isinstance(accel, np.ma.MaskedArray):
+        raise ControlError("accel is a masked array: pass the samples, the masked ones left out")
+    arr = float_array(accel, "accel")
+    if not np.all(np.isfinite(arr)):
+        raise ControlError("accel holds NaN or inf: a block's feature needs finite samples, m/s^2")
+    return arr
 
 
 def _quantiles(x: np.ndarray, levels: tuple[float, ...]) -> np.ndarray:
@@ -277,7 +296,7 @@ def window_feature(accel: np.ndarray, feature: str = "log_var") -> float:
     Returns:
         y; NaN for "log_var" of a window with zero variance.
     """
-    accel = np.asarray(accel, dtype=float)
+    accel = _samples(accel)
     if accel.ndim != 1 or accel.size < 2:
         raise ControlError(f"accel must be 1-D with >= 2 samples, got shape {accel.shape}")
     return float(feature_of_variance(np.var(accel), feature))  # var: normalised by T (eq. 5)

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
-from control.validation import float_array
+from control.validation import float_array, is_real
 from gpmsa.io.container import jsonable
 
 
@@ -79,15 +79,33 @@ def pooled_rmse(errors: Sequence[Sequence[GDError]], gd: float) -> float:
     """RMSE at prescribed GD `gd` pooled over several runs (all their estimates together).
 
     NaN when no run made an estimate there (a part shorter than the first block), as
-    `GDError.rmse` for one run.
+    `GDError.rmse` for one run; ControlError when no run has a part at ``gd`` at all (a GD
+    mistyped would otherwise read as "no estimate").
 
     Args:
-        errors: per run, its `GDError`s (``[r.metrics.gd_errors for r in results]``).
+        errors: per run, its `GDError`s (``[r.metrics.gd_errors for r in results]``; any
+            iterable, read once).
     """
+    if not is_real(gd):
+        raise ControlError(f"gd must be a real number (1e-6 m^3), got {gd!r}")
+    try:
+        errors = [run if isinstance(run, GDError) else tuple(run) for run in errors]
+    except TypeError as exc:
+        raise ControlError(f"errors must hold one sequence of GDError per run: {exc}") from exc
     if any(isinstance(run, GDError) for run in errors):
         raise ControlError(
             "errors must hold one sequence of GDError per run; for one run's errors pass "
             "[metrics.gd_errors]"
+        )
+    for k, run in enumerate(errors):
+        for e in run:
+            if not isinstance(e, GDError):
+                raise ControlError(f"errors[{k}] holds {e!r:.60}, not a GDError")
+    parts = sorted({e.gd for run in errors for e in run})
+    if gd not in parts:
+        raise ControlError(
+            f"no run has a part at GD {gd!r}; the runs' parts are at GD "
+            f"{', '.join(f'{g:g}' for g in parts) or 'none'}"
         )
     sse = sum(e.sse for run in errors for e in run if e.gd == gd)
     n = sum(e.n for run in errors for e in run if e.gd == gd)
@@ -158,9 +176,14 @@ def fast_on_rough_m(
         position, speed: (n,) the vehicle's samples (front axle), m (finite, non-decreasing)
             and m/s.
     """
+    for name, value in (("gd_max", gd_max), ("v_safe", v_safe), ("tol", tol)):
+        if not (is_real(value) and np.isfinite(value)):
+            raise ControlError(f"{name} must be a finite real number, got {value!r}")
     position, speed = _traces(position, speed, "speed")
     if not (np.all(np.isfinite(position)) and np.all(np.diff(position) >= 0)):
         raise ControlError("position must hold finite, non-decreasing samples, m")
+    if not np.all(np.isfinite(speed)):
+        raise ControlError("speed must hold finite samples, m/s")
     if position.size < 2:
         return 0.0
     seg_gd = np.array([gd for _, gd in track.segments], dtype=float)

@@ -28,6 +28,9 @@ from scipy.linalg import cholesky
 from control.errors import ControlError, EmulatorMismatchError
 from control.validation import float_array, is_integer, is_real, require_reals, within
 
+MAX_TABLE_NODES = 1_000_000
+"""Most (speed, GD) nodes of an ObservationModel's mean table (the default has 3,751)."""
+
 
 @dataclass(frozen=True, eq=False)
 class BlockScatter:
@@ -52,7 +55,12 @@ class BlockScatter:
             raise ControlError(f"speed must be >= 2 increasing finite nodes, got {s}")
         if c.ndim != 3 or c.shape[0] != s.size or c.shape[1] != c.shape[2]:
             raise ControlError(f"cov must have shape ({s.size}, K, K), got {c.shape}")
-        if not np.all(np.isfinite(c)) or np.any(np.linalg.eigvalsh(c)[:, 0] <= 0):
+        if not np.all(np.isfinite(c)):
+            raise ControlError("cov must hold finite, positive-definite matrices")
+        scale = np.max(np.abs(c), axis=(1, 2), keepdims=True)
+        if np.any(np.abs(c - c.transpose(0, 2, 1)) > 1e-10 * scale):
+            raise ControlError("cov must hold symmetric matrices (a covariance)")
+        if np.any(np.linalg.eigvalsh(c)[:, 0] <= 0):
             raise ControlError("cov must hold finite, positive-definite matrices")
         if not (self.dof > 2):
             raise ControlError(f"dof must be > 2 (or inf), got {self.dof}")
@@ -74,7 +82,7 @@ class BlockScatter:
         try:
             dof = np.inf if d.get("dof") is None else float(d["dof"])
             return cls(np.asarray(d["speed_mps"], float), np.asarray(d["cov"], float), dof)
-        except (KeyError, TypeError, ValueError) as exc:
+        except (AttributeError, KeyError, TypeError, ValueError, ControlError) as exc:
             raise EmulatorMismatchError(
                 f"the emulator's block_scatter is malformed: {exc}"
             ) from exc
@@ -95,6 +103,15 @@ class ObservationModel:
     def __init__(
         self, emulator, scatter: BlockScatter | None = None, n_grid: int = 121, n_speed: int = 31
     ) -> None:
+        if not all(hasattr(emulator, a) for a in ("p", "q", "l_sim", "domain", "predict")):
+            raise ControlError(
+                f"emulator must be a gpmsa.Emulator, got {emulator!r:.60} "
+                f"({type(emulator).__name__})"
+            )
+        if scatter is not None and not isinstance(scatter, BlockScatter):
+            raise ControlError(
+                f"scatter must be a control BlockScatter or None, got {scatter!r:.60}"
+            )
         if emulator.p != 1 or emulator.q != 1:
             raise EmulatorMismatchError(
                 f"the block likelihood needs one known input (speed) and one calibration "
@@ -118,6 +135,11 @@ class ObservationModel:
             raise ControlError(f"n_grid must be an integer >= 16, got {n_grid}")
         if not (is_integer(n_speed) and n_speed >= 2):
             raise ControlError(f"n_speed must be an integer >= 2, got {n_speed}")
+        if n_grid * n_speed > MAX_TABLE_NODES:
+            raise ControlError(
+                f"n_grid x n_speed = {n_grid * n_speed} nodes, above MAX_TABLE_NODES = "
+                f"{MAX_TABLE_NODES} (the mean table: one emulator prediction per node)"
+            )
         self.emulator = emulator
         self.scatter = scatter
         (v_lo, v_hi) = emulator.domain[emulator.x_names[0]]

@@ -227,8 +227,8 @@ class SimplexRun:
             s.v_safe,
             "safety",
             np.nan,
-            f"latched by a {first.status} at {first.time:.2f} s ({first.reason}); "
-            "reset() to resume",
+            f"latched by an estimate of status {first.status!r} at {first.time:.2f} s"
+            + (f" ({first.reason})" if first.reason else "") + "; reset() to resume",
         )
 
     def _latches(self, estimate: Estimate) -> bool:

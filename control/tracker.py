@@ -30,12 +30,17 @@ from control.validation import (
     check_instance,
     check_n_draws,
     float_array,
+    is_real,
     require_integers,
     require_reals,
 )
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("uniform", "log_uniform")
+
+
+MAX_GRID = 100_000
+"""Most nodes of a GDTracker's grid."""
 
 
 @dataclass(frozen=True)
@@ -68,15 +73,18 @@ class TrackerSettings:
             )
         if self.prior not in PRIORS:
             raise ControlError(f"prior must be one of {PRIORS}, got {self.prior!r}")
-        if self.n_grid < 16:
-            raise ControlError(f"n_grid must be >= 16, got {self.n_grid}")
+        if not 16 <= self.n_grid <= MAX_GRID:
+            raise ControlError(f"n_grid must lie in [16, {MAX_GRID}], got {self.n_grid}")
 
 
 class GDTracker:
     """Grid filter for GD on [lo, hi] (native units); see the module docstring."""
 
     def __init__(self, domain: tuple[float, float], settings: TrackerSettings | None = None):
-        lo, hi = (float(d) for d in domain)
+        pair = tuple(domain) if isinstance(domain, tuple | list | np.ndarray) else ()
+        if len(pair) != 2 or not all(is_real(d) for d in pair):
+            raise ControlError(f"domain must be a pair (lo, hi) of real numbers, got {domain!r}")
+        lo, hi = (float(d) for d in pair)
         if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
             raise ControlError(f"domain must satisfy 0 < lo < hi, got {domain}")
         self.settings = TrackerSettings() if settings is None else settings
@@ -94,14 +102,16 @@ class GDTracker:
 
     def predict(self, ds_m: float) -> None:
         """Propagate the state over ds_m metres travelled (random walk, then change point)."""
-        if not ds_m >= 0:
-            raise ControlError(f"ds_m must be >= 0, got {ds_m}")
+        if not (is_real(ds_m) and ds_m >= 0):
+            raise ControlError(f"ds_m must be a real number >= 0, got {ds_m!r}")
         s = self.settings
         if s.mean_segment_m == 0 or np.isinf(ds_m):
             self.reset()
             return
         mass = np.exp(self.log_mass - self.log_mass.max())
         sigma_idx = s.drift_per_sqrt_m * np.sqrt(ds_m) / (self.log_grid[1] - self.log_grid[0])
+        # beyond ten grids wide the reflected walk is flat on the grid: no wider kernel is needed
+        sigma_idx = min(sigma_idx, 10.0 * self.log_grid.size)
         if sigma_idx > 0.05:
             mass = gaussian_filter1d(mass, sigma_idx, mode="reflect", truncate=5.0)
         mass /= mass.sum()
@@ -118,8 +128,8 @@ class GDTracker:
             power: tempering exponent in (0, 1]: the likelihood enters as likelihood**power
                 (the fraction of the window's samples that are new to this tracker).
         """
-        if not 0 < power <= 1:
-            raise ControlError(f"power must lie in (0, 1], got {power}")
+        if not (is_real(power) and 0 < power <= 1):
+            raise ControlError(f"power must be a real number in (0, 1], got {power!r}")
         grid = float_array(grid, "grid")
         loglik = float_array(loglik, "loglik")
         if grid.ndim != 1 or grid.shape != loglik.shape or grid.size < 2:

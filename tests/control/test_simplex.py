@@ -117,7 +117,7 @@ def test_a_fault_latches_safety_mode_until_reset():
     assert run.command(bare_estimate("sensor_fault", time=3.5)).speed == 1.0
     cmd = run.command(gaussian_estimate(260, 5))  # clean data again: the BCR is ok, the robot not
     assert run.latched and cmd.mode == "safety" and cmd.speed == 1.0
-    assert "latched by a sensor_fault at 3.50 s (why sensor_fault)" in cmd.reason
+    assert "status 'sensor_fault' at 3.50 s (why sensor_fault)" in cmd.reason
     run.reset()
     assert not run.latched and run.command(gaussian_estimate(260, 5)).mode == "performance"
 

@@ -64,7 +64,7 @@ def test_tempered_updates_add_up_to_one_full_update():
     weak = GDTracker((200, 600), rigid)
     weak.update(GRID, gauss_loglik(400, 20), power=0.25)
     assert weak.posterior().sd("GD") == pytest.approx(40, rel=0.02)
-    with pytest.raises(ControlError, match="power must lie in"):
+    with pytest.raises(ControlError, match=r"power must be a real number in \(0, 1\]"):
         weak.update(GRID, gauss_loglik(400, 20), power=0.0)
 
 
@@ -98,8 +98,18 @@ def test_bad_input_raises():
     with pytest.raises(ControlError, match="mean_segment_m"):
         TrackerSettings(mean_segment_m=-1)
     tr = GDTracker((200, 600))
-    with pytest.raises(ControlError, match="ds_m must be >= 0"):
-        tr.predict(-1.0)
+    for ds in (-1.0, True, "1"):
+        with pytest.raises(ControlError, match="ds_m must be a real number >= 0"):
+            tr.predict(ds)
+    for domain in (("200", "600"), (True, 600), (200, 400, 600), 200):
+        with pytest.raises(ControlError, match="domain must be a pair"):
+            GDTracker(domain)
+    with pytest.raises(ControlError, match=r"n_grid must lie in \[16, 100000\]"):
+        TrackerSettings(n_grid=10**9)
+    far = GDTracker((200, 600))  # a huge step flattens the walk without a huge kernel
+    far.update(GRID, gauss_loglik(350, 25))
+    far.predict(1e12)
+    assert np.exp(far.log_mass).sum() == pytest.approx(1.0, abs=1e-9)
     with pytest.raises(ControlError, match="loglik must be finite"):
         tr.update(GRID, np.full(GRID.size, np.nan))
     with pytest.raises(ControlError, match="TrackerSettings.n_grid must be an integer"):
