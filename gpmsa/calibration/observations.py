@@ -22,13 +22,11 @@ from gpmsa.model.data import (
     check_parameter_names,
     values_digest,
 )
-from gpmsa.model.problem import SIGOBS_RIDGE, ObsProblem, reduce_obs
+from gpmsa.model.problem import MAX_STD_OBS, SIGOBS_RIDGE, ObsProblem, reduce_obs
 
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 EMULATOR_PARAM_MODES = ("point", "draws")
-MAX_STD_OBS = 1e6
-"""Reduced observations farther than this from the simulation mean (in its sds) are refused."""
 OUTSIDE_SDS = 5.0
 """An observation farther than this many predictive sds from every emulator prediction at its
 x (over the whole theta domain) lies outside what the emulator has seen: a warning

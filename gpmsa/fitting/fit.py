@@ -25,11 +25,28 @@ N_KEEP = 1000
 """Default number of retained draws (all chains together) after burn-in and thinning."""
 
 
-def _seed(seed):
+def _seed(seed) -> int:
+    """The integer seed the fit runs with and records: ``seed`` itself, one drawn from a
+    Generator, or for None one drawn from fresh OS entropy (so that every fit can be rerun)."""
     seed = check_seed(seed, generator=True)
+    if seed is None:
+        seed = np.random.default_rng()
     if isinstance(seed, np.random.Generator):
         return int(seed.integers(2**63))
     return seed
+
+
+_UNRECORDED = object()
+
+
+def _recorded_option(value):
+    """A backend option as the settings record it: plain values as they are, a torch dtype or
+    device by its name ("float32", "cuda"); anything else is not recorded (_UNRECORDED)."""
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    if type(value).__module__.split(".")[0] == "torch":
+        return str(value).removeprefix("torch.")
+    return _UNRECORDED
 
 
 def _check_fit_memory(problem, n_iter: int, n_chains: int) -> None:
@@ -80,7 +97,9 @@ def fit(
     discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. n_jobs, executor: where
     the chains run (numpy backend: ``n_jobs`` worker processes, None or -1 = every CPU but never
     more than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws
-    are the same wherever they run. options: passed to the backend's ``sample`` (e.g. ``init``).
+    are the same wherever they run. seed: an integer, a numpy Generator or None (fresh
+    entropy); the integer the fit ran with is ``settings["seed"]``, and ``fit(..., seed=that)``
+    repeats it. options: passed to the backend's ``sample`` (e.g. ``init``).
 
     Beyond GPM/SA's model (numpy backend; docs/categorical-and-constraints.md): categorical
     inputs are declared in ``SimData`` (a categorical theta of a joint fit is sampled over its
@@ -101,6 +120,10 @@ def fit(
     n_burn = n_iter // 5 if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     check_point(point)
     n_keep = check_count(n_keep, "n_keep")
+    if n_keep < n_chains:
+        raise GPMSAError(
+            f"n_keep={n_keep} is fewer than n_chains={n_chains}: every chain keeps a draw"
+        )
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     metadata = check_metadata(metadata)
     if obs is None and discrepancy is not None:
@@ -139,6 +162,8 @@ def fit(
     chains.check_finite()
     kept = n_iter - n_burn
     thin = max(1, math.ceil(n_chains * kept / n_keep))
+    while n_chains * math.ceil(kept / thin) > n_keep:  # each chain keeps ceil(kept / thin)
+        thin += 1
     # float64 whatever the backend sampled in (torch float32), a fixed parameter exactly at its
     # value; a mean within its draws' range (a parameter that never moved: float rounding)
     post = {k: np.asarray(v[:, n_burn:], dtype=float) for k, v in chains.draws.items()}
@@ -170,9 +195,9 @@ def fit(
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),
-        "backend_options": {k: v for k, v in sorted(options.items())  # not where they ran
-                            if k not in ("n_jobs", "executor")
-                            and (v is None or isinstance(v, (bool, int, float, str)))},
+        "backend_options": {k: _recorded_option(v) for k, v in sorted(options.items())
+                            if k not in ("n_jobs", "executor")  # not where they ran
+                            and _recorded_option(v) is not _UNRECORDED},
         "mean_basis": None if problem.mean_basis is None else problem.mean_basis.kind,
         "fixed": {k: problem.init[k].tolist() for k in sorted(problem.fixed)},
         "constraint": constraint is not None,

@@ -41,6 +41,8 @@ def _first_non_number(value) -> str | None:
                 return f"{arr.dtype.name} values"
             item = arr.reshape(-1)[0].item()
             return f"{type(item).__name__} {item!r}"
+        if arr.dtype.kind in "mM":  # dates and durations: numbers only by an epoch and unit
+            return f"{arr.dtype.name} values"
         if arr.dtype.kind == "O":
             stack.extend(x for x in reversed(arr.reshape(-1).tolist()) if x is not v)
     return None
@@ -54,7 +56,8 @@ def as_float(value, name: str) -> np.ndarray:
     bad = _first_non_number(value)
     if bad is not None:
         raise GPMSAError(
-            f"{name} must be a numeric array, got {bad} (text, bools and None are not converted)"
+            f"{name} must be a numeric array, got {bad} (text, bools, dates and None are not "
+            "converted)"
         )
     try:
         is_complex = np.iscomplexobj(value)
@@ -115,20 +118,23 @@ def by_column_names(value, names, name: str):
 
 
 def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
-    """Return ``value`` as a finite float64 2-D array; a 1-D array becomes one column.
+    """Return ``value`` as a finite float64 2-D array; a 1-D array becomes one column, or, where
+    ``ncols`` > 1 and it has exactly ``ncols`` entries, one row.
 
     Raises GPMSAError naming ``name`` for non-numeric or complex values, a wrong shape or
     non-finite entries.
     """
     arr = as_float(value, name)
+    given = arr.shape
     if arr.ndim == 1:
-        arr = arr[:, None]
+        one_row = ncols is not None and ncols > 1 and arr.size == ncols
+        arr = arr[None, :] if one_row else arr[:, None]
     if arr.ndim != 2 or arr.shape[0] == 0 or arr.shape[1] == 0:
         raise GPMSAError(
-            f"{name} must be a non-empty 2-D array (rows x columns), got shape {arr.shape}"
+            f"{name} must be a non-empty 2-D array (rows x columns), got shape {given}"
         )
     if ncols is not None and arr.shape[1] != ncols:
-        raise GPMSAError(f"{name} must have {ncols} columns, got shape {arr.shape}")
+        raise GPMSAError(f"{name} must have {ncols} columns, got shape {given}")
     check_finite(arr, name)
     return arr
 
@@ -224,6 +230,9 @@ def check_parameter_names(names, what: str = "t_names") -> None:
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
     if names is None:
         return tuple(f"{prefix}{i}" for i in range(n))
+    if isinstance(names, str):
+        raise GPMSAError(f"{what} must be a list of names, got the string {names!r} (for one "
+                         f"name pass [{names!r}])")  # fmt: skip
     names = tuple(str(s) for s in names)
     if len(names) != n:
         raise GPMSAError(f"{what} must have {n} entries, got {len(names)}: {names}")
@@ -235,6 +244,9 @@ def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple
 def _units(units: Sequence[str] | None, n: int, what: str) -> tuple[str, ...]:
     if units is None:
         return ("",) * n
+    if isinstance(units, str):
+        raise GPMSAError(f"{what} must be a list of units, got the string {units!r} (for one "
+                         f"unit pass [{units!r}])")  # fmt: skip
     units = tuple(str(s) for s in units)
     if len(units) != n:
         raise GPMSAError(f"{what} must have {n} entries, got {len(units)}: {units}")

@@ -240,6 +240,11 @@ def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
         )
 
 
+MAX_STD_OBS = 1e6
+"""Observations farther than this from the simulation mean (in its sds) are refused: wrong
+units, not data (the samplers' squares would overflow or the fit be meaningless)."""
+
+
 def reduce_obs(
     obs: ObsData,
     std: Standardizer,
@@ -271,6 +276,12 @@ def reduce_obs(
         ys = [std.y_to_std(e, g) for e, g in zip(obs.experiments, obs.grids, strict=True)]
     for j, e in enumerate(ys):
         check_finite(e, f"y_obs[{j}] in standardised units")
+    far = max(float(np.max(np.abs(e))) for e in ys)
+    if far > MAX_STD_OBS:
+        raise GPMSAError(
+            f"y_obs lies {far:.3g} standard deviations of the simulation outputs from their "
+            f"mean; allowed at most {MAX_STD_OBS:g} (wrong units?)"
+        )
     lamy = [np.eye(e.size) for e in ys]
     if obs.precisions is not None:
         lamy = [lam * std.y_sd**2 for lam in obs.precisions]
@@ -300,10 +311,10 @@ def reduce_obs(
             vu = cho_solve(cho_factor(ridge), rhs) if np.all(np.isfinite(rhs)) else rhs
             resid = e - DK @ vu
             ss += float(resid @ lam @ resid)
-        if not (np.all(np.isfinite(vu)) and np.isfinite(ss)):
+        if not (np.all(np.isfinite(vu)) and np.isfinite(ss)):  # huge precisions
             raise GPMSAError(
                 f"y_obs[{j}] is too large for the emulator's basis: its projection overflows "
-                "float64 (wrong units?)"
+                "float64 (wrong units, or observation precisions?)"
             )
         rank += int(np.linalg.matrix_rank(A, hermitian=True))
         total += e.size

@@ -599,7 +599,8 @@ def test_saving_keeps_permissions_writes_through_links_and_takes_long_names(emu,
 def test_an_observation_too_large_for_the_basis_is_named_and_cli_json_is_strict(vec_emu):
     y = np.full((1, 6), 0.5)
     y[0, 0] = 1e308  # finite, but its projection on the basis overflows
-    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs\[0\] is too large for the emulator's"):
+    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs lies .* standard deviations of the "
+                                               r"simulation outputs .*wrong units"):
         gpmsa.Calibrator(vec_emu).update([[0.5]], y)
     out = container.jsonable({"sd": float("inf"), "q": [np.float64("nan"), 1.0], "n": 3})
     assert json.loads(json.dumps(out, allow_nan=False)) == {"sd": None, "q": [None, 1.0], "n": 3}
