@@ -158,7 +158,10 @@ def _check_faults(faults) -> tuple[SensorFault, ...]:
 
 
 def _check_record_path(record) -> None:
-    """ControlError before the drive when ``record`` names a folder or has no writable folder."""
+    """ControlError before the drive when ``record`` is not a path, names a folder or has no
+    writable folder."""
+    if not isinstance(record, str | os.PathLike) or not str(record):
+        raise ControlError(f"record must be a path (a str or os.PathLike), got {record!r:.60}")
     path = Path(record)
     if path.is_dir():
         raise ControlError(f"record={str(record)!r} is a folder; name the .mcap file to write")
@@ -243,6 +246,9 @@ def run_closed_loop(
     if bcr is not None:
         check_instance(bcr, "bcr", BCRSettings)
     _check_seed(seed)
+    for name, flag in (("check", check), ("progress", progress)):
+        if not isinstance(flag, bool | np.bool_):
+            raise ControlError(f"{name} must be True or False, got {flag!r:.60}")
     noise_std = vehicle.sensor.check_noise(noise_std)
     faults = _check_faults(faults)
     if max_time_s is not None and not (is_real(max_time_s) and max_time_s > 0):

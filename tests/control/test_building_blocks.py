@@ -108,3 +108,14 @@ def test_a_block_scatter_must_be_symmetric_and_helpers_name_wrong_types(emulator
                       ({"noise_std": True}, "noise_std must be a finite real")):  # fmt: skip
         with pytest.raises(ControlError, match=match):
             control.check_emulator(emulator_a, **kw)
+
+
+def test_run_closed_loop_names_a_record_or_flag_of_the_wrong_type(emulator_a):
+    import roadgen
+
+    track = roadgen.track([(10.0, 300.0)], seed=0)
+    for kw, match in (({"record": 5}, "record must be a path"),
+                      ({"check": "no"}, "check must be True or False"),
+                      ({"progress": "yes"}, "progress must be True or False")):  # fmt: skip
+        with pytest.raises(ControlError, match=match):
+            control.run_closed_loop(track, emulator_a, **kw)
