@@ -49,6 +49,7 @@ from control.sensor_checks import SensorLimits, signal_fault, stream_fault, timi
 from control.tracker import GDTracker, TrackerSettings
 from control.validation import (
     check_instance,
+    check_not_masked,
     is_integer,
     is_real,
     require_instance,
@@ -214,10 +215,7 @@ def _samples(name: str, values) -> np.ndarray:
     samples: sensor faults, not errors)."""
     if values is None:
         raise ControlError(f"{name} must be a 1-D sequence of numbers, got None")
-    if isinstance(values, np.ma.MaskedArray):  # its mask would be read as data
-        raise ControlError(
-            f"{name} is a masked array: give NaN for missing samples ({name}.filled(np.nan))"
-        )
+    check_not_masked(values, name)
     try:
         a = np.atleast_1d(np.asarray(values))
     except ValueError as exc:  # a ragged list

@@ -6,7 +6,6 @@ import os
 import time as _time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -28,7 +27,7 @@ from control.metrics import (
 )
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
-from control.validation import check_instance, is_real
+from control.validation import check_instance, is_real, path_argument
 
 EXACT_CLOCK_SILENCE = 0.5
 """The simulated sensor's clock is exact, so any sample missing at an update is silence: the
@@ -160,9 +159,7 @@ def _check_faults(faults) -> tuple[SensorFault, ...]:
 def _check_record_path(record) -> None:
     """ControlError before the drive when ``record`` is not a path, names a folder or has no
     writable folder."""
-    if not isinstance(record, str | os.PathLike) or not str(record):
-        raise ControlError(f"record must be a path (a str or os.PathLike), got {record!r:.60}")
-    path = Path(record)
+    path = path_argument(record, "record", " of the .mcap file to write")
     if path.is_dir():
         raise ControlError(f"record={str(record)!r} is a folder; name the .mcap file to write")
     folder = next((p for p in path.absolute().parents if p.exists()), None)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
-from control.validation import check_instance, require_reals
+from control.validation import check_instance, float_array, require_reals
 
 FAULT_KINDS = (
     "nan",  # the accelerometer reads NaN
@@ -131,13 +131,8 @@ class FaultInjector:
 
 def _batch(name: str, value) -> np.ndarray:
     """A batch's ``value`` as a 1-D float array (a copy); `ControlError` naming ``name`` for
-    what is not a sequence of real numbers."""
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ControlError(
-            f"{name} must be a 1-D sequence of real numbers, got {value!r:.60}"
-        ) from exc
+    what is not a 1-D sequence of real numbers."""
+    arr = float_array(value, name)
     if arr.ndim != 1:
         raise ControlError(f"{name} must be 1-D, got shape {arr.shape}")
     return arr

@@ -265,8 +265,6 @@ def _samples(accel) -> np.ndarray:
     """``accel`` as a float array; ControlError unless it holds finite real numbers (no strings,
     bools, complex numbers, masked arrays, NaN or inf: the BCR's sample checks, for the public
     feature functions)."""
-    if isinstance(accel, np.ma.MaskedArray):
-        raise ControlError("accel is a masked array: pass the samples, the masked ones left out")
     arr = float_array(accel, "accel")
     if not np.all(np.isfinite(arr)):
         raise ControlError("accel holds NaN or inf: a block's feature needs finite samples, m/s^2")

@@ -3,7 +3,9 @@
 
 from __future__ import annotations
 
+import os
 from numbers import Integral, Real
+from pathlib import Path
 
 import numpy as np
 
@@ -28,10 +30,31 @@ def within(value: float, lo: float, hi: float) -> bool:
     return lo - tol <= value <= hi + tol
 
 
+def path_argument(value, name: str, of: str = "") -> Path:
+    """``value`` (a str or os.PathLike, not empty) as a Path; ControlError naming the argument
+    ``name`` for anything else (None, a number, ""); ``of`` says what the path is of."""
+    if not isinstance(value, str | os.PathLike) or not str(value):
+        raise ControlError(
+            f"{name} must be the path (a str or os.PathLike){of}, got {value!r:.60} "
+            f"({type(value).__name__})"
+        )
+    return Path(value)
+
+
+def check_not_masked(values, name: str) -> None:
+    """ControlError naming ``name`` for a numpy masked array: converted, its mask would be read
+    as data."""
+    if isinstance(values, np.ma.MaskedArray):
+        raise ControlError(
+            f"{name} is a masked array: give NaN for missing samples ({name}.filled(np.nan))"
+        )
+
+
 def float_array(values, name: str) -> np.ndarray:
     """``values`` as a new float array; ControlError naming ``name`` unless they are real
-    numbers (ints or floats: not bools, strings such as "1.5", complex numbers or objects;
-    ``roadgen.checks.real_array`` with control's error). NaN and inf pass."""
+    numbers (ints or floats: not bools, strings such as "1.5", complex numbers, objects or a
+    masked array; ``roadgen.checks.real_array`` with control's error). NaN and inf pass."""
+    check_not_masked(values, name)
     return checks.real_array(name, values, ControlError)
 
 

@@ -35,6 +35,7 @@ from control.errors import BagError, ControlError
 from control.robot import messages as msgs
 from control.robot import storage as storage_mod
 from control.robot.extra import require
+from control.validation import float_array, path_argument
 
 STORAGES = ("mcap", "sqlite3")
 
@@ -165,12 +166,7 @@ def _resolve(path: Path) -> tuple[Path, str]:
 def recording_path(value, name: str = "path") -> Path:
     """``value`` (a str or `os.PathLike`, not empty) as a Path; `ControlError` naming the
     argument ``name`` for anything else (None, a number, ...)."""
-    if not isinstance(value, str | os.PathLike) or not str(value):
-        raise ControlError(
-            f"{name} must be the path (a str or os.PathLike) of a ROS 2 bag folder, a *.mcap "
-            f"file or a ROS 1 *.bag, got {value!r} ({type(value).__name__})"
-        )
-    return Path(value)
+    return path_argument(value, name, " of a ROS 2 bag folder, a *.mcap file or a ROS 1 *.bag")
 
 
 def read_recording(
@@ -519,15 +515,10 @@ MAX_LOG_NS = 2**63
 """A bag's receive times are int64 ns."""
 
 
-def to_ns(t) -> np.ndarray:
-    """Times in seconds as int nanoseconds (rounded to the nearest)."""
-    return np.rint(np.asarray(t, dtype=float) * 1e9).astype(np.int64)
-
-
 def stamps_ns(name: str, t, limit: int = MAX_STAMP_NS, offset_ns: int = 0) -> np.ndarray:
     """Times ``t`` (s, 1-D) as int64 ns plus ``offset_ns``; `ControlError` naming ``name``
     unless every one is a finite number that lands in [0, ``limit``) ns."""
-    arr = _floats(name, np.atleast_1d(t) if t is not None else t)
+    arr = np.atleast_1d(float_array(t, name))
     if arr.ndim != 1:
         raise ControlError(f"{name} must be 1-D (times in s), got shape {arr.shape}")
     with np.errstate(invalid="ignore", over="ignore"):
@@ -542,21 +533,8 @@ def stamps_ns(name: str, t, limit: int = MAX_STAMP_NS, offset_ns: int = 0) -> np
     return ns.astype(np.int64) + np.int64(offset_ns)
 
 
-def _floats(name: str, value) -> np.ndarray:
-    """``value`` as a float array; `ControlError` naming ``name`` for what is not numbers."""
-    try:
-        return np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ControlError(f"{name} must hold real numbers, got {_brief(value)}") from exc
-
-
-def _brief(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _vectors(name: str, a, n: int, axis: str = "x") -> np.ndarray:
-    a = _floats(name, a)
+    a = float_array(a, name)
     if a.ndim == 1:
         if a.size != n:
             raise ControlError(f"{name} must have length {n}, got {a.size}")

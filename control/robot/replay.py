@@ -56,7 +56,7 @@ from control.robot.bags import (
 )
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
-from control.validation import require_instance, require_reals
+from control.validation import path_argument, require_instance, require_reals
 from gpmsa.io.atomic import atomic_write
 
 TIME_BASES = ("header", "log")
@@ -472,9 +472,7 @@ def _check_outputs(bag: Path, csv, out_bag) -> tuple[Path | None, Path | None]:
         if value is None:
             paths.append(None)
             continue
-        if not isinstance(value, str | os.PathLike) or not str(value):
-            raise ControlError(f"{name} must be a path (a str or os.PathLike), got {value!r}")
-        path = Path(value)
+        path = path_argument(value, name)
         target, source = path.resolve(), bag.resolve()
         if target == source or source in target.parents:
             raise ControlError(f"{name}={str(path)!r} would overwrite the recording {str(bag)!r}")

@@ -195,9 +195,9 @@ def fit(
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),
-        "backend_options": {k: _recorded_option(v) for k, v in sorted(options.items())
+        "backend_options": {k: r for k, v in sorted(options.items())
                             if k not in ("n_jobs", "executor")  # not where they ran
-                            and _recorded_option(v) is not _UNRECORDED},
+                            and (r := _recorded_option(v)) is not _UNRECORDED},
         "mean_basis": None if problem.mean_basis is None else problem.mean_basis.kind,
         "fixed": {k: problem.init[k].tolist() for k in sorted(problem.fixed)},
         "constraint": constraint is not None,

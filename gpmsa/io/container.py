@@ -23,7 +23,8 @@ import stat
 import struct
 import zipfile
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -518,16 +519,27 @@ def stored_format(path: str | Path) -> str | None:
     if not path.exists():
         return None
     try:
-        fh, size = _open_regular(path)
-        with fh:
-            _check_directory(fh, size, path)
-            fh.seek(0)
-            with zipfile.ZipFile(fh) as zf:
-                members = _check_members(zf, path)
-                raw = bytes(_read_member(zf, members[MANIFEST], path))
+        with _opened(path) as (zf, members):
+            raw = bytes(_read_member(zf, members[MANIFEST], path))
         return _parse_manifest(raw, path, (FORMAT, STUDY_FORMAT))["format"]
     except Exception:  # any damage: not a gpmsa file that can be told apart
         return None
+
+
+@contextmanager
+def _opened(path: Path) -> Iterator[tuple[zipfile.ZipFile, dict[str, zipfile.ZipInfo]]]:
+    """The zip at ``path`` and its checked members (``read_raw``'s steps 1-3: a regular file
+    within the size limit, its directory, then its members), open for reading."""
+    fh, size = _open_regular(path)
+    with fh:
+        _check_directory(fh, size, path)
+        fh.seek(0)
+        try:
+            zf = zipfile.ZipFile(fh)
+        except Exception as exc:  # zipfile raises many types on hostile bytes
+            raise _fail(path, f"not a gpmsa emulator file (not a readable zip: {exc})") from exc
+        with zf:
+            yield zf, _check_members(zf, path)
 
 
 def read_raw(
@@ -546,30 +558,21 @@ def read_raw(
     EmulatorFileError naming the problem.
     """
     path = check_path(path)
-    fh, size = _open_regular(path)
-    with fh:
-        _check_directory(fh, size, path)
-        fh.seek(0)
-        try:
-            zf = zipfile.ZipFile(fh)
-        except Exception as exc:  # zipfile raises many types on hostile bytes
-            raise _fail(path, f"not a gpmsa emulator file (not a readable zip: {exc})") from exc
-        with zf:
-            members = _check_members(zf, path)
-            raw = bytes(_read_member(zf, members[MANIFEST], path))
-            manifest = _parse_manifest(raw, path, formats)
-            specs = manifest["arrays"]
-            npy = {n[len(ARRAY_DIR) : -4]: info for n, info in members.items() if n != MANIFEST}
-            _check_specs(specs, npy, path)
-            if check is not None:
-                try:
-                    check(manifest)
-                except EmulatorFileError as exc:
-                    raise _fail(path, str(exc)) from exc
-            arrays = {
-                name: _load_array(_read_member(zf, info, path), name, specs[name], path)
-                for name, info in npy.items()
-            }
+    with _opened(path) as (zf, members):
+        raw = bytes(_read_member(zf, members[MANIFEST], path))
+        manifest = _parse_manifest(raw, path, formats)
+        specs = manifest["arrays"]
+        npy = {n[len(ARRAY_DIR) : -4]: info for n, info in members.items() if n != MANIFEST}
+        _check_specs(specs, npy, path)
+        if check is not None:
+            try:
+                check(manifest)
+            except EmulatorFileError as exc:
+                raise _fail(path, str(exc)) from exc
+        arrays = {
+            name: _load_array(_read_member(zf, info, path), name, specs[name], path)
+            for name, info in npy.items()
+        }
     if content_hash(arrays, manifest) != manifest["content_sha256"]:
         raise _fail(
             path, "content hash mismatch: the file was edited or damaged after it was written"

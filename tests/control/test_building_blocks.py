@@ -62,10 +62,13 @@ def test_spikes_keep_their_spacing_and_sign_across_batches():
     assert spikes.size == 200 and set(np.sign(whole[spikes[:4]])) == {-1.0, 1.0}
     with pytest.raises(ControlError, match="must have one length, got 10, 5, 10 and 10"):
         inject(t[:10], t[:5], a[:10], np.ones(10))
-    with pytest.raises(ControlError, match=r"t must be 1-D, got shape \(\)"):
+    with pytest.raises(ControlError, match=r"t must be an array of real numbers, got dtype object"):
         inject(None, None, None, None)
-    with pytest.raises(ControlError, match="accel must be a 1-D sequence of real numbers"):
+    text = r"accel must be an array of real numbers, got dtype <U1"
+    with pytest.raises(ControlError, match=text):
         inject(t[:2], t[:2], ["a", "b"], np.ones(2))
+    with pytest.raises(ControlError, match=r"t must be 1-D, got shape \(2, 1\)"):
+        inject(t[:2, None], t[:2], a[:2], np.ones(2))
 
 
 def test_feature_functions_take_finite_real_samples_only():
@@ -114,7 +117,8 @@ def test_run_closed_loop_names_a_record_or_flag_of_the_wrong_type(emulator_a):
     import roadgen
 
     track = roadgen.track([(10.0, 300.0)], seed=0)
-    for kw, match in (({"record": 5}, "record must be a path"),
+    record = r"record must be the path \(a str or os.PathLike\) of the \.mcap"
+    for kw, match in (({"record": 5}, record),
                       ({"check": "no"}, "check must be True or False"),
                       ({"progress": "yes"}, "progress must be True or False")):  # fmt: skip
         with pytest.raises(ControlError, match=match):
