@@ -112,9 +112,7 @@ def check_emulator(
             f"model must be a vehicle model (e.g. vehicle.Jackal()), got {model!r:.60}"
         )
     if noise_std is not None and not (is_real(noise_std) and 0 <= noise_std < np.inf):
-        raise ControlError(
-            f"noise_std must be a finite real number >= 0, m/s^2, got {noise_std!r}"
-        )
+        raise ControlError(f"noise_std must be a finite real number >= 0, m/s^2, got {noise_std!r}")
     if bcr is not None:
         check_instance(bcr, "bcr", BCRSettings)
     if track is not None and not hasattr(track, "segments"):

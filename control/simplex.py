@@ -228,7 +228,8 @@ class SimplexRun:
             "safety",
             np.nan,
             f"latched by an estimate of status {first.status!r} at {first.time:.2f} s"
-            + (f" ({first.reason})" if first.reason else "") + "; reset() to resume",
+            + (f" ({first.reason})" if first.reason else "")
+            + "; reset() to resume",
         )
 
     def _latches(self, estimate: Estimate) -> bool:

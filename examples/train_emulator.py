@@ -408,8 +408,16 @@ def main(argv: list[str] | None = None) -> None:
     if args.n_runs < min_runs:
         why = "gpmsa.SimData's minimum and --n-pc" if band else "gpmsa.SimData's minimum"
         parser.error(f"--n-runs must be >= {min_runs} ({why}), got {args.n_runs}")
-    needs = [(2 * BATCH * args.block_samples / RATE_HZ,
-              f"band emulators: two batches of {BATCH} blocks of --block-samples")] if band else []
+    needs = (
+        [
+            (
+                2 * BATCH * args.block_samples / RATE_HZ,
+                f"band emulators: two batches of {BATCH} blocks of --block-samples",
+            )
+        ]
+        if band
+        else []
+    )
     if "window" in args.features:
         needs.append((PAPER_WINDOW.block_samples / RATE_HZ, "the window emulators' window"))
     min_keep_s, why = max(needs)

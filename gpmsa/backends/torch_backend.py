@@ -270,6 +270,7 @@ def _factor_scaled(
     trtrs = lapack.dtrtrs if corr.dtype == torch.float64 else lapack.strtrs
     alpha = np.zeros((c_n, j_n, m), dtype=cr.dtype)
     ll = np.full((c_n, j_n), -np.inf)
+
     def views(a_: np.ndarray) -> tuple[np.ndarray, list, np.ndarray]:
         """a_'s transpose (LAPACK's view), its row blocks and its diagonal."""
         return a_.T, [(a_[a:b, :b], rows) for a, b, rows in blocks], a_.reshape(-1)[:: m + 1]
@@ -684,8 +685,10 @@ def sample(
 
 def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_threads) -> dict:
     """``sample``'s placement of the sampling phase: {"groups", "n_jobs", "executor"}."""
-    if isinstance(chain_groups, bool) or not isinstance(chain_groups, (int, np.integer)) or not (
-        1 <= chain_groups <= n_chains
+    if (
+        isinstance(chain_groups, bool)
+        or not isinstance(chain_groups, (int, np.integer))
+        or not (1 <= chain_groups <= n_chains)
     ):
         raise GPMSAError(
             f"chain_groups must be an integer in [1, n_chains={n_chains}], got {chain_groups!r}"

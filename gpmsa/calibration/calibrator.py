@@ -191,8 +191,10 @@ class Calibrator:
         opts = self.mcmc_options
         backend = opts.get("backend", backend)
         if backend != "numpy":
-            for what, given in (("constraint", opts.get("constraint") is not None),
-                                ("emulator_params='draws'", self.emulator_params == "draws")):
+            for what, given in (
+                ("constraint", opts.get("constraint") is not None),
+                ("emulator_params='draws'", self.emulator_params == "draws"),
+            ):
                 if given:
                     raise GPMSAError(f"{what} needs backend='numpy', got backend={backend!r}")
         if self.emulator_params == "draws" and opts.get("fast") is False:

@@ -141,9 +141,7 @@ def _checked_samples(samples) -> dict[str, np.ndarray]:
     return out
 
 
-def _checked_chains(
-    chains, samples: dict[str, np.ndarray] | None
-) -> dict[str, np.ndarray] | None:
+def _checked_chains(chains, samples: dict[str, np.ndarray] | None) -> dict[str, np.ndarray] | None:
     """``chains`` as name -> float draws (n_chains, n_draws) for every parameter of the
     posterior (the names of ``samples``; None: not known yet), each the samples of that name
     split into chains, or None; GPMSAError naming what is wrong."""

@@ -155,6 +155,8 @@ def _convergence_line(rec: object) -> str:
                        f"{number(rec.get('ess_min'), '.0f')})")  # fmt: skip
     if not isinstance(flagged, dict):
         return head + "NOT converged: " + value(flagged)
-    return head + "NOT converged: " + "; ".join(
-        f"{safe(k, 60)}: {plain(v)}" for k, v in flagged.items()
+    return (
+        head
+        + "NOT converged: "
+        + "; ".join(f"{safe(k, 60)}: {plain(v)}" for k, v in flagged.items())
     )

@@ -117,8 +117,10 @@ def test_plot_counts_and_flags_are_checked():
     held_out = gpmsa.SimData(x=x[:5], t=t[:5], y=(x + t)[:5], x_names=["x"], t_names=["t"])
     with pytest.raises(GPMSAError, match="draws must be"):
         gpmsa.plots.emulator_fit(emu, held_out, draws="no")
-    for call in (lambda: gpmsa.plots.emulator_fit(emu, held_out, draws=False, n_draws=-1),
-                 lambda: gpmsa.sensitivity(emu, draws=False, n_draws=0),
-                 lambda: gpmsa.emulator_prediction(emu, [[0.5]], [[0.5]], draws=False, n_draws=-5)):
+    for call in (
+        lambda: gpmsa.plots.emulator_fit(emu, held_out, draws=False, n_draws=-1),
+        lambda: gpmsa.sensitivity(emu, draws=False, n_draws=0),
+        lambda: gpmsa.emulator_prediction(emu, [[0.5]], [[0.5]], draws=False, n_draws=-5),
+    ):
         with pytest.raises(GPMSAError, match="n_draws must be an integer >= 1"):
             call()

@@ -27,8 +27,15 @@ def test_the_example_runs_and_sharing_pins_the_density(tmp_path, capsys):
     st = load_script()
     summary = st.main(["--out", str(tmp_path), "--n-iter", "800"])
     assert "shared (emulators fixed)" in capsys.readouterr().out
-    for name in ("posterior_E_rho.png", "pairs_E_rho.png", "traces.png", "summary.json",
-                 "beam_study.gpmsa", "beam_study.static.gpmsa", "beam_study.modal.gpmsa"):
+    for name in (
+        "posterior_E_rho.png",
+        "pairs_E_rho.png",
+        "traces.png",
+        "summary.json",
+        "beam_study.gpmsa",
+        "beam_study.static.gpmsa",
+        "beam_study.modal.gpmsa",
+    ):
         assert (tmp_path / name).stat().st_size > 0, name
     post = json.loads((tmp_path / "summary.json").read_text())["posterior"]
     assert post == json.loads(json.dumps(summary["posterior"]))

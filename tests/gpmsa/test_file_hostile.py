@@ -570,9 +570,7 @@ def test_a_manifest_key_given_twice_is_a_file_error(saved, tmp_path):
     assert main(["info", str(path)]) == 2
 
 
-def test_a_design_width_beyond_float64_and_array_names_with_a_newline_are_refused(
-    saved, tmp_path
-):
+def test_a_design_width_beyond_float64_and_array_names_with_a_newline_are_refused(saved, tmp_path):
     manifest, arrays = read_members(saved["scalar"])
     wide = {**arrays, "t_min": np.array([-1e308]), "t_max": np.array([1e308])}
     path = write_members(tmp_path / "wide.gpmsa", manifest, wide)
@@ -599,8 +597,11 @@ def test_saving_keeps_permissions_writes_through_links_and_takes_long_names(emu,
 def test_an_observation_too_large_for_the_basis_is_named_and_cli_json_is_strict(vec_emu):
     y = np.full((1, 6), 0.5)
     y[0, 0] = 1e308  # finite, but its projection on the basis overflows
-    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs lies .* standard deviations of the "
-                                               r"simulation outputs .*wrong units"):
+    with pytest.raises(
+        gpmsa.GPMSAError,
+        match=r"y_obs lies .* standard deviations of the "
+        r"simulation outputs .*wrong units",
+    ):
         gpmsa.Calibrator(vec_emu).update([[0.5]], y)
     out = container.jsonable({"sd": float("inf"), "q": [np.float64("nan"), 1.0], "n": 3})
     assert json.loads(json.dumps(out, allow_nan=False)) == {"sd": None, "q": [None, 1.0], "n": 3}

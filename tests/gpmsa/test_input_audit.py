@@ -131,8 +131,11 @@ def test_a_study_is_not_saved_over_another_studys_model_file(tmp_path):
     label = gpmsa.load_study(first).labels[0]
     member = tmp_path / f"beam.{label}.gpmsa"
     assert member.exists()
-    with pytest.raises(GPMSAError, match=rf"refusing to write .*beam\.{label}\.gpmsa: it holds an "
-                                         r"emulator file \(another study's model\?\)"):
+    with pytest.raises(
+        GPMSAError,
+        match=rf"refusing to write .*beam\.{label}\.gpmsa: it holds an "
+        r"emulator file \(another study's model\?\)",
+    ):
         _study(2.0).save(member)
     # a study file at "x.m0.gpmsa" would be replaced by model m0 of a study saved at "x.gpmsa"
     other = tmp_path / "plate.gpmsa"

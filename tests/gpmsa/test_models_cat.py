@@ -219,8 +219,12 @@ def test_mean_basis_recovers_a_linear_trend_better(tmp_path):
 
 
 def test_callable_mean_basis_cannot_be_saved(tmp_path):
-    emu = gpmsa.fit(_trend_data(), n_iter=50, seed=1,
-                    mean_basis=lambda z: np.column_stack([np.ones(len(z)), z[:, 0]]))
+    emu = gpmsa.fit(
+        _trend_data(),
+        n_iter=50,
+        seed=1,
+        mean_basis=lambda z: np.column_stack([np.ones(len(z)), z[:, 0]]),
+    )
     assert emu.predict([[0.5]], [[0.5]])[0].shape == (1, 1)
     with pytest.raises(gpmsa.GPMSAError, match="callable mean_basis cannot be saved"):
         emu.save(tmp_path / "x.gpmsa")

@@ -101,8 +101,9 @@ def test_grid_priors_have_the_grids_shape():
     table = np.zeros((9, 9))
     table[:, :4] = -50.0  # the second parameter's low half unlikely: rows are the first
     post = cal.update([[0.5]], [[0.5]], prior=table)
-    np.testing.assert_allclose(post.mean("w"),
-                               cal.update([[0.5]], [[0.5]], prior=table.reshape(-1)).mean("w"))
+    np.testing.assert_allclose(
+        post.mean("w"), cal.update([[0.5]], [[0.5]], prior=table.reshape(-1)).mean("w")
+    )
     assert post.mean("w") > 0.5
     with pytest.raises(GPMSAError, match=r"of shape \(81,\) or \(9, 9\) .*got \(81, 1\)"):
         cal.update([[0.5]], [[0.5]], prior=table.reshape(81, 1))
@@ -195,8 +196,9 @@ def test_callables_keep_several_chains_in_this_process():
     obs = gpmsa.ObsData(x=[[0.2], [0.5]], y=[[0.9], [1.1]])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a short fit: not converged
-        emu = gpmsa.fit(sim, obs, n_iter=20, n_chains=2, seed=0,
-                        constraint=lambda th: bool(th[0] + th[1] < 1.2))  # a lambda: no pickle
+        emu = gpmsa.fit(
+            sim, obs, n_iter=20, n_chains=2, seed=0, constraint=lambda th: bool(th[0] + th[1] < 1.2)
+        )  # a lambda: no pickle
     assert np.all(emu.calibration["theta_native"].sum(axis=1) < 1.2)
     with pytest.raises(GPMSAError, match="callables of this process: they cannot go to executor"):
         from concurrent.futures import ThreadPoolExecutor
@@ -217,8 +219,7 @@ def test_a_categorical_theta_start_is_a_level_the_end_levels_included():
                            n_burn=10, seed=0)  # fmt: skip
     assert set(np.unique(post.samples["t0"])) == {1.0}
     with pytest.raises(GPMSAError, match=r"t0 must be one of its training levels \[0, 1\], got"):
-        gpmsa.calibrate(emu, xo, yo, constraint=not_zero, theta_init=[0.9], n_samples=60,
-                        n_burn=10)
+        gpmsa.calibrate(emu, xo, yo, constraint=not_zero, theta_init=[0.9], n_samples=60, n_burn=10)
 
 
 def test_study_labels_and_per_model_errors_name_the_model():

@@ -126,8 +126,10 @@ def test_hierarchical_intervals_cover_at_the_nominal_rate(hyper, mu_floor):
     n_sets = 20
     hit_theta, hit_mu, _ = coverage(np.random.default_rng(2024), 6, 0.12, n_sets, hyper, 100)
     rate_theta, rate_mu = np.mean(hit_theta), np.mean(hit_mu)
-    print(f"coverage of 90% intervals: theta_i {rate_theta:.3f} ({len(hit_theta)}), "
-          f"mu {rate_mu:.3f} ({n_sets})")
+    print(
+        f"coverage of 90% intervals: theta_i {rate_theta:.3f} ({len(hit_theta)}), "
+        f"mu {rate_mu:.3f} ({n_sets})"
+    )
     # 120 theta intervals: binomial sd 0.027 at 0.9 (more with the within-set correlation)
     assert 0.8 <= rate_theta <= 0.98
     assert rate_mu >= mu_floor  # 20 intervals: binomial sd 0.067

@@ -101,8 +101,9 @@ def test_a_track_of_many_segments_costs_o_n_and_matches_the_running_sum():
             t = np.clip((x - start) / blend + 0.5, 0.0, 1.0)
             reference += step * 0.5 * (1.0 - np.cos(np.pi * t))
         np.testing.assert_array_equal(_amplitude(x, starts, amps, blend), reference)
-    many = roadgen.track([(1.0, 300.0 + 200.0 * (i % 2)) for i in range(3000)], seed=0,
-                         lead_in_m=0.5)
+    many = roadgen.track(
+        [(1.0, 300.0 + 200.0 * (i % 2)) for i in range(3000)], seed=0, lead_in_m=0.5
+    )
     assert many.gd_at(1500.5) == 300.0 and many.length_m == pytest.approx(3000.0)
 
 
