@@ -135,10 +135,21 @@ class Estimate:
             value = getattr(self, name)
             if not is_real(value):
                 raise ControlError(f"{name} must be a real number (NaN: none), got {value!r}")
+        self._check_interval()
         if self.domain_edge not in ("", *DOMAIN_EDGES):
             raise ControlError(
                 f"domain_edge must be '' or one of {DOMAIN_EDGES}, got {self.domain_edge!r}"
             )
+
+    def _check_interval(self) -> None:
+        """ControlError unless ``interval`` is a pair (lo, hi) of real numbers with lo <= hi, or
+        a pair of NaNs."""
+        pair = self.interval
+        if not (isinstance(pair, tuple | list) and len(pair) == 2 and all(map(is_real, pair))):
+            raise ControlError(f"interval must be a pair (lo, hi) of real numbers, got {pair!r}")
+        lo, hi = float(pair[0]), float(pair[1])
+        if np.isnan(lo) != np.isnan(hi) or lo > hi:
+            raise ControlError(f"interval must have lo <= hi (or be two NaNs), got {pair!r}")
 
     @property
     def ok(self) -> bool:

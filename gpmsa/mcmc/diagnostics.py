@@ -25,10 +25,17 @@ def to_inference_data(draws: dict[str, np.ndarray], log_post: np.ndarray | None 
         return az.from_dict(posterior=dict(draws), sample_stats=sample_stats)
 
 
+MIN_DRAWS_ESS = 4
+"""Fewest draws per chain for which ArviZ computes an ESS (it logs a shape error below)."""
+MIN_DRAWS_RHAT = 8
+"""Fewest draws per chain for a split R-hat (each half needs 4)."""
+
+
 def ess(x: np.ndarray) -> float:
-    """Bulk effective sample size of x (n_chains, n_draws) (rank-normalised, as ArviZ)."""
-    x = np.asarray(x, dtype=np.float64)
-    if np.ptp(x) == 0:
+    """Bulk effective sample size of x (n_chains, n_draws) (rank-normalised, as ArviZ); NaN for
+    constant draws or fewer than MIN_DRAWS_ESS per chain."""
+    x = np.atleast_2d(np.asarray(x, dtype=np.float64))
+    if np.ptp(x) == 0 or x.shape[1] < MIN_DRAWS_ESS:
         return float("nan")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -45,7 +52,7 @@ def hdi(x: np.ndarray, level: float) -> tuple[float, float]:
 def rhat(x: np.ndarray) -> float:
     """Rank-normalised split R-hat of x (n_chains, n_draws); one chain is split in two."""
     x = np.atleast_2d(np.asarray(x, dtype=np.float64))
-    if np.ptp(x) == 0 or x.shape[1] < 8:
+    if np.ptp(x) == 0 or x.shape[1] < MIN_DRAWS_RHAT:
         return float("nan")
     if x.shape[0] == 1:
         half = x.shape[1] // 2
@@ -61,14 +68,17 @@ def summarize(
     """Per parameter and element (flattened, C order): mean, sd, ESS, R-hat, acceptance.
 
     ``draws``: name -> (n_chains, n_draws, *shape) after burn-in; ``accept_rate``: name ->
-    (n_chains, *shape). JSON-able (lists of floats; NaN for constant chains).
+    (n_chains, *shape). JSON-able (lists of floats; NaN for constant chains, and an sd of NaN
+    from a single draw).
     """
     out = {}
     for name, d in draws.items():
         flat = d.reshape(d.shape[0], d.shape[1], -1)
+        n_total = flat.shape[0] * flat.shape[1]
+        sd = flat.std(axis=(0, 1), ddof=1) if n_total > 1 else np.full(flat.shape[2], np.nan)
         entry = {
             "mean": [float(v) for v in flat.mean(axis=(0, 1))],
-            "sd": [float(v) for v in flat.std(axis=(0, 1), ddof=1)],
+            "sd": [float(v) for v in sd],
             "ess": [ess(flat[:, :, i]) for i in range(flat.shape[2])],
             "rhat": [rhat(flat[:, :, i]) for i in range(flat.shape[2])],
         }
@@ -105,7 +115,8 @@ def convergence(
     ``shapes``: name -> element shape of every sampled parameter to judge. Returns n_chains,
     n_draws (per chain), the limits, per parameter ``rhat`` and ``ess`` (bulk) lists (C order),
     the worst element of each kind, and ``flagged``: element -> reason, for every element with
-    R-hat > RHAT_MAX, ESS < ESS_MIN, or no movement at all (constant draws: NaN R-hat and ESS).
+    R-hat > RHAT_MAX, ESS < ESS_MIN, no movement at all (constant draws: NaN R-hat and ESS), or
+    too few draws to judge (fewer than MIN_DRAWS_ESS a chain).
     """
     rhat_of, ess_of, flagged = {}, {}, {}
     worst_r, worst_e = ("", -np.inf), ("", np.inf)
@@ -115,6 +126,9 @@ def convergence(
         for el, r, e in zip(element_names(name, shape), rs, es, strict=True):
             r = float("nan") if r is None else float(r)
             e = float("nan") if e is None else float(e)
+            if n_draws < MIN_DRAWS_ESS:
+                flagged[el] = f"too few draws to judge ({n_draws} a chain)"
+                continue
             if not (np.isfinite(r) or np.isfinite(e)):
                 flagged[el] = "constant draws (no proposal accepted)"
                 continue

@@ -136,6 +136,10 @@ def test_an_estimate_names_a_status_or_edge_it_does_not_know():
         Estimate(time=0.0, position=0.0, status="bogus")
     with pytest.raises(ControlError, match="domain_edge must be '' or one of .*got 'top'"):
         Estimate(time=0.0, position=0.0, status="ok", domain_edge="top")
+    for pair in ((300.0,), (300.0, "400"), 300.0, (300.0, 200.0), (np.nan, 300.0)):
+        with pytest.raises(ControlError, match=r"interval must (be a pair|have lo <= hi)"):
+            Estimate(time=0.0, position=0.0, status="ok", interval=pair)
+    assert Estimate(time=0.0, position=0.0, status="ok", interval=(250.0, 350.0)).interval
 
 
 def test_the_simplex_and_the_recorder_name_an_argument_of_the_wrong_kind(tmp_path):

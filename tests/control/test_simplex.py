@@ -58,6 +58,8 @@ def test_switch_law_is_two_speeds():
     s = Simplex(law="switch")
     assert s.command(gaussian_estimate(340, 2)).speed == 2.0
     assert s.command(gaussian_estimate(360, 2)).speed == 1.0
+    with pytest.raises(ControlError, match=r"kp has no effect with law='switch'"):
+        Simplex(law="switch", kp=0.01)  # it was ignored
 
 
 def test_any_fault_means_safety_mode():

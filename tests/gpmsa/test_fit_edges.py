@@ -74,3 +74,19 @@ def test_one_point_may_be_given_as_a_vector_of_its_inputs():
     np.testing.assert_array_equal(emu.predict([[0.5]], [0.5, 0.2])[0], row[0])
     with pytest.raises(GPMSAError, match=r"t must have 2 columns, got shape \(3,\)"):
         emu.predict([[0.5]], [0.5, 0.2, 0.1])
+
+
+def test_one_kept_draw_gives_nan_spreads_without_numpy_or_arviz_noise(data, monkeypatch):
+    stats_utils = pytest.importorskip("arviz.stats.stats_utils")
+    logged = []  # ArviZ's own logger (it does not propagate): "Shape validation failed"
+    monkeypatch.setattr(stats_utils._log, "warning", lambda msg, *a, **k: logged.append(msg))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # numpy's "Degrees of freedom <= 0"
+        emu = gpmsa.fit(data, n_iter=20, n_burn=19, seed=1, progress=False)
+    assert emu.n_draws == 1
+    assert all(np.isnan(v) for entry in emu.diagnostics.values() for v in entry["sd"])
+    with pytest.warns(gpmsa.ConvergenceWarning) as record:
+        gpmsa.fit(data, n_iter=20, n_burn=19, n_chains=2, n_jobs=1, seed=1, progress=False)
+    assert logged == []
+    message = str(record[0].message)
+    assert "too few draws to judge (1 a chain)" in message and "constant draws" not in message
