@@ -285,10 +285,7 @@ def run_closed_loop(
     bar = tqdm(total=round(float(track.length_m)), unit="m", disable=not progress, leave=False)
     while not sim.finished:
         if sim.time > limit:
-            raise ControlError(
-                f"the vehicle stood or crawled: {sim.position:.1f} of {track.length_m:.1f} m "
-                f"after {sim.time:.0f} s (max_time_s = {limit:g})"
-            )
+            raise ControlError(_timeout_message(sim, track, simplex, limit))
         samples = sim.advance(dt, command.speed)
         if len(samples) == 0:
             break
@@ -365,3 +362,14 @@ def run_closed_loop(
     if record is not None:
         record_run(result, record)
     return result
+
+
+def _timeout_message(sim, track, simplex: Simplex, limit: float) -> str:
+    """Why a run passed its time limit ``limit`` (s): a limit shorter than the drive at v_max, or
+    a vehicle that stood or crawled."""
+    fastest = float(track.length_m) / simplex.v_max
+    where = f"{sim.position:.1f} of {track.length_m:.1f} m after {sim.time:.3g} s"
+    if limit < fastest:
+        return (f"max_time_s = {limit:g} s ended the run at {where}: the track takes at least "
+                f"{fastest:.3g} s at v_max")  # fmt: skip
+    return f"the vehicle stood or crawled: {where} (max_time_s = {limit:g})"

@@ -128,7 +128,7 @@ class Simplex:
         if self.law not in LAWS:
             raise ControlError(f"law must be one of {LAWS}, got {self.law!r}")
         if self.law == "switch" and self.kp is not None:
-            raise ControlError("kp has no effect with law='switch' (v_max or v_safe); leave it None")
+            raise ControlError("kp has no effect with law='switch' (v_max or v_safe): leave it")
         if not (np.isfinite(self.speed_step_mps) and 0 <= self.speed_step_mps <= self.v_max):
             raise ControlError(
                 f"speed_step_mps must lie in [0, v_max] = [0, {self.v_max:g}], "

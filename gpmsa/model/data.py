@@ -292,7 +292,15 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
             raise GPMSAError(f"design column {label} spans [{col.min()}, {col.max()}]: its width "
                              "overflows float64; rescale it (e.g. other units)")  # fmt: skip
         if span[j] <= 1e-12 * float(np.abs(col).max()):  # relative: small units are fine
-            raise GPMSAError(f"design column {label} is constant ({col[0]}); every input must vary")
+            if span[j] == 0:
+                raise GPMSAError(
+                    f"design column {label} is constant ({col[0]}); every input must vary"
+                )
+            raise GPMSAError(
+                f"design column {label} varies by only {span[j]:.3g} around {col.mean():.6g} "
+                "(within 1e-12 of its size, near float64's resolution there); subtract an "
+                "offset or rescale it"
+            )
 
 
 @dataclass(frozen=True, eq=False)

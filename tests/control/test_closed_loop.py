@@ -237,6 +237,8 @@ def test_arguments_are_checked_before_the_drive(emulator_a, likelihood_a, tmp_pa
             run_closed_loop(track, emulator_a, likelihood=likelihood_a, **kwargs)
     with pytest.raises(vehicle.VehicleError, match="model='jackal' is not allowed"):
         run_closed_loop(track, emulator_a, model="jackal")
+    with pytest.raises(ControlError, match=r"max_time_s = 0.001 s ended the run .* at least 10 s"):
+        run_closed_loop(track, emulator_a, likelihood=likelihood_a, max_time_s=1e-3)
 
 
 def test_a_likelihood_prepared_for_another_emulator_is_refused(emulator_a):

@@ -342,3 +342,5 @@ def test_a_design_column_in_small_units_varies():
         np.testing.assert_allclose(emus[0].params[name], emus[1].params[name], rtol=1e-9)
     with pytest.raises(gpmsa.GPMSAError, match=r"design column k is constant \(1e-14\)"):
         gpmsa.SimData(x=x, t=np.full((40, 1), 1e-14), y=y, t_names=["k"])
+    with pytest.raises(gpmsa.GPMSAError, match=r"k varies by only 1 around 1e\+15 .*offset"):
+        gpmsa.SimData(x=x, t=x + 1e15, y=y, t_names=["k"])  # was "constant (1e15)"
