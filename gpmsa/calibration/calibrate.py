@@ -27,6 +27,7 @@ from gpmsa.calibration.observations import (
     check_emulator,
     check_log_prior,
     check_x,
+    check_y,
     emulator_param_sets,
     fit_of,
     fixed_gp,
@@ -45,7 +46,7 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
-from gpmsa.model.data import ObsData, as_float, check_count, check_flag, check_seed
+from gpmsa.model.data import ObsData, check_count, check_flag, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
@@ -68,7 +69,7 @@ def calibration_problem(
         start = lamos_start(fit, data.lamos)
     else:
         x, _ = check_x(emulator, x_obs, extrapolate)
-        y = as_float(y_obs, "y_obs")
+        y = check_y(emulator, y_obs)
         if emulator.K.shape[0] == 1 and y.size == x.shape[0]:
             y = y.reshape(-1, 1)
         obs, corr = reduce_obs(
@@ -151,6 +152,8 @@ def calibrate(
         emulator: a gpmsa.Emulator.
         x_obs: (n, p) known inputs of the observations, native units.
         y_obs: (n, l_sim) observed outputs, native units (a scalar output also takes (n,)).
+            A pandas DataFrame (or Series) is read by name, the emulator's x_names / y_names
+            in any order, never by position; a numpy masked array is refused.
         n_samples: sweeps per chain after tuning; n_burn: of these, burned (kept: the rest).
         tune: GPM/SA step-size tuning first (tune_rounds x tune_levels sweeps).
         tune_rounds, tune_levels: the tuning's rounds and candidate widths per element (None:
@@ -160,6 +163,8 @@ def calibrate(
         backend: "numpy" (default), "torch" or "pyro" (``gpmsa.backends.available()``).
         emulator_params: "point" (the emulator's point estimate) or "draws" (the likelihood
             averaged over ``n_emulator_draws`` of its retained draws; numpy fast path only).
+            ``n_emulator_draws`` must be an integer >= 1 in either mode (at most the retained
+            draws are used).
         discrepancy: None (no discrepancy, the default) or a discrepancy basis (generic backends).
         n_chains: independent chains (their kept draws are pooled in ``samples``).
         extrapolate: allow x_obs outside the emulator's x domain (with a warning).
@@ -185,9 +190,11 @@ def calibrate(
 
     Returns:
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
-        native units), "lamOs" (and "betaV", "lamVz" with a discrepancy), and chains per name;
-        ``info["obs_values_sha256"]`` fingerprints the observations (`ObsData.values_digest`),
-        so that ``gpmsa.full_prediction`` refuses other ones with these draws.
+        native units), "lamOs" (and with a discrepancy "betaV", or "betaV[k]" per known input
+        when p > 1, and "lamVz"), and chains per name;
+        ``info["obs_values_sha256"]`` fingerprints the observations
+        (``ObsData.values_digest(emulator.x_names)``: x_obs as a table is read by name), so that
+        ``gpmsa.full_prediction`` refuses other ones with these draws.
     """
     check_emulator(emulator, categorical_theta=True)
     seed = check_seed(seed)
@@ -200,6 +207,7 @@ def calibrate(
     progress = check_flag(progress, "progress")
     backends.get(backend)  # unknown or not installed: a clear error before any work
     tuning_opts = _tuning_options(backend, tune_rounds, tune_levels)
+    n_emulator_draws = check_count(n_emulator_draws, "n_emulator_draws")  # as Calibrator's
     sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
     can_fast = backend == "numpy" and discrepancy is None
     if fast is None:
@@ -380,9 +388,7 @@ def _run_backend(
     theta = std.t_from_unit(np.asarray(chains.draws["theta"]))
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.asarray(chains.draws["lamOs"])[:, :, 0]
-    for name in ("betaV", "lamVz"):
-        if name in chains.draws:
-            draws[name] = np.asarray(chains.draws[name]).reshape(n_chains, n_samples, -1)[..., 0]
+    draws.update(_discrepancy_draws(chains.draws, n_chains, n_samples))
     info = {
         "engine": "backend",
         "backend": backend,
@@ -390,3 +396,20 @@ def _run_backend(
         "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
     }
     return draws, info
+
+
+def _discrepancy_draws(draws: dict, n_chains: int, n_samples: int) -> dict[str, np.ndarray]:
+    """The discrepancy parameters' draws (n_chains, n_samples) under their Posterior names, as
+    ``gpmsa.calibration_posterior`` names a joint fit's: betaV's correlation parameter per
+    known input ("betaV" for one input, "betaV[k]" (k = 0 .. p-1) for more), then "lamVz"
+    (``gpmsa.full_prediction`` reads them so). None of them without a discrepancy."""
+    out = {}
+    if "betaV" in draws:
+        bv = np.asarray(draws["betaV"]).reshape(n_chains, n_samples, -1)
+        if bv.shape[2] == 1:
+            out["betaV"] = bv[..., 0]
+        else:
+            out.update({f"betaV[{k}]": bv[..., k] for k in range(bv.shape[2])})
+    if "lamVz" in draws:
+        out["lamVz"] = np.asarray(draws["lamVz"]).reshape(n_chains, n_samples, -1)[..., 0]
+    return out

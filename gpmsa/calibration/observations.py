@@ -17,9 +17,9 @@ from gpmsa.model.data import (
     ObsData,
     as_float,
     by_column_names,
-    check_count,
     check_finite,
     check_parameter_names,
+    evenly_spaced,
     values_digest,
 )
 from gpmsa.model.problem import MAX_STD_OBS, SIGOBS_RIDGE, ObsProblem, reduce_obs
@@ -79,8 +79,7 @@ def emulator_param_sets(emulator, mode: str, n_sets: int) -> list[dict]:
     n = len(next(iter(draws.values()))) if draws else 0
     if n == 0:
         raise GPMSAError("emulator_params='draws' needs retained draws; this emulator has none")
-    n_sets = check_count(n_sets, "n_emulator_draws")
-    idx = np.unique(np.linspace(0, n - 1, min(n_sets, n)).astype(int))
+    idx = evenly_spaced(n, n_sets, "n_emulator_draws")
     return [{k: np.asarray(draws[k][i]) for k in EMULATOR_PARAMS} for i in idx]
 
 
@@ -135,16 +134,28 @@ def check_x(
     return x, xu
 
 
+def check_y(emulator, y_obs) -> np.ndarray:
+    """y_obs as a float array with its columns in the order of the emulator's ``y_names``: a
+    table with named columns by name (`by_column_names`: other names are a GPMSAError), a pandas
+    Series by its labels (`series_by_names`), an array as it is (by position). A numpy masked
+    array is refused (`as_float`)."""
+    names = getattr(emulator, "y_names", None)
+    names = None if names is None else tuple(names)
+    return as_float(by_column_names(y_obs, names, "y_obs"), "y_obs")
+
+
 def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     """Check and reduce (x_obs, y_obs) for the no-discrepancy model of ``emulator``.
 
-    y_obs: (n, l_sim) on the emulator's output grid (a scalar output takes (n, 1) or (n,)).
+    y_obs: (n, l_sim) on the emulator's output grid (a scalar output takes (n, 1) or (n,)); a
+    table with named columns (a pandas DataFrame) or a pandas Series is read by the emulator's
+    ``y_names`` (`check_y`).
     """
     x, xu = check_x(emulator, x_obs, extrapolate)
     n = x.shape[0]
     std, K = emulator.standardizer, emulator.K
     l_sim = K.shape[0]
-    y = as_float(y_obs, "y_obs")
+    y = check_y(emulator, y_obs)
     if l_sim == 1 and y.ndim == 2 and y.size == n:  # a scalar output as one row (1, n)
         y = y.reshape(n, 1)
     y = _as_rows(y, "y_obs", l_sim)

@@ -106,6 +106,34 @@ class GridMarginal:
         return self.ppf(rng.random(size))
 
 
+def _percent_key(value: float, tolerance: float) -> str:
+    """``value`` in 6 significant digits, more until it prints within ``tolerance`` of itself."""
+    for digits in range(6, 18):
+        key = f"{value:.{digits}g}"
+        if abs(float(key) - value) <= tolerance:
+            break
+    return key
+
+
+def quantile_keys(level: float) -> tuple[str, str]:
+    """``Posterior.summary``'s keys of the ends of the central interval of probability
+    ``level``: "q" and the percentage, 100 (1 -+ level) / 2, in 6 significant digits ("q5",
+    "q95" for 0.9; "q2.5", "q97.5" for 0.95), with more digits where an end needs them to
+    print within 1e-5 of its distance to the nearest of 0, 50 and 100 (e.g. "q49.999995",
+    "q50.000005" for 1e-7; "q5e-07", "q99.9999995" for 0.99999999), so that no two levels'
+    keys collide and no end prints as 0, 50 or 100. GPMSAError for a level so small that its
+    ends are the median in float64 (below about 1e-16)."""
+    lo, hi = 100 * (1 - level) / 2, 100 * (1 + level) / 2
+    tolerance = 1e-5 * min(lo, hi - 50.0)
+    keys = _percent_key(lo, tolerance), _percent_key(hi, tolerance)
+    if tolerance > 0 and keys[0] != keys[1]:
+        return f"q{keys[0]}", f"q{keys[1]}"
+    raise GPMSAError(
+        f"level={level!r} is too small: the ends of its interval, at probabilities "
+        "(1 -+ level) / 2, are both the median (0.5) in float64; give a larger level"
+    )
+
+
 def _named_arrays(value, what: str, kind: str, ndim: int, wrong_shape: str) -> dict:
     """``value`` as name -> finite float arrays of ``ndim`` dimensions, none empty; GPMSAError
     naming ``what`` (a dict name -> ``kind``) and the entry, ``wrong_shape`` (a template with
@@ -164,6 +192,45 @@ def _checked_chains(chains, samples: dict[str, np.ndarray] | None) -> dict[str, 
     return out
 
 
+def _checked_info(info) -> dict:
+    """``info`` as a new dict (None: empty); GPMSAError unless it is a dict with string keys
+    whose "names", where given, is a list of parameter names (strings)."""
+    if info is None:
+        return {}
+    if not isinstance(info, dict):
+        raise GPMSAError(f"info must be a dict (how the posterior was computed), got "
+                         f"{type(info).__name__}")  # fmt: skip
+    if bad := [k for k in info if not isinstance(k, str)]:
+        raise GPMSAError(f"info: keys must be strings, got {bad[0]!r}")
+    names = info.get("names")
+    if names is not None and (
+        isinstance(names, str)
+        or not isinstance(names, list | tuple)
+        or not all(isinstance(n, str) for n in names)
+    ):
+        raise GPMSAError(f"info['names'] must be a list of parameter names (strings), got "
+                         f"{names!r}")  # fmt: skip
+    return dict(info)
+
+
+def _checked_grids(grids, names) -> dict[str, GridMarginal]:
+    """``grids`` as a new dict name -> GridMarginal (None: empty); GPMSAError for anything else,
+    or for a name that is not a parameter of the posterior (``names``; None: not known yet)."""
+    if grids is None:
+        return {}
+    if not isinstance(grids, dict):
+        raise GPMSAError(f"grids must be a dict name -> GridMarginal, got {type(grids).__name__}")
+    for name, grid in grids.items():
+        if not isinstance(name, str):
+            raise GPMSAError(f"grids: parameter names must be strings, got {name!r}")
+        if not isinstance(grid, GridMarginal):
+            raise GPMSAError(f"grids[{name!r}] must be a GridMarginal, got {type(grid).__name__}")
+        if names is not None and name not in names:
+            raise GPMSAError(f"grids[{name!r}] is not a parameter of the posterior, which has "
+                             f"{tuple(names)}")  # fmt: skip
+    return dict(grids)
+
+
 class Posterior:
     """Posterior of a calibration, native units.
 
@@ -174,7 +241,12 @@ class Posterior:
         draw: a callable returning the samples dict, called once on first access of ``samples``
             (the fast path draws lazily so that an update costs nothing it does not need).
         chains: name -> (n_chains, n_draws) the MCMC draws per chain (for ``to_arviz`` and traces).
-        info: how the posterior was computed (method, settings, timings).
+        info: how the posterior was computed (method, settings, timings): a dict with string
+            keys; "names", where given, lists the parameter names (the names of lazily drawn
+            samples, before they are drawn).
+
+    ``samples`` and ``draw``: exactly one of them. Every argument is checked here (GPMSAError
+    naming it).
     """
 
     def __init__(
@@ -188,11 +260,18 @@ class Posterior:
     ) -> None:
         if samples is None and draw is None:
             raise GPMSAError("a Posterior needs samples or a draw callable")
+        if samples is not None and draw is not None:
+            raise GPMSAError("give a Posterior samples or a draw callable, not both (draw would "
+                             "never be called)")  # fmt: skip
+        if draw is not None and not callable(draw):
+            raise GPMSAError(f"draw must be a callable returning the samples dict, got "
+                             f"{type(draw).__name__}")  # fmt: skip
         self._samples = None if samples is None else _checked_samples(samples)
         self._draw = draw
-        self.grids = dict(grids or {})
+        self.info = _checked_info(info)
+        known = tuple(self._samples) if self._samples is not None else self.info.get("names")
+        self.grids = _checked_grids(grids, known)
         self.chains = _checked_chains(chains, self._samples)
-        self.info = dict(info or {})
 
     def __getstate__(self) -> dict:
         """For pickle (a Posterior sent to another process): lazily drawn samples are drawn
@@ -285,7 +364,10 @@ class Posterior:
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
         """name -> {mean, sd, q_lo, median, q_hi, n_draws, exact_grid} (the interval at
-        ``level``; MCMC posteriors add the bulk ESS)."""
+        ``level``; MCMC posteriors add the bulk ESS). q_lo and q_hi are named by their
+        percentages (`quantile_keys`): "q5" and "q95" for level 0.9."""
+        level = check_level(level)
+        lo_key, hi_key = quantile_keys(level)
         out = {}
         for name in self.names:
             lo, hi = self.interval(name, level)
@@ -293,9 +375,9 @@ class Posterior:
             out[name] = {
                 "mean": self.mean(name),
                 "sd": float("nan") if one_draw else self.sd(name),
-                f"q{100 * (1 - level) / 2:g}": lo,
+                lo_key: lo,
                 "median": float(self.quantile(name, 0.5)),
-                f"q{100 * (1 + level) / 2:g}": hi,
+                hi_key: hi,
                 "n_draws": int(np.size(self.samples[name])),
                 "exact_grid": name in self.grids,
             }

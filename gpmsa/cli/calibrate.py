@@ -10,6 +10,7 @@ import warnings
 
 import numpy as np
 
+from gpmsa.calibration.posterior import quantile_keys
 from gpmsa.cli.text import safe
 from gpmsa.errors import GPMSAError
 from gpmsa.io.container import jsonable
@@ -35,25 +36,19 @@ def add_parser(sub) -> None:
     p.set_defaults(func=run)
 
 
-def _quantile_keys(level: float) -> tuple[str, str]:
-    """The summary's keys of the ends of the central interval of probability ``level``."""
-    return f"q{100 * (1 - level) / 2:g}", f"q{100 * (1 + level) / 2:g}"
-
-
 def _level(text: str) -> float:
-    """argparse type of --level: a number in (0, 1) whose interval ends print apart from the
-    median and from 0 and 100 (checked before any work)."""
+    """argparse type of --level: a number in (0, 1) whose interval ends differ from the median
+    in float64 (checked before any work)."""
     try:
         level = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
     if not 0 < level < 1:  # NaN too
         raise argparse.ArgumentTypeError(f"{text!r} must lie in (0, 1)")
-    if set(_quantile_keys(level)) & {"q0", "q50", "q100"}:
-        raise argparse.ArgumentTypeError(
-            f"{text!r} is so near 0 or 1 that its interval's ends print as the median or as "
-            "0 and 100: give a level in [1e-4, 0.9999]"
-        )
+    try:
+        quantile_keys(level)
+    except GPMSAError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
     return level
 
 
@@ -121,7 +116,7 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
         }
         print(json.dumps(jsonable(out), indent=1, allow_nan=False))  # RFC 8259: no NaN
         return 0
-    lo_key, hi_key = _quantile_keys(args.level)
+    lo_key, hi_key = quantile_keys(args.level)
     print(f"posterior ({post.info.get('method')}, {1e3 * seconds:.2f} ms) given "
           + ", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(emu.x_names, x[0], strict=True))
           + "; "

@@ -25,7 +25,14 @@ from gpmsa.fitting.validation import (
     check_manifest,
     check_record,
 )
-from gpmsa.io.container import check_path, jsonable, read_raw, write_raw
+from gpmsa.io.container import (
+    FORMAT,
+    check_path,
+    jsonable,
+    read_raw,
+    refuse_to_replace,
+    write_raw,
+)
 from gpmsa.limits import check_memory
 from gpmsa.model import categorical as categorical_mod
 from gpmsa.model.correlation import correlation
@@ -36,6 +43,7 @@ from gpmsa.model.data import (
     by_column_names,
     check_count,
     check_flag,
+    evenly_spaced,
 )
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
@@ -43,7 +51,14 @@ from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
-__all__ = ["EMULATOR_PARAMS", "REQUIRED", "STD_FIELDS", "Emulator", "LooResult", "load"]
+__all__ = [
+    "EMULATOR_PARAMS",
+    "REQUIRED",
+    "STD_FIELDS",
+    "Emulator",
+    "LooResult",
+    "load",
+]
 
 
 @dataclass(frozen=True)
@@ -281,7 +296,9 @@ class Emulator:
             self._factors[-1] = self._factor(self.params)
         return self._factors[-1]
 
-    def _inputs(self, x, t) -> np.ndarray:
+    def _inputs(self, x, t, *, far_ok: bool = False) -> np.ndarray:
+        """Unit-scale z (N, p + q) of native x and t; beyond ``EXTRAPOLATION_MARGIN`` of the
+        domain a GPMSAError unless ``far_ok`` (a caller that allows it and has warned)."""
         x = as_float(by_column_names(x, self.x_names, "x"), "x")  # ragged: named here
         t = as_float(by_column_names(t, self.t_names, "t"), "t")
         x = as_matrix(x, "x", ncols=self.p) if np.ndim(x) != 1 or self.p != 1 else as_matrix(x, "x")
@@ -300,7 +317,7 @@ class Emulator:
         z = np.hstack([self.standardizer.x_to_unit(x), self.standardizer.t_to_unit(t)])
         lo, hi = z.min(axis=0), z.max(axis=0)
         far = (lo < -EXTRAPOLATION_MARGIN) | (hi > 1 + EXTRAPOLATION_MARGIN)
-        if far.any():
+        if far.any() and not far_ok:
             k = int(np.flatnonzero(far)[0])
             col = np.hstack([x, t])[:, k]
             a, b = self.domain[names[k]]
@@ -333,21 +350,8 @@ class Emulator:
             var += 1.0 / params["lamWOs"][0]
         return mean, var
 
-    def predict(
-        self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Predictive mean and variance (N, l_sim) of the simulator output in native units.
-
-        x (N, p) known inputs and t (N, q) parameters, native units (a single row broadcasts).
-        ``draws=False``: at the point estimate ``params``; ``draws=True``: averaged over the
-        retained posterior draws (the first ``n_draws`` of them evenly spaced), combining the
-        variances by the law of total variance. ``resid`` adds the nugget 1/lamWs and the residual
-        variance 1/lamWOs (the spread of a new simulation run about the smooth emulator).
-        """
-        draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
-        if n_draws is not None:  # also where draws=False leaves it unused
-            check_count(n_draws, "n_draws")
-        try:  # the size before converting; a ragged input is named by _inputs below
+    def _check_predict_memory(self, x, t) -> None:
+        try:  # the size before converting; a ragged input is named by _inputs
             n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
         except ValueError:
             n = 1
@@ -355,17 +359,39 @@ class Emulator:
             8.0 * n * (4.0 * self.m + 6.0 * self.l_sim + 4.0 * (self.p + self.q)),
             f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs)",
         )
+
+    def _predict_point(self, x, t, resid: bool, *, far_ok: bool = False):
+        """``predict(x, t, resid=resid)`` at the point estimate (native mean and variance);
+        ``far_ok``: x or t beyond ``EXTRAPOLATION_MARGIN`` of the domain allowed (for a caller
+        that allows extrapolation and has warned, as ``calibrated_predict(extrapolate=True)``)."""
+        self._check_predict_memory(x, t)
+        z = self._inputs(x, t, far_ok=far_ok)
+        m, v = self._predict_std(z, self.params, self._point_factor(), resid)
+        return self.standardizer.y_from_std(m), self.standardizer.var_from_std(v)
+
+    def predict(
+        self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Predictive mean and variance (N, l_sim) of the simulator output in native units.
+
+        x (N, p) known inputs and t (N, q) parameters, native units (a single row broadcasts).
+        ``draws=False``: at the point estimate ``params``; ``draws=True``: averaged over the
+        retained posterior draws (or ``n_draws`` of them, evenly spaced from the first to the
+        last: ``evenly_spaced``), combining the variances by the law of total variance.
+        ``resid`` adds the nugget 1/lamWs and the residual variance 1/lamWOs (the spread of a new
+        simulation run about the smooth emulator).
+        """
+        draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
+        if n_draws is not None:  # also where draws=False leaves it unused
+            check_count(n_draws, "n_draws")
+        if not draws:
+            return self._predict_point(x, t, resid)
+        self._check_predict_memory(x, t)
         z = self._inputs(x, t)
         s = self.standardizer
-        if not draws:
-            m, v = self._predict_std(z, self.params, self._point_factor(), resid)
-            return s.y_from_std(m), s.var_from_std(v)
         if not self.draws:
             raise GPMSAError("this emulator has no posterior draws (built by from_params)")
-        idx = np.arange(self.n_draws)
-        if n_draws is not None:
-            k = min(check_count(n_draws, "n_draws"), self.n_draws)
-            idx = np.unique(np.linspace(0, self.n_draws - 1, k).astype(int))
+        idx = evenly_spaced(self.n_draws, n_draws)
         means, vars_ = [], []
         with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
             for i in idx:
@@ -382,14 +408,15 @@ class Emulator:
     def loo(self) -> LooResult:
         """Exact leave-one-out cross-validation at the point estimate (Cholesky of Sigma_W).
 
-        For component j: mean_i = w_i - [S^-1 w]_i / [S^-1]_ii, var_i = 1 / [S^-1]_ii (the
-        nugget included); outputs through K, plus the residual 1/lamWOs for l_sim > 1.
+        For component j with precision P = S^-1 (zero mean), or with a mean basis H the
+        projected precision P = S^-1 - S^-1 H (H^T S^-1 H)^-1 H^T S^-1 (the GLS coefficients
+        refitted without run i): mean_i = w_i - [P w]_i / P_ii, var_i = 1 / P_ii (the nugget
+        included); outputs through K, plus the residual 1/lamWOs for l_sim > 1.
         """
         mean_w = np.zeros((self.m, self.p_u))
         var_w = np.zeros((self.m, self.p_u))
-        for j, (L, a, _) in enumerate(self._point_factor()):
-            Linv = solve_triangular(L, np.eye(self.m), lower=True)
-            d = np.sum(Linv**2, axis=0)
+        for j, (L, a, gls) in enumerate(self._point_factor()):
+            d = _precision_diagonal(L, gls)
             mean_w[:, j] = self.w[:, j] - a / d
             var_w[:, j] = 1.0 / d
         mean = mean_w @ self.K.T
@@ -535,10 +562,13 @@ class Emulator:
         """Write the emulator file (see docs/emulator-file.md); returns the path.
 
         Refuses (GPMSAError, before writing anything) an emulator that ``load`` would refuse:
-        invalid content, non-finite metadata, or sizes beyond ``gpmsa.limits``. The file is
-        replaced in one step, never left half-written.
+        invalid content, non-finite metadata, or sizes beyond ``gpmsa.limits``. An existing
+        emulator file is replaced in one step, never left half-written; a study file is not
+        replaced (GPMSAError): its study would no longer load. (A study's model file is an
+        emulator file: replaced, its study refuses it on loading, the sha256 differing.)
         """
         path = check_path(path)
+        refuse_to_replace(path, FORMAT)
         manifest, arrays = self.checked_record(path)
         return write_raw(path, manifest, arrays)
 
@@ -557,6 +587,18 @@ class Emulator:
             f"Emulator(m={self.m}, x={list(self.x_names)}, t={list(self.t_names)}, "
             f"y={self.l_sim} outputs, p_u={self.p_u}, draws={self.n_draws})"
         )
+
+
+def _precision_diagonal(L: np.ndarray, gls: GLS | None) -> np.ndarray:
+    """Diagonal (m,) of S^-1 (S = L L^T), or with a GLS mean of its projection
+    S^-1 - B (H^T S^-1 H)^-1 B^T, B = S^-1 H = L^-T A: the precision of each run's weight
+    given the others, the mean's coefficients integrated out."""
+    Linv = solve_triangular(L, np.eye(L.shape[0]), lower=True)
+    d = np.sum(Linv**2, axis=0)
+    if gls is not None:
+        B = solve_triangular(L, gls.A, lower=True, trans="T")
+        d = d - np.sum(B * cho_solve(gls.Q, B.T).T, axis=1)
+    return d
 
 
 def load(path: str | Path, *, sha256: str | None = None) -> Emulator:

@@ -3,6 +3,7 @@ new one, never a part."""
 
 from __future__ import annotations
 
+import errno
 import os
 import secrets
 import stat
@@ -57,8 +58,11 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
         if "\0" in os.fsdecode(path):
             raise error(f"{os.fsdecode(path)!r}: cannot write (a path holds no NUL byte)")
         path = Path(path)
-        if path.is_symlink():  # write through the link, as open() would, not over it
-            path = Path(os.path.realpath(path))
+        try:
+            if path.is_symlink():  # write through the link, as open() would, not over it
+                path = Path(os.path.realpath(path))
+        except OSError as exc:  # e.g. a name longer than the file system allows
+            raise error(_cannot_write(path, exc)) from exc
         tmp, fd = _new_temporary(path, error)
         staged.append((tmp, path))
         kw = {"encoding": "utf-8", "newline": ""} if text else {}
@@ -88,7 +92,7 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
     except FileNotFoundError:
         mode = None
     except OSError as exc:
-        raise error(f"{path}: cannot write ({exc.strerror})") from exc
+        raise error(_cannot_write(path, exc)) from exc
     if mode is not None and not stat.S_ISREG(mode):
         raise error(f"{path} exists and is not a regular file: refusing to replace it")
     # the name's start only: a 255-byte name plus the suffix would exceed the file system's limit
@@ -97,7 +101,24 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
     try:
         fd = os.open(tmp, flags, 0o666)
     except OSError as exc:  # e.g. a missing folder or one without write permission
-        raise error(f"{path}: cannot write ({exc.strerror})") from exc
+        raise error(_cannot_write(path, exc)) from exc
     if mode is not None:  # a file replaced keeps its permissions (a private one stays so)
         os.chmod(tmp, stat.S_IMODE(mode))
     return tmp, fd
+
+
+def _cannot_write(path: Path, exc: OSError) -> str:
+    """Why ``path`` cannot be written, from the OS error ``exc``; a name or path too long says
+    how long it is and what the file system allows."""
+    why = exc.strerror or str(exc)
+    if exc.errno == errno.ENAMETOOLONG:
+        name = len(os.fsencode(path.name))
+        try:
+            most = os.pathconf(path.parent, "PC_NAME_MAX")
+        except (OSError, ValueError, AttributeError):  # no pathconf (Windows), or no folder
+            most = 255
+        if name > most:
+            why += f": the file name is {name} bytes, the file system allows at most {most}"
+        else:
+            why += f": the path is {len(os.fsencode(path))} bytes, too long for the OS"
+    return f"{path}: cannot write ({why})"

@@ -516,14 +516,30 @@ def stored_format(path: str | Path) -> str | None:
     there is none (no file, another kind of file, or one too damaged to tell). Reads the
     manifest only, with ``read_raw``'s checks; its content is not verified."""
     path = check_path(path)
-    if not path.exists():
-        return None
     try:
+        if not path.exists():
+            return None
         with _opened(path) as (zf, members):
             raw = bytes(_read_member(zf, members[MANIFEST], path))
         return _parse_manifest(raw, path, (FORMAT, STUDY_FORMAT))["format"]
-    except Exception:  # any damage: not a gpmsa file that can be told apart
+    except Exception:  # any damage (or a name the OS refuses): not a gpmsa file to tell apart
         return None
+
+
+def refuse_to_replace(target: Path, fmt: str) -> None:
+    """GPMSAError if ``target`` holds a gpmsa file of the other kind than ``fmt``: a study
+    written over an emulator file (another study's model, say) or an emulator file written over
+    a study would leave that file's owner unreadable."""
+    found = stored_format(target)
+    if found is not None and found != fmt:
+        if found == STUDY_FORMAT:
+            held, wanted = "a study file", "an emulator file"
+        else:
+            held, wanted = "an emulator file (another study's model?)", "a study file"
+        raise GPMSAError(
+            f"refusing to write {target}: it holds {held}, which {wanted} would replace; "
+            "choose another path or remove it first"
+        )
 
 
 @contextmanager

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import re
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -48,11 +49,22 @@ def _first_non_number(value) -> str | None:
     return None
 
 
+def check_not_masked(value, name: str) -> None:
+    """GPMSAError naming ``name`` for a numpy masked array: converted, its masked entries would
+    be read as data (numpy drops the mask)."""
+    if isinstance(value, np.ma.MaskedArray):
+        raise GPMSAError(
+            f"{name} is a numpy masked array: converting it would drop the mask and read the "
+            "masked entries as data; pass a plain array without the masked rows"
+        )
+
+
 def as_float(value, name: str) -> np.ndarray:
     """Return ``value`` as a float64 array (a copy); GPMSAError naming ``name`` when it is not
     real numbers (strings, even numeric ones, bools, None, objects, ragged lists; complex
     values, which are never cast to their real part). numpy integer and float scalars are
-    numbers."""
+    numbers. A numpy masked array is refused (`check_not_masked`)."""
+    check_not_masked(value, name)
     bad = _first_non_number(value)
     if bad is not None:
         raise GPMSAError(
@@ -108,13 +120,54 @@ def column_order(labels, names, name: str) -> list[int]:
 
 def by_column_names(value, names, name: str):
     """A table with named columns (`column_labels`) as its columns in the order of ``names``;
-    any other value as it is. GPMSAError naming ``name`` when the table's columns are not
-    ``names`` (in some order): its columns are never read by position."""
+    a pandas Series by its labels (`series_by_names`); any other value as it is. GPMSAError
+    naming ``name`` when the table's columns are not ``names`` (in some order): its columns are
+    never read by position."""
+    if names is None:
+        return value
+    if is_series(value):
+        return series_by_names(value, names, name)
     labels = column_labels(value)
-    if labels is None or names is None:
+    if labels is None:
         return value
     column_order(labels, names, name)
     return value[list(names)]
+
+
+def is_series(value) -> bool:
+    """Whether ``value`` is a pandas Series (without importing pandas: a Series exists only
+    where pandas is imported already)."""
+    pd = sys.modules.get("pandas")
+    return pd is not None and isinstance(value, pd.Series)
+
+
+def series_by_names(series, names, name: str) -> np.ndarray:
+    """A pandas Series as values in the order of ``names`` (d names), matched by its labels:
+
+    - indexed by ``names`` (in any order; e.g. a table's row, ``df.iloc[0]``): one point (1, d);
+    - named as the only input, ``names == [series.name]`` (e.g. ``df["v"]``): its values (n,),
+      the column of that input;
+    - carrying no names (no ``name`` and an integer index): its values (n,), read as a plain
+      1-D array (by position, as a list would be).
+
+    Any other Series (e.g. the column ``df["b"]`` of one of several inputs, or an index of
+    other names) is a GPMSAError naming ``name``: its entries are never matched by position
+    against names it does not carry."""
+    labels = tuple(str(i) for i in series.index)
+    names = [str(n) for n in names]
+    if sorted(labels) == sorted(names):
+        return series.to_numpy()[column_order(labels, names, name)][None, :]
+    title = None if series.name is None else str(series.name)
+    if title is not None and [title] == names:
+        return series.to_numpy()
+    if title is None and all(isinstance(i, int | np.integer) for i in series.index):
+        return series.to_numpy()
+    one = f", the values of the one input as a Series named {names[0]!r}" if len(names) == 1 else ""
+    raise GPMSAError(
+        f"{name} is a pandas Series named {title!r} with the index {list(labels)[:10]}: give one "
+        f"point as a Series indexed by {names} (in any order){one}, or a table with these "
+        "columns"
+    )
 
 
 def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
@@ -155,6 +208,18 @@ def check_count(value, name: str, low: int = 1, high: int | None = None) -> int:
         allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
         raise GPMSAError(f"{name} must be an integer {allowed}, got {value!r}")
     return int(value)
+
+
+def evenly_spaced(n: int, k: int | None, name: str = "n_draws") -> np.ndarray:
+    """Indices of at most ``k`` of ``n`` draws, evenly spaced from the first to the last
+    (rounded to the nearest); all n for ``k`` None (``name``: the argument ``k`` came as, for
+    the error). Every call that averages over a subset of draws (``Emulator.predict``,
+    ``gpmsa.predictive``, calibration with ``emulator_params="draws"``) picks them so: the same
+    count gives the same draws everywhere."""
+    if k is None:
+        return np.arange(n)
+    k = min(check_count(k, name), n)
+    return np.unique(np.linspace(0, n - 1, k).round().astype(int))
 
 
 def check_level(level) -> float:
@@ -472,10 +537,13 @@ class ObsData:
             return self.x
         return self.x[:, column_order(self.x_columns, x_names, "x_obs")]
 
-    def values_digest(self) -> str:
+    def values_digest(self, x_names=None) -> str:
         """SHA-256 of x and every experiment's y (`values_digest`): what ``gpmsa.calibrate``,
-        which takes no grids or precisions, records of its observations."""
-        return values_digest(self.x, self.experiments)
+        which takes no grids or precisions, records of its observations. ``x_names``: x with
+        its columns in that order (`inputs`: a table's by name, as calibrate reads x_obs);
+        None: as given."""
+        x = self.x if x_names is None else self.inputs(x_names)
+        return values_digest(x, self.experiments)
 
     def digest(self) -> str:
         """SHA-256 of the observations (x, every experiment's y, grid and precision, as float64):

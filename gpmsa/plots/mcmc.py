@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Mapping
+
 import numpy as np
 
 from gpmsa.calibration.posterior import Posterior
@@ -55,13 +57,35 @@ def _series(source) -> dict[str, np.ndarray]:
     )
 
 
+def _name_list(names, available: list[str]) -> list[str]:
+    """``names`` (one parameter name, or a sequence of them) as a non-empty list of strings;
+    GPMSAError otherwise, listing the ``available`` names."""
+    if isinstance(names, np.ndarray) and names.ndim == 0:  # not iterable, though it says so
+        names = names.item()
+    if isinstance(names, str):
+        return [names]
+    if isinstance(names, (bytes, Mapping)) or not isinstance(names, Iterable):
+        raise GPMSAError(
+            f"names must be a parameter name (str) or a sequence of names, got {names!r} "
+            f"({type(names).__name__}); available: {available}"
+        )
+    names = list(names)
+    bad = [n for n in names if not isinstance(n, str)]
+    if bad:
+        raise GPMSAError(
+            f"names must hold parameter names (str), got {bad[0]!r} ({type(bad[0]).__name__}); "
+            f"available: {available}"
+        )
+    if not names:
+        raise GPMSAError(f"names is empty; available: {available}")
+    return names
+
+
 def _pick(series: dict, names, max_params: int) -> list[str]:
     max_params = check_count(max_params, "max_params")
     if names is None:
         return list(series)[:max_params]
-    names = [names] if isinstance(names, str) else list(names)
-    if not names:
-        raise GPMSAError(f"names is empty; available: {list(series)}")
+    names = _name_list(names, list(series))
     picked = []
     for n in names:
         hits = [k for k in series if k == n or k.startswith(f"{n}[")]
@@ -77,8 +101,8 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
     Args:
         source: a gpmsa.Emulator (its retained draws; a joint fit's calibration draws first), a
             Posterior (its chains), a Chains, or a study (its pooled posterior's chains).
-        names: parameters to show (a name selects all its elements, e.g. "betaU"); default: the
-            first ``max_params`` scalars.
+        names: a parameter name or a sequence of names to show (a name selects all its
+            elements, e.g. "betaU"); default: the first ``max_params`` scalars.
         max_params: rows at most when ``names`` is None.
         bins: histogram bins.
 
@@ -156,9 +180,10 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
     Args:
         source: a Posterior, a study (its pooled posterior), or an Emulator from a joint fit
             (its calibration draws).
-        names: the parameters (default: every calibration parameter, i.e. not lamOs, lamVz,
-            betaV, nor a study's per-model lamOs[LABEL] or a hierarchical parameter's unit-scale
-            precision NAME.lam; its group mean NAME.mu and sd NAME.sd are shown).
+        names: a parameter name or a sequence of names (default: every calibration
+            parameter, i.e. not lamOs, lamVz, betaV, nor a study's per-model lamOs[LABEL] or a
+            hierarchical parameter's unit-scale precision NAME.lam; its group mean NAME.mu and
+            sd NAME.sd are shown).
         truth: name -> value to mark (e.g. the value a synthetic case was made with).
         bins: histogram bins.
 
@@ -182,9 +207,7 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
         names = [n for n in post.names if _is_calibration_parameter(n, post.names)]
         if not names:
             raise GPMSAError(f"the posterior has no calibration parameter to plot: {post.names}")
-    names = [names] if isinstance(names, str) else list(names)
-    if not names:
-        raise GPMSAError(f"names is empty: give at least one of {post.names}")
+    names = _name_list(names, list(post.names))
     unknown = [n for n in names if n not in post.names]
     if unknown:
         raise GPMSAError(f"unknown parameters {unknown}; the posterior has {post.names}")

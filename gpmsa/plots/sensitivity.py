@@ -16,7 +16,8 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
     """Main- and total-effect indices per input with their spread over posterior draws.
 
     Left: bars of the aggregated indices (mean over draws) with the central interval of
-    probability ``level`` over draws as error bars. Right (a functional output): main (solid)
+    probability ``level`` over draws as error bars (the interval itself: a skewed spread over
+    draws can leave the mean outside it). Right (a functional output): main (solid)
     and total (dashed) effect of each input along the output grid, with their bands.
 
     Example:
@@ -41,11 +42,11 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
     pos = np.arange(d)
     for off, kind, arr, color in ((-0.2, "main", sens.main_aggregated, "C0"),
                                   (0.2, "total", sens.total_aggregated, "C1")):  # fmt: skip
-        mean = arr.mean(axis=0)
         lo, hi = np.quantile(arr, q, axis=0)
-        err = np.vstack([mean - lo, hi - mean])
-        axes[0].bar(pos + off, mean, width=0.4, color=color, yerr=err, capsize=3,
-                    label=f"{kind} effect")  # fmt: skip
+        axes[0].bar(pos + off, arr.mean(axis=0), width=0.4, color=color, label=f"{kind} effect")
+        # the interval [lo, hi] itself: a skewed spread can leave the mean outside it
+        axes[0].errorbar(pos + off, (lo + hi) / 2, yerr=(hi - lo) / 2, fmt="none", ecolor="k",
+                         capsize=3)  # fmt: skip
     axes[0].set_xticks(pos, sens.names)
     axes[0].set_ylim(0.0, 1.05)
     axes[0].set_ylabel("Sobol index")

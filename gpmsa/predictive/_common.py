@@ -14,7 +14,7 @@ from scipy.linalg import cho_solve, solve_triangular
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import as_matrix, by_column_names, check_count, check_seed
+from gpmsa.model.data import as_matrix, by_column_names, check_count, check_seed, evenly_spaced
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
 
@@ -122,7 +122,8 @@ def param_sets(emulator, draws: bool, n_draws: int | None, what: str):
     """(indices, list of parameter dicts) the prediction averages over.
 
     ``draws=False``: the point estimate only (index -1). ``draws=True``: the retained posterior
-    draws, or ``n_draws`` of them evenly spaced; GPMSAError when the emulator kept none.
+    draws, or ``n_draws`` of them evenly spaced (``evenly_spaced``); GPMSAError when the
+    emulator kept none.
     """
     if n_draws is not None:  # checked also where draws=False leaves it unused
         n_draws = check_count(n_draws, "n_draws")
@@ -135,10 +136,7 @@ def param_sets(emulator, draws: bool, n_draws: int | None, what: str):
             "emulator kept none (built by Emulator.from_params, or read from a file without "
             "draws); pass draws=False to use its point estimate"
         )
-    idx = np.arange(n)
-    if n_draws is not None:
-        k = check_count(n_draws, "n_draws")
-        idx = np.unique(np.linspace(0, n - 1, min(k, n)).round().astype(int))
+    idx = evenly_spaced(n, n_draws)
     sets = [{k: np.asarray(emulator.draws[k][i]) for k in EMULATOR_PARAMS} for i in idx]
     return idx, sets
 

@@ -11,7 +11,15 @@ from scipy.special import ndtr
 from gpmsa.calibration.observations import check_x
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import as_float, as_real, check_count, check_finite, check_flag, check_level
+from gpmsa.model.data import (
+    as_float,
+    as_real,
+    check_count,
+    check_finite,
+    check_flag,
+    check_level,
+    evenly_spaced,
+)
 from gpmsa.predictive._common import posterior_lamos, posterior_theta
 
 
@@ -102,13 +110,16 @@ def calibrated_predict(
             each node adds the exact E[1/lamOs | data, theta]; otherwise each draw its own lamOs.
         resid: include the emulator's nugget and residual variance (see ``Emulator.predict``).
         n_theta: at most this many posterior draws when draws are used.
-        extrapolate: allow x_new outside the emulator's x domain (with a warning).
+        extrapolate: allow x_new outside the emulator's x domain, however far (with a
+            warning naming x_new), as ``gpmsa.calibrate`` allows x_obs; False: GPMSAError for
+            x_new outside it.
 
     Returns:
         CalibratedPrediction (native units).
     """
     noise, resid = check_flag(noise, "noise"), check_flag(resid, "resid")
-    x, _ = check_x(emulator, x_new, check_flag(extrapolate, "extrapolate"), "x_new")
+    extrapolate = check_flag(extrapolate, "extrapolate")
+    x, _ = check_x(emulator, x_new, extrapolate, "x_new")
     if not isinstance(posterior, Posterior):
         raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
     names = tuple(emulator.t_names)
@@ -128,7 +139,7 @@ def calibrated_predict(
             lam = 1.0 / np.asarray(inv_lam)[live]
     else:
         n = np.size(posterior.samples[names[0]])
-        idx = np.unique(np.linspace(0, n - 1, min(n_theta, n)).astype(int))
+        idx = evenly_spaced(n, n_theta)
         theta = np.column_stack([np.asarray(posterior.samples[k])[idx] for k in names])
         weights = np.full(idx.size, 1.0 / idx.size)
         if noise:
@@ -139,7 +150,7 @@ def calibrated_predict(
     ts = np.repeat(theta, N, axis=0)
     with warnings.catch_warnings():  # x_new and theta were checked (and warned about) above
         warnings.simplefilter("ignore")
-        mean, var = emulator.predict(xs, ts, resid=resid)
+        mean, var = emulator._predict_point(xs, ts, resid, far_ok=extrapolate)
     l_sim = mean.shape[1]
     mean = mean.reshape(K, N, l_sim)
     var = var.reshape(K, N, l_sim)

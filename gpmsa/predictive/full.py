@@ -35,7 +35,14 @@ from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.basis import discrepancy_basis, interpolate_basis
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import ObsData, as_float, check_count, check_finite, check_level
+from gpmsa.model.data import (
+    ObsData,
+    as_float,
+    check_count,
+    check_finite,
+    check_level,
+    evenly_spaced,
+)
 from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive._common import (
     EMULATOR_PARAMS,
@@ -101,8 +108,11 @@ class FullPrediction:
         return self.D.shape[1]
 
     def _check(self, what: str) -> None:
-        if what not in QUANTITIES:
-            raise GPMSAError(f"what must be one of {QUANTITIES}, got {what!r}")
+        """GPMSAError unless ``what`` is one of ``QUANTITIES`` (a str: an array or list, whose
+        ``in`` test numpy would refuse or answer elementwise, is named as such)."""
+        if not isinstance(what, str) or what not in QUANTITIES:
+            got = f"{what!r}"[:80] + ("" if isinstance(what, str) else f" ({type(what).__name__})")
+            raise GPMSAError(f"what must be one of {QUANTITIES} (one str), got {got}")
 
     def _moments_std(self, what: str) -> tuple[np.ndarray, np.ndarray]:
         """Per draw mean and variance (S, N, l), standardised scale, of one quantity."""
@@ -194,10 +204,7 @@ def _posterior_sets(emulator, posterior, n_draws):
                 prm["lamVz"] = float(samples["lamVz"][i])
             return prm
 
-    idx = np.arange(n)
-    if n_draws is not None:
-        k = check_count(n_draws, "n_draws")
-        idx = np.unique(np.linspace(0, n - 1, min(k, n)).round().astype(int))
+    idx = evenly_spaced(n, n_draws)
     return idx, [get(i) for i in idx]
 
 
@@ -288,12 +295,14 @@ def _check_fitted_obs(emulator, obs: ObsData) -> None:
         )
 
 
-def _check_calibrated_obs(posterior, obs: ObsData) -> None:
+def _check_calibrated_obs(posterior, obs: ObsData, x_names) -> None:
     """GPMSAError when ``posterior`` recorded the values of its observations (``gpmsa.calibrate``:
-    info "obs_values_sha256") and ``obs`` holds other ones."""
+    info "obs_values_sha256") and ``obs`` holds other ones. Its x is compared with its columns
+    in the order of ``x_names`` (`ObsData.values_digest`), as ``gpmsa.calibrate`` read them: the
+    same table, columns in any order, is the same observations."""
     info = getattr(posterior, "info", None) or {}
     digest = info.get("obs_values_sha256")
-    if digest is not None and obs.values_digest() != digest:
+    if digest is not None and obs.values_digest(x_names) != digest:
         raise GPMSAError(
             "obs holds other observations (x or y) than the calibration that drew posterior=: "
             "pass the x_obs and y_obs given to gpmsa.calibrate as ObsData(x=x_obs, y=y_obs)"
@@ -372,7 +381,7 @@ def full_prediction(
     if posterior is None:
         _check_fitted_obs(emulator, obs)
     else:
-        _check_calibrated_obs(posterior, obs)
+        _check_calibrated_obs(posterior, obs, emulator.x_names)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
     with warnings.catch_warnings():

@@ -37,6 +37,7 @@ from scipy.special import erf, erfc
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
+from gpmsa.limits import check_memory
 from gpmsa.model.data import as_real, check_flag, check_level
 from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, unit_inputs
 
@@ -165,6 +166,16 @@ def _component_moments(zt, coef, beta, varied, lo, hi):
     return mu, Vall, Vmain, Vcomp
 
 
+def _memory_estimate(m: int, d: int, p_u: int, S: int, l_sim: int) -> float:
+    """Bytes that ``sensitivity`` needs at once: per draw the factors of Sigma_W (about 2 p_u
+    + 2 arrays m x m) and ``_component_moments``' pair integrals with their prefix and suffix
+    products (about 4 d + 6 of them; the peaks measured for m = 200, d <= 6, p_u <= 4 stayed
+    below this), and the indices kept over the S draws."""
+    return 8.0 * (
+        m * m * (4.0 * d + 8.0 + 2.0 * p_u) + S * (2.0 * d * (l_sim + p_u + 1) + 2.0 * l_sim)
+    )
+
+
 def _ratio(num: np.ndarray, den: np.ndarray, scale: float) -> np.ndarray:
     """The variance share num / den clipped to [0, 1] (the rounding left in the differences
     of second moments, about 1e-11 of the variance, can put a share of 0 or 1 just outside);
@@ -263,6 +274,10 @@ def sensitivity(
         fix_u[k] = float(u[0, 0])
     idx, sets = param_sets(emulator, draws, n_draws, "sensitivity")
     S, l_sim, p_u, d = len(sets), emulator.l_sim, emulator.p_u, len(varied)
+    check_memory(_memory_estimate(emulator.m, d, p_u, S, l_sim),
+                 f"sensitivity() of an emulator of {emulator.m} runs x {p_u} basis components "
+                 f"over {d} varied inputs (about {4 * d + 8 + 2 * p_u} arrays of "
+                 f"{emulator.m} x {emulator.m} at once)")  # fmt: skip
     KtK = emulator.K.T @ emulator.K
     K = emulator.K
     out = {k: np.empty((S, l_sim, d)) for k in ("main", "total")}

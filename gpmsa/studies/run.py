@@ -47,14 +47,21 @@ def _same_count(**lists) -> int:
     return n
 
 
-def _check_run(n_iter, n_burn, n_chains, seed, hyper, what: str = "n_samples") -> HyperPriors:
+def _run_seed(seed) -> int:
+    """The integer seed a study runs with and records (``settings["seed"]``, each fitted model's
+    ``settings["seed"]``): ``seed`` itself, or for None one drawn from fresh OS entropy, as
+    ``gpmsa.fit`` does, so that every study can be rerun."""
+    seed = check_seed(seed)
+    return int(np.random.default_rng().integers(2**63)) if seed is None else seed
+
+
+def _check_run(n_iter, n_burn, n_chains, hyper, what: str = "n_samples") -> HyperPriors:
     for name, val, low in ((what, n_iter, 2), ("n_chains", n_chains, 1)):
         if isinstance(val, bool) or not (isinstance(val, (int, np.integer)) and val >= low):
             raise GPMSAError(f"{name} must be an integer >= {low}, got {val!r}")
     if isinstance(n_burn, bool) or not (isinstance(n_burn, (int, np.integer))
                                         and 0 <= n_burn < n_iter - 1):  # fmt: skip
         raise GPMSAError(f"n_burn must be an integer in [0, {what} - 1), got {n_burn!r}")
-    check_seed(seed)
     if hyper is None:
         return HyperPriors()
     if not isinstance(hyper, HyperPriors):
@@ -105,7 +112,9 @@ def calibrate_study(
             (``hyper``: their priors, ``gpmsa.HyperPriors()``: a uniform group sd; SEPIA's:
             ``HyperPriors.sepia()``). Every other parameter is its model's.
         n_samples, n_burn, tune, seed, n_chains, init, tune_rounds, tune_levels, extrapolate,
-            progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep).
+            progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep);
+            seed None draws one from fresh entropy, and the integer the study ran with is
+            ``study.settings["seed"]`` (``seed=that`` reruns it).
         metadata: a JSON-able dict saved with the study.
 
     Returns a ``Study``; ``study.posterior`` names each shared parameter by its name, every
@@ -131,7 +140,8 @@ def calibrate_study(
     n = _same_count(emulators=emulators, x_obs=x_obs, y_obs=y_obs)
     for e in emulators:
         check_emulator(e)
-    hyper = _check_run(n_samples, n_burn, n_chains, seed, hyper)
+    hyper = _check_run(n_samples, n_burn, n_chains, hyper)
+    seed = _run_seed(seed)
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     extrapolate = check_flag(extrapolate, "extrapolate")
@@ -186,7 +196,9 @@ def fit_study(
         sims, obs: per model, its ``gpmsa.SimData`` and ``gpmsa.ObsData``.
         labels, shared, hierarchical, hyper: as ``calibrate_study``.
         n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, priors, n_pc, discrepancy:
-            as ``gpmsa.fit`` (priors, n_pc, discrepancy: the same for every model).
+            as ``gpmsa.fit`` (priors, n_pc, discrepancy: the same for every model); the seed
+            the study ran with is ``study.settings["seed"]`` and each model's
+            ``settings["seed"]``.
         metadata: a JSON-able dict saved with the study.
 
     Returns a ``Study`` of kind "fit": ``study.members`` are the models' fitted emulators (their
@@ -207,7 +219,8 @@ def fit_study(
         if not isinstance(o, ObsData):
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
     n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int) else n_burn
-    hyper = _check_run(n_iter, n_burn, n_chains, seed, hyper, "n_iter")
+    hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
+    seed = _run_seed(seed)
     check_point(point)
     if isinstance(n_keep, bool) or not isinstance(n_keep, (int, np.integer)) or n_keep < 1:
         raise GPMSAError(f"n_keep must be an integer >= 1, got {n_keep!r}")

@@ -23,8 +23,8 @@ from gpmsa.io.container import (
     check_path,
     jsonable,
     read_raw,
+    refuse_to_replace,
     seal,
-    stored_format,
     write_sealed,
 )
 from gpmsa.mcmc.diagnostics import convergence, summarize
@@ -163,11 +163,11 @@ class Study:
         such a file belongs to another study, which would no longer load.
         """
         path = check_path(path)
-        _refuse_to_replace(path, STUDY_FORMAT)
+        refuse_to_replace(path, STUDY_FORMAT)
         files, hashes, sealed = [], [], []
         for lab, emu in zip(self.labels, self.members, strict=True):
             file = f"{path.stem}.{lab}.gpmsa"
-            _refuse_to_replace(path.with_name(file), FORMAT)
+            refuse_to_replace(path.with_name(file), FORMAT)
             manifest, arrays = emu.checked_record(path.with_name(file))
             head, raw = seal(manifest, arrays)
             files.append(file)
@@ -226,22 +226,6 @@ def load_study(path: str | Path) -> Study:
         raise EmulatorFileError(f"{path}: {exc}") from exc
     except GPMSAError as exc:
         raise EmulatorFileError(f"{path}: study: {exc}") from exc
-
-
-def _refuse_to_replace(target: Path, fmt: str) -> None:
-    """GPMSAError if ``target`` holds a gpmsa file of the other kind than ``fmt``: a study
-    written over an emulator file (another study's model, say) or a model file written over a
-    study would leave that file's owner unreadable."""
-    found = stored_format(target)
-    if found is not None and found != fmt:
-        if found == STUDY_FORMAT:
-            held, wanted = "a study file", "a model's emulator file"
-        else:
-            held, wanted = "an emulator file (another study's model?)", "a study file"
-        raise GPMSAError(
-            f"refusing to write {target}: it holds {held}, which {wanted} would replace; "
-            "choose another path or remove it first"
-        )
 
 
 def _discrepancy_chains(member, shape: tuple[int, int]) -> dict[str, np.ndarray]:

@@ -61,10 +61,17 @@ def test_cli_bad_input(emu_file, capsys, extra, match):
     assert re.search(match, capsys.readouterr().err)
 
 
+def test_cli_level_near_one_names_its_ends_exactly(emu_file, capsys):
+    args = ["calibrate", str(emu_file), "--x", "v=1.25", "--y", "f=12.1", "--json"]
+    assert main([*args, "--level", "0.99999999"]) == 0
+    gd = json.loads(capsys.readouterr().out)["posterior"]["GD"]
+    assert gd["q5e-07"] < gd["median"] < gd["q99.9999995"]
+
+
 @pytest.mark.parametrize(
     ("level", "match"),
     [("0", r"'0' must lie in \(0, 1\)"), ("nan", "must lie in"), ("x", "is not a number"),
-     ("1e-300", "print as the median"), ("0.99999999", "print as the median or as 0 and 100")],
+     ("1e-300", "are both the median")],
 )  # fmt: skip
 def test_cli_level_is_checked_before_any_work(emu_file, capsys, level, match):
     with pytest.raises(SystemExit) as exit_:
