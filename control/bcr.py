@@ -26,12 +26,12 @@ next one, as those overlap the fault's block or the block before or after it).
 
 Every update returns an `Estimate` whose status says why there is no number: ``filling`` (not
 enough contiguous samples yet, or the first block after a fault), ``sensor_fault`` (non-finite
-values, dropped, repeated or backwards time stamps, a stuck, quantised, clipped or dead signal),
-``implausible`` (no GD in the emulator's domain explains the observation), ``out_of_domain``
-(speed outside the emulator's range and no earlier estimate), ``calibration_failed``, ``stale``
-(no new information for ``max_age_s``). While the speed is outside the emulator's range (e.g.
-standing) there is no new information: the change-point estimate is carried on (its reason says
-so) until it turns stale.
+values, a speed beyond any vehicle's, dropped, repeated or backwards time stamps, a stuck,
+quantised, clipped or dead signal), ``implausible`` (no GD in the emulator's domain explains the
+observation), ``out_of_domain`` (speed outside the emulator's range and no earlier estimate),
+``calibration_failed``, ``stale`` (no new information for ``max_age_s``). While the speed is
+outside the emulator's range (e.g. standing) there is no new information: the change-point
+estimate is carried on (its reason says so) until it turns stale.
 """
 
 from __future__ import annotations
@@ -152,6 +152,8 @@ class BCRSettings:
                 f"[{self.feature.block_samples / MAX_PHASES:g}, {self.feature.block_samples}], "
                 f"got {every}"
             )
+        if self.method == "window":
+            _check_window_tracker(self.tracker)
         if not block and every > self.feature.block_samples:
             raise ControlError(
                 f"update_every ({every}) must not exceed the window ({self.feature.block_samples})"
@@ -190,6 +192,24 @@ class BCRSettings:
     def rate_hz(self) -> float:
         """Accelerometer rate, Hz."""
         return self.feature.rate_hz
+
+
+def _check_window_tracker(tracker: TrackerSettings) -> None:
+    """ControlError for a tracker setting that method "window" would ignore: it starts every
+    window from the prior (``mean_segment_m = 0``), so it has no memory to set."""
+    default = TrackerSettings()
+    if tracker.mean_segment_m not in (0.0, default.mean_segment_m):
+        raise ControlError(
+            f"tracker.mean_segment_m = {tracker.mean_segment_m:g} is ignored by method "
+            "'window' (each window alone, mean_segment_m = 0); use method 'filter' or "
+            "'tempered' for a filter with memory"
+        )
+    if tracker.drift_per_sqrt_m != default.drift_per_sqrt_m:
+        raise ControlError(
+            f"tracker.drift_per_sqrt_m = {tracker.drift_per_sqrt_m:g} is ignored by method "
+            "'window' (each window alone); use method 'filter' or 'tempered' for a filter "
+            "with memory"
+        )
 
 
 @dataclass
@@ -360,7 +380,8 @@ class BCR:
                 time). With it, the BCR knows time passes while no samples arrive: the estimate
                 ages, and silence longer than ``max_silence_s`` is a "sensor_fault". A control
                 loop should pass it: without it a silent sensor keeps the last estimate.
-            Non-finite values are sensor faults, never errors.
+            Non-finite values and speeds beyond ``MAX_SPEED_MPS`` are sensor faults, never
+            errors.
         """
         if now is not None and not (is_real(now) and np.isfinite(now)):
             raise ControlError(f"now must be a finite time, s, got {now!r}")
@@ -379,20 +400,13 @@ class BCR:
         if n == 0:
             return self._check_silence(self._check_age(self.last))
         t, position, accel, speed = arrays
-        drop, restart, reason = stream_fault(
-            t, position, accel, speed, self._t_prev, self.settings.rate_hz
-        )
-        stamped = np.flatnonzero(np.isfinite(t))
-        if stamped.size:  # steps run from the previous stamp, kept or dropped, in any chunking
-            self._t_prev = float(t[stamped[-1]])
         every = self.settings.samples_per_update
         start = 0
         fault = None  # the gravest fault found by this call's updates
         while start < n:
             stop = min(n, start + every - self._received)
             part = slice(start, stop)
-            self._take(t[part], position[part], accel[part], speed[part], drop[part],
-                       restart[part], reason)  # fmt: skip
+            self._take(t[part], position[part], accel[part], speed[part])
             self._received += stop - start
             start = stop
             if self._received == every:
@@ -404,8 +418,14 @@ class BCR:
 
     # --- internals -------------------------------------------------------------------------------
 
-    def _take(self, t, pos, acc, spd, drop, restart, reason) -> None:
-        """Append samples; a dropped sample or a gap restarts the contiguous buffer."""
+    def _take(self, t, pos, acc, spd) -> None:
+        """Append the samples of one update (or part of one); a dropped sample or a gap
+        (`stream_fault`) restarts the contiguous buffer, and its reason, for these samples
+        alone, waits for the update's estimate."""
+        drop, restart, reason = stream_fault(t, pos, acc, spd, self._t_prev, self.settings.rate_hz)
+        stamped = np.flatnonzero(np.isfinite(t))
+        if stamped.size:  # steps run from the previous stamp, kept or dropped, in any chunking
+            self._t_prev = float(t[stamped[-1]])
         good = np.isfinite(t) & np.isfinite(pos) & ~drop
         if good.any():
             k = int(np.flatnonzero(good)[-1])
@@ -471,16 +491,34 @@ class BCR:
         """The feature vector (K,) of the newest block of clean samples."""
         return features_of_blocks(block[None, :], self.settings.feature)[0]
 
-    def _signal_reason(self, accel: np.ndarray) -> str:
-        """The checks of the buffer's time stamps and odometry (`timing_fault`), then the
-        signal checks on the new samples of a window, or on a whole block."""
+    def _signal_reason(self, accel: np.ndarray, timing: bool = True, steady: bool = True) -> str:
+        """The checks of the buffer's time stamps and odometry (`timing_fault`; with
+        ``timing``), then the signal checks on ``accel`` (`signal_fault`, with ``steady``): a
+        whole block, or a window's new samples (`_window_signal_reason`)."""
         s = self.settings
-        timing = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
         if timing:
-            return timing
-        if s.method != "changepoint":
-            accel = accel[-s.samples_per_update :]
-        return signal_fault(accel, s.sensor)
+            reason = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
+            if reason:
+                return reason
+        return signal_fault(accel, s.sensor, steady=steady)
+
+    def _window_signal_reason(self) -> str:
+        """The window methods' checks: the signal checks on the buffer's samples that came
+        since the previous update (those a restart kept), as the window fills too, so that
+        every sample of a window has passed them once; the timing checks on a full window.
+        New samples over which the speed changes by more than MAX_SPEED_CHANGE (starting,
+        stopping) skip the level-jump check: their level changes with the speed."""
+        every = self.settings.samples_per_update
+        spd = np.abs(self._spd[-every:])
+        steady = spd.size == 0 or np.min(spd) >= MAX_SPEED_CHANGE * np.max(spd)
+        return self._signal_reason(
+            self._acc[-every:], timing=self._acc.size >= self.buffer, steady=steady
+        )
+
+    def _restart_window(self) -> None:
+        """Empty the window (its samples failed a check)."""
+        self._acc, self._spd, self._t, self._pos = (np.empty(0),) * 4
+        self._fresh = 0
 
     # --- the change-point method -----------------------------------------------------------------
 
@@ -575,7 +613,7 @@ class BCR:
             )
         phase.undo = (phase.filter.state(), phase.data_time, ds)
         phase.filter.update(self.model.loglik(y, v), ds)
-        phase.data_time = self._now()[0]
+        phase.data_time = float(self._t[-1])  # the block's newest sample, not the caller's clock
         return self._posterior_estimate("", tic, v, y)
 
     def _posterior_estimate(self, reason: str, tic: float, v: float, y) -> Estimate:
@@ -674,19 +712,21 @@ class BCR:
 
     def _estimate_window(self) -> Estimate:
         s = self.settings
+        bad_signal = self._window_signal_reason()
         if self._fault:
             reason, self._fault = self._fault, ""
+            if bad_signal:  # the samples kept after the break fail too
+                self._restart_window()
+                reason += f" and {bad_signal}"
             return self._no_estimate("sensor_fault", reason + "; buffer restarted")
+        if bad_signal:
+            self._restart_window()
+            return self._no_estimate("sensor_fault", bad_signal + "; buffer restarted")
         if self._acc.size < self.buffer:
             return self._no_estimate(
                 "filling", f"buffer holds {self._acc.size} of {self.buffer} samples"
             )
         tic = _time.perf_counter()
-        bad_signal = self._signal_reason(self._acc)
-        if bad_signal:
-            self._acc, self._spd, self._t, self._pos = (np.empty(0),) * 4
-            self._fresh = 0
-            return self._no_estimate("sensor_fault", bad_signal + "; buffer restarted")
         v = float(np.mean(self._spd))
         lo, hi = self.speed_range
         unit = float(self.model.emulator.standardizer.x_to_unit([[v]])[0, 0])
@@ -720,7 +760,7 @@ class BCR:
         tracker.update(np.ravel(grid), np.ravel(loglik), power=power)
         self._fresh = 0
         self._tracked_at[chain] = pos_now
-        self._data_time = t_now
+        self._data_time = float(self._t[-1])  # the window's newest sample, not the caller's clock
         post = tracker.posterior(self.gd_name)
         name = self.gd_name
         edge, note = self._edge_note(post, np.exp(tracker.log_prior))
@@ -736,7 +776,7 @@ class BCR:
             latency_s=_time.perf_counter() - tic,
             speed=v,
             feature=np.array([y]),
-            data_time=t_now,
+            data_time=self._data_time,
             domain_edge=edge,
         )
 

@@ -136,11 +136,15 @@ class ChangePointFilter:
 
     def _predicted(self, ds_m: float) -> tuple[np.ndarray, np.ndarray]:
         """(mass, dist) after ds_m metres, the filter unchanged. Runs beyond ``max_runs`` are
-        merged into the last row at their mass-weighted mean distance, which keeps growing."""
+        merged into the last row at their mass-weighted mean distance, which keeps growing.
+        No distance (``ds_m == 0``, a standstill) is no hazard: the state stays as it is (a
+        run-length row of no mass per step would push real runs into the merged last row)."""
         if not (is_real(ds_m) and np.isfinite(ds_m) and ds_m >= 0):
             raise ControlError(f"ds_m must be finite and >= 0, got {ds_m!r}")
         if not self._has_data:  # before any block the prior already is "a new segment"
             return self._mass, self._dist + ds_m
+        if ds_m == 0:
+            return self._mass, self._dist
         h = self._hazard(ds_m)
         ended = (h[:, None] * self._mass).sum(axis=0)
         mass = np.vstack([(ended @ self._jump)[None, :], self._mass * (1.0 - h)[:, None]])

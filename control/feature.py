@@ -95,7 +95,9 @@ class FeatureSpec:
                 f"bands_hz must be a sequence of finite edges, Hz, got {self.bands_hz!r}"
             )
         object.__setattr__(self, "bands_hz", tuple(float(b) for b in edges))
-        if self.name == "log_band_power":
+        if self.name != "log_band_power":
+            self._refuse_band_settings()
+        else:
             nyquist = self.rate_hz / 2
             if edges.size < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
                 raise ControlError(f"bands_hz must be >= 2 increasing edges >= 0, got {edges}")
@@ -137,6 +139,19 @@ class FeatureSpec:
                 f"quantiles go with the log_band_power feature only, not {self.name!r}"
             )
         object.__setattr__(self, "quantiles", tuple(float(q) for q in levels))
+
+    def _refuse_band_settings(self) -> None:
+        """ControlError for a band setting (bands, tapers) that differs from its default: the
+        window features ignore them (the variance of the window, no spectrum)."""
+        default = FeatureSpec.__dataclass_fields__
+        for name in ("bands_hz", "taper_nw", "n_tapers"):
+            value, usual = getattr(self, name), default[name].default
+            if value != usual:
+                raise ControlError(
+                    f"{name} = {value!r} is ignored by the {self.name!r} feature (the window's "
+                    f"variance, no spectrum): leave it at its default {usual!r}, or use "
+                    "name='log_band_power'"
+                )
 
     @property
     def dim(self) -> int:

@@ -37,6 +37,10 @@ quantisation as short as 6 samples (`lattice_stretch`)."""
 MAX_ACCEL_MPS2 = 1e5
 """Largest |acceleration| the signal checks take as a reading, m/s^2 (about 10,000 g: beyond any
 accelerometer's range; larger values are a fault, and their squares could overflow)."""
+MAX_SPEED_MPS = 50.0
+"""Largest |speed| the stream checks take as a reading, m/s (180 km/h: 25 times a Jackal-class
+ground robot's 2 m/s top speed, beyond any vehicle this BCR serves; a larger value is a broken
+sample, dropped like a non-finite one, before a mean or the odometry check overflows on it)."""
 MAX_NOISE_SD_MPS2 = 1e4
 """Largest sensor noise sd the checks take, m/s^2 (about 1,000 g: beyond any accelerometer;
 its square must stay finite)."""
@@ -178,10 +182,11 @@ def longest_repeat(a: np.ndarray) -> int:
     return int(np.max(np.diff(edges)))
 
 
-def signal_fault(accel: np.ndarray, limits: SensorLimits) -> str:
+def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True) -> str:
     """Why a block of accelerations (finite values, m/s^2) cannot come from a healthy sensor,
     or "" (stuck, quantised, clipped, a dead stretch, quieter than the sensor's noise, a level
-    that jumps within the block)."""
+    that jumps within the block). ``steady=False``: the vehicle started or stopped within the
+    block, whose level then changes with the speed: no level-jump check."""
     a = np.asarray(accel, dtype=float)
     if a.size < 2:
         return ""
@@ -230,7 +235,7 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits) -> str:
                     f"the sensor's own noise (variance {variance:.3g} (m/s^2)^2, below "
                     f"{fraction:.3g} of the noise variance {noise_var:g})"
                 )
-    ratio, (start, stop) = level_jump(a)
+    ratio, (start, stop) = level_jump(a) if steady else (1.0, (0, 0))
     if ratio > limits.max_level_jump:
         return (
             f"signal level jumps within the block: the variance of samples {start}-{stop - 1} "
@@ -429,12 +434,16 @@ def stream_fault(
 ) -> tuple[np.ndarray, np.ndarray, str]:  # fmt: skip
     """Samples that break the stream: (drop (n,), restart (n,), reason or "").
 
-    ``drop`` marks samples to discard: a value that is not finite, or a time stamp that repeats
-    or goes backwards (a step below half a period from the previous sample; ``t_prev``: the
-    time of the sample before the first, NaN if none). ``restart`` marks samples after a gap (a
-    step above 1.5 periods: dropped samples): they are kept but begin a new contiguous run.
+    ``drop`` marks samples to discard: a value that is not finite, a speed beyond
+    ``MAX_SPEED_MPS``, or a time stamp that repeats or goes backwards (a step below half a
+    period from the previous sample; ``t_prev``: the time of the sample before the first, NaN
+    if none). ``restart`` marks samples after a gap (a step above 1.5 periods: dropped
+    samples): they are kept but begin a new contiguous run.
     """
-    bad_value = ~(np.isfinite(t) & np.isfinite(position) & np.isfinite(accel) & np.isfinite(speed))
+    finite = np.isfinite(t) & np.isfinite(position) & np.isfinite(accel) & np.isfinite(speed)
+    with np.errstate(invalid="ignore"):
+        too_fast = np.abs(speed) > MAX_SPEED_MPS
+    bad_value = ~finite | too_fast
     dt = 1.0 / rate_hz
     step = t - _previous_finite(t, t_prev)
     finite_step = np.isfinite(step)  # a non-finite time stamp is a bad value, not a step
@@ -442,13 +451,19 @@ def stream_fault(
         backwards = finite_step & (step < 0.5 * dt)
         gap = finite_step & (step > 1.5 * dt)
     what = []
-    if bad_value.any():
+    if not finite.all():
         names = [
             name
             for name, a in (("t", t), ("position", position), ("accel", accel), ("speed", speed))
             if not np.all(np.isfinite(a))
         ]
-        what.append(f"{int(bad_value.sum())} sample(s) with non-finite {'/'.join(names)}")
+        what.append(f"{int((~finite).sum())} sample(s) with non-finite {'/'.join(names)}")
+    if too_fast.any():
+        fastest = float(np.max(np.abs(speed[too_fast])))
+        what.append(
+            f"{int(too_fast.sum())} sample(s) with |speed| up to {fastest:.3g} m/s, beyond any "
+            f"ground robot's (MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
+        )
     if backwards.any():
         what.append(f"{int(backwards.sum())} repeated or backwards time stamp(s)")
     if gap.any():
@@ -464,9 +479,15 @@ def timing_fault(
     come from a stream at ``rate_hz`` with working odometry, or "": its time stamps span
     another duration than its samples at that rate (beyond ``limits.rate_tolerance``), or its
     positions advance otherwise than its speeds say (beyond ``limits.odometry_tolerance`` and
-    ``limits.odometry_slack_m``)."""
+    ``limits.odometry_slack_m``), or a speed exceeds ``MAX_SPEED_MPS``."""
     if t.size < 2:
         return ""
+    fastest = float(np.max(np.abs(speed)))
+    if fastest > MAX_SPEED_MPS:  # before the odometry check integrates them (and overflows)
+        return (
+            f"out of range: |speed| reaches {fastest:.3g} m/s, beyond any ground robot's "
+            f"(MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
+        )
     span, expected = float(t[-1] - t[0]), (t.size - 1) / rate_hz
     if abs(span / expected - 1.0) > limits.rate_tolerance:
         return (
