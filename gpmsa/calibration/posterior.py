@@ -81,12 +81,14 @@ class GridMarginal:
         """Quantile function: the inverse of ``cdf`` (exact for the piecewise-linear density)."""
         q = np.asarray(q, dtype=float)
         mass = self._cell_mass()
-        cum = np.concatenate([[0.0], np.cumsum(mass)])
+        cells = np.flatnonzero(mass > 0.0)  # cells without mass hold no quantile
+        cum = np.concatenate([[0.0], np.cumsum(mass[cells])])
         target = q * cum[-1]
-        k = np.clip(np.searchsorted(cum, target, side="right") - 1, 0, mass.size - 1)
+        j = np.clip(np.searchsorted(cum, target, side="left") - 1, 0, cells.size - 1)
+        k = cells[j]
         a, h = self.nodes[k], np.diff(self.nodes)[k]
         f0, f1 = self.density[k], self.density[k + 1]
-        r = target - cum[k]  # solve f0 t + (f1 - f0) t^2 / (2h) = r for t in [0, h]
+        r = target - cum[j]  # solve f0 t + (f1 - f0) t^2 / (2h) = r for t in [0, h]
         slope = (f1 - f0) / h
         denom = f0 + np.sqrt(np.maximum(f0 * f0 + 2.0 * slope * r, 0.0))
         t = 2.0 * r / np.where(denom > 0.0, denom, 1.0)
