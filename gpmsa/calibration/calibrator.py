@@ -6,7 +6,8 @@ is Gaussian at every theta (``gpmsa.calibration.model``), lamOs is integrated ou
 quadrature, and the posterior is the prior times that likelihood on the grid, refined around each
 mode (separated region of mass) that the grid does not resolve. Between nodes the posterior
 density is linear (bilinear for two parameters): its moments, quantiles and draws all use that
-density. More parameters use the MCMC of ``gpmsa.calibrate``.
+density (``gpmsa.calibration.grid``: interpolation, constraint boundaries, draws, refinement).
+More parameters use the MCMC of ``gpmsa.calibrate``.
 
 The fixed grid (``Calibrator.theta_grid``): ``n_grid`` equally spaced nodes per calibration
 parameter spanning the emulator's training range [t_min, t_max] of that parameter, end points
@@ -16,13 +17,23 @@ included (default 129 for one parameter, 65 x 65 for two, in 'ij' order, first p
 from __future__ import annotations
 
 import inspect
-import itertools
 
 import numpy as np
-from scipy.interpolate import RegularGridInterpolator
 from scipy.special import ndtr
 
 from gpmsa import backends
+from gpmsa.calibration.grid import (
+    check_log_density,
+    check_mass,
+    constrained,
+    draw_bilinear,
+    interp_log,
+    mesh,
+    nearest,
+    refined_axes,
+    trimmed_marginal,
+    with_edges,
+)
 from gpmsa.calibration.model import GridPredictor, LamOsMarginal, lamos_marginal
 from gpmsa.calibration.observations import (
     EMULATOR_PARAM_MODES,
@@ -36,42 +47,17 @@ from gpmsa.calibration.observations import (
     reduce,
     warn_if_outside,
 )
-from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
+from gpmsa.calibration.posterior import Posterior, trapezoid_weights
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 
 METHODS = ("auto", "grid", "mcmc")
-RESOLVE_SD = 4.0
-"""The grid resolves a mode of the posterior whose sd spans at least this many node spacings
-(per parameter); otherwise that mode is recomputed on a finer grid over the region holding its
-mass."""
-MASS_CUTOFF = 1e-14
-"""Nodes whose (marginal) posterior density is below this fraction of the peak carry no mass; the
-runs of nodes above it are the posterior's modes."""
-MODE_MASS = 1e-9
-"""Modes holding less than this fraction of the posterior mass are not refined."""
-VALLEY = 0.5
-"""A local minimum of the density separates two peaks when it is below this fraction of the
-highest density on either side of it."""
-N_REFINE = 129
-N_REFINE_2D = 49
-"""Nodes per parameter of a refined mode (one, two calibration parameters)."""
-REFINE_MODES = 2
-"""Up to this many modes are refined with N_REFINE (N_REFINE_2D) nodes each; more share
-REFINE_MODES times that, at least MIN_MODE_NODES each."""
-MIN_MODE_NODES = 9
 MAX_REFINE = 4
-MAX_REFINED = 4
-"""A refined grid holds at most this many times the nodes of one refined mode (N_REFINE, or
-N_REFINE_2D squared); refinement stops before a grid would hold more."""
-REFINE_FACTORS = (2.0, 1.5, 1.25)
-"""A refined region has at least this many times the cells it had (the first that fits)."""
+"""Refinement passes of one update, at most (each refines the peaks still unresolved)."""
 BISECT_STEPS = 64
 """Bisection steps locating a constraint's boundary between two nodes (to adjacent floats)."""
-SAME_NODE = 0.01
-"""A refined node this close to a grid line it must keep (in node spacings) gives way to it."""
 
 
 def _check_mcmc_options(options) -> dict:
@@ -190,7 +176,7 @@ class Calibrator:
             f"x {n_sets} emulator parameter set(s)",
         )
         self._axes = [np.linspace(0.0, 1.0, self.n_grid)] * q
-        self._theta_unit = _mesh(self._axes)
+        self._theta_unit = mesh(self._axes)
         std = emulator.standardizer
         self.theta_grid = std.t_from_unit(self._theta_unit)
         if q == 1:
@@ -292,7 +278,7 @@ class Calibrator:
     # --- posterior ------------------------------------------------------------------------------
     def _prior_values(self, prior, theta_unit: np.ndarray, on_grid: bool) -> np.ndarray:
         """User log prior at unit-scale nodes (callable of native theta, or values on the grid,
-        interpolated by `_interp_log` off the grid)."""
+        interpolated by `interp_log` off the grid)."""
         if prior is None:
             return np.zeros(theta_unit.shape[0])
         if callable(prior):
@@ -314,10 +300,10 @@ class Calibrator:
                     f"{' or '.join(map(str, shapes))} (theta_grid's order), got {vals.shape}"
                 )
             vals = vals.reshape(-1)
-            _check_log_density(vals)
+            check_log_density(vals)
             if not on_grid:
-                vals = _interp_log(vals, self._axes[0], theta_unit)
-        _check_log_density(vals)
+                vals = interp_log(vals, self._axes[0], theta_unit)
+        check_log_density(vals)
         return vals
 
     def update(self, x_obs, y_obs, prior=None, seed=None) -> Posterior:
@@ -359,18 +345,18 @@ class Calibrator:
                 user = self._prior_values(prior, theta, True)
                 free = free + user
                 keep = self._axes if not callable(prior) and np.isneginf(user).any() else None
-            logp = _constrained(free, ok)
-            _check_mass(logp)
+            logp = constrained(free, ok)
+            check_mass(logp)
             for _ in range(MAX_REFINE):
-                finer = _refined_axes(axes, logp, keep)
+                finer = refined_axes(axes, logp, keep)
                 if finer is None:
                     break
-                axes, theta = finer, _mesh(finer)
+                axes, theta = finer, mesh(finer)
                 margs = self._marginals(data, theta)
                 free = self._combine(margs) + self._theta_prior_at(theta, prior)
                 ok = None if self.constraint is None else self._allowed(theta)
-                logp = _constrained(free, ok)
-                _check_mass(logp)
+                logp = constrained(free, ok)
+                check_mass(logp)
         key = check_seed(seed) if seed is not None else (self._entropy, self._count)
         post = self._posterior(axes, free, ok, margs, key)
         post.info["outside_sds"] = outside
@@ -438,14 +424,14 @@ class Calibrator:
         native = [a * (std.t_max[k] - std.t_min[k]) + std.t_min[k] for k, a in enumerate(axes)]
         inv_lamos = None
         if self.q == 1:
-            nodes, logd, lik = axes[0], _constrained(free, ok), None
+            nodes, logd, lik = axes[0], constrained(free, ok), None
             if ok is not None:
                 edges = self._base_edges if base else self._constraint_edges(nodes, ok)
-                nodes, logd, lik = _with_edges(nodes, free, ok, edges)
+                nodes, logd, lik = with_edges(nodes, free, ok, edges)
             inserted = nodes.size > free.size
             x = native[0] if not inserted else nodes * (std.t_max[0] - std.t_min[0]) + std.t_min[0]
             w = self._weights if base and not inserted else trapezoid_weights(x)
-            gm, kept = _trimmed_marginal(x, logd, w)
+            gm, kept = trimmed_marginal(x, logd, w)
             grids = {names[0]: gm}
             peak = float(logd.max())
             log_evidence = float(np.log(w @ np.exp(logd - peak))) + peak
@@ -455,13 +441,13 @@ class Calibrator:
                 lik = np.arange(x.size) if lik is None else lik
                 inv_lamos = inv_lamos[lik][kept]
         else:
-            logd = _constrained(free, ok)
+            logd = constrained(free, ok)
             dens = np.exp(logd - logd.max()).reshape(axes[0].size, axes[1].size)
             w = [trapezoid_weights(a) for a in native]
             with np.errstate(divide="ignore"):
                 grids = {
-                    names[0]: _trimmed_marginal(native[0], np.log(dens @ w[1]))[0],
-                    names[1]: _trimmed_marginal(native[1], np.log(w[0] @ dens))[0],
+                    names[0]: trimmed_marginal(native[0], np.log(dens @ w[1]))[0],
+                    names[1]: trimmed_marginal(native[1], np.log(w[0] @ dens))[0],
                 }
             log_evidence = None
         n_draws = self.n_draws
@@ -471,10 +457,10 @@ class Calibrator:
             if self.q == 1:
                 th = grids[names[0]].sample(rng, n_draws)
                 out = {names[0]: th}
-                node = _nearest(x, th)
+                node = nearest(x, th)
                 node = node if lik is None else lik[node]
             else:
-                vals, node = _draw_bilinear(native, dens, rng, n_draws)
+                vals, node = draw_bilinear(native, dens, rng, n_draws)
                 out = {name: vals[:, k] for k, name in enumerate(names)}
             out["lamOs"] = _draw_lamos(margs, node, rng)
             return out
@@ -508,250 +494,6 @@ def _block_diag(cov: np.ndarray) -> np.ndarray:
     for c in range(p_u):
         out[:, c * n : (c + 1) * n, c * n : (c + 1) * n] = cov[:, c]
     return out
-
-
-def _mesh(axes: list) -> np.ndarray:
-    """The nodes (G, q) of the grid with the given axes, 'ij' order (first parameter slowest)."""
-    if len(axes) == 1:
-        return axes[0][:, None]
-    mesh = np.meshgrid(*axes, indexing="ij")
-    return np.column_stack([g.ravel() for g in mesh])
-
-
-def _constrained(free: np.ndarray, ok: np.ndarray | None) -> np.ndarray:
-    """Log density ``free`` (G,) set to -inf where ``ok`` (G,) is False (None: nowhere)."""
-    return free if ok is None else np.where(ok, free, -np.inf)
-
-
-def _check_log_density(vals: np.ndarray) -> None:
-    if np.any(np.isnan(vals)) or np.any(vals == np.inf):
-        raise GPMSAError("prior log densities must not be NaN or +inf")
-
-
-def _check_mass(logp: np.ndarray) -> None:
-    if np.any(np.isnan(logp)) or not np.any(np.isfinite(logp)):
-        raise GPMSAError("the posterior has no mass on the grid (prior zero everywhere?)")
-
-
-def _interp_log(table: np.ndarray, axis: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Log densities ``table`` on the grid axis^q ((n^q,), 'ij' order; -inf: zero density) at
-    the points (k, q), q = 1 or 2: linear (bilinear) in the log where the nodes around a point
-    are finite, in the density where one of them is zero. A point gets -inf only where the
-    density is zero, and never NaN."""
-
-    def at(values: np.ndarray) -> np.ndarray:
-        if points.shape[1] == 1:
-            return np.interp(points[:, 0], axis, values)
-        return RegularGridInterpolator((axis, axis), values.reshape(axis.size, -1))(points)
-
-    finite = np.isfinite(table)
-    if finite.all():
-        return at(table)
-    if not finite.any():
-        return np.full(points.shape[0], -np.inf)
-    peak = float(table[finite].max())
-    by_log = at(np.where(finite, table, peak))
-    near_zero = at((~finite).astype(float)) > 0.0
-    with np.errstate(divide="ignore"):
-        by_density = np.log(at(np.exp(table - peak))) + peak
-    return np.where(near_zero, by_density, by_log)
-
-
-def _with_edges(
-    nodes: np.ndarray, free: np.ndarray, ok: np.ndarray, edges: tuple[np.ndarray, ...]
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One parameter: the unit-scale ``nodes`` (k,) with the constraint's boundary points
-    ``edges`` (``Calibrator._constraint_edges``) inserted, so that the piecewise-linear density
-    ends at the boundary instead of ramping to zero across the cell beyond it.
-
-    Returns (nodes, log density, likelihood node of each node (its allowed neighbour for an
-    inserted point)); an inserted point gets the log density ``free`` interpolated there
-    (`_interp_log`), or -inf where the constraint forbids it."""
-    cells, first, second = edges
-    logd = _constrained(free, ok)
-    if cells.size == 0:
-        return nodes, logd, np.arange(nodes.size)
-    cell = np.concatenate([cells, cells])
-    pts = np.concatenate([first, second])
-    allowed = np.concatenate([ok[cells], ok[cells + 1]])
-    new = (pts > nodes[cell]) & (pts < nodes[cell + 1])  # a point on a node is that node
-    cell, pts, allowed = cell[new], pts[new], allowed[new]
-    vals = np.where(allowed, _interp_log(free, nodes, pts[:, None]), -np.inf)
-    lik = np.where(ok[cell], cell, cell + 1)
-    x = np.concatenate([nodes, pts])
-    order = np.argsort(x, kind="stable")
-    lik_all = np.concatenate([np.arange(nodes.size), lik])
-    return x[order], np.concatenate([logd, vals])[order], lik_all[order]
-
-
-def _trimmed_marginal(
-    nodes: np.ndarray, log_density: np.ndarray, weights: np.ndarray | None = None
-) -> tuple[GridMarginal, slice]:
-    """The GridMarginal of exp(log_density) on ``nodes`` cut to its support: one node of zero
-    density is kept past the outermost nodes of positive density, no more (so that its quantile
-    function ends where the mass ends); also the slice of the nodes kept."""
-    gm = GridMarginal.from_log_density(nodes, log_density, weights)
-    if gm.density[0] > 0.0 and gm.density[-1] > 0.0:
-        return gm, slice(0, nodes.size)
-    live = np.flatnonzero(gm.density > 0.0)
-    kept = slice(max(int(live[0]) - 1, 0), min(int(live[-1]) + 2, nodes.size))
-    if kept.stop - kept.start == nodes.size:
-        return gm, kept
-    return GridMarginal.from_log_density(nodes[kept], log_density[kept]), kept
-
-
-def _nearest(nodes: np.ndarray, values: np.ndarray) -> np.ndarray:
-    """Index of the node of the increasing ``nodes`` (k,) nearest to each value."""
-    j = np.clip(np.searchsorted(nodes, values), 1, nodes.size - 1)
-    return j - (values - nodes[j - 1] < nodes[j] - values)
-
-
-def _cell_inverse(g0: np.ndarray, g1: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """Inverse CDF on [0, 1] of the density proportional to (1 - s) g0 + s g1 at probabilities
-    ``r`` (all (n,), g0, g1 >= 0)."""
-    target = 0.5 * r * (g0 + g1)  # solve g0 s + (g1 - g0) s^2 / 2 = target
-    denom = g0 + np.sqrt(np.maximum(g0 * g0 + 2.0 * (g1 - g0) * target, 0.0))
-    return np.clip(2.0 * target / np.where(denom > 0.0, denom, 1.0), 0.0, 1.0)
-
-
-def _draw_bilinear(
-    axes: list, dens: np.ndarray, rng: np.random.Generator, size: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """``size`` draws (size, 2) from the bilinear interpolant of ``dens`` (n0, n1) on the grid of
-    the native ``axes`` (the density whose marginals the posterior's GridMarginals are: a cell by
-    its mass, then the first parameter from the cell's marginal, the second from its
-    conditional), and the flat index ('ij') of each draw's nearest node."""
-    h0, h1 = np.diff(axes[0]), np.diff(axes[1])
-    corners = dens[:-1, :-1] + dens[1:, :-1] + dens[:-1, 1:] + dens[1:, 1:]
-    cum = np.cumsum((np.outer(h0, h1) * corners).ravel())
-    cell = np.searchsorted(cum, rng.random(size) * cum[-1], side="right")
-    i, j = np.divmod(np.minimum(cell, cum.size - 1), h1.size)
-    f00, f10, f01, f11 = dens[i, j], dens[i + 1, j], dens[i, j + 1], dens[i + 1, j + 1]
-    s = _cell_inverse(f00 + f01, f10 + f11, rng.random(size))
-    t = _cell_inverse((1 - s) * f00 + s * f10, (1 - s) * f01 + s * f11, rng.random(size))
-    vals = np.column_stack([axes[0][i] + s * h0[i], axes[1][j] + t * h1[j]])
-    node = (i + np.rint(s).astype(int)) * axes[1].size + j + np.rint(t).astype(int)
-    return vals, node
-
-
-def _one_resolved_peak(axis: np.ndarray, density: np.ndarray) -> bool:
-    """Whether the density (k,) on ``axis`` (k,) rises to one peak and falls (no valley) with an
-    sd of at least RESOLVE_SD of the widest node spacing: a quick sufficient test that `_modes`
-    finds nothing to refine (the usual case on the fixed grid)."""
-    k = int(np.argmax(density))
-    slope = np.diff(density)
-    if slope[:k].min(initial=0.0) < 0.0 or slope[k:].max(initial=0.0) > 0.0:
-        return False
-    total = density.sum()
-    mean = density @ axis / total
-    return bool(density @ (axis - mean) ** 2 / total >= (RESOLVE_SD * np.diff(axis).max()) ** 2)
-
-
-def _modes(axis: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The modes of a (marginal) density (k,) on the increasing ``axis`` (k,): the runs of nodes
-    above MASS_CUTOFF of the peak, as (first (r,), last (r,), unresolved (r,)). A run is
-    unresolved when a peak in it (the run cut at its `_valleys`) holds at least MODE_MASS of the
-    mass and its sd spans fewer than RESOLVE_SD of its node spacings. Nodes are equally spaced
-    within a run (a refined region)."""
-    live = np.flatnonzero(density >= MASS_CUTOFF * density.max())
-    slope = np.diff(density)
-    dips = np.flatnonzero((slope[:-1] < 0.0) & (slope[1:] > 0.0)) + 1  # local minima
-    if live[-1] - live[0] + 1 == live.size:
-        first, last = live[:1], live[-1:]
-        if dips.size == 0:  # one peak, the usual case
-            _, sd, spacing = _mode_stats(axis, density, live[0], live[-1])
-            return first, last, np.array([sd < RESOLVE_SD * spacing])
-    else:
-        cut = np.flatnonzero(np.diff(live) > 1)
-        first = live[np.concatenate(([0], cut + 1))]
-        last = live[np.concatenate((cut, [live.size - 1]))]
-    peaks, owner = [], []
-    for r, (i0, i1) in enumerate(zip(first, last, strict=True)):
-        bounds = [i0, *_valleys(density, dips, i0, i1), i1]
-        peaks += [_mode_stats(axis, density, b0, b1) for b0, b1 in itertools.pairwise(bounds)]
-        owner += [r] * (len(bounds) - 1)
-    mass, sd, spacing = np.array(peaks).T
-    narrow = (mass >= MODE_MASS * mass.sum()) & (sd < RESOLVE_SD * spacing)
-    unresolved = np.zeros(first.size, dtype=bool)
-    unresolved[np.asarray(owner)[narrow]] = True
-    return first, last, unresolved
-
-
-def _valleys(density: np.ndarray, dips: np.ndarray, i0: int, i1: int) -> list[int]:
-    """The local minima ``dips`` inside the run i0..i1 of ``density`` that separate two peaks:
-    lower than VALLEY times the highest density on either side, within the run (a shallow dip,
-    such as rounding noise on a flat density, separates nothing)."""
-    inside = dips[(dips > i0) & (dips < i1)]
-    if inside.size == 0:
-        return []
-    run = density[i0 : i1 + 1]
-    left = np.maximum.accumulate(run)[inside - i0]
-    right = np.maximum.accumulate(run[::-1])[::-1][inside - i0]
-    return inside[density[inside] < VALLEY * np.minimum(left, right)].tolist()
-
-
-def _mode_stats(axis: np.ndarray, density: np.ndarray, i0: int, i1: int) -> tuple[float, ...]:
-    """(mass, sd, node spacing) of the mode on nodes i0..i1 (and one more each side)."""
-    d, a = density[i0 : i1 + 1], axis[i0 : i1 + 1]
-    j0, j1 = max(i0 - 1, 0), min(i1 + 1, axis.size - 1)
-    spacing = (axis[j1] - axis[j0]) / (j1 - j0)
-    total = d.sum()
-    mean = d @ a / total
-    return total * spacing, np.sqrt(d @ (a - mean) ** 2 / total), spacing
-
-
-def _finer_axis(
-    axis: np.ndarray, modes: tuple, n: int, keep: np.ndarray | None, factor: float
-) -> np.ndarray:
-    """The axis of a refined grid: each mode's region (its nodes and one more each side) with
-    ``n`` equally spaced nodes (fewer beyond REFINE_MODES modes), at least ``factor`` times as
-    many cells as it has, where the mode is unresolved; its present nodes where it is resolved;
-    the grid lines ``keep`` inside a refined region are kept."""
-    first, last, unresolved = modes
-    k = int(unresolved.sum())
-    if k > REFINE_MODES:
-        n = max(REFINE_MODES * n // k, MIN_MODE_NODES)
-    pieces = []
-    for i0, i1, finer in zip(first, last, unresolved, strict=True):
-        j0, j1 = max(i0 - 1, 0), min(i1 + 1, axis.size - 1)
-        if not finer:
-            pieces.append(axis[j0 : j1 + 1])
-            continue
-        piece = np.linspace(axis[j0], axis[j1], max(n, int(np.ceil(factor * (j1 - j0))) + 1))
-        if keep is not None:
-            lines = keep[(keep > axis[j0]) & (keep < axis[j1])]
-            near = np.abs(piece[:, None] - lines[None, :]).min(axis=1, initial=np.inf)
-            piece = np.concatenate([piece[near > SAME_NODE * (piece[1] - piece[0])], lines])
-        pieces.append(piece)
-    return np.unique(np.concatenate(pieces))
-
-
-def _refined_axes(axes: list, logp: np.ndarray, keep: list | None) -> list | None:
-    """The unit-scale axes of a finer grid where a mode of the posterior (log density ``logp``
-    (G,) on the grid of ``axes``) is not resolved along some parameter (`_modes` of its
-    marginal), None when all are; ``keep``: grid lines per parameter that a refined region
-    keeps (None: none)."""
-    f = np.exp(logp - np.max(logp))
-    if len(axes) == 1:
-        if _one_resolved_peak(axes[0], f):
-            return None
-        marginals = [f]  # no trapezoid weights: equally spaced within a mode
-    else:
-        f = f.reshape(axes[0].size, axes[1].size)
-        w = [trapezoid_weights(a) for a in axes]
-        marginals = [f @ w[1], w[0] @ f]
-    modes = [_modes(a, m) for a, m in zip(axes, marginals, strict=True)]
-    if not any(m[2].any() for m in modes):
-        return None
-    n = N_REFINE if len(axes) == 1 else N_REFINE_2D
-    for factor in REFINE_FACTORS:  # the largest that keeps the grid within MAX_REFINED
-        finer = [
-            _finer_axis(a, m, n, None if keep is None else keep[k], factor)
-            for k, (a, m) in enumerate(zip(axes, modes, strict=True))
-        ]
-        if np.prod([a.size for a in finer]) <= MAX_REFINED * n ** len(axes):
-            return finer
-    return None
 
 
 def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
