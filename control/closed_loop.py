@@ -25,6 +25,7 @@ from control.metrics import (
     segment_index,
     strict_json,
 )
+from control.robot.storage import check_mcap_target
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_instance, is_real, path_argument
@@ -157,11 +158,10 @@ def _check_faults(faults) -> tuple[SensorFault, ...]:
 
 
 def _check_record_path(record) -> None:
-    """ControlError before the drive when ``record`` is not a path, names a folder or has no
-    writable folder."""
+    """ControlError before the drive when ``record`` is not a path, names a folder or a file
+    that is not an earlier recording (`check_mcap_target`), or has no writable folder."""
     path = path_argument(record, "record", " of the .mcap file to write")
-    if path.is_dir():
-        raise ControlError(f"record={str(record)!r} is a folder; name the .mcap file to write")
+    check_mcap_target(path, "record")
     folder = next((p for p in path.absolute().parents if p.exists()), None)
     if folder is None or not folder.is_dir() or not os.access(folder, os.W_OK):
         raise ControlError(f"record={str(record)!r}: cannot write under {folder}")

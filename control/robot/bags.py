@@ -136,6 +136,18 @@ def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic
             )
 
 
+def in_bag_folder(path: Path) -> bool:
+    """Whether ``path`` is a ``*.mcap`` or ``*.db3`` file of a ROS 2 bag folder (beside its
+    ``metadata.yaml``): then the folder is what is read."""
+    return path.suffix in (".mcap", ".db3") and (path.parent / "metadata.yaml").is_file()
+
+
+def source_of(path: Path) -> Path:
+    """What reading the recording ``path`` reads: the bag folder for a file inside one
+    (`in_bag_folder`), else ``path`` itself."""
+    return path.parent if in_bag_folder(path) else path
+
+
 def _resolve(path: Path) -> tuple[Path, str]:
     """(what to open, its kind) for a path the user gave."""
     if not path.exists():
@@ -149,7 +161,7 @@ def _resolve(path: Path) -> tuple[Path, str]:
                 "folder, a *.mcap file or a ROS 1 *.bag file)"
             )
         return path, "rosbag2"
-    if path.suffix in (".mcap", ".db3") and (path.parent / "metadata.yaml").is_file():
+    if in_bag_folder(path):
         return path.parent, "rosbag2"
     if path.suffix == ".mcap":
         return path, "mcap"
@@ -423,6 +435,8 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
             reader = reader_mod.make_reader(f, validate_crcs=True)
             summary = reader.get_summary()
         except Exception as exc:  # the mcap package raises its own errors for damaged files
+            if cut := storage_mod.truncation(f):  # its errors for these say nothing of why
+                raise BagError(f"{path} {cut}") from exc
             raise BagError(f"cannot read {path} as an MCAP file: {_why(exc)}") from exc
         if summary is not None:
             topics = {

@@ -26,7 +26,8 @@ from control.errors import ControlError
 from control.robot import messages as msgs
 from control.robot.bags import MAX_STAMP_NS, merge_in_time, sensor_messages, stamps_ns
 from control.robot.extra import require
-from control.validation import check_instance
+from control.robot.storage import check_mcap_target
+from control.validation import check_instance, path_argument
 from gpmsa.io.atomic import atomic_write
 
 TOPICS = {
@@ -78,7 +79,8 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
 
     Args:
         result: the closed loop's result (`control.run_closed_loop`).
-        path: the ``*.mcap`` file to write (replaced if it exists; its folder is made).
+        path: the ``*.mcap`` file to write (an earlier MCAP file there is replaced; any other
+            file is refused, `storage.check_mcap_target`; its folder is made).
         start_ns: the time stamp of the run's time 0, ns, in [0, 2**31 s) (0: the epoch;
             Foxglove shows seconds from the start either way); every header stamp and receive
             time is that much later.
@@ -90,6 +92,8 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     from control.robot.replay import estimate_message
 
     check_instance(result, "result", ClosedLoopResult)
+    path = path_argument(path, "path", " of the .mcap file to write")
+    check_mcap_target(path, "path")
     writer_mod = require("mcap.writer", "recording a run as MCAP")
     if (isinstance(start_ns, bool) or not isinstance(start_ns, int | np.integer)
             or not 0 <= start_ns < MAX_STAMP_NS):  # fmt: skip
@@ -116,7 +120,6 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     truth = [bytes(store.serialize_cdr(f64(data=float(g)), msgs.FLOAT64_TYPE))
              for g in result.gd_true]  # fmt: skip
 
-    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_write(path, error=ControlError) as f:
         writer = writer_mod.Writer(f)

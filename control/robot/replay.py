@@ -53,6 +53,7 @@ from control.robot.bags import (
     open_bag_writer,
     read_recording,
     recording_path,
+    source_of,
 )
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
@@ -68,6 +69,8 @@ CSV_COLUMNS = (
     "gd_mean", "gd_sd", "gd_lo", "gd_hi", "prob_gd_above_max", "prob_change", "command_mps",
     "mode",
 )  # fmt: skip
+CSV_HEADER = ",".join(CSV_COLUMNS).encode()
+"""The first line of a CSV of estimates (`ReplayResult.to_csv`), without its line end."""
 
 
 MIN_HIGHPASS_HZ = 1e-4
@@ -232,8 +235,10 @@ class ReplayResult:
 
     def to_csv(self, path: str | os.PathLike) -> Path:
         """Write the estimates as CSV (columns CSV_COLUMNS; floats in full precision, "nan"
-        where there is no number)."""
-        path = Path(path)
+        where there is no number). An existing file at ``path`` is replaced only where it is
+        empty or a CSV of estimates (`check_csv_target`): `ControlError` for any other."""
+        path = path_argument(path, "path")
+        check_csv_target(path, "path")
         with atomic_write(path, text=True, error=ControlError) as f:
             writer = csv.writer(f)
             writer.writerow(CSV_COLUMNS)
@@ -427,13 +432,19 @@ def replay_bag(
         likelihood: the BCR's prepared likelihood model for ``emulator`` (as in
             `control.run_closed_loop`), to save preparing it per replay; one prepared for
             another emulator is refused (`control.check_likelihood`).
-        csv: write the estimates here as CSV (`ReplayResult.to_csv`).
-        out_bag: write the estimates here as a ROS 2 bag folder (`ReplayResult.write_bag`).
+        csv: write the estimates here as CSV (`ReplayResult.to_csv`); an existing file there
+            is replaced only where it is empty or a CSV of estimates (its first line
+            CSV_COLUMNS' header, as a replay writes it), any other is refused.
+        out_bag: write the estimates here as a ROS 2 bag folder (`ReplayResult.write_bag`); a
+            new one: an existing path is refused.
         progress: show a tqdm bar over the blocks.
 
     Returns:
         `ReplayResult`. Raises `BagError` (a topic missing, mistyped or empty; an IMU slower
-        than the emulator's rate; a damaged file), `ControlError` (``bag`` not a path; an
+        than the emulator's rate; a damaged file), `ControlError` (``bag`` not a path; ``csv``
+        or ``out_bag`` not a path, one in or on what is read (the recording, the whole bag
+        folder of a file given inside one, or the emulator file) or an existing output
+        refused as above; an
         override that is no `ReplaySettings` field; ``emulator`` none of the forms above, a
         missing file or one gpmsa cannot load, its `gpmsa.EmulatorFileError` chained; a
         setting that does not fit the emulator, a likelihood prepared for another one, a
@@ -441,7 +452,7 @@ def replay_bag(
         `MissingExtraError` (the ``robot`` extra not installed).
     """
     bag = recording_path(bag, "bag")
-    csv, out_bag = _check_outputs(bag, csv, out_bag)
+    csv, out_bag = _check_outputs(bag, emulator, csv, out_bag)
     s = _settings(settings, overrides)
     emulator = load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
@@ -463,19 +474,20 @@ def replay_bag(
     return result
 
 
-def _check_outputs(bag: Path, csv, out_bag) -> tuple[Path | None, Path | None]:
+def _check_outputs(bag: Path, emulator, csv, out_bag) -> tuple[Path | None, Path | None]:
     """``csv`` and ``out_bag`` as Paths, checked before the replay: `ControlError` where one is
-    not a path, lies in or on the recording ``bag``, both are the same, ``out_bag`` exists
-    (even as a dangling link) or ``csv`` is a folder."""
+    not a path, lies in or on an input (`_inputs`), both are the same, ``out_bag`` exists
+    (even as a dangling link) or ``csv`` is refused by `check_csv_target`."""
+    inputs = _inputs(bag, emulator)
     paths = []
     for name, value in (("csv", csv), ("out_bag", out_bag)):
         if value is None:
             paths.append(None)
             continue
         path = path_argument(value, name)
-        target, source = path.resolve(), bag.resolve()
-        if target == source or source in target.parents:
-            raise ControlError(f"{name}={str(path)!r} would overwrite the recording {str(bag)!r}")
+        for what, read in inputs:
+            if _overlaps(path, read):
+                raise ControlError(f"{name}={str(path)!r} would overwrite {what}")
         paths.append(path)
     csv, out_bag = paths
     if csv is not None and out_bag is not None and csv.resolve() == out_bag.resolve():
@@ -483,9 +495,60 @@ def _check_outputs(bag: Path, csv, out_bag) -> tuple[Path | None, Path | None]:
     if out_bag is not None and os.path.lexists(out_bag):
         raise ControlError(f"out_bag={str(out_bag)!r} exists already; a bag is written to a new "
                            "folder")  # fmt: skip
-    if csv is not None and csv.is_dir():
-        raise ControlError(f"csv={str(csv)!r} is a folder; give the CSV file's path")
+    if csv is not None:
+        check_csv_target(csv, "csv")
     return csv, out_bag
+
+
+def _inputs(bag: Path, emulator) -> list[tuple[str, Path]]:
+    """(what it is, for a message; the path read) of each input on disk: the recording (its
+    whole bag folder for a file given inside one, as `read_recording` reads it) and the
+    emulator file where ``emulator`` is given as a path."""
+    source = source_of(bag)
+    what = f"the recording {str(bag)!r}"
+    if source != bag:
+        what += f" (its bag folder {str(source)!r} is read)"
+    inputs = [(what, source)]
+    if (isinstance(emulator, str | os.PathLike) and str(emulator)
+            and not (isinstance(emulator, str) and emulator in SHIPPED)):  # fmt: skip
+        inputs.append((f"the emulator file {str(emulator)!r}", Path(emulator)))
+    return inputs
+
+
+def _overlaps(target: Path, source: Path) -> bool:
+    """Whether writing ``target`` would replace ``source`` or a file inside it (links followed;
+    a hard link to ``source`` counts)."""
+    target_r, source_r = target.resolve(), source.resolve()
+    if target_r == source_r or source_r in target_r.parents:
+        return True
+    try:
+        return os.path.samefile(target, source)
+    except OSError:  # either is missing: no file to replace
+        return False
+
+
+def check_csv_target(path: Path, name: str) -> None:
+    """`ControlError` naming the argument ``name`` unless ``path`` is free for a CSV of
+    estimates: missing, an empty file or a CSV of estimates (its first line `CSV_HEADER`, as
+    `ReplayResult.to_csv` writes it), which is replaced. A folder, a link to nowhere, a FIFO
+    or device, and any other file (an emulator, a recording, someone's data) are refused."""
+    if path.is_dir():
+        raise ControlError(f"{name}={str(path)!r} is a folder; give the CSV file's path")
+    if not os.path.lexists(path):
+        return
+    if not path.is_file():
+        raise ControlError(f"{name}={str(path)!r} exists and is not a regular file")
+    try:
+        with open(path, "rb") as f:
+            head = f.read(len(CSV_HEADER) + 2)
+    except OSError as exc:
+        raise ControlError(f"{name}={str(path)!r}: cannot read it ({exc.strerror})") from exc
+    if head and head.split(b"\n", 1)[0].rstrip(b"\r") != CSV_HEADER:
+        raise ControlError(
+            f"{name}={str(path)!r} exists and is not a CSV of estimates (its first line is not "
+            f"the columns' header {CSV_HEADER.decode()[:30]}...); refusing to replace it: "
+            "remove it or choose another path"
+        )
 
 
 def replay_recording(

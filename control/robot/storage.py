@@ -22,7 +22,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from control.errors import BagError
+from control.errors import BagError, ControlError
 from control.robot.extra import require
 
 _RECORD = struct.Struct("<BQ")  # opcode, length
@@ -32,6 +32,10 @@ _CHUNK = struct.Struct("<QQQI")  # start and end time, uncompressed size, crc
 OP_MESSAGE, OP_CHUNK, OP_DATA_END = 0x05, 0x06, 0x0F
 MAGIC = b"\x89MCAP0\r\n"
 _PIECE = 1 << 22  # bytes decompressed at a time (the chunk's declared size bounds the total)
+_FOOTER = 9 + 8 + 8 + 4  # a Footer record: opcode, length, summary start and offset, CRC
+MIN_MCAP_BYTES = 2 * len(MAGIC) + 9 + 4 + 4 + _FOOTER
+"""Size of the smallest MCAP file: magic bytes, a Header record (two empty strings), a Footer
+record and the magic bytes again, bytes."""
 
 
 class _Damaged(Exception):
@@ -172,6 +176,56 @@ def mcap_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics | N
         if not simple:
             return None
     return out
+
+
+def check_mcap_target(path: Path, name: str) -> None:
+    """ControlError naming ``name`` when a recording written to ``path`` would destroy something
+    that is not a recording: a folder, something other than a plain file, or a non-empty file
+    that does not start with MCAP's magic bytes (someone's data, an emulator file). An earlier
+    MCAP file, an empty file or a new path may be written."""
+    if not path.exists():
+        return
+    if path.is_dir():
+        raise ControlError(f"{name}={str(path)!r} is a folder; name the .mcap file to write")
+
+    def refused(what: str) -> ControlError:
+        return ControlError(
+            f"{name}={str(path)!r} holds {what}; a recording replaces only an earlier MCAP "
+            "file: remove it or choose another path"
+        )
+
+    if not path.is_file():
+        raise refused("something other than a plain file")
+    try:
+        with path.open("rb") as f:
+            head = f.read(len(MAGIC))
+    except OSError as exc:
+        raise ControlError(f"{name}={str(path)!r} cannot be read to check it: {exc}") from None
+    if head and head != MAGIC:
+        raise refused("a file that is not an MCAP recording")
+
+
+def truncation(f) -> str:
+    """Why the open MCAP file ``f`` is cut short ("is truncated: ...", to follow its name), or
+    "" where it opens and ends with MCAP's magic bytes and is no shorter than `MIN_MCAP_BYTES`;
+    "is not an MCAP file ..." where its first bytes are not MCAP's magic."""
+    size = os.fstat(f.fileno()).st_size
+    f.seek(0)
+    head = f.read(len(MAGIC))
+    if head != MAGIC[: len(head)]:
+        return "is not an MCAP file: it does not start with MCAP's magic bytes"
+    if size < MIN_MCAP_BYTES:
+        return (
+            f"is truncated: {size} bytes, shorter than an MCAP file's magic bytes, header and "
+            f"footer ({MIN_MCAP_BYTES} bytes at least)"
+        )
+    f.seek(size - len(MAGIC))
+    if f.read(len(MAGIC)) != MAGIC:
+        return (
+            f"is truncated: its {size} bytes do not end with MCAP's magic bytes (a file cut "
+            "short, e.g. an interrupted recording, or damaged at its end)"
+        )
+    return ""
 
 
 def note_type(types: dict[str, str | None], topic: str, msgtype: str) -> None:

@@ -524,3 +524,30 @@ def test_start_ns_moves_every_stamp_and_a_stamp_beyond_ros2_is_refused(loop_run,
         with pytest.raises(ControlError, match=r"start_ns must be an integer in \[0, 2\*\*31 s\)"):
             control.record_run(result, tmp_path / "bad.mcap", start_ns=bad)
     assert not (tmp_path / "bad.mcap").exists()
+
+
+def test_a_recording_replaces_an_earlier_one_but_no_other_file(loop_run, emulator_a, tmp_path):
+    """record_run and run_closed_loop(record=) replaced whatever the path held (an emulator
+    file, someone's data); now only an earlier MCAP file or an empty file."""
+    result, path = loop_run
+    earlier = tmp_path / "earlier.mcap"
+    earlier.write_bytes(path.read_bytes()[:100])  # an MCAP file, even a damaged one
+    empty = tmp_path / "empty.mcap"
+    empty.touch()
+    for target in (earlier, empty):
+        assert control.record_run(result, target) == target
+        assert target.read_bytes() == path.read_bytes()
+    emulator_file = tmp_path / "emulator.gpmsa"
+    emulator_file.write_bytes(control.shipped_emulator_path("A").read_bytes())
+    notes = tmp_path / "notes.txt"
+    notes.write_text("field notes\n")
+    track = roadgen.track([(5, 300)], seed=3)
+    for target in (emulator_file, notes):
+        before = target.read_bytes()
+        with pytest.raises(ControlError, match="is not an MCAP recording; a recording replaces"):
+            control.record_run(result, target)
+        with pytest.raises(ControlError, match=r"record=.* is not an MCAP recording"):
+            control.run_closed_loop(track, emulator_a, seed=3, record=target)
+        assert target.read_bytes() == before
+    with pytest.raises(ControlError, match="is a folder"):
+        control.record_run(result, tmp_path)
