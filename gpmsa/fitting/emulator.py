@@ -565,7 +565,8 @@ class Emulator:
         invalid content, non-finite metadata, or sizes beyond ``gpmsa.limits``. An existing
         emulator file is replaced in one step, never left half-written; a study file is not
         replaced (GPMSAError): its study would no longer load. (A study's model file is an
-        emulator file: replaced, its study refuses it on loading, the sha256 differing.)
+        emulator file: replaced, its study refuses it on loading, the sha256 differing.) Nor is
+        a non-empty file that is not a gpmsa file (a user's CSV or notes: GPMSAError).
         """
         path = check_path(path)
         refuse_to_replace(path, FORMAT)

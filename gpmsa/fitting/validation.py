@@ -88,6 +88,8 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
     if "index" in shapes:
         want["index"] = (l_sim,)
     for name in shapes:
+        if n == 0 and name.startswith(("draw_", "cal_")):  # would average nothing into NaN
+            raise _fail(f"arrays/{name}", "needs >= 1 draw (log_post has none)")
         if name.startswith("draw_"):
             key = name[5:]
             if key not in pshape:

@@ -526,16 +526,53 @@ def stored_format(path: str | Path) -> str | None:
         return None
 
 
+def _gpmsa_layout(path: Path) -> bool:
+    """Whether the regular file ``path`` is a zip laid out as a gpmsa file (``manifest.json``
+    and ``arrays/*.npy`` members only): a file gpmsa wrote that ``stored_format`` cannot read
+    (damaged content, a newer schema, sizes beyond the limits set now)."""
+    try:
+        with open(path, "rb") as fh:
+            _check_directory(fh, os.fstat(fh.fileno()).st_size, path)  # bounds the directory
+            fh.seek(0)
+            with zipfile.ZipFile(fh) as zf:
+                names = zf.namelist()
+    except Exception:  # not a zip, or too damaged to tell: not known to be gpmsa's
+        return False
+    arrays = (n.startswith(ARRAY_DIR) and n.endswith(".npy") for n in names if n != MANIFEST)
+    return MANIFEST in names and all(arrays)
+
+
+def _foreign_size(target: Path) -> int | None:
+    """Size in bytes of the regular, non-empty file at ``target`` that is not a gpmsa file;
+    None when replacing ``target`` loses nothing of another program's (no file, an empty one,
+    a gpmsa file) or when it is not a regular file (``write_sealed`` refuses that)."""
+    try:
+        st = os.stat(target)
+    except (OSError, ValueError):
+        return None
+    if not stat.S_ISREG(st.st_mode) or st.st_size == 0 or _gpmsa_layout(target):
+        return None
+    return st.st_size
+
+
 def refuse_to_replace(target: Path, fmt: str) -> None:
-    """GPMSAError if ``target`` holds a gpmsa file of the other kind than ``fmt``: a study
-    written over an emulator file (another study's model, say) or an emulator file written over
-    a study would leave that file's owner unreadable."""
+    """GPMSAError if ``target`` holds data a file of format ``fmt`` must not replace: a file that
+    is not a gpmsa file (a user's CSV or notes; an empty file may be replaced), or a gpmsa file
+    of the other kind, as a study written over an emulator file (another study's model, say) or
+    an emulator file written over a study would leave that file's owner unreadable."""
+    wanted = "a study file" if fmt == STUDY_FORMAT else "an emulator file"
     found = stored_format(target)
-    if found is not None and found != fmt:
-        if found == STUDY_FORMAT:
-            held, wanted = "a study file", "an emulator file"
-        else:
-            held, wanted = "an emulator file (another study's model?)", "a study file"
+    if found is None:
+        size = _foreign_size(target)
+        if size is not None:
+            raise GPMSAError(
+                f"refusing to write {target}: it holds a file that is not a gpmsa file ({size} "
+                f"bytes), which {wanted} would replace; choose another path or remove it first"
+            )
+    elif found != fmt:
+        held = (
+            "a study file" if found == STUDY_FORMAT else "an emulator file (another study's model?)"
+        )
         raise GPMSAError(
             f"refusing to write {target}: it holds {held}, which {wanted} would replace; "
             "choose another path or remove it first"

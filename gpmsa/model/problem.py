@@ -258,9 +258,9 @@ def reduce_obs(
     ``levels``: the x columns' training levels (``SimData.levels``); an unseen level is refused.
     """
     x_native = obs.inputs(x_names)
+    if x_native.ndim != 2 or x_native.shape[1] != std.x_min.size:  # before x_to_unit broadcasts
+        raise GPMSAError(f"x_obs must have shape (n, {std.x_min.size}), got {x_native.shape}")
     x = std.x_to_unit(x_native)
-    if x.shape[1] != std.x_min.size:
-        raise GPMSAError(f"x_obs must have {std.x_min.size} columns, got {x_native.shape[1]}")
     if levels is not None:
         categorical.check_levels(x_native, levels[: x.shape[1]], x_names, "x_obs")
     check_x_obs(x, x_names)

@@ -93,6 +93,9 @@ def check_study_manifest(manifest: dict) -> None:
     if len(shape["log_post"]) != 2:
         raise _fail("arrays/log_post", f"must be (chains, draws), got {shape['log_post']}")
     cn = shape["log_post"]
+    for what, size in zip(("chain", "draw"), cn, strict=True):
+        if size < 1:
+            raise _fail("arrays/log_post", f"needs >= 1 {what}, got shape {cn}")
     for k in ("theta", "mu", "lam", "lamOs"):
         if len(shape[k]) != 3 or shape[k][:2] != cn:
             raise _fail(f"arrays/{k}", f"must be (chains, draws, k) with (chains, draws) = {cn}, "

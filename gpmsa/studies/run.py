@@ -272,8 +272,8 @@ def fit_study(
                         "joint_obs": True, "discrepancy": fitted_discrepancy,
                         "obs_lengths": [int(e.size) for e in obs[i].experiments],
                         "obs_sha256": obs[i].digest(),
-                        "study": {"label": labels[i], "shared": list(shared),
-                                                     "hierarchical": list(hierarchical)},
+                        "study": {"label": labels[i], "shared": list(layout.shared),
+                                  "hierarchical": list(layout.groups)},  # as read, once
                         "versions": settings["versions"]}  # fmt: skip
         members.append(Emulator._from_prepared(
             sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,

@@ -30,7 +30,7 @@ from gpmsa.io.container import (
 from gpmsa.mcmc.diagnostics import convergence, summarize
 from gpmsa.model.data import check_count
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
-from gpmsa.studies.record import check_study_arrays, check_study_manifest
+from gpmsa.studies.record import FILE_RE, check_study_arrays, check_study_manifest
 
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
@@ -40,6 +40,22 @@ def layout_of(emulators, labels, shared, hierarchical) -> Layout:
         [(e.standardizer.t_min, e.standardizer.t_max) for e in emulators],
         [(e.priors.theta_mean, e.priors.theta_sd) for e in emulators], shared, hierarchical,
     )  # fmt: skip
+
+
+def _check_study_name(path: Path, labels) -> None:
+    """GPMSAError unless the model files ``<stem>.<label>.gpmsa`` that a study saved to ``path``
+    writes beside it have names ``FILE_RE`` allows (ASCII letters, digits, '_', '-', '.'; no
+    leading '.'; at most 157 characters)."""
+    longest = max(labels, key=len)
+    member = f"{path.stem}.{longest}.gpmsa"
+    if not FILE_RE.match(member):
+        most = 150 - len(longest)  # FILE_RE: 151 characters before ".gpmsa", "." + label here
+        raise GPMSAError(
+            f"path: the study file's name {path.name!r} may use only ASCII letters, digits, "
+            f"'_', '-' and '.', not start with '.', and have a stem of at most {most} "
+            f"characters with these labels (it names the model files beside it, e.g. "
+            f"{member!r}); choose another name"
+        )
 
 
 def native_chains(layout: Layout, draws: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -160,9 +176,14 @@ class Study:
         (``gpmsa.io.atomic.atomic_group``), so a save that fails leaves an existing study at
         ``path`` as it was (only an OS failure during the final moves could mix the two). A study
         is not written over an emulator file, nor a model file over a study file (GPMSAError):
-        such a file belongs to another study, which would no longer load.
+        such a file belongs to another study, which would no longer load. Nor is any file written
+        over a non-empty file that is not a gpmsa file (a user's CSV or notes). ``path``'s name
+        names the model files, so it may use only ASCII letters, digits, '_', '-' and '.', not
+        start with '.', and its stem be at most 150 - len(longest label) characters (GPMSAError
+        up front otherwise).
         """
         path = check_path(path)
+        _check_study_name(path, self.labels)
         refuse_to_replace(path, STUDY_FORMAT)
         files, hashes, sealed = [], [], []
         for lab, emu in zip(self.labels, self.members, strict=True):
