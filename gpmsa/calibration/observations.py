@@ -172,7 +172,8 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
         )
     base = emulator.priors.lamOs
     if l_sim == 1:  # GPM/SA's scalar-output reduction, as gpmsa.model.problem.reduce_obs
-        u = (y - std.y_mean) / std.y_sd
+        with np.errstate(over="ignore"):  # an overflow is refused below, as far off
+            u = (y - std.y_mean) / std.y_sd
         sig = np.eye(n) / (1.0 + SIGOBS_RIDGE)
         obs = ObsProblem(xu, u, np.zeros((n, 0)), sig, True, (np.ones((1, 1)),) * n, None)
         corr = (0.0, 0.0)
@@ -181,11 +182,13 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
             warnings.simplefilter("ignore")
             obs, corr = reduce_obs(ObsData(x, y), std, K, None, emulator.x_names)
     z = obs.z
-    far = np.abs(z) > MAX_STD_OBS
+    far = ~(np.abs(z) <= MAX_STD_OBS)  # an overflow (inf, NaN) is far too
     if far.any():
+        worst = np.max(np.abs(z))
+        shown = f"{worst:.3g}" if np.isfinite(worst) else "more than 1.8e308 (overflow)"
         raise GPMSAError(
-            f"y_obs lies {np.max(np.abs(z)):.3g} standard deviations of the simulation outputs "
-            f"from their mean; allowed at most {MAX_STD_OBS:g} (wrong units?)"
+            f"y_obs lies {shown} standard deviations of the simulation outputs from their "
+            f"mean; allowed at most {MAX_STD_OBS:g} (wrong units?)"
         )
     lamos = LamOsPrior(base.a + corr[0], base.b + corr[1], base.lower, base.upper)
     sig = obs.sig_obs

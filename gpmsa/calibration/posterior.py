@@ -183,6 +183,12 @@ def _checked_chains(chains, samples: dict[str, np.ndarray] | None) -> dict[str, 
     missing = sorted(set(names or ()) - set(out))
     if missing:
         raise GPMSAError(f"chains lacks {missing}: give the chains of every parameter or none")
+    shapes = {arr.shape for arr in out.values()}
+    if len(shapes) > 1:
+        listed = ", ".join(f"{name}: {arr.shape}" for name, arr in out.items())
+        raise GPMSAError(
+            f"chains of every parameter must have one shape (n_chains, n_draws), got {listed}"
+        )
     for name, arr in out.items():
         drawn = None if samples is None else samples.get(name)
         if drawn is not None and not np.array_equal(arr.reshape(-1), drawn):

@@ -436,7 +436,12 @@ class Emulator:
         n_ch = int(self.settings.get("n_chains", 1)) or 1
         if self.n_draws == 0:
             raise GPMSAError("this emulator has no posterior draws (built by from_params)")
-        per = self.n_draws // n_ch
+        per, left = divmod(self.n_draws, n_ch)
+        if left:
+            raise GPMSAError(
+                f"settings['n_chains'] = {n_ch} does not divide the {self.n_draws} draws; "
+                "each chain keeps as many draws"
+            )
         draws = {k: v[: per * n_ch].reshape(n_ch, per, *v.shape[1:]) for k, v in self.draws.items()}
         if self.calibration:
             for k, v in self.calibration.items():

@@ -198,6 +198,12 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
         n_ch = settings["n_chains"]
         if isinstance(n_ch, bool) or not isinstance(n_ch, int) or n_ch < 1:
             raise _fail("settings.n_chains", f"must be an integer >= 1, got {_short(n_ch)}")
+        n_draws = dims.get("n_draws", 0)
+        if n_draws and n_draws % n_ch:
+            raise _fail(
+                "settings.n_chains",
+                f"{n_ch} chains cannot hold the {n_draws} draws (each chain keeps as many)",
+            )
     for key in ("metadata", "diagnostics"):
         if not isinstance(manifest.get(key), dict):
             raise _fail(key, f"must be an object, got {_short(manifest.get(key))}")

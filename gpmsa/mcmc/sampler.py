@@ -48,6 +48,38 @@ class Chains:
     step_widths: dict[str, np.ndarray]
     info: dict = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        """GPMSAError naming the array whose shape disagrees with the chains' (n_chains,
+        n_draws), the shape of ``log_post``: arrays of different shapes would be padded with NaN
+        by ArviZ or broadcast wrongly."""
+        self.log_post = np.asarray(self.log_post, dtype=float)
+        if self.log_post.ndim != 2:
+            raise GPMSAError(
+                f"Chains: log_post must be (n_chains, n_draws), got shape {self.log_post.shape}"
+            )
+        for what in ("draws", "accept_rate", "step_widths"):
+            if not isinstance(getattr(self, what), dict):
+                raise GPMSAError(
+                    f"Chains: {what} must be a dict name -> array, got "
+                    f"{type(getattr(self, what)).__name__}"
+                )
+        if not self.draws:
+            raise GPMSAError("Chains: draws is empty")
+        lead = self.log_post.shape
+        for name, arr in self.draws.items():
+            if np.shape(arr)[:2] != lead:
+                raise GPMSAError(
+                    f"Chains: draws[{name!r}] has shape {np.shape(arr)}; its first two "
+                    f"axes must be log_post's (n_chains, n_draws) = {lead}"
+                )
+        for what in ("accept_rate", "step_widths"):
+            for name, arr in getattr(self, what).items():
+                if np.shape(arr)[:1] != lead[:1]:
+                    raise GPMSAError(
+                        f"Chains: {what}[{name!r}] has shape {np.shape(arr)}; its "
+                        f"first axis must be the {lead[0]} chains"
+                    )
+
     @property
     def n_chains(self) -> int:
         """Number of chains."""

@@ -605,3 +605,15 @@ def test_an_observation_too_large_for_the_basis_is_named_and_cli_json_is_strict(
         gpmsa.Calibrator(vec_emu).update([[0.5]], y)
     out = container.jsonable({"sd": float("inf"), "q": [np.float64("nan"), 1.0], "n": 3})
     assert json.loads(json.dumps(out, allow_nan=False)) == {"sd": None, "q": [None, 1.0], "n": 3}
+
+
+@pytest.mark.parametrize("extra", [1, 1000])
+def test_a_chain_count_that_does_not_divide_the_draws_is_refused(saved, tmp_path, extra):
+    """settings.n_chains was checked only as an integer >= 1: a file saying 3 chains of 320
+    draws lost 2 draws in to_arviz, one saying 1000 gave 1000 chains of 0 draws."""
+    manifest, arrays = read_members(saved["scalar"])
+    n_draws = arrays["log_post"].shape[0]
+    manifest["settings"]["n_chains"] = n_draws + extra
+    path = write_members(tmp_path / "chains.gpmsa", manifest, arrays)
+    with pytest.raises(gpmsa.EmulatorFileError, match="settings.n_chains.*cannot hold the"):
+        gpmsa.load(path)
