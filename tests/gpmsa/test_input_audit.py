@@ -147,7 +147,7 @@ def test_a_study_is_not_saved_over_another_studys_model_file(tmp_path):
     assert gpmsa.load_study(tmp_path / f"plate.{label}.gpmsa").members[0].params["lamUz"][0] == 1.0
     assert set(names) <= set(os.listdir(tmp_path))
     # saving over a study of its own kind goes on; over a file that is no gpmsa file it is
-    # refused (that file's content would be lost: tests/gpmsa/test_probe49_gpmsa.py)
+    # refused (that file's content would be lost: tests/gpmsa/test_fit_and_save_guards.py)
     _study(2.0).save(first)
     (tmp_path / "notes.gpmsa").write_text("not a zip")
     with pytest.raises(GPMSAError, match=r"notes\.gpmsa: it holds a file that is not a gpmsa"):

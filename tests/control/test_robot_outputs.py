@@ -1,4 +1,4 @@
-"""From a probe of the replay's outputs and the MCAP reader: an output never replaces what is
+"""The replay's and the recorder's outputs, and the MCAP reader: an output never replaces what is
 read (the whole bag folder of a file given inside one, the emulator file) nor a file that is no
 CSV of estimates, and a truncated bare MCAP file is named as truncated."""
 

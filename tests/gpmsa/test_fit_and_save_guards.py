@@ -1,4 +1,4 @@
-"""Defects found by probe 49: observations with too few x columns broadcast by gpmsa.fit, saves
+"""Guards of fit and save: observations with too few x columns (gpmsa.fit broadcast them), saves
 over files that are not gpmsa files, files holding zero draws, a generator given as shared, and
 a study file name that could not name its model files."""
 

@@ -1,7 +1,7 @@
-"""Calibration inputs a probe found read wrongly or not checked: tables of outputs and Series
-read by position, a discrepancy's betaV per known input dropped, masked arrays unmasked,
-colliding summary keys, unchecked Posterior arguments, a calibration's own x_obs refused by
-full_prediction, and an unchecked n_emulator_draws."""
+"""Calibration inputs read by name and checked, and what a calibration records (each once
+wrong): tables of outputs and Series read by position, a discrepancy's betaV per known input
+dropped, masked arrays unmasked, colliding summary keys, unchecked Posterior arguments, a
+calibration's own x_obs refused by full_prediction, and an unchecked n_emulator_draws."""
 
 import warnings
 

@@ -1,4 +1,4 @@
-"""Defects found by a probe: LOO with a mean basis, saving over a study's files, the draws that
+"""After the fit, at the edges: LOO with a mean basis, saving over a study's files, the draws that
 n_draws picks, studies' seeds, sensitivity bars and memory, long file names, calibrated
 extrapolation, plot name lists and FullPrediction's ``what``."""
 

@@ -1,4 +1,4 @@
-"""Probe fixes: checked window samples, data time, standstill, wild speeds, per-part fault
+"""The BCR at the edges: checked window samples, data time, standstill, wild speeds, per-part fault
 reasons, ignored feature and tracker settings."""
 
 import numpy as np
