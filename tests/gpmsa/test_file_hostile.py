@@ -153,6 +153,7 @@ def array_edit(draw, arrays):
     kind = draw(st.sampled_from(["value", "scale", "row", "shape", "dtype", "empty", "swap"]))
     if kind == "value" and a.size:
         idx = draw(st.integers(0, a.size - 1))
+        a = a.astype(np.float64)  # an earlier edit may have made it integer: NaN, inf need floats
         a.reshape(-1)[idx] = draw(SPECIAL)
     elif kind == "scale":
         a = a * draw(st.sampled_from([0.0, -1.0, 2.0, 1e10, 1 + 1e-6]))
