@@ -120,7 +120,9 @@ def _identified(chains) -> dict[str, np.ndarray]:
 @pytest.mark.parametrize(
     ("backend", "options", "max_rhat"),
     [
-        ("torch", {"n_iter": 2500, "n_chains": 16}, 1.01),
+        # 16 x 2,500 sweeps put theta's R-hat at 1.006-1.019 by seed (7, 8, 6): the bound
+        # judged the seed; at 5,000 seed 6 gives 1.008
+        ("torch", {"n_iter": 5000, "n_chains": 16}, 1.01),
         ("pyro", {"n_iter": 400, "n_chains": 2, "n_warmup": 200}, 1.05),
     ],
 )
