@@ -45,6 +45,8 @@ FORMAT = "vehicle.campaign/1"
 _F_NAMES = ("f_full", "f_window", "f_full_noisy", "f_window_noisy")
 _ARRAYS = ("v", "gd", "seed", *_F_NAMES, "status")
 _TRACES = ("accel", "accel_measured")
+_MEMBERS = frozenset(f"{name}.npy" for name in (*_ARRAYS, "settings", *_TRACES))
+"""The members a campaign file may hold."""
 _MAX_DEFLATE_RATIO = 1032
 """Most bytes that one deflated byte expands to: what a compressed member can hold."""
 _READ_ERRORS = (
@@ -123,13 +125,15 @@ class Campaign:
     def save(self, path: str | os.PathLike) -> None:
         """Write a plain ``.npz`` (no pickle): the arrays and the settings as JSON. The table is
         checked again first (its arrays may have been changed in place since construction);
-        VehicleError if it is invalid or ``path`` names no file. The file is replaced in one
-        step (a refusal or a failure leaves an existing file whole); CampaignFileError if it
-        cannot be written."""
+        VehicleError if it is invalid or ``path`` names no file. A campaign file (or an empty
+        file) at ``path`` is replaced in one step, keeping its permissions (a refusal or a
+        failure leaves it whole); CampaignFileError if it cannot be written, or if ``path``
+        holds anything else (another program's file, a folder), which is never replaced."""
         _check_path(path)
         target = Path(path)
         if target.name in ("", ".."):
             raise VehicleError(f"path={str(path)!r} names no file: need a file name, e.g. 'c.npz'")
+        _refuse_to_replace(target)
         table = _checked_table(self)
         arrays = {name: table[name] for name in _ARRAYS}
         arrays["settings"] = np.asarray(json.dumps({"format": FORMAT, **self.settings}))
@@ -294,15 +298,49 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
     return out
 
 
+def _refuse_to_replace(path: Path) -> None:
+    """CampaignFileError if ``path`` holds what a campaign file must not replace: a folder or
+    other non-regular file, or a non-empty file that is not a campaign file (a zip of campaign
+    members only, the settings among them), e.g. an emulator file or a user's notes."""
+    try:
+        info = os.stat(path)
+    except (OSError, ValueError):  # nothing there (or nothing the write can reach: it says why)
+        return
+    if not stat.S_ISREG(info.st_mode):
+        raise CampaignFileError(
+            f"refusing to write {str(path)!r}: it exists and is not a regular file"
+        )
+    if info.st_size == 0:
+        return
+    try:
+        with zipfile.ZipFile(path) as zf:
+            names = set(zf.namelist())
+    except _READ_ERRORS:
+        names = set()
+    if "settings.npy" not in names or not names <= _MEMBERS:
+        raise CampaignFileError(
+            f"refusing to write {str(path)!r}: it holds a file that is not a campaign file "
+            f"({info.st_size} bytes), which the campaign would replace; choose another path or "
+            "remove it first"
+        )
+
+
 def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
     """``np.savez`` to a new temporary file beside ``path``, moved over it in one step: a crash
-    or an error never leaves a half-written file, and an existing one stays whole."""
+    or an error never leaves a half-written file, and an existing one stays whole and keeps
+    its permissions."""
+    try:
+        mode = stat.S_IMODE(os.stat(path).st_mode)
+    except (OSError, ValueError):
+        mode = None
     # the name's start (at most 32 characters) keeps the temporary name within the 255 bytes
     # a file name may have
     tmp = path.with_name(f".{path.name[:32]}.{secrets.token_hex(6)}.part")
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     try:
         with os.fdopen(fd, "wb") as fh:
+            if mode is not None:  # a private file stays private
+                os.chmod(tmp, mode)
             np.savez(fh, **arrays)
             fh.flush()
             os.fsync(fh.fileno())
