@@ -26,14 +26,16 @@ def prediction_bands(
 
     A functional output gets one column per new x (at most ``max_panels``, evenly chosen): on
     top the central bands of probability ``level`` of a new observation y, of the real process
-    eta + delta and of the simulator eta over the output grid, with the observed values; below,
+    eta + delta and of the simulator eta over the output grid (drawn in increasing order of the
+    grid, whatever the order of ``pred.grid``), with the observed values; below,
     the discrepancy delta. A scalar output gets the same bands against the known input
     ``x_column``. With ``relative`` the top panels show everything minus the predicted mean of
     y, so that narrow bands on a large output (say 0.05 s on 4 s) can be seen.
 
     Args:
         pred: a FullPrediction from ``full_prediction``.
-        observed: (N, l) observed values at ``pred.x`` (e.g. held-out observations), or None.
+        observed: (N, l) observed values at ``pred.x`` and ``pred.grid`` (e.g. held-out
+            observations), or None.
         level: probability of the bands.
         max_panels: columns at most (functional output).
         x_column: the known input on the horizontal axis (scalar output).
@@ -99,18 +101,20 @@ def prediction_bands(
     cols = np.unique(np.linspace(0, N - 1, min(max_panels, N)).round().astype(int))
     fig = figure(2.8 * cols.size + 0.6, 5.6)
     axes = fig.subplots(2, cols.size, squeeze=False, sharex=True, height_ratios=[2, 1])
+    by_index = np.argsort(pred.grid, kind="stable")  # a grid may come in any order
+    grid, delta_mean = pred.grid[by_index], pred.mean("delta")
     for c, i in enumerate(cols):
         top, bottom = axes[0, c], axes[1, c]
         for what, label, color in BANDS:
             lo, hi = bands[what]
-            top.fill_between(pred.grid, lo[i], hi[i], color=color, alpha=0.35,
+            top.fill_between(grid, lo[i, by_index], hi[i, by_index], color=color, alpha=0.35,
                              label=f"{label} ({pct})")  # fmt: skip
-        top.plot(pred.grid, eta_mean[i], color="C0", lw=1)
+        top.plot(grid, eta_mean[i, by_index], color="C0", lw=1)
         if observed is not None:
-            top.plot(pred.grid, observed[i], "o", color="k", ms=3, label="observed")
+            top.plot(grid, observed[i, by_index], "o", color="k", ms=3, label="observed")
         lo, hi = bands["delta"]
-        bottom.fill_between(pred.grid, lo[i], hi[i], color="C2", alpha=0.4)
-        bottom.plot(pred.grid, pred.mean("delta")[i], color="C2", lw=1)
+        bottom.fill_between(grid, lo[i, by_index], hi[i, by_index], color="C2", alpha=0.4)
+        bottom.plot(grid, delta_mean[i, by_index], color="C2", lw=1)
         bottom.axhline(0.0, color="0.6", lw=0.6)
         bottom.set_xlabel("output index")
         xs = ", ".join(f"{v:.3g}" for v in pred.x[i])
