@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if manifest["format"] == STUDY_FORMAT:
         lines = study_lines(args.file, manifest, study)
-        lines.append(_convergence_line(manifest.get("convergence")))
+        lines.append(_convergence_line(study.convergence))  # from the draws, as load_study
     else:
         lines = _lines(args.file, manifest, arrays)
     print("\n".join(lines))

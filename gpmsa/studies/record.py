@@ -130,3 +130,70 @@ def check_study_arrays(manifest: dict, arrays: dict[str, np.ndarray], layout: La
         a = arrays[name]
         if a.size and not a.min() > 0.0:
             raise _fail(f"arrays/{name}", f"precisions must be > 0, got min {a.min():.6g}")
+
+
+def check_study_claims(manifest: dict, study) -> None:
+    """The manifest's descriptions against the study built from the file's models and draws:
+    the models' labels, t_names and units, the kind (a "fit" study's models are its fitted
+    members, their theta draws the study's) and the settings' chain and draw counts. The
+    diagnostics and convergence record are not compared: a loaded Study computes its own from
+    the draws, and a comparison would refuse a genuine file whenever ArviZ's estimators (or
+    the convergence limits) change."""
+    labels = list(study.labels)
+    want = {
+        "names.models": (manifest["names"].get("models"), labels),
+        "names.t": (manifest["names"].get("t"),
+                    {lab: list(e.t_names) for lab, e in zip(labels, study.members, strict=True)}),
+        "units": (manifest.get("units"),
+                  {lab: list(e.t_units) for lab, e in zip(labels, study.members, strict=True)}),
+    }  # fmt: skip
+    for field, (saved, expected) in want.items():
+        if saved != expected:
+            raise _fail(field, f"{_short(saved, 200)} differ from the models' {expected}")
+    _check_kind(study)
+    _check_counts(manifest["settings"], study.draws["log_post"].shape)
+
+
+def _check_kind(study) -> None:
+    """kind "fit" if and only if every model file is this study's fitted member: it names the
+    study's label, shared and hierarchical parameters, and its calibration theta draws are the
+    study's draws of its elements (a calibration's models are fitted elsewhere)."""
+    fitted = [_is_member_fit(study, i) for i in range(len(study.members))]
+    if study.kind == "fit" and not all(fitted):
+        lab = study.labels[fitted.index(False)]
+        raise _fail("study.kind", f"'fit', but model {lab!r}'s file is not this study's fitted "
+                                  "member (its study label or theta draws differ)")  # fmt: skip
+    if study.kind == "calibration" and all(fitted):
+        raise _fail("study.kind", "'calibration', but every model file is this study's fitted "
+                                  "member: the draws are a joint fit's")  # fmt: skip
+
+
+def _is_member_fit(study, i: int) -> bool:
+    """Whether model i's emulator was fitted in this study (``fit_study``'s member)."""
+    layout, emu = study.layout, study.members[i]
+    tag = {"label": study.labels[i], "shared": list(layout.shared),
+           "hierarchical": list(layout.groups)}  # fmt: skip
+    mine = study.draws["theta"][:, :, list(layout.index[i])].reshape(-1, len(layout.index[i]))
+    cal = getattr(emu, "calibration", None) or {}
+    return emu.settings.get("study") == tag and np.array_equal(cal.get("theta", ()), mine)
+
+
+def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
+    """settings' n_chains and the draws a chain kept (n_iter, n_burn, thin) against the draws'
+    (chains, draws) ``shape``."""
+    got = {k: settings.get(k, 1 if k == "thin" else None)
+           for k in ("n_chains", "n_iter", "n_burn", "thin")}  # fmt: skip
+    for k, v in got.items():
+        if isinstance(v, bool) or not isinstance(v, int) or v < (0 if k == "n_burn" else 1):
+            raise _fail(f"settings.{k}", f"must be an integer, got {_short(v)}")
+    if settings.get("n_samples", got["n_iter"]) != got["n_iter"]:  # calibrate_study's name
+        raise _fail("settings.n_samples", f"{_short(settings['n_samples'])} differs from n_iter "
+                                          f"{got['n_iter']}")  # fmt: skip
+    if got["n_chains"] != shape[0]:
+        raise _fail("settings.n_chains", f"{got['n_chains']}, but the draws have {shape[0]} "
+                                         "chains")  # fmt: skip
+    kept = len(range(got["n_burn"], got["n_iter"], got["thin"]))
+    if kept != shape[1]:
+        raise _fail("settings", f"n_iter={got['n_iter']}, n_burn={got['n_burn']}, thin="
+                                f"{got['thin']} keep {kept} draws a chain, but the draws have "
+                                f"{shape[1]}")  # fmt: skip

@@ -30,7 +30,12 @@ from gpmsa.io.container import (
 from gpmsa.mcmc.diagnostics import convergence, summarize
 from gpmsa.model.data import check_count
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
-from gpmsa.studies.record import FILE_RE, check_study_arrays, check_study_manifest
+from gpmsa.studies.record import (
+    FILE_RE,
+    check_study_arrays,
+    check_study_claims,
+    check_study_manifest,
+)
 
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
@@ -199,6 +204,7 @@ class Study:
         try:
             check_study_manifest(head)
             check_study_arrays(head, arrays, self.layout)
+            check_study_claims(head, self)
         except EmulatorFileError as exc:
             raise GPMSAError(f"refusing to write {path}, it could not be read back: {exc}") from exc
         sealed.append((path, raw, arrays))
@@ -218,7 +224,10 @@ def load_study(path: str | Path) -> Study:
 
     Every model file is read by ``gpmsa.load`` with the sha256 the study lists (an edited or
     replaced model file is refused); the study's fields and draws are validated against the
-    models. Raises EmulatorFileError naming the file and the field.
+    models, and what the manifest says of them (the models' names and units, the kind, the
+    chain and draw counts) against the draws and models
+    (``gpmsa.studies.record.check_study_claims``); the diagnostics and convergence record are
+    computed anew from the draws. Raises EmulatorFileError naming the file and the field.
 
     >>> import gpmsa
     >>> gpmsa.load_study("no-such-study.gpmsa")  # doctest: +ELLIPSIS
@@ -241,8 +250,10 @@ def load_study(path: str | Path) -> Study:
         check_study_arrays(manifest, arrays, layout)
         saved = manifest["priors"]["hyper"]
         hyper = HyperPriors(**{"sd_prior": "gamma", **saved})  # no sd_prior: SEPIA's, as before
-        return Study(study["kind"], members, layout, hyper, arrays, manifest["settings"],
-                     manifest["metadata"])  # fmt: skip
+        out = Study(study["kind"], members, layout, hyper, arrays, manifest["settings"],
+                    manifest["metadata"])  # fmt: skip
+        check_study_claims(manifest, out)
+        return out
     except EmulatorFileError as exc:
         raise EmulatorFileError(f"{path}: {exc}") from exc
     except GPMSAError as exc:
