@@ -112,9 +112,11 @@ def gpmsa_model_only(emulator, what: str) -> None:
     if getattr(emulator, "mean_basis", None) is not None:
         used.append("a mean basis")
     if used:
+        instead = "Emulator.predict, gpmsa.calibrate or gpmsa.Calibrator"
+        if what == "cross_validate":
+            instead = "Emulator.loo() (exact leave-one-out at the point estimate) or " + instead
         raise GPMSAError(
-            f"{what} does not support an emulator with {' and '.join(used)}; use "
-            "Emulator.predict, gpmsa.calibrate or gpmsa.Calibrator"
+            f"{what} does not support an emulator with {' and '.join(used)}; use {instead}"
         )
 
 

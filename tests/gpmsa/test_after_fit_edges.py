@@ -69,6 +69,14 @@ def test_loo_equals_refits_without_each_run(mean_basis):
     np.testing.assert_allclose(loo.var, var, rtol=1e-9)
 
 
+def test_cross_validate_with_a_mean_basis_points_to_loo():
+    """cross_validate refuses a mean basis; its advice named predict and calibrate, not loo(),
+    the one cross-validation that supports it."""
+    emu = _functional_emulator("linear")
+    with pytest.raises(GPMSAError, match=r"a mean basis; use Emulator\.loo\(\)"):
+        gpmsa.cross_validate(emu, folds=3)
+
+
 @pytest.fixture(scope="module")
 def saved_study(tmp_path_factory):
     rng = np.random.default_rng(0)
