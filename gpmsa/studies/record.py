@@ -156,8 +156,8 @@ def check_study_claims(manifest: dict, study) -> None:
 
 def _check_kind(study) -> None:
     """kind "fit" if and only if every model file is this study's fitted member: it names the
-    study's label, shared and hierarchical parameters, and its calibration theta draws are the
-    study's draws of its elements (a calibration's models are fitted elsewhere)."""
+    study's label, and its calibration theta draws are the study's draws of its elements (a
+    calibration's models are fitted elsewhere)."""
     fitted = [_is_member_fit(study, i) for i in range(len(study.members))]
     if study.kind == "fit" and not all(fitted):
         lab = study.labels[fitted.index(False)]
@@ -169,13 +169,19 @@ def _check_kind(study) -> None:
 
 
 def _is_member_fit(study, i: int) -> bool:
-    """Whether model i's emulator was fitted in this study (``fit_study``'s member)."""
+    """Whether model i's emulator was fitted in this study (``fit_study``'s member): its study
+    tag names the label, and its calibration theta draws are the study's. The tag's shared and
+    hierarchical names are not compared: files written before they were recorded from the
+    layout may hold the caller's spelling of them."""
     layout, emu = study.layout, study.members[i]
-    tag = {"label": study.labels[i], "shared": list(layout.shared),
-           "hierarchical": list(layout.groups)}  # fmt: skip
+    tag = emu.settings.get("study")
     mine = study.draws["theta"][:, :, list(layout.index[i])].reshape(-1, len(layout.index[i]))
     cal = getattr(emu, "calibration", None) or {}
-    return emu.settings.get("study") == tag and np.array_equal(cal.get("theta", ()), mine)
+    return (
+        isinstance(tag, dict)
+        and tag.get("label") == study.labels[i]
+        and np.array_equal(cal.get("theta", ()), mine)
+    )
 
 
 def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
