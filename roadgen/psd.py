@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
@@ -130,6 +131,8 @@ def estimate_gd(
     window's main lobe, clear of its edges), and "periodogram" needs content at its harmonic.
     waviness: w of the fit; default the road's ``settings.waviness`` if it has one, else 2.
         "welch" takes w up to WELCH_MAX_WAVINESS (3.5).
+    A road without roughness in the band (flat; for "fit" also a straight ramp, which the end
+    match removes) gives 0.0.
 
     Raises RoadgenError for an unknown method, a bad band or waviness (or settings.band or
     settings.waviness), a waviness above 3.5 for "welch", a band outside the road's content
@@ -148,7 +151,7 @@ def estimate_gd(
                 "band applies to method='fit' and 'welch'; method='periodogram' reads the one "
                 f"harmonic nearest n0 = {N0} cycles/m"
             )
-        return _nonzero_gd(_periodogram_gd(z, dx, w, content), z)
+        return _nonzero_gd(lambda h: _periodogram_gd(h, dx, w, content), z)
     lo, hi = _fit_band(band, dx)
     if method == "welch" and w > WELCH_MAX_WAVINESS:
         raise RoadgenError(
@@ -156,30 +159,49 @@ def estimate_gd(
             f"w={w:g}: beyond it the Hann window's leakage biases the estimate (x2 at w = 5); "
             "use method='fit'"
         )
+    if method == "welch" and z.size < 32:  # profile_psd's default segment, N // 4, holds 8
+        raise RoadgenError(f"method='welch' needs a road of >= 32 heights, got {z.size}")
+    return _nonzero_gd(lambda h: _fitted_gd(h, dx, method, (lo, hi), content, w), z)
+
+
+def _fitted_gd(
+    z: np.ndarray,
+    dx: float,
+    method: str,
+    band: tuple[float, float],
+    content: tuple[float, float] | None,
+    w: float,
+) -> float:
+    """GD of checked heights z (N,) m on a step dx m: the fixed-slope (-w) fit over ``band``
+    (cycles/m) of their end-matched periodogram ("fit") or Welch PSD ("welch")."""
     if method == "fit":
         n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
-        keep = _fit_bins(n, (lo, hi), content, z.size, dx, method)
+        keep = _fit_bins(n, band, content, z.size, dx, method)
     else:
-        if z.size < 32:  # profile_psd's default Welch segment, N // 4, must hold 8 points
-            raise RoadgenError(f"method='welch' needs a road of >= 32 heights, got {z.size}")
         n, gd = _psd(z, dx, "welch", z.size // 4, end_match=False)
-        keep = _fit_bins(n, (lo, hi), content, z.size, dx, method)
+        keep = _fit_bins(n, band, content, z.size, dx, method)
         k = n / n[0]
         if not np.any(keep & (k >= WELCH_MIN_BIN)):
-            raise _welch_too_short((lo, hi), float(n[keep][-1]), z.size, dx)
+            raise _welch_too_short(band, float(n[keep][-1]), z.size, dx)
         keep &= k >= WELCH_MIN_BIN
         gd = gd / (1.0 + w * (w + 1.0) / (6.0 * k**2))
-    return _nonzero_gd(float(_finite_psd(np.mean(gd[keep] * (n[keep] / N0) ** w) / GD_SCALE, z)), z)
+    return float(_finite_psd(np.mean(gd[keep] * (n[keep] / N0) ** w) / GD_SCALE, z))
 
 
-def _nonzero_gd(value: float, z: np.ndarray) -> float:
-    """``value``, a GD from heights z (N,) m; RoadgenError where it is 0 although z is not flat:
-    heights so small that their squares underflow float64."""
+def _nonzero_gd(estimate: Callable[[np.ndarray], float], z: np.ndarray) -> float:
+    """``estimate(z)``, a GD from heights z (N,) m. Where it is 0 although z is not flat, it is
+    computed again on z scaled by a power of 2 (exactly) to a largest |z| in [0.5, 1) m: a GD
+    above 0 there means the heights are so small that their squares underflow float64
+    (RoadgenError); 0 again means the road has no roughness in the band (a straight ramp with
+    the end-matched fit), and 0.0 is returned."""
+    value = estimate(z)
     if value == 0.0 and np.ptp(z) > 0.0:
-        raise RoadgenError(
-            f"road.z holds heights of at most {np.max(np.abs(z)):.3g} m: their PSD underflows "
-            "float64; give heights in m"
-        )
+        exponent = np.frexp(np.max(np.abs(z)))[1]
+        if estimate(np.ldexp(z, -exponent)) > 0.0:
+            raise RoadgenError(
+                f"road.z holds heights of at most {np.max(np.abs(z)):.3g} m: their PSD "
+                "underflows float64; give heights in m"
+            )
     return value
 
 

@@ -198,18 +198,30 @@ def _check_total_length(
 
 
 def _check_segments(segments: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+    """``segments`` as ((length_m, gd), ...) floats, or RoadgenError naming the first bad one by
+    its index (not the whole list, which may hold thousands)."""
     try:
-        pairs = [tuple(seg) for seg in segments]
-    except TypeError as exc:
-        raise RoadgenError(f"segments={segments!r} must be a sequence of (length_m, gd)") from exc
-    if not pairs or any(len(p) != 2 for p in pairs):
+        items = list(segments)
+    except TypeError:
+        raise RoadgenError(
+            f"segments={segments!r} must be a sequence of (length_m, gd) pairs"
+        ) from None
+    if not items:
         raise RoadgenError(
             f"segments={segments!r} must be a non-empty sequence of (length_m, gd) pairs"
         )
-    return tuple(
-        (
-            checks.positive(f"segments[{i}] length_m", length),
-            checks.gd(f"segments[{i}] gd", g),
+    return tuple(_check_segment(i, seg) for i, seg in enumerate(items))
+
+
+def _check_segment(i: int, seg: tuple[float, float]) -> tuple[float, float]:
+    """Segment ``i`` as (length_m, gd) floats, or RoadgenError naming it."""
+    try:
+        pair = tuple(seg)
+    except TypeError:
+        pair = ()
+    if len(pair) != 2:
+        raise RoadgenError(
+            f"segments[{i}]={seg!r} is not a (length_m, gd) pair: segments must be such pairs"
         )
-        for i, (length, g) in enumerate(pairs)
-    )
+    length = checks.positive(f"segments[{i}] length_m", pair[0])
+    return length, checks.gd(f"segments[{i}] gd", pair[1])
