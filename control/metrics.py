@@ -150,19 +150,24 @@ def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tu
     """Distance past each GD change until the estimate first crosses the midpoint of the two GDs, m.
 
     One value per boundary between segments of different GD; NaN if the estimate never crosses
-    before the next boundary (or the end of the data).
+    before the next change of GD (adjacent segments of one GD are one part; or the end of the
+    data). ``position`` and ``gd_estimate`` are (n,) in time order ("first" is first in time);
+    estimates that are not finite (NaN: none) detect nothing, as in `gd_errors`.
     """
     position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
     starts = np.asarray(track.boundaries_m, dtype=float)
-    ends = np.append(starts[1:], np.inf)
+    seg_gd = [gd for _, gd in track.segments]
+    finite = np.isfinite(gd_estimate)
     delays = []
-    for k in range(1, len(track.segments)):
-        before, after = track.segments[k - 1][1], track.segments[k][1]
+    for k in range(1, len(seg_gd)):
+        before, after = seg_gd[k - 1], seg_gd[k]
         if before == after:
             continue
+        nxt = next((j for j in range(k + 1, len(seg_gd)) if seg_gd[j] != after), None)
+        end = np.inf if nxt is None else starts[nxt]
         mid = (before + after) / 2
         crossed = (gd_estimate > mid) if after > before else (gd_estimate < mid)
-        sel = np.flatnonzero((position >= starts[k]) & (position < ends[k]) & crossed)
+        sel = np.flatnonzero((position >= starts[k]) & (position < end) & crossed & finite)
         delays.append(float(position[sel[0]] - starts[k]) if sel.size else np.nan)
     return tuple(delays)
 

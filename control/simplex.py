@@ -12,7 +12,13 @@ paper's robot did (it drove at up to 2.0 m/s on GD 300). Laws offered here:
   K_p = (v_max - v_safe) / (GD_max - GD_min): v_max at and below GD_min, v_safe at GD_max, so the
   command is continuous where the safety mode takes over;
 - ``"paper"``: eq. 8 literally, clipped to [0, v_max] (v_max below GD_min; K_p defaults to
-  v_max / ((GD_max - GD_min) / 2), which gives v_max at GD_min). It stops the robot mid-band;
+  v_max / ((GD_max - GD_min) / 2), which gives v_max at GD_min). It stops the robot mid-band
+  and commands less than v_safe over part of the band (GD 275-350 with the defaults). Below
+  the emulator's speed domain (0.5 m/s for the shipped emulators, from GD 287.5) the BCR learns
+  nothing: the robot creeps or stands on its last estimate until that turns stale
+  (``BCRSettings.max_age_s``) and safety mode moves it on at v_safe. And as safety mode is then
+  faster than the law, a fault (or the latch after one) can make the robot faster than its
+  fault-free twin: the latch's guarantee below holds for "linear" and "switch" only;
 - ``"switch"``: v_max in performance mode, v_safe in safety mode.
 
 Speed grid: in performance mode the law's speed is rounded down to v_safe + k ``speed_step_mps``
@@ -37,7 +43,8 @@ goes on estimating, so its trace still shows what it sees. With ``"resume"`` the
 again at the first "ok" estimate. Once a run has diverged from its fault-free twin the closed
 loop is chaotic, and a resumed run may meet the next rough stretch a block sooner or later than
 the twin; a latched one drives at the safe speed from the fault on, so a fault that the checks
-flag in its first block never makes the robot faster on rough ground (docs/closed-loop.md).
+flag in its first block never makes the robot faster on rough ground (docs/closed-loop.md), on
+the laws whose performance speed is never below v_safe ("linear", "switch"; not "paper").
 The latch needs the run's history: `Simplex.command` is memoryless, `Simplex.start` gives the
 stateful `SimplexRun` that the closed loop and the replay use.
 """
@@ -83,7 +90,8 @@ class Simplex:
         v_safe: safety-mode speed, m/s (the paper's 1.0).
         kp: proportional gain, (m/s) per GD unit; None for the law's default.
         risk: None (use the posterior mean) or alpha in (0, 1) (use the (1 - alpha) quantile).
-        law: "linear", "paper" or "switch".
+        law: "linear", "paper" or "switch" ("paper" commands speeds below v_safe, down to 0, and
+            below the emulator's speed domain; see the module docstring).
         after_fault: "latch" (safety mode for the rest of the run after a fault) or "resume"
             (back to the law at the next ok estimate); used by `start`'s `SimplexRun`.
         latch_p: an "implausible" estimate latches only when its ``plausibility_p`` is below

@@ -269,11 +269,12 @@ def main(argv: list[str] | None = None) -> dict:
             metrics[key][case] = summarise(results, gds)
             label = "ours" if key == "ours" else "paper's method"
             figures[f"gd_trace_{case}_{key}.png"] = plot_gd_trace(
-                results, track, title=f"{title}, {label}: GD"
+                results, track, title=f"{title}, {label}: GD", gd_max=simplex.gd_max
             )
             figures[f"speed_{case}_{key}.png"] = plot_speed(
-                results, track, title=f"{title}, {label}: speed"
-            )
+                results, track, title=f"{title}, {label}: speed", gd_max=simplex.gd_max,
+                v_safe=simplex.v_safe,
+            )  # fmt: skip
     for name, fig in figures.items():
         save_figure(fig, out / name, dpi=150)
     if paper_track:

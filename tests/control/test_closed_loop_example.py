@@ -71,6 +71,24 @@ def test_another_track_and_seed_give_one_rmse_per_prescribed_gd(tmp_path, capsys
     assert "edge of the emulator's GD domain" not in printed  # inside the domain: none named
 
 
+def test_the_speed_figures_mark_the_simplex_settings_given(tmp_path, monkeypatch):
+    """--v-safe 0.8 drew a line labelled "safe speed 1 m/s": the figures took plot_speed's
+    defaults, not the Simplex's settings."""
+    script = load_script()
+    seen = []
+    real = script.plot_speed
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(script, "plot_speed", spy)
+    argv = ["--out", str(tmp_path), "--runs", "1", "--track", "10:250,10:450", "--v-safe", "0.8"]
+    script.main(argv)
+    assert len(seen) == 4  # two cases x (ours, the paper's method)
+    assert all(kw.get("v_safe") == 0.8 and kw.get("gd_max") == 350.0 for kw in seen)
+
+
 def test_a_part_too_short_for_an_estimate_prints_a_dash_and_writes_null(tmp_path, capsys):
     # 2 m at <= 2 m/s ends before the paper's method fills its 1,000-sample window.
     metrics = load_script().main(["--out", str(tmp_path), "--runs", "1", "--track", "2:300"])
