@@ -43,6 +43,7 @@ from gpmsa.model.data import (
     by_column_names,
     check_count,
     check_flag,
+    check_same_rows,
     evenly_spaced,
 )
 from gpmsa.model.likelihood import lower_cholesky
@@ -299,6 +300,7 @@ class Emulator:
     def _inputs(self, x, t, *, far_ok: bool = False) -> np.ndarray:
         """Unit-scale z (N, p + q) of native x and t; beyond ``EXTRAPOLATION_MARGIN`` of the
         domain a GPMSAError unless ``far_ok`` (a caller that allows it and has warned)."""
+        check_same_rows({"x": x, "t": t}, {"x": self.x_names, "t": self.t_names})
         x = as_float(by_column_names(x, self.x_names, "x"), "x")  # ragged: named here
         t = as_float(by_column_names(t, self.t_names, "t"), "t")
         x = as_matrix(x, "x", ncols=self.p) if np.ndim(x) != 1 or self.p != 1 else as_matrix(x, "x")
@@ -374,7 +376,8 @@ class Emulator:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Predictive mean and variance (N, l_sim) of the simulator output in native units.
 
-        x (N, p) known inputs and t (N, q) parameters, native units (a single row broadcasts).
+        x (N, p) known inputs and t (N, q) parameters, native units (a single row broadcasts;
+        pandas tables of N > 1 rows must carry the same row labels: rows pair by position).
         ``draws=False``: at the point estimate ``params``; ``draws=True``: averaged over the
         retained posterior draws (or ``n_draws`` of them, evenly spaced from the first to the
         last: ``evenly_spaced``), combining the variances by the law of total variance.

@@ -74,6 +74,8 @@ def as_float(value, name: str) -> np.ndarray:
     try:
         is_complex = np.iscomplexobj(value)
         arr = None if is_complex else np.array(value, dtype=np.float64)
+    except OverflowError as exc:  # a Python int beyond float64's range
+        raise GPMSAError(f"{name} holds a number too large for float64: {exc}") from exc
     except (TypeError, ValueError) as exc:
         raise GPMSAError(f"{name} must be a numeric array, got {type(value).__name__}") from exc
     if arr is None:
@@ -132,6 +134,40 @@ def by_column_names(value, names, name: str):
         return value
     column_order(labels, names, name)
     return value[list(names)]
+
+
+def pandas_rows(value, names=None):
+    """The row labels of a pandas DataFrame, or of a Series read as the values of one input;
+    None for any other value and for a Series indexed by ``names`` (one point, not rows)."""
+    pd = sys.modules.get("pandas")
+    if pd is None or not isinstance(value, pd.DataFrame | pd.Series):
+        return None
+    if isinstance(value, pd.Series) and names is not None:
+        if sorted(str(i) for i in value.index) == sorted(str(n) for n in names):
+            return None
+    return value.index
+
+
+def check_same_rows(values: dict, names: dict | None = None) -> None:
+    """GPMSAError when two pandas inputs (name -> value; ``names``: name -> the input names a
+    one-point Series is indexed by) of as many rows (> 1) carry different row labels: gpmsa
+    pairs rows by position, pandas by label, so their rows would be silently mispaired."""
+    first = None
+    for name, value in values.items():
+        rows = pandas_rows(value, (names or {}).get(name))
+        if rows is None:
+            continue
+        if first is None:
+            first = (name, rows)
+            continue
+        ref, ref_rows = first
+        if len(rows) == len(ref_rows) > 1 and not rows.equals(ref_rows):
+            raise GPMSAError(
+                f"{ref} and {name} are pandas objects whose row labels differ ({ref}: "
+                f"{list(ref_rows[:5])}..., {name}: {list(rows[:5])}...): gpmsa pairs rows by "
+                f"position, not by label; align them first (e.g. {name}.loc[{ref}.index]), or "
+                "pass plain arrays (.to_numpy())"
+            )
 
 
 def is_series(value) -> bool:
@@ -377,7 +413,9 @@ class SimData:
     columns of ``y`` together). Names default to x0.., t0.., y0..; units to "". ``t_names`` may
     not be a reserved name (lamOs, lamVz, betaV, betaV[k]: the other parameters of a calibration
     posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every entry must be a real number
-    (strings, bools and None are refused, never converted).
+    (strings, bools and None are refused, never converted). A pandas table names its columns
+    (read by ``*_names`` where given), a named pandas Series (``df["a"]``) its one column;
+    pandas inputs of several rows must carry the same row labels (rows pair by position).
     ``x_categorical``, ``t_categorical``: the categorical inputs (column indices or names; None:
     none), whose values are integer level codes; see docs/categorical-and-constraints.md.
     """
@@ -396,9 +434,13 @@ class SimData:
     t_categorical: Sequence[int | str] | None = None
 
     def __post_init__(self) -> None:
+        check_same_rows({"x": self.x, "t": self.t, "y": self.y})
         for part in ("x", "t", "y"):  # a table: its columns by name, never by position
-            labels, names = column_labels(getattr(self, part)), getattr(self, f"{part}_names")
-            if labels is not None and names is None:
+            value, names = getattr(self, part), getattr(self, f"{part}_names")
+            labels = column_labels(value)
+            if names is None and is_series(value) and value.name is not None:
+                object.__setattr__(self, f"{part}_names", (str(value.name),))  # df["a"]: "a"
+            elif labels is not None and names is None:
                 object.__setattr__(self, f"{part}_names", labels)
             elif labels is not None:
                 value = by_column_names(getattr(self, part), tuple(names), part)
@@ -505,7 +547,8 @@ class ObsData:
     (1/unit^2): None (identity in standardised units, GPM/SA's default), a scalar (the same for
     every experiment), or per experiment a scalar or an (l_j, l_j) matrix (a list, or an array
     of shape (n,) or (n, l, l)). Every entry must be a real number (strings, bools and None are
-    refused, never converted).
+    refused, never converted). ``x`` and ``y`` given as pandas objects of several rows must carry
+    the same row labels (rows pair by position).
     """
 
     x: np.ndarray
@@ -518,6 +561,7 @@ class ObsData:
     x_columns: tuple[str, ...] | None = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        check_same_rows({"x_obs": self.x, "y_obs": self.y})
         object.__setattr__(self, "x_columns", column_labels(self.x))
         x = as_matrix(self.x, "x_obs")
         n = x.shape[0]

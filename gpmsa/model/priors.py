@@ -63,7 +63,8 @@ class Priors:
     theta (unit scale): Normal(theta_mean, theta_sd) truncated to (0, 1).
     betaU, betaV: Beta(rho_a, rho_b) on rho = exp(-beta/4), rho capped at ``rho_cap`` in the
     density; beta in (0, inf). Precisions: Gamma priors below. ``lamWOs`` and ``lamOs`` here are
-    the base priors before the data corrections of GPM/SA (see ``with_data``).
+    the base priors before the data corrections of GPM/SA (see ``with_data``); ``gpmsa.fit``
+    refuses corrected priors (``corrected=True``, e.g. an Emulator's ``priors``).
     """
 
     theta_mean: float = 0.5

@@ -363,6 +363,8 @@ def prepare(
 
     ``mean_basis``: None (zero mean), "constant", "linear" or a callable of unit-scale [x, t]
     (n, p + q) -> (n, k) (``gpmsa.model.mean_basis``). Categorical inputs come from ``sim``.
+    ``priors``: before the data corrections (``corrected=False``; an Emulator's ``priors``,
+    corrected for its own data, are refused).
     """
     if not isinstance(sim, SimData):
         raise GPMSAError(f"data must be a gpmsa.SimData, got {type(sim).__name__}")
@@ -370,6 +372,13 @@ def prepare(
         raise GPMSAError(f"obs must be a gpmsa.ObsData or None, got {type(obs).__name__}")
     if priors is not None and not isinstance(priors, Priors):
         raise GPMSAError(f"priors must be a gpmsa.Priors or None, got {priors!r}")
+    if priors is not None and priors.corrected:
+        raise GPMSAError(
+            "priors are already data-corrected (corrected=True, as an Emulator's .priors): their "
+            "lamWOs and lamOs priors hold the corrections of the data they were fitted to, and "
+            "would not be corrected for these data; pass the priors as set before fitting "
+            "(gpmsa.Priors(...), corrected=False)"
+        )
     std = Standardizer.from_sim(sim)
     y_std = std.y_to_std(sim.y)
     K = pca_basis(y_std, n_pc)

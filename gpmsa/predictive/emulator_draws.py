@@ -21,7 +21,7 @@ import numpy as np
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.model.data import check_count, check_flag, check_level
+from gpmsa.model.data import check_count, check_flag, check_level, check_same_rows
 from gpmsa.predictive._common import (
     factors,
     gpmsa_model_only,
@@ -150,6 +150,7 @@ def emulator_prediction(
     n_rlz = check_count(n_rlz, "n_rlz")
     rng = rng_of(seed)
     s = emulator.standardizer
+    check_same_rows({"x": x, "t": t}, {"x": emulator.x_names, "t": emulator.t_names})
     x_nat, xu = unit_inputs(x, emulator.x_names, s.x_min, s.x_max, "x")
     t_nat, tu = unit_inputs(t, emulator.t_names, s.t_min, s.t_max, "t")
     if x_nat.shape[0] != t_nat.shape[0]:
