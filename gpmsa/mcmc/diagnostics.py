@@ -116,7 +116,8 @@ def convergence(
     n_draws (per chain), the limits, per parameter ``rhat`` and ``ess`` (bulk) lists (C order),
     the worst element of each kind, and ``flagged``: element -> reason, for every element with
     R-hat > RHAT_MAX, ESS < ESS_MIN, no movement at all (constant draws: NaN R-hat and ESS), or
-    too few draws to judge (fewer than MIN_DRAWS_ESS a chain).
+    too few draws to judge (fewer than MIN_DRAWS_RHAT a chain: no R-hat, and ArviZ's ESS of
+    such short chains can exceed ESS_MIN even for chains stuck at different values).
     """
     rhat_of, ess_of, flagged = {}, {}, {}
     worst_r, worst_e = ("", -np.inf), ("", np.inf)
@@ -126,7 +127,7 @@ def convergence(
         for el, r, e in zip(element_names(name, shape), rs, es, strict=True):
             r = float("nan") if r is None else float(r)
             e = float("nan") if e is None else float(e)
-            if n_draws < MIN_DRAWS_ESS:
+            if n_draws < MIN_DRAWS_RHAT:
                 flagged[el] = f"too few draws to judge ({n_draws} a chain)"
                 continue
             if not (np.isfinite(r) or np.isfinite(e)):

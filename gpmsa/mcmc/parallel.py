@@ -9,7 +9,9 @@ Failures: a task that raises ``GPMSAError`` (bad input, the same on any machine)
 with ``ChainError`` naming the chain. Any other failure (a worker that died, a lost connection,
 an executor whose ``submit`` raises) is retried ``retries`` times, with a ``RuntimeWarning``,
 in a fresh pool when the pool was ours; then ``ChainError`` names the chain and the cause. A
-chain is never dropped silently.
+chain is never dropped silently. When a run stops early (a chain failed, or KeyboardInterrupt),
+the chains not yet finished are cancelled: gpmsa's own worker processes are ended, an
+executor's futures cancelled.
 """
 
 from __future__ import annotations
@@ -86,6 +88,10 @@ def as_executor(executor) -> Executor | None:
     if executor is None or isinstance(executor, Executor):
         return executor
     if callable(getattr(executor, "get_executor", None)):  # distributed.Client
+        if getattr(executor, "status", None) in ("closing", "closed"):
+            raise GPMSAError(  # its executor would hang: a task resubmitted there never ends
+                f"executor: the dask Client is {executor.status}; pass a running Client"
+            )
         return executor.get_executor()
     raise GPMSAError(
         f"executor must be a concurrent.futures.Executor or a dask Client, got {executor!r}"
@@ -97,6 +103,30 @@ def _own_pool(workers: int) -> ProcessPoolExecutor:
     # spawn, which re-import numpy and scipy. The workers run numpy only, one BLAS thread.
     ctx = multiprocessing.get_context("fork") if sys.platform == "linux" else None
     return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+
+
+_JOIN_S = 5.0
+"""Seconds to wait for a terminated worker process to exit."""
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Shut our pool down at once: cancel the chains not started and end the workers still
+    running one (``terminate_workers`` of Python 3.14), so that a failed or interrupted run
+    leaves no process computing chains nobody will read."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        if proc.is_alive():
+            proc.terminate()
+    for proc in processes:
+        proc.join(timeout=_JOIN_S)
+
+
+def _closed(exc: BaseException) -> bool:
+    """Whether ``exc``, raised by an executor's ``submit``, says the executor is shut down or
+    its dask Client closed (no retry can help; dask would even accept the next task, never to
+    run it)."""
+    return "shutdown" in str(exc) or type(exc).__name__ == "ClosedClientError"
 
 
 def _describe(exc: BaseException) -> str:
@@ -168,7 +198,7 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
             f"draws)", RuntimeWarning, stacklevel=2,
         )  # fmt: skip
         if own and isinstance(exc, BrokenExecutor):  # a dead worker breaks the whole pool
-            pool.shutdown(wait=False, cancel_futures=True)
+            _stop(pool)
             pool = _own_pool(workers)
             others = list(running.items())
             running.clear()
@@ -185,8 +215,8 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
         try:
             submit(i)
         except Exception as exc:  # the executor refused the task
-            if not own and "shutdown" in str(exc):  # the caller's executor is shut down:
-                raise GPMSAError(  # no retry can help (a transient refusal is retried)
+            if not own and _closed(exc):  # a transient refusal is retried
+                raise GPMSAError(
                     f"the executor refused {what} {i} of {n}: {_describe(exc)}; pass an "
                     "executor that is running"
                 ) from exc
@@ -211,7 +241,7 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
         for fut in running:
             fut.cancel()
         if own:
-            pool.shutdown(wait=False, cancel_futures=True)
+            _stop(pool)
         raise
     finally:
         bar.close()

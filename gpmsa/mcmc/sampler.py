@@ -19,9 +19,10 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import ChainError, GPMSAError
+from gpmsa.limits import check_memory
 from gpmsa.mcmc import ridge, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
-from gpmsa.model.data import as_float, check_count, check_seed
+from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 from gpmsa.model.likelihood import IncrementalLikelihood, log_prior
 from gpmsa.model.problem import Problem
 
@@ -269,12 +270,20 @@ class ChainState:
 
 
 def check_sample_args(n_iter, n_chains, seed) -> None:
-    """The checks every backend's ``sample`` makes on its run arguments (GPMSAError naming it)."""
-    if not isinstance(n_iter, (int, np.integer)) or n_iter < 1:
-        raise GPMSAError(f"n_iter must be an integer >= 1, got {n_iter!r}")
-    if not isinstance(n_chains, (int, np.integer)) or n_chains < 1:
-        raise GPMSAError(f"n_chains must be an integer >= 1, got {n_chains!r}")
+    """The checks every backend's ``sample`` makes on its run arguments (GPMSAError naming it;
+    a bool is not a count)."""
+    check_count(n_iter, "n_iter")
+    check_count(n_chains, "n_chains")
     check_seed(seed)
+
+
+def check_draws_memory(problem: Problem, n_iter: int, n_chains: int) -> None:
+    """ResourceLimitError (before any chain runs) when the stored sweeps of every chain, kept
+    twice while the chains are stacked, exceed ``gpmsa.limits.MAX_MEMORY_BYTES``."""
+    n_el = sum(int(np.size(v)) for v in problem.init.values()) + 1  # and the log posterior
+    check_memory(16.0 * n_chains * n_iter * n_el,
+                 f"sample(n_iter={n_iter}, n_chains={n_chains}) of {n_el - 1} parameter "
+                 "elements")  # fmt: skip
 
 
 def check_ridge(ridge_moves, problem: Problem) -> int:
@@ -428,6 +437,8 @@ def sample(
     chain that failed or whose draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
+    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    check_draws_memory(problem, int(n_iter), int(n_chains))
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     how = starts.check_init(init, int(n_chains))
     if how == "gpmsa":  # here, not in a worker: a plain GPMSAError naming the prior

@@ -1,0 +1,160 @@
+"""Chain runs that stop early leave nothing running, a closed dask Client is refused (not a
+hang), short chains are never judged converged, and ``sample`` refuses bad run arguments."""
+
+import multiprocessing
+import os
+import re
+import signal
+import threading
+import time
+from contextlib import nullcontext
+
+import numpy as np
+import pytest
+
+import gpmsa
+from gpmsa import backends
+from gpmsa.mcmc import diagnostics, parallel
+
+
+@pytest.fixture(scope="module")
+def problem():
+    from _backend_cases import multi_data
+
+    return gpmsa.prepare(multi_data()[0]).problem
+
+
+# --- a run that stops early ends its workers ------------------------------------------------------
+def _first_fails(x, error, progress=False, desc=""):
+    if x == 0:
+        time.sleep(0.3)  # the other chain is running by now
+        raise error
+    time.sleep(30.0)  # a long chain nobody will read
+    return x
+
+
+def _sleeps(x, progress=False, desc=""):
+    time.sleep(30.0)
+    return x
+
+
+def _workers_left(before: set, wait_s: float = 5.0) -> list:
+    deadline = time.monotonic() + wait_s
+    while True:
+        left = [p for p in multiprocessing.active_children() if p.pid not in before]
+        if not left or time.monotonic() > deadline:
+            return left
+        time.sleep(0.1)
+
+
+@pytest.mark.skipif(parallel.available_cpus() < 2, reason="needs two CPUs for a pool")
+@pytest.mark.parametrize(
+    ("error", "match"),
+    [
+        (gpmsa.GPMSAError("bad input 42"), "chain 0 of 2 failed: GPMSAError: bad input 42"),
+        (ValueError("broke 42"), "chain 0 of 2 failed after 2 attempts: ValueError: broke 42"),
+    ],
+)
+def test_a_failed_chain_ends_the_workers_still_running(error, match):
+    before = {p.pid for p in multiprocessing.active_children()}
+    tasks = [{"x": i, "error": error} for i in range(2)]
+    start = time.monotonic()
+    retried = not isinstance(error, gpmsa.GPMSAError)  # not an input error: run once more
+    with pytest.warns(RuntimeWarning, match="running it again") if retried else nullcontext():
+        with pytest.raises(gpmsa.ChainError, match=match):
+            parallel.run_chains(_first_fails, tasks, n_jobs=2)
+    assert time.monotonic() - start < 10.0  # the error comes without waiting for chain 1
+    assert _workers_left(before) == []
+
+
+@pytest.mark.skipif(parallel.available_cpus() < 2, reason="needs two CPUs for a pool")
+def test_an_interrupted_run_ends_its_workers():
+    before = {p.pid for p in multiprocessing.active_children()}
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            parallel.run_chains(_sleeps, [{"x": i} for i in range(2)], n_jobs=2)
+    finally:
+        timer.cancel()
+    assert _workers_left(before) == []
+
+
+# --- a closed dask Client -------------------------------------------------------------------------
+def _double(x, progress=False, desc=""):
+    return 2 * x
+
+
+def test_a_closed_dask_client_is_refused_without_a_hang():
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    )
+    client = distributed.Client(cluster)
+    tasks = [{"x": i} for i in range(3)]
+    assert parallel.run_chains(_double, tasks, executor=client) == [0, 2, 4]
+    executor = client.get_executor()
+    client.close()
+    cluster.close()
+    # dask takes a task resubmitted to a closed Client and never runs it: a daemon thread
+    # bounds the wait
+    for given, match in ((client, "the dask Client is closed"),
+                         (executor, "refused chain 0 of 3: ClosedClientError")):  # fmt: skip
+        got = []
+
+        def run(given=given, got=got):
+            try:
+                parallel.run_chains(_double, tasks, executor=given)
+            except Exception as exc:
+                got.append(exc)
+
+        thread = threading.Thread(target=run, daemon=True)
+        thread.start()
+        thread.join(60)
+        assert not thread.is_alive(), f"run_chains hung on a closed Client ({match})"
+        assert isinstance(got[0], gpmsa.GPMSAError) and re.search(match, str(got[0]))
+
+
+# --- the convergence verdict ----------------------------------------------------------------------
+def _verdict(x: np.ndarray) -> dict:
+    summary = diagnostics.summarize({"a": x[:, :, None]})
+    return diagnostics.convergence(summary, {"a": (1,)}, x.shape[0], x.shape[1])
+
+
+def test_chains_stuck_apart_are_flagged_however_short():
+    rng = np.random.default_rng(0)
+    for n_draws in (5, 7, 8, 20):  # ArviZ's bulk ESS of these is above 100
+        stuck = np.repeat(rng.normal(size=(64, 1)), n_draws, axis=1)
+        stuck += 1e-3 * rng.normal(size=stuck.shape)
+        record = _verdict(stuck)
+        assert not record["converged"], n_draws
+        why = record["flagged"]["a[0]"]
+        assert why.startswith("R-hat") or why == f"too few draws to judge ({n_draws} a chain)"
+    same = np.repeat(rng.normal(size=(1, 2000)), 4, axis=0)  # identical chains: R-hat 1
+    record = _verdict(same)
+    assert record["converged"] and abs(record["rhat"]["a"][0] - 1.0) < 0.01
+
+
+# --- sample's run arguments -----------------------------------------------------------------------
+SHORT = {"n_iter": 20, "tune_rounds": 2, "tune_levels": 5, "n_jobs": 1}
+
+
+@pytest.mark.parametrize(
+    ("bad", "match"),
+    [
+        ({"tune": "no"}, "tune must be True or False, got 'no'"),
+        ({"progress": "no"}, "progress must be True or False, got 'no'"),
+        ({"n_chains": True}, "n_chains must be an integer >= 1, got True"),
+        ({"n_iter": True}, "n_iter must be an integer >= 1, got True"),
+    ],
+)
+def test_sample_refuses_a_flag_or_count_of_another_type(problem, capsys, bad, match):
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        backends.get("numpy").sample(problem, **{**SHORT, **bad})
+    assert capsys.readouterr().err == ""  # progress="no" drew no bar
+
+
+def test_sample_refuses_draws_beyond_the_memory_limit(problem, monkeypatch):
+    monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", 100_000)
+    with pytest.raises(gpmsa.ResourceLimitError, match=r"sample\(n_iter=1000, n_chains=2\)"):
+        backends.get("numpy").sample(problem, n_chains=2, tune=False, **{**SHORT, "n_iter": 1000})
