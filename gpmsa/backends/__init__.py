@@ -44,7 +44,8 @@ def available() -> tuple[str, ...]:
 def get(name: str) -> ModuleType:
     """The backend module called ``name``.
 
-    Raises GPMSAError for an unknown name and BackendUnavailableError when its packages are missing.
+    Raises GPMSAError for an unknown name and BackendUnavailableError when its packages are missing
+    or fail to import (e.g. a pyro-ppl release that does not work with the installed torch).
     """
     if not isinstance(name, str) or name not in _REGISTRY:
         raise GPMSAError(f"unknown backend {name!r}; registered: {names()}")
@@ -54,9 +55,24 @@ def get(name: str) -> ModuleType:
     except ModuleNotFoundError as exc:
         if exc.name == path:
             raise GPMSAError(f"backend {name!r} is registered but {path} does not exist") from exc
+        if _own(exc):
+            raise
         raise BackendUnavailableError(
             f'backend {name!r} needs {exc.name}: pip install "terrain-gpmsa[{extra}]"'
         ) from exc
+    except (ImportError, OSError) as exc:  # installed but broken: incompatible versions, libraries
+        if isinstance(exc, ImportError) and _own(exc):
+            raise
+        raise BackendUnavailableError(
+            f"backend {name!r}: its packages are installed but fail to import "
+            f"({type(exc).__name__}: {exc}); install compatible versions: "
+            f'pip install --upgrade "terrain-gpmsa[{extra}]"'
+        ) from exc
+
+
+def _own(exc: ImportError) -> bool:
+    """Whether an import error is gpmsa's own (a bug to show as it is, not a missing package)."""
+    return (exc.name or "").split(".")[0] == "gpmsa"
 
 
 def placement(backend: str, n_jobs=None, executor=None) -> dict:

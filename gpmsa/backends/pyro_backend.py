@@ -185,6 +185,7 @@ def sample(
     if step_widths:
         raise GPMSAError("the pyro backend (NUTS) takes no step_widths; leave step_widths=None")
     check_sample_args(n_iter, n_chains, seed)
+    progress = check_flag(progress, "progress")
     if problem.extensions:
         raise GPMSAError(
             f"the pyro backend does not support {', '.join(problem.extensions)}; use "

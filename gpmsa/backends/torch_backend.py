@@ -44,7 +44,7 @@ from gpmsa.mcmc.sampler import (
     check_step_widths,
     elements,
 )
-from gpmsa.model.data import check_count
+from gpmsa.model.data import check_count, check_flag
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem
 
@@ -589,20 +589,30 @@ def torch_threads(num_threads: int | None):
         torch.set_num_threads(previous)
 
 
+_DTYPES = {"float64": torch.float64, "float32": torch.float32}
+
+
 def _dtype(dtype) -> torch.dtype:
-    if dtype in (torch.float64, torch.float32):
+    """``dtype`` ("float64", "float32" or that torch dtype) as a torch dtype; GPMSAError for
+    anything else (a numpy dtype too: the fit records the name)."""
+    if isinstance(dtype, torch.dtype) and dtype in _DTYPES.values():
         return dtype
-    if dtype in ("float64", "float32"):
-        return getattr(torch, dtype)
+    if isinstance(dtype, str) and dtype in _DTYPES:
+        return _DTYPES[dtype]
     raise GPMSAError(f"dtype must be 'float64' or 'float32', got {dtype!r}")
 
 
 def _device(device) -> torch.device:
     """``device`` as a torch.device (`_parsed_device`); GPMSAError for CUDA where torch sees
-    none."""
+    none, or fewer than ``cuda:N`` needs."""
     dev = _parsed_device(device)
     if dev.type == "cuda" and not torch.cuda.is_available():
         raise GPMSAError(f"device={device!r} was asked for but torch sees no CUDA device")
+    if dev.type == "cuda" and dev.index is not None and dev.index >= torch.cuda.device_count():
+        raise GPMSAError(
+            f"device={device!r} was asked for but torch sees {torch.cuda.device_count()} CUDA "
+            f"device(s): cuda:0 to cuda:{torch.cuda.device_count() - 1}"
+        )
     return dev
 
 
@@ -671,6 +681,7 @@ def sample(
     backend's chains are (``gpmsa.mcmc.parallel``), then ``ChainError`` names its chains.
     """
     check_sample_args(n_iter, n_chains, seed)
+    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     if problem.extensions:
         raise GPMSAError(
             f"the torch backend does not support {', '.join(problem.extensions)}; use "
@@ -719,10 +730,8 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     """``sample`` without the thread setting."""
     dev, dt = _device(device), _dtype(dtype)
     how = starts.check_init(init, n_chains)
-    if warmup is None:
-        warmup = WARMUP if tune else 0
-    if not isinstance(warmup, (int, np.integer)) or warmup < 0:
-        raise GPMSAError(f"warmup must be an integer >= 0, got {warmup!r}")
+    warmup = (WARMUP if tune else 0) if warmup is None else check_count(warmup, "warmup", 0)
+    tune_stages = check_count(tune_stages, "tune_stages")
     if tune_rounds is None:
         tune_rounds = math.ceil(tuning.N_BURN / n_chains)
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
@@ -734,8 +743,6 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     state = BatchState(problem, int(n_chains), dt, dev, start, n_ridge)
     els = state.els
     w = np.array([float(widths[n][idx]) for n, idx in els])
-    if not isinstance(tune_stages, (int, np.integer)) or tune_stages < 1:
-        raise GPMSAError(f"tune_stages must be an integer >= 1, got {tune_stages!r}")
     n_stages = tune_stages if tune else 1
     total = n_iter + n_stages * (warmup + (tune_rounds * tune_levels if tune else 0))
     names = problem.names
