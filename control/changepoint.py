@@ -234,6 +234,10 @@ def mixture_posterior(
     filters: list[ChangePointFilter], weights, name: str = "GD", n_draws: int = 4000
 ) -> Posterior:
     """The mixture of the GD posteriors of filters on one GD grid, with (positive) weights."""
+    if not isinstance(filters, list | tuple):
+        raise ControlError(f"filters must be a list of ChangePointFilters, got {filters!r:.60}")
+    for i, f in enumerate(filters):
+        check_instance(f, f"filters[{i}]", ChangePointFilter)
     w = np.asarray(weights, dtype=float)
     if not filters or w.shape != (len(filters),) or not np.all(np.isfinite(w) & (w > 0)):
         raise ControlError(

@@ -323,7 +323,7 @@ def feature_of_variance(f: np.ndarray | float, feature: str = "log_var") -> np.n
     """
     if feature not in SCALAR_FEATURES:
         raise ControlError(f"feature must be one of {SCALAR_FEATURES}, got {feature!r}")
-    f = np.asarray(f, dtype=float)
+    f = float_array(f, "f")  # (None or a string is no variance: not NaN)
     if feature == "var":
         return f[()]
     with np.errstate(divide="ignore", invalid="ignore"):

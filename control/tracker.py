@@ -123,7 +123,8 @@ class GDTracker:
         """Multiply in a likelihood given on any sorted grid of native GD (interpolated in log GD).
 
         Args:
-            grid: (k,) increasing GD values where loglik is known (e.g. the Calibrator's grid).
+            grid: (k,) increasing GD values where loglik is known (e.g. the Calibrator's grid),
+                spanning the tracker's domain.
             loglik: (k,) log-likelihood values (any additive constant).
             power: tempering exponent in (0, 1]: the likelihood enters as likelihood**power
                 (the fraction of the window's samples that are new to this tracker).
@@ -138,9 +139,23 @@ class GDTracker:
             raise ControlError(f"grid must hold increasing, finite, positive GD values, got {grid}")
         if not np.all(np.isfinite(loglik)):
             raise ControlError("loglik must be finite")
+        self._check_covers(grid)
         ll = power * np.interp(self.log_grid, np.log(grid), loglik - loglik.max())
         log_mass = self.log_mass + ll
         self.log_mass = log_mass - logsumexp(log_mass)
+
+    def _check_covers(self, grid: np.ndarray) -> None:
+        """ControlError unless the likelihood's ``grid`` spans the tracker's domain (to 1e-9 of
+        log GD): beyond its ends the interpolation would hold the end values, a flat likelihood
+        the data never gave."""
+        lo, hi = self.log_grid[0], self.log_grid[-1]
+        tol = 1e-9 * (hi - lo)
+        if np.log(grid[0]) > lo + tol or np.log(grid[-1]) < hi - tol:
+            raise ControlError(
+                f"grid spans GD [{grid[0]:g}, {grid[-1]:g}] but the tracker's domain is "
+                f"[{self.grid[0]:g}, {self.grid[-1]:g}]: give the likelihood on a grid that "
+                "covers the domain (outside its grid it would be read as flat)"
+            )
 
     def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
         """The current posterior of GD as a gpmsa Posterior holding the exact grid marginal.

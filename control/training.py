@@ -113,26 +113,16 @@ def block_scatter(
     Args:
         speed: (m,) the runs' speeds, m/s.
         stats_: their `block_statistics`.
-        nodes: speed nodes (default 16 over the runs' range).
+        nodes: >= 2 increasing speed nodes, m/s (default 16 over the runs' range).
     """
+    check_instance(stats_, "stats_", BlockStatistics)
     speed = float_array(speed, "speed")
     if speed.shape != (stats_.mean.shape[0],) or not np.all(np.isfinite(speed)):
         raise ControlError(f"speed must hold one finite value per run ({stats_.mean.shape[0]})")
     if not (is_real(bandwidth) and np.isfinite(bandwidth) and bandwidth > 0):
         raise ControlError(f"bandwidth must be a finite speed > 0, m/s, got {bandwidth!r}")
-    if nodes is None:
-        nodes = np.linspace(speed.min(), speed.max(), 16)
-    nodes = float_array(nodes, "nodes")
-    if nodes.ndim != 1 or nodes.size == 0 or not np.all(np.isfinite(nodes)):
-        raise ControlError(f"nodes must be a non-empty 1-D array of finite speeds, got {nodes!r}")
-    z = (nodes[:, None] - speed[None, :]) / bandwidth
-    far = np.min(np.abs(z), axis=1) > 30.0  # the kernel weights would all underflow
-    if far.any():
-        raise ControlError(
-            f"speed node {nodes[int(np.argmax(far))]:g} m/s lies more than 30 bandwidths "
-            f"({bandwidth:g} m/s) from every run's speed: no run informs its covariance"
-        )
-    w = np.exp(-0.5 * z**2)
+    nodes = _scatter_nodes(nodes, speed, bandwidth)
+    w = np.exp(-0.5 * ((nodes[:, None] - speed[None, :]) / bandwidth) ** 2)
     w /= w.sum(axis=1, keepdims=True)
     cov = np.einsum("sr,rij->sij", w, stats_.cov)
     for node, c in zip(nodes, cov, strict=True):
@@ -142,6 +132,30 @@ def block_scatter(
                 "combination of them) does not vary from block to block"
             )
     return BlockScatter(nodes, cov, _fit_dof(speed, stats_, nodes, cov))
+
+
+def _scatter_nodes(nodes, speed: np.ndarray, bandwidth: float) -> np.ndarray:
+    """The speed nodes of `block_scatter` (default: 16 over the runs' speeds) as >= 2
+    increasing finite speeds, each within 30 bandwidths of a run; ControlError naming them."""
+    if nodes is None:
+        if speed.min() == speed.max():
+            raise ControlError(
+                f"every run drove at {speed[0]:g} m/s: the default nodes span the runs' speeds, "
+                "so give nodes (>= 2 increasing speeds, m/s, e.g. around that speed)"
+            )
+        nodes = np.linspace(speed.min(), speed.max(), 16)
+    nodes = float_array(nodes, "nodes")
+    if nodes.ndim != 1 or nodes.size == 0 or not np.all(np.isfinite(nodes)):
+        raise ControlError(f"nodes must be >= 2 increasing finite speeds, m/s, got {nodes!r}")
+    far = np.min(np.abs(nodes[:, None] - speed[None, :]), axis=1) > 30.0 * bandwidth
+    if far.any():  # the kernel weights would all underflow
+        raise ControlError(
+            f"speed node {nodes[int(np.argmax(far))]:g} m/s lies more than 30 bandwidths "
+            f"({bandwidth:g} m/s) from every run's speed: no run informs its covariance"
+        )
+    if nodes.size < 2 or np.any(np.diff(nodes) <= 0):
+        raise ControlError(f"nodes must be >= 2 increasing finite speeds, m/s, got {nodes!r}")
+    return nodes
 
 
 def _fit_dof(speed, stats_: BlockStatistics, nodes, cov) -> float:
