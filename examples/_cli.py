@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from gpmsa.io.atomic import atomic_write
+from gpmsa.model.data import MAX_SEED
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -20,6 +21,15 @@ def path_option(text: str) -> str:
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path: give a file or folder name")
     return text
+
+
+def check_seed(parser: argparse.ArgumentParser, seed: int, offset: int = 0) -> None:
+    """Usage error unless ``--seed`` and ``seed + offset`` (the largest seed the script derives
+    from it) are seeds the libraries take: integers in [0, 2**128)."""
+    if seed < 0:
+        parser.error(f"--seed must be >= 0, got {seed}")
+    if seed + offset >= MAX_SEED:
+        parser.error(f"--seed must be <= 2**128 - {offset + 1} (the seeds' range), got {seed}")
 
 
 def check_option_memory(parser: argparse.ArgumentParser, nbytes: float, what: str) -> None:

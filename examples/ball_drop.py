@@ -36,6 +36,7 @@ matplotlib.use("Agg")
 import numpy as np  # noqa: E402
 from _cli import (  # noqa: E402
     check_option_memory,
+    check_seed,
     output_folder,
     path_option,
     save_figure,
@@ -116,8 +117,7 @@ def main(argv: list[str] | None = None) -> dict:
     sweep = 8.0 * 2 * 6  # bytes a sweep keeps, at least: theta (2), lamOs, lamVz, betaU (2)
     check_option_memory(parser, sweep * args.n_iter, f"--n-iter {args.n_iter}: gpmsa.fit's draws")
     check_option_memory(parser, 8.0 * 4 * args.runs**2, f"--runs {args.runs}: the GP's covariances")
-    if args.seed < 0:
-        parser.error(f"--seed must be >= 0, got {args.seed}")
+    check_seed(parser, args.seed)
     out = output_folder(parser, "--out", args.out)
     rng = np.random.default_rng(args.seed)
     t0 = time.perf_counter()

@@ -4,9 +4,11 @@
     python examples/posterior_check.py --case B --roads 10 --out DIR
 
 For v in {0.75, 1.25, 1.75} m/s and GD in {250, 300, ..., 550}: a fresh 21 m road per cell, made
-as the training roads are (roadgen.iso8608_profile with a 1 m lead-in, wheel-enveloped), one Jackal
-drive at constant v, one observation from the last 1,000 samples (the emulator's window), and the
-posterior of GD from ``gpmsa.Calibrator.update`` (uniform prior on [200, 600], the paper's eq. 3).
+as the training roads are (roadgen.iso8608_profile with a 1 m lead-in, wheel-enveloped), one drive
+at constant v of the vehicle, with the noise, that the emulator records (the Jackal for the shipped
+files), one observation from the last 1,000 samples (the emulator's window), and the posterior of
+GD from ``gpmsa.Calibrator.update`` (uniform prior on the emulator's GD domain: [200, 600], the
+paper's eq. 3, for the shipped files; a file whose domain misses a cell is refused).
 The table's first block is road 1 of each cell (one window per cell, as the paper); the second is
 the mean absolute percent error over ``--roads`` roads per cell, a steadier figure. The histograms
 (Appendix A) are of road 1's posterior draws.
@@ -22,7 +24,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder, path_option, save_figure, write_text  # noqa: E402
+from _cli import check_seed, output_folder, path_option, save_figure, write_text  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -62,6 +64,20 @@ def cell_posterior(calibrator, model, v: float, gd: float, seed: int, noise_std:
     return calibrator.update([[v]], [[y]])
 
 
+def check_domain(emu) -> None:
+    """ValueError unless the emulator's domain holds every cell of the table (speeds in m/s, GD
+    in 1e-6 m^3): shipped files retrained with ``train_emulator.py --ship`` may cover less, and
+    the calibration would refuse a speed outside it, or bound GD's prior short of the cell's."""
+    (v_lo, v_hi), (gd_lo, gd_hi) = emu.domain[emu.x_names[0]], emu.domain[emu.t_names[0]]
+    if not (v_lo <= min(SPEEDS) <= max(SPEEDS) <= v_hi and gd_lo <= min(GDS) <= max(GDS) <= gd_hi):
+        raise ValueError(
+            f"the shipped window emulator covers v [{v_lo:g}, {v_hi:g}] m/s and GD "
+            f"[{gd_lo:g}, {gd_hi:g}]; Table 2's cells need v [{min(SPEEDS):g}, {max(SPEEDS):g}] "
+            f"m/s and GD [{min(GDS):g}, {max(GDS):g}] (the paper's: v [0.5, 2], GD [200, 600]): "
+            "retrain it with examples/train_emulator.py --ship over those ranges"
+        )
+
+
 MAX_ROADS = 10_000
 """Most fresh roads per cell (``--roads``): each is a drive of its own."""
 
@@ -75,13 +91,16 @@ def main(argv: list[str] | None = None) -> dict:
     args = parser.parse_args(argv)
     if not 1 <= args.roads <= MAX_ROADS:
         parser.error(f"--roads must be in [1, {MAX_ROADS}] (a drive each), got {args.roads}")
-    if args.seed < 0:
-        parser.error(f"--seed must be >= 0, got {args.seed}")
-    out = output_folder(parser, "--out", args.out)
+    check_seed(parser, args.seed)
     emu = control.shipped_emulator(args.case, "window")  # the paper's feature
+    try:
+        check_domain(emu)
+    except ValueError as exc:
+        parser.error(f"--case {args.case}: {exc}")
+    out = output_folder(parser, "--out", args.out)
     calibrator = gpmsa.Calibrator(emu, seed=args.seed)
-    model = vehicle.Jackal()
-    noise = float(emu.metadata["noise_std"])
+    model = control.emulator_vehicle(emu)  # `train_emulator.py --ship --vehicle` replaces it
+    noise = control.emulator_noise_std(emu) or 0.0
 
     errors = np.zeros((len(GDS), len(SPEEDS), args.roads))
     cells = []

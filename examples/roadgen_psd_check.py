@@ -1,7 +1,8 @@
 """Repeat the paper's PSD check: a road generated with GD 450 gives back ~450 at 0.1 cycles/m.
 
 Prints prescribed against recovered GD for a few GDs and seeds (150 m and 21 m roads, 6 mm grid)
-and saves the profile/PSD figure of the GD 450 road (paper Figs 3-4).
+and saves the profile/PSD figures of the GD 450 road (paper Figs 3-4) and of the paper's track
+(GD 300 / 500 / 300, 50 m each).
 
     python examples/roadgen_psd_check.py [--out DIR]     # default ./out/
 """
@@ -25,7 +26,7 @@ LENGTHS = (150.0, 21.0)
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=path_option, default="out", help="folder for the figure")
+    parser.add_argument("--out", type=path_option, default="out", help="folder for the figures")
     args = parser.parse_args(argv)
     out = output_folder(parser, "--out", args.out)
 

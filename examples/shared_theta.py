@@ -30,7 +30,14 @@ import json
 import warnings
 
 import numpy as np
-from _cli import check_option_memory, output_folder, path_option, save_figure, write_text
+from _cli import (
+    check_option_memory,
+    check_seed,
+    output_folder,
+    path_option,
+    save_figure,
+    write_text,
+)
 from matplotlib.figure import Figure
 from scipy.stats import qmc
 
@@ -114,8 +121,7 @@ def main(argv: list[str] | None = None) -> dict:
         parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
     sweep = 8.0 * 2 * 4  # bytes a sweep keeps, at least: E, lamOs and the emulator's
     check_option_memory(parser, sweep * args.n_iter, f"--n-iter {args.n_iter}: the draws")
-    if args.seed < 0:
-        parser.error(f"--seed must be >= 0, got {args.seed}")
+    check_seed(parser, args.seed, offset=1)
     out = output_folder(parser, "--out", args.out)
     rng = np.random.default_rng(args.seed)
     static, modal = simulations(24, 40, args.seed)

@@ -53,7 +53,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import check_option_memory, output_folder, path_option, save_figure  # noqa: E402
+from _cli import check_option_memory, check_seed, output_folder, path_option, save_figure  # noqa: E402
 from closed_loop import GD_MAX, PAPER_SEGMENTS  # noqa: E402
 
 import control  # noqa: E402
@@ -268,6 +268,41 @@ def check_anchors(parser: argparse.ArgumentParser, args) -> None:
         )
 
 
+def design_title(args) -> str:
+    """Title of the design figure: the Latin hypercube's runs and the anchor runs apart (the
+    window emulators fit the former only)."""
+    title = f"Latin hypercube design, {args.n_runs} runs"
+    if args.anchor_speeds:
+        speeds = ", ".join(f"{v:g}" for v in args.anchor_speeds)
+        title += f"\n+ {args.anchor_runs} anchor runs at each of {speeds} m/s"
+    return title
+
+
+def fit_memory(m: int, n_pc: int, n_iter: int) -> float:
+    """Bytes `gpmsa.fit` needs (its own estimate, which it refuses beyond the limit) for ``m``
+    runs of v and GD, ``n_pc`` components and ``n_iter`` sweeps: every sweep kept twice (betaU,
+    lamUz, lamWs: 4 elements a component, lamWOs and the log posterior) and (2 + 4 n_pc + 2) m^2
+    floats of the likelihood's covariances."""
+    return 8.0 * (2.0 * n_iter * (4 * n_pc + 2) + m * m * (4 * n_pc + 4))
+
+
+def check_fit_memory(parser: argparse.ArgumentParser, args) -> None:
+    """Usage error, before the campaign, where a fit would refuse its runs' covariances: the
+    band emulators fit --n-runs and the anchor runs (``n_pc`` components), the window
+    emulators --n-runs (one)."""
+    runs = {
+        "band": (args.n_runs + len(args.anchor_speeds) * args.anchor_runs, args.n_pc),
+        "window": (args.n_runs, 1),
+    }
+    for kind in args.features:
+        m, n_pc = runs[kind]
+        check_option_memory(
+            parser, fit_memory(m, n_pc, args.n_iter),
+            f"--n-runs {args.n_runs} and --n-iter {args.n_iter}: the {kind} emulators' "
+            f"covariances of {m} runs and gpmsa.fit's draws",
+        )  # fmt: skip
+
+
 def band_feature(args) -> FeatureSpec:
     """The band emulators' feature: `BAND_FEATURE` with ``--block-samples`` and ``--quantiles``."""
     return dataclasses.replace(
@@ -390,8 +425,7 @@ def main(argv: list[str] | None = None) -> None:
     )  # fmt: skip
     args = parser.parse_args(argv)
     args.cases, args.features = list(dict.fromkeys(args.cases)), list(dict.fromkeys(args.features))
-    if args.seed < 0:
-        parser.error(f"--seed must be >= 0, got {args.seed}")
+    check_seed(parser, args.seed)
     for option, fields in (
         ("--quantiles", {"quantiles": tuple(args.quantiles)}),
         ("--block-samples", {"block_samples": args.block_samples}),
@@ -425,8 +459,6 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"--keep-s must be >= {min_keep_s:.4g} s ({why}), got {args.keep_s}")
     if args.n_iter < 2:
         parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
-    sweep = 8.0 * 2 * (4 * args.n_pc + 1)  # bytes a sweep keeps: betaU, lamUz, lamWs, lamWOs
-    check_option_memory(parser, sweep * args.n_iter, f"--n-iter {args.n_iter}: gpmsa.fit's draws")
     lo, hi = args.gd_range
     if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi <= GD_MAX):
         parser.error(
@@ -456,6 +488,7 @@ def main(argv: list[str] | None = None) -> None:
     if args.ship:
         check_shippable(parser, args)
     check_anchors(parser, args)
+    check_fit_memory(parser, args)
     out = output_folder(parser, "--out", args.out)
     if args.ship:
         emu_dir = output_folder(parser, "--ship", EMULATOR_DIR)
@@ -480,7 +513,8 @@ def main(argv: list[str] | None = None) -> None:
         )  # fmt: skip
     except vehicle.VehicleError as exc:
         parser.error(f"the campaign (--n-runs, --anchor-runs, --keep-s): {exc}")
-    save_figure(plot_design(design[:, 0], design[:, 1]), out / "lhs_design.png", dpi=150)
+    fig = plot_design(design[:, 0], design[:, 1], title=design_title(args))
+    save_figure(fig, out / "lhs_design.png", dpi=150)
     print(f"campaign: {campaign.v.size} runs in {time.perf_counter() - tic:.0f} s")
     if not campaign.ok.all():
         print(f"  {np.count_nonzero(~campaign.ok)} failed runs are left out")
@@ -496,7 +530,13 @@ def main(argv: list[str] | None = None) -> None:
     for case in args.cases:
         for kind in args.features:
             tic = time.perf_counter()
-            emu = fitters[kind](case, campaign, model, args)
+            try:
+                emu = fitters[kind](case, campaign, model, args)
+            except control.ControlError as exc:  # the block scatter: too few batches near a speed
+                parser.error(
+                    f"case {case}, {kind} emulator: {exc}; too few runs or blocks for its "
+                    "covariance: raise --n-runs or --keep-s"
+                )
             path = emu_dir / emulator_file_name(case, kind)
             emu.save(path)
             params = {k: np.round(np.ravel(v), 3).tolist() for k, v in emu.params.items()}
