@@ -14,7 +14,7 @@ from types import ModuleType
 from gpmsa.errors import BackendUnavailableError, GPMSAError
 from gpmsa.mcmc.sampler import check_sample_args
 
-__all__ = ["available", "check_sample_args", "get", "names", "placement"]
+__all__ = ["available", "check_options", "check_sample_args", "get", "names", "placement"]
 
 _REGISTRY: dict[str, tuple[str, str]] = {
     # name: (module path, pip extra that provides its packages)
@@ -73,6 +73,22 @@ def get(name: str) -> ModuleType:
 def _own(exc: ImportError) -> bool:
     """Whether an import error is gpmsa's own (a bug to show as it is, not a missing package)."""
     return (exc.name or "").split(".")[0] == "gpmsa"
+
+
+def check_options(backend: str, options: dict, reserved: tuple[str, ...], caller: str) -> None:
+    """GPMSAError naming every key of ``options`` that backend ``backend``'s ``sample`` does not
+    take, or that ``caller`` sets itself (``reserved``: its own arguments)."""
+    accepted = inspect.signature(get(backend).sample).parameters
+    open_ended = any(a.kind is inspect.Parameter.VAR_KEYWORD for a in accepted.values())
+    taken = sorted(set(options) & set(reserved))
+    if taken:
+        raise GPMSAError(f"{caller}: {taken} are {caller}'s own arguments, not backend options")
+    unknown = [] if open_ended else sorted(set(options) - set(accepted))
+    if unknown:
+        offered = sorted(set(accepted) - set(reserved) - {"problem"})
+        raise GPMSAError(
+            f"{caller}: unknown option(s) {unknown} for the {backend!r} backend; it takes {offered}"
+        )
 
 
 def placement(backend: str, n_jobs=None, executor=None) -> dict:

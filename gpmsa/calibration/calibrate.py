@@ -145,6 +145,7 @@ def calibrate(
     executor=None,
     constraint=None,
     theta_init=None,
+    **options,
 ) -> Posterior:
     """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
 
@@ -182,6 +183,9 @@ def calibrate(
             allowed: zero prior mass there (no draw inside the forbidden region); a constraint
             that rejects the start is a GPMSAError. Chains run in this process.
         theta_init: start of theta (native, (q,); default the centre of the design's range).
+        options: passed to the backend's ``sample`` (``fast=False`` or another backend than
+            numpy), e.g. ``device="cuda"``, ``dtype="float32"`` for torch; the fast sampler
+            takes none.
 
     With more than one chain, ``info["diagnostics"]`` holds each parameter's rank-normalised
     R-hat and bulk ESS (and mean, sd), ``info["convergence"]`` the verdict, and a
@@ -224,6 +228,14 @@ def calibrate(
         )
     if not fast:  # a categorical theta: the fast sampler only
         check_emulator(emulator)
+    if options and fast:
+        raise GPMSAError(
+            f"calibrate: options {sorted(options)} go to a backend's sampler, which the fast "
+            "numpy sampler replaces; pass fast=False (or another backend) to use them"
+        )
+    reserved = ("n_iter", "n_chains", "tune", "seed", "progress", "n_jobs", "executor",
+                "tune_rounds", "tune_levels")  # fmt: skip
+    backends.check_options(backend, options, reserved, "calibrate")
     _check_calibrate_memory(emulator, n_samples, n_chains, fast)
     _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}
@@ -241,7 +253,7 @@ def calibrate(
         else:
             draws, info = _run_backend(
                 emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
-                tuning_opts, seed, extrapolate, progress, where, theta_opts,
+                {**tuning_opts, **options}, seed, extrapolate, progress, where, theta_opts,
             )  # fmt: skip
     require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
@@ -251,6 +263,8 @@ def calibrate(
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds, obs_values_sha256=data.values_sha256,
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
+        backend_options={k: v if v is None or isinstance(v, bool | int | float | str) else str(v)
+                         for k, v in sorted(options.items())},
     )  # fmt: skip
     if n_chains > 1:
         info["diagnostics"] = summarize(chains)

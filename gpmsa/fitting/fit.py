@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import inspect
 import math
 from dataclasses import replace
 from datetime import datetime, timezone
@@ -138,15 +137,9 @@ def fit(
                    mean_basis=mean_basis)  # fmt: skip
     problem = _model_options(prep, data, fixed, constraint, theta_init)
     _check_fit_memory(problem, int(n_iter), int(n_chains))
-    accepted = inspect.signature(module.sample).parameters
-    open_ended = any(a.kind is inspect.Parameter.VAR_KEYWORD for a in accepted.values())
-    unknown = [] if open_ended else sorted(set(options) - set(accepted))
-    if unknown:
-        offered = sorted(set(accepted) - {"problem", "n_iter", "n_chains", "tune", "step_widths",
-                                          "seed", "progress", "n_jobs", "executor"})  # fmt: skip
-        raise GPMSAError(
-            f"fit: unknown option(s) {unknown} for the {backend!r} backend; it takes {offered}"
-        )
+    reserved = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress", "n_jobs",
+                "executor")  # fmt: skip
+    backends.check_options(backend, options, reserved, "fit")
     if backend == "numpy":  # (the others refuse these extensions)
         basis = problem.mean_basis
         callables = [name for name, on in (

@@ -1,0 +1,40 @@
+"""``calibrate`` passes backend options (torch's device and dtype) to the backend's sampler, and
+refuses options the sampler does not take, its own arguments, and options with the fast path."""
+
+import numpy as np
+import pytest
+from _calib_cases import road_emulator, road_obs
+
+import gpmsa
+
+pytest.importorskip("torch")
+
+SHORT = {"n_samples": 60, "n_burn": 10, "tune_rounds": 2, "tune_levels": 5, "seed": 3}
+
+
+def test_torch_options_reach_the_sampler():
+    x, y = road_obs()
+    single = gpmsa.calibrate(road_emulator(), x, y, backend="torch", dtype="float32", **SHORT)
+    double = gpmsa.calibrate(road_emulator(), x, y, backend="torch", dtype="float64", **SHORT)
+    assert single.info["backend_options"] == {"dtype": "float32"}
+    assert single.samples["GD"].shape == (50,) and np.all(np.isfinite(single.samples["GD"]))
+    assert not np.array_equal(single.samples["GD"], double.samples["GD"])  # float32 arithmetic
+    with pytest.raises(gpmsa.GPMSAError, match="torch sees no CUDA device|cuda:0 to cuda:"):
+        gpmsa.calibrate(road_emulator(), x, y, backend="torch", device="cuda:64", **SHORT)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"backend": "torch", "dtyp": "float32"},
+         r"calibrate: unknown option\(s\) \['dtyp'\] for the 'torch' backend; it takes \[.*'dtype'"),
+        ({"backend": "numpy", "fast": False, "n_iter": 9},
+         r"calibrate: \['n_iter'\] are calibrate's own arguments"),
+        ({"backend": "numpy", "ridge_moves": 0},
+         r"options \['ridge_moves'\] go to a backend's sampler, .* pass fast=False"),
+    ],
+)  # fmt: skip
+def test_options_the_sampler_would_not_take_are_refused(kwargs, match):
+    x, y = road_obs()
+    with pytest.raises(gpmsa.GPMSAError, match=match):
+        gpmsa.calibrate(road_emulator(), x, y, **{**SHORT, **kwargs})
