@@ -7,6 +7,8 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
+from control.errors import ControlError
+
 
 def _track_steps(track) -> tuple[np.ndarray, np.ndarray]:
     x = np.append(np.asarray(track.boundaries_m, dtype=float), float(track.length_m))
@@ -106,20 +108,30 @@ def plot_design(v: np.ndarray, gd: np.ndarray, title: str = "") -> Figure:
 
 
 def plot_posterior_grid(
-    cells: Sequence[tuple[float, float, np.ndarray]], title: str = ""
+    cells: Sequence[tuple[float, float, np.ndarray]],
+    title: str = "",
+    gd_range: tuple[float, float] | None = None,
 ) -> Figure:
     """Histograms of posterior GD draws per (v, GD) cell (paper Appendix A).
 
     Args:
         cells: (v, true GD, draws) triples; the true GD is drawn as a vertical line.
+        gd_range: (lo, hi) of the histograms' common GD axis (1e-6 m^3), e.g. the emulator's GD
+            domain; None: the span of every draw and true GD, rounded out to whole steps of the
+            power of ten at or below it ((200, 600) for the paper's cells on its domain).
+
+    Raises ControlError for draws that are empty or not finite, or a gd_range that is not two
+    finite values lo < hi.
     """
+    values = _cell_values(cells)
+    hist_range = _gd_range(values) if gd_range is None else _checked_gd_range(gd_range)
     speeds = sorted({c[0] for c in cells})
     gds = sorted({c[1] for c in cells})
     fig = Figure(figsize=(2.6 * len(speeds), 1.5 * len(gds)), constrained_layout=True)
     axes = fig.subplots(len(gds), len(speeds), sharex=True, squeeze=False)
     for v, gd, draws in cells:
         ax = axes[gds.index(gd), speeds.index(v)]
-        ax.hist(draws, bins=40, range=(200, 600), density=True, alpha=0.7)
+        ax.hist(draws, bins=40, range=hist_range, density=True, alpha=0.7)
         ax.axvline(gd, color="k", lw=1)
         ax.set_yticks([])
         if gd == gds[0]:
@@ -131,3 +143,45 @@ def plot_posterior_grid(
     if title:
         fig.suptitle(title)
     return fig
+
+
+def _cell_values(cells: Sequence[tuple[float, float, np.ndarray]]) -> np.ndarray:
+    """Every cell's draws and true GD (1e-6 m^3) in one array, or ControlError naming the first
+    cell whose draws are empty or not finite, or whose true GD is not a finite number."""
+    values = []
+    for i, (_, gd, draws) in enumerate(cells):
+        arr = np.asarray(draws, dtype=float).ravel()
+        try:
+            true_gd = float(gd)
+        except (TypeError, ValueError):
+            true_gd = float("nan")
+        if arr.size == 0 or not np.all(np.isfinite(arr)) or not np.isfinite(true_gd):
+            raise ControlError(
+                f"cells[{i}]: the draws must be a non-empty array of finite GD values and the "
+                f"true GD a finite number, got {arr.size} draws "
+                f"({np.count_nonzero(~np.isfinite(arr))} not finite) and GD {gd!r}"
+            )
+        values.append(np.append(arr, true_gd))
+    if not values:
+        raise ControlError("cells is empty: need at least one (v, true GD, draws) triple")
+    return np.concatenate(values)
+
+
+def _gd_range(values: np.ndarray) -> tuple[float, float]:
+    """The span (1e-6 m^3) of ``values``, rounded out to whole steps of the power of ten at or
+    below it (one step more either side where the span rounds to nothing)."""
+    lo, hi = float(values.min()), float(values.max())
+    step = 10.0 ** np.floor(np.log10(hi - lo if hi > lo else max(abs(lo), 1.0)))
+    lo_r, hi_r = float(np.floor(lo / step) * step), float(np.ceil(hi / step) * step)
+    return (lo_r, hi_r) if hi_r > lo_r else (lo_r - step, hi_r + step)
+
+
+def _checked_gd_range(gd_range: tuple[float, float]) -> tuple[float, float]:
+    """``gd_range`` (1e-6 m^3) as two floats lo < hi, or ControlError."""
+    try:
+        lo, hi = (float(g) for g in gd_range)
+    except (TypeError, ValueError):
+        lo = hi = float("nan")
+    if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+        raise ControlError(f"gd_range={gd_range!r} must be two finite GD values lo < hi")
+    return lo, hi

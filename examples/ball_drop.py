@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 
 import matplotlib
@@ -98,6 +99,18 @@ def design(m: int, seed: int) -> np.ndarray:
     lo = [RANGES[k][0] for k in ("R", "Cd", "g")]
     hi = [RANGES[k][1] for k in ("R", "Cd", "g")]
     return qmc.scale(qmc.LatinHypercube(3, seed=seed).random(m), lo, hi)
+
+
+def _json_values(value):
+    """``value`` (dicts, lists and numbers) with every NaN or infinity as None (JSON's null):
+    JSON has neither, and a short chain's ESS, for one, is NaN."""
+    if isinstance(value, dict):
+        return {k: _json_values(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_values(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
 
 
 def main(argv: list[str] | None = None) -> dict:
@@ -185,7 +198,7 @@ def main(argv: list[str] | None = None) -> dict:
         "seconds": time.perf_counter() - t0,
         "figures": sorted(f"{name}.png" for name in figs),
     }  # fmt: skip
-    write_text(out / "summary.json", json.dumps(summary, indent=2))
+    write_text(out / "summary.json", json.dumps(_json_values(summary), indent=2, allow_nan=False))
     p = summary["prediction_held_out_balls"]
     print(
         f"Cd = {post.mean('Cd'):.3f} +- {post.sd('Cd'):.3f}, g = {post.mean('g'):.3f} +- "

@@ -139,7 +139,8 @@ def main(argv: list[str] | None = None) -> dict:
         f"{summary['all_roads']['max_cell_mean']:.1f} / {summary['all_roads']['mean']:.1f}"
     )
     title = f"Posterior GD, case {args.case}, one window per cell"
-    save_figure(plot_posterior_grid(cells, title=title), out / f"posterior_grid_{args.case}.png")
+    fig = plot_posterior_grid(cells, title=title, gd_range=emu.domain[emu.t_names[0]])
+    save_figure(fig, out / f"posterior_grid_{args.case}.png")
     write_text(
         out / f"table2_{args.case}.json",
         json.dumps({"summary": summary, "percent_error": errors.tolist()}, indent=1),

@@ -194,7 +194,8 @@ def main(argv: list[str] | None = None) -> dict:
     ax = fig.subplots()
     for name in ("E", "rho[modal]"):
         ch = back.posterior.chains[name][0]
-        ax.plot((ch - ch.mean()) / ch.std(), lw=0.5, label=name)
+        # a short chain may not move at all (sd 0): drawn flat at 0, not as NaN
+        ax.plot((ch - ch.mean()) / (ch.std() or 1.0), lw=0.5, label=name)
     ax.set_xlabel("sweep (after burn-in)")
     ax.set_ylabel("standardised draw")
     ax.legend(fontsize=8)

@@ -95,6 +95,23 @@ def _psd(
     return n[1:], _finite_psd(gd[1:], z)
 
 
+def _fit_psd(
+    z: np.ndarray, dx: float, method: str, nperseg: int, end_match: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """``_psd`` less the Nyquist bin of an even ``nperseg``, for the GD and slope fits: a
+    one-sided PSD (scipy's) does not double that bin, which has no mirror image, so it reads
+    half the density of a random road, and roadgen synthesises nothing there (an exact 0).
+    RoadgenError for a road of 2 heights, whose only bin above 0 is the Nyquist bin."""
+    if z.size < 3:
+        raise RoadgenError(
+            f"the road holds {z.size} heights: its only PSD bin above n = 0 is the Nyquist "
+            f"frequency {0.5 / dx:.6g} cycles/m, which the GD and slope fits leave out; need >= 3 "
+            "heights"
+        )
+    n, gd = _psd(z, dx, method, nperseg, end_match)
+    return (n[:-1], gd[:-1]) if nperseg % 2 == 0 else (n, gd)
+
+
 def _finite_psd(values: np.ndarray, z: np.ndarray) -> np.ndarray:
     """``values`` (a PSD, or a GD from it) if all finite; RoadgenError where heights z m so
     large that their squares overflow float64 made them inf or NaN."""
@@ -129,6 +146,8 @@ def estimate_gd(
     A road that records the band of its content (``settings.band`` of a Profile or Track) is
     fitted only inside it (edges as ``profile.band_edges``; Welch bins also keep 2 bins, the Hann
     window's main lobe, clear of its edges), and "periodogram" needs content at its harmonic.
+    No method reads the Nyquist bin of an even record: scipy's one-sided PSD does not double it,
+    so it holds half the density (and nothing, on roadgen's profiles).
     waviness: w of the fit; default the road's ``settings.waviness`` if it has one, else 2.
         "welch" takes w up to WELCH_MAX_WAVINESS (3.5).
     A road without roughness in the band (flat; for "fit" also a straight ramp, which the end
@@ -136,10 +155,10 @@ def estimate_gd(
 
     Raises RoadgenError for an unknown method, a bad band or waviness (or settings.band or
     settings.waviness), a waviness above 3.5 for "welch", a band outside the road's content
-    band, a road too short to hold a PSD bin in the band, heights whose PSD under- or overflows,
-    and for "periodogram" a band (it reads one harmonic), a road without content at the
-    harmonic nearest n0 or whose nearest harmonic lies more than PERIODOGRAM_REACH from n0 (a
-    road under 5 m).
+    band, a road of 2 heights or too short to hold a PSD bin in the band, heights whose PSD
+    under- or overflows, and for "periodogram" a band (it reads one harmonic), a road without
+    content at the harmonic nearest n0 or whose nearest harmonic lies more than
+    PERIODOGRAM_REACH from n0 (a road under 5 m).
     """
     checks.choice("method", method, GD_METHODS)
     z, dx = checks.heights("road", road)
@@ -175,10 +194,10 @@ def _fitted_gd(
     """GD of checked heights z (N,) m on a step dx m: the fixed-slope (-w) fit over ``band``
     (cycles/m) of their end-matched periodogram ("fit") or Welch PSD ("welch")."""
     if method == "fit":
-        n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
+        n, gd = _fit_psd(z, dx, "periodogram", z.size, end_match=True)
         keep = _fit_bins(n, band, content, z.size, dx, method)
     else:
-        n, gd = _psd(z, dx, "welch", z.size // 4, end_match=False)
+        n, gd = _fit_psd(z, dx, "welch", z.size // 4, end_match=False)
         keep = _fit_bins(n, band, content, z.size, dx, method)
         k = n / n[0]
         if not np.any(keep & (k >= WELCH_MIN_BIN)):
@@ -213,7 +232,7 @@ def _periodogram_gd(
     z: np.ndarray, dx: float, w: float, content: tuple[float, float] | None
 ) -> float:
     """GD from the periodogram ordinate of z (N,) m nearest n0, scaled to n0 along slope -w."""
-    n, gd = _psd(z, dx, "periodogram", z.size, end_match=False)
+    n, gd = _fit_psd(z, dx, "periodogram", z.size, end_match=False)
     k = int(np.argmin(np.abs(np.log(n / N0))))
     if abs(np.log(n[k] / N0)) > np.log(PERIODOGRAM_REACH) + 1e-9:
         raise RoadgenError(
@@ -294,7 +313,7 @@ def psd_slope(road: HasHeights, band: tuple[float, float] | None = None) -> floa
     """
     z, dx = checks.heights("road", road)
     lo, hi = _fit_band(band, dx)
-    n, gd = _psd(z, dx, "periodogram", z.size, end_match=True)
+    n, gd = _fit_psd(z, dx, "periodogram", z.size, end_match=True)
     in_band = (n >= lo) & (n <= hi)
     if np.count_nonzero(in_band) >= 2:
         in_band &= _fit_bins(n, (lo, hi), _content_band(road, dx), z.size, dx, "fit")

@@ -84,8 +84,9 @@ def track(
     segment; the length is rounded to whole dx_m steps.
 
     Raises RoadgenError for an empty or malformed segment list, non-positive lengths or GDs,
-    blend_m < 2 dx_m or longer than the shortest segment, a lead-in that reaches into the first
-    blend, and the band errors of ``iso8608_profile``.
+    blend_m < 2 dx_m or longer than the shortest segment (two or more segments; one segment has
+    no boundary to blend), a lead-in that reaches into the first blend (or past a single
+    segment), and the band and length errors of ``iso8608_profile``.
     """
     segs = _check_segments(segments)
     dx = checks.grid_step("dx_m", dx_m)
@@ -138,8 +139,24 @@ def _check_blend_and_lead(
     segs: tuple[tuple[float, float], ...], dx: float, blend: float, lead: float
 ) -> None:
     """Raise RoadgenError unless ``blend`` (m) lies between two grid steps ``dx`` and the
-    shortest segment, and the lead-in ``lead`` (m) ends before the first blend."""
+    shortest segment, and the lead-in ``lead`` (m) ends before the first blend. A single segment
+    has no boundary, hence no blend: only its lead-in is checked (against its length)."""
     lengths = np.array([length for length, _ in segs])
+    if len(segs) > 1:
+        _check_blend(lengths, dx, blend)
+    lead_max = lengths[0] - (0.5 * blend if len(segs) > 1 else 0.0)
+    if lead > lead_max:
+        reach = f", less half of blend_m={blend:g} m" if len(segs) > 1 else ""
+        raise RoadgenError(
+            f"lead_in_m={lead:g} is out of range: allowed [0, {lead_max:.6g}] m "
+            f"(the first segment, {lengths[0]:g} m{reach}); lengthen the first segment or "
+            "shorten lead_in_m"
+        )
+
+
+def _check_blend(lengths: np.ndarray, dx: float, blend: float) -> None:
+    """Raise RoadgenError unless ``blend`` (m) lies between two grid steps ``dx`` and the
+    shortest of the segments' ``lengths`` (m)."""
     if lengths.min() < 2 * dx:  # no blend fits: name the segment, not an empty range
         k = int(np.argmin(lengths))
         raise RoadgenError(
@@ -150,14 +167,6 @@ def _check_blend_and_lead(
         raise RoadgenError(
             f"blend_m={blend:g} is out of range: allowed [{2 * dx:.6g}, {lengths.min():.6g}] m "
             "(two grid steps to the shortest segment)"
-        )
-    lead_max = lengths[0] - (0.5 * blend if len(segs) > 1 else 0.0)
-    if lead > lead_max:
-        reach = f", less half of blend_m={blend:g} m" if len(segs) > 1 else ""
-        raise RoadgenError(
-            f"lead_in_m={lead:g} is out of range: allowed [0, {lead_max:.6g}] m "
-            f"(the first segment, {lengths[0]:g} m{reach}); lengthen the first segment or "
-            "shorten lead_in_m"
         )
 
 

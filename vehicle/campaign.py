@@ -127,12 +127,15 @@ class Campaign:
         checked again first (its arrays may have been changed in place since construction);
         VehicleError if it is invalid or ``path`` names no file. A campaign file (or an empty
         file) at ``path`` is replaced in one step, keeping its permissions (a refusal or a
-        failure leaves it whole); CampaignFileError if it cannot be written, or if ``path``
-        holds anything else (another program's file, a folder), which is never replaced."""
+        failure leaves it whole); a symbolic link at ``path`` is written through (the file it
+        leads to is replaced, as ``open`` and gpmsa's ``atomic_write`` do), not replaced.
+        CampaignFileError if it cannot be written, or if ``path`` (or the link's target) holds
+        anything else (another program's file, a folder), which is never replaced."""
         _check_path(path)
         target = Path(path)
         if target.name in ("", ".."):
             raise VehicleError(f"path={str(path)!r} names no file: need a file name, e.g. 'c.npz'")
+        target = _through_link(target)
         _refuse_to_replace(target)
         table = _checked_table(self)
         arrays = {name: table[name] for name in _ARRAYS}
@@ -296,6 +299,20 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
                 i = int(np.argmax(broken))
                 raise VehicleError(f"Campaign.{name}[{i}] is not finite but status[{i}] is 'ok'")
     return out
+
+
+def _through_link(path: Path) -> Path:
+    """``path``, or where it leads if it is a symbolic link (a file that need not exist yet, as
+    ``open`` would create it); CampaignFileError for a link that leads nowhere (a loop) or a
+    path the OS cannot look at (a name too long)."""
+    try:
+        if not path.is_symlink():
+            return path
+        return Path(os.path.realpath(path, strict=True))
+    except FileNotFoundError:  # a link to a file not made yet: write it there
+        return Path(os.path.realpath(path))
+    except (OSError, ValueError) as exc:  # a loop, or a name too long for the file system
+        raise CampaignFileError(f"cannot write campaign file {str(path)!r}: {exc}") from exc
 
 
 def _refuse_to_replace(path: Path) -> None:
