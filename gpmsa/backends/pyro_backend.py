@@ -4,8 +4,9 @@ The model is the torch backend's likelihood (``gpmsa.backends.torch_backend``) w
 priors: theta on (0, 1); betaU/betaV sampled as rho = exp(-beta/4) on (0, 1) with the Beta prior
 density of rho (the same target as the Metropolis samplers, which walk on rho); precisions on
 their prior bounds with Gamma densities. Bounds are pyro constraints (NUTS moves in the
-unconstrained space); densities enter through ``pyro.factor``. Chains start at ``problem.init``
-(GPM/SA's initial values); fixed parameters are constants.
+unconstrained space); densities enter through ``pyro.factor``. Chains start where the numpy
+backend's chain c would (``gpmsa.mcmc.starts``: GPM/SA's initial values for one chain, dispersed
+ones for several); fixed parameters are constants.
 """
 
 from __future__ import annotations
@@ -30,7 +31,8 @@ from gpmsa.backends.torch_backend import (
     torch_threads,
 )
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc.sampler import RHO_PARAMS, Chains
+from gpmsa.mcmc import starts
+from gpmsa.mcmc.sampler import RHO_PARAMS, Chains, check_draws_memory
 from gpmsa.model.data import as_real, check_count, check_flag
 from gpmsa.model.problem import Problem
 
@@ -72,11 +74,13 @@ class PyroModel:
             )
             self.sim_cache = (chol, alpha, ll.sum(-1))
 
-    def init_values(self) -> dict[str, torch.Tensor]:
-        """GPM/SA's initial values in the model's sample sites."""
+    def init_values(self, start: dict[str, np.ndarray] | None = None) -> dict[str, torch.Tensor]:
+        """A chain's starting values (name -> array; default GPM/SA's ``problem.init``) in the
+        model's sample sites."""
+        start = self.problem.init if start is None else start
         out = {}
         for name in self.problem.sampled:
-            v = torch.as_tensor(self.problem.init[name], dtype=self.dtype)
+            v = torch.as_tensor(start[name], dtype=self.dtype)
             out[_site(name)] = torch.exp(-0.25 * v) if name in RHO_PARAMS else v
         return out
 
@@ -125,10 +129,6 @@ class PyroModel:
         pyro.factor("log_likelihood", self.log_likelihood(prm)[0])
 
 
-def _chain_seeds(seed, n_chains: int) -> list[int]:
-    return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(n_chains)]
-
-
 MIN_DRAWS = 4
 """Draws a NUTS chain needs: pyro's diagnostics split it into two halves of two draws."""
 
@@ -164,9 +164,14 @@ def sample(
     full_mass: bool = True,
     jit: bool = True,
     num_threads: int | None = 1,
+    init: str = "auto",
 ) -> Chains:
     """NUTS draws of every sampled parameter: ``n_chains`` chains (one after another) of
-    ``n_iter`` draws after ``n_warmup`` adaptation steps, each from GPM/SA's initial values.
+    ``n_iter`` draws after ``n_warmup`` adaptation steps.
+
+    Starts: ``init`` ("auto": GPM/SA's initial values for one chain, dispersed ones for several,
+    so that R-hat can see chains that have not forgotten them; chain c starts as the numpy
+    backend's chain c; see ``gpmsa.mcmc.starts``), recorded in ``info["starts"]``.
 
     ``tune=False`` skips the adaptation (unit step size and mass matrix, no warm-up); a chain
     that never leaves its starting point (as then on the road case) is a GPMSAError, not a
@@ -186,6 +191,7 @@ def sample(
         raise GPMSAError("the pyro backend (NUTS) takes no step_widths; leave step_widths=None")
     check_sample_args(n_iter, n_chains, seed)
     progress = check_flag(progress, "progress")
+    check_draws_memory(problem, int(n_iter), int(n_chains))
     if problem.extensions:
         raise GPMSAError(
             f"the pyro backend does not support {', '.join(problem.extensions)}; use "
@@ -193,15 +199,19 @@ def sample(
         )
     warmup = _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass,
                               jit)  # fmt: skip
+    how = starts.check_init(init, int(n_chains))
+    seqs = np.random.SeedSequence(seed).spawn(int(n_chains))
+    firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seqs]
     model = PyroModel(problem)
     runs = []
-    for seed_c in _chain_seeds(seed, int(n_chains)):
+    for seq, first in zip(seqs, firsts, strict=True):
+        seed_c = int(seq.generate_state(1)[0])
         kernel = NUTS(
             model, adapt_step_size=tune, adapt_mass_matrix=tune, target_accept_prob=target_accept,
             max_tree_depth=max_tree_depth, max_plate_nesting=0, jit_compile=jit,
             full_mass=full_mass,
             ignore_jit_warnings=True,
-            init_strategy=init_to_value(values=model.init_values()),
+            init_strategy=init_to_value(values=model.init_values(first)),
         )  # fmt: skip
         with torch.random.fork_rng(), torch_threads(num_threads):
             torch.manual_seed(seed_c)
@@ -244,7 +254,8 @@ def sample(
         step_widths=wid,
         info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": tune,
               "n_warmup": warmup, "target_accept": target_accept, "full_mass": full_mass,
-              "seed": seed,
+              "seed": seed, "init": how,
+              "starts": {k: np.stack([f[k] for f in firsts]) for k in problem.init},
               "backend": "pyro", "sampler": "NUTS"},
     )  # fmt: skip
 

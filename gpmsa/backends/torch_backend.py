@@ -40,6 +40,7 @@ from gpmsa.mcmc.sampler import (
     PRECISION_PARAMS,
     RHO_PARAMS,
     Chains,
+    check_draws_memory,
     check_ridge,
     check_step_widths,
     elements,
@@ -682,6 +683,7 @@ def sample(
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    check_draws_memory(problem, int(n_iter), int(n_chains))
     if problem.extensions:
         raise GPMSAError(
             f"the torch backend does not support {', '.join(problem.extensions)}; use "

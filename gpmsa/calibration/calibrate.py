@@ -391,8 +391,11 @@ def _run_backend(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate, **theta_opts
     )
     module = backends.get(backend)
-    if problem.constraint is not None:  # a callable of this process: the chains run here
-        where = {"n_jobs": 1, "executor": None}
+    if backend == "numpy" and problem.constraint is not None:  # (the others refuse it)
+        n_jobs, executor = in_this_process(
+            ["constraint"], where["n_jobs"], where["executor"], n_chains
+        )
+        where = {"n_jobs": n_jobs, "executor": executor}
     opts = {**tuning_opts, **backends.placement(backend, **where)}
     chains = module.sample(
         problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed, progress=progress,

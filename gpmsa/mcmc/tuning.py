@@ -85,21 +85,24 @@ def fit_logistic(x: np.ndarray, k: np.ndarray, n: int, ridge: float = 1e-6) -> n
 def choose_widths(
     widths: np.ndarray, candidates: np.ndarray, accepted: np.ndarray, n_burn: int
 ) -> np.ndarray:
-    """Tuned width per element: where the fitted acceptance equals 1/e.
+    """Tuned width per element: where the fitted acceptance equals 1/e, within the candidates.
 
     ``candidates`` (n_levels, n_el) widths, ``accepted`` (n_levels, n_el) acceptance counts out of
-    ``n_burn``. An element whose fit fails (or gives acceptance rising with width) keeps ``widths``.
+    ``n_burn``. The fit only knows the tested range, so the width is held to the element's
+    candidates [min, max]: a fitted 1/e point beyond them (acceptance above 1/e at every
+    candidate) gives the widest, one below them the narrowest. An element whose fit fails (or
+    gives acceptance rising with width) keeps ``widths``.
     """
     logit = np.log(TARGET / (1 - TARGET))
     out = widths.copy()
     for i in range(widths.size):
-        b = fit_logistic(np.log(candidates[:, i]), accepted[:, i], n_burn)
+        cand = candidates[:, i]
+        b = fit_logistic(np.log(cand), accepted[:, i], n_burn)
         if b is None or not b[1] < 0:
             continue
-        with np.errstate(over="ignore"):  # an overflow gives inf: refused just below
+        with np.errstate(over="ignore"):  # a tiny slope gives inf: clipped to the widest
             w = np.exp((logit - b[0]) / b[1])
-        if np.isfinite(w) and w > 0:
-            out[i] = w
+        out[i] = np.clip(w, cand.min(), cand.max())
     return out
 
 

@@ -38,3 +38,14 @@ def test_options_the_sampler_would_not_take_are_refused(kwargs, match):
     x, y = road_obs()
     with pytest.raises(gpmsa.GPMSAError, match=match):
         gpmsa.calibrate(road_emulator(), x, y, **{**SHORT, **kwargs})
+
+
+def test_pyro_with_a_constraint_names_the_constraint():
+    """(The constraint's chains run in this process: calibrate asked pyro for n_jobs=1, which
+    it refused, naming an n_jobs the caller never gave.)"""
+    x, y = road_obs()
+    short = {k: v for k, v in SHORT.items() if not k.startswith("tune_")}
+    with pytest.raises(gpmsa.GPMSAError, match="the pyro backend does not support theta constr"):
+        gpmsa.calibrate(
+            road_emulator(), x, y, backend="pyro", constraint=lambda t: t[0] < 500, **short
+        )
