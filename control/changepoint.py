@@ -7,10 +7,12 @@ a jump law that depends on the GD before the change. One step per block, ds metr
 
 1. predict: a run of d metres ends within the next ds metres with the hazard
    h(d) = 1 - S(d + ds) / S(d) of a gamma segment-length law (shape k, mean L; k = 1 is the
-   memoryless 1 - exp(-ds / L)); the mass that ends moves to run length 0 with GD redrawn by the
-   jump law T(GD -> GD'): the prior on GD' (log-uniform on the domain by default), times a
-   log-normal factor of the ratio GD'/GD (sd ``jump_sd``; None: no factor), and zero for
-   |log(GD'/GD)| < ``min_jump`` (a change smaller than that is not a change);
+   memoryless 1 - exp(-ds / L)), d the metres the run spans so far; the mass that ends starts
+   a new run (placed at the step's start: it spans the ds metres, as the first run spans its
+   first step) with GD redrawn by the jump law T(GD -> GD'): the prior on GD' (log-uniform on
+   the domain by default), times a log-normal factor of the ratio GD'/GD (sd ``jump_sd``;
+   None: no factor), and zero for |log(GD'/GD)| < ``min_jump`` (a change smaller than that is
+   not a change);
 2. update: every run length's GD posterior is multiplied by the block's likelihood.
 
 On steady ground the long run holds the mass and pools every block since the change; after a
@@ -115,7 +117,7 @@ class ChangePointFilter:
     def reset(self) -> None:
         """Back to the prior: no data, run length 0."""
         self._mass = self.prior[None, :].copy()  # (R, G) joint P(r, GD)
-        self._dist = np.zeros(1)  # metres spanned by each run length
+        self._dist = np.zeros(1)  # metres each run length spans, the latest step included
         self._has_data = False
 
     def _hazard(self, ds: float) -> np.ndarray:
@@ -148,7 +150,7 @@ class ChangePointFilter:
         h = self._hazard(ds_m)
         ended = (h[:, None] * self._mass).sum(axis=0)
         mass = np.vstack([(ended @ self._jump)[None, :], self._mass * (1.0 - h)[:, None]])
-        dist = np.concatenate([[0.0], self._dist + ds_m])
+        dist = np.concatenate([[0.0], self._dist]) + ds_m  # a new run holds the step, as the first
         R = self.settings.max_runs
         if mass.shape[0] > R:
             tail = mass[R - 1 :].sum(axis=1)

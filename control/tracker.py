@@ -91,9 +91,12 @@ class GDTracker:
         check_instance(self.settings, "settings", TrackerSettings)
         self.log_grid = np.linspace(np.log(lo), np.log(hi), self.settings.n_grid)
         self.grid = np.exp(self.log_grid)
-        # Uniform prior on GD: mass of a log-grid cell is proportional to GD; log-uniform: equal.
-        log_density = self.log_grid if self.settings.prior == "uniform" else 0.0 * self.log_grid
-        self.log_prior = log_density - logsumexp(log_density)
+        # node mass = density x trapezoid weight (the end nodes hold half a cell), as the
+        # posterior reads it: uniform in GD (density 1) or log-uniform (density 1 / GD)
+        self._log_weights = np.log(trapezoid_weights(self.grid))
+        log_density = 0.0 * self.log_grid if self.settings.prior == "uniform" else -self.log_grid
+        self.log_prior = log_density + self._log_weights
+        self.log_prior -= logsumexp(self.log_prior)
         self.reset()
 
     def reset(self) -> None:
@@ -108,12 +111,15 @@ class GDTracker:
         if s.mean_segment_m == 0 or np.isinf(ds_m):
             self.reset()
             return
-        mass = np.exp(self.log_mass - self.log_mass.max())
+        # the walk moves density (mass per trapezoid weight): a flat density stays flat
+        log_density = self.log_mass - self._log_weights
+        mass = np.exp(log_density - log_density.max())
         sigma_idx = s.drift_per_sqrt_m * np.sqrt(ds_m) / (self.log_grid[1] - self.log_grid[0])
         # beyond ten grids wide the reflected walk is flat on the grid: no wider kernel is needed
         sigma_idx = min(sigma_idx, 10.0 * self.log_grid.size)
         if sigma_idx > 0.05:
             mass = gaussian_filter1d(mass, sigma_idx, mode="reflect", truncate=5.0)
+        mass = mass * np.exp(self._log_weights)
         mass /= mass.sum()
         hazard = -np.expm1(-ds_m / s.mean_segment_m)
         mass = (1 - hazard) * mass + hazard * np.exp(self.log_prior)
@@ -165,8 +171,9 @@ class GDTracker:
         draws with a fixed seed, made only when read.
         """
         check_n_draws(n_draws)
-        w = trapezoid_weights(self.grid)
-        marginal = GridMarginal.from_log_density(self.grid, self.log_mass - np.log(w), w)
+        marginal = GridMarginal.from_log_density(
+            self.grid, self.log_mass - self._log_weights, np.exp(self._log_weights)
+        )
         return Posterior(
             grids={name: marginal},
             draw=lambda: {name: marginal.sample(np.random.default_rng(0), n_draws)},

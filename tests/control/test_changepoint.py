@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from scipy.special import gammaincc
 
 from control import ChangePointFilter, ChangePointSettings, ControlError
 from gpmsa.calibration.posterior import trapezoid_weights
@@ -99,13 +100,28 @@ def test_a_step_is_detected_and_the_old_blocks_forgotten():
 def test_the_hazard_of_a_gamma_segment_length():
     s = ChangePointSettings(mean_segment_m=40.0, segment_shape=1.0)
     f = ChangePointFilter(GD, s)
-    f.update(gauss_loglik(300.0), 0.0)
+    f.update(gauss_loglik(300.0), 1.0)
     f.predict(10.0)  # memoryless: P(change within 10 m) = 1 - exp(-10 / 40)
-    assert f.prob_change_within(0.0) == pytest.approx(1 - np.exp(-0.25), rel=1e-9)
+    assert f.prob_change_within(10.0) == pytest.approx(1 - np.exp(-0.25), rel=1e-9)
+    assert f.prob_change_within(9.99) == 0.0  # the new run spans the 10 m, as they came
     g = ChangePointFilter(GD, ChangePointSettings(mean_segment_m=40.0, segment_shape=2.0))
-    g.update(gauss_loglik(300.0), 0.0)
+    g.update(gauss_loglik(300.0), 1.0)
     g.predict(10.0)  # shape 2: a new segment rarely ends in its first metres
-    assert g.prob_change_within(0.0) < f.prob_change_within(0.0)
+    assert g.prob_change_within(10.0) < f.prob_change_within(10.0)
+
+
+def test_a_new_run_spans_its_first_block_as_the_first_run_does():
+    s = ChangePointSettings(mean_segment_m=40.0, segment_shape=2.0)
+    f = ChangePointFilter(GD, s)
+    f.update(gauss_loglik(300.0), 1.5)
+    assert f.state()[1].tolist() == [1.5]  # the first block: its run spans 1.5 m
+    state = f.state()
+    f.predict(1.5)  # the hazard of a run 1.5 m long over the next 1.5 m: 1 - S(3.0) / S(1.5)
+    survive = gammaincc(2.0, 3.0 / 20.0) / gammaincc(2.0, 1.5 / 20.0)
+    assert f.prob_change_within(1.5) == pytest.approx(1.0 - survive, rel=1e-12)
+    f.restore(state)
+    f.update(gauss_loglik(300.0), 1.5)
+    assert f.state()[1].tolist() == [1.5, 3.0]  # a run begun with the second block: 1.5 m too
 
 
 def test_the_jump_law_excludes_small_changes():

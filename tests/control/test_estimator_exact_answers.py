@@ -20,8 +20,9 @@ GD = np.geomspace(200.0, 600.0, 9)
 
 def _enumerated(f: ChangePointFilter, logliks, ds) -> dict[float, np.ndarray]:
     """P(run length, GD | blocks) by summing over all 2^(n-1) change-point configurations: a
-    run's distance counts the blocks after its first (the initial run: all of its blocks), the
-    hazard is the gamma law's, GD follows the prior and then the filter's jump law."""
+    run's distance counts all of its blocks (a change falls at a block's start, for the first
+    run as for the others), the hazard is the gamma law's, GD follows the prior and then the
+    filter's jump law."""
     s, n = f.settings, len(ds)
     theta = s.mean_segment_m / s.segment_shape
     survival = lambda d: gammaincc(s.segment_shape, d / theta)  # noqa: E731
@@ -31,7 +32,7 @@ def _enumerated(f: ChangePointFilter, logliks, ds) -> dict[float, np.ndarray]:
         p = 1.0
         for j in range(1, n):
             start = max(k for k in starts if k <= j - 1)
-            d = ds[:j].sum() if start == 0 else ds[start + 1 : j].sum()
+            d = ds[start:j].sum()
             h = 1.0 - survival(d + ds[j]) / survival(d)
             p *= h if config[j - 1] else 1.0 - h
         ends = starts[1:] + [n]
@@ -39,7 +40,7 @@ def _enumerated(f: ChangePointFilter, logliks, ds) -> dict[float, np.ndarray]:
         for a, b in zip(starts[1:], ends[1:], strict=True):
             alpha = (alpha @ f._jump) * np.exp(sum(logliks[a:b]))
         last = starts[-1]
-        key = round(float(ds.sum() if last == 0 else ds[last + 1 :].sum()), 9)
+        key = round(float(ds[last:].sum()), 9)
         out[key] = out.get(key, 0.0) + p * alpha
     return out
 

@@ -124,3 +124,21 @@ def test_bad_input_raises():
 def test_a_grid_that_is_not_increasing_finite_and_positive_is_refused(grid):
     with pytest.raises(ControlError, match="grid must hold increasing, finite, positive"):
         GDTracker((200, 600)).update(grid, [-10.0, -10.0, 0.0])
+
+
+def test_the_prior_density_holds_at_the_end_nodes():
+    """Node masses are density x trapezoid weight: the end nodes hold half a cell, so the
+    prior density is flat (uniform) or 1 / GD (log-uniform) to the domain's ends, and the
+    random walk keeps a flat density flat."""
+    for prior, expected in (
+        ("uniform", lambda gd: np.ones_like(gd)),
+        ("log_uniform", np.reciprocal),
+    ):
+        tr = GDTracker((200, 600), TrackerSettings(prior=prior, n_grid=64))
+        density = tr.posterior().grids["GD"].density
+        ratio = density / expected(tr.grid)
+        np.testing.assert_allclose(ratio, ratio[1], rtol=1e-12)  # the ends as the inside
+    flat = GDTracker((200, 600), TrackerSettings(prior="uniform", n_grid=64, mean_segment_m=1e9))
+    flat.predict(100.0)  # drift 0.01 / sqrt(m): a walk of sd 0.1 in log GD
+    density = flat.posterior().grids["GD"].density
+    np.testing.assert_allclose(density, density[1], rtol=1e-9)
