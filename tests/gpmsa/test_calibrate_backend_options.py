@@ -27,7 +27,8 @@ def test_torch_options_reach_the_sampler():
     ("kwargs", "match"),
     [
         ({"backend": "torch", "dtyp": "float32"},
-         r"calibrate: unknown option\(s\) \['dtyp'\] for the 'torch' backend; it takes \[.*'dtype'"),
+         r"calibrate: unknown option\(s\) \['dtyp'\] for the 'torch' backend; it takes "
+         r"\[.*'dtype'"),
         ({"backend": "numpy", "fast": False, "n_iter": 9},
          r"calibrate: \['n_iter'\] are calibrate's own arguments"),
         ({"backend": "numpy", "ridge_moves": 0},
