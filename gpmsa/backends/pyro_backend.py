@@ -31,7 +31,7 @@ from gpmsa.backends.torch_backend import (
     torch_threads,
 )
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import starts
+from gpmsa.mcmc import parallel, starts
 from gpmsa.mcmc.sampler import RHO_PARAMS, Chains, check_draws_memory
 from gpmsa.model.data import as_real, check_count, check_flag
 from gpmsa.model.problem import Problem
@@ -165,6 +165,7 @@ def sample(
     jit: bool = True,
     num_threads: int | None = 1,
     init: str = "auto",
+    n_jobs: int | None = None,
 ) -> Chains:
     """NUTS draws of every sampled parameter: ``n_chains`` chains (one after another) of
     ``n_iter`` draws after ``n_warmup`` adaptation steps.
@@ -185,13 +186,20 @@ def sample(
     ``accept_rate`` holds pyro's per-chain "acceptance rate" diagnostic and ``step_widths`` the
     adapted NUTS step size, each repeated over every sampled element. ``jit``: compile the potential
     energy with the torch JIT (about 1.6x faster on the road case). ``num_threads``: torch CPU
-    threads while sampling (see the torch backend; None: unchanged).
+    threads while sampling (see the torch backend; None: unchanged). ``n_jobs``: None, 1 or -1
+    (the chains run one after another in this process; any other number is a GPMSAError).
     """
     if step_widths:
         raise GPMSAError("the pyro backend (NUTS) takes no step_widths; leave step_widths=None")
     check_sample_args(n_iter, n_chains, seed)
     progress = check_flag(progress, "progress")
     check_draws_memory(problem, int(n_iter), int(n_chains))
+    parallel.n_workers(n_jobs, 1)  # refuse a bad n_jobs
+    if n_jobs is not None and n_jobs > 1:
+        raise GPMSAError(
+            f"n_jobs={n_jobs}: the pyro backend runs its chains one after another in this "
+            "process; leave n_jobs=None (or 1)"
+        )
     if problem.extensions:
         raise GPMSAError(
             f"the pyro backend does not support {', '.join(problem.extensions)}; use "

@@ -50,3 +50,15 @@ def test_pyro_with_a_constraint_names_the_constraint():
         gpmsa.calibrate(
             road_emulator(), x, y, backend="pyro", constraint=lambda t: t[0] < 500, **short
         )
+
+
+def test_pyro_takes_n_jobs_1_as_the_chains_run_there():
+    """n_jobs=1 asks for what pyro does (chains one after another here): accepted, as torch
+    accepts it; its NUTS options pass through calibrate."""
+    x, y = road_obs()
+    post = gpmsa.calibrate(
+        road_emulator(), x, y, backend="pyro", n_jobs=1, n_samples=8, n_burn=2, seed=1,
+        n_warmup=10, jit=False,
+    )  # fmt: skip
+    assert post.samples["GD"].shape == (6,) and np.all(np.isfinite(post.samples["GD"]))
+    assert post.info["backend_options"] == {"jit": False, "n_warmup": 10}

@@ -185,8 +185,11 @@ def test_bad_chain_arguments_raise_naming_them(multi, problem):
             gpmsa.fit(sim, n_iter=10, n_chains=2, n_jobs=1, executor=ex)
     with pytest.raises(gpmsa.GPMSAError, match="executor must be a concurrent.futures.Executor"):
         gpmsa.fit(sim, n_iter=10, n_chains=2, executor="cluster")
-    with pytest.raises(gpmsa.GPMSAError, match="backend 'pyro' runs its chains in one process"):
-        gpmsa.fit(sim, n_iter=10, n_chains=2, backend="pyro", n_jobs=1)
+    with pytest.raises(gpmsa.GPMSAError, match="n_jobs=2: the pyro backend runs its chains one"):
+        gpmsa.fit(sim, n_iter=10, n_chains=2, backend="pyro", n_jobs=2)
+    with ThreadPoolExecutor(1) as ex:
+        with pytest.raises(gpmsa.GPMSAError, match="backend 'pyro' runs its chains in one pro"):
+            gpmsa.fit(sim, n_iter=10, n_chains=2, backend="pyro", executor=ex)
     with pytest.raises(gpmsa.GPMSAError, match="n_jobs=2 with chain_groups=1: the torch backend"):
         gpmsa.fit(sim, n_iter=10, n_chains=2, backend="torch", n_jobs=2)
     with pytest.raises(gpmsa.GPMSAError, match="init must be one of"):
@@ -334,5 +337,5 @@ def test_calibrate_refuses_bad_placement():
         gpmsa.calibrate(emu, x, y, n_chains=more, n_jobs=more, log_prior=lambda t: 0.0 * t)
     with ThreadPoolExecutor(1) as ex, pytest.raises(gpmsa.GPMSAError, match="cannot go to exec"):
         gpmsa.calibrate(emu, x, y, n_chains=2, executor=ex, log_prior=lambda t: 0.0 * t)
-    with pytest.raises(gpmsa.GPMSAError, match="backend 'pyro' runs its chains in one process"):
-        gpmsa.calibrate(emu, x, y, n_chains=2, backend="pyro", n_jobs=1)
+    with pytest.raises(gpmsa.GPMSAError, match="n_jobs=2: the pyro backend runs its chains one"):
+        gpmsa.calibrate(emu, x, y, n_chains=2, backend="pyro", n_jobs=2)
