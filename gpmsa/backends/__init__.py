@@ -14,7 +14,15 @@ from types import ModuleType
 from gpmsa.errors import BackendUnavailableError, GPMSAError
 from gpmsa.mcmc.sampler import check_sample_args
 
-__all__ = ["available", "check_options", "check_sample_args", "get", "names", "placement"]
+__all__ = [
+    "available",
+    "check_options",
+    "check_sample_args",
+    "get",
+    "names",
+    "placement",
+    "recorded_options",
+]
 
 _REGISTRY: dict[str, tuple[str, str]] = {
     # name: (module path, pip extra that provides its packages)
@@ -89,6 +97,26 @@ def check_options(backend: str, options: dict, reserved: tuple[str, ...], caller
         raise GPMSAError(
             f"{caller}: unknown option(s) {unknown} for the {backend!r} backend; it takes {offered}"
         )
+
+
+_UNRECORDED = object()
+
+
+def _recorded_option(value):
+    """A backend option as a record holds it: plain values as they are, a torch dtype or
+    device by its name ("float32", "cuda"); anything else is not recorded (_UNRECORDED)."""
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
+    if type(value).__module__.split(".")[0] == "torch":
+        return str(value).removeprefix("torch.")
+    return _UNRECORDED
+
+
+def recorded_options(options: dict) -> dict:
+    """``options`` as ``fit``'s settings and ``calibrate``'s info record them, sorted by name:
+    plain values as they are, a torch dtype or device by its name; other values left out."""
+    recorded = {k: _recorded_option(v) for k, v in sorted(options.items())}
+    return {k: v for k, v in recorded.items() if v is not _UNRECORDED}
 
 
 def placement(backend: str, n_jobs=None, executor=None) -> dict:

@@ -263,8 +263,7 @@ def calibrate(
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds, obs_values_sha256=data.values_sha256,
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
-        backend_options={k: v if v is None or isinstance(v, bool | int | float | str) else str(v)
-                         for k, v in sorted(options.items())},
+        backend_options=backends.recorded_options(options),
     )  # fmt: skip
     if n_chains > 1:
         info["diagnostics"] = summarize(chains)

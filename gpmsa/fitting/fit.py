@@ -15,6 +15,7 @@ from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
+from gpmsa.mcmc.sampler import draws_nbytes, parameter_elements
 from gpmsa.model import constraints
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
 from gpmsa.model.priors import Priors
@@ -35,28 +36,14 @@ def _seed(seed) -> int:
     return seed
 
 
-_UNRECORDED = object()
-
-
-def _recorded_option(value):
-    """A backend option as the settings record it: plain values as they are, a torch dtype or
-    device by its name ("float32", "cuda"); anything else is not recorded (_UNRECORDED)."""
-    if value is None or isinstance(value, (bool, int, float, str)):
-        return value
-    if type(value).__module__.split(".")[0] == "torch":
-        return str(value).removeprefix("torch.")
-    return _UNRECORDED
-
-
 def _check_fit_memory(problem, n_iter: int, n_chains: int) -> None:
     """Refuse (before sampling) a fit whose draws or factorisations exceed the memory limit:
     every sweep of every chain is stored (n_chains x n_iter x parameter elements, kept twice
     while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats."""
-    n_el = sum(int(np.size(v)) for v in problem.init.values()) + 1
     m, d, p_u = problem.m, problem.p + problem.q, problem.p_u
-    nbytes = 8.0 * (2.0 * n_chains * n_iter * n_el + m * m * (d + 4 * p_u + 2))
-    check_memory(nbytes, f"fit(n_iter={n_iter}, n_chains={n_chains}) of {m} runs x {n_el - 1} "
-                 "parameter elements")  # fmt: skip
+    nbytes = draws_nbytes(problem, n_iter, n_chains) + 8.0 * m * m * (d + 4 * p_u + 2)
+    check_memory(nbytes, f"fit(n_iter={n_iter}, n_chains={n_chains}) of {m} runs x "
+                 f"{parameter_elements(problem)} parameter elements")  # fmt: skip
 
 
 def fit(
@@ -188,9 +175,10 @@ def fit(
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),
-        "backend_options": {k: r for k, v in sorted(options.items())
-                            if k not in ("n_jobs", "executor")  # not where they ran
-                            and (r := _recorded_option(v)) is not _UNRECORDED},
+        # n_jobs and executor say where the chains ran, not what they were: not recorded
+        "backend_options": backends.recorded_options(
+            {k: v for k, v in options.items() if k not in ("n_jobs", "executor")}
+        ),
         "mean_basis": None if problem.mean_basis is None else problem.mean_basis.kind,
         "fixed": {k: problem.init[k].tolist() for k in sorted(problem.fixed)},
         "constraint": constraint is not None,

@@ -277,13 +277,23 @@ def check_sample_args(n_iter, n_chains, seed) -> None:
     check_seed(seed)
 
 
+def parameter_elements(problem: Problem) -> int:
+    """Parameter elements a sweep stores (every parameter of ``problem.init``, fixed ones too)."""
+    return sum(int(np.size(v)) for v in problem.init.values())
+
+
+def draws_nbytes(problem: Problem, n_iter: int, n_chains: int) -> float:
+    """Bytes of the stored sweeps of every chain (the parameter elements and the log
+    posterior), kept twice while the chains are stacked."""
+    return 16.0 * n_chains * n_iter * (parameter_elements(problem) + 1)
+
+
 def check_draws_memory(problem: Problem, n_iter: int, n_chains: int) -> None:
-    """ResourceLimitError (before any chain runs) when the stored sweeps of every chain, kept
-    twice while the chains are stacked, exceed ``gpmsa.limits.MAX_MEMORY_BYTES``."""
-    n_el = sum(int(np.size(v)) for v in problem.init.values()) + 1  # and the log posterior
-    check_memory(16.0 * n_chains * n_iter * n_el,
-                 f"sample(n_iter={n_iter}, n_chains={n_chains}) of {n_el - 1} parameter "
-                 "elements")  # fmt: skip
+    """ResourceLimitError (before any chain runs) when `draws_nbytes` exceeds
+    ``gpmsa.limits.MAX_MEMORY_BYTES``."""
+    check_memory(draws_nbytes(problem, n_iter, n_chains),
+                 f"sample(n_iter={n_iter}, n_chains={n_chains}) of "
+                 f"{parameter_elements(problem)} parameter elements")  # fmt: skip
 
 
 def check_ridge(ridge_moves, problem: Problem) -> int:
