@@ -23,9 +23,11 @@ from scipy.special import ndtr
 
 from gpmsa import backends
 from gpmsa.calibration.grid import (
+    ConstraintCut,
     check_log_density,
     check_mass,
     constrained,
+    draw_allowed,
     draw_bilinear,
     interp_log,
     mesh,
@@ -99,10 +101,15 @@ class Calibrator:
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there. On the grid, for one parameter the density is cut at
             the boundary (located by bisection between nodes, to float precision), so that no
-            mass lies outside; for two parameters forbidden nodes get weight 0 and the density
-            falls to zero across the cells the boundary crosses (a leak of at most one, possibly
-            refined, cell). MCMC passes it to ``gpmsa.calibrate``. It is evaluated on the fixed
-            grid once, here.
+            mass lies outside; for two parameters each cell the boundary crosses (corners of
+            both verdicts) is split into N_SUB x N_SUB (``gpmsa.calibration.grid``), the
+            constraint evaluated at the new nodes, and the density falls to zero across the
+            split cells the boundary crosses (its only error: mass in that band, a quarter of
+            a cell wide, may lie on the wrong side), and draws the constraint rejects are
+            redrawn: none lies outside. A region of either verdict that touches no node (nor
+            new node) is not seen by the density (draws are still checked). MCMC passes it to
+            ``gpmsa.calibrate``. It is evaluated on the fixed grid once, here (on a refined
+            grid, at the update).
     """
 
     def __init__(
@@ -195,9 +202,7 @@ class Calibrator:
             np.log(pri.theta_sd * np.sqrt(2 * np.pi) * (ndtr(z[0]) - ndtr(z[1])))
         )
         self._base_ok = None if self.constraint is None else self._allowed(self._theta_unit)
-        self._base_edges = None
-        if self._base_ok is not None and q == 1:
-            self._base_edges = self._constraint_edges(self._axes[0], self._base_ok)
+        self._base_cut = None if self._base_ok is None else self._cut(self._axes, self._base_ok)
 
     def _check_mcmc_path(self, backend: str) -> None:
         """GPMSAError now, not at every update, for MCMC settings ``gpmsa.calibrate`` refuses:
@@ -256,7 +261,7 @@ class Calibrator:
                 "this Calibrator uses MCMC (q > 2 or method='mcmc'); no grid likelihood"
             )
 
-    def log_likelihood_grid(self, x_obs, y_obs) -> tuple[np.ndarray, np.ndarray]:
+    def log_likelihood_grid(self, x_obs=None, y_obs=None) -> tuple[np.ndarray, np.ndarray]:
         """Exact log-likelihood of theta on the fixed grid, lamOs integrated out.
 
         Returns (theta_grid, loglik): theta_grid native units, (G,) for one calibration parameter
@@ -306,11 +311,12 @@ class Calibrator:
         check_log_density(vals)
         return vals
 
-    def update(self, x_obs, y_obs, prior=None, seed=None) -> Posterior:
+    def update(self, x_obs=None, y_obs=None, prior=None, seed=None) -> Posterior:
         """Posterior of the calibration parameters (and lamOs) given one observation window.
 
         Args:
-            x_obs: (n, p) known inputs, native units (e.g. [[v]]).
+            x_obs: (n, p) known inputs, native units (e.g. [[v]]); None for an emulator
+                without known inputs (p = 0), e.g. ``update(y_obs=[[f]])``.
             y_obs: (n, l_sim) observed outputs, native units (e.g. [[f]]).
             prior: optional extra log prior of theta: log-density values on ``theta_grid`` (G,)
                 (for two parameters also (n_grid, n_grid), rows the first parameter;
@@ -386,7 +392,15 @@ class Calibrator:
 
     def _allowed(self, theta_unit: np.ndarray) -> np.ndarray:
         """(G,) bool: whether the constraint allows each unit-scale node (G, q)."""
-        return np.array([self.constraint(t) for t in theta_unit], dtype=bool)
+        return self.constraint.allows(self.constraint.native(theta_unit))
+
+    def _cut(self, axes: list, ok: np.ndarray) -> tuple[np.ndarray, ...] | ConstraintCut:
+        """The constraint's boundary on the grid of unit-scale ``axes`` whose nodes have the
+        verdicts ``ok`` (G,): its points between nodes (`_constraint_edges`) for one parameter,
+        the grid with the cells it crosses split (`ConstraintCut`) for two."""
+        if self.q == 1:
+            return self._constraint_edges(axes[0], ok)
+        return ConstraintCut.make(axes, ok, self._allowed)
 
     def _constraint_edges(self, nodes: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, ...]:
         """Where the constraint's status changes between the unit-scale nodes (k,) (one
@@ -426,7 +440,7 @@ class Calibrator:
         if self.q == 1:
             nodes, logd, lik = axes[0], constrained(free, ok), None
             if ok is not None:
-                edges = self._base_edges if base else self._constraint_edges(nodes, ok)
+                edges = self._base_cut if base else self._cut(axes, ok)
                 nodes, logd, lik = with_edges(nodes, free, ok, edges)
             inserted = nodes.size > free.size
             x = native[0] if not inserted else nodes * (std.t_max[0] - std.t_min[0]) + std.t_min[0]
@@ -441,13 +455,21 @@ class Calibrator:
                 lik = np.arange(x.size) if lik is None else lik
                 inv_lamos = inv_lamos[lik][kept]
         else:
-            logd = constrained(free, ok)
-            dens = np.exp(logd - logd.max()).reshape(axes[0].size, axes[1].size)
-            w = [trapezoid_weights(a) for a in native]
+            shape = (axes[0].size, axes[1].size)
+            if ok is None:
+                dens = np.exp(free - free.max()).reshape(shape)
+                split = native
+            else:  # the free density, cut by the constraint on the split grid
+                cut = self._base_cut if base else self._cut(axes, ok)
+                logd = np.where(cut.live.ravel(), free, -np.inf)
+                dens = cut.density(np.exp(logd - logd.max()).reshape(shape))
+                split = [a * (std.t_max[k] - std.t_min[k]) + std.t_min[k]
+                         for k, a in enumerate(cut.axes)]  # fmt: skip
+            w = [trapezoid_weights(a) for a in split]
             with np.errstate(divide="ignore"):
                 grids = {
-                    names[0]: trimmed_marginal(native[0], np.log(dens @ w[1]))[0],
-                    names[1]: trimmed_marginal(native[1], np.log(w[0] @ dens))[0],
+                    names[0]: trimmed_marginal(split[0], np.log(dens @ w[1]))[0],
+                    names[1]: trimmed_marginal(split[1], np.log(w[0] @ dens))[0],
                 }
             log_evidence = None
         n_draws = self.n_draws
@@ -459,9 +481,14 @@ class Calibrator:
                 out = {names[0]: th}
                 node = nearest(x, th)
                 node = node if lik is None else lik[node]
-            else:
+            elif ok is None:
                 vals, node = draw_bilinear(native, dens, rng, n_draws)
                 out = {name: vals[:, k] for k, name in enumerate(names)}
+            else:  # no draw where the constraint forbids: redrawn
+                vals = draw_allowed(split, dens, rng, n_draws, self.constraint.allows)
+                out = {name: vals[:, k] for k, name in enumerate(names)}
+                node = nearest(native[0], vals[:, 0]) * native[1].size
+                node += nearest(native[1], vals[:, 1])
             out["lamOs"] = _draw_lamos(margs, node, rng)
             return out
 

@@ -1,7 +1,8 @@
 """The grid posterior's machinery for one or two calibration parameters: the density's
 interpolation between nodes (linear, bilinear; in the log between finite values, in the density
-next to a zero), a constraint's boundary inserted into a one-parameter grid, marginals cut to
-their support, draws from the bilinear density, and the refinement of each peak the grid does
+next to a zero), a constraint's boundary inserted into a one-parameter grid and resolved on
+split cells of a two-parameter one, marginals cut to their support, draws from the bilinear
+density (those a constraint rejects redrawn), and the refinement of each peak the grid does
 not resolve. ``gpmsa.calibration.calibrator`` composes them; all work on unit-scale or native
 axes given by the caller.
 """
@@ -9,6 +10,8 @@ axes given by the caller.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
@@ -42,6 +45,14 @@ REFINE_FACTORS = (2.0, 1.5, 1.25)
 """A refined region has at least this many times the cells it had (the first that fits)."""
 SAME_NODE = 0.01
 """A refined node this close to a grid line it must keep (in node spacings) gives way to it."""
+N_SUB = 4
+"""Two parameters: each side of a grid cell that a constraint's boundary crosses is split into
+this many parts, the constraint evaluated at the new nodes (`ConstraintCut`). The cut density
+errs only in the split cells the boundary crosses; on tests/gpmsa/test_constraint_two_params.py's
+case its mean and quantiles are within 6e-4 sd of the exact cut (2 parts: 4e-3, 8: 1.4e-4) and
+an update costs 5-8 % more than without the constraint (8 parts: 20 %)."""
+MAX_REDRAW_ROUNDS = 100
+"""Rounds of redrawing the draws a constraint rejects (`draw_allowed`), at most."""
 
 
 def mesh(axes: list) -> np.ndarray:
@@ -166,6 +177,105 @@ def draw_bilinear(
     vals = np.column_stack([axes[0][i] + s * h0[i], axes[1][j] + t * h1[j]])
     node = (i + np.rint(s).astype(int)) * axes[1].size + j + np.rint(t).astype(int)
     return vals, node
+
+
+def draw_allowed(
+    axes: list,
+    dens: np.ndarray,
+    rng: np.random.Generator,
+    size: int,
+    allows: Callable[[np.ndarray], np.ndarray],
+) -> np.ndarray:
+    """``size`` draws (size, 2) from the bilinear interpolant of ``dens`` (n0, n1) on the native
+    ``axes`` (`draw_bilinear`) restricted to where ``allows`` (native (k, 2) -> (k,) bool) holds:
+    those it rejects are redrawn (each round draws the remainder over the acceptance seen so
+    far). GPMSAError when MAX_REDRAW_ROUNDS rounds leave some undrawn."""
+    kept, drawn, accepted = [], 0, 0
+    for _ in range(MAX_REDRAW_ROUNDS):
+        need = size - accepted
+        if need == 0:
+            break
+        n = need if accepted == 0 else min(int(np.ceil(need * drawn / accepted)), 100 * need)
+        vals = draw_bilinear(axes, dens, rng, n)[0]
+        vals = vals[allows(vals)][:need]
+        kept.append(vals)
+        drawn, accepted = drawn + n, accepted + vals.shape[0]
+    if accepted < size:
+        raise GPMSAError(
+            f"the constraint rejected {drawn - accepted} of {drawn} draws from the grid density "
+            "(its allowed region is narrower than the grid resolves); use method='mcmc'"
+        )
+    return np.concatenate(kept)
+
+
+@dataclass(frozen=True, eq=False)
+class ConstraintCut:
+    """A two-parameter grid (unit-scale ``axes``) whose cells that a constraint's boundary
+    crosses (corners of both verdicts) are split N_SUB x N_SUB, the constraint evaluated at the
+    new nodes in them: the density cut by the constraint is the bilinear interpolant of the
+    free density onto the split grid, zero at its forbidden nodes, so that it falls to zero
+    within one split cell of the boundary (a cell that no boundary crossing touches keeps the
+    verdict of its corners).
+
+    Attributes:
+        axes: the split grid's unit-scale axes [(N0,), (N1,)] (every interval of a parameter
+            that a crossed cell spans split in N_SUB).
+        cells, frac: per parameter, the grid's interval (N_k,) holding each split node and its
+            position in it, in [0, 1].
+        allowed: (N0, N1) the constraint's verdict at the split grid's nodes.
+        live: (n0, n1) the grid's nodes the cut density depends on: allowed ones and corners of
+            crossed cells.
+    """
+
+    axes: list
+    cells: list
+    frac: list
+    allowed: np.ndarray
+    live: np.ndarray
+
+    @classmethod
+    def make(
+        cls, axes: list, ok: np.ndarray, allows: Callable[[np.ndarray], np.ndarray]
+    ) -> ConstraintCut:
+        """The cut of the grid of unit-scale ``axes`` whose nodes have the verdicts ``ok``
+        ((n0 n1,), 'ij' order); ``allows`` (unit-scale (k, 2) -> (k,) bool) gives the verdict
+        at the new nodes."""
+        ok = ok.reshape(axes[0].size, axes[1].size)
+        corners = np.stack([ok[:-1, :-1], ok[1:, :-1], ok[:-1, 1:], ok[1:, 1:]])
+        crossed = corners.any(axis=0) & ~corners.all(axis=0)
+        fine, cells, frac, near = [], [], [], []
+        for k, a in enumerate(axes):
+            split = crossed.any(axis=1 - k)
+            step = np.arange(1, N_SUB) / N_SUB
+            new = (a[:-1, None] + np.diff(a)[:, None] * step)[split].ravel()
+            f = np.sort(np.concatenate([a, new]))
+            c = np.clip(np.searchsorted(a, f, side="right") - 1, 0, a.size - 2)
+            t = np.clip((f - a[c]) / (a[c + 1] - a[c]), 0.0, 1.0)
+            on_node = np.isin(f, a)
+            below = np.where(on_node & (t == 0.0), np.maximum(c - 1, 0), c)  # cells touched
+            fine.append(f), cells.append(c), frac.append(t), near.append((below, c, on_node))
+        (lo0, hi0, node0), (lo1, hi1, node1) = near
+        touches = (crossed[lo0][:, lo1] | crossed[lo0][:, hi1] | crossed[hi0][:, lo1]
+                   | crossed[hi0][:, hi1])  # fmt: skip
+        allowed = corners.all(axis=0)[cells[0]][:, cells[1]]  # the verdict of a cell not crossed
+        allowed[np.ix_(node0, node1)] = ok
+        check = touches & ~(node0[:, None] & node1[None, :])
+        i, j = np.nonzero(check)
+        allowed[i, j] = allows(np.column_stack([fine[0][i], fine[1][j]]))
+        live = ok.copy()
+        for di in (0, 1):
+            for dj in (0, 1):
+                live[di : di + crossed.shape[0], dj : dj + crossed.shape[1]] |= crossed
+        return cls(fine, cells, frac, allowed, live)
+
+    def density(self, dens: np.ndarray) -> np.ndarray:
+        """The cut density (N0, N1) on the split grid from the free density ``dens`` (n0, n1)
+        on the grid (bilinear, zero at forbidden nodes)."""
+        (c0, c1), (t0, t1) = self.cells, self.frac
+        rows = (1.0 - t0)[:, None] * dens[c0] + t0[:, None] * dens[c0 + 1]
+        out = rows[:, c1] * (1.0 - t1) + rows[:, c1 + 1] * t1
+        out[~self.allowed] = 0.0
+        return out
 
 
 def _one_resolved_peak(axis: np.ndarray, density: np.ndarray) -> bool:

@@ -30,12 +30,25 @@ class ThetaConstraint:
     names: tuple[str, ...]
 
     def native(self, theta_unit: np.ndarray) -> np.ndarray:
-        """Unit-scale theta (q,) -> native (q,)."""
+        """Unit-scale theta (q,) or (k, q) -> native, the same shape."""
         return np.asarray(theta_unit, dtype=np.float64) * (self.t_max - self.t_min) + self.t_min
 
     def __call__(self, theta_unit: np.ndarray) -> bool:
         """Whether unit-scale theta (q,) is allowed; GPMSAError if ``fn`` fails or is not bool."""
-        native = self.native(theta_unit)
+        return self._verdict(self.native(theta_unit))
+
+    def allows(self, native: np.ndarray) -> np.ndarray:
+        """(k,) bool: whether each row of native theta (k, q) is allowed (``fn`` called once
+        per row, on a copy); GPMSAError as ``__call__``.
+
+        >>> c = ThetaConstraint(lambda th: th[0] < th[1], np.zeros(2), np.ones(2), ("a", "b"))
+        >>> c.allows(np.array([[1.0, 2.0], [3.0, 2.0]])).tolist()
+        [True, False]
+        """
+        return np.array([self._verdict(row) for row in native], dtype=bool)
+
+    def _verdict(self, native: np.ndarray) -> bool:
+        """``fn`` at native theta (q,), checked."""
         try:
             ok = self.fn(native.copy())
         except Exception as exc:
