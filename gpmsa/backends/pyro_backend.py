@@ -61,11 +61,12 @@ class PyroModel:
         self.problem = problem
         self.dtype = dtype
         self.data = ModelTensors.from_problem(problem, dtype, "cpu")
-        self.const = {
+        self.const = {  # fixed, or empty (betaV with no known inputs, p = 0): no sample site
             k: torch.as_tensor(v, dtype=dtype).unsqueeze(0)
             for k, v in problem.init.items()
-            if k in problem.fixed
+            if k in problem.fixed or np.size(v) == 0
         }
+        self.free = tuple(k for k in problem.sampled if k not in self.const)
         self.sim_cache = None
         if all(k in self.const for k in SIM_PARAMS):  # Sigma_W constant: factor it once
             d = self.data
@@ -79,7 +80,7 @@ class PyroModel:
         model's sample sites."""
         start = self.problem.init if start is None else start
         out = {}
-        for name in self.problem.sampled:
+        for name in self.free:
             v = torch.as_tensor(start[name], dtype=self.dtype)
             out[_site(name)] = torch.exp(-0.25 * v) if name in RHO_PARAMS else v
         return out
@@ -112,7 +113,7 @@ class PyroModel:
         """Sum of the sampled parameters' log priors (C,)."""
         c = prm["betaU"].shape[0]
         lp = torch.zeros(c, dtype=self.dtype)
-        for name in self.problem.sampled:
+        for name in self.free:
             lp = lp + log_prior_elements(self.problem.priors, name, prm[name]).reshape(c, -1).sum(
                 -1
             )
@@ -120,7 +121,7 @@ class PyroModel:
 
     def __call__(self) -> None:
         sites = {}
-        for name in self.problem.sampled:
+        for name in self.free:
             shape = self.problem.init[name].shape
             base = dist.ImproperUniform(_support(self.problem, name), (), shape)
             sites[_site(name)] = pyro.sample(_site(name), base).unsqueeze(0)

@@ -152,7 +152,7 @@ def scaled_correlation(beta: Tensor, d: Tensor, lam: Tensor) -> Tensor:
     """
     c, k, j = beta.shape
     bias = -torch.log(lam).reshape(c * j, 1)
-    expo = torch.addmm(bias, beta.transpose(1, 2).reshape(c * j, k), d.reshape(k, -1), alpha=-1.0)
+    expo = torch.addmm(bias, beta.transpose(1, 2).reshape(c * j, k), d.flatten(1), alpha=-1.0)
     return expo.exp_().reshape(c, j, *d.shape[1:])
 
 

@@ -32,6 +32,7 @@ from gpmsa.calibration.observations import (
     fit_of,
     fixed_gp,
     lamos_start,
+    obs_inputs,
     reduce,
     theta_levels,
     theta_probe,
@@ -68,7 +69,7 @@ def calibration_problem(
         fit = _probe(emulator, data, [emulator.params])
         start = lamos_start(fit, data.lamos)
     else:
-        x, _ = check_x(emulator, x_obs, extrapolate)
+        x, _ = check_x(emulator, obs_inputs(emulator, x_obs, y_obs), extrapolate)
         y = check_y(emulator, y_obs)
         if emulator.K.shape[0] == 1 and y.size == x.shape[0]:
             y = y.reshape(-1, 1)
@@ -123,8 +124,8 @@ def _theta_options(emulator, constraint, theta_init):
 
 def calibrate(
     emulator,
-    x_obs,
-    y_obs,
+    x_obs=None,
+    y_obs=None,
     n_samples: int = 5000,
     n_burn: int = 1000,
     tune: bool = True,
@@ -151,7 +152,9 @@ def calibrate(
 
     Args:
         emulator: a gpmsa.Emulator.
-        x_obs: (n, p) known inputs of the observations, native units.
+        x_obs: (n, p) known inputs of the observations, native units; None (or (n, 0)) for an
+            emulator without known inputs (p = 0): each row of y_obs is then a replicate
+            observation of the one experiment.
         y_obs: (n, l_sim) observed outputs, native units (a scalar output also takes (n,)).
             A pandas DataFrame (or Series) is read by name, the emulator's x_names / y_names
             in any order, never by position; a numpy masked array is refused.

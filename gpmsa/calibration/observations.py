@@ -115,8 +115,11 @@ def check_x(
     emulator, x_obs, extrapolate: bool, what: str = "x_obs"
 ) -> tuple[np.ndarray, np.ndarray]:
     """x_obs native (n, p) and unit scale; outside the emulator's x domain: GPMSAError, or with
-    ``extrapolate=True`` a warning. ``what``: the argument's name in messages."""
+    ``extrapolate=True`` a warning. ``what``: the argument's name in messages. An emulator
+    without known inputs (p = 0) takes None as one row of no columns (1, 0)."""
     p = emulator.x_unit.shape[1]
+    if x_obs is None and p == 0:
+        x_obs = np.empty((1, 0))
     x = _as_rows(by_column_names(x_obs, emulator.x_names, what), what, p)
     levels = getattr(emulator, "levels", None)
     if levels is not None:
@@ -144,13 +147,38 @@ def check_y(emulator, y_obs) -> np.ndarray:
     return as_float(by_column_names(y_obs, names, "y_obs"), "y_obs")
 
 
+def obs_inputs(emulator, x_obs, y_obs, what: str = "x_obs"):
+    """``x_obs`` as given, or, where it is None and the emulator has no known inputs (p = 0), an
+    (n, 0) array: one row per observation of ``y_obs`` (each a replicate of the one experiment,
+    as SEPIA's dummy x; a scalar output reads every value of ``y_obs`` as one observation).
+    GPMSAError when ``y_obs`` is None, or ``x_obs`` is None and the emulator has known inputs."""
+    if y_obs is None:
+        raise GPMSAError("y_obs is required: the observed outputs (n, l_sim), native units")
+    if x_obs is not None:
+        return x_obs
+    p = emulator.x_unit.shape[1]
+    if p > 0:
+        raise GPMSAError(
+            f"{what} is required: the emulator has p = {p} known input(s) "
+            f"{list(emulator.x_names)}; only an emulator without known inputs (p = 0) takes none"
+        )
+    y = check_y(emulator, y_obs)
+    if emulator.K.shape[0] == 1:
+        n = y.size
+    else:
+        n = 1 if y.ndim < 2 else y.shape[0]
+    return np.empty((n, 0))
+
+
 def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     """Check and reduce (x_obs, y_obs) for the no-discrepancy model of ``emulator``.
 
     y_obs: (n, l_sim) on the emulator's output grid (a scalar output takes (n, 1) or (n,)); a
     table with named columns (a pandas DataFrame) or a pandas Series is read by the emulator's
-    ``y_names`` (`check_y`).
+    ``y_names`` (`check_y`). x_obs: (n, p); None (or (n, 0)) for an emulator with p = 0
+    (`obs_inputs`).
     """
+    x_obs = obs_inputs(emulator, x_obs, y_obs)
     x, xu = check_x(emulator, x_obs, extrapolate)
     n = x.shape[0]
     std, K = emulator.standardizer, emulator.K

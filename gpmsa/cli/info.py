@@ -82,7 +82,7 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
             dom = manifest["domain"].get(n) if kind != "y" else None
             rng = f" in [{dom[0]:.6g}, {dom[1]:.6g}]" if dom else ""
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
-        lines.append(f"{label + ':':17s}{', '.join(parts)}")
+        lines.append(f"{label + ':':17s}{', '.join(parts) or 'none'}")
     cat = model.get("categorical") or {}
     if cat:
         lines.append("categorical:     " + ", ".join(

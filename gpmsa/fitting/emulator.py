@@ -301,9 +301,16 @@ class Emulator:
         """Unit-scale z (N, p + q) of native x and t; beyond ``EXTRAPOLATION_MARGIN`` of the
         domain a GPMSAError unless ``far_ok`` (a caller that allows it and has warned)."""
         check_same_rows({"x": x, "t": t}, {"x": self.x_names, "t": self.t_names})
+        if x is None and self.p == 0:  # no known inputs: one row of none, broadcast against t
+            x = np.empty((1, 0))
         x = as_float(by_column_names(x, self.x_names, "x"), "x")  # ragged: named here
         t = as_float(by_column_names(t, self.t_names, "t"), "t")
-        x = as_matrix(x, "x", ncols=self.p) if np.ndim(x) != 1 or self.p != 1 else as_matrix(x, "x")
+        if self.p == 0:
+            x = as_matrix(x, "x", ncols=0, no_columns=True)
+        elif np.ndim(x) != 1 or self.p != 1:
+            x = as_matrix(x, "x", ncols=self.p)
+        else:
+            x = as_matrix(x, "x")
         t = as_matrix(t, "t", ncols=self.q) if np.ndim(t) != 1 or self.q != 1 else as_matrix(t, "t")
         if x.shape[0] != t.shape[0]:
             if x.shape[0] == 1:
@@ -377,7 +384,8 @@ class Emulator:
         """Predictive mean and variance (N, l_sim) of the simulator output in native units.
 
         x (N, p) known inputs and t (N, q) parameters, native units (a single row broadcasts;
-        pandas tables of N > 1 rows must carry the same row labels: rows pair by position).
+        pandas tables of N > 1 rows must carry the same row labels: rows pair by position). An
+        emulator without known inputs (p = 0) takes x None (or (N, 0)): ``predict(None, t)``.
         ``draws=False``: at the point estimate ``params``; ``draws=True``: averaged over the
         retained posterior draws (or ``n_draws`` of them, evenly spaced from the first to the
         last: ``evenly_spaced``), combining the variances by the law of total variance.

@@ -150,8 +150,9 @@ def fit(
     for k in problem.fixed & set(post):
         post[k][...] = np.asarray(problem.init[k], dtype=float).reshape(post[k].shape[2:])
     lp = chains.log_post[:, n_burn:]
-    retained = {k: v[:, ::thin].reshape(-1, *v.shape[2:]) for k, v in post.items()}
     lp_kept = lp[:, ::thin].reshape(-1)
+    n_kept = lp_kept.size  # explicit: an empty parameter (betaV when p = 0) has no -1 to infer
+    retained = {k: v[:, ::thin].reshape(n_kept, *v.shape[2:]) for k, v in post.items()}
     if point == "mean":
         params = {k: np.clip(retained[k].mean(axis=0), retained[k].min(axis=0),
                              retained[k].max(axis=0)) for k in EMULATOR_PARAMS}  # fmt: skip

@@ -68,10 +68,8 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
     m, p = two("x_unit")
     _, q = two("t_unit")
     l_sim, p_u = two("K")
-    if p < 1 or q < 1:
-        raise _fail(
-            "arrays/x_unit", f"needs p >= 1 known inputs and q >= 1 parameters, got {p}, {q}"
-        )
+    if q < 1:  # p = 0 (no known inputs) is a valid emulator; q = 0 is not
+        raise _fail("arrays/t_unit", f"needs q >= 1 parameters, got {q}")
     if m < p + q + 2:
         raise _fail("arrays/x_unit", f"{m} runs: at least p + q + 2 = {p + q + 2} are needed")
     if l_sim < 1 or not 1 <= p_u <= min(m, l_sim):

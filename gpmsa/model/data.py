@@ -206,9 +206,12 @@ def series_by_names(series, names, name: str) -> np.ndarray:
     )
 
 
-def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
+def as_matrix(
+    value, name: str, *, ncols: int | None = None, no_columns: bool = False
+) -> np.ndarray:
     """Return ``value`` as a finite float64 2-D array; a 1-D array becomes one column, or, where
-    ``ncols`` > 1 and it has exactly ``ncols`` entries, one row.
+    ``ncols`` > 1 and it has exactly ``ncols`` entries, one row. ``no_columns``: a 2-D array of
+    rows with no columns (n, 0) is accepted (known inputs x when there are none, p = 0).
 
     Raises GPMSAError naming ``name`` for non-numeric or complex values, a wrong shape or
     non-finite entries.
@@ -218,7 +221,7 @@ def as_matrix(value, name: str, *, ncols: int | None = None) -> np.ndarray:
     if arr.ndim == 1:
         one_row = ncols is not None and ncols > 1 and arr.size == ncols
         arr = arr[None, :] if one_row else arr[:, None]
-    if arr.ndim != 2 or arr.shape[0] == 0 or arr.shape[1] == 0:
+    if arr.ndim != 2 or arr.shape[0] == 0 or (arr.shape[1] == 0 and not no_columns):
         raise GPMSAError(
             f"{name} must be a non-empty 2-D array (rows x columns), got shape {given}"
         )
@@ -408,6 +411,10 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
 class SimData:
     """Simulation runs: inputs ``x`` (m, p), parameters ``t`` (m, q), outputs ``y`` (m, l_sim).
 
+    ``x`` may be omitted (None) or have no columns (m, 0) when the simulator has no known inputs
+    (p = 0): the emulator then correlates over ``t`` only (docs/models.md, "No known inputs").
+    ``t`` and ``y`` are required (keywords, or positionally after ``x``: ``SimData(x, t, y)``).
+
     ``index`` (l_sim,) is the output grid of a multivariate output (None: 0..l_sim-1); it must
     be strictly increasing (a descending or unsorted grid is refused: sort the index and the
     columns of ``y`` together). Names default to x0.., t0.., y0..; units to "". ``t_names`` may
@@ -420,9 +427,9 @@ class SimData:
     none), whose values are integer level codes; see docs/categorical-and-constraints.md.
     """
 
-    x: np.ndarray
-    t: np.ndarray
-    y: np.ndarray
+    x: np.ndarray | None = None
+    t: np.ndarray | None = None
+    y: np.ndarray | None = None
     index: np.ndarray | None = None
     x_names: tuple[str, ...] | None = None
     t_names: tuple[str, ...] | None = None
@@ -445,9 +452,13 @@ class SimData:
             elif labels is not None:
                 value = by_column_names(getattr(self, part), tuple(names), part)
                 object.__setattr__(self, part, value)
-        x = as_matrix(self.x, "x")
+        if self.t is None or self.y is None:
+            raise GPMSAError(
+                "SimData needs t (m, q) and y (m, l_sim); only x may be omitted (no known inputs)"
+            )
         t = as_matrix(self.t, "t")
         y = as_matrix(self.y, "y")
+        x = np.empty((t.shape[0], 0)) if self.x is None else as_matrix(self.x, "x", no_columns=True)
         m = x.shape[0]
         if t.shape[0] != m or y.shape[0] != m:
             raise GPMSAError(
@@ -549,10 +560,15 @@ class ObsData:
     of shape (n,) or (n, l, l)). Every entry must be a real number (strings, bools and None are
     refused, never converted). ``x`` and ``y`` given as pandas objects of several rows must carry
     the same row labels (rows pair by position).
+
+    ``x`` may be omitted (None) or have no columns (n, 0) for a simulator without known inputs
+    (p = 0): the n experiments are then replicate observations of the one experiment (as
+    SEPIA's dummy x); each row of a 2-D ``y`` (each array of a list) is one experiment, a 1-D
+    ``y`` is one. ``y`` is required.
     """
 
-    x: np.ndarray
-    y: np.ndarray | list[np.ndarray]
+    x: np.ndarray | None = None
+    y: np.ndarray | list[np.ndarray] | None = None
     index: np.ndarray | list[np.ndarray] | None = None
     precision: np.ndarray | list[np.ndarray] | None = None
     experiments: list[np.ndarray] = field(init=False, repr=False)
@@ -563,9 +579,15 @@ class ObsData:
     def __post_init__(self) -> None:
         check_same_rows({"x_obs": self.x, "y_obs": self.y})
         object.__setattr__(self, "x_columns", column_labels(self.x))
-        x = as_matrix(self.x, "x_obs")
-        n = x.shape[0]
-        ys = self._experiments(self.y, n)
+        if self.y is None:
+            raise GPMSAError("ObsData needs y (n, l_obs), the observed outputs; only x may be "
+                             "omitted (no known inputs)")  # fmt: skip
+        if self.x is None:
+            ys = self._experiments(self.y, None)
+            x = np.empty((len(ys), 0))
+        else:
+            x = as_matrix(self.x, "x_obs", no_columns=True)
+            ys = self._experiments(self.y, x.shape[0])
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "experiments", ys)
         object.__setattr__(self, "grids", self._grids(self.index, ys))
@@ -597,7 +619,9 @@ class ObsData:
         return _arrays_digest(parts, f"grids:{[g is None for g in self.grids]}")
 
     @staticmethod
-    def _experiments(y, n: int) -> list[np.ndarray]:
+    def _experiments(y, n: int | None) -> list[np.ndarray]:
+        """y as one 1-D array per experiment; ``n``: the experiments x_obs gives (None: no x,
+        a 1-D y is one experiment)."""
         if isinstance(y, (list, tuple)) and any(np.ndim(e) == 1 and np.size(e) > 1 for e in y):
             ys = [as_float(e, f"y_obs[{j}]").reshape(-1) for j, e in enumerate(y)]
         else:
@@ -609,7 +633,7 @@ class ObsData:
                     f"y_obs must be (n, l_obs) or a list of 1-D arrays, got {arr.shape}"
                 )
             ys = list(arr)
-        if len(ys) != n:
+        if n is not None and len(ys) != n:
             raise GPMSAError(f"y_obs must have one row per x_obs row ({n}), got {len(ys)}")
         for j, e in enumerate(ys):
             if e.size == 0:

@@ -57,8 +57,14 @@ def prediction_bands(
         raise GPMSAError(f"pred must be a FullPrediction, got {type(pred).__name__}")
     level = check_level(level)
     max_panels = check_count(max_panels, "max_panels")
-    x_column = check_count(x_column, "x_column", 0, pred.x.shape[1] - 1)
     N, l = pred.x.shape[0], pred.grid.size
+    if pred.x.shape[1] == 0 and l == 1:
+        raise GPMSAError(
+            "prediction_bands draws a scalar output against a known input, and this prediction "
+            "has none (p = 0, no known inputs): read its bands with pred.interval(...) instead"
+        )
+    if pred.x.shape[1]:  # a functional output without known inputs draws no x axis
+        x_column = check_count(x_column, "x_column", 0, pred.x.shape[1] - 1)
     if observed is not None:
         observed = as_float(observed, "observed")
         if observed.ndim == 1 and l == 1:

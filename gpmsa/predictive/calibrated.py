@@ -87,7 +87,7 @@ class CalibratedPrediction:
 def calibrated_predict(
     emulator,
     posterior: Posterior,
-    x_new,
+    x_new=None,
     *,
     noise: bool = False,
     resid: bool = True,
@@ -104,7 +104,8 @@ def calibrated_predict(
     Args:
         emulator: the gpmsa.Emulator the posterior was computed with.
         posterior: a Posterior from ``calibrate`` or ``Calibrator.update``.
-        x_new: (N, p) known inputs, native units.
+        x_new: (N, p) known inputs, native units; None (one point) for an emulator without
+            known inputs (p = 0).
         noise: add the observation error 1/lamOs (standardised units): the predictive of a new
             observation rather than of the simulator output. On a one-parameter grid posterior
             each node adds the exact E[1/lamOs | data, theta]; otherwise each draw its own lamOs.
