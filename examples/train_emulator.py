@@ -64,6 +64,7 @@ from control.feature import feature_of_variance  # noqa: E402
 from control.plotting import plot_design  # noqa: E402
 from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
 from control.training import block_scatter, block_statistics  # noqa: E402
+from gpmsa.fitting.fit import simulation_fit_nbytes  # noqa: E402
 
 V_RANGE = (0.5, 2.0)
 GD_RANGE = (200.0, 600.0)
@@ -280,10 +281,8 @@ def design_title(args) -> str:
 
 def fit_memory(m: int, n_pc: int, n_iter: int) -> float:
     """Bytes `gpmsa.fit` needs (its own estimate, which it refuses beyond the limit) for ``m``
-    runs of v and GD, ``n_pc`` components and ``n_iter`` sweeps: every sweep kept twice (betaU,
-    lamUz, lamWs: 4 elements a component, lamWOs and the log posterior) and (2 + 4 n_pc + 2) m^2
-    floats of the likelihood's covariances."""
-    return 8.0 * (2.0 * n_iter * (4 * n_pc + 2) + m * m * (4 * n_pc + 4))
+    runs of v and GD, ``n_pc`` components and ``n_iter`` sweeps."""
+    return simulation_fit_nbytes(m, p=1, q=1, p_u=n_pc, n_iter=n_iter)
 
 
 def check_fit_memory(parser: argparse.ArgumentParser, args) -> None:

@@ -36,14 +36,33 @@ def _seed(seed) -> int:
     return seed
 
 
+def _factor_nbytes(m: int, p: int, q: int, p_u: int) -> float:
+    """Bytes of the likelihood's covariances and factors: (p + q + 4 p_u + 2) m^2 floats."""
+    return 8.0 * m * m * (p + q + 4 * p_u + 2)
+
+
 def _check_fit_memory(problem, n_iter: int, n_chains: int) -> None:
     """Refuse (before sampling) a fit whose draws or factorisations exceed the memory limit:
     every sweep of every chain is stored (n_chains x n_iter x parameter elements, kept twice
     while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats."""
-    m, d, p_u = problem.m, problem.p + problem.q, problem.p_u
-    nbytes = draws_nbytes(problem, n_iter, n_chains) + 8.0 * m * m * (d + 4 * p_u + 2)
+    m = problem.m
+    nbytes = draws_nbytes(problem, n_iter, n_chains) + _factor_nbytes(
+        m, problem.p, problem.q, problem.p_u
+    )
     check_memory(nbytes, f"fit(n_iter={n_iter}, n_chains={n_chains}) of {m} runs x "
                  f"{parameter_elements(problem)} parameter elements")  # fmt: skip
+
+
+def simulation_fit_nbytes(
+    m: int, p: int, q: int, p_u: int, n_iter: int, n_chains: int = 1
+) -> float:
+    """Bytes that `fit` checks against ``gpmsa.limits.MAX_MEMORY_BYTES`` for a simulation-only
+    fit (no observations, default parameters) of ``m`` runs, ``p`` known inputs, ``q``
+    parameters and ``p_u`` components: the same figure as for the prepared problem, for a
+    caller that plans a design before its runs exist. The stored sweeps hold betaU
+    ((p + q) x p_u), lamUz and lamWs (p_u each), lamWOs and the log posterior."""
+    elements = (p + q + 2) * p_u + 1
+    return 16.0 * n_chains * n_iter * (elements + 1) + _factor_nbytes(m, p, q, p_u)
 
 
 def fit(

@@ -176,3 +176,27 @@ def test_study_save_names_the_rule_for_its_file_name(study, tmp_path):
     longest = tmp_path / ("x" * 144 + ".gpmsa")  # model0: x*144.model0.gpmsa, 157 characters
     study.save(longest)
     assert gpmsa.load_study(longest).labels == study.labels
+
+
+class _Checked(Exception):
+    """Carries the bytes that fit's memory check was asked about."""
+
+
+@pytest.mark.parametrize(("p", "q", "n_pc"), [(1, 1, 1), (1, 1, 3), (2, 2, 2), (0, 1, 2)])
+def test_a_planned_simulation_fit_needs_the_bytes_fit_checks(monkeypatch, p, q, n_pc):
+    """simulation_fit_nbytes, which a caller uses before its runs exist (train_emulator.py's
+    preflight), gives the figure fit checks for the prepared problem."""
+    from gpmsa.fitting import fit as fit_module
+
+    def record(nbytes, what):
+        raise _Checked(nbytes)
+
+    rng = np.random.default_rng(3)
+    m = 12
+    x, t = rng.uniform(size=(m, p)), rng.uniform(size=(m, q))
+    y = np.sin(np.arange(1, 5) * (t.sum(axis=1, keepdims=True) + x.sum(axis=1, keepdims=True)))
+    monkeypatch.setattr(fit_module, "check_memory", record)
+    with pytest.raises(_Checked) as checked:
+        gpmsa.fit(gpmsa.SimData(x=x, t=t, y=y), n_iter=700, n_chains=2, n_pc=n_pc, seed=0)
+    planned = fit_module.simulation_fit_nbytes(m, p, q, n_pc, n_iter=700, n_chains=2)
+    assert checked.value.args[0] == planned
