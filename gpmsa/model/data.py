@@ -397,8 +397,10 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
                              "overflows float64; rescale it (e.g. other units)")  # fmt: skip
         if span[j] <= 1e-12 * float(np.abs(col).max()):  # relative: small units are fine
             if span[j] == 0:
+                dummy = (" (a dummy x, as SEPIA's 0.5 for a simulator without known inputs: "
+                         "leave x out, SimData(t=..., y=...))") if name == "x" else ""  # fmt: skip
                 raise GPMSAError(
-                    f"design column {label} is constant ({col[0]}); every input must vary"
+                    f"design column {label} is constant ({col[0]}); every input must vary{dummy}"
                 )
             raise GPMSAError(
                 f"design column {label} varies by only {span[j]:.3g} around {col.mean():.6g} "

@@ -62,6 +62,20 @@ def test_simdata_still_needs_t_and_y():
         gpmsa.SimData(t=t, y=np.sin(3 * t), x_names=["a"])
 
 
+def test_a_dummy_x_column_is_refused_with_the_way_to_leave_it_out():
+    """SEPIA's users fill in x = 0.5 for a simulator without known inputs; here a constant
+    column is refused, and the message says to leave x out."""
+    t = np.linspace(0.0, 1.0, 12)[:, None]
+    with pytest.raises(gpmsa.GPMSAError) as err:
+        gpmsa.SimData(x=np.full((12, 1), 0.5), t=t, y=np.sin(3 * t))
+    assert str(err.value) == (
+        "design column x[:, 0] is constant (0.5); every input must vary (a dummy x, as SEPIA's 0.5 "
+        "for a simulator without known inputs: leave x out, SimData(t=..., y=...))"
+    )
+    with pytest.raises(gpmsa.GPMSAError, match=r"constant \(0.5\); every input must vary$"):
+        gpmsa.SimData(x=t, t=np.full((12, 1), 0.5), y=np.sin(3 * t))
+
+
 def test_obsdata_without_x_rows_are_replicates():
     obs = gpmsa.ObsData(y=np.vstack([y_star(), y_star(0.01)]))
     assert obs.n == 2 and obs.x.shape == (2, 0)
