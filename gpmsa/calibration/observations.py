@@ -153,7 +153,11 @@ def obs_inputs(emulator, x_obs, y_obs, what: str = "x_obs"):
     as SEPIA's dummy x; a scalar output reads every value of ``y_obs`` as one observation).
     GPMSAError when ``y_obs`` is None, or ``x_obs`` is None and the emulator has known inputs."""
     if y_obs is None:
-        raise GPMSAError("y_obs is required: the observed outputs (n, l_sim), native units")
+        hint = ""
+        if x_obs is not None and emulator.x_unit.shape[1] == 0:
+            hint = ("; this emulator has no known inputs, so give the outputs by name, "
+                    "y_obs=... (the first positional argument is x_obs)")  # fmt: skip
+        raise GPMSAError(f"y_obs is required: the observed outputs (n, l_sim), native units{hint}")
     if x_obs is not None:
         return x_obs
     p = emulator.x_unit.shape[1]

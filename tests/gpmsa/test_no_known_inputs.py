@@ -118,8 +118,10 @@ def test_x_obs_none_equals_empty_columns(functional_emu):
 
 
 def test_calibration_refusals(functional_emu, scalar_emu):
-    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs is required"):
+    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs is required: .*give the outputs by name"):
         gpmsa.Calibrator(functional_emu).update(y_star())  # positional: that is x_obs
+    with pytest.raises(gpmsa.GPMSAError, match=r"y_obs is required: .*native units$"):
+        gpmsa.Calibrator(functional_emu).update()
     with pytest.raises(gpmsa.GPMSAError, match=r"x_obs must have shape \(n, 0\)"):
         gpmsa.calibrate(scalar_emu, [[0.5]], [[0.9]], n_samples=10, n_burn=0)
     rng = np.random.default_rng(2)
