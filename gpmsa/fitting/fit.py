@@ -15,7 +15,7 @@ from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
-from gpmsa.mcmc.sampler import draws_nbytes, parameter_elements
+from gpmsa.mcmc.sampler import draws_nbytes, parameter_elements, sweeps_nbytes
 from gpmsa.model import constraints
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
 from gpmsa.model.priors import Priors
@@ -60,9 +60,9 @@ def simulation_fit_nbytes(
     fit (no observations, default parameters) of ``m`` runs, ``p`` known inputs, ``q``
     parameters and ``p_u`` components: the same figure as for the prepared problem, for a
     caller that plans a design before its runs exist. The stored sweeps hold betaU
-    ((p + q) x p_u), lamUz and lamWs (p_u each), lamWOs and the log posterior."""
+    ((p + q) x p_u), lamUz and lamWs (p_u each) and lamWOs."""
     elements = (p + q + 2) * p_u + 1
-    return 16.0 * n_chains * n_iter * (elements + 1) + _factor_nbytes(m, p, q, p_u)
+    return sweeps_nbytes(elements, n_iter, n_chains) + _factor_nbytes(m, p, q, p_u)
 
 
 def fit(

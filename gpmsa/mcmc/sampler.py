@@ -282,10 +282,15 @@ def parameter_elements(problem: Problem) -> int:
     return sum(int(np.size(v)) for v in problem.init.values())
 
 
+def sweeps_nbytes(elements: int, n_iter: int, n_chains: int) -> float:
+    """Bytes of the stored sweeps of every chain, each holding ``elements`` parameter elements
+    and the log posterior, kept twice while the chains are stacked."""
+    return 16.0 * n_chains * n_iter * (elements + 1)
+
+
 def draws_nbytes(problem: Problem, n_iter: int, n_chains: int) -> float:
-    """Bytes of the stored sweeps of every chain (the parameter elements and the log
-    posterior), kept twice while the chains are stacked."""
-    return 16.0 * n_chains * n_iter * (parameter_elements(problem) + 1)
+    """`sweeps_nbytes` of ``problem``'s parameter elements."""
+    return sweeps_nbytes(parameter_elements(problem), n_iter, n_chains)
 
 
 def check_draws_memory(problem: Problem, n_iter: int, n_chains: int) -> None:
