@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import control
@@ -58,6 +59,10 @@ CASES = [
     ),
     ("benchmarks/feature_information.py", ["--gd-band", "500", "300"], "--gd-band must lie in"),
     ("benchmarks/hierarchical_coverage.py", ["--sets", "0"], "--sets must be >= 1, got 0"),
+    ("benchmarks/oracle_bounds.py", ["--seeds", "3-1"], "--seeds: '3-1' must name seeds >= 0"),
+    ("benchmarks/oracle_bounds.py", ["--seeds", "1-x"], "--seeds: '1-x' is not a seed or a"),
+    ("benchmarks/oracle_bounds.py", ["--cases", "C"], "--cases must be among"),
+    ("benchmarks/oracle_bounds.py", ["--workers", "0"], "--workers must be >= 1, got 0"),
     ("benchmarks/replay_speed.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
     ("benchmarks/reproducibility.py", ["--runs", "199"], "--runs must be in [1, 198]"),
     ("benchmarks/roadgen_speed.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
@@ -199,6 +204,7 @@ def test_bad_argument_is_a_usage_error_naming_it(tmp_path, script, argv, message
 def _load_benchmark(name: str):
     spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module  # (a dataclass looks its module up there)
     spec.loader.exec_module(module)
     return module
 
@@ -270,3 +276,19 @@ def test_accuracy_benchmark_refuses_emulators_it_cannot_drive(tmp_path) -> None:
             ["--sets", "random", "--cases", "A", "--emulator-dir", str(folder)]
         )
         assert "--emulator-dir: " in error and message in error
+
+
+def test_oracle_replay_is_the_loops_estimator_and_the_oracles_know_more() -> None:
+    """The oracle benchmark's replay without an oracle follows the loop's own estimates (it
+    lacks only the sensor guards, which a clean simulated drive rarely calls); knowing the
+    change points lowers the error of both parts."""
+    bench = _load_benchmark("oracle_bounds")
+    out = bench._run(("A", 1))
+    loop, replayed = (
+        [control.pooled_rmse([out[name]], gd) for gd in (300.0, 500.0)]
+        for name in ("loop", "filters")
+    )  # fmt: skip
+    assert np.allclose(replayed, loop, atol=1.0)
+    for name in ("reset", "no change"):
+        oracle = [control.pooled_rmse([out[name]], gd) for gd in (300.0, 500.0)]
+        assert oracle[0] < loop[0] - 5 and oracle[1] < loop[1] - 5, (name, oracle, loop)
