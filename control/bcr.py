@@ -41,7 +41,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from control.changepoint import ChangePointFilter, ChangePointSettings, mixture_posterior
+from control.changepoint import ChangePointFilter, ChangePointSettings, _mixture_posterior
 from control.errors import ControlError
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, feature_of_variance, features_of_blocks
@@ -423,14 +423,12 @@ class BCR:
         (`stream_fault`) restarts the contiguous buffer, and its reason, for these samples
         alone, waits for the update's estimate."""
         drop, restart, reason = stream_fault(t, pos, acc, spd, self._t_prev, self.settings.rate_hz)
-        stamped = np.flatnonzero(np.isfinite(t))
-        if stamped.size:  # steps run from the previous stamp, kept or dropped, in any chunking
-            self._t_prev = float(t[stamped[-1]])
-        good = np.isfinite(t) & np.isfinite(pos) & ~drop
-        if good.any():
-            k = int(np.flatnonzero(good)[-1])
-            self._t_last, self._pos_last = float(t[k]), float(pos[k])
         broken = np.flatnonzero(drop | restart)
+        if broken.size == 0 and t.size:  # (the usual case) all finite and kept: the last is newest
+            self._t_prev = self._t_last = float(t[-1])
+            self._pos_last = float(pos[-1])
+        else:
+            self._take_stamps(t, pos, drop)
         if broken.size:  # every cause until a block reports them, whatever the chunking
             if reason not in self._fault:
                 self._fault = f"{self._fault} and {reason}" if self._fault else reason
@@ -444,6 +442,17 @@ class BCR:
         self._t = np.concatenate([self._t, t])[-self.buffer :]
         self._pos = np.concatenate([self._pos, pos])[-self.buffer :]
         self._fresh = min(self._fresh + acc.size, self.buffer)
+
+    def _take_stamps(self, t, pos, drop) -> None:
+        """Remember the newest time stamp, kept or dropped, and the newest kept sample's time
+        and position, of samples some of which `stream_fault` drops or restarts on."""
+        stamped = np.flatnonzero(np.isfinite(t))
+        if stamped.size:  # steps run from the previous stamp, kept or dropped, in any chunking
+            self._t_prev = float(t[stamped[-1]])
+        good = np.isfinite(t) & np.isfinite(pos) & ~drop
+        if good.any():
+            k = int(np.flatnonzero(good)[-1])
+            self._t_last, self._pos_last = float(t[k]), float(pos[k])
 
     def _now(self) -> tuple[float, float]:
         """(time, position) now: the newest sample's, or the caller's clock when it is later."""
@@ -575,7 +584,7 @@ class BCR:
         why = ""
         if not within(v, lo, hi):
             why = f"speed {v:.3g} m/s outside the emulator's [{lo:g}, {hi:g}]"
-        elif np.min(spd) < MAX_SPEED_CHANGE * np.max(spd):
+        elif spd.min() < MAX_SPEED_CHANGE * spd.max():
             why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"
         if why:  # the emulator knows constant speeds in its range only
             timing = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
@@ -676,7 +685,7 @@ class BCR:
             return filters[0].posterior(self.gd_name), filters[0].prob_change_within(recent)
         change = np.array([f.prob_change_within(recent) for f in filters])
         return (
-            mixture_posterior(filters, weights, self.gd_name),
+            _mixture_posterior(filters, weights, self.gd_name),
             float(weights @ change / weights.sum()),
         )
 

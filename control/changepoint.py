@@ -149,7 +149,9 @@ class ChangePointFilter:
             return self._mass, self._dist
         h = self._hazard(ds_m)
         ended = (h[:, None] * self._mass).sum(axis=0)
-        mass = np.vstack([(ended @ self._jump)[None, :], self._mass * (1.0 - h)[:, None]])
+        mass = np.empty((self._mass.shape[0] + 1, self.gd.size))
+        mass[0] = ended @ self._jump  # the new run: the mass that ended, redrawn
+        np.multiply(self._mass, (1.0 - h)[:, None], out=mass[1:])
         dist = np.concatenate([[0.0], self._dist]) + ds_m  # a new run holds the step, as the first
         R = self.settings.max_runs
         if mass.shape[0] > R:
@@ -158,7 +160,8 @@ class ChangePointFilter:
                 dist[R - 1] = float(tail @ dist[R - 1 :] / tail.sum())
             mass[R - 1] += mass[R:].sum(axis=0)
             mass, dist = mass[:R], dist[:R]
-        return mass / mass.sum(), dist
+        mass /= mass.sum()  # (a new array: in place)
+        return mass, dist
 
     def update(self, loglik: np.ndarray, ds_m: float) -> None:
         """One block ds_m metres long with log-likelihood ``loglik`` on the grid (G,). All or
@@ -177,7 +180,8 @@ class ChangePointFilter:
                 "product underflows on every grid node (the block contradicts the prior or the "
                 "estimate so far)"
             )
-        self._mass, self._dist = mass / total, dist
+        mass /= total  # (the product above is a new array: in place)
+        self._mass, self._dist = mass, dist
         self._has_data = True
 
     def state(self) -> tuple:
@@ -248,6 +252,13 @@ def mixture_posterior(
         )
     if any(not np.array_equal(f.gd, filters[0].gd) for f in filters[1:]):
         raise ControlError("mixture_posterior needs filters on one GD grid")
+    return _mixture_posterior(filters, w, name, n_draws)
+
+
+def _mixture_posterior(
+    filters: list[ChangePointFilter], w: np.ndarray, name: str = "GD", n_draws: int = 4000
+) -> Posterior:
+    """`mixture_posterior` of filters and weights (an array) known to fit (the BCR's own)."""
     mass = (w[:, None] * np.array([f.gd_mass for f in filters])).sum(axis=0) / w.sum()
     return _grid_posterior(filters[0].gd, filters[0]._weights, mass, name, n_draws)
 

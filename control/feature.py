@@ -290,13 +290,26 @@ def _quantiles(x: np.ndarray, levels: tuple[float, ...]) -> np.ndarray:
     """(n, L) quantiles of each row of x (n, B) at ``levels``: numpy's default (linear) method,
     to the last bit, from a partition around the order statistics it interpolates (a twentieth
     of np.quantile's time for one block)."""
-    position = np.asarray(levels) * (x.shape[1] - 1)
-    below = np.floor(position).astype(int)
-    above = np.minimum(below + 1, x.shape[1] - 1)
-    ordered = np.partition(x, np.unique(np.concatenate([below, above])), axis=1)
-    low, high, weight = ordered[:, below], ordered[:, above], position - below
+    below, above, kth, weight = _quantile_ranks(x.shape[1], levels)
+    ordered = np.partition(x, kth, axis=1)
+    low, high = ordered[:, below], ordered[:, above]
     step = high - low  # numpy interpolates from the nearer order statistic
     return np.where(weight < 0.5, low + step * weight, high - step * (1 - weight))
+
+
+@lru_cache(maxsize=8)
+def _quantile_ranks(
+    n: int, levels: tuple[float, ...]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(order statistic below, above, both sorted and unique, the weight of the upper one) of
+    each level's quantile of n values (`_quantiles`; read-only: every call shares them)."""
+    position = np.asarray(levels) * (n - 1)
+    below = np.floor(position).astype(int)
+    above = np.minimum(below + 1, n - 1)
+    out = below, above, np.unique(np.concatenate([below, above])), position - below
+    for arr in out:
+        arr.flags.writeable = False
+    return out
 
 
 def window_feature(accel: np.ndarray, feature: str = "log_var") -> float:

@@ -177,9 +177,9 @@ def longest_repeat(a: np.ndarray) -> int:
     """Length of the longest run of identical consecutive values of ``a``."""
     if a.size == 0:
         return 0
-    change = np.flatnonzero(np.diff(a) != 0)
+    change = np.flatnonzero((a[1:] - a[:-1]) != 0)  # np.diff(a) != 0, without its wrapper
     edges = np.concatenate([[-1], change, [a.size - 1]])
-    return int(np.max(np.diff(edges)))
+    return int((edges[1:] - edges[:-1]).max())
 
 
 def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True) -> str:
@@ -190,35 +190,40 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
     a = np.asarray(accel, dtype=float)
     if a.size < 2:
         return ""
-    peak = float(np.max(np.abs(a)))
+    peak = float(np.abs(a).max())
     if peak > MAX_ACCEL_MPS2:  # before any check squares them (and overflows)
         return f"out of range: |a| reaches {peak:.3g} m/s^2, beyond any accelerometer's range"
     run = longest_repeat(a)
     if run > limits.max_repeats:
         return f"stuck sensor: {run} identical consecutive samples (allowed {limits.max_repeats})"
-    distinct = np.unique(a).size
+    ordered = np.sort(a)  # one sort for the distinct values, the near-equal groups, the lattice
+    gaps = ordered[1:] - ordered[:-1]
+    positive = gaps[gaps > 0]
+    distinct = _distinct_count(ordered, positive)
     need = min(limits.min_distinct, a.size // 2)
     if distinct < need:
         return f"quantised or clipped signal: {distinct} distinct values in {a.size} samples"
     if limits.range_mps2 is not None and np.any(np.abs(a) >= limits.range_mps2):
         return f"clipped signal: |a| reaches the sensor's range {limits.range_mps2:g} m/s^2"
-    values, counts = _near_equal_groups(a)
-    top = np.argsort(counts, kind="stable")[::-1][:2]
-    if top.size == 2 and counts[top[1]] > limits.max_same:  # free flight piles up at one value
+    values, counts = _near_equal_groups(ordered, gaps, peak)
+    if np.count_nonzero(counts > limits.max_same) >= 2:  # free flight piles up at one value
+        top = np.argsort(counts, kind="stable")[::-1][:2]
         lo, hi = sorted(top, key=lambda i: values[i])
         return (
             f"clipped signal: {counts[lo]} samples at {values[lo]:.4g} m/s^2 and {counts[hi]} at "
             f"{values[hi]:.4g} m/s^2 (allowed {limits.max_same} at two values)"
         )
     flight = flight_reading(limits)
-    start = dead_stretch(a, limits.dead_fraction, flight)
+    s1, s2, sd = _centred_sums(a)  # shared by the dead, noise-floor and level checks
+    start = _dead_stretch(a, limits.dead_fraction, flight, sd)
     if start >= 0:
         return (
             f"dead sensor: samples {start}-{start + DEAD_STRETCH - 1} span less than "
             f"{limits.dead_fraction:g} of the block's standard deviation"
         )
     if limits.lattice_p > 0:
-        p, start, stretch, step = most_lattice_like(a, flight)
+        resolution = float(positive.min()) if positive.size else None  # (`_resolution`)
+        p, start, stretch, step = _most_lattice_like(a, flight, resolution)
         if p < limits.lattice_p:
             return (
                 f"quantised signal: samples {start}-{start + stretch - 1} sit on a lattice of "
@@ -228,20 +233,27 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
     if limits.noise_sd_mps2 is not None:
         noise_var = limits.noise_sd_mps2**2
         for stretch, fraction in noise_floors(limits.noise_floor):
-            variance, start = quietest_stretch(a, stretch)
+            variance, start = _quietest_stretch(s1, s2, stretch)
             if variance < fraction * noise_var:
                 return (
                     f"attenuated signal: samples {start}-{start + stretch - 1} vary less than "
                     f"the sensor's own noise (variance {variance:.3g} (m/s^2)^2, below "
                     f"{fraction:.3g} of the noise variance {noise_var:g})"
                 )
-    ratio, (start, stop) = level_jump(a) if steady else (1.0, (0, 0))
+    ratio, (start, stop) = _level_jump(s1, s2, MIN_SEGMENT) if steady else (1.0, (0, 0))
     if ratio > limits.max_level_jump:
         return (
             f"signal level jumps within the block: the variance of samples {start}-{stop - 1} "
             f"differs from the rest's by a factor {ratio:.3g} (allowed {limits.max_level_jump:g})"
         )
     return ""
+
+
+def _distinct_count(ordered: np.ndarray, positive_gaps: np.ndarray) -> int:
+    """``np.unique(ordered).size`` of sorted values, from their positive gaps: NaNs (sorted
+    last) count as one value, as np.unique counts them."""
+    nan_group = bool(np.isnan(ordered[-1]) and not np.isnan(ordered[0]))
+    return 1 + positive_gaps.size + nan_group
 
 
 def flight_reading(limits: SensorLimits) -> float | None:
@@ -255,17 +267,25 @@ def dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None) -> int
     """Start of the first stretch of ``DEAD_STRETCH`` samples of ``a`` whose range is below
     ``fraction`` times the standard deviation of ``a``, its mean not within 5% of ``free_fall``;
     -1 if none (or ``a`` is shorter than a stretch)."""
+    return _dead_stretch(a, fraction, free_fall, float(np.std(a)))
+
+
+def _dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None, sd: float) -> int:
+    """`dead_stretch` with the standard deviation ``sd`` of ``a`` known."""
     n = a.size - DEAD_STRETCH + 1
     if n < 1:
         return -1
-    hi, lo, total = a[:n].copy(), a[:n].copy(), a[:n].copy()
-    for j in range(1, DEAD_STRETCH):  # running max, min and sum over the stretch
-        part = a[j : j + n]
-        np.maximum(hi, part, out=hi)
-        np.minimum(lo, part, out=lo)
-        total += part
-    dead = hi - lo < fraction * np.std(a)
+    hi, lo = a[:n].copy(), a[:n].copy()
+    for j in range(1, DEAD_STRETCH):  # running max and min over the stretch
+        np.maximum(hi, a[j : j + n], out=hi)
+        np.minimum(lo, a[j : j + n], out=lo)
+    dead = hi - lo < fraction * sd
+    if not dead.any():  # the usual case: no flight exemption to work out
+        return -1
     if free_fall is not None:
+        total = a[:n].copy()
+        for j in range(1, DEAD_STRETCH):  # running sum over the stretch
+            total += a[j : j + n]
         dead &= ~_in_flight(total / DEAD_STRETCH, free_fall)
     hit = np.flatnonzero(dead)
     return int(hit[0]) if hit.size else -1
@@ -282,7 +302,14 @@ def most_lattice_like(
     """What the lattice check compares with ``SensorLimits.lattice_p``: (the smallest
     `lattice_stretch` probability over ``LATTICE_STRETCHES`` times their number (Bonferroni),
     that stretch's start, its length, its step in m/s^2)."""
-    found = [(*lattice_stretch(a, n, free_fall), n) for n in LATTICE_STRETCHES]
+    return _most_lattice_like(a, free_fall, _resolution(a))
+
+
+def _most_lattice_like(
+    a: np.ndarray, free_fall: float | None, resolution: float | None
+) -> tuple[float, int, int, float]:
+    """`most_lattice_like` with the block's `_resolution` known."""
+    found = [(*_lattice_stretch(a, n, free_fall, resolution), n) for n in LATTICE_STRETCHES]
     p, start, step, stretch = min(found, key=lambda f: f[0])
     return p * len(LATTICE_STRETCHES), start, stretch, step
 
@@ -301,26 +328,43 @@ def lattice_stretch(
     of that many hits; a signal rounded to a coarse step puts every value there. Values within
     5% of ``free_fall`` (a wheel in the air reads it) neither count nor make a step.
     """
+    return _lattice_stretch(a, stretch, free_fall, _resolution(a))
+
+
+def _resolution(a: np.ndarray) -> float | None:
+    """The smallest gap between distinct values of ``a`` (None for fewer than two)."""
     gaps = np.diff(np.sort(a))
     gaps = gaps[gaps > 0]
-    if gaps.size == 0 or a.size < stretch:
+    return float(gaps.min()) if gaps.size else None
+
+
+def _lattice_stretch(
+    a: np.ndarray, stretch: int, free_fall: float | None, resolution: float | None
+) -> tuple[float, int, float]:
+    """`lattice_stretch` with the block's `_resolution` known."""
+    if resolution is None or a.size < stretch:
         return 1.0, -1, float("nan")
-    resolution = float(gaps.min())
-    w = a[_window_index(a.size, stretch)]  # (stretch, stretches)
-    ordered = np.sort(w, axis=0)
-    step = np.diff(ordered, axis=0)  # (stretch - 1 steps, stretches): neighbours in value
+    ordered = np.sort(a[_window_index(a.size, stretch)], axis=0)  # (stretch, stretches)
     low = ordered[:-1]
+    step = ordered[1:] - low  # (stretch - 1 steps, stretches): neighbours in value
     usable = step > resolution
-    flight = np.zeros(w.shape, dtype=bool)
     if free_fall is not None:
-        flight = _in_flight(w, free_fall)
         flying = _in_flight(ordered, free_fall)
         usable &= ~(flying[:-1] | flying[1:])
     if not usable.any():
         return 1.0, -1, float("nan")
     g = np.where(usable, step, 1.0)
-    x = (w[None] - low[:, None]) / g[:, None]  # (steps, stretch, stretches)
-    on = (np.abs(x - np.rint(x)) * g[:, None] <= 0.5 * resolution) & ~flight[None]
+    # |x - rint(x)| g <= r / 2 with x = (value - low) / g for each of the stretch's values (in
+    # value order: the hits count them), in one buffer (in place): this (steps, stretch,
+    # stretches) array is the check's main cost
+    x = np.subtract(ordered[None], low[:, None])
+    x /= g[:, None]
+    x -= np.rint(x)
+    np.abs(x, out=x)
+    x *= g[:, None]
+    on = x <= 0.5 * resolution
+    if free_fall is not None:
+        on &= ~flying[None]
     hits = on.sum(axis=1) - 2  # the two values that make the step are on it
     row, col = np.nonzero(usable & (hits > 0))
     if row.size == 0:
@@ -355,20 +399,29 @@ def quietest_stretch(a: np.ndarray, stretch: int = NOISE_STRETCH) -> tuple[float
     its start); (inf, -1) if ``a`` is shorter than a stretch."""
     if a.size < stretch:
         return float("inf"), -1
-    s1, s2 = _running_sums(a)
+    s1, s2, _ = _centred_sums(a)
+    return _quietest_stretch(s1, s2, stretch)
+
+
+def _quietest_stretch(s1: np.ndarray, s2: np.ndarray, stretch: int) -> tuple[float, int]:
+    """`quietest_stretch` from the block's `_centred_sums`."""
+    if s1.size - 1 < stretch:
+        return float("inf"), -1
     total, squares = s1[stretch:] - s1[:-stretch], s2[stretch:] - s2[:-stretch]
     variance = np.maximum((squares - total**2 / stretch) / (stretch - 1), 0.0)
     i = int(np.argmin(variance))
     return float(variance[i]), i
 
 
-def _near_equal_groups(a: np.ndarray, rel: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """(a value, the count) of each group of values equal within rel * max|a| (free-fall
-    samples read -g up to the solver's residual: two flights of one block can differ by ~1e-8)."""
-    x = np.sort(a)
-    tol = rel * (float(np.max(np.abs(x))) or 1.0)
-    starts = np.concatenate([[0], np.flatnonzero(np.diff(x) > tol) + 1])
-    return x[starts], np.diff(np.concatenate([starts, [x.size]]))
+def _near_equal_groups(
+    ordered: np.ndarray, gaps: np.ndarray, peak: float, rel: float = 1e-6
+) -> tuple[np.ndarray, np.ndarray]:
+    """(a value, the count) of each group of sorted values ``ordered`` (``gaps``: their
+    differences; ``peak``: their largest magnitude) equal within rel * peak (free-fall samples
+    read -g up to the solver's residual: two flights of one block can differ by ~1e-8)."""
+    tol = rel * (peak or 1.0)
+    starts = np.concatenate([[0], np.flatnonzero(gaps > tol) + 1])
+    return ordered[starts], np.diff(np.concatenate([starts, [ordered.size]]))
 
 
 def level_jump(a: np.ndarray, min_segment: int = MIN_SEGMENT) -> tuple[float, tuple[int, int]]:
@@ -377,35 +430,57 @@ def level_jump(a: np.ndarray, min_segment: int = MIN_SEGMENT) -> tuple[float, tu
     outside; each part's variance about its own mean, so that a part held near any constant (a
     gain that dropped) counts as no variance. (1, (0, 0)) for blocks shorter than
     2 * min_segment."""
-    n = a.size
+    if a.size < 2 * min_segment:
+        return 1.0, (0, 0)
+    s1, s2, _ = _centred_sums(a)
+    return _level_jump(s1, s2, min_segment)
+
+
+def _level_jump(s1: np.ndarray, s2: np.ndarray, min_segment: int) -> tuple[float, tuple[int, int]]:
+    """`level_jump` from the block's `_centred_sums`."""
+    n = s1.size - 1
     if n < 2 * min_segment:
         return 1.0, (0, 0)
-    s1, s2 = _running_sums(a)
     best = (1.0, (0, 0))
     per_chunk = _starts_per_chunk(n)
     for first in range(0, n + 1, per_chunk):
-        start, stop = _segments(n, min_segment, first, per_chunk)
+        start, stop, (n_in, n_in_1, n_out, n_out_1) = _segments(n, min_segment, first, per_chunk)
         if start.size == 0:
             continue
-        n_in = stop - start
-        n_out = n - n_in
+        # (sq - sum**2 / count) / (count - 1) of each part, in place: the same operations,
+        # fewer temporaries
         sum_in, sq_in = s1[stop] - s1[start], s2[stop] - s2[start]
-        var_in = np.maximum((sq_in - sum_in**2 / n_in) / (n_in - 1), 0.0)
-        var_out = np.maximum(((s2[-1] - sq_in) - (s1[-1] - sum_in) ** 2 / n_out) / (n_out - 1), 0.0)
+        var_in = sum_in * sum_in
+        var_in /= n_in
+        np.subtract(sq_in, var_in, out=var_in)
+        var_in /= n_in_1
+        np.maximum(var_in, 0.0, out=var_in)
+        var_out = s1[-1] - sum_in
+        var_out *= var_out
+        var_out /= n_out
+        np.subtract(s2[-1] - sq_in, var_out, out=var_out)
+        var_out /= n_out_1
+        np.maximum(var_out, 0.0, out=var_out)
         with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.maximum(var_in / var_out, var_out / var_in)
-        ratio = np.where(np.isnan(ratio), 1.0, ratio)
+            ratio = var_in / var_out
+            np.maximum(ratio, var_out / var_in, out=ratio)
+        np.fmax(ratio, 1.0, out=ratio)  # NaN (0 / 0: both parts constant) as 1; the rest >= 1
         i = int(np.argmax(ratio))
         if ratio[i] > best[0]:
             best = (float(ratio[i]), (int(start[i]), int(stop[i])))
     return best
 
 
-def _running_sums(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _centred_sums(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Cumulative sums (with a leading 0) of ``a - mean(a)`` and of its square: the sum of
-    samples i..j-1 is s[j] - s[i] (centred first: fewer cancellation digits)."""
+    samples i..j-1 is s[j] - s[i] (centred first: fewer cancellation digits); and the standard
+    deviation of ``a`` from the same squares (np.std's operations, to the last bit)."""
     x = a - a.mean()
-    return np.concatenate([[0.0], np.cumsum(x)]), np.concatenate([[0.0], np.cumsum(x * x)])
+    squares = x * x
+    s1, s2 = np.zeros(a.size + 1), np.zeros(a.size + 1)
+    np.cumsum(x, out=s1[1:])
+    np.cumsum(squares, out=s2[1:])
+    return s1, s2, float(np.sqrt(squares.sum() / a.size))
 
 
 SEGMENT_PAIRS_PER_CHUNK = 1 << 16
@@ -418,14 +493,22 @@ def _starts_per_chunk(n: int) -> int:
 
 
 @functools.lru_cache(maxsize=8)
-def _segments(n: int, min_segment: int, first: int, count: int) -> tuple[np.ndarray, np.ndarray]:
-    """(start, stop) of every segment of n samples with >= min_segment samples in and out whose
-    start lies in [first, first + count)."""
+def _segments(
+    n: int, min_segment: int, first: int, count: int
+) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, ...]]:
+    """(start, stop, counts) of every segment of n samples with >= min_segment samples in and
+    out whose start lies in [first, first + count); counts: (samples inside, the same - 1,
+    samples outside, the same - 1) as floats. Read-only: every call shares them."""
     start, stop = np.meshgrid(
         np.arange(first, min(first + count, n + 1)), np.arange(n + 1), indexing="ij"
     )
     keep = (stop - start >= min_segment) & (n - (stop - start) >= min_segment)
-    return start[keep], stop[keep]
+    start, stop = start[keep], stop[keep]
+    n_in = (stop - start).astype(float)
+    counts = n_in, n_in - 1, n - n_in, n - n_in - 1
+    for arr in (start, stop, *counts):
+        arr.flags.writeable = False
+    return start, stop, counts
 
 
 def stream_fault(
@@ -508,5 +591,7 @@ def _previous_finite(t: np.ndarray, t_prev: float) -> np.ndarray:
     """Per sample, the newest finite time stamp before it (``t_prev`` before the first; NaN
     if there is none)."""
     before = np.concatenate([[t_prev], t[:-1]])
+    if np.isfinite(before[1:]).all():  # (the usual case) each sample's previous stamp
+        return before
     index = np.where(np.isfinite(before), np.arange(before.size), 0)
     return before[np.maximum.accumulate(index)]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -80,13 +81,17 @@ class GridMarginal:
     def ppf(self, q: np.ndarray | float) -> np.ndarray:
         """Quantile function: the inverse of ``cdf`` (exact for the piecewise-linear density)."""
         q = np.asarray(q, dtype=float)
-        mass = self._cell_mass()
+        width = self.nodes[1:] - self.nodes[:-1]
+        mass = 0.5 * width * (self.density[:-1] + self.density[1:])  # (`_cell_mass`)
         cells = np.flatnonzero(mass > 0.0)  # cells without mass hold no quantile
-        cum = np.concatenate([[0.0], np.cumsum(mass[cells])])
+        cum = np.zeros(cells.size + 1)
+        np.cumsum(mass[cells], out=cum[1:])
         target = q * cum[-1]
-        j = np.clip(np.searchsorted(cum, target, side="left") - 1, 0, cells.size - 1)
+        # the cell of each target: searchsorted(cum, target) - 1 clipped to [0, cells - 1]
+        # (cum[0] = 0 < cum[1] <= ... <= cum[-1]), without the clip
+        j = np.searchsorted(cum[1:-1], target, side="left")
         k = cells[j]
-        a, h = self.nodes[k], np.diff(self.nodes)[k]
+        a, h = self.nodes[k], width[k]
         f0, f1 = self.density[k], self.density[k + 1]
         r = target - cum[j]  # solve f0 t + (f1 - f0) t^2 / (2h) = r for t in [0, h]
         slope = (f1 - f0) / h
@@ -98,14 +103,29 @@ class GridMarginal:
         """The shortest interval holding probability ``level`` (the highest-density interval of a
         unimodal density; it reaches a grid end where the density piles up there), its lower
         tail probability resolved to (1 - level) / (HDI_STEPS - 1)."""
-        p = np.linspace(0.0, 1.0 - level, HDI_STEPS)
-        lo, hi = np.split(self.ppf(np.concatenate([p, p + level])), 2)
+        tails = _float_hdi_probabilities if isinstance(level, float) else _hdi_probabilities
+        ends = self.ppf(tails(level))
+        lo, hi = ends[:HDI_STEPS], ends[HDI_STEPS:]
         k = int(np.argmin(hi - lo))
         return float(lo[k]), float(hi[k])
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """Independent draws from the piecewise-linear density."""
         return self.ppf(rng.random(size))
+
+
+def _hdi_probabilities(level: float) -> np.ndarray:
+    """The lower tail probabilities `GridMarginal.hdi` tries, then the same plus ``level``."""
+    p = np.linspace(0.0, 1.0 - level, HDI_STEPS)
+    return np.concatenate([p, p + level])
+
+
+@functools.lru_cache(maxsize=16)
+def _float_hdi_probabilities(level: float) -> np.ndarray:
+    """`_hdi_probabilities` of a float level, kept (read-only: every call shares them)."""
+    out = _hdi_probabilities(level)
+    out.flags.writeable = False
+    return out
 
 
 def _percent_key(value: float, tolerance: float) -> str:
