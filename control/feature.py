@@ -22,7 +22,6 @@ from dataclasses import asdict, dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy.signal.windows import dpss
 
 from control.errors import ControlError
 from control.validation import check_instance, float_array, require_integers, require_reals
@@ -217,6 +216,8 @@ class FeatureSpec:
 
 @lru_cache(maxsize=8)
 def _tapers(n: int, nw: float, k: int) -> np.ndarray:
+    from scipy.signal.windows import dpss  # here, not at import (tests/test_import_cost.py)
+
     return np.atleast_2d(dpss(n, nw, k))
 
 

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-from matplotlib.figure import Figure
 
 from roadgen.errors import RoadgenError
 from roadgen.iso8608 import N0, gd_spectrum
 from roadgen.psd import FIT_BAND, estimate_gd, profile_psd
 from roadgen.road import Road, check_road
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 def plot_profile_psd(
@@ -40,6 +44,8 @@ def plot_profile_psd(
             "on log axes"
         )
     recovered = estimate_gd(road, band=_fit_band(road.dx_m) if band is None else band)
+    from matplotlib.figure import Figure  # here, not at import (tests/test_import_cost.py)
+
     fig = Figure(figsize=(7.0, 6.5), layout="constrained")
     ax_z, ax_p = fig.subplots(2, 1)
     ax_z.plot(road.x, 1e3 * road.z, lw=0.6)

@@ -6,7 +6,6 @@ from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
-import scipy.signal
 
 from roadgen import checks
 from roadgen.errors import RoadgenError
@@ -84,6 +83,8 @@ def _psd(
     z: np.ndarray, dx: float, method: str, nperseg: int, end_match: bool
 ) -> tuple[np.ndarray, np.ndarray]:
     """``profile_psd`` of checked heights z (N,) m on a step dx m (n = 0 dropped)."""
+    import scipy.signal  # here, not at import (tests/test_import_cost.py)
+
     with np.errstate(over="ignore", invalid="ignore"):  # overflow: _finite_psd names it
         if method == "periodogram":
             detrend = _end_match if end_match else "constant"

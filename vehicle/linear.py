@@ -16,15 +16,18 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy import signal
 
 from vehicle import checks
 from vehicle.errors import SolverStepWarning, VehicleError
 from vehicle.kinematics import check_speed
 from vehicle.models import HalfCar, Jackal, Model, check_model
 from vehicle.road_input import RoadInput
+
+if TYPE_CHECKING:
+    from scipy import signal
 
 BYTES_PER_POINT = 256
 """Memory per point of ``linear_response``'s fine time grid (n_samples * oversample points):
@@ -131,6 +134,8 @@ def linear_model(model: Model) -> LinearModel:
 
 def state_space(lm: LinearModel) -> signal.StateSpace:
     """State x = [q, q'], input [u1, u2, u1', u2'], output [a_front, a_rear, q (d)]."""
+    from scipy import signal  # here, not at import (tests/test_import_cost.py)
+
     d = lm.mass.shape[0]
     acc_x = np.linalg.solve(lm.mass, np.hstack([-lm.stiffness, -lm.damping]))  # (d, 2d)
     acc_u = np.linalg.solve(lm.mass, np.hstack([lm.tyre_stiffness, lm.tyre_damping]))  # (d, 4)
@@ -203,6 +208,8 @@ def linear_response(
     # at rest on the road: static deflection solves K q0 = Kt u(0)
     q0 = np.linalg.solve(lm.stiffness, lm.tyre_stiffness @ u[0, :2])
     x0 = np.concatenate([q0, np.zeros_like(q0)])
+    from scipy import signal  # (as in `state_space`)
+
     _, y, _ = signal.lsim(state_space(lm), u, t, X0=x0)
     keep = slice(oversample, None, oversample)
     return LinearTrace(t=t[keep], accel_front=y[keep, 0], accel_rear=y[keep, 1], q=y[keep, 2:])

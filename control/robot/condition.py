@@ -33,7 +33,6 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
-from scipy.signal import butter, firwin, kaiserord, resample_poly, sosfiltfilt
 
 from control.errors import BagError, ControlError
 
@@ -185,6 +184,8 @@ def resampling_filter(rate_in: float, rate_out: float, method: str) -> tuple[int
     "sample": cut-off 0.45 rate_in, transition 0.1 rate_in wide, 60 dB (`scipy.signal.kaiserord`);
     "lowpass": resample_poly's own design (cut-off rate_out / 2, 20 max(up, down) + 1 taps,
     Kaiser beta 5)."""
+    from scipy.signal import firwin, kaiserord  # here, not at import (tests/test_import_cost.py)
+
     if method not in METHODS:
         raise ControlError(f"method must be one of {METHODS}, got {method!r}")
     up, down = _ratio(rate_in, rate_out)
@@ -220,6 +221,8 @@ def to_rate(
     Returns:
         (t, a, `Resampling`). Raises `BagError` for an input slower than ``rate_hz``.
     """
+    from scipy import signal  # (as in `resampling_filter`)
+
     t, a = np.asarray(t, dtype=float), np.asarray(a, dtype=float)
     period = nominal_period(t)
     if not np.isfinite(period):
@@ -267,7 +270,7 @@ def to_rate(
         grid = tr[0] + np.arange(m) / grid_rate
         x = np.interp(grid, tr, ar)
         mean = float(np.mean(x))
-        y = resample_poly(x - mean, up, down, window=fir) + mean
+        y = signal.resample_poly(x - mean, up, down, window=fir) + mean
         ty = tr[0] + np.arange(y.size) / rate_hz
         inside = ty <= tr[-1] + 1e-12
         cut = slice(trim, max(int(np.count_nonzero(inside)) - trim, trim))
@@ -305,6 +308,8 @@ def highpass(t: np.ndarray, a: np.ndarray, rate_hz: float, cutoff_hz: float) -> 
     out = a.copy()
     if a.size == 0:
         return out
+    from scipy.signal import butter, sosfiltfilt  # (as in `resampling_filter`)
+
     sos = butter(2, cutoff_hz, btype="highpass", fs=rate_hz, output="sos")
     pad = 3 * (2 * len(sos) + 1)
     good = np.isfinite(a) & np.isfinite(t)
