@@ -116,9 +116,18 @@ class ChangePointFilter:
 
     def reset(self) -> None:
         """Back to the prior: no data, run length 0."""
-        self._mass = self.prior[None, :].copy()  # (R, G) joint P(r, GD)
-        self._dist = np.zeros(1)  # metres each run length spans, the latest step included
+        # (R, G) joint P(r, GD); metres each run length spans, the latest step included
+        self._set(self.prior[None, :].copy(), np.zeros(1))
         self._has_data = False
+
+    def _set(self, mass: np.ndarray, dist: np.ndarray) -> None:
+        """Take the state (mass, dist). Each step makes new arrays and never changes them (they
+        are made read-only), so that `state` can share them and a summary, once computed,
+        holds until the next step."""
+        mass.flags.writeable = dist.flags.writeable = False
+        self._mass, self._dist = mass, dist
+        self._summed = None  # `_gd_mass`
+        self._within: dict[float, float] = {}  # `prob_change_within` per distance
 
     def _hazard(self, ds: float) -> np.ndarray:
         """P(a run of d metres ends within the next ds metres), per run length (R,)."""
@@ -134,7 +143,7 @@ class ChangePointFilter:
 
     def predict(self, ds_m: float) -> None:
         """Propagate over ds_m metres (change points; GD unchanged within a run)."""
-        self._mass, self._dist = self._predicted(ds_m)
+        self._set(*self._predicted(ds_m))
 
     def _predicted(self, ds_m: float) -> tuple[np.ndarray, np.ndarray]:
         """(mass, dist) after ds_m metres, the filter unchanged. Runs beyond ``max_runs`` are
@@ -181,17 +190,19 @@ class ChangePointFilter:
                 "estimate so far)"
             )
         mass /= total  # (the product above is a new array: in place)
-        self._mass, self._dist = mass, dist
+        self._set(mass, dist)
         self._has_data = True
 
     def state(self) -> tuple:
-        """A copy of the filter's state (for `restore`)."""
-        return self._mass.copy(), self._dist.copy(), self._has_data
+        """The filter's state (for `restore`): its arrays are read-only, and later steps make
+        new ones, so the state stays as taken."""
+        return self._mass, self._dist, self._has_data
 
     def restore(self, state: tuple) -> None:
         """Return to a state taken by `state` (e.g. to undo a block found suspect later)."""
         mass, dist, has_data = state
-        self._mass, self._dist, self._has_data = mass.copy(), dist.copy(), has_data
+        self._set(np.array(mass, dtype=float), np.array(dist, dtype=float))
+        self._has_data = has_data
 
     @property
     def has_data(self) -> bool:
@@ -201,7 +212,14 @@ class ChangePointFilter:
     @property
     def gd_mass(self) -> np.ndarray:
         """Posterior mass of GD per grid node (G,)."""
-        return self._mass.sum(axis=0)
+        return self._gd_mass().copy()
+
+    def _gd_mass(self) -> np.ndarray:
+        """`gd_mass`, computed once a step (read-only: it is shared)."""
+        if self._summed is None:
+            self._summed = self._mass.sum(axis=0)
+            self._summed.flags.writeable = False
+        return self._summed
 
     def prob_change_within(self, distance_m: float) -> float:
         """P(the current segment began within the last ``distance_m`` metres)."""
@@ -209,7 +227,10 @@ class ChangePointFilter:
             raise ControlError(f"distance_m must be a distance >= 0, m, got {distance_m!r}")
         if not self._has_data:
             return float("nan")
-        return float(min(1.0, self._mass[self._dist <= distance_m].sum()))
+        key = float(distance_m)
+        if key not in self._within:  # (computed once a step: the BCR asks for every phase)
+            self._within[key] = float(min(1.0, self._mass[self._dist <= key].sum()))
+        return self._within[key]
 
     def mass_by_run(self, edges_m) -> np.ndarray:
         """GD mass per run-length class: row i holds the runs that began more than
@@ -233,7 +254,7 @@ class ChangePointFilter:
 
     def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
         """The GD posterior as a gpmsa Posterior holding the grid marginal (draws made lazily)."""
-        return _grid_posterior(self.gd, self._weights, self.gd_mass, name, n_draws)
+        return _grid_posterior(self.gd, self._weights, self._gd_mass(), name, n_draws)
 
 
 def mixture_posterior(
@@ -259,7 +280,7 @@ def _mixture_posterior(
     filters: list[ChangePointFilter], w: np.ndarray, name: str = "GD", n_draws: int = 4000
 ) -> Posterior:
     """`mixture_posterior` of filters and weights (an array) known to fit (the BCR's own)."""
-    mass = (w[:, None] * np.array([f.gd_mass for f in filters])).sum(axis=0) / w.sum()
+    mass = (w[:, None] * np.array([f._gd_mass() for f in filters])).sum(axis=0) / w.sum()
     return _grid_posterior(filters[0].gd, filters[0]._weights, mass, name, n_draws)
 
 

@@ -205,3 +205,32 @@ def test_a_mixture_of_filters_needs_one_grid_and_positive_weights():
             mixture_posterior([a, b], weights)
     with pytest.raises(ControlError, match="one GD grid"):
         mixture_posterior([a, ChangePointFilter(np.geomspace(200, 600, 21))], [1.0, 1.0])
+
+
+def test_a_state_is_a_snapshot_and_the_summaries_follow_every_step():
+    """`state` shares the filter's arrays (read-only: each step makes new ones), so a state
+    taken stays as it was; `gd_mass` is the caller's own copy, and the summaries computed once
+    a step (`gd_mass`, `prob_change_within`) follow each step, restore and reset."""
+    f = ChangePointFilter(np.geomspace(200.0, 600.0, 61))
+    loglik = lambda gd: -0.5 * ((np.log(f.gd) - np.log(gd)) / 0.3) ** 2  # noqa: E731
+    f.update(loglik(300.0), 1.0)
+    taken = f.state()
+    mass, dist = taken[0].copy(), taken[1].copy()
+    with pytest.raises(ValueError, match="read-only"):
+        taken[0][0, 0] = 1.0
+    mine = f.gd_mass
+    mine[:] = 0.0  # the caller's copy: the filter keeps its own
+    before = (f.gd_mass.copy(), f.prob_change_within(5.0))
+    assert before[0].sum() == pytest.approx(1.0)
+    for _ in range(5):
+        f.update(loglik(550.0), 1.0)
+    np.testing.assert_array_equal(taken[0], mass)  # later steps left the state alone
+    np.testing.assert_array_equal(taken[1], dist)
+    assert not np.array_equal(f.gd_mass, before[0])
+    assert f.prob_change_within(5.0) != before[1]
+    f.restore(taken)
+    np.testing.assert_array_equal(f.gd_mass, before[0])
+    assert f.prob_change_within(5.0) == before[1]
+    f.reset()
+    np.testing.assert_allclose(f.gd_mass, f.prior)
+    assert np.isnan(f.prob_change_within(5.0))
