@@ -72,7 +72,7 @@ def replay(
 ) -> np.ndarray:  # fmt: skip
     """Posterior means of GD at the run's updates (k,) from the ``oracle`` filter (`ORACLES`);
     ``change_m``: the track's change points, m (used by the oracles only); NaN before the
-    first block."""
+    drive's first whole block."""
     s: control.BCRSettings = result.settings["bcr"]
     cp = s.changepoint
     if oracle == "no change":
@@ -106,16 +106,17 @@ def replay(
             ph.data_time = float(result.sample_time[end - 1])
         else:
             ph.filter.predict(ds)
-        means[i] = _pooled_mean(phases, model.gd)
+        if end >= B:  # (before the drive's first whole block the BCR has no estimate either)
+            means[i] = _pooled_mean(phases, model.gd)
     return means
 
 
 def _pooled_mean(phases: list[_Phase], gd: np.ndarray) -> float:
     """The BCR's pooled posterior mean: phases with data, the newest weighing K, the next K - 1,
-    ...; the prior's mean when none has data since its reset (NaN before any block at all)."""
+    ...; the prior's mean when none has data since its reset."""
     used = sorted((ph for ph in phases if ph.filter.has_data), key=lambda ph: -ph.data_time)
     if not used:
-        return float(phases[0].filter.prior @ gd) if np.isfinite(phases[0].pos_block) else np.nan
+        return float(phases[0].filter.prior @ gd)
     weights = np.arange(len(phases), len(phases) - len(used), -1, dtype=float)
     mass = weights @ np.array([ph.filter.gd_mass for ph in used]) / weights.sum()
     return float(mass @ gd)
