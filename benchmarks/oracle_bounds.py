@@ -43,6 +43,7 @@ import numpy as np
 import control
 import roadgen
 from control.bcr import MAX_SPEED_CHANGE
+from control.changepoint import mixture_posterior
 
 PAPER_TRACK = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 NOISE_STD = {"A": 0.0, "B": 1.0}
@@ -107,19 +108,19 @@ def replay(
         else:
             ph.filter.predict(ds)
         if end >= B:  # (before the drive's first whole block the BCR has no estimate either)
-            means[i] = _pooled_mean(phases, model.gd)
+            means[i] = _pooled_mean(phases)
     return means
 
 
-def _pooled_mean(phases: list[_Phase], gd: np.ndarray) -> float:
-    """The BCR's pooled posterior mean: phases with data, the newest weighing K, the next K - 1,
-    ...; the prior's mean when none has data since its reset."""
+def _pooled_mean(phases: list[_Phase]) -> float:
+    """The BCR's pooled posterior mean (`control.changepoint.mixture_posterior`, as the BCR
+    pools): phases with data, the newest weighing K, the next K - 1, ...; the prior's mean when
+    none has data since its reset."""
     used = sorted((ph for ph in phases if ph.filter.has_data), key=lambda ph: -ph.data_time)
     if not used:
-        return float(phases[0].filter.prior @ gd)
+        return phases[0].filter.posterior().mean("GD")
     weights = np.arange(len(phases), len(phases) - len(used), -1, dtype=float)
-    mass = weights @ np.array([ph.filter.gd_mass for ph in used]) / weights.sum()
-    return float(mass @ gd)
+    return mixture_posterior([ph.filter for ph in used], weights).mean("GD")
 
 
 def _run(job: tuple[str, int]) -> dict:
