@@ -14,6 +14,7 @@ import pytest
 
 import control
 import vehicle
+from tests._script_runs import run_scripts
 
 ROOT = Path(__file__).resolve().parents[1]
 FILE = "{file}"
@@ -183,21 +184,29 @@ CASES = [
 ]
 
 
+@pytest.fixture(scope="module")
+def usage_runs(tmp_path_factory) -> list[tuple[dict, Path]]:
+    """Each case's run, all in one interpreter (`run_scripts`), and the file it was given (one
+    a case, written "kept")."""
+    folder = tmp_path_factory.mktemp("usage")
+    files, runs = [], []
+    for k, (script, argv, _) in enumerate(CASES):
+        a_file = folder / f"a_file_{k}"
+        a_file.write_text("kept")
+        files.append(a_file)
+        runs.append((script, [str(a_file) if arg == FILE else arg for arg in argv]))
+    return list(zip(run_scripts(runs), files, strict=True))
+
+
 @pytest.mark.parametrize(
-    "script, argv, message", CASES, ids=[f"{Path(s).name} {' '.join(a)}" for s, a, _ in CASES]
+    "case", range(len(CASES)), ids=[f"{Path(s).name} {' '.join(a)}" for s, a, _ in CASES]
 )
-def test_bad_argument_is_a_usage_error_naming_it(tmp_path, script, argv, message) -> None:
-    a_file = tmp_path / "a_file"
-    a_file.write_text("kept")
-    argv = [str(a_file) if arg == FILE else arg for arg in argv]
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run(
-        [sys.executable, str(ROOT / script), *argv],
-        capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
-    )  # fmt: skip
-    assert done.returncode == 2, done.stderr[-2000:]
-    assert "Traceback" not in done.stderr, done.stderr[-2000:]
-    (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
+def test_bad_argument_is_a_usage_error_naming_it(usage_runs, case) -> None:
+    done, a_file = usage_runs[case]
+    message = CASES[case][2]
+    assert done["returncode"] == 2, done["stderr"][-2000:]
+    assert "Traceback" not in done["stderr"], done["stderr"][-2000:]
+    (error,) = [line for line in done["stderr"].splitlines() if ": error: " in line]
     assert message.replace(FILE, repr(str(a_file))) in error
     assert a_file.read_text() == "kept"
 

@@ -1,11 +1,10 @@
 """Every benchmark and example script answers ``--help`` (its imports and argument parser work)."""
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
+
+from tests._script_runs import run_scripts
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = [
@@ -16,12 +15,15 @@ SCRIPTS = [
 ]
 
 
+@pytest.fixture(scope="module")
+def helps() -> dict:
+    """Each script's run with ``--help``, all in one interpreter (`run_scripts`)."""
+    runs = [(str(path.relative_to(ROOT)), ["--help"]) for path in SCRIPTS]
+    return dict(zip(SCRIPTS, run_scripts(runs), strict=True))
+
+
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: f"{p.parent.name}/{p.name}")
-def test_script_answers_help(script: Path) -> None:
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run(
-        [sys.executable, str(script), "--help"],
-        capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert "usage:" in done.stdout
+def test_script_answers_help(helps, script: Path) -> None:
+    done = helps[script]
+    assert done["returncode"] == 0, done["stderr"][-2000:]
+    assert "usage:" in done["stdout"]
