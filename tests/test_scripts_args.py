@@ -45,6 +45,7 @@ CASES = [
     ),
     ("benchmarks/closed_loop_speed.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
     ("benchmarks/closed_loop_speed.py", ["--long-m", "-1"], "--long-m must be a length >= 0"),
+    ("benchmarks/closed_loop_speed.py", ["--replays", "0"], "--replays must be >= 1, got 0"),
     (
         "benchmarks/emulator_bias.py",
         ["--keep-s", "nan"],
