@@ -27,6 +27,7 @@ import gpmsa
 from gpmsa.cli.main import main
 from gpmsa.cli.text import safe
 from gpmsa.io import container
+from gpmsa.model.data import RESERVED_NAMES
 
 FIELD = re.compile(
     r"(arrays/\w+|arrays:|array '\w+'|priors|names|units|domain|settings|model|metadata|"
@@ -435,9 +436,12 @@ def emulators(draw):
     if l_sim > 1 and draw(st.booleans()):
         y[:, -1] = 0.0  # zero padding
     names = draw(st.lists(NAMES, min_size=p + q + l_sim, max_size=p + q + l_sim, unique=True))
+    # (no calibration parameter named as the posterior's others: SimData refuses those names)
+    t_names = names[p : p + q]
+    assume(not any(n in RESERVED_NAMES or re.fullmatch(r"betaV\[\d+\]", n) for n in t_names))
     units = draw(st.lists(NAMES, min_size=p + q + l_sim, max_size=p + q + l_sim))
     sim = gpmsa.SimData(
-        x=x, t=t, y=y, x_names=names[:p], t_names=names[p : p + q], y_names=names[p + q :],
+        x=x, t=t, y=y, x_names=names[:p], t_names=t_names, y_names=names[p + q :],
         x_units=units[:p], t_units=units[p : p + q], y_units=units[p + q :],
     )  # fmt: skip
     meta = draw(st.dictionaries(NAMES, META, max_size=4))
