@@ -11,7 +11,8 @@ an executor whose ``submit`` raises) is retried ``retries`` times, with a ``Runt
 in a fresh pool when the pool was ours; then ``ChainError`` names the chain and the cause. A
 chain is never dropped silently. When a run stops early (a chain failed, or KeyboardInterrupt),
 the chains not yet finished are cancelled: gpmsa's own worker processes are ended, an
-executor's futures cancelled.
+executor's futures cancelled. Ctrl-C stops a parallel run within a quarter of a second,
+whichever of the process's threads the kernel hands the signal to.
 """
 
 from __future__ import annotations
@@ -107,6 +108,11 @@ def _own_pool(workers: int) -> ProcessPoolExecutor:
 
 _JOIN_S = 5.0
 """Seconds to wait for a terminated worker process to exit."""
+
+_POLL_S = 0.25
+"""Seconds between the main thread's checks for an interrupt while chains run. The kernel may
+hand a process's SIGINT (Ctrl-C) to any of its threads, BLAS's or the pool's; Python acts on it
+in the main thread only, and a wait without a timeout would hold it until a chain ends."""
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:
@@ -226,7 +232,7 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
         for i in range(n):
             _submit_checked(i)
         while running:
-            done, _ = wait(list(running), return_when=FIRST_COMPLETED)
+            done, _ = wait(list(running), timeout=_POLL_S, return_when=FIRST_COMPLETED)
             for fut in done:
                 i = running.pop(fut, None)
                 if i is None:  # resubmitted after its pool broke

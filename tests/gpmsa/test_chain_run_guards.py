@@ -1,7 +1,9 @@
 """Chain runs that stop early leave nothing running, a closed dask Client is refused (not a
 hang), short chains are never judged converged, and ``sample`` refuses bad run arguments."""
 
+import functools
 import multiprocessing
+import os
 import re
 import signal
 import threading
@@ -67,19 +69,24 @@ def test_a_failed_chain_ends_the_workers_still_running(error, match):
 
 
 @pytest.mark.skipif(parallel.available_cpus() < 2, reason="needs two CPUs for a pool")
-def test_an_interrupted_run_ends_its_workers():
+@pytest.mark.parametrize("taken_by", ["the process", "another thread"])
+def test_an_interrupted_run_stops_at_once_and_ends_its_workers(taken_by):
+    # Ctrl-C is a SIGINT to the process, which the kernel may hand to any of its threads; one
+    # that another thread takes must stop the run as well (it once waited for the chains' 30 s)
+    if taken_by == "the process":
+        interrupt = functools.partial(os.kill, os.getpid(), signal.SIGINT)
+    else:  # the timer's own thread takes it
+        interrupt = lambda: signal.pthread_kill(threading.get_ident(), signal.SIGINT)  # noqa: E731
     before = {p.pid for p in multiprocessing.active_children()}
-    # to the main thread itself: a process-directed SIGINT (os.kill) may go to another thread
-    # (BLAS's, the pool's), and then nothing breaks the main thread's wait until the chains end
-    # (seen once in a full suite: the run took its 30 s and no KeyboardInterrupt came)
-    main = threading.main_thread().ident
-    timer = threading.Timer(1.0, signal.pthread_kill, (main, signal.SIGINT))
+    timer = threading.Timer(1.0, interrupt)
+    start = time.monotonic()
     timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
             parallel.run_chains(_sleeps, [{"x": i} for i in range(2)], n_jobs=2)
     finally:
         timer.cancel()
+    assert time.monotonic() - start < 10.0  # not after the chains' 30 s
     assert _workers_left(before) == []
 
 
