@@ -98,9 +98,23 @@ def test_an_interrupted_run_stops_at_once_and_ends_its_workers(taken_by):
         faulthandler.cancel_dump_traceback_later()
     took = time.monotonic() - start
     sent = f"sent after {sent_after[0]:.2f} s" if sent_after else "never sent"
-    assert interrupted, f"the run ended after {took:.1f} s without a KeyboardInterrupt ({sent})"
+    assert interrupted, (
+        f"the run ended after {took:.1f} s without a KeyboardInterrupt ({sent}); a second one, "
+        f"sent to the main thread now, {_second_interrupt()}"
+    )
     assert took < 10.0, f"the interrupt ({sent}) stopped the run after {took:.1f} s"
     assert _workers_left(before) == []
+
+
+def _second_interrupt() -> str:
+    """What a SIGINT sent to the main thread (this one) does now: whether Python still turns it
+    into a KeyboardInterrupt (the diagnosis of a lost one)."""
+    try:
+        signal.pthread_kill(threading.get_ident(), signal.SIGINT)
+        time.sleep(0.5)
+    except KeyboardInterrupt:
+        return "raised one"
+    return f"raised none either (Python's handler: {signal.getsignal(signal.SIGINT)!r})"
 
 
 # --- a closed dask Client -------------------------------------------------------------------------
