@@ -94,11 +94,7 @@ def main() -> None:
         sims.append(r.metrics.traversal_time_s)
         rtf.append(r.metrics.real_time_factor)
         # Replay the drive's samples through a fresh BCR to time the estimator alone.
-        sim = vehicle.Simulation(vehicle.Jackal(), track, noise_std=noise, seed=k)
-        chunks = []
-        while not sim.finished:
-            s = sim.advance(settings.samples_per_update / settings.rate_hz, 1.5)
-            chunks.append((s.t, s.position, s.accel_front, s.speed))
+        chunks = update_samples(track, settings, noise, seed=k, speed=1.5)
         bcr = control.BCR(likelihood, settings)
         tic = time.perf_counter()
         for chunk in chunks:
@@ -156,11 +152,7 @@ def steady_state_latency(likelihood, settings, length_m: float, noise: float, re
     replayed ``replays`` times from the same state; max_runs)."""
     third = length_m / 3
     track = roadgen.track([(third, 300.0), (third, 450.0), (third, 350.0)], seed=1)
-    sim = vehicle.Simulation(vehicle.Jackal(), track, noise_std=noise, seed=1)
-    chunks = []
-    while not sim.finished:
-        s = sim.advance(settings.samples_per_update / settings.rate_hz, 2.0)
-        chunks.append((s.t, s.position, s.accel_front, s.speed))
+    chunks = update_samples(track, settings, noise, seed=1, speed=2.0)
     bcr = control.BCR(likelihood, settings)
     runs = settings.changepoint.max_runs
     first = 0
@@ -176,6 +168,17 @@ def steady_state_latency(likelihood, settings, length_m: float, noise: float, re
             bcr.update(*chunk)
             out[r, k] = time.perf_counter() - tic
     return out * 1e3, runs
+
+
+def update_samples(track, settings, noise: float, seed: int, speed: float) -> list[tuple]:
+    """The Jackal's drive over ``track`` at ``speed`` m/s, cut into the BCR's updates: one
+    (t, position, accel, speed) tuple of arrays per update."""
+    sim = vehicle.Simulation(vehicle.Jackal(), track, noise_std=noise, seed=seed)
+    chunks = []
+    while not sim.finished:
+        s = sim.advance(settings.samples_per_update / settings.rate_hz, speed)
+        chunks.append((s.t, s.position, s.accel_front, s.speed))
+    return chunks
 
 
 if __name__ == "__main__":
