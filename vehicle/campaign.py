@@ -33,7 +33,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import roadgen
-from vehicle import checks
+from vehicle import checks, kinematics
 from vehicle.design import check_design, lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
 from vehicle.linear import warn_if_step_too_coarse
@@ -433,7 +433,8 @@ def run_campaign(
 
     Raises VehicleError for bad input (checked before any run: each argument's type and range,
     a road too short for the window, traces beyond ``vehicle.checks.MAX_MEMORY_BYTES``, a
-    ``keep_s`` that keeps no sample, a ``cache_dir`` that cannot be a folder), and
+    ``keep_s`` that keeps no sample, a drive longer than ``simulate``'s limit
+    ``vehicle.kinematics.MAX_DRIVE_S``, a ``cache_dir`` that cannot be a folder), and
     RoadgenError for road settings that no road can have (too long for
     ``roadgen.checks.MAX_MEMORY_BYTES``, a band its length cannot hold).
     """
@@ -488,6 +489,7 @@ def run_campaign(
         need = lead_in_m + model.wheelbase_m + v * (keep_s + 1.0) if keep else 0.0
         return float(max(road_length_m, need))
 
+    _check_drives(points, [length(float(v)) for v in points[:, 0]], model, dx_m)
     seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
     specs = [
         RunSpec(model, float(v), float(gd), int(s), length(float(v)), dx_m, lead_in_m, band,
@@ -547,6 +549,23 @@ def run_campaign(
         settings=settings,
         **traces,
     )
+
+
+def _check_drives(points: np.ndarray, lengths: list[float], model: Model, dx_m: float) -> None:
+    """Raise, before any run, for what would make runs fail: a road (``lengths``, m, one per
+    design point) beyond ``roadgen.checks.MAX_MEMORY_BYTES`` (RoadgenError), or a drive,
+    from a wheelbase in to the road's end at the point's speed, longer than ``simulate``'s limit
+    ``kinematics.MAX_DRIVE_S`` (VehicleError naming the point)."""
+    roadgen.profile.grid_points(max(lengths), dx_m)
+    drives = np.round(np.asarray(lengths) / dx_m) * dx_m - model.wheelbase_m  # as grid_points
+    seconds = drives / points[:, 0]
+    i = int(np.argmax(seconds))
+    if seconds[i] > kinematics.MAX_DRIVE_S:
+        raise VehicleError(
+            f"design[{i}] (v={points[i, 0]:.4g} m/s) drives {drives[i]:.6g} m of road in "
+            f"{seconds[i]:.4g} s: simulate allows drives of <= {kinematics.MAX_DRIVE_S:g} s "
+            "(vehicle.kinematics.MAX_DRIVE_S); use a shorter road_length_m or keep_s"
+        )
 
 
 def package_versions() -> dict[str, str]:

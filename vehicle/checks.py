@@ -3,7 +3,8 @@
 
 Resource limit: ``MAX_MEMORY_BYTES`` (module attribute, read at call time). A drive is
 integrated only when the memory of its time grid (about ``BYTES_PER_STEP`` per solver step) and
-a design only when its table fit below it; otherwise VehicleError states the estimate and the
+of a speed schedule of position (``kinematics.BYTES_PER_POSITION`` per mm), and a design only
+when its table, fit below it; otherwise VehicleError states the estimate and the
 limit. A program that has the memory raises it: ``vehicle.checks.MAX_MEMORY_BYTES = 16 *
 1024**3``. The road itself is limited by ``roadgen.checks.MAX_MEMORY_BYTES``.
 """

@@ -16,6 +16,14 @@ from scipy.integrate import cumulative_trapezoid
 from vehicle import checks
 from vehicle.errors import VehicleError
 
+MAX_DRIVE_S = 3600.0
+"""Longest drive (s) that ``schedule_grid``, hence ``simulate``, integrates (module attribute,
+read at call time)."""
+
+BYTES_PER_POSITION = 48
+"""Memory per point of a position schedule's 1 mm grid (measured): the positions, the speeds,
+their inverse and the cumulative time."""
+
 SpeedSchedule = float | Callable | tuple
 """A constant speed (m/s); a callable of time (s) or of position (m); or a pair of arrays
 (points, speeds) interpolated linearly and held constant beyond the ends."""
@@ -102,26 +110,35 @@ def schedule_grid(
     end_m: float,
     h: float,
     max_speed: float,
-    max_duration_s: float = 3600.0,
+    max_duration_s: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Front-axle (s, v) at t = k h from s = start_m until s reaches end_m (inclusive).
 
     Args:
         speed: see ``SpeedSchedule``; a callable/array is read as a function of time when
             ``speed_of="time"`` and of the front-axle position when ``speed_of="position"``.
-        h: grid step, s. max_duration_s: give up (VehicleError) if the drive would be longer.
+        h: grid step, s. max_duration_s: give up (VehicleError) if the drive would be longer
+            (default ``MAX_DRIVE_S``).
     Returns:
         s, v: arrays (N + 1,) with s[-1] >= end_m.
     """
     checks.choice("speed_of", speed_of, ("time", "position"))
+    max_duration_s = MAX_DRIVE_S if max_duration_s is None else max_duration_s
     fun = _as_function(speed)
     if speed_of == "position":
         n_s = max(2, math.ceil((end_m - start_m) / 1e-3) + 1)
+        checks.memory(
+            BYTES_PER_POSITION * n_s,
+            f"a speed schedule of position tabulated every mm from {start_m:.6g} m to "
+            f"{end_m:.6g} m ({n_s} points)",
+        )
         s_grid = np.linspace(start_m, end_m, n_s)
         v_grid = check_speed("speed", fun(s_grid), max_speed)
         t_of_s = cumulative_trapezoid(1.0 / v_grid, s_grid, initial=0.0)
         if t_of_s[-1] > max_duration_s:
-            raise VehicleError(f"the drive takes {t_of_s[-1]:.4g} s: allowed <= {max_duration_s} s")
+            raise VehicleError(
+                f"the drive takes {t_of_s[-1]:.4g} s: allowed <= {max_duration_s:g} s"
+            )
         n = math.ceil(t_of_s[-1] / h)
         checks.memory(checks.BYTES_PER_STEP * (n + 1), f"a drive of {n + 1} solver steps")
         t = h * np.arange(n + 1)
@@ -129,6 +146,10 @@ def schedule_grid(
         return s, fun(s)
     if not (callable(speed) or isinstance(speed, tuple)):  # a constant: the length is known
         v0 = float(check_speed("speed", fun(0.0), max_speed))
+        if (end_m - start_m) / v0 > max_duration_s:  # exact here, not up to a block beyond
+            raise VehicleError(
+                f"the drive takes {(end_m - start_m) / v0:.4g} s: allowed <= {max_duration_s:g} s"
+            )
         n_est = (end_m - start_m) / (v0 * h) + 1
         checks.memory(checks.BYTES_PER_STEP * n_est, f"a drive of {n_est:.4g} solver steps")
     s_parts, v_parts, s_now, k0 = [], [], start_m, 0
@@ -147,7 +168,7 @@ def schedule_grid(
             return np.concatenate(s_parts), np.concatenate(v_parts)
         s_now, k0 = float(s[-1]), k0 + block
         if k0 * h > max_duration_s:
-            raise VehicleError(f"the drive takes more than {max_duration_s} s: allowed less")
+            raise VehicleError(f"the drive takes more than {max_duration_s:g} s: allowed less")
 
 
 def ramp_grid(

@@ -106,7 +106,8 @@ def simulate(
         envelope: the tyres follow the road enveloped by the model's wheel radius
             (``roadgen.wheel_envelope``); False: they follow the road's raw heights.
     Returns:
-        Trace. Raises VehicleError on bad input, SimulationDivergedError if the run diverges.
+        Trace. Raises VehicleError on bad input (also a drive longer than
+        ``vehicle.kinematics.MAX_DRIVE_S``, 3600 s), SimulationDivergedError if the run diverges.
     """
     check_model(model)
     rate = check_rate(rate_hz)

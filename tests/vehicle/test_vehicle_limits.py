@@ -67,3 +67,56 @@ def test_campaign_records_the_versions_that_made_it(tmp_path):
     assert "blas" in versions and "machine" in versions
     camp.save(tmp_path / "c.npz")
     assert vehicle.load_campaign(tmp_path / "c.npz").settings["versions"] == versions
+
+
+class NoRunExecutor:
+    """Fails the test if a campaign gets as far as submitting a run."""
+
+    def submit(self, *args, **kwargs):
+        raise AssertionError("a run was submitted")
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"road_length_m": 1900.0}, r"^design\[1\] \(v=0.5 m/s\) drives 1899.74 m .* 3799 s"),
+        ({"keep_s": 3700.0}, r"^design\[1\] \(v=0.5 m/s\) drives 1851.5 m .* 3703 s"),
+    ],
+)
+def test_a_campaign_whose_drives_exceed_the_drive_limit_is_refused_before_any_run(kwargs, match):
+    """simulate refuses a drive over MAX_DRIVE_S: every run would fail, so the campaign says so
+    before it makes any road (a long road_length_m, or keep_s that lengthens the roads)."""
+    args = {"design": np.array([[1.0, 300.0], [0.5, 300.0]]), "progress": False,
+            "executor": NoRunExecutor()} | kwargs  # fmt: skip
+    with pytest.raises(vehicle.VehicleError, match=match):
+        vehicle.run_campaign(**args)
+
+
+def test_a_constant_speed_drive_over_the_limit_is_refused_at_once(monkeypatch):
+    """The drive limit holds exactly for a constant speed (not up to a block of solver steps
+    beyond it), named with the drive's duration."""
+    from vehicle import kinematics
+
+    monkeypatch.setattr(kinematics, "MAX_DRIVE_S", 10.0)
+    road = roadgen.iso8608_profile(11.0, 300.0, seed=0)
+    with pytest.raises(vehicle.VehicleError, match=r"^the drive takes 10.74 s: allowed <= 10 s"):
+        vehicle.simulate(vehicle.Jackal(), road, 1.0)
+    assert len(vehicle.simulate(vehicle.Jackal(), road, 1.1)) > 1000
+
+
+def test_a_position_schedule_is_refused_before_its_fine_grid_outgrows_the_limit(monkeypatch):
+    """speed_of="position" tabulates the schedule every mm of the drive (48 bytes a point): that
+    grid is checked against the memory limit before it is made, as the time grid is."""
+    from vehicle import kinematics
+
+    monkeypatch.setattr(checks, "MAX_MEMORY_BYTES", 12_000_000)
+    s, _ = kinematics.schedule_grid(2.0, "time", 0.0, 300.0, 1 / 600, 2.0)  # 9 MB: allowed
+    assert s[-1] >= 300.0
+    with pytest.raises(vehicle.VehicleError, match=r"^a speed schedule of position tabulated"):
+        kinematics.schedule_grid(2.0, "position", 0.0, 300.0, 1 / 600, 2.0)
+    road = roadgen.iso8608_profile(300.0, 300.0, seed=0)
+    with pytest.raises(
+        vehicle.VehicleError, match=r"\(300001 points\) needs .*checks.MAX_MEMORY_BYTES"
+    ):
+        vehicle.simulate(vehicle.Jackal(), road, lambda s: 2.0 + 0 * s, speed_of="position",
+                         start_m=0.0)  # fmt: skip
