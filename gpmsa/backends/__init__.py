@@ -83,14 +83,24 @@ def _own(exc: ImportError) -> bool:
     return (exc.name or "").split(".")[0] == "gpmsa"
 
 
-def check_options(backend: str, options: dict, reserved: tuple[str, ...], caller: str) -> None:
+def check_options(
+    backend: str, options: dict, reserved: tuple[str, ...], caller: str, renamed=None
+) -> None:
     """GPMSAError naming every key of ``options`` that backend ``backend``'s ``sample`` does not
-    take, or that ``caller`` sets itself (``reserved``: its own arguments)."""
+    take, or that ``caller`` sets itself (``reserved``: its own arguments; ``renamed``: a
+    reserved name -> the caller's argument that sets it, where their names differ)."""
     accepted = inspect.signature(get(backend).sample).parameters
     open_ended = any(a.kind is inspect.Parameter.VAR_KEYWORD for a in accepted.values())
     taken = sorted(set(options) & set(reserved))
     if taken:
-        raise GPMSAError(f"{caller}: {taken} are {caller}'s own arguments, not backend options")
+        hints = "".join(
+            f"; {caller} sets {k} from its argument {renamed[k]}"
+            for k in taken
+            if renamed and k in renamed
+        )
+        raise GPMSAError(
+            f"{caller}: {taken} are {caller}'s own arguments, not backend options{hints}"
+        )
     unknown = [] if open_ended else sorted(set(options) - set(accepted))
     if unknown:
         offered = sorted(set(accepted) - set(reserved) - {"problem"})

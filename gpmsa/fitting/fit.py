@@ -124,11 +124,7 @@ def fit(
     n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
     n_burn = n_iter // 5 if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     check_point(point)
-    n_keep = check_count(n_keep, "n_keep")
-    if n_keep < n_chains:
-        raise GPMSAError(
-            f"n_keep={n_keep} is fewer than n_chains={n_chains}: every chain keeps a draw"
-        )
+    n_keep = check_keep(n_keep, n_chains)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     metadata = check_metadata(metadata)
     if obs is None and discrepancy is not None:
@@ -160,9 +156,7 @@ def fit(
     )  # fmt: skip
     chains.check_finite()
     kept = n_iter - n_burn
-    thin = max(1, math.ceil(n_chains * kept / n_keep))
-    while n_chains * math.ceil(kept / thin) > n_keep:  # each chain keeps ceil(kept / thin)
-        thin += 1
+    thin = thinning(n_chains, kept, n_keep)  # each chain keeps ceil(kept / thin)
     # float64 whatever the backend sampled in (torch float32), a fixed parameter exactly at its
     # value; a mean within its draws' range (a parameter that never moved: float rounding)
     post = {k: np.asarray(v[:, n_burn:], dtype=float) for k, v in chains.draws.items()}
@@ -218,6 +212,26 @@ def fit(
         metadata=metadata, settings=settings,
         diagnostics=summary, calibration=calibration, convergence=record,
     )  # fmt: skip
+
+
+def check_keep(n_keep, n_chains: int) -> int:
+    """``n_keep`` checked: an integer >= 1 and at least ``n_chains`` (every chain keeps a draw);
+    GPMSAError otherwise."""
+    n_keep = check_count(n_keep, "n_keep")
+    if n_keep < n_chains:
+        raise GPMSAError(
+            f"n_keep={n_keep} is fewer than n_chains={n_chains}: every chain keeps a draw"
+        )
+    return n_keep
+
+
+def thinning(n_chains: int, kept: int, n_keep: int) -> int:
+    """The smallest thinning step at which ``n_chains`` chains of ``kept`` sweeps each keep at
+    most ``n_keep`` draws in all (a chain keeps ceil(kept / thin) of its sweeps)."""
+    thin = max(1, math.ceil(n_chains * kept / n_keep))
+    while n_chains * math.ceil(kept / thin) > n_keep:
+        thin += 1
+    return thin
 
 
 def check_point(point) -> None:

@@ -109,6 +109,8 @@ def calibrated_predict(
         noise: add the observation error 1/lamOs (standardised units): the predictive of a new
             observation rather than of the simulator output. On a one-parameter grid posterior
             each node adds the exact E[1/lamOs | data, theta]; otherwise each draw its own lamOs.
+            A posterior with discrepancy draws (lamVz) is refused (GPMSAError): a new
+            observation then includes the discrepancy, which ``gpmsa.full_prediction`` adds.
         resid: include the emulator's nugget and residual variance (see ``Emulator.predict``).
         n_theta: at most this many posterior draws when draws are used.
         extrapolate: allow x_new outside the emulator's x domain, however far (with a
@@ -128,6 +130,13 @@ def calibrated_predict(
     if missing:
         raise GPMSAError(f"posterior lacks {missing}; it has {posterior.names}")
     n_theta = check_count(n_theta, "n_theta")
+    if noise and "lamVz" in posterior.names:
+        raise GPMSAError(
+            "noise=True: this posterior has discrepancy draws (lamVz), and a new observation "
+            "includes the discrepancy, which calibrated_predict omits; use gpmsa.full_prediction("
+            "emulator, obs, x, posterior=posterior, discrepancy=...) and its 'y', or noise=False "
+            "for the simulator output at the calibrated theta"
+        )
     lam = None
     inv_lam = posterior.info.get("expected_inv_lamOs")
     if len(names) == 1 and names[0] in posterior.grids and (inv_lam is not None or not noise):

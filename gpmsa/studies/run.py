@@ -3,7 +3,6 @@ jointly): several models whose calibration parameters are shared or hierarchical
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from datetime import datetime, timezone
@@ -15,7 +14,7 @@ from gpmsa.calibration.calibrate import calibration_problem
 from gpmsa.calibration.observations import check_emulator
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
-from gpmsa.fitting.fit import check_point
+from gpmsa.fitting.fit import check_keep, check_point, thinning
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
@@ -218,12 +217,11 @@ def fit_study(
     for o in obs:
         if not isinstance(o, ObsData):
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
-    n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int) else n_burn
+    n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int | np.integer) else n_burn
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
     seed = _run_seed(seed)
     check_point(point)
-    if isinstance(n_keep, bool) or not isinstance(n_keep, (int, np.integer)) or n_keep < 1:
-        raise GPMSAError(f"n_keep must be an integer >= 1, got {n_keep!r}")
+    n_keep = check_keep(n_keep, n_chains)
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
@@ -247,7 +245,7 @@ def fit_study(
         seed=seed, init=init, tune_rounds=tune_rounds, tune_levels=tune_levels,
         progress=progress, n_jobs=n_jobs, executor=executor,
     )  # fmt: skip
-    thin = max(1, math.ceil(n_chains * (n_iter - n_burn) / n_keep))
+    thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
     keep = slice(int(n_burn), None, thin)
     settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point)
     draws = _study_draws(chains, keep)

@@ -227,6 +227,20 @@ def test_calibrated_predict_extrapolates_as_far_as_asked():
         calibrated_predict(emu, post, [[1.3]])
 
 
+def test_calibrated_predict_refuses_a_new_observation_without_its_discrepancy():
+    """noise=True on a posterior with discrepancy draws (calibrate(..., discrepancy=...), a joint
+    fit's, a study member's) gave the emulator plus 1/lamOs: a new observation's predictive
+    silently without the fitted discrepancy. The simulator output (noise=False) stays."""
+    emu = sc.emulator()
+    n = 20
+    post = gpmsa.Posterior({"t": np.linspace(0.3, 0.7, n), "lamOs": np.full(n, 400.0),
+                            "betaV": np.full(n, 0.5), "lamVz": np.full(n, 10.0)})  # fmt: skip
+    with pytest.raises(GPMSAError, match=r"discrepancy .*gpmsa\.full_prediction"):
+        calibrated_predict(emu, post, [[0.5]], noise=True)
+    eta = calibrated_predict(emu, post, [[0.5]])
+    assert np.all(np.isfinite(eta.mean)) and np.all(eta.var > 0)
+
+
 @pytest.mark.parametrize(
     ("plot", "names", "match"),
     [

@@ -31,6 +31,11 @@ def test_torch_options_reach_the_sampler():
          r"\[.*'dtype'"),
         ({"backend": "numpy", "fast": False, "n_iter": 9},
          r"calibrate: \['n_iter'\] are calibrate's own arguments"),
+        # gpmsa.fit's n_iter on the fast path: the advice was "pass fast=False", which then
+        # refused it as "calibrate's own argument" that calibrate does not have
+        ({"backend": "numpy", "n_iter": 9},
+         r"calibrate: \['n_iter'\] are calibrate's own arguments, not backend options; "
+         r"calibrate sets n_iter from its argument n_samples"),
         ({"backend": "numpy", "ridge_moves": 0},
          r"options \['ridge_moves'\] go to a backend's sampler, .* pass fast=False"),
     ],

@@ -149,3 +149,32 @@ def test_mismatched_numbers_are_refused():
         gpmsa.calibrate_study([emu], [x], [y], shared=["t"])
     with pytest.raises(gpmsa.GPMSAError, match="mismatched numbers of models"):
         gpmsa.fit_study([emu], [], shared=["t"])
+
+
+def _tiny_fit_study(**kwargs):
+    from tests.gpmsa._study_cases import sim_data
+
+    sim = sim_data()
+    obs = [gpmsa.ObsData(x=[[0.3]], y=[[0.5]]), gpmsa.ObsData(x=[[0.7]], y=[[1.2]])]
+    return gpmsa.fit_study([sim, sim], obs, shared=["t"], seed=2, tune=False, n_jobs=1,
+                           **kwargs)  # fmt: skip
+
+
+def test_fit_study_keeps_at_most_n_keep_draws_as_fit_does():
+    """fit_study thinned by ceil(chains x kept / n_keep) alone: 2 chains x 3 kept sweeps with
+    n_keep=3 kept 4 draws (3 chains, 30,000 sweeps, n_keep=1000: 1002); fit keeps <= n_keep."""
+    for n_iter, n_burn, chains, n_keep in ((5, 2, 2, 3), (20, 10, 3, 4), (50, 10, 2, 7)):
+        with pytest.warns(gpmsa.ConvergenceWarning):
+            study = _tiny_fit_study(n_iter=n_iter, n_burn=n_burn, n_chains=chains,
+                                    n_keep=n_keep)  # fmt: skip
+        assert study.posterior.samples["t"].size <= n_keep
+        assert all(e.n_draws <= n_keep for e in study.members)
+    with pytest.raises(gpmsa.GPMSAError, match=r"n_keep=2 is fewer than n_chains=3"):
+        _tiny_fit_study(n_iter=6, n_burn=1, n_chains=3, n_keep=2)
+
+
+def test_fit_study_takes_a_numpy_integer_n_iter_as_fit_does():
+    """n_iter=np.int64(20) left n_burn None: 'n_burn must be an integer ..., got None'."""
+    study = _tiny_fit_study(n_iter=np.int64(20))
+    assert study.settings["n_burn"] == 4
+    assert study.members[0].n_draws == 16
