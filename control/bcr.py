@@ -336,7 +336,10 @@ class BCR:
 
     @property
     def filter(self) -> ChangePointFilter:
-        """The change-point filter of the newest estimate (the only one without phases)."""
+        """The change-point filter of the newest estimate (the only one without phases).
+        Method "changepoint" only (the window methods keep `GDTracker`s, ``trackers``)."""
+        if self.settings.method != "changepoint":
+            raise ControlError(f"filter needs method 'changepoint', not {self.settings.method!r}")
         return self._phases[self._phase].filter
 
     def reset(self) -> None:

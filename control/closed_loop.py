@@ -66,8 +66,9 @@ class LoopMetrics:
 
     @property
     def real_time_factor(self) -> float:
-        """Simulated seconds per wall-clock second."""
-        return self.traversal_time_s / self.wall_time_s
+        """Simulated seconds per wall-clock second (NaN where no wall-clock time was
+        measured)."""
+        return self.traversal_time_s / self.wall_time_s if self.wall_time_s > 0 else np.nan
 
     def rmse(self, gd: float) -> float:
         """RMSE of the estimates on the parts with prescribed GD `gd` (NaN where those parts

@@ -127,7 +127,10 @@ def clustered_mean(per_run: Sequence) -> tuple[float, float]:
         (mean, standard error); NaN for the mean without values and for the standard error
         with fewer than two runs that have values.
     """
-    runs = [float_array(x, f"per_run[{k}]") for k, x in enumerate(per_run)]
+    try:
+        runs = [float_array(x, f"per_run[{k}]") for k, x in enumerate(per_run)]
+    except TypeError as exc:  # (float_array raises ControlError for what it refuses)
+        raise ControlError(f"per_run must hold one sequence of values per run: {exc}") from exc
     for k, x in enumerate(runs):
         if x.ndim != 1 or not np.all(np.isfinite(x)):
             raise ControlError(

@@ -8,7 +8,8 @@ and the odometry's stamps, receive times, positions and linear velocities. Any o
 - a ``*.db3`` or ``*.mcap`` file inside such a folder (the folder is read);
 - a ROS 1 ``*.bag`` file (rosbags);
 - a bare ``*.mcap`` file with ROS 2 (CDR) messages, e.g. one `control.record_run` wrote or
-  Foxglove recorded (the ``mcap`` package).
+  Foxglove recorded (the ``mcap`` package); a file of another name is one too where its
+  first bytes are MCAP's magic (`control.record_run` writes to any name).
 
 rosbags and mcap are the ``robot`` extra; they are imported when a function needs them.
 A recording whose bytes are damaged (truncated, corrupted) raises `BagError` naming the file
@@ -117,6 +118,16 @@ def _check_distinct(imu_topic: str, odom_topic: str, error: type[Exception]) -> 
         raise error(f"imu_topic and odom_topic must differ, both are {imu_topic!r}")
 
 
+def _check_topic_names(imu_topic: str, odom_topic: str, *, written: bool = False) -> None:
+    """`ControlError` for a topic name that is not a str, or (``written``) does not start with
+    "/" (a recorder's names do, and `ReplaySettings` refuses others)."""
+    for name, topic in (("imu_topic", imu_topic), ("odom_topic", odom_topic)):
+        if not isinstance(topic, str):
+            raise ControlError(f"{name} must be a str, got {topic!r:.60} ({type(topic).__name__})")
+        if written and not topic.startswith("/"):
+            raise ControlError(f"{name} must start with '/', got {topic!r}")
+
+
 def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic: str) -> None:
     _check_distinct(imu_topic, odom_topic, BagError)
     for topic, role, want, option in (
@@ -163,7 +174,7 @@ def _resolve(path: Path) -> tuple[Path, str]:
         return path, "rosbag2"
     if in_bag_folder(path):
         return path.parent, "rosbag2"
-    if path.suffix == ".mcap":
+    if path.suffix == ".mcap" or _starts_with(path, storage_mod.MAGIC):  # record_run: any name
         return path, "mcap"
     if path.suffix == ".bag":
         return path, "ros1"
@@ -173,6 +184,15 @@ def _resolve(path: Path) -> tuple[Path, str]:
         f"{path}: not a recording this reader knows (a ROS 2 bag folder, *.mcap, *.db3 in its "
         "bag folder, or a ROS 1 *.bag)"
     )
+
+
+def _starts_with(path: Path, magic: bytes) -> bool:
+    """Whether the file ``path`` begins with ``magic`` (False where it cannot be read)."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(len(magic)) == magic
+    except OSError:
+        return False
 
 
 def recording_path(value, name: str = "path") -> Path:
@@ -187,10 +207,11 @@ def read_recording(
     """Read the IMU and odometry messages of a recording (see the module docstring for what
     opens), each topic in receive-time order. Raises `BagError` naming the topic when a topic is
     missing, holds another message type or has no messages, and naming the file when it is
-    damaged; `ControlError` when ``path`` is not a path; `MissingExtraError` when the ``robot``
-    extra is not installed."""
+    damaged; `ControlError` when ``path`` is not a path or a topic not a str; `MissingExtraError`
+    when the ``robot`` extra is not installed."""
     tic = time.perf_counter()
     path = recording_path(path)
+    _check_topic_names(imu_topic, odom_topic)
     require("rosbags.typesys", "reading a robot recording")
     target, kind = _resolve(path)
     if kind == "mcap":
@@ -570,8 +591,8 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
     bag is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves
     it 0), so that a reader refuses a chunk whose bytes changed."""
     _check_storage(storage)
+    path = path_argument(path, "path", " of the new bag folder")
     rosbag2 = require("rosbags.rosbag2", "writing a ROS 2 bag")
-    path = Path(path)
     if path.exists():
         raise ControlError(f"{path} exists already; a bag is written to a new folder")
     plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
@@ -652,7 +673,7 @@ def write_sensor_bag(
         position: (m,) positions along the odometry frame's x axis (m), or (m, 3).
         speed: (m,) forward speeds (twist.linear.x, m/s), or (m, 3) linear velocities.
         storage: "mcap" (ROS 2's default) or "sqlite3".
-        imu_topic, odom_topic: topic names.
+        imu_topic, odom_topic: topic names (starting with "/", as `ReplaySettings` reads them).
         axis: the IMU axis that holds ``accel`` when it is 1-D.
         log_time: (n + m,) receive times in s, IMU messages first (default: the stamps); in
             [0, 2**63) ns.
@@ -660,6 +681,7 @@ def write_sensor_bag(
     Returns:
         the bag folder.
     """
+    _check_topic_names(imu_topic, odom_topic, written=True)
     _check_distinct(imu_topic, odom_topic, ControlError)
     t_imu, imu, t_odom, odom = sensor_messages(
         imu_time, accel, odom_time, position, speed, axis=axis

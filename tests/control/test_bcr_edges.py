@@ -227,3 +227,11 @@ def test_the_window_method_refuses_a_tracker_memory_it_would_ignore(tracker, mes
         assert BCR(FakeCalibrator(), feature=PAPER_WINDOW, method=method, tracker=tracker)
     for ok in (TrackerSettings(), TrackerSettings(mean_segment_m=0.0)):
         assert BCR(FakeCalibrator(), feature=PAPER_WINDOW, method="window", tracker=ok)
+
+
+@pytest.mark.parametrize("method", WINDOW_METHODS)
+def test_the_change_point_filter_of_a_window_method_is_a_control_error(method):
+    bcr = BCR(FakeCalibrator(), feature=PAPER_WINDOW, method=method)
+    with pytest.raises(ControlError, match=rf"filter needs method 'changepoint', not '{method}'"):
+        bcr.filter  # noqa: B018 (a property)
+    assert BCR(FakeBlockModel()).filter.gd.size  # the change-point method has one

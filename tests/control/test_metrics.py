@@ -114,3 +114,21 @@ def test_clustered_mean_weighs_runs_by_their_values_and_leaves_empty_runs_out():
 def test_clustered_mean_refuses_what_is_not_runs_of_finite_values(bad):
     with pytest.raises(ControlError, match=r"per_run\[0\]"):
         clustered_mean(bad)
+
+
+def test_a_run_timed_at_zero_wall_clock_has_no_real_time_factor_not_a_crash():
+    """As `ReplayResult.real_time_factor`: NaN (null in the JSON) where no time was measured."""
+    import json
+
+    from control import LoopMetrics
+
+    metrics = LoopMetrics((), (), 0.0, 12.0, 0.0, np.nan, np.nan, 0.0)
+    assert np.isnan(metrics.real_time_factor)
+    assert json.loads(json.dumps(metrics.as_dict(), allow_nan=False))["real_time_factor"] is None
+    assert LoopMetrics((), (), 0.0, 12.0, 3.0, np.nan, np.nan, 0.0).real_time_factor == 4.0
+
+
+@pytest.mark.parametrize("value", [None, 5, 2.5])
+def test_clustered_mean_of_something_that_holds_no_runs_is_a_control_error(value):
+    with pytest.raises(ControlError, match="per_run must hold one sequence of values per run"):
+        clustered_mean(value)

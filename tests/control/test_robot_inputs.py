@@ -359,3 +359,50 @@ def test_stamps_a_nanosecond_apart_are_refused_before_a_huge_lowpass(tmp_path):
     path = write_sensor_bag(tmp_path / "ns", 1.0 + np.arange(t.size) * 1e-9, accel, t, pos, spd)
     with pytest.raises(BagError, match=r"needs a filter of \d+ taps, above MAX_LOWPASS_TAPS"):
         replay_bag(path, "A", resample="lowpass")
+
+
+def test_a_recorded_run_named_without_the_mcap_suffix_replays(bag, tmp_path):
+    """An MCAP file is known by its magic bytes, whatever its name (record_run writes any)."""
+    from control.errors import BagError
+    from control.robot.bags import read_recording
+
+    for name in ("run", "run.MCAP"):
+        (tmp_path / name).write_bytes(_mcap_file(bag).read_bytes())
+        rec = read_recording(tmp_path / name)
+        assert rec.kind == "mcap" and rec.imu.stamp_ns.size == 400
+    (tmp_path / "notes.txt").write_text("not a recording")
+    with pytest.raises(BagError, match="not a recording this reader knows"):
+        read_recording(tmp_path / "notes.txt")
+
+
+def _mcap_file(folder):
+    (path,) = folder.glob("*.mcap")
+    return path
+
+
+@pytest.mark.parametrize("value", [None, 3, ""])
+def test_writing_a_bag_to_a_path_that_is_no_path_is_a_control_error(value, bag, emulator_a):
+    with pytest.raises(ControlError, match="path must be the path"):
+        write_sensor_bag(value, *_drive())
+    result = replay_bag(bag, emulator_a)
+    with pytest.raises(ControlError, match="path must be the path"):
+        result.write_bag(value)
+
+
+@pytest.mark.parametrize(
+    "topic, message",
+    [(3, "must be a str"), ("", "must start with '/'"), ("imu", "must start with '/'")],
+)
+def test_written_topics_are_checked_as_the_replay_reads_them(topic, message, tmp_path):
+    for name in ("imu_topic", "odom_topic"):
+        with pytest.raises(ControlError, match=rf"{name} {message}"):
+            write_sensor_bag(tmp_path / "b", *_drive(), **{name: topic})
+    assert not (tmp_path / "b").exists()
+
+
+@pytest.mark.parametrize("topic", [None, 3, ["/imu/data"]])
+def test_reading_a_topic_that_is_no_str_is_a_control_error(topic, bag):
+    from control.robot.bags import read_recording
+
+    with pytest.raises(ControlError, match="imu_topic must be a str"):
+        read_recording(bag, imu_topic=topic)
