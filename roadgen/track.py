@@ -54,9 +54,13 @@ class Track(Road):
         """Prescribed GD at positions ``s`` (m): that of the segment holding each position.
 
         This is the step function the paper scores against; the realised roughness changes over
-        ``blend_m`` around each boundary and is tapered over the lead-in.
+        ``blend_m`` around each boundary and is tapered over the lead-in. Positions lie in [0,
+        end], end the segments' total length or the road's, whichever is longer: the grid
+        rounds the length to whole steps (by up to dx_m / 2), and the segments' own end stays
+        a position of the last one. RoadgenError for a position outside, or NaN.
         """
-        arr = checks.positions("s", s, self.length_m)
+        end = max(self.length_m, sum(length for length, _ in self.segments))
+        arr = checks.positions("s", s, end)
         idx = np.searchsorted(np.asarray(self.boundaries_m), arr, side="right") - 1
         gds = np.array([g for _, g in self.segments])
         out = gds[np.clip(idx, 0, len(gds) - 1)]

@@ -90,13 +90,14 @@ class RunSpec:
 class Campaign:
     """The campaign's table; arrays (n,) in design order.
 
-    v: speed, m/s. gd: GD, 1e-6 m^3. seed: the run's road seed, in [0, 2**128) (its noise seed
-    is [seed, 1]). f_full, f_window, f_full_noisy, f_window_noisy: (m/s^2)^2, finite where the
-    status is "ok", NaN for a failed run (see the module docstring for the spans). status: "ok"
-    or the failure message. settings: dict of the campaign's settings (model description, road,
-    sensor, window, solver, seed). accel, accel_measured: (n, keep) the last ``keep_s`` seconds
-    of each drive's noise-free and measured front-axle accelerations, m/s^2 (NaN rows for failed
-    runs); None unless kept.
+    v: speed, m/s. gd: GD, 1e-6 m^3. seed: the run's road seed, int64 in [0, 2**63) (its noise
+    seed is [seed, 1]; ``run_campaign`` draws them in [0, 2**32), as
+    ``SeedSequence(seed).generate_state(n)``). f_full, f_window, f_full_noisy, f_window_noisy:
+    (m/s^2)^2, finite where the status is "ok", NaN for a failed run (see the module docstring
+    for the spans). status: "ok" or the failure message. settings: dict of the campaign's
+    settings (model description, road, sensor, window, solver, seed). accel, accel_measured:
+    (n, keep) the last ``keep_s`` seconds of each drive's noise-free and measured front-axle
+    accelerations, m/s^2 (NaN rows for failed runs); None unless kept.
     """
 
     v: np.ndarray
@@ -113,7 +114,7 @@ class Campaign:
 
     def __post_init__(self) -> None:
         """Check the table (VehicleError naming the field) and hold its arrays as numpy arrays
-        (float v, gd, f and traces; int seed; str status), so that what is saved can be read."""
+        (float v, gd, f and traces; int64 seed; str status), so that what is saved can be read."""
         for name, array in _checked_table(self).items():
             object.__setattr__(self, name, array)
 
@@ -248,7 +249,13 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
         raise VehicleError(f"Campaign.seed and .status must be arrays: {exc}") from exc
     if seed.size == 0 and status.size == 0:  # an empty table: any dtype will do
         seed, status = seed.astype(np.int64), status.astype(str)
-    if seed.dtype.kind not in "iu":
+    if seed.dtype.kind in "fO" and not isinstance(c.seed, np.ndarray):
+        # integers beyond int64 in a list: numpy holds them as floats or objects
+        items = np.asarray(c.seed, dtype=object)
+        seed = items if all(map(_is_integer, items.flat)) else seed
+    if not (
+        seed.dtype.kind in "iu" or (seed.dtype.kind == "O" and all(map(_is_integer, seed.flat)))
+    ):
         raise VehicleError(f"Campaign.seed must hold integers, got dtype {seed.dtype}")
     if status.dtype.kind != "U":
         raise VehicleError(f"Campaign.status must hold strings, got dtype {status.dtype}")
@@ -257,11 +264,14 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
     if len(n) != 1 or any(out[k].shape != n for k in _ARRAYS):
         shapes = {k: out[k].shape for k in _ARRAYS}
         raise VehicleError(f"Campaign arrays must be 1-D of one length, got shapes {shapes}")
-    if np.any(seed < 0):  # an integer dtype holds nothing at or above 2**128
-        i = int(np.argmax(seed < 0))
+    beyond = np.asarray((seed < 0) | (seed > np.iinfo(np.int64).max), dtype=bool)
+    if np.any(beyond):
+        i = int(np.argmax(beyond))
         raise VehicleError(
-            f"Campaign.seed[{i}]={int(seed[i])} is out of range: allowed integers in [0, 2**128)"
+            f"Campaign.seed[{i}]={int(seed[i])} is out of range: allowed integers in [0, 2**63) "
+            "(the int64 column; run_campaign's seeds lie in [0, 2**32))"
         )
+    out["seed"] = seed.astype(np.int64)
     for name in ("v", "gd"):
         if not np.all(np.isfinite(out[name]) & (out[name] > 0)):
             raise VehicleError(f"Campaign.{name} must be finite and > 0 in every run")
@@ -299,6 +309,11 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
                 i = int(np.argmax(broken))
                 raise VehicleError(f"Campaign.{name}[{i}] is not finite but status[{i}] is 'ok'")
     return out
+
+
+def _is_integer(value: object) -> bool:
+    """Whether ``value`` is a Python or numpy integer (not a bool)."""
+    return isinstance(value, int | np.integer) and not isinstance(value, bool | np.bool_)
 
 
 def _through_link(path: Path) -> Path:
@@ -412,7 +427,9 @@ def run_campaign(
     Args:
         design: (n, 2) array [v (m/s), GD]; default ``lhs_design(198, seed=seed)``.
         model: default ``Jackal()``. band: road content band (cycles/m), default the full grid.
-        noise_std: accelerometer noise std for the ``*_noisy`` columns (paper: 1 m/s^2).
+        dx_m: the roads' grid step, m, in [``roadgen.checks.MIN_DX_M``, road_length_m / 1.5].
+        noise_std: accelerometer noise std for the ``*_noisy`` columns (paper: 1 m/s^2), in
+            [0, ``vehicle.sensor.MAX_NOISE_STD``].
         window: samples in the ``f_window`` span.
         executor: any ``concurrent.futures.Executor`` (e.g. a dask ``Client.get_executor()``);
             default a process pool over all cores, shut down at the end.
@@ -445,7 +462,7 @@ def run_campaign(
     design = lhs_design(198, seed=seed) if design is None else design
     points = check_design(design, model)
     road_length_m = checks.positive("road_length_m", road_length_m, unit="m")
-    dx_m = checks.positive("dx_m", dx_m, unit="m")
+    dx_m = checks.grid_step("dx_m", dx_m, road_length_m, "road_length_m")
     lead_in_m = checks.non_negative("lead_in_m", lead_in_m, unit="m")
     band = None if band is None else checks.band("band", band, 0.5 / dx_m)
     rate_hz = check_rate(rate_hz)

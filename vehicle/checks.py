@@ -11,6 +11,8 @@ limit. A program that has the memory raises it: ``vehicle.checks.MAX_MEMORY_BYTE
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from roadgen import checks as roadgen_checks
@@ -68,6 +70,24 @@ def positive(name: str, value: object, unit: str = "") -> float:
 def non_negative(name: str, value: object, unit: str = "") -> float:
     """``value`` as a float if it is a finite real number >= 0, else VehicleError."""
     return roadgen_checks.non_negative(name, value, VehicleError, unit)
+
+
+def grid_step(name: str, value: object, length_m: float, length_name: str) -> float:
+    """``value`` as a float if it is a road's grid step: in [``roadgen.checks.MIN_DX_M``,
+    ``MAX_DX_M``] m and leaving a road of ``length_m`` (the argument ``length_name``) at least 2
+    whole steps (at most length_m / 1.5, as ``roadgen.profile.grid_points`` rounds), else
+    VehicleError stating that range."""
+    v = real(name, value)
+    if not math.isfinite(v):
+        raise VehicleError(f"{name}={value!r} must be finite")
+    low, high = roadgen_checks.MIN_DX_M, roadgen_checks.MAX_DX_M
+    if not (low <= v <= high and round(length_m / v) >= 2):
+        raise VehicleError(
+            f"{name}={value!r} is out of range: allowed [{low:g}, {min(high, length_m / 1.5):.6g}] "
+            f"m (a road's grid step, at most {length_name} / 1.5: each road holds at least 2 "
+            "whole steps)"
+        )
+    return v
 
 
 def choice(name: str, value: object, allowed: tuple[str, ...]) -> str:

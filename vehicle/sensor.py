@@ -5,8 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from vehicle import checks
+from vehicle.errors import VehicleError
 from vehicle.models import Model
 from vehicle.road_input import RoadInput
+
+MAX_NOISE_STD = 1e100
+"""Largest accelerometer noise std, m/s^2: far beyond any sensor, and small enough that the
+measured samples and their variance over any drive (a campaign's f) stay finite."""
 
 
 def check_rate(rate_hz: float) -> float:
@@ -15,9 +20,16 @@ def check_rate(rate_hz: float) -> float:
 
 
 def check_noise(noise_std: float) -> float:
-    """Return the noise standard deviation as a float, or raise VehicleError unless a finite
-    real >= 0."""
-    return checks.non_negative("noise_std", noise_std, unit="m/s^2")
+    """Return the noise standard deviation as a float, or raise VehicleError unless a real in
+    [0, ``MAX_NOISE_STD``]."""
+    std = checks.non_negative("noise_std", noise_std, unit="m/s^2")
+    if std > MAX_NOISE_STD:
+        raise VehicleError(
+            f"noise_std={noise_std!r} is out of range: allowed [0, {MAX_NOISE_STD:g}] m/s^2 "
+            "(vehicle.sensor.MAX_NOISE_STD: far beyond any sensor; from about 1e154 the "
+            "measured accelerations' variance, f, overflows)"
+        )
+    return std
 
 
 def add_noise(accel: np.ndarray, noise_std: float, rng: np.random.Generator) -> np.ndarray:

@@ -100,8 +100,8 @@ def simulate(
             scalar; or a pair of arrays ``(points, speeds)`` read the same way (linear
             interpolation, constant beyond the ends). Every speed must lie in
             (0, model.max_speed_mps]. The schedule is followed exactly.
-        rate_hz: accelerometer sample rate, Hz. noise_std: accelerometer noise std, m/s^2.
-        seed: seed or Generator of the noise.
+        rate_hz: accelerometer sample rate, Hz. noise_std: accelerometer noise std, m/s^2, in
+            [0, ``vehicle.sensor.MAX_NOISE_STD``] (1e100). seed: seed or Generator of the noise.
         substeps: solver steps per sample period (fixed step 1 / (rate_hz * substeps)).
         envelope: the tyres follow the road enveloped by the model's wheel radius
             (``roadgen.wheel_envelope``); False: they follow the road's raw heights.

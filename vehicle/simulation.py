@@ -54,9 +54,10 @@ class Simulation:
 
     Args:
         model: HalfCar or Jackal. track: roadgen Track or Profile. rate_hz: accelerometer rate, Hz.
-        noise_std: accelerometer noise std, m/s^2. seed: seed or Generator of the noise (the
-            rear accelerometer's noise comes from a generator spawned from it, so the front
-            one's noise does not depend on whether the rear is read).
+        noise_std: accelerometer noise std, m/s^2, in [0, ``vehicle.sensor.MAX_NOISE_STD``].
+        seed: seed or Generator of the noise (the rear accelerometer's noise comes from a
+            generator spawned from it, so the front one's noise does not depend on whether the
+            rear is read).
         start_m: initial front-axle position, m, in [0, track length).
         substeps: solver steps per sample period.
         envelope: the tyres follow the track enveloped by the model's wheel radius (as in the

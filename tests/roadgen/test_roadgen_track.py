@@ -133,3 +133,18 @@ def test_track_built_directly_checks_boundaries_against_segments(change, match):
         roadgen.Track(**(fields | change))
     same = roadgen.Track(**(fields | {"boundaries_m": (0, 50, 100)}))
     assert same.gd_at(75.0) == 500.0 and same.boundaries_m == (0.0, 50.0, 100.0)
+
+
+def test_gd_at_takes_the_nominal_end_that_the_grid_rounds_off():
+    """10 + 10 m on a 6 mm grid is 3333 steps, 19.998 m: the segments' end, 20 m, is still a
+    position of the last segment (the step function is the segments'); beyond it is not."""
+    t = roadgen.track([(10, 100), (10, 200)], seed=0)
+    assert t.length_m == pytest.approx(19.998)
+    assert t.gd_at(20.0) == 200.0
+    np.testing.assert_array_equal(t.gd_at([0.0, 10.0, 19.998, 20.0]), [100, 200, 200, 200])
+    with pytest.raises(roadgen.RoadgenError, match=r"allowed positions are \[0, 20\] m"):
+        t.gd_at(20.001)
+    with pytest.raises(roadgen.RoadgenError, match="allowed positions"):
+        t.height_at(20.0)  # the heights end where the grid does
+    longer = roadgen.track([(10, 100), (10.004, 200)], seed=0)  # rounded up: 20.004 m of road
+    assert longer.length_m == pytest.approx(20.004) and longer.gd_at(20.004) == 200.0

@@ -511,3 +511,44 @@ def test_cache_write_failures_traces_and_folder_paths_are_named(tmp_path):
     np.savez(tmp_path / "lost.npz", **arrays)
     with pytest.raises(vehicle.CampaignFileError, match="keep 0.5 s of traces .* holds no"):
         vehicle.load_campaign(tmp_path / "lost.npz")
+
+
+def _hand_built(seed):
+    ones = np.ones(2)
+    return vehicle.Campaign(v=ones, gd=ones, seed=seed, f_full=ones, f_window=ones,
+                            f_full_noisy=ones, f_window_noisy=ones, status=np.array(["ok", "ok"]),
+                            settings={})  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "seed, shown",
+    [
+        ([1, 2**63], "9223372036854775808"),  # numpy would hold these as floats
+        ([1, 2**64], "18446744073709551616"),  # or as objects
+        ([1, 2**127], str(2**127)),
+        (np.array([1, 2**63], dtype=np.uint64), "9223372036854775808"),
+        (np.array([1, 2**70], dtype=object), str(2**70)),
+    ],
+)
+def test_seeds_beyond_the_int64_column_are_named_with_its_range(seed, shown):
+    with pytest.raises(
+        vehicle.VehicleError,
+        match=rf"^Campaign.seed\[1\]={shown} is out of range: allowed integers in \[0, 2\*\*63\)",
+    ):
+        _hand_built(seed)
+
+
+def test_a_hand_built_campaign_holds_its_seeds_as_int64_like_a_run_one(tmp_path):
+    """run_campaign's seeds are SeedSequence words (< 2**32) held as int64; any integer column
+    in [0, 2**63) is held the same way, and round trips."""
+    seeds = np.random.SeedSequence(0).generate_state(2)
+    assert seeds.dtype == np.uint32
+    for given in (seeds, seeds.tolist(), np.array([0, 2**63 - 1], dtype=np.uint64),
+                  [0, 2**63 - 1], np.array([3, 4], dtype=object)):  # fmt: skip
+        camp = _hand_built(given)
+        assert camp.seed.dtype == np.int64
+        np.testing.assert_array_equal(camp.seed, np.asarray(given).astype(np.int64))
+    camp.save(tmp_path / "c.npz")
+    assert vehicle.load_campaign(tmp_path / "c.npz").seed.tolist() == [3, 4]
+    with pytest.raises(vehicle.VehicleError, match=r"^Campaign.seed must hold integers"):
+        _hand_built(np.array([1, "a"], dtype=object))

@@ -178,3 +178,14 @@ def test_a_solver_step_too_coarse_for_the_stiffest_mode_warns_naming_the_substep
         vehicle.simulate(stiff, rough_road, 1.0, substeps=16)
         for model in (vehicle.Jackal(), vehicle.HalfCar()):
             vehicle.simulate(model, rough_road, 1.0)
+
+
+def test_the_largest_noise_std_keeps_the_measured_variance_finite(rough_road):
+    """noise_std up to vehicle.MAX_NOISE_STD: f, the measured accelerations' variance, stays
+    finite (1e154 overflowed it to inf, and 1e308 the samples themselves)."""
+    limit = vehicle.sensor.MAX_NOISE_STD
+    trace = vehicle.simulate(vehicle.Jackal(), rough_road, 2.0, noise_std=limit, seed=0)
+    for accel in (trace.accel_front_measured, trace.accel_rear_measured):
+        assert np.all(np.isfinite(accel)) and np.isfinite(np.var(accel))
+    with pytest.raises(vehicle.VehicleError, match=r"^noise_std=1e\+154 is out of range"):
+        vehicle.simulate(vehicle.Jackal(), rough_road, 2.0, noise_std=1e154)
