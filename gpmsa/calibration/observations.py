@@ -111,12 +111,32 @@ def _as_rows(value, name: str, ncols: int) -> np.ndarray:
     return arr
 
 
+def refuse_obs_data(**given) -> None:
+    """GPMSAError naming what to pass instead when an argument (``x_obs``, ``y_obs`` or
+    ``x_new``, by keyword) is a ``gpmsa.ObsData``: these functions take its arrays."""
+    for what, value in given.items():
+        if not isinstance(value, ObsData):
+            continue
+        if what == "x_new":
+            raise GPMSAError("x_new is a gpmsa.ObsData: pass its inputs, x_new=obs.x")
+        unused = [k for k in ("index", "precision") if getattr(value, k) is not None]
+        note = ""
+        if unused:
+            note = (f" (y_obs on the emulator's output grid; its {' and '.join(unused)} "
+                    f"{'is' if len(unused) == 1 else 'are'} not used here)")  # fmt: skip
+        raise GPMSAError(
+            f"{what} is a gpmsa.ObsData: pass its arrays, x_obs=obs.x, y_obs=obs.y{note}"
+        )
+
+
 def check_x(
     emulator, x_obs, extrapolate: bool, what: str = "x_obs"
 ) -> tuple[np.ndarray, np.ndarray]:
     """x_obs native (n, p) and unit scale; outside the emulator's x domain: GPMSAError, or with
     ``extrapolate=True`` a warning. ``what``: the argument's name in messages. An emulator
-    without known inputs (p = 0) takes None as one row of no columns (1, 0)."""
+    without known inputs (p = 0) takes None as one row of no columns (1, 0); a gpmsa.ObsData
+    is refused (`refuse_obs_data`)."""
+    refuse_obs_data(**{what: x_obs})
     p = emulator.x_unit.shape[1]
     if x_obs is None and p == 0:
         x_obs = np.empty((1, 0))
@@ -151,7 +171,9 @@ def obs_inputs(emulator, x_obs, y_obs, what: str = "x_obs"):
     """``x_obs`` as given, or, where it is None and the emulator has no known inputs (p = 0), an
     (n, 0) array: one row per observation of ``y_obs`` (each a replicate of the one experiment,
     as SEPIA's dummy x; a scalar output reads every value of ``y_obs`` as one observation).
-    GPMSAError when ``y_obs`` is None, or ``x_obs`` is None and the emulator has known inputs."""
+    GPMSAError when ``y_obs`` is None, or ``x_obs`` is None and the emulator has known inputs,
+    or either is a gpmsa.ObsData (`refuse_obs_data`)."""
+    refuse_obs_data(x_obs=x_obs, y_obs=y_obs)
     if y_obs is None:
         hint = ""
         if x_obs is not None and emulator.x_unit.shape[1] == 0:

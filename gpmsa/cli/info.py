@@ -120,8 +120,12 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
                     ", ".join(number(v, fmt) for v in vals if v is not None)
                     if isinstance(vals, list) else value(vals)
                 )  # fmt: skip
+            label = safe(name, 60)
+            if name == "theta":  # stored on the unit scale; printed native, as calibrate does
+                native = _native_theta(manifest, d["mean"])
+                label, cells["mean"] = native or ("theta (unit scale)", cells["mean"])
             lines.append(
-                f"posterior {safe(name, 60)}: mean [{safe(cells['mean'], 300)}] ESS "
+                f"posterior {label}: mean [{safe(cells['mean'], 300)}] ESS "
                 f"[{safe(cells['ess'], 300)}] R-hat [{safe(cells['rhat'], 300)}]"
             )
         else:
@@ -130,6 +134,21 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
     n_arr = sum(int(a.size) for a in arrays.values())
     lines.append(f"arrays:          {len(arrays)} ({n_arr} values)")
     return lines
+
+
+def _native_theta(manifest: dict, means: list) -> tuple[str, str] | None:
+    """The label and the theta means as NAME=VALUE in native units, lo + u (hi - lo) over each
+    parameter's domain (as ``gpmsa.fit``'s ``theta_native``) from the unit-scale means the
+    file's diagnostics hold; None for means that are not one number per parameter."""
+    names = manifest["names"]["t"]
+    real = all(isinstance(u, (int, float)) and not isinstance(u, bool) for u in means)
+    if not real or len(means) != len(names):
+        return None
+    cells = []
+    for n, u in zip(names, means, strict=True):
+        lo, hi = manifest["domain"][n]
+        cells.append(f"{safe(n, 60)}={number(lo + u * (hi - lo), '.4g')}")
+    return "theta (native)", ", ".join(cells)
 
 
 def _convergence_line(rec: object) -> str:

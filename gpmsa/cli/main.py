@@ -19,7 +19,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``gpmsa`` console script (and of ``python -m gpmsa.cli``)."""
+    """Entry point of the ``gpmsa`` console script (and of ``python -m gpmsa`` and
+    ``python -m gpmsa.cli``)."""
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)

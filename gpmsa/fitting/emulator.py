@@ -62,6 +62,10 @@ __all__ = [
 ]
 
 
+NO_DRAWS = "(built by Emulator.from_params, or read from a file without draws)"
+"""Why an emulator has no retained posterior draws, for the messages that need them."""
+
+
 @dataclass(frozen=True)
 class LooResult:
     """Exact leave-one-out predictions of the simulation runs (native units).
@@ -401,7 +405,10 @@ class Emulator:
         z = self._inputs(x, t)
         s = self.standardizer
         if not self.draws:
-            raise GPMSAError("this emulator has no posterior draws (built by from_params)")
+            raise GPMSAError(
+                f"this emulator has no posterior draws {NO_DRAWS}; pass draws=False to use its "
+                "point estimate"
+            )
         idx = evenly_spaced(self.n_draws, n_draws)
         means, vars_ = [], []
         with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
@@ -446,7 +453,7 @@ class Emulator:
 
         n_ch = int(self.settings.get("n_chains", 1)) or 1
         if self.n_draws == 0:
-            raise GPMSAError("this emulator has no posterior draws (built by from_params)")
+            raise GPMSAError(f"this emulator has no posterior draws {NO_DRAWS}")
         per, left = divmod(self.n_draws, n_ch)
         if left:
             raise GPMSAError(

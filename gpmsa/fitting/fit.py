@@ -158,7 +158,7 @@ def fit(
     kept = n_iter - n_burn
     thin = thinning(n_chains, kept, n_keep)  # each chain keeps ceil(kept / thin)
     # float64 whatever the backend sampled in (torch float32), a fixed parameter exactly at its
-    # value; a mean within its draws' range (a parameter that never moved: float rounding)
+    # value
     post = {k: np.asarray(v[:, n_burn:], dtype=float) for k, v in chains.draws.items()}
     for k in problem.fixed & set(post):
         post[k][...] = np.asarray(problem.init[k], dtype=float).reshape(post[k].shape[2:])
@@ -166,12 +166,7 @@ def fit(
     lp_kept = lp[:, ::thin].reshape(-1)
     n_kept = lp_kept.size  # explicit: an empty parameter (betaV when p = 0) has no -1 to infer
     retained = {k: v[:, ::thin].reshape(n_kept, *v.shape[2:]) for k, v in post.items()}
-    if point == "mean":
-        params = {k: np.clip(retained[k].mean(axis=0), retained[k].min(axis=0),
-                             retained[k].max(axis=0)) for k in EMULATOR_PARAMS}  # fmt: skip
-    else:
-        best = int(np.argmax(lp_kept))
-        params = {k: retained[k][best].copy() for k in EMULATOR_PARAMS}
+    params = point_estimate(retained, lp_kept, point)
     calibration = None
     if obs is not None:
         calibration = {k: v for k, v in retained.items() if k not in EMULATOR_PARAMS}
@@ -232,6 +227,18 @@ def thinning(n_chains: int, kept: int, n_keep: int) -> int:
     while n_chains * math.ceil(kept / thin) > n_keep:
         thin += 1
     return thin
+
+
+def point_estimate(draws: dict[str, np.ndarray], log_post: np.ndarray, point: str) -> dict:
+    """The emulator parameters' point estimate from their retained draws (n, *shape) and log
+    posteriors (n,): "mean" each element's mean within its draws' range (a parameter that never
+    moved keeps its value exactly: the mean of equal floats can round past it), "map" the draw
+    of the highest log posterior."""
+    if point == "mean":
+        return {k: np.clip(draws[k].mean(axis=0), draws[k].min(axis=0), draws[k].max(axis=0))
+                for k in EMULATOR_PARAMS}  # fmt: skip
+    best = int(np.argmax(log_post))
+    return {k: np.array(draws[k][best], dtype=float) for k in EMULATOR_PARAMS}
 
 
 def check_point(point) -> None:

@@ -12,7 +12,7 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa.errors import GPMSAError
-from gpmsa.fitting.emulator import Emulator
+from gpmsa.fitting.emulator import NO_DRAWS, Emulator
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import as_matrix, by_column_names, check_count, check_seed, evenly_spaced
 from gpmsa.model.likelihood import lower_cholesky
@@ -138,8 +138,7 @@ def param_sets(emulator, draws: bool, n_draws: int | None, what: str):
     if n == 0:
         raise GPMSAError(
             f"{what} with draws=True needs the emulator's retained posterior draws, but this "
-            "emulator kept none (built by Emulator.from_params, or read from a file without "
-            "draws); pass draws=False to use its point estimate"
+            f"emulator kept none {NO_DRAWS}; pass draws=False to use its point estimate"
         )
     idx = evenly_spaced(n, n_draws)
     sets = [{k: np.asarray(emulator.draws[k][i]) for k in EMULATOR_PARAMS} for i in idx]

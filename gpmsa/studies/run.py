@@ -14,7 +14,7 @@ from gpmsa.calibration.calibrate import calibration_problem
 from gpmsa.calibration.observations import check_emulator
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
-from gpmsa.fitting.fit import check_keep, check_point, thinning
+from gpmsa.fitting.fit import check_keep, check_point, point_estimate, thinning
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
@@ -258,10 +258,7 @@ def fit_study(
         flat = {k: v.reshape(-1, *v.shape[2:]) for k, v in post.items()}
         theta = draws["theta"][:, :, list(layout.index[i])]
         flat["theta"] = theta.reshape(-1, theta.shape[2])
-        if point == "mean":
-            params = {k: flat[k].mean(axis=0) for k in EMULATOR_PARAMS}
-        else:
-            params = {k: flat[k][int(np.argmax(lp))].copy() for k in EMULATOR_PARAMS}
+        params = point_estimate(flat, lp, point)
         cal = {k: v for k, v in flat.items() if k not in EMULATOR_PARAMS}
         cal["theta_native"] = prep.standardizer.t_from_unit(cal["theta"])
         emu_settings = {"n_iter": int(n_iter), "n_burn": int(n_burn), "thin": thin,

@@ -14,6 +14,7 @@ import gpmsa
 from gpmsa import GPMSAError, Posterior
 from gpmsa.calibration.calibrate import _discrepancy_draws
 from gpmsa.calibration.posterior import GridMarginal
+from gpmsa.predictive.calibrated import calibrated_predict
 
 PARAMS = {"betaU": [[1.0], [1.0], [1.0]], "lamUz": [1.0], "lamWs": [5000.0], "lamWOs": [5000.0]}
 
@@ -194,3 +195,28 @@ def test_calibrate_checks_n_emulator_draws_in_point_mode(n):
     emu, (x, y) = road_emulator(), road_obs()
     with pytest.raises(GPMSAError, match=r"n_emulator_draws must be an integer >= 1"):
         gpmsa.calibrate(emu, x, y, n_samples=20, n_burn=5, tune=False, n_emulator_draws=n)
+
+
+def test_an_obsdata_given_for_the_arrays_says_to_pass_its_x_and_y():
+    """calibrate, Calibrator.update and calibrated_predict take arrays; a gpmsa.ObsData in their
+    place is refused naming what to pass, not as a missing y_obs or a non-numeric x_obs."""
+    emu = road_emulator()
+    x, y = road_obs()
+    obs = gpmsa.ObsData(x=x, y=y)
+    want = r"x_obs is a gpmsa.ObsData: pass its arrays, x_obs=obs.x, y_obs=obs.y"
+    with pytest.raises(GPMSAError, match=want):
+        gpmsa.calibrate(emu, obs, n_samples=10, n_burn=0, tune=False)
+    with pytest.raises(GPMSAError, match=want):
+        gpmsa.calibrate(emu, obs, y, n_samples=10, n_burn=0, tune=False)
+    with pytest.raises(GPMSAError, match=want):
+        gpmsa.Calibrator(emu).update(obs)
+    with pytest.raises(GPMSAError, match="y_obs is a gpmsa.ObsData: pass its arrays"):
+        gpmsa.Calibrator(emu).update(x, obs)
+    with pytest.raises(GPMSAError, match=want):
+        gpmsa.calibrate(emu, x_obs=obs, discrepancy="constant", n_samples=10, n_burn=0)
+    post = gpmsa.Calibrator(emu).update(x, y)
+    with pytest.raises(GPMSAError, match=r"x_new is a gpmsa.ObsData: pass its inputs, x_new=obs.x"):
+        calibrated_predict(emu, post, obs)
+    gridded = gpmsa.ObsData(x=x, y=y, precision=4.0)
+    with pytest.raises(GPMSAError, match="its precision is not used here"):
+        gpmsa.Calibrator(emu).update(gridded)

@@ -121,6 +121,22 @@ def test_draws_of_an_emulator_file_that_kept_none_are_refused(tmp_path):
     assert pred.y.shape == (3, 1, 1)
 
 
+@pytest.mark.parametrize("loaded", [False, True])
+def test_emulator_predict_and_to_arviz_without_draws_name_both_sources(tmp_path, loaded):
+    """Emulator.predict(draws=True) and to_arviz on an emulator that kept no draws: the message
+    is true of one built by from_params and of one read from a file saved without draws."""
+    emu = two_param_emulator()
+    if loaded:
+        emu = gpmsa.load(emu.save(tmp_path / "no_draws.gpmsa"))
+    want = (
+        r"no posterior draws \(built by Emulator.from_params, or read from a file without draws\)"
+    )
+    with pytest.raises(GPMSAError, match=want + r"; pass draws=False"):
+        emu.predict([[0.5]], [[0.5, 0.5]], draws=True)
+    with pytest.raises(GPMSAError, match=want):
+        emu.to_arviz()
+
+
 @pytest.mark.parametrize(
     ("kw", "match"),
     [({"n_rlz": 0}, "n_rlz must be an integer >= 1"), ({"n_draws": 0}, "n_draws must be"),

@@ -178,3 +178,35 @@ def test_fit_study_takes_a_numpy_integer_n_iter_as_fit_does():
     study = _tiny_fit_study(n_iter=np.int64(20))
     assert study.settings["n_burn"] == 4
     assert study.members[0].n_draws == 16
+
+
+def test_fit_study_mean_point_lies_within_its_draws_as_fit_does():
+    """point="mean" clips each element's mean to its draws' range, as gpmsa.fit does: a
+    parameter whose draws never moved keeps exactly its value (the mean of equal floats can
+    round one ulp past it; seed 5 leaves model b's lamUz constant)."""
+    import warnings
+
+    t = np.linspace(0.1, 0.9, 12)[:, None]
+    x = np.tile([[0.0], [1.0]], (6, 1))
+    sim = gpmsa.SimData(x=x, t=t, y=(x + 2 * t), t_names=["E"])
+    obs = [gpmsa.ObsData(x=[[0.5]], y=[[1.5]]), gpmsa.ObsData(x=[[0.2]], y=[[1.2]])]
+    for seed in (5, 12):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # a run this short does not converge
+            study = gpmsa.fit_study([sim, sim], obs, shared=["E"], n_iter=12, n_burn=2,
+                                    seed=seed, tune=False)  # fmt: skip
+        for emu in study.members:
+            for k, v in emu.params.items():
+                d = emu.draws[k]
+                assert np.all(d.min(axis=0) <= v) and np.all(v <= d.max(axis=0)), (seed, k)
+
+
+def test_the_point_estimate_helper_clips_a_constant_mean():
+    from gpmsa.fitting.fit import point_estimate
+
+    draws = {k: np.full((3, 1), 0.1) for k in ("betaU", "lamUz", "lamWs", "lamWOs")}
+    assert np.mean(draws["lamUz"]) != 0.1  # (0.1 + 0.1 + 0.1) / 3 rounds up
+    params = point_estimate(draws, np.zeros(3), "mean")
+    assert all(np.array_equal(v, [0.1]) for v in params.values())
+    draws["lamUz"] = np.array([[1.0], [2.0], [3.0]])
+    assert point_estimate(draws, np.array([0.0, 5.0, 1.0]), "map")["lamUz"] == [2.0]
