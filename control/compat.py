@@ -243,12 +243,16 @@ def emulator_noise_std(emulator) -> float | None:
 
 
 def bcr_settings_for(emulator, **overrides) -> BCRSettings:
-    """BCR settings for the emulator's recorded feature: the change-point method for the block
-    feature, the paper's one-window estimator's filter for a window feature; the sensor checks
-    know the sensor's noise sd from the emulator's training noise (`emulator_noise_std`: the
-    noise-floor check). ``method=``, ``sensor=`` and any other `BCRSettings` field may be
-    overridden; a ``sensor=`` given replaces the emulator's noise sd too, so set its
-    ``noise_sd_mps2`` (the sensor's own, if lower than the training noise) to keep that check."""
+    """BCR settings for the emulator's recorded feature: method "changepoint" for the block
+    feature (log_band_power); for a window feature (log_var, var) method "filter": the paper's
+    windows, disjoint and interleaved, combined by a grid filter (`control.tracker`; the
+    default before the change-point method), not the paper's estimator of each window alone:
+    pass ``method="window"`` for that (as examples/closed_loop.py does for "the paper's
+    method"). The sensor checks know the sensor's noise sd from the emulator's training noise
+    (`emulator_noise_std`: the noise-floor check). ``method=``, ``sensor=`` and any other
+    `BCRSettings` field may be overridden; a ``sensor=`` given replaces the emulator's noise sd
+    too, so set its ``noise_sd_mps2`` (the sensor's own, if lower than the training noise) to
+    keep that check."""
     feature = overrides.pop("feature", None)
     if feature is None:
         feature = emulator_feature(emulator)

@@ -33,11 +33,48 @@ class GDError:
         return float(np.sqrt(self.sse / self.n)) if self.n else np.nan
 
 
+def _track_parts(track) -> tuple[np.ndarray, np.ndarray]:
+    """(start of each segment, m; its prescribed GD) of ``track``: `ControlError` naming what is
+    wrong where it lacks a roadgen Track's ``segments`` ((length_m, gd) pairs) and
+    ``boundaries_m`` (one finite start per segment, increasing)."""
+    for name in ("segments", "boundaries_m"):
+        if not hasattr(track, name):
+            raise ControlError(
+                f"track must be a roadgen Track (segments, boundaries_m), got {track!r:.60} "
+                f"({type(track).__name__}), which has no {name}"
+            )
+    try:
+        seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
+        starts = np.asarray(track.boundaries_m, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ControlError(
+            f"track.segments must hold (length_m, gd) pairs and track.boundaries_m numbers: {exc}"
+        ) from exc
+    if not seg_gd.size:
+        raise ControlError("track has no segment")
+    if starts.shape != seg_gd.shape:
+        raise ControlError(
+            f"track.boundaries_m must hold one start per segment, got {starts.size} for "
+            f"{seg_gd.size} segments"
+        )
+    if not (np.all(np.isfinite(starts)) and np.all(np.diff(starts) > 0)):
+        raise ControlError(f"track.boundaries_m must be finite and increasing, got {starts}")
+    return starts, seg_gd
+
+
 def segment_index(track, position: np.ndarray) -> np.ndarray:
-    """Index of the track segment holding each position (clipped to the first/last segment)."""
-    starts = np.asarray(track.boundaries_m, dtype=float)
-    idx = np.searchsorted(starts, np.asarray(position, dtype=float), side="right") - 1
-    return np.clip(idx, 0, len(track.segments) - 1)
+    """Index of the track segment holding each position (clipped to the first/last segment).
+    `ControlError` for a position that is NaN (it lies in no segment: leave it out first) and
+    for a ``track`` without a roadgen Track's segments and boundaries_m."""
+    starts, seg_gd = _track_parts(track)
+    position = float_array(position, "position")
+    if np.isnan(position).any():
+        raise ControlError(
+            f"position holds NaN at index {int(np.flatnonzero(np.isnan(position))[0])}: a "
+            "position that is NaN lies in no segment (leave it out first)"
+        )
+    idx = np.searchsorted(starts, position, side="right") - 1
+    return np.clip(idx, 0, seg_gd.size - 1)
 
 
 def _traces(position, values, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -65,9 +102,10 @@ def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDE
         One `GDError` per distinct prescribed GD, in increasing GD.
     """
     position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
-    seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
-    truth = seg_gd[segment_index(track, position)]
+    _, seg_gd = _track_parts(track)
     ok = np.isfinite(gd_estimate) & np.isfinite(position)
+    truth = np.full(position.shape, np.nan)  # no segment: left out
+    truth[ok] = seg_gd[segment_index(track, position[ok])]
     out = []
     for gd in np.unique(seg_gd):
         sel = ok & (truth == gd)
@@ -158,8 +196,8 @@ def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tu
     estimates that are not finite (NaN: none) detect nothing, as in `gd_errors`.
     """
     position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
-    starts = np.asarray(track.boundaries_m, dtype=float)
-    seg_gd = [gd for _, gd in track.segments]
+    starts, seg_gd = _track_parts(track)
+    seg_gd = seg_gd.tolist()
     finite = np.isfinite(gd_estimate)
     delays = []
     for k in range(1, len(seg_gd)):
@@ -187,6 +225,7 @@ def fast_on_rough_m(
     for name, value in (("gd_max", gd_max), ("v_safe", v_safe), ("tol", tol)):
         if not (is_real(value) and np.isfinite(value)):
             raise ControlError(f"{name} must be a finite real number, got {value!r}")
+    _, seg_gd = _track_parts(track)
     position, speed = _traces(position, speed, "speed")
     if not (np.all(np.isfinite(position)) and np.all(np.diff(position) >= 0)):
         raise ControlError("position must hold finite, non-decreasing samples, m")
@@ -194,7 +233,6 @@ def fast_on_rough_m(
         raise ControlError("speed must hold finite samples, m/s")
     if position.size < 2:
         return 0.0
-    seg_gd = np.array([gd for _, gd in track.segments], dtype=float)
     mid = 0.5 * (position[1:] + position[:-1])
     rough = seg_gd[segment_index(track, mid)] > gd_max
     fast = 0.5 * (speed[1:] + speed[:-1]) > v_safe + tol

@@ -57,7 +57,7 @@ import numpy as np
 
 from control.errors import ControlError
 from control.estimate import FAULT_STATUSES, Estimate
-from control.validation import check_instance, require_reals
+from control.validation import check_instance, is_real, require_reals
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
@@ -198,7 +198,10 @@ class Simplex:
 
     def on_speed_grid(self, speed: float) -> float:
         """``speed`` rounded down to the grid v_safe + k ``speed_step_mps`` (k any integer; v_max
-        and 0 are on it too), m/s; unchanged when the step is 0. Never above ``speed``."""
+        and 0 are on it too), m/s; unchanged when the step is 0. Never above ``speed``.
+        `ControlError` for a ``speed`` that is not a finite real number >= 0."""
+        if not (is_real(speed) and np.isfinite(speed) and speed >= 0):
+            raise ControlError(f"speed must be a finite real number >= 0, m/s, got {speed!r}")
         step = self.speed_step_mps
         if step == 0 or speed >= self.v_max:
             return speed

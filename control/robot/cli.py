@@ -7,14 +7,16 @@ BAG: a ROS 2 bag folder (MCAP or sqlite3), a ``*.mcap`` file or a ROS 1 ``*.bag`
 ``DIR/estimates.csv``, ``DIR/estimates/`` (a ROS 2 bag with the topic ``/bcr/estimate``) and
 ``DIR/replay.json`` (settings, what was found in the recording, timing; strict JSON: a number
 that is not finite, such as the rate of a topic with one message, is ``null``), and prints a
-summary. DIR is made only once the replay has run, and removed again (with the parents this
-made) if writing into it fails; a folder that was there before is never removed, none of the
-three outputs may be there already, and a failed write removes those it wrote.
+summary. DIR may not lie inside the recording (its bag folder, for a file given inside one),
+as ``replay_bag`` refuses its outputs there: replaying ``.`` from inside a bag folder needs an
+``--out`` outside it. DIR is made only once the replay has run, and removed again (with the
+parents this made) if writing into it fails; a folder that was there before is never removed,
+none of the three outputs may be there already, and a failed write removes those it wrote.
 Exit status 0 on success, also for a recording too short for one estimate (the summary then
-says "no estimate" and why); 2 with a one-line message on a usage error (``--out`` a file, a
-setting out of range), an emulator file that is missing or cannot be loaded, a recording that
-cannot be replayed (a missing topic, a damaged file, ...) or a missing extra (the message says
-which extra to install).
+says "no estimate" and why); 2 with a one-line message on a usage error (``--out`` a file or
+inside the recording, a setting out of range), an emulator file that is missing or cannot be
+loaded, a recording that cannot be replayed (a missing topic, a damaged file, ...) or a
+missing extra (the message says which extra to install).
 """
 
 from __future__ import annotations
@@ -39,7 +41,9 @@ from control.robot.replay import (
     ReplayResult,
     ReplaySettings,
     load_emulator,
+    overlapped_input,
     replay_bag,
+    replay_inputs,
 )
 from control.simplex import Simplex
 from gpmsa.io.atomic import atomic_write
@@ -68,6 +72,21 @@ def _check_out(out: Path) -> None:
         raise ControlError(
             f"{out / there_already[0]} exists already: choose another --out (this command "
             f"writes {', '.join(OUTPUTS)} and overwrites none of them)"
+        )
+
+
+def _check_out_apart(out: Path, bag: Path, default: bool) -> None:
+    """`ControlError` where ``out`` is, or lies inside, the recording (the whole bag folder of a
+    file given inside one), as `replay_bag` refuses its ``csv`` and ``out_bag`` there (an
+    emulator file holds no folder; ``out`` that file: `_check_out`); ``default``: ``out`` is
+    the default, BAG's name + _bcr."""
+    what = overlapped_input(out, replay_inputs(bag, None))
+    if what is not None:
+        given = (f"the default --out {str(out)!r} (BAG's name + _bcr, in the current folder)"
+                 if default else f"--out {str(out)!r}")  # fmt: skip
+        raise ControlError(
+            f"{given} lies inside {what}: the outputs would be written into what is read; "
+            "give --out a folder outside it"
         )
 
 
@@ -129,7 +148,11 @@ def parser() -> argparse.ArgumentParser:
         help="the emulator file (*.gpmsa) trained for this vehicle and IMU; A or B: the shipped "
         "Jackal ones (noise-free / N(0, 1) noise)",
     )  # fmt: skip
-    p.add_argument("--out", default=None, help="output folder (default: BAG's name + _bcr)")
+    p.add_argument(
+        "--out", default=None,
+        help="output folder, outside the recording (default: BAG's name + _bcr, in the current "
+        "folder)",
+    )  # fmt: skip
     p.add_argument("--imu-topic", default=DEFAULTS.imu_topic, help="sensor_msgs/msg/Imu topic")
     p.add_argument("--odom-topic", default=DEFAULTS.odom_topic, help="nav_msgs/msg/Odometry topic")
     p.add_argument(
@@ -198,6 +221,7 @@ def main(argv: list[str] | None = None) -> int:
             storage=args.storage,
         )
         simplex = Simplex(v_max=args.v_max, v_safe=args.v_safe)
+        _check_out_apart(out, bag, args.out is None)
         _check_out(out)
         emulator = load_emulator(args.emulator, "--emulator")
         check_emulator(emulator, simplex=simplex)

@@ -171,6 +171,11 @@ def increasing(t: np.ndarray) -> np.ndarray:
     return keep
 
 
+def _imu(topic: str | None) -> str:
+    """The IMU's topic for a message ("the IMU topic '/imu/data'")."""
+    return "the IMU topic" if topic is None else f"the IMU topic {topic!r}"
+
+
 def _ratio(rate_in: float, rate_out: float) -> tuple[int, int]:
     """(up, down), up / down nearest rate_out / rate_in (< 1) with down at most 100, or at
     most the whole number above rate_in / rate_out where that is more (never up = 0)."""
@@ -179,11 +184,13 @@ def _ratio(rate_in: float, rate_out: float) -> tuple[int, int]:
     return frac.numerator, frac.denominator
 
 
-def resampling_filter(rate_in: float, rate_out: float, method: str) -> tuple[int, int, np.ndarray]:
+def resampling_filter(
+    rate_in: float, rate_out: float, method: str, topic: str | None = None
+) -> tuple[int, int, np.ndarray]:
     """(up, down, FIR coefficients at the upsampled rate) of `to_rate`'s ``method``:
     "sample": cut-off 0.45 rate_in, transition 0.1 rate_in wide, 60 dB (`scipy.signal.kaiserord`);
     "lowpass": resample_poly's own design (cut-off rate_out / 2, 20 max(up, down) + 1 taps,
-    Kaiser beta 5)."""
+    Kaiser beta 5). ``topic``: the IMU's topic, named in a `BagError`."""
     from scipy.signal import firwin, kaiserord  # here, not at import (tests/test_import_cost.py)
 
     if method not in METHODS:
@@ -194,9 +201,10 @@ def resampling_filter(rate_in: float, rate_out: float, method: str) -> tuple[int
         half_len = 10 * max(up, down)
         if 2 * half_len + 1 > MAX_LOWPASS_TAPS:
             raise BagError(
-                f"the IMU's stamps say {rate_in:.4g} Hz: resampling that to {rate_out:g} Hz with "
-                f"'lowpass' needs a filter of {2 * half_len + 1} taps, above MAX_LOWPASS_TAPS = "
-                f"{MAX_LOWPASS_TAPS}; check the IMU's time stamps (or use resample 'sample')"
+                f"the stamps of {_imu(topic)} say {rate_in:.4g} Hz: resampling that to "
+                f"{rate_out:g} Hz with 'lowpass' needs a filter of {2 * half_len + 1} taps, above "
+                f"MAX_LOWPASS_TAPS = {MAX_LOWPASS_TAPS}; check the IMU's time stamps (or use "
+                "resample 'sample')"
             )
         return up, down, firwin(2 * half_len + 1, 1.0 / max(up, down), window=("kaiser", 5.0))
     grid = fs / up
@@ -206,7 +214,7 @@ def resampling_filter(rate_in: float, rate_out: float, method: str) -> tuple[int
 
 def to_rate(
     t: np.ndarray, a: np.ndarray, rate_hz: float, tolerance: float = 0.02,
-    method: str = "sample",
+    method: str = "sample", topic: str | None = None,
 ) -> tuple[np.ndarray, np.ndarray, Resampling]:  # fmt: skip
     """The samples (t s, a) at ``rate_hz`` (see the module docstring).
 
@@ -217,27 +225,29 @@ def to_rate(
         tolerance: relative difference of the nominal rate from ``rate_hz`` within which the
             samples are used as recorded.
         method: "sample" or "lowpass" (see the module docstring).
+        topic: the IMU's topic, named in a `BagError`.
 
     Returns:
-        (t, a, `Resampling`). Raises `BagError` for an input slower than ``rate_hz``.
+        (t, a, `Resampling`). Raises `BagError` for an input with fewer than two distinct
+        stamps, slower than ``rate_hz`` or, for "lowpass", with stamps too close together.
     """
     from scipy import signal  # (as in `resampling_filter`)
 
     t, a = np.asarray(t, dtype=float), np.asarray(a, dtype=float)
     period = nominal_period(t)
     if not np.isfinite(period):
-        raise BagError("the IMU topic has fewer than two distinct time stamps")
+        raise BagError(f"{_imu(topic)} has fewer than two distinct time stamps")
     rate_in = 1.0 / period
     if abs(rate_in / rate_hz - 1.0) <= tolerance:
         text = f"none: the IMU's {rate_in:.4g} Hz is the emulator's {rate_hz:g} Hz"
         return t, a, Resampling(rate_in, rate_hz, False, filter=text)
     if rate_in < rate_hz:
         raise BagError(
-            f"the IMU runs at {rate_in:.4g} Hz, slower than the emulator's {rate_hz:g} Hz: its "
-            f"samples hold nothing above {rate_in / 2:.4g} Hz, and the emulator's feature needs "
-            f"up to {rate_hz / 2:g} Hz (record the IMU at >= {rate_hz:g} Hz)"
+            f"{_imu(topic)} runs at {rate_in:.4g} Hz, slower than the emulator's {rate_hz:g} "
+            f"Hz: its samples hold nothing above {rate_in / 2:.4g} Hz, and the emulator's "
+            f"feature needs up to {rate_hz / 2:g} Hz (record the IMU at >= {rate_hz:g} Hz)"
         )
-    up, down, fir = resampling_filter(rate_in, rate_hz, method)
+    up, down, fir = resampling_filter(rate_in, rate_hz, method, topic)
     grid_rate = rate_hz * down / up
     trim = math.ceil((fir.size - 1) / 2 / down)
     finite = np.isfinite(a)

@@ -476,18 +476,18 @@ def replay_bag(
 
 def _check_outputs(bag: Path, emulator, csv, out_bag) -> tuple[Path | None, Path | None]:
     """``csv`` and ``out_bag`` as Paths, checked before the replay: `ControlError` where one is
-    not a path, lies in or on an input (`_inputs`), both are the same, ``out_bag`` exists
+    not a path, lies in or on an input (`replay_inputs`), both are the same, ``out_bag`` exists
     (even as a dangling link) or ``csv`` is refused by `check_csv_target`."""
-    inputs = _inputs(bag, emulator)
+    inputs = replay_inputs(bag, emulator)
     paths = []
     for name, value in (("csv", csv), ("out_bag", out_bag)):
         if value is None:
             paths.append(None)
             continue
         path = path_argument(value, name)
-        for what, read in inputs:
-            if _overlaps(path, read):
-                raise ControlError(f"{name}={str(path)!r} would overwrite {what}")
+        what = overlapped_input(path, inputs)
+        if what is not None:
+            raise ControlError(f"{name}={str(path)!r} would overwrite {what}")
         paths.append(path)
     csv, out_bag = paths
     if csv is not None and out_bag is not None and csv.resolve() == out_bag.resolve():
@@ -500,7 +500,7 @@ def _check_outputs(bag: Path, emulator, csv, out_bag) -> tuple[Path | None, Path
     return csv, out_bag
 
 
-def _inputs(bag: Path, emulator) -> list[tuple[str, Path]]:
+def replay_inputs(bag: Path, emulator) -> list[tuple[str, Path]]:
     """(what it is, for a message; the path read) of each input on disk: the recording (its
     whole bag folder for a file given inside one, as `read_recording` reads it) and the
     emulator file where ``emulator`` is given as a path."""
@@ -513,6 +513,12 @@ def _inputs(bag: Path, emulator) -> list[tuple[str, Path]]:
             and not (isinstance(emulator, str) and emulator in SHIPPED)):  # fmt: skip
         inputs.append((f"the emulator file {str(emulator)!r}", Path(emulator)))
     return inputs
+
+
+def overlapped_input(target: Path, inputs: list[tuple[str, Path]]) -> str | None:
+    """What of ``inputs`` (`replay_inputs`: the recording, the emulator file) writing ``target``
+    would replace or write into (for a message), or None."""
+    return next((what for what, read in inputs if _overlaps(target, read)), None)
 
 
 def _overlaps(target: Path, source: Path) -> bool:
@@ -659,7 +665,9 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
         condition.check_stream(rec.imu.topic, t_imu, np.isfinite(accel), base, note),
         condition.check_stream(rec.odometry.topic, t_odom, odom_finite, base, note),
     )
-    t, a, resampling = condition.to_rate(t_imu, accel, rate_hz, s.rate_tolerance, s.resample)
+    t, a, resampling = condition.to_rate(
+        t_imu, accel, rate_hz, s.rate_tolerance, s.resample, rec.imu.topic
+    )
     if t.size == 0:  # resampled: every run too short for the filter's start-up at both ends
         raise BagError(
             f"the IMU topic {rec.imu.topic!r} gives no sample at {rate_hz:g} Hz: resampling "

@@ -78,6 +78,45 @@ def test_traces_of_different_lengths_or_not_numbers_are_refused(call):
         call()
 
 
+def test_a_position_that_is_nan_has_no_segment():
+    """segment_index put NaN in the last segment; callers that did not mask it charged it
+    there. gd_errors leaves such estimates out (above); the index refuses them."""
+    from control.metrics import segment_index
+
+    assert segment_index(TRACK, [-5.0, 10.0, 60.0, 149.0, 1e9]).tolist() == [0, 0, 1, 2, 2]
+    with pytest.raises(ControlError, match=r"position holds NaN .*no segment"):
+        segment_index(TRACK, [10.0, np.nan])
+    with pytest.raises(ControlError, match="position"):
+        segment_index(TRACK, ["10"])
+
+
+BAD_TRACKS = [
+    (None, "NoneType"),
+    ("track", "str"),
+    (SimpleNamespace(segments=((50.0, 300.0),)), "boundaries_m"),
+    (SimpleNamespace(segments=((50.0, 300.0),), boundaries_m=(0.0, 50.0)), "one start"),
+    (SimpleNamespace(segments=(), boundaries_m=()), "no segment"),
+    (SimpleNamespace(segments=(("a", "b"),), boundaries_m=(0.0,)), "segments"),
+    (SimpleNamespace(segments=((50.0, 300.0), (50.0, 500.0)), boundaries_m=(50.0, 0.0)), "increas"),
+]
+
+
+@pytest.mark.parametrize("track, what", BAD_TRACKS)
+def test_the_metrics_refuse_what_is_no_track_naming_it(track, what):
+    """None gave an AttributeError; boundaries that do not match the segments were read as
+    they came."""
+    from control.metrics import segment_index
+
+    for call in (
+        lambda: segment_index(track, [1.0]),
+        lambda: gd_errors(track, [1.0], [300.0]),
+        lambda: detection_delays(track, [1.0], [300.0]),
+        lambda: fast_on_rough_m(track, [1.0, 2.0], [1.0, 1.0], 350.0, 1.0),
+    ):
+        with pytest.raises(ControlError, match=rf"^track\b.*{what}"):
+            call()
+
+
 def test_fast_on_rough_refuses_positions_that_go_backwards():
     with pytest.raises(ControlError, match="non-decreasing"):
         fast_on_rough_m(TRACK, [69.0, 62.0], [2.0, 2.0], 350.0, 1.0)

@@ -406,3 +406,23 @@ def test_reading_a_topic_that_is_no_str_is_a_control_error(topic, bag):
 
     with pytest.raises(ControlError, match="imu_topic must be a str"):
         read_recording(bag, imu_topic=topic)
+
+
+def test_imu_stamp_errors_name_the_imu_topic(tmp_path):
+    """As docs/robot.md says of the BagErrors about a topic: "fewer than two distinct time
+    stamps" said "the IMU topic" without its name, as did an IMU too slow and stamps too close
+    for "lowpass"."""
+    from control.errors import BagError
+
+    t, accel, _, pos, spd = _drive()
+    cases = (
+        (np.full(t.size, 1.5), {}, "has fewer than two distinct time stamps"),
+        (1.0 + np.arange(t.size) / 60.0, {}, r"runs at 60 Hz, slower than the emulator's"),
+        (1.0 + np.arange(t.size) * 1e-9, {"resample": "lowpass"}, r"needs a filter of \d+ taps"),
+    )
+    for k, (stamps, settings, message) in enumerate(cases):
+        odom = np.linspace(stamps[0], stamps[-1] + 1.0, t.size)
+        path = write_sensor_bag(tmp_path / f"b{k}", stamps, accel, odom, pos, spd,
+                                imu_topic="/my/imu")  # fmt: skip
+        with pytest.raises(BagError, match=rf"IMU topic '/my/imu'.*{message}"):
+            replay_bag(path, "A", imu_topic="/my/imu", **settings)

@@ -105,3 +105,37 @@ def test_a_truncated_bare_mcap_file_is_named_truncated_with_its_size(bag, tmp_pa
         read_recording(cut)
     cut.write_bytes(data)
     assert read_recording(cut).imu.stamp_ns.size == 400  # whole, it reads
+
+
+def _snapshot(folder):
+    """Every path under ``folder`` with the bytes of each file (None for a folder)."""
+    return {p: (p.read_bytes() if p.is_file() else None) for p in folder.rglob("*")}
+
+
+def test_terrain_replay_never_writes_into_the_recording_it_reads(bag, tmp_path, monkeypatch,
+                                                                 capsys):  # fmt: skip
+    """As replay_bag refuses csv and out_bag there: replaying "." put the default --out, "_bcr",
+    inside the bag folder, and an --out in it (or the folder itself) was written into."""
+    from control.robot import cli
+
+    mcap = next(bag.glob("*.mcap"))
+    before = _snapshot(bag)
+    monkeypatch.chdir(bag)
+    for argv, default in (
+        (["."], True),  # the default --out, "_bcr", in the bag folder
+        ([mcap.name], True),  # a file of the bag folder: the folder is read
+        ([bag, "--out", bag / "sub"], False),
+        ([bag, "--out", bag], False),
+        ([mcap, "--out", bag / "sub" / "deeper"], False),
+        ([".", "--out", "sub"], False),
+    ):
+        code = cli.main([str(a) for a in argv] + ["--emulator", "A"])
+        err = capsys.readouterr().err
+        assert code == 2 and "lies inside the recording" in err, (argv, err)
+        assert ("the default --out" in err) == default, err
+        assert err.count("\n") == 1
+    assert _snapshot(bag) == before
+    assert read_recording(bag).imu.stamp_ns.size == 400
+    monkeypatch.chdir(tmp_path)  # beside the bag, the default is made and written
+    assert cli.main([str(bag.name), "--emulator", "A"]) == 0
+    assert (tmp_path / "drive_bcr" / "replay.json").is_file()

@@ -192,6 +192,14 @@ def test_the_speed_grid_keeps_its_end_points_and_stops():
     assert Simplex(speed_step_mps=0).on_speed_grid(1.2345) == 1.2345  # no grid: the law as is
 
 
+@pytest.mark.parametrize("speed", [-1.0, -1e-12, np.nan, np.inf, "1.5", None, True])
+@pytest.mark.parametrize("step", [0.1, 0.0])
+def test_the_speed_grid_refuses_a_speed_that_is_no_finite_number_at_least_0(speed, step):
+    """-1 came back as -1, NaN and inf as themselves, a string as a bare TypeError."""
+    with pytest.raises(ControlError, match=r"speed must be a finite real number >= 0, m/s, got"):
+        Simplex(speed_step_mps=step).on_speed_grid(speed)
+
+
 def test_on_the_speed_grid_an_invisible_change_of_the_estimate_changes_no_command():
     s = Simplex(speed_step_mps=0.1)
     gds = np.linspace(251, 349, 200)
