@@ -49,10 +49,27 @@ class GridMarginal:
         cls, nodes: np.ndarray, log_density: np.ndarray, weights: np.ndarray | None = None
     ) -> GridMarginal:
         """Normalise exp(log_density) on ``nodes`` (any additive constant); ``weights``: the
-        grid's trapezoid weights when already known."""
+        grid's trapezoid weights when already known. GPMSAError unless ``nodes`` are at least 2
+        finite, strictly increasing values and ``log_density`` one value per node, none NaN or
+        +inf, some finite (-inf: zero density)."""
         nodes = np.asarray(nodes, dtype=float)
+        log_density = np.asarray(log_density, dtype=float)
+        if nodes.ndim != 1 or nodes.size < 2:
+            raise GPMSAError(f"a grid marginal needs at least 2 finite nodes (k,), got "
+                             f"{nodes.size} of shape {nodes.shape}")  # fmt: skip
+        # strictly increasing between finite ends: all finite (a NaN fails the comparison)
+        if not (np.min(np.diff(nodes)) > 0 and np.isfinite(nodes[0]) and np.isfinite(nodes[-1])):
+            raise GPMSAError("a grid marginal's nodes must be finite and strictly increasing")
+        if log_density.shape != nodes.shape:
+            raise GPMSAError(f"log_density must have one value per node {nodes.shape}, got "
+                             f"{log_density.shape}")  # fmt: skip
+        top = np.max(log_density)  # NaN if any is NaN
+        if np.isnan(top) or top == np.inf:
+            raise GPMSAError("log_density must not be NaN or +inf")
+        if top == -np.inf:
+            raise GPMSAError("log_density is -inf at every node: the density has no mass")
         w = trapezoid_weights(nodes) if weights is None else weights
-        f = np.exp(log_density - np.max(log_density))
+        f = np.exp(log_density - top)
         return cls(nodes, f / float(w @ f), w)
 
     def _cell_mass(self) -> np.ndarray:
@@ -313,7 +330,16 @@ class Posterior:
     def samples(self) -> dict[str, np.ndarray]:
         """Named draws, native units: name -> (n_draws,)."""
         if self._samples is None:
-            self._samples = _checked_samples(self._draw())
+            drawn = _checked_samples(self._draw())
+            missing = [n for n in (*(self.info.get("names") or ()), *self.grids)
+                       if n not in drawn]  # fmt: skip
+            if missing:
+                raise GPMSAError(
+                    f"the draw callable returned samples of {tuple(drawn)}, but the posterior "
+                    f"has {sorted(set(missing))} (info['names'] or grids) too: draw every "
+                    "parameter"
+                )
+            self._samples = drawn
         return self._samples
 
     @property

@@ -180,3 +180,39 @@ def test_the_hdi_of_draws_is_arviz_and_bad_arguments_are_named():
         post.hdi("y")
     with pytest.raises(GPMSAError, match="level"):
         post.hdi("x", 1.5)
+
+
+@pytest.mark.parametrize(
+    ("nodes", "log_density", "message"),
+    [
+        ([0.5], [0.0], "at least 2 finite nodes"),
+        ([0.0, np.nan, 1.0], [0.0, 0.0, 0.0], "finite and strictly increasing"),
+        ([1.0, 0.5, 0.0], [0.0, 0.0, 0.0], "strictly increasing"),
+        ([0.0, 0.5, 0.5], [0.0, 0.0, 0.0], "strictly increasing"),
+        ([0.0, 0.5, 1.0], [0.0, 0.0], r"one value per node \(3,\), got \(2,\)"),
+        ([0.0, 0.5, 1.0], [0.0, np.nan, 0.0], "NaN or \\+inf"),
+        ([0.0, 0.5, 1.0], [0.0, np.inf, 0.0], "NaN or \\+inf"),
+        ([0.0, 0.5, 1.0], [-np.inf] * 3, "no mass"),
+    ],
+)
+def test_a_grid_marginal_of_bad_nodes_or_densities_is_refused(nodes, log_density, message):
+    """Before: one node, unsorted nodes, NaN or no mass gave a NaN density (mean NaN) silently;
+    a length mismatch failed inside numpy's matmul."""
+    with pytest.raises(GPMSAError, match=message):
+        GridMarginal.from_log_density(np.array(nodes), np.array(log_density))
+    g = GridMarginal.from_log_density(np.array([0.0, 1.0]), np.array([-np.inf, 0.0]))
+    assert g.mean() == pytest.approx(1.0) and g.ppf(1.0) == 1.0  # trapezoid moments
+
+
+def test_a_lazy_draw_lacking_an_announced_parameter_is_named():
+    """Before: summary() (or mean of a name only the draw had to give) raised a bare KeyError."""
+    g = gaussian_grid()
+    post = Posterior(grids={"b": g}, draw=lambda: {"a": np.arange(5.0)}, info={"names": ["a", "b"]})
+    assert post.mean("b") == pytest.approx(3.0)  # from the grid: nothing drawn yet
+    with pytest.raises(GPMSAError, match=r"returned samples of \('a',\).*\['b'\]"):
+        post.summary()
+    lazy = Posterior(draw=lambda: {"a": np.arange(5.0)}, info={"names": ["b"]})
+    with pytest.raises(GPMSAError, match=r"\['b'\]"):
+        lazy.mean("b")
+    ok = Posterior(grids={"b": g}, draw=lambda: {"b": np.arange(5.0)}, info={"names": ["b"]})
+    assert ok.summary()["b"]["n_draws"] == 5
