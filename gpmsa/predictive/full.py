@@ -275,11 +275,11 @@ def _check_fitted_discrepancy(emulator, discrepancy) -> None:
         )
 
 
-def _check_fitted_obs(emulator, obs: ObsData) -> None:
+def _check_fitted_obs(settings: dict, obs: ObsData) -> None:
     """GPMSAError when ``obs`` has other experiments (their count or lengths) or other values
-    than the joint fit's, where the fit recorded them (settings "obs_lengths", "obs_sha256";
-    files written before the digest are checked by their lengths alone)."""
-    settings = getattr(emulator, "settings", None) or {}
+    than the joint fit's, where the fit recorded them (its ``settings``, or the info of its
+    `calibration_posterior`: "obs_lengths", "obs_sha256"; files written before the digest are
+    checked by their lengths alone)."""
     fitted = settings.get("obs_lengths")
     lengths = [int(e.size) for e in obs.experiments]
     if fitted is not None and lengths != list(fitted):
@@ -379,8 +379,9 @@ def full_prediction(
     elif posterior is None:
         _check_fitted_discrepancy(emulator, discrepancy)
     if posterior is None:
-        _check_fitted_obs(emulator, obs)
+        _check_fitted_obs(getattr(emulator, "settings", None) or {}, obs)
     else:
+        _check_fitted_obs(getattr(posterior, "info", None) or {}, obs)  # a joint fit's draws
         _check_calibrated_obs(posterior, obs, emulator.x_names)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
     idx, sets = _posterior_sets(emulator, posterior, n_draws)

@@ -14,7 +14,9 @@ def calibration_posterior(emulator) -> Posterior:
     Samples (native units): each calibration parameter under its name in ``emulator.t_names``,
     ``lamOs``, and with a discrepancy ``lamVz`` and ``betaV`` (``betaV[k]`` per known input when
     p > 1). ``chains`` splits the retained draws into the fit's chains, so ``to_arviz()``,
-    ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``.
+    ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``. ``info`` carries the
+    fit's record of its observations ("obs_lengths", "obs_sha256"), so that
+    ``gpmsa.full_prediction(..., posterior=)`` refuses other ones, as it does without it.
 
     Example:
         >>> import numpy as np, gpmsa
@@ -58,6 +60,7 @@ def calibration_posterior(emulator) -> Posterior:
         "names": list(samples),
         "n_chains": n_chains,
         **{k: emulator.settings[k] for k in ("n_iter", "n_burn", "thin", "seed", "backend",
-                                              "discrepancy") if k in emulator.settings},
+                                              "discrepancy", "obs_lengths", "obs_sha256")
+           if k in emulator.settings},
     }  # fmt: skip
     return Posterior(samples, chains=chains, info=info)

@@ -234,6 +234,15 @@ def test_discrepancy_and_obs_must_be_the_joint_fits():
     same = full_prediction(emu, obs, [[0.5]], discrepancy="linear", n_draws=2, seed=0)
     default = full_prediction(emu, obs, [[0.5]], n_draws=2, seed=0)
     np.testing.assert_array_equal(same.y, default.y)
+    # the joint fit's draws passed as posterior= (calibration_posterior) carry the same record:
+    # other observations were accepted there without a check
+    post = gpmsa.calibration_posterior(emu)
+    assert post.info["obs_sha256"] == emu.settings["obs_sha256"]
+    for other in (*others, fewer):
+        with pytest.raises(GPMSAError, match="pass the ObsData the fit used"):
+            full_prediction(emu, other, [[0.5]], posterior=post, discrepancy="linear")
+    assert full_prediction(emu, obs, [[0.5]], posterior=post, discrepancy="linear",
+                           n_draws=2, seed=0).y.shape[1:] == default.y.shape[1:]  # fmt: skip
 
 
 def test_huge_realization_counts_are_refused_before_allocating():
