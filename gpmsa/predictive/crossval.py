@@ -26,6 +26,7 @@ from scipy.special import ndtr
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
+from gpmsa.limits import check_memory
 from gpmsa.model.data import check_flag, check_level
 from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, rng_of
 
@@ -147,6 +148,9 @@ def cross_validate(
     labels = _fold_labels(folds, m, seed)
     groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1)]
     idx, sets = param_sets(emulator, draws, n_draws, "cross_validate")
+    check_memory(  # per draw: each component's Cholesky factor, the precision, their work copies
+        8.0 * (p_u + 3) * m * m, f"cross_validate: {p_u} covariance factors of {m} x {m} runs"
+    )
     std = emulator.standardizer
     y_std = std.y_to_std(emulator.y)
     K2 = emulator.K**2

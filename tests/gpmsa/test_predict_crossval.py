@@ -118,3 +118,15 @@ def test_no_draws_kept():
         cross_validate(two_param_emulator())
     with pytest.raises(GPMSAError, match=r"level must be a number in \(0, 1\)"):
         cross_validate(two_param_emulator(), draws=False).coverage(1.0)
+
+
+def test_a_cross_validation_beyond_the_memory_limit_is_refused_before_its_factors(monkeypatch):
+    """Per draw it holds each component's m x m Cholesky factor and the precision: checked against
+    gpmsa.limits.MAX_MEMORY_BYTES first, as the other predictive functions are (was unchecked)."""
+    emu = two_param_emulator()
+    need = 8.0 * (emu.p_u + 3) * emu.m**2
+    monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", need - 1)
+    with pytest.raises(gpmsa.ResourceLimitError, match=r"cross_validate: \d+ covariance factors"):
+        cross_validate(emu, draws=False)
+    monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", need)
+    assert np.all(np.isfinite(cross_validate(emu, draws=False).mean))
