@@ -11,6 +11,8 @@ import importlib
 import inspect
 from types import ModuleType
 
+import numpy as np
+
 from gpmsa.errors import BackendUnavailableError, GPMSAError
 from gpmsa.mcmc.sampler import check_sample_args
 
@@ -113,8 +115,11 @@ _UNRECORDED = object()
 
 
 def _recorded_option(value):
-    """A backend option as a record holds it: plain values as they are, a torch dtype or
-    device by its name ("float32", "cuda"); anything else is not recorded (_UNRECORDED)."""
+    """A backend option as a record holds it: plain values as they are (a numpy scalar as its
+    Python value), a torch dtype or device by its name ("float32", "cuda"); anything else is
+    not recorded (_UNRECORDED)."""
+    if isinstance(value, np.generic):
+        value = value.item()
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
     if type(value).__module__.split(".")[0] == "torch":
@@ -124,7 +129,8 @@ def _recorded_option(value):
 
 def recorded_options(options: dict) -> dict:
     """``options`` as ``fit``'s settings and ``calibrate``'s info record them, sorted by name:
-    plain values as they are, a torch dtype or device by its name; other values left out."""
+    plain values as they are (numpy scalars as Python ones), a torch dtype or device by its
+    name; other values left out."""
     recorded = {k: _recorded_option(v) for k, v in sorted(options.items())}
     return {k: v for k, v in recorded.items() if v is not _UNRECORDED}
 

@@ -34,6 +34,7 @@ from tqdm.auto import tqdm
 
 from gpmsa.backends import check_sample_args
 from gpmsa.errors import ChainError, GPMSAError
+from gpmsa.limits import check_memory
 from gpmsa.mcmc import ridge, starts, tuning
 from gpmsa.mcmc.parallel import n_workers, run_chains
 from gpmsa.mcmc.sampler import (
@@ -43,7 +44,9 @@ from gpmsa.mcmc.sampler import (
     check_draws_memory,
     check_ridge,
     check_step_widths,
+    draws_nbytes,
     elements,
+    wrong_result,
 )
 from gpmsa.model.data import check_count, check_flag
 from gpmsa.model.priors import Priors
@@ -689,11 +692,30 @@ def sample(
             f"the torch backend does not support {', '.join(problem.extensions)}; use "
             "backend='numpy'"
         )
+    check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype))
     where = _check_groups(chain_groups, n_jobs, executor, int(n_chains), device, num_threads)
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,
                        tune_stages, check_ridge(ridge_moves, problem), where)  # fmt: skip
+
+
+def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torch.dtype) -> None:
+    """ResourceLimitError (before any chain is set up) when the draws (`check_draws_memory`) and
+    the batch's per-chain caches exceed ``gpmsa.limits.MAX_MEMORY_BYTES``: per chain and basis
+    component the packed correlation matrix and its proposal buffer, and with observations the
+    Sigma_W factor and its buffer (m x m each); none where Sigma_W is fixed (one for all)."""
+    if all(k in problem.fixed for k in SIM_PARAMS):
+        return
+    m = problem.m
+    packed = sum((b - a) * b for a, b in row_blocks(m))
+    per_chain = problem.p_u * (2 * packed + (2 * m * m if problem.obs is not None else 0))
+    caches = float(dtype.itemsize) * n_chains * per_chain
+    mats = "Sigma_W" if problem.p_u == 1 else "Sigma_W's"
+    name = str(dtype).replace("torch.", "")
+    check_memory(draws_nbytes(problem, n_iter, n_chains) + caches,
+                 f"torch sample(n_iter={n_iter}, n_chains={n_chains}), which caches "
+                 f"{problem.p_u} {mats} of {m} x {m} ({name}) per chain,")  # fmt: skip
 
 
 def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_threads) -> dict:
@@ -843,10 +865,18 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
             "prop_mh": bool(prop_mh), "dtype": dtype, "ridge_moves": state.ridge_moves,
             "stream": int(seq.generate_state(1, dtype=np.uint64)[0]) & (2**63 - 1),
         })  # fmt: skip
+    shapes = {n: v.shape[1:] for n, v in state.params.items()}
+
+    def check(g: int, result) -> str | None:
+        size = int(bounds[g + 1] - bounds[g])
+        expected = ({n: (size, int(n_iter), *v) for n, v in shapes.items()},
+                    (size, int(n_iter)), (len(state.els), size))  # fmt: skip
+        return wrong_result(result, expected, f"{size} chains x {n_iter} sweeps")
+
     try:
         runs = run_chains(_group_task, tasks, n_jobs=where["n_jobs"], executor=where["executor"],
-                          progress=progress, desc="torch chain groups",
-                          what="chain group")  # fmt: skip
+                          progress=progress, desc="torch chain groups", what="chain group",
+                          check=check)  # fmt: skip
     except ChainError as exc:
         g = exc.chains[0] if exc.chains else 0
         chains = tuple(range(int(bounds[g]), int(bounds[g + 1])))

@@ -149,6 +149,7 @@ def run_chains(
     desc: str = "chains",
     retries: int = RETRIES,
     what: str = "chain",
+    check: Callable[[int, object], str | None] | None = None,
 ) -> list:
     """``[fn(**task, progress=..., desc=...) for task in tasks]``, the tasks run in parallel.
 
@@ -159,6 +160,8 @@ def run_chains(
     ``progress``: in this process, each chain's own bar; in parallel, one bar over the chains.
     Returns the results in chain order. Raises ChainError naming the failed chain (see the
     module docstring for retries); ``what`` is what a task is called there ("chain").
+    ``check(i, result)``: what is wrong with task i's result (None: nothing), e.g. from an
+    executor that returned something else; ChainError names the first such chain.
     """
     n = len(tasks)
     if executor is not None and n_jobs is not None:
@@ -168,8 +171,15 @@ def run_chains(
         raise GPMSAError(f"retries must be an integer >= 0, got {retries!r}")
     workers = 1 if executor is not None else n_workers(n_jobs, n)
     if executor is None and workers == 1:
-        return [_in_process(fn, task, i, n, progress, desc, what) for i, task in enumerate(tasks)]
-    return _parallel(fn, tasks, executor, workers, progress, desc, retries, what)
+        results = [_in_process(fn, task, i, n, progress, desc, what)
+                   for i, task in enumerate(tasks)]  # fmt: skip
+    else:
+        results = _parallel(fn, tasks, executor, workers, progress, desc, retries, what)
+    for i, result in enumerate(results if check is not None else ()):
+        wrong = check(i, result)
+        if wrong is not None:
+            raise ChainError(f"{what} {i} of {n} returned {wrong}", (i,))
+    return results
 
 
 def _in_process(fn, task, i, n, progress, desc, what):

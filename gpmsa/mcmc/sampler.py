@@ -419,6 +419,23 @@ def _chain_task(
     return (*out, start)
 
 
+def wrong_result(result, expected: tuple, what: str) -> str | None:
+    """What is wrong with a chain task's ``result`` (None: nothing): it must be a tuple of one
+    item per ``expected`` entry, a shape tuple (an array of that shape) or a dict name -> shape
+    (a dict of such arrays); ``what`` names the draws in the message (``run_chains``' check)."""
+    ok = isinstance(result, tuple) and len(result) == len(expected)
+    for got, want in zip(result if ok else (), expected, strict=False):
+        if isinstance(want, dict):
+            ok = ok and isinstance(got, dict) and set(got) == set(want)
+            ok = ok and all(np.shape(got[k]) == shape for k, shape in want.items())
+        else:
+            ok = ok and isinstance(got, np.ndarray) and got.shape == want
+    if ok:
+        return None
+    return (f"a {type(result).__name__} that is not its draws ({what}); an executor must return "
+            "each task's own result")  # fmt: skip
+
+
 def sample(
     problem: Problem,
     *,
@@ -467,9 +484,13 @@ def sample(
          "ridge_moves": n_ridge}
         for s in seq.spawn(int(n_chains))
     ]  # fmt: skip
-    runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
-                      desc="chain")  # fmt: skip
     names = problem.names
+    shapes = {n: problem.init[n].shape for n in names}
+    expected = ({n: (int(n_iter), *v) for n, v in shapes.items()}, (int(n_iter),), shapes,
+                shapes, shapes)  # fmt: skip
+    runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
+                      desc="chain",
+                      check=lambda _, r: wrong_result(r, expected, f"{n_iter} sweeps"))  # fmt: skip
     chains = Chains(
         draws={n: np.stack([r[0][n] for r in runs]) for n in names},
         log_post=np.stack([r[1] for r in runs]),

@@ -132,3 +132,21 @@ def test_calibrator_takes_a_backend():
     ess = diagnostics.ess(draws)  # kept draws are pooled chain after chain
     tol = 4.0 * exact.sd("GD") / np.sqrt(ess)
     assert post.mean("GD") == pytest.approx(exact.mean("GD"), abs=tol)
+
+
+def test_numpy_scalar_options_are_recorded_as_plain_values(tmp_path):
+    """An option given as a numpy scalar (np.int64 from an array of settings) changes the draws
+    as the plain value does: the record keeps it, not drops it as an unknown object."""
+    from _backend_cases import multi_data
+
+    given = {"tune_rounds": np.int64(1), "tune_levels": np.int64(3), "ridge_moves": np.int64(0),
+             "init": np.str_("prior")}  # fmt: skip
+    assert backends.recorded_options(given) == {"init": "prior", "ridge_moves": 0,
+                                                "tune_levels": 3,
+                                                "tune_rounds": 1}  # fmt: skip
+    assert type(backends.recorded_options(given)["tune_rounds"]) is int
+    assert backends.recorded_options({"jit": np.bool_(False)}) == {"jit": False}
+    emu = gpmsa.fit(multi_data()[0], n_iter=10, seed=1, **given)
+    assert emu.settings["backend_options"] == backends.recorded_options(given)
+    path = emu.save(tmp_path / "np.gpmsa")
+    assert gpmsa.load(path).settings["backend_options"] == emu.settings["backend_options"]

@@ -285,6 +285,33 @@ def test_an_executor_that_fails_a_task_is_retried_then_reported():
             parallel.run_chains(_fails_on_input, tasks, executor=ex)
 
 
+class ReturnsOther(ThreadPoolExecutor):
+    """Returns something else than the task's result: ``garbage`` itself, or (None) the result
+    of the task run with other arguments (``changes``)."""
+
+    def __init__(self, garbage=None, **changes):
+        super().__init__(1)
+        self.garbage, self.changes = garbage, changes
+
+    def submit(self, fn, /, *args, **kwargs):
+        if self.garbage is not None:
+            fut = Future()
+            fut.set_result(self.garbage)
+            return fut
+        return super().submit(fn, *args, **{**kwargs, **self.changes})
+
+
+@pytest.mark.parametrize("executor", [
+    ReturnsOther(("garbage",)), ReturnsOther(0.0), ReturnsOther(n_iter=20)
+], ids=["tuple", "float", "shorter-chain"])  # fmt: skip
+def test_an_executor_that_returns_wrong_results_is_a_chain_error(problem, executor):
+    """Not a TypeError deep in the stacking, nor (other draws than asked) a silent success."""
+    why = r"chain 0 of 2 returned a \w+ that is not its draws \(60 sweeps\); an executor must"
+    with executor, pytest.raises(gpmsa.ChainError, match=why) as exc:
+        backends.get("numpy").sample(problem, n_chains=2, seed=5, executor=executor, **SHORT)
+    assert exc.value.chains == (0,)
+
+
 @pytest.mark.skipif(parallel.available_cpus() < 2, reason="needs two CPUs for a pool")
 def test_a_worker_that_dies_is_replaced_and_its_chain_rerun(tmp_path):
     marker = str(tmp_path / "died")

@@ -205,3 +205,18 @@ def test_bad_chain_groups_are_named():
                                                    r"after 2 attempts") as info:  # fmt: skip
             _grouped(problem, executor=ex)
     assert info.value.chains == (0, 1)
+
+
+@pytest.mark.parametrize("changes", [{"garbage": (None,)}, {"n_iter": 5}], ids=["tuple", "short"])
+def test_a_group_executor_that_returns_wrong_results_names_the_group_s_chains(changes):
+    """Not a TypeError while the groups' draws are joined, nor a silent run with other draws."""
+    from _backend_cases import multi_data
+    from test_chains import ReturnsOther
+
+    problem = gpmsa.prepare(multi_data()[0]).problem
+    with ReturnsOther(**changes) as ex, pytest.raises(gpmsa.ChainError) as exc:
+        _grouped(problem, executor=ex)
+    assert exc.value.chains == (0, 1)
+    assert "chain group 0 of 3 returned a tuple that is not its draws (2 chains x 12" in str(
+        exc.value
+    )

@@ -74,6 +74,30 @@ def test_torch_and_pyro_refuse_draws_beyond_the_memory_limit(backend, runner, mo
         module.sample(_road_calibration_problem(), n_iter=1000, n_chains=2, tune=False)
 
 
+def test_torch_refuses_a_batch_whose_cached_factors_exceed_the_memory_limit(monkeypatch):
+    """Each chain of a batch caches its correlations and Sigma_W factors (m x m per component):
+    many chains of few draws pass the draws' check but not the memory limit."""
+    pytest.importorskip("torch")
+    from _backend_cases import road_problem
+
+    module = backends.get("torch")
+    problem = road_problem().problem  # m = 198, with observations
+
+    def no_chain(*args, **kwargs):
+        raise AssertionError("a chain was set up before the memory check")
+
+    monkeypatch.setattr(module, "BatchState", no_chain)
+    monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", 400 * 1024**2)
+    why = (
+        r"^torch sample\(n_iter=2, n_chains=500\), which caches 1 Sigma_W of 198 x 198 "
+        r"\(float64\) per chain, needs about 4\d\d MiB of memory, above the limit"
+    )
+    with pytest.raises(gpmsa.ResourceLimitError, match=why):
+        module.sample(problem, n_iter=2, n_chains=500, tune=False)
+    with pytest.raises(AssertionError, match="before the memory check"):  # float32: half
+        module.sample(problem, n_iter=2, n_chains=250, tune=False, dtype="float32")
+
+
 # --- pyro: several chains start dispersed, each where the numpy chain c starts --------------------
 def _captured_starts(monkeypatch, **kw) -> tuple[list[dict], Chains]:
     pytest.importorskip("pyro")
