@@ -39,7 +39,7 @@ from gpmsa.calibration.observations import (
     warn_if_outside,
 )
 from gpmsa.calibration.posterior import Posterior
-from gpmsa.calibration.sampler import CalibrationSampler
+from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
@@ -366,7 +366,10 @@ def _run_fast(
         {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune, **tuning_opts}
         for s in np.random.SeedSequence(seed).spawn(n_chains)
     ]  # fmt: skip
-    runs = run_chains(_fast_chain, tasks, progress=progress, desc="calibrate chain", **where)
+    runs = run_chains(
+        _fast_chain, tasks, progress=progress, desc="calibrate chain",
+        check=lambda _, r: _wrong_fast_run(r, n_samples, sampler.q), **where,
+    )  # fmt: skip
     if any(not np.isfinite(r.log_post[-1]) for r in runs):
         raise GPMSAError(
             "the posterior has no mass where the sampler looked: log_prior is -inf there "
@@ -386,6 +389,16 @@ def _run_fast(
         "chebyshev": all(p.cheb is not None or p.cheb2 is not None for p in sampler.preds),
     }
     return draws, info
+
+
+def _wrong_fast_run(run, n_samples: int, q: int) -> str | None:
+    """What is wrong with a fast calibration chain's result (None: nothing); see
+    ``run_chains``' ``check``: an executor must return each task's own ChainResult."""
+    if isinstance(run, ChainResult) and np.shape(run.theta) == (n_samples, q):
+        if np.shape(run.lamOs) == np.shape(run.log_post) == (n_samples,):
+            return None
+    return (f"a {type(run).__name__} that is not its draws ({n_samples} samples); an executor "
+            "must return each task's own result")  # fmt: skip
 
 
 def _run_backend(

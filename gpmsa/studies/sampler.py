@@ -244,6 +244,19 @@ def run_study_chain(
     return out
 
 
+def _wrong_run(run, n_iter: int, n_elements: int) -> str | None:
+    """What is wrong with a study chain's result (None: nothing); see ``run_chains``' ``check``:
+    an executor must return each task's own result, as `run_study_chain` makes it."""
+    keys = {"theta", "mu", "lam", "log_post", "members", "accept_rate", "widths", "names"}
+    if isinstance(run, dict) and keys <= set(run):
+        if np.shape(run["theta"]) == (n_iter, n_elements) and np.shape(run["log_post"]) == (
+            n_iter,
+        ):
+            return None
+    return (f"a {type(run).__name__} that is not its draws ({n_iter} sweeps); an executor must "
+            "return each task's own result")  # fmt: skip
+
+
 def sample_study(
     problems: list[Problem], layout: Layout, hyper: HyperPriors, *, n_iter: int,
     n_chains: int = 1, tune: bool = True, seed=None, init: str = "auto",
@@ -264,7 +277,8 @@ def sample_study(
         for s in seq.spawn(int(n_chains))
     ]  # fmt: skip
     runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
-                      progress=progress, desc="study chain")  # fmt: skip
+                      progress=progress, desc="study chain",
+                      check=lambda _, r: _wrong_run(r, int(n_iter), layout.n_elements))  # fmt: skip
     members = tuple(
         {n: np.stack([r["members"][i][n] for r in runs]) for n in runs[0]["members"][i]}
         for i in range(len(problems))

@@ -312,6 +312,31 @@ def test_an_executor_that_returns_wrong_results_is_a_chain_error(problem, execut
     assert exc.value.chains == (0,)
 
 
+@pytest.mark.parametrize("executor", [
+    ReturnsOther(("garbage",)), ReturnsOther(n_samples=20)
+], ids=["tuple", "shorter-chain"])  # fmt: skip
+def test_calibrate_and_a_study_check_what_an_executor_returns(executor):
+    """The fast calibration and the study sampler run their chains through run_chains too: a
+    wrong result is a ChainError there as well (was an AttributeError or KeyError while the
+    draws were stacked, or another chain length silently)."""
+    from _study_cases import emulator, observations
+
+    emu = emulator()
+    x, y = observations(0.4, 6, 0.05, np.random.default_rng(3))
+    run = {"n_samples": 40, "n_burn": 10, "n_chains": 2, "seed": 1, "tune_rounds": 2,
+           "tune_levels": 5, "executor": executor}  # fmt: skip
+    with executor:
+        with pytest.raises(gpmsa.ChainError, match=r"chain 0 of 2 returned a \w+ that is not "
+                           r"its draws \(40 samples\)"):  # fmt: skip
+            gpmsa.calibrate(emu, x, y, **run)
+        if executor.changes:  # the study's task takes n_iter: another length through that name
+            executor.changes = {"n_iter": 20}
+        with pytest.raises(gpmsa.ChainError, match=r"chain 0 of 2 returned a \w+ that is not "
+                           r"its draws \(40 sweeps\)"):  # fmt: skip
+            gpmsa.calibrate_study([emu, emu], [x[::2], x[1::2]], [y[::2], y[1::2]],
+                                  shared=["t"], **run)  # fmt: skip
+
+
 @pytest.mark.skipif(parallel.available_cpus() < 2, reason="needs two CPUs for a pool")
 def test_a_worker_that_dies_is_replaced_and_its_chain_rerun(tmp_path):
     marker = str(tmp_path / "died")
