@@ -132,8 +132,7 @@ def by_column_names(value, names, name: str):
     labels = column_labels(value)
     if labels is None:
         return value
-    column_order(labels, names, name)
-    return value[list(names)]
+    return value.iloc[:, column_order(labels, [str(n) for n in names], name)]
 
 
 def pandas_rows(value, names=None):
@@ -331,6 +330,20 @@ def check_parameter_names(names, what: str = "t_names") -> None:
             )
 
 
+def _labels(value, what: str, kind: str):
+    """Names or units as given, a sequence of them as a tuple (a generator is read once);
+    GPMSAError naming ``what`` for a value that is not an ordered sequence of them (a number,
+    bytes, or a set or dict, whose order is not the columns')."""
+    if value is None or isinstance(value, str):
+        return value  # None: the defaults; a string: refused with its own message
+    if isinstance(value, (set, frozenset, dict, bytes)) or not hasattr(value, "__iter__"):
+        raise GPMSAError(
+            f"{what} must be a list of {kind}, one per column in order, got {type(value).__name__}"
+            f" {value!r}"
+        )
+    return tuple(value)
+
+
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
     if names is None:
         return tuple(f"{prefix}{i}" for i in range(n))
@@ -444,6 +457,10 @@ class SimData:
 
     def __post_init__(self) -> None:
         check_same_rows({"x": self.x, "t": self.t, "y": self.y})
+        for part in ("x", "t", "y"):
+            for kind in ("names", "units"):
+                attr = f"{part}_{kind}"
+                object.__setattr__(self, attr, _labels(getattr(self, attr), attr, kind))
         for part in ("x", "t", "y"):  # a table: its columns by name, never by position
             value, names = getattr(self, part), getattr(self, f"{part}_names")
             labels = column_labels(value)
@@ -676,7 +693,8 @@ class ObsData:
                     f"precision[{j}] must be a scalar or ({e.size}, {e.size}), got {lam.shape}"
                 )
             check_finite(lam, f"precision[{j}]")
-            if not np.allclose(lam, lam.T) or np.linalg.eigvalsh(lam).min() <= 0:
+            scale = float(np.max(np.abs(lam)))  # relative: a precision in small units is fine
+            if not np.allclose(lam, lam.T, atol=1e-8 * scale) or np.linalg.eigvalsh(lam).min() <= 0:
                 raise GPMSAError(f"precision[{j}] must be symmetric positive definite")
             out.append(lam)
         return out

@@ -9,6 +9,7 @@ through ``gpmsa.load`` with the listed sha256, so an edited model file is refuse
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +62,15 @@ def _check_study_name(path: Path, labels) -> None:
             f"characters with these labels (it names the model files beside it, e.g. "
             f"{member!r}); choose another name"
         )
+
+
+def _through_link(path: Path) -> Path:
+    """``path``, or the file a symbolic link ``path`` points to: the model files lie beside the
+    study file itself, not beside a link to it."""
+    try:
+        return Path(os.path.realpath(path)) if path.is_symlink() else path
+    except OSError:  # e.g. a name too long: reading or writing it says so
+        return path
 
 
 def native_chains(layout: Layout, draws: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -185,9 +195,12 @@ class Study:
         over a non-empty file that is not a gpmsa file (a user's CSV or notes). ``path``'s name
         names the model files, so it may use only ASCII letters, digits, '_', '-' and '.', not
         start with '.', and its stem be at most 150 - len(longest label) characters (GPMSAError
-        up front otherwise).
+        up front otherwise). A symbolic link ``path`` is written through: the study file and
+        its model files go beside the link's target, named after it (as ``load_study`` reads
+        them).
         """
-        path = check_path(path)
+        given = check_path(path)
+        path = _through_link(given)
         _check_study_name(path, self.labels)
         refuse_to_replace(path, STUDY_FORMAT)
         files, hashes, sealed = [], [], []
@@ -211,7 +224,7 @@ class Study:
         with atomic_group() as stage:
             for target, raw_manifest, member_arrays in sealed:
                 write_sealed(target, raw_manifest, member_arrays, stage)
-        return path
+        return given
 
     def __repr__(self) -> str:
         c, n = self.draws["log_post"].shape
@@ -227,7 +240,8 @@ def load_study(path: str | Path) -> Study:
     models, and what the manifest says of them (the models' names and units, the kind, the
     chain and draw counts) against the draws and models
     (``gpmsa.studies.record.check_study_claims``); the diagnostics and convergence record are
-    computed anew from the draws. Raises EmulatorFileError naming the file and the field.
+    computed anew from the draws. A symbolic link ``path`` reads the model files beside the
+    link's target. Raises EmulatorFileError naming the file and the field.
 
     >>> import gpmsa
     >>> gpmsa.load_study("no-such-study.gpmsa")  # doctest: +ELLIPSIS
@@ -235,7 +249,7 @@ def load_study(path: str | Path) -> Study:
     ...
     gpmsa.errors.EmulatorFileError: ...no-such-study.gpmsa...
     """
-    path = check_path(path)
+    path = _through_link(check_path(path))
     manifest, arrays = read_raw(path, check_study_manifest, formats=(STUDY_FORMAT,))
     study = manifest["study"]
     members = []

@@ -344,3 +344,27 @@ def test_a_design_column_in_small_units_varies():
         gpmsa.SimData(x=x, t=np.full((40, 1), 1e-14), y=y, t_names=["k"])
     with pytest.raises(gpmsa.GPMSAError, match=r"k varies by only 1 around 1e\+15 .*offset"):
         gpmsa.SimData(x=x, t=x + 1e15, y=y, t_names=["k"])  # was "constant (1e15)"
+
+
+def test_names_and_units_any_ordered_sequence_but_not_a_set_or_number():
+    s = sim(p=1, q=2, x_names=(n for n in ["a"]), t_names=iter(["b", "c"]), t_units=iter("uv"))
+    assert s.x_names == ("a",) and s.t_names == ("b", "c") and s.t_units == ("u", "v")
+    for kw in (
+        {"t_names": {"b", "c"}},
+        {"t_names": {"b": 0, "c": 1}},
+        {"x_units": 3},
+        {"x_names": b"a"},
+    ):
+        key = next(iter(kw))
+        with pytest.raises(gpmsa.GPMSAError, match=rf"{key} must be a list of .*, one per column"):
+            sim(p=1, q=2, **kw)
+
+
+def test_precision_symmetry_is_relative_to_its_scale():
+    """A precision in small units (1/Pa^2, say) is checked for symmetry as any other: an
+    absolute tolerance would pass any matrix whose entries are below it."""
+    lopsided = [[[1e-10, 5e-11], [0.0, 1e-10]]]
+    with pytest.raises(gpmsa.GPMSAError, match=r"precision\[0\] must be symmetric"):
+        gpmsa.ObsData(x=[[0.5]], y=[[1.0, 2.0]], precision=lopsided)
+    small = gpmsa.ObsData(x=[[0.5]], y=[[1.0, 2.0]], precision=[[[2e-10, 5e-11], [5e-11, 1e-10]]])
+    assert small.precisions[0][0, 1] == 5e-11

@@ -113,3 +113,17 @@ def test_an_integer_beyond_float64_is_named():
     x[0][0] = 10**400
     with pytest.raises(GPMSAError, match=r"x holds a number too large for float64"):
         gpmsa.SimData(x, df[["b"]], df["out"])
+
+
+def test_a_table_with_integer_column_labels_is_read_by_those_labels():
+    """pd.DataFrame(array) labels its columns 0, 1, ...: they name the inputs "0", "1", and a
+    table labelled so is read by them again (not a KeyError from pandas)."""
+    df = frame()
+    x, t = pd.DataFrame(df[["a"]].to_numpy()), pd.DataFrame({1: df["b"].to_numpy()})
+    data = gpmsa.SimData(x, t, df["out"])
+    assert data.x_names == ("0",) and data.t_names == ("1",)
+    again = gpmsa.SimData(x, t, df["out"], x_names=["0"], t_names=["1"])
+    assert again.t_names == ("1",) and np.array_equal(again.t, t.to_numpy())
+    emu = gpmsa.Emulator.from_params(data, PARAMS)
+    mean, _ = emu.predict(x.iloc[:3], t.iloc[:3])
+    assert np.allclose(mean, emu.predict(x.to_numpy()[:3], t.to_numpy()[:3])[0])

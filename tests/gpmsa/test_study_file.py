@@ -148,3 +148,20 @@ def test_gpmsa_info_describes_a_study(tmp_path, capsys):
     ).save(tmp_path / "run.a.gpmsa")  # fmt: skip
     assert main(["info", str(path)]) == 2
     assert "sha256" in capsys.readouterr().err
+
+
+def test_a_study_saved_and_loaded_through_a_link_keeps_its_members_beside_the_file(tmp_path):
+    """A symbolic link to a study file: the models' files lie beside the file it points to (a
+    save through the link writes them there, named after it; a load reads them there)."""
+    store, elsewhere = tmp_path / "store", tmp_path / "elsewhere"
+    store.mkdir(), elsewhere.mkdir()
+    study = _study()
+    study.save(store / "run.gpmsa")
+    link = elsewhere / "link.gpmsa"
+    link.symlink_to(store / "run.gpmsa")
+    assert gpmsa.load_study(link).labels == ("a", "b", "c")
+    assert study.save(link) == link
+    assert sorted(p.name for p in elsewhere.iterdir()) == ["link.gpmsa"]
+    assert sorted(p.name for p in store.iterdir()) == [
+        "run.a.gpmsa", "run.b.gpmsa", "run.c.gpmsa", "run.gpmsa"]  # fmt: skip
+    assert gpmsa.load_study(store / "run.gpmsa").labels == ("a", "b", "c")
