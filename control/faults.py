@@ -22,6 +22,10 @@ FAULT_KINDS = (
     "position_nan",  # the odometry reads NaN
 )
 
+MAX_SPIKE_SPACING = 2**62
+"""Largest spike spacing counted, samples: a larger one (beyond numpy's integers) spikes the
+fault's first sample alone, as any spacing longer than the fault does."""
+
 
 @dataclass(frozen=True)
 class SensorFault:
@@ -64,7 +68,16 @@ class FaultInjector:
     """
 
     def __init__(self, faults, rng: np.random.Generator) -> None:
-        self.faults = tuple(faults)
+        if isinstance(faults, SensorFault):
+            raise ControlError("faults must be a sequence of SensorFault: pass [fault]")
+        try:
+            if isinstance(faults, str | bytes):
+                raise TypeError
+            self.faults = tuple(faults)
+        except TypeError:
+            raise ControlError(
+                f"faults must be a sequence of SensorFault, got {faults!r:.60}"
+            ) from None
         for k, fault in enumerate(self.faults):
             check_instance(fault, f"faults[{k}]", SensorFault)
         check_instance(rng, "rng", np.random.Generator)
@@ -95,7 +108,7 @@ class FaultInjector:
                 keep &= ~hit
             elif k == "spike":
                 # counted over the fault's whole span, not per batch: the nearest whole spacing
-                every, seen = max(1, round(m)), self._spiked.get(i, 0)
+                every, seen = max(1, round(min(m, MAX_SPIKE_SPACING))), self._spiked.get(i, 0)
                 covered = seen + np.arange(int(hit.sum()))
                 on = covered % every == 0
                 acc[np.flatnonzero(hit)[on]] = 1e6 * np.where((covered[on] // every) % 2, 1.0, -1.0)
@@ -105,7 +118,9 @@ class FaultInjector:
             elif k == "scale":
                 acc[hit] *= m
             elif k == "quantize":
-                acc[hit] = np.round(acc[hit] / m) * m
+                with np.errstate(over="ignore"):  # a step far below a reading's resolution
+                    steps = np.round(acc[hit] / m) * m
+                acc[hit] = np.where(np.isfinite(steps), steps, acc[hit])  # ... leaves it
             elif k == "stuck":
                 acc[hit] = self._held.setdefault(i, self._before(acc, int(np.flatnonzero(hit)[0])))
             elif k == "clip":

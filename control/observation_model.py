@@ -27,6 +27,7 @@ from scipy.linalg import cholesky
 from scipy.linalg.lapack import dpotrf
 
 from control.errors import ControlError, EmulatorMismatchError
+from control.feature import FeatureSpec
 from control.validation import float_array, is_integer, is_real, require_reals, within
 
 MAX_TABLE_NODES = 1_000_000
@@ -132,6 +133,7 @@ class ObservationModel:
                 f"block_scatter is {scatter.cov.shape[1]}-dimensional but the emulator has "
                 f"{emulator.l_sim} outputs"
             )
+        _check_feature_length(emulator)
         if not (is_integer(n_grid) and n_grid >= 16):
             raise ControlError(f"n_grid must be an integer >= 16, got {n_grid}")
         if not (is_integer(n_speed) and n_speed >= 2):
@@ -211,6 +213,24 @@ class ObservationModel:
         K, nu = self.dim, self.scatter.dof
         p = special.chdtrc(K, d2_min) if np.isinf(nu) else special.fdtrc(K, nu, d2_min / K)
         return d2_min, float(p)
+
+
+def _check_feature_length(emulator) -> None:
+    """EmulatorMismatchError where the emulator's metadata records a feature (``feature``)
+    whose length is not its number of outputs (the BCR computes that feature from each block),
+    or a malformed one; nothing recorded: nothing to check."""
+    record = (getattr(emulator, "metadata", None) or {}).get("feature")
+    if record is None:
+        return
+    try:
+        feature = FeatureSpec.from_dict(record)
+    except (AttributeError, TypeError, ValueError) as exc:
+        raise EmulatorMismatchError(f"the emulator's feature is malformed: {exc}") from exc
+    if feature.dim != emulator.l_sim:
+        raise EmulatorMismatchError(
+            f"the emulator's metadata records the feature {feature.name!r} of {feature.dim} "
+            f"outputs ({', '.join(feature.names())}), but the emulator has {emulator.l_sim}"
+        )
 
 
 def _clip(x: float, lo: float, hi: float) -> float:

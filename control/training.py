@@ -23,6 +23,7 @@ from scipy import optimize, stats
 from control.errors import ControlError
 from control.feature import FeatureSpec, block_features
 from control.observation_model import BlockScatter
+from control.sensor_checks import MAX_ACCEL_MPS2
 from control.validation import check_instance, float_array, is_integer, is_real
 
 
@@ -65,13 +66,26 @@ def block_statistics(accel: np.ndarray, spec: FeatureSpec, batch: int = 8) -> Bl
             f"accel must be (runs, samples) with >= {2 * batch * B} samples per run (two batches "
             f"of {batch} blocks of {B}), got shape {accel.shape}"
         )
+    if accel.shape[0] == 0:
+        raise ControlError(f"accel holds no runs: shape {accel.shape}")
     if not np.all(np.isfinite(accel)):
         raise ControlError("accel holds non-finite values (failed runs?): leave those runs out")
+    peak = float(np.max(np.abs(accel)))
+    if peak > MAX_ACCEL_MPS2:  # its squares would overflow the band powers
+        raise ControlError(
+            f"accel reaches {peak:.3g} m/s^2, beyond any accelerometer's range "
+            f"(MAX_ACCEL_MPS2 = {MAX_ACCEL_MPS2:g}; the BCR refuses such blocks as faults)"
+        )
     n_blocks = accel.shape[1] // B
     blocks = accel[:, : n_blocks * B].reshape(-1, B)
     feats = block_features(blocks, spec).reshape(accel.shape[0], n_blocks, spec.dim)
-    if not np.all(np.isfinite(feats)):
-        raise ControlError("a block of the campaign has no power in a band")
+    bad = ~np.all(np.isfinite(feats), axis=2)
+    if bad.any():
+        run, block = np.argwhere(bad)[0]
+        raise ControlError(
+            f"block {block} of run {run} gives a non-finite {spec.name} feature: it has no "
+            "power in a band or is constant (a stuck or failed run?)"
+        )
     return feature_statistics(feats, batch)
 
 

@@ -309,11 +309,37 @@ def band_feature(args) -> FeatureSpec:
     )
 
 
+def fit_runs(kind: str, case: str, campaign, args) -> np.ndarray:
+    """The runs an emulator of ``kind`` and ``case`` fits (mask over the campaign's runs):
+    finished with finite data; for the window emulators, of the Latin hypercube only."""
+    if kind == "band":
+        accel = campaign.accel if case == "A" else campaign.accel_measured
+        return campaign.ok & np.all(np.isfinite(accel), axis=1)
+    f = campaign.f_window if case == "A" else campaign.f_window_noisy
+    return campaign.ok & np.isfinite(f) & (f > 0) & (np.arange(f.size) < args.n_runs)
+
+
+def check_finished_runs(parser: argparse.ArgumentParser, campaign, args) -> None:
+    """Usage error, before any fit, where an emulator would have fewer finished runs than its
+    fit needs (the window emulators fit the Latin hypercube's runs alone, not the anchors)."""
+    for kind in args.features:
+        need = max(MIN_RUNS, args.n_pc) if kind == "band" else MIN_RUNS
+        runs = campaign.v.size if kind == "band" else args.n_runs
+        for case in args.cases:
+            n_ok = int(np.count_nonzero(fit_runs(kind, case, campaign, args)))
+            if n_ok < need:
+                parser.error(
+                    f"only {n_ok} of the {kind} emulators' {runs} runs finished (the vehicle "
+                    f"left the road in the others), fewer than the {need} a fit needs: lower "
+                    "--gd-range HI or --speed-range HI, or raise --n-runs"
+                )
+
+
 def fit_band(case: str, campaign, model, args):
     """The block-feature emulator of one case, with its block scatter in the metadata."""
     feature = band_feature(args)
     accel = campaign.accel if case == "A" else campaign.accel_measured
-    ok = campaign.ok & np.all(np.isfinite(accel), axis=1)
+    ok = fit_runs("band", case, campaign, args)
     stats_ = block_statistics(accel[ok], feature, batch=BATCH)
     scatter = block_scatter(campaign.v[ok], stats_, nodes=np.linspace(*args.speed_range, 16))
     data = gpmsa.SimData(
@@ -336,7 +362,7 @@ def fit_window(case: str, campaign, model, args):
     """The paper-feature emulator of one case: log f of the last 1,000 samples of each drive of
     the Latin hypercube (the paper's design: the anchor runs are the band emulators')."""
     f = campaign.f_window if case == "A" else campaign.f_window_noisy
-    ok = np.isfinite(f) & (f > 0) & (np.arange(f.size) < args.n_runs)
+    ok = fit_runs("window", case, campaign, args)
     data = gpmsa.SimData(
         x=campaign.v[ok, None], t=campaign.gd[ok, None],
         y=feature_of_variance(f[ok], "log_var")[:, None],
@@ -481,8 +507,8 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(str(exc))
     if v_hi > model.max_speed_mps:
         parser.error(
-            f"--speed-range HI = {v_hi:g} m/s exceeds the vehicle's top speed "
-            f"{model.max_speed_mps:g} m/s"
+            f"--speed-range HI = {v_hi:.10g} m/s exceeds the vehicle's top speed "
+            f"{model.max_speed_mps:.10g} m/s"
         )
     if args.ship:
         check_shippable(parser, args)
@@ -511,18 +537,13 @@ def main(argv: list[str] | None = None) -> None:
             seed=args.seed, keep_s=args.keep_s,
         )  # fmt: skip
     except vehicle.VehicleError as exc:
-        parser.error(f"the campaign (--n-runs, --anchor-runs, --keep-s): {exc}")
+        parser.error(f"the campaign (--n-runs, --anchor-runs, --keep-s, --speed-range): {exc}")
     fig = plot_design(design[:, 0], design[:, 1], title=design_title(args))
     save_figure(fig, out / "lhs_design.png", dpi=150)
     print(f"campaign: {campaign.v.size} runs in {time.perf_counter() - tic:.0f} s")
     if not campaign.ok.all():
         print(f"  {np.count_nonzero(~campaign.ok)} failed runs are left out")
-    if np.count_nonzero(campaign.ok) < min_runs:
-        parser.error(
-            f"only {np.count_nonzero(campaign.ok)} of {campaign.v.size} runs finished (the "
-            f"vehicle left the road in the others), fewer than the {min_runs} a fit needs: "
-            "lower --gd-range HI or --speed-range HI"
-        )
+    check_finished_runs(parser, campaign, args)
     campaign.save(out / "campaign.npz")
 
     fitters = {"band": fit_band, "window": fit_window}

@@ -158,6 +158,11 @@ CASES = [
     ),
     (
         "examples/train_emulator.py",
+        ["--speed-range", "0.5", "2.0000001"],  # was "HI = 2 m/s exceeds ... top speed 2 m/s"
+        "--speed-range HI = 2.0000001 m/s exceeds the vehicle's top speed 2 m/s",
+    ),
+    (
+        "examples/train_emulator.py",
         ["--speed-range", "0.5", "2.5"],
         "--speed-range HI = 2.5 m/s exceeds the vehicle's top speed 2 m/s",
     ),

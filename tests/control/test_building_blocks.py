@@ -123,3 +123,29 @@ def test_run_closed_loop_names_a_record_or_flag_of_the_wrong_type(emulator_a):
                       ({"progress": "yes"}, "progress must be True or False")):  # fmt: skip
         with pytest.raises(ControlError, match=match):
             control.run_closed_loop(track, emulator_a, **kw)
+
+
+def test_fault_injector_at_the_edges_of_its_magnitudes_and_its_arguments():
+    """A spike spacing beyond int64 crashed in numpy (OverflowError), a quantisation step so
+    fine that a reading divided by it overflows turned the readings into inf, and one fault
+    passed without a list was a TypeError."""
+    t, a = np.arange(240) / 120.0, np.random.default_rng(0).normal(size=240)
+    hit = (t >= 0.5) & (t < 1.5)
+
+    def inject(kind, magnitude):
+        fault = SensorFault(0.5, 1.0, kind, magnitude)
+        with np.errstate(over="raise", invalid="raise"):  # no overflow on the way
+            return FaultInjector([fault], np.random.default_rng(0))(t, t, a, np.ones(240))[2]
+
+    for spacing in (1e19, 1e300, np.finfo(float).max):  # one spike, at the fault's start
+        spiked = inject("spike", spacing)
+        assert np.flatnonzero(spiked != a).tolist() == [60] and spiked[60] == -1e6
+    for step in (5e-324, 1e-310):  # far below the readings' resolution: unchanged
+        np.testing.assert_array_equal(inject("quantize", step), a)
+    assert np.all(inject("quantize", 1e300)[hit] == 0.0)
+    for faults, match in ((SensorFault(0.5, 1.0), "pass \\[fault\\]"), (None, "got None"),
+                          ("nan", "got 'nan'"), (5, "got 5")):  # fmt: skip
+        with pytest.raises(
+            ControlError, match=f"faults must be a sequence of SensorFault.*{match}"
+        ):
+            FaultInjector(faults, np.random.default_rng(0))

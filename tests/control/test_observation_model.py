@@ -398,3 +398,40 @@ def test_the_level_check_in_chunks_finds_the_same_segment_as_every_pair_at_once(
     chunked = level_jump(a)
     assert whole[1] == chunked[1] == best[1] and 70 <= best[1][0] < best[1][1] <= 150
     assert whole[0] == pytest.approx(best[0], rel=1e-6) and chunked[0] == whole[0]
+
+
+def test_an_emulator_whose_recorded_feature_has_another_length_is_refused_at_once(emulator_a):
+    """Metadata naming a feature of 9 outputs on an emulator of 10 passed, and the loop failed
+    at its first block with "y must be 10 finite numbers", blaming the block."""
+    import copy
+
+    emu = copy.deepcopy(emulator_a)
+    emu.metadata["feature"]["quantiles"] = [0.9]
+    text = r"records the feature 'log_band_power' of 9 outputs.*the emulator has 10"
+    with pytest.raises(EmulatorMismatchError, match=text):
+        ObservationModel(emu)
+    with pytest.raises(EmulatorMismatchError, match=text):
+        control.BCR.from_emulator(emu)
+    emu.metadata["feature"] = {"name": "log_band_power", "block_samples": "125"}
+    with pytest.raises(EmulatorMismatchError, match="the emulator's feature is malformed"):
+        ObservationModel(emu)
+    del emu.metadata["feature"]  # nothing recorded: nothing to check here
+    assert ObservationModel(emu, n_grid=16, n_speed=2).dim == 10
+
+
+def test_block_statistics_name_an_empty_campaign_and_blocks_without_a_feature():
+    """No runs were reported as features of shape (0, 16, 10); accelerations beyond any
+    accelerometer overflowed (RuntimeWarnings) into "no power in a band"; a constant run of
+    the window feature was said to have no power in a band."""
+    spec = control.FeatureSpec()
+    with pytest.raises(ControlError, match=r"accel holds no runs: shape \(0, 2000\)"):
+        block_statistics(np.zeros((0, 2000)), spec)
+    accel = np.random.default_rng(3).standard_normal((2, 2000))
+    with np.errstate(all="raise"), pytest.raises(ControlError, match="beyond any accelerometer"):
+        block_statistics(accel * 1e200, spec)
+    accel[1, 250:375] = 4.0  # the third block of run 1
+    with pytest.raises(ControlError, match=r"block 2 of run 1 .*log_band_power.*no power"):
+        block_statistics(accel, spec)
+    window = control.FeatureSpec(name="log_var", block_samples=125)
+    with pytest.raises(ControlError, match=r"block 2 of run 1 .*log_var.*constant"):
+        block_statistics(accel, window)

@@ -192,3 +192,48 @@ def test_a_slower_robots_emulators_and_a_simplex_within_their_speeds(tmp_path, c
     assert "--v-safe / --v-max: the Simplex's v_max = 2 m/s" in capsys.readouterr().err
     metrics = loop.main([*argv, "--v-max", "0.9", "--v-safe", "0.6"])  # both below the default
     assert 0 < metrics["ours"]["A"]["rmse"]["300"] < 400
+
+
+def test_too_few_finished_latin_hypercube_runs_for_the_window_fit_is_a_usage_error(
+    tmp_path, monkeypatch, capsys
+):
+    """The check counted the anchor runs too, which the window emulators do not fit: 3 of 4
+    Latin-hypercube runs finished (5 of 6 in all) and gpmsa.SimData raised a traceback."""
+    import dataclasses
+
+    script = load_script()
+    real = script.vehicle.run_campaign
+
+    def one_lhs_run_fails(design, *args, **kwargs):  # as a vehicle leaving the road would
+        campaign = real(design, *args, **kwargs)
+        nan, status = np.full(campaign.accel.shape[1], np.nan), campaign.status.copy()
+        status[0] = "SimulationDivergedError: states out of range"
+        changed = {"status": status}
+        for name in ("f_full", "f_window", "f_full_noisy", "f_window_noisy"):
+            changed[name] = getattr(campaign, name).copy()
+            changed[name][0] = np.nan
+        for name in ("accel", "accel_measured"):
+            changed[name] = getattr(campaign, name).copy()
+            changed[name][0] = nan
+        return dataclasses.replace(campaign, **changed)
+
+    monkeypatch.setattr(script.vehicle, "run_campaign", one_lhs_run_fails)
+    with pytest.raises(SystemExit):
+        script.main(
+            ["--out", str(tmp_path), "--n-runs", "4", "--n-pc", "4", "--n-iter", "20",
+             "--keep-s", "17", "--cases", "A", "--features", "window", "band"]
+        )  # fmt: skip
+    err = capsys.readouterr().err
+    assert "only 3 of the window emulators' 4 runs finished" in err
+    assert "fewer than the 4 a fit needs" in err
+    assert not list((tmp_path / "emulators").glob("*.gpmsa"))  # refused before any fit
+
+
+def test_a_speed_range_too_slow_to_drive_names_the_option(tmp_path, capsys):
+    """The campaign's refusal of a drive too long named --n-runs, --anchor-runs and --keep-s
+    only, where --speed-range LO made it."""
+    with pytest.raises(SystemExit):
+        load_script().main(["--out", str(tmp_path), "--speed-range", "1e-9", "2"])
+    err = capsys.readouterr().err
+    assert "the campaign (--n-runs, --anchor-runs, --keep-s, --speed-range): design[" in err
+    assert "(v=1e-09 m/s)" in err
