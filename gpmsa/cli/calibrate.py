@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 
 from gpmsa.calibration.posterior import quantile_keys
-from gpmsa.cli.text import safe
+from gpmsa.cli.text import internal_error, safe
 from gpmsa.errors import GPMSAError
 from gpmsa.io.container import jsonable
 
@@ -54,18 +54,20 @@ def _level(text: str) -> float:
 
 def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
     """Values ordered as ``names`` from NAME=VALUE strings (split at the last "=": a name may
-    hold "=", a number never does)."""
+    hold "=", a number never does). A NAME that is not one of ``names`` is read without its
+    surrounding spaces (``" v=1"`` gives v); one that is, whole (a name may end in a space)."""
     given = {}
     for item in items:
         name, sep, value = item.rpartition("=")
         if not sep:
             raise GPMSAError(f"--{what} expects NAME=VALUE, got {item!r}")
-        if name.strip() in given:  # the later one silently won
-            raise GPMSAError(f"--{what} {name.strip()} is given twice; give each name once")
+        key = name if name in names else name.strip()
+        if key in given:  # the later one silently won
+            raise GPMSAError(f"--{what} {key} is given twice; give each name once")
         try:
             if "_" in value:  # float() reads "1_0" as 10: a typo for 1.0 must not pass
                 raise ValueError(value)
-            given[name.strip()] = float(value)
+            given[key] = float(value)
         except ValueError as exc:
             raise GPMSAError(f"--{what} {name}: {value!r} is not a number") from exc
     unknown = sorted(set(given) - set(names))
@@ -78,7 +80,8 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the subcommand; exit status 0, or 2 with a message on stderr for bad input."""
+    """Run the subcommand; exit status 0, or 2 with a message on stderr for bad input (1 for
+    an unexpected error, named in one line)."""
     from gpmsa.calibration.calibrator import Calibrator
     from gpmsa.fitting.emulator import load
 
@@ -104,6 +107,9 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
         advice = str(exc).replace("pass extrapolate=True", "pass --extrapolate")
         print(f"gpmsa calibrate: {safe(advice)}", file=sys.stderr)
         return 2
+    except Exception as exc:  # a gap in the library's checks: one line, not a traceback
+        print(f"gpmsa calibrate: {safe(args.file)}: {internal_error(exc)}", file=sys.stderr)
+        return 1
     if args.json:
         out = {
             "file": args.file,
@@ -117,11 +123,10 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
         print(json.dumps(jsonable(out), indent=1, allow_nan=False))  # RFC 8259: no NaN
         return 0
     lo_key, hi_key = quantile_keys(args.level)
+    given = [", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(names, row, strict=True))
+             for names, row in ((emu.x_names, x[0]), (emu.y_names, y[0])) if names]  # fmt: skip
     print(f"posterior ({post.info.get('method')}, {1e3 * seconds:.2f} ms) given "
-          + ", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(emu.x_names, x[0], strict=True))
-          + "; "
-          + ", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(emu.y_names, y[0], strict=True))
-          )  # fmt: skip
+          + "; ".join(given))  # fmt: skip
     print(f"{'name':>10s} {'mean':>12s} {'sd':>12s} {lo_key:>12s} {'median':>12s} {hi_key:>12s}")
     for name, s in summary.items():
         print(f"{safe(name, 60):>10s} {s['mean']:12.5g} {s['sd']:12.5g} {s[lo_key]:12.5g} "

@@ -6,7 +6,7 @@ import argparse
 import json
 import sys
 
-from gpmsa.cli.text import number, plain, safe, value
+from gpmsa.cli.text import internal_error, number, plain, safe, value
 from gpmsa.errors import GPMSAError
 
 
@@ -20,7 +20,8 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Run the subcommand; exit status 0, or 2 with a message on stderr for a bad file or path.
+    """Run the subcommand; exit status 0, or 2 with a message on stderr for a bad file or path
+    (1 for an unexpected error, named in one line).
 
     The file is verified as ``gpmsa.load`` verifies it (hash and every field of the content)
     before anything is printed; every string from it is printed escaped (``gpmsa.cli.text``).
@@ -46,6 +47,9 @@ def run(args: argparse.Namespace) -> int:
     except GPMSAError as exc:  # a damaged file (EmulatorFileError), or no file path at all
         print(f"gpmsa info: {safe(exc)}", file=sys.stderr)
         return 2
+    except Exception as exc:  # a gap in the checks a hostile file found: one line, no traceback
+        print(f"gpmsa info: {safe(args.file)}: {internal_error(exc)}", file=sys.stderr)
+        return 1
     if args.json:  # ensure_ascii: control characters come out as \u001b escapes
         print(json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True))
         return 0
@@ -92,8 +96,11 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
     lines.append(f"mean basis:      {'zero (GPM/SA)' if mean is None else safe(mean, 60)}")
     fixed = manifest["settings"].get("fixed")
     if isinstance(fixed, dict) and fixed:
-        lines.append("fixed:           " + ", ".join(
-            f"{safe(k, 60)}={plain(v)}" for k, v in fixed.items()))  # fmt: skip
+        cells = []
+        for k, v in fixed.items():  # theta is stored on the unit scale: printed native, by name
+            native = _native_theta(manifest, v) if k == "theta" and isinstance(v, list) else None
+            cells.append(f"theta (native)=[{native[1]}]" if native else f"{safe(k, 60)}={plain(v)}")
+        lines.append("fixed:           " + ", ".join(cells))
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))
@@ -151,6 +158,11 @@ def _native_theta(manifest: dict, means: list) -> tuple[str, str] | None:
     return "theta (native)", ", ".join(cells)
 
 
+def _element(name: object) -> str:
+    """The element a worst value belongs to, as " (NAME)"; "" for none."""
+    return f" ({safe(name, 60)})" if name else ""
+
+
 def _convergence_line(rec: object) -> str:
     """One line on the chains' convergence (files of one chain or older ones have no record)."""
     if not rec:
@@ -161,11 +173,13 @@ def _convergence_line(rec: object) -> str:
         (r_el, r_val), (e_el, e_val) = rec["max_rhat"], rec["min_ess"]
     except (KeyError, TypeError, ValueError):
         return f"convergence:     {value(rec)}"
-    if r_val is None or e_val is None:
+    if r_val is None and e_val is None and not (r_el or e_el):
         worst = "R-hat and ESS undefined (constant draws)"
-    else:
-        worst = (f"max R-hat {number(r_val, '.3f')} ({safe(r_el, 60)}), min bulk ESS "
-                 f"{number(e_val, '.0f')} ({safe(e_el, 60)})")  # fmt: skip
+    else:  # a value None with an element: not finite (an infinite R-hat: stuck chains)
+        r_txt = number(r_val, ".3f") if r_val is not None else ("inf" if r_el else "undefined")
+        e_txt = number(e_val, ".0f") if e_val is not None else "undefined"
+        worst = (f"max R-hat {r_txt}{_element(r_el)}, min bulk ESS {e_txt}"
+                 f"{_element(e_el)}")  # fmt: skip
     head = (f"convergence:     {plain(rec.get('n_chains'))} chains x "
             f"{plain(rec.get('n_draws'))} draws; {worst}; ")  # fmt: skip
     flagged = rec.get("flagged") or {}

@@ -22,6 +22,8 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``gpmsa`` console script (and of ``python -m gpmsa`` and
     ``python -m gpmsa.cli``)."""
     args = build_parser().parse_args(argv)
+    if hasattr(sys.stdout, "reconfigure"):  # a name that the output's encoding (cp1252 in a
+        sys.stdout.reconfigure(errors="backslashreplace")  # file on Windows) lacks: \u03c3
     try:
         return args.func(args)
     except BrokenPipeError:  # the reader went away (`gpmsa info FILE | head`): not an error

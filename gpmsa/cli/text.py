@@ -55,3 +55,12 @@ def number(obj: object, fmt: str = ".4g") -> str:
     if isinstance(obj, (int, float)) and not isinstance(obj, bool):
         return format(obj, fmt)
     return value(obj)
+
+
+def internal_error(exc: BaseException) -> str:
+    """One line for an error that the library's checks should have turned into a GPMSAError
+    (printed instead of a traceback: its text is escaped, cut at MAX_VALUE_CHARS)."""
+    return (
+        f"unexpected {type(exc).__name__} ({safe(exc, MAX_VALUE_CHARS)}): the file or the input "
+        "is outside what gpmsa checks; please report it"
+    )

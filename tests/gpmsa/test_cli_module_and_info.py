@@ -1,6 +1,8 @@
 """``python -m gpmsa`` (the ``gpmsa`` command) and what ``gpmsa info`` says of the theta
 posterior."""
 
+import io
+import json
 import subprocess
 import sys
 import warnings
@@ -48,3 +50,100 @@ def test_info_prints_the_theta_posterior_in_native_units(tmp_path, capsys) -> No
     native = 2.0 + 4.0 * unit
     assert "native" in line and f"k={native:.4g}" in line, line
     assert f"[{unit:.4g}]" not in line  # not the unit-scale mean, unlabelled
+
+
+def _ab_emulator(x_names=("v",), t_names=("k",), y_names=("f",), x_units=("",)):
+    """A small scalar emulator of y = x t at fixed parameters (no fit)."""
+    rng = np.random.default_rng(0)
+    x, t = rng.uniform(0.0, 1.0, (20, 1)), 2.0 + 4.0 * rng.uniform(0.0, 1.0, (20, 1))
+    data = gpmsa.SimData(x=x, t=t, y=x * t, x_names=list(x_names), t_names=list(t_names),
+                         y_names=list(y_names), x_units=list(x_units))  # fmt: skip
+    params = {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1000.0], "lamWOs": [1000.0]}
+    return gpmsa.Emulator.from_params(data, params)
+
+
+def test_calibrate_reads_a_name_with_surrounding_spaces_whole(tmp_path, capsys) -> None:
+    """Names may end or start with a space (a CSV header's "v "); the given NAME was stripped
+    before it was matched, so such an emulator could not be calibrated from the command line."""
+    path = _ab_emulator(x_names=["v "], y_names=[" f"]).save(tmp_path / "ws.gpmsa")
+    assert main(["calibrate", str(path), "--x", "v =0.5", "--y", " f=2", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["x"] == {"v ": 0.5} and out["y"] == {" f": 2.0}
+    path = _ab_emulator().save(tmp_path / "plain.gpmsa")  # a stray space still reads as v
+    assert main(["calibrate", str(path), "--x", " v=0.5", "--y", "f =2"]) == 0
+    assert main(["calibrate", str(path), "--x", "v=0.5", "--x", " v=0.6", "--y", "f=2"]) == 2
+    assert "--x v is given twice" in capsys.readouterr().err
+
+
+def test_calibrate_without_known_inputs_names_only_the_outputs(tmp_path, capsys) -> None:
+    rng = np.random.default_rng(1)
+    t = rng.uniform(0.0, 1.0, (20, 1))
+    data = gpmsa.SimData(t=t, y=np.sin(3.0 * t), t_names=["k"], y_names=["f"])
+    params = {"betaU": [[1.0]], "lamUz": [1.0], "lamWs": [1000.0], "lamWOs": [1000.0]}
+    path = gpmsa.Emulator.from_params(data, params).save(tmp_path / "nox.gpmsa")
+    assert main(["calibrate", str(path), "--y", "f=0.5"]) == 0
+    head = capsys.readouterr().out.splitlines()[0]
+    assert head.endswith(" given f=0.5"), head  # not "given ; f=0.5"
+
+
+def test_output_in_an_encoding_lacking_a_name_is_escaped_not_a_traceback(
+    tmp_path, monkeypatch
+) -> None:
+    """``gpmsa info FILE > out.txt`` on Windows writes cp1252: a parameter named "σ" raised
+    UnicodeEncodeError (a traceback); it is written as \\u03c3, as ``safe`` escapes."""
+    path = _ab_emulator(t_names=["σ"], x_units=["m/s²"]).save(tmp_path / "uni.gpmsa")
+    for argv in (["info", str(path)], ["calibrate", str(path), "--x", "v=0.5", "--y", "f=2"]):
+        raw = io.BytesIO()
+        out = io.TextIOWrapper(raw, encoding="ascii", newline="\n")
+        monkeypatch.setattr(sys, "stdout", out)
+        assert main(argv) == 0
+        out.flush()
+        text = raw.getvalue().decode("ascii")
+        assert "\\u03c3" in text and (argv[0] != "info" or "m/s\\xb2" in text), text
+
+
+def test_info_prints_a_fixed_theta_in_native_units(tmp_path, capsys) -> None:
+    """``fit(..., fixed={"theta": 4.0})`` takes native units; the file stores the unit-scale
+    value, which info printed as ``theta=[0.5...]`` as if it were the value given."""
+    rng = np.random.default_rng(2)
+    x, t = rng.uniform(0.0, 1.0, (20, 1)), 2.0 + 4.0 * rng.uniform(0.0, 1.0, (20, 1))
+    data = gpmsa.SimData(x=x, t=t, y=x * t, t_names=["k"])
+    obs = gpmsa.ObsData(x=[[0.2], [0.5]], y=[[0.8], [2.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        emu = gpmsa.fit(data, obs, n_iter=40, seed=0, tune=False, fixed={"theta": 4.0})
+    assert main(["info", str(emu.save(tmp_path / "fixed.gpmsa"))]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if s.startswith("fixed:"))
+    assert "theta (native)=[k=4]" in line, line
+
+
+def test_an_unexpected_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch) -> None:
+    """A gap in the library's checks (a study file with sd_max = 10**30 made HyperPriors raise
+    TypeError) is named in one line on stderr, exit status 1 (2 once the check refuses it)."""
+    from _study_cases import emulator, observations
+
+    from gpmsa.io.container import ENVELOPE, STUDY_FORMAT, read_raw, write_raw
+
+    rng = np.random.default_rng(3)
+    data = [observations(0.4, 3, 0.05, rng) for _ in range(2)]
+    study = gpmsa.calibrate_study(
+        [emulator(None)] * 2, [d[0] for d in data], [d[1] for d in data], shared=["t"],
+        n_samples=60, n_burn=20, seed=1, tune=False,
+    )  # fmt: skip
+    path = study.save(tmp_path / "run.gpmsa")
+    manifest, arrays = read_raw(path, formats=(STUDY_FORMAT,))
+    manifest = {k: v for k, v in manifest.items() if k not in ENVELOPE}
+    manifest["priors"]["hyper"]["sd_max"] = 10**30
+    write_raw(path, manifest, arrays, fmt=STUDY_FORMAT)
+    assert main(["info", str(path)]) in (1, 2)
+    err = capsys.readouterr().err
+    assert err.startswith("gpmsa info: ") and err.count("\n") == 1, err
+
+    def broken(self, x_obs, y_obs, **kw):
+        raise TypeError("a \x1b[31m message")
+
+    monkeypatch.setattr(gpmsa.Calibrator, "update", broken)
+    path = _ab_emulator().save(tmp_path / "ab.gpmsa")
+    assert main(["calibrate", str(path), "--x", "v=0.5", "--y", "f=2"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unexpected TypeError (a \\x1b[31m message)" in err, err
