@@ -114,7 +114,9 @@ def convergence(
 
     ``shapes``: name -> element shape of every sampled parameter to judge. Returns n_chains,
     n_draws (per chain), the limits, per parameter ``rhat`` and ``ess`` (bulk) lists (C order),
-    the worst element of each kind, and ``flagged``: element -> reason, for every element with
+    the worst element of each kind (``max_rhat``, ``min_ess``: [element, value]; the value None
+    where it is not finite, an infinite R-hat of chains stuck at different values; the element
+    "" where no element has a value), and ``flagged``: element -> reason, for every element with
     R-hat > RHAT_MAX, ESS < ESS_MIN, no movement at all (constant draws: NaN R-hat and ESS), or
     too few draws to judge (fewer than MIN_DRAWS_RHAT a chain: no R-hat, and ArviZ's ESS of
     such short chains can exceed ESS_MIN even for chains stuck at different values).
@@ -140,7 +142,7 @@ def convergence(
                 why.append(f"ESS {e:.0f}")
             if why:
                 flagged[el] = ", ".join(why)
-            if np.isfinite(r) and r > worst_r[1]:
+            if r > worst_r[1]:  # +inf too (chains stuck at different values); NaN never
                 worst_r = (el, r)
             if np.isfinite(e) and e < worst_e[1]:
                 worst_e = (el, e)

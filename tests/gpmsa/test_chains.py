@@ -109,6 +109,26 @@ def test_short_chains_warn_naming_parameters_and_the_record_is_kept(multi, tmp_p
     assert main(["info", str(path)]) == 0
 
 
+def test_an_infinite_r_hat_is_the_worst_element_not_left_out():
+    """Chains stuck at different values have R-hat inf: the record named a milder element as
+    the worst (max R-hat 2.5 of b while a[1] was inf)."""
+    from gpmsa.mcmc.diagnostics import convergence
+
+    summary = {"a": {"rhat": [1.2, float("inf")], "ess": [50.0, 3.0]},
+               "b": {"rhat": [2.5], "ess": [10.0]}}  # fmt: skip
+    rec = convergence(summary, {"a": (2,), "b": ()}, n_chains=2, n_draws=100)
+    assert rec["max_rhat"] == ["a[1]", None] and rec["min_ess"] == ["a[1]", 3.0]
+    assert rec["flagged"]["a[1]"] == "R-hat inf, ESS 3" and not rec["converged"]
+    none = convergence({"c": {"rhat": [None], "ess": [None]}}, {"c": ()}, 2, 100)
+    assert none["max_rhat"] == ["", None] and "constant" in none["flagged"]["c"]
+    # gpmsa info: the file's JSON holds inf as null; an element with it is an infinite R-hat
+    from gpmsa.cli.info import _convergence_line
+
+    line = _convergence_line(rec)
+    assert "max R-hat inf (a[1]), min bulk ESS 3 (a[1]); NOT converged" in line, line
+    assert "R-hat and ESS undefined (constant draws)" in _convergence_line(none)
+
+
 def test_the_convergence_warning_names_the_argument_that_lengthens_the_chains():
     from _calib_cases import two_param_emulator
 
