@@ -45,8 +45,19 @@ DOMAIN_EDGES = ("upper", "lower")
 
 def edge_counts(domain_edge) -> dict[str, int]:
     """How many estimates name each edge of the GD domain, from their ``domain_edge`` values
-    (e.g. `ClosedLoopResult.domain_edge`), keyed by DOMAIN_EDGES."""
+    (e.g. `ClosedLoopResult.domain_edge`), keyed by DOMAIN_EDGES; ControlError unless those
+    are a sequence of "" and DOMAIN_EDGES."""
     edges = np.asarray(domain_edge, dtype=object)
+    known = ("", *DOMAIN_EDGES)
+    if (
+        isinstance(domain_edge, str)
+        or edges.ndim != 1
+        or not all(isinstance(e, str) and e in known for e in edges)
+    ):
+        raise ControlError(
+            f"domain_edge must be a sequence of '', 'upper' or 'lower' (one per estimate), got "
+            f"{domain_edge!r:.60}"
+        )
     return {edge: int(np.sum(edges == edge)) for edge in DOMAIN_EDGES}
 
 
@@ -140,6 +151,29 @@ class Estimate:
             raise ControlError(
                 f"domain_edge must be '' or one of {DOMAIN_EDGES}, got {self.domain_edge!r}"
             )
+        if self.posterior is not None and not isinstance(self.posterior, Posterior):
+            raise ControlError(
+                f"posterior must be a gpmsa.Posterior or None, got {type(self.posterior).__name__}"
+            )
+        if not self.ok:
+            self._check_empty()
+
+    def _check_empty(self) -> None:
+        """ControlError naming the first of the posterior's numbers (gd_mean, gd_sd, interval,
+        posterior, domain_edge) that an estimate other than "ok" holds."""
+        held = {
+            "gd_mean": not np.isnan(self.gd_mean),
+            "gd_sd": not np.isnan(self.gd_sd),
+            "interval": not np.isnan(float(self.interval[0])),
+            "posterior": self.posterior is not None,
+            "domain_edge": self.domain_edge != "",
+        }
+        for name, holds in held.items():
+            if holds:
+                raise ControlError(
+                    f"a {self.status!r} estimate has no {name} (only an 'ok' one carries the "
+                    f"posterior's numbers), got {getattr(self, name)!r:.60}"
+                )
 
     def _check_interval(self) -> None:
         """ControlError unless ``interval`` is a pair (lo, hi) of real numbers with lo <= hi, or

@@ -91,6 +91,11 @@ class GDTracker:
         check_instance(self.settings, "settings", TrackerSettings)
         self.log_grid = np.linspace(np.log(lo), np.log(hi), self.settings.n_grid)
         self.grid = np.exp(self.log_grid)
+        if not np.all(np.diff(self.grid) > 0):  # nodes rounded together: no trapezoid weights
+            raise ControlError(
+                f"domain {(lo, hi)} is too narrow for {self.settings.n_grid} distinct grid nodes: "
+                "widen it or lower TrackerSettings.n_grid"
+            )
         # node mass = density x trapezoid weight (the end nodes hold half a cell), as the
         # posterior reads it: uniform in GD (density 1) or log-uniform (density 1 / GD)
         self._log_weights = np.log(trapezoid_weights(self.grid))

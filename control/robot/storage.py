@@ -282,15 +282,21 @@ def write_chunk_crcs(path: Path) -> None:
     """Write into each chunk of an MCAP file whose CRC field is 0 ("not computed"; rosbags'
     writer leaves it so) the CRC32 of its (decompressed) records, in place, so that this module,
     rosbags and the mcap package (``validate_crcs``) refuse a chunk whose bytes changed.
-    `BagError` for a file that is not an MCAP file or whose chunks are damaged."""
+    `BagError` for a file that is not an MCAP file, whose chunks are damaged or one of whose
+    records runs past its end."""
     with open(path, "r+b") as f:
         if f.read(len(MAGIC)) != MAGIC:
             raise BagError(f"{path} is not an MCAP file (no magic bytes)")
-        pos = len(MAGIC)
+        pos, size = len(MAGIC), os.fstat(f.fileno()).st_size
         while len(head := f.read(_RECORD.size)) == _RECORD.size:
             op, length = _RECORD.unpack(head)
             if op == OP_DATA_END:
                 break
+            if pos + _RECORD.size + length > size:  # a damaged length, or a file cut short
+                raise BagError(
+                    f"{path} is damaged: the record at byte {pos} runs past the file's end "
+                    f"({length} bytes declared, {size - pos - _RECORD.size} left)"
+                )
             if op == OP_CHUNK:
                 raw = head + f.read(length)
                 try:

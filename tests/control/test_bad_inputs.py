@@ -142,6 +142,38 @@ def test_an_estimate_names_a_status_or_edge_it_does_not_know():
     assert Estimate(time=0.0, position=0.0, status="ok", interval=(250.0, 350.0)).interval
 
 
+@pytest.mark.parametrize(
+    "field, value",
+    [("gd_mean", 300.0), ("gd_sd", 10.0), ("interval", (250.0, 350.0)), ("domain_edge", "upper")],
+)
+def test_an_estimate_that_is_not_ok_carries_none_of_the_posteriors_numbers(field, value):
+    # a "stale" estimate holding a GD was counted as an estimate by the loop's metrics (which
+    # read a finite gd_mean as one) while the Simplex drove it as none
+    with pytest.raises(ControlError, match=f"a 'stale' estimate has no {field}"):
+        Estimate(time=0.0, position=0.0, status="stale", **{field: value})
+    assert Estimate(time=0.0, position=0.0, status="ok", **{field: value}).ok
+
+
+def test_only_an_ok_estimate_holds_a_posterior():
+    post = control.GDTracker((200.0, 600.0)).posterior()
+    with pytest.raises(ControlError, match="a 'filling' estimate has no posterior"):
+        Estimate(time=0.0, position=0.0, status="filling", posterior=post)
+    ok = Estimate(time=0.0, position=0.0, status="ok", posterior=post)
+    assert ok.quantile(0.0) == pytest.approx(200.0) and ok.quantile(1.0) == pytest.approx(600.0)
+    with pytest.raises(ControlError, match="posterior must be a gpmsa.Posterior or None"):
+        Estimate(time=0.0, position=0.0, status="ok", posterior="GD ~ 300")
+
+
+def test_edge_counts_name_what_is_not_a_sequence_of_edges():
+    # a result, a single string or a misspelt edge was counted as no edge: {"upper": 0, ...}
+    assert control.edge_counts(np.array(["", "upper", "upper"], dtype=object)) == {
+        "upper": 2, "lower": 0}  # fmt: skip
+    assert control.edge_counts([]) == {"upper": 0, "lower": 0}
+    for bad in (None, "upper", [["upper"]], ["upper", "top"], [1.0]):
+        with pytest.raises(ControlError, match="domain_edge must be a sequence of '', 'upper'"):
+            control.edge_counts(bad)
+
+
 def test_the_simplex_and_the_recorder_name_an_argument_of_the_wrong_kind(tmp_path):
     for simplex in (Simplex(), Simplex().start()):
         with pytest.raises(ControlError, match="estimate must be a control.Estimate, got None"):

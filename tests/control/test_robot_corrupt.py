@@ -318,3 +318,23 @@ def test_an_interrupted_bag_write_leaves_nothing_and_the_next_one_succeeds(
     assert [p.name for p in tmp_path.joinpath("sub").iterdir()] == ["drive"]
     with pytest.raises(ControlError, match="exists already"):
         write_sensor_bag(path, *_signals(), storage=storage)
+
+
+def test_giving_chunks_crcs_names_a_record_that_runs_past_the_files_end(recordings, tmp_path):
+    # a damaged length of a record between chunks (a message index) sent the writer seeking
+    # 2**62 bytes on (an OSError "Invalid argument"), and a chunk's reading 2**40 bytes (a
+    # MemoryError): neither named the file nor the damage
+    from control.robot.storage import write_chunk_crcs
+
+    _, file = _copy(recordings, "mcap-none", tmp_path)
+    data = file.read_bytes()
+    start, length = _chunks(file)[0]
+    after = start + length  # the record after the first chunk
+    assert data[after] != 0x06  # not a chunk: its length is only skipped
+    huge = data[: after + 1] + (1 << 62).to_bytes(8, "little") + data[after + 9 :]
+    huge_chunk = data[: start + 1] + (1 << 40).to_bytes(8, "little") + data[start + 9 :]
+    for damaged, at in ((huge, after), (data[: after + 20], after), (huge_chunk, start)):
+        file.write_bytes(damaged)  # a huge length; a file cut short in the record
+        with pytest.raises(BagError, match=f"{file} is damaged: the record at byte {at} runs "
+                           "past the file's end"):  # fmt: skip
+            write_chunk_crcs(file)

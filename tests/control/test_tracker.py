@@ -118,6 +118,16 @@ def test_bad_input_raises():
         tr.posterior(n_draws=-1)
 
 
+@pytest.mark.parametrize("hi", [300.0 * (1 + 1e-14), np.nextafter(300.0, 400.0)])
+def test_a_domain_too_narrow_for_the_grid_is_refused(hi):
+    # its nodes rounded to equal values: a divide-by-zero warning, then a GPMSAError about a
+    # grid marginal's nodes from posterior()
+    with pytest.raises(ControlError, match=r"domain \(300.0, 300.*\) is too narrow for 400 "
+                       "distinct grid nodes"):  # fmt: skip
+        GDTracker((300.0, hi))
+    assert GDTracker((300.0, 300.0 * (1 + 1e-9))).posterior().quantile("GD", 0.5) > 300.0
+
+
 @pytest.mark.parametrize(
     "grid", [[600.0, 200.0, 400.0], [200.0, np.nan, 600.0], [-1.0, 200.0, 600.0]]
 )
