@@ -62,6 +62,7 @@ import control
 import gpmsa
 import roadgen
 import vehicle
+from gpmsa.model.data import MAX_SEED
 
 PAPER_TRACK = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 NOISE_STD = {"A": 0.0, "B": 1.0}
@@ -406,6 +407,13 @@ def main() -> None:
         parser.error(f"--random-tracks must be >= 1, got {args.random_tracks}")
     if args.random_first_seed < 0:
         parser.error(f"--random-first-seed must be >= 0, got {args.random_first_seed}")
+    for option, first, n in (
+        ("--random-first-seed", args.random_first_seed, args.random_tracks),
+        ("--steady-first-seed", args.steady_first_seed, args.steady_roads),
+    ):  # fmt: skip
+        if first + n - 1 >= MAX_SEED:
+            parser.error(f"{option} {first}: its {n} seeds run beyond the seeds' range "
+                         "[0, 2**128)")  # fmt: skip
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
     names = list(dict.fromkeys(n for n in args.sets.split(",") if n))  # each set once

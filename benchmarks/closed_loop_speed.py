@@ -66,6 +66,12 @@ def main() -> None:
         parser.error(f"--repeats must be >= 1, got {args.repeats}")
     if not (np.isfinite(args.long_m) and args.long_m >= 0):
         parser.error(f"--long-m must be a length >= 0, m, got {args.long_m}")
+    long_track = None
+    if args.long_m > 0 and args.method == "changepoint":
+        try:  # before the runs: a drive too short for its three segments, or too long
+            long_track = steady_track(args.long_m)
+        except roadgen.RoadgenError as exc:
+            parser.error(f"--long-m {args.long_m:g} (three segments of a third): {exc}")
     emu = control.shipped_emulator(args.case, "band" if args.method == "changepoint" else "window")
     noise = float(emu.metadata["noise_std"])
     try:
@@ -124,9 +130,9 @@ def main() -> None:
         f"p99 {np.percentile(lat, 99):.2f} (target <= 2), "
         f"max {lat.max():.2f} over {lat.size} updates of {settings.samples_per_update} samples"
     )
-    if args.long_m > 0 and args.method == "changepoint":
+    if long_track is not None:
         long_lat, runs = steady_state_latency(
-            likelihood, settings, args.long_m, noise, args.replays
+            likelihood, settings, long_track, noise, args.replays
         )  # fmt: skip
         if long_lat.size == 0:
             print(f"  (a {args.long_m:g} m drive keeps fewer than 90% of max_runs = {runs})")
@@ -146,12 +152,16 @@ def main() -> None:
         )
 
 
-def steady_state_latency(likelihood, settings, length_m: float, noise: float, replays: int):
-    """(BCR.update latencies, ms, (replays, updates): the updates of a ``length_m`` drive from
-    the first at which the newest phase's filter keeps >= 90% of max_runs run lengths, each
-    replayed ``replays`` times from the same state; max_runs)."""
+def steady_track(length_m: float) -> roadgen.Track:
+    """The steady-state drive's road: ``length_m`` over GD 300 / 450 / 350, a third each."""
     third = length_m / 3
-    track = roadgen.track([(third, 300.0), (third, 450.0), (third, 350.0)], seed=1)
+    return roadgen.track([(third, 300.0), (third, 450.0), (third, 350.0)], seed=1)
+
+
+def steady_state_latency(likelihood, settings, track, noise: float, replays: int):
+    """(BCR.update latencies, ms, (replays, updates): the updates of a drive over ``track``
+    (`steady_track`) from the first at which the newest phase's filter keeps >= 90% of max_runs
+    run lengths, each replayed ``replays`` times from the same state; max_runs)."""
     chunks = update_samples(track, settings, noise, seed=1, speed=2.0)
     bcr = control.BCR(likelihood, settings)
     runs = settings.changepoint.max_runs

@@ -64,6 +64,7 @@ import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy import stats
@@ -72,6 +73,7 @@ import control
 import gpmsa
 import vehicle
 from control.training import block_statistics
+from gpmsa.model.data import MAX_SEED
 
 N_SPEEDS = 7
 N_GDS = 9
@@ -417,13 +419,30 @@ def main(argv: list[str] | None = None) -> None:
     min_keep_s = 2 * BATCH * 125 / RATE_HZ
     if roads < 1:
         parser.error(f"--roads must be >= 1, got {roads}")
-    if not args.keep_s >= min_keep_s:  # NaN fails too
+    if not min_keep_s <= args.keep_s < np.inf:  # NaN fails too
         parser.error(
-            f"--keep-s must be >= {min_keep_s:.2f} s (two batches of 8 blocks), got {args.keep_s}"
+            f"--keep-s must be >= {min_keep_s:.2f} s (two batches of 8 blocks) and finite, got "
+            f"{args.keep_s}"
         )
     for option, value in (("--seed", args.seed), ("--boot-seed", args.boot_seed)):
         if value < 0:
             parser.error(f"{option} must be >= 0, got {value}")
+    if args.seed >= MAX_SEED:
+        parser.error(f"--seed must be < 2**128 (the seeds' range), got {args.seed}")
+    n_drives = N_SPEEDS * N_GDS * roads
+    try:  # the campaign's design and traces (its own check, made before the design is built)
+        vehicle.checks.memory(
+            (64.0 + 16.0 * round(args.keep_s * RATE_HZ)) * n_drives,
+            f"--roads {roads} and --keep-s {args.keep_s:g}: the traces of {n_drives} drives",
+        )  # fmt: skip
+    except vehicle.VehicleError as exc:
+        parser.error(str(exc))
+    if args.cache_dir:
+        try:  # a file of that name: refused now, not by the campaign
+            Path(args.cache_dir).mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            parser.error(f"--cache-dir {args.cache_dir!r}: cannot make that folder: "
+                         f"{exc.strerror or exc}")  # fmt: skip
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
 

@@ -61,6 +61,7 @@ from scipy import stats
 
 import control
 import roadgen
+from gpmsa.model.data import MAX_SEED
 
 NOISE_STD = {"A": 0.0, "B": 1.0}
 PAPER_TRACK = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
@@ -526,6 +527,9 @@ def main(argv: list[str] | None = None) -> int:
     ):  # fmt: skip
         if value < minimum:
             parser.error(f"{option} must be >= {minimum}, got {value}")
+    for seed in args.example_seeds:  # each a track and a noise seed
+        if seed >= MAX_SEED:
+            parser.error(f"--example-seeds must be < 2**128 (the seeds' range), got {seed}")
     try:
         simplex = control.Simplex(after_fault=args.after_fault, speed_step_mps=args.speed_step)
     except control.ControlError as exc:

@@ -53,6 +53,7 @@ import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
@@ -61,6 +62,7 @@ from scipy.signal.windows import hann
 import vehicle
 from control import FeatureSpec, block_features
 from control.feature import STANDARD_GRAVITY
+from gpmsa.model.data import MAX_SEED
 
 RATE_HZ = 120.0
 V_RANGE = (0.5, 2.0)
@@ -434,21 +436,34 @@ def main(argv: list[str] | None = None) -> None:
     min_keep_s = max(SPANS) / RATE_HZ
     if n_runs < 10:
         parser.error(f"--n-runs must be >= 10 (a cubic mean per output), got {n_runs}")
-    if not keep_s >= min_keep_s:  # NaN fails too
+    if not min_keep_s <= keep_s < np.inf:  # NaN fails too
         parser.error(
-            f"--keep-s must be >= {min_keep_s:.2f} s (the longest stretch pooled), got {keep_s}"
+            f"--keep-s must be >= {min_keep_s:.2f} s (the longest stretch pooled) and finite, "
+            f"got {keep_s}"
         )
     for option, value in (
         ("--train-seed", args.train_seed), ("--test-seed", args.test_seed), ("--seed", args.seed)
     ):  # fmt: skip
-        if value < 0:
-            parser.error(f"{option} must be >= 0, got {value}")
+        if not 0 <= value < MAX_SEED:
+            parser.error(f"{option} must be in [0, 2**128), got {value}")
     lo, hi = args.gd_band
     if not GD_RANGE[0] <= lo < hi <= GD_RANGE[1]:
         parser.error(f"--gd-band must lie in {list(GD_RANGE)} with low < high, got {lo:g} {hi:g}")
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
+    try:  # each campaign's design and traces (its own check, before the campaigns)
+        vehicle.checks.memory(
+            (64.0 + 16.0 * round(keep_s * RATE_HZ)) * n_runs,
+            f"--n-runs {n_runs} and --keep-s {keep_s:g}: a campaign's traces",
+        )  # fmt: skip
+    except vehicle.VehicleError as exc:
+        parser.error(str(exc))
     cache = args.cache_dir or None
+    if cache:
+        try:  # a file of that name: refused now, not by the first campaign
+            Path(cache).mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            parser.error(f"--cache-dir {cache!r}: cannot make that folder: {exc.strerror or exc}")
 
     tic = time.perf_counter()
     v_tr, gd_tr, acc_tr = campaign(n_runs, keep_s, args.train_seed, args.workers, cache)

@@ -44,6 +44,7 @@ import control
 import roadgen
 from control.bcr import MAX_SPEED_CHANGE
 from control.changepoint import mixture_posterior
+from gpmsa.model.data import MAX_SEED
 
 PAPER_TRACK = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 NOISE_STD = {"A": 0.0, "B": 1.0}
@@ -138,7 +139,7 @@ def _run(job: tuple[str, int]) -> dict:
 
 def seed_group(text: str) -> list[int]:
     """One group of seeds as text, "11-20" or "7", as a list; ValueError unless it names
-    seeds >= 0 in increasing order."""
+    seeds in [0, 2**128) in increasing order."""
     lo, dash, hi = text.partition("-")
     try:
         first, last = int(lo), int(hi) if dash else int(lo)
@@ -146,6 +147,8 @@ def seed_group(text: str) -> list[int]:
         raise ValueError(f"{text!r} is not a seed or a range of seeds like 11-20") from None
     if first < 0 or last < first:
         raise ValueError(f"{text!r} must name seeds >= 0, the first no larger than the last")
+    if last >= MAX_SEED:
+        raise ValueError(f"{text!r} names seeds beyond the seeds' range [0, 2**128)")
     return list(range(first, last + 1))
 
 

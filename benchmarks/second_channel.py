@@ -188,8 +188,10 @@ def main() -> None:
         args.roads, args.duration_s = 4, 60.0
     if args.roads < 4 or args.roads % 2:
         parser.error(f"--roads must be an even integer >= 4, got {args.roads}")
-    if not args.duration_s >= 30.0:  # NaN fails too
-        parser.error(f"--duration-s must be >= 30 (two batches per road), got {args.duration_s}")
+    if not 30.0 <= args.duration_s < np.inf:  # NaN fails too
+        parser.error(
+            f"--duration-s must be >= 30 (two batches per road) and finite, got {args.duration_s}"
+        )
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
 

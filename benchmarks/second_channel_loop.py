@@ -58,9 +58,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "examples"))
 import closed_loop_accuracy as cla  # noqa: E402
-from _cli import output_folder, path_option  # noqa: E402
+from _cli import check_option_memory, output_folder, path_option  # noqa: E402
 from second_channel import GYRO_NOISE_RAD_S, spectral_derivative  # noqa: E402
-from train_emulator import BATCH, LEAD_IN_M, stretched_design  # noqa: E402
+from train_emulator import BATCH, LEAD_IN_M, fit_memory, stretched_design  # noqa: E402
 
 SPEC = control.FeatureSpec(quantiles=())  # as measured: the band powers alone
 FRONT_PCS = 5
@@ -308,6 +308,10 @@ def main() -> None:
     if all(p.exists() for p in emulators):
         print(f"emulators from {out} (delete them to refit)")
     else:
+        check_option_memory(  # before the campaign; the fewest components, a lower bound
+            parser, fit_memory(design.shape[0], 1, args.n_iter),
+            f"--n-iter {args.n_iter}: gpmsa.fit's draws",
+        )  # fmt: skip
         seeds = np.random.SeedSequence(0).generate_state(design.shape[0]).astype(int)
         jobs = [(v, gd, int(s), 120.0) for (v, gd), s in zip(design, seeds, strict=True)]
         with ProcessPoolExecutor(args.workers) as pool:

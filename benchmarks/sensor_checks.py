@@ -26,6 +26,7 @@ import numpy as np
 
 import vehicle
 from control.sensor_checks import SensorLimits, flight_reading, most_lattice_like, signal_fault
+from gpmsa.model.data import MAX_SEED
 
 BLOCK = 125
 RESOLUTIONS = (0.001, 0.0048, 0.02, 0.05, 0.1)  # m/s^2; 0.0048: a 16-bit part at +-16 g
@@ -43,8 +44,12 @@ def main() -> None:
     args = parser.parse_args()
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
-    if not args.keep_s >= BLOCK / 120.0:  # NaN fails too
-        parser.error(f"--keep-s must be >= {BLOCK / 120.0:.2f} s (one block), got {args.keep_s}")
+    if args.seed >= MAX_SEED:
+        parser.error(f"--seed must be < 2**128 (the seeds' range), got {args.seed}")
+    if not BLOCK / 120.0 <= args.keep_s < np.inf:  # NaN fails too
+        parser.error(
+            f"--keep-s must be >= {BLOCK / 120.0:.2f} s (one block) and finite, got {args.keep_s}"
+        )
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
     tic = time.perf_counter()

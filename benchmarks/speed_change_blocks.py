@@ -49,6 +49,7 @@ import roadgen
 import vehicle
 from control.bcr import MAX_SPEED_CHANGE
 from control.shipped import shipped_emulator
+from gpmsa.model.data import MAX_SEED
 
 RATE_HZ = 120.0
 STEPS = ((2.0, 1.0), (1.0, 2.0), (1.5, 1.2), (1.2, 1.5))
@@ -237,6 +238,10 @@ def main() -> None:
     args = ap.parse_args()
     if args.roads < 2 or args.runs < 2 or args.workers < 1 or args.first_seed < 0:
         ap.error("--roads and --runs must be >= 2, --workers >= 1, --first-seed >= 0")
+    last = args.first_seed + max(args.roads, args.runs) - 1 + OTHER_ROAD  # the other roads' too
+    if last >= MAX_SEED:
+        ap.error(f"--first-seed {args.first_seed}: its seeds run to {last}, beyond the seeds' "
+                 "range [0, 2**128)")  # fmt: skip
     tic = time.perf_counter()
     print(load())
     if args.part in ("open", "both"):

@@ -31,6 +31,7 @@ import numpy as np
 import control
 import roadgen
 from control.bcr import emulator_domain
+from gpmsa.model.data import MAX_SEED
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from closed_loop_accuracy import (  # noqa: E402  (the steady set's definition)
@@ -118,6 +119,9 @@ def main() -> None:
         parser.error(f"--roads must be >= 2 (a standard error needs two), got {args.roads}")
     if args.first_seed < 0:
         parser.error(f"--first-seed must be >= 0, got {args.first_seed}")
+    if args.first_seed + args.roads - 1 >= MAX_SEED:
+        parser.error(f"--first-seed {args.first_seed}: its {args.roads} seeds run beyond the "
+                     "seeds' range [0, 2**128)")  # fmt: skip
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
     cases = [c for c in args.cases.split(",") if c]

@@ -21,6 +21,12 @@ FILE = "{file}"
 """In argv: an existing regular file where the script wants a folder; in the message: its path
 as the script prints it (repr)."""
 NOT_A_FOLDER = FILE + ": cannot make that folder"
+BIG_SEED = str(2**128)
+"""A seed just beyond the libraries' range [0, 2**128)."""
+LAST_SEED = str(2**128 - 1)
+"""The last seed in range: a script that derives more seeds from it goes beyond."""
+FOLDER = "{folder}"
+"""In argv: a fresh folder (for a script's output)."""
 
 CASES = [
     ("benchmarks/backends.py", ["--repeats", "0"], "--repeats must be >= 1, got 0"),
@@ -187,6 +193,47 @@ CASES = [
         ["--ship", "--gd-range", "350", "600"],
         "--ship with --gd-range 350 600: the shipped files must cover [300, 500]",
     ),
+    # odd values: a drive too short for its road, infinite lengths, folders that are files, and
+    # seeds beyond the seeds' range [0, 2**128) (the first seed, or the last one derived from it)
+    (
+        "benchmarks/closed_loop_speed.py",
+        ["--long-m", "1"],
+        "--long-m 1 (three segments of a third): blend_m=1 is out of range",
+    ),
+    ("benchmarks/emulator_bias.py", ["--keep-s", "inf"], "(two batches of 8 blocks) and finite"),
+    ("benchmarks/emulator_bias.py", ["--cache-dir", FILE], "--cache-dir " + NOT_A_FOLDER),
+    ("benchmarks/emulator_bias.py", ["--seed", BIG_SEED], "--seed must be < 2**128"),
+    ("benchmarks/feature_information.py", ["--keep-s", "inf"], "pooled) and finite, got inf"),
+    ("benchmarks/feature_information.py", ["--cache-dir", FILE], "--cache-dir " + NOT_A_FOLDER),
+    (
+        "benchmarks/feature_information.py",
+        ["--test-seed", BIG_SEED],
+        "--test-seed must be in [0, 2**128), got " + BIG_SEED,
+    ),
+    ("benchmarks/sensor_checks.py", ["--keep-s", "inf"], "(one block) and finite, got inf"),
+    ("benchmarks/sensor_checks.py", ["--seed", BIG_SEED], "--seed must be < 2**128"),
+    ("benchmarks/second_channel.py", ["--duration-s", "inf"], "road) and finite, got inf"),
+    ("benchmarks/speed_change_blocks.py", ["--first-seed", LAST_SEED], "beyond the seeds' range"),
+    ("benchmarks/steady_hedge.py", ["--first-seed", LAST_SEED], "its 8 seeds run beyond"),
+    (
+        "benchmarks/closed_loop_accuracy.py",
+        ["--random-first-seed", LAST_SEED],
+        "--random-first-seed " + LAST_SEED + ": its 40 seeds run beyond",
+    ),
+    ("benchmarks/oracle_bounds.py", ["--seeds", "1-" + BIG_SEED], "beyond the seeds' range"),
+    ("benchmarks/fault_soak.py", ["--example-seeds", "1", BIG_SEED], "--example-seeds must be <"),
+    # counts whose memory the libraries would refuse only after (or while) building the work
+    (
+        "benchmarks/emulator_bias.py",
+        ["--roads", "10" * 5],
+        "the traces of 63636363630 drives needs",
+    ),
+    ("benchmarks/feature_information.py", ["--n-runs", "10" * 5], "a campaign's traces needs"),
+    (
+        "benchmarks/second_channel_loop.py",
+        ["--n-iter", "10" * 6, "--out", FOLDER],
+        "--n-iter 101010101010: gpmsa.fit's draws needs about",
+    ),
 ]
 
 
@@ -200,7 +247,8 @@ def usage_runs(tmp_path_factory) -> list[tuple[dict, Path]]:
         a_file = folder / f"a_file_{k}"
         a_file.write_text("kept")
         files.append(a_file)
-        runs.append((script, [str(a_file) if arg == FILE else arg for arg in argv]))
+        args = [str(a_file) if arg == FILE else arg for arg in argv]
+        runs.append((script, [str(folder / f"out_{k}") if arg == FOLDER else arg for arg in args]))
     return list(zip(run_scripts(runs), files, strict=True))
 
 
