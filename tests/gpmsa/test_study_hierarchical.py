@@ -109,6 +109,14 @@ def test_bad_hyperpriors_are_named():
     with pytest.raises(gpmsa.GPMSAError, match="HyperPriors.lam_start"):
         gpmsa.HyperPriors(sd_max=0.3, lam_start=5.0)  # start sd 0.45 > sd_max
     assert gpmsa.HyperPriors(sd_max=0.3).lam_start == pytest.approx(4 / 0.09)  # sd 0.15
+    # Python integers: 10**30 is a number (numpy's isfinite raised TypeError on it), 10**400
+    # is beyond float64 (OverflowError before)
+    assert gpmsa.HyperPriors(sd_max=10**30).lam_start == 5.0
+    with pytest.raises(gpmsa.GPMSAError, match=r"HyperPriors.sd_max must be finite and > 0, got "
+                       r"1000000000"):  # fmt: skip
+        gpmsa.HyperPriors(sd_max=10**400)
+    with pytest.raises(gpmsa.GPMSAError, match=r"HyperPriors.mu_mean must be finite"):
+        gpmsa.HyperPriors(mu_mean=-(10**400))
 
 
 @pytest.mark.slow
