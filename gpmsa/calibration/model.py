@@ -242,11 +242,12 @@ class LamOsPrior:
     upper: float = np.inf
 
     def log_norm(self) -> float:
-        """log P(lower < lamOs < upper) under the untruncated Gamma."""
+        """log P(lower < lamOs < upper) under the untruncated Gamma (-inf where it rounds to 0)."""
         mass = gammainc(self.shape, self.rate * self.upper) - gammainc(
             self.shape, self.rate * self.lower
         )
-        return float(np.log(mass))
+        with np.errstate(divide="ignore"):
+            return float(np.log(mass))
 
     def upper_quantile(self, tail: float) -> float:
         """The value above which the (untruncated) prior has mass `tail`."""
@@ -415,10 +416,18 @@ def _prior_terms(prior: LamOsPrior, d: int) -> tuple[float, np.ndarray]:
         - prior.log_norm()
         - 0.5 * d * _LOG_2PI
     )
-    s_hi = float(np.log(min(prior.upper, prior.upper_quantile(1e-17))))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s_hi = float(np.log(min(prior.upper, prior.upper_quantile(1e-17))))
     s_lo = s_hi - 80.0
     if prior.lower > 0.0:
         s_lo = max(s_lo, float(np.log(prior.lower)))
+    if not (np.isfinite(const) and np.isfinite(s_hi) and s_lo < s_hi):
+        raise GPMSAError(
+            f"the lamOs prior Gamma(a={prior.shape:g}, b={prior.rate:g}) on ({prior.lower:g}, "
+            f"{prior.upper:g}) has no mass that the grid's integral over lamOs can reach in "
+            "float64 (the mass above its lower bound rounds to 0, or its shape is too close to "
+            "0); use a lamOs prior with mass in float64's range"
+        )
     coarse = np.linspace(s_lo, s_hi, int(np.ceil((s_hi - s_lo) / 2.0)) + 1)
     coarse.flags.writeable = False
     return float(const), coarse

@@ -236,3 +236,20 @@ def test_gridded_prior_with_zeros_survives_refinement_in_one_parameter():
     assert post.prob_above("GD", end) == 0.0
     assert post.samples["GD"].max() <= end
     assert post.quantile("GD", 1.0) == pytest.approx(end, abs=1e-6)  # mass ends there
+
+
+@pytest.mark.parametrize(
+    "prior",
+    [gpmsa.GammaPrior(1e-30, 1e-3), gpmsa.GammaPrior(1.0, 1e-3, lower=1e300)],
+    ids=["shape-near-0", "lower-beyond-the-mass"],
+)
+def test_a_lamos_prior_beyond_float64s_reach_is_named_by_the_grid(prior):
+    """Legal priors whose mass the grid's integral over lamOs cannot reach: ValueError from
+    int(NaN) or a negative sample count inside numpy before."""
+    from _study_cases import emulator
+
+    emu = emulator(gpmsa.Priors(lamOs=prior))
+    with pytest.raises(gpmsa.GPMSAError, match=r"the lamOs prior Gamma\(a=.* has no mass"):
+        Calibrator(emu, method="grid").update([[0.5]], [[0.6]])
+    ok = emulator(gpmsa.Priors(lamOs=gpmsa.GammaPrior(1.0, 1e-3, lower=10.0)))
+    assert 0.0 <= Calibrator(ok, method="grid").update([[0.5]], [[0.6]]).mean("t") <= 1.0
