@@ -9,10 +9,11 @@ GPM/SA's start value.
 
 import warnings
 
+import arviz
 import numpy as np
 import pytest
 from _calib_cases import road_emulator, road_obs, two_param_emulator, vector_emulator
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy import integrate
 from scipy.special import gammaln
@@ -28,15 +29,26 @@ from gpmsa.calibration.observations import (
     theta_probe,
 )
 from gpmsa.cli.main import main
-from gpmsa.mcmc.diagnostics import ess
 
 
 def _agree(grid, mc, name, k=4.5):
-    """|mean difference| and |sd difference| within k Monte-Carlo standard errors."""
-    n_eff = ess(mc.chains[name])
+    """|mean difference| and |sd difference| within k Monte-Carlo standard errors: the mean's
+    sd / sqrt(ESS of the mean), the sd's sd sqrt((kurtosis - 1) / (4 ESS of the sd)). The sample
+    sd's error grows with the posterior's kurtosis (the grid's, exact): a posterior piled at
+    the domain's edge with a heavy tail has 114, and there a Gaussian se (kurtosis 3), even
+    widened by 1.5, failed on agreeing posteriors (8 chains x 58,000 draws: the MCMC's tail mass
+    0.0036 +- 0.0007, the grid's 0.0042)."""
+    chains = np.atleast_2d(mc.chains[name])
+    ess_mean, ess_sd = (float(arviz.ess(chains, method=m)) for m in ("mean", "sd"))
     sd = grid.sd(name)
-    assert abs(mc.mean(name) - grid.mean(name)) < k * sd / np.sqrt(n_eff)
-    assert abs(mc.sd(name) - sd) < k * sd / np.sqrt(2 * n_eff) * 1.5
+    marginal = grid.grids.get(name)
+    kurtosis = 3.0  # (no 1-D grid of this name: a Gaussian's)
+    if marginal is not None:
+        w = marginal.density * marginal.weights
+        dev = marginal.nodes - w @ marginal.nodes / w.sum()
+        kurtosis = (w @ dev**4) * w.sum() / (w @ dev**2) ** 2
+    assert abs(mc.mean(name) - grid.mean(name)) < k * sd / np.sqrt(ess_mean)
+    assert abs(mc.sd(name) - sd) < k * sd * np.sqrt((kurtosis - 1) / (4 * ess_sd))
 
 
 def _both(emu, x, y, n_samples=8000, seed=1):
@@ -115,6 +127,7 @@ def test_grid_likelihood_is_exact_for_far_out_observations():
     side=st.sampled_from([-1.0, 1.0]),
     log_dist=st.floats(-1.0, 5.0),
 )
+@example(v_unit=1.0, side=1.0, log_dist=0.375)  # kurtosis 114: see _agree
 def test_grid_and_mcmc_agree_on_generated_observations(v_unit, side, log_dist):
     """Observations from inside the outputs' range to 1e5 beyond either end: the grid and the
     MCMC compute the same posterior (within Monte-Carlo error); both warn beyond the margin."""
