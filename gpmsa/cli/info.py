@@ -44,21 +44,21 @@ def run(args: argparse.Namespace) -> int:
             study = load_study(args.file)
         else:
             Emulator.from_record(manifest, arrays)
+        if args.json:  # ensure_ascii: control characters come out as \u001b escapes
+            text = json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True)
+        elif manifest["format"] == STUDY_FORMAT:
+            lines = study_lines(args.file, manifest, study)
+            lines.append(_convergence_line(study.convergence))  # from the draws, as load_study
+            text = "\n".join(lines)
+        else:
+            text = "\n".join(_lines(args.file, manifest, arrays))
     except GPMSAError as exc:  # a damaged file (EmulatorFileError), or no file path at all
         print(f"gpmsa info: {safe(exc)}", file=sys.stderr)
         return 2
     except Exception as exc:  # a gap in the checks a hostile file found: one line, no traceback
         print(f"gpmsa info: {safe(args.file)}: {internal_error(exc)}", file=sys.stderr)
         return 1
-    if args.json:  # ensure_ascii: control characters come out as \u001b escapes
-        print(json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True))
-        return 0
-    if manifest["format"] == STUDY_FORMAT:
-        lines = study_lines(args.file, manifest, study)
-        lines.append(_convergence_line(study.convergence))  # from the draws, as load_study
-    else:
-        lines = _lines(args.file, manifest, arrays)
-    print("\n".join(lines))
+    print(text)
     return 0
 
 

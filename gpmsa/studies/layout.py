@@ -48,14 +48,14 @@ class HyperPriors:
     def __post_init__(self) -> None:
         if self.lam_start is None:
             ok = isinstance(self.sd_max, (int, float, np.floating, np.integer))
-            sd_max = float(self.sd_max) if ok and self.sd_max > 0 and _finite(self.sd_max) else 1.0
+            sd_max = float(self.sd_max) if ok and self.sd_max > 0 and finite(self.sd_max) else 1.0
             inside = self.sd_prior != "uniform" or 5.0 * sd_max**2 > 1.0
             object.__setattr__(self, "lam_start", 5.0 if inside else 4.0 / sd_max**2)
         for name in NUMBERS:
             val = getattr(self, name)
             if isinstance(val, bool) or not isinstance(val, (int, float, np.floating, np.integer)):
                 raise GPMSAError(f"HyperPriors.{name} must be a number, got {val!r}")
-            if not _finite(val) or (name != "mu_mean" and not val > 0):
+            if not finite(val) or (name != "mu_mean" and not val > 0):
                 need = "finite" if name == "mu_mean" else "finite and > 0"
                 raise GPMSAError(f"HyperPriors.{name} must be {need}, got {val!r:.60}")
         if self.sd_prior not in SD_PRIORS:
@@ -273,7 +273,7 @@ def check_study_names(layout: Layout) -> None:
         )
 
 
-def _finite(val) -> bool:
+def finite(val) -> bool:
     """Whether the number ``val`` is finite; an integer beyond float64 (10**400) is not, and a
     huge one within it (10**30, which numpy's isfinite refuses) is."""
     try:

@@ -3,13 +3,12 @@ the field ("study.models[1].sha256", "arrays/theta", ...). docs/models.md descri
 
 from __future__ import annotations
 
-import math
 import re
 
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError
-from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout
+from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout, finite
 
 KINDS = ("calibration", "fit")
 """How a study's draws were made: calibration with the emulators fixed, or a joint fit."""
@@ -79,7 +78,7 @@ def check_study_manifest(manifest: dict) -> None:
         if key == "sd_max" and key not in hyper:
             continue
         val = hyper.get(key)
-        ok = isinstance(val, (int, float)) and not isinstance(val, bool) and math.isfinite(val)
+        ok = isinstance(val, (int, float)) and not isinstance(val, bool) and finite(val)
         if not ok or (key != "mu_mean" and not val > 0):
             need = "a finite number" if key == "mu_mean" else "a finite number > 0"
             raise _fail(f"priors.hyper.{key}", f"must be {need}, got {_short(val)}")

@@ -118,8 +118,9 @@ def test_info_prints_a_fixed_theta_in_native_units(tmp_path, capsys) -> None:
 
 
 def test_an_unexpected_error_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch) -> None:
-    """A gap in the library's checks (a study file with sd_max = 10**30 made HyperPriors raise
-    TypeError) is named in one line on stderr, exit status 1 (2 once the check refuses it)."""
+    """A gap in the library's checks is named in one line on stderr, exit status 1. (A study
+    file with sd_max = 10**30 made HyperPriors raise TypeError; HyperPriors now takes it, and
+    refuses 10**400 as a bad file: status 2.)"""
     from _study_cases import emulator, observations
 
     from gpmsa.io.container import ENVELOPE, STUDY_FORMAT, read_raw, write_raw
@@ -133,11 +134,20 @@ def test_an_unexpected_error_is_one_line_not_a_traceback(tmp_path, capsys, monke
     path = study.save(tmp_path / "run.gpmsa")
     manifest, arrays = read_raw(path, formats=(STUDY_FORMAT,))
     manifest = {k: v for k, v in manifest.items() if k not in ENVELOPE}
-    manifest["priors"]["hyper"]["sd_max"] = 10**30
+    manifest["priors"]["hyper"]["sd_max"] = 10**400
     write_raw(path, manifest, arrays, fmt=STUDY_FORMAT)
-    assert main(["info", str(path)]) in (1, 2)
+    assert main(["info", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.startswith("gpmsa info: ") and err.count("\n") == 1, err
+
+    def gap(*args, **kwargs):
+        raise TypeError("a \x1b[31m gap")
+
+    monkeypatch.setattr(gpmsa.cli.info, "_lines", gap)
+    emu_path = _ab_emulator().save(tmp_path / "info.gpmsa")
+    assert main(["info", str(emu_path)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unexpected TypeError (a \\x1b[31m gap)" in err, err
 
     def broken(self, x_obs, y_obs, **kw):
         raise TypeError("a \x1b[31m message")
