@@ -301,9 +301,11 @@ class Emulator:
             self._factors[-1] = self._factor(self.params)
         return self._factors[-1]
 
-    def _inputs(self, x, t, *, far_ok: bool = False) -> np.ndarray:
+    def _inputs(self, x, t, *, far_ok: bool = False, stacklevel: int = 3) -> np.ndarray:
         """Unit-scale z (N, p + q) of native x and t; beyond ``EXTRAPOLATION_MARGIN`` of the
-        domain a GPMSAError unless ``far_ok`` (a caller that allows it and has warned)."""
+        domain a GPMSAError unless ``far_ok`` (a caller that allows it and has warned);
+        ``stacklevel``: of the extrapolation warning, counted from here (3: the caller's
+        caller), so that it names the user's line."""
         check_same_rows({"x": x, "t": t}, {"x": self.x_names, "t": self.t_names})
         if x is None and self.p == 0:  # no known inputs: one row of none, broadcast against t
             x = np.empty((1, 0))
@@ -339,7 +341,9 @@ class Emulator:
                 f"domain [{a:.6g}, {b:.6g}] by more than {EXTRAPOLATION_MARGIN:.0%} of its width"
             )
         if (lo < 0).any() or (hi > 1).any():
-            warnings.warn("predict() extrapolates beyond the training domain", stacklevel=3)
+            warnings.warn(
+                "predict() extrapolates beyond the training domain", stacklevel=stacklevel
+            )
         return z
 
     def _predict_std(self, z: np.ndarray, params, factors, resid: bool):
@@ -378,7 +382,7 @@ class Emulator:
         ``far_ok``: x or t beyond ``EXTRAPOLATION_MARGIN`` of the domain allowed (for a caller
         that allows extrapolation and has warned, as ``calibrated_predict(extrapolate=True)``)."""
         self._check_predict_memory(x, t)
-        z = self._inputs(x, t, far_ok=far_ok)
+        z = self._inputs(x, t, far_ok=far_ok, stacklevel=4)  # the caller of predict()
         m, v = self._predict_std(z, self.params, self._point_factor(), resid)
         return self.standardizer.y_from_std(m), self.standardizer.var_from_std(v)
 
@@ -700,6 +704,11 @@ def _check_metadata(value, where: str, depth: int = 0) -> None:
     if value is None or isinstance(value, (str, bool, int, np.integer, np.bool_)):
         return
     if isinstance(value, (float, np.floating)):
+        if isinstance(value, np.floating) and value.dtype.itemsize > 8:
+            raise GPMSAError(
+                f"{where}: a {value.dtype.name} does not fit a JSON number (float64); convert "
+                "it with float()"
+            )
         if not np.isfinite(value):
             raise GPMSAError(
                 f"{where} = {value}: metadata must be finite (NaN and inf are not JSON and would "

@@ -104,10 +104,33 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
                 want[name] = (n, q)
         elif name.startswith("param_") and name[6:] not in pshape:
             raise _fail(f"arrays/{name}", f"unknown emulator parameter (have {EMULATOR_PARAMS})")
+    _check_complete(shapes, n)
     for name, shape in want.items():
         if tuple(shapes[name]) != tuple(shape):
             raise _fail(f"arrays/{name}", f"has shape {list(shapes[name])}, expected {list(shape)}")
     return {"m": m, "p": p, "q": q, "l_sim": l_sim, "p_u": p_u, "n_draws": n}
+
+
+def _check_complete(shapes: dict[str, tuple[int, ...]], n: int) -> None:
+    """Draws come whole: with n >= 1 rows of log_post every emulator parameter's ``draw_``
+    array; calibration draws (``cal_``) hold theta, theta_native and lamOs, betaV and lamVz
+    together (a discrepancy) or neither (a fit writes them so; the readers of draws rely on it)."""
+    missing = [f"draw_{k}" for k in EMULATOR_PARAMS if f"draw_{k}" not in shapes]
+    if n and missing:
+        raise _fail(
+            "arrays/log_post",
+            f"{n} draws, but the draws of {missing} are missing (a file holds the draws of "
+            "every emulator parameter, or none)",
+        )
+    cal = {k[4:] for k in shapes if k.startswith("cal_")}
+    if not cal:
+        return
+    need = {"theta", "theta_native", "lamOs"} | (
+        {"betaV", "lamVz"} if cal & {"betaV", "lamVz"} else set()
+    )
+    if need - cal:
+        missing = sorted(f"cal_{k}" for k in need - cal)
+        raise _fail("arrays/cal_", f"calibration draws without {missing}")
 
 
 # --- manifest fields ----------------------------------------------------------------------------
@@ -183,7 +206,7 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
     if len(set(names["y"])) != len(names["y"]):
         raise _fail("names.y", "output names must be unique")
     check_priors(manifest.get("priors"))
-    model = manifest.get("model", {})
+    model = manifest.get("model")
     if not isinstance(model, dict):
         raise _fail("model", f"must be an object, got {_short(model)}")
     for key in ("m", "p", "q", "l_sim", "p_u"):

@@ -123,3 +123,13 @@ def test_predict_with_more_draws_than_kept_uses_all_of_them():
     for n in (emu.n_draws, 10**18):
         np.testing.assert_array_equal(emu.predict([[0.5]], [[0.5]], draws=True, n_draws=n)[0],
                                       every[0])  # fmt: skip
+
+
+def test_the_extrapolation_warning_names_the_callers_line(emu):
+    """At the point estimate (the default) the warning named emulator.py, not the caller: it
+    pointed into gpmsa, and under Python's default filter (once per location) a second call
+    site that extrapolated was not warned about."""
+    lo, hi = emu.domain["x"]
+    with pytest.warns(UserWarning, match="extrapolates") as rec:
+        emu.predict([[hi + 0.05 * (hi - lo)]], [[0.5]])
+    assert [w.filename for w in rec] == [__file__]

@@ -263,6 +263,23 @@ def test_metadata_must_be_jsonable(emu, tmp_path):
         emu2.save(tmp_path / "b.gpmsa")
 
 
+def test_long_double_metadata_is_refused_by_name_not_by_recursion(emu, tmp_path):
+    """A np.longdouble passed the metadata check and then recursed without end in the writer
+    (RecursionError): its .item() is itself, not a Python float."""
+    value = np.longdouble(1.5)
+    if value.dtype.itemsize <= 8:  # where long double is float64 it is a plain float64
+        pytest.skip("long double is float64 here")
+    with pytest.raises(gpmsa.GPMSAError, match=r"metadata\['a'\]\[0\]: a float.* float\(\)"):
+        gpmsa.Emulator.from_params(
+            gpmsa.SimData(x=emu.x_unit, t=emu.t_unit, y=emu.y), emu.params, metadata={"a": [value]}
+        )
+    emu2 = gpmsa.load(emu.save(tmp_path / "a.gpmsa"))
+    emu2.metadata["a"] = value
+    with pytest.raises(gpmsa.GPMSAError, match=r"metadata\['a'\]: a float"):
+        emu2.save(tmp_path / "b.gpmsa")
+    assert not (tmp_path / "b.gpmsa").exists()
+
+
 def test_cli_info_prints_manifest(saved, capsys, tmp_path):
     assert main(["info", str(saved)]) == 0
     out = capsys.readouterr().out

@@ -622,3 +622,37 @@ def test_a_chain_count_that_does_not_divide_the_draws_is_refused(saved, tmp_path
     path = write_members(tmp_path / "chains.gpmsa", manifest, arrays)
     with pytest.raises(gpmsa.EmulatorFileError, match="settings.n_chains.*cannot hold the"):
         gpmsa.load(path)
+
+
+@pytest.mark.parametrize(
+    ("drop", "match"),
+    [(["draw_lamUz"], r"arrays/log_post: \d+ draws, but the draws of \['draw_lamUz'\] are missing"),
+     (["draw_betaU", "draw_lamUz", "draw_lamWs", "draw_lamWOs"], "draws of .* are missing")],
+)  # fmt: skip
+def test_draws_of_some_parameters_only_are_refused(saved, tmp_path, drop, match):
+    """A file holding the draws of some emulator parameters only loaded, and predict(draws=True)
+    then raised KeyError: 'lamUz'."""
+    manifest, arrays = read_members(saved["scalar"])
+    for name in drop:
+        del arrays[name]
+    path = write_members(tmp_path / "partial.gpmsa", manifest, arrays)
+    with pytest.raises(gpmsa.EmulatorFileError, match=match):
+        gpmsa.load(path)
+
+
+def test_calibration_draws_without_theta_are_refused(saved, tmp_path):
+    """cal_lamOs alone loaded; theta_summary then raised KeyError: 'theta_native'."""
+    manifest, arrays = read_members(saved["scalar"])
+    arrays["cal_lamOs"] = np.ones((arrays["log_post"].shape[0], 1))
+    path = write_members(tmp_path / "cal.gpmsa", manifest, arrays)
+    with pytest.raises(gpmsa.EmulatorFileError, match=r"arrays/cal_: .*'cal_theta'"):
+        gpmsa.load(path)
+
+
+def test_a_manifest_without_its_model_field_names_it(saved, tmp_path):
+    """Without "model" the reader failed late, as "inconsistent content (KeyError: 'model')"."""
+    manifest, arrays = read_members(saved["scalar"])
+    del manifest["model"]
+    path = write_members(tmp_path / "nomodel.gpmsa", manifest, arrays)
+    with pytest.raises(gpmsa.EmulatorFileError, match="model: must be an object, got None"):
+        gpmsa.load(path)
