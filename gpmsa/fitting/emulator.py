@@ -433,7 +433,10 @@ class Emulator:
         For component j with precision P = S^-1 (zero mean), or with a mean basis H the
         projected precision P = S^-1 - S^-1 H (H^T S^-1 H)^-1 H^T S^-1 (the GLS coefficients
         refitted without run i): mean_i = w_i - [P w]_i / P_ii, var_i = 1 / P_ii (the nugget
-        included); outputs through K, plus the residual 1/lamWOs for l_sim > 1.
+        included); outputs through K. For l_sim > 1 the held-out run's outputs y_i = K w_i + e_i:
+        1/P_ii is the variance of its projected weights, which holds the projection noise
+        1/(lam_sim lamWOs); that is taken out and the residual 1/lamWOs added once (the dense
+        conditional of y_i given the other runs' outputs, to rounding).
         """
         mean_w = np.zeros((self.m, self.p_u))
         var_w = np.zeros((self.m, self.p_u))
@@ -442,9 +445,7 @@ class Emulator:
             mean_w[:, j] = self.w[:, j] - a / d
             var_w[:, j] = 1.0 / d
         mean = mean_w @ self.K.T
-        var = var_w @ (self.K**2).T
-        if self.l_sim > 1:
-            var = var + 1.0 / self.params["lamWOs"][0]
+        var = output_variance(var_w, self.K, self.lam_sim, self.params["lamWOs"][0])
         s = self.standardizer
         mean, var = s.y_from_std(mean), s.var_from_std(var)
         z = (self.y - mean) / np.sqrt(var)
@@ -693,6 +694,16 @@ def check_metadata(metadata) -> dict:
         raise GPMSAError(f"metadata must be None or a dict, got {type(metadata).__name__}")
     _check_metadata(metadata, "metadata")
     return dict(metadata)
+
+
+def output_variance(var_w: np.ndarray, K: np.ndarray, lam_sim: np.ndarray, lam_wos: float):
+    """Held-out outputs' variance (standardised) from the held-out projected weights' variance
+    ``var_w`` (n, p_u): for l_sim > 1 the weights' own part (less the projection noise
+    1/(lam_sim lamWOs) that a held-out w-hat holds) through K, plus the residual 1/lamWOs; for
+    one output the weights' variance through K (its projection noise is the residual)."""
+    if K.shape[0] == 1:
+        return var_w @ (K**2).T
+    return (var_w - 1.0 / (lam_sim * lam_wos)) @ (K**2).T + 1.0 / lam_wos
 
 
 def _check_metadata(value, where: str, depth: int = 0) -> None:

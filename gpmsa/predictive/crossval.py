@@ -26,6 +26,7 @@ from scipy.special import ndtr
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
+from gpmsa.fitting.emulator import output_variance
 from gpmsa.limits import check_memory
 from gpmsa.model.data import check_flag, check_level
 from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, rng_of
@@ -153,7 +154,6 @@ def cross_validate(
     )
     std = emulator.standardizer
     y_std = std.y_to_std(emulator.y)
-    K2 = emulator.K**2
     S = len(sets)
     acc = {k: np.zeros((m, l_sim)) for k in ("m", "m2", "v", "pit")}
     acc_w = {k: np.zeros((m, p_u)) for k in ("m", "m2", "v")}
@@ -173,9 +173,7 @@ def cross_validate(
                         mw[F, j] = emulator.w[F, j] - C @ alpha[F]
                         vw[F, j] = np.diag(C)
             my = mw @ emulator.K.T
-            vy = vw @ K2.T
-            if l_sim > 1:
-                vy = vy + 1.0 / prm["lamWOs"][0]
+            vy = output_variance(vw, emulator.K, emulator.lam_sim, prm["lamWOs"][0])
             acc["m"] += my
             acc["m2"] += my**2
             acc["v"] += vy
