@@ -542,6 +542,19 @@ def _gpmsa_layout(path: Path) -> bool:
     return MANIFEST in names and all(arrays)
 
 
+def _declared_format(path: Path) -> str | None:
+    """The format (``FORMAT`` or ``STUDY_FORMAT``) that a gpmsa file's manifest declares, read
+    without the manifest's other checks (a newer schema, a field this version refuses); None
+    where even that cannot be read."""
+    try:
+        with _opened(path) as (zf, members):
+            raw = bytes(_read_member(zf, members[MANIFEST], path))
+        declared = json.loads(raw.decode("utf-8")).get("format")
+    except Exception:  # no file, not a zip, a manifest that is no JSON object: not known
+        return None
+    return declared if declared in (FORMAT, STUDY_FORMAT) else None
+
+
 def _foreign_size(target: Path) -> int | None:
     """Size in bytes of the regular, non-empty file at ``target`` that is not a gpmsa file;
     None when replacing ``target`` loses nothing of another program's (no file, an empty one,
@@ -561,7 +574,7 @@ def refuse_to_replace(target: Path, fmt: str) -> None:
     of the other kind, as a study written over an emulator file (another study's model, say) or
     an emulator file written over a study would leave that file's owner unreadable."""
     wanted = "a study file" if fmt == STUDY_FORMAT else "an emulator file"
-    found = stored_format(target)
+    found = stored_format(target) or _declared_format(target)  # a newer schema's too
     if found is None:
         size = _foreign_size(target)
         if size is not None:

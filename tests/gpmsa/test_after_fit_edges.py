@@ -98,6 +98,30 @@ def test_emulator_save_refuses_a_study_file(saved_study):
     assert gpmsa.load_study(saved_study).labels == ("model0", "model1")
 
 
+def test_emulator_save_refuses_a_study_file_of_a_newer_schema(saved_study, tmp_path):
+    """A study this version cannot read (written by a newer gpmsa) is still a study: an
+    emulator saved there replaced it (the kind came from the full manifest check, which
+    refuses a newer schema)."""
+    import json
+    import zipfile
+
+    newer = tmp_path / "newer.gpmsa"
+    with zipfile.ZipFile(saved_study) as src, zipfile.ZipFile(newer, "w") as dst:
+        for name in src.namelist():
+            data = src.read(name)
+            if name == "manifest.json":
+                manifest = json.loads(data)
+                manifest["schema_version"] += 1
+                data = json.dumps(manifest).encode()
+            dst.writestr(name, data)
+    with pytest.raises(GPMSAError, match="newer than this library reads"):
+        gpmsa.load_study(newer)
+    before = newer.read_bytes()
+    with pytest.raises(GPMSAError, match=r"it holds a study file, which an emulator file"):
+        sc.emulator().save(newer)
+    assert newer.read_bytes() == before
+
+
 def test_emulator_save_still_replaces_an_emulator_file(tmp_path):
     """As documented: an emulator file (a study's model file too) is replaced."""
     emu = sc.emulator()
