@@ -64,7 +64,10 @@ def test_loo_equals_refits_without_each_run(mean_basis):
             mean_w[i, j], var_w[i, j] = _refit_without(emu, j, i)
     s = emu.standardizer
     mean = s.y_from_std(mean_w @ emu.K.T)
-    var = s.var_from_std(var_w @ (emu.K**2).T + 1.0 / emu.params["lamWOs"][0])
+    # the outputs: the weights' own variance (w-hat's, less its projection noise) through K,
+    # plus the residual once (test_predict_crossval checks this against output-space solves)
+    lam = emu.params["lamWOs"][0]
+    var = s.var_from_std((var_w - 1.0 / (emu.lam_sim * lam)) @ (emu.K**2).T + 1.0 / lam)
     np.testing.assert_allclose(loo.mean, mean, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(loo.var, var, rtol=1e-9)
 
