@@ -14,6 +14,7 @@ stiffness matrix), and they agree with eq. 1 everywhere else.
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -57,12 +58,13 @@ def warn_if_step_too_coarse(model: Model, rate_hz: float, substeps: int, stackle
     omega = highest_mode_rad_s(model)
     omega_h = omega / (rate_hz * substeps)
     if omega_h > MAX_OMEGA_H:
-        need = int(np.ceil(omega / (MAX_OMEGA_H * rate_hz)))
+        step = MAX_OMEGA_H * rate_hz
+        need = omega / step if step > 0 else math.inf  # inf for an absurdly low rate_hz
+        fix = f"substeps >= {math.ceil(need)}" if need < 1e15 else "a higher rate_hz"
         warnings.warn(
             f"the model's stiffest mode ({omega / (2 * np.pi):.4g} Hz) is too fast for the solver "
             f"step 1/({rate_hz:g} x {substeps}) s (omega h = {omega_h:.2f} > {MAX_OMEGA_H}): its "
-            f"accelerations would be biased (half the variance at omega h = 0.8); use "
-            f"substeps >= {need}",
+            f"accelerations would be biased (half the variance at omega h = 0.8); use {fix}",
             SolverStepWarning,
             stacklevel=stacklevel,
         )
@@ -93,7 +95,7 @@ def linear_model(model: Model) -> LinearModel:
         kt, ct = model.axle_stiffness_n_per_m, model.axle_damping_ns_per_m
         front, rear = np.array([1.0, b1]), np.array([1.0, -b2])
         arms = np.stack([front, rear], axis=1)  # (2, 2): generalised force of each tyre
-        return LinearModel(
+        lm = LinearModel(
             mass=np.diag([model.mass_kg, model.pitch_inertia_kgm2]),
             damping=ct * arms @ arms.T,
             stiffness=kt * arms @ arms.T,
@@ -102,6 +104,7 @@ def linear_model(model: Model) -> LinearModel:
             front=front,
             rear=rear,
         )
+        return _check_finite(model, lm)
     assert isinstance(model, HalfCar)
     k1, k2 = model.suspension_stiffness_front_n_per_m, model.suspension_stiffness_rear_n_per_m
     c1, c2 = model.suspension_damping_front_ns_per_m, model.suspension_damping_rear_ns_per_m
@@ -114,7 +117,7 @@ def linear_model(model: Model) -> LinearModel:
     tyres = np.stack([tyre1, tyre2], axis=1)
     stiffness = k1 * np.outer(d1, d1) + k2 * np.outer(d2, d2) + kt * tyres @ tyres.T
     damping = c1 * np.outer(d1, d1) + c2 * np.outer(d2, d2) + ct * tyres @ tyres.T
-    return LinearModel(
+    lm = LinearModel(
         mass=np.diag(
             [
                 model.unsprung_mass_front_kg,
@@ -130,6 +133,30 @@ def linear_model(model: Model) -> LinearModel:
         front=tyre1,
         rear=tyre2,
     )
+    return _check_finite(model, lm)
+
+
+def _check_finite(model: Model, lm: LinearModel) -> LinearModel:
+    """``lm``, or VehicleError naming the mass or inertia field over which a stiffness or
+    damping (M^-1 K, M^-1 C and the road gains) overflows: fields far too large or too small."""
+    rows = (
+        ("mass_kg", "pitch_inertia_kgm2")
+        if isinstance(model, Jackal)
+        else ("unsprung_mass_front_kg", "unsprung_mass_rear_kg", "sprung_mass_kg",
+              "pitch_inertia_kgm2")
+    )  # fmt: skip
+    with np.errstate(over="ignore", invalid="ignore"):
+        inv_mass = 1.0 / np.diag(lm.mass)[:, None]  # both models' mass matrices are diagonal
+        gains = np.hstack([lm.stiffness, lm.damping, lm.tyre_stiffness, lm.tyre_damping]) * inv_mass
+    bad = ~np.all(np.isfinite(gains), axis=1)
+    if np.any(bad):
+        field = rows[int(np.argmax(bad))]
+        raise VehicleError(
+            f"{model.name}: a stiffness or damping over {model.name}.{field}="
+            f"{getattr(model, field)!r} overflows its equations of motion: the fields are out "
+            "of range (far too large or too small)"
+        )
+    return lm
 
 
 def state_space(lm: LinearModel) -> signal.StateSpace:

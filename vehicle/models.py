@@ -3,12 +3,14 @@
 Both are frozen dataclasses in SI units. Vertical motions are measured from the static equilibrium
 (gravity only enters through the static tyre loads that bound the unilateral contact force).
 A field that is not a finite real number in range (an integer for ``wheels_per_axle``, True or
-False for ``lift_off``) raises VehicleError naming it; numpy numbers are stored as Python ones.
+False for ``lift_off``) raises VehicleError naming it, as do fields whose wheelbase, static loads
+or axle stiffness overflow; numpy numbers are stored as Python ones.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass
 
 from vehicle import checks
@@ -38,6 +40,22 @@ def _check_fields(
     for name in counts:
         object.__setattr__(model, name, checks.integer(f"{cls}.{name}", getattr(model, name), 1))
     object.__setattr__(model, "lift_off", checks.flag(f"{cls}.lift_off", model.lift_off))
+    derived = {"wheelbase_m": "b1_m + b2_m", "static_tyre_loads_n": "masses x GRAVITY"}
+    if counts:
+        derived |= {
+            "axle_stiffness_n_per_m": "wheels_per_axle x tyre_stiffness_n_per_m",
+            "axle_damping_ns_per_m": "wheels_per_axle x tyre_damping_ns_per_m",
+        }
+    for name, made_of in derived.items():
+        try:
+            value = getattr(model, name)
+            finite = all(math.isfinite(v) for v in (value if isinstance(value, tuple) else [value]))
+        except OverflowError:  # an int too large for a float
+            value, finite = "too large for a float", False
+        if not finite:
+            raise VehicleError(
+                f"{cls}.{name} = {made_of} overflows ({value}): those fields are out of range"
+            )
 
 
 @dataclass(frozen=True)

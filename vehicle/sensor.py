@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from vehicle import checks
@@ -15,8 +17,14 @@ measured samples and their variance over any drive (a campaign's f) stay finite.
 
 
 def check_rate(rate_hz: float) -> float:
-    """Return the sample rate as a float, or raise VehicleError unless a finite real > 0."""
-    return checks.positive("rate_hz", rate_hz, unit="Hz")
+    """Return the sample rate as a float, or raise VehicleError unless a finite real > 0 whose
+    sample period 1 / rate_hz is finite."""
+    rate = checks.positive("rate_hz", rate_hz, unit="Hz")
+    if not math.isfinite(1.0 / rate):
+        raise VehicleError(
+            f"rate_hz={rate_hz!r} Hz is out of range: its sample period 1/rate_hz overflows"
+        )
+    return rate
 
 
 def check_noise(noise_std: float) -> float:

@@ -129,9 +129,12 @@ class Simulation:
         t_end = abs(v_set - self.speed) / self.model.max_accel_mps2 + (
             max(self.end_m - self.position, 0.0) / v_set if v_set > 0 else np.inf
         )
-        n = max(1, round(min(dt, t_end + 2.0 / self.rate_hz) * self.rate_hz))
+        n_real = max(1.0, min(dt, t_end + 2.0 / self.rate_hz) * self.rate_hz)  # inf: too many
         sub = self._substeps
-        checks.memory(checks.BYTES_PER_STEP * n * sub, f"advance(dt={dt:g}) ({n * sub} steps)")
+        checks.memory(
+            checks.BYTES_PER_STEP * n_real * sub, f"advance(dt={dt:g}) ({n_real * sub:.4g} steps)"
+        )
+        n = round(n_real)
         s, v = ramp_grid(
             self.position, self.speed, v_set, self.model.max_accel_mps2, self._h, n * sub
         )

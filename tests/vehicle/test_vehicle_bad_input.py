@@ -170,6 +170,7 @@ def test_numpy_numbers_drive_like_python_ones(road):
     ("kwargs", "match"),
     [
         ({"rate_hz": "120"}, r"^rate_hz='120' must be a real number"),
+        ({"rate_hz": 5e-324}, r"^rate_hz=5e-324 Hz is out of range: its sample period 1/rate"),
         ({"noise_std": True}, r"^noise_std=True must be a real number"),
         ({"noise_std": 1e308}, r"^noise_std=1e\+308 is out of range: allowed \[0, 1e\+100\]"),
         ({"start_m": "1"}, r"^start_m='1' must be a real number \(got str\)"),

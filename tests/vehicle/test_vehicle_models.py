@@ -68,3 +68,40 @@ def test_a_description_makes_the_model_it_describes():
     ):
         with pytest.raises(vehicle.VehicleError, match=match):
             vehicle.from_description(bad)
+
+
+@pytest.mark.parametrize(
+    ("cls", "kwargs", "match"),
+    [
+        (vehicle.Jackal, {"b1_m": 1e308, "b2_m": 1e308}, r"^Jackal.wheelbase_m = b1_m \+ b2_m"),
+        (vehicle.Jackal, {"wheels_per_axle": 10**400}, r"^Jackal.axle_stiffness_n_per_m = wheels"),
+        (vehicle.Jackal, {"tyre_stiffness_n_per_m": 1e308}, r"^Jackal.axle_stiffness_n_per_m"),
+        (vehicle.HalfCar, {"sprung_mass_kg": 1e308}, r"^HalfCar.static_tyre_loads_n = masses"),
+    ],
+)
+def test_fields_whose_derived_quantities_overflow_raise(cls, kwargs, match):
+    """Each field finite is not enough: a wheelbase, load or axle stiffness made of them must
+    be a finite float too (not inf, NaN loads or an OverflowError later)."""
+    with pytest.raises(vehicle.VehicleError, match=match + ".* overflows"):
+        cls(**kwargs)
+
+
+@pytest.mark.parametrize(
+    ("model", "field"),
+    [
+        (vehicle.Jackal(pitch_inertia_kgm2=5e-324), "Jackal.pitch_inertia_kgm2=5e-324"),
+        (vehicle.HalfCar(unsprung_mass_rear_kg=1e-310), "HalfCar.unsprung_mass_rear_kg=1e-310"),
+    ],
+)
+def test_equations_of_motion_that_overflow_name_the_field(model, field):
+    """A stiffness over a (tiny) mass or inertia that overflows is a VehicleError naming that
+    field, not numpy's LinAlgError, wherever the linear model is used."""
+    import roadgen
+
+    road = roadgen.iso8608_profile(4.0, gd=400, seed=0)
+    for call in (
+        lambda: vehicle.Simulation(model, road),
+        lambda: vehicle.linear_response(model, road, 1.0, 3),
+    ):
+        with pytest.raises(vehicle.VehicleError, match=rf"over {field} overflows"):
+            call()

@@ -1,5 +1,7 @@
 """Simulation: the steppable drive of the closed loop."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -162,3 +164,23 @@ def test_a_diverged_simulation_refuses_to_go_on():
         with pytest.raises(vehicle.SimulationDivergedError, match="diverged at t = 1.5 s .*new"):
             sim.advance(1.0 / 120, speed)
     assert (sim.time, sim.position) == (time, position)
+
+
+def test_a_huge_advance_while_standing_is_refused_by_the_memory_limit(track):
+    """A standing vehicle never reaches the end, so dt alone sets the grid: one whose step count
+    overflows a float is refused by the memory limit like any other (not an OverflowError), and
+    the Simulation goes on."""
+    sim = vehicle.Simulation(vehicle.Jackal(), track)
+    for dt, steps in ((1e308, "inf"), (1e12, "6e+14")):
+        what = re.escape(f"advance(dt={dt:g}) ({steps} steps) needs")
+        with pytest.raises(vehicle.VehicleError, match=f"^{what}"):
+            sim.advance(dt, 0.0)
+    assert sim.time == 0.0 and len(sim.advance(0.1, 0.0)) == 12
+
+
+def test_a_rate_too_low_for_any_substeps_warns_without_overflowing(track):
+    """The step warning names the substeps that would do, or a higher rate_hz when none could."""
+    with pytest.warns(
+        vehicle.SolverStepWarning, match=r"1/\(1e-307 x 5\) s .*use a higher rate_hz"
+    ):
+        vehicle.Simulation(vehicle.Jackal(), track, rate_hz=1e-307)
