@@ -246,7 +246,7 @@ def _samples(name: str, values) -> np.ndarray:
         wrong = [v for v in a if not (v is None or is_real(v))]
         if wrong:
             raise ControlError(
-                f"{name} must hold real numbers (None for a missing sample), got {wrong[0]!r} "
+                f"{name} must hold real numbers (None for a missing sample), got {wrong[0]!r:.60} "
                 f"({type(wrong[0]).__name__})"
             )
         return np.array([np.nan if v is None else float(v) for v in a])
@@ -292,7 +292,10 @@ class BCR:
             check_feature(emulator, s)  # an emulator that records its feature must match
         if s.method == "changepoint":
             if not hasattr(model, "loglik"):
-                raise ControlError("method 'changepoint' needs an ObservationModel")
+                raise ControlError(
+                    f"method 'changepoint' needs an ObservationModel, got {type(model).__name__}"
+                    " (BCR.from_emulator(emulator) builds the model an emulator needs)"
+                )
             self.speed_range = tuple(model.speed_range)
             self.gd_range = (float(model.gd[0]), float(model.gd[-1]))
             self.gd_name = model.emulator.t_names[0]
@@ -300,7 +303,10 @@ class BCR:
                             for _ in range(s.phases)]  # fmt: skip
         else:
             if not hasattr(model, "log_likelihood_grid"):
-                raise ControlError(f"method {s.method!r} needs a gpmsa.Calibrator")
+                raise ControlError(
+                    f"method {s.method!r} needs a gpmsa.Calibrator, got {type(model).__name__}"
+                    " (BCR.from_emulator(emulator) builds the model an emulator needs)"
+                )
             self.speed_range, self.gd_range = emulator_domain(model.emulator)
             self.gd_name = model.emulator.t_names[0]
             tracker, n = s.tracker, 1

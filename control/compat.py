@@ -133,12 +133,13 @@ def check_emulator(
                 f"emulator was made for another vehicle ({_vehicle_diff(meta['vehicle'], model)})"
             )
     if noise_std is not None:
-        if not is_real(meta.get("noise_std")):
+        trained = _recorded_noise_std(meta)
+        if trained is None:
             warnings.warn("emulator metadata has no 'noise_std'", ControlWarning, stacklevel=3)
-        elif not np.isclose(float(meta["noise_std"]), float(noise_std)):
+        elif not np.isclose(trained, float(noise_std)):
             warnings.warn(
                 f"noise_std = {noise_std:g} m/s^2 in the data but the emulator was trained with "
-                f"noise_std = {float(meta['noise_std']):g}: the GD estimates will be biased",
+                f"noise_std = {trained:g}: the GD estimates will be biased",
                 ControlWarning,
                 stacklevel=3,
             )
@@ -234,12 +235,21 @@ def emulator_noise_std(emulator) -> float | None:
     """The accelerometer noise sd the emulator was trained with (metadata ``noise_std``), m/s^2;
     None when it is missing, not a positive number, or 0 (noise-free training data)."""
     _check_is_emulator(emulator)
-    meta = dict(getattr(emulator, "metadata", None) or {})
-    try:
-        value = float(meta.get("noise_std", 0.0))
-    except (TypeError, ValueError):
+    value = _recorded_noise_std(dict(getattr(emulator, "metadata", None) or {}))
+    return value if value is not None and value > 0 else None
+
+
+def _recorded_noise_std(meta: dict) -> float | None:
+    """The metadata's ``noise_std`` as a finite float; None when it is missing or not a finite
+    real number (a bool, a string, an integer beyond a float's range)."""
+    value = meta.get("noise_std")
+    if not is_real(value):
         return None
-    return value if np.isfinite(value) and value > 0 else None
+    try:
+        value = float(value)
+    except OverflowError:
+        return None
+    return value if np.isfinite(value) else None
 
 
 def bcr_settings_for(emulator, **overrides) -> BCRSettings:

@@ -18,6 +18,7 @@ Two features (the emulator records which one it was trained on; training and BCR
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from functools import lru_cache
 
@@ -186,10 +187,20 @@ class FeatureSpec:
 
     @classmethod
     def from_dict(cls, d: dict) -> FeatureSpec:
-        """Inverse of `to_dict`; also reads the older metadata form (name, window_samples)."""
+        """Inverse of `to_dict`; also reads the older metadata form (name, window_samples).
+        ControlError for a record that is not a mapping or lacks the name, the block length or
+        the rate (both forms record them: their defaults would stand in unseen)."""
+        if not isinstance(d, Mapping):
+            raise ControlError(
+                f"a feature record must be a mapping (FeatureSpec.to_dict), got {d!r:.60} "
+                f"({type(d).__name__})"
+            )
         d = dict(d)
         if "window_samples" in d and "block_samples" not in d:
             d["block_samples"] = d.pop("window_samples")
+        for key in ("name", "block_samples", "rate_hz"):
+            if key not in d:
+                raise ControlError(f"the feature record has no {key!r}: {d!r:.80}")
         known = {k: d[k] for k in cls.__dataclass_fields__ if k in d}
         for key in ("bands_hz", "quantiles"):
             if key in known:
@@ -201,6 +212,7 @@ class FeatureSpec:
 
     def same_as(self, other: FeatureSpec) -> list[str]:
         """Names of the fields in which ``other`` differs (empty when they agree)."""
+        check_instance(other, "other", FeatureSpec)
         diff = []
         for key in ("name", "block_samples", "rate_hz"):
             a, b = getattr(self, key), getattr(other, key)

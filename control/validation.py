@@ -14,8 +14,16 @@ from roadgen import checks
 
 
 def is_real(value) -> bool:
-    """Whether ``value`` is a real number (a bool, Python's or numpy's, is not)."""
-    return isinstance(value, Real) and not isinstance(value, (bool, np.bool_))
+    """Whether ``value`` is a real number that numpy holds as one (a bool, Python's or numpy's,
+    is not; nor an int beyond 64 bits or a Fraction: numpy keeps those as objects, and its
+    comparisons and ufuncs fail on them)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real):
+        return False
+    if isinstance(value, float | np.floating | np.integer):
+        return True
+    if isinstance(value, int):
+        return -(2**63) <= value < 2**64
+    return np.asarray(value).dtype.kind in "iuf"
 
 
 def is_integer(value) -> bool:
@@ -71,8 +79,10 @@ def require_reals(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -
         value = getattr(obj, name)
         if not (is_real(value) or (value is None and name in optional)):
             allowed = "a real number or None" if name in optional else "a real number"
+            if isinstance(value, Real) and not isinstance(value, (bool, np.bool_)):
+                allowed += " numpy holds (a float, or an int of at most 64 bits)"
             raise ControlError(
-                f"{type(obj).__name__}.{name} must be {allowed}, got {value!r} "
+                f"{type(obj).__name__}.{name} must be {allowed}, got {value!r:.60} "
                 f"({type(value).__name__})"
             )
 
@@ -85,7 +95,7 @@ def require_integers(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()
         if not (is_integer(value) or (value is None and name in optional)):
             allowed = "an integer or None" if name in optional else "an integer"
             raise ControlError(
-                f"{type(obj).__name__}.{name} must be {allowed}, got {value!r} "
+                f"{type(obj).__name__}.{name} must be {allowed}, got {value!r:.60} "
                 f"({type(value).__name__})"
             )
 

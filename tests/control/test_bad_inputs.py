@@ -3,6 +3,7 @@ the wrong kind: a sensor fault for what a robot can send, a ControlError for wha
 pass, never a silent estimate or a numpy traceback."""
 
 import shutil
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -255,3 +256,34 @@ def test_shipped_emulator_checks_its_folder_and_the_file_kind(tmp_path):
     shutil.copyfile(window, tmp_path / control.shipped.emulator_file_name("A", "band"))
     with pytest.raises(EmulatorMismatchError, match="feature 'log_var', not of kind 'band'"):
         control.shipped_emulator("A", "band", folder=tmp_path)
+
+
+@pytest.mark.parametrize("value", [10**400, 2**64, Fraction(1, 2)], ids=["huge", "2**64", "frac"])
+@pytest.mark.parametrize(
+    ("make", "field"),
+    [
+        (lambda v: BCRSettings(max_age_s=v), "BCRSettings.max_age_s"),
+        (lambda v: BCRSettings(recent_change_m=v), "BCRSettings.recent_change_m"),
+        (lambda v: control.FeatureSpec(rate_hz=v), "FeatureSpec.rate_hz"),
+        (lambda v: SensorLimits(noise_floor=v), "SensorLimits.noise_floor"),
+        (lambda v: SensorLimits(range_mps2=v), "SensorLimits.range_mps2"),
+        (lambda v: control.TrackerSettings(mean_segment_m=v), "TrackerSettings.mean_segment_m"),
+        (lambda v: ChangePointSettings(mean_segment_m=v), "ChangePointSettings.mean_segment_m"),
+    ],
+)
+def test_a_number_numpy_cannot_hold_is_named_in_the_settings(make, field, value):
+    """An int beyond 64 bits or a Fraction passed the real-number check and failed in numpy
+    ("ufunc 'isfinite' not supported", or OverflowError)."""
+    with pytest.raises(ControlError, match=rf"{field} must be a real number .*numpy holds"):
+        make(value)
+
+
+def test_a_clock_or_samples_numpy_cannot_hold_are_control_errors():
+    bcr = BCR(FakeBlockModel())
+    for now in (10**400, Fraction(1, 2)):  # TypeError: ufunc 'isfinite' not supported
+        with pytest.raises(ControlError, match="now must be a finite time"):
+            bcr.update([], [], [], [], now=now)
+    t = np.arange(1, 4) / 120
+    with pytest.raises(ControlError, match=r"accel must hold real numbers .*, got 1000+ \(int\)"):
+        bcr.update(t, t, [0.0, 10**400, 1.0], np.ones(3))  # OverflowError in float()
+    assert bcr.update(t, t, [0.0, 2**63, 1.0], np.ones(3)).status == "filling"

@@ -655,3 +655,13 @@ def test_the_fault_injector_names_what_it_cannot_inject():
     t, a = np.arange(120) / 120.0, np.zeros(120)
     spiked = FaultInjector([SensorFault(0.0, 1.0, "spike", 2.9)], np.random.default_rng(0))
     assert np.flatnonzero(spiked(t, t, a, np.ones(120))[2])[:3].tolist() == [0, 3, 6]  # not 2
+
+
+def test_an_emulator_passed_as_the_model_is_named_with_the_way_to_build_one(emulator_a):
+    """BCR(emulator) said only "needs an ObservationModel", as for None, without naming what it
+    got or that BCR.from_emulator builds the model."""
+    with pytest.raises(ControlError, match=r"needs an ObservationModel, got Emulator .*from_emul"):
+        BCR(emulator_a)
+    window = BCRSettings(method="window", feature=PAPER_WINDOW)
+    with pytest.raises(ControlError, match=r"needs a gpmsa.Calibrator, got NoneType .*from_emul"):
+        BCR(None, window)

@@ -266,3 +266,50 @@ def test_the_emulators_vehicle_is_rebuilt_from_its_record():
         emulator_vehicle(fake_emulator())
     with pytest.raises(EmulatorMismatchError, match="vehicle record is malformed: .*no parameter"):
         emulator_vehicle(fake_emulator(vehicle={"model": "Jackal", "wings": 2}))
+
+
+@pytest.mark.parametrize(
+    "record, match",
+    [
+        ({}, "no 'name'"),  # read as the default band feature, without its quantiles
+        ({"name": "log_var", "rate_hz": 120.0}, "no 'block_samples'"),  # read as 125 samples
+        ({"name": "log_var", "window_samples": 1000}, "no 'rate_hz'"),  # read as 120 Hz
+        (None, "must be a mapping"),  # TypeError: 'NoneType' object is not iterable
+        ("log_var", "must be a mapping"),  # ValueError from dict(): "dictionary update sequence"
+        ([], "must be a mapping"),  # read as the default band feature
+    ],
+)
+def test_a_feature_record_without_its_name_length_or_rate_is_refused(record, match):
+    """A record missing the name, the block length or the rate was read with the defaults in
+    their place (an empty one as the band feature), and one that was not a mapping failed with
+    numpy- or dict()-level messages."""
+    from control.compat import emulator_feature
+
+    with pytest.raises(ControlError, match=match):
+        FeatureSpec.from_dict(record)
+    with pytest.raises(EmulatorMismatchError, match=f"feature is malformed: .*{match}"):
+        emulator_feature(fake_emulator(feature=record))
+    old = {"name": "log_var", "window_samples": 1000, "rate_hz": 120.0, "span": "ignored"}
+    assert FeatureSpec.from_dict(old) == PAPER_WINDOW  # the first form still reads
+
+
+def test_same_as_names_an_argument_that_is_not_a_feature():
+    with pytest.raises(ControlError, match="other must be a control.FeatureSpec, got 'log_var'"):
+        FeatureSpec().same_as("log_var")  # AttributeError: 'str' object has no attribute 'name'
+
+
+@pytest.mark.parametrize(
+    "value", [True, "0.7", 10**400, [0.7]], ids=["bool", "str", "huge", "list"]
+)
+def test_a_training_noise_record_that_is_not_a_number_is_no_noise_sd(value):
+    """A bool or a string was read as a noise sd by emulator_noise_std (True as 1 m/s^2) while
+    check_emulator said there was none; an integer beyond a float's range raised
+    OverflowError in both."""
+    from control.compat import emulator_noise_std
+
+    emu = fake_emulator(feature=FeatureSpec().to_dict(), noise_std=value)
+    assert emulator_noise_std(emu) is None
+    assert bcr_settings_for(emu).sensor.noise_sd_mps2 is None
+    with pytest.warns(ControlWarning, match="no 'noise_std'"):
+        check_emulator(emu, noise_std=0.7)
+    assert emulator_noise_std(fake_emulator(noise_std=np.float32(0.5))) == 0.5
