@@ -17,15 +17,18 @@ included (default 129 for one parameter, 65 x 65 for two, in 'ij' order, first p
 from __future__ import annotations
 
 import inspect
+import warnings
 
 import numpy as np
 from scipy.special import ndtr
 
 from gpmsa import backends
 from gpmsa.calibration.grid import (
+    RIDGE_SD,
     ConstraintCut,
     check_log_density,
     check_mass,
+    conditional_sds,
     constrained,
     draw_allowed,
     draw_bilinear,
@@ -328,16 +331,18 @@ class Calibrator:
                 (effectively uniform on the domain).
             seed: seed of the lazily drawn samples, or of the MCMC (there it wins over
                 ``mcmc_options["seed"]``; default: derived from the Calibrator's seed and a
-                per-update counter).
+                counter of its updates, an update that raises not counted).
 
         Returns:
             Posterior; for the grid method its summaries of theta are exact (grid) and
             ``info["log_evidence"]`` holds log p(u_obs) under the emulator's (normalised) theta
             prior times the given prior (as given, unnormalised), for one parameter.
         """
-        self._count += 1
+        count = self._count + 1  # counted once it succeeds
         if self.method == "mcmc":
-            return self._update_mcmc(x_obs, y_obs, prior, seed)
+            post = self._update_mcmc(x_obs, y_obs, prior, seed, count)
+            self._count = count
+            return post
         data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
         fits: list[Fit] = []
         with blas_controller().limit(limits=1, user_api="blas"):
@@ -363,13 +368,17 @@ class Calibrator:
                 ok = None if self.constraint is None else self._allowed(theta)
                 logp = constrained(free, ok)
                 check_mass(logp)
-        key = check_seed(seed) if seed is not None else (self._entropy, self._count)
+        key = check_seed(seed) if seed is not None else (self._entropy, count)
         post = self._posterior(axes, free, ok, margs, key)
         post.info["outside_sds"] = outside
+        if self.q == 2:
+            post.info["conditional_sds"] = sds = conditional_sds(axes, logp)
+            _warn_if_ridge(sds, tuple(self.emulator.t_names), self.n_grid)
+        self._count = count
         return post
 
-    def _update_mcmc(self, x_obs, y_obs, prior, seed) -> Posterior:
-        """``update`` on the MCMC path (``gpmsa.calibrate``)."""
+    def _update_mcmc(self, x_obs, y_obs, prior, seed, count: int) -> Posterior:
+        """``update`` on the MCMC path (``gpmsa.calibrate``), the ``count``-th update."""
         from gpmsa.calibration.calibrate import calibrate
 
         if prior is not None and not callable(prior):
@@ -379,7 +388,7 @@ class Calibrator:
                 "has no theta_grid)"
             )
         opts = dict(self.mcmc_options)
-        auto = int(_seed_sequence((self._entropy, self._count)).generate_state(1)[0])
+        auto = int(_seed_sequence((self._entropy, count)).generate_state(1)[0])
         if seed is not None:  # this update's seed wins over mcmc_options' and the default
             opts["seed"] = check_seed(seed)
         opts.setdefault("seed", auto)
@@ -503,6 +512,22 @@ class Calibrator:
             "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
         return Posterior(grids=grids, draw=draw, info=info)
+
+
+def _warn_if_ridge(sds: tuple[float, float], names: tuple, n_grid: int) -> None:
+    """Warn when the two-parameter posterior is a ridge narrower than the grid resolves: its sd
+    along a parameter given the other spans fewer than RIDGE_SD node spacings
+    (`conditional_sds`)."""
+    k = int(np.argmin(sds))
+    if sds[k] < RIDGE_SD:
+        warnings.warn(
+            f"the grid does not resolve the posterior (a ridge across both parameters, or a "
+            f"peak narrower than refinement reaches): the sd of {names[k]} given "
+            f"{names[1 - k]} spans {sds[k]:.2g} node spacings (fewer than {RIDGE_SD:g}), so its "
+            f"summaries and draws may be off by a large fraction of an sd; use a larger n_grid "
+            f"(now {n_grid}) or method='mcmc'",
+            stacklevel=3,
+        )
 
 
 def _seed_sequence(key) -> np.random.SeedSequence:

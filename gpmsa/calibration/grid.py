@@ -53,6 +53,12 @@ case its mean and quantiles are within 6e-4 sd of the exact cut (2 parts: 4e-3, 
 an update costs 5-8 % more than without the constraint (8 parts: 20 %)."""
 MAX_REDRAW_ROUNDS = 100
 """Rounds of redrawing the draws a constraint rejects (`draw_allowed`), at most."""
+RIDGE_SD = 0.5
+"""Two parameters: a posterior whose sd along a parameter given the other (`conditional_sds`)
+spans fewer than this many node spacings is a ridge the (refined) grid does not resolve (its
+marginals can be wide, so refinement does not see it): a warning. Above it (0.54-1.9 spacings
+on the cases tried) the summaries erred by about 2 % of an sd or less; far below it by tens of
+per cent."""
 
 
 def mesh(axes: list) -> np.ndarray:
@@ -368,6 +374,29 @@ def _finer_axis(
             piece = np.concatenate([piece[near > SAME_NODE * (piece[1] - piece[0])], lines])
         pieces.append(piece)
     return np.unique(np.concatenate(pieces))
+
+
+def conditional_sds(axes: list, logp: np.ndarray) -> tuple[float, float]:
+    """Two parameters: per parameter, the root of the mean (over the posterior, log density
+    ``logp`` (G,) on the grid of ``axes``) of its variance given the other parameter's node, in
+    units of the local node spacing (root of the mean squared spacing at the posterior's nodes).
+    Computed on the nodes, so a ridge narrower than a spacing gets well under RIDGE_SD."""
+    f = np.exp(logp - np.max(logp)).reshape(axes[0].size, axes[1].size)
+    w = [trapezoid_weights(a) for a in axes]
+    mass = f * np.outer(w[0], w[1])
+    out = []
+    for k, a in enumerate(axes):
+        m = mass if k == 1 else mass.T  # rows: the other parameter's nodes
+        row = m.sum(axis=1)
+        live = row > 0.0
+        m, row = m[live], row[live]
+        mean = m @ a / row
+        var = np.sum(m * (a[None, :] - mean[:, None]) ** 2, axis=1) / row
+        h = np.diff(a)
+        local = np.concatenate(([h[0]], np.maximum(h[:-1], h[1:]), [h[-1]]))
+        spacing2 = m.sum(axis=0) @ local**2 / row.sum()
+        out.append(float(np.sqrt(row @ var / row.sum() / spacing2)))
+    return out[0], out[1]
 
 
 def refined_axes(axes: list, logp: np.ndarray, keep: list | None) -> list | None:

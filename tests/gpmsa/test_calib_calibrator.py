@@ -367,3 +367,19 @@ def test_mcmc_options_are_checked_when_the_calibrator_is_made():
         Calibrator(emu, mcmc_options={"log_prior": None})  # the Calibrator passes its prior itself
     with pytest.raises(GPMSAError, match="mcmc_options must be None or a dict, got list"):
         Calibrator(emu, mcmc_options=[("n_samples", 500)])
+
+
+@pytest.mark.parametrize("method", ["grid", "mcmc"])
+def test_calib_a_refused_update_does_not_shift_the_next_draws(method):
+    """A control loop's bad window (here NaN) is refused; it used to count as an update, so that
+    every later default-seeded posterior's draws depended on how many windows had failed."""
+    emu, (x, y) = road_emulator(), road_obs()
+    opts = {"mcmc_options": {"n_samples": 300, "n_burn": 50}} if method == "mcmc" else {}
+    clean, dirty = (Calibrator(emu, method=method, seed=4, **opts) for _ in range(2))
+    with pytest.raises(GPMSAError, match="y_obs"):
+        dirty.update(x, [[np.nan]])
+    with pytest.raises(GPMSAError, match="prior"):
+        dirty.update(x, y, prior=lambda t: np.full(t.shape, np.nan))
+    for _ in range(2):
+        a, b = clean.update(x, y).samples["GD"], dirty.update(x, y).samples["GD"]
+        np.testing.assert_array_equal(a, b)
