@@ -39,6 +39,10 @@ def test_save_into_a_missing_folder_or_to_no_path_names_the_problem(emu, tmp_pat
     for bad in (None, 5, ""):
         with pytest.raises(gpmsa.GPMSAError, match="path must be a file name"):
             emu.save(bad)
+    folder = f"{tmp_path / 'out'}/"  # Path("out/") is "out": a file named out was written
+    with pytest.raises(gpmsa.GPMSAError, match="ends with a separator: it names a folder"):
+        emu.save(folder)
+    assert not (tmp_path / "out").exists()
 
 
 def test_round_trip_is_exact(emu, saved):
