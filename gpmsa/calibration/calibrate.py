@@ -392,13 +392,12 @@ def _run_fast(
 
 
 def _wrong_fast_run(run, n_samples: int, q: int) -> str | None:
-    """What is wrong with a fast calibration chain's result (None: nothing); see
-    ``run_chains``' ``check``: an executor must return each task's own ChainResult."""
+    """``run_chains``' check of a fast calibration chain's result: None when it is the task's
+    own ChainResult, else the draws it should hold."""
     if isinstance(run, ChainResult) and np.shape(run.theta) == (n_samples, q):
         if np.shape(run.lamOs) == np.shape(run.log_post) == (n_samples,):
             return None
-    return (f"a {type(run).__name__} that is not its draws ({n_samples} samples); an executor "
-            "must return each task's own result")  # fmt: skip
+    return f"{n_samples} samples"
 
 
 def _run_backend(

@@ -160,8 +160,9 @@ def run_chains(
     ``progress``: in this process, each chain's own bar; in parallel, one bar over the chains.
     Returns the results in chain order. Raises ChainError naming the failed chain (see the
     module docstring for retries); ``what`` is what a task is called there ("chain").
-    ``check(i, result)``: what is wrong with task i's result (None: nothing), e.g. from an
-    executor that returned something else; ChainError names the first such chain.
+    ``check(i, result)``: None when task i's result is its own, else the draws it should hold
+    (e.g. "60 sweeps"): an executor returned something else; ChainError names the first such
+    chain.
     """
     n = len(tasks)
     if executor is not None and n_jobs is not None:
@@ -176,9 +177,13 @@ def run_chains(
     else:
         results = _parallel(fn, tasks, executor, workers, progress, desc, retries, what)
     for i, result in enumerate(results if check is not None else ()):
-        wrong = check(i, result)
-        if wrong is not None:
-            raise ChainError(f"{what} {i} of {n} returned {wrong}", (i,))
+        expected = check(i, result)
+        if expected is not None:
+            raise ChainError(
+                f"{what} {i} of {n} returned a {type(result).__name__} that is not its draws "
+                f"({expected}); an executor must return each task's own result",
+                (i,),
+            )
     return results
 
 

@@ -420,9 +420,9 @@ def _chain_task(
 
 
 def wrong_result(result, expected: tuple, what: str) -> str | None:
-    """What is wrong with a chain task's ``result`` (None: nothing): it must be a tuple of one
-    item per ``expected`` entry, a shape tuple (an array of that shape) or a dict name -> shape
-    (a dict of such arrays); ``what`` names the draws in the message (``run_chains``' check)."""
+    """``run_chains``' check of a chain task's ``result``: None when it is a tuple of one item
+    per ``expected`` entry, a shape tuple (an array of that shape) or a dict name -> shape (a
+    dict of such arrays); otherwise ``what``, the draws it should hold."""
     ok = isinstance(result, tuple) and len(result) == len(expected)
     for got, want in zip(result if ok else (), expected, strict=False):
         if isinstance(want, dict):
@@ -430,10 +430,7 @@ def wrong_result(result, expected: tuple, what: str) -> str | None:
             ok = ok and all(np.shape(got[k]) == shape for k, shape in want.items())
         else:
             ok = ok and isinstance(got, np.ndarray) and got.shape == want
-    if ok:
-        return None
-    return (f"a {type(result).__name__} that is not its draws ({what}); an executor must return "
-            "each task's own result")  # fmt: skip
+    return None if ok else what
 
 
 def sample(

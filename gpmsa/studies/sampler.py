@@ -245,16 +245,15 @@ def run_study_chain(
 
 
 def _wrong_run(run, n_iter: int, n_elements: int) -> str | None:
-    """What is wrong with a study chain's result (None: nothing); see ``run_chains``' ``check``:
-    an executor must return each task's own result, as `run_study_chain` makes it."""
+    """``run_chains``' check of a study chain's result: None when it is the task's own, as
+    `run_study_chain` makes it, else the draws it should hold."""
     keys = {"theta", "mu", "lam", "log_post", "members", "accept_rate", "widths", "names"}
     if isinstance(run, dict) and keys <= set(run):
         if np.shape(run["theta"]) == (n_iter, n_elements) and np.shape(run["log_post"]) == (
             n_iter,
         ):
             return None
-    return (f"a {type(run).__name__} that is not its draws ({n_iter} sweeps); an executor must "
-            "return each task's own result")  # fmt: skip
+    return f"{n_iter} sweeps"
 
 
 def sample_study(
