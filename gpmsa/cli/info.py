@@ -6,6 +6,8 @@ import argparse
 import json
 import sys
 
+import numpy as np
+
 from gpmsa.cli.text import internal_error, number, plain, safe, value
 from gpmsa.errors import GPMSAError
 
@@ -43,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
         if manifest["format"] == STUDY_FORMAT:
             study = load_study(args.file)
         else:
-            Emulator.from_record(manifest, arrays)
+            emulator = Emulator.from_record(manifest, arrays)
         if args.json:  # ensure_ascii: control characters come out as \u001b escapes
             text = json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True)
         elif manifest["format"] == STUDY_FORMAT:
@@ -51,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
             lines.append(_convergence_line(study.convergence))  # from the draws, as load_study
             text = "\n".join(lines)
         else:
-            text = "\n".join(_lines(args.file, manifest, arrays))
+            text = "\n".join(_lines(args.file, manifest, arrays, emulator.standardizer))
     except GPMSAError as exc:  # a damaged file (EmulatorFileError), or no file path at all
         print(f"gpmsa info: {safe(exc)}", file=sys.stderr)
         return 2
@@ -62,8 +64,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
-    """The manifest for a person (the content already validated: names, units, domain, model)."""
+def _lines(file: str, manifest: dict, arrays: dict, standardizer) -> list[str]:
+    """The manifest for a person (the content already validated: names, units, domain, model);
+    ``standardizer``: the loaded emulator's, for theta in native units."""
     model = manifest.get("model", {})
     lines = [
         f"file:            {safe(file)}",
@@ -98,7 +101,7 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
     if isinstance(fixed, dict) and fixed:
         cells = []
         for k, v in fixed.items():  # theta is stored on the unit scale: printed native, by name
-            native = _native_theta(manifest, v) if k == "theta" and isinstance(v, list) else None
+            native = _native_theta(manifest, v, standardizer) if k == "theta" else None
             cells.append(f"theta (native)=[{native[1]}]" if native else f"{safe(k, 60)}={plain(v)}")
         lines.append("fixed:           " + ", ".join(cells))
     s = manifest["settings"]
@@ -129,7 +132,7 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
                 )  # fmt: skip
             label = safe(name, 60)
             if name == "theta":  # stored on the unit scale; printed native, as calibrate does
-                native = _native_theta(manifest, d["mean"])
+                native = _native_theta(manifest, d["mean"], standardizer)
                 label, cells["mean"] = native or ("theta (unit scale)", cells["mean"])
             lines.append(
                 f"posterior {label}: mean [{safe(cells['mean'], 300)}] ESS "
@@ -143,18 +146,17 @@ def _lines(file: str, manifest: dict, arrays: dict) -> list[str]:
     return lines
 
 
-def _native_theta(manifest: dict, means: list) -> tuple[str, str] | None:
-    """The label and the theta means as NAME=VALUE in native units, lo + u (hi - lo) over each
-    parameter's domain (as ``gpmsa.fit``'s ``theta_native``) from the unit-scale means the
-    file's diagnostics hold; None for means that are not one number per parameter."""
+def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str] | None:
+    """The label and the unit-scale theta ``means`` (a fixed theta, the diagnostics' means) as
+    NAME=VALUE in native units (``standardizer.t_from_unit``); None for means that are not one
+    number per parameter."""
     names = manifest["names"]["t"]
-    real = all(isinstance(u, (int, float)) and not isinstance(u, bool) for u in means)
-    if not real or len(means) != len(names):
+    if not isinstance(means, list) or len(means) != len(names):
         return None
-    cells = []
-    for n, u in zip(names, means, strict=True):
-        lo, hi = manifest["domain"][n]
-        cells.append(f"{safe(n, 60)}={number(lo + u * (hi - lo), '.4g')}")
+    if not all(isinstance(u, (int, float)) and not isinstance(u, bool) for u in means):
+        return None
+    native = standardizer.t_from_unit(np.array([means], dtype=float))[0]
+    cells = [f"{safe(n, 60)}={number(float(v), '.4g')}" for n, v in zip(names, native, strict=True)]
     return "theta (native)", ", ".join(cells)
 
 
