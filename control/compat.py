@@ -241,14 +241,12 @@ def emulator_noise_std(emulator) -> float | None:
 
 def _recorded_noise_std(meta: dict) -> float | None:
     """The metadata's ``noise_std`` as a finite float; None when it is missing or not a finite
-    real number (a bool, a string, an integer beyond a float's range)."""
+    real number (a bool, a string, an integer beyond 64 bits: `is_real` refuses those, so the
+    conversion cannot overflow)."""
     value = meta.get("noise_std")
     if not is_real(value):
         return None
-    try:
-        value = float(value)
-    except OverflowError:
-        return None
+    value = float(value)
     return value if np.isfinite(value) else None
 
 
