@@ -66,15 +66,20 @@ def segment_index(track, position: np.ndarray) -> np.ndarray:
     """Index of the track segment holding each position (clipped to the first/last segment).
     `ControlError` for a position that is NaN (it lies in no segment: leave it out first) and
     for a ``track`` without a roadgen Track's segments and boundaries_m."""
-    starts, seg_gd = _track_parts(track)
+    starts, _ = _track_parts(track)
     position = float_array(position, "position")
     if np.isnan(position).any():
         raise ControlError(
             f"position holds NaN at index {int(np.flatnonzero(np.isnan(position))[0])}: a "
             "position that is NaN lies in no segment (leave it out first)"
         )
+    return _segment_of(starts, position)
+
+
+def _segment_of(starts: np.ndarray, position: np.ndarray) -> np.ndarray:
+    """`segment_index` of checked segment starts and positions (no NaN)."""
     idx = np.searchsorted(starts, position, side="right") - 1
-    return np.clip(idx, 0, seg_gd.size - 1)
+    return np.clip(idx, 0, starts.size - 1)
 
 
 def _traces(position, values, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -102,10 +107,10 @@ def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDE
         One `GDError` per distinct prescribed GD, in increasing GD.
     """
     position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
-    _, seg_gd = _track_parts(track)
+    starts, seg_gd = _track_parts(track)
     ok = np.isfinite(gd_estimate) & np.isfinite(position)
     truth = np.full(position.shape, np.nan)  # no segment: left out
-    truth[ok] = seg_gd[segment_index(track, position[ok])]
+    truth[ok] = seg_gd[_segment_of(starts, position[ok])]
     out = []
     for gd in np.unique(seg_gd):
         sel = ok & (truth == gd)
@@ -225,7 +230,7 @@ def fast_on_rough_m(
     for name, value in (("gd_max", gd_max), ("v_safe", v_safe), ("tol", tol)):
         if not (is_real(value) and np.isfinite(value)):
             raise ControlError(f"{name} must be a finite real number, got {value!r}")
-    _, seg_gd = _track_parts(track)
+    starts, seg_gd = _track_parts(track)
     position, speed = _traces(position, speed, "speed")
     if not (np.all(np.isfinite(position)) and np.all(np.diff(position) >= 0)):
         raise ControlError("position must hold finite, non-decreasing samples, m")
@@ -234,7 +239,7 @@ def fast_on_rough_m(
     if position.size < 2:
         return 0.0
     mid = 0.5 * (position[1:] + position[:-1])
-    rough = seg_gd[segment_index(track, mid)] > gd_max
+    rough = seg_gd[_segment_of(starts, mid)] > gd_max
     fast = 0.5 * (speed[1:] + speed[:-1]) > v_safe + tol
     return float(np.sum(np.diff(position)[rough & fast]))
 
