@@ -47,7 +47,7 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
-from gpmsa.model.data import ObsData, check_count, check_flag, check_seed
+from gpmsa.model.data import ObsData, by_column_names, check_count, check_flag, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
@@ -112,7 +112,7 @@ def _theta_options(emulator, constraint, theta_init):
     closed = None if levels is None else [lv is not None for lv in levels]
     start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, names, closed)
     if start is not None and levels is not None:
-        native = np.asarray(theta_init, dtype=float).reshape(-1)
+        native = np.asarray(by_column_names(theta_init, names, "theta_init"), float).reshape(-1)
         for k, lv in enumerate(levels):
             if lv is not None and not np.any(np.isclose(lv, native[k], rtol=0, atol=1e-9)):
                 raise GPMSAError(

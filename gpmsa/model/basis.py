@@ -83,7 +83,11 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
             raise GPMSAError(f"discrepancy basis must be ({grid.size}, p_v), got {D.shape}")
         if not np.all(np.isfinite(D)):
             raise GPMSAError("discrepancy basis must be finite")
-    scale = np.max(np.sum(D**2, axis=1))
+    with np.errstate(over="ignore", under="ignore"):
+        scale = np.max(np.sum(D**2, axis=1))
+    if not np.finfo(np.float64).tiny <= scale < np.inf and np.any(D):
+        D = D / np.max(np.abs(D))  # its squares overflow or underflow float64: rescale first
+        scale = np.max(np.sum(D**2, axis=1))
     if not scale > 0:
         raise GPMSAError("discrepancy basis is all zeros")
     return D / np.sqrt(scale)

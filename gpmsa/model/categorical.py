@@ -8,7 +8,7 @@ and equal levels stay exactly equal, which is all the categorical correlation
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -27,8 +27,12 @@ def columns(spec: Sequence | None, names: tuple[str, ...], what: str) -> tuple[i
     """
     if spec is None:
         return ()
+    if isinstance(spec, np.ndarray) and spec.ndim == 0:
+        spec = spec.item()  # a 0-d array: its one value
     if isinstance(spec, (str, int, np.integer)):
         spec = [spec]
+    elif isinstance(spec, (bytes, bytearray)) or not isinstance(spec, Iterable):
+        raise GPMSAError(f"{what} must hold column indices or names, got {spec!r}")
     out = set()
     for item in spec:
         if isinstance(item, str):

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import as_float, check_finite
+from gpmsa.model.data import as_float, by_column_names, check_finite
 
 
 @dataclass(frozen=True, eq=False)
@@ -95,12 +95,13 @@ def make(constraint, t_min, t_max, names) -> ThetaConstraint | None:
 def theta_init_unit(
     theta_init, t_min, t_max, names, closed=None, what: str = "theta_init"
 ) -> np.ndarray | None:
-    """The user's ``theta_init`` (native, (q,)) on the unit scale; GPMSAError naming ``what``
-    outside (0, 1) (outside [0, 1] for the elements that ``closed`` (q,) bool marks: categorical
-    levels)."""
+    """The user's ``theta_init`` (native, (q,); a pandas Series or one-row table by its labels,
+    ``names``) on the unit scale; GPMSAError naming ``what`` outside (0, 1) (outside [0, 1] for
+    the elements that ``closed`` (q,) bool marks: categorical levels)."""
     if theta_init is None:
         return None
     q = len(names)
+    theta_init = by_column_names(theta_init, names, what)  # pandas: by label, not position
     arr = as_float(theta_init, what).reshape(-1)
     if arr.size != q:
         raise GPMSAError(f"{what} must have {q} values ({names}), got {arr.size}")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 
 import numpy as np
 
@@ -24,6 +24,16 @@ def _real(obj, name: str) -> float:
             f"({type(value).__name__})"
         )
     object.__setattr__(obj, name, float(value))
+    return float(value)
+
+
+def _float(value, name: str) -> float:
+    """A number of ``Priors.from_dict`` (the string "inf" is infinity, as ``to_dict`` writes
+    it); GPMSAError naming the field otherwise."""
+    if isinstance(value, str) and value == "inf":
+        return math.inf
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise GPMSAError(f"Priors.from_dict: {name} must be a number, got {value!r}")
     return float(value)
 
 
@@ -125,10 +135,21 @@ class Priors:
 
     @classmethod
     def from_dict(cls, d: dict) -> Priors:
-        """Inverse of ``to_dict``."""
+        """Inverse of ``to_dict``; GPMSAError naming a missing or unknown field."""
+        if not isinstance(d, dict):
+            raise GPMSAError(f"Priors.from_dict needs a dict, got {type(d).__name__}")
+        known = {f.name for f in fields(cls)}
+        if unknown := sorted(str(k) for k in set(d) - known):
+            raise GPMSAError(f"Priors.from_dict: unknown fields {unknown}; known {sorted(known)}")
         kw = dict(d)
         for name in PRECISIONS:
-            kw[name] = GammaPrior(**{k: float(v) for k, v in d[name].items()})
+            g = d.get(name)
+            if not isinstance(g, dict) or not {"a", "b"} <= set(g) <= {"a", "b", "lower", "upper"}:
+                raise GPMSAError(
+                    f"Priors.from_dict: {name} must be a dict with a, b (and lower, upper), "
+                    f"got {g!r}"
+                )
+            kw[name] = GammaPrior(**{k: _float(v, f"{name}.{k}") for k, v in g.items()})
         return cls(**kw)
 
     def log_theta(self, theta: np.ndarray) -> float:

@@ -308,3 +308,26 @@ def test_info_shows_categorical_and_mean_basis(cat_emulator, tmp_path, capsys):
     out = capsys.readouterr().out
     assert "categorical:     kind levels [0, 1, 2]" in out
     assert "mean basis:      zero (GPM/SA)" in out
+
+
+def test_calibrate_reads_a_pandas_theta_init_by_its_labels_for_the_level_check():
+    """A pandas theta_init is read by its labels (as theta_init_unit does), also where
+    calibrate checks that a categorical element is one of its levels: a Series listing the
+    continuous parameter first is not read by position."""
+    pd = pytest.importorskip("pandas")
+    rng = np.random.default_rng(3)
+    level, cont = np.arange(24) % 2, rng.random(24)
+    x = rng.random(24)
+    sim = gpmsa.SimData(x, np.column_stack([level, cont]), x + level + cont,
+                        t_categorical=[0])  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
+        emu = gpmsa.fit(sim, n_iter=200, seed=0)
+    x_obs = np.array([[0.3], [0.6]])
+    start = pd.Series({"t1": 0.4, "t0": 1.0})
+    post = gpmsa.calibrate(emu, x_obs, x_obs[:, 0] + 1.4, n_samples=50, n_burn=10, seed=1,
+                           theta_init=start)  # fmt: skip
+    assert set(np.unique(post.samples["t0"])) <= {0.0, 1.0}
+    with pytest.raises(gpmsa.GPMSAError, match="t0 must be one of its training levels"):
+        gpmsa.calibrate(emu, x_obs, x_obs[:, 0] + 1.4, n_samples=50, n_burn=10, seed=1,
+                        theta_init=pd.Series({"t1": 0.7, "t0": 0.4}))  # fmt: skip
