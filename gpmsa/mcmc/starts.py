@@ -8,7 +8,8 @@ values, as GPM/SA does.
 - ``"gpmsa"``: ``problem.init`` (theta 0.5, betaU 0.1, lamUz 1, lamWs 1000, ...).
 - ``"jitter"``: around GPM/SA's start: theta ~ U(0.1, 0.9); beta through rho = exp(-beta/4)
   ~ U(RHO_JITTER); each precision log-uniform on [x0 / f, x0 f] (x0 its GPM/SA start, f =
-  ``PRECISION_JITTER``) cut to its prior's bounds.
+  ``PRECISION_JITTER``) cut to its prior's bounds (bounds too narrow for the cut: x0; bounds
+  out of its reach: GPMSAError).
 - ``"prior"``: from the (data-corrected) prior: theta from the truncated normal, rho from
   Beta(rho_a, rho_b) capped at rho_cap, precisions from their truncated Gammas.
 
@@ -120,12 +121,32 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
                 x = x0.ravel()
                 lo = np.maximum(x / PRECISION_JITTER, g.lower * (1.0 + 1e-3) + 1e-12)
                 hi = np.minimum(x * PRECISION_JITTER, g.upper * (1.0 - 1e-3))
+                lo, hi = _jitter_range(name, g, x, lo, hi)
                 val = np.exp(rng.uniform(np.log(lo), np.log(hi)))
             else:
                 val = _gamma(g, size, rng)
         out[name] = np.asarray(val, dtype=np.float64).reshape(x0.shape)
     check_start(problem, out, how)
     return out
+
+
+def _jitter_range(name: str, g: GammaPrior, x: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """(lo, hi) of a precision's jittered start where the cut [x0 / f, x0 f] is empty: x0 itself
+    when it lies inside the prior's bounds (bounds narrower than their 1e-3 margins), a
+    GPMSAError naming the parameter and its bounds when it lies outside them (as the 'gpmsa'
+    start's, ``check_start``)."""
+    empty = lo > hi
+    if not empty.any():
+        return lo, hi
+    inside = (x > g.lower) & (x < g.upper)
+    if np.any(empty & ~inside):
+        raise GPMSAError(
+            f"the chains' start {name} = {x.tolist()} ('jitter' start: log-uniform on "
+            f"[x0 / {PRECISION_JITTER:g}, x0 * {PRECISION_JITTER:g}]) cannot reach the bounds "
+            f"({g.lower:g}, {g.upper:g}) of Priors.{name}: zero prior density. Widen the prior's "
+            "bounds, or start inside them (init='prior', or a fixed= value)"
+        )
+    return np.where(empty, x, lo), np.where(empty, x, hi)
 
 
 def _theta_start(problem: Problem, how: str, size: int, rng: np.random.Generator) -> np.ndarray:

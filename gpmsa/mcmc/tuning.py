@@ -90,13 +90,22 @@ def choose_widths(
     ``candidates`` (n_levels, n_el) widths, ``accepted`` (n_levels, n_el) acceptance counts out of
     ``n_burn``. The fit only knows the tested range, so the width is held to the element's
     candidates [min, max]: a fitted 1/e point beyond them (acceptance above 1/e at every
-    candidate) gives the widest, one below them the narrowest. An element whose fit fails (or
-    gives acceptance rising with width) keeps ``widths``.
+    candidate) gives the widest, one below them the narrowest. An element that accepted every
+    proposal at every candidate gets the widest, one that accepted none the narrowest (no
+    logistic fit exists there: its slope would be the ridge's, whose sign follows that of the
+    widths' logarithms, not the data). An element whose fit fails (or gives acceptance rising
+    with width) keeps ``widths``.
     """
     logit = np.log(TARGET / (1 - TARGET))
     out = widths.copy()
     for i in range(widths.size):
         cand = candidates[:, i]
+        if np.all(accepted[:, i] <= 0):
+            out[i] = cand.min()
+            continue
+        if np.all(accepted[:, i] >= n_burn):
+            out[i] = cand.max()
+            continue
         b = fit_logistic(np.log(cand), accepted[:, i], n_burn)
         if b is None or not b[1] < 0:
             continue

@@ -51,8 +51,25 @@ def test_a_width_inside_the_candidates_is_the_fit_s_and_a_rising_fit_keeps_the_w
     fitted = np.exp((np.log(TARGET / (1 - TARGET)) - b[0]) / b[1])
     assert CANDS[0, 0] < fitted < CANDS[-1, 0]
     assert choose_widths(np.array([0.1]), CANDS, acc[:, None], 50)[0] == fitted
-    # acceptance rising with width (none accepted: a ridge-held positive slope) keeps the width
-    assert choose_widths(np.array([0.1]), CANDS, np.zeros((20, 1)), 50)[0] == 0.1
+    # acceptance rising with width keeps the width
+    rising = np.round(np.linspace(5, 45, 20))
+    assert choose_widths(np.array([0.1]), CANDS, rising[:, None], 50)[0] == 0.1
+
+
+@pytest.mark.parametrize("name", ["theta", "betaU", "lamUz", "lamWs", "lamWOs"])
+@pytest.mark.parametrize("width", [0.1, 5.0, 100.0])
+def test_none_or_every_proposal_accepted_gives_the_narrowest_or_widest_whatever_the_widths(
+    name, width
+):
+    """With no acceptance (or every proposal accepted) at every candidate the logistic fit's slope
+    was the ridge's, whose sign followed that of the candidates' log widths: a precision (default
+    width 5 or 100) that accepted nothing got the narrowest width, a theta or betaU (0.2, 0.1)
+    kept its width; every proposal accepted: theta the widest, lamUz kept its width."""
+    cands = level_widths([name], np.array([width]), 20)
+    none = choose_widths(np.array([width]), cands, np.zeros((20, 1)), 50)
+    every = choose_widths(np.array([width]), cands, np.full((20, 1), 50.0), 50)
+    assert none[0] == cands[:, 0].min()
+    assert every[0] == cands[:, 0].max()
 
 
 # --- torch and pyro: the draws' memory is checked before any chain runs ---------------------------
