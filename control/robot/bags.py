@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import importlib
 import os
+import re
 import shutil
 import struct
 import sys
@@ -39,6 +40,9 @@ from control.robot.extra import require
 from control.validation import float_array, path_argument
 
 STORAGES = ("mcap", "sqlite3")
+URI_PARTS = re.compile(r"[?#]|%[0-9A-Fa-f]{2}")
+"""What rosbags' sqlite3 writer misreads in a path (it opens ``file:PATH`` as a URI): a query,
+a fragment, a percent-encoded byte."""
 
 
 @dataclass(frozen=True)
@@ -142,9 +146,8 @@ def _check_topics(path: Path, topics: dict[str, str], imu_topic: str, odom_topic
                 f"reads one, {want}, per topic"
             )
         if _normalise(topics[topic]) != want:
-            raise BagError(
-                f"the {role} topic {topic!r} in {path} holds {topics[topic]}, expected {want}"
-            )
+            held = topics[topic] or "messages without a schema (no message type)"
+            raise BagError(f"the {role} topic {topic!r} in {path} holds {held}, expected {want}")
 
 
 def in_bag_folder(path: Path) -> bool:
@@ -460,8 +463,8 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
                 raise BagError(f"{path} {cut}") from exc
             raise BagError(f"cannot read {path} as an MCAP file: {_why(exc)}") from exc
         if summary is not None:
-            topics = {
-                ch.topic: summary.schemas[ch.schema_id].name if ch.schema_id else ""
+            topics = {  # "": no schema (id 0), or one the summary lacks (a damaged file)
+                ch.topic: getattr(summary.schemas.get(ch.schema_id), "name", "")
                 for ch in summary.channels.values()
             }
             _check_topics(path, topics, imu_topic, odom_topic)
@@ -581,6 +584,19 @@ def _vectors(name: str, a, n: int, axis: str = "x") -> np.ndarray:
     return a
 
 
+def check_bag_path(path: Path, storage: str, name: str = "path") -> None:
+    """`ControlError` naming ``name`` where a bag of ``storage`` cannot be written to ``path``:
+    a sqlite3 bag to a path holding a '?', a '#' or a '%' and two hex digits (`URI_PARTS`:
+    rosbags' sqlite3 writer would put its database elsewhere and leave the bag without one)."""
+    odd = URI_PARTS.search(str(path))
+    if storage == "sqlite3" and odd:
+        raise ControlError(
+            f"{name}={str(path)!r}: a sqlite3 bag cannot be written to a path holding "
+            f"{odd.group()!r} (rosbags' sqlite3 writer reads the path as a URI: its database would "
+            "land elsewhere and the bag hold none); choose another path or storage 'mcap'"
+        )
+
+
 @contextmanager
 def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
     """A rosbags ROS 2 bag writer (format version 9), open, for a new folder ``path``.
@@ -589,12 +605,14 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
     an interrupted write (an exception, a killed process) never leaves a bag without its
     metadata at ``path``; on an exception the hidden folder is removed. Each chunk of an MCAP
     bag is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves
-    it 0), so that a reader refuses a chunk whose bytes changed."""
+    it 0), so that a reader refuses a chunk whose bytes changed. `ControlError` where ``path``
+    exists (a link to nowhere too) or `check_bag_path` refuses it."""
     _check_storage(storage)
     path = path_argument(path, "path", " of the new bag folder")
     rosbag2 = require("rosbags.rosbag2", "writing a ROS 2 bag")
-    if path.exists():
+    if os.path.lexists(path):  # a link to nowhere too: the bag could not be moved onto it
         raise ControlError(f"{path} exists already; a bag is written to a new folder")
+    check_bag_path(path, storage)
     plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

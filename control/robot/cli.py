@@ -33,6 +33,7 @@ from control.compat import check_emulator
 from control.errors import ControlError, MissingExtraError
 from control.estimate import edge_counts
 from control.metrics import strict_json
+from control.robot.bags import check_bag_path
 from control.robot.replay import (
     GRAVITY,
     POSITIONS,
@@ -223,6 +224,7 @@ def main(argv: list[str] | None = None) -> int:
         simplex = Simplex(v_max=args.v_max, v_safe=args.v_safe)
         _check_out_apart(out, bag, args.out is None)
         _check_out(out)
+        check_bag_path(out / "estimates", settings.storage, "--out")
         emulator = load_emulator(args.emulator, "--emulator")
         check_emulator(emulator, simplex=simplex)
         result = replay_bag(bag, emulator, settings, simplex=simplex, progress=args.progress)

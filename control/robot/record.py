@@ -26,7 +26,7 @@ from control.errors import ControlError
 from control.robot import messages as msgs
 from control.robot.bags import MAX_STAMP_NS, merge_in_time, sensor_messages, stamps_ns
 from control.robot.extra import require
-from control.robot.storage import check_mcap_target
+from control.robot.storage import LIBRARY, check_mcap_target
 from control.validation import check_instance, path_argument
 from gpmsa.io.atomic import atomic_write
 
@@ -79,8 +79,9 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
 
     Args:
         result: the closed loop's result (`control.run_closed_loop`).
-        path: the ``*.mcap`` file to write (an earlier MCAP file there is replaced; any other
-            file is refused, `storage.check_mcap_target`; its folder is made).
+        path: the ``*.mcap`` file to write (an earlier recording of this function there is
+            replaced; any other file, an MCAP file another program wrote included, is refused,
+            `storage.check_mcap_target`; its folder is made).
         start_ns: the time stamp of the run's time 0, ns, in [0, 2**31 s) (0: the epoch;
             Foxglove shows seconds from the start either way); every header stamp and receive
             time is that much later.
@@ -120,10 +121,13 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     truth = [bytes(store.serialize_cdr(f64(data=float(g)), msgs.FLOAT64_TYPE))
              for g in result.gd_true]  # fmt: skip
 
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # e.g. a file where a folder of the path should be
+        raise ControlError(f"path={str(path)!r}: cannot make its folder ({exc.strerror})") from exc
     with atomic_write(path, error=ControlError) as f:
         writer = writer_mod.Writer(f)
-        writer.start(profile="ros2", library="terrain-gpmsa")
+        writer.start(profile="ros2", library=LIBRARY)
         channels = {}
         for key, msgtype in (
             ("imu", msgs.IMU_TYPE), ("odometry", msgs.ODOMETRY_TYPE),

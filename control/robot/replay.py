@@ -49,6 +49,7 @@ from control.robot import messages as msgs
 from control.robot.bags import (
     STORAGES,
     Recording,
+    check_bag_path,
     merge_in_time,
     open_bag_writer,
     read_recording,
@@ -436,7 +437,8 @@ def replay_bag(
             is replaced only where it is empty or a CSV of estimates (its first line
             CSV_COLUMNS' header, as a replay writes it), any other is refused.
         out_bag: write the estimates here as a ROS 2 bag folder (`ReplayResult.write_bag`); a
-            new one: an existing path is refused.
+            new one: an existing path is refused, and so is, for storage "sqlite3", a path
+            holding '?', '#' or '%XX' (`control.robot.bags.check_bag_path`).
         progress: show a tqdm bar over the blocks.
 
     Returns:
@@ -454,6 +456,8 @@ def replay_bag(
     bag = recording_path(bag, "bag")
     csv, out_bag = _check_outputs(bag, emulator, csv, out_bag)
     s = _settings(settings, overrides)
+    if out_bag is not None:
+        check_bag_path(out_bag, s.storage, "out_bag")
     emulator = load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex

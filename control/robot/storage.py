@@ -36,6 +36,9 @@ _FOOTER = 9 + 8 + 8 + 4  # a Footer record: opcode, length, summary start and of
 MIN_MCAP_BYTES = 2 * len(MAGIC) + 9 + 4 + 4 + _FOOTER
 """Size of the smallest MCAP file: magic bytes, a Header record (two empty strings), a Footer
 record and the magic bytes again, bytes."""
+LIBRARY = "terrain-gpmsa"
+"""The ``library`` field of the Header record of the MCAP files `control.record_run` writes."""
+_HEADER_BYTES = 1 << 12  # bytes read to find a Header record's library field
 
 
 class _Damaged(Exception):
@@ -178,11 +181,33 @@ def mcap_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics | N
     return out
 
 
+def writer_library(head: bytes) -> str | None:
+    """The ``library`` field of the Header record that follows MCAP's magic bytes in ``head``
+    (the first bytes of a file): the program that wrote the file; None where ``head`` ends
+    before it or holds no Header record there."""
+    pos = len(MAGIC) + _RECORD.size
+    if len(head) < pos or head[len(MAGIC)] != 0x01:  # opcode of a Header record
+        return None
+    try:
+        (n_profile,) = struct.unpack_from("<I", head, pos)
+        (n_library,) = struct.unpack_from("<I", head, pos + 4 + n_profile)
+    except struct.error:
+        return None
+    start = pos + 8 + n_profile
+    if len(head) < start + n_library:
+        return None
+    return head[start : start + n_library].decode(errors="replace")
+
+
 def check_mcap_target(path: Path, name: str) -> None:
     """ControlError naming ``name`` when a recording written to ``path`` would destroy something
-    that is not a recording: a folder, something other than a plain file, or a non-empty file
-    that does not start with MCAP's magic bytes (someone's data, an emulator file). An earlier
-    MCAP file, an empty file or a new path may be written."""
+    that is not an earlier recording of `control.record_run`: a folder, something other than a
+    plain file, a non-empty file that does not start with MCAP's magic bytes (someone's data,
+    an emulator file), or an MCAP file written by another program (whose Header record does
+    not name `LIBRARY` as its writer: a robot's recording, a bag's file, Foxglove's; one of
+    at least `MIN_MCAP_BYTES` whose header cannot be read too). An earlier recording of
+    `control.record_run`, an empty file, a stub shorter than any MCAP file or a new path may
+    be written."""
     if not path.exists():
         return
     if path.is_dir():
@@ -191,18 +216,24 @@ def check_mcap_target(path: Path, name: str) -> None:
     def refused(what: str) -> ControlError:
         return ControlError(
             f"{name}={str(path)!r} holds {what}; a recording replaces only an earlier MCAP "
-            "file: remove it or choose another path"
+            "file of record_run: remove it or choose another path"
         )
 
     if not path.is_file():
         raise refused("something other than a plain file")
     try:
         with path.open("rb") as f:
-            head = f.read(len(MAGIC))
+            head = f.read(_HEADER_BYTES)
+            size = os.fstat(f.fileno()).st_size
     except OSError as exc:
         raise ControlError(f"{name}={str(path)!r} cannot be read to check it: {exc}") from None
-    if head and head != MAGIC:
+    if head and head[: len(MAGIC)] != MAGIC:
         raise refused("a file that is not an MCAP recording")
+    library = writer_library(head)
+    if library is None and size >= MIN_MCAP_BYTES:
+        raise refused("an MCAP file whose header does not say which program wrote it")
+    if library is not None and library != LIBRARY:
+        raise refused(f"an MCAP recording written by {library!r}, not by record_run")
 
 
 def truncation(f) -> str:
@@ -329,7 +360,8 @@ def sqlite_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics:
 
 def _sqlite_file(path: Path, out: RawTopics) -> None:
     """Append the messages of ``out``'s topics in one rosbag2 sqlite3 file."""
-    con = sqlite3.connect(f"file:{path.resolve()}?mode=ro", uri=True)
+    # as_uri: a '#', '?' or '%' in the path is percent-encoded, not read as the URI's parts
+    con = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
     try:
         _check_complete(con, path)
         rows = con.execute("SELECT id, name, type, serialization_format FROM topics")

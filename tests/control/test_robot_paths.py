@@ -1,0 +1,133 @@
+"""Paths and writers of robot recordings: what a user recorded is never replaced by
+`record_run` (an MCAP file another program wrote, a bag's file), a sqlite3 bag is read and
+written whatever characters its path holds (or refused before anything is written), and a
+channel whose schema the file lacks is a `BagError`."""
+
+import os
+import shutil
+
+import numpy as np
+import pytest
+
+pytest.importorskip("rosbags")
+pytest.importorskip("mcap")
+
+import control  # noqa: E402
+from control.closed_loop import ClosedLoopResult  # noqa: E402
+from control.errors import BagError, ControlError  # noqa: E402
+from control.robot import messages as msgs  # noqa: E402
+from control.robot import read_recording, replay_bag, write_sensor_bag  # noqa: E402
+from control.robot.bags import merge_in_time, sensor_messages  # noqa: E402
+
+TOPICS = ("/imu/data", "/odometry/filtered")
+
+
+def _drive(n: int = 60):
+    t = 1.0 + np.arange(n) / 120.0
+    return t, np.random.default_rng(0).normal(size=n), t, 0.5 * (t - 1.0), np.full(n, 0.5)
+
+
+def _result(n: int = 240) -> ClosedLoopResult:
+    """A small closed-loop result (no drive needed to record one)."""
+    t = np.arange(n) / 120.0
+    te = t[41::42]
+    k = te.size
+    return ClosedLoopResult(
+        time=te, position=0.5 * te, gd_mean=np.full(k, 300.0), gd_lo=np.full(k, 250.0),
+        gd_hi=np.full(k, 350.0), gd_true=np.full(k, 300.0), status=np.array(["ok"] * k),
+        reason=np.array([""] * k), domain_edge=np.array([""] * k), prob_change=np.zeros(k),
+        command=np.ones(k), mode=np.array(["performance"] * k), latency_s=np.zeros(k),
+        sample_time=t, sample_position=0.5 * t, sample_speed=np.full(n, 0.5),
+        sample_accel=np.random.default_rng(0).normal(size=n), metrics={}, settings={},
+    )  # fmt: skip
+
+
+def _write_mcap(path, library: str = "foxglove", bad_schema: bool = False, chunked=True):
+    """An MCAP file of ROS 2 IMU and odometry messages written by ``library``; ``bad_schema``:
+    the odometry channel names a schema the file does not hold."""
+    from mcap.writer import Writer
+
+    t_imu, imu, t_odom, odom = sensor_messages(*_drive())
+    store = msgs.typestore()
+    with open(path, "wb") as f:
+        writer = Writer(f, use_chunking=chunked)
+        writer.start(profile="ros2", library=library)
+        channels = []
+        for topic, msgtype in zip(TOPICS, (msgs.IMU_TYPE, msgs.ODOMETRY_TYPE), strict=True):
+            definition, _ = store.generate_msgdef(msgtype, ros_version=2)
+            schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
+            odd = bad_schema and topic == TOPICS[1]
+            channels.append(writer.register_channel(topic, "cdr", 99 if odd else schema))
+        for channel, stamp, data in merge_in_time(
+            [(channels[0], t_imu, imu), (channels[1], t_odom, odom)]
+        ):
+            writer.add_message(channel, log_time=stamp, data=data, publish_time=stamp)
+        writer.finish()
+    return path
+
+
+def test_a_recording_never_replaces_an_mcap_file_another_program_wrote(tmp_path):
+    """record_run replaced any MCAP file: a robot's recording (a bag's file, Foxglove's)."""
+    result = _result()
+    bag = write_sensor_bag(tmp_path / "bag", *_drive())
+    bag_file = next(bag.glob("*.mcap"))
+    foreign = _write_mcap(tmp_path / "field.mcap")
+    header_lost = tmp_path / "header_lost.mcap"
+    data = foreign.read_bytes()
+    header_lost.write_bytes(data[:8] + b"\x07" + data[9:])  # not a Header record
+    for target, why in ((bag_file, "written by 'rosbags-"), (foreign, "written by 'foxglove'"),
+                        (header_lost, "does not say which program wrote it")):  # fmt: skip
+        before = target.read_bytes()
+        with pytest.raises(ControlError, match=why):
+            control.record_run(result, target)
+        assert target.read_bytes() == before
+    assert read_recording(bag).imu.stamp_ns.size == 60  # the bag as recorded
+    ours = tmp_path / "run.mcap"
+    control.record_run(result, ours)
+    stub = tmp_path / "stub.mcap"
+    stub.write_bytes(ours.read_bytes()[:20])  # cut inside its header: holds nothing
+    for target in (ours, stub):  # an earlier recording of record_run is replaced
+        assert control.record_run(result, target) == target
+        assert target.read_bytes() == ours.read_bytes()
+
+
+def test_record_run_names_a_folder_it_cannot_make(tmp_path):
+    (tmp_path / "notes").write_text("x")
+    with pytest.raises(ControlError, match="path=.*cannot make its folder"):
+        control.record_run(_result(), tmp_path / "notes" / "runs" / "run.mcap")
+
+
+@pytest.mark.parametrize("chunked", [True, False])
+def test_a_channel_whose_schema_the_file_lacks_is_a_bag_error(chunked, tmp_path):
+    path = _write_mcap(tmp_path / "odd.mcap", bad_schema=True, chunked=chunked)
+    with pytest.raises(BagError, match="odometry.*holds messages without a schema"):
+        read_recording(path)
+
+
+@pytest.mark.parametrize("name", ["trial#3", "a?b", "p%41q"])
+def test_a_sqlite3_bag_reads_whatever_its_folder_is_named(name, tmp_path):
+    """The reader opened the database as a URI: '#' or '?' cut the path (and made an empty
+    database there), '%41' read another file."""
+    bag = write_sensor_bag(tmp_path / "bag", *_drive(), storage="sqlite3")
+    shutil.copytree(bag, tmp_path / name)
+    before = sorted(os.listdir(tmp_path))
+    assert read_recording(tmp_path / name).imu.stamp_ns.size == 60
+    assert sorted(os.listdir(tmp_path)) == before  # reading made no file
+
+
+@pytest.mark.parametrize("name", ["trial#3", "a?b", "p%41q"])
+def test_a_sqlite3_bag_is_not_written_where_its_database_would_be_lost(name, tmp_path):
+    """rosbags' sqlite3 writer put the database beside the folder (or failed with sqlite3's
+    bare error) and the bag was written without it."""
+    with pytest.raises(ControlError, match="sqlite3 bag cannot be written to a path holding"):
+        write_sensor_bag(tmp_path / name, *_drive(), storage="sqlite3")
+    assert os.listdir(tmp_path) == []
+    assert read_recording(write_sensor_bag(tmp_path / name, *_drive())).imu.stamp_ns.size == 60
+    with pytest.raises(ControlError, match="out_bag=.*sqlite3 bag cannot be written"):
+        replay_bag(tmp_path / name, "A", storage="sqlite3", out_bag=tmp_path / f"out{name}")
+
+
+def test_a_bag_is_not_written_onto_a_link_to_nowhere(tmp_path):
+    os.symlink(tmp_path / "nowhere", tmp_path / "link")
+    with pytest.raises(ControlError, match="exists already"):
+        write_sensor_bag(tmp_path / "link", *_drive())
