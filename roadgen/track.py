@@ -99,6 +99,12 @@ def track(
     _check_blend_and_lead(segs, dx, blend, lead)
     lengths = np.array([length for length, _ in segs])
     n_points = grid_points(float(lengths.sum()), dx)
+    if lead > (n_points - 1) * dx:  # one segment, its length rounded down to whole steps
+        raise RoadgenError(
+            f"lead_in_m={lead:g} is out of range: allowed [0, {(n_points - 1) * dx:.6g}] m (the "
+            f"track's length, {lengths.sum():g} m rounded to whole dx_m = {dx:g} m steps); "
+            "shorten lead_in_m"
+        )
     unit, settings = unit_road(n_points, dx, seed, band, amplitudes, waviness, lead)
     x = np.arange(n_points) * dx
     starts = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
