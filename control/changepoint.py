@@ -199,10 +199,27 @@ class ChangePointFilter:
         return self._mass, self._dist, self._has_data
 
     def restore(self, state: tuple) -> None:
-        """Return to a state taken by `state` (e.g. to undo a block found suspect later)."""
-        mass, dist, has_data = state
-        self._set(np.array(mass, dtype=float), np.array(dist, dtype=float))
-        self._has_data = has_data
+        """Return to a state taken by `state` (e.g. to undo a block found suspect later).
+        ControlError for anything else (e.g. a state of a filter on another GD grid)."""
+        try:
+            mass, dist, has_data = state
+            mass, dist = np.array(mass, dtype=float), np.array(dist, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ControlError(
+                f"state must be one taken by ChangePointFilter.state(): {exc}"
+            ) from None
+        if not (
+            dist.ndim == 1 and dist.size >= 1 and mass.shape == (dist.size, self.gd.size)
+            and isinstance(has_data, bool | np.bool_)
+        ):  # fmt: skip
+            raise ControlError(
+                f"state must be one taken by ChangePointFilter.state() of a filter on this GD "
+                f"grid: run-length masses ({dist.size if dist.ndim == 1 else 'R'}, "
+                f"{self.gd.size}), their distances and a has_data flag, got masses of shape "
+                f"{mass.shape}, distances of shape {dist.shape} and has_data {has_data!r:.40}"
+            )
+        self._set(mass, dist)
+        self._has_data = bool(has_data)
 
     @property
     def has_data(self) -> bool:
@@ -265,7 +282,12 @@ def mixture_posterior(
         raise ControlError(f"filters must be a list of ChangePointFilters, got {filters!r:.60}")
     for i, f in enumerate(filters):
         check_instance(f, f"filters[{i}]", ChangePointFilter)
-    w = np.asarray(weights, dtype=float)
+    try:
+        w = np.asarray(weights, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ControlError(
+            f"weights must be one finite positive number per filter: {exc}"
+        ) from None
     if not filters or w.shape != (len(filters),) or not np.all(np.isfinite(w) & (w > 0)):
         raise ControlError(
             f"mixture_posterior needs one finite positive weight per filter: {len(filters)} "

@@ -8,12 +8,28 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from control.errors import ControlError
+from control.validation import is_real
 
 
 def _track_steps(track) -> tuple[np.ndarray, np.ndarray]:
     x = np.append(np.asarray(track.boundaries_m, dtype=float), float(track.length_m))
     gd = np.array([gd for _, gd in track.segments] + [track.segments[-1][1]], dtype=float)
     return x, gd
+
+
+def _runs(results) -> list:
+    """``results`` as a list of runs; ControlError for one run passed alone or a non-sequence."""
+    if hasattr(results, "position") or isinstance(results, str):
+        raise ControlError(
+            f"results must be a sequence of ClosedLoopResults, got one {type(results).__name__}: "
+            "for one run pass [result]"
+        )
+    try:
+        return list(results)
+    except TypeError:
+        raise ControlError(
+            f"results must be a sequence of ClosedLoopResults, got {results!r:.60}"
+        ) from None
 
 
 def _mark_track(ax, track, gd_max: float | None) -> None:
@@ -42,8 +58,11 @@ def plot_gd_trace(
         results: `ClosedLoopResult`s driven over `track` (or tracks with the same segments).
         track: the track whose prescribed GD is drawn as a black step line.
         gd_max: the Simplex's GD_max: the parts rougher than it are shaded (None: no shading).
-        level: the level of the BCR's interval (for the legend).
+        level: the level of the BCR's interval (for the legend), in (0, 1).
     """
+    results = _runs(results)
+    if not (is_real(level) and 0 < level < 1):
+        raise ControlError(f"level must lie in (0, 1) (e.g. 0.9 for 90%), got {level!r}")
     fig = Figure(figsize=(7.5, 4.6), layout="constrained")
     ax = fig.add_subplot()
     _mark_track(ax, track, gd_max)
@@ -79,6 +98,7 @@ def plot_speed(
 
     The start (the vehicle ramps up from rest within a few centimetres) is left out.
     """
+    results = _runs(results)
     fig = Figure(figsize=(7.5, 3.0), constrained_layout=True)
     ax = fig.add_subplot()
     _mark_track(ax, track, gd_max)
@@ -123,6 +143,12 @@ def plot_posterior_grid(
     Raises ControlError for draws that are empty or not finite, or a gd_range that is not two
     finite values lo < hi.
     """
+    try:
+        cells = list(cells)  # (read twice: a generator too)
+    except TypeError:
+        raise ControlError(
+            f"cells must be a sequence of (v, true GD, draws), got {cells!r:.60}"
+        ) from None
     values = _cell_values(cells)
     hist_range = _gd_range(values) if gd_range is None else _checked_gd_range(gd_range)
     speeds = sorted({c[0] for c in cells})
@@ -149,12 +175,21 @@ def _cell_values(cells: Sequence[tuple[float, float, np.ndarray]]) -> np.ndarray
     """Every cell's draws and true GD (1e-6 m^3) in one array, or ControlError naming the first
     cell whose draws are empty or not finite, or whose true GD is not a finite number."""
     values = []
-    for i, (_, gd, draws) in enumerate(cells):
-        arr = np.asarray(draws, dtype=float).ravel()
+    for i, cell in enumerate(cells):
         try:
-            true_gd = float(gd)
+            v, gd, draws = cell
         except (TypeError, ValueError):
-            true_gd = float("nan")
+            v = None
+        if not (is_real(v) and np.isfinite(v)):
+            raise ControlError(
+                f"cells[{i}] must be a (v, true GD, draws) triple with v a finite speed, m/s, "
+                f"got {cell!r:.80}"
+            )
+        try:
+            arr = np.asarray(draws, dtype=float).ravel()
+        except (TypeError, ValueError):
+            arr = np.full(1, np.nan)  # refused below
+        true_gd = float(gd) if is_real(gd) else float("nan")
         if arr.size == 0 or not np.all(np.isfinite(arr)) or not np.isfinite(true_gd):
             raise ControlError(
                 f"cells[{i}]: the draws must be a non-empty array of finite GD values and the "

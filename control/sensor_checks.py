@@ -16,7 +16,7 @@ from scipy.special import bdtrc
 from scipy.stats import chi2
 
 from control.errors import ControlError
-from control.validation import require_integers, require_reals
+from control.validation import is_integer, require_integers, require_reals
 from vehicle.models import GRAVITY
 
 MIN_SEGMENT = 32
@@ -188,10 +188,14 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
     that jumps within the block). ``steady=False``: the vehicle started or stopped within the
     block, whose level then changes with the speed: no level-jump check."""
     a = np.asarray(accel, dtype=float)
+    if a.ndim != 1:
+        raise ControlError(f"accel must be a 1-D block of accelerations, got shape {a.shape}")
     if a.size < 2:
         return ""
     peak = float(np.abs(a).max())
-    if peak > MAX_ACCEL_MPS2:  # before any check squares them (and overflows)
+    if not peak <= MAX_ACCEL_MPS2:  # before any check squares them (and overflows); NaN too
+        if np.isnan(peak):
+            return f"{int(np.isnan(a).sum())} sample(s) with non-finite accel"
         return f"out of range: |a| reaches {peak:.3g} m/s^2, beyond any accelerometer's range"
     run = longest_repeat(a)
     if run > limits.max_repeats:
@@ -328,7 +332,14 @@ def lattice_stretch(
     of that many hits; a signal rounded to a coarse step puts every value there. Values within
     5% of ``free_fall`` (a wheel in the air reads it) neither count nor make a step.
     """
+    _check_count(stretch, "stretch", 2)
     return _lattice_stretch(a, stretch, free_fall, _resolution(a))
+
+
+def _check_count(value, name: str, least: int) -> None:
+    """ControlError unless ``value`` is an integer >= ``least`` (samples)."""
+    if not (is_integer(value) and value >= least):
+        raise ControlError(f"{name} must be an integer >= {least} (samples), got {value!r}")
 
 
 def _resolution(a: np.ndarray) -> float | None:
@@ -397,6 +408,7 @@ def noise_floors(noise_floor: float) -> tuple[tuple[int, float], ...]:
 def quietest_stretch(a: np.ndarray, stretch: int = NOISE_STRETCH) -> tuple[float, int]:
     """(smallest variance about its own mean of any ``stretch`` consecutive samples of ``a``,
     its start); (inf, -1) if ``a`` is shorter than a stretch."""
+    _check_count(stretch, "stretch", 2)
     if a.size < stretch:
         return float("inf"), -1
     s1, s2, _ = _centred_sums(a)
@@ -430,6 +442,7 @@ def level_jump(a: np.ndarray, min_segment: int = MIN_SEGMENT) -> tuple[float, tu
     outside; each part's variance about its own mean, so that a part held near any constant (a
     gain that dropped) counts as no variance. (1, (0, 0)) for blocks shorter than
     2 * min_segment."""
+    _check_count(min_segment, "min_segment", 2)
     if a.size < 2 * min_segment:
         return 1.0, (0, 0)
     s1, s2, _ = _centred_sums(a)
@@ -573,6 +586,8 @@ def timing_fault(
         )
     span, expected = float(t[-1] - t[0]), (t.size - 1) / rate_hz
     if abs(span / expected - 1.0) > limits.rate_tolerance:
+        if not span > 0:  # (no rate to name)
+            return f"time stamps that do not advance: the block's {t.size} stamps span {span:.4g} s"
         return (
             f"samples at another rate: the block's {t.size} time stamps span {span:.4g} s "
             f"({(t.size - 1) / span:.4g} Hz), not the {expected:.4g} s of {rate_hz:g} Hz"

@@ -159,7 +159,10 @@ class Simplex:
         return (self.v_max - self.v_safe) / (self.gd_max - self.gd_min)
 
     def performance_speed(self, gd: float) -> float:
-        """The performance-mode law v(GD) for GD <= gd_max, m/s."""
+        """The performance-mode law v(GD) for GD <= gd_max, m/s. `ControlError` for a ``gd``
+        that is not a real number or is NaN (it has no speed)."""
+        if not (is_real(gd) and not np.isnan(gd)):
+            raise ControlError(f"gd must be a real number (1e-6 m^3), got {gd!r}")
         if self.law == "linear":
             return float(
                 np.clip(self.v_max - self.gain * (gd - self.gd_min), self.v_safe, self.v_max)
