@@ -92,7 +92,9 @@ class GridMarginal:
         a, h = self.nodes[k], np.diff(self.nodes)[k]
         f0, f1 = self.density[k], self.density[k + 1]
         t = np.clip(x - a, 0.0, h)
-        out = cum[k] + f0 * t + 0.5 * (f1 - f0) * t * t / h
+        # a whole cell adds its mass as the cumsum did (the ramp's formula can round 1 ulp off
+        # it): exact at every node, so exactly 1 from the last node with mass on
+        out = np.where(t < h, cum[k] + f0 * t + 0.5 * (f1 - f0) * t * t / h, cum[k + 1])
         return np.clip(out / cum[-1], 0.0, 1.0)
 
     def ppf(self, q: np.ndarray | float) -> np.ndarray:

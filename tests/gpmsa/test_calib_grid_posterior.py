@@ -285,3 +285,19 @@ def test_calib_a_ridge_narrower_than_the_grid_is_named_not_summarised_silently()
             warnings.simplefilter("error")
             post = Calibrator(emu).update(x[:n], y)
         assert min(post.info["conditional_sds"]) > 0.5
+
+
+def test_grid_cdf_is_exact_at_every_node_and_one_where_the_mass_ends():
+    """The cdf at a node is the cumulative cell mass itself, not the ramp's formula evaluated
+    at the cell's end (1 ulp off it, so that P(X > the support's end) read 1e-16)."""
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        nodes = np.sort(rng.uniform(0, 10, 40))
+        log_density = rng.normal(size=40)
+        log_density[rng.integers(20, 40) :] = -np.inf  # the mass ends at a node
+        g = GridMarginal.from_log_density(nodes, log_density)
+        mass = 0.5 * np.diff(nodes) * (g.density[:-1] + g.density[1:])
+        cum = np.concatenate([[0.0], np.cumsum(mass)])
+        np.testing.assert_array_equal(g.cdf(nodes), np.clip(cum / cum[-1], 0.0, 1.0))
+        last = nodes[np.flatnonzero(g.density > 0)[-1] + 1]  # the mass ends at this node
+        assert g.cdf(last) == 1.0 and g.cdf(nodes[-1]) == 1.0
