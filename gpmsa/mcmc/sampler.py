@@ -407,9 +407,12 @@ def _chain_task(
     problem: Problem, n_iter: int, tune: bool, widths: dict[str, np.ndarray],
     seed: np.random.SeedSequence, init: str, tune_rounds: int, tune_levels: int,
     ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
+    start: dict[str, np.ndarray] | None = None,
 ):  # fmt: skip
-    """One chain from plain data (run in a worker process): its start, then ``run_chain``."""
-    start = starts.draw_start(problem, init, starts.start_generator(seed))
+    """One chain from plain data (run in a worker process): its start (``start``, else drawn
+    under rule ``init`` from ``seed``), then ``run_chain``."""
+    if start is None:
+        start = starts.draw_start(problem, init, starts.start_generator(seed))
     with threadpool_limits(1):
         out = run_chain(
             problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
@@ -470,16 +473,18 @@ def sample(
     check_draws_memory(problem, int(n_iter), int(n_chains))
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     how = starts.check_init(init, int(n_chains))
-    if how == "gpmsa":  # here, not in a worker: a plain GPMSAError naming the prior
-        starts.check_start(problem, problem.init, how)
+    seq = np.random.SeedSequence(seed)
+    seeds = seq.spawn(int(n_chains))
+    # every chain's start drawn here, not in a worker: a start outside a prior's support (or a
+    # jitter range out of reach of its bounds) is a plain GPMSAError before any chain runs
+    firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seeds]
     n_ridge = check_ridge(ridge_moves, problem)
     widths = check_step_widths(step_widths, problem)
-    seq = np.random.SeedSequence(seed)
     tasks = [
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": widths, "seed": s,
          "init": how, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
-         "ridge_moves": n_ridge}
-        for s in seq.spawn(int(n_chains))
+         "ridge_moves": n_ridge, "start": first}
+        for s, first in zip(seeds, firsts, strict=True)
     ]  # fmt: skip
     names = problem.names
     shapes = {n: problem.init[n].shape for n in names}
