@@ -252,6 +252,14 @@ def _bag_files(folder: Path) -> tuple[list[Path], str, bool]:
         compression = str(info.get("compression_mode", "") or "").lower()
     except Exception:  # rosbags reads (and reports on) whatever this does not understand
         return [], "", False
+    seen: set[Path] = set()
+    for f in files:  # a file listed twice: each of its messages would be read twice
+        if f in seen:
+            raise BagError(
+                f"{folder / 'metadata.yaml'} is damaged: its relative_file_paths list the file "
+                f"{f.name!r} more than once"
+            )
+        seen.add(f)
     odd = [f for f in files if f.exists() and not f.is_file()]
     if odd:  # a FIFO would block the reader for ever
         raise BagError(f"{odd[0]}, a file of the bag {folder}, is not a regular file")

@@ -653,6 +653,22 @@ def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simple
         check_likelihood(emulator, likelihood)
 
 
+def _check_span(rec: Recording, base: str, imu_ns, odom_ns, t0: int) -> None:
+    """`BagError` naming the topic and the time when a time of either topic lies further from
+    t0 (the first IMU time, ns) than int64 holds (e.g. a receive time of -2**63 in a damaged
+    file): its difference from t0 would wrap around silently."""
+    limit = np.iinfo(np.int64).max
+    for topic_msgs, times in ((rec.imu, imu_ns), (rec.odometry, odom_ns)):
+        for value in (int(times.min()), int(times.max())):
+            if abs(value - t0) > limit:
+                what = "receive time" if base == "log" else "header stamp"
+                raise BagError(
+                    f"{rec.path} is damaged: the first IMU {what} is {t0} ns and the topic "
+                    f"{topic_msgs.topic!r} has one of {value} ns, {abs(value - t0) / 1e9:.4g} "
+                    "s apart: more than int64 ns hold (their difference would wrap around)"
+                )
+
+
 def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
     """The BCR's samples (t s from t0, accel, position, speed), the reports and t0 (ns)."""
     notes: list[str] = []
@@ -660,6 +676,7 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
     imu_ns, odom_ns = _times(rec.imu, base), _times(rec.odometry, base)
     accel = s.imu_sign * rec.imu.accel[:, "xyz".index(s.imu_axis)]
     t0 = int(imu_ns[0])
+    _check_span(rec, base, imu_ns, odom_ns, t0)
     t_imu = (imu_ns - t0) / 1e9
     t_odom = (odom_ns - t0) / 1e9
     odom_finite = np.all(np.isfinite(rec.odometry.position), axis=1) & np.all(
