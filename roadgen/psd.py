@@ -262,17 +262,19 @@ def _fit_bins(
     content: tuple[float, float] | None,
     n_points: int,
     dx: float,
-    method: str,
+    method: str | None,
 ) -> np.ndarray:
     """Mask of the PSD bins n (M,) cycles/m of a road of ``n_points`` heights on a step ``dx`` m
     that lie in ``band`` and, if known, in its ``content`` band (for "welch" 2 bins inside its
-    edges); raises RoadgenError if none does, naming the cause."""
+    edges); raises RoadgenError if none does, naming the cause (and ``method``, estimate_gd's;
+    None for a caller without one, psd_slope)."""
     lo, hi = band
+    how = "" if method is None else f" with method={method!r}"
     in_band = (n >= lo) & (n <= hi)
     if not np.any(in_band):
         raise RoadgenError(
             f"the road (length {n_points * dx:.6g} m) is too short for band=({lo:.6g}, {hi:.6g}) "
-            f"cycles/m with method={method!r}: its PSD has no bin there (spacing {n[0]:.6g} "
+            f"cycles/m{how}: its PSD has no bin there (spacing {n[0]:.6g} "
             "cycles/m)"
         )
     if content is None:
@@ -284,8 +286,9 @@ def _fit_bins(
         clear = f" less 2 Welch bins ({margin:.6g} cycles/m) at each edge" if margin else ""
         raise RoadgenError(
             f"band=({lo:.6g}, {hi:.6g}) cycles/m holds no PSD bin of the road inside its content "
-            f"band settings.band=({content[0]:.6g}, {content[1]:.6g}) cycles/m{clear}, with "
-            f"method={method!r}: the road has no content there; pass a band inside settings.band"
+            f"band settings.band=({content[0]:.6g}, {content[1]:.6g}) cycles/m{clear}"
+            f"{',' if how else ''}{how}: the road has no content there; pass a band inside "
+            "settings.band"
         )
     return keep
 
@@ -318,7 +321,7 @@ def psd_slope(road: HasHeights, band: tuple[float, float] | None = None) -> floa
     n, gd = _fit_psd(z, dx, "periodogram", z.size, end_match=True)
     in_band = (n >= lo) & (n <= hi)
     if np.count_nonzero(in_band) >= 2:
-        in_band &= _fit_bins(n, (lo, hi), _content_band(road, dx), z.size, dx, "fit")
+        in_band &= _fit_bins(n, (lo, hi), _content_band(road, dx), z.size, dx, None)
     keep = in_band & (gd > 0)
     if np.count_nonzero(keep) < 2:
         if np.count_nonzero((n >= lo) & (n <= hi)) < 2:
