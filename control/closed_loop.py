@@ -36,6 +36,17 @@ loop's BCR uses ``max_silence_s`` no longer than this many sample periods (a rea
 is what the BCR's own default of 0.5 s allows for)."""
 
 
+_GD_RTOL = 1e-6
+"""Relative tolerance of `LoopMetrics.rmse`'s match of a GD to the track's (float32 rounding is
+below 6e-8)."""
+
+
+def _exact(x: float) -> str:
+    """``x`` as %g where that reads back as ``x``, else all its digits (300.1000061)."""
+    short = f"{x:g}"
+    return short if float(short) == x else repr(float(x))
+
+
 @dataclass(frozen=True)
 class LoopMetrics:
     """Scores of one run.
@@ -72,15 +83,22 @@ class LoopMetrics:
 
     def rmse(self, gd: float) -> float:
         """RMSE of the estimates on the parts with prescribed GD `gd` (NaN where those parts
-        hold no estimate, e.g. shorter than the first block); ControlError for a `gd` that no
-        part of the track has, or that is not a number."""
+        hold no estimate, e.g. shorter than the first block); the GD matches to a relative
+        1e-6, so a GD that went through float32 (300.1 as 300.1000061) finds its parts.
+        ControlError for a `gd` that no part of the track has, or that is not a number."""
         if not is_real(gd):
             raise ControlError(f"gd must be a real number, got {gd!r} ({type(gd).__name__})")
-        for e in self.gd_errors:
-            if e.gd == gd:
-                return e.rmse
-        track_gds = ", ".join(f"{e.gd:g}" for e in self.gd_errors)
-        raise ControlError(f"no part of the track has prescribed GD {gd:g}; its GDs: {track_gds}")
+        gd = float(gd)
+        track = np.array([e.gd for e in self.gd_errors], dtype=float)
+        if track.size:
+            off = np.abs(track - gd)
+            i = int(np.argmin(off))  # the nearest, should two lie within the tolerance
+            if off[i] <= _GD_RTOL * abs(gd):
+                return self.gd_errors[i].rmse
+        track_gds = ", ".join(_exact(e.gd) for e in self.gd_errors)
+        raise ControlError(
+            f"no part of the track has prescribed GD {_exact(gd)}; its GDs: {track_gds}"
+        )
 
     def as_dict(self) -> dict:
         """JSON-able summary (`strict_json`: a value that is not finite, e.g. ``latched_at_s``
