@@ -113,6 +113,24 @@ def _too_compressible(file_size: int, compress_size: int) -> bool:
     return file_size > limits.MAX_RATIO * max(compress_size, 1) + 1024
 
 
+def _span_bytes(shape, itemsize: int) -> int:
+    """Bytes of an array of ``shape`` with its zero dimensions counted as 1: bounds the
+    dimensions of an empty array too (numpy cannot even describe ``(0, 2**70)``)."""
+    return math.prod(max(n, 1) for n in shape) * itemsize
+
+
+def _span_problem(name: str, shape, itemsize: int) -> str | None:
+    """Why an array of ``shape`` is refused for its dimensions (None: it is not): an empty
+    array whose other dimensions would exceed ``limits.MAX_ARRAY_BYTES``."""
+    span = _span_bytes(shape, itemsize)
+    if span <= limits.MAX_ARRAY_BYTES:
+        return None
+    return (
+        f"array {name!r} declares shape {_short(list(shape))}: with each 0 counted as 1 it spans "
+        f"{span} bytes, above gpmsa.limits.MAX_ARRAY_BYTES = {limits.MAX_ARRAY_BYTES}"
+    )
+
+
 def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
     """Apply the reader's limits to a record about to be written; returns the manifest's JSON.
 
@@ -128,6 +146,8 @@ def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
             )
         if arr.ndim > MAX_NDIM:
             raise GPMSAError(f"array {name!r} has {arr.ndim} dimensions (limit {MAX_NDIM})")
+        if not arr.size and (why := _span_problem(name, arr.shape, arr.itemsize)) is not None:
+            raise GPMSAError(why)  # a full array counts in the total below
     if len(arrays) + 1 > limits.MAX_MEMBERS:
         raise GPMSAError(
             f"{len(arrays)} arrays: a file holds at most gpmsa.limits.MAX_MEMBERS - 1 = "
@@ -210,8 +230,9 @@ def write_sealed(
     """Write a sealed record (``seal``'s JSON and the arrays) to ``path``.
 
     The zip is written to a new temporary file beside ``path``, checked as the reader checks a
-    zip's structure, flushed to disk and then moved over ``path`` in one step: a failure at any
-    point leaves an existing ``path`` untouched and no temporary file behind. ``stage``: an
+    zip's structure and size (above ``limits.MAX_FILE_BYTES``: GPMSAError), flushed to disk and
+    then moved over ``path`` in one step: a failure at any point leaves an existing ``path``
+    untouched and no temporary file behind. ``stage``: an
     ``atomic_group``'s stage, to defer the move to the end of that group (several files replaced
     together); None: moved at once. A member that deflates beyond ``limits.MAX_RATIO`` (e.g.
     zero padding) is stored uncompressed. An existing ``path`` that is not a regular file (a
@@ -223,8 +244,14 @@ def write_sealed(
             _write_member(zf, MANIFEST, raw_manifest)
             for name, arr in arrays.items():
                 _write_member(zf, ARRAY_DIR + name + ".npy", _npy_bytes(arr))
-        fh.seek(0, os.SEEK_END)  # the reader's structural checks, before the file is seen
-        _check_directory(fh, fh.tell(), path)
+        size = fh.seek(0, os.SEEK_END)  # the reader's structural checks, before it is seen
+        if size > limits.MAX_FILE_BYTES:
+            raise GPMSAError(
+                f"refusing to write {path}: the file would take {size} bytes, above "
+                f"gpmsa.limits.MAX_FILE_BYTES = {limits.MAX_FILE_BYTES} that readers accept; "
+                "keep fewer draws or outputs, or raise the limit (on every reader's machine too)"
+            )
+        _check_directory(fh, size, path)
         fh.seek(0)
         with zipfile.ZipFile(fh) as zf:
             _check_members(zf, path)
@@ -288,18 +315,17 @@ def _check_directory(fh, size: int, path) -> None:
         what = f"{extra} bytes follow" if extra > 0 else "a truncated comment ends"
         raise _fail(path, f"damaged zip: {what} the end record (appended to, or cut?)")
     entries, cd_size = struct.unpack("<xxxxxxxxxxHI", tail[at : at + 16])
-    if entries == 0xFFFF or cd_size == 0xFFFFFFFF:  # a zip64 record: read that one
-        loc = tail[at - 20 : at] if at >= 20 else b""
-        if len(loc) != 20 or loc[:4] != b"PK\x06\x07":
-            raise _fail(path, "damaged zip64 end record")
-        (offset,) = struct.unpack("<Q", loc[8:16])
-        if offset > size - 56:
-            raise _fail(path, "damaged zip64 end record")
-        fh.seek(offset)
-        rec = fh.read(56)
-        if rec[:4] != b"PK\x06\x06":
-            raise _fail(path, "damaged zip64 end record")
+    # zipfile takes the sizes of a zip64 record whenever its locator precedes the end record
+    # (whatever the classic fields say), reading the record just before the locator: check the
+    # values zipfile will use
+    end = size - tail_len + at  # where the end record starts
+    fh.seek(max(end - 76, 0))
+    before = fh.read(min(end, 76))
+    rec, loc = before[:-20], before[-20:]
+    if len(before) == 76 and loc[:4] == b"PK\x06\x07" and rec[:4] == b"PK\x06\x06":
         entries, cd_size = struct.unpack("<QQ", rec[32:48])
+    elif entries == 0xFFFF or cd_size == 0xFFFFFFFF:
+        raise _fail(path, "damaged zip64 end record")
     if entries > limits.MAX_MEMBERS:
         raise _fail(path, f"{entries} members (limit gpmsa.limits.MAX_MEMBERS = "
                           f"{limits.MAX_MEMBERS})")  # fmt: skip
@@ -483,6 +509,8 @@ def _check_specs(specs: dict, npy: dict[str, zipfile.ZipInfo], path) -> None:
                 f"array {name!r}: its member holds {npy[name].file_size} bytes, not a .npy of "
                 f"shape {shape} {dtype} ({nbytes} bytes of data)",
             )
+        if (why := _span_problem(name, shape, np.dtype(dtype).itemsize)) is not None:
+            raise _fail(path, why)  # an empty array (a full one's size was checked just now)
 
 
 def _load_array(raw: bytearray, name: str, spec: dict, path) -> np.ndarray:
@@ -514,6 +542,16 @@ def _load_array(raw: bytearray, name: str, spec: dict, path) -> np.ndarray:
     return np.ascontiguousarray(flat.reshape(shape, order="F" if fortran else "C"))
 
 
+def read_manifest(path: str | Path, formats: tuple[str, ...] = (FORMAT,)) -> dict:
+    """The manifest of the gpmsa file at ``path`` with ``read_raw``'s checks of the zip and the
+    envelope (``formats``: the format names accepted); no array is read, and the content is
+    neither hashed nor validated. Raises EmulatorFileError naming the problem."""
+    path = check_path(path)
+    with _opened(path) as (zf, members):
+        raw = bytes(_read_member(zf, members[MANIFEST], path))
+    return _parse_manifest(raw, path, formats)
+
+
 def stored_format(path: str | Path) -> str | None:
     """The format name (``FORMAT`` or ``STUDY_FORMAT``) of the gpmsa file at ``path``; None when
     there is none (no file, another kind of file, or one too damaged to tell). Reads the
@@ -522,9 +560,7 @@ def stored_format(path: str | Path) -> str | None:
     try:
         if not path.exists():
             return None
-        with _opened(path) as (zf, members):
-            raw = bytes(_read_member(zf, members[MANIFEST], path))
-        return _parse_manifest(raw, path, (FORMAT, STUDY_FORMAT))["format"]
+        return read_manifest(path, (FORMAT, STUDY_FORMAT))["format"]
     except Exception:  # any damage (or a name the OS refuses): not a gpmsa file to tell apart
         return None
 

@@ -23,6 +23,7 @@ from gpmsa.io.container import (
     STUDY_FORMAT,
     check_path,
     jsonable,
+    read_manifest,
     read_raw,
     refuse_to_replace,
     seal,
@@ -62,6 +63,31 @@ def _check_study_name(path: Path, labels) -> None:
             f"characters with these labels (it names the model files beside it, e.g. "
             f"{member!r}); choose another name"
         )
+
+
+def _refuse_other_studies(path: Path, files: list[str]) -> None:
+    """GPMSAError if another study file beside ``path`` with the same stem (``run`` or
+    ``run.bak`` beside ``run.gpmsa``) lists one of the model files ``files`` that saving to
+    ``path`` writes: replaced, that study would no longer load (its sha256 differing)."""
+    try:
+        names = [e.name for e in os.scandir(path.parent) if e.name != path.name]
+    except OSError:  # no folder, or not listable: writing there says why
+        return
+    for name in sorted(n for n in names if Path(n).stem == path.stem):
+        other = path.with_name(name)
+        try:
+            manifest = read_manifest(other, (STUDY_FORMAT,))
+            check_study_manifest(manifest)
+        except (GPMSAError, OSError):  # not a readable study: no model files of its own
+            continue
+        theirs = {mod["file"] for mod in manifest["study"]["models"]}
+        shared = [f for f in files if f in theirs]
+        if shared:
+            raise GPMSAError(
+                f"refusing to write {path}: its model file {shared[0]} belongs to the study "
+                f"{other} beside it, which would no longer load; choose another name, or remove "
+                "that study first"
+            )
 
 
 def _through_link(path: Path) -> Path:
@@ -191,18 +217,20 @@ class Study:
         (``gpmsa.io.atomic.atomic_group``), so a save that fails leaves an existing study at
         ``path`` as it was (only an OS failure during the final moves could mix the two). A study
         is not written over an emulator file, nor a model file over a study file (GPMSAError):
-        such a file belongs to another study, which would no longer load. Nor is any file written
-        over a non-empty file that is not a gpmsa file (a user's CSV or notes). ``path``'s name
-        names the model files, so it may use only ASCII letters, digits, '_', '-' and '.', not
-        start with '.', and its stem be at most 150 - len(longest label) characters (GPMSAError
-        up front otherwise). A symbolic link ``path`` is written through: the study file and
-        its model files go beside the link's target, named after it (as ``load_study`` reads
-        them).
+        such a file belongs to another study, which would no longer load; nor are the model
+        files of another study beside ``path`` with the same stem (``run`` or ``run.bak`` beside
+        ``run.gpmsa``) replaced. Nor is any file written over a non-empty file that is not a
+        gpmsa file (a user's CSV or notes). ``path``'s name names the model files, so it may
+        use only ASCII letters, digits, '_', '-' and '.', not start with '.', and its stem be at
+        most 150 - len(longest label) characters (GPMSAError up front otherwise). A symbolic
+        link ``path`` is written through: the study file and its model files go beside the
+        link's target, named after it (as ``load_study`` reads them).
         """
         given = check_path(path)
         path = _through_link(given)
         _check_study_name(path, self.labels)
         refuse_to_replace(path, STUDY_FORMAT)
+        _refuse_other_studies(path, [f"{path.stem}.{lab}.gpmsa" for lab in self.labels])
         files, hashes, sealed = [], [], []
         for lab, emu in zip(self.labels, self.members, strict=True):
             file = f"{path.stem}.{lab}.gpmsa"
