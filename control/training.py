@@ -100,10 +100,10 @@ def feature_statistics(features: np.ndarray, batch: int = 8) -> BlockStatistics:
     """
     batch = _check_batch(batch)
     feats = float_array(features, "features")
-    if feats.ndim != 3 or feats.shape[0] == 0 or feats.shape[1] < 2 * batch:
+    if feats.ndim != 3 or feats.shape[0] == 0 or feats.shape[1] < 2 * batch or not feats.shape[2]:
         raise ControlError(
             f"features must be (runs, blocks, K) with >= {2 * batch} blocks per run (two batches "
-            f"of {batch}), got shape {feats.shape}"
+            f"of {batch}) and K >= 1, got shape {feats.shape}"
         )
     if not np.all(np.isfinite(feats)):
         raise ControlError("features hold non-finite values")

@@ -58,9 +58,11 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
     """``"50:300,50:500,50:300"`` -> ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0)): length in m, GD.
 
     Raises ValueError naming the segment that is not ``LENGTH:GD`` with two finite positive
-    numbers, GD at most `GD_MAX`.
+    numbers, GD at most `GD_MAX`, and naming two GDs that differ but print alike (``f"{gd:g}"``,
+    six digits: the tables and metrics.json key each part by it, so one would hide the other).
     """
     segments = []
+    labels: dict[str, float] = {}
     for part in text.split(","):
         fields = part.strip().split(":")
         try:
@@ -71,6 +73,12 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
             raise ValueError(f"segment {part.strip()!r}: length and GD must be finite and > 0")
         if gd > GD_MAX:
             raise ValueError(f"segment {part.strip()!r}: GD must be at most {GD_MAX:g}")
+        if labels.setdefault(f"{gd:g}", gd) != gd:
+            raise ValueError(
+                f"segment {part.strip()!r}: GD {gd!r} differs from GD {labels[f'{gd:g}']!r} but "
+                f"both print as {gd:g} (the tables and metrics.json key each part by its GD to "
+                "six digits): give both parts one GD, or GDs that differ within six digits"
+            )
         segments.append((length, gd))
     return tuple(segments)
 

@@ -446,7 +446,8 @@ def main(argv: list[str] | None = None) -> None:
     )  # fmt: skip
     parser.add_argument(
         "--n-pc", type=int, default=BAND_PCS,
-        help="principal components of the band emulators (1 to the number of bands)",
+        help="principal components of the band emulators (1 to the feature's outputs: its "
+        f"{len(BAND_FEATURE.bands_hz) - 1} band powers and one per --quantiles level)",
     )  # fmt: skip
     args = parser.parse_args(argv)
     args.cases, args.features = list(dict.fromkeys(args.cases)), list(dict.fromkeys(args.features))
