@@ -19,7 +19,8 @@ class RoadInput:
     Args:
         road: object with ``z`` (N,) heights in m on a uniform grid of spacing ``dx_m`` from 0.
         wheel_radius_m: if given, the road is first enveloped by a rigid wheel of this radius
-            (``roadgen.wheel_envelope``): what the tyre's contact point follows.
+            (``roadgen.wheel_envelope``): what the tyre's contact point follows. VehicleError
+            for a road shorter than the radius.
     """
 
     def __init__(self, road, wheel_radius_m: float | None = None) -> None:
@@ -28,6 +29,12 @@ class RoadInput:
                 raise VehicleError(
                     f"road={type(road).__name__} cannot be enveloped: need a roadgen Profile or "
                     "Track (or envelope=False)"
+                )
+            if wheel_radius_m > road.length_m:  # roadgen's error would name its own radius_m
+                raise VehicleError(
+                    f"road length {road.length_m:.6g} m is shorter than the wheel radius "
+                    f"wheel_radius_m={wheel_radius_m!r} m: it cannot be enveloped (use a longer "
+                    "road, or envelope=False)"
                 )
             road = roadgen.wheel_envelope(road, wheel_radius_m)
         z, dx = roadgen_checks.heights("road", road, VehicleError, min_points=3)
