@@ -102,8 +102,16 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
                 raise _fail(f"arrays/{name}", f"shape {list(shapes[name])}: needs {n} draws first")
             if name[4:] in ("theta", "theta_native"):
                 want[name] = (n, q)
-        elif name.startswith("param_") and name[6:] not in pshape:
-            raise _fail(f"arrays/{name}", f"unknown emulator parameter (have {EMULATOR_PARAMS})")
+        elif name.startswith("param_"):
+            if name[6:] not in pshape:
+                raise _fail(
+                    f"arrays/{name}", f"unknown emulator parameter (have {EMULATOR_PARAMS})"
+                )
+        elif name not in REQUIRED and name != "index":
+            raise _fail(  # a save would drop it: not a file this library wrote
+                f"arrays/{name}",
+                "unknown array (an emulator file holds only the arrays of docs/emulator-file.md)",
+            )
     _check_complete(shapes, n)
     for name, shape in want.items():
         if tuple(shapes[name]) != tuple(shape):

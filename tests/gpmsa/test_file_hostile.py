@@ -245,6 +245,9 @@ def test_edited_content_many_more_examples(saved, tmp_path, data, which, n_edits
         ("scalar", lambda m, a: m["model"].update(m=10**9), "model.m"),
         ("scalar", lambda m, a: a.update(draw_lamWs=-a["draw_lamWs"]), "arrays/draw_lamWs"),
         ("scalar", lambda m, a: a.update(draw_foo=a["draw_lamWs"]), "arrays/draw_foo"),
+        # an array no emulator holds: it loaded, and the next save dropped it
+        ("scalar", lambda m, a: a.update(zz=a["y_mean"]), "arrays/zz: unknown array"),
+        ("vector", lambda m, a: a.update(obs_y=a["grid"]), "arrays/obs_y: unknown array"),
     ],
 )
 def test_issue_examples_of_edited_files_name_the_field(saved, tmp_path, which, edit, field):
