@@ -4,6 +4,7 @@ jointly): several models whose calibration parameters are shared or hierarchical
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Sequence
 from datetime import datetime, timezone
 
@@ -11,7 +12,7 @@ import numpy as np
 
 from gpmsa._version import library_versions
 from gpmsa.calibration.calibrate import calibration_problem
-from gpmsa.calibration.observations import check_emulator
+from gpmsa.calibration.observations import check_emulator, reduce
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.fitting.fit import check_keep, check_point, point_estimate, thinning
@@ -24,7 +25,7 @@ from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
 from gpmsa.studies.sampler import StudyChains, sample_study
-from gpmsa.studies.study import Study, layout_of
+from gpmsa.studies.study import OBS_DIGESTS, Study, layout_of
 
 
 def _sequence(value, what: str) -> list:
@@ -158,6 +159,11 @@ def calibrate_study(
         progress=progress, n_jobs=n_jobs, executor=executor,
     )  # fmt: skip
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the problems above already warned
+        settings[OBS_DIGESTS] = {lab: reduce(e, x, y, extrapolate).values_sha256
+                                 for lab, e, x, y in zip(labels, emulators, x_obs, y_obs,
+                                                         strict=True)}  # fmt: skip
     study = Study("calibration", emulators, layout, hyper,
                   _study_draws(chains, slice(int(n_burn), None)), settings, metadata)  # fmt: skip
     if study.convergence is not None:

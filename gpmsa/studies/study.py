@@ -39,6 +39,11 @@ from gpmsa.studies.record import (
     check_study_manifest,
 )
 
+OBS_DIGESTS = "obs_values_sha256_by_model"
+"""The settings key of a calibrated study's record of each model's observations: label ->
+``ObsData.values_digest()`` of its x_obs and y_obs (``member_posterior``'s info
+"obs_values_sha256", as ``gpmsa.calibrate`` records it)."""
+
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
     """The study layout of fitted emulators (their t names, t ranges and theta priors)."""
@@ -170,7 +175,9 @@ class Study:
         """One model's calibration as a ``gpmsa.Posterior`` named as its emulator's t_names and
         "lamOs" (native units), and for a study fitted with a discrepancy its "betaV" (one
         input; "betaV[k]" for several) and "lamVz", e.g. for ``gpmsa.full_prediction``'s
-        ``posterior=`` or ``gpmsa.predictive.calibrated_predict``."""
+        ``posterior=`` or ``gpmsa.predictive.calibrated_predict``. Its info carries the record of
+        the model's observations (a fitted model's "obs_sha256", a calibrated one's
+        "obs_values_sha256"), so that ``full_prediction(posterior=)`` refuses other ones."""
         i = self._member(model)
         chains = self.posterior.chains
         out = {}
@@ -178,11 +185,17 @@ class Study:
             out[name] = chains[self.layout.elements[self.layout.index[i][k]].name]
         out["lamOs"] = chains[f"lamOs[{self.labels[i]}]"]
         out.update(_discrepancy_chains(self.members[i], out["lamOs"].shape))
-        return Posterior(
-            {k: v.reshape(-1) for k, v in out.items()},
-            chains=out,
-            info={"method": f"study {self.kind}", "model": self.labels[i]},
-        )
+        info = {"method": f"study {self.kind}", "model": self.labels[i]}
+        # the record of the model's observations, so that full_prediction(posterior=) refuses
+        # other ones: a fitted model's (as calibration_posterior), a calibrated one's (as
+        # gpmsa.calibrate; absent from study files written before it was kept)
+        settings = self.members[i].settings if self.kind == "fit" else {}
+        info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256") if k in settings})
+        digests = self.settings.get(OBS_DIGESTS)
+        digest = digests.get(self.labels[i]) if isinstance(digests, dict) else None
+        if isinstance(digest, str):
+            info["obs_values_sha256"] = digest
+        return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out, info=info)
 
     def to_record(self, files: list[str], hashes: list[str]) -> tuple[dict, dict]:
         """The study file's (manifest, arrays), its models' files and sha256 given."""

@@ -124,3 +124,22 @@ def test_plot_counts_and_flags_are_checked():
     ):
         with pytest.raises(GPMSAError, match="n_draws must be an integer >= 1"):
             call()
+
+
+def test_a_study_models_posterior_refuses_other_observations(tmp_path):
+    """``full_prediction(posterior=study.member_posterior(i))`` conditions on ``obs``: another
+    model's observations were taken silently (the member posterior lacked the record that
+    ``calibration_posterior`` and ``gpmsa.calibrate`` posteriors carry)."""
+    study, obs_a, obs_b = _study()
+    post = study.member_posterior(0)
+    assert post.info["obs_sha256"] == obs_a.digest()
+    with pytest.raises(GPMSAError, match="obs holds other observations .* than the joint fit's"):
+        gpmsa.full_prediction(study.members[0], obs_b, [[0.5]], posterior=post,
+                              discrepancy="linear", n_draws=5, seed=0)  # fmt: skip
+    study.save(tmp_path / "two.gpmsa")
+    loaded = gpmsa.load_study(tmp_path / "two.gpmsa")
+    post = loaded.member_posterior(0)
+    with pytest.raises(GPMSAError, match="obs holds other observations"):
+        gpmsa.full_prediction(
+            loaded.members[0], obs_b, [[0.5]], posterior=post, discrepancy="linear"
+        )

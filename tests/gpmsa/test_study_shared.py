@@ -210,3 +210,26 @@ def test_the_point_estimate_helper_clips_a_constant_mean():
     assert all(np.array_equal(v, [0.1]) for v in params.values())
     draws["lamUz"] = np.array([[1.0], [2.0], [3.0]])
     assert point_estimate(draws, np.array([0.0, 5.0, 1.0]), "map")["lamUz"] == [2.0]
+
+
+def test_a_calibrated_models_posterior_refuses_other_observations(tmp_path):
+    """calibrate_study records each model's observations as gpmsa.calibrate does (info
+    "obs_values_sha256" of ``member_posterior``), so that ``full_prediction(posterior=)``
+    refuses another model's (before: taken silently), also after saving and loading."""
+    emu = emulator(None)
+    rng = np.random.default_rng(7)
+    (x1, y1), (x2, y2) = observations(0.3, 3, 0.05, rng), observations(0.7, 3, 0.05, rng)
+    study = gpmsa.calibrate_study([emu, emu], [x1, x2], [y1, y2], shared=["t"],
+                                  n_samples=200, n_burn=50, seed=2, tune=False)  # fmt: skip
+    own, other = gpmsa.ObsData(x=x1, y=y1), gpmsa.ObsData(x=x2, y=y2)
+    one = gpmsa.calibrate(emu, x1, y1, n_samples=100, n_burn=10, seed=0)
+    post = study.member_posterior(0)
+    assert post.info["obs_values_sha256"] == one.info["obs_values_sha256"]
+    gpmsa.full_prediction(emu, own, [[0.5]], posterior=post, discrepancy=None, n_draws=3)
+    with pytest.raises(gpmsa.GPMSAError, match="obs holds other observations"):
+        gpmsa.full_prediction(emu, other, [[0.5]], posterior=post, discrepancy=None)
+    study.save(tmp_path / "s.gpmsa")
+    loaded = gpmsa.load_study(tmp_path / "s.gpmsa").member_posterior(1)
+    assert loaded.info["obs_values_sha256"] == other.values_digest()
+    with pytest.raises(gpmsa.GPMSAError, match="obs holds other observations"):
+        gpmsa.full_prediction(emu, own, [[0.5]], posterior=loaded, discrepancy=None)
