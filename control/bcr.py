@@ -408,6 +408,7 @@ class BCR:
             self._clock = float(now)  # the latest: one wild value is forgotten at the next call
         if n == 0:
             return self._check_silence(self._check_age(self.last))
+        updates = self._n_updates
         t, position, accel, speed = arrays
         every = self.settings.samples_per_update
         start = 0
@@ -423,7 +424,8 @@ class BCR:
                 fault = graver_fault(fault, self.last)
                 self._received = 0
                 self._n_updates += 1
-        return self._check_silence(self._check_age(fault or self.last))
+        est = self._check_age(fault or self.last)
+        return self._check_silence(est, fresh=self._n_updates > updates)
 
     # --- internals -------------------------------------------------------------------------------
 
@@ -470,9 +472,11 @@ class BCR:
             return t, self._pos_last
         return float(self.last.time), float(self.last.position)
 
-    def _check_silence(self, est: Estimate) -> Estimate:
+    def _check_silence(self, est: Estimate, fresh: bool = False) -> Estimate:
         """'sensor_fault' when the caller's clock is more than max_silence_s past the newest
-        sample (or, before any sample, past the first call)."""
+        sample (or, before any sample, past the first call); a sensor fault that this call's
+        samples gave (``fresh``: e.g. readings that arrived but were NaN, which leave no
+        newest sample) is named before the silence."""
         if not np.isfinite(self._clock):
             return est
         last = self._t_last if np.isfinite(self._t_last) else self._clock_start
@@ -480,11 +484,10 @@ class BCR:
         if silence <= self.settings.max_silence_s:
             return est
         t_now, pos_now = self._now()
-        return Estimate(
-            t_now, pos_now, "sensor_fault",
-            f"no samples for {silence:.2f} s (max_silence_s = {self.settings.max_silence_s:g})",
-            data_time=est.data_time,
-        )  # fmt: skip
+        reason = f"no samples for {silence:.2f} s (max_silence_s = {self.settings.max_silence_s:g})"
+        if fresh and est.status == "sensor_fault" and est.reason:
+            reason = f"{est.reason}; {reason}"
+        return Estimate(t_now, pos_now, "sensor_fault", reason, data_time=est.data_time)
 
     def _block_distance(self, phase: _Phase) -> float:
         """Metres since the end of the last block ``phase`` saw (0 before any), with the

@@ -36,7 +36,7 @@ string reason            # why there is no estimate (on an ok one: a note, or ""
 string domain_edge       # upper, lower: the data favour that edge of the emulator's GD domain
                          # (the road may lie beyond it); "" for none
 float64 position         # m along the path (odometry)
-float64 speed            # m/s, mean measured speed over the block
+float64 speed            # m/s, the measured (odometry) speed at the header stamp
 float64 gd_mean          # posterior mean of GD
 float64 gd_sd            # posterior standard deviation of GD
 float64 gd_lo            # credible interval of GD (the BCR's interval_kind), lower end

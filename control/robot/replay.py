@@ -41,7 +41,7 @@ from tqdm.auto import tqdm
 
 import gpmsa
 from control.bcr import BCR, BCRSettings
-from control.compat import bcr_settings_for, check_emulator, check_likelihood
+from control.compat import bcr_settings_for, check_emulator, check_feature, check_likelihood
 from control.errors import BagError, ControlError
 from control.estimate import Estimate, edge_counts
 from control.robot import condition
@@ -58,7 +58,7 @@ from control.robot.bags import (
 )
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
-from control.validation import path_argument, require_instance, require_reals
+from control.validation import check_instance, path_argument, require_instance, require_reals
 from gpmsa.io.atomic import atomic_write
 
 TIME_BASES = ("header", "log")
@@ -637,12 +637,17 @@ def replay_recording(
 
 
 def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simplex: Simplex) -> None:
-    """`ControlError` for settings that do not fit the BCR's rate (a high-pass cut-off at or
-    above its Nyquist frequency), `EmulatorMismatchError` for a likelihood prepared for
-    another emulator or a Simplex whose speeds lie outside the emulator's speed domain."""
+    """`ControlError` for BCR settings that are not `BCRSettings` or settings that do not fit
+    the BCR's rate (a high-pass cut-off at or above its Nyquist frequency),
+    `EmulatorMismatchError` for a BCR feature other than the one the emulator records, a
+    likelihood prepared for another emulator or a Simplex whose speeds lie outside the
+    emulator's speed domain: all before the recording is read."""
     if not isinstance(simplex, Simplex):
         raise ControlError(f"simplex must be a control.Simplex, got {type(simplex).__name__}")
+    check_instance(bcr, "bcr", BCRSettings)
     check_emulator(emulator, simplex=simplex)
+    if "feature" in (getattr(emulator, "metadata", None) or {}):
+        check_feature(emulator, bcr)  # as the BCR would, once the recording was read
     nyquist = bcr.rate_hz / 2
     if s.gravity == "highpass" and s.highpass_hz >= nyquist:
         raise ControlError(
