@@ -568,8 +568,10 @@ def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
 def _draw_lamos(
     margs: list[LamOsMarginal], node: np.ndarray, rng: np.random.Generator
 ) -> np.ndarray:
-    """lamOs draws from its conditional at the given theta nodes (log-grid cell jitter); with
-    several emulator parameter sets, each draw's set is chosen by its likelihood at the node."""
+    """lamOs draws from its conditional at the given theta nodes (log-grid cell jitter: within
+    half a step of the node, inwards only at the end nodes, whose trapezoid cells are half ones,
+    so that no draw lies beyond a bound of the lamOs prior that ends the grid); with several
+    emulator parameter sets, each draw's set is chosen by its likelihood at the node."""
     k = np.zeros(node.size, dtype=int)
     if len(margs) > 1:
         ll = np.stack([m.loglik[node] for m in margs], axis=1)  # (n, J)
@@ -583,5 +585,8 @@ def _draw_lamos(
         cum = np.cumsum(np.exp(margs[j].log_cond(node[sel])), axis=1)
         u = rng.random(int(sel.sum())) * cum[:, -1]
         idx = np.minimum((cum < u[:, None]).sum(axis=1), s.size - 1)
-        out[sel] = np.exp(s[idx] + (rng.random(idx.size) - 0.5) * (s[1] - s[0]))
+        jitter = (rng.random(idx.size) - 0.5) * (s[1] - s[0])
+        jitter = np.where(idx == 0, np.abs(jitter), jitter)
+        jitter = np.where(idx == s.size - 1, -np.abs(jitter), jitter)
+        out[sel] = np.exp(s[idx] + jitter)
     return out

@@ -329,12 +329,16 @@ def warn_if_outside(fit: Fit, stacklevel: int = 3) -> None:
 def lamos_start(fit: Fit, prior: LamOsPrior) -> float:
     """A start of lamOs for the samplers: GPM/SA's max(20, a/b), lowered to 1/excess_var when
     the observation needs a larger observation error than that (else an additive random walk
-    started there never reaches the posterior, decades below, and theta sticks at a bound)."""
+    started there never reaches the posterior, decades below, and theta sticks at a bound),
+    and kept inside the prior's bounds (the middle of (lower, upper) where it would reach the
+    upper bound: a chain started outside has no posterior mass)."""
     start = max(20.0, prior.shape / prior.rate)
     if fit.excess_var > 0.0:
         start = min(start, 1.0 / fit.excess_var)
     if prior.lower > 0.0:
         start = max(start, 1.01 * prior.lower)
+    if start >= prior.upper:
+        start = 0.5 * (prior.lower + prior.upper)
     return start
 
 
