@@ -1,5 +1,5 @@
-"""Figures users look at: MCMC traces, theta pairs, the PC basis, emulator fit, prediction bands,
-sensitivity bars.
+"""Figures users look at: MCMC traces, theta pairs, the PC basis, rho box plots, emulator fit,
+prediction bands, sensitivity bars.
 
 Each function returns a ``matplotlib.figure.Figure`` (matplotlib is imported only when one runs;
 nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a notebook.
@@ -8,12 +8,14 @@ nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a 
 from gpmsa.plots.emulator import emulator_fit, pc_basis
 from gpmsa.plots.mcmc import theta_pairs, traces
 from gpmsa.plots.prediction import prediction_bands
+from gpmsa.plots.rho import rho_boxplots
 from gpmsa.plots.sensitivity import sensitivity_bars
 
 __all__ = [
     "emulator_fit",
     "pc_basis",
     "prediction_bands",
+    "rho_boxplots",
     "sensitivity_bars",
     "theta_pairs",
     "traces",

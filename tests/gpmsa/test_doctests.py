@@ -16,6 +16,7 @@ MODULES = [
     "gpmsa.plots.mcmc",
     "gpmsa.plots.emulator",
     "gpmsa.plots.prediction",
+    "gpmsa.plots.rho",
     "gpmsa.plots.sensitivity",
     "gpmsa.model.categorical",
     "gpmsa.model.mean_basis",
