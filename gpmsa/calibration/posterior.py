@@ -84,6 +84,11 @@ class GridMarginal:
         d = self.nodes - self.mean()
         return float(np.sqrt((self.weights * self.density) @ (d * d)))
 
+    def __repr__(self) -> str:
+        k = np.size(self.nodes)
+        span = f" on [{self.nodes[0]:.4g}, {self.nodes[-1]:.4g}]" if k else ""
+        return f"GridMarginal({k} nodes{span}, mean={self.mean():.4g}, sd={self.sd():.3g})"
+
     def cdf(self, value: np.ndarray | float) -> np.ndarray:
         """P(X <= value) under the piecewise-linear density."""
         x = np.asarray(value, dtype=float)

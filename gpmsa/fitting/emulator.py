@@ -80,6 +80,19 @@ class LooResult:
     rmse: np.ndarray
     coverage95: float
 
+    def __repr__(self) -> str:
+        m, l_sim = np.shape(self.mean)[:2] if np.ndim(self.mean) == 2 else (0, 0)
+        return (f"LooResult({m} runs x {l_sim} outputs, rmse={span_text(self.rmse)}, "
+                f"coverage95={self.coverage95:.3g})")  # fmt: skip
+
+
+def span_text(values) -> str:
+    """For a result's repr: one value as ``0.0123``, several as their range ``[0.0101, 0.0302]``."""
+    values = np.ravel(values)
+    if values.size == 1:
+        return f"{values[0]:.3g}"
+    return f"[{np.min(values):.3g}, {np.max(values):.3g}]"
+
 
 def _param_shapes(p: int, q: int, p_u: int) -> dict[str, tuple[int, ...]]:
     return {"betaU": (p + q, p_u), "lamUz": (p_u,), "lamWs": (p_u,), "lamWOs": (1,)}

@@ -101,6 +101,12 @@ class Chains:
         """Raise ChainError naming every chain whose draws or log posterior are not finite."""
         require_finite(self.draws, self.log_post)
 
+    def __repr__(self) -> str:
+        names, shown = list(self.draws), 6
+        more = f", +{len(names) - shown} more" if len(names) > shown else ""
+        return (f"Chains({self.n_chains} chains x {self.n_draws} draws, "
+                f"params={names[:shown]}{more})")  # fmt: skip
+
 
 def require_finite(draws: dict[str, np.ndarray], log_post: np.ndarray | None = None) -> None:
     """Raise ChainError naming every chain (and its first bad draw) with a NaN or inf in

@@ -123,6 +123,13 @@ def gpmsa_model_only(emulator, what: str) -> None:
         )
 
 
+def draws_text(draw_index) -> str:
+    """For a result's repr: "point estimate" for ``param_sets``'s index [-1], else "S draws"."""
+    if list(np.ravel(draw_index)) == [-1]:
+        return "point estimate"
+    return f"{np.size(draw_index)} draws"
+
+
 def param_sets(emulator, draws: bool, n_draws: int | None, what: str):
     """(indices, list of parameter dicts) the prediction averages over.
 

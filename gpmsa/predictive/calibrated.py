@@ -83,6 +83,11 @@ class CalibratedPrediction:
         level = check_level(level)
         return self.quantile((1.0 - level) / 2.0), self.quantile((1.0 + level) / 2.0)
 
+    def __repr__(self) -> str:
+        n, l_sim = np.shape(self.mean)[:2] if np.ndim(self.mean) == 2 else (0, 0)
+        return (f"CalibratedPrediction({n} points x {l_sim} outputs, "
+                f"{np.size(self.weights)} mixture components)")  # fmt: skip
+
 
 def calibrated_predict(
     emulator,

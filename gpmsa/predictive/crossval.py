@@ -26,10 +26,10 @@ from scipy.special import ndtr
 
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
-from gpmsa.fitting.emulator import output_variance
+from gpmsa.fitting.emulator import output_variance, span_text
 from gpmsa.limits import check_memory
 from gpmsa.model.data import check_flag, check_level
-from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, rng_of
+from gpmsa.predictive._common import draws_text, factors, gpmsa_model_only, param_sets, rng_of
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,6 +70,14 @@ class CrossValidation:
         """Share of held-out values inside their central predictive interval of ``level``."""
         level = check_level(level)
         return float(np.mean(np.abs(self.pit - 0.5) <= level / 2))
+
+    def __repr__(self) -> str:
+        m, l_sim = np.shape(self.y)[:2] if np.ndim(self.y) == 2 else (0, 0)
+        n_folds = np.unique(self.folds).size
+        folds = "leave-one-out" if n_folds == m else f"{n_folds} folds"
+        draws, rmse = draws_text(self.draw_index), span_text(self.rmse)
+        return (f"CrossValidation({m} runs x {l_sim} outputs, {folds}, {draws}, rmse={rmse}, "
+                f"coverage(0.9)={self.coverage(0.9):.3g})")  # fmt: skip
 
 
 def _fold_labels(folds, m: int, seed) -> np.ndarray:

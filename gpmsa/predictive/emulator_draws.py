@@ -23,6 +23,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.data import check_count, check_flag, check_level, check_same_rows
 from gpmsa.predictive._common import (
+    draws_text,
     factors,
     gpmsa_model_only,
     mvn_factor,
@@ -97,6 +98,13 @@ class EmulatorPrediction:
         (a warning when there are too few for its tails: `realization_interval`)."""
         level = check_level(level)
         return realization_interval(self.y, level, "emulator_prediction's n_draws or n_rlz")
+
+    def __repr__(self) -> str:
+        s = np.shape(self.mu_w)[0]
+        rlz = np.shape(self.w)[0] // s if s else 0
+        return (f"EmulatorPrediction({np.shape(self.x)[0]} points x {np.size(self.grid)} "
+                f"outputs, {draws_text(self.draw_index)} x {rlz} realizations, "
+                f"resid={self.resid})")  # fmt: skip
 
 
 def emulator_prediction(

@@ -150,6 +150,13 @@ class FullPrediction:
         fix = "full_prediction's n_draws or n_rlz"
         return realization_interval(getattr(self, what), level, fix)
 
+    def __repr__(self) -> str:
+        s = np.shape(self.theta)[0]
+        rlz = np.shape(self.eta)[0] // s if s else 0
+        return (f"FullPrediction({np.shape(self.x)[0]} points x {np.size(self.grid)} outputs, "
+                f"{s} draws x {rlz} realizations, p_u={np.shape(self.K)[1]}, "
+                f"p_v={self.p_v})")  # fmt: skip
+
 
 def _posterior_sets(emulator, posterior, n_draws):
     """Indices and per-draw parameter dicts (unit theta) from a joint fit or a Posterior."""

@@ -39,7 +39,7 @@ from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.data import as_real, check_flag, check_level
-from gpmsa.predictive._common import factors, gpmsa_model_only, param_sets, unit_inputs
+from gpmsa.predictive._common import draws_text, factors, gpmsa_model_only, param_sets, unit_inputs
 
 _SQRT_PI_2 = 0.5 * np.sqrt(np.pi)
 ZERO_VARIANCE = 1e-12
@@ -96,6 +96,14 @@ class Sensitivity:
                             f"{kind}_lo": float(lo), f"{kind}_hi": float(hi)})  # fmt: skip
             out[name] = row
         return out
+
+    def __repr__(self) -> str:
+        d, shown = len(self.names), 4
+        total = np.mean(self.total_aggregated, axis=0) if d else ()
+        effects = ", ".join(f"{n}={v:.2f}" for n, v in zip(self.names[:shown], total, strict=False))
+        more = f", +{d - shown} more" if d > shown else ""
+        return (f"Sensitivity({d} inputs, {len(self.fixed)} fixed, {np.size(self.grid)} outputs, "
+                f"{draws_text(self.draw_index)}, total effect: {effects}{more})")  # fmt: skip
 
 
 def _mean_gauss(gamma: float, c: np.ndarray, a: float, b: float) -> np.ndarray:

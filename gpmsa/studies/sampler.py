@@ -56,6 +56,12 @@ class StudyChains:
     names: tuple[str, ...]
     info: dict
 
+    def __repr__(self) -> str:
+        c, n = np.shape(self.log_post)[:2] if np.ndim(self.log_post) == 2 else (0, 0)
+        g, h = np.shape(self.theta)[-1], np.shape(self.mu)[-1]
+        return (f"StudyChains({c} chains x {n} draws, {g} study elements, {h} groups, "
+                f"{len(self.members)} models)")  # fmt: skip
+
 
 class StudyState:
     """The current state of one study chain: the models' ``ChainState``s (theta held), the study
