@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import json
 import warnings
-from dataclasses import replace
 
 import numpy as np
 
 import vehicle
-from control.bcr import BCRSettings, emulator_domain
+from control.bcr import BCRSettings, emulator_domain, with_overrides
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
@@ -271,4 +270,4 @@ def bcr_settings_for(emulator, **overrides) -> BCRSettings:
     sensor = overrides.pop("sensor", None)
     if sensor is None:
         sensor = SensorLimits(noise_sd_mps2=emulator_noise_std(emulator))
-    return replace(BCRSettings(feature=feature, method=method, sensor=sensor), **overrides)
+    return with_overrides(BCRSettings(feature=feature, method=method, sensor=sensor), overrides)
