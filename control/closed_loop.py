@@ -102,10 +102,12 @@ class LoopMetrics:
 
     def as_dict(self) -> dict:
         """JSON-able summary (`strict_json`: a value that is not finite, e.g. ``latched_at_s``
-        of a run that never latched or the RMSE of a part without estimates, is None)."""
+        of a run that never latched or the RMSE of a part without estimates, is None). The
+        parts are keyed by their GD as ``%g`` ("300"), or all its digits where ``%g`` would
+        not read back as it (two GDs that differ never share a key)."""
         summary = {
-            "rmse": {f"{e.gd:g}": e.rmse for e in self.gd_errors},
-            "n_estimates": {f"{e.gd:g}": e.n for e in self.gd_errors},
+            "rmse": {_exact(e.gd): e.rmse for e in self.gd_errors},  # (keys that differ)
+            "n_estimates": {_exact(e.gd): e.n for e in self.gd_errors},
             "detection_delay_m": list(self.detection_delay_m),
             "fast_on_rough_m": self.fast_on_rough_m,
             "traversal_time_s": self.traversal_time_s,

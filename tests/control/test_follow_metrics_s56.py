@@ -31,3 +31,12 @@ def test_a_gd_off_by_more_than_the_tolerance_is_refused_with_its_digits():
         m.rmse(300.11)
     m = _metrics([300.0, 500.0])
     assert m.rmse(np.float32(300.0)) == m.gd_errors[0].rmse
+
+
+def test_as_dict_keeps_two_gds_that_print_alike_apart():
+    """Keyed by %g, a part of GD 300.0000001 overwrote the part of GD 300 (one rmse, one count)."""
+    m = _metrics([300.0, 300.0000001])
+    summary = m.as_dict()
+    assert list(summary["rmse"]) == ["300", "300.0000001"]
+    assert summary["n_estimates"] == {"300": 1, "300.0000001": 1}
+    assert list(_metrics([300.0, 500.0]).as_dict()["rmse"]) == ["300", "500"]  # as before
