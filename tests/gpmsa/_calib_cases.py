@@ -82,6 +82,6 @@ def with_draws(emu: Emulator, n: int = 5, seed: int = 3) -> Emulator:
         w=emu.w, index=emu.index, params=emu.params, priors=emu.priors,
         names={"x": emu.x_names, "t": emu.t_names, "y": emu.y_names},
         units={"x": emu.x_units, "t": emu.t_units, "y": emu.y_units},
-        draws=draws, log_post=np.zeros(n),
+        draws=draws, log_post=np.zeros(n), levels=emu.levels, mean_basis=emu.mean_basis,
     )  # fmt: skip
     return out

@@ -60,9 +60,7 @@ def _small_emulator(**sim_kw) -> gpmsa.Emulator:
     sim = gpmsa.SimData(x=x, t=t, y=y, t_names=["u", "v"], **sim_kw)
     params = {"betaU": np.ones((sim.p + 2, 1)), "lamUz": [1.0], "lamWs": [1e4], "lamWOs": [1e4]}
     emu = gpmsa.Emulator.from_params(sim, params)
-    out = with_draws(emu, n=6)
-    out.levels = emu.levels  # with_draws keeps no categorical levels
-    return out
+    return with_draws(emu, n=6)
 
 
 def test_no_known_inputs_shows_the_calibration_inputs_only():
