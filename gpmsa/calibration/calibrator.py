@@ -5,8 +5,11 @@ with the emulator parameters fixed, the observation's reduced data u given the s
 is Gaussian at every theta (``gpmsa.calibration.model``), lamOs is integrated out per theta node by
 quadrature, and the posterior is the prior times that likelihood on the grid, refined around each
 mode (separated region of mass) that the grid does not resolve. Between nodes the posterior
-density is linear (bilinear for two parameters): its moments, quantiles and draws all use that
-density (``gpmsa.calibration.grid``: interpolation, constraint boundaries, draws, refinement).
+density is linear (bilinear for two parameters): its quantiles, CDF and draws use that density,
+its moments the trapezoid sums over the nodes (``GridMarginal``; the two differ by about h^2 / 6
+in variance, h the node spacing, so the draws' sd can exceed ``sd()`` by a fraction of a percent
+on a grid that resolves the posterior) (``gpmsa.calibration.grid``: interpolation, constraint
+boundaries, draws, refinement).
 More parameters use the MCMC of ``gpmsa.calibrate``.
 
 The fixed grid (``Calibrator.theta_grid``): ``n_grid`` equally spaced nodes per calibration
