@@ -142,7 +142,9 @@ def block_scatter(
     for node, c in zip(nodes, cov, strict=True):
         if not np.all(np.linalg.eigvalsh(c) > 1e-12 * max(float(np.trace(c)), 1e-300)):
             raise ControlError(
-                f"the runs' block covariance at {node:g} m/s is singular: a feature (or a "
+                f"the runs' block covariance at {node:g} m/s is singular: the runs near that "
+                f"speed hold too few blocks to estimate the {c.shape[0]} x {c.shape[0]} "
+                "covariance of the features (more runs or longer drives), or a feature (or a "
                 "combination of them) does not vary from block to block"
             )
     return BlockScatter(nodes, cov, _fit_dof(speed, stats_, nodes, cov))

@@ -111,8 +111,10 @@ def test_the_training_helpers_name_their_bad_arguments():
     flat = control.training.BlockStatistics(
         mean=stats_.mean, cov=np.zeros_like(stats_.cov), features=stats_.features
     )
-    with pytest.raises(ControlError, match="block covariance at 0.5 m/s is singular"):
+    with pytest.raises(ControlError, match="block covariance at 0.5 m/s is singular") as err:
         block_scatter(speed, flat)
+    k = stats_.cov.shape[1]  # a likely cause named too: too few runs or blocks for its size
+    assert f"too few blocks to estimate the {k} x {k} covariance" in str(err.value)
 
 
 def test_a_feature_spec_stores_python_numbers():
