@@ -4,9 +4,7 @@ For one or two calibration parameters the posterior is computed exactly on a gri
 with the emulator parameters fixed, the observation's reduced data u given the simulation weights w
 is Gaussian at every theta (``gpmsa.calibration.model``), lamOs is integrated out per theta node by
 quadrature, and the posterior is the prior times that likelihood on the grid, refined around each
-mode (separated region of mass) that the grid does not resolve (heavy tails first cut to all but
-``grid.TAIL_MASS`` of the mass; a warning where a peak still spans fewer than
-``grid.UNRESOLVED_SD`` node spacings per sd). Between nodes the posterior
+mode (separated region of mass) that the grid does not resolve. Between nodes the posterior
 density is linear (bilinear for two parameters): its quantiles, CDF and draws use that density,
 its moments the trapezoid sums over the nodes (``GridMarginal``; the two differ by about h^2 / 6
 in variance, h the node spacing, so the draws' sd can exceed ``sd()`` by a fraction of a percent
@@ -30,7 +28,6 @@ from scipy.special import ndtr
 from gpmsa import backends
 from gpmsa.calibration.grid import (
     RIDGE_SD,
-    UNRESOLVED_SD,
     ConstraintCut,
     check_log_density,
     check_mass,
@@ -42,7 +39,6 @@ from gpmsa.calibration.grid import (
     mesh,
     nearest,
     refined_axes,
-    resolution,
     trimmed_marginal,
     with_edges,
 )
@@ -341,12 +337,7 @@ class Calibrator:
                 counter of its updates, an update that raises not counted).
 
         Returns:
-            Posterior; for the grid method its summaries of theta are exact (grid),
-            ``info["discarded_mass"]`` the fraction of the mass that refinement cut off with
-            the tails (``grid.TAIL_MASS``; 0.0 mostly), ``info["resolution"]`` None where
-            every mode is resolved (its sd spans at least ``grid.RESOLVE_SD`` node spacings),
-            else, where refinement had to stop short, per parameter the fewest node spacings
-            a peak's sd spans (under ``grid.UNRESOLVED_SD``: a warning), and
+            Posterior; for the grid method its summaries of theta are exact (grid) and
             ``info["log_evidence"]`` holds log p(u_obs) under the emulator's (normalised) theta
             prior times the given prior (as given, unnormalised), for one parameter.
         """
@@ -370,13 +361,10 @@ class Calibrator:
                 keep = self._axes if not callable(prior) and np.isneginf(user).any() else None
             logp = constrained(free, ok)
             check_mass(logp)
-            discarded = 0.0  # the tails' mass that refinement cut off (grid.TAIL_MASS)
-            resolved = False
             for _ in range(MAX_REFINE):
-                finer, dropped, resolved = refined_axes(axes, logp, keep)
+                finer = refined_axes(axes, logp, keep)
                 if finer is None:
                     break
-                discarded += dropped
                 axes, theta = finer, mesh(finer)
                 margs = self._marginals(data, theta)
                 free = self._combine(margs) + self._theta_prior_at(theta, prior)
@@ -386,11 +374,6 @@ class Calibrator:
         key = check_seed(seed) if seed is not None else (self._entropy, count)
         post = self._posterior(axes, free, ok, margs, key)
         post.info["outside_sds"] = outside
-        post.info["discarded_mass"] = discarded
-        post.info["resolution"] = None  # every mode resolved (RESOLVE_SD spacings or more)
-        if not resolved:  # refinement had to stop short: measure what it left
-            post.info["resolution"] = res = resolution(axes, logp)
-            _warn_if_unresolved(res, tuple(self.emulator.t_names), self.n_grid)
         if self.q == 2:
             post.info["conditional_sds"] = sds = conditional_sds(axes, logp)
             _warn_if_ridge(sds, tuple(self.emulator.t_names), self.n_grid)
@@ -532,21 +515,6 @@ class Calibrator:
             "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
         return Posterior(grids=grids, draw=draw, info=info)
-
-
-def _warn_if_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> None:
-    """Warn when refinement has left a peak of a marginal narrower than the grid resolves: its sd
-    spans fewer than UNRESOLVED_SD node spacings (`gpmsa.calibration.grid.resolution`)."""
-    k = int(np.argmin(res))
-    if res[k] < UNRESOLVED_SD:
-        warnings.warn(
-            f"the grid does not resolve the posterior of {names[k]}: its sd spans {res[k]:.2g} "
-            f"node spacings (fewer than {UNRESOLVED_SD:g}) where refinement had to stop, so its "
-            f"quantiles, cdf and draws may be off by several per cent of an sd; use "
-            f"method='mcmc', a narrower domain (the emulator's training range of {names[k]}) "
-            f"or another n_grid (now {n_grid})",
-            stacklevel=3,
-        )
 
 
 def _warn_if_ridge(sds: tuple[float, float], names: tuple, n_grid: int) -> None:

@@ -3,8 +3,7 @@ interpolation between nodes (linear, bilinear; in the log between finite values,
 next to a zero), a constraint's boundary inserted into a one-parameter grid and resolved on
 split cells of a two-parameter one, marginals cut to their support, draws from the bilinear
 density (those a constraint rejects redrawn), and the refinement of each peak the grid does
-not resolve (heavy tails cut first, TAIL_MASS; what stays unresolved measured, `resolution`).
-``gpmsa.calibration.calibrator`` composes them; all work on unit-scale or native
+not resolve. ``gpmsa.calibration.calibrator`` composes them; all work on unit-scale or native
 axes given by the caller.
 """
 
@@ -44,26 +43,6 @@ MAX_REFINED = 4
 N_REFINE_2D squared); refinement stops before a grid would hold more."""
 REFINE_FACTORS = (2.0, 1.5, 1.25)
 """A refined region has at least this many times the cells it had (the first that fits)."""
-TAIL_MASS = 1e-5
-"""When no refinement factor fits (heavy tails: the nodes above MASS_CUTOFF span the whole axis,
-so refining them all would exceed MAX_REFINED), each unresolved parameter's axis is cut to the
-nodes holding all but at most this fraction of its marginal mass (half each side, trapezoid
-masses on the present grid) and refined there; the mass beyond is dropped and
-``Posterior.info["discarded_mass"]`` sums what the cuts dropped (each pass may cut). Measured on
-`two_param_emulator` with 5 observations (tails at 1e-7.5 of the peak over the whole domain):
-1e-9 and 1e-7 cut nothing or too little (the quantiles stay 0.1-0.19 sd off), 1e-6 leaves the
-peak at 1.5-1.7 node spacings per sd (0.05-0.06 sd); 1e-5 resolves it (quantiles within 0.015
-sd, cdf 0.003, mean 5e-5 sd) for 2.7e-5 of the mass dropped, which makes the sd 0.2 % small (1e-4:
-quantiles 0.005 sd, sd 0.55 % small)."""
-UNRESOLVED_SD = 2.0
-"""A peak of a marginal (holding at least UNRESOLVED_MASS) whose sd spans fewer than this many
-node spacings once refinement has ended is not resolved: a warning. On the cases tried (two
-parameters, few observations, `two_param_emulator`) the quantiles erred by about 0.15 / r**2 sd
-at r node spacings per sd (0.19 sd at r = 0.91, 0.10 at 1.2, 0.049 at 1.75, 0.025 at 2.3): at
-r = 2 about 0.04 sd, with the cdf 0.007 off."""
-UNRESOLVED_MASS = 1e-3
-"""Peaks holding less than this fraction of the mass do not trigger the warning of
-UNRESOLVED_SD (their errors are below it in any probability)."""
 SAME_NODE = 0.01
 """A refined node this close to a grid line it must keep (in node spacings) gives way to it."""
 N_SUB = 4
@@ -318,19 +297,20 @@ def _one_resolved_peak(axis: np.ndarray, density: np.ndarray) -> bool:
     return bool(density @ (axis - mean) ** 2 / total >= (RESOLVE_SD * np.diff(axis).max()) ** 2)
 
 
-def _peaks(axis: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, ...]:
+def _modes(axis: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The modes of a (marginal) density (k,) on the increasing ``axis`` (k,): the runs of nodes
-    above MASS_CUTOFF of the peak, as (first (r,), last (r,)), and the peaks in them (each run
-    cut at its `_valleys`): (mass, sd, node spacing) (P, 3) (`_mode_stats`) and the run of each
-    (P,)."""
+    above MASS_CUTOFF of the peak, as (first (r,), last (r,), unresolved (r,)). A run is
+    unresolved when a peak in it (the run cut at its `_valleys`) holds at least MODE_MASS of the
+    mass and its sd spans fewer than RESOLVE_SD of its node spacings. Nodes are equally spaced
+    within a run (a refined region)."""
     live = np.flatnonzero(density >= MASS_CUTOFF * density.max())
     slope = np.diff(density)
     dips = np.flatnonzero((slope[:-1] < 0.0) & (slope[1:] > 0.0)) + 1  # local minima
     if live[-1] - live[0] + 1 == live.size:
         first, last = live[:1], live[-1:]
         if dips.size == 0:  # one peak, the usual case
-            peak = _mode_stats(axis, density, live[0], live[-1])
-            return first, last, np.array([peak]), np.zeros(1, dtype=int)
+            _, sd, spacing = _mode_stats(axis, density, live[0], live[-1])
+            return first, last, np.array([sd < RESOLVE_SD * spacing])
     else:
         cut = np.flatnonzero(np.diff(live) > 1)
         first = live[np.concatenate(([0], cut + 1))]
@@ -340,19 +320,10 @@ def _peaks(axis: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, ...]:
         bounds = [i0, *_valleys(density, dips, i0, i1), i1]
         peaks += [_mode_stats(axis, density, b0, b1) for b0, b1 in itertools.pairwise(bounds)]
         owner += [r] * (len(bounds) - 1)
-    return first, last, np.array(peaks), np.asarray(owner)
-
-
-def _modes(axis: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The modes of a (marginal) density (k,) on the increasing ``axis`` (k,) (`_peaks`), as
-    (first (r,), last (r,), unresolved (r,)). A run is unresolved when a peak in it holds at
-    least MODE_MASS of the mass and its sd spans fewer than RESOLVE_SD of its node spacings.
-    Nodes are equally spaced within a run (a refined region)."""
-    first, last, peaks, owner = _peaks(axis, density)
-    mass, sd, spacing = peaks.T
+    mass, sd, spacing = np.array(peaks).T
     narrow = (mass >= MODE_MASS * mass.sum()) & (sd < RESOLVE_SD * spacing)
     unresolved = np.zeros(first.size, dtype=bool)
-    unresolved[owner[narrow]] = True
+    unresolved[np.asarray(owner)[narrow]] = True
     return first, last, unresolved
 
 
@@ -428,67 +399,25 @@ def conditional_sds(axes: list, logp: np.ndarray) -> tuple[float, float]:
     return out[0], out[1]
 
 
-def _marginals(axes: list, logp: np.ndarray) -> list:
-    """Per parameter, the posterior's marginal density (unnormalised) at the nodes of its axis
-    (one parameter: the density itself)."""
-    f = np.exp(logp - np.max(logp))
-    if len(axes) == 1:
-        return [f]
-    f = f.reshape(axes[0].size, axes[1].size)
-    w = [trapezoid_weights(a) for a in axes]
-    return [f @ w[1], w[0] @ f]
-
-
-def _tail_cut(axis: np.ndarray, density: np.ndarray) -> tuple[slice, float]:
-    """The nodes of ``axis`` (k,) holding all but at most TAIL_MASS of the mass of the
-    piecewise-linear ``density`` (k,) (at most half of it beyond each end), and the fraction of
-    the mass beyond them."""
-    cells = 0.5 * np.diff(axis) * (density[:-1] + density[1:])
-    below = np.concatenate(([0.0], np.cumsum(cells)))  # mass before each node
-    total = below[-1]
-    above = np.concatenate((np.cumsum(cells[::-1])[::-1], [0.0]))  # mass after each node
-    i0 = int(np.flatnonzero(below <= 0.5 * TAIL_MASS * total)[-1])
-    i1 = int(np.flatnonzero(above <= 0.5 * TAIL_MASS * total)[0])
-    return slice(i0, i1 + 1), float((below[i0] + above[i1]) / total)
-
-
-def refined_axes(
-    axes: list, logp: np.ndarray, keep: list | None
-) -> tuple[list | None, float, bool]:
+def refined_axes(axes: list, logp: np.ndarray, keep: list | None) -> list | None:
     """The unit-scale axes of a finer grid where a mode of the posterior (log density ``logp``
     (G,) on the grid of ``axes``) is not resolved along some parameter (`_modes` of its
-    marginal), None when all are (or when even its tails cut (TAIL_MASS) it would hold more than
-    MAX_REFINED); ``keep``: grid lines per parameter that a refined region keeps (None: none).
-    Also the fraction of the posterior's mass that the finer grid leaves out by cutting the
-    tails (0.0 without a cut), and whether every mode is resolved (None for the axes then; with
-    RESOLVE_SD > UNRESOLVED_SD and MODE_MASS < UNRESOLVED_MASS no peak then needs `resolution`'s
-    warning)."""
-    if len(axes) == 1 and _one_resolved_peak(axes[0], np.exp(logp - np.max(logp))):
-        return None, 0.0, True
-    marginals = _marginals(axes, logp)  # one parameter: no trapezoid weights (equally spaced)
+    marginal), None when all are; ``keep``: grid lines per parameter that a refined region
+    keeps (None: none)."""
+    f = np.exp(logp - np.max(logp))
+    if len(axes) == 1:
+        if _one_resolved_peak(axes[0], f):
+            return None
+        marginals = [f]  # no trapezoid weights: equally spaced within a mode
+    else:
+        f = f.reshape(axes[0].size, axes[1].size)
+        w = [trapezoid_weights(a) for a in axes]
+        marginals = [f @ w[1], w[0] @ f]
     modes = [_modes(a, m) for a, m in zip(axes, marginals, strict=True)]
     if not any(m[2].any() for m in modes):
-        return None, 0.0, True
+        return None
     n = N_REFINE if len(axes) == 1 else N_REFINE_2D
-    finer = _fitting_axes(axes, modes, n, keep)
-    if finer is not None:
-        return finer, 0.0, False
-    # heavy tails: refine each unresolved parameter over the nodes holding its mass
-    cut_axes, cut_modes, dropped = [], [], 0.0
-    for a, m, md in zip(axes, marginals, modes, strict=True):
-        if md[2].any():
-            kept, out = _tail_cut(a, m)
-            a, m, dropped = a[kept], m[kept], dropped + out
-            md = _modes(a, m)
-        cut_axes.append(a), cut_modes.append(md)
-    finer = _fitting_axes(cut_axes, cut_modes, n, keep)
-    return finer, (0.0 if finer is None else dropped), False
-
-
-def _fitting_axes(axes: list, modes: list, n: int, keep: list | None) -> list | None:
-    """`_finer_axis` of each axis with the largest of REFINE_FACTORS that keeps the grid within
-    MAX_REFINED times the nodes of one refined mode; None when none does."""
-    for factor in REFINE_FACTORS:
+    for factor in REFINE_FACTORS:  # the largest that keeps the grid within MAX_REFINED
         finer = [
             _finer_axis(a, m, n, None if keep is None else keep[k], factor)
             for k, (a, m) in enumerate(zip(axes, modes, strict=True))
@@ -496,15 +425,3 @@ def _fitting_axes(axes: list, modes: list, n: int, keep: list | None) -> list | 
         if np.prod([a.size for a in finer]) <= MAX_REFINED * n ** len(axes):
             return finer
     return None
-
-
-def resolution(axes: list, logp: np.ndarray) -> tuple[float, ...]:
-    """Per parameter, the fewest node spacings that the sd of a peak of its marginal (one holding
-    at least UNRESOLVED_MASS of the mass; `_peaks`) spans on the grid of ``axes`` (inf: none)."""
-    out = []
-    for a, m in zip(axes, _marginals(axes, logp), strict=True):
-        peaks = _peaks(a, m)[2]
-        mass, sd, spacing = peaks.T
-        big = mass >= UNRESOLVED_MASS * mass.sum()
-        out.append(float(np.min(sd[big] / spacing[big], initial=np.inf)))
-    return tuple(out)
