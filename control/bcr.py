@@ -37,7 +37,7 @@ estimate is carried on (its reason says so) until it turns stale.
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -52,6 +52,7 @@ from control.validation import (
     check_not_masked,
     is_integer,
     is_real,
+    replace_fields,
     require_instance,
     require_reals,
     within,
@@ -194,25 +195,6 @@ class BCRSettings:
         return self.feature.rate_hz
 
 
-def with_overrides(settings: BCRSettings, overrides: dict) -> BCRSettings:
-    """``settings`` with ``overrides`` replacing its fields; `ControlError` naming an override
-    that is no `BCRSettings` field (one of a nested settings class named with the way to set
-    it, e.g. ``changepoint=ChangePointSettings(mean_segment_m=...)``)."""
-    names = [f.name for f in fields(BCRSettings)]
-    for key in overrides:
-        if key in names:
-            continue
-        hint = ""
-        for name in names:
-            inner = type(getattr(settings, name))
-            if hasattr(inner, "__dataclass_fields__") and key in inner.__dataclass_fields__:
-                hint += f"; a field of {inner.__name__}: pass {name}={inner.__name__}({key}=...)"
-        raise ControlError(
-            f"{key!r} is no BCRSettings field{hint} (its fields: {', '.join(names)})"
-        )
-    return replace(settings, **overrides)
-
-
 def _check_window_tracker(tracker: TrackerSettings) -> None:
     """ControlError for a tracker setting that method "window" would ignore: it starts every
     window from the prior (``mean_segment_m = 0``), so it has no memory to set."""
@@ -348,7 +330,7 @@ class BCR:
             s = bcr_settings_for(emulator, **overrides)
         else:
             check_instance(settings, "settings", BCRSettings)
-            s = with_overrides(settings, overrides)
+            s = replace_fields(settings, overrides)
         check_feature(emulator, s)
         if s.method == "changepoint":
             return cls(ObservationModel(emulator), s)

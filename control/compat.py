@@ -14,12 +14,12 @@ import warnings
 import numpy as np
 
 import vehicle
-from control.bcr import BCRSettings, emulator_domain, with_overrides
+from control.bcr import BCRSettings, emulator_domain
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
-from control.validation import check_instance, is_real, within
+from control.validation import check_instance, is_real, replace_fields, within
 
 
 def _canon(obj) -> str:
@@ -270,4 +270,4 @@ def bcr_settings_for(emulator, **overrides) -> BCRSettings:
     sensor = overrides.pop("sensor", None)
     if sensor is None:
         sensor = SensorLimits(noise_sd_mps2=emulator_noise_std(emulator))
-    return with_overrides(BCRSettings(feature=feature, method=method, sensor=sensor), overrides)
+    return replace_fields(BCRSettings(feature=feature, method=method, sensor=sensor), overrides)

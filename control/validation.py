@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import os
+from dataclasses import fields, is_dataclass, replace
 from numbers import Integral, Real
 from pathlib import Path
 
@@ -113,3 +114,24 @@ def check_instance(value, name: str, cls: type) -> None:
         raise ControlError(
             f"{name} must be a {package}.{cls.__name__}, got {value!r} ({type(value).__name__})"
         )
+
+
+def replace_fields(settings, overrides: dict):
+    """``settings`` (a settings dataclass) with ``overrides`` replacing its fields; `ControlError`
+    naming the overrides that are no field of it, and for one that is a field of a nested
+    settings field, how to set it (e.g. ``changepoint=ChangePointSettings(mean_segment_m=...)``)."""
+    names = [f.name for f in fields(settings)]
+    unknown = [key for key in overrides if key not in names]
+    if unknown:
+        nested = [(name, type(getattr(settings, name))) for name in names]
+        hint = "".join(
+            f"; {key!r} is a field of {cls.__name__}: pass {name}={cls.__name__}({key}=...)"
+            for key in unknown
+            for name, cls in nested
+            if is_dataclass(cls) and key in {f.name for f in fields(cls)}
+        )
+        raise ControlError(
+            f"{', '.join(map(repr, unknown))}: no {type(settings).__name__} field{hint} (its "
+            f"fields: {', '.join(names)})"
+        )
+    return replace(settings, **overrides)

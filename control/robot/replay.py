@@ -33,7 +33,7 @@ import csv
 import os
 import shutil
 import time
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -58,7 +58,13 @@ from control.robot.bags import (
 )
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
-from control.validation import check_instance, path_argument, require_instance, require_reals
+from control.validation import (
+    check_instance,
+    path_argument,
+    replace_fields,
+    require_instance,
+    require_reals,
+)
 from gpmsa.io.atomic import atomic_write
 
 TIME_BASES = ("header", "log")
@@ -376,14 +382,7 @@ def _settings(settings: ReplaySettings | None, overrides: dict) -> ReplaySetting
     s = ReplaySettings() if settings is None else settings
     if not isinstance(s, ReplaySettings):
         raise ControlError(f"settings must be a ReplaySettings, got {type(s).__name__}")
-    names = [f.name for f in fields(ReplaySettings)]
-    unknown = [name for name in overrides if name not in names]
-    if unknown:
-        raise ControlError(
-            f"{', '.join(map(repr, unknown))}: no ReplaySettings field (its fields: "
-            f"{', '.join(names)})"
-        )
-    return replace(s, **overrides)
+    return replace_fields(s, overrides)
 
 
 def _time_base(rec: Recording, time_base: str) -> tuple[str, str]:

@@ -15,7 +15,7 @@ def emu():
 @pytest.mark.parametrize(
     ("key", "hint"),
     [
-        ("bogus", r"'bogus' is no BCRSettings field \(its fields: feature, method"),
+        ("bogus", r"'bogus': no BCRSettings field \(its fields: feature, method"),
         ("mean_segment_m", r"pass changepoint=ChangePointSettings\(mean_segment_m=\.\.\.\)"),
         ("noise_sd_mps2", r"pass sensor=SensorLimits\(noise_sd_mps2=\.\.\.\)"),
     ],
