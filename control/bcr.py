@@ -282,15 +282,13 @@ class BCR:
     """
 
     def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
-        from control.compat import check_feature
+        from control.compat import check_recorded_feature
 
         settings = BCRSettings() if settings is None else settings
         check_instance(settings, "settings", BCRSettings)
-        self.settings = s = replace(settings, **overrides)
+        self.settings = s = replace_fields(settings, overrides)
         self.model = model
-        emulator = getattr(model, "emulator", None)
-        if "feature" in (getattr(emulator, "metadata", None) or {}):
-            check_feature(emulator, s)  # an emulator that records its feature must match
+        check_recorded_feature(getattr(model, "emulator", None), s)
         if s.method == "changepoint":
             if not hasattr(model, "loglik"):
                 raise ControlError(

@@ -84,6 +84,13 @@ def check_feature(emulator, bcr: BCRSettings) -> None:
         raise EmulatorMismatchError(f"the BCR's feature differs from the emulator's ({pairs})")
 
 
+def check_recorded_feature(emulator, bcr: BCRSettings) -> None:
+    """`check_feature` where the emulator records its feature (metadata ``feature``); an
+    emulator without that record (or a model without an emulator) is taken as it is."""
+    if "feature" in (getattr(emulator, "metadata", None) or {}):
+        check_feature(emulator, bcr)
+
+
 def check_emulator(
     emulator,
     *,

@@ -41,7 +41,12 @@ from tqdm.auto import tqdm
 
 import gpmsa
 from control.bcr import BCR, BCRSettings
-from control.compat import bcr_settings_for, check_emulator, check_feature, check_likelihood
+from control.compat import (
+    bcr_settings_for,
+    check_emulator,
+    check_likelihood,
+    check_recorded_feature,
+)
 from control.errors import BagError, ControlError
 from control.estimate import Estimate, edge_counts
 from control.robot import condition
@@ -645,8 +650,7 @@ def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simple
         raise ControlError(f"simplex must be a control.Simplex, got {type(simplex).__name__}")
     check_instance(bcr, "bcr", BCRSettings)
     check_emulator(emulator, simplex=simplex)
-    if "feature" in (getattr(emulator, "metadata", None) or {}):
-        check_feature(emulator, bcr)  # as the BCR would, once the recording was read
+    check_recorded_feature(emulator, bcr)  # as the BCR would, once the recording was read
     nyquist = bcr.rate_hz / 2
     if s.gravity == "highpass" and s.highpass_hz >= nyquist:
         raise ControlError(

@@ -25,6 +25,9 @@ def test_an_override_that_is_no_field_is_named(emu, key, hint):
         control.bcr_settings_for(emu, **{key: 1.0})
     with pytest.raises(ControlError, match=hint):
         control.BCR.from_emulator(emu, control.bcr_settings_for(emu), **{key: 1.0})
+    model = control.BCR.from_emulator(emu).model
+    with pytest.raises(ControlError, match=hint):
+        control.BCR(model, control.bcr_settings_for(emu), **{key: 1.0})
 
 
 def test_a_field_override_still_applies(emu):
