@@ -411,21 +411,17 @@ def run_chain(
 
 def _chain_task(
     problem: Problem, n_iter: int, tune: bool, widths: dict[str, np.ndarray],
-    seed: np.random.SeedSequence, init: str, tune_rounds: int, tune_levels: int,
-    ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
-    start: dict[str, np.ndarray] | None = None,
+    seed: np.random.SeedSequence, start: dict[str, np.ndarray], tune_rounds: int,
+    tune_levels: int, ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
 ):  # fmt: skip
-    """One chain from plain data (run in a worker process): its start (``start``, else drawn
-    under rule ``init`` from ``seed``), then ``run_chain``."""
-    if start is None:
-        start = starts.draw_start(problem, init, starts.start_generator(seed))
+    """One chain from plain data (run in a worker process): ``run_chain`` from ``start`` (drawn
+    by ``sample`` in the parent), its generator from ``seed``; ``run_chain``'s result."""
     with threadpool_limits(1):
-        out = run_chain(
+        return run_chain(
             problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
             tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress, desc=desc,
             start=start, ridge_moves=ridge_moves,
         )  # fmt: skip
-    return (*out, start)
 
 
 def wrong_result(result, expected: tuple, what: str) -> str | None:
@@ -488,14 +484,14 @@ def sample(
     widths = check_step_widths(step_widths, problem)
     tasks = [
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": widths, "seed": s,
-         "init": how, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
-         "ridge_moves": n_ridge, "start": first}
+         "start": first, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
+         "ridge_moves": n_ridge}
         for s, first in zip(seeds, firsts, strict=True)
     ]  # fmt: skip
     names = problem.names
     shapes = {n: problem.init[n].shape for n in names}
     expected = ({n: (int(n_iter), *v) for n, v in shapes.items()}, (int(n_iter),), shapes,
-                shapes, shapes)  # fmt: skip
+                shapes)  # fmt: skip
     runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
                       desc="chain",
                       check=lambda _, r: wrong_result(r, expected, f"{n_iter} sweeps"))  # fmt: skip
@@ -507,7 +503,7 @@ def sample(
         info={"n_iter": n_iter, "n_chains": n_chains, "tune": tune, "tune_rounds": tune_rounds,
               "tune_levels": tune_levels, "seed": seed, "seed_entropy": str(seq.entropy),
               "init": how, "ridge_moves": n_ridge,
-              "starts": {n: np.stack([r[4][n] for r in runs]) for n in names},
+              "starts": {n: np.stack([first[n] for first in firsts]) for n in names},
               "backend": "numpy"},
     )  # fmt: skip
     chains.check_finite()
