@@ -98,3 +98,21 @@ class FakeBlockModel:
 
         d2 = float(np.min(self._d2(y, v)))
         return d2, float(chi2.sf(d2, self.dim))
+
+
+def plotted_run_and_track():
+    """(a closed-loop result's traces, a two-segment track): the parts of ClosedLoopResult and
+    roadgen.Track that the figures read, 50 estimates over GD 300 / 500."""
+    track = SimpleNamespace(
+        segments=((50.0, 300.0), (50.0, 500.0)), boundaries_m=(0.0, 50.0), length_m=100.0
+    )
+    pos = np.linspace(10, 100, 50)
+    run = SimpleNamespace(
+        position=pos,
+        gd_mean=np.full(50, 350.0),
+        gd_lo=np.full(50, 300.0),
+        gd_hi=np.full(50, 400.0),
+        sample_position=pos,
+        sample_speed=np.full(50, 1.5),
+    )
+    return run, track

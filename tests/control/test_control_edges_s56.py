@@ -2,10 +2,9 @@
 figures: refused with a ControlError naming the argument (they crashed deep inside numpy or
 matplotlib, or gave garbage)."""
 
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
+from control_doubles import plotted_run_and_track
 
 from control import ChangePointFilter, ControlError, Simplex
 from control.changepoint import mixture_posterior
@@ -90,24 +89,8 @@ def test_stretch_lengths_must_be_integers_of_two_samples_or_more(call, name):
         call(a)
 
 
-def _run_and_track():
-    track = SimpleNamespace(
-        segments=((50.0, 300.0), (50.0, 500.0)), boundaries_m=(0.0, 50.0), length_m=100.0
-    )
-    pos = np.linspace(10, 100, 50)
-    run = SimpleNamespace(
-        position=pos,
-        gd_mean=np.full(50, 350.0),
-        gd_lo=np.full(50, 300.0),
-        gd_hi=np.full(50, 400.0),
-        sample_position=pos,
-        sample_speed=np.full(50, 1.5),
-    )
-    return run, track
-
-
 def test_one_result_passed_alone_is_refused_with_the_fix():
-    run, track = _run_and_track()
+    run, track = plotted_run_and_track()
     for plot in (plot_gd_trace, plot_speed):  # TypeError: object is not iterable
         with pytest.raises(ControlError, match=r"for one run pass \[result\]"):
             plot(run, track)

@@ -8,6 +8,7 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+from control_doubles import plotted_run_and_track  # noqa: E402
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
@@ -212,18 +213,8 @@ def test_the_quantiles_are_numpys_linear_quantiles(n, levels, seed):
 
 
 def test_plots_return_figures_with_one_line_per_run():
-    track = SimpleNamespace(
-        segments=((50.0, 300.0), (50.0, 500.0)), boundaries_m=(0.0, 50.0), length_m=100.0
-    )
-    pos = np.linspace(10, 100, 50)
-    run = SimpleNamespace(
-        position=pos,
-        gd_mean=np.full(50, 350.0),
-        gd_lo=np.full(50, 300.0),
-        gd_hi=np.full(50, 400.0),
-        sample_position=pos,
-        sample_speed=np.full(50, 1.5),
-    )
+    run, track = plotted_run_and_track()
+    pos = run.position
     fig = plot_gd_trace([run, run], track)
     assert isinstance(fig, Figure) and len(fig.axes[0].lines) >= 3  # prescribed + 2 runs
     assert isinstance(plot_speed([run], track), Figure)
