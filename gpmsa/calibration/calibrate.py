@@ -23,6 +23,7 @@ from gpmsa import backends
 from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
     Fit,
+    Observations,
     blas_controller,
     check_emulator,
     check_log_prior,
@@ -53,18 +54,23 @@ from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 def calibration_problem(
     emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False, constraint=None,
-    theta_init=None,
+    theta_init=None, reduced: Observations | None = None,
 ) -> Problem:  # fmt: skip
     """The calibration-only Problem: the emulator's parameters at its point estimate in ``fixed``.
 
     Sampled: theta, lamOs (and betaV, lamVz with a discrepancy basis, "constant" for a scalar
     output; "constant", "linear" or a matrix for a vector output). ``constraint`` and
-    ``theta_init`` as ``calibrate``'s.
+    ``theta_init`` as ``calibrate``'s. ``reduced``: ``reduce(emulator, x_obs, y_obs,
+    extrapolate)`` where the caller has it already (no discrepancy only), so that the
+    observations are checked and reduced once.
     """
     check_emulator(emulator)
+    if reduced is not None and discrepancy is not None:
+        raise GPMSAError("calibration_problem: reduced= is the no-discrepancy reduction; with a "
+                         "discrepancy basis pass reduced=None")  # fmt: skip
     start = None
     if discrepancy is None:
-        data = reduce(emulator, x_obs, y_obs, extrapolate)
+        data = reduce(emulator, x_obs, y_obs, extrapolate) if reduced is None else reduced
         obs, corr = data.obs, data.os_corr
         fit = _probe(emulator, data, [emulator.params])
         start = lamos_start(fit, data.lamos)
@@ -258,7 +264,7 @@ def calibrate(
             )  # fmt: skip
         else:
             draws, info = _run_backend(
-                emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
+                emulator, data, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
                 {**tuning_opts, **options}, seed, extrapolate, progress, where, theta_opts,
             )  # fmt: skip
     require_finite(draws)
@@ -401,12 +407,13 @@ def _wrong_fast_run(run, n_samples: int, q: int) -> str | None:
 
 
 def _run_backend(
-    emulator, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tuning_opts, seed,
-    extrapolate, progress, where, theta_opts,
+    emulator, data, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tuning_opts,
+    seed, extrapolate, progress, where, theta_opts,
 ):  # fmt: skip
     problem = calibration_problem(
-        emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate, **theta_opts
-    )
+        emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate,
+        reduced=data if discrepancy is None else None, **theta_opts,
+    )  # fmt: skip
     module = backends.get(backend)
     if backend == "numpy" and problem.constraint is not None:  # (the others refuse it)
         n_jobs, executor = in_this_process(

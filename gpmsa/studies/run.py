@@ -4,7 +4,6 @@ jointly): several models whose calibration parameters are shared or hierarchical
 from __future__ import annotations
 
 import time
-import warnings
 from collections.abc import Sequence
 from datetime import datetime, timezone
 
@@ -149,8 +148,10 @@ def calibrate_study(
     layout = layout_of(emulators, labels, shared, hierarchical)
     check_study_names(layout)
     t0 = time.perf_counter()
-    problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate)
-                for lab, e, x, y in zip(labels, emulators, x_obs, y_obs, strict=True)]  # fmt: skip
+    models = list(zip(labels, emulators, x_obs, y_obs, strict=True))
+    reduced = [_per_model(lab, reduce, e, x, y, extrapolate) for lab, e, x, y in models]
+    problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate, reduced=r)
+                for (lab, e, x, y), r in zip(models, reduced, strict=True)]  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})")  # fmt: skip
     chains = sample_study(
@@ -159,11 +160,7 @@ def calibrate_study(
         progress=progress, n_jobs=n_jobs, executor=executor,
     )  # fmt: skip
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the problems above already warned
-        settings[OBS_DIGESTS] = {lab: reduce(e, x, y, extrapolate).values_sha256
-                                 for lab, e, x, y in zip(labels, emulators, x_obs, y_obs,
-                                                         strict=True)}  # fmt: skip
+    settings[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
     study = Study("calibration", emulators, layout, hyper,
                   _study_draws(chains, slice(int(n_burn), None)), settings, metadata)  # fmt: skip
     if study.convergence is not None:

@@ -233,3 +233,48 @@ def test_a_calibrated_models_posterior_refuses_other_observations(tmp_path):
     assert loaded.info["obs_values_sha256"] == other.values_digest()
     with pytest.raises(gpmsa.GPMSAError, match="obs holds other observations"):
         gpmsa.full_prediction(emu, own, [[0.5]], posterior=loaded, discrepancy=None)
+
+
+def test_each_models_observations_are_checked_and_reduced_once(monkeypatch):
+    """calibrate_study reduces each model's observations once and records the digest of that
+    reduction (it reduced them a second time for the digest, under a warnings filter); a
+    backend calibration (fast=False) hands calibrate's reduction to its Problem. Draws as
+    before: the same Problem is built."""
+    import gpmsa.calibration.calibrate as calibrate_mod
+    import gpmsa.studies.run as run_mod
+
+    emu = emulator(None)
+    rng = np.random.default_rng(7)
+    (x1, y1), (x2, y2) = observations(0.3, 3, 0.05, rng), observations(0.7, 3, 0.05, rng)
+    calls = []
+    real = calibrate_mod.reduce
+
+    def counted(*args, **kwargs):
+        calls.append(args[1])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(run_mod, "reduce", counted)
+    monkeypatch.setattr(calibrate_mod, "reduce", counted)
+    study = gpmsa.calibrate_study([emu, emu], [x1, x2], [y1, y2], shared=["t"],
+                                  n_samples=60, n_burn=10, seed=2, tune=False)  # fmt: skip
+    assert len(calls) == 2
+    digests = [study.member_posterior(i).info["obs_values_sha256"] for i in (0, 1)]
+    assert digests == [gpmsa.ObsData(x=x, y=y).values_digest() for x, y in ((x1, y1), (x2, y2))]
+    calls.clear()
+    post = gpmsa.calibrate(emu, x1, y1, fast=False, n_samples=40, n_burn=10, seed=0, tune=False)
+    assert len(calls) == 1
+    assert post.info["obs_values_sha256"] == digests[0]
+
+
+def test_calibration_problem_takes_a_reduction_only_without_a_discrepancy():
+    from gpmsa.calibration.calibrate import calibration_problem
+    from gpmsa.calibration.observations import reduce
+
+    emu = emulator(None)
+    x, y = observations(0.3, 3, 0.05, np.random.default_rng(1))
+    data = reduce(emu, x, y)
+    given, own = calibration_problem(emu, x, y, reduced=data), calibration_problem(emu, x, y)
+    assert np.array_equal(given.obs.z, own.obs.z)
+    assert all(np.array_equal(given.init[k], own.init[k]) for k in own.init)
+    with pytest.raises(gpmsa.GPMSAError, match="reduced= is the no-discrepancy reduction"):
+        calibration_problem(emu, x, y, discrepancy="constant", reduced=data)
