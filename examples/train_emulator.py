@@ -63,7 +63,13 @@ from control import PAPER_WINDOW, FeatureSpec  # noqa: E402
 from control.feature import feature_of_variance  # noqa: E402
 from control.plotting import plot_design  # noqa: E402
 from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
-from control.training import block_scatter, block_statistics  # noqa: E402
+from control.training import (  # noqa: E402
+    SINGULAR_WEIGHT,
+    block_scatter,
+    block_statistics,
+    covariance_rank,
+    weight_beyond_rank,
+)
 from gpmsa.fitting.fit import simulation_fit_nbytes  # noqa: E402
 
 V_RANGE = (0.5, 2.0)
@@ -87,6 +93,8 @@ MIN_RUNS = 4
 BATCH = 8
 """Blocks per batch of the band emulators' block scatter (`control.training.block_statistics`,
 which needs two batches per run: ``--keep-s`` >= 2 * BATCH * ``--block-samples`` / RATE_HZ)."""
+SCATTER_NODES = 16
+"""Speed nodes of the band emulators' block scatter, evenly over ``--speed-range``."""
 ANCHOR_SHARE = 6
 """Default ``--anchor-runs``: ``--n-runs`` // this at each anchor speed (33 for the paper's 198)."""
 SPEED_SPACINGS = ("uniform", "arcsine")
@@ -302,6 +310,36 @@ def check_fit_memory(parser: argparse.ArgumentParser, args) -> None:
         )  # fmt: skip
 
 
+def check_scatter_rank(parser: argparse.ArgumentParser, design: np.ndarray, args) -> None:
+    """Usage error, before the campaign, where the band emulators' block covariance would be
+    singular at a speed node whatever the roads (`control.training.weight_beyond_rank`): each
+    run's batches give it a rank of at most their number, and too few runs lie near the node."""
+    K = band_feature(args).dim
+    n_blocks = int(round(args.keep_s * RATE_HZ)) // args.block_samples  # as run_campaign keeps
+    rank = covariance_rank(n_blocks, BATCH)
+    nodes = np.linspace(*args.speed_range, SCATTER_NODES)
+    share = weight_beyond_rank(design[:, 0], rank, K, nodes)
+    if np.all(share > SINGULAR_WEIGHT):
+        return
+    m, need = design.shape[0], -(-K // rank)
+    anchors = m > args.n_runs
+    runs = f"--n-runs {args.n_runs}" + (f" and {m - args.n_runs} anchor runs" if anchors else "")
+    bands, quantiles = len(BAND_FEATURE.bands_hz) - 1, len(args.quantiles)
+    where = (
+        f"{m} runs x {rank} < {K} at every speed"
+        if m * rank < K
+        else f"at {nodes[int(np.argmin(share))]:g} m/s all but {share.min():.1g} of the kernel "
+        f"weight lies on the {need - 1} nearest runs"
+    )
+    parser.error(
+        f"{runs} with --keep-s {args.keep_s:g}: the band emulators' {K} x {K} block covariance "
+        f"(K = {bands} band powers + {quantiles} quantiles) would be singular whatever the "
+        f"roads: each run's {n_blocks // BATCH} batches of {BATCH} blocks give it rank {rank}, "
+        f"so it needs {need} runs near each speed, and {where}: raise --n-runs"
+        f"{', --anchor-runs' if anchors else ''} or --keep-s"
+    )
+
+
 def band_feature(args) -> FeatureSpec:
     """The band emulators' feature: `BAND_FEATURE` with ``--block-samples`` and ``--quantiles``."""
     return dataclasses.replace(
@@ -341,7 +379,8 @@ def fit_band(case: str, campaign, model, args):
     accel = campaign.accel if case == "A" else campaign.accel_measured
     ok = fit_runs("band", case, campaign, args)
     stats_ = block_statistics(accel[ok], feature, batch=BATCH)
-    scatter = block_scatter(campaign.v[ok], stats_, nodes=np.linspace(*args.speed_range, 16))
+    nodes = np.linspace(*args.speed_range, SCATTER_NODES)
+    scatter = block_scatter(campaign.v[ok], stats_, nodes=nodes)
     data = gpmsa.SimData(
         x=campaign.v[ok, None], t=campaign.gd[ok, None], y=stats_.mean,
         x_names=["v"], t_names=["GD"], y_names=feature.names(),
@@ -515,6 +554,15 @@ def main(argv: list[str] | None = None) -> None:
         check_shippable(parser, args)
     check_anchors(parser, args)
     check_fit_memory(parser, args)
+    design = np.concatenate([
+        stretched_design(
+            args.n_runs, args.seed, tuple(args.gd_range), tuple(args.speed_range),
+            args.speed_spacing,
+        ),
+        anchor_design(tuple(args.anchor_speeds), args.anchor_runs, args.seed, tuple(args.gd_range)),
+    ])  # fmt: skip
+    if "band" in args.features:
+        check_scatter_rank(parser, design, args)
     out = output_folder(parser, "--out", args.out)
     if args.ship:
         emu_dir = output_folder(parser, "--ship", EMULATOR_DIR)
@@ -523,13 +571,6 @@ def main(argv: list[str] | None = None) -> None:
     else:
         emu_dir = output_folder(parser, "--out", out / "emulators")
 
-    design = np.concatenate([
-        stretched_design(
-            args.n_runs, args.seed, tuple(args.gd_range), tuple(args.speed_range),
-            args.speed_spacing,
-        ),
-        anchor_design(tuple(args.anchor_speeds), args.anchor_runs, args.seed, tuple(args.gd_range)),
-    ])  # fmt: skip
     tic = time.perf_counter()
     try:  # its memory and settings are checked before the first run
         campaign = vehicle.run_campaign(

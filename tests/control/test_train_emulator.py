@@ -218,10 +218,10 @@ def test_too_few_finished_latin_hypercube_runs_for_the_window_fit_is_a_usage_err
         return dataclasses.replace(campaign, **changed)
 
     monkeypatch.setattr(script.vehicle, "run_campaign", one_lhs_run_fails)
-    with pytest.raises(SystemExit):
+    with pytest.raises(SystemExit):  # 50 s: 6 batches a run, so 6 runs can give the scatter
         script.main(
             ["--out", str(tmp_path), "--n-runs", "4", "--n-pc", "4", "--n-iter", "20",
-             "--keep-s", "17", "--cases", "A", "--features", "window", "band"]
+             "--keep-s", "50", "--cases", "A", "--features", "window", "band"]
         )  # fmt: skip
     err = capsys.readouterr().err
     assert "only 3 of the window emulators' 4 runs finished" in err
