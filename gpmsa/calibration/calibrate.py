@@ -207,7 +207,9 @@ def calibrate(
         when p > 1, and "lamVz"), and chains per name;
         ``info["obs_values_sha256"]`` fingerprints the observations
         (``ObsData.values_digest(emulator.x_names)``: x_obs as a table is read by name), so that
-        ``gpmsa.full_prediction`` refuses other ones with these draws.
+        ``gpmsa.full_prediction`` refuses other ones with these draws;
+        ``info["emulator_sha256"]`` the emulator (``Emulator.model_sha256``), so that the
+        predictions taking an emulator and ``posterior=`` refuse another one.
     """
     check_emulator(emulator, categorical_theta=True)
     seed = check_seed(seed)
@@ -274,6 +276,7 @@ def calibrate(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds, obs_values_sha256=data.values_sha256,
+        emulator_sha256=emulator.model_sha256,
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
         backend_options=backends.recorded_options(options),
     )  # fmt: skip

@@ -7,6 +7,7 @@ reads; ``Emulator.save`` and ``load`` join the two.
 
 from __future__ import annotations
 
+import functools
 import json
 import re
 import warnings
@@ -28,6 +29,7 @@ from gpmsa.fitting.validation import (
 from gpmsa.io.container import (
     FORMAT,
     check_path,
+    content_hash,
     jsonable,
     read_raw,
     refuse_to_replace,
@@ -510,22 +512,7 @@ class Emulator:
                 "an emulator with a callable mean_basis cannot be saved (a file holds no code); "
                 f"fit with one of the named mean bases {MEAN_BASIS_KINDS} to save it"
             )
-        s = self.standardizer
-        arrays = {
-            "x_unit": self.x_unit, "t_unit": self.t_unit, "y": self.y, "K": self.K, "w": self.w,
-            "x_min": s.x_min, "x_max": s.x_max, "t_min": s.t_min, "t_max": s.t_max,
-            "y_mean": s.y_mean, "y_sd": np.array([s.y_sd]), "grid": s.grid,
-            "log_post": self.log_post,
-        }  # fmt: skip
-        if self.index is not None:
-            arrays["index"] = self.index
-        for k, v in self.params.items():
-            arrays[f"param_{k}"] = v
-        for k, v in self.draws.items():
-            arrays[f"draw_{k}"] = v
-        for k, v in (self.calibration or {}).items():
-            arrays[f"cal_{k}"] = v
-        arrays = {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
+        arrays = self._record_arrays()
         manifest = {
             "names": {"x": list(self.x_names), "t": list(self.t_names), "y": list(self.y_names)},
             "units": {"x": list(self.x_units), "t": list(self.t_units), "y": list(self.y_units)},
@@ -560,6 +547,51 @@ class Emulator:
                 f"Emulator.metadata must be JSON-able (str, numbers, lists, dicts): {exc}"
             ) from exc
         return manifest, arrays
+
+    def _record_arrays(self) -> dict[str, np.ndarray]:
+        """The arrays of the file's record (``to_record``), float64 and contiguous."""
+        s = self.standardizer
+        arrays = {
+            "x_unit": self.x_unit, "t_unit": self.t_unit, "y": self.y, "K": self.K, "w": self.w,
+            "x_min": s.x_min, "x_max": s.x_max, "t_min": s.t_min, "t_max": s.t_max,
+            "y_mean": s.y_mean, "y_sd": np.array([s.y_sd]), "grid": s.grid,
+            "log_post": self.log_post,
+        }  # fmt: skip
+        if self.index is not None:
+            arrays["index"] = self.index
+        for k, v in self.params.items():
+            arrays[f"param_{k}"] = v
+        for k, v in self.draws.items():
+            arrays[f"draw_{k}"] = v
+        for k, v in (self.calibration or {}).items():
+            arrays[f"cal_{k}"] = v
+        return {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
+
+    @functools.cached_property
+    def model_sha256(self) -> str:
+        """SHA-256 (64 hex digits) of what defines this emulator's predictions and calibrations:
+        every array its file holds (training runs, basis, weights, standardisation, point
+        estimate, retained draws, a joint fit's calibration draws; as float64), its input and
+        output names, categorical levels, mean basis and priors. Not its metadata, settings,
+        diagnostics or units, nor (unlike a file's ``content_sha256``, which ``gpmsa.load``'s
+        ``sha256=`` checks) the time of writing or the library version: an emulator read back
+        by ``gpmsa.load`` has the ``model_sha256`` of the one saved. A calibration records it
+        (Posterior info "emulator_sha256") so that predictions refuse another emulator with its
+        draws. Computed once, on first use (0.4 ms for the shipped band emulator's 0.3 MB of
+        arrays): an emulator is not changed after construction."""
+        mb = self.mean_basis
+        basis = None if mb is None else mb.kind
+        if mb is not None and mb.kind not in MEAN_BASIS_KINDS:  # a callable: by its identity
+            fn = mb.fn
+            basis = f"{mb.kind}:{getattr(fn, '__module__', '')}.{getattr(fn, '__qualname__', '')}"
+            basis += f"@{id(fn):x}"
+        defining = {
+            "names": {"x": list(self.x_names), "t": list(self.t_names), "y": list(self.y_names)},
+            "categorical": {k: list(v) for k, v in self.categorical.items()},
+            "mean_basis": basis,
+            "priors": self.priors.to_dict(),
+        }
+        return content_hash(self._record_arrays(), jsonable(defining))
 
     @classmethod
     def from_record(cls, manifest: dict, arrays: dict[str, np.ndarray]) -> Emulator:

@@ -103,6 +103,25 @@ def posterior_lamos(posterior, idx: np.ndarray | None = None) -> np.ndarray:
     return lam
 
 
+def check_posterior_emulator(emulator, posterior) -> None:
+    """GPMSAError when ``posterior`` recorded the emulator it was drawn with (info
+    "emulator_sha256": that emulator's ``Emulator.model_sha256``, as ``gpmsa.calibrate``,
+    ``Calibrator.update``, ``calibration_posterior`` and ``Study.member_posterior`` record it)
+    and ``emulator`` is another one: its draws would be mixed with another emulator's
+    predictive. A posterior without the record (made by hand, or by older code) is taken."""
+    info = getattr(posterior, "info", None) or {}
+    recorded = info.get("emulator_sha256")
+    if not isinstance(recorded, str) or recorded == emulator.model_sha256:
+        return
+    model = info.get("model")
+    whose = f" (study model {model!r})" if isinstance(model, str) else ""
+    raise GPMSAError(
+        f"posterior= was drawn with another emulator{whose} (model_sha256 {recorded[:12]}..., "
+        f"this emulator's {emulator.model_sha256[:12]}...): pass the emulator it was "
+        "calibrated with"
+    )
+
+
 def gpmsa_model_only(emulator, what: str) -> None:
     """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or uses categorical inputs or a mean
     basis, which ``what`` does not support (``Emulator.predict``, ``gpmsa.calibrate`` and

@@ -20,7 +20,11 @@ from gpmsa.model.data import (
     check_level,
     evenly_spaced,
 )
-from gpmsa.predictive._common import posterior_lamos, posterior_theta
+from gpmsa.predictive._common import (
+    check_posterior_emulator,
+    posterior_lamos,
+    posterior_theta,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,7 +112,9 @@ def calibrated_predict(
 
     Args:
         emulator: the gpmsa.Emulator the posterior was computed with.
-        posterior: a Posterior from ``calibrate`` or ``Calibrator.update``.
+        posterior: a Posterior from ``calibrate`` or ``Calibrator.update``; one that recorded
+            another emulator (info "emulator_sha256", ``Emulator.model_sha256``) is refused
+            (GPMSAError).
         x_new: (N, p) known inputs, native units; None (one point) for an emulator without
             known inputs (p = 0).
         noise: add the observation error 1/lamOs (standardised units): the predictive of a new
@@ -130,6 +136,7 @@ def calibrated_predict(
     x, _ = check_x(emulator, x_new, extrapolate, "x_new")
     if not isinstance(posterior, Posterior):
         raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
+    check_posterior_emulator(emulator, posterior)
     names = tuple(emulator.t_names)
     missing = [n for n in names if n not in posterior.names]
     if missing:

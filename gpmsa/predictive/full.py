@@ -46,6 +46,7 @@ from gpmsa.model.data import (
 from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive._common import (
     EMULATOR_PARAMS,
+    check_posterior_emulator,
     factors,
     gpmsa_model_only,
     mvn_factor,
@@ -339,7 +340,8 @@ def full_prediction(
         posterior: instead of the joint fit's draws, a Posterior of gpmsa.calibrate (theta,
             lamOs, and betaV, lamVz with a discrepancy) with the emulator at its point estimate;
             ``obs`` must then hold the calibration's x_obs and y_obs (where the Posterior
-            recorded them: info "obs_values_sha256").
+            recorded them: info "obs_values_sha256"), and ``emulator`` be the one it was drawn
+            with (where it recorded it: info "emulator_sha256", ``Emulator.model_sha256``).
         discrepancy: the discrepancy basis of the calibration: None, "constant", "linear" or an
             (l_obs, p_v) array; the default takes the joint fit's recorded choice (an array must
             be passed again).
@@ -388,6 +390,7 @@ def full_prediction(
     if posterior is None:
         _check_fitted_obs(getattr(emulator, "settings", None) or {}, obs)
     else:
+        check_posterior_emulator(emulator, posterior)
         _check_fitted_obs(getattr(posterior, "info", None) or {}, obs)  # a joint fit's draws
         _check_calibrated_obs(posterior, obs, emulator.x_names)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")

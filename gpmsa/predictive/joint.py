@@ -16,7 +16,8 @@ def calibration_posterior(emulator) -> Posterior:
     p > 1). ``chains`` splits the retained draws into the fit's chains, so ``to_arviz()``,
     ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``. ``info`` carries the
     fit's record of its observations ("obs_lengths", "obs_sha256"), so that
-    ``gpmsa.full_prediction(..., posterior=)`` refuses other ones, as it does without it.
+    ``gpmsa.full_prediction(..., posterior=)`` refuses other ones, as it does without it, and
+    the emulator's ``model_sha256`` ("emulator_sha256"), so that it refuses another emulator.
 
     Example:
         >>> import numpy as np, gpmsa
@@ -59,6 +60,7 @@ def calibration_posterior(emulator) -> Posterior:
         "method": "joint fit",
         "names": list(samples),
         "n_chains": n_chains,
+        "emulator_sha256": emulator.model_sha256,
         **{k: emulator.settings[k] for k in ("n_iter", "n_burn", "thin", "seed", "backend",
                                               "discrepancy", "obs_lengths", "obs_sha256")
            if k in emulator.settings},

@@ -177,7 +177,8 @@ class Study:
         input; "betaV[k]" for several) and "lamVz", e.g. for ``gpmsa.full_prediction``'s
         ``posterior=`` or ``gpmsa.predictive.calibrated_predict``. Its info carries the record of
         the model's observations (a fitted model's "obs_sha256", a calibrated one's
-        "obs_values_sha256"), so that ``full_prediction(posterior=)`` refuses other ones."""
+        "obs_values_sha256"), so that ``full_prediction(posterior=)`` refuses other ones, and
+        its emulator's ``model_sha256`` ("emulator_sha256"): another emulator is refused."""
         i = self._member(model)
         chains = self.posterior.chains
         out = {}
@@ -185,7 +186,11 @@ class Study:
             out[name] = chains[self.layout.elements[self.layout.index[i][k]].name]
         out["lamOs"] = chains[f"lamOs[{self.labels[i]}]"]
         out.update(_discrepancy_chains(self.members[i], out["lamOs"].shape))
-        info = {"method": f"study {self.kind}", "model": self.labels[i]}
+        info = {
+            "method": f"study {self.kind}",
+            "model": self.labels[i],
+            "emulator_sha256": self.members[i].model_sha256,
+        }
         # the record of the model's observations, so that full_prediction(posterior=) refuses
         # other ones: a fitted model's (as calibration_posterior), a calibrated one's (as
         # gpmsa.calibrate; absent from study files written before it was kept)
