@@ -53,7 +53,7 @@ def run(args: argparse.Namespace) -> int:
             lines.append(_convergence_line(study.convergence))  # from the draws, as load_study
             text = "\n".join(lines)
         else:
-            text = "\n".join(_lines(args.file, manifest, arrays, emulator.standardizer))
+            text = "\n".join(_lines(args.file, manifest, arrays, emulator))
     except GPMSAError as exc:  # a damaged file (EmulatorFileError), or no file path at all
         print(f"gpmsa info: {safe(exc)}", file=sys.stderr)
         return 2
@@ -64,9 +64,11 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _lines(file: str, manifest: dict, arrays: dict, standardizer) -> list[str]:
+def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     """The manifest for a person (the content already validated: names, units, domain, model);
-    ``standardizer``: the loaded emulator's, for theta in native units."""
+    ``emulator``: the loaded one, for theta in native units and its ``model_sha256`` (what a
+    calibration's Posterior records as info "emulator_sha256")."""
+    standardizer = emulator.standardizer
     model = manifest.get("model", {})
     lines = [
         f"file:            {safe(file)}",
@@ -74,6 +76,7 @@ def _lines(file: str, manifest: dict, arrays: dict, standardizer) -> list[str]:
         f"(gpmsa {plain(manifest.get('library_version'))}, written "
         f"{plain(manifest.get('created_utc'))})",
         f"content sha256:  {safe(manifest['content_sha256'])} (verified)",
+        f"model sha256:    {emulator.model_sha256} (a calibration's info 'emulator_sha256')",
         f"model:           m={model.get('m')} runs, p={model.get('p')}, q={model.get('q')}, "
         f"l_sim={model.get('l_sim')}, p_u={model.get('p_u')}",
     ]

@@ -157,3 +157,16 @@ def test_an_unexpected_error_is_one_line_not_a_traceback(tmp_path, capsys, monke
     assert main(["calibrate", str(path), "--x", "v=0.5", "--y", "f=2"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "unexpected TypeError (a \\x1b[31m message)" in err, err
+
+
+def test_info_prints_the_model_sha256_a_calibration_records(tmp_path, capsys) -> None:
+    """``gpmsa info`` shows the emulator's ``model_sha256``: the value a calibration with this
+    file's emulator records as info "emulator_sha256", so a shared posterior can be matched to
+    its file."""
+    path = road_emulator().save(tmp_path / "road.gpmsa")
+    assert main(["info", str(path)]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if s.startswith("model sha256:"))
+    emu = gpmsa.load(path)
+    post = gpmsa.Calibrator(emu, method="grid").update([[1.0]], [[emu.y[0, 0]]])
+    assert post.info["emulator_sha256"] == emu.model_sha256
+    assert line.split()[2] == emu.model_sha256
