@@ -5,7 +5,9 @@ burn-in (n_iter // 5 per chain, as ``gpmsa.fit``); per second of wall time of th
 (tuning or warm-up included). Fit: the simulation-only emulator (198 runs, scalar output;
 betaU, lamUz, lamWs, lamWOs sampled). Calibrate: ``gpmsa.calibrate`` at the SEPIA full-joint
 posterior means (theta and lamOs sampled). Prints one line per configuration, medians over
-``--repeats`` runs. Usage: python benchmarks/backends.py [--repeats 3] [--quick]
+``--repeats`` runs, and ``vs numpy``: the ESS/s over that of the task's first row in this run
+(numpy, one chain; for calibrate its fast sampler, ``gpmsa.calibrate``'s default), with the load
+average before and after. Usage: python benchmarks/backends.py [--repeats 3] [--quick]
 [--only fit:pyro]. The pyro fit (4 chains x 1,500 draws, one after another) takes ~10 min,
 the pyro calibrate (4 x 1,000) ~80 s a repeat.
 """
@@ -51,7 +53,8 @@ def ess_rhat(draws: dict[str, np.ndarray], names) -> tuple[float, float]:
         e += [ess(flat[:, :, i]) for i in range(flat.shape[2])]
         if d.shape[0] > 1:
             r += [rhat(flat[:, :, i]) for i in range(flat.shape[2])]
-    return float(np.nanmin(e)), float(np.nanmax(r)) if r else float("nan")
+    r = [x for x in r if not np.isnan(x)]  # (NaN: too few draws for a split R-hat)
+    return float(np.nanmin(e)), float(max(r)) if r else float("nan")
 
 
 def bench_fit(backend: str, n_iter: int, n_chains: int, options: dict, seed: int) -> tuple:
@@ -115,10 +118,11 @@ def main(argv=None) -> None:
         ("torch", 64, int(500 * s), False),
         ("pyro", 4, int(1000 * s), False),
     ]
-    print(f"# load average at start: {os.getloadavg()}; {os.cpu_count()} CPUs; torch threads 1")
+    print(f"# {load()} at start; {os.cpu_count()} CPUs; torch threads 1")
     print(f"{'task':9} {'backend':14} {'chains':>6} {'draws':>6} {'wall s':>8} {'min ESS':>8} "
-          f"{'ESS/s':>8} {'R-hat':>6}")  # fmt: skip
+          f"{'ESS/s':>8} {'R-hat':>6} {'vs numpy':>8}")  # fmt: skip
     for task, configs in (("fit", fits), ("calibrate", cals)):
+        baseline = None  # the ESS/s of the task's first row, numpy with one chain
         for backend, chains, n, extra in configs:
             if args.only and args.only != f"{task}:{backend}":
                 continue
@@ -133,8 +137,17 @@ def main(argv=None) -> None:
             rate = statistics.median(e / w for w, e, _ in runs)
             r_hat = max(r for _, _, r in runs)
             label = backend + (" (fast)" if task == "calibrate" and extra else "")
+            if (backend, chains, n, extra) == configs[0]:
+                baseline = rate
+            ratio = f"{rate / baseline:7.2f}x" if baseline else f"{'-':>8}"
             print(f"{task:9} {label:14} {chains:6d} {n:6d} {wall:8.2f} {n_eff:8.0f} {rate:8.1f} "
-                  f"{r_hat:6.3f}", flush=True)  # fmt: skip
+                  f"{r_hat:6.3f} {ratio}", flush=True)  # fmt: skip
+    print(f"# {load()} at the end")
+
+
+def load() -> str:
+    """The load average (1, 5, 15 min), printed with the figures: the machine is shared."""
+    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ Prints, single-threaded (BLAS limited to one thread; --pin also pins the process
 - memory: the Calibrator's cached arrays and the peak Python allocation of preparing and of an
   update (tracemalloc).
 SEPIA's figures are from tests/data/reference_posteriors.json (same case, this machine class).
+The load average is printed before and after: the machine is shared.
 
 Usage: python benchmarks/calibrate_speed.py [--updates 2000] [--runs 10] [--pin]
 """
@@ -101,7 +102,7 @@ def main() -> None:
         return post.mean("GD"), post.prob_above("GD", 350.0)
 
     print(f"road case: m = {emu.m} runs, grid of {cal.theta_grid.size} GD nodes; "
-          f"Calibrator prepared in {1e3 * prep_s:.1f} ms")  # fmt: skip
+          f"Calibrator prepared in {1e3 * prep_s:.1f} ms; {load()}")  # fmt: skip
     print(f"{'latency, ms':50s} {'median':>9s} {'p90':>9s} {'p99':>9s} {'max':>9s} {'calls':>7s}"
           "  SEPIA")  # fmt: skip
     for name, fn in (
@@ -142,6 +143,12 @@ def main() -> None:
         f"memory: Calibrator cached arrays {cached / 2**20:.2f} MiB; peak allocation while "
         f"preparing {prep_peak / 2**20:.2f} MiB, per update {upd_peak / 2**20:.3f} MiB"
     )
+    print(load())
+
+
+def load() -> str:
+    """The load average with the cores, printed with the timings (the machine is shared)."""
+    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*os.getloadavg(), os.cpu_count())
 
 
 if __name__ == "__main__":

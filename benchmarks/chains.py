@@ -117,7 +117,7 @@ def _worst_rhat(chains, burn: int) -> str:
         for i in range(flat.shape[2]):
             if np.ptp(flat[:, :, i]) > 0:
                 worst = max(worst, (rhat(flat[:, :, i]), f"{name}[{i}]"))
-    return worst[1]
+    return worst[1] or "no finite R-hat"  # (one chain, or too few draws)
 
 
 def sweep_cost(n_chains: int, rounds: int = 12) -> None:

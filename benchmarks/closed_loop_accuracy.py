@@ -254,12 +254,17 @@ def report_random(results, case: str, kind: str = "random") -> str:
     rises = np.array([d for r in runs for d, (a, b) in zip(r["delays"], r["steps"], strict=True)
                       if b - a >= 150])  # fmt: skip
     cov = coverage(runs)
+    head = (
+        f"{case:<3}{kind:<9}{len(runs):>4} runs  relative RMSE {np.sqrt(np.mean(rel**2)):.3f}  "
+        f"90% cover {cov:.3f}  rises >= 150: "
+    )
+    if rises.size == 0:  # a few random tracks (--random-tracks) may hold none
+        return head + "none  target not judged (no rise to time)"
     met = "met" if 0.85 <= cov <= 0.95 and np.nanmedian(rises) <= 5.0 else "NOT met"
     resampled = np.random.default_rng(0).choice(rises, (2000, rises.size))
     lo, hi = np.nanpercentile(np.nanmedian(resampled, axis=1), [5, 95])
     return (
-        f"{case:<3}{kind:<9}{len(runs):>4} runs  relative RMSE {np.sqrt(np.mean(rel**2)):.3f}  "
-        f"90% cover {cov:.3f}  rises >= 150: n {rises.size}, median delay "
+        head + f"n {rises.size}, median delay "
         f"{np.nanmedian(rises):.1f} m [{lo:.1f}, {hi:.1f}], never detected "
         f"{int(np.sum(np.isnan(rises)))}  target {met}"
     )

@@ -465,6 +465,16 @@ def summarise(outcomes: list[Outcome]) -> None:
         print(f"  {kind:<13}" + ", ".join(f"{k} {v}" for k, v in total.most_common()))
 
 
+def worst_outcomes(random_out: list[Outcome], example_out: list[Outcome]) -> tuple[list, list]:
+    """(runs that drove faster on rough ground than their clean run while the fault lasted, of
+    the random scenarios and the examples; random scenarios faster over the whole run), each
+    worst first; crashed runs are left out."""
+    ok = [o for o in (*random_out, *example_out) if not o.crash]
+    during = sorted((o for o in ok if o.during_diff > 0), key=lambda o: -o.during_diff)
+    worse = sorted((o for o in random_out if not o.crash and o.diff > 0), key=lambda o: -o.diff)
+    return during, worse
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -588,9 +598,7 @@ def main(argv: list[str] | None = None) -> int:
                 f"{o.fast_fault:9.2f}{o.diff:+7.2f}{o.during_diff:+7.2f}  {st}"
             )
 
-    ok = [o for o in outcomes if not o.crash]
-    during = sorted((o for o in ok if o.during_diff > 0), key=lambda o: -o.during_diff)
-    worse = sorted((o for o in ok[:n] if o.diff > 0), key=lambda o: -o.diff)
+    during, worse = worst_outcomes(random_out, example_out)
     for title, chosen in (
         ("faster on rough ground than the clean run while the fault lasts", during),
         ("random scenarios with the largest excess over the whole run", worse),

@@ -102,6 +102,20 @@ BAND_VARIANTS = {  # name: (block samples, FeatureSpec fields, extra moment or N
     "64-sample blocks": (64, BANDS_ONLY, None),
 }
 
+FIRST_VARIANT = next(iter(BAND_VARIANTS))
+"""The 8-band vector: the variants' J is given as a ratio to its J."""
+
+
+def singular(what: str, n_runs: int, keep_s: float) -> str:
+    """Why a feature's block covariance Sigma(v) cannot be factorised (``what``: the
+    feature, or "" in a table row): the runs near a speed hold fewer batch means than it has
+    outputs."""
+    return (
+        (f"{what}: " if what else "")
+        + f"Sigma(v) singular: {n_runs} runs x {keep_s:g} s hold too few batches of "
+        f"{BATCH_SAMPLES} samples for its outputs (raise --n-runs or --keep-s)"
+    )
+
 
 def lhs(n: int, seed: int) -> np.ndarray:
     """(n, 2) Latin-hypercube design [v, GD] over the paper's domain."""
@@ -253,7 +267,8 @@ def fit(v: np.ndarray, gd: np.ndarray, feats: np.ndarray, batch: int) -> Model:
     sig = model.sigma(v) / feats.shape[1]
     d2 = [r @ np.linalg.solve(s, r) for r, s in zip(resid, sig, strict=True)]
     dof = 1.0 - X.shape[1] / v.size  # residuals of a least-squares fit are smaller
-    model.lack_of_fit = float(np.mean(d2) / feats.shape[2] / dof)
+    # (10 runs: the cubic goes through every run mean, and its lack of fit is unknown)
+    model.lack_of_fit = float(np.mean(d2) / feats.shape[2] / dof) if dof > 0 else np.nan
     return model
 
 
@@ -501,19 +516,22 @@ def main(argv: list[str] | None = None) -> None:
             f_te = features(bl_te, B, pg_te, s_te)
             batch = max(1, BATCH_SAMPLES // B)
             for name in FEATURES:
-                model = fit(v_tr, gd_tr, f_tr[name], batch)
+                try:
+                    model = fit(v_tr, gd_tr, f_tr[name], batch)
+                    jfit[case, name, B] = fisher_j(model, v_s, gd_s, B)
+                    for span in SPANS:
+                        if span < B:
+                            continue
+                        sc = estimates(model, v_s, gd_s, f_te[name], span // B, log_grid)
+                        table[case, name, B, span] = info_per_s(sc, span / RATE_HZ, rng)
+                        if span == 1000:
+                            for lo, hi, label in SPEED_BANDS:
+                                sel = (sc.speed >= lo) & (sc.speed < hi)
+                                sub = sc.subset(sel)
+                                band_j[case, name, B, label] = info_per_s(sub, span / RATE_HZ, rng)
+                except np.linalg.LinAlgError:
+                    raise SystemExit(singular(f"{name}, B = {B}", n_runs, keep_s)) from None
                 lack[case, name, B] = model.lack_of_fit
-                jfit[case, name, B] = fisher_j(model, v_s, gd_s, B)
-                for span in SPANS:
-                    if span < B:
-                        continue
-                    sc = estimates(model, v_s, gd_s, f_te[name], span // B, log_grid)
-                    table[case, name, B, span] = info_per_s(sc, span / RATE_HZ, rng)
-                    if span == 1000:
-                        for lo, hi, label in SPEED_BANDS:
-                            sel = (sc.speed >= lo) & (sc.speed < hi)
-                            sub = sc.subset(sel)
-                            band_j[case, name, B, label] = info_per_s(sub, span / RATE_HZ, rng)
 
     def reference(case: str, span: int) -> tuple:
         """log f of the paper's 1,000-sample window, or of the longest block within T."""
@@ -606,12 +624,16 @@ def main(argv: list[str] | None = None) -> None:
             f_tr = band_variant(acc_tr[case], B, fields, extra)
             f_te = band_variant(acc_te[case], B, fields, extra)[scored]
             per = 1000 // B
-            model = fit(v_tr, gd_tr, f_tr, max(1, BATCH_SAMPLES // B))
-            sc = estimates(model, v_s, gd_s, f_te, per, log_grid)
-            if bands is None:  # the first variant is the 8-band vector
+            try:
+                model = fit(v_tr, gd_tr, f_tr, max(1, BATCH_SAMPLES // B))
+                sc = estimates(model, v_s, gd_s, f_te, per, log_grid)
+            except np.linalg.LinAlgError:  # more outputs than the short campaigns resolve
+                print(f"{name:<34}{B:5d}{f_tr.shape[2]:4d} {singular('', n_runs, keep_s)}")
+                continue
+            if name == FIRST_VARIANT:
                 bands = sc, per * B
             t = info_per_s(sc, per * B / RATE_HZ, rng)
-            r, r_se = paired_j_ratio(sc, per * B, *bands, rng)
+            r, r_se = paired_j_ratio(sc, per * B, *bands, rng) if bands else (np.nan, np.nan)
             print(f"{name:<34}{B:5d}{f_tr.shape[2]:4d} {t['J']:7.2f} +- {t['se']:4.2f} "
                   f"{t['Jlin']:7.2f} +- {t['se_lin']:4.2f} {t['cov']:5.2f} "
                   f"{r:7.3f} +- {r_se:5.3f}")  # fmt: skip

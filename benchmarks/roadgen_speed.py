@@ -1,11 +1,14 @@
 """Time roadgen's hot paths on the paper's sizes (150 m at 6 mm, 25,001 points); prints medians.
 
 python benchmarks/roadgen_speed.py [--repeats 21]
+
+Prints the load average before and after: the machine is shared.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import statistics
 import time
 from collections.abc import Callable
@@ -41,9 +44,15 @@ def main(argv: list[str] | None = None) -> None:
         "estimate_gd welch, 150 m": lambda: roadgen.estimate_gd(road, method="welch"),
         "height_at 10,000 positions": lambda: road.height_at(road.x[::2][:10_000]),
     }
-    print(f"median of {args.repeats} runs")
+    print(f"median of {args.repeats} runs; {load()}")
     for name, func in cases.items():
         print(f"{name:34s} {1e3 * median_seconds(func, args.repeats):8.2f} ms")
+    print(load())
+
+
+def load() -> str:
+    """The load average with the cores, printed with the timings (the machine is shared)."""
+    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*os.getloadavg(), os.cpu_count())
 
 
 if __name__ == "__main__":

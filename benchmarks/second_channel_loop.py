@@ -149,10 +149,10 @@ class TwoChannelBCR(control.BCR):
         self._second_in, self._offset = np.asarray(second, dtype=float), 0
         return self.update(t, position, first, speed, now=now)
 
-    def _take(self, t, pos, acc, spd, drop, restart, reason) -> None:
+    def _take(self, t, pos, acc, spd) -> None:
         part = self._second_in[self._offset : self._offset + acc.size]
         self._offset += acc.size
-        super()._take(t, pos, acc, spd, drop, restart, reason)
+        super()._take(t, pos, acc, spd)
         n = self._acc.size  # the first channel's contiguous clean samples: the same tail
         self._second = np.concatenate([self._second, part])[-n:] if n else np.empty(0)
 
@@ -160,9 +160,11 @@ class TwoChannelBCR(control.BCR):
         second = control.block_features(self._second[-block.size :], self.settings.feature)[0]
         return np.concatenate([super()._block_feature(block), second])
 
-    def _signal_reason(self, accel: np.ndarray) -> str:
-        return signal_fault(accel, self.settings.sensor) or signal_fault(
-            self._second[-accel.size :], self.settings.sensor
+    def _signal_reason(self, accel: np.ndarray, timing: bool = True, steady: bool = True) -> str:
+        """The shipped checks (time stamps, odometry, the first channel), then the signal
+        checks on the second channel's samples alongside ``accel``."""
+        return super()._signal_reason(accel, timing, steady) or signal_fault(
+            self._second[-accel.size :], self.settings.sensor, steady=steady
         )
 
 
@@ -203,6 +205,12 @@ def two_channel_loop(track, likelihood, bcr, simplex, noise_std: float, seed: in
     return position, mean, lo, hi, np.array([c for _, _, c in rows])
 
 
+def loop_settings() -> control.BCRSettings:
+    """The BCR's defaults with the feature the benchmark's emulators were fitted to (`SPEC`, the
+    band powers alone: the shipped feature has added two quantiles since)."""
+    return control.BCRSettings(feature=SPEC)
+
+
 def drive(job: tuple) -> dict:
     """One closed-loop run of closed_loop_accuracy's kinds, with one channel set."""
     channels, case, kind, seed, extra, emulator_dir, pcs = job
@@ -211,7 +219,7 @@ def drive(job: tuple) -> dict:
         emu = gpmsa.load(path)
         _MODELS[path] = (emu, control.ObservationModel(emu))
     emu, likelihood = _MODELS[path]
-    bcr = control.BCRSettings()
+    bcr = loop_settings()
     simplex = control.Simplex()
     if kind == "steady":
         gd, speed = extra
