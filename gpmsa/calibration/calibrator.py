@@ -4,12 +4,14 @@ For one or two calibration parameters the posterior is computed exactly on a gri
 with the emulator parameters fixed, the observation's reduced data u given the simulation weights w
 is Gaussian at every theta (``gpmsa.calibration.model``), lamOs is integrated out per theta node by
 quadrature, and the posterior is the prior times that likelihood on the grid, refined around each
-mode (separated region of mass) that the grid does not resolve. Between nodes the posterior
-density is linear (bilinear for two parameters): its quantiles, CDF and draws use that density,
-its moments the trapezoid sums over the nodes (``GridMarginal``; the two differ by about h^2 / 6
-in variance, h the node spacing, so the draws' sd can exceed ``sd()`` by a fraction of a percent
-on a grid that resolves the posterior) (``gpmsa.calibration.grid``: interpolation, constraint
-boundaries, draws, refinement).
+mode (separated region of mass) that the grid does not resolve (for two parameters whose heavy
+tails hold the grid beyond its node budget, the core of each marginal, its tails on fewer
+nodes; a warning where a marginal stays under ``grid.UNRESOLVED_SD`` node spacings per sd).
+Between nodes the posterior density is linear (bilinear for two parameters): its quantiles, CDF
+and draws use that density, its moments the trapezoid sums over the nodes (``GridMarginal``; the
+two differ by about h^2 / 6 in variance, h the node spacing, so the draws' sd can exceed ``sd()``
+by a fraction of a percent on a grid that resolves the posterior) (``gpmsa.calibration.grid``:
+interpolation, constraint boundaries, draws, refinement).
 More parameters use the MCMC of ``gpmsa.calibrate``.
 
 The fixed grid (``Calibrator.theta_grid``): ``n_grid`` equally spaced nodes per calibration
@@ -28,6 +30,7 @@ from scipy.special import ndtr
 from gpmsa import backends
 from gpmsa.calibration.grid import (
     RIDGE_SD,
+    UNRESOLVED_SD,
     ConstraintCut,
     check_log_density,
     check_mass,
@@ -39,6 +42,8 @@ from gpmsa.calibration.grid import (
     mesh,
     nearest,
     refined_axes,
+    resolution,
+    tail_refined_axes,
     trimmed_marginal,
     with_edges,
 )
@@ -337,9 +342,12 @@ class Calibrator:
                 counter of its updates, an update that raises not counted).
 
         Returns:
-            Posterior; for the grid method its summaries of theta are exact (grid) and
-            ``info["log_evidence"]`` holds log p(u_obs) under the emulator's (normalised) theta
-            prior times the given prior (as given, unnormalised), for one parameter.
+            Posterior; for the grid method its summaries of theta are exact (grid),
+            ``info["resolution"]`` holds per parameter the node spacings per sd of its marginal
+            on the final grid (two parameters; ``grid.resolution``; under
+            ``grid.UNRESOLVED_SD`` a warning names it) and ``info["log_evidence"]`` holds
+            log p(u_obs) under the emulator's (normalised) theta prior times the given prior
+            (as given, unnormalised), for one parameter.
         """
         count = self._count + 1  # counted once it succeeds
         if self.method == "mcmc":
@@ -361,24 +369,41 @@ class Calibrator:
                 keep = self._axes if not callable(prior) and np.isneginf(user).any() else None
             logp = constrained(free, ok)
             check_mass(logp)
+            res = None  # two parameters: the resolution (grid.resolution) of the last grid
             for _ in range(MAX_REFINE):
                 finer = refined_axes(axes, logp, keep)
+                last = finer is None  # resolved, or no refinement factor fits
+                if last and self.q == 2:  # heavy tails may be what holds it: one last pass
+                    res = resolution(axes, logp)
+                    finer = tail_refined_axes(axes, logp, keep, res)
                 if finer is None:
                     break
-                axes, theta = finer, mesh(finer)
-                margs = self._marginals(data, theta)
-                free = self._combine(margs) + self._theta_prior_at(theta, prior)
-                ok = None if self.constraint is None else self._allowed(theta)
-                logp = constrained(free, ok)
-                check_mass(logp)
+                axes = finer
+                margs, free, ok, logp = self._on_grid(data, axes, prior)
+                if last:
+                    res = resolution(axes, logp)
+                    break
         key = check_seed(seed) if seed is not None else (self._entropy, count)
         post = self._posterior(axes, free, ok, margs, key)
         post.info["outside_sds"] = outside
         if self.q == 2:
+            post.info["resolution"] = res = res or resolution(axes, logp)
+            _warn_if_unresolved(res, tuple(self.emulator.t_names), self.n_grid)
             post.info["conditional_sds"] = sds = conditional_sds(axes, logp)
             _warn_if_ridge(sds, tuple(self.emulator.t_names), self.n_grid)
         self._count = count
         return post
+
+    def _on_grid(self, data, axes: list, prior) -> tuple:
+        """The lamOs marginals, unconstrained log posterior (G,), constraint verdicts (G,) (None:
+        no constraint) and log posterior (G,) at the nodes of the refined unit-scale ``axes``."""
+        theta = mesh(axes)
+        margs = self._marginals(data, theta)
+        free = self._combine(margs) + self._theta_prior_at(theta, prior)
+        ok = None if self.constraint is None else self._allowed(theta)
+        logp = constrained(free, ok)
+        check_mass(logp)
+        return margs, free, ok, logp
 
     def _update_mcmc(self, x_obs, y_obs, prior, seed, count: int) -> Posterior:
         """``update`` on the MCMC path (``gpmsa.calibrate``), the ``count``-th update."""
@@ -516,6 +541,20 @@ class Calibrator:
             "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
         return Posterior(grids=grids, draw=draw, info=info)
+
+
+def _warn_if_unresolved(res: tuple[float, float], names: tuple, n_grid: int) -> None:
+    """Warn when a two-parameter marginal spans fewer than UNRESOLVED_SD node spacings per sd on
+    the grid refinement ended with (`gpmsa.calibration.grid.resolution`)."""
+    k = int(np.argmin(res))
+    if res[k] < UNRESOLVED_SD:
+        warnings.warn(
+            f"the grid does not resolve the posterior of {names[k]}: its sd spans {res[k]:.2g} "
+            f"node spacings (fewer than {UNRESOLVED_SD:g}) on the grid refinement ended with, so "
+            f"its quantiles, cdf and draws may be off by several per cent of an sd; use "
+            f"method='mcmc' or another n_grid (now {n_grid})",
+            stacklevel=3,
+        )
 
 
 def _warn_if_ridge(sds: tuple[float, float], names: tuple, n_grid: int) -> None:
