@@ -1,4 +1,5 @@
-"""Load a script of examples/ as a module (its functions tested without running main)."""
+"""Load a script of examples/ or benchmarks/ as a module (its functions tested without running
+main)."""
 
 import importlib.util
 import sys
@@ -6,6 +7,7 @@ from pathlib import Path
 from types import ModuleType
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+BENCHMARKS = EXAMPLES.parent / "benchmarks"
 
 
 def load_example(name: str) -> ModuleType:
@@ -15,5 +17,15 @@ def load_example(name: str) -> ModuleType:
         sys.path.append(str(EXAMPLES))
     spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def load_benchmark(name: str) -> ModuleType:
+    """benchmarks/<name>.py imported as module ``name``, registered in sys.modules (a dataclass
+    of the script looks its module up there)."""
+    spec = importlib.util.spec_from_file_location(name, BENCHMARKS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
     spec.loader.exec_module(module)
     return module

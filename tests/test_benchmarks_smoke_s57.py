@@ -1,9 +1,7 @@
 """Benchmarks at their smallest settings (session 57): what broke or mislabelled there, tested on
 the pure functions (a benchmark's own run takes 5-350 s) and one run that takes about a second."""
 
-import importlib.util
 import inspect
-import sys
 import warnings
 from collections import Counter
 from dataclasses import replace
@@ -14,23 +12,16 @@ import pytest
 
 import control
 from control.sensor_checks import SensorLimits, flight_reading
+from tests._examples import load_benchmark
 from tests._script_runs import run_scripts
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _load_benchmark(name: str):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # (a dataclass looks its module up there)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_sensor_checks_power_table_takes_every_block_when_there_are_fewer_than_1000() -> None:
     # --keep-s 1.05 (valid: one block a drive) gives 198 blocks: the power table drew 1,000
     # without replacement and stopped with numpy's "Cannot take a larger sample" traceback
-    bench = _load_benchmark("sensor_checks")
+    bench = load_benchmark("sensor_checks")
     blocks = np.random.default_rng(0).standard_normal((30, bench.BLOCK))
     limits = SensorLimits(noise_sd_mps2=1.0)
     hits, tried = bench.lattice_hits(
@@ -45,7 +36,7 @@ def test_sensor_checks_power_table_takes_every_block_when_there_are_fewer_than_1
 def test_fault_soak_worst_runs_over_the_whole_run_are_random_scenarios_only() -> None:
     # the list sliced the outcomes that did not crash by the number of random scenarios: one
     # crashed scenario let the first example into "random scenarios with the largest excess"
-    bench = _load_benchmark("fault_soak")
+    bench = load_benchmark("fault_soak")
 
     def outcome(name: str, crash: str = "", diff: float = 0.0, during: float = 0.0):
         sc = bench.Scenario(name, "A", ((50.0, 300.0),), 1, 1, "spike", 1.0, 1.0)
@@ -68,7 +59,7 @@ def _random_run(steps, delays) -> dict:
 def test_accuracy_random_set_without_a_rise_does_not_judge_the_delay_target() -> None:
     # --random-tracks 1 (track 401: no rise of 150) printed "median delay nan m [nan, nan] ...
     # target NOT met" after numpy's empty-slice warnings
-    bench = _load_benchmark("closed_loop_accuracy")
+    bench = load_benchmark("closed_loop_accuracy")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         line = bench.report_random([_random_run([(400.0, 300.0)], [np.nan])], "A")
@@ -82,7 +73,7 @@ def test_accuracy_random_set_without_a_rise_does_not_judge_the_delay_target() ->
 def test_feature_information_lack_of_fit_is_unknown_with_as_many_runs_as_coefficients() -> None:
     # --n-runs 10 (the smallest allowed): the cubic's 10 coefficients go through every run mean;
     # the lack of fit divided by zero degrees of freedom (a RuntimeWarning, then inf in the table)
-    bench = _load_benchmark("feature_information")
+    bench = load_benchmark("feature_information")
     rng = np.random.default_rng(0)
     v, gd = rng.uniform(0.5, 2.0, 10), rng.uniform(200.0, 600.0, 10)
     feats = np.log(gd)[:, None, None] + 0.1 * rng.standard_normal((10, 16, 2))
@@ -98,7 +89,7 @@ def test_feature_information_singular_covariance_is_named_with_its_remedy() -> N
     # a variant with more outputs than the short campaigns' batch means (--n-runs 10 --keep-s
     # 16.67, 10 outputs) stopped section 4 with numpy's "Singular matrix" traceback
     # (the table row says so and section 4 goes on; fit raises what the rows catch)
-    bench = _load_benchmark("feature_information")
+    bench = load_benchmark("feature_information")
     rng = np.random.default_rng(0)
     v, gd = rng.uniform(0.5, 2.0, 12), rng.uniform(200.0, 600.0, 12)
     feats = rng.standard_normal((12, 16, 3))
@@ -114,7 +105,7 @@ def test_feature_information_singular_covariance_is_named_with_its_remedy() -> N
 def test_second_channel_loop_reads_the_feature_its_emulators_were_fitted_to() -> None:
     # the loops ran the default BCRSettings, whose feature has had two quantiles added (10
     # outputs) since: every run stopped on "y must be 8 finite numbers" (the 8 band powers)
-    bench = _load_benchmark("second_channel_loop")
+    bench = load_benchmark("second_channel_loop")
     settings = bench.loop_settings()
     assert settings.feature == bench.SPEC
     assert settings.feature.dim == 8
@@ -125,13 +116,13 @@ def test_second_channel_loop_reads_the_feature_its_emulators_were_fitted_to() ->
 def test_second_channel_loop_bcr_overrides_the_bcr_hooks_it_extends(hook: str) -> None:
     # BCR._take lost its (drop, restart, reason) arguments and _signal_reason gained (timing,
     # steady): the two-channel runs stopped with "_take() missing 3 required positional args"
-    bench = _load_benchmark("second_channel_loop")
+    bench = load_benchmark("second_channel_loop")
     mine = inspect.signature(getattr(bench.TwoChannelBCR, hook))
     assert mine == inspect.signature(getattr(control.BCR, hook))
 
 
 def test_backends_rhat_of_too_few_draws_is_nan_without_a_warning() -> None:
-    bench = _load_benchmark("backends")
+    bench = load_benchmark("backends")
     draws = {"a": np.random.default_rng(0).standard_normal((2, 4))}  # split R-hat: NaN
     with warnings.catch_warnings():
         warnings.simplefilter("error")

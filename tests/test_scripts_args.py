@@ -3,7 +3,6 @@
 from deep inside a library). Also: the accuracy benchmark drives the robot that its emulators
 record."""
 
-import importlib.util
 import os
 import subprocess
 import sys
@@ -14,6 +13,7 @@ import pytest
 
 import control
 import vehicle
+from tests._examples import load_benchmark
 from tests._script_runs import run_scripts
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -265,14 +265,6 @@ def test_bad_argument_is_a_usage_error_naming_it(usage_runs, case) -> None:
     assert a_file.read_text() == "kept"
 
 
-def _load_benchmark(name: str):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module  # (a dataclass looks its module up there)
-    spec.loader.exec_module(module)
-    return module
-
-
 def _emulators_for_another_robot(folder: Path, noise_std: float) -> Path:
     """The shipped band emulator of case A, its record changed to a 21.5 kg Jackal and the
     given training noise, saved in ``folder``."""
@@ -285,7 +277,7 @@ def _emulators_for_another_robot(folder: Path, noise_std: float) -> Path:
 
 
 def test_accuracy_benchmark_drives_the_robot_its_emulators_record(tmp_path) -> None:
-    bench = _load_benchmark("closed_loop_accuracy")
+    bench = load_benchmark("closed_loop_accuracy")
     for case in ("A", "B"):  # the shipped emulators: the default Jackal and the cases' noise
         emu = bench.emulator_for(case, "changepoint", None)
         assert bench.driven(emu) == (vehicle.Jackal(), bench.NOISE_STD[case])
@@ -346,7 +338,7 @@ def test_oracle_replay_is_the_loops_estimator_and_the_oracles_know_more() -> Non
     """The oracle benchmark's replay without an oracle follows the loop's own estimates (it
     lacks only the sensor guards, which a clean simulated drive rarely calls); knowing the
     change points lowers the error of both parts."""
-    bench = _load_benchmark("oracle_bounds")
+    bench = load_benchmark("oracle_bounds")
     out = bench._run(("A", 1))
     loop, replayed = (
         [control.pooled_rmse([out[name]], gd) for gd in (300.0, 500.0)]
