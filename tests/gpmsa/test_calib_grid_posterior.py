@@ -196,7 +196,10 @@ def test_two_parameter_peaks_are_each_refined():
     emu = symmetric_two_param_emulator()
     x = np.linspace(0.05, 0.95, 12)[:, None]
     y = (0.3 - 0.5) ** 2 * (1 + x) + 0.3 * 0.5 * x
-    post = Calibrator(emu).update(x, y)
+    # two peaks too far apart to refine both within the node budget: the moments below are
+    # right, the quantiles and cdf of a are not (0.026 off), and a warning says so
+    with pytest.warns(UserWarning, match="does not resolve the posterior of a: its sd spans 0.8"):
+        post = Calibrator(emu).update(x, y)
     fine = Calibrator(emu, n_grid=257).update(x, y)  # resolved: not refined
     assert post.info["refined"] and not fine.info["refined"]
     assert post.prob_above("a", 0.5) == pytest.approx(fine.prob_above("a", 0.5), abs=1e-4)
@@ -215,12 +218,15 @@ def test_gridded_prior_with_zeros_survives_refinement_in_two_parameters():
     a = cal.theta_grid[:, 0]
     end = a[a > 0.4].min()  # the prior is zero from the first grid line past a = 0.4
     flat = cal.update(x, y)
-    post = cal.update(x, y, prior=np.where(a <= 0.4, 0.0, -np.inf))
+    # every grid line of the gridded prior is kept, so its tails cannot be thinned: a warning
+    with pytest.warns(UserWarning, match="does not resolve the posterior of a"):
+        post = cal.update(x, y, prior=np.where(a <= 0.4, 0.0, -np.inf))
     assert post.info["refined"]
     assert post.prob_above("a", end) == 0.0
     assert post.samples["a"].max() <= end
     assert post.mean("a") < flat.mean("a")
-    as_table = cal.update(x, y, prior=np.where(a <= 0.4, 0.0, -np.inf).reshape(65, 65))
+    with pytest.warns(UserWarning, match="does not resolve the posterior of a"):
+        as_table = cal.update(x, y, prior=np.where(a <= 0.4, 0.0, -np.inf).reshape(65, 65))
     assert as_table.mean("a") == post.mean("a")
 
 
