@@ -4,9 +4,10 @@ For one or two calibration parameters the posterior is computed exactly on a gri
 with the emulator parameters fixed, the observation's reduced data u given the simulation weights w
 is Gaussian at every theta (``gpmsa.calibration.model``), lamOs is integrated out per theta node by
 quadrature, and the posterior is the prior times that likelihood on the grid, refined around each
-mode (separated region of mass) that the grid does not resolve (for two parameters whose heavy
-tails hold the grid beyond its node budget, the core of each marginal, its tails on fewer
-nodes; a warning where a marginal stays under ``grid.UNRESOLVED_SD`` node spacings per sd).
+mode (separated region of mass) that the grid does not resolve (where heavy tails hold the grid
+beyond its node budget, the core of each marginal, its tails on fewer nodes; for one parameter
+down to float64's resolution; a warning where a marginal stays under ``grid.UNRESOLVED_SD``
+node spacings per sd).
 Between nodes the posterior density is linear (bilinear for two parameters): its quantiles, CDF
 and draws use that density, its moments the trapezoid sums over the nodes (``GridMarginal``; the
 two differ by about h^2 / 6 in variance, h the node spacing, so the draws' sd can exceed ``sd()``
@@ -42,6 +43,7 @@ from gpmsa.calibration.grid import (
     mesh,
     nearest,
     refined_axes,
+    refined_axis,
     resolution,
     tail_refined_axes,
     trimmed_marginal,
@@ -69,6 +71,13 @@ from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 METHODS = ("auto", "grid", "mcmc")
 MAX_REFINE = 4
 """Refinement passes of one update, at most (each refines the peaks still unresolved)."""
+MAX_REFINE_ONE = 9
+"""The same for one parameter, whose passes are cheap (N_REFINE nodes): a peak on one node
+narrows the spacing about 64-fold per pass, from 1/128 of the range to float64's resolution
+(``Calibrator._min_step``) in 8 (4 passes resolved an sd down to about 1e-9 of the range)."""
+MIN_STEP_ULPS = 8
+"""One parameter: refined nodes are at least this many float64 spacings (ulps) apart, in the
+unit scale and in the parameter's native units (``Calibrator._min_step``)."""
 BISECT_STEPS = 64
 """Bisection steps locating a constraint's boundary between two nodes (to adjacent floats)."""
 
@@ -212,6 +221,9 @@ class Calibrator:
         self._log_prior_norm = float(
             np.log(pri.theta_sd * np.sqrt(2 * np.pi) * (ndtr(z[0]) - ndtr(z[1])))
         )
+        lo, hi = float(std.t_min[0]), float(std.t_max[0])  # one parameter: float64's resolution
+        self._min_step = MIN_STEP_ULPS * max(np.spacing(1.0), np.spacing(max(abs(lo), abs(hi)))
+                                             / (hi - lo))  # fmt: skip
         self._base_ok = None if self.constraint is None else self._allowed(self._theta_unit)
         self._base_cut = None if self._base_ok is None else self._cut(self._axes, self._base_ok)
 
@@ -370,9 +382,15 @@ class Calibrator:
             logp = constrained(free, ok)
             check_mass(logp)
             res = None  # two parameters: the resolution (grid.resolution) of the last grid
-            for _ in range(MAX_REFINE):
-                finer = refined_axes(axes, logp, keep)
-                last = finer is None  # resolved, or no refinement factor fits
+            why = "resolved"  # one parameter: why refinement ended (grid.refined_axis)
+            for _ in range(MAX_REFINE if self.q == 2 else MAX_REFINE_ONE):
+                if self.q == 1:
+                    line = None if keep is None else keep[0]
+                    finer, why = refined_axis(axes[0], logp, line, self._min_step)
+                    finer, last = (None if finer is None else [finer]), why != "refine"
+                else:
+                    finer = refined_axes(axes, logp, keep)
+                    last = finer is None  # resolved, or no refinement factor fits
                 if last and self.q == 2:  # heavy tails may be what holds it: one last pass
                     res = resolution(axes, logp)
                     finer = tail_refined_axes(axes, logp, keep, res)
@@ -386,6 +404,12 @@ class Calibrator:
         key = check_seed(seed) if seed is not None else (self._entropy, count)
         post = self._posterior(axes, free, ok, margs, key)
         post.info["outside_sds"] = outside
+        if self.q == 1 and why != "resolved":  # passes, node budget or float64 ran out
+            res = res or resolution(axes, logp)
+            if why == "float":
+                _warn_at_float(res[0], post.grids[self.emulator.t_names[0]], self.emulator)
+            else:
+                _warn_if_unresolved(res, tuple(self.emulator.t_names), self.n_grid)
         if self.q == 2:
             post.info["resolution"] = res = res or resolution(axes, logp)
             _warn_if_unresolved(res, tuple(self.emulator.t_names), self.n_grid)
@@ -543,9 +567,26 @@ class Calibrator:
         return Posterior(grids=grids, draw=draw, info=info)
 
 
-def _warn_if_unresolved(res: tuple[float, float], names: tuple, n_grid: int) -> None:
-    """Warn when a two-parameter marginal spans fewer than UNRESOLVED_SD node spacings per sd on
-    the grid refinement ended with (`gpmsa.calibration.grid.resolution`)."""
+def _warn_at_float(res: float, marginal, emulator) -> None:
+    """Warn when the one-parameter posterior's sd spans fewer than UNRESOLVED_SD node spacings
+    where refinement stopped at float64's resolution of the parameter (``marginal``: its
+    GridMarginal, native units)."""
+    if res < UNRESOLVED_SD:
+        name, unit = emulator.t_names[0], emulator.t_units[0]
+        k = int(np.argmax(marginal.density))
+        h = float(np.diff(marginal.nodes)[max(k - 1, 0) : k + 1].max())
+        warnings.warn(
+            f"the posterior of {name} is narrower than the grid can represent: refinement "
+            f"reached float64's resolution of {name} with its sd spanning {res:.2g} node "
+            f"spacings (fewer than {UNRESOLVED_SD:g}); its sd, quantiles and draws are good "
+            f"to about the node spacing there, {h:.3g}{f' {unit}' if unit else ''}",
+            stacklevel=3,
+        )
+
+
+def _warn_if_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> None:
+    """Warn when a marginal spans fewer than UNRESOLVED_SD node spacings per sd on the grid
+    refinement ended with (`gpmsa.calibration.grid.resolution`)."""
     k = int(np.argmin(res))
     if res[k] < UNRESOLVED_SD:
         warnings.warn(

@@ -3,9 +3,10 @@ interpolation between nodes (linear, bilinear; in the log between finite values,
 next to a zero), a constraint's boundary inserted into a one-parameter grid and resolved on
 split cells of a two-parameter one, marginals cut to their support, draws from the bilinear
 density (those a constraint rejects redrawn), and the refinement of each peak the grid does
-not resolve (for two parameters whose heavy tails hold the grid beyond its node budget, of the
-core of each marginal, `tail_refined_axes`). ``gpmsa.calibration.calibrator`` composes them;
-all work on unit-scale or native axes given by the caller.
+not resolve (where heavy tails hold the grid beyond its node budget, of the core of each
+marginal, `tail_refined_axes`; one parameter: `refined_axis`).
+``gpmsa.calibration.calibrator`` composes them; all work on unit-scale or native axes given by
+the caller.
 """
 
 from __future__ import annotations
@@ -57,7 +58,9 @@ MAX_REDRAW_ROUNDS = 100
 UNRESOLVED_SD = 1.5
 """Two parameters: where no refinement factor fits and a marginal's `resolution` is under this
 many node spacings per sd, one last pass refines the core of each marginal under RESOLVE_SD
-(`tail_refined_axes`); a marginal still under it afterwards is named in a warning. On
+(`tail_refined_axes`; one parameter, `refined_axis`: where it is under RESOLVE_SD); a marginal
+still under UNRESOLVED_SD afterwards is named in a warning (one parameter also where the
+refinement passes run out or reach float64's resolution). On
 `two_param_emulator` (few observations, one peak) the quantiles erred by about 0.15 / r**2 sd
 and the cdf by about 0.025 / r**2 at r spacings per sd (0.19 sd, 0.029 at r = 0.91; 0.105,
 0.019 at 1.22; 0.05, 0.009 at 1.75); the two-peak cases of the tests at 1.7 and 2.2 (their
@@ -414,8 +417,10 @@ def conditional_sds(axes: list, logp: np.ndarray) -> tuple[float, float]:
 
 
 def _marginals(axes: list, logp: np.ndarray) -> list:
-    """Two parameters: the posterior's (log density ``logp`` (G,) on the grid of ``axes``)
-    marginal density (unnormalised) at the nodes of each axis (trapezoid sums)."""
+    """The posterior's (log density ``logp`` (G,) on the grid of ``axes``) marginal density
+    (unnormalised) at the nodes of each axis (trapezoid sums; one parameter: the density)."""
+    if len(axes) == 1:
+        return [np.exp(logp - np.max(logp))]
     f = np.exp(logp - np.max(logp)).reshape(axes[0].size, axes[1].size)
     w = [trapezoid_weights(a) for a in axes]
     return [f @ w[1], w[0] @ f]
@@ -453,11 +458,10 @@ def _resolution(axis: np.ndarray, density: np.ndarray) -> float:
     return float(np.sqrt(total / inverse2))
 
 
-def resolution(axes: list, logp: np.ndarray) -> tuple[float, float]:
-    """Two parameters: per parameter, the node spacings per sd of its marginal on the grid of
-    ``axes`` (`_resolution`; the posterior's log density ``logp`` (G,))."""
-    r = [_resolution(a, m) for a, m in zip(axes, _marginals(axes, logp), strict=True)]
-    return r[0], r[1]
+def resolution(axes: list, logp: np.ndarray) -> tuple[float, ...]:
+    """Per parameter, the node spacings per sd of its marginal on the grid of ``axes``
+    (`_resolution`; the posterior's log density ``logp`` (G,))."""
+    return tuple(_resolution(a, m) for a, m in zip(axes, _marginals(axes, logp), strict=True))
 
 
 def _core(axis: np.ndarray, density: np.ndarray) -> tuple[int, int]:
@@ -472,20 +476,27 @@ def _core(axis: np.ndarray, density: np.ndarray) -> tuple[int, int]:
 
 
 def tail_refined_axes(
-    axes: list, logp: np.ndarray, keep: list | None, res: tuple[float, float]
+    axes: list,
+    logp: np.ndarray,
+    keep: list | None,
+    res: tuple[float, ...],
+    below: float = UNRESOLVED_SD,
 ) -> list | None:
-    """Two parameters, where `refined_axes` found no refinement factor that fits MAX_REFINED:
-    when the resolution ``res`` (`resolution`) of some parameter is under UNRESOLVED_SD, the
+    """Where `refined_axes` found no refinement factor that fits MAX_REFINED: when the
+    resolution ``res`` (`resolution`) of some parameter is under ``below`` (two parameters:
+    UNRESOLVED_SD; one, `refined_axis`: RESOLVE_SD), the
     unit-scale axes of a grid on which each parameter under RESOLVE_SD has the nodes of its
     core (`_core`: the region holding all but TAIL_MASS of its marginal mass) replaced by
-    equally spaced ones, about RESOLVE_SD per sd (at least N_REFINE_2D, and REFINE_FACTORS[-1]
-    times the cells), and a share of its tails' nodes kept (`_with_core`; the first of
-    TAIL_SHARES that fits the grid within MAX_REFINED times N_REFINE_2D squared nodes);
+    equally spaced ones, about RESOLVE_SD per sd (at least N_REFINE_2D, N_REFINE for one
+    parameter, and REFINE_FACTORS[-1] times the cells), and a share of its tails' nodes kept
+    (`_with_core`; the first of TAIL_SHARES that fits the grid within MAX_REFINED times
+    N_REFINE_2D squared nodes, N_REFINE for one parameter);
     ``keep``: grid lines per parameter that it keeps (None: none). None where no parameter is
-    under UNRESOLVED_SD, or no core is narrower than its axis (heavy tails are not what holds
+    under ``below``, or no core is narrower than its axis (heavy tails are not what holds
     the grid), or nothing fits."""
-    if min(res) >= UNRESOLVED_SD:
+    if min(res) >= below:
         return None
+    n_core = N_REFINE if len(axes) == 1 else N_REFINE_2D
     parts = []
     for k, (a, m) in enumerate(zip(axes, _marginals(axes, logp), strict=True)):
         c0, c1 = _core(a, m)
@@ -493,7 +504,7 @@ def tail_refined_axes(
             parts.append((a, None, None, None))
             continue
         factor = max(REFINE_FACTORS[-1], RESOLVE_SD / max(res[k], 0.1))
-        n = max(N_REFINE_2D, int(np.ceil(factor * (c1 - c0))) + 1)
+        n = max(n_core, int(np.ceil(factor * (c1 - c0))) + 1)
         core = np.linspace(a[c0], a[c1], n)
         if keep is not None:
             lines = keep[k][(keep[k] > a[c0]) & (keep[k] < a[c1])]
@@ -502,11 +513,11 @@ def tail_refined_axes(
         parts.append((a, core, c0, c1))
     if all(core is None for _, core, _, _ in parts):
         return None
-    limit = MAX_REFINED * N_REFINE_2D**2
+    limit = MAX_REFINED * n_core ** len(axes)
     for share in TAIL_SHARES:
         finer = [a if core is None else _with_core(a, core, c0, c1, share, keep, k)
                  for k, (a, core, c0, c1) in enumerate(parts)]  # fmt: skip
-        if finer[0].size * finer[1].size <= limit:
+        if np.prod([a.size for a in finer]) <= limit:
             return finer
     return None
 
@@ -530,28 +541,52 @@ def _with_core(
 
 
 def refined_axes(axes: list, logp: np.ndarray, keep: list | None) -> list | None:
-    """The unit-scale axes of a finer grid where a mode of the posterior (log density ``logp``
-    (G,) on the grid of ``axes``) is not resolved along some parameter (`_modes` of its
-    marginal), None when all are; ``keep``: grid lines per parameter that a refined region
-    keeps (None: none)."""
-    f = np.exp(logp - np.max(logp))
-    if len(axes) == 1:
-        if _one_resolved_peak(axes[0], f):
-            return None
-        marginals = [f]  # no trapezoid weights: equally spaced within a mode
-    else:
-        f = f.reshape(axes[0].size, axes[1].size)
-        w = [trapezoid_weights(a) for a in axes]
-        marginals = [f @ w[1], w[0] @ f]
-    modes = [_modes(a, m) for a, m in zip(axes, marginals, strict=True)]
+    """Two parameters: the unit-scale axes of a finer grid where a mode of the posterior (log
+    density ``logp`` (G,) on the grid of ``axes``) is not resolved along some parameter
+    (`_modes` of its marginal), None when all are or no refinement factor fits MAX_REFINED;
+    ``keep``: grid lines per parameter that a refined region keeps (None: none). One
+    parameter: `refined_axis`."""
+    modes = [_modes(a, m) for a, m in zip(axes, _marginals(axes, logp), strict=True)]
     if not any(m[2].any() for m in modes):
         return None
-    n = N_REFINE if len(axes) == 1 else N_REFINE_2D
     for factor in REFINE_FACTORS:  # the largest that keeps the grid within MAX_REFINED
         finer = [
-            _finer_axis(a, m, n, None if keep is None else keep[k], factor)
+            _finer_axis(a, m, N_REFINE_2D, None if keep is None else keep[k], factor)
             for k, (a, m) in enumerate(zip(axes, modes, strict=True))
         ]
-        if np.prod([a.size for a in finer]) <= MAX_REFINED * n ** len(axes):
+        if finer[0].size * finer[1].size <= MAX_REFINED * N_REFINE_2D**2:
             return finer
     return None
+
+
+def refined_axis(
+    axis: np.ndarray, logp: np.ndarray, keep: np.ndarray | None, min_step: float
+) -> tuple[np.ndarray | None, str]:
+    """One parameter: the unit-scale axis of the next grid and why, from the posterior's log
+    density ``logp`` (k,) on ``axis`` (k,):
+
+    - (None, "resolved"): every peak is resolved (the usual case, found by a quick test);
+    - (finer, "refine"): a finer axis over each unresolved peak (as `refined_axes` for two);
+    - (finer, "tails") or (None, "tails"): no refinement factor fits MAX_REFINED (heavy tails
+      hold a region above MASS_CUTOFF wider than the node budget): `tail_refined_axes` (None
+      where it does not apply or fit); the last pass;
+    - (None, "float"): the finer axis would space nodes closer than ``min_step`` (float64's
+      resolution of the parameter, unit scale): the posterior is narrower than the grid can
+      represent.
+
+    ``keep``: grid lines a refined region keeps (None: none)."""
+    f = np.exp(logp - np.max(logp))
+    if _one_resolved_peak(axis, f):
+        return None, "resolved"
+    modes = _modes(axis, f)  # no trapezoid weights: equally spaced within a mode
+    if not modes[2].any():
+        return None, "resolved"
+    for factor in REFINE_FACTORS:  # the largest that keeps the grid within MAX_REFINED
+        finer = _finer_axis(axis, modes, N_REFINE, keep, factor)
+        if finer.size <= MAX_REFINED * N_REFINE:
+            return (None, "float") if np.diff(finer).min() < min_step else (finer, "refine")
+    keeps = None if keep is None else [keep]
+    tails = tail_refined_axes([axis], logp, keeps, resolution([axis], logp), RESOLVE_SD)
+    if tails is not None and np.diff(tails[0]).min() < min_step:
+        return None, "float"
+    return (None if tails is None else tails[0]), "tails"
