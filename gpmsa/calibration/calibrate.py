@@ -30,6 +30,7 @@ from gpmsa.calibration.observations import (
     check_x,
     check_y,
     emulator_param_sets,
+    emulator_record,
     fit_of,
     fixed_gp,
     lamos_start,
@@ -276,7 +277,7 @@ def calibrate(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds, obs_values_sha256=data.values_sha256,
-        emulator_sha256=emulator.model_sha256,
+        **emulator_record(emulator),
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
         backend_options=backends.recorded_options(options),
     )  # fmt: skip

@@ -57,6 +57,7 @@ from gpmsa.calibration.observations import (
     blas_controller,
     check_emulator,
     emulator_param_sets,
+    emulator_record,
     fit_of,
     fixed_gp,
     reduce,
@@ -561,7 +562,7 @@ class Calibrator:
             "refined": not base,
             "log_evidence": log_evidence,
             "emulator_params": self.emulator_params,
-            "emulator_sha256": self.emulator.model_sha256,  # computed once per emulator
+            **emulator_record(self.emulator),  # its model_sha256, computed once per emulator
             "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
         return Posterior(grids=grids, draw=draw, info=info)

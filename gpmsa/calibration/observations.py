@@ -69,6 +69,14 @@ def check_emulator(emulator, categorical_theta: bool = False) -> None:
         )
 
 
+def emulator_record(emulator) -> dict[str, str]:
+    """What a calibration's Posterior info records of its emulator: {"emulator_sha256":
+    ``Emulator.model_sha256``}; {} for an object with only the attributes calibration checks
+    for (``check_emulator``), not a gpmsa.Emulator: it has no fingerprint to record."""
+    sha = getattr(emulator, "model_sha256", None)
+    return {"emulator_sha256": sha} if isinstance(sha, str) else {}
+
+
 def emulator_param_sets(emulator, mode: str, n_sets: int) -> list[dict]:
     """The emulator parameter sets the calibration conditions on (point, or evenly spaced draws)."""
     if mode not in EMULATOR_PARAM_MODES:

@@ -108,17 +108,24 @@ def check_posterior_emulator(emulator, posterior) -> None:
     "emulator_sha256": that emulator's ``Emulator.model_sha256``, as ``gpmsa.calibrate``,
     ``Calibrator.update``, ``calibration_posterior`` and ``Study.member_posterior`` record it)
     and ``emulator`` is another one: its draws would be mixed with another emulator's
-    predictive. A posterior without the record (made by hand, or by older code) is taken."""
+    predictive; or is no gpmsa.Emulator (it has no ``model_sha256``). A posterior without the
+    record (made by hand, by older code, or from an object with only the attributes
+    calibration checks for) is taken."""
     info = getattr(posterior, "info", None) or {}
     recorded = info.get("emulator_sha256")
-    if not isinstance(recorded, str) or recorded == emulator.model_sha256:
+    own = getattr(emulator, "model_sha256", None)
+    if not isinstance(recorded, str) or recorded == own:
         return
+    if not isinstance(own, str):  # not a gpmsa.Emulator: no fingerprint to compare
+        raise GPMSAError(
+            "posterior= records the gpmsa.Emulator it was drawn with (info 'emulator_sha256'); "
+            f"emulator must be that gpmsa.Emulator, got {type(emulator).__name__}"
+        )
     model = info.get("model")
     whose = f" (study model {model!r})" if isinstance(model, str) else ""
     raise GPMSAError(
         f"posterior= was drawn with another emulator{whose} (model_sha256 {recorded[:12]}..., "
-        f"this emulator's {emulator.model_sha256[:12]}...): pass the emulator it was "
-        "calibrated with"
+        f"this emulator's {own[:12]}...): pass the emulator it was calibrated with"
     )
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gpmsa.calibration.observations import emulator_record
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 
@@ -60,7 +61,7 @@ def calibration_posterior(emulator) -> Posterior:
         "method": "joint fit",
         "names": list(samples),
         "n_chains": n_chains,
-        "emulator_sha256": emulator.model_sha256,
+        **emulator_record(emulator),
         **{k: emulator.settings[k] for k in ("n_iter", "n_burn", "thin", "seed", "backend",
                                               "discrepancy", "obs_lengths", "obs_sha256")
            if k in emulator.settings},

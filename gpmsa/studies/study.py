@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from gpmsa.calibration.observations import emulator_record
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, load
@@ -189,7 +190,7 @@ class Study:
         info = {
             "method": f"study {self.kind}",
             "model": self.labels[i],
-            "emulator_sha256": self.members[i].model_sha256,
+            **emulator_record(self.members[i]),
         }
         # the record of the model's observations, so that full_prediction(posterior=) refuses
         # other ones: a fitted model's (as calibration_posterior), a calibrated one's (as
