@@ -48,6 +48,7 @@ from gpmsa.calibration.grid import (
     tail_refined_axes,
     trimmed_marginal,
     with_edges,
+    zero_edges,
 )
 from gpmsa.calibration.model import GridPredictor, LamOsMarginal, lamos_marginal
 from gpmsa.calibration.observations import (
@@ -379,7 +380,8 @@ class Calibrator:
             if prior is not None:
                 user = self._prior_values(prior, theta, True)
                 free = free + user
-                keep = self._axes if not callable(prior) and np.isneginf(user).any() else None
+                if not callable(prior) and np.isneginf(user).any():
+                    keep = zero_edges(self._axes, user)
             logp = constrained(free, ok)
             check_mass(logp)
             res = None  # two parameters: the resolution (grid.resolution) of the last grid

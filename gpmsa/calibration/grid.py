@@ -393,6 +393,21 @@ def _finer_axis(
     return np.unique(np.concatenate(pieces))
 
 
+def zero_edges(axes: list, log_prior: np.ndarray) -> list:
+    """Per parameter, the grid lines a refined grid keeps for a gridded prior with zeros (log
+    values ``log_prior`` (G,) on the grid of ``axes``, -inf where it is zero): both lines of
+    every cell across which the prior changes between zero and non-zero, so that its zero region
+    and the linear ramp into it stay where the fixed grid puts them. Only those: keeping every
+    line held a fine base grid (n_grid > 516) at its own nodes, unrefined."""
+    zero = np.isneginf(log_prior).reshape([a.size for a in axes])
+    out = []
+    for k, a in enumerate(axes):
+        z = np.moveaxis(zero, k, 0).reshape(a.size, -1)
+        crossed = np.any(z[1:] != z[:-1], axis=1)  # cell i (lines i, i + 1) crossed
+        out.append(a[np.concatenate(([False], crossed)) | np.concatenate((crossed, [False]))])
+    return out
+
+
 def conditional_sds(axes: list, logp: np.ndarray) -> tuple[float, float]:
     """Two parameters: per parameter, the root of the mean (over the posterior, log density
     ``logp`` (G,) on the grid of ``axes``) of its variance given the other parameter's node, in
