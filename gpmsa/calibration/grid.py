@@ -314,24 +314,28 @@ def _one_resolved_peak(axis: np.ndarray, density: np.ndarray) -> bool:
     return bool(density @ (axis - mean) ** 2 / total >= (RESOLVE_SD * np.diff(axis).max()) ** 2)
 
 
+def _runs(density: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The runs of nodes of ``density`` (k,) above MASS_CUTOFF of its peak, as (first (r,),
+    last (r,)), and its local minima (indices, for `_valleys`)."""
+    live = np.flatnonzero(density >= MASS_CUTOFF * density.max())
+    slope = np.diff(density)
+    dips = np.flatnonzero((slope[:-1] < 0.0) & (slope[1:] > 0.0)) + 1
+    cut = np.flatnonzero(np.diff(live) > 1)
+    first = live[np.concatenate(([0], cut + 1))]
+    last = live[np.concatenate((cut, [live.size - 1]))]
+    return first, last, dips
+
+
 def _modes(axis: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The modes of a (marginal) density (k,) on the increasing ``axis`` (k,): the runs of nodes
     above MASS_CUTOFF of the peak, as (first (r,), last (r,), unresolved (r,)). A run is
     unresolved when a peak in it (the run cut at its `_valleys`) holds at least MODE_MASS of the
     mass and its sd spans fewer than RESOLVE_SD of its node spacings. Nodes are equally spaced
     within a run (a refined region)."""
-    live = np.flatnonzero(density >= MASS_CUTOFF * density.max())
-    slope = np.diff(density)
-    dips = np.flatnonzero((slope[:-1] < 0.0) & (slope[1:] > 0.0)) + 1  # local minima
-    if live[-1] - live[0] + 1 == live.size:
-        first, last = live[:1], live[-1:]
-        if dips.size == 0:  # one peak, the usual case
-            _, sd, spacing = _mode_stats(axis, density, live[0], live[-1])
-            return first, last, np.array([sd < RESOLVE_SD * spacing])
-    else:
-        cut = np.flatnonzero(np.diff(live) > 1)
-        first = live[np.concatenate(([0], cut + 1))]
-        last = live[np.concatenate((cut, [live.size - 1]))]
+    first, last, dips = _runs(density)
+    if first.size == 1 and dips.size == 0:  # one peak, the usual case
+        _, sd, spacing = _mode_stats(axis, density, first[0], last[0])
+        return first, last, np.array([sd < RESOLVE_SD * spacing])
     peaks, owner = [], []
     for r, (i0, i1) in enumerate(zip(first, last, strict=True)):
         bounds = [i0, *_valleys(density, dips, i0, i1), i1]
@@ -451,12 +455,7 @@ def _resolution(axis: np.ndarray, density: np.ndarray) -> float:
     w = trapezoid_weights(axis)
     h = np.diff(axis)
     local2 = np.concatenate(([h[0]], np.maximum(h[:-1], h[1:]), [h[-1]])) ** 2
-    live = np.flatnonzero(density >= MASS_CUTOFF * density.max())
-    slope = np.diff(density)
-    dips = np.flatnonzero((slope[:-1] < 0.0) & (slope[1:] > 0.0)) + 1  # local minima
-    cut = np.flatnonzero(np.diff(live) > 1)
-    first = live[np.concatenate(([0], cut + 1))]
-    last = live[np.concatenate((cut, [live.size - 1]))]
+    first, last, dips = _runs(density)
     total, inverse2 = 0.0, 0.0
     for i0, i1 in zip(first, last, strict=True):
         bounds = [i0, *_valleys(density, dips, i0, i1), i1]
