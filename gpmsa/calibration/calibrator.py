@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import inspect
 import warnings
+from collections.abc import Callable
 
 import numpy as np
 from scipy.special import ndtr
@@ -350,7 +351,10 @@ class Calibrator:
                 (-inf), so that the prior is zero beyond its zero nodes), or a callable of
                 native theta ((k,) for one parameter, (k, 2) for two) returning (k,); on the
                 MCMC path a callable only. It multiplies the emulator's theta prior
-                (effectively uniform on the domain).
+                (effectively uniform on the domain). For one parameter a callable's zero
+                region (-inf) is cut at its edge, located by bisection as a constraint's
+                boundary is; for two the cell at its edge ramps to zero (``constraint`` cuts
+                exactly).
             seed: seed of the lazily drawn samples, or of the MCMC (there it wins over
                 ``mcmc_options["seed"]``; default: derived from the Calibrator's seed and a
                 counter of its updates, an update that raises not counted).
@@ -405,7 +409,7 @@ class Calibrator:
                     res = resolution(axes, logp)
                     break
         key = check_seed(seed) if seed is not None else (self._entropy, count)
-        post = self._posterior(axes, free, ok, margs, key)
+        post = self._posterior(axes, free, ok, margs, key, prior)
         post.info["outside_sds"] = outside
         if self.q == 1 and why != "resolved":  # passes, node budget or float64 ran out
             res = res or resolution(axes, logp)
@@ -466,11 +470,15 @@ class Calibrator:
             return self._constraint_edges(axes[0], ok)
         return ConstraintCut.make(axes, ok, self._allowed)
 
-    def _constraint_edges(self, nodes: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, ...]:
+    def _constraint_edges(
+        self, nodes: np.ndarray, ok: np.ndarray, allows: Callable | None = None
+    ) -> tuple[np.ndarray, ...]:
         """Where the constraint's status changes between the unit-scale nodes (k,) (one
         parameter; ``ok`` (k,) their status): (cells i (e,), first (e,), second (e,)), the
         boundary bracketed by adjacent floats in [nodes[i], nodes[i + 1]]: ``first`` has the
-        status of node i, ``second`` that of node i + 1."""
+        status of node i, ``second`` that of node i + 1. ``allows`` (unit-scale (1,) -> bool)
+        gives the status between nodes (default: the constraint's)."""
+        allows = self.constraint if allows is None else allows
         cells = np.flatnonzero(ok[:-1] != ok[1:])
         first, second = nodes[cells].copy(), nodes[cells + 1].copy()
         for j, i in enumerate(cells):
@@ -479,12 +487,37 @@ class Calibrator:
                 mid = 0.5 * (a + b)
                 if not a < mid < b:
                     break
-                if self.constraint(np.array([mid])) == ok[i]:
+                if allows(np.array([mid])) == ok[i]:
                     a = mid
                 else:
                     b = mid
             first[j], second[j] = a, b
         return cells, first, second
+
+    def _with_prior_edges(
+        self, axis: np.ndarray, ok, margs: list, prior: Callable, base: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """One parameter, a callable ``prior`` that is zero somewhere on the unit-scale ``axis``
+        (k,): `with_edges` with the edges of its zero region located as a constraint's are (by
+        bisection between nodes, together with the constraint's verdict ``ok`` (k,), None:
+        none), so that the density ends there instead of ramping to zero across the cell
+        beyond. The likelihood at a point inserted there is interpolated from its nodes (their
+        lamOs marginals ``margs``), the prior evaluated at it."""
+        theta = axis[:, None]
+        emulator_prior = self._log_prior_theta if base else self._theta_prior_at(theta, None)
+        free = self._combine(margs) + emulator_prior  # finite: no zeros of the user's prior
+
+        def user(points: np.ndarray) -> np.ndarray:
+            return self._prior_values(prior, points[:, None], False)
+
+        def allows(point: np.ndarray) -> bool:
+            inside = self.constraint is None or bool(self.constraint(point))
+            return inside and bool(np.isfinite(user(point))[0])
+
+        nonzero = np.isfinite(user(axis))
+        allowed = nonzero if ok is None else ok & nonzero
+        edges = self._constraint_edges(axis, allowed, allows)
+        return with_edges(axis, free, allowed, edges, user)
 
     def _theta_prior_at(self, theta_unit: np.ndarray, prior) -> np.ndarray:
         """The emulator's theta prior plus the user's at refined unit-scale nodes."""
@@ -492,10 +525,11 @@ class Calibrator:
         base = -0.5 * np.sum(((theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1)
         return base if prior is None else base + self._prior_values(prior, theta_unit, False)
 
-    def _posterior(self, axes: list, free: np.ndarray, ok, margs: list, key) -> Posterior:
+    def _posterior(self, axes: list, free: np.ndarray, ok, margs: list, key, prior) -> Posterior:
         """The grid posterior on the unit-scale ``axes``, whose nodes (in 'ij' order) have the
-        unconstrained log posterior ``free`` (G,), the constraint's verdict ``ok`` (G,) (None:
-        no constraint) and the lamOs marginals ``margs``; ``key`` seeds the lazy draws."""
+        unconstrained log posterior ``free`` (G,) (the user's ``prior`` in it), the constraint's
+        verdict ``ok`` (G,) (None: no constraint) and the lamOs marginals ``margs``; ``key``
+        seeds the lazy draws."""
         std = self.emulator.standardizer
         names = tuple(self.emulator.t_names)
         base = axes is self._axes
@@ -503,7 +537,9 @@ class Calibrator:
         inv_lamos = None
         if self.q == 1:
             nodes, logd, lik = axes[0], constrained(free, ok), None
-            if ok is not None:
+            if callable(prior) and np.isneginf(free).any():
+                nodes, logd, lik = self._with_prior_edges(axes[0], ok, margs, prior, base)
+            elif ok is not None:
                 edges = self._base_cut if base else self._cut(axes, ok)
                 nodes, logd, lik = with_edges(nodes, free, ok, edges)
             inserted = nodes.size > free.size

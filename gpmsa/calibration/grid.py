@@ -126,7 +126,11 @@ def interp_log(table: np.ndarray, axis: np.ndarray, points: np.ndarray) -> np.nd
 
 
 def with_edges(
-    nodes: np.ndarray, free: np.ndarray, ok: np.ndarray, edges: tuple[np.ndarray, ...]
+    nodes: np.ndarray,
+    free: np.ndarray,
+    ok: np.ndarray,
+    edges: tuple[np.ndarray, ...],
+    prior: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One parameter: the unit-scale ``nodes`` (k,) with the constraint's boundary points
     ``edges`` (``Calibrator._constraint_edges``) inserted, so that the piecewise-linear density
@@ -134,9 +138,11 @@ def with_edges(
 
     Returns (nodes, log density, likelihood node of each node (its allowed neighbour for an
     inserted point)); an inserted point gets the log density ``free`` interpolated there
-    (`interp_log`), or -inf where the constraint forbids it."""
+    (`interp_log`), or -inf where the constraint forbids it. ``prior`` (unit-scale points
+    (e,) -> log densities (e,)): a log prior not in ``free`` (finite where ``ok``), added at
+    the nodes and at the inserted points."""
     cells, first, second = edges
-    logd = constrained(free, ok)
+    logd = constrained(free if prior is None else free + prior(nodes), ok)
     if cells.size == 0:
         return nodes, logd, np.arange(nodes.size)
     cell = np.concatenate([cells, cells])
@@ -144,7 +150,10 @@ def with_edges(
     allowed = np.concatenate([ok[cells], ok[cells + 1]])
     new = (pts > nodes[cell]) & (pts < nodes[cell + 1])  # a point on a node is that node
     cell, pts, allowed = cell[new], pts[new], allowed[new]
-    vals = np.where(allowed, interp_log(free, nodes, pts[:, None]), -np.inf)
+    vals = interp_log(free, nodes, pts[:, None])
+    if prior is not None and allowed.any():
+        vals[allowed] += prior(pts[allowed])
+    vals = np.where(allowed, vals, -np.inf)
     lik = np.where(ok[cell], cell, cell + 1)
     x = np.concatenate([nodes, pts])
     order = np.argsort(x, kind="stable")

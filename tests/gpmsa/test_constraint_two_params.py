@@ -50,9 +50,9 @@ def cut_posterior(case, n_draws=20_000):
     seen = {}
     inner = cal._posterior
 
-    def spy(axes, free, ok, margs, key):
+    def spy(axes, free, ok, margs, key, prior):
         seen.update(axes=axes, free=free)
-        return inner(axes, free, ok, margs, key)
+        return inner(axes, free, ok, margs, key, prior)
 
     cal._posterior = spy
     post = cal.update(x, y)
