@@ -49,6 +49,7 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
+from gpmsa.model.basis import basis_digest
 from gpmsa.model.data import ObsData, by_column_names, check_count, check_flag, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
@@ -440,6 +441,8 @@ def _run_backend(
         "accept_rate": {k: np.asarray(v).tolist() for k, v in chains.accept_rate.items()},
         "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
     }
+    if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
+        info["discrepancy_sha256"] = basis_digest(problem.obs.D)
     return draws, info
 
 

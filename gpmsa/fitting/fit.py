@@ -17,6 +17,7 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.mcmc.sampler import draws_nbytes, parameter_elements, sweeps_nbytes
 from gpmsa.model import constraints
+from gpmsa.model.basis import basis_digest
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, prepare
@@ -195,6 +196,8 @@ def fit(
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "versions": library_versions(backend),
     }  # fmt: skip
+    if obs is not None and discrepancy is not None:  # full_prediction refuses another basis
+        settings["discrepancy_sha256"] = basis_digest(problem.obs.D)
     summary = summarize(post, chains.accept_rate)
     record = None
     if n_chains > 1:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 
 from gpmsa.errors import GPMSAError
@@ -91,3 +93,17 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
     if not scale > 0:
         raise GPMSAError("discrepancy basis is all zeros")
     return D / np.sqrt(scale)
+
+
+def basis_digest(bases) -> str | None:
+    """SHA-256 of the normalised discrepancy bases of a reduction (``ObsProblem.D``: one array
+    per experiment, as float64 with their shapes); None without a discrepancy. A joint fit and
+    ``gpmsa.calibrate`` record it, so that ``gpmsa.full_prediction`` refuses another basis."""
+    if bases is None:
+        return None
+    h = hashlib.sha256()
+    for k, D in enumerate(bases):
+        arr = np.ascontiguousarray(D, dtype="<f8")
+        h.update(f"{k}:{arr.shape}".encode())
+        h.update(arr.tobytes())
+    return h.hexdigest()

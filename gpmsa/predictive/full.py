@@ -33,7 +33,7 @@ from gpmsa.calibration.observations import blas_controller
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.model.basis import discrepancy_basis, interpolate_basis
+from gpmsa.model.basis import basis_digest, discrepancy_basis, interpolate_basis
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
     ObsData,
@@ -403,6 +403,14 @@ def full_prediction(
         raise GPMSAError(
             f"the draws {'have' if 'betaV' in sets[0] else 'lack'} discrepancy parameters but "
             f"discrepancy={discrepancy!r} gives {p_v} discrepancy basis vectors"
+        )
+    record = posterior.info if posterior is not None else getattr(emulator, "settings", None)
+    fitted = (record or {}).get("discrepancy_sha256")  # the joint fit's or calibrate's basis
+    if fitted is not None and basis_digest(ob.D) != fitted:
+        raise GPMSAError(
+            "the discrepancy basis differs from the one the draws were made with (its recorded "
+            "SHA-256, normalised on the observations' grids): pass the calibration's "
+            "discrepancy= (the same kind, or the same array)"
         )
     g = _pred_grid(emulator, obs, grid)
     K_pred = interpolate_basis(K, std.grid, g) if not scalar else K

@@ -63,7 +63,8 @@ def calibration_posterior(emulator) -> Posterior:
         "n_chains": n_chains,
         **emulator_record(emulator),
         **{k: emulator.settings[k] for k in ("n_iter", "n_burn", "thin", "seed", "backend",
-                                              "discrepancy", "obs_lengths", "obs_sha256")
+                                              "discrepancy", "discrepancy_sha256", "obs_lengths",
+                                              "obs_sha256")
            if k in emulator.settings},
     }  # fmt: skip
     return Posterior(samples, chains=chains, info=info)

@@ -19,6 +19,7 @@ from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
+from gpmsa.model.basis import basis_digest
 from gpmsa.model.data import ObsData, SimData, check_flag, check_seed
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
@@ -273,6 +274,8 @@ def fit_study(
                         "study": {"label": labels[i], "shared": list(layout.shared),
                                   "hierarchical": list(layout.groups)},  # as read, once
                         "versions": settings["versions"]}  # fmt: skip
+        if discrepancy is not None:  # full_prediction refuses another basis
+            emu_settings["discrepancy_sha256"] = basis_digest(prep.problem.obs.D)
         members.append(Emulator._from_prepared(
             sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,
             settings=emu_settings, diagnostics=summarize({**post, "theta": theta}),

@@ -196,7 +196,8 @@ class Study:
         # other ones: a fitted model's (as calibration_posterior), a calibrated one's (as
         # gpmsa.calibrate; absent from study files written before it was kept)
         settings = self.members[i].settings if self.kind == "fit" else {}
-        info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256") if k in settings})
+        info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy_sha256")
+                     if k in settings})  # fmt: skip
         digests = self.settings.get(OBS_DIGESTS)
         digest = digests.get(self.labels[i]) if isinstance(digests, dict) else None
         if isinstance(digest, str):
