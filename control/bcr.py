@@ -380,8 +380,14 @@ class BCR:
 
         Args:
             t: (n,) sample times, s, increasing by 1 / rate_hz (a larger step means dropped
-                samples, a smaller or negative one repeated or misordered samples).
-            position: (n,) front-axle positions, m.
+                samples, a smaller or negative one repeated or misordered samples). Seconds,
+                not a ROS stamp's nanoseconds (every step would read as a gap), and float64
+                for stamps since the epoch (float32 holds them only to ~2 min: every step
+                would read as repeated).
+            position: (n,) front-axle positions along the path driven, m: the distance
+                travelled (as the replay's odometry path length), not a map coordinate (one
+                that decreases while the speed is positive is broken odometry, a
+                "sensor_fault").
             accel: (n,) measured vertical front-axle accelerations, m/s^2.
             speed: (n,) measured speeds, m/s.
             now: the caller's clock, s, on the time base of ``t`` (None: the newest sample's

@@ -112,7 +112,8 @@ class Estimate:
         feature: the newest observation (the block's feature vector, or the window's log f);
             None if none.
         prob_change: P(the roughness changed within the BCR's ``recent_change_m``) (change-point
-            method; NaN otherwise).
+            method; NaN otherwise). It is 1 over the first metres of a stream (or after
+            ``BCR.reset``): the only segment the filter knows began there.
         data_time: s, time of the newest sample whose information the estimate holds.
         plausibility_p: for an "implausible" estimate, the upper-tail probability of the
             newest observation under the emulator's law at the GD that explains it best (the

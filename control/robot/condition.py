@@ -212,6 +212,15 @@ def resampling_filter(
     return up, down, firwin(taps | 1, 0.45 * grid, window=("kaiser", beta), fs=fs)
 
 
+def _rate_text(rate: float, other: float) -> str:
+    """``rate`` (Hz) to 4 significant digits, or to as many more (up to 12) as tell it apart from
+    ``other`` at the same precision (119.98 Hz is not "120 Hz", slower than 120 Hz)."""
+    for digits in range(4, 13):
+        if f"{rate:.{digits}g}" != f"{other:.{digits}g}":
+            return f"{rate:.{digits}g}"
+    return f"{rate:.12g}"
+
+
 def to_rate(
     t: np.ndarray, a: np.ndarray, rate_hz: float, tolerance: float = 0.02,
     method: str = "sample", topic: str | None = None,
@@ -243,8 +252,9 @@ def to_rate(
         return t, a, Resampling(rate_in, rate_hz, False, filter=text)
     if rate_in < rate_hz:
         raise BagError(
-            f"{_imu(topic)} runs at {rate_in:.4g} Hz, slower than the emulator's {rate_hz:g} "
-            f"Hz: its samples hold nothing above {rate_in / 2:.4g} Hz, and the emulator's "
+            f"{_imu(topic)} runs at {_rate_text(rate_in, rate_hz)} Hz, slower than the "
+            f"emulator's {rate_hz:g} Hz: its samples hold nothing above "
+            f"{_rate_text(rate_in / 2, rate_hz / 2)} Hz, and the emulator's "
             f"feature needs up to {rate_hz / 2:g} Hz (record the IMU at >= {rate_hz:g} Hz)"
         )
     up, down, fir = resampling_filter(rate_in, rate_hz, method, topic)

@@ -50,6 +50,13 @@ def test_an_imu_slower_than_the_emulator_is_refused_with_both_rates():
         condition.to_rate(t, np.zeros(200), RATE)
 
 
+def test_an_imu_a_hair_slower_names_a_rate_below_the_emulators():
+    # 119.98 Hz refused (rate_tolerance 0) must not read "120 Hz, slower than ... 120 Hz"
+    t = np.arange(600) / 119.98
+    with pytest.raises(BagError, match=r"runs at 119\.98 Hz, slower than the emulator's 120 Hz"):
+        condition.to_rate(t, np.zeros(600), RATE, tolerance=0.0)
+
+
 def _tone(rate_in: float, freq: float, seconds: float = 6.0):
     t = np.arange(int(seconds * rate_in)) / rate_in
     return t, np.sin(2 * np.pi * freq * t)
