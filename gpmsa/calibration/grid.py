@@ -25,9 +25,9 @@ N_REFINE = 129
 N_REFINE_2D = 49
 """Nodes per parameter of a refined mode (one, two calibration parameters)."""
 RESOLVE_SD = 4.0
-"""The grid resolves a mode of the posterior whose sd spans at least this many node spacings
-(per parameter); otherwise that mode is recomputed on a finer grid over the region holding its
-mass."""
+"""The grid resolves a mode of the posterior whose spread (`_spread`: its sd, or less where
+heavy tails inflate the sd) spans at least this many node spacings (per parameter); otherwise
+that mode is recomputed on a finer grid over the region holding its mass."""
 MASS_CUTOFF = 1e-14
 """Nodes whose (marginal) posterior density is below this fraction of the peak carry no mass; the
 runs of nodes above it are the posterior's modes."""
@@ -311,16 +311,32 @@ class ConstraintCut:
 
 
 def _one_resolved_peak(axis: np.ndarray, density: np.ndarray) -> bool:
-    """Whether the density (k,) on ``axis`` (k,) rises to one peak and falls (no valley) with an
-    sd of at least RESOLVE_SD of the widest node spacing: a quick sufficient test that `_modes`
-    finds nothing to refine (the usual case on the fixed grid)."""
+    """Whether the density (k,) on ``axis`` (k,) rises to one peak and falls (no valley) with a
+    spread (`_spread`) of at least RESOLVE_SD of the widest node spacing: a quick sufficient
+    test that `_modes` finds nothing to refine (the usual case on the fixed grid)."""
     k = int(np.argmax(density))
     slope = np.diff(density)
     if slope[:k].min(initial=0.0) < 0.0 or slope[k:].max(initial=0.0) > 0.0:
         return False
-    total = density.sum()
-    mean = density @ axis / total
-    return bool(density @ (axis - mean) ** 2 / total >= (RESOLVE_SD * np.diff(axis).max()) ** 2)
+    return bool(_spread(axis, density) >= RESOLVE_SD * np.diff(axis).max())
+
+
+IQR_PER_SD = 1.3489795003921634
+"""The interquartile range of a normal distribution, in sds."""
+
+
+def _spread(axis: np.ndarray, mass: np.ndarray) -> float:
+    """The smaller of the sd and IQR / IQR_PER_SD of the masses ``mass`` (k,) at the nodes
+    ``axis`` (k,): the sd for a peak with light tails, less where heavy tails inflate the sd
+    beyond the width of the peak's core (a heavy-tailed posterior cut by a constraint next to
+    its peak: sd 2.2-2.8 times IQR / IQR_PER_SD, and the summaries at 4 spacings per sd up to
+    0.15 sd off)."""
+    total = mass.sum()
+    mean = mass @ axis / total
+    sd = float(np.sqrt(mass @ (axis - mean) ** 2 / total))
+    cdf = (np.cumsum(mass) - 0.5 * mass) / total  # node i's mass centred on it
+    q1, q3 = np.interp([0.25, 0.75], cdf, axis)
+    return min(sd, float(q3 - q1) / IQR_PER_SD)
 
 
 def _runs(density: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -339,8 +355,8 @@ def _modes(axis: np.ndarray, density: np.ndarray) -> tuple[np.ndarray, np.ndarra
     """The modes of a (marginal) density (k,) on the increasing ``axis`` (k,): the runs of nodes
     above MASS_CUTOFF of the peak, as (first (r,), last (r,), unresolved (r,)). A run is
     unresolved when a peak in it (the run cut at its `_valleys`) holds at least MODE_MASS of the
-    mass and its sd spans fewer than RESOLVE_SD of its node spacings. Nodes are equally spaced
-    within a run (a refined region)."""
+    mass and its spread (`_spread`) spans fewer than RESOLVE_SD of its node spacings. Nodes are
+    equally spaced within a run (a refined region)."""
     first, last, dips = _runs(density)
     if first.size == 1 and dips.size == 0:  # one peak, the usual case
         _, sd, spacing = _mode_stats(axis, density, first[0], last[0])
@@ -371,13 +387,12 @@ def _valleys(density: np.ndarray, dips: np.ndarray, i0: int, i1: int) -> list[in
 
 
 def _mode_stats(axis: np.ndarray, density: np.ndarray, i0: int, i1: int) -> tuple[float, ...]:
-    """(mass, sd, node spacing) of the mode on nodes i0..i1 (and one more each side)."""
+    """(mass, spread (`_spread`), node spacing) of the mode on nodes i0..i1 (and one more each
+    side)."""
     d, a = density[i0 : i1 + 1], axis[i0 : i1 + 1]
     j0, j1 = max(i0 - 1, 0), min(i1 + 1, axis.size - 1)
     spacing = (axis[j1] - axis[j0]) / (j1 - j0)
-    total = d.sum()
-    mean = d @ a / total
-    return total * spacing, np.sqrt(d @ (a - mean) ** 2 / total), spacing
+    return d.sum() * spacing, _spread(a, d), spacing
 
 
 def _finer_axis(
@@ -457,7 +472,8 @@ def _marginals(axes: list, logp: np.ndarray) -> list:
 def _resolution(axis: np.ndarray, density: np.ndarray) -> float:
     """The node spacings per sd of the marginal ``density`` (k,) on ``axis`` (k,), its peaks
     (runs above MASS_CUTOFF cut at their `_valleys`) taken together: the inverse root of the
-    mass-weighted mean of (local spacing / sd)^2 over the peaks, a peak's sd and spacing taken
+    mass-weighted mean of (local spacing / sd)^2 over the peaks, a peak's sd (its `_spread`)
+    and spacing taken
     at its own nodes (trapezoid weights; the local spacing the wider interval next to a node,
     root-mean-squared over the peak's mass), so that a refined, non-uniform axis is measured
     by the spacing where the mass lies. The interpolation errors go as its inverse square."""
@@ -471,8 +487,7 @@ def _resolution(axis: np.ndarray, density: np.ndarray) -> float:
         for b0, b1 in itertools.pairwise(bounds):
             m, a = density[b0 : b1 + 1] * w[b0 : b1 + 1], axis[b0 : b1 + 1]
             mass = m.sum()
-            mean = m @ a / mass
-            var = m @ (a - mean) ** 2 / mass
+            var = _spread(a, m) ** 2
             if var > 0.0:
                 inverse2 += m @ local2[b0 : b1 + 1] / var
                 total += mass

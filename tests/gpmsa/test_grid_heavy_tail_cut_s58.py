@@ -1,0 +1,56 @@
+"""A heavy-tailed one-parameter posterior cut by a constraint just past its peak: what is left
+falls steeply from the cut, then slowly, so its sd (the tails') is 2.2-2.8 times the width of
+its core. Refinement measured a peak by its sd and stopped at 4 spacings per sd, with the core
+on 1-2 cells per e-fold: quantiles 0.06-0.15 sd and the cdf 0.002-0.006 off a dense grid,
+silently. A peak's spread is now the smaller of its sd and IQR / 1.349 (`grid._spread`)."""
+
+import numpy as np
+import pytest
+from scipy.integrate import cumulative_trapezoid
+from test_grid_one_param_edges_s57 import LEVELS, observations, vague_lamos_emulator
+
+from gpmsa import Calibrator
+from gpmsa.calibration.grid import _spread
+from gpmsa.calibration.observations import reduce
+
+
+def dense_cut_reference(cal, x, y, cut: float) -> tuple[float, np.ndarray]:
+    """(sd, quantiles at LEVELS) of the exact posterior cut below ``cut`` (native), on nodes
+    1/400,000 of the range apart near the peak and 1/20,000 elsewhere."""
+    std = cal.emulator.standardizer
+    span = std.t_max[0] - std.t_min[0]
+    u = np.unique(np.concatenate([np.linspace(0, 1, 20001), np.linspace(0.35, 0.45, 40001)]))
+    data = reduce(cal.emulator, x, y, False)
+    logp = np.concatenate([cal._combine(cal._marginals(data, t)) + cal._theta_prior_at(t, None)
+                           for t in np.array_split(u[:, None], 15)])  # fmt: skip
+    native = u * span + std.t_min[0]
+    nodes = np.unique(np.concatenate([native[native >= cut], [cut]]))
+    logp = np.interp(nodes, native, logp)
+    f = np.exp(logp - logp.max())
+    cdf = cumulative_trapezoid(f, nodes, initial=0.0)
+    f, cdf = f / cdf[-1], cdf / cdf[-1]
+    mean = np.trapezoid(nodes * f, nodes)
+    sd = np.sqrt(np.trapezoid((nodes - mean) ** 2 * f, nodes))
+    return sd, np.interp(LEVELS, cdf, nodes)
+
+
+@pytest.mark.parametrize(("n", "cut", "n_grid"), [(2, 0.406, 33), (2, 0.42, 129), (3, 0.42, 33)])
+def test_a_heavy_tail_cut_past_its_peak_is_refined_over_its_core(n, cut, n_grid):
+    """Were 0.154 / 0.125 / 0.059 sd off in the quantiles, 0.0055 / 0.0039 / 0.0024 in the cdf."""
+    x, y = observations(n)
+    cal = Calibrator(vague_lamos_emulator(), n_grid=n_grid, constraint=lambda t: t[0] >= cut)
+    post = cal.update(x, y)
+    sd, quantiles = dense_cut_reference(cal, x, y, cut)
+    assert np.max(np.abs(post.quantile("t", LEVELS) - quantiles)) < 0.04 * sd
+    assert np.max(np.abs(post.grids["t"].cdf(quantiles) - LEVELS)) < 0.0015
+
+
+def test_the_spread_is_the_sd_of_a_light_tailed_peak():
+    """A Gaussian's spread is its sd (IQR / 1.349 is larger on a grid by at most a few %); a
+    Student-t's with 1.5 dof is its IQR's, well under its sd."""
+    axis = np.linspace(-10.0, 10.0, 4001)
+    gauss = np.exp(-0.5 * axis**2)
+    assert _spread(axis, gauss) == pytest.approx(1.0, rel=1e-3)
+    heavy = (1.0 + axis**2 / 1.5) ** -1.25
+    sd = np.sqrt(heavy @ axis**2 / heavy.sum())
+    assert _spread(axis, heavy) < 0.65 * sd  # 1.25 against 2.07 (the axis cuts its tails)
