@@ -28,18 +28,31 @@ Every update returns an `Estimate` whose status says why there is no number: ``f
 enough contiguous samples yet, or the first block after a fault), ``sensor_fault`` (non-finite
 values, a speed beyond any vehicle's, dropped, repeated or backwards time stamps, a stuck,
 quantised, clipped or dead signal), ``implausible`` (no GD in the emulator's domain explains the
-observation), ``out_of_domain`` (speed outside the emulator's range and no earlier estimate),
+observation; with the change-point method also where a phase's last ``quiet_blocks`` blocks
+together read quieter than any GD explains: the quiet-signal check, see below),
+``out_of_domain`` (speed outside the emulator's range and no earlier estimate),
 ``calibration_failed``, ``stale`` (no new information for ``max_age_s``). While the speed is
 outside the emulator's range (e.g. standing) there is no new information: the change-point
 estimate is carried on (its reason says so) until it turns stale.
+
+The quiet-signal check: a sensor gain below 1 (or sensor noise below the emulator's) lowers
+every band power and quantile and reads as smoother ground, within each block's scatter. Each
+block's level score (`ObservationModel.level_score`: its residual at the best GD along the
+direction a lower gain moves the feature, in sds) is kept per phase; where the last
+``quiet_blocks`` scores, summed over the root of their count (over sqrt(nu / (nu - 2)) for a
+Student-t block law), fall below the normal quantile of ``plausibility_p``, the estimate is
+"implausible" (its ``plausibility_p`` the tail probability). Ground smoother than the
+emulator's domain reads the same way (docs/closed-loop.md, "Guards").
 """
 
 from __future__ import annotations
 
 import time as _time
+from collections import deque
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+from scipy.special import ndtr
 
 from control.changepoint import ChangePointFilter, ChangePointSettings, _mixture_posterior
 from control.errors import ControlError
@@ -70,6 +83,8 @@ and the rise delay over 120 development tracks was 0.5 m shorter (on the held-ou
 within its scatter; docs/closed-loop.md, "How often to estimate")."""
 MAX_PHASES = 8
 """Most interleaved change-point filters (``block_samples / update_every``) a BCR runs."""
+MAX_QUIET_BLOCKS = 1024
+"""Longest memory of the quiet-signal check, blocks (`BCRSettings.quiet_blocks`)."""
 MAX_SPEED_CHANGE = 0.5
 """A block whose lowest speed is below this fraction of its highest (starting, stopping) carries
 no information for the change-point method: the emulator knows constant speeds only."""
@@ -103,6 +118,11 @@ class BCRSettings:
         sensor: thresholds of the signal checks (stuck, quantised, clipped, dead, below the
             noise floor, a level jump).
         recent_change_m: the distance of ``Estimate.prob_change``, m.
+        quiet_blocks: change-point method: the quiet-signal check's memory, blocks of a phase
+            (~1 s each): an estimate is "implausible" where its phase's last ``quiet_blocks``
+            blocks together read quieter than any GD explains (`BCR`, "The quiet-signal
+            check"), with a probability under the emulator below ``plausibility_p``; 0
+            switches the check off.
     """
 
     feature: FeatureSpec = field(default_factory=FeatureSpec)
@@ -117,6 +137,7 @@ class BCRSettings:
     plausibility_p: float = 1e-6
     sensor: SensorLimits = field(default_factory=SensorLimits)
     recent_change_m: float = 5.0
+    quiet_blocks: int = 16
 
     def __post_init__(self) -> None:
         for name, cls in (
@@ -173,6 +194,11 @@ class BCRSettings:
             raise ControlError(f"plausibility_p must lie in [0, 1), got {self.plausibility_p}")
         if not (np.isfinite(self.recent_change_m) and self.recent_change_m >= 0):
             raise ControlError(f"recent_change_m must be >= 0, got {self.recent_change_m}")
+        if not (is_integer(self.quiet_blocks) and 0 <= self.quiet_blocks <= MAX_QUIET_BLOCKS):
+            raise ControlError(
+                f"quiet_blocks must be an integer in [0, {MAX_QUIET_BLOCKS}], got "
+                f"{self.quiet_blocks!r}"
+            )
 
     @property
     def samples_per_update(self) -> int:
@@ -223,11 +249,13 @@ class _Phase:
     data_time: float = np.nan  # sample time of its newest information, s
     undo: tuple | None = None  # (filter state, data time, distance) before its newest block
     guard: bool = False  # skip its next block: it may hold the end of a fault
+    levels: deque = field(default_factory=deque)  # level scores of its newest blocks (quiet)
 
     def reset(self) -> None:
         self.filter.reset()
         self.pos_block, self.pending_m, self.data_time = np.nan, 0.0, np.nan
         self.undo, self.guard = None, False
+        self.levels.clear()
 
 
 def _samples(name: str, values) -> np.ndarray:
@@ -298,8 +326,18 @@ class BCR:
             self.speed_range = tuple(model.speed_range)
             self.gd_range = (float(model.gd[0]), float(model.gd[-1]))
             self.gd_name = model.emulator.t_names[0]
-            self._phases = [_Phase(ChangePointFilter(model.gd, s.changepoint))
+            if s.quiet_blocks and not hasattr(model, "level_score"):
+                raise ControlError(
+                    f"the quiet-signal check (quiet_blocks = {s.quiet_blocks}) needs the "
+                    f"model's level_score(y, v, direction), which {type(model).__name__} lacks "
+                    "(control.ObservationModel has it); quiet_blocks=0 switches the check off"
+                )
+            self._phases = [_Phase(ChangePointFilter(model.gd, s.changepoint),
+                                   levels=deque(maxlen=s.quiet_blocks))
                             for _ in range(s.phases)]  # fmt: skip
+            dof = getattr(getattr(model, "scatter", None), "dof", np.inf)
+            # the scores' sd under a multivariate t law (dof > 2) is sqrt(dof / (dof - 2))
+            self._level_sd = float(np.sqrt(dof / (dof - 2.0))) if 2.0 < dof < np.inf else 1.0
         else:
             if not hasattr(model, "log_likelihood_grid"):
                 raise ControlError(
@@ -640,7 +678,34 @@ class BCR:
         phase.undo = (phase.filter.state(), phase.data_time, ds)
         phase.filter.update(self.model.loglik(y, v), ds)
         phase.data_time = float(self._t[-1])  # the block's newest sample, not the caller's clock
+        if phase.levels.maxlen:
+            quiet = self._quiet_reason(phase, y, v)
+            if quiet:
+                return self._no_estimate("implausible", quiet[0], speed=v, feature=y,
+                                         plausibility_p=quiet[1])  # fmt: skip
         return self._posterior_estimate("", tic, v, y)
+
+    def _quiet_reason(self, phase: _Phase, y: np.ndarray, v: float) -> tuple[str, float] | None:
+        """The quiet-signal check (module docstring): adds the newest block's level score to
+        ``phase``'s; (reason, probability) where their standardised sum says that the phase's
+        last blocks read quieter than any GD explains, with a probability below
+        ``plausibility_p``; None otherwise."""
+        bands = len(self.settings.feature.bands_hz) - 1
+        # d y / d log(gain): 2 for a log band power, the value itself for a quantile
+        direction = np.concatenate([np.full(bands, 2.0), y[bands:]])
+        phase.levels.append(self.model.level_score(y, v, direction))
+        n = len(phase.levels)
+        z = sum(phase.levels) / (np.sqrt(n) * self._level_sd)
+        p = float(ndtr(z))
+        if p >= self.settings.plausibility_p:
+            return None
+        lo, hi = self.gd_range
+        return (
+            f"the last {n} block(s) read quieter than any GD in [{lo:g}, {hi:g}] explains at "
+            f"{v:.3g} m/s: level score {z:.3g} sd (p = {p:.2g} < {self.settings.plausibility_p:g})"
+            f"; a sensor gain or noise below the emulator's, or ground smoother than it knows",
+            p,
+        )
 
     def _posterior_estimate(self, reason: str, tic: float, v: float, y) -> Estimate:
         t_now, pos_now = self._now()

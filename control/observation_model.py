@@ -188,9 +188,11 @@ class ObservationModel:
         mean, chol = self._at(float(v))
         # an explicit inverse of the 8 x 8 factor: a LAPACK triangular solve of this size costs
         # ~1 ms in OpenBLAS's threads, the product microseconds
-        r = np.linalg.inv(chol) @ (y[None, :] - mean).T  # (K, G)
-        out = np.sum(r**2, axis=0), float(np.sum(np.log(np.diag(chol))))
-        self._last = (key, out)
+        inverse = np.linalg.inv(chol)
+        r = inverse @ (y[None, :] - mean).T  # (K, G)
+        d2 = np.sum(r**2, axis=0)
+        out = d2, float(np.sum(np.log(np.diag(chol))))
+        self._last = (key, out, (inverse, r[:, int(np.argmin(d2))]))
         return out
 
     def loglik(self, y: np.ndarray, v: float) -> np.ndarray:
@@ -213,6 +215,23 @@ class ObservationModel:
         K, nu = self.dim, self.scatter.dof
         p = special.chdtrc(K, d2_min) if np.isinf(nu) else special.fdtrc(K, nu, d2_min / K)
         return d2_min, float(p)
+
+    def level_score(self, y: np.ndarray, v: float, direction: np.ndarray) -> float:
+        """The residual of y from the mean at its best GD (the node of the smallest Mahalanobis
+        distance) along ``direction`` (K,), in sds of that projection under Sigma(v) (the
+        generalised least-squares estimate of a shift of y along ``direction``, standardised):
+        about N(0, 1) or narrower under the model (the best GD absorbs part of any shift), and
+        negative where y lies further below the mean along ``direction`` than a GD explains. The
+        BCR's direction is that of a lower sensor gain (`BCR`'s quiet-signal check).
+
+        Args:
+            y: (K,) the block's feature. v: the block's mean speed, m/s.
+            direction: (K,) finite, not all zero.
+        """
+        self._mahalanobis(y, v)
+        inverse, residual = self._last[2]
+        w = inverse @ direction
+        return float(w @ residual / np.sqrt(w @ w))
 
 
 def _check_feature_length(emulator) -> None:

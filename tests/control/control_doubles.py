@@ -80,13 +80,23 @@ class FakeBlockModel:
         self.emulator = SimpleNamespace(t_names=["GD"], x_names=["v"])
         self.calls = 0
 
-    def _d2(self, y, v):
+    def _whitened(self, y, v):
         lf = log_f(v, self.gd)[:, None]  # (G, 1)
         y = np.asarray(y)[None, :]
         nb = self.dim - self.n_quantiles
         unit = np.concatenate([y[:, :nb] - lf, y[:, nb:] / np.exp(0.5 * lf)], axis=1)
-        r = np.linalg.solve(self.chol, (unit - self.offset[None, :]).T)
-        return np.sum(r**2, axis=0)
+        return np.linalg.solve(self.chol, (unit - self.offset[None, :]).T), lf[:, 0]  # (K, G)
+
+    def _d2(self, y, v):
+        return np.sum(self._whitened(y, v)[0] ** 2, axis=0)
+
+    def level_score(self, y, v, direction):
+        r, lf = self._whitened(y, v)
+        best = int(np.argmin(np.sum(r**2, axis=0)))
+        nb = self.dim - self.n_quantiles
+        unit = np.concatenate([direction[:nb], direction[nb:] / np.exp(0.5 * lf[best])])
+        w = np.linalg.solve(self.chol, unit)
+        return float(w @ r[:, best] / np.sqrt(w @ w))
 
     def loglik(self, y, v):
         self.calls += 1

@@ -87,7 +87,13 @@ def test_a_road_beyond_the_domain_is_named_and_a_rougher_one_means_safety(
     block_model, fake_calibrator, method, gd, edge, side, mode
 ):
     if method == "changepoint":
-        bcr, lo, hi = BCR(block_model), block_model.gd[0], block_model.gd[-1]
+        if gd < block_model.gd[0]:  # smoother than any GD: the quiet-signal check's case
+            quiet = feed(BCR(block_model), *stream(const(gd), 1.5, 120, seed=0))[-10:]
+            assert all(e.status == "implausible" and "read quieter" in e.reason for e in quiet)
+            assert all(Simplex(gd_min=100.0, gd_max=650.0).command(e).mode == "safety"
+                       for e in quiet)  # fmt: skip
+        # without the check the edge is named, as by the window methods
+        bcr, lo, hi = BCR(block_model, quiet_blocks=0), block_model.gd[0], block_model.gd[-1]
     else:
         bcr, lo, hi = BCR(fake_calibrator, method=method, **WINDOW), 200.0, 600.0
     ests = feed(bcr, *stream(const(gd), 1.5, 120, seed=0))
