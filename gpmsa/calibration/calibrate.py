@@ -260,7 +260,7 @@ def calibrate(
         where = {"n_jobs": n_jobs, "executor": executor}
         data = reduce(emulator, x_obs, y_obs, extrapolate)
         fit = _probe(emulator, data, sets)
-        warn_if_outside(fit)
+        warn_if_outside(fit, discrepancy=discrepancy is not None)
         if fast:
             draws, info = _run_fast(
                 emulator, data, fit, sets, n_samples, n_chains, tune, tuning_opts, seed,

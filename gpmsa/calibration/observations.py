@@ -319,16 +319,24 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
     return Fit(float(np.min(sds)), float(np.min(excess)))
 
 
-def warn_if_outside(fit: Fit, stacklevel: int = 3) -> None:
+def warn_if_outside(fit: Fit, stacklevel: int = 3, discrepancy: bool = False) -> None:
     """Warn (``OutsideEmulatorWarning``) when the observation lies more than ``OUTSIDE_SDS``
-    predictive sds from every emulator prediction at its x."""
+    predictive sds from every emulator prediction at its x; ``discrepancy``: a discrepancy
+    model is calibrated too (the warning says that it must explain the difference)."""
     if fit.outside_sds > OUTSIDE_SDS:
+        then = (
+            "The discrepancy term and the observation error must then explain the difference "
+            "(as they would a units error); if it is larger than the discrepancy you expect, "
+            if discrepancy
+            else "The posterior then explains it by a large observation error (small lamOs) "
+            "and theta falls back towards its prior; "
+        )
         warnings.warn(
             f"y_obs lies {fit.outside_sds:.3g} predictive sds from the nearest emulator "
-            f"prediction at x_obs over the whole theta domain (more than {OUTSIDE_SDS:g}): the "
-            "observation is outside what the emulator has seen. The posterior then explains it "
-            "by a large observation error (small lamOs) and theta falls back towards its prior; "
-            "check the units, the feature and the emulator's domain",
+            f"prediction at x_obs over the whole theta domain (more than {OUTSIDE_SDS:g})"
+            f"{' (the emulator alone)' if discrepancy else ''}: the observation is outside "
+            f"what the emulator has seen. {then}check the units, the feature and the "
+            "emulator's domain",
             OutsideEmulatorWarning,
             stacklevel=stacklevel,
         )
