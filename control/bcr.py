@@ -114,7 +114,8 @@ class BCRSettings:
         interval_kind: "hdi" (the shortest interval: it reaches the emulator's GD bound where the
             posterior piles up there) or "central" (equal tails, which never holds a bound).
         plausibility_p: an observation whose upper-tail probability under the emulator is below
-            this for every GD in the domain is "implausible".
+            this for every GD in the domain is "implausible"; also the level of the quiet-signal
+            check (``quiet_blocks``). 0 switches both off.
         sensor: thresholds of the signal checks (stuck, quantised, clipped, dead, below the
             noise floor, a level jump).
         recent_change_m: the distance of ``Estimate.prob_change``, m.
@@ -588,14 +589,17 @@ class BCR:
 
     def _skip_block(self, phase: _Phase, ds: float, status: str, reason: str, **kw) -> Estimate:
         """No information from this block; a fault or an implausible block also undoes every
-        phase's newest block (the block before it, and those overlapping it) and makes every
-        phase skip its next block (they may hold part of it)."""
+        phase's newest block (the block before it, and those overlapping it: in the filter and
+        in the quiet-signal check) and makes every phase skip its next block (they may hold
+        part of it)."""
         undone = False
         for other in self._phases:
             if other.undo is not None:
                 state, data_time, ds_before = other.undo
                 other.filter.restore(state)
                 other.data_time = data_time
+                if other.levels:  # its level score, added with the update undone
+                    other.levels.pop()
                 if other is phase:
                     ds += ds_before
                 else:
@@ -675,25 +679,41 @@ class BCR:
             return self._no_estimate(
                 "filling", "first block after a fault: skipped (it may hold its end)", speed=v
             )
+        score = self._level_score(y, v) if phase.levels.maxlen else None  # before the update
         phase.undo = (phase.filter.state(), phase.data_time, ds)
         phase.filter.update(self.model.loglik(y, v), ds)
         phase.data_time = float(self._t[-1])  # the block's newest sample, not the caller's clock
-        if phase.levels.maxlen:
-            quiet = self._quiet_reason(phase, y, v)
+        if score is not None:
+            quiet = self._quiet_reason(phase, score, v)
             if quiet:
                 return self._no_estimate("implausible", quiet[0], speed=v, feature=y,
                                          plausibility_p=quiet[1])  # fmt: skip
         return self._posterior_estimate("", tic, v, y)
 
-    def _quiet_reason(self, phase: _Phase, y: np.ndarray, v: float) -> tuple[str, float] | None:
-        """The quiet-signal check (module docstring): adds the newest block's level score to
-        ``phase``'s; (reason, probability) where their standardised sum says that the phase's
-        last blocks read quieter than any GD explains, with a probability below
+    def _level_score(self, y: np.ndarray, v: float) -> float:
+        """The block's level score (`ObservationModel.level_score`) along the direction of a
+        lower sensor gain; ControlError where the model gives no finite number."""
+        feature = self.settings.feature
+        bands = len(feature.bands_hz) - 1
+        quantiles = slice(bands, bands + len(feature.quantiles))
+        # d y / d log(gain): 2 for a log band power (a subclass's longer feature: its extra
+        # channels' too), the value itself for a quantile
+        direction = np.full(y.size, 2.0)
+        direction[quantiles] = y[quantiles]
+        score = self.model.level_score(y, v, direction)
+        if not (is_real(score) and np.isfinite(score)):
+            raise ControlError(
+                f"the model's level_score(y, v, direction) must return a finite number, got "
+                f"{score!r} (quiet_blocks=0 switches the quiet-signal check off)"
+            )
+        return float(score)
+
+    def _quiet_reason(self, phase: _Phase, score: float, v: float) -> tuple[str, float] | None:
+        """The quiet-signal check (module docstring): adds the newest block's level ``score``
+        to ``phase``'s; (reason, probability) where their standardised sum says that the
+        phase's last blocks read quieter than any GD explains, with a probability below
         ``plausibility_p``; None otherwise."""
-        bands = len(self.settings.feature.bands_hz) - 1
-        # d y / d log(gain): 2 for a log band power, the value itself for a quantile
-        direction = np.concatenate([np.full(bands, 2.0), y[bands:]])
-        phase.levels.append(self.model.level_score(y, v, direction))
+        phase.levels.append(score)
         n = len(phase.levels)
         z = sum(phase.levels) / (np.sqrt(n) * self._level_sd)
         p = float(ndtr(z))

@@ -229,8 +229,14 @@ class ObservationModel:
             direction: (K,) finite, not all zero.
         """
         self._mahalanobis(y, v)
+        d = np.asarray(direction)
+        if (d.shape != (self.dim,) or d.dtype.kind not in "iuf" or not np.all(np.isfinite(d))
+                or not np.any(d)):  # fmt: skip
+            raise ControlError(
+                f"direction must be {self.dim} finite numbers (K,), not all zero, got {d!r}"
+            )
         inverse, residual = self._last[2]
-        w = inverse @ direction
+        w = inverse @ d
         return float(w @ residual / np.sqrt(w @ w))
 
 

@@ -477,8 +477,11 @@ class Calibrator:
         parameter; ``ok`` (k,) their status): (cells i (e,), first (e,), second (e,)), the
         boundary bracketed by adjacent floats in [nodes[i], nodes[i + 1]]: ``first`` has the
         status of node i, ``second`` that of node i + 1. ``allows`` (unit-scale (1,) -> bool)
-        gives the status between nodes (default: the constraint's)."""
+        gives the status between nodes (default: the constraint's). A point whose native value
+        is its node's (an edge on a node, e.g. ``th[0] > t_min``) is that node."""
         allows = self.constraint if allows is None else allows
+        std = self.emulator.standardizer
+        span, low = std.t_max[0] - std.t_min[0], std.t_min[0]  # native as `_posterior` has it
         cells = np.flatnonzero(ok[:-1] != ok[1:])
         first, second = nodes[cells].copy(), nodes[cells + 1].copy()
         for j, i in enumerate(cells):
@@ -491,6 +494,10 @@ class Calibrator:
                     a = mid
                 else:
                     b = mid
+            if a * span + low == nodes[i] * span + low:
+                a = nodes[i]
+            if b * span + low == nodes[i + 1] * span + low:
+                b = nodes[i + 1]
             first[j], second[j] = a, b
         return cells, first, second
 

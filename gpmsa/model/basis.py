@@ -95,15 +95,22 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
     return D / np.sqrt(scale)
 
 
+DIGEST_STEP = 2.0**-24
+"""`basis_digest` rounds the normalised bases (max row norm 1) to multiples of this, so that
+a multiple of a basis, whose normalisation differs from the basis's by an ulp or two, is the
+same basis (one element in about 1e8 lands within an ulp of a rounding point)."""
+
+
 def basis_digest(bases) -> str | None:
     """SHA-256 of the normalised discrepancy bases of a reduction (``ObsProblem.D``: one array
-    per experiment, as float64 with their shapes); None without a discrepancy. A joint fit and
-    ``gpmsa.calibrate`` record it, so that ``gpmsa.full_prediction`` refuses another basis."""
+    per experiment, rounded to DIGEST_STEP, with their shapes); None without a discrepancy. A
+    joint fit and ``gpmsa.calibrate`` record it, so that ``gpmsa.full_prediction`` refuses
+    another basis."""
     if bases is None:
         return None
     h = hashlib.sha256()
     for k, D in enumerate(bases):
-        arr = np.ascontiguousarray(D, dtype="<f8")
+        arr = np.ascontiguousarray(np.rint(np.asarray(D, dtype=np.float64) / DIGEST_STEP), "<i8")
         h.update(f"{k}:{arr.shape}".encode())
         h.update(arr.tobytes())
     return h.hexdigest()

@@ -98,3 +98,88 @@ def test_a_model_without_a_level_score_names_the_setting_that_drops_the_check():
     with pytest.raises(ControlError, match=r"level_score.*quiet_blocks=0"):
         BCR(bare)
     assert BCR(bare, quiet_blocks=0).settings.quiet_blocks == 0
+
+
+class _OneQuietBlock(FakeBlockModel):
+    """FakeBlockModel whose ``quiet``-th level score is far below any GD's (-100 sd)."""
+
+    def __init__(self, quiet: int):
+        super().__init__()
+        self.quiet, self.scores = quiet, 0
+
+    def level_score(self, y, v, direction):
+        self.scores += 1
+        score = super().level_score(y, v, direction)
+        return -100.0 if self.scores == self.quiet else score
+
+
+def test_a_block_a_fault_undoes_leaves_the_quiet_check_too():
+    """A fault undoes the newest block of every phase (it may hold the fault's start): its
+    information leaves the filter, and now its level score the quiet-signal check. Before, a
+    block of -100 sd undone by the fault after it read 'quieter than any GD' for the next 16
+    blocks of its phase."""
+    from control_doubles import stream
+
+    t, p, a, v = stream(lambda s: np.full_like(s, 400.0), 1.5, 60, seed=3)
+    a = a.copy()
+    a[20 * 125 + 60] = np.nan  # a fault in update 20: the block before (20th score) is undone
+    bcr = BCR(_OneQuietBlock(quiet=20), update_every=125)
+    ests = [bcr.update(t[k : k + 125], p[k : k + 125], a[k : k + 125], v[k : k + 125])
+            for k in range(0, t.size, 125)]  # fmt: skip
+    fault = next(i for i, e in enumerate(ests) if e.status == "sensor_fault")
+    assert "undone" in ests[fault].reason
+    assert ests[fault - 1].status == "implausible"  # the quiet block read quiet before the fault
+    assert not any("read quieter" in e.reason for e in ests[fault:])
+    assert all(e.ok for e in ests[fault + 2 :])
+
+
+@pytest.mark.parametrize(
+    "direction", [np.ones(3), np.full(10, np.nan), np.zeros(10), np.array(["a"] * 10)]
+)
+def test_level_score_names_a_bad_direction(emulator_b, direction):
+    """A direction of another length, non-finite or all zero gave a numpy error or NaN."""
+    model = control.ObservationModel(emulator_b)
+    mean, _ = model._at(1.5)
+    with pytest.raises(ControlError, match="direction must be"):
+        model.level_score(mean[5], 1.5, direction)
+
+
+class _ScoreOf(FakeBlockModel):
+    def __init__(self, value):
+        super().__init__()
+        self.value = value
+
+    def level_score(self, y, v, direction):
+        return self.value
+
+
+@pytest.mark.parametrize("value", [np.nan, -np.inf, np.inf, "low", None])
+def test_a_model_whose_level_score_is_not_a_finite_number_is_named(value):
+    """A NaN level score read 'implausible' with p = nan for the next 16 blocks of its phase,
+    +inf switched the check off for them, silently."""
+    from control_doubles import stream
+
+    t, p, a, v = stream(lambda s: np.full_like(s, 400.0), 1.5, 3, seed=3)
+    bcr = BCR(_ScoreOf(value), update_every=125)
+    with pytest.raises(ControlError, match="level_score"):
+        for k in range(0, t.size, 125):
+            bcr.update(t[k : k + 125], p[k : k + 125], a[k : k + 125], v[k : k + 125])
+    assert not bcr._phases[0].levels
+
+
+def test_the_gain_direction_moves_only_the_quantiles_by_their_values():
+    """d y / d log(gain): 2 for a log band power, the value for a quantile. A BCR subclass whose
+    feature is longer than its FeatureSpec's (benchmarks/second_channel_loop.py appends a second
+    channel's 8 band powers to the first's, quantiles=()) took the extra band powers for
+    quantiles: their values (log powers, of either sign) as the direction."""
+    seen = []
+    model = FakeBlockModel()
+    stub = SimpleNamespace(**{k: getattr(model, k) for k in ("gd", "speed_range", "emulator")},
+                           loglik=model.loglik, plausibility=model.plausibility,
+                           level_score=lambda y, v, d: seen.append(d) or 0.0)  # fmt: skip
+    y = np.linspace(-4.0, 1.0, 16)
+    BCR(stub, feature=control.FeatureSpec(quantiles=()))._level_score(y, 1.5)
+    np.testing.assert_array_equal(seen[-1], np.full(16, 2.0))
+    y = np.linspace(-4.0, 1.0, 10)  # the default feature: 8 band powers, 2 quantiles
+    BCR(stub)._level_score(y, 1.5)
+    np.testing.assert_array_equal(seen[-1], np.concatenate([np.full(8, 2.0), y[8:]]))

@@ -102,3 +102,48 @@ def test_a_refined_grid_cuts_a_callable_prior_like_the_constraint(offset):
     expected = by_constraint.quantile("t", LEVELS)
     np.testing.assert_allclose(by_prior.quantile("t", LEVELS), expected, rtol=0, atol=1e-6 * sd)
     assert by_prior.samples["t"].min() >= cut
+
+
+@pytest.mark.parametrize("end", ["lower", "upper"])
+def test_a_prior_zero_only_at_the_domain_end_is_no_error(end):
+    """A prior that vanishes at an end of the domain (log(GD - GD_min), a Gamma-like prior): the
+    edge lies within float64 of the end node in native units, so the point bisection inserted
+    there duplicated the node's native GD and update raised 'a grid marginal's nodes must be
+    finite and strictly increasing' (it worked before the zero region was cut)."""
+    emu = road_emulator()
+    x, y = road_obs()
+    lo, hi = emu.standardizer.t_min[0], emu.standardizer.t_max[0]
+
+    def prior(gd):
+        with np.errstate(divide="ignore"):
+            return np.log(np.maximum(gd - lo if end == "lower" else hi - gd, 0.0))
+
+    post = Calibrator(emu).update(x, y, prior=prior)
+    nodes = post.grids["GD"].nodes
+    assert np.all(np.diff(nodes) > 0)
+    dense = dense_reference(Calibrator(emu), x, y, prior)
+    assert post.mean("GD") == pytest.approx(dense[0], abs=0.005 * dense[1])
+
+
+@pytest.mark.parametrize(("node", "strict"), [(60, True), (64, True), (70, False), (70, True)])
+@pytest.mark.parametrize("as_prior", [False, True])
+def test_an_edge_on_a_grid_node_is_cut_there(node, strict, as_prior):
+    """A constraint or callable prior whose edge is a grid node's native value (GD > node, GD >=
+    node): the bisection's point on the node's side had the node's native GD, and update raised
+    'strictly increasing' (the constraint since its edges were cut, the prior since 851a31f)."""
+    x, y = road_obs()
+    c = Calibrator(road_emulator()).theta_grid[node]
+
+    def allowed(gd):
+        return gd > c if strict else gd >= c
+
+    if as_prior:
+        post = Calibrator(road_emulator()).update(
+            x, y, prior=lambda gd: np.where(allowed(gd), 0.0, -np.inf)
+        )
+    else:
+        post = Calibrator(road_emulator(), constraint=lambda th: allowed(th[0])).update(x, y)
+    gm = post.grids["GD"]
+    assert np.all(np.diff(gm.nodes) > 0)
+    assert float(gm.ppf(0.0)) == pytest.approx(c, abs=1e-9)
+    assert allowed(post.samples["GD"]).all()

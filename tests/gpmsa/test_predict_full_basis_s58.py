@@ -82,3 +82,17 @@ def test_fit_study_member_refuses_another_basis():
         with pytest.raises(GPMSAError, match="differs from the (joint fit's|one the draws)"):
             full_prediction(member, obs, [[0.5]], discrepancy="constant", n_draws=2, **kw)
         full_prediction(member, obs, [[0.5]], discrepancy="linear", n_draws=2, **kw)
+
+
+def test_any_multiple_of_the_basis_is_the_same_basis():
+    """docs/prediction.md: a multiple of the basis is the same basis. Only powers of two were:
+    3 D or D / 10 normalise to D's basis within an ulp or two, and the exact SHA-256 refused
+    them ('differs from the one the draws were made with'), though the prediction is the same
+    to 2e-15."""
+    emu, obs, D = _joint_with_array_basis()
+    a = full_prediction(emu, obs, [[0.5]], discrepancy=D, n_draws=2, seed=0)
+    for multiple in (3.0 * D, 0.1 * D, D / 7.0 * 7.0, 1e200 * D):
+        b = full_prediction(emu, obs, [[0.5]], discrepancy=multiple, n_draws=2, seed=0)
+        np.testing.assert_allclose(b.y, a.y, rtol=0, atol=1e-12)
+    with pytest.raises(GPMSAError, match="discrepancy basis differs from the one the draws"):
+        full_prediction(emu, obs, [[0.5]], discrepancy=D + 1e-4, n_draws=2)
