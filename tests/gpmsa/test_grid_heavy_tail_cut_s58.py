@@ -6,32 +6,15 @@ silently. A peak's spread is now the smaller of its sd and IQR / 1.349 (`grid._s
 
 import numpy as np
 import pytest
-from scipy.integrate import cumulative_trapezoid
-from test_grid_one_param_edges_s57 import LEVELS, observations, vague_lamos_emulator
+from test_grid_one_param_edges_s57 import (
+    LEVELS,
+    dense_reference,
+    observations,
+    vague_lamos_emulator,
+)
 
 from gpmsa import Calibrator
 from gpmsa.calibration.grid import _spread
-from gpmsa.calibration.observations import reduce
-
-
-def dense_cut_reference(cal, x, y, cut: float) -> tuple[float, np.ndarray]:
-    """(sd, quantiles at LEVELS) of the exact posterior cut below ``cut`` (native), on nodes
-    1/400,000 of the range apart near the peak and 1/20,000 elsewhere."""
-    std = cal.emulator.standardizer
-    span = std.t_max[0] - std.t_min[0]
-    u = np.unique(np.concatenate([np.linspace(0, 1, 20001), np.linspace(0.35, 0.45, 40001)]))
-    data = reduce(cal.emulator, x, y, False)
-    logp = np.concatenate([cal._combine(cal._marginals(data, t)) + cal._theta_prior_at(t, None)
-                           for t in np.array_split(u[:, None], 15)])  # fmt: skip
-    native = u * span + std.t_min[0]
-    nodes = np.unique(np.concatenate([native[native >= cut], [cut]]))
-    logp = np.interp(nodes, native, logp)
-    f = np.exp(logp - logp.max())
-    cdf = cumulative_trapezoid(f, nodes, initial=0.0)
-    f, cdf = f / cdf[-1], cdf / cdf[-1]
-    mean = np.trapezoid(nodes * f, nodes)
-    sd = np.sqrt(np.trapezoid((nodes - mean) ** 2 * f, nodes))
-    return sd, np.interp(LEVELS, cdf, nodes)
 
 
 @pytest.mark.parametrize(("n", "cut", "n_grid"), [(2, 0.406, 33), (2, 0.42, 129), (3, 0.42, 33)])
@@ -40,7 +23,7 @@ def test_a_heavy_tail_cut_past_its_peak_is_refined_over_its_core(n, cut, n_grid)
     x, y = observations(n)
     cal = Calibrator(vague_lamos_emulator(), n_grid=n_grid, constraint=lambda t: t[0] >= cut)
     post = cal.update(x, y)
-    sd, quantiles = dense_cut_reference(cal, x, y, cut)
+    sd, quantiles = dense_reference(cal, x, y, around=0.4, cut=cut)
     assert np.max(np.abs(post.quantile("t", LEVELS) - quantiles)) < 0.04 * sd
     assert np.max(np.abs(post.grids["t"].cdf(quantiles) - LEVELS)) < 0.0015
 

@@ -40,10 +40,11 @@ def observations(n: int):
     return x, 0.3 * x + 0.4 + 1e-4 * np.random.default_rng(0).standard_normal(x.shape)
 
 
-def dense_reference(cal, x, y, around: float):
+def dense_reference(cal, x, y, around: float, cut: float | None = None):
     """(sd, quantiles at LEVELS) of the exact posterior (the Calibrator's per-node likelihood,
     lamOs integrated) on the whole axis at 1/20000 plus nodes 1/400000 apart within 0.05 of
-    ``around`` (unit scale; tens of nodes per sd)."""
+    ``around`` (unit scale; tens of nodes per sd); ``cut``: cut below this (native), a node
+    inserted there."""
     u = np.unique(np.concatenate([np.linspace(0, 1, 20001),
                                   np.linspace(around - 0.05, around + 0.05, 40001)]))  # fmt: skip
     data = reduce(cal.emulator, x, y, False)
@@ -51,6 +52,9 @@ def dense_reference(cal, x, y, around: float):
                            for t in np.array_split(u[:, None], 15)])  # fmt: skip
     std = cal.emulator.standardizer
     nodes = u * (std.t_max[0] - std.t_min[0]) + std.t_min[0]
+    if cut is not None:
+        native, nodes = nodes, np.unique(np.concatenate([nodes[nodes >= cut], [cut]]))
+        logp = np.interp(nodes, native, logp)
     f = np.exp(logp - logp.max())
     cdf = cumulative_trapezoid(f, nodes, initial=0.0)
     f, cdf = f / cdf[-1], cdf / cdf[-1]
