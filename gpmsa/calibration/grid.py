@@ -473,10 +473,10 @@ def _resolution(axis: np.ndarray, density: np.ndarray) -> float:
     """The node spacings per sd of the marginal ``density`` (k,) on ``axis`` (k,), its peaks
     (runs above MASS_CUTOFF cut at their `_valleys`) taken together: the inverse root of the
     mass-weighted mean of (local spacing / sd)^2 over the peaks, a peak's sd (its `_spread`)
-    and spacing taken
-    at its own nodes (trapezoid weights; the local spacing the wider interval next to a node,
-    root-mean-squared over the peak's mass), so that a refined, non-uniform axis is measured
-    by the spacing where the mass lies. The interpolation errors go as its inverse square."""
+    and spacing taken at its own nodes (trapezoid weights; the local spacing the wider interval
+    next to a node, root-mean-squared over the peak's mass), so that a refined, non-uniform
+    axis is measured by the spacing where the mass lies. The interpolation errors go as its
+    inverse square."""
     w = trapezoid_weights(axis)
     h = np.diff(axis)
     local2 = np.concatenate(([h[0]], np.maximum(h[:-1], h[1:]), [h[-1]])) ** 2
