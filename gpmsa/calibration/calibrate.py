@@ -14,6 +14,7 @@ predictive at each proposed theta; ``fast=False`` uses the generic numpy backend
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -29,10 +30,12 @@ from gpmsa.calibration.observations import (
     check_log_prior,
     check_x,
     check_y,
+    checked_obs_data,
     emulator_param_sets,
     emulator_record,
     fit_of,
     fixed_gp,
+    given_obs_data,
     lamos_start,
     obs_inputs,
     reduce,
@@ -77,18 +80,21 @@ def calibration_problem(
         fit = _probe(emulator, data, [emulator.params])
         start = lamos_start(fit, data.lamos)
     else:
-        x, _ = check_x(emulator, obs_inputs(emulator, x_obs, y_obs), extrapolate)
-        y = check_y(emulator, y_obs)
-        if emulator.K.shape[0] == 1 and y.size == x.shape[0]:
-            y = y.reshape(-1, 1)
-        obs, corr = reduce_obs(
-            ObsData(x, y),
-            emulator.standardizer,
-            emulator.K,
-            discrepancy,
-            emulator.x_names,
-            getattr(emulator, "levels", None),
-        )
+        given = given_obs_data(x_obs, y_obs)
+        if given is None:
+            x, _ = check_x(emulator, obs_inputs(emulator, x_obs, y_obs), extrapolate)
+            y = check_y(emulator, y_obs)
+            if emulator.K.shape[0] == 1 and y.size == x.shape[0]:
+                y = y.reshape(-1, 1)
+            given = ObsData(x, y)
+        else:
+            checked_obs_data(emulator, given, extrapolate)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # check_x already warned about an extrapolated x
+            obs, corr = reduce_obs(
+                given, emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
+                getattr(emulator, "levels", None),
+            )  # fmt: skip
     pri = emulator.priors
     lo = pri.lamOs
     priors = replace(pri, lamOs=replace(lo, a=lo.a + corr[0], b=lo.b + corr[1]))
@@ -166,6 +172,10 @@ def calibrate(
         y_obs: (n, l_sim) observed outputs, native units (a scalar output also takes (n,)).
             A pandas DataFrame (or Series) is read by name, the emulator's x_names / y_names
             in any order, never by position; a numpy masked array is refused.
+            Or pass one ``gpmsa.ObsData`` as x_obs (y_obs None), as ``gpmsa.fit(data, obs)``
+            takes it: each experiment then lies on its own ``index`` within the simulation
+            grid (the basis is interpolated there, as SEPIA's y_ind_obs) and may carry its
+            observation-error ``precision`` (native units; lamOs still scales it).
         n_samples: sweeps per chain after tuning; n_burn: of these, burned (kept: the rest).
         tune: GPM/SA step-size tuning first (tune_rounds x tune_levels sweeps).
         tune_rounds, tune_levels: the tuning's rounds and candidate widths per element (None:
@@ -209,7 +219,8 @@ def calibrate(
         when p > 1, and "lamVz"), and chains per name;
         ``info["obs_values_sha256"]`` fingerprints the observations
         (``ObsData.values_digest(emulator.x_names)``: x_obs as a table is read by name), so that
-        ``gpmsa.full_prediction`` refuses other ones with these draws;
+        ``gpmsa.full_prediction`` refuses other ones with these draws, and
+        ``info["obs_layout_sha256"]`` their index grids and precisions (`layout_digest`);
         ``info["emulator_sha256"]`` the emulator (``Emulator.model_sha256``), so that the
         predictions taking an emulator and ``posterior=`` refuse another one.
     """
@@ -278,6 +289,7 @@ def calibrate(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds, obs_values_sha256=data.values_sha256,
+        obs_layout_sha256=data.layout_sha256,
         **emulator_record(emulator),
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
         backend_options=backends.recorded_options(options),

@@ -294,7 +294,8 @@ class Calibrator:
         or (G, 2) for two (``Calibrator.theta_grid``); loglik (G,) = log p(u_obs | theta) with
         all normalising constants (the density of the reduced observation data u, standardised
         units), lamOs integrated against its prior (each window has its own lamOs). Successive
-        independent windows multiply: add their logliks. Raises GPMSAError for invalid input.
+        independent windows multiply: add their logliks. x_obs, y_obs (or one ObsData) as
+        ``update``'s. Raises GPMSAError for invalid input.
         """
         self._check_grid_method()
         data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
@@ -343,7 +344,9 @@ class Calibrator:
         Args:
             x_obs: (n, p) known inputs, native units (e.g. [[v]]); None for an emulator
                 without known inputs (p = 0), e.g. ``update(y_obs=[[f]])``.
-            y_obs: (n, l_sim) observed outputs, native units (e.g. [[f]]).
+            y_obs: (n, l_sim) observed outputs, native units (e.g. [[f]]). Or one
+                ``gpmsa.ObsData`` as x_obs (y_obs None): experiments on their own index grids
+                and with their own precisions (as ``gpmsa.calibrate`` takes it).
             prior: optional extra log prior of theta: log-density values on ``theta_grid`` (G,)
                 (for two parameters also (n_grid, n_grid), rows the first parameter;
                 interpolated linearly, bilinearly for two parameters, where the grid is
@@ -410,7 +413,8 @@ class Calibrator:
                     break
         key = check_seed(seed) if seed is not None else (self._entropy, count)
         post = self._posterior(axes, free, ok, margs, key, prior)
-        post.info["outside_sds"] = outside
+        post.info.update(outside_sds=outside, obs_values_sha256=data.values_sha256,
+                         obs_layout_sha256=data.layout_sha256)  # fmt: skip
         if self.q == 1 and why != "resolved":  # passes, node budget or float64 ran out
             res = res or resolution(axes, logp)
             if why == "float":

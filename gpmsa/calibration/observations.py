@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import warnings
 from dataclasses import dataclass
 from functools import cache
@@ -39,7 +40,8 @@ class Observations:
     d = n p_u);
     obs_chol (d, d) lower Cholesky factor of Sigma_obs; lamos the data-corrected lamOs prior;
     obs the ObsProblem for the samplers; values_sha256 the SHA-256 of the native x and y rows
-    (`gpmsa.model.data.values_digest`: an ObsData of the same values has the same)."""
+    (`gpmsa.model.data.values_digest`: an ObsData of the same values has the same);
+    layout_sha256 that of where they lie and how precise they are (`layout_digest`)."""
 
     x: np.ndarray
     z: np.ndarray
@@ -48,6 +50,7 @@ class Observations:
     obs: ObsProblem
     os_corr: tuple[float, float]
     values_sha256: str
+    layout_sha256: str
 
 
 def check_emulator(emulator, categorical_theta: bool = False) -> None:
@@ -120,21 +123,51 @@ def _as_rows(value, name: str, ncols: int) -> np.ndarray:
 
 
 def refuse_obs_data(**given) -> None:
-    """GPMSAError naming what to pass instead when an argument (``x_obs``, ``y_obs`` or
-    ``x_new``, by keyword) is a ``gpmsa.ObsData``: these functions take its arrays."""
+    """GPMSAError naming what to pass instead when an argument (``x_new``, or ``x_obs`` /
+    ``y_obs`` where arrays are needed, by keyword) is a ``gpmsa.ObsData``."""
     for what, value in given.items():
         if not isinstance(value, ObsData):
             continue
         if what == "x_new":
             raise GPMSAError("x_new is a gpmsa.ObsData: pass its inputs, x_new=obs.x")
-        unused = [k for k in ("index", "precision") if getattr(value, k) is not None]
-        note = ""
-        if unused:
-            note = (f" (y_obs on the emulator's output grid; its {' and '.join(unused)} "
-                    f"{'is' if len(unused) == 1 else 'are'} not used here)")  # fmt: skip
         raise GPMSAError(
-            f"{what} is a gpmsa.ObsData: pass its arrays, x_obs=obs.x, y_obs=obs.y{note}"
+            f"{what} is a gpmsa.ObsData: pass it alone, as the observations (x_obs=obs, "
+            "y_obs=None), or its arrays, x_obs=obs.x, y_obs=obs.y"
         )
+
+
+def given_obs_data(x_obs, y_obs) -> ObsData | None:
+    """The ``gpmsa.ObsData`` given in place of (x_obs, y_obs): as x_obs (positionally, as
+    ``gpmsa.fit(data, obs)`` takes it) or as y_obs, the other None; None where neither is one.
+    GPMSAError where an ObsData comes with the other argument too."""
+    for what, value, other in (("x_obs", x_obs, y_obs), ("y_obs", y_obs, x_obs)):
+        if isinstance(value, ObsData):
+            if other is not None:
+                raise GPMSAError(
+                    f"{what} is a gpmsa.ObsData, which holds both x and y: pass it alone "
+                    f"({'y_obs' if what == 'x_obs' else 'x_obs'}=None)"
+                )
+            return value
+    return None
+
+
+def layout_digest(grids: list, precisions: list | None, grid: np.ndarray) -> str:
+    """SHA-256 of where experiments lie on the output grid (``ObsData.grids``) and of their
+    precisions (``ObsData.precisions``): an index equal to the simulation ``grid`` counts as
+    none (the same reduction). What ``gpmsa.calibrate`` records (info "obs_layout_sha256")
+    beside the values' digest, so that a prediction conditioned on the same values placed or
+    weighted otherwise is refused."""
+    h = hashlib.sha256()
+    for j, g in enumerate(grids):
+        if g is None or (g.shape == grid.shape and np.array_equal(g, grid)):
+            h.update(f"{j}:grid:simulation;".encode())
+        else:
+            h.update(f"{j}:grid{g.shape}:".encode())
+            h.update(np.ascontiguousarray(g, dtype="<f8").tobytes())
+    for j, lam in enumerate(precisions or []):
+        h.update(f"{j}:precision{lam.shape}:".encode())
+        h.update(np.ascontiguousarray(lam, dtype="<f8").tobytes())
+    return h.hexdigest()
 
 
 def check_x(
@@ -210,8 +243,12 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     y_obs: (n, l_sim) on the emulator's output grid (a scalar output takes (n, 1) or (n,)); a
     table with named columns (a pandas DataFrame) or a pandas Series is read by the emulator's
     ``y_names`` (`check_y`). x_obs: (n, p); None (or (n, 0)) for an emulator with p = 0
-    (`obs_inputs`).
+    (`obs_inputs`). Or a ``gpmsa.ObsData`` alone (`given_obs_data`): experiments on their own
+    index grids and with their own precisions (`checked_obs_data`).
     """
+    given = given_obs_data(x_obs, y_obs)
+    if given is not None:
+        return _reduce_obs_data(emulator, given, extrapolate)
     x_obs = obs_inputs(emulator, x_obs, y_obs)
     x, xu = check_x(emulator, x_obs, extrapolate)
     n = x.shape[0]
@@ -223,16 +260,7 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     y = _as_rows(y, "y_obs", l_sim)
     if y.shape[0] != n:
         raise GPMSAError(f"y_obs must have one row per x_obs row ({n}), got {y.shape[0]}")
-    d = n * K.shape[1]
-    if not d <= limits.MAX_OBS_VALUES:  # a NaN limit refuses too
-        raise ResourceLimitError(
-            f"x_obs/y_obs have {n} rows x {K.shape[1]} basis components = {d} reduced values, "
-            f"above gpmsa.limits.MAX_OBS_VALUES = {limits.MAX_OBS_VALUES}: the exact likelihood "
-            f"costs a {d} x {d} eigendecomposition per theta value (time ~ d^3); split the rows "
-            "into windows and add their Calibrator.log_likelihood_grid (or pass one window's as "
-            "the next one's prior=), or raise gpmsa.limits.MAX_OBS_VALUES"
-        )
-    base = emulator.priors.lamOs
+    _check_obs_values(n, K.shape[1])
     if l_sim == 1:  # GPM/SA's scalar-output reduction, as gpmsa.model.problem.reduce_obs
         with np.errstate(over="ignore"):  # an overflow is refused below, as far off
             u = (y - std.y_mean) / std.y_sd
@@ -243,6 +271,64 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             obs, corr = reduce_obs(ObsData(x, y), std, K, None, emulator.x_names)
+    digests = values_digest(x, list(y)), layout_digest([None] * n, None, std.grid)
+    return _observations(emulator, obs, corr, digests, xu)
+
+
+def _check_obs_values(n: int, p_u: int) -> None:
+    """ResourceLimitError where n experiments of p_u basis components exceed
+    ``limits.MAX_OBS_VALUES`` reduced values."""
+    d = n * p_u
+    if not d <= limits.MAX_OBS_VALUES:  # a NaN limit refuses too
+        raise ResourceLimitError(
+            f"x_obs/y_obs have {n} rows x {p_u} basis components = {d} reduced values, "
+            f"above gpmsa.limits.MAX_OBS_VALUES = {limits.MAX_OBS_VALUES}: the exact likelihood "
+            f"costs a {d} x {d} eigendecomposition per theta value (time ~ d^3); split the rows "
+            "into windows and add their Calibrator.log_likelihood_grid (or pass one window's as "
+            "the next one's prior=), or raise gpmsa.limits.MAX_OBS_VALUES"
+        )
+
+
+def checked_obs_data(emulator, obs: ObsData, extrapolate: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Check a ``gpmsa.ObsData`` given to calibration against ``emulator``; returns its x
+    native (n, p) in the order of the emulator's x_names (`ObsData.inputs`) and on the unit
+    scale. Its x as ``check_x``'s; a scalar output takes one value per experiment and no
+    index; a functional output's experiments lie on the simulation grid or on their own index
+    within it (checked by the reduction)."""
+    x, xu = check_x(emulator, obs.inputs(emulator.x_names), extrapolate, "ObsData x")
+    _check_obs_values(x.shape[0], emulator.K.shape[1])
+    if emulator.K.shape[0] == 1:
+        if any(g is not None for g in obs.grids):
+            raise GPMSAError("the emulator's output is a scalar: ObsData index (an output grid) "
+                             "is for a functional output")  # fmt: skip
+        sizes = sorted({e.size for e in obs.experiments} - {1})
+        if sizes:
+            raise GPMSAError(
+                f"the emulator's output is a scalar: each ObsData experiment needs one value, "
+                f"got {sizes[0]}"
+            )
+    return x, xu
+
+
+def _reduce_obs_data(emulator, obs: ObsData, extrapolate: bool) -> Observations:
+    """``reduce`` for a ``gpmsa.ObsData``: GPM/SA's reduction of its experiments on their own
+    grids (interpolated basis) and with their precisions (`gpmsa.model.problem.reduce_obs`)."""
+    x, xu = checked_obs_data(emulator, obs, extrapolate)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # check_x already warned about an extrapolated x
+        reduced, corr = reduce_obs(
+            obs, emulator.standardizer, emulator.K, None, emulator.x_names,
+            getattr(emulator, "levels", None),
+        )  # fmt: skip
+    digests = (obs.values_digest(emulator.x_names),
+               layout_digest(obs.grids, obs.precisions, emulator.standardizer.grid))  # fmt: skip
+    return _observations(emulator, reduced, corr, digests, xu)
+
+
+def _observations(emulator, obs: ObsProblem, corr, digests: tuple[str, str], xu) -> Observations:
+    """The ``Observations`` of a reduction ``obs`` (lamOs prior correction ``corr``; the data's
+    values and layout ``digests``); GPMSAError where its reduced data lie more than
+    ``MAX_STD_OBS`` simulation sds from the mean (wrong units)."""
     z = obs.z
     far = ~(np.abs(z) <= MAX_STD_OBS)  # an overflow (inf, NaN) is far too
     if far.any():
@@ -252,10 +338,11 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
             f"y_obs lies {shown} standard deviations of the simulation outputs from their "
             f"mean; allowed at most {MAX_STD_OBS:g} (wrong units?)"
         )
+    base = emulator.priors.lamOs
     lamos = LamOsPrior(base.a + corr[0], base.b + corr[1], base.lower, base.upper)
     sig = obs.sig_obs
     chol = np.sqrt(sig) if sig.shape == (1, 1) else np.linalg.cholesky(sig)
-    return Observations(xu, z, chol, lamos, obs, corr, values_digest(x, list(y)))
+    return Observations(xu, z, chol, lamos, obs, corr, *digests)
 
 
 @dataclass(frozen=True)

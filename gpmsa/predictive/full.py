@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import solve_triangular
 
-from gpmsa.calibration.observations import blas_controller
+from gpmsa.calibration.observations import blas_controller, layout_digest
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
@@ -303,17 +303,27 @@ def _check_fitted_obs(settings: dict, obs: ObsData) -> None:
         )
 
 
-def _check_calibrated_obs(posterior, obs: ObsData, x_names) -> None:
+def _check_calibrated_obs(posterior, obs: ObsData, x_names, grid: np.ndarray) -> None:
     """GPMSAError when ``posterior`` recorded the values of its observations (``gpmsa.calibrate``:
     info "obs_values_sha256") and ``obs`` holds other ones. Its x is compared with its columns
     in the order of ``x_names`` (`ObsData.values_digest`), as ``gpmsa.calibrate`` read them: the
-    same table, columns in any order, is the same observations."""
+    same table, columns in any order, is the same observations. Likewise their index grids and
+    precisions (info "obs_layout_sha256", `layout_digest` against the simulation ``grid``)."""
     info = getattr(posterior, "info", None) or {}
     digest = info.get("obs_values_sha256")
     if digest is not None and obs.values_digest(x_names) != digest:
         raise GPMSAError(
             "obs holds other observations (x or y) than the calibration that drew posterior=: "
-            "pass the x_obs and y_obs given to gpmsa.calibrate as ObsData(x=x_obs, y=y_obs)"
+            "pass the ObsData given to gpmsa.calibrate (or its x_obs and y_obs as "
+            "ObsData(x=x_obs, y=y_obs))"
+        )
+    layout = info.get("obs_layout_sha256")
+    if layout is not None and layout_digest(obs.grids, obs.precisions, grid) != layout:
+        raise GPMSAError(
+            "obs places its observations on other index grids or gives them other precisions "
+            "than the calibration that drew posterior=: pass the ObsData given to "
+            "gpmsa.calibrate (arrays given there: ObsData(x=x_obs, y=y_obs), without index or "
+            "precision)"
         )
 
 
@@ -392,7 +402,7 @@ def full_prediction(
     else:
         check_posterior_emulator(emulator, posterior)
         _check_fitted_obs(getattr(posterior, "info", None) or {}, obs)  # a joint fit's draws
-        _check_calibrated_obs(posterior, obs, emulator.x_names)
+        _check_calibrated_obs(posterior, obs, emulator.x_names, std.grid)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
     with warnings.catch_warnings():

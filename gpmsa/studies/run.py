@@ -25,7 +25,7 @@ from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
 from gpmsa.studies.sampler import StudyChains, sample_study
-from gpmsa.studies.study import OBS_DIGESTS, Study, layout_of
+from gpmsa.studies.study import OBS_DIGESTS, OBS_LAYOUTS, Study, layout_of
 
 
 def _sequence(value, what: str) -> list:
@@ -92,7 +92,7 @@ def _study_draws(chains: StudyChains, keep: slice) -> dict[str, np.ndarray]:
 
 
 def calibrate_study(
-    emulators, x_obs, y_obs, *, labels=None, shared=(), hierarchical=(),
+    emulators, x_obs, y_obs=None, *, labels=None, shared=(), hierarchical=(),
     hyper: HyperPriors | None = None, n_samples: int = 5000, n_burn: int = 1000,
     tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
@@ -104,7 +104,8 @@ def calibrate_study(
 
     Args:
         emulators: one ``gpmsa.Emulator`` per model; x_obs, y_obs: per model, its observations
-            as ``gpmsa.calibrate`` takes them.
+            as ``gpmsa.calibrate`` takes them; or x_obs one ``gpmsa.ObsData`` per model and
+            y_obs None (or a None entry for a model given an ObsData).
         labels: the models' labels (default model0, model1, ...).
         shared: parameter names (emulator t_names) that take one value in every model that has
             them. hierarchical: names whose per-model values are draws of
@@ -136,7 +137,16 @@ def calibrate_study(
     True
     """
     emulators = _sequence(emulators, "emulators")
-    x_obs, y_obs = _sequence(x_obs, "x_obs"), _sequence(y_obs, "y_obs")
+    x_obs = _sequence(x_obs, "x_obs")
+    if y_obs is None:
+        y_obs = [None] * len(x_obs)
+        arrays = [k for k, x in enumerate(x_obs) if not isinstance(x, ObsData)]
+        if arrays:
+            raise GPMSAError(
+                f"y_obs is required unless every x_obs entry is a gpmsa.ObsData; entry "
+                f"{arrays[0]} is a {type(x_obs[arrays[0]]).__name__}"
+            )
+    y_obs = _sequence(y_obs, "y_obs")
     n = _same_count(emulators=emulators, x_obs=x_obs, y_obs=y_obs)
     for e in emulators:
         check_emulator(e)
@@ -162,6 +172,7 @@ def calibrate_study(
     )  # fmt: skip
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
     settings[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
+    settings[OBS_LAYOUTS] = {lab: r.layout_sha256 for lab, r in zip(labels, reduced, strict=True)}
     study = Study("calibration", emulators, layout, hyper,
                   _study_draws(chains, slice(int(n_burn), None)), settings, metadata)  # fmt: skip
     if study.convergence is not None:

@@ -44,6 +44,10 @@ OBS_DIGESTS = "obs_values_sha256_by_model"
 """The settings key of a calibrated study's record of each model's observations: label ->
 ``ObsData.values_digest()`` of its x_obs and y_obs (``member_posterior``'s info
 "obs_values_sha256", as ``gpmsa.calibrate`` records it)."""
+OBS_LAYOUTS = "obs_layout_sha256_by_model"
+"""The settings key of a calibrated study's record of where each model's observations lie and
+how precise they are: label -> ``layout_digest`` (``member_posterior``'s info
+"obs_layout_sha256", as ``gpmsa.calibrate`` records it)."""
 
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
@@ -198,10 +202,11 @@ class Study:
         settings = self.members[i].settings if self.kind == "fit" else {}
         info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy_sha256")
                      if k in settings})  # fmt: skip
-        digests = self.settings.get(OBS_DIGESTS)
-        digest = digests.get(self.labels[i]) if isinstance(digests, dict) else None
-        if isinstance(digest, str):
-            info["obs_values_sha256"] = digest
+        for key, name in ((OBS_DIGESTS, "obs_values_sha256"), (OBS_LAYOUTS, "obs_layout_sha256")):
+            digests = self.settings.get(key)
+            digest = digests.get(self.labels[i]) if isinstance(digests, dict) else None
+            if isinstance(digest, str):
+                info[name] = digest
         return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out, info=info)
 
     def to_record(self, files: list[str], hashes: list[str]) -> tuple[dict, dict]:

@@ -197,26 +197,26 @@ def test_calibrate_checks_n_emulator_draws_in_point_mode(n):
         gpmsa.calibrate(emu, x, y, n_samples=20, n_burn=5, tune=False, n_emulator_draws=n)
 
 
-def test_an_obsdata_given_for_the_arrays_says_to_pass_its_x_and_y():
-    """calibrate, Calibrator.update and calibrated_predict take arrays; a gpmsa.ObsData in their
-    place is refused naming what to pass, not as a missing y_obs or a non-numeric x_obs."""
+def test_an_obsdata_is_taken_alone_and_refused_with_arrays_or_as_x_new():
+    """calibrate and Calibrator.update take a gpmsa.ObsData alone in place of the arrays (the
+    same posterior); given with the other array too it is refused naming that, not as a
+    missing y_obs or a non-numeric x_obs; as calibrated_predict's x_new it is refused."""
     emu = road_emulator()
     x, y = road_obs()
     obs = gpmsa.ObsData(x=x, y=y)
-    want = r"x_obs is a gpmsa.ObsData: pass its arrays, x_obs=obs.x, y_obs=obs.y"
-    with pytest.raises(GPMSAError, match=want):
-        gpmsa.calibrate(emu, obs, n_samples=10, n_burn=0, tune=False)
+    a = gpmsa.calibrate(emu, obs, n_samples=30, n_burn=0, tune=False, seed=1)
+    b = gpmsa.calibrate(emu, x, y, n_samples=30, n_burn=0, tune=False, seed=1)
+    np.testing.assert_array_equal(a.samples["GD"], b.samples["GD"])
+    assert gpmsa.Calibrator(emu).update(obs).mean("GD") == gpmsa.Calibrator(emu).update(x, y).mean(
+        "GD"
+    )
+    want = r"x_obs is a gpmsa.ObsData, which holds both x and y: pass it alone \(y_obs=None\)"
     with pytest.raises(GPMSAError, match=want):
         gpmsa.calibrate(emu, obs, y, n_samples=10, n_burn=0, tune=False)
-    with pytest.raises(GPMSAError, match=want):
-        gpmsa.Calibrator(emu).update(obs)
-    with pytest.raises(GPMSAError, match="y_obs is a gpmsa.ObsData: pass its arrays"):
+    with pytest.raises(GPMSAError, match=r"y_obs is a gpmsa.ObsData, which holds both x and y"):
         gpmsa.Calibrator(emu).update(x, obs)
     with pytest.raises(GPMSAError, match=want):
-        gpmsa.calibrate(emu, x_obs=obs, discrepancy="constant", n_samples=10, n_burn=0)
+        gpmsa.calibrate(emu, obs, y, discrepancy="constant", n_samples=10, n_burn=0)
     post = gpmsa.Calibrator(emu).update(x, y)
     with pytest.raises(GPMSAError, match=r"x_new is a gpmsa.ObsData: pass its inputs, x_new=obs.x"):
         calibrated_predict(emu, post, obs)
-    gridded = gpmsa.ObsData(x=x, y=y, precision=4.0)
-    with pytest.raises(GPMSAError, match="its precision is not used here"):
-        gpmsa.Calibrator(emu).update(gridded)

@@ -1,0 +1,253 @@
+"""Calibration with a fixed emulator of observations on their own index grids, with their own
+precisions (a ``gpmsa.ObsData`` given to ``calibrate``, ``Calibrator`` and ``calibrate_study``),
+as SEPIA's y_ind_obs: checked against the un-reduced likelihood, the arrays' draws and every
+backend; the predictions conditioned on it refuse the same values placed otherwise."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from _calib_cases import road_emulator, road_obs, vector_emulator
+from scipy.special import logsumexp
+
+import gpmsa
+from gpmsa.calibration.observations import fixed_gp
+from gpmsa.errors import GPMSAError
+from gpmsa.model.basis import interpolate_basis
+
+# The vector emulator keeps 2 principal components of an 8-point output; on GRID_B, which
+# covers part of the output range, the truncated components no longer project out, and its
+# data lie 5.5 (no noise) to 6.8 predictive sds from the emulator's: the OutsideEmulatorWarning
+# is right, and not what these tests check.
+pytestmark = pytest.mark.filterwarnings("ignore::gpmsa.OutsideEmulatorWarning")
+
+T_TRUE = 0.4
+GRID_A = np.linspace(0.05, 0.95, 23)
+GRID_B = np.linspace(0.8, 0.1, 9)  # decreasing: any order is allowed
+
+
+def vector_truth(x: np.ndarray, grid: np.ndarray, t: float = T_TRUE) -> np.ndarray:
+    """The vector emulator's simulator (``_calib_cases.vector_emulator``) at (x, t) on ``grid``."""
+    return (1.0 + t) * np.sin(np.pi * grid[None, :] * (0.5 + x[:, None])) + 0.3 * t
+
+
+def ragged_obs(precision=None, noise: float = 0.02, seed: int = 0) -> gpmsa.ObsData:
+    """Two experiments of the vector emulator on grids of 23 and 9 points, neither the
+    simulation grid (8 points): the simulator's output interpolated linearly there (as the
+    emulator's basis is), plus noise of sd ``noise``."""
+    rng = np.random.default_rng(seed)
+    x = np.array([0.3, 0.7])
+    sim_grid = vector_emulator().standardizer.grid
+    on_sim = vector_truth(x, sim_grid)
+    ys = [np.interp(g, sim_grid, on_sim[k]) + noise * rng.standard_normal(g.size)
+          for k, g in enumerate((GRID_A, GRID_B))]  # fmt: skip
+    return gpmsa.ObsData(x[:, None], ys, index=[GRID_A, GRID_B], precision=precision)
+
+
+def unreduced_log_posterior(emu, obs: gpmsa.ObsData, theta_unit: np.ndarray) -> np.ndarray:
+    """log p(theta | y) (unnormalised) on unit-scale nodes (G,) from the full likelihood of
+    every observed value on its own grid: y_std = sum_c K_c(grid) u_c + e, u the emulator's
+    predictive at (x, theta), e ~ N(0, P^-1 / lamOs) (P the precision in standardised units,
+    the identity where none is given), lamOs integrated against its Gamma prior on a fine log
+    grid; times the emulator's theta prior. No GPM/SA reduction."""
+    std, K = emu.standardizer, emu.K
+    xu = std.x_to_unit(obs.x)
+    mean, cov = fixed_gp(emu).predict(xu, theta_unit[:, None])  # (G, p_u, n), (G, p_u, n, n)
+    bases = [interpolate_basis(K, std.grid, g) for g in obs.grids]
+    y = np.concatenate(
+        [(e - std.mean_on(g)) / std.y_sd for e, g in zip(obs.experiments, obs.grids, strict=True)]
+    )
+    L = y.size
+    starts = np.cumsum([0] + [b.shape[0] for b in bases])
+    B = np.zeros((L, K.shape[1], len(bases)))  # value <- (component, experiment)
+    for j, b in enumerate(bases):
+        B[starts[j] : starts[j + 1], :, j] = b
+    prec = np.zeros((L, L))
+    for j, b in enumerate(bases):
+        block = np.eye(b.shape[0]) if obs.precisions is None else obs.precisions[j] * std.y_sd**2
+        prec[starts[j] : starts[j + 1], starts[j] : starts[j + 1]] = block
+    R = np.linalg.cholesky(prec).T  # prec = R^T R: R y has noise I / lamOs
+    log_det_r = np.sum(np.log(np.diag(R)))
+    Bf = B.reshape(L, -1)  # columns (component, experiment)
+    lam = np.exp(np.linspace(np.log(1e-4), np.log(1e6), 6001))
+    pri = emu.priors.lamOs
+    log_prior_lam = (pri.a - 1) * np.log(lam) - pri.b * lam + np.log(lam)  # d log lamOs
+    out = np.empty(theta_unit.size)
+    for g in range(theta_unit.size):
+        m = Bf @ mean[g].reshape(-1)
+        C = np.zeros((B.shape[1] * B.shape[2],) * 2)
+        for c in range(K.shape[1]):
+            sl = slice(c * len(bases), (c + 1) * len(bases))
+            C[sl, sl] = cov[g, c]
+        Cw = R @ Bf @ C @ Bf.T @ R.T
+        ev, V = np.linalg.eigh(0.5 * (Cw + Cw.T))
+        r2 = (V.T @ (R @ (y - m))) ** 2
+        var = np.maximum(ev, 0.0)[None, :] + 1.0 / lam[:, None]
+        ll = -0.5 * np.sum(np.log(var) + r2[None, :] / var, axis=1) + log_det_r
+        out[g] = logsumexp(ll + log_prior_lam)
+    mu, sd = (float(np.ravel(v)[0]) for v in (emu.priors.theta_mean, emu.priors.theta_sd))
+    return out - 0.5 * ((theta_unit - mu) / sd) ** 2
+
+
+def reference_summaries(emu, obs) -> dict[str, float]:
+    """Mean, sd and quantiles of theta (native) from `unreduced_log_posterior` on a fine grid
+    over its mass (where a coarse grid's log density is within 40 of its peak)."""
+    coarse = np.linspace(0.0, 1.0, 401)
+    lp = unreduced_log_posterior(emu, obs, coarse)
+    mass = coarse[lp > lp.max() - 40.0]
+    fine = np.linspace(max(0.0, mass[0] - 0.0025), min(1.0, mass[-1] + 0.0025), 2001)
+    lp = unreduced_log_posterior(emu, obs, fine)
+    w = np.exp(lp - lp.max())
+    w /= w.sum()
+    t = emu.standardizer.t_from_unit(fine[:, None])[:, 0]
+    mean = float(w @ t)
+    sd = float(np.sqrt(w @ (t - mean) ** 2))
+    cdf = np.cumsum(w)
+    q = {p: float(np.interp(p, cdf, t)) for p in (0.05, 0.5, 0.95)}
+    return {"mean": mean, "sd": sd, **q}
+
+
+@pytest.mark.parametrize(
+    "precision",
+    [None, [1e4, 2.5e3], [np.diag(np.linspace(1e3, 4e3, 23)), 0.5e4 * np.eye(9)]],
+    ids=["none", "scalars", "matrices"],
+)
+def test_calibrator_on_own_grids_matches_the_unreduced_likelihood(precision):
+    """The Calibrator's grid posterior of ObsData on ragged grids of their own (23 and 9
+    points, one decreasing, against a simulation grid of 8) equals the posterior of the full
+    likelihood of every observed value, no reduction, to a small fraction of an sd."""
+    emu = vector_emulator()
+    obs = ragged_obs(precision)
+    ref = reference_summaries(emu, obs)
+    post = gpmsa.Calibrator(emu).update(obs)
+    sd = ref["sd"]
+    assert abs(post.mean("t") - ref["mean"]) < 0.02 * sd
+    assert abs(post.sd("t") / sd - 1.0) < 0.02
+    for p in (0.05, 0.5, 0.95):
+        assert abs(float(post.quantile("t", p)) - ref[p]) < 0.03 * sd
+
+
+def test_the_posterior_depends_on_the_index_given():
+    """The same values placed on grids 10 % shorter give another posterior (the index is
+    used, not dropped): they misfit there, so lamOs falls and theta widens."""
+    emu = vector_emulator()
+    obs = ragged_obs([1e4, 2.5e3])
+    shifted = gpmsa.ObsData(obs.x, obs.experiments, index=[GRID_A * 0.9, GRID_B * 0.9],
+                            precision=[1e4, 2.5e3])  # fmt: skip
+    a = gpmsa.Calibrator(emu).update(obs)
+    with pytest.warns(gpmsa.OutsideEmulatorWarning):
+        b = gpmsa.Calibrator(emu).update(shifted)
+    assert abs(a.mean("t") - T_TRUE) < 4 * a.sd("t")
+    assert b.mean("lamOs") < a.mean("lamOs") / 5  # the values misfit there
+    assert b.sd("t") > 2 * a.sd("t")
+
+
+def test_obsdata_on_the_simulation_grid_gives_the_arrays_draws():
+    """An ObsData without index or precision is the arrays (x_obs, y_obs): the same draws from
+    the fast and the generic numpy sampler, with a discrepancy, and the same grid posterior;
+    an index equal to the simulation grid is the same too."""
+    emu = vector_emulator()
+    grid = emu.standardizer.grid
+    x = np.array([[0.3], [0.7]])
+    y = vector_truth(x[:, 0], grid) + 0.01 * np.random.default_rng(1).standard_normal((2, 8))
+    kw = {"n_samples": 300, "n_burn": 50, "seed": 3}
+    for extra in ({}, {"fast": False}, {"discrepancy": "constant"}):
+        a = gpmsa.calibrate(emu, x, y, **kw, **extra)
+        for obs in (gpmsa.ObsData(x, y), gpmsa.ObsData(x, y, index=grid)):
+            b = gpmsa.calibrate(emu, obs, **kw, **extra)
+            for name in a.names:
+                np.testing.assert_array_equal(a.samples[name], b.samples[name])
+            assert a.info["obs_values_sha256"] == b.info["obs_values_sha256"]
+            assert a.info["obs_layout_sha256"] == b.info["obs_layout_sha256"]
+    ga = gpmsa.Calibrator(emu).update(x, y)
+    gb = gpmsa.Calibrator(emu).update(y_obs=gpmsa.ObsData(x, y))
+    assert ga.mean("t") == gb.mean("t") and ga.sd("t") == gb.sd("t")
+
+
+@pytest.mark.parametrize("backend", ["numpy-generic", "torch"])
+def test_every_sampler_agrees_with_the_grid_on_own_grids(backend):
+    """calibrate's samplers on ragged grids with precisions: within Monte-Carlo error of the
+    exact grid posterior (the fast numpy sampler, the generic one, torch)."""
+    emu = vector_emulator()
+    obs = ragged_obs([1e4, 2.5e3])
+    exact = gpmsa.Calibrator(emu).update(obs)
+    opts = {"fast": False} if backend == "numpy-generic" else {"backend": backend}
+    for kw in ({}, opts):
+        post = gpmsa.calibrate(emu, obs, n_samples=2000, n_burn=200, seed=5, **kw)
+        assert abs(post.mean("t") - exact.mean("t")) < 0.25 * exact.sd("t")
+        assert abs(post.sd("t") / exact.sd("t") - 1.0) < 0.25
+
+
+def test_full_prediction_conditions_on_the_calibrated_layout_and_refuses_another():
+    """full_prediction(posterior=) of a calibration on own grids takes that ObsData; the same
+    values on other grids, with other precisions, or as the arrays on the simulation grid are
+    refused, naming the layout. The Calibrator's posterior records the same digests."""
+    emu = vector_emulator()
+    obs = ragged_obs([1e4, 2.5e3])
+    post = gpmsa.calibrate(emu, obs, n_samples=300, n_burn=50, seed=2)
+    pred = gpmsa.full_prediction(emu, obs, [[0.5]], posterior=post, discrepancy=None, seed=0)
+    assert pred.y.shape[1:] == (1, emu.l_sim)
+    others = [
+        gpmsa.ObsData(obs.x, obs.experiments, index=[GRID_A, GRID_B * 0.99],
+                      precision=[1e4, 2.5e3]),
+        gpmsa.ObsData(obs.x, obs.experiments, index=[GRID_A, GRID_B], precision=[1e4, 1e3]),
+        gpmsa.ObsData(obs.x, obs.experiments, index=[GRID_A, GRID_B]),
+    ]  # fmt: skip
+    for other in others:
+        with pytest.raises(GPMSAError, match="other index grids or gives them other precisions"):
+            gpmsa.full_prediction(emu, other, [[0.5]], posterior=post, discrepancy=None)
+    grid_post = gpmsa.Calibrator(emu).update(obs)
+    for key in ("obs_values_sha256", "obs_layout_sha256"):
+        assert grid_post.info[key] == post.info[key]
+
+
+def test_a_scalar_output_takes_precisions_and_refuses_an_index():
+    """A scalar output: per-experiment precisions weight the observations as the unreduced
+    likelihood does (a precision 4x another halves that value's noise sd); an index is
+    refused, as is more than one value per experiment."""
+    emu = road_emulator()
+    x, y = road_obs()
+    xs, ys = [x[0], [1.5]], [y[0], [y[0][0] * 1.1]]
+    obs = gpmsa.ObsData(xs, ys, precision=[4e3, 1e3])
+    ref = reference_summaries(emu, obs)
+    post = gpmsa.Calibrator(emu).update(obs)
+    assert abs(post.mean("GD") - ref["mean"]) < 0.02 * ref["sd"]
+    assert abs(post.sd("GD") / ref["sd"] - 1.0) < 0.02
+    with pytest.raises(GPMSAError, match="output is a scalar: ObsData index"):
+        gpmsa.Calibrator(emu).update(gpmsa.ObsData(x, y, index=[0.0]))
+    with pytest.raises(GPMSAError, match="each ObsData experiment needs one value, got 2"):
+        gpmsa.calibrate(emu, gpmsa.ObsData(x, [[1.0, 2.0]]), n_samples=10, n_burn=0)
+
+
+def test_an_obsdata_given_with_other_arrays_is_refused():
+    """An ObsData holds x and y: given with y_obs (or x_obs) too, it is refused naming that;
+    a study takes one ObsData per model with y_obs left out, and arrays need y_obs."""
+    emu = vector_emulator()
+    obs = ragged_obs()
+    with pytest.raises(GPMSAError, match=r"x_obs is a gpmsa.ObsData, which holds both x and y"):
+        gpmsa.calibrate(emu, obs, obs.experiments[0], n_samples=10, n_burn=0)
+    with pytest.raises(GPMSAError, match=r"y_obs is a gpmsa.ObsData, which holds both x and y"):
+        gpmsa.Calibrator(emu).update([[0.3]], obs)
+    with pytest.raises(GPMSAError, match="x_new is a gpmsa.ObsData"):
+        gpmsa.predictive.calibrated_predict(emu, gpmsa.Calibrator(emu).update(obs), obs)
+    with pytest.raises(GPMSAError, match="y_obs is required unless every x_obs entry"):
+        gpmsa.calibrate_study([emu, emu], [obs, [[0.3]]], n_samples=10, n_burn=0)
+
+
+def test_a_study_takes_obsdata_per_model():
+    """calibrate_study with one ObsData per model on its own grids: each member posterior
+    records its layout, so full_prediction refuses the arrays on the simulation grid; a
+    shared parameter lands near the truth."""
+    emu = vector_emulator()
+    a, b = ragged_obs([1e4, 2.5e3], seed=1), ragged_obs([1e4, 2.5e3], seed=2)
+    study = gpmsa.calibrate_study([emu, emu], [a, b], shared=["t"], n_samples=600, n_burn=100,
+                                  seed=4)  # fmt: skip
+    assert abs(study.posterior.mean("t") - T_TRUE) < 0.05
+    member = study.member_posterior(0)
+    assert (
+        member.info["obs_layout_sha256"]
+        == gpmsa.Calibrator(emu).update(a).info["obs_layout_sha256"]
+    )
+    plain = gpmsa.ObsData(a.x, a.experiments, index=[GRID_A, GRID_B])
+    with pytest.raises(GPMSAError, match="other index grids or gives them other precisions"):
+        gpmsa.full_prediction(emu, plain, [[0.5]], posterior=member, discrepancy=None)
