@@ -15,6 +15,7 @@ from gpmsa.errors import (
     EmulatorFileError,
     GPMSAError,
     OutsideEmulatorWarning,
+    ReductionWarning,
     ResourceLimitError,
 )
 from gpmsa.fitting.emulator import Emulator, LooResult, load
@@ -52,6 +53,7 @@ __all__ = [
     "Posterior",
     "Priors",
     "Problem",
+    "ReductionWarning",
     "ResourceLimitError",
     "SimData",
     "Study",

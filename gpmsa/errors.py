@@ -22,6 +22,13 @@ class OutsideEmulatorWarning(UserWarning):
     """An observation lies outside what the emulator has seen (far from all its predictions)."""
 
 
+class ReductionWarning(UserWarning):
+    """The observations as reduced may not say what the data say
+    (``gpmsa.model.problem.reduce_obs``): an experiment has fewer independent values than
+    basis vectors, or their precisions declare an error larger than the simulation outputs'
+    spread (a variance passed for a precision?)."""
+
+
 class ChainError(GPMSAError):
     """A chain failed (its task raised, its worker died, or its draws are not finite).
 

@@ -23,6 +23,7 @@ from threadpoolctl import threadpool_limits
 from gpmsa import backends
 from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
+    EXTRAPOLATED,
     Fit,
     Observations,
     blas_controller,
@@ -90,10 +91,10 @@ def calibration_problem(
         else:
             checked_obs_data(emulator, given, extrapolate)
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # check_x already warned about an extrapolated x
+            warnings.filterwarnings("ignore", message=EXTRAPOLATED)  # check_x warned already
             obs, corr = reduce_obs(
                 given, emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
-                getattr(emulator, "levels", None),
+                getattr(emulator, "levels", None), getattr(emulator, "y_names", None),
             )  # fmt: skip
     pri = emulator.priors
     lo = pri.lamOs
@@ -218,7 +219,8 @@ def calibrate(
         native units), "lamOs" (and with a discrepancy "betaV", or "betaV[k]" per known input
         when p > 1, and "lamVz"), and chains per name;
         ``info["obs_values_sha256"]`` fingerprints the observations
-        (``ObsData.values_digest(emulator.x_names)``: x_obs as a table is read by name), so that
+        (``ObsData.values_digest(emulator.x_names, emulator.y_names)``: tables are read by
+        name), so that
         ``gpmsa.full_prediction`` refuses other ones with these draws, and
         ``info["obs_layout_sha256"]`` their index grids and precisions (`layout_digest`);
         ``info["emulator_sha256"]`` the emulator (``Emulator.model_sha256``), so that the

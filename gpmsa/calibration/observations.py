@@ -28,6 +28,8 @@ from gpmsa.model.problem import MAX_STD_OBS, SIGOBS_RIDGE, ObsProblem, reduce_ob
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 EMULATOR_PARAM_MODES = ("point", "draws")
+EXTRAPOLATED = "x_obs lies outside the simulation design's range"
+"""The start of `gpmsa.model.problem.check_x_obs`'s warning, which ``check_x`` gives first."""
 OUTSIDE_SDS = 5.0
 """An observation farther than this many predictive sds from every emulator prediction at its
 x (over the whole theta domain) lies outside what the emulator has seen: a warning
@@ -198,14 +200,18 @@ def check_x(
     return x, xu
 
 
+def _y_names(emulator) -> tuple[str, ...] | None:
+    """The emulator's y_names (None for an object without them)."""
+    names = getattr(emulator, "y_names", None)
+    return None if names is None else tuple(names)
+
+
 def check_y(emulator, y_obs) -> np.ndarray:
     """y_obs as a float array with its columns in the order of the emulator's ``y_names``: a
     table with named columns by name (`by_column_names`: other names are a GPMSAError), a pandas
     Series by its labels (`series_by_names`), an array as it is (by position). A numpy masked
     array is refused (`as_float`)."""
-    names = getattr(emulator, "y_names", None)
-    names = None if names is None else tuple(names)
-    return as_float(by_column_names(y_obs, names, "y_obs"), "y_obs")
+    return as_float(by_column_names(y_obs, _y_names(emulator), "y_obs"), "y_obs")
 
 
 def obs_inputs(emulator, x_obs, y_obs, what: str = "x_obs"):
@@ -269,7 +275,7 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
         corr = (0.0, 0.0)
     else:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
+            warnings.filterwarnings("ignore", message=EXTRAPOLATED)  # check_x warned already
             obs, corr = reduce_obs(ObsData(x, y), std, K, None, emulator.x_names)
     digests = values_digest(x, list(y)), layout_digest([None] * n, None, std.grid)
     return _observations(emulator, obs, corr, digests, xu)
@@ -295,7 +301,7 @@ def checked_obs_data(emulator, obs: ObsData, extrapolate: bool) -> tuple[np.ndar
     scale. Its x as ``check_x``'s; a scalar output takes one value per experiment and no
     index; a functional output's experiments lie on the simulation grid or on their own index
     within it (checked by the reduction)."""
-    x, xu = check_x(emulator, obs.inputs(emulator.x_names), extrapolate, "ObsData x")
+    x, xu = check_x(emulator, obs.inputs(emulator.x_names), extrapolate, "the ObsData's input")
     _check_obs_values(x.shape[0], emulator.K.shape[1])
     if emulator.K.shape[0] == 1:
         if any(g is not None for g in obs.grids):
@@ -315,12 +321,12 @@ def _reduce_obs_data(emulator, obs: ObsData, extrapolate: bool) -> Observations:
     grids (interpolated basis) and with their precisions (`gpmsa.model.problem.reduce_obs`)."""
     x, xu = checked_obs_data(emulator, obs, extrapolate)
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # check_x already warned about an extrapolated x
+        warnings.filterwarnings("ignore", message=EXTRAPOLATED)  # check_x warned already
         reduced, corr = reduce_obs(
             obs, emulator.standardizer, emulator.K, None, emulator.x_names,
-            getattr(emulator, "levels", None),
+            getattr(emulator, "levels", None), _y_names(emulator),
         )  # fmt: skip
-    digests = (obs.values_digest(emulator.x_names),
+    digests = (obs.values_digest(emulator.x_names, _y_names(emulator)),
                layout_digest(obs.grids, obs.precisions, emulator.standardizer.grid))  # fmt: skip
     return _observations(emulator, reduced, corr, digests, xu)
 

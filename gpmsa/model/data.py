@@ -594,10 +594,12 @@ class ObsData:
     grids: list[np.ndarray | None] = field(init=False, repr=False)
     precisions: list[np.ndarray] | None = field(init=False, repr=False)
     x_columns: tuple[str, ...] | None = field(init=False, repr=False)
+    y_columns: tuple[str, ...] | None = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         check_same_rows({"x_obs": self.x, "y_obs": self.y})
         object.__setattr__(self, "x_columns", column_labels(self.x))
+        object.__setattr__(self, "y_columns", column_labels(self.y))
         if self.y is None:
             raise GPMSAError("ObsData needs y (n, l_obs), the observed outputs; only x may be "
                              "omitted (no known inputs)")  # fmt: skip
@@ -622,13 +624,27 @@ class ObsData:
             return self.x
         return self.x[:, column_order(self.x_columns, x_names, "x_obs")]
 
-    def values_digest(self, x_names=None) -> str:
-        """SHA-256 of x and every experiment's y (`values_digest`): what ``gpmsa.calibrate``,
-        which takes no grids or precisions, records of its observations. ``x_names``: x with
-        its columns in that order (`inputs`: a table's by name, as calibrate reads x_obs);
-        None: as given."""
+    def outputs(self, y_names=None) -> list[np.ndarray]:
+        """Every experiment's y (``experiments``); for y given as a table with named columns
+        (``y_columns``) and no index, its columns in the order of ``y_names`` (by name, as
+        ``gpmsa.calibrate`` reads a table y_obs; GPMSAError when those names are not
+        ``y_names``). A table's default labels 0, 1, ... are no names: by position, as are
+        the columns of a y with an index (they follow the index); ``y_names`` None: as
+        given."""
+        labels = self.y_columns
+        default = labels is not None and labels == tuple(str(k) for k in range(len(labels)))
+        if labels is None or default or y_names is None or any(g is not None for g in self.grids):
+            return self.experiments
+        order = column_order(labels, [str(n) for n in y_names], "ObsData y")
+        return [e[order] for e in self.experiments]
+
+    def values_digest(self, x_names=None, y_names=None) -> str:
+        """SHA-256 of x and every experiment's y (`values_digest`): what ``gpmsa.calibrate``
+        records of its observations' values. ``x_names``: x with its columns in that order
+        (`inputs`: a table's by name, as calibrate reads x_obs); ``y_names``: likewise y
+        (`outputs`); None: as given."""
         x = self.x if x_names is None else self.inputs(x_names)
-        return values_digest(x, self.experiments)
+        return values_digest(x, self.outputs(y_names))
 
     def digest(self) -> str:
         """SHA-256 of the observations (x, every experiment's y, grid and precision, as float64):
@@ -664,11 +680,21 @@ class ObsData:
     def _grids(index, ys: list[np.ndarray]) -> list[np.ndarray | None]:
         if index is None:
             return [None] * len(ys)
-        if isinstance(index, (list, tuple)) and len(index) == len(ys) and np.ndim(index[0]) == 1:
+        per_experiment = isinstance(index, (list, tuple)) and len(index) > 0
+        per_experiment = per_experiment and all(np.ndim(g) == 1 for g in index)
+        if per_experiment or (isinstance(index, np.ndarray) and index.ndim == 2):
+            if len(index) != len(ys):
+                raise GPMSAError(
+                    f"index_obs has {len(index)} grids for {len(ys)} experiment(s): give one "
+                    "grid per experiment, or one grid for all"
+                )
             grids = [as_float(g, f"index_obs[{j}]").reshape(-1) for j, g in enumerate(index)]
         else:
-            g = as_float(index, "index_obs").reshape(-1)
-            grids = [g] * len(ys)
+            g = as_float(index, "index_obs")
+            if g.ndim > 1:
+                raise GPMSAError(f"index_obs must be one grid (l,) or one per experiment, got "
+                                 f"shape {g.shape}")  # fmt: skip
+            grids = [g.reshape(-1)] * len(ys)
         for j, (g, e) in enumerate(zip(grids, ys, strict=True)):
             if g.size != e.size:
                 raise GPMSAError(f"index of experiment {j} has {g.size} points, y_obs has {e.size}")
@@ -682,7 +708,10 @@ class ObsData:
         if not isinstance(precision, (list, tuple)) and np.ndim(precision) == 0:
             precision = [precision] * len(ys)  # one scalar for every experiment
         if len(precision) != len(ys):
-            raise GPMSAError(f"precision must have one entry per experiment ({len(ys)})")
+            raise GPMSAError(
+                f"precision must have one entry per experiment ({len(ys)}), got {len(precision)}"
+                " (a matrix for one experiment goes in a list: [matrix])"
+            )
         out = []
         for j, (lam, e) in enumerate(zip(precision, ys, strict=True)):
             lam = as_float(lam, f"precision[{j}]")

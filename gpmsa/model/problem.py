@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, ReductionWarning
 from gpmsa.model import categorical
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
@@ -252,10 +252,13 @@ def reduce_obs(
     discrepancy,
     x_names: tuple[str, ...],
     levels: categorical.Levels | None = None,
+    y_names=None,
 ) -> tuple[ObsProblem, tuple[float, float]]:
     """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db).
 
     ``levels``: the x columns' training levels (``SimData.levels``); an unseen level is refused.
+    ``y_names``: the simulation outputs' names, by which a y table with named columns and no
+    index is read (`ObsData.outputs`).
     """
     x_native = obs.inputs(x_names)
     if x_native.ndim != 2 or x_native.shape[1] != std.x_min.size:  # before x_to_unit broadcasts
@@ -266,14 +269,15 @@ def reduce_obs(
     check_x_obs(x, x_names)
     n, p_u = obs.n, K.shape[1]
     scalar = K.shape[0] == 1
-    for j, (e, g) in enumerate(zip(obs.experiments, obs.grids, strict=True)):
+    experiments = obs.outputs(y_names)
+    for j, (e, g) in enumerate(zip(experiments, obs.grids, strict=True)):
         if not scalar and g is None and e.size != K.shape[0]:
             raise GPMSAError(
                 f"experiment {j} has {e.size} values but the simulation output has {K.shape[0]}; "
                 "give ObsData an index grid"
             )
     with np.errstate(over="ignore"):  # an overflow gives inf: refused just below
-        ys = [std.y_to_std(e, g) for e, g in zip(obs.experiments, obs.grids, strict=True)]
+        ys = [std.y_to_std(e, g) for e, g in zip(experiments, obs.grids, strict=True)]
     for j, e in enumerate(ys):
         check_finite(e, f"y_obs[{j}] in standardised units")
     far = max(float(np.max(np.abs(e))) for e in ys)
@@ -285,6 +289,7 @@ def reduce_obs(
     lamy = [np.eye(e.size) for e in ys]
     if obs.precisions is not None:
         lamy = [lam * std.y_sd**2 for lam in obs.precisions]
+        _warn_if_vague(lamy)
     if scalar:
         if any(e.size != 1 for e in ys):
             raise GPMSAError("a scalar simulation output needs one value per experiment in y_obs")
@@ -298,9 +303,16 @@ def reduce_obs(
         v = np.zeros((n, 0))
         obs_p = ObsProblem(x, u, v, sig, True, Ks, Ds, p_v, tuple(ys))
         return obs_p, (0.0, 0.0)
+    _check_discrepancy_scales(discrepancy, [std.grid if g is None else g for g in obs.grids])
     Ks, Ds, vs, us, blocks = [], [], [], [], []
-    rank, total, ss = 0, 0, 0.0
+    rank, total, ss, short = 0, 0, 0.0, []
+    lo, hi = std.grid.min(), std.grid.max()
     for j, (e, g, lam) in enumerate(zip(ys, obs.grids, lamy, strict=True)):
+        if g is not None and not (g.min() >= lo and g.max() <= hi):
+            raise GPMSAError(
+                f"the index of experiment {j} reaches [{g.min():.6g}, {g.max():.6g}], outside the "
+                f"simulation grid [{lo:.6g}, {hi:.6g}]; observations must lie within it"
+            )
         Kj = interpolate_basis(K, std.grid, g)
         Dj = discrepancy_basis(discrepancy, std.grid if g is None else g)
         DK = Kj if Dj is None else np.hstack([Dj, Kj])
@@ -316,7 +328,10 @@ def reduce_obs(
                 f"y_obs[{j}] is too large for the emulator's basis: its projection overflows "
                 "float64 (wrong units, or observation precisions?)"
             )
-        rank += int(np.linalg.matrix_rank(A, hermitian=True))
+        r_j = int(np.linalg.matrix_rank(A, hermitian=True))
+        if r_j < A.shape[0]:
+            short.append((j, r_j))
+        rank += r_j
         total += e.size
         blocks.append(
             cho_solve(cho_factor(ridge + SIGOBS_RIDGE * np.eye(A.shape[0])), np.eye(A.shape[0]))
@@ -330,6 +345,8 @@ def reduce_obs(
     if any(v.size != p_v for v in vs):
         raise GPMSAError("every experiment needs the same number of discrepancy basis vectors")
     n_c = p_v + p_u
+    if short:
+        _warn_rank_deficient(short, n_c)
     sig = np.zeros((n * n_c, n * n_c))
     for e, blk in enumerate(blocks):
         idx = np.arange(n_c) * n + e
@@ -339,6 +356,59 @@ def reduce_obs(
         tuple(Ks), None if p_v == 0 else tuple(Ds), p_v, tuple(ys),
     )  # fmt: skip
     return obs_p, (0.5 * (total - rank), 0.5 * ss)
+
+
+def _check_discrepancy_scales(kind, grids: list[np.ndarray]) -> None:
+    """GPMSAError where a "linear" discrepancy basis, normalised on each experiment's grid
+    (`discrepancy_basis`), takes different scales on the experiments' grids: the same weights
+    would mean a different discrepancy in each (and ``gpmsa.full_prediction`` refuses it)."""
+    if not (isinstance(kind, str) and kind == "linear") or len(grids) < 2:
+        return
+    reach = [float(np.max(np.abs(g))) for g in grids]
+    if max(reach) != min(reach):
+        j, k = int(np.argmin(reach)), int(np.argmax(reach))
+        raise GPMSAError(
+            "discrepancy='linear' is normalised on each experiment's grid by its largest "
+            f"|index|, which differs between them (experiment {j}: {reach[j]:.6g}, experiment "
+            f"{k}: {reach[k]:.6g}), so the same weights would mean a different discrepancy in "
+            "each: give every experiment a grid that reaches the same largest |index|, or use "
+            "discrepancy='constant'"
+        )
+
+
+def _warn_if_vague(precisions: list[np.ndarray]) -> None:
+    """``ReductionWarning`` where the observation precisions, in standardised units, declare
+    a median error sd above 1: larger than the spread of the simulation outputs. lamOs scales
+    the precisions, but its prior (mean a / b, GPM/SA's 1000) holds it near its scale, so the
+    posterior stays as vague as declared (a variance given for a precision: measured 12 times
+    wider in theta)."""
+    sd = float(np.median(np.concatenate([1.0 / np.sqrt(np.diag(lam)) for lam in precisions])))
+    if sd > 1.0:
+        warnings.warn(
+            f"the observation precisions declare errors of sd {sd:.3g} simulation-output sds "
+            "(median), larger than the simulation outputs' spread: precision is 1 / variance "
+            "in the outputs' native units (a variance given for a precision?). lamOs scales "
+            "it, but its prior holds it near its own scale",
+            ReductionWarning,
+            stacklevel=4,
+        )
+
+
+def _warn_rank_deficient(short: list[tuple[int, int]], n_c: int) -> None:
+    """``ReductionWarning`` naming the experiments (index, rank) whose values span fewer than
+    the ``n_c`` basis vectors (discrepancy and emulator) they are reduced onto."""
+    shown = ", ".join(f"{j} (rank {r})" for j, r in short[:5]) + (" ..." if len(short) > 5 else "")
+    warnings.warn(
+        f"{len(short)} experiment(s) have fewer independent values than the {n_c} basis vectors "
+        f"(discrepancy and emulator) they are reduced onto: {shown}. GPM/SA's reduction (as "
+        "SEPIA's) then reads each unobserved direction as a datum of variance "
+        f"{1 / GLS_RIDGE:g} / lamOs, which pulls lamOs up and narrows theta's posterior "
+        "(measured: sd 0.0071 against 0.0146 from the likelihood of the values themselves, two "
+        "one-point experiments of a 3-component emulator). Give each experiment at least that "
+        "many values, or use fewer basis vectors (gpmsa.fit's n_pc, a smaller discrepancy)",
+        ReductionWarning,
+        stacklevel=4,
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -391,7 +461,7 @@ def prepare(
     obs_p, os_corr = (None, (0.0, 0.0))
     levels = sim.levels
     if obs is not None:
-        obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels)
+        obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels, sim.y_names)
     priors = (Priors() if priors is None else priors).with_data(wos, os_corr)
     init = default_init(sim.p, sim.q, p_u, priors, obs_p)
     x_unit, t_unit = std.x_to_unit(sim.x), std.t_to_unit(sim.t)

@@ -303,15 +303,16 @@ def _check_fitted_obs(settings: dict, obs: ObsData) -> None:
         )
 
 
-def _check_calibrated_obs(posterior, obs: ObsData, x_names, grid: np.ndarray) -> None:
+def _check_calibrated_obs(posterior, obs: ObsData, x_names, y_names, grid: np.ndarray) -> None:
     """GPMSAError when ``posterior`` recorded the values of its observations (``gpmsa.calibrate``:
     info "obs_values_sha256") and ``obs`` holds other ones. Its x is compared with its columns
-    in the order of ``x_names`` (`ObsData.values_digest`), as ``gpmsa.calibrate`` read them: the
-    same table, columns in any order, is the same observations. Likewise their index grids and
+    in the order of ``x_names`` and y with its columns in the order of ``y_names``
+    (`ObsData.values_digest`), as ``gpmsa.calibrate`` read them: the same table, columns in any
+    order, is the same observations. Likewise their index grids and
     precisions (info "obs_layout_sha256", `layout_digest` against the simulation ``grid``)."""
     info = getattr(posterior, "info", None) or {}
     digest = info.get("obs_values_sha256")
-    if digest is not None and obs.values_digest(x_names) != digest:
+    if digest is not None and obs.values_digest(x_names, y_names) != digest:
         raise GPMSAError(
             "obs holds other observations (x or y) than the calibration that drew posterior=: "
             "pass the ObsData given to gpmsa.calibrate (or its x_obs and y_obs as "
@@ -402,12 +403,12 @@ def full_prediction(
     else:
         check_posterior_emulator(emulator, posterior)
         _check_fitted_obs(getattr(posterior, "info", None) or {}, obs)  # a joint fit's draws
-        _check_calibrated_obs(posterior, obs, emulator.x_names, std.grid)
+        _check_calibrated_obs(posterior, obs, emulator.x_names, emulator.y_names, std.grid)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the calibration already warned about its x_obs
-        ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names)
+        ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, None, emulator.y_names)
     p_v = ob.p_v
     if ("betaV" in sets[0]) != (p_v > 0):
         raise GPMSAError(

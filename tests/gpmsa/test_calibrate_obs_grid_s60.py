@@ -5,6 +5,8 @@ backend; the predictions conditioned on it refuse the same values placed otherwi
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 from _calib_cases import road_emulator, road_obs, vector_emulator
@@ -251,3 +253,98 @@ def test_a_study_takes_obsdata_per_model():
     plain = gpmsa.ObsData(a.x, a.experiments, index=[GRID_A, GRID_B])
     with pytest.raises(GPMSAError, match="other index grids or gives them other precisions"):
         gpmsa.full_prediction(emu, plain, [[0.5]], posterior=member, discrepancy=None)
+
+
+def test_a_named_y_table_in_obsdata_is_read_by_the_emulator_y_names():
+    """A y table with named columns inside an ObsData (no index) is read by the emulator's
+    y_names, as calibrate reads a table y_obs: its columns reversed give the arrays' posterior
+    (they gave t 0.16 for 0.40, read by position), and full_prediction takes that ObsData with
+    the arrays' posterior. Other names are refused; a frame's default labels 0, 1, ... are no
+    names (by position)."""
+    pd = pytest.importorskip("pandas")
+    emu = vector_emulator()
+    grid = emu.standardizer.grid
+    x = np.array([[0.3], [0.7]])
+    y = vector_truth(x[:, 0], grid) + 0.01 * np.random.default_rng(4).standard_normal((2, 8))
+    table = pd.DataFrame(y, columns=list(emu.y_names))[list(emu.y_names)[::-1]]
+    arrays = gpmsa.Calibrator(emu).update(x, y)
+    named = gpmsa.Calibrator(emu).update(gpmsa.ObsData(x, table))
+    assert named.mean("t") == arrays.mean("t") and named.sd("t") == arrays.sd("t")
+    post = gpmsa.calibrate(emu, x, table, n_samples=200, n_burn=50, seed=1)
+    gpmsa.full_prediction(emu, gpmsa.ObsData(x, table), [[0.5]], posterior=post, discrepancy=None)
+    plain = gpmsa.Calibrator(emu).update(gpmsa.ObsData(x, pd.DataFrame(y)))
+    assert plain.mean("t") == arrays.mean("t")
+    with pytest.raises(GPMSAError, match=r"ObsData y has the columns \['a0'"):
+        gpmsa.Calibrator(emu).update(gpmsa.ObsData(x, table.set_axis(
+            [f"a{k}" for k in range(8)], axis=1)))  # fmt: skip
+
+
+def test_experiments_with_fewer_values_than_basis_vectors_warn():
+    """An experiment whose values span fewer directions than the basis vectors it is reduced
+    onto (one point, two components) makes GPM/SA's reduction read its unobserved direction as
+    a datum of variance 1e6 / lamOs: a ReductionWarning names it (the posterior is narrower
+    than the values' own likelihood); experiments of full rank do not warn."""
+    emu = vector_emulator()
+    x = np.array([[0.3], [0.7]])
+    sparse = gpmsa.ObsData(x, [[1.0], [1.2]], index=[[0.5], [0.5]])
+    with pytest.warns(
+        gpmsa.ReductionWarning, match=r"2 experiment\(s\) .* 0 \(rank 1\), 1 \(rank 1\)"
+    ):
+        narrow = gpmsa.Calibrator(emu).update(sparse)
+    assert narrow.sd("t") < 0.9 * reference_summaries(emu, sparse)["sd"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", gpmsa.ReductionWarning)
+        gpmsa.Calibrator(emu).update(ragged_obs([1e4, 2.5e3]))
+
+
+def test_precisions_declaring_errors_beyond_the_outputs_spread_warn():
+    """A variance passed where a precision belongs (4e-4 for 2,500) declares errors far larger
+    than the simulation outputs' spread: a ReductionWarning says so (lamOs, held by its prior,
+    cannot undo it: theta's sd came out 12 times wider); the right precision does not warn."""
+    emu = vector_emulator()
+    with pytest.warns(gpmsa.ReductionWarning, match="a variance given for a precision"):
+        gpmsa.Calibrator(emu).update(ragged_obs([4e-4, 4e-4]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", gpmsa.ReductionWarning)
+        gpmsa.Calibrator(emu).update(ragged_obs([2.5e3, 2.5e3]))
+
+
+def test_a_linear_discrepancy_of_different_scales_per_experiment_is_refused_up_front():
+    """discrepancy='linear' is normalised on each experiment's grid by its largest |index|;
+    grids that reach different ones would give the same weights a different meaning in each
+    (and full_prediction refused it only after the calibration): calibrate and the joint fit
+    refuse it naming both; grids of the same reach are taken."""
+    emu = vector_emulator()
+    obs = gpmsa.ObsData([[0.3], [0.7]], [np.ones(5), np.ones(9)],
+                        index=[np.linspace(0, 0.8, 5), GRID_B])  # fmt: skip
+    want = r"largest \|index\|, which differs .* \(experiment 1: 0.8, experiment 0: 0.95\)"
+    with pytest.raises(GPMSAError, match=want):
+        gpmsa.calibrate(emu, ragged_obs(), discrepancy="linear", n_samples=10, n_burn=0)
+    rng = np.random.default_rng(0)
+    x, t = rng.uniform(size=20), rng.uniform(size=20)
+    grid = np.linspace(0, 1, 8)
+    sim = gpmsa.SimData(x=x[:, None], t=t[:, None], y=vector_truth(x, grid, t[:, None]),
+                        index=grid, x_names=["x"], t_names=["t"])  # fmt: skip
+    with pytest.raises(GPMSAError, match=want):
+        gpmsa.fit(sim, ragged_obs(), discrepancy="linear", n_iter=10, tune=False, seed=0)
+    same = gpmsa.calibrate(emu, obs, discrepancy="linear", n_samples=20, n_burn=0, tune=False)
+    assert "lamVz" in same.names
+
+
+def test_malformed_indexes_and_precisions_are_named():
+    """A list of grids of the wrong count, an index of three dimensions, an index beyond the
+    simulation grid and a precision list of the wrong length are refused, each naming the
+    experiment or the counts (they were flattened, or named no experiment)."""
+    emu = vector_emulator()
+    x, y = [[0.3], [0.7]], np.ones((2, 5))
+    g = np.linspace(0, 1, 5)
+    with pytest.raises(GPMSAError, match=r"index_obs has 3 grids for 2 experiment"):
+        gpmsa.ObsData(x, y, index=[g, g, g])
+    with pytest.raises(GPMSAError, match=r"one grid \(l,\) or one per experiment"):
+        gpmsa.ObsData(x, y, index=np.zeros((2, 2, 2)))
+    rows = gpmsa.ObsData(x, y, index=np.vstack([g, g]))  # one row per experiment
+    assert all(np.array_equal(r, g) for r in rows.grids)
+    with pytest.raises(GPMSAError, match=r"index of experiment 1 reaches \[0, 1.2\]"):
+        gpmsa.Calibrator(emu).update(gpmsa.ObsData(x, y, index=[g, 1.2 * g]))
+    with pytest.raises(GPMSAError, match=r"one entry per experiment \(2\), got 3"):
+        gpmsa.ObsData(x, y, precision=[1.0, 1.0, 1.0])

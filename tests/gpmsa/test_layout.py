@@ -46,7 +46,7 @@ LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 PUBLIC = [
     "BackendUnavailableError", "Calibrator", "ChainError", "Chains", "ConvergenceWarning",
     "Emulator", "EmulatorFileError", "GPMSAError", "GammaPrior", "LooResult", "ObsData",
-    "ObsProblem", "OutsideEmulatorWarning",
+    "ObsProblem", "OutsideEmulatorWarning", "ReductionWarning",
     "Posterior", "Priors", "Problem", "ResourceLimitError", "SimData", "backends", "calibrate",
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
     "limits", "load", "plots", "predictive", "prepare", "sensitivity",
