@@ -83,6 +83,11 @@ MIN_STEP_ULPS = 8
 unit scale and in the parameter's native units (``Calibrator._min_step``)."""
 BISECT_STEPS = 64
 """Bisection steps locating a constraint's boundary between two nodes (to adjacent floats)."""
+PRIOR_BISECT_LEVELS = 4
+"""Bisection steps per call of a callable prior locating its zero region's edges (one parameter,
+no constraint): it is called at the 2**4 - 1 midpoints those steps may visit, of all edges at
+once (16 calls of 15 points an edge instead of 64 of one; 4-8 levels measured alike for a
+cheap prior, and a prior's cost per point grows with the level)."""
 
 
 def _check_mcmc_options(options) -> dict:
@@ -475,45 +480,36 @@ class Calibrator:
         return ConstraintCut.make(axes, ok, self._allowed)
 
     def _constraint_edges(
-        self, nodes: np.ndarray, ok: np.ndarray, allows: Callable | None = None
+        self, nodes: np.ndarray, ok: np.ndarray, allows: Callable | None = None, levels: int = 1
     ) -> tuple[np.ndarray, ...]:
         """Where the constraint's status changes between the unit-scale nodes (k,) (one
         parameter; ``ok`` (k,) their status): (cells i (e,), first (e,), second (e,)), the
-        boundary bracketed by adjacent floats in [nodes[i], nodes[i + 1]]: ``first`` has the
-        status of node i, ``second`` that of node i + 1. ``allows`` (unit-scale (1,) -> bool)
-        gives the status between nodes (default: the constraint's). A point whose native value
-        is its node's (an edge on a node, e.g. ``th[0] > t_min``) is that node."""
-        allows = self.constraint if allows is None else allows
+        boundary bracketed by adjacent floats in [nodes[i], nodes[i + 1]] (`_bisect`, ``levels``
+        steps per call of ``allows``): ``first`` has the status of node i, ``second`` that of
+        node i + 1. ``allows`` (unit-scale points (m,) -> status (m,) bool) gives the status
+        between nodes (default: the constraint's). A point whose native value is its node's (an
+        edge on a node, e.g. ``th[0] > t_min``) is that node."""
+        allows = allows or (lambda points: np.array([self.constraint(p) for p in points[:, None]]))
         std = self.emulator.standardizer
         span, low = std.t_max[0] - std.t_min[0], std.t_min[0]  # native as `_posterior` has it
         cells = np.flatnonzero(ok[:-1] != ok[1:])
-        first, second = nodes[cells].copy(), nodes[cells + 1].copy()
-        for j, i in enumerate(cells):
-            a, b = first[j], second[j]
-            for _ in range(BISECT_STEPS):
-                mid = 0.5 * (a + b)
-                if not a < mid < b:
-                    break
-                if allows(np.array([mid])) == ok[i]:
-                    a = mid
-                else:
-                    b = mid
-            if a * span + low == nodes[i] * span + low:
-                a = nodes[i]
-            if b * span + low == nodes[i + 1] * span + low:
-                b = nodes[i + 1]
-            first[j], second[j] = a, b
+        first, second = _bisect(nodes[cells], nodes[cells + 1], ok[cells], allows, levels)
+        first = np.where(first * span + low == nodes[cells] * span + low, nodes[cells], first)
+        second = np.where(
+            second * span + low == nodes[cells + 1] * span + low, nodes[cells + 1], second
+        )
         return cells, first, second
 
     def _with_prior_edges(
-        self, axis: np.ndarray, ok, margs: list, prior: Callable, base: bool
+        self, axis: np.ndarray, total: np.ndarray, ok, margs: list, prior: Callable, base: bool
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """One parameter, a callable ``prior`` that is zero somewhere on the unit-scale ``axis``
         (k,): `with_edges` with the edges of its zero region located as a constraint's are (by
         bisection between nodes, together with the constraint's verdict ``ok`` (k,), None:
         none), so that the density ends there instead of ramping to zero across the cell
-        beyond. The likelihood at a point inserted there is interpolated from its nodes (their
-        lamOs marginals ``margs``), the prior evaluated at it."""
+        beyond. ``total`` (k,): the unconstrained log posterior at the nodes, the prior in it
+        (not evaluated there again). The likelihood at a point inserted there is interpolated
+        from its nodes (their lamOs marginals ``margs``), the prior evaluated at it."""
         theta = axis[:, None]
         emulator_prior = self._log_prior_theta if base else self._theta_prior_at(theta, None)
         free = self._combine(margs) + emulator_prior  # finite: no zeros of the user's prior
@@ -521,14 +517,20 @@ class Calibrator:
         def user(points: np.ndarray) -> np.ndarray:
             return self._prior_values(prior, points[:, None], False)
 
-        def allows(point: np.ndarray) -> bool:
-            inside = self.constraint is None or bool(self.constraint(point))
-            return inside and bool(np.isfinite(user(point))[0])
+        def allows(points: np.ndarray) -> np.ndarray:
+            if self.constraint is None:
+                inside = np.ones(points.size, bool)
+            else:
+                inside = self._allowed(points[:, None])
+            if inside.any():  # the prior only where the constraint allows
+                inside[inside] = np.isfinite(user(points[inside]))
+            return inside
 
-        nonzero = np.isfinite(user(axis))
+        nonzero = np.isfinite(total)  # free is finite: the prior's zeros
         allowed = nonzero if ok is None else ok & nonzero
-        edges = self._constraint_edges(axis, allowed, allows)
-        return with_edges(axis, free, allowed, edges, user)
+        levels = PRIOR_BISECT_LEVELS if self.constraint is None else 1  # its fn: point by point
+        edges = self._constraint_edges(axis, allowed, allows, levels)
+        return with_edges(axis, free, allowed, edges, user, total)
 
     def _theta_prior_at(self, theta_unit: np.ndarray, prior) -> np.ndarray:
         """The emulator's theta prior plus the user's at refined unit-scale nodes."""
@@ -549,7 +551,7 @@ class Calibrator:
         if self.q == 1:
             nodes, logd, lik = axes[0], constrained(free, ok), None
             if callable(prior) and np.isneginf(free).any():
-                nodes, logd, lik = self._with_prior_edges(axes[0], ok, margs, prior, base)
+                nodes, logd, lik = self._with_prior_edges(axes[0], free, ok, margs, prior, base)
             elif ok is not None:
                 edges = self._base_cut if base else self._cut(axes, ok)
                 nodes, logd, lik = with_edges(nodes, free, ok, edges)
@@ -724,3 +726,52 @@ def _draw_lamos(
         jitter = np.where(idx == s.size - 1, -np.abs(jitter), jitter)
         out[sel] = np.exp(s[idx] + jitter)
     return out
+
+
+def _bisect(
+    a: np.ndarray, b: np.ndarray, side: np.ndarray, allows: Callable, levels: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The brackets [a, b] (e,) of changes of status, each bisected to adjacent floats (at most
+    BISECT_STEPS steps; ``side`` (e,) the status at a): ``levels`` steps per call of ``allows``
+    (unit-scale points (m,) -> status (m,)), at the 2**levels - 1 midpoints those steps of each
+    bracket may visit, so that the result is that of one point per step."""
+    a, b, side = a.tolist(), b.tolist(), side.tolist()
+    live, steps = list(range(len(a))), 0
+    while live and steps < BISECT_STEPS:
+        depth = min(levels, BISECT_STEPS - steps)
+        mids = [_midpoints(a[j], b[j], depth) for j in live]
+        status = allows(np.array(mids).ravel()).tolist()
+        n, more = len(mids[0]), []
+        for r, j in enumerate(live):
+            a[j], b[j], go_on = _walk(a[j], b[j], mids[r], status[r * n : r * n + n], side[j])
+            if go_on:
+                more.append(j)
+        live, steps = more, steps + depth
+    return np.array(a, dtype=np.float64), np.array(b, dtype=np.float64)
+
+
+def _midpoints(a: float, b: float, depth: int) -> list[float]:
+    """The 2**depth - 1 midpoints that ``depth`` bisection steps of [a, b] may visit, in
+    increasing order (each the midpoint of its neighbours at the step that makes it)."""
+    points = [a, b]
+    for _ in range(depth):
+        finer = [a]
+        for lo, hi in zip(points[:-1], points[1:], strict=True):
+            finer += (0.5 * (lo + hi), hi)
+        points = finer
+    return points[1:-1]
+
+
+def _walk(a: float, b: float, mids: list, status: list, side: bool) -> tuple[float, float, bool]:
+    """Bisection steps of [a, b] through its ``_midpoints`` ``mids``, moving a up to a midpoint
+    whose ``status`` is ``side`` (a's): the bracket, and whether it can be bisected further."""
+    lo, hi = -1, len(mids)  # the bracket's ends' places among the midpoints
+    while hi - lo > 1:
+        k = (lo + hi) // 2
+        if not a < mids[k] < b:
+            return a, b, False
+        if status[k] == side:
+            a, lo = mids[k], k
+        else:
+            b, hi = mids[k], k
+    return a, b, True

@@ -131,6 +131,7 @@ def with_edges(
     ok: np.ndarray,
     edges: tuple[np.ndarray, ...],
     prior: Callable[[np.ndarray], np.ndarray] | None = None,
+    total: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One parameter: the unit-scale ``nodes`` (k,) with the constraint's boundary points
     ``edges`` (``Calibrator._constraint_edges``) inserted, so that the piecewise-linear density
@@ -140,9 +141,12 @@ def with_edges(
     inserted point)); an inserted point gets the log density ``free`` interpolated there
     (`interp_log`), or -inf where the constraint forbids it. ``prior`` (unit-scale points
     (e,) -> log densities (e,)): a log prior not in ``free`` (finite where ``ok``), added at
-    the nodes and at the inserted points."""
+    the nodes (``total`` (k,): ``free`` plus that prior there, where the caller has it) and at
+    the inserted points."""
     cells, first, second = edges
-    logd = constrained(free if prior is None else free + prior(nodes), ok)
+    if prior is not None and total is None:
+        total = free + prior(nodes)
+    logd = constrained(free if prior is None else total, ok)
     if cells.size == 0:
         return nodes, logd, np.arange(nodes.size)
     cell = np.concatenate([cells, cells])
