@@ -398,6 +398,7 @@ class BCR:
         self._t_last = np.nan  # time and position of the newest finite sample
         self._t_prev = np.nan  # the newest finite time stamp, kept or dropped
         self._pos_last = np.nan
+        self._clock_back = 0.0  # the sample clock's newest step back, s, while now= disagrees
         self._clock = np.nan  # the caller's clock (update's now=), newest value
         self._clock_start = np.nan  # its first value (silence before any sample)
         self._n_updates = 0
@@ -432,7 +433,11 @@ class BCR:
             now: the caller's clock, s, on the time base of ``t`` (None: the newest sample's
                 time). With it, the BCR knows time passes while no samples arrive: the estimate
                 ages, and silence longer than ``max_silence_s`` is a "sensor_fault". A control
-                loop should pass it: without it a silent sensor keeps the last estimate.
+                loop should pass it: without it a silent sensor keeps the last estimate. Where
+                ``t`` steps back by more than ``max_silence_s`` (a clock corrected, a bag
+                replayed from its start, a driver restarted), the BCR's time base restarts with
+                it (what it holds ages on the new clock); a ``now`` that did not step back is
+                then ahead of every sample: a "sensor_fault" naming the step, until they agree.
             Non-finite values and speeds beyond ``MAX_SPEED_MPS`` are sensor faults, never
             errors.
         """
@@ -482,7 +487,8 @@ class BCR:
         if broken.size == 0 and t.size:  # (the usual case) all finite and kept: the last is newest
             self._t_prev = self._t_last = float(t[-1])
             self._pos_last = float(pos[-1])
-        else:
+        else:  # a clock step first: it moves the newest kept sample's time too
+            reason += self._clock_step(t)
             self._take_stamps(t, pos, drop)
         if broken.size:  # every cause until a block reports them, whatever the chunking
             if reason not in self._fault:
@@ -497,6 +503,31 @@ class BCR:
         self._t = np.concatenate([self._t, t])[-self.buffer :]
         self._pos = np.concatenate([self._pos, pos])[-self.buffer :]
         self._fresh = min(self._fresh + acc.size, self.buffer)
+
+    def _clock_step(self, t: np.ndarray) -> str:
+        """Where the stamps ``t`` step back from the stamp before them (kept or dropped) by
+        more than max_silence_s (a clock corrected, a bag replayed from its start, a
+        driver restarted), the time base restarts: the times of the newest kept sample, of the
+        information held and of the newest estimate move back by the clock's steps (so that
+        the information ages on the new clock, and the phases keep their order). Returns the
+        clause naming the steps ("" for none)."""
+        stamps = t[np.isfinite(t)]
+        steps = np.diff(stamps, prepend=self._t_prev)  # NaN before the first stamp: no step
+        s = self.settings
+        back = float(np.sum(1.0 / s.rate_hz - steps[steps < -s.max_silence_s]))  # vs. the next
+        if not back > 0:
+            return ""
+        self._clock_back = back
+        self._t_last -= back
+        self._data_time -= back
+        last = self.last
+        self.last = replace(last, time=last.time - back, data_time=last.data_time - back)
+        for phase in getattr(self, "_phases", ()):
+            phase.data_time -= back
+            if phase.undo is not None:
+                state, data_time, ds = phase.undo
+                phase.undo = (state, data_time - back, ds)
+        return f" (the sample clock stepped back {back:.4g} s)"
 
     def _take_stamps(self, t, pos, drop) -> None:
         """Remember the newest time stamp, kept or dropped, and the newest kept sample's time
@@ -526,9 +557,17 @@ class BCR:
         last = self._t_last if np.isfinite(self._t_last) else self._clock_start
         silence = self._clock - last
         if silence <= self.settings.max_silence_s:
+            self._clock_back = 0.0  # the clocks agree (again)
             return est
         t_now, pos_now = self._now()
-        reason = f"no samples for {silence:.2f} s (max_silence_s = {self.settings.max_silence_s:g})"
+        limit = f"max_silence_s = {self.settings.max_silence_s:g}"
+        reason = f"no samples for {silence:.2f} s ({limit})"
+        if self._clock_back:  # samples come, on a clock that stepped back while now= did not
+            reason = (
+                f"the newest sample is {silence:.2f} s behind the caller's clock (now=; {limit}): "
+                f"the sample clock stepped back {self._clock_back:.4g} s, now= did not (now= "
+                "must run on the samples' clock)"
+            )
         if fresh and est.status == "sensor_fault" and est.reason:
             reason = f"{est.reason}; {reason}"
         return Estimate(t_now, pos_now, "sensor_fault", reason, data_time=est.data_time)
