@@ -369,8 +369,9 @@ class Calibrator:
 
         Returns:
             Posterior; for the grid method its summaries of theta are exact (grid),
-            ``info["resolution"]`` holds per parameter the node spacings per sd of its marginal
-            on the final grid (two parameters; ``grid.resolution``; under
+            ``info["resolution"]`` holds per parameter the node spacings per width of its
+            marginal (the smaller of its sd and IQR / 1.349: a heavy tail does not hide an
+            unresolved core) on the final grid (two parameters; ``grid.resolution``; under
             ``grid.UNRESOLVED_SD`` a warning names it) and ``info["log_evidence"]`` holds
             log p(u_obs) under the emulator's (normalised) theta prior times the given prior
             (as given, unnormalised), for one parameter.
@@ -629,8 +630,9 @@ def _warn_at_float(res: float, marginal, emulator) -> None:
         h = float(np.diff(marginal.nodes)[max(k - 1, 0) : k + 1].max())
         warnings.warn(
             f"the posterior of {name} is narrower than the grid can represent: refinement "
-            f"reached float64's resolution of {name} with its sd spanning {res:.2g} node "
-            f"spacings (fewer than {UNRESOLVED_SD:g}); its sd, quantiles and draws are good "
+            f"reached float64's resolution of {name} with its width (the smaller of its sd and "
+            f"IQR / 1.349) spanning {res:.2g} node spacings (fewer than {UNRESOLVED_SD:g}); its "
+            "sd, quantiles and draws are good "
             f"to about the node spacing there, {h:.3g}{f' {unit}' if unit else ''}",
             stacklevel=3,
         )
@@ -642,8 +644,9 @@ def _warn_if_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> No
     k = int(np.argmin(res))
     if res[k] < UNRESOLVED_SD:
         warnings.warn(
-            f"the grid does not resolve the posterior of {names[k]}: its sd spans {res[k]:.2g} "
-            f"node spacings (fewer than {UNRESOLVED_SD:g}) on the grid refinement ended with, so "
+            f"the grid does not resolve the posterior of {names[k]}: its width (the smaller of its "
+            f"sd and IQR / 1.349) spans {res[k]:.2g} node spacings (fewer than "
+            f"{UNRESOLVED_SD:g}) on the grid refinement ended with, so "
             f"its quantiles, cdf and draws may be off by several per cent of an sd; use "
             f"method='mcmc' or another n_grid (now {n_grid})",
             stacklevel=3,

@@ -99,7 +99,7 @@ def test_a_posterior_the_budget_cannot_resolve_is_named():
     """Two unconstrained peaks of a (near 0.3 and 0.7, sd 0.006) refined as far as MAX_REFINED
     allows: 0.81 node spacings per sd, the cdf of a 0.026 and the quantiles of b 0.12 sd off a
     dense grid. Their core spans both peaks, too many nodes to refine: a warning names a."""
-    match = r"does not resolve the posterior of a: its sd spans 0\.81 node spacings .*\(now 65\)"
+    match = r"does not resolve the posterior of a: its width \(.*\) spans 0\.81 node .*\(now 65\)"
     with pytest.warns(UserWarning, match=match):
         post = Calibrator(symmetric_two_param_emulator()).update(*peaks_data())
     assert post.info["resolution"][0] < UNRESOLVED_SD
