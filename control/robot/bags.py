@@ -18,7 +18,9 @@ and what is wrong, whichever library found it.
 
 from __future__ import annotations
 
+import hashlib
 import importlib
+import json
 import os
 import re
 import shutil
@@ -40,6 +42,10 @@ from control.robot.extra import require
 from control.validation import float_array, path_argument
 
 STORAGES = ("mcap", "sqlite3")
+DIGEST_KEY = "terrain_gpmsa.messages_sha256"
+"""The ``custom_data`` key of a ROS 2 bag this package writes (`open_bag_writer`): JSON
+{topic: `messages_digest` of its messages}, which `read_recording` checks, so that a damaged
+message is refused in a sqlite3 bag too (an MCAP bag's chunks carry CRCs as well)."""
 URI_PARTS = re.compile(r"[?#]|%[0-9A-Fa-f]{2}")
 """What rosbags' sqlite3 writer misreads in a path (it opens ``file:PATH`` as a URI): a query,
 a fragment, a percent-encoded byte."""
@@ -220,9 +226,10 @@ def read_recording(
     if kind == "mcap":
         require("mcap.reader", "reading an MCAP file")
     wanted = [imu_topic, odom_topic]
-    raw, storage = None, ""
+    raw, storage, digests = None, "", {}
     if kind == "rosbag2":
         files, storage, simple = _bag_files(target)
+        digests = _recorded_digests(target)
         if simple and storage == "mcap":
             raw = storage_mod.mcap_messages(files, wanted)
         elif simple and storage == "sqlite3":
@@ -230,11 +237,15 @@ def read_recording(
     elif kind == "mcap":
         raw = storage_mod.mcap_messages([target], wanted)
     if raw is not None:
+        for topic in wanted:
+            _check_digest(
+                target, digests, topic, raw.log_ns.get(topic, []), raw.data.get(topic, [])
+            )
         topics, imu, odom = _from_raw(target, raw, imu_topic, odom_topic)
     elif kind == "mcap":
         topics, imu, odom = _read_mcap(target, imu_topic, odom_topic)
     else:
-        topics, imu, odom = _read_rosbags(target, kind, imu_topic, odom_topic)
+        topics, imu, odom = _read_rosbags(target, kind, imu_topic, odom_topic, digests)
     for topic, got in ((imu_topic, imu), (odom_topic, odom)):
         if got.stamp_ns.size == 0:
             raise BagError(f"the topic {topic!r} in {target} has no messages")
@@ -265,6 +276,84 @@ def _bag_files(folder: Path) -> tuple[list[Path], str, bool]:
         raise BagError(f"{odd[0]}, a file of the bag {folder}, is not a regular file")
     simple = compression in ("", "none") and all(f.is_file() for f in files) and bool(files)
     return files, storage, simple
+
+
+def _recorded_digests(folder: Path) -> dict[str, str]:
+    """{topic: SHA-256} recorded in a ROS 2 bag's metadata by `open_bag_writer` (``custom_data``
+    ``DIGEST_KEY``); {} for a bag without the record (another writer's). `BagError` for a
+    record that is not such a mapping."""
+    yaml = require("ruamel.yaml", "reading a ROS 2 bag")
+    try:
+        meta = yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_text())
+        custom = meta["rosbag2_bagfile_information"].get("custom_data") or {}
+        text = custom.get(DIGEST_KEY) if isinstance(custom, dict) else None
+    except Exception:  # rosbags reads (and reports on) whatever this does not understand
+        return {}
+    if text is None:
+        return {}
+    try:
+        record = json.loads(text) if isinstance(text, str) else None
+    except ValueError:
+        record = None
+    good = isinstance(record, dict) and all(
+        isinstance(k, str) and isinstance(v, str) and re.fullmatch(r"[0-9a-f]{64}", v)
+        for k, v in record.items()
+    )
+    if not good:
+        raise BagError(
+            f"{folder / 'metadata.yaml'} is damaged: its custom_data {DIGEST_KEY} is not the "
+            "record of the messages' SHA-256 that this package writes"
+        )
+    return record
+
+
+def messages_digest(log_ns: Sequence[int], data: Sequence[bytes]) -> str:
+    """SHA-256 of a topic's messages, whatever order a storage returns them in: of each
+    message's (receive time ns, SHA-256 of its bytes), sorted."""
+    return _sorted_digest(log_ns, [hashlib.sha256(d).digest() for d in data])
+
+
+def _sorted_digest(log_ns: Sequence[int], digests: Sequence[bytes]) -> str:
+    """SHA-256 of the (receive time, message SHA-256) pairs, sorted."""
+    h = hashlib.sha256()
+    for stamp, digest in sorted(zip((int(t) for t in log_ns), digests, strict=True)):
+        h.update(struct.pack("<q", stamp))
+        h.update(digest)
+    return h.hexdigest()
+
+
+def _check_digest(path: Path, digests: dict[str, str], topic: str, log_ns, data) -> None:
+    """`BagError` where the bag recorded the SHA-256 of ``topic``'s messages and they no longer
+    have it (a message's bytes or time changed, one lost or added)."""
+    want = digests.get(topic)
+    if want is not None and messages_digest(log_ns, data) != want:
+        raise BagError(
+            f"{path} is damaged: the messages of the topic {topic!r} are not those written (their "
+            f"SHA-256, recorded in metadata.yaml's custom_data {DIGEST_KEY!r}, differs)"
+        )
+
+
+class _DigestingWriter:
+    """A rosbags writer that also keeps, per topic, what `messages_digest` needs."""
+
+    def __init__(self, writer):
+        self._writer = writer
+        self._messages: dict[str, tuple[list[int], list[bytes]]] = {}  # times, SHA-256s
+
+    def add_connection(self, topic: str, *args, **kwargs):
+        self._messages.setdefault(topic, ([], []))
+        return self._writer.add_connection(topic, *args, **kwargs)
+
+    def write(self, connection, timestamp: int, data: bytes) -> None:
+        self._writer.write(connection, timestamp, data)
+        log, digests = self._messages[connection.topic]
+        log.append(int(timestamp))
+        digests.append(hashlib.sha256(data).digest())
+
+    def record(self) -> str:
+        """The JSON of {topic: SHA-256 of its messages} (`messages_digest` of what was written)."""
+        out = {topic: _sorted_digest(*messages) for topic, messages in self._messages.items()}
+        return json.dumps(out, sort_keys=True)
 
 
 def _from_raw(path: Path, raw, imu_topic: str, odom_topic: str):
@@ -416,7 +505,7 @@ def _xyz(v) -> tuple[float, float, float]:
     return float(v.x), float(v.y), float(v.z)
 
 
-def _read_rosbags(path: Path, kind: str, imu_topic: str, odom_topic: str):
+def _read_rosbags(path: Path, kind: str, imu_topic: str, odom_topic: str, digests=None):
     highlevel = require("rosbags.highlevel", "reading a ROS bag")
     stores = require("rosbags.typesys", "reading a ROS bag")
     default = stores.get_typestore(
@@ -434,6 +523,7 @@ def _read_rosbags(path: Path, kind: str, imu_topic: str, odom_topic: str):
         for topic, make in ((imu_topic, _imu), (odom_topic, _odometry)):
             conns = [c for c in reader.connections if c.topic == topic]
             log, raws = _messages(reader, conns, path, topic)
+            _check_digest(path, digests or {}, topic, log, raws)
             msgtype = conns[0].msgtype
 
             def decode(raw, msgtype=msgtype):
@@ -613,7 +703,9 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
     an interrupted write (an exception, a killed process) never leaves a bag without its
     metadata at ``path``; on an exception the hidden folder is removed. Each chunk of an MCAP
     bag is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves
-    it 0), so that a reader refuses a chunk whose bytes changed. `ControlError` where ``path``
+    it 0), so that a reader refuses a chunk whose bytes changed, and the bag's metadata records
+    the SHA-256 of each topic's messages (``DIGEST_KEY``), which `read_recording` checks in any
+    storage (sqlite3 has no checksums of its own). `ControlError` where ``path``
     exists (a link to nowhere too) or `check_bag_path` refuses it."""
     _check_storage(storage)
     path = path_argument(path, "path", " of the new bag folder")
@@ -629,7 +721,9 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
         raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
     try:
         with rosbag2.Writer(work / path.name, version=9, storage_plugin=plugin) as writer:
-            yield writer
+            digesting = _DigestingWriter(writer)
+            yield digesting
+            writer.set_custom_data(DIGEST_KEY, digesting.record())
         for file in (work / path.name).glob("*.mcap"):  # rosbags writes chunks without CRCs
             storage_mod.write_chunk_crcs(file)
         try:
