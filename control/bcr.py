@@ -509,13 +509,17 @@ class BCR:
         more than max_silence_s (a clock corrected, a bag replayed from its start, a
         driver restarted), the time base restarts: the times of the newest kept sample, of the
         information held and of the newest estimate move back by the clock's steps (so that
-        the information ages on the new clock, and the phases keep their order). Returns the
-        clause naming the steps ("" for none)."""
+        the information ages on the new clock, and the phases keep their order). Later steps
+        forward of the same chunk count against them, so that one wild stamp among good ones
+        moves nothing (one at a chunk's end is taken as a step: the information held reads
+        older until the samples catch up, the cautious side). Returns the clause naming the
+        steps ("" for none)."""
         stamps = t[np.isfinite(t)]
         steps = np.diff(stamps, prepend=self._t_prev)  # NaN before the first stamp: no step
         s = self.settings
-        back = float(np.sum(1.0 / s.rate_hz - steps[steps < -s.max_silence_s]))  # vs. the next
-        if not back > 0:
+        big = np.abs(steps) > s.max_silence_s
+        back = float(np.sum(1.0 / s.rate_hz - steps[big]))  # vs. the next sample's place
+        if not back > s.max_silence_s or not np.any(steps[big] < 0):
             return ""
         self._clock_back = back
         self._t_last -= back

@@ -1,5 +1,7 @@
 """Exceptions raised by gpmsa."""
 
+import sys
+
 
 class GPMSAError(ValueError):
     """Invalid input to a gpmsa function (a ValueError subclass)."""
@@ -20,6 +22,15 @@ class BackendUnavailableError(ImportError):
 
 class OutsideEmulatorWarning(UserWarning):
     """An observation lies outside what the emulator has seen (far from all its predictions)."""
+
+
+def user_stacklevel() -> int:
+    """``warnings.warn``'s stacklevel, in the function that calls this, of the first frame
+    outside gpmsa (the user's call, however deep the library's own calls run)."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_globals.get("__name__", "").split(".")[0] == "gpmsa":
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 class ReductionWarning(UserWarning):

@@ -46,7 +46,7 @@ from gpmsa.calibration.observations import (
 )
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, ReductionWarning
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
@@ -271,7 +271,10 @@ def calibrate(
     t0 = time.perf_counter()
     with blas_controller().limit(limits=1, user_api="blas"):
         where = {"n_jobs": n_jobs, "executor": executor}
-        data = reduce(emulator, x_obs, y_obs, extrapolate)
+        with warnings.catch_warnings():
+            if discrepancy is not None:  # the reduction with its basis warns (_run_backend)
+                warnings.simplefilter("ignore", ReductionWarning)
+            data = reduce(emulator, x_obs, y_obs, extrapolate)
         fit = _probe(emulator, data, sets)
         warn_if_outside(fit, discrepancy=discrepancy is not None)
         if fast:

@@ -419,8 +419,10 @@ class Calibrator:
                     break
         key = check_seed(seed) if seed is not None else (self._entropy, count)
         post = self._posterior(axes, free, ok, margs, key, prior)
-        post.info.update(outside_sds=outside, obs_values_sha256=data.values_sha256,
-                         obs_layout_sha256=data.layout_sha256)  # fmt: skip
+        post.info["outside_sds"] = outside
+        if prior is None or callable(prior):  # an array: maybe other windows' log-likelihood
+            post.info.update(obs_values_sha256=data.values_sha256,
+                             obs_layout_sha256=data.layout_sha256)  # fmt: skip
         if self.q == 1 and why != "resolved":  # passes, node budget or float64 ran out
             res = res or resolution(axes, logp)
             if why == "float":

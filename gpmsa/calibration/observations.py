@@ -327,7 +327,8 @@ def _reduce_obs_data(emulator, obs: ObsData, extrapolate: bool) -> Observations:
             getattr(emulator, "levels", None), _y_names(emulator),
         )  # fmt: skip
     digests = (obs.values_digest(emulator.x_names, _y_names(emulator)),
-               layout_digest(obs.grids, obs.precisions, emulator.standardizer.grid))  # fmt: skip
+               layout_digest(obs.grids, obs.output_precisions(_y_names(emulator)),
+                             emulator.standardizer.grid))  # fmt: skip
     return _observations(emulator, reduced, corr, digests, xu)
 
 

@@ -628,15 +628,36 @@ class ObsData:
         """Every experiment's y (``experiments``); for y given as a table with named columns
         (``y_columns``) and no index, its columns in the order of ``y_names`` (by name, as
         ``gpmsa.calibrate`` reads a table y_obs; GPMSAError when those names are not
-        ``y_names``). A table's default labels 0, 1, ... are no names: by position, as are
-        the columns of a y with an index (they follow the index); ``y_names`` None: as
-        given."""
+        ``y_names``). A table's default labels 0, 1, ... are no names: by position; with an
+        index the columns follow it, by position (GPMSAError where they are ``y_names`` in
+        another order: ambiguous); ``y_names`` None: as given."""
+        order = self._output_order(y_names)
+        return self.experiments if order is None else [e[order] for e in self.experiments]
+
+    def output_precisions(self, y_names=None) -> list[np.ndarray] | None:
+        """``precisions`` with their rows and columns in the order `outputs` gives y's."""
+        order = self._output_order(y_names)
+        if order is None or self.precisions is None:
+            return self.precisions
+        return [lam[np.ix_(order, order)] for lam in self.precisions]
+
+    def _output_order(self, y_names) -> list[int] | None:
+        """The positions of ``y_names`` among y's named columns (`outputs`); None: as given."""
         labels = self.y_columns
-        default = labels is not None and labels == tuple(str(k) for k in range(len(labels)))
-        if labels is None or default or y_names is None or any(g is not None for g in self.grids):
-            return self.experiments
-        order = column_order(labels, [str(n) for n in y_names], "ObsData y")
-        return [e[order] for e in self.experiments]
+        if labels is None or y_names is None:
+            return None
+        if labels == tuple(str(k) for k in range(len(labels))):  # a frame's default labels
+            return None
+        names = [str(n) for n in y_names]
+        if any(g is not None for g in self.grids):
+            if sorted(labels) == sorted(names) and list(labels) != names:
+                raise GPMSAError(
+                    f"ObsData y has the columns {list(labels)}, the simulation outputs' names in "
+                    "another order, and an index, whose order its columns follow: give the "
+                    "columns in the index's order, or y without the index (read by name)"
+                )
+            return None
+        return column_order(labels, names, "ObsData y")
 
     def values_digest(self, x_names=None, y_names=None) -> str:
         """SHA-256 of x and every experiment's y (`values_digest`): what ``gpmsa.calibrate``
@@ -682,7 +703,10 @@ class ObsData:
             return [None] * len(ys)
         per_experiment = isinstance(index, (list, tuple)) and len(index) > 0
         per_experiment = per_experiment and all(np.ndim(g) == 1 for g in index)
-        if per_experiment or (isinstance(index, np.ndarray) and index.ndim == 2):
+        if per_experiment and len(index) != len(ys) and all(np.size(g) == 1 for g in index):
+            per_experiment = False  # one grid as a column of 1-point lists
+        rows = isinstance(index, np.ndarray) and index.ndim == 2 and min(index.shape) > 1
+        if per_experiment or rows:  # an (n, l) array: a grid per experiment; (l, 1): one
             if len(index) != len(ys):
                 raise GPMSAError(
                     f"index_obs has {len(index)} grids for {len(ys)} experiment(s): give one "
@@ -691,7 +715,7 @@ class ObsData:
             grids = [as_float(g, f"index_obs[{j}]").reshape(-1) for j, g in enumerate(index)]
         else:
             g = as_float(index, "index_obs")
-            if g.ndim > 1:
+            if g.ndim > 1 and sorted(g.shape)[-2] > 1:
                 raise GPMSAError(f"index_obs must be one grid (l,) or one per experiment, got "
                                  f"shape {g.shape}")  # fmt: skip
             grids = [g.reshape(-1)] * len(ys)

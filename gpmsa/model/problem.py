@@ -8,7 +8,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from gpmsa.errors import GPMSAError, ReductionWarning
+from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.model import categorical
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
@@ -288,7 +288,7 @@ def reduce_obs(
         )
     lamy = [np.eye(e.size) for e in ys]
     if obs.precisions is not None:
-        lamy = [lam * std.y_sd**2 for lam in obs.precisions]
+        lamy = [lam * std.y_sd**2 for lam in obs.output_precisions(y_names)]
         _warn_if_vague(lamy)
     if scalar:
         if any(e.size != 1 for e in ys):
@@ -365,7 +365,7 @@ def _check_discrepancy_scales(kind, grids: list[np.ndarray]) -> None:
     if not (isinstance(kind, str) and kind == "linear") or len(grids) < 2:
         return
     reach = [float(np.max(np.abs(g))) for g in grids]
-    if max(reach) != min(reach):
+    if not np.isclose(max(reach), min(reach), rtol=1e-12, atol=0.0):  # 0.1 + 0.2 is 0.3
         j, k = int(np.argmin(reach)), int(np.argmax(reach))
         raise GPMSAError(
             "discrepancy='linear' is normalised on each experiment's grid by its largest "
@@ -390,7 +390,7 @@ def _warn_if_vague(precisions: list[np.ndarray]) -> None:
             "in the outputs' native units (a variance given for a precision?). lamOs scales "
             "it, but its prior holds it near its own scale",
             ReductionWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
 
 
@@ -407,7 +407,7 @@ def _warn_rank_deficient(short: list[tuple[int, int]], n_c: int) -> None:
         "one-point experiments of a 3-component emulator). Give each experiment at least that "
         "many values, or use fewer basis vectors (gpmsa.fit's n_pc, a smaller discrepancy)",
         ReductionWarning,
-        stacklevel=4,
+        stacklevel=user_stacklevel(),
     )
 
 

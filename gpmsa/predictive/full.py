@@ -315,16 +315,17 @@ def _check_calibrated_obs(posterior, obs: ObsData, x_names, y_names, grid: np.nd
     if digest is not None and obs.values_digest(x_names, y_names) != digest:
         raise GPMSAError(
             "obs holds other observations (x or y) than the calibration that drew posterior=: "
-            "pass the ObsData given to gpmsa.calibrate (or its x_obs and y_obs as "
-            "ObsData(x=x_obs, y=y_obs))"
+            "pass the ObsData given to gpmsa.calibrate or Calibrator.update (or its x_obs and "
+            "y_obs as ObsData(x=x_obs, y=y_obs))"
         )
     layout = info.get("obs_layout_sha256")
-    if layout is not None and layout_digest(obs.grids, obs.precisions, grid) != layout:
+    precisions = obs.output_precisions(y_names)
+    if layout is not None and layout_digest(obs.grids, precisions, grid) != layout:
         raise GPMSAError(
             "obs places its observations on other index grids or gives them other precisions "
             "than the calibration that drew posterior=: pass the ObsData given to "
-            "gpmsa.calibrate (arrays given there: ObsData(x=x_obs, y=y_obs), without index or "
-            "precision)"
+            "gpmsa.calibrate or Calibrator.update (arrays given there: ObsData(x=x_obs, "
+            "y=y_obs), without index or precision)"
         )
 
 

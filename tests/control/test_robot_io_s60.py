@@ -68,7 +68,11 @@ def test_after_a_clock_step_back_a_carried_estimate_still_turns_stale(chunk):
 
 
 def test_one_stamp_far_back_costs_a_block_in_any_chunking():
-    """A single wild stamp (not a clock step: the next one is back on time) leaves no trace."""
+    """A single wild stamp (not a clock step: the next one is back on time) costs a block or
+    two and the same final estimate in any chunking. Among good stamps of its chunk it moves
+    nothing: no clock step is named and every estimate's data time stays within seconds of
+    its time (the review found them 1.7e9 s apart after a 0.0 stamp). Alone at a chunk's end
+    it reads as a step back (the cautious side: what is held reads older)."""
     t, p, a, v = stream(lambda s: np.full_like(s, 400.0), 1.5, 30, seed=1)
     wild = t.copy()
     wild[2000] -= 1000.0
@@ -77,7 +81,11 @@ def test_one_stamp_far_back_costs_a_block_in_any_chunking():
         out = _feed(BCR(FakeBlockModel()), wild, p, a, v, chunk, now=t)
         faults = [e for e in out if e.status == "sensor_fault"]
         assert out[-1].ok and len({e.time for e in faults}) <= 2, (chunk, faults)
-        assert "stepped back 1000 s" in faults[0].reason
+        named = any("stepped back 1000 s" in e.reason for e in faults)
+        assert named == (chunk == 1), (chunk, faults)
+        if chunk > 1:
+            lags = [e.time - e.data_time for e in out if np.isfinite(e.data_time)]
+            assert max(abs(lag) for lag in lags) < 5.0, chunk
         finals[chunk] = out[-1].gd_mean
     assert len(set(finals.values())) == 1, finals  # the same estimate, however chunked
 
