@@ -357,8 +357,10 @@ class Fit:
     """How well the emulator can explain an observation, over a set of theta values.
 
     outside_sds: the smallest over theta of the largest |z_i - mean_i| / sd_i over the reduced
-        data's elements (sd_i: the emulator's predictive sd, nugget included): how many
-        predictive sds the observation lies from the nearest emulator prediction at its x.
+        data's elements (sd_i: the emulator's predictive sd, nugget included, and where the
+        data have values beyond their basis, the observation error those residuals estimate,
+        `_residual_noise`): how many predictive sds the observation lies from the nearest
+        emulator prediction at its x.
     excess_var: the smallest over theta of max(0, (||L^-1 (z - mean)||^2 - tr(L^-1 S L^-T)) / d)
         (Sigma_obs = L L^T): the observation-error variance per unit lamOs that the misfit beyond
         the emulator's own predictive variance needs (0 when some theta explains the data).
@@ -394,7 +396,7 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
     var = np.maximum(np.diagonal(cov, axis1=2, axis2=3).reshape(G, p_u * n), 1e-300)
     resid = data.z[None, :] - m
     with np.errstate(over="ignore"):
-        sds = np.max(np.abs(resid) / np.sqrt(var), axis=1)
+        sds = np.max(np.abs(resid) / np.sqrt(var + _residual_noise(data)), axis=1)
     L = data.obs_chol
     d = data.z.size
     if d == 1:
@@ -411,6 +413,19 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
             tr += np.einsum("ai,gij,aj->g", blk, cov[:, c], blk)
     excess = np.maximum(0.0, (y2 - tr) / d)
     return Fit(float(np.min(sds)), float(np.min(excess)))
+
+
+def _residual_noise(data: Observations) -> np.ndarray | float:
+    """Per reduced datum, the observation-error variance that the data's residuals beyond the
+    basis estimate: diag(Sigma_obs) / lamOs at the mean of lamOs's prior corrected by them
+    (``Observations.lamos``; GPM/SA's correction: their count and sum of squares); 0 where no
+    value lies beyond the basis (a scalar output, or as many values as basis vectors), where
+    the prior alone would set it. Projected onto a coarse or partial grid the noise grows, and
+    without it data straight from the simulator read as far outside (8.6 sds on 10 points)."""
+    if not data.os_corr[0] > 0:
+        return 0.0
+    lamos = data.lamos.shape / data.lamos.rate
+    return np.sum(data.obs_chol**2, axis=1) / lamos
 
 
 def warn_if_outside(fit: Fit, stacklevel: int = 3, discrepancy: bool = False) -> None:
