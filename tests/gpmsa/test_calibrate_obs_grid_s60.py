@@ -415,3 +415,20 @@ def test_a_reduction_warning_comes_once_and_names_the_callers_line():
     mine = [w for w in caught if issubclass(w.category, gpmsa.ReductionWarning)]
     assert len(mine) == 1 and "3 basis vectors" in str(mine[0].message)
     assert mine[0].filename == __file__
+
+
+def test_data_from_the_simulator_on_a_partial_grid_are_not_outside_but_wrong_units_are():
+    """The outside check's predictive sd includes the observation error the values beyond the
+    basis estimate: the simulator's output with noise on grids of 23 and 9 points (one over
+    part of the range) no longer reads as outside (it read 6.8 sds), while the same data 10
+    times too large still do."""
+    emu = vector_emulator()
+    obs = ragged_obs([1e4, 2.5e3])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", gpmsa.OutsideEmulatorWarning)
+        post = gpmsa.Calibrator(emu).update(obs)
+    assert post.info["outside_sds"] < 5.0
+    big = gpmsa.ObsData(obs.x, [10.0 * e for e in obs.experiments], index=obs.grids,
+                        precision=[1e2, 25.0])  # fmt: skip
+    with pytest.warns(gpmsa.OutsideEmulatorWarning):
+        assert gpmsa.Calibrator(emu).update(big).info["outside_sds"] > 20.0
