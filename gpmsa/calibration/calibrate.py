@@ -54,7 +54,7 @@ from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
 from gpmsa.model.basis import basis_digest
-from gpmsa.model.data import ObsData, by_column_names, check_count, check_flag, check_seed
+from gpmsa.model.data import ObsData, check_count, check_flag, check_seed
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
@@ -127,7 +127,7 @@ def _theta_options(emulator, constraint, theta_init):
     closed = None if levels is None else [lv is not None for lv in levels]
     start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, names, closed)
     if start is not None and levels is not None:
-        native = np.asarray(by_column_names(theta_init, names, "theta_init"), float).reshape(-1)
+        native = constraints.theta_native(theta_init, names)
         for k, lv in enumerate(levels):
             if lv is not None and not np.any(np.isclose(lv, native[k], rtol=0, atol=1e-9)):
                 raise GPMSAError(
@@ -204,7 +204,8 @@ def calibrate(
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there (no draw inside the forbidden region); a constraint
             that rejects the start is a GPMSAError. Chains run in this process.
-        theta_init: start of theta (native, (q,); default the centre of the design's range).
+        theta_init: start of theta (native, (q,), or a dict / pandas Series by t_names;
+            default the centre of the design's range).
         options: passed to the backend's ``sample`` (``fast=False`` or another backend than
             numpy), e.g. ``device="cuda"``, ``dtype="float32"`` for torch; the fast sampler
             takes none.

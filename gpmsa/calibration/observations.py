@@ -311,7 +311,7 @@ def checked_obs_data(emulator, obs: ObsData, extrapolate: bool) -> tuple[np.ndar
         if sizes:
             raise GPMSAError(
                 f"the emulator's output is a scalar: each ObsData experiment needs one value, "
-                f"got {sizes[0]}"
+                f"got {sizes[0]} (give y as a column (n, 1), one row per experiment)"
             )
     return x, xu
 

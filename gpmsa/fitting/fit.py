@@ -114,8 +114,8 @@ def fit(
     integrated out (flat prior). fixed: name -> value held fixed (model scales as
     ``Emulator.params``; theta in native units), e.g. ``{"lamWOs": 1e5 - 1}``. constraint (joint
     fit only): a callable of native theta (q,) -> bool, False where theta is not allowed (zero
-    prior mass there). theta_init: the chains' start of theta (native, (q,); default the centre;
-    a categorical element: one of its levels).
+    prior mass there). theta_init: the chains' start of theta (native, (q,) or a dict by
+    t_names; default the centre; a categorical element: one of its levels).
 
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``

@@ -92,17 +92,29 @@ def make(constraint, t_min, t_max, names) -> ThetaConstraint | None:
                            np.asarray(t_max, dtype=np.float64), tuple(names))  # fmt: skip
 
 
+def theta_native(value, names, what: str = "theta_init") -> np.ndarray:
+    """A theta given natively as values in the order of ``names``: a dict by its keys (which
+    must be ``names``), a pandas Series or one-row table by its labels, a sequence or array
+    by position; flattened, float."""
+    if isinstance(value, dict):
+        keys = [str(k) for k in value]
+        if sorted(keys) != sorted(str(n) for n in names):
+            raise GPMSAError(f"{what} has the keys {keys}; expected {list(names)} (in any order)")
+        value = [value[k] for k in names]
+    value = by_column_names(value, names, what)  # pandas: by label, not position
+    return as_float(value, what).reshape(-1)
+
+
 def theta_init_unit(
     theta_init, t_min, t_max, names, closed=None, what: str = "theta_init"
 ) -> np.ndarray | None:
-    """The user's ``theta_init`` (native, (q,); a pandas Series or one-row table by its labels,
-    ``names``) on the unit scale; GPMSAError naming ``what`` outside (0, 1) (outside [0, 1] for
-    the elements that ``closed`` (q,) bool marks: categorical levels)."""
+    """The user's ``theta_init`` (native, (q,); a dict, a pandas Series or a one-row table by
+    its keys or labels, ``names``) on the unit scale; GPMSAError naming ``what`` outside (0, 1)
+    (outside [0, 1] for the elements that ``closed`` (q,) bool marks: categorical levels)."""
     if theta_init is None:
         return None
     q = len(names)
-    theta_init = by_column_names(theta_init, names, what)  # pandas: by label, not position
-    arr = as_float(theta_init, what).reshape(-1)
+    arr = theta_native(theta_init, names, what)
     if arr.size != q:
         raise GPMSAError(f"{what} must have {q} values ({names}), got {arr.size}")
     check_finite(arr, what)
