@@ -432,3 +432,34 @@ def test_data_from_the_simulator_on_a_partial_grid_are_not_outside_but_wrong_uni
                         precision=[1e2, 25.0])  # fmt: skip
     with pytest.warns(gpmsa.OutsideEmulatorWarning):
         assert gpmsa.Calibrator(emu).update(big).info["outside_sds"] > 20.0
+
+
+def test_the_chains_find_lamos_where_precisions_are_declared_far_too_large():
+    """Precisions declared 1e12 times too large put lamOs near 3e-9, where the data's values
+    beyond the basis (the prior's correction) say it lies; the chains started at 1 /
+    excess_var (3.6e-6 here), decades above, and never came down (theta 0.3980 +- 0.0029
+    against the exact 0.4029 +- 0.0038). They now start at the corrected prior's mean and
+    agree with the grid within Monte-Carlo error. A 30-point output with 3 components,
+    three experiments on grids of 12, 20 and 25 points."""
+    grid = np.linspace(0.0, 1.0, 30)
+    rng = np.random.default_rng(0)
+    x = (rng.permutation(50) + rng.uniform(size=50)) / 50
+    t = (rng.permutation(50) + rng.uniform(size=50)) / 50
+    sim = gpmsa.SimData(x=x[:, None], t=t[:, None], y=vector_truth(x, grid, t[:, None]),
+                        index=grid, x_names=["x"], t_names=["t"])  # fmt: skip
+    prm = {"betaU": [[1.0] * 3] * 2, "lamUz": [1.0] * 3, "lamWs": [5e3] * 3, "lamWOs": [5e3]}
+    emu = gpmsa.Emulator.from_params(sim, prm, n_pc=3)
+    xs = np.array([0.25, 0.6, 0.85])
+    grids = [np.linspace(0, 1, 12), np.linspace(0.1, 0.9, 20), np.linspace(0.05, 0.95, 25)]
+    noise = [
+        0.02 * np.random.default_rng(10 + k).standard_normal(g.size) for k, g in enumerate(grids)
+    ]
+    ys = [vector_truth(xs[k : k + 1], g)[0] + noise[k] for k, g in enumerate(grids)]
+    obs = gpmsa.ObsData(xs[:, None], ys, index=grids, precision=1e12)
+    exact = gpmsa.Calibrator(emu).update(obs)
+    assert exact.mean("lamOs") < 1e-7
+    for kw in ({}, {"fast": False}):
+        post = gpmsa.calibrate(emu, obs, n_samples=2000, n_burn=200, seed=5, **kw)
+        assert abs(post.mean("t") - exact.mean("t")) < 0.25 * exact.sd("t")
+        assert abs(post.sd("t") / exact.sd("t") - 1.0) < 0.25
+        assert abs(post.mean("lamOs") / exact.mean("lamOs") - 1.0) < 0.25
