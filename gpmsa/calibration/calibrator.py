@@ -492,7 +492,7 @@ class Calibrator:
         node i + 1. ``allows`` (unit-scale points (m,) -> status (m,) bool) gives the status
         between nodes (default: the constraint's). A point whose native value is its node's (an
         edge on a node, e.g. ``th[0] > t_min``) is that node."""
-        allows = allows or (lambda points: np.array([self.constraint(p) for p in points[:, None]]))
+        allows = allows or (lambda points: self._allowed(points[:, None]))
         std = self.emulator.standardizer
         span, low = std.t_max[0] - std.t_min[0], std.t_min[0]  # native as `_posterior` has it
         cells = np.flatnonzero(ok[:-1] != ok[1:])

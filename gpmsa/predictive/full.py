@@ -319,8 +319,9 @@ def _check_calibrated_obs(posterior, obs: ObsData, x_names, y_names, grid: np.nd
             "y_obs as ObsData(x=x_obs, y=y_obs))"
         )
     layout = info.get("obs_layout_sha256")
-    precisions = obs.output_precisions(y_names)
-    if layout is not None and layout_digest(obs.grids, precisions, grid) != layout:
+    if layout is not None and (
+        layout_digest(obs.grids, obs.output_precisions(y_names), grid) != layout
+    ):
         raise GPMSAError(
             "obs places its observations on other index grids or gives them other precisions "
             "than the calibration that drew posterior=: pass the ObsData given to "
