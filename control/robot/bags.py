@@ -228,8 +228,9 @@ def read_recording(
     wanted = [imu_topic, odom_topic]
     raw, storage, digests = None, "", {}
     if kind == "rosbag2":
-        files, storage, simple = _bag_files(target)
-        digests = _recorded_digests(target)
+        info = _bag_information(target)
+        files, storage, simple = _bag_files(target, info)
+        digests = _recorded_digests(target, info)
         if simple and storage == "mcap":
             raw = storage_mod.mcap_messages(files, wanted)
         elif simple and storage == "sqlite3":
@@ -252,12 +253,22 @@ def read_recording(
     return Recording(target, kind, storage, topics, imu, odom, time.perf_counter() - tic)
 
 
-def _bag_files(folder: Path) -> tuple[list[Path], str, bool]:
-    """(storage files, storage id, whether the fast readers can take them) of a bag folder."""
+def _bag_information(folder: Path):
+    """The ``rosbag2_bagfile_information`` of a bag folder's metadata.yaml, read once; None
+    where it does not read (rosbags reads, and reports on, whatever this does not)."""
     yaml = require("ruamel.yaml", "reading a ROS 2 bag")
     try:
-        meta = yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_text())
-        info = meta["rosbag2_bagfile_information"]
+        return yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_text())[
+            "rosbag2_bagfile_information"
+        ]
+    except Exception:  # rosbags reads (and reports on) whatever this does not understand
+        return None
+
+
+def _bag_files(folder: Path, info) -> tuple[list[Path], str, bool]:
+    """(storage files, storage id, whether the fast readers can take them) of a bag folder
+    (``info``: its `_bag_information`)."""
+    try:
         files = [folder / PurePath(x).name for x in info["relative_file_paths"]]
         storage = str(info["storage_identifier"])
         compression = str(info.get("compression_mode", "") or "").lower()
@@ -278,14 +289,12 @@ def _bag_files(folder: Path) -> tuple[list[Path], str, bool]:
     return files, storage, simple
 
 
-def _recorded_digests(folder: Path) -> dict[str, str]:
-    """{topic: SHA-256} recorded in a ROS 2 bag's metadata by `open_bag_writer` (``custom_data``
-    ``DIGEST_KEY``); {} for a bag without the record (another writer's). `BagError` for a
-    record that is not such a mapping."""
-    yaml = require("ruamel.yaml", "reading a ROS 2 bag")
+def _recorded_digests(folder: Path, info) -> dict[str, str]:
+    """{topic: SHA-256} recorded in a ROS 2 bag's metadata (``info``: its `_bag_information`)
+    by `open_bag_writer` (``custom_data`` ``DIGEST_KEY``); {} for a bag without the record
+    (another writer's). `BagError` for a record that is not such a mapping."""
     try:
-        meta = yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_text())
-        custom = meta["rosbag2_bagfile_information"].get("custom_data") or {}
+        custom = info.get("custom_data") or {}
         text = custom.get(DIGEST_KEY) if isinstance(custom, dict) else None
     except Exception:  # rosbags reads (and reports on) whatever this does not understand
         return {}
