@@ -72,7 +72,9 @@ class ModelTensors:
     (p, n, m) squared differences of the known inputs (obs-obs, obs-sim); ``z`` (N,) the stacked
     reduced data, N = n * n_blocks; ``sig_obs`` (N, N) its covariance per unit lamOs;
     ``u_blocks`` the n-block of each basis component, ``v_blocks`` the n-blocks that receive the
-    discrepancy covariance (GPM/SA's order, see ``gpmsa.model.problem.ObsProblem``).
+    discrepancy covariance (GPM/SA's order, see ``gpmsa.model.problem.ObsProblem``) and
+    ``v_groups`` the precision group of each (a column of betaV, an element of lamVz; empty:
+    all in group 0).
     Packed lower triangle (a factorisation reads only that): ``rows`` the row blocks (a, b)
     (rows a..b-1, columns 0..b-1), ``d_packed`` (p+q, P) d_sim over them, ``packed_index`` (P,)
     their flat positions in an m x m matrix.
@@ -90,6 +92,7 @@ class ModelTensors:
     sig_obs: Tensor | None = None
     u_blocks: tuple[int, ...] = ()
     v_blocks: tuple[int, ...] = ()
+    v_groups: tuple[int, ...] = ()
     rows: tuple[tuple[int, int], ...] = ()
     d_packed: Tensor | None = None
     packed_index: Tensor | None = None
@@ -103,22 +106,23 @@ class ModelTensors:
     def from_problem(cls, problem: Problem, dtype: torch.dtype, device) -> ModelTensors:
         """Tensors of ``problem`` on ``device``."""
 
-        def t(a: np.ndarray) -> Tensor:
-            return torch.as_tensor(np.ascontiguousarray(a), dtype=dtype, device=device)
+        def t(a: np.ndarray) -> Tensor:  # a copy: the emulator's arrays are read-only
+            return torch.tensor(np.ascontiguousarray(a), dtype=dtype, device=device)
 
         zt = problem.zt
         kw = {}
         obs = problem.obs
         if obs is not None:
             u_blocks = (0,) if obs.scalar_out else tuple(obs.p_v + j for j in range(problem.p_u))
-            n_v = 1 if (obs.scalar_out and obs.p_v) else obs.p_v
+            groups = obs.block_groups if "betaV" in problem.init else ()
             kw = {
                 "d_obs": t(pairwise_sq(obs.x, obs.x)),
                 "d_cross": t(pairwise_sq(obs.x, problem.x_sim)),
                 "z": t(obs.z),
                 "sig_obs": t(obs.sig_obs),
                 "u_blocks": u_blocks,
-                "v_blocks": tuple(range(n_v)) if "betaV" in problem.init else (),
+                "v_blocks": tuple(range(len(groups))),
+                "v_groups": groups,
             }
         d_sim = pairwise_sq(zt, zt)
         rows = row_blocks(problem.m)
@@ -312,7 +316,8 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
 
     chol (C, p_u, m, m), alpha (C, p_u, m) from ``sim_factor`` (a leading 1 instead of C: one
     Sigma_W shared by all chains); prm: theta (C, q), betaU (C, p+q, p_u), lamUz, lamWs (C, p_u),
-    lamOs (C, 1), and betaV (C, p, 1), lamVz (C, 1) when there is a discrepancy. Returns (C,).
+    lamOs (C, 1), and betaV (C, p, G), lamVz (C, G) when there is a discrepancy of G precision
+    groups. Returns (C,).
     """
     p, n = data.p, data.d_obs.shape[-1]
     betaU, lamUz = prm["betaU"], prm["lamUz"]
@@ -338,9 +343,10 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
         full[:, sl, sl] += cond[:, j]
         mean[:, sl] = mean_u[:, j]
     if data.v_blocks:
-        s_v = scaled_correlation(prm["betaV"], data.d_obs, prm["lamVz"])[:, 0]
-        for blk in data.v_blocks:
-            full[:, blk * n : (blk + 1) * n, blk * n : (blk + 1) * n] += s_v
+        s_v = scaled_correlation(prm["betaV"], data.d_obs, prm["lamVz"])  # (C, G, n, n)
+        groups = data.v_groups or (0,) * len(data.v_blocks)  # none given: one group
+        for blk, g in zip(data.v_blocks, groups, strict=True):
+            full[:, blk * n : (blk + 1) * n, blk * n : (blk + 1) * n] += s_v[:, g]
     chol_z, info = torch.linalg.cholesky_ex(full)
     ll, _ = _gaussian_loglik(chol_z, info, data.z - mean)
     return ll

@@ -53,22 +53,23 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
-from gpmsa.model.basis import basis_digest
 from gpmsa.model.data import ObsData, check_count, check_flag, check_seed
+from gpmsa.model.discrepancy import check_groups, to_samples
+from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.problem import Problem, default_init, reduce_obs
 
 
 def calibration_problem(
     emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False, constraint=None,
-    theta_init=None, reduced: Observations | None = None,
+    theta_init=None, reduced: Observations | None = None, discrepancy_groups=None,
 ) -> Problem:  # fmt: skip
     """The calibration-only Problem: the emulator's parameters at its point estimate in ``fixed``.
 
     Sampled: theta, lamOs (and betaV, lamVz with a discrepancy basis, "constant" for a scalar
-    output; "constant", "linear" or a matrix for a vector output). ``constraint`` and
-    ``theta_init`` as ``calibrate``'s. ``reduced``: ``reduce(emulator, x_obs, y_obs,
-    extrapolate)`` where the caller has it already (no discrepancy only), so that the
-    observations are checked and reduced once.
+    output; "constant", "linear" or a matrix for a vector output; ``discrepancy_groups`` as
+    ``gpmsa.fit``'s). ``constraint`` and ``theta_init`` as ``calibrate``'s. ``reduced``:
+    ``reduce(emulator, x_obs, y_obs, extrapolate)`` where the caller has it already (no
+    discrepancy only), so that the observations are checked and reduced once.
     """
     check_emulator(emulator)
     if reduced is not None and discrepancy is not None:
@@ -76,6 +77,7 @@ def calibration_problem(
                          "discrepancy basis pass reduced=None")  # fmt: skip
     start = None
     if discrepancy is None:
+        check_groups(discrepancy_groups, 0)  # groups without a basis: refused
         data = reduce(emulator, x_obs, y_obs, extrapolate) if reduced is None else reduced
         obs, corr = data.obs, data.os_corr
         fit = _probe(emulator, data, [emulator.params])
@@ -95,6 +97,7 @@ def calibration_problem(
             obs, corr = reduce_obs(
                 given, emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
                 getattr(emulator, "levels", None), getattr(emulator, "y_names", None),
+                discrepancy_groups,
             )  # fmt: skip
     pri = emulator.priors
     lo = pri.lamOs
@@ -150,6 +153,7 @@ def calibrate(
     emulator_params: str = "point",
     n_emulator_draws: int = 20,
     discrepancy=None,
+    discrepancy_groups=None,
     n_chains: int = 1,
     tune_rounds: int | None = None,
     tune_levels: int | None = None,
@@ -189,6 +193,8 @@ def calibrate(
             ``n_emulator_draws`` must be an integer >= 1 in either mode (at most the retained
             draws are used).
         discrepancy: None (no discrepancy, the default) or a discrepancy basis (generic backends).
+        discrepancy_groups: the precision group of each discrepancy basis vector, as
+            ``gpmsa.fit``'s (GPM/SA's lamVzGroup; None: one group).
         n_chains: independent chains (their kept draws are pooled in ``samples``).
         extrapolate: allow x_obs outside the emulator's x domain (with a warning).
         fast: None (auto: the specialised sampler when it applies), True, or False (the backend).
@@ -240,6 +246,8 @@ def calibrate(
     tuning_opts = _tuning_options(backend, tune_rounds, tune_levels)
     n_emulator_draws = check_count(n_emulator_draws, "n_emulator_draws")  # as Calibrator's
     sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
+    if discrepancy is None:
+        check_groups(discrepancy_groups, 0)  # groups without a basis: refused
     can_fast = backend == "numpy" and discrepancy is None
     if fast is None:
         fast = can_fast
@@ -285,8 +293,9 @@ def calibrate(
             )  # fmt: skip
         else:
             draws, info = _run_backend(
-                emulator, data, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune,
-                {**tuning_opts, **options}, seed, extrapolate, progress, where, theta_opts,
+                emulator, data, x_obs, y_obs, backend, (discrepancy, discrepancy_groups),
+                n_samples, n_chains, tune, {**tuning_opts, **options}, seed, extrapolate,
+                progress, where, theta_opts,
             )  # fmt: skip
     require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
@@ -433,9 +442,11 @@ def _run_backend(
     emulator, data, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tuning_opts,
     seed, extrapolate, progress, where, theta_opts,
 ):  # fmt: skip
+    """The generic backend's draws and info; ``discrepancy``: (basis, groups)."""
+    discrepancy, groups = discrepancy
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate,
-        reduced=data if discrepancy is None else None, **theta_opts,
+        reduced=data if discrepancy is None else None, discrepancy_groups=groups, **theta_opts,
     )  # fmt: skip
     module = backends.get(backend)
     if backend == "numpy" and problem.constraint is not None:  # (the others refuse it)
@@ -452,7 +463,8 @@ def _run_backend(
     theta = std.t_from_unit(np.asarray(chains.draws["theta"]))
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.asarray(chains.draws["lamOs"])[:, :, 0]
-    draws.update(_discrepancy_draws(chains.draws, n_chains, n_samples))
+    if "lamVz" in chains.draws:
+        draws.update(to_samples(np.asarray(chains.draws["betaV"]), chains.draws["lamVz"]))
     info = {
         "engine": "backend",
         "backend": backend,
@@ -460,22 +472,5 @@ def _run_backend(
         "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
     }
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
-        info["discrepancy_sha256"] = basis_digest(problem.obs.D)
+        info.update(discrepancy_record(problem.obs))
     return draws, info
-
-
-def _discrepancy_draws(draws: dict, n_chains: int, n_samples: int) -> dict[str, np.ndarray]:
-    """The discrepancy parameters' draws (n_chains, n_samples) under their Posterior names, as
-    ``gpmsa.calibration_posterior`` names a joint fit's: betaV's correlation parameter per
-    known input ("betaV" for one input, "betaV[k]" (k = 0 .. p-1) for more), then "lamVz"
-    (``gpmsa.full_prediction`` reads them so). None of them without a discrepancy."""
-    out = {}
-    if "betaV" in draws:
-        bv = np.asarray(draws["betaV"]).reshape(n_chains, n_samples, -1)
-        if bv.shape[2] == 1:
-            out["betaV"] = bv[..., 0]
-        else:
-            out.update({f"betaV[{k}]": bv[..., k] for k in range(bv.shape[2])})
-    if "lamVz" in draws:
-        out["lamVz"] = np.asarray(draws["lamVz"]).reshape(n_chains, n_samples, -1)[..., 0]
-    return out

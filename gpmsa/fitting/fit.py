@@ -17,8 +17,8 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.mcmc.sampler import draws_nbytes, parameter_elements, sweeps_nbytes
 from gpmsa.model import constraints
-from gpmsa.model.basis import basis_digest
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
+from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, prepare
 
@@ -82,6 +82,7 @@ def fit(
     point: str = "mean",
     n_pc: int | None = None,
     discrepancy=None,
+    discrepancy_groups=None,
     step_widths: dict | None = None,
     metadata: dict | None = None,
     n_jobs: int | None = None,
@@ -100,7 +101,9 @@ def fit(
     n_burn: sweeps discarded per chain (default n_iter // 5). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
     posterior) for ``Emulator.params``. n_pc: basis size (default: 99.5% of the variance).
-    discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. n_jobs, executor: where
+    discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. discrepancy_groups: the
+    precision group (0 .. G-1) of each discrepancy basis vector, GPM/SA's lamVzGroup (None: one
+    group; each group has its own betaV column and lamVz). n_jobs, executor: where
     the chains run (numpy backend: ``n_jobs`` worker processes, None or -1 = every CPU but never
     more than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws
     are the same wherever they run. seed: an integer, a numpy Generator or None (fresh
@@ -137,7 +140,7 @@ def fit(
     seed = _seed(seed)
     module = backends.get(backend)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
-                   mean_basis=mean_basis)  # fmt: skip
+                   mean_basis=mean_basis, discrepancy_groups=discrepancy_groups)  # fmt: skip
     problem = _model_options(prep, data, fixed, constraint, theta_init)
     _check_fit_memory(problem, int(n_iter), int(n_chains))
     reserved = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress", "n_jobs",
@@ -197,7 +200,7 @@ def fit(
         "versions": library_versions(backend),
     }  # fmt: skip
     if obs is not None and discrepancy is not None:  # full_prediction refuses another basis
-        settings["discrepancy_sha256"] = basis_digest(problem.obs.D)
+        settings.update(discrepancy_record(problem.obs))
     summary = summarize(post, chains.accept_rate)
     record = None
     if n_chains > 1:

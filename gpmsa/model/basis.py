@@ -101,14 +101,17 @@ a multiple of a basis, whose normalisation differs from the basis's by an ulp or
 same basis (one element in about 1e8 lands within an ulp of a rounding point)."""
 
 
-def basis_digest(bases) -> str | None:
+def basis_digest(bases, groups=None) -> str | None:
     """SHA-256 of the normalised discrepancy bases of a reduction (``ObsProblem.D``: one array
-    per experiment, rounded to DIGEST_STEP, with their shapes); None without a discrepancy. A
+    per experiment, rounded to DIGEST_STEP, with their shapes) and of their precision groups
+    (``ObsProblem.v_groups``; None, one group, adds nothing); None without a discrepancy. A
     joint fit and ``gpmsa.calibrate`` record it, so that ``gpmsa.full_prediction`` refuses
-    another basis."""
+    another basis or grouping."""
     if bases is None:
         return None
     h = hashlib.sha256()
+    if groups is not None:
+        h.update(f"groups:{list(groups)}".encode())
     for k, D in enumerate(bases):
         arr = np.ascontiguousarray(np.rint(np.asarray(D, dtype=np.float64) / DIGEST_STEP), "<i8")
         h.update(f"{k}:{arr.shape}".encode())

@@ -314,18 +314,20 @@ def output_scale(y: np.ndarray) -> float:
 
 
 RESERVED_NAMES = ("lamOs", "lamVz", "betaV")
-"""Names a calibration posterior gives its other parameters (with "betaV[k]", k = 0, 1, ...):
-no calibration parameter (t_names) may take them."""
+"""Names a calibration posterior gives its other parameters (with "betaV[k]", "betaV[k,g]" and
+"lamVz[g]", k, g = 0, 1, ...): no calibration parameter (t_names) may take them."""
 
 
 def check_parameter_names(names, what: str = "t_names") -> None:
     """GPMSAError when a calibration parameter name is reserved (``RESERVED_NAMES`` or
-    betaV[k]): its draws would overwrite, or be confused with, those of that parameter."""
+    betaV[k], betaV[k,g], lamVz[g]): its draws would overwrite, or be confused with, those of
+    that parameter."""
     for name in names:
-        if name in RESERVED_NAMES or re.fullmatch(r"betaV\[\d+\]", name):
+        if name in RESERVED_NAMES or re.fullmatch(r"(betaV|lamVz)\[\d+(,\d+)?\]", name):
             raise GPMSAError(
                 f"{what}: {name!r} is a reserved name: a calibration posterior names its other "
-                f"parameters {', '.join(RESERVED_NAMES)} and betaV[k] (k = 0, 1, ...); rename the "
+                f"parameters {', '.join(RESERVED_NAMES)}, betaV[k] and, with several discrepancy "
+                "precision groups, betaV[k,g] and lamVz[g] (k, g = 0, 1, ...); rename the "
                 "calibration parameter"
             )
 
@@ -433,11 +435,12 @@ class SimData:
     ``index`` (l_sim,) is the output grid of a multivariate output (None: 0..l_sim-1); it must
     be strictly increasing (a descending or unsorted grid is refused: sort the index and the
     columns of ``y`` together). Names default to x0.., t0.., y0..; units to "". ``t_names`` may
-    not be a reserved name (lamOs, lamVz, betaV, betaV[k]: the other parameters of a calibration
-    posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every entry must be a real number
-    (strings, bools and None are refused, never converted). A pandas table names its columns
-    (read by ``*_names`` where given), a named pandas Series (``df["a"]``) its one column;
-    pandas inputs of several rows must carry the same row labels (rows pair by position).
+    not be a reserved name (lamOs, lamVz, betaV, betaV[k], betaV[k,g], lamVz[g]: the other
+    parameters of a calibration posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every
+    entry must be a real number (strings, bools and None are refused, never converted). A
+    pandas table names its columns (read by ``*_names`` where given), a named pandas Series
+    (``df["a"]``) its one column; pandas inputs of several rows must carry the same row labels
+    (rows pair by position).
     ``x_categorical``, ``t_categorical``: the categorical inputs (column indices or names; None:
     none), whose values are integer level codes; see docs/categorical-and-constraints.md.
     """

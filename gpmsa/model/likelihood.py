@@ -86,9 +86,10 @@ def log_likelihood(problem: Problem, params: dict[str, np.ndarray]) -> float:
             mu[o : o + n] += h_obs @ coefs[j]
     if p_v:
         x_cat = None if cat is None else cat[: problem.p]
-        sig_v = correlation(obs.x, None, params["betaV"][:, 0], x_cat) / params["lamVz"][0]
-        for i in range(1 if obs.scalar_out else p_v):
-            C[i * n : (i + 1) * n, i * n : (i + 1) * n] += sig_v
+        bv, lvz = params["betaV"], params["lamVz"]
+        sig_v = [correlation(obs.x, None, bv[:, g], x_cat) / lvz[g] for g in range(obs.n_groups)]
+        for i, g in enumerate(obs.block_groups):
+            C[i * n : (i + 1) * n, i * n : (i + 1) * n] += sig_v[g]
     L = lower_cholesky(C)
     if L is None:
         return -np.inf
@@ -283,8 +284,9 @@ class IncrementalLikelihood:
         return [(c.mu, c.cond) if c.ok else (None, None) for c in self.comps]
 
     def _sig_v(self, prm: dict) -> np.ndarray:
-        sig_v = np.exp(-(prm["betaV"][:, 0] @ self.Dxo)) / prm["lamVz"][0]
-        return sig_v.reshape(self.shape_nn)
+        """(G, n, n) discrepancy covariance of each precision group."""
+        sig_v = np.exp(-(prm["betaV"].T @ self.Dxo)) / prm["lamVz"][:, None]
+        return sig_v.reshape(-1, *self.shape_nn)
 
     def _vu(self, terms: list[tuple], sig_v, prm: dict) -> float:
         obs = self.problem.obs
@@ -300,8 +302,8 @@ class IncrementalLikelihood:
             C[o : o + n, o : o + n] += cond
             mean[o : o + n] = mu
         if sig_v is not None:
-            for i in range(1 if obs.scalar_out else p_v):
-                C[i * n : (i + 1) * n, i * n : (i + 1) * n] += sig_v
+            for i, g in enumerate(obs.block_groups):
+                C[i * n : (i + 1) * n, i * n : (i + 1) * n] += sig_v[g]
         if C.shape[0] == 1:  # one scalar observation: no factorisation needed
             var = float(C[0, 0])
             r = float(self.z[0] - mean[0])

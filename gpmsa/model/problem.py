@@ -14,6 +14,7 @@ from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.data import ObsData, SimData, as_float, check_finite
+from gpmsa.model.discrepancy import check_groups, n_groups
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
@@ -35,6 +36,8 @@ class ObsProblem:
     The stacked order is GPM/SA's:
     v component 0 over all experiments, v component 1, ..., then u components likewise.
     K, D: per-experiment bases on the observation grids (D None without discrepancy).
+    v_groups: the precision group of each discrepancy basis vector (GPM/SA's lamVzGroup;
+    None: one group, `gpmsa.model.discrepancy`).
     """
 
     x: np.ndarray
@@ -46,10 +49,28 @@ class ObsProblem:
     D: tuple[np.ndarray, ...] | None
     p_v: int = 0
     y_std: tuple[np.ndarray, ...] = field(repr=False, default=())
+    v_groups: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         if not self.scalar_out and self.p_v != self.v.shape[1]:
             raise GPMSAError(f"p_v = {self.p_v} but v has {self.v.shape[1]} columns")
+        if self.v_groups is not None and len(self.v_groups) != self.p_v:
+            raise GPMSAError(f"p_v = {self.p_v} but v_groups has {len(self.v_groups)} entries")
+
+    @property
+    def n_groups(self) -> int:
+        """Number of discrepancy precision groups (1 without a discrepancy too)."""
+        return n_groups(self.v_groups)
+
+    @property
+    def block_groups(self) -> tuple[int, ...]:
+        """The group of each n-block that receives a discrepancy covariance (the p_v v blocks;
+        a scalar output's one shared block); empty without a discrepancy."""
+        if not self.p_v:
+            return ()
+        if self.scalar_out:
+            return (0,)
+        return self.v_groups or (0,) * self.p_v
 
     @property
     def n(self) -> int:
@@ -216,8 +237,8 @@ def default_init(p: int, q: int, p_u: int, priors: Priors, obs: ObsProblem | Non
         init["theta"] = np.full(q, 0.5)
         init["lamOs"] = np.array([max(20.0, lo.a / lo.b)])
         if obs.p_v > 0:
-            init["betaV"] = np.full((p, 1), 0.1)
-            init["lamVz"] = np.array([20.0])
+            init["betaV"] = np.full((p, obs.n_groups), 0.1)
+            init["lamVz"] = np.full(obs.n_groups, 20.0)
     return init
 
 
@@ -253,8 +274,12 @@ def reduce_obs(
     x_names: tuple[str, ...],
     levels: categorical.Levels | None = None,
     y_names=None,
+    groups=None,
 ) -> tuple[ObsProblem, tuple[float, float]]:
     """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db).
+
+    ``groups``: the precision group of each discrepancy basis vector (`check_groups`; None:
+    one group).
 
     ``levels``: the x columns' training levels (``SimData.levels``); an unseen level is refused.
     ``y_names``: the simulation outputs' names, by which a y table with named columns and no
@@ -300,6 +325,7 @@ def reduce_obs(
         sig = np.diag([1.0 / (lam[0, 0] + SIGOBS_RIDGE) for lam in lamy])
         Ks = tuple(np.ones((1, 1)) for _ in ys)
         Ds = tuple(np.ones((1, 1)) for _ in ys) if p_v else None
+        check_groups(groups, p_v)  # one basis vector: one group
         v = np.zeros((n, 0))
         obs_p = ObsProblem(x, u, v, sig, True, Ks, Ds, p_v, tuple(ys))
         return obs_p, (0.0, 0.0)
@@ -344,6 +370,7 @@ def reduce_obs(
     p_v = vs[0].size
     if any(v.size != p_v for v in vs):
         raise GPMSAError("every experiment needs the same number of discrepancy basis vectors")
+    v_groups = check_groups(groups, p_v)
     n_c = p_v + p_u
     if short:
         _warn_rank_deficient(short, n_c)
@@ -353,7 +380,7 @@ def reduce_obs(
         sig[np.ix_(idx, idx)] = blk
     obs_p = ObsProblem(
         x, np.array(us), np.array(vs).reshape(n, p_v), sig, False,
-        tuple(Ks), None if p_v == 0 else tuple(Ds), p_v, tuple(ys),
+        tuple(Ks), None if p_v == 0 else tuple(Ds), p_v, tuple(ys), v_groups,
     )  # fmt: skip
     return obs_p, (0.5 * (total - rank), 0.5 * ss)
 
@@ -428,13 +455,14 @@ def prepare(
     n_pc: int | None = None,
     discrepancy=None,
     mean_basis=None,
+    discrepancy_groups=None,
 ) -> Prepared:
     """Standardise, build the PCA basis and weights, reduce observations, set priors and inits.
 
     ``mean_basis``: None (zero mean), "constant", "linear" or a callable of unit-scale [x, t]
     (n, p + q) -> (n, k) (``gpmsa.model.mean_basis``). Categorical inputs come from ``sim``.
     ``priors``: before the data corrections (``corrected=False``; an Emulator's ``priors``,
-    corrected for its own data, are refused).
+    corrected for its own data, are refused). ``discrepancy_groups``: `reduce_obs`'s groups.
     """
     if not isinstance(sim, SimData):
         raise GPMSAError(f"data must be a gpmsa.SimData, got {type(sim).__name__}")
@@ -461,7 +489,11 @@ def prepare(
     obs_p, os_corr = (None, (0.0, 0.0))
     levels = sim.levels
     if obs is not None:
-        obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels, sim.y_names)
+        obs_p, os_corr = reduce_obs(
+            obs, std, K, discrepancy, sim.x_names, levels, sim.y_names, discrepancy_groups
+        )
+    elif discrepancy_groups is not None:
+        check_groups(discrepancy_groups, 0)  # refused: no discrepancy without observations
     priors = (Priors() if priors is None else priors).with_data(wos, os_corr)
     init = default_init(sim.p, sim.q, p_u, priors, obs_p)
     x_unit, t_unit = std.x_to_unit(sim.x), std.t_to_unit(sim.t)

@@ -20,6 +20,7 @@ from gpmsa.model.data import (
     check_level,
     evenly_spaced,
 )
+from gpmsa.model.discrepancy import has_draws
 from gpmsa.predictive._common import (
     check_posterior_emulator,
     posterior_lamos,
@@ -142,7 +143,7 @@ def calibrated_predict(
     if missing:
         raise GPMSAError(f"posterior lacks {missing}; it has {posterior.names}")
     n_theta = check_count(n_theta, "n_theta")
-    if noise and "lamVz" in posterior.names:
+    if noise and has_draws(posterior.names):
         raise GPMSAError(
             "noise=True: this posterior has discrepancy draws (lamVz), and a new observation "
             "includes the discrepancy, which calibrated_predict omits; use gpmsa.full_prediction("

@@ -43,6 +43,7 @@ from gpmsa.model.data import (
     check_level,
     evenly_spaced,
 )
+from gpmsa.model.discrepancy import groups_of, params_at, sample_names
 from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive._common import (
     EMULATOR_PARAMS,
@@ -171,14 +172,17 @@ def _posterior_sets(emulator, posterior, n_draws):
         if not emulator.draws:
             raise GPMSAError("the emulator kept no posterior draws of its own parameters")
         n = cal["theta"].shape[0]
+        p = emulator.p
 
         def get(i):
             prm = {k: np.asarray(emulator.draws[k][i]) for k in EMULATOR_PARAMS}
             prm["theta"] = np.asarray(cal["theta"][i], dtype=float).reshape(-1)
             prm["lamOs"] = float(np.ravel(cal["lamOs"][i])[0])
             if "betaV" in cal:
-                prm["betaV"] = np.asarray(cal["betaV"][i], dtype=float).reshape(-1)
-                prm["lamVz"] = float(np.ravel(cal["lamVz"][i])[0])
+                prm["lamVz"] = np.asarray(cal["lamVz"][i], dtype=float).reshape(-1)
+                prm["betaV"] = np.asarray(cal["betaV"][i], dtype=float).reshape(
+                    p, prm["lamVz"].size
+                )
             return prm
 
     else:
@@ -195,11 +199,9 @@ def _posterior_sets(emulator, posterior, n_draws):
         lam_os = posterior_lamos(posterior)
         n = theta.shape[0]
         p = emulator.p
-        bnames = ["betaV"] if "betaV" in samples else [f"betaV[{k}]" for k in range(p)]
-        has_v = all(k in samples for k in bnames) and "lamVz" in samples
-        if has_v and len(bnames) != p:
-            raise GPMSAError(f"posterior has one betaV but the emulator has p = {p} known inputs")
-        for k in (*bnames, "lamVz") if has_v else ():
+        n_grp = groups_of(samples, p)
+        bnames, lnames = sample_names(p, n_grp) if n_grp else ([], [])
+        for k in (*bnames, *lnames):
             if not np.all(np.asarray(samples[k]) > 0):
                 raise GPMSAError(f"the posterior's {k} draws must be > 0")
 
@@ -207,9 +209,8 @@ def _posterior_sets(emulator, posterior, n_draws):
             prm = {k: emulator.params[k] for k in EMULATOR_PARAMS}
             prm["theta"] = theta[i]
             prm["lamOs"] = float(lam_os[i])
-            if has_v:
-                prm["betaV"] = np.array([float(samples[k][i]) for k in bnames])
-                prm["lamVz"] = float(samples["lamVz"][i])
+            if n_grp:
+                prm["betaV"], prm["lamVz"] = params_at(samples, p, n_grp, i)
             return prm
 
     idx = evenly_spaced(n, n_draws)
@@ -337,6 +338,7 @@ def full_prediction(
     *,
     posterior: Posterior | None = None,
     discrepancy=AS_FITTED,
+    discrepancy_groups=AS_FITTED,
     n_draws: int | None = None,
     n_rlz: int = 1,
     grid=None,
@@ -358,6 +360,9 @@ def full_prediction(
         discrepancy: the discrepancy basis of the calibration: None, "constant", "linear" or an
             (l_obs, p_v) array; the default takes the joint fit's recorded choice (an array must
             be passed again).
+        discrepancy_groups: the precision group of each discrepancy basis vector (as
+            ``gpmsa.fit``'s); the default takes the one the joint fit or ``gpmsa.calibrate``
+            recorded (none recorded: one group).
         n_draws: at most this many posterior draws, evenly spaced (None: all).
         n_rlz: realizations per draw.
         grid: output grid of the prediction within the simulation grid, in any order (default:
@@ -408,22 +413,34 @@ def full_prediction(
         _check_calibrated_obs(posterior, obs, emulator.x_names, emulator.y_names, std.grid)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
+    record = (
+        posterior.info if posterior is not None else getattr(emulator, "settings", None)
+    ) or {}
+    if isinstance(discrepancy_groups, str) and discrepancy_groups == AS_FITTED:
+        discrepancy_groups = record.get("discrepancy_groups") if discrepancy is not None else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the calibration already warned about its x_obs
-        ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, None, emulator.y_names)
+        ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, None, emulator.y_names,
+                           discrepancy_groups)  # fmt: skip
     p_v = ob.p_v
     if ("betaV" in sets[0]) != (p_v > 0):
         raise GPMSAError(
             f"the draws {'have' if 'betaV' in sets[0] else 'lack'} discrepancy parameters but "
             f"discrepancy={discrepancy!r} gives {p_v} discrepancy basis vectors"
         )
-    record = posterior.info if posterior is not None else getattr(emulator, "settings", None)
-    fitted = (record or {}).get("discrepancy_sha256")  # the joint fit's or calibrate's basis
-    if fitted is not None and basis_digest(ob.D) != fitted:
+    drawn = sets[0]["lamVz"].size if p_v else 1
+    if drawn != ob.n_groups:
         raise GPMSAError(
-            "the discrepancy basis differs from the one the draws were made with (its recorded "
-            "SHA-256, normalised on the observations' grids): pass the calibration's "
-            "discrepancy= (the same kind, or the same array)"
+            f"the draws have {drawn} discrepancy precision group(s) but discrepancy_groups="
+            f"{discrepancy_groups!r} gives {ob.n_groups}: pass the calibration's groups"
+        )
+    fitted = record.get("discrepancy_sha256")  # the joint fit's or calibrate's basis
+    if fitted is not None and basis_digest(ob.D, ob.v_groups) != fitted:
+        raise GPMSAError(
+            "the discrepancy basis differs from the one the draws were made with, or its "
+            "precision groups do (their recorded SHA-256, normalised on the observations' "
+            "grids): pass the calibration's discrepancy= (the same kind, or the same array) and "
+            "discrepancy_groups="
         )
     g = _pred_grid(emulator, obs, grid)
     K_pred = interpolate_basis(K, std.grid, g) if not scalar else K
@@ -467,7 +484,8 @@ def full_prediction(
 def _conditional(emulator, ob, prm, fac, xu_new, p_v, scalar):
     """Mean (n_c N,) and covariance of the weights [v comps; u comps] at the new x (comp-major).
 
-    Prior (per component, over the n observed and N new points): v_k ~ GP(0, R(x; betaV)/lamVz);
+    Prior (per component, over the n observed and N new points): v_k ~ GP(0, R(x; betaV[:, g]) /
+    lamVz[g]), g the precision group of basis vector k;
     u_j | w ~ the emulator GP given the runs (nugget 1/lamWs_j on every point; ``fac``: per
     component the Cholesky factor of Sigma_W_j and Sigma_W_j^-1 w_j); then condition
     on the observations' reduced data z = H [v_obs; u_obs] + N(0, Sigma_obs / lamOs), H the
@@ -482,8 +500,10 @@ def _conditional(emulator, ob, prm, fac, xu_new, p_v, scalar):
     means = np.zeros((n_c, P))
     covs = np.empty((n_c, P, P))
     if p_v:
-        cv = correlation(x_all, None, prm["betaV"]) / prm["lamVz"]
-        covs[:p_v] = cv
+        lam_vz, beta_v = prm["lamVz"], prm["betaV"]
+        cv = [correlation(x_all, None, beta_v[:, g]) / lam_vz[g] for g in range(lam_vz.size)]
+        for c, g in enumerate(ob.block_groups):
+            covs[c] = cv[g]
     for j, (L, alpha) in enumerate(fac):
         lam = prm["lamUz"][j]
         beta = prm["betaU"][:, j]

@@ -7,6 +7,7 @@ import numpy as np
 from gpmsa.calibration.observations import emulator_record
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
+from gpmsa.model.discrepancy import to_samples
 
 
 def calibration_posterior(emulator) -> Posterior:
@@ -14,9 +15,10 @@ def calibration_posterior(emulator) -> Posterior:
 
     Samples (native units): each calibration parameter under its name in ``emulator.t_names``,
     ``lamOs``, and with a discrepancy ``lamVz`` and ``betaV`` (``betaV[k]`` per known input when
-    p > 1). ``chains`` splits the retained draws into the fit's chains, so ``to_arviz()``,
-    ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``. ``info`` carries the
-    fit's record of its observations ("obs_lengths", "obs_sha256"), so that
+    p > 1; with several precision groups ``lamVz[g]`` and ``betaV[k,g]``,
+    `gpmsa.model.discrepancy`). ``chains`` splits the retained draws into the fit's chains, so
+    ``to_arviz()``, ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``.
+    ``info`` carries the fit's record of its observations ("obs_lengths", "obs_sha256"), so that
     ``gpmsa.full_prediction(..., posterior=)`` refuses other ones, as it does without it, and
     the emulator's ``model_sha256`` ("emulator_sha256"), so that it refuses another emulator.
 
@@ -44,13 +46,10 @@ def calibration_posterior(emulator) -> Posterior:
     samples = {name: theta[:, k].copy() for k, name in enumerate(emulator.t_names)}
     samples["lamOs"] = np.asarray(cal["lamOs"], dtype=float).reshape(theta.shape[0], -1)[:, 0]
     if "lamVz" in cal:
-        samples["lamVz"] = np.asarray(cal["lamVz"], dtype=float).reshape(theta.shape[0], -1)[:, 0]
-    if "betaV" in cal:
-        bv = np.asarray(cal["betaV"], dtype=float).reshape(theta.shape[0], -1)
-        if bv.shape[1] == 1:
-            samples["betaV"] = bv[:, 0].copy()
-        else:
-            samples.update({f"betaV[{k}]": bv[:, k].copy() for k in range(bv.shape[1])})
+        lam_vz = np.asarray(cal["lamVz"], dtype=float).reshape(theta.shape[0], -1)
+        rows, n_grp = lam_vz.shape
+        beta_v = np.asarray(cal["betaV"], dtype=float).reshape(rows, emulator.p, n_grp)
+        samples.update(to_samples(beta_v, lam_vz))
     n_chains = int(emulator.settings.get("n_chains", 1) or 1)
     n = theta.shape[0]
     per = n // n_chains
@@ -63,8 +62,8 @@ def calibration_posterior(emulator) -> Posterior:
         "n_chains": n_chains,
         **emulator_record(emulator),
         **{k: emulator.settings[k] for k in ("n_iter", "n_burn", "thin", "seed", "backend",
-                                              "discrepancy", "discrepancy_sha256", "obs_lengths",
-                                              "obs_sha256")
+                                              "discrepancy", "discrepancy_sha256",
+                                              "discrepancy_groups", "obs_lengths", "obs_sha256")
            if k in emulator.settings},
     }  # fmt: skip
     return Posterior(samples, chains=chains, info=info)

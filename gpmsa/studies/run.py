@@ -19,8 +19,8 @@ from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
-from gpmsa.model.basis import basis_digest
 from gpmsa.model.data import ObsData, SimData, check_flag, check_seed
+from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
@@ -197,7 +197,7 @@ def fit_study(
     n_iter: int = 30_000, n_burn: int | None = None, n_keep: int = 1000, point: str = "mean",
     tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
     priors: Priors | None = None, n_pc: int | None = None, discrepancy=None,
-    tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
+    discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
     metadata: dict | None = None,
 ) -> Study:  # fmt: skip
@@ -209,8 +209,9 @@ def fit_study(
     Args:
         sims, obs: per model, its ``gpmsa.SimData`` and ``gpmsa.ObsData``.
         labels, shared, hierarchical, hyper: as ``calibrate_study``.
-        n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, priors, n_pc, discrepancy:
-            as ``gpmsa.fit`` (priors, n_pc, discrepancy: the same for every model); the seed
+        n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, priors, n_pc, discrepancy,
+            discrepancy_groups: as ``gpmsa.fit`` (priors, n_pc, discrepancy and its groups: the
+            same for every model); the seed
             the study ran with is ``study.settings["seed"]`` and each model's
             ``settings["seed"]``.
         metadata: a JSON-able dict saved with the study.
@@ -240,7 +241,8 @@ def fit_study(
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
-    preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy)
+    preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
+                        discrepancy_groups=discrepancy_groups)
              for lab, s, o in zip(labels, sims, obs, strict=True)]  # fmt: skip
     for lab, sim in zip(labels, sims, strict=True):  # the study's theta moves are continuous
         categorical.refuse_categorical_theta(sim.levels, sim.p, sim.x_names + sim.t_names,
@@ -286,7 +288,7 @@ def fit_study(
                                   "hierarchical": list(layout.groups)},  # as read, once
                         "versions": settings["versions"]}  # fmt: skip
         if discrepancy is not None:  # full_prediction refuses another basis
-            emu_settings["discrepancy_sha256"] = basis_digest(prep.problem.obs.D)
+            emu_settings.update(discrepancy_record(prep.problem.obs))
         members.append(Emulator._from_prepared(
             sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,
             settings=emu_settings, diagnostics=summarize({**post, "theta": theta}),

@@ -32,6 +32,7 @@ from gpmsa.io.container import (
 )
 from gpmsa.mcmc.diagnostics import convergence, summarize
 from gpmsa.model.data import check_count
+from gpmsa.model.discrepancy import to_samples
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
 from gpmsa.studies.record import (
     FILE_RE,
@@ -179,7 +180,8 @@ class Study:
     def member_posterior(self, model: int | str) -> Posterior:
         """One model's calibration as a ``gpmsa.Posterior`` named as its emulator's t_names and
         "lamOs" (native units), and for a study fitted with a discrepancy its "betaV" (one
-        input; "betaV[k]" for several) and "lamVz", e.g. for ``gpmsa.full_prediction``'s
+        input; "betaV[k]" for several) and "lamVz" (several precision groups: "betaV[k,g]",
+        "lamVz[g]"), e.g. for ``gpmsa.full_prediction``'s
         ``posterior=`` or ``gpmsa.predictive.calibrated_predict``. Its info carries the record of
         the model's observations (a fitted model's "obs_sha256", a calibrated one's
         "obs_values_sha256"), so that ``full_prediction(posterior=)`` refuses other ones, and
@@ -200,7 +202,8 @@ class Study:
         # other ones: a fitted model's (as calibration_posterior), a calibrated one's (as
         # gpmsa.calibrate; absent from study files written before it was kept)
         settings = self.members[i].settings if self.kind == "fit" else {}
-        info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy_sha256")
+        info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy_sha256",
+                                              "discrepancy_groups")
                      if k in settings})  # fmt: skip
         for key, name in ((OBS_DIGESTS, "obs_values_sha256"), (OBS_LAYOUTS, "obs_layout_sha256")):
             digests = self.settings.get(key)
@@ -329,12 +332,11 @@ def load_study(path: str | Path) -> Study:
 
 def _discrepancy_chains(member, shape: tuple[int, int]) -> dict[str, np.ndarray]:
     """A fitted study model's discrepancy draws as chains of ``shape`` (n_chains, n_draws):
-    "betaV" (one known input) or "betaV[k]", and "lamVz"; none for a model without one."""
+    "betaV" (one known input) or "betaV[k]", and "lamVz" (several precision groups:
+    "betaV[k,g]", "lamVz[g]"); none for a model without one."""
     cal = getattr(member, "calibration", None) or {}
     if "betaV" not in cal or "lamVz" not in cal:
         return {}
-    beta = np.asarray(cal["betaV"], dtype=float).reshape(shape[0] * shape[1], -1)
-    names = ["betaV"] if beta.shape[1] == 1 else [f"betaV[{k}]" for k in range(beta.shape[1])]
-    out = {name: beta[:, k].reshape(shape) for k, name in enumerate(names)}
-    out["lamVz"] = np.asarray(cal["lamVz"], dtype=float).reshape(shape)
-    return out
+    lam_vz = np.asarray(cal["lamVz"], dtype=float).reshape(*shape, -1)
+    beta_v = np.asarray(cal["betaV"], dtype=float).reshape(*shape, member.p, lam_vz.shape[-1])
+    return to_samples(beta_v, lam_vz)

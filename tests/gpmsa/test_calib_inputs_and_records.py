@@ -12,8 +12,8 @@ from _calib_cases import road_emulator, road_obs, vector_emulator
 
 import gpmsa
 from gpmsa import GPMSAError, Posterior
-from gpmsa.calibration.calibrate import _discrepancy_draws
 from gpmsa.calibration.posterior import GridMarginal
+from gpmsa.model.discrepancy import to_samples
 from gpmsa.predictive.calibrated import calibrated_predict
 
 PARAMS = {"betaU": [[1.0], [1.0], [1.0]], "lamUz": [1.0], "lamWs": [5000.0], "lamWOs": [5000.0]}
@@ -91,12 +91,12 @@ def test_a_series_is_matched_by_its_labels_never_by_position():
 def test_discrepancy_draws_keep_betaV_of_every_known_input():
     raw = {"betaV": np.arange(2 * 3 * 2, dtype=float).reshape(2, 3, 2, 1),
            "lamVz": np.full((2, 3, 1), 7.0)}  # fmt: skip
-    out = _discrepancy_draws(raw, 2, 3)
+    out = to_samples(raw["betaV"], raw["lamVz"])
     assert list(out) == ["betaV[0]", "betaV[1]", "lamVz"]
     np.testing.assert_array_equal(out["betaV[0]"], raw["betaV"][:, :, 0, 0])
     np.testing.assert_array_equal(out["betaV[1]"], raw["betaV"][:, :, 1, 0])
-    one = _discrepancy_draws({"betaV": raw["betaV"][:, :, :1]}, 2, 3)
-    assert list(one) == ["betaV"] and one["betaV"].shape == (2, 3)
+    one = to_samples(raw["betaV"][:, :, :1], raw["lamVz"])
+    assert list(one) == ["betaV", "lamVz"] and one["betaV"].shape == (2, 3)
 
 
 def test_calibrate_with_a_discrepancy_and_two_inputs_feeds_full_prediction():

@@ -33,7 +33,7 @@ def test_traces_of_an_emulator_joint_fit_and_a_selection():
     assert isinstance(fig, Figure)
     labels = [ax.get_ylabel() for ax in fig.axes[::2]]
     n_scalars = 4 + 2 * emu.p_u + 2 * emu.p_u + 1  # t lamOs lamVz betaV, betaU, lamUz lamWs, lamWOs
-    assert labels[:4] == ["t", "lamOs", "lamVz", "betaV"] and len(labels) == min(12, n_scalars)
+    assert labels[:4] == ["t", "lamOs", "betaV", "lamVz"] and len(labels) == min(12, n_scalars)
     line = fig.axes[0].lines[0]
     np.testing.assert_array_equal(line.get_ydata(), emu.calibration["theta_native"][:, 0])
     fig = plots.traces(emu, names=["betaU"])

@@ -171,7 +171,7 @@ def test_calibration_posterior_of_a_joint_fit():
     emu, *_ = known_truth_case()
     post = gpmsa.calibration_posterior(emu)
     assert isinstance(post, gpmsa.Posterior)
-    assert post.names == ("t", "lamOs", "lamVz", "betaV")
+    assert post.names == ("t", "lamOs", "betaV", "lamVz")  # as gpmsa.calibrate names them
     np.testing.assert_array_equal(post.samples["t"], emu.calibration["theta_native"][:, 0])
     assert post.mean("t") == pytest.approx(emu.theta_summary()["t"]["mean"], rel=1e-12)
     assert post.chains["t"].shape == (1, emu.n_draws)

@@ -28,7 +28,8 @@ def _draw(emu, i):
     prm = {k: emu.draws[k][i] for k in ("betaU", "lamUz", "lamWs", "lamWOs")}
     cal = emu.calibration
     prm.update(theta=cal["theta"][i], lamOs=float(cal["lamOs"][i][0]),
-               betaV=cal["betaV"][i].ravel(), lamVz=float(cal["lamVz"][i][0]))  # fmt: skip
+               betaV=cal["betaV"][i].reshape(emu.p, -1),
+               lamVz=np.ravel(cal["lamVz"][i]))  # fmt: skip
     return prm
 
 
@@ -38,7 +39,8 @@ def _dense_reference(emu, ob, prm, xn):
     th = prm["theta"]
     xto, xtn = np.hstack([ob.x, np.tile(th, (n, 1))]), np.hstack([xn, np.tile(th, (N, 1))])
     bu, luz, lws = prm["betaU"], prm["lamUz"], prm["lamWs"]
-    SV = R(ob.x, None, prm["betaV"]) / prm["lamVz"]
+    bv, lvz, groups = prm["betaV"], prm["lamVz"], ob.block_groups
+    SV = [R(ob.x, None, bv[:, g]) / lvz[g] for g in groups]  # per basis vector, by its group
     SU = [R(xto, None, bu[:, j]) / luz[j] + np.eye(n) / lws[j] for j in range(pu)]
     nug = [1 / (emu.lam_sim[j] * prm["lamWOs"][0]) + 1 / lws[j] for j in range(pu)]
     SW = [R(emu.zt, None, bu[:, j]) / luz[j] + nug[j] * np.eye(m) for j in range(pu)]
@@ -46,18 +48,18 @@ def _dense_reference(emu, ob, prm, xn):
     o = n * pv
     dim = o + n * pu + m * pu
     sig = np.zeros((dim, dim))
-    sig[:o, :o] = block_diag(*[SV] * pv)
+    sig[:o, :o] = block_diag(*SV)
     sig[o : o + n * pu, o : o + n * pu] = block_diag(*SU)
     sig[o + n * pu :, o + n * pu :] = block_diag(*SW)
     sig[o : o + n * pu, o + n * pu :] = SUW
     sig[o + n * pu :, o : o + n * pu] = SUW.T
     sig[: n * (pv + pu), : n * (pv + pu)] += ob.sig_obs / prm["lamOs"]
     data = np.concatenate([ob.z, emu.w.T.reshape(-1)])
-    pred = block_diag(*([R(xn, None, prm["betaV"]) / prm["lamVz"]] * pv
+    pred = block_diag(*([R(xn, None, bv[:, g]) / lvz[g] for g in groups]
                         + [R(xtn, None, bu[:, j]) / luz[j] + np.eye(N) / lws[j]
                            for j in range(pu)]))  # fmt: skip
     cross = np.zeros((dim, N * (pv + pu)))
-    cross[:o, : N * pv] = block_diag(*[R(ob.x, xn, prm["betaV"]) / prm["lamVz"]] * pv)
+    cross[:o, : N * pv] = block_diag(*[R(ob.x, xn, bv[:, g]) / lvz[g] for g in groups])
     cross[o : o + n * pu, N * pv :] = block_diag(*[R(xto, xtn, bu[:, j]) / luz[j]
                                                    for j in range(pu)])  # fmt: skip
     cross[o + n * pu :, N * pv :] = block_diag(*[R(emu.zt, xtn, bu[:, j]) / luz[j]
@@ -66,14 +68,19 @@ def _dense_reference(emu, ob, prm, xn):
     return W.T @ data, pred - W.T @ cross
 
 
-def test_conditional_equals_the_dense_joint_gaussian():
+@pytest.mark.parametrize("groups", [None, [1, 0]])
+def test_conditional_equals_the_dense_joint_gaussian(groups):
     """The two-step conditioning (on w, then on the reduced observations) equals conditioning
-    on everything at once, as SEPIA's uvPred does."""
+    on everything at once, as SEPIA's uvPred does; with two discrepancy precision groups each
+    basis vector takes its own group's betaV column and lamVz."""
     emu, obs, *_ = known_truth_case()
-    ob, _ = reduce_obs(obs, emu.standardizer, emu.K, "linear", emu.x_names)
+    ob, _ = reduce_obs(obs, emu.standardizer, emu.K, "linear", emu.x_names, groups=groups)
     xn = np.array([[0.1], [0.45], [0.9]])
     for i in (0, emu.n_draws // 2, emu.n_draws - 1):
         prm = _draw(emu, i)
+        if groups is not None:  # a second group of other correlation and precision
+            prm["betaV"] = np.hstack([prm["betaV"], 3.0 * prm["betaV"]])
+            prm["lamVz"] = np.concatenate([prm["lamVz"], 0.2 * prm["lamVz"]])
         mean, cov = _conditional(emu, ob, prm, factors(emu, prm), xn, ob.p_v, False)
         ref_mean, ref_cov = _dense_reference(emu, ob, prm, xn)
         np.testing.assert_allclose(mean, ref_mean, atol=1e-10 * np.abs(ref_mean).max())

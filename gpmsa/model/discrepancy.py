@@ -1,0 +1,117 @@
+"""Discrepancy precision groups (GPM/SA's ``lamVzGroup``) and the discrepancy parameters' names.
+
+Each discrepancy basis vector k has its weight process v_k ~ GP(0, R(x; betaV[:, g]) / lamVz[g])
+with g = groups[k]: the vectors of one group share a correlation (betaV column) and a
+precision (lamVz element). One group (the default) is GPM/SA's default model.
+
+Posterior names: with one group "betaV" (one known input) or "betaV[k]" (k = 0 .. p-1) and
+"lamVz", as before groups existed; with G > 1 groups "betaV[k,g]" and "lamVz[g]".
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+from gpmsa.model.basis import basis_digest
+
+NAME_PATTERN = re.compile(r"(betaV|lamVz)(\[\d+(,\d+)?\])?")
+"""The discrepancy parameters' posterior names."""
+
+
+def check_groups(groups, p_v: int) -> tuple[int, ...] | None:
+    """The group (0 .. G-1) of each of the ``p_v`` discrepancy basis vectors, or None for one
+    group; GPMSAError naming what is wrong. Every group from 0 to G-1 must hold a vector."""
+    if groups is None:
+        return None
+    if p_v == 0:
+        raise GPMSAError(
+            "discrepancy_groups needs a discrepancy basis (discrepancy='constant', 'linear' or "
+            "an array)"
+        )
+    if isinstance(groups, (str, bytes, dict)):
+        raise GPMSAError(f"discrepancy_groups must be a sequence of {p_v} integers, got {groups!r}")
+    arr = np.asarray(groups)
+    if arr.ndim != 1 or arr.size != p_v:
+        raise GPMSAError(
+            f"discrepancy_groups must give one group per discrepancy basis vector: {p_v} "
+            f"integers, got shape {arr.shape}"
+        )
+    if arr.dtype.kind not in "iu":
+        raise GPMSAError(f"discrepancy_groups must be integers, got {arr.tolist()!r}")
+    used = sorted(set(arr.tolist()))
+    if used != list(range(len(used))):
+        raise GPMSAError(
+            f"discrepancy_groups must number the groups 0 .. G-1, each used at least once; got "
+            f"{arr.tolist()} (GPM/SA's lamVzGroup counts from 1: subtract 1)"
+        )
+    return None if len(used) == 1 else tuple(int(g) for g in arr)
+
+
+def n_groups(groups: tuple[int, ...] | None) -> int:
+    """Number of discrepancy precision groups (1 for None)."""
+    return 1 if groups is None else max(groups) + 1
+
+
+def sample_names(p: int, n_grp: int) -> tuple[list[str], list[str]]:
+    """The posterior names of betaV's elements (input-major: betaV[k,g] for k, then g) and of
+    lamVz's, for ``p`` known inputs and ``n_grp`` groups."""
+    if n_grp == 1:
+        return (["betaV"] if p == 1 else [f"betaV[{k}]" for k in range(p)]), ["lamVz"]
+    beta = [f"betaV[{k},{g}]" for g in range(n_grp) for k in range(p)]
+    return beta, [f"lamVz[{g}]" for g in range(n_grp)]
+
+
+def to_samples(beta_v: np.ndarray, lam_vz: np.ndarray) -> dict[str, np.ndarray]:
+    """Posterior samples from draws betaV (*lead, p, G) and lamVz (*lead, G)."""
+    p, n_grp = beta_v.shape[-2:]
+    bnames, lnames = sample_names(p, n_grp)
+    out = {}
+    for i, name in enumerate(bnames):
+        k, g = i % p, i // p
+        out[name] = np.array(beta_v[..., k, g], dtype=np.float64)
+    for g, name in enumerate(lnames):
+        out[name] = np.array(lam_vz[..., g], dtype=np.float64)
+    return out
+
+
+def has_draws(names) -> bool:
+    """Whether posterior ``names`` include discrepancy precisions ("lamVz" or "lamVz[g]")."""
+    return any(re.fullmatch(r"lamVz(\[\d+\])?", name) for name in names)
+
+
+def groups_of(samples, p: int) -> int:
+    """Number of groups whose discrepancy names ``samples`` (a name -> draws mapping) holds
+    in full for ``p`` known inputs; 0 when it holds none; GPMSAError when it holds some."""
+    present = [k for k in samples if NAME_PATTERN.fullmatch(k)]
+    if not present:
+        return 0
+    n_grp = 1 if "lamVz" in samples else sum(1 for k in samples if re.fullmatch(r"lamVz\[\d+\]", k))
+    if n_grp:
+        bnames, lnames = sample_names(p, n_grp)
+        if sorted(present) == sorted(bnames + lnames):
+            return n_grp
+    raise GPMSAError(
+        f"the posterior's discrepancy draws {sorted(present)} are not those of a discrepancy "
+        f"with {p} known input(s): betaV or betaV[k] and lamVz for one precision group, "
+        "betaV[k,g] and lamVz[g] for several"
+    )
+
+
+def params_at(samples, p: int, n_grp: int, i: int) -> tuple[np.ndarray, np.ndarray]:
+    """Draw ``i`` of ``samples`` as betaV (p, G) and lamVz (G,)."""
+    bnames, lnames = sample_names(p, n_grp)
+    beta = np.array([float(samples[k][i]) for k in bnames]).reshape(n_grp, p).T
+    return beta, np.array([float(samples[k][i]) for k in lnames])
+
+
+def record(obs) -> dict:
+    """What a fit or calibration records of its discrepancy (``obs``: an ObsProblem with a
+    basis): the bases' and groups' digest, and the groups where there are several, so that
+    ``gpmsa.full_prediction`` refuses another basis or grouping and finds the groups."""
+    out = {"discrepancy_sha256": basis_digest(obs.D, obs.v_groups)}
+    if obs.v_groups is not None:
+        out["discrepancy_groups"] = list(obs.v_groups)
+    return out
