@@ -7,12 +7,15 @@ reads; ``Emulator.save`` and ``load`` join the two.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import re
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
@@ -96,15 +99,38 @@ def span_text(values) -> str:
     return f"[{np.min(values):.3g}, {np.max(values):.3g}]"
 
 
+_ARRAYS = ("x_unit", "t_unit", "y", "K", "w", "lam_sim", "index", "log_post")
+"""The Emulator's array attributes, read-only after construction (``Emulator._freeze``)."""
+
+_MAPPINGS = ("params", "draws", "calibration")
+"""Its name -> array attributes, read-only mappings of read-only arrays (None stays None)."""
+
+
+def _read_only_copy(value: np.ndarray | None) -> np.ndarray | None:
+    """A read-only copy of ``value`` (None: None); ``value`` itself stays writable."""
+    if value is None:
+        return None
+    out = np.array(value, copy=True)
+    out.setflags(write=False)
+    return out
+
+
+def _read_only_mapping(value: Mapping[str, np.ndarray] | None) -> Mapping | None:
+    """A read-only mapping of read-only copies of ``value``'s arrays (None: None)."""
+    if value is None:
+        return None
+    return MappingProxyType({k: _read_only_copy(v) for k, v in value.items()})
+
+
 def _param_shapes(p: int, q: int, p_u: int) -> dict[str, tuple[int, ...]]:
     return {"betaU": (p + q, p_u), "lamUz": (p_u,), "lamWs": (p_u,), "lamWOs": (1,)}
 
 
-def _check_params(params: dict, shapes: dict) -> dict[str, np.ndarray]:
+def _check_params(params: Mapping, shapes: dict) -> dict[str, np.ndarray]:
     """``params`` as arrays of ``shapes``; an array of another shape is taken only where it
     differs by axes of length 1 ((1, p_u) for (p_u,), as SEPIA stores them), never reordered
     (a transposed betaU is refused)."""
-    if not isinstance(params, dict):
+    if not isinstance(params, Mapping):
         raise GPMSAError(f"params must be a dict name -> array, got {type(params).__name__}")
     out = {}
     for name, shape in shapes.items():
@@ -133,7 +159,8 @@ class Emulator:
     ESS of every sampled parameter and the elements flagged, see
     ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files), levels
     (per column of [x, t]: a categorical input's training levels, else None), mean_basis (the
-    weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md.
+    weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md. The arrays are
+    read-only copies, params, draws and calibration read-only mappings (``model_sha256`` holds).
     """
 
     def __init__(
@@ -180,6 +207,35 @@ class Emulator:
         self.levels = (None,) * (self.p + self.q) if levels is None else tuple(levels)
         self.mean_basis = mean_basis
         self._factors: dict[int, list] = {}
+        self._freeze()
+
+    def _freeze(self) -> None:
+        """The arrays that define the predictions and ``model_sha256`` as read-only copies (an
+        in-place change raises numpy's ValueError "assignment destination is read-only"; the
+        caller's arrays stay writable), ``params``, ``draws`` and ``calibration`` as read-only
+        mappings of them, the standardizer as one with read-only arrays."""
+        for name in _ARRAYS:
+            setattr(self, name, _read_only_copy(getattr(self, name)))
+        for name in _MAPPINGS:
+            setattr(self, name, _read_only_mapping(getattr(self, name)))
+        std = self.standardizer
+        self.standardizer = dataclasses.replace(
+            std, **{k: _read_only_copy(getattr(std, k)) for k in STD_FIELDS}
+        )
+
+    def __getstate__(self) -> dict:
+        """For pickle and ``copy`` (a worker process gets the emulator): the read-only mappings
+        as dicts, which pickle."""
+        state = dict(self.__dict__)
+        for name in _MAPPINGS:
+            if state[name] is not None:
+                state[name] = dict(state[name])
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickled or copied: read-only again, as constructed."""
+        self.__dict__.update(state)
+        self._freeze()
 
     # --- construction -------------------------------------------------------------------------
     @classmethod
@@ -202,7 +258,7 @@ class Emulator:
         from gpmsa.model.problem import prepare
 
         metadata = check_metadata(metadata)
-        if isinstance(params, dict) and (unknown := sorted(set(params) - set(EMULATOR_PARAMS))):
+        if isinstance(params, Mapping) and (unknown := sorted(set(params) - set(EMULATOR_PARAMS))):
             raise GPMSAError(
                 f"params has unknown keys {unknown}: an emulator's parameters are "
                 f"{list(EMULATOR_PARAMS)}"
@@ -578,7 +634,7 @@ class Emulator:
         by ``gpmsa.load`` has the ``model_sha256`` of the one saved. A calibration records it
         (Posterior info "emulator_sha256") so that predictions refuse another emulator with its
         draws. Computed once, on first use (0.4 ms for the shipped band emulator's 0.3 MB of
-        arrays): an emulator is not changed after construction."""
+        arrays): what it digests is read-only (``_freeze``)."""
         mb = self.mean_basis
         basis = None if mb is None else mb.kind
         if mb is not None and mb.kind not in MEAN_BASIS_KINDS:  # a callable: by its identity
