@@ -35,9 +35,8 @@ def user_stacklevel() -> int:
 
 class ReductionWarning(UserWarning):
     """The observations as reduced may not say what the data say
-    (``gpmsa.model.problem.reduce_obs``): an experiment has fewer independent values than
-    basis vectors, or their precisions declare an error larger than the simulation outputs'
-    spread (a variance passed for a precision?)."""
+    (``gpmsa.model.problem.reduce_obs``): their precisions declare an error larger than the
+    simulation outputs' spread (a variance passed for a precision?)."""
 
 
 class ChainError(GPMSAError):

@@ -74,7 +74,8 @@ class ModelTensors:
     ``u_blocks`` the n-block of each basis component, ``v_blocks`` the n-blocks that receive the
     discrepancy covariance (GPM/SA's order, see ``gpmsa.model.problem.ObsProblem``) and
     ``v_groups`` the precision group of each (a column of betaV, an element of lamVz; empty:
-    all in group 0).
+    all in group 0); ``n_null`` the reduced data's unobserved directions
+    (``ObsProblem.n_null``).
     Packed lower triangle (a factorisation reads only that): ``rows`` the row blocks (a, b)
     (rows a..b-1, columns 0..b-1), ``d_packed`` (p+q, P) d_sim over them, ``packed_index`` (P,)
     their flat positions in an m x m matrix.
@@ -93,6 +94,7 @@ class ModelTensors:
     u_blocks: tuple[int, ...] = ()
     v_blocks: tuple[int, ...] = ()
     v_groups: tuple[int, ...] = ()
+    n_null: int = 0
     rows: tuple[tuple[int, int], ...] = ()
     d_packed: Tensor | None = None
     packed_index: Tensor | None = None
@@ -123,6 +125,7 @@ class ModelTensors:
                 "u_blocks": u_blocks,
                 "v_blocks": tuple(range(len(groups))),
                 "v_groups": groups,
+                "n_null": obs.n_null,
             }
         d_sim = pairwise_sq(zt, zt)
         rows = row_blocks(problem.m)
@@ -349,6 +352,8 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
             full[:, blk * n : (blk + 1) * n, blk * n : (blk + 1) * n] += s_v[:, g]
     chol_z, info = torch.linalg.cholesky_ex(full)
     ll, _ = _gaussian_loglik(chol_z, info, data.z - mean)
+    if data.n_null:  # ObsProblem.null_term
+        ll = ll - 0.5 * data.n_null * torch.log(prm["lamOs"][:, 0])
     return ll
 
 

@@ -272,8 +272,13 @@ class Calibrator:
             G = mean.shape[0]
             out.append(
                 lamos_marginal(
-                    mean.reshape(G, d), _block_diag(cov), data.z, data.obs_chol, data.lamos
-                )
+                    mean.reshape(G, d),
+                    _block_diag(cov),
+                    data.z,
+                    data.obs_chol,
+                    data.lamos,
+                    null=data.obs.n_null,
+                )  # fmt: skip
             )
         return out
 

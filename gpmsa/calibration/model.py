@@ -293,11 +293,12 @@ def _whiten(
 
 
 def _log_integrand(
-    s: np.ndarray, e: np.ndarray, y2: np.ndarray, prior: LamOsPrior, const: float
+    s: np.ndarray, e: np.ndarray, y2: np.ndarray, prior: LamOsPrior, const: float, null: int = 0
 ) -> np.ndarray:
-    """log p(u | theta, lamOs) p(lamOs) lamOs at s = log lamOs; s (S,), e, y2 (G, d) -> (G, S)."""
+    """log p(u | theta, lamOs) p(lamOs) lamOs at s = log lamOs; s (S,), e, y2 (G, d) -> (G, S);
+    ``null``: the reduced data's unobserved directions (``ObsProblem.null_term``)."""
     lam = np.exp(s)
-    tail = prior.shape * s - prior.rate * lam + const
+    tail = (prior.shape - 0.5 * null) * s - prior.rate * lam + const
     if e.shape[1] == 1:
         var = e + 1.0 / lam
         return tail - 0.5 * (np.log(var) + y2 / var)
@@ -313,6 +314,7 @@ def lamos_marginal(
     prior: LamOsPrior,
     cutoff: float = 25.0,
     max_step: float = 0.45,
+    null: int = 0,
 ) -> LamOsMarginal:
     """Integrate lamOs out of N(u; mean_g, cov_g + Sigma_obs / lamOs) against its prior.
 
@@ -330,6 +332,8 @@ def lamos_marginal(
         mean: (G, d) predictive means of u (d = n p_u); cov: (G, d, d) predictive covariances.
         u: (d,) reduced observation data; obs_chol: (d, d) lower Cholesky factor of Sigma_obs.
         prior: the lamOs prior.
+        null: the directions of u that no value observed (``ObsProblem.n_null``): their
+            log(lamOs) / 2 each is taken off the integrand (``ObsProblem.null_term``).
 
     Returns:
         LamOsMarginal with loglik = log p(u | theta_g) (all normalising constants included).
@@ -348,7 +352,7 @@ def lamos_marginal(
     y2_sum = y2.sum(axis=1)
     ends = [G - 1, int(np.argmax(y2_sum)), int(np.argmin(y2_sum)), int(np.argmin(e[:, 0]))]
     probe = np.concatenate([np.arange(0, G, COARSE_STRIDE), ends])
-    phi = _log_integrand(coarse, e[probe], y2[probe], prior, const)
+    phi = _log_integrand(coarse, e[probe], y2[probe], prior, const, null)
     keep = (phi >= phi.max(axis=1, keepdims=True) - cutoff).any(axis=0)
     inside = np.flatnonzero(keep)
     lo = coarse[max(inside[0] - 1, 0)]
@@ -365,9 +369,9 @@ def lamos_marginal(
     n_nodes = int(n_float)
     step = (hi - lo) / (n_nodes - 1)
     s = lo + step * np.arange(n_nodes)
-    if d == 1:
+    if d == 1 and not null:
         return _fine_pass_scalar(s, step, e[:, 0], y2[:, 0], prior, const)
-    phi = _log_integrand(s, e, y2, prior, const)
+    phi = _log_integrand(s, e, y2, prior, const, null)
     phi[:, 0] -= _LOG_2
     phi[:, -1] -= _LOG_2
     peak = phi.max(axis=1)

@@ -246,6 +246,7 @@ class CalibrationSampler:
         self.preds = [ThetaPredictive(gp, data, expand=smooth) for gp in gps]
         self.priors = priors
         self.lamos = data.lamos
+        self.lam_power = data.lamos.shape - 1.0 - 0.5 * data.obs.n_null
         self.extra = log_prior
         lo = data.lamos
         self.init_lamos = max(20.0, lo.shape / lo.rate) if init_lamos is None else init_lamos
@@ -275,10 +276,12 @@ class CalibrationSampler:
         return lp
 
     def _log_prior_lamos(self, lam: float) -> float:
+        """lamOs's log prior, with the reduced data's null term (``ObsProblem.null_term``): the
+        only terms in lamOs beyond ``_loglik``."""
         p = self.lamos
         if not p.lower < lam < p.upper:
             return -math.inf
-        return (p.shape - 1.0) * math.log(lam) - p.rate * lam
+        return self.lam_power * math.log(lam) - p.rate * lam
 
     def run(
         self,

@@ -94,7 +94,7 @@ def log_likelihood(problem: Problem, params: dict[str, np.ndarray]) -> float:
     if L is None:
         return -np.inf
     r = _tri_solve(L, obs.z - mu)
-    return ll - _logdet_half(L) - 0.5 * float(r @ r)
+    return ll - _logdet_half(L) - 0.5 * float(r @ r) + obs.null_term(float(params["lamOs"][0]))
 
 
 def log_posterior(problem: Problem, params: dict[str, np.ndarray]) -> float:
@@ -312,7 +312,7 @@ class IncrementalLikelihood:
         if L is None:
             return -np.inf
         r = _tri_solve(L, self.z - mean)
-        return -_logdet_half(L) - 0.5 * float(r @ r)
+        return -_logdet_half(L) - 0.5 * float(r @ r) + obs.null_term(float(prm["lamOs"][0]))
 
     # --- proposals ----------------------------------------------------------------------------
     def propose(self, name: str, idx: tuple[int, ...], value: float) -> float:

@@ -276,23 +276,9 @@ def test_a_named_y_table_in_obsdata_is_read_by_the_emulator_y_names():
             [f"a{k}" for k in range(8)], axis=1)))  # fmt: skip
 
 
-def test_experiments_with_fewer_values_than_basis_vectors_warn():
-    """An experiment whose values span fewer directions than the basis vectors it is reduced
-    onto (one point, two components) makes GPM/SA's reduction read its unobserved direction as
-    a datum of variance 1e6 / lamOs: a ReductionWarning names it (the posterior is narrower
-    than the values' own likelihood); experiments of full rank do not warn."""
+def test_full_rank_experiments_do_not_warn():
+    """(Experiments with fewer values than basis vectors: tests/gpmsa/test_sparse_obs_s61.py.)"""
     emu = vector_emulator()
-    x = np.array([[0.3], [0.7]])
-    sparse = gpmsa.ObsData(x, [[1.0], [1.2]], index=[[0.5], [0.5]])
-    with (
-        pytest.warns(
-            gpmsa.ReductionWarning, match=r"2 experiment\(s\) .* 0 \(rank 1\), 1 \(rank 1\)"
-        ),
-        warnings.catch_warnings(),
-    ):
-        warnings.simplefilter("ignore", gpmsa.OutsideEmulatorWarning)  # values made up
-        narrow = gpmsa.Calibrator(emu).update(sparse)
-    assert narrow.sd("t") < 0.9 * reference_summaries(emu, sparse)["sd"]
     with warnings.catch_warnings():
         warnings.simplefilter("error", gpmsa.ReductionWarning)
         gpmsa.Calibrator(emu).update(ragged_obs([1e4, 2.5e3]))
@@ -408,12 +394,12 @@ def test_a_reduction_warning_comes_once_and_names_the_callers_line():
     sampler): the warning comes once, from the reduction with the basis, and points at the
     caller's line, not into the library."""
     emu = vector_emulator()
-    sparse = gpmsa.ObsData([[0.3], [0.7]], [[1.0], [1.2]], index=[[0.5], [0.5]])
+    vague = ragged_obs([1e-6, 1e-6])  # a variance given for a precision
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        gpmsa.calibrate(emu, sparse, discrepancy="constant", n_samples=20, n_burn=0, tune=False)
+        gpmsa.calibrate(emu, vague, discrepancy="constant", n_samples=20, n_burn=0, tune=False)
     mine = [w for w in caught if issubclass(w.category, gpmsa.ReductionWarning)]
-    assert len(mine) == 1 and "3 basis vectors" in str(mine[0].message)
+    assert len(mine) == 1 and "declare errors of sd" in str(mine[0].message)
     assert mine[0].filename == __file__
 
 
