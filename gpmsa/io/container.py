@@ -490,7 +490,7 @@ def _check_specs(specs: dict, npy: dict[str, zipfile.ZipInfo], path) -> None:
     for name, spec in specs.items():
         shape = spec.get("shape") if isinstance(spec, dict) else None
         dtype = spec.get("dtype") if isinstance(spec, dict) else None
-        if dtype not in ALLOWED_DTYPES:
+        if not isinstance(dtype, str) or dtype not in ALLOWED_DTYPES:  # a list: unhashable
             allowed = sorted(ALLOWED_DTYPES)
             shown = dtype if isinstance(dtype, str) and len(dtype) < 20 else _short(dtype)
             raise _fail(path, f"array {name!r} has dtype {shown} (allowed {allowed}; "

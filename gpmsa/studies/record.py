@@ -82,6 +82,9 @@ def check_study_manifest(manifest: dict) -> None:
         if not ok or (key != "mu_mean" and not val > 0):
             need = "a finite number" if key == "mu_mean" else "a finite number > 0"
             raise _fail(f"priors.hyper.{key}", f"must be {need}, got {_short(val)}")
+        if key == "sd_max" and not (finite(val * val) and val * val > 0):  # HyperPriors squares it
+            raise _fail(f"priors.hyper.{key}", f"{_short(val)}: its square is not a finite, "
+                                               "non-zero float64")  # fmt: skip
     specs = manifest["arrays"]
     if set(specs) != set(ARRAYS):
         raise _fail("arrays", f"a study holds exactly {list(ARRAYS)}, got {sorted(specs)[:10]}")
