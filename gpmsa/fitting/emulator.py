@@ -126,6 +126,12 @@ def _param_shapes(p: int, q: int, p_u: int) -> dict[str, tuple[int, ...]]:
     return {"betaU": (p + q, p_u), "lamUz": (p_u,), "lamWs": (p_u,), "lamWOs": (1,)}
 
 
+MIN_LAMUZ = 1e-8
+"""Smallest lamUz an emulator takes: at 1e-12 the predictive variance at the runs was 7% off,
+at 1e-16 negative, at 1e-30 -1.5e14 (the prior variance's rounding swamps it); fits keep lamUz
+above its prior's bound, 0.3."""
+
+
 def _check_params(params: Mapping, shapes: dict) -> dict[str, np.ndarray]:
     """``params`` as arrays of ``shapes``; an array of another shape is taken only where it
     differs by axes of length 1 ((1, p_u) for (p_u,), as SEPIA stores them), never reordered
@@ -142,6 +148,12 @@ def _check_params(params: Mapping, shapes: dict) -> dict[str, np.ndarray]:
         val = val.reshape(shape)
         if not np.all(np.isfinite(val)) or np.any(val <= 0):
             raise GPMSAError(f"params[{name!r}] must be finite and > 0, got {val.ravel()}")
+        if name == "lamUz" and np.any(val < MIN_LAMUZ):
+            raise GPMSAError(
+                f"params['lamUz'] = {val.ravel()}: below {MIN_LAMUZ:g} the GP's prior variance "
+                "1 / lamUz (in units of the outputs' variance) is too large for float64 to "
+                "resolve the predictive variance near the runs (GPM/SA bounds lamUz at 0.3)"
+            )
         out[name] = val
     return out
 

@@ -46,18 +46,24 @@ class HyperPriors:
     lam_start: float | None = None
 
     def __post_init__(self) -> None:
-        if self.lam_start is None:
-            ok = isinstance(self.sd_max, (int, float, np.floating, np.integer))
-            sd_max = float(self.sd_max) if ok and self.sd_max > 0 and finite(self.sd_max) else 1.0
-            inside = self.sd_prior != "uniform" or 5.0 * sd_max**2 > 1.0
-            object.__setattr__(self, "lam_start", 5.0 if inside else 4.0 / sd_max**2)
         for name in NUMBERS:
             val = getattr(self, name)
+            if name == "lam_start" and val is None:
+                continue  # its default is set below, from sd_max
             if isinstance(val, bool) or not isinstance(val, (int, float, np.floating, np.integer)):
                 raise GPMSAError(f"HyperPriors.{name} must be a number, got {val!r}")
             if not finite(val) or (name != "mu_mean" and not val > 0):
                 need = "finite" if name == "mu_mean" else "finite and > 0"
                 raise GPMSAError(f"HyperPriors.{name} must be {need}, got {val!r:.60}")
+        with np.errstate(over="ignore", under="ignore"):
+            sd2 = float(np.float64(self.sd_max) ** 2)
+        if not (finite(sd2) and sd2 > 0 and finite(1.0 / sd2)):  # the prior works with sd^2
+            raise GPMSAError(f"HyperPriors.sd_max={self.sd_max!r:.60}: its square must be a "
+                             "finite, non-zero float64 (an sd on the unit scale: 0.01 to 10 "
+                             "is the useful range)")  # fmt: skip
+        if self.lam_start is None:
+            inside = self.sd_prior != "uniform" or 5.0 * sd2 > 1.0
+            object.__setattr__(self, "lam_start", 5.0 if inside else 4.0 / sd2)
         if self.sd_prior not in SD_PRIORS:
             raise GPMSAError(f"HyperPriors.sd_prior must be one of {SD_PRIORS}, got "
                              f"{self.sd_prior!r}")  # fmt: skip
