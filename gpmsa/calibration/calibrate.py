@@ -224,7 +224,8 @@ def calibrate(
     Returns:
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
         native units), "lamOs" (and with a discrepancy "betaV", or "betaV[k]" per known input
-        when p > 1, and "lamVz"), and chains per name;
+        when p > 1, and "lamVz"; with several precision groups "betaV[k,g]" and "lamVz[g]",
+        the groups in ``info["discrepancy_groups"]``), and chains per name;
         ``info["obs_values_sha256"]`` fingerprints the observations
         (``ObsData.values_digest(emulator.x_names, emulator.y_names)``: tables are read by
         name), so that

@@ -110,6 +110,10 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))
+    if s.get("discrepancy") is not None:
+        groups = s.get("discrepancy_groups")
+        lines.append(f"discrepancy:     {plain(s['discrepancy'])}, precision groups "
+                     f"{plain(groups) if isinstance(groups, list) else 'one'}")  # fmt: skip
     options = s.get("backend_options")
     if isinstance(options, dict) and options:
         lines.append("backend options: " + ", ".join(
@@ -124,6 +128,9 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     for k, v in manifest["metadata"].items():
         if k != "versions" or not isinstance(v, dict):
             lines.append(f"metadata {safe(k, 60)}: {value(v)}")
+    shapes = {"betaU": (emulator.p + emulator.q, emulator.p_u)}  # the 2-D parameters
+    if emulator.calibration and "betaV" in emulator.calibration:
+        shapes["betaV"] = emulator.calibration["betaV"].shape[1:]
     for name, d in manifest["diagnostics"].items():
         if isinstance(d, dict) and isinstance(d.get("mean"), list):
             cells = {}
@@ -134,6 +141,8 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
                     if isinstance(vals, list) else value(vals)
                 )  # fmt: skip
             label = safe(name, 60)
+            if name in shapes and min(shapes[name]) > 1:  # summarize flattens in C order
+                label += " ({} x {}, row by row)".format(*shapes[name])
             if name == "theta":  # stored on the unit scale; printed native, as calibrate does
                 native = _native_theta(manifest, d["mean"], standardizer)
                 label, cells["mean"] = native or ("theta (unit scale)", cells["mean"])

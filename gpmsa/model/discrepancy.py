@@ -31,23 +31,32 @@ def check_groups(groups, p_v: int) -> tuple[int, ...] | None:
             "discrepancy_groups needs a discrepancy basis (discrepancy='constant', 'linear' or "
             "an array)"
         )
-    if isinstance(groups, (str, bytes, dict)):
-        raise GPMSAError(f"discrepancy_groups must be a sequence of {p_v} integers, got {groups!r}")
-    arr = np.asarray(groups)
-    if arr.ndim != 1 or arr.size != p_v:
+    count = f"{p_v} integer{'s' if p_v != 1 else ''}"
+    try:  # the elements as given: np.asarray would turn [0, True] into [0, 1]
+        items = groups.tolist() if isinstance(groups, np.ndarray) else list(groups)
+    except TypeError:
+        items = None
+    if isinstance(groups, (str, bytes, dict, set)) or not isinstance(items, list):
+        raise GPMSAError(f"discrepancy_groups must be a sequence of {count}, got {groups!r:.80}")
+    if len(items) != p_v:
         raise GPMSAError(
-            f"discrepancy_groups must give one group per discrepancy basis vector: {p_v} "
-            f"integers, got shape {arr.shape}"
+            f"discrepancy_groups must give one group per discrepancy basis vector: {count}, "
+            f"got {len(items)} entries"
         )
-    if arr.dtype.kind not in "iu":
-        raise GPMSAError(f"discrepancy_groups must be integers, got {arr.tolist()!r}")
-    used = sorted(set(arr.tolist()))
+    if not all(isinstance(g, int | np.integer) and not isinstance(g, bool) for g in items):
+        raise GPMSAError(f"discrepancy_groups must be integers (not bools), got {items!r:.80}")
+    used = sorted({int(g) for g in items})
+    if used[0] < 0:
+        raise GPMSAError(f"discrepancy_groups must be >= 0, got {items}")
     if used != list(range(len(used))):
+        hint = ("GPM/SA's lamVzGroup counts from 1: subtract 1"
+                if used == list(range(1, len(used) + 1))
+                else f"{len(used)} groups numbered up to {used[-1]}")  # fmt: skip
         raise GPMSAError(
             f"discrepancy_groups must number the groups 0 .. G-1, each used at least once; got "
-            f"{arr.tolist()} (GPM/SA's lamVzGroup counts from 1: subtract 1)"
+            f"{items} ({hint})"
         )
-    return None if len(used) == 1 else tuple(int(g) for g in arr)
+    return None if len(used) == 1 else tuple(int(g) for g in items)
 
 
 def n_groups(groups: tuple[int, ...] | None) -> int:

@@ -435,6 +435,13 @@ def full_prediction(
             f"{discrepancy_groups!r} gives {ob.n_groups}: pass the calibration's groups"
         )
     fitted = record.get("discrepancy_sha256")  # the joint fit's or calibrate's basis
+    recorded = record.get("discrepancy_groups")  # absent beside a digest: one group
+    given = None if ob.v_groups is None else list(ob.v_groups)
+    if fitted is not None and recorded != given:
+        raise GPMSAError(
+            f"discrepancy_groups={given} (None: one group) differs from the calibration's "
+            f"{recorded}: pass its groups (the default takes them)"
+        )
     if fitted is not None and basis_digest(ob.D, ob.v_groups) != fitted:
         raise GPMSAError(
             "the discrepancy basis differs from the one the draws were made with, or its "

@@ -18,9 +18,11 @@ def calibration_posterior(emulator) -> Posterior:
     p > 1; with several precision groups ``lamVz[g]`` and ``betaV[k,g]``,
     `gpmsa.model.discrepancy`). ``chains`` splits the retained draws into the fit's chains, so
     ``to_arviz()``, ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``.
-    ``info`` carries the fit's record of its observations ("obs_lengths", "obs_sha256"), so that
-    ``gpmsa.full_prediction(..., posterior=)`` refuses other ones, as it does without it, and
-    the emulator's ``model_sha256`` ("emulator_sha256"), so that it refuses another emulator.
+    ``info`` carries the fit's discrepancy record ("discrepancy", "discrepancy_sha256",
+    "discrepancy_groups" where there are several groups) and its record of its observations
+    ("obs_lengths", "obs_sha256"), so that ``gpmsa.full_prediction(..., posterior=)`` refuses
+    other ones, as it does without it, and the emulator's ``model_sha256`` ("emulator_sha256"),
+    so that it refuses another emulator.
 
     Example:
         >>> import numpy as np, gpmsa

@@ -1,7 +1,9 @@
 """Discrepancy precision groups (GPM/SA's lamVzGroup): the likelihood against a dense formula,
 every backend, the names, records, files and the refusals."""
 
+import contextlib
 import functools
+import io
 import warnings
 
 import numpy as np
@@ -9,6 +11,7 @@ import pytest
 
 import gpmsa
 from gpmsa import GPMSAError
+from gpmsa.cli.main import main
 from gpmsa.model.discrepancy import check_groups, groups_of, sample_names, to_samples
 from gpmsa.model.likelihood import IncrementalLikelihood, log_likelihood
 from gpmsa.model.problem import prepare
@@ -145,6 +148,10 @@ def test_equal_group_parameters_give_the_one_group_likelihood():
 @pytest.mark.parametrize(
     ("groups", "match"),
     [
+        ([0, True, True], "must be integers"),  # np.asarray would read it as [0, 1, 1]
+        ([0, -1, -1], "must be >= 0"),
+        ([0, 2, 2], r"2 groups numbered up to 2"),
+        ([0, 10**30, 1], "numbered up to"),
         ([0, 1], "one group per discrepancy basis vector: 3"),
         ([[0, 1, 1]], "one group per discrepancy basis vector"),
         ([1, 2, 2], "counts from 1: subtract 1"),
@@ -210,7 +217,9 @@ def test_joint_fit_records_groups_saves_and_predicts(tmp_path):
     assert post.names == ("t", "lamOs", "betaV[0,0]", "betaV[0,1]", "lamVz[0]", "lamVz[1]")
     pred = gpmsa.full_prediction(back, obs, [[0.5]], discrepancy=BASIS, seed=0)
     assert pred.delta.shape == (80, 1, 10) and np.all(np.isfinite(pred.y))
-    with pytest.raises(GPMSAError, match="or its precision groups do"):
+    with pytest.raises(
+        GPMSAError, match=r"\[0, 0, 1\] .* differs from the calibration's \[0, 1, 1"
+    ):
         gpmsa.full_prediction(back, obs, [[0.5]], discrepancy=BASIS, discrepancy_groups=[0, 0, 1])
     with pytest.raises(GPMSAError, match="2 discrepancy precision group"):
         gpmsa.full_prediction(back, obs, [[0.5]], discrepancy=BASIS, discrepancy_groups=None)
@@ -280,3 +289,18 @@ def test_calibrated_predict_refuses_noise_with_grouped_discrepancy_draws():
                            n_burn=0, tune=False, seed=0)  # fmt: skip
     with pytest.raises(GPMSAError, match="has discrepancy draws"):
         gpmsa.predictive.calibrated_predict(emu, post, [[0.5]], noise=True)
+
+
+def test_gpmsa_info_shows_the_groups_and_betaU_layout(tmp_path):
+    data, obs = _data()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        emu = gpmsa.fit(data, obs, n_iter=40, tune=False, seed=0, discrepancy=BASIS,
+                        discrepancy_groups=GROUPS)  # fmt: skip
+    path = emu.save(tmp_path / "e.gpmsa")
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        main(["info", str(path)])
+    text = out.getvalue()
+    assert "discrepancy:     given, precision groups [0, 1, 1]" in text
+    assert f"posterior betaU (2 x {emu.p_u}, row by row)" in text
