@@ -165,7 +165,7 @@ def sample(
     full_mass: bool = True,
     jit: bool = True,
     num_threads: int | None = 1,
-    init: str = "auto",
+    init: str | dict = "auto",
     n_jobs: int | None = None,
 ) -> Chains:
     """NUTS draws of every sampled parameter: ``n_chains`` chains (one after another) of
@@ -173,7 +173,8 @@ def sample(
 
     Starts: ``init`` ("auto": GPM/SA's initial values for one chain, dispersed ones for several,
     so that R-hat can see chains that have not forgotten them; chain c starts as the numpy
-    backend's chain c; see ``gpmsa.mcmc.starts``), recorded in ``info["starts"]``.
+    backend's chain c; a dict name -> (n_chains, *shape) gives them; see
+    ``gpmsa.mcmc.starts``), recorded in ``info["starts"]``.
 
     ``tune=False`` skips the adaptation (unit step size and mass matrix, no warm-up); a chain
     that never leaves its starting point (as then on the road case) is a GPMSAError, not a
@@ -208,9 +209,8 @@ def sample(
         )
     warmup = _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass,
                               jit)  # fmt: skip
-    how = starts.check_init(init, int(n_chains))
     seqs = np.random.SeedSequence(seed).spawn(int(n_chains))
-    firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seqs]
+    how, firsts = starts.chain_starts(problem, init, seqs)
     model = PyroModel(problem)
     runs = []
     for seq, first in zip(seqs, firsts, strict=True):

@@ -661,7 +661,7 @@ def sample(
     device="cpu",
     dtype="float64",
     num_threads: int | None = 1,
-    init: str = "auto",
+    init: str | dict = "auto",
     warmup: int | None = None,
     tune_stages: int = TUNE_STAGES,
     ridge_moves: int | None = None,
@@ -672,7 +672,8 @@ def sample(
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
     Starts: ``init`` ("auto": GPM/SA's initial values for one chain, dispersed ones for several,
-    chain c as the numpy backend's chain c; see ``gpmsa.mcmc.starts``). Warm-up and tuning
+    chain c as the numpy backend's chain c; a dict name -> (n_chains, *shape) gives them; see
+    ``gpmsa.mcmc.starts``). Warm-up and tuning
     (``tune=True``): ``tune_stages`` (3) stages of ``warmup`` (100) sweeps followed by GPM/SA's
     tuning: ``tune_levels`` candidate widths per element, each level swept ``tune_rounds`` times
     by every chain, the acceptance counts pooled over the chains (the default ``tune_rounds`` =
@@ -764,7 +765,6 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
             where) -> Chains:  # fmt: skip
     """``sample`` without the thread setting."""
     dev, dt = _device(device), _dtype(dtype)
-    how = starts.check_init(init, n_chains)
     warmup = (WARMUP if tune else 0) if warmup is None else check_count(warmup, "warmup", 0)
     tune_stages = check_count(tune_stages, "tune_stages")
     if tune_rounds is None:
@@ -773,7 +773,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     widths = check_step_widths(step_widths, problem)
     gen = _seed_generator(seed, dev)
     seeds = np.random.SeedSequence(seed).spawn(n_chains)  # chain c starts as the numpy chain c
-    firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seeds]
+    how, firsts = starts.chain_starts(problem, init, seeds)
     start = {k: np.stack([f[k] for f in firsts]) for k in problem.init}
     state = BatchState(problem, int(n_chains), dt, dev, start, n_ridge)
     els = state.els

@@ -98,7 +98,8 @@ def fit(
     data: the simulation runs. obs: field data for GPM/SA's classic joint calibration (theta and
     lamOs are sampled together with the emulator; the draws land in ``Emulator.calibration``).
     n_iter: sweeps per chain after step-size tuning (``tune``: 50 rounds x 20 levels).
-    n_burn: sweeps discarded per chain (default n_iter // 5). n_keep: retained draws in all
+    n_burn: sweeps discarded per chain (default n_iter // 5; 0 when ``init`` is an emulator whose
+    chains continue). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
     posterior) for ``Emulator.params``. n_pc: basis size (default: 99.5% of the variance).
     discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. discrepancy_groups: the
@@ -108,7 +109,10 @@ def fit(
     more than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws
     are the same wherever they run. seed: an integer, a numpy Generator or None (fresh
     entropy); the integer the fit ran with is ``settings["seed"]``, and ``fit(..., seed=that)``
-    repeats it. options: passed to the backend's ``sample`` (e.g. ``init``).
+    repeats it. options: passed to the backend's ``sample`` (e.g. ``init``: a rule of
+    ``gpmsa.mcmc.starts``, or an Emulator of this fit, whose chains then continue from their
+    last kept draws: ``fit(data, n_iter=..., n_chains=emu's, init=emu)``, see
+    ``continued_starts``).
 
     Beyond GPM/SA's model (numpy backend; docs/categorical-and-constraints.md): categorical
     inputs are declared in ``SimData`` (a categorical theta of a joint fit is sampled over its
@@ -126,7 +130,9 @@ def fit(
     non-finite draws raises ``gpmsa.ChainError`` naming it.
     """
     n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
-    n_burn = n_iter // 5 if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
+    continuing = isinstance(options.get("init"), Emulator)  # its chains start past burn-in
+    default_burn = 0 if continuing else n_iter // 5
+    n_burn = default_burn if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     check_point(point)
     n_keep = check_keep(n_keep, n_chains)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
@@ -154,6 +160,9 @@ def fit(
         ) if on]  # fmt: skip
         n_jobs, executor = in_this_process(callables, n_jobs, executor, int(n_chains))
     options.update(backends.placement(backend, n_jobs, executor))
+    resumed = options.get("init")
+    if continuing:
+        options["init"] = continued_starts(resumed, problem, prep.K, obs, int(n_chains))
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,
@@ -188,6 +197,7 @@ def fit(
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
         else "given",
         "init": chains.info.get("init", "gpmsa"),
+        **({"continued_from": resumed.model_sha256} if continuing else {}),
         # n_jobs and executor say where the chains ran, not what they were: not recorded
         "backend_options": backends.recorded_options(
             {k: v for k, v in options.items() if k not in ("n_jobs", "executor")}
@@ -206,7 +216,11 @@ def fit(
     if n_chains > 1:
         shapes = {k: problem.init[k].shape for k in problem.sampled}
         record = convergence(summary, shapes, n_chains, kept)
-        warn_unconverged(record, f"gpmsa.fit (backend {backend!r})")
+        warn_unconverged(
+            record,
+            f"gpmsa.fit (backend {backend!r})",
+            more=", or continue these: gpmsa.fit(..., init=the returned emulator)",
+        )
     return Emulator._from_prepared(
         data, prep, params,
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,
@@ -287,3 +301,46 @@ def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Proble
             _check_levels(problem, fixed["theta"], data.t_names, "fixed theta")
         problem = problem.with_fixed(fixed)
     return problem
+
+
+def continued_starts(
+    emulator: Emulator, problem: Problem, K: np.ndarray, obs: ObsData | None, n_chains: int
+) -> dict[str, np.ndarray]:
+    """Each chain's start at its last kept draw in ``emulator`` (a fit of the same data, and
+    observations for a joint fit, with ``n_chains`` chains): name -> (n_chains, *shape), for a
+    backend's ``init``. Its chains continue where they stopped being recorded (a draw of each
+    chain, not a fresh dispersed start): a fit that warned of R-hat or ESS runs on without
+    starting over. GPMSAError naming what differs."""
+    if not emulator.draws or not emulator.log_post.size:
+        raise GPMSAError("init=emulator continues a fit's chains; this emulator has no draws "
+                         "(Emulator.from_params?)")  # fmt: skip
+    settings = emulator.settings or {}
+    n_prev = int(settings.get("n_chains", 1) or 1)
+    if n_prev != n_chains:
+        raise GPMSAError(f"init=emulator continues its {n_prev} chain(s): pass n_chains={n_prev}")
+    same = (emulator.x_unit.shape == problem.x_sim.shape and emulator.K.shape == K.shape
+            and np.array_equal(emulator.x_unit, problem.x_sim)
+            and np.array_equal(emulator.t_unit, problem.t_sim)
+            and np.allclose(emulator.w, problem.w, rtol=0.0, atol=1e-12))  # fmt: skip
+    if not same:
+        raise GPMSAError("init=emulator was fitted to other simulation runs (or another n_pc)")
+    cal = emulator.calibration or {}
+    if (obs is None) != (not cal):
+        raise GPMSAError(
+            "init=emulator is a joint fit: pass its observations (obs=)" if cal else
+            "init=emulator is a simulator-only fit; a joint fit (obs=) starts its own chains"
+        )  # fmt: skip
+    if obs is not None and settings.get("obs_sha256") not in (None, obs.digest()):
+        raise GPMSAError("init=emulator was fitted jointly with other observations")
+    per = emulator.log_post.size // n_chains
+    last = np.arange(1, n_chains + 1) * per - 1  # kept draws are stored chain after chain
+    out = {}
+    for name, init in problem.init.items():
+        source = emulator.draws if name in EMULATOR_PARAMS else cal
+        if name not in source or np.shape(source[name])[1:] != init.shape:
+            raise GPMSAError(
+                f"init=emulator has no {name} of shape {init.shape} (another discrepancy basis, "
+                "groups or model?)"
+            )
+        out[name] = np.array(source[name][last], dtype=np.float64)
+    return out

@@ -160,9 +160,12 @@ def convergence(
     }
 
 
-def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str = "n_iter") -> None:
+def warn_unconverged(
+    record: dict, what: str, stacklevel: int = 3, length: str = "n_iter", more: str = ""
+) -> None:
     """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record
-    and the caller's argument ``length`` that sets the chains' length."""
+    and the caller's argument ``length`` that sets the chains' length (``more``: a further
+    remedy, appended)."""
     from gpmsa.errors import ConvergenceWarning
 
     flagged = record.get("flagged") or {}
@@ -172,6 +175,6 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str =
     warnings.warn(
         f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "
         f"chains x {record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
-        f"{record['ess_min']:.0f}): {items}. Run longer chains ({length}) or more of them.",
+        f"{record['ess_min']:.0f}): {items}. Run longer chains ({length}) or more of them{more}.",
         ConvergenceWarning, stacklevel=stacklevel,
     )  # fmt: skip

@@ -449,7 +449,7 @@ def sample(
     progress: bool = False,
     tune_rounds: int = tuning.N_BURN,
     tune_levels: int = tuning.N_LEVELS,
-    init: str = "auto",
+    init: str | dict = "auto",
     n_jobs: int | None = None,
     executor=None,
     ridge_moves: int | None = None,
@@ -465,21 +465,21 @@ def sample(
     ``n_jobs`` workers (None or -1: every CPU, never more than the chains) or any
     ``concurrent.futures.Executor`` / dask ``Client`` given as ``executor``. ``init``: the
     chains' starts (``gpmsa.mcmc.starts``: "auto" is GPM/SA's initial values for one chain,
-    dispersed ones for several). ``ridge_moves``: moves along the lamWs/lamWOs nugget ridge per
-    sweep (``gpmsa.mcmc.ridge``; None: ``ridge.N_MOVES`` where the move applies, a simulation-only
-    problem with one basis component; 0: GPM/SA's sweep alone). Raises ChainError naming a
+    dispersed ones for several; a dict name -> (n_chains, *shape) gives them).
+    ``ridge_moves``: moves along the lamWs/lamWOs nugget ridge per sweep (``gpmsa.mcmc.ridge``;
+    None: ``ridge.N_MOVES`` where the move applies, a simulation-only problem with one basis
+    component; 0: GPM/SA's sweep alone). Raises ChainError naming a
     chain that failed or whose draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     check_draws_memory(problem, int(n_iter), int(n_chains))
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
-    how = starts.check_init(init, int(n_chains))
     seq = np.random.SeedSequence(seed)
     seeds = seq.spawn(int(n_chains))
     # every chain's start drawn here, not in a worker: a start outside a prior's support (or a
     # jitter range out of reach of its bounds) is a plain GPMSAError before any chain runs
-    firsts = [starts.draw_start(problem, how, starts.start_generator(s)) for s in seeds]
+    how, firsts = starts.chain_starts(problem, init, seeds)
     n_ridge = check_ridge(ridge_moves, problem)
     widths = check_step_widths(step_widths, problem)
     tasks = [

@@ -13,6 +13,11 @@ values, as GPM/SA does.
 - ``"prior"``: from the (data-corrected) prior: theta from the truncated normal, rho from
   Beta(rho_a, rho_b) capped at rho_cap, precisions from their truncated Gammas.
 
+- given: a dict name -> (n_chains, *shape) of each chain's start, on the model's scales (as
+  ``Chains.info["starts"]`` records them; ``gpmsa.fit(..., init=emulator)`` builds it from a
+  fit's last kept draws, to continue its chains). Parameters left out start at
+  ``problem.init``.
+
 Fixed parameters keep ``problem.init``. With a theta constraint (``problem.constraint``),
 dispersed and prior starts of theta are redrawn until the constraint holds (``MAX_REDRAWS``).
 Each chain draws its start from its own generator
@@ -43,6 +48,38 @@ def check_init(init, n_chains: int) -> str:
     if init == "auto":
         return "gpmsa" if n_chains == 1 else "jitter"
     return init
+
+
+def chain_starts(
+    problem: Problem, init, seeds: list[np.random.SeedSequence]
+) -> tuple[str, list[dict[str, np.ndarray]]]:
+    """The init rule's name ("given" for a dict) and each chain's start (one per seed);
+    GPMSAError for an unknown rule, a start of the wrong names or shapes, or one where a prior
+    (or the theta constraint) has no mass."""
+    if not isinstance(init, dict):
+        how = check_init(init, len(seeds))
+        return how, [draw_start(problem, how, start_generator(s)) for s in seeds]
+    unknown = sorted(set(init) - set(problem.init))
+    if unknown:
+        raise GPMSAError(f"init: unknown parameter(s) {unknown}; this model has {problem.names}")
+    firsts = []
+    for c in range(len(seeds)):
+        start = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+        for name in set(init) - problem.fixed:
+            want = (len(seeds), *problem.init[name].shape)
+            val = np.asarray(init[name], dtype=np.float64)
+            if val.shape != want:
+                raise GPMSAError(
+                    f"init[{name!r}] must have shape {want} (chains, *shape), got {val.shape}"
+                )
+            start[name] = val[c].copy()
+        if not all(np.all(np.isfinite(v)) for v in start.values()):
+            raise GPMSAError(f"init: chain {c}'s start is not finite")
+        check_start(problem, start, "given")
+        if problem.constraint is not None and "theta" in start:
+            problem.constraint.check_start(start["theta"], f"init: chain {c}'s theta")
+        firsts.append(start)
+    return "given", firsts
 
 
 def start_generator(seed: np.random.SeedSequence) -> np.random.Generator:
