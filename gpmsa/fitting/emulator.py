@@ -54,7 +54,7 @@ from gpmsa.model.data import (
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
-from gpmsa.model.priors import Priors
+from gpmsa.model.priors import GammaPrior, Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
 __all__ = [
@@ -553,6 +553,31 @@ class Emulator:
             for k, v in self.calibration.items():
                 draws[k] = v[: per * n_ch].reshape(n_ch, per, *v.shape[1:])
         return to_inference_data(draws, self.log_post[: per * n_ch].reshape(n_ch, per))
+
+    def with_calibration_priors(
+        self, *, theta_mean=None, theta_sd=None, lamOs=None, lamVz=None
+    ) -> Emulator:
+        """A copy of this emulator whose calibrations use other priors: theta's truncated normal
+        (``theta_mean``, ``theta_sd``, unit scale), the observation precision ``lamOs`` and the
+        discrepancy precision ``lamVz`` (``gpmsa.GammaPrior``s, before any data correction);
+        None keeps the emulator's. ``gpmsa.calibrate``, ``gpmsa.Calibrator`` and the predictions
+        then use them; the emulator's own parameters, draws and their priors are unchanged.
+        The priors are part of ``model_sha256`` (a posterior of the copy refuses the original)
+        and of the saved file. E.g. a known sensor noise sd s (native units) on a scalar
+        output: ``lamOs=GammaPrior(a, a * (s / y_sd) ** 2)`` centres lamOs on (y_sd / s)^2 with
+        relative sd 1/sqrt(a)."""
+        given = {"theta_mean": theta_mean, "theta_sd": theta_sd, "lamOs": lamOs, "lamVz": lamVz}
+        given = {k: v for k, v in given.items() if v is not None}
+        for name in ("lamOs", "lamVz"):
+            if name in given and not isinstance(given[name], GammaPrior):
+                raise GPMSAError(f"{name} must be a gpmsa.GammaPrior, got {given[name]!r:.80}")
+        priors = dataclasses.replace(self.priors, **given)  # checked by Priors' own rules
+        state = self.__getstate__()
+        state["priors"] = priors
+        state.pop("model_sha256", None)  # the cached digest of the original
+        out = object.__new__(Emulator)
+        out.__setstate__(state)
+        return out
 
     def theta_summary(self) -> dict[str, dict[str, float]]:
         """Posterior of the calibration parameters (native units) from a joint sim+obs fit."""
