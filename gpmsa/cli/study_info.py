@@ -28,6 +28,11 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
         lines.append(f"model {safe(mod['label'], 60)}: file {safe(mod['file'], 160)} sha256 "
                      f"{safe(mod['sha256'], 64)} (verified); m={emu.m}, p={emu.p}, "
                      f"l_sim={emu.l_sim}; parameters {params}")  # fmt: skip
+        disc = (emu.settings or {}).get("discrepancy")
+        if disc is not None:  # a fitted model's discrepancy and its precision groups
+            groups = emu.settings.get("discrepancy_groups")
+            lines.append(f"  discrepancy {plain(disc)}, precision groups "
+                         f"{plain(groups) if isinstance(groups, list) else 'one'}")  # fmt: skip
     if st["hierarchical"]:
         hp = manifest["priors"]["hyper"]
         if hp.get("sd_prior", "gamma") == "uniform":

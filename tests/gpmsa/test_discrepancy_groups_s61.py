@@ -304,3 +304,16 @@ def test_gpmsa_info_shows_the_groups_and_betaU_layout(tmp_path):
     text = out.getvalue()
     assert "discrepancy:     given, precision groups [0, 1, 1]" in text
     assert f"posterior betaU (2 x {emu.p_u}, row by row)" in text
+
+
+def test_gpmsa_info_of_a_study_shows_each_models_groups(tmp_path):
+    data, obs = _data()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        study = gpmsa.fit_study([data, data], [obs, obs], shared=["t"], n_iter=40, tune=False,
+                                seed=0, discrepancy=BASIS, discrepancy_groups=GROUPS)  # fmt: skip
+    path = study.save(tmp_path / "st")
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        main(["info", str(path)])
+    assert out.getvalue().count("discrepancy given, precision groups [0, 1, 1]") == 2
