@@ -303,8 +303,9 @@ class Calibrator:
         Returns (theta_grid, loglik): theta_grid native units, (G,) for one calibration parameter
         or (G, 2) for two (``Calibrator.theta_grid``); loglik (G,) = log p(u_obs | theta) with
         all normalising constants (the density of the reduced observation data u, standardised
-        units), lamOs integrated against its prior (each window has its own lamOs). Successive
-        independent windows multiply: add their logliks. x_obs, y_obs (or one ObsData) as
+        units), lamOs integrated against its prior (each window has its own lamOs); with
+        unobserved directions (``ObsProblem.n_null``) a likelihood of theta, not a density.
+        Successive independent windows multiply: add their logliks. x_obs, y_obs (or one ObsData) as
         ``update``'s. Raises GPMSAError for invalid input.
         """
         self._check_grid_method()

@@ -23,7 +23,7 @@ from gpmsa.model.data import (
     evenly_spaced,
     values_digest,
 )
-from gpmsa.model.problem import MAX_STD_OBS, SIGOBS_RIDGE, ObsProblem, reduce_obs
+from gpmsa.model.problem import GLS_RIDGE, MAX_STD_OBS, SIGOBS_RIDGE, ObsProblem, reduce_obs
 
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -393,10 +393,20 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
     mean (G, p_u, n), cov (G, p_u, n, n) (``FixedGP.predict`` / ``GridPredictor.predict``)."""
     G, p_u, n = mean.shape
     m = mean.reshape(G, p_u * n)
-    var = np.maximum(np.diagonal(cov, axis1=2, axis2=3).reshape(G, p_u * n), 1e-300)
+    var = np.diagonal(cov, axis1=2, axis2=3).reshape(G, p_u * n)
     resid = data.z[None, :] - m
+    noise = _residual_noise(data)
+    P = _observed_projector(data.obs)
+    if P is not None:  # the unobserved directions' stand-in 0 is no miss
+        full = np.zeros((G, p_u * n, p_u * n))
+        for c in range(p_u):
+            full[:, c * n : (c + 1) * n, c * n : (c + 1) * n] = cov[:, c]
+        resid = resid @ P
+        var = np.einsum("ij,gjk,ik->gi", P, full, P)
+        noise = np.diag(P @ np.diag(np.broadcast_to(noise, p_u * n)) @ P)
+    var = np.maximum(var, 1e-300)
     with np.errstate(over="ignore"):
-        sds = np.max(np.abs(resid) / np.sqrt(var + _residual_noise(data)), axis=1)
+        sds = np.max(np.abs(resid) / np.sqrt(var + noise), axis=1)
     L = data.obs_chol
     d = data.z.size
     if d == 1:
@@ -411,8 +421,25 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
         for c in range(p_u):  # tr(L^-1 S L^-T), S block-diagonal over components
             blk = Linv[:, c * n : (c + 1) * n]
             tr += np.einsum("ai,gij,aj->g", blk, cov[:, c], blk)
-    excess = np.maximum(0.0, (y2 - tr) / d)
+    excess = np.maximum(0.0, (y2 - tr) / max(d - data.obs.n_null, 1))  # observed directions
     return Fit(float(np.min(sds)), float(np.min(excess)))
+
+
+def _observed_projector(obs: ObsProblem) -> np.ndarray | None:
+    """The projector (d, d) onto the reduced data's observed directions, None where every
+    direction is observed: per experiment, its Sigma_obs block's eigenvectors of variance
+    above half the reduction's 1 / GLS_RIDGE are the unobserved ones (``ObsProblem.n_null``)."""
+    if not obs.n_null or obs.scalar_out:
+        return None
+    d = obs.z.size
+    n = obs.n
+    P = np.eye(d)
+    for e in range(n):
+        idx = np.arange(d // n) * n + e
+        w, V = np.linalg.eigh(obs.sig_obs[np.ix_(idx, idx)])
+        N = V[:, w > 0.5 / GLS_RIDGE]
+        P[np.ix_(idx, idx)] -= N @ N.T
+    return P
 
 
 def _residual_noise(data: Observations) -> np.ndarray | float:

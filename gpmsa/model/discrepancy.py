@@ -44,7 +44,9 @@ def check_groups(groups, p_v: int) -> tuple[int, ...] | None:
             f"got {len(items)} entries"
         )
     if not all(isinstance(g, int | np.integer) and not isinstance(g, bool) for g in items):
-        raise GPMSAError(f"discrepancy_groups must be integers (not bools), got {items!r:.80}")
+        raise GPMSAError(
+            f"discrepancy_groups must be integers (not floats or bools), got {items!r:.80}"
+        )
     used = sorted({int(g) for g in items})
     if used[0] < 0:
         raise GPMSAError(f"discrepancy_groups must be >= 0, got {items}")

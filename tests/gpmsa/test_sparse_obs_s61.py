@@ -123,3 +123,29 @@ def test_fast_sampler_agrees_with_the_values_own_posterior():
     assert post.info["engine"] == "fast"
     assert post.mean("t") == pytest.approx(ref["mean"], abs=0.1 * ref["sd"])
     assert post.sd("t") == pytest.approx(ref["sd"], rel=0.1)
+
+
+def _own_mean_obs(scale: float = 1.0) -> gpmsa.ObsData:
+    """One point per experiment at the emulator's own predictive mean at t = 0.5 (times
+    ``scale``)."""
+    emu = vector_emulator()
+    x = np.array([[0.3], [0.7], [0.5]])
+    mean, _ = emu.predict(x, np.full((3, 1), 0.5))
+    index = [[0.1], [0.9], [0.3]]
+    y = [scale * np.interp(index[i], emu.index, mean[i]) for i in range(3)]
+    return gpmsa.ObsData(x, y=y, index=index)
+
+
+def test_sparse_data_from_the_emulator_are_not_outside_it_and_wrong_units_are():
+    """The outside check read the reduction's stand-in 0 of each unobserved direction as a miss
+    (51.8 sds for the emulator's own mean); it now looks at the observed directions only."""
+    emu = vector_emulator()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", gpmsa.OutsideEmulatorWarning)
+        post = gpmsa.Calibrator(emu).update(_own_mean_obs())
+        gpmsa.calibrate(emu, _own_mean_obs(), n_samples=200, n_burn=50, seed=0)
+        gpmsa.calibrate(emu, _own_mean_obs(), discrepancy="constant", n_samples=50, n_burn=10,
+                        tune=False, seed=0)  # fmt: skip
+    assert post.mean("t") == pytest.approx(0.5, abs=0.05)
+    with pytest.warns(gpmsa.OutsideEmulatorWarning, match="predictive sds"):
+        gpmsa.Calibrator(emu).update(_own_mean_obs(10.0))
