@@ -43,6 +43,15 @@ def _emulator():
         return gpmsa.fit(data, n_iter=600, seed=0)
 
 
+def _grouped_fit(n_iter: int):
+    """A joint fit of the toy with BASIS in GROUPS."""
+    data, obs = _data()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return gpmsa.fit(data, obs, n_iter=n_iter, tune=False, seed=0, discrepancy=BASIS,
+                         discrepancy_groups=GROUPS)  # fmt: skip
+
+
 def _kernel(a, b, beta):
     return np.exp(-np.sum(beta * (a[:, None, :] - b[None, :, :]) ** 2, axis=-1))
 
@@ -205,10 +214,7 @@ def test_group_names_are_reserved(name):
 
 def test_joint_fit_records_groups_saves_and_predicts(tmp_path):
     data, obs = _data()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        emu = gpmsa.fit(data, obs, n_iter=100, tune=False, seed=0, discrepancy=BASIS,
-                        discrepancy_groups=GROUPS)  # fmt: skip
+    emu = _grouped_fit(100)
     assert emu.calibration["betaV"].shape[1:] == (1, 2)
     assert emu.settings["discrepancy_groups"] == GROUPS
     emu.save(tmp_path / "e.gpmsa")
@@ -292,11 +298,7 @@ def test_calibrated_predict_refuses_noise_with_grouped_discrepancy_draws():
 
 
 def test_gpmsa_info_shows_the_groups_and_betaU_layout(tmp_path):
-    data, obs = _data()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        emu = gpmsa.fit(data, obs, n_iter=40, tune=False, seed=0, discrepancy=BASIS,
-                        discrepancy_groups=GROUPS)  # fmt: skip
+    emu = _grouped_fit(40)
     path = emu.save(tmp_path / "e.gpmsa")
     out = io.StringIO()
     with contextlib.redirect_stdout(out):

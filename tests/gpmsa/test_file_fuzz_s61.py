@@ -13,6 +13,7 @@ import gpmsa
 from gpmsa.io import container
 from gpmsa.io.container import ENVELOPE, STUDY_FORMAT, read_raw, write_raw
 from tests.gpmsa._study_cases import emulator, observations
+from tests.gpmsa.test_file_hostile import read_members
 
 
 @pytest.fixture(scope="module")
@@ -22,14 +23,6 @@ def saved(tmp_path_factory):
     sim = gpmsa.SimData(x=x, t=t, y=0.02 * t * x**1.6, x_names=["v"], t_names=["GD"])
     emu = gpmsa.fit(sim, n_iter=50, seed=1, tune=False)
     return emu.save(tmp_path_factory.mktemp("fuzz") / "e.gpmsa")
-
-
-def _members(path):
-    with zipfile.ZipFile(path) as zf:
-        members = {n: zf.read(n) for n in zf.namelist()}
-    manifest = json.loads(members.pop("manifest.json"))
-    arrays = {n[7:-4]: np.load(io.BytesIO(b), allow_pickle=False) for n, b in members.items()}
-    return manifest, arrays
 
 
 def _write(path, manifest, arrays):
@@ -48,7 +41,7 @@ def _write(path, manifest, arrays):
 def test_an_array_dtype_that_is_not_a_string_is_refused(saved, tmp_path, dtype):
     """A JSON list or object as an array's declared dtype (numpy's structured-dtype spelling)
     was looked up in a set: TypeError (unhashable type) escaped ``gpmsa.load``."""
-    manifest, arrays = _members(saved)
+    manifest, arrays = read_members(saved)
     manifest["arrays"]["x_unit"]["dtype"] = dtype
     path = _write(tmp_path / "e.gpmsa", manifest, arrays)
     with pytest.raises(gpmsa.EmulatorFileError, match="array 'x_unit' has dtype"):

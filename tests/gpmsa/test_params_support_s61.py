@@ -37,10 +37,11 @@ def test_out_of_prior_values_that_compute_well_are_still_taken():
 
 def test_a_file_with_such_a_lamUz_is_refused(tmp_path):
     """A file rewritten by hand (hash recomputed): EmulatorFileError, not negative variances."""
-    from test_file_fuzz_s61 import _members, _write
+    from test_file_fuzz_s61 import _write
+    from test_file_hostile import read_members
 
     emu = gpmsa.Emulator.from_params(_sim(), _params())
-    manifest, arrays = _members(emu.save(tmp_path / "e.gpmsa"))
+    manifest, arrays = read_members(emu.save(tmp_path / "e.gpmsa"))
     arrays["param_lamUz"] = np.array([1e-30])
     with pytest.raises(gpmsa.EmulatorFileError, match=r"params\['lamUz'\]"):
         gpmsa.load(_write(tmp_path / "bad.gpmsa", manifest, arrays))
