@@ -563,9 +563,11 @@ class Emulator:
         None keeps the emulator's. ``gpmsa.calibrate``, ``gpmsa.Calibrator`` and the predictions
         then use them; the emulator's own parameters, draws and their priors are unchanged.
         The priors are part of ``model_sha256`` (a posterior of the copy refuses the original)
-        and of the saved file. E.g. a known sensor noise sd s (native units) on a scalar
-        output: ``lamOs=GammaPrior(a, a * (s / y_sd) ** 2)`` centres lamOs on (y_sd / s)^2 with
-        relative sd 1/sqrt(a)."""
+        and of the saved file. A joint fit's calibration draws, made under the old priors, are
+        not copied (calibrate the copy; ``full_prediction`` then takes ``posterior=``). E.g. a
+        known sensor noise sd s (native units) on a scalar output:
+        ``lamOs=GammaPrior(a, a * (s / y_sd) ** 2)`` centres lamOs on (y_sd / s)^2 with relative
+        sd 1/sqrt(a)."""
         given = {"theta_mean": theta_mean, "theta_sd": theta_sd, "lamOs": lamOs, "lamVz": lamVz}
         given = {k: v for k, v in given.items() if v is not None}
         for name in ("lamOs", "lamVz"):
@@ -574,6 +576,8 @@ class Emulator:
         priors = dataclasses.replace(self.priors, **given)  # checked by Priors' own rules
         state = self.__getstate__()
         state["priors"] = priors
+        if given and state["calibration"] is not None:  # a joint fit's draws, made under the old
+            state["calibration"] = None
         state.pop("model_sha256", None)  # the cached digest of the original
         out = object.__new__(Emulator)
         out.__setstate__(state)

@@ -332,6 +332,12 @@ def continued_starts(
         )  # fmt: skip
     if obs is not None and settings.get("obs_sha256") not in (None, obs.digest()):
         raise GPMSAError("init=emulator was fitted jointly with other observations")
+    differs = _model_differences(emulator, problem)
+    if differs:
+        raise GPMSAError(
+            f"init=emulator was another model: its {', '.join(differs)} differ from this fit's; "
+            "continue it with the same settings, or start afresh"
+        )
     per = emulator.log_post.size // n_chains
     last = np.arange(1, n_chains + 1) * per - 1  # kept draws are stored chain after chain
     out = {}
@@ -344,3 +350,22 @@ def continued_starts(
             )
         out[name] = np.array(source[name][last], dtype=np.float64)
     return out
+
+
+def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
+    """What of the model ``emulator`` was fitted with differs from ``problem``'s: its priors,
+    mean basis, fixed parameters, theta constraint and discrepancy basis and groups."""
+    settings = emulator.settings or {}
+    mb = problem.mean_basis
+    disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
+    checks = {
+        "priors": (emulator.priors.to_dict(), problem.priors.to_dict()),
+        "mean_basis": (settings.get("mean_basis"), None if mb is None else mb.kind),
+        "fixed parameters": (settings.get("fixed", {}),
+                             {k: problem.init[k].tolist() for k in sorted(problem.fixed)}),
+        "theta constraint": (bool(settings.get("constraint", False)),
+                             problem.constraint is not None),
+        "discrepancy": ({k: settings.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")},
+                        {k: disc.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")}),
+    }  # fmt: skip
+    return [name for name, (old, new) in checks.items() if old != new]

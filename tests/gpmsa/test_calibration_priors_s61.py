@@ -72,3 +72,19 @@ def test_bad_priors_are_refused(kw, match):
     emu, _, _ = _case()
     with pytest.raises(gpmsa.GPMSAError, match=match):
         emu.with_calibration_priors(**kw)
+
+
+def test_a_joint_fits_copy_drops_the_draws_made_under_the_old_priors():
+    """It predicted from the old theta draws without posterior= (walkthrough)."""
+    rng = np.random.default_rng(4)
+    x, t = rng.random((20, 1)), rng.random((20, 1))
+    data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t, x_names=["x"], t_names=["t"])
+    obs = gpmsa.ObsData(x=[[0.2], [0.7]], y=[[np.sin(0.6) + 0.6], [np.sin(2.1) + 0.6]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        joint = gpmsa.fit(data, obs, n_iter=60, seed=0, tune=False)
+    copy = joint.with_calibration_priors(theta_mean=0.2, theta_sd=0.01)
+    assert joint.calibration and not copy.calibration
+    with pytest.raises(gpmsa.GPMSAError, match="calibration draws"):
+        gpmsa.full_prediction(copy, obs, [[0.5]])
+    assert joint.with_calibration_priors().calibration  # nothing changed: kept

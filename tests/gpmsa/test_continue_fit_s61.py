@@ -106,3 +106,21 @@ def test_the_convergence_warning_points_at_continuing():
     data, _ = _data()
     with pytest.warns(gpmsa.ConvergenceWarning, match=r"init=the returned emulator"):
         gpmsa.fit(data, n_iter=30, seed=0, n_chains=2, tune=False)
+
+
+@pytest.mark.parametrize(
+    ("first", "then", "what"),
+    [
+        ({"mean_basis": "linear"}, {}, "mean_basis"),
+        ({"fixed": {"lamWOs": 5e4}}, {}, "fixed parameters"),
+        ({}, {"priors": gpmsa.Priors(lamUz=gpmsa.GammaPrior(5.0, 4.0, 0.3))}, "priors"),
+    ],
+)
+def test_continuing_another_model_is_refused(first, then, what):
+    """A continuation of another model (walkthrough) ran as one, burn-in 0 and all."""
+    data, _ = _data()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        emu = gpmsa.fit(data, n_iter=20, seed=0, n_chains=2, tune=False, **first)
+    with pytest.raises(gpmsa.GPMSAError, match=f"another model: its {what} differ"):
+        gpmsa.fit(data, n_iter=10, seed=0, n_chains=2, tune=False, init=emu, **then)
