@@ -2,10 +2,6 @@
 readers as non-library exceptions. Each rewrites a real file as an attacker would (any
 manifest, the content hash recomputed) and expects EmulatorFileError naming the field."""
 
-import io
-import json
-import zipfile
-
 import numpy as np
 import pytest
 
@@ -13,7 +9,7 @@ import gpmsa
 from gpmsa.io import container
 from gpmsa.io.container import ENVELOPE, STUDY_FORMAT, read_raw, write_raw
 from tests.gpmsa._study_cases import emulator, observations
-from tests.gpmsa.test_file_hostile import read_members
+from tests.gpmsa.test_file_hostile import read_members, write_zip
 
 
 @pytest.fixture(scope="module")
@@ -28,13 +24,7 @@ def saved(tmp_path_factory):
 def _write(path, manifest, arrays):
     """A zip with this manifest (its hash recomputed) and these arrays."""
     manifest = dict(manifest, content_sha256=container.content_hash(arrays, manifest))
-    with zipfile.ZipFile(path, "w") as zf:
-        zf.writestr("manifest.json", json.dumps(manifest))
-        for name, arr in arrays.items():
-            buf = io.BytesIO()
-            np.save(buf, arr)
-            zf.writestr(f"arrays/{name}.npy", buf.getvalue())
-    return path
+    return write_zip(path, manifest, arrays)
 
 
 @pytest.mark.parametrize("dtype", [["<f8"], [["a", "<f8"]], {"descr": "<f8"}])

@@ -77,6 +77,11 @@ def write_members(path, manifest, arrays, rehash=True):
                           for k, v in arrays.items()}  # fmt: skip
     if rehash:
         manifest["content_sha256"] = container.content_hash(arrays, manifest)
+    return write_zip(path, manifest, arrays)
+
+
+def write_zip(path, manifest, arrays):
+    """A zip of this manifest, as it is, and these arrays (stored, not compressed)."""
     with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_STORED) as zf:
         zf.writestr("manifest.json", json.dumps(manifest))
         for name, arr in arrays.items():
@@ -312,13 +317,7 @@ def test_sizes_are_checked_before_decompressing(saved, tmp_path, monkeypatch):
     manifest["arrays"] = {k: {"shape": list(v.shape), "dtype": v.dtype.str}
                           for k, v in arrays.items()}  # fmt: skip
     manifest["arrays"]["y"]["shape"] = [10**6, 1000]  # 8 GB declared for a small member
-    path = tmp_path / "liar.gpmsa"
-    with zipfile.ZipFile(path, "w") as zf:
-        zf.writestr("manifest.json", json.dumps(manifest))
-        for name, arr in arrays.items():
-            buf = io.BytesIO()
-            np.save(buf, arr)
-            zf.writestr(f"arrays/{name}.npy", buf.getvalue())
+    path = write_zip(tmp_path / "liar.gpmsa", manifest, arrays)
     with pytest.raises(gpmsa.EmulatorFileError, match=r"array 'y': its member holds \d+ bytes"):
         gpmsa.load(path)
     opened = []
