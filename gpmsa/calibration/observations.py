@@ -403,7 +403,7 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
             full[:, c * n : (c + 1) * n, c * n : (c + 1) * n] = cov[:, c]
         resid = resid @ P
         var = np.einsum("ij,gjk,ik->gi", P, full, P)
-        noise = np.diag(P @ np.diag(np.broadcast_to(noise, p_u * n)) @ P)
+        noise = (P * P) @ np.broadcast_to(noise, p_u * n)  # diag(P diag(noise) P), P symmetric
     var = np.maximum(var, 1e-300)
     with np.errstate(over="ignore"):
         sds = np.max(np.abs(resid) / np.sqrt(var + noise), axis=1)
