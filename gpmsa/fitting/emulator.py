@@ -172,7 +172,8 @@ class Emulator:
     ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files), levels
     (per column of [x, t]: a categorical input's training levels, else None), mean_basis (the
     weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md. The arrays are
-    read-only copies, params, draws and calibration read-only mappings (``model_sha256`` holds).
+    read-only copies, params, draws and calibration read-only mappings, and no attribute but
+    ``metadata`` can be replaced (``model_sha256`` holds).
     """
 
     def __init__(
@@ -227,13 +228,29 @@ class Emulator:
         caller's arrays stay writable), ``params``, ``draws`` and ``calibration`` as read-only
         mappings of them, the standardizer as one with read-only arrays."""
         for name in _ARRAYS:
-            setattr(self, name, _read_only_copy(getattr(self, name)))
+            object.__setattr__(self, name, _read_only_copy(getattr(self, name)))
         for name in _MAPPINGS:
-            setattr(self, name, _read_only_mapping(getattr(self, name)))
+            object.__setattr__(self, name, _read_only_mapping(getattr(self, name)))
         std = self.standardizer
-        self.standardizer = dataclasses.replace(
+        object.__setattr__(self, "standardizer", dataclasses.replace(
             std, **{k: _read_only_copy(getattr(std, k)) for k in STD_FIELDS}
-        )
+        ))  # fmt: skip
+        object.__setattr__(self, "_sealed", True)
+
+    def __setattr__(self, name: str, value) -> None:
+        """Only ``metadata`` (the user's dict, not part of the model) may be replaced once
+        constructed: the predictions, ``model_sha256`` and the cached factors depend on the rest."""
+        if name != "metadata" and self.__dict__.get("_sealed", False):
+            raise AttributeError(
+                f"Emulator.{name} cannot be replaced: an emulator is read-only (its predictions, "
+                f"cached factors and model_sha256 depend on it); build another with "
+                f"gpmsa.Emulator.from_params or gpmsa.fit, or use emu.with_calibration_priors"
+            )
+        object.__setattr__(self, name, value)
+
+    def __delattr__(self, name: str) -> None:
+        """Attributes cannot be deleted (as ``__setattr__``)."""
+        raise AttributeError(f"Emulator.{name} cannot be deleted: an emulator is read-only")
 
     def __getstate__(self) -> dict:
         """For pickle and ``copy`` (a worker process gets the emulator): the read-only mappings

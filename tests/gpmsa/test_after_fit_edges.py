@@ -20,6 +20,7 @@ from gpmsa.predictive.calibrated import calibrated_predict
 from gpmsa.predictive.full import FullPrediction
 from gpmsa.predictive.sobol import Sensitivity, _memory_estimate
 from tests.gpmsa import _study_cases as sc
+from tests.gpmsa._emulator_edit import replaced
 
 
 def _functional_emulator(mean_basis) -> gpmsa.Emulator:
@@ -136,9 +137,8 @@ def test_emulator_save_still_replaces_an_emulator_file(tmp_path):
 
 def _with_draws(scales) -> gpmsa.Emulator:
     emu = gpmsa.Emulator.from_params(sc.sim_data(), sc.PARAMS)
-    emu.draws = {k: np.stack([np.asarray(v) * f for f in scales]) for k, v in emu.params.items()}
-    emu.log_post = np.zeros(len(scales))
-    return emu
+    draws = {k: np.stack([np.asarray(v) * f for f in scales]) for k, v in emu.params.items()}
+    return replaced(emu, draws=draws, log_post=np.zeros(len(scales)))
 
 
 def test_n_draws_picks_the_same_draws_everywhere():

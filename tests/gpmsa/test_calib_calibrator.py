@@ -17,6 +17,7 @@ import gpmsa
 from gpmsa import Calibrator, GPMSAError, calibrate
 from gpmsa.calibration.posterior import trapezoid_weights
 from gpmsa.mcmc.diagnostics import ess
+from tests.gpmsa._emulator_edit import replaced
 
 
 def kurtosis(post, name):
@@ -171,8 +172,7 @@ def test_emulator_draws_average_the_likelihood():
     singles = []
     for i in range(4):
         prm = {k: v[i] for k, v in emu.draws.items()}
-        one = with_draws(road_emulator(), n=1)
-        one.params = prm
+        one = replaced(with_draws(road_emulator(), n=1), params=prm)
         singles.append(Calibrator(one).log_likelihood_grid(x, y)[1])
     expected = np.log(np.mean(np.exp(np.array(singles)), axis=0))
     np.testing.assert_allclose(ll, expected, rtol=0, atol=1e-9)

@@ -1,7 +1,6 @@
 """A lamOs prior with an upper bound (a known observation precision): the MCMC's start of lamOs
 and the grid posterior's lamOs draws stay inside the prior's support."""
 
-import copy
 import warnings
 from dataclasses import replace
 
@@ -13,15 +12,17 @@ import gpmsa
 from gpmsa import Calibrator
 from gpmsa.calibration.model import LamOsPrior
 from gpmsa.calibration.observations import Fit, lamos_start
+from tests.gpmsa._emulator_edit import replaced
 
 LAM0 = 400.0
 
 
 def known_precision_emulator(lower: float, upper: float):
     """The road emulator with its lamOs prior cut to (lower, upper)."""
-    emu = copy.copy(road_emulator())
-    emu.priors = replace(emu.priors, lamOs=replace(emu.priors.lamOs, lower=lower, upper=upper))
-    return emu
+    emu = road_emulator()
+    return replaced(
+        emu, priors=replace(emu.priors, lamOs=replace(emu.priors.lamOs, lower=lower, upper=upper))
+    )
 
 
 def window():

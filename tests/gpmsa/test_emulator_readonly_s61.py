@@ -99,3 +99,41 @@ def test_a_saved_and_loaded_emulator_is_read_only(fitted, tmp_path):
     assert loaded.model_sha256 == fitted.model_sha256
     with pytest.raises(ValueError, match=READ_ONLY):
         loaded.params["betaU"][0, 0] = 2.0
+
+
+REPLACED = {
+    "w": lambda e: np.zeros_like(e.w),
+    "params": lambda e: dict(e.params, lamUz=np.asarray(e.params["lamUz"]) * 1e3),
+    "priors": lambda e: gpmsa.Priors(theta_sd=0.1),
+    "draws": lambda e: {},
+    "t_names": lambda e: ("other",),
+    "standardizer": lambda e: e.standardizer,
+    "settings": lambda e: {},
+}
+
+
+@pytest.mark.parametrize("name", sorted(REPLACED))
+def test_replacing_an_attribute_is_refused_and_the_digest_holds(fitted, name):
+    """Before session 62, ``emu.priors = other`` or ``emu.w = other`` replaced the attribute and
+    kept the cached ``model_sha256`` (and the cached factors) of the emulator as constructed."""
+    sha = fitted.model_sha256
+    with pytest.raises(AttributeError, match=rf"Emulator\.{name} cannot be replaced.*from_params"):
+        setattr(fitted, name, REPLACED[name](fitted))
+    with pytest.raises(AttributeError, match=rf"Emulator\.{name} cannot be deleted"):
+        delattr(fitted, name)
+    fitted.__dict__.pop("model_sha256")
+    assert fitted.model_sha256 == sha
+
+
+@pytest.mark.parametrize("how", ["pickle", "copy", "load", "with_calibration_priors"])
+def test_every_way_to_another_emulator_keeps_it_sealed_and_metadata_free(fitted, how, tmp_path):
+    other = {
+        "pickle": lambda: pickle.loads(pickle.dumps(fitted)),
+        "copy": lambda: copy.deepcopy(fitted),
+        "load": lambda: gpmsa.load(fitted.save(tmp_path / "e.gpmsa")),
+        "with_calibration_priors": lambda: fitted.with_calibration_priors(theta_sd=0.3),
+    }[how]()
+    with pytest.raises(AttributeError, match="cannot be replaced"):
+        other.K = np.ones_like(other.K)
+    other.metadata = {"robot": "jackal-2"}  # the user's dict, not part of the model
+    assert gpmsa.load(other.save(tmp_path / "m.gpmsa")).metadata["robot"] == "jackal-2"

@@ -28,6 +28,7 @@ from gpmsa.cli.main import main
 from gpmsa.cli.text import safe
 from gpmsa.io import container
 from gpmsa.model.data import RESERVED_NAMES
+from tests.gpmsa._emulator_edit import replaced
 
 FIELD = re.compile(
     r"(arrays/\w+|arrays:|array '\w+'|priors|names|units|domain|settings|model|metadata|"
@@ -396,8 +397,8 @@ def test_refused_save_writes_nothing_and_keeps_the_old_file(emu, tmp_path, monke
     big.metadata = {1: "a"}
     with pytest.raises(gpmsa.GPMSAError, match="keys must be strings"):
         big.save(path)
-    broken = gpmsa.load(path)
-    broken.params = dict(broken.params, lamUz=broken.params["lamUz"] * 1e3)
+    loaded = gpmsa.load(path)
+    broken = replaced(loaded, params=dict(loaded.params, lamUz=loaded.params["lamUz"] * 1e3))
     with pytest.raises(gpmsa.GPMSAError, match="refusing to write .*param_lamUz"):
         broken.save(path)
     monkeypatch.setattr(gpmsa.limits, "MAX_ARRAY_BYTES", 5000)
@@ -485,11 +486,12 @@ def test_save_then_load_round_trips_generated_emulators(tmp_path, emu):
 # --- gpmsa info -----------------------------------------------------------------------------------
 def test_info_escapes_terminal_codes_from_the_file(emu, tmp_path, capsys):
     evil = "\x1b[2J\x1b]0;pwned\x07\r\u202e\x9b31m"
-    sim_emu = gpmsa.load(emu.save(tmp_path / "a.gpmsa"))
+    loaded = gpmsa.load(emu.save(tmp_path / "a.gpmsa"))
+    sim_emu = replaced(
+        loaded, settings=dict(loaded.settings, note=evil), x_names=(evil,), t_units=(evil,),
+        diagnostics={evil: {"mean": [evil, 1.0], "ess": evil}, "x": 5},
+    )  # fmt: skip
     sim_emu.metadata = {evil: evil, "versions": {evil: evil}}
-    sim_emu.settings = dict(sim_emu.settings, note=evil)
-    sim_emu.x_names, sim_emu.t_units = (evil,), (evil,)
-    sim_emu.diagnostics = {evil: {"mean": [evil, 1.0], "ess": evil}, "x": 5}
     path = sim_emu.save(tmp_path / (evil + ".gpmsa"))
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out

@@ -15,6 +15,7 @@ import gpmsa
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.io.container import content_hash
 from tests.gpmsa import _study_cases as sc
+from tests.gpmsa._emulator_edit import replaced
 
 
 def _read(path):
@@ -130,9 +131,8 @@ def test_a_study_file_with_zero_draws_is_refused(study, tmp_path, cut):
 
 def _with_draws(n: int) -> gpmsa.Emulator:
     emu = gpmsa.Emulator.from_params(sc.sim_data(), sc.PARAMS)
-    emu.draws = {k: np.repeat(np.asarray(v)[None], n, axis=0) for k, v in emu.params.items()}
-    emu.log_post = np.zeros(n)
-    return emu
+    draws = {k: np.repeat(np.asarray(v)[None], n, axis=0) for k, v in emu.params.items()}
+    return replaced(emu, draws=draws, log_post=np.zeros(n))
 
 
 def test_an_emulator_file_with_zero_draws_is_refused(tmp_path):

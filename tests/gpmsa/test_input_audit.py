@@ -22,6 +22,7 @@ from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive.calibrated import calibrated_predict
 from gpmsa.predictive.sobol import _mean_gauss
 from gpmsa.studies.layout import build_layout, check_study_names
+from tests.gpmsa._emulator_edit import replaced
 
 
 def _functional_sim(index: np.ndarray, reverse: bool = False) -> dict:
@@ -165,8 +166,8 @@ def test_a_calibration_parameter_with_a_reserved_name_is_refused(name):
 
 
 def test_calibrate_refuses_an_emulator_whose_parameter_has_a_reserved_name():
-    emu = gpmsa.Emulator.from_params(sim_data(), PARAMS)
-    emu.t_names = ("lamOs",)  # as an older file could hold it
+    emu = replaced(gpmsa.Emulator.from_params(sim_data(), PARAMS), t_names=("lamOs",))  # as an
+    # older file could hold it
     with pytest.raises(GPMSAError, match="the emulator's t_names: 'lamOs' is a reserved name"):
         gpmsa.calibrate(emu, [[0.5]], [[1.0]], n_samples=20, n_burn=0, tune=False)
 
