@@ -42,6 +42,17 @@ def ess(x: np.ndarray) -> float:
         return float(_arviz().ess(np.atleast_2d(x)))
 
 
+def autocorrelation(x: np.ndarray) -> np.ndarray:
+    """Autocorrelation of each chain of x (n_chains, n_draws) at lags 0 .. n_draws - 1 (ArviZ's
+    FFT estimate); NaN rows for constant chains."""
+    x = np.atleast_2d(np.asarray(x, dtype=np.float64))
+    out = np.full(x.shape, np.nan)
+    varied = np.ptp(x, axis=1) > 0
+    if np.any(varied):
+        out[varied] = _arviz().autocorr(x[varied], axis=-1)
+    return out
+
+
 def hdi(x: np.ndarray, level: float) -> tuple[float, float]:
     """Highest-density interval (ArviZ's: the shortest one) of 1-D draws x with probability
     ``level``."""

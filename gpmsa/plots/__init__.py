@@ -1,17 +1,18 @@
-"""Figures users look at: MCMC traces, theta pairs, the PC basis, rho box plots, emulator fit,
-prediction bands, sensitivity bars.
+"""Figures users look at: MCMC traces and autocorrelations, theta pairs, the PC basis, rho box
+plots, emulator fit, prediction bands, sensitivity bars.
 
 Each function returns a ``matplotlib.figure.Figure`` (matplotlib is imported only when one runs;
 nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a notebook.
 """
 
 from gpmsa.plots.emulator import emulator_fit, pc_basis
-from gpmsa.plots.mcmc import theta_pairs, traces
+from gpmsa.plots.mcmc import autocorrelation, theta_pairs, traces
 from gpmsa.plots.prediction import prediction_bands
 from gpmsa.plots.rho import rho_boxplots
 from gpmsa.plots.sensitivity import sensitivity_bars
 
 __all__ = [
+    "autocorrelation",
     "emulator_fit",
     "pc_basis",
     "prediction_bands",

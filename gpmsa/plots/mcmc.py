@@ -1,4 +1,4 @@
-"""MCMC traces and the pair plot of the calibration parameters."""
+"""MCMC traces, autocorrelations and the pair plot of the calibration parameters."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import numpy as np
 
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
+from gpmsa.mcmc import diagnostics
 from gpmsa.mcmc.sampler import Chains
 from gpmsa.model.data import as_float, check_count
 from gpmsa.plots._figure import check_bins, figure
@@ -130,6 +131,62 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
     axes[-1, 1].set_xlabel("count")
     if len(series[picked[0]]) > 1:
         axes[0, 0].legend(fontsize="small", loc="upper right")
+    return fig
+
+
+def autocorrelation(source, names=None, *, max_params: int = 12, max_lag: int = 40):
+    """Autocorrelation of each scalar parameter's draws against the lag, a line per chain, the
+    bulk ESS in each panel's title (SEPIA's ``plot_acf``): a Figure.
+
+    The dashed band, +-1.96 / sqrt(draws per chain), is where independent draws' estimates fall
+    95% of the time. A fitted emulator's draws are its retained ones, so that a lag counts
+    ``settings["thin"]`` sweeps; a calibration's chains count every sweep after burn-in.
+
+    Args:
+        source: as ``traces``: a gpmsa.Emulator, a Posterior, a Chains, or a study.
+        names: a parameter name or a sequence of names (a name selects all its elements);
+            default: the first ``max_params`` scalars.
+        max_params: panels at most when ``names`` is None.
+        max_lag: the largest lag shown (in draws; at most draws per chain - 1).
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> ar = np.zeros(500); e = np.random.default_rng(0).normal(size=500)
+        >>> for i in range(1, 500): ar[i] = 0.9 * ar[i - 1] + e[i]
+        >>> fig = gpmsa.plots.autocorrelation(gpmsa.Posterior({"t": ar}), max_lag=20)
+        >>> fig.axes[0].get_title().startswith("t: ESS")
+        True
+    """
+    series = _series(_calibration_source(source))
+    picked = _pick(series, names, max_params)
+    max_lag = check_count(max_lag, "max_lag")
+    n_draws = series[picked[0]].shape[1]
+    if n_draws < 2:
+        raise GPMSAError(f"autocorrelation needs >= 2 draws per chain, got {n_draws}")
+    lags = np.arange(min(max_lag, n_draws - 1) + 1)
+    n_cols = min(3, len(picked))
+    n_rows = -(-len(picked) // n_cols)
+    fig = figure(3.2 * n_cols + 0.4, 2.3 * n_rows + 0.4)
+    axes = fig.subplots(n_rows, n_cols, squeeze=False, sharex=True, sharey=True).ravel()
+    band = 1.96 / np.sqrt(n_draws)
+    for ax, name in zip(axes, picked, strict=False):
+        chains = series[name]
+        for c, acf in enumerate(diagnostics.autocorrelation(chains)):
+            ax.plot(lags, acf[: lags.size], lw=1.0, color=f"C{c}",
+                    label=f"chain {c}" if len(chains) > 1 else None)  # fmt: skip
+        ax.axhline(0.0, color="0.3", lw=0.6)
+        ax.axhspan(-band, band, color="0.85", zorder=0)
+        ess = diagnostics.ess(chains)
+        ess_text = "constant" if np.isnan(ess) else f"{ess:.0f} of {chains.size}"
+        ax.set_title(f"{name}: ESS {ess_text}", fontsize="medium")
+    for ax in axes[len(picked) :]:
+        ax.set_axis_off()
+    for ax in axes[-n_cols:]:
+        ax.set_xlabel("lag (draws)")
+    for ax in axes[::n_cols]:
+        ax.set_ylabel("autocorrelation")
+    if len(series[picked[0]]) > 1:
+        axes[0].legend(fontsize="small", loc="upper right")
     return fig
 
 

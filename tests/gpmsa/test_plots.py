@@ -231,3 +231,36 @@ def test_theta_pairs_truth_and_prediction_observations_are_checked():
     ):
         with pytest.raises(GPMSAError, match=match):
             plots.theta_pairs(post, truth=truth)
+
+
+def test_autocorrelation_draws_each_chains_acf_with_its_ess():
+    """SEPIA's plot_acf: an AR(1) chain of coefficient 0.8 shows 0.8 ** lag; the title gives its
+    bulk ESS; a constant chain is named, not drawn as NaN noise."""
+    rng = np.random.default_rng(1)
+    ar = np.zeros((2, 4000, 1))
+    for i in range(1, 4000):
+        ar[:, i] = 0.8 * ar[:, i - 1] + rng.normal(size=(2, 1))
+    draws = {"theta": ar, "lamOs": np.ones((2, 4000, 1))}
+    chains = gpmsa.Chains(draws=draws, log_post=np.zeros((2, 4000)), accept_rate={},
+                          step_widths={}, info={})  # fmt: skip
+    fig = plots.autocorrelation(chains, max_lag=10)
+    first = fig.axes[0]
+    assert len(first.lines) == 2 + 1 and first.get_legend() is not None  # 2 chains + zero line
+    lags, acf = first.lines[0].get_data()
+    np.testing.assert_array_equal(lags, np.arange(11))
+    np.testing.assert_allclose(acf, 0.8 ** np.arange(11), atol=0.05)
+    ess = gpmsa.mcmc.diagnostics.ess(ar[:, :, 0])
+    assert 700 < ess < 1100  # (1 - 0.8) / (1 + 0.8) x 8000 = 889
+    assert first.get_title() == f"theta: ESS {ess:.0f} of 8000"
+    assert fig.axes[1].get_title() == "lamOs: ESS constant"
+    emu, *_ = known_truth_case()
+    fig = plots.autocorrelation(emu, names=["t", "betaU"], max_lag=5000)
+    per_chain = emu.n_draws // emu.settings["n_chains"]
+    assert [ax.get_title().split(":")[0] for ax in fig.axes if ax.axison] == [
+        "t", *[f"betaU[{i},{j}]" for i in range(2) for j in range(emu.p_u)]
+    ]
+    assert fig.axes[0].lines[0].get_xdata()[-1] == per_chain - 1  # max_lag capped
+    with pytest.raises(GPMSAError, match="max_lag must be an integer >= 1"):
+        plots.autocorrelation(emu, max_lag=0)
+    with pytest.raises(GPMSAError, match="needs >= 2 draws per chain"):
+        plots.autocorrelation(gpmsa.Posterior({"t": np.array([0.5])}))
