@@ -1,5 +1,5 @@
-"""Figures users look at: MCMC traces and autocorrelations, theta pairs, the PC basis, rho box
-plots, emulator fit, prediction bands, sensitivity bars.
+"""Figures users look at: MCMC traces and autocorrelations, theta pairs, the PC basis and the
+observations' projection onto it, rho box plots, emulator fit, prediction bands, sensitivity bars.
 
 Each function returns a ``matplotlib.figure.Figure`` (matplotlib is imported only when one runs;
 nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a notebook.
@@ -7,6 +7,7 @@ nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a 
 
 from gpmsa.plots.emulator import emulator_fit, pc_basis
 from gpmsa.plots.mcmc import autocorrelation, theta_pairs, traces
+from gpmsa.plots.observations import obs_projection
 from gpmsa.plots.prediction import prediction_bands
 from gpmsa.plots.rho import rho_boxplots
 from gpmsa.plots.sensitivity import sensitivity_bars
@@ -14,6 +15,7 @@ from gpmsa.plots.sensitivity import sensitivity_bars
 __all__ = [
     "autocorrelation",
     "emulator_fit",
+    "obs_projection",
     "pc_basis",
     "prediction_bands",
     "rho_boxplots",

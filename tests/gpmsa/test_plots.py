@@ -14,6 +14,7 @@ from matplotlib.figure import Figure
 
 import gpmsa
 from gpmsa import GPMSAError, plots
+from gpmsa.model.problem import GLS_RIDGE
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -257,10 +258,49 @@ def test_autocorrelation_draws_each_chains_acf_with_its_ess():
     fig = plots.autocorrelation(emu, names=["t", "betaU"], max_lag=5000)
     per_chain = emu.n_draws // emu.settings["n_chains"]
     assert [ax.get_title().split(":")[0] for ax in fig.axes if ax.axison] == [
-        "t", *[f"betaU[{i},{j}]" for i in range(2) for j in range(emu.p_u)]
+        "t",
+        *[f"betaU[{i},{j}]" for i in range(2) for j in range(emu.p_u)],
     ]
     assert fig.axes[0].lines[0].get_xdata()[-1] == per_chain - 1  # max_lag capped
     with pytest.raises(GPMSAError, match="max_lag must be an integer >= 1"):
         plots.autocorrelation(emu, max_lag=0)
     with pytest.raises(GPMSAError, match="needs >= 2 draws per chain"):
         plots.autocorrelation(gpmsa.Posterior({"t": np.array([0.5])}))
+
+
+def test_obs_projection_shows_each_experiments_weights_and_what_the_basis_misses():
+    """SEPIA's plot_K_weights / plot_K_residuals: the lines are the weights calibration fits
+    (GLS on the basis interpolated to an experiment's own index), the residual panel what that
+    basis leaves of the runs and of each experiment, in native units."""
+    emu = vector_fit()
+    s = emu.standardizer.grid
+    own = np.linspace(0.1, 0.9, 7)  # an experiment on its own index
+    y_in = np.sin(1.0) * (1.0 + s) + 0.2 * s**2
+    y_own = np.sin(1.0) * (1.0 + own) + 5.0 * own**2 + 0.05 * np.sin(20 * own)
+    obs = gpmsa.ObsData(x=[[0.5], [0.5]], y=[y_in, y_own], index=[s, own])
+    fig = plots.obs_projection(emu, obs)
+    hist = fig.axes[:2]
+    std, K = emu.standardizer, emu.K
+    for e, (y, grid) in enumerate([(y_in, s), (y_own, own)]):
+        Ke = np.column_stack([np.interp(grid, s, K[:, j]) for j in range(2)])
+        y_std = (y - np.interp(grid, s, std.y_mean)) / std.y_sd
+        u = np.linalg.solve(Ke.T @ Ke + GLS_RIDGE * np.eye(2), Ke.T @ y_std)  # GPM/SA's ridge
+        for j in range(2):
+            np.testing.assert_allclose(hist[j].lines[e].get_xdata()[0], u[j], rtol=1e-9)
+        line = fig.axes[2].lines[emu.m + e]
+        np.testing.assert_array_equal(line.get_xdata(), grid)
+        np.testing.assert_allclose(line.get_ydata(), std.y_sd * (y_std - Ke @ u), atol=1e-9)
+    w = emu.w
+    for j in range(2):
+        u = [hist[j].lines[e].get_xdata()[0] for e in range(2)]
+        outside = sum(not w[:, j].min() <= v <= w[:, j].max() for v in u)
+        assert hist[j].get_title() == f"PC {j + 1}: {outside} of 2 outside the runs"
+    assert "outside the runs" in hist[1].get_title() and hist[1].get_title().startswith("PC 2: 1")
+    runs = (emu.y - std.y_mean) - std.y_sd * w @ K.T
+    np.testing.assert_allclose(fig.axes[2].lines[0].get_ydata(), runs[0])
+    scalar = plots.obs_projection(two_param_emulator(), gpmsa.ObsData(x=[[0.3]], y=[[1.0]]))
+    assert len(scalar.axes) == 1 and scalar.axes[0].get_title() == "PC 1: 0 of 1 outside the runs"
+    with pytest.raises(GPMSAError, match="obs must be a gpmsa.ObsData, got tuple"):
+        plots.obs_projection(emu, ([[0.5]], [y_in]))
+    with pytest.raises(GPMSAError, match="max_pc must be an integer >= 1"):
+        plots.obs_projection(emu, obs, max_pc=0)

@@ -1,0 +1,89 @@
+"""The observations projected onto the emulator's basis, against the simulation runs."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gpmsa.calibration.observations import check_emulator, reduce
+from gpmsa.errors import GPMSAError
+from gpmsa.model.data import ObsData, check_count
+from gpmsa.plots._figure import check_bins, figure
+
+
+def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
+    """Can the emulator reach the observations? Per basis component (at most ``max_pc``): a
+    histogram of the runs' weights w_j with each experiment's weight u_j (its GLS projection,
+    as calibration reduces it) as a vertical line, the title counting the experiments outside
+    the runs' range; for a functional output a last panel of what the basis misses (native
+    units over the output grid): the runs' residuals y - mean - y_sd K w in grey, each
+    experiment's in colour. SEPIA's ``plot_K_weights``, ``plot_u_w_pairs`` (diagonal) and
+    ``plot_K_residuals`` in one Figure. No discrepancy basis: the weights shown are those a
+    calibration without one fits.
+
+    Args:
+        emulator: a gpmsa.Emulator.
+        obs: a gpmsa.ObsData (experiments on the simulation grid or their own index).
+        max_pc: components shown at most.
+        bins: histogram bins.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t, s = rng.uniform(size=(20, 1)), rng.uniform(size=(20, 1)), np.linspace(0, 1, 8)
+        >>> data = gpmsa.SimData(x=x, t=t, y=np.outer(x, s) + np.outer(t, s**2), index=s)
+        >>> emu = gpmsa.Emulator.from_params(data, {"betaU": [[1, 1], [1, 1]], "lamUz": [1, 1],
+        ...                                         "lamWs": [1e3, 1e3], "lamWOs": [1e3]})
+        >>> obs = gpmsa.ObsData(x=[[0.5], [0.5]], y=[0.5 * s + 0.5 * s**2, 0.5 * s + 3 * s**2])
+        >>> fig = gpmsa.plots.obs_projection(emu, obs)    # the second: t = 3, beyond the runs
+        >>> [ax.get_title() for ax in fig.axes[:2]]
+        ['PC 1: 1 of 2 outside the runs', 'PC 2: 1 of 2 outside the runs']
+    """
+    check_emulator(emulator)
+    if not isinstance(obs, ObsData):
+        raise GPMSAError(f"obs must be a gpmsa.ObsData, got {type(obs).__name__}")
+    max_pc = check_count(max_pc, "max_pc")
+    reduced = reduce(emulator, obs, None).obs
+    n_pc = min(max_pc, emulator.p_u)
+    functional = emulator.K.shape[0] > 1
+    bins = check_bins(bins, n_pc, "plots.obs_projection")
+    n_cols = min(3, n_pc)
+    n_rows = -(-n_pc // n_cols)
+    fig = figure(3.2 * n_cols + 0.4, 2.4 * (n_rows + functional) + 0.4)
+    grid = fig.add_gridspec(n_rows + functional, n_cols)
+    for j in range(n_pc):
+        ax = fig.add_subplot(grid[j // n_cols, j % n_cols])
+        w, u = emulator.w[:, j], reduced.u[:, j]
+        ax.hist(w, bins=bins, color="0.7", label="runs")
+        for e, value in enumerate(u):
+            ax.axvline(
+                value, color=f"C{e % 10}", lw=1.2, label=f"experiment {e}" if e < 10 else None
+            )
+        outside = int(np.sum((u < w.min()) | (u > w.max())))
+        ax.set_title(f"PC {j + 1}: {outside} of {u.size} outside the runs", fontsize="medium")
+        ax.set_xlabel(f"weight w{j + 1}")
+    fig.axes[0].legend(fontsize="small", loc="upper right")
+    if functional:
+        _residuals(fig.add_subplot(grid[n_rows, :]), emulator, obs, reduced)
+    return fig
+
+
+def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
+    """What the basis misses of the runs (grey) and of each experiment (colour), native units."""
+    std = emulator.standardizer
+    runs = (emulator.y - std.y_mean) - std.y_sd * emulator.w @ emulator.K.T
+    ax.plot(std.grid, runs.T, color="0.75", lw=0.6)
+    misses = []
+    for e, (y_std, K, u) in enumerate(zip(reduced.y_std, reduced.K, reduced.u, strict=True)):
+        grid = std.grid if obs.grids[e] is None else obs.grids[e]
+        miss = std.y_sd * (y_std - K @ u)
+        misses.append(miss)
+        ax.plot(grid, miss, color=f"C{e % 10}", lw=1.2)
+    rms_runs = float(np.sqrt(np.mean(runs**2)))
+    rms_obs = float(np.sqrt(np.mean(np.concatenate(misses) ** 2)))
+    ax.axhline(0.0, color="0.3", lw=0.6)
+    ax.set_title(
+        f"beyond {emulator.p_u} components: rms {rms_runs:.3g} (runs), {rms_obs:.3g} (experiments)",
+        fontsize="medium",
+    )
+    ax.set_xlabel("output index")
+    ax.set_ylabel("residual")
