@@ -19,7 +19,7 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
         f"[{', '.join(safe(n, 60) for n in st['shared'])}], hierarchical "
         f"[{', '.join(safe(n, 60) for n in st['hierarchical'])}]",
     ]
-    for mod, emu in zip(st["models"], study.members, strict=True):
+    for i, (mod, emu) in enumerate(zip(st["models"], study.members, strict=True)):
         params = ", ".join(
             f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''} in "
             f"[{emu.domain[n][0]:.6g}, {emu.domain[n][1]:.6g}]"
@@ -28,10 +28,10 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
         lines.append(f"model {safe(mod['label'], 60)}: file {safe(mod['file'], 160)} sha256 "
                      f"{safe(mod['sha256'], 64)} (verified); m={emu.m}, p={emu.p}, "
                      f"l_sim={emu.l_sim}; parameters {params}")  # fmt: skip
-        disc = (emu.settings or {}).get("discrepancy")
-        if disc is not None:  # a fitted model's discrepancy and its precision groups
-            groups = emu.settings.get("discrepancy_groups")
-            lines.append(f"  discrepancy {plain(disc)}, precision groups "
+        disc = study.discrepancy(i)
+        if disc is not None:  # the model's discrepancy and its precision groups
+            groups = disc["discrepancy_groups"]
+            lines.append(f"  discrepancy {plain(disc['discrepancy'])}, precision groups "
                          f"{plain(groups) if isinstance(groups, list) else 'one'}")  # fmt: skip
     if st["hierarchical"]:
         hp = manifest["priors"]["hyper"]

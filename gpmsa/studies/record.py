@@ -14,9 +14,21 @@ KINDS = ("calibration", "fit")
 """How a study's draws were made: calibration with the emulators fixed, or a joint fit."""
 ARRAYS = ("theta", "mu", "lam", "lamOs", "log_post")
 """The arrays of a study file: (C, N, G), (C, N, H), (C, N, H), (C, N, M), (C, N)."""
+DISCREPANCIES = "discrepancy_by_model"
+"""The settings key of a calibrated study's record of each model's discrepancy: label ->
+{"discrepancy": "constant", "linear" or "given" (an array), "discrepancy_sha256": the basis
+digest (``gpmsa.model.discrepancy.record``), and with several precision groups
+"discrepancy_groups"}; absent for a study without one (and in files written before it)."""
+DISCREPANCY_KINDS = ("constant", "linear", "given")
 FILE_RE = re.compile(r"\A[A-Za-z0-9_-][A-Za-z0-9_.-]{0,150}\.gpmsa\Z")
 """A model's file name: beside the study file, no folder, no leading dot."""
 SHA_RE = re.compile(r"^[0-9a-f]{64}$")
+
+
+def discrepancy_arrays(j: int) -> tuple[str, str]:
+    """The study file's arrays of model j's discrepancy draws: betaV (C, N, p, G), lamVz
+    (C, N, G) (array names allow no label: a label may hold '-')."""
+    return f"betaV_{j}", f"lamVz_{j}"
 
 
 def _fail(field: str, problem: str) -> EmulatorFileError:
@@ -85,9 +97,11 @@ def check_study_manifest(manifest: dict) -> None:
         if key == "sd_max" and not (finite(val * val) and val * val > 0):  # HyperPriors squares it
             raise _fail(f"priors.hyper.{key}", f"{_short(val)}: its square is not a finite, "
                                                "non-zero float64")  # fmt: skip
+    n_groups = _check_discrepancies(manifest, study["kind"], labels)
     specs = manifest["arrays"]
-    if set(specs) != set(ARRAYS):
-        raise _fail("arrays", f"a study holds exactly {list(ARRAYS)}, got {sorted(specs)[:10]}")
+    want = [*ARRAYS, *(a for j in n_groups for a in discrepancy_arrays(j))]
+    if set(specs) != set(want):
+        raise _fail("arrays", f"this study holds exactly {want}, got {sorted(specs)[:10]}")
     for name, spec in specs.items():
         if spec["dtype"] != "<f8":
             raise _fail(f"arrays/{name}", f"dtype {spec['dtype']}: must be <f8 (float64)")
@@ -108,10 +122,69 @@ def check_study_manifest(manifest: dict) -> None:
     if shape["mu"] != shape["lam"] or shape["mu"][2] != n_h:
         raise _fail("arrays/mu", f"mu {shape['mu']} and lam {shape['lam']} need one column per "
                                  f"hierarchical parameter ({n_h})")  # fmt: skip
+    for j, g in n_groups.items():
+        beta, lam = discrepancy_arrays(j)
+        for name, ndim in ((beta, 4), (lam, 3)):
+            got = tuple(specs[name]["shape"])
+            if len(got) != ndim or got[:2] != cn or got[-1] != g:
+                what = "(chains, draws, p, G)" if ndim == 4 else "(chains, draws, G)"
+                raise _fail(f"arrays/{name}", f"must be {what} with (chains, draws) = {cn} and "
+                                              f"G = {g} precision group(s) (model "
+                                              f"{labels[j]}), got {got}")  # fmt: skip
 
 
-def check_study_arrays(manifest: dict, arrays: dict[str, np.ndarray], layout: Layout) -> None:
-    """The arrays against the models' layout: shapes, finiteness and ranges."""
+def _check_discrepancies(manifest: dict, kind: str, labels: list[str]) -> dict[int, int]:
+    """The settings' record of the models' discrepancies (``DISCREPANCIES``): model index ->
+    its number of precision groups."""
+    record = manifest["settings"].get(DISCREPANCIES)  # settings: an object (the container's)
+    field = f"settings.{DISCREPANCIES}"
+    if record is None:
+        return {}
+    if kind != "calibration":
+        raise _fail(field, f"belongs to a calibration; a {kind!r} study keeps its discrepancy "
+                           "draws in its members' files")  # fmt: skip
+    if not isinstance(record, dict) or not record:
+        raise _fail(field, f"must be a non-empty object, got {_short(record)}")
+    out = {}
+    for lab, rec in record.items():
+        where = f"{field}.{lab}"
+        if lab not in labels:
+            raise _fail(field, f"names the model {_short(lab)}, not one of {labels}")
+        keys = {"discrepancy", "discrepancy_sha256", "discrepancy_groups"}
+        if not isinstance(rec, dict) or set(rec) - keys:
+            raise _fail(
+                where,
+                "must be an object of discrepancy, discrepancy_sha256 and (several groups) "
+                f"discrepancy_groups, got {_short(rec)}",
+            )
+        if rec.get("discrepancy") not in DISCREPANCY_KINDS:
+            raise _fail(f"{where}.discrepancy", f"must be one of {DISCREPANCY_KINDS}, got "
+                                                f"{_short(rec.get('discrepancy'))}")  # fmt: skip
+        sha = rec.get("discrepancy_sha256")
+        if not isinstance(sha, str) or not SHA_RE.match(sha):
+            raise _fail(f"{where}.discrepancy_sha256", f"must be 64 lowercase hex digits, got "
+                                                       f"{_short(sha)}")  # fmt: skip
+        groups = rec.get("discrepancy_groups")
+        n_grp = 1
+        if groups is not None:
+            ints = isinstance(groups, list) and all(
+                isinstance(g, int) and not isinstance(g, bool) for g in groups
+            )
+            n_grp = len(set(groups)) if ints else 0
+            if n_grp < 2 or min(groups) != 0 or max(groups) != n_grp - 1:  # 0 .. G-1, each used
+                raise _fail(
+                    f"{where}.discrepancy_groups",
+                    f"must number two or more groups 0 .. G-1, got {_short(groups)}",
+                )
+        out[labels.index(lab)] = n_grp
+    return out
+
+
+def check_study_arrays(
+    manifest: dict, arrays: dict[str, np.ndarray], layout: Layout, inputs: tuple[int, ...]
+) -> None:
+    """The arrays against the models' layout and their numbers of known inputs ``inputs`` (a
+    model's discrepancy betaV has one row per input): shapes, finiteness and ranges."""
     names = manifest.get("names", {}).get("elements")
     want = [el.name for el in layout.elements]
     if names != want:
@@ -120,7 +193,12 @@ def check_study_arrays(manifest: dict, arrays: dict[str, np.ndarray], layout: La
     if arrays["theta"].shape[2] != layout.n_elements:
         raise _fail("arrays/theta", f"has {arrays['theta'].shape[2]} columns for "
                                     f"{layout.n_elements} study elements")  # fmt: skip
-    for name in ARRAYS:
+    for j, p in enumerate(inputs):
+        beta = discrepancy_arrays(j)[0]
+        if beta in arrays and arrays[beta].shape[2] != p:
+            raise _fail(f"arrays/{beta}", f"has {arrays[beta].shape[2]} rows of betaV for model "
+                                          f"{layout.labels[j]}'s {p} known input(s)")  # fmt: skip
+    for name in arrays:
         if not np.all(np.isfinite(arrays[name])):
             raise _fail(f"arrays/{name}", "holds NaN or inf")
     for name in ("theta", "mu"):
@@ -128,10 +206,11 @@ def check_study_arrays(manifest: dict, arrays: dict[str, np.ndarray], layout: La
         if a.size and not (a.min() > 0.0 and a.max() < 1.0):
             raise _fail(f"arrays/{name}", f"must lie in (0, 1) (unit scale), got "
                                           f"{a.min():.6g}..{a.max():.6g}")  # fmt: skip
-    for name in ("lam", "lamOs"):
+    for name in ("lam", "lamOs", *(k for k in arrays if k not in ARRAYS)):
         a = arrays[name]
         if a.size and not a.min() > 0.0:
-            raise _fail(f"arrays/{name}", f"precisions must be > 0, got min {a.min():.6g}")
+            what = "correlation parameters" if name.startswith("betaV") else "precisions"
+            raise _fail(f"arrays/{name}", f"{what} must be > 0, got min {a.min():.6g}")
 
 
 def check_study_claims(manifest: dict, study) -> None:

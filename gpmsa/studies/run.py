@@ -4,6 +4,7 @@ jointly): several models whose calibration parameters are shared or hierarchical
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Sequence
 from datetime import datetime, timezone
 
@@ -12,7 +13,7 @@ import numpy as np
 from gpmsa._version import library_versions
 from gpmsa.calibration.calibrate import calibration_problem
 from gpmsa.calibration.observations import check_emulator, reduce
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, ReductionWarning
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.fitting.fit import check_keep, check_point, point_estimate, thinning
 from gpmsa.limits import check_memory
@@ -24,6 +25,7 @@ from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
+from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
 from gpmsa.studies.sampler import StudyChains, sample_study
 from gpmsa.studies.study import OBS_DIGESTS, OBS_LAYOUTS, Study, layout_of
 
@@ -85,10 +87,55 @@ def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
             "versions": library_versions("numpy")}  # fmt: skip
 
 
-def _study_draws(chains: StudyChains, keep: slice) -> dict[str, np.ndarray]:
+def _study_draws(chains: StudyChains, keep: slice, discrepancy: bool = False
+                 ) -> dict[str, np.ndarray]:  # fmt: skip
+    """The study's kept draws; with ``discrepancy`` also each model's betaV (C, N, p, G) and
+    lamVz (C, N, G) as "betaV_j", "lamVz_j" (j: the model's index), where it has them."""
     lam_os = np.stack([m["lamOs"][:, keep, 0] for m in chains.members], axis=2)
-    return {"theta": chains.theta[:, keep], "mu": chains.mu[:, keep], "lam": chains.lam[:, keep],
-            "lamOs": lam_os, "log_post": chains.log_post[:, keep]}  # fmt: skip
+    out = {"theta": chains.theta[:, keep], "mu": chains.mu[:, keep], "lam": chains.lam[:, keep],
+           "lamOs": lam_os, "log_post": chains.log_post[:, keep]}  # fmt: skip
+    for j, m in enumerate(chains.members):
+        if discrepancy and "lamVz" in m:
+            beta, lam = discrepancy_arrays(j)
+            out[beta], out[lam] = m["betaV"][:, keep], m["lamVz"][:, keep]
+    return out
+
+
+def _per_model_discrepancy(discrepancy, groups, n: int) -> list[tuple]:
+    """Each model's (basis, groups) from ``calibrate_study``'s ``discrepancy`` and
+    ``discrepancy_groups``: one value for every model, or a list or tuple with one entry per
+    model. A basis given as a list is read as the per-model list (one matrix for every model:
+    a numpy array); groups as one list of integers are every model's."""
+    if discrepancy is None or isinstance(discrepancy, (str, np.ndarray)):
+        bases = [discrepancy] * n
+    elif isinstance(discrepancy, (list, tuple)):
+        bases = list(discrepancy)
+    else:
+        raise GPMSAError(
+            "discrepancy must be None, 'constant', 'linear', a numpy array (every model's basis) "
+            f"or a list with one of these per model, got {type(discrepancy).__name__}"
+        )
+    if len(bases) != n:
+        raise GPMSAError(
+            f"discrepancy has {len(bases)} entries for {n} models: give one value for every "
+            "model, or a list with one entry (None, 'constant', 'linear' or an array) per model"
+        )
+    one = groups is None or isinstance(groups, np.ndarray) or (
+        isinstance(groups, (list, tuple))
+        and all(isinstance(g, int | np.integer) for g in groups)
+    )  # fmt: skip
+    if one:
+        per = [groups] * n
+    elif isinstance(groups, (list, tuple)):
+        per = list(groups)
+        if len(per) != n:
+            raise GPMSAError(
+                f"discrepancy_groups has {len(per)} entries for {n} models: give one list of "
+                "groups for every model, or a list with one entry (None or a list) per model"
+            )
+    else:
+        per = [groups] * n  # check_groups names what is wrong with it
+    return list(zip(bases, per, strict=True))
 
 
 def calibrate_study(
@@ -97,7 +144,7 @@ def calibrate_study(
     tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     extrapolate: bool = False, progress: bool = False, n_jobs: int | None = None,
-    executor=None, metadata: dict | None = None,
+    executor=None, metadata: dict | None = None, discrepancy=None, discrepancy_groups=None,
 ) -> Study:  # fmt: skip
     """Calibrate several fitted emulators at once, their emulator parameters fixed (as
     ``gpmsa.calibrate`` does for one), with shared and/or hierarchical calibration parameters.
@@ -117,12 +164,19 @@ def calibrate_study(
             seed None draws one from fresh entropy, and the integer the study ran with is
             ``study.settings["seed"]`` (``seed=that`` reruns it).
         metadata: a JSON-able dict saved with the study.
+        discrepancy, discrepancy_groups: each model's discrepancy basis and its precision
+            groups, as ``gpmsa.calibrate``'s (None, "constant", "linear" or an array; groups
+            None or one integer per basis vector): one value for every model, or a list with
+            one entry per model (``["constant", None]``). A list is read as the per-model list:
+            give one matrix for every model as a numpy array.
 
     Returns a ``Study``; ``study.posterior`` names each shared parameter by its name, every
-    other by "NAME[LABEL]", each model's "lamOs[LABEL]" and each hierarchical group's "NAME.mu",
-    "NAME.sd" (native units) and "NAME.lam" (unit-scale precision). GPMSAError names a bad
-    input: mismatched numbers of models, an unknown shared name, a shared or hierarchical
-    parameter whose range differs between the models.
+    other by "NAME[LABEL]", each model's "lamOs[LABEL]" (and with a discrepancy its
+    "betaV[LABEL]" and "lamVz[LABEL]", NAME as ``gpmsa.calibrate`` names it: "betaV[0][LABEL]"
+    for several inputs, "lamVz[1][LABEL]" for several groups) and each hierarchical group's
+    "NAME.mu", "NAME.sd" (native units) and "NAME.lam" (unit-scale precision). GPMSAError
+    names a bad input: mismatched numbers of models (or discrepancy entries), an unknown
+    shared name, a shared or hierarchical parameter whose range differs between the models.
 
     >>> import numpy as np, gpmsa
     >>> t = np.linspace(0.1, 0.9, 12)[:, None]; x = np.tile([[0.0], [1.0]], (6, 1))
@@ -156,13 +210,22 @@ def calibrate_study(
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     extrapolate = check_flag(extrapolate, "extrapolate")
     labels = check_labels(labels, n)
+    bases = _per_model_discrepancy(discrepancy, discrepancy_groups, n)
     layout = layout_of(emulators, labels, shared, hierarchical)
     check_study_names(layout)
     t0 = time.perf_counter()
     models = list(zip(labels, emulators, x_obs, y_obs, strict=True))
-    reduced = [_per_model(lab, reduce, e, x, y, extrapolate) for lab, e, x, y in models]
-    problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate, reduced=r)
-                for (lab, e, x, y), r in zip(models, reduced, strict=True)]  # fmt: skip
+    reduced = []
+    for (lab, e, x, y), (basis, _) in zip(models, bases, strict=True):
+        with warnings.catch_warnings():
+            if basis is not None:  # the reduction with its basis warns (as gpmsa.calibrate)
+                warnings.simplefilter("ignore", ReductionWarning)
+            reduced.append(_per_model(lab, reduce, e, x, y, extrapolate))
+    problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate,
+                           reduced=None if basis is not None else r, discrepancy=basis,
+                           discrepancy_groups=groups)
+                for (lab, e, x, y), r, (basis, groups) in zip(models, reduced, bases,
+                                                              strict=True)]  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})")  # fmt: skip
     chains = sample_study(
@@ -173,8 +236,15 @@ def calibrate_study(
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
     settings[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
     settings[OBS_LAYOUTS] = {lab: r.layout_sha256 for lab, r in zip(labels, reduced, strict=True)}
+    recorded = {lab: {"discrepancy": basis if isinstance(basis, str) else "given",
+                      **discrepancy_record(prob.obs)}
+                for lab, (basis, _), prob in zip(labels, bases, problems, strict=True)
+                if basis is not None}  # fmt: skip
+    if recorded:  # full_prediction(posterior=member_posterior(LABEL)) refuses another basis
+        settings[DISCREPANCIES] = recorded
     study = Study("calibration", emulators, layout, hyper,
-                  _study_draws(chains, slice(int(n_burn), None)), settings, metadata)  # fmt: skip
+                  _study_draws(chains, slice(int(n_burn), None), discrepancy=True), settings,
+                  metadata)  # fmt: skip
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
     return study

@@ -35,10 +35,12 @@ from gpmsa.model.data import check_count
 from gpmsa.model.discrepancy import to_samples
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
 from gpmsa.studies.record import (
+    DISCREPANCIES,
     FILE_RE,
     check_study_arrays,
     check_study_claims,
     check_study_manifest,
+    discrepancy_arrays,
 )
 
 OBS_DIGESTS = "obs_values_sha256_by_model"
@@ -112,14 +114,18 @@ def _through_link(path: Path) -> Path:
 
 def native_chains(layout: Layout, draws: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Named (C, N) chains in native units from the unit-scale draws: each study element, each
-    model's lamOs ("lamOs[LABEL]"), each group's mean "NAME.mu" and sd "NAME.sd" (native: the
-    unit-scale 1/sqrt(lam) times the parameter's range) and precision "NAME.lam" (unit scale)."""
+    model's lamOs ("lamOs[LABEL]") and, where its draws hold them, its discrepancy parameters
+    (NAME[LABEL], NAME as ``gpmsa.calibrate`` names them: "betaV[LABEL]", "lamVz[LABEL]";
+    "betaV[k][LABEL]" for several inputs; "betaV[k,g][LABEL]", "lamVz[g][LABEL]" for several
+    groups), each group's mean "NAME.mu" and sd "NAME.sd" (native: the unit-scale 1/sqrt(lam)
+    times the parameter's range) and precision "NAME.lam" (unit scale)."""
     out = {}
     for e, el in enumerate(layout.elements):
         lo, hi = layout.bounds[e]
         out[el.name] = lo + draws["theta"][:, :, e] * (hi - lo)
     for i, lab in enumerate(layout.labels):
         out[f"lamOs[{lab}]"] = draws["lamOs"][:, :, i]
+        out.update({f"{k}[{lab}]": v for k, v in _drawn_discrepancy(draws, i).items()})
     for h, name in enumerate(layout.groups):
         e = layout.members_of(h)[0]
         lo, hi = layout.bounds[e]
@@ -138,7 +144,8 @@ class Study:
         members: the models' ``gpmsa.Emulator``s, in order; labels: their labels.
         layout: the study elements (``gpmsa.studies.layout.Layout``); hyper: the hyperpriors.
         draws: unit-scale kept draws: theta (C, N, G), mu and lam (C, N, H), lamOs (C, N, M),
-            log_post (C, N).
+            log_post (C, N); a calibration with a discrepancy: model j's betaV (C, N, p, G) and
+            lamVz (C, N, G) as "betaV_j", "lamVz_j".
         posterior: ``gpmsa.Posterior`` in native units (names: ``native_chains``).
         settings, metadata: how it was run; the user's JSON-able dict (saved).
     """
@@ -192,7 +199,9 @@ class Study:
         for k, name in enumerate(self.members[i].t_names):
             out[name] = chains[self.layout.elements[self.layout.index[i][k]].name]
         out["lamOs"] = chains[f"lamOs[{self.labels[i]}]"]
-        out.update(_discrepancy_chains(self.members[i], out["lamOs"].shape))
+        if self.kind == "fit":  # a calibration's members may be joint fits of their own
+            out.update(_discrepancy_chains(self.members[i], out["lamOs"].shape))
+        out.update(_drawn_discrepancy(self.draws, i))
         info = {
             "method": f"study {self.kind}",
             "model": self.labels[i],
@@ -205,12 +214,29 @@ class Study:
         info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy_sha256",
                                               "discrepancy_groups")
                      if k in settings})  # fmt: skip
+        basis = self.settings.get(DISCREPANCIES, {}).get(self.labels[i])
+        if basis is not None:  # a calibration's basis: full_prediction refuses another
+            info.update({k: v for k, v in basis.items() if k != "discrepancy"})
         for key, name in ((OBS_DIGESTS, "obs_values_sha256"), (OBS_LAYOUTS, "obs_layout_sha256")):
             digests = self.settings.get(key)
             digest = digests.get(self.labels[i]) if isinstance(digests, dict) else None
             if isinstance(digest, str):
                 info[name] = digest
         return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out, info=info)
+
+    def discrepancy(self, model: int | str) -> dict | None:
+        """One model's discrepancy as its calibration or fit recorded it: {"discrepancy":
+        "constant", "linear" or "given" (an array), "discrepancy_groups": the precision groups
+        (several) or None (one)}; None for a model without one."""
+        i = self._member(model)
+        if self.kind == "fit":
+            rec = self.members[i].settings or {}
+        else:
+            rec = self.settings.get(DISCREPANCIES, {}).get(self.labels[i]) or {}
+        if rec.get("discrepancy") is None:
+            return None
+        return {"discrepancy": rec["discrepancy"],
+                "discrepancy_groups": rec.get("discrepancy_groups")}  # fmt: skip
 
     def to_record(self, files: list[str], hashes: list[str]) -> tuple[dict, dict]:
         """The study file's (manifest, arrays), its models' files and sha256 given."""
@@ -272,7 +298,7 @@ class Study:
         head, raw = seal(manifest, arrays, fmt=STUDY_FORMAT)
         try:
             check_study_manifest(head)
-            check_study_arrays(head, arrays, self.layout)
+            check_study_arrays(head, arrays, self.layout, tuple(e.p for e in self.members))
             check_study_claims(head, self)
         except EmulatorFileError as exc:
             raise GPMSAError(f"refusing to write {path}, it could not be read back: {exc}") from exc
@@ -317,7 +343,7 @@ def load_study(path: str | Path) -> Study:
     labels = [mod["label"] for mod in study["models"]]
     try:
         layout = layout_of(members, labels, study["shared"], study["hierarchical"])
-        check_study_arrays(manifest, arrays, layout)
+        check_study_arrays(manifest, arrays, layout, tuple(e.p for e in members))
         saved = manifest["priors"]["hyper"]
         hyper = HyperPriors(**{"sd_prior": "gamma", **saved})  # no sd_prior: SEPIA's, as before
         out = Study(study["kind"], members, layout, hyper, arrays, manifest["settings"],
@@ -328,6 +354,15 @@ def load_study(path: str | Path) -> Study:
         raise EmulatorFileError(f"{path}: {exc}") from exc
     except GPMSAError as exc:
         raise EmulatorFileError(f"{path}: study: {exc}") from exc
+
+
+def _drawn_discrepancy(draws: dict[str, np.ndarray], j: int) -> dict[str, np.ndarray]:
+    """Model j's discrepancy chains (C, N) from a calibration's draws ("betaV_j", "lamVz_j"),
+    named as ``gpmsa.calibrate`` names them; none where the draws hold none."""
+    beta, lam = discrepancy_arrays(j)
+    if lam not in draws:
+        return {}
+    return to_samples(draws[beta], draws[lam])
 
 
 def _discrepancy_chains(member, shape: tuple[int, int]) -> dict[str, np.ndarray]:
