@@ -40,14 +40,29 @@ N_WARMUP = 500
 """Default NUTS warm-up (step size and mass-matrix adaptation) iterations per chain."""
 
 
-def _support(problem: Problem, name: str) -> constraints.Constraint:
-    """Constraint of the sampled coordinate of ``name`` (rho for the correlation parameters)."""
+def _support(problem: Problem, name: str, dtype: torch.dtype) -> constraints.Constraint:
+    """Constraint of the sampled coordinate of ``name`` (rho for the correlation parameters);
+    per-group lamVz priors of different bounds give per-element bounds, whose upper ones must be
+    all finite or all infinite (GPMSAError otherwise)."""
     if name == "theta" or name in RHO_PARAMS:
         return constraints.interval(0.0, 1.0)
-    g = getattr(problem.priors, name)
-    if np.isfinite(g.upper):
-        return constraints.interval(g.lower, g.upper)
-    return constraints.greater_than(g.lower)
+    size = int(np.size(problem.init[name]))
+    gs = [problem.priors.precision_prior(name, k) for k in range(size)]
+    if len({(g.lower, g.upper) for g in gs}) == 1:  # one prior's bounds, as floats
+        lower, upper = gs[0].lower, gs[0].upper
+    else:
+        lower = torch.tensor([g.lower for g in gs], dtype=dtype)
+        upper = torch.tensor([g.upper for g in gs], dtype=dtype)
+    finite = np.isfinite(np.atleast_1d(np.asarray(upper, dtype=float)))
+    if finite.all():
+        return constraints.interval(lower, upper)
+    if not finite.any():
+        return constraints.greater_than(lower)
+    raise GPMSAError(
+        f"backend='pyro' samples {name} on its per-group priors' bounds, whose upper bounds "
+        f"{[g.upper for g in gs]} mix finite and infinite ones: give every group a finite "
+        "upper bound, or none (or use backend='numpy' or 'torch')"
+    )
 
 
 def _site(name: str) -> str:
@@ -67,6 +82,7 @@ class PyroModel:
             if k in problem.fixed or np.size(v) == 0
         }
         self.free = tuple(k for k in problem.sampled if k not in self.const)
+        self.support = {name: _support(problem, name, dtype) for name in self.free}
         self.sim_cache = None
         if all(k in self.const for k in SIM_PARAMS):  # Sigma_W constant: factor it once
             d = self.data
@@ -123,7 +139,7 @@ class PyroModel:
         sites = {}
         for name in self.free:
             shape = self.problem.init[name].shape
-            base = dist.ImproperUniform(_support(self.problem, name), (), shape)
+            base = dist.ImproperUniform(self.support[name], (), shape)
             sites[_site(name)] = pyro.sample(_site(name), base).unsqueeze(0)
         prm = self.params(sites)
         pyro.factor("log_prior", self.log_prior(prm)[0])

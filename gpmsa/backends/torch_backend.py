@@ -357,8 +357,13 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
     return ll
 
 
-def log_prior_elements(priors: Priors, name: str, x: Tensor) -> Tensor:
-    """GPM/SA log prior of each element of ``x`` (any shape); -inf outside the bounds."""
+def log_prior_elements(priors: Priors, name: str, x: Tensor, element: int | None = None) -> Tensor:
+    """GPM/SA log prior of each element of ``x`` (any shape); -inf outside the bounds.
+
+    ``element``: x holds that element (index in a 1-D parameter) of ``name`` in every chain;
+    None: x holds whole parameters, along its last axis (lamVz with per-group priors: group g's
+    prior on x[..., g]).
+    """
     inf = torch.full_like(x, -torch.inf)
     if name == "theta":
         val = -0.5 * ((x - priors.theta_mean) / priors.theta_sd) ** 2
@@ -367,8 +372,13 @@ def log_prior_elements(priors: Priors, name: str, x: Tensor) -> Tensor:
         rho = torch.clamp(torch.exp(-0.25 * x), max=priors.rho_cap)
         val = (priors.rho_a - 1.0) * torch.log(rho) + (priors.rho_b - 1.0) * torch.log1p(-rho)
         ok = (x > 0.0) & torch.isfinite(x)
+    elif name == "lamVz" and priors.per_group and element is None:
+        a, b, lo, hi = (x.new_tensor([getattr(g, k) for g in priors.lamvz_priors(x.shape[-1])])
+                        for k in ("a", "b", "lower", "upper"))  # fmt: skip
+        val = (a - 1.0) * torch.log(x) - b * x
+        ok = (x > lo) & (x < hi)
     elif name in PRECISION_PARAMS:
-        g = getattr(priors, name)
+        g = priors.precision_prior(name, element or 0)
         val = (g.a - 1.0) * torch.log(x) - g.b * x
         ok = (x > g.lower) & (x < g.upper)
     else:
@@ -499,7 +509,7 @@ class BatchState:
             corr = torch.log(w0 / w1)
         else:
             cand = x + width * step
-        lp_new = log_prior_elements(self.priors, name, cand)
+        lp_new = log_prior_elements(self.priors, name, cand, idx[-1])
         valid &= torch.isfinite(lp_new)
         accepted = torch.zeros_like(valid)
         if not valid.any():
@@ -534,7 +544,8 @@ class BatchState:
                     chol[:, comps], alpha[:, comps] = chol_c, alpha_c
         ll_obs = self._obs(prm, chol, alpha)
         ll_new = ll_w.sum(-1) + ll_obs
-        ratio = ll_new - self.loglik + lp_new - log_prior_elements(self.priors, name, x) + corr
+        lp_old = log_prior_elements(self.priors, name, x, idx[-1])
+        ratio = ll_new - self.loglik + lp_new - lp_old + corr
         acc = (torch.log(u[1]) < ratio) & valid
         take = torch.nonzero(acc).squeeze(-1)
         accepted[take] = True

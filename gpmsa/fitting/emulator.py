@@ -54,7 +54,7 @@ from gpmsa.model.data import (
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
-from gpmsa.model.priors import GammaPrior, Priors
+from gpmsa.model.priors import GammaPrior, Priors, as_group_priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
 __all__ = [
@@ -576,20 +576,22 @@ class Emulator:
     ) -> Emulator:
         """A copy of this emulator whose calibrations use other priors: theta's truncated normal
         (``theta_mean``, ``theta_sd``, unit scale), the observation precision ``lamOs`` and the
-        discrepancy precision ``lamVz`` (``gpmsa.GammaPrior``s, before any data correction);
-        None keeps the emulator's. ``gpmsa.calibrate``, ``gpmsa.Calibrator`` and the predictions
-        then use them; the emulator's own parameters, draws and their priors are unchanged.
-        The priors are part of ``model_sha256`` (a posterior of the copy refuses the original)
-        and of the saved file. A joint fit's calibration draws, made under the old priors, are
-        not copied (calibrate the copy; ``full_prediction`` then takes ``posterior=``). E.g. a
-        known sensor noise sd s (native units) on a scalar output:
+        discrepancy precision ``lamVz`` (``gpmsa.GammaPrior``s, before any data correction;
+        ``lamVz`` also a sequence of them, one per discrepancy precision group, as
+        ``Priors.lamVz``); None keeps the emulator's. ``gpmsa.calibrate``, ``gpmsa.Calibrator``
+        and the predictions then use them; the emulator's own parameters, draws and their
+        priors are unchanged. The priors are part of ``model_sha256`` (a posterior of the copy
+        refuses the original) and of the saved file. A joint fit's calibration draws, made under
+        the old priors, are not copied (calibrate the copy; ``full_prediction`` then takes
+        ``posterior=``). E.g. a known sensor noise sd s (native units) on a scalar output:
         ``lamOs=GammaPrior(a, a * (s / y_sd) ** 2)`` centres lamOs on (y_sd / s)^2 with relative
         sd 1/sqrt(a)."""
         given = {"theta_mean": theta_mean, "theta_sd": theta_sd, "lamOs": lamOs, "lamVz": lamVz}
         given = {k: v for k, v in given.items() if v is not None}
-        for name in ("lamOs", "lamVz"):
-            if name in given and not isinstance(given[name], GammaPrior):
-                raise GPMSAError(f"{name} must be a gpmsa.GammaPrior, got {given[name]!r:.80}")
+        if "lamOs" in given and not isinstance(given["lamOs"], GammaPrior):
+            raise GPMSAError(f"lamOs must be a gpmsa.GammaPrior, got {given['lamOs']!r:.80}")
+        if "lamVz" in given:
+            given["lamVz"] = as_group_priors(given["lamVz"], "lamVz")
         priors = dataclasses.replace(self.priors, **given)  # checked by Priors' own rules
         state = self.__getstate__()
         state["priors"] = priors

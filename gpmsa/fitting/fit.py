@@ -358,8 +358,9 @@ def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
     settings = emulator.settings or {}
     mb = problem.mean_basis
     disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
+    n_grp = problem.obs.n_groups if problem.obs is not None and problem.obs.p_v else 0
     checks = {
-        "priors": (emulator.priors.to_dict(), problem.priors.to_dict()),
+        "priors": (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp)),
         "mean_basis": (settings.get("mean_basis"), None if mb is None else mb.kind),
         "fixed parameters": (settings.get("fixed", {}),
                              {k: problem.init[k].tolist() for k in sorted(problem.fixed)}),
@@ -369,3 +370,14 @@ def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
                         {k: disc.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")}),
     }  # fmt: skip
     return [name for name, (old, new) in checks.items() if old != new]
+
+
+def _prior_record(priors: Priors, n_grp: int) -> dict:
+    """``priors.to_dict()`` with lamVz as the list of the ``n_grp`` groups' priors (a shared
+    prior and equal per-group ones are one model); as written without a discrepancy, or where
+    the per-group priors do not fit the groups."""
+    out = priors.to_dict()
+    if n_grp and (not priors.per_group or len(priors.lamVz) == n_grp):
+        one = replace(priors, lamVz=priors.lamvz_priors(n_grp)).to_dict()
+        out["lamVz"] = one["lamVz"]
+    return out

@@ -184,18 +184,43 @@ def check_priors(priors) -> None:
         raise _fail("priors.corrected", f"must be true or false, got {_short(priors['corrected'])}")
     for name in PRECISIONS:
         g = priors[name]
-        field = f"priors.{name}"
-        if not isinstance(g, dict) or set(g) != {"a", "b", "lower", "upper"}:
-            raise _fail(field, f"must be an object {{a, b, lower, upper}}, got {_short(g)}")
-        a, b = _number(g["a"], f"{field}.a"), _number(g["b"], f"{field}.b")
-        if not 0 < a <= MAX_PRIOR_SHAPE:
-            raise _fail(f"{field}.a", f"{a!r} is out of range: allowed (0, {MAX_PRIOR_SHAPE:g}]")
-        if not (0 < b and math.isfinite(b)):
-            raise _fail(f"{field}.b", f"{b!r} is out of range: allowed (0, inf), finite")
-        lo = _number(g["lower"], f"{field}.lower")
-        hi = math.inf if g["upper"] == "inf" else _number(g["upper"], f"{field}.upper")
-        if not (math.isfinite(lo) and 0 <= lo < hi):
-            raise _fail(f"{field}.lower", f"bounds ({lo!r}, {hi!r}): need 0 <= lower < upper")
+        if name == "lamVz" and isinstance(g, list):  # one prior per discrepancy precision group
+            if not g:
+                raise _fail("priors.lamVz", "an empty list: per-group priors need one per group")
+            for i, e in enumerate(g):
+                _check_gamma(e, f"priors.lamVz[{i}]")
+        else:
+            _check_gamma(g, f"priors.{name}")
+
+
+def _check_gamma(g, field: str) -> None:
+    """One Gamma prior as ``Priors.to_dict`` writes it, with valid values."""
+    if not isinstance(g, dict) or set(g) != {"a", "b", "lower", "upper"}:
+        raise _fail(field, f"must be an object {{a, b, lower, upper}}, got {_short(g)}")
+    a, b = _number(g["a"], f"{field}.a"), _number(g["b"], f"{field}.b")
+    if not 0 < a <= MAX_PRIOR_SHAPE:
+        raise _fail(f"{field}.a", f"{a!r} is out of range: allowed (0, {MAX_PRIOR_SHAPE:g}]")
+    if not (0 < b and math.isfinite(b)):
+        raise _fail(f"{field}.b", f"{b!r} is out of range: allowed (0, inf), finite")
+    lo = _number(g["lower"], f"{field}.lower")
+    hi = math.inf if g["upper"] == "inf" else _number(g["upper"], f"{field}.upper")
+    if not (math.isfinite(lo) and 0 <= lo < hi):
+        raise _fail(f"{field}.lower", f"bounds ({lo!r}, {hi!r}): need 0 <= lower < upper")
+
+
+def check_prior_groups(priors: dict, shapes: dict[str, tuple[int, ...]]) -> None:
+    """Per-group lamVz priors (a list) give one prior per precision group of a joint fit's
+    discrepancy draws (``cal_lamVz``, (n_draws, G))."""
+    groups = priors["lamVz"]
+    lam = shapes.get("cal_lamVz")
+    if isinstance(groups, list) and lam is not None:
+        n_grp = lam[1] if len(lam) == 2 else 1
+        if len(groups) != n_grp:
+            raise _fail(
+                "priors.lamVz",
+                f"{len(groups)} per-group priors, but arrays/cal_lamVz holds draws of {n_grp} "
+                "discrepancy precision group(s)",
+            )
 
 
 def check_fields(manifest: dict, dims: dict[str, int]) -> None:
@@ -289,11 +314,13 @@ def check_manifest(manifest: dict) -> None:
     """The declared content of a file, before its arrays are decompressed (``read_raw``'s
     ``check``): the shapes the manifest lists and every other field."""
     specs = manifest["arrays"]
-    dims = check_shapes({k: tuple(v["shape"]) for k, v in specs.items()})
+    shapes = {k: tuple(v["shape"]) for k, v in specs.items()}
+    dims = check_shapes(shapes)
     for name in specs:
         if _known(name) and specs[name]["dtype"] != "<f8":
             raise _fail(f"arrays/{name}", f"dtype {specs[name]['dtype']}: must be <f8 (float64)")
     check_fields(manifest, dims)
+    check_prior_groups(manifest["priors"], shapes)
 
 
 def _known(name: str) -> bool:
@@ -423,8 +450,10 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     for name, arr in arrays.items():
         if not isinstance(arr, np.ndarray):
             raise _fail(f"arrays/{name}", f"must be an array, got {type(arr).__name__}")
-    dims = check_shapes({k: v.shape for k, v in arrays.items()})
+    shapes = {k: v.shape for k, v in arrays.items()}
+    dims = check_shapes(shapes)
     check_fields(manifest, dims)
+    check_prior_groups(manifest["priors"], shapes)
     check_values(arrays, dims)
     check_categorical(manifest, arrays, dims)
     return dims

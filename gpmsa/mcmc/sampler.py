@@ -184,7 +184,7 @@ class ChainState:
         self.kinds = [
             1 if n in RHO_PARAMS else 2 if n in PRECISION_PARAMS else 0 for n, _ in self.els
         ]
-        self.el_prior = [problem.priors.scalar_log_prior(n) for n, _ in self.els]
+        self.el_prior = [pri.scalar_log_prior(n, idx[-1]) for n, idx in self.els]
         levels = problem.theta_levels or []
         self.levels: list[np.ndarray | None] = [None] * len(self.els)
         for i, (n, idx) in enumerate(self.els):  # a categorical theta: a move to another level

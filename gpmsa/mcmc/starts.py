@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.priors import GammaPrior
+from gpmsa.model.priors import GammaPrior, Priors
 from gpmsa.model.problem import Problem
 
 CHOICES = ("auto", "gpmsa", "jitter", "prior")
@@ -88,16 +88,25 @@ def start_generator(seed: np.random.SeedSequence) -> np.random.Generator:
     return np.random.default_rng(child)
 
 
-def _gamma(g: GammaPrior, size: int, rng: np.random.Generator) -> np.ndarray:
-    out = rng.gamma(g.a, 1.0 / g.b, size)
+def _bounds(pri: Priors, name: str, size: int) -> tuple[np.ndarray, ...]:
+    """(a, b, lower, upper), each (size,): the Gamma prior of each element of precision
+    ``name`` (lamVz's per-group priors element by element, ``Priors.precision_prior``)."""
+    gs = [pri.precision_prior(name, k) for k in range(size)]
+    return tuple(np.array([getattr(g, f) for g in gs]) for f in ("a", "b", "lower", "upper"))
+
+
+def _gamma(pri: Priors, name: str, size: int, rng: np.random.Generator) -> np.ndarray:
+    """A draw of each of ``size`` elements of precision ``name`` from its truncated Gamma."""
+    a, b, lower, upper = _bounds(pri, name, size)
+    out = rng.gamma(a, 1.0 / b)
     for _ in range(1000):
-        bad = (out <= g.lower) | (out >= g.upper)
+        bad = (out <= lower) | (out >= upper)
         if not bad.any():
             return out
-        out[bad] = rng.gamma(g.a, 1.0 / g.b, int(bad.sum()))
+        out[bad] = rng.gamma(a[bad], 1.0 / b[bad])
     # a prior with little mass inside its bounds: the bounds' geometric middle
-    hi = g.upper if np.isfinite(g.upper) else 10.0 * max(g.lower, g.a / g.b)
-    out[bad] = np.sqrt(max(g.lower, 1e-12) * hi)
+    hi = np.where(np.isfinite(upper), upper, 10.0 * np.maximum(lower, a / b))
+    out[bad] = np.sqrt(np.maximum(lower, 1e-12) * hi)[bad]
     return out
 
 
@@ -125,6 +134,9 @@ def check_start(problem: Problem, start: dict[str, np.ndarray], how: str) -> Non
             where = f"the support of the {name} prior"
             if isinstance(prior, GammaPrior):
                 where = f"the bounds ({prior.lower:g}, {prior.upper:g}) of Priors.{name}"
+            elif isinstance(prior, tuple):
+                cells = ", ".join(f"({g.lower:g}, {g.upper:g})" for g in prior)
+                where = f"the bounds of the per-group Priors.{name} [{cells}]"
             raise GPMSAError(
                 f"the chains' start {name} = {np.ravel(value).tolist()} ({how!r} start) lies "
                 f"outside {where}: zero prior density. Widen the prior's bounds, or start inside "
@@ -152,36 +164,38 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
             else:
                 rho = np.minimum(rng.beta(pri.rho_a, pri.rho_b, size), pri.rho_cap)
             val = -4.0 * np.log(rho)
+        elif how == "jitter":  # log-uniform on [x0 / f, x0 f] cut to the bounds
+            x = x0.ravel()
+            _, _, lower, upper = _bounds(pri, name, size)
+            lo = np.maximum(x / PRECISION_JITTER, lower * (1.0 + 1e-3) + 1e-12)
+            hi = np.minimum(x * PRECISION_JITTER, upper * (1.0 - 1e-3))
+            lo, hi = _jitter_range(name, lower, upper, x, lo, hi)
+            val = np.exp(rng.uniform(np.log(lo), np.log(hi)))
         else:
-            g = getattr(pri, name)
-            if how == "jitter":  # log-uniform on [x0 / f, x0 f] cut to the bounds
-                x = x0.ravel()
-                lo = np.maximum(x / PRECISION_JITTER, g.lower * (1.0 + 1e-3) + 1e-12)
-                hi = np.minimum(x * PRECISION_JITTER, g.upper * (1.0 - 1e-3))
-                lo, hi = _jitter_range(name, g, x, lo, hi)
-                val = np.exp(rng.uniform(np.log(lo), np.log(hi)))
-            else:
-                val = _gamma(g, size, rng)
+            val = _gamma(pri, name, size, rng)
         out[name] = np.asarray(val, dtype=np.float64).reshape(x0.shape)
     check_start(problem, out, how)
     return out
 
 
-def _jitter_range(name: str, g: GammaPrior, x: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+def _jitter_range(name: str, lower: np.ndarray, upper: np.ndarray, x: np.ndarray,
+                  lo: np.ndarray, hi: np.ndarray):  # fmt: skip
     """(lo, hi) of a precision's jittered start where the cut [x0 / f, x0 f] is empty: x0 itself
-    when it lies inside the prior's bounds (bounds narrower than their 1e-3 margins), a
-    GPMSAError naming the parameter and its bounds when it lies outside them (as the 'gpmsa'
-    start's, ``check_start``)."""
+    when it lies inside the prior's bounds (lower, upper) (bounds narrower than their 1e-3
+    margins), a GPMSAError naming the parameter and its bounds when it lies outside them (as
+    the 'gpmsa' start's, ``check_start``)."""
     empty = lo > hi
     if not empty.any():
         return lo, hi
-    inside = (x > g.lower) & (x < g.upper)
+    inside = (x > lower) & (x < upper)
     if np.any(empty & ~inside):
+        k = int(np.argmax(empty & ~inside))
+        group = f" (group {k}'s)" if name == "lamVz" and x.size > 1 else ""
         raise GPMSAError(
             f"the chains' start {name} = {x.tolist()} ('jitter' start: log-uniform on "
             f"[x0 / {PRECISION_JITTER:g}, x0 * {PRECISION_JITTER:g}]) cannot reach the bounds "
-            f"({g.lower:g}, {g.upper:g}) of Priors.{name}: zero prior density. Widen the prior's "
-            "bounds, or start inside them (init='prior', or a fixed= value)"
+            f"({lower[k]:g}, {upper[k]:g}) of Priors.{name}{group}: zero prior density. Widen "
+            "the prior's bounds, or start inside them (init='prior', or a fixed= value)"
         )
     return np.where(empty, x, lo), np.where(empty, x, hi)
 

@@ -75,6 +75,9 @@ class Priors:
     density; beta in (0, inf). Precisions: Gamma priors below. ``lamWOs`` and ``lamOs`` here are
     the base priors before the data corrections of GPM/SA (see ``with_data``); ``gpmsa.fit``
     refuses corrected priors (``corrected=True``, e.g. an Emulator's ``priors``).
+    ``lamVz``: one GammaPrior shared by every discrepancy precision group, or a sequence of them
+    (stored as a tuple), one per group, as GPM/SA's per-group rows of priors.lamVz.params:
+    group g's lamVz[g] gets the g-th; a model with a discrepancy of G groups needs G of them.
     """
 
     theta_mean: float = 0.5
@@ -82,7 +85,9 @@ class Priors:
     rho_a: float = 1.0
     rho_b: float = 0.1
     rho_cap: float = 0.999
-    lamVz: GammaPrior = field(default_factory=lambda: GammaPrior(1.0, 1e-3))
+    lamVz: GammaPrior | tuple[GammaPrior, ...] = field(
+        default_factory=lambda: GammaPrior(1.0, 1e-3)
+    )
     lamUz: GammaPrior = field(default_factory=lambda: GammaPrior(5.0, 5.0, 0.3))
     lamWs: GammaPrior = field(default_factory=lambda: GammaPrior(3.0, 3e-3, 60.0, 1e5))
     lamWOs: GammaPrior = field(default_factory=lambda: GammaPrior(5.0, 5e-3, 60.0, 1e5))
@@ -103,8 +108,9 @@ class Priors:
                 name == "theta_mean" or v > 0)  # fmt: skip
             if not ok:
                 raise GPMSAError(f"Priors.{name} must be {rule}, got {v}")
+        object.__setattr__(self, "lamVz", as_group_priors(self.lamVz, "Priors.lamVz"))
         for name in PRECISIONS:
-            if not isinstance(getattr(self, name), GammaPrior):
+            if name != "lamVz" and not isinstance(getattr(self, name), GammaPrior):
                 raise GPMSAError(f"Priors.{name} must be a gpmsa.GammaPrior, got "
                                  f"{getattr(self, name)!r}")  # fmt: skip
         if not isinstance(self.corrected, bool):
@@ -126,11 +132,46 @@ class Priors:
             corrected=True,
         )
 
+    @property
+    def per_group(self) -> bool:
+        """Whether ``lamVz`` holds one prior per discrepancy precision group (a tuple)."""
+        return isinstance(self.lamVz, tuple)
+
+    def lamvz_priors(self, n_groups: int) -> tuple[GammaPrior, ...]:
+        """The lamVz prior of each of ``n_groups`` discrepancy precision groups: the shared one
+        repeated, or the per-group ones; GPMSAError naming both counts when they differ."""
+        if not self.per_group:
+            return (self.lamVz,) * n_groups
+        if len(self.lamVz) != n_groups:
+            raise GPMSAError(
+                f"Priors.lamVz gives {len(self.lamVz)} per-group prior(s) but the discrepancy has "
+                f"{n_groups} precision group(s) (discrepancy_groups): give one GammaPrior per "
+                "group, or one GammaPrior shared by all"
+            )
+        return self.lamVz
+
+    def precision_prior(self, name: str, element: int = 0) -> GammaPrior:
+        """The Gamma prior of element ``element`` of precision ``name``: lamVz[g]'s is the g-th
+        of per-group priors; every other element shares its parameter's one prior."""
+        g = getattr(self, name)
+        if not isinstance(g, tuple):
+            return g
+        if not 0 <= element < len(g):
+            raise GPMSAError(
+                f"Priors.lamVz gives {len(g)} per-group prior(s); there is none for group "
+                f"{element}: give one GammaPrior per discrepancy precision group"
+            )
+        return g[element]
+
     def to_dict(self) -> dict:
-        """JSON-able dict (infinite bounds as the string "inf")."""
+        """JSON-able dict (infinite bounds as the string "inf"); per-group lamVz priors as a
+        list of such dicts, one per group."""
         d = asdict(self)
         for name in PRECISIONS:
-            d[name] = {k: ("inf" if v == float("inf") else v) for k, v in d[name].items()}
+            if isinstance(d[name], tuple):
+                d[name] = [_gamma_dict(g) for g in d[name]]
+            else:
+                d[name] = _gamma_dict(d[name])
         return d
 
     @classmethod
@@ -144,12 +185,15 @@ class Priors:
         kw = dict(d)
         for name in PRECISIONS:
             g = d.get(name)
-            if not isinstance(g, dict) or not {"a", "b"} <= set(g) <= {"a", "b", "lower", "upper"}:
-                raise GPMSAError(
-                    f"Priors.from_dict: {name} must be a dict with a, b (and lower, upper), "
-                    f"got {g!r}"
-                )
-            kw[name] = GammaPrior(**{k: _float(v, f"{name}.{k}") for k, v in g.items()})
+            if name == "lamVz" and isinstance(g, list):
+                if not g:
+                    raise GPMSAError(
+                        f"Priors.from_dict: {name} as a list needs one prior per discrepancy "
+                        "precision group, got an empty list"
+                    )
+                kw[name] = tuple(_gamma_from(e, f"{name}[{i}]") for i, e in enumerate(g))
+            else:
+                kw[name] = _gamma_from(g, name)
         return cls(**kw)
 
     def log_theta(self, theta: np.ndarray) -> float:
@@ -167,8 +211,9 @@ class Priors:
         rho = np.minimum(np.exp(-0.25 * beta), self.rho_cap)
         return float(np.sum((self.rho_a - 1.0) * np.log(rho) + (self.rho_b - 1.0) * np.log1p(-rho)))
 
-    def scalar_log_prior(self, name: str):
-        """A fast function float -> float: the log prior of one element of ``name``."""
+    def scalar_log_prior(self, name: str, element: int = 0):
+        """A fast function float -> float: the log prior of element ``element`` (its index in a
+        1-D parameter: lamVz's group, whose prior may be its own) of ``name``."""
         if name == "theta":
             mu, sd = self.theta_mean, self.theta_sd
 
@@ -185,7 +230,7 @@ class Priors:
                 return a1 * math.log(rho) + b1 * math.log1p(-rho)
 
         elif name in PRECISIONS:
-            g = getattr(self, name)
+            g = self.precision_prior(name, element)
             a1, b, lo, hi = g.a - 1.0, g.b, g.lower, g.upper
 
             def f(x: float) -> float:
@@ -196,11 +241,51 @@ class Priors:
         return f
 
     def log_prior(self, name: str, value: np.ndarray) -> float:
-        """Log prior of parameter ``name`` at ``value`` (any shape)."""
+        """Log prior of parameter ``name`` at ``value`` (any shape; lamVz with per-group priors:
+        (G,), element g under the g-th)."""
         if name == "theta":
             return self.log_theta(value)
         if name in ("betaU", "betaV"):
             return self.log_beta(value)
+        if name == "lamVz" and self.per_group:
+            x = np.asarray(value, dtype=np.float64).reshape(-1)
+            gs = self.lamvz_priors(x.size)
+            a, b, lo, hi = (np.array([getattr(g, k) for g in gs]) for k in ("a", "b", "lower",
+                                                                           "upper"))  # fmt: skip
+            if np.any(x <= lo) or np.any(x >= hi):
+                return -np.inf
+            return float(np.sum((a - 1.0) * np.log(x) - b * x))
         if name in PRECISIONS:
             return getattr(self, name).log_density(value)
         raise GPMSAError(f"unknown parameter name {name!r}")
+
+
+def as_group_priors(value, what: str) -> GammaPrior | tuple[GammaPrior, ...]:
+    """``value`` as a lamVz prior: one GammaPrior, or a non-empty sequence of them as a tuple
+    (one per discrepancy precision group); GPMSAError naming ``what`` otherwise."""
+    if isinstance(value, GammaPrior):
+        return value
+    if isinstance(value, list | tuple) and value and all(isinstance(g, GammaPrior) for g in value):
+        return tuple(value)
+    raise GPMSAError(
+        f"{what} must be a gpmsa.GammaPrior (shared by every discrepancy precision group) or a "
+        f"non-empty list or tuple of them (one per group), got {value!r:.120}"
+    )
+
+
+def _gamma_dict(g: dict) -> dict:
+    """A GammaPrior's ``asdict`` with an infinite bound as the string "inf"."""
+    return {k: ("inf" if v == float("inf") else v) for k, v in g.items()}
+
+
+def _gamma_from(g, name: str) -> GammaPrior:
+    """The GammaPrior of a ``to_dict`` entry; GPMSAError naming ``name`` otherwise."""
+    if not isinstance(g, dict) or not {"a", "b"} <= set(g) <= {"a", "b", "lower", "upper"}:
+        raise GPMSAError(
+            f"Priors.from_dict: {name} must be a dict with a, b (and lower, upper), got {g!r}"
+        )
+    values = {k: _float(v, f"{name}.{k}") for k, v in g.items()}
+    try:
+        return GammaPrior(**values)
+    except GPMSAError as exc:
+        raise GPMSAError(f"Priors.from_dict: {name}: {exc}") from None

@@ -120,6 +120,12 @@ class Problem:
     mean_basis: mean_basis_mod.MeanBasis | None = None
     constraint: ThetaConstraint | None = None
 
+    def __post_init__(self) -> None:
+        """GPMSAError when per-group lamVz priors do not give one prior per discrepancy
+        precision group (``Priors.lamvz_priors``), before any sampling."""
+        if self.obs is not None and self.obs.p_v:
+            self.priors.lamvz_priors(self.obs.n_groups)
+
     @property
     def m(self) -> int:
         """Number of simulation runs."""

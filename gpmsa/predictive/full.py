@@ -434,6 +434,8 @@ def full_prediction(
             f"the draws have {drawn} discrepancy precision group(s) but discrepancy_groups="
             f"{discrepancy_groups!r} gives {ob.n_groups}: pass the calibration's groups"
         )
+    if p_v:  # per-group lamVz priors, one per group
+        emulator.priors.lamvz_priors(ob.n_groups)
     fitted = record.get("discrepancy_sha256")  # the joint fit's or calibrate's basis
     recorded = record.get("discrepancy_groups")  # absent beside a digest: one group
     given = None if ob.v_groups is None else list(ob.v_groups)
