@@ -80,7 +80,7 @@ def calibration_problem(
         check_groups(discrepancy_groups, 0)  # groups without a basis: refused
         data = reduce(emulator, x_obs, y_obs, extrapolate) if reduced is None else reduced
         obs, corr = data.obs, data.os_corr
-        fit = _probe(emulator, data, [emulator.params])
+        fit = observation_fit(emulator, data, [emulator.params])
         start = lamos_start(fit, data.lamos)
     else:
         given = given_obs_data(x_obs, y_obs)
@@ -285,7 +285,7 @@ def calibrate(
             if discrepancy is not None:  # the reduction with its basis warns (_run_backend)
                 warnings.simplefilter("ignore", ReductionWarning)
             data = reduce(emulator, x_obs, y_obs, extrapolate)
-        fit = _probe(emulator, data, sets)
+        fit = observation_fit(emulator, data, sets)
         warn_if_outside(fit, discrepancy=discrepancy is not None)
         if fast:
             draws, info = _run_fast(
@@ -339,7 +339,7 @@ def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:
     return {k: checked[k] for k in given}
 
 
-def _probe(emulator, data, sets) -> Fit:
+def observation_fit(emulator, data, sets) -> Fit:
     """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets)."""
     theta = theta_probe(emulator.t_unit.shape[1])
     fits = [fit_of(*fixed_gp(emulator, s).predict(data.x, theta), data) for s in sets]

@@ -455,10 +455,13 @@ def _residual_noise(data: Observations) -> np.ndarray | float:
     return np.sum(data.obs_chol**2, axis=1) / lamos
 
 
-def warn_if_outside(fit: Fit, stacklevel: int = 3, discrepancy: bool = False) -> None:
+def warn_if_outside(
+    fit: Fit, stacklevel: int = 3, discrepancy: bool = False, model: str | None = None
+) -> None:
     """Warn (``OutsideEmulatorWarning``) when the observation lies more than ``OUTSIDE_SDS``
     predictive sds from every emulator prediction at its x; ``discrepancy``: a discrepancy
-    model is calibrated too (the warning says that it must explain the difference)."""
+    model is calibrated too (the warning says that it must explain the difference); ``model``:
+    the study model's label the warning names."""
     if fit.outside_sds > OUTSIDE_SDS:
         then = (
             "The discrepancy term and the observation error must then explain the difference "
@@ -468,6 +471,7 @@ def warn_if_outside(fit: Fit, stacklevel: int = 3, discrepancy: bool = False) ->
             "and theta falls back towards its prior; "
         )
         warnings.warn(
+            f"{'' if model is None else f'model {model!r}: '}"
             f"y_obs lies {fit.outside_sds:.3g} predictive sds from the nearest emulator "
             f"prediction at x_obs over the whole theta domain (more than {OUTSIDE_SDS:g})"
             f"{' (the emulator alone)' if discrepancy else ''}: the observation is outside "

@@ -11,8 +11,8 @@ from datetime import datetime, timezone
 import numpy as np
 
 from gpmsa._version import library_versions
-from gpmsa.calibration.calibrate import calibration_problem
-from gpmsa.calibration.observations import check_emulator, reduce
+from gpmsa.calibration.calibrate import calibration_problem, observation_fit
+from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.fitting.fit import check_keep, check_point, point_estimate, thinning
@@ -221,6 +221,8 @@ def calibrate_study(
             if basis is not None:  # the reduction with its basis warns (as gpmsa.calibrate)
                 warnings.simplefilter("ignore", ReductionWarning)
             reduced.append(_per_model(lab, reduce, e, x, y, extrapolate))
+        fit = observation_fit(e, reduced[-1], [e.params])  # as gpmsa.calibrate warns
+        warn_if_outside(fit, stacklevel=3, discrepancy=basis is not None, model=lab)
     problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate,
                            reduced=None if basis is not None else r, discrepancy=basis,
                            discrepancy_groups=groups)
