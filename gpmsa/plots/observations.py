@@ -22,7 +22,9 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
 
     Args:
         emulator: a gpmsa.Emulator.
-        obs: a gpmsa.ObsData (experiments on the simulation grid or their own index).
+        obs: a gpmsa.ObsData (experiments on the simulation grid or their own index; known
+            inputs up to calibration's extrapolation margin outside the runs' range are shown,
+            with its warning).
         max_pc: components shown at most.
         bins: histogram bins.
 
@@ -42,7 +44,7 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be a gpmsa.ObsData, got {type(obs).__name__}")
     max_pc = check_count(max_pc, "max_pc")
-    reduced = reduce(emulator, obs, None).obs
+    reduced = reduce(emulator, obs, None, extrapolate=True).obs  # a plot shows them all
     n_pc = min(max_pc, emulator.p_u)
     functional = emulator.K.shape[0] > 1
     bins = check_bins(bins, n_pc, "plots.obs_projection")

@@ -14,6 +14,7 @@ MODULES = [
     "gpmsa.predictive.sobol",
     "gpmsa.predictive.crossval",
     "gpmsa.plots.mcmc",
+    "gpmsa.plots.observations",
     "gpmsa.plots.emulator",
     "gpmsa.plots.prediction",
     "gpmsa.plots.rho",
