@@ -254,6 +254,11 @@ class _Phase:
 
     def reset(self) -> None:
         self.filter.reset()
+        self.forget_stream()
+
+    def forget_stream(self) -> None:
+        """Forget its blocks' positions, times, undo and guard, and the quiet check's scores;
+        keep the filter's GD state."""
         self.pos_block, self.pending_m, self.data_time = np.nan, 0.0, np.nan
         self.undo, self.guard = None, False
         self.levels.clear()
@@ -388,6 +393,40 @@ class BCR:
 
     def reset(self) -> None:
         """Empty the buffers and forget the GD state."""
+        self._forget_stream()
+        if self.settings.method == "changepoint":
+            for phase in self._phases:
+                phase.reset()
+        else:
+            for tracker in self.trackers:
+                tracker.reset()
+        self.last = Estimate(time=0.0, position=0.0, status="filling", reason="no samples yet")
+
+    def resume(self, moved_m: float) -> None:
+        """Start a new stream after downtime (a restart, or a BCR restored from a pickle),
+        keeping the GD state: the buffers, clocks and faults emptied as ``reset`` empties them,
+        and the GD state propagated over ``moved_m`` metres the robot may have moved while down
+        (its prior of change points over that distance: 0, it stood still; the longer, the
+        likelier a change; ``math.inf``, forget it, as ``reset``). The first estimates then
+        start from what the BCR knew instead of the prior (docs/robot.md, "A saved BCR")."""
+        if not (is_real(moved_m) and moved_m >= 0):
+            raise ControlError(f"moved_m must be a real number >= 0 (metres), got {moved_m!r}")
+        if np.isinf(moved_m):
+            self.reset()
+            return
+        self._forget_stream()
+        if self.settings.method == "changepoint":
+            for phase in self._phases:
+                phase.forget_stream()
+                phase.filter.relocate(float(moved_m))
+        else:
+            for tracker in self.trackers:
+                tracker.predict(float(moved_m))
+        reason = f"resumed ({moved_m:g} m moved while down); no samples yet"
+        self.last = Estimate(time=0.0, position=0.0, status="filling", reason=reason)
+
+    def _forget_stream(self) -> None:
+        """Empty the buffers, clocks and fault state (what ``reset`` and ``resume`` share)."""
         self._acc = np.empty(0)  # contiguous clean samples (block or window)
         self._spd = np.empty(0)
         self._t = np.empty(0)  # their times and positions (the timing and odometry check)
@@ -405,13 +444,6 @@ class BCR:
         self._data_time = np.nan  # newest information of the window methods (phases keep theirs)
         self._phase = 0  # the change-point phase of the newest update
         self._tracked_at: list[float | None] = [None] * len(getattr(self, "trackers", ()))
-        if self.settings.method == "changepoint":
-            for phase in self._phases:
-                phase.reset()
-        else:
-            for tracker in self.trackers:
-                tracker.reset()
-        self.last = Estimate(time=0.0, position=0.0, status="filling", reason="no samples yet")
 
     def update(self, t, position, accel, speed, *, now: float | None = None) -> Estimate:
         """Take new samples; return the newest estimate (or why there is none), or the gravest
@@ -839,8 +871,9 @@ class BCR:
         first, and their weights in the pooled estimate (`_pooled_posterior`)."""
         if len(self._phases) == 1:
             return [self._phases[0].filter], np.ones(1)
-        used = sorted(
-            (ph for ph in self._phases if ph.filter.has_data), key=lambda ph: -ph.data_time
+        used = sorted(  # data of this stream (a resumed phase's GD state joins with its block)
+            (ph for ph in self._phases if ph.filter.has_data and np.isfinite(ph.data_time)),
+            key=lambda ph: -ph.data_time,
         )
         weights = np.arange(len(self._phases), len(self._phases) - len(used), -1, dtype=float)
         return [ph.filter for ph in used], weights

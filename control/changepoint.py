@@ -145,7 +145,15 @@ class ChangePointFilter:
         """Propagate over ds_m metres (change points; GD unchanged within a run)."""
         self._set(*self._predicted(ds_m))
 
-    def _predicted(self, ds_m: float) -> tuple[np.ndarray, np.ndarray]:
+    def relocate(self, ds_m: float) -> None:
+        """Propagate over ds_m metres moved without data (a robot moved while down): as
+        ``predict``, but a run that ended there is followed by GD from the prior, not by a
+        jump from the last GD (the ground it ended on is unrelated to the last, and a long
+        move holds many changes, not the one ``predict`` allows per step), and starts here, as
+        after ``reset`` (where the move ended says nothing of how long ago the ground changed)."""
+        self._set(*self._predicted(ds_m, from_prior=True))
+
+    def _predicted(self, ds_m: float, from_prior: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """(mass, dist) after ds_m metres, the filter unchanged. Runs beyond ``max_runs`` are
         merged into the last row at their mass-weighted mean distance, which keeps growing.
         No distance (``ds_m == 0``, a standstill) is no hazard: the state stays as it is (a
@@ -159,9 +167,12 @@ class ChangePointFilter:
         h = self._hazard(ds_m)
         ended = (h[:, None] * self._mass).sum(axis=0)
         mass = np.empty((self._mass.shape[0] + 1, self.gd.size))
-        mass[0] = ended @ self._jump  # the new run: the mass that ended, redrawn
+        # the new run: the mass that ended, redrawn (by a jump, or from the prior)
+        mass[0] = ended.sum() * self.prior if from_prior else ended @ self._jump
         np.multiply(self._mass, (1.0 - h)[:, None], out=mass[1:])
         dist = np.concatenate([[0.0], self._dist]) + ds_m  # a new run holds the step, as the first
+        if from_prior:  # a new segment here, as after `reset`: a move's end tells not its age
+            dist[0] = 0.0
         R = self.settings.max_runs
         if mass.shape[0] > R:
             tail = mass[R - 1 :].sum(axis=1)

@@ -170,3 +170,68 @@ def test_a_drive_whose_clock_steps_back_half_way_resumes_with_now_on_that_clock(
     out, _ = _loop(control.BCR.from_emulator(control.shipped_emulator("B")), stepped, p, a, v)
     after = [e.status for e in out[half // EVERY :]]
     assert after[:5] == ["sensor_fault"] + ["filling"] * 4 and set(after[5:]) == {"ok"}
+
+
+def test_a_restored_bcr_resumes_with_its_gd_state_kept_and_moved():
+    """Session 62: ``resume(moved_m)`` starts a new stream as ``reset`` does (no latch, the
+    first ok estimate at the third update) but keeps the GD state, so the first estimates are
+    tighter than ``reset``'s (sd 49 against 85 above); a long move forgets most of it, and
+    ``math.inf`` is ``reset``."""
+    import math
+    import pickle
+
+    import control
+
+    t, p, a, v = _drive([(80.0, 300.0)], 1.0)
+    half = t.size // 2 // EVERY * EVERY
+    bcr = control.BCR.from_emulator(control.shipped_emulator("B"))
+    _loop(bcr, t[:half], p[:half], a[:half], v[:half])
+    saved = pickle.dumps(bcr)
+    rest = (t[half:] + 600.0, p[half:], a[half:], v[half:])
+    sd = {}
+    for moved in (0.0, 5.0, 1e4, math.inf):
+        resumed = pickle.loads(saved)
+        resumed.resume(moved_m=moved)
+        assert resumed.last.status == "filling"
+        out, run = _loop(resumed, *rest)
+        assert not run.latched and [e.ok for e in out].index(True) == 2
+        sd[moved] = out[2].gd_sd
+        assert abs(out[2].gd_mean - 300.0) < 3 * out[2].gd_sd
+    fresh = pickle.loads(saved)
+    fresh.reset()
+    reset_out, _ = _loop(fresh, *rest)
+    assert sd[math.inf] == reset_out[2].gd_sd
+    assert sd[0.0] < 0.7 * sd[math.inf] and sd[0.0] <= sd[5.0] < sd[1e4] <= sd[math.inf] * 1.01
+    for bad in (-1.0, float("nan"), "5", None):
+        with pytest.raises(control.ControlError, match="moved_m must be a real number >= 0"):
+            pickle.loads(saved).resume(moved_m=bad)
+    t2, p2, a2, v2 = _drive([(40.0, 500.0)], 1.0)  # resumed, wrongly, on rougher ground
+    wrong = pickle.loads(saved)
+    wrong.resume(moved_m=0.0)
+    out, _ = _loop(wrong, t2 + rest[0][0], p2, a2, v2)
+    above = [e.position for e in out if e.ok and e.gd_mean > 400.0]
+    assert above and above[0] < 5.0  # as a change while driving (measured 3.9 m; reset 1.8 m)
+
+
+def test_the_window_filters_resume_with_their_tracker_state():
+    """``resume`` on method "filter": the tracker's state kept (first sd 47 against 91 after
+    ``reset``), forgotten over a long move (as ``reset``)."""
+    import pickle
+
+    import control
+
+    t, p, a, v = _drive([(80.0, 300.0)], 1.0)
+    half = t.size // 2 // EVERY * EVERY
+    bcr = control.BCR.from_emulator(control.shipped_emulator("B", kind="window"), method="filter")
+    _loop(bcr, t[:half], p[:half], a[:half], v[:half])
+    saved = pickle.dumps(bcr)
+    rest = (t[half:] + 600.0, p[half:], a[half:], v[half:])
+    first = {}
+    for how in (0.0, 1e4, "reset"):
+        r = pickle.loads(saved)
+        r.reset() if how == "reset" else r.resume(moved_m=how)
+        out, run = _loop(r, *rest)
+        assert not run.latched
+        first[how] = next(e for e in out if e.ok)
+    assert first[0.0].gd_sd < 0.6 * first["reset"].gd_sd
+    assert first[1e4].gd_sd == pytest.approx(first["reset"].gd_sd, rel=1e-9)
