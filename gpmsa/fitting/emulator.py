@@ -275,7 +275,7 @@ class Emulator:
         priors: Priors | None = None,
         metadata: dict | None = None,
         *,
-        n_pc: int | None = None,
+        n_pc: int | float | None = None,
         mean_basis=None,
     ) -> Emulator:
         """An emulator at given unit-scale parameter values (no MCMC).

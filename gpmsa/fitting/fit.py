@@ -80,7 +80,7 @@ def fit(
     n_burn: int | None = None,
     n_keep: int = N_KEEP,
     point: str = "mean",
-    n_pc: int | None = None,
+    n_pc: int | float | None = None,
     discrepancy=None,
     discrepancy_groups=None,
     step_widths: dict | None = None,
@@ -101,7 +101,8 @@ def fit(
     n_burn: sweeps discarded per chain (default n_iter // 5; 0 when ``init`` is an emulator whose
     chains continue). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
-    posterior) for ``Emulator.params``. n_pc: basis size (default: 99.5% of the variance).
+    posterior) for ``Emulator.params``. n_pc: basis size, or a variance fraction in (0, 1)
+    (SEPIA's n_pc < 1; default 99.5%).
     discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. discrepancy_groups: the
     precision group (0 .. G-1) of each discrepancy basis vector, GPM/SA's lamVzGroup (None: one
     group; each group has its own betaV column and lamVz). n_jobs, executor: where

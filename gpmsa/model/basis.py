@@ -13,15 +13,23 @@ VARIANCE_FRACTION = 0.995
 
 
 def pca_basis(
-    y_std: np.ndarray, n_pc: int | None = None, fraction: float = VARIANCE_FRACTION
+    y_std: np.ndarray, n_pc: int | float | None = None, fraction: float = VARIANCE_FRACTION
 ) -> np.ndarray:
     """PCA basis K (l_sim, p_u) of standardised outputs y_std (m, l_sim): K = U S / sqrt(m).
 
-    p_u = ``n_pc`` if given, else the fewest components reaching ``fraction`` of the variance.
-    A scalar output (l_sim = 1) gives K = [[1]].
+    p_u = ``n_pc`` if an integer; a float in (0, 1) is a variance fraction (as SEPIA's
+    ``create_K_basis(n_pc=0.99)``): the fewest components reaching it, as ``fraction`` is when
+    ``n_pc`` is None. A scalar output (l_sim = 1) gives K = [[1]].
     """
     m, l_sim = y_std.shape
-    if n_pc is not None:
+    if isinstance(n_pc, float | np.floating) and 0.0 < n_pc < 1.0:
+        n_pc, fraction = None, float(n_pc)
+    elif n_pc is not None:
+        if isinstance(n_pc, float | np.floating):
+            raise GPMSAError(
+                f"n_pc must be an integer >= 1 (components) or a variance fraction in (0, 1), "
+                f"got {n_pc!r}"
+            )
         n_pc = check_count(n_pc, "n_pc")
     if l_sim == 1:
         if n_pc not in (None, 1):

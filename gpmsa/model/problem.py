@@ -447,7 +447,7 @@ def prepare(
     obs: ObsData | None = None,
     *,
     priors: Priors | None = None,
-    n_pc: int | None = None,
+    n_pc: int | float | None = None,
     discrepancy=None,
     mean_basis=None,
     discrepancy_groups=None,

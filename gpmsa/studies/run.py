@@ -268,7 +268,7 @@ def fit_study(
     sims, obs, *, labels=None, shared=(), hierarchical=(), hyper: HyperPriors | None = None,
     n_iter: int = 30_000, n_burn: int | None = None, n_keep: int = 1000, point: str = "mean",
     tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
-    priors: Priors | None = None, n_pc: int | None = None, discrepancy=None,
+    priors: Priors | None = None, n_pc: int | float | None = None, discrepancy=None,
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
     metadata: dict | None = None,

@@ -120,6 +120,13 @@ def test_pca_basis_variance_fraction_and_weights():
     assert np.array_equal(pca_basis(ys[:, :1]), [[1.0]])
     with pytest.raises(gpmsa.GPMSAError, match=r"n_pc must be in \[1, 30\], got 31"):
         pca_basis(ys, n_pc=31)
+    for frac in (0.5, 0.9, 0.99, 0.9999):  # SEPIA's create_K_basis(n_pc=0.99): a fraction
+        n = int(np.searchsorted(share, frac - 1e-12) + 1)
+        assert n >= 1 and share[n - 1] >= frac and (n == 1 or share[n - 2] < frac)
+        np.testing.assert_array_equal(pca_basis(ys, n_pc=frac), pca_basis(ys, n_pc=n))
+    for bad in (1.0, 1.5, 0.0, -0.2, float("nan")):
+        with pytest.raises(gpmsa.GPMSAError, match=r"an integer >= 1 \(components\) or a variance"):
+            pca_basis(ys, n_pc=bad)
     grid = np.linspace(0, 1, 40)
     Ki = interpolate_basis(K, grid, grid[::3])
     assert np.allclose(Ki, K[::3])
