@@ -210,9 +210,7 @@ class Emulator:
         self.x_units, self.t_units, self.y_units = units["x"], units["t"], units["y"]
         self.draws = draws if draws is not None else {}
         self.log_post = log_post if log_post is not None else np.zeros(0)
-        if metadata is not None and not isinstance(metadata, dict):
-            raise GPMSAError(f"metadata must be None or a dict, got {type(metadata).__name__}")
-        self.metadata = dict(metadata or {})
+        self.metadata = metadata  # a dict (copied) or None (``__setattr__`` checks it)
         self.settings = dict(settings or {})
         self.diagnostics = dict(diagnostics or {})
         self.calibration = calibration
@@ -239,8 +237,13 @@ class Emulator:
 
     def __setattr__(self, name: str, value) -> None:
         """Only ``metadata`` (the user's dict, not part of the model) may be replaced once
-        constructed: the predictions, ``model_sha256`` and the cached factors depend on the rest."""
-        if name != "metadata" and self.__dict__.get("_sealed", False):
+        constructed: the predictions, ``model_sha256`` and the cached factors depend on the rest.
+        ``metadata`` as the constructor takes it: a dict (copied), or None for none."""
+        if name == "metadata":
+            if value is not None and not isinstance(value, dict):
+                raise GPMSAError(f"metadata must be None or a dict, got {type(value).__name__}")
+            value = dict(value or {})
+        elif self.__dict__.get("_sealed", False):
             raise AttributeError(
                 f"Emulator.{name} cannot be replaced: an emulator is read-only (its predictions, "
                 f"cached factors and model_sha256 depend on it); build another with "

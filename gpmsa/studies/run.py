@@ -13,7 +13,7 @@ import numpy as np
 from gpmsa._version import library_versions
 from gpmsa.calibration.calibrate import calibration_problem, observation_fit
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
-from gpmsa.errors import GPMSAError, ReductionWarning
+from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.fitting.fit import check_keep, check_point, point_estimate, thinning
 from gpmsa.limits import check_memory
@@ -253,15 +253,23 @@ def calibrate_study(
 
 
 def _per_model(label: str, make, *args, **kwargs):
-    """``make(*args, **kwargs)`` for the model ``label``; its GPMSAError names that model."""
+    """``make(*args, **kwargs)`` for the model ``label``; its GPMSAError and its warnings name
+    that model (so that two models' alike warnings both show, and say which)."""
+    caught: list[warnings.WarningMessage] = []
     try:
-        return make(*args, **kwargs)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            return make(*args, **kwargs)
     except GPMSAError as exc:
         try:
             named = type(exc)(f"model {label!r}: {exc}")  # the same class, where it can be
         except TypeError:
             named = GPMSAError(f"model {label!r}: {exc}")
         raise named from exc
+    finally:
+        for w in caught:  # the caller's filters apply to them here
+            warnings.warn(f"model {label!r}: {w.message}", w.category,
+                          stacklevel=user_stacklevel())  # fmt: skip
 
 
 def fit_study(
