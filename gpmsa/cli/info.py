@@ -107,6 +107,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
             native = _native_theta(manifest, v, standardizer) if k == "theta" else None
             cells.append(f"theta (native)=[{native[1]}]" if native else f"{safe(k, 60)}={plain(v)}")
         lines.append("fixed:           " + ", ".join(cells))
+    lines.extend(_prior_lines(manifest["priors"]))
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))
@@ -156,6 +157,33 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     n_arr = sum(int(a.size) for a in arrays.values())
     lines.append(f"arrays:          {len(arrays)} ({n_arr} values)")
     return lines
+
+
+def _gamma(g: dict) -> str:
+    """A validated Gamma prior of the manifest as text: Gamma(a, b) on (lower, upper)."""
+    text = f"Gamma({number(g['a'], '.6g')}, {number(g['b'], '.6g')})"
+    if g["lower"] != 0 or g["upper"] != "inf":
+        upper = "inf" if g["upper"] == "inf" else number(g["upper"], ".6g")
+        text += f" on ({number(g['lower'], '.6g')}, {upper})"
+    return text
+
+
+def _prior_lines(priors: dict) -> list[str]:
+    """The priors (validated): those a calibration with this file uses (theta, lamOs, lamVz, one
+    per precision group where so set; ``Emulator.with_calibration_priors`` changes them), then
+    the emulator's own (data-corrected)."""
+    vz = priors["lamVz"]
+    lam_vz = ("[" + ", ".join(_gamma(g) for g in vz) + "] (one per group)"
+              if isinstance(vz, list) else _gamma(vz))  # fmt: skip
+    return [
+        f"calibration priors: theta Normal({number(priors['theta_mean'], '.6g')}, "
+        f"{number(priors['theta_sd'], '.6g')}) on (0, 1) (unit scale), lamOs "
+        f"{_gamma(priors['lamOs'])}, lamVz {lam_vz}, betaV as betaU",
+        f"emulator priors: rho = exp(-betaU / 4) Beta({number(priors['rho_a'], '.6g')}, "
+        f"{number(priors['rho_b'], '.6g')}), lamUz {_gamma(priors['lamUz'])}, lamWs "
+        f"{_gamma(priors['lamWs'])}, lamWOs {_gamma(priors['lamWOs'])}"
+        + (" (with GPM/SA's data corrections)" if priors["corrected"] is True else ""),
+    ]
 
 
 def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str] | None:

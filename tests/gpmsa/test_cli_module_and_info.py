@@ -170,3 +170,20 @@ def test_info_prints_the_model_sha256_a_calibration_records(tmp_path, capsys) ->
     post = gpmsa.Calibrator(emu, method="grid").update([[1.0]], [[emu.y[0, 0]]])
     assert post.info["emulator_sha256"] == emu.model_sha256
     assert line.split()[2] == emu.model_sha256
+
+
+def test_info_prints_the_priors_a_calibration_uses(tmp_path, capsys) -> None:
+    """Session 62: a shared file's calibration priors (set with ``with_calibration_priors``,
+    one lamVz prior per group included) were not shown anywhere."""
+    emu = _ab_emulator().with_calibration_priors(
+        theta_sd=0.2, lamOs=gpmsa.GammaPrior(50.0, 0.5),
+        lamVz=[gpmsa.GammaPrior(1.0, 1e-3), gpmsa.GammaPrior(1000.0, 0.1, 10.0, 1e6)],
+    )  # fmt: skip
+    assert main(["info", str(emu.save(tmp_path / "p.gpmsa"))]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "calibration priors: theta Normal(0.5, 0.2) on (0, 1) (unit scale), lamOs Gamma(50, 0.5), "
+        "lamVz [Gamma(1, 0.001), Gamma(1000, 0.1) on (10, 1e+06)] (one per group), betaV as betaU"
+    ) in out
+    assert "lamUz Gamma(5, 5) on (0.3, inf), lamWs Gamma(3, 0.003) on (60, 100000)" in out
+    assert "lamWOs Gamma(5, 0.005) on (60, 100000) (with GPM/SA's data corrections)" in out
