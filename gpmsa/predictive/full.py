@@ -284,6 +284,13 @@ def _check_fitted_discrepancy(emulator, discrepancy) -> None:
         )
 
 
+def _shown(discrepancy) -> str:
+    """A discrepancy argument for a message: its name, or an array's shape (not its values)."""
+    if discrepancy is None or isinstance(discrepancy, str):
+        return repr(discrepancy)
+    return f"an array of shape {np.shape(discrepancy)}"
+
+
 def _check_fitted_obs(settings: dict, obs: ObsData) -> None:
     """GPMSAError when ``obs`` has other experiments (their count or lengths) or other values
     than the joint fit's, where the fit recorded them (its ``settings``, or the info of its
@@ -426,7 +433,7 @@ def full_prediction(
     if ("betaV" in sets[0]) != (p_v > 0):
         raise GPMSAError(
             f"the draws {'have' if 'betaV' in sets[0] else 'lack'} discrepancy parameters but "
-            f"discrepancy={discrepancy!r} gives {p_v} discrepancy basis vectors"
+            f"discrepancy={_shown(discrepancy)} gives {p_v} discrepancy basis vectors"
         )
     drawn = sets[0]["lamVz"].size if p_v else 1
     if drawn != ob.n_groups:

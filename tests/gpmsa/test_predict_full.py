@@ -186,6 +186,9 @@ def test_posterior_path_scalar_output_and_grid_option():
     np.testing.assert_allclose(pred.D[::3], coarse.D, rtol=1e-12)
     for what in ("eta", "delta", "y"):
         np.testing.assert_allclose(pred.mean(what)[:, ::3], coarse.mean(what), rtol=1e-12)
+    bare = gpmsa.calibrate(emu_v, obs_v, n_samples=50, n_burn=10, seed=0)  # no discrepancy
+    with pytest.raises(GPMSAError, match=r"lack discrepancy .*=an array of shape \(12, 2\) gives"):
+        full_prediction(emu_v, obs_v, [[0.5]], posterior=bare, discrepancy=np.ones((12, 2)))
 
 
 # --- bad input ---------------------------------------------------------------------------------
