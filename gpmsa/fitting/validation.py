@@ -41,6 +41,10 @@ REL_TOL = 1e-9
 """Relative tolerance of the recomputed redundancies (y_mean, y_sd)."""
 W_TOL = 1e-7
 """Tolerance of the recomputed basis weights, relative to their largest magnitude (plus 1)."""
+DISCREPANCY_KINDS = ("constant", "linear", "given")
+"""A recorded discrepancy basis: named, or "given" (an array the caller passed)."""
+BASIS_VECTORS = {"constant": 1, "linear": 2}
+"""The number of vectors of each named discrepancy basis (``gpmsa.model.basis``)."""
 
 
 def _fail(field: str, problem: str) -> EmulatorFileError:
@@ -102,6 +106,8 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
                 raise _fail(f"arrays/{name}", f"shape {list(shapes[name])}: needs {n} draws first")
             if name[4:] in ("theta", "theta_native"):
                 want[name] = (n, q)
+            elif name[4:] == "lamOs":
+                want[name] = (n, 1)
         elif name.startswith("param_"):
             if name[6:] not in pshape:
                 raise _fail(
@@ -113,6 +119,12 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
                 "unknown array (an emulator file holds only the arrays of docs/emulator-file.md)",
             )
     _check_complete(shapes, n)
+    if "cal_lamVz" in shapes:  # a discrepancy's draws: lamVz (n, G), betaV (n, p, G)
+        lam = tuple(shapes["cal_lamVz"])
+        if len(lam) != 2 or lam[1] < 1:
+            raise _fail("arrays/cal_lamVz", f"shape {list(lam)}: must be (n_draws, G), G >= 1 "
+                                            "discrepancy precision groups")  # fmt: skip
+        want["cal_betaV"] = (n, p, lam[1])
     for name, shape in want.items():
         if tuple(shapes[name]) != tuple(shape):
             raise _fail(f"arrays/{name}", f"has shape {list(shapes[name])}, expected {list(shape)}")
@@ -214,13 +226,59 @@ def check_prior_groups(priors: dict, shapes: dict[str, tuple[int, ...]]) -> None
     groups = priors["lamVz"]
     lam = shapes.get("cal_lamVz")
     if isinstance(groups, list) and lam is not None:
-        n_grp = lam[1] if len(lam) == 2 else 1
+        n_grp = lam[1]  # check_shapes: (n_draws, G)
         if len(groups) != n_grp:
             raise _fail(
                 "priors.lamVz",
                 f"{len(groups)} per-group priors, but arrays/cal_lamVz holds draws of {n_grp} "
                 "discrepancy precision group(s)",
             )
+
+
+def group_count(kind, groups, field: str) -> int:
+    """The number of precision groups G of a recorded discrepancy: a ``kind`` basis
+    (``DISCREPANCY_KINDS``) with ``groups`` ("discrepancy_groups": None for one group, else one
+    integer 0 .. G-1 per basis vector, G >= 2, each used). EmulatorFileError naming ``field``
+    for groups that number no such G, or that a basis of ``kind`` cannot have (one group per
+    basis vector: "constant" has one, "linear" two)."""
+    if groups is None:
+        return 1
+    ints = isinstance(groups, list) and all(
+        isinstance(g, int) and not isinstance(g, bool) for g in groups
+    )
+    n_grp = len(set(groups)) if ints else 0
+    if n_grp < 2 or min(groups) != 0 or max(groups) != n_grp - 1:  # 0 .. G-1, each used
+        raise _fail(field, f"must number two or more groups 0 .. G-1, got {_short(groups)}")
+    n_vec = BASIS_VECTORS.get(kind)
+    if n_vec is not None and len(groups) != n_vec:
+        raise _fail(field, f"{_short(groups)}: one group per basis vector, but a {kind!r} "
+                           f"discrepancy has {n_vec}")  # fmt: skip
+    return n_grp
+
+
+def check_discrepancy_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None:
+    """A joint fit's record of its discrepancy (settings "discrepancy" and
+    "discrepancy_groups", as ``gpmsa.fit`` writes them) against its calibration draws: a basis
+    exactly where there are discrepancy draws, and the G groups of their ``cal_lamVz`` (n_draws,
+    G). Files without calibration draws, or written before "discrepancy" was recorded, have
+    nothing to compare."""
+    if "cal_theta" not in shapes or "discrepancy" not in settings:
+        return
+    kind, lam = settings["discrepancy"], shapes.get("cal_lamVz")
+    if kind is not None and kind not in DISCREPANCY_KINDS:
+        raise _fail("settings.discrepancy", f"must be null or one of {DISCREPANCY_KINDS}, got "
+                                            f"{_short(kind)}")  # fmt: skip
+    if (kind is None) != (lam is None):
+        held = "holds" if lam is not None else "holds none (arrays/cal_betaV, arrays/cal_lamVz)"
+        raise _fail("settings.discrepancy", f"{_short(kind)}, but the file {held} of "
+                                            "discrepancy draws")  # fmt: skip
+    if lam is None:
+        return
+    groups = settings.get("discrepancy_groups")
+    n_grp = group_count(kind, groups, "settings.discrepancy_groups")
+    if n_grp != lam[1]:
+        raise _fail("settings.discrepancy_groups", f"{_short(groups)} (None: one group) numbers "
+                    f"{n_grp} group(s), but arrays/cal_lamVz holds draws of {lam[1]}")  # fmt: skip
 
 
 def check_fields(manifest: dict, dims: dict[str, int]) -> None:
@@ -258,6 +316,17 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
                 "settings.n_chains",
                 f"{n_ch} chains cannot hold the {n_draws} draws (each chain keeps as many)",
             )
+    lengths = settings.get("obs_lengths")  # full_prediction compares them with its obs
+    if lengths is not None and not (
+        isinstance(lengths, list)
+        and lengths
+        and all(isinstance(n, int) and not isinstance(n, bool) and n >= 1 for n in lengths)
+    ):
+        raise _fail(
+            "settings.obs_lengths",
+            f"must be null or a list of integers >= 1 (the joint fit's experiments), got "
+            f"{_short(lengths)}",
+        )
     for key in ("metadata", "diagnostics"):
         if not isinstance(manifest.get(key), dict):
             raise _fail(key, f"must be an object, got {_short(manifest.get(key))}")
@@ -321,6 +390,7 @@ def check_manifest(manifest: dict) -> None:
             raise _fail(f"arrays/{name}", f"dtype {specs[name]['dtype']}: must be <f8 (float64)")
     check_fields(manifest, dims)
     check_prior_groups(manifest["priors"], shapes)
+    check_discrepancy_record(manifest["settings"], shapes)
 
 
 def _known(name: str) -> bool:
@@ -454,6 +524,7 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     dims = check_shapes(shapes)
     check_fields(manifest, dims)
     check_prior_groups(manifest["priors"], shapes)
+    check_discrepancy_record(manifest["settings"], shapes)
     check_values(arrays, dims)
     check_categorical(manifest, arrays, dims)
     return dims

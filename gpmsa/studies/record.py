@@ -8,6 +8,7 @@ import re
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError
+from gpmsa.fitting.validation import DISCREPANCY_KINDS, group_count
 from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout, finite
 
 KINDS = ("calibration", "fit")
@@ -19,7 +20,6 @@ DISCREPANCIES = "discrepancy_by_model"
 {"discrepancy": "constant", "linear" or "given" (an array), "discrepancy_sha256": the basis
 digest (``gpmsa.model.discrepancy.record``), and with several precision groups
 "discrepancy_groups"}; absent for a study without one (and in files written before it)."""
-DISCREPANCY_KINDS = ("constant", "linear", "given")
 FILE_RE = re.compile(r"\A[A-Za-z0-9_-][A-Za-z0-9_.-]{0,150}\.gpmsa\Z")
 """A model's file name: beside the study file, no folder, no leading dot."""
 SHA_RE = re.compile(r"^[0-9a-f]{64}$")
@@ -165,18 +165,8 @@ def _check_discrepancies(manifest: dict, kind: str, labels: list[str]) -> dict[i
             raise _fail(f"{where}.discrepancy_sha256", f"must be 64 lowercase hex digits, got "
                                                        f"{_short(sha)}")  # fmt: skip
         groups = rec.get("discrepancy_groups")
-        n_grp = 1
-        if groups is not None:
-            ints = isinstance(groups, list) and all(
-                isinstance(g, int) and not isinstance(g, bool) for g in groups
-            )
-            n_grp = len(set(groups)) if ints else 0
-            if n_grp < 2 or min(groups) != 0 or max(groups) != n_grp - 1:  # 0 .. G-1, each used
-                raise _fail(
-                    f"{where}.discrepancy_groups",
-                    f"must number two or more groups 0 .. G-1, got {_short(groups)}",
-                )
-        out[labels.index(lab)] = n_grp
+        out[labels.index(lab)] = group_count(rec["discrepancy"], groups,
+                                             f"{where}.discrepancy_groups")  # fmt: skip
     return out
 
 
@@ -279,7 +269,8 @@ def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
     if got["n_chains"] != shape[0]:
         raise _fail("settings.n_chains", f"{got['n_chains']}, but the draws have {shape[0]} "
                                          "chains")  # fmt: skip
-    kept = len(range(got["n_burn"], got["n_iter"], got["thin"]))
+    # len(range(n_burn, n_iter, thin)) without its OverflowError: a JSON integer has any size
+    kept = max(0, -(-(got["n_iter"] - got["n_burn"]) // got["thin"]))
     if kept != shape[1]:
         raise _fail("settings", f"n_iter={got['n_iter']}, n_burn={got['n_burn']}, thin="
                                 f"{got['thin']} keep {kept} draws a chain, but the draws have "
