@@ -352,7 +352,7 @@ def fit_study(
                           else "given")  # fmt: skip
     for i, (sim, prep) in enumerate(zip(sims, preps, strict=True)):
         post = {k: v[:, keep] for k, v in chains.members[i].items()}
-        flat = {k: v.reshape(-1, *v.shape[2:]) for k, v in post.items()}
+        flat = {k: v.reshape(v.shape[0] * v.shape[1], *v.shape[2:]) for k, v in post.items()}
         theta = draws["theta"][:, :, list(layout.index[i])]
         flat["theta"] = theta.reshape(-1, theta.shape[2])
         params = point_estimate(flat, lp, point)

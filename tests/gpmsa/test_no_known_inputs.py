@@ -212,3 +212,22 @@ def test_generic_backends_calibrate_p_zero(scalar_emu, backend):
                            backend=backend, discrepancy="constant")  # fmt: skip
     assert "lamVz" in post.names
     assert abs(post.mean("t0") - T_STAR) < 3 * post.sd("t0")
+
+
+def test_fit_study_of_models_without_known_inputs_takes_a_discrepancy(tmp_path):
+    """Session 62: fit_study with p = 0 models and a discrepancy failed reshaping betaV's
+    (chains, draws, 0, G) draws ("cannot reshape array of size 0"); gpmsa.fit took it."""
+    t = np.linspace(0.05, 0.95, 12)[:, None]
+    sim = gpmsa.SimData(t=t, y=np.exp(1.5 * t), t_names=["t"])
+    obs = gpmsa.ObsData(y=[[float(np.exp(0.6)) + 0.1], [float(np.exp(0.6)) + 0.08]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # 60 sweeps
+        study = gpmsa.fit_study([sim, sim], [obs, obs], shared=["t"], discrepancy="constant",
+                                n_iter=60, n_keep=20, tune=False, seed=0)  # fmt: skip
+        alone = gpmsa.fit(sim, obs, discrepancy="constant", n_iter=60, tune=False, seed=0)
+    names = gpmsa.calibration_posterior(alone).names
+    assert study.member_posterior(0).names == names == ("t", "lamOs", "lamVz")
+    back = gpmsa.load_study(study.save(tmp_path / "s.gpmsa"))
+    np.testing.assert_array_equal(
+        back.member_posterior(1).samples["lamVz"], study.member_posterior(1).samples["lamVz"]
+    )
