@@ -150,7 +150,12 @@ class ChangePointFilter:
         ``predict``, but a run that ended there is followed by GD from the prior, not by a
         jump from the last GD (the ground it ended on is unrelated to the last, and a long
         move holds many changes, not the one ``predict`` allows per step), and starts here, as
-        after ``reset`` (where the move ended says nothing of how long ago the ground changed)."""
+        after ``reset`` (where the move ended says nothing of how long ago the ground changed).
+        A filter that has seen no block is reset: it holds the prior, a run starting here."""
+        if not self._has_data:
+            _check_distance(ds_m)
+            self.reset()
+            return
         self._set(*self._predicted(ds_m, from_prior=True))
 
     def _predicted(self, ds_m: float, from_prior: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -158,8 +163,7 @@ class ChangePointFilter:
         merged into the last row at their mass-weighted mean distance, which keeps growing.
         No distance (``ds_m == 0``, a standstill) is no hazard: the state stays as it is (a
         run-length row of no mass per step would push real runs into the merged last row)."""
-        if not (is_real(ds_m) and np.isfinite(ds_m) and ds_m >= 0):
-            raise ControlError(f"ds_m must be finite and >= 0, got {ds_m!r}")
+        _check_distance(ds_m)
         if not self._has_data:  # before any block the prior already is "a new segment"
             return self._mass, self._dist + ds_m
         if ds_m == 0:
@@ -339,6 +343,12 @@ def _increasing_positive(values, name: str, min_size: int, what: str) -> np.ndar
     ):  # fmt: skip
         raise ControlError(f"{name} must be {what}, got {a}")
     return a
+
+
+def _check_distance(ds_m) -> None:
+    """ControlError unless ``ds_m`` is a finite distance >= 0, m."""
+    if not (is_real(ds_m) and np.isfinite(ds_m) and ds_m >= 0):
+        raise ControlError(f"ds_m must be finite and >= 0, got {ds_m!r}")
 
 
 def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:
