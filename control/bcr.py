@@ -407,8 +407,10 @@ class BCR:
         keeping the GD state: the buffers, clocks and faults emptied as ``reset`` empties them,
         and the GD state propagated over ``moved_m`` metres the robot may have moved while down
         (its prior of change points over that distance: 0, it stood still; the longer, the
-        likelier a change; ``math.inf``, forget it, as ``reset``). The first estimates then
-        start from what the BCR knew instead of the prior (docs/robot.md, "A saved BCR")."""
+        likelier a change; ``math.inf``, forget it, as ``reset``). As a gap in a stream, the
+        downtime undoes each phase's newest block (it may hold the start of what stopped the
+        robot). The first estimates then start from what the BCR knew instead of the prior
+        (docs/robot.md, "A saved BCR")."""
         if not (is_real(moved_m) and moved_m >= 0):
             raise ControlError(f"moved_m must be a real number >= 0 (metres), got {moved_m!r}")
         if np.isinf(moved_m):
@@ -417,8 +419,13 @@ class BCR:
         self._forget_stream()
         if self.settings.method == "changepoint":
             for phase in self._phases:
+                moved = float(moved_m)
+                if phase.undo is not None:  # downtime is a gap: as after a fault, the block
+                    state, _, ds_before = phase.undo  # before it may hold part of it
+                    phase.filter.restore(state)
+                    moved += ds_before
                 phase.forget_stream()
-                phase.filter.relocate(float(moved_m))
+                phase.filter.relocate(moved)
         else:
             for tracker in self.trackers:
                 tracker.predict(float(moved_m))

@@ -174,8 +174,9 @@ def test_a_drive_whose_clock_steps_back_half_way_resumes_with_now_on_that_clock(
 
 def test_a_restored_bcr_resumes_with_its_gd_state_kept_and_moved():
     """Session 62: ``resume(moved_m)`` starts a new stream as ``reset`` does (no latch, the
-    first ok estimate at the third update) but keeps the GD state, so the first estimates are
-    tighter than ``reset``'s (sd 49 against 85 above); a long move forgets most of it, and
+    first ok estimate at the third update) but keeps the GD state (less each phase's newest
+    block, as a gap undoes it), so the first estimates are tighter than ``reset``'s (sd 35
+    against 85); a long move forgets most of it, and
     ``math.inf`` is ``reset``."""
     import math
     import pickle
@@ -235,3 +236,28 @@ def test_the_window_filters_resume_with_their_tracker_state():
         first[how] = next(e for e in out if e.ok)
     assert first[0.0].gd_sd < 0.6 * first["reset"].gd_sd
     assert first[1e4].gd_sd == pytest.approx(first["reset"].gd_sd, rel=1e-9)
+
+
+def test_resume_undoes_each_phases_newest_block_as_a_gap_does():
+    """The downtime is a gap: each phase's newest block (which may hold the start of what
+    stopped the robot) is undone, then the move is propagated over that block's distance too."""
+    import copy
+
+    import control
+
+    t, p, a, v = _drive([(40.0, 300.0)], 1.0)
+    bcr = control.BCR.from_emulator(control.shipped_emulator("B"))
+    _loop(bcr, t, p, a, v)
+    expected = []
+    for phase in bcr._phases:
+        state, _, ds_before = phase.undo
+        twin = copy.deepcopy(phase.filter)
+        twin.restore(state)
+        twin.relocate(2.0 + ds_before)
+        expected.append(twin.state())
+    bcr.resume(moved_m=2.0)
+    for phase, (mass, dist, has_data) in zip(bcr._phases, expected, strict=True):
+        got_mass, got_dist, got_has = phase.filter.state()
+        np.testing.assert_array_equal(got_mass, mass)
+        np.testing.assert_array_equal(got_dist, dist)
+        assert got_has == has_data and phase.undo is None
