@@ -46,21 +46,19 @@ def _support(problem: Problem, name: str, dtype: torch.dtype) -> constraints.Con
     all finite or all infinite (GPMSAError otherwise)."""
     if name == "theta" or name in RHO_PARAMS:
         return constraints.interval(0.0, 1.0)
-    size = int(np.size(problem.init[name]))
-    gs = [problem.priors.precision_prior(name, k) for k in range(size)]
-    if len({(g.lower, g.upper) for g in gs}) == 1:  # one prior's bounds, as floats
-        lower, upper = gs[0].lower, gs[0].upper
+    _, _, lows, highs = problem.priors.gamma_arrays(name, int(np.size(problem.init[name])))
+    if np.all(lows == lows[0]) and np.all(highs == highs[0]):  # one prior's bounds, as floats
+        lower, upper = float(lows[0]), float(highs[0])
     else:
-        lower = torch.tensor([g.lower for g in gs], dtype=dtype)
-        upper = torch.tensor([g.upper for g in gs], dtype=dtype)
-    finite = np.isfinite(np.atleast_1d(np.asarray(upper, dtype=float)))
+        lower, upper = torch.tensor(lows, dtype=dtype), torch.tensor(highs, dtype=dtype)
+    finite = np.isfinite(highs)
     if finite.all():
         return constraints.interval(lower, upper)
     if not finite.any():
         return constraints.greater_than(lower)
     raise GPMSAError(
         f"backend='pyro' samples {name} on its per-group priors' bounds, whose upper bounds "
-        f"{[g.upper for g in gs]} mix finite and infinite ones: give every group a finite "
+        f"{highs.tolist()} mix finite and infinite ones: give every group a finite "
         "upper bound, or none (or use backend='numpy' or 'torch')"
     )
 

@@ -373,8 +373,7 @@ def log_prior_elements(priors: Priors, name: str, x: Tensor, element: int | None
         val = (priors.rho_a - 1.0) * torch.log(rho) + (priors.rho_b - 1.0) * torch.log1p(-rho)
         ok = (x > 0.0) & torch.isfinite(x)
     elif name == "lamVz" and priors.per_group and element is None:
-        a, b, lo, hi = (x.new_tensor([getattr(g, k) for g in priors.lamvz_priors(x.shape[-1])])
-                        for k in ("a", "b", "lower", "upper"))  # fmt: skip
+        a, b, lo, hi = (x.new_tensor(v) for v in priors.gamma_arrays("lamVz", x.shape[-1]))
         val = (a - 1.0) * torch.log(x) - b * x
         ok = (x > lo) & (x < hi)
     elif name in PRECISION_PARAMS:

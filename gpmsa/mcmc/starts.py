@@ -88,16 +88,9 @@ def start_generator(seed: np.random.SeedSequence) -> np.random.Generator:
     return np.random.default_rng(child)
 
 
-def _bounds(pri: Priors, name: str, size: int) -> tuple[np.ndarray, ...]:
-    """(a, b, lower, upper), each (size,): the Gamma prior of each element of precision
-    ``name`` (lamVz's per-group priors element by element, ``Priors.precision_prior``)."""
-    gs = [pri.precision_prior(name, k) for k in range(size)]
-    return tuple(np.array([getattr(g, f) for g in gs]) for f in ("a", "b", "lower", "upper"))
-
-
 def _gamma(pri: Priors, name: str, size: int, rng: np.random.Generator) -> np.ndarray:
     """A draw of each of ``size`` elements of precision ``name`` from its truncated Gamma."""
-    a, b, lower, upper = _bounds(pri, name, size)
+    a, b, lower, upper = pri.gamma_arrays(name, size)
     out = rng.gamma(a, 1.0 / b)
     for _ in range(1000):
         bad = (out <= lower) | (out >= upper)
@@ -166,7 +159,7 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
             val = -4.0 * np.log(rho)
         elif how == "jitter":  # log-uniform on [x0 / f, x0 f] cut to the bounds
             x = x0.ravel()
-            _, _, lower, upper = _bounds(pri, name, size)
+            _, _, lower, upper = pri.gamma_arrays(name, size)
             lo = np.maximum(x / PRECISION_JITTER, lower * (1.0 + 1e-3) + 1e-12)
             hi = np.minimum(x * PRECISION_JITTER, upper * (1.0 - 1e-3))
             lo, hi = _jitter_range(name, lower, upper, x, lo, hi)

@@ -163,6 +163,12 @@ class Priors:
             )
         return g[element]
 
+    def gamma_arrays(self, name: str, size: int) -> tuple[np.ndarray, ...]:
+        """(a, b, lower, upper), each (size,): the Gamma prior of each of ``size`` elements of
+        precision ``name`` (lamVz's per-group priors one per element, ``lamvz_priors``)."""
+        gs = self.lamvz_priors(size) if name == "lamVz" else (getattr(self, name),) * size
+        return tuple(np.array([getattr(g, k) for g in gs]) for k in ("a", "b", "lower", "upper"))
+
     def to_dict(self) -> dict:
         """JSON-able dict (infinite bounds as the string "inf"); per-group lamVz priors as a
         list of such dicts, one per group."""
@@ -249,9 +255,7 @@ class Priors:
             return self.log_beta(value)
         if name == "lamVz" and self.per_group:
             x = np.asarray(value, dtype=np.float64).reshape(-1)
-            gs = self.lamvz_priors(x.size)
-            a, b, lo, hi = (np.array([getattr(g, k) for g in gs]) for k in ("a", "b", "lower",
-                                                                           "upper"))  # fmt: skip
+            a, b, lo, hi = self.gamma_arrays("lamVz", x.size)
             if np.any(x <= lo) or np.any(x >= hi):
                 return -np.inf
             return float(np.sum((a - 1.0) * np.log(x) - b * x))
