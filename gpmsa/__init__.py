@@ -10,6 +10,7 @@ from gpmsa.calibration.calibrator import Calibrator
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import (
     BackendUnavailableError,
+    BasisWarning,
     ChainError,
     ConvergenceWarning,
     EmulatorFileError,
@@ -37,6 +38,7 @@ from gpmsa.studies.study import Study, load_study
 
 __all__ = [
     "BackendUnavailableError",
+    "BasisWarning",
     "Calibrator",
     "ChainError",
     "Chains",

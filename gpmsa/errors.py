@@ -33,6 +33,11 @@ def user_stacklevel() -> int:
     return level
 
 
+class BasisWarning(UserWarning):
+    """A user-supplied emulator basis gives the runs weights on a scale that the priors do not
+    expect (``gpmsa.fit(..., basis=)``)."""
+
+
 class ReductionWarning(UserWarning):
     """The observations as reduced may not say what the data say
     (``gpmsa.model.problem.reduce_obs``): their precisions declare an error larger than the

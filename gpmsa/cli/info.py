@@ -64,6 +64,18 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _basis_line(settings: dict, emulator) -> str:
+    """Where the emulator basis came from, its size and the share of the standardised runs'
+    variance it holds."""
+    given = settings.get("basis") == "given"
+    y_std = emulator.standardizer.y_to_std(emulator.y)
+    total = float(np.sum(y_std**2))
+    left = float(np.sum((y_std - emulator.w @ emulator.K.T) ** 2))
+    share = f", {1.0 - left / total:.2%} of the runs' variance" if total > 0 else ""
+    source = "given (fit(..., basis=))" if given else "PCA of the runs"
+    return f"{source}, {emulator.K.shape[1]} vector(s){share}"
+
+
 def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     """The manifest for a person (the content already validated: names, units, domain, model);
     ``emulator``: the loaded one, for theta in native units and its ``model_sha256`` (what a
@@ -98,6 +110,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
         lines.append("categorical:     " + ", ".join(
             f"{safe(n, 60)} levels [{safe(', '.join(str(v) for v in lv), 300)}]"
             for n, lv in cat.items()))  # fmt: skip
+    lines.append(f"basis:           {_basis_line(manifest['settings'], emulator)}")
     mean = model.get("mean_basis")
     lines.append(f"mean basis:      {'zero (GPM/SA)' if mean is None else safe(mean, 60)}")
     fixed = manifest["settings"].get("fixed")

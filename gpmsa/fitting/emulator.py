@@ -280,12 +280,13 @@ class Emulator:
         *,
         n_pc: int | float | None = None,
         mean_basis=None,
+        basis=None,
     ) -> Emulator:
         """An emulator at given unit-scale parameter values (no MCMC).
 
         ``params``: betaU (p+q, p_u), lamUz (p_u,), lamWs (p_u,), lamWOs (1,); arrays of the
         same sizes in other shapes (e.g. (1, p_u) as SEPIA stores them) are accepted.
-        ``mean_basis``: as ``gpmsa.fit``'s.
+        ``mean_basis``, ``basis``: as ``gpmsa.fit``'s.
         """
         from gpmsa.model.problem import prepare
 
@@ -295,9 +296,9 @@ class Emulator:
                 f"params has unknown keys {unknown}: an emulator's parameters are "
                 f"{list(EMULATOR_PARAMS)}"
             )
-        prep = prepare(sim_data, priors=priors, n_pc=n_pc, mean_basis=mean_basis)
-        return cls._from_prepared(sim_data, prep, params, metadata=metadata,
-                                  settings={"source": "from_params"})  # fmt: skip
+        prep = prepare(sim_data, priors=priors, n_pc=n_pc, mean_basis=mean_basis, basis=basis)
+        settings = {"source": "from_params", "basis": "pca" if basis is None else "given"}
+        return cls._from_prepared(sim_data, prep, params, metadata=metadata, settings=settings)
 
     @classmethod
     def _from_prepared(cls, sim: SimData, prep, params, **kw) -> Emulator:

@@ -81,6 +81,7 @@ def fit(
     n_keep: int = N_KEEP,
     point: str = "mean",
     n_pc: int | float | None = None,
+    basis=None,
     discrepancy=None,
     discrepancy_groups=None,
     step_widths: dict | None = None,
@@ -102,7 +103,10 @@ def fit(
     chains continue). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
     posterior) for ``Emulator.params``. n_pc: basis size, or a variance fraction in (0, 1)
-    (SEPIA's n_pc < 1; default 99.5%).
+    (SEPIA's n_pc < 1; default 99.5%). basis: instead of the runs' PCA, a given basis
+    (l_sim, p_u), columns the orthogonal basis vectors on the simulation grid in standardised
+    output units (GPM/SA's ``Ksim``; ``gpmsa.BasisWarning`` when its weights' scale is not
+    the one lamUz's prior expects; docs/prediction.md).
     discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. discrepancy_groups: the
     precision group (0 .. G-1) of each discrepancy basis vector, GPM/SA's lamVzGroup (None: one
     group; each group has its own betaV column and lamVz). n_jobs, executor: where
@@ -147,17 +151,18 @@ def fit(
     seed = _seed(seed)
     module = backends.get(backend)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
-                   mean_basis=mean_basis, discrepancy_groups=discrepancy_groups)  # fmt: skip
+                   mean_basis=mean_basis, discrepancy_groups=discrepancy_groups,
+                   basis=basis)  # fmt: skip
     problem = _model_options(prep, data, fixed, constraint, theta_init)
     _check_fit_memory(problem, int(n_iter), int(n_chains))
     reserved = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress", "n_jobs",
                 "executor")  # fmt: skip
     backends.check_options(backend, options, reserved, "fit")
     if backend == "numpy":  # (the others refuse these extensions)
-        basis = problem.mean_basis
+        mean = problem.mean_basis
         callables = [name for name, on in (
             ("constraint", problem.constraint is not None),
-            ("mean_basis", basis is not None and basis.kind == "callable"),
+            ("mean_basis", mean is not None and mean.kind == "callable"),
         ) if on]  # fmt: skip
         n_jobs, executor = in_this_process(callables, n_jobs, executor, int(n_chains))
     options.update(backends.placement(backend, n_jobs, executor))
@@ -192,7 +197,8 @@ def fit(
     settings = {
         "n_iter": int(n_iter), "n_burn": n_burn, "thin": thin, "n_chains": int(n_chains),
         "tune": bool(tune), "backend": backend, "seed": seed, "point": point,
-        "n_pc": int(prep.K.shape[1]), "joint_obs": obs is not None,
+        "n_pc": int(prep.K.shape[1]), "basis": "pca" if basis is None else "given",
+        "joint_obs": obs is not None,
         "obs_lengths": None if obs is None else [int(e.size) for e in obs.experiments],
         "obs_sha256": None if obs is None else obs.digest(),
         "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
@@ -324,7 +330,9 @@ def continued_starts(
             and np.array_equal(emulator.t_unit, problem.t_sim)
             and np.allclose(emulator.w, problem.w, rtol=0.0, atol=1e-12))  # fmt: skip
     if not same:
-        raise GPMSAError("init=emulator was fitted to other simulation runs (or another n_pc)")
+        raise GPMSAError(
+            "init=emulator was fitted to other simulation runs (or another n_pc or basis)"
+        )
     cal = emulator.calibration or {}
     if (obs is None) != (not cal):
         raise GPMSAError(

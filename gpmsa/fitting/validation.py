@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.model.basis import ORTHOGONAL_TOL
 from gpmsa.model.data import output_scale
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import MAX_PRIOR_SHAPE
@@ -488,8 +489,8 @@ def check_values(arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
     else:
         gram = K.T @ K
         off = np.abs(gram - np.diag(np.diag(gram)))
-        if off.max() > 1e-8 * lam.max():
-            raise _fail("arrays/K", "basis vectors are not orthogonal (not a PCA basis)")
+        if off.max() > ORTHOGONAL_TOL * lam.max():
+            raise _fail("arrays/K", "basis vectors are not orthogonal")
     w = arrays["w"]
     w_ref = ((y - y_mean) / y_sd) @ np.linalg.pinv(K).T
     if np.max(np.abs(w - w_ref)) > W_TOL * (1.0 + np.max(np.abs(w_ref))):

@@ -3,13 +3,21 @@
 from __future__ import annotations
 
 import hashlib
+import warnings
 
 import numpy as np
+from scipy import stats
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import BasisWarning, GPMSAError, user_stacklevel
 from gpmsa.model.data import as_float, check_count, check_increasing
 
 VARIANCE_FRACTION = 0.995
+ORTHOGONAL_TOL = 1e-8
+"""Largest |off-diagonal of K^T K| relative to its largest diagonal element that counts as
+orthogonal (a basis from a QR or SVD is orthogonal to ~1e-15); emulator files are held to it."""
+WEIGHT_PRIOR_MASS = 0.99
+"""`given_basis` warns when a basis vector's weights spread outside the central part of this
+mass of what lamUz's prior allows."""
 
 
 def pca_basis(
@@ -44,6 +52,83 @@ def pca_basis(
     if not 1 <= n_pc <= min(m, l_sim):
         raise GPMSAError(f"n_pc must be in [1, {min(m, l_sim)}], got {n_pc!r}")
     return u[:, :n_pc] * s[:n_pc] / np.sqrt(m)
+
+
+def given_basis(basis, y_std: np.ndarray, lamuz_prior) -> np.ndarray:
+    """A user's emulator basis K (l_sim, p_u) of the standardised outputs y_std (m, l_sim),
+    checked (GPM/SA's ``Ksim``, SEPIA's ``create_K_basis(K=)``, transposed: columns are the
+    basis vectors on the simulation grid).
+
+    GPMSAError unless finite, of l_sim rows and 1 <= p_u <= l_sim nonzero columns that are
+    orthogonal (GPM/SA's simulation likelihood uses only diag(K^T K); it is exact for
+    orthogonal columns alone). A scalar output's basis is [[1]]. ``BasisWarning`` when a column's
+    weights (the runs' projections, root mean square) lie outside the spread that ``lamUz``'s
+    prior (``lamuz_prior``, a GammaPrior) gives them: 1 / sqrt(lamUz) over its central
+    ``WEIGHT_PRIOR_MASS``; the PCA basis gives exactly 1.
+    """
+    l_sim = y_std.shape[1]
+    K = as_float(basis, "basis")
+    if K.ndim != 2:
+        raise GPMSAError(f"basis must be a 2-D array (l_sim, p_u) = ({l_sim}, p_u), got shape "
+                         f"{K.shape}")  # fmt: skip
+    if K.shape[0] != l_sim:
+        hint = "; SEPIA stores K as (p_u, l_sim): pass K.T" if K.shape[1] == l_sim else ""
+        raise GPMSAError(
+            f"basis must have one row per simulation output value ({l_sim}), columns the "
+            f"basis vectors; got shape {K.shape}{hint}"
+        )
+    if not np.all(np.isfinite(K)):
+        raise GPMSAError("basis must be finite")
+    if l_sim == 1:
+        if K.shape != (1, 1) or K[0, 0] != 1.0:
+            raise GPMSAError(f"a scalar output's basis is [[1.0]], got {K.tolist()}")
+        return K
+    p_u = K.shape[1]
+    if not 1 <= p_u <= l_sim:
+        raise GPMSAError(f"basis must have 1 to {l_sim} columns, got {p_u}")
+    with np.errstate(over="ignore", under="ignore"):
+        gram = K.T @ K
+    lam = np.diag(gram)
+    if not np.all(np.isfinite(gram)):
+        raise GPMSAError("basis columns are too large to square in float64")
+    zero = np.flatnonzero(~(lam > np.finfo(np.float64).tiny))
+    if zero.size:
+        raise GPMSAError(f"basis column(s) {zero.tolist()} are zero (or too small to square)")
+    off = np.abs(gram - np.diag(lam)).max()
+    if off > ORTHOGONAL_TOL * lam.max():
+        raise GPMSAError(
+            f"basis columns must be orthogonal (largest |K^T K| off the diagonal "
+            f"{off / lam.max():.2g} of the largest diagonal element, tolerance "
+            f"{ORTHOGONAL_TOL:g}): GPM/SA's likelihood of the runs is exact only then. "
+            "numpy.linalg.qr(K) or an SVD gives an orthogonal basis of the same span (the "
+            "weights' GP prior then applies to its columns)"
+        )
+    _warn_weight_scale(basis_weights(y_std, K), lamuz_prior)
+    return K
+
+
+def _warn_weight_scale(w: np.ndarray, lamuz_prior) -> None:
+    """``BasisWarning`` naming each column of w (m, p_u) whose root mean square lies outside
+    1 / sqrt(lamUz) over the central WEIGHT_PRIOR_MASS of lamUz's (truncated) Gamma prior."""
+    a, b, lower, upper = lamuz_prior.a, lamuz_prior.b, lamuz_prior.lower, lamuz_prior.upper
+    gamma = stats.gamma(a, scale=1.0 / b)
+    tail = 0.5 * (1.0 - WEIGHT_PRIOR_MASS)
+    c_lo, c_hi = gamma.cdf(lower), gamma.cdf(upper)
+    lam_lo, lam_hi = gamma.ppf(c_lo + (c_hi - c_lo) * np.array([tail, 1.0 - tail]))
+    sd_lo, sd_hi = 1.0 / np.sqrt(lam_hi), 1.0 / np.sqrt(lam_lo)
+    rms = np.sqrt(np.mean(w**2, axis=0))
+    bad = np.flatnonzero((rms < sd_lo) | (rms > sd_hi))
+    if bad.size:
+        shown = ", ".join(f"{j}: {rms[j]:.3g}" for j in bad[:5])
+        warnings.warn(
+            f"basis column(s) {bad.tolist()} give the runs weights of root mean square {shown}; "
+            f"lamUz's prior (Gamma({a:g}, {b:g}) on ({lower:g}, {upper:g})) lets them spread "
+            f"{sd_lo:.2g} to {sd_hi:.2g} ({WEIGHT_PRIOR_MASS:.0%} of its mass). Multiply column "
+            "j of the basis by its weights' root mean square to give them the unit scale "
+            "GPM/SA's priors expect (the PCA basis's)",
+            BasisWarning,
+            stacklevel=user_stacklevel(),
+        )
 
 
 def basis_weights(y_std: np.ndarray, K: np.ndarray) -> np.ndarray:

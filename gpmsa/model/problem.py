@@ -12,7 +12,13 @@ from scipy.linalg import cho_factor, cho_solve
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.model import categorical
 from gpmsa.model import mean_basis as mean_basis_mod
-from gpmsa.model.basis import basis_weights, discrepancy_basis, interpolate_basis, pca_basis
+from gpmsa.model.basis import (
+    basis_weights,
+    discrepancy_basis,
+    given_basis,
+    interpolate_basis,
+    pca_basis,
+)
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.data import ObsData, SimData, as_float, check_finite
 from gpmsa.model.discrepancy import check_groups, n_groups
@@ -451,11 +457,14 @@ def prepare(
     discrepancy=None,
     mean_basis=None,
     discrepancy_groups=None,
+    basis=None,
 ) -> Prepared:
     """Standardise, build the PCA basis and weights, reduce observations, set priors and inits.
 
-    ``mean_basis``: None (zero mean), "constant", "linear" or a callable of unit-scale [x, t]
-    (n, p + q) -> (n, k) (``gpmsa.model.mean_basis``). Categorical inputs come from ``sim``.
+    ``basis``: the emulator basis K (l_sim, p_u) in standardised output units (`given_basis`)
+    instead of the runs' PCA (``n_pc``); not both. ``mean_basis``: None (zero mean),
+    "constant", "linear" or a callable of unit-scale [x, t] (n, p + q) -> (n, k)
+    (``gpmsa.model.mean_basis``). Categorical inputs come from ``sim``.
     ``priors``: before the data corrections (``corrected=False``; an Emulator's ``priors``,
     corrected for its own data, are refused). ``discrepancy_groups``: `reduce_obs`'s groups.
     """
@@ -472,9 +481,12 @@ def prepare(
             "would not be corrected for these data; pass the priors as set before fitting "
             "(gpmsa.Priors(...), corrected=False)"
         )
+    if basis is not None and n_pc is not None:
+        raise GPMSAError(f"give n_pc (a PCA basis) or basis, not both; got n_pc={n_pc!r}")
     std = Standardizer.from_sim(sim)
     y_std = std.y_to_std(sim.y)
-    K = pca_basis(y_std, n_pc)
+    base = Priors() if priors is None else priors
+    K = pca_basis(y_std, n_pc) if basis is None else given_basis(basis, y_std, base.lamUz)
     w = basis_weights(y_std, K)
     lam_sim = np.sum(K**2, axis=0)
     m, p_u = w.shape
@@ -489,7 +501,7 @@ def prepare(
         )
     elif discrepancy_groups is not None:
         check_groups(discrepancy_groups, 0)  # refused: no discrepancy without observations
-    priors = (Priors() if priors is None else priors).with_data(wos, os_corr)
+    priors = base.with_data(wos, os_corr)
     init = default_init(sim.p, sim.q, p_u, priors, obs_p)
     x_unit, t_unit = std.x_to_unit(sim.x), std.t_to_unit(sim.t)
     basis = mean_basis_mod.make(mean_basis, sim.p + sim.q, sim.m)

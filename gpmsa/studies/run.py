@@ -101,6 +101,25 @@ def _study_draws(chains: StudyChains, keep: slice, discrepancy: bool = False
     return out
 
 
+def _per_model_basis(basis, n: int) -> list:
+    """Each model's emulator basis from ``fit_study``'s ``basis``: None (every model's PCA), a
+    numpy array (every model's), or a list or tuple with one entry (None or an array) per
+    model."""
+    if basis is None or isinstance(basis, np.ndarray):
+        return [basis] * n
+    if not isinstance(basis, (list, tuple)):
+        raise GPMSAError(
+            "basis must be None, a numpy array (every model's basis) or a list with one entry "
+            f"(None or an array) per model, got {type(basis).__name__}"
+        )
+    if len(basis) != n:
+        raise GPMSAError(
+            f"basis has {len(basis)} entries for {n} models: give one numpy array for every "
+            "model, or a list with one entry (None or an array) per model"
+        )
+    return list(basis)
+
+
 def _per_model_discrepancy(discrepancy, groups, n: int) -> list[tuple]:
     """Each model's (basis, groups) from ``calibrate_study``'s ``discrepancy`` and
     ``discrepancy_groups``: one value for every model, or a list or tuple with one entry per
@@ -276,7 +295,7 @@ def fit_study(
     sims, obs, *, labels=None, shared=(), hierarchical=(), hyper: HyperPriors | None = None,
     n_iter: int = 30_000, n_burn: int | None = None, n_keep: int = 1000, point: str = "mean",
     tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
-    priors: Priors | None = None, n_pc: int | float | None = None, discrepancy=None,
+    priors: Priors | None = None, n_pc: int | float | None = None, basis=None, discrepancy=None,
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
     metadata: dict | None = None,
@@ -294,6 +313,8 @@ def fit_study(
             same for every model); the seed
             the study ran with is ``study.settings["seed"]`` and each model's
             ``settings["seed"]``.
+        basis: as ``gpmsa.fit``'s, a numpy array for every model or a list with one entry
+            (None: the model's PCA, as ``n_pc`` says) per model.
         metadata: a JSON-able dict saved with the study.
 
     Returns a ``Study`` of kind "fit": ``study.members`` are the models' fitted emulators (their
@@ -321,9 +342,10 @@ def fit_study(
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
+    bases = _per_model_basis(basis, n)
     preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
-                        discrepancy_groups=discrepancy_groups)
-             for lab, s, o in zip(labels, sims, obs, strict=True)]  # fmt: skip
+                        discrepancy_groups=discrepancy_groups, basis=k)
+             for lab, s, o, k in zip(labels, sims, obs, bases, strict=True)]  # fmt: skip
     for lab, sim in zip(labels, sims, strict=True):  # the study's theta moves are continuous
         categorical.refuse_categorical_theta(sim.levels, sim.p, sim.x_names + sim.t_names,
                                              f"fit_study (model {lab})")  # fmt: skip
@@ -361,6 +383,7 @@ def fit_study(
         emu_settings = {"n_iter": int(n_iter), "n_burn": int(n_burn), "thin": thin,
                         "n_chains": int(n_chains), "tune": bool(tune), "backend": "numpy",
                         "seed": seed, "point": point, "n_pc": int(prep.K.shape[1]),
+                        "basis": "pca" if bases[i] is None else "given",
                         "joint_obs": True, "discrepancy": fitted_discrepancy,
                         "obs_lengths": [int(e.size) for e in obs[i].experiments],
                         "obs_sha256": obs[i].digest(),

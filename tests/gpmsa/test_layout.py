@@ -44,8 +44,9 @@ limits, read at call time) sits just above the leaves."""
 LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 
 PUBLIC = [
-    "BackendUnavailableError", "Calibrator", "ChainError", "Chains", "ConvergenceWarning",
-    "Emulator", "EmulatorFileError", "GPMSAError", "GammaPrior", "LooResult", "ObsData",
+    "BackendUnavailableError", "BasisWarning", "Calibrator", "ChainError", "Chains",
+    "ConvergenceWarning", "Emulator", "EmulatorFileError", "GPMSAError", "GammaPrior",
+    "LooResult", "ObsData",
     "ObsProblem", "OutsideEmulatorWarning", "ReductionWarning",
     "Posterior", "Priors", "Problem", "ResourceLimitError", "SimData", "backends", "calibrate",
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
