@@ -120,12 +120,15 @@ def _warn_weight_scale(w: np.ndarray, lamuz_prior) -> None:
     bad = np.flatnonzero((rms < sd_lo) | (rms > sd_hi))
     if bad.size:
         shown = ", ".join(f"{j}: {rms[j]:.3g}" for j in bad[:5])
+        unused = np.flatnonzero(rms <= 1e-12 * rms.max())
+        drop = (f" Column(s) {unused.tolist()} hold none of the runs' variation: leave them out."
+                if unused.size else "")  # fmt: skip
         warnings.warn(
             f"basis column(s) {bad.tolist()} give the runs weights of root mean square {shown}; "
             f"lamUz's prior (Gamma({a:g}, {b:g}) on ({lower:g}, {upper:g})) lets them spread "
             f"{sd_lo:.2g} to {sd_hi:.2g} ({WEIGHT_PRIOR_MASS:.0%} of its mass). Multiply column "
             "j of the basis by its weights' root mean square to give them the unit scale "
-            "GPM/SA's priors expect (the PCA basis's)",
+            f"GPM/SA's priors expect (the PCA basis's).{drop}",
             BasisWarning,
             stacklevel=user_stacklevel(),
         )

@@ -105,6 +105,17 @@ def test_weights_off_the_prior_scale_warn_naming_the_columns_and_the_cure():
     _no_warnings(gpmsa.prepare, sim, basis=K)  # the cure: unit-scale weights
 
 
+def test_a_column_the_runs_do_not_use_is_named_to_leave_out():
+    sim = _sim()  # every run is 0 at GRID[0]: the unit vector there holds none of their variation
+    raw = np.column_stack([np.eye(25)[:, 0], np.cos(np.pi * np.outer(GRID, np.arange(4)))])
+    q, _ = np.linalg.qr(raw)
+    y_std = gpmsa.prepare(sim).standardizer.y_to_std(sim.y)
+    assert np.all(y_std[:, 0] == 0.0)
+    used = q[:, 1:] * np.sqrt(np.mean((y_std @ q[:, 1:]) ** 2, axis=0))
+    with pytest.warns(gpmsa.BasisWarning, match=r"Column\(s\) \[4\] hold none"):
+        gpmsa.prepare(sim, basis=np.column_stack([used, q[:, 0]]))
+
+
 def test_the_weight_scale_is_judged_by_the_lamuz_prior_given():
     sim = _sim()
     K = _cosine_basis(sim, 4)
