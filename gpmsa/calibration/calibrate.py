@@ -267,14 +267,17 @@ def calibrate(
     reserved = ("n_iter", "n_chains", "tune", "seed", "progress", "n_jobs", "executor",
                 "tune_rounds", "tune_levels")  # fmt: skip
     renamed = {"n_iter": "n_samples"}  # gpmsa.fit's name: no backend option (nor fast=False)
-    if set(options) & set(reserved):
-        backends.check_options(backend, options, reserved, "calibrate", renamed)
+    if on_obs := sorted(set(options) & {"index", "precision"}):
+        raise GPMSAError(
+            f"calibrate: {on_obs} describe the observations: give them with x and y as "
+            "gpmsa.ObsData(x, y, index=..., precision=...) in place of x_obs (y_obs left out)"
+        )
+    backends.check_options(backend, options, reserved, "calibrate", renamed)
     if options and fast:
         raise GPMSAError(
             f"calibrate: options {sorted(options)} go to a backend's sampler, which the fast "
             "numpy sampler replaces; pass fast=False (or another backend) to use them"
         )
-    backends.check_options(backend, options, reserved, "calibrate", renamed)
     _check_calibrate_memory(emulator, n_samples, n_chains, fast)
     _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}

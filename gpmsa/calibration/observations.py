@@ -210,8 +210,29 @@ def check_y(emulator, y_obs) -> np.ndarray:
     """y_obs as a float array with its columns in the order of the emulator's ``y_names``: a
     table with named columns by name (`by_column_names`: other names are a GPMSAError), a pandas
     Series by its labels (`series_by_names`), an array as it is (by position). A numpy masked
-    array is refused (`as_float`)."""
+    array is refused (`as_float`); so is a list of experiments of different lengths
+    (`refuse_ragged`)."""
+    refuse_ragged(y_obs)
     return as_float(by_column_names(y_obs, _y_names(emulator), "y_obs"), "y_obs")
+
+
+def refuse_ragged(y_obs) -> None:
+    """GPMSAError pointing at gpmsa.ObsData when ``y_obs`` is a list of experiments of
+    different lengths (SEPIA's ragged y_obs, each on its own grid)."""
+    if not isinstance(y_obs, (list, tuple)):
+        return
+    try:
+        if not all(np.ndim(e) == 1 for e in y_obs):
+            return
+    except ValueError:  # an experiment ragged itself: as_float refuses it
+        return
+    lengths = [int(np.size(e)) for e in y_obs]
+    if len(set(lengths)) > 1:
+        raise GPMSAError(
+            f"y_obs holds experiments of different lengths {lengths}: give observations on "
+            "their own output grids as gpmsa.ObsData(x, y, index=[one grid per experiment]) in "
+            "place of x_obs (y_obs left out)"
+        )
 
 
 def obs_inputs(emulator, x_obs, y_obs, what: str = "x_obs"):

@@ -425,7 +425,8 @@ class Posterior:
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
         """name -> {mean, sd, q_lo, median, q_hi, n_draws, exact_grid} (the interval at
-        ``level``; MCMC posteriors add the bulk ESS). q_lo and q_hi are named by their
+        ``level``; MCMC posteriors add the bulk ESS and the rank-normalised split R-hat, NaN
+        where the chains are too short or constant). q_lo and q_hi are named by their
         percentages (`quantile_keys`): "q5" and "q95" for level 0.9."""
         level = check_level(level)
         lo_key, hi_key = quantile_keys(level)
@@ -443,9 +444,9 @@ class Posterior:
                 "exact_grid": name in self.grids,
             }
             if self.chains is not None:
-                from gpmsa.mcmc.diagnostics import ess
-
-                out[name]["ess"] = ess(np.atleast_2d(self.chains[name]))
+                chains = np.atleast_2d(self.chains[name])
+                out[name]["ess"] = diagnostics.ess(chains)
+                out[name]["rhat"] = diagnostics.rhat(chains)
         return out
 
     def to_arviz(self):

@@ -33,19 +33,33 @@ def columns(spec: Sequence | None, names: tuple[str, ...], what: str) -> tuple[i
         spec = [spec]
     elif isinstance(spec, (bytes, bytearray)) or not isinstance(spec, Iterable):
         raise GPMSAError(f"{what} must hold column indices or names, got {spec!r}")
+    spec = list(spec)
+    hint = _sepia_hint(what)
     out = set()
     for item in spec:
         if isinstance(item, str):
             if item not in names:
                 raise GPMSAError(f"{what}: {item!r} is not an input; the inputs are {names}")
-            out.add(names.index(item))
+            k = names.index(item)
         elif isinstance(item, (int, np.integer)) and not isinstance(item, bool):
             if not 0 <= int(item) < len(names):
-                raise GPMSAError(f"{what}: column {item} out of range [0, {len(names)})")
-            out.add(int(item))
+                raise GPMSAError(f"{what}: column {item} out of range [0, {len(names)}){hint}")
+            k = int(item)
         else:
             raise GPMSAError(f"{what} must hold column indices or names, got {item!r}")
+        if k in out:
+            raise GPMSAError(f"{what} lists column {k} ({names[k]}) twice{hint}")
+        out.add(k)
     return tuple(sorted(out))
+
+
+def _sepia_hint(what: str) -> str:
+    """Advice for SEPIA's form of ``what`` (x_cat_ind: a level count per column, 0 for a
+    continuous one), which reads here as column indices."""
+    sepia = f"{what[0]}_cat_ind"
+    return (f" ({what} lists the categorical columns, by index or name; SEPIA's {sepia}, one "
+            f"level count per column with 0 for a continuous one, is not this form: for "
+            f"{sepia}=[0, 3] pass {what}=[1])")  # fmt: skip
 
 
 def check_integer_levels(arr: np.ndarray, cols: tuple[int, ...], names, what: str) -> None:

@@ -712,20 +712,21 @@ class ObsData:
         if per_experiment or rows:  # an (n, l) array: a grid per experiment; (l, 1): one
             if len(index) != len(ys):
                 raise GPMSAError(
-                    f"index_obs has {len(index)} grids for {len(ys)} experiment(s): give one "
+                    f"index has {len(index)} grids for {len(ys)} experiment(s): give one "
                     "grid per experiment, or one grid for all"
                 )
-            grids = [as_float(g, f"index_obs[{j}]").reshape(-1) for j, g in enumerate(index)]
+            grids = [as_float(g, f"index[{j}]").reshape(-1) for j, g in enumerate(index)]
         else:
-            g = as_float(index, "index_obs")
+            g = as_float(index, "index")
             if g.ndim > 1 and sorted(g.shape)[-2] > 1:
-                raise GPMSAError(f"index_obs must be one grid (l,) or one per experiment, got "
+                raise GPMSAError(f"index must be one grid (l,) or one per experiment, got "
                                  f"shape {g.shape}")  # fmt: skip
             grids = [g.reshape(-1)] * len(ys)
         for j, (g, e) in enumerate(zip(grids, ys, strict=True)):
+            name = f"index[{j}]" if per_experiment or rows else "index"
             if g.size != e.size:
-                raise GPMSAError(f"index of experiment {j} has {g.size} points, y_obs has {e.size}")
-            check_finite(g, f"index_obs[{j}]")
+                raise GPMSAError(f"{name} has {g.size} points, y[{j}] has {e.size}")
+            check_finite(g, name)
         return grids
 
     @staticmethod

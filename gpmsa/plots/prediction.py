@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import as_float, check_count, check_level
+from gpmsa.model.data import ObsData, as_float, check_count, check_level
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.full import FullPrediction
 
@@ -66,12 +66,7 @@ def prediction_bands(
     if pred.x.shape[1]:  # a functional output without known inputs draws no x axis
         x_column = check_count(x_column, "x_column", 0, pred.x.shape[1] - 1)
     if observed is not None:
-        observed = as_float(observed, "observed")
-        if observed.ndim == 1 and l == 1:
-            observed = observed[:, None]
-        if observed.shape != (N, l):
-            raise GPMSAError(f"observed must have shape ({N}, {l}) (one row per predicted x), "
-                             f"got {observed.shape}")  # fmt: skip
+        observed = _observed(observed, N, l)
     if not isinstance(relative, bool | np.bool_):
         raise GPMSAError(f"relative must be True or False, got {relative!r}")
     bands = {w: pred.interval(w, level) for w in ("y", "zeta", "eta", "delta")}
@@ -129,3 +124,23 @@ def prediction_bands(
     axes[1, 0].set_ylabel("discrepancy delta")
     axes[0, 0].legend(fontsize="x-small")
     return fig
+
+
+def _observed(observed, N: int, l: int) -> np.ndarray:
+    """``observed`` as (N, l) values at the prediction's x and grid; GPMSAError naming that
+    shape otherwise, with advice for experiments on their own grids (an ObsData, a ragged
+    list)."""
+    want = f"observed must have shape ({N}, {l}) on pred.grid (one row per predicted x)"
+    ragged = isinstance(observed, (list, tuple)) and len({np.size(e) for e in observed}) > 1
+    if isinstance(observed, ObsData) or ragged:
+        raise GPMSAError(
+            f"{want}, got {type(observed).__name__} of experiments on their own grids: draw "
+            "each with a prediction on its grid, full_prediction(emu, obs, obs.x[[j]], "
+            "grid=obs.grids[j]), and observed=[obs.experiments[j]]"
+        )
+    observed = as_float(observed, "observed")
+    if observed.ndim == 1 and l == 1:
+        observed = observed[:, None]
+    if observed.shape != (N, l):
+        raise GPMSAError(f"{want}, got {observed.shape}")
+    return observed

@@ -325,7 +325,7 @@ def test_malformed_indexes_and_precisions_are_named():
     emu = vector_emulator()
     x, y = [[0.3], [0.7]], np.ones((2, 5))
     g = np.linspace(0, 1, 5)
-    with pytest.raises(GPMSAError, match=r"index_obs has 3 grids for 2 experiment"):
+    with pytest.raises(GPMSAError, match=r"^index has 3 grids for 2 experiment"):
         gpmsa.ObsData(x, y, index=[g, g, g])
     with pytest.raises(GPMSAError, match=r"one grid \(l,\) or one per experiment"):
         gpmsa.ObsData(x, y, index=np.zeros((2, 2, 2)))

@@ -272,7 +272,7 @@ def test_complex_data_are_refused_not_cast(kw, match):
     [({"y": np.array([[0.3 + 1j]])}, "y_obs must hold real numbers"),
      ({"y": [np.ones(3) + 0j, np.ones(2)]}, r"y_obs\[0\] must hold real numbers"),
      ({"x": np.array([[0.5 + 0j]])}, "x_obs must hold real numbers"),
-     ({"index": np.array([1j])}, "index_obs must hold real numbers"),
+     ({"index": np.array([1j])}, "index must hold real numbers"),
      ({"precision": [2 + 1j]}, r"precision\[0\] must hold real numbers"),
      ({"y": [["a"]]}, "y_obs must be a numeric array")],
 )  # fmt: skip
