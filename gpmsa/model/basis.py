@@ -174,6 +174,17 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
                 f"discrepancy must be None, 'constant', 'linear' or an array, got {kind!r}"
             )
     else:
+        if (
+            isinstance(kind, (list, tuple))
+            and kind
+            and all(isinstance(d, np.ndarray) and d.ndim == 2 for d in kind)
+        ):
+            raise GPMSAError(
+                f"discrepancy basis: a list of {len(kind)} matrices (one per experiment, as "
+                "SEPIA's create_D_basis takes for experiments on their own grids) is not taken: "
+                f"give one ({grid.size}, p_v) array on the grid every experiment shares, or "
+                "'constant' / 'linear', which are built on each experiment's own grid"
+            )
         D = as_float(kind, "discrepancy basis")
         if D.ndim == 1:
             D = D[:, None]

@@ -368,7 +368,12 @@ def _units(units: Sequence[str] | None, n: int, what: str) -> tuple[str, ...]:
                          f"unit pass [{units!r}])")  # fmt: skip
     units = tuple(str(s) for s in units)
     if len(units) != n:
-        raise GPMSAError(f"{what} must have {n} entries, got {len(units)}: {units}")
+        each = ""
+        if what == "y_units" and len(units) == 1:
+            each = (
+                f" (one per output value, on a functional output's grid too: [{units[0]!r}] * {n})"
+            )
+        raise GPMSAError(f"{what} must have {n} entries, got {len(units)}: {units}{each}")
     return units
 
 
@@ -578,8 +583,9 @@ class ObsData:
     simulation grid, which is increasing), but must lie within the simulation grid; the columns
     of ``y`` follow its order. ``precision`` is the observation-error precision in native units
     (1/unit^2): None (identity in standardised units, GPM/SA's default), a scalar (the same for
-    every experiment), or per experiment a scalar or an (l_j, l_j) matrix (a list, or an array
-    of shape (n,) or (n, l, l)). Every entry must be a real number (strings, bools and None are
+    every experiment), or per experiment a scalar, an (l_j,) vector (one precision per value:
+    the diagonal of the matrix) or an (l_j, l_j) matrix (a list, or an array of shape (n,),
+    (n, l) or (n, l, l)). Every entry must be a real number (strings, bools and None are
     refused, never converted). ``x`` and ``y`` given as pandas objects of several rows must carry
     the same row labels (rows pair by position).
 
@@ -745,9 +751,14 @@ class ObsData:
             lam = as_float(lam, f"precision[{j}]")
             if lam.ndim == 0:
                 lam = lam * np.eye(e.size)
+            elif lam.shape == (e.size,):  # one precision per value
+                if not np.all(lam > 0):
+                    raise GPMSAError(f"precision[{j}] must be positive, got {lam.tolist()}")
+                lam = np.diag(lam)
             if lam.shape != (e.size, e.size):
                 raise GPMSAError(
-                    f"precision[{j}] must be a scalar or ({e.size}, {e.size}), got {lam.shape}"
+                    f"precision[{j}] must be a scalar, ({e.size},) or ({e.size}, {e.size}), got "
+                    f"{lam.shape}"
                 )
             check_finite(lam, f"precision[{j}]")
             scale = float(np.max(np.abs(lam)))  # relative: a precision in small units is fine

@@ -441,11 +441,30 @@ def _warn_if_vague(precisions: list[np.ndarray]) -> None:
 
 @dataclass(frozen=True, eq=False)
 class Prepared:
-    """A problem with the transforms and basis that produced it."""
+    """A problem with the transforms and basis that produced it; ``runs_sum_squares``: the
+    standardised runs' sum of squares (what `variance_shares` divides)."""
 
     problem: Problem
     standardizer: Standardizer
     K: np.ndarray
+    runs_sum_squares: float
+
+    @property
+    def variance_shares(self) -> np.ndarray:
+        """(p_u,) the share of the standardised runs' variance each basis vector holds,
+        ||w_j||^2 ||K_j||^2 / ||Y||^2 (orthogonal columns: they add up to the basis's share)."""
+        held = np.sum(self.problem.w**2, axis=0) * self.problem.lam_sim
+        return held / self.runs_sum_squares if self.runs_sum_squares > 0 else held * np.nan
+
+    def __repr__(self) -> str:
+        prob, shares = self.problem, self.variance_shares
+        shown = ", ".join(f"{v:.3%}" for v in shares[:6]) + (", ..." if shares.size > 6 else "")
+        obs = "none" if prob.obs is None else f"{prob.obs.n} experiment(s)"
+        return (
+            f"Prepared(m={prob.m} runs, p={prob.p}, q={prob.q}, l_sim={self.K.shape[0]}, "
+            f"p_u={self.K.shape[1]} basis vectors holding {np.sum(shares):.3%} of the runs' "
+            f"variance [{shown}], observations: {obs})"
+        )
 
 
 def prepare(
@@ -513,4 +532,4 @@ def prepare(
     )  # fmt: skip
     if obs is not None and prob.theta_levels is not None:  # a categorical theta starts at a level
         prob = prob.with_init({"theta": prob.snap_theta(init["theta"])})
-    return Prepared(prob, std, K)
+    return Prepared(prob, std, K, float(np.sum(y_std**2)))

@@ -192,3 +192,17 @@ def test_from_params_takes_a_basis():
               "lamWOs": np.array([1e3])}  # fmt: skip
     emu = gpmsa.Emulator.from_params(sim, params, basis=K)
     assert np.array_equal(emu.K, K) and emu.settings["basis"] == "given"
+
+
+def test_prepare_shows_each_basis_vector_s_share_of_the_runs_variance():
+    sim = _sim()
+    prep = gpmsa.prepare(sim, n_pc=3)
+    y_std = prep.standardizer.y_to_std(sim.y)
+    s = np.linalg.svd(y_std, compute_uv=False)
+    assert np.allclose(prep.variance_shares, s[:3] ** 2 / np.sum(s**2), rtol=1e-10)
+    given = gpmsa.prepare(sim, basis=_cosine_basis(sim, 5))
+    left = np.sum((y_std - given.problem.w @ given.K.T) ** 2) / np.sum(y_std**2)
+    assert np.sum(given.variance_shares) == pytest.approx(1.0 - left, rel=1e-10)
+    text = repr(prep)
+    assert "p_u=3 basis vectors" in text and f"{np.sum(prep.variance_shares):.3%}" in text
+    assert len(text) < 300  # no arrays dumped

@@ -101,3 +101,34 @@ def test_prediction_bands_refuses_ragged_observations_naming_the_grid():
     for observed in (ys, obs):
         with pytest.raises(GPMSAError, match=r"\(2, 8\) on pred\.grid.*grid="):
             gpmsa.plots.prediction_bands(pred, observed=observed)
+
+
+def test_a_precision_vector_per_experiment_is_its_diagonal():
+    x, ys, grids = _ragged()
+    vectors = [np.linspace(1e3, 2e3, 5), np.array([5e2, 1e3, 4e3])]
+    obs = gpmsa.ObsData(x, ys, index=grids, precision=vectors)
+    same = gpmsa.ObsData(x, ys, index=grids, precision=[np.diag(v) for v in vectors])
+    assert all(np.array_equal(a, b) for a, b in zip(obs.precisions, same.precisions, strict=True))
+    assert obs.digest() == same.digest()
+    with pytest.raises(GPMSAError, match=r"precision\[1\] must be positive"):
+        gpmsa.ObsData(x, ys, index=grids, precision=[vectors[0], -vectors[1]])
+    with pytest.raises(GPMSAError, match=r"precision\[1\] must be a scalar, \(3,\) or \(3, 3\)"):
+        gpmsa.ObsData(x, ys, index=grids, precision=[vectors[0], vectors[1][:2]])
+
+
+def test_a_list_of_per_experiment_discrepancy_bases_is_refused_naming_what_is_taken():
+    x, ys, grids = _ragged()
+    rng = np.random.default_rng(4)
+    xs, ts = rng.uniform(size=(24, 1)), rng.uniform(size=(24, 1))
+    data = gpmsa.SimData(x=xs, t=ts, y=_simulator(xs, ts), index=GRID)
+    obs = gpmsa.ObsData(x, ys, index=grids)
+    per = [np.column_stack([np.ones(g.size), g]) for g in grids]
+    with pytest.raises(GPMSAError, match=r"a list of 2 matrices .* is not taken.*'linear'"):
+        gpmsa.fit(data, obs, n_iter=10, discrepancy=per)
+
+
+def test_one_unit_for_a_functional_output_says_one_per_value():
+    rng = np.random.default_rng(5)
+    x, t = rng.uniform(size=(12, 1)), rng.uniform(size=(12, 1))
+    with pytest.raises(GPMSAError, match=r"y_units must have 8 entries.*\['s'\] \* 8"):
+        gpmsa.SimData(x=x, t=t, y=_simulator(x, t), index=GRID, y_units=["s"])
