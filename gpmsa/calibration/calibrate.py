@@ -225,7 +225,8 @@ def calibrate(
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
         native units), "lamOs" (and with a discrepancy "betaV", or "betaV[k]" per known input
         when p > 1, and "lamVz"; with several precision groups "betaV[k,g]" and "lamVz[g]",
-        the groups in ``info["discrepancy_groups"]``), and chains per name;
+        the groups in ``info["discrepancy_groups"]``, the basis's kind in
+        ``info["discrepancy"]``: "constant", "linear" or "given"), and chains per name;
         ``info["obs_values_sha256"]`` fingerprints the observations
         (``ObsData.values_digest(emulator.x_names, emulator.y_names)``: tables are read by
         name), so that
@@ -476,5 +477,6 @@ def _run_backend(
         "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
     }
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
-        info.update(discrepancy_record(problem.obs))
+        kind = discrepancy if isinstance(discrepancy, str) else "given"
+        info.update({"discrepancy": kind, **discrepancy_record(problem.obs)})
     return draws, info

@@ -338,6 +338,26 @@ def _check_calibrated_obs(posterior, obs: ObsData, x_names, y_names, grid: np.nd
         )
 
 
+def _recorded_discrepancy(emulator, posterior: Posterior | None):
+    """The discrepancy basis kind the joint fit (``posterior`` None) or the calibration behind
+    ``posterior`` recorded (None: none); GPMSAError where it must be passed again: a basis
+    given as an array, or a Posterior that recorded the basis's digest but not its kind
+    (made before the kind was kept)."""
+    record = (emulator.settings if posterior is None else posterior.info) or {}
+    kind = record.get("discrepancy")
+    source = "the joint fit" if posterior is None else "the calibration"
+    if kind is None and posterior is not None and "discrepancy_sha256" in record:
+        raise GPMSAError(
+            "with this posterior= pass the discrepancy basis the calibration used (None, "
+            "'constant', 'linear' or the array): it records the basis's digest, not its kind"
+        )
+    if isinstance(kind, str) and kind == "given":
+        raise GPMSAError(
+            f"{source} used a discrepancy basis given as an array; pass it again as discrepancy="
+        )
+    return kind
+
+
 def full_prediction(
     emulator,
     obs: ObsData,
@@ -365,8 +385,8 @@ def full_prediction(
             recorded them: info "obs_values_sha256"), and ``emulator`` be the one it was drawn
             with (where it recorded it: info "emulator_sha256", ``Emulator.model_sha256``).
         discrepancy: the discrepancy basis of the calibration: None, "constant", "linear" or an
-            (l_obs, p_v) array; the default takes the joint fit's recorded choice (an array must
-            be passed again).
+            (l_obs, p_v) array; the default takes the choice the joint fit, or the calibration
+            behind ``posterior``, recorded (an array must be passed again).
         discrepancy_groups: the precision group of each discrepancy basis vector (as
             ``gpmsa.fit``'s); the default takes the one the joint fit or ``gpmsa.calibrate``
             recorded (none recorded: one group).
@@ -401,15 +421,7 @@ def full_prediction(
     std, K = emulator.standardizer, emulator.K
     scalar = emulator.l_sim == 1
     if isinstance(discrepancy, str) and discrepancy == AS_FITTED:
-        if posterior is not None:
-            raise GPMSAError("with posterior= pass the discrepancy basis the calibration used "
-                             "(None, 'constant', 'linear' or the array)")  # fmt: skip
-        discrepancy = emulator.settings.get("discrepancy")
-        if isinstance(discrepancy, str) and discrepancy == "given":
-            raise GPMSAError(
-                "the joint fit used a discrepancy basis given as an array; pass it again as "
-                "discrepancy="
-            )
+        discrepancy = _recorded_discrepancy(emulator, posterior)
     elif posterior is None:
         _check_fitted_discrepancy(emulator, discrepancy)
     if posterior is None:

@@ -211,12 +211,12 @@ class Study:
         # other ones: a fitted model's (as calibration_posterior), a calibrated one's (as
         # gpmsa.calibrate; absent from study files written before it was kept)
         settings = self.members[i].settings if self.kind == "fit" else {}
-        info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy_sha256",
-                                              "discrepancy_groups")
-                     if k in settings})  # fmt: skip
+        info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy",
+                                              "discrepancy_sha256", "discrepancy_groups")
+                     if settings.get(k) is not None})  # fmt: skip
         basis = self.settings.get(DISCREPANCIES, {}).get(self.labels[i])
         if basis is not None:  # a calibration's basis: full_prediction refuses another
-            info.update({k: v for k, v in basis.items() if k != "discrepancy"})
+            info.update(basis)
         for key, name in ((OBS_DIGESTS, "obs_values_sha256"), (OBS_LAYOUTS, "obs_layout_sha256")):
             digests = self.settings.get(key)
             digest = digests.get(self.labels[i]) if isinstance(digests, dict) else None

@@ -164,8 +164,13 @@ def test_posterior_path_scalar_output_and_grid_option():
     # the observations were made at theta + discrepancy = 0.5: eta + delta is close to it
     truth = np.sin(2 * np.array([0.2, 0.6])) + 0.5
     assert np.all(np.abs(pred.mean("zeta")[:, 0] - truth) < 3 * np.sqrt(pred.var("zeta")[:, 0]))
-    with pytest.raises(GPMSAError, match="pass the discrepancy basis"):
-        full_prediction(emu, obs, [[0.2]], posterior=post)
+    assert post.info["discrepancy"] == "constant"  # the default reads it
+    same = full_prediction(emu, obs, [[0.2], [0.6]], posterior=post, n_draws=200, n_rlz=4, seed=1)
+    assert np.array_equal(same.y, pred.y)
+    kept = {k: v for k, v in post.info.items() if k != "discrepancy"}
+    old = gpmsa.Posterior(post.samples, info=kept)
+    with pytest.raises(GPMSAError, match="pass the discrepancy basis.*not its kind"):
+        full_prediction(emu, obs, [[0.2]], posterior=old)  # made before the kind was recorded
     with pytest.raises(GPMSAError, match="have discrepancy parameters"):
         full_prediction(emu, obs, [[0.2]], posterior=post, discrepancy=None)
     with pytest.raises(GPMSAError, match="no output grid"):

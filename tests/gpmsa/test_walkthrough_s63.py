@@ -132,3 +132,25 @@ def test_one_unit_for_a_functional_output_says_one_per_value():
     x, t = rng.uniform(size=(12, 1)), rng.uniform(size=(12, 1))
     with pytest.raises(GPMSAError, match=r"y_units must have 8 entries.*\['s'\] \* 8"):
         gpmsa.SimData(x=x, t=t, y=_simulator(x, t), index=GRID, y_units=["s"])
+
+
+def test_full_prediction_reads_the_discrepancy_kind_a_calibration_recorded():
+    emu = _emulator()
+    xo = np.array([[0.2], [0.5], [0.8]])
+    obs = gpmsa.ObsData(xo, _simulator(xo, 0.4) + 0.05)
+    post = gpmsa.calibrate(emu, obs, n_samples=60, n_burn=10, seed=0, discrepancy="linear")
+    auto = gpmsa.full_prediction(emu, obs, [[0.4]], posterior=post, n_draws=10, seed=1)
+    told = gpmsa.full_prediction(emu, obs, [[0.4]], posterior=post, n_draws=10, seed=1,
+                                 discrepancy="linear")  # fmt: skip
+    assert auto.p_v == 2 and np.array_equal(auto.y, told.y)
+    D = np.column_stack([np.ones(GRID.size), GRID**2])
+    given = gpmsa.calibrate(emu, obs, n_samples=60, n_burn=10, seed=0, discrepancy=D)
+    assert given.info["discrepancy"] == "given"
+    with pytest.raises(GPMSAError, match="given as an array; pass it again"):
+        gpmsa.full_prediction(emu, obs, [[0.4]], posterior=given)
+    study = gpmsa.calibrate_study([emu, emu], [obs, obs], shared=["t"], n_samples=60,
+                                  n_burn=10, seed=0, discrepancy=["constant", None])  # fmt: skip
+    first, second = (study.member_posterior(k) for k in study.labels)
+    assert first.info["discrepancy"] == "constant" and "discrepancy" not in second.info
+    assert gpmsa.full_prediction(emu, obs, [[0.4]], posterior=first, n_draws=5).p_v == 1
+    assert gpmsa.full_prediction(emu, obs, [[0.4]], posterior=second, n_draws=5).p_v == 0
