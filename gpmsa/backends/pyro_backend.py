@@ -71,6 +71,15 @@ class PyroModel:
     """The GPM/SA posterior of ``problem`` as a pyro model (call it with no arguments)."""
 
     def __init__(self, problem: Problem, dtype: torch.dtype = torch.float64):
+        """GPMSAError for held elements (``problem.fixed_elements``): each parameter is one
+        NUTS sample site, sampled or constant as a whole."""
+        if problem.fixed_elements:
+            held = ", ".join(sorted(problem.fixed_elements))
+            raise GPMSAError(
+                f"the pyro backend samples each parameter as a whole; fixed= holds single "
+                f"elements of {held}: fix the whole array (a scalar or an array of its shape), "
+                "or use backend='numpy' or 'torch'"
+            )
         self.problem = problem
         self.dtype = dtype
         self.data = ModelTensors.from_problem(problem, dtype, "cpu")

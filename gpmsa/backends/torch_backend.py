@@ -49,6 +49,7 @@ from gpmsa.mcmc.sampler import (
     wrong_result,
 )
 from gpmsa.model.data import check_count, check_flag
+from gpmsa.model.likelihood import held_log_prior
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem
 
@@ -416,6 +417,8 @@ class BatchState:
         self.data = ModelTensors.from_problem(problem, dtype, device)
         self.priors = problem.priors
         self.els = elements(problem)
+        # the held elements' constant share of the whole-array priors in log_post
+        self._held_lp = held_log_prior(problem, problem.init) if problem.fixed_elements else 0.0
         self.n_chains = n_chains
         if start is None:
             start = {k: np.broadcast_to(v, (n_chains, *v.shape)) for k, v in problem.init.items()}
@@ -477,7 +480,7 @@ class BatchState:
         for name in self.problem.sampled:
             x = self.params[name]
             lp = lp + log_prior_elements(self.priors, name, x).reshape(x.shape[0], -1).sum(-1)
-        return lp
+        return lp - self._held_lp if self.problem.fixed_elements else lp
 
     def _obs(self, prm: dict[str, Tensor], chol: Tensor | None, alpha: Tensor | None) -> Tensor:
         """Observation term (C',) at ``prm`` given the Sigma_W factors (zeros without obs)."""

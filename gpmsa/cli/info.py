@@ -115,11 +115,10 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     lines.append(f"mean basis:      {'zero (GPM/SA)' if mean is None else safe(mean, 60)}")
     fixed = manifest["settings"].get("fixed")
     if isinstance(fixed, dict) and fixed:
-        cells = []
-        for k, v in fixed.items():  # theta is stored on the unit scale: printed native, by name
-            native = _native_theta(manifest, v, standardizer) if k == "theta" else None
-            cells.append(f"theta (native)=[{native[1]}]" if native else f"{safe(k, 60)}={plain(v)}")
-        lines.append("fixed:           " + ", ".join(cells))
+        cells = [_fixed_cell(manifest, k, v, standardizer) for k, v in fixed.items()]
+        some = any(_held_elements(v) for v in fixed.values())
+        lines.append("fixed:           " + ", ".join(cells)
+                     + (" (single elements: the others sampled)" if some else ""))  # fmt: skip
     lines.extend(_prior_lines(manifest["priors"]))
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
@@ -211,6 +210,39 @@ def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str
     native = standardizer.t_from_unit(np.array([means], dtype=float))[0]
     cells = [f"{safe(n, 60)}={number(float(v), '.4g')}" for n, v in zip(names, native, strict=True)]
     return "theta (native)", ", ".join(cells)
+
+
+def _held_elements(record: object) -> list[tuple[list[int], float]] | None:
+    """A ``settings["fixed"]`` entry of held elements ({"elements": [index, ...], "values":
+    [...]}) as (index, value) pairs; None for any other entry (a whole parameter's values)."""
+    if not (isinstance(record, dict) and set(record) == {"elements", "values"}):
+        return None
+    els, vals = record["elements"], record["values"]
+    if not (isinstance(els, list) and isinstance(vals, list) and len(els) == len(vals) and els):
+        return None
+    ints = all(isinstance(i, list) and i and all(isinstance(k, int) and not isinstance(k, bool)
+               and k >= 0 for k in i) for i in els)  # fmt: skip
+    nums = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals)
+    return list(zip(els, vals, strict=True)) if ints and nums else None
+
+
+def _fixed_cell(manifest: dict, name: str, record: object, standardizer) -> str:
+    """One entry of ``settings["fixed"]`` as printed: NAME=VALUES for a whole parameter, or
+    NAME[i]=VALUE per held element; theta (stored on the unit scale) native, by name."""
+    held = _held_elements(record)
+    if name == "theta" and held is not None:
+        names = manifest["names"]["t"]
+        if all(len(i) == 1 and i[0] < len(names) for i, _ in held):
+            unit = np.full((1, len(names)), 0.5)
+            for (k,), u in held:
+                unit[0, k] = u
+            native = standardizer.t_from_unit(unit)[0]
+            cells = [f"{safe(names[k], 60)}={number(float(native[k]), '.4g')}" for (k,), _ in held]
+            return f"theta (native)=[{', '.join(cells)}]"
+    if held is not None:
+        return ", ".join(f"{safe(name, 60)}[{','.join(map(str, i))}]={plain(v)}" for i, v in held)
+    native = _native_theta(manifest, record, standardizer) if name == "theta" else None
+    return f"theta (native)=[{native[1]}]" if native else f"{safe(name, 60)}={plain(record)}"
 
 
 def _element(name: object) -> str:

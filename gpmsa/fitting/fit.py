@@ -17,6 +17,7 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.mcmc.sampler import draws_nbytes, parameter_elements, sweeps_nbytes
 from gpmsa.model import constraints
+from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
@@ -124,10 +125,17 @@ def fit(
     levels, uniform prior). mean_basis: None (zero mean, GPM/SA), "constant",
     "linear" or a callable of unit-scale [x, t] (n, p + q) -> (n, k); its coefficients are
     integrated out (flat prior). fixed: name -> value held fixed (model scales as
-    ``Emulator.params``; theta in native units), e.g. ``{"lamWOs": 1e5 - 1}``. constraint (joint
-    fit only): a callable of native theta (q,) -> bool, False where theta is not allowed (zero
-    prior mass there). theta_init: the chains' start of theta (native, (q,) or a dict by
-    t_names; default the centre; a categorical element: one of its levels).
+    ``Emulator.params``; theta in native units), e.g. ``{"lamWOs": 1e5 - 1}``: a scalar or an
+    array of the parameter's shape holds the whole array; a dict element index -> value holds
+    those elements and samples the others (SEPIA's per-element fixing; numpy and torch
+    backends, pyro refuses it), e.g. ``{"lamVz": {1: 1e6}}`` (group 1's discrepancy switched
+    off), ``{"betaU": {(2, 0): 0.5}}``. Indices count from 0: an int for a 1-D parameter (theta
+    also by t_name); a tuple (i, j) for betaU (p + q, p_u) and betaV (p, G), where an int i
+    means (i, 0) only if there is one column (``gpmsa.model.fixed_elements``); naming every
+    element equals fixing the whole array. constraint (joint fit only): a callable of native
+    theta (q,) -> bool, False where theta is not allowed (zero prior mass there). theta_init:
+    the chains' start of theta (native, (q,) or a dict by t_names; default the centre; a
+    categorical element: one of its levels).
 
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
@@ -181,6 +189,9 @@ def fit(
     post = {k: np.asarray(v[:, n_burn:], dtype=float) for k, v in chains.draws.items()}
     for k in problem.fixed & set(post):
         post[k][...] = np.asarray(problem.init[k], dtype=float).reshape(post[k].shape[2:])
+    for k, held in problem.fixed_elements.items():
+        for idx in held:
+            post[k][(slice(None), slice(None), *idx)] = float(problem.init[k][idx])
     lp = chains.log_post[:, n_burn:]
     lp_kept = lp[:, ::thin].reshape(-1)
     n_kept = lp_kept.size  # explicit: an empty parameter (betaV when p = 0) has no -1 to infer
@@ -210,7 +221,7 @@ def fit(
             {k: v for k, v in options.items() if k not in ("n_jobs", "executor")}
         ),
         "mean_basis": None if problem.mean_basis is None else problem.mean_basis.kind,
-        "fixed": {k: problem.init[k].tolist() for k in sorted(problem.fixed)},
+        "fixed": fixed_record(problem),
         "constraint": constraint is not None,
         "step_widths": {k: v.tolist() for k, v in chains.step_widths.items()},
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
@@ -222,7 +233,8 @@ def fit(
     record = None
     if n_chains > 1:
         shapes = {k: problem.init[k].shape for k in problem.sampled}
-        record = convergence(summary, shapes, n_chains, kept)
+        held = {per_element.label(k, i) for k, v in problem.fixed_elements.items() for i in v}
+        record = convergence(summary, shapes, n_chains, kept, held=held)
         warn_unconverged(
             record,
             f"gpmsa.fit (backend {backend!r})",
@@ -274,9 +286,13 @@ def check_point(point) -> None:
         raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
 
 
-def _check_levels(problem: Problem, theta_unit: np.ndarray, names, what: str) -> None:
-    """GPMSAError when a categorical element of ``theta_unit`` is not one of its levels."""
+def _check_levels(problem: Problem, theta_unit: np.ndarray, names, what: str,
+                  only=None) -> None:  # fmt: skip
+    """GPMSAError when a categorical element of ``theta_unit`` (those at positions ``only``;
+    None: all) is not one of its levels."""
     for k, lv in enumerate(problem.theta_levels or ()):
+        if only is not None and k not in only:
+            continue
         if lv is not None and not np.any(np.isclose(lv, theta_unit[k], rtol=0, atol=1e-12)):
             raise GPMSAError(f"{what}: categorical calibration parameter {names[k]} must be one "
                              "of its training levels")  # fmt: skip
@@ -302,12 +318,50 @@ def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Proble
             raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
         fixed = dict(fixed)
         if "theta" in fixed and problem.obs is not None:
-            fixed["theta"] = constraints.theta_init_unit(
-                fixed["theta"], std.t_min, std.t_max, data.t_names, closed, "fixed['theta']"
-            )
-            _check_levels(problem, fixed["theta"], data.t_names, "fixed theta")
+            fixed["theta"] = _fixed_theta_unit(problem, fixed["theta"], std, data.t_names, closed)
         problem = problem.with_fixed(fixed)
     return problem
+
+
+def _fixed_theta_unit(problem: Problem, value, std, names, closed):
+    """``fixed['theta']`` (native) on the unit scale: the whole vector (as ``theta_init``), or
+    for a dict of some elements (by t_name or position) a dict position -> unit value; a dict
+    that names every element is the whole vector."""
+    if isinstance(value, dict):
+        given = per_element.parse("theta", per_element.theta_by_position(value, names),
+                                  (len(names),))  # fmt: skip
+        if len(given) < len(names):
+            return _held_theta_unit(problem, given, std, names, closed)
+        value = list(given.values())
+    unit = constraints.theta_init_unit(value, std.t_min, std.t_max, names, closed,
+                                       "fixed['theta']")  # fmt: skip
+    _check_levels(problem, unit, names, "fixed theta")
+    return unit
+
+
+def _held_theta_unit(problem: Problem, given: dict, std, names, closed) -> dict[int, float]:
+    """Some elements of theta (position tuple -> native value) on the unit scale, each checked
+    as ``theta_init``'s (inside the design's range; a categorical one at a level)."""
+    native = 0.5 * (np.asarray(std.t_min, dtype=float) + np.asarray(std.t_max, dtype=float))
+    for (k,), x in given.items():  # the other elements: the centre, only to check these
+        native[k] = x
+    unit = constraints.theta_init_unit(native, std.t_min, std.t_max, names, closed,
+                                       "fixed['theta']")  # fmt: skip
+    keep = [k for (k,) in given]
+    _check_levels(problem, unit, names, "fixed theta", keep)
+    return {k: float(unit[k]) for k in keep}
+
+
+def fixed_record(problem: Problem) -> dict:
+    """``settings["fixed"]``: name -> the value list of each parameter fixed whole (as files
+    always held), or for one with held elements {"elements": [index, ...], "values": [...]}
+    (model scales; theta unit scale), by name."""
+    out = {k: problem.init[k].tolist() for k in problem.fixed}
+    for k, held in problem.fixed_elements.items():
+        idx = sorted(held)
+        out[k] = {"elements": [list(i) for i in idx],
+                  "values": [float(problem.init[k][i]) for i in idx]}  # fmt: skip
+    return dict(sorted(out.items()))
 
 
 def continued_starts(
@@ -371,8 +425,7 @@ def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
     checks = {
         "priors": (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp)),
         "mean_basis": (settings.get("mean_basis"), None if mb is None else mb.kind),
-        "fixed parameters": (settings.get("fixed", {}),
-                             {k: problem.init[k].tolist() for k in sorted(problem.fixed)}),
+        "fixed parameters": (settings.get("fixed", {}), fixed_record(problem)),
         "theta constraint": (bool(settings.get("constraint", False)),
                              problem.constraint is not None),
         "discrepancy": ({k: settings.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")},

@@ -120,10 +120,12 @@ def convergence(
     shapes: dict[str, tuple[int, ...]],
     n_chains: int,
     n_draws: int,
+    held: frozenset[str] | set[str] = frozenset(),
 ) -> dict:
     """The convergence record of sampled parameters from ``summarize`` output (JSON-able).
 
-    ``shapes``: name -> element shape of every sampled parameter to judge. Returns n_chains,
+    ``shapes``: name -> element shape of every sampled parameter to judge; ``held``: names of
+    elements held fixed within them ("lamVz[1]"), not judged. Returns n_chains,
     n_draws (per chain), the limits, per parameter ``rhat`` and ``ess`` (bulk) lists (C order),
     the worst element of each kind (``max_rhat``, ``min_ess``: [element, value]; the value None
     where it is not finite, an infinite R-hat of chains stuck at different values; the element
@@ -138,6 +140,8 @@ def convergence(
         rs, es = summary[name]["rhat"], summary[name]["ess"]
         rhat_of[name], ess_of[name] = list(rs), list(es)
         for el, r, e in zip(element_names(name, shape), rs, es, strict=True):
+            if el in held:
+                continue
             r = float("nan") if r is None else float(r)
             e = float("nan") if e is None else float(e)
             if n_draws < MIN_DRAWS_RHAT:

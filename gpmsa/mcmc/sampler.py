@@ -141,14 +141,17 @@ def default_widths(problem: Problem) -> dict[str, np.ndarray]:
 
 
 def elements(problem: Problem) -> list[tuple[str, tuple[int, ...]]]:
-    """(name, index) of every sampled scalar element, in sweep order."""
+    """(name, index) of every sampled scalar element, in sweep order (held elements,
+    ``problem.fixed_elements``, left out)."""
     out = []
     for name in problem.sampled:
         shape = problem.init[name].shape
         if len(shape) == 2:  # column-major, as GPM/SA
-            out += [(name, (k, j)) for j in range(shape[1]) for k in range(shape[0])]
+            idx = [(k, j) for j in range(shape[1]) for k in range(shape[0])]
         else:
-            out += [(name, (k,)) for k in range(shape[0])]
+            idx = [(k,) for k in range(shape[0])]
+        held = problem.fixed_elements.get(name, frozenset())
+        out += [(name, i) for i in idx if i not in held]
     return out
 
 

@@ -18,7 +18,8 @@ values, as GPM/SA does.
   fit's last kept draws, to continue its chains). Parameters left out start at
   ``problem.init``.
 
-Fixed parameters keep ``problem.init``. With a theta constraint (``problem.constraint``),
+Fixed parameters and held elements (``problem.fixed_elements``) keep ``problem.init``. With a
+theta constraint (``problem.constraint``),
 dispersed and prior starts of theta are redrawn until the constraint holds (``MAX_REDRAWS``).
 Each chain draws its start from its own generator
 (``start_generator``), separate from the stream of its sweeps.
@@ -72,7 +73,7 @@ def chain_starts(
                 raise GPMSAError(
                     f"init[{name!r}] must have shape {want} (chains, *shape), got {val.shape}"
                 )
-            start[name] = val[c].copy()
+            start[name] = hold(problem, name, val[c].copy())
         if not all(np.all(np.isfinite(v)) for v in start.values()):
             raise GPMSAError(f"init: chain {c}'s start is not finite")
         check_start(problem, start, "given")
@@ -80,6 +81,14 @@ def chain_starts(
             problem.constraint.check_start(start["theta"], f"init: chain {c}'s theta")
         firsts.append(start)
     return "given", firsts
+
+
+def hold(problem: Problem, name: str, value: np.ndarray) -> np.ndarray:
+    """``value`` (a start of parameter ``name``) with its held elements
+    (``problem.fixed_elements``) set to ``problem.init``'s, in place."""
+    for idx in problem.fixed_elements.get(name, ()):
+        value[idx] = problem.init[name][idx]
+    return value
 
 
 def start_generator(seed: np.random.SeedSequence) -> np.random.Generator:
@@ -166,7 +175,7 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
             val = np.exp(rng.uniform(np.log(lo), np.log(hi)))
         else:
             val = _gamma(pri, name, size, rng)
-        out[name] = np.asarray(val, dtype=np.float64).reshape(x0.shape)
+        out[name] = hold(problem, name, np.asarray(val, dtype=np.float64).reshape(x0.shape))
     check_start(problem, out, how)
     return out
 
@@ -203,6 +212,7 @@ def _theta_start(problem: Problem, how: str, size: int, rng: np.random.Generator
             val = _truncnorm01(pri.theta_mean, pri.theta_sd, size, rng)
         if problem.theta_levels is not None:  # a categorical element starts at its nearest level
             val = problem.snap_theta(val)
+        val = hold(problem, "theta", val)
         if problem.constraint is None or problem.constraint(val):
             return val
     raise GPMSAError(

@@ -37,9 +37,24 @@ def _logdet_half(L: np.ndarray) -> float:
 
 def log_prior(problem: Problem, params: dict[str, np.ndarray]) -> float:
     """Sum of the log priors of the sampled (non-fixed) parameters (a categorical theta element:
-    uniform over its levels, ``Problem.theta_log_prior``)."""
-    return sum(problem.theta_log_prior(params[n]) if n == "theta"
-               else problem.priors.log_prior(n, params[n]) for n in problem.sampled)  # fmt: skip
+    uniform over its levels, ``Problem.theta_log_prior``); held elements
+    (``problem.fixed_elements``) add nothing."""
+    total = sum(problem.theta_log_prior(params[n]) if n == "theta"
+                else problem.priors.log_prior(n, params[n]) for n in problem.sampled)  # fmt: skip
+    return total - held_log_prior(problem, params) if problem.fixed_elements else total
+
+
+def held_log_prior(problem: Problem, params: dict[str, np.ndarray]) -> float:
+    """Sum of the element log priors of the held elements (``problem.fixed_elements``) at
+    ``params``: the constant that the sampled parameters' whole-array priors count for them (a
+    categorical theta element: 0, its uniform prior)."""
+    levels = problem.theta_levels or [None] * problem.q
+    total = 0.0
+    for name, held in problem.fixed_elements.items():
+        for idx in held:
+            if name != "theta" or levels[idx[0]] is None:
+                total += problem.priors.scalar_log_prior(name, idx[-1])(float(params[name][idx]))
+    return total
 
 
 def log_likelihood(problem: Problem, params: dict[str, np.ndarray]) -> float:

@@ -11,6 +11,7 @@ from scipy.linalg import cho_factor, cho_solve
 
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.model import categorical
+from gpmsa.model import fixed_elements as per_element
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import (
     basis_weights,
@@ -112,6 +113,8 @@ class Problem:
     categorical: boolean mask (p + q,) of the categorical inputs (None: none); mean_basis: the
     weights' GP mean basis (None: zero mean); constraint: allowed region of unit-scale theta
     (None: all of it). See docs/categorical-and-constraints.md.
+    fixed_elements: name -> the elements (index tuples) of a parameter not in ``fixed`` held at
+    their init value, the others sampled (``gpmsa.model.fixed_elements``).
     """
 
     x_sim: np.ndarray
@@ -125,6 +128,7 @@ class Problem:
     categorical: np.ndarray | None = None
     mean_basis: mean_basis_mod.MeanBasis | None = None
     constraint: ThetaConstraint | None = None
+    fixed_elements: dict[str, frozenset[tuple[int, ...]]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         """GPMSAError when per-group lamVz priors do not give one prior per discrepancy
@@ -209,19 +213,32 @@ class Problem:
                 raise GPMSAError(f"unknown parameter {name!r}; this model has {self.names}")
             val = np.array(val, dtype=np.float64).reshape(init[name].shape)
             init[name] = val
-        return replace(self, init=init, fixed=self.fixed if fixed is None else frozenset(fixed))
+        if fixed is None:
+            return replace(self, init=init)
+        held = {k: v for k, v in self.fixed_elements.items() if k not in fixed}
+        return replace(self, init=init, fixed=frozenset(fixed), fixed_elements=held)
 
     def with_fixed(self, values: dict) -> Problem:
         """A copy holding the parameters in ``values`` (name -> value on the model's scales,
-        scalar or the parameter's shape) at those values; GPMSAError naming an unknown
-        parameter, a wrong shape, a non-finite value or one outside its prior's bounds."""
+        scalar or the parameter's shape) at those values; a value given as a dict element index
+        -> value holds those elements only (``gpmsa.model.fixed_elements``; naming every
+        element holds the whole parameter). GPMSAError naming an unknown parameter, a wrong
+        shape or index, a non-finite value or one outside its prior's bounds."""
         if not isinstance(values, dict):
             raise GPMSAError(f"fixed must be a dict name -> value, got {type(values).__name__}")
-        out = {}
+        out, held = {}, {}
         for name, val in values.items():
             if name not in self.init:
                 raise GPMSAError(f"fixed: unknown parameter {name!r}; this model has {self.names}")
             shape = self.init[name].shape
+            if isinstance(val, dict):
+                elements = per_element.parse(name, val, shape)
+                levels = (self.theta_levels or [None] * self.q) if name == "theta" else None
+                per_element.check_values(name, elements, self.priors, levels)
+                if len(elements) < self.init[name].size:
+                    held[name] = elements
+                    continue
+                val = np.array(list(elements.values())).reshape(shape)  # C order: every element
             arr = as_float(val, f"fixed[{name!r}]")
             if arr.size == 1:
                 arr = np.full(shape, float(arr.reshape(-1)[0]))
@@ -241,9 +258,27 @@ class Problem:
                     "density)"
                 )
             out[name] = arr
-        if "theta" in out and self.constraint is not None:
-            self.constraint.check_start(out["theta"], "fixed theta")
-        return self.with_init(out, self.fixed | frozenset(out))
+        return self._holding(out, held)
+
+    def _holding(self, whole: dict[str, np.ndarray], held: dict[str, dict]) -> Problem:
+        """A copy with the parameters in ``whole`` fixed at those arrays and the elements in
+        ``held`` (name -> index -> value) held, the theta constraint checked at the new start;
+        a parameter whose every element ends up held is fixed whole."""
+        values = dict(whole)
+        for name, elements in held.items():
+            arr = self.init[name].copy()
+            for idx, x in elements.items():
+                arr[idx] = x
+            values[name] = arr
+        if "theta" in values and self.constraint is not None:
+            self.constraint.check_start(values["theta"], "fixed theta")
+        prob = self.with_init(values, self.fixed | frozenset(whole))
+        merged = dict(prob.fixed_elements)
+        for name, elements in held.items():
+            merged[name] = merged.get(name, frozenset()) | frozenset(elements)
+        full = {k for k, v in merged.items() if len(v) == self.init[k].size}
+        merged = {k: v for k, v in merged.items() if k not in full}
+        return replace(prob, fixed=prob.fixed | full, fixed_elements=merged)
 
 
 def default_init(p: int, q: int, p_u: int, priors: Priors, obs: ObsProblem | None) -> dict:

@@ -1,0 +1,141 @@
+"""Single elements of a parameter held fixed (SEPIA's per-element ``SepiaParam.fixed`` mask).
+
+``fit(..., fixed={"lamVz": {1: 1e6}})``: a ``fixed=`` value given as a dict element index ->
+value holds those elements at their values; the parameter's other elements are sampled as usual.
+Index forms:
+
+- a 1-D parameter (theta (q,), lamVz (G,), lamUz and lamWs (p_u,), lamWOs and lamOs (1,)): an
+  int k, or the 1-tuple (k,);
+- a 2-D parameter (betaU (p + q, p_u): input i, basis component j; betaV (p, G): known input
+  i, precision group j): the tuple (i, j). An int i is read as (i, 0) only where the parameter
+  has one column (p_u = 1, G = 1); with more columns it would be ambiguous and is refused.
+
+Indices count from 0 and are never negative. A dict that names every element holds the whole
+parameter, exactly as the array of those values (``Problem.fixed``); one that names some holds
+those (``Problem.fixed_elements``). ``gpmsa.fit`` also takes theta's elements by their t_names.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+from gpmsa.model.data import as_real
+
+Index = tuple[int, ...]
+
+
+def _is_int(key) -> bool:
+    """An integer index (a Python or numpy int; not a bool)."""
+    return isinstance(key, (int, np.integer)) and not isinstance(key, (bool, np.bool_))
+
+
+def _allowed(name: str, shape: tuple[int, ...]) -> str:
+    """The index forms and ranges ``name`` of ``shape`` takes, for an error message."""
+    if 0 in shape:
+        return f"none ({name} has shape {shape}: no elements)"
+    if len(shape) == 1:
+        return f"an int in 0..{shape[0] - 1} ({name} has shape {shape})"
+    one_col = f", or an int i in 0..{shape[0] - 1} (one column)" if shape[1] == 1 else ""
+    return (f"a tuple (i, j) with i in 0..{shape[0] - 1} and j in 0..{shape[1] - 1} ({name} has "
+            f"shape {shape}){one_col}")  # fmt: skip
+
+
+def element_index(name: str, key, shape: tuple[int, ...]) -> Index:
+    """The element of ``name`` (of ``shape``, 1-D or 2-D) that dict key ``key`` names, as a
+    full index tuple; GPMSAError naming the parameter, the key and the allowed range for a key
+    of the wrong type or out of range."""
+    what = f"fixed[{name!r}]: element index {key!r}"
+    if _is_int(key) and len(shape) == 2 and shape[1] > 1:
+        raise GPMSAError(f"{what} must be {_allowed(name, shape)}: an int names a row only "
+                         "where there is one column")  # fmt: skip
+    if _is_int(key):
+        key = (key, 0) if len(shape) == 2 else (key,)
+    if not (isinstance(key, tuple) and all(_is_int(k) for k in key)):
+        raise GPMSAError(f"{what} must be {_allowed(name, shape)}")
+    if len(key) != len(shape):
+        raise GPMSAError(f"{what} has {len(key)} entries; {name} takes {_allowed(name, shape)}")
+    idx = tuple(int(k) for k in key)
+    if any(not 0 <= k < n for k, n in zip(idx, shape, strict=True)):
+        raise GPMSAError(f"{what} is out of range; {name} takes {_allowed(name, shape)}")
+    return idx
+
+
+def parse(name: str, given: dict, shape: tuple[int, ...]) -> dict[Index, float]:
+    """``given`` (element index -> value) as full index tuple -> float, in C order; GPMSAError
+    naming the parameter for an empty dict, a bad index (`element_index`), two keys naming one
+    element, or a value that is not one finite number."""
+    if not given:
+        raise GPMSAError(f"fixed[{name!r}] is an empty dict: give element index -> value for "
+                         "the elements to hold (or leave the parameter out)")  # fmt: skip
+    out: dict[Index, float] = {}
+    keys: dict[Index, object] = {}
+    for key, val in given.items():
+        idx = element_index(name, key, shape)
+        if idx in out:
+            raise GPMSAError(
+                f"fixed[{name!r}]: the entries {keys[idx]!r} and {key!r} both name element "
+                f"{label(name, idx)}; give each element once"
+            )
+        x = as_real(val, f"fixed[{name!r}][{key!r}]")
+        if not np.isfinite(x):
+            raise GPMSAError(f"fixed[{name!r}][{key!r}] must be finite, got {x}")
+        out[idx], keys[idx] = x, key
+    return dict(sorted(out.items()))
+
+
+def label(name: str, idx: Index) -> str:
+    """The element's name as the diagnostics write it: "lamVz[1]", "betaU[2,0]"."""
+    return f"{name}[{','.join(map(str, idx))}]"
+
+
+def theta_by_position(given: dict, names) -> dict:
+    """fit's ``fixed['theta']`` dict with each key that is one of ``names`` (the t_names) replaced
+    by its position; other keys are left for `element_index` to judge. GPMSAError for an unknown
+    name, or a name and a position that both name one element."""
+    names = [str(n) for n in names]
+    out: dict = {}
+    for key, val in given.items():
+        if isinstance(key, str):
+            if key not in names:
+                raise GPMSAError(
+                    f"fixed['theta']: unknown calibration parameter {key!r}; give a name of "
+                    f"{names} or a position 0..{len(names) - 1}"
+                )
+            pos = names.index(key)
+        else:
+            pos = int(key) if _is_int(key) else key
+        if _is_int(pos) and pos in out:
+            raise GPMSAError(
+                f"fixed['theta']: two entries name element {pos} ({names[pos]!r} and "
+                f"{pos}); give each element once"
+            )
+        out[pos] = val
+    return out
+
+
+def check_values(name: str, elements: dict[Index, float], priors, levels=None) -> None:
+    """GPMSAError naming the element and its allowed range where a value of ``elements`` (index
+    -> value, model scale) lies outside its prior's bounds under ``priors`` (a ``Priors``);
+    ``levels``: theta's per-element levels (unit scale; None: continuous), a categorical
+    element must be one of them."""
+    for idx, x in elements.items():
+        lv = None if levels is None else levels[idx[0]]
+        if lv is not None:
+            ok, where = bool(np.any(lv == x)), f"its levels {np.asarray(lv).tolist()}"
+        else:
+            ok = priors.scalar_log_prior(name, idx[-1])(x) > -np.inf
+            where = f"its prior's bounds {_bounds(name, idx[-1], priors)}"
+        if not ok:
+            raise GPMSAError(f"fixed[{name!r}]: element {label(name, idx)} = {x:g} lies outside "
+                             f"{where} (zero prior density)")  # fmt: skip
+
+
+def _bounds(name: str, element: int, priors) -> str:
+    """The open support of element ``element`` of ``name``'s prior (model scale)."""
+    if name == "theta":
+        return "(0, 1) (unit scale)"
+    if name in ("betaU", "betaV"):
+        return "(0, inf)"
+    g = priors.precision_prior(name, element)
+    return f"({g.lower:g}, {g.upper:g})"
