@@ -693,8 +693,10 @@ def sample(
     ceil(50 / n_chains) gives each level at least GPM/SA's 50 trials per element); each stage
     starts from the last one's widths, where the chains then are (tuned once from dispersed
     starts, the widths fit the transient, not the posterior). All chains share the widths.
-    ``step_widths`` replace GPM/SA's initial widths. ``ridge_moves``: nugget-ridge moves per
-    sweep (``gpmsa.mcmc.ridge``). Draws hold every sweep after the warm-up (no burn-in removed).
+    ``step_widths`` replace GPM/SA's initial widths (given per chain, as a numpy fit records
+    them: each element's median over the chains, which share one set). ``ridge_moves``:
+    nugget-ridge moves per sweep (``gpmsa.mcmc.ridge``). Draws hold every sweep after the
+    warm-up (no burn-in removed).
     ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
     ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
@@ -783,7 +785,8 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     if tune_rounds is None:
         tune_rounds = math.ceil(tuning.N_BURN / n_chains)
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
-    widths = check_step_widths(step_widths, problem)
+    per_chain = check_step_widths(step_widths, problem, n_chains)  # the chains share widths:
+    widths = {k: np.median([w[k] for w in per_chain], axis=0) for k in problem.init}  # median
     gen = _seed_generator(seed, dev)
     seeds = np.random.SeedSequence(seed).spawn(n_chains)  # chain c starts as the numpy chain c
     how, firsts = starts.chain_starts(problem, init, seeds)

@@ -15,7 +15,12 @@ from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
-from gpmsa.mcmc.sampler import draws_nbytes, parameter_elements, sweeps_nbytes
+from gpmsa.mcmc.sampler import (
+    check_step_widths,
+    draws_nbytes,
+    parameter_elements,
+    sweeps_nbytes,
+)
 from gpmsa.model import constraints
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
@@ -71,7 +76,7 @@ def fit(
     data: SimData,
     obs: ObsData | None = None,
     n_iter: int = 30_000,
-    tune: bool = True,
+    tune: bool | None = None,
     n_chains: int = 1,
     backend: str = "numpy",
     seed=None,
@@ -99,7 +104,9 @@ def fit(
 
     data: the simulation runs. obs: field data for GPM/SA's classic joint calibration (theta and
     lamOs are sampled together with the emulator; the draws land in ``Emulator.calibration``).
-    n_iter: sweeps per chain after step-size tuning (``tune``: 50 rounds x 20 levels).
+    n_iter: sweeps per chain after step-size tuning (``tune``: 50 rounds x 20 levels; None:
+    tune, but for a continuation (``init`` an emulator), which runs on with the widths its chains
+    were tuned to, as SEPIA's second ``do_mcmc``).
     n_burn: sweeps discarded per chain (default n_iter // 5; 0 when ``init`` is an emulator whose
     chains continue). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
@@ -148,7 +155,8 @@ def fit(
     n_burn = default_burn if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     check_point(point)
     n_keep = check_keep(n_keep, n_chains)
-    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    tune = None if tune is None else check_flag(tune, "tune")
+    progress = check_flag(progress, "progress")
     metadata = check_metadata(metadata)
     if obs is None and discrepancy is not None:
         given = repr(discrepancy) if isinstance(discrepancy, str) else "an array"
@@ -177,6 +185,10 @@ def fit(
     resumed = options.get("init")
     if continuing:
         options["init"] = continued_starts(resumed, problem, prep.K, obs, int(n_chains))
+        if step_widths is None and backend != "pyro":  # NUTS adapts its own steps
+            step_widths = continued_widths(resumed, problem, int(n_chains))
+    if tune is None:
+        tune = not (continuing and step_widths is not None)
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,
@@ -413,6 +425,23 @@ def continued_starts(
             )
         out[name] = np.array(source[name][last], dtype=np.float64)
     return out
+
+
+def continued_widths(emulator: Emulator, problem: Problem, n_chains: int) -> dict | None:
+    """The step widths ``emulator``'s chains ran with (``settings["step_widths"]``, per chain),
+    for its continuation; None where it recorded none. GPMSAError where the record does not fit
+    ``problem``'s chains and parameters (a damaged file)."""
+    record = (emulator.settings or {}).get("step_widths")
+    if not record:
+        return None
+    try:
+        check_step_widths(record, problem, n_chains)
+    except GPMSAError as exc:
+        raise GPMSAError(
+            f"init=emulator: its recorded step widths (settings['step_widths']) do not fit "
+            f"this fit ({exc}); pass step_widths= or tune=True"
+        ) from None
+    return record
 
 
 def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:

@@ -320,31 +320,59 @@ def check_ridge(ridge_moves, problem: Problem) -> int:
     return n if ridge.applies(problem) else 0
 
 
-def check_step_widths(step_widths, problem: Problem) -> dict[str, np.ndarray]:
-    """GPM/SA's initial step widths with ``step_widths`` (None, or a dict name -> a scalar or
-    the parameter's shape) in place; GPMSAError naming an unknown parameter, a wrong shape or a
-    width that is not finite and > 0 (a chain would never move)."""
+def check_step_widths(
+    step_widths, problem: Problem, n_chains: int = 1
+) -> list[dict[str, np.ndarray]]:
+    """Each chain's step widths: GPM/SA's initial ones with ``step_widths`` (None, or a dict
+    name -> a scalar, the parameter's shape, or (n_chains, *shape): one set per chain, as
+    ``Emulator.settings["step_widths"]`` records them) in place. Elements that are not sampled
+    (fixed parameters, held elements) may hold anything, NaN or None as the record writes them,
+    and keep the defaults. GPMSAError naming an unknown parameter, a wrong shape or a sampled
+    element's width that is not finite and > 0 (a chain would never move)."""
     widths = default_widths(problem)
+    per_chain = [{k: v.copy() for k, v in widths.items()} for _ in range(n_chains)]
     if step_widths is None:
-        return widths
+        return per_chain
     if not isinstance(step_widths, dict):
         raise GPMSAError(
             f"step_widths must be None or a dict name -> widths, got {type(step_widths).__name__}"
         )
+    sampled: dict[str, list] = {}
+    for name, idx in elements(problem):
+        sampled.setdefault(name, []).append(idx)
     for name, val in step_widths.items():
         if name not in widths:
             raise GPMSAError(f"step_widths: unknown parameter {name!r}; this model has "
                              f"{problem.names}")  # fmt: skip
         shape = widths[name].shape
-        arr = as_float(val, f"step_widths[{name!r}]")
-        if arr.size != 1 and arr.shape != shape:
+        arr = as_float(_none_as_nan(val), f"step_widths[{name!r}]")
+        if arr.size == 1:
+            arr = np.full((n_chains, *shape), arr.item())
+        elif arr.shape == shape:
+            arr = np.broadcast_to(arr, (n_chains, *shape))
+        elif arr.shape != (n_chains, *shape):
             raise GPMSAError(
-                f"step_widths[{name!r}] must be a scalar or have shape {shape}, got {arr.shape}"
+                f"step_widths[{name!r}] must be a scalar or have shape {shape} (or "
+                f"{(n_chains, *shape)}, one per chain), got {arr.shape}"
             )
-        if not np.all(np.isfinite(arr) & (arr > 0)):
-            raise GPMSAError(f"step_widths[{name!r}] must be finite and > 0, got {arr.ravel()}")
-        widths[name] = arr.reshape(shape) if arr.size > 1 else np.full(shape, arr.item())
-    return widths
+        used = [arr[(slice(None), *idx)] for idx in sampled.get(name, [])]
+        if used and not np.all(np.isfinite(used) & (np.asarray(used) > 0)):
+            raise GPMSAError(
+                f"step_widths[{name!r}] must be finite and > 0, got {np.ravel(used).tolist()}"
+            )
+        for c in range(n_chains):
+            for idx in sampled.get(name, []):
+                per_chain[c][name][idx] = arr[(c, *idx)]
+    return per_chain
+
+
+def _none_as_nan(value):
+    """``value`` with None (JSON's NaN, in a file's recorded widths) as NaN, in nested lists."""
+    if value is None:
+        return float("nan")
+    if isinstance(value, list | tuple):
+        return [_none_as_nan(v) for v in value]
+    return value
 
 
 def _flat_widths(problem: Problem, els, widths: dict[str, np.ndarray]) -> np.ndarray:
@@ -460,8 +488,9 @@ def sample(
     """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
 
     The numpy backend's ``sample``. ``tune_rounds`` x ``tune_levels`` tuning sweeps (default
-    50 x 20 = 1,000) precede the draws of each chain; ``step_widths`` (name -> widths) replace
-    GPM/SA's initial widths. Draws hold every sweep (no burn-in removed).
+    50 x 20 = 1,000) precede the draws of each chain; ``step_widths`` (name -> widths, or
+    (n_chains, *shape) per chain: `check_step_widths`) replace GPM/SA's initial widths. Draws
+    hold every sweep (no burn-in removed).
 
     Chains: chain c runs on ``SeedSequence(seed).spawn(n_chains)[c]``, so its draws do not
     depend on where it runs; they run in parallel processes (``gpmsa.mcmc.parallel``):
@@ -484,12 +513,12 @@ def sample(
     # jitter range out of reach of its bounds) is a plain GPMSAError before any chain runs
     how, firsts = starts.chain_starts(problem, init, seeds)
     n_ridge = check_ridge(ridge_moves, problem)
-    widths = check_step_widths(step_widths, problem)
+    widths = check_step_widths(step_widths, problem, int(n_chains))
     tasks = [
-        {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": widths, "seed": s,
+        {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": w, "seed": s,
          "start": first, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
          "ridge_moves": n_ridge}
-        for s, first in zip(seeds, firsts, strict=True)
+        for s, first, w in zip(seeds, firsts, widths, strict=True)
     ]  # fmt: skip
     names = problem.names
     shapes = {n: problem.init[n].shape for n in names}

@@ -1,0 +1,85 @@
+"""A continuation (``gpmsa.fit(..., init=emu)``) runs on with the step widths its chains were
+tuned to, as SEPIA's second ``do_mcmc``, instead of tuning again; recorded per-chain widths can
+be passed back as ``step_widths``."""
+
+import functools
+import warnings
+
+import numpy as np
+import pytest
+from _emulator_edit import replaced
+
+import gpmsa
+
+
+@functools.cache
+def _data():
+    rng = np.random.default_rng(1)
+    x, t = rng.random((24, 1)), rng.random((24, 1))
+    data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t**2, x_names=["x"], t_names=["t"])
+    obs = gpmsa.ObsData(x=[[0.2], [0.7]], y=[[np.sin(0.6) + 0.16], [np.sin(2.1) + 0.16]])
+    return data, obs
+
+
+def _fit(**kw):
+    data, obs = _data()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
+        return gpmsa.fit(data, obs, seed=0, n_chains=2, **kw)
+
+
+@functools.cache
+def _tuned(backend: str = "numpy"):
+    return _fit(n_iter=60, tune_rounds=3, backend=backend)
+
+
+@pytest.mark.parametrize("backend", ["numpy", "torch"])
+def test_a_continuation_keeps_its_chains_tuned_widths_without_tuning(backend):
+    if backend == "torch":
+        pytest.importorskip("torch")
+    first = _tuned(backend)
+    recorded = first.settings["step_widths"]
+    more = _fit(n_iter=40, init=first, backend=backend)
+    assert more.settings["tune"] is False
+    for name, w in more.settings["step_widths"].items():  # the tuned widths, per chain, as used
+        np.testing.assert_array_equal(np.array(w, dtype=float), np.array(recorded[name], float))
+    told = _fit(n_iter=40, init=first, backend=backend, tune=False, step_widths=recorded)
+    for name, draws in more.draws.items():
+        np.testing.assert_array_equal(draws, told.draws[name])
+    retuned = _fit(n_iter=40, init=first, backend=backend, tune=True, tune_rounds=2)
+    assert retuned.settings["tune"] is True
+    assert not np.array_equal(retuned.draws["betaU"], more.draws["betaU"])
+
+
+def test_recorded_widths_pass_back_with_their_gaps_after_a_file_round_trip(tmp_path):
+    data, obs = _data()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
+        first = gpmsa.fit(data, obs, n_iter=60, seed=0, n_chains=2, tune_rounds=3,
+                          fixed={"lamWOs": 1e3})  # fmt: skip
+    first.save(tmp_path / "a.gpmsa")
+    loaded = gpmsa.load(tmp_path / "a.gpmsa")
+    recorded = loaded.settings["step_widths"]
+    assert recorded["lamWOs"] == [[None], [None]]  # a fixed parameter has no width
+    more = _fit(n_iter=30, init=loaded, fixed={"lamWOs": 1e3})
+    direct = _fit(n_iter=30, init=loaded, fixed={"lamWOs": 1e3}, tune=False,
+                  step_widths=recorded)  # fmt: skip
+    np.testing.assert_array_equal(more.draws["lamUz"], direct.draws["lamUz"])
+
+
+def test_a_fresh_fit_still_tunes_and_per_chain_widths_are_checked():
+    emu = _fit(n_iter=20, tune_rounds=2)
+    assert emu.settings["tune"] is True
+    with pytest.raises(gpmsa.GPMSAError, match=r"\(2, 2, 1\), one per chain\), got \(3, 2, 1\)"):
+        _fit(n_iter=10, tune=False, step_widths={"betaU": np.full((3, 2, 1), 0.2)})
+    with pytest.raises(gpmsa.GPMSAError, match=r"step_widths\['lamUz'\] must be finite and > 0"):
+        _fit(n_iter=10, tune=False, step_widths={"lamUz": [[1.0], [None]]})
+
+
+def test_a_damaged_width_record_is_named_with_the_way_out():
+    first = _tuned()
+    record = {k: v for k, v in first.settings.items() if k != "step_widths"}
+    record["step_widths"] = {"betaU": [[0.1, 0.2, 0.3]]}
+    damaged = replaced(first, settings=record)
+    with pytest.raises(gpmsa.GPMSAError, match=r"recorded step widths .*pass step_widths= or tune"):
+        _fit(n_iter=10, init=damaged)
