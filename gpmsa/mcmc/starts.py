@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model.data import as_float
 from gpmsa.model.priors import GammaPrior, Priors
 from gpmsa.model.problem import Problem
 
@@ -67,11 +68,15 @@ def chain_starts(
     for c in range(len(seeds)):
         start = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
         for name in set(init) - problem.fixed:
-            want = (len(seeds), *problem.init[name].shape)
-            val = np.asarray(init[name], dtype=np.float64)
+            shape = problem.init[name].shape
+            want = (len(seeds), *shape)
+            val = as_float(init[name], f"init[{name!r}]")
+            if len(seeds) == 1 and val.shape == shape:  # one chain: its start
+                val = val[None]
             if val.shape != want:
+                one = f" or {shape} for one chain" if len(seeds) == 1 else ""
                 raise GPMSAError(
-                    f"init[{name!r}] must have shape {want} (chains, *shape), got {val.shape}"
+                    f"init[{name!r}] must have shape {want} (chains, *shape){one}, got {val.shape}"
                 )
             start[name] = hold(problem, name, val[c].copy())
         if not all(np.all(np.isfinite(v)) for v in start.values()):

@@ -83,3 +83,18 @@ def test_a_damaged_width_record_is_named_with_the_way_out():
     damaged = replaced(first, settings=record)
     with pytest.raises(gpmsa.GPMSAError, match=r"recorded step widths .*pass step_widths= or tune"):
         _fit(n_iter=10, init=damaged)
+
+
+def test_one_chain_takes_its_start_in_the_parameter_s_shape():
+    data, _ = _data()
+    problem = gpmsa.prepare(data).problem
+    start = {"lamUz": [0.8], "betaU": [[0.7], [0.3]]}
+    chains = gpmsa.backends.get("numpy").sample(problem, n_iter=3, seed=0, init=start, tune=False)
+    np.testing.assert_array_equal(chains.info["starts"]["lamUz"], [[0.8]])
+    np.testing.assert_array_equal(chains.info["starts"]["betaU"], [[[0.7], [0.3]]])
+    with pytest.raises(
+        gpmsa.GPMSAError, match=r"must have shape \(2, [^)]*\) \(chains, \*shape\), got"
+    ):
+        gpmsa.backends.get("numpy").sample(problem, n_iter=3, n_chains=2, seed=0, init=start)
+    with pytest.raises(gpmsa.GPMSAError, match=r"init\['lamUz'\] must be a numeric array"):
+        gpmsa.backends.get("numpy").sample(problem, n_iter=3, seed=0, init={"lamUz": ["a"]})
