@@ -1,10 +1,12 @@
-"""Figures users look at: MCMC traces and autocorrelations, theta pairs, the PC basis and the
-observations' projection onto it, rho box plots, emulator fit, prediction bands, sensitivity bars.
+"""Figures users look at: the data before fitting, MCMC traces and autocorrelations, theta
+pairs, the PC basis and the observations' projection onto it, rho box plots, emulator fit,
+prediction bands, sensitivity bars.
 
 Each function returns a ``matplotlib.figure.Figure`` (matplotlib is imported only when one runs;
 nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a notebook.
 """
 
+from gpmsa.plots.data import data
 from gpmsa.plots.emulator import emulator_fit, pc_basis
 from gpmsa.plots.mcmc import autocorrelation, theta_pairs, traces
 from gpmsa.plots.observations import obs_projection
@@ -14,6 +16,7 @@ from gpmsa.plots.sensitivity import sensitivity_bars
 
 __all__ = [
     "autocorrelation",
+    "data",
     "emulator_fit",
     "obs_projection",
     "pc_basis",

@@ -13,6 +13,7 @@ MODULES = [
     "gpmsa.predictive.joint",
     "gpmsa.predictive.sobol",
     "gpmsa.predictive.crossval",
+    "gpmsa.plots.data",
     "gpmsa.plots.mcmc",
     "gpmsa.plots.observations",
     "gpmsa.plots.emulator",
