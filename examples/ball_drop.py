@@ -149,11 +149,14 @@ def main(argv: list[str] | None = None) -> dict:
     obs = gpmsa.ObsData(x=r_obs, y=np.array([real_world(r, rng) for r in r_obs[:, 0]]),
                         index=HEIGHTS)  # fmt: skip
 
+    data_fig = gpmsa.plots.data(data, obs, color_by="Cd")  # a first look, before fitting
+
     # 2. joint fit: emulator, theta = (Cd, g), discrepancy, observation noise
     D = kernel_basis()
     emu = gpmsa.fit(data, obs, n_iter=args.n_iter, seed=args.seed, discrepancy=D)
     post = gpmsa.calibration_posterior(emu)
     figs = {
+        "data": data_fig,
         "traces": gpmsa.plots.traces(emu, names=["Cd", "g", "lamOs", "lamVz", "betaV"]),
         "autocorrelation": gpmsa.plots.autocorrelation(emu, names=["Cd", "g", "lamOs"]),
         "theta_pairs": gpmsa.plots.theta_pairs(post, truth={"Cd": WORLD["Cd"], "g": WORLD["g"]}),

@@ -8,7 +8,7 @@ from scipy.integrate import solve_ivp
 
 from tests._examples import load_example
 
-FIGURES = ["autocorrelation.png", "emulator_held_out.png", "emulator_loo.png",
+FIGURES = ["autocorrelation.png", "data.png", "emulator_held_out.png", "emulator_loo.png",
            "obs_projection.png", "pc_basis.png", "prediction.png", "sensitivity.png",
            "theta_pairs.png", "traces.png"]  # fmt: skip
 
