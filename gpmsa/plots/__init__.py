@@ -1,6 +1,6 @@
 """Figures users look at: the data before fitting, MCMC traces and autocorrelations, theta
-pairs, the PC basis and the observations' projection onto it, rho box plots, emulator fit,
-prediction bands, sensitivity bars.
+pairs, the PC basis and the observations' projection onto it (per component and in pairs), rho
+box plots, emulator fit, prediction bands, sensitivity bars.
 
 Each function returns a ``matplotlib.figure.Figure`` (matplotlib is imported only when one runs;
 nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a notebook.
@@ -9,7 +9,7 @@ nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a 
 from gpmsa.plots.data import data
 from gpmsa.plots.emulator import emulator_fit, pc_basis
 from gpmsa.plots.mcmc import autocorrelation, theta_pairs, traces
-from gpmsa.plots.observations import obs_projection
+from gpmsa.plots.observations import obs_projection, weight_pairs
 from gpmsa.plots.prediction import prediction_bands
 from gpmsa.plots.rho import rho_boxplots
 from gpmsa.plots.sensitivity import sensitivity_bars
@@ -25,4 +25,5 @@ __all__ = [
     "sensitivity_bars",
     "theta_pairs",
     "traces",
+    "weight_pairs",
 ]

@@ -1,4 +1,5 @@
-"""The observations projected onto the emulator's basis, against the simulation runs."""
+"""The observations projected onto the emulator's basis, against the simulation runs: per
+component (``obs_projection``) and in pairs of components (``weight_pairs``)."""
 
 from __future__ import annotations
 
@@ -67,6 +68,78 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     if functional:
         _residuals(fig.add_subplot(grid[n_rows, :]), emulator, obs, reduced)
     return fig
+
+
+def weight_pairs(emulator, obs: ObsData | None = None, *, max_pc: int = 4, bins: int = 20):
+    """The runs' weights in pairs of basis components (SEPIA's ``plot_u_w_pairs``): below the
+    diagonal, w_j against w_i of every run (grey) with each experiment's u (its GLS
+    projection, as calibration without a discrepancy reduces it) in colour, the title counting
+    the experiments outside the runs' convex hull in that plane (inside every range, an
+    experiment can still lie where no run went); on the diagonal, each component's histogram.
+    At most ``max_pc`` components: a Figure.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t, s = rng.uniform(size=(20, 1)), rng.uniform(size=(20, 1)), np.linspace(0, 1, 8)
+        >>> data = gpmsa.SimData(x=x, t=t, y=np.outer(x, s) + np.outer(t, s**2), index=s)
+        >>> emu = gpmsa.Emulator.from_params(data, {"betaU": [[1, 1], [1, 1]], "lamUz": [1, 1],
+        ...                                         "lamWs": [1e3, 1e3], "lamWOs": [1e3]})
+        >>> obs = gpmsa.ObsData(x=[[0.5], [0.5]], y=[0.5 * s + 0.5 * s**2, 0.5 * s + 3 * s**2])
+        >>> fig = gpmsa.plots.weight_pairs(emu, obs)
+        >>> fig.axes[2].get_title()     # w2 against w1
+        '1 of 2 outside the runs'
+    """
+    from matplotlib.lines import Line2D
+
+    check_emulator(emulator)
+    if obs is not None and not isinstance(obs, ObsData):
+        raise GPMSAError(f"obs must be a gpmsa.ObsData or None, got {type(obs).__name__}")
+    n_pc = min(check_count(max_pc, "max_pc"), emulator.p_u)
+    bins = check_bins(bins, n_pc, "plots.weight_pairs")
+    u = None if obs is None else reduce(emulator, obs, None, extrapolate=True).obs.u
+    w = emulator.w
+    fig = figure(2.2 * n_pc + 0.6, 2.2 * n_pc + 0.4)
+    axes = fig.subplots(n_pc, n_pc, squeeze=False)
+    for i in range(n_pc):
+        for j in range(n_pc):
+            ax = axes[i, j]
+            if j > i:
+                ax.set_axis_off()
+                continue
+            if i == j:
+                ax.hist(w[:, i], bins=bins, color="0.7")
+            else:
+                ax.plot(w[:, j], w[:, i], ".", ms=3, color="0.6")
+                if u is not None:
+                    for e in range(u.shape[0]):
+                        ax.plot(u[e, j], u[e, i], "o", ms=5, color=f"C{e % 10}")
+                    outside = _outside_hull(w[:, [j, i]], u[:, [j, i]])
+                    if outside is not None:
+                        ax.set_title(f"{outside} of {u.shape[0]} outside the runs",
+                                     fontsize="small")  # fmt: skip
+            if i == n_pc - 1:
+                ax.set_xlabel(f"w{j + 1}")
+            if j == 0 and i > 0:
+                ax.set_ylabel(f"w{i + 1}")
+    if u is not None and n_pc > 1:  # the experiments' colours, in the empty upper corner
+        handles = [Line2D([], [], ls="", marker=".", color="0.6", label="runs")]
+        handles += [Line2D([], [], ls="", marker="o", color=f"C{e % 10}", label=f"experiment {e}")
+                    for e in range(min(u.shape[0], 10))]  # fmt: skip
+        axes[0, n_pc - 1].legend(handles=handles, fontsize="small", loc="upper right")
+    return fig
+
+
+def _outside_hull(runs: np.ndarray, points: np.ndarray) -> int | None:
+    """How many of ``points`` (k, 2) lie outside the convex hull of ``runs`` (m, 2); None where
+    the runs span no area (collinear)."""
+    from scipy.spatial import Delaunay, QhullError
+
+    try:
+        hull = Delaunay(runs)
+    except QhullError:
+        return None
+    return int(np.sum(hull.find_simplex(points) < 0))
 
 
 def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
