@@ -105,8 +105,9 @@ def fit(
     data: the simulation runs. obs: field data for GPM/SA's classic joint calibration (theta and
     lamOs are sampled together with the emulator; the draws land in ``Emulator.calibration``).
     n_iter: sweeps per chain after step-size tuning (``tune``: 50 rounds x 20 levels; None:
-    tune, but for a continuation (``init`` an emulator), which runs on with the widths its chains
-    were tuned to, as SEPIA's second ``do_mcmc``).
+    tune, but for a continuation (``init`` a numpy or torch fit's emulator, no
+    ``step_widths``), which runs on with the widths its chains were tuned to, as SEPIA's second
+    ``do_mcmc``; True tunes again from GPM/SA's widths).
     n_burn: sweeps discarded per chain (default n_iter // 5; 0 when ``init`` is an emulator whose
     chains continue). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
@@ -114,7 +115,7 @@ def fit(
     (SEPIA's n_pc < 1; default 99.5%). basis: instead of the runs' PCA, a given basis
     (l_sim, p_u), columns the orthogonal basis vectors on the simulation grid in standardised
     output units (GPM/SA's ``Ksim``; ``gpmsa.BasisWarning`` when its weights' scale is not
-    the one lamUz's prior expects; docs/prediction.md).
+    the one lamUz's prior expects; docs/categorical-and-constraints.md).
     discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. discrepancy_groups: the
     precision group (0 .. G-1) of each discrepancy basis vector, GPM/SA's lamVzGroup (None: one
     group; each group has its own betaV column and lamVz). n_jobs, executor: where
@@ -182,13 +183,13 @@ def fit(
         ) if on]  # fmt: skip
         n_jobs, executor = in_this_process(callables, n_jobs, executor, int(n_chains))
     options.update(backends.placement(backend, n_jobs, executor))
-    resumed = options.get("init")
+    resumed, recorded = options.get("init"), None
     if continuing:
         options["init"] = continued_starts(resumed, problem, prep.K, obs, int(n_chains))
-        if step_widths is None and backend != "pyro":  # NUTS adapts its own steps
-            step_widths = continued_widths(resumed, problem, int(n_chains))
-    if tune is None:
-        tune = not (continuing and step_widths is not None)
+        if step_widths is None and tune is not True and backend != "pyro":  # NUTS adapts
+            step_widths = recorded = continued_widths(resumed, problem, int(n_chains))
+    if tune is None:  # only the widths the chains were tuned to run on untuned
+        tune = recorded is None
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,
@@ -427,12 +428,19 @@ def continued_starts(
     return out
 
 
+MH_BACKENDS = ("numpy", "torch")
+"""Backends whose recorded ``step_widths`` are GPM/SA's Metropolis widths (a continuation runs
+on with them)."""
+
+
 def continued_widths(emulator: Emulator, problem: Problem, n_chains: int) -> dict | None:
     """The step widths ``emulator``'s chains ran with (``settings["step_widths"]``, per chain),
-    for its continuation; None where it recorded none. GPMSAError where the record does not fit
-    ``problem``'s chains and parameters (a damaged file)."""
-    record = (emulator.settings or {}).get("step_widths")
-    if not record:
+    for its continuation; None where it recorded none or its backend's are not Metropolis widths
+    (``MH_BACKENDS``; pyro records its NUTS step size there). GPMSAError where the record does
+    not fit ``problem``'s chains and parameters (a damaged file)."""
+    settings = emulator.settings or {}
+    record = settings.get("step_widths")
+    if not record or settings.get("backend") not in MH_BACKENDS:
         return None
     try:
         check_step_widths(record, problem, n_chains)

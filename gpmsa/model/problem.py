@@ -270,8 +270,9 @@ class Problem:
             for idx, x in elements.items():
                 arr[idx] = x
             values[name] = arr
-        if "theta" in values and self.constraint is not None:
-            self.constraint.check_start(values["theta"], "fixed theta")
+        if "theta" in values and self.constraint is not None:  # held elements: theta_init helps
+            what = "fixed theta" if "theta" in whole else "fixed theta (held elements)"
+            self.constraint.check_start(values["theta"], what)
         prob = self.with_init(values, self.fixed | frozenset(whole))
         merged = dict(prob.fixed_elements)
         for name, elements in held.items():

@@ -343,9 +343,10 @@ def fit_study(
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
     bases = _per_model_basis(basis, n)
-    preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
+    pcs = [n_pc if k is None or all(b is not None for b in bases) else None for k in bases]
+    preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=pc, discrepancy=discrepancy,
                         discrepancy_groups=discrepancy_groups, basis=k)
-             for lab, s, o, k in zip(labels, sims, obs, bases, strict=True)]  # fmt: skip
+             for lab, s, o, k, pc in zip(labels, sims, obs, bases, pcs, strict=True)]  # fmt: skip
     for lab, sim in zip(labels, sims, strict=True):  # the study's theta moves are continuous
         categorical.refuse_categorical_theta(sim.levels, sim.p, sim.x_names + sim.t_names,
                                              f"fit_study (model {lab})")  # fmt: skip

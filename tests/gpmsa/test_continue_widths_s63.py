@@ -98,3 +98,47 @@ def test_one_chain_takes_its_start_in_the_parameter_s_shape():
         gpmsa.backends.get("numpy").sample(problem, n_iter=3, n_chains=2, seed=0, init=start)
     with pytest.raises(gpmsa.GPMSAError, match=r"init\['lamUz'\] must be a numeric array"):
         gpmsa.backends.get("numpy").sample(problem, n_iter=3, seed=0, init={"lamUz": ["a"]})
+
+
+def test_a_pyro_fit_continues_with_tuning_not_with_its_nuts_step_size():
+    """pyro records its NUTS step size as "step_widths": not a Metropolis width, so a numpy
+    continuation of a pyro fit tunes (from GPM/SA's widths) as before continuations kept widths."""
+    pytest.importorskip("pyro")
+    data, _ = _data()
+    first = gpmsa.fit(data, n_iter=20, backend="pyro", seed=0, n_warmup=10)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
+        more = gpmsa.fit(data, n_iter=10, init=first, seed=1, tune_rounds=2)
+        fresh = gpmsa.fit(data, n_iter=10, init=first, seed=1, tune_rounds=2, tune=True)
+    assert more.settings["tune"] is True
+    for name, draws in fresh.draws.items():
+        np.testing.assert_array_equal(more.draws[name], draws)
+
+
+def test_tune_true_retunes_from_gpmsa_widths_past_a_damaged_record():
+    """The way out the damaged-record error names: tune=True tunes as a fresh fit does, from
+    GPM/SA's initial widths, without reading the record."""
+    first = _tuned()
+    record = {k: v for k, v in first.settings.items() if k != "step_widths"}
+    record["step_widths"] = {"betaU": [[0.1, 0.2, 0.3]]}
+    damaged = replaced(first, settings=record)
+    again = _fit(n_iter=10, init=damaged, tune=True, tune_rounds=2)
+    same = _fit(n_iter=10, init=first, tune=True, tune_rounds=2, step_widths={})
+    assert again.settings["tune"] is True
+    for name, draws in same.draws.items():
+        np.testing.assert_array_equal(again.draws[name], draws)
+
+
+def test_a_continuation_given_its_own_widths_tunes_from_them_as_before():
+    """Only the recorded widths skip tuning: step_widths= for some parameters (the others at
+    GPM/SA's initial widths) tunes from them by default, as every fit did before the record
+    was kept; tune=False runs them untuned."""
+    first = _tuned()
+    some = {"lamUz": 0.3}
+    more = _fit(n_iter=10, init=first, step_widths=some, tune_rounds=2)
+    told = _fit(n_iter=10, init=first, step_widths=some, tune_rounds=2, tune=True)
+    assert more.settings["tune"] is True
+    for name, draws in told.draws.items():
+        np.testing.assert_array_equal(more.draws[name], draws)
+    untuned = _fit(n_iter=10, init=first, step_widths=some, tune=False)
+    assert np.all(np.array(untuned.settings["step_widths"]["lamUz"]) == 0.3)

@@ -249,6 +249,16 @@ def test_a_held_theta_element_must_satisfy_the_constraint_at_the_start():
         _theta2_fit({"theta": {"b": 2.9}}, n_iter=5, constraint=lambda th: th[1] < 2.5)
 
 
+def test_a_start_the_constraint_refuses_beside_a_held_element_points_at_theta_init():
+    """Held b = 2 with a at the design's centre (about 1.08) breaks a + b < 2.5: theta_init=
+    moves a (the advice), and then the fit runs with b held."""
+    fixed, below = {"theta": {"b": 2.0}}, lambda th: th[0] + th[1] < 2.5
+    with pytest.raises(GPMSAError, match=r"fixed theta \(held elements\): .* pass theta_init="):
+        _theta2_fit(fixed, n_iter=5, constraint=below)
+    emu = _theta2_fit(fixed, n_iter=5, constraint=below, theta_init={"a": 0.3, "b": 2.0})
+    assert np.all(emu.calibration["theta_native"][:, 1] == 2.0)
+
+
 def test_pyro_refuses_held_elements_and_names_them():
     pytest.importorskip("pyro")
     with pytest.raises(GPMSAError, match=r"pyro backend samples each parameter as a whole; "

@@ -185,6 +185,21 @@ def test_fit_study_takes_a_basis_per_model(tmp_path):
         gpmsa.fit_study([sim, sim], [obs, obs], n_iter=10, basis=[None, np.ones((25, 2))])
 
 
+def test_fit_study_s_n_pc_sizes_the_pca_of_the_models_without_a_basis():
+    """basis=[K, None] with n_pc=3: model 0 takes K, model 1 its PCA of 3 vectors (the
+    docstring's "None: the model's PCA, as n_pc says"); n_pc beside a basis for every model
+    is refused, as fit refuses it."""
+    sim, obs = _sim(), _obs()
+    K = _cosine_basis(sim, 5)
+    study = gpmsa.fit_study([sim, sim], [obs, obs], shared=["t"], n_iter=40, seed=1,
+                            tune_rounds=2, basis=[K, None], n_pc=3)  # fmt: skip
+    first, second = study.members
+    assert np.array_equal(first.K, K) and second.K.shape[1] == 3
+    assert second.settings["n_pc"] == 3 and second.settings["basis"] == "pca"
+    with pytest.raises(gpmsa.GPMSAError, match=r"n_pc .* or basis, not both; got n_pc=3"):
+        gpmsa.fit_study([sim, sim], [obs, obs], n_iter=10, basis=K, n_pc=3)
+
+
 def test_from_params_takes_a_basis():
     sim = _sim()
     K = _cosine_basis(sim, 3)
