@@ -362,16 +362,21 @@ def log_prior_elements(priors: Priors, name: str, x: Tensor, element: int | None
     """GPM/SA log prior of each element of ``x`` (any shape); -inf outside the bounds.
 
     ``element``: x holds that element (index in a 1-D parameter) of ``name`` in every chain;
-    None: x holds whole parameters, along its last axis (lamVz with per-group priors: group g's
-    prior on x[..., g]).
+    None: x holds whole parameters, along its last axis (lamVz or betaV with per-group priors:
+    group g's prior on x[..., g]).
     """
     inf = torch.full_like(x, -torch.inf)
     if name == "theta":
         val = -0.5 * ((x - priors.theta_mean) / priors.theta_sd) ** 2
         ok = (x > 0.0) & (x < 1.0)
     elif name in RHO_PARAMS:
+        if element is None:  # betaV with per-group priors: group g's on x[..., g]
+            a, b = priors.rho_arrays(name, x.shape[-1])
+            a, b = (x.new_tensor(v) if isinstance(v, np.ndarray) else v for v in (a, b))
+        else:
+            a, b = priors.rho_prior(name, element)
         rho = torch.clamp(torch.exp(-0.25 * x), max=priors.rho_cap)
-        val = (priors.rho_a - 1.0) * torch.log(rho) + (priors.rho_b - 1.0) * torch.log1p(-rho)
+        val = (a - 1.0) * torch.log(rho) + (b - 1.0) * torch.log1p(-rho)
         ok = (x > 0.0) & torch.isfinite(x)
     elif name == "lamVz" and priors.per_group and element is None:
         a, b, lo, hi = (x.new_tensor(v) for v in priors.gamma_arrays("lamVz", x.shape[-1]))

@@ -180,6 +180,18 @@ def _gamma(g: dict) -> str:
     return text
 
 
+def _beta_v(priors: dict) -> str:
+    """betaV's prior of validated priors: its own Beta(rhoV_a, rhoV_b) on rho = exp(-betaV / 4)
+    (one per group where so set), or "betaV as betaU"."""
+    a, b = priors.get("rhoV_a"), priors.get("rhoV_b")
+    if a is None:
+        return "betaV as betaU"
+    pairs = zip(a, b, strict=True) if isinstance(a, list) else [(a, b)]
+    cells = [f"Beta({number(x, '.6g')}, {number(y, '.6g')})" for x, y in pairs]
+    text = f"[{', '.join(cells)}] (one per group)" if isinstance(a, list) else cells[0]
+    return f"rho = exp(-betaV / 4) {text}"
+
+
 def _prior_lines(priors: dict) -> list[str]:
     """The priors (validated): those a calibration with this file uses (theta, lamOs, lamVz, one
     per precision group where so set; ``Emulator.with_calibration_priors`` changes them), then
@@ -190,7 +202,7 @@ def _prior_lines(priors: dict) -> list[str]:
     return [
         f"calibration priors: theta Normal({number(priors['theta_mean'], '.6g')}, "
         f"{number(priors['theta_sd'], '.6g')}) on (0, 1) (unit scale), lamOs "
-        f"{_gamma(priors['lamOs'])}, lamVz {lam_vz}, betaV as betaU",
+        f"{_gamma(priors['lamOs'])}, lamVz {lam_vz}, {_beta_v(priors)}",
         f"emulator priors: rho = exp(-betaU / 4) Beta({number(priors['rho_a'], '.6g')}, "
         f"{number(priors['rho_b'], '.6g')}), lamUz {_gamma(priors['lamUz'])}, lamWs "
         f"{_gamma(priors['lamWs'])}, lamWOs {_gamma(priors['lamWOs'])}"

@@ -576,21 +576,24 @@ class Emulator:
         return to_inference_data(draws, self.log_post[: per * n_ch].reshape(n_ch, per))
 
     def with_calibration_priors(
-        self, *, theta_mean=None, theta_sd=None, lamOs=None, lamVz=None
+        self, *, theta_mean=None, theta_sd=None, lamOs=None, lamVz=None, rhoV_a=None, rhoV_b=None
     ) -> Emulator:
         """A copy of this emulator whose calibrations use other priors: theta's truncated normal
         (``theta_mean``, ``theta_sd``, unit scale), the observation precision ``lamOs`` and the
         discrepancy precision ``lamVz`` (``gpmsa.GammaPrior``s, before any data correction;
         ``lamVz`` also a sequence of them, one per discrepancy precision group, as
-        ``Priors.lamVz``); None keeps the emulator's. ``gpmsa.calibrate``, ``gpmsa.Calibrator``
-        and the predictions then use them; the emulator's own parameters, draws and their
-        priors are unchanged. The priors are part of ``model_sha256`` (a posterior of the copy
-        refuses the original) and of the saved file. A joint fit's calibration draws, made under
-        the old priors, are not copied (calibrate the copy; ``full_prediction`` then takes
-        ``posterior=``). E.g. a known sensor noise sd s (native units) on a scalar output:
-        ``lamOs=GammaPrior(a, a * (s / y_sd) ** 2)`` centres lamOs on (y_sd / s)^2 with relative
-        sd 1/sqrt(a)."""
-        given = {"theta_mean": theta_mean, "theta_sd": theta_sd, "lamOs": lamOs, "lamVz": lamVz}
+        ``Priors.lamVz``) and the discrepancy's correlation prior Beta(``rhoV_a``, ``rhoV_b``) on
+        rho = exp(-betaV/4) (numbers, or sequences of one per group, as ``Priors.rhoV_a``; give
+        both where the emulator has none); None keeps the emulator's. ``gpmsa.calibrate``,
+        ``gpmsa.Calibrator`` and the predictions then use them; the emulator's own parameters,
+        draws and their priors are unchanged. The priors are part of ``model_sha256`` (a
+        posterior of the copy refuses the original) and of the saved file. A joint fit's
+        calibration draws, made under the old priors, are not copied (calibrate the copy;
+        ``full_prediction`` then takes ``posterior=``). E.g. a known sensor noise sd s (native
+        units) on a scalar output: ``lamOs=GammaPrior(a, a * (s / y_sd) ** 2)`` centres lamOs on
+        (y_sd / s)^2 with relative sd 1/sqrt(a)."""
+        given = {"theta_mean": theta_mean, "theta_sd": theta_sd, "lamOs": lamOs, "lamVz": lamVz,
+                 "rhoV_a": rhoV_a, "rhoV_b": rhoV_b}  # fmt: skip
         given = {k: v for k, v in given.items() if v is not None}
         if "lamOs" in given and not isinstance(given["lamOs"], GammaPrior):
             raise GPMSAError(f"lamOs must be a gpmsa.GammaPrior, got {given['lamOs']!r:.80}")

@@ -472,11 +472,15 @@ def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
 
 
 def _prior_record(priors: Priors, n_grp: int) -> dict:
-    """``priors.to_dict()`` with lamVz as the list of the ``n_grp`` groups' priors (a shared
-    prior and equal per-group ones are one model); as written without a discrepancy, or where
-    the per-group priors do not fit the groups."""
+    """``priors.to_dict()`` with lamVz as the list of the ``n_grp`` groups' priors and rhoV_a,
+    rhoV_b as the lists of the groups' betaV Beta parameters (a shared prior, equal per-group
+    ones and, for betaV, none (betaU's) are one model); as written without a discrepancy, or
+    where the per-group priors do not fit the groups."""
     out = priors.to_dict()
     if n_grp and (not priors.per_group or len(priors.lamVz) == n_grp):
         one = replace(priors, lamVz=priors.lamvz_priors(n_grp)).to_dict()
         out["lamVz"] = one["lamVz"]
+    if n_grp and (not priors.rhov_per_group or len(priors.rhoV_a) == n_grp):
+        pairs = priors.rhov_priors(n_grp)
+        out["rhoV_a"], out["rhoV_b"] = [a for a, _ in pairs], [b for _, b in pairs]
     return out

@@ -38,6 +38,8 @@ REQUIRED = ("x_unit", "t_unit", "y", "K", "w", "log_post", "y_sd", *STD_FIELDS) 
 CALIBRATION_ARRAYS = ("theta", "theta_native", "lamOs", "betaV", "lamVz")
 PRECISIONS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
 PRIOR_SCALARS = ("theta_mean", "theta_sd", "rho_a", "rho_b", "rho_cap")
+PRIOR_OPTIONAL = ("rhoV_a", "rhoV_b")
+"""betaV's own Beta prior: in a file both or neither (a file without them: betaU's)."""
 REL_TOL = 1e-9
 """Relative tolerance of the recomputed redundancies (y_mean, y_sd)."""
 W_TOL = 1e-7
@@ -177,10 +179,14 @@ def check_priors(priors) -> None:
     if not isinstance(priors, dict):
         raise _fail("priors", f"must be an object, got {_short(priors)}")
     expected = {*PRIOR_SCALARS, *PRECISIONS, "corrected"}
-    if set(priors) != expected:
+    if set(priors) - set(PRIOR_OPTIONAL) != expected or len(set(priors) & {*PRIOR_OPTIONAL}) == 1:
         raise _fail(
-            "priors", f"fields {sorted(priors)} differ from the expected {sorted(expected)}"
+            "priors",
+            f"fields {sorted(priors)} differ from the expected {sorted(expected)} "
+            f"(and optionally both of {list(PRIOR_OPTIONAL)})",
         )
+    if PRIOR_OPTIONAL[0] in priors:
+        _check_rhov(priors)
     for name in PRIOR_SCALARS:
         v = _number(priors[name], f"priors.{name}")
         ok = {
@@ -206,6 +212,27 @@ def check_priors(priors) -> None:
             _check_gamma(g, f"priors.{name}")
 
 
+def _check_rhov(priors: dict) -> None:
+    """rhoV_a, rhoV_b as ``Priors.to_dict`` writes them: both numbers, or both non-empty lists
+    of numbers of equal length, each finite and > 0."""
+    a, b = priors["rhoV_a"], priors["rhoV_b"]
+    for name, v in (("rhoV_a", a), ("rhoV_b", b)):
+        items = v if isinstance(v, list) else [v]
+        if not items:
+            raise _fail(f"priors.{name}", "an empty list: per-group priors need one per group")
+        for i, e in enumerate(items):
+            field = f"priors.{name}[{i}]" if isinstance(v, list) else f"priors.{name}"
+            x = _number(e, field)
+            if not (math.isfinite(x) and x > 0):
+                raise _fail(field, f"{x!r} is out of range: allowed (0, inf), finite")
+    if isinstance(a, list) != isinstance(b, list) or (isinstance(a, list) and len(a) != len(b)):
+        raise _fail(
+            "priors.rhoV_b",
+            f"{_short(b)} must match priors.rhoV_a {_short(a)}: both numbers, or both lists of "
+            "one number per discrepancy precision group",
+        )
+
+
 def _check_gamma(g, field: str) -> None:
     """One Gamma prior as ``Priors.to_dict`` writes it, with valid values."""
     if not isinstance(g, dict) or set(g) != {"a", "b", "lower", "upper"}:
@@ -222,15 +249,17 @@ def _check_gamma(g, field: str) -> None:
 
 
 def check_prior_groups(priors: dict, shapes: dict[str, tuple[int, ...]]) -> None:
-    """Per-group lamVz priors (a list) give one prior per precision group of a joint fit's
-    discrepancy draws (``cal_lamVz``, (n_draws, G))."""
-    groups = priors["lamVz"]
+    """Per-group lamVz and betaV priors (lists) give one prior per precision group of a joint
+    fit's discrepancy draws (``cal_lamVz``, (n_draws, G))."""
     lam = shapes.get("cal_lamVz")
-    if isinstance(groups, list) and lam is not None:
-        n_grp = lam[1]  # check_shapes: (n_draws, G)
-        if len(groups) != n_grp:
+    if lam is None:
+        return
+    n_grp = lam[1]  # check_shapes: (n_draws, G)
+    for name in ("lamVz", "rhoV_a"):
+        groups = priors.get(name)
+        if isinstance(groups, list) and len(groups) != n_grp:
             raise _fail(
-                "priors.lamVz",
+                f"priors.{name}",
                 f"{len(groups)} per-group priors, but arrays/cal_lamVz holds draws of {n_grp} "
                 "discrepancy precision group(s)",
             )

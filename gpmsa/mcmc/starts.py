@@ -11,7 +11,8 @@ values, as GPM/SA does.
   ``PRECISION_JITTER``) cut to its prior's bounds (bounds too narrow for the cut: x0; bounds
   out of its reach: GPMSAError).
 - ``"prior"``: from the (data-corrected) prior: theta from the truncated normal, rho from
-  Beta(rho_a, rho_b) capped at rho_cap, precisions from their truncated Gammas.
+  Beta(rho_a, rho_b) (betaV's: Beta(rhoV_a, rhoV_b) where set, ``Priors.rho_arrays``) capped at
+  rho_cap, precisions from their truncated Gammas.
 
 - given: a dict name -> (n_chains, *shape) of each chain's start, on the model's scales (as
   ``Chains.info["starts"]`` records them; ``gpmsa.fit(..., init=emulator)`` builds it from a
@@ -169,7 +170,10 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
             if how == "jitter":
                 rho = rng.uniform(*RHO_JITTER, size)
             else:
-                rho = np.minimum(rng.beta(pri.rho_a, pri.rho_b, size), pri.rho_cap)
+                a, b = pri.rho_arrays(name, x0.shape[-1] if x0.ndim else 1)
+                if isinstance(a, np.ndarray):  # betaV's per-group priors, column by column
+                    a, b = (np.broadcast_to(v, x0.shape).ravel() for v in (a, b))
+                rho = np.minimum(rng.beta(a, b, size), pri.rho_cap)
             val = -4.0 * np.log(rho)
         elif how == "jitter":  # log-uniform on [x0 / f, x0 f] cut to the bounds
             x = x0.ravel()

@@ -10,6 +10,8 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 
 PRECISIONS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
+RHOV = ("rhoV_a", "rhoV_b")
+"""betaV's own Beta prior on rho (GPM/SA's priors.rhoV); unset: betaU's."""
 MAX_PRIOR_SHAPE = 1e12
 """Largest Gamma shape a of a prior (the data corrections give (l_sim - p_u) m / 2; a shape of
 1e30 would make the lamOs quadrature ask for petabytes); emulator files are held to it too."""
@@ -71,8 +73,12 @@ class Priors:
     """GPM/SA priors (Gamma in shape/rate form); data corrections are added by ``with_data``.
 
     theta (unit scale): Normal(theta_mean, theta_sd) truncated to (0, 1).
-    betaU, betaV: Beta(rho_a, rho_b) on rho = exp(-beta/4), rho capped at ``rho_cap`` in the
-    density; beta in (0, inf). Precisions: Gamma priors below. ``lamWOs`` and ``lamOs`` here are
+    betaU: Beta(rho_a, rho_b) on rho = exp(-beta/4), rho capped at ``rho_cap`` in the density;
+    beta in (0, inf). betaV: Beta(rhoV_a, rhoV_b) likewise (GPM/SA's priors.rhoV), under the same
+    cap; None for both (the default): betaU's Beta(rho_a, rho_b). ``rhoV_a``, ``rhoV_b``: both
+    numbers (shared by every discrepancy precision group) or both sequences of one number per
+    group (stored as tuples; group g's column betaV[:, g] gets the g-th pair), each finite and
+    > 0. Precisions: Gamma priors below. ``lamWOs`` and ``lamOs`` here are
     the base priors before the data corrections of GPM/SA (see ``with_data``); ``gpmsa.fit``
     refuses corrected priors (``corrected=True``, e.g. an Emulator's ``priors``).
     ``lamVz``: one GammaPrior shared by every discrepancy precision group, or a sequence of them
@@ -93,6 +99,8 @@ class Priors:
     lamWOs: GammaPrior = field(default_factory=lambda: GammaPrior(5.0, 5e-3, 60.0, 1e5))
     lamOs: GammaPrior = field(default_factory=lambda: GammaPrior(1.0, 1e-3))
     corrected: bool = False
+    rhoV_a: float | tuple[float, ...] | None = None
+    rhoV_b: float | tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         allowed = {
@@ -115,6 +123,31 @@ class Priors:
                                  f"{getattr(self, name)!r}")  # fmt: skip
         if not isinstance(self.corrected, bool):
             raise GPMSAError(f"Priors.corrected must be True or False, got {self.corrected!r}")
+        self._check_rhov()
+
+    def _check_rhov(self) -> None:
+        """rhoV_a, rhoV_b: both None, both numbers or both sequences of equal length (stored as
+        floats or tuples of floats), each finite and > 0; GPMSAError naming the field."""
+        a, b = self.rhoV_a, self.rhoV_b
+        if (a is None) != (b is None):
+            raise GPMSAError(
+                "Priors.rhoV_a and Priors.rhoV_b set betaV's Beta prior together: give both, or "
+                f"neither (betaV then has betaU's Beta(rho_a, rho_b)), got rhoV_a={a!r:.60}, "
+                f"rhoV_b={b!r:.60}"
+            )
+        if a is None:
+            return
+        va, vb = _rho_values(a, "Priors.rhoV_a"), _rho_values(b, "Priors.rhoV_b")
+        if isinstance(va, tuple) != isinstance(vb, tuple) or (
+            isinstance(va, tuple) and len(va) != len(vb)
+        ):
+            raise GPMSAError(
+                "Priors.rhoV_a and Priors.rhoV_b must both be numbers (shared by every "
+                "discrepancy precision group) or both sequences of one number per group, of "
+                f"equal length, got rhoV_a={a!r:.60}, rhoV_b={b!r:.60}"
+            )
+        object.__setattr__(self, "rhoV_a", va)
+        object.__setattr__(self, "rhoV_b", vb)
 
     def with_data(self, wos: tuple[float, float], os: tuple[float, float] = (0.0, 0.0)) -> Priors:
         """Add GPM/SA's data corrections (delta a, delta b) to the lamWOs and lamOs priors.
@@ -150,6 +183,47 @@ class Priors:
             )
         return self.lamVz
 
+    @property
+    def rhov_per_group(self) -> bool:
+        """Whether ``rhoV_a``, ``rhoV_b`` hold one Beta prior per discrepancy precision group."""
+        return isinstance(self.rhoV_a, tuple)
+
+    def rhov_priors(self, n_groups: int) -> tuple[tuple[float, float], ...]:
+        """(a, b) of betaV's Beta prior on rho for each of ``n_groups`` discrepancy precision
+        groups: betaU's (rho_a, rho_b) where rhoV is unset, the shared pair repeated, or the
+        per-group pairs; GPMSAError naming both counts when they differ."""
+        if not self.rhov_per_group:
+            return (self.rho_prior("betaV"),) * n_groups
+        if len(self.rhoV_a) != n_groups:
+            raise GPMSAError(
+                f"Priors.rhoV_a, rhoV_b give {len(self.rhoV_a)} per-group prior(s) but the "
+                f"discrepancy has {n_groups} precision group(s) (discrepancy_groups): give one "
+                "number per group in each, or one number shared by all"
+            )
+        return tuple(zip(self.rhoV_a, self.rhoV_b, strict=True))
+
+    def rho_prior(self, name: str, element: int = 0) -> tuple[float, float]:
+        """(a, b) of the Beta prior on rho = exp(-beta/4) of column ``element`` of ``name``
+        (betaU or betaV; betaV's column g is precision group g's, whose prior may be its own)."""
+        if name == "betaU" or self.rhoV_a is None:
+            return self.rho_a, self.rho_b
+        if not self.rhov_per_group:
+            return self.rhoV_a, self.rhoV_b
+        if not 0 <= element < len(self.rhoV_a):
+            raise GPMSAError(
+                f"Priors.rhoV_a, rhoV_b give {len(self.rhoV_a)} per-group prior(s); there is none "
+                f"for group {element}: give one number per discrepancy precision group"
+            )
+        return self.rhoV_a[element], self.rhoV_b[element]
+
+    def rho_arrays(self, name: str, n_groups: int):
+        """(a, b) of the Beta priors on rho of ``name`` (betaU or betaV): floats where one prior
+        covers every element, else arrays (n_groups,) along betaV's last axis (its groups)."""
+        if name == "betaV" and self.rhov_per_group:
+            a, b = zip(*self.rhov_priors(n_groups), strict=True)
+            return np.array(a), np.array(b)
+        return self.rho_prior(name)
+
     def precision_prior(self, name: str, element: int = 0) -> GammaPrior:
         """The Gamma prior of element ``element`` of precision ``name``: lamVz[g]'s is the g-th
         of per-group priors; every other element shares its parameter's one prior."""
@@ -171,8 +245,14 @@ class Priors:
 
     def to_dict(self) -> dict:
         """JSON-able dict (infinite bounds as the string "inf"); per-group lamVz priors as a
-        list of such dicts, one per group."""
+        list of such dicts, one per group; rhoV_a, rhoV_b only where set (a number, or a list
+        of one per group), so that priors without them have the dict they had before."""
         d = asdict(self)
+        for name in RHOV:
+            if d[name] is None:
+                del d[name]
+            elif isinstance(d[name], tuple):
+                d[name] = list(d[name])
         for name in PRECISIONS:
             if isinstance(d[name], tuple):
                 d[name] = [_gamma_dict(g) for g in d[name]]
@@ -209,17 +289,20 @@ class Priors:
             return -np.inf
         return float(-0.5 * np.sum(((theta - self.theta_mean) / self.theta_sd) ** 2))
 
-    def log_beta(self, beta: np.ndarray) -> float:
-        """Log prior of correlation parameters beta via rho = exp(-beta/4); -inf unless beta > 0."""
+    def log_beta(self, beta: np.ndarray, name: str = "betaU") -> float:
+        """Log prior of correlation parameters beta of ``name`` (betaU or betaV; betaV's
+        per-group priors along its last axis) via rho = exp(-beta/4); -inf unless beta > 0."""
         beta = np.asarray(beta)
         if np.any(beta <= 0.0) or np.any(~np.isfinite(beta)):
             return -np.inf
+        a, b = self.rho_arrays(name, beta.shape[-1] if beta.ndim else 1)
         rho = np.minimum(np.exp(-0.25 * beta), self.rho_cap)
-        return float(np.sum((self.rho_a - 1.0) * np.log(rho) + (self.rho_b - 1.0) * np.log1p(-rho)))
+        return float(np.sum((a - 1.0) * np.log(rho) + (b - 1.0) * np.log1p(-rho)))
 
     def scalar_log_prior(self, name: str, element: int = 0):
         """A fast function float -> float: the log prior of element ``element`` (its index in a
-        1-D parameter: lamVz's group, whose prior may be its own) of ``name``."""
+        1-D parameter, its column in a 2-D one: lamVz's or betaV's group, whose prior may be its
+        own) of ``name``."""
         if name == "theta":
             mu, sd = self.theta_mean, self.theta_sd
 
@@ -227,7 +310,8 @@ class Priors:
                 return -0.5 * ((x - mu) / sd) ** 2 if 0.0 < x < 1.0 else -math.inf
 
         elif name in ("betaU", "betaV"):
-            a1, b1, cap = self.rho_a - 1.0, self.rho_b - 1.0, self.rho_cap
+            a, b = self.rho_prior(name, element)
+            a1, b1, cap = a - 1.0, b - 1.0, self.rho_cap
 
             def f(x: float) -> float:
                 if not 0.0 < x < math.inf:
@@ -248,11 +332,12 @@ class Priors:
 
     def log_prior(self, name: str, value: np.ndarray) -> float:
         """Log prior of parameter ``name`` at ``value`` (any shape; lamVz with per-group priors:
-        (G,), element g under the g-th)."""
+        (G,), element g under the g-th; betaV with per-group priors: (p, G), column g under the
+        g-th)."""
         if name == "theta":
             return self.log_theta(value)
         if name in ("betaU", "betaV"):
-            return self.log_beta(value)
+            return self.log_beta(value, name)
         if name == "lamVz" and self.per_group:
             x = np.asarray(value, dtype=np.float64).reshape(-1)
             a, b, lo, hi = self.gamma_arrays("lamVz", x.size)
@@ -262,6 +347,27 @@ class Priors:
         if name in PRECISIONS:
             return getattr(self, name).log_density(value)
         raise GPMSAError(f"unknown parameter name {name!r}")
+
+
+def _rho_values(value, name: str) -> float | tuple[float, ...]:
+    """``value`` as a Beta parameter of betaV's prior: a float, or a tuple of floats (one per
+    discrepancy precision group), each finite and > 0; GPMSAError naming ``name`` otherwise."""
+    many = isinstance(value, list | tuple) or (isinstance(value, np.ndarray) and value.ndim == 1)
+    items = list(value) if many else [value]
+    if many and not items:
+        raise GPMSAError(
+            f"{name} must be a number or a non-empty sequence of numbers (one per discrepancy "
+            f"precision group), got {value!r:.80}"
+        )
+    out = []
+    for i, v in enumerate(items):
+        where = f"{name}[{i}]" if many else name
+        if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+            raise GPMSAError(f"{where} must be a real number, got {v!r:.60} ({type(v).__name__})")
+        if not (math.isfinite(v) and v > 0):
+            raise GPMSAError(f"{where} must be finite and > 0, got {float(v)}")
+        out.append(float(v))
+    return tuple(out) if many else out[0]
 
 
 def as_group_priors(value, what: str) -> GammaPrior | tuple[GammaPrior, ...]:

@@ -131,10 +131,11 @@ class Problem:
     fixed_elements: dict[str, frozenset[tuple[int, ...]]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        """GPMSAError when per-group lamVz priors do not give one prior per discrepancy
-        precision group (``Priors.lamvz_priors``), before any sampling."""
+        """GPMSAError when per-group lamVz or betaV priors do not give one prior per discrepancy
+        precision group (``Priors.lamvz_priors``, ``Priors.rhov_priors``), before any sampling."""
         if self.obs is not None and self.obs.p_v:
             self.priors.lamvz_priors(self.obs.n_groups)
+            self.priors.rhov_priors(self.obs.n_groups)
 
     @property
     def m(self) -> int:
