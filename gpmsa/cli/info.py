@@ -219,7 +219,11 @@ def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str
         return None
     if not all(isinstance(u, (int, float)) and not isinstance(u, bool) for u in means):
         return None
-    native = standardizer.t_from_unit(np.array([means], dtype=float))[0]
+    try:
+        unit = np.array([means], dtype=float)
+    except OverflowError:  # an integer beyond float64 (10**400 in a file's diagnostics)
+        return None
+    native = standardizer.t_from_unit(unit)[0]
     cells = [f"{safe(n, 60)}={number(float(v), '.4g')}" for n, v in zip(names, native, strict=True)]
     return "theta (native)", ", ".join(cells)
 

@@ -51,9 +51,13 @@ def plain(obj: object) -> str:
 
 
 def number(obj: object, fmt: str = ".4g") -> str:
-    """A number formatted with ``fmt``, or the value as ``value`` shows it if it is none."""
+    """A number formatted with ``fmt``, or the value as ``value`` shows it if it is none (or
+    an integer beyond float64, 10**400 from a file's JSON, that a float format cannot take)."""
     if isinstance(obj, (int, float)) and not isinstance(obj, bool):
-        return format(obj, fmt)
+        try:
+            return format(obj, fmt)
+        except OverflowError:
+            pass
     return value(obj)
 
 

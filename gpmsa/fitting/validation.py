@@ -24,7 +24,8 @@ import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.model.basis import ORTHOGONAL_TOL
-from gpmsa.model.data import output_scale
+from gpmsa.model.data import as_float, output_scale
+from gpmsa.model.fixed_elements import label
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import MAX_PRIOR_SHAPE
 from gpmsa.model.transforms import UNIT_TOL
@@ -48,6 +49,10 @@ DISCREPANCY_KINDS = ("constant", "linear", "given")
 """A recorded discrepancy basis: named, or "given" (an array the caller passed)."""
 BASIS_VECTORS = {"constant": 1, "linear": 2}
 """The number of vectors of each named discrepancy basis (``gpmsa.model.basis``)."""
+EMULATOR_BASES = ("pca", "given")
+"""settings.basis: the runs' PCA, or a basis the caller gave (``fit(..., basis=)``)."""
+FIXABLE_CALIBRATION = ("theta", "lamOs", "betaV", "lamVz")
+"""A joint fit's parameters that ``fit(..., fixed=)`` can hold (their draws: ``cal_<name>``)."""
 
 
 def _fail(field: str, problem: str) -> EmulatorFileError:
@@ -160,7 +165,10 @@ def _check_complete(shapes: dict[str, tuple[int, ...]], n: int) -> None:
 def _number(value, field: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise _fail(field, f"must be a number, got {_short(value)}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # a JSON integer beyond float64 (10**400)
+        raise _fail(field, f"{_short(value)} is beyond float64") from None
     if math.isnan(v):
         raise _fail(field, "must be a number, got NaN")
     return v
@@ -311,6 +319,93 @@ def check_discrepancy_record(settings: dict, shapes: dict[str, tuple[int, ...]])
                     f"{n_grp} group(s), but arrays/cal_lamVz holds draws of {lam[1]}")  # fmt: skip
 
 
+def check_fixed_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> dict:
+    """settings.fixed as ``gpmsa.fit`` writes it (absent in files without it): parameter name ->
+    the values it was held at whole (nested lists of its shape), or {"elements": [index, ...],
+    "values": [...]} of held single elements, each index within its shape and named once; every
+    value a finite number, of a parameter this file holds. Returns name -> (the element index
+    tuples, None for the whole parameter; the values), for ``check_fixed_draws``."""
+    fixed = settings.get("fixed")
+    if fixed is None:
+        return {}
+    if not isinstance(fixed, dict):
+        raise _fail("settings.fixed", f"must be an object name -> values, got {_short(fixed)}")
+    params = {k: tuple(shapes[f"param_{k}"]) for k in EMULATOR_PARAMS}
+    params.update({k: tuple(shapes[f"cal_{k}"][1:]) for k in FIXABLE_CALIBRATION
+                   if f"cal_{k}" in shapes})  # fmt: skip
+    out = {}
+    for name, rec in fixed.items():
+        field = f"settings.fixed[{_short(name, 40)}]"
+        if name not in params:
+            raise _fail(field, f"names no parameter of this file (it has {sorted(params)})")
+        shape = params[name]
+        if isinstance(rec, dict):
+            out[name] = _held_elements(rec, shape, field)
+            continue
+        values = _finite_values(rec, field)
+        if values.shape != shape and not values.size == 0 == math.prod(shape):
+            raise _fail(field, f"{_short(rec)}: the values of {name} held whole need its shape "
+                               f"{list(shape)}, got {list(values.shape)}")  # fmt: skip
+        out[name] = (None, values)
+    return out
+
+
+def _held_elements(rec: dict, shape: tuple[int, ...], field: str) -> tuple[list, np.ndarray]:
+    """A held-elements entry of settings.fixed ({"elements", "values"}) as (index tuples,
+    values), each index an element of a parameter of ``shape``."""
+    els, vals = rec.get("elements"), rec.get("values")
+    if set(rec) != {"elements", "values"} or not (
+        isinstance(els, list) and els and isinstance(vals, list) and len(vals) == len(els)
+    ):
+        raise _fail(field, f"held elements need {{elements: [index, ...], values: [...]}}, one "
+                           f"value per element, got {_short(rec)}")  # fmt: skip
+    seen = []
+    for i, idx in enumerate(els):
+        ok = isinstance(idx, list) and len(idx) == len(shape) and all(
+            isinstance(k, int) and not isinstance(k, bool) and 0 <= k < n
+            for k, n in zip(idx, shape, strict=True))  # fmt: skip
+        if not ok or tuple(idx) in seen:
+            why = "named twice" if ok else f"not an element of shape {list(shape)}"
+            raise _fail(f"{field}.elements[{i}]", f"{_short(idx)} is {why}")
+        seen.append(tuple(idx))
+    values = _finite_values(vals, f"{field}.values")
+    if values.ndim != 1:
+        raise _fail(f"{field}.values", f"must be one number per element, got {_short(vals)}")
+    return seen, values
+
+
+def _finite_values(value, field: str) -> np.ndarray:
+    """``value`` (numbers in nested lists) as a float array; EmulatorFileError naming ``field``
+    for anything else (text, bools, null, ragged lists) or a value that is not finite."""
+    try:
+        arr = as_float(value, field)
+    except GPMSAError as exc:
+        raise EmulatorFileError(str(exc)) from None
+    if not np.all(np.isfinite(arr)):
+        raise _fail(field, f"must be finite numbers, got {_short(value)}")
+    return arr
+
+
+def check_fixed_draws(held: dict, arrays: dict[str, np.ndarray]) -> None:
+    """The draws of each parameter settings.fixed holds (``check_fixed_record``'s ``held``) are
+    its values: a fit records the held values exactly, and a record its draws contradict would
+    tell ``gpmsa info`` and a continuation of another model."""
+    for name, (elements, values) in held.items():
+        draws = arrays.get(f"draw_{name}", arrays.get(f"cal_{name}"))
+        if draws is None or not values.size:  # no draws (n = 0), no element: nothing to compare
+            continue
+        got = draws if elements is None else draws[(slice(None), *np.array(elements).T)]
+        if np.all(got == values):
+            continue
+        if elements is None:
+            what, at = name, _short(values.tolist())
+        else:
+            k = int(np.argmax(np.any(got != values, axis=0)))
+            what, at = label(name, elements[k]), repr(float(values[k]))
+        raise _fail(f"settings.fixed[{_short(name, 40)}]",
+                    f"holds {what} at {at}, but its draws are not held there")  # fmt: skip
+
+
 def check_fields(manifest: dict, dims: dict[str, int]) -> None:
     """Names, units, priors, the model sizes and the settings the code reads."""
     p, q, l_sim = dims["p"], dims["q"], dims["l_sim"]
@@ -346,6 +441,9 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
                 "settings.n_chains",
                 f"{n_ch} chains cannot hold the {n_draws} draws (each chain keeps as many)",
             )
+    basis = settings.get("basis", "pca")  # absent in files written before it: the PCA
+    if not (isinstance(basis, str) and basis in EMULATOR_BASES):
+        raise _fail("settings.basis", f"must be one of {EMULATOR_BASES}, got {_short(basis)}")
     lengths = settings.get("obs_lengths")  # full_prediction compares them with its obs
     if lengths is not None and not (
         isinstance(lengths, list)
@@ -421,6 +519,7 @@ def check_manifest(manifest: dict) -> None:
     check_fields(manifest, dims)
     check_prior_groups(manifest["priors"], shapes)
     check_discrepancy_record(manifest["settings"], shapes)
+    check_fixed_record(manifest["settings"], shapes)
 
 
 def _known(name: str) -> bool:
@@ -555,6 +654,8 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     check_fields(manifest, dims)
     check_prior_groups(manifest["priors"], shapes)
     check_discrepancy_record(manifest["settings"], shapes)
+    held = check_fixed_record(manifest["settings"], shapes)
     check_values(arrays, dims)
+    check_fixed_draws(held, arrays)
     check_categorical(manifest, arrays, dims)
     return dims

@@ -346,6 +346,8 @@ def check_step_widths(
                              f"{problem.names}")  # fmt: skip
         shape = widths[name].shape
         arr = as_float(_none_as_nan(val), f"step_widths[{name!r}]")
+        if arr.size == 0 == widths[name].size:  # betaV (0, G) when p = 0: nothing to set (its
+            continue  # record holds [] per chain: JSON keeps no empty shape)
         if arr.size == 1:
             arr = np.full((n_chains, *shape), arr.item())
         elif arr.shape == shape:

@@ -87,8 +87,8 @@ def check_study_manifest(manifest: dict) -> None:
         raise _fail("priors.hyper.sd_prior", f"must be one of {SD_PRIORS}, got "
                                              f"{_short(hyper.get('sd_prior'))}")  # fmt: skip
     for key in NUMBERS:
-        if key == "sd_max" and key not in hyper:
-            continue
+        if key == "sd_max" and key not in hyper and hyper.get("sd_prior", "gamma") == "gamma":
+            continue  # files before sd_prior (SEPIA's Gamma) have no sd_max; a uniform one does
         val = hyper.get(key)
         ok = isinstance(val, (int, float)) and not isinstance(val, bool) and finite(val)
         if not ok or (key != "mu_mean" and not val > 0):
