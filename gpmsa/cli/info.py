@@ -10,6 +10,7 @@ import numpy as np
 
 from gpmsa.cli.text import internal_error, number, plain, safe, value
 from gpmsa.errors import GPMSAError
+from gpmsa.model.basis import variance_shares
 
 
 def add_parser(sub) -> None:
@@ -68,10 +69,9 @@ def _basis_line(settings: dict, emulator) -> str:
     """Where the emulator basis came from, its size and the share of the standardised runs'
     variance it holds."""
     given = settings.get("basis") == "given"
-    y_std = emulator.standardizer.y_to_std(emulator.y)
-    total = float(np.sum(y_std**2))
-    left = float(np.sum((y_std - emulator.w @ emulator.K.T) ** 2))
-    share = f", {1.0 - left / total:.2%} of the runs' variance" if total > 0 else ""
+    total = float(np.sum(emulator.standardizer.y_to_std(emulator.y) ** 2))
+    held = np.sum(variance_shares(emulator.w, emulator.lam_sim, total))
+    share = f", {held:.2%} of the runs' variance" if total > 0 else ""
     source = "given (fit(..., basis=))" if given else "PCA of the runs"
     return f"{source}, {emulator.K.shape[1]} vector(s){share}"
 

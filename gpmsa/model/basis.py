@@ -16,7 +16,7 @@ ORTHOGONAL_TOL = 1e-8
 """Largest |off-diagonal of K^T K| relative to its largest diagonal element that counts as
 orthogonal (a basis from a QR or SVD is orthogonal to ~1e-15); emulator files are held to it."""
 WEIGHT_PRIOR_MASS = 0.99
-"""`given_basis` warns when a basis vector's weights spread outside the central part of this
+"""`warn_weight_scale` warns when a basis vector's weights spread outside the central part of this
 mass of what lamUz's prior allows."""
 
 
@@ -54,19 +54,16 @@ def pca_basis(
     return u[:, :n_pc] * s[:n_pc] / np.sqrt(m)
 
 
-def given_basis(basis, y_std: np.ndarray, lamuz_prior) -> np.ndarray:
-    """A user's emulator basis K (l_sim, p_u) of the standardised outputs y_std (m, l_sim),
+def given_basis(basis, l_sim: int) -> np.ndarray:
+    """A user's emulator basis K (l_sim, p_u) of standardised outputs of ``l_sim`` values,
     checked (GPM/SA's ``Ksim``, SEPIA's ``create_K_basis(K=)``, transposed: columns are the
     basis vectors on the simulation grid).
 
     GPMSAError unless finite, of l_sim rows and 1 <= p_u <= l_sim nonzero columns that are
     orthogonal (GPM/SA's simulation likelihood uses only diag(K^T K); it is exact for
-    orthogonal columns alone). A scalar output's basis is [[1]]. ``BasisWarning`` when a column's
-    weights (the runs' projections, root mean square) lie outside the spread that ``lamUz``'s
-    prior (``lamuz_prior``, a GammaPrior) gives them: 1 / sqrt(lamUz) over its central
-    ``WEIGHT_PRIOR_MASS``; the PCA basis gives exactly 1.
+    orthogonal columns alone). A scalar output's basis is [[1]]. The runs' weights on it are
+    judged by `warn_weight_scale`.
     """
-    l_sim = y_std.shape[1]
     K = as_float(basis, "basis")
     if K.ndim != 2:
         raise GPMSAError(f"basis must be a 2-D array (l_sim, p_u) = ({l_sim}, p_u), got shape "
@@ -103,13 +100,13 @@ def given_basis(basis, y_std: np.ndarray, lamuz_prior) -> np.ndarray:
             "numpy.linalg.qr(K) or an SVD gives an orthogonal basis of the same span (the "
             "weights' GP prior then applies to its columns)"
         )
-    _warn_weight_scale(basis_weights(y_std, K), lamuz_prior)
     return K
 
 
-def _warn_weight_scale(w: np.ndarray, lamuz_prior) -> None:
-    """``BasisWarning`` naming each column of w (m, p_u) whose root mean square lies outside
-    1 / sqrt(lamUz) over the central WEIGHT_PRIOR_MASS of lamUz's (truncated) Gamma prior."""
+def warn_weight_scale(w: np.ndarray, lamuz_prior) -> None:
+    """``BasisWarning`` naming each column of a given basis's weights w (m, p_u) whose root
+    mean square lies outside 1 / sqrt(lamUz) over the central WEIGHT_PRIOR_MASS of lamUz's
+    (truncated) Gamma prior ``lamuz_prior``; the PCA basis gives exactly 1."""
     a, b, lower, upper = lamuz_prior.a, lamuz_prior.b, lamuz_prior.lower, lamuz_prior.upper
     gamma = stats.gamma(a, scale=1.0 / b)
     tail = 0.5 * (1.0 - WEIGHT_PRIOR_MASS)
@@ -132,6 +129,14 @@ def _warn_weight_scale(w: np.ndarray, lamuz_prior) -> None:
             BasisWarning,
             stacklevel=user_stacklevel(),
         )
+
+
+def variance_shares(w: np.ndarray, lam_sim: np.ndarray, total: float) -> np.ndarray:
+    """(p_u,) the share of the standardised runs' sum of squares ``total`` each basis vector
+    holds, ||w_j||^2 ||K_j||^2 / total (lam_sim = diag(K^T K); orthogonal columns: they add up
+    to the basis's share); NaN where ``total`` is 0."""
+    held = np.sum(w**2, axis=0) * lam_sim
+    return held / total if total > 0 else held * np.nan
 
 
 def basis_weights(y_std: np.ndarray, K: np.ndarray) -> np.ndarray:

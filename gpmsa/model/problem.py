@@ -19,6 +19,8 @@ from gpmsa.model.basis import (
     given_basis,
     interpolate_basis,
     pca_basis,
+    variance_shares,
+    warn_weight_scale,
 )
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.data import ObsData, SimData, as_float, check_finite
@@ -490,8 +492,7 @@ class Prepared:
     def variance_shares(self) -> np.ndarray:
         """(p_u,) the share of the standardised runs' variance each basis vector holds,
         ||w_j||^2 ||K_j||^2 / ||Y||^2 (orthogonal columns: they add up to the basis's share)."""
-        held = np.sum(self.problem.w**2, axis=0) * self.problem.lam_sim
-        return held / self.runs_sum_squares if self.runs_sum_squares > 0 else held * np.nan
+        return variance_shares(self.problem.w, self.problem.lam_sim, self.runs_sum_squares)
 
     def __repr__(self) -> str:
         prob, shares = self.problem, self.variance_shares
@@ -542,8 +543,10 @@ def prepare(
     std = Standardizer.from_sim(sim)
     y_std = std.y_to_std(sim.y)
     base = Priors() if priors is None else priors
-    K = pca_basis(y_std, n_pc) if basis is None else given_basis(basis, y_std, base.lamUz)
+    K = pca_basis(y_std, n_pc) if basis is None else given_basis(basis, sim.l_sim)
     w = basis_weights(y_std, K)
+    if basis is not None and sim.l_sim > 1:
+        warn_weight_scale(w, base.lamUz)
     lam_sim = np.sum(K**2, axis=0)
     m, p_u = w.shape
     wos = (0.5 * (sim.l_sim - p_u) * m, 0.5 * float(np.sum((y_std - w @ K.T) ** 2)))

@@ -7,6 +7,7 @@ from scipy.special import ndtri
 
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
+from gpmsa.model.basis import variance_shares
 from gpmsa.model.data import SimData, check_count, check_flag, check_level, column_order
 from gpmsa.plots._figure import figure
 from gpmsa.predictive.crossval import CrossValidation
@@ -41,7 +42,7 @@ def pc_basis(emulator, *, max_pc: int = 6):
                for k, n in enumerate(emulator.t_names)]  # fmt: skip
     y_std = std.y_to_std(emulator.y)
     total = float(np.sum(y_std**2))
-    share = emulator.lam_sim * np.sum(emulator.w**2, axis=0) / total if total > 0 else None
+    share = variance_shares(emulator.w, emulator.lam_sim, total) if total > 0 else None
     n_col = len(inputs) + (0 if scalar else 1)
     fig = figure(2.6 * n_col + 0.4, 2.2 * p_u + 0.4)
     axes = fig.subplots(p_u, n_col, squeeze=False)
