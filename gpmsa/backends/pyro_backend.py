@@ -6,7 +6,10 @@ density of rho (the same target as the Metropolis samplers, which walk on rho); 
 their prior bounds with Gamma densities. Bounds are pyro constraints (NUTS moves in the
 unconstrained space); densities enter through ``pyro.factor``. Chains start where the numpy
 backend's chain c would (``gpmsa.mcmc.starts``: GPM/SA's initial values for one chain, dispersed
-ones for several); fixed parameters are constants.
+ones for several); fixed parameters are constants. A parameter with held elements
+(``problem.fixed_elements``) is one site of its free elements (flattened, C order; their own
+bounds), scattered with the held values into the full array; the held elements' priors are left
+out, as the numpy backend leaves them out.
 """
 
 from __future__ import annotations
@@ -40,13 +43,18 @@ N_WARMUP = 500
 """Default NUTS warm-up (step size and mass-matrix adaptation) iterations per chain."""
 
 
-def _support(problem: Problem, name: str, dtype: torch.dtype) -> constraints.Constraint:
+def _support(
+    problem: Problem, name: str, dtype: torch.dtype, free: np.ndarray | None = None
+) -> constraints.Constraint:
     """Constraint of the sampled coordinate of ``name`` (rho for the correlation parameters);
     per-group lamVz priors of different bounds give per-element bounds, whose upper ones must be
-    all finite or all infinite (GPMSAError otherwise)."""
+    all finite or all infinite (GPMSAError otherwise). ``free``: the flat indices of the sampled
+    elements of a parameter with held elements (None: every element)."""
     if name == "theta" or name in RHO_PARAMS:
         return constraints.interval(0.0, 1.0)
     _, _, lows, highs = problem.priors.gamma_arrays(name, int(np.size(problem.init[name])))
+    if free is not None:
+        lows, highs = lows[free], highs[free]
     if np.all(lows == lows[0]) and np.all(highs == highs[0]):  # one prior's bounds, as floats
         lower, upper = float(lows[0]), float(highs[0])
     else:
@@ -71,15 +79,9 @@ class PyroModel:
     """The GPM/SA posterior of ``problem`` as a pyro model (call it with no arguments)."""
 
     def __init__(self, problem: Problem, dtype: torch.dtype = torch.float64):
-        """GPMSAError for held elements (``problem.fixed_elements``): each parameter is one
-        NUTS sample site, sampled or constant as a whole."""
-        if problem.fixed_elements:
-            held = ", ".join(sorted(problem.fixed_elements))
-            raise GPMSAError(
-                f"the pyro backend samples each parameter as a whole; fixed= holds single "
-                f"elements of {held}: fix the whole array (a scalar or an array of its shape), "
-                "or use backend='numpy' or 'torch'"
-            )
+        """Each parameter is one NUTS sample site, or a constant when fixed whole (or empty);
+        one with held elements (``problem.fixed_elements``) is a site of its free elements,
+        ``self.held[name]`` = (free flat indices, scatter order, held values (model scale))."""
         self.problem = problem
         self.dtype = dtype
         self.data = ModelTensors.from_problem(problem, dtype, "cpu")
@@ -89,7 +91,16 @@ class PyroModel:
             if k in problem.fixed or np.size(v) == 0
         }
         self.free = tuple(k for k in problem.sampled if k not in self.const)
-        self.support = {name: _support(problem, name, dtype) for name in self.free}
+        self.held = {
+            k: _scatter(problem.init[k], problem.fixed_elements[k], dtype)
+            for k in self.free
+            if problem.fixed_elements.get(k)
+        }
+        self.support = {
+            name: _support(problem, name, dtype, self.held[name][0].numpy() if name in self.held
+                           else None)
+            for name in self.free
+        }  # fmt: skip
         self.sim_cache = None
         if all(k in self.const for k in SIM_PARAMS):  # Sigma_W constant: factor it once
             d = self.data
@@ -105,6 +116,8 @@ class PyroModel:
         out = {}
         for name in self.free:
             v = torch.as_tensor(start[name], dtype=self.dtype)
+            if name in self.held:
+                v = v.reshape(-1)[self.held[name][0]]
             out[_site(name)] = torch.exp(-0.25 * v) if name in RHO_PARAMS else v
         return out
 
@@ -115,7 +128,12 @@ class PyroModel:
             if name in self.const:
                 continue
             v = sites[_site(name)]
-            out[name] = -4.0 * torch.log(v) if name in RHO_PARAMS else v
+            v = -4.0 * torch.log(v) if name in RHO_PARAMS else v
+            if name in self.held:  # free elements (C, n_free) and held values, in C order
+                _, order, values = self.held[name]
+                full = torch.cat([v, values.expand(v.shape[0], -1)], -1)[:, order]
+                v = full.reshape(v.shape[0], *self.problem.init[name].shape)
+            out[name] = v
         c = next(iter(out.values())).shape[0] if out else 1
         out.update({k: v.expand(c, *v.shape[1:]) for k, v in self.const.items()})
         return out
@@ -133,24 +151,42 @@ class PyroModel:
         return ll_w
 
     def log_prior(self, prm: dict[str, torch.Tensor]) -> torch.Tensor:
-        """Sum of the sampled parameters' log priors (C,)."""
+        """Sum of the sampled elements' log priors (C,) (held elements left out)."""
         c = prm["betaU"].shape[0]
         lp = torch.zeros(c, dtype=self.dtype)
         for name in self.free:
-            lp = lp + log_prior_elements(self.problem.priors, name, prm[name]).reshape(c, -1).sum(
-                -1
-            )
+            each = log_prior_elements(self.problem.priors, name, prm[name]).reshape(c, -1)
+            if name in self.held:
+                each = each[:, self.held[name][0]]
+            lp = lp + each.sum(-1)
         return lp
 
     def __call__(self) -> None:
         sites = {}
         for name in self.free:
             shape = self.problem.init[name].shape
+            if name in self.held:
+                shape = self.held[name][0].shape
             base = dist.ImproperUniform(self.support[name], (), shape)
             sites[_site(name)] = pyro.sample(_site(name), base).unsqueeze(0)
         prm = self.params(sites)
         pyro.factor("log_prior", self.log_prior(prm)[0])
         pyro.factor("log_likelihood", self.log_likelihood(prm)[0])
+
+
+def _scatter(init: np.ndarray, held, dtype: torch.dtype):
+    """(free flat indices (n_free,), order (n,), held values (n_held,)) of a parameter of
+    initial value ``init`` whose elements ``held`` (index tuples) are held at ``init``'s values:
+    ``cat([free values, held values])[..., order]`` is the flattened full array."""
+    mask = np.zeros(init.shape, dtype=bool)
+    for idx in held:
+        mask[idx] = True
+    mask = mask.reshape(-1)
+    free, fixed = np.flatnonzero(~mask), np.flatnonzero(mask)
+    order = np.empty(mask.size, dtype=np.int64)
+    order[free], order[fixed] = np.arange(free.size), free.size + np.arange(fixed.size)
+    values = torch.as_tensor(init.reshape(-1)[fixed], dtype=dtype)
+    return torch.as_tensor(free), torch.as_tensor(order), values
 
 
 MIN_DRAWS = 4
@@ -209,10 +245,12 @@ def sample(
     ``step_widths`` do not apply to NUTS (an error if given). Each chain's torch randomness is
     seeded from ``seed`` inside ``torch.random.fork_rng`` (the global RNG is left as it was).
     ``accept_rate`` holds pyro's per-chain "acceptance rate" diagnostic and ``step_widths`` the
-    adapted NUTS step size, each repeated over every sampled element. ``jit``: compile the potential
-    energy with the torch JIT (about 1.6x faster on the road case). ``num_threads``: torch CPU
-    threads while sampling (see the torch backend; None: unchanged). ``n_jobs``: None, 1 or -1
-    (the chains run one after another in this process; any other number is a GPMSAError).
+    adapted NUTS step size, each repeated over every sampled element (NaN for held elements,
+    ``problem.fixed_elements``, whose draws are their values exactly). ``jit``: compile the
+    potential energy with the torch JIT (about 1.6x faster on the road case). ``num_threads``:
+    torch CPU threads while sampling (see the torch backend; None: unchanged). ``n_jobs``: None,
+    1 or -1 (the chains run one after another in this process; any other number is a
+    GPMSAError).
     """
     if step_widths:
         raise GPMSAError("the pyro backend (NUTS) takes no step_widths; leave step_widths=None")
@@ -279,6 +317,8 @@ def sample(
             [np.full(shape, r[1] if sampled else np.nan, dtype=float) for r in runs]
         )
         wid[name] = np.stack([np.full(shape, r[2] if sampled else np.nan) for r in runs])
+        for idx in problem.fixed_elements.get(name, ()):  # held: no step, no acceptance
+            rate[name][(slice(None), *idx)] = wid[name][(slice(None), *idx)] = np.nan
     return Chains(
         draws={k: np.stack(v) for k, v in draws.items()},
         log_post=np.stack(log_post),

@@ -135,15 +135,15 @@ def fit(
     integrated out (flat prior). fixed: name -> value held fixed (model scales as
     ``Emulator.params``; theta in native units), e.g. ``{"lamWOs": 1e5 - 1}``: a scalar or an
     array of the parameter's shape holds the whole array; a dict element index -> value holds
-    those elements and samples the others (SEPIA's per-element fixing; numpy and torch
-    backends, pyro refuses it), e.g. ``{"lamVz": {1: 1e6}}`` (group 1's discrepancy switched
-    off), ``{"betaU": {(2, 0): 0.5}}``. Indices count from 0: an int for a 1-D parameter (theta
-    also by t_name); a tuple (i, j) for betaU (p + q, p_u) and betaV (p, G), where an int i
-    means (i, 0) only if there is one column (``gpmsa.model.fixed_elements``); naming every
-    element equals fixing the whole array. constraint (joint fit only): a callable of native
-    theta (q,) -> bool, False where theta is not allowed (zero prior mass there). theta_init:
-    the chains' start of theta (native, (q,) or a dict by t_names; default the centre; a
-    categorical element: one of its levels).
+    those elements and samples the others (SEPIA's per-element fixing; every backend: pyro
+    samples a site of the free elements), e.g. ``{"lamVz": {1: 1e6}}`` (group 1's discrepancy
+    switched off), ``{"betaU": {(2, 0): 0.5}}``. Indices count from 0: an int for a 1-D
+    parameter (theta also by t_name); a tuple (i, j) for betaU (p + q, p_u) and betaV (p, G),
+    where an int i means (i, 0) only if there is one column (``gpmsa.model.fixed_elements``);
+    naming every element equals fixing the whole array. constraint (joint fit only): a
+    callable of native theta (q,) -> bool, False where theta is not allowed (zero prior mass
+    there). theta_init: the chains' start of theta (native, (q,) or a dict by t_names; default
+    the centre; a categorical element: one of its levels).
 
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``

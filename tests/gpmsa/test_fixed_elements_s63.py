@@ -1,7 +1,7 @@
 """Fixing single elements of a parameter array (SEPIA's per-element ``SepiaParam.fixed``):
 ``fit(..., fixed={"lamVz": {1: 1e4}})`` holds those elements and samples the others, on the
-numpy and torch backends; the whole-array form draws exactly as before; the checks, the file
-record, ``gpmsa info``, the continuation check and pyro's refusal."""
+numpy and torch backends (pyro: test_pyro_fixed_elements_s64.py); the whole-array form draws
+exactly as before; the checks, the file record, ``gpmsa info`` and the continuation check."""
 
 import functools
 import warnings
@@ -257,13 +257,6 @@ def test_a_start_the_constraint_refuses_beside_a_held_element_points_at_theta_in
         _theta2_fit(fixed, n_iter=5, constraint=below)
     emu = _theta2_fit(fixed, n_iter=5, constraint=below, theta_init={"a": 0.3, "b": 2.0})
     assert np.all(emu.calibration["theta_native"][:, 1] == 2.0)
-
-
-def test_pyro_refuses_held_elements_and_names_them():
-    pytest.importorskip("pyro")
-    with pytest.raises(GPMSAError, match=r"pyro backend samples each parameter as a whole; "
-                       r"fixed= holds single elements of betaU, lamVz"):  # fmt: skip
-        _fit(HELD, "pyro", n_iter=10, n_chains=1, n_keep=10)
 
 
 # --- the file, info and continuing --------------------------------------------------------------
