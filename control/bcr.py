@@ -308,7 +308,8 @@ class BCR:
             (`EmulatorMismatchError` otherwise).
         settings: `BCRSettings` (default: the change-point method); ``overrides`` replace fields.
 
-    A BCR is a stream's state: feed it from one thread (it holds no lock), and copy it with
+    A BCR is a stream's state: feed it from one thread (it holds no lock; BCRs on several
+    threads may share one `ObservationModel`, whose cache holds no lock either), and copy it with
     ``copy.deepcopy`` (``copy.copy`` shares its filters). It pickles, and so do its estimates
     (their posteriors' lazily drawn samples are drawn then). Its estimates do not depend on
     how the samples are chunked across calls; a call returns the newest estimate, or the
@@ -359,6 +360,19 @@ class BCR:
                 tracker = replace(tracker, mean_segment_m=0.0)
             self.trackers = [GDTracker(self.gd_range, tracker) for _ in range(n)]
         self.reset()
+        self._warm_up()
+
+    def __setstate__(self, state: dict) -> None:  # a restored BCR warms up as a new one
+        self.__dict__.update({"_start_note": "", **state})  # (one pickled before it had a note)
+        self._warm_up()
+
+    def _warm_up(self) -> None:
+        """Build the feature's cached tables now (the DPSS tapers import scipy.signal: 0.1-0.2 s
+        once a process), so that the stream's first block does not pay for them inside the
+        control loop."""
+        if self.settings.feature.name == "log_band_power":
+            with np.errstate(divide="ignore"):
+                features_of_blocks(np.zeros((1, self.buffer)), self.settings.feature)
 
     @classmethod
     def from_emulator(cls, emulator, settings: BCRSettings | None = None, **overrides) -> BCR:
@@ -400,6 +414,7 @@ class BCR:
         else:
             for tracker in self.trackers:
                 tracker.reset()
+        self._start_note = ""
         self.last = Estimate(time=0.0, position=0.0, status="filling", reason="no samples yet")
 
     def resume(self, moved_m: float) -> None:
@@ -429,7 +444,8 @@ class BCR:
         else:
             for tracker in self.trackers:
                 tracker.predict(float(moved_m))
-        reason = f"resumed ({moved_m:g} m moved while down); no samples yet"
+        self._start_note = f"resumed ({moved_m:g} m moved while down); "
+        reason = f"{self._start_note}no samples yet"
         self.last = Estimate(time=0.0, position=0.0, status="filling", reason=reason)
 
     def _forget_stream(self) -> None:
@@ -512,6 +528,9 @@ class BCR:
                 fault = graver_fault(fault, self.last)
                 self._received = 0
                 self._n_updates += 1
+        if self._n_updates == 0 and self._received:  # samples in, the first update to come
+            reason = f"{self._start_note}{self._received} of the first update's {every} samples"
+            self.last = replace(self.last, reason=reason)
         est = self._check_age(fault or self.last)
         return self._check_silence(est, fresh=self._n_updates > updates)
 

@@ -176,6 +176,12 @@ class ObservationModel:
     def _mahalanobis(self, y: np.ndarray, v: float) -> tuple[np.ndarray, float]:
         """Squared Mahalanobis distances of y from the mean at every GD node (G,), and half the
         log-determinant of Sigma(v). The last call is remembered (the BCR asks twice)."""
+        return self._solve(y, v)[1]
+
+    def _solve(self, y: np.ndarray, v: float) -> tuple:
+        """(key, `_mahalanobis`'s pair, (the factor's inverse, the whitened residual at the
+        nearest GD node)) of y at v: one tuple, so that a caller reads the parts of one call
+        even where BCRs on other threads share this model."""
         y = np.asarray(y)
         if y.shape != (self.dim,) or y.dtype.kind not in "iuf" or not np.all(np.isfinite(y)):
             raise ControlError(f"y must be {self.dim} finite numbers (K,), got {y!r}")
@@ -183,8 +189,9 @@ class ObservationModel:
         if not (is_real(v) and np.isfinite(v)):
             raise ControlError(f"v must be a finite speed, m/s, got {v!r}")
         key = (y.tobytes(), float(v))
-        if self._last is not None and self._last[0] == key:
-            return self._last[1]
+        last = self._last
+        if last is not None and last[0] == key:
+            return last
         mean, chol = self._at(float(v))
         # an explicit inverse of the 8 x 8 factor: a LAPACK triangular solve of this size costs
         # ~1 ms in OpenBLAS's threads, the product microseconds
@@ -192,8 +199,8 @@ class ObservationModel:
         r = inverse @ (y[None, :] - mean).T  # (K, G)
         d2 = np.sum(r**2, axis=0)
         out = d2, float(np.sum(np.log(np.diag(chol))))
-        self._last = (key, out, (inverse, r[:, int(np.argmin(d2))]))
-        return out
+        self._last = last = (key, out, (inverse, r[:, int(np.argmin(d2))]))
+        return last
 
     def loglik(self, y: np.ndarray, v: float) -> np.ndarray:
         """log p(y | GD) on ``self.gd`` (G,), all constants included.
@@ -228,14 +235,13 @@ class ObservationModel:
             y: (K,) the block's feature. v: the block's mean speed, m/s.
             direction: (K,) finite, not all zero.
         """
-        self._mahalanobis(y, v)
+        _, _, (inverse, residual) = self._solve(y, v)
         d = np.asarray(direction)
         if (d.shape != (self.dim,) or d.dtype.kind not in "iuf" or not np.all(np.isfinite(d))
                 or not np.any(d)):  # fmt: skip
             raise ControlError(
                 f"direction must be {self.dim} finite numbers (K,), not all zero, got {d!r}"
             )
-        inverse, residual = self._last[2]
         w = inverse @ d
         return float(w @ residual / np.sqrt(w @ w))
 

@@ -564,8 +564,25 @@ def stream_fault(
         what.append(f"{int(backwards.sum())} repeated or backwards time stamp(s)")
     if gap.any():
         worst = float(np.max(step[gap]))
-        what.append(f"a gap of {worst:.4g} s (about {round(worst / dt) - 1:.4g} dropped samples)")
+        what.append(
+            f"a gap of {worst:.4g} s (about {round(worst / dt) - 1:.4g} dropped samples)"
+            + _stamp_unit_hint(worst / dt)
+        )
     return bad_value | backwards, gap & ~bad_value, " and ".join(what)
+
+
+STAMP_UNITS = (("milliseconds", 1e3), ("microseconds", 1e6), ("nanoseconds", 1e9))
+"""Time stamps in these units, fed as seconds, step by this many sample periods."""
+
+
+def _stamp_unit_hint(periods: float) -> str:
+    """A clause asking whether the stamps are in another unit than seconds, where a step of
+    ``periods`` sample periods is 1e3, 1e6 or 1e9 of them (within 10%: a ROS stamp's
+    nanoseconds fed as seconds read as gaps of ~8e6 s at 120 Hz), else ""."""
+    for unit, factor in STAMP_UNITS:
+        if abs(periods / factor - 1.0) < 0.1:
+            return f"; if every step reads so, the time stamps are in {unit}: t must be seconds"
+    return ""
 
 
 def timing_fault(
