@@ -107,7 +107,7 @@ def check_emulator(
     top or safe speed lies outside the emulator's speed domain (the BCR learns nothing at such
     a speed: the robot would drive on an estimate that only ages), or whose GD_max is not below
     the emulator's highest GD (the posterior never exceeds that, so the estimate could never
-    call for safety mode). Warnings: a
+    call for safety mode) or not above its lowest (safety mode would never end). Warnings: a
     different noise level (the paper's Test Cases pair the noise-free emulator with noise-free
     data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
     want it); vehicle or noise metadata missing.
@@ -161,11 +161,17 @@ def check_emulator(
             )
     if simplex is not None:
         _check_speeds(emulator, simplex)
-        hi = emulator_domain(emulator)[1][1]
+        lo, hi = emulator_domain(emulator)[1]
         if not simplex.gd_max < hi:
             raise EmulatorMismatchError(
                 f"Simplex gd_max = {simplex.gd_max:g} is not below the emulator's highest GD "
                 f"{hi:g}: no GD estimate could exceed it, so safety mode would never start"
+            )
+        if not simplex.gd_max > lo:
+            raise EmulatorMismatchError(
+                f"Simplex gd_max = {simplex.gd_max:g} is not above the emulator's lowest GD "
+                f"{lo:g}: every GD estimate exceeds it, so the robot would never leave safety "
+                f"mode; are gd_min and gd_max in the emulator's units (1e-6 m^3)?"
             )
 
 

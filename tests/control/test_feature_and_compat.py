@@ -125,6 +125,14 @@ def test_check_emulator_refuses_a_gd_max_that_no_estimate_can_exceed():
             check_emulator(emu, simplex=Simplex(gd_min=400, gd_max=gd_max))
 
 
+def test_check_emulator_refuses_a_gd_max_that_every_estimate_exceeds():
+    emu = fake_emulator()  # GD domain [200, 600]: gd_max 150 would hold safety mode for good
+    check_emulator(emu, simplex=Simplex(gd_min=100, gd_max=210))
+    for gd_max in (200, 150):
+        with pytest.raises(EmulatorMismatchError, match=rf"gd_max = {gd_max} is not above .* 200"):
+            check_emulator(emu, simplex=Simplex(gd_min=50, gd_max=gd_max))
+
+
 def test_feature_spec_checks_and_round_trips():
     spec = FeatureSpec()
     assert spec.dim == 10 and len(spec.names()) == 10 and spec.block_s == pytest.approx(125 / 120)
