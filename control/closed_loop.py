@@ -276,6 +276,9 @@ def run_closed_loop(
 
         check_can_record()
         _check_record_path(record)
+    if check and "vehicle" in (getattr(emulator, "metadata", None) or {}):
+        # first: a model left at its default says so, not that the Simplex is too fast for it
+        check_emulator(emulator, model=model)
     top = float(model.max_speed_mps)
     if simplex.v_max > top * (1 + 1e-12):
         raise ControlError(

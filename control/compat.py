@@ -107,7 +107,8 @@ def check_emulator(
     top or safe speed lies outside the emulator's speed domain (the BCR learns nothing at such
     a speed: the robot would drive on an estimate that only ages), or whose GD_max is not below
     the emulator's highest GD (the posterior never exceeds that, so the estimate could never
-    call for safety mode) or not above its lowest (safety mode would never end). Warnings: a
+    call for safety mode) or not above its lowest (every estimate exceeds that: safety mode for
+    good, e.g. a GD band given in m^3). Warnings: a
     different noise level (the paper's Test Cases pair the noise-free emulator with noise-free
     data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
     want it); vehicle or noise metadata missing.
@@ -171,7 +172,8 @@ def check_emulator(
             raise EmulatorMismatchError(
                 f"Simplex gd_max = {simplex.gd_max:g} is not above the emulator's lowest GD "
                 f"{lo:g}: every GD estimate exceeds it, so the robot would never leave safety "
-                f"mode; are gd_min and gd_max in the emulator's units (1e-6 m^3)?"
+                "mode; GD is in units of 1e-6 m^3 (Gd(n0) x 1e6: the paper's band is "
+                "Simplex(gd_min=250, gd_max=350))"
             )
 
 

@@ -44,6 +44,7 @@ import roadgen  # noqa: E402
 import vehicle  # noqa: E402
 from control.metrics import strict_json  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
+from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
 
 PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 PAPER_RMSE = {"A": {"300": 42.58, "500": 94.42}, "B": {"300": 50.19, "500": 96.23}}
@@ -121,6 +122,23 @@ def run_case(
         )  # fmt: skip
         for k in seeds
     ]
+
+
+def check_same_robot(band, window) -> None:
+    """EmulatorMismatchError unless the band and window emulators of one case record one
+    vehicle and one noise level: each run drives the robot its emulator records
+    (`run_case`), so emulators of two robots would compare the methods on different ones."""
+    robots = [control.emulator_vehicle(emu).describe() for emu in (band, window)]
+    differ = [
+        f"{k}: band {robots[0].get(k)!r} vs window {robots[1].get(k)!r}"
+        for k in sorted(set(robots[0]) | set(robots[1]))
+        if robots[0].get(k) != robots[1].get(k)
+    ]
+    noise = (control.emulator_noise_std(band) or 0.0, control.emulator_noise_std(window) or 0.0)
+    if not np.isclose(*noise):
+        differ.append(f"noise sd: band {noise[0]:g} vs window {noise[1]:g} m/s^2")
+    if differ:
+        raise control.EmulatorMismatchError(", ".join(differ))
 
 
 def summarise(results, gds: list[float]) -> dict:
@@ -252,6 +270,18 @@ def main(argv: list[str] | None = None) -> dict:
             control.check_emulator(emu, simplex=simplex)
         except control.EmulatorMismatchError as err:  # speeds outside the emulator's domain
             parser.error(f"--v-safe / --v-max: {err}")
+    for case in args.cases:  # the two methods of a case are compared on one robot
+        try:
+            check_same_robot(emulators[case, "band"], emulators[case, "window"])
+        except control.EmulatorMismatchError as err:
+            where = emulator_dir if emulator_dir else EMULATOR_DIR
+            parser.error(
+                f"--emulator-dir: case {case}'s {emulator_file_name(case, 'band')} and "
+                f"{emulator_file_name(case, 'window')} were trained for different robots "
+                f"({err}), so its table would compare the two methods on different robots (one "
+                f"left from an earlier training?): train both for one robot (examples/"
+                f"train_emulator.py --features band window --emulator-dir {where})"
+            )
     if args.record:
         from control.robot.record import check_can_record
 

@@ -87,6 +87,10 @@ runs of 60 s, 8 blocks pooled, 1-2 m/s) the quantiles raise the information per 
 (GPM/SA's default 99.5% kept 3-4 and dropped GD-dependent shape: held-out RMSE of log GD over
 8.3 s of driving 0.116 with 3, 0.110 with 5, 0.109 with all 8; docs/closed-loop.md)."""
 WINDOW_PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(1.0, 1e-3, 1.0, 1e5))
+GD_MIN_HI = 1.0
+"""Smallest ``--gd-range`` HI (1e-6 m^3): 16 times smoother than the middle of ISO 8608's class A.
+Every ISO road's Gd(n0) in m^3 lies below it (class H's 0.13), so a range below it is a range
+given in m^3, which would train on roads a million times too smooth."""
 MIN_RUNS = 4
 """Fewest design points (``--n-runs``): gpmsa.SimData needs p + q + 2 = 4 runs for v and GD
 (and the band emulators at least ``--n-pc``)."""
@@ -463,9 +467,9 @@ def main(argv: list[str] | None = None) -> None:
         help="accelerometer noise sd of case B, m/s^2 (your IMU's; default 1.0, the paper's)",
     )  # fmt: skip
     parser.add_argument(
-        "--vehicle", nargs="+", default=[], metavar="NAME=VALUE",
+        "--vehicle", nargs="+", action="extend", default=[], metavar="NAME=VALUE",
         help="Jackal parameters to change, e.g. mass_kg=21.5 tyre_stiffness_n_per_m=26000 "
-        "(vehicle.Jackal's attributes, SI units)",
+        "(vehicle.Jackal's attributes, SI units; the option may be repeated)",
     )  # fmt: skip
     parser.add_argument(
         "--features", nargs="+", default=["band", "window"], choices=["band", "window"]
@@ -530,6 +534,12 @@ def main(argv: list[str] | None = None) -> None:
             f"--gd-range must be finite with 0 < LO < HI <= {GD_MAX:g} (beyond ISO 8608's "
             f"roughest class, H, from 131072), got {lo} {hi}"
         )
+    if hi < GD_MIN_HI:  # every ISO 8608 road in m^3 lies below 1: a unit slip, not a floor
+        parser.error(
+            f"--gd-range {lo:g} {hi:g}: GD is Gd(n0) in units of 1e-6 m^3 (ISO 8608's smoothest "
+            f"class, A, spans 0-32), so HI must be >= {GD_MIN_HI:g}; a range given in m^3 is "
+            f"--gd-range {lo * 1e6:g} {hi * 1e6:g}"
+        )
     v_lo, v_hi = args.speed_range
     if not (np.isfinite(v_lo) and np.isfinite(v_hi) and 0 < v_lo < v_hi):
         parser.error(f"--speed-range must be finite with 0 < LO < HI, m/s, got {v_lo} {v_hi}")
@@ -548,7 +558,7 @@ def main(argv: list[str] | None = None) -> None:
     if v_hi > model.max_speed_mps:
         parser.error(
             f"--speed-range HI = {v_hi:.10g} m/s exceeds the vehicle's top speed "
-            f"{model.max_speed_mps:.10g} m/s"
+            f"{model.max_speed_mps:.10g} m/s (a faster robot: --vehicle max_speed_mps=...)"
         )
     if args.ship:
         check_shippable(parser, args)
@@ -595,9 +605,17 @@ def main(argv: list[str] | None = None) -> None:
             try:
                 emu = fitters[kind](case, campaign, model, args)
             except control.ControlError as exc:  # the block scatter: too few batches near a speed
+                failed = int(np.count_nonzero(~fit_runs(kind, case, campaign, args)))
+                why = (
+                    f"; {failed} of the {campaign.v.size} runs failed (the vehicle left the road: "
+                    "campaign.npz's status), which leaves speeds without runs: lower --gd-range "
+                    "HI or --speed-range HI"
+                    if failed
+                    else ""
+                )
                 parser.error(
                     f"case {case}, {kind} emulator: {exc}; too few runs or blocks for its "
-                    "covariance: raise --n-runs or --keep-s"
+                    f"covariance: raise --n-runs or --keep-s{why}"
                 )
             path = emu_dir / emulator_file_name(case, kind)
             emu.save(path)

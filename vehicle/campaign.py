@@ -481,14 +481,6 @@ def run_campaign(
         _check_path(cache_dir, "cache_dir", "folder")
         if not os.fsdecode(cache_dir):  # Path("") is the working directory: never by accident
             raise VehicleError("cache_dir='' must be a folder path, got the empty string")
-    usable_m = road_length_m - lead_in_m - 2 * model.wheelbase_m
-    need_m = window * float(np.max(points[:, 0])) / rate_hz
-    if not usable_m >= need_m:
-        raise VehicleError(
-            f"road_length_m={road_length_m!r} is too short: a {window}-sample window at "
-            f"{np.max(points[:, 0]):.4g} m/s after the lead-in ({lead_in_m} m) needs "
-            f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
-        )
     roadgen.profile.grid_points(road_length_m, dx_m)  # one road fits in memory
     if band is not None:  # and holds the band: roadgen's check, on the shortest road
         roadgen.iso8608_profile(road_length_m, 1.0, dx_m, seed=0, band=band, lead_in_m=lead_in_m)
@@ -505,6 +497,19 @@ def run_campaign(
     def length(v: float) -> float:
         need = lead_in_m + model.wheelbase_m + v * (keep_s + 1.0) if keep else 0.0
         return float(max(road_length_m, need))
+
+    # each run's own road, lengthened for keep_s or not, must hold the window after the lead-in
+    speeds = points[:, 0]
+    usable_m = np.array([length(float(v)) for v in speeds]) - lead_in_m - 2 * model.wheelbase_m
+    short = ~(usable_m >= window * speeds / rate_hz)
+    if short.any():
+        v_short = float(np.max(speeds[short]))
+        need_m = window * v_short / rate_hz
+        raise VehicleError(
+            f"road_length_m={road_length_m!r} is too short: a {window}-sample window at "
+            f"{v_short:.4g} m/s after the lead-in ({lead_in_m} m) needs "
+            f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
+        )
 
     _check_drives(points, [length(float(v)) for v in points[:, 0]], model, dx_m)
     seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
