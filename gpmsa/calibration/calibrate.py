@@ -53,15 +53,19 @@ from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
+from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, check_count, check_flag, check_seed
 from gpmsa.model.discrepancy import check_groups, to_samples
 from gpmsa.model.discrepancy import record as discrepancy_record
-from gpmsa.model.problem import Problem, default_init, reduce_obs
+from gpmsa.model.problem import Problem, checked_fixed, default_init, reduce_obs
+
+CALIBRATION_FIXED = ("theta", "lamOs", "betaV", "lamVz")
+"""The parameters ``calibrate(fixed=)`` may hold (betaV and lamVz with a discrepancy only)."""
 
 
 def calibration_problem(
     emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False, constraint=None,
-    theta_init=None, reduced: Observations | None = None, discrepancy_groups=None,
+    theta_init=None, reduced: Observations | None = None, discrepancy_groups=None, fixed=None,
 ) -> Problem:  # fmt: skip
     """The calibration-only Problem: the emulator's parameters at its point estimate in ``fixed``.
 
@@ -69,7 +73,9 @@ def calibration_problem(
     output; "constant", "linear" or a matrix for a vector output; ``discrepancy_groups`` as
     ``gpmsa.fit``'s). ``constraint`` and ``theta_init`` as ``calibrate``'s. ``reduced``:
     ``reduce(emulator, x_obs, y_obs, extrapolate)`` where the caller has it already (no
-    discrepancy only), so that the observations are checked and reduced once.
+    discrepancy only), so that the observations are checked and reduced once. ``fixed``:
+    ``calibration_fixed(emulator, fixed=, discrepancy)`` (theta on the unit scale): held in
+    the Problem (``Problem.with_fixed``) beside the emulator's parameters.
     """
     check_emulator(emulator)
     if reduced is not None and discrepancy is not None:
@@ -111,11 +117,72 @@ def calibration_problem(
     con, theta0 = _theta_options(emulator, constraint, theta_init)
     if theta0 is not None:
         init["theta"] = theta0
-    return Problem(
+    problem = Problem(
         emulator.x_unit, emulator.t_unit, emulator.w, emulator.lam_sim, priors, init,
         frozenset(EMULATOR_PARAMS), obs, getattr(emulator, "categorical_mask", None),
         getattr(emulator, "mean_basis", None), con,
     )  # fmt: skip
+    return problem if not fixed else problem.with_fixed(fixed)
+
+
+def calibration_fixed(emulator, fixed, discrepancy=None) -> dict | None:
+    """``calibrate``'s ``fixed=`` checked by name, theta's values on the unit scale (an array
+    (q,) for the whole vector, or position -> value for some elements: ``fixed_elements``'s
+    ``theta_unit``; a categorical one exactly at its level); the other values as given (model
+    scales), for ``Problem.with_fixed`` or the fast sampler to check. None for None.
+
+    GPMSAError for a non-dict, an emulator parameter (not sampled in a calibration), a
+    discrepancy parameter without a discrepancy, or an unknown name."""
+    if fixed is None:
+        return None
+    if not isinstance(fixed, dict):
+        raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
+    names = [str(n) for n in emulator.t_names]
+    allowed = ["theta", "lamOs"] + (["betaV", "lamVz"] if discrepancy is not None else [])
+    for name in fixed:
+        if name in EMULATOR_PARAMS:
+            raise GPMSAError(
+                f"fixed[{name!r}]: {name} is an emulator parameter, which calibrate does not "
+                "sample: it is held at the emulator's point estimate (emulator_params='point') "
+                "or its retained draws ('draws'). To hold it at a value, fit the emulator so: "
+                f"gpmsa.fit(..., fixed={{{name!r}: value}}); calibrate holds {allowed}"
+            )
+        if name in ("betaV", "lamVz") and discrepancy is None:
+            raise GPMSAError(
+                f"fixed[{name!r}]: {name} is a discrepancy parameter and this calibration has "
+                "no discrepancy: give discrepancy= ('constant', 'linear' or a basis), or leave "
+                f"{name} out; calibrate holds {allowed}"
+            )
+        if name not in CALIBRATION_FIXED:
+            hint = ""
+            if name in names:
+                hint = f" ({name!r} is a calibration parameter: fixed={{'theta': {{{name!r}: v}}}})"
+            raise GPMSAError(f"fixed: unknown parameter {name!r}{hint}; calibrate holds {allowed}")
+    out = dict(fixed)
+    if "theta" in out:
+        levels = theta_levels(emulator)
+        unit = per_element.theta_unit(out["theta"], emulator.standardizer, names, levels)
+        at = dict(enumerate(unit)) if isinstance(unit, np.ndarray) else unit
+        for k, lv in enumerate(levels or ()):  # a categorical element: exactly its level
+            if lv is not None and k in at:
+                at[k] = float(np.asarray(lv)[np.argmin(np.abs(np.asarray(lv) - at[k]))])
+        out["theta"] = np.array([at[k] for k in range(len(names))]) if len(at) == len(
+            names) else at  # fmt: skip
+    return out
+
+
+def _held_native(emulator, fixed) -> dict[str, float]:
+    """The native value of each theta element that ``fixed`` (as the user gave it) holds, by
+    t_name: the draws hold exactly these."""
+    if not fixed or "theta" not in fixed:
+        return {}
+    names = [str(n) for n in emulator.t_names]
+    value = fixed["theta"]
+    if isinstance(value, dict):
+        given = per_element.theta_by_position(value, names)
+        return {names[int(k)]: float(v) for k, v in given.items()}
+    native = constraints.theta_native(value, names, "fixed['theta']")
+    return {n: float(v) for n, v in zip(names, native, strict=True)}
 
 
 def _theta_options(emulator, constraint, theta_init):
@@ -165,6 +232,7 @@ def calibrate(
     executor=None,
     constraint=None,
     theta_init=None,
+    fixed: dict | None = None,
     **options,
 ) -> Posterior:
     """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
@@ -212,6 +280,22 @@ def calibrate(
             that rejects the start is a GPMSAError. Chains run in this process.
         theta_init: start of theta (native, (q,), or a dict / pandas Series by t_names;
             default the centre of the design's range).
+        fixed: None, or name -> value of the calibration parameters held at known values (as
+            ``gpmsa.fit``'s ``fixed=``, SEPIA's ``SepiaParam.fixed``): "theta" in native units,
+            the whole vector ((q,), or a dict by every t_name) or some elements as a dict
+            t_name or position -> value (``{"theta": {"E": 2.1}}``: E known, the others
+            calibrated); "lamOs" (a known observation precision, ``{"lamOs": 1.0}``); with a
+            discrepancy "lamVz" and "betaV", whole or by element (``{"lamVz": {1: 1e6}}``: group
+            1's discrepancy switched off; indices as ``gpmsa.model.fixed_elements``). A held
+            element is never proposed and is exactly its value in every draw (its sd 0); the
+            values are checked as ``fit``'s (theta inside the design's range, a categorical
+            one at a level; others inside their prior's bounds); ``info["fixed"]`` records
+            them as ``fit``'s ``settings["fixed"]`` (theta on the unit scale). The fast
+            sampler holds theta and lamOs itself (the default path stays fast; its
+            draws of the others are those of the generic numpy backend's model); the numpy,
+            torch and pyro backends hold any of them, whole or by element. The emulator's
+            parameters (betaU, lamUz, lamWs, lamWOs) are not sampled here: naming one is a
+            GPMSAError (fix them in ``gpmsa.fit(..., fixed=)``).
         options: passed to the backend's ``sample`` (``fast=False`` or another backend than
             numpy), e.g. ``device="cuda"``, ``dtype="float32"`` for torch; the fast sampler
             takes none.
@@ -282,6 +366,9 @@ def calibrate(
     _check_calibrate_memory(emulator, n_samples, n_chains, fast)
     _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}
+    held = calibration_fixed(emulator, fixed, discrepancy)
+    if held is not None and fast:
+        theta_opts["held"] = _fast_held(emulator, held)  # checked before any work
     t0 = time.perf_counter()
     with blas_controller().limit(limits=1, user_api="blas"):
         where = {"n_jobs": n_jobs, "executor": executor}
@@ -300,8 +387,11 @@ def calibrate(
             draws, info = _run_backend(
                 emulator, data, x_obs, y_obs, backend, (discrepancy, discrepancy_groups),
                 n_samples, n_chains, tune, {**tuning_opts, **options}, seed, extrapolate,
-                progress, where, theta_opts,
+                progress, where, {**theta_opts, "fixed": held},
             )  # fmt: skip
+    held_names = info.pop("held_names", ())
+    for name, value in _held_native(emulator, fixed).items():  # exactly the value given
+        draws[name][...] = value
     require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
     samples = {k: v.reshape(-1) for k, v in chains.items()}
@@ -314,10 +404,14 @@ def calibrate(
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
         backend_options=backends.recorded_options(options),
     )  # fmt: skip
+    if held is not None:
+        info["fixed"] = info.pop("fixed", {})  # after the run's own keys
     if n_chains > 1:
         info["diagnostics"] = summarize(chains)
         shapes = {k: v.shape[2:] for k, v in chains.items()}
-        info["convergence"] = convergence(info["diagnostics"], shapes, n_chains, n_samples - n_burn)
+        info["convergence"] = convergence(
+            info["diagnostics"], shapes, n_chains, n_samples - n_burn, held=set(held_names)
+        )
         warn_unconverged(
             info["convergence"], f"gpmsa.calibrate (backend {backend!r})", length="n_samples"
         )
@@ -384,6 +478,8 @@ def _run_fast(
     progress, where, theta_opts,
 ):  # fmt: skip
     std = emulator.standardizer
+    theta_opts = dict(theta_opts)
+    held_theta, held_lamos = theta_opts.pop("held", (None, None))
     con, theta0 = _theta_options(emulator, **theta_opts)
     extra = None
     if log_prior is not None:
@@ -399,7 +495,7 @@ def _run_fast(
     sampler = CalibrationSampler(
         [fixed_gp(emulator, s) for s in sets], data, emulator.priors, extra,
         init_lamos=lamos_start(fit, data.lamos), constraint=con, init_theta=theta0,
-        theta_levels=theta_levels(emulator),
+        theta_levels=theta_levels(emulator), held_theta=held_theta, held_lamos=held_lamos,
     )  # fmt: skip
     callables = [name for name, on in (("log_prior", extra is not None),
                                        ("constraint", con is not None)) if on]  # fmt: skip
@@ -431,7 +527,36 @@ def _run_fast(
         "step_widths": np.stack([r.widths for r in runs]).tolist(),
         "chebyshev": all(p.cheb is not None or p.cheb2 is not None for p in sampler.preds),
     }
+    if held_theta is not None or held_lamos is not None:
+        values = {} if held_theta is None else {"theta": held_theta}
+        if held_lamos is not None:
+            values["lamOs"] = [held_lamos]
+        if len(values.get("theta", ())) == sampler.q:
+            values["theta"] = [held_theta[k] for k in range(sampler.q)]
+        elif "theta" in values:
+            values["theta"] = {(k,): v for k, v in held_theta.items()}
+        names = list(emulator.t_names)
+        info["fixed"] = per_element.record(values)
+        info["held_names"] = [names[k] for k in held_theta or ()] + (
+            ["lamOs"] if held_lamos is not None else [])  # fmt: skip
     return draws, info
+
+
+def _fast_held(emulator, held: dict) -> tuple[dict[int, float] | None, float | None]:
+    """The fast sampler's held theta elements (position -> unit value; None: none) and held
+    lamOs (None: sampled) from ``calibration_fixed``'s ``held``, checked as
+    ``Problem.with_fixed`` checks them (shape, index, finite, inside the prior's bounds)."""
+    levels = theta_levels(emulator)
+    levels = None if levels is None else [None if lv is None else np.asarray(lv) for lv in levels]
+    theta = lamos = None
+    if "theta" in held:
+        q = emulator.t_unit.shape[1]
+        val = checked_fixed("theta", held["theta"], (q,), emulator.priors, levels)
+        items = val.items() if isinstance(val, dict) else (((k,), v) for k, v in enumerate(val))
+        theta = {k: float(v) for (k,), v in items}
+    if "lamOs" in held:
+        lamos = float(checked_fixed("lamOs", held["lamOs"], (1,), emulator.priors)[0])
+    return theta, lamos
 
 
 def _wrong_fast_run(run, n_samples: int, q: int) -> str | None:
@@ -447,7 +572,8 @@ def _run_backend(
     emulator, data, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tuning_opts,
     seed, extrapolate, progress, where, theta_opts,
 ):  # fmt: skip
-    """The generic backend's draws and info; ``discrepancy``: (basis, groups)."""
+    """The generic backend's draws and info; ``discrepancy``: (basis, groups); ``theta_opts``
+    with ``calibration_problem``'s ``fixed``."""
     discrepancy, groups = discrepancy
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate,
@@ -465,6 +591,13 @@ def _run_backend(
         **opts,
     )  # fmt: skip
     std = emulator.standardizer
+    held = (problem.fixed - set(EMULATOR_PARAMS)) | set(problem.fixed_elements)
+    masks = _held_masks(problem)
+    if held:  # float64 whatever the backend sampled in, a held parameter exactly its value
+        chains_draws = {k: np.array(v, dtype=float) for k, v in chains.draws.items()}
+        for k, mask in masks.items():
+            chains_draws[k][:, :, mask] = problem.init[k][mask]
+        chains = replace(chains, draws=chains_draws)
     theta = std.t_from_unit(np.asarray(chains.draws["theta"]))
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.asarray(chains.draws["lamOs"])[:, :, 0]
@@ -479,4 +612,31 @@ def _run_backend(
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
         kind = discrepancy if isinstance(discrepancy, str) else "given"
         info.update({"discrepancy": kind, **discrepancy_record(problem.obs)})
+    if held:
+        info["fixed"] = per_element.record({k: problem.init[k] if k in problem.fixed else
+                                            {i: problem.init[k][i] for i in
+                                             problem.fixed_elements[k]} for k in held})  # fmt: skip
+        names = list(emulator.t_names)
+        info["held_names"] = [names[k] for k in np.flatnonzero(masks.get("theta", []))]
+        info["held_names"] += ["lamOs"] if "lamOs" in masks else []
+        if "lamVz" in problem.init:
+            shown = to_samples(
+                masks.get("betaV", np.zeros_like(problem.init["betaV"], bool)),
+                masks.get("lamVz", np.zeros_like(problem.init["lamVz"], bool)),
+            )
+            info["held_names"] += [k for k, v in shown.items() if v]
     return draws, info
+
+
+def _held_masks(problem: Problem) -> dict[str, np.ndarray]:
+    """name -> boolean mask of its held elements, for each calibration parameter the
+    Problem holds (whole: every element) beyond the emulator's."""
+    out = {}
+    for k in (problem.fixed - set(EMULATOR_PARAMS)) | set(problem.fixed_elements):
+        mask = np.zeros(problem.init[k].shape, dtype=bool)
+        if k in problem.fixed:
+            mask[...] = True
+        for idx in problem.fixed_elements.get(k, ()):
+            mask[idx] = True
+        out[k] = mask
+    return out

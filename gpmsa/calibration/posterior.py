@@ -368,7 +368,11 @@ class Posterior:
         self._check(name)
         if name in self.grids:
             return self.grids[name].mean()
-        return float(np.mean(self.samples[name]))
+        draws = self.samples[name]
+        mean = float(np.mean(draws))
+        if draws.size and not draws.min() <= mean <= draws.max():  # equal draws: their value
+            return float(np.clip(mean, draws.min(), draws.max()))
+        return mean
 
     def sd(self, name: str) -> float:
         """Posterior standard deviation of ``name``."""
@@ -378,6 +382,8 @@ class Posterior:
         draws = self.samples[name]
         if len(draws) < 2:
             raise GPMSAError(f"the sd of {name!r} needs at least 2 draws, the posterior has 1")
+        if draws.min() == draws.max():  # a held parameter: exactly 0 (np.std can give 1e-16)
+            return 0.0
         return float(np.std(draws, ddof=1))
 
     def quantile(self, name: str, q: float | np.ndarray) -> float | np.ndarray:

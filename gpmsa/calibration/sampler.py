@@ -225,6 +225,9 @@ class CalibrationSampler:
         theta_levels: per calibration parameter, its levels on the unit scale if categorical
             (uniform prior over them, proposals to another level drawn uniformly), else None;
             None: every parameter continuous.
+        held_theta: position -> unit-scale value of the theta elements held there (never
+            proposed; ``calibrate(fixed={"theta": ...})``); None: none.
+        held_lamos: lamOs held at this value (never proposed); None: sampled.
     """
 
     def __init__(
@@ -237,6 +240,8 @@ class CalibrationSampler:
         constraint: ThetaConstraint | None = None,
         init_theta: np.ndarray | None = None,
         theta_levels: list[tuple[float, ...] | None] | None = None,
+        held_theta: dict[int, float] | None = None,
+        held_lamos: float | None = None,
     ) -> None:
         self.q = gps[0].q
         self.levels = [None] * self.q if theta_levels is None else list(theta_levels)
@@ -250,8 +255,15 @@ class CalibrationSampler:
         self.extra = log_prior
         lo = data.lamos
         self.init_lamos = max(20.0, lo.shape / lo.rate) if init_lamos is None else init_lamos
+        self.held_lamos = held_lamos is not None
+        if held_lamos is not None:
+            self.init_lamos = float(held_lamos)
         self.constraint = constraint
         start = [0.5] * self.q if init_theta is None else [float(v) for v in init_theta]
+        held_theta = {} if held_theta is None else dict(held_theta)
+        for k, v in held_theta.items():
+            start[k] = float(v)
+        self.free = [k for k in range(self.q) if k not in held_theta]  # the elements proposed
         self.init_theta = snap_to_levels(start, self.levels).tolist()  # categorical: nearest level
         if constraint is not None:
             constraint.check_start(np.array(self.init_theta), "calibrate")
@@ -350,14 +362,15 @@ class _State:
         return self.ll + self.lp_theta + self.lp_lam
 
     def sweep(self, widths: list[float], prop_mh: bool, accepted, u: list[float]) -> None:
-        """One sweep: each theta element, lamOs, then (several sets) the set index.
+        """One sweep: each theta element, lamOs, then (several sets) the set index; held elements
+        (``held_theta``, ``held_lamos``) are skipped, their random numbers drawn all the same.
 
         ``u``: 2 (q + 2) uniform numbers (a step and an acceptance draw per element).
         """
         s = self.s
         q = s.q
         pred = s.preds[self.k]
-        for i in range(q):
+        for i in s.free:
             cand = list(self.theta)
             levels = s.levels[i]
             if levels is None:
@@ -375,25 +388,26 @@ class _State:
             if math.log(u[2 * i + 1]) < ll - self.ll + lp_new - self.lp_theta:
                 self.theta, self.ey, self.ll, self.lp_theta = cand, ey, ll, lp_new
                 accepted[i] += 1
-        x = self.lam
-        step = u[2 * q] - 0.5
-        corr = 0.0
-        if prop_mh:  # GPM/SA's proportional step for an untuned precision, with its correction
-            w0 = max(1.0, x / 3.0)
-            cand_l = x + w0 * 2.0 * step
-            w1 = max(1.0, cand_l / 3.0)
-            if x > cand_l + w1:
-                cand_l = -1.0
+        if not s.held_lamos:
+            x = self.lam
+            step = u[2 * q] - 0.5
+            corr = 0.0
+            if prop_mh:  # GPM/SA's proportional step for an untuned precision, its correction
+                w0 = max(1.0, x / 3.0)
+                cand_l = x + w0 * 2.0 * step
+                w1 = max(1.0, cand_l / 3.0)
+                if x > cand_l + w1:
+                    cand_l = -1.0
+                else:
+                    corr = math.log(w0 / w1)
             else:
-                corr = math.log(w0 / w1)
-        else:
-            cand_l = x + widths[q] * step
-        lp_new = s._log_prior_lamos(cand_l) if cand_l > 0.0 else -math.inf
-        if lp_new != -math.inf:
-            ll = _loglik(self.ey, cand_l)
-            if math.log(u[2 * q + 1]) < ll - self.ll + lp_new - self.lp_lam + corr:
-                self.lam, self.ll, self.lp_lam = cand_l, ll, lp_new
-                accepted[q] += 1
+                cand_l = x + widths[q] * step
+            lp_new = s._log_prior_lamos(cand_l) if cand_l > 0.0 else -math.inf
+            if lp_new != -math.inf:
+                ll = _loglik(self.ey, cand_l)
+                if math.log(u[2 * q + 1]) < ll - self.ll + lp_new - self.lp_lam + corr:
+                    self.lam, self.ll, self.lp_lam = cand_l, ll, lp_new
+                    accepted[q] += 1
         if len(s.preds) > 1:
             k = int(u[2 * q + 2] * len(s.preds))
             ey = s.preds[k].at(self.theta)

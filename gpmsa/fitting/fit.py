@@ -331,38 +331,9 @@ def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Proble
             raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
         fixed = dict(fixed)
         if "theta" in fixed and problem.obs is not None:
-            fixed["theta"] = _fixed_theta_unit(problem, fixed["theta"], std, data.t_names, closed)
+            fixed["theta"] = per_element.theta_unit(fixed["theta"], std, data.t_names, levels)
         problem = problem.with_fixed(fixed)
     return problem
-
-
-def _fixed_theta_unit(problem: Problem, value, std, names, closed):
-    """``fixed['theta']`` (native) on the unit scale: the whole vector (as ``theta_init``), or
-    for a dict of some elements (by t_name or position) a dict position -> unit value; a dict
-    that names every element is the whole vector."""
-    if isinstance(value, dict):
-        given = per_element.parse("theta", per_element.theta_by_position(value, names),
-                                  (len(names),))  # fmt: skip
-        if len(given) < len(names):
-            return _held_theta_unit(problem, given, std, names, closed)
-        value = list(given.values())
-    unit = constraints.theta_init_unit(value, std.t_min, std.t_max, names, closed,
-                                       "fixed['theta']")  # fmt: skip
-    _check_levels(problem, unit, names, "fixed theta")
-    return unit
-
-
-def _held_theta_unit(problem: Problem, given: dict, std, names, closed) -> dict[int, float]:
-    """Some elements of theta (position tuple -> native value) on the unit scale, each checked
-    as ``theta_init``'s (inside the design's range; a categorical one at a level)."""
-    native = 0.5 * (np.asarray(std.t_min, dtype=float) + np.asarray(std.t_max, dtype=float))
-    for (k,), x in given.items():  # the other elements: the centre, only to check these
-        native[k] = x
-    unit = constraints.theta_init_unit(native, std.t_min, std.t_max, names, closed,
-                                       "fixed['theta']")  # fmt: skip
-    keep = [k for (k,) in given]
-    _check_levels(problem, unit, names, "fixed theta", keep)
-    return {k: float(unit[k]) for k in keep}
 
 
 def fixed_record(problem: Problem) -> dict:

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
+from gpmsa.model import constraints
 from gpmsa.model.data import as_real
 
 Index = tuple[int, ...]
@@ -111,6 +112,53 @@ def theta_by_position(given: dict, names) -> dict:
                 f"{pos}); give each element once"
             )
         out[pos] = val
+    return out
+
+
+def theta_unit(value, std, names, levels=None):
+    """``fixed['theta']`` (native) on the unit scale: the whole vector (as ``theta_init``, an
+    array (q,)), or for a dict of some elements (by t_name or position) a dict position -> unit
+    value; a dict that names every element is the whole vector. Each value is checked as
+    ``theta_init``'s: inside the design's range ``std.t_min`` .. ``std.t_max``, and a
+    categorical element (``levels``: per element its unit-scale levels or None; None: all
+    continuous) at one of its levels."""
+    names = list(names)
+    closed = None if levels is None else [lv is not None for lv in levels]
+    keep = None
+    if isinstance(value, dict):
+        given = parse("theta", theta_by_position(value, names), (len(names),))
+        if len(given) < len(names):
+            keep = [k for (k,) in given]
+            # the other elements: the centre, only to check these
+            value = 0.5 * (np.asarray(std.t_min, dtype=float) + np.asarray(std.t_max, dtype=float))
+            for (k,), x in given.items():
+                value[k] = x
+        else:
+            value = list(given.values())
+    unit = constraints.theta_init_unit(value, std.t_min, std.t_max, names, closed,
+                                       "fixed['theta']")  # fmt: skip
+    for k, lv in enumerate(levels or ()):
+        if keep is not None and k not in keep:
+            continue
+        if lv is not None and not np.any(np.isclose(lv, unit[k], rtol=0, atol=1e-12)):
+            raise GPMSAError("fixed theta: categorical calibration parameter "
+                             f"{names[k]} must be one of its training levels")  # fmt: skip
+    return unit if keep is None else {k: float(unit[k]) for k in keep}
+
+
+def record(values: dict) -> dict:
+    """The JSON-able record of held parameters (``gpmsa.fit``'s ``settings["fixed"]``,
+    ``calibrate``'s ``info["fixed"]``) from ``values``: name -> the array of a parameter held
+    whole (recorded as its value list), or index -> value of its held elements (recorded as
+    {"elements": [index, ...], "values": [...]}); by name."""
+    out: dict = {}
+    for name, val in sorted(values.items()):
+        if isinstance(val, dict):
+            idx = sorted(val)
+            out[name] = {"elements": [list(i) for i in idx],
+                         "values": [float(val[i]) for i in idx]}  # fmt: skip
+        else:
+            out[name] = np.asarray(val, dtype=float).tolist()
     return out
 
 

@@ -190,14 +190,7 @@ class Problem:
     def theta_log_prior(self, theta: np.ndarray) -> float:
         """Log prior of unit-scale theta (q,): the priors' truncated normal for the continuous
         elements; uniform over its levels (-inf off them) for a categorical one."""
-        levels = self.theta_levels
-        if levels is None:
-            return self.priors.log_prior("theta", theta)
-        theta = np.asarray(theta, dtype=np.float64).reshape(-1)
-        if any(lv is not None and not np.any(lv == v) for lv, v in zip(levels, theta, strict=True)):
-            return -np.inf
-        cont = [k for k, lv in enumerate(levels) if lv is None]
-        return self.priors.log_prior("theta", theta[cont]) if cont else 0.0
+        return theta_log_prior(self.priors, self.theta_levels, theta)
 
     def snap_theta(self, theta: np.ndarray) -> np.ndarray:
         """``theta`` (unit scale, (q,)) with each categorical element moved to its nearest level."""
@@ -233,34 +226,11 @@ class Problem:
         for name, val in values.items():
             if name not in self.init:
                 raise GPMSAError(f"fixed: unknown parameter {name!r}; this model has {self.names}")
-            shape = self.init[name].shape
-            if isinstance(val, dict):
-                elements = per_element.parse(name, val, shape)
-                levels = (self.theta_levels or [None] * self.q) if name == "theta" else None
-                per_element.check_values(name, elements, self.priors, levels)
-                if len(elements) < self.init[name].size:
-                    held[name] = elements
-                    continue
-                val = np.array(list(elements.values())).reshape(shape)  # C order: every element
-            arr = as_float(val, f"fixed[{name!r}]")
-            if arr.size == 1:
-                arr = np.full(shape, float(arr.reshape(-1)[0]))
-            elif [d for d in arr.shape if d != 1] != [d for d in shape if d != 1]:
-                # another layout (a transposed betaU) would be reshuffled, not read
-                raise GPMSAError(
-                    f"fixed[{name!r}] must be a scalar or have shape {shape}, got {arr.shape}"
-                )
-            arr = arr.reshape(shape)
-            if not np.all(np.isfinite(arr)):
-                raise GPMSAError(f"fixed[{name!r}] must be finite, got {arr.ravel()}")
-            is_theta = name == "theta"
-            lp = self.theta_log_prior(arr) if is_theta else self.priors.log_prior(name, arr)
-            if lp == -np.inf:
-                raise GPMSAError(
-                    f"fixed[{name!r}] = {arr.ravel()} lies outside its prior's bounds (zero prior "
-                    "density)"
-                )
-            out[name] = arr
+            value = checked_fixed(name, val, self.init[name].shape, self.priors, self.theta_levels)
+            if isinstance(value, dict):
+                held[name] = value
+            else:
+                out[name] = value
         return self._holding(out, held)
 
     def _holding(self, whole: dict[str, np.ndarray], held: dict[str, dict]) -> Problem:
@@ -283,6 +253,52 @@ class Problem:
         full = {k for k, v in merged.items() if len(v) == self.init[k].size}
         merged = {k: v for k, v in merged.items() if k not in full}
         return replace(prob, fixed=prob.fixed | full, fixed_elements=merged)
+
+
+def theta_log_prior(priors: Priors, levels, theta) -> float:
+    """Log prior of unit-scale theta (q,) under ``priors``: the truncated normal for the
+    continuous elements; uniform over its levels (-inf off them) for a categorical one.
+    ``levels``: per element its unit-scale levels or None (``Problem.theta_levels``); None:
+    every element continuous."""
+    if levels is None:
+        return priors.log_prior("theta", theta)
+    theta = np.asarray(theta, dtype=np.float64).reshape(-1)
+    if any(lv is not None and not np.any(lv == v) for lv, v in zip(levels, theta, strict=True)):
+        return -np.inf
+    cont = [k for k, lv in enumerate(levels) if lv is None]
+    return priors.log_prior("theta", theta[cont]) if cont else 0.0
+
+
+def checked_fixed(name: str, val, shape: tuple[int, ...], priors: Priors, theta_levels=None):
+    """One entry of ``fixed=`` (``Problem.with_fixed``) checked: the parameter ``name`` of
+    ``shape`` held at ``val`` (model scales; theta unit scale). Returns the whole array (a
+    scalar, an array of ``shape``, or a dict naming every element), or for a dict naming some
+    elements index -> value (``gpmsa.model.fixed_elements``). ``theta_levels`` as
+    `theta_log_prior`'s. GPMSAError naming a wrong shape or index, a non-finite value or one
+    outside its prior's bounds."""
+    if isinstance(val, dict):
+        elements = per_element.parse(name, val, shape)
+        levels = (theta_levels or [None] * shape[0]) if name == "theta" else None
+        per_element.check_values(name, elements, priors, levels)
+        if len(elements) < math.prod(shape):
+            return elements
+        val = np.array(list(elements.values())).reshape(shape)  # C order: every element
+    arr = as_float(val, f"fixed[{name!r}]")
+    if arr.size == 1:
+        arr = np.full(shape, float(arr.reshape(-1)[0]))
+    elif [d for d in arr.shape if d != 1] != [d for d in shape if d != 1]:
+        # another layout (a transposed betaU) would be reshuffled, not read
+        raise GPMSAError(f"fixed[{name!r}] must be a scalar or have shape {shape}, got {arr.shape}")
+    arr = arr.reshape(shape)
+    if not np.all(np.isfinite(arr)):
+        raise GPMSAError(f"fixed[{name!r}] must be finite, got {arr.ravel()}")
+    is_theta = name == "theta"
+    lp = theta_log_prior(priors, theta_levels, arr) if is_theta else priors.log_prior(name, arr)
+    if lp == -np.inf:
+        raise GPMSAError(
+            f"fixed[{name!r}] = {arr.ravel()} lies outside its prior's bounds (zero prior density)"
+        )
+    return arr
 
 
 def default_init(p: int, q: int, p_u: int, priors: Priors, obs: ObsProblem | None) -> dict:

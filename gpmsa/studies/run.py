@@ -6,27 +6,30 @@ from __future__ import annotations
 import time
 import warnings
 from collections.abc import Sequence
+from dataclasses import replace
 from datetime import datetime, timezone
 
 import numpy as np
 
 from gpmsa._version import library_versions
-from gpmsa.calibration.calibrate import calibration_problem, observation_fit
+from gpmsa.calibration.calibrate import calibration_fixed, calibration_problem, observation_fit
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
-from gpmsa.fitting.fit import check_keep, check_point, point_estimate, thinning
+from gpmsa.fitting.fit import check_keep, check_point, fixed_record, point_estimate, thinning
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
+from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, SimData, check_flag, check_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
+from gpmsa.model.discrepancy import to_samples
 from gpmsa.model.priors import Priors
-from gpmsa.model.problem import prepare
+from gpmsa.model.problem import ORDER, prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
 from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
-from gpmsa.studies.sampler import StudyChains, sample_study
+from gpmsa.studies.sampler import StudyChains, held_elements, sample_study
 from gpmsa.studies.study import OBS_DIGESTS, OBS_LAYOUTS, Study, layout_of
 
 
@@ -90,7 +93,8 @@ def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
 def _study_draws(chains: StudyChains, keep: slice, discrepancy: bool = False
                  ) -> dict[str, np.ndarray]:  # fmt: skip
     """The study's kept draws; with ``discrepancy`` also each model's betaV (C, N, p, G) and
-    lamVz (C, N, G) as "betaV_j", "lamVz_j" (j: the model's index), where it has them."""
+    lamVz (C, N, G) as "betaV_j", "lamVz_j" (j: the model's index), where it has them.
+    ``chains.members`` holds the held parameters too (``_with_held``)."""
     lam_os = np.stack([m["lamOs"][:, keep, 0] for m in chains.members], axis=2)
     out = {"theta": chains.theta[:, keep], "mu": chains.mu[:, keep], "lam": chains.lam[:, keep],
            "lamOs": lam_os, "log_post": chains.log_post[:, keep]}  # fmt: skip
@@ -99,6 +103,65 @@ def _study_draws(chains: StudyChains, keep: slice, discrepancy: bool = False
             beta, lam = discrepancy_arrays(j)
             out[beta], out[lam] = m["betaV"][:, keep], m["lamVz"][:, keep]
     return out
+
+
+def _with_held(chains: StudyChains, problems, names, fixes) -> StudyChains:
+    """``chains`` with each model's parameters of ``names`` that its problem holds whole
+    (``fixes``: the models' ``fixed=``) as draws (C, N, *shape) at their value, beside the
+    sampled ones; ``chains`` itself without ``fixed=``."""
+    if all(f is None for f in fixes):
+        return chains
+    members = []
+    lead = chains.log_post.shape
+    for m, prob in zip(chains.members, problems, strict=True):
+        extra = {k: np.tile(prob.init[k], (*lead, *([1] * prob.init[k].ndim)))
+                 for k in names if k in prob.fixed and k not in m and k != "theta"}  # fmt: skip
+        members.append({**m, **extra})
+    return replace(chains, members=tuple(members))
+
+
+def _held_names(problems, layout, fixes) -> list[str]:
+    """The posterior names (``native_chains``') of what the models hold: the study elements
+    and each model's lamOs, betaV and lamVz elements; [] without ``fixed=``."""
+    if all(f is None for f in fixes):
+        return []
+    names = [layout.elements[e].name for e in sorted(held_elements(problems, layout))]
+    for lab, prob in zip(layout.labels, problems, strict=True):
+        masks = {}
+        for k in ("lamOs", "betaV", "lamVz"):
+            if k in prob.init:
+                mask = np.full(prob.init[k].shape, k in prob.fixed)
+                for idx in prob.fixed_elements.get(k, ()):
+                    mask[idx] = True
+                masks[k] = mask
+        if masks["lamOs"].all():
+            names.append(f"lamOs[{lab}]")
+        if "lamVz" in masks:
+            shown = to_samples(masks["betaV"], masks["lamVz"])
+            names += [f"{k}[{lab}]" for k, v in shown.items() if v]
+    return names
+
+
+def _per_model_fixed(fixed, n: int) -> list:
+    """Each model's ``fixed=`` from a study's ``fixed``: None (none), one dict (every model's)
+    or a list or tuple with one entry (None or a dict) per model, as ``basis``."""
+    if fixed is None or isinstance(fixed, dict):
+        return [fixed] * n
+    if not isinstance(fixed, (list, tuple)):
+        raise GPMSAError(
+            "fixed must be None, a dict name -> value (every model's) or a list with one entry "
+            f"(None or a dict) per model, got {type(fixed).__name__}"
+        )
+    if len(fixed) != n:
+        raise GPMSAError(
+            f"fixed has {len(fixed)} entries for {n} models: give one dict for every model, or "
+            "a list with one entry (None or a dict) per model"
+        )
+    for k, f in enumerate(fixed):
+        if f is not None and not isinstance(f, dict):
+            raise GPMSAError(f"fixed[{k}] must be None or a dict name -> value, got "
+                             f"{type(f).__name__}")  # fmt: skip
+    return list(fixed)
 
 
 def _per_model_basis(basis, n: int) -> list:
@@ -164,6 +227,7 @@ def calibrate_study(
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     extrapolate: bool = False, progress: bool = False, n_jobs: int | None = None,
     executor=None, metadata: dict | None = None, discrepancy=None, discrepancy_groups=None,
+    fixed=None,
 ) -> Study:  # fmt: skip
     """Calibrate several fitted emulators at once, their emulator parameters fixed (as
     ``gpmsa.calibrate`` does for one), with shared and/or hierarchical calibration parameters.
@@ -188,6 +252,13 @@ def calibrate_study(
             None or one integer per basis vector): one value for every model, or a list with
             one entry per model (``["constant", None]``). A list is read as the per-model list:
             give one matrix for every model as a numpy array.
+        fixed: parameters held at known values, as ``gpmsa.calibrate``'s ``fixed=`` (theta
+            elements by t_name or position, native units; lamOs; with a discrepancy betaV and
+            lamVz, whole or by element): one dict for every model, or a list with one entry
+            (None or a dict) per model. A shared parameter held must be held at one value by
+            every model that has it (one dict for all does so); a held hierarchical element
+            stays in its group at its value. ``settings["fixed"]`` records each model's (as
+            ``calibrate``'s ``info["fixed"]``).
 
     Returns a ``Study``; ``study.posterior`` names each shared parameter by its name, every
     other by "NAME[LABEL]", each model's "lamOs[LABEL]" (and with a discrepancy its
@@ -230,6 +301,9 @@ def calibrate_study(
     extrapolate = check_flag(extrapolate, "extrapolate")
     labels = check_labels(labels, n)
     bases = _per_model_discrepancy(discrepancy, discrepancy_groups, n)
+    fixes = _per_model_fixed(fixed, n)
+    held = [_per_model(lab, calibration_fixed, e, f, b)
+            for lab, e, f, (b, _) in zip(labels, emulators, fixes, bases, strict=True)]  # fmt: skip
     layout = layout_of(emulators, labels, shared, hierarchical)
     check_study_names(layout)
     t0 = time.perf_counter()
@@ -244,9 +318,9 @@ def calibrate_study(
         warn_if_outside(fit, stacklevel=3, discrepancy=basis is not None, model=lab)
     problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate,
                            reduced=None if basis is not None else r, discrepancy=basis,
-                           discrepancy_groups=groups)
-                for (lab, e, x, y), r, (basis, groups) in zip(models, reduced, bases,
-                                                              strict=True)]  # fmt: skip
+                           discrepancy_groups=groups, fixed=h)
+                for (lab, e, x, y), r, (basis, groups), h in zip(models, reduced, bases, held,
+                                                                 strict=True)]  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})")  # fmt: skip
     chains = sample_study(
@@ -254,7 +328,9 @@ def calibrate_study(
         seed=seed, init=init, tune_rounds=tune_rounds, tune_levels=tune_levels,
         progress=progress, n_jobs=n_jobs, executor=executor,
     )  # fmt: skip
+    chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
+    _record_fixed(settings, labels, problems, layout, fixes)
     settings[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
     settings[OBS_LAYOUTS] = {lab: r.layout_sha256 for lab, r in zip(labels, reduced, strict=True)}
     recorded = {lab: {"discrepancy": basis if isinstance(basis, str) else "given",
@@ -269,6 +345,26 @@ def calibrate_study(
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
     return study
+
+
+def _record_fixed(settings: dict, labels, problems, layout, fixes, emulator=False) -> None:
+    """With ``fixed=``: ``settings["fixed"]`` label -> the model's held parameters (as
+    ``calibrate``'s ``info["fixed"]``; ``emulator``: the emulator's parameters too, as
+    ``fit``'s ``settings["fixed"]``) and ``settings["held"]`` the posterior names held (not
+    judged for convergence)."""
+    if all(f is None for f in fixes):
+        return
+    keep = set(EMULATOR_PARAMS) if emulator else set()
+    out = {}
+    for lab, prob, f in zip(labels, problems, fixes, strict=True):
+        if f is None:
+            continue
+        whole = {k: prob.init[k] for k in prob.fixed
+                 if k not in EMULATOR_PARAMS or (k in keep and k in f)}  # fmt: skip
+        some = {k: {i: prob.init[k][i] for i in v} for k, v in prob.fixed_elements.items()}
+        out[lab] = per_element.record({**whole, **some})
+    settings["fixed"] = out
+    settings["held"] = _held_names(problems, layout, fixes)
 
 
 def _per_model(label: str, make, *args, **kwargs):
@@ -298,7 +394,7 @@ def fit_study(
     priors: Priors | None = None, n_pc: int | float | None = None, basis=None, discrepancy=None,
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
-    metadata: dict | None = None,
+    metadata: dict | None = None, fixed=None,
 ) -> Study:  # fmt: skip
     """Fit several GPM/SA models jointly (each its emulator and observations, as ``gpmsa.fit``
     with ``obs``) whose calibration parameters are shared and/or hierarchical (SEPIA's shared
@@ -316,6 +412,12 @@ def fit_study(
         basis: as ``gpmsa.fit``'s, a numpy array for every model or a list with one entry
             (None: the model's PCA, as ``n_pc`` says) per model.
         metadata: a JSON-able dict saved with the study.
+        fixed: parameters held at known values, as ``gpmsa.fit``'s ``fixed=`` (the emulator's
+            too; theta by t_name or position, native units), whole or by element: one dict for
+            every model, or a list with one entry (None or a dict) per model. A shared
+            parameter held must be held at one value by every model that has it; each model's
+            ``settings["fixed"]`` records its own (as ``fit``'s), ``study.settings["fixed"]``
+            all of them.
 
     Returns a ``Study`` of kind "fit": ``study.members`` are the models' fitted emulators (their
     ``calibration`` holds the model's theta draws), ``study.posterior`` as ``calibrate_study``.
@@ -343,6 +445,7 @@ def fit_study(
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
     bases = _per_model_basis(basis, n)
+    fixes = _per_model_fixed(fixed, n)
     pcs = [n_pc if k is None or all(b is not None for b in bases) else None for k in bases]
     preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=pc, discrepancy=discrepancy,
                         discrepancy_groups=discrepancy_groups, basis=k)
@@ -357,7 +460,8 @@ def fit_study(
         shared, hierarchical,
     )  # fmt: skip
     check_study_names(layout)
-    problems = [p.problem for p in preps]
+    problems = [p.problem if f is None else _per_model(lab, _fit_fixed, p, s, f)
+                for lab, p, s, f in zip(labels, preps, sims, fixes, strict=True)]  # fmt: skip
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})")
     t0 = time.perf_counter()
     chains = sample_study(
@@ -365,9 +469,11 @@ def fit_study(
         seed=seed, init=init, tune_rounds=tune_rounds, tune_levels=tune_levels,
         progress=progress, n_jobs=n_jobs, executor=executor,
     )  # fmt: skip
+    chains = _with_held(chains, problems, ORDER, fixes)
     thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
     keep = slice(int(n_burn), None, thin)
     settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point)
+    _record_fixed(settings, labels, problems, layout, fixes, emulator=True)
     draws = _study_draws(chains, keep)
     lp = draws["log_post"].reshape(-1)
     members = []
@@ -393,6 +499,8 @@ def fit_study(
                         "versions": settings["versions"]}  # fmt: skip
         if discrepancy is not None:  # full_prediction refuses another basis
             emu_settings.update(discrepancy_record(prep.problem.obs))
+        if fixes[i] is not None:  # as gpmsa.fit records it (continuations compare it)
+            emu_settings["fixed"] = fixed_record(problems[i])
         members.append(Emulator._from_prepared(
             sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,
             settings=emu_settings, diagnostics=summarize({**post, "theta": theta}),
@@ -402,3 +510,14 @@ def fit_study(
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.fit_study")
     return study
+
+
+def _fit_fixed(prep, sim: SimData, fixed: dict):
+    """``prep.problem`` holding ``fixed`` (``gpmsa.fit``'s ``fixed=``: theta in native units)."""
+    if not isinstance(fixed, dict):
+        raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
+    fixed = dict(fixed)
+    if "theta" in fixed:
+        fixed["theta"] = per_element.theta_unit(fixed["theta"], prep.standardizer, sim.t_names,
+                                                prep.problem.theta_levels)  # fmt: skip
+    return prep.problem.with_fixed(fixed)

@@ -63,6 +63,41 @@ class StudyChains:
                 f"{len(self.members)} models)")  # fmt: skip
 
 
+def held_elements(problems: list[Problem], layout: Layout) -> dict[int, float]:
+    """Study element -> its unit-scale value, for each element the models' problems hold (their
+    theta fixed whole or by element: ``fixed={"theta": ...}``); GPMSAError where models that
+    share an element hold it at different values, or some of them do not hold it."""
+    held: dict[int, float] = {}
+    for i, prob in enumerate(problems):
+        if "theta" in prob.fixed:
+            pos = range(prob.q)
+        else:
+            pos = sorted(k for (k,) in prob.fixed_elements.get("theta", ()))
+        for k in pos:
+            e, v = layout.index[i][k], float(prob.init["theta"][k])
+            if held.get(e, v) != v:
+                raise GPMSAError(
+                    f"fixed theta: the models sharing {layout.elements[e].name} hold it at "
+                    "different values; hold a shared parameter at one value"
+                )
+            held[e] = v
+    for e in held:
+        el = layout.elements[e]
+        free = [layout.labels[i] for i, k in el.uses if not _holds(problems[i], k)]
+        if free:
+            raise GPMSAError(
+                f"fixed theta: {el.name} is shared, held by some of its models but not by "
+                f"{free}: hold it in every model that has it (one fixed= dict for every model "
+                "does so)"
+            )
+    return held
+
+
+def _holds(problem: Problem, k: int) -> bool:
+    """Whether ``problem`` holds its theta element ``k``."""
+    return "theta" in problem.fixed or (k,) in problem.fixed_elements.get("theta", ())
+
+
 class StudyState:
     """The current state of one study chain: the models' ``ChainState``s (theta held), the study
     elements g, and the groups' (mu, lam)."""
@@ -73,7 +108,10 @@ class StudyState:
         rng: np.random.Generator,
     ):  # fmt: skip
         self.layout, self.hyper, self.rng = layout, hyper, rng
+        self.held = held_elements(problems, layout)  # never proposed
         self.g, self.mu, self.lam = g.copy(), mu.copy(), lam.copy()
+        for e, v in self.held.items():
+            self.g[e] = v
         self.states = []
         for i, prob in enumerate(problems):
             held = prob.with_init({}, fixed=prob.fixed | {"theta"})
@@ -123,6 +161,8 @@ class StudyState:
         G, H = self.layout.n_elements, len(self.group_els)
         u = self.rng.random((G + 2 * H, 2))
         for e, el in enumerate(self.layout.elements):
+            if e in self.held:
+                continue
             x = float(self.g[e])
             cand = x + widths[e] * (u[e, 0] - 0.5)
             lp_new = self._theta_lp(e, cand)
@@ -273,6 +313,7 @@ def sample_study(
     ``gpmsa.mcmc.parallel.run_chains``). ChainError names a chain that failed or whose draws are
     not finite."""
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
+    held_elements(problems, layout)  # a held element the models disagree on: before any work
     how = starts.check_init(init, int(n_chains))
     seq = np.random.SeedSequence(seed)
     tasks = [

@@ -168,7 +168,9 @@ class Study:
         self.convergence = None
         if n_chains > 1:
             shapes = {k: () for k in chains}
-            self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws)
+            held = self.settings.get("held")  # fitted with fixed=: not judged
+            held = {h for h in held if isinstance(h, str)} if isinstance(held, list) else set()
+            self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held)
             info["convergence"] = self.convergence
         self.posterior = Posterior(samples, chains=chains, info=info)
 
