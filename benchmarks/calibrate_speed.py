@@ -6,7 +6,8 @@ Prints, single-threaded (BLAS limited to one thread; --pin also pins the process
   also with the posterior's mean and P(GD > 350) read (what a control loop does);
 - ``Calibrator.log_likelihood_grid`` latency (the sequential-filter hook);
 - ``gpmsa.calibrate`` with the paper's settings (tuning 50 x 20, 5,000 draws, 1,000 burned), the
-  fast sampler and the generic numpy backend;
+  fast sampler and the generic numpy backend; the same on a two-parameter case with three
+  observations (the fast sampler's dense path: no Chebyshev series), with their ratio;
 - memory: the Calibrator's cached arrays and the peak Python allocation of preparing and of an
   update (tracemalloc).
 SEPIA's figures are from tests/data/reference_posteriors.json (same case, this machine class).
@@ -43,6 +44,19 @@ def road_emulator() -> tuple[Emulator, dict]:
     )  # fmt: skip
     params = ref["sepia_calibration_only"]["fixed_emulator_params_unit_scale"]
     return Emulator.from_params(sim, params), ref
+
+
+def two_parameter_case() -> tuple[Emulator, np.ndarray, np.ndarray]:
+    """A scalar output of one x and two calibration parameters (60 runs, emulator parameters
+    set), observed at 3 x values: the fast sampler's dense path (no Chebyshev series)."""
+    rng = np.random.default_rng(7)
+    x, t = rng.uniform(0, 1, 60), rng.uniform(0, 1, (60, 2))
+    y = np.sin(2.0 * x + 1.5 * t[:, 0]) + 0.8 * t[:, 1] * x
+    sim = gpmsa.SimData(x=x[:, None], t=t, y=y[:, None], x_names=["x"], t_names=["a", "b"])
+    params = {"betaU": [[1.0], [1.5], [0.8]], "lamUz": [1.0], "lamWs": [5000.0],
+              "lamWOs": [5000.0]}  # fmt: skip
+    x_obs = np.array([[0.2], [0.5], [0.8]])
+    return Emulator.from_params(sim, params), x_obs, np.sin(2 * x_obs + 0.6) + 0.48 * x_obs
 
 
 def observations(emu: Emulator, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -130,6 +144,19 @@ def main() -> None:
     print(
         row("calibrate, paper settings (numpy backend)", 1e3 * np.array(runs), f"{1e3 * sepia:.0f}")
     )
+    emu2, x2, y2 = two_parameter_case()
+    timed = {}
+    for fast in (True, False):
+        runs = []
+        for seed in range(max(2, args.runs // 5)):
+            t0 = time.perf_counter()
+            gpmsa.calibrate(emu2, x2, y2, seed=seed, fast=fast)
+            runs.append(time.perf_counter() - t0)
+        timed[fast] = np.array(runs)
+        engine = "fast sampler" if fast else "numpy backend"
+        print(row(f"calibrate, 2 parameters, 3 obs ({engine})", 1e3 * timed[fast]))
+    ratio = np.median(timed[True]) / np.median(timed[False])
+    print(f"  fast / numpy backend, 2 parameters: {ratio:.2f}")
     cached = sum(a.nbytes for p in cal._predictors for a in [p.rt_alpha, *(p.H or [])])
     cached += sum(g.chol.nbytes + g.alpha.nbytes for g in cal._gps)
     tracemalloc.start()

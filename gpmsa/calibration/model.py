@@ -19,7 +19,7 @@ from functools import lru_cache
 
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
-from scipy.linalg import cho_solve, cholesky, solve_triangular
+from scipy.linalg import cho_solve, cholesky, lapack, solve_triangular
 from scipy.special import gammainc, gammainccinv, gammaln
 
 from gpmsa.errors import GPMSAError
@@ -149,6 +149,19 @@ class FixedGP:
             v = solve_triangular(self.chol[c], r.T, lower=True).T.reshape(G, n, self.m)
             cov[:, c] = self.prior_cov(x, c)[None] - np.einsum("gim,gjm->gij", v, v)
         return mean, cov
+
+
+def lower_solve(L: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``solve_triangular(L, b, lower=True)`` for float64 arrays without its input checks: the
+    same LAPACK call on the same layout, so the same result, in a few microseconds instead of
+    ~50 (a fast-path proposal makes several such solves of small systems)."""
+    if L.flags.f_contiguous:
+        x, info = lapack.dtrtrs(L, b, lower=1)
+    else:  # the transposed system, as scipy solves it for a C-ordered factor
+        x, info = lapack.dtrtrs(L.T, b, lower=0, trans=1)
+    if info != 0:
+        raise GPMSAError(f"a triangular solve failed (LAPACK dtrtrs info {info})")
+    return x
 
 
 def _cheb_coefficients(gp: FixedGP, c: int, tol: float, max_deg: int) -> np.ndarray | None:

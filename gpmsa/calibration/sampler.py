@@ -22,7 +22,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 from scipy.linalg import solve_triangular
 
-from gpmsa.calibration.model import FixedGP
+from gpmsa.calibration.model import FixedGP, lower_solve
 from gpmsa.calibration.observations import Observations
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
@@ -84,6 +84,7 @@ class ThetaPredictive:
         self._sig = float(data.obs_chol[0, 0])
         self.cheb: tuple[np.ndarray, np.ndarray] | None = None
         self.cheb2: tuple[np.ndarray, np.ndarray] | None = None
+        self._x_parts: list[tuple[np.ndarray, np.ndarray]] | None = None  # `_dense_one`'s
         if not expand:  # a categorical theta: no smooth series, dense solves at each level
             pass
         elif gp.q == 1:
@@ -104,6 +105,28 @@ class ThetaPredictive:
             b = solve_triangular(self.L, a.transpose(1, 0, 2).reshape(d, k * d), lower=True)
             self._cvw = b.reshape(d, k, d).transpose(1, 0, 2)
             self._orders = np.arange(k)
+
+    def _dense_one(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """mean (d,) and covariance (d, d) of u at one unit-scale theta (q,): ``_dense``'s
+        values (the same operations) with the x_obs parts computed once."""
+        gp = self.gp
+        if gp.coef is not None:  # a GLS mean basis: the general path
+            mean, cov = self._dense(theta[None, :])
+            return mean[0], cov[0]
+        if self._x_parts is None:  # per component: R_x(x_obs, x_sim) and Sigma_U at x_obs
+            self._x_parts = [(gp.corr_x(self.x, c), gp.prior_cov(self.x, c))
+                             for c in range(gp.p_u)]  # fmt: skip
+        n = self.x.shape[0]
+        mean = np.empty(self.d)
+        cov = np.zeros((self.d, self.d))
+        for c, (rx, prior) in enumerate(self._x_parts):
+            rt = gp.corr_t(theta[None, :], c)
+            r = (rt[:, None, :] * rx[None, :, :]).reshape(n, gp.m) / gp.lamUz[c]
+            block = slice(c * n, (c + 1) * n)
+            mean[block] = r @ gp.alpha[c]
+            v = lower_solve(gp.chol[c], r.T).T.reshape(1, n, gp.m)
+            cov[block, block] = prior - np.einsum("gim,gjm->gij", v, v)[0]
+        return mean, cov
 
     def _dense(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """mean (G, d) and covariance (G, d, d) of u at unit-scale theta (G, q)."""
@@ -174,13 +197,13 @@ class ThetaPredictive:
             zw = self._zw - t @ self._cmw
             b = np.tensordot(t, self._cvw, 1)
         else:
-            mean, cov = self._dense(np.asarray(theta, dtype=float)[None, :])
+            mean, cov = self._dense_one(np.asarray(theta, dtype=float))
             if self.d == 1:
-                r = (float(self.z[0]) - float(mean[0, 0])) / self._sig
-                return float(cov[0, 0, 0]) / (self._sig * self._sig), r * r
-            zw = solve_triangular(self.L, self.z - mean[0], lower=True)
-            a = solve_triangular(self.L, cov[0], lower=True)
-            b = solve_triangular(self.L, a.T, lower=True)
+                r = (float(self.z[0]) - float(mean[0])) / self._sig
+                return float(cov[0, 0]) / (self._sig * self._sig), r * r
+            zw = lower_solve(self.L, self.z - mean)
+            a = lower_solve(self.L, cov)
+            b = lower_solve(self.L, a.T)
         e, vecs = np.linalg.eigh(0.5 * (b + b.T))
         y = vecs.T @ zw
         return np.maximum(e, 0.0), y * y
