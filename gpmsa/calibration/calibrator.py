@@ -122,7 +122,9 @@ class Calibrator:
         extrapolate: allow x_obs outside the emulator's x domain (with a warning).
         n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``.
         seed: seed of those draws (and of the MCMC), for reproducibility.
-        mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC.
+        mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC
+            (``"fixed"``, which holds parameters at known values, only there: with the grid
+            method it is a GPMSAError).
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
             ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
             "auto" choose MCMC.
@@ -193,6 +195,13 @@ class Calibrator:
         if constraint is not None:
             self.mcmc_options.setdefault("constraint", constraint)
         self._check_mcmc_path(backend)
+        if self.method == "grid" and self.mcmc_options.get("fixed") is not None:
+            raise GPMSAError(
+                "mcmc_options['fixed'] holds parameters on the MCMC path, and this Calibrator "
+                "uses the exact grid (method='auto' chooses it for 1 or 2 parameters), which "
+                "would ignore it: use Calibrator(emu, method='mcmc', mcmc_options={'fixed': "
+                "...}), or gpmsa.calibrate(..., fixed=...)"
+            )
         if n_grid is None:
             n_grid = 129 if q == 1 else 65
         self.n_grid = check_count(n_grid, "n_grid", 3)

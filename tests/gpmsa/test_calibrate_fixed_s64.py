@@ -391,3 +391,15 @@ def test_a_categorical_theta_held_at_a_level_by_the_fast_sampler():
     assert np.all(post.samples["t0"] == 1.0) and post.info["fixed"] == {"theta": [0.5]}
     with pytest.raises(GPMSAError, match="categorical calibration parameter t0 must be one of"):
         _calibrate(emu, x_obs, x_obs[:, 0], fixed={"theta": {"t0": 1.5}})
+
+
+def test_a_calibrator_holds_fixed_on_mcmc_and_refuses_it_on_the_grid():
+    emu = two_param_emulator()
+    with pytest.raises(GPMSAError, match=r"mcmc_options\['fixed'\].*exact grid.*method='mcmc'"):
+        gpmsa.Calibrator(emu, mcmc_options={"fixed": {"theta": {"a": 0.4}}})
+    cal = gpmsa.Calibrator(emu, method="mcmc", seed=2,
+                           mcmc_options={"fixed": {"theta": {"a": 0.4}}, **RUN})  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        post = cal.update(XO, YO)
+    assert np.all(post.samples["a"] == 0.4) and post.sd("b") > 0
