@@ -23,8 +23,10 @@ import math
 import os
 import secrets
 import stat
+import tokenize
 import zipfile
 import zlib
+from collections import Counter
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,10 +53,13 @@ _MAX_DEFLATE_RATIO = 1032
 """Most bytes that one deflated byte expands to: what a compressed member can hold."""
 _READ_ERRORS = (
     OSError, EOFError, ValueError, KeyError, RuntimeError, NotImplementedError,
-    zipfile.BadZipFile, zlib.error,
+    zipfile.BadZipFile, zlib.error, SyntaxError, tokenize.TokenError,
 )  # fmt: skip
 """What reading a damaged or hostile ``.npz`` raises (zipfile: RuntimeError for an encrypted
-member, NotImplementedError for an unknown method; zlib; numpy's .npy parser: ValueError)."""
+member, NotImplementedError for an unknown method; zlib; numpy's .npy parser: ValueError, and
+tokenize's TokenError for a header with an unclosed bracket or string or SyntaxError for a dtype
+such as ',f8', raised as it parses a header before zipfile has checked the member's CRC: one
+flipped bit of a large member's header)."""
 
 
 @dataclass(frozen=True)
@@ -199,7 +204,11 @@ def _read_npz(
         raise CampaignFileError(f"campaign file {str(path)!r} is not a regular file")
     try:
         with zipfile.ZipFile(path) as zf:
-            present = {n.removesuffix(".npy") for n in zf.namelist()}
+            listed = zf.namelist()
+            twice = sorted(n for n, k in Counter(listed).items() if k > 1)
+            if twice:  # zipfile would read the last of them, another reader the first
+                raise ValueError(f"it holds the member {twice[0]!r} more than once")
+            present = {n.removesuffix(".npy") for n in listed}
             wanted = (*names, *(n for n in optional if n in present))
             return {name: _read_member(zf, name, info.st_size) for name in wanted}
     except _READ_ERRORS as exc:
@@ -756,6 +765,9 @@ def _read_cached(path: Path, spec: RunSpec) -> RunResult | None:
         and key.shape == () and str(key) == spec.key()
         and f.shape == (len(_F_NAMES),) and f.dtype.kind == "f"
         and bool(np.all(np.isfinite(f) & (f >= 0)))
-        and all(a.shape == (spec.keep_samples,) and a.dtype.kind == "f" for a in traces)
+        and all(
+            a.shape == (spec.keep_samples,) and a.dtype.kind == "f" and bool(np.all(np.isfinite(a)))
+            for a in traces
+        )
     )  # fmt: skip
     return (f, "ok", *traces) if finished else None

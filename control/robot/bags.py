@@ -253,14 +253,20 @@ def read_recording(
     return Recording(target, kind, storage, topics, imu, odom, time.perf_counter() - tic)
 
 
+_TOO_DEEP = "its metadata.yaml is nested too deep to parse (a damaged or hostile file)"
+
+
 def _bag_information(folder: Path):
     """The ``rosbag2_bagfile_information`` of a bag folder's metadata.yaml, read once; None
-    where it does not read (rosbags reads, and reports on, whatever this does not)."""
+    where it does not read (rosbags reads, and reports on, whatever this does not); `BagError`
+    for one nested too deep to parse (rosbags' parser would take seconds more to fail too)."""
     yaml = require("ruamel.yaml", "reading a ROS 2 bag")
     try:
         return yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_text())[
             "rosbag2_bagfile_information"
         ]
+    except RecursionError as exc:
+        raise BagError(f"cannot open {folder} as a ROS bag: {_TOO_DEEP}") from exc
     except Exception:  # rosbags reads (and reports on) whatever this does not understand
         return None
 
@@ -415,8 +421,9 @@ def _damage_errors() -> tuple[type[BaseException], ...]:
     them: its own errors, apsw's (a sqlite3 bag), the zstd module's (a compressed ROS 2 bag)
     and (found by corrupting bags byte by byte) Python's for a garbled length or offset (a
     read of more memory than there is, a seek outside the file), index, text or number, a
-    failed assertion on the format, or a sqlite3 value of another type than the column's
-    (passed on to the decompressor)."""
+    failed assertion on the format, a sqlite3 value of another type than the column's
+    (passed on to the decompressor), or a metadata.yaml nested too deep for its YAML parser
+    (RecursionError)."""
     purpose = "reading a ROS bag"
     zstd = "compression.zstd" if sys.version_info >= (3, 14) else "backports.zstd"  # as rosbags
     backends = tuple(  # rosbags' own dependencies, absent from its older releases
@@ -431,7 +438,7 @@ def _damage_errors() -> tuple[type[BaseException], ...]:
         require("rosbags.rosbag2", purpose).ReaderError,
         *backends,
         AssertionError, EOFError, LookupError, ValueError, ArithmeticError, MemoryError,
-        OSError, TypeError, struct.error,
+        OSError, TypeError, struct.error, RecursionError,
     )  # fmt: skip
 
 
@@ -524,7 +531,8 @@ def _read_rosbags(path: Path, kind: str, imu_topic: str, odom_topic: str, digest
         reader = highlevel.AnyReader([path], default_typestore=default)
         reader.open()
     except _damage_errors() as exc:
-        raise BagError(f"cannot open {path} as a ROS bag: {_why(exc)}") from exc
+        why = _TOO_DEEP if isinstance(exc, RecursionError) else _why(exc)  # rosbags' YAML parser
+        raise BagError(f"cannot open {path} as a ROS bag: {why}") from exc
     try:
         topics = {t: info.msgtype for t, info in reader.topics.items()}
         _check_topics(path, topics, imu_topic, odom_topic)
