@@ -63,6 +63,7 @@ from gpmsa.calibration.observations import (
     fit_of,
     fixed_gp,
     reduce,
+    theta_probe,
     warn_if_outside,
 )
 from gpmsa.calibration.posterior import Posterior, trapezoid_weights
@@ -72,6 +73,8 @@ from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 
 METHODS = ("auto", "grid", "mcmc")
+_PROBE_AXIS = {1: 129, 2: 33}
+"""Nodes per axis of `theta_probe` (q = 1, 2): the outside check's nodes on a coarser grid."""
 MAX_REFINE = 4
 """Refinement passes of one update, at most (each refines the peaks still unresolved)."""
 MAX_REFINE_ONE = 9
@@ -268,7 +271,9 @@ class Calibrator:
         self, data: Observations, theta_unit: np.ndarray | None, fits: list | None = None
     ) -> list[LamOsMarginal]:
         """lamOs-marginal likelihoods per emulator parameter set on the fixed grid (None) or on
-        the given unit-scale nodes (dense solves); ``fits`` collects each set's ``Fit``."""
+        the given unit-scale nodes (dense solves); ``fits`` collects each set's ``Fit``, on
+        `theta_probe`'s nodes where the fixed grid is coarser (its distance otherwise grew as
+        the grid coarsened: n_grid=3 read an observation at 0.3 of the range 34 sds outside)."""
         out = []
         d = data.z.size
         for gp, pred in zip(self._gps, self._predictors, strict=True):
@@ -276,7 +281,9 @@ class Calibrator:
                 mean, cov = pred.predict(data.x)
             else:
                 mean, cov = gp.predict(data.x, theta_unit)
-            if fits is not None:
+            if fits is not None and theta_unit is None and self.n_grid < _PROBE_AXIS[self.q]:
+                fits.append(fit_of(*gp.predict(data.x, theta_probe(self.q)), data))
+            elif fits is not None:
                 fits.append(fit_of(mean, cov, data))
             G = mean.shape[0]
             out.append(

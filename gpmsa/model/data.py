@@ -429,6 +429,50 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
             )
 
 
+def _check_resolution(y: np.ndarray, sd: float) -> None:
+    """GPMSAError when the outputs' spread ``sd`` (`output_scale`) is within 1e-13 of their
+    largest magnitude: float64 then holds y to about 2e-3 of its spread or coarser (y = 1e9 +
+    1e-7 f kept 3 distinct values of 30 runs; y = 1 + 1e-14 f, 27). y = 1e9 + 1e-3 f (6.5e-13)
+    still calibrates as y = f does (t 0.307 +- 0.024 against 0.309 +- 0.018)."""
+    big = float(np.max(np.abs(y)))
+    if sd <= 1e-13 * big:
+        raise GPMSAError(
+            f"y varies by only sd {sd:.3g} around values up to {big:.6g} (within 1e-13 of their "
+            f"size, near float64's resolution there: {np.unique(y).size} distinct values in "
+            f"{y.size}); subtract the offset before the values are rounded (in the simulator "
+            "or its output file), or rescale y"
+        )
+
+
+RANK_TOL = 1e-8
+"""A design whose centred unit-scale columns [x, t] have a singular value below this fraction
+of the largest is rank deficient (`_check_rank`)."""
+
+
+def _check_rank(x: np.ndarray, t: np.ndarray, x_names, t_names) -> None:
+    """GPMSAError when one design column is (to ``RANK_TOL``) a linear function of the others,
+    e.g. t1 = 2 t0 + 1: the runs then lie on a line (plane) of the input box, the emulator never
+    sees the other directions, and a calibration over the whole box reads its prior mean
+    there (two collinear t: t0's sd 0.17 against 0.018 with t0 alone)."""
+    design = np.hstack([x, t])
+    if design.shape[1] < 2:
+        return
+    unit = (design - design.min(axis=0)) / (design.max(axis=0) - design.min(axis=0))
+    unit = unit - unit.mean(axis=0)
+    _, s, vt = np.linalg.svd(unit, full_matrices=False)
+    if s[-1] > RANK_TOL * s[0]:
+        return
+    names = [*x_names, *t_names]
+    involved = [names[j] for j in np.flatnonzero(np.abs(vt[-1]) > 1e-6)]
+    raise GPMSAError(
+        f"the design columns {', '.join(involved)} are linearly dependent (one is a linear "
+        "function of the others across all runs): the runs lie on a lower-dimensional part of "
+        "the input box, so the emulator cannot tell these inputs' effects apart and would "
+        "extrapolate over the rest; drop one of them (calibrate their combination) or spread "
+        "the design"
+    )
+
+
 @dataclass(frozen=True, eq=False)
 class SimData:
     """Simulation runs: inputs ``x`` (m, p), parameters ``t`` (m, q), outputs ``y`` (m, l_sim).
@@ -501,7 +545,7 @@ class SimData:
         _check_spans(t, "t", self.t_names)
         if np.ptp(y) == 0.0:
             raise GPMSAError(f"y is constant ({y[0, 0]}); the simulation output must vary")
-        output_scale(y)
+        _check_resolution(y, output_scale(y))
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "y", y)
@@ -523,6 +567,7 @@ class SimData:
             cols = categorical.columns(getattr(self, attr), names, attr)
             categorical.check_integer_levels(arr, cols, names, attr[0])
             object.__setattr__(self, attr, cols)
+        _check_rank(x, t, self.x_names, self.t_names)
 
     @property
     def m(self) -> int:

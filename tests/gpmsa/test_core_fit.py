@@ -141,7 +141,7 @@ def test_multivariate_output_with_discrepancy_recovers_true_theta():
 
 
 def test_an_unknown_fit_option_is_named_with_the_backends_options():
-    sim = gpmsa.SimData(x=np.linspace(0, 1, 8)[:, None], t=np.linspace(1, 0, 8)[:, None],
-                        y=np.linspace(0, 1, 8) ** 2)  # fmt: skip
+    t = np.linspace(1, 0, 8)[[1, 0, 3, 2, 5, 4, 7, 6], None]  # not collinear with x
+    sim = gpmsa.SimData(x=np.linspace(0, 1, 8)[:, None], t=t, y=np.linspace(0, 1, 8) ** 2)
     with pytest.raises(gpmsa.GPMSAError, match=r"unknown option\(s\) \['tune_round'\] .* takes \["):
         gpmsa.fit(sim, n_iter=5, tune_round=3)
