@@ -520,11 +520,14 @@ def _run_fast(
             theta[:, :, k] = np.round(theta[:, :, k])
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.stack([r.lamOs for r in runs])
+    rates, widths = np.stack([r.accept_rate for r in runs]), np.stack([r.widths for r in runs])
+    held = [*(held_theta or ())] + ([sampler.q] if held_lamos is not None else [])
+    rates[:, held] = widths[:, held] = np.nan  # held: no step, no acceptance (as the backends)
     info = {
         "engine": "fast",
         "backend": "numpy",
-        "accept_rate": np.stack([r.accept_rate for r in runs]).tolist(),
-        "step_widths": np.stack([r.widths for r in runs]).tolist(),
+        "accept_rate": rates.tolist(),
+        "step_widths": widths.tolist(),
         "chebyshev": all(p.cheb is not None or p.cheb2 is not None for p in sampler.preds),
     }
     if held_theta is not None or held_lamos is not None:
@@ -592,7 +595,7 @@ def _run_backend(
     )  # fmt: skip
     std = emulator.standardizer
     held = (problem.fixed - set(EMULATOR_PARAMS)) | set(problem.fixed_elements)
-    masks = _held_masks(problem)
+    masks = held_masks(problem)
     if held:  # float64 whatever the backend sampled in, a held parameter exactly its value
         chains_draws = {k: np.array(v, dtype=float) for k, v in chains.draws.items()}
         for k, mask in masks.items():
@@ -619,16 +622,21 @@ def _run_backend(
         names = list(emulator.t_names)
         info["held_names"] = [names[k] for k in np.flatnonzero(masks.get("theta", []))]
         info["held_names"] += ["lamOs"] if "lamOs" in masks else []
-        if "lamVz" in problem.init:
-            shown = to_samples(
-                masks.get("betaV", np.zeros_like(problem.init["betaV"], bool)),
-                masks.get("lamVz", np.zeros_like(problem.init["lamVz"], bool)),
-            )
-            info["held_names"] += [k for k, v in shown.items() if v]
+        info["held_names"] += held_discrepancy_names(problem, masks)
     return draws, info
 
 
-def _held_masks(problem: Problem) -> dict[str, np.ndarray]:
+def held_discrepancy_names(problem: Problem, masks: dict[str, np.ndarray]) -> list[str]:
+    """The posterior names (``to_samples``': "lamVz[1]", "betaV[0,1]", ...) of the discrepancy
+    elements that ``masks`` (`held_masks`) hold; [] without a discrepancy."""
+    if "lamVz" not in problem.init:
+        return []
+    shown = to_samples(*(masks.get(k, np.zeros(problem.init[k].shape, bool))
+                         for k in ("betaV", "lamVz")))  # fmt: skip
+    return [k for k, v in shown.items() if v]
+
+
+def held_masks(problem: Problem) -> dict[str, np.ndarray]:
     """name -> boolean mask of its held elements, for each calibration parameter the
     Problem holds (whole: every element) beyond the emulator's."""
     out = {}

@@ -288,8 +288,10 @@ class CalibrationSampler:
             start[k] = float(v)
         self.free = [k for k in range(self.q) if k not in held_theta]  # the elements proposed
         self.init_theta = snap_to_levels(start, self.levels).tolist()  # categorical: nearest level
-        if constraint is not None:
-            constraint.check_start(np.array(self.init_theta), "calibrate")
+        if constraint is not None:  # named as Problem.with_fixed names a held theta
+            what = "calibrate" if not held_theta else "fixed theta (held elements)"
+            what = "fixed theta" if len(held_theta) == self.q else what
+            constraint.check_start(np.array(self.init_theta), what)
 
     def _log_prior_theta(self, theta: list[float]) -> float:
         """Truncated-normal prior of unit-scale theta (plus the extra prior), pure Python."""

@@ -74,6 +74,12 @@ class ThetaConstraint:
                     f"fixed theta: the theta constraint rejects the fixed value {value}; fix theta "
                     "inside the allowed region, or drop the constraint"
                 )
+            if what == "fixed theta (held elements)":  # the others' start may help, or not
+                raise GPMSAError(
+                    f"{what}: the theta constraint rejects the start {value} (the held "
+                    "elements at their fixed values): hold them inside the allowed region, or "
+                    "pass theta_init= (native units) for the others inside it"
+                )
             raise GPMSAError(
                 f"{what}: the theta constraint rejects the initial value {value}; pass "
                 "theta_init= (native units) inside the allowed region"

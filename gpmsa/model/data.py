@@ -430,17 +430,19 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
 
 
 def _check_resolution(y: np.ndarray, sd: float) -> None:
-    """GPMSAError when the outputs' spread ``sd`` (`output_scale`) is within 1e-13 of their
-    largest magnitude: float64 then holds y to about 2e-3 of its spread or coarser (y = 1e9 +
-    1e-7 f kept 3 distinct values of 30 runs; y = 1 + 1e-14 f, 27). y = 1e9 + 1e-3 f (6.5e-13)
-    still calibrates as y = f does (t 0.307 +- 0.024 against 0.309 +- 0.018)."""
-    big = float(np.max(np.abs(y)))
+    """GPMSAError when the outputs' spread ``sd`` (`output_scale`) is within 1e-13 of the
+    largest magnitude of a column that varies: float64 then holds y to about 2e-3 of its spread
+    or coarser (y = 1e9 + 1e-7 f kept 3 distinct values of 30 runs; y = 1 + 1e-14 f, 27).
+    y = 1e9 + 1e-3 f (6.5e-13) still calibrates as y = f does (t 0.307 +- 0.024 against 0.309
+    +- 0.018). A constant column has nothing to round, whatever its size."""
+    varying = y[:, np.ptp(y, axis=0) > 0]
+    big = float(np.max(np.abs(varying)))
     if sd <= 1e-13 * big:
         raise GPMSAError(
             f"y varies by only sd {sd:.3g} around values up to {big:.6g} (within 1e-13 of their "
-            f"size, near float64's resolution there: {np.unique(y).size} distinct values in "
-            f"{y.size}); subtract the offset before the values are rounded (in the simulator "
-            "or its output file), or rescale y"
+            f"size, near float64's resolution there: {np.unique(varying).size} distinct values "
+            f"in {varying.size}); subtract the offset before the values are rounded (in the "
+            "simulator or its output file), or rescale y"
         )
 
 

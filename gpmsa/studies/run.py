@@ -12,7 +12,13 @@ from datetime import datetime, timezone
 import numpy as np
 
 from gpmsa._version import library_versions
-from gpmsa.calibration.calibrate import calibration_fixed, calibration_problem, observation_fit
+from gpmsa.calibration.calibrate import (
+    calibration_fixed,
+    calibration_problem,
+    held_discrepancy_names,
+    held_masks,
+    observation_fit,
+)
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
@@ -24,7 +30,6 @@ from gpmsa.model import categorical
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, SimData, check_flag, check_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
-from gpmsa.model.discrepancy import to_samples
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
@@ -127,18 +132,10 @@ def _held_names(problems, layout, fixes) -> list[str]:
         return []
     names = [layout.elements[e].name for e in sorted(held_elements(problems, layout))]
     for lab, prob in zip(layout.labels, problems, strict=True):
-        masks = {}
-        for k in ("lamOs", "betaV", "lamVz"):
-            if k in prob.init:
-                mask = np.full(prob.init[k].shape, k in prob.fixed)
-                for idx in prob.fixed_elements.get(k, ()):
-                    mask[idx] = True
-                masks[k] = mask
-        if masks["lamOs"].all():
+        masks = held_masks(prob)
+        if "lamOs" in masks:  # one element: held whole
             names.append(f"lamOs[{lab}]")
-        if "lamVz" in masks:
-            shown = to_samples(masks["betaV"], masks["lamVz"])
-            names += [f"{k}[{lab}]" for k, v in shown.items() if v]
+        names += [f"{k}[{lab}]" for k in held_discrepancy_names(prob, masks)]
     return names
 
 

@@ -75,7 +75,7 @@ def held_elements(problems: list[Problem], layout: Layout) -> dict[int, float]:
             pos = sorted(k for (k,) in prob.fixed_elements.get("theta", ()))
         for k in pos:
             e, v = layout.index[i][k], float(prob.init["theta"][k])
-            if held.get(e, v) != v:
+            if not _same_unit_value(layout, e, held.get(e, v), v):
                 raise GPMSAError(
                     f"fixed theta: the models sharing {layout.elements[e].name} hold it at "
                     "different values; hold a shared parameter at one value"
@@ -91,6 +91,14 @@ def held_elements(problems: list[Problem], layout: Layout) -> dict[int, float]:
                 "does so)"
             )
     return held
+
+
+def _same_unit_value(layout: Layout, e: int, a: float, b: float) -> bool:
+    """Whether unit-scale values ``a`` and ``b`` of study element ``e`` are one native value: the
+    layout takes models whose ranges of a shared parameter agree to 1e-12 (relative), so one
+    native value reads unit values that far apart (and a few ulps of rounding)."""
+    lo, hi = layout.bounds[e]
+    return abs(a - b) <= 2e-12 * (abs(lo) + abs(hi)) / (hi - lo) + 8 * np.finfo(float).eps
 
 
 def _holds(problem: Problem, k: int) -> bool:
