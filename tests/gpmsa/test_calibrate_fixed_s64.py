@@ -145,7 +145,7 @@ def test_a_held_theta_element_is_its_value_in_every_draw(engine, given):
 def test_the_whole_theta_and_lamos_held(engine):
     run = {**RUN, **engine}
     if engine.get("backend") == "pyro":  # NUTS: no GPM/SA tuning
-        run = {"n_samples": 40, "n_burn": 10, **engine}
+        run = {"n_samples": 40, "n_burn": 10, "n_warmup": 60, "max_tree_depth": 4, **engine}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         post = gpmsa.calibrate(two_param_emulator(), XO, YO, seed=1, **run,
@@ -162,7 +162,8 @@ def test_pyro_holds_a_single_theta_element():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         post = gpmsa.calibrate(two_param_emulator(), XO, YO, n_samples=40, n_burn=10, seed=1,
-                               backend="pyro", fixed={"theta": {"a": 0.4}})  # fmt: skip
+                               backend="pyro", n_warmup=20,
+                               fixed={"theta": {"a": 0.4}})  # fmt: skip
     assert np.all(post.samples["a"] == 0.4) and post.sd("a") == 0.0 and post.sd("b") > 0
     fast = gpmsa.calibrate(two_param_emulator(), XO, YO, n_samples=40, n_burn=10, seed=1,
                            fixed={"theta": {"a": 0.4}})  # fmt: skip
