@@ -57,7 +57,7 @@ from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, check_count, check_flag, check_seed
 from gpmsa.model.discrepancy import check_groups, to_samples
 from gpmsa.model.discrepancy import record as discrepancy_record
-from gpmsa.model.problem import Problem, checked_fixed, default_init, reduce_obs
+from gpmsa.model.problem import Problem, checked_fixed, default_init, fixed_record, reduce_obs
 
 CALIBRATION_FIXED = ("theta", "lamOs", "betaV", "lamVz")
 """The parameters ``calibrate(fixed=)`` may hold (betaV and lamVz with a discrepancy only)."""
@@ -594,9 +594,8 @@ def _run_backend(
         **opts,
     )  # fmt: skip
     std = emulator.standardizer
-    held = (problem.fixed - set(EMULATOR_PARAMS)) | set(problem.fixed_elements)
     masks = held_masks(problem)
-    if held:  # float64 whatever the backend sampled in, a held parameter exactly its value
+    if masks:  # float64 whatever the backend sampled in, a held parameter exactly its value
         chains_draws = {k: np.array(v, dtype=float) for k, v in chains.draws.items()}
         for k, mask in masks.items():
             chains_draws[k][:, :, mask] = problem.init[k][mask]
@@ -615,10 +614,8 @@ def _run_backend(
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
         kind = discrepancy if isinstance(discrepancy, str) else "given"
         info.update({"discrepancy": kind, **discrepancy_record(problem.obs)})
-    if held:
-        info["fixed"] = per_element.record({k: problem.init[k] if k in problem.fixed else
-                                            {i: problem.init[k][i] for i in
-                                             problem.fixed_elements[k]} for k in held})  # fmt: skip
+    if masks:
+        info["fixed"] = fixed_record(problem, masks)
         names = list(emulator.t_names)
         info["held_names"] = [names[k] for k in np.flatnonzero(masks.get("theta", []))]
         info["held_names"] += ["lamOs"] if "lamOs" in masks else []

@@ -26,7 +26,7 @@ from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
-from gpmsa.model.problem import Problem, prepare
+from gpmsa.model.problem import Problem, fixed_record, prepare
 
 N_KEEP = 1000
 """Default number of retained draws (all chains together) after burn-in and thinning."""
@@ -328,26 +328,19 @@ def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Proble
     if start is not None:
         _check_levels(problem, start, data.t_names, "theta_init")
         problem = problem.with_init({"theta": start})
-    if fixed is not None:
-        if not isinstance(fixed, dict):
-            raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
-        fixed = dict(fixed)
-        if "theta" in fixed and problem.obs is not None:
-            fixed["theta"] = per_element.theta_unit(fixed["theta"], std, data.t_names, levels)
-        problem = problem.with_fixed(fixed)
-    return problem
+    return problem if fixed is None else hold_fixed(problem, fixed, std, data.t_names)
 
 
-def fixed_record(problem: Problem) -> dict:
-    """``settings["fixed"]``: name -> the value list of each parameter fixed whole (as files
-    always held), or for one with held elements {"elements": [index, ...], "values": [...]}
-    (model scales; theta unit scale), by name."""
-    out = {k: problem.init[k].tolist() for k in problem.fixed}
-    for k, held in problem.fixed_elements.items():
-        idx = sorted(held)
-        out[k] = {"elements": [list(i) for i in idx],
-                  "values": [float(problem.init[k][i]) for i in idx]}  # fmt: skip
-    return dict(sorted(out.items()))
+def hold_fixed(problem: Problem, fixed, standardizer, t_names) -> Problem:
+    """``problem`` holding ``fit``'s ``fixed=`` (name -> value; theta in native units, put on
+    the unit scale where the problem has theta, a joint fit); GPMSAError for a non-dict."""
+    if not isinstance(fixed, dict):
+        raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
+    fixed = dict(fixed)
+    if "theta" in fixed and problem.obs is not None:
+        fixed["theta"] = per_element.theta_unit(fixed["theta"], standardizer, t_names,
+                                                problem.theta_levels)  # fmt: skip
+    return problem.with_fixed(fixed)
 
 
 def continued_starts(

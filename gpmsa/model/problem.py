@@ -269,6 +269,17 @@ def theta_log_prior(priors: Priors, levels, theta) -> float:
     return priors.log_prior("theta", theta[cont]) if cont else 0.0
 
 
+def fixed_record(problem: Problem, names=None) -> dict:
+    """``settings["fixed"]`` (``per_element.record``): name -> the value list of each parameter
+    fixed whole (as files always held), or for one with held elements {"elements": [index,
+    ...], "values": [...]} (model scales; theta unit scale), by name; ``names``: only these
+    (None: every one the problem holds)."""
+    values = {k: problem.init[k] for k in problem.fixed}
+    values.update({k: {i: problem.init[k][i] for i in held}
+                   for k, held in problem.fixed_elements.items()})  # fmt: skip
+    return per_element.record({k: v for k, v in values.items() if names is None or k in names})
+
+
 def checked_fixed(name: str, val, shape: tuple[int, ...], priors: Priors, theta_levels=None):
     """One entry of ``fixed=`` (``Problem.with_fixed``) checked: the parameter ``name`` of
     ``shape`` held at ``val`` (model scales; theta unit scale). Returns the whole array (a

@@ -22,16 +22,15 @@ from gpmsa.calibration.calibrate import (
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
-from gpmsa.fitting.fit import check_keep, check_point, fixed_record, point_estimate, thinning
+from gpmsa.fitting.fit import check_keep, check_point, hold_fixed, point_estimate, thinning
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
-from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.data import ObsData, SimData, check_flag, check_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
-from gpmsa.model.problem import ORDER, prepare
+from gpmsa.model.problem import ORDER, fixed_record, prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
 from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
 from gpmsa.studies.sampler import StudyChains, held_elements, sample_study
@@ -351,15 +350,14 @@ def _record_fixed(settings: dict, labels, problems, layout, fixes, emulator=Fals
     judged for convergence)."""
     if all(f is None for f in fixes):
         return
-    keep = set(EMULATOR_PARAMS) if emulator else set()
     out = {}
     for lab, prob, f in zip(labels, problems, fixes, strict=True):
         if f is None:
             continue
-        whole = {k: prob.init[k] for k in prob.fixed
-                 if k not in EMULATOR_PARAMS or (k in keep and k in f)}  # fmt: skip
-        some = {k: {i: prob.init[k][i] for i in v} for k, v in prob.fixed_elements.items()}
-        out[lab] = per_element.record({**whole, **some})
+        # a calibration holds every emulator parameter: record only those the user named
+        named = {k for k in (*prob.fixed, *prob.fixed_elements)
+                 if k not in EMULATOR_PARAMS or (emulator and k in f)}  # fmt: skip
+        out[lab] = fixed_record(prob, named)
     settings["fixed"] = out
     settings["held"] = _held_names(problems, layout, fixes)
 
@@ -457,7 +455,8 @@ def fit_study(
         shared, hierarchical,
     )  # fmt: skip
     check_study_names(layout)
-    problems = [p.problem if f is None else _per_model(lab, _fit_fixed, p, s, f)
+    problems = [p.problem if f is None else _per_model(lab, hold_fixed, p.problem, f,
+                                                       p.standardizer, s.t_names)
                 for lab, p, s, f in zip(labels, preps, sims, fixes, strict=True)]  # fmt: skip
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})")
     t0 = time.perf_counter()
@@ -507,14 +506,3 @@ def fit_study(
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.fit_study")
     return study
-
-
-def _fit_fixed(prep, sim: SimData, fixed: dict):
-    """``prep.problem`` holding ``fixed`` (``gpmsa.fit``'s ``fixed=``: theta in native units)."""
-    if not isinstance(fixed, dict):
-        raise GPMSAError(f"fixed must be None or a dict name -> value, got {fixed!r}")
-    fixed = dict(fixed)
-    if "theta" in fixed:
-        fixed["theta"] = per_element.theta_unit(fixed["theta"], prep.standardizer, sim.t_names,
-                                                prep.problem.theta_levels)  # fmt: skip
-    return prep.problem.with_fixed(fixed)
