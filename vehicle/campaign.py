@@ -509,7 +509,8 @@ def run_campaign(
 
     # each run's own road, lengthened for keep_s or not, must hold the window after the lead-in
     speeds = points[:, 0]
-    usable_m = np.array([length(float(v)) for v in speeds]) - lead_in_m - 2 * model.wheelbase_m
+    lengths = [length(float(v)) for v in speeds]
+    usable_m = np.array(lengths) - lead_in_m - 2 * model.wheelbase_m
     short = ~(usable_m >= window * speeds / rate_hz)
     if short.any():
         v_short = float(np.max(speeds[short]))
@@ -520,12 +521,12 @@ def run_campaign(
             f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
         )
 
-    _check_drives(points, [length(float(v)) for v in points[:, 0]], model, dx_m)
+    _check_drives(points, lengths, model, dx_m)
     seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
     specs = [
-        RunSpec(model, float(v), float(gd), int(s), length(float(v)), dx_m, lead_in_m, band,
-                rate_hz, noise_std, window, substeps, keep)
-        for (v, gd), s in zip(points, seeds, strict=True)
+        RunSpec(model, float(v), float(gd), int(s), road_m, dx_m, lead_in_m, band, rate_hz,
+                noise_std, window, substeps, keep)
+        for (v, gd), s, road_m in zip(points, seeds, lengths, strict=True)
     ]  # fmt: skip
     cache = None if cache_dir is None else _cache_folder(cache_dir)
     results: list[RunResult | None] = [None] * len(specs)
