@@ -54,7 +54,7 @@ from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
 from gpmsa.model import fixed_elements as per_element
-from gpmsa.model.data import ObsData, check_count, check_flag, check_seed
+from gpmsa.model.data import ObsData, check_count, check_flag, run_seed
 from gpmsa.model.discrepancy import check_groups, to_samples
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.problem import Problem, checked_fixed, default_init, fixed_record, reduce_obs
@@ -254,7 +254,9 @@ def calibrate(
         tune_rounds, tune_levels: the tuning's rounds and candidate widths per element (None:
             the backend's default; numpy 50 x 20; torch ceil(50 / n_chains) x 20). The pyro
             backend (NUTS) has no such tuning: giving either to it is a GPMSAError.
-        seed: seed of the random numbers (same seed, same draws).
+        seed: an integer, a numpy Generator or None (fresh entropy): the same seed gives the
+            same draws, with any number of chains' workers; the integer the run used is
+            ``info["seed"]`` (``seed=`` that integer repeats it).
         backend: "numpy" (default), "torch" or "pyro" (``gpmsa.backends.available()``).
         emulator_params: "point" (the emulator's point estimate) or "draws" (the likelihood
             averaged over ``n_emulator_draws`` of its retained draws; numpy fast path only).
@@ -320,7 +322,7 @@ def calibrate(
         predictions taking an emulator and ``posterior=`` refuse another one.
     """
     check_emulator(emulator, categorical_theta=True)
-    seed = check_seed(seed)
+    seed = run_seed(seed)
     n_samples = check_count(n_samples, "n_samples", 2)
     n_chains = check_count(n_chains, "n_chains")
     ok = not isinstance(n_burn, bool) and isinstance(n_burn, int | np.integer)
@@ -397,6 +399,7 @@ def calibrate(
     samples = {k: v.reshape(-1) for k, v in chains.items()}
     info.update(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
+        seed=seed,
         emulator_params=emulator_params, seconds=time.perf_counter() - t0,
         outside_sds=fit.outside_sds, obs_values_sha256=data.values_sha256,
         obs_layout_sha256=data.layout_sha256,

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 
 import numpy as np
 
 from gpmsa.cli.text import internal_error, number, plain, safe, value
 from gpmsa.errors import GPMSAError
+from gpmsa.mcmc.diagnostics import beyond
 from gpmsa.model.basis import variance_shares
 
 
@@ -266,6 +268,22 @@ def _element(name: object) -> str:
     return f" ({safe(name, 60)})" if name else ""
 
 
+def _figure(val: object, limit: object, places: int, none: str, above: bool) -> str:
+    """A worst R-hat (``above``: failing above its limit) or ESS (below) of a record with
+    ``places`` decimals, or with as many more as show it beyond its ``limit`` where it fails
+    (an R-hat of 1.0102 against 1.01: not "1.010")."""
+    if val is None:
+        return none
+    if all(isinstance(v, int | float) and not isinstance(v, bool) for v in (val, limit)):
+        try:
+            v, lim = float(val), float(limit)
+        except OverflowError:  # an integer beyond float64 from a file's JSON
+            return number(val, f".{places}f")
+        if math.isfinite(v) and math.isfinite(lim) and (v > lim if above else v < lim):
+            return beyond(v, lim, places)
+    return number(val, f".{places}f")
+
+
 def _convergence_line(rec: object) -> str:
     """One line on the chains' convergence (files of one chain or older ones have no record)."""
     if not rec:
@@ -279,8 +297,8 @@ def _convergence_line(rec: object) -> str:
     if r_val is None and e_val is None and not (r_el or e_el):
         worst = "R-hat and ESS undefined (constant draws)"
     else:  # a value None with an element: not finite (an infinite R-hat: stuck chains)
-        r_txt = number(r_val, ".3f") if r_val is not None else ("inf" if r_el else "undefined")
-        e_txt = number(e_val, ".0f") if e_val is not None else "undefined"
+        r_txt = _figure(r_val, rec.get("rhat_max"), 3, "inf" if r_el else "undefined", True)
+        e_txt = _figure(e_val, rec.get("ess_min"), 0, "undefined", False)
         worst = (f"max R-hat {r_txt}{_element(r_el)}, min bulk ESS {e_txt}"
                  f"{_element(e_el)}")  # fmt: skip
     head = (f"convergence:     {plain(rec.get('n_chains'))} chains x "

@@ -23,24 +23,13 @@ from gpmsa.mcmc.sampler import (
 )
 from gpmsa.model import constraints
 from gpmsa.model import fixed_elements as per_element
-from gpmsa.model.data import ObsData, SimData, check_count, check_flag, check_seed
+from gpmsa.model.data import ObsData, SimData, check_count, check_flag, run_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, fixed_record, prepare
 
 N_KEEP = 1000
 """Default number of retained draws (all chains together) after burn-in and thinning."""
-
-
-def _seed(seed) -> int:
-    """The integer seed the fit runs with and records: ``seed`` itself, one drawn from a
-    Generator, or for None one drawn from fresh OS entropy (so that every fit can be rerun)."""
-    seed = check_seed(seed, generator=True)
-    if seed is None:
-        seed = np.random.default_rng()
-    if isinstance(seed, np.random.Generator):
-        return int(seed.integers(2**63))
-    return seed
 
 
 def _factor_nbytes(m: int, p: int, q: int, p_u: int) -> float:
@@ -167,7 +156,7 @@ def fit(
             f"discrepancy={given} needs observations (obs=): a discrepancy is fitted with the "
             "field data, and a simulator-only fit has none"
         )
-    seed = _seed(seed)
+    seed = run_seed(seed)
     module = backends.get(backend)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
                    mean_basis=mean_basis, discrepancy_groups=discrepancy_groups,

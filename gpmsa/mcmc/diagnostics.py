@@ -103,6 +103,21 @@ RHAT_MAX = 1.01
 """Largest R-hat (rank-normalised, split) of a converged parameter (Vehtari et al. 2021)."""
 ESS_MIN = 100.0
 """Smallest bulk effective sample size of a converged parameter (all chains together)."""
+RHAT_APART = 1.1
+"""R-hat above which the chains are not merely short but apart (Gelman and Rubin's old limit):
+the convergence warning then says that longer chains may not join them."""
+
+
+def beyond(value: float, limit: float, places: int) -> str:
+    """``value``, which lies beyond ``limit`` (an R-hat above it, an ESS below), with ``places``
+    decimals, or as many more as show it beyond: an R-hat of 1.0102 is "1.0102", not "1.010"
+    beside a limit of 1.01, an ESS of 99.6 "99.6", not "100"."""
+    txt = f"{value:.{places}f}"
+    for more in range(places + 1, places + 9):
+        if (float(txt) - limit) * (value - limit) > 0:
+            break
+        txt = f"{value:.{more}f}"
+    return txt
 
 
 def element_names(name: str, shape: tuple[int, ...]) -> list[str]:
@@ -152,9 +167,9 @@ def convergence(
                 continue
             why = []
             if r > RHAT_MAX:
-                why.append(f"R-hat {r:.3f}")
+                why.append(f"R-hat {beyond(r, RHAT_MAX, 3)}")
             if e < ESS_MIN:
-                why.append(f"ESS {e:.0f}")
+                why.append(f"ESS {beyond(e, ESS_MIN, 0)}")
             if why:
                 flagged[el] = ", ".join(why)
             if r > worst_r[1]:  # +inf too (chains stuck at different values); NaN never
@@ -180,16 +195,28 @@ def warn_unconverged(
 ) -> None:
     """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record
     and the caller's argument ``length`` that sets the chains' length (``more``: a further
-    remedy, appended)."""
+    remedy, appended). Where the worst R-hat exceeds RHAT_APART (or is infinite) the warning
+    adds that the chains lie apart, which longer chains may not mend (several modes)."""
     from gpmsa.errors import ConvergenceWarning
 
     flagged = record.get("flagged") or {}
     if not flagged:
         return
     items = "; ".join(f"{el}: {why}" for el, why in flagged.items())
+    apart = ""
+    el, r = record.get("max_rhat") or ("", None)
+    if el and (r is None or r > RHAT_APART):  # None with an element: an infinite R-hat
+        shown = "inf" if r is None else f"{r:.3f}"
+        apart = (
+            f" R-hat {shown} ({el}) says the chains lie apart, not merely that they are short: "
+            "if longer chains do not bring them together, the posterior may have several "
+            "modes that no chain crosses (compare the chains: to_arviz(), "
+            "gpmsa.plots.traces)."
+        )
     warnings.warn(
         f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "
         f"chains x {record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
-        f"{record['ess_min']:.0f}): {items}. Run longer chains ({length}) or more of them{more}.",
+        f"{record['ess_min']:.0f}): {items}. Run longer chains ({length}) or more of them{more}."
+        f"{apart}",
         ConvergenceWarning, stacklevel=stacklevel,
     )  # fmt: skip

@@ -289,6 +289,19 @@ def check_seed(seed, name: str = "seed", *, generator: bool = False):
     return int(seed)
 
 
+def run_seed(seed) -> int:
+    """The integer seed a run (``fit``, ``calibrate``, a study) uses and records: ``seed``
+    itself, one drawn from a numpy Generator, or for None one drawn from fresh OS entropy, so
+    that every run can be repeated with ``seed=`` the recorded integer. GPMSAError as
+    ``check_seed``."""
+    seed = check_seed(seed, generator=True)
+    if seed is None:
+        seed = np.random.default_rng()
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(2**63))
+    return seed
+
+
 def output_scale(y: np.ndarray) -> float:
     """GPM/SA's output scale of simulation outputs ``y`` (m, l): the sd (ddof=1) of all values
     after centring each column; GPMSAError naming ``y`` when it is zero, or when its square

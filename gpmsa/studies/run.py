@@ -27,7 +27,7 @@ from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
-from gpmsa.model.data import ObsData, SimData, check_flag, check_seed
+from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
@@ -54,14 +54,6 @@ def _same_count(**lists) -> int:
     if n < 1:
         raise GPMSAError("a study needs at least one model")
     return n
-
-
-def _run_seed(seed) -> int:
-    """The integer seed a study runs with and records (``settings["seed"]``, each fitted model's
-    ``settings["seed"]``): ``seed`` itself, or for None one drawn from fresh OS entropy, as
-    ``gpmsa.fit`` does, so that every study can be rerun."""
-    seed = check_seed(seed)
-    return int(np.random.default_rng().integers(2**63)) if seed is None else seed
 
 
 def _check_run(n_iter, n_burn, n_chains, hyper, what: str = "n_samples") -> HyperPriors:
@@ -240,8 +232,9 @@ def calibrate_study(
             ``HyperPriors.sepia()``). Every other parameter is its model's.
         n_samples, n_burn, tune, seed, n_chains, init, tune_rounds, tune_levels, extrapolate,
             progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep);
-            seed None draws one from fresh entropy, and the integer the study ran with is
-            ``study.settings["seed"]`` (``seed=that`` reruns it).
+            seed None (or a numpy Generator) draws one from fresh entropy (from the
+            Generator), and the integer the study ran with is ``study.settings["seed"]``
+            (``seed=that`` reruns it).
         metadata: a JSON-able dict saved with the study.
         discrepancy, discrepancy_groups: each model's discrepancy basis and its precision
             groups, as ``gpmsa.calibrate``'s (None, "constant", "linear" or an array; groups
@@ -291,7 +284,7 @@ def calibrate_study(
     for e in emulators:
         check_emulator(e)
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
-    seed = _run_seed(seed)
+    seed = run_seed(seed)
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     extrapolate = check_flag(extrapolate, "extrapolate")
@@ -433,7 +426,7 @@ def fit_study(
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
     n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int | np.integer) else n_burn
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
-    seed = _run_seed(seed)
+    seed = run_seed(seed)
     check_point(point)
     n_keep = check_keep(n_keep, n_chains)
     metadata = check_metadata(metadata)
