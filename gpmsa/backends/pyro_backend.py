@@ -91,11 +91,8 @@ class PyroModel:
             if k in problem.fixed or np.size(v) == 0
         }
         self.free = tuple(k for k in problem.sampled if k not in self.const)
-        self.held = {
-            k: _scatter(problem.init[k], problem.fixed_elements[k], dtype)
-            for k in self.free
-            if problem.fixed_elements.get(k)
-        }
+        masks = problem.held_masks(self.free)
+        self.held = {k: _scatter(problem.init[k], mask, dtype) for k, mask in masks.items()}
         self.support = {
             name: _support(problem, name, dtype, self.held[name][0].numpy() if name in self.held
                            else None)
@@ -174,14 +171,12 @@ class PyroModel:
         pyro.factor("log_likelihood", self.log_likelihood(prm)[0])
 
 
-def _scatter(init: np.ndarray, held, dtype: torch.dtype):
+def _scatter(init: np.ndarray, held: np.ndarray, dtype: torch.dtype):
     """(free flat indices (n_free,), order (n,), held values (n_held,)) of a parameter of
-    initial value ``init`` whose elements ``held`` (index tuples) are held at ``init``'s values:
-    ``cat([free values, held values])[..., order]`` is the flattened full array."""
-    mask = np.zeros(init.shape, dtype=bool)
-    for idx in held:
-        mask[idx] = True
-    mask = mask.reshape(-1)
+    initial value ``init`` whose elements ``held`` (a boolean mask, ``Problem.held_masks``) are
+    held at ``init``'s values: ``cat([free values, held values])[..., order]`` is the flattened
+    full array."""
+    mask = np.asarray(held, dtype=bool).reshape(-1)
     free, fixed = np.flatnonzero(~mask), np.flatnonzero(mask)
     order = np.empty(mask.size, dtype=np.int64)
     order[free], order[fixed] = np.arange(free.size), free.size + np.arange(fixed.size)
@@ -310,15 +305,11 @@ def sample(
         for name in problem.names:
             draws.setdefault(name, []).append(prm[name].numpy())
     rate, wid = {}, {}
-    for name in problem.names:
-        shape = problem.init[name].shape
-        sampled = name not in problem.fixed
-        rate[name] = np.stack(
-            [np.full(shape, r[1] if sampled else np.nan, dtype=float) for r in runs]
-        )
-        wid[name] = np.stack([np.full(shape, r[2] if sampled else np.nan) for r in runs])
-        for idx in problem.fixed_elements.get(name, ()):  # held: no step, no acceptance
-            rate[name][(slice(None), *idx)] = wid[name][(slice(None), *idx)] = np.nan
+    masks = problem.held_masks()
+    for name in problem.names:  # held: no step, no acceptance
+        held = masks.get(name, np.zeros(problem.init[name].shape, dtype=bool))
+        rate[name] = np.stack([np.where(held, np.nan, float(r[1])) for r in runs])
+        wid[name] = np.stack([np.where(held, np.nan, float(r[2])) for r in runs])
     return Chains(
         draws={k: np.stack(v) for k, v in draws.items()},
         log_post=np.stack(log_post),

@@ -160,29 +160,20 @@ def calibration_fixed(emulator, fixed, discrepancy=None) -> dict | None:
             raise GPMSAError(f"fixed: unknown parameter {name!r}{hint}; calibrate holds {allowed}")
     out = dict(fixed)
     if "theta" in out:
-        levels = theta_levels(emulator)
-        unit = per_element.theta_unit(out["theta"], emulator.standardizer, names, levels)
-        at = dict(enumerate(unit)) if isinstance(unit, np.ndarray) else unit
-        for k, lv in enumerate(levels or ()):  # a categorical element: exactly its level
-            if lv is not None and k in at:
-                at[k] = float(np.asarray(lv)[np.argmin(np.abs(np.asarray(lv) - at[k]))])
-        out["theta"] = np.array([at[k] for k in range(len(names))]) if len(at) == len(
-            names) else at  # fmt: skip
+        out["theta"] = per_element.theta_unit(out["theta"], emulator.standardizer, names,
+                                              theta_levels(emulator))  # fmt: skip
     return out
 
 
-def _held_native(emulator, fixed) -> dict[str, float]:
-    """The native value of each theta element that ``fixed`` (as the user gave it) holds, by
-    t_name: the draws hold exactly these."""
+def calibration_held_native(emulator, fixed) -> dict[int, float]:
+    """position -> native value of each theta element that ``fixed`` (``calibrate``'s, as the
+    user gave it, checked by `calibration_fixed`) holds: the draws hold exactly these
+    (``fixed_elements.held_native``: the value given, a categorical one its level)."""
     if not fixed or "theta" not in fixed:
         return {}
-    names = [str(n) for n in emulator.t_names]
-    value = fixed["theta"]
-    if isinstance(value, dict):
-        given = per_element.theta_by_position(value, names)
-        return {names[int(k)]: float(v) for k, v in given.items()}
-    native = constraints.theta_native(value, names, "fixed['theta']")
-    return {n: float(v) for n, v in zip(names, native, strict=True)}
+    levels = theta_levels(emulator)
+    cat = None if levels is None else [lv is not None for lv in levels]
+    return per_element.held_native(fixed["theta"], emulator.t_names, cat)
 
 
 def _theta_options(emulator, constraint, theta_init):
@@ -392,8 +383,8 @@ def calibrate(
                 progress, where, {**theta_opts, "fixed": held},
             )  # fmt: skip
     held_names = info.pop("held_names", ())
-    for name, value in _held_native(emulator, fixed).items():  # exactly the value given
-        draws[name][...] = value
+    for k, value in calibration_held_native(emulator, fixed).items():  # the value given
+        draws[emulator.t_names[k]][...] = value
     require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
     samples = {k: v.reshape(-1) for k, v in chains.items()}
@@ -597,7 +588,7 @@ def _run_backend(
         **opts,
     )  # fmt: skip
     std = emulator.standardizer
-    masks = held_masks(problem)
+    masks = problem.held_masks(CALIBRATION_FIXED)
     if masks:  # float64 whatever the backend sampled in, a held parameter exactly its value
         chains_draws = {k: np.array(v, dtype=float) for k, v in chains.draws.items()}
         for k, mask in masks.items():
@@ -628,23 +619,9 @@ def _run_backend(
 
 def held_discrepancy_names(problem: Problem, masks: dict[str, np.ndarray]) -> list[str]:
     """The posterior names (``to_samples``': "lamVz[1]", "betaV[0,1]", ...) of the discrepancy
-    elements that ``masks`` (`held_masks`) hold; [] without a discrepancy."""
+    elements that ``masks`` (``Problem.held_masks``) hold; [] without a discrepancy."""
     if "lamVz" not in problem.init:
         return []
     shown = to_samples(*(masks.get(k, np.zeros(problem.init[k].shape, bool))
                          for k in ("betaV", "lamVz")))  # fmt: skip
     return [k for k, v in shown.items() if v]
-
-
-def held_masks(problem: Problem) -> dict[str, np.ndarray]:
-    """name -> boolean mask of its held elements, for each calibration parameter the
-    Problem holds (whole: every element) beyond the emulator's."""
-    out = {}
-    for k in (problem.fixed - set(EMULATOR_PARAMS)) | set(problem.fixed_elements):
-        mask = np.zeros(problem.init[k].shape, dtype=bool)
-        if k in problem.fixed:
-            mask[...] = True
-        for idx in problem.fixed_elements.get(k, ()):
-            mask[idx] = True
-        out[k] = mask
-    return out

@@ -191,11 +191,8 @@ def fit(
     # float64 whatever the backend sampled in (torch float32), a fixed parameter exactly at its
     # value
     post = {k: np.asarray(v[:, n_burn:], dtype=float) for k, v in chains.draws.items()}
-    for k in problem.fixed & set(post):
-        post[k][...] = np.asarray(problem.init[k], dtype=float).reshape(post[k].shape[2:])
-    for k, held in problem.fixed_elements.items():
-        for idx in held:
-            post[k][(slice(None), slice(None), *idx)] = float(problem.init[k][idx])
+    for k, mask in problem.held_masks(post).items():
+        post[k][:, :, mask] = problem.init[k][mask]
     lp = chains.log_post[:, n_burn:]
     lp_kept = lp[:, ::thin].reshape(-1)
     n_kept = lp_kept.size  # explicit: an empty parameter (betaV when p = 0) has no -1 to infer
@@ -208,6 +205,8 @@ def fit(
         for k, lv in enumerate(problem.theta_levels or ()):
             if lv is not None:  # categorical draws: exactly the level codes
                 native[..., k] = np.round(native[..., k])
+        for k, v in fit_held_native(problem, fixed, data.t_names).items():
+            native[:, k] = v  # exactly the value given (as gpmsa.calibrate)
         calibration["theta_native"] = native
     settings = {
         "n_iter": int(n_iter), "n_burn": n_burn, "thin": thin, "n_chains": int(n_chains),
@@ -330,6 +329,17 @@ def hold_fixed(problem: Problem, fixed, standardizer, t_names) -> Problem:
         fixed["theta"] = per_element.theta_unit(fixed["theta"], standardizer, t_names,
                                                 problem.theta_levels)  # fmt: skip
     return problem.with_fixed(fixed)
+
+
+def fit_held_native(problem: Problem, fixed, t_names) -> dict[int, float]:
+    """position -> native value of each theta element that ``fit``'s ``fixed=`` (checked by
+    `hold_fixed`) holds in ``problem``, a joint fit: exactly the value given, a categorical
+    one its level (``fixed_elements.held_native``); {} where it holds none."""
+    if not isinstance(fixed, dict) or "theta" not in fixed or problem.obs is None:
+        return {}
+    levels = problem.theta_levels
+    cat = None if levels is None else [lv is not None for lv in levels]
+    return per_element.held_native(fixed["theta"], t_names, cat)
 
 
 def continued_starts(

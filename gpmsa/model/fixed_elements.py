@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model import constraints
+from gpmsa.model import categorical, constraints
 from gpmsa.model.data import as_real
 
 Index = tuple[int, ...]
@@ -121,7 +121,9 @@ def theta_unit(value, std, names, levels=None):
     value; a dict that names every element is the whole vector. Each value is checked as
     ``theta_init``'s: inside the design's range ``std.t_min`` .. ``std.t_max``, and a
     categorical element (``levels``: per element its unit-scale levels or None; None: all
-    continuous) at one of its levels."""
+    continuous) at one of its levels (within 1e-12 on the unit scale), returned as exactly
+    that level: ``fit``, ``calibrate`` and the studies hold it so (`held_native` is its
+    native value)."""
     names = list(names)
     closed = None if levels is None else [lv is not None for lv in levels]
     keep = None
@@ -143,7 +145,24 @@ def theta_unit(value, std, names, levels=None):
         if lv is not None and not np.any(np.isclose(lv, unit[k], rtol=0, atol=1e-12)):
             raise GPMSAError("fixed theta: categorical calibration parameter "
                              f"{names[k]} must be one of its training levels")  # fmt: skip
+    unit = categorical.snap_to_levels(unit, levels or ())  # a categorical one: its level
     return unit if keep is None else {k: float(unit[k]) for k in keep}
+
+
+def held_native(value, names, categorical_at=None) -> dict[int, float]:
+    """position -> native value of each theta element that ``fixed['theta']`` (``value``, as
+    `theta_unit` takes it, checked there) holds: exactly the value given, a categorical
+    element (``categorical_at``: per element whether it is; None: none) its level's integer
+    code (the value `theta_unit` snaps to). The draws report these, not their unit values
+    read back through the range (which can come back an ulp off)."""
+    names = [str(n) for n in names]
+    if isinstance(value, dict):
+        given = parse("theta", theta_by_position(value, names), (len(names),))
+        out = {k: x for (k,), x in given.items()}
+    else:
+        out = dict(enumerate(map(float, constraints.theta_native(value, names, "fixed['theta']"))))
+    cat = categorical_at or [False] * len(names)
+    return {k: float(np.round(x)) if cat[k] else x for k, x in out.items()}
 
 
 def record(values: dict) -> dict:

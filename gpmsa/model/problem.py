@@ -214,6 +214,20 @@ class Problem:
         held = {k: v for k, v in self.fixed_elements.items() if k not in fixed}
         return replace(self, init=init, fixed=frozenset(fixed), fixed_elements=held)
 
+    def held_masks(self, names=None) -> dict[str, np.ndarray]:
+        """name -> boolean mask (the parameter's shape) of its held elements, for each parameter
+        the problem holds (``fixed``: every element; ``fixed_elements``: those), in ``names``
+        (None: every parameter; a calibration passes its own, as its emulator's are held
+        whole)."""
+        out = {}
+        for k in self.names:
+            if (names is None or k in names) and (k in self.fixed or self.fixed_elements.get(k)):
+                mask = np.full(self.init[k].shape, k in self.fixed)
+                for idx in self.fixed_elements.get(k, ()):
+                    mask[idx] = True
+                out[k] = mask
+        return out
+
     def with_fixed(self, values: dict) -> Problem:
         """A copy holding the parameters in ``values`` (name -> value on the model's scales,
         scalar or the parameter's shape) at those values; a value given as a dict element index

@@ -142,6 +142,14 @@ class Layout:
         """Study elements of hierarchical group g."""
         return [e for e, el in enumerate(self.elements) if el.group == g]
 
+    def same_unit_value(self, e: int, a: float, b: float) -> bool:
+        """Whether unit-scale values ``a`` and ``b`` of study element ``e`` are one native
+        value: the layout takes models whose ranges of a shared parameter agree to 1e-12
+        (relative), so one native value reads unit values that far apart (and a few ulps of
+        rounding)."""
+        lo, hi = self.bounds[e]
+        return abs(a - b) <= 2e-12 * (abs(lo) + abs(hi)) / (hi - lo) + 8 * np.finfo(float).eps
+
 
 def _names(arg, what: str) -> tuple[str, ...]:
     if isinstance(arg, str):

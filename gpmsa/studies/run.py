@@ -13,16 +13,24 @@ import numpy as np
 
 from gpmsa._version import library_versions
 from gpmsa.calibration.calibrate import (
+    CALIBRATION_FIXED,
     calibration_fixed,
+    calibration_held_native,
     calibration_problem,
     held_discrepancy_names,
-    held_masks,
     observation_fit,
 )
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
-from gpmsa.fitting.fit import check_keep, check_point, hold_fixed, point_estimate, thinning
+from gpmsa.fitting.fit import (
+    check_keep,
+    check_point,
+    fit_held_native,
+    hold_fixed,
+    point_estimate,
+    thinning,
+)
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
@@ -34,7 +42,7 @@ from gpmsa.model.problem import ORDER, fixed_record, prepare
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
 from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
 from gpmsa.studies.sampler import StudyChains, held_elements, sample_study
-from gpmsa.studies.study import OBS_DIGESTS, OBS_LAYOUTS, Study, layout_of
+from gpmsa.studies.study import HELD_THETA, OBS_DIGESTS, OBS_LAYOUTS, Study, layout_of
 
 
 def _sequence(value, what: str) -> list:
@@ -123,7 +131,7 @@ def _held_names(problems, layout, fixes) -> list[str]:
         return []
     names = [layout.elements[e].name for e in sorted(held_elements(problems, layout))]
     for lab, prob in zip(layout.labels, problems, strict=True):
-        masks = held_masks(prob)
+        masks = prob.held_masks(CALIBRATION_FIXED)
         if "lamOs" in masks:  # one element: held whole
             names.append(f"lamOs[{lab}]")
         names += [f"{k}[{lab}]" for k in held_discrepancy_names(prob, masks)]
@@ -319,7 +327,8 @@ def calibrate_study(
     )  # fmt: skip
     chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
-    _record_fixed(settings, labels, problems, layout, fixes)
+    natives = [calibration_held_native(e, f) for e, f in zip(emulators, fixes, strict=True)]
+    _record_fixed(settings, labels, problems, layout, fixes, natives)
     settings[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
     settings[OBS_LAYOUTS] = {lab: r.layout_sha256 for lab, r in zip(labels, reduced, strict=True)}
     recorded = {lab: {"discrepancy": basis if isinstance(basis, str) else "given",
@@ -336,11 +345,14 @@ def calibrate_study(
     return study
 
 
-def _record_fixed(settings: dict, labels, problems, layout, fixes, emulator=False) -> None:
+def _record_fixed(settings: dict, labels, problems, layout, fixes, natives,
+                  emulator=False) -> None:  # fmt: skip
     """With ``fixed=``: ``settings["fixed"]`` label -> the model's held parameters (as
     ``calibrate``'s ``info["fixed"]``; ``emulator``: the emulator's parameters too, as
-    ``fit``'s ``settings["fixed"]``) and ``settings["held"]`` the posterior names held (not
-    judged for convergence)."""
+    ``fit``'s ``settings["fixed"]``), ``settings["held"]`` the posterior names held (not
+    judged for convergence) and, where theta elements are held, ``settings[HELD_THETA]``
+    each one's native value as given (``natives``: per model, position -> value; a shared
+    element its first model's), which the posterior reports exactly (``Study``)."""
     if all(f is None for f in fixes):
         return
     out = {}
@@ -348,11 +360,16 @@ def _record_fixed(settings: dict, labels, problems, layout, fixes, emulator=Fals
         if f is None:
             continue
         # a calibration holds every emulator parameter: record only those the user named
-        named = {k for k in (*prob.fixed, *prob.fixed_elements)
-                 if k not in EMULATOR_PARAMS or (emulator and k in f)}  # fmt: skip
+        named = {k for k in prob.held_masks() if k not in EMULATOR_PARAMS or (emulator and k in f)}
         out[lab] = fixed_record(prob, named)
     settings["fixed"] = out
     settings["held"] = _held_names(problems, layout, fixes)
+    theta = {}
+    for i, values in enumerate(natives):
+        for k, v in values.items():
+            theta.setdefault(layout.elements[layout.index[i][k]].name, v)
+    if theta:
+        settings[HELD_THETA] = theta
 
 
 def _per_model(label: str, make, *args, **kwargs):
@@ -462,7 +479,9 @@ def fit_study(
     thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
     keep = slice(int(n_burn), None, thin)
     settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point)
-    _record_fixed(settings, labels, problems, layout, fixes, emulator=True)
+    natives = [fit_held_native(p, f, s.t_names)
+               for p, f, s in zip(problems, fixes, sims, strict=True)]  # fmt: skip
+    _record_fixed(settings, labels, problems, layout, fixes, natives, emulator=True)
     draws = _study_draws(chains, keep)
     lp = draws["log_post"].reshape(-1)
     members = []
@@ -476,6 +495,8 @@ def fit_study(
         params = point_estimate(flat, lp, point)
         cal = {k: v for k, v in flat.items() if k not in EMULATOR_PARAMS}
         cal["theta_native"] = prep.standardizer.t_from_unit(cal["theta"])
+        for k, v in natives[i].items():
+            cal["theta_native"][:, k] = v  # exactly the value given (as gpmsa.fit)
         emu_settings = {"n_iter": int(n_iter), "n_burn": int(n_burn), "thin": thin,
                         "n_chains": int(n_chains), "tune": bool(tune), "backend": "numpy",
                         "seed": seed, "point": point, "n_pc": int(prep.K.shape[1]),

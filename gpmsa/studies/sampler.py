@@ -69,13 +69,9 @@ def held_elements(problems: list[Problem], layout: Layout) -> dict[int, float]:
     share an element hold it at different values, or some of them do not hold it."""
     held: dict[int, float] = {}
     for i, prob in enumerate(problems):
-        if "theta" in prob.fixed:
-            pos = range(prob.q)
-        else:
-            pos = sorted(k for (k,) in prob.fixed_elements.get("theta", ()))
-        for k in pos:
+        for k in np.flatnonzero(_theta_mask(prob)):
             e, v = layout.index[i][k], float(prob.init["theta"][k])
-            if not _same_unit_value(layout, e, held.get(e, v), v):
+            if not layout.same_unit_value(e, held.get(e, v), v):
                 raise GPMSAError(
                     f"fixed theta: the models sharing {layout.elements[e].name} hold it at "
                     "different values; hold a shared parameter at one value"
@@ -93,17 +89,14 @@ def held_elements(problems: list[Problem], layout: Layout) -> dict[int, float]:
     return held
 
 
-def _same_unit_value(layout: Layout, e: int, a: float, b: float) -> bool:
-    """Whether unit-scale values ``a`` and ``b`` of study element ``e`` are one native value: the
-    layout takes models whose ranges of a shared parameter agree to 1e-12 (relative), so one
-    native value reads unit values that far apart (and a few ulps of rounding)."""
-    lo, hi = layout.bounds[e]
-    return abs(a - b) <= 2e-12 * (abs(lo) + abs(hi)) / (hi - lo) + 8 * np.finfo(float).eps
+def _theta_mask(problem: Problem) -> np.ndarray:
+    """The theta elements ``problem`` holds (``Problem.held_masks``), a boolean mask (q,)."""
+    return problem.held_masks(("theta",)).get("theta", np.zeros(problem.q, dtype=bool))
 
 
 def _holds(problem: Problem, k: int) -> bool:
     """Whether ``problem`` holds its theta element ``k``."""
-    return "theta" in problem.fixed or (k,) in problem.fixed_elements.get("theta", ())
+    return bool(_theta_mask(problem)[k])
 
 
 class StudyState:

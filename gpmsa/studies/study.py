@@ -31,7 +31,7 @@ from gpmsa.io.container import (
     write_sealed,
 )
 from gpmsa.mcmc.diagnostics import convergence, summarize
-from gpmsa.model.data import check_count
+from gpmsa.model.data import as_real, check_count
 from gpmsa.model.discrepancy import to_samples
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
 from gpmsa.studies.record import (
@@ -51,6 +51,12 @@ OBS_LAYOUTS = "obs_layout_sha256_by_model"
 """The settings key of a calibrated study's record of where each model's observations lie and
 how precise they are: label -> ``layout_digest`` (``member_posterior``'s info
 "obs_layout_sha256", as ``gpmsa.calibrate`` records it)."""
+
+HELD_THETA = "held_theta"
+"""The settings key of a study whose models hold theta elements (``fixed=``): study element
+name -> the native value held, as given; the posterior reports exactly it (as
+``gpmsa.calibrate`` does), where the unit-scale draws read back through the element's range
+can come back an ulp off."""
 
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
@@ -135,6 +141,36 @@ def native_chains(layout: Layout, draws: dict[str, np.ndarray]) -> dict[str, np.
     return out
 
 
+def _held_theta(layout: Layout, draws: dict[str, np.ndarray], settings: dict) -> dict[str, float]:
+    """``settings[HELD_THETA]`` checked against the draws (absent: {}, as in files written
+    before it): GPMSAError unless each name is a study element whose every draw is one unit
+    value, the value given within the rounding ``Layout.same_unit_value`` allows."""
+    held = settings.get(HELD_THETA)
+    if held is None:
+        return {}
+    where = f"settings[{HELD_THETA!r}]"
+    if not isinstance(held, dict):
+        raise GPMSAError(f"{where} must be an object element name -> native value, got "
+                         f"{type(held).__name__}")  # fmt: skip
+    names = [el.name for el in layout.elements]
+    out = {}
+    for name, value in held.items():
+        if name not in names:
+            raise GPMSAError(f"{where}: {name!r} is no study element; they are {names}")
+        value = as_real(value, f"{where}[{name!r}]")
+        if not np.isfinite(value):
+            raise GPMSAError(f"{where}[{name!r}] must be finite, got {value!r}")
+        e = names.index(name)
+        lo, hi = layout.bounds[e]
+        col = draws["theta"][:, :, e]
+        if col.size and not (np.all(col == col.flat[0])
+                             and layout.same_unit_value(e, float(col.flat[0]),
+                                                        (value - lo) / (hi - lo))):  # fmt: skip
+            raise GPMSAError(f"{where}[{name!r}] = {value!r} is not the value its draws hold")
+        out[name] = value
+    return out
+
+
 class Study:
     """Several models calibrated together (shared and hierarchical theta); docs/models.md.
 
@@ -161,6 +197,8 @@ class Study:
         self.settings = dict(settings or {})
         self.metadata = dict(metadata or {})
         chains = native_chains(layout, self.draws)
+        for name, value in _held_theta(layout, self.draws, self.settings).items():
+            chains[name][...] = value
         samples = {k: v.reshape(-1) for k, v in chains.items()}
         self.diagnostics = summarize(chains)
         n_chains, n_draws = self.draws["log_post"].shape
