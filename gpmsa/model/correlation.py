@@ -63,6 +63,24 @@ def correlation(
     return np.exp(exponent, out=exponent)
 
 
+def correlation_row(
+    a: list[float], b_cols: list[np.ndarray], beta: list[float], categorical: list[bool]
+) -> np.ndarray:
+    """``correlation(np.array([a]), b, beta, categorical)[0]`` (the same operations, so the same
+    values) for one point a (d floats) against b given as its d contiguous columns (n_b,): the
+    per-proposal call of a sampler, without the array set-up (a few microseconds)."""
+    exponent = np.zeros(b_cols[0].shape[0])
+    for ak, bk, beta_k, cat in zip(a, b_cols, beta, categorical, strict=True):
+        if cat:
+            diff = CATEGORICAL_DISTANCE * (ak != bk)
+        else:
+            diff = ak - bk
+            diff *= diff
+        diff *= beta_k
+        exponent -= diff
+    return np.exp(exponent, out=exponent)
+
+
 def beta_to_rho(beta: np.ndarray) -> np.ndarray:
     """rho = exp(-beta / 4): the correlation at distance 1/2 on the unit scale."""
     return np.exp(-0.25 * np.asarray(beta))
