@@ -159,7 +159,8 @@ def main() -> None:
     ratio = np.median(wall[True]) / np.median(wall[False])
     ratio_cpu = np.median(cpu[True]) / np.median(cpu[False])
     print(f"  fast / numpy backend, 2 parameters: {ratio:.2f} (wall), {ratio_cpu:.2f} (CPU)")
-    cached = sum(a.nbytes for p in cal._predictors for a in [p.rt_alpha, *(p.H or [])])
+    predictors = [*cal._predictors, *(cal._refined[1] if cal._refined else [])]
+    cached = sum(a.nbytes for p in predictors for a in [p.rt_alpha, *(p.H or [])])
     cached += sum(g.chol.nbytes + g.alpha.nbytes for g in cal._gps)
     tracemalloc.start()
     gpmsa.Calibrator(emu)

@@ -601,6 +601,15 @@ def refined_axes(axes: list, logp: np.ndarray, keep: list | None) -> list | None
     return None
 
 
+def whole_refined_axis(axis: np.ndarray) -> np.ndarray:
+    """One parameter: the axis `refined_axis` gives when one unresolved mode holds the whole
+    ``axis`` (the usual refinement of a narrow posterior with heavy tails, no grid lines kept):
+    what a Calibrator can prepare its predictor for once, instead of dense solves per update."""
+    last = np.array([axis.size - 1])
+    return _finer_axis(axis, (np.array([0]), last, np.array([True])), N_REFINE, None,
+                       REFINE_FACTORS[0])  # fmt: skip
+
+
 def refined_axis(
     axis: np.ndarray, logp: np.ndarray, keep: np.ndarray | None, min_step: float
 ) -> tuple[np.ndarray | None, str]:
