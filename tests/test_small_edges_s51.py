@@ -1,8 +1,8 @@
 """Small edges: the posterior grid's GD axis follows its draws; a one-segment track needs no
 blend; the GD fits leave out the Nyquist bin; Campaign.save writes through a symbolic link;
-shared_theta's traces and ball_drop's summary stay finite / valid JSON for a short chain."""
+shared_theta's traces stay finite for a short chain (ball_drop's summary stays valid JSON for
+one: tests/gpmsa/test_example_ball_drop.py checks it in its run of the example)."""
 
-import json
 import os
 from types import SimpleNamespace
 
@@ -147,15 +147,3 @@ def test_shared_theta_draws_a_chain_that_never_moved(tmp_path):
     # two sweeps: the shared E never moves, so its trace (standardised by sd 0) was NaN
     assert summary["posterior"]["shared (emulators fixed)"]["E"]["sd"] == 0.0
     assert (tmp_path / "traces.png").stat().st_size > 0
-
-
-@pytest.mark.filterwarnings("ignore::UserWarning")
-def test_ball_drop_summary_is_json_with_null_for_an_undefined_ess(tmp_path):
-    load_example("ball_drop").main(["--n-iter", "2", "--runs", "12", "--out", str(tmp_path)])
-
-    def refuse(name):
-        raise AssertionError(f"summary.json holds {name}, which JSON does not allow")
-
-    summary = json.loads((tmp_path / "summary.json").read_text(), parse_constant=refuse)
-    assert summary["posterior"]["Cd"]["n_draws"] == 2
-    assert summary["posterior"]["Cd"]["ess"] is None  # fewer draws than an ESS needs

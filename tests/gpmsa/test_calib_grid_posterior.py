@@ -43,6 +43,22 @@ def symmetric_two_param_emulator() -> Emulator:
     return Emulator.from_params(sim, params)
 
 
+def peaks_data() -> tuple[np.ndarray, np.ndarray]:
+    """12 observations of `symmetric_two_param_emulator` at a = 0.3, b = 0.5: peaks of a near
+    0.3 and 0.7."""
+    x = np.linspace(0.05, 0.95, 12)[:, None]
+    return x, (0.3 - 0.5) ** 2 * (1 + x) + 0.3 * 0.5 * x
+
+
+@cache
+def fine_peaks_posterior():
+    """`peaks_data` on a 257 x 257 grid (resolved: no warning, not refined), made once (5 s)
+    for the tests that read it; a warning is an error wherever it is made first."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return Calibrator(symmetric_two_param_emulator(), n_grid=257).update(*peaks_data())
+
+
 CONSTRAINTS = {  # name: (constraint, the allowed region's bounds within the design, GD)
     "upper": (lambda th: th[0] <= 401.3, (None, 401.3)),
     "lower": (lambda th: th[0] >= 447.7, (447.7, None)),
@@ -194,15 +210,14 @@ def test_two_parameter_peaks_are_each_refined():
     both parameters with 49 nodes over their whole live range (coarser than the grid for b) and
     found P(a < 0.5) = 0.1366 instead of 0.1473."""
     emu = symmetric_two_param_emulator()
-    x = np.linspace(0.05, 0.95, 12)[:, None]
-    y = (0.3 - 0.5) ** 2 * (1 + x) + 0.3 * 0.5 * x
+    x, y = peaks_data()
     # two peaks too far apart to refine both within the node budget: the moments below are
     # right, the quantiles and cdf of a are not (0.026 off), and a warning says so
     with pytest.warns(
         UserWarning, match=r"does not resolve the posterior of a: its width \(.*\) spans 0\.8"
     ):
         post = Calibrator(emu).update(x, y)
-    fine = Calibrator(emu, n_grid=257).update(x, y)  # resolved: not refined
+    fine = fine_peaks_posterior()  # resolved: not refined
     assert post.info["refined"] and not fine.info["refined"]
     assert post.prob_above("a", 0.5) == pytest.approx(fine.prob_above("a", 0.5), abs=1e-4)
     for name in ("a", "b"):

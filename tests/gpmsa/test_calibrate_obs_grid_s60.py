@@ -163,18 +163,29 @@ def test_obsdata_on_the_simulation_grid_gives_the_arrays_draws():
     assert ga.mean("t") == gb.mean("t") and ga.sd("t") == gb.sd("t")
 
 
-@pytest.mark.parametrize("backend", ["numpy-generic", "torch"])
-def test_every_sampler_agrees_with_the_grid_on_own_grids(backend):
+@pytest.mark.parametrize(
+    ("sampler", "opts"),
+    [
+        ("numpy", {}),
+        ("numpy-generic", {"fast": False}),
+        # 10 tuning rounds, not the 50 of one chain's default: 3.5 s, not 6.5 s; over seeds
+        # 0-11 the mean within 0.09 sd of the exact one, the sd within 7 %, ESS 340-560
+        ("torch", {"backend": "torch", "tune_rounds": 10}),
+    ],
+    ids=["numpy", "numpy-generic", "torch"],
+)  # fmt: skip
+def test_every_sampler_agrees_with_the_grid_on_own_grids(sampler, opts):
     """calibrate's samplers on ragged grids with precisions: within Monte-Carlo error of the
-    exact grid posterior (the fast numpy sampler, the generic one, torch)."""
+    exact grid posterior (the fast numpy sampler, the generic one, torch). Equal precisions
+    would move the exact mean by 0.32 sd."""
+    if sampler == "torch":
+        pytest.importorskip("torch")
     emu = vector_emulator()
     obs = ragged_obs([1e4, 2.5e3])
     exact = gpmsa.Calibrator(emu).update(obs)
-    opts = {"fast": False} if backend == "numpy-generic" else {"backend": backend}
-    for kw in ({}, opts):
-        post = gpmsa.calibrate(emu, obs, n_samples=2000, n_burn=200, seed=5, **kw)
-        assert abs(post.mean("t") - exact.mean("t")) < 0.25 * exact.sd("t")
-        assert abs(post.sd("t") / exact.sd("t") - 1.0) < 0.25
+    post = gpmsa.calibrate(emu, obs, n_samples=2000, n_burn=200, seed=5, **opts)
+    assert abs(post.mean("t") - exact.mean("t")) < 0.25 * exact.sd("t")
+    assert abs(post.sd("t") / exact.sd("t") - 1.0) < 0.25
 
 
 def test_full_prediction_conditions_on_the_calibrated_layout_and_refuses_another():

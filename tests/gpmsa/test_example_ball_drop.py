@@ -37,12 +37,22 @@ def test_the_real_world_is_slower_than_the_simulator_at_its_own_cd_and_g():
         assert np.all(gap >= bd.WORLD["delay"]) and np.all(np.diff(gap) > 0)
 
 
+@pytest.mark.filterwarnings("ignore::UserWarning")
 def test_small_run_saves_every_figure_and_the_summary(tmp_path):
-    summary = load_script().main(["--out", str(tmp_path), "--n-iter", "300", "--runs", "40"])
+    """Two sweeps of 12 runs (one run of the example, 6 s, serves both checks): every figure
+    and the summary, which is JSON with null for an ESS that two draws leave undefined."""
+    summary = load_script().main(["--out", str(tmp_path), "--n-iter", "2", "--runs", "12"])
     assert sorted(p.name for p in tmp_path.glob("*.png")) == FIGURES
-    assert json.loads((tmp_path / "summary.json").read_text())["figures"] == FIGURES
     assert set(summary["posterior"]) == {"Cd", "g", "lamOs", "lamVz", "betaV"}
     assert set(summary["sensitivity"]) == {"R", "Cd", "g"}
+
+    def refuse(name):
+        raise AssertionError(f"summary.json holds {name}, which JSON does not allow")
+
+    written = json.loads((tmp_path / "summary.json").read_text(), parse_constant=refuse)
+    assert written["figures"] == FIGURES
+    assert written["posterior"]["Cd"]["n_draws"] == 2
+    assert written["posterior"]["Cd"]["ess"] is None  # fewer draws than an ESS needs
 
 
 @pytest.mark.slow

@@ -53,7 +53,8 @@ def test_a_fit_without_a_seed_records_one_that_repeats_it(data):
 
 def test_a_torch_dtype_is_recorded_by_name(data):
     torch = pytest.importorskip("torch")
-    emu = _fit(data, seed=0, backend="torch", dtype=torch.float32)
+    emu = _fit(data, seed=0, backend="torch", dtype=torch.float32, tune=False)  # tuning: 3,300
+    # sweeps of one chain, 9 s, for a record that does not depend on it
     assert emu.settings["backend_options"] == {"dtype": "float32"}
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from _calib_cases import two_param_emulator
 from scipy.integrate import cumulative_trapezoid
-from test_calib_grid_posterior import symmetric_two_param_emulator
+from test_calib_grid_posterior import fine_peaks_posterior, peaks_data, symmetric_two_param_emulator
 from test_constraint_two_params import broad_case, cut_posterior, peaks_case
 
 from gpmsa import Calibrator
@@ -53,8 +53,15 @@ def dense_reference(cal, x, y):
     return out
 
 
+@pytest.fixture(scope="module")
+def five_dense():
+    """`dense_reference` of `five_observations` (10 s): the per-node likelihood does not depend
+    on the Calibrator's n_grid (the same to the bit at 65 and 129), so both grids share it."""
+    return dense_reference(Calibrator(two_param_emulator()), *five_observations())
+
+
 @pytest.mark.parametrize("n_grid", [65, 129])
-def test_heavy_tailed_posterior_is_refined_over_its_core(n_grid):
+def test_heavy_tailed_posterior_is_refined_over_its_core(n_grid, five_dense):
     """The default grid stopped with a at 0.91 node spacings per sd (quantiles 0.19 sd and the
     cdf 0.029 off the dense grid); n_grid=129 could not refine at all (0.105 sd, 0.019); neither
     warned. Now the core holding all but TAIL_MASS of each marginal is refined, the tails kept
@@ -65,18 +72,13 @@ def test_heavy_tailed_posterior_is_refined_over_its_core(n_grid):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         post = cal.update(x, y)
-    for name, (mean, sd, quantiles) in zip(emu.t_names, dense_reference(cal, x, y), strict=True):
+    for name, (mean, sd, quantiles) in zip(emu.t_names, five_dense, strict=True):
         assert np.max(np.abs(post.quantile(name, LEVELS) - quantiles)) < 0.03 * sd
         assert np.max(np.abs(post.grids[name].cdf(quantiles) - LEVELS)) < 0.005
         assert post.mean(name) == pytest.approx(mean, abs=1e-3 * sd)
         assert post.sd(name) == pytest.approx(sd, rel=2e-3)
     assert post.info["refined"] and post.info["n_nodes"] <= 4 * 49**2
     assert min(post.info["resolution"]) > 3.5
-
-
-def peaks_data():
-    x = np.linspace(0.05, 0.95, 12)[:, None]
-    return x, (0.3 - 0.5) ** 2 * (1 + x) + 0.3 * 0.5 * x
 
 
 def test_resolved_posteriors_raise_no_warning():
@@ -88,7 +90,7 @@ def test_resolved_posteriors_raise_no_warning():
         warnings.simplefilter("error")
         broad = Calibrator(two_param_emulator()).update(*broad_case()[1:3])
         constrained = cut_posterior(peaks_case())[0]
-        fine = Calibrator(symmetric_two_param_emulator(), n_grid=257).update(*peaks_data())
+        fine = fine_peaks_posterior()  # shared with test_calib_grid_posterior (warning: error)
     assert min(broad.info["resolution"]) > 4.0 and not broad.info["refined"]
     assert constrained.info["refined"]
     assert UNRESOLVED_SD < constrained.info["resolution"][0] < 4.0

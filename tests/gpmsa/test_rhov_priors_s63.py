@@ -6,6 +6,7 @@ Before: one ``rho_a``, ``rho_b`` served betaU and betaV, so a belief that the di
 smooth (rho near 1, betaV small) also changed the emulator's betaU prior."""
 
 import contextlib
+import functools
 import io
 import math
 import warnings
@@ -210,21 +211,37 @@ def _assert_smooth(default: np.ndarray, smooth: np.ndarray, per_group=None) -> N
     assert per_group is None or (per_group[0] > 0.7 and per_group[1] < 0.1)
 
 
+NUMPY_KW = dict(n_samples=400, n_burn=100, tune_rounds=5)
+
+
+@functools.cache
+def _default_medians() -> np.ndarray:
+    """betaV medians of the default prior's posterior (numpy, seed 1): the reference of every
+    backend. Each backend's own default run (7 s on pyro) moved with the seed far more than a
+    smooth prior's (group 1's median 0.01 to 3.1 over seeds on torch, 0.06 to 0.19 on pyro:
+    its prior puts rho near 1 and the chains barely mix there), so that comparison judged the
+    seed; the default posterior is the same on every backend (test_backend_agreement)."""
+    return _medians(_calibrate(_emulator(), "numpy", **NUMPY_KW))
+
+
 @pytest.mark.parametrize(
     ("backend", "kw", "variants"),
     [
-        ("numpy", dict(n_samples=400, n_burn=100, tune_rounds=5), (SMOOTH, SMOOTH_1)),
+        ("numpy", NUMPY_KW, (SMOOTH, SMOOTH_1)),
         ("torch", dict(n_samples=150, n_burn=50, tune_rounds=3), (SMOOTH, SMOOTH_1)),
-        ("pyro", dict(n_samples=30, n_burn=10, n_warmup=30), (SMOOTH,)),  # 6-9 s a run
+        # 3 s a run; measured over seeds 0-11 (numpy's default as the reference): group 0's
+        # median 0.12-0.22 (< 0.31), group 1's 0.008-0.058 (< 0.074)
+        ("pyro", dict(n_samples=30, n_burn=10, n_warmup=30, max_tree_depth=4), (SMOOTH,)),
     ],
 )  # fmt: skip
 def test_calibrate_with_a_smooth_discrepancy_prior_moves_betav(backend, kw, variants):
+    """Each backend's posterior under SMOOTH (and SMOOTH_1) against the default's (numpy's)."""
     if backend != "numpy":
         pytest.importorskip(backend)
     emu = _emulator()
     copies = [emu.with_calibration_priors(**v) for v in variants]
     assert all(c.priors.rho_prior("betaU") == emu.priors.rho_prior("betaU") for c in copies)
-    _assert_smooth(*(_medians(_calibrate(e, backend, **kw)) for e in (emu, *copies)))
+    _assert_smooth(_default_medians(), *(_medians(_calibrate(e, backend, **kw)) for e in copies))
 
 
 def test_joint_fit_with_a_smooth_discrepancy_prior_moves_betav_only():
