@@ -260,6 +260,14 @@ class Calibrator:
         axis = whole_refined_axis(self._axes[0])
         return axis, [GridPredictor(gp, axis[:, None]) for gp in self._gps]
 
+    def __setstate__(self, state: dict) -> None:
+        """Unpickling: one pickled before the prepared refinement (session 65; a saved BCR
+        holds one) prepares it now, as a Calibrator built now does."""
+        self.__dict__.update(state)
+        if "_refined" not in state and self.method == "grid":
+            with blas_controller().limit(limits=1, user_api="blas"):
+                self._refined = self._refined_predictors()
+
     def _check_mcmc_path(self, backend: str) -> None:
         """GPMSAError now, not at every update, for MCMC settings ``gpmsa.calibrate`` refuses:
         a constraint or the emulator's draws on another backend than numpy, or the draws with

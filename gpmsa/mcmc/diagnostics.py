@@ -206,7 +206,7 @@ def warn_unconverged(
     apart = ""
     el, r = record.get("max_rhat") or ("", None)
     if el and (r is None or r > RHAT_APART):  # None with an element: an infinite R-hat
-        shown = "inf" if r is None else f"{r:.3f}"
+        shown = "inf" if r is None else beyond(r, RHAT_APART, 3)
         apart = (
             f" R-hat {shown} ({el}) says the chains lie apart, not merely that they are short: "
             "if longer chains do not bring them together, the posterior may have several "

@@ -37,6 +37,7 @@ from gpmsa.studies.layout import HyperPriors, Layout, build_layout
 from gpmsa.studies.record import (
     DISCREPANCIES,
     FILE_RE,
+    _short,
     check_study_arrays,
     check_study_claims,
     check_study_manifest,
@@ -156,17 +157,20 @@ def _held_theta(layout: Layout, draws: dict[str, np.ndarray], settings: dict) ->
     out = {}
     for name, value in held.items():
         if name not in names:
-            raise GPMSAError(f"{where}: {name!r} is no study element; they are {names}")
-        value = as_real(value, f"{where}[{name!r}]")
+            raise GPMSAError(f"{where}: {_short(name)} is no study element; they are {names}")
+        key = f"{where}[{name!r}]"
+        if isinstance(value, bool) or not isinstance(value, int | float | np.number):
+            raise GPMSAError(f"{key} must be a number, got {_short(value)}")
+        value = as_real(value, key)
         if not np.isfinite(value):
-            raise GPMSAError(f"{where}[{name!r}] must be finite, got {value!r}")
+            raise GPMSAError(f"{key} must be finite, got {value!r}")
         e = names.index(name)
         lo, hi = layout.bounds[e]
         col = draws["theta"][:, :, e]
         if col.size and not (np.all(col == col.flat[0])
                              and layout.same_unit_value(e, float(col.flat[0]),
                                                         (value - lo) / (hi - lo))):  # fmt: skip
-            raise GPMSAError(f"{where}[{name!r}] = {value!r} is not the value its draws hold")
+            raise GPMSAError(f"{key} = {value!r} is not the value its draws hold")
         out[name] = value
     return out
 

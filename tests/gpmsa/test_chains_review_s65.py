@@ -42,6 +42,8 @@ def test_chains_that_lie_apart_are_told_longer_chains_may_not_mend_it():
     stuck = _record(float("inf"), 2.0)  # chains stuck at different values
     with pytest.warns(gpmsa.ConvergenceWarning, match=r"R-hat inf \(t\) says the chains lie"):
         diagnostics.warn_unconverged(stuck, "gpmsa.fit")
+    with pytest.warns(gpmsa.ConvergenceWarning, match=r"R-hat 1\.1004 \(t\) says the chains lie"):
+        diagnostics.warn_unconverged(_record(1.1004, 50.0), "gpmsa.fit")  # not "1.100"
     with pytest.warns(gpmsa.ConvergenceWarning) as got:  # merely short: no such line
         diagnostics.warn_unconverged(_record(1.05, 50.0), "gpmsa.fit")
     assert "apart" not in str(got[0].message)
