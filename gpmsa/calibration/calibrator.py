@@ -71,7 +71,7 @@ from gpmsa.calibration.posterior import Posterior, trapezoid_weights
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
-from gpmsa.model.data import as_float, check_count, check_flag, check_seed
+from gpmsa.model.data import as_float, check_count, check_flag, run_seed
 
 METHODS = ("auto", "grid", "mcmc")
 _PROBE_AXIS = {1: 129, 2: 33}
@@ -125,7 +125,8 @@ class Calibrator:
             likelihood over up to ``n_emulator_draws`` of its retained draws, evenly spaced).
         extrapolate: allow x_obs outside the emulator's x domain (with a warning).
         n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``.
-        seed: seed of those draws (and of the MCMC), for reproducibility.
+        seed: seed of those draws (and of the MCMC), for reproducibility: an integer, a numpy
+            Generator (an integer is drawn from it) or None (fresh entropy).
         mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC
             (``"fixed"``, which holds parameters at known values, only there: with the grid
             method it is a GPMSAError).
@@ -193,7 +194,7 @@ class Calibrator:
         )
         self._n_emulator_draws = check_count(n_emulator_draws, "n_emulator_draws")
         self.emulator_params = emulator_params
-        self._entropy = np.random.SeedSequence(check_seed(seed)).entropy
+        self._entropy = np.random.SeedSequence(None if seed is None else run_seed(seed)).entropy
         self._count = 0
         self.mcmc_options = _check_mcmc_options(mcmc_options)
         if constraint is not None:
@@ -410,7 +411,8 @@ class Calibrator:
                 region (-inf) is cut at its edge, located by bisection as a constraint's
                 boundary is; for two the cell at its edge ramps to zero (``constraint`` cuts
                 exactly).
-            seed: seed of the lazily drawn samples, or of the MCMC (there it wins over
+            seed: seed (an integer or a numpy Generator) of the lazily drawn samples, or of
+                the MCMC (there it wins over
                 ``mcmc_options["seed"]``; default: derived from the Calibrator's seed and a
                 counter of its updates, an update that raises not counted).
 
@@ -464,7 +466,7 @@ class Calibrator:
                 if last:
                     res = resolution(axes, logp)
                     break
-        key = check_seed(seed) if seed is not None else (self._entropy, count)
+        key = run_seed(seed) if seed is not None else (self._entropy, count)
         post = self._posterior(axes, free, ok, margs, key, prior)
         post.info["outside_sds"] = outside
         if prior is None or callable(prior):  # an array: maybe other windows' log-likelihood
@@ -508,7 +510,7 @@ class Calibrator:
         opts = dict(self.mcmc_options)
         auto = int(_seed_sequence((self._entropy, count)).generate_state(1)[0])
         if seed is not None:  # this update's seed wins over mcmc_options' and the default
-            opts["seed"] = check_seed(seed)
+            opts["seed"] = run_seed(seed)
         opts.setdefault("seed", auto)
         opts.setdefault("emulator_params", self.emulator_params)
         opts.setdefault("n_emulator_draws", self._n_emulator_draws)

@@ -78,3 +78,16 @@ def test_a_study_takes_a_generator_seed_as_fit_does():
     b = gpmsa.calibrate_study(emus, xs, ys, seed=a.settings["seed"], **kw)
     assert a.settings["seed"] == int(np.random.default_rng(4).integers(2**63))
     np.testing.assert_array_equal(a.posterior.samples["t"], b.posterior.samples["t"])
+
+
+def test_a_calibrator_takes_a_generator_seed_as_calibrate_does():
+    from _calib_cases import road_emulator, road_obs
+
+    emu, (x, y) = road_emulator(), road_obs()
+    drawn = int(np.random.default_rng(6).integers(2**63))
+    a = gpmsa.Calibrator(emu, seed=np.random.default_rng(6)).update(x, y)
+    b = gpmsa.Calibrator(emu, seed=drawn).update(x, y)
+    np.testing.assert_array_equal(a.samples["GD"], b.samples["GD"])
+    c = gpmsa.Calibrator(emu).update(x, y, seed=np.random.default_rng(6))  # an update's seed
+    np.testing.assert_array_equal(c.samples["GD"], gpmsa.Calibrator(emu).update(
+        x, y, seed=drawn).samples["GD"])  # fmt: skip
