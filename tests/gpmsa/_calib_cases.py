@@ -85,3 +85,14 @@ def with_draws(emu: Emulator, n: int = 5, seed: int = 3) -> Emulator:
         draws=draws, log_post=np.zeros(n), levels=emu.levels, mean_basis=emu.mean_basis,
     )  # fmt: skip
     return out
+
+
+@cache
+def categorical_emulator() -> Emulator:
+    """30 runs of y = x + (0, 1, -0.7)[t] with a categorical calibration parameter t0 of three
+    levels, at fixed parameters."""
+    rng = np.random.default_rng(0)
+    x, t = rng.random(30), np.arange(30) % 3
+    sim = gpmsa.SimData(x, t, x + np.array([0.0, 1.0, -0.7])[t], t_categorical=[0])
+    return Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e3],
+                                      "lamWOs": [1e3]})  # fmt: skip

@@ -5,7 +5,7 @@ bit: the emulator's full predictive (``FixedGP.predict``), scipy's triangular so
 
 import numpy as np
 import pytest
-from _calib_cases import two_param_emulator, with_draws
+from _calib_cases import categorical_emulator, two_param_emulator, with_draws
 from scipy.linalg import solve_triangular
 from threadpoolctl import threadpool_limits
 
@@ -44,13 +44,8 @@ def _functional_two_parameters(mean_basis=None) -> gpmsa.Emulator:
 
 
 def _categorical() -> tuple[gpmsa.Emulator, np.ndarray, np.ndarray]:
-    rng = np.random.default_rng(0)
-    x, t = rng.random(30), np.arange(30) % 3
-    sim = gpmsa.SimData(x, t, x + np.array([0.0, 1.0, -0.7])[t], t_categorical=[0])
-    emu = gpmsa.Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0],
-                                           "lamWs": [1e3], "lamWOs": [1e3]})  # fmt: skip
     x_obs = np.linspace(0.1, 0.9, 5)[:, None]
-    return emu, x_obs, x_obs[:, 0] + 0.5
+    return categorical_emulator(), x_obs, x_obs[:, 0] + 0.5
 
 
 def _case(name: str):

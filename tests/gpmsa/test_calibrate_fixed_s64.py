@@ -16,7 +16,13 @@ import gpmsa
 from gpmsa import GPMSAError
 from gpmsa.calibration.observations import fixed_gp, reduce
 from gpmsa.calibration.sampler import CalibrationSampler
-from tests.gpmsa._calib_cases import road_emulator, road_obs, two_param_emulator, vector_emulator
+from tests.gpmsa._calib_cases import (
+    categorical_emulator,
+    road_emulator,
+    road_obs,
+    two_param_emulator,
+    vector_emulator,
+)
 from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator
 
 RUN = {"n_samples": 60, "n_burn": 10, "tune_rounds": 3, "tune_levels": 4}
@@ -394,11 +400,7 @@ def test_summaries_of_equal_draws_are_their_value():
 
 
 def test_a_categorical_theta_held_at_a_level_by_the_fast_sampler():
-    rng = np.random.default_rng(0)
-    x, t = rng.random(30), np.arange(30) % 3
-    sim = gpmsa.SimData(x, t, x + np.array([0.0, 1.0, -0.7])[t], t_categorical=[0])
-    emu = gpmsa.Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0],
-                                           "lamWs": [1e3], "lamWOs": [1e3]})  # fmt: skip
+    emu = categorical_emulator()
     x_obs = np.linspace(0.1, 0.9, 5)[:, None]
     post = _calibrate(emu, x_obs, x_obs[:, 0] - 0.7, seed=1, fixed={"theta": {"t0": 1}})
     assert np.all(post.samples["t0"] == 1.0) and post.info["fixed"] == {"theta": [0.5]}
