@@ -329,7 +329,29 @@ def messages_digest(log_ns: Sequence[int], data: Sequence[bytes]) -> str:
 
 
 def _sorted_digest(log_ns: Sequence[int], digests: Sequence[bytes]) -> str:
-    """SHA-256 of the (receive time, message SHA-256) pairs, sorted."""
+    """SHA-256 of the (receive time, message SHA-256) pairs, sorted: of each pair's time as a
+    little-endian int64 then its 32 bytes, by time, then by digest. Hashed as one array (a 400 Hz
+    IMU's 40,000 pairs in a few ms instead of ~20); `_sorted_digest_pairs` where a time does not
+    fit int64, as the format has always been written."""
+    n = len(digests)
+    try:
+        stamps = np.array([int(t) for t in log_ns], dtype=np.int64)
+    except OverflowError:
+        return _sorted_digest_pairs(log_ns, digests)
+    joined = b"".join(digests)
+    if stamps.size != n or len(joined) != 32 * n:
+        return _sorted_digest_pairs(log_ns, digests)
+    pairs = np.empty(n, dtype=[("t", "<i8"), ("d", "V32")])
+    pairs["t"] = stamps
+    pairs["d"] = np.frombuffer(joined, dtype="V32")
+    if n > 1 and not np.all(stamps[1:] > stamps[:-1]):  # disordered or tied: sort as tuples do
+        words = np.frombuffer(joined, dtype=">u8").reshape(n, 4)  # bytes order, word by word
+        pairs = pairs[np.lexsort((words[:, 3], words[:, 2], words[:, 1], words[:, 0], stamps))]
+    return hashlib.sha256(pairs.tobytes()).hexdigest()
+
+
+def _sorted_digest_pairs(log_ns: Sequence[int], digests: Sequence[bytes]) -> str:
+    """`_sorted_digest` pair by pair (its definition; struct.error for a time beyond int64)."""
     h = hashlib.sha256()
     for stamp, digest in sorted(zip((int(t) for t in log_ns), digests, strict=True)):
         h.update(struct.pack("<q", stamp))

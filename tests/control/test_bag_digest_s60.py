@@ -98,3 +98,26 @@ def test_the_digest_does_not_depend_on_the_order_messages_come_in():
     assert messages_digest(log, data) == messages_digest([log[i] for i in order],
                                                          [data[i] for i in order])  # fmt: skip
     assert messages_digest(log, data) != messages_digest(log, [b"c", b"a", b"b2", b"b0"])
+
+
+def test_the_array_digest_is_the_pairwise_definition_bit_for_bit():
+    """Session 65: `_sorted_digest` hashes one sorted array; the same digest as its definition,
+    pair by pair, for ordered, shuffled, tied (time) and repeated messages, empty and one, and
+    a time beyond int64 (the definition's own error)."""
+    import hashlib
+    import struct
+
+    from control.robot.bags import _sorted_digest, _sorted_digest_pairs
+
+    rng = np.random.default_rng(0)
+    for n in (0, 1, 2, 50, 4000):
+        log = np.sort(rng.integers(-(2**40), 2**62, n)).tolist()
+        digests = [hashlib.sha256(rng.bytes(int(k))).digest() for k in rng.integers(0, 9, n)]
+        tied = [t // 2**58 for t in log]  # few distinct times: ties broken by the digest
+        shuffled = rng.permutation(n)
+        for times, data in ((log, digests), (tied, digests),
+                            ([log[i] for i in shuffled], [digests[i] for i in shuffled]),
+                            (tied + tied, digests + digests)):  # fmt: skip
+            assert _sorted_digest(times, data) == _sorted_digest_pairs(times, data)
+    with pytest.raises(struct.error):
+        _sorted_digest([2**63], [hashlib.sha256(b"").digest()])
