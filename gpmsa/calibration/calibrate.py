@@ -171,9 +171,7 @@ def calibration_held_native(emulator, fixed) -> dict[int, float]:
     (``fixed_elements.held_native``: the value given, a categorical one its level)."""
     if not fixed or "theta" not in fixed:
         return {}
-    levels = theta_levels(emulator)
-    cat = None if levels is None else [lv is not None for lv in levels]
-    return per_element.held_native(fixed["theta"], emulator.t_names, cat)
+    return per_element.held_native(fixed["theta"], emulator.t_names, theta_levels(emulator))
 
 
 def _theta_options(emulator, constraint, theta_init):

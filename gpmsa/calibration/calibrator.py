@@ -254,7 +254,7 @@ class Calibrator:
     def _refined_predictors(self) -> tuple[np.ndarray, list[GridPredictor]] | None:
         """One parameter whose predictors need no solves per update (``GridPredictor.H``): the
         axis of the usual refinement (`grid.whole_refined_axis`) and predictors on it, so that
-        an update that refines so costs no dense solves either (the road case: 2.4 -> 1.2 ms,
+        an update that refines so costs no dense solves either (the road case: 2.4 -> 1.5 ms,
         2.5% of its updates); None otherwise (refined nodes get dense solves)."""
         if self.q != 1 or any(pred.H is None for pred in self._predictors):
             return None

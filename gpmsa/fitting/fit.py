@@ -337,9 +337,7 @@ def fit_held_native(problem: Problem, fixed, t_names) -> dict[int, float]:
     one its level (``fixed_elements.held_native``); {} where it holds none."""
     if not isinstance(fixed, dict) or "theta" not in fixed or problem.obs is None:
         return {}
-    levels = problem.theta_levels
-    cat = None if levels is None else [lv is not None for lv in levels]
-    return per_element.held_native(fixed["theta"], t_names, cat)
+    return per_element.held_native(fixed["theta"], t_names, problem.theta_levels)
 
 
 def continued_starts(

@@ -149,19 +149,20 @@ def theta_unit(value, std, names, levels=None):
     return unit if keep is None else {k: float(unit[k]) for k in keep}
 
 
-def held_native(value, names, categorical_at=None) -> dict[int, float]:
+def held_native(value, names, levels=None) -> dict[int, float]:
     """position -> native value of each theta element that ``fixed['theta']`` (``value``, as
     `theta_unit` takes it, checked there) holds: exactly the value given, a categorical
-    element (``categorical_at``: per element whether it is; None: none) its level's integer
-    code (the value `theta_unit` snaps to). The draws report these, not their unit values
-    read back through the range (which can come back an ulp off)."""
+    element (``levels`` as `theta_unit`'s: per element its levels or None; None: all
+    continuous) its level's integer code (the value `theta_unit` snaps to). The draws report
+    these, not their unit values read back through the range (which can come back an ulp
+    off)."""
     names = [str(n) for n in names]
     if isinstance(value, dict):
         given = parse("theta", theta_by_position(value, names), (len(names),))
         out = {k: x for (k,), x in given.items()}
     else:
         out = dict(enumerate(map(float, constraints.theta_native(value, names, "fixed['theta']"))))
-    cat = categorical_at or [False] * len(names)
+    cat = [lv is not None for lv in levels] if levels is not None else [False] * len(names)
     return {k: float(np.round(x)) if cat[k] else x for k, x in out.items()}
 
 

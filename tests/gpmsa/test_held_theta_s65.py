@@ -138,8 +138,8 @@ def test_theta_unit_puts_a_held_categorical_value_exactly_on_its_level():
     std, lv = emu.standardizer, [(0.0, 0.5, 1.0)]
     assert per_element.theta_unit({"t0": NEAR}, std, ["t0"], lv).tolist() == [0.5]  # whole
     assert per_element.theta_unit([NEAR], std, ["t0"], lv)[0] == 0.5
-    assert per_element.held_native({"t0": NEAR}, ["t0"], [True]) == {0: 4.0}
-    assert per_element.held_native([NEAR], ["t0"], [False]) == {0: NEAR}
+    assert per_element.held_native({"t0": NEAR}, ["t0"], lv) == {0: 4.0}
+    assert per_element.held_native([NEAR], ["t0"], [None]) == {0: NEAR}
     with pytest.raises(GPMSAError, match=NOT_A_LEVEL):
         per_element.theta_unit({"t0": 4 + 1e-9}, std, ["t0"], lv)
 
