@@ -52,7 +52,13 @@ from gpmsa.calibration.grid import (
     with_edges,
     zero_edges,
 )
-from gpmsa.calibration.model import GridPredictor, LamOsMarginal, lamos_marginal
+from gpmsa.calibration.model import (
+    GridPredictor,
+    LamOsMarginal,
+    chebyshev_plan,
+    lamos_marginal,
+    predictor_bytes,
+)
 from gpmsa.calibration.observations import (
     EMULATOR_PARAM_MODES,
     Fit,
@@ -216,15 +222,13 @@ class Calibrator:
         kept = emulator.n_draws if emulator.draws else 0  # at most these draws are used
         n_sets = 1 if emulator_params == "point" else min(self._n_emulator_draws, max(kept, 1))
         G = self.n_grid**q
-        # per parameter set: R_t on the grid and its product with alpha (G x m per component;
-        # one parameter: also on the usual refinement's ~2G nodes) and Sigma_W's factor
-        # (GridPredictor checks its Chebyshev products once sized)
-        per_set = 8.0 * p_u * (2.0 * G * m * (3 if q == 1 else 1) + 2.0 * m * m)
-        check_memory(
-            n_sets * per_set + 8.0 * 8 * G,
-            f"Calibrator(n_grid={self.n_grid}): {G} grid nodes x {m} runs x {p_u} components "
-            f"x {n_sets} emulator parameter set(s)",
-        )
+        # per parameter set: R_t on the grid and its product with alpha (G x m per component)
+        # and Sigma_W's factor; once the Chebyshev degrees are known, `_check_predictor_memory`
+        # adds the predictors' products H and the prepared refinement
+        per_set = 8.0 * p_u * (2.0 * G * m + 2.0 * m * m)
+        what = (f"Calibrator(n_grid={self.n_grid}): {G} grid nodes x {m} runs x {p_u} "
+                f"components x {n_sets} emulator parameter set(s)")  # fmt: skip
+        check_memory(n_sets * per_set + 8.0 * 8 * G, what)
         self._axes = [np.linspace(0.0, 1.0, self.n_grid)] * q
         self._theta_unit = mesh(self._axes)
         std = emulator.standardizer
@@ -234,8 +238,12 @@ class Calibrator:
         with blas_controller().limit(limits=1, user_api="blas"):
             sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
             self._gps = [fixed_gp(emulator, prm) for prm in sets]
-            self._predictors = [GridPredictor(gp, self._theta_unit) for gp in self._gps]
-            self._refined = self._refined_predictors()
+            plans = [chebyshev_plan(gp) for gp in self._gps]
+            refined = self._refined_axis(plans)
+            _check_predictor_memory(self._gps, plans, G, refined, 8.0 * 8 * G, what)
+            self._predictors = [GridPredictor(gp, self._theta_unit, plan)
+                                for gp, plan in zip(self._gps, plans, strict=True)]  # fmt: skip
+            self._refined = self._refined_predictors(refined, plans)
         pri = emulator.priors
         self._log_prior_theta = -0.5 * np.sum(
             ((self._theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1
@@ -251,15 +259,24 @@ class Calibrator:
         self._base_ok = None if self.constraint is None else self._allowed(self._theta_unit)
         self._base_cut = None if self._base_ok is None else self._cut(self._axes, self._base_ok)
 
-    def _refined_predictors(self) -> tuple[np.ndarray, list[GridPredictor]] | None:
-        """One parameter whose predictors need no solves per update (``GridPredictor.H``): the
-        axis of the usual refinement (`grid.whole_refined_axis`) and predictors on it, so that
-        an update that refines so costs no dense solves either (the road case: 2.4 -> 1.5 ms,
-        2.5% of its updates); None otherwise (refined nodes get dense solves)."""
-        if self.q != 1 or any(pred.H is None for pred in self._predictors):
+    def _refined_axis(self, plans: list) -> np.ndarray | None:
+        """One parameter whose predictors need no solves per update (a Chebyshev plan for every
+        parameter set): the unit-scale axis of the usual refinement (`grid.whole_refined_axis`),
+        for which `_refined_predictors` prepares predictors; None otherwise."""
+        if self.q != 1 or any(plan is None for plan in plans):
             return None
-        axis = whole_refined_axis(self._axes[0])
-        return axis, [GridPredictor(gp, axis[:, None]) for gp in self._gps]
+        return whole_refined_axis(self._axes[0])
+
+    def _refined_predictors(
+        self, axis: np.ndarray | None, plans: list
+    ) -> tuple[np.ndarray, list[GridPredictor]] | None:
+        """Predictors on the refined ``axis`` (`_refined_axis`), so that an update that refines
+        so costs no dense solves either (the road case: 2.4 -> 1.5 ms, 2.5% of its updates);
+        None without an axis (refined nodes get dense solves)."""
+        if axis is None:
+            return None
+        return axis, [GridPredictor(gp, axis[:, None], plan)
+                      for gp, plan in zip(self._gps, plans, strict=True)]  # fmt: skip
 
     def __setstate__(self, state: dict) -> None:
         """Unpickling: one pickled before the prepared refinement (session 65; a saved BCR
@@ -267,7 +284,8 @@ class Calibrator:
         self.__dict__.update(state)
         if "_refined" not in state and self.method == "grid":
             with blas_controller().limit(limits=1, user_api="blas"):
-                self._refined = self._refined_predictors()
+                plans = [chebyshev_plan(gp) for gp in self._gps]
+                self._refined = self._refined_predictors(self._refined_axis(plans), plans)
 
     def _check_mcmc_path(self, backend: str) -> None:
         """GPMSAError now, not at every update, for MCMC settings ``gpmsa.calibrate`` refuses:
@@ -829,3 +847,24 @@ def _walk(a: float, b: float, mids: list, status: list, side: bool) -> tuple[flo
         else:
             b, hi = mids[k], k
     return a, b, True
+
+
+def _check_predictor_memory(
+    gps: list, plans: list, n_nodes: int, refined: np.ndarray | None, other: float, what: str
+) -> None:
+    """ResourceLimitError before the grid's predictors are built where they, with the prepared
+    refinement's (``refined``: its axis, or None) and Sigma_W's factors of every emulator
+    parameter set, and ``other`` bytes, would need more than ``gpmsa.limits.MAX_MEMORY_BYTES``:
+    their Chebyshev products H (nodes x (degree + 1)^2 per component) can be most of it."""
+    total, peak = other, 0.0
+    degree = 0
+    for gp, plan in zip(gps, plans, strict=True):
+        total += 8.0 * gp.p_u * gp.m * gp.m
+        for nodes in (n_nodes,) if refined is None else (n_nodes, refined.size):
+            kept, building = predictor_bytes(gp, nodes, plan)
+            total += kept
+            peak = max(peak, building)
+        degree = max([degree] + ([] if plan is None else [cf.shape[0] - 1 for cf in plan]))
+    extra = f", Chebyshev degree {degree}" if degree else ""
+    extra += "" if refined is None else f", and {refined.size} nodes of a refined grid"
+    check_memory(total + peak, what + extra)

@@ -180,40 +180,48 @@ def _cheb_coefficients(gp: FixedGP, c: int, tol: float, max_deg: int) -> np.ndar
     return None
 
 
+def chebyshev_plan(gp: FixedGP, tol: float = 1e-14, max_deg: int = 128) -> tuple | None:
+    """Per component, the Chebyshev coefficients (deg + 1, m) of x -> R_x(x, x_i) that let a
+    `GridPredictor` on ``gp`` skip the solves per update (accurate to ``tol``, degree at most
+    ``max_deg``); None where it solves densely: p > 1, a categorical input, a mean basis, or an
+    expansion that does not reach ``tol``."""
+    if not (gp.p == 1 and gp.cat is None and gp.mean_basis is None):
+        return None
+    coefs = tuple(_cheb_coefficients(gp, c, tol, max_deg) for c in range(gp.p_u))
+    return None if any(cf is None for cf in coefs) else coefs
+
+
+def predictor_bytes(gp: FixedGP, n_nodes: int, plan: tuple | None) -> tuple[float, float]:
+    """Bytes a `GridPredictor` on ``n_nodes`` theta nodes keeps (R_t alpha, and H per
+    component: nodes x (degree + 1)^2) and the most it needs besides while it is built (one
+    component's R_t, and its Chebyshev products and their solve)."""
+    sizes = [0] * gp.p_u if plan is None else [cf.shape[0] for cf in plan]
+    kept = 8.0 * n_nodes * (gp.p_u * gp.m + sum(na * na for na in sizes))
+    return kept, 8.0 * n_nodes * gp.m * (1 + 2 * max(sizes))
+
+
 class GridPredictor:
     """Predictive of u on a fixed theta grid for any x_obs, with a per-update cost of O(G m n).
 
-    Precomputes, per grid node g and component c, R_t(theta_g) and (for p == 1) the matrix
-    H_g = E_g^T Sigma_W^-1 E_g of a Chebyshev expansion of R_x(x, x_i) in x (accurate to `tol`,
-    checked at set-up), so that Sigma_UW Sigma_W^-1 Sigma_UW^T = T(x) H_g T(x)^T needs no solve per
-    update. Falls back to dense solves (`FixedGP.predict`) for p > 1, for x outside [0, 1], or
-    when the expansion does not reach `tol` within `max_deg`.
+    Precomputes, per grid node g and component c, R_t(theta_g) and, where ``plan`` (from
+    `chebyshev_plan`) is not None, the matrix H_g = E_g^T Sigma_W^-1 E_g of the Chebyshev
+    expansion of R_x(x, x_i) in x, so that Sigma_UW Sigma_W^-1 Sigma_UW^T = T(x) H_g T(x)^T needs
+    no solve per update. Falls back to dense solves (`FixedGP.predict`) without a plan and for x
+    outside [0, 1]. Its memory (`predictor_bytes`) is the caller's to check.
     """
 
-    def __init__(
-        self, gp: FixedGP, theta: np.ndarray, tol: float = 1e-14, max_deg: int = 128
-    ) -> None:
+    def __init__(self, gp: FixedGP, theta: np.ndarray, plan: tuple | None) -> None:
         self.gp = gp
         self.theta = np.asarray(theta, dtype=float)
         G = self.theta.shape[0]
         self.rt_alpha = np.empty((gp.p_u, G, gp.m))
-        plain = gp.p == 1 and gp.cat is None and gp.mean_basis is None  # else: dense solves
-        coefs = [_cheb_coefficients(gp, c, tol, max_deg) for c in range(gp.p_u)] if plain else []
-        usable = len(coefs) == gp.p_u and all(cf is not None for cf in coefs)
-        na = max((cf.shape[0] for cf in coefs if cf is not None), default=0) if usable else 0
-        check_memory(
-            8.0 * gp.p_u * G * (2.0 * gp.m + na * na) + 8.0 * G * gp.m * 3 * na,
-            f"the calibration grid's predictor ({G} nodes x {gp.m} runs x {gp.p_u} components"
-            + (f", Chebyshev degree {na - 1}" if na else "")
-            + ")",
-        )
-        self.H: list[np.ndarray] | None = [] if usable else None
+        self.H: list[np.ndarray] | None = None if plan is None else []
         for c in range(gp.p_u):
             rt = gp.corr_t(self.theta, c) / gp.lamUz[c]
             self.rt_alpha[c] = rt * gp.alpha[c][None, :]
             if self.H is None:
                 continue
-            coef = coefs[c]
+            coef = plan[c]
             na = coef.shape[0]
             e = rt[:, :, None] * coef.T[None, :, :]  # (G, m, na)
             v = solve_triangular(gp.chol[c], e.transpose(1, 0, 2).reshape(gp.m, G * na), lower=True)

@@ -383,3 +383,28 @@ def test_calib_a_refused_update_does_not_shift_the_next_draws(method):
     for _ in range(2):
         a, b = clean.update(x, y).samples["GD"], dirty.update(x, y).samples["GD"]
         np.testing.assert_array_equal(a, b)
+
+
+def _cached_bytes(cal: Calibrator) -> int:
+    """Bytes of what a grid Calibrator keeps: Sigma_W's factors and the predictors' arrays."""
+    preds = list(cal._predictors) + ([] if cal._refined is None else list(cal._refined[1]))
+    kept = sum(p.rt_alpha.nbytes + sum(h.nbytes for h in p.H or []) for p in preds)
+    return kept + sum(gp.chol.nbytes for gp in cal._gps)
+
+
+def test_calibrator_memory_check_counts_every_parameter_set(monkeypatch):
+    """Each grid predictor checked only its own memory, and the Calibrator's check left out
+    their Chebyshev products H: 20 emulator parameter sets kept 41.6 MiB while no check saw
+    more than 12.4 MiB, so a limit between the two passed (12 sets: 25 MiB). Now the whole
+    is checked before anything is built, and the estimate is close (a limit 1.25x what is
+    kept passes)."""
+    emu = with_draws(vector_emulator(), 12)
+    kw = {"emulator_params": "draws", "n_emulator_draws": 12}
+    cached = _cached_bytes(Calibrator(emu, **kw))
+    monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", int(0.9 * cached))
+    with pytest.raises(
+        gpmsa.ResourceLimitError, match=r"12 emulator parameter set\(s\), Chebyshev degree \d+"
+    ):
+        Calibrator(emu, **kw)
+    monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", int(1.25 * cached))
+    assert _cached_bytes(Calibrator(emu, **kw)) == cached

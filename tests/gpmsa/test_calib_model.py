@@ -7,7 +7,7 @@ from scipy.integrate import quad
 from scipy.stats import gamma, multivariate_normal, norm
 
 from gpmsa.calibration.calibrate import calibration_problem
-from gpmsa.calibration.model import GridPredictor, LamOsPrior, lamos_marginal
+from gpmsa.calibration.model import GridPredictor, LamOsPrior, chebyshev_plan, lamos_marginal
 from gpmsa.calibration.observations import fixed_gp, reduce
 from gpmsa.calibration.sampler import ThetaPredictive
 from gpmsa.model.likelihood import log_likelihood
@@ -59,7 +59,7 @@ def test_predict_vector_output_components():
 def test_grid_predictor_chebyshev_matches_dense():
     gp = fixed_gp(road_emulator())
     theta = np.linspace(0, 1, 33)[:, None]
-    pred = GridPredictor(gp, theta)
+    pred = GridPredictor(gp, theta, chebyshev_plan(gp))
     assert pred.H is not None  # the expansion converged
     for xv in (0.0, 0.123, 0.5, 0.999, 1.0):
         x = np.array([[xv]])
@@ -73,7 +73,7 @@ def test_grid_predictor_outside_unit_range_uses_dense():
     gp = fixed_gp(road_emulator())
     theta = np.linspace(0, 1, 9)[:, None]
     x = np.array([[1.05]])
-    m1, c1 = GridPredictor(gp, theta).predict(x)
+    m1, c1 = GridPredictor(gp, theta, chebyshev_plan(gp)).predict(x)
     m2, c2 = gp.predict(x, theta)
     np.testing.assert_array_equal(m1, m2)
     np.testing.assert_array_equal(c1, c2)
