@@ -88,6 +88,17 @@ def posterior_theta(emulator, theta: np.ndarray) -> np.ndarray:
     return unit_inputs(theta, emulator.t_names, s.t_min, s.t_max, "posterior theta")[1]
 
 
+def lacks_text(missing: list[str], names) -> str:
+    """The message for a posterior without the draws ``missing`` (it has ``names``); where it
+    holds them per model ("t[model]", a study's pooled posterior), it points to
+    ``study.member_posterior``."""
+    text = f"posterior lacks {missing}; it has {tuple(names)}"
+    if any(str(n).startswith(f"{k}[") for k in missing for n in names):
+        text += (" (a study's pooled posterior names each model's parameters 'name[model]': "
+                 "pass study.member_posterior(model))")  # fmt: skip
+    return text
+
+
 def posterior_lamos(posterior, idx: np.ndarray | None = None) -> np.ndarray:
     """The posterior's lamOs draws (those at ``idx``; None: all); GPMSAError when it has none
     or one is not a finite precision > 0 (1/lamOs is the observation-error variance)."""

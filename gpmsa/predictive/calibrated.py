@@ -23,6 +23,7 @@ from gpmsa.model.data import (
 from gpmsa.model.discrepancy import has_draws
 from gpmsa.predictive._common import (
     check_posterior_emulator,
+    lacks_text,
     posterior_lamos,
     posterior_theta,
 )
@@ -141,7 +142,7 @@ def calibrated_predict(
     names = tuple(emulator.t_names)
     missing = [n for n in names if n not in posterior.names]
     if missing:
-        raise GPMSAError(f"posterior lacks {missing}; it has {posterior.names}")
+        raise GPMSAError(lacks_text(missing, posterior.names))
     n_theta = check_count(n_theta, "n_theta")
     if noise and has_draws(posterior.names):
         raise GPMSAError(

@@ -50,6 +50,7 @@ from gpmsa.predictive._common import (
     check_posterior_emulator,
     factors,
     gpmsa_model_only,
+    lacks_text,
     mvn_factor,
     posterior_lamos,
     posterior_theta,
@@ -192,7 +193,7 @@ def _posterior_sets(emulator, posterior, n_draws):
         samples = posterior.samples
         missing = [k for k in (*names, "lamOs") if k not in samples]
         if missing:
-            raise GPMSAError(f"posterior lacks {missing}; it has {tuple(samples)}")
+            raise GPMSAError(lacks_text(missing, tuple(samples)))
         theta = posterior_theta(
             emulator, np.column_stack([np.asarray(samples[k], dtype=float) for k in names])
         )

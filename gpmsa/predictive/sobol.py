@@ -122,8 +122,14 @@ def _mean_gauss(gamma: float, c: np.ndarray, a: float, b: float) -> np.ndarray:
             out += 0.5 * weight * np.exp(-gamma * (mid + half * node - c) ** 2)
         return out
     lo, hi = s * (a - c), s * (b - c)
-    diff = np.where(lo > 0, erfc(lo) - erfc(hi), np.where(hi < 0, erfc(-hi) - erfc(-lo),
-                                                           erf(hi) - erf(lo)))  # fmt: skip
+    # reflect a range below 0 into the upper tail: erfc(-hi) - erfc(-lo) = erfc(lo') - erfc(hi')
+    below = hi < 0
+    lo, hi = np.where(below, -hi, lo), np.where(below, -lo, hi)
+    tail = lo > 0  # both ends in the upper tail: erfc; the range straddles 0: erf
+    diff = np.empty(np.shape(lo))
+    diff[tail] = erfc(lo[tail]) - erfc(hi[tail])
+    mid = ~tail
+    diff[mid] = erf(hi[mid]) - erf(lo[mid])
     return _SQRT_PI_2 * diff / (s * (b - a))
 
 

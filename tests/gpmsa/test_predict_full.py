@@ -287,3 +287,20 @@ def emu_data(emu) -> gpmsa.SimData:
     std = emu.standardizer
     return gpmsa.SimData(x=std.x_from_unit(emu.x_unit), t=std.t_from_unit(emu.t_unit), y=emu.y,
                          index=emu.index, x_names=["x"], t_names=["t"])  # fmt: skip
+
+
+def test_a_studys_pooled_posterior_is_refused_pointing_to_member_posterior():
+    """A study's pooled posterior names each model's parameters "t[model]": full_prediction and
+    calibrated_predict point to ``study.member_posterior(model)`` rather than only listing the
+    names it lacks."""
+    emu, obs, *_ = known_truth_case()
+    draws = {"t[m0]": np.full(4, 1.2), "t[m1]": np.full(4, 1.1)}
+    pooled = gpmsa.Posterior({**draws, "lamOs[m0]": np.ones(4), "lamOs[m1]": np.ones(4)})
+    hint = r"lacks \['t', 'lamOs'\].*study.member_posterior\(model\)"
+    with pytest.raises(GPMSAError, match=hint):
+        full_prediction(emu, obs, [[0.5]], posterior=pooled, discrepancy=None)
+    with pytest.raises(GPMSAError, match=r"lacks \['t'\].*study.member_posterior\(model\)"):
+        gpmsa.predictive.calibrated_predict(emu, pooled, [[0.5]])
+    with pytest.raises(GPMSAError, match=r"posterior lacks \['t', 'lamOs'\]; it has \('s',\)$"):
+        full_prediction(emu, obs, [[0.5]], posterior=gpmsa.Posterior({"s": np.ones(4)}),
+                        discrepancy=None)  # fmt: skip
