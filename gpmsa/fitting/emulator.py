@@ -415,6 +415,8 @@ class Emulator:
             x = np.empty((1, 0))
         x = as_float(by_column_names(x, self.x_names, "x"), "x")  # ragged: named here
         t = as_float(by_column_names(t, self.t_names, "t"), "t")
+        x = x.reshape(1) if self.p == 1 and x.ndim == 0 else x  # a number: one point
+        t = t.reshape(1) if self.q == 1 and t.ndim == 0 else t
         if self.p == 0:
             x = as_matrix(x, "x", ncols=0, no_columns=True)
         elif np.ndim(x) != 1 or self.p != 1:

@@ -46,7 +46,8 @@ def rng_of(seed) -> np.random.Generator:
 def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarray]:
     """Native rows (N, d) -> (native, unit scale), with the library's extrapolation rule.
 
-    A 1-D array is one column when d = 1 and one row otherwise. Inside the design range: silent;
+    A 1-D array is one column when d = 1 and one row otherwise; a number one point when d = 1
+    (as ``gpmsa.calibrate`` takes x_obs). Inside the design range: silent;
     up to ``EXTRAPOLATION_MARGIN`` of the range outside it: a warning; beyond: GPMSAError naming
     the input, the values and the domain. With no inputs (d = 0, an emulator without known
     inputs) None, or an (N, 0) array, is one row of no columns (broadcast against t's rows).
@@ -55,7 +56,9 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
     if d == 0 and values is None:
         values = np.empty((1, 0))
     values = by_column_names(values, names, what)
-    if d > 1 and np.ndim(values) == 1 and np.size(values) == d:
+    if (d > 1 and np.ndim(values) == 1 and np.size(values) == d) or (
+        d == 1 and np.ndim(values) == 0
+    ):
         values = [values]
     native = as_matrix(values, what, ncols=d, no_columns=d == 0)
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)

@@ -82,6 +82,18 @@ def test_predict_input_errors(emu):
     assert mean.shape == (3, 1)
 
 
+def test_a_number_is_one_point_for_a_one_column_input(emu):
+    """``predict(1.0, 0.5)`` and ``emulator_prediction(emu, 1.0, 0.5)`` raised "x must be a
+    non-empty 2-D array, got shape ()" where ``calibrate`` and ``calibrated_predict`` take a
+    number for one x; a number is one point of a one-column input, as [[1.0]] is."""
+    np.testing.assert_array_equal(emu.predict(1.0, 0.5)[1], emu.predict([[1.0]], [[0.5]])[1])
+    one = gpmsa.emulator_prediction(emu, 1.0, 0.5, draws=False, seed=1)
+    np.testing.assert_array_equal(one.y, gpmsa.emulator_prediction(
+        emu, [[1.0]], [[0.5]], draws=False, seed=1).y)  # fmt: skip
+    with pytest.raises(gpmsa.GPMSAError, match="x must be finite"):
+        emu.predict(np.nan, 0.5)
+
+
 def test_from_params_shape_errors(emu):
     rng = np.random.default_rng(0)
     sim = gpmsa.SimData(x=rng.random(10), t=rng.random(10), y=rng.random(10))
