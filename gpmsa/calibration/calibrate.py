@@ -54,6 +54,7 @@ from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints
 from gpmsa.model import fixed_elements as per_element
+from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, check_count, check_flag, run_seed
 from gpmsa.model.discrepancy import check_groups, to_samples
 from gpmsa.model.discrepancy import record as discrepancy_record
@@ -70,12 +71,12 @@ def calibration_problem(
     """The calibration-only Problem: the emulator's parameters at its point estimate in ``fixed``.
 
     Sampled: theta, lamOs (and betaV, lamVz with a discrepancy basis, "constant" for a scalar
-    output; "constant", "linear" or a matrix for a vector output; ``discrepancy_groups`` as
-    ``gpmsa.fit``'s). ``constraint`` and ``theta_init`` as ``calibrate``'s. ``reduced``:
-    ``reduce(emulator, x_obs, y_obs, extrapolate)`` where the caller has it already (no
-    discrepancy only), so that the observations are checked and reduced once. ``fixed``:
-    ``calibration_fixed(emulator, fixed=, discrepancy)`` (theta on the unit scale): held in
-    the Problem (``Problem.with_fixed``) beside the emulator's parameters.
+    output; "constant", "linear", a matrix or a list of per-experiment ones for a vector
+    output; ``discrepancy_groups`` as ``gpmsa.fit``'s). ``constraint`` and ``theta_init`` as
+    ``calibrate``'s. ``reduced``: ``reduce(emulator, x_obs, y_obs, extrapolate)`` where the
+    caller has it already (no discrepancy only), so that the observations are checked and
+    reduced once. ``fixed``: ``calibration_fixed(emulator, fixed=, discrepancy)`` (theta on
+    the unit scale): held in the Problem (``Problem.with_fixed``) beside the emulator's parameters.
     """
     check_emulator(emulator)
     if reduced is not None and discrepancy is not None:
@@ -251,7 +252,10 @@ def calibrate(
             averaged over ``n_emulator_draws`` of its retained draws; numpy fast path only).
             ``n_emulator_draws`` must be an integer >= 1 in either mode (at most the retained
             draws are used).
-        discrepancy: None (no discrepancy, the default) or a discrepancy basis (generic backends).
+        discrepancy: None (no discrepancy, the default) or a discrepancy basis (generic backends):
+            "constant", "linear", an (l_obs, p_v) array, or a list of one (l_j, p_v) array per
+            experiment of an ObsData on its own index grid (normalised jointly, as
+            ``gpmsa.fit``'s).
         discrepancy_groups: the precision group of each discrepancy basis vector, as
             ``gpmsa.fit``'s (GPM/SA's lamVzGroup; None: one group).
         n_chains: independent chains (their kept draws are pooled in ``samples``).
@@ -301,7 +305,7 @@ def calibrate(
         native units), "lamOs" (and with a discrepancy "betaV", or "betaV[k]" per known input
         when p > 1, and "lamVz"; with several precision groups "betaV[k,g]" and "lamVz[g]",
         the groups in ``info["discrepancy_groups"]``, the basis's kind in
-        ``info["discrepancy"]``: "constant", "linear" or "given"), and chains per name;
+        ``info["discrepancy"]``: "constant", "linear", "given" or "list"), and chains per name;
         ``info["obs_values_sha256"]`` fingerprints the observations
         (``ObsData.values_digest(emulator.x_names, emulator.y_names)``: tables are read by
         name), so that
@@ -336,7 +340,8 @@ def calibrate(
                 else "log_prior (a Calibrator update's prior=)")  # fmt: skip
         raise GPMSAError(
             f"{what} needs the fast numpy sampler: backend='numpy', no discrepancy and fast "
-            f"not False; got backend={backend!r}, discrepancy={discrepancy!r}, fast={fast}"
+            f"not False; got backend={backend!r}, discrepancy={describe_discrepancy(discrepancy)}, "
+            f"fast={fast}"
         )
     if not fast:  # a categorical theta: the fast sampler only
         check_emulator(emulator)
@@ -604,8 +609,8 @@ def _run_backend(
         "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
     }
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
-        kind = discrepancy if isinstance(discrepancy, str) else "given"
-        info.update({"discrepancy": kind, **discrepancy_record(problem.obs)})
+        info.update({"discrepancy": discrepancy_kind(discrepancy),
+                     **discrepancy_record(problem.obs)})  # fmt: skip
     if masks:
         info["fixed"] = fixed_record(problem, masks)
         names = list(emulator.t_names)

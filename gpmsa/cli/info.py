@@ -11,6 +11,7 @@ import numpy as np
 
 from gpmsa.cli.text import internal_error, number, plain, safe, value
 from gpmsa.errors import GPMSAError
+from gpmsa.fitting.validation import DISCREPANCY_ARRAY
 from gpmsa.mcmc.diagnostics import beyond
 from gpmsa.model.basis import variance_shares
 
@@ -65,6 +66,16 @@ def run(args: argparse.Namespace) -> int:
         return 1
     print(text)
     return 0
+
+
+def _bases_text(manifest: dict) -> str:
+    """The per-experiment discrepancy bases a file keeps (settings.discrepancy "list"), in
+    words; "" for none."""
+    spec = manifest["arrays"].get(DISCREPANCY_ARRAY)
+    if spec is None:
+        return ""
+    n_exp, p_v = len(manifest["settings"]["obs_lengths"]), spec["shape"][1]
+    return f" (one basis per experiment: {n_exp} experiments x {p_v} vectors, in the file)"
 
 
 def _basis_line(settings: dict, emulator) -> str:
@@ -127,7 +138,8 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     lines.append("settings:        " + ", ".join(flat))
     if s.get("discrepancy") is not None:
         groups = s.get("discrepancy_groups")
-        lines.append(f"discrepancy:     {plain(s['discrepancy'])}, precision groups "
+        lines.append(f"discrepancy:     {plain(s['discrepancy'])}{_bases_text(manifest)}, "
+                     "precision groups "
                      f"{plain(groups) if isinstance(groups, list) else 'one'}")  # fmt: skip
     options = s.get("backend_options")
     if isinstance(options, dict) and options:

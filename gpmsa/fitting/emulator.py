@@ -23,11 +23,13 @@ from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.validation import (
+    DISCREPANCY_ARRAY,
     EMULATOR_PARAMS,
     REQUIRED,
     STD_FIELDS,
     check_manifest,
     check_record,
+    split_bases,
 )
 from gpmsa.io.container import (
     FORMAT,
@@ -171,9 +173,12 @@ class Emulator:
     ESS of every sampled parameter and the elements flagged, see
     ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files), levels
     (per column of [x, t]: a categorical input's training levels, else None), mean_basis (the
-    weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md. The arrays are
-    read-only copies, params, draws and calibration read-only mappings, and no attribute but
-    ``metadata`` can be replaced (``model_sha256`` holds).
+    weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md;
+    discrepancy_bases (a joint fit given a list of per-experiment discrepancy bases: the
+    normalised (l_j, p_v) basis of each experiment, as the fit used them, ``gpmsa.model.basis.
+    discrepancy_bases``; else None). The arrays are read-only copies, params, draws and
+    calibration read-only mappings, and no attribute but ``metadata`` can be replaced
+    (``model_sha256`` holds).
     """
 
     def __init__(
@@ -199,6 +204,7 @@ class Emulator:
         convergence: dict | None = None,
         levels: categorical_mod.Levels | None = None,
         mean_basis: MeanBasis | None = None,
+        discrepancy_bases: tuple[np.ndarray, ...] | None = None,
     ):
         self.standardizer = standardizer
         self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
@@ -217,6 +223,7 @@ class Emulator:
         self.convergence = convergence
         self.levels = (None,) * (self.p + self.q) if levels is None else tuple(levels)
         self.mean_basis = mean_basis
+        self.discrepancy_bases = None if discrepancy_bases is None else tuple(discrepancy_bases)
         self._factors: dict[int, list] = {}
         self._freeze()
 
@@ -229,6 +236,9 @@ class Emulator:
             object.__setattr__(self, name, _read_only_copy(getattr(self, name)))
         for name in _MAPPINGS:
             object.__setattr__(self, name, _read_only_mapping(getattr(self, name)))
+        if self.discrepancy_bases is not None:
+            bases = tuple(_read_only_copy(D) for D in self.discrepancy_bases)
+            object.__setattr__(self, "discrepancy_bases", bases)
         std = self.standardizer
         object.__setattr__(self, "standardizer", dataclasses.replace(
             std, **{k: _read_only_copy(getattr(std, k)) for k in STD_FIELDS}
@@ -265,8 +275,10 @@ class Emulator:
         return state
 
     def __setstate__(self, state: dict) -> None:
-        """Unpickled or copied: read-only again, as constructed."""
+        """Unpickled or copied: read-only again, as constructed (an emulator pickled before
+        ``discrepancy_bases`` existed has none)."""
         self.__dict__.update(state)
+        self.__dict__.setdefault("discrepancy_bases", None)
         self._freeze()
 
     # --- construction -------------------------------------------------------------------------
@@ -606,6 +618,7 @@ class Emulator:
         state["priors"] = priors
         if given and state["calibration"] is not None:  # a joint fit's draws, made under the old
             state["calibration"] = None
+            state["discrepancy_bases"] = None  # kept for those draws alone
         state.pop("model_sha256", None)  # the cached digest of the original
         out = object.__new__(Emulator)
         out.__setstate__(state)
@@ -690,6 +703,8 @@ class Emulator:
             arrays[f"draw_{k}"] = v
         for k, v in (self.calibration or {}).items():
             arrays[f"cal_{k}"] = v
+        if self.discrepancy_bases is not None:  # stacked; settings.obs_lengths splits them
+            arrays[DISCREPANCY_ARRAY] = np.vstack(self.discrepancy_bases)
         return {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
 
     @functools.cached_property
@@ -743,6 +758,7 @@ class Emulator:
                 settings=manifest["settings"], diagnostics=manifest["diagnostics"],
                 calibration=cal, convergence=manifest.get("convergence"),  # check_fields checked it
                 levels=_levels(manifest, names), mean_basis=_mean_basis(manifest, names),
+                discrepancy_bases=split_bases(arrays, manifest["settings"]),
             )  # fmt: skip
             _check_consistent(emu)
             domain = {k: list(v) for k, v in emu.domain.items()}

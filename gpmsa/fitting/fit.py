@@ -23,7 +23,9 @@ from gpmsa.mcmc.sampler import (
 )
 from gpmsa.model import constraints
 from gpmsa.model import fixed_elements as per_element
+from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, run_seed
+from gpmsa.model.discrepancy import kept_bases
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, fixed_record, prepare
@@ -107,7 +109,11 @@ def fit(
     (l_sim, p_u), columns the orthogonal basis vectors on the simulation grid in standardised
     output units (GPM/SA's ``Ksim``; ``gpmsa.BasisWarning`` when its weights' scale is not
     the one lamUz's prior expects; docs/categorical-and-constraints.md).
-    discrepancy: None, "constant", "linear" or an (l_obs, p_v) array. discrepancy_groups: the
+    discrepancy: None, "constant", "linear", an (l_obs, p_v) array on the grid every
+    experiment shares, or a list of one (l_j, p_v) array per experiment on its own index grid
+    (SEPIA's ``create_D_basis(D_obs=[...])``, GPM/SA's per-experiment ``Dobs``; normalised
+    jointly, ``gpmsa.model.basis.discrepancy_bases``; kept in ``Emulator.discrepancy_bases`` and
+    the file). discrepancy_groups: the
     precision group (0 .. G-1) of each discrepancy basis vector, GPM/SA's lamVzGroup (None: one
     group; each group has its own betaV column and lamVz). n_jobs, executor: where
     the chains run (numpy backend: ``n_jobs`` worker processes, None or -1 = every CPU but never
@@ -151,7 +157,7 @@ def fit(
     progress = check_flag(progress, "progress")
     metadata = check_metadata(metadata)
     if obs is None and discrepancy is not None:
-        given = repr(discrepancy) if isinstance(discrepancy, str) else "an array"
+        given = describe_discrepancy(discrepancy)
         raise GPMSAError(
             f"discrepancy={given} needs observations (obs=): a discrepancy is fitted with the "
             "field data, and a simulator-only fit has none"
@@ -215,8 +221,7 @@ def fit(
         "joint_obs": obs is not None,
         "obs_lengths": None if obs is None else [int(e.size) for e in obs.experiments],
         "obs_sha256": None if obs is None else obs.digest(),
-        "discrepancy": discrepancy if isinstance(discrepancy, str) or discrepancy is None
-        else "given",
+        "discrepancy": discrepancy_kind(discrepancy),
         "init": chains.info.get("init", "gpmsa"),
         **({"continued_from": resumed.model_sha256} if continuing else {}),
         # n_jobs and executor say where the chains ran, not what they were: not recorded
@@ -248,6 +253,7 @@ def fit(
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,
         metadata=metadata, settings=settings,
         diagnostics=summary, calibration=calibration, convergence=record,
+        discrepancy_bases=kept_bases(problem.obs, discrepancy),
     )  # fmt: skip
 
 

@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
-from gpmsa.model.basis import ORTHOGONAL_TOL
+from gpmsa.model.basis import ORTHOGONAL_TOL, basis_digest
 from gpmsa.model.data import as_float, output_scale
 from gpmsa.model.fixed_elements import label
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
@@ -45,8 +45,14 @@ REL_TOL = 1e-9
 """Relative tolerance of the recomputed redundancies (y_mean, y_sd)."""
 W_TOL = 1e-7
 """Tolerance of the recomputed basis weights, relative to their largest magnitude (plus 1)."""
-DISCREPANCY_KINDS = ("constant", "linear", "given")
-"""A recorded discrepancy basis: named, or "given" (an array the caller passed)."""
+DISCREPANCY_KINDS = ("constant", "linear", "given", "list")
+"""A recorded discrepancy basis: named, "given" (an array the caller passed) or "list" (one
+array per experiment, which an emulator file keeps: ``DISCREPANCY_ARRAY``)."""
+DISCREPANCY_ARRAY = "discrepancy_D"
+"""The array of a joint fit's per-experiment discrepancy bases (settings.discrepancy "list"):
+the normalised bases stacked (sum of l_j, p_v), split by settings.obs_lengths."""
+NORM_TOL = 1e-9
+"""Tolerance of the stored per-experiment bases' normalisation (largest diag(D D^T) = 1)."""
 BASIS_VECTORS = {"constant": 1, "linear": 2}
 """The number of vectors of each named discrepancy basis (``gpmsa.model.basis``)."""
 EMULATOR_BASES = ("pca", "given")
@@ -121,6 +127,10 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
                 raise _fail(
                     f"arrays/{name}", f"unknown emulator parameter (have {EMULATOR_PARAMS})"
                 )
+        elif name == DISCREPANCY_ARRAY:
+            if len(shapes[name]) != 2 or min(shapes[name]) < 1:
+                raise _fail(f"arrays/{name}", f"shape {list(shapes[name])}: must be (sum of the "
+                                              "experiments' lengths, p_v), p_v >= 1")  # fmt: skip
         elif name not in REQUIRED and name != "index":
             raise _fail(  # a save would drop it: not a file this library wrote
                 f"arrays/{name}",
@@ -300,6 +310,7 @@ def check_discrepancy_record(settings: dict, shapes: dict[str, tuple[int, ...]])
     exactly where there are discrepancy draws, and the G groups of their ``cal_lamVz`` (n_draws,
     G). Files without calibration draws, or written before "discrepancy" was recorded, have
     nothing to compare."""
+    _check_bases_shape(settings, shapes)
     if "cal_theta" not in shapes or "discrepancy" not in settings:
         return
     kind, lam = settings["discrepancy"], shapes.get("cal_lamVz")
@@ -317,6 +328,76 @@ def check_discrepancy_record(settings: dict, shapes: dict[str, tuple[int, ...]])
     if n_grp != lam[1]:
         raise _fail("settings.discrepancy_groups", f"{_short(groups)} (None: one group) numbers "
                     f"{n_grp} group(s), but arrays/cal_lamVz holds draws of {lam[1]}")  # fmt: skip
+
+
+def _check_bases_shape(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None:
+    """``DISCREPANCY_ARRAY`` exactly where settings.discrepancy is "list" (with calibration
+    draws), one row per observed value (the sum of settings.obs_lengths) and, with several
+    precision groups, one column per entry of settings.discrepancy_groups."""
+    kind = settings.get("discrepancy")
+    held = shapes.get(DISCREPANCY_ARRAY)
+    field = f"arrays/{DISCREPANCY_ARRAY}"
+    if held is None:
+        if isinstance(kind, str) and kind == "list" and "cal_theta" in shapes:
+            raise _fail("settings.discrepancy", f"'list', but the file holds no {field} (the "
+                                                "per-experiment bases)")  # fmt: skip
+        return
+    if not (isinstance(kind, str) and kind == "list"):
+        raise _fail(
+            field,
+            "the per-experiment discrepancy bases of a joint fit whose "
+            f"settings.discrepancy is 'list', but it is {_short(kind)}",
+        )
+    if "cal_theta" not in shapes:
+        raise _fail(
+            field,
+            "the per-experiment discrepancy bases of a joint fit, but the file "
+            "holds no calibration draws (arrays/cal_theta)",
+        )
+    lengths = settings.get("obs_lengths")
+    if not isinstance(lengths, list):  # check_fields: null or a list of integers >= 1
+        raise _fail("settings.obs_lengths", f"must list the experiments' lengths beside {field}")
+    if held[0] != sum(lengths):
+        raise _fail(field, f"has {held[0]} rows, but settings.obs_lengths {_short(lengths)} "
+                           f"has {sum(lengths)} observed values (one row each)")  # fmt: skip
+    groups = settings.get("discrepancy_groups")
+    if isinstance(groups, list) and len(groups) != held[1]:
+        raise _fail("settings.discrepancy_groups", f"{_short(groups)}: one group per basis "
+                    f"vector, but {field} has {held[1]} columns")  # fmt: skip
+
+
+def split_bases(arrays: dict[str, np.ndarray], settings: dict) -> tuple[np.ndarray, ...] | None:
+    """The per-experiment bases of ``DISCREPANCY_ARRAY`` (None where the record has none),
+    split by settings.obs_lengths (checked: ``_check_bases_shape``)."""
+    stacked = arrays.get(DISCREPANCY_ARRAY)
+    if stacked is None:
+        return None
+    cuts = np.cumsum(settings["obs_lengths"])[:-1]
+    return tuple(np.split(stacked, cuts, axis=0))
+
+
+def check_discrepancy_bases(settings: dict, arrays: dict[str, np.ndarray]) -> None:
+    """The stored per-experiment discrepancy bases: finite, none all zero, normalised jointly
+    (largest diag(D_j D_j^T) over the experiments 1, within NORM_TOL) and the bases (and
+    groups) whose digest settings.discrepancy_sha256 records."""
+    if DISCREPANCY_ARRAY not in arrays:
+        return
+    field = f"arrays/{DISCREPANCY_ARRAY}"
+    stacked = _finite(arrays, DISCREPANCY_ARRAY)
+    bases = split_bases(arrays, settings)
+    for j, D in enumerate(bases):
+        if not np.any(D):
+            raise _fail(field, f"experiment {j}'s basis (rows of its {D.shape[0]} values) is all "
+                               "zeros")  # fmt: skip
+    with np.errstate(over="ignore"):
+        top = float(np.max(np.sum(stacked**2, axis=1)))
+    if not abs(top - 1.0) <= NORM_TOL:
+        raise _fail(field, f"is not normalised: its largest diag(D D^T) is {top:.6g}, not 1")
+    groups = settings.get("discrepancy_groups")
+    digest = settings.get("discrepancy_sha256")
+    if digest != basis_digest(bases, None if groups is None else tuple(groups)):
+        raise _fail(field, "differs from the bases (and groups) whose digest "
+                           "settings.discrepancy_sha256 records")  # fmt: skip
 
 
 def check_fixed_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> dict:
@@ -523,7 +604,9 @@ def check_manifest(manifest: dict) -> None:
 
 
 def _known(name: str) -> bool:
-    return name in REQUIRED or name == "index" or name.startswith(("draw_", "cal_", "param_"))
+    return name in (*REQUIRED, "index", DISCREPANCY_ARRAY) or name.startswith(
+        ("draw_", "cal_", "param_")
+    )
 
 
 # --- values ------------------------------------------------------------------------------------
@@ -656,6 +739,7 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     check_discrepancy_record(manifest["settings"], shapes)
     held = check_fixed_record(manifest["settings"], shapes)
     check_values(arrays, dims)
+    check_discrepancy_bases(manifest["settings"], arrays)
     check_fixed_draws(held, arrays)
     check_categorical(manifest, arrays, dims)
     return dims

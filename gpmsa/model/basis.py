@@ -165,7 +165,7 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
     """Discrepancy basis D (l_obs, p_v) on ``grid`` (l_obs,), normalised so max diag(D D^T) = 1.
 
     ``kind``: None (no discrepancy), "constant", "linear" (1 and the index), or a given
-    (l_obs, p_v) array.
+    (l_obs, p_v) array. A list of per-experiment bases: `discrepancy_bases`.
     """
     if kind is None:
         return None
@@ -176,19 +176,14 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
             D = np.column_stack([np.ones(grid.size), grid])
         else:
             raise GPMSAError(
-                f"discrepancy must be None, 'constant', 'linear' or an array, got {kind!r}"
+                f"discrepancy must be None, 'constant', 'linear', an array or a list of one "
+                f"array per experiment, got {kind!r}"
             )
     else:
-        if (
-            isinstance(kind, (list, tuple))
-            and kind
-            and all(isinstance(d, np.ndarray) and d.ndim == 2 for d in kind)
-        ):
+        if is_basis_list(kind):
             raise GPMSAError(
-                f"discrepancy basis: a list of {len(kind)} matrices (one per experiment, as "
-                "SEPIA's create_D_basis takes for experiments on their own grids) is not taken: "
-                f"give one ({grid.size}, p_v) array on the grid every experiment shares, or "
-                "'constant' / 'linear', which are built on each experiment's own grid"
+                f"discrepancy basis: a list of {len(kind)} matrices (one per experiment) is "
+                "built by discrepancy_bases, on the experiments' grids"
             )
         D = as_float(kind, "discrepancy basis")
         if D.ndim == 1:
@@ -197,14 +192,116 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
             raise GPMSAError(f"discrepancy basis must be ({grid.size}, p_v), got {D.shape}")
         if not np.all(np.isfinite(D)):
             raise GPMSAError("discrepancy basis must be finite")
+    return _normalised([D], "discrepancy basis is all zeros")[0]
+
+
+def _normalised(bases: list[np.ndarray], zero: str) -> list[np.ndarray]:
+    """``bases`` divided by one scale, so that the largest diag(D D^T) over all of them is 1
+    (GPMSAError ``zero`` when they are all zero)."""
     with np.errstate(over="ignore", under="ignore"):
-        scale = np.max(np.sum(D**2, axis=1))
-    if not np.finfo(np.float64).tiny <= scale < np.inf and np.any(D):
-        D = D / np.max(np.abs(D))  # its squares overflow or underflow float64: rescale first
-        scale = np.max(np.sum(D**2, axis=1))
+        scale = max(np.max(np.sum(D**2, axis=1)) for D in bases)
+    if not np.finfo(np.float64).tiny <= scale < np.inf and any(np.any(D) for D in bases):
+        big = max(np.max(np.abs(D)) for D in bases)  # squares over/underflow: rescale first
+        bases = [D / big for D in bases]
+        scale = max(np.max(np.sum(D**2, axis=1)) for D in bases)
     if not scale > 0:
-        raise GPMSAError("discrepancy basis is all zeros")
-    return D / np.sqrt(scale)
+        raise GPMSAError(zero)
+    return [D / np.sqrt(scale) for D in bases]
+
+
+def is_basis_list(kind) -> bool:
+    """Whether a ``discrepancy`` argument is a list (or tuple) of per-experiment bases: one of
+    its entries is 2-D (an array, or a list of rows); a 2-D array given as a list of rows has
+    1-D entries."""
+    if not isinstance(kind, (list, tuple)) or not kind:
+        return False
+    return any(getattr(d, "ndim", None) == 2 or _rows(d) for d in kind)
+
+
+def _rows(value) -> bool:
+    """Whether ``value`` is a non-empty list (or tuple) of rows (lists, tuples or arrays)."""
+    return (
+        isinstance(value, (list, tuple))
+        and bool(value)
+        and isinstance(value[0], (list, tuple, np.ndarray))
+    )
+
+
+def discrepancy_kind(kind) -> str | None:
+    """The recorded name of a ``discrepancy`` argument: None, "constant", "linear", "list"
+    (per-experiment bases, `discrepancy_bases`) or "given" (one array)."""
+    if kind is None or isinstance(kind, str):
+        return kind
+    return "list" if is_basis_list(kind) else "given"
+
+
+def describe_discrepancy(kind) -> str:
+    """A ``discrepancy`` argument for a message: its name, an array's shape or a list's
+    shapes (not their values)."""
+    if kind is None or isinstance(kind, str):
+        return repr(kind)
+    if is_basis_list(kind):
+        shapes = ", ".join(str(np.shape(d)) if _rectangular(d) else "ragged" for d in kind[:4])
+        more = ", ..." if len(kind) > 4 else ""
+        return f"a list of {len(kind)} bases of shapes [{shapes}{more}]"
+    return f"an array of shape {np.shape(kind) if _rectangular(kind) else 'ragged'}"
+
+
+def _rectangular(value) -> bool:
+    try:
+        np.shape(value)
+    except ValueError:  # a ragged nested list
+        return False
+    return True
+
+
+def discrepancy_bases(kind, grids: list[np.ndarray]) -> tuple[np.ndarray, ...] | None:
+    """The discrepancy bases D_j (l_j, p_v) of the experiments on ``grids`` (their index
+    grids, l_j values each); None without a discrepancy.
+
+    A named kind or one array: `discrepancy_basis` on each grid (each normalised on its own,
+    max diag(D_j D_j^T) = 1). A list of one (l_j, p_v) array per experiment (SEPIA's
+    ``create_D_basis(D_obs=[...])``, GPM/SA's per-experiment ``obsData(k).Dobs``, e.g. kernels
+    on each experiment's own grid): checked (GPMSAError naming the experiment: count, rows,
+    the same p_v, finite, not all zero) and normalised jointly, by one scale so that the
+    largest diag(D_j D_j^T) over all experiments is 1: the same weights mean the same
+    discrepancy in each. SEPIA also divides every experiment's D by one scale, taken from the
+    first experiment's (or D_sim's); the largest over all of them is GPM/SA's convention
+    (max diag(D D^T) = 1) for the stacked bases, and the two agree where experiment 0 reaches
+    that largest value (a hand-built "constant" or "linear" list: the string kinds' bases).
+    """
+    if not is_basis_list(kind):
+        return None if kind is None else tuple(discrepancy_basis(kind, g) for g in grids)
+    if len(kind) != len(grids):
+        raise GPMSAError(
+            f"discrepancy: a list of {len(kind)} bases for {len(grids)} experiments: give one "
+            "(l_j, p_v) array per experiment, rows on its own index grid"
+        )
+    bases = []
+    for j, (d, g) in enumerate(zip(kind, grids, strict=True)):
+        what = f"discrepancy[{j}] (experiment {j}'s basis)"
+        D = as_float(d, what)
+        if D.ndim != 2 or D.shape[0] != g.size:
+            hint = "; SEPIA stores D as (p_v, l_obs): pass its transpose" if (
+                D.ndim == 2 and D.shape[1] == g.size) else ""  # fmt: skip
+            raise GPMSAError(
+                f"{what} must be ({g.size}, p_v): one row per value of experiment {j}'s index "
+                f"grid ({g.size}), columns the basis vectors; got shape {D.shape}{hint}"
+            )
+        if D.shape[1] < 1:
+            raise GPMSAError(f"{what} has no columns: give at least one basis vector")
+        if bases and D.shape[1] != bases[0].shape[1]:
+            raise GPMSAError(
+                f"{what} has {D.shape[1]} column(s) but discrepancy[0] has "
+                f"{bases[0].shape[1]}: every experiment's basis needs the same p_v basis "
+                "vectors (columns), one weight each"
+            )
+        if not np.all(np.isfinite(D)):
+            raise GPMSAError(f"{what} must be finite")
+        if not np.any(D):
+            raise GPMSAError(f"{what} is all zeros")
+        bases.append(D)
+    return tuple(_normalised(bases, "discrepancy bases are all zeros"))
 
 
 DIGEST_STEP = 2.0**-24

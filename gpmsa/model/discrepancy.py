@@ -15,7 +15,7 @@ import re
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.basis import basis_digest
+from gpmsa.model.basis import basis_digest, is_basis_list
 
 NAME_PATTERN = re.compile(r"(betaV|lamVz)(\[\d+(,\d+)?\])?")
 """The discrepancy parameters' posterior names."""
@@ -126,3 +126,13 @@ def record(obs) -> dict:
     if obs.v_groups is not None:
         out["discrepancy_groups"] = list(obs.v_groups)
     return out
+
+
+def kept_bases(obs, kind) -> tuple[np.ndarray, ...] | None:
+    """The normalised per-experiment bases (``obs.D``, ``obs`` an ObsProblem or None) that a
+    fit keeps with its emulator and file: those of a ``kind`` given as a list of per-experiment
+    bases (`gpmsa.model.basis.discrepancy_bases`), which ``gpmsa.full_prediction`` then uses;
+    None for the other kinds, which it rebuilds (a named kind) or is given again (an array)."""
+    if obs is None or obs.D is None or not is_basis_list(kind):
+        return None
+    return tuple(obs.D)

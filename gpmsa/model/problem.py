@@ -15,7 +15,7 @@ from gpmsa.model import fixed_elements as per_element
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import (
     basis_weights,
-    discrepancy_basis,
+    discrepancy_bases,
     given_basis,
     interpolate_basis,
     pca_basis,
@@ -381,6 +381,8 @@ def reduce_obs(
 ) -> tuple[ObsProblem, tuple[float, float]]:
     """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db).
 
+    ``discrepancy``: None, "constant", "linear", one (l_obs, p_v) array, or a list of one
+    (l_j, p_v) array per experiment on its own grid (`discrepancy_bases`: normalised jointly).
     ``groups``: the precision group of each discrepancy basis vector (`check_groups`; None:
     one group).
 
@@ -432,7 +434,9 @@ def reduce_obs(
         v = np.zeros((n, 0))
         obs_p = ObsProblem(x, u, v, sig, True, Ks, Ds, p_v, tuple(ys))
         return obs_p, (0.0, 0.0)
-    _check_discrepancy_scales(discrepancy, [std.grid if g is None else g for g in obs.grids])
+    grids = [std.grid if g is None else g for g in obs.grids]
+    _check_discrepancy_scales(discrepancy, grids)
+    bases = discrepancy_bases(discrepancy, grids)  # a list: one per experiment, scaled jointly
     Ks, Ds, vs, us, blocks = [], [], [], [], []
     rank, total, ss = 0, 0, 0.0
     lo, hi = std.grid.min(), std.grid.max()
@@ -443,7 +447,7 @@ def reduce_obs(
                 f"simulation grid [{lo:.6g}, {hi:.6g}]; observations must lie within it"
             )
         Kj = interpolate_basis(K, std.grid, g)
-        Dj = discrepancy_basis(discrepancy, std.grid if g is None else g)
+        Dj = None if bases is None else bases[j]
         DK = Kj if Dj is None else np.hstack([Dj, Kj])
         A = DK.T @ lam @ DK
         ridge = A + GLS_RIDGE * np.eye(A.shape[0])

@@ -33,7 +33,14 @@ from gpmsa.calibration.observations import blas_controller, layout_digest
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.model.basis import basis_digest, discrepancy_basis, interpolate_basis
+from gpmsa.model.basis import (
+    basis_digest,
+    describe_discrepancy,
+    discrepancy_basis,
+    discrepancy_kind,
+    interpolate_basis,
+    is_basis_list,
+)
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
     ObsData,
@@ -241,13 +248,16 @@ def _pred_grid(emulator, obs: ObsData, grid):
     return grids[0] if same else std.grid
 
 
-def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool):
-    """D (l, p_v) on the prediction grid with the normalisation the fit used for the data."""
+def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool, bases=None):
+    """D (l, p_v) on the prediction grid with the normalisation the fit used for the data
+    (``bases``: the reduction's per-experiment bases, ``ObsProblem.D``)."""
     if kind is None:
         return np.zeros((grid.size, 0))
     if scalar:
         return np.ones((1, 1))
     obs_grids = [std.grid if g is None else g for g in obs.grids]
+    if is_basis_list(kind):
+        return _experiment_basis(bases, obs_grids, grid)
     if not isinstance(kind, str):
         if not all(g.shape == grid.shape and np.array_equal(g, grid) for g in obs_grids):
             raise GPMSAError(
@@ -266,30 +276,44 @@ def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool):
     return D * (scales.pop() / D[0, 0])
 
 
+def _experiment_basis(bases, obs_grids: list[np.ndarray], grid: np.ndarray) -> np.ndarray:
+    """Per-experiment bases (a list, normalised jointly): the basis of the experiments whose
+    index grid is ``grid`` (SEPIA's full prediction likewise takes one experiment's D_obs,
+    ``obs_ref``); GPMSAError where no experiment has that grid, or those that do differ."""
+    on = [j for j, g in enumerate(obs_grids) if g.shape == grid.shape and np.array_equal(g, grid)]
+    if not on:
+        sizes = ", ".join(f"{j}: {g.size} values" for j, g in enumerate(obs_grids[:6]))
+        raise GPMSAError(
+            "per-experiment discrepancy bases (a list) are known on their experiments' index "
+            "grids only: pass grid= one experiment's grid (obs.grids[j]; experiments "
+            f"{sizes}{', ...' if len(obs_grids) > 6 else ''}); delta is then its basis's"
+        )
+    D = bases[on[0]]
+    if any(not np.array_equal(bases[j], D) for j in on[1:]):
+        raise GPMSAError(
+            f"experiments {on} share this grid but their discrepancy bases differ, so delta on "
+            "it is not one function: predict on a grid that one of them alone has"
+        )
+    return D
+
+
 def _check_fitted_discrepancy(emulator, discrepancy) -> None:
     """GPMSAError when ``discrepancy`` is not the basis the joint fit recorded (its settings'
-    "discrepancy": None, "constant", "linear", or "given" for an array, which cannot be compared
-    further)."""
+    "discrepancy": None, "constant", "linear", "given" for an array or "list" for
+    per-experiment bases, which the basis digest compares further)."""
     settings = getattr(emulator, "settings", None) or {}
     if "discrepancy" not in settings:
         return
     fitted = settings["discrepancy"]
-    as_array = not (discrepancy is None or isinstance(discrepancy, str))
-    if as_array != (fitted == "given") or (not as_array and discrepancy != fitted):
-        given = "an array" if as_array else repr(discrepancy)
-        was = "an array" if fitted == "given" else repr(fitted)
+    if discrepancy_kind(discrepancy) != fitted:
+        shown = {"given": "an array", "list": "a list of per-experiment bases"}
+        given = shown.get(discrepancy_kind(discrepancy), repr(discrepancy))
+        was = shown.get(fitted, repr(fitted))
         raise GPMSAError(
             f"discrepancy={given} differs from the joint fit's discrepancy ({was}); the draws "
             "belong to that basis: leave discrepancy= at its default"
             + (" (or pass the fit's array again)" if fitted == "given" else "")
         )
-
-
-def _shown(discrepancy) -> str:
-    """A discrepancy argument for a message: its name, or an array's shape (not its values)."""
-    if discrepancy is None or isinstance(discrepancy, str):
-        return repr(discrepancy)
-    return f"an array of shape {np.shape(discrepancy)}"
 
 
 def _check_fitted_obs(settings: dict, obs: ObsData) -> None:
@@ -341,9 +365,10 @@ def _check_calibrated_obs(posterior, obs: ObsData, x_names, y_names, grid: np.nd
 
 def _recorded_discrepancy(emulator, posterior: Posterior | None):
     """The discrepancy basis kind the joint fit (``posterior`` None) or the calibration behind
-    ``posterior`` recorded (None: none); GPMSAError where it must be passed again: a basis
-    given as an array, or a Posterior that recorded the basis's digest but not its kind
-    (made before the kind was kept)."""
+    ``posterior`` recorded (None: none), or the per-experiment bases the joint fit kept
+    (``Emulator.discrepancy_bases``); GPMSAError where it must be passed again: a basis given
+    as an array, a list of them for a Posterior, or a Posterior that recorded the basis's
+    digest but not its kind (made before the kind was kept)."""
     record = (emulator.settings if posterior is None else posterior.info) or {}
     kind = record.get("discrepancy")
     source = "the joint fit" if posterior is None else "the calibration"
@@ -356,6 +381,14 @@ def _recorded_discrepancy(emulator, posterior: Posterior | None):
         raise GPMSAError(
             f"{source} used a discrepancy basis given as an array; pass it again as discrepancy="
         )
+    if isinstance(kind, str) and kind == "list":
+        kept = getattr(emulator, "discrepancy_bases", None) if posterior is None else None
+        if kept is None:
+            raise GPMSAError(
+                f"{source} used per-experiment discrepancy bases (a list); pass the list again "
+                "as discrepancy="
+            )
+        return kept
     return kind
 
 
@@ -385,9 +418,11 @@ def full_prediction(
             ``obs`` must then hold the calibration's x_obs and y_obs (where the Posterior
             recorded them: info "obs_values_sha256"), and ``emulator`` be the one it was drawn
             with (where it recorded it: info "emulator_sha256", ``Emulator.model_sha256``).
-        discrepancy: the discrepancy basis of the calibration: None, "constant", "linear" or an
-            (l_obs, p_v) array; the default takes the choice the joint fit, or the calibration
-            behind ``posterior``, recorded (an array must be passed again).
+        discrepancy: the discrepancy basis of the calibration: None, "constant", "linear", an
+            (l_obs, p_v) array or a list of per-experiment bases; the default takes the choice
+            the joint fit, or the calibration behind ``posterior``, recorded (an array must be
+            passed again, and a list too with ``posterior``; a joint fit keeps its list,
+            ``Emulator.discrepancy_bases``).
         discrepancy_groups: the precision group of each discrepancy basis vector (as
             ``gpmsa.fit``'s); the default takes the one the joint fit or ``gpmsa.calibrate``
             recorded (none recorded: one group).
@@ -395,6 +430,8 @@ def full_prediction(
         n_rlz: realizations per draw.
         grid: output grid of the prediction within the simulation grid, in any order (default:
             the observations' grid when all experiments share one, else the simulation grid).
+            With per-experiment discrepancy bases (a list) one experiment's index grid: delta
+            there is that experiment's basis's (as SEPIA's ``obs_ref``).
         seed: int, numpy Generator or None.
 
     Returns:
@@ -446,7 +483,8 @@ def full_prediction(
     if ("betaV" in sets[0]) != (p_v > 0):
         raise GPMSAError(
             f"the draws {'have' if 'betaV' in sets[0] else 'lack'} discrepancy parameters but "
-            f"discrepancy={_shown(discrepancy)} gives {p_v} discrepancy basis vectors"
+            f"discrepancy={describe_discrepancy(discrepancy)} gives {p_v} discrepancy basis "
+            "vectors"
         )
     drawn = sets[0]["lamVz"].size if p_v else 1
     if drawn != ob.n_groups:
@@ -468,12 +506,12 @@ def full_prediction(
         raise GPMSAError(
             "the discrepancy basis differs from the one the draws were made with, or its "
             "precision groups do (their recorded SHA-256, normalised on the observations' "
-            "grids): pass the calibration's discrepancy= (the same kind, or the same array) and "
+            "grids): pass the calibration's discrepancy= (the same kind, array or list) and "
             "discrepancy_groups="
         )
     g = _pred_grid(emulator, obs, grid)
     K_pred = interpolate_basis(K, std.grid, g) if not scalar else K
-    D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar)
+    D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar, ob.D)
     N, p_u = xu.shape[0], emulator.p_u
     n_c = p_v + p_u
     S = len(sets)

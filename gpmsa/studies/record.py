@@ -17,7 +17,8 @@ ARRAYS = ("theta", "mu", "lam", "lamOs", "log_post")
 """The arrays of a study file: (C, N, G), (C, N, H), (C, N, H), (C, N, M), (C, N)."""
 DISCREPANCIES = "discrepancy_by_model"
 """The settings key of a calibrated study's record of each model's discrepancy: label ->
-{"discrepancy": "constant", "linear" or "given" (an array), "discrepancy_sha256": the basis
+{"discrepancy": "constant", "linear", "given" (an array) or "list" (per-experiment arrays),
+"discrepancy_sha256": the basis
 digest (``gpmsa.model.discrepancy.record``), and with several precision groups
 "discrepancy_groups"}; absent for a study without one (and in files written before it)."""
 FILE_RE = re.compile(r"\A[A-Za-z0-9_-][A-Za-z0-9_.-]{0,150}\.gpmsa\Z")

@@ -35,6 +35,7 @@ from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
+from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
@@ -197,6 +198,11 @@ def _per_model_discrepancy(discrepancy, groups, n: int) -> list[tuple]:
         raise GPMSAError(
             f"discrepancy has {len(bases)} entries for {n} models: give one value for every "
             "model, or a list with one entry (None, 'constant', 'linear' or an array) per model"
+            + (
+                "; a model's per-experiment bases (a list) are its entry: [[D_0, D_1], ...]"
+                if is_basis_list(discrepancy)
+                else ""
+            )  # fmt: skip
         )
     one = groups is None or isinstance(groups, np.ndarray) or (
         isinstance(groups, (list, tuple))
@@ -248,7 +254,8 @@ def calibrate_study(
             groups, as ``gpmsa.calibrate``'s (None, "constant", "linear" or an array; groups
             None or one integer per basis vector): one value for every model, or a list with
             one entry per model (``["constant", None]``). A list is read as the per-model list:
-            give one matrix for every model as a numpy array.
+            give one matrix for every model as a numpy array, and a model's per-experiment
+            bases (``gpmsa.calibrate``'s list) as its entry (``[[D_0, D_1], None]``).
         fixed: parameters held at known values, as ``gpmsa.calibrate``'s ``fixed=`` (theta
             elements by t_name or position, native units; lamOs; with a discrepancy betaV and
             lamVz, whole or by element): one dict for every model, or a list with one entry
@@ -331,8 +338,7 @@ def calibrate_study(
     _record_fixed(settings, labels, problems, layout, fixes, natives)
     settings[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
     settings[OBS_LAYOUTS] = {lab: r.layout_sha256 for lab, r in zip(labels, reduced, strict=True)}
-    recorded = {lab: {"discrepancy": basis if isinstance(basis, str) else "given",
-                      **discrepancy_record(prob.obs)}
+    recorded = {lab: {"discrepancy": discrepancy_kind(basis), **discrepancy_record(prob.obs)}
                 for lab, (basis, _), prob in zip(labels, bases, problems, strict=True)
                 if basis is not None}  # fmt: skip
     if recorded:  # full_prediction(posterior=member_posterior(LABEL)) refuses another basis
@@ -411,7 +417,7 @@ def fit_study(
         labels, shared, hierarchical, hyper: as ``calibrate_study``.
         n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, priors, n_pc, discrepancy,
             discrepancy_groups: as ``gpmsa.fit`` (priors, n_pc, discrepancy and its groups: the
-            same for every model); the seed
+            same for every model, so not a list of per-experiment bases); the seed
             the study ran with is ``study.settings["seed"]`` and each model's
             ``settings["seed"]``.
         basis: as ``gpmsa.fit``'s, a numpy array for every model or a list with one entry
@@ -449,6 +455,12 @@ def fit_study(
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     labels = check_labels(labels, n)
+    if is_basis_list(discrepancy):
+        raise GPMSAError(
+            "fit_study takes one discrepancy for every model (None, 'constant', 'linear' or an "
+            "array); per-experiment bases (a list) are taken by gpmsa.fit, gpmsa.calibrate and "
+            "gpmsa.calibrate_study (one list per model)"
+        )
     bases = _per_model_basis(basis, n)
     fixes = _per_model_fixed(fixed, n)
     pcs = [n_pc if k is None or all(b is not None for b in bases) else None for k in bases]
@@ -485,8 +497,7 @@ def fit_study(
     draws = _study_draws(chains, keep)
     lp = draws["log_post"].reshape(-1)
     members = []
-    fitted_discrepancy = (discrepancy if isinstance(discrepancy, str) or discrepancy is None
-                          else "given")  # fmt: skip
+    fitted_discrepancy = discrepancy_kind(discrepancy)
     for i, (sim, prep) in enumerate(zip(sims, preps, strict=True)):
         post = {k: v[:, keep] for k, v in chains.members[i].items()}
         flat = {k: v.reshape(v.shape[0] * v.shape[1], *v.shape[2:]) for k, v in post.items()}

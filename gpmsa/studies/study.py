@@ -270,7 +270,8 @@ class Study:
 
     def discrepancy(self, model: int | str) -> dict | None:
         """One model's discrepancy as its calibration or fit recorded it: {"discrepancy":
-        "constant", "linear" or "given" (an array), "discrepancy_groups": the precision groups
+        "constant", "linear", "given" (an array) or "list" (per-experiment arrays),
+        "discrepancy_groups": the precision groups
         (several) or None (one)}; None for a model without one."""
         i = self._member(model)
         if self.kind == "fit":

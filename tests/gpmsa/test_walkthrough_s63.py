@@ -116,17 +116,6 @@ def test_a_precision_vector_per_experiment_is_its_diagonal():
         gpmsa.ObsData(x, ys, index=grids, precision=[vectors[0], vectors[1][:2]])
 
 
-def test_a_list_of_per_experiment_discrepancy_bases_is_refused_naming_what_is_taken():
-    x, ys, grids = _ragged()
-    rng = np.random.default_rng(4)
-    xs, ts = rng.uniform(size=(24, 1)), rng.uniform(size=(24, 1))
-    data = gpmsa.SimData(x=xs, t=ts, y=_simulator(xs, ts), index=GRID)
-    obs = gpmsa.ObsData(x, ys, index=grids)
-    per = [np.column_stack([np.ones(g.size), g]) for g in grids]
-    with pytest.raises(GPMSAError, match=r"a list of 2 matrices .* is not taken.*'linear'"):
-        gpmsa.fit(data, obs, n_iter=10, discrepancy=per)
-
-
 def test_one_unit_for_a_functional_output_says_one_per_value():
     rng = np.random.default_rng(5)
     x, t = rng.uniform(size=(12, 1)), rng.uniform(size=(12, 1))
