@@ -758,6 +758,11 @@ class ObsData:
                     f"y_obs must be (n, l_obs) or a list of 1-D arrays, got {arr.shape}"
                 )
             ys = list(arr)
+            if not ys:  # np.stack of none raised numpy's "need at least one array to stack"
+                raise GPMSAError(
+                    f"y_obs has no experiments (shape {arr.shape}): ObsData needs at least one "
+                    "observation (a study's every model needs its own)"
+                )
         if n is not None and len(ys) != n:
             raise GPMSAError(f"y_obs must have one row per x_obs row ({n}), got {len(ys)}")
         for j, e in enumerate(ys):

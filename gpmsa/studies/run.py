@@ -296,14 +296,14 @@ def calibrate_study(
             )
     y_obs = _sequence(y_obs, "y_obs")
     n = _same_count(emulators=emulators, x_obs=x_obs, y_obs=y_obs)
-    for e in emulators:
-        check_emulator(e)
+    labels = check_labels(labels, n)
+    for lab, e in zip(labels, emulators, strict=True):  # its error names the model
+        _per_model(lab, check_emulator, e)
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
     seed = run_seed(seed)
     metadata = check_metadata(metadata)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     extrapolate = check_flag(extrapolate, "extrapolate")
-    labels = check_labels(labels, n)
     bases = _per_model_discrepancy(discrepancy, discrepancy_groups, n)
     fixes = _per_model_fixed(fixed, n)
     held = [_per_model(lab, calibration_fixed, e, f, b)
