@@ -39,6 +39,7 @@ from gpmsa.calibration.observations import (
     given_obs_data,
     lamos_start,
     obs_inputs,
+    probe_layout,
     reduce,
     theta_levels,
     theta_probe,
@@ -436,8 +437,9 @@ def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:
 
 def observation_fit(emulator, data, sets) -> Fit:
     """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets)."""
-    theta = theta_probe(emulator.t_unit.shape[1])
-    fits = [fit_of(*fixed_gp(emulator, s).predict(data.x, theta), data) for s in sets]
+    q = emulator.t_unit.shape[1]
+    theta, layout = theta_probe(q), probe_layout(q)
+    fits = [fit_of(*fixed_gp(emulator, s).predict(data.x, theta), data, layout) for s in sets]
     return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
 
 

@@ -69,6 +69,7 @@ from gpmsa.calibration.observations import (
     emulator_record,
     fit_of,
     fixed_gp,
+    probe_layout,
     reduce,
     theta_probe,
     warn_if_outside,
@@ -80,8 +81,6 @@ from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, run_seed
 
 METHODS = ("auto", "grid", "mcmc")
-_PROBE_AXIS = {1: 129, 2: 33}
-"""Nodes per axis of `theta_probe` (q = 1, 2): the outside check's nodes on a coarser grid."""
 MAX_REFINE = 4
 """Refinement passes of one update, at most (each refines the peaks still unresolved)."""
 MAX_REFINE_ONE = 9
@@ -325,10 +324,11 @@ class Calibrator:
                 mean, cov = self._refined[1][k].predict(data.x)
             else:
                 mean, cov = gp.predict(data.x, theta_unit)
-            if fits is not None and theta_unit is None and self.n_grid < _PROBE_AXIS[self.q]:
-                fits.append(fit_of(*gp.predict(data.x, theta_probe(self.q)), data))
-            elif fits is not None:
-                fits.append(fit_of(mean, cov, data))
+            if fits is not None and theta_unit is None and self.n_grid < probe_layout(self.q)[0]:
+                probe = gp.predict(data.x, theta_probe(self.q))
+                fits.append(fit_of(*probe, data, probe_layout(self.q)))
+            elif fits is not None:  # on the fixed grid (fits are kept only there)
+                fits.append(fit_of(mean, cov, data, (self.n_grid,) * self.q))
             G = mean.shape[0]
             out.append(
                 lamos_marginal(

@@ -401,9 +401,9 @@ def theta_probe(q: int) -> np.ndarray:
     parameter, a 33 x 33 grid for two, else the 3^q corners, edge midpoints and centre plus 256
     points of an unscrambled Sobol sequence."""
     if q == 1:
-        return np.linspace(0.0, 1.0, 129)[:, None]
+        return np.linspace(0.0, 1.0, probe_layout(1)[0])[:, None]
     if q == 2:
-        axis = np.linspace(0.0, 1.0, 33)
+        axis = np.linspace(0.0, 1.0, probe_layout(2)[0])
         return np.column_stack([g.ravel() for g in np.meshgrid(axis, axis, indexing="ij")])
     from scipy.stats import qmc
 
@@ -414,9 +414,21 @@ def theta_probe(q: int) -> np.ndarray:
     return np.vstack([lattice, sobol])
 
 
-def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
+def probe_layout(q: int) -> tuple[int, ...] | None:
+    """The grid shape of `theta_probe`'s nodes ('ij' order), None for its scattered ones."""
+    return {1: (129,), 2: (33, 33)}.get(q)
+
+
+def fit_of(
+    mean: np.ndarray, cov: np.ndarray, data: Observations, layout: tuple[int, ...] | None = None
+) -> Fit:
     """``Fit`` of the observation from the emulator's predictive on some theta values:
-    mean (G, p_u, n), cov (G, p_u, n, n) (``FixedGP.predict`` / ``GridPredictor.predict``)."""
+    mean (G, p_u, n), cov (G, p_u, n, n) (``FixedGP.predict`` / ``GridPredictor.predict``).
+    ``layout``: the theta values' grid shape ('ij' order, G nodes), where they form one: a
+    datum judged on its own whose residual changes sign between neighbouring nodes is met
+    between them (the predictive mean is continuous in theta), however far the nodes' means
+    lie from it in predictive sds (an emulator with a negligible nugget read a datum exactly
+    on the simulator 11 sds outside, between probe nodes)."""
     G, p_u, n = mean.shape
     m = mean.reshape(G, p_u * n)
     var = np.diagonal(cov, axis1=2, axis2=3).reshape(G, p_u * n)
@@ -434,7 +446,10 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
     with np.errstate(over="ignore"):
         dist = np.abs(resid) / np.sqrt(var + noise)
     if np.ndim(noise) == 0 and noise == 0.0:  # no error estimate: each datum on its own
-        outside = float(np.max(np.min(dist, axis=0)))
+        nearest = np.min(dist, axis=0)
+        if layout is not None:
+            nearest[_crossed(resid, layout)] = 0.0
+        outside = float(np.max(nearest))
     else:
         outside = float(np.min(np.max(dist, axis=1)))
     L = data.obs_chol
@@ -453,6 +468,18 @@ def fit_of(mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
             tr += np.einsum("ai,gij,aj->g", blk, cov[:, c], blk)
     excess = np.maximum(0.0, (y2 - tr) / max(d - data.obs.n_null, 1))  # observed directions
     return Fit(outside, float(np.min(excess)))
+
+
+def _crossed(resid: np.ndarray, layout: tuple[int, ...]) -> np.ndarray:
+    """Per datum (resid (G, d) on a grid of shape ``layout``), whether its residual is zero
+    at a node or changes sign between two neighbouring nodes along an axis."""
+    r = np.sign(resid).reshape(*layout, -1)
+    hit = np.any(r == 0, axis=tuple(range(len(layout))))
+    for axis in range(len(layout)):
+        lo = np.take(r, range(layout[axis] - 1), axis=axis)
+        hi = np.take(r, range(1, layout[axis]), axis=axis)
+        hit |= np.any(lo * hi < 0, axis=tuple(range(len(layout))))
+    return hit
 
 
 def _observed_projector(obs: ObsProblem) -> np.ndarray | None:

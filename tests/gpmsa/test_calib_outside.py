@@ -292,3 +292,27 @@ def test_oversized_requests_are_refused_before_allocating(monkeypatch):
     monkeypatch.setattr(gpmsa.limits, "MAX_OBS_VALUES", 3)
     post = Calibrator(emu).update(*three)
     assert np.isfinite(post.mean("GD"))
+
+
+def test_an_exact_observation_between_probe_nodes_is_not_outside():
+    """An emulator with a negligible nugget (from_params, lamWs 1e6) read observations exactly
+    on the simulator as 11-85 predictive sds outside (17 of 40 values of E), because no probe
+    node lay within a few of its tiny sds; a residual that changes sign between neighbouring
+    nodes is met between them. An observation off the simulator still warns."""
+    rng = np.random.default_rng(0)
+    x, t = rng.uniform(0, 1, 40), rng.uniform(2, 4, 40)
+    sim = gpmsa.SimData(x=x[:, None], t=t[:, None], y=(1.0 + 2.0 * t + x)[:, None],
+                        x_names=["x"], t_names=["E"])  # fmt: skip
+    emu = gpmsa.Emulator.from_params(
+        sim, {"betaU": [[0.5], [0.5]], "lamUz": [1.0], "lamWs": [1e6], "lamWOs": [1e6]}
+    )
+    xo = np.array([[0.4], [0.6]])
+    cal = gpmsa.Calibrator(emu)
+    for truth in (2.154, 2.2456, 2.612):  # each read > 5 sds outside before
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", gpmsa.OutsideEmulatorWarning)
+            cal.update(xo, 1.0 + 2.0 * truth + xo)
+            gpmsa.calibrate(emu, xo, 1.0 + 2.0 * truth + xo, n_samples=20, n_burn=5, tune=False,
+                            seed=0)  # fmt: skip
+    with pytest.warns(gpmsa.OutsideEmulatorWarning, match="predictive sds"):
+        cal.update(xo, 1.0 + 2.0 * 4.5 + xo)  # E = 4.5: beyond every run's output
