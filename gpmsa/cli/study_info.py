@@ -47,7 +47,12 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
     for k, v in manifest["metadata"].items():
         lines.append(f"metadata {safe(k, 60)}: {value(v)}")
     post = study.posterior
+    held = manifest["settings"].get("held")
+    held = {h for h in held if isinstance(h, str)} if isinstance(held, list) else set()
     for name in post.names:
+        if name in held and post.sd(name) == 0:  # fixed=: no ESS or R-hat to give
+            lines.append(f"posterior {safe(name, 80)}: held at {post.mean(name):.6g} (fixed=)")
+            continue
         lo, hi = post.interval(name, 0.9)
         d = study.diagnostics.get(name, {})
         e, r = (d.get(k, [None])[0] for k in ("ess", "rhat"))

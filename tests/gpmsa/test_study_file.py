@@ -165,3 +165,22 @@ def test_a_study_saved_and_loaded_through_a_link_keeps_its_members_beside_the_fi
     assert sorted(p.name for p in store.iterdir()) == [
         "run.a.gpmsa", "run.b.gpmsa", "run.c.gpmsa", "run.gpmsa"]  # fmt: skip
     assert gpmsa.load_study(store / "run.gpmsa").labels == ("a", "b", "c")
+
+
+def test_gpmsa_info_says_a_held_parameter_is_held(tmp_path, capsys):
+    """A study with fixed={"lamOs": 1.0} printed "lamOs[a]: mean 1 sd 0 ... ESS nan R-hat nan";
+    it says the value is held. A hostile "held" list does not make a sampled name read so."""
+    rng = np.random.default_rng(4)
+    data = [observations(th, 3, 0.03, rng) for th in (0.35, 0.5)]
+    study = gpmsa.calibrate_study(
+        [emulator(None)] * 2, [d[0] for d in data], [d[1] for d in data], labels=["a", "b"],
+        n_samples=60, n_burn=20, tune=False, seed=0, fixed={"lamOs": 1.0},
+    )  # fmt: skip
+    path = study.save(tmp_path / "held.gpmsa")
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "posterior lamOs[a]: held at 1 (fixed=)" in out and "nan" not in out
+    _rewrite(path, lambda m: m["settings"].update(held=["t[a]", 5]))
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "posterior t[a]: mean" in out and "lamOs[a]: mean 1 sd 0" in out
