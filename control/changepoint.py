@@ -32,6 +32,7 @@ from control.errors import ControlError
 from control.validation import (
     check_instance,
     check_n_draws,
+    check_posterior_name,
     float_array,
     is_real,
     require_integers,
@@ -285,7 +286,8 @@ class ChangePointFilter:
         return float(self._mass.sum(axis=1) @ self._dist)
 
     def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
-        """The GD posterior as a gpmsa Posterior holding the grid marginal (draws made lazily)."""
+        """The GD posterior as a gpmsa Posterior holding the grid marginal under ``name``;
+        ``samples`` are ``n_draws`` draws with a fixed seed, made only when read."""
         return _grid_posterior(self.gd, self._weights, self._gd_mass(), name, n_draws)
 
 
@@ -322,6 +324,7 @@ def _mixture_posterior(
 
 
 def _grid_posterior(gd, weights, mass, name: str, n_draws: int) -> Posterior:
+    check_posterior_name(name)
     check_n_draws(n_draws)
     with np.errstate(divide="ignore"):
         log_density = np.log(mass) - np.log(weights)

@@ -157,11 +157,19 @@ class ClosedLoopResult:
     settings: dict = field(default_factory=dict)
 
 
-def _check_seed(seed) -> None:
+def _run_seed(seed) -> int | None:
+    """The seed a run uses and records: None, an integer >= 0, or one drawn from a numpy
+    Generator (as gpmsa's calls take one), so that ``seed=`` the recorded integer repeats the
+    run; ControlError for anything else."""
     if seed is None:
-        return
+        return None
+    if isinstance(seed, np.random.Generator):
+        return int(seed.integers(2**63))
     if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise ControlError(f"seed must be None or an integer >= 0, got {seed!r}")
+        raise ControlError(
+            f"seed must be None or an integer >= 0, got {seed!r} (or a numpy Generator)"
+        )
+    return int(seed)
 
 
 def _check_faults(faults) -> tuple[SensorFault, ...]:
@@ -212,7 +220,7 @@ def run_closed_loop(
     emulator,
     model=None,
     noise_std: float = 0.0,
-    seed: int | None = None,
+    seed: int | np.random.Generator | None = None,
     bcr: BCRSettings | None = None,
     simplex: Simplex | None = None,
     progress: bool = False,
@@ -231,7 +239,8 @@ def run_closed_loop(
             `control.shipped_emulator`).
         model: vehicle model (default `vehicle.Jackal()`); must match the emulator's metadata.
         noise_std: accelerometer noise standard deviation, m/s^2 (Test Case B: 1.0).
-        seed: seed (integer >= 0) of the measurement noise and of the injected faults.
+        seed: seed (integer >= 0, or a numpy Generator to draw one from) of the measurement
+            noise and of the injected faults; the integer is ``settings["seed"]``.
         bcr: BCR settings (default: `bcr_settings_for(emulator)`, the emulator's feature); the
             loop shortens ``max_silence_s`` to `EXACT_CLOCK_SILENCE` sample periods, since the
             simulation's clock is exact (a dropped sample at the end of an update is a fault
@@ -263,7 +272,7 @@ def run_closed_loop(
     check_instance(simplex, "simplex", Simplex)
     if bcr is not None:
         check_instance(bcr, "bcr", BCRSettings)
-    _check_seed(seed)
+    seed = _run_seed(seed)
     for name, flag in (("check", check), ("progress", progress)):
         if not isinstance(flag, bool | np.bool_):
             raise ControlError(f"{name} must be True or False, got {flag!r:.60}")

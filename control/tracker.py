@@ -29,6 +29,7 @@ from control.errors import ControlError
 from control.validation import (
     check_instance,
     check_n_draws,
+    check_posterior_name,
     float_array,
     is_real,
     require_integers,
@@ -169,12 +170,14 @@ class GDTracker:
             )
 
     def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
-        """The current posterior of GD as a gpmsa Posterior holding the exact grid marginal.
+        """The current posterior of GD as a gpmsa Posterior holding the exact grid marginal
+        under ``name``.
 
         The node masses become a density through the grid's trapezoid weights, so the mean and
         sd are the mass-weighted sums; ``samples`` (for histograms) are ``n_draws`` inverse-CDF
         draws with a fixed seed, made only when read.
         """
+        check_posterior_name(name)
         check_n_draws(n_draws)
         marginal = GridMarginal.from_log_density(
             self.grid, self.log_mass - self._log_weights, np.exp(self._log_weights)

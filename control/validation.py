@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from control.errors import ControlError
+from gpmsa import limits
 from roadgen import checks
 
 
@@ -68,9 +69,18 @@ def float_array(values, name: str) -> np.ndarray:
 
 
 def check_n_draws(n_draws) -> None:
-    """ControlError unless ``n_draws`` (posterior draws made for histograms) is an integer >= 1."""
+    """ControlError unless ``n_draws`` (posterior draws made for histograms) is an integer >= 1;
+    gpmsa.ResourceLimitError, as ``gpmsa.Calibrator(n_draws=)``, when they would need more than
+    ``gpmsa.limits.MAX_MEMORY_BYTES`` (they are drawn lazily, when first read)."""
     if not (is_integer(n_draws) and n_draws >= 1):
         raise ControlError(f"n_draws must be an integer >= 1, got {n_draws!r}")
+    limits.check_memory(24.0 * n_draws, f"posterior(n_draws={n_draws}): the draws of GD")
+
+
+def check_posterior_name(name) -> None:
+    """ControlError unless ``name`` (the posterior's name of GD) is a non-empty str."""
+    if not isinstance(name, str) or not name:
+        raise ControlError(f"name must be the parameter's name (a non-empty str), got {name!r:.60}")
 
 
 def require_reals(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:

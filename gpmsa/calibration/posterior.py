@@ -464,7 +464,8 @@ class Posterior:
         return to_inference_data({k: np.asarray(v)[None, :] for k, v in self.samples.items()})
 
     def plot(self, name: str, bins: int = 50, unit: str | None = None):
-        """Histogram (with the grid density when there is one) and trace of ``name``: a Figure.
+        """Histogram of ``bins`` bars (with the grid density when there is one) and trace of
+        ``name``: a Figure.
 
         ``unit`` labels the axes (None: ``info["units"][name]`` where calibrate or Calibrator
         recorded the emulator's units)."""

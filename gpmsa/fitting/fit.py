@@ -120,7 +120,9 @@ def fit(
     more than the chains; or any ``concurrent.futures.Executor`` / dask ``Client``); the draws
     are the same wherever they run. seed: an integer, a numpy Generator or None (fresh
     entropy); the integer the fit ran with is ``settings["seed"]``, and ``fit(..., seed=that)``
-    repeats it. options: passed to the backend's ``sample`` (e.g. ``init``: a rule of
+    repeats it. priors: a ``gpmsa.Priors`` (None: GPM/SA's, ``Priors()``; the data
+    corrections are added here). metadata: a JSON-able dict kept in ``Emulator.metadata``
+    and the file. options: passed to the backend's ``sample`` (e.g. ``init``: a rule of
     ``gpmsa.mcmc.starts``, or an Emulator of this fit, whose chains then continue from their
     last kept draws: ``fit(data, n_iter=..., n_chains=emu's, init=emu)``, see
     ``continued_starts``).

@@ -14,10 +14,11 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
     SEPIA's ``plot_data``): a Figure.
 
     A functional output (l_sim > 1): every run over the output grid, coloured by the input
-    ``color_by`` (a name of ``sim``'s x or t inputs; default its first calibration parameter)
-    with a colour bar, and every experiment over its own grid in black. A scalar output: the
-    output against each input, one panel each; an experiment at its known inputs in the x
-    panels, and as a horizontal line in the t panels (where the runs cross it, theta may lie).
+    ``color_by`` (a name of ``sim``'s x or t inputs, checked for a scalar output too; default
+    its first calibration parameter) with a colour bar, and every experiment over its own grid
+    in black. A scalar output: the output against each input, one panel each; an experiment at
+    its known inputs in the x panels, and as a horizontal line in the t panels (where the runs
+    cross it, theta may lie).
 
     Example:
         >>> import numpy as np, gpmsa
@@ -37,6 +38,9 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
               for k, (n, u) in enumerate(zip(sim.x_names, sim.x_units, strict=True))]  # fmt: skip
     inputs += [(n, sim.t[:, k], u)
                for k, (n, u) in enumerate(zip(sim.t_names, sim.t_units, strict=True))]  # fmt: skip
+    names = [n for n, _, _ in inputs]
+    if color_by is not None and color_by not in names:  # a scalar output's too, though unused
+        raise GPMSAError(f"color_by must be one of the inputs {names}, got {color_by!r}")
     x_obs = None if obs is None else obs.inputs(sim.x_names)
     ys = None if obs is None else obs.outputs(sim.y_names)
     if x_obs is not None and x_obs.shape[1] != sim.p:
@@ -82,8 +86,6 @@ def _functional(sim: SimData, inputs, obs, ys, color_by):
 
     names = [n for n, _, _ in inputs]
     color_by = sim.t_names[0] if color_by is None else color_by
-    if color_by not in names:
-        raise GPMSAError(f"color_by must be one of the inputs {names}, got {color_by!r}")
     _, values, unit = inputs[names.index(color_by)]
     grid = np.arange(sim.l_sim, dtype=float) if sim.index is None else sim.index
     norm = colors.Normalize(float(np.min(values)), float(np.max(values)))

@@ -14,7 +14,14 @@ from scipy.linalg import cho_solve, solve_triangular
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import NO_DRAWS, Emulator
 from gpmsa.model.correlation import correlation
-from gpmsa.model.data import as_matrix, by_column_names, check_count, check_seed, evenly_spaced
+from gpmsa.model.data import (
+    as_float,
+    as_matrix,
+    by_column_names,
+    check_count,
+    check_seed,
+    evenly_spaced,
+)
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
 
@@ -59,7 +66,7 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
     if (d > 1 and np.ndim(values) == 1 and np.size(values) == d) or (
         d == 1 and np.ndim(values) == 0
     ):
-        values = [values]
+        values = as_float(values, what).reshape(1, -1)  # a dict is refused by its own name
     native = as_matrix(values, what, ncols=d, no_columns=d == 0)
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     unit = snap_to_unit((native - lo) / (hi - lo))

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
-from gpmsa.calibration.observations import check_x
+from gpmsa.calibration.observations import EMULATOR_ATTRS, check_x
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import (
@@ -133,6 +133,10 @@ def calibrated_predict(
     Returns:
         CalibratedPrediction (native units).
     """
+    missing = [a for a in EMULATOR_ATTRS if not hasattr(emulator, a)]
+    if missing:  # as gpmsa.calibrate: a stand-in with these attributes is taken
+        raise GPMSAError(f"emulator lacks {missing}: calibrated_predict needs a gpmsa.Emulator, "
+                         f"got {type(emulator).__name__}")  # fmt: skip
     noise, resid = check_flag(noise, "noise"), check_flag(resid, "resid")
     extrapolate = check_flag(extrapolate, "extrapolate")
     x, _ = check_x(emulator, x_new, extrapolate, "x_new")

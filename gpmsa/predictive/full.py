@@ -153,8 +153,9 @@ class FullPrediction:
         return (v.mean(axis=0) + m.var(axis=0)) * self.y_sd**2
 
     def interval(self, what: str = "y", level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
-        """Central interval (N, l) of probability ``level`` from the realizations' quantiles
-        (a warning when there are too few for its tails: `realization_interval`)."""
+        """Central interval (N, l) of ``what`` (as `mean`), probability ``level``, native units,
+        from the realizations' quantiles (a warning when there are too few for its tails:
+        `realization_interval`)."""
         self._check(what)
         level = check_level(level)
         fix = "full_prediction's n_draws or n_rlz"
@@ -193,9 +194,7 @@ def _posterior_sets(emulator, posterior, n_draws):
                 )
             return prm
 
-    else:
-        if not isinstance(posterior, Posterior):
-            raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
+    else:  # a gpmsa.Posterior (checked by full_prediction)
         names = tuple(emulator.t_names)
         samples = posterior.samples
         missing = [k for k in (*names, "lamOs") if k not in samples]
@@ -454,6 +453,8 @@ def full_prediction(
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be the gpmsa.ObsData of the calibration, got "
                          f"{type(obs).__name__}")  # fmt: skip
+    if posterior is not None and not isinstance(posterior, Posterior):
+        raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
     n_rlz = check_count(n_rlz, "n_rlz")
     rng = rng_of(seed)
     std, K = emulator.standardizer, emulator.K

@@ -37,7 +37,11 @@ def calibration_posterior(emulator) -> Posterior:
         >>> 0.0 <= post.mean("t") <= 1.0
         True
     """
-    cal = getattr(emulator, "calibration", None)
+    if not hasattr(emulator, "calibration"):
+        hint = " (a study: study.member_posterior(model))" if hasattr(emulator, "members") else ""
+        raise GPMSAError(f"calibration_posterior needs a gpmsa.Emulator of a joint fit, got "
+                         f"{type(emulator).__name__}{hint}")  # fmt: skip
+    cal = emulator.calibration
     if not cal:
         raise GPMSAError(
             "this emulator has no calibration draws: it was fitted without observations "
