@@ -41,14 +41,16 @@ def within(value: float, lo: float, hi: float) -> bool:
 
 
 def path_argument(value, name: str, of: str = "") -> Path:
-    """``value`` (a str or os.PathLike, not empty) as a Path; ControlError naming the argument
-    ``name`` for anything else (None, a number, ""); ``of`` says what the path is of."""
+    """``value`` (a str or os.PathLike, not empty) as a Path, a leading ``~`` expanded to the
+    home folder (as the shell would: a folder named "~" was made in the working directory);
+    ControlError naming the argument ``name`` for anything else (None, a number, ""); ``of``
+    says what the path is of."""
     if not isinstance(value, str | os.PathLike) or not str(value):
         raise ControlError(
             f"{name} must be the path (a str or os.PathLike){of}, got {value!r:.60} "
             f"({type(value).__name__})"
         )
-    return Path(value)
+    return Path(value).expanduser()
 
 
 def check_not_masked(values, name: str) -> None:

@@ -652,7 +652,8 @@ def run_one(spec: RunSpec, cache_dir: str | None = None) -> RunResult:
         f, status = np.full(len(_F_NAMES), np.nan), f"{type(exc).__name__}: {exc}"
         acc = measured = empty
     if cache_dir is not None and status == "ok":
-        _write_cached(Path(cache_dir) / f"run-{spec.key()}.npz", (f, status, acc, measured), spec)
+        cached = Path(cache_dir).expanduser() / f"run-{spec.key()}.npz"
+        _write_cached(cached, (f, status, acc, measured), spec)
     return f, status, acc, measured
 
 
@@ -734,7 +735,7 @@ def _write_cached(path: Path, result: RunResult, spec: RunSpec) -> None:
 def _cache_folder(cache_dir: str | os.PathLike) -> Path:
     """``cache_dir`` as a Path, made if missing; VehicleError naming it if it cannot be a folder
     (a file, below a file, not writable)."""
-    cache = Path(cache_dir)
+    cache = Path(cache_dir).expanduser()  # not a folder named "~"
     try:
         cache.mkdir(parents=True, exist_ok=True)
         probe = cache / f".write-test-{os.getpid()}"  # an existing folder may not be writable

@@ -858,7 +858,7 @@ def write_sensor_bag(
         streams = [(c_imu, log[: t_imu.size], imu), (c_odom, log[t_imu.size :], odom)]
         for conn, stamp, data in merge_in_time(streams):
             writer.write(conn, stamp, data)
-    return Path(path)
+    return Path(path).expanduser()
 
 
 def write_run_bag(result, path: str | os.PathLike, **kw) -> Path:

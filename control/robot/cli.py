@@ -208,7 +208,7 @@ def main(argv: list[str] | None = None) -> int:
             return 2
     bag = Path(args.bag)
     default_out = Path(f"{bag.name.removesuffix(bag.suffix)}_bcr")
-    out = default_out if args.out is None else Path(args.out)
+    out = default_out if args.out is None else Path(args.out).expanduser()
     try:
         settings = ReplaySettings(
             imu_topic=args.imu_topic,

@@ -274,7 +274,7 @@ class ReplayResult:
             )
             for c, stamp, data in merge_in_time([(conn, self.stamp_ns, datas)]):
                 writer.write(c, stamp, data)
-        return Path(path)
+        return Path(path).expanduser()
 
     def _count_line(self) -> str:
         """How many estimates of each status, or why there is none."""

@@ -178,14 +178,15 @@ def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
 
 
 def check_path(path) -> Path:
-    """``path`` as a Path; GPMSAError unless it is a non-empty str or path-like (bytes, numbers
+    """``path`` as a Path, a leading ``~`` expanded to the home folder (as the shell would; not
+    a folder named "~"); GPMSAError unless it is a non-empty str or path-like (bytes, numbers
     and None are not file names here), or for a str that ends with a path separator (it names a
     folder; Path would drop the separator, and save("out/") write a file named out)."""
     if not isinstance(path, str | os.PathLike) or not str(path):
         raise GPMSAError(f"path must be a file name (str or path-like), got {path!r}")
     if isinstance(path, str) and path.endswith(tuple(filter(None, (os.sep, os.altsep)))):
         raise GPMSAError(f"path {path!r} ends with a separator: it names a folder, not a file")
-    return Path(path)
+    return Path(path).expanduser()
 
 
 def seal(manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT) -> tuple[dict, bytes]:

@@ -131,3 +131,15 @@ def test_a_bag_is_not_written_onto_a_link_to_nowhere(tmp_path):
     os.symlink(tmp_path / "nowhere", tmp_path / "link")
     with pytest.raises(ControlError, match="exists already"):
         write_sensor_bag(tmp_path / "link", *_drive())
+
+
+def test_a_path_that_starts_with_a_tilde_is_the_home_folder(tmp_path, monkeypatch):
+    """record_run("~/runs/run.mcap") made a folder literally named "~" in the working
+    directory; a leading ~ is the home folder, as the shell reads it (write_sensor_bag too)."""
+    home, work = tmp_path / "home", tmp_path / "work"
+    home.mkdir(), work.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir(work)
+    assert control.record_run(_result(), "~/runs/run.mcap") == home / "runs" / "run.mcap"
+    assert write_sensor_bag("~/bags/b", *_drive()) == home / "bags" / "b"
+    assert not (work / "~").exists() and (home / "runs" / "run.mcap").is_file()

@@ -295,3 +295,17 @@ def test_cli_info_prints_manifest(saved, capsys, tmp_path):
     bad.write_bytes(b"PK\x03\x04junk")
     assert main(["info", str(bad)]) == 2
     assert "not a readable zip" in capsys.readouterr().err
+
+
+def test_a_path_that_starts_with_a_tilde_is_the_home_folder(tmp_path, monkeypatch):
+    """save("~/a.gpmsa") raised "No such file or directory" (a folder named "~" in the working
+    directory); a leading ~ is the home folder, as the shell reads it, for load and info too."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.chdir(tmp_path)
+    emu = gpmsa.Emulator.from_params(
+        gpmsa.SimData(x=np.linspace(0, 1, 6), t=np.linspace(1, 0, 6) ** 2, y=np.arange(6.0)),
+        {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e3], "lamWOs": [1e3]},
+    )
+    assert emu.save("~/a.gpmsa") == tmp_path / "a.gpmsa"
+    assert gpmsa.load("~/a.gpmsa").model_sha256 == emu.model_sha256
+    assert main(["info", "~/a.gpmsa"]) == 0
