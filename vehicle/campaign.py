@@ -138,7 +138,7 @@ class Campaign:
         CampaignFileError if it cannot be written, or if ``path`` (or the link's target) holds
         anything else (another program's file, a folder), which is never replaced."""
         _check_path(path)
-        target = Path(path)
+        target = Path(path).expanduser()  # ~: the home folder
         if target.name in ("", ".."):
             raise VehicleError(f"path={str(path)!r} names no file: need a file name, e.g. 'c.npz'")
         target = _through_link(target)
@@ -158,7 +158,7 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
     """Read a file written by ``Campaign.save``; CampaignFileError if missing, not a regular
     file, damaged or invalid, VehicleError if ``path`` is not a path."""
     _check_path(path)
-    arrays = _read_npz(Path(path), (*_ARRAYS, "settings"), _TRACES)
+    arrays = _read_npz(Path(path).expanduser(), (*_ARRAYS, "settings"), _TRACES)
     settings = arrays.pop("settings")
     if settings.dtype.kind != "U" or settings.ndim != 0:
         raise CampaignFileError(

@@ -114,3 +114,14 @@ def test_a_cache_entry_with_non_finite_traces_is_recomputed(saved, tmp_path):
         again = vehicle.run_campaign(DESIGN, keep_s=5.0, cache_dir=folder, executor=ex, **SHORT)
     assert again.ok.all()
     np.testing.assert_array_equal(again.accel, camp.accel)
+
+
+def test_a_path_that_starts_with_a_tilde_is_the_home_folder(saved, tmp_path, monkeypatch):
+    """Campaign.save("~/c.npz") failed "No such file" (a folder named "~" in the working
+    directory); a leading ~ is the home folder, as gpmsa's and control's files take it."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.chdir(tmp_path)
+    campaign = saved[2]
+    campaign.save("~/c.npz")
+    assert (tmp_path / "c.npz").is_file()
+    np.testing.assert_array_equal(vehicle.load_campaign("~/c.npz").f_full, campaign.f_full)
