@@ -23,13 +23,15 @@ def path_option(text: str) -> str:
     return text
 
 
-def check_seed(parser: argparse.ArgumentParser, seed: int, offset: int = 0) -> None:
-    """Usage error unless ``--seed`` and ``seed + offset`` (the largest seed the script derives
-    from it) are seeds the libraries take: integers in [0, 2**128)."""
+def check_seed(
+    parser: argparse.ArgumentParser, seed: int, offset: int = 0, option: str = "--seed"
+) -> None:
+    """Usage error unless ``seed`` (given as ``option``) and ``seed + offset`` (the largest seed
+    the script derives from it) are seeds the libraries take: integers in [0, 2**128)."""
     if seed < 0:
-        parser.error(f"--seed must be >= 0, got {seed}")
+        parser.error(f"{option} must be >= 0, got {seed}")
     if seed + offset >= MAX_SEED:
-        parser.error(f"--seed must be <= 2**128 - {offset + 1} (the seeds' range), got {seed}")
+        parser.error(f"{option} must be <= 2**128 - {offset + 1} (the seeds' range), got {seed}")
 
 
 def check_option_memory(parser: argparse.ArgumentParser, nbytes: float, what: str) -> None:

@@ -113,6 +113,14 @@ def _json_values(value):
     return value
 
 
+def _label_heights(fig) -> None:
+    """Name the output grid on ``fig``'s axes: gpmsa's plots label it "output index", which here
+    is the drop height h in m."""
+    for ax in fig.axes:
+        if ax.get_xlabel() == "output index":
+            ax.set_xlabel("drop height h (m)")
+
+
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -187,6 +195,7 @@ def main(argv: list[str] | None = None) -> dict:
     figs["sensitivity"] = gpmsa.plots.sensitivity_bars(sens)
 
     for name, fig in figs.items():
+        _label_heights(fig)
         save_figure(fig, out / f"{name}.png")
     summary = {
         "posterior": post.summary(0.9),

@@ -36,7 +36,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import output_folder, path_option, save_figure, write_text  # noqa: E402
+from _cli import check_seed, output_folder, path_option, save_figure, write_text  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -225,8 +225,7 @@ def main(argv: list[str] | None = None) -> dict:
     args.cases = list(dict.fromkeys(args.cases))  # each case once
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
-    if args.first_seed < 0:
-        parser.error(f"--first-seed must be >= 0, got {args.first_seed}")
+    check_seed(parser, args.first_seed, args.runs - 1, "--first-seed")  # each run's seed
     try:
         segments = PAPER_SEGMENTS if args.track is None else parse_segments(args.track)
         track = roadgen.track(segments, seed=args.first_seed)
@@ -318,6 +317,8 @@ def main(argv: list[str] | None = None) -> dict:
     if paper_track:
         metrics["paper"] = PAPER_RMSE
     metrics["settings"] = {**vars(args), "segments": segments, "seeds": list(seeds)}
+    # written before the tables: a reader that stops reading (`... | head`) ends it at a print
+    write_text(out / "metrics.json", json.dumps(strict_json(metrics), indent=2, allow_nan=False))
 
     source = "paper: Lewis et al. 2025" if paper_track else "no paper figures for this track"
     which = f"seed {seeds.start}" if len(seeds) == 1 else f"seeds {seeds.start}-{seeds[-1]} pooled"
@@ -354,8 +355,6 @@ def main(argv: list[str] | None = None) -> dict:
     if named:
         print("\nestimates naming an edge of the emulator's GD domain (the road may lie beyond):")
         print("\n".join(f"  {line}" for line in named))
-    metrics_json = json.dumps(strict_json(metrics), indent=2, allow_nan=False)
-    write_text(out / "metrics.json", metrics_json)
     print(f"\nwrote {out / 'metrics.json'} and the figures gd_trace_*.png, speed_*.png")
     if args.record:
         print(f"wrote one MCAP per run in {args.record} (open in Foxglove with "

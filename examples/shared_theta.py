@@ -100,11 +100,17 @@ def experiments(rng: np.random.Generator) -> dict[str, tuple[np.ndarray, np.ndar
     return {"static": (P, d), "modal": (L, f)}
 
 
+COLOURS = {"static alone": "C0", "modal alone": "C1", "shared (emulators fixed)": "C2",
+           "shared (joint fit)": "C3"}  # fmt: skip
+"""One colour per posterior in every figure (the rho panel has no "static alone")."""
+
+
 def _hist(ax, draws: dict[str, np.ndarray], truth: float, label: str) -> None:
     for name, d in draws.items():
-        ax.hist(d, bins=40, density=True, histtype="step", label=name)
+        ax.hist(d, bins=40, density=True, histtype="step", label=name, color=COLOURS[name])
     ax.axvline(truth, color="k", ls="--", label="truth")
     ax.set_xlabel(label)
+    ax.set_ylabel("posterior density")
     ax.legend(fontsize=8)
 
 
@@ -155,12 +161,12 @@ def main(argv: list[str] | None = None) -> dict:
                                "rho": joint.posterior.samples["rho[modal]"]},
     }  # fmt: skip
     summary = {"truth": TRUTH, "posterior": {}}
-    print(f"{'':26s} {'E [GPa] mean  90% interval':32s} {'rho [kg/m^3] mean  90% interval'}")
+    lines = [f"{'':26s} {'E [GPa] mean  90% interval':32s} {'rho [kg/m^3] mean  90% interval'}"]
     for label, draws in rows.items():
         cells, rec = [], {}
         for name in ("E", "rho"):
             if name not in draws:
-                cells.append(f"{'-':32s}")
+                cells.append(f"{'-':>9s}{'':23s}")
                 continue
             d = draws[name]
             lo, hi = np.quantile(d, [0.05, 0.95])
@@ -168,8 +174,10 @@ def main(argv: list[str] | None = None) -> dict:
                          "q95": float(hi)}  # fmt: skip
             cells.append(f"{d.mean():9.4g}  [{lo:8.4g}, {hi:8.4g}]      ")
         summary["posterior"][label] = rec
-        print(f"{label:26s} " + " ".join(cells))
-    print(f"{'truth':26s} {TRUTH['E']:9.4g}{'':23s} {TRUTH['rho']:9.4g}")
+        lines.append(f"{label:26s} " + " ".join(cells))
+    lines.append(f"{'truth':26s} {TRUTH['E']:9.4g}{'':23s} {TRUTH['rho']:9.4g}")
+    # the table is printed after the files: a reader that stops reading (`... | head`) ends the
+    # script at a print
 
     fig = Figure(figsize=(10, 4))
     ax1, ax2 = fig.subplots(1, 2)
@@ -182,7 +190,8 @@ def main(argv: list[str] | None = None) -> dict:
     fig = Figure(figsize=(5, 4.5))
     ax = fig.subplots()
     for label in ("modal alone", "shared (emulators fixed)"):
-        ax.plot(rows[label]["E"][::4], rows[label]["rho"][::4], ".", ms=2, label=label)
+        ax.plot(rows[label]["E"][::4], rows[label]["rho"][::4], ".", ms=2, label=label,
+                color=COLOURS[label])  # fmt: skip
     ax.plot(TRUTH["E"], TRUTH["rho"], "k*", ms=12, label="truth")
     ax.set_xlabel("E [GPa]")
     ax.set_ylabel("rho [kg/m^3]")
@@ -202,6 +211,8 @@ def main(argv: list[str] | None = None) -> dict:
     fig.tight_layout()
     save_figure(fig, out / "traces.png")
     write_text(out / "summary.json", json.dumps(summary, indent=1))
+    print("\n".join(lines))
+    print(f"wrote the study (beam_study*.gpmsa), the figures and summary.json to {out}")
     return summary
 
 

@@ -37,7 +37,10 @@ campaign, speed or GD ranges that would not cover the default Simplex's speeds (
 paper's track (GD 300-500), which the README's main command needs. Each file's metadata records the
 vehicle, the noise level, the feature, the road settings, the design, the fit settings and the
 versions of Python, numpy, scipy, exudyn and BLAS that made the training data (`gpmsa info`
-shows them, with those of the fit).
+shows them, with those of the fit). OUT also gets ``campaign.npz`` (the drives' features and
+traces) and ``lhs_design.png``; each finished drive is kept in ``OUT/campaign_cache`` (keyed by
+its settings and those versions), so a run stopped during the campaign (Ctrl-C) starts again
+where it stopped; delete the folder (~60 MB for the default campaign) once the emulators exist.
 """
 
 from __future__ import annotations
@@ -289,6 +292,20 @@ def design_title(args) -> str:
         speeds = ", ".join(f"{v:g}" for v in args.anchor_speeds)
         title += f"\n+ {args.anchor_runs} anchor runs at each of {speeds} m/s"
     return title
+
+
+def design_figure(design: np.ndarray, args):
+    """The design (paper Fig. 5): the Latin hypercube's runs (rows up to ``--n-runs``), and the
+    anchor runs after them marked apart."""
+    lhs, anchors = design[: args.n_runs], design[args.n_runs :]
+    fig = plot_design(lhs[:, 0], lhs[:, 1], title=design_title(args))
+    if anchors.size:
+        ax = fig.axes[0]
+        ax.collections[0].set_label("Latin hypercube")
+        ax.scatter(anchors[:, 0], anchors[:, 1], s=14, marker="x", color="C1",
+                   label="anchor runs (band emulators)")  # fmt: skip
+        fig.legend(loc="outside lower center", ncols=2, fontsize=8, frameon=False)
+    return fig
 
 
 def fit_memory(m: int, n_pc: int, n_iter: int) -> float:
@@ -590,8 +607,7 @@ def main(argv: list[str] | None = None) -> None:
         )  # fmt: skip
     except vehicle.VehicleError as exc:
         parser.error(f"the campaign (--n-runs, --anchor-runs, --keep-s, --speed-range): {exc}")
-    fig = plot_design(design[:, 0], design[:, 1], title=design_title(args))
-    save_figure(fig, out / "lhs_design.png", dpi=150)
+    save_figure(design_figure(design, args), out / "lhs_design.png", dpi=150)
     print(f"campaign: {campaign.v.size} runs in {time.perf_counter() - tic:.0f} s")
     if not campaign.ok.all():
         print(f"  {np.count_nonzero(~campaign.ok)} failed runs are left out")

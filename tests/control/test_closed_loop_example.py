@@ -29,6 +29,10 @@ def test_segments_parse_and_bad_ones_are_named():
         (["--track", "40:250,30:700"], "outside the emulator's GD domain [200, 600] (--beyond"),
         (["--track", "40:250,30"], "not LENGTH_M:GD"),
         (["--first-seed", "-2"], "--first-seed must be >= 0"),
+        (  # its last run's seed, 2**128 + 1, beyond the seeds' range
+            ["--first-seed", str(2**128 - 2)],
+            "--first-seed must be <= 2**128 - 3 (the seeds' range)",
+        ),
         (["--runs", "0"], "--runs must be >= 1"),
         (["--speed-step", "-0.1"], "speed_step_mps must lie in"),
         (

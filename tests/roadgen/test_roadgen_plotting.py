@@ -54,6 +54,24 @@ def test_example_prints_the_check_and_saves_figures(tmp_path, capsys):
     assert (tmp_path / "roadgen_track.png").exists()
 
 
+def test_example_saves_its_figures_before_a_closed_pipe_stops_it(tmp_path, monkeypatch):
+    """`python examples/roadgen_psd_check.py | head` (with PYTHONUNBUFFERED, each print is
+    written at once) ends the script at its first print after the reader went away: the figures
+    come first."""
+    module = load_example("roadgen_psd_check")
+    saved = []
+
+    def closed_pipe(*args, **kwargs):
+        raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(module, "print", closed_pipe, raising=False)
+    monkeypatch.setattr(roadgen, "plot_profile_psd", lambda road, title: title)  # fast
+    monkeypatch.setattr(module, "save_figure", lambda fig, path: saved.append(path.name))
+    with pytest.raises(BrokenPipeError):
+        module.main(["--out", str(tmp_path)])
+    assert saved == ["roadgen_psd_gd450.png", "roadgen_track.png"]
+
+
 def test_a_flat_road_has_no_psd_to_draw():
     x = np.arange(0.0, 30.0, 0.006)
     flat = roadgen.Road(x=x, z=np.full_like(x, 0.01), dx_m=0.006)
