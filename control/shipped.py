@@ -40,9 +40,10 @@ def shipped_emulator_path(case: str = "A", kind: str = "band", folder=None) -> P
     else:
         if not str(folder).strip():
             raise ControlError("folder is an empty path: give the folder of the emulators")
-        if Path(folder).exists() and not Path(folder).is_dir():
+        given = Path(folder).expanduser()  # ~: the home folder
+        if given.exists() and not given.is_dir():
             raise ControlError(f"folder {str(folder)!r} is not a folder")
-        path = Path(folder) / name
+        path = given / name
         make = (
             f"`python examples/train_emulator.py --emulator-dir {folder} --cases {case} "
             f"--features {kind}`"

@@ -56,7 +56,7 @@ def output_folder(parser: argparse.ArgumentParser, option: str, folder: str | Pa
     file written: one that cannot be made (a file of that name, no permission) or that is not
     writable.
     """
-    folder = Path(folder)
+    folder = Path(folder).expanduser()  # --out=~/x: the shell leaves that ~ to us
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

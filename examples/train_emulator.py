@@ -563,7 +563,8 @@ def main(argv: list[str] | None = None) -> None:
     if args.ship and args.emulator_dir is not None:
         parser.error("--ship and --emulator-dir exclude each other")
     shipped_dir = EMULATOR_DIR.resolve()
-    if args.emulator_dir is not None and Path(args.emulator_dir).resolve() == shipped_dir:
+    given = None if args.emulator_dir is None else Path(args.emulator_dir).expanduser()
+    if given is not None and given.resolve() == shipped_dir:
         parser.error(f"--emulator-dir {args.emulator_dir!r} is the shipped emulators' folder: "
                      "use --ship, which checks the settings first")  # fmt: skip
     if not (np.isfinite(args.noise_std) and args.noise_std >= 0):

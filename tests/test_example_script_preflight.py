@@ -5,6 +5,7 @@ runs whose fit would exceed gpmsa's memory limit, turns a block scatter that its
 estimate into a usage error naming the options, and titles its design figure with the Latin
 hypercube's and the anchor runs' counts apart."""
 
+import argparse
 from types import SimpleNamespace
 
 import numpy as np
@@ -144,3 +145,18 @@ def test_a_seed_beyond_the_libraries_range_is_a_usage_error(
     assert exc.value.code == 2
     assert f"{message}, got {seed}" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_an_output_folder_with_a_leading_tilde_is_in_the_home_folder(monkeypatch, tmp_path):
+    """`--out=~/runs` (the shell leaves a ~ after = alone) made a folder named "~" in the
+    working directory; it is the home folder, as gpmsa's and control's paths read it, and the
+    emulators' folder too."""
+    home, work = tmp_path / "home", tmp_path / "work"
+    home.mkdir(), work.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir(work)
+    cli = load_example("_cli")
+    assert cli.output_folder(argparse.ArgumentParser(), "--out", "~/runs") == home / "runs"
+    assert (home / "runs").is_dir() and not (work / "~").exists()
+    with pytest.raises(control.ControlError, match="emulator .*home/runs/jackal_A.gpmsa is miss"):
+        control.shipped_emulator_path("A", folder="~/runs")
