@@ -416,8 +416,9 @@ def fit_study(
         sims, obs: per model, its ``gpmsa.SimData`` and ``gpmsa.ObsData``.
         labels, shared, hierarchical, hyper: as ``calibrate_study``.
         n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, priors, n_pc, discrepancy,
-            discrepancy_groups: as ``gpmsa.fit`` (priors, n_pc, discrepancy and its groups: the
-            same for every model, so not a list of per-experiment bases); the seed
+            discrepancy_groups, tune_rounds, tune_levels, progress, n_jobs, executor: as
+            ``gpmsa.fit`` (priors, n_pc, discrepancy and its groups: the same for every model,
+            so not a list of per-experiment bases); the seed
             the study ran with is ``study.settings["seed"]`` and each model's
             ``settings["seed"]``.
         basis: as ``gpmsa.fit``'s, a numpy array for every model or a list with one entry
