@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
-import re
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -33,11 +32,13 @@ from gpmsa.fitting.validation import (
 )
 from gpmsa.io.container import (
     FORMAT,
+    check_expected_sha256,
     check_path,
     content_hash,
     jsonable,
     read_raw,
     refuse_to_replace,
+    verify_content,
     write_raw,
 )
 from gpmsa.limits import check_memory
@@ -827,16 +828,9 @@ def load(path: str | Path, *, sha256: str | None = None) -> Emulator:
     Raises EmulatorFileError naming the problem (and the field) for a damaged, edited,
     inconsistent, foreign or newer file.
     """
-    if sha256 is not None and not (
-        isinstance(sha256, str) and re.fullmatch(r"[0-9a-fA-F]{64}", sha256.strip())
-    ):
-        raise GPMSAError(f"sha256 must be 64 hexadecimal digits, got {str(sha256)[:80]!r}")
+    expected = check_expected_sha256(sha256)
     manifest, arrays = read_raw(path, check_manifest)
-    if sha256 is not None and manifest["content_sha256"] != sha256.strip().lower():
-        raise EmulatorFileError(
-            f"{path}: content sha256 {manifest['content_sha256']} differs from the expected "
-            f"{str(sha256)[:80]!r}"
-        )
+    verify_content(manifest, expected, path)
     try:
         return Emulator.from_record(manifest, arrays)
     except EmulatorFileError as exc:

@@ -189,6 +189,26 @@ def check_path(path) -> Path:
     return Path(path).expanduser()
 
 
+def check_expected_sha256(sha256) -> str | None:
+    """A reader's ``sha256=`` argument (the file's expected ``content_sha256``) in lower case,
+    or None; GPMSAError unless it is None or 64 hexadecimal digits."""
+    if sha256 is None:
+        return None
+    if not (isinstance(sha256, str) and re.fullmatch(r"[0-9a-fA-F]{64}", sha256.strip())):
+        raise GPMSAError(f"sha256 must be 64 hexadecimal digits, got {str(sha256)[:80]!r}")
+    return sha256.strip().lower()
+
+
+def verify_content(manifest: dict, expected: str | None, path) -> None:
+    """EmulatorFileError where ``expected`` (`check_expected_sha256`) is not None and differs
+    from the file's ``content_sha256``."""
+    if expected is not None and manifest["content_sha256"] != expected:
+        raise EmulatorFileError(
+            f"{path}: content sha256 {manifest['content_sha256']} differs from the expected "
+            f"{expected!r}"
+        )
+
+
 def seal(manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT) -> tuple[dict, bytes]:
     """``manifest`` with the container's envelope (``ENVELOPE``: format ``fmt``, schema and
     library versions, time, the arrays' shapes and dtypes, the content sha256) and its JSON as

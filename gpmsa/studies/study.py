@@ -22,12 +22,14 @@ from gpmsa.io.atomic import atomic_group
 from gpmsa.io.container import (
     FORMAT,
     STUDY_FORMAT,
+    check_expected_sha256,
     check_path,
     jsonable,
     read_manifest,
     read_raw,
     refuse_to_replace,
     seal,
+    verify_content,
     write_sealed,
 )
 from gpmsa.mcmc.diagnostics import convergence, summarize
@@ -359,8 +361,10 @@ class Study:
                 f", hierarchical={list(self.layout.groups)}, {c} chains x {n} draws)")  # fmt: skip
 
 
-def load_study(path: str | Path) -> Study:
+def load_study(path: str | Path, *, sha256: str | None = None) -> Study:
     """Read a study written by ``Study.save``: the study file and each model's file beside it.
+    ``sha256``: the study file's expected ``content_sha256`` (``gpmsa info`` prints it), as
+    ``gpmsa.load`` takes one: the study file lists each model file's, so it vouches for all.
 
     Every model file is read by ``gpmsa.load`` with the sha256 the study lists (an edited or
     replaced model file is refused); the study's fields and draws are validated against the
@@ -376,8 +380,10 @@ def load_study(path: str | Path) -> Study:
     ...
     gpmsa.errors.EmulatorFileError: ...no-such-study.gpmsa...
     """
+    expected = check_expected_sha256(sha256)
     path = _through_link(check_path(path))
     manifest, arrays = read_raw(path, check_study_manifest, formats=(STUDY_FORMAT,))
+    verify_content(manifest, expected, path)
     study = manifest["study"]
     members = []
     for j, mod in enumerate(study["models"]):

@@ -184,3 +184,16 @@ def test_gpmsa_info_says_a_held_parameter_is_held(tmp_path, capsys):
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert "posterior t[a]: mean" in out and "lamOs[a]: mean 1 sd 0" in out
+
+
+def test_load_study_checks_the_expected_sha256_as_load_does(tmp_path):
+    """gpmsa.load(path, sha256=) refuses a file other than the one its author vouched for;
+    load_study had no such argument. The study file lists its models' digests, so its own
+    vouches for all of them."""
+    path = _study().save(tmp_path / "run.gpmsa")
+    digest = read_raw(path, lambda m: None, formats=(STUDY_FORMAT,))[0]["content_sha256"]
+    assert gpmsa.load_study(path, sha256=" " + digest.upper()).labels == ("a", "b", "c")
+    with pytest.raises(gpmsa.EmulatorFileError, match="differs from the expected"):
+        gpmsa.load_study(path, sha256="0" * 64)
+    with pytest.raises(gpmsa.GPMSAError, match="sha256 must be 64 hexadecimal digits"):
+        gpmsa.load_study(path, sha256="abc")
