@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 
 from control.errors import ControlError, EmulatorMismatchError
+from roadgen.checks import home_path
 
 EMULATOR_DIR = Path(__file__).parent / "emulators"
 
@@ -40,7 +41,7 @@ def shipped_emulator_path(case: str = "A", kind: str = "band", folder=None) -> P
     else:
         if not str(folder).strip():
             raise ControlError("folder is an empty path: give the folder of the emulators")
-        given = Path(folder).expanduser()  # ~: the home folder
+        given = home_path(folder)  # ~: the home folder
         if given.exists() and not given.is_dir():
             raise ControlError(f"folder {str(folder)!r} is not a folder")
         path = given / name

@@ -41,8 +41,8 @@ def within(value: float, lo: float, hi: float) -> bool:
 
 
 def path_argument(value, name: str, of: str = "") -> Path:
-    """``value`` (a str or os.PathLike, not empty) as a Path, a leading ``~`` expanded to the
-    home folder (as the shell would: a folder named "~" was made in the working directory);
+    """``value`` (a str or os.PathLike, not empty) as a Path, a leading ``~`` (alone or before a
+    separator) the home folder (``roadgen.checks.home_path``; a folder named "~" was made);
     ControlError naming the argument ``name`` for anything else (None, a number, ""); ``of``
     says what the path is of."""
     if not isinstance(value, str | os.PathLike) or not str(value):
@@ -50,7 +50,7 @@ def path_argument(value, name: str, of: str = "") -> Path:
             f"{name} must be the path (a str or os.PathLike){of}, got {value!r:.60} "
             f"({type(value).__name__})"
         )
-    return Path(value).expanduser()
+    return checks.home_path(value)
 
 
 def check_not_masked(values, name: str) -> None:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 from gpmsa.io.atomic import atomic_write
 from gpmsa.model.data import MAX_SEED
+from roadgen.checks import home_path
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -56,7 +57,7 @@ def output_folder(parser: argparse.ArgumentParser, option: str, folder: str | Pa
     file written: one that cannot be made (a file of that name, no permission) or that is not
     writable.
     """
-    folder = Path(folder).expanduser()  # --out=~/x: the shell leaves that ~ to us
+    folder = home_path(folder)  # --out=~/x: the shell leaves that ~ to us
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

@@ -49,7 +49,6 @@ import argparse
 import dataclasses
 import json
 import time
-from pathlib import Path
 
 import matplotlib
 
@@ -74,6 +73,7 @@ from control.training import (  # noqa: E402
     weight_beyond_rank,
 )
 from gpmsa.fitting.fit import simulation_fit_nbytes  # noqa: E402
+from roadgen.checks import home_path  # noqa: E402
 
 V_RANGE = (0.5, 2.0)
 GD_RANGE = (200.0, 600.0)
@@ -563,7 +563,7 @@ def main(argv: list[str] | None = None) -> None:
     if args.ship and args.emulator_dir is not None:
         parser.error("--ship and --emulator-dir exclude each other")
     shipped_dir = EMULATOR_DIR.resolve()
-    given = None if args.emulator_dir is None else Path(args.emulator_dir).expanduser()
+    given = None if args.emulator_dir is None else home_path(args.emulator_dir)
     if given is not None and given.resolve() == shipped_dir:
         parser.error(f"--emulator-dir {args.emulator_dir!r} is the shipped emulators' folder: "
                      "use --ship, which checks the settings first")  # fmt: skip

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 import numbers
+import os
+from pathlib import Path
 
 import numpy as np
 
@@ -28,6 +30,18 @@ MIN_DX_M, MAX_DX_M = 1e-9, 1e6
 """Grid steps allowed, m: beyond them a road's spatial frequencies under- or overflow."""
 MIN_GD = 1e-12
 """Smallest GD allowed (1e-6 m^3): below it the PSD and the heights' squares underflow."""
+
+
+def home_path(path: str | os.PathLike) -> Path:
+    """``path`` as a Path, a leading ``~`` alone or before a separator the home folder (as the
+    shell reads it: ``~/runs``); any other name as it is, ``~x`` included (a file may be named
+    so, and ``Path.expanduser`` reads it as user x's home, a RuntimeError where there is none).
+    """
+    text = os.fspath(path)
+    seps = tuple("~" + s for s in filter(None, (os.sep, os.altsep)))
+    if isinstance(text, str) and (text == "~" or text.startswith(seps)):
+        return Path(os.path.expanduser(text))  # no home known: left as it is, never raises
+    return Path(path)
 
 
 def memory(nbytes: float, what: str) -> None:

@@ -160,3 +160,17 @@ def test_an_output_folder_with_a_leading_tilde_is_in_the_home_folder(monkeypatch
     assert (home / "runs").is_dir() and not (work / "~").exists()
     with pytest.raises(control.ControlError, match="emulator .*home/runs/jackal_A.gpmsa is miss"):
         control.shipped_emulator_path("A", folder="~/runs")
+
+
+def test_an_output_folder_that_only_starts_with_a_tilde_is_a_folder_of_that_name(
+    monkeypatch, tmp_path
+):
+    """`--out=~runs` raised RuntimeError (Path.expanduser reads "~runs" as user runs's home):
+    only "~" and "~/..." are the home folder."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    cli = load_example("_cli")
+    folder = cli.output_folder(argparse.ArgumentParser(), "--out", "~nosuchuser")
+    assert folder.resolve() == tmp_path / "~nosuchuser" and folder.is_dir()
+    with pytest.raises(control.ControlError, match="emulator .*~nosuchuser/jackal_A.gpmsa is miss"):
+        control.shipped_emulator_path("A", folder="~nosuchuser")

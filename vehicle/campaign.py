@@ -138,7 +138,7 @@ class Campaign:
         CampaignFileError if it cannot be written, or if ``path`` (or the link's target) holds
         anything else (another program's file, a folder), which is never replaced."""
         _check_path(path)
-        target = Path(path).expanduser()  # ~: the home folder
+        target = roadgen.checks.home_path(path)  # ~: the home folder
         if target.name in ("", ".."):
             raise VehicleError(f"path={str(path)!r} names no file: need a file name, e.g. 'c.npz'")
         target = _through_link(target)
@@ -158,7 +158,7 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
     """Read a file written by ``Campaign.save``; CampaignFileError if missing, not a regular
     file, damaged or invalid, VehicleError if ``path`` is not a path."""
     _check_path(path)
-    arrays = _read_npz(Path(path).expanduser(), (*_ARRAYS, "settings"), _TRACES)
+    arrays = _read_npz(roadgen.checks.home_path(path), (*_ARRAYS, "settings"), _TRACES)
     settings = arrays.pop("settings")
     if settings.dtype.kind != "U" or settings.ndim != 0:
         raise CampaignFileError(
@@ -652,7 +652,7 @@ def run_one(spec: RunSpec, cache_dir: str | None = None) -> RunResult:
         f, status = np.full(len(_F_NAMES), np.nan), f"{type(exc).__name__}: {exc}"
         acc = measured = empty
     if cache_dir is not None and status == "ok":
-        cached = Path(cache_dir).expanduser() / f"run-{spec.key()}.npz"
+        cached = roadgen.checks.home_path(cache_dir) / f"run-{spec.key()}.npz"
         _write_cached(cached, (f, status, acc, measured), spec)
     return f, status, acc, measured
 
@@ -735,7 +735,7 @@ def _write_cached(path: Path, result: RunResult, spec: RunSpec) -> None:
 def _cache_folder(cache_dir: str | os.PathLike) -> Path:
     """``cache_dir`` as a Path, made if missing; VehicleError naming it if it cannot be a folder
     (a file, below a file, not writable)."""
-    cache = Path(cache_dir).expanduser()  # not a folder named "~"
+    cache = roadgen.checks.home_path(cache_dir)  # not a folder named "~"
     try:
         cache.mkdir(parents=True, exist_ok=True)
         probe = cache / f".write-test-{os.getpid()}"  # an existing folder may not be writable

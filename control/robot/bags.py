@@ -40,6 +40,7 @@ from control.robot import messages as msgs
 from control.robot import storage as storage_mod
 from control.robot.extra import require
 from control.validation import float_array, path_argument
+from roadgen.checks import home_path
 
 STORAGES = ("mcap", "sqlite3")
 DIGEST_KEY = "terrain_gpmsa.messages_sha256"
@@ -858,7 +859,7 @@ def write_sensor_bag(
         streams = [(c_imu, log[: t_imu.size], imu), (c_odom, log[t_imu.size :], odom)]
         for conn, stamp, data in merge_in_time(streams):
             writer.write(conn, stamp, data)
-    return Path(path).expanduser()
+    return home_path(path)
 
 
 def write_run_bag(result, path: str | os.PathLike, **kw) -> Path:

@@ -48,6 +48,7 @@ from control.robot.replay import (
 )
 from control.simplex import Simplex
 from gpmsa.io.atomic import atomic_write
+from roadgen.checks import home_path
 
 DEFAULTS = ReplaySettings()
 OUTPUTS = ("estimates.csv", "estimates", "replay.json")
@@ -208,7 +209,7 @@ def main(argv: list[str] | None = None) -> int:
             return 2
     bag = Path(args.bag)
     default_out = Path(f"{bag.name.removesuffix(bag.suffix)}_bcr")
-    out = default_out if args.out is None else Path(args.out).expanduser()
+    out = default_out if args.out is None else home_path(args.out)
     try:
         settings = ReplaySettings(
             imu_topic=args.imu_topic,

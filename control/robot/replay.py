@@ -71,6 +71,7 @@ from control.validation import (
     require_reals,
 )
 from gpmsa.io.atomic import atomic_write
+from roadgen.checks import home_path
 
 TIME_BASES = ("header", "log")
 POSITIONS = ("path", "speed")
@@ -274,7 +275,7 @@ class ReplayResult:
             )
             for c, stamp, data in merge_in_time([(conn, self.stamp_ns, datas)]):
                 writer.write(c, stamp, data)
-        return Path(path).expanduser()
+        return home_path(path)
 
     def _count_line(self) -> str:
         """How many estimates of each status, or why there is none."""

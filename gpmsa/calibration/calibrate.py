@@ -436,9 +436,12 @@ def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:
 
 
 def observation_fit(emulator, data, sets) -> Fit:
-    """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets)."""
+    """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets); with
+    a categorical theta no sign-change rule (`fit_of`'s layout): off its levels the predictive
+    mean is not the levels' (no crossing between a level's node and its neighbour)."""
     q = emulator.t_unit.shape[1]
-    theta, layout = theta_probe(q), probe_layout(q)
+    theta = theta_probe(q)
+    layout = probe_layout(q) if theta_levels(emulator) is None else None
     fits = [fit_of(*fixed_gp(emulator, s).predict(data.x, theta), data, layout) for s in sets]
     return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
 

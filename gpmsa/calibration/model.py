@@ -194,10 +194,11 @@ def chebyshev_plan(gp: FixedGP, tol: float = 1e-14, max_deg: int = 128) -> tuple
 def predictor_bytes(gp: FixedGP, n_nodes: int, plan: tuple | None) -> tuple[float, float]:
     """Bytes a `GridPredictor` on ``n_nodes`` theta nodes keeps (R_t alpha, and H per
     component: nodes x (degree + 1)^2) and the most it needs besides while it is built (one
-    component's R_t, and its Chebyshev products and their solve)."""
+    component's R_t with the work arrays of its correlation and scaling, 3 nodes x m, or R_t
+    and its Chebyshev products and their solve, nodes x m x (1 + 2 (degree + 1)))."""
     sizes = [0] * gp.p_u if plan is None else [cf.shape[0] for cf in plan]
     kept = 8.0 * n_nodes * (gp.p_u * gp.m + sum(na * na for na in sizes))
-    return kept, 8.0 * n_nodes * gp.m * (1 + 2 * max(sizes))
+    return kept, 8.0 * n_nodes * gp.m * max(3, 1 + 2 * max(sizes))
 
 
 class GridPredictor:
@@ -219,14 +220,8 @@ class GridPredictor:
         for c in range(gp.p_u):
             rt = gp.corr_t(self.theta, c) / gp.lamUz[c]
             self.rt_alpha[c] = rt * gp.alpha[c][None, :]
-            if self.H is None:
-                continue
-            coef = plan[c]
-            na = coef.shape[0]
-            e = rt[:, :, None] * coef.T[None, :, :]  # (G, m, na)
-            v = solve_triangular(gp.chol[c], e.transpose(1, 0, 2).reshape(gp.m, G * na), lower=True)
-            v = v.reshape(gp.m, G, na)
-            self.H.append(np.einsum("mga,mgb->gab", v, v))
+            if self.H is not None:  # its work arrays freed before the next component's
+                self.H.append(_chebyshev_products(gp, c, rt, plan[c]))
 
     def predict(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """mean (G, p_u, n) and covariance (G, p_u, n, n) of u at (x, theta_g); x (n, p) unit."""
@@ -246,6 +241,17 @@ class GridPredictor:
             HT = (H.reshape(G * na, na) @ T.T).reshape(G, na, n)
             cov[:, c] = gp.prior_cov(x, c)[None] - np.matmul(T[None], HT)
         return mean, cov
+
+
+def _chebyshev_products(gp: FixedGP, c: int, rt: np.ndarray, coef: np.ndarray) -> np.ndarray:
+    """H_g = E_g^T Sigma_W^-1 E_g (G, na, na) of component ``c``: E_g (m, na) the Chebyshev
+    coefficients ``coef`` (na, m) of R_x(x, x_i) times R_t(theta_g, t_i) (``rt`` (G, m))."""
+    G, na = rt.shape[0], coef.shape[0]
+    e = rt.T[:, :, None] * coef.T[:, None, :]  # (m, G, na): the solve's right-hand sides
+    v = solve_triangular(gp.chol[c], e.reshape(gp.m, G * na), lower=True)
+    del e
+    v = v.reshape(gp.m, G, na)
+    return np.einsum("mga,mgb->gab", v, v)
 
 
 def _cheb_vander(s: np.ndarray, size: int) -> np.ndarray:

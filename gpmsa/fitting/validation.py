@@ -396,7 +396,8 @@ def check_discrepancy_bases(settings: dict, arrays: dict[str, np.ndarray]) -> No
     groups = settings.get("discrepancy_groups")
     digest = settings.get("discrepancy_sha256")
     if digest != basis_digest(bases, None if groups is None else tuple(groups)):
-        raise _fail(field, "differs from the bases (and groups) whose digest "
+        raise _fail(field, f"split by settings.obs_lengths {_short(settings['obs_lengths'])}, "
+                           "differs from the bases (and groups) whose digest "
                            "settings.discrepancy_sha256 records")  # fmt: skip
 
 

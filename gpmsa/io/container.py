@@ -178,15 +178,28 @@ def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
 
 
 def check_path(path) -> Path:
-    """``path`` as a Path, a leading ``~`` expanded to the home folder (as the shell would; not
-    a folder named "~"); GPMSAError unless it is a non-empty str or path-like (bytes, numbers
-    and None are not file names here), or for a str that ends with a path separator (it names a
-    folder; Path would drop the separator, and save("out/") write a file named out)."""
+    """``path`` as a Path, a leading ``~`` (alone or before a separator) the home folder
+    (`home_path`; not a folder named "~"); GPMSAError unless it is a non-empty str or
+    path-like (bytes, numbers and None are not file names here), or for a str that ends with a
+    path separator (it names a folder; Path would drop the separator, and save("out/") write a
+    file named out)."""
     if not isinstance(path, str | os.PathLike) or not str(path):
         raise GPMSAError(f"path must be a file name (str or path-like), got {path!r}")
     if isinstance(path, str) and path.endswith(tuple(filter(None, (os.sep, os.altsep)))):
         raise GPMSAError(f"path {path!r} ends with a separator: it names a folder, not a file")
-    return Path(path).expanduser()
+    return home_path(path)
+
+
+def home_path(path: str | os.PathLike) -> Path:
+    """``path`` as a Path, a leading ``~`` alone or before a separator the home folder (as the
+    shell reads it: ``~/runs``); any other name as it is, ``~x`` included (a file may be named
+    so, and ``Path.expanduser`` reads it as user x's home, a RuntimeError where there is none).
+    """
+    text = os.fspath(path)
+    seps = tuple("~" + s for s in filter(None, (os.sep, os.altsep)))
+    if isinstance(text, str) and (text == "~" or text.startswith(seps)):
+        return Path(os.path.expanduser(text))  # no home known: left as it is, never raises
+    return Path(path)
 
 
 def check_expected_sha256(sha256) -> str | None:

@@ -143,3 +143,13 @@ def test_a_path_that_starts_with_a_tilde_is_the_home_folder(tmp_path, monkeypatc
     assert control.record_run(_result(), "~/runs/run.mcap") == home / "runs" / "run.mcap"
     assert write_sensor_bag("~/bags/b", *_drive()) == home / "bags" / "b"
     assert not (work / "~").exists() and (home / "runs" / "run.mcap").is_file()
+
+
+def test_a_name_that_only_starts_with_a_tilde_is_a_file_of_that_name(tmp_path, monkeypatch):
+    """record_run("~x.mcap") raised RuntimeError (Path.expanduser reads "~x" as user x's home):
+    only "~" and "~/..." are the home folder."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    written = control.record_run(_result(), "~nosuchuser.mcap")
+    assert written.resolve() == tmp_path / "~nosuchuser.mcap"
+    assert (tmp_path / "~nosuchuser.mcap").is_file()

@@ -1,5 +1,6 @@
 """gpmsa.Calibrator: the exact grid path against MCMC, references, and its contract."""
 
+import tracemalloc
 import warnings
 
 import numpy as np
@@ -14,6 +15,7 @@ from _calib_cases import (
 )
 
 import gpmsa
+import gpmsa.calibration.calibrator as calibrator
 from gpmsa import Calibrator, GPMSAError, calibrate
 from gpmsa.calibration.posterior import trapezoid_weights
 from gpmsa.mcmc.diagnostics import ess
@@ -408,3 +410,36 @@ def test_calibrator_memory_check_counts_every_parameter_set(monkeypatch):
         Calibrator(emu, **kw)
     monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", int(1.25 * cached))
     assert _cached_bytes(Calibrator(emu, **kw)) == cached
+
+
+def _checked_and_peak(monkeypatch, emu, **kw) -> tuple[float, int]:
+    """The largest estimate Calibrator(emu, **kw) checked, and the peak memory it traced."""
+    seen = []
+    check = calibrator.check_memory
+    monkeypatch.setattr(
+        calibrator, "check_memory", lambda n, what: (seen.append(n), check(n, what))
+    )
+    tracemalloc.start()
+    try:
+        Calibrator(emu, **kw)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    return max(seen), peak
+
+
+def test_calibrator_memory_check_bounds_the_peak_of_building_the_predictors(monkeypatch):
+    """The check bounds what the set-up needs at its peak: a two-component emulator's predictors
+    kept one component's Chebyshev work arrays while the next one's were made (peak 1.17x the
+    estimate), and predictors that solve densely (p > 1) needed R_t's correlation work arrays
+    (1.44x)."""
+    vec = vector_emulator()
+    checked, peak = _checked_and_peak(monkeypatch, vec, n_grid=801)
+    assert peak <= checked
+    rng = np.random.default_rng(0)
+    x, t = rng.random((60, 2)), rng.random(60)
+    sim = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x[:, 0] + t) + x[:, 1])
+    dense = gpmsa.Emulator.from_params(sim, {"betaU": [[2.0], [2.0], [2.0]], "lamUz": [1.0],
+                                             "lamWs": [1e4], "lamWOs": [1e4]})  # fmt: skip
+    checked, peak = _checked_and_peak(monkeypatch, dense, n_grid=4001)
+    assert peak <= checked

@@ -316,3 +316,21 @@ def test_an_exact_observation_between_probe_nodes_is_not_outside():
                             seed=0)  # fmt: skip
     with pytest.warns(gpmsa.OutsideEmulatorWarning, match="predictive sds"):
         cal.update(xo, 1.0 + 2.0 * 4.5 + xo)  # E = 4.5: beyond every run's output
+
+
+def test_a_sign_change_next_to_a_categorical_level_is_no_crossing():
+    """The sign-change rule reads a residual that changes sign between neighbouring probe nodes
+    as met between them, for a predictive mean continuous in theta; a categorical theta's is
+    not (off its levels the mean is another's), and an observation between two levels' outputs
+    read 0.0 sds outside instead of the 1.4 it reads against the nodes themselves."""
+    from gpmsa.calibration.calibrate import observation_fit
+
+    rng = np.random.default_rng(0)
+    x, t = rng.random(30), (np.arange(30) % 3) * 3 + 1
+    shift = np.zeros(8)
+    shift[[4, 7]] = 1.0, -0.7
+    sim = gpmsa.SimData(x, t, x + shift[t], t_categorical=[0])
+    emu = gpmsa.Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0],
+                                           "lamWs": [1e3], "lamWOs": [1e3]})  # fmt: skip
+    data = reduce(emu, [[0.5]], [[0.0]], False)
+    assert observation_fit(emu, data, [emu.params]).outside_sds > 1.0

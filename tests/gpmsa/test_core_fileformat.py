@@ -309,3 +309,18 @@ def test_a_path_that_starts_with_a_tilde_is_the_home_folder(tmp_path, monkeypatc
     assert emu.save("~/a.gpmsa") == tmp_path / "a.gpmsa"
     assert gpmsa.load("~/a.gpmsa").model_sha256 == emu.model_sha256
     assert main(["info", "~/a.gpmsa"]) == 0
+
+
+def test_a_name_that_only_starts_with_a_tilde_is_a_file_of_that_name(tmp_path, monkeypatch):
+    """save("~x.gpmsa") raised RuntimeError "Could not determine home directory" (Path.expanduser
+    reads "~x" as user x's home) and gpmsa info called it an internal error; only "~" and
+    "~/..." are the home folder, as the shell reads them."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    emu = gpmsa.Emulator.from_params(
+        gpmsa.SimData(x=np.linspace(0, 1, 6), t=np.linspace(1, 0, 6) ** 2, y=np.arange(6.0)),
+        {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e3], "lamWOs": [1e3]},
+    )
+    assert emu.save("~nosuchuser.gpmsa").resolve() == tmp_path / "~nosuchuser.gpmsa"
+    assert gpmsa.load("~nosuchuser.gpmsa").model_sha256 == emu.model_sha256
+    assert main(["info", "~nosuchuser.gpmsa"]) == 0

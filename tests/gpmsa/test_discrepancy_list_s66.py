@@ -145,7 +145,10 @@ def _edit_array(a):
     [
         (lambda m, a: _edit_array(a), r"arrays/discrepancy_D: has 7 rows"),
         (lambda m, a: a["discrepancy_D"].__setitem__((1, 1), np.nan), "must be finite"),
-        (lambda m, a: m["settings"].__setitem__("obs_lengths", [4, 4]), "differs from the bases"),
+        (
+            lambda m, a: m["settings"].__setitem__("obs_lengths", [4, 4]),
+            r"split by settings.obs_lengths \[4, 4\], differs from the bases",
+        ),
         (lambda m, a: a.__setitem__("discrepancy_D", 2 * a["discrepancy_D"]), "not normalised"),
         (lambda m, a: a.pop("discrepancy_D"), r"'list', but the file holds no arrays/discrepa"),
         (lambda m, a: m["settings"].__setitem__("discrepancy", "given"), r"but it is 'given'"),

@@ -125,3 +125,13 @@ def test_a_path_that_starts_with_a_tilde_is_the_home_folder(saved, tmp_path, mon
     campaign.save("~/c.npz")
     assert (tmp_path / "c.npz").is_file()
     np.testing.assert_array_equal(vehicle.load_campaign("~/c.npz").f_full, campaign.f_full)
+
+
+def test_a_name_that_only_starts_with_a_tilde_is_a_file_of_that_name(saved, tmp_path, monkeypatch):
+    """Campaign.save("~x.npz") raised RuntimeError (Path.expanduser reads "~x" as user x's
+    home): only "~" and "~/..." are the home folder."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    saved[2].save("~nosuchuser.npz")
+    assert (tmp_path / "~nosuchuser.npz").is_file()
+    assert vehicle.load_campaign("~nosuchuser.npz").f_full.shape == saved[2].f_full.shape
