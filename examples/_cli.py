@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -78,3 +80,41 @@ def save_figure(fig: Figure, path: Path, dpi: int = 120) -> None:
     """``fig.savefig`` to ``path`` in one step (the format from its suffix), as `write_text`."""
     with atomic_write(path) as fh:
         fig.savefig(fh, format=path.suffix.lstrip("."), dpi=dpi)
+
+
+class _UntilTheReaderLeaves:
+    """stdout that, once its reader has gone (``... | head``: BrokenPipeError), drops what is
+    printed instead of raising, so that the script still finishes its work and its files."""
+
+    def __init__(self, stream) -> None:
+        self._stream, self._gone = stream, False
+
+    def _call(self, name: str, *args):
+        if not self._gone:
+            try:
+                return getattr(self._stream, name)(*args)
+            except BrokenPipeError:
+                self._gone = True  # and no error when Python flushes it at exit:
+                os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+        return len(args[0]) if args else None
+
+    def write(self, text: str) -> int:
+        return self._call("write", text)
+
+    def flush(self) -> None:
+        self._call("flush")
+
+    def __getattr__(self, name: str):
+        return getattr(self._stream, name)
+
+
+def run(main: Callable[[], object]) -> None:
+    """Run a script's ``main`` as a command: Ctrl-C ends it with one line on stderr and exit
+    status 130 instead of a traceback (the files are written in one step each, so none is left
+    in part); a reader that stops reading its output does not stop it."""
+    sys.stdout = _UntilTheReaderLeaves(sys.stdout)
+    try:
+        main()
+    except KeyboardInterrupt:
+        print(f"{Path(sys.argv[0]).name}: interrupted (Ctrl-C)", file=sys.stderr)
+        raise SystemExit(130) from None

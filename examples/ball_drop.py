@@ -40,6 +40,7 @@ from _cli import (  # noqa: E402
     check_seed,
     output_folder,
     path_option,
+    run,
     save_figure,
     write_text,
 )
@@ -236,4 +237,4 @@ def main(argv: list[str] | None = None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

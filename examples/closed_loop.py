@@ -36,7 +36,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import check_seed, output_folder, path_option, save_figure, write_text  # noqa: E402
+from _cli import check_seed, output_folder, path_option, run, save_figure, write_text  # noqa: E402
 
 import control  # noqa: E402
 import gpmsa  # noqa: E402
@@ -363,4 +363,4 @@ def main(argv: list[str] | None = None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

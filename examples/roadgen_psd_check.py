@@ -15,7 +15,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-from _cli import output_folder, path_option, save_figure  # noqa: E402
+from _cli import output_folder, path_option, run, save_figure  # noqa: E402
 
 import roadgen  # noqa: E402
 
@@ -72,4 +72,4 @@ def main(argv: list[str] | None = None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -35,6 +35,7 @@ from _cli import (
     check_seed,
     output_folder,
     path_option,
+    run,
     save_figure,
     write_text,
 )
@@ -217,4 +218,4 @@ def main(argv: list[str] | None = None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -55,7 +55,14 @@ import matplotlib
 matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
-from _cli import check_option_memory, check_seed, output_folder, path_option, save_figure  # noqa: E402
+from _cli import (  # noqa: E402
+    check_option_memory,
+    check_seed,
+    output_folder,
+    path_option,
+    run,
+    save_figure,
+)
 from closed_loop import GD_MAX, PAPER_SEGMENTS  # noqa: E402
 
 import control  # noqa: E402
@@ -643,4 +650,4 @@ def main(argv: list[str] | None = None) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run(main)

@@ -6,6 +6,8 @@ estimate into a usage error naming the options, and titles its design figure wit
 hypercube's and the anchor runs' counts apart."""
 
 import argparse
+import os
+import sys
 from types import SimpleNamespace
 
 import numpy as np
@@ -174,3 +176,52 @@ def test_an_output_folder_that_only_starts_with_a_tilde_is_a_folder_of_that_name
     assert folder.resolve() == tmp_path / "~nosuchuser" and folder.is_dir()
     with pytest.raises(control.ControlError, match="emulator .*~nosuchuser/jackal_A.gpmsa is miss"):
         control.shipped_emulator_path("A", folder="~nosuchuser")
+
+
+class _ClosedPipe:
+    """A stdout whose reader has gone: every write raises BrokenPipeError."""
+
+    def __init__(self, fd: int) -> None:
+        self.fd, self.writes = fd, 0
+
+    def write(self, text: str) -> int:
+        self.writes += 1
+        raise BrokenPipeError(32, "Broken pipe")
+
+    def flush(self) -> None:
+        raise BrokenPipeError(32, "Broken pipe")
+
+    def fileno(self) -> int:
+        return self.fd
+
+
+def test_a_script_run_as_a_command_ends_ctrl_c_in_one_line_and_outlives_its_reader(
+    monkeypatch, tmp_path, capsys
+):
+    """Ctrl-C printed a traceback, and a reader that stopped reading (`| head`) ended a script
+    at its next print, part-way through its files (train_emulator prints between them)."""
+    cli = load_example("_cli")
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sys, "argv", ["closed_loop.py"])
+    with pytest.raises(SystemExit) as stop:
+        cli.run(interrupted)
+    assert stop.value.code == 130
+    assert capsys.readouterr().err == "closed_loop.py: interrupted (Ctrl-C)\n"
+
+    done = []
+
+    def prints_then_writes():
+        print("a table the reader leaves after")
+        print("and more")
+        done.append(True)
+
+    fd = os.open(tmp_path / "stdout", os.O_WRONLY | os.O_CREAT)
+    pipe = _ClosedPipe(fd)
+    monkeypatch.setattr(sys, "stdout", pipe)
+    cli.run(prints_then_writes)
+    sys.stdout.flush()
+    assert done == [True] and pipe.writes == 1  # the first print found the reader gone
+    os.close(fd)

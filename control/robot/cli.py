@@ -237,6 +237,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ControlError, OSError) as exc:  # OSError: e.g. a full disk
         print(f"terrain-replay: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback (_write left no part)
+        print("terrain-replay: interrupted (Ctrl-C)", file=sys.stderr)
+        return 130
     print(result.describe())
     print(f"wrote {out / 'estimates.csv'}, {out / 'estimates'} (topic "
           f"{settings.estimate_topic}) and {out / 'replay.json'}")  # fmt: skip

@@ -29,3 +29,6 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # the reader went away (`gpmsa info FILE | head`): not an error
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback
+        print("gpmsa: interrupted (Ctrl-C)", file=sys.stderr)
+        return 130

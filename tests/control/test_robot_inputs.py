@@ -426,3 +426,17 @@ def test_imu_stamp_errors_name_the_imu_topic(tmp_path):
                                 imu_topic="/my/imu")  # fmt: skip
         with pytest.raises(BagError, match=rf"IMU topic '/my/imu'.*{message}"):
             replay_bag(path, "A", imu_topic="/my/imu", **settings)
+
+
+def test_ctrl_c_during_a_replay_is_one_line_and_leaves_no_output(bag, tmp_path, capsys,
+                                                                 monkeypatch):  # fmt: skip
+    """Ctrl-C printed a traceback; it is one line, exit status 130, no output folder left."""
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "replay_bag", interrupted)
+    out = tmp_path / "made" / "out"
+    code, _, err = _run(capsys, bag, "--emulator", "A", "--out", out)
+    assert (code, err) == (130, "terrain-replay: interrupted (Ctrl-C)\n")
+    assert not (tmp_path / "made").exists()

@@ -187,3 +187,14 @@ def test_info_prints_the_priors_a_calibration_uses(tmp_path, capsys) -> None:
     ) in out
     assert "lamUz Gamma(5, 5) on (0.3, inf), lamWs Gamma(3, 0.003) on (60, 100000)" in out
     assert "lamWOs Gamma(5, 0.005) on (60, 100000) (with GPM/SA's data corrections)" in out
+
+
+def test_ctrl_c_is_one_line_and_exit_status_130(monkeypatch, capsys) -> None:
+    """Ctrl-C during a gpmsa command printed a traceback."""
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(gpmsa.cli.info, "run", interrupted)
+    assert main(["info", "x.gpmsa"]) == 130
+    assert capsys.readouterr().err == "gpmsa: interrupted (Ctrl-C)\n"
