@@ -1,6 +1,7 @@
 """Test doubles for control: a calibrator and a block model with known likelihoods, and a
 synthetic sensor stream."""
 
+import functools
 from types import SimpleNamespace
 
 import numpy as np
@@ -55,6 +56,21 @@ def stream(gd_of_position, speed, duration_s, rate_hz=120.0, seed=0, t0=0.0, s0=
     return t, pos, acc, np.full(n, float(speed))
 
 
+@functools.cache
+def _unit_statistics(spec):
+    """(mean, Cholesky factor of the covariance) of the block features of unit-variance white
+    noise (8,000 blocks, seed 123) for a FeatureSpec: computed once a spec (~0.1 s) and shared,
+    read-only, by every FakeBlockModel of that spec."""
+    from control.feature import block_features
+
+    unit = np.random.default_rng(123).standard_normal((8000, spec.block_samples))
+    feats = block_features(unit, spec)
+    offset, chol = feats.mean(axis=0), np.linalg.cholesky(np.cov(feats.T))
+    offset.setflags(write=False)
+    chol.setflags(write=False)
+    return offset, chol
+
+
 class FakeBlockModel:
     """The part of control.ObservationModel the BCR uses, for white-noise blocks of `stream`.
 
@@ -66,14 +82,11 @@ class FakeBlockModel:
     """
 
     def __init__(self, spec=None, v_range=(0.5, 2.0)):
-        from control.feature import FeatureSpec, block_features
+        from control.feature import FeatureSpec
 
         self.spec = spec or FeatureSpec()
-        unit = np.random.default_rng(123).standard_normal((8000, self.spec.block_samples))
-        feats = block_features(unit, self.spec)
-        self.offset = feats.mean(axis=0)
-        self.chol = np.linalg.cholesky(np.cov(feats.T))
-        self.dim = feats.shape[1]
+        self.offset, self.chol = _unit_statistics(self.spec)
+        self.dim = self.offset.size
         self.n_quantiles = len(self.spec.quantiles)
         self.gd = np.geomspace(200.0, 600.0, 121)
         self.speed_range = tuple(v_range)

@@ -12,9 +12,11 @@ from control import ControlError, Estimate
 
 
 @pytest.fixture(scope="module")
-def stream(emulator_a):
+def stream(emulator_a, likelihood_a):
     """A clean 60 m drive's samples (t, position, accel, speed)."""
-    result = control.run_closed_loop(roadgen.track([(60, 300)], seed=1), emulator_a, seed=1)
+    result = control.run_closed_loop(
+        roadgen.track([(60, 300)], seed=1), emulator_a, seed=1, likelihood=likelihood_a
+    )
     return (result.sample_time, result.sample_position, result.sample_accel,
             result.sample_speed)  # fmt: skip
 

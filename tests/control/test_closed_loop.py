@@ -157,23 +157,25 @@ def test_samples_missing_at_the_end_of_an_update_are_a_fault_at_that_update(
     assert r.settings["bcr"].max_silence_s < 1 / 120
 
 
-def test_a_gain_drop_late_in_a_noisy_block_is_a_fault_at_that_update():
+def test_a_gain_drop_late_in_a_noisy_block_is_a_fault_at_that_update(likelihood_b):
     """Case B: a gain of 0.04 over the last 0.4 s of an update reads quieter than the sensor's
     own N(0, 1) noise, so that update is already a fault; noise-free data with the noisy
     emulator has no noise floor (the loop lowers it to the simulated noise)."""
     emu_b = control.shipped_emulator("B")
+    b = {"likelihood": likelihood_b}  # prepared once for the session
     track = roadgen.track([(25, 500)], seed=7)
-    clean = run_closed_loop(track, emu_b, noise_std=1.0, seed=7)
+    clean = run_closed_loop(track, emu_b, noise_std=1.0, seed=7, **b)
     assert clean.settings["bcr"].sensor.noise_sd_mps2 == 1.0
     assert not np.any(clean.status == "sensor_fault")
     j = int(np.flatnonzero(clean.time > 6.0)[0])
     fault = SensorFault(start_s=clean.time[j] - 0.4, duration_s=3.0, kind="scale", magnitude=0.04)
-    r = run_closed_loop(track, emu_b, noise_std=1.0, seed=7, faults=[fault])
+    r = run_closed_loop(track, emu_b, noise_std=1.0, seed=7, faults=[fault], **b)
     np.testing.assert_array_equal(r.status[:j], clean.status[:j])
     assert r.status[j] == "sensor_fault" and "attenuated signal" in r.reason[j]
     assert r.metrics.latched_at_s == pytest.approx(clean.time[j])
     with pytest.warns(ControlWarning, match="noise_std = 0 m/s\\^2 in the data"):
-        quiet = run_closed_loop(roadgen.track([(8, 300)], seed=7), emu_b, noise_std=0.0, seed=7)
+        quiet = run_closed_loop(roadgen.track([(8, 300)], seed=7), emu_b, noise_std=0.0, seed=7,
+                                **b)  # fmt: skip
     assert quiet.settings["bcr"].sensor.noise_sd_mps2 is None
 
 
@@ -241,13 +243,14 @@ def test_arguments_are_checked_before_the_drive(emulator_a, likelihood_a, tmp_pa
         run_closed_loop(track, emulator_a, likelihood=likelihood_a, max_time_s=1e-3)
 
 
-def test_a_likelihood_prepared_for_another_emulator_is_refused(emulator_a):
+def test_a_likelihood_prepared_for_another_emulator_is_refused(
+    emulator_a, likelihood_a, likelihood_b
+):
     track = roadgen.track([(20, 300)], seed=1)
-    emulator_b = control.shipped_emulator("B")
     with pytest.raises(EmulatorMismatchError, match=r"metadata differ in \[.*'noise_std'\]"):
-        run_closed_loop(track, emulator_a, likelihood=control.ObservationModel(emulator_b))
-    # the same file loaded twice is the same emulator
-    control.check_likelihood(emulator_a, control.ObservationModel(control.shipped_emulator("A")))
+        run_closed_loop(track, emulator_a, likelihood=likelihood_b)
+    # the same file loaded twice is the same emulator (the likelihood: of the session's load)
+    control.check_likelihood(control.shipped_emulator("A"), likelihood_a)
 
 
 def test_a_noise_mismatch_warns():

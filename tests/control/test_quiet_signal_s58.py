@@ -17,11 +17,6 @@ from control import BCR, BCRSettings, ControlError, Simplex
 from control.bcr import MAX_QUIET_BLOCKS
 
 
-@pytest.fixture(scope="module")
-def emulator_b():
-    return control.shipped_emulator("B")
-
-
 def drive(segments, speed, noise, seed):
     """A constant-speed simulated drive over ``segments`` ((length m, GD), ...)."""
     track = roadgen.track(list(segments), seed=seed)
@@ -41,14 +36,14 @@ def run(bcr, trace, gain=1.0):
     return out, simplex
 
 
-def test_a_low_gain_is_implausible_and_never_fast_on_rough_ground(emulator_b):
+def test_a_low_gain_is_implausible_and_never_fast_on_rough_ground(new_bcr):
     trace = drive([(30.0, 300.0), (40.0, 500.0)], 1.5, 1.0, seed=5)
     rough = lambda steps: [c.speed for e, c in steps if e.position > 35.0]  # noqa: E731
     # without the check (the library before it): the GD-500 part read smooth, and fast
-    unchecked, _ = run(BCR.from_emulator(emulator_b, quiet_blocks=0), trace, gain=0.7)
+    unchecked, _ = run(new_bcr("B", quiet_blocks=0), trace, gain=0.7)
     assert max(rough(unchecked)) > Simplex().v_safe
     assert all(e.status == "ok" for e, _ in unchecked if e.position > 35.0)
-    steps, simplex = run(BCR.from_emulator(emulator_b), trace, gain=0.7)
+    steps, simplex = run(new_bcr("B"), trace, gain=0.7)
     quiet = [e for e, _ in steps if e.status == "implausible" and "read quieter" in e.reason]
     assert quiet and quiet[0].position < 30.0  # found on the smooth part already
     assert max(rough(steps)) <= Simplex().v_safe
@@ -56,27 +51,26 @@ def test_a_low_gain_is_implausible_and_never_fast_on_rough_ground(emulator_b):
     assert all(0.0 <= e.plausibility_p < 1e-6 for e in quiet)
 
 
-def test_the_right_gain_reads_ok(emulator_b):
+def test_the_right_gain_reads_ok(new_bcr):
     trace = drive([(30.0, 300.0), (40.0, 500.0)], 1.5, 1.0, seed=5)
-    steps, simplex = run(BCR.from_emulator(emulator_b), trace)
+    steps, simplex = run(new_bcr("B"), trace)
     assert not any("read quieter" in e.reason for e, _ in steps)
     assert not simplex.latched
 
 
 @pytest.mark.parametrize("case", ["A", "B"])
 @pytest.mark.parametrize("speed", [1.0, 2.0])
-def test_clean_drives_across_the_domain_never_read_quiet(case, speed):
+def test_clean_drives_across_the_domain_never_read_quiet(new_bcr, case, speed):
     """GD 205-590, as the loop drives them (the Simplex's two speeds)."""
-    emulator = control.shipped_emulator(case)
     segments = [(25.0, 205.0), (25.0, 300.0), (25.0, 450.0), (25.0, 590.0), (25.0, 230.0)]
     trace = drive(segments, speed, 1.0 if case == "B" else 0.0, seed=11)
-    steps, _ = run(BCR.from_emulator(emulator), trace)
+    steps, _ = run(new_bcr(case), trace)
     assert sum(e.ok for e, _ in steps) > 0.8 * len(steps)
     assert not any("read quieter" in e.reason for e, _ in steps)
 
 
-def test_the_level_score_has_the_sign_of_the_shift(emulator_b):
-    model = control.ObservationModel(emulator_b)
+def test_the_level_score_has_the_sign_of_the_shift(likelihood_b):
+    model = likelihood_b
     mean, _ = model._at(1.5)
     direction = np.concatenate([np.full(8, 2.0), mean[0, 8:]])
     assert model.level_score(mean[0] - 0.3 * direction, 1.5, direction) < -3.0  # below GD 200
@@ -136,9 +130,9 @@ def test_a_block_a_fault_undoes_leaves_the_quiet_check_too():
 @pytest.mark.parametrize(
     "direction", [np.ones(3), np.full(10, np.nan), np.zeros(10), np.array(["a"] * 10)]
 )
-def test_level_score_names_a_bad_direction(emulator_b, direction):
+def test_level_score_names_a_bad_direction(likelihood_b, direction):
     """A direction of another length, non-finite or all zero gave a numpy error or NaN."""
-    model = control.ObservationModel(emulator_b)
+    model = likelihood_b
     mean, _ = model._at(1.5)
     with pytest.raises(ControlError, match="direction must be"):
         model.level_score(mean[5], 1.5, direction)

@@ -3,7 +3,6 @@
 import numpy as np
 from test_robot_io_s60 import _drive, _loop
 
-import control
 from control.changepoint import ChangePointFilter
 
 
@@ -19,13 +18,13 @@ def test_relocating_a_filter_without_data_is_a_reset():
         np.testing.assert_array_equal(got, want)
 
 
-def test_resume_of_a_bcr_without_gd_state_is_a_fresh_bcr():
+def test_resume_of_a_bcr_without_gd_state_is_a_fresh_bcr(new_bcr):
     """``resume(moved_m)`` keeps the GD state; with none to keep (no block yet) the stream that
     follows computes as a fresh BCR's (as ``reset()``), whatever the distance."""
     t, p, a, v = _drive([(80.0, 300.0)], 1.0)
-    want, _ = _loop(control.BCR.from_emulator(control.shipped_emulator("B")), t, p, a, v)
+    want, _ = _loop(new_bcr("B"), t, p, a, v)
     for moved in (5.0, 1e4):
-        bcr = control.BCR.from_emulator(control.shipped_emulator("B"))
+        bcr = new_bcr("B")
         bcr.resume(moved_m=moved)
         got, _ = _loop(bcr, t, p, a, v)
         assert [e.gd_mean for e in got if e.ok] == [e.gd_mean for e in want if e.ok]

@@ -1,5 +1,7 @@
 """The BCR's time base in a robot user's loop: a sample clock that steps back (session 60)."""
 
+import functools
+
 import numpy as np
 import pytest
 from control_doubles import FakeBlockModel, stream
@@ -94,12 +96,23 @@ def test_one_stamp_far_back_costs_a_block_in_any_chunking():
 
 
 def _drive(parts, noise):
+    """(t, position, measured acceleration, speed) of a 1.5 m/s drive over ``parts`` ((length
+    m, GD), ...), simulated once a (parts, noise) and shared read-only (several tests drive the
+    same road)."""
+    return _simulated(tuple(map(tuple, parts)), noise)
+
+
+@functools.cache
+def _simulated(parts, noise):
     import roadgen
     import vehicle
 
-    trace = vehicle.simulate(vehicle.Jackal(), roadgen.track(parts, seed=1), 1.5,
+    trace = vehicle.simulate(vehicle.Jackal(), roadgen.track(list(parts), seed=1), 1.5,
                              noise_std=noise, seed=1)  # fmt: skip
-    return trace.t, trace.position, trace.accel_front_measured, trace.speed
+    out = (trace.t, trace.position, trace.accel_front_measured, trace.speed)
+    for x in out:
+        x.setflags(write=False)
+    return out
 
 
 def _loop(bcr, t, p, a, v):
@@ -115,15 +128,12 @@ def _loop(bcr, t, p, a, v):
     return out, run
 
 
-def test_gravity_left_in_reaches_the_checks_of_emulator_a_only():
-    import control
-
+def test_gravity_left_in_reaches_the_checks_of_emulator_a_only(new_bcr):
     for case, noise in (("B", 1.0), ("A", 0.0)):
-        emu = control.shipped_emulator(case)
         t, p, a, v = _drive([(40.0, 300.0), (40.0, 500.0)], noise)
-        free, _ = _loop(control.BCR.from_emulator(emu), t, p, a, v)
+        free, _ = _loop(new_bcr(case), t, p, a, v)
         assert len(free) == 151 and sum(e.ok for e in free) == 149
-        raw, run = _loop(control.BCR.from_emulator(emu), t, p, a + 9.81, v)
+        raw, run = _loop(new_bcr(case), t, p, a + 9.81, v)
         if case == "B":
             assert [e.status for e in raw] == [e.status for e in free] and not run.latched
             gd = np.array([e.gd_mean for e in raw if e.ok])
@@ -132,18 +142,16 @@ def test_gravity_left_in_reaches_the_checks_of_emulator_a_only():
         assert sum(e.status == "sensor_fault" for e in raw) == 94
         assert run.latched and run.latched_by.position == pytest.approx(2.4, abs=0.05)
         for offset in (-0.45, 0.45):  # gravity subtracted, not exactly
-            near, run = _loop(control.BCR.from_emulator(emu), t, p, a + offset, v)
+            near, run = _loop(new_bcr(case), t, p, a + offset, v)
             assert [e.status for e in near] == [e.status for e in free] and not run.latched
 
 
-def test_a_bcr_restored_after_downtime_continues_its_stream_unless_reset():
+def test_a_bcr_restored_after_downtime_continues_its_stream_unless_reset(new_bcr):
     import pickle
-
-    import control
 
     t, p, a, v = _drive([(80.0, 300.0)], 1.0)
     half = t.size // 2 // EVERY * EVERY
-    bcr = control.BCR.from_emulator(control.shipped_emulator("B"))
+    bcr = new_bcr("B")
     _loop(bcr, t[:half], p[:half], a[:half], v[:half])
     saved = pickle.dumps(bcr)
     rest = (t[half:] + 600.0, p[half:], a[half:], v[half:])  # 10 min later
@@ -161,18 +169,16 @@ def test_a_bcr_restored_after_downtime_continues_its_stream_unless_reset():
     assert (round(kept[5].gd_sd), round(new[2].gd_sd)) == (49, 85)
 
 
-def test_a_drive_whose_clock_steps_back_half_way_resumes_with_now_on_that_clock():
-    import control
-
+def test_a_drive_whose_clock_steps_back_half_way_resumes_with_now_on_that_clock(new_bcr):
     t, p, a, v = _drive([(80.0, 300.0)], 1.0)
     half = t.size // 2 // EVERY * EVERY
     stepped = np.where(np.arange(t.size) >= half, t - STEP_S, t)
-    out, _ = _loop(control.BCR.from_emulator(control.shipped_emulator("B")), stepped, p, a, v)
+    out, _ = _loop(new_bcr("B"), stepped, p, a, v)
     after = [e.status for e in out[half // EVERY :]]
     assert after[:5] == ["sensor_fault"] + ["filling"] * 4 and set(after[5:]) == {"ok"}
 
 
-def test_a_restored_bcr_resumes_with_its_gd_state_kept_and_moved():
+def test_a_restored_bcr_resumes_with_its_gd_state_kept_and_moved(new_bcr):
     """Session 62: ``resume(moved_m)`` starts a new stream as ``reset`` does (no latch, the
     first ok estimate at the third update) but keeps the GD state (less each phase's newest
     block, as a gap undoes it), so the first estimates are tighter than ``reset``'s (sd 35
@@ -185,7 +191,7 @@ def test_a_restored_bcr_resumes_with_its_gd_state_kept_and_moved():
 
     t, p, a, v = _drive([(80.0, 300.0)], 1.0)
     half = t.size // 2 // EVERY * EVERY
-    bcr = control.BCR.from_emulator(control.shipped_emulator("B"))
+    bcr = new_bcr("B")
     _loop(bcr, t[:half], p[:half], a[:half], v[:half])
     saved = pickle.dumps(bcr)
     rest = (t[half:] + 600.0, p[half:], a[half:], v[half:])
@@ -238,15 +244,13 @@ def test_the_window_filters_resume_with_their_tracker_state():
     assert first[1e4].gd_sd == pytest.approx(first["reset"].gd_sd, rel=1e-9)
 
 
-def test_resume_undoes_each_phases_newest_block_as_a_gap_does():
+def test_resume_undoes_each_phases_newest_block_as_a_gap_does(new_bcr):
     """The downtime is a gap: each phase's newest block (which may hold the start of what
     stopped the robot) is undone, then the move is propagated over that block's distance too."""
     import copy
 
-    import control
-
     t, p, a, v = _drive([(40.0, 300.0)], 1.0)
-    bcr = control.BCR.from_emulator(control.shipped_emulator("B"))
+    bcr = new_bcr("B")
     _loop(bcr, t, p, a, v)
     expected = []
     for phase in bcr._phases:

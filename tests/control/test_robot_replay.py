@@ -270,12 +270,6 @@ def test_an_imu_whose_every_message_is_doubled_is_an_error_saying_why(emulator_a
         replay_bag(bag, emulator_a)
 
 
-@pytest.fixture(scope="module")
-def likelihood_b():
-    """The block likelihood of case B's emulator (not case A's)."""
-    return control.ObservationModel(control.shipped_emulator("B"))
-
-
 def test_settings_that_do_not_fit_the_emulator_are_refused_before_reading(
     emulator_a, likelihood_b, tmp_path
 ):

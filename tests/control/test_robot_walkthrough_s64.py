@@ -18,10 +18,10 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
-def drive(emulator_a):
+def drive(emulator_a, likelihood_a):
     """30 m of GD 300 then 40 m of GD 500, closed loop (t, position, accel, speed)."""
     result = control.run_closed_loop(
-        roadgen.track([(30, 300), (40, 500)], seed=3), emulator_a, seed=3
+        roadgen.track([(30, 300), (40, 500)], seed=3), emulator_a, seed=3, likelihood=likelihood_a
     )
     return (result.sample_time, result.sample_position, result.sample_accel,
             result.sample_speed)  # fmt: skip
@@ -36,11 +36,12 @@ def _feed(bcr, samples, chunk=42, **kw):
 FIRST_BLOCK = """
 import pickle, sys, numpy as np, control
 t, p, a, s = np.load(sys.argv[1]).values()
-bcr = control.BCR.from_emulator(control.shipped_emulator("A"))
-if sys.argv[2] == "restored":  # the BCR a robot saved, restored in a new process
-    with open(sys.argv[3], "rb") as f:
+if sys.argv[2] == "restored":  # the BCR a robot saved, restored in a new process (no BCR
+    with open(sys.argv[3], "rb") as f:  # built here first: its tables would mask the restore's)
         bcr = pickle.load(f)
     bcr.reset()
+else:
+    bcr = control.BCR.from_emulator(control.shipped_emulator("A"))
 before, statuses = set(sys.modules), []
 for k in range(0, t.size, 42):
     statuses.append(bcr.update(t[k:k + 42], p[k:k + 42], a[k:k + 42], s[k:k + 42]).status)
@@ -57,7 +58,8 @@ def test_the_first_estimate_imports_nothing_inside_the_loop(drive, tmp_path, how
     t, p, a, s = drive
     np.savez(tmp_path / "drive.npz", t=t[:1200], p=p[:1200], a=a[:1200], s=s[:1200])
     saved = tmp_path / "bcr.pickle"
-    saved.write_bytes(pickle.dumps(control.BCR.from_emulator(control.shipped_emulator("A"))))
+    if how == "restored":
+        saved.write_bytes(pickle.dumps(control.BCR.from_emulator(control.shipped_emulator("A"))))
     script = tmp_path / "first_block.py"
     script.write_text(textwrap.dedent(FIRST_BLOCK))
     done = subprocess.run(
@@ -71,27 +73,27 @@ def test_the_first_estimate_imports_nothing_inside_the_loop(drive, tmp_path, how
 
 
 @pytest.mark.parametrize(("factor", "unit"), [(1e9, "nanoseconds"), (1e3, "milliseconds")])
-def test_time_stamps_in_another_unit_say_so(drive, emulator_a, factor, unit):
+def test_time_stamps_in_another_unit_say_so(drive, new_bcr, factor, unit):
     t, p, a, s = drive
-    bcr = control.BCR.from_emulator(emulator_a)
+    bcr = new_bcr("A")
     out = _feed(bcr, (t[:420] * factor, p[:420], a[:420], s[:420]))
     assert all(e.status == "sensor_fault" for e in out)
     assert f"the time stamps are in {unit}: t must be seconds" in out[-1].reason, out[-1].reason
 
 
-def test_an_honest_gap_is_not_called_a_unit(drive, emulator_a):
+def test_an_honest_gap_is_not_called_a_unit(drive, new_bcr):
     t, p, a, s = drive
     late = t.copy()
     late[600:] += 2.0  # the sensor silent for 2 s
-    reasons = [e.reason for e in _feed(control.BCR.from_emulator(emulator_a), (late, p, a, s))]
+    reasons = [e.reason for e in _feed(new_bcr("A"), (late, p, a, s))]
     gap = [r for r in reasons if "a gap of 2.008 s" in r]
     assert gap and not any("time stamps are in" in r for r in reasons), gap
 
 
-def test_before_the_first_update_the_reason_counts_the_samples(drive, emulator_a):
+def test_before_the_first_update_the_reason_counts_the_samples(drive, new_bcr):
     # Before: "no samples yet" after 1, 2, ... 41 samples of a sample-by-sample feed.
     t, p, a, s = drive
-    bcr = control.BCR.from_emulator(emulator_a)
+    bcr = new_bcr("A")
     assert bcr.last.reason == "no samples yet"
     est = [bcr.update(t[k], p[k], a[k], s[k]) for k in range(3)]
     assert [e.reason for e in est] == [f"{k} of the first update's 42 samples" for k in (1, 2, 3)]
@@ -100,14 +102,14 @@ def test_before_the_first_update_the_reason_counts_the_samples(drive, emulator_a
     assert est.reason == "resumed (5 m moved while down); 1 of the first update's 42 samples"
 
 
-def test_odometry_that_over_reads_the_speed_reads_rough_ground_smoother(drive, emulator_a):
+def test_odometry_that_over_reads_the_speed_reads_rough_ground_smoother(drive, new_bcr):
     # docs/robot.md, "Odometry's speed": no check sees an odometry scale error (positions and
     # speeds agree), and the feature grows with speed, so an over-read reads smoother, an
     # under-read rougher.
     t, p, a, s = drive
     rough = {}
     for scale in (0.9, 1.0, 1.1):
-        out = _feed(control.BCR.from_emulator(emulator_a), (t, p * scale, a, s * scale))
+        out = _feed(new_bcr("A"), (t, p * scale, a, s * scale))
         where = np.array([e.position / scale for e in out])
         on_500 = [e.gd_mean for e, x in zip(out, where, strict=True) if e.ok and x > 45]
         assert len(on_500) > 40

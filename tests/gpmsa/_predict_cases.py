@@ -45,12 +45,17 @@ def known_truth_world(x: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     return truth + NOISE_SD * rng.standard_normal(truth.shape)
 
 
-@cache
 def known_truth_case(seed: int = 0):
     """A joint fit of a simulator with a known discrepancy and noise, and 60 held-out points.
 
     Returns (emulator, obs, x_new (60, 1), y_new (60, 12) noisy held-out observations).
     """
+    return _known_truth_case(seed)  # one cache entry for ``()`` and ``(0)``
+
+
+@cache
+def _known_truth_case(seed: int):
+    """`known_truth_case`, computed once a seed."""
     rng = np.random.default_rng(seed)
     d = qmc.LatinHypercube(2, seed=seed).random(40)
     x, t = d[:, 0], 0.5 + 1.5 * d[:, 1]

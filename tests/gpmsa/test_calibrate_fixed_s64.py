@@ -11,6 +11,7 @@ import warnings
 
 import numpy as np
 import pytest
+from test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator
 
 import gpmsa
 from gpmsa import GPMSAError
@@ -23,7 +24,6 @@ from tests.gpmsa._calib_cases import (
     two_param_emulator,
     vector_emulator,
 )
-from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator
 
 RUN = {"n_samples": 60, "n_burn": 10, "tune_rounds": 3, "tune_levels": 4}
 XO, YO = [[0.3], [0.7]], [[0.9], [1.2]]

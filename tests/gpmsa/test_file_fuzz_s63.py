@@ -12,6 +12,7 @@ from functools import cache
 
 import numpy as np
 import pytest
+from test_discrepancy_groups_s61 import BASIS, GROUPS, _data
 
 import gpmsa
 from gpmsa import Priors
@@ -19,7 +20,6 @@ from gpmsa.cli.main import main
 from gpmsa.io.container import ENVELOPE, STUDY_FORMAT, read_raw, write_raw
 from tests.gpmsa._study_cases import emulator as study_emulator
 from tests.gpmsa._study_cases import observations
-from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data
 from tests.gpmsa.test_file_hostile import read_members, write_members
 
 HELD = {"lamVz": {1: 1e6}, "betaU": {(1, 0): 0.7}}

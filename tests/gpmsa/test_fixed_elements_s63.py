@@ -8,6 +8,7 @@ import warnings
 
 import numpy as np
 import pytest
+from test_discrepancy_groups_s61 import BASIS, GROUPS, _data
 
 import gpmsa
 from gpmsa import GPMSAError
@@ -16,7 +17,6 @@ from gpmsa.cli.main import main
 from gpmsa.mcmc.sampler import ChainState, elements
 from gpmsa.model.likelihood import log_likelihood, log_posterior
 from gpmsa.model.problem import prepare
-from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data
 
 HELD = {"lamVz": {1: 1e4}, "betaU": {(1, 0): 0.7}}
 RUN = {"tune_rounds": 2, "tune_levels": 3}

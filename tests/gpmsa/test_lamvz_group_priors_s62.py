@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator, _random_params
 
 import gpmsa
 from gpmsa import EmulatorFileError, GammaPrior, GPMSAError, Priors
@@ -17,7 +18,6 @@ from gpmsa.mcmc import starts
 from gpmsa.mcmc.sampler import ChainState
 from gpmsa.model.likelihood import log_likelihood, log_posterior
 from gpmsa.model.problem import prepare
-from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator, _random_params
 
 VAGUE = GammaPrior(1.0, 1e-3)  # GPM/SA's default lamVz prior
 TIGHT = GammaPrior(1000.0, 0.1)  # mean 1e4, sd 316: far above group 1's data-driven ~800

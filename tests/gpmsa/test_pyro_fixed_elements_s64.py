@@ -13,12 +13,13 @@ import pytest
 pyro = pytest.importorskip("pyro")
 torch = pytest.importorskip("torch")
 
+from test_discrepancy_groups_s61 import BASIS, GROUPS, _data  # noqa: E402
+
 import gpmsa  # noqa: E402
 from gpmsa.backends import pyro_backend as pb  # noqa: E402
 from gpmsa.model.likelihood import log_posterior  # noqa: E402
 from gpmsa.model.problem import prepare  # noqa: E402
 from tests.gpmsa.test_backend_agreement import assert_agree  # noqa: E402
-from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data  # noqa: E402
 from tests.gpmsa.test_fixed_elements_s63 import _problem  # noqa: E402
 
 HELD = {"betaU": {(1, 0): 0.5}}

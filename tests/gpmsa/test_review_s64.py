@@ -80,7 +80,7 @@ def test_a_held_theta_the_constraint_rejects_is_named_with_its_way_out(engine):
 
 def test_a_studys_held_discrepancy_elements_are_named_as_its_posterior_names_them():
     # settings["held"] (not judged for convergence) from the masks gpmsa.calibrate uses too
-    from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator
+    from test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator
 
     _, obs = _data()
     emu = _emulator()

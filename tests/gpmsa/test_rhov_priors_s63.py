@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator, _random_params
 
 import gpmsa
 from gpmsa import EmulatorFileError, GPMSAError, Priors
@@ -26,7 +27,6 @@ from gpmsa.model.likelihood import log_likelihood, log_posterior
 from gpmsa.model.problem import prepare
 from tests.gpmsa._study_cases import emulator as study_emulator
 from tests.gpmsa._study_cases import simulator
-from tests.gpmsa.test_discrepancy_groups_s61 import BASIS, GROUPS, _data, _emulator, _random_params
 
 SMOOTH = {"rhoV_a": 100.0, "rhoV_b": 1.0}
 """Beta(100, 1) on rho = exp(-betaV/4): rho near 1, a smooth discrepancy (betaV's prior 90%

@@ -249,7 +249,7 @@ def test_per_model_discrepancies_and_their_groups_are_checked():
 
 @cache
 def _vector_case():
-    from tests.gpmsa._predict_cases import known_truth_case
+    from _predict_cases import known_truth_case  # the module (and cache) the others import
 
     return known_truth_case()
 
