@@ -11,7 +11,14 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import BYTES_PER_HISTOGRAM_BIN, check_memory
 from gpmsa.mcmc import diagnostics
-from gpmsa.model.data import as_float, as_real, check_count, check_finite, check_level
+from gpmsa.model.data import (
+    as_float,
+    as_real,
+    check_count,
+    check_finite,
+    check_level,
+    check_probabilities,
+)
 
 #: Lower tail probabilities tried by `GridMarginal.hdi`.
 HDI_STEPS = 201
@@ -390,9 +397,7 @@ class Posterior:
         """Posterior quantile(s) of ``name`` at probability q in [0, 1]: a number, or an array
         of them (vectorised: an array of quantiles of the same shape)."""
         self._check(name)
-        q_arr = as_float(q, "q")
-        if q_arr.size == 0 or np.any(~np.isfinite(q_arr)) or np.any((q_arr < 0) | (q_arr > 1)):
-            raise GPMSAError(f"q must lie in [0, 1], got {q!r}")
+        q_arr = check_probabilities(q, "q")
         out = (
             self.grids[name].ppf(q_arr)
             if name in self.grids

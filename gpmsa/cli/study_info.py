@@ -46,17 +46,11 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
     lines.append("settings:        " + ", ".join(flat))
     for k, v in manifest["metadata"].items():
         lines.append(f"metadata {safe(k, 60)}: {value(v)}")
-    post = study.posterior
-    held = manifest["settings"].get("held")
-    held = {h for h in held if isinstance(h, str)} if isinstance(held, list) else set()
-    for name in post.names:
-        if name in held and post.sd(name) == 0:  # fixed=: no ESS or R-hat to give
-            lines.append(f"posterior {safe(name, 80)}: held at {post.mean(name):.6g} (fixed=)")
+    for name, row in study.summary(0.9).items():
+        if row["held"]:  # fixed=: no ESS or R-hat to give
+            lines.append(f"posterior {safe(name, 80)}: held at {row['mean']:.6g} (fixed=)")
             continue
-        lo, hi = post.interval(name, 0.9)
-        d = study.diagnostics.get(name, {})
-        e, r = (d.get(k, [None])[0] for k in ("ess", "rhat"))
-        lines.append(f"posterior {safe(name, 80)}: mean {post.mean(name):.6g} sd "
-                     f"{post.sd(name):.4g} 90% [{lo:.6g}, {hi:.6g}] ESS {number(e, '.0f')} "
-                     f"R-hat {number(r, '.3f')}")  # fmt: skip
+        lines.append(f"posterior {safe(name, 80)}: mean {row['mean']:.6g} sd "
+                     f"{row['sd']:.4g} 90% [{row['q5']:.6g}, {row['q95']:.6g}] ESS "
+                     f"{number(row['ess'], '.0f')} R-hat {number(row['rhat'], '.3f')}")  # fmt: skip
     return lines

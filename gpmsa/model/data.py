@@ -269,6 +269,16 @@ def check_level(level) -> float:
     return float(level)
 
 
+def check_probabilities(q, name: str = "q") -> np.ndarray:
+    """``q`` as a float64 array of probabilities in [0, 1] (a number: a 0-d array); GPMSAError
+    naming ``name`` and the value given for none, a NaN or an infinity, or one outside [0, 1]
+    (the quantile functions' ``q``)."""
+    arr = as_float(q, name)
+    if arr.size == 0 or np.any(~np.isfinite(arr)) or np.any((arr < 0) | (arr > 1)):
+        raise GPMSAError(f"{name} must lie in [0, 1], got {q!r}")
+    return arr
+
+
 MAX_SEED = 2**128
 """Seeds are integers in [0, MAX_SEED) (numpy's SeedSequence takes non-negative integers)."""
 

@@ -19,6 +19,7 @@ from gpmsa.model.data import (
     as_matrix,
     by_column_names,
     check_count,
+    check_probabilities,
     check_seed,
     evenly_spaced,
 )
@@ -40,8 +41,16 @@ def realization_interval(samples: np.ndarray, level: float, fix: str) -> tuple[n
             f"at least {need}; draw more ({fix})",
             stacklevel=3,
         )
-    lo, hi = np.quantile(samples, [(1 - level) / 2, (1 + level) / 2], axis=0)
+    lo, hi = realization_quantile(samples, [(1 - level) / 2, (1 + level) / 2])
     return lo, hi
+
+
+def realization_quantile(samples: np.ndarray, q) -> np.ndarray:
+    """The realizations' quantiles along axis 0 at probabilities ``q`` in [0, 1] (a number or
+    an array of them, checked: GPMSAError naming q), numpy's default (linear) rule: shape
+    ``np.shape(q) + samples.shape[1:]``; `realization_interval`'s ends are these at
+    (1 -+ level) / 2."""
+    return np.quantile(samples, check_probabilities(q, "q"), axis=0)
 
 
 def rng_of(seed) -> np.random.Generator:

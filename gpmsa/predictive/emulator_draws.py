@@ -29,6 +29,7 @@ from gpmsa.predictive._common import (
     mvn_factor,
     param_sets,
     realization_interval,
+    realization_quantile,
     rng_of,
     unit_inputs,
     w_conditional,
@@ -93,9 +94,18 @@ class EmulatorPrediction:
         """(N, l_sim) predictive variance, native units^2 (law of total variance over draws)."""
         return self._moments_std()[1] * self.y_sd**2
 
+    def quantile(self, q: float | np.ndarray) -> np.ndarray:
+        """Predictive quantile(s) of the output, native units, at probability q in [0, 1] (a
+        number, or an array of them): the empirical quantiles of the S * n_rlz realizations
+        ``y`` (numpy's linear rule, so Monte-Carlo estimates), shape (N, l_sim) for a number and
+        ``np.shape(q) + (N, l_sim)`` for an array; ``interval(level)`` gives those at
+        (1 -+ level) / 2. GPMSAError naming q for one outside [0, 1], NaN or not a number."""
+        return realization_quantile(self.y, q)
+
     def interval(self, level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval (N, l_sim) of probability ``level`` from the realizations' quantiles
-        (a warning when there are too few for its tails: `realization_interval`)."""
+        (`quantile` at (1 -+ level) / 2; a warning when there are too few for its tails:
+        `realization_interval`)."""
         level = check_level(level)
         return realization_interval(self.y, level, "emulator_prediction's n_draws or n_rlz")
 

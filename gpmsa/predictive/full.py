@@ -62,6 +62,7 @@ from gpmsa.predictive._common import (
     posterior_lamos,
     posterior_theta,
     realization_interval,
+    realization_quantile,
     rng_of,
     unit_inputs,
 )
@@ -152,10 +153,24 @@ class FullPrediction:
         m, v = self._moments_std(what)
         return (v.mean(axis=0) + m.var(axis=0)) * self.y_sd**2
 
+    def quantile(self, q: float | np.ndarray, what: str = "y") -> np.ndarray:
+        """Predictive quantile(s) of ``what`` (as `mean`), native units, at probability q in
+        [0, 1] (a number, or an array of them): the empirical quantiles of its S * n_rlz
+        realizations (numpy's linear rule, so Monte-Carlo estimates), shape (N, l) for a number
+        and ``np.shape(q) + (N, l)`` for an array; ``interval(what, level)`` gives those at
+        (1 -+ level) / 2. GPMSAError naming q for one outside [0, 1], NaN or not a number."""
+        self._check(what)
+        if isinstance(q, str) and q in QUANTITIES:  # quantile("eta") for quantile(q, "eta")
+            raise GPMSAError(
+                f"q must be a probability in [0, 1] (or an array of them), got {q!r}: the "
+                f"quantity comes second, quantile(q, what={q!r})"
+            )
+        return realization_quantile(getattr(self, what), q)
+
     def interval(self, what: str = "y", level: float = 0.9) -> tuple[np.ndarray, np.ndarray]:
         """Central interval (N, l) of ``what`` (as `mean`), probability ``level``, native units,
-        from the realizations' quantiles (a warning when there are too few for its tails:
-        `realization_interval`)."""
+        from the realizations' quantiles (`quantile` at (1 -+ level) / 2; a warning when there
+        are too few for its tails: `realization_interval`)."""
         self._check(what)
         level = check_level(level)
         fix = "full_prediction's n_draws or n_rlz"

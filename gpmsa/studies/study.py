@@ -32,7 +32,7 @@ from gpmsa.io.container import (
     verify_content,
     write_sealed,
 )
-from gpmsa.mcmc.diagnostics import convergence, summarize
+from gpmsa.mcmc.diagnostics import convergence, summarize, to_inference_data
 from gpmsa.model.data import as_real, check_count
 from gpmsa.model.discrepancy import to_samples
 from gpmsa.studies.layout import HyperPriors, Layout, build_layout
@@ -60,6 +60,14 @@ HELD_THETA = "held_theta"
 name -> the native value held, as given; the posterior reports exactly it (as
 ``gpmsa.calibrate`` does), where the unit-scale draws read back through the element's range
 can come back an ulp off."""
+
+
+def held_names(settings: dict) -> set[str]:
+    """The posterior names a study's ``settings["held"]`` lists (fitted or calibrated with
+    ``fixed=``: held, not judged for convergence), its strings only (a file may hold other
+    entries); none without it."""
+    held = settings.get("held")
+    return {h for h in held if isinstance(h, str)} if isinstance(held, list) else set()
 
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
@@ -188,7 +196,8 @@ class Study:
         draws: unit-scale kept draws: theta (C, N, G), mu and lam (C, N, H), lamOs (C, N, M),
             log_post (C, N); a calibration with a discrepancy: model j's betaV (C, N, p, G) and
             lamVz (C, N, G) as "betaV_j", "lamVz_j".
-        posterior: ``gpmsa.Posterior`` in native units (names: ``native_chains``).
+        posterior: ``gpmsa.Posterior`` in native units (names: ``native_chains``); ``summary()``
+            and ``to_arviz()`` give its summary (held parameters marked) and its chains.
         settings, metadata: how it was run; the user's JSON-able dict (saved).
     """
 
@@ -212,8 +221,7 @@ class Study:
         self.convergence = None
         if n_chains > 1:
             shapes = {k: () for k in chains}
-            held = self.settings.get("held")  # fitted with fixed=: not judged
-            held = {h for h in held if isinstance(h, str)} if isinstance(held, list) else set()
+            held = held_names(self.settings)  # fitted with fixed=: not judged
             self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held)
             info["convergence"] = self.convergence
         self.posterior = Posterior(samples, chains=chains, info=info)
@@ -269,6 +277,32 @@ class Study:
             if isinstance(digest, str):
                 info[name] = digest
         return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out, info=info)
+
+    def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
+        """The pooled posterior's summary over every chain, native units: name -> {mean, sd,
+        q_lo, median, q_hi, n_draws, exact_grid, ess, rhat, held} (``Posterior.summary`` of
+        ``study.posterior``: the interval at ``level``, its ends named by their percentages,
+        "q5" and "q95" for 0.9; the bulk ESS and split R-hat over the chains). The names are
+        ``study.posterior``'s: a shared element by its own name ("E"), a model's own parameter
+        as "NAME[LABEL]" (its theta elements, "lamOs[LABEL]", its discrepancy's), a
+        hierarchical group's "NAME.mu", "NAME.sd", "NAME.lam"; a model's entries equal those
+        of ``member_posterior(LABEL).summary(level)`` under its own names. "held": True for a
+        parameter held with ``fixed=`` (every draw its value: sd 0, ESS and R-hat NaN), as
+        ``gpmsa info`` prints it."""
+        out = self.posterior.summary(level)
+        held = held_names(self.settings)
+        for name, entry in out.items():
+            draws = self.posterior.samples[name]
+            entry["held"] = bool(name in held and draws.min() == draws.max())
+        return out
+
+    def to_arviz(self):
+        """ArviZ InferenceData of the pooled posterior (arviz imported lazily): every name of
+        ``study.posterior`` (native units) as (chain, draw), the study's chains kept apart, and
+        the log posterior as sample_stats "lp", as ``Emulator.to_arviz`` gives it. A parameter
+        held with ``fixed=`` is its value in every draw (``summary``'s "held")."""
+        chains = {k: np.asarray(v) for k, v in self.posterior.chains.items()}
+        return to_inference_data(chains, self.draws["log_post"])
 
     def discrepancy(self, model: int | str) -> dict | None:
         """One model's discrepancy as its calibration or fit recorded it: {"discrepancy":
