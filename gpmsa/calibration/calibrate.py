@@ -39,6 +39,7 @@ from gpmsa.calibration.observations import (
     given_obs_data,
     lamos_start,
     obs_inputs,
+    outside_at_levels,
     probe_layout,
     reduce,
     theta_levels,
@@ -436,14 +437,21 @@ def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:
 
 
 def observation_fit(emulator, data, sets) -> Fit:
-    """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets); with
-    a categorical theta no sign-change rule (`fit_of`'s layout): off its levels the predictive
-    mean is not the levels' (no crossing between a level's node and its neighbour)."""
+    """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets). A
+    categorical theta takes its levels only: its outside_sds over them (`outside_at_levels`:
+    the levels crossed with the continuous parameters' nodes); its excess_var (the lamOs
+    start, `lamos_start`) still over ``theta_probe`` without the sign-change rule, as before."""
     q = emulator.t_unit.shape[1]
     theta = theta_probe(q)
-    layout = probe_layout(q) if theta_levels(emulator) is None else None
-    fits = [fit_of(*fixed_gp(emulator, s).predict(data.x, theta), data, layout) for s in sets]
-    return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
+    levels = theta_levels(emulator)
+    layout = probe_layout(q) if levels is None else None
+    gps = [fixed_gp(emulator, s) for s in sets]
+    fits = [fit_of(*gp.predict(data.x, theta), data, layout) for gp in gps]
+    if levels is None:
+        outside = min(f.outside_sds for f in fits)
+    else:
+        outside = min(outside_at_levels(gp.predict, data, levels) for gp in gps)
+    return Fit(outside, min(f.excess_var for f in fits))
 
 
 def _check_calibrate_memory(emulator, n_samples: int, n_chains: int, fast: bool) -> None:

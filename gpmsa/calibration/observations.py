@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import itertools
 import warnings
 from dataclasses import dataclass
 from functools import cache
@@ -34,6 +35,9 @@ OUTSIDE_SDS = 5.0
 """An observation farther than this many predictive sds from every emulator prediction at its
 x (over the whole theta domain) lies outside what the emulator has seen: a warning
 (``OutsideEmulatorWarning``), and ``Posterior.info["outside_sds"]`` holds the distance."""
+LEVEL_PROBE_NODES = 1089
+"""About how many theta values `outside_at_levels` predicts at in one call (`theta_probe`'s
+most: 33 x 33), so that many combinations of levels cost time, not memory."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -430,22 +434,8 @@ def fit_of(
     lie from it in predictive sds (an emulator with a negligible nugget read a datum exactly
     on the simulator 11 sds outside, between probe nodes)."""
     G, p_u, n = mean.shape
-    m = mean.reshape(G, p_u * n)
-    var = np.diagonal(cov, axis1=2, axis2=3).reshape(G, p_u * n)
-    resid = data.z[None, :] - m
-    noise = _residual_noise(data)
-    P = _observed_projector(data.obs)
-    if P is not None:  # the unobserved directions' stand-in 0 is no miss
-        full = np.zeros((G, p_u * n, p_u * n))
-        for c in range(p_u):
-            full[:, c * n : (c + 1) * n, c * n : (c + 1) * n] = cov[:, c]
-        resid = resid @ P
-        var = np.einsum("ij,gjk,ik->gi", P, full, P)
-        noise = (P * P) @ np.broadcast_to(noise, p_u * n)  # diag(P diag(noise) P), P symmetric
-    var = np.maximum(var, 1e-300)
-    with np.errstate(over="ignore"):
-        dist = np.abs(resid) / np.sqrt(var + noise)
-    if np.ndim(noise) == 0 and noise == 0.0:  # no error estimate: each datum on its own
+    resid, var, dist, alone = _distances(mean, cov, data)
+    if alone:  # no error estimate: each datum on its own
         nearest = np.min(dist, axis=0)
         if layout is not None:
             nearest[_crossed(resid, layout)] = 0.0
@@ -468,6 +458,76 @@ def fit_of(
             tr += np.einsum("ai,gij,aj->g", blk, cov[:, c], blk)
     excess = np.maximum(0.0, (y2 - tr) / max(d - data.obs.n_null, 1))  # observed directions
     return Fit(outside, float(np.min(excess)))
+
+
+def _distances(mean: np.ndarray, cov: np.ndarray, data: Observations) -> tuple:
+    """`fit_of`'s misfit on G theta values: the residuals (G, d) and predictive variances
+    (G, d), projected onto the observed directions; the distances |resid| / sd (G, d), sd with
+    `_residual_noise`; and whether each datum is judged on its own (no error estimate)."""
+    G, p_u, n = mean.shape
+    m = mean.reshape(G, p_u * n)
+    var = np.diagonal(cov, axis1=2, axis2=3).reshape(G, p_u * n)
+    resid = data.z[None, :] - m
+    noise = _residual_noise(data)
+    P = _observed_projector(data.obs)
+    if P is not None:  # the unobserved directions' stand-in 0 is no miss
+        full = np.zeros((G, p_u * n, p_u * n))
+        for c in range(p_u):
+            full[:, c * n : (c + 1) * n, c * n : (c + 1) * n] = cov[:, c]
+        resid = resid @ P
+        var = np.einsum("ij,gjk,ik->gi", P, full, P)
+        noise = (P * P) @ np.broadcast_to(noise, p_u * n)  # diag(P diag(noise) P), P symmetric
+    var = np.maximum(var, 1e-300)
+    with np.errstate(over="ignore"):
+        dist = np.abs(resid) / np.sqrt(var + noise)
+    return resid, var, dist, bool(np.ndim(noise) == 0 and noise == 0.0)
+
+
+def level_probe_blocks(levels: list, nodes: int = LEVEL_PROBE_NODES):
+    """The theta values at which `outside_at_levels` looks, for a categorical theta (``levels``:
+    per parameter its unit-scale levels, None for a continuous one): every combination of the
+    categorical parameters' levels, each crossed with `theta_probe`'s nodes of the continuous
+    ones (one node without them). Yields (theta (b k, q), b, layout): b combinations of k nodes
+    each, about ``nodes`` in all (at least one combination), and the continuous nodes' grid
+    shape (`probe_layout`; None without continuous parameters or for scattered nodes)."""
+    q = len(levels)
+    cont = [k for k in range(q) if levels[k] is None]
+    cat = [k for k in range(q) if levels[k] is not None]
+    base = theta_probe(len(cont)) if cont else np.zeros((1, 0))
+    layout = probe_layout(len(cont)) if cont else None
+    combos = np.array(list(itertools.product(*[levels[k] for k in cat])), dtype=float)
+    step = max(1, nodes // base.shape[0])
+    for start in range(0, combos.shape[0], step):
+        chunk = combos[start : start + step]
+        theta = np.empty((chunk.shape[0] * base.shape[0], q))
+        theta[:, cont] = np.tile(base, (chunk.shape[0], 1))
+        theta[:, cat] = np.repeat(chunk, base.shape[0], axis=0)
+        yield theta, chunk.shape[0], layout
+
+
+def outside_at_levels(predict, data: Observations, levels: list) -> float:
+    """``Fit.outside_sds`` for a categorical theta, which takes its levels only: over
+    `level_probe_blocks` (``predict(x, theta)``: ``FixedGP.predict``), in chunks. Off its levels
+    the predictive mean is no level's (the kernel's other-level correlation) and its sd about
+    the prior's, so `theta_probe`'s nodes there read an observation that no level explains as
+    within a few sds. A datum judged on its own is met where its residual changes sign between
+    neighbouring continuous nodes of one combination of levels (`fit_of`'s rule), never
+    between levels."""
+    nearest, best = None, np.inf
+    for theta, b, layout in level_probe_blocks(levels):
+        mean, cov = predict(data.x, theta)
+        resid, _, dist, alone = _distances(mean, cov, data)
+        if not alone:
+            best = min(best, float(np.min(np.max(dist, axis=1))))
+            continue
+        k = theta.shape[0] // b
+        near = np.min(dist.reshape(b, k, -1), axis=1)  # (b, d): per combination of levels
+        if layout is not None:
+            for i in range(b):
+                near[i, _crossed(resid[i * k : (i + 1) * k], layout)] = 0.0
+        near = np.min(near, axis=0)
+        nearest = near if nearest is None else np.minimum(nearest, near)
+    return best if nearest is None else float(np.max(nearest))
 
 
 def _crossed(resid: np.ndarray, layout: tuple[int, ...]) -> np.ndarray:

@@ -263,12 +263,15 @@ def discrepancy_bases(kind, grids: list[np.ndarray]) -> tuple[np.ndarray, ...] |
     max diag(D_j D_j^T) = 1). A list of one (l_j, p_v) array per experiment (SEPIA's
     ``create_D_basis(D_obs=[...])``, GPM/SA's per-experiment ``obsData(k).Dobs``, e.g. kernels
     on each experiment's own grid): checked (GPMSAError naming the experiment: count, rows,
-    the same p_v, finite, not all zero) and normalised jointly, by one scale so that the
-    largest diag(D_j D_j^T) over all experiments is 1: the same weights mean the same
-    discrepancy in each. SEPIA also divides every experiment's D by one scale, taken from the
-    first experiment's (or D_sim's); the largest over all of them is GPM/SA's convention
-    (max diag(D D^T) = 1) for the stacked bases, and the two agree where experiment 0 reaches
-    that largest value (a hand-built "constant" or "linear" list: the string kinds' bases).
+    the same p_v, finite; not all of them zero) and normalised jointly, by one scale so that
+    the largest diag(D_j D_j^T) over all experiments is 1: the same weights mean the same
+    discrepancy in each. One experiment's basis may be zero, as a zero ``Dobs`` in GPM/SA:
+    that experiment has no discrepancy (its weights' reduced data are unobserved directions,
+    ``ObsProblem.n_null``, and its delta is 0). SEPIA also divides every experiment's D by one
+    scale, taken from the first experiment's (or D_sim's); the largest over all of them is
+    GPM/SA's convention (max diag(D D^T) = 1) for the stacked bases, and the two agree where
+    experiment 0 reaches that largest value (a hand-built "constant" or "linear" list: the
+    string kinds' bases).
     """
     if not is_basis_list(kind):
         return None if kind is None else tuple(discrepancy_basis(kind, g) for g in grids)
@@ -298,10 +301,12 @@ def discrepancy_bases(kind, grids: list[np.ndarray]) -> tuple[np.ndarray, ...] |
             )
         if not np.all(np.isfinite(D)):
             raise GPMSAError(f"{what} must be finite")
-        if not np.any(D):
-            raise GPMSAError(f"{what} is all zeros")
         bases.append(D)
-    return tuple(_normalised(bases, "discrepancy bases are all zeros"))
+    zero = (
+        "discrepancy bases are all zeros, every experiment's: give at least one experiment "
+        "a nonzero basis, or discrepancy=None"
+    )
+    return tuple(_normalised(bases, zero))
 
 
 DIGEST_STEP = 2.0**-24

@@ -49,7 +49,8 @@ class ObsProblem:
     v_groups: the precision group of each discrepancy basis vector (GPM/SA's lamVzGroup;
     None: one group, `gpmsa.model.discrepancy`).
     n_null: the directions of the reduced data that no value observed (an experiment with fewer
-    independent values than the n_c basis vectors it is reduced onto). GPM/SA's reduction gives
+    independent values than the n_c basis vectors it is reduced onto, or its discrepancy
+    weights where its basis in a list is zero: it has no discrepancy). GPM/SA's reduction gives
     each a datum 0 of variance ~1e6 / lamOs, which adds ~log(lamOs) / 2 to the log-likelihood
     and pulls lamOs up; every likelihood takes ``null_term(lamOs)`` off again.
     """
