@@ -134,6 +134,8 @@ class ClosedLoopResult:
     ``latency_s``.
     Per sensor sample (length n): ``sample_time``, ``sample_position``, ``sample_speed``,
     ``sample_accel`` (the measured front-axle acceleration, m/s^2, before injected faults).
+    ``settings``: what ran: ``model`` (the vehicle), ``noise_std``, ``seed``, ``bcr``,
+    ``simplex``, ``faults``.
     """
 
     time: np.ndarray
@@ -385,6 +387,7 @@ def run_closed_loop(
         sample_accel=sample_accel,
         metrics=metrics,
         settings={
+            "model": model,
             "noise_std": noise_std,
             "seed": seed,
             "bcr": bcr,

@@ -26,13 +26,15 @@ def _canon(obj) -> str:
     return json.dumps(obj, sort_keys=True, default=str)
 
 
-def _vehicle_diff(trained, model) -> str:
-    """The fields in which the vehicle the emulator was made for differs from ``model``'s."""
+def _vehicle_diff(trained, model, label: str = "model") -> str:
+    """The fields in which the vehicle the emulator was made for differs from ``model``'s
+    (called ``label`` in the text)."""
     if not isinstance(trained, dict):
-        return f"emulator {_canon(trained)} vs model {_canon(model.describe())}"
+        return f"emulator {_canon(trained)} vs {label} {_canon(model.describe())}"
     used = model.describe()
     return ", ".join(
-        f"{k}: model {_canon(used.get(k, '(none)'))} vs emulator {_canon(trained.get(k, '(none)'))}"
+        f"{k}: {label} {_canon(used.get(k, '(none)'))} vs emulator "
+        f"{_canon(trained.get(k, '(none)'))}"
         for k in sorted(set(trained) | set(used), key=lambda k: (k != "model", k))  # model first
         if _canon(trained.get(k)) != _canon(used.get(k))
     )
@@ -175,6 +177,49 @@ def check_emulator(
                 "mode; GD is in units of 1e-6 m^3 (Gd(n0) x 1e6: the paper's band is "
                 "Simplex(gd_min=250, gd_max=350))"
             )
+
+
+def recorded_vehicle_mismatch(emulator, model, what: str = "the recording") -> str:
+    """Why the emulator does not suit ``what``, a recording of a simulation of the vehicle
+    ``model`` (naming each differing parameter); "" where it does, where ``model`` is None (no
+    vehicle recorded) or where the emulator records no vehicle (metadata ``vehicle``)."""
+    meta = dict(getattr(emulator, "metadata", None) or {})
+    if (
+        model is None
+        or "vehicle" not in meta
+        or _canon(meta["vehicle"]) == _canon(model.describe())
+    ):
+        return ""
+    return (
+        f"{what} was simulated with another vehicle than the emulator was made for "
+        f"({_vehicle_diff(meta['vehicle'], model, 'recording')})"
+    )
+
+
+def check_recorded_vehicle(emulator, model=None, noise_std: float | None = None,
+                           what: str = "the recording") -> None:  # fmt: skip
+    """Check an emulator against the vehicle model and accelerometer noise sd (m/s^2) a
+    recording of a simulation records (`control.robot.Recording.vehicle`, ``noise_std``; None:
+    not recorded, nothing checked). `EmulatorMismatchError` naming each differing parameter
+    where the emulator records a vehicle (metadata ``vehicle``) and ``model`` differs from it
+    (`recorded_vehicle_mismatch`); `ControlWarning` where it records a noise sd other than
+    ``noise_std``. An emulator without those records is taken as it is (a real robot's
+    recording records neither)."""
+    why = recorded_vehicle_mismatch(emulator, model, what)
+    if why:
+        raise EmulatorMismatchError(
+            f"{why}: replay it with an emulator trained for that vehicle "
+            "(examples/train_emulator.py), or, to replay it anyway, pass check_vehicle=False "
+            "(terrain-replay --ignore-vehicle)"
+        )
+    trained = _recorded_noise_std(dict(getattr(emulator, "metadata", None) or {}))
+    if noise_std is not None and trained is not None and not np.isclose(trained, noise_std):
+        warnings.warn(
+            f"{what} was simulated with noise_std = {noise_std:g} m/s^2 but the emulator was "
+            f"trained with noise_std = {trained:g}: the GD estimates will be biased",
+            ControlWarning,
+            stacklevel=4,
+        )
 
 
 def _check_speeds(emulator, simplex: Simplex) -> None:

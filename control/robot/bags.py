@@ -11,6 +11,10 @@ and the odometry's stamps, receive times, positions and linear velocities. Any o
   Foxglove recorded (the ``mcap`` package); a file of another name is one too where its
   first bytes are MCAP's magic (`control.record_run` writes to any name).
 
+A recording this package wrote from a simulation also records the simulated vehicle and noise
+sd (`SIMULATION_KEYS`, `SIMULATION_RECORD`), read into `Recording.vehicle` and ``noise_std``;
+any other recording (a robot's) reads with None for both.
+
 rosbags and mcap are the ``robot`` extra; they are imported when a function needs them.
 A recording whose bytes are damaged (truncated, corrupted) raises `BagError` naming the file
 and what is wrong, whichever library found it.
@@ -35,6 +39,7 @@ from pathlib import Path, PurePath
 
 import numpy as np
 
+import vehicle
 from control.errors import BagError, ControlError
 from control.robot import messages as msgs
 from control.robot import storage as storage_mod
@@ -47,6 +52,16 @@ DIGEST_KEY = "terrain_gpmsa.messages_sha256"
 """The ``custom_data`` key of a ROS 2 bag this package writes (`open_bag_writer`): JSON
 {topic: `messages_digest` of its messages}, which `read_recording` checks, so that a damaged
 message is refused in a sqlite3 bag too (an MCAP bag's chunks carry CRCs as well)."""
+SIMULATION_KEYS = {"vehicle": "terrain_gpmsa.vehicle", "noise_std": "terrain_gpmsa.noise_std"}
+"""The ``custom_data`` keys of a ROS 2 bag this package writes from a simulation
+(`write_sensor_bag` given ``model=`` / ``noise_std=``): the simulated vehicle's
+``model.describe()`` as JSON, the accelerometer noise sd (m/s^2) as a JSON number; which
+`read_recording` reads into `Recording.vehicle` and `Recording.noise_std`."""
+SIMULATION_RECORD = "terrain_gpmsa.simulation"
+"""The name of the MCAP Metadata record of a run `control.record_run` writes, holding the same
+two fields as `SIMULATION_KEYS` under the keys "vehicle" and "noise_std"."""
+MAX_SIMULATION_CHARS = 4096
+"""Longest text of a field of that record (a Jackal's description is ~300 characters)."""
 URI_PARTS = re.compile(r"[?#]|%[0-9A-Fa-f]{2}")
 """What rosbags' sqlite3 writer misreads in a path (it opens ``file:PATH`` as a URI): a query,
 a fragment, a percent-encoded byte."""
@@ -98,6 +113,10 @@ class Recording:
         topics: every topic of the recording and its message type.
         imu, odometry: the messages of the two topics asked for.
         read_s: wall-clock time of the reading, s.
+        vehicle: the simulated vehicle model a recording this package wrote from a simulation
+            records (`SIMULATION_KEYS`, `SIMULATION_RECORD`); None for any other (a robot's).
+        noise_std: the simulated accelerometer noise sd such a recording records, m/s^2; None
+            where none is recorded.
     """
 
     path: Path
@@ -107,6 +126,8 @@ class Recording:
     imu: ImuMessages
     odometry: OdometryMessages
     read_s: float
+    vehicle: vehicle.Model | None = None
+    noise_std: float | None = None
 
 
 def _normalise(msgtype: str) -> str:
@@ -227,11 +248,12 @@ def read_recording(
     if kind == "mcap":
         require("mcap.reader", "reading an MCAP file")
     wanted = [imu_topic, odom_topic]
-    raw, storage, digests = None, "", {}
+    raw, storage, digests, simulated = None, "", {}, {}
     if kind == "rosbag2":
         info = _bag_information(target)
         files, storage, simple = _bag_files(target, info)
         digests = _recorded_digests(target, info)
+        simulated = _custom_simulation(target, info)
         if simple and storage == "mcap":
             raw = storage_mod.mcap_messages(files, wanted)
         elif simple and storage == "sqlite3":
@@ -251,7 +273,12 @@ def read_recording(
     for topic, got in ((imu_topic, imu), (odom_topic, odom)):
         if got.stamp_ns.size == 0:
             raise BagError(f"the topic {topic!r} in {target} has no messages")
-    return Recording(target, kind, storage, topics, imu, odom, time.perf_counter() - tic)
+    if kind == "mcap":
+        simulated = _mcap_simulation(target)
+    model, noise_std = simulation_from_record(simulated)
+    return Recording(
+        target, kind, storage, topics, imu, odom, time.perf_counter() - tic, model, noise_std
+    )
 
 
 _TOO_DEEP = "its metadata.yaml is nested too deep to parse (a damaged or hostile file)"
@@ -321,6 +348,134 @@ def _recorded_digests(folder: Path, info) -> dict[str, str]:
             "record of the messages' SHA-256 that this package writes"
         )
     return record
+
+
+def _custom_simulation(folder: Path, info) -> dict[str, tuple[str, object]]:
+    """{field: (where, value)} of the simulation record (`SIMULATION_KEYS`) in a ROS 2 bag's
+    custom_data (``info``: its `_bag_information`); {} for a bag without it."""
+    try:
+        custom = info.get("custom_data") or {}
+    except Exception:  # rosbags reads (and reports on) whatever this does not understand
+        return {}
+    if not isinstance(custom, dict):
+        return {}
+    meta = folder / "metadata.yaml"
+    return {
+        name: (f"{meta} is damaged: its custom_data {key!r}", custom[key])
+        for name, key in SIMULATION_KEYS.items()
+        if key in custom
+    }
+
+
+def _mcap_simulation(path: Path) -> dict[str, tuple[str, object]]:
+    """{field: (where, value)} of the MCAP file's `SIMULATION_RECORD` Metadata record (found
+    through its summary's index; in a file without a summary, by reading its records); {} for a
+    file without it. `BagError` for several such records, a damaged one or one over
+    `MAX_SIMULATION_CHARS` per field."""
+    reader_mod = require("mcap.reader", "reading an MCAP file")
+    where = f"{path} is damaged: its {SIMULATION_RECORD!r} metadata record"
+    try:
+        with open(path, "rb") as f:
+            records = _simulation_records(reader_mod, f, where)
+    except BagError:
+        raise
+    except Exception as exc:  # the mcap package raises its own errors for damaged files
+        raise BagError(f"{where} cannot be read ({_why(exc)})") from exc
+    if not records:
+        return {}
+    if len(records) > 1:
+        raise BagError(f"{where} is there {len(records)} times; a recording holds one at most")
+    fields = records[0]
+    unknown = sorted(set(fields) - set(SIMULATION_KEYS))
+    if unknown:
+        raise BagError(
+            f"{where} holds unknown field(s) {[k[:40] for k in unknown[:5]]}; allowed "
+            f"{sorted(SIMULATION_KEYS)}"
+        )
+    return {name: (f"{where}, field {name!r}", value) for name, value in fields.items()}
+
+
+def _simulation_records(reader_mod, f, where: str) -> list[dict]:
+    """The metadata (a dict) of each `SIMULATION_RECORD` record of the open MCAP file ``f``."""
+    limit = 2 * len(SIMULATION_KEYS) * (MAX_SIMULATION_CHARS + 64)  # bytes of a record at most
+    summary = reader_mod.make_reader(f).get_summary()
+    if summary is None:  # an unindexed file: read its records (the messages were read so too)
+        f.seek(0)
+        return [
+            dict(m.metadata)
+            for m in reader_mod.NonSeekingReader(f).iter_metadata()
+            if m.name == SIMULATION_RECORD
+        ]
+    out = []
+    stream_reader = require("mcap.stream_reader", "reading an MCAP file")
+    for index in summary.metadata_indexes:
+        if index.name != SIMULATION_RECORD:
+            continue
+        if index.length > limit:
+            raise BagError(f"{where} is {index.length} bytes long, more than {limit} allowed")
+        f.seek(index.offset)
+        record = next(
+            stream_reader.StreamReader(f, skip_magic=True, record_size_limit=limit).records
+        )
+        if type(record).__name__ != "Metadata" or record.name != SIMULATION_RECORD:
+            raise BagError(f"{where}: the summary's index points at another record")
+        out.append(dict(record.metadata))
+    return out
+
+
+def simulation_record(model=None, noise_std=None) -> dict[str, str]:
+    """{field: text} recording a simulated vehicle model (``model.describe()`` as JSON) and
+    its accelerometer noise sd (m/s^2, a JSON number), each where given (not None);
+    `ControlError` naming the argument otherwise."""
+    out = {}
+    if model is not None:
+        try:
+            model = vehicle.models.check_model(model)
+        except vehicle.VehicleError as exc:
+            raise ControlError(str(exc)) from None
+        out["vehicle"] = json.dumps(model.describe(), sort_keys=True)
+    if noise_std is not None:
+        try:
+            out["noise_std"] = json.dumps(vehicle.sensor.check_noise(noise_std))
+        except vehicle.VehicleError as exc:
+            raise ControlError(str(exc)) from None
+    return out
+
+
+def simulation_from_record(
+    fields: dict[str, tuple[str, object]],
+) -> tuple[vehicle.Model | None, float | None]:
+    """(vehicle model, noise sd m/s^2) from a recording's simulation record ({field: (where it
+    is, for a message; its text)}), None for each field absent. `BagError` naming the field
+    where its text is not a str of at most `MAX_SIMULATION_CHARS` characters holding JSON of a
+    vehicle description (`vehicle.from_description`: a known model, known parameters, finite
+    values in range) or of a noise sd (a finite number >= 0)."""
+    values = {}
+    for name, (where, text) in fields.items():
+        if not isinstance(text, str):
+            raise BagError(f"{where} is a {type(text).__name__}, not the JSON text written")
+        if len(text) > MAX_SIMULATION_CHARS:
+            raise BagError(
+                f"{where} is {len(text)} characters long, more than {MAX_SIMULATION_CHARS} "
+                "allowed (a damaged or hostile record)"
+            )
+        try:
+            values[name] = json.loads(text)
+        except (ValueError, RecursionError) as exc:
+            raise BagError(f"{where} is not JSON ({_why(exc)})") from exc
+    model = noise = None
+    if "vehicle" in values:
+        try:
+            model = vehicle.from_description(values["vehicle"])
+        except (vehicle.VehicleError, TypeError) as exc:
+            where = fields["vehicle"][0]
+            raise BagError(f"{where} is not a vehicle description: {exc}") from exc
+    if "noise_std" in values:
+        try:
+            noise = vehicle.sensor.check_noise(values["noise_std"])
+        except vehicle.VehicleError as exc:
+            raise BagError(f"{fields['noise_std'][0]} is not a noise sd: {exc}") from exc
+    return model, noise
 
 
 def messages_digest(log_ns: Sequence[int], data: Sequence[bytes]) -> str:
@@ -736,7 +891,9 @@ def check_bag_path(path: Path, storage: str, name: str = "path") -> None:
 
 
 @contextmanager
-def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
+def open_bag_writer(
+    path: str | os.PathLike, storage: str = "mcap", custom_data: dict[str, str] | None = None
+) -> Iterator:
     """A rosbags ROS 2 bag writer (format version 9), open, for a new folder ``path``.
 
     The bag is written in a hidden folder beside ``path`` and moved to ``path`` once closed, so
@@ -745,8 +902,9 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
     bag is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves
     it 0), so that a reader refuses a chunk whose bytes changed, and the bag's metadata records
     the SHA-256 of each topic's messages (``DIGEST_KEY``), which `read_recording` checks in any
-    storage (sqlite3 has no checksums of its own). `ControlError` where ``path``
-    exists (a link to nowhere too) or `check_bag_path` refuses it."""
+    storage (sqlite3 has no checksums of its own); ``custom_data`` ({str: str}) is added to
+    that metadata's custom_data. `ControlError` where ``path`` exists (a link to nowhere too)
+    or `check_bag_path` refuses it."""
     _check_storage(storage)
     path = path_argument(path, "path", " of the new bag folder")
     rosbag2 = require("rosbags.rosbag2", "writing a ROS 2 bag")
@@ -763,6 +921,8 @@ def open_bag_writer(path: str | os.PathLike, storage: str = "mcap") -> Iterator:
         with rosbag2.Writer(work / path.name, version=9, storage_plugin=plugin) as writer:
             digesting = _DigestingWriter(writer)
             yield digesting
+            for key, value in (custom_data or {}).items():
+                writer.set_custom_data(key, value)
             writer.set_custom_data(DIGEST_KEY, digesting.record())
         for file in (work / path.name).glob("*.mcap"):  # rosbags writes chunks without CRCs
             storage_mod.write_chunk_crcs(file)
@@ -821,6 +981,8 @@ def write_sensor_bag(
     odom_topic: str = "/odometry/filtered",
     axis: str = "z",
     log_time=None,
+    model=None,
+    noise_std: float | None = None,
 ) -> Path:
     """Write sampled signals as a ROS 2 bag of standard messages (``sensor_msgs/msg/Imu``,
     ``nav_msgs/msg/Odometry``), e.g. a simulated drive to try the replay on.
@@ -837,12 +999,18 @@ def write_sensor_bag(
         axis: the IMU axis that holds ``accel`` when it is 1-D.
         log_time: (n + m,) receive times in s, IMU messages first (default: the stamps); in
             [0, 2**63) ns.
+        model, noise_std: for signals simulated, the vehicle model (`vehicle.Jackal`,
+            `vehicle.HalfCar`) and the accelerometer noise sd (m/s^2) they were simulated
+            with, recorded in the bag's metadata (`SIMULATION_KEYS`), each where given: the
+            replay refuses an emulator made for another vehicle (`control.replay_bag`).
 
     Returns:
         the bag folder.
     """
     _check_topic_names(imu_topic, odom_topic, written=True)
     _check_distinct(imu_topic, odom_topic, ControlError)
+    record = simulation_record(model, noise_std)
+    custom = {SIMULATION_KEYS[name]: text for name, text in record.items()}
     t_imu, imu, t_odom, odom = sensor_messages(
         imu_time, accel, odom_time, position, speed, axis=axis
     )
@@ -853,7 +1021,7 @@ def write_sensor_bag(
     if log.size != t_imu.size + t_odom.size:
         raise ControlError(f"log_time must have length {t_imu.size + t_odom.size}, got {log.size}")
     store = msgs.typestore()
-    with open_bag_writer(path, storage) as writer:
+    with open_bag_writer(path, storage, custom) as writer:
         c_imu = writer.add_connection(imu_topic, msgs.IMU_TYPE, typestore=store)
         c_odom = writer.add_connection(odom_topic, msgs.ODOMETRY_TYPE, typestore=store)
         streams = [(c_imu, log[: t_imu.size], imu), (c_odom, log[t_imu.size :], odom)]
@@ -865,8 +1033,12 @@ def write_sensor_bag(
 def write_run_bag(result, path: str | os.PathLike, **kw) -> Path:
     """Write the samples of a `control.ClosedLoopResult` (front-axle acceleration on the IMU's
     z axis, position and speed as odometry along x, both at the loop's rate) as a ROS 2 bag;
-    keyword arguments as `write_sensor_bag`."""
+    keyword arguments as `write_sensor_bag`; ``model`` and ``noise_std`` default to the run's
+    (its ``settings``), so that the bag records the vehicle simulated."""
     t = result.sample_time
+    settings = getattr(result, "settings", None) or {}
+    for name in ("model", "noise_std"):
+        kw.setdefault(name, settings.get(name))
     return write_sensor_bag(
         path, t, result.sample_accel, t, result.sample_position, result.sample_speed, **kw
     )

@@ -15,8 +15,11 @@ none of the three outputs may be there already, and a failed write removes those
 Exit status 0 on success, also for a recording too short for one estimate (the summary then
 says "no estimate" and why); 2 with a one-line message on a usage error (``--out`` a file or
 inside the recording, a setting out of range), an emulator file that is missing or cannot be
-loaded, a recording that cannot be replayed (a missing topic, a damaged file, ...) or a
-missing extra (the message says which extra to install).
+loaded, a recording that cannot be replayed (a missing topic, a damaged file, a simulated
+recording that records another vehicle than the emulator's, ...) or a missing extra (the
+message says which extra to install). ``--ignore-vehicle`` replays such a simulated recording
+anyway (`replay_bag`'s ``check_vehicle=False``; a note says so); a robot's recording records
+no vehicle and is never refused for one.
 """
 
 from __future__ import annotations
@@ -196,6 +199,11 @@ def parser() -> argparse.ArgumentParser:
         "--v-safe", type=float, default=Simplex.v_safe, metavar="M_PER_S",
         help="the Simplex's safety-mode speed, m/s (default 1.0, the paper's)",
     )  # fmt: skip
+    p.add_argument(
+        "--ignore-vehicle", action="store_true",
+        help="replay a simulated recording that records another vehicle than the emulator's "
+        "(refused by default; a robot's recording records none)",
+    )  # fmt: skip
     p.add_argument("--progress", action="store_true", help="show a progress bar")
     return p
 
@@ -228,7 +236,8 @@ def main(argv: list[str] | None = None) -> int:
         check_bag_path(out / "estimates", settings.storage, "--out")
         emulator = load_emulator(args.emulator, "--emulator")
         check_emulator(emulator, simplex=simplex)
-        result = replay_bag(bag, emulator, settings, simplex=simplex, progress=args.progress)
+        result = replay_bag(bag, emulator, settings, simplex=simplex, progress=args.progress,
+                            check_vehicle=not args.ignore_vehicle)  # fmt: skip
         source = f"shipped emulator {args.emulator}" if args.emulator in SHIPPED else args.emulator
         _write(out, result, _report(bag, source, settings, result))
     except MissingExtraError as exc:

@@ -12,7 +12,10 @@ robot's bag and the replay's output, and `control.replay_bag` reads the file bac
 | ``/sim/gd_true`` | ``std_msgs/msg/Float64`` | one per BCR update | the GD prescribed at the vehicle's position |
 
 The loop's result keeps no posterior sd nor P(GD > GD_max): those fields are NaN here (the
-replay fills them).
+replay fills them). A Metadata record named ``terrain_gpmsa.simulation``
+(`control.robot.bags.SIMULATION_RECORD`) holds the simulated vehicle's ``model.describe()``
+(JSON, key "vehicle") and the accelerometer noise sd (m/s^2, key "noise_std"), as the run's
+``settings`` give them, so that the replay refuses an emulator made for another vehicle.
 """  # noqa: E501
 
 from __future__ import annotations
@@ -24,7 +27,14 @@ import numpy as np
 
 from control.errors import ControlError
 from control.robot import messages as msgs
-from control.robot.bags import MAX_STAMP_NS, merge_in_time, sensor_messages, stamps_ns
+from control.robot.bags import (
+    MAX_STAMP_NS,
+    SIMULATION_RECORD,
+    merge_in_time,
+    sensor_messages,
+    simulation_record,
+    stamps_ns,
+)
 from control.robot.extra import require
 from control.robot.storage import LIBRARY, check_mcap_target
 from control.validation import check_instance, path_argument
@@ -86,6 +96,9 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
             Foxglove shows seconds from the start either way); every header stamp and receive
             time is that much later.
 
+    The file records the vehicle model and noise sd the run's ``settings`` hold (``"model"``,
+    ``"noise_std"``; `control.run_closed_loop` sets both), each where it is there.
+
     Returns:
         the path written. Raises `MissingExtraError` without the ``robot`` extra.
     """
@@ -111,6 +124,7 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     stamps = stamps_ns("the run's update times", result.time, offset_ns=start_ns)
     rows = _estimate_rows(result)
     settings = getattr(result, "settings", None) or {}
+    simulated = simulation_record(settings.get("model"), settings.get("noise_std"))
     level = getattr(settings.get("bcr"), "interval_level", np.nan)
     gd_max = getattr(settings.get("simplex"), "gd_max", np.nan)
     estimates = []
@@ -128,6 +142,8 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     with atomic_write(path, error=ControlError) as f:
         writer = writer_mod.Writer(f)
         writer.start(profile="ros2", library=LIBRARY)
+        if simulated:
+            writer.add_metadata(SIMULATION_RECORD, simulated)
         channels = {}
         for key, msgtype in (
             ("imu", msgs.IMU_TYPE), ("odometry", msgs.ODOMETRY_TYPE),

@@ -46,6 +46,8 @@ from control.compat import (
     check_emulator,
     check_likelihood,
     check_recorded_feature,
+    check_recorded_vehicle,
+    recorded_vehicle_mismatch,
 )
 from control.errors import BagError, ControlError
 from control.estimate import Estimate, edge_counts
@@ -419,6 +421,7 @@ def replay_bag(
     csv: str | os.PathLike | None = None,
     out_bag: str | os.PathLike | None = None,
     progress: bool = False,
+    check_vehicle: bool = True,
     **overrides,
 ) -> ReplayResult:
     """Run the BCR and the Simplex over a robot recording.
@@ -445,10 +448,18 @@ def replay_bag(
             new one: an existing path is refused, and so is, for storage "sqlite3", a path
             holding '?', '#' or '%XX' (`control.robot.bags.check_bag_path`).
         progress: show a tqdm bar over the blocks.
+        check_vehicle: where the recording is a simulation this package wrote and records its
+            vehicle (`Recording.vehicle`: `control.record_run`, `write_sensor_bag(model=...)`)
+            and the emulator records its own (metadata ``vehicle``), refuse the replay when
+            they differ (`control.compat.check_recorded_vehicle`; a noise sd that differs is
+            a `ControlWarning`). False: replay anyway (a note in ``notes`` says so). A robot's
+            recording records no vehicle: nothing is checked.
 
     Returns:
         `ReplayResult`. Raises `BagError` (a topic missing, mistyped or empty; an IMU slower
-        than the emulator's rate; a damaged file), `ControlError` (``bag`` not a path; ``csv``
+        than the emulator's rate; a damaged file or simulation record),
+        `EmulatorMismatchError` (the recording's simulated vehicle is not the emulator's, see
+        ``check_vehicle``), `ControlError` (``bag`` not a path; ``csv``
         or ``out_bag`` not a path, one in or on what is read (the recording, the whole bag
         folder of a file given inside one, or the emulator file) or an existing output
         refused as above; an
@@ -469,8 +480,9 @@ def replay_bag(
     _check_fit(s, bcr, emulator, likelihood, simplex)
     rec = read_recording(bag, s.imu_topic, s.odom_topic)
     result = replay_recording(
-        rec, emulator, s, bcr=bcr, simplex=simplex, likelihood=likelihood, progress=progress
-    )
+        rec, emulator, s, bcr=bcr, simplex=simplex, likelihood=likelihood, progress=progress,
+        check_vehicle=check_vehicle,
+    )  # fmt: skip
     if out_bag is not None:  # a new folder, written whole or not at all
         result.write_bag(out_bag)
     if csv is not None:
@@ -575,6 +587,7 @@ def replay_recording(
     simplex: Simplex | None = None,
     likelihood=None,
     progress: bool = False,
+    check_vehicle: bool = True,
 ) -> ReplayResult:
     """`replay_bag` on a recording already read (`control.robot.bags.read_recording`)."""
     s = _settings(settings, {})
@@ -582,9 +595,11 @@ def replay_recording(
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
     simplex = Simplex() if simplex is None else simplex
     _check_fit(s, bcr, emulator, likelihood, simplex)
+    unchecked = _check_vehicle(rec, emulator, check_vehicle)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     tic = time.perf_counter()
     t, a, pos, spd, reports, resampling, notes, t0 = _condition(rec, s, bcr.rate_hz)
+    notes[:0] = unchecked
     condition_s = time.perf_counter() - tic
 
     tic = time.perf_counter()
@@ -639,6 +654,19 @@ def replay_recording(
         simplex=simplex,
         source=str(rec.path),
     )
+
+
+def _check_vehicle(rec: Recording, emulator, check: bool) -> list[str]:
+    """`check_recorded_vehicle` of the recording's simulation record (``check``); where not
+    asked to check, a note for a vehicle that it would have refused."""
+    if not isinstance(check, bool):
+        raise ControlError(f"check_vehicle must be True or False, got {check!r}")
+    what = f"the recording {str(rec.path)!r}"
+    if check:
+        check_recorded_vehicle(emulator, rec.vehicle, rec.noise_std, what)
+        return []
+    why = recorded_vehicle_mismatch(emulator, rec.vehicle, what)
+    return [f"{why}: replayed anyway (check_vehicle=False)"] if why else []
 
 
 def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simplex: Simplex) -> None:
