@@ -99,8 +99,9 @@ once (16 calls of 15 points an edge instead of 64 of one; 4-8 levels measured al
 cheap prior, and a prior's cost per point grows with the level)."""
 
 
-def _check_mcmc_options(options) -> dict:
-    """``options`` (None or a dict of ``gpmsa.calibrate`` keywords) as a dict; GPMSAError naming
+def _check_mcmc_options(options, backend: str) -> dict:
+    """``options`` (None or a dict of ``gpmsa.calibrate`` keywords, backend ``backend``'s
+    sampler options among them, as ``calibrate`` passes them on) as a dict; GPMSAError naming
     what is not a keyword the Calibrator may pass on (it gives the data, ``extrapolate`` and
     the prior itself)."""
     from gpmsa.calibration.calibrate import calibrate  # calibrate imports this module
@@ -110,13 +111,31 @@ def _check_mcmc_options(options) -> dict:
     if not isinstance(options, dict):
         raise GPMSAError(f"mcmc_options must be None or a dict, got {type(options).__name__}")
     own = {"emulator", "x_obs", "y_obs", "extrapolate", "log_prior"}
-    allowed = sorted(set(inspect.signature(calibrate).parameters) - own)
+    named = {k for k, v in inspect.signature(calibrate).parameters.items()
+             if v.kind is not inspect.Parameter.VAR_KEYWORD}  # fmt: skip
+    sampler = set(inspect.signature(backends.get(backend).sample).parameters) - {"problem"}
+    allowed = sorted((named | sampler) - own - {"n_iter"})  # n_iter: calibrate's n_samples
     unknown = sorted(set(options) - set(allowed), key=str)
     if unknown:
         raise GPMSAError(
-            f"mcmc_options: unknown keyword(s) {unknown}; gpmsa.calibrate takes {allowed}"
+            f"mcmc_options: unknown keyword(s) {unknown}; gpmsa.calibrate takes {allowed} "
+            f"(with the {backend!r} backend)"
         )
     return dict(options)
+
+
+def _mcmc_backend(backend, options) -> str:
+    """The Calibrator's backend: ``backend``, or ``options["backend"]`` (``mcmc_options``)
+    where ``backend`` is numpy, the default; GPMSAError where the two name different ones."""
+    if not isinstance(options, dict) or "backend" not in options:
+        return backend
+    given = options["backend"]
+    if given == backend or backend == "numpy":
+        return given
+    raise GPMSAError(
+        f"backend={backend!r} and mcmc_options['backend']={given!r} disagree: give the "
+        "backend once, as Calibrator(..., backend=)"
+    )
 
 
 class Calibrator:
@@ -134,10 +153,13 @@ class Calibrator:
             Generator (an integer is drawn from it) or None (fresh entropy).
         mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC
             (``"fixed"``, which holds parameters at known values, only there: with the grid
-            method it is a GPMSAError).
+            method it is a GPMSAError), the backend's sampler options among them, as
+            ``calibrate`` takes them (``{"dtype": "float32"}`` for torch, ``{"n_warmup": 200}``
+            for pyro).
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
             ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
-            "auto" choose MCMC.
+            "auto" choose MCMC. ``mcmc_options["backend"]`` is taken as this argument (a
+            GPMSAError where both are given and differ).
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there. On the grid, for one parameter the density is cut at
             the boundary (located by bisection between nodes, to float precision), so that no
@@ -173,6 +195,7 @@ class Calibrator:
                                            tuple(emulator.t_names))  # fmt: skip
         if method not in METHODS:
             raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
+        backend = _mcmc_backend(backend, mcmc_options)
         backends.get(backend)  # unknown or not installed: a clear error now, not at update()
         if backend != "numpy" and method == "grid":
             raise GPMSAError(
@@ -201,7 +224,7 @@ class Calibrator:
         self.emulator_params = emulator_params
         self._entropy = np.random.SeedSequence(None if seed is None else run_seed(seed)).entropy
         self._count = 0
-        self.mcmc_options = _check_mcmc_options(mcmc_options)
+        self.mcmc_options = _check_mcmc_options(mcmc_options, backend)
         if constraint is not None:
             self.mcmc_options.setdefault("constraint", constraint)
         self._check_mcmc_path(backend)
