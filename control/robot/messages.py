@@ -74,10 +74,11 @@ def _align(n: np.ndarray | int, to: int):
 
 def _groups(raws: Sequence[bytes]):
     """(indices, (m, L) uint8 array) per distinct message length L."""
-    lengths = np.fromiter((len(r) for r in raws), dtype=np.int64, count=len(raws))
-    for size in np.unique(lengths):
+    lengths = np.fromiter(map(len, raws), dtype=np.int64, count=len(raws))
+    sizes = np.unique(lengths)
+    for size in sizes:
         idx = np.flatnonzero(lengths == size)
-        buf = b"".join([raws[i] for i in idx])
+        buf = b"".join(raws if sizes.size == 1 else [raws[i] for i in idx.tolist()])
         yield idx, np.frombuffer(buf, dtype=np.uint8).reshape(idx.size, int(size))
 
 

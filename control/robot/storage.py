@@ -27,6 +27,7 @@ from control.robot.extra import require
 
 _RECORD = struct.Struct("<BQ")  # opcode, length
 _MESSAGE = struct.Struct("<HIQ")  # channel id, sequence, log time (publish time follows)
+_RECORD_MESSAGE = struct.Struct("<BQHIQ")  # a record's opcode and length, a message's fields
 _MESSAGE_DATA = 9 + 2 + 4 + 8 + 8  # offset of a Message record's data from the record's start
 _CHUNK = struct.Struct("<QQQI")  # start and end time, uncompressed size, crc
 OP_MESSAGE, OP_CHUNK, OP_DATA_END = 0x05, 0x06, 0x0F
@@ -148,7 +149,20 @@ def _text(data: bytes, what: str) -> str:
 def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
     """Append the Message records of the wanted channels (id -> topic)."""
     pos, end = 0, len(records)
-    head, message = _RECORD.unpack_from, _MESSAGE.unpack_from
+    full, head, message = _RECORD_MESSAGE.unpack_from, _RECORD.unpack_from, _MESSAGE.unpack_from
+    logs = {channel: out.log_ns[topic] for channel, topic in wanted.items()}
+    datas = {channel: out.data[topic] for channel, topic in wanted.items()}
+    last = end - _RECORD_MESSAGE.size  # from here on a record may end before a message's fields
+    while pos <= last:  # one unpack a record: its opcode and length, a message's fields
+        op, length, channel, _seq, log = full(records, pos)
+        if op == OP_MESSAGE:
+            if length < _MESSAGE_DATA - 9:
+                raise _Damaged(f"a message record at byte {pos} of its records is too short")
+            times = logs.get(channel)
+            if times is not None:
+                times.append(log)
+                datas[channel].append(records[pos + _MESSAGE_DATA : pos + 9 + length])
+        pos += 9 + length
     while pos < end:
         op, length = head(records, pos)
         if op == OP_MESSAGE:
@@ -381,13 +395,14 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
                 "SELECT timestamp, data FROM messages WHERE topic_id = ? ORDER BY timestamp, id",
                 (tid,),
             ).fetchall()
-            if not all(type(stamp) is int and type(data) is bytes for stamp, data in rows):
+            stamps, data = zip(*rows, strict=True) if rows else ((), ())
+            if set(map(type, stamps)) - {int} or set(map(type, data)) - {bytes}:
                 raise BagError(
                     f"{path} is damaged: a message of the topic {name!r} lacks an integer "
                     "time stamp or its data"
                 )
-            out.log_ns[name].extend(r[0] for r in rows)
-            out.data[name].extend(r[1] for r in rows)
+            out.log_ns[name].extend(stamps)
+            out.data[name].extend(data)
     finally:
         con.close()
 
