@@ -20,7 +20,7 @@ Band emulator (``control.shipped_emulator(case, "band")``, the change-point BCR'
 125-sample block's feature vector (`control.block_features`: the log band powers, then the
 quantiles less the mean); per cell
 
-- ``z``: per output, (mean over the cell's blocks - ``emu.predict(v, GD, resid=False)``) in units
+- ``z``: per output, (mean over the cell's blocks - ``emu.predict_mean(v, GD)``) in units
   of its Monte-Carlo standard error (the cell's long-run block variance, batch means of 8
   blocks as `control.training`, over the number of blocks);
 - ``chi2``: d' (Sigma(v) / n)^-1 d over the K outputs with the emulator's own block scatter
@@ -217,10 +217,10 @@ class Cell:
 
 
 def slope(emu, v: float, gd: float, h: float = 0.02) -> np.ndarray:
-    """d mean / d log GD (K,) of ``emu.predict`` at (v, GD), central within the domain."""
+    """d mean / d log GD (K,) of ``emu.predict_mean`` at (v, GD), central within the domain."""
     lo, hi = emu.domain["GD"]
     a, b = max(gd * np.exp(-h), lo), min(gd * np.exp(h), hi)
-    mean, _ = emu.predict([v, v], [a, b], resid=False)
+    mean = emu.predict_mean([v, v], [a, b])
     return (mean[1] - mean[0]) / np.log(b / a)
 
 
@@ -265,7 +265,7 @@ def band_cells(case: str, emu, c, grid: Grid, rng) -> list[Cell]:
             n_batch = st.features.shape[1] // BATCH
             feats = st.features[:, : n_batch * BATCH].reshape(-1, spec.dim)
             n = feats.shape[0]
-            mu, _ = emu.predict([min(v, v_hi)], [gd], resid=False)
+            mu = emu.predict_mean([min(v, v_hi)], [gd])
             d = feats.mean(axis=0) - mu[0]
             cell_cov = st.cov.mean(axis=0)
             z = d / np.sqrt(np.diag(cell_cov) / n)

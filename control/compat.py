@@ -275,7 +275,7 @@ def _probe(emulator) -> np.ndarray:
     (v_lo, v_hi), (g_lo, g_hi) = (emulator.domain[n] for n in emulator.x_names + emulator.t_names)
     v = np.array([v_lo, v_lo, v_hi, v_hi, (v_lo + v_hi) / 2])
     gd = np.array([g_lo, g_hi, g_lo, g_hi, (g_lo + g_hi) / 2])
-    mean, _ = emulator.predict(v, gd, resid=False)
+    mean = emulator.predict_mean(v, gd)
     return np.asarray(mean, dtype=float)
 
 

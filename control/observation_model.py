@@ -105,7 +105,7 @@ class ObservationModel:
     def __init__(
         self, emulator, scatter: BlockScatter | None = None, n_grid: int = 121, n_speed: int = 31
     ) -> None:
-        if not all(hasattr(emulator, a) for a in ("p", "q", "l_sim", "domain", "predict")):
+        if not all(hasattr(emulator, a) for a in ("p", "q", "l_sim", "domain", "predict_mean")):
             raise ControlError(
                 f"emulator must be a gpmsa.Emulator, got {emulator!r:.60} "
                 f"({type(emulator).__name__})"
@@ -151,7 +151,7 @@ class ObservationModel:
         self.gd = np.geomspace(g_lo, g_hi, int(n_grid))
         self.speed = np.linspace(v_lo, v_hi, int(n_speed))
         V, G = np.meshgrid(self.speed, self.gd, indexing="ij")
-        mean, _ = emulator.predict(V.ravel(), G.ravel(), resid=False)
+        mean = emulator.predict_mean(V.ravel(), G.ravel())
         self._mean = mean.reshape(self.speed.size, self.gd.size, -1)  # (S, G, K)
         self.dim = self._mean.shape[2]
         self._last = None

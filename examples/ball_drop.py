@@ -202,7 +202,7 @@ def main(argv: list[str] | None = None) -> dict:
         "posterior": post.summary(0.9),
         "world": WORLD,
         "emulator": {"p_u": emu.p_u, "held_out_rmse_s": float(np.sqrt(np.mean(
-            (emu.predict(test.x, test.t, draws=True, n_draws=100)[0] - test.y) ** 2))),
+            (emu.predict_mean(test.x, test.t, draws=True, n_draws=100) - test.y) ** 2))),
             "loo_coverage90": cv.coverage(0.9), "loo_rmse_s": float(np.mean(cv.rmse))},
         "prediction_held_out_balls": {
             "R": list(HELD_OUT_R),

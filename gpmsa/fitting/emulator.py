@@ -465,26 +465,30 @@ class Emulator:
             )
         return z
 
-    def _predict_std(self, z: np.ndarray, params, factors, resid: bool):
+    def _predict_std(self, z: np.ndarray, params, factors, resid: bool, *, var: bool = True):
+        """Standardised predictive mean and variance (N, l_sim) at unit-scale z; ``var=False``:
+        the variance None, its triangular solves skipped (the mean's operations unchanged)."""
         mean = np.zeros((z.shape[0], self.l_sim))
-        var = np.zeros((z.shape[0], self.l_sim))
+        out = np.zeros((z.shape[0], self.l_sim)) if var else None
         cat = self.categorical_mask
         h = None if self.mean_basis is None else self.mean_basis.matrix(z)
         for j, (L, a, gls) in enumerate(factors):
             r = correlation(z, self.zt, params["betaU"][:, j], cat) / params["lamUz"][j]
             mw = r @ a
-            v = solve_triangular(L, r.T, lower=True)
-            vw = 1.0 / params["lamUz"][j] - np.sum(v**2, axis=0)
-            if gls is not None:  # the GLS mean and its coefficients' variance
+            if gls is not None:  # the GLS mean
                 mw = mw + h @ gls.coef
-                vw = vw + gls.variance(h, v)
-            if resid:
-                vw = vw + 1.0 / params["lamWs"][j]
             mean += np.outer(mw, self.K[:, j])
-            var += np.outer(vw, self.K[:, j] ** 2)
-        if resid:
-            var += 1.0 / params["lamWOs"][0]
-        return mean, var
+            if var:
+                v = solve_triangular(L, r.T, lower=True)
+                vw = 1.0 / params["lamUz"][j] - np.sum(v**2, axis=0)
+                if gls is not None:  # the variance of its coefficients
+                    vw = vw + gls.variance(h, v)
+                if resid:
+                    vw = vw + 1.0 / params["lamWs"][j]
+                out += np.outer(vw, self.K[:, j] ** 2)
+        if var and resid:
+            out += 1.0 / params["lamWOs"][0]
+        return mean, out
 
     def _check_predict_memory(self, x, t) -> None:
         try:  # the size before converting; a ragged input is named by _inputs
@@ -496,14 +500,42 @@ class Emulator:
             f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs)",
         )
 
-    def _predict_point(self, x, t, resid: bool, *, far_ok: bool = False):
+    def _predict_point(self, x, t, resid: bool, *, far_ok: bool = False, var: bool = True):
         """``predict(x, t, resid=resid)`` at the point estimate (native mean and variance);
         ``far_ok``: x or t beyond ``EXTRAPOLATION_MARGIN`` of the domain allowed (for a caller
-        that allows extrapolation and has warned, as ``calibrated_predict(extrapolate=True)``)."""
+        that allows extrapolation and has warned, as ``calibrated_predict(extrapolate=True)``);
+        ``var=False``: the variance None (``predict_mean``)."""
         self._check_predict_memory(x, t)
         z = self._inputs(x, t, far_ok=far_ok, stacklevel=4)  # the caller of predict()
-        m, v = self._predict_std(z, self.params, self._point_factor(), resid)
-        return self.standardizer.y_from_std(m), self.standardizer.var_from_std(v)
+        m, v = self._predict_std(z, self.params, self._point_factor(), resid, var=var)
+        s = self.standardizer
+        return s.y_from_std(m), None if v is None else s.var_from_std(v)
+
+    def _predict_draws(self, x, t, n_draws: int | None, resid: bool, *, var: bool = True):
+        """``predict(x, t, draws=True, n_draws=n_draws, resid=resid)``; ``var=False``: the
+        variance None (``predict_mean``)."""
+        self._check_predict_memory(x, t)
+        z = self._inputs(x, t, stacklevel=4)  # the caller of predict()
+        s = self.standardizer
+        if not self.draws:
+            raise GPMSAError(
+                f"this emulator has no posterior draws {NO_DRAWS}; pass draws=False to use its "
+                "point estimate"
+            )
+        idx = evenly_spaced(self.n_draws, n_draws)
+        means, vars_ = [], []
+        with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
+            for i in idx:
+                prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
+                m, v = self._predict_std(z, prm, self._factor(prm), resid, var=var)
+                means.append(m)
+                vars_.append(v)
+        means = np.array(means)
+        mean = means.mean(axis=0)
+        if not var:
+            return s.y_from_std(mean), None
+        var_ = np.array(vars_).mean(axis=0) + means.var(axis=0)
+        return s.y_from_std(mean), s.var_from_std(var_)
 
     def predict(
         self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True
@@ -517,33 +549,27 @@ class Emulator:
         retained posterior draws (or ``n_draws`` of them, evenly spaced from the first to the
         last: ``evenly_spaced``), combining the variances by the law of total variance.
         ``resid`` adds the nugget 1/lamWs and the residual variance 1/lamWOs (the spread of a new
-        simulation run about the smooth emulator).
+        simulation run about the smooth emulator). The mean alone: `predict_mean`.
         """
         draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
         if n_draws is not None:  # also where draws=False leaves it unused
             check_count(n_draws, "n_draws")
         if not draws:
             return self._predict_point(x, t, resid)
-        self._check_predict_memory(x, t)
-        z = self._inputs(x, t)
-        s = self.standardizer
-        if not self.draws:
-            raise GPMSAError(
-                f"this emulator has no posterior draws {NO_DRAWS}; pass draws=False to use its "
-                "point estimate"
-            )
-        idx = evenly_spaced(self.n_draws, n_draws)
-        means, vars_ = [], []
-        with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
-            for i in idx:
-                prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
-                m, v = self._predict_std(z, prm, self._factor(prm), resid)
-                means.append(m)
-                vars_.append(v)
-        means, vars_ = np.array(means), np.array(vars_)
-        mean = means.mean(axis=0)
-        var = vars_.mean(axis=0) + means.var(axis=0)
-        return s.y_from_std(mean), s.var_from_std(var)
+        return self._predict_draws(x, t, n_draws, resid)
+
+    def predict_mean(self, x, t, *, draws: bool = False, n_draws: int | None = None) -> np.ndarray:
+        """Predictive mean (N, l_sim) in native units: ``predict(x, t, draws=draws,
+        n_draws=n_draws)[0]`` to the last bit, without computing the variance (its triangular
+        solves, about half of ``predict``'s time at many points). The mean does not depend on
+        ``resid``; the arguments and their checks are ``predict``'s.
+        """
+        draws = check_flag(draws, "draws")
+        if n_draws is not None:  # also where draws=False leaves it unused
+            check_count(n_draws, "n_draws")
+        if not draws:
+            return self._predict_point(x, t, False, var=False)[0]
+        return self._predict_draws(x, t, n_draws, False, var=False)[0]
 
     # --- checks -------------------------------------------------------------------------------
     def loo(self) -> LooResult:

@@ -437,3 +437,19 @@ def test_block_statistics_name_an_empty_campaign_and_blocks_without_a_feature():
     window = control.FeatureSpec(name="log_var", block_samples=125)
     with pytest.raises(ControlError, match=r"block 2 of run 1 .*log_var.*constant"):
         block_statistics(accel, window)
+
+
+def test_the_mean_table_is_the_emulators_predictive_mean_to_the_last_bit(model):
+    """The table and the compatibility probe take ``predict_mean`` (session 67: the variance
+    they threw away was ~60% of the start-up): the same numbers as ``predict``'s mean."""
+    from control.compat import _probe
+
+    emu = model.emulator
+    small = ObservationModel(emu, n_grid=16, n_speed=2)
+    V, G = np.meshgrid(small.speed, small.gd, indexing="ij")
+    want, _ = emu.predict(V.ravel(), G.ravel(), resid=False)
+    np.testing.assert_array_equal(small._mean, want.reshape(small._mean.shape))
+    (v_lo, v_hi), (g_lo, g_hi) = emu.domain["v"], emu.domain["GD"]
+    v = np.array([v_lo, v_lo, v_hi, v_hi, (v_lo + v_hi) / 2])
+    gd = np.array([g_lo, g_hi, g_lo, g_hi, (g_lo + g_hi) / 2])
+    np.testing.assert_array_equal(_probe(emu), emu.predict(v, gd, resid=False)[0])
