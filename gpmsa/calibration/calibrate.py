@@ -287,7 +287,8 @@ def calibrate(
             element is never proposed and is exactly its value in every draw (its sd 0); the
             values are checked as ``fit``'s (theta inside the design's range, a categorical
             one at a level; others inside their prior's bounds); ``info["fixed"]`` records
-            them as ``fit``'s ``settings["fixed"]`` (theta on the unit scale). The fast
+            them as ``fit``'s ``settings["fixed"]`` (theta on the unit scale), ``info["held"]``
+            the posterior names held (``Posterior.summary``'s "held": True). The fast
             sampler holds theta and lamOs itself (the default path stays fast; its
             draws of the others are those of the generic numpy backend's model); the numpy,
             torch and pyro backends hold any of them, whole or by element. The emulator's
@@ -405,6 +406,7 @@ def calibrate(
     )  # fmt: skip
     if held is not None:
         info["fixed"] = info.pop("fixed", {})  # after the run's own keys
+        info["held"] = list(held_names)  # the posterior names held (Posterior.summary's "held")
     if n_chains > 1:
         info["diagnostics"] = summarize(chains)
         shapes = {k: v.shape[2:] for k, v in chains.items()}

@@ -290,6 +290,14 @@ def _checked_grids(grids, names) -> dict[str, GridMarginal]:
     return dict(grids)
 
 
+def held_names(info: dict) -> set[str]:
+    """The names ``info["held"]`` lists (``calibrate(..., fixed=)``, ``calibration_posterior``
+    of a fit with ``fixed=``, a study's settings: held at their values), its strings only
+    (a file may hold other entries); none without it."""
+    held = info.get("held")
+    return {h for h in held if isinstance(h, str)} if isinstance(held, list | tuple) else set()
+
+
 class Posterior:
     """Posterior of a calibration, native units.
 
@@ -435,12 +443,15 @@ class Posterior:
         return float(np.mean(self.samples[name] > value))
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
-        """name -> {mean, sd, q_lo, median, q_hi, n_draws, exact_grid} (the interval at
+        """name -> {mean, sd, q_lo, median, q_hi, n_draws, exact_grid, held} (the interval at
         ``level``; MCMC posteriors add the bulk ESS and the rank-normalised split R-hat, NaN
         where the chains are too short or constant). q_lo and q_hi are named by their
-        percentages (`quantile_keys`): "q5" and "q95" for level 0.9."""
+        percentages (`quantile_keys`): "q5" and "q95" for level 0.9. "held": True for a
+        parameter held with ``fixed=`` (``info["held"]`` names it and every draw is its value:
+        sd 0, ESS and R-hat NaN), as ``Study.summary`` marks one."""
         level = check_level(level)
         lo_key, hi_key = quantile_keys(level)
+        held = held_names(self.info)
         out = {}
         for name in self.names:
             lo, hi = self.interval(name, level)
@@ -458,7 +469,15 @@ class Posterior:
                 chains = np.atleast_2d(self.chains[name])
                 out[name]["ess"] = diagnostics.ess(chains)
                 out[name]["rhat"] = diagnostics.rhat(chains)
+            out[name]["held"] = name in held and self._constant(name)
         return out
+
+    def _constant(self, name: str) -> bool:
+        """Whether every draw of ``name`` is one value (a grid marginal's never is)."""
+        if name in self.grids:
+            return False
+        draws = np.asarray(self.samples[name])
+        return bool(draws.size > 0 and draws.min() == draws.max())
 
     def to_arviz(self):
         """ArviZ InferenceData of the draws (arviz imported lazily)."""

@@ -158,13 +158,16 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     shapes = {"betaU": (emulator.p + emulator.q, emulator.p_u)}  # the 2-D parameters
     if emulator.calibration and "betaV" in emulator.calibration:
         shapes["betaV"] = emulator.calibration["betaV"].shape[1:]
+    fixed = fixed if isinstance(fixed, dict) else {}
     for name, d in manifest["diagnostics"].items():
         if isinstance(d, dict) and isinstance(d.get("mean"), list):
+            held = _held_positions(fixed.get(name), shapes.get(name), len(d["mean"]))
             cells = {}
             for key, fmt in (("mean", ".4g"), ("ess", ".0f"), ("rhat", ".3f")):
                 vals = d.get(key, [])
                 cells[key] = (
-                    ", ".join(number(v, fmt) for v in vals if v is not None)
+                    ", ".join("held" if key != "mean" and k in held else number(v, fmt)
+                              for k, v in enumerate(vals) if v is not None or k in held)
                     if isinstance(vals, list) else value(vals)
                 )  # fmt: skip
             label = safe(name, 60)
@@ -173,6 +176,9 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
             if name == "theta":  # stored on the unit scale; printed native, as calibrate does
                 native = _native_theta(manifest, d["mean"], standardizer)
                 label, cells["mean"] = native or ("theta (unit scale)", cells["mean"])
+            if held and len(held) == len(d["mean"]):  # fixed= whole: no ESS or R-hat to give
+                lines.append(f"posterior {label}: held at [{safe(cells['mean'], 300)}] (fixed=)")
+                continue
             lines.append(
                 f"posterior {label}: mean [{safe(cells['mean'], 300)}] ESS "
                 f"[{safe(cells['ess'], 300)}] R-hat [{safe(cells['rhat'], 300)}]"
@@ -240,6 +246,20 @@ def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str
     native = standardizer.t_from_unit(unit)[0]
     cells = [f"{safe(n, 60)}={number(float(v), '.4g')}" for n, v in zip(names, native, strict=True)]
     return "theta (native)", ", ".join(cells)
+
+
+def _held_positions(record: object, shape, size: int) -> set[int]:
+    """The positions (C order, as the diagnostics list them) of the ``size`` elements that a
+    ``settings["fixed"]`` entry holds: all for a parameter held whole, its elements' for held
+    elements (``shape``: a 2-D parameter's; None: 1-D); none for no entry, or one unread."""
+    if isinstance(record, list):
+        return set(range(size))
+    held = _held_elements(record)
+    if held is None:
+        return set()
+    cols = shape[1] if shape is not None and len(shape) == 2 else 1
+    flat = {i[0] * cols + (i[1] if len(i) == 2 else 0) for i, _ in held if i}
+    return {k for k in flat if 0 <= k < size}
 
 
 def _held_elements(record: object) -> list[tuple[list[int], float]] | None:

@@ -5,11 +5,11 @@ spread wider than the posterior (Gelman and Rubin 1992; Vehtari et al. 2021), so
 start from dispersed values by default (``init="auto"``); one chain starts at GPM/SA's initial
 values, as GPM/SA does.
 
-- ``"gpmsa"``: ``problem.init`` (theta 0.5, betaU 0.1, lamUz 1, lamWs 1000, ...).
+- ``"gpmsa"``: ``problem.init`` (theta 0.5, betaU 0.1, lamUz 1, lamWs 1000, ...), inside
+  each prior's bounds (``default_start``).
 - ``"jitter"``: around GPM/SA's start: theta ~ U(0.1, 0.9); beta through rho = exp(-beta/4)
-  ~ U(RHO_JITTER); each precision log-uniform on [x0 / f, x0 f] (x0 its GPM/SA start, f =
-  ``PRECISION_JITTER``) cut to its prior's bounds (bounds too narrow for the cut: x0; bounds
-  out of its reach: GPMSAError).
+  ~ U(RHO_JITTER); each precision log-uniform on [x0 / f, x0 f] (x0 its ``default_start``, f
+  = ``PRECISION_JITTER``) cut to its prior's bounds (bounds too narrow for the cut: x0).
 - ``"prior"``: from the (data-corrected) prior: theta from the truncated normal, rho from
   Beta(rho_a, rho_b) (betaV's: Beta(rhoV_a, rhoV_b) where set, ``Priors.rho_arrays``) capped at
   rho_cap, precisions from their truncated Gammas.
@@ -18,6 +18,12 @@ values, as GPM/SA does.
   ``Chains.info["starts"]`` records them; ``gpmsa.fit(..., init=emulator)`` builds it from a
   fit's last kept draws, to continue its chains). Parameters left out start at
   ``problem.init``.
+
+A precision whose GPM/SA start lies outside its prior's bounds (lamVz 20 under a per-group
+prior with bounds (1000, inf), lamWs 1000 under (1e4, 1e5)) starts instead at its prior's median
+inside those bounds (``default_start``; every start inside them is GPM/SA's, as before), under
+"gpmsa", as the centre of "jitter", and for a parameter a given dict leaves out. A value the
+user gives (``init=``, ``theta_init=``, ``fixed=``) is never moved: outside, a GPMSAError.
 
 Fixed parameters and held elements (``problem.fixed_elements``) keep ``problem.init``. With a
 theta constraint (``problem.constraint``),
@@ -29,10 +35,11 @@ Each chain draws its start from its own generator
 from __future__ import annotations
 
 import numpy as np
+from scipy.special import gammainc, gammaincc, gammainccinv, gammaincinv
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import as_float
-from gpmsa.model.priors import GammaPrior, Priors
+from gpmsa.model.priors import PRECISIONS, GammaPrior, Priors
 from gpmsa.model.problem import Problem
 
 CHOICES = ("auto", "gpmsa", "jitter", "prior")
@@ -65,9 +72,9 @@ def chain_starts(
     unknown = sorted(set(init) - set(problem.init))
     if unknown:
         raise GPMSAError(f"init: unknown parameter(s) {unknown}; this model has {problem.names}")
-    firsts = []
+    firsts, base = [], default_start(problem)
     for c in range(len(seeds)):
-        start = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+        start = {k: v.copy() for k, v in base.items()}
         for name in set(init) - problem.fixed:
             shape = problem.init[name].shape
             want = (len(seeds), *shape)
@@ -87,6 +94,57 @@ def chain_starts(
             problem.constraint.check_start(start["theta"], f"init: chain {c}'s theta")
         firsts.append(start)
     return "given", firsts
+
+
+def default_start(problem: Problem) -> dict[str, np.ndarray]:
+    """GPM/SA's start (a copy of ``problem.init``), each element of a sampled precision that
+    lies outside its prior's bounds moved to that prior's median inside them (``inside_median``):
+    GPM/SA's values are defaults, not the user's, and a chain can only start where the prior
+    has density. Every element inside its bounds keeps GPM/SA's value exactly."""
+    out = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+    for name in set(problem.sampled) & set(PRECISIONS):
+        x = out[name].reshape(-1)  # a view: moved in place
+        a, b, lower, upper = problem.priors.gamma_arrays(name, x.size)
+        bad = (x <= lower) | (x >= upper)
+        if bad.any():
+            x[bad] = inside_median(a[bad], b[bad], lower[bad], upper[bad])
+    return out
+
+
+def inside_median(a: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray):
+    """The median of each Gamma(a, rate b) truncated to (lower, upper), from the tail holding
+    less of the prior's mass (where the other's CDF rounds to 1); where that mass underflows,
+    the median of the density's exponential approximation at the bound it piles against
+    (``_edge_median``)."""
+    lo_p, hi_p = gammainc(a, b * lower), gammainc(a, b * upper)
+    lo_q, hi_q = gammaincc(a, b * lower), gammaincc(a, b * upper)
+    upper_tail = lo_p > 0.5
+    with np.errstate(all="ignore"):
+        x = np.where(upper_tail, gammainccinv(a, 0.5 * (lo_q + hi_q)),
+                     gammaincinv(a, 0.5 * (lo_p + hi_p))) / b  # fmt: skip
+    mass = np.where(upper_tail, lo_q > hi_q, hi_p > lo_p)
+    ok = mass & np.isfinite(x) & (x > lower) & (x < upper)
+    return np.where(ok, x, _edge_median(a, b, lower, upper))
+
+
+def _edge_median(a: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray):
+    """Median of a truncated Gamma whose mass inside (lower, upper) underflows: it piles at
+    the bound nearer the mode (a - 1)/b, where the density is ~exp(-s |x - bound|), s = |(a -
+    1)/bound - b|, so ln 2 / s inside that bound; the bounds' geometric middle
+    (``_bounds_middle``) where that is not inside them."""
+    at_upper = np.maximum(a - 1.0, 0.0) / b >= upper
+    edge = np.where(at_upper, upper, lower)
+    with np.errstate(all="ignore"):
+        step = np.log(2.0) / np.abs((a - 1.0) / edge - b)
+        x = np.where(at_upper, edge - step, edge + step)
+    ok = np.isfinite(x) & (x > lower) & (x < upper)
+    return np.where(ok, x, _bounds_middle(a, b, lower, upper))
+
+
+def _bounds_middle(a: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray):
+    """The geometric middle of bounds (lower, upper) (an infinite upper as 10 max(lower, a/b))."""
+    hi = np.where(np.isfinite(upper), upper, 10.0 * np.maximum(lower, a / b))
+    return np.sqrt(np.maximum(lower, 1e-12) * hi)
 
 
 def hold(problem: Problem, name: str, value: np.ndarray) -> np.ndarray:
@@ -113,8 +171,7 @@ def _gamma(pri: Priors, name: str, size: int, rng: np.random.Generator) -> np.nd
             return out
         out[bad] = rng.gamma(a[bad], 1.0 / b[bad])
     # a prior with little mass inside its bounds: the bounds' geometric middle
-    hi = np.where(np.isfinite(upper), upper, 10.0 * np.maximum(lower, a / b))
-    out[bad] = np.sqrt(np.maximum(lower, 1e-12) * hi)[bad]
+    out[bad] = _bounds_middle(a, b, lower, upper)[bad]
     return out
 
 
@@ -131,7 +188,7 @@ def _truncnorm01(mean: float, sd: float, size: int, rng: np.random.Generator) ->
 
 def check_start(problem: Problem, start: dict[str, np.ndarray], how: str) -> None:
     """GPMSAError naming the parameter and its prior when a start lies where that prior has no
-    density (e.g. GPM/SA's start lamUz = 1 outside a prior's bounds (0.3, 0.31)): no chain could
+    density (e.g. a given start lamUz = 0.1 outside a prior's bounds (0.3, inf)): no chain could
     have a finite log posterior there."""
     pri = problem.priors
     for name in problem.sampled:
@@ -145,10 +202,13 @@ def check_start(problem: Problem, start: dict[str, np.ndarray], how: str) -> Non
             elif isinstance(prior, tuple):
                 cells = ", ".join(f"({g.lower:g}, {g.upper:g})" for g in prior)
                 where = f"the bounds of the per-group Priors.{name} [{cells}]"
+            hint = "init='prior', or a fixed= value"
+            if how == "given":  # the user's own value: refused, never moved
+                hint = f"init[{name!r}] inside them, or leave {name} out of init="
             raise GPMSAError(
                 f"the chains' start {name} = {np.ravel(value).tolist()} ({how!r} start) lies "
                 f"outside {where}: zero prior density. Widen the prior's bounds, or start inside "
-                "them (init='prior', or a fixed= value)"
+                f"them ({hint})"
             )
 
 
@@ -156,11 +216,11 @@ def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str
     """One chain's starting values (name -> array of the init's shape) under rule ``how``;
     GPMSAError (``check_start``) for one where a prior has no density."""
     if how == "gpmsa":
-        start = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+        start = default_start(problem)
         check_start(problem, start, how)
         return start
     pri = problem.priors
-    out = {k: np.array(v, dtype=np.float64) for k, v in problem.init.items()}
+    out = default_start(problem)
     for name in problem.sampled:
         x0 = out[name]
         size = x0.size

@@ -22,7 +22,8 @@ def calibration_posterior(emulator) -> Posterior:
     "discrepancy_groups" where there are several groups) and its record of its observations
     ("obs_lengths", "obs_sha256"), so that ``gpmsa.full_prediction(..., posterior=)`` refuses
     other ones, as it does without it, and the emulator's ``model_sha256`` ("emulator_sha256"),
-    so that it refuses another emulator.
+    so that it refuses another emulator; a fit with ``fixed=`` of calibration parameters,
+    "held": the names held (``summary()``'s "held", as ``gpmsa.calibrate`` records them).
 
     Example:
         >>> import numpy as np, gpmsa
@@ -72,4 +73,34 @@ def calibration_posterior(emulator) -> Posterior:
                                               "discrepancy_groups", "obs_lengths", "obs_sha256")
            if k in emulator.settings},
     }  # fmt: skip
+    shapes = {"theta": (len(emulator.t_names),), "lamOs": (1,)}
+    if "lamVz" in cal:
+        shapes.update(betaV=(emulator.p, n_grp), lamVz=(n_grp,))
+    held = fixed_calibration_names(emulator.settings.get("fixed"), emulator.t_names, shapes)
+    if held:  # fixed=: as calibrate records it (Posterior.summary's "held")
+        info["held"] = held
     return Posterior(samples, chains=chains, info=info)
+
+
+def fixed_calibration_names(fixed, t_names, shapes: dict[str, tuple[int, ...]]) -> list[str]:
+    """The posterior names (``calibration_posterior``'s) of the calibration parameters a fit's
+    ``settings["fixed"]`` (``fixed``: name -> values held whole, or {"elements": [index, ...],
+    "values": [...]}) holds, of those in ``shapes`` (name -> shape: theta, lamOs, and with a
+    discrepancy betaV, lamVz); [] for none."""
+    masks = {}
+    for name, shape in shapes.items():
+        rec = (fixed or {}).get(name)
+        if rec is None:
+            continue
+        masks[name] = np.zeros(shape, dtype=bool)
+        if isinstance(rec, dict):
+            for idx in rec.get("elements", ()):
+                masks[name][tuple(idx)] = True
+        else:
+            masks[name][...] = True
+    out = [t_names[k] for k in np.flatnonzero(masks.get("theta", []))]
+    out += ["lamOs"] if masks.get("lamOs", np.zeros(1, bool)).any() else []
+    if "lamVz" in shapes:
+        shown = to_samples(*(masks.get(k, np.zeros(shapes[k], bool)) for k in ("betaV", "lamVz")))
+        out += [k for k, v in shown.items() if v]
+    return out

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from gpmsa.calibration.observations import emulator_record
-from gpmsa.calibration.posterior import Posterior
+from gpmsa.calibration.posterior import Posterior, held_names
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, load
 from gpmsa.io.atomic import atomic_group
@@ -60,14 +60,6 @@ HELD_THETA = "held_theta"
 name -> the native value held, as given; the posterior reports exactly it (as
 ``gpmsa.calibrate`` does), where the unit-scale draws read back through the element's range
 can come back an ulp off."""
-
-
-def held_names(settings: dict) -> set[str]:
-    """The posterior names a study's ``settings["held"]`` lists (fitted or calibrated with
-    ``fixed=``: held, not judged for convergence), its strings only (a file may hold other
-    entries); none without it."""
-    held = settings.get("held")
-    return {h for h in held if isinstance(h, str)} if isinstance(held, list) else set()
 
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
@@ -246,7 +238,8 @@ class Study:
         ``posterior=`` or ``gpmsa.predictive.calibrated_predict``. Its info carries the record of
         the model's observations (a fitted model's "obs_sha256", a calibrated one's
         "obs_values_sha256"), so that ``full_prediction(posterior=)`` refuses other ones, and
-        its emulator's ``model_sha256`` ("emulator_sha256"): another emulator is refused."""
+        its emulator's ``model_sha256`` ("emulator_sha256"): another emulator is refused; with
+        ``fixed=``, "held": its names held (``summary()``'s "held", as ``calibrate``'s)."""
         i = self._member(model)
         chains = self.posterior.chains
         out = {}
@@ -276,6 +269,12 @@ class Study:
             digest = digests.get(self.labels[i]) if isinstance(digests, dict) else None
             if isinstance(digest, str):
                 info[name] = digest
+        held = held_names(self.settings)  # fixed=: under the model's own names, as calibrate's
+        pooled = {n: self.layout.elements[self.layout.index[i][k]].name
+                  for k, n in enumerate(self.members[i].t_names)}  # fmt: skip
+        own = [n for n in out if pooled.get(n, f"{n}[{self.labels[i]}]") in held]
+        if own:
+            info["held"] = own
         return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out, info=info)
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:

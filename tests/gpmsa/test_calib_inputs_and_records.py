@@ -131,7 +131,7 @@ def test_a_masked_array_is_refused_not_unmasked():
 def test_summary_keys_are_unique_and_exact_for_close_levels():
     post = Posterior({"a": np.random.default_rng(0).normal(size=200)})
     assert list(post.summary()["a"]) == ["mean", "sd", "q5", "median", "q95", "n_draws",
-                                         "exact_grid"]  # fmt: skip
+                                         "exact_grid", "held"]  # fmt: skip
     assert {"q2.5", "q97.5"} <= set(post.summary(0.95)["a"])
     row = post.summary(1e-7)["a"]
     assert row["q49.999995"] <= row["median"] <= row["q50.000005"]

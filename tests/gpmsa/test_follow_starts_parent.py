@@ -18,16 +18,18 @@ def _problem(**priors):
 
 @pytest.mark.parametrize("n_jobs", [1, 2])
 def test_an_unreachable_jitter_start_is_a_plain_gpmsa_error_before_any_chain(n_jobs, monkeypatch):
-    """lamWs's jitter range [100, 1e4] misses bounds (1e4, 1e5): before, 'ChainError: chain 0
-    of 2 failed: GPMSAError: ...' raised in a worker; now the GPMSAError itself, no chain run."""
+    """A start outside lamWs's bounds (1e4, 1e5) (once GPM/SA's 1000 under "jitter", which now
+    starts inside them; here a given one): before, 'ChainError: chain 0 of 2 failed:
+    GPMSAError: ...' raised in a worker; now the GPMSAError itself, no chain run."""
     problem = _problem(lamWs=GammaPrior(1.0, 0.0025, 1e4, 1e5))
 
     def launched(*args, **kwargs):
         raise AssertionError("a chain was launched")
 
     monkeypatch.setattr(sampler, "run_chains", launched)
-    with pytest.raises(gpmsa.GPMSAError, match="cannot reach the bounds") as info:
-        sampler.sample(problem, n_iter=5, n_chains=2, init="jitter", seed=0, n_jobs=n_jobs)
+    given = {"lamWs": np.full((2, problem.p_u), 1000.0)}
+    with pytest.raises(gpmsa.GPMSAError, match="lamWs .* outside the bounds") as info:
+        sampler.sample(problem, n_iter=5, n_chains=2, init=given, seed=0, n_jobs=n_jobs)
     assert type(info.value) is gpmsa.GPMSAError
 
 
