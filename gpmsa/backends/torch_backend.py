@@ -46,6 +46,7 @@ from gpmsa.mcmc.sampler import (
     check_step_widths,
     draws_nbytes,
     elements,
+    proportional_step_choice,
     wrong_result,
 )
 from gpmsa.model.data import check_count, check_flag
@@ -686,6 +687,7 @@ def sample(
     chain_groups: int = 1,
     n_jobs: int | None = None,
     executor=None,
+    proportional_steps: bool | None = None,
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
@@ -700,8 +702,10 @@ def sample(
     starts, the widths fit the transient, not the posterior). All chains share the widths.
     ``step_widths`` replace GPM/SA's initial widths (given per chain, as a numpy fit records
     them: each element's median over the chains, which share one set). ``ridge_moves``:
-    nugget-ridge moves per sweep (``gpmsa.mcmc.ridge``). Draws hold every sweep after the
-    warm-up (no burn-in removed).
+    nugget-ridge moves per sweep (``gpmsa.mcmc.ridge``). ``proportional_steps``: the
+    precisions' steps in the warm-up and sampling sweeps, GPM/SA's proportional one (True) or
+    uniform with their widths (False); None: ``not tune``, as the numpy backend's ``sample``.
+    Draws hold every sweep after the warm-up (no burn-in removed).
     ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
     ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
@@ -718,6 +722,7 @@ def sample(
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    prop_mh = proportional_step_choice(proportional_steps, tune)
     check_draws_memory(problem, int(n_iter), int(n_chains))
     if problem.extensions:
         raise GPMSAError(
@@ -729,7 +734,7 @@ def sample(
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,
-                       tune_stages, check_ridge(ridge_moves, problem), where)  # fmt: skip
+                       tune_stages, check_ridge(ridge_moves, problem), where, prop_mh)  # fmt: skip
 
 
 def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torch.dtype) -> None:
@@ -782,8 +787,8 @@ def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_thr
 
 def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
             tune_levels, device, dtype, init, warmup, tune_stages, n_ridge,
-            where) -> Chains:  # fmt: skip
-    """``sample`` without the thread setting."""
+            where, prop_mh: bool) -> Chains:  # fmt: skip
+    """``sample`` without the thread setting (``prop_mh``: its ``proportional_steps``, decided)."""
     dev, dt = _device(device), _dtype(dtype)
     warmup = (WARMUP if tune else 0) if warmup is None else check_count(warmup, "warmup", 0)
     tune_stages = check_count(tune_stages, "tune_stages")
@@ -809,7 +814,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
         for _stage in range(n_stages):
             bar.set_description("torch MCMC: warm-up and tuning" if tune else "torch MCMC: warm-up")
             for _ in range(warmup):  # leave the starts (then the last widths' region) first
-                state.sweep(w, not tune, gen)
+                state.sweep(w, prop_mh, gen)
                 bar.update(1)
             if not (tune and els):
                 break
@@ -822,9 +827,9 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
             w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
         if in_process:
             bar.set_description("torch MCMC: sampling")
-            draws, log_post, accepted = _sweeps(state, w, n_iter, not tune, gen, bar)
+            draws, log_post, accepted = _sweeps(state, w, n_iter, prop_mh, gen, bar)
     if not in_process:
-        draws, log_post, accepted = _grouped_sweeps(state, w, n_iter, not tune, seeds[0], where,
+        draws, log_post, accepted = _grouped_sweeps(state, w, n_iter, prop_mh, seeds[0], where,
                                                     dtype=str(dt).replace("torch.", ""),
                                                     progress=progress)  # fmt: skip
     rate = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
@@ -842,7 +847,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
               "tune_rounds": tune_rounds, "tune_levels": tune_levels, "seed": seed,
               "init": how, "warmup": int(warmup), "tune_stages": n_stages, "starts": start,
               "ridge_moves": state.ridge_moves, "chain_groups": where["groups"],
-              "backend": "torch",
+              "backend": "torch", "proportional_steps": prop_mh,
               "device": str(dev), "dtype": str(dt).replace("torch.", "")},
     )  # fmt: skip
 

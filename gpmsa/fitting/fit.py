@@ -100,7 +100,10 @@ def fit(
     ~0.35 s at 2,000 on a 2-core machine, so tuning alone takes 1 and 6 minutes there;
     ``progress=True`` shows it; None: tune, but for a continuation (``init`` a numpy or torch
     fit's emulator, no ``step_widths``), which runs on with the widths its chains were tuned
-    to, as SEPIA's second ``do_mcmc``; True tunes again from GPM/SA's widths).
+    to, as SEPIA's second ``do_mcmc``; True tunes again from GPM/SA's widths). An untuned
+    continuation steps the precisions as the chains it continues did (``continued_steps``:
+    uniformly with the tuned widths after tuning, as SEPIA, else GPM/SA's proportional step),
+    unless ``proportional_steps`` (a numpy and torch option) is given; settings record it.
     n_burn: sweeps discarded per chain (default n_iter // 5; 0 when ``init`` is an emulator whose
     chains continue). n_keep: retained draws in all
     (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
@@ -189,9 +192,13 @@ def fit(
             step_widths = recorded = continued_widths(resumed, problem, int(n_chains))
     if tune is None:  # only the widths the chains were tuned to run on untuned
         tune = recorded is None
+    steps = None  # the precisions' steps as the chains it continues (SEPIA: once tuned, always)
+    if continuing and not tune and "proportional_steps" not in options:
+        steps = continued_steps(resumed)
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,
+        **({} if steps is None else {"proportional_steps": steps}),
     )  # fmt: skip
     chains.check_finite()
     kept = n_iter - n_burn
@@ -219,6 +226,7 @@ def fit(
     settings = {
         "n_iter": int(n_iter), "n_burn": n_burn, "thin": thin, "n_chains": int(n_chains),
         "tune": bool(tune), "backend": backend, "seed": seed, "point": point,
+        "proportional_steps": chains.info.get("proportional_steps"),  # None: NUTS (pyro)
         "n_pc": int(prep.K.shape[1]), "basis": "pca" if basis is None else "given",
         "joint_obs": obs is not None,
         "obs_lengths": None if obs is None else [int(e.size) for e in obs.experiments],
@@ -421,6 +429,25 @@ def continued_widths(emulator: Emulator, problem: Problem, n_chains: int) -> dic
             f"this fit ({exc}); pass step_widths= or tune=True"
         ) from None
     return record
+
+
+def continued_steps(emulator: Emulator) -> bool | None:
+    """Whether ``emulator``'s chains stepped the precisions by GPM/SA's proportional step (its
+    ``settings["proportional_steps"]``; a file written before that was recorded: ``not
+    settings["tune"]``, the rule its sampler followed), for its untuned continuation; None where
+    its backend is not a Metropolis one (``MH_BACKENDS``). GPMSAError naming a damaged record."""
+    settings = emulator.settings or {}
+    if settings.get("backend") not in MH_BACKENDS:
+        return None
+    steps = settings.get("proportional_steps")
+    if steps is None and isinstance(settings.get("tune"), bool):
+        steps = not settings["tune"]
+    if steps is not None and not isinstance(steps, bool):
+        raise GPMSAError(
+            f"init=emulator: its settings['proportional_steps'] must be true, false or null, got "
+            f"{steps!r}; pass proportional_steps= or tune=True"
+        )
+    return steps
 
 
 def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:

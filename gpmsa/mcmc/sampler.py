@@ -4,7 +4,9 @@ Each sweep updates every scalar element of the sampled parameters once, in the o
 betaV, betaU, lamVz, lamUz, lamWs, lamWOs, lamOs (betaU element order: input index fastest, as
 GPM/SA's column-major loop). Proposals: uniform random walk (theta; beta on the rho = exp(-beta/4)
 scale; precisions). Untuned precisions use GPM/SA's proportional step (width max(1, x/3)) with its
-Hastings correction. A proposal outside the prior bounds is rejected without a likelihood call.
+Hastings correction (``sample``'s ``proportional_steps`` chooses; a continuation of a tuned fit
+steps them uniformly with its tuned widths, as SEPIA). A proposal outside the prior bounds is
+rejected without a likelihood call.
 Where it applies (one basis component, no observations) each sweep ends with moves along the
 lamWs/lamWOs nugget ridge (``gpmsa.mcmc.ridge``; not in GPM/SA, ``ridge_moves=0`` turns them off).
 Several chains run as parallel tasks (``gpmsa.mcmc.parallel``), each on its own seed.
@@ -310,6 +312,18 @@ def check_draws_memory(problem: Problem, n_iter: int, n_chains: int) -> None:
                  f"{parameter_elements(problem)} parameter elements")  # fmt: skip
 
 
+def proportional_step_choice(proportional_steps, tune: bool) -> bool:
+    """Whether the precisions take GPM/SA's proportional step: ``proportional_steps`` (True or
+    False), or None: ``not tune`` (GPM/SA's and SEPIA's rule). GPMSAError naming another value."""
+    if proportional_steps is None:
+        return not tune
+    if not isinstance(proportional_steps, (bool, np.bool_)):
+        raise GPMSAError(
+            f"proportional_steps must be None (not tune), True or False, got {proportional_steps!r}"
+        )
+    return bool(proportional_steps)
+
+
 def check_ridge(ridge_moves, problem: Problem) -> int:
     """Moves along the nugget ridge per sweep: ``ridge_moves`` (None: the default where the move
     applies), 0 where it does not apply; GPMSAError for a value that is not an integer in
@@ -394,8 +408,10 @@ def run_chain(
     desc: str = "MCMC",
     start: dict[str, np.ndarray] | None = None,
     ridge_moves: int = 0,
+    proportional_steps: bool | None = None,
 ) -> tuple[dict[str, np.ndarray], np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
-    """Tune (optionally), then ``n_iter`` sweeps from ``start`` (default ``problem.init``).
+    """Tune (optionally), then ``n_iter`` sweeps from ``start`` (default ``problem.init``), the
+    precisions by GPM/SA's proportional step where ``proportional_steps`` (None: ``not tune``).
 
     Returns draws, log_post, accept rates, widths. GPMSAError when the start's log posterior is
     NaN (no proposal could ever be accepted).
@@ -422,7 +438,7 @@ def run_chain(
         draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
         log_post = np.empty(n_iter)
         accepted = np.zeros(len(els))
-        prop_mh = not tune
+        prop_mh = (not tune) if proportional_steps is None else proportional_steps
         names = problem.names
         for it in range(n_iter):
             state.sweep(w, prop_mh, accepted)
@@ -446,6 +462,7 @@ def _chain_task(
     problem: Problem, n_iter: int, tune: bool, widths: dict[str, np.ndarray],
     seed: np.random.SeedSequence, start: dict[str, np.ndarray], tune_rounds: int,
     tune_levels: int, ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
+    proportional_steps: bool | None = None,
 ):  # fmt: skip
     """One chain from plain data (run in a worker process): ``run_chain`` from ``start`` (drawn
     by ``sample`` in the parent), its generator from ``seed``; ``run_chain``'s result."""
@@ -453,7 +470,7 @@ def _chain_task(
         return run_chain(
             problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
             tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress, desc=desc,
-            start=start, ridge_moves=ridge_moves,
+            start=start, ridge_moves=ridge_moves, proportional_steps=proportional_steps,
         )  # fmt: skip
 
 
@@ -486,6 +503,7 @@ def sample(
     n_jobs: int | None = None,
     executor=None,
     ridge_moves: int | None = None,
+    proportional_steps: bool | None = None,
 ) -> Chains:
     """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
 
@@ -502,11 +520,15 @@ def sample(
     dispersed ones for several; a dict name -> (n_chains, *shape) gives them).
     ``ridge_moves``: moves along the lamWs/lamWOs nugget ridge per sweep (``gpmsa.mcmc.ridge``;
     None: ``ridge.N_MOVES`` where the move applies, a simulation-only problem with one basis
-    component; 0: GPM/SA's sweep alone). Raises ChainError naming a
+    component; 0: GPM/SA's sweep alone). ``proportional_steps``: the precisions (lamVz, lamUz,
+    lamWs, lamWOs, lamOs) step by GPM/SA's proportional step, width max(1, x/3) whatever their
+    step widths (True), or uniformly with their widths (False); None: ``not tune``, as GPM/SA
+    and SEPIA (``info["proportional_steps"]`` records it). Raises ChainError naming a
     chain that failed or whose draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    prop_mh = proportional_step_choice(proportional_steps, tune)
     check_draws_memory(problem, int(n_iter), int(n_chains))
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     seq = np.random.SeedSequence(seed)
@@ -519,7 +541,7 @@ def sample(
     tasks = [
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": w, "seed": s,
          "start": first, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
-         "ridge_moves": n_ridge}
+         "ridge_moves": n_ridge, "proportional_steps": prop_mh}
         for s, first, w in zip(seeds, firsts, widths, strict=True)
     ]  # fmt: skip
     names = problem.names
@@ -536,7 +558,7 @@ def sample(
         step_widths={n: np.stack([r[3][n] for r in runs]) for n in names},
         info={"n_iter": n_iter, "n_chains": n_chains, "tune": tune, "tune_rounds": tune_rounds,
               "tune_levels": tune_levels, "seed": seed, "seed_entropy": str(seq.entropy),
-              "init": how, "ridge_moves": n_ridge,
+              "init": how, "ridge_moves": n_ridge, "proportional_steps": prop_mh,
               "starts": {n: np.stack([first[n] for first in firsts]) for n in names},
               "backend": "numpy"},
     )  # fmt: skip
