@@ -130,7 +130,7 @@ def _mcmc_backend(backend, options) -> str:
     if not isinstance(options, dict) or "backend" not in options:
         return backend
     given = options["backend"]
-    if given == backend or backend == "numpy":
+    if backend == "numpy" or (isinstance(given, str) and given == backend):
         return given
     raise GPMSAError(
         f"backend={backend!r} and mcmc_options['backend']={given!r} disagree: give the "

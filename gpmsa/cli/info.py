@@ -166,8 +166,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
             for key, fmt in (("mean", ".4g"), ("ess", ".0f"), ("rhat", ".3f")):
                 vals = d.get(key, [])
                 cells[key] = (
-                    ", ".join("held" if key != "mean" and k in held else number(v, fmt)
-                              for k, v in enumerate(vals) if v is not None or k in held)
+                    _cells(vals, fmt, held if key != "mean" else set())
                     if isinstance(vals, list) else value(vals)
                 )  # fmt: skip
             label = safe(name, 60)
@@ -246,6 +245,16 @@ def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str
     native = standardizer.t_from_unit(unit)[0]
     cells = [f"{safe(n, 60)}={number(float(v), '.4g')}" for n, v in zip(names, native, strict=True)]
     return "theta (native)", ", ".join(cells)
+
+
+def _cells(vals: list, fmt: str, held: set[int]) -> str:
+    """A diagnostic's values, one cell per element in its place: "held" at ``held``'s
+    positions, "nan" for a value stored as null (non-finite) among others; none where every
+    value is null (a diagnostic one chain cannot give)."""
+    if all(v is None for k, v in enumerate(vals) if k not in held):
+        return ", ".join("held" for k in range(len(vals)) if k in held)
+    return ", ".join("held" if k in held else "nan" if v is None else number(v, fmt)
+                     for k, v in enumerate(vals))  # fmt: skip
 
 
 def _held_positions(record: object, shape, size: int) -> set[int]:

@@ -288,12 +288,7 @@ class Study:
         of ``member_posterior(LABEL).summary(level)`` under its own names. "held": True for a
         parameter held with ``fixed=`` (every draw its value: sd 0, ESS and R-hat NaN), as
         ``gpmsa info`` prints it."""
-        out = self.posterior.summary(level)
-        held = held_names(self.settings)
-        for name, entry in out.items():
-            draws = self.posterior.samples[name]
-            entry["held"] = bool(name in held and draws.min() == draws.max())
-        return out
+        return self.posterior.summary(level)  # its info holds the settings' "held"
 
     def to_arviz(self):
         """ArviZ InferenceData of the pooled posterior (arviz imported lazily): every name of
