@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import math
 import warnings
 from dataclasses import dataclass
 from functools import cache
@@ -38,6 +39,11 @@ x (over the whole theta domain) lies outside what the emulator has seen: a warni
 LEVEL_PROBE_NODES = 1089
 """About how many theta values `outside_at_levels` predicts at in one call (`theta_probe`'s
 most: 33 x 33), so that many combinations of levels cost time, not memory."""
+LEVEL_PROBE_BUDGET = 8 * LEVEL_PROBE_NODES
+"""Most theta values `outside_at_levels` looks at (8,712: eight of `theta_probe`'s largest
+probe): with many combinations of levels the continuous parameters are probed more coarsely
+(`continuous_probe`), and with more combinations than this the check is `theta_probe`'s, as
+for a continuous theta (off the levels: weaker)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -483,18 +489,48 @@ def _distances(mean: np.ndarray, cov: np.ndarray, data: Observations) -> tuple:
     return resid, var, dist, bool(np.ndim(noise) == 0 and noise == 0.0)
 
 
+def continuous_probe(n_cont: int, n_combos: int):
+    """(nodes (k, n_cont), grid shape or None) at which `level_probe_blocks` probes the
+    continuous parameters for ``n_combos`` combinations of levels: `theta_probe`'s where
+    n_combos x k is within `LEVEL_PROBE_BUDGET`, else the finest coarser one that is (one or
+    two parameters: 33, 9, 3 nodes an axis; more: the 3^n lattice of corners, edge midpoints
+    and centre), else the centre alone; None where even that is over the budget."""
+    if n_cont == 0:
+        candidates = [(np.zeros((1, 0)), None)]
+    else:
+        full = theta_probe(n_cont)
+        candidates = [(full, probe_layout(n_cont))]
+        if n_cont <= 2:
+            for n in (33, 9, 3):
+                if n < probe_layout(n_cont)[0]:
+                    axes = np.meshgrid(*[np.linspace(0.0, 1.0, n)] * n_cont, indexing="ij")
+                    candidates.append((np.column_stack([a.ravel() for a in axes]), (n,) * n_cont))
+        else:
+            candidates.append((full[: 3 ** min(n_cont, 6)], None))  # theta_probe's lattice
+        candidates.append((np.full((1, n_cont), 0.5), None))
+    for base, layout in candidates:
+        if n_combos * base.shape[0] <= LEVEL_PROBE_BUDGET:
+            return base, layout
+    return None
+
+
 def level_probe_blocks(levels: list, nodes: int = LEVEL_PROBE_NODES):
     """The theta values at which `outside_at_levels` looks, for a categorical theta (``levels``:
     per parameter its unit-scale levels, None for a continuous one): every combination of the
-    categorical parameters' levels, each crossed with `theta_probe`'s nodes of the continuous
-    ones (one node without them). Yields (theta (b k, q), b, layout): b combinations of k nodes
-    each, about ``nodes`` in all (at least one combination), and the continuous nodes' grid
-    shape (`probe_layout`; None without continuous parameters or for scattered nodes)."""
+    categorical parameters' levels, each crossed with the continuous ones' nodes
+    (`continuous_probe`: `theta_probe`'s, coarser for many combinations; one node without
+    them). Yields (theta (b k, q), b, layout): b combinations of k nodes each, about ``nodes``
+    in all (at least one combination), and the continuous nodes' grid shape (`probe_layout`;
+    None without continuous parameters or for scattered nodes). Yields nothing where the
+    combinations alone exceed `LEVEL_PROBE_BUDGET`."""
     q = len(levels)
     cont = [k for k in range(q) if levels[k] is None]
     cat = [k for k in range(q) if levels[k] is not None]
-    base = theta_probe(len(cont)) if cont else np.zeros((1, 0))
-    layout = probe_layout(len(cont)) if cont else None
+    n_combos = math.prod(len(levels[k]) for k in cat)
+    probe = continuous_probe(len(cont), n_combos)
+    if probe is None:
+        return
+    base, layout = probe
     combos = np.array(list(itertools.product(*[levels[k] for k in cat])), dtype=float)
     step = max(1, nodes // base.shape[0])
     for start in range(0, combos.shape[0], step):
@@ -505,16 +541,18 @@ def level_probe_blocks(levels: list, nodes: int = LEVEL_PROBE_NODES):
         yield theta, chunk.shape[0], layout
 
 
-def outside_at_levels(predict, data: Observations, levels: list) -> float:
+def outside_at_levels(predict, data: Observations, levels: list) -> float | None:
     """``Fit.outside_sds`` for a categorical theta, which takes its levels only: over
     `level_probe_blocks` (``predict(x, theta)``: ``FixedGP.predict``), in chunks. Off its levels
     the predictive mean is no level's (the kernel's other-level correlation) and its sd about
     the prior's, so `theta_probe`'s nodes there read an observation that no level explains as
     within a few sds. A datum judged on its own is met where its residual changes sign between
     neighbouring continuous nodes of one combination of levels (`fit_of`'s rule), never
-    between levels."""
-    nearest, best = None, np.inf
+    between levels. None where the combinations of levels exceed `LEVEL_PROBE_BUDGET`
+    (`level_probe_blocks` yields none)."""
+    nearest, best, looked = None, np.inf, False
     for theta, b, layout in level_probe_blocks(levels):
+        looked = True
         mean, cov = predict(data.x, theta)
         resid, _, dist, alone = _distances(mean, cov, data)
         if not alone:
@@ -527,6 +565,8 @@ def outside_at_levels(predict, data: Observations, levels: list) -> float:
                 near[i, _crossed(resid[i * k : (i + 1) * k], layout)] = 0.0
         near = np.min(near, axis=0)
         nearest = near if nearest is None else np.minimum(nearest, near)
+    if not looked:
+        return None
     return best if nearest is None else float(np.max(nearest))
 
 

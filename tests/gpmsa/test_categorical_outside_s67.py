@@ -15,7 +15,14 @@ import pytest
 
 import gpmsa
 from gpmsa.calibration.calibrate import observation_fit
-from gpmsa.calibration.observations import OUTSIDE_SDS, level_probe_blocks, reduce
+from gpmsa.calibration.observations import (
+    LEVEL_PROBE_BUDGET,
+    OUTSIDE_SDS,
+    continuous_probe,
+    level_probe_blocks,
+    outside_at_levels,
+    reduce,
+)
 from gpmsa.errors import OutsideEmulatorWarning
 
 X_OBS = np.linspace(0.1, 0.9, 5)[:, None]
@@ -87,3 +94,32 @@ def test_the_level_probe_is_every_combination_crossed_with_the_continuous_nodes(
     assert {tuple(r) for c in chunks for r in c[0]} == {
         (a, b) for a in (0.0, 0.5, 1.0) for b in np.linspace(0, 1, 7)
     }
+
+
+def test_many_combinations_of_levels_stay_within_the_probe_budget():
+    """10 x 10 levels beside two continuous parameters asked 108,900 predictions (5 s at 200
+    runs; 20^3 levels 70 s): the continuous nodes get coarser so that the whole probe stays
+    within LEVEL_PROBE_BUDGET, and beyond it the check is theta_probe's (review, session 67)."""
+    ten = tuple(np.linspace(0, 1, 10))
+    blocks = list(level_probe_blocks([ten, ten, None, None]))
+    n = sum(b[0].shape[0] for b in blocks)
+    assert n <= LEVEL_PROBE_BUDGET and blocks[0][2] == (9, 9) and sum(b[1] for b in blocks) == 100
+    twenty = tuple(np.linspace(0, 1, 20))
+    blocks = list(level_probe_blocks([twenty, twenty, twenty, None]))
+    assert sum(b[0].shape[0] for b in blocks) == 8000 and blocks[0][2] is None
+    np.testing.assert_array_equal(np.vstack([b[0] for b in blocks])[:, 3], 0.5)  # the centre
+    assert list(level_probe_blocks([twenty, twenty, twenty, (0.0, 1.0)])) == []
+    base, layout = continuous_probe(1, 3)
+    assert base.shape == (129, 1) and layout == (129,)  # few levels: theta_probe's, unchanged
+
+
+def test_too_many_combinations_fall_back_to_the_continuous_probe():
+    levels = [tuple(np.linspace(0, 1, 20))] * 3 + [(0.0, 1.0)]
+    assert outside_at_levels(None, None, levels) is None  # nothing predicted
+    rng = np.random.default_rng(0)
+    x = rng.random(63)  # three parameters of 21 levels: 9,261 combinations, over the budget
+    t = np.column_stack([np.arange(63) % 21, (np.arange(63) // 3) % 21, rng.integers(0, 21, 63)])
+    sim = gpmsa.SimData(x, t, x + 0.05 * t[:, 0], t_categorical=[0, 1, 2])
+    emu = gpmsa.Emulator.from_params(sim, {"betaU": [[1.0]] * 4, **PARAMS})
+    post = gpmsa.calibrate(emu, X_OBS, X_OBS[:, 0] + 0.5, n_samples=20, n_burn=5, seed=0)
+    assert np.isfinite(post.info["outside_sds"])  # theta_probe's, as before session 67
