@@ -11,12 +11,22 @@ import numpy as np
 from gpmsa import backends
 from gpmsa._version import library_versions
 from gpmsa.errors import GPMSAError
+from gpmsa.fitting.continuation import (
+    MH_BACKENDS,
+    appended_record,
+    appended_thin,
+    check_append,
+    continued_starts,
+    continued_steps,
+    continued_widths,
+    pool_accept,
+    pool_draws,
+)
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.mcmc.sampler import (
-    check_step_widths,
     draws_nbytes,
     parameter_elements,
     sweeps_nbytes,
@@ -39,16 +49,20 @@ def _factor_nbytes(m: int, p: int, q: int, p_u: int) -> float:
     return 8.0 * m * m * (p + q + 4 * p_u + 2)
 
 
-def _check_fit_memory(problem, n_iter: int, n_chains: int) -> None:
+def _check_fit_memory(problem, n_iter: int, n_chains: int, pooled: int = 0) -> None:
     """Refuse (before sampling) a fit whose draws or factorisations exceed the memory limit:
     every sweep of every chain is stored (n_chains x n_iter x parameter elements, kept twice
-    while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats."""
+    while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats;
+    ``pooled``: the retained draws of an appended fit (``append=True``), source's and its own,
+    held three times (the parts, the pooled arrays, the emulator's read-only copies)."""
     m = problem.m
     nbytes = draws_nbytes(problem, n_iter, n_chains) + _factor_nbytes(
         m, problem.p, problem.q, problem.p_u
     )
+    nbytes += 1.5 * sweeps_nbytes(parameter_elements(problem), pooled, 1)
+    what = f" appending to {pooled} retained draws" if pooled else ""
     check_memory(nbytes, f"fit(n_iter={n_iter}, n_chains={n_chains}) of {m} runs x "
-                 f"{parameter_elements(problem)} parameter elements")  # fmt: skip
+                 f"{parameter_elements(problem)} parameter elements{what}")  # fmt: skip
 
 
 def simulation_fit_nbytes(
@@ -75,7 +89,7 @@ def fit(
     priors: Priors | None = None,
     *,
     n_burn: int | None = None,
-    n_keep: int = N_KEEP,
+    n_keep: int | None = None,
     point: str = "mean",
     n_pc: int | float | None = None,
     basis=None,
@@ -89,6 +103,7 @@ def fit(
     fixed: dict | None = None,
     constraint=None,
     theta_init=None,
+    append: bool = False,
     **options,
 ) -> Emulator:
     """Fit the emulator by GPM/SA's Metropolis-within-Gibbs; returns an ``Emulator``.
@@ -105,13 +120,21 @@ def fit(
     uniformly with the tuned widths after tuning, as SEPIA, else GPM/SA's proportional step),
     unless ``proportional_steps`` (a numpy and torch option) is given; settings record it.
     n_burn: sweeps discarded per chain (default n_iter // 5; 0 when ``init`` is an emulator whose
-    chains continue). n_keep: retained draws in all
-    (evenly thinned). point: "mean" (posterior mean, default) or "map" (the draw of highest log
-    posterior) for ``Emulator.params``. n_pc: basis size, or a variance fraction in (0, 1)
-    (SEPIA's n_pc < 1; default 99.5%). basis: instead of the runs' PCA, a given basis
-    (l_sim, p_u), columns the orthogonal basis vectors on the simulation grid in standardised
-    output units (GPM/SA's ``Ksim``; ``gpmsa.BasisWarning`` when its weights' scale is not
-    the one lamUz's prior expects; docs/categorical-and-constraints.md).
+    chains continue). n_keep: retained draws in all (evenly thinned; None: 1,000, ``N_KEEP``).
+    append: with ``init`` an emulator, return its retained draws followed, chain by chain, by
+    this continuation's, thinned by its step (``settings["thin"]``: the continuation keeps its
+    sweeps thin, 2 thin, ... after each chain's last kept draw, so each pooled chain is evenly
+    spaced in sweeps), as SEPIA's second ``do_mcmc`` and GPM/SA's ``gpmmcmc(pout, n)``; point
+    estimate, diagnostics and convergence over the pooled retained draws; settings
+    "appended_to" (the source's ``model_sha256``), "appended_after" (its draws per chain),
+    "pooled_sweeps" and "sweeps_run" (per chain, after burn-in and in all). It refuses (naming
+    the argument) n_burn > 0, tuning (numpy, torch), an n_keep other than the draws the step
+    keeps, and ``init`` not an emulator. point: "mean" (posterior mean, default) or "map" (the
+    draw of highest log posterior) for ``Emulator.params``. n_pc: basis size, or a variance
+    fraction in (0, 1) (SEPIA's n_pc < 1; default 99.5%). basis: instead of the runs' PCA, a
+    given basis (l_sim, p_u), columns the orthogonal basis vectors on the simulation grid in
+    standardised output units (GPM/SA's ``Ksim``; ``gpmsa.BasisWarning`` when its weights'
+    scale is not the one lamUz's prior expects; docs/categorical-and-constraints.md).
     discrepancy: None, "constant", "linear", an (l_obs, p_v) array on the grid every
     experiment shares, or a list of one (l_j, p_v) array per experiment on its own index grid
     (SEPIA's ``create_D_basis(D_obs=[...])``, GPM/SA's per-experiment ``Dobs``; normalised
@@ -154,10 +177,14 @@ def fit(
     """
     n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
     continuing = isinstance(options.get("init"), Emulator)  # its chains start past burn-in
+    append = check_append(append, options.get("init"), n_burn)
     default_burn = 0 if continuing else n_iter // 5
     n_burn = default_burn if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     check_point(point)
-    n_keep = check_keep(n_keep, n_chains)
+    thin = None  # append: the source's step
+    if append:
+        thin = appended_thin(options["init"], int(n_iter), int(n_chains), n_keep)
+    n_keep = check_keep(N_KEEP if n_keep is None else n_keep, n_chains)
     tune = None if tune is None else check_flag(tune, "tune")
     progress = check_flag(progress, "progress")
     metadata = check_metadata(metadata)
@@ -173,7 +200,8 @@ def fit(
                    mean_basis=mean_basis, discrepancy_groups=discrepancy_groups,
                    basis=basis)  # fmt: skip
     problem = _model_options(prep, data, fixed, constraint, theta_init)
-    _check_fit_memory(problem, int(n_iter), int(n_chains))
+    pooled = options["init"].n_draws + int(n_chains) * (n_iter // thin) if append else 0
+    _check_fit_memory(problem, int(n_iter), int(n_chains), pooled)
     reserved = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress", "n_jobs",
                 "executor")  # fmt: skip
     backends.check_options(backend, options, reserved, "fit")
@@ -192,6 +220,13 @@ def fit(
             step_widths = recorded = continued_widths(resumed, problem, int(n_chains))
     if tune is None:  # only the widths the chains were tuned to run on untuned
         tune = recorded is None
+    if append and tune and backend in MH_BACKENDS:
+        raise GPMSAError(
+            "append=True pools the chains' draws evenly spaced in sweeps; tuning (tune=True, "
+            "or tune=None where init=emulator records no Metropolis step widths) would run "
+            "1,000 sweeps between the source's and the continuation's: pass tune=False (and "
+            "step_widths= to choose the widths)"
+        )
     steps = None  # the precisions' steps as the chains it continues (SEPIA: once tuned, always)
     if continuing and not tune and "proportional_steps" not in options:
         steps = continued_steps(resumed)
@@ -202,17 +237,20 @@ def fit(
     )  # fmt: skip
     chains.check_finite()
     kept = n_iter - n_burn
-    thin = thinning(n_chains, kept, n_keep)  # each chain keeps ceil(kept / thin)
+    first = 0  # append: sweep thin - 1 lies thin sweeps after the source's last kept draw
+    if append:
+        first = thin - 1
+    else:
+        thin = thinning(n_chains, kept, n_keep)  # each chain keeps ceil(kept / thin)
     # float64 whatever the backend sampled in (torch float32), a fixed parameter exactly at its
     # value
     post = {k: np.asarray(v[:, n_burn:], dtype=float) for k, v in chains.draws.items()}
     for k, mask in problem.held_masks(post).items():
         post[k][:, :, mask] = problem.init[k][mask]
     lp = chains.log_post[:, n_burn:]
-    lp_kept = lp[:, ::thin].reshape(-1)
+    lp_kept = lp[:, first::thin].reshape(-1)
     n_kept = lp_kept.size  # explicit: an empty parameter (betaV when p = 0) has no -1 to infer
-    retained = {k: v[:, ::thin].reshape(n_kept, *v.shape[2:]) for k, v in post.items()}
-    params = point_estimate(retained, lp_kept, point)
+    retained = {k: v[:, first::thin].reshape(n_kept, *v.shape[2:]) for k, v in post.items()}
     calibration = None
     if obs is not None:
         calibration = {k: v for k, v in retained.items() if k not in EMULATOR_PARAMS}
@@ -223,6 +261,11 @@ def fit(
         for k, v in fit_held_native(problem, fixed, data.t_names).items():
             native[:, k] = v  # exactly the value given (as gpmsa.calibrate)
         calibration["theta_native"] = native
+    if append:
+        retained, lp_kept, calibration = pool_draws(
+            resumed, retained, lp_kept, calibration, int(n_chains)
+        )
+    params = point_estimate(retained, lp_kept, point)
     settings = {
         "n_iter": int(n_iter), "n_burn": n_burn, "thin": thin, "n_chains": int(n_chains),
         "tune": bool(tune), "backend": backend, "seed": seed, "point": point,
@@ -234,6 +277,7 @@ def fit(
         "discrepancy": discrepancy_kind(discrepancy),
         "init": chains.info.get("init", "gpmsa"),
         **({"continued_from": resumed.model_sha256} if continuing else {}),
+        **(appended_record(resumed, int(n_iter), int(n_chains)) if append else {}),
         # n_jobs and executor say where the chains ran, not what they were: not recorded
         "backend_options": backends.recorded_options(
             {k: v for k, v in options.items() if k not in ("n_jobs", "executor")}
@@ -247,17 +291,23 @@ def fit(
     }  # fmt: skip
     if obs is not None and discrepancy is not None:  # full_prediction refuses another basis
         settings.update(discrepancy_record(problem.obs))
-    summary = summarize(post, chains.accept_rate)
+    if append:  # the source's sweeps are gone: its retained draws and these, as pooled
+        per = lp_kept.size // n_chains
+        summary = summarize({k: v.reshape(n_chains, per, *v.shape[1:])
+                             for k, v in retained.items()})  # fmt: skip
+        pool_accept(summary, resumed, chains.accept_rate, int(n_iter), backend)
+    else:
+        per = kept
+        summary = summarize(post, chains.accept_rate)
     record = None
     if n_chains > 1:
         shapes = {k: problem.init[k].shape for k in problem.sampled}
         held = {per_element.label(k, i) for k, v in problem.fixed_elements.items() for i in v}
-        record = convergence(summary, shapes, n_chains, kept, held=held)
-        warn_unconverged(
-            record,
-            f"gpmsa.fit (backend {backend!r})",
-            more=", or continue these: gpmsa.fit(..., init=the returned emulator)",
-        )
+        record = convergence(summary, shapes, n_chains, per, held=held)
+        how = "append more: gpmsa.fit(..., init=the returned emulator, append=True)"
+        if not append:
+            how = "continue these: gpmsa.fit(..., init=the returned emulator)"
+        warn_unconverged(record, f"gpmsa.fit (backend {backend!r})", more=f", or {how}")
     return Emulator._from_prepared(
         data, prep, params,
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,
@@ -354,131 +404,3 @@ def fit_held_native(problem: Problem, fixed, t_names) -> dict[int, float]:
     if not isinstance(fixed, dict) or "theta" not in fixed or problem.obs is None:
         return {}
     return per_element.held_native(fixed["theta"], t_names, problem.theta_levels)
-
-
-def continued_starts(
-    emulator: Emulator, problem: Problem, K: np.ndarray, obs: ObsData | None, n_chains: int
-) -> dict[str, np.ndarray]:
-    """Each chain's start at its last kept draw in ``emulator`` (a fit of the same data, and
-    observations for a joint fit, with ``n_chains`` chains): name -> (n_chains, *shape), for a
-    backend's ``init``. Its chains continue where they stopped being recorded (a draw of each
-    chain, not a fresh dispersed start): a fit that warned of R-hat or ESS runs on without
-    starting over. GPMSAError naming what differs."""
-    if not emulator.draws or not emulator.log_post.size:
-        raise GPMSAError("init=emulator continues a fit's chains; this emulator has no draws "
-                         "(Emulator.from_params?)")  # fmt: skip
-    settings = emulator.settings or {}
-    n_prev = int(settings.get("n_chains", 1) or 1)
-    if n_prev != n_chains:
-        raise GPMSAError(f"init=emulator continues its {n_prev} chain(s): pass n_chains={n_prev}")
-    same = (emulator.x_unit.shape == problem.x_sim.shape and emulator.K.shape == K.shape
-            and np.array_equal(emulator.x_unit, problem.x_sim)
-            and np.array_equal(emulator.t_unit, problem.t_sim)
-            and np.allclose(emulator.w, problem.w, rtol=0.0, atol=1e-12))  # fmt: skip
-    if not same:
-        raise GPMSAError(
-            "init=emulator was fitted to other simulation runs (or another n_pc or basis)"
-        )
-    cal = emulator.calibration or {}
-    if (obs is None) != (not cal):
-        raise GPMSAError(
-            "init=emulator is a joint fit: pass its observations (obs=)" if cal else
-            "init=emulator is a simulator-only fit; a joint fit (obs=) starts its own chains"
-        )  # fmt: skip
-    if obs is not None and settings.get("obs_sha256") not in (None, obs.digest()):
-        raise GPMSAError("init=emulator was fitted jointly with other observations")
-    differs = _model_differences(emulator, problem)
-    if differs:
-        raise GPMSAError(
-            f"init=emulator was another model: its {', '.join(differs)} differ from this fit's; "
-            "continue it with the same settings, or start afresh"
-        )
-    per = emulator.log_post.size // n_chains
-    last = np.arange(1, n_chains + 1) * per - 1  # kept draws are stored chain after chain
-    out = {}
-    for name, init in problem.init.items():
-        source = emulator.draws if name in EMULATOR_PARAMS else cal
-        if name not in source or np.shape(source[name])[1:] != init.shape:
-            raise GPMSAError(
-                f"init=emulator has no {name} of shape {init.shape} (another discrepancy basis, "
-                "groups or model?)"
-            )
-        out[name] = np.array(source[name][last], dtype=np.float64)
-    return out
-
-
-MH_BACKENDS = ("numpy", "torch")
-"""Backends whose recorded ``step_widths`` are GPM/SA's Metropolis widths (a continuation runs
-on with them)."""
-
-
-def continued_widths(emulator: Emulator, problem: Problem, n_chains: int) -> dict | None:
-    """The step widths ``emulator``'s chains ran with (``settings["step_widths"]``, per chain),
-    for its continuation; None where it recorded none or its backend's are not Metropolis widths
-    (``MH_BACKENDS``; pyro records its NUTS step size there). GPMSAError where the record does
-    not fit ``problem``'s chains and parameters (a damaged file)."""
-    settings = emulator.settings or {}
-    record = settings.get("step_widths")
-    if not record or settings.get("backend") not in MH_BACKENDS:
-        return None
-    try:
-        check_step_widths(record, problem, n_chains)
-    except GPMSAError as exc:
-        raise GPMSAError(
-            f"init=emulator: its recorded step widths (settings['step_widths']) do not fit "
-            f"this fit ({exc}); pass step_widths= or tune=True"
-        ) from None
-    return record
-
-
-def continued_steps(emulator: Emulator) -> bool | None:
-    """Whether ``emulator``'s chains stepped the precisions by GPM/SA's proportional step (its
-    ``settings["proportional_steps"]``; a file written before that was recorded: ``not
-    settings["tune"]``, the rule its sampler followed), for its untuned continuation; None where
-    its backend is not a Metropolis one (``MH_BACKENDS``). GPMSAError naming a damaged record."""
-    settings = emulator.settings or {}
-    if settings.get("backend") not in MH_BACKENDS:
-        return None
-    steps = settings.get("proportional_steps")
-    if steps is None and isinstance(settings.get("tune"), bool):
-        steps = not settings["tune"]
-    if steps is not None and not isinstance(steps, bool):
-        raise GPMSAError(
-            f"init=emulator: its settings['proportional_steps'] must be true, false or null, got "
-            f"{steps!r}; pass proportional_steps= or tune=True"
-        )
-    return steps
-
-
-def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
-    """What of the model ``emulator`` was fitted with differs from ``problem``'s: its priors,
-    mean basis, fixed parameters, theta constraint and discrepancy basis and groups."""
-    settings = emulator.settings or {}
-    mb = problem.mean_basis
-    disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
-    n_grp = problem.obs.n_groups if problem.obs is not None and problem.obs.p_v else 0
-    checks = {
-        "priors": (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp)),
-        "mean_basis": (settings.get("mean_basis"), None if mb is None else mb.kind),
-        "fixed parameters": (settings.get("fixed", {}), fixed_record(problem)),
-        "theta constraint": (bool(settings.get("constraint", False)),
-                             problem.constraint is not None),
-        "discrepancy": ({k: settings.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")},
-                        {k: disc.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")}),
-    }  # fmt: skip
-    return [name for name, (old, new) in checks.items() if old != new]
-
-
-def _prior_record(priors: Priors, n_grp: int) -> dict:
-    """``priors.to_dict()`` with lamVz as the list of the ``n_grp`` groups' priors and rhoV_a,
-    rhoV_b as the lists of the groups' betaV Beta parameters (a shared prior, equal per-group
-    ones and, for betaV, none (betaU's) are one model); as written without a discrepancy, or
-    where the per-group priors do not fit the groups."""
-    out = priors.to_dict()
-    if n_grp and (not priors.per_group or len(priors.lamVz) == n_grp):
-        one = replace(priors, lamVz=priors.lamvz_priors(n_grp)).to_dict()
-        out["lamVz"] = one["lamVz"]
-    if n_grp and (not priors.rhov_per_group or len(priors.rhoV_a) == n_grp):
-        pairs = priors.rhov_priors(n_grp)
-        out["rhoV_a"], out["rhoV_b"] = [a for a, _ in pairs], [b for _, b in pairs]
-    return out

@@ -1,0 +1,284 @@
+"""Continuing a fit's chains (``gpmsa.fit(..., init=emulator)``): where each chain starts, its
+step widths and precision steps, the checks that the model is the same, and ``append=True``,
+which pools the source's retained draws with the continuation's (SEPIA's second ``do_mcmc``)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.mcmc.sampler import check_step_widths
+from gpmsa.model.data import ObsData, check_flag
+from gpmsa.model.discrepancy import record as discrepancy_record
+from gpmsa.model.priors import Priors
+from gpmsa.model.problem import Problem, fixed_record
+
+
+def continued_starts(
+    emulator: Emulator, problem: Problem, K: np.ndarray, obs: ObsData | None, n_chains: int
+) -> dict[str, np.ndarray]:
+    """Each chain's start at its last kept draw in ``emulator`` (a fit of the same data, and
+    observations for a joint fit, with ``n_chains`` chains): name -> (n_chains, *shape), for a
+    backend's ``init``. Its chains continue where they stopped being recorded (a draw of each
+    chain, not a fresh dispersed start): a fit that warned of R-hat or ESS runs on without
+    starting over. GPMSAError naming what differs."""
+    _has_draws(emulator)
+    _chains_of(emulator, n_chains)
+    settings = emulator.settings or {}
+    same = (emulator.x_unit.shape == problem.x_sim.shape and emulator.K.shape == K.shape
+            and np.array_equal(emulator.x_unit, problem.x_sim)
+            and np.array_equal(emulator.t_unit, problem.t_sim)
+            and np.allclose(emulator.w, problem.w, rtol=0.0, atol=1e-12))  # fmt: skip
+    if not same:
+        raise GPMSAError(
+            "init=emulator was fitted to other simulation runs (or another n_pc or basis)"
+        )
+    cal = emulator.calibration or {}
+    if (obs is None) != (not cal):
+        raise GPMSAError(
+            "init=emulator is a joint fit: pass its observations (obs=)" if cal else
+            "init=emulator is a simulator-only fit; a joint fit (obs=) starts its own chains"
+        )  # fmt: skip
+    if obs is not None and settings.get("obs_sha256") not in (None, obs.digest()):
+        raise GPMSAError("init=emulator was fitted jointly with other observations")
+    differs = _model_differences(emulator, problem)
+    if differs:
+        raise GPMSAError(
+            f"init=emulator was another model: its {', '.join(differs)} differ from this fit's; "
+            "continue it with the same settings, or start afresh"
+        )
+    per = emulator.log_post.size // n_chains
+    last = np.arange(1, n_chains + 1) * per - 1  # kept draws are stored chain after chain
+    out = {}
+    for name, init in problem.init.items():
+        source = emulator.draws if name in EMULATOR_PARAMS else cal
+        if name not in source or np.shape(source[name])[1:] != init.shape:
+            raise GPMSAError(
+                f"init=emulator has no {name} of shape {init.shape} (another discrepancy basis, "
+                "groups or model?)"
+            )
+        out[name] = np.array(source[name][last], dtype=np.float64)
+    return out
+
+
+MH_BACKENDS = ("numpy", "torch")
+"""Backends whose recorded ``step_widths`` are GPM/SA's Metropolis widths (a continuation runs
+on with them)."""
+
+
+def continued_widths(emulator: Emulator, problem: Problem, n_chains: int) -> dict | None:
+    """The step widths ``emulator``'s chains ran with (``settings["step_widths"]``, per chain),
+    for its continuation; None where it recorded none or its backend's are not Metropolis widths
+    (``MH_BACKENDS``; pyro records its NUTS step size there). GPMSAError where the record does
+    not fit ``problem``'s chains and parameters (a damaged file)."""
+    settings = emulator.settings or {}
+    record = settings.get("step_widths")
+    if not record or settings.get("backend") not in MH_BACKENDS:
+        return None
+    try:
+        check_step_widths(record, problem, n_chains)
+    except GPMSAError as exc:
+        raise GPMSAError(
+            f"init=emulator: its recorded step widths (settings['step_widths']) do not fit "
+            f"this fit ({exc}); pass step_widths= or tune=True"
+        ) from None
+    return record
+
+
+def continued_steps(emulator: Emulator) -> bool | None:
+    """Whether ``emulator``'s chains stepped the precisions by GPM/SA's proportional step (its
+    ``settings["proportional_steps"]``; a file written before that was recorded: ``not
+    settings["tune"]``, the rule its sampler followed), for its untuned continuation; None where
+    its backend is not a Metropolis one (``MH_BACKENDS``). GPMSAError naming a damaged record."""
+    settings = emulator.settings or {}
+    if settings.get("backend") not in MH_BACKENDS:
+        return None
+    steps = settings.get("proportional_steps")
+    if steps is None and isinstance(settings.get("tune"), bool):
+        steps = not settings["tune"]
+    if steps is not None and not isinstance(steps, bool):
+        raise GPMSAError(
+            f"init=emulator: its settings['proportional_steps'] must be true, false or null, got "
+            f"{steps!r}; pass proportional_steps= or tune=True"
+        )
+    return steps
+
+
+def check_append(append, init, n_burn) -> bool:
+    """``fit``'s ``append`` checked: a flag, True only with ``init`` an emulator (whose draws it
+    appends to) and ``n_burn`` None or 0 (the source's burn-in is already removed); GPMSAError
+    naming the argument otherwise."""
+    append = check_flag(append, "append")
+    if append and not isinstance(init, Emulator):
+        raise GPMSAError(
+            f"append=True appends a continuation's draws to those of the fit it continues: pass "
+            f"init=that emulator (got init={type(init).__name__ if init is not None else None})"
+        )
+    if append and n_burn not in (None, 0):
+        raise GPMSAError(
+            f"append=True pools every kept sweep of the continuation (its chains start at the "
+            f"source's last kept draws, past burn-in): n_burn must be 0 or None, got {n_burn!r}"
+        )
+    return append
+
+
+def _has_draws(emulator: Emulator) -> None:
+    """GPMSAError unless ``emulator`` (``fit``'s ``init``) holds retained draws."""
+    if not emulator.draws or not emulator.log_post.size:
+        raise GPMSAError("init=emulator continues a fit's chains; this emulator has no draws "
+                         "(Emulator.from_params?)")  # fmt: skip
+
+
+def _chains_of(emulator: Emulator, n_chains: int) -> None:
+    """GPMSAError unless ``emulator`` was fitted with ``n_chains`` chains."""
+    n_prev = int((emulator.settings or {}).get("n_chains", 1) or 1)
+    if n_prev != n_chains:
+        raise GPMSAError(f"init=emulator continues its {n_prev} chain(s): pass n_chains={n_prev}")
+
+
+def appended_thin(source: Emulator, n_iter: int, n_chains: int, n_keep) -> int:
+    """The thinning step of ``fit(..., init=source, append=True)``: the source's
+    (``settings["thin"]``), whose continuation keeps n_chains x (n_iter // thin) draws.
+    GPMSAError where the source has no draws, other chains or no step, where ``n_iter`` keeps
+    no draw at it, or where ``n_keep`` (None: the step's) is not that count (naming it)."""
+    _has_draws(source)
+    _chains_of(source, n_chains)
+    thin = (source.settings or {}).get("thin")
+    if isinstance(thin, bool) or not isinstance(thin, int) or thin < 1:
+        raise GPMSAError(
+            f"append=True thins the continuation by its source's step, and init=emulator "
+            f"records none (settings['thin'] = {thin!r}): continue it without append"
+        )
+    new = n_chains * (n_iter // thin)
+    if not new:
+        raise GPMSAError(
+            f"append=True keeps every {thin}th sweep (init=emulator's step, settings['thin']): "
+            f"n_iter={n_iter} keeps none; pass n_iter >= {thin}"
+        )
+    if n_keep is not None and n_keep != new:
+        raise GPMSAError(
+            f"append=True thins by init=emulator's step {thin} (settings['thin']), which keeps "
+            f"{new} draws of {n_chains} chain(s) x {n_iter} sweeps: pass n_keep={new}, or leave "
+            f"n_keep out (got n_keep={n_keep!r})"
+        )
+    return thin
+
+
+def pool_chains(first: np.ndarray, second: np.ndarray, n_chains: int) -> np.ndarray:
+    """Chain-major draws (n_chains a, *shape) and (n_chains b, *shape) pooled as
+    (n_chains (a + b), *shape): each chain's ``first`` draws, then its ``second``."""
+    first, second = np.asarray(first, dtype=float), np.asarray(second, dtype=float)
+    a, b = first.shape[0] // n_chains, second.shape[0] // n_chains
+    both = np.concatenate([first.reshape(n_chains, a, *first.shape[1:]),
+                           second.reshape(n_chains, b, *second.shape[1:])], axis=1)  # fmt: skip
+    return both.reshape(n_chains * (a + b), *first.shape[1:])
+
+
+def pool_draws(source: Emulator, retained: dict, log_post: np.ndarray, calibration, n_chains):
+    """``source``'s retained draws (emulator and calibration ones), log posteriors and
+    calibration draws, each chain followed by a continuation's (``retained``, ``log_post``,
+    ``calibration``, chain-major as ``fit`` keeps them). GPMSAError where the source lacks a
+    parameter the continuation sampled or its shape differs."""
+    cal = dict(source.calibration or {})
+    pooled = {}
+    for k, v in retained.items():
+        old = source.draws.get(k) if k in EMULATOR_PARAMS else cal.get(k)
+        if old is None or np.shape(old)[1:] != v.shape[1:]:
+            raise GPMSAError(f"append=True: init=emulator has no {k} draws of shape "
+                             f"{v.shape[1:]} to append to (another model?)")  # fmt: skip
+        pooled[k] = pool_chains(old, v, n_chains)
+    if calibration is not None:
+        if set(cal) != set(calibration):
+            raise GPMSAError(f"append=True: init=emulator's calibration draws {sorted(cal)} are "
+                             f"not this fit's {sorted(calibration)}")  # fmt: skip
+        calibration = {k: pool_chains(cal[k], v, n_chains) for k, v in calibration.items()}
+    return pooled, pool_chains(source.log_post, log_post, n_chains), calibration
+
+
+def _sweeps(settings: dict) -> tuple[int | None, int | None]:
+    """A fit's sweeps per chain (after burn-in, and in all) from its ``settings``: an appended
+    fit's "pooled_sweeps" and "sweeps_run", else n_iter - n_burn and n_iter; None where not
+    recorded as integers."""
+
+    def whole(v):
+        return v if isinstance(v, int) and not isinstance(v, bool) and v >= 0 else None
+
+    if "appended_to" in settings:
+        return whole(settings.get("pooled_sweeps")), whole(settings.get("sweeps_run"))
+    n_iter, n_burn = whole(settings.get("n_iter")), whole(settings.get("n_burn"))
+    return (None if n_iter is None or n_burn is None else n_iter - n_burn), n_iter
+
+
+def appended_record(source: Emulator, n_iter: int, n_chains: int) -> dict:
+    """The settings of ``fit(..., init=source, n_iter=n_iter, append=True)``: appended_to (the
+    source's ``model_sha256``), appended_after (its retained draws per chain: the pooled chain
+    c's first ones), pooled_sweeps and sweeps_run (per chain: after burn-in, and in all, tuning
+    aside; None where the source does not record its own)."""
+    pooled, run = _sweeps(source.settings or {})
+    return {
+        "appended_to": source.model_sha256,
+        "appended_after": int(source.n_draws // n_chains),
+        "pooled_sweeps": None if pooled is None else pooled + n_iter,
+        "sweeps_run": None if run is None else run + n_iter,
+    }
+
+
+def pool_accept(
+    summary: dict, source: Emulator, accept_rate: dict, n_iter: int, backend: str
+) -> None:
+    """Each entry of ``summary`` (``summarize`` of pooled draws) given the acceptance rate of
+    both parts, weighted by their sweeps (the source's "accept" in its diagnostics over its
+    sweeps run, ``accept_rate`` (n_chains, *shape) over ``n_iter``); none where the source
+    records no rate or sweeps, or where one part is Metropolis (``MH_BACKENDS``) and the other
+    NUTS (pyro's rate is another figure)."""
+    settings = source.settings or {}
+    run = _sweeps(settings)[1]
+    if (settings.get("backend") in MH_BACKENDS) != (backend in MH_BACKENDS):
+        return
+    for name, entry in summary.items():
+        old = (source.diagnostics or {}).get(name, {}).get("accept")
+        if run is None or old is None or name not in accept_rate:
+            continue
+        new = accept_rate[name].reshape(accept_rate[name].shape[0], -1).mean(0)
+        old = np.array([np.nan if v is None else v for v in old], dtype=float)
+        if old.shape != new.shape:
+            continue
+        both = (old * run + new * n_iter) / (run + n_iter)
+        entry["accept"] = [float(v) for v in both]
+
+
+def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
+    """What of the model ``emulator`` was fitted with differs from ``problem``'s: its priors,
+    mean basis, fixed parameters, theta constraint and discrepancy basis and groups."""
+    settings = emulator.settings or {}
+    mb = problem.mean_basis
+    disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
+    n_grp = problem.obs.n_groups if problem.obs is not None and problem.obs.p_v else 0
+    checks = {
+        "priors": (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp)),
+        "mean_basis": (settings.get("mean_basis"), None if mb is None else mb.kind),
+        "fixed parameters": (settings.get("fixed", {}), fixed_record(problem)),
+        "theta constraint": (bool(settings.get("constraint", False)),
+                             problem.constraint is not None),
+        "discrepancy": ({k: settings.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")},
+                        {k: disc.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")}),
+    }  # fmt: skip
+    return [name for name, (old, new) in checks.items() if old != new]
+
+
+def _prior_record(priors: Priors, n_grp: int) -> dict:
+    """``priors.to_dict()`` with lamVz as the list of the ``n_grp`` groups' priors and rhoV_a,
+    rhoV_b as the lists of the groups' betaV Beta parameters (a shared prior, equal per-group
+    ones and, for betaV, none (betaU's) are one model); as written without a discrepancy, or
+    where the per-group priors do not fit the groups."""
+    out = priors.to_dict()
+    if n_grp and (not priors.per_group or len(priors.lamVz) == n_grp):
+        one = replace(priors, lamVz=priors.lamvz_priors(n_grp)).to_dict()
+        out["lamVz"] = one["lamVz"]
+    if n_grp and (not priors.rhov_per_group or len(priors.rhoV_a) == n_grp):
+        pairs = priors.rhov_priors(n_grp)
+        out["rhoV_a"], out["rhoV_b"] = [a for a, _ in pairs], [b for _, b in pairs]
+    return out
