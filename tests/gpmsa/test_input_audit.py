@@ -412,11 +412,16 @@ def test_messages_name_the_argument_at_fault():
         gpmsa.SimData(**tiny)
 
 
-def test_a_prior_whose_bounds_exclude_the_start_is_named():
+def test_a_prior_whose_bounds_exclude_the_start_starts_inside_them_or_is_named():
+    """GPM/SA's start lamUz = 1 outside the prior's bounds (0.3, 0.31): the chain starts inside
+    them (session 67; refused before); a start the user gives there is still refused by name."""
     sim = gpmsa.SimData(**_functional_sim(np.linspace(0, 1, 12)))
     priors = gpmsa.Priors(lamUz=gpmsa.GammaPrior(5.0, 5.0, 0.3, 0.31))
+    emu = gpmsa.fit(sim, n_iter=5, tune=False, priors=priors, seed=0)
+    assert np.all((emu.draws["lamUz"] > 0.3) & (emu.draws["lamUz"] < 0.31))
+    start = {"lamUz": np.ones(emu.draws["lamUz"].shape[1])}
     with pytest.raises(GPMSAError, match=r"start lamUz = \[1.0.*bounds \(0.3, 0.31\) of Priors"):
-        gpmsa.fit(sim, n_iter=5, tune=False, priors=priors)
+        gpmsa.fit(sim, n_iter=5, tune=False, priors=priors, init=start)
 
 
 # --- 13, 14: the CLI's NAME=VALUE; metadata tuples ----------------------------------------------
