@@ -306,9 +306,32 @@ def _experiment_basis(bases, obs_grids: list[np.ndarray], grid: np.ndarray) -> n
     if any(not np.array_equal(bases[j], D) for j in on[1:]):
         raise GPMSAError(
             f"experiments {on} share this grid but their discrepancy bases differ, so delta on "
-            "it is not one function: predict on a grid that one of them alone has"
+            "it is not one function: pass experiment=j (SEPIA's obs_ref) for experiment j's "
+            "basis, or predict on a grid that one of them alone has"
         )
     return D
+
+
+def _experiment_prediction(kind, obs: ObsData, std, grid, experiment, bases):
+    """(grid, D) of ``full_prediction(..., experiment=j)``: experiment j's index grid and its
+    per-experiment basis (``bases``: the reduction's, normalised as the fit's); GPMSAError for
+    another kind of discrepancy, j outside the experiments, or a ``grid`` that is not j's."""
+    if not is_basis_list(kind):
+        raise GPMSAError(
+            "experiment= chooses among per-experiment discrepancy bases (a list), got "
+            f"discrepancy={describe_discrepancy(kind)}: leave experiment out (grid= chooses "
+            "the output grid)"
+        )
+    j = check_count(experiment, "experiment", 0, obs.n - 1)
+    own = std.grid if obs.grids[j] is None else obs.grids[j]
+    if grid is not None:
+        g = as_float(grid, "grid").reshape(-1)
+        if g.shape != own.shape or not np.array_equal(g, own):
+            raise GPMSAError(
+                f"experiment={j} predicts on its grid (obs.grids[{j}], {own.size} values), "
+                "where its basis is known: leave grid= out"
+            )
+    return own, bases[j]
 
 
 def _check_fitted_discrepancy(emulator, discrepancy) -> None:
@@ -418,6 +441,7 @@ def full_prediction(
     n_rlz: int = 1,
     grid=None,
     seed=None,
+    experiment: int | None = None,
 ) -> FullPrediction:
     """The calibrated prediction at new x: eta(x, theta), delta(x) and y(x), draw by draw.
 
@@ -447,6 +471,9 @@ def full_prediction(
             With per-experiment discrepancy bases (a list) one experiment's index grid: delta
             there is that experiment's basis's (as SEPIA's ``obs_ref``).
         seed: int, numpy Generator or None.
+        experiment: with per-experiment bases, the experiment (0-based) whose basis gives
+            delta, on its index grid (SEPIA's ``obs_ref``): needed where experiments share a
+            grid with different bases (``[D_0, zeros]`` on one grid); None: ``grid``'s.
 
     Returns:
         FullPrediction (native units; ``u``, ``v``, ``mu``, ``cov`` in the basis space).
@@ -525,9 +552,12 @@ def full_prediction(
             "grids): pass the calibration's discrepancy= (the same kind, array or list) and "
             "discrepancy_groups="
         )
-    g = _pred_grid(emulator, obs, grid)
+    if experiment is None:
+        g = _pred_grid(emulator, obs, grid)
+        D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar, ob.D)
+    else:
+        g, D_pred = _experiment_prediction(discrepancy, obs, std, grid, experiment, ob.D)
     K_pred = interpolate_basis(K, std.grid, g) if not scalar else K
-    D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar, ob.D)
     N, p_u = xu.shape[0], emulator.p_u
     n_c = p_v + p_u
     S = len(sets)

@@ -145,3 +145,33 @@ def test_a_damaged_zero_block_file_is_still_refused(tmp_path, edit, field):
     edit(arrays)
     with pytest.raises(EmulatorFileError, match=field):
         gpmsa.load(write_members(tmp_path / "edit.gpmsa", manifest, arrays))
+
+
+def test_experiments_sharing_a_grid_predict_with_the_basis_experiment_names():
+    """[D_0, zeros] with both experiments on one grid (session 67's review): full_prediction
+    refused every grid ("share this grid but their discrepancy bases differ"), so such a fit
+    had no prediction; ``experiment=j`` takes experiment j's basis (SEPIA's ``obs_ref``)."""
+    data, _ = _case()
+    grid = GRIDS[0]
+    per = _kernels([grid, grid])
+    obs = gpmsa.ObsData([[0.3], [0.7]], [np.interp(grid, GRIDS[0], 0.3 + grid)] * 2, index=grid)
+    bases = [per[0], np.zeros_like(per[1])]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # short chains
+        emu = gpmsa.fit(data, obs, n_iter=30, tune=False, seed=3, discrepancy=bases)
+    with pytest.raises(gpmsa.GPMSAError, match=r"share this grid.*experiment=j"):
+        gpmsa.full_prediction(emu, obs, [[0.5]], n_draws=2, seed=0)
+    on = [gpmsa.full_prediction(emu, obs, [[0.5]], n_draws=4, seed=0, experiment=j) for j in (0, 1)]
+    assert np.max(np.abs(on[0].delta)) > 1e-3 and np.all(on[1].delta == 0.0)
+    np.testing.assert_array_equal(on[0].mu[..., 3:], on[1].mu[..., 3:])  # the same conditional
+    for bad in (2, True, 0.0):
+        with pytest.raises(
+            gpmsa.GPMSAError, match=rf"experiment must be an integer in \[0, 1\], got {bad}"
+        ):
+            gpmsa.full_prediction(emu, obs, [[0.5]], n_draws=2, experiment=bad)
+    with pytest.raises(gpmsa.GPMSAError, match=r"experiment=0 predicts on its grid"):
+        gpmsa.full_prediction(emu, obs, [[0.5]], n_draws=2, experiment=0, grid=grid[:3])
+    one = _fit()  # its own bases on own grids: experiment=1 is grid=GRIDS[1]
+    a = gpmsa.full_prediction(one, _case()[1], [[0.5]], n_draws=2, seed=0, experiment=1)
+    b = gpmsa.full_prediction(one, _case()[1], [[0.5]], n_draws=2, seed=0, grid=GRIDS[1])
+    np.testing.assert_array_equal(a.y, b.y)
