@@ -1,4 +1,5 @@
-"""``gpmsa calibrate FILE --x v=1.25 --y f=12.1``: print the posterior of one observation."""
+"""``gpmsa calibrate FILE --x v=1.25 --y f=12.1``: print the posterior of one observation
+(``--fixed GD=400`` holds a calibration parameter, or lamOs, at a known value: MCMC)."""
 
 from __future__ import annotations
 
@@ -27,8 +28,12 @@ def add_parser(sub) -> None:
                    help="a known input, native units (repeat for each x name)")  # fmt: skip
     p.add_argument("--y", action="append", default=[], metavar="NAME=VALUE",
                    help="an observed output, native units (repeat for each y name)")  # fmt: skip
+    p.add_argument("--fixed", action="append", default=[], metavar="NAME=VALUE",
+                   help="hold a calibration parameter (a t_name, or lamOs) at VALUE, native "
+                        "units (repeat for each; MCMC)")  # fmt: skip
     p.add_argument("--method", choices=("auto", "grid", "mcmc"), default="auto",
-                   help="exact grid (1-2 parameters) or MCMC (default: auto)")  # fmt: skip
+                   help="exact grid (1-2 parameters) or MCMC (default: auto, MCMC with "
+                        "--fixed)")  # fmt: skip
     p.add_argument("--level", type=_level, default=0.9, help="central interval level (0.9)")
     p.add_argument("--seed", type=int, default=None, help="seed of the draws / MCMC")
     p.add_argument("--extrapolate", action="store_true", help="allow x outside the domain")
@@ -52,10 +57,11 @@ def _level(text: str) -> float:
     return level
 
 
-def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
-    """Values ordered as ``names`` from NAME=VALUE strings (split at the last "=": a name may
-    hold "=", a number never does). A NAME that is not one of ``names`` is read without its
-    surrounding spaces (``" v=1"`` gives v); one that is, whole (a name may end in a space)."""
+def _given(items: list[str], names: tuple[str, ...], what: str) -> dict[str, float]:
+    """NAME -> value from NAME=VALUE strings (split at the last "=": a name may hold "=", a
+    number never does). A NAME that is not one of ``names`` is read without its surrounding
+    spaces (``" v=1"`` gives v); one that is, whole (a name may end in a space). GPMSAError for
+    an item without "=", a name given twice or a value that is not a number."""
     given = {}
     for item in items:
         name, sep, value = item.rpartition("=")
@@ -70,6 +76,12 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
             given[key] = float(value)
         except ValueError as exc:
             raise GPMSAError(f"--{what} {name}: {value!r} is not a number") from exc
+    return given
+
+
+def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
+    """Values ordered as ``names`` from NAME=VALUE strings (`_given`), one for every name."""
+    given = _given(items, names, what)
     unknown = sorted(set(given) - set(names))
     missing = [n for n in names if n not in given]
     if unknown or missing:
@@ -77,6 +89,60 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
             f"--{what} needs exactly the names {list(names)}; unknown {unknown}, missing {missing}"
         )
     return np.array([[given[n] for n in names]])
+
+
+def _fixed(items: list[str], emu) -> dict[str, float]:
+    """``--fixed``'s NAME -> value (native units; NAME one of the file's t_names or lamOs),
+    each checked now, before any work, as ``calibrate(..., fixed=)`` checks it (`_check_held`);
+    GPMSAError naming the item otherwise (first, as the Calibrator would: a file it refuses,
+    such as one with a categorical calibration parameter)."""
+    from gpmsa.calibration.observations import check_emulator
+
+    if not items:
+        return {}
+    check_emulator(emu)
+    t_names = tuple(str(n) for n in emu.t_names)
+    allowed = (*t_names, "lamOs")
+    given = _given(items, allowed, "fixed")
+    for name, value in given.items():
+        if name not in allowed:
+            raise GPMSAError(f"--fixed {name}: not a calibration parameter of the file; give "
+                             f"one of {list(allowed)}")  # fmt: skip
+        if not np.isfinite(value):
+            raise GPMSAError(f"--fixed {name}: {value} is not a finite number")
+        _check_held(emu, t_names, name, value)
+    return given
+
+
+def _check_held(emu, t_names: tuple[str, ...], name: str, value: float) -> None:
+    """GPMSAError where ``calibrate`` would refuse to hold ``name`` at ``value`` (its own
+    checks: theta inside the design's open range, a categorical one at one of its levels;
+    lamOs inside its prior's bounds), in the command's words, naming what is allowed."""
+    from gpmsa.calibration.calibrate import calibration_fixed
+    from gpmsa.model.problem import checked_fixed
+
+    try:
+        if name == "lamOs":
+            checked_fixed("lamOs", value, (1,), emu.priors)
+        else:
+            calibration_fixed(emu, {"theta": {name: value}})
+        return
+    except GPMSAError:
+        allowed = _holdable(emu, t_names, name)
+    raise GPMSAError(f"--fixed {name}={value:.12g} cannot be held: give a value {allowed}")
+
+
+def _holdable(emu, t_names: tuple[str, ...], name: str) -> str:
+    """The values ``--fixed`` may hold ``name`` at, in words (native units)."""
+    if name == "lamOs":
+        g = emu.priors.precision_prior("lamOs")
+        return f"inside its prior's bounds ({g.lower:g}, {g.upper:g})"
+    k = t_names.index(name)
+    levels = None if emu.levels is None else emu.levels[emu.x_unit.shape[1] + k]
+    if levels is not None:
+        return f"at one of its levels {[float(v) for v in levels]}"
+    lo, hi = emu.standardizer.t_min[k], emu.standardizer.t_max[k]
+    return f"inside the design's open range ({lo:.12g}, {hi:.12g})"
 
 
 def run(args: argparse.Namespace) -> int:
@@ -95,10 +161,18 @@ def run(args: argparse.Namespace) -> int:
 
 def _run(args: argparse.Namespace, load, Calibrator) -> int:
     try:
+        if args.fixed and args.method == "grid":  # the grid refuses fixed=
+            raise GPMSAError("--fixed holds parameters on the MCMC path, and --method grid "
+                             "cannot hold them: use --method mcmc, or leave --method out "
+                             "(auto chooses MCMC with --fixed)")  # fmt: skip
         emu = load(args.file)
         x = _pairs(args.x, tuple(emu.x_names), "x")
         y = _pairs(args.y, tuple(emu.y_names), "y")
-        cal = Calibrator(emu, method=args.method, extrapolate=args.extrapolate, seed=args.seed)
+        fixed = _fixed(args.fixed, emu)
+        options = {"fixed": _fixed_option(fixed)} if fixed else None
+        method = "mcmc" if fixed else args.method  # auto: MCMC with --fixed
+        cal = Calibrator(emu, method=method, extrapolate=args.extrapolate, seed=args.seed,
+                         mcmc_options=options)  # fmt: skip
         t0 = time.perf_counter()
         post = cal.update(x, y)
         summary = post.summary(args.level)
@@ -117,6 +191,7 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
             "y": dict(zip(emu.y_names, y[0].tolist(), strict=True)),
             "method": post.info.get("method"),
             "level": args.level,
+            **({"fixed": fixed} if fixed else {}),
             "seconds": seconds,
             "posterior": summary,
         }
@@ -129,6 +204,21 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
           + "; ".join(given))  # fmt: skip
     print(f"{'name':>10s} {'mean':>12s} {'sd':>12s} {lo_key:>12s} {'median':>12s} {hi_key:>12s}")
     for name, s in summary.items():
+        if s.get("held"):  # as `gpmsa info` prints a parameter held whole
+            print(f"{safe(name, 60):>10s} held at {s['mean']:.12g} (fixed=)")
+            continue
         print(f"{safe(name, 60):>10s} {s['mean']:12.5g} {s['sd']:12.5g} {s[lo_key]:12.5g} "
               f"{s['median']:12.5g} {s[hi_key]:12.5g}")  # fmt: skip
     return 0
+
+
+def _fixed_option(fixed: dict[str, float]) -> dict:
+    """``calibrate``'s ``fixed=`` from `_fixed`'s NAME -> value: {"theta": {t_name: value},
+    "lamOs": value}."""
+    out: dict = {}
+    theta = {n: v for n, v in fixed.items() if n != "lamOs"}
+    if theta:
+        out["theta"] = theta
+    if "lamOs" in fixed:
+        out["lamOs"] = fixed["lamOs"]
+    return out
