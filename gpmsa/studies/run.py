@@ -40,6 +40,8 @@ from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
+from gpmsa.studies import continuation as cont
+from gpmsa.studies.continuation import STEPS, WIDTHS_BY_CHAIN
 from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
 from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
 from gpmsa.studies.sampler import StudyChains, held_elements, sample_study
@@ -90,9 +92,39 @@ def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
             "accept_rate": {n: float(r) for n, r in zip(chains.names, rate, strict=True)},
             "step_widths": {n: float(w) for n, w in zip(chains.names, chains.widths[0],
                                                         strict=True)},
+            **({WIDTHS_BY_CHAIN: {n: [float(w) for w in col] for n, col in
+                                  zip(chains.names, chains.widths.T, strict=True)}}
+               if chains.widths.shape[0] > 1 else {}),
             "seconds": time.perf_counter() - t0,
             "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
             "versions": library_versions("numpy")}  # fmt: skip
+
+
+def _tune_rule(tune, init) -> bool | None:
+    """``tune`` checked (None: decided by ``_continue``, else True)."""
+    if tune is None:
+        return None if isinstance(init, Study) else True
+    return check_flag(tune, "tune")
+
+
+def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool | None,
+              models: list[list[dict]]) -> tuple[bool, dict, dict]:  # fmt: skip
+    """A continuation of ``source``'s chains from ``models`` (per chain, each model's start):
+    (tune, ``sample_study``'s continuation arguments, the settings it adds). Untuned (``tune``
+    None where ``source`` records its chains' widths, or False), each chain runs on with its
+    recorded widths and precision steps; tuned, from GPM/SA's widths."""
+    starts = cont.chain_starts(source, models)
+    names = cont.sweep_names(problems, layout, hyper, starts[0])
+    widths = None if tune is True else cont.continued_widths(source, names, n_chains)
+    if tune is None:
+        tune = widths is None
+    if tune:
+        widths = None
+    steps = None if tune else cont.continued_steps(source)
+    extra = {"continued_from": cont.source_digest(source)}
+    if steps is not None:
+        extra[STEPS] = steps
+    return tune, {"chain_starts": starts, "widths": widths, "prop_mh": steps}, extra
 
 
 def _study_draws(chains: StudyChains, keep: slice, discrepancy: bool = False
@@ -224,8 +256,8 @@ def _per_model_discrepancy(discrepancy, groups, n: int) -> list[tuple]:
 
 def calibrate_study(
     emulators, x_obs, y_obs=None, *, labels=None, shared=(), hierarchical=(),
-    hyper: HyperPriors | None = None, n_samples: int = 5000, n_burn: int = 1000,
-    tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
+    hyper: HyperPriors | None = None, n_samples: int = 5000, n_burn: int | None = None,
+    tune: bool | None = None, seed=None, n_chains: int = 1, init: str | Study = "auto",
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     extrapolate: bool = False, progress: bool = False, n_jobs: int | None = None,
     executor=None, metadata: dict | None = None, discrepancy=None, discrepancy_groups=None,
@@ -248,7 +280,14 @@ def calibrate_study(
             progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep);
             seed None (or a numpy Generator) draws one from fresh entropy (from the
             Generator), and the integer the study ran with is ``study.settings["seed"]``
-            (``seed=that`` reruns it).
+            (``seed=that`` reruns it). n_burn None: 1000 (0 for a continuation); tune None:
+            True (for a continuation: False where the study records its chains' widths).
+        init: a start rule ("auto", ...), or a calibration ``Study`` of the same models, labels,
+            shared and hierarchical names, observations, hyperpriors, fixed values,
+            discrepancies and number of chains (GPMSAError naming what differs), whose chains
+            continue from their last kept draws with the step widths they ran with
+            (``docs/models.md``, "Continuing a study"); settings "continued_from": its
+            ``sha256``.
         metadata: a JSON-able dict saved with the study.
         discrepancy, discrepancy_groups: each model's discrepancy basis and its precision
             groups, as ``gpmsa.calibrate``'s (None, "constant", "linear" or an array; groups
@@ -299,10 +338,12 @@ def calibrate_study(
     labels = check_labels(labels, n)
     for lab, e in zip(labels, emulators, strict=True):  # its error names the model
         _per_model(lab, check_emulator, e)
+    continuing = isinstance(init, Study)
+    n_burn = (0 if continuing else 1000) if n_burn is None else n_burn
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
     seed = run_seed(seed)
     metadata = check_metadata(metadata)
-    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
     extrapolate = check_flag(extrapolate, "extrapolate")
     bases = _per_model_discrepancy(discrepancy, discrepancy_groups, n)
     fixes = _per_model_fixed(fixed, n)
@@ -327,22 +368,39 @@ def calibrate_study(
                                                                  strict=True)]  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})")  # fmt: skip
-    chains = sample_study(
-        problems, layout, hyper, n_iter=int(n_samples), n_chains=int(n_chains), tune=tune,
-        seed=seed, init=init, tune_rounds=tune_rounds, tune_levels=tune_levels,
-        progress=progress, n_jobs=n_jobs, executor=executor,
-    )  # fmt: skip
-    chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
-    settings = _settings(chains, n_burn, t0, n_samples=int(n_samples))
     natives = [calibration_held_native(e, f) for e, f in zip(emulators, fixes, strict=True)]
-    _record_fixed(settings, labels, problems, layout, fixes, natives)
-    settings[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
-    settings[OBS_LAYOUTS] = {lab: r.layout_sha256 for lab, r in zip(labels, reduced, strict=True)}
+    record: dict = {}  # what the study records of its models, before any sampling
+    _record_fixed(record, labels, problems, layout, fixes, natives)
+    record[OBS_DIGESTS] = {lab: r.values_sha256 for lab, r in zip(labels, reduced, strict=True)}
+    record[OBS_LAYOUTS] = {lab: r.layout_sha256 for lab, r in zip(labels, reduced, strict=True)}
     recorded = {lab: {"discrepancy": discrepancy_kind(basis), **discrepancy_record(prob.obs)}
                 for lab, (basis, _), prob in zip(labels, bases, problems, strict=True)
                 if basis is not None}  # fmt: skip
     if recorded:  # full_prediction(posterior=member_posterior(LABEL)) refuses another basis
-        settings[DISCREPANCIES] = recorded
+        record[DISCREPANCIES] = recorded
+    resumed, extra = {}, {}
+    if continuing:
+        old = init.settings
+        cont.check_source(
+            init, "calibration", layout, hyper, int(n_chains),
+            emulators=([e.model_sha256 for e in init.members],
+                       [e.model_sha256 for e in emulators]),
+            observations=([old.get(OBS_DIGESTS), old.get(OBS_LAYOUTS)],
+                          [record[OBS_DIGESTS], record[OBS_LAYOUTS]]),
+            **{"fixed values": ([old.get(k) for k in ("fixed", HELD_THETA)],
+                                [record.get(k) for k in ("fixed", HELD_THETA)]),
+               "discrepancy": (old.get(DISCREPANCIES), record.get(DISCREPANCIES))},
+        )  # fmt: skip
+        tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
+                                         cont.calibration_starts(init, problems))  # fmt: skip
+    chains = sample_study(
+        problems, layout, hyper, n_iter=int(n_samples), n_chains=int(n_chains), tune=tune,
+        seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
+        tune_levels=tune_levels, progress=progress, n_jobs=n_jobs, executor=executor, **resumed,
+    )  # fmt: skip
+    chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
+    settings = _settings(chains, n_burn, t0, n_samples=int(n_samples), **extra)
+    settings.update(record)
     study = Study("calibration", emulators, layout, hyper,
                   _study_draws(chains, slice(int(n_burn), None), discrepancy=True), settings,
                   metadata)  # fmt: skip
@@ -401,7 +459,7 @@ def _per_model(label: str, make, *args, **kwargs):
 def fit_study(
     sims, obs, *, labels=None, shared=(), hierarchical=(), hyper: HyperPriors | None = None,
     n_iter: int = 30_000, n_burn: int | None = None, n_keep: int = 1000, point: str = "mean",
-    tune: bool = True, seed=None, n_chains: int = 1, init: str = "auto",
+    tune: bool | None = None, seed=None, n_chains: int = 1, init: str | Study = "auto",
     priors: Priors | None = None, n_pc: int | float | None = None, basis=None, discrepancy=None,
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
@@ -420,7 +478,11 @@ def fit_study(
             ``gpmsa.fit`` (priors, n_pc, discrepancy and its groups: the same for every model,
             so not a list of per-experiment bases); the seed
             the study ran with is ``study.settings["seed"]`` and each model's
-            ``settings["seed"]``.
+            ``settings["seed"]``. n_burn None: n_iter // 5 (0 for a continuation); tune None:
+            True (for a continuation: False where the study records its chains' widths).
+            init: a start rule, or a fit ``Study`` to continue, as ``calibrate_study``'s (each
+            model's emulator parameters too; its models' checks are ``gpmsa.fit``'s for
+            ``init=emulator``, naming the model).
         basis: as ``gpmsa.fit``'s, a numpy array for every model or a list with one entry
             (None: the model's PCA, as ``n_pc`` says) per model.
         metadata: a JSON-able dict saved with the study.
@@ -448,13 +510,15 @@ def fit_study(
     for o in obs:
         if not isinstance(o, ObsData):
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
-    n_burn = n_iter // 5 if n_burn is None and isinstance(n_iter, int | np.integer) else n_burn
+    continuing = isinstance(init, Study)
+    if n_burn is None and isinstance(n_iter, int | np.integer):
+        n_burn = 0 if continuing else n_iter // 5
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
     seed = run_seed(seed)
     check_point(point)
     n_keep = check_keep(n_keep, n_chains)
     metadata = check_metadata(metadata)
-    tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
+    tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
     labels = check_labels(labels, n)
     if is_basis_list(discrepancy):
         raise GPMSAError(
@@ -483,18 +547,30 @@ def fit_study(
                 for lab, p, s, f in zip(labels, preps, sims, fixes, strict=True)]  # fmt: skip
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})")
     t0 = time.perf_counter()
+    natives = [fit_held_native(p, f, s.t_names)
+               for p, f, s in zip(problems, fixes, sims, strict=True)]  # fmt: skip
+    record: dict = {}
+    _record_fixed(record, labels, problems, layout, fixes, natives, emulator=True)
+    resumed, extra = {}, {}
+    if continuing:
+        cont.check_source(
+            init, "fit", layout, hyper, int(n_chains),
+            **{"fixed values": ([init.settings.get(k) for k in ("fixed", HELD_THETA)],
+                                [record.get(k) for k in ("fixed", HELD_THETA)])},
+        )  # fmt: skip
+        models = cont.fit_starts(init, problems, preps, obs, int(n_chains))
+        tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
+                                         models)  # fmt: skip
     chains = sample_study(
         problems, layout, hyper, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
-        seed=seed, init=init, tune_rounds=tune_rounds, tune_levels=tune_levels,
-        progress=progress, n_jobs=n_jobs, executor=executor,
+        seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
+        tune_levels=tune_levels, progress=progress, n_jobs=n_jobs, executor=executor, **resumed,
     )  # fmt: skip
     chains = _with_held(chains, problems, ORDER, fixes)
     thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
     keep = slice(int(n_burn), None, thin)
-    settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point)
-    natives = [fit_held_native(p, f, s.t_names)
-               for p, f, s in zip(problems, fixes, sims, strict=True)]  # fmt: skip
-    _record_fixed(settings, labels, problems, layout, fixes, natives, emulator=True)
+    settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point, **extra)
+    settings.update(record)
     draws = _study_draws(chains, keep)
     lp = draws["log_post"].reshape(-1)
     members = []

@@ -237,12 +237,26 @@ def _start(problems, layout, hyper, how, rng):
     return start, g, mu, lam
 
 
+def _default_widths(state: StudyState, layout: Layout) -> np.ndarray:
+    """GPM/SA's initial step widths of the sweep's elements, in sweep order."""
+    w = [np.full(layout.n_elements, DEFAULT_WIDTHS["theta"])]
+    for s in state.states:
+        dw = default_widths(s.problem)
+        w.append(np.array([float(dw[n][idx]) for n, idx in s.els]))
+    w.append(np.tile([MU_WIDTH, LOG_LAM_WIDTH], len(layout.groups)))
+    return np.concatenate(w)
+
+
 def run_study_chain(
     problems: list[Problem], layout: Layout, hyper: HyperPriors, n_iter: int, *, tune: bool,
     seed: np.random.SeedSequence, init: str = "gpmsa", tune_rounds: int = tuning.N_BURN,
     tune_levels: int = tuning.N_LEVELS, progress: bool = False, desc: str = "study",
+    start: tuple | None = None, widths: np.ndarray | None = None, prop_mh: bool | None = None,
 ) -> dict:  # fmt: skip
-    """One chain: its start (``gpmsa.mcmc.starts`` rule ``init``), tuning, ``n_iter`` sweeps.
+    """One chain: its start (``gpmsa.mcmc.starts`` rule ``init``; a continuation's ``start``:
+    (models' starts, g, mu, lam)), tuning, ``n_iter`` sweeps; ``widths``: the initial step
+    widths in sweep order (None: GPM/SA's); ``prop_mh``: GPM/SA's proportional precision steps
+    (None: when not tuned).
 
     Returns plain arrays: theta (N, G), mu, lam (N, H), log_post (N,), members (per model,
     name -> (N, *shape)), accept_rate and widths per element.
@@ -250,16 +264,13 @@ def run_study_chain(
     from tqdm.auto import tqdm
 
     rng = np.random.default_rng(seed)
-    start, g, mu, lam = _start(problems, layout, hyper, init, starts.start_generator(seed))
-    state = StudyState(problems, layout, hyper, start, g, mu, lam, rng)
+    if start is None:
+        start = _start(problems, layout, hyper, init, starts.start_generator(seed))
+    state = StudyState(problems, layout, hyper, *start, rng)
     if math.isnan(state.log_post()):
         raise GPMSAError("the starting values give a log posterior of NaN; check the data")
-    w = [np.full(layout.n_elements, DEFAULT_WIDTHS["theta"])]
-    for s in state.states:
-        dw = default_widths(s.problem)
-        w.append(np.array([float(dw[n][idx]) for n, idx in s.els]))
-    w.append(np.tile([MU_WIDTH, LOG_LAM_WIDTH], len(layout.groups)))
-    w = np.concatenate(w)
+    w = _default_widths(state, layout) if widths is None else np.array(widths, dtype=float)
+    prop_mh = not tune if prop_mh is None else prop_mh
     total = n_iter + (tune_rounds * tune_levels if tune else 0)
     own = [s.problem.sampled for s in state.states]
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
@@ -276,7 +287,7 @@ def run_study_chain(
                    for s, names in zip(state.states, own, strict=True)]  # fmt: skip
         accepted = np.zeros(w.size)
         for it in range(n_iter):
-            state.sweep(w, not tune, accepted)
+            state.sweep(w, prop_mh, accepted)
             out["theta"][it], out["mu"][it], out["lam"][it] = state.g, state.mu, state.lam
             for s, names, rec in zip(state.states, own, members, strict=True):
                 for n in names:
@@ -308,14 +319,17 @@ def sample_study(
     n_chains: int = 1, tune: bool = True, seed=None, init: str = "auto",
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
+    chain_starts: list | None = None, widths: list | None = None, prop_mh: bool | None = None,
 ) -> StudyChains:  # fmt: skip
     """``n_chains`` study chains, chain c on ``SeedSequence(seed).spawn(n_chains)[c]`` (its draws
     do not depend on where it runs: ``n_jobs`` processes or ``executor``, as
-    ``gpmsa.mcmc.parallel.run_chains``). ChainError names a chain that failed or whose draws are
-    not finite."""
+    ``gpmsa.mcmc.parallel.run_chains``). A continuation gives ``chain_starts`` (per chain:
+    models' starts, g, mu, lam; init "continued"), ``widths`` (per chain, sweep order; None:
+    GPM/SA's) and ``prop_mh`` (``run_study_chain``'s). ChainError names a chain that failed or
+    whose draws are not finite."""
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     held_elements(problems, layout)  # a held element the models disagree on: before any work
-    how = starts.check_init(init, int(n_chains))
+    how = "continued" if chain_starts else starts.check_init(init, int(n_chains))
     seq = np.random.SeedSequence(seed)
     tasks = [
         {"problems": problems, "layout": layout, "hyper": hyper, "n_iter": int(n_iter),
@@ -323,6 +337,11 @@ def sample_study(
          "tune_levels": tune_levels}
         for s in seq.spawn(int(n_chains))
     ]  # fmt: skip
+    for c, task in enumerate(tasks):  # a fresh study's tasks as before
+        if chain_starts:
+            task.update(start=chain_starts[c], prop_mh=prop_mh)
+        if widths is not None:
+            task["widths"] = widths[c]
     runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
                       progress=progress, desc="study chain",
                       check=lambda _, r: _wrong_run(r, int(n_iter), layout.n_elements))  # fmt: skip

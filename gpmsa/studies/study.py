@@ -191,6 +191,9 @@ class Study:
         posterior: ``gpmsa.Posterior`` in native units (names: ``native_chains``); ``summary()``
             and ``to_arviz()`` give its summary (held parameters marked) and its chains.
         settings, metadata: how it was run; the user's JSON-able dict (saved).
+        sha256: the ``content_sha256`` of the study file it was read from or last saved to
+            (None before either); a continuation (``init=study``) records it as
+            ``settings["continued_from"]``.
     """
 
     def __init__(self, kind: str, members, layout: Layout, hyper: HyperPriors,
@@ -203,6 +206,7 @@ class Study:
         self.draws = {k: np.asarray(v, dtype=np.float64) for k, v in draws.items()}
         self.settings = dict(settings or {})
         self.metadata = dict(metadata or {})
+        self.sha256: str | None = None
         chains = native_chains(layout, self.draws)
         for name, value in _held_theta(layout, self.draws, self.settings).items():
             chains[name][...] = value
@@ -381,6 +385,7 @@ class Study:
         with atomic_group() as stage:
             for target, raw_manifest, member_arrays in sealed:
                 write_sealed(target, raw_manifest, member_arrays, stage)
+        self.sha256 = head["content_sha256"]
         return given
 
     def __repr__(self) -> str:
@@ -428,6 +433,7 @@ def load_study(path: str | Path, *, sha256: str | None = None) -> Study:
         out = Study(study["kind"], members, layout, hyper, arrays, manifest["settings"],
                     manifest["metadata"])  # fmt: skip
         check_study_claims(manifest, out)
+        out.sha256 = manifest["content_sha256"]
         return out
     except EmulatorFileError as exc:
         raise EmulatorFileError(f"{path}: {exc}") from exc

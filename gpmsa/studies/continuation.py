@@ -1,0 +1,167 @@
+"""Continuing a study's chains (``calibrate_study(..., init=study)``, ``fit_study(...,
+init=study)``): the checks that the study is this one's, each chain's start at its last kept
+draw, its step widths and precision steps (SEPIA's second ``do_mcmc`` of its shared and
+hierarchical models)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gpmsa.errors import GPMSAError
+from gpmsa.fitting.continuation import continued_starts
+from gpmsa.model.problem import Problem
+from gpmsa.studies.layout import HyperPriors, Layout
+from gpmsa.studies.record import discrepancy_arrays
+from gpmsa.studies.sampler import StudyState, element_names
+from gpmsa.studies.study import Study
+
+WIDTHS_BY_CHAIN = "step_widths_by_chain"
+"""The settings key of a study of several chains: sweep element name -> each chain's step width
+(``settings["step_widths"]`` holds chain 0's); absent with one chain and in files written
+before it."""
+STEPS = "proportional_steps"
+"""The settings key of a continued study: whether its chains stepped the precisions by GPM/SA's
+proportional step (absent: ``not settings["tune"]``, the rule its sampler followed)."""
+
+
+def check_source(source: Study, kind: str, layout: Layout, hyper: HyperPriors,
+                 n_chains: int, **same) -> None:  # fmt: skip
+    """GPMSAError naming what of ``source`` (``init=``) differs from this study: its kind, its
+    number of chains, its labels, shared and hierarchical names, elements (ranges and theta
+    priors), hyperpriors, and each ``same`` entry (name -> (the source's, this one's))."""
+    what = "calibrate_study" if kind == "calibration" else "fit_study"
+    if source.kind != kind:
+        raise GPMSAError(f"init=study is a {source.kind} study; {what} continues a study of kind "
+                         f"{kind!r} (made by {what})")  # fmt: skip
+    n_prev = int(source.draws["log_post"].shape[0])
+    if n_prev != n_chains:
+        raise GPMSAError(f"init=study continues its {n_prev} chain(s): pass n_chains={n_prev}")
+    old = source.layout
+    checks = {
+        "labels": (list(old.labels), list(layout.labels)),
+        "shared": (list(old.shared), list(layout.shared)),
+        "hierarchical": (list(old.groups), list(layout.groups)),
+        "calibration parameters (names, ranges, theta priors)": (
+            [(e.name, e.prior, b) for e, b in zip(old.elements, old.bounds, strict=True)],
+            [(e.name, e.prior, b) for e, b in zip(layout.elements, layout.bounds, strict=True)]),
+        "hyper": (source.hyper.to_dict(), hyper.to_dict()),
+        **same,
+    }  # fmt: skip
+    differs = [name for name, (a, b) in checks.items() if a != b]
+    if differs:
+        detail = "; ".join(f"{n}: {_brief(checks[n][0])} there, {_brief(checks[n][1])} here"
+                           for n in differs)  # fmt: skip
+        raise GPMSAError(f"init=study was another study: its {', '.join(differs)} differ "
+                         f"({detail}); continue it with the same models and settings, or start "
+                         "afresh")  # fmt: skip
+
+
+def _brief(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 120 else text[:117] + "..."
+
+
+def calibration_starts(source: Study, problems: list[Problem]) -> list[list[dict]]:
+    """Per chain, each model's start for ``calibrate_study``: its lamOs (and discrepancy's betaV,
+    lamVz) at the chain's last kept draw in ``source``, the rest (the emulator's parameters,
+    held) its problem's."""
+    out = []
+    for c in range(source.draws["log_post"].shape[0]):
+        chain = []
+        for j, prob in enumerate(problems):
+            beta, lam = discrepancy_arrays(j)
+            drawn = {"lamOs": source.draws["lamOs"][:, :, j], "betaV": source.draws.get(beta),
+                     "lamVz": source.draws.get(lam)}  # fmt: skip
+            start = dict(prob.init)
+            for name in ("lamOs", "betaV", "lamVz"):
+                if name not in prob.init or not prob.init[name].size:
+                    continue
+                if drawn[name] is None:
+                    raise GPMSAError(f"init=study has no {name} draws of model "
+                                     f"{source.labels[j]!r} (another discrepancy?)")  # fmt: skip
+                val = np.asarray(drawn[name][c, -1], dtype=np.float64)
+                if val.size != prob.init[name].size:
+                    raise GPMSAError(f"init=study's {name} of model {source.labels[j]!r} has "
+                                     f"{val.size} elements, this one's {prob.init[name].size} "
+                                     "(another discrepancy basis or groups?)")  # fmt: skip
+                start[name] = val.reshape(prob.init[name].shape)
+            chain.append(start)
+        out.append(chain)
+    return out
+
+
+def fit_starts(source: Study, problems: list[Problem], preps, obs, n_chains: int
+               ) -> list[list[dict]]:  # fmt: skip
+    """Per chain, each model's start for ``fit_study``: every parameter at the chain's last kept
+    draw in its fitted member (``gpmsa.fitting.continuation.continued_starts``, which refuses
+    other simulation runs, observations, priors, fixed parameters or discrepancy, naming the
+    model)."""
+    per_model = []
+    for lab, emu, prob, prep, o in zip(source.labels, source.members, problems, preps, obs,
+                                       strict=True):  # fmt: skip
+        try:
+            per_model.append(continued_starts(emu, prob, prep.K, o, n_chains))
+        except GPMSAError as exc:
+            raise GPMSAError(f"model {lab!r}: {str(exc).replace('init=emulator', 'init=study')}"
+                             ) from None  # fmt: skip
+    return [[{k: v[c] for k, v in m.items()} for m in per_model] for c in range(n_chains)]
+
+
+def chain_starts(source: Study, models: list[list[dict]]) -> list[tuple]:
+    """Each chain's (models' starts, study elements g, groups' mu, lam) at its last kept draw."""
+    return [(m, source.draws["theta"][c, -1].copy(), source.draws["mu"][c, -1].copy(),
+             source.draws["lam"][c, -1].copy()) for c, m in enumerate(models)]  # fmt: skip
+
+
+def sweep_names(problems, layout, hyper, start) -> list[str]:
+    """The sweep's element names from chain 0's start (a ``StudyState``); GPMSAError where the
+    source's draws give no finite log posterior here."""
+    state = StudyState(problems, layout, hyper, *start, np.random.default_rng(0))
+    if not math.isfinite(state.log_post()):
+        raise GPMSAError("init=study: its last kept draws have no finite log posterior in this "
+                         "study (other data or priors?); start afresh")  # fmt: skip
+    return element_names(state.states, layout)
+
+
+def continued_widths(source: Study, names: list[str], n_chains: int) -> list[np.ndarray] | None:
+    """Each chain's step widths in sweep order (``names``) as ``source`` recorded them (its
+    ``WIDTHS_BY_CHAIN``, else ``settings["step_widths"]`` for every chain: one chain, or
+    untuned ones, which run on GPM/SA's widths); None where it records none. GPMSAError where
+    the record does not fit this study's sweep."""
+    settings = source.settings
+    record = settings.get(WIDTHS_BY_CHAIN)
+    if record is None:
+        one = settings.get("step_widths")
+        if one is None:
+            return None
+        if n_chains > 1 and settings.get("tune") is not False:
+            return None  # tuned chains' own widths not recorded: tune again
+        record = {k: [v] * n_chains for k, v in one.items()} if isinstance(one, dict) else one
+    if not isinstance(record, dict) or sorted(record) != sorted(names):
+        raise GPMSAError("init=study: its recorded step widths do not name this study's sweep "
+                         "elements (another model?); pass tune=True")  # fmt: skip
+    try:
+        w = np.array([record[n] for n in names], dtype=np.float64).T
+    except (TypeError, ValueError):
+        w = np.empty(0)
+    if w.shape != (n_chains, len(names)) or not (np.all(np.isfinite(w)) and np.all(w > 0)):
+        raise GPMSAError(f"init=study: its recorded step widths are not finite positive widths "
+                         f"for {n_chains} chain(s); pass tune=True")  # fmt: skip
+    return list(w)
+
+
+def continued_steps(source: Study) -> bool:
+    """Whether ``source``'s chains stepped the precisions proportionally (``STEPS``, else
+    ``not settings["tune"]``), for its untuned continuation."""
+    steps = source.settings.get(STEPS, not source.settings.get("tune", True))
+    if not isinstance(steps, bool):
+        raise GPMSAError(f"init=study: its settings[{STEPS!r}] must be true or false, got "
+                         f"{steps!r}; pass tune=True")  # fmt: skip
+    return steps
+
+
+def source_digest(source: Study) -> str | None:
+    """The source's study file digest (``content_sha256``) where it was saved or loaded."""
+    return getattr(source, "sha256", None)
