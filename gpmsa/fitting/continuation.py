@@ -217,13 +217,26 @@ def appended_record(source: Emulator, n_iter: int, n_chains: int) -> dict:
     source's ``model_sha256``), appended_after (its retained draws per chain: the pooled chain
     c's first ones), pooled_sweeps and sweeps_run (per chain: after burn-in, and in all, tuning
     aside; None where the source does not record its own)."""
-    pooled, run = _sweeps(source.settings or {})
+    return appended_counts(source.settings or {}, source.model_sha256,
+                           int(source.n_draws // n_chains), n_iter)  # fmt: skip
+
+
+def appended_counts(settings: dict, digest: str | None, per_chain: int, n_iter: int) -> dict:
+    """The appended settings (``appended_record``'s) of a source whose ``settings``, digest and
+    retained draws per chain are given, continued by ``n_iter`` sweeps a chain."""
+    pooled, run = _sweeps(settings)
     return {
-        "appended_to": source.model_sha256,
-        "appended_after": int(source.n_draws // n_chains),
+        "appended_to": digest,
+        "appended_after": int(per_chain),
         "pooled_sweeps": None if pooled is None else pooled + n_iter,
         "sweeps_run": None if run is None else run + n_iter,
     }
+
+
+def sweeps_run(settings: dict) -> int | None:
+    """A fit's (or study's) sweeps per chain in all, tuning aside, from its ``settings`` (an
+    appended one's "sweeps_run"); None where not recorded."""
+    return _sweeps(settings)[1]
 
 
 def pool_accept(

@@ -1,7 +1,8 @@
 """Continuing a study's chains (``calibrate_study(..., init=study)``, ``fit_study(...,
 init=study)``): the checks that the study is this one's, each chain's start at its last kept
 draw, its step widths and precision steps (SEPIA's second ``do_mcmc`` of its shared and
-hierarchical models)."""
+hierarchical models), and ``append=True``, which pools the source's kept draws with the
+continuation's (as ``gpmsa.fit``'s, ``gpmsa.fitting.continuation``)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ import math
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.fitting.continuation import continued_starts
+from gpmsa.fitting.continuation import appended_counts, continued_starts, pool_chains, sweeps_run
+from gpmsa.fitting.emulator import EMULATOR_PARAMS
+from gpmsa.model.data import check_flag
 from gpmsa.model.problem import Problem
 from gpmsa.studies.layout import HyperPriors, Layout
 from gpmsa.studies.record import discrepancy_arrays
@@ -165,3 +168,114 @@ def continued_steps(source: Study) -> bool:
 def source_digest(source: Study) -> str | None:
     """The source's study file digest (``content_sha256``) where it was saved or loaded."""
     return getattr(source, "sha256", None)
+
+
+def check_append(append, init, n_burn) -> bool:
+    """A study function's ``append`` checked: a flag, True only with ``init`` a Study (whose
+    draws it appends to) and ``n_burn`` None or 0 (the source's burn-in is already removed);
+    GPMSAError naming the argument otherwise."""
+    append = check_flag(append, "append")
+    if append and not isinstance(init, Study):
+        got = type(init).__name__ if not isinstance(init, str) else repr(init)
+        raise GPMSAError(f"append=True appends a continuation's draws to those of the study it "
+                         f"continues: pass init=that study (got init={got})")  # fmt: skip
+    if append and n_burn not in (None, 0):
+        raise GPMSAError(
+            f"append=True pools every kept sweep of the continuation (its chains start at the "
+            f"source's last kept draws, past burn-in): n_burn must be 0 or None, got {n_burn!r}"
+        )
+    return append
+
+
+def appended_thin(source: Study, n_iter: int, n_chains: int, n_keep=None) -> int:
+    """The thinning step of an appended study: the source's (``settings["thin"]``; a
+    calibration study keeps every sweep: 1), whose continuation keeps n_chains x (n_iter //
+    thin) draws. GPMSAError where the source records no step, where ``n_iter`` keeps no draw
+    at it, or where ``n_keep`` (``fit_study``'s; None: the step's) is not that count."""
+    thin = source.settings.get("thin", 1)
+    if isinstance(thin, bool) or not isinstance(thin, int) or thin < 1:
+        raise GPMSAError(f"append=True thins the continuation by its source's step, and "
+                         f"init=study records none (settings['thin'] = {thin!r}): continue it "
+                         "without append")  # fmt: skip
+    new = n_chains * (n_iter // thin)
+    if not new:
+        raise GPMSAError(f"append=True keeps every {thin}th sweep (init=study's step, "
+                         f"settings['thin']): n_iter={n_iter} keeps none; pass n_iter >= "
+                         f"{thin}")  # fmt: skip
+    if n_keep is not None and n_keep != new:
+        raise GPMSAError(
+            f"append=True thins by init=study's step {thin} (settings['thin']), which keeps "
+            f"{new} draws of {n_chains} chain(s) x {n_iter} sweeps: pass n_keep={new}, or leave "
+            f"n_keep out (got n_keep={n_keep!r})"
+        )
+    return thin
+
+
+def refuse_tuning() -> None:
+    """The GPMSAError of an appended study whose continuation would tune."""
+    raise GPMSAError(
+        "append=True pools the chains' draws evenly spaced in sweeps; tuning (tune=True, or "
+        "tune=None where init=study records no step widths for its chains) would run its "
+        "sweeps between the source's and the continuation's: pass tune=False"
+    )
+
+
+def _pool(old: np.ndarray, new: np.ndarray, what: str) -> np.ndarray:
+    """(C, a, *shape) and (C, b, *shape) chains pooled as (C, a + b, *shape): each chain's
+    ``old`` draws, then its ``new`` (``pool_chains``)."""
+    old, new = np.asarray(old, dtype=np.float64), np.asarray(new, dtype=np.float64)
+    if old.ndim != new.ndim or old.shape[0] != new.shape[0] or old.shape[2:] != new.shape[2:]:
+        raise GPMSAError(f"append=True: init=study has no {what} draws of shape "
+                         f"{new.shape[2:]} for {new.shape[0]} chain(s) to append to (another "
+                         "model?)")  # fmt: skip
+    c, a, b = new.shape[0], old.shape[1], new.shape[1]
+    both = pool_chains(old.reshape(c * a, *old.shape[2:]), new.reshape(c * b, *new.shape[2:]), c)
+    return both.reshape(c, a + b, *new.shape[2:])
+
+
+def pool_study_draws(source: Study, draws: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """``source``'s draws (theta, mu, lam, lamOs, log_post, a calibration's betaV_j, lamVz_j;
+    each (C, N, ...)), each chain followed by a continuation's ``draws``."""
+    if set(source.draws) != set(draws):
+        raise GPMSAError(f"append=True: init=study's draws {sorted(source.draws)} are not this "
+                         f"study's {sorted(draws)}")  # fmt: skip
+    return {k: _pool(source.draws[k], v, k) for k, v in draws.items()}
+
+
+def pool_member(member, post: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """A fitted member's retained draws (its ``draws`` and ``calibration``, flat chain-major),
+    each chain followed by the continuation's ``post`` (name -> (C, N, ...))."""
+    cal = dict(member.calibration or {})
+    out = {}
+    for k, v in post.items():
+        old = member.draws.get(k) if k in EMULATOR_PARAMS else cal.get(k)
+        c = v.shape[0]
+        if old is None or np.shape(old)[0] % c:
+            raise GPMSAError(f"append=True: init=study's member has no {k} draws to append to "
+                             "(another model?)")  # fmt: skip
+        old = np.asarray(old).reshape(c, np.shape(old)[0] // c, *np.shape(old)[1:])
+        out[k] = _pool(old, v, k)
+    return out
+
+
+def appended_settings(source: Study, n_iter: int, accept_rate: dict | None) -> dict:
+    """The settings an appended study adds: appended_to (the source's study file digest, None
+    for a study never saved), appended_after (its draws per chain), pooled_sweeps and
+    sweeps_run (per chain; as ``gpmsa.fit``'s), and accept_rate: each element's rate of both
+    parts weighted by their sweeps (the source's ``settings["accept_rate"]`` over its sweeps
+    run, ``accept_rate`` over ``n_iter``); none where the source records no rate or sweeps."""
+    settings = source.settings
+    out = appended_counts(settings, source_digest(source),
+                          int(source.draws["log_post"].shape[1]), n_iter)  # fmt: skip
+    old, run = settings.get("accept_rate"), sweeps_run(settings)
+    ok = (
+        isinstance(old, dict)
+        and accept_rate is not None
+        and run is not None
+        and set(old) == set(accept_rate)
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in old.values())
+    )
+    out["accept_rate"] = None if not ok else {
+        k: float((old[k] * run + r * n_iter) / (run + n_iter)) for k, r in accept_rate.items()
+    }  # fmt: skip
+    return out

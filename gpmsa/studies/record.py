@@ -257,8 +257,8 @@ def _is_member_fit(study, i: int) -> bool:
 
 
 def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
-    """settings' n_chains and the draws a chain kept (n_iter, n_burn, thin) against the draws'
-    (chains, draws) ``shape``."""
+    """settings' n_chains and the draws a chain kept (n_iter, n_burn, thin; an appended study's
+    "appended_after" draws of its source first) against the draws' (chains, draws) ``shape``."""
     got = {k: settings.get(k, 1 if k == "thin" else None)
            for k in ("n_chains", "n_iter", "n_burn", "thin")}  # fmt: skip
     for k, v in got.items():
@@ -272,7 +272,15 @@ def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
                                          "chains")  # fmt: skip
     # len(range(n_burn, n_iter, thin)) without its OverflowError: a JSON integer has any size
     kept = max(0, -(-(got["n_iter"] - got["n_burn"]) // got["thin"]))
-    if kept != shape[1]:
+    before, what = 0, ""
+    if "appended_to" in settings:  # the source's draws, then sweeps thin - 1, 2 thin - 1, ...
+        before = settings.get("appended_after")
+        if isinstance(before, bool) or not isinstance(before, int) or before < 1:
+            raise _fail("settings.appended_after", f"must be an integer >= 1, got "
+                                                   f"{_short(before)}")  # fmt: skip
+        kept = max(0, (got["n_iter"] - got["n_burn"]) // got["thin"])
+        what = f" after appended_after={before}"
+    if before + kept != shape[1]:
         raise _fail("settings", f"n_iter={got['n_iter']}, n_burn={got['n_burn']}, thin="
-                                f"{got['thin']} keep {kept} draws a chain, but the draws have "
-                                f"{shape[1]}")  # fmt: skip
+                                f"{got['thin']} keep {kept} draws a chain{what}, but the draws "
+                                f"have {shape[1]}")  # fmt: skip

@@ -22,8 +22,10 @@ from gpmsa.calibration.calibrate import (
 )
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
+from gpmsa.fitting.continuation import appended_record
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.fitting.fit import (
+    N_KEEP,
     check_keep,
     check_point,
     fit_held_native,
@@ -261,7 +263,7 @@ def calibrate_study(
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     extrapolate: bool = False, progress: bool = False, n_jobs: int | None = None,
     executor=None, metadata: dict | None = None, discrepancy=None, discrepancy_groups=None,
-    fixed=None,
+    fixed=None, append: bool = False,
 ) -> Study:  # fmt: skip
     """Calibrate several fitted emulators at once, their emulator parameters fixed (as
     ``gpmsa.calibrate`` does for one), with shared and/or hierarchical calibration parameters.
@@ -288,6 +290,13 @@ def calibrate_study(
             continue from their last kept draws with the step widths they ran with
             (``docs/models.md``, "Continuing a study"); settings "continued_from": its
             ``sha256``.
+        append: with ``init`` a study, return its kept draws followed, chain by chain, by this
+            continuation's every sweep (a calibration study keeps every sweep after burn-in),
+            as ``gpmsa.fit``'s ``append``: diagnostics, convergence and posterior over the
+            pooled chains; settings n_burn 0, "appended_to" (the source's ``sha256``),
+            "appended_after" (its draws per chain), "pooled_sweeps", "sweeps_run" and
+            "accept_rate" weighted by the parts' sweeps. Refused (naming the argument):
+            ``init`` not a study, n_burn > 0, tuning (pass tune=False).
         metadata: a JSON-able dict saved with the study.
         discrepancy, discrepancy_groups: each model's discrepancy basis and its precision
             groups, as ``gpmsa.calibrate``'s (None, "constant", "linear" or an array; groups
@@ -339,6 +348,7 @@ def calibrate_study(
     for lab, e in zip(labels, emulators, strict=True):  # its error names the model
         _per_model(lab, check_emulator, e)
     continuing = isinstance(init, Study)
+    append = cont.check_append(append, init, n_burn)
     n_burn = (0 if continuing else 1000) if n_burn is None else n_burn
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
     seed = run_seed(seed)
@@ -378,7 +388,7 @@ def calibrate_study(
                 if basis is not None}  # fmt: skip
     if recorded:  # full_prediction(posterior=member_posterior(LABEL)) refuses another basis
         record[DISCREPANCIES] = recorded
-    resumed, extra = {}, {}
+    resumed, extra, thin = {}, {}, 1  # thin: an appended study's step (a calibration keeps all)
     if continuing:
         old = init.settings
         cont.check_source(
@@ -391,8 +401,11 @@ def calibrate_study(
                                 [record.get(k) for k in ("fixed", HELD_THETA)]),
                "discrepancy": (old.get(DISCREPANCIES), record.get(DISCREPANCIES))},
         )  # fmt: skip
+        thin = cont.appended_thin(init, int(n_samples), int(n_chains)) if append else 1
         tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
                                          cont.calibration_starts(init, problems))  # fmt: skip
+        if append and tune:
+            cont.refuse_tuning()
     chains = sample_study(
         problems, layout, hyper, n_iter=int(n_samples), n_chains=int(n_chains), tune=tune,
         seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
@@ -401,9 +414,12 @@ def calibrate_study(
     chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples), **extra)
     settings.update(record)
-    study = Study("calibration", emulators, layout, hyper,
-                  _study_draws(chains, slice(int(n_burn), None), discrepancy=True), settings,
-                  metadata)  # fmt: skip
+    keep = slice(thin - 1, None, thin) if append else slice(int(n_burn), None)
+    draws = _study_draws(chains, keep, discrepancy=True)
+    if append:  # the source's draws, then every sweep at its step (1)
+        draws = cont.pool_study_draws(init, draws)
+        settings.update(cont.appended_settings(init, int(n_samples), settings["accept_rate"]))
+    study = Study("calibration", emulators, layout, hyper, draws, settings, metadata)
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
     return study
@@ -458,12 +474,13 @@ def _per_model(label: str, make, *args, **kwargs):
 
 def fit_study(
     sims, obs, *, labels=None, shared=(), hierarchical=(), hyper: HyperPriors | None = None,
-    n_iter: int = 30_000, n_burn: int | None = None, n_keep: int = 1000, point: str = "mean",
+    n_iter: int = 30_000, n_burn: int | None = None, n_keep: int | None = None,
+    point: str = "mean",
     tune: bool | None = None, seed=None, n_chains: int = 1, init: str | Study = "auto",
     priors: Priors | None = None, n_pc: int | float | None = None, basis=None, discrepancy=None,
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
-    metadata: dict | None = None, fixed=None,
+    metadata: dict | None = None, fixed=None, append: bool = False,
 ) -> Study:  # fmt: skip
     """Fit several GPM/SA models jointly (each its emulator and observations, as ``gpmsa.fit``
     with ``obs``) whose calibration parameters are shared and/or hierarchical (SEPIA's shared
@@ -479,10 +496,17 @@ def fit_study(
             so not a list of per-experiment bases); the seed
             the study ran with is ``study.settings["seed"]`` and each model's
             ``settings["seed"]``. n_burn None: n_iter // 5 (0 for a continuation); tune None:
-            True (for a continuation: False where the study records its chains' widths).
+            True (for a continuation: False where the study records its chains' widths);
+            n_keep None: 1,000 (an appended study's: the draws its step keeps).
             init: a start rule, or a fit ``Study`` to continue, as ``calibrate_study``'s (each
             model's emulator parameters too; its models' checks are ``gpmsa.fit``'s for
             ``init=emulator``, naming the model).
+        append: with ``init`` a study, as ``calibrate_study``'s: the study's draws and each
+            member's retained and calibration draws are the source's followed, chain by chain,
+            by the continuation's sweeps thin, 2 thin, ... (``thin`` the source's
+            ``settings["thin"]``, as ``gpmsa.fit``'s ``append``); each member's settings
+            record its own source member (``gpmsa.fit``'s appended settings). Also refused: an
+            n_keep other than the n_chains x (n_iter // thin) draws that step keeps.
         basis: as ``gpmsa.fit``'s, a numpy array for every model or a list with one entry
             (None: the model's PCA, as ``n_pc`` says) per model.
         metadata: a JSON-able dict saved with the study.
@@ -511,12 +535,14 @@ def fit_study(
         if not isinstance(o, ObsData):
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
     continuing = isinstance(init, Study)
+    append = cont.check_append(append, init, n_burn)
     if n_burn is None and isinstance(n_iter, int | np.integer):
         n_burn = 0 if continuing else n_iter // 5
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
     seed = run_seed(seed)
     check_point(point)
-    n_keep = check_keep(n_keep, n_chains)
+    given_keep = n_keep
+    n_keep = check_keep(N_KEEP if n_keep is None else n_keep, n_chains)
     metadata = check_metadata(metadata)
     tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
     labels = check_labels(labels, n)
@@ -561,22 +587,32 @@ def fit_study(
         models = cont.fit_starts(init, problems, preps, obs, int(n_chains))
         tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
                                          models)  # fmt: skip
+        if append:
+            thin = cont.appended_thin(init, int(n_iter), int(n_chains), given_keep)
+            if tune:
+                cont.refuse_tuning()
     chains = sample_study(
         problems, layout, hyper, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
         tune_levels=tune_levels, progress=progress, n_jobs=n_jobs, executor=executor, **resumed,
     )  # fmt: skip
     chains = _with_held(chains, problems, ORDER, fixes)
-    thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
-    keep = slice(int(n_burn), None, thin)
+    if not append:
+        thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
+    keep = slice(thin - 1, None, thin) if append else slice(int(n_burn), None, thin)
     settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point, **extra)
     settings.update(record)
     draws = _study_draws(chains, keep)
+    if append:  # the source's draws, then the continuation's at its step
+        draws = cont.pool_study_draws(init, draws)
+        settings.update(cont.appended_settings(init, int(n_iter), settings["accept_rate"]))
     lp = draws["log_post"].reshape(-1)
     members = []
     fitted_discrepancy = discrepancy_kind(discrepancy)
     for i, (sim, prep) in enumerate(zip(sims, preps, strict=True)):
         post = {k: v[:, keep] for k, v in chains.members[i].items()}
+        if append:
+            post = cont.pool_member(init.members[i], post)
         flat = {k: v.reshape(v.shape[0] * v.shape[1], *v.shape[2:]) for k, v in post.items()}
         theta = draws["theta"][:, :, list(layout.index[i])]
         flat["theta"] = theta.reshape(-1, theta.shape[2])
@@ -599,6 +635,8 @@ def fit_study(
             emu_settings.update(discrepancy_record(prep.problem.obs))
         if fixes[i] is not None:  # as gpmsa.fit records it (continuations compare it)
             emu_settings["fixed"] = fixed_record(problems[i])
+        if append:  # as gpmsa.fit(..., init=the source member, append=True) records it
+            emu_settings.update(appended_record(init.members[i], int(n_iter), int(n_chains)))
         members.append(Emulator._from_prepared(
             sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,
             settings=emu_settings, diagnostics=summarize({**post, "theta": theta}),
