@@ -83,9 +83,25 @@ def _check_run(n_iter, n_burn, n_chains, hyper, what: str = "n_samples") -> Hype
     return hyper
 
 
-def _check_memory(problems, n_iter: int, n_chains: int, what: str) -> None:
+def _check_memory(problems, n_iter: int, n_chains: int, what: str, pooled: int = 0) -> None:
+    """Refuse (before sampling) a study whose stored sweeps (every sweep of every chain, kept
+    twice while stacked) exceed the memory limit; ``pooled``: an appended study's draws per
+    chain (its source's and its own, `_appended_draws`), held 1.5 times more (the parts and
+    the pooled arrays), as ``gpmsa.fit`` counts an appended fit's."""
     per_sweep = sum(sum(int(np.size(p.init[n])) for n in p.sampled) for p in problems) + 4
-    check_memory(8.0 * 2.0 * per_sweep * n_iter * n_chains, what)
+    nbytes = 8.0 * 2.0 * per_sweep * n_iter * n_chains
+    if pooled:
+        nbytes += 8.0 * 1.5 * per_sweep * pooled * n_chains
+        what += f" appending to {pooled} draws a chain"
+    check_memory(nbytes, what)
+
+
+def _appended_draws(source: Study, n_iter: int) -> int:
+    """An appended study's draws per chain: the source's, then the continuation's at its step
+    (``settings["thin"]``; 1 where it records none usable, which ``appended_thin`` refuses)."""
+    thin = source.settings.get("thin", 1)
+    step = thin if isinstance(thin, int) and not isinstance(thin, bool) and thin >= 1 else 1
+    return int(source.draws["log_post"].shape[1]) + int(n_iter) // step
 
 
 def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
@@ -377,7 +393,8 @@ def calibrate_study(
                 for (lab, e, x, y), r, (basis, groups), h in zip(models, reduced, bases, held,
                                                                  strict=True)]  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
-                  f"n_chains={n_chains})")  # fmt: skip
+                  f"n_chains={n_chains})",
+                  _appended_draws(init, n_samples) if append else 0)  # fmt: skip
     natives = [calibration_held_native(e, f) for e, f in zip(emulators, fixes, strict=True)]
     record: dict = {}  # what the study records of its models, before any sampling
     _record_fixed(record, labels, problems, layout, fixes, natives)
@@ -571,7 +588,8 @@ def fit_study(
     problems = [p.problem if f is None else _per_model(lab, hold_fixed, p.problem, f,
                                                        p.standardizer, s.t_names)
                 for lab, p, s, f in zip(labels, preps, sims, fixes, strict=True)]  # fmt: skip
-    _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})")
+    _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})",
+                  _appended_draws(init, n_iter) if append else 0)  # fmt: skip
     t0 = time.perf_counter()
     natives = [fit_held_native(p, f, s.t_names)
                for p, f, s in zip(problems, fixes, sims, strict=True)]  # fmt: skip
@@ -635,6 +653,8 @@ def fit_study(
             emu_settings.update(discrepancy_record(prep.problem.obs))
         if fixes[i] is not None:  # as gpmsa.fit records it (continuations compare it)
             emu_settings["fixed"] = fixed_record(problems[i])
+        if continuing:  # as gpmsa.fit(..., init=the source member) records it
+            emu_settings["continued_from"] = init.members[i].model_sha256
         if append:  # as gpmsa.fit(..., init=the source member, append=True) records it
             emu_settings.update(appended_record(init.members[i], int(n_iter), int(n_chains)))
         members.append(Emulator._from_prepared(

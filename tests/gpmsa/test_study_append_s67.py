@@ -149,3 +149,18 @@ def test_what_cannot_be_appended_is_refused_naming_the_argument():
         with pytest.raises(gpmsa.GPMSAError, match=message):
             run(n, 1, **args)
     assert _fit(8, 1, init=fit, append=True, n_keep=4).draws["theta"].shape == (C, 10, 1)
+
+
+def test_the_memory_check_counts_an_appended_studys_pooled_draws(monkeypatch):
+    """The draws pooled with the source's are counted before sampling, as gpmsa.fit counts an
+    appended fit's (session 67's review: the study's check left them out)."""
+    import gpmsa.studies.run as run
+
+    seen = []
+    monkeypatch.setattr(run, "check_memory", lambda nbytes, what: seen.append((nbytes, what)))
+    _calibrate(6, 2, init=_cal_source(), tune=False)
+    _calibrate(6, 2, init=_cal_source(), tune=False, append=True)
+    _fit(8, 2, init=_fit_source(), tune=False, append=True)
+    (plain, _), (pooled, what), (fitted, fit_what) = seen
+    assert pooled > plain and "appending to 26 draws a chain" in what  # 20 + 6 at step 1
+    assert "appending to 10 draws a chain" in fit_what  # 8 + 8 // 4

@@ -113,6 +113,8 @@ def test_fit_study_continues_a_loaded_study_and_records_its_digest(tmp_path):
     more.save(tmp_path / "m.gpmsa")
     back = gpmsa.load_study(tmp_path / "m.gpmsa")
     assert back.settings["continued_from"] == loaded.sha256
+    for j, member in enumerate(back.members):  # each member names its own source, as fit's
+        assert member.settings["continued_from"] == loaded.members[j].model_sha256
     assert np.array_equal(back.draws["theta"], more.draws["theta"])
 
 
