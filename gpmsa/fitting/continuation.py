@@ -107,15 +107,17 @@ def continued_steps(emulator: Emulator) -> bool | None:
     return steps
 
 
-def check_append(append, init, n_burn) -> bool:
-    """``fit``'s ``append`` checked: a flag, True only with ``init`` an emulator (whose draws it
-    appends to) and ``n_burn`` None or 0 (the source's burn-in is already removed); GPMSAError
-    naming the argument otherwise."""
+def check_append(append, init, n_burn, kind: type = Emulator, source: str = "emulator",
+                 of: str = "fit") -> bool:  # fmt: skip
+    """``append`` checked (``fit``'s; a study function's with ``kind`` Study): a flag, True only
+    with ``init`` a ``kind`` (its ``source``, whose draws it appends to) and ``n_burn`` None or
+    0 (the source's burn-in is already removed); GPMSAError naming the argument otherwise."""
     append = check_flag(append, "append")
-    if append and not isinstance(init, Emulator):
+    if append and not isinstance(init, kind):
+        got = repr(init) if init is None or isinstance(init, str) else type(init).__name__
         raise GPMSAError(
-            f"append=True appends a continuation's draws to those of the fit it continues: pass "
-            f"init=that emulator (got init={type(init).__name__ if init is not None else None})"
+            f"append=True appends a continuation's draws to those of the {of} it continues: "
+            f"pass init=that {source} (got init={got})"
         )
     if append and n_burn not in (None, 0):
         raise GPMSAError(
@@ -146,21 +148,27 @@ def appended_thin(source: Emulator, n_iter: int, n_chains: int, n_keep) -> int:
     no draw at it, or where ``n_keep`` (None: the step's) is not that count (naming it)."""
     _has_draws(source)
     _chains_of(source, n_chains)
-    thin = (source.settings or {}).get("thin")
+    return append_step((source.settings or {}).get("thin"), n_iter, n_chains, n_keep)
+
+
+def append_step(thin, n_iter: int, n_chains: int, n_keep, source: str = "init=emulator") -> int:
+    """``thin``, the step its ``source`` (``init=``) recorded (settings["thin"]), checked for
+    an append: an integer >= 1 at which ``n_iter`` sweeps keep a draw, and ``n_keep`` (None:
+    the step's) the n_chains x (n_iter // thin) draws it keeps; GPMSAError naming each."""
     if isinstance(thin, bool) or not isinstance(thin, int) or thin < 1:
         raise GPMSAError(
-            f"append=True thins the continuation by its source's step, and init=emulator "
+            f"append=True thins the continuation by its source's step, and {source} "
             f"records none (settings['thin'] = {thin!r}): continue it without append"
         )
     new = n_chains * (n_iter // thin)
     if not new:
         raise GPMSAError(
-            f"append=True keeps every {thin}th sweep (init=emulator's step, settings['thin']): "
+            f"append=True keeps every {thin}th sweep ({source}'s step, settings['thin']): "
             f"n_iter={n_iter} keeps none; pass n_iter >= {thin}"
         )
     if n_keep is not None and n_keep != new:
         raise GPMSAError(
-            f"append=True thins by init=emulator's step {thin} (settings['thin']), which keeps "
+            f"append=True thins by {source}'s step {thin} (settings['thin']), which keeps "
             f"{new} draws of {n_chains} chain(s) x {n_iter} sweeps: pass n_keep={new}, or leave "
             f"n_keep out (got n_keep={n_keep!r})"
         )

@@ -11,9 +11,15 @@ import math
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.fitting.continuation import appended_counts, continued_starts, pool_chains, sweeps_run
+from gpmsa.fitting.continuation import (
+    append_step,
+    appended_counts,
+    continued_starts,
+    pool_chains,
+    sweeps_run,
+)
+from gpmsa.fitting.continuation import check_append as check_fit_append
 from gpmsa.fitting.emulator import EMULATOR_PARAMS
-from gpmsa.model.data import check_flag
 from gpmsa.model.problem import Problem
 from gpmsa.studies.layout import HyperPriors, Layout
 from gpmsa.studies.record import discrepancy_arrays
@@ -171,44 +177,16 @@ def source_digest(source: Study) -> str | None:
 
 
 def check_append(append, init, n_burn) -> bool:
-    """A study function's ``append`` checked: a flag, True only with ``init`` a Study (whose
-    draws it appends to) and ``n_burn`` None or 0 (the source's burn-in is already removed);
-    GPMSAError naming the argument otherwise."""
-    append = check_flag(append, "append")
-    if append and not isinstance(init, Study):
-        got = type(init).__name__ if not isinstance(init, str) else repr(init)
-        raise GPMSAError(f"append=True appends a continuation's draws to those of the study it "
-                         f"continues: pass init=that study (got init={got})")  # fmt: skip
-    if append and n_burn not in (None, 0):
-        raise GPMSAError(
-            f"append=True pools every kept sweep of the continuation (its chains start at the "
-            f"source's last kept draws, past burn-in): n_burn must be 0 or None, got {n_burn!r}"
-        )
-    return append
+    """A study function's ``append`` checked (`gpmsa.fitting.continuation.check_append`): a
+    flag, True only with ``init`` a Study and ``n_burn`` None or 0."""
+    return check_fit_append(append, init, n_burn, Study, "study", "study")
 
 
 def appended_thin(source: Study, n_iter: int, n_chains: int, n_keep=None) -> int:
     """The thinning step of an appended study: the source's (``settings["thin"]``; a
-    calibration study keeps every sweep: 1), whose continuation keeps n_chains x (n_iter //
-    thin) draws. GPMSAError where the source records no step, where ``n_iter`` keeps no draw
-    at it, or where ``n_keep`` (``fit_study``'s; None: the step's) is not that count."""
-    thin = source.settings.get("thin", 1)
-    if isinstance(thin, bool) or not isinstance(thin, int) or thin < 1:
-        raise GPMSAError(f"append=True thins the continuation by its source's step, and "
-                         f"init=study records none (settings['thin'] = {thin!r}): continue it "
-                         "without append")  # fmt: skip
-    new = n_chains * (n_iter // thin)
-    if not new:
-        raise GPMSAError(f"append=True keeps every {thin}th sweep (init=study's step, "
-                         f"settings['thin']): n_iter={n_iter} keeps none; pass n_iter >= "
-                         f"{thin}")  # fmt: skip
-    if n_keep is not None and n_keep != new:
-        raise GPMSAError(
-            f"append=True thins by init=study's step {thin} (settings['thin']), which keeps "
-            f"{new} draws of {n_chains} chain(s) x {n_iter} sweeps: pass n_keep={new}, or leave "
-            f"n_keep out (got n_keep={n_keep!r})"
-        )
-    return thin
+    calibration study keeps every sweep: 1), checked as an appended fit's
+    (`gpmsa.fitting.continuation.append_step`)."""
+    return append_step(source.settings.get("thin", 1), n_iter, n_chains, n_keep, "init=study")
 
 
 def refuse_tuning() -> None:

@@ -83,25 +83,19 @@ def _check_run(n_iter, n_burn, n_chains, hyper, what: str = "n_samples") -> Hype
     return hyper
 
 
-def _check_memory(problems, n_iter: int, n_chains: int, what: str, pooled: int = 0) -> None:
+def _check_memory(problems, n_iter: int, n_chains: int, what: str,
+                  append_to: Study | None = None, thin: int = 1) -> None:  # fmt: skip
     """Refuse (before sampling) a study whose stored sweeps (every sweep of every chain, kept
-    twice while stacked) exceed the memory limit; ``pooled``: an appended study's draws per
-    chain (its source's and its own, `_appended_draws`), held 1.5 times more (the parts and
-    the pooled arrays), as ``gpmsa.fit`` counts an appended fit's."""
+    twice while stacked) exceed the memory limit; appending to ``append_to`` at its step
+    ``thin``, also the pooled draws a chain (its and the continuation's), held 1.5 times more
+    (the parts and the pooled arrays), as ``gpmsa.fit`` counts an appended fit's."""
     per_sweep = sum(sum(int(np.size(p.init[n])) for n in p.sampled) for p in problems) + 4
     nbytes = 8.0 * 2.0 * per_sweep * n_iter * n_chains
-    if pooled:
+    if append_to is not None:
+        pooled = int(append_to.draws["log_post"].shape[1]) + int(n_iter) // thin
         nbytes += 8.0 * 1.5 * per_sweep * pooled * n_chains
         what += f" appending to {pooled} draws a chain"
     check_memory(nbytes, what)
-
-
-def _appended_draws(source: Study, n_iter: int) -> int:
-    """An appended study's draws per chain: the source's, then the continuation's at its step
-    (``settings["thin"]``; 1 where it records none usable, which ``appended_thin`` refuses)."""
-    thin = source.settings.get("thin", 1)
-    step = thin if isinstance(thin, int) and not isinstance(thin, bool) and thin >= 1 else 1
-    return int(source.draws["log_post"].shape[1]) + int(n_iter) // step
 
 
 def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
@@ -126,16 +120,19 @@ def _tune_rule(tune, init) -> bool | None:
 
 
 def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool | None,
-              models: list[list[dict]]) -> tuple[bool, dict, dict]:  # fmt: skip
+              models: list[list[dict]], append: bool) -> tuple[bool, dict, dict]:  # fmt: skip
     """A continuation of ``source``'s chains from ``models`` (per chain, each model's start):
     (tune, ``sample_study``'s continuation arguments, the settings it adds). Untuned (``tune``
     None where ``source`` records its chains' widths, or False), each chain runs on with its
-    recorded widths and precision steps; tuned, from GPM/SA's widths."""
+    recorded widths and precision steps; tuned, from GPM/SA's widths (refused where it
+    ``append``s: `continuation.refuse_tuning`)."""
     starts = cont.chain_starts(source, models)
     names = cont.sweep_names(problems, layout, hyper, starts[0])
     widths = None if tune is True else cont.continued_widths(source, names, n_chains)
     if tune is None:
         tune = widths is None
+    if tune and append:
+        cont.refuse_tuning()
     if tune:
         widths = None
     steps = None if tune else cont.continued_steps(source)
@@ -392,9 +389,6 @@ def calibrate_study(
                            discrepancy_groups=groups, fixed=h)
                 for (lab, e, x, y), r, (basis, groups), h in zip(models, reduced, bases, held,
                                                                  strict=True)]  # fmt: skip
-    _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
-                  f"n_chains={n_chains})",
-                  _appended_draws(init, n_samples) if append else 0)  # fmt: skip
     natives = [calibration_held_native(e, f) for e, f in zip(emulators, fixes, strict=True)]
     record: dict = {}  # what the study records of its models, before any sampling
     _record_fixed(record, labels, problems, layout, fixes, natives)
@@ -419,10 +413,11 @@ def calibrate_study(
                "discrepancy": (old.get(DISCREPANCIES), record.get(DISCREPANCIES))},
         )  # fmt: skip
         thin = cont.appended_thin(init, int(n_samples), int(n_chains)) if append else 1
+        starts = cont.calibration_starts(init, problems)
         tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
-                                         cont.calibration_starts(init, problems))  # fmt: skip
-        if append and tune:
-            cont.refuse_tuning()
+                                         starts, append)  # fmt: skip
+    _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
+                  f"n_chains={n_chains})", init if append else None, thin)  # fmt: skip
     chains = sample_study(
         problems, layout, hyper, n_iter=int(n_samples), n_chains=int(n_chains), tune=tune,
         seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
@@ -588,8 +583,6 @@ def fit_study(
     problems = [p.problem if f is None else _per_model(lab, hold_fixed, p.problem, f,
                                                        p.standardizer, s.t_names)
                 for lab, p, s, f in zip(labels, preps, sims, fixes, strict=True)]  # fmt: skip
-    _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})",
-                  _appended_draws(init, n_iter) if append else 0)  # fmt: skip
     t0 = time.perf_counter()
     natives = [fit_held_native(p, f, s.t_names)
                for p, f, s in zip(problems, fixes, sims, strict=True)]  # fmt: skip
@@ -602,13 +595,13 @@ def fit_study(
             **{"fixed values": ([init.settings.get(k) for k in ("fixed", HELD_THETA)],
                                 [record.get(k) for k in ("fixed", HELD_THETA)])},
         )  # fmt: skip
-        models = cont.fit_starts(init, problems, preps, obs, int(n_chains))
-        tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
-                                         models)  # fmt: skip
         if append:
             thin = cont.appended_thin(init, int(n_iter), int(n_chains), given_keep)
-            if tune:
-                cont.refuse_tuning()
+        models = cont.fit_starts(init, problems, preps, obs, int(n_chains))
+        tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
+                                         models, append)  # fmt: skip
+    _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})",
+                  init if append else None, thin if append else 1)  # fmt: skip
     chains = sample_study(
         problems, layout, hyper, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
