@@ -7,26 +7,11 @@ import warnings
 
 import numpy as np
 import pytest
+from _continue_cases import continue_data as _data
+from _continue_cases import continue_fit as _fit
 from _emulator_edit import replaced
 
 import gpmsa
-
-
-@functools.cache
-def _data():
-    rng = np.random.default_rng(1)
-    x, t = rng.random((24, 1)), rng.random((24, 1))
-    data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t**2, x_names=["x"], t_names=["t"])
-    obs = gpmsa.ObsData(x=[[0.2], [0.7]], y=[[np.sin(0.6) + 0.16], [np.sin(2.1) + 0.16]])
-    return data, obs
-
-
-def _fit(**kw):
-    data, obs = _data()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
-        return gpmsa.fit(data, obs, seed=0, n_chains=2, **kw)
-
 
 WARMUP = {"numpy": {}, "torch": {"warmup": 10}}
 """torch's warm-up before each of its 3 tuning stages: 10 sweeps, not 100 (3 s of the test's 5
