@@ -34,12 +34,12 @@ from gpmsa.calibration.observations import (
     checked_obs_data,
     emulator_param_sets,
     emulator_record,
+    fit_at_levels,
     fit_of,
     fixed_gp,
     given_obs_data,
     lamos_start,
     obs_inputs,
-    outside_at_levels,
     probe_layout,
     reduce,
     theta_levels,
@@ -440,21 +440,21 @@ def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:
 
 def observation_fit(emulator, data, sets) -> Fit:
     """The observation's ``Fit`` over ``theta_probe`` (the best over the parameter sets). A
-    categorical theta takes its levels only: its outside_sds over them (`outside_at_levels`:
-    the levels crossed with the continuous parameters' nodes; over ``theta_probe`` where the
-    combinations of levels exceed `LEVEL_PROBE_BUDGET`); its excess_var (the lamOs start,
-    `lamos_start`) still over ``theta_probe`` without the sign-change rule, as before."""
+    categorical theta takes its levels only: its outside_sds and excess_var (the lamOs start,
+    `lamos_start`) both over them, from one probe (`fit_at_levels`: the levels crossed with the
+    continuous parameters' nodes); over ``theta_probe`` (without the sign-change rule) where
+    the combinations of levels exceed `LEVEL_PROBE_BUDGET`."""
+    levels = theta_levels(emulator)
+    gps = [fixed_gp(emulator, s) for s in sets]
+    if levels is not None:
+        at_levels = [fit_at_levels(gp.predict, data, levels) for gp in gps]
+        if None not in at_levels:
+            return Fit(min(f.outside_sds for f in at_levels), min(f.excess_var for f in at_levels))
     q = emulator.t_unit.shape[1]
     theta = theta_probe(q)
-    levels = theta_levels(emulator)
     layout = probe_layout(q) if levels is None else None
-    gps = [fixed_gp(emulator, s) for s in sets]
     fits = [fit_of(*gp.predict(data.x, theta), data, layout) for gp in gps]
-    outside = min(f.outside_sds for f in fits)
-    if levels is not None:  # at the levels, unless there are too many of them
-        at_levels = [outside_at_levels(gp.predict, data, levels) for gp in gps]
-        outside = outside if None in at_levels else min(at_levels)
-    return Fit(outside, min(f.excess_var for f in fits))
+    return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
 
 
 def _check_calibrate_memory(emulator, n_samples: int, n_chains: int, fast: bool) -> None:

@@ -37,13 +37,13 @@ OUTSIDE_SDS = 5.0
 x (over the whole theta domain) lies outside what the emulator has seen: a warning
 (``OutsideEmulatorWarning``), and ``Posterior.info["outside_sds"]`` holds the distance."""
 LEVEL_PROBE_NODES = 1089
-"""About how many theta values `outside_at_levels` predicts at in one call (`theta_probe`'s
+"""About how many theta values `fit_at_levels` predicts at in one call (`theta_probe`'s
 most: 33 x 33), so that many combinations of levels cost time, not memory."""
 LEVEL_PROBE_BUDGET = 8 * LEVEL_PROBE_NODES
-"""Most theta values `outside_at_levels` looks at (8,712: eight of `theta_probe`'s largest
+"""Most theta values `fit_at_levels` looks at (8,712: eight of `theta_probe`'s largest
 probe): with many combinations of levels the continuous parameters are probed more coarsely
-(`continuous_probe`), and with more combinations than this the check is `theta_probe`'s, as
-for a continuous theta (off the levels: weaker)."""
+(`continuous_probe`), and with more combinations than this the check and the lamOs start are
+`theta_probe`'s, as for a continuous theta (off the levels: weaker)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -439,7 +439,6 @@ def fit_of(
     between them (the predictive mean is continuous in theta), however far the nodes' means
     lie from it in predictive sds (an emulator with a negligible nugget read a datum exactly
     on the simulator 11 sds outside, between probe nodes)."""
-    G, p_u, n = mean.shape
     resid, var, dist, alone = _distances(mean, cov, data)
     if alone:  # no error estimate: each datum on its own
         nearest = np.min(dist, axis=0)
@@ -448,6 +447,23 @@ def fit_of(
         outside = float(np.max(nearest))
     else:
         outside = float(np.min(np.max(dist, axis=1)))
+    return Fit(outside, float(np.min(_excess(resid, var, cov, data, _chol_inverse(data)))))
+
+
+def _chol_inverse(data: Observations) -> np.ndarray | None:
+    """L^-1 (d, d) of ``data.obs_chol``, which `_excess` needs; None for one datum (d = 1)."""
+    if data.z.size == 1:
+        return None
+    from scipy.linalg import solve_triangular
+
+    return solve_triangular(data.obs_chol, np.eye(data.z.size), lower=True)
+
+
+def _excess(resid, var, cov, data: Observations, Linv: np.ndarray | None) -> np.ndarray:
+    """Per theta value (G,), the observation-error variance (unit lamOs) beyond the emulator's
+    that the residuals need (`Fit.excess_var`): `_distances`' resid and var (G, d), the
+    predictive cov (G, p_u, n, n), ``Linv`` `_chol_inverse`'s."""
+    G, p_u, n = cov.shape[:3]
     L = data.obs_chol
     d = data.z.size
     if d == 1:
@@ -457,13 +473,11 @@ def fit_of(
         from scipy.linalg import solve_triangular
 
         y2 = np.sum(solve_triangular(L, resid.T, lower=True) ** 2, axis=0)
-        Linv = solve_triangular(L, np.eye(d), lower=True)
         tr = np.zeros(G)
         for c in range(p_u):  # tr(L^-1 S L^-T), S block-diagonal over components
             blk = Linv[:, c * n : (c + 1) * n]
             tr += np.einsum("ai,gij,aj->g", blk, cov[:, c], blk)
-    excess = np.maximum(0.0, (y2 - tr) / max(d - data.obs.n_null, 1))  # observed directions
-    return Fit(outside, float(np.min(excess)))
+    return np.maximum(0.0, (y2 - tr) / max(d - data.obs.n_null, 1))  # observed directions
 
 
 def _distances(mean: np.ndarray, cov: np.ndarray, data: Observations) -> tuple:
@@ -515,7 +529,7 @@ def continuous_probe(n_cont: int, n_combos: int):
 
 
 def level_probe_blocks(levels: list, nodes: int = LEVEL_PROBE_NODES):
-    """The theta values at which `outside_at_levels` looks, for a categorical theta (``levels``:
+    """The theta values at which `fit_at_levels` looks, for a categorical theta (``levels``:
     per parameter its unit-scale levels, None for a continuous one): every combination of the
     categorical parameters' levels, each crossed with the continuous ones' nodes
     (`continuous_probe`: `theta_probe`'s, coarser for many combinations; one node without
@@ -541,20 +555,23 @@ def level_probe_blocks(levels: list, nodes: int = LEVEL_PROBE_NODES):
         yield theta, chunk.shape[0], layout
 
 
-def outside_at_levels(predict, data: Observations, levels: list) -> float | None:
-    """``Fit.outside_sds`` for a categorical theta, which takes its levels only: over
-    `level_probe_blocks` (``predict(x, theta)``: ``FixedGP.predict``), in chunks. Off its levels
-    the predictive mean is no level's (the kernel's other-level correlation) and its sd about
-    the prior's, so `theta_probe`'s nodes there read an observation that no level explains as
-    within a few sds. A datum judged on its own is met where its residual changes sign between
-    neighbouring continuous nodes of one combination of levels (`fit_of`'s rule), never
-    between levels. None where the combinations of levels exceed `LEVEL_PROBE_BUDGET`
-    (`level_probe_blocks` yields none)."""
-    nearest, best, looked = None, np.inf, False
+def fit_at_levels(predict, data: Observations, levels: list) -> Fit | None:
+    """``Fit`` of the observation for a categorical theta, which takes its levels only: over
+    `level_probe_blocks` (``predict(x, theta)``: ``FixedGP.predict``), in chunks, both numbers
+    from the same predictions. Off its levels the predictive mean is no level's (the kernel's
+    other-level correlation) and its sd about the prior's, so `theta_probe`'s nodes there read
+    an observation that no level explains as within a few sds, and their excess_var (the lamOs
+    start, `lamos_start`) is that of theta values the chain never visits. A datum judged on its
+    own is met where its residual changes sign between neighbouring continuous nodes of one
+    combination of levels (`fit_of`'s rule), never between levels. None where the combinations
+    of levels exceed `LEVEL_PROBE_BUDGET` (`level_probe_blocks` yields none)."""
+    nearest, best, excess, Linv, looked = None, np.inf, np.inf, None, False
     for theta, b, layout in level_probe_blocks(levels):
+        Linv = _chol_inverse(data) if not looked else Linv
         looked = True
         mean, cov = predict(data.x, theta)
-        resid, _, dist, alone = _distances(mean, cov, data)
+        resid, var, dist, alone = _distances(mean, cov, data)
+        excess = min(excess, float(np.min(_excess(resid, var, cov, data, Linv))))
         if not alone:
             best = min(best, float(np.min(np.max(dist, axis=1))))
             continue
@@ -567,7 +584,7 @@ def outside_at_levels(predict, data: Observations, levels: list) -> float | None
         nearest = near if nearest is None else np.minimum(nearest, near)
     if not looked:
         return None
-    return best if nearest is None else float(np.max(nearest))
+    return Fit(best if nearest is None else float(np.max(nearest)), excess)
 
 
 def _crossed(resid: np.ndarray, layout: tuple[int, ...]) -> np.ndarray:

@@ -19,8 +19,11 @@ from gpmsa.calibration.observations import (
     LEVEL_PROBE_BUDGET,
     OUTSIDE_SDS,
     continuous_probe,
+    fit_at_levels,
+    fit_of,
+    fixed_gp,
+    lamos_start,
     level_probe_blocks,
-    outside_at_levels,
     reduce,
 )
 from gpmsa.errors import OutsideEmulatorWarning
@@ -115,7 +118,7 @@ def test_many_combinations_of_levels_stay_within_the_probe_budget():
 
 def test_too_many_combinations_fall_back_to_the_continuous_probe():
     levels = [tuple(np.linspace(0, 1, 20))] * 3 + [(0.0, 1.0)]
-    assert outside_at_levels(None, None, levels) is None  # nothing predicted
+    assert fit_at_levels(None, None, levels) is None  # nothing predicted
     rng = np.random.default_rng(0)
     x = rng.random(63)  # three parameters of 21 levels: 9,261 combinations, over the budget
     t = np.column_stack([np.arange(63) % 21, (np.arange(63) // 3) % 21, rng.integers(0, 21, 63)])
@@ -123,3 +126,48 @@ def test_too_many_combinations_fall_back_to_the_continuous_probe():
     emu = gpmsa.Emulator.from_params(sim, {"betaU": [[1.0]] * 4, **PARAMS})
     post = gpmsa.calibrate(emu, X_OBS, X_OBS[:, 0] + 0.5, n_samples=20, n_burn=5, seed=0)
     assert np.isfinite(post.info["outside_sds"])  # theta_probe's, as before session 67
+
+
+def _fit(emu, offset):
+    data = reduce(emu, X_OBS, (X_OBS[:, 0] + offset)[:, None], False)
+    return data, observation_fit(emu, data, [emu.params])
+
+
+def test_the_lamos_start_is_taken_at_the_levels():
+    """The lamOs start (excess_var) came from theta_probe's nodes, off the levels (session 68):
+    data that level 1 explains (1.15 sds) read an excess of 1.03 there, the chain started at
+    lamOs 0.97 against a posterior near 1,300 and its lamOs steps were accepted 0.93-0.96 of
+    the time at 300 sweeps (0.98-0.99 at 3,000, ESS 4-7 of 2,000); data between two levels read
+    none (start 1,000, posterior 3.3). Now both from the levels: 0 and 0.38."""
+    emu = _one_level_parameter()
+    data, fit = _fit(emu, 1.0 + 0.02)
+    assert fit.excess_var == 0.0
+    assert lamos_start(fit, data.lamos) == max(20.0, data.lamos.shape / data.lamos.rate)
+    data, fit = _fit(emu, 0.5)
+    levels = np.array([[0.0], [1.0 / 3.0], [1.0]])  # the unit-scale levels
+    at = fit_of(*fixed_gp(emu).predict(data.x, levels), data)
+    assert fit.excess_var == at.excess_var > 0.3
+    assert lamos_start(fit, data.lamos) < 3.0
+    post = gpmsa.calibrate(emu, X_OBS, X_OBS[:, 0] + 1.02, n_samples=300, n_burn=100, seed=0)
+    assert post.info["accept_rate"][0][-1] < 0.6  # lamOs: 0.96 before
+
+
+@pytest.mark.parametrize(
+    ("case", "rows", "levels"),
+    [
+        (_one_level_parameter, 3, [0.0, 1.0 / 3.0, 1.0]),
+        (_level_and_continuous, 387, [0.0, 0.5, 1.0]),
+    ],
+)
+def test_observation_fit_predicts_once_and_at_the_levels_only(case, rows, levels, monkeypatch):
+    """One probe serves the outside check and the lamOs start: before, theta_probe's 129
+    (1,089) nodes off the levels were predicted too."""
+    from gpmsa.calibration.model import FixedGP
+
+    emu, seen = case(), []
+    predict = FixedGP.predict
+    monkeypatch.setattr(FixedGP, "predict", lambda gp, x, t: seen.append(t) or predict(gp, x, t))
+    _fit(emu, 2.0)
+    theta = np.vstack(seen)
+    assert theta.shape[0] == rows
+    assert np.isin(theta[:, 0], levels).all()
