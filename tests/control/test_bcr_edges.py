@@ -92,9 +92,10 @@ def test_after_a_wild_clock_an_estimate_still_turns_stale():
     for k in range(0, 1000, CHUNK):
         now = 1e9 if k == 1000 - CHUNK else t[k + CHUNK - 1]
         bcr.update(t[k : k + CHUNK], p[k : k + CHUNK], a[k : k + CHUNK], v[k : k + CHUNK], now=now)
+    rest = np.random.default_rng(2).normal(0.0, 0.01, CHUNK)  # a sensor at rest: its noise
     for k in range(10):  # 10 s standing still, the caller's clock sane again
         standing = t[-1] + (k * CHUNK + np.arange(1, CHUNK + 1)) / 120
-        est = bcr.update(standing, np.full(CHUNK, p[-1]), a[:CHUNK], np.zeros(CHUNK),
+        est = bcr.update(standing, np.full(CHUNK, p[-1]), rest, np.zeros(CHUNK),
                          now=standing[-1])  # fmt: skip
     assert est.status == "stale" and "old (max_age_s = 5)" in est.reason
 
