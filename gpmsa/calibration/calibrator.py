@@ -125,12 +125,13 @@ def _check_mcmc_options(options, backend: str) -> dict:
 
 
 def _mcmc_backend(backend, options) -> str:
-    """The Calibrator's backend: ``backend``, or ``options["backend"]`` (``mcmc_options``)
-    where ``backend`` is numpy, the default; GPMSAError where the two name different ones."""
+    """The Calibrator's backend: ``backend``, or where it is None (the default)
+    ``options["backend"]`` (``mcmc_options``), else numpy; GPMSAError where both are given and
+    name different ones (an explicit "numpy" too)."""
     if not isinstance(options, dict) or "backend" not in options:
-        return backend
+        return "numpy" if backend is None else backend
     given = options["backend"]
-    if backend == "numpy" or (isinstance(given, str) and given == backend):
+    if backend is None or (isinstance(given, str) and given == backend):
         return given
     raise GPMSAError(
         f"backend={backend!r} and mcmc_options['backend']={given!r} disagree: give the "
@@ -158,8 +159,9 @@ class Calibrator:
             for pyro).
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
             ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
-            "auto" choose MCMC. ``mcmc_options["backend"]`` is taken as this argument (a
-            GPMSAError where both are given and differ).
+            "auto" choose MCMC. None (the default): ``mcmc_options["backend"]`` where it names
+            one, else "numpy"; a GPMSAError where both are given and differ (an explicit
+            "numpy" too).
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there. On the grid, for one parameter the density is cut at
             the boundary (located by bisection between nodes, to float precision), so that no
@@ -186,7 +188,7 @@ class Calibrator:
         n_draws: int = 4000,
         seed=None,
         mcmc_options: dict | None = None,
-        backend: str = "numpy",
+        backend: str | None = None,
         constraint=None,
     ) -> None:
         check_emulator(emulator)

@@ -4,6 +4,7 @@ which pools the source's retained draws with the continuation's (SEPIA's second 
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -11,30 +12,38 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
 from gpmsa.mcmc.sampler import check_step_widths
+from gpmsa.model.basis import reordered_basis
 from gpmsa.model.data import ObsData, check_flag
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, fixed_record
 
 
-def continued_starts(
-    emulator: Emulator, problem: Problem, K: np.ndarray, obs: ObsData | None, n_chains: int
-) -> dict[str, np.ndarray]:
+def continued_starts(emulator: Emulator, problem: Problem, K: np.ndarray, obs: ObsData | None,
+                     n_chains: int, reorder: bool = True) -> dict[str, np.ndarray]:  # fmt: skip
     """Each chain's start at its last kept draw in ``emulator`` (a fit of the same data, and
     observations for a joint fit, with ``n_chains`` chains): name -> (n_chains, *shape), for a
     backend's ``init``. Its chains continue where they stopped being recorded (a draw of each
     chain, not a fresh dispersed start): a fit that warned of R-hat or ESS runs on without
-    starting over. GPMSAError naming what differs."""
+    starting over. A basis K or discrepancy basis D whose columns are the source's up to their
+    signs and order is the same model (``component_order``, ``reordered_basis``): the starts
+    of the per-component parameters (betaU's columns, lamUz, lamWs) follow K's columns (with
+    ``reorder`` False another order is refused). GPMSAError naming what differs."""
     _has_draws(emulator)
     _chains_of(emulator, n_chains)
     settings = emulator.settings or {}
     same = (emulator.x_unit.shape == problem.x_sim.shape and emulator.K.shape == K.shape
             and np.array_equal(emulator.x_unit, problem.x_sim)
-            and np.array_equal(emulator.t_unit, problem.t_sim)
-            and np.allclose(emulator.w, problem.w, rtol=0.0, atol=1e-12))  # fmt: skip
-    if not same:
+            and np.array_equal(emulator.t_unit, problem.t_sim))  # fmt: skip
+    order = component_order(emulator, problem) if same else None
+    if order is None:
         raise GPMSAError(
             "init=emulator was fitted to other simulation runs (or another n_pc or basis)"
+        )
+    if not reorder and order != sorted(order):
+        raise GPMSAError(
+            f"init=emulator's basis vectors are this fit's in another order (this fit's "
+            f"component j is its {order}[j]); continue it with the basis in its order"
         )
     cal = emulator.calibration or {}
     if (obs is None) != (not cal):
@@ -44,7 +53,7 @@ def continued_starts(
         )  # fmt: skip
     if obs is not None and settings.get("obs_sha256") not in (None, obs.digest()):
         raise GPMSAError("init=emulator was fitted jointly with other observations")
-    differs = _model_differences(emulator, problem)
+    differs = _model_differences(emulator, problem, order)
     if differs:
         raise GPMSAError(
             f"init=emulator was another model: its {', '.join(differs)} differ from this fit's; "
@@ -60,8 +69,45 @@ def continued_starts(
                 f"init=emulator has no {name} of shape {init.shape} (another discrepancy basis, "
                 "groups or model?)"
             )
-        out[name] = np.array(source[name][last], dtype=np.float64)
+        out[name] = np.array(reordered(name, source[name], order)[last], dtype=np.float64)
     return out
+
+
+PER_COMPONENT = ("betaU", "lamUz", "lamWs")
+"""The emulator parameters with one entry per basis vector of K (their last axis)."""
+
+
+def component_order(emulator: Emulator, problem: Problem) -> list[int] | None:
+    """Where each of ``problem``'s basis vectors (K's columns) is among ``emulator``'s (a fit of
+    the same runs): its component j is the emulator's ``order[j]``, up to its sign (the weights
+    w agree to 1e-12, a sign flipped or not); None where they are not the same vectors. Their
+    model is the same (each component's weights have a zero-mean GP prior of their own), its
+    per-component parameters ``PER_COMPONENT`` in another order."""
+    old, new = np.asarray(emulator.w), np.asarray(problem.w)
+    if old.shape != new.shape:
+        return None
+    order = []
+    for j in range(new.shape[1]):
+        hits = [i for i in range(old.shape[1]) if i not in order
+                and _same_up_to_sign(old[:, i], new[:, j])]  # fmt: skip
+        if not hits:
+            return None
+        order.append(hits[0])
+    return order
+
+
+def _same_up_to_sign(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether weights ``a`` and ``b`` (m,) agree to 1e-12, one's sign flipped or not."""
+    return any(np.allclose(s * a, b, rtol=0.0, atol=1e-12) for s in (1.0, -1.0))
+
+
+def reordered(name: str, values, order: list[int] | None):
+    """A source's draws (or widths, rates) of parameter ``name``, (..., p_u) for a per-component
+    one (``PER_COMPONENT``), in the order of this fit's components (``component_order``);
+    other parameters, or ``order`` None, as given."""
+    if order is None or name not in PER_COMPONENT or order == sorted(order):
+        return values
+    return np.asarray(values)[..., order]
 
 
 MH_BACKENDS = ("numpy", "torch")
@@ -69,15 +115,19 @@ MH_BACKENDS = ("numpy", "torch")
 on with them)."""
 
 
-def continued_widths(emulator: Emulator, problem: Problem, n_chains: int) -> dict | None:
+def continued_widths(emulator: Emulator, problem: Problem, n_chains: int,
+                     order: list[int] | None = None) -> dict | None:  # fmt: skip
     """The step widths ``emulator``'s chains ran with (``settings["step_widths"]``, per chain),
     for its continuation; None where it recorded none or its backend's are not Metropolis widths
     (``MH_BACKENDS``; pyro records its NUTS step size there). GPMSAError where the record does
-    not fit ``problem``'s chains and parameters (a damaged file)."""
+    not fit ``problem``'s chains and parameters (a damaged file). ``order``: this fit's
+    components among the source's (``component_order``)."""
     settings = emulator.settings or {}
     record = settings.get("step_widths")
     if not record or settings.get("backend") not in MH_BACKENDS:
         return None
+    if isinstance(record, dict):
+        record = {k: _reordered_list(k, v, order) for k, v in record.items()}
     try:
         check_step_widths(record, problem, n_chains)
     except GPMSAError as exc:
@@ -175,6 +225,17 @@ def append_step(thin, n_iter: int, n_chains: int, n_keep, source: str = "init=em
     return thin
 
 
+def _reordered_list(name: str, values, order: list[int] | None):
+    """A recorded nested list (of numbers and None) of ``name``, its last axis in the order of
+    this fit's components (``reordered``); as given where that fails (a damaged record, which
+    its check then names)."""
+    try:
+        moved = reordered(name, np.asarray(values, dtype=object), order)
+    except (IndexError, ValueError):
+        return values
+    return values if moved is not None and moved.ndim == 0 else moved.tolist()
+
+
 def pool_chains(first: np.ndarray, second: np.ndarray, n_chains: int) -> np.ndarray:
     """Chain-major draws (n_chains a, *shape) and (n_chains b, *shape) pooled as
     (n_chains (a + b), *shape): each chain's ``first`` draws, then its ``second``."""
@@ -185,15 +246,18 @@ def pool_chains(first: np.ndarray, second: np.ndarray, n_chains: int) -> np.ndar
     return both.reshape(n_chains * (a + b), *first.shape[1:])
 
 
-def pool_draws(source: Emulator, retained: dict, log_post: np.ndarray, calibration, n_chains):
+def pool_draws(source: Emulator, retained: dict, log_post: np.ndarray, calibration, n_chains,
+               order: list[int] | None = None):  # fmt: skip
     """``source``'s retained draws (emulator and calibration ones), log posteriors and
     calibration draws, each chain followed by a continuation's (``retained``, ``log_post``,
     ``calibration``, chain-major as ``fit`` keeps them). GPMSAError where the source lacks a
-    parameter the continuation sampled or its shape differs."""
+    parameter the continuation sampled or its shape differs. ``order``: this fit's components
+    among the source's (``component_order``): the pooled draws are in this fit's."""
     cal = dict(source.calibration or {})
     pooled = {}
     for k, v in retained.items():
         old = source.draws.get(k) if k in EMULATOR_PARAMS else cal.get(k)
+        old = None if old is None else reordered(k, old, order)
         if old is None or np.shape(old)[1:] != v.shape[1:]:
             raise GPMSAError(f"append=True: init=emulator has no {k} draws of shape "
                              f"{v.shape[1:]} to append to (another model?)")  # fmt: skip
@@ -247,14 +311,14 @@ def sweeps_run(settings: dict) -> int | None:
     return _sweeps(settings)[1]
 
 
-def pool_accept(
-    summary: dict, source: Emulator, accept_rate: dict, n_iter: int, backend: str
-) -> None:
+def pool_accept(summary: dict, source: Emulator, accept_rate: dict, n_iter: int, backend: str,
+                order: list[int] | None = None) -> None:  # fmt: skip
     """Each entry of ``summary`` (``summarize`` of pooled draws) given the acceptance rate of
     both parts, weighted by their sweeps (the source's "accept" in its diagnostics over its
     sweeps run, ``accept_rate`` (n_chains, *shape) over ``n_iter``); none where the source
     records no rate or sweeps, or where one part is Metropolis (``MH_BACKENDS``) and the other
-    NUTS (pyro's rate is another figure)."""
+    NUTS (pyro's rate is another figure). ``order``: this fit's components among the source's
+    (``component_order``)."""
     settings = source.settings or {}
     run = _sweeps(settings)[1]
     if (settings.get("backend") in MH_BACKENDS) != (backend in MH_BACKENDS):
@@ -267,27 +331,54 @@ def pool_accept(
         old = np.array([np.nan if v is None else v for v in old], dtype=float)
         if old.shape != new.shape:
             continue
+        shape = accept_rate[name].shape[1:]
+        old = np.asarray(reordered(name, old.reshape(shape), order)).reshape(-1)
         both = (old * run + new * n_iter) / (run + n_iter)
         entry["accept"] = [float(v) for v in both]
 
 
-def _model_differences(emulator: Emulator, problem: Problem) -> list[str]:
+def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | None = None
+                       ) -> list[str]:  # fmt: skip
     """What of the model ``emulator`` was fitted with differs from ``problem``'s: its priors,
-    mean basis, fixed parameters, theta constraint and discrepancy basis and groups."""
+    mean basis, fixed parameters, theta constraint and discrepancy basis and groups. A
+    discrepancy basis whose columns are the source's up to their signs and order (each with
+    its group: ``reordered_basis``) is the same; where it or K (``order``, from
+    ``component_order``) is reordered, the data-corrected priors agree to 1e-12 (the
+    correction's sums run in another order), and a per-component parameter held (fixed) with
+    K in another order is another model."""
     settings = emulator.settings or {}
     mb = problem.mean_basis
     disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
     n_grp = problem.obs.n_groups if problem.obs is not None and problem.obs.p_v else 0
-    checks = {
-        "priors": (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp)),
-        "mean_basis": (settings.get("mean_basis"), None if mb is None else mb.kind),
-        "fixed parameters": (settings.get("fixed", {}), fixed_record(problem)),
-        "theta constraint": (bool(settings.get("constraint", False)),
-                             problem.constraint is not None),
-        "discrepancy": ({k: settings.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")},
-                        {k: disc.get(k) for k in ("discrepancy_sha256", "discrepancy_groups")}),
-    }  # fmt: skip
-    return [name for name, (old, new) in checks.items() if old != new]
+    keys = ("discrepancy_sha256", "discrepancy_groups")
+    old_disc, new_disc = {k: settings.get(k) for k in keys}, {k: disc.get(k) for k in keys}
+    k_moved = order is not None and order != sorted(order)
+    d_moved = old_disc != new_disc and problem.obs is not None and reordered_basis(
+        old_disc["discrepancy_sha256"], old_disc["discrepancy_groups"], problem.obs.D,
+        problem.obs.v_groups)  # fmt: skip
+    fixed = (settings.get("fixed", {}), fixed_record(problem))
+    priors = (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp))
+    differs = {
+        "priors": priors[0] != priors[1] and not ((k_moved or d_moved) and _close(*priors)),
+        "mean_basis": settings.get("mean_basis") != (None if mb is None else mb.kind),
+        "fixed parameters": fixed[0] != fixed[1]
+        or (k_moved and any(k in f for f in fixed for k in PER_COMPONENT)),
+        "theta constraint": bool(settings.get("constraint", False))
+        != (problem.constraint is not None),
+        "discrepancy": old_disc != new_disc and not d_moved,
+    }
+    return [name for name, differ in differs.items() if differ]
+
+
+def _close(a, b) -> bool:
+    """Whether two prior records (``_prior_record``) are equal but for floats within 1e-12."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_close(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(_close(x, y) for x, y in zip(a, b, strict=True))
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b or math.isclose(a, b, rel_tol=1e-12, abs_tol=0.0)
+    return a == b
 
 
 def _prior_record(priors: Priors, n_grp: int) -> dict:

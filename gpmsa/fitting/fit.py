@@ -16,6 +16,7 @@ from gpmsa.fitting.continuation import (
     appended_record,
     appended_thin,
     check_append,
+    component_order,
     continued_starts,
     continued_steps,
     continued_widths,
@@ -213,11 +214,12 @@ def fit(
         ) if on]  # fmt: skip
         n_jobs, executor = in_this_process(callables, n_jobs, executor, int(n_chains))
     options.update(backends.placement(backend, n_jobs, executor))
-    resumed, recorded = options.get("init"), None
-    if continuing:
+    resumed, recorded, order = options.get("init"), None, None
+    if continuing:  # order: K's columns among the source's (per-component parameters follow)
         options["init"] = continued_starts(resumed, problem, prep.K, obs, int(n_chains))
+        order = component_order(resumed, problem)
         if step_widths is None and tune is not True and backend != "pyro":  # NUTS adapts
-            step_widths = recorded = continued_widths(resumed, problem, int(n_chains))
+            step_widths = recorded = continued_widths(resumed, problem, int(n_chains), order)
     if tune is None:  # only the widths the chains were tuned to run on untuned
         tune = recorded is None
     if append and tune and backend in MH_BACKENDS:
@@ -263,7 +265,7 @@ def fit(
         calibration["theta_native"] = native
     if append:
         retained, lp_kept, calibration = pool_draws(
-            resumed, retained, lp_kept, calibration, int(n_chains)
+            resumed, retained, lp_kept, calibration, int(n_chains), order
         )
     params = point_estimate(retained, lp_kept, point)
     settings = {
@@ -295,7 +297,7 @@ def fit(
         per = lp_kept.size // n_chains
         summary = summarize({k: v.reshape(n_chains, per, *v.shape[1:])
                              for k, v in retained.items()})  # fmt: skip
-        pool_accept(summary, resumed, chains.accept_rate, int(n_iter), backend)
+        pool_accept(summary, resumed, chains.accept_rate, int(n_iter), backend, order)
     else:
         per = kept
         summary = summarize(post, chains.accept_rate)

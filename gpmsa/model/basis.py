@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import hashlib
+import itertools
+import math
 import warnings
 
 import numpy as np
@@ -331,3 +333,51 @@ def basis_digest(bases, groups=None) -> str | None:
         h.update(f"{k}:{arr.shape}".encode())
         h.update(arr.tobytes())
     return h.hexdigest()
+
+
+REORDER_LIMIT = 8_192
+"""Most signed column permutations of a discrepancy basis that `reordered_basis` hashes (~0.1 s;
+its search is exhaustive within it: the signs and orders of 5 columns in one group, or of more
+in several, else the signs alone of up to 13 columns in their given order)."""
+
+
+def reordered_basis(digest: str, groups, bases, new_groups) -> bool:
+    """Whether ``bases`` (``ObsProblem.D``, normalised) with precision groups ``new_groups`` are,
+    up to the signs and order of their columns (each keeping its group), the bases of
+    ``digest`` (`basis_digest`) whose groups were ``groups`` (None: one): the same model, each
+    discrepancy weight's sign or position changed. False where they are not, or where more
+    than ``REORDER_LIMIT`` candidates (orders consistent with the groups, times 2^p_v signs)
+    would have to be hashed (beyond it, the columns' signs alone)."""
+    if bases is None or digest is None or (groups is None) != (new_groups is None):
+        return False
+    ints = [np.rint(np.asarray(D, dtype=np.float64) / DIGEST_STEP).astype("<i8") for D in bases]
+    p_v = ints[0].shape[1]
+    old = [0] * p_v if groups is None else [int(g) for g in groups]
+    new = [0] * p_v if new_groups is None else [int(g) for g in new_groups]
+    if sorted(old) != sorted(new):
+        return False
+    head = b"" if groups is None else f"groups:{old}".encode()
+    for order in _orders(old, new):
+        for signs in itertools.product((1, -1), repeat=p_v):
+            h = hashlib.sha256(head)
+            for k, arr in enumerate(ints):
+                h.update(f"{k}:{arr.shape}".encode())
+                h.update(np.ascontiguousarray(arr[:, order] * np.array(signs, "<i8")).tobytes())
+            if h.hexdigest() == digest:
+                return True
+    return False
+
+
+def _orders(old: list[int], new: list[int]) -> list[list[int]]:
+    """The orders of the columns of ``new`` (their groups) that give each of ``old``'s columns
+    one of its group, all of them within ``REORDER_LIMIT`` with their signs, else the given
+    order alone (where the groups agree and 2^p_v signs are within it)."""
+    labels, p_v = sorted(set(old)), len(old)
+    if math.prod(math.factorial(old.count(g)) for g in labels) * 2**p_v > REORDER_LIMIT:
+        return [list(range(p_v))] if old == new and 2**p_v <= REORDER_LIMIT else []
+    orders = []
+    for choice in itertools.product(*(itertools.permutations(
+            [i for i, g in enumerate(new) if g == lab]) for lab in labels)):  # fmt: skip
+        slots = dict(zip(labels, map(iter, choice), strict=True))
+        orders.append([next(slots[g]) for g in old])
+    return orders

@@ -106,12 +106,14 @@ def fit_starts(source: Study, problems: list[Problem], preps, obs, n_chains: int
     """Per chain, each model's start for ``fit_study``: every parameter at the chain's last kept
     draw in its fitted member (``gpmsa.fitting.continuation.continued_starts``, which refuses
     other simulation runs, observations, priors, fixed parameters or discrepancy, naming the
-    model)."""
+    model; bases whose columns differ in sign only, or a discrepancy basis's in order too, are
+    the same model; K's columns in another order are refused: the sweep's widths are not
+    mapped)."""
     per_model = []
     for lab, emu, prob, prep, o in zip(source.labels, source.members, problems, preps, obs,
                                        strict=True):  # fmt: skip
         try:
-            per_model.append(continued_starts(emu, prob, prep.K, o, n_chains))
+            per_model.append(continued_starts(emu, prob, prep.K, o, n_chains, reorder=False))
         except GPMSAError as exc:
             raise GPMSAError(f"model {lab!r}: {str(exc).replace('init=emulator', 'init=study')}"
                              ) from None  # fmt: skip

@@ -47,3 +47,14 @@ def test_calibrator_refuses_another_backend_s_options_naming_what_it_takes():
         Calibrator(road_emulator(), backend="torch", mcmc_options={"n_warmup": 50})
     with pytest.raises(GPMSAError, match=r"\['dtype'\].*'pyro' backend"):
         Calibrator(road_emulator(), backend="pyro", mcmc_options={"dtype": "float32"})
+
+
+def test_an_explicit_numpy_backend_is_not_overridden_by_mcmc_options():
+    """(s68) backend="numpy" looked the same as the default, so mcmc_options["backend"] took
+    over silently; now the default is None and an explicit backend that disagrees is refused."""
+    with pytest.raises(GPMSAError, match=r"backend='numpy' and mcmc_options\['backend'\]='torch'"):
+        Calibrator(road_emulator(), backend="numpy", mcmc_options={"backend": "torch"})
+    assert Calibrator(road_emulator()).backend == "numpy"  # the default as before
+    same = Calibrator(road_emulator(), backend="numpy", mcmc_options={"backend": "numpy"})
+    assert same.backend == "numpy"
+    assert Calibrator(road_emulator(), backend="torch").backend == "torch"
