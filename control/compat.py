@@ -15,7 +15,7 @@ import numpy as np
 
 import vehicle
 from control.bcr import BCRSettings, emulator_domain
-from control.errors import ControlError, ControlWarning, EmulatorMismatchError
+from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
@@ -135,7 +135,7 @@ def check_emulator(
                 "emulator metadata has no 'vehicle'; cannot check it was made for "
                 f"{model.describe().get('model', type(model).__name__)}",
                 ControlWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
         elif _canon(meta["vehicle"]) != _canon(model.describe()):
             raise EmulatorMismatchError(
@@ -144,13 +144,15 @@ def check_emulator(
     if noise_std is not None:
         trained = _recorded_noise_std(meta)
         if trained is None:
-            warnings.warn("emulator metadata has no 'noise_std'", ControlWarning, stacklevel=3)
+            warnings.warn(
+                "emulator metadata has no 'noise_std'", ControlWarning, stacklevel=user_stacklevel()
+            )
         elif not np.isclose(trained, float(noise_std)):
             warnings.warn(
                 f"noise_std = {noise_std:g} m/s^2 in the data but the emulator was trained with "
                 f"noise_std = {trained:g}: the GD estimates will be biased",
                 ControlWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
     if bcr is not None:
         check_feature(emulator, bcr)
@@ -218,7 +220,7 @@ def check_recorded_vehicle(emulator, model=None, noise_std: float | None = None,
             f"{what} was simulated with noise_std = {noise_std:g} m/s^2 but the emulator was "
             f"trained with noise_std = {trained:g}: the GD estimates will be biased",
             ControlWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -1,5 +1,17 @@
 """Exceptions and warnings raised by control."""
 
+import sys
+
+
+def user_stacklevel() -> int:
+    """``warnings.warn``'s stacklevel, in the function that calls this, of the first frame
+    outside control (the user's call, however deep control's own calls run; as
+    ``gpmsa.errors.user_stacklevel`` for gpmsa)."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_globals.get("__name__", "").split(".")[0] == "control":
+        frame, level = frame.f_back, level + 1
+    return level
+
 
 class ControlError(ValueError):
     """Invalid input to a control function (a ValueError subclass)."""

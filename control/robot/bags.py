@@ -60,8 +60,17 @@ SIMULATION_KEYS = {"vehicle": "terrain_gpmsa.vehicle", "noise_std": "terrain_gpm
 SIMULATION_RECORD = "terrain_gpmsa.simulation"
 """The name of the MCAP Metadata record of a run `control.record_run` writes, holding the same
 two fields as `SIMULATION_KEYS` under the keys "vehicle" and "noise_std"."""
+SIMULATION_SHA256 = "terrain_gpmsa.simulation_sha256"
+"""The checksum written beside that record, the `simulation_checksum` of its fields: a ROS 2
+bag's ``custom_data`` key, and the name of an MCAP Metadata record with the one field "sha256"
+(a record of its own: readers before it refuse a field they do not know in `SIMULATION_RECORD`).
+`read_recording` refuses a record that does not match it; a record without it (written before)
+reads unchecked."""
+SIMULATION_NAMES = (SIMULATION_RECORD, SIMULATION_SHA256)
 MAX_SIMULATION_CHARS = 4096
 """Longest text of a field of that record (a Jackal's description is ~300 characters)."""
+_METADATA_BYTES = 2 * len(SIMULATION_KEYS) * (MAX_SIMULATION_CHARS + 64)
+"""Longest indexed Metadata record read for that record or its checksum, bytes."""
 URI_PARTS = re.compile(r"[?#]|%[0-9A-Fa-f]{2}")
 """What rosbags' sqlite3 writer misreads in a path (it opens ``file:PATH`` as a URI): a query,
 a fragment, a percent-encoded byte."""
@@ -248,34 +257,35 @@ def read_recording(
     if kind == "mcap":
         require("mcap.reader", "reading an MCAP file")
     wanted = [imu_topic, odom_topic]
-    raw, storage, digests, simulated = None, "", {}, {}
+    raw, storage, digests, simulated, checksum = None, "", {}, {}, None
     if kind == "rosbag2":
         info = _bag_information(target)
         files, storage, simple = _bag_files(target, info)
         digests = _recorded_digests(target, info)
-        simulated = _custom_simulation(target, info)
+        simulated, checksum = _custom_simulation(target, info)
         if simple and storage == "mcap":
             raw = storage_mod.mcap_messages(files, wanted)
         elif simple and storage == "sqlite3":
             raw = storage_mod.sqlite_messages(files, wanted)
     elif kind == "mcap":
-        raw = storage_mod.mcap_messages([target], wanted)
+        raw = storage_mod.mcap_messages([target], wanted, SIMULATION_NAMES, _METADATA_BYTES)
     if raw is not None:
         for topic in wanted:
             _check_digest(
                 target, digests, topic, raw.log_ns.get(topic, []), raw.data.get(topic, [])
             )
         topics, imu, odom = _from_raw(target, raw, imu_topic, odom_topic)
+        metadata = raw.metadata
     elif kind == "mcap":
-        topics, imu, odom = _read_mcap(target, imu_topic, odom_topic)
+        topics, imu, odom, metadata = _read_mcap(target, imu_topic, odom_topic)
     else:
         topics, imu, odom = _read_rosbags(target, kind, imu_topic, odom_topic, digests)
     for topic, got in ((imu_topic, imu), (odom_topic, odom)):
         if got.stamp_ns.size == 0:
             raise BagError(f"the topic {topic!r} in {target} has no messages")
     if kind == "mcap":
-        simulated = _mcap_simulation(target)
-    model, noise_std = simulation_from_record(simulated)
+        simulated, checksum = _mcap_simulation(target, metadata)
+    model, noise_std = simulation_from_record(simulated, checksum)
     return Recording(
         target, kind, storage, topics, imu, odom, time.perf_counter() - tic, model, noise_std
     )
@@ -350,77 +360,67 @@ def _recorded_digests(folder: Path, info) -> dict[str, str]:
     return record
 
 
-def _custom_simulation(folder: Path, info) -> dict[str, tuple[str, object]]:
-    """{field: (where, value)} of the simulation record (`SIMULATION_KEYS`) in a ROS 2 bag's
-    custom_data (``info``: its `_bag_information`); {} for a bag without it."""
+def _custom_simulation(folder: Path, info) -> tuple[dict[str, tuple[str, object]], tuple | None]:
+    """The simulation record (`SIMULATION_KEYS`) in a ROS 2 bag's custom_data (``info``: its
+    `_bag_information`) as {field: (where, value)}, {} for a bag without it; and its checksum
+    (`SIMULATION_SHA256`) as (what the record is, for a message; value), None where absent."""
     try:
         custom = info.get("custom_data") or {}
     except Exception:  # rosbags reads (and reports on) whatever this does not understand
-        return {}
+        return {}, None
     if not isinstance(custom, dict):
-        return {}
+        return {}, None
     meta = folder / "metadata.yaml"
-    return {
+    fields = {
         name: (f"{meta} is damaged: its custom_data {key!r}", custom[key])
         for name, key in SIMULATION_KEYS.items()
         if key in custom
     }
+    if SIMULATION_SHA256 not in custom:
+        return fields, None
+    keys = ", ".join(repr(k) for k in SIMULATION_KEYS.values())
+    what = f"{meta} is damaged: its simulation record (custom_data {keys})"
+    return fields, (what, custom[SIMULATION_SHA256])
 
 
-def _mcap_simulation(path: Path) -> dict[str, tuple[str, object]]:
-    """{field: (where, value)} of the MCAP file's `SIMULATION_RECORD` Metadata record (found
-    through its summary's index; in a file without a summary, by reading its records); {} for a
-    file without it. `BagError` for several such records, a damaged one or one over
-    `MAX_SIMULATION_CHARS` per field."""
-    reader_mod = require("mcap.reader", "reading an MCAP file")
+def _mcap_simulation(
+    path: Path, metadata: dict[str, list[dict[str, str]]]
+) -> tuple[dict[str, tuple[str, object]], tuple | None]:
+    """The MCAP file's `SIMULATION_RECORD` Metadata record as {field: (where, value)}, {} for a
+    file without it, and its checksum (`SIMULATION_SHA256`) as (what the record is, for a
+    message; value), None where absent; ``metadata``: {name: the metadata of each record of that
+    name}, as read with the messages. `BagError` for several such records or one with fields
+    other than those written."""
     where = f"{path} is damaged: its {SIMULATION_RECORD!r} metadata record"
-    try:
-        with open(path, "rb") as f:
-            records = _simulation_records(reader_mod, f, where)
-    except BagError:
-        raise
-    except Exception as exc:  # the mcap package raises its own errors for damaged files
-        raise BagError(f"{where} cannot be read ({_why(exc)})") from exc
+    fields = _only_record(where, metadata.get(SIMULATION_RECORD, []), set(SIMULATION_KEYS))
+    sums = metadata.get(SIMULATION_SHA256, [])
+    digest = _only_record(f"{path} is damaged: its {SIMULATION_SHA256!r} metadata record", sums,
+                          {"sha256"})  # fmt: skip
+    named = {name: (f"{where}, field {name!r}", value) for name, value in fields.items()}
+    return named, ((where, digest.get("sha256")) if sums else None)
+
+
+def _only_record(where: str, records: list[dict], allowed: set[str]) -> dict:
+    """The fields of the one record of ``records`` ({} for none); `BagError` for several or
+    for a field not in ``allowed``."""
     if not records:
         return {}
     if len(records) > 1:
         raise BagError(f"{where} is there {len(records)} times; a recording holds one at most")
-    fields = records[0]
-    unknown = sorted(set(fields) - set(SIMULATION_KEYS))
+    unknown = sorted(set(records[0]) - allowed)
     if unknown:
         raise BagError(
             f"{where} holds unknown field(s) {[k[:40] for k in unknown[:5]]}; allowed "
-            f"{sorted(SIMULATION_KEYS)}"
+            f"{sorted(allowed)}"
         )
-    return {name: (f"{where}, field {name!r}", value) for name, value in fields.items()}
+    return records[0]
 
 
-def _simulation_records(reader_mod, f, where: str) -> list[dict]:
-    """The metadata (a dict) of each `SIMULATION_RECORD` record of the open MCAP file ``f``."""
-    limit = 2 * len(SIMULATION_KEYS) * (MAX_SIMULATION_CHARS + 64)  # bytes of a record at most
-    summary = reader_mod.make_reader(f).get_summary()
-    if summary is None:  # an unindexed file: read its records (the messages were read so too)
-        f.seek(0)
-        return [
-            dict(m.metadata)
-            for m in reader_mod.NonSeekingReader(f).iter_metadata()
-            if m.name == SIMULATION_RECORD
-        ]
-    out = []
-    stream_reader = require("mcap.stream_reader", "reading an MCAP file")
-    for index in summary.metadata_indexes:
-        if index.name != SIMULATION_RECORD:
-            continue
-        if index.length > limit:
-            raise BagError(f"{where} is {index.length} bytes long, more than {limit} allowed")
-        f.seek(index.offset)
-        record = next(
-            stream_reader.StreamReader(f, skip_magic=True, record_size_limit=limit).records
-        )
-        if type(record).__name__ != "Metadata" or record.name != SIMULATION_RECORD:
-            raise BagError(f"{where}: the summary's index points at another record")
-        out.append(dict(record.metadata))
-    return out
+def simulation_checksum(record: dict[str, str]) -> str:
+    """SHA-256 (hex) of a simulation record's canonical JSON: its {field: text} (as
+    `simulation_record` gives it) with sorted keys, no spaces, ASCII."""
+    text = json.dumps(record, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode()).hexdigest()
 
 
 def simulation_record(model=None, noise_std=None) -> dict[str, str]:
@@ -443,13 +443,15 @@ def simulation_record(model=None, noise_std=None) -> dict[str, str]:
 
 
 def simulation_from_record(
-    fields: dict[str, tuple[str, object]],
+    fields: dict[str, tuple[str, object]], checksum: tuple[str, object] | None = None
 ) -> tuple[vehicle.Model | None, float | None]:
     """(vehicle model, noise sd m/s^2) from a recording's simulation record ({field: (where it
     is, for a message; its text)}), None for each field absent. `BagError` naming the field
     where its text is not a str of at most `MAX_SIMULATION_CHARS` characters holding JSON of a
     vehicle description (`vehicle.from_description`: a known model, known parameters, finite
-    values in range) or of a noise sd (a finite number >= 0)."""
+    values in range) or of a noise sd (a finite number >= 0); then, where ``checksum`` (what the
+    record is, for a message; the recorded `simulation_checksum`) is given, naming the record
+    where it does not match (a digit changed: another vehicle) or is not a SHA-256."""
     values = {}
     for name, (where, text) in fields.items():
         if not isinstance(text, str):
@@ -475,7 +477,22 @@ def simulation_from_record(
             noise = vehicle.sensor.check_noise(values["noise_std"])
         except vehicle.VehicleError as exc:
             raise BagError(f"{fields['noise_std'][0]} is not a noise sd: {exc}") from exc
+    if checksum is not None:
+        _check_simulation_checksum({name: text for name, (_, text) in fields.items()}, *checksum)
     return model, noise
+
+
+def _check_simulation_checksum(record: dict[str, str], what: str, recorded) -> None:
+    """`BagError` naming the record (``what``) where ``recorded`` is not a SHA-256 or not the
+    `simulation_checksum` of ``record``."""
+    if not (isinstance(recorded, str) and re.fullmatch(r"[0-9a-f]{64}", recorded)):
+        raise BagError(f"{what}: its checksum {SIMULATION_SHA256!r} is not a SHA-256 (64 hex "
+                       f"digits), got {str(recorded)[:80]!r}")  # fmt: skip
+    if simulation_checksum(record) != recorded:
+        raise BagError(
+            f"{what} does not match its SHA-256 ({SIMULATION_SHA256!r}): it was changed after it "
+            "was written (another vehicle or noise sd than the one simulated)"
+        )
 
 
 def messages_digest(log_ns: Sequence[int], data: Sequence[bytes]) -> str:
@@ -761,13 +778,17 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
                 for ch in summary.channels.values()
             }
             _check_topics(path, topics, imu_topic, odom_topic)
-            wanted = [imu_topic, odom_topic]
+            metadata = storage_mod.indexed_metadata(
+                path, f, summary, SIMULATION_NAMES, _METADATA_BYTES
+            )
+            messages = reader.iter_messages(topics=[imu_topic, odom_topic])
         else:  # an unindexed (e.g. truncated) file: find the topics by reading it all
-            topics, wanted = {}, None
+            topics, metadata = {}, {name: [] for name in SIMULATION_NAMES}
+            messages = _unindexed_messages(f, metadata)
         collected: dict[str, tuple[list, list]] = {imu_topic: ([], []), odom_topic: ([], [])}
         schemas: dict[str, object] = {}
         try:
-            for schema, channel, message in reader.iter_messages(topics=wanted):
+            for schema, channel, message in messages:
                 topics.setdefault(channel.topic, schema.name if schema else "")
                 if channel.topic not in collected:
                     continue
@@ -799,7 +820,35 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
 
     imu = _imu(path, imu_topic, *collected[imu_topic], decoder(imu_topic))
     odom = _odometry(path, odom_topic, *collected[odom_topic], decoder(odom_topic))
-    return topics, imu, odom
+    return topics, imu, odom, metadata
+
+
+def _unindexed_messages(f, metadata: dict[str, list[dict[str, str]]]) -> Iterator[tuple]:
+    """(schema, channel, message) of each message of the MCAP file ``f`` (without a summary) in
+    log-time order, as the mcap package's reader gives them, appending to ``metadata``
+    ({name: []}) the metadata of each Metadata record of those names met on the way: one
+    pass over the file for both."""
+    records = require("mcap.records", "reading an MCAP file")
+    error = require("mcap.exceptions", "reading an MCAP file").McapError
+    f.seek(0)
+    stream = require("mcap.stream_reader", "reading an MCAP file").StreamReader(f)
+    schemas, channels, found = {}, {}, []
+    for record in stream.records:
+        if isinstance(record, records.Message):
+            channel = channels.get(record.channel_id)
+            if channel is None:
+                raise error(f"no channel record found with id {record.channel_id}")
+            found.append((schemas.get(channel.schema_id), channel, record))
+        elif isinstance(record, records.Schema):
+            schemas[record.id] = record
+        elif isinstance(record, records.Channel):
+            if record.schema_id != 0 and record.schema_id not in schemas:
+                raise error(f"no schema record found with id {record.schema_id}")
+            channels[record.id] = record
+        elif isinstance(record, records.Metadata) and record.name in metadata:
+            metadata[record.name].append(dict(record.metadata))
+    found.sort(key=lambda item: item[2].log_time)  # stable, as the mcap package's reader
+    yield from found
 
 
 def _check_counts(path: Path, summary, found: dict[str, int]) -> None:
@@ -1011,6 +1060,8 @@ def write_sensor_bag(
     _check_distinct(imu_topic, odom_topic, ControlError)
     record = simulation_record(model, noise_std)
     custom = {SIMULATION_KEYS[name]: text for name, text in record.items()}
+    if record:
+        custom[SIMULATION_SHA256] = simulation_checksum(record)
     t_imu, imu, t_odom, odom = sensor_messages(
         imu_time, accel, odom_time, position, speed, axis=axis
     )

@@ -15,7 +15,9 @@ The loop's result keeps no posterior sd nor P(GD > GD_max): those fields are NaN
 replay fills them). A Metadata record named ``terrain_gpmsa.simulation``
 (`control.robot.bags.SIMULATION_RECORD`) holds the simulated vehicle's ``model.describe()``
 (JSON, key "vehicle") and the accelerometer noise sd (m/s^2, key "noise_std"), as the run's
-``settings`` give them, so that the replay refuses an emulator made for another vehicle.
+``settings`` give them, so that the replay refuses an emulator made for another vehicle; a
+record ``terrain_gpmsa.simulation_sha256`` (`SIMULATION_SHA256`, key "sha256") its SHA-256, so
+that a digit changed in it is refused rather than read as another vehicle.
 """  # noqa: E501
 
 from __future__ import annotations
@@ -30,8 +32,10 @@ from control.robot import messages as msgs
 from control.robot.bags import (
     MAX_STAMP_NS,
     SIMULATION_RECORD,
+    SIMULATION_SHA256,
     merge_in_time,
     sensor_messages,
+    simulation_checksum,
     simulation_record,
     stamps_ns,
 )
@@ -144,6 +148,7 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
         writer.start(profile="ros2", library=LIBRARY)
         if simulated:
             writer.add_metadata(SIMULATION_RECORD, simulated)
+            writer.add_metadata(SIMULATION_SHA256, {"sha256": simulation_checksum(simulated)})
         channels = {}
         for key, msgtype in (
             ("imu", msgs.IMU_TYPE), ("odometry", msgs.ODOMETRY_TYPE),

@@ -56,6 +56,8 @@ class RawTopics:
         data: topic -> serialised messages (bytes).
         definitions: topic -> (schema encoding, schema text) where the file has one.
         encodings: topic -> message encoding ("cdr" for ROS 2).
+        metadata: name -> the metadata (a dict) of each Metadata record of that name, for
+            the names asked for (an MCAP file's, found through its summary).
     """
 
     types: dict[str, str | None] = field(default_factory=dict)
@@ -63,6 +65,7 @@ class RawTopics:
     data: dict[str, list[bytes]] = field(default_factory=dict)
     definitions: dict[str, tuple[str, str]] = field(default_factory=dict)
     encodings: dict[str, str] = field(default_factory=dict)
+    metadata: dict[str, list[dict[str, str]]] = field(default_factory=dict)
 
 
 def _read_at_most(read, limit: int) -> bytes:
@@ -178,20 +181,55 @@ def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
         raise _Damaged("its last record runs past its end")
 
 
-def mcap_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics | None:
-    """The messages of ``topics`` in MCAP files (None where a file is not the simple case).
-    Raises `BagError` for a file whose chunks, chunk index or schemas are damaged."""
-    out = RawTopics()
+def mcap_messages(
+    paths: Sequence[Path],
+    topics: Sequence[str],
+    metadata: Sequence[str] = (),
+    limit: int = 0,
+) -> RawTopics | None:
+    """The messages of ``topics`` in MCAP files (None where a file is not the simple case),
+    and the Metadata records named in ``metadata`` (`indexed_metadata`, at most ``limit`` bytes
+    each). Raises `BagError` for a file whose chunks, chunk index, schemas or those records
+    are damaged."""
+    out = RawTopics(metadata={name: [] for name in metadata})
     for topic in topics:
         out.log_ns[topic], out.data[topic] = [], []
     for path in paths:
         with open(path, "rb") as f:
             try:
-                simple = _mcap_file(f, out)
+                summary = _mcap_file(f, out)
             except _Damaged as exc:
                 raise BagError(f"{path} is damaged: {exc}") from exc
-        if not simple:
-            return None
+            if summary is None:
+                return None
+            for name, found in indexed_metadata(path, f, summary, metadata, limit).items():
+                out.metadata[name].extend(found)
+    return out
+
+
+def indexed_metadata(
+    path: Path, f, summary, names: Sequence[str], limit: int
+) -> dict[str, list[dict[str, str]]]:
+    """{name: the metadata of each Metadata record of that name} of the open MCAP file ``f``
+    (``path``), found through its ``summary``'s metadata index; `BagError` for a record over
+    ``limit`` bytes, one that does not read or an index that points at another record."""
+    out: dict[str, list[dict[str, str]]] = {name: [] for name in names}
+    for index in summary.metadata_indexes:
+        if index.name not in out:
+            continue
+        where = f"{path} is damaged: its {index.name!r} metadata record"
+        if index.length > limit:
+            raise BagError(f"{where} is {index.length} bytes long, more than {limit} allowed")
+        stream = require("mcap.stream_reader", "reading an MCAP file")
+        try:
+            f.seek(index.offset)
+            record = next(stream.StreamReader(f, skip_magic=True, record_size_limit=limit).records)
+        except Exception as exc:  # the mcap package raises its own errors for damaged files
+            why = " ".join(str(exc).split())
+            raise BagError(f"{where} cannot be read ({type(exc).__name__}: {why})") from exc
+        if type(record).__name__ != "Metadata" or record.name != index.name:
+            raise BagError(f"{where}: the summary's index points at another record")
+        out[index.name].append(dict(record.metadata))
     return out
 
 
@@ -279,16 +317,16 @@ def note_type(types: dict[str, str | None], topic: str, msgtype: str) -> None:
         types[topic] = None
 
 
-def _mcap_file(f, out: RawTopics) -> bool:
-    """Append the messages of ``out``'s topics in one MCAP file; False where it is not the
-    simple case."""
+def _mcap_file(f, out: RawTopics):
+    """Append the messages of ``out``'s topics in one MCAP file; its summary, None where it
+    is not the simple case."""
     reader_mod = require("mcap.reader", "reading an MCAP file")
     try:
         summary = reader_mod.make_reader(f).get_summary()
     except Exception:  # a damaged or unindexed file: the generic reader reports it
-        return False
+        return None
     if summary is None or not summary.chunk_indexes or summary.statistics is None:
-        return False
+        return None
     wanted = {}
     for cid, channel in summary.channels.items():
         schema = summary.schemas.get(channel.schema_id)
@@ -319,8 +357,8 @@ def _mcap_file(f, out: RawTopics) -> bool:
     for cid, topic in wanted.items():
         found = len(out.log_ns[topic]) - before[topic]
         if counts.get(cid, found) != found:  # messages outside chunks
-            return False
-    return True
+            return None
+    return summary
 
 
 def write_chunk_crcs(path: Path) -> None:

@@ -19,7 +19,7 @@ import control  # noqa: E402
 import roadgen  # noqa: E402
 import vehicle  # noqa: E402
 from control.errors import BagError, ControlWarning, EmulatorMismatchError  # noqa: E402
-from control.robot import cli, read_recording, replay_bag, write_run_bag  # noqa: E402
+from control.robot import bags, cli, read_recording, replay_bag, write_run_bag  # noqa: E402
 from control.robot.bags import SIMULATION_KEYS  # noqa: E402
 
 HEAVY = vehicle.Jackal(mass_kg=18.431 * 1.17)
@@ -120,6 +120,8 @@ def test_a_damaged_record_in_a_bag_folder_is_a_bag_error_naming_the_field(heavy,
     bag = write_run_bag(result, tmp_path / "bag", storage="sqlite3")
     vehicle_key, noise_key = SIMULATION_KEYS["vehicle"], SIMULATION_KEYS["noise_std"]
     jackal = '{"model": "Jackal", '
+    written = bags.simulation_record(HEAVY, 0.0)
+    written = {SIMULATION_KEYS[name]: text for name, text in written.items()}
     cases = [
         (vehicle_key, "not json", "is not JSON"),
         (vehicle_key, "[1, 2]", "not a vehicle description: .* is a dict, got list"),
@@ -136,9 +138,8 @@ def test_a_damaged_record_in_a_bag_folder_is_a_bag_error_naming_the_field(heavy,
         _set_custom(bag, key, value)
         with pytest.raises(BagError, match=f"custom_data '{key}' .*{why}"):
             read_recording(bag)
-        _set_custom(bag, key, json.dumps(vehicle.Jackal().describe()) if key == vehicle_key
-                    else "0.0")  # fmt: skip
-    assert read_recording(bag).vehicle == vehicle.Jackal()
+        _set_custom(bag, key, written[key])  # as written: its SHA-256 matches
+    assert read_recording(bag).vehicle == HEAVY
 
 
 def test_a_damaged_record_in_an_mcap_file_is_a_bag_error_naming_the_field(
