@@ -6,14 +6,14 @@ channel whose schema the file lacks is a `BagError`."""
 import os
 import shutil
 
-import numpy as np
 import pytest
 
 pytest.importorskip("rosbags")
 pytest.importorskip("mcap")
 
+from _robot_cases import short_drive, small_result  # noqa: E402
+
 import control  # noqa: E402
-from control.closed_loop import ClosedLoopResult  # noqa: E402
 from control.errors import BagError, ControlError  # noqa: E402
 from control.robot import messages as msgs  # noqa: E402
 from control.robot import read_recording, replay_bag, write_sensor_bag  # noqa: E402
@@ -22,32 +22,12 @@ from control.robot.bags import merge_in_time, sensor_messages  # noqa: E402
 TOPICS = ("/imu/data", "/odometry/filtered")
 
 
-def _drive(n: int = 60):
-    t = 1.0 + np.arange(n) / 120.0
-    return t, np.random.default_rng(0).normal(size=n), t, 0.5 * (t - 1.0), np.full(n, 0.5)
-
-
-def _result(n: int = 240) -> ClosedLoopResult:
-    """A small closed-loop result (no drive needed to record one)."""
-    t = np.arange(n) / 120.0
-    te = t[41::42]
-    k = te.size
-    return ClosedLoopResult(
-        time=te, position=0.5 * te, gd_mean=np.full(k, 300.0), gd_lo=np.full(k, 250.0),
-        gd_hi=np.full(k, 350.0), gd_true=np.full(k, 300.0), status=np.array(["ok"] * k),
-        reason=np.array([""] * k), domain_edge=np.array([""] * k), prob_change=np.zeros(k),
-        command=np.ones(k), mode=np.array(["performance"] * k), latency_s=np.zeros(k),
-        sample_time=t, sample_position=0.5 * t, sample_speed=np.full(n, 0.5),
-        sample_accel=np.random.default_rng(0).normal(size=n), metrics={}, settings={},
-    )  # fmt: skip
-
-
 def _write_mcap(path, library: str = "foxglove", bad_schema: bool = False, chunked=True):
     """An MCAP file of ROS 2 IMU and odometry messages written by ``library``; ``bad_schema``:
     the odometry channel names a schema the file does not hold."""
     from mcap.writer import Writer
 
-    t_imu, imu, t_odom, odom = sensor_messages(*_drive())
+    t_imu, imu, t_odom, odom = sensor_messages(*short_drive())
     store = msgs.typestore()
     with open(path, "wb") as f:
         writer = Writer(f, use_chunking=chunked)
@@ -68,8 +48,8 @@ def _write_mcap(path, library: str = "foxglove", bad_schema: bool = False, chunk
 
 def test_a_recording_never_replaces_an_mcap_file_another_program_wrote(tmp_path):
     """record_run replaced any MCAP file: a robot's recording (a bag's file, Foxglove's)."""
-    result = _result()
-    bag = write_sensor_bag(tmp_path / "bag", *_drive())
+    result = small_result()
+    bag = write_sensor_bag(tmp_path / "bag", *short_drive())
     bag_file = next(bag.glob("*.mcap"))
     foreign = _write_mcap(tmp_path / "field.mcap")
     header_lost = tmp_path / "header_lost.mcap"
@@ -94,7 +74,7 @@ def test_a_recording_never_replaces_an_mcap_file_another_program_wrote(tmp_path)
 def test_record_run_names_a_folder_it_cannot_make(tmp_path):
     (tmp_path / "notes").write_text("x")
     with pytest.raises(ControlError, match="path=.*cannot make its folder"):
-        control.record_run(_result(), tmp_path / "notes" / "runs" / "run.mcap")
+        control.record_run(small_result(), tmp_path / "notes" / "runs" / "run.mcap")
 
 
 @pytest.mark.parametrize("chunked", [True, False])
@@ -108,7 +88,7 @@ def test_a_channel_whose_schema_the_file_lacks_is_a_bag_error(chunked, tmp_path)
 def test_a_sqlite3_bag_reads_whatever_its_folder_is_named(name, tmp_path):
     """The reader opened the database as a URI: '#' or '?' cut the path (and made an empty
     database there), '%41' read another file."""
-    bag = write_sensor_bag(tmp_path / "bag", *_drive(), storage="sqlite3")
+    bag = write_sensor_bag(tmp_path / "bag", *short_drive(), storage="sqlite3")
     shutil.copytree(bag, tmp_path / name)
     before = sorted(os.listdir(tmp_path))
     assert read_recording(tmp_path / name).imu.stamp_ns.size == 60
@@ -120,9 +100,9 @@ def test_a_sqlite3_bag_is_not_written_where_its_database_would_be_lost(name, tmp
     """rosbags' sqlite3 writer put the database beside the folder (or failed with sqlite3's
     bare error) and the bag was written without it."""
     with pytest.raises(ControlError, match="sqlite3 bag cannot be written to a path holding"):
-        write_sensor_bag(tmp_path / name, *_drive(), storage="sqlite3")
+        write_sensor_bag(tmp_path / name, *short_drive(), storage="sqlite3")
     assert os.listdir(tmp_path) == []
-    assert read_recording(write_sensor_bag(tmp_path / name, *_drive())).imu.stamp_ns.size == 60
+    assert read_recording(write_sensor_bag(tmp_path / name, *short_drive())).imu.stamp_ns.size == 60
     with pytest.raises(ControlError, match="out_bag=.*sqlite3 bag cannot be written"):
         replay_bag(tmp_path / name, "A", storage="sqlite3", out_bag=tmp_path / f"out{name}")
 
@@ -130,7 +110,7 @@ def test_a_sqlite3_bag_is_not_written_where_its_database_would_be_lost(name, tmp
 def test_a_bag_is_not_written_onto_a_link_to_nowhere(tmp_path):
     os.symlink(tmp_path / "nowhere", tmp_path / "link")
     with pytest.raises(ControlError, match="exists already"):
-        write_sensor_bag(tmp_path / "link", *_drive())
+        write_sensor_bag(tmp_path / "link", *short_drive())
 
 
 def test_a_path_that_starts_with_a_tilde_is_the_home_folder(tmp_path, monkeypatch):
@@ -140,8 +120,8 @@ def test_a_path_that_starts_with_a_tilde_is_the_home_folder(tmp_path, monkeypatc
     home.mkdir(), work.mkdir()
     monkeypatch.setenv("HOME", str(home))
     monkeypatch.chdir(work)
-    assert control.record_run(_result(), "~/runs/run.mcap") == home / "runs" / "run.mcap"
-    assert write_sensor_bag("~/bags/b", *_drive()) == home / "bags" / "b"
+    assert control.record_run(small_result(), "~/runs/run.mcap") == home / "runs" / "run.mcap"
+    assert write_sensor_bag("~/bags/b", *short_drive()) == home / "bags" / "b"
     assert not (work / "~").exists() and (home / "runs" / "run.mcap").is_file()
 
 
@@ -150,6 +130,6 @@ def test_a_name_that_only_starts_with_a_tilde_is_a_file_of_that_name(tmp_path, m
     only "~" and "~/..." are the home folder."""
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     monkeypatch.chdir(tmp_path)
-    written = control.record_run(_result(), "~nosuchuser.mcap")
+    written = control.record_run(small_result(), "~nosuchuser.mcap")
     assert written.resolve() == tmp_path / "~nosuchuser.mcap"
     assert (tmp_path / "~nosuchuser.mcap").is_file()

@@ -12,9 +12,10 @@ import pytest
 pytest.importorskip("rosbags")
 pytest.importorskip("mcap")
 
+from _robot_cases import short_drive, small_result  # noqa: E402
+
 import control  # noqa: E402
 import vehicle  # noqa: E402
-from control.closed_loop import ClosedLoopResult  # noqa: E402
 from control.errors import BagError, ControlWarning  # noqa: E402
 from control.robot import bags, read_recording, replay_bag, write_sensor_bag  # noqa: E402
 from control.robot import messages as msgs  # noqa: E402
@@ -25,25 +26,9 @@ MODEL = vehicle.Jackal(mass_kg=21.5)
 TOPICS = ("/imu/data", "/odometry/filtered")
 
 
-def _drive(n: int = 60):
-    t = 1.0 + np.arange(n) / 120.0
-    return t, np.random.default_rng(0).normal(size=n), t, 0.5 * (t - 1.0), np.full(n, 0.5)
-
-
-def _result(n: int = 240) -> ClosedLoopResult:
+def _result(n: int = 240):
     """A small closed-loop result of ``MODEL`` with noise sd 0.25 (no drive needed)."""
-    t = np.arange(n) / 120.0
-    te = t[41::42]
-    k = te.size
-    return ClosedLoopResult(
-        time=te, position=0.5 * te, gd_mean=np.full(k, 300.0), gd_lo=np.full(k, 250.0),
-        gd_hi=np.full(k, 350.0), gd_true=np.full(k, 300.0), status=np.array(["ok"] * k),
-        reason=np.array([""] * k), domain_edge=np.array([""] * k), prob_change=np.zeros(k),
-        command=np.ones(k), mode=np.array(["performance"] * k), latency_s=np.zeros(k),
-        sample_time=t, sample_position=0.5 * t, sample_speed=np.full(n, 0.5),
-        sample_accel=np.random.default_rng(0).normal(size=n), metrics={},
-        settings={"model": MODEL, "noise_std": 0.25},
-    )  # fmt: skip
+    return small_result(n, {"model": MODEL, "noise_std": 0.25})
 
 
 def _flip(path, old: bytes, new: bytes) -> None:
@@ -90,7 +75,7 @@ def test_a_changed_digit_in_an_mcap_files_record_is_a_bag_error(tmp_path, summar
 
 
 def test_a_changed_digit_in_a_bags_metadata_is_a_bag_error(tmp_path):
-    bag = write_sensor_bag(tmp_path / "bag", *_drive(), model=MODEL, noise_std=0.25,
+    bag = write_sensor_bag(tmp_path / "bag", *short_drive(), model=MODEL, noise_std=0.25,
                            storage="sqlite3")  # fmt: skip
     assert read_recording(bag).vehicle == MODEL
     meta = bag / "metadata.yaml"
@@ -113,14 +98,14 @@ def test_a_record_written_before_the_checksum_reads_as_before(tmp_path):
     from control.robot.bags import SIMULATION_KEYS, merge_in_time, sensor_messages
 
     record = bags.simulation_record(MODEL, 0.25)
-    bag = write_sensor_bag(tmp_path / "bag", *_drive(), model=MODEL, noise_std=0.25)
+    bag = write_sensor_bag(tmp_path / "bag", *short_drive(), model=MODEL, noise_std=0.25)
     yaml = YAML(typ="safe")
     meta = yaml.load((bag / "metadata.yaml").read_text())
     del meta["rosbag2_bagfile_information"]["custom_data"][bags.SIMULATION_SHA256]
     with (bag / "metadata.yaml").open("w") as f:
         yaml.dump(meta, f)
     path = tmp_path / "old.mcap"  # as record_run wrote it before
-    t_imu, imu, t_odom, odom = sensor_messages(*_drive())
+    t_imu, imu, t_odom, odom = sensor_messages(*short_drive())
     store = msgs.typestore()
     with open(path, "wb") as f:
         writer = Writer(f)
