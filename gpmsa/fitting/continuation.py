@@ -19,16 +19,17 @@ from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, fixed_record
 
 
-def continued_starts(emulator: Emulator, problem: Problem, K: np.ndarray, obs: ObsData | None,
-                     n_chains: int, reorder: bool = True) -> dict[str, np.ndarray]:  # fmt: skip
+def continued_starts(
+    emulator: Emulator, problem: Problem, K: np.ndarray, obs: ObsData | None, n_chains: int
+) -> dict[str, np.ndarray]:
     """Each chain's start at its last kept draw in ``emulator`` (a fit of the same data, and
     observations for a joint fit, with ``n_chains`` chains): name -> (n_chains, *shape), for a
     backend's ``init``. Its chains continue where they stopped being recorded (a draw of each
     chain, not a fresh dispersed start): a fit that warned of R-hat or ESS runs on without
     starting over. A basis K or discrepancy basis D whose columns are the source's up to their
     signs and order is the same model (``component_order``, ``reordered_basis``): the starts
-    of the per-component parameters (betaU's columns, lamUz, lamWs) follow K's columns (with
-    ``reorder`` False another order is refused). GPMSAError naming what differs."""
+    of the per-component parameters (betaU's columns, lamUz, lamWs) follow K's columns.
+    GPMSAError naming what differs."""
     _has_draws(emulator)
     _chains_of(emulator, n_chains)
     settings = emulator.settings or {}
@@ -39,11 +40,6 @@ def continued_starts(emulator: Emulator, problem: Problem, K: np.ndarray, obs: O
     if order is None:
         raise GPMSAError(
             "init=emulator was fitted to other simulation runs (or another n_pc or basis)"
-        )
-    if not reorder and order != sorted(order):
-        raise GPMSAError(
-            f"init=emulator's basis vectors are this fit's in another order (this fit's "
-            f"component j is its {order}[j]); continue it with the basis in its order"
         )
     cal = emulator.calibration or {}
     if (obs is None) != (not cal):
@@ -353,9 +349,7 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
     keys = ("discrepancy_sha256", "discrepancy_groups")
     old_disc, new_disc = {k: settings.get(k) for k in keys}, {k: disc.get(k) for k in keys}
     k_moved = order is not None and order != sorted(order)
-    d_moved = old_disc != new_disc and problem.obs is not None and reordered_basis(
-        old_disc["discrepancy_sha256"], old_disc["discrepancy_groups"], problem.obs.D,
-        problem.obs.v_groups)  # fmt: skip
+    d_moved = discrepancy_moved(old_disc, new_disc, problem.obs)
     fixed = (settings.get("fixed", {}), fixed_record(problem))
     priors = (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp))
     differs = {
@@ -368,6 +362,17 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
         "discrepancy": old_disc != new_disc and not d_moved,
     }
     return [name for name, differ in differs.items() if differ]
+
+
+def discrepancy_moved(old: dict, new: dict, obs) -> bool:
+    """Whether discrepancy records ``old`` and ``new`` (``discrepancy.record``'s
+    discrepancy_sha256 and discrepancy_groups) differ, ``obs``'s bases (an ObsProblem, or None)
+    being ``old``'s up to their columns' signs and order, each column keeping its group
+    (``reordered_basis``): the same model."""
+    if old == new or obs is None:
+        return False
+    digest, groups = old.get("discrepancy_sha256"), old.get("discrepancy_groups")
+    return reordered_basis(digest, groups, obs.D, obs.v_groups)
 
 
 def _close(a, b) -> bool:

@@ -7,15 +7,20 @@ continuation's (as ``gpmsa.fit``'s, ``gpmsa.fitting.continuation``)."""
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.continuation import (
+    PER_COMPONENT,
     append_step,
     appended_counts,
+    component_order,
     continued_starts,
+    discrepancy_moved,
     pool_chains,
+    reordered,
     sweeps_run,
 )
 from gpmsa.fitting.continuation import check_append as check_fit_append
@@ -106,18 +111,45 @@ def fit_starts(source: Study, problems: list[Problem], preps, obs, n_chains: int
     """Per chain, each model's start for ``fit_study``: every parameter at the chain's last kept
     draw in its fitted member (``gpmsa.fitting.continuation.continued_starts``, which refuses
     other simulation runs, observations, priors, fixed parameters or discrepancy, naming the
-    model; bases whose columns differ in sign only, or a discrepancy basis's in order too, are
-    the same model; K's columns in another order are refused: the sweep's widths are not
-    mapped)."""
+    model; bases whose columns are the source's up to their signs and order are the same
+    model, the per-component parameters following K's columns: ``member_orders``)."""
     per_model = []
     for lab, emu, prob, prep, o in zip(source.labels, source.members, problems, preps, obs,
                                        strict=True):  # fmt: skip
         try:
-            per_model.append(continued_starts(emu, prob, prep.K, o, n_chains, reorder=False))
+            per_model.append(continued_starts(emu, prob, prep.K, o, n_chains))
         except GPMSAError as exc:
             raise GPMSAError(f"model {lab!r}: {str(exc).replace('init=emulator', 'init=study')}"
                              ) from None  # fmt: skip
     return [[{k: v[c] for k, v in m.items()} for m in per_model] for c in range(n_chains)]
+
+
+def member_orders(source: Study, problems: list[Problem]) -> list[list[int] | None]:
+    """Per model, where its basis vectors (K's columns) are among its source member's
+    (``component_order``; a model ``fit_starts`` took), for the per-component parameters'
+    widths, draws and acceptance rates."""
+    return [component_order(emu, prob) for emu, prob in zip(source.members, problems,
+                                                            strict=True)]  # fmt: skip
+
+
+def same_discrepancies(old: dict | None, new: dict | None, obs: dict) -> dict | None:
+    """This calibration study's discrepancy record ``new`` (label -> its ``DISCREPANCIES``
+    entry) with each model's entry that is the source's (``old``) up to its basis's columns'
+    signs and order (``discrepancy_moved``, each column keeping its group; the same kind) as
+    the source's: the same model, which ``check_source`` then finds equal. ``obs``: label ->
+    the model's ObsProblem."""
+    if not isinstance(old, dict) or not isinstance(new, dict):
+        return new
+    out = dict(new)
+    for lab, entry in new.items():
+        was = old.get(lab)
+        if not isinstance(was, dict) or was == entry:
+            continue
+        kinds = [{k: v for k, v in d.items() if not k.startswith("discrepancy_")}
+                 for d in (was, entry)]  # fmt: skip
+        if kinds[0] == kinds[1] and discrepancy_moved(was, entry, obs.get(lab)):
+            out[lab] = was
+    return out
 
 
 def chain_starts(source: Study, models: list[list[dict]]) -> list[tuple]:
@@ -126,14 +158,32 @@ def chain_starts(source: Study, models: list[list[dict]]) -> list[tuple]:
              source.draws["lam"][c, -1].copy()) for c, m in enumerate(models)]  # fmt: skip
 
 
-def sweep_names(problems, layout, hyper, start) -> list[str]:
-    """The sweep's element names from chain 0's start (a ``StudyState``); GPMSAError where the
-    source's draws give no finite log posterior here."""
+def sweep_names(problems, layout, hyper, start, orders=None) -> tuple[list[str], list[str]]:
+    """The sweep's element names from chain 0's start (a ``StudyState``), and each one's name
+    in the source: a per-component element (``PER_COMPONENT``) at its source component
+    (``orders``: per model, ``member_orders``; None: as here). GPMSAError where the source's
+    draws give no finite log posterior here."""
     state = StudyState(problems, layout, hyper, *start, np.random.default_rng(0))
     if not math.isfinite(state.log_post()):
         raise GPMSAError("init=study: its last kept draws have no finite log posterior in this "
                          "study (other data or priors?); start afresh")  # fmt: skip
-    return element_names(state.states, layout)
+    orders = [None] * len(state.states) if orders is None else orders
+    there = [SimpleNamespace(els=_source_elements(s.problem, s.els, o))
+             for s, o in zip(state.states, orders, strict=True)]  # fmt: skip
+    return element_names(state.states, layout), element_names(there, layout)
+
+
+def _source_elements(problem: Problem, els, order: list[int] | None) -> list[tuple]:
+    """A model's sweep elements (name, index) with each per-component one's index at its
+    source component (``reordered``: this model's component j is the source's ``order[j]``)."""
+    out = []
+    for name, idx in els:
+        if name in PER_COMPONENT:
+            shape = problem.init[name].shape
+            flat = reordered(name, np.arange(math.prod(shape)).reshape(shape), order)[idx]
+            idx = tuple(int(i) for i in np.unravel_index(int(flat), shape))
+        out.append((name, idx))
+    return out
 
 
 def continued_widths(source: Study, names: list[str], n_chains: int) -> list[np.ndarray] | None:
@@ -222,13 +272,17 @@ def pool_study_draws(source: Study, draws: dict[str, np.ndarray]) -> dict[str, n
     return {k: _pool(source.draws[k], v, k) for k, v in draws.items()}
 
 
-def pool_member(member, post: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def pool_member(member, post: dict[str, np.ndarray], order: list[int] | None = None
+                ) -> dict[str, np.ndarray]:  # fmt: skip
     """A fitted member's retained draws (its ``draws`` and ``calibration``, flat chain-major),
-    each chain followed by the continuation's ``post`` (name -> (C, N, ...))."""
+    each chain followed by the continuation's ``post`` (name -> (C, N, ...)); ``order``: this
+    model's components among the member's (``member_orders``): the per-component draws are
+    taken in this model's order (``reordered``)."""
     cal = dict(member.calibration or {})
     out = {}
     for k, v in post.items():
         old = member.draws.get(k) if k in EMULATOR_PARAMS else cal.get(k)
+        old = None if old is None else reordered(k, old, order)
         c = v.shape[0]
         if old is None or np.shape(old)[0] % c:
             raise GPMSAError(f"append=True: init=study's member has no {k} draws to append to "
@@ -238,13 +292,16 @@ def pool_member(member, post: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
-def appended_settings(source: Study, n_iter: int, accept_rate: dict | None) -> dict:
+def appended_settings(source: Study, n_iter: int, accept_rate: dict | None,
+                      renamed: dict[str, str] | None = None) -> dict:  # fmt: skip
     """The settings an appended study adds: appended_to (the source's study file digest, None
     for a study never saved), appended_after (its draws per chain), pooled_sweeps and
     sweeps_run (per chain; as ``gpmsa.fit``'s), and accept_rate: each element's rate of both
     parts weighted by their sweeps (the source's ``settings["accept_rate"]`` over its sweeps
-    run, ``accept_rate`` over ``n_iter``); none where the source records no rate or sweeps."""
+    run, ``accept_rate`` over ``n_iter``); none where the source records no rate or sweeps.
+    ``renamed``: a sweep element's name -> its name in the source (``sweep_names``)."""
     settings = source.settings
+    renamed = renamed or {}
     out = appended_counts(settings, source_digest(source),
                           int(source.draws["log_post"].shape[1]), n_iter)  # fmt: skip
     old, run = settings.get("accept_rate"), sweeps_run(settings)
@@ -256,6 +313,7 @@ def appended_settings(source: Study, n_iter: int, accept_rate: dict | None) -> d
         and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in old.values())
     )
     out["accept_rate"] = None if not ok else {
-        k: float((old[k] * run + r * n_iter) / (run + n_iter)) for k, r in accept_rate.items()
+        k: float((old[renamed.get(k, k)] * run + r * n_iter) / (run + n_iter))
+        for k, r in accept_rate.items()
     }  # fmt: skip
     return out

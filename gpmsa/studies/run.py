@@ -120,15 +120,18 @@ def _tune_rule(tune, init) -> bool | None:
 
 
 def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool | None,
-              models: list[list[dict]], append: bool) -> tuple[bool, dict, dict]:  # fmt: skip
+              models: list[list[dict]], append: bool, orders=None
+              ) -> tuple[bool, dict, dict, dict[str, str]]:  # fmt: skip
     """A continuation of ``source``'s chains from ``models`` (per chain, each model's start):
-    (tune, ``sample_study``'s continuation arguments, the settings it adds). Untuned (``tune``
-    None where ``source`` records its chains' widths, or False), each chain runs on with its
-    recorded widths and precision steps; tuned, from GPM/SA's widths (refused where it
+    (tune, ``sample_study``'s continuation arguments, the settings it adds, each sweep
+    element's name -> its name in ``source``). Untuned (``tune`` None where ``source`` records
+    its chains' widths, or False), each chain runs on with its recorded widths and precision
+    steps (a per-component element's its source component's: ``orders``, per model,
+    ``continuation.member_orders``); tuned, from GPM/SA's widths (refused where it
     ``append``s: `continuation.refuse_tuning`)."""
     starts = cont.chain_starts(source, models)
-    names = cont.sweep_names(problems, layout, hyper, starts[0])
-    widths = None if tune is True else cont.continued_widths(source, names, n_chains)
+    names, there = cont.sweep_names(problems, layout, hyper, starts[0], orders)
+    widths = None if tune is True else cont.continued_widths(source, there, n_chains)
     if tune is None:
         tune = widths is None
     if tune and append:
@@ -139,7 +142,8 @@ def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool 
     extra = {"continued_from": cont.source_digest(source)}
     if steps is not None:
         extra[STEPS] = steps
-    return tune, {"chain_starts": starts, "widths": widths, "prop_mh": steps}, extra
+    resumed = {"chain_starts": starts, "widths": widths, "prop_mh": steps}
+    return tune, resumed, extra, dict(zip(names, there, strict=True))
 
 
 def _study_draws(chains: StudyChains, keep: slice, discrepancy: bool = False
@@ -299,10 +303,11 @@ def calibrate_study(
             True (for a continuation: False where the study records its chains' widths).
         init: a start rule ("auto", ...), or a calibration ``Study`` of the same models, labels,
             shared and hierarchical names, observations, hyperpriors, fixed values,
-            discrepancies and number of chains (GPMSAError naming what differs), whose chains
-            continue from their last kept draws with the step widths they ran with
-            (``docs/models.md``, "Continuing a study"); settings "continued_from": its
-            ``sha256``.
+            discrepancies (a basis whose columns are the source's up to their signs and order,
+            each keeping its group, is the same) and number of chains (GPMSAError naming what
+            differs), whose chains continue from their last kept draws with the step widths
+            they ran with (``docs/models.md``, "Continuing a study"); settings
+            "continued_from": its ``sha256``.
         append: with ``init`` a study, return its kept draws followed, chain by chain, by this
             continuation's every sweep (a calibration study keeps every sweep after burn-in),
             as ``gpmsa.fit``'s ``append``: diagnostics, convergence and posterior over the
@@ -399,9 +404,10 @@ def calibrate_study(
                 if basis is not None}  # fmt: skip
     if recorded:  # full_prediction(posterior=member_posterior(LABEL)) refuses another basis
         record[DISCREPANCIES] = recorded
-    resumed, extra, thin = {}, {}, 1  # thin: an appended study's step (a calibration keeps all)
+    resumed, extra, thin, renamed = {}, {}, 1, {}  # thin: an appended study's step (all: 1)
     if continuing:
         old = init.settings
+        obs_of = {lab: prob.obs for lab, prob in zip(labels, problems, strict=True)}
         cont.check_source(
             init, "calibration", layout, hyper, int(n_chains),
             emulators=([e.model_sha256 for e in init.members],
@@ -410,12 +416,13 @@ def calibrate_study(
                           [record[OBS_DIGESTS], record[OBS_LAYOUTS]]),
             **{"fixed values": ([old.get(k) for k in ("fixed", HELD_THETA)],
                                 [record.get(k) for k in ("fixed", HELD_THETA)]),
-               "discrepancy": (old.get(DISCREPANCIES), record.get(DISCREPANCIES))},
+               "discrepancy": (old.get(DISCREPANCIES), cont.same_discrepancies(
+                   old.get(DISCREPANCIES), record.get(DISCREPANCIES), obs_of))},
         )  # fmt: skip
         thin = cont.appended_thin(init, int(n_samples), int(n_chains)) if append else 1
         starts = cont.calibration_starts(init, problems)
-        tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
-                                         starts, append)  # fmt: skip
+        tune, resumed, extra, renamed = _continue(init, problems, layout, hyper, int(n_chains),
+                                                  tune, starts, append)  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})", init if append else None, thin)  # fmt: skip
     chains = sample_study(
@@ -430,7 +437,8 @@ def calibrate_study(
     draws = _study_draws(chains, keep, discrepancy=True)
     if append:  # the source's draws, then every sweep at its step (1)
         draws = cont.pool_study_draws(init, draws)
-        settings.update(cont.appended_settings(init, int(n_samples), settings["accept_rate"]))
+        settings.update(cont.appended_settings(init, int(n_samples), settings["accept_rate"],
+                                               renamed))  # fmt: skip
     study = Study("calibration", emulators, layout, hyper, draws, settings, metadata)
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
@@ -588,7 +596,7 @@ def fit_study(
                for p, f, s in zip(problems, fixes, sims, strict=True)]  # fmt: skip
     record: dict = {}
     _record_fixed(record, labels, problems, layout, fixes, natives, emulator=True)
-    resumed, extra = {}, {}
+    resumed, extra, renamed, orders = {}, {}, {}, [None] * n
     if continuing:
         cont.check_source(
             init, "fit", layout, hyper, int(n_chains),
@@ -598,8 +606,9 @@ def fit_study(
         if append:
             thin = cont.appended_thin(init, int(n_iter), int(n_chains), given_keep)
         models = cont.fit_starts(init, problems, preps, obs, int(n_chains))
-        tune, resumed, extra = _continue(init, problems, layout, hyper, int(n_chains), tune,
-                                         models, append)  # fmt: skip
+        orders = cont.member_orders(init, problems)  # K's columns among each member's
+        tune, resumed, extra, renamed = _continue(init, problems, layout, hyper, int(n_chains),
+                                                  tune, models, append, orders)  # fmt: skip
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})",
                   init if append else None, thin if append else 1)  # fmt: skip
     chains = sample_study(
@@ -616,14 +625,15 @@ def fit_study(
     draws = _study_draws(chains, keep)
     if append:  # the source's draws, then the continuation's at its step
         draws = cont.pool_study_draws(init, draws)
-        settings.update(cont.appended_settings(init, int(n_iter), settings["accept_rate"]))
+        settings.update(cont.appended_settings(init, int(n_iter), settings["accept_rate"],
+                                               renamed))  # fmt: skip
     lp = draws["log_post"].reshape(-1)
     members = []
     fitted_discrepancy = discrepancy_kind(discrepancy)
     for i, (sim, prep) in enumerate(zip(sims, preps, strict=True)):
         post = {k: v[:, keep] for k, v in chains.members[i].items()}
         if append:
-            post = cont.pool_member(init.members[i], post)
+            post = cont.pool_member(init.members[i], post, orders[i])
         flat = {k: v.reshape(v.shape[0] * v.shape[1], *v.shape[2:]) for k, v in post.items()}
         theta = draws["theta"][:, :, list(layout.index[i])]
         flat["theta"] = theta.reshape(-1, theta.shape[2])
