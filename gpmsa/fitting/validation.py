@@ -19,6 +19,7 @@ sha256=...)``) for that.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 
@@ -59,6 +60,12 @@ EMULATOR_BASES = ("pca", "given")
 """settings.basis: the runs' PCA, or a basis the caller gave (``fit(..., basis=)``)."""
 FIXABLE_CALIBRATION = ("theta", "lamOs", "betaV", "lamVz")
 """A joint fit's parameters that ``fit(..., fixed=)`` can hold (their draws: ``cal_<name>``)."""
+MAX_SWEEPS = 2**63 - 1
+"""Largest sweep count a file's settings may record (a C int64; a JSON integer has any size,
+and a continuation weighs acceptance rates by these counts in floats)."""
+APPENDED = ("appended_to", "appended_after", "pooled_sweeps", "sweeps_run")
+"""The settings of an appended fit (``fit(..., append=True)``), all four or none."""
+SHA256_RE = re.compile(r"[0-9a-f]{64}")
 
 
 def _fail(field: str, problem: str) -> EmulatorFileError:
@@ -537,9 +544,85 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
     for key in ("metadata", "diagnostics"):
         if not isinstance(manifest.get(key), dict):
             raise _fail(key, f"must be an object, got {_short(manifest.get(key))}")
+    check_sweeps(settings, dims.get("n_draws", 0))
+    check_accept(manifest["diagnostics"])
     if manifest.get("convergence") is not None and not isinstance(manifest["convergence"], dict):
         raise _fail("convergence", f"must be an object, got {_short(manifest['convergence'])}")
     _check_model_options(model, inputs)
+
+
+def _sweep_count(settings: dict, key: str, low: int) -> int | None:
+    """settings[key], a sweep count: null (or absent) or an integer in [low, MAX_SWEEPS]."""
+    v = settings.get(key)
+    if v is not None and (isinstance(v, bool) or not isinstance(v, int)
+                          or not low <= v <= MAX_SWEEPS):  # fmt: skip
+        raise _fail(f"settings.{key}", f"must be null or an integer in [{low}, {MAX_SWEEPS}], "
+                                       f"got {_short(v)}")  # fmt: skip
+    return v
+
+
+def check_sweeps(settings: dict, n_draws: int, unsaved: bool = False) -> None:
+    """The sweep counts a continuation reads (``gpmsa.fitting.continuation``): n_iter and n_burn
+    (0 <= n_burn < n_iter) and an appended fit's record (``APPENDED``, all or none):
+    appended_to the source's digest (64 hex digits; with ``unsaved``, a study's, also null: a
+    source never saved), appended_after the source's draws per chain (at least one, and
+    fewer than each chain's ``n_draws / n_chains``), pooled_sweeps and sweeps_run (per chain;
+    null or above n_iter, the continuation's own, and pooled_sweeps <= sweeps_run)."""
+    n_iter, n_burn = _sweep_count(settings, "n_iter", 1), _sweep_count(settings, "n_burn", 0)
+    if n_iter is not None and n_burn is not None and n_burn >= n_iter:
+        raise _fail("settings.n_burn", f"{n_burn} must be below n_iter={n_iter}")
+    given = [k for k in APPENDED if k in settings]
+    if not given:
+        return
+    if len(given) < len(APPENDED):
+        lacking = [k for k in APPENDED if k not in settings]
+        raise _fail(f"settings.{lacking[0]}", f"an appended fit records {list(APPENDED)} "
+                                              f"together; the file has only {given}")  # fmt: skip
+    digest = settings["appended_to"]
+    if not (isinstance(digest, str) and SHA256_RE.fullmatch(digest)) and not (
+        unsaved and digest is None
+    ):
+        raise _fail("settings.appended_to", f"must be the source's digest (64 hex digits), got "
+                                            f"{_short(digest)}")  # fmt: skip
+    per = n_draws // settings.get("n_chains", 1)  # n_chains checked: it divides n_draws
+    after = settings["appended_after"]
+    if isinstance(after, bool) or not isinstance(after, int) or not 1 <= after < per:
+        raise _fail("settings.appended_after", f"must be an integer in [1, {per - 1}] (the "
+                    f"source's draws of each chain, before the continuation's), got "
+                    f"{_short(after)}")  # fmt: skip
+    pooled, run = (
+        _sweep_count(settings, "pooled_sweeps", 1),
+        _sweep_count(settings, "sweeps_run", 1),
+    )
+    for key, v in (("pooled_sweeps", pooled), ("sweeps_run", run)):
+        if v is not None and n_iter is not None and v <= n_iter:
+            raise _fail(f"settings.{key}", f"{v} must exceed n_iter={n_iter} (the source's "
+                                           "sweeps, then the continuation's)")  # fmt: skip
+    if pooled is not None and run is not None and pooled > run:
+        raise _fail("settings.pooled_sweeps", f"{pooled} exceeds sweeps_run={run}")
+
+
+def check_rate(value, field: str) -> None:
+    """An acceptance rate as a file records it: null (NaN) or a number in [0, 1]."""
+    ok = value is None or (isinstance(value, (int, float)) and not isinstance(value, bool)
+                           and 0.0 <= value <= 1.0)  # fmt: skip
+    if not ok:
+        raise _fail(field, f"must be null or an acceptance rate in [0, 1], got {_short(value)}")
+
+
+def check_accept(diagnostics: dict) -> None:
+    """Each parameter's acceptance rates in ``diagnostics`` (its "accept", where recorded: a
+    list of rates, ``check_rate``), which an appended fit pools (``pool_accept``)."""
+    for name, entry in diagnostics.items():
+        if not isinstance(entry, dict) or "accept" not in entry:
+            continue
+        field, rates = f"diagnostics[{_short(name, 40)}].accept", entry["accept"]
+        if rates is None:
+            continue
+        if not isinstance(rates, list):
+            raise _fail(field, f"must be null or a list of acceptance rates, got {_short(rates)}")
+        for i, v in enumerate(rates):
+            check_rate(v, f"{field}[{i}]")
 
 
 def _check_model_options(model: dict, inputs: list[str]) -> None:

@@ -8,7 +8,7 @@ import re
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError
-from gpmsa.fitting.validation import DISCREPANCY_KINDS, group_count
+from gpmsa.fitting.validation import DISCREPANCY_KINDS, check_rate, check_sweeps, group_count
 from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout, finite
 
 KINDS = ("calibration", "fit")
@@ -284,3 +284,17 @@ def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
         raise _fail("settings", f"n_iter={got['n_iter']}, n_burn={got['n_burn']}, thin="
                                 f"{got['thin']} keep {kept} draws a chain{what}, but the draws "
                                 f"have {shape[1]}")  # fmt: skip
+    check_sweeps(settings, shape[0] * shape[1], unsaved=True)  # as an appended fit's
+    _check_rates(settings.get("accept_rate"))
+
+
+def _check_rates(rates) -> None:
+    """settings.accept_rate (absent in files written before it): null or sweep element name ->
+    its acceptance rate (null or in [0, 1]), which an appended study pools."""
+    if rates is None:
+        return
+    if not isinstance(rates, dict):
+        raise _fail("settings.accept_rate", f"must be an object element -> rate, got "
+                                            f"{_short(rates)}")  # fmt: skip
+    for name, v in rates.items():
+        check_rate(v, f"settings.accept_rate[{_short(name, 40)}]")
