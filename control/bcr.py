@@ -42,7 +42,12 @@ direction a lower gain moves the feature, in sds) is kept per phase; where the l
 ``quiet_blocks`` scores, summed over the root of their count (over sqrt(nu / (nu - 2)) for a
 Student-t block law), fall below the normal quantile of ``plausibility_p``, the estimate is
 "implausible" (its ``plausibility_p`` the tail probability). Ground smoother than the
-emulator's domain reads the same way (docs/closed-loop.md, "Guards").
+emulator's domain reads the same way (docs/closed-loop.md, "Guards"). A hold follows any
+"implausible" estimate (``release_p``): a phase that has not reached the limit yet (its memory
+still holds blocks from before a gain dropped) would give an "ok" estimate that reads the quiet
+blocks as smoother ground, so until every phase has read blocks since the hold began, an
+estimate is "implausible" wherever a phase's scores of those blocks, summed alike, fall below
+the normal quantile of ``release_p``.
 
 Frozen odometry: a block whose speeds all read standing (below ``STANDING_MPS``) carries the
 last estimate, but a dead odometry (the pose held, the twist 0) reads so while the robot drives
@@ -135,6 +140,11 @@ class BCRSettings:
             blocks together read quieter than any GD explains (`BCR`, "The quiet-signal
             check"), with a probability under the emulator below ``plausibility_p``; 0
             switches the check off.
+        release_p: change-point method with the quiet-signal check on: after an "implausible"
+            estimate, the estimates stay "implausible" while a phase's level scores of the
+            blocks it read since then, summed as the check sums them, read a probability below
+            this, until every phase has read such blocks (a hysteresis: `BCR`, "The
+            quiet-signal check"); 0 switches the hold off.
     """
 
     feature: FeatureSpec = field(default_factory=FeatureSpec)
@@ -150,6 +160,7 @@ class BCRSettings:
     sensor: SensorLimits = field(default_factory=SensorLimits)
     recent_change_m: float = 5.0
     quiet_blocks: int = 16
+    release_p: float = 0.05
 
     def __post_init__(self) -> None:
         for name, cls in (
@@ -161,7 +172,14 @@ class BCRSettings:
             require_instance(self, name, cls)
         require_reals(
             self,
-            ("max_age_s", "max_silence_s", "interval_level", "plausibility_p", "recent_change_m"),
+            (
+                "max_age_s",
+                "max_silence_s",
+                "interval_level",
+                "plausibility_p",
+                "recent_change_m",
+                "release_p",
+            ),
         )
         if self.method not in METHODS:
             raise ControlError(f"method must be one of {METHODS}, got {self.method!r}")
@@ -204,6 +222,8 @@ class BCRSettings:
             )
         if not 0 <= self.plausibility_p < 1:
             raise ControlError(f"plausibility_p must lie in [0, 1), got {self.plausibility_p}")
+        if not 0 <= self.release_p < 1:
+            raise ControlError(f"release_p must lie in [0, 1), got {self.release_p}")
         if not (np.isfinite(self.recent_change_m) and self.recent_change_m >= 0):
             raise ControlError(f"recent_change_m must be >= 0, got {self.recent_change_m}")
         if not (is_integer(self.quiet_blocks) and 0 <= self.quiet_blocks <= MAX_QUIET_BLOCKS):
@@ -262,6 +282,7 @@ class _Phase:
     undo: tuple | None = None  # (filter state, data time, distance) before its newest block
     guard: bool = False  # skip its next block: it may hold the end of a fault
     levels: deque = field(default_factory=deque)  # level scores of its newest blocks (quiet)
+    held_n: int = 0  # how many of the newest levels came since a hold began (`BCR._hold`)
 
     def reset(self) -> None:
         self.filter.reset()
@@ -273,6 +294,7 @@ class _Phase:
         self.pos_block, self.pending_m, self.data_time = np.nan, 0.0, np.nan
         self.undo, self.guard = None, False
         self.levels.clear()
+        self.held_n = 0
 
 
 def _samples(name: str, values) -> np.ndarray:
@@ -374,7 +396,8 @@ class BCR:
         self._warm_up()
 
     def __setstate__(self, state: dict) -> None:  # a restored BCR warms up as a new one
-        self.__dict__.update({"_start_note": "", **state})  # (one pickled before it had a note)
+        # (one pickled before it had a note, or the quiet-signal hold)
+        self.__dict__.update({"_start_note": "", "_held_by": None, **state})
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -477,6 +500,7 @@ class BCR:
         self._n_updates = 0
         self._data_time = np.nan  # newest information of the window methods (phases keep theirs)
         self._phase = 0  # the change-point phase of the newest update
+        self._held_by: Estimate | None = None  # the implausible estimate that started a hold
         self._tracked_at: list[float | None] = [None] * len(getattr(self, "trackers", ()))
 
     def update(self, t, position, accel, speed, *, now: float | None = None) -> Estimate:
@@ -712,6 +736,7 @@ class BCR:
                 other.data_time = data_time
                 if other.levels:  # its level score, added with the update undone
                     other.levels.pop()
+                    other.held_n = max(other.held_n - 1, 0)
                 if other is phase:
                     ds += ds_before
                 else:
@@ -768,7 +793,9 @@ class BCR:
             phase.filter.predict(ds)
             if not np.isfinite(self._newest_data_time()):
                 return self._no_estimate("out_of_domain", why, speed=v)
-            return self._posterior_estimate("no new information: " + why, tic, v, None)
+            return self._held_reason(v, None) or self._posterior_estimate(
+                "no new information: " + why, tic, v, None
+            )
         bad_signal = self._signal_reason(acc)
         if bad_signal:
             return self._skip_block(phase, ds, "sensor_fault", bad_signal, speed=v)
@@ -784,9 +811,8 @@ class BCR:
                 f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = {p:.2g} < "
                 f"{s.plausibility_p:g})"
             )
-            return self._skip_block(
-                phase, ds, "implausible", why, speed=v, feature=y, plausibility_p=p
-            )
+            return self._hold(self._skip_block(
+                phase, ds, "implausible", why, speed=v, feature=y, plausibility_p=p))  # fmt: skip
         if phase.guard:
             phase.guard = False
             phase.undo = None
@@ -801,9 +827,9 @@ class BCR:
         if score is not None:
             quiet = self._quiet_reason(phase, score, v)
             if quiet:
-                return self._no_estimate("implausible", quiet[0], speed=v, feature=y,
-                                         plausibility_p=quiet[1])  # fmt: skip
-        return self._posterior_estimate("", tic, v, y)
+                return self._hold(self._no_estimate("implausible", quiet[0], speed=v, feature=y,
+                                                    plausibility_p=quiet[1]))  # fmt: skip
+        return self._held_reason(v, y) or self._posterior_estimate("", tic, v, y)
 
     def _frozen_odometry(self, phase: _Phase, acc: np.ndarray, spd: np.ndarray) -> str:
         """Why a block whose speeds read standing (every |speed| below ``STANDING_MPS``) comes
@@ -856,6 +882,8 @@ class BCR:
         ``plausibility_p``; None otherwise."""
         phase.levels.append(score)
         n = len(phase.levels)
+        if self._held_by is not None:
+            phase.held_n = min(phase.held_n + 1, n)
         z = sum(phase.levels) / (np.sqrt(n) * self._level_sd)
         p = float(ndtr(z))
         if p >= self.settings.plausibility_p:
@@ -867,6 +895,42 @@ class BCR:
             f"; a sensor gain or noise below the emulator's, or ground smoother than it knows",
             p,
         )
+
+    def _hold(self, est: Estimate) -> Estimate:
+        """``est``, an "implausible" estimate; with the quiet-signal check and ``release_p`` on,
+        it begins a hold (`_held_reason`) unless one is on."""
+        s = self.settings
+        on = s.release_p > 0 and s.plausibility_p > 0 and self._phases[0].levels.maxlen
+        if on and self._held_by is None:
+            self._held_by = est
+            for phase in self._phases:
+                phase.held_n = 0
+        return est
+
+    def _held_reason(self, v: float, y) -> Estimate | None:
+        """During a hold (since an "implausible" estimate): an "implausible" estimate where a
+        phase's level scores of the blocks it read since the hold began (at most its last
+        ``quiet_blocks``), summed as `_quiet_reason` sums them, read a probability below
+        ``release_p``; else None, and the hold ends once every phase has read such blocks.
+        None without a hold."""
+        if self._held_by is None:
+            return None
+        z = np.inf
+        for phase in self._phases:
+            if phase.held_n:
+                fresh = list(phase.levels)[-phase.held_n :]
+                z = min(z, sum(fresh) / (np.sqrt(len(fresh)) * self._level_sd))
+        p = float(ndtr(z))
+        if p >= self.settings.release_p:
+            if all(phase.held_n for phase in self._phases):
+                self._held_by = None
+            return None
+        reason = (
+            f"held since the implausible estimate at {self._held_by.time:.2f} s: the blocks "
+            f"read since then still read quiet on a phase (level score {z:.3g} sd, p = {p:.2g}"
+            f" < release_p {self.settings.release_p:g})"
+        )
+        return self._no_estimate("implausible", reason, speed=v, feature=y, plausibility_p=p)
 
     def _posterior_estimate(self, reason: str, tic: float, v: float, y) -> Estimate:
         t_now, pos_now = self._now()
