@@ -223,13 +223,14 @@ def append_step(thin, n_iter: int, n_chains: int, n_keep, source: str = "init=em
 
 def _reordered_list(name: str, values, order: list[int] | None):
     """A recorded nested list (of numbers and None) of ``name``, its last axis in the order of
-    this fit's components (``reordered``); as given where that fails (a damaged record, which
-    its check then names)."""
+    this fit's components (``reordered``); as given where nothing moves or that fails (a damaged
+    record, which its check then names)."""
     try:
-        moved = reordered(name, np.asarray(values, dtype=object), order)
+        given = np.asarray(values, dtype=object)
+        moved = reordered(name, given, order)
     except (IndexError, ValueError):
         return values
-    return values if moved is not None and moved.ndim == 0 else moved.tolist()
+    return values if moved is given else moved.tolist()
 
 
 def pool_chains(first: np.ndarray, second: np.ndarray, n_chains: int) -> np.ndarray:
