@@ -53,7 +53,11 @@ Frozen odometry: a block whose speeds all read standing (below ``STANDING_MPS``)
 last estimate, but a dead odometry (the pose held, the twist 0) reads so while the robot drives
 on. With the quiet-signal check on, a standing block whose level score at the emulator's lowest
 speed is not below the normal quantile of ``plausibility_p`` (the accelerometer reads as a
-vehicle driving there, not as a sensor at rest reads its noise) is a "sensor_fault".
+vehicle driving there, not as a sensor at rest reads its noise) is a "sensor_fault" once the
+odometry has read standing for ``STANDING_SETTLE_S`` before it, and gives no estimate
+("out_of_domain") before: a robot that stops rings on its suspension for a second or so.
+Without the quiet-signal check (``quiet_blocks=0`` or ``plausibility_p=0``) and with the window
+methods, a dead odometry reads as standing.
 """
 
 from __future__ import annotations
@@ -104,6 +108,11 @@ STANDING_MPS = 0.05
 block: the ground gives next to no vertical acceleration). Where its accelerometer reads at
 least as loud as driving at the emulator's lowest speed over its smoothest ground, the odometry
 froze while the robot drove (`BCR`, "Frozen odometry")."""
+STANDING_SETTLE_S = 2.0
+"""A robot that stops rings on its suspension for a second or so (its first standing blocks
+read as driving: up to 1.3 s after a 20 m/s^2 stop from 2 m/s over GD 300-600), s: a standing
+block that reads as driving is a "sensor_fault" only once the odometry has read standing this
+long before it; until then it gives no estimate ("out_of_domain")."""
 PAPER_WINDOW = FeatureSpec(name="log_var", block_samples=1000)
 """The paper's observation: log of the variance of the last 1,000 samples at 120 Hz."""
 
@@ -131,7 +140,8 @@ class BCRSettings:
             posterior piles up there) or "central" (equal tails, which never holds a bound).
         plausibility_p: an observation whose upper-tail probability under the emulator is below
             this for every GD in the domain is "implausible"; also the level of the quiet-signal
-            check (``quiet_blocks``). 0 switches both off.
+            check (``quiet_blocks``) and of the frozen-odometry check (`BCR`). 0 switches them
+            off.
         sensor: thresholds of the signal checks (stuck, quantised, clipped, dead, below the
             noise floor, a level jump).
         recent_change_m: the distance of ``Estimate.prob_change``, m.
@@ -139,7 +149,8 @@ class BCRSettings:
             (~1 s each): an estimate is "implausible" where its phase's last ``quiet_blocks``
             blocks together read quieter than any GD explains (`BCR`, "The quiet-signal
             check"), with a probability under the emulator below ``plausibility_p``; 0
-            switches the check off.
+            switches the check off, and the frozen-odometry check (`BCR`), which reads its
+            level scores.
         release_p: change-point method with the quiet-signal check on: after an "implausible"
             estimate, the estimates stay "implausible" while a phase's level scores of the
             blocks it read since then, summed as the check sums them, read a probability below
@@ -396,8 +407,9 @@ class BCR:
         self._warm_up()
 
     def __setstate__(self, state: dict) -> None:  # a restored BCR warms up as a new one
-        # (one pickled before it had a note, or the quiet-signal hold)
-        self.__dict__.update({"_start_note": "", "_held_by": None, **state})
+        # (one pickled before it had a note, the quiet-signal hold or the standing time)
+        self.__dict__.update({"_start_note": "", "_held_by": None, "_standing_from": np.nan,
+                              **state})  # fmt: skip
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -501,6 +513,7 @@ class BCR:
         self._data_time = np.nan  # newest information of the window methods (phases keep theirs)
         self._phase = 0  # the change-point phase of the newest update
         self._held_by: Estimate | None = None  # the implausible estimate that started a hold
+        self._standing_from = np.nan  # first sample time of the newest standing blocks in a row
         self._tracked_at: list[float | None] = [None] * len(getattr(self, "trackers", ()))
 
     def update(self, t, position, accel, speed, *, now: float | None = None) -> Estimate:
@@ -762,6 +775,7 @@ class BCR:
         phase = self._phases[self._phase]
         ds = self._block_distance(phase)
         acc, spd = self._acc, self._spd  # the newest block_samples contiguous samples
+        standing_from, self._standing_from = self._standing_from, np.nan  # (set while standing)
         if self._fault:
             reason, self._fault = self._fault, ""
             return self._skip_block(phase, ds, "sensor_fault", reason + "; block skipped")
@@ -786,13 +800,13 @@ class BCR:
             timing = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
             if timing:  # odometry that disagrees with the speeds (a sign flip, a wild speed)
                 return self._skip_block(phase, ds, "sensor_fault", timing, speed=v)
-            frozen = self._frozen_odometry(phase, acc, spd)
-            if frozen:  # standing by the odometry, driving by the accelerometer
-                return self._skip_block(phase, ds, "sensor_fault", frozen, speed=v)
+            status, frozen = self._frozen_odometry(phase, acc, spd, standing_from)
+            if status == "sensor_fault":  # standing by the odometry, driving by the accelerometer
+                return self._skip_block(phase, ds, status, frozen, speed=v)
             phase.undo = None
             phase.filter.predict(ds)
-            if not np.isfinite(self._newest_data_time()):
-                return self._no_estimate("out_of_domain", why, speed=v)
+            if status or not np.isfinite(self._newest_data_time()):
+                return self._no_estimate("out_of_domain", frozen or why, speed=v)
             return self._held_reason(v, None) or self._posterior_estimate(
                 "no new information: " + why, tic, v, None
             )
@@ -831,30 +845,42 @@ class BCR:
                                                     plausibility_p=quiet[1]))  # fmt: skip
         return self._held_reason(v, y) or self._posterior_estimate("", tic, v, y)
 
-    def _frozen_odometry(self, phase: _Phase, acc: np.ndarray, spd: np.ndarray) -> str:
-        """Why a block whose speeds read standing (every |speed| below ``STANDING_MPS``) comes
-        from a robot that drives, or "": its accelerometer reads no quieter than driving at the
+    def _frozen_odometry(
+        self, phase: _Phase, acc: np.ndarray, spd: np.ndarray, standing_from: float
+    ) -> tuple[str, str]:
+        """(status, why) for a block whose speeds read standing (every |speed| below
+        ``STANDING_MPS``) but whose accelerometer reads no quieter than driving at the
         emulator's lowest speed over the smoothest ground (the block's level score there, in
-        the quiet-signal check's sds, not below the normal quantile of ``plausibility_p``;
-        with that check on). A robot at rest reads its own noise (a block of N(0, 1) noise
-        scores -6.6 sd at worst in 5,000 with emulator B, a drive at 0.5-2 m/s over GD 200-500
-        -3.8 at worst)."""
+        the quiet-signal check's sds, not below the normal quantile of ``plausibility_p``; with
+        that check on): "sensor_fault" (the odometry froze while the robot drove) once the
+        odometry has read standing for ``STANDING_SETTLE_S`` before the block, "out_of_domain"
+        before (a stop's ringing); ("", "") otherwise. ``standing_from``: the first sample time
+        of the standing blocks in a row before this one (NaN: none). A robot at rest reads its
+        own noise (a block of N(0, 1) noise scores -6.6 sd at worst in 5,000 with emulator B,
+        a drive at 0.5-2 m/s over GD 200-500 -3.8 at worst)."""
         s = self.settings
-        if not (phase.levels.maxlen and s.plausibility_p > 0):
-            return ""
         if not np.max(np.abs(spd)) < STANDING_MPS:
-            return ""
+            return "", ""
+        self._standing_from = self._t[0] if np.isnan(standing_from) else standing_from
+        if not (phase.levels.maxlen and s.plausibility_p > 0):
+            return "", ""
         y = self._block_feature(acc)
         if not np.all(np.isfinite(y)):  # a sensor at rest without noise: no power in a band
-            return ""
-        lo = self.speed_range[0]
+            return "", ""
+        lo, limit = self.speed_range[0], ndtri(s.plausibility_p)
         z = self._level_score(y, lo) / self._level_sd
-        if not z >= ndtri(s.plausibility_p):
-            return ""
-        return (
-            f"frozen odometry: the speeds read standing (below {STANDING_MPS:g} m/s) but the "
-            f"accelerometer reads as driving at {lo:g} m/s or faster (level score {z:.3g} sd, "
-            f"a sensor at rest reads below {ndtri(s.plausibility_p):.3g})"
+        if not z >= limit:
+            return "", ""
+        why = (
+            f"the speeds read standing (below {STANDING_MPS:g} m/s) but the accelerometer reads "
+            f"as driving at {lo:g} m/s or faster (level score {z:.3g} sd, a sensor at rest reads "
+            f"below {limit:.3g})"
+        )
+        if self._t[0] - self._standing_from >= STANDING_SETTLE_S:
+            return "sensor_fault", f"frozen odometry: {why}"
+        return "out_of_domain", (
+            f"{why}: a stop's ringing, or frozen odometry (a sensor_fault once it has read "
+            f"standing for STANDING_SETTLE_S = {STANDING_SETTLE_S:g} s)"
         )
 
     def _level_score(self, y: np.ndarray, v: float) -> float:
@@ -911,24 +937,27 @@ class BCR:
         """During a hold (since an "implausible" estimate): an "implausible" estimate where a
         phase's level scores of the blocks it read since the hold began (at most its last
         ``quiet_blocks``), summed as `_quiet_reason` sums them, read a probability below
-        ``release_p``; else None, and the hold ends once every phase has read such blocks.
-        None without a hold."""
-        if self._held_by is None:
+        ``release_p``, or where no phase has read a block since (the hold's own probability);
+        else None, and the hold ends once every phase has read such blocks. None without a
+        hold."""
+        held = self._held_by
+        if held is None:
             return None
-        z = np.inf
-        for phase in self._phases:
-            if phase.held_n:
-                fresh = list(phase.levels)[-phase.held_n :]
-                z = min(z, sum(fresh) / (np.sqrt(len(fresh)) * self._level_sd))
+        since = f"held since the implausible estimate at {held.time:.2f} s"
+        scores = [list(phase.levels)[-phase.held_n :] for phase in self._phases if phase.held_n]
+        if not scores:  # (standing or accelerating since): nothing read to end it
+            reason = f"{since}: no block read since then"
+            return self._no_estimate("implausible", reason, speed=v, feature=y,
+                                     plausibility_p=held.plausibility_p)  # fmt: skip
+        z = min(sum(fresh) / (np.sqrt(len(fresh)) * self._level_sd) for fresh in scores)
         p = float(ndtr(z))
         if p >= self.settings.release_p:
-            if all(phase.held_n for phase in self._phases):
+            if len(scores) == len(self._phases):
                 self._held_by = None
             return None
         reason = (
-            f"held since the implausible estimate at {self._held_by.time:.2f} s: the blocks "
-            f"read since then still read quiet on a phase (level score {z:.3g} sd, p = {p:.2g}"
-            f" < release_p {self.settings.release_p:g})"
+            f"{since}: the blocks read since then still read quiet on a phase (level score "
+            f"{z:.3g} sd, p = {p:.2g} < release_p {self.settings.release_p:g})"
         )
         return self._no_estimate("implausible", reason, speed=v, feature=y, plausibility_p=p)
 

@@ -4,6 +4,8 @@ ground and the Simplex sped up on the GD-500 part (session 68: 2.0 m/s where the
 commanded 1.4). After a flag the BCR gives "ok" again only where the blocks read since then are
 not quiet on any phase; on a healthy sensor they are not, and nothing changes."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -94,3 +96,23 @@ def test_a_bcr_pickled_before_the_hold_still_runs(new_bcr):
     old.__setstate__(state)
     trace = drive([(8.0, 300.0)], 1.5, seed=4)
     assert run(old, trace, trace.accel_front_measured)[-1][0].ok
+
+
+def test_a_hold_holds_while_the_robot_stands_after_the_flag(new_bcr):
+    """A gain of 0.5 from 2 s, flagged at 3.85 s, and the robot stops at 5 s for 3 s: before
+    any block is read after the flag, the carried estimate ("no new information", GD 268 on
+    the GD-500 part) was "ok" and the Simplex commanded 1.8 m/s."""
+    sim = vehicle.Simulation(
+        vehicle.Jackal(), roadgen.track([(6.0, 300.0), (24.0, 500.0)], seed=1), noise_std=1.0,
+        seed=1,
+    )  # fmt: skip
+    parts = [sim.advance(5.0, 1.5), sim.advance(3.0, 0.0)]
+    trace = SimpleNamespace(**{k: np.concatenate([getattr(p, k) for p in parts])
+                               for k in ("t", "position", "speed")})  # fmt: skip
+    accel = np.concatenate([p.accel_front for p in parts]) * np.where(trace.t >= 2.0, 0.5, 1.0)
+    unheld = after_first_flag(run(new_bcr("B", release_p=0.0), trace, accel))
+    assert any(e.ok and "no new information" in e.reason for e, _ in unheld)
+    held = after_first_flag(run(new_bcr("B"), trace, accel))
+    assert not any(e.ok for e, _ in held)
+    assert max(c.speed for _, c in held) <= Simplex().v_safe
+    assert any("no block read since" in e.reason for e, _ in held)
