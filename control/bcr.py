@@ -47,7 +47,8 @@ emulator's domain reads the same way (docs/closed-loop.md, "Guards"). A hold fol
 still holds blocks from before a gain dropped) would give an "ok" estimate that reads the quiet
 blocks as smoother ground, so until every phase has read blocks since the hold began, an
 estimate is "implausible" wherever a phase's scores of those blocks, summed alike, fall below
-the normal quantile of ``release_p``.
+the normal quantile of ``release_p`` (at most until every phase's memory of ``quiet_blocks`` was
+read since then: the check itself rules from there).
 
 Frozen odometry: a block whose speeds all read standing (below ``STANDING_MPS``) carries the
 last estimate, but a dead odometry (the pose held, the twist 0) reads so while the robot drives
@@ -154,8 +155,9 @@ class BCRSettings:
         release_p: change-point method with the quiet-signal check on: after an "implausible"
             estimate, the estimates stay "implausible" while a phase's level scores of the
             blocks it read since then, summed as the check sums them, read a probability below
-            this, until every phase has read such blocks (a hysteresis: `BCR`, "The
-            quiet-signal check"); 0 switches the hold off.
+            this, until every phase has read such blocks, at most until every phase's memory
+            (``quiet_blocks``) was read since then (a hysteresis: `BCR`, "The quiet-signal
+            check"); 0 switches the hold off.
     """
 
     feature: FeatureSpec = field(default_factory=FeatureSpec)
@@ -938,10 +940,14 @@ class BCR:
         phase's level scores of the blocks it read since the hold began (at most its last
         ``quiet_blocks``), summed as `_quiet_reason` sums them, read a probability below
         ``release_p``, or where no phase has read a block since (the hold's own probability);
-        else None, and the hold ends once every phase has read such blocks. None without a
-        hold."""
+        else None, and the hold ends once every phase has read such blocks that read loud
+        enough, or, whatever they read, its whole memory (``quiet_blocks``) since the flag: the
+        check itself then rules. None without a hold."""
         held = self._held_by
         if held is None:
+            return None
+        if all(phase.held_n >= phase.levels.maxlen for phase in self._phases):
+            self._held_by = None  # every phase's memory read since the flag
             return None
         since = f"held since the implausible estimate at {held.time:.2f} s"
         scores = [list(phase.levels)[-phase.held_n :] for phase in self._phases if phase.held_n]

@@ -116,3 +116,19 @@ def test_a_hold_holds_while_the_robot_stands_after_the_flag(new_bcr):
     assert not any(e.ok for e, _ in held)
     assert max(c.speed for _, c in held) <= Simplex().v_safe
     assert any("no block read since" in e.reason for e, _ in held)
+
+
+def test_a_hold_ends_once_every_phase_has_read_its_memory_since_the_flag(new_bcr):
+    """Emulator A at 0.5 m/s on GD 200 (its smooth edge): the blocks read a little quiet
+    (-0.3 to -1.1 sd), so the sum of those read since a flag drifted below release_p's quantile
+    and the hold never ended (212 of 228 updates held). Once every phase's quiet-signal memory
+    (16 blocks) was read since the flag, the check itself, at plausibility_p, is the rule."""
+    track = roadgen.track([(20.0, 200.0)], seed=1)
+    trace = vehicle.simulate(vehicle.Jackal(), track, 0.5, noise_std=0.0, seed=1)
+    steps = run(new_bcr("A"), trace, trace.accel_front_measured)
+    held = [(e.time, float(e.reason.split(" at ")[1].split(" s")[0]))
+            for e, _ in steps if "held since the implausible estimate" in e.reason]  # fmt: skip
+    assert held  # a hold started
+    per_phase = 16 * 125 / 120  # s: a phase reads a block of 125 samples every 125 samples
+    assert max(t - since for t, since in held) <= per_phase + 1.0
+    assert len(held) < 0.5 * len(steps)
