@@ -6,6 +6,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _basis_cases import GROUPS, D, basis_obs, basis_sim
 
 import gpmsa
 from gpmsa.fitting.continuation import continued_starts
@@ -13,20 +14,10 @@ from gpmsa.model.basis import basis_digest, reordered_basis
 from gpmsa.model.likelihood import log_posterior
 from gpmsa.model.problem import prepare
 
-GRID = np.linspace(0.0, 1.0, 12)
-D = np.exp(-((GRID[:, None] - np.array([0.1, 0.5, 0.9])) ** 2) / 0.05)
-GROUPS = [0, 0, 1]
-
 
 @functools.cache
 def _data():
-    rng = np.random.default_rng(1)
-    x, t = rng.random((20, 1)), rng.random((20, 1))
-    y = np.sin(3 * x + GRID) + t**2 * np.cos(2 * GRID) + 0.1 * t * GRID
-    data = gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["t"], index=GRID)
-    xo = np.array([[0.2], [0.7]])
-    obs = gpmsa.ObsData(x=xo, y=np.sin(3 * xo + GRID) + 0.16 * np.cos(2 * GRID), index=GRID)
-    return data, obs
+    return basis_sim(), basis_obs()
 
 
 def _fit(backend="numpy", **kw):

@@ -7,6 +7,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _basis_cases import GROUPS, D, basis_obs, basis_sim
 
 import gpmsa
 from gpmsa.calibration.calibrate import calibration_problem
@@ -17,24 +18,12 @@ from gpmsa.studies import continuation as cont
 from gpmsa.studies.record import DISCREPANCIES
 from gpmsa.studies.sampler import StudyState
 
-GRID = np.linspace(0.0, 1.0, 12)
-D = np.exp(-((GRID[:, None] - np.array([0.1, 0.5, 0.9])) ** 2) / 0.05)
-GROUPS = [0, 0, 1]
 KW = {"labels": ["a", "b"], "shared": ["t"], "n_chains": 2, "tune_rounds": 3, "tune_levels": 3}
 
 
 @functools.cache
 def _data():
-    rng = np.random.default_rng(1)
-    x, t = rng.random((20, 1)), rng.random((20, 1))
-    y = np.sin(3 * x + GRID) + t**2 * np.cos(2 * GRID) + 0.1 * t * GRID
-    sim = gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["t"], index=GRID)
-    obs = []
-    for k in range(2):
-        xo = np.array([[0.2], [0.7]]) + 0.05 * k
-        y_obs = np.sin(3 * xo + GRID) + 0.16 * np.cos(2 * GRID)
-        obs.append(gpmsa.ObsData(x=xo, y=y_obs, index=GRID))
-    return sim, obs
+    return basis_sim(), [basis_obs(0.05 * k) for k in range(2)]
 
 
 def _fit_study(**kw):
