@@ -69,6 +69,7 @@ CALIBRATION_FIXED = ("theta", "lamOs", "betaV", "lamVz")
 def calibration_problem(
     emulator, x_obs, y_obs, *, discrepancy=None, extrapolate=False, constraint=None,
     theta_init=None, reduced: Observations | None = None, discrepancy_groups=None, fixed=None,
+    fit: Fit | None = None,
 ) -> Problem:  # fmt: skip
     """The calibration-only Problem: the emulator's parameters at its point estimate in ``fixed``.
 
@@ -79,17 +80,21 @@ def calibration_problem(
     caller has it already (no discrepancy only), so that the observations are checked and
     reduced once. ``fixed``: ``calibration_fixed(emulator, fixed=, discrepancy)`` (theta on
     the unit scale): held in the Problem (``Problem.with_fixed``) beside the emulator's parameters.
+    ``fit``: ``observation_fit(emulator, reduced, [emulator.params])`` where the caller has it
+    (with ``reduced``), for the lamOs start.
     """
     check_emulator(emulator)
     if reduced is not None and discrepancy is not None:
         raise GPMSAError("calibration_problem: reduced= is the no-discrepancy reduction; with a "
                          "discrepancy basis pass reduced=None")  # fmt: skip
+    if fit is not None and reduced is None:
+        raise GPMSAError("calibration_problem: fit= is the fit of reduced=; pass both or neither")
     start = None
     if discrepancy is None:
         check_groups(discrepancy_groups, 0)  # groups without a basis: refused
         data = reduce(emulator, x_obs, y_obs, extrapolate) if reduced is None else reduced
         obs, corr = data.obs, data.os_corr
-        fit = observation_fit(emulator, data, [emulator.params])
+        fit = observation_fit(emulator, data, [emulator.params]) if fit is None else fit
         start = lamos_start(fit, data.lamos)
     else:
         given = given_obs_data(x_obs, y_obs)
@@ -386,7 +391,8 @@ def calibrate(
             draws, info = _run_backend(
                 emulator, data, x_obs, y_obs, backend, (discrepancy, discrepancy_groups),
                 n_samples, n_chains, tune, {**tuning_opts, **options}, seed, extrapolate,
-                progress, where, {**theta_opts, "fixed": held},
+                progress, where,
+                {**theta_opts, "fixed": held, "fit": None if discrepancy is not None else fit},
             )  # fmt: skip
     held_names = info.pop("held_names", ())
     for k, value in calibration_held_native(emulator, fixed).items():  # the value given

@@ -381,19 +381,20 @@ def calibrate_study(
     check_study_names(layout)
     t0 = time.perf_counter()
     models = list(zip(labels, emulators, x_obs, y_obs, strict=True))
-    reduced = []
+    reduced, fits = [], []
     for (lab, e, x, y), (basis, _) in zip(models, bases, strict=True):
         with warnings.catch_warnings():
             if basis is not None:  # the reduction with its basis warns (as gpmsa.calibrate)
                 warnings.simplefilter("ignore", ReductionWarning)
             reduced.append(_per_model(lab, reduce, e, x, y, extrapolate))
-        fit = observation_fit(e, reduced[-1], [e.params])  # as gpmsa.calibrate warns
-        warn_if_outside(fit, stacklevel=3, discrepancy=basis is not None, model=lab)
+        fits.append(observation_fit(e, reduced[-1], [e.params]))  # as gpmsa.calibrate warns
+        warn_if_outside(fits[-1], stacklevel=3, discrepancy=basis is not None, model=lab)
     problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate,
                            reduced=None if basis is not None else r, discrepancy=basis,
-                           discrepancy_groups=groups, fixed=h)
-                for (lab, e, x, y), r, (basis, groups), h in zip(models, reduced, bases, held,
-                                                                 strict=True)]  # fmt: skip
+                           discrepancy_groups=groups, fixed=h,
+                           fit=None if basis is not None else f)
+                for (lab, e, x, y), r, f, (basis, groups), h in zip(
+                    models, reduced, fits, bases, held, strict=True)]  # fmt: skip
     natives = [calibration_held_native(e, f) for e, f in zip(emulators, fixes, strict=True)]
     record: dict = {}  # what the study records of its models, before any sampling
     _record_fixed(record, labels, problems, layout, fixes, natives)
