@@ -11,3 +11,17 @@ DATA_DIR = Path(__file__).parent / "data"
 def data_dir() -> Path:
     """Folder of test data files copied into the project (never ../shared)."""
     return DATA_DIR
+
+
+@pytest.fixture
+def dask_client():
+    """A dask.distributed client of two single-thread workers in this process (threads: a
+    cluster of worker processes takes seconds to start); skipped without distributed."""
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        yield client

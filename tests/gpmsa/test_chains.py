@@ -53,15 +53,8 @@ def test_same_seed_same_draws_with_1_2_or_4_workers(problem, four_serial):
         np.testing.assert_array_equal(four_serial.draws[name][:2], val)
 
 
-def test_dask_client_runs_the_chains_with_the_same_draws(problem, four_serial):
-    distributed = pytest.importorskip("distributed")
-    with (
-        distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
-        ) as cluster,
-        distributed.Client(cluster) as client,
-    ):
-        got = backends.get("numpy").sample(problem, n_chains=4, seed=5, executor=client, **SHORT)
+def test_dask_client_runs_the_chains_with_the_same_draws(problem, four_serial, dask_client):
+    got = backends.get("numpy").sample(problem, n_chains=4, seed=5, executor=dask_client, **SHORT)
     _same(four_serial, got)
 
 

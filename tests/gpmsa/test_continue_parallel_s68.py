@@ -8,7 +8,6 @@ import warnings
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-import pytest
 from _basis_cases import GROUPS, D, basis_obs, basis_sim
 from _continue_cases import continue_fit
 
@@ -105,15 +104,7 @@ def test_a_source_fitted_in_processes_continues_serially_as_a_serial_one():
     _assert_same(_serial(), _continuations({"n_jobs": 1}, src))
 
 
-def test_continuations_on_a_dask_client_match_serial():
+def test_continuations_on_a_dask_client_match_serial(dask_client):
     """Threads here (a cluster of worker processes took ~3 s to start; the pickling is the
     process pool's above)."""
-    distributed = pytest.importorskip("distributed")
-    with (
-        distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
-        ) as cluster,
-        distributed.Client(cluster) as client,
-    ):
-        got = _continuations({"executor": client}, _sources())
-    _assert_same(_serial(), got)
+    _assert_same(_serial(), _continuations({"executor": dask_client}, _sources()))
