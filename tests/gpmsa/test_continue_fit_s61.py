@@ -6,6 +6,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _continue_cases import continue_data
 
 import gpmsa
 from gpmsa import backends
@@ -13,13 +14,8 @@ from gpmsa.fitting.fit import continued_starts
 from gpmsa.model.problem import prepare
 
 
-@functools.cache
 def _data():
-    rng = np.random.default_rng(0)
-    x, t = rng.random((24, 1)), rng.random((24, 1))
-    data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t**2, x_names=["x"], t_names=["t"])
-    obs = gpmsa.ObsData(x=[[0.2], [0.7]], y=[[np.sin(0.6) + 0.16], [np.sin(2.1) + 0.16]])
-    return data, obs
+    return continue_data(0)
 
 
 @functools.cache
