@@ -196,13 +196,17 @@ def linear_response(
 ) -> LinearTrace:
     """Response of the linear model at constant ``speed`` (m/s), from rest on the road.
 
-    The front axle starts at ``start_m`` (default: wheelbase; the road continues flat beyond its
-    ends). The road input is evaluated on a grid ``oversample`` times finer than the samples and
-    interpolated linearly by ``lsim``; ``envelope`` as in ``simulate``.
+    The front axle starts at ``start_m`` (default: wheelbase; in [0, road length), the rear axle
+    reading a flat extension at the road's first height while behind its start), as in
+    ``simulate``, and its last sample must lie on the road. The road input is evaluated on a grid
+    ``oversample`` times finer than the samples and interpolated linearly by ``lsim``;
+    ``envelope`` as in ``simulate``.
 
     Raises VehicleError for a speed outside (0, model.max_speed_mps], n_samples or oversample
-    not an integer >= 1, a rate_hz not finite and > 0, a start_m not finite, an envelope not a
-    bool, or a grid that would need more than ``vehicle.checks.MAX_MEMORY_BYTES``.
+    not an integer >= 1, a rate_hz not finite and > 0, a start_m not finite or off the road, a
+    road no longer than the wheelbase, n_samples that take the front axle past the road's end,
+    an envelope not a bool, or a grid that would need more than
+    ``vehicle.checks.MAX_MEMORY_BYTES``.
     """
     check_model(model)
     speed = checks.real("speed", speed)
@@ -220,6 +224,7 @@ def linear_response(
         raise VehicleError(f"start_m={start_m!r} must be finite")
     envelope = checks.flag("envelope", envelope)
     road_in = RoadInput(road, model.wheel_radius_m if envelope else None)
+    _check_drive(model, road_in, s0, speed, n_samples, rate_hz)
     lm = linear_model(model)
     t = np.arange(n_samples * oversample + 1) / (rate_hz * oversample)
     s = s0 + speed * t
@@ -240,3 +245,22 @@ def linear_response(
     _, y, _ = signal.lsim(state_space(lm), u, t, X0=x0)
     keep = slice(oversample, None, oversample)
     return LinearTrace(t=t[keep], accel_front=y[keep, 0], accel_rear=y[keep, 1], q=y[keep, 2:])
+
+
+def _check_drive(
+    model: Model, road: RoadInput, start_m: float, speed: float, n_samples: int, rate_hz: float
+) -> None:
+    """VehicleError unless the drive of ``n_samples`` at ``speed`` (m/s) and ``rate_hz`` from
+    ``start_m`` (m) lies on ``road`` as ``simulate``'s would (``simulate.check_span``): beyond
+    the road's end the road is not known, and reading it as flat returned zeros silently."""
+    from vehicle.simulate import check_span  # here: simulate imports this module
+
+    check_span(model, road, start_m, road.length_m)
+    end = start_m + speed * n_samples / rate_hz
+    if end > road.length_m + 1e-9:
+        most = math.floor((road.length_m + 1e-9 - start_m) * rate_hz / speed)
+        raise VehicleError(
+            f"n_samples={n_samples} at speed={speed:g} m/s and rate_hz={rate_hz:g} Hz from "
+            f"start_m={start_m:.6g} m take the front axle to {end:.6g} m, past the road's end at "
+            f"{road.length_m:.6g} m: allowed n_samples <= {most} (or a longer road)"
+        )
