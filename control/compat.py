@@ -113,7 +113,9 @@ def check_emulator(
     good, e.g. a GD band given in m^3). Warnings: a
     different noise level (the paper's Test Cases pair the noise-free emulator with noise-free
     data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
-    want it); vehicle or noise metadata missing.
+    want it); a track whose grid step or band top differs from the training roads' (metadata
+    ``road``: the GD estimates are biased; on the paper's track a 2 cm grid read GD 500 as
+    358); vehicle or noise metadata missing.
     """
     _check_is_emulator(emulator)
     if model is not None and not callable(getattr(model, "describe", None)):
@@ -163,6 +165,15 @@ def check_emulator(
         if outside:
             raise EmulatorMismatchError(
                 f"track GD {outside} outside the emulator's GD domain [{lo:g}, {hi:g}]"
+            )
+        differ = _track_road_mismatch(meta, track)
+        if differ:
+            warnings.warn(
+                f"the track's road differs from the emulator's training roads ({differ}): the "
+                "vehicle feels the short waves that a grid and a band hold, so the GD estimates "
+                "will be biased (roadgen.track's default dx_m and band make the training roads')",
+                ControlWarning,
+                stacklevel=user_stacklevel(),
             )
     if simplex is not None:
         _check_speeds(emulator, simplex)
@@ -298,6 +309,35 @@ def emulator_noise_std(emulator) -> float | None:
     _check_is_emulator(emulator)
     value = _recorded_noise_std(dict(getattr(emulator, "metadata", None) or {}))
     return value if value is not None and value > 0 else None
+
+
+def _track_road_mismatch(meta: dict, track) -> str:
+    """How ``track``'s road differs from the emulator's training roads (metadata ``road``): its
+    grid step ``dx_m`` and the top of its band (cycles/m; a ``band`` of None is the grid's
+    Nyquist limit), each named where it differs by more than 0.1 %; "" where both agree, and
+    where the metadata or the track does not say (a record that is not a positive number)."""
+    road = meta.get("road")
+    if not isinstance(road, dict) or not is_real(road.get("dx_m")):
+        return ""
+    dx_trained = float(road["dx_m"])
+    band = road.get("band")
+    if band is None:
+        top_trained = 0.5 / dx_trained if dx_trained > 0 else np.nan
+    elif isinstance(band, list | tuple) and len(band) == 2 and is_real(band[1]):
+        top_trained = float(band[1])
+    else:
+        top_trained = np.nan
+    dx = getattr(track, "dx_m", None)
+    top = getattr(getattr(track, "settings", None), "band", (None, None))[1]
+    differ = []
+    for name, mine, trained, unit in (
+        ("dx_m = ", dx, dx_trained, " m"),
+        ("band up to ", top, top_trained, " cycles/m"),
+    ):
+        known = is_real(mine) and np.isfinite(trained) and trained > 0
+        if known and not abs(float(mine) - trained) <= 1e-3 * trained:
+            differ.append(f"{name}{float(mine):.3g}{unit} against {trained:.3g}{unit}")
+    return "; ".join(differ)
 
 
 def _recorded_noise_std(meta: dict) -> float | None:
