@@ -32,6 +32,7 @@ from gpmsa.calibration.observations import (
     check_x,
     check_y,
     checked_obs_data,
+    closer_fit,
     emulator_param_sets,
     emulator_record,
     fit_at_levels,
@@ -459,7 +460,10 @@ def observation_fit(emulator, data, sets) -> Fit:
     q = emulator.t_unit.shape[1]
     theta = theta_probe(q)
     layout = probe_layout(q) if levels is None else None
-    fits = [fit_of(*gp.predict(data.x, theta), data, layout) for gp in gps]
+    if layout is None and levels is None:  # scattered nodes: look closer before warning
+        fits = [closer_fit(gp.predict, data, theta) for gp in gps]
+    else:
+        fits = [fit_of(*gp.predict(data.x, theta), data, layout) for gp in gps]
     return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
 
 
