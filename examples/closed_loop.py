@@ -14,7 +14,11 @@ emulators trained with it. Run k drives a track synthesised with seed k (and noi
 k = FIRST_SEED .. FIRST_SEED + RUNS - 1. ``--emulator-dir DIR`` takes the four emulators that
 ``examples/train_emulator.py --emulator-dir DIR`` writes instead of the shipped ones; the loop then
 drives the vehicle they were trained for, with their noise level. The Simplex's speeds
-(``--v-safe``, ``--v-max``; the paper's 1.0 and 2.0 m/s) must lie in the emulators' speed range.
+(``--v-safe``, ``--v-max``; the paper's 1.0 and 2.0 m/s) must lie in the emulators' speed range,
+and its GD band (``--gd-min``, ``--gd-max``; the paper's 250 and 350) fit their GD range: its
+``--gd-max`` above the lowest GD and below the highest. A run whose Simplex a fault latched in
+safety mode (v_safe for the rest of the run) is named below the tables, with the estimate that
+latched it.
 
 Each case is run twice: with our estimator (default: the change-point BCR on log band powers of
 1 s blocks, `control.bcr`) and with the paper's method run here (one 1,000-sample window, its
@@ -42,9 +46,11 @@ import control  # noqa: E402
 import gpmsa  # noqa: E402
 import roadgen  # noqa: E402
 import vehicle  # noqa: E402
+from control.bcr import emulator_domain  # noqa: E402
 from control.metrics import strict_json  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
 from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
+from control.validation import within  # noqa: E402
 
 PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 PAPER_RMSE = {"A": {"300": 42.58, "500": 94.42}, "B": {"300": 50.19, "500": 96.23}}
@@ -141,10 +147,21 @@ def check_same_robot(band, window) -> None:
         raise control.EmulatorMismatchError(", ".join(differ))
 
 
+def latched_by(result) -> str | None:
+    """``"STATUS: REASON"`` of the estimate that latched the run's Simplex in safety mode (the
+    rest of the run at v_safe), None where none did."""
+    when = result.metrics.latched_at_s
+    if not np.isfinite(when):
+        return None
+    k = int(np.argmin(np.abs(result.time - when)))
+    return f"{result.status[k]}: {result.reason[k]}"
+
+
 def summarise(results, gds: list[float]) -> dict:
     """Pooled RMSE per prescribed GD (keys ``f"{gd:g}"``, as the per-run metrics'), pooled
     interval coverage and the per-run metrics (with ``domain_edge``: how many estimates named
-    each edge of the emulator's GD domain); NaN where a part has no estimate."""
+    each edge of the emulator's GD domain; ``latched_by``: the estimate that latched safety
+    mode, `latched_by`); NaN where a part has no estimate."""
     errors = [r.metrics.gd_errors for r in results]
     ok = np.concatenate([np.isfinite(r.gd_mean) for r in results])
     lo, hi, true = (
@@ -155,7 +172,11 @@ def summarise(results, gds: list[float]) -> dict:
         "rmse": {f"{gd:g}": control.pooled_rmse(errors, gd) for gd in gds},
         "coverage": float(np.mean(covered)) if covered.size else float("nan"),
         "runs": [
-            {**r.metrics.as_dict(), "domain_edge": control.edge_counts(r.domain_edge)}
+            {
+                **r.metrics.as_dict(),
+                "domain_edge": control.edge_counts(r.domain_edge),
+                "latched_by": latched_by(r),
+            }
             for r in results
         ],
     }
@@ -213,6 +234,16 @@ def main(argv: list[str] | None = None) -> dict:
         help="the Simplex's safety-mode speed, m/s (default 1.0, the paper's)",
     )  # fmt: skip
     parser.add_argument(
+        "--gd-min", type=float, default=control.Simplex.gd_min, metavar="GD",
+        help="the Simplex's GD band, 1e-6 m^3: v_max at and below --gd-min (default 250, the "
+        "paper's) ...",
+    )  # fmt: skip
+    parser.add_argument(
+        "--gd-max", type=float, default=control.Simplex.gd_max, metavar="GD",
+        help="... v_safe at --gd-max and safety mode above it (default 350, the paper's); "
+        "within the emulators' GD range",
+    )  # fmt: skip
+    parser.add_argument(
         "--cases", nargs="+", choices=["A", "B"], default=["A", "B"],
         help="test cases: A (noise-free), B (with the noise the case-B emulators were trained on)",
     )  # fmt: skip
@@ -238,10 +269,14 @@ def main(argv: list[str] | None = None) -> dict:
         control.Simplex(risk=args.risk)
     except control.ControlError as err:
         parser.error(f"--risk: {err}")
+    try:
+        control.Simplex(gd_min=args.gd_min, gd_max=args.gd_max)
+    except control.ControlError as err:
+        parser.error(f"--gd-min / --gd-max: {err}")
     try:  # the speeds are checked together (v_safe <= v_max, the step <= v_max); --law: choices
         simplex = control.Simplex(
             risk=args.risk, law=args.law, speed_step_mps=args.speed_step,
-            v_max=args.v_max, v_safe=args.v_safe,
+            v_max=args.v_max, v_safe=args.v_safe, gd_min=args.gd_min, gd_max=args.gd_max,
         )  # fmt: skip
     except control.ControlError as err:
         parser.error(f"--v-safe, --v-max, --speed-step: {err}")
@@ -267,8 +302,10 @@ def main(argv: list[str] | None = None) -> dict:
                 parser.error(f"--track: {err} (--beyond-domain drives it anyway)")
         try:
             control.check_emulator(emu, simplex=simplex)
-        except control.EmulatorMismatchError as err:  # speeds outside the emulator's domain
-            parser.error(f"--v-safe / --v-max: {err}")
+        except control.EmulatorMismatchError as err:  # speeds, or GD band, outside the domain
+            (v_lo, v_hi), _ = emulator_domain(emu)
+            speeds = all(within(v, v_lo, v_hi) for v in (simplex.v_safe, simplex.v_max))
+            parser.error(f"{'--gd-min / --gd-max' if speeds else '--v-safe / --v-max'}: {err}")
     for case in args.cases:  # the two methods of a case are compared on one robot
         try:
             check_same_robot(emulators[case, "band"], emulators[case, "window"])
@@ -335,17 +372,27 @@ def main(argv: list[str] | None = None) -> dict:
                 f"{figure(ours['rmse'][gd], '.1f'):>8}   {per_run}"
             )
     print()
-    head = ("fast on GD>350", "90% cover", "time (s)", "x real time")
+    head = (f"fast on GD>{simplex.gd_max:g}", "90% cover", "time (s)", "x real time")
     print(f"{'case':<6}{'seed':<6}" + "".join(f"{h:>{len(h) + 2}}" for h in head)
           + "   delay at each change (m)")  # fmt: skip
     for case in args.cases:
         for k, r in zip(seeds, metrics["ours"][case]["runs"], strict=True):
             delays = " ".join(figure(d, ".1f") for d in r["detection_delay_m"])
             print(
-                f"{case:<6}{k:<6}{r['fast_on_rough_m']:14.1f} m"
+                f"{case:<6}{k:<6}{r['fast_on_rough_m']:{len(head[0])}.1f} m"
                 f"{figure(r['coverage'], '.2f'):>11}{r['traversal_time_s']:10.1f}"
                 f"{r['real_time_factor']:13.0f}   {delays}"
             )
+    latched = [
+        f"{case} seed {k} ({label}): at {r['latched_at_s']:.2f} s, {r['latched_by']}"
+        for case in args.cases
+        for key, label in (("ours", "ours"), ("paper_method", "paper's method"))
+        for k, r in zip(seeds, metrics[key][case]["runs"], strict=True)
+        if r["latched_by"] is not None
+    ]
+    if latched:
+        print("\nruns latched in safety mode by a fault (v_safe for the rest of the run):")
+        print("\n".join(f"  {line}" for line in latched))
     named = [
         f"{case} seed {k}: " + ", ".join(f"{n} {e}" for e, n in r["domain_edge"].items() if n)
         for case in args.cases

@@ -269,6 +269,39 @@ def check_shippable(parser: argparse.ArgumentParser, args) -> None:
             )
 
 
+BAND_OPTIONS = {
+    "anchor_speeds": None,
+    "anchor_runs": None,
+    "block_samples": BAND_FEATURE.block_samples,
+    "quantiles": list(BAND_FEATURE.quantiles),
+    "n_pc": BAND_PCS,
+}
+"""The options that shape the band emulators alone, with their defaults (None: filled later)."""
+
+
+def check_applies(parser: argparse.ArgumentParser, args) -> None:
+    """Usage error for an option given where it has no effect (the files would not say that
+    it was dropped): a band emulators' option without ``--features band``, ``--noise-std``
+    without case B (case A is noise-free); then fill the defaults of those left out."""
+    if "band" not in args.features:
+        for name in BAND_OPTIONS:
+            if getattr(args, name) is not None:
+                option = "--" + name.replace("_", "-")
+                parser.error(
+                    f"{option} shapes the band emulators only, which --features "
+                    f"{' '.join(args.features)} does not fit: add band to --features, or "
+                    f"leave {option} out"
+                )
+    if args.noise_std is not None and "B" not in args.cases:
+        parser.error(
+            f"--noise-std {args.noise_std:g} is case B's noise (case A is trained noise-free), "
+            "but --cases leaves B out: for an emulator of your IMU's noise give --cases B"
+        )
+    for name, default in (*BAND_OPTIONS.items(), ("noise_std", NOISE_STD["B"])):
+        if getattr(args, name) is None:
+            setattr(args, name, default)
+
+
 def check_anchors(parser: argparse.ArgumentParser, args) -> None:
     """Refuse anchor speeds outside ``--speed-range`` and fewer than one run a speed; fill the
     default ``--anchor-runs``; no anchors where no band emulator is fitted."""
@@ -487,7 +520,7 @@ def main(argv: list[str] | None = None) -> None:
     )  # fmt: skip
     parser.add_argument("--cases", nargs="+", default=["A", "B"], choices=["A", "B"])
     parser.add_argument(
-        "--noise-std", type=float, default=NOISE_STD["B"],
+        "--noise-std", type=float, default=None,
         help="accelerometer noise sd of case B, m/s^2 (your IMU's; default 1.0, the paper's)",
     )  # fmt: skip
     parser.add_argument(
@@ -499,26 +532,26 @@ def main(argv: list[str] | None = None) -> None:
         "--features", nargs="+", default=["band", "window"], choices=["band", "window"]
     )
     parser.add_argument(
-        "--block-samples", type=int, default=BAND_FEATURE.block_samples,
+        "--block-samples", type=int, default=None,
         help="samples per block of the band emulators (the change-point BCR takes the length "
         "from the emulator file and updates three times a block; the default 125 is the length the "
         "BCR's settings and sensor checks were chosen for: docs/closed-loop.md)",
     )  # fmt: skip
     parser.add_argument(
-        "--quantiles", nargs="*", type=float, default=list(BAND_FEATURE.quantiles),
-        metavar="LEVEL",
+        "--quantiles", nargs="*", type=float, default=None, metavar="LEVEL",
         help="levels in (0, 1) of the block quantiles (minus the block mean) appended to the "
-        "band powers (control.FeatureSpec.quantiles; default: %(default)s; the option alone: "
-        "none, the band powers only)",
+        f"band powers (control.FeatureSpec.quantiles; default: {list(BAND_FEATURE.quantiles)}; "
+        "the option alone: none, the band powers only)",
     )  # fmt: skip
     parser.add_argument(
-        "--n-pc", type=int, default=BAND_PCS,
+        "--n-pc", type=int, default=None,
         help="principal components of the band emulators (1 to the feature's outputs: its "
         f"{len(BAND_FEATURE.bands_hz) - 1} band powers and one per --quantiles level)",
     )  # fmt: skip
     args = parser.parse_args(argv)
     args.cases, args.features = list(dict.fromkeys(args.cases)), list(dict.fromkeys(args.features))
     check_seed(parser, args.seed)
+    check_applies(parser, args)
     for option, fields in (
         ("--quantiles", {"quantiles": tuple(args.quantiles)}),
         ("--block-samples", {"block_samples": args.block_samples}),
