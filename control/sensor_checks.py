@@ -66,10 +66,12 @@ class SensorLimits:
             None: unknown.
         max_level_jump: largest ratio allowed between the variance of any segment of at least
             ``MIN_SEGMENT`` samples of a block and that of the rest of the block, each about its
-            own mean (a gain that drops or jumps within the block; of the 22,770 clean blocks of
-            125 samples of the shipped emulators' campaign none exceeded 323 without noise, 255
-            with it: lift-off gives near-constant free-flight stretches, so the limit is high,
-            and catches gains below ~0.05 or above ~20).
+            own mean, where the level drops (`level_jump`: a gain that drops within the block,
+            or jumps and comes back; a level that only rises reads rougher and is not counted;
+            of the 22,770 clean blocks of 125 samples of the shipped emulators' campaign none
+            exceeded 323 without noise, 255 with it, counting rises too: lift-off gives
+            near-constant free-flight stretches, so the limit is high, and catches gains below
+            ~0.05).
         dead_fraction: a stretch of ``DEAD_STRETCH`` consecutive samples whose range is below
             this fraction of the block's standard deviation, away from ``free_fall_mps2``, is a
             dead sensor (a gain near zero, a clip or quantisation near zero, a short stuck
@@ -185,7 +187,7 @@ def longest_repeat(a: np.ndarray) -> int:
 def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True) -> str:
     """Why a block of accelerations (finite values, m/s^2) cannot come from a healthy sensor,
     or "" (stuck, quantised, clipped, a dead stretch, quieter than the sensor's noise, a level
-    that jumps within the block). ``steady=False``: the vehicle started or stopped within the
+    that drops within the block). ``steady=False``: the vehicle started or stopped within the
     block, whose level then changes with the speed: no level-jump check."""
     a = np.asarray(accel, dtype=float)
     if a.ndim != 1:
@@ -440,8 +442,14 @@ def level_jump(a: np.ndarray, min_segment: int = MIN_SEGMENT) -> tuple[float, tu
     """(largest ratio between the variance of a segment of ``a`` and that of the rest, the
     segment as (start, stop)) over the segments with at least ``min_segment`` samples inside and
     outside; each part's variance about its own mean, so that a part held near any constant (a
-    gain that dropped) counts as no variance. (1, (0, 0)) for blocks shorter than
-    2 * min_segment."""
+    gain that dropped) counts as no variance. Only drops count: a quiet segment is held to the
+    samples before it as well (the smaller of the two ratios), a loud one to the samples after
+    it, and one with fewer than ``min_segment`` samples on that side scores 1. A level that only
+    rises (a quiet start, then louder to the block's end: a robot driving from a smooth floor
+    onto rough ground, a simulated track's flat lead-in, a signal coming back) reads rougher,
+    never smoother; a gain that falls reads smoother, and the first block of the change-point
+    BCR that holds its fall holds it with 83 or more samples before it. (1, (0, 0)) for blocks
+    shorter than 2 * min_segment."""
     _check_count(min_segment, "min_segment", 2)
     if a.size < 2 * min_segment:
         return 1.0, (0, 0)
@@ -455,6 +463,7 @@ def _level_jump(s1: np.ndarray, s2: np.ndarray, min_segment: int) -> tuple[float
     if n < 2 * min_segment:
         return 1.0, (0, 0)
     best = (1.0, (0, 0))
+    before, after = _part_variances(s1, s2, min_segment)
     per_chunk = _starts_per_chunk(n)
     for first in range(0, n + 1, per_chunk):
         start, stop, (n_in, n_in_1, n_out, n_out_1) = _segments(n, min_segment, first, per_chunk)
@@ -474,14 +483,32 @@ def _level_jump(s1: np.ndarray, s2: np.ndarray, min_segment: int) -> tuple[float
         np.subtract(s2[-1] - sq_in, var_out, out=var_out)
         var_out /= n_out_1
         np.maximum(var_out, 0.0, out=var_out)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = var_in / var_out
-            np.maximum(ratio, var_out / var_in, out=ratio)
+        with np.errstate(divide="ignore", invalid="ignore"):  # a drop, either way round:
+            ratio = var_in / np.maximum(var_out, after[stop])  # loud, then quieter after it
+            np.maximum(ratio, np.minimum(var_out, before[start]) / var_in, out=ratio)  # quiet
         np.fmax(ratio, 1.0, out=ratio)  # NaN (0 / 0: both parts constant) as 1; the rest >= 1
         i = int(np.argmax(ratio))
         if ratio[i] > best[0]:
             best = (float(ratio[i]), (int(start[i]), int(stop[i])))
     return best
+
+
+def _part_variances(
+    s1: np.ndarray, s2: np.ndarray, min_segment: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """(before, after): before[i] the variance of samples 0..i-1, after[j] that of samples
+    j..n-1, each about its own mean, from the block's `_centred_sums`; 0 before fewer than
+    ``min_segment`` samples, inf after fewer (a side too short to hold a level: no drop)."""
+    n = s1.size - 1
+    count = np.arange(n + 1, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        before = (s2 - s1 * s1 / count) / (count - 1)
+        rest = count[::-1]
+        tail1, tail2 = s1[-1] - s1, s2[-1] - s2
+        after = (tail2 - tail1 * tail1 / rest) / (rest - 1)
+    before[:min_segment] = 0.0
+    after[n - min_segment + 1 :] = np.inf
+    return np.maximum(before, 0.0), np.maximum(after, 0.0)
 
 
 def _centred_sums(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:

@@ -98,20 +98,27 @@ def test_the_loop_takes_the_simplex_gd_band(tmp_path, monkeypatch, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_the_loop_says_which_runs_latched_in_safety_mode(tmp_path, capsys):
-    """With ``--v-safe 0.6`` in case A the first steady block spans the track's 1 m lead-in,
-    whose road fades in from flat: its level jump (x1,480) is a sensor fault that latched safety
-    mode at 1.05 s, and the robot drove the whole track at 0.6 m/s; the tables showed 0 m fast
-    on rough ground and a long time, and nothing said the run had latched."""
-    metrics = load_example("closed_loop").main(
+def test_the_loop_says_which_runs_latched_in_safety_mode(tmp_path, capsys, monkeypatch):
+    """A run that a fault latches in safety mode drives the rest of the track at v_safe: the
+    tables showed 0 m fast on rough ground and a long time, and nothing said the run had
+    latched (found with ``--v-safe 0.6``, whose first steady block spanned the track's flat
+    lead-in and read a level jump; that is no longer a fault: a NaN burst stands in for it)."""
+    script = load_example("closed_loop")
+    loop = control.run_closed_loop
+
+    def with_a_fault(*args, **kwargs):
+        return loop(*args, **kwargs, faults=[control.SensorFault(1.5, 0.5, "nan")])
+
+    monkeypatch.setattr(script.control, "run_closed_loop", with_a_fault)
+    metrics = script.main(
         ["--out", str(tmp_path), "--runs", "1", "--track", "4:300", "--cases", "A",
          "--v-safe", "0.6", "--method", "changepoint"]
     )  # fmt: skip
     latched = metrics["ours"]["A"]["runs"][0]["latched_at_s"]
-    assert latched == pytest.approx(1.05)
+    assert 1.5 <= latched <= 2.5
     out = capsys.readouterr().out
     assert "runs latched in safety mode by a fault" in out
-    assert "A seed 1 (ours): at 1.05 s, sensor_fault: signal level jumps" in out
+    assert f"A seed 1 (ours): at {latched:.2f} s, sensor_fault: " in out
 
 
 def test_check_emulator_still_refuses_a_gd_band_outside_the_domain():
