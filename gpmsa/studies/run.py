@@ -35,8 +35,9 @@ from gpmsa.fitting.fit import (
 )
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
-from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
+from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.model import categorical
+from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
@@ -493,6 +494,20 @@ def _per_model(label: str, make, *args, **kwargs):
                           stacklevel=user_stacklevel())  # fmt: skip
 
 
+def _member_convergence(problem, summary: dict, counts: tuple[int, int]):
+    """A ``fit_study`` model's convergence records over its kept draws (``counts``: chains,
+    draws a chain): (every parameter it sampled, as ``gpmsa.fit`` records it; those but theta
+    and lamOs, which the study's own record judges under the study's names); (None, None) for
+    one chain."""
+    if counts[0] < 2:
+        return None, None
+    shapes = {k: problem.init[k].shape for k in problem.sampled}
+    held = {per_element.label(k, i) for k, v in problem.fixed_elements.items() for i in v}
+    own = {k: v for k, v in shapes.items() if k not in ("theta", "lamOs")}
+    return (convergence(summary, shapes, *counts, held=held),
+            convergence(summary, own, *counts, held=held))  # fmt: skip
+
+
 def fit_study(
     sims, obs, *, labels=None, shared=(), hierarchical=(), hyper: HyperPriors | None = None,
     n_iter: int = 30_000, n_burn: int | None = None, n_keep: int | None = None,
@@ -540,6 +555,11 @@ def fit_study(
 
     Returns a ``Study`` of kind "fit": ``study.members`` are the models' fitted emulators (their
     ``calibration`` holds the model's theta draws), ``study.posterior`` as ``calibrate_study``.
+    With several chains each member's ``convergence`` judges every parameter its model sampled
+    over its retained draws (thinned to n_keep, as the study's record;
+    ``gpmsa.fit``'s judges every sweep after burn-in), and a ``gpmsa.ConvergenceWarning`` naming
+    the model lists its flagged emulator (and discrepancy) elements; theta and lamOs are judged
+    by the study's record and warning, under the study's names.
 
     >>> import numpy as np, gpmsa
     >>> t = np.linspace(0.1, 0.9, 12)[:, None]; x = np.tile([[0.0], [1.0]], (6, 1))
@@ -661,11 +681,15 @@ def fit_study(
             emu_settings["continued_from"] = init.members[i].model_sha256
         if append:  # as gpmsa.fit(..., init=the source member, append=True) records it
             emu_settings.update(appended_record(init.members[i], int(n_iter), int(n_chains)))
+        summary = summarize({**post, "theta": theta})
+        records = _member_convergence(problems[i], summary, theta.shape[:2])
         members.append(Emulator._from_prepared(
             sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,
-            settings=emu_settings, diagnostics=summarize({**post, "theta": theta}),
-            calibration=cal,
+            settings=emu_settings, diagnostics=summary, calibration=cal,
+            convergence=records[0],
         ))  # fmt: skip
+        if records[1] is not None:  # its emulator's (and discrepancy's) elements
+            warn_unconverged(records[1], f"gpmsa.fit_study (model {labels[i]!r})")
     study = Study("fit", members, layout, hyper, draws, settings, metadata)
     if study.convergence is not None:
         warn_unconverged(study.convergence, "gpmsa.fit_study")
