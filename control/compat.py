@@ -328,7 +328,8 @@ def _track_road_mismatch(meta: dict, track) -> str:
     else:
         top_trained = np.nan
     dx = getattr(track, "dx_m", None)
-    top = getattr(getattr(track, "settings", None), "band", (None, None))[1]
+    band = getattr(getattr(track, "settings", None), "band", None)
+    top = band[1] if isinstance(band, list | tuple) and len(band) == 2 else None
     differ = []
     for name, mine, trained, unit in (
         ("dx_m = ", dx, dx_trained, " m"),

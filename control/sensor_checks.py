@@ -448,8 +448,8 @@ def level_jump(a: np.ndarray, min_segment: int = MIN_SEGMENT) -> tuple[float, tu
     rises (a quiet start, then louder to the block's end: a robot driving from a smooth floor
     onto rough ground, a simulated track's flat lead-in, a signal coming back) reads rougher,
     never smoother; a gain that falls reads smoother, and the first block of the change-point
-    BCR that holds its fall holds it with 83 or more samples before it. (1, (0, 0)) for blocks
-    shorter than 2 * min_segment."""
+    BCR that holds its fall holds it late (at the default three updates a block, with 83 or more
+    samples before it). (1, (0, 0)) for blocks shorter than 2 * min_segment."""
     _check_count(min_segment, "min_segment", 2)
     if a.size < 2 * min_segment:
         return 1.0, (0, 0)

@@ -427,9 +427,10 @@ def theta_probe(q: int) -> np.ndarray:
     return np.vstack([lattice, sobol])
 
 
-def closer_fit(predict, data: Observations, theta: np.ndarray) -> Fit:
+def closer_fit(predict, data: Observations, theta: np.ndarray, probe: tuple | None = None) -> Fit:
     """``Fit`` of the observation over ``theta`` (unit scale (G, q): `theta_probe`'s scattered
-    nodes for three or more parameters) and, where those nodes read it outside
+    nodes for three or more parameters; ``probe``: ``predict(data.x, theta)`` where the caller
+    has it) and, where those nodes read it outside
     (``OUTSIDE_SDS``), over the ends of local searches (bounded L-BFGS-B on the unit cube of
     the sum of squared distances, `_distances`) from its best nodes, up to ``CLOSER_STARTS``
     of them, until one end lies inside.
@@ -438,7 +439,7 @@ def closer_fit(predict, data: Observations, theta: np.ndarray) -> Fit:
     experiments of 40 values made by the simulator at an interior theta of three parameters
     read 11-18 predictive sds outside, warned of as a units error, while the posterior was
     right (tests/gpmsa/test_outside_many_theta_s69.py)."""
-    mean, cov = predict(data.x, theta)
+    mean, cov = predict(data.x, theta) if probe is None else probe
     fit = fit_of(mean, cov, data)
     if not fit.outside_sds > OUTSIDE_SDS:
         return fit

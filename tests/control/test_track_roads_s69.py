@@ -61,3 +61,17 @@ def test_road_metadata_that_says_nothing_is_not_questioned(emulator_a, road):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         control.check_emulator(bare, track=track)
+
+
+def test_a_track_like_object_without_a_band_is_judged_by_its_grid_alone(emulator_a):
+    """A track-like object whose settings say ``band=None`` (or have no settings): only its
+    grid step is compared (this raised TypeError, indexing None)."""
+    from types import SimpleNamespace
+
+    from control.compat import _track_road_mismatch
+
+    for settings in (SimpleNamespace(band=None), None):
+        coarse = SimpleNamespace(dx_m=0.02, settings=settings)
+        assert _track_road_mismatch(emulator_a.metadata, coarse) == "dx_m = 0.02 m against 0.006 m"
+        same = SimpleNamespace(dx_m=0.006, settings=settings)
+        assert _track_road_mismatch(emulator_a.metadata, same) == ""
