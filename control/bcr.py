@@ -78,7 +78,7 @@ from control.changepoint import ChangePointFilter, ChangePointSettings, _mixture
 from control.errors import ControlError
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, feature_of_variance, features_of_blocks
-from control.sensor_checks import SensorLimits, signal_fault, stream_fault, timing_fault
+from control.sensor_checks import SensorLimits, signal_fault, stream_breaks, timing_fault
 from control.tracker import GDTracker, TrackerSettings
 from control.validation import (
     check_instance,
@@ -426,7 +426,7 @@ class BCR:
     def __setstate__(self, state: dict) -> None:  # a restored BCR warms up as a new one
         # (one pickled before it had a note, the quiet-signal hold or the standing time)
         self.__dict__.update({"_start_note": "", "_held_by": None, "_standing_from": np.nan,
-                              **state})  # fmt: skip
+                              "_breaks": None, **state})  # fmt: skip
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -519,7 +519,8 @@ class BCR:
         self._pos = np.empty(0)
         self._fresh = 0  # samples in the window the tempered filter has not seen
         self._received = 0  # samples received since the last estimate
-        self._fault = ""
+        self._breaks = None  # what broke the samples of the coming update (`StreamBreaks`)
+        self._fault = ""  # the clock steps among them (before session 69: their whole reason)
         self._t_last = np.nan  # time and position of the newest finite sample
         self._t_prev = np.nan  # the newest finite time stamp, kept or dropped
         self._pos_last = np.nan
@@ -597,25 +598,28 @@ class BCR:
             reason = f"{self._start_note}{self._received} of the first update's {every} samples"
             self.last = replace(self.last, reason=reason)
         est = self._check_age(fault or self.last)
-        return self._check_silence(est, fresh=self._n_updates > updates)
+        return self._check_silence(est, fresh=self._n_updates > updates, pending=True)
 
     # --- internals -------------------------------------------------------------------------------
 
     def _take(self, t, pos, acc, spd) -> None:
         """Append the samples of one update (or part of one); a dropped sample or a gap
-        (`stream_fault`) restarts the contiguous buffer, and its reason, for these samples
-        alone, waits for the update's estimate."""
-        drop, restart, reason = stream_fault(t, pos, acc, spd, self._t_prev, self.settings.rate_hz)
+        (`stream_breaks`) restarts the contiguous buffer, and what broke them waits for the
+        update's estimate, counted with what broke its earlier parts (the same reason in any
+        chunking)."""
+        drop, restart, found = stream_breaks(t, pos, acc, spd, self._t_prev, self.settings.rate_hz)
         broken = np.flatnonzero(drop | restart)
+        step = ""
         if broken.size == 0 and t.size:  # (the usual case) all finite and kept: the last is newest
             self._t_prev = self._t_last = float(t[-1])
             self._pos_last = float(pos[-1])
         else:  # a clock step first: it moves the newest kept sample's time too
-            reason += self._clock_step(t)
+            step = self._clock_step(t)
             self._take_stamps(t, pos, drop)
         if broken.size:  # every cause until a block reports them, whatever the chunking
-            if reason not in self._fault:
-                self._fault = f"{self._fault} and {reason}" if self._fault else reason
+            self._breaks = found if self._breaks is None else self._breaks + found
+            if step not in self._fault:
+                self._fault += step
             k = int(broken[-1])
             keep = slice(k + 1, None) if drop[k] else slice(k, None)
             self._acc, self._spd, self._t, self._pos = acc[keep], spd[keep], t[keep], pos[keep]
@@ -626,6 +630,17 @@ class BCR:
         self._t = np.concatenate([self._t, t])[-self.buffer :]
         self._pos = np.concatenate([self._pos, pos])[-self.buffer :]
         self._fresh = min(self._fresh + acc.size, self.buffer)
+
+    def _pending_fault(self) -> str:
+        """The reason of what broke the samples of the coming update ("" for nothing)."""
+        breaks = "" if self._breaks is None else self._breaks.reason(self.settings.rate_hz)
+        return breaks + self._fault
+
+    def _pop_fault(self) -> str:
+        """`_pending_fault`, forgotten: the update reports it."""
+        reason = self._pending_fault()
+        self._breaks, self._fault = None, ""
+        return reason
 
     def _clock_step(self, t: np.ndarray) -> str:
         """Where the stamps ``t`` step back from the stamp before them (kept or dropped) by
@@ -674,11 +689,12 @@ class BCR:
             return t, self._pos_last
         return float(self.last.time), float(self.last.position)
 
-    def _check_silence(self, est: Estimate, fresh: bool = False) -> Estimate:
+    def _check_silence(self, est: Estimate, fresh: bool = False, pending: bool = False) -> Estimate:
         """'sensor_fault' when the caller's clock is more than max_silence_s past the newest
         sample (or, before any sample, past the first call); a sensor fault that this call's
         samples gave (``fresh``: e.g. readings that arrived but were NaN, which leave no
-        newest sample) is named before the silence."""
+        newest sample) is named before the silence, and so (``pending``) are the breaks of
+        samples that wait for the coming update (fed in chunks smaller than an update)."""
         if not np.isfinite(self._clock):
             return est
         last = self._t_last if np.isfinite(self._t_last) else self._clock_start
@@ -697,6 +713,8 @@ class BCR:
             )
         if fresh and est.status == "sensor_fault" and est.reason:
             reason = f"{est.reason}; {reason}"
+        elif pending and (waiting := self._pending_fault()):
+            reason = f"{waiting}; {reason}"
         return Estimate(t_now, pos_now, "sensor_fault", reason, data_time=est.data_time)
 
     def _block_distance(self, phase: _Phase) -> float:
@@ -793,8 +811,8 @@ class BCR:
         ds = self._block_distance(phase)
         acc, spd = self._acc, self._spd  # the newest block_samples contiguous samples
         standing_from, self._standing_from = self._standing_from, np.nan  # (set while standing)
-        if self._fault:
-            reason, self._fault = self._fault, ""
+        if self._breaks is not None or self._fault:
+            reason = self._pop_fault()
             return self._skip_block(phase, ds, "sensor_fault", reason + "; block skipped")
         if acc.size < s.feature.block_samples:  # (re)starting, with phases
             phase.undo = None
@@ -1094,8 +1112,8 @@ class BCR:
     def _estimate_window(self) -> Estimate:
         s = self.settings
         bad_signal = self._window_signal_reason()
-        if self._fault:
-            reason, self._fault = self._fault, ""
+        if self._breaks is not None or self._fault:
+            reason = self._pop_fault()
             if bad_signal:  # the samples kept after the break fail too
                 self._restart_window()
                 reason += f" and {bad_signal}"

@@ -551,11 +551,81 @@ def _segments(
     return start, stop, counts
 
 
+@dataclass(frozen=True)
+class StreamBreaks:
+    """What broke a stream's samples (`stream_breaks`), counted so that the counts of
+    consecutive chunks add up (``a + b``) to those of the chunks joined: the reason of an
+    update's samples does not depend on how they were chunked.
+
+    Attributes:
+        nonfinite: samples with a non-finite value; names: which of t, position, accel, speed
+            held one (`STREAM_FIELDS` order).
+        too_fast: samples with |speed| beyond ``MAX_SPEED_MPS``; fastest: the largest such
+            |speed|, m/s.
+        backwards: repeated or backwards time stamps.
+        worst_gap: the largest step above 1.5 periods, s (0: none).
+    """
+
+    nonfinite: int = 0
+    names: tuple[str, ...] = ()
+    too_fast: int = 0
+    fastest: float = 0.0
+    backwards: int = 0
+    worst_gap: float = 0.0
+
+    def __add__(self, other: StreamBreaks) -> StreamBreaks:
+        names = tuple(n for n in STREAM_FIELDS if n in self.names or n in other.names)
+        return StreamBreaks(
+            self.nonfinite + other.nonfinite,
+            names,
+            self.too_fast + other.too_fast,
+            max(self.fastest, other.fastest),
+            self.backwards + other.backwards,
+            max(self.worst_gap, other.worst_gap),
+        )
+
+    def reason(self, rate_hz: float) -> str:
+        """The sentence naming them ("" for none), for a stream at ``rate_hz``."""
+        what = []
+        if self.nonfinite:
+            what.append(f"{self.nonfinite} sample(s) with non-finite {'/'.join(self.names)}")
+        if self.too_fast:
+            what.append(
+                f"{self.too_fast} sample(s) with |speed| up to {self.fastest:.3g} m/s, beyond any "
+                f"ground robot's (MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
+            )
+        if self.backwards:
+            what.append(f"{self.backwards} repeated or backwards time stamp(s)")
+        if self.worst_gap:
+            dt = 1.0 / rate_hz
+            what.append(
+                f"a gap of {self.worst_gap:.4g} s (about {round(self.worst_gap / dt) - 1:.4g} "
+                f"dropped samples)" + _stamp_unit_hint(self.worst_gap / dt)
+            )
+        return " and ".join(what)
+
+
+STREAM_FIELDS = ("t", "position", "accel", "speed")
+"""The arrays of a stream, in the order `StreamBreaks.names` lists them."""
+NO_BREAKS = StreamBreaks()
+"""The `StreamBreaks` of samples that break nothing."""
+
+
 def stream_fault(
     t: np.ndarray, position: np.ndarray, accel: np.ndarray, speed: np.ndarray, t_prev: float,
     rate_hz: float,
 ) -> tuple[np.ndarray, np.ndarray, str]:  # fmt: skip
-    """Samples that break the stream: (drop (n,), restart (n,), reason or "").
+    """Samples that break the stream: (drop (n,), restart (n,), reason or ""); `stream_breaks`
+    with the breaks' reason."""
+    drop, restart, breaks = stream_breaks(t, position, accel, speed, t_prev, rate_hz)
+    return drop, restart, breaks.reason(rate_hz)
+
+
+def stream_breaks(
+    t: np.ndarray, position: np.ndarray, accel: np.ndarray, speed: np.ndarray, t_prev: float,
+    rate_hz: float,
+) -> tuple[np.ndarray, np.ndarray, StreamBreaks]:  # fmt: skip
+    """Samples that break the stream: (drop (n,), restart (n,), `StreamBreaks`).
 
     ``drop`` marks samples to discard: a value that is not finite, a speed beyond
     ``MAX_SPEED_MPS``, or a time stamp that repeats or goes backwards (a step below half a
@@ -573,29 +643,18 @@ def stream_fault(
     with np.errstate(invalid="ignore"):
         backwards = finite_step & (step < 0.5 * dt)
         gap = finite_step & (step > 1.5 * dt)
-    what = []
-    if not finite.all():
-        names = [
-            name
-            for name, a in (("t", t), ("position", position), ("accel", accel), ("speed", speed))
-            if not np.all(np.isfinite(a))
-        ]
-        what.append(f"{int((~finite).sum())} sample(s) with non-finite {'/'.join(names)}")
-    if too_fast.any():
-        fastest = float(np.max(np.abs(speed[too_fast])))
-        what.append(
-            f"{int(too_fast.sum())} sample(s) with |speed| up to {fastest:.3g} m/s, beyond any "
-            f"ground robot's (MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
+    breaks = NO_BREAKS
+    if not finite.all() or too_fast.any() or backwards.any() or gap.any():
+        arrays = zip(STREAM_FIELDS, (t, position, accel, speed), strict=True)
+        breaks = StreamBreaks(
+            int((~finite).sum()),
+            tuple(name for name, a in arrays if not np.all(np.isfinite(a))),
+            int(too_fast.sum()),
+            float(np.max(np.abs(speed[too_fast]))) if too_fast.any() else 0.0,
+            int(backwards.sum()),
+            float(np.max(step[gap])) if gap.any() else 0.0,
         )
-    if backwards.any():
-        what.append(f"{int(backwards.sum())} repeated or backwards time stamp(s)")
-    if gap.any():
-        worst = float(np.max(step[gap]))
-        what.append(
-            f"a gap of {worst:.4g} s (about {round(worst / dt) - 1:.4g} dropped samples)"
-            + _stamp_unit_hint(worst / dt)
-        )
-    return bad_value | backwards, gap & ~bad_value, " and ".join(what)
+    return bad_value | backwards, gap & ~bad_value, breaks
 
 
 STAMP_UNITS = (("milliseconds", 1e3), ("microseconds", 1e6), ("nanoseconds", 1e9))
