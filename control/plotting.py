@@ -32,6 +32,39 @@ def _runs(results) -> list:
         ) from None
 
 
+def _optional_real(value, name: str, what: str) -> float | None:
+    """``value`` (None or a finite real number) as a float; ControlError naming it otherwise."""
+    if value is None:
+        return None
+    if not (is_real(value) and np.isfinite(value)):
+        raise ControlError(f"{name} must be a finite {what} or None, got {value!r:.60}")
+    return float(value)
+
+
+def _interval_level(results: list, level: float | None) -> float:
+    """The level of the runs' credible interval: ``level`` where given (it must agree with the
+    level each run's BCR recorded, ``settings["bcr"].interval_level``), else the recorded one
+    (0.9, BCRSettings' default, where none is recorded); ControlError otherwise."""
+    recorded = sorted({float(bcr.interval_level) for r in results
+                       if (bcr := (getattr(r, "settings", None) or {}).get("bcr")) is not None
+                       and hasattr(bcr, "interval_level")})  # fmt: skip
+    if level is None:
+        if len(recorded) > 1:
+            raise ControlError(
+                f"the runs' BCRs used different interval levels {recorded}: plot them apart"
+            )
+        return recorded[0] if recorded else 0.9
+    if not (is_real(level) and 0 < level < 1):
+        raise ControlError(f"level must lie in (0, 1) (e.g. 0.9 for 90%), got {level!r}")
+    if recorded and recorded != [float(level)]:
+        raise ControlError(
+            f"level={level!r} is not the level the runs' BCR reported its interval at "
+            f"(settings['bcr'].interval_level={', '.join(f'{v:g}' for v in recorded)}): leave "
+            "level=None"
+        )
+    return float(level)
+
+
 def _mark_track(ax, track, gd_max: float | None) -> None:
     """Segment changes (dotted verticals) and the parts rougher than gd_max (shaded)."""
     for i, b in enumerate(track.boundaries_m[1:]):
@@ -48,7 +81,11 @@ def _mark_track(ax, track, gd_max: float | None) -> None:
 
 
 def plot_gd_trace(
-    results: Sequence, track, title: str = "", gd_max: float | None = 350.0, level: float = 0.9
+    results: Sequence,
+    track,
+    title: str = "",
+    gd_max: float | None = 350.0,
+    level: float | None = None,
 ) -> Figure:
     """GD estimate (posterior mean, and the credible interval as thin lines) against position;
     estimates that name an edge of the emulator's GD domain (``domain_edge``) are marked with a
@@ -58,11 +95,13 @@ def plot_gd_trace(
         results: `ClosedLoopResult`s driven over `track` (or tracks with the same segments).
         track: the track whose prescribed GD is drawn as a black step line.
         gd_max: the Simplex's GD_max: the parts rougher than it are shaded (None: no shading).
-        level: the level of the BCR's interval (for the legend), in (0, 1).
+        level: the level of the BCR's interval (for the legend), in (0, 1); None: the
+            ``interval_level`` the runs' BCR recorded (``settings["bcr"]``; 0.9 where none is
+            recorded). A level other than the recorded one is a ControlError.
     """
     results = _runs(results)
-    if not (is_real(level) and 0 < level < 1):
-        raise ControlError(f"level must lie in (0, 1) (e.g. 0.9 for 90%), got {level!r}")
+    level = _interval_level(results, level)
+    gd_max = _optional_real(gd_max, "gd_max", "GD (1e-6 m^3)")
     fig = Figure(figsize=(7.5, 4.6), layout="constrained")
     ax = fig.add_subplot()
     _mark_track(ax, track, gd_max)
@@ -99,11 +138,14 @@ def plot_speed(
     The start (the vehicle ramps up from rest within a few centimetres) is left out.
     """
     results = _runs(results)
+    gd_max = _optional_real(gd_max, "gd_max", "GD (1e-6 m^3)")
+    v_safe = _optional_real(v_safe, "v_safe", "speed (m/s)")
     fig = Figure(figsize=(7.5, 3.0), constrained_layout=True)
     ax = fig.add_subplot()
     _mark_track(ax, track, gd_max)
     for i, r in enumerate(results):
-        moving = r.sample_position > r.sample_position[0] + 0.1
+        start = r.sample_position[0] if len(r.sample_position) else 0.0  # a run without samples
+        moving = r.sample_position > start + 0.1
         ax.plot(r.sample_position[moving], r.sample_speed[moving], lw=1.0, label=f"run {i + 1}")
     if v_safe is not None:
         ax.axhline(v_safe, color="0.3", lw=0.8, ls="--", label=f"safe speed {v_safe:g} m/s")

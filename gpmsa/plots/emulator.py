@@ -36,10 +36,12 @@ def pc_basis(emulator, *, max_pc: int = 6):
     std = emulator.standardizer
     p_u = min(emulator.p_u, check_count(max_pc, "max_pc"))
     scalar = emulator.l_sim == 1
+    units = (*emulator.x_units, *emulator.t_units)
     inputs = [(n, emulator.x_unit[:, k] * (std.x_max[k] - std.x_min[k]) + std.x_min[k])
               for k, n in enumerate(emulator.x_names)]  # fmt: skip
     inputs += [(n, emulator.t_unit[:, k] * (std.t_max[k] - std.t_min[k]) + std.t_min[k])
                for k, n in enumerate(emulator.t_names)]  # fmt: skip
+    inputs = [(f"{n} ({u})" if u else n, v) for (n, v), u in zip(inputs, units, strict=True)]
     y_std = std.y_to_std(emulator.y)
     total = float(np.sum(y_std**2))
     share = variance_shares(emulator.w, emulator.lam_sim, total) if total > 0 else None

@@ -58,6 +58,25 @@ def _series(source) -> dict[str, np.ndarray]:
     )
 
 
+def _units(source) -> dict[str, str]:
+    """name -> unit of the calibration parameters where ``source`` records them (a Posterior's
+    ``info["units"]``, as calibrate and Calibrator write it; a joint fit's t_units)."""
+    if isinstance(source, Posterior):
+        units = source.info.get("units")
+    elif getattr(source, "calibration", None) and hasattr(source, "t_units"):
+        units = dict(zip(source.t_names, source.t_units, strict=True))
+    else:
+        return {}
+    if not isinstance(units, Mapping):
+        return {}
+    return {k: v for k, v in units.items() if isinstance(k, str) and isinstance(v, str) and v}
+
+
+def _label(name: str, units: dict[str, str]) -> str:
+    """``name (unit)`` as Posterior.plot labels it, or the name alone without a unit."""
+    return f"{name} ({units[name]})" if name in units else name
+
+
 def _name_list(names, available: list[str]) -> list[str]:
     """``names`` (one parameter name, or a sequence of them) as a non-empty list of strings;
     GPMSAError otherwise, listing the ``available`` names."""
@@ -114,7 +133,8 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
         >>> len(fig.axes)
         2
     """
-    series = _series(_calibration_source(source))
+    source = _calibration_source(source)
+    series, units = _series(source), _units(source)
     picked = _pick(series, names, max_params)
     bins = check_bins(bins, len(picked), "plots.traces")
     fig = figure(9.0, 1.6 * len(picked) + 0.6)
@@ -123,7 +143,7 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
         chains = series[name]
         for c, ch in enumerate(chains):
             row[0].plot(ch, lw=0.6, color=f"C{c}", label=f"chain {c}" if len(chains) > 1 else None)
-        row[0].set_ylabel(name)
+        row[0].set_ylabel(_label(name, units))
         row[1].sharey(row[0])
         row[1].hist(chains.reshape(-1), bins=bins, orientation="horizontal", color="0.6")
         row[1].tick_params(labelleft=False)
@@ -269,6 +289,7 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
     if unknown:
         raise GPMSAError(f"unknown parameters {unknown}; the posterior has {post.names}")
     truth = _check_truth(truth, post.names)
+    units = _units(source)
     k = len(names)
     bins = check_bins(bins, k, "plots.theta_pairs")
     fig = figure(2.4 * k + 0.6, 2.4 * k + 0.4)
@@ -286,11 +307,12 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
                     ax.axvline(truth[ni], color="C3", lw=1.2)
                 ax.set_yticks([])
             else:
-                ax.plot(draws[nj], draws[ni], ".", ms=2, alpha=0.3, color="C0")
+                # rasterised: 1e5 draws as vector markers made SVGs of hundreds of MB
+                ax.plot(draws[nj], draws[ni], ".", ms=2, alpha=0.3, color="C0", rasterized=True)
                 if ni in truth and nj in truth:
                     ax.plot(truth[nj], truth[ni], "x", color="C3", ms=8, mew=2)
             if i == k - 1:
-                ax.set_xlabel(nj)
+                ax.set_xlabel(_label(nj, units))
             if j == 0 and i > 0:
-                ax.set_ylabel(ni)
+                ax.set_ylabel(_label(ni, units))
     return fig
