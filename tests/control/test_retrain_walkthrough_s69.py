@@ -2,29 +2,14 @@
 train_emulator.py) and drives the closed loop on them (examples/closed_loop.py): session 69."""
 
 import pytest
+from _train_cases import CampaignReached, run_until_the_campaign
 
 import control
 from tests._examples import load_example
 
 
-class CampaignReached(Exception):
-    pass
-
-
 class LoopReached(Exception):
     pass
-
-
-def train_until_the_campaign(monkeypatch, tmp_path, argv):
-    """train_emulator.main(argv) with the campaign replaced: CampaignReached where every
-    check passed."""
-    script = load_example("train_emulator")
-
-    def campaign(*args, **kwargs):
-        raise CampaignReached
-
-    monkeypatch.setattr(script.vehicle, "run_campaign", campaign)
-    script.main([*argv, "--out", str(tmp_path / "out")])
 
 
 @pytest.mark.parametrize(
@@ -42,7 +27,7 @@ def test_band_options_without_band_emulators_are_refused(tmp_path, monkeypatch, 
     --block-samples 60`` trained the window emulators and silently dropped every one of these
     (the file recorded anchor_speeds [] and no n_pc): they shape the band emulators only."""
     with pytest.raises(SystemExit) as exc:
-        train_until_the_campaign(monkeypatch, tmp_path, ["--features", "window", *option])
+        run_until_the_campaign(monkeypatch, tmp_path, ["--features", "window", *option])
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert f"{option[0]} shapes the band emulators only" in err
@@ -53,13 +38,13 @@ def test_a_noise_level_without_case_b_is_refused(tmp_path, monkeypatch, capsys):
     """``--cases A --noise-std 0.3`` wrote a noise-free jackal_A.gpmsa (metadata noise_std 0.0)
     and said nothing: the noise is case B's."""
     with pytest.raises(SystemExit) as exc:
-        train_until_the_campaign(monkeypatch, tmp_path, ["--cases", "A", "--noise-std", "0.3"])
+        run_until_the_campaign(monkeypatch, tmp_path, ["--cases", "A", "--noise-std", "0.3"])
     assert exc.value.code == 2
     assert "--noise-std 0.3 is case B's noise" in capsys.readouterr().err
     with pytest.raises(CampaignReached):  # the defaults, and each option where it applies
-        train_until_the_campaign(monkeypatch, tmp_path, ["--cases", "A"])
+        run_until_the_campaign(monkeypatch, tmp_path, ["--cases", "A"])
     with pytest.raises(CampaignReached):
-        train_until_the_campaign(
+        run_until_the_campaign(
             monkeypatch, tmp_path,
             ["--cases", "B", "--noise-std", "0.3", "--features", "band", "--n-pc", "6"],
         )  # fmt: skip

@@ -3,6 +3,7 @@ must be singular (it drove the whole campaign, then failed in control.training.b
 
 import numpy as np
 import pytest
+from _train_cases import CampaignReached, run_until_the_campaign
 
 from control.errors import ControlError
 from control.observation_model import BlockScatter
@@ -14,22 +15,6 @@ from control.training import (
     feature_statistics,
     weight_beyond_rank,
 )
-from tests._examples import load_example
-
-
-class CampaignReached(Exception):
-    pass
-
-
-def run_until_the_campaign(monkeypatch, tmp_path, argv):
-    """main(argv) with the campaign replaced: CampaignReached where every check passed."""
-    script = load_example("train_emulator")
-
-    def campaign(*args, **kwargs):
-        raise CampaignReached
-
-    monkeypatch.setattr(script.vehicle, "run_campaign", campaign)
-    script.main([*argv, "--out", str(tmp_path / "out")])
 
 
 @pytest.mark.parametrize(

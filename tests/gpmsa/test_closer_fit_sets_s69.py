@@ -10,30 +10,15 @@ best set's nodes only.
 import numpy as np
 import pytest
 import scipy.optimize
+from _outside_cases import PARAMS, X_OBS, simulator, three_parameter_emulator
 
-import gpmsa
 from gpmsa.calibration.calibrate import observation_fit
 from gpmsa.calibration.observations import CLOSER_STARTS, OUTSIDE_SDS, reduce
-
-GRID = np.linspace(0.0, 1.0, 40)
-X_OBS = np.array([[0.2], [0.5], [0.8]])
-PARAMS = {"betaU": np.full((4, 3), 0.15), "lamUz": np.full(3, 0.33),
-          "lamWs": np.full(3, 5e3), "lamWOs": np.array([1e5])}  # fmt: skip
-
-
-def _simulator(x, t):
-    return (1 + x)[:, None] * (t[:, [0]] * np.sin(3 * GRID) + t[:, [1]] * GRID**2) + t[
-        :, [2]
-    ] * np.cos(2 * GRID)
 
 
 @pytest.fixture(scope="module")
 def emulator():
-    rng = np.random.default_rng(7)
-    x = rng.uniform(size=60)
-    t = rng.uniform(size=(60, 3))
-    sim = gpmsa.SimData(x=x, t=t, y=_simulator(x, t), index=GRID)
-    return gpmsa.Emulator.from_params(sim, PARAMS)
+    return three_parameter_emulator()
 
 
 @pytest.fixture
@@ -50,7 +35,7 @@ def searches(monkeypatch):
 
 
 def _data(emulator, scale=1.0):
-    y = _simulator(X_OBS[:, 0], np.tile([0.37, 0.61, 0.23], (3, 1)))
+    y = simulator(X_OBS[:, 0], np.tile([0.37, 0.61, 0.23], (3, 1)))
     y = y + 0.002 * np.random.default_rng(0).standard_normal(y.shape)
     return reduce(emulator, X_OBS, scale * y)
 

@@ -12,36 +12,22 @@ import warnings
 
 import numpy as np
 import pytest
+from _outside_cases import X_OBS, simulator, three_parameter_emulator
 
 import gpmsa
 from gpmsa.calibration.calibrate import observation_fit
 from gpmsa.calibration.observations import OUTSIDE_SDS, reduce
 
-GRID = np.linspace(0.0, 1.0, 40)
 TRUTH = np.array([0.37, 0.61, 0.23])
-X_OBS = np.array([[0.2], [0.5], [0.8]])
-
-
-def _simulator(x, t):
-    return (1 + x)[:, None] * (t[:, [0]] * np.sin(3 * GRID) + t[:, [1]] * GRID**2) + t[
-        :, [2]
-    ] * np.cos(2 * GRID)
 
 
 @pytest.fixture(scope="module")
 def emulator():
-    rng = np.random.default_rng(7)
-    x = rng.uniform(size=60)
-    t = rng.uniform(size=(60, 3))
-    x[:2], t[:2] = [0.0, 1.0], [[0.0] * 3, [1.0] * 3]
-    sim = gpmsa.SimData(x=x, t=t, y=_simulator(x, t), index=GRID)
-    params = {"betaU": np.full((4, 3), 0.15), "lamUz": np.full(3, 0.33),
-              "lamWs": np.full(3, 5e3), "lamWOs": [1e5]}  # fmt: skip
-    return gpmsa.Emulator.from_params(sim, params)
+    return three_parameter_emulator(corners=True)
 
 
 def _observed(noise: float, seed: int = 0) -> np.ndarray:
-    y = _simulator(X_OBS[:, 0], np.tile(TRUTH, (3, 1)))
+    y = simulator(X_OBS[:, 0], np.tile(TRUTH, (3, 1)))
     return y + noise * np.random.default_rng(seed).standard_normal(y.shape)
 
 
