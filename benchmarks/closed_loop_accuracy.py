@@ -348,7 +348,7 @@ def vehicle_changes(model) -> str:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     defaults = control.ChangePointSettings()
     parser.add_argument("--sets", default="paper,heldout,random,steady",
                         help=f"comma-separated sets among {list(SETS)}")  # fmt: skip

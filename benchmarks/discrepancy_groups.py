@@ -26,13 +26,19 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 from scipy.stats import qmc
 
 import gpmsa
+from roadgen.checks import home_path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
+from _cli import path_option, write_text  # noqa: E402
 
 TRUE_T = 0.4
 GRID = np.linspace(0.0, 1.0, 15)
@@ -88,11 +94,18 @@ def run(seeds: int) -> dict:
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=20)
-    parser.add_argument("--out", default=None)
-    args = parser.parse_args()
+    parser.add_argument("--out", type=path_option, default=None, help="JSON file of the results")
+    args = parser.parse_args(argv)
+    if args.seeds < 1:
+        parser.error(f"--seeds must be >= 1, got {args.seeds}")
+    out = None if args.out is None else home_path(args.out)
+    if out is not None and out.is_dir():  # refused before the minutes of work, not after
+        parser.error(f"--out {args.out!r}: a folder, not a file")
+    if out is not None and not out.parent.is_dir():
+        parser.error(f"--out {args.out!r}: its folder does not exist")
     warnings.simplefilter("ignore")  # small fits: convergence and outside-emulator warnings
     load0, t0 = os.getloadavg()[0], time.perf_counter()
     res = run(args.seeds)
@@ -108,9 +121,8 @@ def main() -> None:
                   f"{np.mean([r['sd'] for r in rows]):8.4f} "
                   f"{np.mean([r['covered'] for r in rows]):8.0%}  "
                   f"{', '.join(f'{v:.3g}' for v in lam)}")  # fmt: skip
-    if args.out:
-        with open(args.out, "w") as fh:
-            json.dump(res, fh, indent=1)
+    if out is not None:
+        write_text(out, json.dumps(res, indent=1))  # in one step: the previous file or the new
 
 
 if __name__ == "__main__":

@@ -27,7 +27,7 @@ CONFIGS = ((4, 0.06), (4, 0.25), (10, 0.06), (10, 0.25))
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     ap.add_argument("--sets", type=int, default=12, help="data sets per row (default 12)")
     args = ap.parse_args(argv)
     if args.sets < 1:

@@ -153,7 +153,7 @@ def seed_group(text: str) -> list[int]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     parser.add_argument("--seeds", default="1-3,11-20",
                         help="seed groups, each reported alone (e.g. 1-3,11-20)")  # fmt: skip
     parser.add_argument("--cases", default="A,B", help="test cases: A (noise-free), B (noise)")

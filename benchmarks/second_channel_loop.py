@@ -276,7 +276,7 @@ def jobs_for(name: str, channels: str, cases, emulator_dir: str, random_tracks: 
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=" ".join(__doc__.split("\n\n")[0].split()))
     sets = ("dev", "steady-dev", "paper", "heldout", "random", "steady")
     parser.add_argument("--sets", default="dev,steady-dev", help=f"comma-separated, among {sets}")
     parser.add_argument("--channels", default=",".join(CHANNELS), help=f"among {CHANNELS}")

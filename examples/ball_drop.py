@@ -126,14 +126,17 @@ def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--out", type=path_option, default="out/ball_drop",
-        help="folder for figures and summary",
+        help="folder for figures and summary (default ./out/ball_drop)",
     )  # fmt: skip
     parser.add_argument(
         "--n-iter", type=int, default=10_000,
-        help="MCMC sweeps after tuning (3,000 left Cd an ESS of 11: see autocorrelation.png)",
+        help="MCMC sweeps after tuning (default 10,000; 3,000 left Cd an ESS of 11: see "
+        "autocorrelation.png)",
     )  # fmt: skip
-    parser.add_argument("--runs", type=int, default=60, help="simulator runs")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--runs", type=int, default=60, help="simulator runs (default 60)")
+    parser.add_argument(
+        "--seed", type=int, default=0, help="seed of the runs, data and fit (default 0)"
+    )
     args = parser.parse_args(argv)
     if args.runs < MIN_RUNS:
         parser.error(f"--runs must be >= {MIN_RUNS} (the emulator's design), got {args.runs}")

@@ -82,6 +82,18 @@ MAX_ROADS = 10_000
 """Most fresh roads per cell (``--roads``): each is a drive of its own."""
 
 
+def road_seeds(seed: int, roads: int) -> np.ndarray:
+    """Seeds (GD, v, road) of each cell's roads and drives: road k's of every cell are the
+    same whatever ``roads``, so that the table's first block (road 1) does not change with
+    --roads. The first 5 roads of a cell are those the script has always drawn with its default
+    5 (the figures README quotes); more come after them in the same stream."""
+    cells = len(GDS) * len(SPEEDS)
+    state = np.random.SeedSequence(seed).generate_state(cells * max(roads, 5))
+    first = state[: cells * 5].reshape(len(GDS), len(SPEEDS), 5)
+    more = state[cells * 5 :].reshape(-1, len(GDS), len(SPEEDS)).transpose(1, 2, 0)
+    return np.concatenate([first, more], axis=2)[:, :, :roads]
+
+
 def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -112,7 +124,7 @@ def main(argv: list[str] | None = None) -> dict:
 
     errors = np.zeros((len(GDS), len(SPEEDS), args.roads))
     cells = []
-    seeds = np.random.SeedSequence(args.seed).generate_state(errors.size).reshape(errors.shape)
+    seeds = road_seeds(args.seed, args.roads)
     for i, gd in enumerate(GDS):
         for j, v in enumerate(SPEEDS):
             for k in range(args.roads):

@@ -34,7 +34,9 @@ KEY = f"""recovered GD of each road (prescribed: GD):
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=path_option, default="out", help="folder for the figures")
+    parser.add_argument(
+        "--out", type=path_option, default="out", help="folder for the figures (default ./out)"
+    )
     args = parser.parse_args(argv)
     out = output_folder(parser, "--out", args.out)
 

@@ -119,10 +119,14 @@ def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--out", type=path_option, default="out/shared_theta",
-        help="folder for the results",
+        help="folder for the results (default ./out/shared_theta)",
     )  # fmt: skip
-    parser.add_argument("--n-iter", type=int, default=2000, help="MCMC sweeps after tuning")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--n-iter", type=int, default=2000, help="MCMC sweeps after tuning (default 2000)"
+    )
+    parser.add_argument(
+        "--seed", type=int, default=0, help="seed of the runs, data and fits (default 0)"
+    )
     args = parser.parse_args(argv)
     if args.n_iter < 2:
         parser.error(f"--n-iter must be >= 2 (gpmsa.fit), got {args.n_iter}")
