@@ -55,6 +55,12 @@ class HyperPriors:
             if not finite(val) or (name != "mu_mean" and not val > 0):
                 need = "finite" if name == "mu_mean" else "finite and > 0"
                 raise GPMSAError(f"HyperPriors.{name} must be {need}, got {val!r:.60}")
+        far = (abs(self.mu_mean - 0.5) + 0.5) / self.mu_sd  # mu's farthest point, in mu_sd
+        if not far < 1e150:  # ((mu - mu_mean) / mu_sd) ** 2 must stay a finite float
+            raise GPMSAError(f"HyperPriors.mu_mean={self.mu_mean!r:.60} with mu_sd="
+                             f"{self.mu_sd!r:.60}: the unit range (0, 1) of mu lies {far:.3g} "
+                             "sds from the mean, beyond float range; give a mean within 1e150 "
+                             "sds of (0, 1)")  # fmt: skip
         with np.errstate(over="ignore", under="ignore"):
             sd2 = float(np.float64(self.sd_max) ** 2)
         if not (finite(sd2) and sd2 > 0 and finite(1.0 / sd2)):  # the prior works with sd^2

@@ -31,9 +31,14 @@ _SQRT_HALF = math.sqrt(0.5)
 
 
 def log_mass01(mu: float, lam: float) -> float:
-    """log P(0 < X < 1) for X ~ Normal(mu, 1/lam), mu in (0, 1) (accurate in both tails)."""
+    """log P(0 < X < 1) for X ~ Normal(mu, 1/lam), mu in (0, 1) (accurate in both tails, and
+    for a tiny lam, where the erfc form's 1 - P rounds to 1)."""
     s = math.sqrt(lam) * _SQRT_HALF
-    return math.log1p(-0.5 * (math.erfc(mu * s) + math.erfc((1.0 - mu) * s)))
+    q = 0.5 * (math.erfc(mu * s) + math.erfc((1.0 - mu) * s))  # 1 - P
+    if q < 0.5:
+        return math.log1p(-q)
+    p = 0.5 * (math.erf(mu * s) + math.erf((1.0 - mu) * s))  # P, no cancellation
+    return math.log(p) if p > 0 else -math.inf  # (lam 0: a flat normal puts no mass there)
 
 
 @dataclass(frozen=True)
