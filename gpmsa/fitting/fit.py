@@ -303,9 +303,7 @@ def fit(
         summary = summarize(post, chains.accept_rate)
     record = None
     if n_chains > 1:
-        shapes = {k: problem.init[k].shape for k in problem.sampled}
-        held = {per_element.label(k, i) for k, v in problem.fixed_elements.items() for i in v}
-        record = convergence(summary, shapes, n_chains, per, held=held)
+        record = sampled_convergence(problem, summary, n_chains, per)
         how = "append more: gpmsa.fit(..., init=the returned emulator, append=True)"
         if not append:
             how = "continue these: gpmsa.fit(..., init=the returned emulator)"
@@ -328,6 +326,16 @@ def check_keep(n_keep, n_chains: int) -> int:
             f"n_keep={n_keep} is fewer than n_chains={n_chains}: every chain keeps a draw"
         )
     return n_keep
+
+
+def sampled_convergence(
+    problem: Problem, summary: dict, n_chains: int, per: int, skip: tuple[str, ...] = ()
+) -> dict:
+    """`convergence` record of every parameter ``problem`` sampled but ``skip``, its held
+    elements (``fixed=``) excepted, over ``n_chains`` chains of ``per`` draws each."""
+    shapes = {k: problem.init[k].shape for k in problem.sampled if k not in skip}
+    held = {per_element.label(k, i) for k, v in problem.fixed_elements.items() for i in v}
+    return convergence(summary, shapes, n_chains, per, held=held)
 
 
 def thinning(n_chains: int, kept: int, n_keep: int) -> int:

@@ -31,13 +31,13 @@ from gpmsa.fitting.fit import (
     fit_held_native,
     hold_fixed,
     point_estimate,
+    sampled_convergence,
     thinning,
 )
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
-from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
+from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.model import categorical
-from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
@@ -501,11 +501,8 @@ def _member_convergence(problem, summary: dict, counts: tuple[int, int]):
     one chain."""
     if counts[0] < 2:
         return None, None
-    shapes = {k: problem.init[k].shape for k in problem.sampled}
-    held = {per_element.label(k, i) for k, v in problem.fixed_elements.items() for i in v}
-    own = {k: v for k, v in shapes.items() if k not in ("theta", "lamOs")}
-    return (convergence(summary, shapes, *counts, held=held),
-            convergence(summary, own, *counts, held=held))  # fmt: skip
+    return (sampled_convergence(problem, summary, *counts),
+            sampled_convergence(problem, summary, *counts, skip=("theta", "lamOs")))  # fmt: skip
 
 
 def fit_study(
