@@ -673,7 +673,7 @@ class BCR:
 
     def _take_stamps(self, t, pos, drop) -> None:
         """Remember the newest time stamp, kept or dropped, and the newest kept sample's time
-        and position, of samples some of which `stream_fault` drops or restarts on."""
+        and position, of samples some of which `stream_breaks` drops or restarts on."""
         stamped = np.flatnonzero(np.isfinite(t))
         if stamped.size:  # steps run from the previous stamp, kept or dropped, in any chunking
             self._t_prev = float(t[stamped[-1]])

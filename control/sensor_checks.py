@@ -106,7 +106,7 @@ class SensorLimits:
         rate_tolerance: a block whose time stamps span more or less than its samples at the
             BCR's rate, by more than this fraction, comes at another rate (a 150 Hz stream fed
             as 120 Hz: its band powers would be read at the wrong frequencies). Single steps
-            within half a period either way are jitter, not a fault (`stream_fault`). Above
+            within half a period either way are jitter, not a fault (`stream_breaks`). Above
             `control.ReplaySettings.rate_tolerance` (0.02), beyond which a recording is
             resampled: one kept as recorded is not refused for its rate and its jitter.
         odometry_tolerance, odometry_slack_m: a block the BCR would use, whose position advances
@@ -609,16 +609,6 @@ STREAM_FIELDS = ("t", "position", "accel", "speed")
 """The arrays of a stream, in the order `StreamBreaks.names` lists them."""
 NO_BREAKS = StreamBreaks()
 """The `StreamBreaks` of samples that break nothing."""
-
-
-def stream_fault(
-    t: np.ndarray, position: np.ndarray, accel: np.ndarray, speed: np.ndarray, t_prev: float,
-    rate_hz: float,
-) -> tuple[np.ndarray, np.ndarray, str]:  # fmt: skip
-    """Samples that break the stream: (drop (n,), restart (n,), reason or ""); `stream_breaks`
-    with the breaks' reason."""
-    drop, restart, breaks = stream_breaks(t, position, accel, speed, t_prev, rate_hz)
-    return drop, restart, breaks.reason(rate_hz)
 
 
 def stream_breaks(

@@ -13,7 +13,7 @@ from control import (
     FeatureSpec,
     TrackerSettings,
 )
-from control.sensor_checks import MAX_SPEED_MPS, stream_fault, timing_fault
+from control.sensor_checks import MAX_SPEED_MPS, stream_breaks, timing_fault
 
 WINDOW_METHODS = ("window", "filter", "tempered")
 CHUNK = 125  # the window methods' default update_every, and one change-point block
@@ -156,7 +156,8 @@ def test_the_stream_and_timing_checks_name_an_absurd_speed():
     t = np.arange(1, 11) / 120.0
     speed = np.full(10, 1.0)
     speed[3] = -1e300
-    drop, _, reason = stream_fault(t, t.copy(), np.zeros(10), speed, np.nan, 120.0)
+    drop, _, breaks = stream_breaks(t, t.copy(), np.zeros(10), speed, np.nan, 120.0)
+    reason = breaks.reason(120.0)
     assert drop.tolist() == [i == 3 for i in range(10)]
     assert reason.startswith("1 sample(s) with |speed| up to 1e+300 m/s")
     from control.sensor_checks import SensorLimits
@@ -164,7 +165,8 @@ def test_the_stream_and_timing_checks_name_an_absurd_speed():
     with np.errstate(all="raise"):
         why = timing_fault(t, t.copy(), speed, 120.0, SensorLimits())
     assert why.startswith("out of range: |speed| reaches 1e+300 m/s")
-    assert stream_fault(t, t.copy(), np.zeros(10), np.full(10, -2.0), np.nan, 120.0)[2] == ""
+    calm = stream_breaks(t, t.copy(), np.zeros(10), np.full(10, -2.0), np.nan, 120.0)[2]
+    assert calm.reason(120.0) == ""
 
 
 # --- 5: each update's fault reason names its own fault -----------------------------------------

@@ -102,7 +102,7 @@ def test_an_imu_hundreds_of_times_faster_than_the_emulator_is_resampled(rate_in)
 
 
 def test_resampling_turns_stamp_faults_into_faults_the_bcr_reports():
-    from control.sensor_checks import stream_fault
+    from control.sensor_checks import stream_breaks
 
     t, a = _tone(400.0, 7.0, 20.0)
     bad = a.copy()
@@ -113,7 +113,8 @@ def test_resampling_turns_stamp_faults_into_faults_the_bcr_reports():
     keep[6000:6040] = False  # 0.1 s lost
     t2, a2, info = condition.to_rate(t[keep], bad[keep], RATE)
     assert info.runs == 4 and info.dropped == 2
-    _, _, reason = stream_fault(t2, np.zeros(t2.size), a2, np.ones(t2.size), np.nan, RATE)
+    _, _, breaks = stream_breaks(t2, np.zeros(t2.size), a2, np.ones(t2.size), np.nan, RATE)
+    reason = breaks.reason(RATE)
     assert "repeated or backwards" in reason and "non-finite accel" in reason and "gap" in reason
 
 
