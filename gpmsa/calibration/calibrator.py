@@ -430,7 +430,7 @@ class Calibrator:
             vals = vals.reshape(-1)
             check_log_density(vals)
             if not on_grid:
-                vals = interp_log(vals, self._axes[0], theta_unit)
+                vals = interp_log(vals, self._axes[0], theta_unit, smooth=True)
         check_log_density(vals)
         return vals
 
@@ -445,9 +445,12 @@ class Calibrator:
                 and with their own precisions (as ``gpmsa.calibrate`` takes it).
             prior: optional extra log prior of theta: log-density values on ``theta_grid`` (G,)
                 (for two parameters also (n_grid, n_grid), rows the first parameter;
-                interpolated linearly, bilinearly for two parameters, where the grid is
-                refined: in the log between finite values, in the density next to a zero
-                (-inf), so that the prior is zero beyond its zero nodes), or a callable of
+                interpolated where the grid is refined: in the log by the cubic through the
+                four nodes around a point (per parameter) where they are finite and smooth
+                (`gpmsa.calibration.local_cubic`: summed log-likelihoods of other windows
+                stay accurate when narrower than a node spacing), linearly (bilinearly)
+                otherwise, in the density next to a zero (-inf), so that the prior is zero
+                beyond its zero nodes), or a callable of
                 native theta ((k,) for one parameter, (k, 2) for two) returning (k,); on the
                 MCMC path a callable only. It multiplies the emulator's theta prior
                 (effectively uniform on the domain). For one parameter a callable's zero

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
+from gpmsa.calibration.local_cubic import STENCIL, local_cubic
 from gpmsa.calibration.posterior import GridMarginal, trapezoid_weights
 from gpmsa.errors import GPMSAError
 
@@ -101,11 +102,14 @@ def check_mass(logp: np.ndarray) -> None:
         raise GPMSAError("the posterior has no mass on the grid (prior zero everywhere?)")
 
 
-def interp_log(table: np.ndarray, axis: np.ndarray, points: np.ndarray) -> np.ndarray:
+def interp_log(
+    table: np.ndarray, axis: np.ndarray, points: np.ndarray, smooth: bool = False
+) -> np.ndarray:
     """Log densities ``table`` on the grid axis^q ((n^q,), 'ij' order; -inf: zero density) at
     the points (k, q), q = 1 or 2: linear (bilinear) in the log where the nodes around a point
-    are finite, in the density where one of them is zero. A point gets -inf only where the
-    density is zero, and never NaN."""
+    are finite, in the density where one of them is zero. ``smooth``: in the log, the local
+    cubic (`local_cubic`) where the four nodes around a point (per axis) are finite and smooth.
+    A point gets -inf only where the density is zero, and never NaN."""
 
     def at(values: np.ndarray) -> np.ndarray:
         if points.shape[1] == 1:
@@ -113,12 +117,15 @@ def interp_log(table: np.ndarray, axis: np.ndarray, points: np.ndarray) -> np.nd
         return RegularGridInterpolator((axis, axis), values.reshape(axis.size, -1))(points)
 
     finite = np.isfinite(table)
-    if finite.all():
-        return at(table)
     if not finite.any():
         return np.full(points.shape[0], -np.inf)
     peak = float(table[finite].max())
     by_log = at(np.where(finite, table, peak))
+    if smooth and axis.size >= STENCIL:
+        cubic = local_cubic(table, axis, points)
+        by_log = np.where(np.isfinite(cubic), cubic, by_log)
+    if finite.all():
+        return by_log
     near_zero = at((~finite).astype(float)) > 0.0
     with np.errstate(divide="ignore"):
         by_density = np.log(at(np.exp(table - peak))) + peak
