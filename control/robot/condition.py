@@ -35,6 +35,7 @@ from fractions import Fraction
 import numpy as np
 
 from control.errors import BagError, ControlError
+from vehicle.models import GRAVITY
 
 GAP_PERIODS = 1.5  # a step above this many periods is a gap (as control.sensor_checks)
 METHODS = ("sample", "lowpass")
@@ -318,6 +319,77 @@ def to_rate(
     if not out_t:
         return np.empty(0), np.empty(0), info
     return np.concatenate(out_t), np.concatenate(out_a), info
+
+
+GRAVITY_BAND = (0.5, 1.5)
+"""An IMU whose mean acceleration over the recording has a norm within these multiples of g
+reads gravity (`gravity_direction`); below, gravity was removed and its direction is unknown."""
+MAX_TILT_DEG = 10.0
+"""Largest angle between the axis read as up and gravity's direction without a warning: the
+vertical then reads scaled by cos(10 deg) = 0.985 at worst (docs/robot.md: keep the scale
+within a few per cent)."""
+
+
+def gravity_direction(
+    accel: np.ndarray, axis: str, sign: float, topic: str, flight_mps2: float | None,
+    gravity: str,
+) -> str:  # fmt: skip
+    """What the IMU's gravity says against the settings, for a warning ("" where nothing).
+
+    ``accel``: (n, 3) accelerations as recorded, m/s^2; ``axis``, ``sign``: the axis read as
+    up and its sign; ``flight_mps2``: the reading the BCR's sensor checks take for a wheel in
+    the air (`control.sensor_checks.flight_reading`; None: no such exemption); ``gravity``:
+    the replay's "keep" or "highpass". Where the mean acceleration's norm lies within
+    `GRAVITY_BAND` g, it is gravity's reaction, pointing up: an axis pointing down, gravity
+    along another axis, an axis more than `MAX_TILT_DEG` from it, or gravity kept where the
+    sensor checks expect flights at -g, are named with their remedy."""
+    rows = np.asarray(accel, dtype=float)
+    rows = rows[np.all(np.isfinite(rows), axis=1)]
+    if not rows.size:
+        return ""
+    mean = rows.mean(axis=0)
+    norm = float(np.linalg.norm(mean))
+    if not GRAVITY_BAND[0] * GRAVITY <= norm <= GRAVITY_BAND[1] * GRAVITY:
+        return ""
+    i = "xyz".index(axis)
+    up = sign * float(mean[i])
+    angle = float(np.degrees(np.arccos(np.clip(up / norm, -1.0, 1.0))))
+    seen = (
+        f"the IMU topic {topic!r} reads gravity (its mean acceleration ("
+        + ", ".join(f"{v:.2f}" for v in mean)
+        + ") m/s^2 over the recording); "
+    )
+    if angle <= MAX_TILT_DEG:
+        if gravity == "keep" and flight_mps2 is not None:
+            return seen + (
+                f"it is kept in the {axis} axis (+{up:.2f} m/s^2), but the emulator records no "
+                f"noise sd, and the BCR's sensor checks expect a wheel in the air at "
+                f"{flight_mps2:.2f} m/s^2, as gravity removed puts it: with gravity in, a quiet "
+                "sensor's flights read as a dead or quantised sensor (sensor_fault); replay "
+                "with gravity='highpass' (--gravity highpass)"
+            )
+        return ""
+    j = int(np.argmax(np.abs(mean)))
+    sj = 1 if mean[j] > 0 else -1
+    if j == i and sj != sign:
+        return seen + (
+            f"the {axis} axis times imu_sign {sign:+g} points down, not up ({up:.2f} m/s^2 "
+            f"along it): a flipped axis reads the landings' peaks as flights (rougher ground, "
+            f"implausible blocks, sensor faults); replay with imu_sign={-sign:+g} "
+            f"(--sign {-sign:g})"
+        )
+    if j != i:
+        return seen + (
+            f"gravity lies along its {'xyz'[j]} axis, {angle:.0f} degrees from the {axis} axis "
+            f"read as up: replay with imu_axis={'xyz'[j]!r}, imu_sign={sj:+d} (--axis "
+            f"{'xyz'[j]} --sign {sj})"
+        )
+    return seen + (
+        f"the {axis} axis read as up lies {angle:.0f} degrees from it (a tilted mount, or a "
+        f"drive up a slope): it reads the vertical acceleration scaled by about "
+        f"{np.cos(np.radians(angle)):.2f}, as ground smoother than it is; mount the IMU with "
+        "an axis vertical, or rotate its accelerations into the robot's frame before the replay"
+    )
 
 
 def highpass(t: np.ndarray, a: np.ndarray, rate_hz: float, cutoff_hz: float) -> np.ndarray:

@@ -33,6 +33,7 @@ import csv
 import os
 import shutil
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,7 +50,7 @@ from control.compat import (
     check_recorded_vehicle,
     recorded_vehicle_mismatch,
 )
-from control.errors import BagError, ControlError
+from control.errors import BagError, ControlError, ControlWarning, user_stacklevel
 from control.estimate import Estimate, edge_counts
 from control.robot import condition
 from control.robot import messages as msgs
@@ -63,6 +64,7 @@ from control.robot.bags import (
     recording_path,
     source_of,
 )
+from control.sensor_checks import flight_reading
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
 from control.validation import (
@@ -598,7 +600,9 @@ def replay_recording(
     unchecked = _check_vehicle(rec, emulator, check_vehicle)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     tic = time.perf_counter()
-    t, a, pos, spd, reports, resampling, notes, t0 = _condition(rec, s, bcr.rate_hz)
+    t, a, pos, spd, reports, resampling, notes, t0 = _condition(
+        rec, s, bcr.rate_hz, flight_reading(bcr.sensor)
+    )
     notes[:0] = unchecked
     condition_s = time.perf_counter() - tic
 
@@ -706,9 +710,17 @@ def _check_span(rec: Recording, base: str, imu_ns, odom_ns, t0: int) -> None:
                 )
 
 
-def _condition(rec: Recording, s: ReplaySettings, rate_hz: float):
-    """The BCR's samples (t s from t0, accel, position, speed), the reports and t0 (ns)."""
+def _condition(rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=None):
+    """The BCR's samples (t s from t0, accel, position, speed), the reports and t0 (ns);
+    ``flight_mps2``: the BCR's `flight_reading`, for `condition.gravity_direction`, whose
+    finding is a note and a `ControlWarning`."""
     notes: list[str] = []
+    upright = condition.gravity_direction(
+        rec.imu.accel, s.imu_axis, s.imu_sign, rec.imu.topic, flight_mps2, s.gravity
+    )
+    if upright:
+        notes.append(upright)
+        warnings.warn(upright, ControlWarning, stacklevel=user_stacklevel())
     base, note = _time_base(rec, s.time_base)
     imu_ns, odom_ns = _times(rec.imu, base), _times(rec.odometry, base)
     accel = s.imu_sign * rec.imu.accel[:, "xyz".index(s.imu_axis)]
