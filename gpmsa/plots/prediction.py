@@ -94,7 +94,8 @@ def prediction_bands(
         bottom.fill_between(xs, lo[order, 0], hi[order, 0], color="C2", alpha=0.4)
         bottom.plot(xs, pred.mean("delta")[order, 0], color="C2", lw=1)
         bottom.axhline(0.0, color="0.6", lw=0.6)
-        bottom.set_xlabel(f"x[{x_column}]")
+        name, unit = _input(pred, x_column)
+        bottom.set_xlabel(f"{name} ({unit})" if unit else name)
         bottom.set_ylabel("discrepancy delta")
         top.set_ylabel(ylabel)
         top.legend(fontsize="small")
@@ -118,12 +119,20 @@ def prediction_bands(
         bottom.plot(grid, delta_mean[i, by_index], color="C2", lw=1)
         bottom.axhline(0.0, color="0.6", lw=0.6)
         bottom.set_xlabel("output index")
-        xs = ", ".join(f"{v:.3g}" for v in pred.x[i])
-        top.set_title(f"x = ({xs})", fontsize="small")
+        named = [(*_input(pred, k), v) for k, v in enumerate(pred.x[i])]
+        xs = ", ".join(f"{n} = {v:.3g}{' ' + u if u else ''}" for n, u, v in named)
+        top.set_title(xs or "no known inputs", fontsize="small")
     axes[0, 0].set_ylabel(ylabel)
     axes[1, 0].set_ylabel("discrepancy delta")
     axes[0, 0].legend(fontsize="x-small")
     return fig
+
+
+def _input(pred: FullPrediction, k: int) -> tuple[str, str]:
+    """(name, unit) of the known input ``k`` of ``pred`` ("x[k]" and "" where it records none)."""
+    names, units = tuple(pred.x_names), tuple(pred.x_units)
+    name = names[k] if k < len(names) else f"x[{k}]"
+    return name, units[k] if k < len(units) else ""
 
 
 def _observed(observed, N: int, l: int) -> np.ndarray:

@@ -51,8 +51,9 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
     axes[0].set_ylim(0.0, 1.05)
     axes[0].set_ylabel("Sobol index")
     title = "aggregated over the output grid" if functional else "Sobol indices"
-    axes[0].set_title(f"{title}; bars: {100 * level:.0f} % over {sens.main.shape[0]} draws",
-                      fontsize="small")  # fmt: skip
+    spread = (" (the point estimate)" if list(np.ravel(sens.draw_index)) == [-1]
+              else f"; bars: {100 * level:.0f} % over {sens.main.shape[0]} draws")  # fmt: skip
+    axes[0].set_title(title + spread, fontsize="small")
     axes[0].legend(fontsize="small")
     if functional:
         ax = axes[1]

@@ -89,6 +89,7 @@ class FullPrediction:
             docstring); ``zeta`` = eta + delta.
         K: (l, p_u) and D: (l, p_v) the bases on ``grid``; y_mean: (l,), y_sd: the
             standardisation.
+        x_names, x_units: (p,) the known inputs' names and units (for figures; empty: unknown).
     """
 
     x: np.ndarray
@@ -107,6 +108,8 @@ class FullPrediction:
     D: np.ndarray
     y_mean: np.ndarray
     y_sd: float
+    x_names: tuple[str, ...] = ()
+    x_units: tuple[str, ...] = ()
 
     @property
     def zeta(self) -> np.ndarray:
@@ -590,7 +593,7 @@ def full_prediction(
     return FullPrediction(
         x=x_nat, grid=g, draw_index=idx, theta=theta, lamOs=lamOs, mu=mu, cov=cov_pt,
         u=u, v=v, eta=eta, delta=delta, y=y, K=K_pred, D=D_pred, y_mean=std.mean_on(g),
-        y_sd=std.y_sd,
+        y_sd=std.y_sd, x_names=tuple(emulator.x_names), x_units=tuple(emulator.x_units),
     )  # fmt: skip
 
 
