@@ -45,7 +45,13 @@ from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
 from gpmsa.studies import continuation as cont
 from gpmsa.studies.continuation import STEPS, WIDTHS_BY_CHAIN
-from gpmsa.studies.layout import HyperPriors, build_layout, check_labels, check_study_names
+from gpmsa.studies.layout import (
+    HyperPriors,
+    build_layout,
+    check_hyper,
+    check_labels,
+    check_study_names,
+)
 from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
 from gpmsa.studies.sampler import StudyChains, held_elements, sample_study
 from gpmsa.studies.study import HELD_THETA, OBS_DIGESTS, OBS_LAYOUTS, Study, layout_of
@@ -68,6 +74,25 @@ def _same_count(**lists) -> int:
     if n < 1:
         raise GPMSAError("a study needs at least one model")
     return n
+
+
+def _refuse_no_observations(label: str, x, y) -> None:
+    """GPMSAError where model ``label``'s x_obs or y_obs (arrays, lists, tables) has no rows:
+    a model without observations (an ObsData holds at least one; checked before the shape
+    checks, whose message would not say so)."""
+    for what, value in (("x_obs", x), ("y_obs", y)):
+        if value is None or isinstance(value, ObsData):
+            continue
+        try:
+            shape = np.shape(value)
+        except (TypeError, ValueError):  # ragged: a list of experiments, not empty
+            continue
+        if len(shape) >= 1 and shape[0] == 0:
+            raise GPMSAError(
+                f"model {label!r} has no observations (its {what} holds no experiments: shape "
+                f"{shape}); give every model at least one experiment, or leave model {label!r} "
+                "out of the study"
+            )
 
 
 def _check_run(n_iter, n_burn, n_chains, hyper, what: str = "n_samples") -> HyperPriors:
@@ -295,7 +320,8 @@ def calibrate_study(
             them. hierarchical: names whose per-model values are draws of
             Normal(mu, 1/lam) truncated to the parameter's range, mu and lam sampled too
             (``hyper``: their priors, ``gpmsa.HyperPriors()``: a uniform group sd; SEPIA's:
-            ``HyperPriors.sepia()``). Every other parameter is its model's.
+            ``HyperPriors.sepia()``; given without a hierarchical name, or with a uniform
+            sd prior's sd_max below 1e-3, a GPMSAError). Every other parameter is its model's.
         n_samples, n_burn, tune, seed, n_chains, init, tune_rounds, tune_levels, extrapolate,
             progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep);
             seed None (or a numpy Generator) draws one from fresh entropy (from the
@@ -364,11 +390,13 @@ def calibrate_study(
     y_obs = _sequence(y_obs, "y_obs")
     n = _same_count(emulators=emulators, x_obs=x_obs, y_obs=y_obs)
     labels = check_labels(labels, n)
-    for lab, e in zip(labels, emulators, strict=True):  # its error names the model
+    for lab, e, x, y in zip(labels, emulators, x_obs, y_obs, strict=True):  # errors name it
         _per_model(lab, check_emulator, e)
+        _refuse_no_observations(lab, x, y)
     continuing = isinstance(init, Study)
     append = cont.check_append(append, init, n_burn)
     n_burn = (0 if continuing else 1000) if n_burn is None else n_burn
+    given_hyper = hyper is not None
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
     seed = run_seed(seed)
     metadata = check_metadata(metadata)
@@ -380,6 +408,7 @@ def calibrate_study(
             for lab, e, f, (b, _) in zip(labels, emulators, fixes, bases, strict=True)]  # fmt: skip
     layout = layout_of(emulators, labels, shared, hierarchical)
     check_study_names(layout)
+    check_hyper(hyper, given_hyper, layout)
     t0 = time.perf_counter()
     models = list(zip(labels, emulators, x_obs, y_obs, strict=True))
     reduced, fits = [], []
@@ -576,6 +605,7 @@ def fit_study(
     append = cont.check_append(append, init, n_burn)
     if n_burn is None and isinstance(n_iter, int | np.integer):
         n_burn = 0 if continuing else n_iter // 5
+    given_hyper = hyper is not None
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
     seed = run_seed(seed)
     check_point(point)
@@ -606,6 +636,7 @@ def fit_study(
         shared, hierarchical,
     )  # fmt: skip
     check_study_names(layout)
+    check_hyper(hyper, given_hyper, layout)
     problems = [p.problem if f is None else _per_model(lab, hold_fixed, p.problem, f,
                                                        p.standardizer, s.t_names)
                 for lab, p, s, f in zip(labels, preps, sims, fixes, strict=True)]  # fmt: skip

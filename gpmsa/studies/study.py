@@ -144,6 +144,25 @@ def native_chains(layout: Layout, draws: dict[str, np.ndarray]) -> dict[str, np.
     return out
 
 
+def study_units(layout: Layout, members) -> dict[str, str]:
+    """The unit of each study posterior name that has one (``Posterior.info["units"]``, as
+    ``gpmsa.calibrate`` records it, so that plots label its axes): each study element's, its
+    models' ``t_units`` of the parameter where they agree (a shared one's models may differ:
+    then none), and each hierarchical group's mean "NAME.mu" and sd "NAME.sd" (native units)
+    their elements'; "NAME.lam" (unit scale) and lamOs have none. Read from the members, so
+    study files of every version have them."""
+    out = {}
+    for el in layout.elements:
+        units = {members[i].t_units[k] for i, k in el.uses}
+        if len(units) == 1:
+            out[el.name] = units.pop()
+    for h, name in enumerate(layout.groups):
+        units = {out.get(layout.elements[e].name) for e in layout.members_of(h)}
+        if len(units) == 1 and None not in units:
+            out[f"{name}.mu"] = out[f"{name}.sd"] = units.pop()
+    return out
+
+
 def _held_theta(layout: Layout, draws: dict[str, np.ndarray], settings: dict) -> dict[str, float]:
     """``settings[HELD_THETA]`` checked against the draws (absent: {}, as in files written
     before it): GPMSAError unless each name is a study element whose every draw is one unit
@@ -213,7 +232,8 @@ class Study:
         samples = {k: v.reshape(-1) for k, v in chains.items()}
         self.diagnostics = summarize(chains)
         n_chains, n_draws = self.draws["log_post"].shape
-        info = {"method": f"study {kind}", "diagnostics": self.diagnostics, **self.settings}
+        info = {"method": f"study {kind}", "diagnostics": self.diagnostics, **self.settings,
+                "units": study_units(layout, self.members)}  # fmt: skip
         self.convergence = None
         if n_chains > 1:
             shapes = {k: () for k in chains}
@@ -257,6 +277,7 @@ class Study:
             "method": f"study {self.kind}",
             "model": self.labels[i],
             **emulator_record(self.members[i]),
+            "units": dict(zip(self.members[i].t_names, self.members[i].t_units, strict=True)),
         }
         # the record of the model's observations, so that full_prediction(posterior=) refuses
         # other ones: a fitted model's (as calibration_posterior), a calibrated one's (as
