@@ -52,6 +52,7 @@ from gpmsa.calibration.grid import (
     with_edges,
     zero_edges,
 )
+from gpmsa.calibration.local_cubic import NARROW_PRIOR_SD, narrowest_sd
 from gpmsa.calibration.model import (
     GridPredictor,
     LamOsMarginal,
@@ -429,7 +430,9 @@ class Calibrator:
                 )
             vals = vals.reshape(-1)
             check_log_density(vals)
-            if not on_grid:
+            if on_grid:
+                _warn_if_narrow_prior(vals, self.n_grid, self.q)
+            else:
                 vals = interp_log(vals, self._axes[0], theta_unit, smooth=True)
         check_log_density(vals)
         return vals
@@ -732,6 +735,22 @@ def _warn_at_float(res: float, marginal, emulator) -> None:
             "sd, quantiles and draws are good "
             f"to about the node spacing there, {h:.3g}{f' {unit}' if unit else ''}",
             stacklevel=3,
+        )
+
+
+def _warn_if_narrow_prior(table: np.ndarray, n_grid: int, q: int) -> None:
+    """Warn when a prior given on the grid is narrower than its interpolation between nodes
+    keeps accurate (`local_cubic.NARROW_PRIOR_SD`)."""
+    sd, least = narrowest_sd(table, n_grid, q), NARROW_PRIOR_SD[q]
+    if sd < least:
+        warnings.warn(
+            f"prior= given on the grid is narrower than the grid represents: its sd at its peak"
+            f"{' (given the other parameter)' if q == 2 else ''} spans {sd:.2g} node spacings "
+            f"(fewer than {least:g}); "
+            f"between the nodes it is interpolated, so the posterior may be a tenth of its sd "
+            f"or more off and too wide; pass prior= as a callable of theta, or use a Calibrator "
+            f"with a larger n_grid (now {n_grid})",
+            stacklevel=4,
         )
 
 
