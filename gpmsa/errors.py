@@ -24,6 +24,12 @@ class OutsideEmulatorWarning(UserWarning):
     """An observation lies outside what the emulator has seen (far from all its predictions)."""
 
 
+class ExtrapolationWarning(UserWarning):
+    """Inputs (x, theta or bounds given to a prediction or a calibration) lie outside the
+    emulator's training domain, within ``EXTRAPOLATION_MARGIN`` of it: the emulator
+    extrapolates there."""
+
+
 def user_stacklevel() -> int:
     """``warnings.warn``'s stacklevel, in the function that calls this, of the first frame
     outside gpmsa (the user's call, however deep the library's own calls run)."""

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 from threadpoolctl import threadpool_limits
 
-from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.errors import EmulatorFileError, ExtrapolationWarning, GPMSAError
 from gpmsa.fitting.validation import (
     DISCREPANCY_ARRAY,
     EMULATOR_PARAMS,
@@ -461,7 +461,9 @@ class Emulator:
             )
         if (lo < 0).any() or (hi > 1).any():
             warnings.warn(
-                "predict() extrapolates beyond the training domain", stacklevel=stacklevel
+                "predict() extrapolates beyond the training domain",
+                ExtrapolationWarning,
+                stacklevel=stacklevel,
             )
         return z
 

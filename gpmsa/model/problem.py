@@ -9,7 +9,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
+from gpmsa.errors import ExtrapolationWarning, GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.model import categorical
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model import mean_basis as mean_basis_mod
@@ -361,6 +361,7 @@ def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
     if (lo < 0).any() or (hi > 1).any():
         warnings.warn(
             "x_obs lies outside the simulation design's range; the emulator extrapolates there",
+            ExtrapolationWarning,
             stacklevel=3,
         )
 

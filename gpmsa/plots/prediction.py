@@ -38,7 +38,8 @@ def prediction_bands(
             observations), or None.
         level: probability of the bands.
         max_panels: columns at most (functional output).
-        x_column: the known input on the horizontal axis (scalar output).
+        x_column: the known input on the horizontal axis (scalar output), labelled with its
+            name and unit as the emulator records them (``SimData(x_names=, x_units=)``).
         relative: subtract the predicted mean of y in the top panels.
 
     Example:

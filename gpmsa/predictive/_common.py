@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import ExtrapolationWarning, GPMSAError
 from gpmsa.fitting.emulator import NO_DRAWS, Emulator
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
@@ -94,6 +94,7 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
         warnings.warn(
             f"{what}: {names[k]} lies outside the emulator's domain [{lo[k]:.6g}, {hi[k]:.6g}]; "
             "the emulator extrapolates there",
+            ExtrapolationWarning,
             stacklevel=3,
         )
     return native, unit
