@@ -103,7 +103,12 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
     except OSError as exc:  # e.g. a missing folder or one without write permission
         raise error(_cannot_write(path, exc)) from exc
     if mode is not None:  # a file replaced keeps its permissions (a private one stays so)
-        os.chmod(tmp, stat.S_IMODE(mode))
+        try:
+            os.chmod(tmp, stat.S_IMODE(mode))
+        except OSError as exc:  # e.g. a file system without permissions: nothing left behind
+            os.close(fd)
+            os.unlink(tmp)
+            raise error(_cannot_write(path, exc)) from exc
     return tmp, fd
 
 

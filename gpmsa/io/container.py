@@ -343,6 +343,10 @@ def _check_directory(fh, size: int, path) -> None:
     tail = fh.read(tail_len)
     at = tail.rfind(b"PK\x05\x06")
     if at < 0 or len(tail) - at < 22:
+        fh.seek(0)
+        if _cut_gpmsa(fh.read(len(CUT_HEAD))):
+            raise _fail(path, f"{CUT_SHORT}: its zip end record is missing (not a readable zip; "
+                              "an incomplete download or copy? fetch it again)")  # fmt: skip
         raise _fail(path, "not a gpmsa emulator file (not a readable zip: no end record)")
     (comment_len,) = struct.unpack("<H", tail[at + 20 : at + 22])
     if (extra := len(tail) - (at + 22 + comment_len)) != 0:
@@ -365,6 +369,18 @@ def _check_directory(fh, size: int, path) -> None:
                           f"{limits.MAX_MEMBERS})")  # fmt: skip
     if cd_size > CENTRAL_ENTRY_MAX * max(entries, 1):
         raise _fail(path, f"zip directory of {cd_size} bytes for {entries} members")
+
+
+CUT_HEAD = b"PK\x03\x04" + bytes(26) + MANIFEST.encode()
+"""The start of every file gpmsa writes: a zip's first local header, of member manifest.json."""
+CUT_SHORT = "a gpmsa file cut short"
+
+
+def _cut_gpmsa(head: bytes) -> bool:
+    """Whether ``head``, a file's first bytes, starts as gpmsa writes a file (``CUT_HEAD``, the
+    header's fields aside): of a file without a zip end record, one cut short."""
+    n = len(CUT_HEAD)
+    return len(head) >= n and head[:4] == CUT_HEAD[:4] and head[30:n] == CUT_HEAD[30:]
 
 
 def _read_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, path) -> bytearray:
@@ -484,9 +500,11 @@ def _parse_manifest(raw: bytes, path, formats: tuple[str, ...] = (FORMAT,)) -> d
         raise _fail(path, f"manifest.json nests deeper than {MAX_MANIFEST_DEPTH} levels")
     if manifest.get("format") not in formats:
         want = " or ".join(repr(f) for f in formats)
-        raise _fail(
-            path, f"format is {_short(manifest.get('format'))}, expected {want} (foreign file)"
-        )
+        kind = {FORMAT: "an emulator file, which gpmsa.load reads",
+                STUDY_FORMAT: "a study file, which gpmsa.load_study reads"}  # fmt: skip
+        found = manifest.get("format")
+        what = kind.get(found, "foreign file") if isinstance(found, str) else "foreign file"
+        raise _fail(path, f"format is {_short(manifest.get('format'))}, expected {want} ({what})")
     version = manifest.get("schema_version")
     if not isinstance(version, int) or isinstance(version, bool) or version < 1:
         raise _fail(path, f"schema_version must be a positive integer, got {_short(version)}")
@@ -641,6 +659,15 @@ def _foreign_size(target: Path) -> int | None:
     return st.st_size
 
 
+def _starts_cut(target: Path) -> bool:
+    """Whether the file at ``target`` starts as a gpmsa file does (`_cut_gpmsa`)."""
+    try:
+        with open(target, "rb") as fh:
+            return _cut_gpmsa(fh.read(len(CUT_HEAD)))
+    except OSError:
+        return False
+
+
 def refuse_to_replace(target: Path, fmt: str) -> None:
     """GPMSAError if ``target`` holds data a file of format ``fmt`` must not replace: a file that
     is not a gpmsa file (a user's CSV or notes; an empty file may be replaced), or a gpmsa file
@@ -651,9 +678,10 @@ def refuse_to_replace(target: Path, fmt: str) -> None:
     if found is None:
         size = _foreign_size(target)
         if size is not None:
+            held = CUT_SHORT if _starts_cut(target) else "a file that is not a gpmsa file"
             raise GPMSAError(
-                f"refusing to write {target}: it holds a file that is not a gpmsa file ({size} "
-                f"bytes), which {wanted} would replace; choose another path or remove it first"
+                f"refusing to write {target}: it holds {held} ({size} bytes), which {wanted} "
+                "would replace; choose another path or remove it first"
             )
     elif found != fmt:
         held = (
