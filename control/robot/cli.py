@@ -103,6 +103,7 @@ def _report(bag: Path, source: str, settings: ReplaySettings, result: ReplayResu
         "settings": asdict(settings),
         "imu": asdict(result.imu),
         "odometry": asdict(result.odometry),
+        "restamping": asdict(result.restamping),
         "resampling": asdict(result.resampling),
         "notes": list(result.notes),
         "status_counts": result.status_counts(),
@@ -187,6 +188,16 @@ def parser() -> argparse.ArgumentParser:
         "sensor model; default) or lowpass (anti-aliasing at the emulator's Nyquist frequency)",
     )  # fmt: skip
     p.add_argument(
+        "--no-restamp", action="store_true",
+        help="feed the IMU's stamps as recorded (default: put them on their fitted regular "
+        "clock where they jitter by less than 1/6 period; dropped messages stay faults)",
+    )  # fmt: skip
+    p.add_argument(
+        "--reorder-periods", type=float, default=DEFAULTS.reorder_periods, metavar="PERIODS",
+        help="put IMU messages received out of header-stamp order by at most this many periods "
+        "in stamp order (default 3; 0: the order received)",
+    )  # fmt: skip
+    p.add_argument(
         "--storage", default=DEFAULTS.storage, choices=["mcap", "sqlite3"],
         help="storage of the output bag",
     )  # fmt: skip
@@ -228,6 +239,8 @@ def main(argv: list[str] | None = None) -> int:
             position=args.position,
             gravity=args.gravity,
             resample=args.resample,
+            restamp=not args.no_restamp,
+            reorder_periods=args.reorder_periods,
             storage=args.storage,
         )
         simplex = Simplex(v_max=args.v_max, v_safe=args.v_safe)

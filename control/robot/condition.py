@@ -79,8 +79,8 @@ class StreamReport:
         """No repeated or backwards stamps, no gaps, no non-finite values."""
         return not (self.repeated or self.backwards or self.gaps or self.non_finite)
 
-    def describe(self) -> str:
-        """One line for a person."""
+    def faults(self) -> str:
+        """The stamp faults for a person ("no stamp faults" where none)."""
         faults = [
             f"{n} {what}"
             for n, what in (
@@ -91,10 +91,13 @@ class StreamReport:
             )
             if n
         ]
+        return ", ".join(faults) or "no stamp faults"
+
+    def describe(self) -> str:
+        """One line for a person."""
         rate = f"at {self.rate_hz:.4g} Hz" if np.isfinite(self.rate_hz) else "without a rate"
-        text = f"{self.topic}: {self.messages} messages {rate} ({self.time_base} stamps); " + (
-            ", ".join(faults) or "no stamp faults"
-        )
+        text = f"{self.topic}: {self.messages} messages {rate} ({self.time_base} stamps); "
+        text += self.faults()
         return text + (f"; {self.note}" if self.note else "")
 
 

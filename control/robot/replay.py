@@ -4,10 +4,13 @@ The pipeline (`replay_bag`):
 
 1. read the IMU and odometry topics (`control.robot.bags.read_recording`);
 2. the IMU's acceleration along ``imu_axis`` times ``imu_sign``, on the time base chosen
-   (header stamps, or receive times); its stamps checked (`condition.check_stream`); brought to
-   the emulator's rate (`condition.to_rate`: as recorded when the rates agree, else resampled);
-   optionally high-passed (``gravity="highpass"``; by default gravity's static part is kept: the
-   BCR removes each block's mean before its feature, so a constant offset leaves the estimate
+   (header stamps, or receive times); its stamps checked (`condition.check_stream`), put in
+   stamp order where delivered late (header stamps; `clock.stamp_order`) and re-stamped on
+   their own fitted clock where they jitter by less than 1/6 period (`clock.restamp`: a dropped
+   message, a duplicate or a clock step stays one); brought to the emulator's rate
+   (`condition.to_rate`: as recorded when the rates agree, else resampled); optionally
+   high-passed (``gravity="highpass"``; by default gravity's static part is kept: the BCR
+   removes each block's mean before its feature, so a constant offset leaves the estimate
    alone, but without a noise sd its sensor checks exempt flights only near -9.81 m/s^2, where
    a gravity-free signal puts them: a noise-free signal with +9.81 in it has its flights
    flagged as dead or quantised, docs/robot.md);
@@ -20,11 +23,11 @@ The pipeline (`replay_bag`):
    newest sample's time as its clock (``now=``), the call `control.run_closed_loop` makes, and
    the Simplex's command for each estimate.
 
-Faults in the recording are reported, never raised: repeated or backwards stamps and gaps reach
-the BCR, which gives ``sensor_fault`` with the reason for the blocks they touch (status and
-reason columns of the CSV), and the per-topic `StreamReport` counts them. A missing topic, a
-topic of another type, no messages or an IMU slower than the emulator's rate raise `BagError`
-naming the topic.
+Faults in the recording are reported, never raised: repeated or backwards stamps and gaps
+(those re-stamping keeps: not jitter) reach the BCR, which gives ``sensor_fault`` with the
+reason for the blocks they touch (status and reason columns of the CSV), and the per-topic
+`StreamReport` counts them. A missing topic, a topic of another type, no messages or an IMU
+slower than the emulator's rate raise `BagError` naming the topic.
 """
 
 from __future__ import annotations
@@ -52,7 +55,7 @@ from control.compat import (
 )
 from control.errors import BagError, ControlError, ControlWarning, user_stacklevel
 from control.estimate import Estimate, edge_counts
-from control.robot import condition
+from control.robot import clock, condition
 from control.robot import messages as msgs
 from control.robot.bags import (
     STORAGES,
@@ -122,6 +125,14 @@ class ReplaySettings:
             `control.robot.condition`.
         max_odometry_gap_s: IMU samples inside a longer odometry gap get no position or speed
             (a sensor fault), s.
+        reorder_periods: IMU messages whose stamps step back by at most this many nominal
+            periods are put in stamp order (received late, stamped right); a longer step back
+            is a clock step and stays (a sensor fault). 0: the order received. Only on header
+            stamps (receive times are in order).
+        restamp: put the IMU's stamps on their own fitted regular clock where they jitter
+            about one by less than 1/6 period (`clock.restamp`): jitter goes, a dropped
+            message, a duplicate or a clock step stays a sensor fault. Exact stamps are kept
+            bit for bit.
         estimate_topic: the output bag's topic of the estimates.
         storage: the output bag's storage, "mcap" or "sqlite3".
     """
@@ -137,13 +148,18 @@ class ReplaySettings:
     rate_tolerance: float = 0.02
     resample: str = "sample"
     max_odometry_gap_s: float = 0.25
+    reorder_periods: float = clock.REORDER_PERIODS
+    restamp: bool = True
     estimate_topic: str = "/bcr/estimate"
     storage: str = "mcap"
 
     def __post_init__(self) -> None:
         for name in ("imu_topic", "odom_topic", "estimate_topic", "imu_axis"):
             require_instance(self, name, str)
-        require_reals(self, ("imu_sign", "highpass_hz", "rate_tolerance", "max_odometry_gap_s"))
+        require_reals(self, ("imu_sign", "highpass_hz", "rate_tolerance", "max_odometry_gap_s",
+                             "reorder_periods"))  # fmt: skip
+        if not isinstance(self.restamp, bool):
+            raise ControlError(f"restamp must be True or False, got {self.restamp!r}")
         if self.imu_axis not in ("x", "y", "z"):
             raise ControlError(f"imu_axis must be 'x', 'y' or 'z', got {self.imu_axis!r}")
         if self.imu_sign not in (1, -1):
@@ -162,6 +178,10 @@ class ReplaySettings:
             )
         if not 0 <= self.rate_tolerance < 0.5:
             raise ControlError(f"rate_tolerance must lie in [0, 0.5), got {self.rate_tolerance}")
+        if not (np.isfinite(self.reorder_periods) and self.reorder_periods >= 0):
+            raise ControlError(
+                f"reorder_periods must be >= 0 (periods), got {self.reorder_periods}"
+            )
         if not (np.isfinite(self.max_odometry_gap_s) and self.max_odometry_gap_s > 0):
             raise ControlError(f"max_odometry_gap_s must be > 0, got {self.max_odometry_gap_s}")
         for name in ("imu_topic", "odom_topic", "estimate_topic"):
@@ -182,9 +202,11 @@ class ReplayResult:
     ``estimates``: the `Estimate` objects (with their posteriors).
     Per sample fed to the BCR (length n): ``sample_time`` (s, as ``time``), ``sample_position``,
     ``sample_speed``, ``sample_accel`` (m/s^2).
-    ``imu``, ``odometry``: `StreamReport` of each topic; ``resampling``: what was done to the
-    IMU's rate; ``notes``: what else was left out. ``read_s``, ``condition_s``, ``bcr_s``:
-    wall-clock times of the three stages, s; ``t0_ns``: stamp of time 0; ``settings``, ``bcr``,
+    ``imu``, ``odometry``: `StreamReport` of each topic (the stamps as recorded; the IMU's note
+    says what re-stamping and ordering did); ``restamping``: what `clock.restamp` did to
+    the IMU's stamps; ``resampling``: what was done to the IMU's rate; ``notes``: what else
+    was left out. ``read_s``, ``condition_s``, ``bcr_s``: wall-clock times of the three
+    stages, s; ``t0_ns``: stamp of time 0; ``settings``, ``bcr``,
     ``simplex``: what ran; ``source``: the recording read.
     """
 
@@ -220,6 +242,7 @@ class ReplayResult:
     bcr: BCRSettings
     simplex: Simplex
     source: str = ""
+    restamping: clock.Restamping = clock.Restamping(False)
 
     @property
     def duration_s(self) -> float:
@@ -600,7 +623,7 @@ def replay_recording(
     unchecked = _check_vehicle(rec, emulator, check_vehicle)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     tic = time.perf_counter()
-    t, a, pos, spd, reports, resampling, notes, t0 = _condition(
+    t, a, pos, spd, reports, resampling, notes, t0, restamping = _condition(
         rec, s, bcr.rate_hz, flight_reading(bcr.sensor)
     )
     notes[:0] = unchecked
@@ -657,6 +680,7 @@ def replay_recording(
         bcr=bcr,
         simplex=simplex,
         source=str(rec.path),
+        restamping=restamping,
     )
 
 
@@ -728,11 +752,16 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=No
     _check_span(rec, base, imu_ns, odom_ns, t0)
     t_imu = (imu_ns - t0) / 1e9
     t_odom = (odom_ns - t0) / 1e9
+    imu_recorded, accel_recorded = t_imu, accel
     odom_finite = np.all(np.isfinite(rec.odometry.position), axis=1) & np.all(
         np.isfinite(rec.odometry.velocity), axis=1
     )
+    t_imu, accel, said, restamping = _imu_clock(rec.imu.topic, t_imu, accel, base, s)
+    imu_note = "; ".join(filter(None, [note, *said]))
     reports = (
-        condition.check_stream(rec.imu.topic, t_imu, np.isfinite(accel), base, note),
+        condition.check_stream(
+            rec.imu.topic, imu_recorded, np.isfinite(accel_recorded), base, imu_note
+        ),  # fmt: skip
         condition.check_stream(rec.odometry.topic, t_odom, odom_finite, base, note),
     )
     t, a, resampling = condition.to_rate(
@@ -786,4 +815,31 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=No
             f"the IMU topic {rec.imu.topic!r} and the odometry topic {rec.odometry.topic!r} do "
             "not overlap in time"
         )
-    return t, a, pos, spd, reports, resampling, notes, t0
+    return t, a, pos, spd, reports, resampling, notes, t0, restamping
+
+
+def _imu_clock(topic: str, t: np.ndarray, accel: np.ndarray, base: str, s: ReplaySettings):
+    """The IMU's (times s, accel) in stamp order within ``s.reorder_periods`` (header stamps
+    only) and re-stamped on their clock (``s.restamp``, `clock.restamp`), what was done
+    (texts for its `StreamReport`'s note) and the `clock.Restamping`."""
+    said = []
+    period = condition.nominal_period(t)
+    if base == "header" and s.reorder_periods > 0 and np.isfinite(period):
+        order = clock.stamp_order(t, s.reorder_periods * period)
+        late = int(np.count_nonzero(np.diff(t) < 0))
+        t, accel = t[order], accel[order]
+        if late > np.count_nonzero(np.diff(t) < 0):
+            said.append(
+                f"messages received out of stamp order by at most {s.reorder_periods:g} "
+                "periods put in stamp order"
+            )
+    if not s.restamp:
+        return t, accel, said, clock.Restamping(False)
+    what = "header stamps" if base == "header" else "receive times"
+    new, info = clock.restamp(t, f"its {what}")
+    if info.restamped:
+        seen = condition.check_stream(topic, new, np.ones(new.size, bool), base)
+        said.append(f"{info.note}; on that clock: {seen.faults()}")
+    elif info.note:
+        said.append(info.note)
+    return new, accel, said, info
