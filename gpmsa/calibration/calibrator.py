@@ -27,7 +27,7 @@ import warnings
 from collections.abc import Callable
 
 import numpy as np
-from scipy.special import ndtr
+from scipy.special import log_ndtr
 
 from gpmsa import backends
 from gpmsa.calibration.grid import (
@@ -274,10 +274,7 @@ class Calibrator:
             ((self._theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1
         )
         self._weights = trapezoid_weights(self.theta_grid) if q == 1 else None
-        z = (1.0 - pri.theta_mean) / pri.theta_sd, (0.0 - pri.theta_mean) / pri.theta_sd
-        self._log_prior_norm = float(
-            np.log(pri.theta_sd * np.sqrt(2 * np.pi) * (ndtr(z[0]) - ndtr(z[1])))
-        )
+        self._log_prior_norm = log_theta_norm(pri.theta_mean, pri.theta_sd)
         lo, hi = float(std.t_min[0]), float(std.t_max[0])  # one parameter: float64's resolution
         self._min_step = MIN_STEP_ULPS * max(np.spacing(1.0), np.spacing(max(abs(lo), abs(hi)))
                                              / (hi - lo))  # fmt: skip
@@ -718,6 +715,22 @@ class Calibrator:
             "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
         return Posterior(grids=grids, draw=draw, info=info)
+
+
+def log_theta_norm(theta_mean: float, theta_sd: float) -> float:
+    """log of the integral over (0, 1) of exp(-((t - theta_mean) / theta_sd)**2 / 2): the
+    normaliser of theta's truncated normal prior (unit scale), finite for every prior that
+    ``Priors`` accepts: an interval narrow in sd units (theta_sd >> 1) by the midpoint rule with
+    its second-order term (the difference of two normal CDFs would cancel to 0), a wider one by
+    ``log_ndtr`` on the lower tail (a mean far outside (0, 1) underflows ``ndtr``)."""
+    a, b = -theta_mean / theta_sd, (1.0 - theta_mean) / theta_sd
+    h, c = (b - a) / 2.0, (a + b) / 2.0  # 2 h theta_sd = 1
+    if h * max(1.0, abs(c)) < 1e-4:  # relative error O((h c)**4)
+        return float(-0.5 * c * c + np.log1p((c * c - 1.0) * h * h / 6.0))
+    if c > 0.0:  # by symmetry, where log_ndtr keeps its precision
+        a, b = -b, -a
+    lb, la = float(log_ndtr(b)), float(log_ndtr(a))
+    return float(np.log(theta_sd * np.sqrt(2.0 * np.pi)) + lb + np.log1p(-np.exp(la - lb)))
 
 
 def _warn_at_float(res: float, marginal, emulator) -> None:

@@ -6,12 +6,14 @@ import argparse
 import os
 import sys
 
+from gpmsa._version import __version__
 from gpmsa.cli import calibrate, info
 
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
     parser = argparse.ArgumentParser(prog="gpmsa", description="GPM/SA emulator tools")
+    parser.add_argument("--version", action="version", version=f"gpmsa {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     info.add_parser(sub)
     calibrate.add_parser(sub)

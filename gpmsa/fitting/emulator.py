@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
+import sys
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -914,14 +915,29 @@ def output_variance(var_w: np.ndarray, K: np.ndarray, lam_sim: np.ndarray, lam_w
     return (var_w - 1.0 / (lam_sim * lam_wos)) @ (K**2).T + 1.0 / lam_wos
 
 
+METADATA_INT_DIGITS = sys.int_info.default_max_str_digits
+"""Most decimal digits of an integer in metadata: Python's default limit of int/str conversion
+(4300), which a reader's json.loads applies (a raised limit on the writer's machine is not the
+reader's)."""
+_INT_BOUND = 10**METADATA_INT_DIGITS
+
+
 def _check_metadata(value, where: str, depth: int = 0) -> None:
-    """Metadata a file can hold: dicts with string keys, lists, tuples, strings, bools, integers,
-    finite floats and None (NaN would come back as null). JSON has no tuple: a tuple comes back
-    as a list (numpy scalars as Python numbers)."""
+    """Metadata a file can hold: dicts with string keys, lists, tuples, strings, bools, integers
+    of at most ``METADATA_INT_DIGITS`` digits, finite floats and None (NaN would come back as
+    null). JSON has no tuple: a tuple comes back as a list (numpy scalars as Python numbers)."""
     if depth > 64:
         raise GPMSAError(f"{where}: nests deeper than 64 levels")
-    if value is None or isinstance(value, (str, bool, int, np.integer, np.bool_)):
+    if value is None or isinstance(value, (str, bool, np.integer, np.bool_)):
         return
+    if isinstance(value, int):
+        if -_INT_BOUND < value < _INT_BOUND:
+            return
+        raise GPMSAError(
+            f"{where}: an integer of more than {METADATA_INT_DIGITS} digits (about "
+            f"{int(value.bit_length() * 0.30103)}), more than a reader's JSON parser accepts; "
+            "store it as a str"
+        )
     if isinstance(value, (float, np.floating)):
         if isinstance(value, np.floating) and value.dtype.itemsize > 8:
             raise GPMSAError(

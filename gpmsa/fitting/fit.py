@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import replace
 from datetime import datetime, timezone
 
@@ -32,6 +33,7 @@ from gpmsa.mcmc.sampler import (
     parameter_elements,
     sweeps_nbytes,
 )
+from gpmsa.mcmc.starts import check_init
 from gpmsa.model import constraints
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
@@ -178,6 +180,8 @@ def fit(
     """
     n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
     continuing = isinstance(options.get("init"), Emulator)  # its chains start past burn-in
+    if isinstance(options.get("init"), str | os.PathLike):  # a rule (a file name: say how)
+        check_init(options["init"], n_chains, "gpmsa.load")
     append = check_append(append, options.get("init"), n_burn)
     default_burn = 0 if continuing else n_iter // 5
     n_burn = default_burn if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)

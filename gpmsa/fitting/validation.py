@@ -28,7 +28,7 @@ from gpmsa.model.basis import ORTHOGONAL_TOL, basis_digest
 from gpmsa.model.data import as_float, output_scale
 from gpmsa.model.fixed_elements import label
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
-from gpmsa.model.priors import MAX_PRIOR_SHAPE
+from gpmsa.model.priors import MAX_PRIOR_SHAPE, theta_prior_overflow
 from gpmsa.model.transforms import UNIT_TOL
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -224,6 +224,9 @@ def check_priors(priors) -> None:
         if not ok:
             allowed = {"theta_mean": "finite", "rho_cap": "(0, 1)"}.get(name, "(0, inf), finite")
             raise _fail(f"priors.{name}", f"{v!r} is out of range: allowed {allowed}")
+    bad = theta_prior_overflow(float(priors["theta_mean"]), float(priors["theta_sd"]))
+    if bad is not None:
+        raise _fail(f"priors.{bad[0]}", bad[1])
     if not isinstance(priors["corrected"], bool):
         raise _fail("priors.corrected", f"must be true or false, got {_short(priors['corrected'])}")
     for name in PRECISIONS:

@@ -34,6 +34,8 @@ Each chain draws its start from its own generator
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 from scipy.special import gammainc, gammaincc, gammainccinv, gammaincinv
 
@@ -51,10 +53,15 @@ PRECISION_JITTER = 10.0
 """Factor f of the log-uniform start of a precision under ``"jitter"``."""
 
 
-def check_init(init, n_chains: int) -> str:
-    """The init rule for ``n_chains`` chains ("auto" resolved); GPMSAError for an unknown one."""
+def check_init(init, n_chains: int, reader: str | None = None) -> str:
+    """The init rule for ``n_chains`` chains ("auto" resolved); GPMSAError for an unknown one.
+    ``reader``: the function whose result continues a run from a saved file ("gpmsa.load",
+    "gpmsa.load_study"), named in the message when ``init`` is some other str or a path."""
     if not isinstance(init, str) or init not in CHOICES:
-        raise GPMSAError(f"init must be one of {CHOICES}, got {init!r}")
+        hint = ""
+        if reader is not None and isinstance(init, str | os.PathLike):
+            hint = f"; to continue from a saved file pass init={reader}(path)"
+        raise GPMSAError(f"init must be one of {CHOICES}, got {init!r}{hint}")
     if init == "auto":
         return "gpmsa" if n_chains == 1 else "jitter"
     return init

@@ -17,6 +17,28 @@ MAX_PRIOR_SHAPE = 1e12
 1e30 would make the lamOs quadrature ask for petabytes); emulator files are held to it too."""
 
 
+def theta_prior_overflow(theta_mean: float, theta_sd: float) -> tuple[str, str] | None:
+    """(field, why) where theta's Normal(theta_mean, theta_sd) on (0, 1) (both finite,
+    theta_sd > 0) has no float64 density: its precision 1/theta_sd**2, or its exponent
+    ((theta - theta_mean) / theta_sd)**2 at the end of (0, 1) farther from theta_mean, not a
+    finite number (the prior would be zero everywhere but at theta_mean, or everywhere); None
+    where it has one."""
+    var = theta_sd * theta_sd
+    if var == 0.0 or not math.isfinite(1.0 / var):
+        return "theta_sd", (
+            f"{theta_sd!r} is too small: its precision 1/theta_sd**2 is beyond float64 "
+            "(theta_sd must exceed about 7.5e-155; hold theta at a value with fixed= instead)"
+        )
+    z = (abs(theta_mean - 0.5) + 0.5) / theta_sd
+    if not math.isfinite(z * z):
+        return "theta_mean", (
+            f"{theta_mean!r} is too far from (0, 1) for theta_sd {theta_sd!r}: "
+            "((theta - theta_mean) / theta_sd)**2 is beyond float64 there, so the prior is zero "
+            "everywhere"
+        )
+    return None
+
+
 def _real(obj, name: str) -> float:
     """Field ``name`` of ``obj`` as a float, stored back; GPMSAError unless a real number."""
     value = getattr(obj, name)
@@ -116,6 +138,9 @@ class Priors:
                 name == "theta_mean" or v > 0)  # fmt: skip
             if not ok:
                 raise GPMSAError(f"Priors.{name} must be {rule}, got {v}")
+        bad = theta_prior_overflow(self.theta_mean, self.theta_sd)
+        if bad is not None:
+            raise GPMSAError(f"Priors.{bad[0]} = {bad[1]}")
         object.__setattr__(self, "lamVz", as_group_priors(self.lamVz, "Priors.lamVz"))
         for name in PRECISIONS:
             if name != "lamVz" and not isinstance(getattr(self, name), GammaPrior):

@@ -51,7 +51,7 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
 
 
 def _label(name: str, unit: str) -> str:
-    return f"{name} [{unit}]" if unit else name
+    return f"{name} ({unit})" if unit else name
 
 
 def _y_label(sim: SimData) -> str:

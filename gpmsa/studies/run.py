@@ -37,6 +37,7 @@ from gpmsa.fitting.fit import (
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
+from gpmsa.mcmc.starts import check_init
 from gpmsa.model import categorical
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
@@ -398,6 +399,8 @@ def calibrate_study(
     n_burn = (0 if continuing else 1000) if n_burn is None else n_burn
     given_hyper = hyper is not None
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
+    if not continuing:
+        check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
     metadata = check_metadata(metadata)
     tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
@@ -607,6 +610,8 @@ def fit_study(
         n_burn = 0 if continuing else n_iter // 5
     given_hyper = hyper is not None
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
+    if not continuing:
+        check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
     check_point(point)
     given_keep = n_keep

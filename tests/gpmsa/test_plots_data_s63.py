@@ -33,7 +33,7 @@ def test_functional_runs_are_coloured_by_an_input_and_experiments_drawn_on_their
     colours = {tuple(line.get_color()) for line in lines[: sim.m]}
     assert len(colours) > 10  # one colour per value of c
     assert bar.get_ylabel() == "c" and "2 experiment(s)" in ax.get_title()
-    assert gpmsa.plots.data(sim).axes[1].get_ylabel() == "E [GPa]"  # default: the first t
+    assert gpmsa.plots.data(sim).axes[1].get_ylabel() == "E (GPa)"  # the first t (s70: not [GPa])
 
 
 def test_scalar_output_gives_a_panel_per_input_with_the_observations():
