@@ -102,6 +102,10 @@ class ObservationModel:
         n_speed: speed nodes of the mean table over the emulator's speed domain.
     """
 
+    # `_speed_terms` of the last speed; a class default, so that a model pickled before it
+    # existed restores without it
+    _last_speed: tuple | None = None
+
     def __init__(
         self, emulator, scatter: BlockScatter | None = None, n_grid: int = 121, n_speed: int = 31
     ) -> None:
@@ -192,15 +196,26 @@ class ObservationModel:
         last = self._last
         if last is not None and last[0] == key:
             return last
-        mean, chol = self._at(float(v))
+        _, mean, inverse, half_logdet = self._speed_terms(float(v))
+        r = inverse @ (y[None, :] - mean).T  # (K, G)
+        d2 = np.sum(r**2, axis=0)
+        out = d2, half_logdet
+        self._last = last = (key, out, (inverse, r[:, int(np.argmin(d2))]))
+        return last
+
+    def _speed_terms(self, v: float) -> tuple:
+        """(v, mean (G, K), the inverse of Sigma's lower Cholesky factor, half the
+        log-determinant of Sigma) at speed v. The last speed's are remembered: a block at the
+        speed of the one before (a steady speed command) reuses them (one tuple: see `_solve`)."""
+        terms = self._last_speed
+        if terms is not None and terms[0] == v:
+            return terms
+        mean, chol = self._at(v)
         # an explicit inverse of the 8 x 8 factor: a LAPACK triangular solve of this size costs
         # ~1 ms in OpenBLAS's threads, the product microseconds
         inverse = np.linalg.inv(chol)
-        r = inverse @ (y[None, :] - mean).T  # (K, G)
-        d2 = np.sum(r**2, axis=0)
-        out = d2, float(np.sum(np.log(np.diag(chol))))
-        self._last = last = (key, out, (inverse, r[:, int(np.argmin(d2))]))
-        return last
+        self._last_speed = terms = (v, mean, inverse, float(np.sum(np.log(np.diag(chol)))))
+        return terms
 
     def loglik(self, y: np.ndarray, v: float) -> np.ndarray:
         """log p(y | GD) on ``self.gd`` (G,), all constants included.

@@ -246,7 +246,10 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
                     f"the sensor's own noise (variance {variance:.3g} (m/s^2)^2, below "
                     f"{fraction:.3g} of the noise variance {noise_var:g})"
                 )
-    ratio, (start, stop) = _level_jump(s1, s2, MIN_SEGMENT) if steady else (1.0, (0, 0))
+    if steady and not _level_within(s1, s2, MIN_SEGMENT, limits.max_level_jump):
+        ratio, (start, stop) = _level_jump(s1, s2, MIN_SEGMENT)
+    else:  # (the usual case: no segment can reach the limit, `_level_within`)
+        ratio, (start, stop) = 1.0, (0, 0)
     if ratio > limits.max_level_jump:
         return (
             f"signal level jumps within the block: the variance of samples {start}-{stop - 1} "
@@ -491,6 +494,32 @@ def _level_jump(s1: np.ndarray, s2: np.ndarray, min_segment: int) -> tuple[float
         if ratio[i] > best[0]:
             best = (float(ratio[i]), (int(start[i]), int(stop[i])))
     return best
+
+
+def _level_within(s1: np.ndarray, s2: np.ndarray, min_segment: int, limit: float) -> bool:
+    """Whether every ratio `_level_jump` computes from the block's `_centred_sums` provably
+    stays below ``limit`` (False: it may not), in O(n) against its O(n^2) segments.
+
+    A segment [s, e) of L samples, m = ``min_segment`` <= L <= n - m, has a variance of at most
+    the sum of squares of [0, e) over m - 1 (a sum of squares about its own mean only grows as
+    samples join), and at least that of [s, s + m) over n - m - 1; so its ratio to the samples
+    after it is at most before[e] (e - 1) / (m - 1) / after[e], and that of the samples before it
+    to it at most before[s] (n - m - 1) / (var[s, s + m) (m - 1)). Both bounds are held to half
+    the limit, each variance widened by ``delta``, a bound on the rounding of the cumulative
+    sums (8 n^2 eps times the block's sum of squares, over m - 1)."""
+    n, m = s1.size - 1, min_segment
+    if n < 2 * m:
+        return True
+    before, after = _part_variances(s1, s2, m)
+    delta = 8.0 * n * n * np.finfo(float).eps * s2[-1] / (m - 1)
+    ends = slice(m, n - m + 1)  # the ends (and starts) of segments with m samples beyond them
+    inside_hi = (before[ends] + delta) * np.arange(m - 1, n - m) / (m - 1) + delta
+    if not np.all(inside_hi <= 0.5 * limit * after[ends]):
+        return False
+    total, squares = s1[2 * m :] - s1[ends], s2[2 * m :] - s2[ends]  # [s, s + m) from each s
+    first = (squares - total * total / m) / (m - 1)
+    inside_lo = (first - delta) * (m - 1) / (n - m - 1) - delta
+    return bool(np.all(before[ends] <= 0.5 * limit * inside_lo))
 
 
 def _part_variances(
