@@ -502,8 +502,11 @@ def _check_discrepancy_scales(kind, grids: list[np.ndarray]) -> None:
             "discrepancy='linear' is normalised on each experiment's grid by its largest "
             f"|index|, which differs between them (experiment {j}: {reach[j]:.6g}, experiment "
             f"{k}: {reach[k]:.6g}), so the same weights would mean a different discrepancy in "
-            "each: give every experiment a grid that reaches the same largest |index|, or use "
-            "discrepancy='constant'"
+            "each: give every experiment a grid that reaches the same largest |index|, use "
+            "discrepancy='constant', or pass the linear basis per experiment, which is "
+            "normalised by one scale for all (as SEPIA's create_D_basis('linear') on ragged "
+            "observations): discrepancy=[np.column_stack([np.ones(g.size), g]) for g in "
+            "obs.grids]"
         )
 
 
