@@ -25,6 +25,7 @@ no vehicle and is never refused for one.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import shutil
@@ -137,8 +138,9 @@ def _write(out: Path, result: ReplayResult, report: dict) -> None:
                 path = out / name
                 if path.is_dir():
                     shutil.rmtree(path, ignore_errors=True)
-                else:
-                    path.unlink(missing_ok=True)
+                else:  # a read-only file system refuses to unlink a missing file too (EROFS)
+                    with contextlib.suppress(OSError):
+                        path.unlink(missing_ok=True)
         raise
 
 
