@@ -135,8 +135,8 @@ def _move_to_free_slots(k: np.ndarray, r: np.ndarray, period: float) -> int:
     moved = 0
     limit = RESTAMP_MOVE_PERIODS * period
     for i in np.flatnonzero(k[1:] == k[:-1]) + 1:
-        if k[i] != k[i - 1]:
-            continue  # resolved by an earlier move
+        if k[i] != k[i - 1] or r[i] == r[i - 1]:
+            continue  # resolved by an earlier move, or a duplicate (one stamp twice): kept
         late = r[i] - period  # message i on the next slot
         early = r[i - 1] + period  # message i - 1 on the slot before
         free_next = i + 1 == k.size or k[i + 1] > k[i] + 1
@@ -162,7 +162,8 @@ step reaches the BCR (`restamp`). Smaller steps are taken for jitter."""
 def _phase_step(r: np.ndarray, period: float) -> int:
     """Index (> 0) where the offsets ``r`` of a run's times from its clock shift by more than
     RESTAMP_STEP_PERIODS periods (medians of blocks of 32, each against the one two blocks on:
-    a step inside the block between splits its median), or 0: none."""
+    a step inside the block between splits its median; located at the split of those 96 into
+    two levels that fits them best), or 0: none."""
     n = r.size // 32
     if n < 3:
         return 0
@@ -170,8 +171,12 @@ def _phase_step(r: np.ndarray, period: float) -> int:
     jump = np.flatnonzero(np.abs(med[2:] - med[:-2]) > RESTAMP_STEP_PERIODS * period)
     if not jump.size:
         return 0
-    j = 32 * int(jump[0])  # the step lies in these 96: at the largest change of offset there
-    return j + int(np.argmax(np.abs(np.diff(r[j : j + 96])))) + 1
+    j = 32 * int(jump[0])  # the step lies in these 96: at the split that fits them best by
+    w = r[j : j + 96]  # two levels (least squares: one jittered offset cannot move it far)
+    i = np.arange(1, w.size)
+    before = np.cumsum(w)[:-1]
+    shift = before / i - (w.sum() - before) / (w.size - i)
+    return j + int(np.argmax(i * (w.size - i) * shift * shift)) + 1
 
 
 def restamp(t: np.ndarray, what: str = "the stamps") -> tuple[np.ndarray, Restamping]:

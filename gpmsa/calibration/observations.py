@@ -19,6 +19,7 @@ from gpmsa.errors import (
     GPMSAError,
     OutsideEmulatorWarning,
     ResourceLimitError,
+    user_stacklevel,
 )
 from gpmsa.model import categorical
 from gpmsa.model.data import (
@@ -219,7 +220,9 @@ def check_x(
         msg = f"{what} {name}={x[j, k]:.6g} lies outside the emulator's domain [{lo:.6g}, {hi:.6g}]"
         if not extrapolate:
             raise GPMSAError(msg + "; pass extrapolate=True to allow it")
-        warnings.warn(msg + "; the emulator extrapolates", ExtrapolationWarning, stacklevel=3)
+        warnings.warn(
+            msg + "; the emulator extrapolates", ExtrapolationWarning, stacklevel=user_stacklevel()
+        )
     return x, xu
 
 

@@ -362,7 +362,7 @@ def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
         warnings.warn(
             "x_obs lies outside the simulation design's range; the emulator extrapolates there",
             ExtrapolationWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -368,12 +368,17 @@ def test_a_dead_stretch_of_six_samples_or_more_is_a_fault_wherever_it_lies(
     """Property: a sensor that goes dead (a gain of 1e-4, stuck, clipped at 1e-3 m/s^2,
     quantised in steps of 1e3 m/s^2) for >= 6 samples anywhere in a block is a fault. (A gain
     over the whole block is no dead stretch: to the signal checks it is a quieter road, and the
-    plausibility check refuses it: test_bcr.)"""
+    plausibility check refuses it: test_bcr. Nor is a gain over all but fewer than 6 of its
+    samples: since session 69 the level check counts drops only, and a block that starts on a
+    gain with at most 5 live samples holds the gain's rise, not its fall; the fall lies in the
+    blocks before it (83 or more samples before the fall: test_level_rise_s69). Hypothesis
+    found (start 0, length 120) in session 70; the scan over 15 seeds and every start and
+    length failed only where 1-5 samples stayed live.)"""
     a = 3 * np.random.default_rng(seed).standard_normal(125)
     stop = min(start + length, 125)
     if stop - start < 6:
         start = stop - 6
-    assume(not (kind == "scale" and stop - start == 125))
+    assume(not (kind == "scale" and 125 - (stop - start) < 6))
     part = a[start:stop]
     a[start:stop] = {
         "scale": 1e-4 * part,
