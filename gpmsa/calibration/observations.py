@@ -491,13 +491,20 @@ class _Settled(Exception):
 
 
 class _Nearest:
-    """`fit_of` (without a layout) over every theta predicted at so far, kept up to date one
-    theta at a time: a datum judged on its own is as near as the nearest theta to it."""
+    """`fit_of` over every theta predicted at so far, kept up to date one theta at a time: a
+    datum judged on its own is as near as the nearest theta to it (``layout``: `fit_of`'s, of
+    the first thetas only)."""
 
-    def __init__(self, data: Observations, mean: np.ndarray, cov: np.ndarray):
+    def __init__(self, data: Observations, mean: np.ndarray, cov: np.ndarray,
+                 layout: tuple[int, ...] | None = None):  # fmt: skip
         self.data, self.Linv = data, _chol_inverse(data)
         resid, var, dist, self.alone = _distances(mean, cov, data)
-        self.nearest = np.min(dist, axis=0) if self.alone else np.min(np.max(dist, axis=1))
+        if self.alone:  # no error estimate: each datum on its own
+            self.nearest = np.min(dist, axis=0)
+            if layout is not None:
+                self.nearest[_crossed(resid, layout)] = 0.0
+        else:
+            self.nearest = np.min(np.max(dist, axis=1))
         self.excess = float(np.min(_excess(resid, var, cov, self.data, self.Linv)))
 
     def add(self, mean: np.ndarray, cov: np.ndarray) -> np.ndarray:
@@ -534,15 +541,7 @@ def fit_of(
     between them (the predictive mean is continuous in theta), however far the nodes' means
     lie from it in predictive sds (an emulator with a negligible nugget read a datum exactly
     on the simulator 11 sds outside, between probe nodes)."""
-    resid, var, dist, alone = _distances(mean, cov, data)
-    if alone:  # no error estimate: each datum on its own
-        nearest = np.min(dist, axis=0)
-        if layout is not None:
-            nearest[_crossed(resid, layout)] = 0.0
-        outside = float(np.max(nearest))
-    else:
-        outside = float(np.min(np.max(dist, axis=1)))
-    return Fit(outside, float(np.min(_excess(resid, var, cov, data, _chol_inverse(data)))))
+    return _Nearest(data, mean, cov, layout).fit()
 
 
 def _chol_inverse(data: Observations) -> np.ndarray | None:
