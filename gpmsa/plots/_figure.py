@@ -1,4 +1,5 @@
-"""A bare matplotlib Figure (no pyplot state, no GUI backend), and the histograms' bin check."""
+"""A bare matplotlib Figure (no pyplot state, no GUI backend), the histograms' bin check, and
+the axes' labels."""
 
 from __future__ import annotations
 
@@ -21,3 +22,8 @@ def check_bins(bins, n_hist: int, what: str) -> int:
         BYTES_PER_HISTOGRAM_BIN * bins * n_hist, f"{what}: {n_hist} histogram(s) of {bins} bins"
     )
     return bins
+
+
+def axis_label(name: str, unit: str) -> str:
+    """``name (unit)``, every figure's label of a quantity, or the name alone without a unit."""
+    return f"{name} ({unit})" if unit else name

@@ -6,7 +6,7 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, SimData
-from gpmsa.plots._figure import figure
+from gpmsa.plots._figure import axis_label, figure
 
 
 def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = None):
@@ -50,13 +50,10 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
     return _functional(sim, inputs, obs, ys, color_by)
 
 
-def _label(name: str, unit: str) -> str:
-    return f"{name} ({unit})" if unit else name
-
-
 def _y_label(sim: SimData) -> str:
     units = set(sim.y_units)
-    return _label("y" if sim.l_sim > 1 else sim.y_names[0], units.pop() if len(units) == 1 else "")
+    unit = units.pop() if len(units) == 1 else ""
+    return axis_label("y" if sim.l_sim > 1 else sim.y_names[0], unit)
 
 
 def _scalar(sim: SimData, inputs, x_obs, ys):
@@ -73,7 +70,7 @@ def _scalar(sim: SimData, inputs, x_obs, ys):
         elif observed is not None:
             for v in observed:
                 ax.axhline(v, color="k", lw=0.8)
-        ax.set_xlabel(_label(name, unit))
+        ax.set_xlabel(axis_label(name, unit))
     axes[0].set_ylabel(_y_label(sim))
     if observed is not None:
         axes[0].legend(fontsize="x-small")
@@ -104,7 +101,7 @@ def _functional(sim: SimData, inputs, obs, ys, color_by):
         ax.plot(grid if g is None else g, e, "o-", ms=3, lw=1.2, color="k",
                 label="observations" if j == 0 else None)  # fmt: skip
     bar = fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax)
-    bar.set_label(_label(color_by, unit))
+    bar.set_label(axis_label(color_by, unit))
     ax.set_xlabel("output index")
     ax.set_ylabel(_y_label(sim))
     ax.set_title(f"{sim.m} runs" + ("" if obs is None else f", {obs.n} experiment(s)"),

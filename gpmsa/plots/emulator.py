@@ -9,7 +9,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.basis import variance_shares
 from gpmsa.model.data import SimData, check_count, check_flag, check_level, column_order
-from gpmsa.plots._figure import figure
+from gpmsa.plots._figure import axis_label, figure
 from gpmsa.predictive.crossval import CrossValidation
 
 
@@ -41,7 +41,7 @@ def pc_basis(emulator, *, max_pc: int = 6):
               for k, n in enumerate(emulator.x_names)]  # fmt: skip
     inputs += [(n, emulator.t_unit[:, k] * (std.t_max[k] - std.t_min[k]) + std.t_min[k])
                for k, n in enumerate(emulator.t_names)]  # fmt: skip
-    inputs = [(f"{n} ({u})" if u else n, v) for (n, v), u in zip(inputs, units, strict=True)]
+    inputs = [(axis_label(n, u), v) for (n, v), u in zip(inputs, units, strict=True)]
     y_std = std.y_to_std(emulator.y)
     total = float(np.sum(y_std**2))
     share = variance_shares(emulator.w, emulator.lam_sim, total) if total > 0 else None

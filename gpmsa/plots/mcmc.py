@@ -11,7 +11,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import diagnostics
 from gpmsa.mcmc.sampler import Chains
 from gpmsa.model.data import as_float, check_count
-from gpmsa.plots._figure import check_bins, figure
+from gpmsa.plots._figure import axis_label, check_bins, figure
 from gpmsa.predictive.joint import calibration_posterior
 
 NUISANCE = ("lamOs", "lamVz")
@@ -70,11 +70,6 @@ def _units(source) -> dict[str, str]:
     if not isinstance(units, Mapping):
         return {}
     return {k: v for k, v in units.items() if isinstance(k, str) and isinstance(v, str) and v}
-
-
-def _label(name: str, units: dict[str, str]) -> str:
-    """``name (unit)`` as Posterior.plot labels it, or the name alone without a unit."""
-    return f"{name} ({units[name]})" if name in units else name
 
 
 def _name_list(names, available: list[str]) -> list[str]:
@@ -143,7 +138,7 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
         chains = series[name]
         for c, ch in enumerate(chains):
             row[0].plot(ch, lw=0.6, color=f"C{c}", label=f"chain {c}" if len(chains) > 1 else None)
-        row[0].set_ylabel(_label(name, units))
+        row[0].set_ylabel(axis_label(name, units.get(name, "")))
         row[1].sharey(row[0])
         row[1].hist(chains.reshape(-1), bins=bins, orientation="horizontal", color="0.6")
         row[1].tick_params(labelleft=False)
@@ -312,7 +307,7 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
                 if ni in truth and nj in truth:
                     ax.plot(truth[nj], truth[ni], "x", color="C3", ms=8, mew=2)
             if i == k - 1:
-                ax.set_xlabel(_label(nj, units))
+                ax.set_xlabel(axis_label(nj, units.get(nj, "")))
             if j == 0 and i > 0:
-                ax.set_ylabel(_label(ni, units))
+                ax.set_ylabel(axis_label(ni, units.get(ni, "")))
     return fig

@@ -6,7 +6,7 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, as_float, check_count, check_level
-from gpmsa.plots._figure import figure
+from gpmsa.plots._figure import axis_label, figure
 from gpmsa.predictive.full import FullPrediction
 
 BANDS = (("y", "new observation y", "0.8"), ("zeta", "eta + delta", "C1"),
@@ -96,7 +96,7 @@ def prediction_bands(
         bottom.plot(xs, pred.mean("delta")[order, 0], color="C2", lw=1)
         bottom.axhline(0.0, color="0.6", lw=0.6)
         name, unit = _input(pred, x_column)
-        bottom.set_xlabel(f"{name} ({unit})" if unit else name)
+        bottom.set_xlabel(axis_label(name, unit))
         bottom.set_ylabel("discrepancy delta")
         top.set_ylabel(ylabel)
         top.legend(fontsize="small")
