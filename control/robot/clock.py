@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.robot.condition import nominal_period
+from control.robot.condition import nominal_period, robust_sd
 
 REORDER_PERIODS = 3.0
 """Messages whose stamps step back by at most this many nominal periods are put in stamp order
@@ -52,7 +52,7 @@ class Restamping:
     Attributes:
         restamped: whether the stamps were replaced by the fitted clock's.
         rate_hz: the fitted clock's rate, Hz (NaN where none was fitted).
-        jitter_sd_s: robust sd (1.4826 MAD) of the stamps about the clock, s (NaN: none).
+        jitter_sd_s: robust sd (`condition.robust_sd`) of the stamps about the clock, s (NaN: none).
         jitter_max_s: largest distance of a stamp from its slot on the clock, s (NaN: none).
         runs: runs fitted (split at pauses and clock steps).
         moved: messages moved to a free neighbouring slot.
@@ -199,9 +199,10 @@ def restamp(t: np.ndarray, what: str = "the stamps") -> tuple[np.ndarray, Restam
 
     The stamps are kept as recorded where every one lies within RESTAMP_EXACT_S of its clock
     (nothing to remove: exact stamps give the same samples bit for bit) or where the jitter's
-    robust sd (1.4826 MAD about the clock, over all runs) exceeds RESTAMP_MAX_JITTER periods:
-    there a sample half a period late cannot be told from a dropped one, and the note says so.
-    ``what`` names the stamps in the note ("the IMU topic '/imu/data''s header stamps").
+    robust sd (`condition.robust_sd` about the clock, over all runs) exceeds RESTAMP_MAX_JITTER
+    periods: there a sample half a period late cannot be told from a dropped one, and the note
+    says so. ``what`` names the stamps in the note ("the IMU topic '/imu/data''s header
+    stamps").
     """
     t = np.asarray(t, dtype=float)
     period = nominal_period(t)
@@ -229,7 +230,7 @@ def restamp(t: np.ndarray, what: str = "the stamps") -> tuple[np.ndarray, Restam
     if not runs:
         return t, Restamping(False)
     r = resid[fitted]
-    sd = 1.4826 * float(np.median(np.abs(r - np.median(r))))
+    sd = robust_sd(r)
     worst = float(np.max(np.abs(r)))
     rate = float(max(rates)[1])  # the longest run's
     info = dict(rate_hz=rate, jitter_sd_s=sd, jitter_max_s=worst, runs=runs, moved=moved)

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
+from scipy.stats import median_abs_deviation
 
 from control.errors import BagError, ControlError
 from vehicle.models import GRAVITY
@@ -132,7 +133,7 @@ class Resampling:
 
 
 HEAVY_JITTER_STEPS = 0.35
-"""Robust sd (1.4826 MAD) of the positive steps, in median steps, above which `nominal_period`
+"""Robust sd (`robust_sd`) of the positive steps, in median steps, above which `nominal_period`
 takes the stamps' mean step instead of the median: Gaussian stamp jitter of sd 0.24 period
 (2 ms at 120 Hz) spreads the steps by about this much. Below it the median step lies within
 0.3 % of the rate (0.1 % at the 1 ms a driver typically adds; the re-stamping's limit, 1/6
@@ -141,6 +142,12 @@ stamps in order, 113 Hz without), while the mean step stays the clock's."""
 SPLIT_STEPS = 16.0
 """Steps longer than this many median steps (pauses), or back by as much (clock steps), are left
 out of the mean step of `nominal_period` (as `clock.RESTAMP_SPLIT_PERIODS`)."""
+
+
+def robust_sd(x: np.ndarray) -> float:
+    """The sd of ``x`` by its median absolute deviation about the median, scaled to a normal's
+    (1.4826 MAD; `scipy.stats.median_abs_deviation`): jitter's spread, blind to a few outliers."""
+    return float(median_abs_deviation(x, scale="normal"))
 
 
 def nominal_period(t: np.ndarray) -> float:
@@ -156,7 +163,7 @@ def nominal_period(t: np.ndarray) -> float:
     if not pos.size:
         return np.nan
     period = float(np.median(pos))
-    if 1.4826 * float(np.median(np.abs(pos - period))) <= HEAVY_JITTER_STEPS * period:
+    if robust_sd(pos) <= HEAVY_JITTER_STEPS * period:
         return period
     run = step[(step != 0) & (np.abs(step) <= SPLIT_STEPS * period)]
     mean = float(np.sum(run)) / run.size
