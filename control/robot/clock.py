@@ -209,24 +209,24 @@ def restamp(t: np.ndarray, what: str = "the stamps") -> tuple[np.ndarray, Restam
     if t.size < RESTAMP_MIN_RUN or not np.isfinite(period):
         return t, Restamping(False)
     step = np.diff(t)
-    cut = np.flatnonzero((step > RESTAMP_SPLIT_PERIODS * period) | (step < 0)) + 1
-    bounds = np.concatenate([[0], cut, [t.size]])
+    splits = np.flatnonzero((step > RESTAMP_SPLIT_PERIODS * period) | (step < 0)) + 1
+    bounds = np.concatenate([[0], splits, [t.size]])
     out, resid, fitted = t.copy(), np.full(t.size, np.nan), np.zeros(t.size, dtype=bool)
-    rates, moved, runs = [], 0, 0
+    rates, moved = [], 0  # rates: (messages, Hz) of each run fitted
     todo = list(zip(bounds[:-1], bounds[1:], strict=True))
     while todo:
         lo, hi = todo.pop()
         if hi - lo < RESTAMP_MIN_RUN:
             continue
-        k, c, p, cut = _clock_slots(t[lo:hi], period)
+        k, c, p, edge = _clock_slots(t[lo:hi], period)
         at = _phase_step(t[lo:hi] - (c + p * k), p)
         if at:  # the clock stepped inside the run: fit each side on its own
             todo += [(lo, lo + at), (lo + at, hi)]
             continue
-        moved += _move_to_free_slots(k, t[lo:hi] - (cut + p * k), p)
+        moved += _move_to_free_slots(k, t[lo:hi] - (edge + p * k), p)
         out[lo:hi], resid[lo:hi], fitted[lo:hi] = c + p * k, t[lo:hi] - (c + p * k), True
         rates.append((hi - lo, 1.0 / p))
-        runs += 1
+    runs = len(rates)
     if not runs:
         return t, Restamping(False)
     r = resid[fitted]
