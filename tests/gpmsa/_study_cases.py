@@ -42,3 +42,14 @@ EXACT = 1e5 - 1.0
 def observations(theta: float, n: int, sd: float, rng: np.random.Generator):
     x = np.linspace(0.1, 0.9, n)[:, None]
     return x, simulator(x, theta) + sd * rng.standard_normal((n, 1))
+
+
+def two_model_study(n_samples: int, n_burn: int, tune_rounds: int) -> gpmsa.Study:
+    """Models "a" and "b" (theta 0.35 and 0.5, three observations each, sd 0.03) sharing a
+    hierarchical t: a small study to save and read back."""
+    rng = np.random.default_rng(4)
+    data = [observations(th, 3, 0.03, rng) for th in (0.35, 0.5)]
+    return gpmsa.calibrate_study(
+        [emulator(None)] * 2, [d[0] for d in data], [d[1] for d in data], labels=["a", "b"],
+        hierarchical=["t"], n_samples=n_samples, n_burn=n_burn, seed=5, tune_rounds=tune_rounds,
+    )  # fmt: skip

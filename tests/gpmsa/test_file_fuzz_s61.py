@@ -8,7 +8,7 @@ import pytest
 import gpmsa
 from gpmsa.io import container
 from gpmsa.io.container import ENVELOPE, STUDY_FORMAT, read_raw, write_raw
-from tests.gpmsa._study_cases import emulator, observations
+from tests.gpmsa._study_cases import two_model_study
 from tests.gpmsa.test_file_hostile import read_members, write_zip
 
 
@@ -42,13 +42,7 @@ def test_an_array_dtype_that_is_not_a_string_is_refused(saved, tmp_path, dtype):
 
 
 def _study_file(tmp_path):
-    rng = np.random.default_rng(4)
-    data = [observations(th, 3, 0.03, rng) for th in (0.35, 0.5)]
-    study = gpmsa.calibrate_study(
-        [emulator(None)] * 2, [d[0] for d in data], [d[1] for d in data], labels=["a", "b"],
-        hierarchical=["t"], n_samples=60, n_burn=20, seed=5, tune_rounds=3,
-    )  # fmt: skip
-    return study.save(tmp_path / "run.gpmsa")
+    return two_model_study(n_samples=60, n_burn=20, tune_rounds=3).save(tmp_path / "run.gpmsa")
 
 
 @pytest.mark.parametrize("sd_max", [1e155, 1e308])

@@ -10,7 +10,7 @@ import pytest
 import gpmsa
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.io import atomic
-from tests.gpmsa._study_cases import emulator, observations
+from tests.gpmsa._study_cases import two_model_study
 
 
 def _small() -> gpmsa.Emulator:
@@ -56,12 +56,7 @@ def test_a_file_cut_short_is_named_truncated_not_foreign(tmp_path):
 
 @pytest.fixture(scope="module")
 def study_path(tmp_path_factory):
-    rng = np.random.default_rng(4)
-    data = [observations(th, 3, 0.03, rng) for th in (0.35, 0.5)]
-    study = gpmsa.calibrate_study(
-        [emulator(None)] * 2, [d[0] for d in data], [d[1] for d in data], labels=["a", "b"],
-        hierarchical=["t"], n_samples=20, n_burn=10, seed=5, tune_rounds=2,
-    )  # fmt: skip
+    study = two_model_study(n_samples=20, n_burn=10, tune_rounds=2)
     return study.save(tmp_path_factory.mktemp("study") / "run.gpmsa")
 
 
