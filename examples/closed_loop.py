@@ -186,12 +186,13 @@ def main(argv: list[str] | None = None) -> dict:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--out", type=path_option, default="out",
-        help="folder for metrics.json and the figures",
+        help="folder for metrics.json and the figures (default ./out)",
     )  # fmt: skip
-    parser.add_argument("--runs", type=int, default=3, help="runs per test case")
+    parser.add_argument("--runs", type=int, default=3, help="runs per test case (default 3)")
     parser.add_argument(
         "--first-seed", type=int, default=1,
-        help="run k drives track and noise seed k, k = FIRST_SEED .. FIRST_SEED + RUNS - 1",
+        help="run k drives track and noise seed k, k = FIRST_SEED .. FIRST_SEED + RUNS - 1 "
+        "(default 1)",
     )  # fmt: skip
     parser.add_argument(
         "--track", default=None, metavar="L:GD,...",
@@ -208,7 +209,8 @@ def main(argv: list[str] | None = None) -> dict:
     )  # fmt: skip
     parser.add_argument(
         "--risk", type=float, default=None,
-        help="risk posture alpha: drive on the (1 - alpha) posterior quantile of GD",
+        help="risk posture alpha: drive on the (1 - alpha) posterior quantile of GD (default: the "
+        "posterior mean, the paper's)",
     )  # fmt: skip
     parser.add_argument(
         "--law", default="linear", choices=list(control.simplex.LAWS),
@@ -245,7 +247,8 @@ def main(argv: list[str] | None = None) -> dict:
     )  # fmt: skip
     parser.add_argument(
         "--cases", nargs="+", choices=["A", "B"], default=["A", "B"],
-        help="test cases: A (noise-free), B (with the noise the case-B emulators were trained on)",
+        help="test cases: A (noise-free), B (with the noise the case-B emulators were trained on) "
+        "(default A B)",
     )  # fmt: skip
     parser.add_argument(
         "--emulator-dir", type=path_option, default=None, metavar="DIR",

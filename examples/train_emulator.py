@@ -480,12 +480,21 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--out", type=path_option, default="out",
-        help="folder for the campaign and the figure",
+        help="folder for the campaign and the figure (default ./out)",
     )  # fmt: skip
-    parser.add_argument("--n-runs", type=int, default=198, help="design points (paper: 198)")
-    parser.add_argument("--keep-s", type=float, default=120.0, help="seconds of driving per run")
-    parser.add_argument("--n-iter", type=int, default=30_000, help="MCMC sweeps per fit")
-    parser.add_argument("--seed", type=int, default=0, help="seed of design, roads and fits")
+    parser.add_argument(
+        "--n-runs", type=int, default=198, help="design points (default 198, the paper's)"
+    )
+    parser.add_argument(
+        "--keep-s", type=float, default=120.0, help="seconds of driving per run (default 120)"
+    )
+    parser.add_argument(
+        "--n-iter", type=int, default=30_000,
+        help="MCMC sweeps per fit (default 30000, the paper's)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--seed", type=int, default=0, help="seed of design, roads and fits (default 0)"
+    )
     parser.add_argument(
         "--emulator-dir", type=path_option, default=None,
         help="default: OUT/emulators",
@@ -518,7 +527,10 @@ def main(argv: list[str] | None = None) -> None:
         "--anchor-runs", type=int, default=None,
         help=f"runs added at each of --anchor-speeds (default: --n-runs // {ANCHOR_SHARE})",
     )  # fmt: skip
-    parser.add_argument("--cases", nargs="+", default=["A", "B"], choices=["A", "B"])
+    parser.add_argument(
+        "--cases", nargs="+", default=["A", "B"], choices=["A", "B"],
+        help="test cases: A (noise-free), B (with --noise-std) (default A B)",
+    )  # fmt: skip
     parser.add_argument(
         "--noise-std", type=float, default=None,
         help="accelerometer noise sd of case B, m/s^2 (your IMU's; default 1.0, the paper's)",
@@ -529,8 +541,10 @@ def main(argv: list[str] | None = None) -> None:
         "(vehicle.Jackal's attributes, SI units; the option may be repeated)",
     )  # fmt: skip
     parser.add_argument(
-        "--features", nargs="+", default=["band", "window"], choices=["band", "window"]
-    )
+        "--features", nargs="+", default=["band", "window"], choices=["band", "window"],
+        help="band: the change-point BCR's block-feature emulators; window: the paper's log f "
+        "of 1,000 samples (default band window)",
+    )  # fmt: skip
     parser.add_argument(
         "--block-samples", type=int, default=None,
         help="samples per block of the band emulators (the change-point BCR takes the length "
