@@ -167,7 +167,7 @@ def main(argv: list[str] | None = None) -> dict:
         f"max / mean percent error: paper {summary['paper']['max']:.1f} / "
         f"{summary['paper']['mean']:.1f}; ours, one road per cell "
         f"{summary['one_road']['max']:.1f} / {summary['one_road']['mean']:.1f}; "
-        f"ours, mean over {args.roads} roads: worst cell "
+        f"ours, mean over {args.roads} road{'s' if args.roads != 1 else ''}: worst cell "
         f"{summary['all_roads']['max_cell_mean']:.1f} / {summary['all_roads']['mean']:.1f}"
     )
     print(f"wrote {table_path} and {figure_path}")
