@@ -1,6 +1,6 @@
 """Figures users look at: the data before fitting, MCMC traces and autocorrelations, theta
 pairs, the PC basis and the observations' projection onto it (per component and in pairs), rho
-box plots, emulator fit, prediction bands, sensitivity bars.
+box plots, emulator fit, prediction bands, sensitivity bars and main-effect curves.
 
 Each function returns a ``matplotlib.figure.Figure`` (matplotlib is imported only when one runs;
 nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a notebook.
@@ -12,12 +12,13 @@ from gpmsa.plots.mcmc import autocorrelation, theta_pairs, traces
 from gpmsa.plots.observations import obs_projection, weight_pairs
 from gpmsa.plots.prediction import prediction_bands
 from gpmsa.plots.rho import rho_boxplots
-from gpmsa.plots.sensitivity import sensitivity_bars
+from gpmsa.plots.sensitivity import main_effect_curves, sensitivity_bars
 
 __all__ = [
     "autocorrelation",
     "data",
     "emulator_fit",
+    "main_effect_curves",
     "obs_projection",
     "pc_basis",
     "prediction_bands",

@@ -1,4 +1,5 @@
-"""Bars of Sobol main and total effects (and, for a functional output, along its grid)."""
+"""Bars of Sobol main and total effects (and, for a functional output, along its grid), and the
+main-effect functions with their band over draws."""
 
 from __future__ import annotations
 
@@ -7,8 +8,8 @@ import warnings
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import check_level
-from gpmsa.plots._figure import figure
+from gpmsa.model.data import check_count, check_level
+from gpmsa.plots._figure import axis_label, figure
 from gpmsa.predictive.sobol import Sensitivity
 
 
@@ -71,4 +72,68 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
         ax.set_xlabel("output index")
         ax.set_ylabel("index (solid: main, dashed: total)")
         ax.legend(fontsize="small")
+    return fig
+
+
+def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0):
+    """Main-effect functions E[y | z_k] of each varied input, with their band over draws.
+
+    One panel per varied input (SEPIA's main-effect plot), on a shared output axis: the mean
+    over posterior draws of ``sens.main_effect`` against the input's grid, the central interval
+    of probability ``level`` over the draws as a band (none for the point estimate), and the
+    output's mean over the box as a dotted line. Axes read "name (unit)".
+
+    Args:
+        sens: a Sensitivity from ``gpmsa.sensitivity(..., main_effect_grid=G)``.
+        level: probability of the bands.
+        output: the output element (index on the simulation grid) of a functional output.
+
+    Example:
+        >>> import numpy as np, gpmsa
+        >>> rng = np.random.default_rng(0)
+        >>> x, t = rng.uniform(size=(30, 1)), rng.uniform(size=(30, 1))
+        >>> data = gpmsa.SimData(x=x, t=t, y=x + 0.3 * t, x_names=["x"], t_names=["t"],
+        ...                      x_units=["m"])
+        >>> emu = gpmsa.Emulator.from_params(data, {"betaU": [[1], [1]], "lamUz": [1],
+        ...                                         "lamWs": [1e4], "lamWOs": [1e4]})
+        >>> sens = gpmsa.sensitivity(emu, draws=False, main_effect_grid=11)
+        >>> fig = gpmsa.plots.main_effect_curves(sens)
+        >>> [ax.get_xlabel() for ax in fig.axes]
+        ['x (m)', 't']
+    """
+    if not isinstance(sens, Sensitivity):
+        raise GPMSAError(f"sens must be a Sensitivity, got {type(sens).__name__}")
+    if sens.main_effect is None:
+        raise GPMSAError("sens has no main-effect functions: compute them with "
+                         "gpmsa.sensitivity(..., main_effect_grid=G)")  # fmt: skip
+    level = check_level(level)
+    l_sim = sens.main_effect.shape[2]
+    output = check_count(output, "output", 0, l_sim - 1)
+    q = [(1 - level) / 2, (1 + level) / 2]
+    d = len(sens.names)
+    cols = min(d, 4)
+    rows = -(-d // cols)
+    fig = figure(3.2 * cols, 2.8 * rows)
+    axes = fig.subplots(rows, cols, squeeze=False, sharey=True).ravel()
+    curves = sens.main_effect[:, :, output, :]  # (S, G, d)
+    spread = curves.shape[0] > 1
+    y_name = sens.y_names[output] if output < len(sens.y_names) else "y"
+    y_unit = sens.y_units[output] if output < len(sens.y_units) else ""
+    for k, name in enumerate(sens.names):
+        ax, grid, cur = axes[k], sens.effect_grid[:, k], curves[:, :, k]
+        ax.plot(grid, cur.mean(axis=0), color="C0", label="mean over draws" if spread else None)
+        if spread:
+            lo, hi = np.quantile(cur, q, axis=0)
+            ax.fill_between(grid, lo, hi, color="C0", alpha=0.25,
+                            label=f"{100 * level:.0f} % over draws")  # fmt: skip
+        ax.axhline(float(np.mean(sens.mean[:, output])), color="0.5", ls=":", lw=1)
+        ax.set_xlabel(axis_label(name, sens.units.get(name, "")))
+    axes[0].set_ylabel(axis_label(f"E[{y_name} | input]", y_unit))
+    for ax in axes[d:]:
+        ax.set_visible(False)
+    if spread:
+        axes[0].legend(fontsize="small")
+    where = f" at output {output}" if l_sim > 1 else ""
+    drawn = f"over {curves.shape[0]} draws" if spread else "the point estimate"
+    fig.suptitle(f"main effects{where} ({drawn})", fontsize="small")
     return fig

@@ -21,6 +21,14 @@ The same is reported per basis component (V^u_jj) and for the variance summed ov
 The spread over draws shows how well the emulator pins the indices down. An output element whose
 variance over the box is below 1e-12 of the largest has undefined indices (NaN).
 
+Opt-in (SEPIA's ``varlist`` and ``jelist`` of pairs, ``ngrid``): for pairs u = {k, l} the
+closed joint index S_{kl} = V_{k,l} / V and the two-factor interaction index
+S_kl = (V_{k,l} - V_k - V_l) / V (the second-order Sobol index), from the same sums with two
+inputs' pair integrals; the main-effect functions E[y_l | z_k = g] on an even grid g over z_k's
+range, and the joint-effect functions E[y_l | z_k = g, z_k' = h] on a grid of grids: with the
+other inputs integrated out, each is a sum over the runs of Gaussians in the gridded inputs (no
+Monte Carlo either). Like the indices, they are the emulator mean's, per posterior draw.
+
 Numerics: each one-dimensional integral over a narrow range (a box of width 1e-6 of the
 domain, say) is computed by Gauss-Legendre quadrature rather than as a difference of error
 functions, which would cancel and give indices wrong by percents; the variances are differences
@@ -30,6 +38,7 @@ or 1 just outside [0, 1], so the indices are clipped to [0, 1].
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,7 +47,7 @@ from scipy.special import erf, erfc
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.model.data import as_real, check_flag, check_level
+from gpmsa.model.data import as_real, check_count, check_flag, check_level
 from gpmsa.predictive._common import draws_text, factors, gpmsa_model_only, param_sets, unit_inputs
 
 _SQRT_PI_2 = 0.5 * np.sqrt(np.pi)
@@ -64,6 +73,22 @@ class Sensitivity:
             its grid (one number per input for a functional output; = main/total for l_sim 1).
         variance: (S, l_sim) variance of the emulator mean over the box, native units^2.
         mean: (S, l_sim) its mean over the box, native units.
+        units: name -> unit of each varied input; y_names, y_units: (l_sim,) the outputs'.
+        pairs: (P,) the pairs of varied inputs asked for (``sensitivity(pairs=)``; () if none).
+        joint, interaction: (S, l_sim, P) closed joint index V_{k,l} / V and interaction index
+            (V_{k,l} - V_k - V_l) / V of each pair (SEPIA's ``sje``, ``sie``); None without
+            pairs. ``joint_pc``, ``interaction_pc`` (S, p_u, P) per basis component,
+            ``joint_aggregated``, ``interaction_aggregated`` (S, P) over the output grid.
+        effect_grid: (G, d) native values of each varied input (column k: G evenly spaced
+            points over its range) where ``main_effect`` is given; None if not asked for.
+        main_effect: (S, G, l_sim, d) main-effect functions E[y | z_k = effect_grid[:, k]] of
+            the emulator mean (the other inputs integrated over the box), native output units
+            (SEPIA's ``mef``); None if not asked for.
+        joint_grid: (G2, d) native grid of each varied input for ``joint_effect``; None if not
+            asked for.
+        joint_effect: (S, G2, G2, l_sim, P) joint-effect functions E[y | z_k = joint_grid[a, k],
+            z_k' = joint_grid[b, k']] of each pair (k, k') (SEPIA's ``jef``); None if not asked
+            for.
     """
 
     names: tuple[str, ...]
@@ -79,22 +104,54 @@ class Sensitivity:
     total_aggregated: np.ndarray
     variance: np.ndarray
     mean: np.ndarray = field(repr=False)
+    units: dict[str, str] = field(default_factory=dict, repr=False)
+    y_names: tuple[str, ...] = field(default=(), repr=False)
+    y_units: tuple[str, ...] = field(default=(), repr=False)
+    pairs: tuple[tuple[str, str], ...] = ()
+    joint: np.ndarray | None = field(default=None, repr=False)
+    interaction: np.ndarray | None = field(default=None, repr=False)
+    joint_pc: np.ndarray | None = field(default=None, repr=False)
+    interaction_pc: np.ndarray | None = field(default=None, repr=False)
+    joint_aggregated: np.ndarray | None = field(default=None, repr=False)
+    interaction_aggregated: np.ndarray | None = field(default=None, repr=False)
+    effect_grid: np.ndarray | None = field(default=None, repr=False)
+    main_effect: np.ndarray | None = field(default=None, repr=False)
+    joint_grid: np.ndarray | None = field(default=None, repr=False)
+    joint_effect: np.ndarray | None = field(default=None, repr=False)
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
         """Per input: the aggregated main and total indices, their mean, sd and central
         interval of probability ``level`` over the draws."""
         level = check_level(level)
+        kinds = (("main", self.main_aggregated), ("total", self.total_aggregated))
+        return {name: _spread(kinds, k, level) for k, name in enumerate(self.names)}
+
+    def pair_summary(self, level: float = 0.9) -> dict[tuple[str, str], dict[str, float]]:
+        """Per pair of ``pairs``: the aggregated joint and interaction indices, their mean, sd
+        and central interval of probability ``level`` over the draws (as ``summary``)."""
+        level = check_level(level)
+        if self.joint_aggregated is None:
+            raise GPMSAError("these indices have no pairs: call sensitivity(..., pairs=[(a, b)]) "
+                             "or pairs='all'")  # fmt: skip
+        kinds = (("joint", self.joint_aggregated), ("interaction", self.interaction_aggregated))
+        return {pair: _spread(kinds, p, level) for p, pair in enumerate(self.pairs)}
+
+    def main_effect_summary(self, level: float = 0.9) -> dict[str, dict[str, np.ndarray]]:
+        """Per varied input: its grid ``"grid"`` (G,) and the main-effect function's mean,
+        sd and central interval of probability ``level`` over the draws, ``"mean"``, ``"sd"``,
+        ``"lo"``, ``"hi"`` (G, l_sim), native output units."""
+        level = check_level(level)
+        if self.main_effect is None:
+            raise GPMSAError("these indices have no main-effect functions: call "
+                             "sensitivity(..., main_effect_grid=G)")  # fmt: skip
         q = [(1 - level) / 2, (1 + level) / 2]
         out = {}
         for k, name in enumerate(self.names):
-            row = {}
-            for kind, arr in (("main", self.main_aggregated), ("total", self.total_aggregated)):
-                col = arr[:, k]
-                lo, hi = np.quantile(col, q)
-                sd = float(np.std(col, ddof=1)) if col.size > 1 else 0.0
-                row.update({kind: float(col.mean()), f"{kind}_sd": sd,
-                            f"{kind}_lo": float(lo), f"{kind}_hi": float(hi)})  # fmt: skip
-            out[name] = row
+            cur = self.main_effect[..., k]
+            lo, hi = np.quantile(cur, q, axis=0)
+            sd = np.std(cur, axis=0, ddof=1) if cur.shape[0] > 1 else np.zeros(cur.shape[1:])
+            out[name] = {"grid": self.effect_grid[:, k], "mean": cur.mean(axis=0), "sd": sd,
+                         "lo": lo, "hi": hi}  # fmt: skip
         return out
 
     def __repr__(self) -> str:
@@ -104,6 +161,20 @@ class Sensitivity:
         more = f", +{d - shown} more" if d > shown else ""
         return (f"Sensitivity({d} inputs, {len(self.fixed)} fixed, {np.size(self.grid)} outputs, "
                 f"{draws_text(self.draw_index)}, total effect: {effects}{more})")  # fmt: skip
+
+
+def _spread(kinds, k: int, level: float) -> dict[str, float]:
+    """Mean, sd and central interval of probability ``level`` over the draws of column ``k``
+    of each (name, (S, n) array) in ``kinds``, keyed name, name_sd, name_lo, name_hi."""
+    q = [(1 - level) / 2, (1 + level) / 2]
+    row = {}
+    for kind, arr in kinds:
+        col = arr[:, k]
+        lo, hi = np.quantile(col, q)
+        sd = float(np.std(col, ddof=1)) if col.size > 1 else 0.0
+        row.update({kind: float(col.mean()), f"{kind}_sd": sd,
+                    f"{kind}_lo": float(lo), f"{kind}_hi": float(hi)})  # fmt: skip
+    return row
 
 
 def _mean_gauss(gamma: float, c: np.ndarray, a: float, b: float) -> np.ndarray:
@@ -140,21 +211,28 @@ def _pair_integral(al: float, be: float, p: np.ndarray, q: np.ndarray, a: float,
     return np.exp(-(al * be / g) * (P - Q) ** 2) * _mean_gauss(g, (al * P + be * Q) / g, a, b)
 
 
-def _component_moments(zt, coef, beta, varied, lo, hi):
-    """Per pair (j, j'): the covariances V^u for u = every varied input, each single input and
-    each complement. Returns Vall (p_u, p_u), Vmain (d, p_u, p_u), Vcomp (d, p_u, p_u)."""
-    p_u = coef.shape[0]
-    d = len(varied)
-    # I1[j, k]: (m,) mean of exp(-beta_kj (z_k - z_ik)^2) over the varied input k's range
-    I1 = np.empty((p_u, d, zt.shape[0]))
-    for j in range(p_u):
+def _single_means(zt, beta, varied, lo, hi) -> np.ndarray:
+    """I1[j, n]: (m,) means of exp(-beta_kj (z_k - z_ik)^2) over the varied input k =
+    varied[n]'s range, for each basis component j: (p_u, d, m)."""
+    I1 = np.empty((beta.shape[1], len(varied), zt.shape[0]))
+    for j in range(beta.shape[1]):
         for n, k in enumerate(varied):
             I1[j, n] = _mean_gauss(beta[k, j], zt[:, k], lo[n], hi[n])
+    return I1
+
+
+def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=()):
+    """Per pair (j, j'): the covariances V^u for u = every varied input, each single input,
+    each complement and each pair (a, b) of ``pairs`` (positions in ``varied``). Returns mu
+    (p_u,), Vall (p_u, p_u), Vmain (d, p_u, p_u), Vcomp (d, p_u, p_u), Vpair (P, p_u, p_u)."""
+    p_u = coef.shape[0]
+    d = len(varied)
     P1 = np.prod(I1, axis=1)  # (p_u, m)
     mu = np.sum(coef * P1, axis=1)  # (p_u,)
     Vall = np.empty((p_u, p_u))
     Vmain = np.empty((d, p_u, p_u))
     Vcomp = np.empty((d, p_u, p_u))
+    Vpair = np.empty((len(pairs), p_u, p_u))
     for j in range(p_u):
         for jj in range(j, p_u):
             I2 = [_pair_integral(beta[k, j], beta[k, jj], zt[:, k], zt[:, k], lo[n], hi[n])
@@ -174,19 +252,74 @@ def _component_moments(zt, coef, beta, varied, lo, hi):
                 Vmain[n, j, jj] = (coef[j] * rest_j) @ I2[n] @ (coef[jj] * rest_jj) - base
                 comp = prefix[n] * suffix[n + 1]
                 Vcomp[n, j, jj] = (coef[j] * I1[j, n]) @ comp @ (coef[jj] * I1[jj, n]) - base
+            for p, (a, b) in enumerate(pairs):
+                rest_j = np.prod(np.delete(I1[j], (a, b), axis=0), axis=0)
+                rest_jj = np.prod(np.delete(I1[jj], (a, b), axis=0), axis=0)
+                Vpair[p, j, jj] = (coef[j] * rest_j) @ (I2[a] * I2[b]) @ (coef[jj] * rest_jj) - base
             Vall[jj, j] = Vall[j, jj]
             Vmain[:, jj, j] = Vmain[:, j, jj]
             Vcomp[:, jj, j] = Vcomp[:, j, jj]
-    return mu, Vall, Vmain, Vcomp
+            Vpair[:, jj, j] = Vpair[:, j, jj]
+    return mu, Vall, Vmain, Vcomp, Vpair
 
 
-def _memory_estimate(m: int, d: int, p_u: int, S: int, l_sim: int) -> float:
+def _gaussians(gamma: float, grid: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(G, m) exp(-gamma (g - c_i)^2) of the grid values g against the runs' c."""
+    return np.exp(-gamma * (grid[:, None] - c[None, :]) ** 2)
+
+
+def _main_effects(zt, coef, beta, varied, I1, grid) -> np.ndarray:
+    """(p_u, G, d) E[f_j | z_k = grid[:, n]] (k = varied[n]; unit scale, standardised), the
+    other varied inputs integrated out (their I1)."""
+    p_u, d = coef.shape[0], len(varied)
+    out = np.empty((p_u, grid.shape[0], d))
+    for j in range(p_u):
+        for n, k in enumerate(varied):
+            rest = np.prod(np.delete(I1[j], n, axis=0), axis=0)
+            out[j, :, n] = _gaussians(beta[k, j], grid[:, n], zt[:, k]) @ (coef[j] * rest)
+    return out
+
+
+def _joint_effects(zt, coef, beta, varied, I1, grid, pairs) -> np.ndarray:
+    """(p_u, G2, G2, P) E[f_j | z_k = grid[a_idx, a], z_k' = grid[b_idx, b]] for each pair
+    (a, b) of positions in ``varied`` (unit scale, standardised)."""
+    p_u = coef.shape[0]
+    out = np.empty((p_u, grid.shape[0], grid.shape[0], len(pairs)))
+    for j in range(p_u):
+        for p, (a, b) in enumerate(pairs):
+            ka, kb = varied[a], varied[b]
+            rest = coef[j] * np.prod(np.delete(I1[j], (a, b), axis=0), axis=0)
+            Ga = _gaussians(beta[ka, j], grid[:, a], zt[:, ka])
+            Gb = _gaussians(beta[kb, j], grid[:, b], zt[:, kb])
+            out[j, :, :, p] = (Ga * rest) @ Gb.T
+    return out
+
+
+def _memory_estimate(
+    m: int,
+    d: int,
+    p_u: int,
+    S: int,
+    l_sim: int,
+    n_pairs: int = 0,
+    n_grid: int = 0,
+    n_joint: int = 0,
+) -> float:
     """Bytes that ``sensitivity`` needs at once: per draw the factors of Sigma_W (about 2 p_u
     + 2 arrays m x m) and ``_component_moments``' pair integrals with their prefix and suffix
     products (about 4 d + 6 of them; the peaks measured for m = 200, d <= 6, p_u <= 4 stayed
-    below this), and the indices kept over the S draws."""
+    below this), and the indices kept over the S draws. With ``n_pairs`` pairs: two m x m
+    arrays more (a pair's product and its matrix-vector product's temporaries) and 6 indices
+    per pair, output element and component per draw; with a main-effect grid of ``n_grid``
+    points: its (n_grid, m) Gaussians and the curves (S, n_grid, l_sim, d) with their
+    per-draw pieces; with a joint grid of ``n_joint`` points: two (n_joint, m) Gaussians and
+    the surfaces (S, n_joint^2, l_sim, n_pairs) with theirs."""
     return 8.0 * (
-        m * m * (4.0 * d + 8.0 + 2.0 * p_u) + S * (2.0 * d * (l_sim + p_u + 1) + 2.0 * l_sim)
+        m * m * (4.0 * d + 8.0 + 2.0 * p_u + (2.0 if n_pairs else 0.0))
+        + S * (2.0 * d * (l_sim + p_u + 1) + 2.0 * l_sim)
+        + 2.0 * S * n_pairs * (l_sim + p_u + 1)
+        + n_grid * (2.0 * m + (S + 2.0) * l_sim * d + p_u * d)
+        + n_joint * (3.0 * m + n_joint * n_pairs * ((S + 2.0) * l_sim + p_u))
     )
 
 
@@ -207,6 +340,41 @@ def _name_dict(value, what: str) -> dict:
     return dict(value)
 
 
+def _pair_positions(pairs, names: list[str], fixed: dict) -> list[tuple[int, int]]:
+    """``pairs`` ("all", or pairs of varied input names) as positions in ``names``;
+    GPMSAError naming the problem (a name unknown or fixed, one input twice, a pair twice)."""
+    if isinstance(pairs, str):
+        if pairs != "all":
+            raise GPMSAError(f"pairs must be 'all' or a list of pairs of input names, got "
+                             f"{pairs!r}")  # fmt: skip
+        if len(names) < 2:
+            raise GPMSAError(f"pairs='all' needs at least 2 varied inputs; {tuple(names)} vary")
+        return list(itertools.combinations(range(len(names)), 2))
+    if not isinstance(pairs, list | tuple) or not pairs:
+        raise GPMSAError(f"pairs must be 'all' or a non-empty list of pairs of input names, "
+                         f"e.g. [('a', 'b')], got {pairs!r}")  # fmt: skip
+    out, seen = [], set()
+    for pair in pairs:
+        if isinstance(pair, str) or not isinstance(pair, list | tuple) or len(pair) != 2:
+            raise GPMSAError(f"each of pairs must be a pair of input names (a, b), got {pair!r} "
+                             f"(one pair: pairs=[(a, b)])")  # fmt: skip
+        for name in pair:
+            if name in fixed:
+                raise GPMSAError(f"pairs names {name!r}, an input held fixed; the varied inputs "
+                                 f"are {tuple(names)}")  # fmt: skip
+            if not isinstance(name, str) or name not in names:
+                raise GPMSAError(f"pairs names an unknown input {name!r}; the varied inputs are "
+                                 f"{tuple(names)}")  # fmt: skip
+        if pair[0] == pair[1]:
+            raise GPMSAError(f"pairs names one input twice in {tuple(pair)}; a pair is two inputs")
+        key = frozenset(pair)
+        if key in seen:
+            raise GPMSAError(f"pairs lists the pair {tuple(pair)} twice")
+        seen.add(key)
+        out.append((names.index(pair[0]), names.index(pair[1])))
+    return out
+
+
 def sensitivity(
     emulator,
     *,
@@ -214,6 +382,9 @@ def sensitivity(
     fixed: dict | None = None,
     draws: bool = True,
     n_draws: int | None = 100,
+    pairs: str | list | None = None,
+    main_effect_grid: int | None = None,
+    joint_effect_grid: int | None = None,
 ) -> Sensitivity:
     """Sobol main- and total-effect indices of the emulator's mean, over posterior draws.
 
@@ -226,10 +397,21 @@ def sensitivity(
             operating point).
         draws: indices for each retained posterior draw (True) or the point estimate only.
         n_draws: at most this many draws, evenly spaced (None: all retained draws).
+        pairs: pairs of varied inputs, [("a", "b"), ...], or "all": their closed joint and
+            two-factor interaction indices (``joint``, ``interaction``; SEPIA's ``jelist``
+            and ``varlist`` of pairs).
+            None (default): none.
+        main_effect_grid: G >= 2 points per varied input, evenly spaced over its range: the
+            main-effect functions E[y | z_k] there (``main_effect``, ``effect_grid``; SEPIA's
+            ``ngrid``). None (default): none.
+        joint_effect_grid: G2 >= 2 points per input of each pair: the joint-effect functions
+            E[y | z_k, z_k'] on the G2 x G2 grid (``joint_effect``, ``joint_grid``); needs
+            ``pairs``. None (default): none.
 
     Returns:
         Sensitivity with indices per draw, per output element, per basis component and
-        aggregated over the output grid.
+        aggregated over the output grid (and, when asked for, per pair and the effect
+        functions per draw).
 
     Example:
         >>> import numpy as np, gpmsa
@@ -244,6 +426,9 @@ def sensitivity(
         >>> s = sens.summary()
         >>> s["x"]["main"] > 0.8 and s["b"]["total"] < 0.05
         True
+        >>> sens = gpmsa.sensitivity(emu, n_draws=10, pairs="all", main_effect_grid=5)
+        >>> sens.pairs, sens.interaction.shape, sens.main_effect.shape   # (S, G, l_sim, d)
+        ((('x', 'a'), ('x', 'b'), ('a', 'b')), (10, 1, 3), (10, 5, 1, 3))
     """
     gpmsa_model_only(emulator, "sensitivity")
     std = emulator.standardizer
@@ -275,6 +460,14 @@ def sensitivity(
         hi_n.append(b)
         box[name] = (a, b)
     k_names = [names[k] for k in varied]
+    pair_pos = [] if pairs is None else _pair_positions(pairs, k_names, fixed)
+    n_grid = 0 if main_effect_grid is None else check_count(main_effect_grid, "main_effect_grid", 2)
+    n_joint = 0
+    if joint_effect_grid is not None:
+        n_joint = check_count(joint_effect_grid, "joint_effect_grid", 2)
+        if not pair_pos:
+            raise GPMSAError("joint_effect_grid needs pairs (whose joint-effect functions to "
+                             "compute): pass pairs=[(a, b)] or pairs='all'")  # fmt: skip
     _, ends = unit_inputs([lo_n, hi_n], k_names, lo_all[varied], hi_all[varied], "bounds")
     lo_u, hi_u = ends[0], ends[1]
     zt = emulator.zt.copy()
@@ -288,9 +481,13 @@ def sensitivity(
         fix_u[k] = float(u[0, 0])
     idx, sets = param_sets(emulator, draws, n_draws, "sensitivity")
     S, l_sim, p_u, d = len(sets), emulator.l_sim, emulator.p_u, len(varied)
-    check_memory(_memory_estimate(emulator.m, d, p_u, S, l_sim),
+    P = len(pair_pos)
+    extra = "".join([f", {P} pairs" if P else "",
+                     f", main effects on {n_grid} points" if n_grid else "",
+                     f", joint effects on {n_joint}^2 points" if n_joint else ""])  # fmt: skip
+    check_memory(_memory_estimate(emulator.m, d, p_u, S, l_sim, P, n_grid, n_joint),
                  f"sensitivity() of an emulator of {emulator.m} runs x {p_u} basis components "
-                 f"over {d} varied inputs (about {4 * d + 8 + 2 * p_u} arrays of "
+                 f"over {d} varied inputs{extra} (about {4 * d + 8 + 2 * p_u} arrays of "
                  f"{emulator.m} x {emulator.m} at once)")  # fmt: skip
     KtK = emulator.K.T @ emulator.K
     K = emulator.K
@@ -299,6 +496,20 @@ def sensitivity(
     out_agg = {k: np.empty((S, d)) for k in ("main", "total")}
     variance = np.empty((S, l_sim))
     mean = np.empty((S, l_sim))
+    out_pair = {k: np.empty((S, l_sim, P)) for k in ("joint", "interaction")} if P else {}
+    out_pair_pc = {k: np.empty((S, p_u, P)) for k in ("joint", "interaction")} if P else {}
+    out_pair_agg = {k: np.empty((S, P)) for k in ("joint", "interaction")} if P else {}
+    a_pos, b_pos = [a for a, _ in pair_pos], [b for _, b in pair_pos]
+    y_mean, y_sd = np.asarray(std.y_mean, dtype=float), std.y_sd
+    effect_grid = main_effect = joint_grid = joint_effect = None
+    if n_grid:
+        effect_grid = np.linspace(lo_n, hi_n, n_grid)  # (G, d), native
+        grid_u = np.linspace(lo_u, hi_u, n_grid)
+        main_effect = np.empty((S, n_grid, l_sim, d))
+    if n_joint:
+        joint_grid = np.linspace(lo_n, hi_n, n_joint)
+        joint_u = np.linspace(lo_u, hi_u, n_joint)
+        joint_effect = np.empty((S, n_joint, n_joint, l_sim, P))
     with blas_controller().limit(limits=1, user_api="blas"):
         for i, prm in enumerate(sets):
             beta = prm["betaU"]
@@ -306,7 +517,9 @@ def sensitivity(
                              enumerate(factors(emulator, prm))])  # fmt: skip
             for k, u in fix_u.items():
                 coef = coef * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
-            mu, Vall, Vmain, Vcomp = _component_moments(zt, coef, beta, varied, lo_u, hi_u)
+            I1 = _single_means(zt, beta, varied, lo_u, hi_u)
+            mu, Vall, Vmain, Vcomp, Vpair = _component_moments(zt, coef, beta, varied, lo_u,
+                                                               hi_u, I1, pair_pos)  # fmt: skip
             v_l = np.einsum("lj,jk,lk->l", K, Vall, K)
             scale = max(float(v_l.max()), 1e-300)
             main_l = np.einsum("lj,njk,lk->ln", K, Vmain, K)
@@ -326,10 +539,37 @@ def sensitivity(
                                                scale_sum)  # fmt: skip
             variance[i] = v_l * std.y_sd**2
             mean[i] = K @ mu * std.y_sd + std.y_mean
+            if P:
+                # V_{k,l} and its interaction part V_{k,l} - V_k - V_l, per output element,
+                # component and summed over the grid, each over the variance as above
+                Vint = Vpair - Vmain[a_pos] - Vmain[b_pos]
+                for kind, Vu in (("joint", Vpair), ("interaction", Vint)):
+                    out_pair[kind][i] = _ratio(np.einsum("lj,njk,lk->ln", K, Vu, K),
+                                               v_l[:, None], scale)  # fmt: skip
+                    out_pair_pc[kind][i] = _ratio(np.diagonal(Vu, axis1=1, axis2=2).T,
+                                                  v_pc[:, None], scale_pc)  # fmt: skip
+                    out_pair_agg[kind][i] = _ratio(np.einsum("jk,njk->n", KtK, Vu), v_sum,
+                                                   scale_sum)  # fmt: skip
+            if n_grid:
+                E = _main_effects(zt, coef, beta, varied, I1, grid_u)  # (p_u, G, d)
+                main_effect[i] = y_mean[None, :, None] + y_sd * np.einsum("lj,jgn->gln", K, E)
+            if n_joint:
+                E = _joint_effects(zt, coef, beta, varied, I1, joint_u, pair_pos)
+                joint_effect[i] = y_mean[:, None] + y_sd * np.einsum("lj,jabp->ablp", K, E)
     return Sensitivity(
         names=tuple(k_names), bounds=box,
         fixed={k: float(v) for k, v in fixed.items()}, draw_index=idx, grid=std.grid,
         main=out["main"], total=out["total"], main_pc=out_pc["main"], total_pc=out_pc["total"],
         main_aggregated=out_agg["main"], total_aggregated=out_agg["total"],
         variance=variance, mean=mean,
+        units={n: u for n, u in zip(names, (*emulator.x_units, *emulator.t_units), strict=True)
+               if n in box},
+        y_names=tuple(emulator.y_names), y_units=tuple(emulator.y_units),
+        pairs=tuple((k_names[a], k_names[b]) for a, b in pair_pos),
+        joint=out_pair.get("joint"), interaction=out_pair.get("interaction"),
+        joint_pc=out_pair_pc.get("joint"), interaction_pc=out_pair_pc.get("interaction"),
+        joint_aggregated=out_pair_agg.get("joint"),
+        interaction_aggregated=out_pair_agg.get("interaction"),
+        effect_grid=effect_grid, main_effect=main_effect, joint_grid=joint_grid,
+        joint_effect=joint_effect,
     )  # fmt: skip
