@@ -16,8 +16,9 @@ interpolation, constraint boundaries, draws, refinement).
 More parameters use the MCMC of ``gpmsa.calibrate``.
 
 The fixed grid (``Calibrator.theta_grid``): ``n_grid`` equally spaced nodes per calibration
-parameter spanning the emulator's training range [t_min, t_max] of that parameter, end points
-included (default 129 for one parameter, 65 x 65 for two, in 'ij' order, first parameter slowest).
+parameter spanning the emulator's domain [t_min, t_max] of that parameter (the design's range,
+or the range given as ``SimData(t_range=)``), end points included (default 129 for one
+parameter, 65 x 65 for two, in 'ij' order, first parameter slowest).
 """
 
 from __future__ import annotations

@@ -116,6 +116,8 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
         for n, u in zip(names, units[kind], strict=True):
             dom = manifest["domain"].get(n) if kind != "y" else None
             rng = f" in [{dom[0]:.6g}, {dom[1]:.6g}]" if dom else ""
+            if dom and n in (model.get("input_ranges") or ()):
+                rng += " (range given, design inside)"
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
         lines.append(f"{label + ':':17s}{', '.join(parts) or 'none'}")
     cat = model.get("categorical") or {}

@@ -358,7 +358,8 @@ class Emulator:
 
     @property
     def domain(self) -> dict[str, tuple[float, float]]:
-        """Training range of every input, native units: name -> (lo, hi)."""
+        """The unit domain of every input, native units: name -> (lo, hi); the design's range,
+        or the range the user gave (``given_ranges``)."""
         s = self.standardizer
         out = {
             n: (float(a), float(b)) for n, a, b in zip(self.x_names, s.x_min, s.x_max, strict=True)
@@ -370,6 +371,12 @@ class Emulator:
             }
         )
         return out
+
+    @property
+    def given_ranges(self) -> tuple[str, ...]:
+        """The inputs whose unit domain is the range the user gave (``SimData(x_range=,
+        t_range=)``), not the design's min/max; ``domain`` holds it."""
+        return self.standardizer.ranged(self.x_names + self.t_names)
 
     @property
     def categorical(self) -> dict[str, tuple[int, ...]]:
@@ -704,6 +711,9 @@ class Emulator:
             "metadata": self.metadata,
             "diagnostics": self.diagnostics,
         }
+        ranged = self.given_ranges
+        if ranged:  # only then: a file without given ranges is written as before
+            manifest["model"]["input_ranges"] = list(ranged)
         _check_metadata(self.metadata, "metadata")
         if self.convergence is not None:
             manifest["convergence"] = self.convergence
@@ -774,8 +784,13 @@ class Emulator:
         except GPMSAError as exc:
             raise EmulatorFileError(str(exc)) from exc
         try:
-            std = Standardizer(**{k: arrays[k] for k in STD_FIELDS}, y_sd=float(arrays["y_sd"][0]))
             names = {k: tuple(manifest["names"][k]) for k in ("x", "t", "y")}
+            ranged = manifest["model"].get("input_ranges", [])  # check_fields checked it
+            std = Standardizer(
+                **{k: arrays[k] for k in STD_FIELDS}, y_sd=float(arrays["y_sd"][0]),
+                x_ranged=tuple(n in ranged for n in names["x"]) if ranged else (),
+                t_ranged=tuple(n in ranged for n in names["t"]) if ranged else (),
+            )  # fmt: skip
             units = {k: tuple(manifest["units"][k]) for k in ("x", "t", "y")}
             draws = {k[5:]: v for k, v in arrays.items() if k.startswith("draw_")}
             cal = {k[4:]: v for k, v in arrays.items() if k.startswith("cal_")} or None

@@ -644,10 +644,36 @@ def _check_model_options(model: dict, inputs: list[str]) -> None:
         if not ok or levels != sorted(set(levels)):
             raise _fail(field, f"must be a sorted list of >= 2 distinct integers, got "
                         f"{_short(levels)}")  # fmt: skip
+    if "input_ranges" in model:  # absent in files without given ranges (all before it)
+        _check_input_ranges(model["input_ranges"], inputs, cat)
     kind = model.get("mean_basis")
     if kind is not None and kind not in MEAN_BASIS_KINDS:
         raise _fail("model.mean_basis",
                     f"must be null or one of {MEAN_BASIS_KINDS}, got {_short(kind)}")  # fmt: skip
+
+
+def _check_input_ranges(ranged, inputs: list[str], cat: dict) -> None:
+    """model.input_ranges: the inputs whose unit domain (x/t min and max) is a range the user
+    gave (``SimData(x_range=, t_range=)``): distinct input names, none categorical."""
+    ok = isinstance(ranged, list) and ranged and all(isinstance(n, str) for n in ranged)
+    if not ok or len(set(ranged)) != len(ranged):
+        raise _fail("model.input_ranges", f"must be a non-empty list of distinct input names, "
+                    f"got {_short(ranged)}")  # fmt: skip
+    for name in ranged:
+        if name not in inputs:
+            raise _fail("model.input_ranges",
+                        f"{_short(name)} is not an input (inputs {_short(inputs)})")  # fmt: skip
+        if name in cat:
+            raise _fail("model.input_ranges", f"{_short(name)} is categorical: its unit scale is "
+                        "its levels', never a given range")  # fmt: skip
+
+
+def ranged_columns(manifest: dict, dims: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
+    """Per x and t column, whether its unit domain is a given range (model.input_ranges,
+    checked by ``check_fields``): such a design column lies in [0, 1] without spanning it."""
+    ranged = manifest["model"].get("input_ranges", [])
+    return (np.array([n in ranged for n in manifest["names"]["x"]], dtype=bool),
+            np.array([n in ranged for n in manifest["names"]["t"]], dtype=bool))  # fmt: skip
 
 
 def check_categorical(manifest: dict, arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
@@ -713,13 +739,16 @@ def _positive(arrays: dict[str, np.ndarray], name: str) -> np.ndarray:
     return a
 
 
-def _in_unit(arrays: dict[str, np.ndarray], name: str, span: bool) -> None:
+def _in_unit(arrays: dict[str, np.ndarray], name: str, span) -> None:
+    """arrays[name] finite and in [0, 1]; where ``span`` (True, False, or one bool per
+    column: a design column whose range was given lies inside [0, 1] without spanning it)
+    each column spanning [0, 1]."""
     a = _finite(arrays, name)
     if a.size and (a.min() < -UNIT_TOL or a.max() > 1 + UNIT_TOL):
         raise _fail(f"arrays/{name}", f"must lie in [0, 1], spans [{a.min():.6g}, {a.max():.6g}]")
-    if span and a.size:
+    if a.size and np.any(span):
         lo, hi = a.min(axis=0), a.max(axis=0)
-        k = np.flatnonzero((lo > UNIT_TOL) | (hi < 1 - UNIT_TOL))
+        k = np.flatnonzero(span & ((lo > UNIT_TOL) | (hi < 1 - UNIT_TOL)))
         if k.size:
             j = int(k[0])
             raise _fail(
@@ -729,10 +758,15 @@ def _in_unit(arrays: dict[str, np.ndarray], name: str, span: bool) -> None:
             )
 
 
-def check_values(arrays: dict[str, np.ndarray], dims: dict[str, int]) -> None:
-    """Finite values, ranges, positive scales and the file's internal redundancies."""
-    _in_unit(arrays, "x_unit", span=True)
-    _in_unit(arrays, "t_unit", span=True)
+def check_values(
+    arrays: dict[str, np.ndarray], dims: dict[str, int], ranged: tuple | None = None
+) -> None:
+    """Finite values, ranges, positive scales and the file's internal redundancies. ``ranged``:
+    per x and t column whether its range was given (`ranged_columns`; None: none), where the
+    design lies inside [0, 1] without spanning it."""
+    x_span, t_span = (True, True) if ranged is None else (~ranged[0], ~ranged[1])
+    _in_unit(arrays, "x_unit", span=x_span)
+    _in_unit(arrays, "t_unit", span=t_span)
     for lo_name, hi_name in (("x_min", "x_max"), ("t_min", "t_max")):
         lo, hi = _finite(arrays, lo_name), _finite(arrays, hi_name)
         bad = np.flatnonzero(~(lo < hi))
@@ -822,7 +856,7 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     check_prior_groups(manifest["priors"], shapes)
     check_discrepancy_record(manifest["settings"], shapes)
     held = check_fixed_record(manifest["settings"], shapes)
-    check_values(arrays, dims)
+    check_values(arrays, dims, ranged_columns(manifest, dims))
     check_discrepancy_bases(manifest["settings"], arrays)
     check_fixed_draws(held, arrays)
     check_categorical(manifest, arrays, dims)

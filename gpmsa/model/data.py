@@ -452,6 +452,61 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
             )
 
 
+def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...], attr: str):
+    """``SimData``'s ``x_range`` / ``t_range`` as one (min, max) or None per column of ``arr``
+    (None where no column is given); GPMSAError naming the column for a range that is not two
+    finite numbers min < max (a width float64 holds), that a design column leaves, or that is
+    given for a categorical column (whose unit scale is its levels')."""
+    if value is None:
+        return None
+    d = arr.shape[1]
+    if isinstance(value, dict):
+        rows = [None] * d
+        for name, pair in value.items():
+            if name not in names:
+                raise GPMSAError(f"{attr}: {name!r} is not a column; the columns are {names}")
+            rows[names.index(name)] = pair
+    elif isinstance(value, (list, tuple)) and len(value) == d and any(r is None for r in value):
+        rows = list(value)  # as SimData stores it: one (min, max) or None per column
+    else:
+        mat = as_float(value, attr)
+        if mat.ndim != 2 or mat.shape != (d, 2):
+            raise GPMSAError(
+                f"{attr} must be ({d}, 2), one (min, max) per column, or a dict name -> "
+                f"(min, max); got shape {mat.shape} (SEPIA's (2, {d}) layout: transpose it)"
+            )
+        rows = list(mat)
+    out = []
+    for j, pair in enumerate(rows):
+        if pair is None:
+            out.append(None)
+            continue
+        label = f"{attr}[{names[j]}]"
+        lo_hi = as_float(pair, label)
+        if lo_hi.shape != (2,):
+            raise GPMSAError(f"{label} must be (min, max), got {pair!r}")
+        lo, hi = float(lo_hi[0]), float(lo_hi[1])
+        with np.errstate(over="ignore", invalid="ignore"):
+            width = hi - lo
+        tiny = np.finfo(float).tiny * max(1.0, abs(lo), abs(hi))
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
+            raise GPMSAError(f"{label} = ({lo!r}, {hi!r}) must be finite numbers with min < max")
+        if not (np.isfinite(width) and width > tiny):
+            raise GPMSAError(f"{label} = ({lo!r}, {hi!r}): the width {width!r} is not a finite, "
+                             "normal number; rescale the column")  # fmt: skip
+        if j in cats:
+            raise GPMSAError(f"{label}: {names[j]} is categorical; its unit scale is its levels', "
+                             "give no range for it")  # fmt: skip
+        col_lo, col_hi = float(arr[:, j].min()), float(arr[:, j].max())
+        if col_lo < lo or col_hi > hi:
+            raise GPMSAError(
+                f"design column {names[j]} spans [{col_lo:.6g}, {col_hi:.6g}], outside its "
+                f"{attr} [{lo:.6g}, {hi:.6g}]: the range must hold every run"
+            )
+        out.append((lo, hi))
+    return tuple(out) if any(r is not None for r in out) else None
+
+
 def _check_resolution(y: np.ndarray, sd: float) -> None:
     """GPMSAError when the outputs' spread ``sd`` (`output_scale`) is within 1e-13 of the
     largest magnitude of a column that varies: float64 then holds y to about 2e-3 of its spread
@@ -517,6 +572,14 @@ class SimData:
     (rows pair by position).
     ``x_categorical``, ``t_categorical``: the categorical inputs (column indices or names; None:
     none), whose values are integer level codes; see docs/categorical-and-constraints.md.
+    ``x_range``, ``t_range``: the native domain the unit scale maps onto [0, 1] (SEPIA's
+    ``transform_xt(x_range=, t_range=)``), instead of the design's own min/max: an array
+    (p, 2) / (q, 2) of (min, max) per column, or a dict name -> (min, max) for some columns
+    (the others keep the design's min/max; so does a None row). Each finite with min < max,
+    the design inside it (else a GPMSAError naming the column), not for a categorical column.
+    Stored as one ``(min, max)`` or None per column (None: no column given). A theta's uniform
+    prior then covers the whole given range, and an input inside it is inside the emulator's
+    domain (docs/internals.md, "The unit domain").
     """
 
     x: np.ndarray | None = None
@@ -531,6 +594,8 @@ class SimData:
     y_units: tuple[str, ...] | None = None
     x_categorical: Sequence[int | str] | None = None
     t_categorical: Sequence[int | str] | None = None
+    x_range: np.ndarray | Sequence | dict | None = None
+    t_range: np.ndarray | Sequence | dict | None = None
 
     def __post_init__(self) -> None:
         check_same_rows({"x": self.x, "t": self.t, "y": self.y})
@@ -592,6 +657,10 @@ class SimData:
             cols = categorical.columns(getattr(self, attr), names, attr)
             categorical.check_integer_levels(arr, cols, names, attr[0])
             object.__setattr__(self, attr, cols)
+        for part, arr in (("x", x), ("t", t)):
+            attr = f"{part}_range"
+            names, cats = getattr(self, f"{part}_names"), getattr(self, f"{part}_categorical")
+            object.__setattr__(self, attr, _ranges(getattr(self, attr), arr, names, cats, attr))
         _check_rank(x, t, self.x_names, self.t_names)
 
     @property

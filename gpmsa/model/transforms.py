@@ -25,11 +25,26 @@ def snap_to_unit(u: np.ndarray) -> np.ndarray:
     return np.where((u > 1.0) & (u < 1.0 + UNIT_TOL), 1.0, u)
 
 
+def _domain(arr: np.ndarray, ranges) -> tuple[np.ndarray, np.ndarray, tuple[bool, ...]]:
+    """Per column of a design ``arr`` its unit domain (lo, hi) and whether it was given:
+    the design's min/max, or the (min, max) of ``ranges`` (`SimData`'s, None: none given)."""
+    lo, hi = arr.min(axis=0), arr.max(axis=0)
+    if ranges is None:
+        return lo, hi, ()
+    for j, r in enumerate(ranges):
+        if r is not None:
+            lo[j], hi[j] = r
+    return lo, hi, tuple(r is not None for r in ranges)
+
+
 @dataclass(frozen=True, eq=False)
 class Standardizer:
-    """x, t -> [0, 1] by the design's min/max; y -> (y - mean) / sd with one scalar sd.
+    """x, t -> [0, 1] by the design's min/max (or the user's range); y -> (y - mean) / sd with
+    one scalar sd.
 
-    Attributes (native units): ``x_min``, ``x_max`` (p,), ``t_min``, ``t_max`` (q,),
+    Attributes (native units): ``x_min``, ``x_max`` (p,), ``t_min``, ``t_max`` (q,): the unit
+    domain, per column the design's min/max or the range the user gave (``SimData(x_range=,
+    t_range=)``), which ``x_ranged``, ``t_ranged`` flag (one bool per column; empty: none);
     ``y_mean`` (l_sim,) on the simulation grid ``grid`` (l_sim,), ``y_sd`` (scalar, ddof=1).
     """
 
@@ -40,19 +55,33 @@ class Standardizer:
     y_mean: np.ndarray
     y_sd: float
     grid: np.ndarray
+    x_ranged: tuple[bool, ...] = ()
+    t_ranged: tuple[bool, ...] = ()
 
     @classmethod
     def from_sim(cls, sim: SimData) -> Standardizer:
-        """GPM/SA's default transforms fitted to the simulation design and outputs."""
+        """GPM/SA's default transforms fitted to the simulation design and outputs; a column
+        with a given range (``sim.x_range``, ``sim.t_range``) maps that range onto [0, 1]."""
+        x_min, x_max, x_ranged = _domain(sim.x, sim.x_range)
+        t_min, t_max, t_ranged = _domain(sim.t, sim.t_range)
         return cls(
-            x_min=sim.x.min(axis=0),
-            x_max=sim.x.max(axis=0),
-            t_min=sim.t.min(axis=0),
-            t_max=sim.t.max(axis=0),
+            x_min=x_min,
+            x_max=x_max,
+            t_min=t_min,
+            t_max=t_max,
             y_mean=sim.y.mean(axis=0),
             y_sd=output_scale(sim.y),
             grid=sim.grid.copy(),
+            x_ranged=x_ranged,
+            t_ranged=t_ranged,
         )
+
+    def ranged(self, names: tuple[str, ...]) -> tuple[str, ...]:
+        """Of the inputs ``names`` (x names, then t names), those whose range the user gave."""
+        flags = (self.x_ranged or (False,) * self.x_min.size) + (
+            self.t_ranged or (False,) * self.t_min.size
+        )
+        return tuple(n for n, f in zip(names, flags, strict=True) if f)
 
     def x_to_unit(self, x: np.ndarray) -> np.ndarray:
         """Known inputs (n, p) native -> unit scale."""
