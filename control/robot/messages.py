@@ -3,7 +3,8 @@
 Read: ``sensor_msgs/msg/Imu`` (``linear_acceleration``, m/s^2) and ``nav_msgs/msg/Odometry``
 (``pose.pose.position``, m; ``twist.twist.linear``, m/s). Written: ``GD_ESTIMATE_TYPE``, one BCR
 estimate with the Simplex's command, a message type of our own whose definition travels inside
-every bag and MCAP file we write (Foxglove and rosbags read it from there; no ROS package needed).
+every bag and MCAP file we write, comments (units) included (`definition`; Foxglove and rosbags
+read it from there; no ROS package needed).
 
 The CDR (ROS 2) forms of Imu and Odometry are decoded and encoded here with numpy, ~50x faster
 than a generic deserializer: their numeric fields sit at fixed offsets once the length of the
@@ -66,6 +67,22 @@ def typestore():
     store = stores.get_typestore(stores.Stores.ROS2_HUMBLE)
     store.register(stores.get_types_from_msg(GD_ESTIMATE_MSG, GD_ESTIMATE_TYPE))
     return store
+
+
+_MSGDEF_SEPARATOR = "=" * 80 + "\n"
+
+
+def definition(store, msgtype: str) -> tuple[str, str]:
+    """(ros2msg definition text, RIHS01 hash) of ``msgtype`` as a file stores it: rosbags'
+    ``generate_msgdef`` (the type's fields, then for each dependency a line of 80 '=' and
+    ``MSG: <type>`` with its fields), but GD_ESTIMATE_TYPE's own text keeps the comments of
+    GD_ESTIMATE_MSG (its units), as ROS 2's bag writers store a .msg file; comments change
+    neither the fields nor the hash."""
+    text, _ = store.generate_msgdef(msgtype, ros_version=2)
+    if msgtype == GD_ESTIMATE_TYPE:
+        _, sep, deps = text.partition(_MSGDEF_SEPARATOR)
+        text = GD_ESTIMATE_MSG + sep + deps
+    return text, store.hash_rihs01(msgtype)
 
 
 def _align(n: np.ndarray | int, to: int):

@@ -154,7 +154,7 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
             ("imu", msgs.IMU_TYPE), ("odometry", msgs.ODOMETRY_TYPE),
             ("estimate", msgs.GD_ESTIMATE_TYPE), ("gd_true", msgs.FLOAT64_TYPE),
         ):  # fmt: skip
-            definition, _ = store.generate_msgdef(msgtype, ros_version=2)
+            definition, _ = msgs.definition(store, msgtype)
             schema = writer.register_schema(msgtype, "ros2msg", definition.encode())
             channels[key] = writer.register_channel(TOPICS[key], "cdr", schema)
         streams = [

@@ -297,8 +297,9 @@ class ReplayResult:
         level, gd_max = self.bcr.interval_level, self.simplex.gd_max
         datas = [estimate_message(store, row, level, gd_max) for row in self.rows()]
         with open_bag_writer(path, storage) as writer:
+            text, rihs01 = msgs.definition(store, msgs.GD_ESTIMATE_TYPE)
             conn = writer.add_connection(
-                self.settings.estimate_topic, msgs.GD_ESTIMATE_TYPE, typestore=store
+                self.settings.estimate_topic, msgs.GD_ESTIMATE_TYPE, msgdef=text, rihs01=rihs01
             )
             for c, stamp, data in merge_in_time([(conn, self.stamp_ns, datas)]):
                 writer.write(c, stamp, data)
