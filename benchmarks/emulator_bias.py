@@ -229,7 +229,7 @@ def mean_cov(emu, v: float, gd: float) -> np.ndarray:
     GP's variance of each principal component's weight at the point estimate (no nugget)
     through the basis, y_sd^2 K diag(var_w) K'."""
     pred = gpmsa.emulator_prediction(emu, [[v]], [[gd]], draws=False, resid=False, seed=0)
-    basis = pred.K * pred.y_sd
+    basis = pred.K * np.reshape(pred.y_sd, (-1, 1))
     return basis @ np.diag(pred.var_w[0, 0]) @ basis.T
 
 

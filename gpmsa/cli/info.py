@@ -125,6 +125,8 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
         lines.append("categorical:     " + ", ".join(
             f"{safe(n, 60)} levels [{safe(', '.join(str(v) for v in lv), 300)}]"
             for n, lv in cat.items()))  # fmt: skip
+    if standardizer.columnwise:  # one sd over all outputs (GPM/SA's) is not said
+        lines.append("output scale:    columnwise (each output element by its own sd)")
     lines.append(f"basis:           {_basis_line(manifest['settings'], emulator)}")
     mean = model.get("mean_basis")
     lines.append(f"mean basis:      {'zero (GPM/SA)' if mean is None else safe(mean, 60)}")

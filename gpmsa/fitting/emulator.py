@@ -243,7 +243,8 @@ class Emulator:
             object.__setattr__(self, "discrepancy_bases", bases)
         std = self.standardizer
         object.__setattr__(self, "standardizer", dataclasses.replace(
-            std, **{k: _read_only_copy(getattr(std, k)) for k in STD_FIELDS}
+            std, **{k: _read_only_copy(getattr(std, k)) for k in STD_FIELDS},
+            **({"y_sd": _read_only_copy(std.y_sd)} if std.columnwise else {}),
         ))  # fmt: skip
         object.__setattr__(self, "_sealed", True)
 
@@ -732,7 +733,8 @@ class Emulator:
         arrays = {
             "x_unit": self.x_unit, "t_unit": self.t_unit, "y": self.y, "K": self.K, "w": self.w,
             "x_min": s.x_min, "x_max": s.x_max, "t_min": s.t_min, "t_max": s.t_max,
-            "y_mean": s.y_mean, "y_sd": np.array([s.y_sd]), "grid": s.grid,
+            "y_mean": s.y_mean, "y_sd": s.y_sd if s.columnwise else np.array([s.y_sd]),
+            "grid": s.grid,
             "log_post": self.log_post,
         }  # fmt: skip
         if self.index is not None:
@@ -787,7 +789,7 @@ class Emulator:
             names = {k: tuple(manifest["names"][k]) for k in ("x", "t", "y")}
             ranged = manifest["model"].get("input_ranges", [])  # check_fields checked it
             std = Standardizer(
-                **{k: arrays[k] for k in STD_FIELDS}, y_sd=float(arrays["y_sd"][0]),
+                **{k: arrays[k] for k in STD_FIELDS}, y_sd=_y_sd(arrays["y_sd"]),
                 x_ranged=tuple(n in ranged for n in names["x"]) if ranged else (),
                 t_ranged=tuple(n in ranged for n in names["t"]) if ranged else (),
             )  # fmt: skip
@@ -890,6 +892,12 @@ def _levels(manifest: dict, names: dict) -> categorical_mod.Levels:
 def _mean_basis(manifest: dict, names: dict) -> MeanBasis | None:
     kind = manifest["model"].get("mean_basis")
     return None if kind is None else MeanBasis(kind, len(names["x"]) + len(names["t"]))
+
+
+def _y_sd(y_sd: np.ndarray) -> float | np.ndarray:
+    """The Standardizer's ``y_sd`` of a file's array: shape (1,) the one sd (a float); (l_sim,)
+    with l_sim > 1 one per output element (``SimData(y_scale="columnwise")``)."""
+    return float(y_sd[0]) if y_sd.size == 1 else y_sd
 
 
 def _check_consistent(emu: Emulator) -> None:

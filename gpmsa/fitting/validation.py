@@ -25,7 +25,7 @@ import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.model.basis import ORTHOGONAL_TOL, basis_digest
-from gpmsa.model.data import as_float, output_scale
+from gpmsa.model.data import as_float, column_scales, output_scale
 from gpmsa.model.fixed_elements import label
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import MAX_PRIOR_SHAPE, theta_prior_overflow
@@ -105,7 +105,8 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
     pshape = {"betaU": (p + q, p_u), "lamUz": (p_u,), "lamWs": (p_u,), "lamWOs": (1,)}
     want = {
         "t_unit": (m, q), "y": (m, l_sim), "w": (m, p_u), "x_min": (p,), "x_max": (p,),
-        "t_min": (q,), "t_max": (q,), "y_mean": (l_sim,), "grid": (l_sim,), "y_sd": (1,),
+        "t_min": (q,), "t_max": (q,), "y_mean": (l_sim,), "grid": (l_sim,),
+        "y_sd": (l_sim,) if tuple(shapes["y_sd"]) == (l_sim,) else (1,),  # (l_sim,): columnwise
         **{f"param_{k}": v for k, v in pshape.items()},
     }  # fmt: skip
     if "index" in shapes:
@@ -796,18 +797,24 @@ def check_values(
         g = arrays.get(name)
         if g is not None and np.any(np.diff(g) <= 0):
             raise _fail(f"arrays/{name}", "must be strictly increasing (the output grid)")
-    y_sd = float(_positive(arrays, "y_sd")[0])
+    y_sd = _positive(arrays, "y_sd")
+    y_sd = float(y_sd[0]) if y_sd.size == 1 else y_sd  # (l_sim,), l_sim > 1: columnwise
     y, y_mean = arrays["y"], arrays["y_mean"]
     mean = y.mean(axis=0)
     tol = REL_TOL * (y_sd + np.abs(mean))
     if np.any(np.abs(mean - y_mean) > tol):
         raise _fail("arrays/y_mean", "differs from the mean of the training outputs arrays/y")
     try:  # the writer's definition of the output scale (Standardizer.from_sim)
-        sd = output_scale(y)
+        sd = output_scale(y) if np.ndim(y_sd) == 0 else column_scales(y, range(y.shape[1]))
     except GPMSAError as exc:  # zero spread, or a spread that overflows
         raise _fail("arrays/y", str(exc)) from None
-    if abs(sd - y_sd) > REL_TOL * sd:
-        raise _fail("arrays/y_sd", f"{y_sd!r}, but the training outputs' sd is {sd!r}")
+    if np.ndim(y_sd) == 0:
+        if abs(sd - y_sd) > REL_TOL * sd:
+            raise _fail("arrays/y_sd", f"{y_sd!r}, but the training outputs' sd is {sd!r}")
+    elif (bad := np.flatnonzero(np.abs(sd - y_sd) > REL_TOL * sd)).size:
+        k = int(bad[0])
+        raise _fail("arrays/y_sd", f"[{k}] = {y_sd[k]!r}, but the sd of the training outputs' "
+                                   f"column {k} is {sd[k]!r} (scaled columnwise)")  # fmt: skip
     K = arrays["K"]
     lam = np.sum(K**2, axis=0)
     if not np.all(lam > 0):

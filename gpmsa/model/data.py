@@ -336,6 +336,31 @@ def output_scale(y: np.ndarray) -> float:
     return sd
 
 
+Y_SCALES = ("scalar", "columnwise")
+"""``SimData(y_scale=)``: one sd over all outputs (GPM/SA's), or each output element its own
+(SEPIA's ``standardize_y(scale='columnwise')``)."""
+
+
+def column_scales(y: np.ndarray, names) -> np.ndarray:
+    """Each column's own output scale (l,): `output_scale` of that column (the sd, ddof=1; for
+    one column `output_scale` itself, to the bit); GPMSAError naming the column (``names``)
+    that does not vary or whose spread float64 cannot hold."""
+    out = np.empty(y.shape[1])
+    for k in range(y.shape[1]):
+        if np.ptp(y[:, k]) == 0.0:
+            raise GPMSAError(
+                f"y column {names[k]!r} is constant ({float(y[0, k])!r}): y_scale='columnwise' "
+                "divides each output element by its own sd; drop the column or use "
+                "y_scale='scalar'"
+            )
+        try:
+            out[k] = output_scale(y[:, k : k + 1])
+            _check_resolution(y[:, k : k + 1], out[k])
+        except GPMSAError as exc:
+            raise GPMSAError(f"y column {names[k]!r}: {exc}") from None
+    return out
+
+
 RESERVED_NAMES = ("lamOs", "lamVz", "betaV")
 """Names a calibration posterior gives its other parameters (with "betaV[k]", "betaV[k,g]" and
 "lamVz[g]", k, g = 0, 1, ...): no calibration parameter (t_names) may take them."""
@@ -580,6 +605,10 @@ class SimData:
     Stored as one ``(min, max)`` or None per column (None: no column given). A theta's uniform
     prior then covers the whole given range, and an input inside it is inside the emulator's
     domain (docs/internals.md, "The unit domain").
+    ``y_scale``: how y is standardised after centring each element: "scalar" (the default,
+    GPM/SA's: one sd over all outputs) or "columnwise" (SEPIA's ``standardize_y(scale=
+    'columnwise')``: each output element by its own sd, for outputs of different units or
+    sizes in one functional output; every column must vary). Same for a scalar output.
     """
 
     x: np.ndarray | None = None
@@ -596,6 +625,7 @@ class SimData:
     t_categorical: Sequence[int | str] | None = None
     x_range: np.ndarray | Sequence | dict | None = None
     t_range: np.ndarray | Sequence | dict | None = None
+    y_scale: str = "scalar"
 
     def __post_init__(self) -> None:
         check_same_rows({"x": self.x, "t": self.t, "y": self.y})
@@ -636,6 +666,8 @@ class SimData:
         if np.ptp(y) == 0.0:
             raise GPMSAError(f"y is constant ({y[0, 0]}); the simulation output must vary")
         _check_resolution(y, output_scale(y))
+        if not (isinstance(self.y_scale, str) and self.y_scale in Y_SCALES):
+            raise GPMSAError(f"y_scale must be one of {Y_SCALES}, got {self.y_scale!r:.80}")
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "y", y)
@@ -652,6 +684,8 @@ class SimData:
         object.__setattr__(self, "x_units", _units(self.x_units, p, "x_units"))
         object.__setattr__(self, "t_units", _units(self.t_units, q, "t_units"))
         object.__setattr__(self, "y_units", _units(self.y_units, y.shape[1], "y_units"))
+        if self.y_scale == "columnwise":
+            column_scales(y, self.y_names)  # refused here, not at the fit
         for arr, attr, names in ((x, "x_categorical", self.x_names),
                                  (t, "t_categorical", self.t_names)):  # fmt: skip
             cols = categorical.columns(getattr(self, attr), names, attr)

@@ -420,7 +420,10 @@ def reduce_obs(
         )
     lamy = [np.eye(e.size) for e in ys]
     if obs.precisions is not None:
-        lamy = [lam * std.y_sd**2 for lam in obs.output_precisions(y_names)]
+        lamy = [
+            std.precision_to_std(lam, g)
+            for lam, g in zip(obs.output_precisions(y_names), obs.grids, strict=True)
+        ]
         _warn_if_vague(lamy)
     if scalar:
         if any(e.size != 1 for e in ys):

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.model.data import SimData, check_increasing, output_scale
+from gpmsa.model.data import SimData, check_increasing, column_scales, output_scale
 
 UNIT_TOL = 1e-9
 """Unit-scale values within this distance outside [0, 1] are rounding of the design's edges (a
@@ -40,12 +40,14 @@ def _domain(arr: np.ndarray, ranges) -> tuple[np.ndarray, np.ndarray, tuple[bool
 @dataclass(frozen=True, eq=False)
 class Standardizer:
     """x, t -> [0, 1] by the design's min/max (or the user's range); y -> (y - mean) / sd with
-    one scalar sd.
+    one scalar sd, or one sd per output element (``SimData(y_scale="columnwise")``).
 
     Attributes (native units): ``x_min``, ``x_max`` (p,), ``t_min``, ``t_max`` (q,): the unit
     domain, per column the design's min/max or the range the user gave (``SimData(x_range=,
     t_range=)``), which ``x_ranged``, ``t_ranged`` flag (one bool per column; empty: none);
-    ``y_mean`` (l_sim,) on the simulation grid ``grid`` (l_sim,), ``y_sd`` (scalar, ddof=1).
+    ``y_mean`` (l_sim,) on the simulation grid ``grid`` (l_sim,), ``y_sd``: a float (one sd,
+    ddof=1, over all outputs: GPM/SA's default) or, scaled columnwise, an array (l_sim,) of
+    each element's sd (``columnwise``); ``sd_on`` gives it on any grid.
     """
 
     x_min: np.ndarray
@@ -53,7 +55,7 @@ class Standardizer:
     t_min: np.ndarray
     t_max: np.ndarray
     y_mean: np.ndarray
-    y_sd: float
+    y_sd: float | np.ndarray
     grid: np.ndarray
     x_ranged: tuple[bool, ...] = ()
     t_ranged: tuple[bool, ...] = ()
@@ -70,7 +72,11 @@ class Standardizer:
             t_min=t_min,
             t_max=t_max,
             y_mean=sim.y.mean(axis=0),
-            y_sd=output_scale(sim.y),
+            y_sd=(
+                column_scales(sim.y, sim.y_names)
+                if sim.y_scale == "columnwise" and sim.l_sim > 1
+                else output_scale(sim.y)
+            ),
             grid=sim.grid.copy(),
             x_ranged=x_ranged,
             t_ranged=t_ranged,
@@ -111,14 +117,35 @@ class Standardizer:
         check_increasing(self.grid, "the simulation grid")
         return np.interp(grid, self.grid, self.y_mean)
 
+    @property
+    def columnwise(self) -> bool:
+        """Whether each output element has its own sd (``SimData(y_scale="columnwise")``)."""
+        return isinstance(self.y_sd, np.ndarray)
+
+    def sd_on(self, grid: np.ndarray | None) -> float | np.ndarray:
+        """The output scale on ``grid`` (as `mean_on`): the one sd (a float), or scaled
+        columnwise each element's sd interpolated onto ``grid`` (l,)."""
+        if not self.columnwise or grid is None:
+            return self.y_sd
+        if grid.shape == self.grid.shape and np.array_equal(grid, self.grid):
+            return self.y_sd
+        check_increasing(self.grid, "the simulation grid")
+        return np.interp(grid, self.grid, self.y_sd)
+
     def y_to_std(self, y: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:
         """Outputs (..., l) native -> standardised, on ``grid`` (None: the simulation grid)."""
-        return (np.asarray(y, dtype=np.float64) - self.mean_on(grid)) / self.y_sd
+        return (np.asarray(y, dtype=np.float64) - self.mean_on(grid)) / self.sd_on(grid)
 
     def y_from_std(self, y: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:
         """Outputs (..., l) standardised -> native."""
-        return np.asarray(y) * self.y_sd + self.mean_on(grid)
+        return np.asarray(y) * self.sd_on(grid) + self.mean_on(grid)
 
-    def var_from_std(self, var: np.ndarray) -> np.ndarray:
-        """Variances in standardised units -> native units^2."""
-        return np.asarray(var) * self.y_sd**2
+    def var_from_std(self, var: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:
+        """Variances (..., l) in standardised units -> native units^2, on ``grid``."""
+        return np.asarray(var) * self.sd_on(grid) ** 2
+
+    def precision_to_std(self, lam: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:
+        """An observation precision matrix (l, l) in native units^-2 -> standardised units:
+        lam * sd^2, or scaled columnwise S lam S with S = diag(sd on ``grid``)."""
+        sd = self.sd_on(grid)
+        return lam * sd**2 if not self.columnwise else lam * np.outer(sd, sd)

@@ -14,7 +14,7 @@ from gpmsa.predictive.crossval import CrossValidation
 
 
 def pc_basis(emulator, *, max_pc: int = 6):
-    """The basis vectors (native units, y_sd K_j over the output grid) and the runs' weights
+    """The basis vectors (native units, sd K_j over the output grid) and the runs' weights
     w_j against each input, one row per component (at most ``max_pc``): a Figure.
 
     The title of each basis panel gives the share of the standardised runs' variance the

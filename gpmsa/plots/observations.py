@@ -16,7 +16,7 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     histogram of the runs' weights w_j with each experiment's weight u_j (its GLS projection,
     as calibration reduces it) as a vertical line, the title counting the experiments outside
     the runs' range; for a functional output a last panel of what the basis misses (native
-    units over the output grid): the runs' residuals y - mean - y_sd K w in grey, each
+    units over the output grid): the runs' residuals y - mean - sd K w in grey, each
     experiment's in colour. SEPIA's ``plot_K_weights``, ``plot_u_w_pairs`` (diagonal) and
     ``plot_K_residuals`` in one Figure. No discrepancy basis: the weights shown are those a
     calibration without one fits.
@@ -145,12 +145,17 @@ def _outside_hull(runs: np.ndarray, points: np.ndarray) -> int | None:
 def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
     """What the basis misses of the runs (grey) and of each experiment (colour), native units."""
     std = emulator.standardizer
-    runs = (emulator.y - std.y_mean) - std.y_sd * emulator.w @ emulator.K.T
+    fitted = (
+        emulator.w @ emulator.K.T * std.y_sd
+        if std.columnwise
+        else std.y_sd * emulator.w @ emulator.K.T
+    )
+    runs = (emulator.y - std.y_mean) - fitted
     ax.plot(std.grid, runs.T, color="0.75", lw=0.6)
     misses = []
     for e, (y_std, K, u) in enumerate(zip(reduced.y_std, reduced.K, reduced.u, strict=True)):
         grid = std.grid if obs.grids[e] is None else obs.grids[e]
-        miss = std.y_sd * (y_std - K @ u)
+        miss = std.sd_on(obs.grids[e]) * (y_std - K @ u)
         misses.append(miss)
         ax.plot(grid, miss, color=f"C{e % 10}", lw=1.2)
     rms_runs = float(np.sqrt(np.mean(runs**2)))

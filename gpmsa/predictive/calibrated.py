@@ -183,7 +183,7 @@ def calibrated_predict(
     mean = mean.reshape(K, N, l_sim)
     var = var.reshape(K, N, l_sim)
     if lam is not None:
-        var = var + emulator.standardizer.var_from_std(1.0 / lam)[:, None, None]
+        var = var + emulator.standardizer.var_from_std((1.0 / lam)[:, None, None])
     m = np.tensordot(weights, mean, axes=1)
     v = np.tensordot(weights, var + (mean - m[None]) ** 2, axes=1)
     return CalibratedPrediction(x, m, v, mean, var, weights)

@@ -50,7 +50,8 @@ class EmulatorPrediction:
         y: (S * n_rlz, N, l_sim) the same realizations as outputs, native units (with the
             residual 1/lamWOs when ``resid``).
         resid: whether nugget and residual are included.
-        K: (l_sim, p_u) the basis; y_mean (l_sim,), y_sd: the output standardisation;
+        K: (l_sim, p_u) the basis; y_mean (l_sim,), y_sd: the output standardisation (a
+            float; scaled columnwise, (l_sim,) each element's sd);
         lamWOs: (S,) the residual precision of each draw; grid: (l_sim,) the output grid.
     """
 
@@ -64,7 +65,7 @@ class EmulatorPrediction:
     resid: bool
     K: np.ndarray
     y_mean: np.ndarray
-    y_sd: float
+    y_sd: float | np.ndarray
     lamWOs: np.ndarray
     grid: np.ndarray
 

@@ -88,7 +88,7 @@ class FullPrediction:
         eta, delta, y: (S * n_rlz, N, l) the realizations on the native scale (see the module
             docstring); ``zeta`` = eta + delta.
         K: (l, p_u) and D: (l, p_v) the bases on ``grid``; y_mean: (l,), y_sd: the
-            standardisation.
+            standardisation (a float; scaled columnwise, (l,) each element's sd on ``grid``).
         x_names, x_units: (p,) the known inputs' names and units (for figures; empty: unknown).
     """
 
@@ -107,7 +107,7 @@ class FullPrediction:
     K: np.ndarray
     D: np.ndarray
     y_mean: np.ndarray
-    y_sd: float
+    y_sd: float | np.ndarray
     x_names: tuple[str, ...] = ()
     x_units: tuple[str, ...] = ()
 
@@ -585,15 +585,16 @@ def full_prediction(
     lat = lat.reshape(S * n_rlz, N, n_c)
     v, u = lat[:, :, :p_v], lat[:, :, p_v:]
     lamOs = np.array([prm["lamOs"] for prm in sets])
-    eta = (u @ K_pred.T) * std.y_sd + std.mean_on(g)
-    delta = (v @ D_pred.T) * std.y_sd
+    sd = std.sd_on(g)  # one sd, or scaled columnwise each element's on g
+    eta = (u @ K_pred.T) * sd + std.mean_on(g)
+    delta = (v @ D_pred.T) * sd
     noise = rng.standard_normal(eta.shape) / np.sqrt(np.repeat(lamOs, n_rlz))[:, None, None]
-    y = eta + delta + noise * std.y_sd
+    y = eta + delta + noise * sd
     theta = std.t_from_unit(np.array([prm["theta"] for prm in sets]))
     return FullPrediction(
         x=x_nat, grid=g, draw_index=idx, theta=theta, lamOs=lamOs, mu=mu, cov=cov_pt,
         u=u, v=v, eta=eta, delta=delta, y=y, K=K_pred, D=D_pred, y_mean=std.mean_on(g),
-        y_sd=std.y_sd, x_names=tuple(emulator.x_names), x_units=tuple(emulator.x_units),
+        y_sd=sd, x_names=tuple(emulator.x_names), x_units=tuple(emulator.x_units),
     )  # fmt: skip
 
 

@@ -501,6 +501,7 @@ def sensitivity(
     out_pair_agg = {k: np.empty((S, P)) for k in ("joint", "interaction")} if P else {}
     a_pos, b_pos = [a for a, _ in pair_pos], [b for _, b in pair_pos]
     y_mean, y_sd = np.asarray(std.y_mean, dtype=float), std.y_sd
+    sd_col = np.reshape(y_sd, (-1, 1))  # along the output axis of the effects (l, ...)
     effect_grid = main_effect = joint_grid = joint_effect = None
     if n_grid:
         effect_grid = np.linspace(lo_n, hi_n, n_grid)  # (G, d), native
@@ -552,10 +553,10 @@ def sensitivity(
                                                    scale_sum)  # fmt: skip
             if n_grid:
                 E = _main_effects(zt, coef, beta, varied, I1, grid_u)  # (p_u, G, d)
-                main_effect[i] = y_mean[None, :, None] + y_sd * np.einsum("lj,jgn->gln", K, E)
+                main_effect[i] = y_mean[None, :, None] + sd_col * np.einsum("lj,jgn->gln", K, E)
             if n_joint:
                 E = _joint_effects(zt, coef, beta, varied, I1, joint_u, pair_pos)
-                joint_effect[i] = y_mean[:, None] + y_sd * np.einsum("lj,jabp->ablp", K, E)
+                joint_effect[i] = y_mean[:, None] + sd_col * np.einsum("lj,jabp->ablp", K, E)
     return Sensitivity(
         names=tuple(k_names), bounds=box,
         fixed={k: float(v) for k, v in fixed.items()}, draw_index=idx, grid=std.grid,
