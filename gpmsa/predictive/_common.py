@@ -24,6 +24,7 @@ from gpmsa.model.data import (
     evenly_spaced,
 )
 from gpmsa.model.likelihood import lower_cholesky
+from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -160,12 +161,21 @@ def check_posterior_emulator(emulator, posterior) -> None:
     )
 
 
-def gpmsa_model_only(emulator, what: str) -> None:
+def gpmsa_model_only(emulator, what: str, *, extensions: bool = False) -> None:
     """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or uses categorical inputs or a mean
     basis, which ``what`` does not support (``Emulator.predict``, ``gpmsa.calibrate`` and
-    ``gpmsa.Calibrator`` do)."""
+    ``gpmsa.Calibrator`` do). ``extensions``: ``what`` supports both, except a callable mean
+    basis (refused: only the named ones, ``MEAN_BASIS_KINDS``, have closed-form integrals)."""
     if not isinstance(emulator, Emulator):
         raise GPMSAError(f"{what} needs a gpmsa.Emulator, got {type(emulator).__name__}")
+    if extensions:
+        basis = getattr(emulator, "mean_basis", None)
+        if basis is not None and basis.kind not in MEAN_BASIS_KINDS:
+            raise GPMSAError(
+                f"{what} supports the mean bases {MEAN_BASIS_KINDS}, not a callable one (its "
+                "integrals over the inputs have no closed form); use Emulator.predict_mean"
+            )
+        return
     used = []
     if any(lv is not None for lv in getattr(emulator, "levels", ())):
         used.append("categorical inputs")

@@ -29,6 +29,17 @@ range, and the joint-effect functions E[y_l | z_k = g, z_k' = h] on a grid of gr
 other inputs integrated out, each is a sum over the runs of Gaussians in the gridded inputs (no
 Monte Carlo either). Like the indices, they are the emulator mean's, per posterior draw.
 
+Categorical inputs and a mean basis (docs/categorical-and-constraints.md), exactly too: a
+categorical input k varies uniformly over its training levels (or those ``bounds`` lists; its
+kernel is exp(-beta_kj / 4 * 1[z_k != z_ik])), so each of its one-dimensional integrals is an
+average over the levels and each pair integral a double average, and its effect functions are
+given at its levels. A named mean basis ("constant", "linear") adds h(z)^T b_j (b_j: the GLS
+coefficients, as ``Emulator.predict``) to f_j: additive in the inputs, it shifts the means and
+adds to V^u_jj' the terms b_jk b_j'k Var z_k + b_j'k Cov(g_j, z_k) + b_jk Cov(g_j', z_k) for k
+in u (g_j: the GP part above; Cov(E[g_j | z_u], z_k) = Cov(g_j, z_k) for k in u), the
+covariances a sum over the runs of the Gaussian's first moment on the box (exp and erf terms,
+``_centred_gauss``) or over the levels. A callable mean basis is refused.
+
 Numerics: each one-dimensional integral over a narrow range (a box of width 1e-6 of the
 domain, say) is computed by Gauss-Legendre quadrature rather than as a difference of error
 functions, which would cancel and give indices wrong by percents; the variances are differences
@@ -47,7 +58,9 @@ from scipy.special import erf, erfc
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
+from gpmsa.model.correlation import CATEGORICAL_DISTANCE
 from gpmsa.model.data import as_real, check_count, check_flag, check_level
+from gpmsa.model.transforms import snap_to_unit
 from gpmsa.predictive._common import draws_text, factors, gpmsa_model_only, param_sets, unit_inputs
 
 _SQRT_PI_2 = 0.5 * np.sqrt(np.pi)
@@ -63,7 +76,8 @@ class Sensitivity:
 
     Attributes:
         names: (d,) the varied inputs (x then t names, those not in ``fixed``).
-        bounds: name -> (lo, hi) native range of each varied input (uniform on it).
+        bounds: name -> (lo, hi) native range of each varied input (uniform on it); for a
+            categorical input the tuple of its levels varied over (each equally likely).
         fixed: name -> native value of each input held fixed.
         draw_index: (S,) the emulator draws used (-1: the point estimate).
         grid: (l_sim,) the output grid.
@@ -80,12 +94,14 @@ class Sensitivity:
             pairs. ``joint_pc``, ``interaction_pc`` (S, p_u, P) per basis component,
             ``joint_aggregated``, ``interaction_aggregated`` (S, P) over the output grid.
         effect_grid: (G, d) native values of each varied input (column k: G evenly spaced
-            points over its range) where ``main_effect`` is given; None if not asked for.
+            points over its range; a categorical input's levels) where ``main_effect`` is
+            given, NaN below a column's points (G: the most levels where an input has more
+            than ``main_effect_grid``); None if not asked for.
         main_effect: (S, G, l_sim, d) main-effect functions E[y | z_k = effect_grid[:, k]] of
             the emulator mean (the other inputs integrated over the box), native output units
-            (SEPIA's ``mef``); None if not asked for.
-        joint_grid: (G2, d) native grid of each varied input for ``joint_effect``; None if not
-            asked for.
+            (SEPIA's ``mef``; NaN where the grid is); None if not asked for.
+        joint_grid: (G2, d) native grid of each varied input for ``joint_effect`` (as
+            ``effect_grid``); None if not asked for.
         joint_effect: (S, G2, G2, l_sim, P) joint-effect functions E[y | z_k = joint_grid[a, k],
             z_k' = joint_grid[b, k']] of each pair (k, k') (SEPIA's ``jef``); None if not asked
             for.
@@ -211,20 +227,64 @@ def _pair_integral(al: float, be: float, p: np.ndarray, q: np.ndarray, a: float,
     return np.exp(-(al * be / g) * (P - Q) ** 2) * _mean_gauss(g, (al * P + be * Q) / g, a, b)
 
 
-def _single_means(zt, beta, varied, lo, hi) -> np.ndarray:
+def _centred_gauss(gamma: float, c: np.ndarray, a: float, b: float) -> np.ndarray:
+    """Mean of (z - (a + b) / 2) exp(-gamma (z - c)^2) over z ~ U[a, b], elementwise over c:
+    the covariance of z with the Gaussian (a mean basis's linear term against the GP part).
+    (c - mid) times ``_mean_gauss`` plus the difference of the two end values over 2 gamma
+    (b - a); on a narrow interval (as ``_mean_gauss``) by Gauss-Legendre quadrature of the
+    centred integrand, which the closed form would cancel."""
+    mid, half = 0.5 * (a + b), 0.5 * (b - a)
+    if np.sqrt(gamma) * (b - a) < NARROW:
+        out = np.zeros(np.shape(c))
+        for node, weight in zip(_GL_NODES, _GL_WEIGHTS, strict=True):
+            out += 0.5 * weight * half * node * np.exp(-gamma * (mid + half * node - c) ** 2)
+        return out
+    ends = np.exp(-gamma * (a - c) ** 2) - np.exp(-gamma * (b - c) ** 2)
+    return (c - mid) * _mean_gauss(gamma, c, a, b) + ends / (2.0 * gamma * (b - a))
+
+
+def _kernel(beta: float, grid: np.ndarray, c: np.ndarray, cat: bool) -> np.ndarray:
+    """(G, m) correlations of the grid values g with the runs' c in one input: the Gaussian
+    exp(-beta (g - c_i)^2), or for a categorical input exp(-beta / 4 * 1[g != c_i]) (the
+    library's categorical kernel); a NaN grid value (padding) gives a NaN row."""
+    if not cat:
+        return _gaussians(beta, grid, c)
+    out = np.exp(-beta * (CATEGORICAL_DISTANCE * (grid[:, None] != c[None, :])))
+    out[np.isnan(grid)] = np.nan
+    return out
+
+
+def _single_means(zt, beta, varied, lo, hi, levels=None) -> np.ndarray:
     """I1[j, n]: (m,) means of exp(-beta_kj (z_k - z_ik)^2) over the varied input k =
-    varied[n]'s range, for each basis component j: (p_u, d, m)."""
+    varied[n]'s range, for each basis component j: (p_u, d, m). A categorical input
+    (``levels[n]``: its unit-scale level codes, each equally likely): the average over them
+    of its kernel, a finite sum."""
     I1 = np.empty((beta.shape[1], len(varied), zt.shape[0]))
     for j in range(beta.shape[1]):
         for n, k in enumerate(varied):
-            I1[j, n] = _mean_gauss(beta[k, j], zt[:, k], lo[n], hi[n])
+            if levels is not None and levels[n] is not None:
+                I1[j, n] = np.mean(_kernel(beta[k, j], levels[n], zt[:, k], True), axis=0)
+            else:
+                I1[j, n] = _mean_gauss(beta[k, j], zt[:, k], lo[n], hi[n])
     return I1
 
 
-def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=()):
+def _input_pair_integral(zt, beta, k, j, jj, lo, hi, lev) -> np.ndarray:
+    """(m, m) means over input k (its box, or its levels ``lev``) of the product of component
+    j's and jj's kernels at runs i and i'."""
+    if lev is None:
+        return _pair_integral(beta[k, j], beta[k, jj], zt[:, k], zt[:, k], lo, hi)
+    Ej = _kernel(beta[k, j], lev, zt[:, k], True)
+    Ejj = Ej if jj == j else _kernel(beta[k, jj], lev, zt[:, k], True)
+    return (Ej.T @ Ejj) / lev.size
+
+
+def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=(), levels=None):
     """Per pair (j, j'): the covariances V^u for u = every varied input, each single input,
     each complement and each pair (a, b) of ``pairs`` (positions in ``varied``). Returns mu
-    (p_u,), Vall (p_u, p_u), Vmain (d, p_u, p_u), Vcomp (d, p_u, p_u), Vpair (P, p_u, p_u)."""
+    (p_u,), Vall (p_u, p_u), Vmain (d, p_u, p_u), Vcomp (d, p_u, p_u), Vpair (P, p_u, p_u).
+    ``levels``: as ``_single_means``'."""
+    levels = [None] * len(varied) if levels is None else levels
     p_u = coef.shape[0]
     d = len(varied)
     P1 = np.prod(I1, axis=1)  # (p_u, m)
@@ -235,7 +295,7 @@ def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=()):
     Vpair = np.empty((len(pairs), p_u, p_u))
     for j in range(p_u):
         for jj in range(j, p_u):
-            I2 = [_pair_integral(beta[k, j], beta[k, jj], zt[:, k], zt[:, k], lo[n], hi[n])
+            I2 = [_input_pair_integral(zt, beta, k, j, jj, lo[n], hi[n], levels[n])
                   for n, k in enumerate(varied)]  # fmt: skip
             prefix = [np.ones_like(I2[0])]
             for M in I2:
@@ -268,31 +328,86 @@ def _gaussians(gamma: float, grid: np.ndarray, c: np.ndarray) -> np.ndarray:
     return np.exp(-gamma * (grid[:, None] - c[None, :]) ** 2)
 
 
-def _main_effects(zt, coef, beta, varied, I1, grid) -> np.ndarray:
+def _main_effects(zt, coef, beta, varied, I1, grid, cat=None) -> np.ndarray:
     """(p_u, G, d) E[f_j | z_k = grid[:, n]] (k = varied[n]; unit scale, standardised), the
-    other varied inputs integrated out (their I1)."""
+    other varied inputs integrated out (their I1). ``cat[n]``: input n is categorical (its
+    column of ``grid`` holds its level codes, NaN-padded: NaN rows out)."""
     p_u, d = coef.shape[0], len(varied)
+    cat = [False] * d if cat is None else cat
     out = np.empty((p_u, grid.shape[0], d))
     for j in range(p_u):
         for n, k in enumerate(varied):
             rest = np.prod(np.delete(I1[j], n, axis=0), axis=0)
-            out[j, :, n] = _gaussians(beta[k, j], grid[:, n], zt[:, k]) @ (coef[j] * rest)
+            out[j, :, n] = _kernel(beta[k, j], grid[:, n], zt[:, k], cat[n]) @ (coef[j] * rest)
     return out
 
 
-def _joint_effects(zt, coef, beta, varied, I1, grid, pairs) -> np.ndarray:
+def _joint_effects(zt, coef, beta, varied, I1, grid, pairs, cat=None) -> np.ndarray:
     """(p_u, G2, G2, P) E[f_j | z_k = grid[a_idx, a], z_k' = grid[b_idx, b]] for each pair
-    (a, b) of positions in ``varied`` (unit scale, standardised)."""
+    (a, b) of positions in ``varied`` (unit scale, standardised; ``cat`` as
+    ``_main_effects``')."""
     p_u = coef.shape[0]
+    cat = [False] * len(varied) if cat is None else cat
     out = np.empty((p_u, grid.shape[0], grid.shape[0], len(pairs)))
     for j in range(p_u):
         for p, (a, b) in enumerate(pairs):
             ka, kb = varied[a], varied[b]
             rest = coef[j] * np.prod(np.delete(I1[j], (a, b), axis=0), axis=0)
-            Ga = _gaussians(beta[ka, j], grid[:, a], zt[:, ka])
-            Gb = _gaussians(beta[kb, j], grid[:, b], zt[:, kb])
+            Ga = _kernel(beta[ka, j], grid[:, a], zt[:, ka], cat[a])
+            Gb = _kernel(beta[kb, j], grid[:, b], zt[:, kb], cat[b])
             out[j, :, :, p] = (Ga * rest) @ Gb.T
     return out
+
+
+@dataclass(frozen=True, eq=False)
+class _Trend:
+    """A named mean basis's part h(z)^T b_j of each component's mean on the box (unit scale,
+    standardised): ``const`` (p_u,) its mean over the box, ``slope`` (p_u, d) its coefficient
+    of each varied input (0 for "constant"), ``centre``, ``var`` (d,) each varied input's mean
+    and variance over the box (uniform, or over its levels)."""
+
+    const: np.ndarray
+    slope: np.ndarray
+    centre: np.ndarray
+    var: np.ndarray
+
+    @classmethod
+    def of(cls, coefs, kind: str, varied, fix_u: dict, lo, hi, levels) -> _Trend:
+        """From the GLS coefficients ``coefs`` (p_u, k) of a mean basis ``kind``."""
+        centre = np.array([0.5 * (a + b) if lv is None else float(np.mean(lv))
+                           for a, b, lv in zip(lo, hi, levels, strict=True)])  # fmt: skip
+        var = np.array([(b - a) ** 2 / 12.0 if lv is None else float(np.var(lv))
+                        for a, b, lv in zip(lo, hi, levels, strict=True)])  # fmt: skip
+        const = coefs[:, 0].copy()
+        slope = np.zeros((coefs.shape[0], len(varied)))
+        if kind == "linear":  # h = [1, z_1, ..., z_{p+q}]
+            slope = coefs[:, 1:][:, varied]
+            const += slope @ centre
+            for k, u in fix_u.items():
+                const += coefs[:, 1 + k] * u
+        return cls(const, slope, centre, var)
+
+    def covariances(self, zt, coef, beta, varied, lo, hi, I1, levels) -> np.ndarray:
+        """D (d, p_u, p_u): the trend's share of Cov(E[f_j | z_u], E[f_j' | z_u]) from each
+        varied input n in u: b_j'n Cov(g_j, z_n) + b_jn Cov(g_j', z_n) + b_jn b_j'n Var z_n,
+        where g_j is the GP part (Cov(E[g_j | z_u], z_n) = Cov(g_j, z_n) for n in u), a sum
+        over the runs of a centred first moment (``_centred_gauss``, or over the levels)."""
+        p_u, d = coef.shape[0], len(varied)
+        C = np.zeros((p_u, d))  # Cov(g_j, z_n)
+        for j in range(p_u):
+            for n, k in enumerate(varied):
+                if not self.slope[:, n].any():
+                    continue
+                rest = np.prod(np.delete(I1[j], n, axis=0), axis=0)
+                if levels[n] is None:
+                    T = _centred_gauss(beta[k, j], zt[:, k], lo[n], hi[n])
+                else:
+                    E = _kernel(beta[k, j], levels[n], zt[:, k], True)
+                    T = np.mean((levels[n] - self.centre[n])[:, None] * E, axis=0)
+                C[j, n] = (coef[j] * rest) @ T
+        b = self.slope
+        return (np.einsum("jn,kn->njk", C, b) + np.einsum("jn,kn->njk", b, C)
+                + np.einsum("jn,kn,n->njk", b, b, self.var))  # fmt: skip
 
 
 def _memory_estimate(
@@ -329,6 +444,40 @@ def _ratio(num: np.ndarray, den: np.ndarray, scale: float) -> np.ndarray:
     NaN where den is below ``ZERO_VARIANCE`` * scale (an index is undefined there)."""
     ok = den > ZERO_VARIANCE * scale
     return np.where(ok, np.clip(num / np.where(ok, den, 1.0), 0.0, 1.0), np.nan)
+
+
+def _level_set(value, levels: tuple[int, ...], name: str) -> tuple[int, ...]:
+    """A categorical input's ``bounds`` entry: the sorted training levels it lists (at least
+    2, each once); GPMSAError naming the input otherwise."""
+    if isinstance(value, str) or not isinstance(value, list | tuple | set | frozenset | np.ndarray):
+        raise GPMSAError(f"bounds[{name!r}]: {name} is categorical; give the levels to vary over "
+                         f"(a list of at least 2 of {list(levels)}), got {value!r}")  # fmt: skip
+    out = []
+    for v in value:
+        v = as_real(v, f"bounds[{name!r}] level")
+        if v not in levels:
+            raise GPMSAError(f"bounds[{name!r}] lists level {v:g}, not a training level of the "
+                             f"categorical input {name} (levels {list(levels)})")  # fmt: skip
+        if int(v) in out:
+            raise GPMSAError(f"bounds[{name!r}] lists level {v:g} twice")
+        out.append(int(v))
+    if len(out) < 2:
+        raise GPMSAError(f"bounds[{name!r}] must list at least 2 levels of {list(levels)}, got "
+                         f"{value!r} (hold one level with fixed={{{name!r}: level}})")  # fmt: skip
+    return tuple(sorted(out))
+
+
+def _effect_grids(n: int, rows: int, lo_n, hi_n, lo_u, hi_u, lev_n, lev_u):
+    """(native, unit) grids (rows, d) of the effect functions: n evenly spaced points over each
+    continuous input's range, a categorical input's levels; NaN below (rows = max(n, the most
+    levels))."""
+    native, unit = np.full((rows, len(lev_n)), np.nan), np.full((rows, len(lev_n)), np.nan)
+    native[:n], unit[:n] = np.linspace(lo_n, hi_n, n), np.linspace(lo_u, hi_u, n)
+    for c, (lev, u) in enumerate(zip(lev_n, lev_u, strict=True)):
+        if lev is not None:
+            native[:, c], unit[:, c] = np.nan, np.nan
+            native[: len(lev), c], unit[: len(lev), c] = lev, u
+    return native, unit
 
 
 def _name_dict(value, what: str) -> dict:
@@ -392,18 +541,20 @@ def sensitivity(
         emulator: a fitted gpmsa.Emulator.
         bounds: name -> (lo, hi), native units: the uniform range of an input (default: the
             emulator's training domain). Beyond the domain: a warning; more than
-            ``EXTRAPOLATION_MARGIN`` (10 %) of its width beyond: GPMSAError.
+            ``EXTRAPOLATION_MARGIN`` (10 %) of its width beyond: GPMSAError. A categorical
+            input: a list of at least 2 of its training levels, each equally likely (default:
+            every training level; ``[0, 2]`` means levels 0 and 2, not a range).
         fixed: name -> native value of inputs held fixed (not varied; e.g. a known input at its
-            operating point).
+            operating point; a categorical input at one of its training levels).
         draws: indices for each retained posterior draw (True) or the point estimate only.
         n_draws: at most this many draws, evenly spaced (None: all retained draws).
         pairs: pairs of varied inputs, [("a", "b"), ...], or "all": their closed joint and
             two-factor interaction indices (``joint``, ``interaction``; SEPIA's ``jelist``
             and ``varlist`` of pairs).
             None (default): none.
-        main_effect_grid: G >= 2 points per varied input, evenly spaced over its range: the
-            main-effect functions E[y | z_k] there (``main_effect``, ``effect_grid``; SEPIA's
-            ``ngrid``). None (default): none.
+        main_effect_grid: G >= 2 points per varied input, evenly spaced over its range (a
+            categorical input: its levels): the main-effect functions E[y | z_k] there
+            (``main_effect``, ``effect_grid``; SEPIA's ``ngrid``). None (default): none.
         joint_effect_grid: G2 >= 2 points per input of each pair: the joint-effect functions
             E[y | z_k, z_k'] on the G2 x G2 grid (``joint_effect``, ``joint_grid``); needs
             ``pairs``. None (default): none.
@@ -430,8 +581,9 @@ def sensitivity(
         >>> sens.pairs, sens.interaction.shape, sens.main_effect.shape   # (S, G, l_sim, d)
         ((('x', 'a'), ('x', 'b'), ('a', 'b')), (10, 1, 3), (10, 5, 1, 3))
     """
-    gpmsa_model_only(emulator, "sensitivity")
+    gpmsa_model_only(emulator, "sensitivity", extensions=True)
     std = emulator.standardizer
+    levels_all = tuple(emulator.levels)
     names = tuple(emulator.x_names) + tuple(emulator.t_names)
     lo_all = np.concatenate([std.x_min, std.t_min])
     hi_all = np.concatenate([std.x_max, std.t_max])
@@ -447,9 +599,17 @@ def sensitivity(
     varied = [k for k, n in enumerate(names) if n not in fixed]
     if not varied:
         raise GPMSAError("every input is fixed; nothing to vary")
-    lo_n, hi_n, box = [], [], {}
+    lo_n, hi_n, box, lev_n = [], [], {}, []
     for k in varied:
         name = names[k]
+        if levels_all[k] is not None:  # categorical: the levels varied over, equally likely
+            lev = _level_set(bounds.get(name, levels_all[k]), levels_all[k], name)
+            lo_n.append(float(lev[0]))
+            hi_n.append(float(lev[-1]))
+            box[name] = lev
+            lev_n.append(lev)
+            continue
+        lev_n.append(None)
         pair = bounds.get(name, (lo_all[k], hi_all[k]))
         if not isinstance(pair, (list, tuple, np.ndarray)) or len(pair) != 2:
             raise GPMSAError(f"bounds[{name!r}] must be (lo, hi), got {pair!r}")
@@ -470,11 +630,19 @@ def sensitivity(
                              "compute): pass pairs=[(a, b)] or pairs='all'")  # fmt: skip
     _, ends = unit_inputs([lo_n, hi_n], k_names, lo_all[varied], hi_all[varied], "bounds")
     lo_u, hi_u = ends[0], ends[1]
+    # a categorical input's unit-scale level codes (as the standardiser maps the design)
+    lev_u = [None if lev is None else snap_to_unit((np.asarray(lev, dtype=float) - lo_all[k])
+                                                   / (hi_all[k] - lo_all[k]))
+             for lev, k in zip(lev_n, varied, strict=True)]  # fmt: skip
+    cat = [lev is not None for lev in lev_n]
     zt = emulator.zt.copy()
     fix_u = {}
     fixed = {name: as_real(value, f"fixed[{name!r}]") for name, value in fixed.items()}
     for name, value in fixed.items():
         k = names.index(name)
+        if levels_all[k] is not None and value not in levels_all[k]:
+            raise GPMSAError(f"fixed[{name!r}] = {value:g}: {name} is categorical; fix it at one "
+                             f"of its training levels {list(levels_all[k])}")  # fmt: skip
         _, u = unit_inputs(
             [[value]], [name], lo_all[k : k + 1], hi_all[k : k + 1], f"fixed[{name!r}]"
         )
@@ -482,10 +650,12 @@ def sensitivity(
     idx, sets = param_sets(emulator, draws, n_draws, "sensitivity")
     S, l_sim, p_u, d = len(sets), emulator.l_sim, emulator.p_u, len(varied)
     P = len(pair_pos)
+    n_lev = max([lev.size for lev in lev_u if lev is not None], default=0)
+    rows, rows_joint = max(n_grid, n_lev) if n_grid else 0, max(n_joint, n_lev) if n_joint else 0
     extra = "".join([f", {P} pairs" if P else "",
                      f", main effects on {n_grid} points" if n_grid else "",
                      f", joint effects on {n_joint}^2 points" if n_joint else ""])  # fmt: skip
-    check_memory(_memory_estimate(emulator.m, d, p_u, S, l_sim, P, n_grid, n_joint),
+    check_memory(_memory_estimate(emulator.m, d, p_u, S, l_sim, P, rows, rows_joint),
                  f"sensitivity() of an emulator of {emulator.m} runs x {p_u} basis components "
                  f"over {d} varied inputs{extra} (about {4 * d + 8 + 2 * p_u} arrays of "
                  f"{emulator.m} x {emulator.m} at once)")  # fmt: skip
@@ -504,23 +674,46 @@ def sensitivity(
     sd_col = np.reshape(y_sd, (-1, 1))  # along the output axis of the effects (l, ...)
     effect_grid = main_effect = joint_grid = joint_effect = None
     if n_grid:
-        effect_grid = np.linspace(lo_n, hi_n, n_grid)  # (G, d), native
-        grid_u = np.linspace(lo_u, hi_u, n_grid)
-        main_effect = np.empty((S, n_grid, l_sim, d))
+        effect_grid, grid_u = _effect_grids(n_grid, rows, lo_n, hi_n, lo_u, hi_u, lev_n, lev_u)
+        main_effect = np.empty((S, rows, l_sim, d))
     if n_joint:
-        joint_grid = np.linspace(lo_n, hi_n, n_joint)
-        joint_u = np.linspace(lo_u, hi_u, n_joint)
-        joint_effect = np.empty((S, n_joint, n_joint, l_sim, P))
+        joint_grid, joint_u = _effect_grids(n_joint, rows_joint, lo_n, hi_n, lo_u, hi_u, lev_n,
+                                            lev_u)  # fmt: skip
+        joint_effect = np.empty((S, rows_joint, rows_joint, l_sim, P))
+    basis = emulator.mean_basis
+    special = basis is not None or any(lv is not None for lv in levels_all)
+    lev_arg = lev_u if any(cat) else None
     with blas_controller().limit(limits=1, user_api="blas"):
         for i, prm in enumerate(sets):
             beta = prm["betaU"]
-            coef = np.array([alpha / prm["lamUz"][j] for j, (_, alpha) in
-                             enumerate(factors(emulator, prm))])  # fmt: skip
+            trend = None
+            if special:  # the emulator's own factors: the categorical kernel, the GLS mean
+                fac = emulator._factor(prm)
+                coef = np.array([alpha / prm["lamUz"][j] for j, (_, alpha, _) in
+                                 enumerate(fac)])  # fmt: skip
+                if basis is not None:
+                    trend = _Trend.of(np.array([g.coef for _, _, g in fac]), basis.kind, varied,
+                                      fix_u, lo_u, hi_u, lev_u)  # fmt: skip
+            else:
+                coef = np.array([alpha / prm["lamUz"][j] for j, (_, alpha) in
+                                 enumerate(factors(emulator, prm))])  # fmt: skip
             for k, u in fix_u.items():
-                coef = coef * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
-            I1 = _single_means(zt, beta, varied, lo_u, hi_u)
-            mu, Vall, Vmain, Vcomp, Vpair = _component_moments(zt, coef, beta, varied, lo_u,
-                                                               hi_u, I1, pair_pos)  # fmt: skip
+                if levels_all[k] is not None:
+                    dist = CATEGORICAL_DISTANCE * (u != zt[None, :, k])
+                    coef = coef * np.exp(-beta[k][:, None] * dist)
+                else:
+                    coef = coef * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
+            I1 = _single_means(zt, beta, varied, lo_u, hi_u, lev_arg)
+            mu, Vall, Vmain, Vcomp, Vpair = _component_moments(
+                zt, coef, beta, varied, lo_u, hi_u, I1, pair_pos, lev_arg
+            )
+            if trend is not None:  # the mean basis's part, additive in the inputs
+                D = trend.covariances(zt, coef, beta, varied, lo_u, hi_u, I1, lev_u)
+                mu = mu + trend.const
+                Vall = Vall + D.sum(axis=0)
+                Vcomp = Vcomp + (D.sum(axis=0) - D)
+                Vmain = Vmain + D
+                Vpair = Vpair + D[a_pos] + D[b_pos]
             v_l = np.einsum("lj,jk,lk->l", K, Vall, K)
             scale = max(float(v_l.max()), 1e-300)
             main_l = np.einsum("lj,njk,lk->ln", K, Vmain, K)
@@ -552,10 +745,20 @@ def sensitivity(
                     out_pair_agg[kind][i] = _ratio(np.einsum("jk,njk->n", KtK, Vu), v_sum,
                                                    scale_sum)  # fmt: skip
             if n_grid:
-                E = _main_effects(zt, coef, beta, varied, I1, grid_u)  # (p_u, G, d)
+                E = _main_effects(zt, coef, beta, varied, I1, grid_u, cat)  # (p_u, G, d)
+                if trend is not None:
+                    E = (
+                        E
+                        + trend.const[:, None, None]
+                        + trend.slope[:, None, :] * (grid_u - trend.centre)[None]
+                    )
                 main_effect[i] = y_mean[None, :, None] + sd_col * np.einsum("lj,jgn->gln", K, E)
             if n_joint:
-                E = _joint_effects(zt, coef, beta, varied, I1, joint_u, pair_pos)
+                E = _joint_effects(zt, coef, beta, varied, I1, joint_u, pair_pos, cat)
+                if trend is not None:
+                    lin = trend.slope[:, None, :] * (joint_u - trend.centre)[None]  # (p_u, G2, d)
+                    E = (E + trend.const[:, None, None, None] + lin[:, :, None, a_pos]
+                         + lin[:, None, :, b_pos])  # fmt: skip
                 joint_effect[i] = y_mean[:, None] + sd_col * np.einsum("lj,jabp->ablp", K, E)
     return Sensitivity(
         names=tuple(k_names), bounds=box,

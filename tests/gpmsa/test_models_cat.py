@@ -294,8 +294,8 @@ def test_constraint_rejecting_the_start():
 
 
 def test_other_backends_and_predictions_refuse_the_extensions(cat_emulator):
-    with pytest.raises(gpmsa.GPMSAError, match="does not support an emulator with categorical"):
-        gpmsa.sensitivity(cat_emulator)
+    # gpmsa.sensitivity takes both (tests/gpmsa/test_sens_extensions_s71.py)
+    assert gpmsa.sensitivity(cat_emulator, n_draws=2).names == ("s", "kind", "k")
     with pytest.raises(gpmsa.GPMSAError, match="does not support an emulator with categorical"):
         gpmsa.emulator_prediction(cat_emulator, [[0.5, 1]], [[0.5]])
     pytest.importorskip("torch")
