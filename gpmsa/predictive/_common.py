@@ -13,6 +13,7 @@ from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa.errors import ExtrapolationWarning, GPMSAError
 from gpmsa.fitting.emulator import NO_DRAWS, Emulator
+from gpmsa.model.categorical import check_levels
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
     as_float,
@@ -60,7 +61,7 @@ def rng_of(seed) -> np.random.Generator:
     return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
 
-def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarray]:
+def unit_inputs(values, names, lo, hi, what: str, levels=None) -> tuple[np.ndarray, np.ndarray]:
     """Native rows (N, d) -> (native, unit scale), with the library's extrapolation rule.
 
     A 1-D array is one column when d = 1 and one row otherwise; a number one point when d = 1
@@ -68,6 +69,9 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
     up to ``EXTRAPOLATION_MARGIN`` of the range outside it: a warning; beyond: GPMSAError naming
     the input, the values and the domain. With no inputs (d = 0, an emulator without known
     inputs) None, or an (N, 0) array, is one row of no columns (broadcast against t's rows).
+    ``levels``: per column the training levels of a categorical input, None for a continuous
+    one (``gpmsa.model.categorical``): a level never seen in training is refused first, as
+    ``Emulator.predict`` does.
     """
     d = len(names)
     if d == 0 and values is None:
@@ -78,6 +82,8 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
     ):
         values = as_float(values, what).reshape(1, -1)  # a dict is refused by its own name
     native = as_matrix(values, what, ncols=d, no_columns=d == 0)
+    if levels is not None and any(lv is not None for lv in levels):
+        check_levels(native, levels, names, what)
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     unit = snap_to_unit((native - lo) / (hi - lo))
     below, above = unit.min(axis=0), unit.max(axis=0)
@@ -104,9 +110,10 @@ def unit_inputs(values, names, lo, hi, what: str) -> tuple[np.ndarray, np.ndarra
 def posterior_theta(emulator, theta: np.ndarray) -> np.ndarray:
     """Unit-scale theta (k, q) of native posterior draws (k, q), under the rule of
     ``Emulator.predict``: outside the emulator's t domain a warning, beyond it by more than
-    ``EXTRAPOLATION_MARGIN`` a GPMSAError naming the parameter."""
-    s = emulator.standardizer
-    return unit_inputs(theta, emulator.t_names, s.t_min, s.t_max, "posterior theta")[1]
+    ``EXTRAPOLATION_MARGIN`` a GPMSAError naming the parameter; a categorical one off its
+    training levels: GPMSAError."""
+    s, levels = emulator.standardizer, tuple(getattr(emulator, "levels", ()))[emulator.p :]
+    return unit_inputs(theta, emulator.t_names, s.t_min, s.t_max, "posterior theta", levels)[1]
 
 
 def lacks_text(missing: list[str], names) -> str:
@@ -161,13 +168,18 @@ def check_posterior_emulator(emulator, posterior) -> None:
     )
 
 
-def gpmsa_model_only(emulator, what: str, *, extensions: bool = False) -> None:
+def gpmsa_model_only(
+    emulator, what: str, *, extensions: bool = False, callable_basis: bool = False
+) -> None:
     """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or uses categorical inputs or a mean
     basis, which ``what`` does not support (``Emulator.predict``, ``gpmsa.calibrate`` and
     ``gpmsa.Calibrator`` do). ``extensions``: ``what`` supports both, except a callable mean
-    basis (refused: only the named ones, ``MEAN_BASIS_KINDS``, have closed-form integrals)."""
+    basis (refused: only the named ones, ``MEAN_BASIS_KINDS``, have closed-form integrals)
+    unless ``callable_basis`` (``what`` only evaluates the basis at points)."""
     if not isinstance(emulator, Emulator):
         raise GPMSAError(f"{what} needs a gpmsa.Emulator, got {type(emulator).__name__}")
+    if extensions and callable_basis:
+        return
     if extensions:
         basis = getattr(emulator, "mean_basis", None)
         if basis is not None and basis.kind not in MEAN_BASIS_KINDS:
@@ -183,8 +195,6 @@ def gpmsa_model_only(emulator, what: str, *, extensions: bool = False) -> None:
         used.append("a mean basis")
     if used:
         instead = "Emulator.predict, gpmsa.calibrate or gpmsa.Calibrator"
-        if what == "cross_validate":
-            instead = "Emulator.loo() (exact leave-one-out at the point estimate) or " + instead
         raise GPMSAError(
             f"{what} does not support an emulator with {' and '.join(used)}; use {instead}"
         )
@@ -239,24 +249,53 @@ def factors(emulator, prm: dict) -> list[tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def extended(emulator) -> bool:
+    """Whether ``emulator`` has categorical inputs or a mean basis (GPM/SA's model extended)."""
+    basis = getattr(emulator, "mean_basis", None)
+    return basis is not None or any(lv is not None for lv in getattr(emulator, "levels", ()))
+
+
+def gp_factors(emulator, prm: dict) -> list[tuple]:
+    """Per basis component j: (L, alpha, gls). An extended emulator (`extended`): its own
+    ``Emulator._factor`` (the categorical kernel; with a mean basis alpha = Sigma_W_j^-1 (w_j -
+    H c_j) and the ``GLS`` fit c_j, else gls None), as ``Emulator.predict``; otherwise
+    `factors`' (L, Sigma_W_j^-1 w_j) with gls None."""
+    if extended(emulator):
+        return emulator._factor(prm)
+    return [(L, alpha, None) for L, alpha in factors(emulator, prm)]
+
+
 def w_conditional(emulator, prm: dict, fac, z: np.ndarray, joint: bool):
     """The smooth GP of the weights at unit-scale points z (N, p + q), given the runs' w.
 
-    Returns mean (N, p_u) and, per component, the variance (N, p_u) or (joint) the covariance
-    (p_u, N, N); no nugget 1/lamWs and no residual 1/lamWOs.
+    ``fac``: `gp_factors`' (L, alpha, gls) per component. Returns mean (N, p_u) and, per
+    component, the variance (N, p_u) or (joint) the covariance (p_u, N, N); no nugget 1/lamWs
+    and no residual 1/lamWOs. With a mean basis (gls not None) the GLS mean h(z) c_j joins the
+    mean and the coefficients' covariance g^T (H^T Sigma^-1 H)^-1 g, g = h(z)^T - H^T
+    Sigma^-1 r, the (co)variance, as ``Emulator.predict``; categorical inputs take their kernel.
     """
     N, p_u = z.shape[0], emulator.p_u
     mean = np.empty((N, p_u))
     spread = np.empty((p_u, N, N)) if joint else np.empty((N, p_u))
-    for j, (L, alpha) in enumerate(fac):
+    cat = emulator.categorical_mask if extended(emulator) else None
+    basis = getattr(emulator, "mean_basis", None)
+    h = None if basis is None else basis.matrix(z)
+    for j, (L, alpha, gls) in enumerate(fac):
         lam = prm["lamUz"][j]
-        r = correlation(z, emulator.zt, prm["betaU"][:, j]) / lam
+        r = correlation(z, emulator.zt, prm["betaU"][:, j], cat) / lam
         mean[:, j] = r @ alpha
         B = solve_triangular(L, r.T, lower=True)
+        if gls is not None:
+            mean[:, j] += h @ gls.coef
         if joint:
-            spread[j] = correlation(z, None, prm["betaU"][:, j]) / lam - B.T @ B
-        else:
+            spread[j] = correlation(z, None, prm["betaU"][:, j], cat) / lam - B.T @ B
+            if gls is not None:
+                g = h.T - gls.A.T @ B
+                spread[j] += g.T @ cho_solve(gls.Q, g)
+        elif gls is None:
             spread[:, j] = np.maximum(1.0 / lam - np.sum(B * B, axis=0), 0.0)
+        else:
+            spread[:, j] = np.maximum(1.0 / lam - np.sum(B * B, axis=0) + gls.variance(h, B), 0.0)
     return mean, spread
 
 

@@ -1,6 +1,8 @@
 """Cross-validation of the emulator over its posterior draws: leave-one-out and k-fold.
 
-For one draw of the emulator parameters and basis component j, with P = Sigma_W_j^-1 and a fold
+For one draw of the emulator parameters and basis component j, with P = Sigma_W_j^-1 (with a
+mean basis H, the projected precision P = S^-1 - S^-1 H (H^T S^-1 H)^-1 H^T S^-1, S = Sigma_W_j:
+the mean's coefficients, flat prior, refitted without the fold, as ``Emulator.loo``) and a fold
 F of held-out runs, the weights of F given the other runs are exactly Gaussian with
 
     cov_F = (P_FF)^-1,   mean_F = w_F - cov_F (P w_j)_F
@@ -29,7 +31,13 @@ from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import output_variance, span_text
 from gpmsa.limits import check_memory
 from gpmsa.model.data import check_flag, check_level
-from gpmsa.predictive._common import draws_text, factors, gpmsa_model_only, param_sets, rng_of
+from gpmsa.predictive._common import (
+    draws_text,
+    gp_factors,
+    gpmsa_model_only,
+    param_sets,
+    rng_of,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -116,6 +124,20 @@ def _fold_labels(folds, m: int, seed) -> np.ndarray:
     return inv.reshape(m)
 
 
+def _check_identified(H: np.ndarray, labels: np.ndarray, groups: list[np.ndarray]) -> None:
+    """GPMSAError when the runs left after holding out a fold do not identify the mean basis's
+    coefficients (H (m, k) on them of rank below k): that fold has no predictive."""
+    for g, F in enumerate(groups):
+        kept = H[labels != g]
+        rank = np.linalg.matrix_rank(kept)
+        if rank < H.shape[1]:
+            raise GPMSAError(
+                f"cross_validate: without fold {g} ({F.size} runs) the other runs leave the mean "
+                f"basis's {H.shape[1]} columns of rank {rank}, so its coefficients are not "
+                "identified; use smaller folds"
+            )
+
+
 def cross_validate(
     emulator,
     *,
@@ -151,11 +173,14 @@ def cross_validate(
         >>> bool(np.allclose(gpmsa.cross_validate(emu, draws=False).mean, emu.loo().mean))
         True
     """
-    gpmsa_model_only(emulator, "cross_validate")
+    gpmsa_model_only(emulator, "cross_validate", extensions=True, callable_basis=True)
     draws = check_flag(draws, "draws")
     m, p_u, l_sim = emulator.m, emulator.p_u, emulator.l_sim
     labels = _fold_labels(folds, m, seed)
     groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1)]
+    H = None if emulator.mean_basis is None else emulator.mean_basis.matrix(emulator.zt)
+    if H is not None:
+        _check_identified(H, labels, groups)
     idx, sets = param_sets(emulator, draws, n_draws, "cross_validate")
     check_memory(  # per draw: each component's Cholesky factor, the precision, their work copies
         8.0 * (p_u + 3) * m * m, f"cross_validate: {p_u} covariance factors of {m} x {m} runs"
@@ -169,8 +194,11 @@ def cross_validate(
         for prm in sets:
             mw = np.empty((m, p_u))
             vw = np.empty((m, p_u))
-            for j, (L, alpha) in enumerate(factors(emulator, prm)):
+            for j, (L, alpha, gls) in enumerate(gp_factors(emulator, prm)):
                 P = cho_solve((L, True), np.eye(m))
+                if gls is not None:  # the projected precision: the GLS mean refitted per fold
+                    B = cho_solve((L, True), H)
+                    P -= B @ cho_solve(gls.Q, B.T)
                 for F in groups:
                     if F.size == 1:
                         c = 1.0 / P[F[0], F[0]]

@@ -10,6 +10,9 @@ inputs z = (x, t) are Gaussian given the simulation runs' weights w,
 and the output is y = y_mean + y_sd (K w + e) on the simulation grid. With ``resid=True`` (the
 default, as ``Emulator.predict``) a new run's nugget 1/lamWs_j joins each weight's variance and the
 residual e ~ N(0, 1/lamWOs) each output element; ``resid=False`` gives the smooth emulator.
+Categorical inputs take their kernel in R; with a mean basis h the weights' mean adds the GLS
+trend h(z)^T c_j and their covariance the coefficients' g^T (H^T Sigma_W_j^-1 H)^-1 g, as
+``Emulator.predict`` (docs/categorical-and-constraints.md).
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from gpmsa.limits import check_memory
 from gpmsa.model.data import check_count, check_flag, check_level, check_same_rows
 from gpmsa.predictive._common import (
     draws_text,
-    factors,
+    gp_factors,
     gpmsa_model_only,
     mvn_factor,
     param_sets,
@@ -136,7 +139,8 @@ def emulator_prediction(
         emulator: a fitted gpmsa.Emulator.
         x: (N, p) known inputs; t: (N, q) calibration parameters; native units (a single row of
             either broadcasts). Outside the training range: a warning; more than
-            ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError.
+            ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError. A categorical
+            input takes its training levels only (another: GPMSAError, as ``predict``).
         draws: use the retained posterior draws (True, the default) or only the point estimate.
         n_draws: at most this many draws, evenly spaced (None: all retained draws).
         n_rlz: realizations per draw.
@@ -163,15 +167,16 @@ def emulator_prediction(
         >>> bool(np.allclose(pred.mean(), emu.predict(x_new, t_new, draws=True)[0]))
         True
     """
-    gpmsa_model_only(emulator, "emulator_prediction")
+    gpmsa_model_only(emulator, "emulator_prediction", extensions=True, callable_basis=True)
     draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
     joint = check_flag(joint, "joint")
     n_rlz = check_count(n_rlz, "n_rlz")
     rng = rng_of(seed)
     s = emulator.standardizer
     check_same_rows({"x": x, "t": t}, {"x": emulator.x_names, "t": emulator.t_names})
-    x_nat, xu = unit_inputs(x, emulator.x_names, s.x_min, s.x_max, "x")
-    t_nat, tu = unit_inputs(t, emulator.t_names, s.t_min, s.t_max, "t")
+    levels, p = tuple(emulator.levels), emulator.p
+    x_nat, xu = unit_inputs(x, emulator.x_names, s.x_min, s.x_max, "x", levels[:p])
+    t_nat, tu = unit_inputs(t, emulator.t_names, s.t_min, s.t_max, "t", levels[p:])
     if x_nat.shape[0] != t_nat.shape[0]:
         if x_nat.shape[0] == 1:
             x_nat, xu = (np.repeat(a, t_nat.shape[0], axis=0) for a in (x_nat, xu))
@@ -195,7 +200,7 @@ def emulator_prediction(
     w = np.empty((S, n_rlz, N, p_u))
     with blas_controller().limit(limits=1, user_api="blas"):
         for i, prm in enumerate(sets):
-            m_i, spread = w_conditional(emulator, prm, factors(emulator, prm), z, joint)
+            m_i, spread = w_conditional(emulator, prm, gp_factors(emulator, prm), z, joint)
             nugget = 1.0 / prm["lamWs"] if resid else np.zeros(p_u)
             mu[i] = m_i
             if joint:

@@ -19,6 +19,8 @@ Cholesky factor) and then on the reduced observations (dense, small). Realizatio
     y = zeta + y_sd e                a new observation (its noise, GPM/SA's default I / lamOs),
 
 on the native scale and on one output grid; ``u`` and ``v`` are the basis-space values.
+Categorical inputs and a mean basis are taken as ``Emulator.predict`` takes them (`_conditional`;
+docs/categorical-and-constraints.md).
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import solve_triangular
+from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa.calibration.observations import blas_controller, layout_digest
 from gpmsa.calibration.posterior import Posterior
@@ -55,7 +57,8 @@ from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive._common import (
     EMULATOR_PARAMS,
     check_posterior_emulator,
-    factors,
+    extended,
+    gp_factors,
     gpmsa_model_only,
     lacks_text,
     mvn_factor,
@@ -494,7 +497,7 @@ def full_prediction(
         >>> bool(np.all(pred.var("y") > pred.var("zeta")))
         True
     """
-    gpmsa_model_only(emulator, "full_prediction")
+    gpmsa_model_only(emulator, "full_prediction", extensions=True, callable_basis=True)
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be the gpmsa.ObsData of the calibration, got "
                          f"{type(obs).__name__}")  # fmt: skip
@@ -514,7 +517,8 @@ def full_prediction(
         check_posterior_emulator(emulator, posterior)
         _check_fitted_obs(getattr(posterior, "info", None) or {}, obs)  # a joint fit's draws
         _check_calibrated_obs(posterior, obs, emulator.x_names, emulator.y_names, std.grid)
-    x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x")
+    levels = tuple(emulator.levels)
+    x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x", levels[: emulator.p])
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
     record = (
         posterior.info if posterior is not None else getattr(emulator, "settings", None)
@@ -523,7 +527,7 @@ def full_prediction(
         discrepancy_groups = record.get("discrepancy_groups") if discrepancy is not None else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the calibration already warned about its x_obs
-        ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, None, emulator.y_names,
+        ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, levels, emulator.y_names,
                            discrepancy_groups)  # fmt: skip
     p_v = ob.p_v
     if ("betaV" in sets[0]) != (p_v > 0):
@@ -572,9 +576,9 @@ def full_prediction(
     cov_pt = np.empty((S, N, n_c, n_c))
     lat = np.empty((S, n_rlz, N, n_c))
     with blas_controller().limit(limits=1, user_api="blas"):
-        point = factors(emulator, emulator.params) if posterior is not None else None
+        point = gp_factors(emulator, emulator.params) if posterior is not None else None
         for i, prm in enumerate(sets):
-            fac = point if point is not None else factors(emulator, prm)
+            fac = point if point is not None else gp_factors(emulator, prm)
             m_i, C_i = _conditional(emulator, ob, prm, fac, xu, p_v, scalar)
             blocks = C_i.reshape(n_c, N, n_c, N)
             cov_pt[i] = np.einsum("cidi->icd", blocks)
@@ -604,9 +608,14 @@ def _conditional(emulator, ob, prm, fac, xu_new, p_v, scalar):
     Prior (per component, over the n observed and N new points): v_k ~ GP(0, R(x; betaV[:, g]) /
     lamVz[g]), g the precision group of basis vector k;
     u_j | w ~ the emulator GP given the runs (nugget 1/lamWs_j on every point; ``fac``: per
-    component the Cholesky factor of Sigma_W_j and Sigma_W_j^-1 w_j); then condition
-    on the observations' reduced data z = H [v_obs; u_obs] + N(0, Sigma_obs / lamOs), H the
-    identity (vector output) or the sum of the blocks (scalar output: z = u + v + e).
+    component `gp_factors`' Cholesky factor of Sigma_W_j, Sigma_W_j^-1 w_j and GLS fit); then
+    condition on the observations' reduced data z = H [v_obs; u_obs] + N(0, Sigma_obs / lamOs),
+    H the identity (vector output) or the sum of the blocks (scalar output: z = u + v + e).
+    Categorical inputs take their kernel in u's correlation and, the x ones, in v's (as the
+    joint fit's likelihood). With a mean basis h, u_j | w has the GLS mean h c_j + r^T alpha and
+    the coefficients' covariance G^T (H^T Sigma_W_j^-1 H)^-1 G, G = h^T - H^T Sigma_W_j^-1 r,
+    over the observed and new points together (``Emulator.predict``'s variance; the c_j, flat
+    prior, integrated out given w, then conditioned on the observations with the rest).
     """
     n, N, p_u = ob.n, xu_new.shape[0], emulator.p_u
     n_c = p_v + p_u
@@ -616,20 +625,30 @@ def _conditional(emulator, ob, prm, fac, xu_new, p_v, scalar):
     xt_all = np.hstack([x_all, theta])
     means = np.zeros((n_c, P))
     covs = np.empty((n_c, P, P))
+    cat = emulator.categorical_mask if extended(emulator) else None
+    basis = emulator.mean_basis
+    h = None if basis is None else basis.matrix(xt_all)
     if p_v:
         lam_vz, beta_v = prm["lamVz"], prm["betaV"]
-        cv = [correlation(x_all, None, beta_v[:, g]) / lam_vz[g] for g in range(lam_vz.size)]
+        x_cat = None if cat is None else cat[: emulator.p]
+        cv = [correlation(x_all, None, beta_v[:, g], x_cat) / lam_vz[g]
+              for g in range(lam_vz.size)]  # fmt: skip
         for c, g in enumerate(ob.block_groups):
             covs[c] = cv[g]
-    for j, (L, alpha) in enumerate(fac):
+    for j, (L, alpha, gls) in enumerate(fac):
         lam = prm["lamUz"][j]
         beta = prm["betaU"][:, j]
-        r = correlation(xt_all, emulator.zt, beta) / lam
+        r = correlation(xt_all, emulator.zt, beta, cat) / lam
         B = solve_triangular(L, r.T, lower=True)
-        c = correlation(xt_all, None, beta) / lam - B.T @ B
+        c = correlation(xt_all, None, beta, cat) / lam - B.T @ B
+        if gls is not None:  # the GLS coefficients' covariance
+            G = h.T - gls.A.T @ B
+            c += G.T @ cho_solve(gls.Q, G)
         c[np.diag_indices(P)] += 1.0 / prm["lamWs"][j]
         covs[p_v + j] = c
         means[p_v + j] = r @ alpha
+        if gls is not None:
+            means[p_v + j] += h @ gls.coef
     o, s = slice(0, n), slice(n, P)
     # H maps the stacked observed latents (n_c n) to the data z.
     if scalar:

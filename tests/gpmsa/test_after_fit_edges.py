@@ -73,12 +73,13 @@ def test_loo_equals_refits_without_each_run(mean_basis):
     np.testing.assert_allclose(loo.var, var, rtol=1e-9)
 
 
-def test_cross_validate_with_a_mean_basis_points_to_loo():
-    """cross_validate refuses a mean basis; its advice named predict and calibrate, not loo(),
-    the one cross-validation that supports it."""
+def test_cross_validate_with_a_mean_basis_equals_loo():
+    """cross_validate refused a mean basis (pointing to loo()); it now takes it, its
+    leave-one-out at the point estimate equal to loo() (functional output, p_u = 2)."""
     emu = _functional_emulator("linear")
-    with pytest.raises(GPMSAError, match=r"a mean basis; use Emulator\.loo\(\)"):
-        gpmsa.cross_validate(emu, folds=3)
+    cv, loo = gpmsa.cross_validate(emu, draws=False), emu.loo()
+    np.testing.assert_allclose(cv.mean, loo.mean, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(cv.var, loo.var, rtol=1e-10)
 
 
 @pytest.fixture(scope="module")

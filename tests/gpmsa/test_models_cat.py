@@ -293,11 +293,12 @@ def test_constraint_rejecting_the_start():
         gpmsa.fit(sim, obs, n_iter=5, constraint=above, fixed={"theta": 0.5})
 
 
-def test_other_backends_and_predictions_refuse_the_extensions(cat_emulator):
-    # gpmsa.sensitivity takes both (tests/gpmsa/test_sens_extensions_s71.py)
+def test_other_backends_refuse_the_extensions(cat_emulator):
+    # gpmsa.sensitivity takes both (tests/gpmsa/test_sens_extensions_s71.py), and so do
+    # emulator_prediction, full_prediction and cross_validate (test_predict_extensions_s71.py)
     assert gpmsa.sensitivity(cat_emulator, n_draws=2).names == ("s", "kind", "k")
-    with pytest.raises(gpmsa.GPMSAError, match="does not support an emulator with categorical"):
-        gpmsa.emulator_prediction(cat_emulator, [[0.5, 1]], [[0.5]])
+    mean = gpmsa.emulator_prediction(cat_emulator, [[0.5, 1]], [[0.5]], n_draws=5).mean()
+    assert np.allclose(mean, cat_emulator.predict([[0.5, 1]], [[0.5]], draws=True, n_draws=5)[0])
     pytest.importorskip("torch")
     with pytest.raises(gpmsa.GPMSAError, match="torch backend does not support categorical"):
         gpmsa.fit(cat_data(), n_iter=5, backend="torch")

@@ -20,7 +20,7 @@ from gpmsa import GPMSAError
 from gpmsa.model.correlation import correlation as R
 from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive import full_prediction
-from gpmsa.predictive._common import factors
+from gpmsa.predictive._common import gp_factors
 from gpmsa.predictive.full import _conditional
 
 
@@ -81,7 +81,7 @@ def test_conditional_equals_the_dense_joint_gaussian(groups):
         if groups is not None:  # a second group of other correlation and precision
             prm["betaV"] = np.hstack([prm["betaV"], 3.0 * prm["betaV"]])
             prm["lamVz"] = np.concatenate([prm["lamVz"], 0.2 * prm["lamVz"]])
-        mean, cov = _conditional(emu, ob, prm, factors(emu, prm), xn, ob.p_v, False)
+        mean, cov = _conditional(emu, ob, prm, gp_factors(emu, prm), xn, ob.p_v, False)
         ref_mean, ref_cov = _dense_reference(emu, ob, prm, xn)
         np.testing.assert_allclose(mean, ref_mean, atol=1e-10 * np.abs(ref_mean).max())
         np.testing.assert_allclose(cov, ref_cov, atol=1e-10 * np.abs(ref_cov).max())
