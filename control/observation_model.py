@@ -151,6 +151,11 @@ class ObservationModel:
         self.scatter = scatter
         (v_lo, v_hi) = emulator.domain[emulator.x_names[0]]
         (g_lo, g_hi) = emulator.domain[emulator.t_names[0]]
+        if not g_lo > 0:  # a given range, SimData(t_range=), may start at 0
+            raise EmulatorMismatchError(
+                f"the emulator's GD domain [{g_lo:g}, {g_hi:g}] must be positive: the block "
+                "likelihood's grid is uniform in log GD (fit with a t_range starting above 0)"
+            )
         self.speed_range = (float(v_lo), float(v_hi))
         self.gd = np.geomspace(g_lo, g_hi, int(n_grid))
         self.speed = np.linspace(v_lo, v_hi, int(n_speed))

@@ -813,8 +813,8 @@ def check_values(
             raise _fail("arrays/y_sd", f"{y_sd!r}, but the training outputs' sd is {sd!r}")
     elif (bad := np.flatnonzero(np.abs(sd - y_sd) > REL_TOL * sd)).size:
         k = int(bad[0])
-        raise _fail("arrays/y_sd", f"[{k}] = {y_sd[k]!r}, but the sd of the training outputs' "
-                                   f"column {k} is {sd[k]!r} (scaled columnwise)")  # fmt: skip
+        raise _fail("arrays/y_sd", f"[{k}] = {float(y_sd[k])!r}, but the sd of the training "
+                    f"outputs' column {k} is {float(sd[k])!r} (scaled columnwise)")  # fmt: skip
     K = arrays["K"]
     lam = np.sum(K**2, axis=0)
     if not np.all(lam > 0):

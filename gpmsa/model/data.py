@@ -477,6 +477,25 @@ def _check_spans(arr: np.ndarray, name: str, names) -> None:
             )
 
 
+def _range_table(value, names: tuple[str, ...], attr: str):
+    """A pandas DataFrame given as ``x_range`` / ``t_range`` read by its labels, as SimData
+    reads its tables (never by position): columns that name inputs (SEPIA's (2, d) layout, each
+    column (min, max)) or an index that names them (one (min, max) row per input), as a dict
+    name -> (min, max); a table whose labels name no input as it is (its rows in column order).
+    GPMSAError naming ``attr`` for a table naming an input twice."""
+    labels = column_labels(value)
+    if labels is None:
+        return value
+    rows = tuple(str(r) for r in value.index)
+    for found, by_column in ((labels, True), (rows, False)):
+        if found and all(n in names for n in found):
+            if len(set(found)) != len(found):
+                raise GPMSAError(f"{attr} names an input twice: {list(found)}")
+            arr = value.to_numpy()
+            return {n: arr[:, k] if by_column else arr[k] for k, n in enumerate(found)}
+    return value
+
+
 def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...], attr: str):
     """``SimData``'s ``x_range`` / ``t_range`` as one (min, max) or None per column of ``arr``
     (None where no column is given); GPMSAError naming the column for a range that is not two
@@ -485,6 +504,7 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
     if value is None:
         return None
     d = arr.shape[1]
+    value = _range_table(value, names, attr)
     if isinstance(value, dict):
         rows = [None] * d
         for name, pair in value.items():
@@ -600,7 +620,9 @@ class SimData:
     ``x_range``, ``t_range``: the native domain the unit scale maps onto [0, 1] (SEPIA's
     ``transform_xt(x_range=, t_range=)``), instead of the design's own min/max: an array
     (p, 2) / (q, 2) of (min, max) per column, or a dict name -> (min, max) for some columns
-    (the others keep the design's min/max; so does a None row). Each finite with min < max,
+    (the others keep the design's min/max; so does a None row); a pandas DataFrame by its
+    labels where its columns (SEPIA's (2, p) layout) or its index name the inputs, else by
+    position (one row per column). Each finite with min < max,
     the design inside it (else a GPMSAError naming the column), not for a categorical column.
     Stored as one ``(min, max)`` or None per column (None: no column given). A theta's uniform
     prior then covers the whole given range, and an input inside it is inside the emulator's
