@@ -515,10 +515,13 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
         rows = list(value)  # as SimData stores it: one (min, max) or None per column
     else:
         mat = as_float(value, attr)
+        if d == 1 and mat.shape == (2,):  # one column: its (min, max) alone
+            mat = mat.reshape(1, 2)
         if mat.ndim != 2 or mat.shape != (d, 2):
+            hint = " (SEPIA's (2, {d}) layout: transpose it)" if mat.shape == (2, d) else ""
             raise GPMSAError(
                 f"{attr} must be ({d}, 2), one (min, max) per column, or a dict name -> "
-                f"(min, max); got shape {mat.shape} (SEPIA's (2, {d}) layout: transpose it)"
+                f"(min, max); got shape {mat.shape}{hint.format(d=d)}"
             )
         rows = list(mat)
     out = []

@@ -38,3 +38,14 @@ def test_a_table_naming_an_input_twice_is_refused():
     twice = pd.DataFrame([[-1.0, 2.0], [90.0, 210.0]], index=["a", "a"])
     with pytest.raises(gpmsa.GPMSAError, match=r"x_range names an input twice"):
         _sim(twice)
+
+
+def test_one_parameter_takes_its_range_as_a_pair():
+    """q = 1: t_range=(lo, hi) is that parameter's (min, max) (it was refused as shape (2,));
+    SEPIA's (2, 1) layout is refused with the hint to transpose it, a (3, 2) without it."""
+    pair = gpmsa.SimData(x=X, t=T, y=X[:, :1] + T, x_names=["a", "b"], t_range=(-0.5, 1.5))
+    assert pair.t_range == ((-0.5, 1.5),)
+    with pytest.raises(gpmsa.GPMSAError, match=r"got shape \(2, 1\) \(SEPIA's"):
+        gpmsa.SimData(x=X, t=T, y=X[:, :1] + T, t_range=[[-0.5], [1.5]])
+    with pytest.raises(gpmsa.GPMSAError, match=r"got shape \(3, 2\)$"):
+        _sim([[0.0, 1.0], [0.0, 1.0], [0.0, 1.0]])

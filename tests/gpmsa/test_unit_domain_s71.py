@@ -72,7 +72,7 @@ def test_ranges_set_the_unit_domain_and_default_is_unchanged():
         ({"t_range": {"GD": (300, 600)}}, r"design column GD spans \[2\d\d.*outside its t_range"),
         ({"x_range": [[0.2, 1.0]]}, r"design column v spans .* outside its x_range \[0.2, 1\]"),
         ({"t_range": {"E": (0, 1)}}, r"t_range: 'E' is not a column"),
-        ({"t_range": [200, 600]}, r"t_range must be \(1, 2\)"),
+        ({"t_range": [[200], [600]]}, r"t_range must be \(1, 2\).*transpose it"),
         ({"x_range": [[0, 1, 2]]}, r"x_range must be \(1, 2\)"),
         ({"t_range": {"GD": "200..600"}}, r"t_range\[GD\] must be a numeric array"),
         ({"t_range": {"GD": (200, 600, 700)}}, r"t_range\[GD\] must be \(min, max\)"),
