@@ -10,6 +10,9 @@ ones for several); fixed parameters are constants. A parameter with held element
 (``problem.fixed_elements``) is one site of its free elements (flattened, C order; their own
 bounds), scattered with the held values into the full array; the held elements' priors are left
 out, as the numpy backend leaves them out.
+Categorical inputs and a "constant" or "linear" mean basis (its coefficients integrated out, as
+the numpy likelihood's) are sampled; a categorical theta, a theta constraint and a callable mean
+basis with theta sampled are refused (`refuse_unsupported`).
 """
 
 from __future__ import annotations
@@ -28,7 +31,9 @@ from gpmsa.backends import check_sample_args
 from gpmsa.backends.torch_backend import (
     SIM_PARAMS,
     ModelTensors,
+    gls,
     log_prior_elements,
+    mean_rows,
     obs_loglik,
     sim_factor,
     torch_threads,
@@ -104,7 +109,10 @@ class PyroModel:
             chol, alpha, ll = sim_factor(
                 d.d_sim, d.w, d.lam_sim, *(self.const[k] for k in SIM_PARAMS)
             )
-            self.sim_cache = (chol, alpha, ll.sum(-1))
+            coef = None
+            if d.h_sim is not None:
+                alpha, ll, coef = gls(chol, alpha, ll, d.h_sim)
+            self.sim_cache = (chol, alpha, ll.sum(-1), coef)
 
     def init_values(self, start: dict[str, np.ndarray] | None = None) -> dict[str, torch.Tensor]:
         """A chain's starting values (name -> array; default GPM/SA's ``problem.init``) in the
@@ -139,12 +147,16 @@ class PyroModel:
         """GPM/SA log-likelihood (C,) at parameters name -> (C, *shape)."""
         d = self.data
         if self.sim_cache is not None:
-            chol, alpha, ll_w = self.sim_cache  # shared by all draws (leading axis 1)
+            chol, alpha, ll_w, coef = self.sim_cache  # shared by all draws (leading axis 1)
         else:
             chol, alpha, ll = sim_factor(d.d_sim, d.w, d.lam_sim, *(prm[k] for k in SIM_PARAMS))
+            coef = None
+            if d.h_sim is not None:  # the mean basis's coefficients integrated out
+                alpha, ll, coef = gls(chol, alpha, ll, d.h_sim)
             ll_w = ll.sum(-1)
         if d.has_obs:
-            ll_w = ll_w + obs_loglik(d, chol, alpha, prm)
+            h_obs = None if coef is None else mean_rows(self.problem, d, prm["theta"])
+            ll_w = ll_w + obs_loglik(d, chol, alpha, prm, coef, h_obs)
         return ll_w
 
     def log_prior(self, prm: dict[str, torch.Tensor]) -> torch.Tensor:
@@ -182,6 +194,34 @@ def _scatter(init: np.ndarray, held: np.ndarray, dtype: torch.dtype):
     order[free], order[fixed] = np.arange(free.size), free.size + np.arange(fixed.size)
     values = torch.as_tensor(init.reshape(-1)[fixed], dtype=dtype)
     return torch.as_tensor(free), torch.as_tensor(order), values
+
+
+def refuse_unsupported(problem: Problem) -> None:
+    """GPMSAError naming what of ``problem``'s extensions NUTS cannot sample (categorical inputs
+    and a named mean basis it can; a fixed or held theta lifts the theta-side refusals): a
+    categorical calibration parameter (discrete: no gradient), a theta constraint (a hard
+    boundary inside theta's support) and a callable mean basis at the observations' sampled
+    theta (a numpy callable: no gradient)."""
+    masks = problem.held_masks(("theta",))
+    held = masks.get("theta", np.zeros(problem.q, dtype=bool)) if "theta" in problem.init else None
+    free = None if held is None else ~held  # theta's free elements (None: no theta)
+    what = []
+    if free is not None and problem.theta_levels is not None:
+        what += [
+            f"categorical calibration parameters (theta element {k})"
+            for k, lv in enumerate(problem.theta_levels)
+            if lv is not None and free[k]
+        ]
+    if free is not None and free.any() and problem.constraint is not None:
+        what.append("theta constraints")
+    mean = problem.mean_basis
+    if free is not None and free.any() and mean is not None and mean.kind == "callable":
+        what.append("a callable mean_basis with theta sampled ('constant' and 'linear' it takes)")
+    if what:
+        raise GPMSAError(
+            f"the pyro backend does not support {'; '.join(what)} (NUTS moves continuously, on "
+            "gradients, inside theta's box); use backend='numpy' or 'torch'"
+        )
 
 
 MIN_DRAWS = 4
@@ -258,11 +298,7 @@ def sample(
             f"n_jobs={n_jobs}: the pyro backend runs its chains one after another in this "
             "process; leave n_jobs=None (or 1)"
         )
-    if problem.extensions:
-        raise GPMSAError(
-            f"the pyro backend does not support {', '.join(problem.extensions)}; use "
-            "backend='numpy'"
-        )
+    refuse_unsupported(problem)
     warmup = _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass,
                               jit)  # fmt: skip
     seqs = np.random.SeedSequence(seed).spawn(int(n_chains))

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import torch
-from scipy.linalg import lapack
+from scipy.linalg import cho_solve, lapack
 from threadpoolctl import threadpool_limits
 from tqdm.auto import tqdm
 
@@ -36,7 +36,7 @@ from gpmsa.backends import check_sample_args
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import ridge, starts, tuning
-from gpmsa.mcmc.parallel import n_workers, run_chains
+from gpmsa.mcmc.parallel import in_this_process, n_workers, run_chains
 from gpmsa.mcmc.sampler import (
     PRECISION_PARAMS,
     RHO_PARAMS,
@@ -49,8 +49,9 @@ from gpmsa.mcmc.sampler import (
     proportional_step_choice,
     wrong_result,
 )
+from gpmsa.model.correlation import CATEGORICAL_DISTANCE, sq_diffs
 from gpmsa.model.data import check_count, check_flag
-from gpmsa.model.likelihood import held_log_prior
+from gpmsa.model.likelihood import held_log_prior, lower_cholesky
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem
 
@@ -81,6 +82,11 @@ class ModelTensors:
     Packed lower triangle (a factorisation reads only that): ``rows`` the row blocks (a, b)
     (rows a..b-1, columns 0..b-1), ``d_packed`` (p+q, P) d_sim over them, ``packed_index`` (P,)
     their flat positions in an m x m matrix.
+    Extensions (``Problem.extensions``; docs/categorical-and-constraints.md): a categorical input's
+    d_sim, d_obs and d_cross hold ``CATEGORICAL_DISTANCE`` between different levels (0 within
+    one) and ``theta_cat`` (q,) marks the categorical calibration parameters (None: none);
+    ``h_sim`` (m, k) the mean basis on the design (None: zero mean), ``x_obs`` (n, p) the
+    observations' unit inputs where the mean basis reads them.
     """
 
     p: int
@@ -100,6 +106,9 @@ class ModelTensors:
     rows: tuple[tuple[int, int], ...] = ()
     d_packed: Tensor | None = None
     packed_index: Tensor | None = None
+    theta_cat: Tensor | None = None
+    h_sim: Tensor | None = None
+    x_obs: Tensor | None = None
 
     @property
     def has_obs(self) -> bool:
@@ -114,14 +123,22 @@ class ModelTensors:
             return torch.tensor(np.ascontiguousarray(a), dtype=dtype, device=device)
 
         zt = problem.zt
+        cat = problem.categorical
+        x_cat = None if cat is None else cat[: problem.p]
         kw = {}
+        if problem.mean_basis is not None:
+            kw["h_sim"] = t(problem.mean_basis.matrix(zt))
         obs = problem.obs
         if obs is not None:
             u_blocks = (0,) if obs.scalar_out else tuple(obs.p_v + j for j in range(problem.p_u))
             groups = obs.block_groups if "betaV" in problem.init else ()
-            kw = {
-                "d_obs": t(pairwise_sq(obs.x, obs.x)),
-                "d_cross": t(pairwise_sq(obs.x, problem.x_sim)),
+            if cat is not None and cat[problem.p :].any():
+                kw["theta_cat"] = torch.as_tensor(cat[problem.p :], device=device)
+            if problem.mean_basis is not None:
+                kw["x_obs"] = t(obs.x)
+            kw |= {
+                "d_obs": t(_sq_diffs(obs.x, obs.x, x_cat)),
+                "d_cross": t(_sq_diffs(obs.x, problem.x_sim, x_cat)),
                 "z": t(obs.z),
                 "sig_obs": t(obs.sig_obs),
                 "u_blocks": u_blocks,
@@ -129,7 +146,7 @@ class ModelTensors:
                 "v_groups": groups,
                 "n_null": obs.n_null,
             }
-        d_sim = pairwise_sq(zt, zt)
+        d_sim = _sq_diffs(zt, zt, cat)
         rows = row_blocks(problem.m)
         index = np.concatenate([(np.arange(a, b)[:, None] * problem.m + np.arange(b)).ravel()
                                 for a, b in rows])  # fmt: skip
@@ -155,6 +172,14 @@ def row_blocks(m: int, n_blocks: int = N_BLOCKS) -> tuple[tuple[int, int], ...]:
 def pairwise_sq(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Squared differences per column: a (na, k), b (nb, k) -> (k, na, nb)."""
     return (a.T[:, :, None] - b.T[:, None, :]) ** 2
+
+
+def _sq_diffs(a: np.ndarray, b: np.ndarray, categorical: np.ndarray | None) -> np.ndarray:
+    """`pairwise_sq`, a categorical column (``categorical``: boolean mask, None: none) giving
+    ``CATEGORICAL_DISTANCE`` between different levels, as the numpy likelihood's."""
+    if categorical is None or not categorical.any():
+        return pairwise_sq(a, b)
+    return sq_diffs(a, b, categorical)
 
 
 def scaled_correlation(beta: Tensor, d: Tensor, lam: Tensor) -> Tensor:
@@ -249,9 +274,10 @@ def _factor_scaled(
     corr: Tensor, scale: Tensor, data: ModelTensors, comps: slice, lamWs: Tensor,
     lamWOs: Tensor, out: Tensor | None = None, scratch: np.ndarray | None = None,
     only: Tensor | None = None,
-) -> tuple[Tensor | None, Tensor, Tensor]:  # fmt: skip
+) -> tuple[Tensor | None, Tensor, Tensor, Tensor | None]:  # fmt: skip
     """``sim_factor`` of components ``comps`` from their packed correlation corr (C, J, P) and
-    scale = 1/lamUz (C, J).
+    scale = 1/lamUz (C, J); with a mean basis (``data.h_sim``) its coefficients integrated out
+    as `gls` (the fourth item, coef (C, J, k); None without one).
 
     On the CPU, chain by chain and component by component: Sigma = corr * scale + nugget I is
     built (lower triangle) in one m x m buffer, factored there by LAPACK and solved against w
@@ -265,9 +291,12 @@ def _factor_scaled(
     if not _on_lapack(corr):
         sig = unpack(corr * scale[..., None], data)
         chol, alpha, ll = _factor_sigma(sig, w, lam_sim, lamWs, lamWOs)
+        coef = None
+        if data.h_sim is not None:
+            alpha, ll, coef = gls(chol, alpha, ll, data.h_sim)
         if out is not None:
             out.copy_(chol)
-        return chol, alpha, ll
+        return chol, alpha, ll, coef
     nugget = (1.0 / (lam_sim * lamWOs) + 1.0 / lamWs).numpy()
     c_n, j_n, _ = corr.shape
     m = data.d_sim.shape[-1]
@@ -283,6 +312,8 @@ def _factor_scaled(
     trtrs = lapack.dtrtrs if corr.dtype == torch.float64 else lapack.strtrs
     alpha = np.zeros((c_n, j_n, m), dtype=cr.dtype)
     ll = np.full((c_n, j_n), -np.inf)
+    h = None if data.h_sim is None else np.asfortranarray(data.h_sim.numpy())
+    coef = None if h is None else np.zeros((c_n, j_n, h.shape[1]), dtype=cr.dtype)
 
     def views(a_: np.ndarray) -> tuple[np.ndarray, list, np.ndarray]:
         """a_'s transpose (LAPACK's view), its row blocks and its diagonal."""
@@ -300,9 +331,22 @@ def _factor_scaled(
             if potrf(lapack_view, lower=0, clean=0, overwrite_a=1)[1] != 0:
                 continue
             v, _ = trtrs(lapack_view, wn[j], lower=0, trans=1)
-            alpha[c, j] = v
-            ll[c, j] = -np.log(diag).sum() - 0.5 * (v @ v)
-    return out, torch.from_numpy(alpha), torch.from_numpy(ll).to(corr.dtype)
+            if h is None:
+                alpha[c, j] = v
+                ll[c, j] = -np.log(diag).sum() - 0.5 * (v @ v)
+                continue
+            # restricted likelihood, as the numpy likelihood's (IncrementalLikelihood._factor)
+            a_h, _ = trtrs(lapack_view, h, lower=0, trans=1)
+            lq = lower_cholesky(a_h.T @ a_h)
+            if lq is None:
+                continue
+            coef[c, j] = cf = cho_solve((lq, True), a_h.T @ v)
+            alpha[c, j] = v = v - a_h @ cf
+            val = -float(np.sum(np.log(diag)))
+            val -= float(np.sum(np.log(np.diagonal(lq))))
+            ll[c, j] = val - 0.5 * float(v @ v)
+    return (out, torch.from_numpy(alpha), torch.from_numpy(ll).to(corr.dtype),
+            None if coef is None else torch.from_numpy(coef))  # fmt: skip
 
 
 def _factor_sigma(
@@ -316,18 +360,58 @@ def _factor_sigma(
     return chol, alpha, ll
 
 
-def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, Tensor]) -> Tensor:
+def gls(chol: Tensor, alpha: Tensor, ll: Tensor, h: Tensor) -> tuple[Tensor, Tensor, Tensor]:
+    """A mean basis's coefficients integrated out (``gpmsa.model.mean_basis``: the restricted
+    likelihood, as the numpy likelihood's): from ``sim_factor``'s chol (C, J, m, m), alpha =
+    chol^-1 w (C, J, m) and ll (C, J), and h (m, k) the basis on the design, returns
+    (chol^-1 (w - h coef), -sum log diag chol - sum log diag chol(A^T A) - |chol^-1 (w - h
+    coef)|^2 / 2, coef (C, J, k)) with A = chol^-1 h and coef = (A^T A)^-1 A^T alpha (GLS);
+    -inf where ll is, or A^T A is not positive definite."""
+    a = torch.linalg.solve_triangular(chol, h.expand(*chol.shape[:-2], *h.shape), upper=False)
+    a_t = a.transpose(-1, -2)
+    lq, info = torch.linalg.cholesky_ex(a_t @ a)
+    coef = torch.cholesky_solve(a_t @ alpha.unsqueeze(-1), lq).squeeze(-1)
+    resid = alpha - (a @ coef.unsqueeze(-1)).squeeze(-1)
+    val = -torch.log(torch.diagonal(chol, dim1=-2, dim2=-1)).sum(-1)
+    val = val - torch.log(torch.diagonal(lq, dim1=-2, dim2=-1)).sum(-1) - 0.5 * (resid**2).sum(-1)
+    bad = (info != 0) | ~torch.isfinite(ll) | ~torch.isfinite(val)
+    return resid, torch.where(bad, torch.full_like(val, -torch.inf), val), coef
+
+
+def mean_rows(problem: Problem, data: ModelTensors, theta: Tensor) -> Tensor:
+    """The mean basis h([x_obs, theta]) (C, n, k) at each chain's theta (C, q): "constant" and
+    "linear" by tensor ops (differentiable), a callable on each chain's (n, p + q) numpy array
+    (``MeanBasis.matrix``, as the numpy likelihood calls it)."""
+    mb, x = problem.mean_basis, data.x_obs
+    c, n = theta.shape[0], x.shape[0]
+    if mb.kind == "constant":
+        return theta.new_ones((c, n, 1))
+    if mb.kind == "linear":
+        return torch.cat([theta.new_ones((c, n, 1)), x.expand(c, -1, -1),
+                          theta.unsqueeze(1).expand(-1, n, -1)], -1)  # fmt: skip
+    x_np, th = problem.obs.x, theta.detach().cpu().numpy().astype(np.float64)
+    rows = [mb.matrix(np.hstack([x_np, np.tile(t_c, (n, 1))])) for t_c in th]
+    return torch.as_tensor(np.stack(rows), dtype=theta.dtype, device=theta.device)
+
+
+def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, Tensor],
+               coef: Tensor | None = None, h_obs: Tensor | None = None) -> Tensor:  # fmt: skip
     """log N(z; [0; S_UW S_W^-1 w], blockdiag(S_V, S_U - S_UW S_W^-1 S_WU) + S_obs / lamOs).
 
     chol (C, p_u, m, m), alpha (C, p_u, m) from ``sim_factor`` (a leading 1 instead of C: one
     Sigma_W shared by all chains); prm: theta (C, q), betaU (C, p+q, p_u), lamUz, lamWs (C, p_u),
     lamOs (C, 1), and betaV (C, p, G), lamVz (C, G) when there is a discrepancy of G precision
-    groups. Returns (C,).
+    groups. With a mean basis: coef (C, p_u, k) from `gls` (alpha its chol^-1 (w - h coef))
+    and h_obs (C, n, k) from `mean_rows`, the u blocks' mean adding h_obs coef.
+    Returns (C,).
     """
     p, n = data.p, data.d_obs.shape[-1]
     betaU, lamUz = prm["betaU"], prm["lamUz"]
     b_x, b_t = betaU[:, :p], betaU[:, p:]
     dt = (prm["theta"].unsqueeze(-1) - data.t_sim.T) ** 2  # (C, q, m)
+    if data.theta_cat is not None:  # a categorical theta: 1/4 between levels
+        differ = (prm["theta"].unsqueeze(-1) != data.t_sim.T).to(dt.dtype)
+        dt = torch.where(data.theta_cat[:, None], CATEGORICAL_DISTANCE * differ, dt)
     expo = torch.einsum("ckj,kab->cjab", b_x, data.d_cross)
     expo = expo + torch.einsum("ckj,ckm->cjm", b_t, dt).unsqueeze(-2)
     s_uw = torch.exp(-expo) / lamUz[..., None, None]  # (C, p_u, n, m)
@@ -339,6 +423,9 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
     else:
         a = torch.linalg.solve_triangular(chol, s_uw.transpose(-1, -2), upper=False)
     mean_u = (a * alpha.unsqueeze(-1)).sum(-2)  # (C, p_u, n)
+    if coef is not None:  # the GLS mean at [x_obs, theta]
+        coef = coef.expand(h_obs.shape[0], -1, -1)  # one shared Sigma_W: one coef
+        mean_u = mean_u + torch.einsum("cnk,cjk->cjn", h_obs, coef)
     cond = scaled_correlation(b_x, data.d_obs, lamUz) - a.transpose(-1, -2) @ a
     cond = _add_diagonal(cond, (1.0 / prm["lamWs"]).unsqueeze(-1))
     full = data.sig_obs / prm["lamOs"][..., None]  # (C, N, N)
@@ -409,7 +496,14 @@ def _copy_rows(dst: Tensor, src: Tensor, rows: Tensor) -> None:
 
 
 class BatchState:
-    """C chains of one problem: parameters, cached Sigma_W factors and the batched sweep."""
+    """C chains of one problem: parameters, cached Sigma_W factors and the batched sweep.
+
+    As the numpy sampler (``gpmsa.mcmc.sampler.ChainState``): a categorical theta element moves
+    to another of its levels drawn uniformly (its prior uniform over them); a theta proposal
+    the theta constraint refuses is rejected before its likelihood (the constraint called per
+    chain); with a mean basis the coefficients are integrated out (`gls`) and the observations'
+    mean adds the GLS trend h([x_obs, theta]) coef (`mean_rows`, cached per chain).
+    """
 
     def __init__(self, problem: Problem, n_chains: int, dtype: torch.dtype, device,
                  start: dict[str, np.ndarray] | None = None, ridge_moves: int = 0):  # fmt: skip
@@ -426,6 +520,15 @@ class BatchState:
         # the held elements' constant share of the whole-array priors in log_post
         self._held_lp = held_log_prior(problem, problem.init) if problem.fixed_elements else 0.0
         self.n_chains = n_chains
+        levels = problem.theta_levels or [None] * problem.q
+        self.levels = {k: torch.as_tensor(lv, dtype=dtype, device=device)
+                       for k, lv in enumerate(levels) if lv is not None}  # fmt: skip
+        self.constraint = problem.constraint if "theta" in problem.sampled else None
+        if self.constraint is not None:
+            for c in range(n_chains):
+                theta = problem.init["theta"] if start is None else start["theta"][c]
+                self.constraint.check_start(np.asarray(theta, dtype=np.float64),
+                                            "the chain's start")  # fmt: skip
         if start is None:
             start = {k: np.broadcast_to(v, (n_chains, *v.shape)) for k, v in problem.init.items()}
         self.reset({
@@ -454,26 +557,32 @@ class BatchState:
         d = self.data
         shared = all(k in self.problem.fixed for k in SIM_PARAMS)  # calibration: one Sigma_W
         prm = {k: params[k][:1] if shared else params[k] for k in SIM_PARAMS}
+        self.coef = None
         if shared:  # one Sigma_W, factored once
             self.corr = None
             sig = scaled_correlation(prm["betaU"], d.d_sim, prm["lamUz"])
             self.chol, self.alpha, self.ll_w = _factor_sigma(
                 sig, d.w, d.lam_sim, prm["lamWs"], prm["lamWOs"]
             )
+            if d.h_sim is not None:
+                self.alpha, self.ll_w, self.coef = gls(self.chol, self.alpha, self.ll_w, d.h_sim)
         else:  # R_j per chain, packed and cached: a precision proposal only rescales it
             n, p_u, m = self.n_chains, d.w.shape[0], d.d_sim.shape[-1]
             corr = prm["betaU"].new_empty((n, p_u, d.d_packed.shape[-1]))
             self.corr = correlation_packed(prm["betaU"], d, corr)
             chol = prm["betaU"].new_empty((n, p_u, m, m)) if d.has_obs else None
-            self.chol, self.alpha, self.ll_w = _factor_scaled(
+            self.chol, self.alpha, self.ll_w, self.coef = _factor_scaled(
                 self.corr, 1.0 / prm["lamUz"], d, slice(None), prm["lamWs"], prm["lamWOs"],
                 out=chol, scratch=self._scratch,
             )  # fmt: skip
         if shared:
             self.ll_w = self.ll_w.expand(self.n_chains, -1).clone()
         if not d.has_obs:
-            self.chol = self.alpha = None  # not needed by the simulation-only likelihood
-        self.ll_obs = self._obs(params, self.chol, self.alpha)
+            self.chol = self.alpha = self.coef = None  # not needed without observations
+        self.h_obs = None
+        if d.has_obs and self.coef is not None:
+            self.h_obs = mean_rows(self.problem, d, params["theta"])
+        self.ll_obs = self._obs(params, self.chol, self.alpha, self.coef, self.h_obs)
 
     @property
     def loglik(self) -> Tensor:
@@ -485,14 +594,44 @@ class BatchState:
         lp = self.loglik
         for name in self.problem.sampled:
             x = self.params[name]
-            lp = lp + log_prior_elements(self.priors, name, x).reshape(x.shape[0], -1).sum(-1)
+            each = log_prior_elements(self.priors, name, x)
+            if name == "theta" and self.data.theta_cat is not None:  # uniform over its levels
+                each = torch.where(self.data.theta_cat, torch.zeros_like(each), each)
+            lp = lp + each.reshape(x.shape[0], -1).sum(-1)
         return lp - self._held_lp if self.problem.fixed_elements else lp
 
-    def _obs(self, prm: dict[str, Tensor], chol: Tensor | None, alpha: Tensor | None) -> Tensor:
+    def _obs(self, prm: dict[str, Tensor], chol: Tensor | None, alpha: Tensor | None,
+             coef: Tensor | None = None, h_obs: Tensor | None = None) -> Tensor:  # fmt: skip
         """Observation term (C',) at ``prm`` given the Sigma_W factors (zeros without obs)."""
         if not self.data.has_obs:
             return self.ll_w.new_zeros(prm["betaU"].shape[0])
-        return obs_loglik(self.data, chol, alpha, prm)
+        return obs_loglik(self.data, chol, alpha, prm, coef, h_obs)
+
+    def _allowed(self, idx: tuple[int, ...], cand: Tensor, valid: Tensor) -> Tensor:
+        """``valid`` less the chains whose theta with element ``idx`` at ``cand`` (C,) the theta
+        constraint refuses (called per chain, as the numpy sampler calls it)."""
+        theta = self.params["theta"].cpu().numpy().astype(np.float64)
+        cands = cand.cpu().numpy().astype(np.float64)
+        out = valid.clone()
+        for c in torch.nonzero(valid).flatten().tolist():
+            th = theta[c].copy()
+            th[idx] = cands[c]
+            out[c] = bool(self.constraint(th))
+        return out
+
+    def _level_move(self, k: int, x: Tensor, u0: Tensor) -> tuple[Tensor, Tensor]:
+        """(candidates, valid) for categorical theta element k at x (C,): another of its levels
+        drawn uniformly by u0 (C,), as the numpy sampler's ``others[int(u0 * others.size)]``
+        (the other levels in order); invalid where it has one level."""
+        lv = self.levels[k]
+        n_other = lv.numel() - 1
+        if n_other == 0:
+            return x, torch.zeros_like(x, dtype=torch.bool)
+        at = lv == x.unsqueeze(-1)  # (C, K): x's level
+        pos = torch.where(at.any(-1), at.to(torch.long).argmax(-1), lv.numel())
+        pick = torch.floor(u0 * n_other).to(torch.long)
+        pick = pick + (pick >= pos).to(torch.long)  # skip x's own level
+        return lv[pick], torch.ones_like(x, dtype=torch.bool)
 
     def update(self, name: str, idx: tuple[int, ...], width: float, kind: int, prop_mh: bool,
                u: Tensor) -> Tensor:  # fmt: skip
@@ -505,7 +644,10 @@ class BatchState:
         step = u[0] - 0.5
         corr = torch.zeros_like(x)
         valid = torch.ones_like(x, dtype=torch.bool)
-        if kind == 1:  # beta on the rho scale
+        level = name == "theta" and idx[0] in self.levels
+        if level:  # another level, uniformly (symmetric; the prior is uniform over them)
+            cand, valid = self._level_move(idx[0], x, u[0])
+        elif kind == 1:  # beta on the rho scale
             r = torch.exp(-0.25 * x) + width * step
             valid = r > 0.0
             cand = -4.0 * torch.log(torch.where(valid, r, torch.ones_like(r)))
@@ -517,8 +659,13 @@ class BatchState:
             corr = torch.log(w0 / w1)
         else:
             cand = x + width * step
-        lp_new = log_prior_elements(self.priors, name, cand, idx[-1])
+        if level:
+            lp_new = torch.zeros_like(x)
+        else:
+            lp_new = log_prior_elements(self.priors, name, cand, idx[-1])
         valid &= torch.isfinite(lp_new)
+        if name == "theta" and self.constraint is not None and valid.any():
+            valid = self._allowed(idx, cand, valid)  # zero prior mass outside the constraint
         accepted = torch.zeros_like(valid)
         if not valid.any():
             return accepted
@@ -528,7 +675,9 @@ class BatchState:
         prm[name] = cur.clone()
         prm[name][(slice(None), *idx)] = cand
         d = self.data
-        chol, alpha, ll_w = self.chol, self.alpha, self.ll_w
+        chol, alpha, ll_w, coef, h_obs = self.chol, self.alpha, self.ll_w, self.coef, self.h_obs
+        if name == "theta" and h_obs is not None:
+            h_obs = mean_rows(self.problem, d, prm["theta"])
         if name in SIM_PARAMS:
             whole = name == "lamWOs" or d.w.shape[0] == 1
             comps = slice(None) if whole else slice(idx[-1], idx[-1] + 1)
@@ -538,21 +687,24 @@ class BatchState:
                                             self._buffer("corr", j_c))  # fmt: skip
             else:  # the cached one, rescaled
                 corr_c = self.corr[:, comps]
-            chol_c, alpha_c, ll_c = _factor_scaled(
+            chol_c, alpha_c, ll_c, coef_c = _factor_scaled(
                 corr_c, 1.0 / prm["lamUz"][:, comps], d, comps, prm["lamWs"][:, comps],
                 prm["lamWOs"], out=self._buffer("chol", j_c) if d.has_obs else None,
                 scratch=self._scratch, only=valid,
             )  # fmt: skip
-            ll_w, chol, alpha = ll_c, chol_c, alpha_c
+            ll_w, chol, alpha, coef = ll_c, chol_c, alpha_c, coef_c
             if not whole:
                 ll_w = self.ll_w.clone()
                 ll_w[:, comps] = ll_c
                 if d.has_obs:
                     chol, alpha = self.chol.clone(), self.alpha.clone()
                     chol[:, comps], alpha[:, comps] = chol_c, alpha_c
-        ll_obs = self._obs(prm, chol, alpha)
+                    if coef_c is not None:
+                        coef = self.coef.clone()
+                        coef[:, comps] = coef_c
+        ll_obs = self._obs(prm, chol, alpha, coef, h_obs)
         ll_new = ll_w.sum(-1) + ll_obs
-        lp_old = log_prior_elements(self.priors, name, x, idx[-1])
+        lp_old = lp_new if level else log_prior_elements(self.priors, name, x, idx[-1])
         ratio = ll_new - self.loglik + lp_new - lp_old + corr
         acc = (torch.log(u[1]) < ratio) & valid
         take = torch.nonzero(acc).squeeze(-1)
@@ -566,6 +718,10 @@ class BatchState:
             if d.has_obs:
                 _copy_rows(self.chol[:, comps], chol_c, take)
                 self.alpha[take, comps] = alpha_c[take]
+                if coef_c is not None:
+                    self.coef[take, comps] = coef_c[take]
+        if name == "theta" and h_obs is not None:
+            self.h_obs[take] = h_obs[take]
         return accepted
 
     def sweep(self, widths: np.ndarray, prop_mh: bool, gen: torch.Generator) -> Tensor:
@@ -719,22 +875,33 @@ def sample(
     ``chain_groups`` and ``seed``, never on ``n_jobs`` or where the groups ran; each worker
     runs one thread (``num_threads`` must be 1); a failed group is retried as the numpy
     backend's chains are (``gpmsa.mcmc.parallel``), then ``ChainError`` names its chains.
+    A theta constraint or a callable mean basis (callables of this process) keeps the groups
+    in this process, one after another (an ``executor`` is refused), as the numpy backend's
+    chains (``gpmsa.mcmc.parallel.in_this_process``).
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
     check_draws_memory(problem, int(n_iter), int(n_chains))
-    if problem.extensions:
-        raise GPMSAError(
-            f"the torch backend does not support {', '.join(problem.extensions)}; use "
-            "backend='numpy'"
-        )
     check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype))
     where = _check_groups(chain_groups, n_jobs, executor, int(n_chains), device, num_threads)
+    where["n_jobs"], where["executor"] = in_this_process(
+        callables(problem), where["n_jobs"], where["executor"], where["groups"]
+    )
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,
                        tune_stages, check_ridge(ridge_moves, problem), where, prop_mh)  # fmt: skip
+
+
+def callables(problem: Problem) -> list[str]:
+    """The callables of this process ``problem`` holds (names for `in_this_process`): a theta
+    constraint, a callable mean basis."""
+    mean = problem.mean_basis
+    return [name for name, on in (
+        ("constraint", problem.constraint is not None),
+        ("mean_basis", mean is not None and mean.kind == "callable"),
+    ) if on]  # fmt: skip
 
 
 def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torch.dtype) -> None:

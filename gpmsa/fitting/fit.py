@@ -210,7 +210,7 @@ def fit(
     reserved = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress", "n_jobs",
                 "executor")  # fmt: skip
     backends.check_options(backend, options, reserved, "fit")
-    if backend == "numpy":  # (the others refuse these extensions)
+    if backend == "numpy":  # (torch's sample keeps its callables here itself; pyro refuses them)
         mean = problem.mean_basis
         callables = [name for name, on in (
             ("constraint", problem.constraint is not None),

@@ -173,7 +173,8 @@ class Problem:
     @property
     def extensions(self) -> tuple[str, ...]:
         """The features beyond GPM/SA's model this problem uses (categorical inputs, a mean
-        basis, a theta constraint): only the numpy backend samples them."""
+        basis, a theta constraint): the numpy and torch backends sample them, pyro some
+        (``gpmsa.backends.pyro_backend.refuse_unsupported``)."""
         used = (("categorical inputs", self.categorical is not None),
                 ("mean_basis", self.mean_basis is not None),
                 ("theta constraint", self.constraint is not None))  # fmt: skip

@@ -293,15 +293,16 @@ def test_constraint_rejecting_the_start():
         gpmsa.fit(sim, obs, n_iter=5, constraint=above, fixed={"theta": 0.5})
 
 
-def test_other_backends_refuse_the_extensions(cat_emulator):
+def test_other_tools_and_the_torch_backend_take_the_extensions(cat_emulator):
     # gpmsa.sensitivity takes both (tests/gpmsa/test_sens_extensions_s71.py), and so do
     # emulator_prediction, full_prediction and cross_validate (test_predict_extensions_s71.py)
     assert gpmsa.sensitivity(cat_emulator, n_draws=2).names == ("s", "kind", "k")
     mean = gpmsa.emulator_prediction(cat_emulator, [[0.5, 1]], [[0.5]], n_draws=5).mean()
     assert np.allclose(mean, cat_emulator.predict([[0.5, 1]], [[0.5]], draws=True, n_draws=5)[0])
+    # the torch backend samples them too (tests/gpmsa/test_backend_extensions_s71.py)
     pytest.importorskip("torch")
-    with pytest.raises(gpmsa.GPMSAError, match="torch backend does not support categorical"):
-        gpmsa.fit(cat_data(), n_iter=5, backend="torch")
+    emu = gpmsa.fit(cat_data(), n_iter=5, backend="torch", tune=False, warmup=0, seed=0)
+    assert emu.categorical == {"kind": (0, 1, 2)} and np.all(np.isfinite(emu.draws["betaU"]))
 
 
 def test_info_shows_categorical_and_mean_basis(cat_emulator, tmp_path, capsys):
