@@ -1,10 +1,12 @@
 """False alarms and power of the sensor checks (`control.sensor_checks`) on clean campaign drives.
 
     PYTHONPATH=. python benchmarks/sensor_checks.py [--seed 7] [--keep-s 120] [--workers 2]
-        [--cases AB]
+        [--cases AB] [--drives 198]
 
-Runs the training campaign's design (198 drives of ``--keep-s`` s, campaign ``--seed``) without
-and with N(0, 1) sensor noise, cuts each drive into blocks of 125 samples and prints, per case:
+Runs the training campaign's design (``--drives`` drives of ``--keep-s`` s, campaign ``--seed``:
+``lhs_design(drives, seed=seed)``, GD 200-600 at 0.5-2 m/s; 198 is the training campaign's)
+without and with N(0, 1) sensor noise, cuts each drive into blocks of 125 samples and prints, per
+case:
 - the blocks that `signal_fault` flags (every check, with the sensor's noise sd where it has
   noise): the false alarms, which should be none;
 - the most lattice-like stretch of the lattice check (`lattice_stretch`, 6 and 8 samples, with
@@ -13,7 +15,11 @@ and with N(0, 1) sensor noise, cuts each drive into blocks of 125 samples and pr
   rounded to ADC resolutions of 0.001-0.1 m/s^2 (every fourth block), as a real IMU's would be;
 - the share of blocks in which the lattice check finds 6, 7 or 10 samples rounded to steps of
   1-8 m/s^2 at a random place (1,000 blocks per cell; every block where a short ``--keep-s``
-  gives fewer).
+  gives fewer);
+- the largest ratio of the short level check per stretch length (`short_level_drop`, flights
+  exempt; flagged above the limits of ``SHORT_LEVEL_STRETCHES``), and the share of blocks that
+  `signal_fault` flags with 8-31 samples at a random place scaled by a gain of 0.01-0.2
+  (``PICKS`` blocks per cell).
 """
 
 from __future__ import annotations
@@ -26,14 +32,25 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 import vehicle
-from control.sensor_checks import SensorLimits, flight_reading, most_lattice_like, signal_fault
+from control.sensor_checks import (
+    FREE_FALL_MPS2,
+    SHORT_LEVEL_STRETCHES,
+    SensorLimits,
+    flight_reading,
+    most_lattice_like,
+    short_level_drop,
+    signal_fault,
+)
 from gpmsa.model.data import MAX_SEED
+from vehicle.design import lhs_design
 
 BLOCK = 125
 RESOLUTIONS = (0.001, 0.0048, 0.02, 0.05, 0.1)  # m/s^2; 0.0048: a 16-bit part at +-16 g
 STEPS = (1.0, 2.0, 2.6, 4.0, 8.0)  # m/s^2; 2.6: soak seed 19, #131
 LENGTHS = (6, 7, 10)  # samples
 PICKS = 1000  # blocks per (step, length) cell of the power table
+GAINS = (0.01, 0.02, 0.035, 0.05, 0.1, 0.2)  # of the scale faults
+GAIN_LENGTHS = (8, 12, 16, 24, 31)  # samples: shorter than the level check's 32
 
 
 def lattice_hits(blocks, step, length, rng, flight, limit) -> tuple[int, int]:
@@ -51,6 +68,20 @@ def lattice_hits(blocks, step, length, rng, flight, limit) -> tuple[int, int]:
     return int(hits), n
 
 
+def scale_hits(blocks, gain, length, rng, limits) -> tuple[int, int]:
+    """(blocks `signal_fault` flags, blocks tried): ``PICKS`` of ``blocks`` (n, BLOCK) drawn
+    without replacement (all of them when there are fewer), each with ``length`` samples at a
+    random place multiplied by ``gain``."""
+    n = min(PICKS, blocks.shape[0])
+    picks = blocks[rng.choice(blocks.shape[0], n, replace=False)].copy()
+    hits = 0
+    for b in picks:
+        start = rng.integers(0, BLOCK - length + 1)
+        b[start : start + length] *= gain
+        hits += bool(signal_fault(b, limits))
+    return int(hits), n
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=7, help="campaign seed")
@@ -58,6 +89,7 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--cases", default="AB", choices=["A", "B", "AB"],
                         help="A: without sensor noise, B: with N(0, 1) noise")  # fmt: skip
+    parser.add_argument("--drives", type=int, default=198, help="drives of the design")
     args = parser.parse_args()
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
@@ -69,17 +101,30 @@ def main() -> None:
         )
     if args.workers < 1:
         parser.error(f"--workers must be >= 1, got {args.workers}")
+    if args.drives < 1:
+        parser.error(f"--drives must be >= 1, got {args.drives}")
+    try:  # the campaign's design and traces (its own check, made before the design is built)
+        vehicle.checks.memory(
+            (64.0 + 16.0 * round(args.keep_s * 120.0)) * args.drives,
+            f"--drives {args.drives} and --keep-s {args.keep_s:g}: a campaign's traces",
+        )  # fmt: skip
+    except vehicle.VehicleError as exc:
+        parser.error(str(exc))
     tic = time.perf_counter()
     limit = SensorLimits().lattice_p
     rng = np.random.default_rng(args.seed)
-    print(f"campaign seed {args.seed}, {args.keep_s:g} s a drive, lattice_p {limit:g}")
+    print(
+        f"campaign seed {args.seed}, {args.drives} drives of {args.keep_s:g} s, lattice_p {limit:g}"
+    )
+    design = lhs_design(args.drives, seed=args.seed)
     for case, noise in (("A", 0.0), ("B", 1.0)):
         if case not in args.cases:
             continue
         with ProcessPoolExecutor(args.workers) as pool:
             camp = vehicle.run_campaign(
-                seed=args.seed, keep_s=args.keep_s, noise_std=noise, executor=pool, progress=False
-            )
+                design, seed=args.seed, keep_s=args.keep_s, noise_std=noise, executor=pool,
+                progress=False,
+            )  # fmt: skip
         acc = camp.accel_measured[camp.ok]
         per_drive = acc.shape[1] // BLOCK
         blocks = acc[:, : per_drive * BLOCK].reshape(-1, BLOCK)
@@ -101,6 +146,19 @@ def main() -> None:
                 found.append(f"{length} samples {100 * hits / tried:5.1f}%")
             fewer = f" ({tried:,} blocks each)" if tried < PICKS else ""
             print(f"   rounded to {step:g} m/s^2 steps for " + ", ".join(found) + fewer)
+        worst = [
+            f"{n} samples {max(short_level_drop(b, n, FREE_FALL_MPS2)[0] for b in blocks):.4g} "
+            f"(limit {most:g})"
+            for n, most in SHORT_LEVEL_STRETCHES
+        ]
+        print("   short level check, largest ratio: " + ", ".join(worst))
+        for length in GAIN_LENGTHS:
+            found = []
+            for gain in GAINS:
+                hits, tried = scale_hits(blocks, gain, length, rng, limits)
+                found.append(f"{gain:g}: {100 * hits / tried:5.1f}%")
+            fewer = f" ({tried:,} blocks each)" if tried < PICKS else ""
+            print(f"   {length} samples scaled by " + ", ".join(found) + fewer)
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
     print(f"{time.perf_counter() - tic:.0f} s; load average {load}")
 

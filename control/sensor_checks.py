@@ -22,6 +22,27 @@ from vehicle.models import GRAVITY
 MIN_SEGMENT = 32
 """Shortest stretch (samples, 0.27 s at 120 Hz) whose variance the level check compares with the
 rest of the block: shorter stretches of a healthy signal scatter too much (free flight)."""
+SHORT_LEVEL_STRETCHES = ((8, 20_000.0), (16, 2_000.0), (24, 400.0))
+"""(stretch in samples, largest ratio allowed) of the short level check (`short_level_drop`):
+the variance of a stretch shorter than ``MIN_SEGMENT`` (0.07, 0.13, 0.2 s at 120 Hz) against
+that of the rest of the block and of each half of the samples before it, where the level
+drops (a gain that drops for 8-31 samples), with or without a known noise sd. Each limit is
+4.2-6.1x the largest ratio of clean campaign blocks (`benchmarks/sensor_checks.py`; 3,282, 471
+and 83 over 302,580 blocks of 318 drives, GD 200-600, 0.5-2 m/s, with and without noise): a
+healthy signal holds short quiet stretches (a wheel resting on a smooth bit at low speed, a
+front wheel in the air while the rear one rolls), so the shorter the stretch, the higher the
+limit."""
+SHORT_LEVEL_BEFORE = 8
+"""Fewest samples before a stretch that the short level check holds it to (4 in each half): a
+stretch with fewer before it scores 1 (a quiet start, then louder, reads as a level that rises:
+`level_jump`)."""
+NEAR_FLIGHT = 0.25
+"""Fraction of |``SensorLimits.free_fall_mps2``| within which the short level check takes a
+stretch's mean as a wheel in the air: a flight (-g) and a front wheel off the ground while the
+rear one rolls (the vehicle pitching about it reads a smooth -0.84 to -0.95 g in the
+simulator). A gain below 0.75 moves a reading (at least -g; 0.65 for a mean of 8 samples with
+N(0, 1) noise) out of that band, so the exemption hides only drops of less than 2.4x in
+variance, far below every limit."""
 DEAD_STRETCH = 6
 """Shortest stretch (samples, 0.05 s at 120 Hz) that the dead-sensor check looks at."""
 NOISE_STRETCH = 32
@@ -46,6 +67,8 @@ MAX_NOISE_SD_MPS2 = 1e4
 its square must stay finite)."""
 FREE_FALL_MPS2 = -GRAVITY
 """What the vertical acceleration reads while a wheel is in the air (the simulator's -g), m/s^2."""
+EPS = float(np.finfo(float).eps)
+"""Machine epsilon of float64 (the rounding bounds of the level checks' shortcuts)."""
 
 
 @dataclass(frozen=True)
@@ -71,7 +94,7 @@ class SensorLimits:
             of the 22,770 clean blocks of 125 samples of the shipped emulators' campaign none
             exceeded 323 without noise, 255 with it, counting rises too: lift-off gives
             near-constant free-flight stretches, so the limit is high, and catches gains below
-            ~0.05).
+            ~0.05). Stretches of 8-31 samples: the short level check (`SHORT_LEVEL_STRETCHES`).
         dead_fraction: a stretch of ``DEAD_STRETCH`` consecutive samples whose range is below
             this fraction of the block's standard deviation, away from ``free_fall_mps2``, is a
             dead sensor (a gain near zero, a clip or quantisation near zero, a short stuck
@@ -82,7 +105,9 @@ class SensorLimits:
             flight holds this one value, so it is exempt from the dead-sensor and lattice
             checks; None: no exemption. Where ``noise_sd_mps2`` is set every reading carries
             noise, flights too, and the exemption is dropped: it would hide a quantisation or a
-            dead stretch that falls in a flight (`flight_reading`).
+            dead stretch that falls in a flight (`flight_reading`). The short level check
+            exempts stretches whose mean lies within 25% of it, noise or not (`NEAR_FLIGHT`: a
+            gain that drops moves the mean out of that band).
         noise_sd_mps2: the sensor's own white-noise standard deviation, m/s^2 (every reading
             carries it, in flight and at rest too); None: unknown, no noise-floor check.
             `control.bcr_settings_for` takes it from the emulator's training noise.
@@ -255,6 +280,16 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
             f"signal level jumps within the block: the variance of samples {start}-{stop - 1} "
             f"differs from the rest's by a factor {ratio:.3g} (allowed {limits.max_level_jump:g})"
         )
+    if steady:  # (the usual case: no stretch to scan, `_short_levels_to_scan`)
+        for stretch, limit in _short_levels_to_scan(s1, s2):
+            flight = limits.free_fall_mps2  # kept where the noise sd is known (`NEAR_FLIGHT`)
+            ratio, start = _short_level_drop(s1, s2, stretch, flight, float(a.mean()))
+            if ratio > limit:
+                return (
+                    f"signal level drops within the block: the variance of samples {start}-"
+                    f"{start + stretch - 1} is 1/{ratio:.3g} of the rest's and of the samples' "
+                    f"before it (allowed 1/{limit:g} for {stretch} samples)"
+                )
     return ""
 
 
@@ -520,6 +555,100 @@ def _level_within(s1: np.ndarray, s2: np.ndarray, min_segment: int, limit: float
     first = (squares - total * total / m) / (m - 1)
     inside_lo = (first - delta) * (m - 1) / (n - m - 1) - delta
     return bool(np.all(before[ends] <= 0.5 * limit * inside_lo))
+
+
+def short_level_drop(
+    a: np.ndarray, stretch: int, free_fall: float | None = FREE_FALL_MPS2
+) -> tuple[float, int]:
+    """What the short level check compares with its limit (`SHORT_LEVEL_STRETCHES`): (the
+    largest ratio, over the stretches of ``stretch`` consecutive samples of ``a``, of the
+    smallest of the variances of the rest of ``a`` and of each half of the samples before the
+    stretch to the stretch's variance, each about its own mean; that stretch's start). Only
+    drops count, as in `level_jump`: a level loud before the stretch throughout (one loud
+    sample before a quiet start makes no drop); a stretch with fewer than
+    ``SHORT_LEVEL_BEFORE`` samples before it scores 1, and so does one whose mean lies within
+    ``NEAR_FLIGHT`` of |``free_fall``| of ``free_fall`` (a wheel in the air; None: no
+    exemption); a stretch held constant (a dead one) scores inf. (1, -1) if none is scored."""
+    _check_count(stretch, "stretch", 2)
+    a = np.asarray(a, dtype=float)
+    if a.ndim != 1:
+        raise ControlError(f"a must be a 1-D block of accelerations, got shape {a.shape}")
+    if a.size == 0:
+        return 1.0, -1
+    s1, s2, _ = _centred_sums(a)
+    return _short_level_drop(s1, s2, stretch, free_fall, float(a.mean()))
+
+
+def _least_spread(s1: np.ndarray, s2: np.ndarray, stretch: int) -> float:
+    """The smallest sum of squares about its own mean of any ``stretch`` consecutive samples,
+    from the block's `_centred_sums` (inf if there are fewer samples)."""
+    if s1.size - 1 < stretch:
+        return float("inf")
+    total, squares = s1[stretch:] - s1[:-stretch], s2[stretch:] - s2[:-stretch]
+    return float((squares - total * total / stretch).min())
+
+
+def _short_levels_to_scan(
+    s1: np.ndarray,
+    s2: np.ndarray,
+    stretches: tuple[tuple[int, float], ...] = SHORT_LEVEL_STRETCHES,
+) -> list[tuple[int, float]]:
+    """The (stretch, limit) pairs of ``stretches`` (lengths in increasing order) whose ratios
+    `_short_level_drop` may find above the limit from the block's `_centred_sums` (the others
+    provably stay at or below it), in O(n) for them all: the variance a stretch is held to (the
+    smallest of the rest's and the halves') is at most the rest's, at most the block's sum of
+    squares over n - stretch - 1, and the stretch's own sum of squares about its mean is at
+    least the `_least_spread` of the shortest stretches (a stretch holds a shorter one, and such
+    a sum only grows as samples join), else of its own length. Each side is widened by a bound
+    on the cumulative sums' rounding (8 n^2 eps times the block's sum of squares, as in
+    `_level_within`)."""
+    n, total = s1.size - 1, float(s2[-1])
+    delta = 8.0 * n * n * EPS * total
+    least = _least_spread(s1, s2, stretches[0][0]) - 2.0 * delta
+    scan = []
+    for stretch, limit in stretches:
+        if n < stretch + SHORT_LEVEL_BEFORE + 2:
+            continue
+        most = (total + delta) * (stretch - 1) / (limit * (n - stretch - 1))
+        if least >= most or _least_spread(s1, s2, stretch) - 2.0 * delta >= most:
+            continue
+        scan.append((stretch, limit))
+    return scan
+
+
+def _short_level_drop(
+    s1: np.ndarray, s2: np.ndarray, stretch: int, free_fall: float | None, mean: float
+) -> tuple[float, int]:
+    """`short_level_drop` from the block's `_centred_sums` and ``mean`` (the sums are
+    centred on it)."""
+    n, m, k = s1.size - 1, stretch, SHORT_LEVEL_BEFORE
+    if n < m + k + 2:  # (a stretch with k samples before it and 2 after, for their variance)
+        return 1.0, -1
+    # the stretches [s, s + m) with s >= k (fewer samples before: a level that rises, scores 1)
+    lead_1, lead_2 = s1[k : n - m + 1], s2[k : n - m + 1]  # sums of the samples before each
+    total, squares = s1[k + m :] - lead_1, s2[k + m :] - lead_2
+    inside = (squares - total * total / m) / (m - 1)
+    np.maximum(inside, 0.0, out=inside)
+    rest_1, rest_2 = s1[-1] - total, s2[-1] - squares  # a drop: quieter than the rest ...
+    rest = (rest_2 - rest_1 * rest_1 / (n - m)) / (n - m - 1)
+    # ... and than each half of the samples before it: loud before it throughout (one loud sample
+    # before a quiet start is a level that rises, not a drop)
+    start = np.arange(k, n - m + 1)
+    half = start // 2
+    for lo_1, lo_2, hi_1, hi_2, count in (
+        (0.0, 0.0, s1[half], s2[half], half),
+        (s1[half], s2[half], lead_1, lead_2, start - half),
+    ):
+        part_1, part_2 = hi_1 - lo_1, hi_2 - lo_2
+        np.minimum(rest, (part_2 - part_1 * part_1 / count) / (count - 1), out=rest)
+    np.maximum(rest, 0.0, out=rest)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = rest / inside
+    if free_fall is not None:  # a wheel in the air (`NEAR_FLIGHT`)
+        ratio[np.abs(total / m - (free_fall - mean)) <= NEAR_FLIGHT * abs(free_fall)] = 1.0
+    np.fmax(ratio, 1.0, out=ratio)  # NaN (0 / 0: constant parts) as 1
+    i = int(np.argmax(ratio))
+    return float(ratio[i]), (i + k if ratio[i] > 1.0 else -1)
 
 
 def _part_variances(

@@ -82,6 +82,7 @@ CASES = [
     ("benchmarks/second_channel_loop.py", ["--out", FILE], "--out " + NOT_A_FOLDER),
     ("benchmarks/sensor_checks.py", ["--keep-s", "0.5"], "--keep-s must be >= 1.04 s"),
     ("benchmarks/sensor_checks.py", ["--seed", "-3"], "--seed must be >= 0, got -3"),
+    ("benchmarks/sensor_checks.py", ["--drives", "0"], "--drives must be >= 1, got 0"),
     ("benchmarks/steady_hedge.py", ["--roads", "1"], "--roads must be >= 2 (a standard error"),
     (
         "benchmarks/steady_hedge.py",
@@ -229,6 +230,11 @@ CASES = [
         "the traces of 63636363630 drives needs",
     ),
     ("benchmarks/feature_information.py", ["--n-runs", "10" * 5], "a campaign's traces needs"),
+    (
+        "benchmarks/sensor_checks.py",
+        ["--drives", "10" * 5],
+        "--drives 1010101010 and --keep-s 120: a campaign's traces needs",
+    ),
     (
         "benchmarks/second_channel_loop.py",
         ["--n-iter", "10" * 6, "--out", FOLDER],

@@ -375,6 +375,10 @@ see them from MIN_SEGMENT samples of a block on. A block that holds fewer (a sho
 longer fault's first samples at the end of the block, before the next update's block holds
 enough) is below what they see, and the fault removes at most a quarter of its power
 (`docs/closed-loop.md`, "Guards")."""
+STREAM_START = 24
+"""A shape fault from the stream's first STREAM_START samples (0.2 s) has too few healthy samples
+before it in the first block for the level checks to tell a drop from a level that rises, which
+they do not count (a robot driving onto rough ground): it can go unflagged (docs)."""
 FAULT_SIZES = {  # fault-like magnitudes: a mild miscalibration (a gain of 0.7, say) looks like
     # another roughness to any check of the signal alone, and is not a sensor fault here
     "spike": (1.0, 60.0),  # one spike every 1 to 60 samples
@@ -410,6 +414,9 @@ FAULT_SIZES = {  # fault-like magnitudes: a mild miscalibration (a gain of 0.7, 
 # a fault's last 31 samples open the first whole block, its first sample never in a block: the
 # exemption counted 32 when it counted by time (data_time - block_s rounds below t[0])
 @example(kind="scale", start=0.0078125, duration=0.25, size=1.0)
+# a gain of 0.035 with 29 healthy samples before it in its first block: too few for the level
+# check's drops (32), read [200, 281] with the truth at 400 (the short level check, session 71)
+@example(kind="scale", start=0.25, duration=0.25, size=1.0)
 def test_no_fault_crashes_the_bcr_or_makes_it_confidently_too_low(kind, start, duration, size):
     if kind in SHAPE_FAULTS:  # shorter ones are below what the block checks see (docs)
         duration = max(duration, MIN_SEGMENT / 120.0)
@@ -422,6 +429,7 @@ def test_no_fault_crashes_the_bcr_or_makes_it_confidently_too_low(kind, start, d
     ests = feed(bcr, *faulted, chunk=bcr.settings.samples_per_update)  # every estimate
     assert all(e.status in STATUSES for e in ests)
     in_fault = (t >= start) & (t < start + duration)
+    first = int(np.searchsorted(t, start))  # the fault's first sample
     block = bcr.settings.feature.block_samples
     for e in ests:  # an accepted estimate is never far below the truth (a faster robot)
         if not e.ok:
@@ -430,6 +438,8 @@ def test_no_fault_crashes_the_bcr_or_makes_it_confidently_too_low(kind, start, d
         seen = np.count_nonzero(in_fault[max(newest - block, 0) : newest])
         if kind in SHAPE_FAULTS and 0 < seen < MIN_SEGMENT:
             continue  # the newest block holds too few of the fault's samples (SHAPE_FAULTS)
+        if kind in SHAPE_FAULTS and seen and first < STREAM_START:
+            continue  # from the stream's first samples (STREAM_START)
         assert e.interval[1] + (e.interval[1] - e.interval[0]) >= 400
 
 
