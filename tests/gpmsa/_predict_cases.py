@@ -90,3 +90,14 @@ def mc_z(samples: np.ndarray, mean: np.ndarray, var: np.ndarray) -> tuple[float,
     z_mean = (samples.mean(axis=0) - mean) / np.sqrt(var / n)
     z_var = (s2 * n / (n - 1) - var) / np.sqrt((m4 - s2**2) / n)
     return float(np.max(np.abs(z_mean))), float(np.max(np.abs(z_var)))
+
+
+def three_input_emulator() -> gpmsa.Emulator:
+    """An emulator of 150 runs over one x and two thetas at fixed parameters (no fit): the
+    sensitivity memory tests' case."""
+    rng = np.random.default_rng(3)
+    xt = rng.uniform(size=(150, 3))
+    data = gpmsa.SimData(x=xt[:, :1], t=xt[:, 1:], y=np.sin(3 * xt[:, :1]) + xt[:, 1:2] ** 2,
+                         x_names=["x"], t_names=["a", "b"])  # fmt: skip
+    prm = {"betaU": [[1.0], [2.0], [0.5]], "lamUz": [1.0], "lamWs": [1e3], "lamWOs": [1e3]}
+    return gpmsa.Emulator.from_params(data, prm)

@@ -21,6 +21,7 @@ from gpmsa.predictive.full import FullPrediction
 from gpmsa.predictive.sobol import Sensitivity, _memory_estimate
 from tests.gpmsa import _study_cases as sc
 from tests.gpmsa._emulator_edit import replaced
+from tests.gpmsa._predict_cases import three_input_emulator
 
 
 def _functional_emulator(mean_basis) -> gpmsa.Emulator:
@@ -202,12 +203,7 @@ def test_sensitivity_bars_draw_the_interval_when_the_mean_lies_outside_it():
 def test_sensitivity_checks_its_memory_before_allocating(monkeypatch):
     """sensitivity() allocated its pairwise m x m integrals without gpmsa.limits; the estimate
     it is now checked against bounds the memory it takes."""
-    rng = np.random.default_rng(3)
-    xt = rng.uniform(size=(150, 3))
-    data = gpmsa.SimData(x=xt[:, :1], t=xt[:, 1:], y=np.sin(3 * xt[:, :1]) + xt[:, 1:2] ** 2,
-                         x_names=["x"], t_names=["a", "b"])  # fmt: skip
-    prm = {"betaU": [[1.0], [2.0], [0.5]], "lamUz": [1.0], "lamWs": [1e3], "lamWOs": [1e3]}
-    emu = gpmsa.Emulator.from_params(data, prm)
+    emu = three_input_emulator()
     need = _memory_estimate(150, 3, 1, 1, 1)
     monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", need - 1)
     with pytest.raises(

@@ -23,6 +23,7 @@ import gpmsa  # noqa: E402
 from gpmsa import GPMSAError  # noqa: E402
 from gpmsa.errors import ResourceLimitError  # noqa: E402
 from gpmsa.predictive.sobol import _memory_estimate  # noqa: E402
+from tests.gpmsa._predict_cases import three_input_emulator  # noqa: E402
 
 
 def _mean_function(emu):
@@ -270,12 +271,7 @@ def test_memory_is_checked_before_allocating(monkeypatch):
     below it is refused, naming what asked for it."""
     import tracemalloc
 
-    rng = np.random.default_rng(3)
-    xt = rng.uniform(size=(150, 3))
-    data = gpmsa.SimData(x=xt[:, :1], t=xt[:, 1:], y=np.sin(3 * xt[:, :1]) + xt[:, 1:2] ** 2,
-                         x_names=["x"], t_names=["a", "b"])  # fmt: skip
-    prm = {"betaU": [[1.0], [2.0], [0.5]], "lamUz": [1.0], "lamWs": [1e3], "lamWOs": [1e3]}
-    emu = gpmsa.Emulator.from_params(data, prm)
+    emu = three_input_emulator()
     kw = {"draws": False, "pairs": "all", "main_effect_grid": 400, "joint_effect_grid": 60}
     need = _memory_estimate(150, 3, 1, 1, 1, 3, 400, 60)
     monkeypatch.setattr(gpmsa.limits, "MAX_MEMORY_BYTES", need - 1)
