@@ -69,6 +69,35 @@ def continued_starts(
     return out
 
 
+def check_same_scales(emulator: Emulator, data, standardizer) -> None:
+    """GPMSAError naming each input whose unit domain, or the output scale, differs between
+    ``emulator``'s fit and this one (``SimData(x_range=, t_range=, y_scale=)``) where the runs
+    are the same (their outputs equal): they then sit at other unit values, so the chains
+    cannot continue. Other runs are left to `continued_starts` to name."""
+    y = np.asarray(data.y, dtype=float)
+    if emulator.y.shape != y.shape or not np.array_equal(emulator.y, y):
+        return
+    old, new = emulator.standardizer, standardizer
+    names = (*emulator.x_names, *emulator.t_names)
+    ends = [np.concatenate([s.x_min, s.t_min, s.x_max, s.t_max]) for s in (old, new)]
+    d = len(names)
+    differs = [
+        f"{n}: [{ends[0][k]:.6g}, {ends[0][d + k]:.6g}] in init=emulator's fit, "
+        f"[{ends[1][k]:.6g}, {ends[1][d + k]:.6g}] here"
+        for k, n in enumerate(names)
+        if ends[0][k] != ends[1][k] or ends[0][d + k] != ends[1][d + k]
+    ]
+    scale = {True: "'columnwise'", False: "'scalar'"}
+    if old.columnwise != new.columnwise:
+        differs.append(f"y_scale: {scale[old.columnwise]} in init=emulator's fit, "
+                       f"{scale[new.columnwise]} here")  # fmt: skip
+    if differs:
+        raise GPMSAError(
+            "init=emulator mapped the same runs onto other unit values (SimData's x_range, "
+            f"t_range or y_scale): {'; '.join(differs)}; give its fit's, or start afresh"
+        )
+
+
 PER_COMPONENT = ("betaU", "lamUz", "lamWs")
 """The emulator parameters with one entry per basis vector of K (their last axis)."""
 

@@ -17,6 +17,7 @@ from gpmsa.fitting.continuation import (
     appended_record,
     appended_thin,
     check_append,
+    check_same_scales,
     component_order,
     continued_starts,
     continued_steps,
@@ -220,6 +221,7 @@ def fit(
     options.update(backends.placement(backend, n_jobs, executor))
     resumed, recorded, order = options.get("init"), None, None
     if continuing:  # order: K's columns among the source's (per-component parameters follow)
+        check_same_scales(resumed, data, prep.standardizer)
         options["init"] = continued_starts(resumed, problem, prep.K, obs, int(n_chains))
         order = component_order(resumed, problem)
         if step_widths is None and tune is not True and backend != "pyro":  # NUTS adapts
