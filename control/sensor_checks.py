@@ -42,7 +42,9 @@ stretch's mean as a wheel in the air: a flight (-g) and a front wheel off the gr
 rear one rolls (the vehicle pitching about it reads a smooth -0.84 to -0.95 g in the
 simulator). A gain below 0.75 moves a reading (at least -g; 0.65 for a mean of 8 samples with
 N(0, 1) noise) out of that band, so the exemption hides only drops of less than 2.4x in
-variance, far below every limit."""
+variance, far below every limit. Where the noise sd is known the band lies |-g| above or below
+the mean of the rest of the block instead (the other checks read no absolute level there: a
+flight reads about 0 with gravity kept, +g with the axis' sign flipped, docs/robot.md)."""
 DEAD_STRETCH = 6
 """Shortest stretch (samples, 0.05 s at 120 Hz) that the dead-sensor check looks at."""
 NOISE_STRETCH = 32
@@ -107,7 +109,8 @@ class SensorLimits:
             noise, flights too, and the exemption is dropped: it would hide a quantisation or a
             dead stretch that falls in a flight (`flight_reading`). The short level check
             exempts stretches whose mean lies within 25% of it, noise or not (`NEAR_FLIGHT`: a
-            gain that drops moves the mean out of that band).
+            gain that drops moves the mean out of that band; with the noise sd, |it| above or
+            below the rest's mean: blind to an offset and to the sign).
         noise_sd_mps2: the sensor's own white-noise standard deviation, m/s^2 (every reading
             carries it, in flight and at rest too); None: unknown, no noise-floor check.
             `control.bcr_settings_for` takes it from the emulator's training noise.
@@ -282,8 +285,9 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
         )
     if steady:  # (the usual case: no stretch to scan, `_short_levels_to_scan`)
         for stretch, limit in _short_levels_to_scan(s1, s2):
-            flight = limits.free_fall_mps2  # kept where the noise sd is known (`NEAR_FLIGHT`)
-            ratio, start = _short_level_drop(s1, s2, stretch, flight, float(a.mean()))
+            # at free fall itself, or (a known noise sd) |free fall| from the rest's mean
+            mean = None if flight is None else float(a.mean())  # (`NEAR_FLIGHT`)
+            ratio, start = _short_level_drop(s1, s2, stretch, limits.free_fall_mps2, mean)
             if ratio > limit:
                 return (
                     f"signal level drops within the block: the variance of samples {start}-"
@@ -558,7 +562,7 @@ def _level_within(s1: np.ndarray, s2: np.ndarray, min_segment: int, limit: float
 
 
 def short_level_drop(
-    a: np.ndarray, stretch: int, free_fall: float | None = FREE_FALL_MPS2
+    a: np.ndarray, stretch: int, free_fall: float | None = FREE_FALL_MPS2, *, anchored: bool = True
 ) -> tuple[float, int]:
     """What the short level check compares with its limit (`SHORT_LEVEL_STRETCHES`): (the
     largest ratio, over the stretches of ``stretch`` consecutive samples of ``a``, of the
@@ -568,7 +572,10 @@ def short_level_drop(
     sample before a quiet start makes no drop); a stretch with fewer than
     ``SHORT_LEVEL_BEFORE`` samples before it scores 1, and so does one whose mean lies within
     ``NEAR_FLIGHT`` of |``free_fall``| of ``free_fall`` (a wheel in the air; None: no
-    exemption); a stretch held constant (a dead one) scores inf. (1, -1) if none is scored."""
+    exemption; ``anchored=False``: of |``free_fall``| above or below the rest's mean, blind to
+    an offset and to the sign as `signal_fault` is where the noise sd is known: gravity kept
+    puts a flight near 0, a flipped axis near +g); a stretch held constant (a dead one) scores
+    inf. (1, -1) if none is scored."""
     _check_count(stretch, "stretch", 2)
     a = np.asarray(a, dtype=float)
     if a.ndim != 1:
@@ -576,7 +583,7 @@ def short_level_drop(
     if a.size == 0:
         return 1.0, -1
     s1, s2, _ = _centred_sums(a)
-    return _short_level_drop(s1, s2, stretch, free_fall, float(a.mean()))
+    return _short_level_drop(s1, s2, stretch, free_fall, float(a.mean()) if anchored else None)
 
 
 def _least_spread(s1: np.ndarray, s2: np.ndarray, stretch: int) -> float:
@@ -617,10 +624,11 @@ def _short_levels_to_scan(
 
 
 def _short_level_drop(
-    s1: np.ndarray, s2: np.ndarray, stretch: int, free_fall: float | None, mean: float
+    s1: np.ndarray, s2: np.ndarray, stretch: int, free_fall: float | None, mean: float | None
 ) -> tuple[float, int]:
     """`short_level_drop` from the block's `_centred_sums` and ``mean`` (the sums are
-    centred on it)."""
+    centred on it; None: ``anchored=False``, a flight |``free_fall``| from the rest's mean,
+    either way)."""
     n, m, k = s1.size - 1, stretch, SHORT_LEVEL_BEFORE
     if n < m + k + 2:  # (a stretch with k samples before it and 2 after, for their variance)
         return 1.0, -1
@@ -645,7 +653,11 @@ def _short_level_drop(
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = rest / inside
     if free_fall is not None:  # a wheel in the air (`NEAR_FLIGHT`)
-        ratio[np.abs(total / m - (free_fall - mean)) <= NEAR_FLIGHT * abs(free_fall)] = 1.0
+        if mean is None:  # offset and sign unknown: |free_fall| from the rest's mean
+            off = np.abs(total * (n / (m * (n - m)))) - abs(free_fall)
+        else:
+            off = total / m - (free_fall - mean)
+        ratio[np.abs(off) <= NEAR_FLIGHT * abs(free_fall)] = 1.0
     np.fmax(ratio, 1.0, out=ratio)  # NaN (0 / 0: constant parts) as 1
     i = int(np.argmax(ratio))
     return float(ratio[i]), (i + k if ratio[i] > 1.0 else -1)
