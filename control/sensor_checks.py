@@ -463,10 +463,16 @@ def _quietest_stretch(s1: np.ndarray, s2: np.ndarray, stretch: int) -> tuple[flo
     """`quietest_stretch` from the block's `_centred_sums`."""
     if s1.size - 1 < stretch:
         return float("inf"), -1
-    total, squares = s1[stretch:] - s1[:-stretch], s2[stretch:] - s2[:-stretch]
-    variance = np.maximum((squares - total**2 / stretch) / (stretch - 1), 0.0)
+    variance = np.maximum(_stretch_spreads(s1, s2, stretch) / (stretch - 1), 0.0)
     i = int(np.argmin(variance))
     return float(variance[i]), i
+
+
+def _stretch_spreads(s1: np.ndarray, s2: np.ndarray, stretch: int) -> np.ndarray:
+    """Each run of ``stretch`` consecutive samples' sum of squares about its own mean, by start,
+    from the block's `_centred_sums` (at least ``stretch`` samples)."""
+    total, squares = s1[stretch:] - s1[:-stretch], s2[stretch:] - s2[:-stretch]
+    return squares - total * total / stretch
 
 
 def _near_equal_groups(
@@ -591,8 +597,7 @@ def _least_spread(s1: np.ndarray, s2: np.ndarray, stretch: int) -> float:
     from the block's `_centred_sums` (inf if there are fewer samples)."""
     if s1.size - 1 < stretch:
         return float("inf")
-    total, squares = s1[stretch:] - s1[:-stretch], s2[stretch:] - s2[:-stretch]
-    return float((squares - total * total / stretch).min())
+    return float(_stretch_spreads(s1, s2, stretch).min())
 
 
 def _short_levels_to_scan(
