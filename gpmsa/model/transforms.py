@@ -110,12 +110,16 @@ class Standardizer:
     def mean_on(self, grid: np.ndarray | None) -> np.ndarray:
         """The simulation mean interpolated onto ``grid`` (any order; None: the simulation
         grid, which is strictly increasing)."""
+        return self._on(self.y_mean, grid)
+
+    def _on(self, values: np.ndarray, grid: np.ndarray | None) -> np.ndarray:
+        """``values`` (l_sim,) on the simulation grid, interpolated onto ``grid``."""
         if grid is None or (grid.shape == self.grid.shape and np.array_equal(grid, self.grid)):
-            return self.y_mean
-        if self.y_mean.size == 1:
-            return np.full(grid.shape, self.y_mean[0])
+            return values
+        if values.size == 1:
+            return np.full(grid.shape, values[0])
         check_increasing(self.grid, "the simulation grid")
-        return np.interp(grid, self.grid, self.y_mean)
+        return np.interp(grid, self.grid, values)
 
     @property
     def columnwise(self) -> bool:
@@ -125,12 +129,7 @@ class Standardizer:
     def sd_on(self, grid: np.ndarray | None) -> float | np.ndarray:
         """The output scale on ``grid`` (as `mean_on`): the one sd (a float), or scaled
         columnwise each element's sd interpolated onto ``grid`` (l,)."""
-        if not self.columnwise or grid is None:
-            return self.y_sd
-        if grid.shape == self.grid.shape and np.array_equal(grid, self.grid):
-            return self.y_sd
-        check_increasing(self.grid, "the simulation grid")
-        return np.interp(grid, self.grid, self.y_sd)
+        return self._on(self.y_sd, grid) if self.columnwise else self.y_sd
 
     def y_to_std(self, y: np.ndarray, grid: np.ndarray | None = None) -> np.ndarray:
         """Outputs (..., l) native -> standardised, on ``grid`` (None: the simulation grid)."""
