@@ -168,35 +168,17 @@ def check_posterior_emulator(emulator, posterior) -> None:
     )
 
 
-def gpmsa_model_only(
-    emulator, what: str, *, extensions: bool = False, callable_basis: bool = False
-) -> None:
-    """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or uses categorical inputs or a mean
-    basis, which ``what`` does not support (``Emulator.predict``, ``gpmsa.calibrate`` and
-    ``gpmsa.Calibrator`` do). ``extensions``: ``what`` supports both, except a callable mean
-    basis (refused: only the named ones, ``MEAN_BASIS_KINDS``, have closed-form integrals)
-    unless ``callable_basis`` (``what`` only evaluates the basis at points)."""
+def gpmsa_model_only(emulator, what: str, *, callable_basis: bool = True) -> None:
+    """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or, where ``what`` integrates the
+    mean over the inputs (``callable_basis`` False: only the named mean bases,
+    ``MEAN_BASIS_KINDS``, have closed-form integrals), has a callable mean basis."""
     if not isinstance(emulator, Emulator):
         raise GPMSAError(f"{what} needs a gpmsa.Emulator, got {type(emulator).__name__}")
-    if extensions and callable_basis:
-        return
-    if extensions:
-        basis = getattr(emulator, "mean_basis", None)
-        if basis is not None and basis.kind not in MEAN_BASIS_KINDS:
-            raise GPMSAError(
-                f"{what} supports the mean bases {MEAN_BASIS_KINDS}, not a callable one (its "
-                "integrals over the inputs have no closed form); use Emulator.predict_mean"
-            )
-        return
-    used = []
-    if any(lv is not None for lv in getattr(emulator, "levels", ())):
-        used.append("categorical inputs")
-    if getattr(emulator, "mean_basis", None) is not None:
-        used.append("a mean basis")
-    if used:
-        instead = "Emulator.predict, gpmsa.calibrate or gpmsa.Calibrator"
+    basis = getattr(emulator, "mean_basis", None)
+    if not callable_basis and basis is not None and basis.kind not in MEAN_BASIS_KINDS:
         raise GPMSAError(
-            f"{what} does not support an emulator with {' and '.join(used)}; use {instead}"
+            f"{what} supports the mean bases {MEAN_BASIS_KINDS}, not a callable one (its "
+            "integrals over the inputs have no closed form); use Emulator.predict_mean"
         )
 
 

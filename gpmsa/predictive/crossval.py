@@ -173,7 +173,7 @@ def cross_validate(
         >>> bool(np.allclose(gpmsa.cross_validate(emu, draws=False).mean, emu.loo().mean))
         True
     """
-    gpmsa_model_only(emulator, "cross_validate", extensions=True, callable_basis=True)
+    gpmsa_model_only(emulator, "cross_validate")
     draws = check_flag(draws, "draws")
     m, p_u, l_sim = emulator.m, emulator.p_u, emulator.l_sim
     labels = _fold_labels(folds, m, seed)

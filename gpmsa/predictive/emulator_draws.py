@@ -167,7 +167,7 @@ def emulator_prediction(
         >>> bool(np.allclose(pred.mean(), emu.predict(x_new, t_new, draws=True)[0]))
         True
     """
-    gpmsa_model_only(emulator, "emulator_prediction", extensions=True, callable_basis=True)
+    gpmsa_model_only(emulator, "emulator_prediction")
     draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
     joint = check_flag(joint, "joint")
     n_rlz = check_count(n_rlz, "n_rlz")

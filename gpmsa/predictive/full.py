@@ -497,7 +497,7 @@ def full_prediction(
         >>> bool(np.all(pred.var("y") > pred.var("zeta")))
         True
     """
-    gpmsa_model_only(emulator, "full_prediction", extensions=True, callable_basis=True)
+    gpmsa_model_only(emulator, "full_prediction")
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be the gpmsa.ObsData of the calibration, got "
                          f"{type(obs).__name__}")  # fmt: skip

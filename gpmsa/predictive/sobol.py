@@ -58,7 +58,7 @@ from scipy.special import erf, erfc
 from gpmsa.calibration.observations import blas_controller
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.model.correlation import CATEGORICAL_DISTANCE
+from gpmsa.model.correlation import CATEGORICAL_DISTANCE, correlation
 from gpmsa.model.data import as_real, check_count, check_flag, check_level
 from gpmsa.model.transforms import snap_to_unit
 from gpmsa.predictive._common import draws_text, factors, gpmsa_model_only, param_sets, unit_inputs
@@ -244,12 +244,10 @@ def _centred_gauss(gamma: float, c: np.ndarray, a: float, b: float) -> np.ndarra
 
 
 def _kernel(beta: float, grid: np.ndarray, c: np.ndarray, cat: bool) -> np.ndarray:
-    """(G, m) correlations of the grid values g with the runs' c in one input: the Gaussian
-    exp(-beta (g - c_i)^2), or for a categorical input exp(-beta / 4 * 1[g != c_i]) (the
-    library's categorical kernel); a NaN grid value (padding) gives a NaN row."""
-    if not cat:
-        return _gaussians(beta, grid, c)
-    out = np.exp(-beta * (CATEGORICAL_DISTANCE * (grid[:, None] != c[None, :])))
+    """(G, m) correlations of the grid values g with the runs' c in one input (the library's
+    ``correlation``: exp(-beta (g - c_i)^2), or for a categorical input exp(-beta / 4 *
+    1[g != c_i])); a NaN grid value (padding) gives a NaN row."""
+    out = correlation(grid[:, None], c[:, None], np.array([beta]), np.array([cat]))
     out[np.isnan(grid)] = np.nan
     return out
 
@@ -321,11 +319,6 @@ def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=(), levels=None
             Vcomp[:, jj, j] = Vcomp[:, j, jj]
             Vpair[:, jj, j] = Vpair[:, j, jj]
     return mu, Vall, Vmain, Vcomp, Vpair
-
-
-def _gaussians(gamma: float, grid: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """(G, m) exp(-gamma (g - c_i)^2) of the grid values g against the runs' c."""
-    return np.exp(-gamma * (grid[:, None] - c[None, :]) ** 2)
 
 
 def _main_effects(zt, coef, beta, varied, I1, grid, cat=None) -> np.ndarray:
@@ -581,7 +574,7 @@ def sensitivity(
         >>> sens.pairs, sens.interaction.shape, sens.main_effect.shape   # (S, G, l_sim, d)
         ((('x', 'a'), ('x', 'b'), ('a', 'b')), (10, 1, 3), (10, 5, 1, 3))
     """
-    gpmsa_model_only(emulator, "sensitivity", extensions=True)
+    gpmsa_model_only(emulator, "sensitivity", callable_basis=False)
     std = emulator.standardizer
     levels_all = tuple(emulator.levels)
     names = tuple(emulator.x_names) + tuple(emulator.t_names)
