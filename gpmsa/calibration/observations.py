@@ -81,7 +81,8 @@ class Observations:
 
 def check_emulator(emulator, categorical_theta: bool = False) -> None:
     """Raise GPMSAError unless ``emulator`` has what calibration needs (a categorical
-    calibration parameter only where ``categorical_theta``: the fast sampler)."""
+    calibration parameter only where ``categorical_theta``: the numpy samplers, with their joint
+    level move, ``gpmsa.mcmc.level_moves``)."""
     missing = [a for a in EMULATOR_ATTRS if not hasattr(emulator, a)]
     if missing:
         raise GPMSAError(f"emulator lacks {missing}: calibration needs a gpmsa.Emulator")

@@ -27,7 +27,7 @@ from scipy.linalg import solve_triangular
 from gpmsa.calibration.model import FixedGP, lower_solve
 from gpmsa.calibration.observations import Observations
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import tuning
+from gpmsa.mcmc import level_moves, tuning
 from gpmsa.model.categorical import snap_to_levels
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.correlation import correlation_row
@@ -407,6 +407,7 @@ class CalibrationSampler:
                         state.sweep(levels[lev], False, acc[lev], u[lev])
                     bar.update(tune_levels)
                 w = tuning.choose_widths(w, cands, acc, tune_rounds)
+            state.learn_level_shifts()  # frozen before the draws (gpmsa.mcmc.level_moves)
             bar.set_description("calibrate: sampling")
             widths_l = w.tolist()
             out = []
@@ -437,6 +438,28 @@ class _State:
         self.ll = _loglik(self.ey, lam)
         self.lp_theta = s._log_prior_theta(self.theta)
         self.lp_lam = s._log_prior_lamos(lam)
+        self.shifts: dict[int, tuple] = {}  # categorical element -> its level move's shifts
+
+    def learn_level_shifts(self) -> None:
+        """The joint level moves' shifts of the continuous free theta elements
+        (``gpmsa.mcmc.level_moves``), from the conditional modes at each level at the current
+        lamOs and set; none without a categorical and a continuous free element."""
+        s = self.s
+        cat = [i for i in s.free if s.levels[i] is not None and len(s.levels[i]) > 1]
+        cont = [j for j in s.free if s.levels[j] is None]
+        if not cat or not cont:
+            return
+        pred, lam = s.preds[self.k], self.lam
+
+        def log_post(theta: np.ndarray) -> float:
+            th = theta.tolist()
+            lp = s._log_prior_theta(th)
+            return lp if lp == -math.inf else lp + _loglik(pred.at(th), lam)
+
+        for i in cat:
+            off = level_moves.level_offsets(log_post, np.array(self.theta), i, s.levels[i], cont)
+            rows = {v: r for r, v in enumerate(s.levels[i])}
+            self.shifts[i] = (rows, level_moves.shift_table(off), cont)
 
     def log_post(self) -> float:
         """Log posterior up to a constant."""
@@ -460,7 +483,12 @@ class _State:
                 continue
             else:  # another level, uniformly: a symmetric proposal
                 others = [v for v in levels if v != cand[i]]
-                cand[i] = others[min(int(u[2 * i] * len(others)), len(others) - 1)]
+                new = others[min(int(u[2 * i] * len(others)), len(others) - 1)]
+                if i in self.shifts:  # with the continuous elements (level_moves)
+                    rows, table, cont = self.shifts[i]
+                    for j, d in zip(cont, table[rows[cand[i]]][rows[new]], strict=True):
+                        cand[j] += d
+                cand[i] = new
             lp_new = s._log_prior_theta(cand)
             if lp_new == -math.inf:
                 continue

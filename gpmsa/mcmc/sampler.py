@@ -22,7 +22,7 @@ from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import ridge, starts, tuning
+from gpmsa.mcmc import level_moves, ridge, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 from gpmsa.model.likelihood import IncrementalLikelihood, log_prior
@@ -200,6 +200,59 @@ class ChainState:
         self.constraint = problem.constraint if "theta" in problem.sampled else None
         if self.constraint is not None:
             self.constraint.check_start(self.lik.params["theta"], "the chain's start")
+        self.level_shifts: dict[int, tuple] = {}  # `learn_level_shifts`: element -> its shifts
+
+    def learn_level_shifts(self) -> None:
+        """Each categorical theta element's joint level move (``gpmsa.mcmc.level_moves``): the
+        shifts of the continuous sampled theta elements between the conditional modes at its
+        levels, the other parameters at their current values; none without a categorical and a
+        continuous sampled theta element (the sweep's moves stay those of GPM/SA's order)."""
+        pos = {idx[0]: i for i, (n, idx) in enumerate(self.els) if n == "theta"}
+        cat = [i for i in pos.values() if self.kinds[i] == 3 and self.levels[i].size > 1]
+        cont = [k for k, i in pos.items() if self.kinds[i] == 0]
+        if not cat or not cont:
+            return
+        priors = [self.el_prior[pos[k]] for k in cont]
+        lik, con = self.lik, self.constraint
+
+        def log_post(theta: np.ndarray) -> float:
+            lp = sum(f(float(theta[k])) for f, k in zip(priors, cont, strict=True))
+            if lp == -math.inf or (con is not None and not con(theta)):
+                return -math.inf
+            return lik.propose_theta(theta) + lp  # never accepted: the state is unchanged
+
+        theta = lik.params["theta"]
+        for i in cat:
+            lv = self.levels[i]
+            off = level_moves.level_offsets(log_post, theta, self.els[i][1][0], lv, cont)
+            rows = {float(v): r for r, v in enumerate(lv)}
+            self.level_shifts[i] = (rows, level_moves.shift_table(off), cont, priors)
+
+    def _level_move(self, i: int, x: float, level: float, u1: float, accepted) -> None:
+        """Element ``i`` (categorical theta, at level ``x``) to ``level`` with the continuous
+        elements shifted (`learn_level_shifts`); Metropolis on the posterior ratio."""
+        rows, table, cont, priors = self.level_shifts[i]
+        lik = self.lik
+        theta = lik.params["theta"].copy()
+        theta[self.els[i][1][0]] = level
+        d_lp = 0.0
+        for k, d, prior in zip(cont, table[rows[x]][rows[level]], priors, strict=True):
+            old = float(theta[k])
+            lp_new = prior(old + d)
+            if lp_new == -math.inf:
+                return
+            d_lp += lp_new - prior(old)
+            theta[k] = old + d
+        if self.constraint is not None and not self.constraint(theta):
+            return
+        ll_old = lik.loglik
+        ll_new = lik.propose_theta(theta)
+        if ll_new == -math.inf:
+            return
+        if math.log(u1) < ll_new - ll_old + d_lp:
+            lik.accept()
+            self.log_prior += d_lp
+            accepted[i] += 1
 
     @property
     def params(self) -> dict[str, np.ndarray]:
@@ -229,6 +282,9 @@ class ChainState:
                 if others.size == 0:
                     continue
                 cand = float(others[int(u[i, 0] * others.size)])
+                if i in self.level_shifts:  # with the continuous theta (level_moves)
+                    self._level_move(i, x, cand, u[i, 1], accepted)
+                    continue
             elif kind == 2 and prop_mh:
                 w0 = max(1.0, x / 3.0)
                 cand = x + w0 * 2.0 * step
@@ -434,6 +490,7 @@ def run_chain(
             bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases
             names = [n for n, _ in els]
             w = tuning.tune_widths(state.sweep, names, w, tune_rounds, tune_levels, bar.update)
+        state.learn_level_shifts()  # frozen before the draws (a categorical theta only)
         bar.set_description(f"{desc}: sampling")
         draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
         log_post = np.empty(n_iter)

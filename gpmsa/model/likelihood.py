@@ -382,6 +382,23 @@ class IncrementalLikelihood:
         self._pending = (prm, changed, sig_v, ll_vu, ll, dxz_t)
         return ll
 
+    def propose_theta(self, theta: np.ndarray) -> float:
+        """Log-likelihood with the whole theta (q,) at ``theta`` (pending accept): ``propose``'s
+        theta case for several elements at once (a joint fit or calibration, with observations)."""
+        prm = {**self.params, "theta": np.array(theta, dtype=np.float64)}
+        dxz_t = self._theta_dists(prm["theta"])
+        beta = prm["betaU"]
+        changed: dict[int, tuple] = {}
+        for j, c in enumerate(self.comps):
+            fac = (c.ri, c.si, c.alpha, c.llw, c.L, c.coef)
+            changed[j] = fac + self._obs_part(fac, j, prm, self._cross_z(beta[:, j], dxz_t), c.cxo)
+        terms = [(out[7], out[8]) if out[4] is not None else (None, None)
+                 for out in changed.values()]  # fmt: skip
+        ll_vu = self._vu(terms, self.sig_v, prm)
+        ll = float(sum([c.llw for c in self.comps])) + ll_vu
+        self._pending = (prm, changed, self.sig_v, ll_vu, ll, dxz_t)
+        return ll
+
     def accept(self) -> None:
         """Commit the last proposal."""
         prm, changed, sig_v, ll_vu, ll, dxz_t = self._pending
