@@ -6,6 +6,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+from scipy.stats import norm
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import check_count, check_level
@@ -81,7 +82,11 @@ def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0
     One panel per varied input (SEPIA's main-effect plot), on a shared output axis: the mean
     over posterior draws of ``sens.main_effect`` against the input's grid, the central interval
     of probability ``level`` over the draws as a band (none for the point estimate), and the
-    output's mean over the box as a dotted line. Axes read "name (unit)".
+    output's mean over the box as a dotted line. Axes read "name (unit)". With the GP's own
+    variance about the curves (``sensitivity(..., effect_variance=True)``; SEPIA's ``mef_v``) a
+    wider, lighter band: the mean -+ the normal quantile of ``level`` times the mixture's sd
+    over draws (the mean GP variance plus the variance of the curves over draws), the GP's
+    uncertainty about the function between the runs as well as the parameters'.
 
     Args:
         sens: a Sensitivity from ``gpmsa.sensitivity(..., main_effect_grid=G)``.
@@ -117,11 +122,18 @@ def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0
     axes = fig.subplots(rows, cols, squeeze=False, sharey=True).ravel()
     curves = sens.main_effect[:, :, output, :]  # (S, G, d)
     spread = curves.shape[0] > 1
+    gp = None if sens.main_effect_variance is None else sens.main_effect_variance[:, :, output, :]
+    z = float(norm.ppf((1 + level) / 2))
     y_name = sens.y_names[output] if output < len(sens.y_names) else "y"
     y_unit = sens.y_units[output] if output < len(sens.y_units) else ""
     for k, name in enumerate(sens.names):
         ax, grid, cur = axes[k], sens.effect_grid[:, k], curves[:, :, k]
         ax.plot(grid, cur.mean(axis=0), color="C0", label="mean over draws" if spread else None)
+        if gp is not None:
+            sd = np.sqrt(gp[:, :, k].mean(axis=0) + np.var(cur, axis=0))
+            ax.fill_between(grid, cur.mean(axis=0) - z * sd, cur.mean(axis=0) + z * sd,
+                            color="C0", alpha=0.12,
+                            label=f"{100 * level:.0f} % with the GP's variance")  # fmt: skip
         if spread:
             lo, hi = np.quantile(cur, q, axis=0)
             ax.fill_between(grid, lo, hi, color="C0", alpha=0.25,
@@ -131,7 +143,7 @@ def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0
     axes[0].set_ylabel(axis_label(f"E[{y_name} | input]", y_unit))
     for ax in axes[d:]:
         ax.set_visible(False)
-    if spread:
+    if spread or gp is not None:
         axes[0].legend(fontsize="small")
     where = f" at output {output}" if l_sim > 1 else ""
     drawn = f"over {curves.shape[0]} draws" if spread else "the point estimate"

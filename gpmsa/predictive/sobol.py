@@ -29,6 +29,26 @@ range, and the joint-effect functions E[y_l | z_k = g, z_k' = h] on a grid of gr
 other inputs integrated out, each is a sum over the runs of Gaussians in the gridded inputs (no
 Monte Carlo either). Like the indices, they are the emulator mean's, per posterior draw.
 
+Groups of any size (SEPIA's ``jelist``, opt-in ``groups=``): the closed joint index
+V_G / V of a group G of varied inputs, the pair's sum with the group's pair integrals
+multiplied (a group of two is the pair's ``joint``, bit for bit in the same order).
+
+The GP's own variance about the effect functions (SEPIA's ``mef_v``, opt-in
+``effect_variance=True``): per draw, M(g) = E_{z_~u}[w_j(z) | z_u = g] is a linear functional
+of the GP given the runs' weights, Gaussian with the curve above as its mean and the variance
+
+    prod_{n not in u} DD_jn / lamUz_j - a_j(g)^T Sigma_W_j^-1 a_j(g)  (+ the GLS term),
+    a_j(g) = int r_j(z) dz_~u = prod_{k in u} R_k(g_k, z_ik) prod_{n not in u} I1_jn / lamUz_j,
+
+the posterior covariance integrated twice over the other inputs: DD_jn, the kernel's mean
+over two independent points of input n (sqrt(pi) erf(x) / x - (1 - exp(-x^2)) / x^2, x =
+sqrt(beta) width; a double average over a categorical input's levels), and the runs' share by
+their single means I1 (a sum over runs, a triangular solve per grid point); with a mean basis
+the coefficients' term g^T (H^T Sigma^-1 H)^-1 g at gbar = h(zbar) - H^T Sigma^-1 a (h linear
+in the inputs: its mean is h at their mean). The components are independent: the output's
+variance is y_sd^2 sum_j K_lj^2 of theirs. The smooth GP (no nugget or residual, which
+average out over a continuum of z).
+
 Categorical inputs and a mean basis (docs/categorical-and-constraints.md), exactly too: a
 categorical input k varies uniformly over its training levels (or those ``bounds`` lists; its
 kernel is exp(-beta_kj / 4 * 1[z_k != z_ik])), so each of its one-dimensional integrals is an
@@ -53,6 +73,7 @@ import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.linalg import solve_triangular
 from scipy.special import erf, erfc
 
 from gpmsa.calibration.observations import blas_controller
@@ -105,6 +126,18 @@ class Sensitivity:
         joint_effect: (S, G2, G2, l_sim, P) joint-effect functions E[y | z_k = joint_grid[a, k],
             z_k' = joint_grid[b, k']] of each pair (k, k') (SEPIA's ``jef``); None if not asked
             for.
+        groups: (n_groups,) the groups of varied inputs asked for (``sensitivity(groups=)``;
+            () if none).
+        group_joint: (S, l_sim, n_groups) closed joint index V_G / V of each group G (the
+            variance of E[y | z_G]; SEPIA's ``sje`` of a ``jelist`` group of any size); None
+            without groups. ``group_joint_pc`` (S, p_u, n_groups) per basis component,
+            ``group_joint_aggregated`` (S, n_groups) over the output grid.
+        main_effect_variance: (S, G, l_sim, d) the GP's own posterior variance of each
+            main-effect function at its grid points (SEPIA's ``mef_v``): per draw, the variance
+            of E_{z_~k}[eta(z)] given the runs (the smooth emulator: no nugget or residual),
+            native output units^2; None unless ``effect_variance`` and ``main_effect_grid``.
+        joint_effect_variance: (S, G2, G2, l_sim, P) the same of each joint-effect function
+            (SEPIA's ``jef_v``); None unless ``effect_variance`` and ``joint_effect_grid``.
     """
 
     names: tuple[str, ...]
@@ -134,6 +167,12 @@ class Sensitivity:
     main_effect: np.ndarray | None = field(default=None, repr=False)
     joint_grid: np.ndarray | None = field(default=None, repr=False)
     joint_effect: np.ndarray | None = field(default=None, repr=False)
+    groups: tuple[tuple[str, ...], ...] = ()
+    group_joint: np.ndarray | None = field(default=None, repr=False)
+    group_joint_pc: np.ndarray | None = field(default=None, repr=False)
+    group_joint_aggregated: np.ndarray | None = field(default=None, repr=False)
+    main_effect_variance: np.ndarray | None = field(default=None, repr=False)
+    joint_effect_variance: np.ndarray | None = field(default=None, repr=False)
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
         """Per input: the aggregated main and total indices, their mean, sd and central
@@ -152,10 +191,23 @@ class Sensitivity:
         kinds = (("joint", self.joint_aggregated), ("interaction", self.interaction_aggregated))
         return {pair: _spread(kinds, p, level) for p, pair in enumerate(self.pairs)}
 
+    def group_summary(self, level: float = 0.9) -> dict[tuple[str, ...], dict[str, float]]:
+        """Per group of ``groups``: the aggregated closed joint index, its mean, sd and central
+        interval of probability ``level`` over the draws (``joint``, ``joint_sd``, ...)."""
+        level = check_level(level)
+        if self.group_joint_aggregated is None:
+            raise GPMSAError("these indices have no groups: call sensitivity(..., "
+                             "groups=[(a, b, c)])")  # fmt: skip
+        kinds = (("joint", self.group_joint_aggregated),)
+        return {group: _spread(kinds, g, level) for g, group in enumerate(self.groups)}
+
     def main_effect_summary(self, level: float = 0.9) -> dict[str, dict[str, np.ndarray]]:
         """Per varied input: its grid ``"grid"`` (G,) and the main-effect function's mean,
         sd and central interval of probability ``level`` over the draws, ``"mean"``, ``"sd"``,
-        ``"lo"``, ``"hi"`` (G, l_sim), native output units."""
+        ``"lo"``, ``"hi"`` (G, l_sim), native output units. With ``main_effect_variance``
+        also ``"gp_sd"``, the root mean over draws of the GP's variance about the curve, and
+        ``"total_sd"``, the sd of the mixture over draws (law of total variance: the mean GP
+        variance plus the variance of the curves over draws, ddof 0)."""
         level = check_level(level)
         if self.main_effect is None:
             raise GPMSAError("these indices have no main-effect functions: call "
@@ -168,6 +220,10 @@ class Sensitivity:
             sd = np.std(cur, axis=0, ddof=1) if cur.shape[0] > 1 else np.zeros(cur.shape[1:])
             out[name] = {"grid": self.effect_grid[:, k], "mean": cur.mean(axis=0), "sd": sd,
                          "lo": lo, "hi": hi}  # fmt: skip
+            if self.main_effect_variance is not None:
+                gp = self.main_effect_variance[..., k].mean(axis=0)
+                out[name]["gp_sd"] = np.sqrt(gp)
+                out[name]["total_sd"] = np.sqrt(gp + np.var(cur, axis=0))
         return out
 
     def __repr__(self) -> str:
@@ -277,11 +333,11 @@ def _input_pair_integral(zt, beta, k, j, jj, lo, hi, lev) -> np.ndarray:
     return (Ej.T @ Ejj) / lev.size
 
 
-def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=(), levels=None):
+def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=(), levels=None, groups=()):
     """Per pair (j, j'): the covariances V^u for u = every varied input, each single input,
-    each complement and each pair (a, b) of ``pairs`` (positions in ``varied``). Returns mu
-    (p_u,), Vall (p_u, p_u), Vmain (d, p_u, p_u), Vcomp (d, p_u, p_u), Vpair (P, p_u, p_u).
-    ``levels``: as ``_single_means``'."""
+    each complement, each pair (a, b) of ``pairs`` and each group of ``groups`` (positions in
+    ``varied``). Returns mu (p_u,), Vall (p_u, p_u), Vmain (d, p_u, p_u), Vcomp (d, p_u, p_u),
+    Vpair (P, p_u, p_u), Vgroup (n_groups, p_u, p_u). ``levels``: as ``_single_means``'."""
     levels = [None] * len(varied) if levels is None else levels
     p_u = coef.shape[0]
     d = len(varied)
@@ -291,6 +347,7 @@ def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=(), levels=None
     Vmain = np.empty((d, p_u, p_u))
     Vcomp = np.empty((d, p_u, p_u))
     Vpair = np.empty((len(pairs), p_u, p_u))
+    Vgroup = np.empty((len(groups), p_u, p_u))
     for j in range(p_u):
         for jj in range(j, p_u):
             I2 = [_input_pair_integral(zt, beta, k, j, jj, lo[n], hi[n], levels[n])
@@ -314,11 +371,19 @@ def _component_moments(zt, coef, beta, varied, lo, hi, I1, pairs=(), levels=None
                 rest_j = np.prod(np.delete(I1[j], (a, b), axis=0), axis=0)
                 rest_jj = np.prod(np.delete(I1[jj], (a, b), axis=0), axis=0)
                 Vpair[p, j, jj] = (coef[j] * rest_j) @ (I2[a] * I2[b]) @ (coef[jj] * rest_jj) - base
+            for g, group in enumerate(groups):  # as a pair's, the group's pair integrals multiplied
+                rest_j = np.prod(np.delete(I1[j], group, axis=0), axis=0)
+                rest_jj = np.prod(np.delete(I1[jj], group, axis=0), axis=0)
+                inner = I2[group[0]] * I2[group[1]]
+                for n in group[2:]:
+                    inner = inner * I2[n]
+                Vgroup[g, j, jj] = (coef[j] * rest_j) @ inner @ (coef[jj] * rest_jj) - base
             Vall[jj, j] = Vall[j, jj]
             Vmain[:, jj, j] = Vmain[:, j, jj]
             Vcomp[:, jj, j] = Vcomp[:, j, jj]
             Vpair[:, jj, j] = Vpair[:, j, jj]
-    return mu, Vall, Vmain, Vcomp, Vpair
+            Vgroup[:, jj, j] = Vgroup[:, j, jj]
+    return mu, Vall, Vmain, Vcomp, Vpair, Vgroup
 
 
 def _main_effects(zt, coef, beta, varied, I1, grid, cat=None) -> np.ndarray:
@@ -349,6 +414,75 @@ def _joint_effects(zt, coef, beta, varied, I1, grid, pairs, cat=None) -> np.ndar
             Ga = _kernel(beta[ka, j], grid[:, a], zt[:, ka], cat[a])
             Gb = _kernel(beta[kb, j], grid[:, b], zt[:, kb], cat[b])
             out[j, :, :, p] = (Ga * rest) @ Gb.T
+    return out
+
+
+def _double_mean(beta: float, a: float, b: float) -> float:
+    """Mean of exp(-beta (z - z')^2) over z, z' independent U[a, b]: 2 int_0^1 (1 - u)
+    exp(-x^2 u^2) du = sqrt(pi) erf(x) / x - (1 - exp(-x^2)) / x^2 with x = sqrt(beta) (b - a)
+    (the terms tend to 2 and 1 as x -> 0: no cancellation); its series 1 - x^2 / 6 + x^4 / 30
+    below x = 1e-3, where x^2 could underflow."""
+    x = float(np.sqrt(beta) * (b - a))
+    if x < 1e-3:
+        return 1.0 - x * x / 6.0 + x**4 / 30.0
+    return float(np.sqrt(np.pi) * erf(x) / x + np.expm1(-x * x) / (x * x))
+
+
+def _double_means(beta, varied, lo, hi, levels) -> np.ndarray:
+    """DD[j, n]: (p_u, d) means of component j's kernel in the varied input k = varied[n] over
+    two independent points of its range (``_double_mean``), or of its levels (a double
+    average of the categorical kernel): the GP prior's covariance integrated twice."""
+    DD = np.empty((beta.shape[1], len(varied)))
+    for j in range(beta.shape[1]):
+        for n, k in enumerate(varied):
+            if levels is not None and levels[n] is not None:
+                DD[j, n] = np.mean(_kernel(beta[k, j], levels[n], levels[n], True))
+            else:
+                DD[j, n] = _double_mean(beta[k, j], lo[n], hi[n])
+    return DD
+
+
+def _basis_at(basis, z_bar: np.ndarray, varied, cols, points):
+    """A mean basis's h (N, k) at the unit-scale points with inputs ``cols`` (positions in
+    ``varied``) at ``points`` and every other input at ``z_bar`` (a varied one's mean over the
+    box, a fixed one's value): h's mean over the other inputs, h being linear in them. None
+    without a basis."""
+    if basis is None:
+        return None
+    z = np.repeat(z_bar[None, :], points[0].shape[0], axis=0)
+    for c, pt in zip(cols, points, strict=True):
+        z[:, varied[c]] = pt
+    return basis.matrix(z)
+
+
+def _effect_variances(zt, beta, lam, fac, varied, I1, DD, fixf, cols, points, cat, hbar=None):
+    """(p_u, N) the GP posterior variance of E[w_j(z) | z_cols = points] (the other varied
+    inputs integrated over the box; unit scale, standardised; the smooth GP: no nugget) for
+    each component j, at N points (``points``: per position in ``cols`` (N,) unit-scale
+    values; a NaN gives NaN):
+
+        prod_{n not in cols} DD[j, n] / lamUz_j - |L_j^-1 a|^2  (+ gbar^T Q_j^-1 gbar),
+        a = fixf_j rest_j prod_{c in cols} R_c(points_c, zt_c) / lamUz_j   (m, N),
+
+    the double integral of the posterior covariance over the other inputs: the prior's kernel
+    integrated twice (``DD``), the runs' share by their single means (``I1``, rest_j: those of
+    the inputs not in cols; fixf_j: the fixed inputs' kernels) and, with a mean basis, the
+    coefficients' share at the basis's mean ``hbar`` (N, k) (gbar = hbar^T - A^T L^-1 a).
+    ``fac``: per component (L, alpha, gls or None)."""
+    p_u, N = beta.shape[1], points[0].shape[0]
+    ok = np.all([np.isfinite(pt) for pt in points], axis=0)
+    out = np.full((p_u, N), np.nan)
+    for j, f in enumerate(fac):
+        L, gls = f[0], f[2] if len(f) > 2 else None
+        rest = np.prod(np.delete(I1[j], cols, axis=0), axis=0) * fixf[j]
+        A = np.repeat((rest / lam[j])[:, None], int(ok.sum()), axis=1)
+        for c, pt in zip(cols, points, strict=True):
+            A *= _kernel(beta[varied[c], j], pt[ok], zt[:, varied[c]], cat[c]).T
+        B = solve_triangular(L, A, lower=True)
+        v = np.prod(np.delete(DD[j], cols)) / lam[j] - np.sum(B * B, axis=0)
+        if gls is not None:
+            v = v + gls.variance(hbar[ok], B)
+        out[j, ok] = np.maximum(v, 0.0)
     return out
 
 
@@ -412,6 +546,8 @@ def _memory_estimate(
     n_pairs: int = 0,
     n_grid: int = 0,
     n_joint: int = 0,
+    n_groups: int = 0,
+    effect_variance: bool = False,
 ) -> float:
     """Bytes that ``sensitivity`` needs at once: per draw the factors of Sigma_W (about 2 p_u
     + 2 arrays m x m) and ``_component_moments``' pair integrals with their prefix and suffix
@@ -421,13 +557,23 @@ def _memory_estimate(
     per pair, output element and component per draw; with a main-effect grid of ``n_grid``
     points: its (n_grid, m) Gaussians and the curves (S, n_grid, l_sim, d) with their
     per-draw pieces; with a joint grid of ``n_joint`` points: two (n_joint, m) Gaussians and
-    the surfaces (S, n_joint^2, l_sim, n_pairs) with theirs."""
+    the surfaces (S, n_joint^2, l_sim, n_pairs) with theirs. With ``n_groups`` groups: as
+    pairs, two m x m arrays more and 3 indices per group, output element and component per
+    draw. With ``effect_variance``: the curves and surfaces once more, and the (m, G) and
+    (m, G2^2) kernel products with their triangular solves (3 arrays each)."""
     return 8.0 * (
-        m * m * (4.0 * d + 8.0 + 2.0 * p_u + (2.0 if n_pairs else 0.0))
+        m * m * (4.0 * d + 8.0 + 2.0 * p_u + (2.0 if n_pairs or n_groups else 0.0))
         + S * (2.0 * d * (l_sim + p_u + 1) + 2.0 * l_sim)
         + 2.0 * S * n_pairs * (l_sim + p_u + 1)
+        + S * n_groups * (l_sim + p_u + 1)
         + n_grid * (2.0 * m + (S + 2.0) * l_sim * d + p_u * d)
         + n_joint * (3.0 * m + n_joint * n_pairs * ((S + 2.0) * l_sim + p_u))
+        + (
+            n_grid * (3.0 * m + (S + 2.0) * l_sim * d + p_u * d)
+            + n_joint * n_joint * (3.0 * m + n_pairs * ((S + 2.0) * l_sim + p_u))
+            if effect_variance
+            else 0.0
+        )
     )
 
 
@@ -517,6 +663,36 @@ def _pair_positions(pairs, names: list[str], fixed: dict) -> list[tuple[int, int
     return out
 
 
+def _group_positions(groups, names: list[str], fixed: dict) -> list[tuple[int, ...]]:
+    """``groups`` (a list of groups of at least 2 varied input names) as tuples of positions in
+    ``names``; GPMSAError naming the problem (a name unknown or fixed, an input twice in a
+    group, a group listed twice in any order, a string where a group belongs)."""
+    if not isinstance(groups, list | tuple) or not groups:
+        raise GPMSAError(f"groups must be a non-empty list of groups of input names, e.g. "
+                         f"[('a', 'b', 'c')], got {groups!r}")  # fmt: skip
+    out, seen = [], set()
+    for group in groups:
+        if isinstance(group, str) or not isinstance(group, list | tuple) or len(group) < 2:
+            raise GPMSAError(f"each of groups must be a tuple of at least 2 input names, got "
+                             f"{group!r} (one group: groups=[('a', 'b', 'c')]; one input's "
+                             f"index is main)")  # fmt: skip
+        for name in group:
+            if name in fixed:
+                raise GPMSAError(f"groups names {name!r}, an input held fixed; the varied "
+                                 f"inputs are {tuple(names)}")  # fmt: skip
+            if not isinstance(name, str) or name not in names:
+                raise GPMSAError(f"groups names an unknown input {name!r}; the varied inputs "
+                                 f"are {tuple(names)}")  # fmt: skip
+        if len(set(group)) != len(group):
+            raise GPMSAError(f"groups names an input twice in {tuple(group)}")
+        key = frozenset(group)
+        if key in seen:
+            raise GPMSAError(f"groups lists the group {tuple(group)} twice")
+        seen.add(key)
+        out.append(tuple(names.index(name) for name in group))
+    return out
+
+
 def sensitivity(
     emulator,
     *,
@@ -527,6 +703,8 @@ def sensitivity(
     pairs: str | list | None = None,
     main_effect_grid: int | None = None,
     joint_effect_grid: int | None = None,
+    groups: list | None = None,
+    effect_variance: bool = False,
 ) -> Sensitivity:
     """Sobol main- and total-effect indices of the emulator's mean, over posterior draws.
 
@@ -551,6 +729,14 @@ def sensitivity(
         joint_effect_grid: G2 >= 2 points per input of each pair: the joint-effect functions
             E[y | z_k, z_k'] on the G2 x G2 grid (``joint_effect``, ``joint_grid``); needs
             ``pairs``. None (default): none.
+        groups: groups of at least 2 varied inputs, [("a", "b", "c"), ...]: the closed joint
+            index V_G / V of each (``group_joint``, with ``_pc`` and ``_aggregated``;
+            ``group_summary()``; SEPIA's ``jelist`` of any size; a group of two is the pair's
+            ``joint``). None (default): none.
+        effect_variance: also the GP's own posterior variance about each main-effect and
+            joint-effect function, per draw (``main_effect_variance``,
+            ``joint_effect_variance``; SEPIA's ``mef_v``, ``jef_v``); needs
+            ``main_effect_grid`` or ``joint_effect_grid``. False (default): not computed.
 
     Returns:
         Sensitivity with indices per draw, per output element, per basis component and
@@ -614,6 +800,7 @@ def sensitivity(
         box[name] = (a, b)
     k_names = [names[k] for k in varied]
     pair_pos = [] if pairs is None else _pair_positions(pairs, k_names, fixed)
+    group_pos = [] if groups is None else _group_positions(groups, k_names, fixed)
     n_grid = 0 if main_effect_grid is None else check_count(main_effect_grid, "main_effect_grid", 2)
     n_joint = 0
     if joint_effect_grid is not None:
@@ -621,6 +808,10 @@ def sensitivity(
         if not pair_pos:
             raise GPMSAError("joint_effect_grid needs pairs (whose joint-effect functions to "
                              "compute): pass pairs=[(a, b)] or pairs='all'")  # fmt: skip
+    effect_variance = check_flag(effect_variance, "effect_variance")
+    if effect_variance and not (n_grid or n_joint):
+        raise GPMSAError("effect_variance=True needs main_effect_grid or joint_effect_grid (the "
+                         "effect functions whose GP variance to compute)")  # fmt: skip
     _, ends = unit_inputs([lo_n, hi_n], k_names, lo_all[varied], hi_all[varied], "bounds")
     lo_u, hi_u = ends[0], ends[1]
     # a categorical input's unit-scale level codes (as the standardiser maps the design)
@@ -642,13 +833,15 @@ def sensitivity(
         fix_u[k] = float(u[0, 0])
     idx, sets = param_sets(emulator, draws, n_draws, "sensitivity")
     S, l_sim, p_u, d = len(sets), emulator.l_sim, emulator.p_u, len(varied)
-    P = len(pair_pos)
+    P, n_groups = len(pair_pos), len(group_pos)
     n_lev = max([lev.size for lev in lev_u if lev is not None], default=0)
     rows, rows_joint = max(n_grid, n_lev) if n_grid else 0, max(n_joint, n_lev) if n_joint else 0
-    extra = "".join([f", {P} pairs" if P else "",
+    extra = "".join([f", {P} pairs" if P else "", f", {n_groups} groups" if n_groups else "",
                      f", main effects on {n_grid} points" if n_grid else "",
-                     f", joint effects on {n_joint}^2 points" if n_joint else ""])  # fmt: skip
-    check_memory(_memory_estimate(emulator.m, d, p_u, S, l_sim, P, rows, rows_joint),
+                     f", joint effects on {n_joint}^2 points" if n_joint else "",
+                     " with their GP variance" if effect_variance else ""])  # fmt: skip
+    check_memory(_memory_estimate(emulator.m, d, p_u, S, l_sim, P, rows, rows_joint, n_groups,
+                                  effect_variance),
                  f"sensitivity() of an emulator of {emulator.m} runs x {p_u} basis components "
                  f"over {d} varied inputs{extra} (about {4 * d + 8 + 2 * p_u} arrays of "
                  f"{emulator.m} x {emulator.m} at once)")  # fmt: skip
@@ -663,19 +856,32 @@ def sensitivity(
     out_pair_pc = {k: np.empty((S, p_u, P)) for k in ("joint", "interaction")} if P else {}
     out_pair_agg = {k: np.empty((S, P)) for k in ("joint", "interaction")} if P else {}
     a_pos, b_pos = [a for a, _ in pair_pos], [b for _, b in pair_pos]
+    out_group = np.empty((S, l_sim, n_groups)) if n_groups else None
+    out_group_pc = np.empty((S, p_u, n_groups)) if n_groups else None
+    out_group_agg = np.empty((S, n_groups)) if n_groups else None
     y_mean, y_sd = np.asarray(std.y_mean, dtype=float), std.y_sd
     sd_col = np.reshape(y_sd, (-1, 1))  # along the output axis of the effects (l, ...)
     effect_grid = main_effect = joint_grid = joint_effect = None
+    main_var = joint_var = None
     if n_grid:
         effect_grid, grid_u = _effect_grids(n_grid, rows, lo_n, hi_n, lo_u, hi_u, lev_n, lev_u)
         main_effect = np.empty((S, rows, l_sim, d))
+        main_var = np.empty((S, rows, l_sim, d)) if effect_variance else None
     if n_joint:
         joint_grid, joint_u = _effect_grids(n_joint, rows_joint, lo_n, hi_n, lo_u, hi_u, lev_n,
                                             lev_u)  # fmt: skip
         joint_effect = np.empty((S, rows_joint, rows_joint, l_sim, P))
+        joint_var = np.empty((S, rows_joint, rows_joint, l_sim, P)) if effect_variance else None
     basis = emulator.mean_basis
     special = basis is not None or any(lv is not None for lv in levels_all)
     lev_arg = lev_u if any(cat) else None
+    if effect_variance:  # the mean basis's h at each grid point, the other inputs at their mean
+        centre = np.array([0.5 * (a + b) if lv is None else float(np.mean(lv))
+                           for a, b, lv in zip(lo_u, hi_u, lev_u, strict=True)])  # fmt: skip
+        z_bar = np.empty(len(names))
+        z_bar[varied] = centre
+        for k, u in fix_u.items():
+            z_bar[k] = u
     with blas_controller().limit(limits=1, user_api="blas"):
         for i, prm in enumerate(sets):
             beta = prm["betaU"]
@@ -688,8 +894,9 @@ def sensitivity(
                     trend = _Trend.of(np.array([g.coef for _, _, g in fac]), basis.kind, varied,
                                       fix_u, lo_u, hi_u, lev_u)  # fmt: skip
             else:
+                fac = factors(emulator, prm)
                 coef = np.array([alpha / prm["lamUz"][j] for j, (_, alpha) in
-                                 enumerate(factors(emulator, prm))])  # fmt: skip
+                                 enumerate(fac)])  # fmt: skip
             for k, u in fix_u.items():
                 if levels_all[k] is not None:
                     dist = CATEGORICAL_DISTANCE * (u != zt[None, :, k])
@@ -697,8 +904,8 @@ def sensitivity(
                 else:
                     coef = coef * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
             I1 = _single_means(zt, beta, varied, lo_u, hi_u, lev_arg)
-            mu, Vall, Vmain, Vcomp, Vpair = _component_moments(
-                zt, coef, beta, varied, lo_u, hi_u, I1, pair_pos, lev_arg
+            mu, Vall, Vmain, Vcomp, Vpair, Vgroup = _component_moments(
+                zt, coef, beta, varied, lo_u, hi_u, I1, pair_pos, lev_arg, group_pos
             )
             if trend is not None:  # the mean basis's part, additive in the inputs
                 D = trend.covariances(zt, coef, beta, varied, lo_u, hi_u, I1, lev_u)
@@ -707,6 +914,8 @@ def sensitivity(
                 Vcomp = Vcomp + (D.sum(axis=0) - D)
                 Vmain = Vmain + D
                 Vpair = Vpair + D[a_pos] + D[b_pos]
+                for g, group in enumerate(group_pos):
+                    Vgroup[g] = Vgroup[g] + D[list(group)].sum(axis=0)
             v_l = np.einsum("lj,jk,lk->l", K, Vall, K)
             scale = max(float(v_l.max()), 1e-300)
             main_l = np.einsum("lj,njk,lk->ln", K, Vmain, K)
@@ -737,6 +946,39 @@ def sensitivity(
                                                   v_pc[:, None], scale_pc)  # fmt: skip
                     out_pair_agg[kind][i] = _ratio(np.einsum("jk,njk->n", KtK, Vu), v_sum,
                                                    scale_sum)  # fmt: skip
+            if n_groups:
+                out_group[i] = _ratio(np.einsum("lj,njk,lk->ln", K, Vgroup, K), v_l[:, None],
+                                      scale)  # fmt: skip
+                out_group_pc[i] = _ratio(np.diagonal(Vgroup, axis1=1, axis2=2).T, v_pc[:, None],
+                                         scale_pc)  # fmt: skip
+                out_group_agg[i] = _ratio(np.einsum("jk,njk->n", KtK, Vgroup), v_sum, scale_sum)
+            if effect_variance:
+                fixf = np.ones((p_u, zt.shape[0]))  # the fixed inputs' kernels, as coef's
+                for k, u in fix_u.items():
+                    if levels_all[k] is not None:
+                        dist = CATEGORICAL_DISTANCE * (u != zt[None, :, k])
+                        fixf = fixf * np.exp(-beta[k][:, None] * dist)
+                    else:
+                        fixf = fixf * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
+                DD = _double_means(beta, varied, lo_u, hi_u, lev_arg)
+                shared = (zt, beta, prm["lamUz"], fac, varied, I1, DD, fixf)
+                K2 = K * K
+                if n_grid:
+                    V = np.empty((p_u, rows, d))
+                    for n in range(d):
+                        pts = [grid_u[:, n]]
+                        hbar = _basis_at(basis, z_bar, varied, (n,), pts)
+                        V[..., n] = _effect_variances(*shared, (n,), pts, cat, hbar)
+                    main_var[i] = sd_col**2 * np.einsum("lj,jgn->gln", K2, V)
+                if n_joint:
+                    V = np.empty((p_u, rows_joint, rows_joint, P))
+                    for p, (a, b) in enumerate(pair_pos):
+                        ga, gb = np.meshgrid(joint_u[:, a], joint_u[:, b], indexing="ij")
+                        pts = [ga.ravel(), gb.ravel()]
+                        hbar = _basis_at(basis, z_bar, varied, (a, b), pts)
+                        V[..., p] = _effect_variances(*shared, (a, b), pts, cat,
+                                                      hbar).reshape(V.shape[:3])  # fmt: skip
+                    joint_var[i] = sd_col**2 * np.einsum("lj,jabp->ablp", K2, V)
             if n_grid:
                 E = _main_effects(zt, coef, beta, varied, I1, grid_u, cat)  # (p_u, G, d)
                 if trend is not None:
@@ -769,4 +1011,7 @@ def sensitivity(
         interaction_aggregated=out_pair_agg.get("interaction"),
         effect_grid=effect_grid, main_effect=main_effect, joint_grid=joint_grid,
         joint_effect=joint_effect,
+        groups=tuple(tuple(k_names[n] for n in group) for group in group_pos),
+        group_joint=out_group, group_joint_pc=out_group_pc, group_joint_aggregated=out_group_agg,
+        main_effect_variance=main_var, joint_effect_variance=joint_var,
     )  # fmt: skip
