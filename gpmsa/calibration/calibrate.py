@@ -56,7 +56,7 @@ from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
-from gpmsa.model import constraints
+from gpmsa.model import constraints, kronecker
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, check_count, check_flag, run_seed
@@ -86,6 +86,7 @@ def calibration_problem(
     (with ``reduced``), for the lamOs start.
     """
     check_emulator(emulator, categorical_theta=True)  # calibrate refuses it for torch, pyro
+    kronecker.check_dense(emulator, "calibration (gpmsa.calibrate)")
     if reduced is not None and discrepancy is not None:
         raise GPMSAError("calibration_problem: reduced= is the no-discrepancy reduction; with a "
                          "discrepancy basis pass reduced=None")  # fmt: skip

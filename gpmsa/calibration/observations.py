@@ -21,7 +21,7 @@ from gpmsa.errors import (
     ResourceLimitError,
     user_stacklevel,
 )
-from gpmsa.model import categorical
+from gpmsa.model import categorical, kronecker
 from gpmsa.model.data import (
     ObsData,
     as_float,
@@ -130,6 +130,7 @@ def blas_controller() -> ThreadpoolController:
 def fixed_gp(emulator, params: dict | None = None) -> FixedGP:
     """The emulator's GP at ``params`` (default: its point estimate)."""
     prm = emulator.params if params is None else params
+    kronecker.check_dense(emulator, "calibration (gpmsa.calibrate, gpmsa.Calibrator)")
     return FixedGP(
         emulator.x_unit, emulator.t_unit, emulator.w, emulator.lam_sim,
         prm["betaU"], prm["lamUz"], prm["lamWs"], prm["lamWOs"],

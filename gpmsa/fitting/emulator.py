@@ -25,10 +25,12 @@ from gpmsa.errors import EmulatorFileError, ExtrapolationWarning, GPMSAError
 from gpmsa.fitting.validation import (
     DISCREPANCY_ARRAY,
     EMULATOR_PARAMS,
+    KRON_ARRAY,
     REQUIRED,
     STD_FIELDS,
     check_manifest,
     check_record,
+    kron_groups,
     split_bases,
 )
 from gpmsa.io.container import (
@@ -44,6 +46,7 @@ from gpmsa.io.container import (
 )
 from gpmsa.limits import check_memory
 from gpmsa.model import categorical as categorical_mod
+from gpmsa.model import kronecker
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
     SimData,
@@ -207,6 +210,7 @@ class Emulator:
         levels: categorical_mod.Levels | None = None,
         mean_basis: MeanBasis | None = None,
         discrepancy_bases: tuple[np.ndarray, ...] | None = None,
+        separable: tuple[tuple[int, ...], ...] | None = None,
     ):
         self.standardizer = standardizer
         self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
@@ -226,6 +230,12 @@ class Emulator:
         self.levels = (None,) * (self.p + self.q) if levels is None else tuple(levels)
         self.mean_basis = mean_basis
         self.discrepancy_bases = None if discrepancy_bases is None else tuple(discrepancy_bases)
+        self.separable = None  # a separable design's factor structure (``SimData(separable=)``)
+        if separable is not None:
+            if self.mean_basis is not None:
+                kronecker.refuse("a mean_basis")
+            names = self.x_names + self.t_names
+            self.separable = kronecker.structure(self.zt, separable, names)
         self._factors: dict[int, list] = {}
         self._freeze()
 
@@ -282,6 +292,7 @@ class Emulator:
         ``discrepancy_bases`` existed has none)."""
         self.__dict__.update(state)
         self.__dict__.setdefault("discrepancy_bases", None)
+        self.__dict__.setdefault("separable", None)
         self._freeze()
 
     # --- construction -------------------------------------------------------------------------
@@ -323,7 +334,8 @@ class Emulator:
             K=prep.K, w=prob.w, index=sim.index, params=params, priors=prob.priors,
             names={"x": sim.x_names, "t": sim.t_names, "y": sim.y_names},
             units={"x": sim.x_units, "t": sim.t_units, "y": sim.y_units},
-            levels=sim.levels, mean_basis=prob.mean_basis, **kw,
+            levels=sim.levels, mean_basis=prob.mean_basis,
+            separable=None if prob.separable is None else prob.separable.groups, **kw,
         )  # fmt: skip
 
     # --- shapes and domain --------------------------------------------------------------------
@@ -399,6 +411,8 @@ class Emulator:
     def _factor(self, params: dict[str, np.ndarray]) -> list[tuple]:
         """Per component: (Cholesky factor of Sigma_W_j, Sigma_W_j^-1 w_j, None), or with a
         mean basis (L, Sigma_W_j^-1 (w_j - H c_j), the ``GLS`` fit c_j)."""
+        what = "this operation (calibration, cross-validation, full prediction, sensitivity)"
+        kronecker.check_dense(self, what)
         out = []
         zt = self.zt
         cat = self.categorical_mask
@@ -426,6 +440,17 @@ class Emulator:
         if -1 not in self._factors:
             self._factors[-1] = self._factor(self.params)
         return self._factors[-1]
+
+    def _predict_factors(self, params, point: bool = False) -> list:
+        """The factors ``_predict_std`` takes: the dense ``_factor`` (``_point_factor`` at the
+        point estimate), or a separable emulator's ``kronecker.KronFactor`` per component."""
+        if self.separable is None:
+            return self._point_factor() if point else self._factor(params)
+        if not point:
+            return kronecker.emulator_factors(self, params)
+        if -2 not in self._factors:
+            self._factors[-2] = kronecker.emulator_factors(self, self.params)
+        return self._factors[-2]
 
     def _inputs(self, x, t, *, far_ok: bool = False, stacklevel: int = 3) -> np.ndarray:
         """Unit-scale z (N, p + q) of native x and t; beyond ``EXTRAPOLATION_MARGIN`` of the
@@ -479,6 +504,8 @@ class Emulator:
     def _predict_std(self, z: np.ndarray, params, factors, resid: bool, *, var: bool = True):
         """Standardised predictive mean and variance (N, l_sim) at unit-scale z; ``var=False``:
         the variance None, its triangular solves skipped (the mean's operations unchanged)."""
+        if self.separable is not None:  # through the factors: no m x m matrix
+            return kronecker.predict_std(self, z, params, factors, resid, var=var)
         mean = np.zeros((z.shape[0], self.l_sim))
         out = np.zeros((z.shape[0], self.l_sim)) if var else None
         cat = self.categorical_mask
@@ -518,7 +545,7 @@ class Emulator:
         ``var=False``: the variance None (``predict_mean``)."""
         self._check_predict_memory(x, t)
         z = self._inputs(x, t, far_ok=far_ok, stacklevel=4)  # the caller of predict()
-        m, v = self._predict_std(z, self.params, self._point_factor(), resid, var=var)
+        m, v = self._predict_std(z, self.params, self._predict_factors(None, True), resid, var=var)
         s = self.standardizer
         return s.y_from_std(m), None if v is None else s.var_from_std(v)
 
@@ -538,7 +565,7 @@ class Emulator:
         with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
             for i in idx:
                 prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
-                m, v = self._predict_std(z, prm, self._factor(prm), resid, var=var)
+                m, v = self._predict_std(z, prm, self._predict_factors(prm), resid, var=var)
                 means.append(m)
                 vars_.append(v)
         means = np.array(means)
@@ -596,8 +623,11 @@ class Emulator:
         """
         mean_w = np.zeros((self.m, self.p_u))
         var_w = np.zeros((self.m, self.p_u))
-        for j, (L, a, gls) in enumerate(self._point_factor()):
-            d = _precision_diagonal(L, gls)
+        if self.separable is None:
+            fac = [(a, _precision_diagonal(L, gls)) for L, a, gls in self._point_factor()]
+        else:  # diag(Sigma_W^-1) through the factors
+            fac = [(f.alpha, f.precision_diagonal()) for f in self._predict_factors(None, True)]
+        for j, (a, d) in enumerate(fac):
             mean_w[:, j] = self.w[:, j] - a / d
             var_w[:, j] = 1.0 / d
         mean = mean_w @ self.K.T
@@ -747,6 +777,8 @@ class Emulator:
             arrays[f"cal_{k}"] = v
         if self.discrepancy_bases is not None:  # stacked; settings.obs_lengths splits them
             arrays[DISCREPANCY_ARRAY] = np.vstack(self.discrepancy_bases)
+        if self.separable is not None:  # only then: other files as before
+            arrays[KRON_ARRAY] = self.separable.factor_of_column()
         return {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
 
     @functools.cached_property
@@ -806,6 +838,7 @@ class Emulator:
                 calibration=cal, convergence=manifest.get("convergence"),  # check_fields checked it
                 levels=_levels(manifest, names), mean_basis=_mean_basis(manifest, names),
                 discrepancy_bases=split_bases(arrays, manifest["settings"]),
+                separable=kron_groups(arrays),
             )  # fmt: skip
             _check_consistent(emu)
             domain = {k: list(v) for k, v in emu.domain.items()}

@@ -35,7 +35,7 @@ from gpmsa.mcmc.sampler import (
     sweeps_nbytes,
 )
 from gpmsa.mcmc.starts import check_init
-from gpmsa.model import constraints
+from gpmsa.model import constraints, kronecker
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, run_seed
@@ -60,8 +60,11 @@ def _check_fit_memory(problem, n_iter: int, n_chains: int, pooled: int = 0) -> N
     ``pooled``: the retained draws of an appended fit (``append=True``), source's and its own,
     held three times (the parts, the pooled arrays, the emulator's read-only copies)."""
     m = problem.m
-    nbytes = draws_nbytes(problem, n_iter, n_chains) + _factor_nbytes(
-        m, problem.p, problem.q, problem.p_u
+    sep = problem.separable  # a separable design's likelihood keeps its factors alone
+    nbytes = draws_nbytes(problem, n_iter, n_chains) + (
+        _factor_nbytes(m, problem.p, problem.q, problem.p_u)
+        if sep is None
+        else kronecker.fit_nbytes(sep, problem.p_u)
     )
     nbytes += 1.5 * sweeps_nbytes(parameter_elements(problem), pooled, 1)
     what = f" appending to {pooled} retained draws" if pooled else ""
@@ -201,6 +204,8 @@ def fit(
             "field data, and a simulator-only fit has none"
         )
     seed = run_seed(seed)
+    if isinstance(data, SimData) and data.separable is not None and backend != "numpy":
+        kronecker.refuse(f"backend={backend!r}")
     module = backends.get(backend)
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
                    mean_basis=mean_basis, discrepancy_groups=discrepancy_groups,

@@ -52,6 +52,9 @@ array per experiment, which an emulator file keeps: ``DISCREPANCY_ARRAY``)."""
 DISCREPANCY_ARRAY = "discrepancy_D"
 """The array of a joint fit's per-experiment discrepancy bases (settings.discrepancy "list"):
 the normalised bases stacked (sum of l_j, p_v), split by settings.obs_lengths."""
+KRON_ARRAY = "kron_factor"
+"""A separable design's declaration (``SimData(separable=)``): the factor (0, 1, ...; factor
+0 varies slowest) of each input column of [x, t], (p + q,); written only for such a design."""
 NORM_TOL = 1e-9
 """Tolerance of the stored per-experiment bases' normalisation (largest diag(D D^T) = 1)."""
 BASIS_VECTORS = {"constant": 1, "linear": 2}
@@ -139,6 +142,8 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
             if len(shapes[name]) != 2 or min(shapes[name]) < 1:
                 raise _fail(f"arrays/{name}", f"shape {list(shapes[name])}: must be (sum of the "
                                               "experiments' lengths, p_v), p_v >= 1")  # fmt: skip
+        elif name == KRON_ARRAY:
+            want[name] = (p + q,)
         elif name not in REQUIRED and name != "index":
             raise _fail(  # a save would drop it: not a file this library wrote
                 f"arrays/{name}",
@@ -375,6 +380,22 @@ def _check_bases_shape(settings: dict, shapes: dict[str, tuple[int, ...]]) -> No
     if isinstance(groups, list) and len(groups) != held[1]:
         raise _fail("settings.discrepancy_groups", f"{_short(groups)}: one group per basis "
                     f"vector, but {field} has {held[1]} columns")  # fmt: skip
+
+
+def kron_groups(arrays: dict[str, np.ndarray]) -> tuple[tuple[int, ...], ...] | None:
+    """The factor column groups of ``KRON_ARRAY`` (None where the record has none); an
+    EmulatorFileError unless it numbers at least two factors 0, 1, ... each holding an input
+    (the design's product structure is checked when the emulator is built)."""
+    held = arrays.get(KRON_ARRAY)
+    if held is None:
+        return None
+    codes = np.asarray(held, dtype=float).reshape(-1)
+    k = int(np.max(codes)) + 1 if codes.size and np.all(np.isfinite(codes)) else 0
+    if k < 2 or not np.array_equal(np.unique(codes), np.arange(k)):
+        raise _fail(f"arrays/{KRON_ARRAY}", f"{_short(codes.tolist())}: must number the "
+                    "factor of each input 0, 1, ..., at least two factors, each holding an "
+                    "input")  # fmt: skip
+    return tuple(tuple(int(c) for c in np.flatnonzero(codes == f)) for f in range(k))
 
 
 def split_bases(arrays: dict[str, np.ndarray], settings: dict) -> tuple[np.ndarray, ...] | None:

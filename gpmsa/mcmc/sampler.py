@@ -25,6 +25,7 @@ from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, ridge, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.data import as_float, check_count, check_flag, check_seed
+from gpmsa.model.kronecker import KroneckerLikelihood
 from gpmsa.model.likelihood import IncrementalLikelihood, log_prior
 from gpmsa.model.problem import Problem
 
@@ -184,7 +185,8 @@ class ChainState:
         self.ridge_accepted = 0
         pri = problem.priors
         self._ridge_priors = (pri.scalar_log_prior("lamWs"), pri.scalar_log_prior("lamWOs"))
-        self.lik = IncrementalLikelihood(problem, params)
+        kron = problem.separable is not None  # a separable design: through its factors
+        self.lik = (KroneckerLikelihood if kron else IncrementalLikelihood)(problem, params)
         self.els = elements(problem) if els is None else list(els)
         self.kinds = [
             1 if n in RHO_PARAMS else 2 if n in PRECISION_PARAMS else 0 for n, _ in self.els

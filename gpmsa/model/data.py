@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model import categorical
+from gpmsa.model import categorical, kronecker
 
 
 def _first_non_number(value) -> str | None:
@@ -634,6 +634,12 @@ class SimData:
     GPM/SA's: one sd over all outputs) or "columnwise" (SEPIA's ``standardize_y(scale=
     'columnwise')``: each output element by its own sd, for outputs of different units or
     sizes in one functional output; every column must vary). Same for a scalar output.
+    ``separable``: the runs are the Cartesian product of factor designs (SEPIA's
+    ``xt_sim_sep``), stored run by run in Kronecker order: True (every input its own factor,
+    in column order x then t), or the factors, slowest-varying first, each an input (name or
+    index into [x, t]) or a list of them, e.g. ``[["v"], ["GD"]]``; the design is checked to be
+    that product (``gpmsa.model.kronecker``; docs/internals.md, "Separable designs"). Stored as
+    the column groups (indices), or None.
     """
 
     x: np.ndarray | None = None
@@ -651,6 +657,7 @@ class SimData:
     x_range: np.ndarray | Sequence | dict | None = None
     t_range: np.ndarray | Sequence | dict | None = None
     y_scale: str = "scalar"
+    separable: bool | Sequence | None = None
 
     def __post_init__(self) -> None:
         check_same_rows({"x": self.x, "t": self.t, "y": self.y})
@@ -721,6 +728,10 @@ class SimData:
             names, cats = getattr(self, f"{part}_names"), getattr(self, f"{part}_categorical")
             object.__setattr__(self, attr, _ranges(getattr(self, attr), arr, names, cats, attr))
         _check_rank(x, t, self.x_names, self.t_names)
+        names = self.x_names + self.t_names  # a separable design: its product checked here
+        if (groups := kronecker.parse_groups(self.separable, names)) is not None:
+            kronecker.structure(np.hstack([x, t]), groups, names)
+        object.__setattr__(self, "separable", groups)
 
     @property
     def m(self) -> int:

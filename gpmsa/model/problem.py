@@ -10,7 +10,7 @@ import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
 from gpmsa.errors import ExtrapolationWarning, GPMSAError, ReductionWarning, user_stacklevel
-from gpmsa.model import categorical
+from gpmsa.model import categorical, kronecker
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import (
@@ -118,6 +118,8 @@ class Problem:
     (None: all of it). See docs/categorical-and-constraints.md.
     fixed_elements: name -> the elements (index tuples) of a parameter not in ``fixed`` held at
     their init value, the others sampled (``gpmsa.model.fixed_elements``).
+    separable: the factor structure of a separable design (``gpmsa.model.kronecker``; None:
+    none), whose likelihood the numpy sampler takes through the factors.
     """
 
     x_sim: np.ndarray
@@ -132,6 +134,7 @@ class Problem:
     mean_basis: mean_basis_mod.MeanBasis | None = None
     constraint: ThetaConstraint | None = None
     fixed_elements: dict[str, frozenset[tuple[int, ...]]] = field(default_factory=dict)
+    separable: kronecker.Separable | None = None
 
     def __post_init__(self) -> None:
         """GPMSAError when per-group lamVz or betaV priors do not give one prior per discrepancy
@@ -620,9 +623,15 @@ def prepare(
     basis = mean_basis_mod.make(mean_basis, sim.p + sim.q, sim.m)
     if basis is not None:  # refused before sampling, not at the first prediction
         mean_basis_mod.check_rank(basis, np.hstack([x_unit, t_unit]))
+    sep = None
+    if sim.separable is not None:  # the unit design keeps the native one's product
+        if obs is not None or basis is not None:
+            kronecker.refuse("observations (obs=)" if obs is not None else "a mean_basis")
+        names = sim.x_names + sim.t_names
+        sep = kronecker.structure(np.hstack([x_unit, t_unit]), sim.separable, names)
     prob = Problem(
         x_unit, t_unit, w, lam_sim, priors, init, frozenset(), obs_p,
-        categorical.mask(levels), basis,
+        categorical.mask(levels), basis, separable=sep,
     )  # fmt: skip
     if obs is not None and prob.theta_levels is not None:  # a categorical theta starts at a level
         prob = prob.with_init({"theta": prob.snap_theta(init["theta"])})

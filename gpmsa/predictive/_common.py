@@ -13,6 +13,7 @@ from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa.errors import ExtrapolationWarning, GPMSAError
 from gpmsa.fitting.emulator import NO_DRAWS, Emulator
+from gpmsa.model import kronecker
 from gpmsa.model.categorical import check_levels
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
@@ -216,6 +217,7 @@ def factors(emulator, prm: dict) -> list[tuple[np.ndarray, np.ndarray]]:
 
     Sigma_W_j = R(zt; betaU_j) / lamUz_j + (1 / (lam_sim_j lamWOs) + 1 / lamWs_j) I.
     """
+    kronecker.check_dense(emulator, "this prediction (cross-validation, full or joint)")
     zt = emulator.zt
     out = []
     for j in range(emulator.p_u):
