@@ -40,6 +40,12 @@ def user_stacklevel() -> int:
     return level
 
 
+class DomainWarning(UserWarning):
+    """A unit domain given to ``SimData(x_range=, t_range=)`` is far wider than its design
+    column spans (below ``gpmsa.model.data.RANGE_COVER_MIN`` of it: a unit mistake?): the
+    runs then fill a sliver of [0, 1], and the fit can no longer resolve that input."""
+
+
 class BasisWarning(UserWarning):
     """A user-supplied emulator basis gives the runs weights on a scale that the priors do not
     expect (``gpmsa.fit(..., basis=)``)."""

@@ -89,6 +89,19 @@ def _basis_line(settings: dict, emulator) -> str:
     return f"{source}, {emulator.K.shape[1]} vector(s){share}"
 
 
+def _given_scale(std) -> str:
+    """The output standardisation of a Standardizer with a given y_mean or y_sd, in words."""
+    each = std.columnwise  # an sd per output element (given, or y_scale="columnwise")
+    mean = "centred by the given y_mean" if "y_mean" in std.y_given else "centred by the runs' mean"
+    if "y_sd" in std.y_given:
+        values = f"{np.min(std.y_sd):.6g}" + (f" to {np.max(std.y_sd):.6g}" if each else "")
+        kind = "one per output element" if each else "one sd"
+        sd = f"divided by the given y_sd ({kind}: {values})"
+    else:
+        sd = "divided by the runs' sd" + (" (each output element by its own)" if each else "")
+    return f"{mean}, {sd}"
+
+
 def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     """The manifest for a person (the content already validated: names, units, domain, model);
     ``emulator``: the loaded one, for theta in native units and its ``model_sha256`` (what a
@@ -125,7 +138,9 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
         lines.append("categorical:     " + ", ".join(
             f"{safe(n, 60)} levels [{safe(', '.join(str(v) for v in lv), 300)}]"
             for n, lv in cat.items()))  # fmt: skip
-    if standardizer.columnwise:  # one sd over all outputs (GPM/SA's) is not said
+    if standardizer.y_given:  # SimData(y_mean=, y_sd=): the user's, not the runs' own
+        lines.append(f"output scale:    {_given_scale(standardizer)}")
+    elif standardizer.columnwise:  # one sd over all outputs (GPM/SA's) is not said
         lines.append("output scale:    columnwise (each output element by its own sd)")
     lines.append(f"basis:           {_basis_line(manifest['settings'], emulator)}")
     mean = model.get("mean_basis")

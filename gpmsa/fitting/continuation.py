@@ -71,9 +71,9 @@ def continued_starts(
 
 def check_same_scales(emulator: Emulator, data, standardizer) -> None:
     """GPMSAError naming each input whose unit domain, or the output scale, differs between
-    ``emulator``'s fit and this one (``SimData(x_range=, t_range=, y_scale=)``) where the runs
-    are the same (their outputs equal): they then sit at other unit values, so the chains
-    cannot continue. Other runs are left to `continued_starts` to name."""
+    ``emulator``'s fit and this one (``SimData(x_range=, t_range=, y_scale=, y_mean=,
+    y_sd=)``) where the runs are the same (their outputs equal): they then sit at other unit
+    values, so the chains cannot continue. Other runs are left to `continued_starts` to name."""
     y = np.asarray(data.y, dtype=float)
     if emulator.y.shape != y.shape or not np.array_equal(emulator.y, y):
         return
@@ -88,14 +88,33 @@ def check_same_scales(emulator: Emulator, data, standardizer) -> None:
         if ends[0][k] != ends[1][k] or ends[0][d + k] != ends[1][d + k]
     ]
     scale = {True: "'columnwise'", False: "'scalar'"}
-    if old.columnwise != new.columnwise:
+    given = set(old.y_given) | set(new.y_given)  # else both the runs' own: the same
+    if "y_mean" in given and not np.array_equal(old.y_mean, new.y_mean):
+        differs.append(f"y_mean: {_given(old, 'y_mean')} in init=emulator's fit, "
+                       f"{_given(new, 'y_mean')} here")  # fmt: skip
+    if "y_sd" in given:
+        if not np.array_equal(old.y_sd, new.y_sd):
+            differs.append(f"y_sd: {_given(old, 'y_sd')} in init=emulator's fit, "
+                           f"{_given(new, 'y_sd')} here")  # fmt: skip
+    elif old.columnwise != new.columnwise:
         differs.append(f"y_scale: {scale[old.columnwise]} in init=emulator's fit, "
                        f"{scale[new.columnwise]} here")  # fmt: skip
     if differs:
         raise GPMSAError(
             "init=emulator mapped the same runs onto other unit values (SimData's x_range, "
-            f"t_range or y_scale): {'; '.join(differs)}; give its fit's, or start afresh"
+            f"t_range, y_scale, y_mean or y_sd): {'; '.join(differs)}; give its fit's, or start "
+            "afresh"
         )
+
+
+def _given(std, name: str) -> str:
+    """A Standardizer's ``name`` ("y_mean" or "y_sd") for a message: its value(s), and whether
+    the user gave it or it is the runs' own."""
+    v = np.ravel(getattr(std, name))
+    text = f"{v[0]:.6g}" if v.size == 1 else f"[{', '.join(f'{a:.6g}' for a in v[:3])}" + (
+        ", ...]" if v.size > 3 else "]")  # fmt: skip
+    who = "given" if name in std.y_given else "the runs' own"
+    return f"{text} ({who})"
 
 
 PER_COMPONENT = ("betaU", "lamUz", "lamWs")

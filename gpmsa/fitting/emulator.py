@@ -745,6 +745,8 @@ class Emulator:
         ranged = self.given_ranges
         if ranged:  # only then: a file without given ranges is written as before
             manifest["model"]["input_ranges"] = list(ranged)
+        if self.standardizer.y_given:  # only then, as input_ranges: other files as before
+            manifest["model"]["y_given"] = list(self.standardizer.y_given)
         _check_metadata(self.metadata, "metadata")
         if self.convergence is not None:
             manifest["convergence"] = self.convergence
@@ -824,6 +826,7 @@ class Emulator:
                 **{k: arrays[k] for k in STD_FIELDS}, y_sd=_y_sd(arrays["y_sd"]),
                 x_ranged=tuple(n in ranged for n in names["x"]) if ranged else (),
                 t_ranged=tuple(n in ranged for n in names["t"]) if ranged else (),
+                y_given=tuple(manifest["model"].get("y_given", ())),  # check_fields checked it
             )  # fmt: skip
             units = {k: tuple(manifest["units"][k]) for k in ("x", "t", "y")}
             draws = {k[5:]: v for k, v in arrays.items() if k.startswith("draw_")}

@@ -29,7 +29,7 @@ from gpmsa.model.data import as_float, column_scales, output_scale
 from gpmsa.model.fixed_elements import label
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import MAX_PRIOR_SHAPE, theta_prior_overflow
-from gpmsa.model.transforms import UNIT_TOL
+from gpmsa.model.transforms import UNIT_TOL, Y_GIVEN
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 STD_FIELDS = ("x_min", "x_max", "t_min", "t_max", "y_mean", "grid")
@@ -668,6 +668,12 @@ def _check_model_options(model: dict, inputs: list[str]) -> None:
                         f"{_short(levels)}")  # fmt: skip
     if "input_ranges" in model:  # absent in files without given ranges (all before it)
         _check_input_ranges(model["input_ranges"], inputs, cat)
+    if "y_given" in model:  # absent in files without a given y_mean, y_sd (all before it)
+        given = model["y_given"]
+        ok = isinstance(given, list) and given and all(isinstance(k, str) for k in given)
+        if not ok or len(set(given)) != len(given) or not set(given) <= set(Y_GIVEN):
+            raise _fail("model.y_given", f"must be a non-empty list of distinct entries of "
+                        f"{list(Y_GIVEN)}, got {_short(given)}")  # fmt: skip
     kind = model.get("mean_basis")
     if kind is not None and kind not in MEAN_BASIS_KINDS:
         raise _fail("model.mean_basis",
@@ -781,11 +787,16 @@ def _in_unit(arrays: dict[str, np.ndarray], name: str, span) -> None:
 
 
 def check_values(
-    arrays: dict[str, np.ndarray], dims: dict[str, int], ranged: tuple | None = None
+    arrays: dict[str, np.ndarray],
+    dims: dict[str, int],
+    ranged: tuple | None = None,
+    given: tuple[str, ...] = (),
 ) -> None:
     """Finite values, ranges, positive scales and the file's internal redundancies. ``ranged``:
     per x and t column whether its range was given (`ranged_columns`; None: none), where the
-    design lies inside [0, 1] without spanning it."""
+    design lies inside [0, 1] without spanning it. ``given``: which of y_mean, y_sd the user
+    gave (model.y_given), not recomputed from the runs (the weights still are their
+    projection)."""
     x_span, t_span = (True, True) if ranged is None else (~ranged[0], ~ranged[1])
     _in_unit(arrays, "x_unit", span=x_span)
     _in_unit(arrays, "t_unit", span=t_span)
@@ -823,19 +834,15 @@ def check_values(
     y, y_mean = arrays["y"], arrays["y_mean"]
     mean = y.mean(axis=0)
     tol = REL_TOL * (y_sd + np.abs(mean))
-    if np.any(np.abs(mean - y_mean) > tol):
+    if "y_mean" not in given and np.any(np.abs(mean - y_mean) > tol):
         raise _fail("arrays/y_mean", "differs from the mean of the training outputs arrays/y")
-    try:  # the writer's definition of the output scale (Standardizer.from_sim)
-        sd = output_scale(y) if np.ndim(y_sd) == 0 else column_scales(y, range(y.shape[1]))
-    except GPMSAError as exc:  # zero spread, or a spread that overflows
-        raise _fail("arrays/y", str(exc)) from None
-    if np.ndim(y_sd) == 0:
-        if abs(sd - y_sd) > REL_TOL * sd:
-            raise _fail("arrays/y_sd", f"{y_sd!r}, but the training outputs' sd is {sd!r}")
-    elif (bad := np.flatnonzero(np.abs(sd - y_sd) > REL_TOL * sd)).size:
-        k = int(bad[0])
-        raise _fail("arrays/y_sd", f"[{k}] = {float(y_sd[k])!r}, but the sd of the training "
-                    f"outputs' column {k} is {float(sd[k])!r} (scaled columnwise)")  # fmt: skip
+    if "y_sd" in given:  # the user's (SimData(y_mean=, y_sd=)): its square a normal float64
+        with np.errstate(over="ignore", under="ignore"):
+            square = np.asarray(y_sd) ** 2
+        if not np.all((square >= np.finfo(np.float64).tiny) & np.isfinite(square)):
+            raise _fail("arrays/y_sd", f"{_short(y_sd)}: its square is not a normal float64")
+    else:
+        _check_runs_sd(y, y_sd)
     K = arrays["K"]
     lam = np.sum(K**2, axis=0)
     if not np.all(lam > 0):
@@ -873,6 +880,22 @@ def check_values(
                 _positive(arrays, name)
 
 
+def _check_runs_sd(y: np.ndarray, y_sd: float | np.ndarray) -> None:
+    """``y_sd`` (a float, or (l_sim,) columnwise) is the training outputs' own sd, as
+    ``Standardizer.from_sim`` computes it (relative ``REL_TOL``)."""
+    try:
+        sd = output_scale(y) if np.ndim(y_sd) == 0 else column_scales(y, range(y.shape[1]))
+    except GPMSAError as exc:  # zero spread, or a spread that overflows
+        raise _fail("arrays/y", str(exc)) from None
+    if np.ndim(y_sd) == 0:
+        if abs(sd - y_sd) > REL_TOL * sd:
+            raise _fail("arrays/y_sd", f"{y_sd!r}, but the training outputs' sd is {sd!r}")
+    elif (bad := np.flatnonzero(np.abs(sd - y_sd) > REL_TOL * sd)).size:
+        k = int(bad[0])
+        raise _fail("arrays/y_sd", f"[{k}] = {float(y_sd[k])!r}, but the sd of the training "
+                    f"outputs' column {k} is {float(sd[k])!r} (scaled columnwise)")  # fmt: skip
+
+
 def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int]:
     """Every check of a record (shapes, fields, values); returns its sizes."""
     for name, arr in arrays.items():
@@ -884,7 +907,8 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     check_prior_groups(manifest["priors"], shapes)
     check_discrepancy_record(manifest["settings"], shapes)
     held = check_fixed_record(manifest["settings"], shapes)
-    check_values(arrays, dims, ranged_columns(manifest, dims))
+    given = tuple(manifest["model"].get("y_given", ()))  # check_fields checked it
+    check_values(arrays, dims, ranged_columns(manifest, dims), given)
     check_discrepancy_bases(manifest["settings"], arrays)
     check_fixed_draws(held, arrays)
     check_categorical(manifest, arrays, dims)

@@ -14,6 +14,11 @@ design stretched onto [0.5, 2.0] may store 1.9999999999999998): they are snapped
 that an input at the domain's end never reads as outside it."""
 
 
+Y_GIVEN = ("y_mean", "y_sd")
+"""What of the output standardisation a user may give (``SimData(y_mean=, y_sd=)``), in the
+order ``Standardizer.y_given`` and the file's ``model.y_given`` list it."""
+
+
 EXTRAPOLATION_MARGIN = 0.1
 """How far (unit scale) inputs may lie outside the design's range, for predictions and
 observations alike: outside the range a warning, beyond the margin a refusal."""
@@ -47,7 +52,9 @@ class Standardizer:
     t_range=)``), which ``x_ranged``, ``t_ranged`` flag (one bool per column; empty: none);
     ``y_mean`` (l_sim,) on the simulation grid ``grid`` (l_sim,), ``y_sd``: a float (one sd,
     ddof=1, over all outputs: GPM/SA's default) or, scaled columnwise, an array (l_sim,) of
-    each element's sd (``columnwise``); ``sd_on`` gives it on any grid.
+    each element's sd (``columnwise``); ``sd_on`` gives it on any grid. ``y_given``: which of
+    "y_mean", "y_sd" the user gave (``SimData(y_mean=, y_sd=)``) instead of the runs' own
+    (empty: neither); a given y_sd array (l_sim,) scales each element by its own.
     """
 
     x_min: np.ndarray
@@ -59,27 +66,32 @@ class Standardizer:
     grid: np.ndarray
     x_ranged: tuple[bool, ...] = ()
     t_ranged: tuple[bool, ...] = ()
+    y_given: tuple[str, ...] = ()
 
     @classmethod
     def from_sim(cls, sim: SimData) -> Standardizer:
         """GPM/SA's default transforms fitted to the simulation design and outputs; a column
-        with a given range (``sim.x_range``, ``sim.t_range``) maps that range onto [0, 1]."""
+        with a given range (``sim.x_range``, ``sim.t_range``) maps that range onto [0, 1]; a
+        given ``sim.y_mean``, ``sim.y_sd`` replaces the runs' mean, sd."""
         x_min, x_max, x_ranged = _domain(sim.x, sim.x_range)
         t_min, t_max, t_ranged = _domain(sim.t, sim.t_range)
+        if sim.y_sd is not None:
+            y_sd = sim.y_sd if isinstance(sim.y_sd, float) else sim.y_sd.copy()
+        elif sim.y_scale == "columnwise" and sim.l_sim > 1:
+            y_sd = column_scales(sim.y, sim.y_names)
+        else:
+            y_sd = output_scale(sim.y)
         return cls(
             x_min=x_min,
             x_max=x_max,
             t_min=t_min,
             t_max=t_max,
-            y_mean=sim.y.mean(axis=0),
-            y_sd=(
-                column_scales(sim.y, sim.y_names)
-                if sim.y_scale == "columnwise" and sim.l_sim > 1
-                else output_scale(sim.y)
-            ),
+            y_mean=sim.y.mean(axis=0) if sim.y_mean is None else sim.y_mean.copy(),
+            y_sd=y_sd,
             grid=sim.grid.copy(),
             x_ranged=x_ranged,
             t_ranged=t_ranged,
+            y_given=tuple(k for k in Y_GIVEN if getattr(sim, k) is not None),
         )
 
     def ranged(self, names: tuple[str, ...]) -> tuple[str, ...]:
@@ -123,7 +135,8 @@ class Standardizer:
 
     @property
     def columnwise(self) -> bool:
-        """Whether each output element has its own sd (``SimData(y_scale="columnwise")``)."""
+        """Whether each output element has its own sd (``SimData(y_scale="columnwise")``, or a
+        given ``y_sd`` array)."""
         return isinstance(self.y_sd, np.ndarray)
 
     def sd_on(self, grid: np.ndarray | None) -> float | np.ndarray:

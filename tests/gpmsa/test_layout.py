@@ -46,7 +46,7 @@ LAYER = {part: i for i, parts in enumerate(LAYERS) for part in parts}
 PUBLIC = [
     "BackendUnavailableError", "BasisWarning", "Calibrator", "ChainError", "Chains",
     "ConvergenceWarning", "Emulator", "EmulatorFileError", "GPMSAError", "GammaPrior",
-    "LooResult", "ObsData", "ExtrapolationWarning",
+    "LooResult", "ObsData", "ExtrapolationWarning", "DomainWarning",
     "ObsProblem", "OutsideEmulatorWarning", "ReductionWarning",
     "Posterior", "Priors", "Problem", "ResourceLimitError", "SimData", "backends", "calibrate",
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
