@@ -1,7 +1,7 @@
 """False alarms and power of the sensor checks (`control.sensor_checks`) on clean campaign drives.
 
     PYTHONPATH=. python benchmarks/sensor_checks.py [--seed 7] [--keep-s 120] [--workers 2]
-        [--cases AB] [--drives 198]
+        [--cases AB] [--drives 198] [--chunks]
 
 Runs the training campaign's design (``--drives`` drives of ``--keep-s`` s, campaign ``--seed``:
 ``lhs_design(drives, seed=seed)``, GD 200-600 at 0.5-2 m/s; 198 is the training campaign's)
@@ -20,6 +20,16 @@ case:
   exempt; flagged above the limits of ``SHORT_LEVEL_STRETCHES``), and the share of blocks that
   `signal_fault` flags with 8-31 samples at a random place scaled by a gain of 0.01-0.2
   (``PICKS`` blocks per cell).
+
+With ``--chunks`` it prints instead, per case and ``update_every`` in ``EVERY``, what the BCR's
+signal checks see when a user feeds each drive from its start, one update at a time: the window
+methods check each update's new samples alone (`BCR._window_signal_reason`: 10-60 samples for
+a small ``update_every``, against limits calibrated on blocks of 125), the change-point method
+the newest 125 samples at each update (`BCR._estimate_changepoint`; ``update_every`` >= 16).
+Per method: the checks made, those `signal_fault` flags (the false alarms), the largest ratio of
+the short level check per stretch in the window methods' chunks ("-": no chunk holds one), and
+the share of ``DROPS`` gain drops per drive (gain 0.02-0.035 for 16-31 samples at a random place
+after the first block) flagged by an update whose samples hold part of the drop.
 """
 
 from __future__ import annotations
@@ -32,7 +42,9 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 import vehicle
+from control.bcr import MAX_PHASES
 from control.sensor_checks import (
+    SHORT_LEVEL_BEFORE,
     SHORT_LEVEL_STRETCHES,
     SensorLimits,
     flight_reading,
@@ -50,6 +62,10 @@ LENGTHS = (6, 7, 10)  # samples
 PICKS = 1000  # blocks per (step, length) cell of the power table
 GAINS = (0.01, 0.02, 0.035, 0.05, 0.1, 0.2)  # of the scale faults
 GAIN_LENGTHS = (8, 12, 16, 24, 31)  # samples: shorter than the level check's 32
+EVERY = (10, 20, 40, 60, 125)  # update_every of the --chunks table, samples
+DROPS = 10  # gain drops per drive of the --chunks table
+DROP_GAIN = (0.02, 0.035)  # their gains (uniform) ...
+DROP_SAMPLES = (16, 31)  # ... and lengths (uniform integers), samples
 
 
 def lattice_hits(blocks, step, length, rng, flight, limit) -> tuple[int, int]:
@@ -81,6 +97,77 @@ def scale_hits(blocks, gain, length, rng, limits) -> tuple[int, int]:
     return int(hits), n
 
 
+def window_spans(n: int, every: int) -> list[tuple[int, int]]:
+    """(start, stop) of the samples the window methods' signal checks see at each update of a
+    stream of ``n`` samples fed from its start: the update's ``every`` new samples."""
+    return [(s, s + every) for s in range(0, n - every + 1, every)]
+
+
+def changepoint_spans(n: int, every: int) -> list[tuple[int, int]]:
+    """(start, stop) of the samples the change-point method's signal checks see at each update
+    of a stream of ``n`` samples fed from its start: the newest ``BLOCK`` (once it holds them)."""
+    return [(e - BLOCK, e) for e in range(every, n + 1, every) if e >= BLOCK]
+
+
+def chunk_row(drives, spans, limits, drops, ratios: bool) -> str:
+    """One method's cell of the --chunks table: its checks of ``drives`` (n, samples) at the
+    ``spans`` (`window_spans`, `changepoint_spans`), those flagged, (with ``ratios``) the
+    largest short level ratio per stretch, and the ``drops`` (per drive: (start, samples,
+    gain)) flagged by a check whose span holds part of the drop."""
+    checks = flagged = found = 0
+    longest = max((stop - start for start, stop in spans), default=0)  # ("-": no stretch)
+    largest = {n: 1.0 for n, _ in SHORT_LEVEL_STRETCHES if n + SHORT_LEVEL_BEFORE + 2 <= longest}
+    anchored = limits.noise_sd_mps2 is None  # (as `signal_fault` exempts flights)
+    for accel, faults in zip(drives, drops, strict=True):
+        for start, stop in spans:
+            checks += 1
+            flagged += bool(signal_fault(accel[start:stop], limits))
+            for n in largest if ratios else ():
+                ratio = short_level_drop(accel[start:stop], n, anchored=anchored)[0]
+                largest[n] = max(largest[n], ratio)
+        for first, length, gain in faults:
+            a = accel.copy()
+            a[first : first + length] *= gain
+            found += any(
+                signal_fault(a[start:stop], limits)
+                for start, stop in spans
+                if start < first + length and stop > first
+            )
+    tried = sum(len(faults) for faults in drops)
+    cell = f"{checks:,} checks, {flagged} flagged, drops found {100 * found / tried:.1f}%"
+    if ratios:
+        found_ratios = (
+            f"{largest[n]:.4g}" if n in largest else "-" for n, _ in SHORT_LEVEL_STRETCHES
+        )
+        cell += ", short level ratios " + " / ".join(found_ratios)
+    return cell
+
+
+def chunk_table(drives, limits, rng) -> None:
+    """Print the --chunks table of the drives' accelerations (n, samples)."""
+    n = drives.shape[1]
+    drops = [
+        [
+            (
+                int(rng.integers(min(BLOCK, n - DROP_SAMPLES[1] - 1), n - DROP_SAMPLES[1])),
+                int(rng.integers(DROP_SAMPLES[0], DROP_SAMPLES[1] + 1)),
+                float(rng.uniform(*DROP_GAIN)),
+            )
+            for _ in range(DROPS)
+        ]
+        for _ in range(drives.shape[0])
+    ]
+    print(f"   {DROPS} drops per drive (gain {DROP_GAIN[0]:g}-{DROP_GAIN[1]:g} for "
+          f"{DROP_SAMPLES[0]}-{DROP_SAMPLES[1]} samples); short level ratios of "
+          + " / ".join(f"{s} samples (limit {m:g})" for s, m in SHORT_LEVEL_STRETCHES))  # fmt: skip
+    for every in EVERY:
+        window = chunk_row(drives, window_spans(n, every), limits, drops, True)
+        print(f"   update_every {every}: window methods: {window}")
+        if every >= BLOCK / MAX_PHASES:  # (the change-point method's least update_every)
+            blocks = chunk_row(drives, changepoint_spans(n, every), limits, drops, False)
+            print(f"   update_every {every}: change-point: {blocks}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=7, help="campaign seed")
@@ -89,6 +176,9 @@ def main() -> None:
     parser.add_argument("--cases", default="AB", choices=["A", "B", "AB"],
                         help="A: without sensor noise, B: with N(0, 1) noise")  # fmt: skip
     parser.add_argument("--drives", type=int, default=198, help="drives of the design")
+    parser.add_argument("--chunks", action="store_true",
+                        help="print only what each method's checks see at update_every "
+                             f"{', '.join(map(str, EVERY))}")  # fmt: skip
     args = parser.parse_args()
     if args.seed < 0:
         parser.error(f"--seed must be >= 0, got {args.seed}")
@@ -128,6 +218,11 @@ def main() -> None:
         per_drive = acc.shape[1] // BLOCK
         blocks = acc[:, : per_drive * BLOCK].reshape(-1, BLOCK)
         limits = SensorLimits(noise_sd_mps2=noise or None)
+        if args.chunks:
+            print(f"{case} (noise sd {noise:g}): {acc.shape[0]} clean drives of "
+                  f"{acc.shape[1]:,} samples")  # fmt: skip
+            chunk_table(acc, limits, rng)
+            continue
         flagged = [b for b in blocks if signal_fault(b, limits)]
         flight = flight_reading(limits)  # the check's exemption: none for a noisy sensor
         floats = min(most_lattice_like(b, flight)[0] for b in blocks)
