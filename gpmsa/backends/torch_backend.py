@@ -35,7 +35,7 @@ from tqdm.auto import tqdm
 from gpmsa.backends import check_sample_args
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import ridge, starts, tuning
+from gpmsa.mcmc import level_moves, ridge, starts, tuning
 from gpmsa.mcmc.parallel import in_this_process, n_workers, run_chains
 from gpmsa.mcmc.sampler import (
     PRECISION_PARAMS,
@@ -499,7 +499,9 @@ class BatchState:
     """C chains of one problem: parameters, cached Sigma_W factors and the batched sweep.
 
     As the numpy sampler (``gpmsa.mcmc.sampler.ChainState``): a categorical theta element moves
-    to another of its levels drawn uniformly (its prior uniform over them); a theta proposal
+    to another of its levels drawn uniformly (its prior uniform over them), after
+    `learn_level_shifts` with the continuous sampled theta elements shifted between their
+    conditional modes at the two levels (``gpmsa.mcmc.level_moves``); a theta proposal
     the theta constraint refuses is rejected before its likelihood (the constraint called per
     chain); with a mean basis the coefficients are integrated out (`gls`) and the observations'
     mean adds the GLS trend h([x_obs, theta]) coef (`mean_rows`, cached per chain).
@@ -523,6 +525,10 @@ class BatchState:
         levels = problem.theta_levels or [None] * problem.q
         self.levels = {k: torch.as_tensor(lv, dtype=dtype, device=device)
                        for k, lv in enumerate(levels) if lv is not None}  # fmt: skip
+        # `learn_level_shifts`: categorical element -> offsets (C, its levels, shift_elements),
+        # the continuous theta elements the joint level move shifts
+        self.level_shifts: dict[int, Tensor] = {}
+        self.shift_elements: list[int] = []
         self.constraint = problem.constraint if "theta" in problem.sampled else None
         if self.constraint is not None:
             for c in range(n_chains):
@@ -607,10 +613,12 @@ class BatchState:
             return self.ll_w.new_zeros(prm["betaU"].shape[0])
         return obs_loglik(self.data, chol, alpha, prm, coef, h_obs)
 
-    def _allowed(self, idx: tuple[int, ...], cand: Tensor, valid: Tensor) -> Tensor:
+    def _allowed(self, idx: tuple[int, ...], cand: Tensor, valid: Tensor,
+                 theta: Tensor | None = None) -> Tensor:  # fmt: skip
         """``valid`` less the chains whose theta with element ``idx`` at ``cand`` (C,) the theta
-        constraint refuses (called per chain, as the numpy sampler calls it)."""
-        theta = self.params["theta"].cpu().numpy().astype(np.float64)
+        constraint refuses (called per chain, as the numpy sampler calls it); ``theta`` (C, q):
+        the proposed theta in place of the current one (the joint level move's)."""
+        theta = (self.params["theta"] if theta is None else theta).cpu().numpy().astype(np.float64)
         cands = cand.cpu().numpy().astype(np.float64)
         out = valid.clone()
         for c in torch.nonzero(valid).flatten().tolist():
@@ -627,11 +635,80 @@ class BatchState:
         n_other = lv.numel() - 1
         if n_other == 0:
             return x, torch.zeros_like(x, dtype=torch.bool)
-        at = lv == x.unsqueeze(-1)  # (C, K): x's level
-        pos = torch.where(at.any(-1), at.to(torch.long).argmax(-1), lv.numel())
+        pos, _ = self._level_rows(k, x)
         pick = torch.floor(u0 * n_other).to(torch.long)
         pick = pick + (pick >= pos).to(torch.long)  # skip x's own level
         return lv[pick], torch.ones_like(x, dtype=torch.bool)
+
+    def _level_rows(self, k: int, x: Tensor) -> tuple[Tensor, Tensor]:
+        """(row, at_level) (C,) of categorical theta element k's values x (C,) among its levels
+        (row = the number of levels where x is none of them)."""
+        lv = self.levels[k]
+        at = lv == x.unsqueeze(-1)  # (C, K): x's level
+        found = at.any(-1)
+        return torch.where(found, at.to(torch.long).argmax(-1), lv.numel()), found
+
+    def learn_level_shifts(self) -> None:
+        """Each categorical theta element's joint level move (``gpmsa.mcmc.level_moves``, as the
+        numpy sampler's ``ChainState.learn_level_shifts``): per chain, the conditional modes of
+        the continuous sampled theta elements at each of its levels, the other parameters at
+        the chain's current values (``level_offsets`` on the chain's log posterior); none
+        without observations, a categorical and a continuous sampled theta element."""
+        sampled = [idx[0] for n, idx in self.els if n == "theta"]
+        cat = [k for k in sampled if k in self.levels and self.levels[k].numel() > 1]
+        cont = [k for k in sampled if k not in self.levels]
+        if not (cat and cont and self.data.has_obs):
+            return
+        self.shift_elements = cont
+        theta = self.params["theta"].cpu().numpy().astype(np.float64)
+        posts = [self._chain_log_post(c, cont) for c in range(self.n_chains)]
+        for k in cat:
+            lv = self.levels[k].cpu().numpy().astype(np.float64)
+            off = [level_moves.level_offsets(f, th, k, lv, cont)
+                   for f, th in zip(posts, theta, strict=True)]  # fmt: skip
+            self.level_shifts[k] = torch.as_tensor(np.stack(off), dtype=self.ll_w.dtype,
+                                                   device=self.ll_w.device)  # fmt: skip
+
+    def _chain_log_post(self, c: int, cont: list[int]):
+        """Chain c's log posterior as a function of its unit theta (q,) alone, up to a constant
+        (the observation term and the priors of the continuous elements ``cont``; -inf outside
+        their bounds or the constraint), the other parameters at their current values."""
+        d, sl = self.data, slice(c, c + 1)
+
+        def rows(t: Tensor | None) -> Tensor | None:  # one shared Sigma_W (calibration): as is
+            return t if t is None or t.shape[0] == 1 else t[sl]
+
+        prm = {k: v[sl] for k, v in self.params.items()}
+        chol, alpha, coef = rows(self.chol), rows(self.alpha), rows(self.coef)
+        like = self.ll_w.new_tensor
+
+        def log_post(theta: np.ndarray) -> float:
+            th = like(theta).unsqueeze(0)
+            lp = log_prior_elements(self.priors, "theta", th[0, cont]).sum()
+            if not torch.isfinite(lp) or (self.constraint is not None
+                                          and not self.constraint(theta)):  # fmt: skip
+                return -math.inf
+            h_obs = None if self.h_obs is None else mean_rows(self.problem, d, th)
+            return float(lp + obs_loglik(d, chol, alpha, {**prm, "theta": th}, coef, h_obs)[0])
+
+        return log_post
+
+    def _shifted(self, k: int, x: Tensor, cand: Tensor) -> tuple[Tensor, Tensor, Tensor]:
+        """The joint level move of categorical theta element k from x to cand (C,): (theta (C, q)
+        with k at cand and the continuous elements shifted by o[cand] - o[x] (`level_shifts`),
+        their log prior there, and at the current theta (C,)); -inf where x is no level."""
+        cont, off = self.shift_elements, self.level_shifts[k]
+        cur = self.params["theta"]
+        row, found = self._level_rows(k, x)
+        new_row, _ = self._level_rows(k, cand)
+        chains = torch.arange(cur.shape[0], device=cur.device)
+        row = torch.where(found, row, 0)
+        theta = cur.clone()
+        theta[:, k] = cand
+        theta[:, cont] = cur[:, cont] + (off[chains, new_row] - off[chains, row])
+        lp_new = log_prior_elements(self.priors, "theta", theta[:, cont]).sum(-1)
+        lp_new = torch.where(found, lp_new, -torch.inf)
+        return theta, lp_new, log_prior_elements(self.priors, "theta", cur[:, cont]).sum(-1)
 
     def update(self, name: str, idx: tuple[int, ...], width: float, kind: int, prop_mh: bool,
                u: Tensor) -> Tensor:  # fmt: skip
@@ -645,8 +722,11 @@ class BatchState:
         corr = torch.zeros_like(x)
         valid = torch.ones_like(x, dtype=torch.bool)
         level = name == "theta" and idx[0] in self.levels
+        joint = None  # the joint level move's theta (C, q) and its continuous elements' priors
         if level:  # another level, uniformly (symmetric; the prior is uniform over them)
             cand, valid = self._level_move(idx[0], x, u[0])
+            if idx[0] in self.level_shifts:  # with the continuous theta (level_moves)
+                joint = self._shifted(idx[0], x, cand)
         elif kind == 1:  # beta on the rho scale
             r = torch.exp(-0.25 * x) + width * step
             valid = r > 0.0
@@ -660,12 +740,12 @@ class BatchState:
         else:
             cand = x + width * step
         if level:
-            lp_new = torch.zeros_like(x)
+            lp_new = torch.zeros_like(x) if joint is None else joint[1]
         else:
             lp_new = log_prior_elements(self.priors, name, cand, idx[-1])
         valid &= torch.isfinite(lp_new)
         if name == "theta" and self.constraint is not None and valid.any():
-            valid = self._allowed(idx, cand, valid)  # zero prior mass outside the constraint
+            valid = self._allowed(idx, cand, valid, None if joint is None else joint[0])
         accepted = torch.zeros_like(valid)
         if not valid.any():
             return accepted
@@ -674,6 +754,8 @@ class BatchState:
         prm = dict(self.params)
         prm[name] = cur.clone()
         prm[name][(slice(None), *idx)] = cand
+        if joint is not None:
+            prm[name] = torch.where(valid.unsqueeze(-1), joint[0], cur)
         d = self.data
         chol, alpha, ll_w, coef, h_obs = self.chol, self.alpha, self.ll_w, self.coef, self.h_obs
         if name == "theta" and h_obs is not None:
@@ -704,12 +786,18 @@ class BatchState:
                         coef[:, comps] = coef_c
         ll_obs = self._obs(prm, chol, alpha, coef, h_obs)
         ll_new = ll_w.sum(-1) + ll_obs
-        lp_old = lp_new if level else log_prior_elements(self.priors, name, x, idx[-1])
+        if level:
+            lp_old = lp_new if joint is None else joint[2]
+        else:
+            lp_old = log_prior_elements(self.priors, name, x, idx[-1])
         ratio = ll_new - self.loglik + lp_new - lp_old + corr
         acc = (torch.log(u[1]) < ratio) & valid
         take = torch.nonzero(acc).squeeze(-1)
         accepted[take] = True
-        cur[(take, *idx)] = cand[take]
+        if joint is None:
+            cur[(take, *idx)] = cand[take]
+        else:
+            cur[take] = prm[name][take]
         self.ll_obs[take] = ll_obs[take]
         if name in SIM_PARAMS:
             self.ll_w[take] = ll_w[take]
@@ -992,6 +1080,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                     acc[lev] += state.sweep(cands[lev], False, gen).sum(-1)
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
+        state.learn_level_shifts()  # frozen before the draws (a categorical theta only)
         if in_process:
             bar.set_description("torch MCMC: sampling")
             draws, log_post, accepted = _sweeps(state, w, n_iter, prop_mh, gen, bar)
@@ -1042,11 +1131,18 @@ def _sweeps(
 
 def _group_task(problem: Problem, start: dict[str, np.ndarray], widths: np.ndarray, n_iter: int,
                 prop_mh: bool, stream: int, dtype: str, ridge_moves: int, progress: bool = False,
-                desc: str = "torch chains") -> tuple:  # fmt: skip
-    """One chain group's sweeps from plain data (run in a worker process, one thread)."""
+                desc: str = "torch chains",
+                level_shifts: tuple | None = None) -> tuple:  # fmt: skip
+    """One chain group's sweeps from plain data (run in a worker process, one thread);
+    ``level_shifts``: the group's (``BatchState.shift_elements``, element -> offsets (C', K,
+    n)) of the joint level move (None: none)."""
     with torch_threads(1), torch.no_grad():
         n_chains = len(next(iter(start.values())))
         state = BatchState(problem, n_chains, _dtype(dtype), "cpu", start, ridge_moves)
+        if level_shifts is not None:
+            state.shift_elements = list(level_shifts[0])
+            state.level_shifts = {k: torch.as_tensor(v, dtype=state.ll_w.dtype)
+                                  for k, v in level_shifts[1].items()}  # fmt: skip
         gen = torch.Generator().manual_seed(stream)
         with tqdm(total=n_iter, desc=desc, disable=not progress) as bar:
             return _sweeps(state, widths, n_iter, prop_mh, gen, bar)
@@ -1068,6 +1164,9 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
             "start": {n: v[lo:hi].cpu().numpy().copy() for n, v in state.params.items()},
             "prop_mh": bool(prop_mh), "dtype": dtype, "ridge_moves": state.ridge_moves,
             "stream": int(seq.generate_state(1, dtype=np.uint64)[0]) & (2**63 - 1),
+            "level_shifts": (tuple(state.shift_elements), {
+                k: v[lo:hi].cpu().numpy().copy() for k, v in state.level_shifts.items()
+            }) if state.level_shifts else None,
         })  # fmt: skip
     shapes = {n: v.shape[1:] for n, v in state.params.items()}
 

@@ -103,10 +103,12 @@ def _constrained(prep):
 def test_torch_chains_move_on_levels_inside_the_constraint_with_numpy_s_log_posterior():
     prep = _problem("linear", True, "linear")
     prob = _constrained(prep)
-    ch = tb.sample(prob, n_iter=12, n_chains=3, seed=3, warmup=4, tune_rounds=1, tune_levels=3,
+    ch = tb.sample(prob, n_iter=40, n_chains=3, seed=3, warmup=4, tune_rounds=1, tune_levels=3,
                    tune_stages=1)  # fmt: skip
     theta = ch.draws["theta"]
-    assert set(np.unique(theta[..., 1])) == {0.0, 0.5, 1.0}  # every level visited
+    # every level visited (the chains start at 0.5; P(level) 0.77 / 0.17 / 0.06 with the joint
+    # level move, session 72: 12 sweeps, enough before it, stay at 0)
+    assert set(np.unique(theta[..., 1])) == {0.0, 0.5, 1.0}
     native = prep.standardizer.t_from_unit(theta.reshape(-1, 2))
     assert np.all(native[:, 0] < 0.8)
     draws = {k: v.reshape(-1, *v.shape[2:]) for k, v in ch.draws.items()}

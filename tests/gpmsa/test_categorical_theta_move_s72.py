@@ -129,8 +129,8 @@ def test_the_move_is_its_own_reverse_and_propose_theta_is_propose(case):
 
 
 def test_the_studies_still_refuse_a_categorical_theta(case):
-    """The studies' theta sampler has no joint level move (nor torch's batched sweep, whose
-    refusal is unchanged): calibrate_study keeps refusing, naming what calibrates one."""
+    """The studies' theta sampler has no joint level move (torch's batched sweep has one:
+    test_torch_level_move_s72): calibrate_study keeps refusing, naming what calibrates one."""
     _, emu, xo, yo = case
-    with pytest.raises(gpmsa.GPMSAError, match=r"kind is categorical.*numpy backend only"):
+    with pytest.raises(gpmsa.GPMSAError, match=r"kind is categorical.*numpy .*torch backend only"):
         gpmsa.calibrate_study([emu, emu], [xo, xo], [yo, yo], n_samples=10, n_burn=2)
