@@ -172,10 +172,16 @@ def _check_discrepancies(manifest: dict, kind: str, labels: list[str]) -> dict[i
 
 
 def check_study_arrays(
-    manifest: dict, arrays: dict[str, np.ndarray], layout: Layout, inputs: tuple[int, ...]
+    manifest: dict,
+    arrays: dict[str, np.ndarray],
+    layout: Layout,
+    inputs: tuple[int, ...],
+    levels: list | None = None,
 ) -> None:
     """The arrays against the models' layout and their numbers of known inputs ``inputs`` (a
-    model's discrepancy betaV has one row per input): shapes, finiteness and ranges."""
+    model's discrepancy betaV has one row per input): shapes, finiteness and ranges (``levels``:
+    per study element its unit-scale levels where it is categorical, its draws one of them,
+    else None; None: every element continuous)."""
     names = manifest.get("names", {}).get("elements")
     want = [el.name for el in layout.elements]
     if names != want:
@@ -192,8 +198,16 @@ def check_study_arrays(
     for name in arrays:
         if not np.all(np.isfinite(arrays[name])):
             raise _fail(f"arrays/{name}", "holds NaN or inf")
-    for name in ("theta", "mu"):
-        a = arrays[name]
+    levels = levels or [None] * layout.n_elements
+    for e, lv in enumerate(levels):  # a categorical element's draws: its levels (0 and 1 too)
+        col = arrays["theta"][:, :, e]
+        if lv is not None and not np.all(np.isin(col, lv)):
+            bad = col[~np.isin(col, lv)].flat[0]
+            raise _fail("arrays/theta", f"column {e} ({layout.elements[e].name}, categorical) "
+                                        f"must hold its unit-scale levels {list(lv)}, got "
+                                        f"{bad:.6g}")  # fmt: skip
+    cont = [e for e, lv in enumerate(levels) if lv is None]
+    for name, a in (("theta", arrays["theta"][:, :, cont]), ("mu", arrays["mu"])):
         if a.size and not (a.min() > 0.0 and a.max() < 1.0):
             raise _fail(f"arrays/{name}", f"must lie in (0, 1) (unit scale), got "
                                           f"{a.min():.6g}..{a.max():.6g}")  # fmt: skip

@@ -38,7 +38,6 @@ from gpmsa.limits import check_memory
 from gpmsa.mcmc import tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.mcmc.starts import check_init
-from gpmsa.model import categorical
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
 from gpmsa.model.discrepancy import record as discrepancy_record
@@ -323,6 +322,9 @@ def calibrate_study(
             (``hyper``: their priors, ``gpmsa.HyperPriors()``: a uniform group sd; SEPIA's:
             ``HyperPriors.sepia()``; given without a hierarchical name, or with a uniform
             sd prior's sd_max below 1e-3, a GPMSAError). Every other parameter is its model's.
+            A categorical parameter (``t_categorical``) may be shared (the same levels in
+            every model) or a model's own, not hierarchical; its level moves with the
+            continuous parameters (``gpmsa.studies.sampler``, docs/models.md).
         n_samples, n_burn, tune, seed, n_chains, init, tune_rounds, tune_levels, extrapolate,
             progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep);
             seed None (or a numpy Generator) draws one from fresh entropy (from the
@@ -392,7 +394,7 @@ def calibrate_study(
     n = _same_count(emulators=emulators, x_obs=x_obs, y_obs=y_obs)
     labels = check_labels(labels, n)
     for lab, e, x, y in zip(labels, emulators, x_obs, y_obs, strict=True):  # errors name it
-        _per_model(lab, check_emulator, e)
+        _per_model(lab, check_emulator, e, categorical_theta=True)  # its level moves
         _refuse_no_observations(lab, x, y)
     continuing = isinstance(init, Study)
     append = cont.check_append(append, init, n_burn)
@@ -428,6 +430,10 @@ def calibrate_study(
                            fit=None if basis is not None else f)
                 for (lab, e, x, y), r, f, (basis, groups), h in zip(
                     models, reduced, fits, bases, held, strict=True)]  # fmt: skip
+    problems = [
+        p if p.theta_levels is None else p.with_init({"theta": p.snap_theta(p.init["theta"])})
+        for p in problems
+    ]  # a categorical theta: at a level
     natives = [calibration_held_native(e, f) for e, f in zip(emulators, fixes, strict=True)]
     record: dict = {}  # what the study records of its models, before any sampling
     _record_fixed(record, labels, problems, layout, fixes, natives)
@@ -631,9 +637,6 @@ def fit_study(
     preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=pc, discrepancy=discrepancy,
                         discrepancy_groups=discrepancy_groups, basis=k)
              for lab, s, o, k, pc in zip(labels, sims, obs, bases, pcs, strict=True)]  # fmt: skip
-    for lab, sim in zip(labels, sims, strict=True):  # the study's theta moves are continuous
-        categorical.refuse_categorical_theta(sim.levels, sim.p, sim.x_names + sim.t_names,
-                                             f"fit_study (model {lab})")  # fmt: skip
     layout = build_layout(
         labels, [tuple(s.t_names) for s in sims],
         [(p.standardizer.t_min, p.standardizer.t_max) for p in preps],
@@ -694,6 +697,9 @@ def fit_study(
         params = point_estimate(flat, lp, point)
         cal = {k: v for k, v in flat.items() if k not in EMULATOR_PARAMS}
         cal["theta_native"] = prep.standardizer.t_from_unit(cal["theta"])
+        for k, lv in enumerate(problems[i].theta_levels or ()):
+            if lv is not None:  # categorical draws: exactly the level codes (as gpmsa.fit)
+                cal["theta_native"][:, k] = np.round(cal["theta_native"][:, k])
         for k, v in natives[i].items():
             cal["theta_native"][:, k] = v  # exactly the value given (as gpmsa.fit)
         emu_settings = {"n_iter": int(n_iter), "n_burn": int(n_burn), "thin": thin,

@@ -6,6 +6,13 @@ or its hierarchical group's truncated normal), then each model's own parameters 
 ``gpmsa.mcmc.sampler.ChainState`` sweep (its theta held by the study), then each hierarchical
 group's mean mu (uniform walk) and precision lam (walk on log lam, with its Hastings factor).
 Step widths are tuned as GPM/SA tunes them (``gpmsa.mcmc.tuning``) over every element at once.
+A categorical study element (shared or a model's own, never hierarchical: `element_levels`)
+moves to another of its levels drawn uniformly, with the continuous free elements of its models
+shifted between their per-level conditional modes (``gpmsa.mcmc.level_moves``; found at the
+start, so that the tuned widths suit every level the chain visits, and again after tuning, then
+frozen for the draws: `StudyState.learn_level_shifts`), accepted on the sum of the
+touched models' log-likelihood changes and the shifted elements' priors (its own prior is
+uniform over its levels).
 """
 
 from __future__ import annotations
@@ -17,7 +24,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import starts, tuning
+from gpmsa.mcmc import level_moves, starts, tuning
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.mcmc.sampler import DEFAULT_WIDTHS, ChainState, default_widths, require_finite
 from gpmsa.model.problem import Problem
@@ -94,6 +101,36 @@ def held_elements(problems: list[Problem], layout: Layout) -> dict[int, float]:
     return held
 
 
+def element_levels(problems: list[Problem], layout: Layout) -> list[np.ndarray | None]:
+    """Each study element's unit-scale levels where it is categorical (its models'
+    ``Problem.theta_levels``), else None. GPMSAError naming the parameter for a categorical
+    hierarchical one (a normal hierarchy over level codes has no meaning) and for a shared one
+    that is categorical in some of its models only, or whose models' levels differ."""
+    out: list[np.ndarray | None] = []
+    for el in layout.elements:
+        per = [(problems[i].theta_levels or [None] * problems[i].q)[k] for i, k in el.uses]
+        if all(lv is None for lv in per):
+            out.append(None)
+            continue
+        if el.group >= 0:
+            raise GPMSAError(
+                f"hierarchical parameter {el.param!r} is categorical: a normal hierarchy over "
+                "its level codes has no meaning; give it as shared (one level in every model) "
+                "or leave it each model's own"
+            )
+        first = per[0]
+        if any(lv is None or not np.array_equal(lv, first) for lv in per):
+            what = {layout.labels[i]: None if lv is None else np.asarray(lv).tolist()
+                    for (i, _), lv in zip(el.uses, per, strict=True)}  # fmt: skip
+            raise GPMSAError(
+                f"shared parameter {el.param!r} is categorical with different levels (or "
+                f"continuous) in its models (unit-scale levels, None: continuous: {what}); "
+                "give every model that shares it the same training levels and range"
+            )
+        out.append(np.asarray(first, dtype=np.float64))
+    return out
+
+
 def _theta_mask(problem: Problem) -> np.ndarray:
     """The theta elements ``problem`` holds (``Problem.held_masks``), a boolean mask (q,)."""
     return problem.held_masks(("theta",)).get("theta", np.zeros(problem.q, dtype=bool))
@@ -125,6 +162,10 @@ class StudyState:
             self.states.append(ChainState(held, init, rng))
         self.group_els = [layout.members_of(h) for h in range(len(layout.groups))]
         self.sizes = [len(s.els) for s in self.states]
+        self.levels = element_levels(problems, layout)  # a categorical element: its level moves
+        self.shifts: dict[int, tuple] = {}  # `learn_level_shifts`: element -> its shifts
+        self.touched = {e: _models_of(layout, [e]) for e, lv in enumerate(self.levels)
+                        if lv is not None}  # fmt: skip
 
     # --- priors -------------------------------------------------------------------------------
     def _theta_lp(self, e: int, x: float) -> float:
@@ -137,6 +178,12 @@ class StudyState:
             return -0.5 * ((x - m) / sd) ** 2
         d = x - self.mu[el.group]
         return -0.5 * self.lam[el.group] * d * d
+
+    def _element_lp(self, e: int, x: float) -> float:
+        """`_theta_lp`, and for a categorical element its uniform prior over its levels."""
+        if self.levels[e] is None:
+            return self._theta_lp(e, x)
+        return 0.0 if x in self.levels[e] else -math.inf
 
     def _group_lp(self, h: int, mu: float, lam: float) -> float:
         """Log density of group h's (mu, lam): hyperpriors and the elements' truncated normals."""
@@ -155,7 +202,7 @@ class StudyState:
         lp = sum(s.log_post() for s in self.states)
         for e, el in enumerate(self.layout.elements):
             if el.group < 0:
-                lp += self._theta_lp(e, float(self.g[e]))
+                lp += self._element_lp(e, float(self.g[e]))
         for h in range(len(self.group_els)):
             lp += self._group_lp(h, float(self.mu[h]), float(self.lam[h]))
         return lp
@@ -168,6 +215,9 @@ class StudyState:
         u = self.rng.random((G + 2 * H, 2))
         for e, el in enumerate(self.layout.elements):
             if e in self.held:
+                continue
+            if self.levels[e] is not None:  # another level (with the continuous elements)
+                self._level_move(e, u[e, 0], u[e, 1], accepted)
                 continue
             x = float(self.g[e])
             cand = x + widths[e] * (u[e, 0] - 0.5)
@@ -208,6 +258,77 @@ class StudyState:
                 self.lam[h] = cand
                 accepted[o + 1] += 1
             o += 2
+
+    # --- a categorical element's level move (gpmsa.mcmc.level_moves) ---------------------------
+    def learn_level_shifts(self) -> None:
+        """Each free categorical element's joint level move: the shifts of the continuous free
+        elements of its models between their conditional modes at its levels (the other
+        parameters at their current values; ``level_moves.level_offsets``); none where its
+        models have no such element (its level moves alone)."""
+        lay = self.layout
+        for e, lv in enumerate(self.levels):
+            if lv is None or e in self.held or lv.size < 2:
+                continue
+            models = {i for i, _ in lay.elements[e].uses}
+            cont = sorted({j for i in models for j in lay.index[i]
+                           if self.levels[j] is None and j not in self.held})  # fmt: skip
+            if not cont:
+                continue
+            touched = _models_of(lay, [e, *cont])
+
+            def log_post(g: np.ndarray, cont=cont, touched=touched) -> float:
+                lp = sum(self._theta_lp(j, float(g[j])) for j in cont)
+                if lp == -math.inf:
+                    return lp
+                for i in touched:  # never accepted: the models' states are unchanged
+                    lp += self.states[i].lik.propose_theta(g[list(lay.index[i])])
+                return lp
+
+            off = level_moves.level_offsets(log_post, self.g, e, lv, cont)
+            rows = {float(v): r for r, v in enumerate(lv)}
+            self.shifts[e] = (rows, level_moves.shift_table(off), cont)
+            self.touched[e] = touched
+
+    def _level_move(self, e: int, u0: float, u1: float, accepted: np.ndarray) -> None:
+        """Categorical element ``e`` to another of its levels (uniformly: a symmetric proposal,
+        its prior uniform), the continuous elements shifted (`learn_level_shifts`); Metropolis
+        on the touched models' log-likelihood change and the shifted elements' priors."""
+        lv = self.levels[e]
+        x = float(self.g[e])
+        others = lv[lv != x]
+        if others.size == 0:
+            return
+        new = float(others[int(u0 * others.size)])
+        cand = self.g.copy()
+        cand[e] = new
+        d_lp = 0.0
+        if e in self.shifts:
+            rows, table, cont = self.shifts[e]
+            for j, d in zip(cont, table[rows[x]][rows[new]], strict=True):
+                old = float(cand[j])
+                lp_new = self._theta_lp(j, old + d)
+                if lp_new == -math.inf:
+                    return
+                d_lp += lp_new - self._theta_lp(j, old)
+                cand[j] = old + d
+        touched = self.touched[e]
+        dll = 0.0
+        for i in touched:
+            lik = self.states[i].lik
+            ll = lik.propose_theta(cand[list(self.layout.index[i])])
+            if ll == -math.inf:
+                return
+            dll += ll - lik.loglik
+        if math.log(u1) < dll + d_lp:
+            for i in touched:
+                self.states[i].lik.accept()
+            self.g = cand
+            accepted[e] += 1
+
+
+def _models_of(layout: Layout, els: list[int]) -> list[int]:
+    """The models that use any of the study elements ``els``, in order."""
+    return sorted({i for e in els for i, _ in layout.elements[e].uses})
 
 
 def element_names(states: list[ChainState], layout: Layout) -> list[str]:
@@ -283,7 +404,9 @@ def run_study_chain(
         if tune:
             bar.set_description(f"{desc}: tuning step widths")
             kinds = _tuning_kinds(state.states, layout)
+            state.learn_level_shifts()  # the widths tuned with the level moves: for both modes
             w = tuning.tune_widths(state.sweep, kinds, w, tune_rounds, tune_levels, bar.update)
+        state.learn_level_shifts()  # found anew, frozen before the draws (a categorical theta)
         bar.set_description(f"{desc}: sampling")
         out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
                "mu": np.empty((n_iter, len(layout.groups))),
@@ -334,6 +457,7 @@ def sample_study(
     whose draws are not finite."""
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     held_elements(problems, layout)  # a held element the models disagree on: before any work
+    element_levels(problems, layout)  # a categorical element the study cannot sample: likewise
     how = "continued" if chain_starts else starts.check_init(init, int(n_chains))
     seq = np.random.SeedSequence(seed)
     tasks = [

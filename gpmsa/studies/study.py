@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gpmsa.calibration.observations import emulator_record
+from gpmsa.calibration.observations import emulator_record, theta_levels
 from gpmsa.calibration.posterior import Posterior, held_names
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, load
@@ -163,6 +163,15 @@ def study_units(layout: Layout, members) -> dict[str, str]:
     return out
 
 
+def element_levels(layout: Layout, members) -> list[tuple[float, ...] | None]:
+    """Each study element's unit-scale levels where its parameter is categorical (its first
+    model's emulator's, ``theta_levels``; ``gpmsa.studies.sampler.element_levels`` makes its
+    models agree), else None."""
+    per = [theta_levels(m) for m in members]
+    return [None if per[el.uses[0][0]] is None else per[el.uses[0][0]][el.uses[0][1]]
+            for el in layout.elements]  # fmt: skip
+
+
 def _held_theta(layout: Layout, draws: dict[str, np.ndarray], settings: dict) -> dict[str, float]:
     """``settings[HELD_THETA]`` checked against the draws (absent: {}, as in files written
     before it): GPMSAError unless each name is a study element whose every draw is one unit
@@ -227,6 +236,9 @@ class Study:
         self.metadata = dict(metadata or {})
         self.sha256: str | None = None
         chains = native_chains(layout, self.draws)
+        for el, lv in zip(layout.elements, element_levels(layout, self.members), strict=True):
+            if lv is not None:  # a categorical element's draws: exactly the level codes
+                chains[el.name] = np.round(chains[el.name])
         for name, value in _held_theta(layout, self.draws, self.settings).items():
             chains[name][...] = value
         samples = {k: v.reshape(-1) for k, v in chains.items()}
@@ -398,7 +410,13 @@ class Study:
         head, raw = seal(manifest, arrays, fmt=STUDY_FORMAT)
         try:
             check_study_manifest(head)
-            check_study_arrays(head, arrays, self.layout, tuple(e.p for e in self.members))
+            check_study_arrays(
+                head,
+                arrays,
+                self.layout,
+                tuple(e.p for e in self.members),
+                element_levels(self.layout, self.members),
+            )
             check_study_claims(head, self)
         except EmulatorFileError as exc:
             raise GPMSAError(f"refusing to write {path}, it could not be read back: {exc}") from exc
@@ -448,7 +466,9 @@ def load_study(path: str | Path, *, sha256: str | None = None) -> Study:
     labels = [mod["label"] for mod in study["models"]]
     try:
         layout = layout_of(members, labels, study["shared"], study["hierarchical"])
-        check_study_arrays(manifest, arrays, layout, tuple(e.p for e in members))
+        check_study_arrays(
+            manifest, arrays, layout, tuple(e.p for e in members), element_levels(layout, members)
+        )
         saved = manifest["priors"]["hyper"]
         hyper = HyperPriors(**{"sd_prior": "gamma", **saved})  # no sd_prior: SEPIA's, as before
         out = Study(study["kind"], members, layout, hyper, arrays, manifest["settings"],

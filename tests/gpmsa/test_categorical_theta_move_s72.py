@@ -128,9 +128,10 @@ def test_the_move_is_its_own_reverse_and_propose_theta_is_propose(case):
     assert ll == pytest.approx(log_likelihood(problem, {**params, "theta": theta}), rel=1e-10)
 
 
-def test_the_studies_still_refuse_a_categorical_theta(case):
-    """The studies' theta sampler has no joint level move (torch's batched sweep has one:
-    test_torch_level_move_s72): calibrate_study keeps refusing, naming what calibrates one."""
+def test_the_studies_refuse_a_hierarchical_categorical_theta(case):
+    """The studies make the joint level move too (``tests/gpmsa/test_study_categorical_s72.py``)
+    for a shared or a model's own categorical theta; a hierarchical one is refused by name."""
     _, emu, xo, yo = case
-    with pytest.raises(gpmsa.GPMSAError, match=r"kind is categorical.*numpy .*torch backend only"):
-        gpmsa.calibrate_study([emu, emu], [xo, xo], [yo, yo], n_samples=10, n_burn=2)
+    with pytest.raises(gpmsa.GPMSAError, match=r"hierarchical parameter 'kind' is categorical"):
+        gpmsa.calibrate_study([emu, emu], [xo, xo], [yo, yo], hierarchical=["kind"],
+                              n_samples=10, n_burn=2)  # fmt: skip

@@ -164,10 +164,9 @@ def test_categorical_theta_in_a_joint_fit_agrees_with_calibrate():
         gpmsa.fit(sim, gpmsa.ObsData(x_obs, y_mid), n_iter=5, fixed={"theta": [1.5]})
     fixed = gpmsa.fit(sim, gpmsa.ObsData(x_obs, y_mid), n_iter=20, fixed={"theta": [2]}, seed=0)
     assert np.all(fixed.calibration["theta_native"] == 2.0)
-    obs = gpmsa.ObsData(x_obs, y_mid)  # a study's theta moves are continuous: refused
-    with pytest.raises(gpmsa.GPMSAError, match=r"fit_study \(model model0\): calibration "
-                                               r"parameter t0 is categorical"):  # fmt: skip
-        gpmsa.fit_study([sim, sim], [obs, obs], shared=["t0"], n_iter=5)
+    obs = gpmsa.ObsData(x_obs, y_mid)  # a study takes it shared (session 72), not hierarchical
+    with pytest.raises(gpmsa.GPMSAError, match=r"hierarchical parameter 't0' is categorical"):
+        gpmsa.fit_study([sim, sim], [obs, obs], hierarchical=["t0"], n_iter=5)
 
 
 def test_file_round_trip_and_edited_declaration(cat_emulator, tmp_path):
