@@ -390,7 +390,12 @@ def kron_groups(arrays: dict[str, np.ndarray]) -> tuple[tuple[int, ...], ...] | 
     if held is None:
         return None
     codes = np.asarray(held, dtype=float).reshape(-1)
-    k = int(np.max(codes)) + 1 if codes.size and np.all(np.isfinite(codes)) else 0
+    ok = (
+        codes.size
+        and np.all(np.isfinite(codes))
+        and 0 <= np.min(codes) <= np.max(codes) < codes.size
+    )
+    k = int(np.max(codes)) + 1 if ok else 0  # a factor per input at most: np.arange(k) small
     if k < 2 or not np.array_equal(np.unique(codes), np.arange(k)):
         raise _fail(f"arrays/{KRON_ARRAY}", f"{_short(codes.tolist())}: must number the "
                     "factor of each input 0, 1, ..., at least two factors, each holding an "
@@ -855,6 +860,13 @@ def check_values(
         off = np.abs(gram - np.diag(np.diag(gram)))
         if off.max() > ORTHOGONAL_TOL * lam.max():
             raise _fail("arrays/K", "basis vectors are not orthogonal")
+    if given:  # SimData's bound on a given scale: the standardised runs, squared, in float64
+        with np.errstate(over="ignore", invalid="ignore"):
+            big = float(np.max(np.abs((y - y_mean) / y_sd)))
+        if not (np.isfinite(big) and np.isfinite(big * big)):
+            raise _fail(" and ".join(f"arrays/{k}" for k in given),
+                        "the training outputs standardised by the given scale overflow float64 "
+                        f"(largest |y - y_mean| / y_sd = {big:.3g})")  # fmt: skip
     w = arrays["w"]
     w_ref = ((y - y_mean) / y_sd) @ np.linalg.pinv(K).T
     if np.max(np.abs(w - w_ref)) > W_TOL * (1.0 + np.max(np.abs(w_ref))):
