@@ -69,7 +69,7 @@ import time as _time
 from collections import deque
 from dataclasses import dataclass, field, replace
 from itertools import islice
-from math import sqrt
+from math import isfinite, sqrt
 
 import numpy as np
 from scipy.special import ndtr, ndtri
@@ -329,6 +329,8 @@ def _samples(name: str, values) -> np.ndarray:
     """``values`` as a 1-D float array; ControlError naming ``name`` for anything but real
     numbers in one dimension (bools and strings are not numbers; NaN and None are missing
     samples: sensor faults, not errors)."""
+    if type(values) is np.ndarray and values.ndim == 1 and values.dtype == np.float64:
+        return values.copy()  # (the usual case: what the last line gives, a copy of its own)
     if values is None:
         raise ControlError(f"{name} must be a 1-D sequence of numbers, got None")
     check_not_masked(values, name)
@@ -684,8 +686,8 @@ class BCR:
 
     def _now(self) -> tuple[float, float]:
         """(time, position) now: the newest sample's, or the caller's clock when it is later."""
-        if np.isfinite(self._t_last):
-            t = max(self._t_last, self._clock) if np.isfinite(self._clock) else self._t_last
+        if isfinite(self._t_last):  # (math's isfinite on these floats: no array round trip)
+            t = max(self._t_last, self._clock) if isfinite(self._clock) else self._t_last
             return t, self._pos_last
         return float(self.last.time), float(self.last.position)
 
@@ -695,9 +697,9 @@ class BCR:
         samples gave (``fresh``: e.g. readings that arrived but were NaN, which leave no
         newest sample) is named before the silence, and so (``pending``) are the breaks of
         samples that wait for the coming update (fed in chunks smaller than an update)."""
-        if not np.isfinite(self._clock):
+        if not isfinite(self._clock):
             return est
-        last = self._t_last if np.isfinite(self._t_last) else self._clock_start
+        last = self._t_last if isfinite(self._t_last) else self._clock_start
         silence = self._clock - last
         if silence <= self.settings.max_silence_s:
             self._clock_back = 0.0  # the clocks agree (again)
@@ -721,7 +723,7 @@ class BCR:
         """Metres since the end of the last block ``phase`` saw (0 before any), with the
         distance of its undone blocks."""
         _, pos = self._now()
-        ds = pos - phase.pos_block if np.isfinite(phase.pos_block) else 0.0
+        ds = pos - phase.pos_block if isfinite(phase.pos_block) else 0.0
         phase.pos_block = pos
         ds = max(float(ds), 0.0) + phase.pending_m
         phase.pending_m = 0.0
@@ -801,7 +803,7 @@ class BCR:
         """Sample time of the newest information any estimate rests on, s (NaN before any)."""
         if self.settings.method != "changepoint":
             return self._data_time
-        times = [p.data_time for p in self._phases if np.isfinite(p.data_time)]
+        times = [p.data_time for p in self._phases if isfinite(p.data_time)]
         return max(times) if times else np.nan
 
     def _estimate_changepoint(self) -> Estimate:
@@ -824,7 +826,7 @@ class BCR:
                 "filling", f"block holds {acc.size} of {s.feature.block_samples} samples"
             )
         tic = _time.perf_counter()
-        v = float(np.mean(spd))
+        v = float(spd.sum() / spd.size)  # np.mean's operations, without its wrapper
         lo, hi = self.speed_range
         why = ""
         if not within(v, lo, hi):
@@ -1084,7 +1086,7 @@ class BCR:
         if len(self._phases) == 1:
             return [self._phases[0].filter], np.ones(1)
         used = sorted(  # data of this stream (a resumed phase's GD state joins with its block)
-            (ph for ph in self._phases if ph.filter.has_data and np.isfinite(ph.data_time)),
+            (ph for ph in self._phases if ph.filter.has_data and isfinite(ph.data_time)),
             key=lambda ph: -ph.data_time,
         )
         weights = np.arange(len(self._phases), len(self._phases) - len(used), -1, dtype=float)

@@ -89,6 +89,9 @@ class ChangePointSettings:
 class ChangePointFilter:
     """The filter on a fixed GD grid (native units, increasing, positive); see the module doc."""
 
+    _survival: tuple[np.ndarray, np.ndarray] | None = None  # (dist, S(dist)): `_survival_now`
+    _survival_next: np.ndarray | None = None  # S(dist + ds) of the step under way (`_hazard`)
+
     def __init__(self, gd: np.ndarray, settings: ChangePointSettings | None = None) -> None:
         gd = _increasing_positive(
             gd, "gd", 3, "an increasing 1-D grid of >= 3 positive, finite values"
@@ -135,12 +138,37 @@ class ChangePointFilter:
         k, theta = self.settings.segment_shape, self._scale
         if k == 1.0:
             return np.full(self._dist.size, -np.expm1(-ds / theta))
-        s0 = gammaincc(k, self._dist / theta)
+        s0 = self._survival_now()
         s1 = gammaincc(k, (self._dist + ds) / theta)
+        self._survival_next = s1  # (`_survival_of`: most of the next step's s0)
         with np.errstate(invalid="ignore", divide="ignore"):
             h = 1.0 - s1 / s0
         tail = -np.expm1(-ds / theta)  # the hazard's limit for long runs
         return np.clip(np.where(s0 > 1e-250, h, tail), 0.0, 1.0)
+
+    def _survival_now(self) -> np.ndarray:
+        """S(d) of the segment-length law at the distances d each run spans (R,): kept from the
+        step that made them (`_survival_of`), else computed."""
+        kept = self._survival
+        if kept is not None and kept[0] is self._dist:
+            return kept[1]
+        return gammaincc(self.settings.segment_shape, self._dist / self._scale)
+
+    def _survival_of(self, dist: np.ndarray, merged: bool) -> None:
+        """Keep S(``dist``) for the next step, ``dist`` the distances a step made from this
+        state's (a new run first, then each run's + ds, the last one ``merged`` or not), from
+        the S(d + ds) that `_hazard` computed: the same numbers, half the gammaincc calls."""
+        k, theta = self.settings.segment_shape, self._scale
+        ahead, self._survival_next = self._survival_next, None
+        if k == 1.0 or ahead is None or ahead.size + 1 < dist.size:
+            return
+        survival = np.empty(dist.size)
+        survival[0] = gammaincc(k, dist[0] / theta)
+        survival[1:] = ahead[: dist.size - 1]
+        if merged:  # the merged last run's mean distance
+            survival[-1] = gammaincc(k, dist[-1] / theta)
+        survival.flags.writeable = False
+        self._survival = (dist, survival)
 
     def predict(self, ds_m: float) -> None:
         """Propagate over ds_m metres (change points; GD unchanged within a run)."""
@@ -170,7 +198,10 @@ class ChangePointFilter:
         if ds_m == 0:
             return self._mass, self._dist
         h = self._hazard(ds_m)
-        ended = (h[:, None] * self._mass).sum(axis=0)
+        # (h[:, None] * mass).sum(axis=0): the same products summed in the same order (row by
+        # row; bit for bit on 3,000 random masses, numpy 2.4), in one pass without the (R, G)
+        # product: a third of the time
+        ended = np.einsum("r,rg->g", h, self._mass)
         mass = np.empty((self._mass.shape[0] + 1, self.gd.size))
         # the new run: the mass that ended, redrawn (by a jump, or from the prior)
         mass[0] = ended.sum() * self.prior if from_prior else ended @ self._jump
@@ -179,13 +210,15 @@ class ChangePointFilter:
         if from_prior:  # a new segment here, as after `reset`: a move's end tells not its age
             dist[0] = 0.0
         R = self.settings.max_runs
-        if mass.shape[0] > R:
+        merged = mass.shape[0] > R
+        if merged:
             tail = mass[R - 1 :].sum(axis=1)
             if tail.sum() > 0:
                 dist[R - 1] = float(tail @ dist[R - 1 :] / tail.sum())
             mass[R - 1] += mass[R:].sum(axis=0)
             mass, dist = mass[:R], dist[:R]
         mass /= mass.sum()  # (a new array: in place)
+        self._survival_of(dist, merged)
         return mass, dist
 
     def update(self, loglik: np.ndarray, ds_m: float) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from math import isnan
 
 import numpy as np
 
@@ -183,7 +184,7 @@ class Estimate:
         if not (isinstance(pair, tuple | list) and len(pair) == 2 and all(map(is_real, pair))):
             raise ControlError(f"interval must be a pair (lo, hi) of real numbers, got {pair!r}")
         lo, hi = float(pair[0]), float(pair[1])
-        if np.isnan(lo) != np.isnan(hi) or lo > hi:
+        if isnan(lo) != isnan(hi) or lo > hi:  # (math's isnan: two floats)
             raise ControlError(f"interval must have lo <= hi (or be two NaNs), got {pair!r}")
 
     @property

@@ -249,7 +249,11 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
         )
     flight = flight_reading(limits)
     s1, s2, sd = _centred_sums(a)  # shared by the dead, noise-floor and level checks
-    start = _dead_stretch(a, limits.dead_fraction, flight, sd)
+    # every DEAD_STRETCH consecutive samples in order: their ranges (the dead check) and the
+    # lattice check's shortest stretches
+    sorted_runs = _sorted_runs(a, DEAD_STRETCH)
+    spread = None if sorted_runs is None else sorted_runs[-1] - sorted_runs[0]
+    start = _dead_stretch(a, limits.dead_fraction, flight, sd, spread)
     if start >= 0:
         return (
             f"dead sensor: samples {start}-{start + DEAD_STRETCH - 1} span less than "
@@ -257,7 +261,7 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
         )
     if limits.lattice_p > 0:
         resolution = float(positive.min()) if positive.size else None  # (`_resolution`)
-        p, start, stretch, step = _most_lattice_like(a, flight, resolution)
+        p, start, stretch, step = _most_lattice_like(a, flight, resolution, sorted_runs)
         if p < limits.lattice_p:
             return (
                 f"quantised signal: samples {start}-{start + stretch - 1} sit on a lattice of "
@@ -318,16 +322,22 @@ def dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None) -> int
     return _dead_stretch(a, fraction, free_fall, float(np.std(a)))
 
 
-def _dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None, sd: float) -> int:
-    """`dead_stretch` with the standard deviation ``sd`` of ``a`` known."""
+def _dead_stretch(
+    a: np.ndarray, fraction: float, free_fall: float | None, sd: float,
+    spread: np.ndarray | None = None,
+) -> int:  # fmt: skip
+    """`dead_stretch` with the standard deviation ``sd`` of ``a`` known, and the range of each
+    stretch (``spread``, by start: from `_sorted_runs`) where given."""
     n = a.size - DEAD_STRETCH + 1
     if n < 1:
         return -1
-    hi, lo = a[:n].copy(), a[:n].copy()
-    for j in range(1, DEAD_STRETCH):  # running max and min over the stretch
-        np.maximum(hi, a[j : j + n], out=hi)
-        np.minimum(lo, a[j : j + n], out=lo)
-    dead = hi - lo < fraction * sd
+    if spread is None:
+        hi, lo = a[:n].copy(), a[:n].copy()
+        for j in range(1, DEAD_STRETCH):  # running max and min over the stretch
+            np.maximum(hi, a[j : j + n], out=hi)
+            np.minimum(lo, a[j : j + n], out=lo)
+        spread = hi - lo
+    dead = spread < fraction * sd
     if not dead.any():  # the usual case: no flight exemption to work out
         return -1
     if free_fall is not None:
@@ -354,10 +364,16 @@ def most_lattice_like(
 
 
 def _most_lattice_like(
-    a: np.ndarray, free_fall: float | None, resolution: float | None
-) -> tuple[float, int, int, float]:
-    """`most_lattice_like` with the block's `_resolution` known."""
-    found = [(*_lattice_stretch(a, n, free_fall, resolution), n) for n in LATTICE_STRETCHES]
+    a: np.ndarray, free_fall: float | None, resolution: float | None,
+    sorted_runs: np.ndarray | None = None,
+) -> tuple[float, int, int, float]:  # fmt: skip
+    """`most_lattice_like` with the block's `_resolution` known (and `_sorted_runs` of
+    ``DEAD_STRETCH`` samples, where given: that stretch's)."""
+    found = [
+        (*_lattice_stretch(a, n, free_fall, resolution,
+                           sorted_runs if n == DEAD_STRETCH else None), n)
+        for n in LATTICE_STRETCHES
+    ]  # fmt: skip
     p, start, step, stretch = min(found, key=lambda f: f[0])
     return p * len(LATTICE_STRETCHES), start, stretch, step
 
@@ -394,12 +410,15 @@ def _resolution(a: np.ndarray) -> float | None:
 
 
 def _lattice_stretch(
-    a: np.ndarray, stretch: int, free_fall: float | None, resolution: float | None
-) -> tuple[float, int, float]:
-    """`lattice_stretch` with the block's `_resolution` known."""
+    a: np.ndarray, stretch: int, free_fall: float | None, resolution: float | None,
+    ordered: np.ndarray | None = None,
+) -> tuple[float, int, float]:  # fmt: skip
+    """`lattice_stretch` with the block's `_resolution` known (and its `_sorted_runs` of
+    ``stretch`` samples, ``ordered``, where given)."""
     if resolution is None or a.size < stretch:
         return 1.0, -1, float("nan")
-    ordered = np.sort(a[_window_index(a.size, stretch)], axis=0)  # (stretch, stretches)
+    if ordered is None:
+        ordered = _sorted_runs(a, stretch)  # (stretch, stretches)
     low = ordered[:-1]
     step = ordered[1:] - low  # (stretch - 1 steps, stretches): neighbours in value
     usable = step > resolution
@@ -428,6 +447,14 @@ def _lattice_stretch(
     p = bdtrc(hits[row, col] - 1, stretch - 2, chance)  # P(hits or more)
     k = int(np.argmin(p))
     return float(p[k] * (stretch - 1)), int(col[k]), float(step[row[k], col[k]])
+
+
+def _sorted_runs(a: np.ndarray, stretch: int) -> np.ndarray | None:
+    """Every ``stretch`` consecutive samples of ``a``, each sorted: (stretch, n - stretch + 1),
+    column i the samples i..i+stretch-1 in increasing order; None if ``a`` is shorter."""
+    if a.size < stretch:
+        return None
+    return np.sort(a[_window_index(a.size, stretch)], axis=0)
 
 
 @functools.lru_cache(maxsize=16)
@@ -556,15 +583,15 @@ def _level_within(s1: np.ndarray, s2: np.ndarray, min_segment: int, limit: float
     if n < 2 * m:
         return True
     before, after = _part_variances(s1, s2, m)
-    delta = 8.0 * n * n * np.finfo(float).eps * s2[-1] / (m - 1)
+    delta = 8.0 * n * n * EPS * s2[-1] / (m - 1)
     ends = slice(m, n - m + 1)  # the ends (and starts) of segments with m samples beyond them
     inside_hi = (before[ends] + delta) * np.arange(m - 1, n - m) / (m - 1) + delta
-    if not np.all(inside_hi <= 0.5 * limit * after[ends]):
+    if not (inside_hi <= 0.5 * limit * after[ends]).all():
         return False
     total, squares = s1[2 * m :] - s1[ends], s2[2 * m :] - s2[ends]  # [s, s + m) from each s
     first = (squares - total * total / m) / (m - 1)
     inside_lo = (first - delta) * (m - 1) / (n - m - 1) - delta
-    return bool(np.all(before[ends] <= 0.5 * limit * inside_lo))
+    return bool((before[ends] <= 0.5 * limit * inside_lo).all())
 
 
 def short_level_drop(
@@ -616,13 +643,16 @@ def _short_levels_to_scan(
     `_level_within`)."""
     n, total = s1.size - 1, float(s2[-1])
     delta = 8.0 * n * n * EPS * total
-    least = _least_spread(s1, s2, stretches[0][0]) - 2.0 * delta
+    shortest = stretches[0][0]
+    least = _least_spread(s1, s2, shortest) - 2.0 * delta
     scan = []
     for stretch, limit in stretches:
         if n < stretch + SHORT_LEVEL_BEFORE + 2:
             continue
         most = (total + delta) * (stretch - 1) / (limit * (n - stretch - 1))
-        if least >= most or _least_spread(s1, s2, stretch) - 2.0 * delta >= most:
+        if least >= most or (
+            stretch != shortest and _least_spread(s1, s2, stretch) - 2.0 * delta >= most
+        ):  # (the shortest's own: ``least``)
             continue
         scan.append((stretch, limit))
     return scan
@@ -690,7 +720,7 @@ def _centred_sums(a: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
     """Cumulative sums (with a leading 0) of ``a - mean(a)`` and of its square: the sum of
     samples i..j-1 is s[j] - s[i] (centred first: fewer cancellation digits); and the standard
     deviation of ``a`` from the same squares (np.std's operations, to the last bit)."""
-    x = a - a.mean()
+    x = a - a.sum() / a.size  # a.mean(): its operations, without its wrapper
     squares = x * x
     s1, s2 = np.zeros(a.size + 1), np.zeros(a.size + 1)
     np.cumsum(x, out=s1[1:])
@@ -798,11 +828,14 @@ def stream_breaks(
     if none). ``restart`` marks samples after a gap (a step above 1.5 periods: dropped
     samples): they are kept but begin a new contiguous run.
     """
+    dt = 1.0 / rate_hz
+    if _unbroken(t, position, accel, speed, t_prev, dt):  # (the usual case)
+        unbroken = np.zeros(t.size, dtype=bool)
+        return unbroken, unbroken.copy(), NO_BREAKS
     finite = np.isfinite(t) & np.isfinite(position) & np.isfinite(accel) & np.isfinite(speed)
     with np.errstate(invalid="ignore"):
         too_fast = np.abs(speed) > MAX_SPEED_MPS
     bad_value = ~finite | too_fast
-    dt = 1.0 / rate_hz
     step = t - _previous_finite(t, t_prev)
     finite_step = np.isfinite(step)  # a non-finite time stamp is a bad value, not a step
     with np.errstate(invalid="ignore"):
@@ -820,6 +853,27 @@ def stream_breaks(
             float(np.max(step[gap])) if gap.any() else 0.0,
         )
     return bad_value | backwards, gap & ~bad_value, breaks
+
+
+def _unbroken(
+    t: np.ndarray, position: np.ndarray, accel: np.ndarray, speed: np.ndarray, t_prev: float,
+    dt: float,
+) -> bool:  # fmt: skip
+    """Whether `stream_breaks` finds nothing (True: every value finite, no |speed| beyond
+    ``MAX_SPEED_MPS``, every step from ``t_prev`` on within [0.5, 1.5] periods ``dt``), in a
+    few whole-array reductions; False where it may find something. A finite sum has finite
+    terms (a sum of finite values that overflows reads False: `stream_breaks` then looks)."""
+    if t.size == 0:
+        return False
+    with np.errstate(over="ignore", invalid="ignore"):  # (`stream_breaks` names what is wrong)
+        total = t.sum() + position.sum() + accel.sum() + speed.sum()
+        if not (np.isfinite(total) and -MAX_SPEED_MPS <= speed.min()
+                and speed.max() <= MAX_SPEED_MPS):  # fmt: skip
+            return False
+        if t_prev == t_prev and not 0.5 * dt <= t[0] - t_prev <= 1.5 * dt:  # (NaN: no step)
+            return False
+        steps = t[1:] - t[:-1]
+    return bool(steps.size == 0 or (steps.min() >= 0.5 * dt and steps.max() <= 1.5 * dt))
 
 
 STAMP_UNITS = (("milliseconds", 1e3), ("microseconds", 1e6), ("nanoseconds", 1e9))
@@ -861,7 +915,8 @@ def timing_fault(
             f"({(t.size - 1) / span:.4g} Hz), not the {expected:.4g} s of {rate_hz:g} Hz"
         )
     moved = float(position[-1] - position[0])
-    by_speed = float(np.trapezoid(speed, t))
+    # np.trapezoid(speed, t): its operations, without its wrapper
+    by_speed = float(((t[1:] - t[:-1]) * (speed[1:] + speed[:-1]) / 2.0).sum())
     if abs(moved - by_speed) > limits.odometry_tolerance * abs(by_speed) + limits.odometry_slack_m:
         return (
             f"odometry disagrees with the speeds: the position moved {moved:.4g} m over the "

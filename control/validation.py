@@ -19,6 +19,8 @@ def is_real(value) -> bool:
     """Whether ``value`` is a real number that numpy holds as one (a bool, Python's or numpy's,
     is not; nor an int beyond 64 bits or a Fraction: numpy keeps those as objects, and its
     comparisons and ufuncs fail on them)."""
+    if type(value) is float:  # (the usual case, first: the ABC check below costs ~0.3 us)
+        return True
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, Real):
         return False
     if isinstance(value, float | np.floating | np.integer):
