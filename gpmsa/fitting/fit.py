@@ -27,6 +27,7 @@ from gpmsa.fitting.continuation import (
 )
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
+from gpmsa.mcmc import tempering
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.mcmc.sampler import (
@@ -53,21 +54,25 @@ def _factor_nbytes(m: int, p: int, q: int, p_u: int) -> float:
     return 8.0 * m * m * (p + q + 4 * p_u + 2)
 
 
-def _check_fit_memory(problem, n_iter: int, n_chains: int, pooled: int = 0) -> None:
+def _check_fit_memory(
+    problem, n_iter: int, n_chains: int, pooled: int = 0, copies: int = 1
+) -> None:
     """Refuse (before sampling) a fit whose draws or factorisations exceed the memory limit:
     every sweep of every chain is stored (n_chains x n_iter x parameter elements, kept twice
-    while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats;
-    ``pooled``: the retained draws of an appended fit (``append=True``), source's and its own,
-    held three times (the parts, the pooled arrays, the emulator's read-only copies)."""
+    while the chains are stacked), and the likelihood keeps O((p + q + 4 p_u) m^2) floats,
+    ``copies`` times (parallel tempering: one likelihood state per temperature); ``pooled``:
+    the retained draws of an appended fit (``append=True``), source's and its own, held three
+    times (the parts, the pooled arrays, the emulator's read-only copies)."""
     m = problem.m
     sep = problem.separable  # a separable design's likelihood keeps its factors alone
-    nbytes = draws_nbytes(problem, n_iter, n_chains) + (
+    nbytes = draws_nbytes(problem, n_iter, n_chains) + copies * (
         _factor_nbytes(m, problem.p, problem.q, problem.p_u)
         if sep is None
         else kronecker.fit_nbytes(sep, problem.p_u)
     )
     nbytes += 1.5 * sweeps_nbytes(parameter_elements(problem), pooled, 1)
     what = f" appending to {pooled} retained draws" if pooled else ""
+    what += f" at {copies} temperatures" if copies > 1 else ""
     check_memory(nbytes, f"fit(n_iter={n_iter}, n_chains={n_chains}) of {m} runs x "
                  f"{parameter_elements(problem)} parameter elements{what}")  # fmt: skip
 
@@ -177,6 +182,20 @@ def fit(
     there). theta_init: the chains' start of theta (native, (q,) or a dict by t_names; default
     the centre; a categorical element: one of its levels).
 
+    Parallel tempering (numpy options ``temperatures`` and ``swap_every``; off by default, and
+    then the draws are GPM/SA's sampler's, bit for bit): for a posterior with several modes
+    that the one-element steps do not cross (a ConvergenceWarning whose chains lie apart, log
+    posteriors tens apart). ``temperatures``: an integer n (the ladder T = 2**k, k = 0 .. n -
+    1) or a ladder (1, T_1, ...), strictly increasing from 1; each chain then runs a copy per
+    temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at its
+    temperature; neighbouring copies propose to swap states every ``swap_every`` (1) sweeps,
+    and only the T = 1 copy's draws are kept. It costs about one sweep per copy (n times the
+    time, memory for n likelihood states). ``settings`` record "temperatures", "swap_every"
+    and "swap_rate" (per chain, per neighbour pair): rates near 0 say the ladder is too
+    sparse, the hottest copy should cross between the modes (a barrier of 50 in log
+    posterior needs T_max of tens). Refused on the torch and pyro backends and with ``init``
+    an emulator (docs/internals.md, "Parallel tempering").
+
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
     names each parameter with R-hat > 1.01 or ESS < 100. A chain that fails or produces
@@ -204,6 +223,7 @@ def fit(
             "field data, and a simulator-only fit has none"
         )
     seed = run_seed(seed)
+    temps = _check_tempering(options, backend, continuing)
     if isinstance(data, SimData) and data.separable is not None and backend != "numpy":
         kronecker.refuse(f"backend={backend!r}")
     module = backends.get(backend)
@@ -212,7 +232,8 @@ def fit(
                    basis=basis)  # fmt: skip
     problem = _model_options(prep, data, fixed, constraint, theta_init)
     pooled = options["init"].n_draws + int(n_chains) * (n_iter // thin) if append else 0
-    _check_fit_memory(problem, int(n_iter), int(n_chains), pooled)
+    _check_fit_memory(problem, int(n_iter), int(n_chains), pooled,
+                      1 if temps is None else len(temps))  # fmt: skip
     reserved = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress", "n_jobs",
                 "executor")  # fmt: skip
     backends.check_options(backend, options, reserved, "fit")
@@ -299,6 +320,10 @@ def fit(
         "fixed": fixed_record(problem),
         "constraint": constraint is not None,
         "step_widths": {k: v.tolist() for k, v in chains.step_widths.items()},
+        **({} if temps is None else {  # parallel tempering: the ladder and the swaps' success
+            "temperatures": list(chains.info["temperatures"]),
+            "swap_every": int(chains.info["swap_every"]),
+            "swap_rate": np.asarray(chains.info["swap_rate"]).tolist()}),
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "versions": library_versions(backend),
     }  # fmt: skip
@@ -326,6 +351,26 @@ def fit(
         diagnostics=summary, calibration=calibration, convergence=record,
         discrepancy_bases=kept_bases(problem.obs, discrepancy),
     )  # fmt: skip
+
+
+def _check_tempering(options: dict, backend: str, continuing: bool):
+    """The ladder of ``fit``'s ``temperatures`` option (``tempering.ladder``; None: off).
+    GPMSAError naming ``temperatures``/``swap_every`` given to another backend than numpy, or
+    ``temperatures`` with ``init`` an emulator (its record holds the T = 1 copy alone)."""
+    given = [k for k in ("temperatures", "swap_every") if options.get(k) is not None]
+    if given and backend != "numpy":
+        raise GPMSAError(
+            f"{' and '.join(given)}: parallel tempering runs on the numpy backend only, not "
+            f"backend={backend!r}"
+        )
+    temps = tempering.ladder(options.get("temperatures"))
+    if temps is not None and continuing:
+        raise GPMSAError(
+            "temperatures= with init=emulator: a fit's record holds its T = 1 chains alone, not "
+            "the tempered copies to continue; fit afresh with temperatures= (init= may give the "
+            "starts as a dict), or continue without temperatures="
+        )
+    return temps
 
 
 def check_keep(n_keep, n_chains: int) -> int:

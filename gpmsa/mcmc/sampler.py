@@ -9,7 +9,9 @@ steps them uniformly with its tuned widths, as SEPIA). A proposal outside the pr
 rejected without a likelihood call.
 Where it applies (one basis component, no observations) each sweep ends with moves along the
 lamWs/lamWOs nugget ridge (``gpmsa.mcmc.ridge``; not in GPM/SA, ``ridge_moves=0`` turns them off).
-Several chains run as parallel tasks (``gpmsa.mcmc.parallel``), each on its own seed.
+Several chains run as parallel tasks (``gpmsa.mcmc.parallel``), each on its own seed. With
+``temperatures`` (opt-in) each chain runs a ladder of tempered copies that swap states
+(``gpmsa.mcmc.tempering``), keeping the T = 1 copy's draws.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import level_moves, ridge, starts, tuning
+from gpmsa.mcmc import level_moves, ridge, starts, tempering, tuning
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 from gpmsa.model.kronecker import KroneckerLikelihood
@@ -168,8 +170,12 @@ class ChainState:
 
     ``els`` restricts the sweep to some (name, index) elements (default: every sampled one).
     ``ridge_moves``: moves along the nugget ridge after each sweep (``gpmsa.mcmc.ridge``; only
-    where the move applies, else none).
+    where the move applies, else none). ``beta``: the power 1/T of the likelihood in the
+    acceptance (a tempered copy, ``gpmsa.mcmc.tempering``; the prior is not tempered); 1.0
+    gives the plain sweep bit for bit (x * 1.0 == x).
     """
+
+    beta = 1.0
 
     def __init__(
         self,
@@ -251,7 +257,7 @@ class ChainState:
         ll_new = lik.propose_theta(theta)
         if ll_new == -math.inf:
             return
-        if math.log(u1) < ll_new - ll_old + d_lp:
+        if math.log(u1) < (ll_new - ll_old) * self.beta + d_lp:
             lik.accept()
             self.log_prior += d_lp
             accepted[i] += 1
@@ -267,7 +273,7 @@ class ChainState:
 
     def sweep(self, widths: np.ndarray, prop_mh: bool, accepted: np.ndarray) -> None:
         """One Metropolis-within-Gibbs sweep; adds 1 to ``accepted[i]`` per accepted element."""
-        lik = self.lik
+        lik, beta = self.lik, self.beta
         u = self.rng.random((len(self.els), 2))
         for i, (name, idx) in enumerate(self.els):
             kind = self.kinds[i]
@@ -310,7 +316,7 @@ class ChainState:
             if ll_new == -math.inf:
                 continue
             lp_old = prior(x)
-            if math.log(u[i, 1]) < ll_new - ll_old + lp_new - lp_old + corr:
+            if math.log(u[i, 1]) < (ll_new - ll_old) * beta + lp_new - lp_old + corr:
                 lik.accept()
                 self.log_prior += lp_new - lp_old
                 accepted[i] += 1
@@ -521,11 +527,22 @@ def _chain_task(
     problem: Problem, n_iter: int, tune: bool, widths: dict[str, np.ndarray],
     seed: np.random.SeedSequence, start: dict[str, np.ndarray], tune_rounds: int,
     tune_levels: int, ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
-    proportional_steps: bool | None = None,
+    proportional_steps: bool | None = None, temperatures: tuple[float, ...] | None = None,
+    swap_every: int = 1,
 ):  # fmt: skip
     """One chain from plain data (run in a worker process): ``run_chain`` from ``start`` (drawn
-    by ``sample`` in the parent), its generator from ``seed``; ``run_chain``'s result."""
+    by ``sample`` in the parent), its generator from ``seed``; ``run_chain``'s result (with
+    ``temperatures``: ``tempering.run_tempered_chain``'s, the swap rates last)."""
     with threadpool_limits(1):
+        if temperatures is not None:
+            rng = np.random.default_rng(seed)
+            first = problem.init if start is None else start
+            return tempering.run_tempered_chain(
+                problem, n_iter, lambda: ChainState(problem, first, rng, ridge_moves=ridge_moves),
+                temperatures=temperatures, swap_every=swap_every, tune=tune, widths=widths,
+                rng=rng, tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress,
+                desc=desc, proportional_steps=proportional_steps,
+            )  # fmt: skip
         return run_chain(
             problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
             tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress, desc=desc,
@@ -563,6 +580,8 @@ def sample(
     executor=None,
     ridge_moves: int | None = None,
     proportional_steps: bool | None = None,
+    temperatures=None,
+    swap_every: int = 1,
 ) -> Chains:
     """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
 
@@ -582,12 +601,20 @@ def sample(
     component; 0: GPM/SA's sweep alone). ``proportional_steps``: the precisions (lamVz, lamUz,
     lamWs, lamWOs, lamOs) step by GPM/SA's proportional step, width max(1, x/3) whatever their
     step widths (True), or uniformly with their widths (False); None: ``not tune``, as GPM/SA
-    and SEPIA (``info["proportional_steps"]`` records it). Raises ChainError naming a
-    chain that failed or whose draws are not finite.
+    and SEPIA (``info["proportional_steps"]`` records it). ``temperatures``: parallel
+    tempering (``gpmsa.mcmc.tempering``; None: off, GPM/SA's sampler bit for bit): an integer
+    n (the ladder 2**k, k = 0 .. n - 1) or a ladder from 1; each chain runs a copy per
+    temperature (each tuned at its temperature), neighbours propose a swap every
+    ``swap_every`` sweeps, and the T = 1 copy's draws are kept; ``info`` records
+    "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1), each neighbour pair's
+    swap acceptance over the draws. Raises ChainError naming a chain that failed or whose
+    draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
+    temps = tempering.ladder(temperatures)
+    swap_every = tempering.check_swap_every(swap_every, temps)
     check_draws_memory(problem, int(n_iter), int(n_chains))
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     seq = np.random.SeedSequence(seed)
@@ -600,13 +627,16 @@ def sample(
     tasks = [
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": w, "seed": s,
          "start": first, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
-         "ridge_moves": n_ridge, "proportional_steps": prop_mh}
+         "ridge_moves": n_ridge, "proportional_steps": prop_mh,
+         **({} if temps is None else {"temperatures": temps, "swap_every": swap_every})}
         for s, first, w in zip(seeds, firsts, widths, strict=True)
     ]  # fmt: skip
     names = problem.names
     shapes = {n: problem.init[n].shape for n in names}
     expected = ({n: (int(n_iter), *v) for n, v in shapes.items()}, (int(n_iter),), shapes,
                 shapes)  # fmt: skip
+    if temps is not None:  # and each neighbour pair's swap rate
+        expected += ((len(temps) - 1,),)
     runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
                       desc="chain",
                       check=lambda _, r: wrong_result(r, expected, f"{n_iter} sweeps"))  # fmt: skip
@@ -621,5 +651,8 @@ def sample(
               "starts": {n: np.stack([first[n] for first in firsts]) for n in names},
               "backend": "numpy"},
     )  # fmt: skip
+    if temps is not None:
+        chains.info.update(temperatures=list(temps), swap_every=swap_every,
+                           swap_rate=np.stack([r[4] for r in runs]))  # fmt: skip
     chains.check_finite()
     return chains

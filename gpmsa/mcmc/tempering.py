@@ -1,0 +1,193 @@
+"""Parallel tempering (opt-in, numpy backend): a move between the modes of a posterior.
+
+GPM/SA's Metropolis-within-Gibbs sweep moves one element a short step at a time; a chain that
+ends tuning in a mode tens of log-posterior units below the main one stays there for thousands
+of sweeps (docs/internals.md, "What the starts cannot fix"). With ``temperatures`` a chain runs
+a ladder of copies at temperatures 1 = T_0 < T_1 < ... < T_{K-1}; copy k targets
+
+    pi_k(x) ∝ L(x)^(1/T_k) p(x),
+
+the likelihood tempered, the prior not (a hot copy roams the prior's support, which the bounds
+keep proper). Each copy sweeps with its own step widths (tuned at its temperature by GPM/SA's
+tuning, ``gpmsa.mcmc.tuning``, or the widths given), holds its own likelihood state and runs
+the nugget-ridge moves (the likelihood cancels there, so they are the same at every
+temperature). Every ``swap_every`` sweeps of all copies, neighbours k, k + 1 (k = 0 .. K - 2 in
+turn) propose to exchange their states, accepted with probability
+
+    min(1, exp((1/T_k - 1/T_{k+1}) (log L(x_{k+1}) - log L(x_k)))),
+
+the priors cancelling: each swap leaves the product of the copies' targets invariant, so the
+T = 1 copy, whose draws alone are kept, samples the posterior. Swaps run through the tuning
+sweeps too (the cold copy can reach the main mode before any draw). A categorical theta's level
+move learns its shifts at T = 1 and every copy uses them (any shifts keep the move exact).
+Every uniform comes from the chain's own Generator: the draws depend on the seed alone.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from gpmsa.errors import GPMSAError
+from gpmsa.mcmc import tuning
+from gpmsa.model.data import check_count
+from gpmsa.model.problem import Problem
+
+RATIO = 2.0
+"""Ratio of neighbouring temperatures of ``temperatures=n``: T_k = RATIO**k, k = 0 .. n - 1."""
+MAX_TEMPERATURES = 32
+"""Most copies per chain (each holds its own likelihood state and costs a sweep)."""
+MAX_SWAP_EVERY = 1_000_000
+"""Largest ``swap_every`` (sweeps between swap rounds)."""
+
+
+def ladder(temperatures) -> tuple[float, ...] | None:
+    """The temperatures of ``sample``'s ``temperatures``: None (no tempering), an integer n in
+    [2, ``MAX_TEMPERATURES``] (RATIO**k, k = 0 .. n - 1), or a sequence of 2 to
+    ``MAX_TEMPERATURES`` finite temperatures, strictly increasing from exactly 1 (the copy
+    whose draws are kept). GPMSAError naming the value otherwise."""
+    if temperatures is None:
+        return None
+    if isinstance(temperatures, int | np.integer) and not isinstance(temperatures, bool):
+        n = check_count(temperatures, "temperatures", 2, MAX_TEMPERATURES)
+        return tuple(RATIO**k for k in range(n))
+    if isinstance(temperatures, str | bytes | dict) or not hasattr(temperatures, "__len__"):
+        raise GPMSAError(
+            f"temperatures must be None, an integer n in [2, {MAX_TEMPERATURES}] (the ladder "
+            f"{RATIO:g}**k) or a sequence of temperatures from 1, got {temperatures!r}"
+        )
+    try:
+        arr = np.asarray(temperatures, dtype=float)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.ndim != 1 or not 2 <= arr.size <= MAX_TEMPERATURES:
+        raise GPMSAError(
+            f"temperatures: a ladder must be a flat sequence of 2 to {MAX_TEMPERATURES} numbers, "
+            f"got {temperatures!r}"
+        )
+    if not (np.all(np.isfinite(arr)) and arr[0] == 1.0 and np.all(np.diff(arr) > 0)):
+        raise GPMSAError(
+            "temperatures: a ladder must start at exactly 1 (the copy whose draws are kept) and "
+            f"increase strictly, every temperature finite, got {arr.tolist()}"
+        )
+    return tuple(float(v) for v in arr)
+
+
+def check_swap_every(swap_every, temperatures) -> int:
+    """``swap_every`` as an int in [1, ``MAX_SWAP_EVERY``]; GPMSAError for another value, or
+    for a value other than 1 without ``temperatures`` (there is nothing to swap)."""
+    n = check_count(swap_every, "swap_every", 1, MAX_SWAP_EVERY)
+    if temperatures is None and n != 1:
+        raise GPMSAError(f"swap_every={n} needs temperatures= (parallel tempering)")
+    return n
+
+
+def swap(states: list, betas: tuple[float, ...], u: np.ndarray, accepted: np.ndarray) -> None:
+    """One round of neighbour swaps: for k = 0 .. K - 2, copies k and k + 1 (``states``,
+    ``ChainState``s at inverse temperatures ``betas``) exchange their likelihood states (the
+    parameters with them) and running log priors where log u[k] is below the log acceptance
+    ratio; adds 1 to ``accepted[k]`` per swap."""
+    for k in range(len(states) - 1):
+        a, b = states[k], states[k + 1]
+        log_r = (betas[k] - betas[k + 1]) * (b.lik.loglik - a.lik.loglik)
+        if math.log(u[k]) < log_r:
+            a.lik, b.lik = b.lik, a.lik
+            a.log_prior, b.log_prior = b.log_prior, a.log_prior
+            accepted[k] += 1
+
+
+def tune_ladder(states: list, betas, rng, names, widths, n_rounds, n_levels, swaps, on_round):
+    """GPM/SA's tuning (``tuning.tune_widths``) of every copy at its temperature, the copies'
+    sweeps interleaved (round, level, copy), a swap round after each level (counted in
+    ``swaps``); returns each copy's tuned widths."""
+    cands = tuning.level_widths(names, widths, n_levels)
+    acc = np.zeros((len(states), n_levels, widths.size))
+    for _ in range(n_rounds):
+        for lev in range(n_levels):
+            for k, state in enumerate(states):
+                state.sweep(cands[lev], False, acc[k, lev])
+            swap(states, betas, rng.random(len(states) - 1), swaps)
+        on_round(n_levels * len(states))
+    return [tuning.choose_widths(widths, cands, a, n_rounds) for a in acc]
+
+
+def run_tempered_chain(
+    problem: Problem,
+    n_iter: int,
+    new_state: Callable[[], object],
+    *,
+    temperatures: tuple[float, ...],
+    swap_every: int,
+    tune: bool,
+    widths: dict[str, np.ndarray],
+    rng: np.random.Generator,
+    tune_rounds: int,
+    tune_levels: int,
+    progress: bool = False,
+    desc: str = "MCMC",
+    proportional_steps: bool | None = None,
+):
+    """``sampler.run_chain`` with a ladder of tempered copies (module docstring), each a
+    ``new_state()`` (a ``sampler.ChainState`` at the chain's start, drawing from ``rng``):
+    ``n_iter`` sweeps of every copy after its tuning; the T = 1 copy's draws are kept. Returns
+    ``run_chain``'s draws, log_post, accept rates and widths (of the T = 1 copy) and the swap
+    acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds."""
+    from tqdm.auto import tqdm
+
+    betas = tuple(1.0 / t for t in temperatures)
+    states = []
+    for beta in betas:
+        state = new_state()
+        state.beta = beta
+        states.append(state)
+    cold = states[0]
+    if math.isnan(cold.log_post()):
+        raise GPMSAError(
+            f"the starting values give a log posterior of NaN (log-likelihood "
+            f"{cold.lik.loglik}); check the data and the starting values"
+        )
+    els = cold.els
+    n_temps = len(states)
+    w = [np.array([float(widths[n][idx]) for n, idx in els])] * n_temps
+    swaps = np.zeros(n_temps - 1)
+    total = n_temps * (n_iter + (tune_rounds * tune_levels if tune else 0))
+    bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    with threadpool_limits(1):
+        if tune and els:
+            bar.set_description(f"{desc}: tuning step widths ({n_temps} temperatures)")
+            names = [n for n, _ in els]
+            w = tune_ladder(states, betas, rng, names, w[0], tune_rounds, tune_levels, swaps,
+                            bar.update)  # fmt: skip
+        cold.learn_level_shifts()  # at T = 1, shared: any shifts keep the move exact
+        for state in states[1:]:
+            state.level_shifts = cold.level_shifts
+        bar.set_description(f"{desc}: sampling ({n_temps} temperatures)")
+        draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
+        log_post = np.empty(n_iter)
+        accepted = [np.zeros(len(els)) for _ in states]
+        swaps[:] = 0.0
+        prop_mh = (not tune) if proportional_steps is None else proportional_steps
+        names = problem.names
+        for it in range(n_iter):
+            for k, state in enumerate(states):
+                state.sweep(w[k], prop_mh, accepted[k])
+            if it % swap_every == swap_every - 1:
+                swap(states, betas, rng.random(n_temps - 1), swaps)
+            prm = cold.params
+            for n in names:
+                draws[n][it] = prm[n]
+            log_post[it] = cold.log_post()
+            if it % 100 == 99:
+                bar.update(100 * n_temps)
+        bar.update((n_iter % 100) * n_temps)
+    bar.close()
+    rate = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
+    wid = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
+    for i, (n, idx) in enumerate(els):
+        rate[n][idx] = accepted[0][i] / max(n_iter, 1)
+        wid[n][idx] = w[0][i]
+    swap_rate = swaps / max(n_iter // swap_every, 1)
+    return draws, log_post, rate, wid, swap_rate
