@@ -646,13 +646,7 @@ def _pair_positions(pairs, names: list[str], fixed: dict) -> list[tuple[int, int
         if isinstance(pair, str) or not isinstance(pair, list | tuple) or len(pair) != 2:
             raise GPMSAError(f"each of pairs must be a pair of input names (a, b), got {pair!r} "
                              f"(one pair: pairs=[(a, b)])")  # fmt: skip
-        for name in pair:
-            if name in fixed:
-                raise GPMSAError(f"pairs names {name!r}, an input held fixed; the varied inputs "
-                                 f"are {tuple(names)}")  # fmt: skip
-            if not isinstance(name, str) or name not in names:
-                raise GPMSAError(f"pairs names an unknown input {name!r}; the varied inputs are "
-                                 f"{tuple(names)}")  # fmt: skip
+        _check_varied(pair, names, fixed, "pairs")
         if pair[0] == pair[1]:
             raise GPMSAError(f"pairs names one input twice in {tuple(pair)}; a pair is two inputs")
         key = frozenset(pair)
@@ -661,6 +655,18 @@ def _pair_positions(pairs, names: list[str], fixed: dict) -> list[tuple[int, int
         seen.add(key)
         out.append((names.index(pair[0]), names.index(pair[1])))
     return out
+
+
+def _check_varied(inputs, names: list[str], fixed: dict, arg: str) -> None:
+    """GPMSAError unless each of ``inputs`` (of argument ``arg``: "pairs", "groups") names a
+    varied input of ``names`` (one held by ``fixed`` or unknown named)."""
+    for name in inputs:
+        if name in fixed:
+            raise GPMSAError(f"{arg} names {name!r}, an input held fixed; the varied inputs are "
+                             f"{tuple(names)}")  # fmt: skip
+        if not isinstance(name, str) or name not in names:
+            raise GPMSAError(f"{arg} names an unknown input {name!r}; the varied inputs are "
+                             f"{tuple(names)}")  # fmt: skip
 
 
 def _group_positions(groups, names: list[str], fixed: dict) -> list[tuple[int, ...]]:
@@ -676,13 +682,7 @@ def _group_positions(groups, names: list[str], fixed: dict) -> list[tuple[int, .
             raise GPMSAError(f"each of groups must be a tuple of at least 2 input names, got "
                              f"{group!r} (one group: groups=[('a', 'b', 'c')]; one input's "
                              f"index is main)")  # fmt: skip
-        for name in group:
-            if name in fixed:
-                raise GPMSAError(f"groups names {name!r}, an input held fixed; the varied "
-                                 f"inputs are {tuple(names)}")  # fmt: skip
-            if not isinstance(name, str) or name not in names:
-                raise GPMSAError(f"groups names an unknown input {name!r}; the varied inputs "
-                                 f"are {tuple(names)}")  # fmt: skip
+        _check_varied(group, names, fixed, "groups")
         if len(set(group)) != len(group):
             raise GPMSAError(f"groups names an input twice in {tuple(group)}")
         key = frozenset(group)

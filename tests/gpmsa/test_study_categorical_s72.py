@@ -16,6 +16,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _level_cases import level_function
 
 import gpmsa
 from gpmsa.calibration.observations import fixed_gp, reduce, theta_levels
@@ -27,10 +28,6 @@ N_K = 100
 """Grid nodes over unit k."""
 
 
-def _f(x, t):
-    return np.sin(3 * x[:, 0]) + t[:, 0] + 0.5 * t[:, 1]
-
-
 def _sim(rng, m=60, k_range=None):
     x = rng.random((m, 1))
     t = np.column_stack([rng.random(m), np.arange(m) % 3])
@@ -38,7 +35,7 @@ def _sim(rng, m=60, k_range=None):
         lo, hi = k_range
         t[:, 0] = lo + (hi - lo) * t[:, 0]
         t[:2, 0] = lo, hi
-    return gpmsa.SimData(x, t, _f(x, t), x_names=["s"], t_names=["k", "kind"],
+    return gpmsa.SimData(x, t, level_function(x, t), x_names=["s"], t_names=["k", "kind"],
                          t_categorical=["kind"])  # fmt: skip
 
 
@@ -48,9 +45,13 @@ def case():
     sim = _sim(rng)
     emu = gpmsa.fit(sim, n_iter=600, seed=0)
     xa = np.linspace(0.1, 0.9, 6)[:, None]
-    ya = _f(xa, np.column_stack([np.full(6, 0.4), np.full(6, 1)])) + rng.normal(0, 0.05, 6)
+    ya = level_function(xa, np.column_stack([np.full(6, 0.4), np.full(6, 1)])) + rng.normal(
+        0, 0.05, 6
+    )
     xb = np.linspace(0.15, 0.85, 5)[:, None]
-    yb = _f(xb, np.column_stack([np.full(5, 0.4), np.full(5, 1)])) + rng.normal(0, 0.05, 5)
+    yb = level_function(xb, np.column_stack([np.full(5, 0.4), np.full(5, 1)])) + rng.normal(
+        0, 0.05, 5
+    )
     k = sim.t[:, 0]
     sim2 = _sim(np.random.default_rng(7), k_range=(k.min(), k.max()))
     emu2 = gpmsa.Emulator.from_params(sim2, {k: emu.params[k] for k in EMULATOR_PARAMS})
@@ -180,7 +181,7 @@ def test_an_even_number_of_levels_starts_at_a_level(case):
     sim, emu, _, _, a, b = case
     t = sim.t.copy()
     t[:, 1] = np.arange(t.shape[0]) % 2
-    two = gpmsa.SimData(sim.x, t, _f(sim.x, t), x_names=["s"], t_names=["k", "kind"],
+    two = gpmsa.SimData(sim.x, t, level_function(sim.x, t), x_names=["s"], t_names=["k", "kind"],
                         t_categorical=["kind"])  # fmt: skip
     emu2 = gpmsa.Emulator.from_params(two, {k: emu.params[k] for k in EMULATOR_PARAMS})
     study = gpmsa.calibrate_study(

@@ -12,6 +12,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _level_cases import level_case
 
 import gpmsa
 from gpmsa.calibration.calibrate import calibration_problem
@@ -23,22 +24,9 @@ torch = pytest.importorskip("torch")
 tb = pytest.importorskip("gpmsa.backends.torch_backend")
 
 
-def _f(x, t):
-    return np.sin(3 * x[:, 0]) + t[:, 0] + 0.5 * t[:, 1]
-
-
 @pytest.fixture(scope="module")
 def case():
-    rng = np.random.default_rng(2)
-    m = 60
-    x = rng.random((m, 1))
-    t = np.column_stack([rng.random(m), np.arange(m) % 3])
-    sim = gpmsa.SimData(x, t, _f(x, t), x_names=["s"], t_names=["k", "kind"],
-                        t_categorical=["kind"])  # fmt: skip
-    emu = gpmsa.fit(sim, n_iter=600, seed=0)
-    xo = np.linspace(0.1, 0.9, 6)[:, None]
-    yo = _f(xo, np.column_stack([np.full(6, 0.4), np.full(6, 1)])) + rng.normal(0, 0.05, 6)
-    return sim, emu, xo, yo
+    return level_case()
 
 
 def _p_kind0(draws: np.ndarray) -> float:
