@@ -862,8 +862,11 @@ def _unbroken(
     """Whether `stream_breaks` finds nothing (True: every value finite, no |speed| beyond
     ``MAX_SPEED_MPS``, every step from ``t_prev`` on within [0.5, 1.5] periods ``dt``), in a
     few whole-array reductions; False where it may find something. A finite sum has finite
-    terms (a sum of finite values that overflows reads False: `stream_breaks` then looks)."""
-    if t.size == 0:
+    terms (a sum of finite values that overflows reads False: `stream_breaks` then looks).
+    Stamps other than float64 (the BCR's) read False: their steps, taken in their own dtype,
+    may wrap around (integers) or round into the band (float32), where `stream_breaks`'s,
+    taken in float64, do not."""
+    if t.size == 0 or t.dtype.char != "d":
         return False
     with np.errstate(over="ignore", invalid="ignore"):  # (`stream_breaks` names what is wrong)
         total = t.sum() + position.sum() + accel.sum() + speed.sum()
