@@ -52,7 +52,7 @@ from gpmsa.calibration.posterior import Posterior
 from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
 from gpmsa.errors import GPMSAError, ReductionWarning
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import tuning
+from gpmsa.mcmc import tempering, tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
@@ -133,6 +133,8 @@ def calibration_problem(
         frozenset(EMULATOR_PARAMS), obs, getattr(emulator, "categorical_mask", None),
         getattr(emulator, "mean_basis", None), con,
     )  # fmt: skip
+    if theta0 is None and problem.theta_levels is not None:  # a categorical theta starts at a
+        problem = problem.with_init({"theta": problem.snap_theta(init["theta"])})  # level
     return problem if not fixed else problem.with_fixed(fixed)
 
 
@@ -370,7 +372,8 @@ def calibrate(
             f"calibrate: options {sorted(options)} go to a backend's sampler, which the fast "
             "numpy sampler replaces; pass fast=False (or another backend) to use them"
         )
-    _check_calibrate_memory(emulator, n_samples, n_chains, fast)
+    temps = tempering.ladder(options.get("temperatures")) if backend == "numpy" else None
+    _check_calibrate_memory(emulator, n_samples, n_chains, fast, 1 if temps is None else len(temps))
     _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}
     held = calibration_fixed(emulator, fixed, discrepancy)
@@ -478,17 +481,22 @@ def observation_fit(emulator, data, sets) -> Fit:
     return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
 
 
-def _check_calibrate_memory(emulator, n_samples: int, n_chains: int, fast: bool) -> None:
-    """Refuse before sampling a run whose stored sweeps exceed gpmsa.limits.MAX_MEMORY_BYTES."""
+def _check_calibrate_memory(
+    emulator, n_samples: int, n_chains: int, fast: bool, copies: int = 1
+) -> None:
+    """Refuse before sampling a run whose stored sweeps exceed gpmsa.limits.MAX_MEMORY_BYTES;
+    with parallel tempering (``copies`` > 1 temperatures, the numpy backend) its ``copies``
+    likelihood states too, as ``gpmsa.fit`` counts them (``_check_fit_memory(copies=)``)."""
     p, q, p_u = emulator.x_unit.shape[1], emulator.t_unit.shape[1], emulator.K.shape[1]
     if fast:  # a tuple of q + 3 Python floats per sweep, then an array
         per_sweep = 64.0 + 56.0 * (q + 3)
     else:  # every parameter (the fixed emulator ones too) per sweep, stacked over chains
         per_sweep = 16.0 * (q + 4 + (p + q) * p_u + 2 * p_u + 1 + p)
-    check_memory(
-        per_sweep * n_samples * n_chains,
-        f"calibrate(n_samples={n_samples}, n_chains={n_chains})",
-    )
+    nbytes, what = per_sweep * n_samples * n_chains, ""
+    if copies > 1:  # one likelihood state per temperature, each O((p + q + 4 p_u) m^2)
+        nbytes += copies * 8.0 * emulator.x_unit.shape[0] ** 2 * (p + q + 4 * p_u + 2)
+        what = f" at {copies} temperatures"
+    check_memory(nbytes, f"calibrate(n_samples={n_samples}, n_chains={n_chains}){what}")
 
 
 def _fast_chain(
@@ -645,6 +653,10 @@ def _run_backend(
         "accept_rate": {k: np.asarray(v).tolist() for k, v in chains.accept_rate.items()},
         "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
     }
+    if "temperatures" in chains.info:  # parallel tempering: as fit's settings record it
+        info.update(temperatures=list(chains.info["temperatures"]),
+                    swap_every=int(chains.info["swap_every"]),
+                    swap_rate=np.asarray(chains.info["swap_rate"]).tolist())  # fmt: skip
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
         info.update({"discrepancy": discrepancy_kind(discrepancy),
                      **discrepancy_record(problem.obs)})  # fmt: skip

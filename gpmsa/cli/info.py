@@ -89,6 +89,33 @@ def _basis_line(settings: dict, emulator) -> str:
     return f"{source}, {emulator.K.shape[1]} vector(s){share}"
 
 
+def _separable_text(emulator) -> str:
+    """A separable design's factors (``Emulator.separable``, validated), in words."""
+    sep, names = emulator.separable, emulator.x_names + emulator.t_names
+    factors = " x ".join(
+        f"[{', '.join(safe(names[k], 60) for k in g)}] ({n} points)"
+        for g, n in zip(sep.groups, sep.sizes, strict=True)
+    )
+    return f"{factors}, the first varying slowest (SimData(separable=); arrays/kron_factor)"
+
+
+def _tempering_text(settings: dict) -> str:
+    """Parallel tempering's records (settings "temperatures", "swap_every", "swap_rate"; not
+    checked by the reader: any JSON printed as it is), in words."""
+    temps, rates = settings.get("temperatures"), settings.get("swap_rate")
+    if isinstance(temps, list):
+        ladder = f"{len(temps)} temperatures [{', '.join(number(t, '.6g') for t in temps)}]"
+    else:
+        ladder = f"temperatures {value(temps)}"
+    if isinstance(rates, list) and all(isinstance(r, list) for r in rates):
+        rate_text = "; ".join(", ".join(number(v, ".3f") for v in r) for r in rates)
+        rate_text = f"[{rate_text}] (per chain; per neighbour pair, over the draws)"
+    else:
+        rate_text = value(rates)
+    return safe(f"{ladder}, a swap round every {plain(settings.get('swap_every'))} sweep(s); "
+                f"swap rates {rate_text}", 600)  # fmt: skip
+
+
 def _given_scale(std) -> str:
     """The output standardisation of a Standardizer with a given y_mean or y_sd, in words."""
     each = std.columnwise  # an sd per output element (given, or y_scale="columnwise")
@@ -133,6 +160,8 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
                 rng += " (range given, design inside)"
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
         lines.append(f"{label + ':':17s}{', '.join(parts) or 'none'}")
+    if emulator.separable is not None:  # SimData(separable=): file array kron_factor
+        lines.append(f"separable:       {_separable_text(emulator)}")
     cat = model.get("categorical") or {}
     if cat:
         lines.append("categorical:     " + ", ".join(
@@ -155,6 +184,8 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))
+    if "temperatures" in s:  # parallel tempering (fit(..., temperatures=)): lists, not above
+        lines.append(f"tempering:       {_tempering_text(s)}")
     if s.get("discrepancy") is not None:
         groups = s.get("discrepancy_groups")
         lines.append(f"discrepancy:     {plain(s['discrepancy'])}{_bases_text(manifest)}, "

@@ -24,6 +24,7 @@ import re
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.model import kronecker
 from gpmsa.model.basis import ORTHOGONAL_TOL, basis_digest
 from gpmsa.model.data import as_float, column_scales, output_scale
 from gpmsa.model.fixed_elements import label
@@ -731,6 +732,26 @@ def check_categorical(manifest: dict, arrays: dict[str, np.ndarray], dims: dict[
             )
 
 
+def check_kron_design(manifest: dict, arrays: dict[str, np.ndarray]) -> None:
+    """A separable declaration (``KRON_ARRAY``, `kron_groups`) matches the unit design: its
+    factors' product in C order (``kronecker.structure``), and no mean basis (the separable
+    likelihood has none); EmulatorFileError naming the array otherwise."""
+    groups = kron_groups(arrays)
+    if groups is None:
+        return
+    field = f"arrays/{KRON_ARRAY}"
+    if manifest["model"].get("mean_basis") is not None:  # check_fields checked it
+        raise _fail(field, "a separable design declared with a mean basis "
+                    f"(model.mean_basis {_short(manifest['model']['mean_basis'])}): a separable "
+                    "fit has the zero-mean GP only")  # fmt: skip
+    names = tuple(manifest["names"]["x"]) + tuple(manifest["names"]["t"])
+    try:
+        kronecker.structure(np.hstack([arrays["x_unit"], arrays["t_unit"]]), groups, names)
+    except GPMSAError as exc:
+        codes = np.asarray(arrays[KRON_ARRAY]).reshape(-1).tolist()
+        raise _fail(field, f"{_short(codes)} does not match the design: {exc}") from None
+
+
 def check_manifest(manifest: dict) -> None:
     """The declared content of a file, before its arrays are decompressed (``read_raw``'s
     ``check``): the shapes the manifest lists and every other field."""
@@ -924,4 +945,5 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     check_discrepancy_bases(manifest["settings"], arrays)
     check_fixed_draws(held, arrays)
     check_categorical(manifest, arrays, dims)
+    check_kron_design(manifest, arrays)
     return dims

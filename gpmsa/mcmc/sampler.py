@@ -497,8 +497,9 @@ def run_chain(
         if tune and els:
             bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases
             names = [n for n, _ in els]
+            state.learn_level_shifts()  # the widths tuned with the level moves (categorical)
             w = tuning.tune_widths(state.sweep, names, w, tune_rounds, tune_levels, bar.update)
-        state.learn_level_shifts()  # frozen before the draws (a categorical theta only)
+        state.learn_level_shifts()  # found anew, frozen before the draws (a categorical theta)
         bar.set_description(f"{desc}: sampling")
         draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
         log_post = np.empty(n_iter)
