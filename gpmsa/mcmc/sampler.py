@@ -606,16 +606,16 @@ def sample(
     tempering (``gpmsa.mcmc.tempering``; None: off, GPM/SA's sampler bit for bit): an integer
     n (the ladder 2**k, k = 0 .. n - 1) or a ladder from 1; each chain runs a copy per
     temperature (each tuned at its temperature), neighbours propose a swap every
-    ``swap_every`` sweeps, and the T = 1 copy's draws are kept; ``info`` records
-    "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1), each neighbour pair's
-    swap acceptance over the draws. Raises ChainError naming a chain that failed or whose
+    ``swap_every`` sweeps (at most ``n_iter``), and the T = 1 copy's draws are kept; ``info``
+    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1), each neighbour
+    pair's swap acceptance over the draws. Raises ChainError naming a chain that failed or whose
     draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
     temps = tempering.ladder(temperatures)
-    swap_every = tempering.check_swap_every(swap_every, temps)
+    swap_every = tempering.check_swap_every(swap_every, temps, int(n_iter))
     check_draws_memory(problem, int(n_iter), int(n_chains))
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     seq = np.random.SeedSequence(seed)

@@ -76,12 +76,19 @@ def ladder(temperatures) -> tuple[float, ...] | None:
     return tuple(float(v) for v in arr)
 
 
-def check_swap_every(swap_every, temperatures) -> int:
-    """``swap_every`` as an int in [1, ``MAX_SWAP_EVERY``]; GPMSAError for another value, or
-    for a value other than 1 without ``temperatures`` (there is nothing to swap)."""
+def check_swap_every(swap_every, temperatures, n_iter: int | None = None) -> int:
+    """``swap_every`` as an int in [1, ``MAX_SWAP_EVERY``]; GPMSAError for another value, for
+    a value other than 1 without ``temperatures`` (there is nothing to swap), or for one above
+    ``n_iter`` with them (no swap round among the draws: its swap rate would read 0)."""
     n = check_count(swap_every, "swap_every", 1, MAX_SWAP_EVERY)
     if temperatures is None and n != 1:
         raise GPMSAError(f"swap_every={n} needs temperatures= (parallel tempering)")
+    if temperatures is not None and n_iter is not None and n > n_iter:
+        raise GPMSAError(
+            f"swap_every={n} exceeds n_iter={n_iter}: no swap round would run among the draws "
+            "(the copies would never exchange states, and the swap rates would read 0); give "
+            "swap_every <= n_iter"
+        )
     return n
 
 
