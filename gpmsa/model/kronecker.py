@@ -15,6 +15,7 @@ of O(m^3) (``nug`` = 1 / (lam_sim lamWOs) + 1 / lamWs). The design is still stor
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from functools import reduce
@@ -108,7 +109,8 @@ def _column(value, names: tuple[str, ...]) -> int:
 
 def structure(zt: np.ndarray, groups, names: tuple[str, ...]) -> Separable:
     """The ``Separable`` of design ``zt`` (m, p + q) with factor column ``groups`` (slowest
-    first); GPMSAError naming the first run that breaks the product or its order."""
+    first); GPMSAError naming the first run that breaks the product or its order, and the
+    factors' order where the runs are the product in another one."""
     m = zt.shape[0]
     sizes = tuple(int(np.unique(zt[:, list(g)], axis=0).shape[0]) for g in groups)
     label = [f"[{', '.join(names[k] for k in g)}]" for g in groups]
@@ -117,22 +119,61 @@ def structure(zt: np.ndarray, groups, names: tuple[str, ...]) -> Separable:
             f"separable: the design is not the product of its factors: "
             f"{' x '.join(f'{n} {lb}' for n, lb in zip(sizes, label, strict=True))} distinct "
             f"points make {math.prod(sizes)}, but there are {m} runs"
+            + _rounding_hint(zt, groups, sizes, label)
         )
     sep = Separable(tuple(tuple(g) for g in groups), sizes)
-    stride = m
-    for k, (cols, F) in enumerate(zip(groups, sep.factor_designs(zt), strict=True)):
-        stride //= sizes[k]
-        expected = np.tile(np.repeat(F, stride, axis=0), (m // (sizes[k] * stride), 1))
+    broken = _order_break(zt, sep)
+    if broken is not None:
+        k, i, expected = broken
+        cols = list(groups[k])
+        hint = ""
+        for order in itertools.islice(itertools.permutations(range(len(groups))), 1, 720):
+            if _order_break(zt, Separable(tuple(sep.groups[j] for j in order),
+                                          tuple(sizes[j] for j in order))) is None:  # fmt: skip
+                named = [[names[c] for c in sep.groups[j]] for j in order]
+                hint = (
+                    f"; these runs are that product with the factors in the order "
+                    f"{' x '.join(label[j] for j in order)}: give separable={named}"
+                )
+                break
+        raise GPMSAError(
+            f"separable: run {i} has {label[k]} = {zt[i, cols].tolist()}, but the "
+            f"Kronecker order gives {expected.tolist()}: the runs must be the product "
+            f"of the factors {' x '.join(label)} in C order (the first factor varying "
+            f"slowest, the last fastest, each factor's points in one order throughout){hint}"
+        )
+    return sep
+
+
+def _rounding_hint(zt: np.ndarray, groups, sizes: tuple[int, ...], label: list[str]) -> str:
+    """A note naming the factors with distinct points that agree to 1e-9 of their column's
+    span ("" for none): a grid computed run by run whose values differ by rounding."""
+    near = []
+    for g, n, lb in zip(groups, sizes, label, strict=True):
+        z = zt[:, list(g)]
+        span = np.ptp(z, axis=0)
+        unit = np.round((z - z.min(axis=0)) / np.where(span > 0, span, 1.0), 9)
+        if np.unique(unit, axis=0).shape[0] < n:
+            near.append(lb)
+    if not near:
+        return ""
+    return (
+        f" ({', '.join(near)}: points that agree to 1e-9 of the range count as distinct; give "
+        "each factor's points as the same numbers in every run)"
+    )
+
+
+def _order_break(zt: np.ndarray, sep: Separable) -> tuple[int, int, np.ndarray] | None:
+    """None where the rows of ``zt`` are ``sep``'s factors in Kronecker order, else (the
+    factor, the first run that breaks it, what that run should hold)."""
+    m, stride = zt.shape[0], zt.shape[0]
+    for k, (cols, F) in enumerate(zip(sep.groups, sep.factor_designs(zt), strict=True)):
+        stride //= sep.sizes[k]
+        expected = np.tile(np.repeat(F, stride, axis=0), (m // (sep.sizes[k] * stride), 1))
         bad = np.flatnonzero(np.any(zt[:, list(cols)] != expected, axis=1))
         if bad.size:
-            i = int(bad[0])
-            raise GPMSAError(
-                f"separable: run {i} has {label[k]} = {zt[i, list(cols)].tolist()}, but the "
-                f"Kronecker order gives {expected[i].tolist()}: the runs must be the product "
-                f"of the factors {' x '.join(label)} in C order (the first factor varying "
-                f"slowest, the last fastest, each factor's points in one order throughout)"
-            )
-    return sep
+            return k, int(bad[0]), expected[int(bad[0])]
+    return None
 
 
 def refuse(what: str) -> None:
