@@ -1066,6 +1066,8 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     if not in_process:
         total -= n_iter  # the groups' sweeps: counted by run_chains' bar over the groups
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
+        if tune:  # the widths tuned with the level moves (a categorical theta; no draws used)
+            state.learn_level_shifts()
         for _stage in range(n_stages):
             bar.set_description("torch MCMC: warm-up and tuning" if tune else "torch MCMC: warm-up")
             for _ in range(warmup):  # leave the starts (then the last widths' region) first
@@ -1080,7 +1082,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                     acc[lev] += state.sweep(cands[lev], False, gen).sum(-1)
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
-        state.learn_level_shifts()  # frozen before the draws (a categorical theta only)
+        state.learn_level_shifts()  # found anew, frozen before the draws (a categorical theta)
         if in_process:
             bar.set_description("torch MCMC: sampling")
             draws, log_post, accepted = _sweeps(state, w, n_iter, prop_mh, gen, bar)

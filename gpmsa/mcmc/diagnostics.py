@@ -211,8 +211,8 @@ def warn_unconverged(
             f" R-hat {shown} ({el}) says the chains lie apart, not merely that they are short: "
             "if longer chains do not bring them together, the posterior may have several "
             "modes that no chain crosses (compare the chains: to_arviz(), "
-            "gpmsa.plots.traces; the numpy sampler's temperatures= option, parallel "
-            "tempering, moves between modes)."
+            "gpmsa.plots.traces; parallel tempering moves between modes: the numpy "
+            "sampler's temperatures= option of gpmsa.fit and calibrate(fast=False))."
         )
     warnings.warn(
         f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "

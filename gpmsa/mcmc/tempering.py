@@ -164,11 +164,14 @@ def run_tempered_chain(
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
     with threadpool_limits(1):
         if tune and els:
+            cold.learn_level_shifts()  # the widths tuned with the level moves (categorical)
+            for state in states[1:]:
+                state.level_shifts = cold.level_shifts
             bar.set_description(f"{desc}: tuning step widths ({n_temps} temperatures)")
             names = [n for n, _ in els]
             w = tune_ladder(states, betas, rng, names, w[0], tune_rounds, tune_levels, swaps,
                             bar.update)  # fmt: skip
-        cold.learn_level_shifts()  # at T = 1, shared: any shifts keep the move exact
+        cold.learn_level_shifts()  # anew at T = 1, shared: any shifts keep the move exact
         for state in states[1:]:
             state.level_shifts = cold.level_shifts
         bar.set_description(f"{desc}: sampling ({n_temps} temperatures)")
