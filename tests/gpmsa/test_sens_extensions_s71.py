@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+from _sens_cases import categorical_emulator  # noqa: E402
 
 import gpmsa  # noqa: E402
 from gpmsa import GPMSAError  # noqa: E402
@@ -26,25 +27,9 @@ from gpmsa import GPMSAError  # noqa: E402
 NAMES = ("x", "kind", "a")
 
 
-def _emulator(mean_basis):
-    """3 inputs (x continuous, kind categorical with levels 0, 1, 3, a continuous), a
-    functional output of 4 elements and 3 components, at fixed parameters."""
-    rng = np.random.default_rng(5)
-    m, s = 45, np.linspace(0, 1, 4)
-    x = np.column_stack([rng.uniform(0, 2, m), rng.choice([0, 1, 3], m)])
-    t = rng.uniform(-1, 1, (m, 1))
-    y = (np.sin(2 * x[:, :1]) * (1 + s) + 0.5 * np.outer(x[:, 1], s)
-         + np.outer(t[:, 0] ** 2 + 0.3 * t[:, 0] * x[:, 1], 1 - s))  # fmt: skip
-    data = gpmsa.SimData(x=x, t=t, y=y, index=s, x_names=["x", "kind"], t_names=["a"],
-                         x_categorical=["kind"])  # fmt: skip
-    params = {"betaU": np.array([[2.0, 3, 1], [1.0, 0.5, 2], [1.5, 2, 3]]), "lamUz": [1, 2, 3],
-              "lamWs": [1e4] * 3, "lamWOs": [1e4]}  # fmt: skip
-    return gpmsa.Emulator.from_params(data, params, n_pc=3, mean_basis=mean_basis)
-
-
 @pytest.fixture(scope="module", params=[None, "constant", "linear"])
 def emu(request):
-    return _emulator(request.param)
+    return categorical_emulator(request.param)
 
 
 class _Tensor:
@@ -278,7 +263,7 @@ def test_a_linear_function_with_a_linear_mean_basis_is_exact():
 
 
 def test_summary_and_figure_take_a_categorical_curve():
-    emu = _emulator("constant")
+    emu = categorical_emulator("constant")
     sens = gpmsa.sensitivity(emu, draws=False, main_effect_grid=5)
     cur = sens.main_effect_summary()["kind"]
     np.testing.assert_array_equal(cur["grid"], [0, 1, 3, np.nan, np.nan])
@@ -288,7 +273,7 @@ def test_summary_and_figure_take_a_categorical_curve():
 
 
 def test_bad_levels_and_a_callable_mean_basis_are_refused():
-    emu = _emulator(None)
+    emu = categorical_emulator(None)
     cases = [
         (
             {"bounds": {"kind": (0, 2)}},

@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+from _sens_cases import categorical_emulator  # noqa: E402
 
 import gpmsa  # noqa: E402
 from gpmsa import GPMSAError  # noqa: E402
@@ -43,21 +44,6 @@ def _functional(n_t: int = 3):
     params = {"betaU": 1.0 + np.arange(3)[None, :] * np.ones((1 + n_t, 1)), "lamUz": [1, 2, 3],
               "lamWs": [1e4] * 3, "lamWOs": [1e4]}  # fmt: skip
     return gpmsa.Emulator.from_params(data, params, n_pc=3)
-
-
-def _categorical(mean_basis):
-    """x continuous, kind categorical (levels 0, 1, 3), a continuous; 4 outputs, 3 components."""
-    rng = np.random.default_rng(5)
-    m, s = 45, np.linspace(0, 1, 4)
-    x = np.column_stack([rng.uniform(0, 2, m), rng.choice([0, 1, 3], m)])
-    t = rng.uniform(-1, 1, (m, 1))
-    y = (np.sin(2 * x[:, :1]) * (1 + s) + 0.5 * np.outer(x[:, 1], s)
-         + np.outer(t[:, 0] ** 2 + 0.3 * t[:, 0] * x[:, 1], 1 - s))  # fmt: skip
-    data = gpmsa.SimData(x=x, t=t, y=y, index=s, x_names=["x", "kind"], t_names=["a"],
-                         x_categorical=["kind"])  # fmt: skip
-    params = {"betaU": np.array([[2.0, 3, 1], [1.0, 0.5, 2], [1.5, 2, 3]]), "lamUz": [1, 2, 3],
-              "lamWs": [1e4] * 3, "lamWOs": [1e4]}  # fmt: skip
-    return gpmsa.Emulator.from_params(data, params, n_pc=3, mean_basis=mean_basis)
 
 
 @pytest.fixture(scope="module")
@@ -103,7 +89,7 @@ def test_groups_identities_and_the_default_results_unchanged():
 def test_groups_with_a_categorical_input_and_a_mean_basis(basis):
     """The identities hold with a categorical input and a linear mean basis (its trend terms
     summed over the group)."""
-    sens = gpmsa.sensitivity(_categorical(basis), draws=False, pairs=[("kind", "a")],
+    sens = gpmsa.sensitivity(categorical_emulator(basis), draws=False, pairs=[("kind", "a")],
                              groups=[("a", "kind"), ("x", "a"), ("x", "kind", "a")])  # fmt: skip
     np.testing.assert_allclose(sens.group_joint[..., 0], sens.joint[..., 0], atol=1e-12)
     np.testing.assert_allclose(sens.group_joint[..., 1], 1 - sens.total[..., 1], atol=1e-10)
@@ -170,7 +156,9 @@ def test_effect_variance_is_the_integrated_posterior_covariance(case):
     integrated twice over the other inputs by a tensor rule (measured: within 2.1e-9 of the
     largest), with a categorical input, a linear mean basis and a categorical input fixed."""
     emu = (
-        _functional(2) if case == "plain" else _categorical("linear" if case == "linear" else None)
+        _functional(2)
+        if case == "plain"
+        else categorical_emulator("linear" if case == "linear" else None)
     )
     fixed = {"kind": 1} if case == "fixed" else {}
     sens = gpmsa.sensitivity(emu, draws=False, pairs="all", main_effect_grid=3,
