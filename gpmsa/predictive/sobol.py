@@ -455,6 +455,18 @@ def _basis_at(basis, z_bar: np.ndarray, varied, cols, points):
     return basis.matrix(z)
 
 
+def _times_fixed_kernels(arr, fix_u: dict, levels_all, beta, zt) -> np.ndarray:
+    """``arr`` (p_u, m) times each fixed input's kernel between its value and the runs (per
+    component; the categorical kernel for a categorical input), one input after another."""
+    for k, u in fix_u.items():
+        if levels_all[k] is not None:
+            dist = CATEGORICAL_DISTANCE * (u != zt[None, :, k])
+            arr = arr * np.exp(-beta[k][:, None] * dist)
+        else:
+            arr = arr * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
+    return arr
+
+
 def _effect_variances(zt, beta, lam, fac, varied, I1, DD, fixf, cols, points, cat, hbar=None):
     """(p_u, N) the GP posterior variance of E[w_j(z) | z_cols = points] (the other varied
     inputs integrated over the box; unit scale, standardised; the smooth GP: no nugget) for
@@ -897,12 +909,7 @@ def sensitivity(
                 fac = factors(emulator, prm)
                 coef = np.array([alpha / prm["lamUz"][j] for j, (_, alpha) in
                                  enumerate(fac)])  # fmt: skip
-            for k, u in fix_u.items():
-                if levels_all[k] is not None:
-                    dist = CATEGORICAL_DISTANCE * (u != zt[None, :, k])
-                    coef = coef * np.exp(-beta[k][:, None] * dist)
-                else:
-                    coef = coef * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
+            coef = _times_fixed_kernels(coef, fix_u, levels_all, beta, zt)
             I1 = _single_means(zt, beta, varied, lo_u, hi_u, lev_arg)
             mu, Vall, Vmain, Vcomp, Vpair, Vgroup = _component_moments(
                 zt, coef, beta, varied, lo_u, hi_u, I1, pair_pos, lev_arg, group_pos
@@ -953,13 +960,8 @@ def sensitivity(
                                          scale_pc)  # fmt: skip
                 out_group_agg[i] = _ratio(np.einsum("jk,njk->n", KtK, Vgroup), v_sum, scale_sum)
             if effect_variance:
-                fixf = np.ones((p_u, zt.shape[0]))  # the fixed inputs' kernels, as coef's
-                for k, u in fix_u.items():
-                    if levels_all[k] is not None:
-                        dist = CATEGORICAL_DISTANCE * (u != zt[None, :, k])
-                        fixf = fixf * np.exp(-beta[k][:, None] * dist)
-                    else:
-                        fixf = fixf * np.exp(-beta[k][:, None] * (u - zt[None, :, k]) ** 2)
+                ones = np.ones((p_u, zt.shape[0]))  # the fixed inputs' kernels, as coef's
+                fixf = _times_fixed_kernels(ones, fix_u, levels_all, beta, zt)
                 DD = _double_means(beta, varied, lo_u, hi_u, lev_arg)
                 shared = (zt, beta, prm["lamUz"], fac, varied, I1, DD, fixf)
                 K2 = K * K
