@@ -271,6 +271,29 @@ class ChainState:
         """Current log posterior (likelihood + priors of the sampled parameters)."""
         return self.lik.loglik + self.log_prior
 
+    def check_start(self) -> None:
+        """GPMSAError where the state (a chain's start) gives a log posterior of NaN."""
+        if math.isnan(self.log_post()):
+            raise GPMSAError(
+                f"the starting values give a log posterior of NaN (log-likelihood "
+                f"{self.lik.loglik}); check the data and the starting values"
+            )
+
+    def flat_widths(self, widths: dict[str, np.ndarray]) -> np.ndarray:
+        """Step widths name -> array as one (len(els),) array in the sweep's element order."""
+        return np.array([float(widths[n][idx]) for n, idx in self.els])
+
+    def element_records(self, accepted: np.ndarray, widths: np.ndarray, n_iter: int):
+        """(acceptance rate, step width) name -> array from the sweep's per-element
+        ``accepted`` counts over ``n_iter`` sweeps and ``widths``; NaN where not sampled."""
+        names, shapes = self.problem.names, self.problem.init
+        rate = {n: np.full(shapes[n].shape, np.nan) for n in names}
+        wid = {n: np.full(shapes[n].shape, np.nan) for n in names}
+        for i, (n, idx) in enumerate(self.els):
+            rate[n][idx] = accepted[i] / max(n_iter, 1)
+            wid[n][idx] = widths[i]
+        return rate, wid
+
     def sweep(self, widths: np.ndarray, prop_mh: bool, accepted: np.ndarray) -> None:
         """One Metropolis-within-Gibbs sweep; adds 1 to ``accepted[i]`` per accepted element."""
         lik, beta = self.lik, self.beta
@@ -455,10 +478,6 @@ def _none_as_nan(value):
     return value
 
 
-def _flat_widths(problem: Problem, els, widths: dict[str, np.ndarray]) -> np.ndarray:
-    return np.array([float(widths[n][idx]) for n, idx in els])
-
-
 def run_chain(
     problem: Problem,
     n_iter: int,
@@ -484,13 +503,9 @@ def run_chain(
 
     state = ChainState(problem, problem.init if start is None else start, rng,
                        ridge_moves=ridge_moves)  # fmt: skip
-    if math.isnan(state.log_post()):
-        raise GPMSAError(
-            f"the starting values give a log posterior of NaN (log-likelihood "
-            f"{state.lik.loglik}); check the data and the starting values"
-        )
+    state.check_start()
     els = state.els
-    w = _flat_widths(problem, els, widths)
+    w = state.flat_widths(widths)
     total = n_iter + (tune_rounds * tune_levels if tune else 0)
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
     with threadpool_limits(1):
@@ -516,12 +531,7 @@ def run_chain(
                 bar.update(100)
         bar.update(n_iter % 100)
     bar.close()
-    rate = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
-    wid = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
-    for i, (n, idx) in enumerate(els):
-        rate[n][idx] = accepted[i] / max(n_iter, 1)
-        wid[n][idx] = w[i]
-    return draws, log_post, rate, wid
+    return draws, log_post, *state.element_records(accepted, w, n_iter)
 
 
 def _chain_task(

@@ -151,14 +151,10 @@ def run_tempered_chain(
         state.beta = beta
         states.append(state)
     cold = states[0]
-    if math.isnan(cold.log_post()):
-        raise GPMSAError(
-            f"the starting values give a log posterior of NaN (log-likelihood "
-            f"{cold.lik.loglik}); check the data and the starting values"
-        )
+    cold.check_start()
     els = cold.els
     n_temps = len(states)
-    w = [np.array([float(widths[n][idx]) for n, idx in els])] * n_temps
+    w = [cold.flat_widths(widths)] * n_temps
     swaps = np.zeros(n_temps - 1)
     total = n_temps * (n_iter + (tune_rounds * tune_levels if tune else 0))
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
@@ -194,10 +190,5 @@ def run_tempered_chain(
                 bar.update(100 * n_temps)
         bar.update((n_iter % 100) * n_temps)
     bar.close()
-    rate = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
-    wid = {n: np.full(problem.init[n].shape, np.nan) for n in problem.names}
-    for i, (n, idx) in enumerate(els):
-        rate[n][idx] = accepted[0][i] / max(n_iter, 1)
-        wid[n][idx] = w[0][i]
-    swap_rate = swaps / max(n_iter // swap_every, 1)
-    return draws, log_post, rate, wid, swap_rate
+    rate, wid = cold.element_records(accepted[0], w[0], n_iter)
+    return draws, log_post, rate, wid, swaps / max(n_iter // swap_every, 1)

@@ -270,30 +270,30 @@ class KroneckerLikelihood:
         self.groups = sep.groups
         self.designs = sep.factor_designs(problem.zt)
         self.cat = problem.categorical
-        self.factor_of = [0] * (problem.p + problem.q)
-        for k, g in enumerate(self.groups):
-            for c in g:
-                self.factor_of[c] = k
+        self.factor_of = [int(k) for k in sep.factor_of_column()]  # input column -> factor
         self.params = {k: np.array(v, dtype=np.float64) for k, v in params.items()}
         beta = self.params["betaU"]
         # per component: (eigenvalues per factor, eigenvectors per factor, lam (m,), wt (m,))
-        self.comps = [self._component(beta[:, j], None, j) for j in range(problem.p_u)]
+        self.comps = [self._component(beta[:, j], j) for j in range(problem.p_u)]
         self.llw = [self._llw(c, j, self.params) for j, c in enumerate(self.comps)]
         self.loglik = float(sum(self.llw))
         self._pending = None
 
-    def _component(self, beta: np.ndarray, old, j: int, only: int | None = None) -> tuple:
-        es, Qs = ([], []) if old is None else (list(old[0]), list(old[1]))
-        for k, (F, g) in enumerate(zip(self.designs, self.groups, strict=True)):
-            if old is None or k == only:
-                e, Q = factor_eigen(F, beta[list(g)], _part(self.cat, g))
-                if old is None:
-                    es.append(e)
-                    Qs.append(Q)
-                else:
-                    es[k], Qs[k] = e, Q
-        w = self.problem.w[:, j]
-        return es, Qs, kron_vector(es), kron_matvec([Q.T for Q in Qs], w)
+    def _eigen(self, k: int, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Factor ``k``'s eigendecomposition at one component's ``beta`` (p + q,)."""
+        g = self.groups[k]
+        return factor_eigen(self.designs[k], beta[list(g)], _part(self.cat, g))
+
+    def _component(self, beta: np.ndarray, j: int, old=None, only: int | None = None) -> tuple:
+        """Component ``j``'s (eigenvalues per factor, eigenvectors per factor, lam (m,), wt
+        (m,)) at ``beta``: every factor anew, or ``old``'s with factor ``only`` redone."""
+        if old is None:
+            eig = [self._eigen(k, beta) for k in range(len(self.groups))]
+            es, Qs = [e for e, _ in eig], [Q for _, Q in eig]
+        else:
+            es, Qs = list(old[0]), list(old[1])
+            es[only], Qs[only] = self._eigen(only, beta)
+        return es, Qs, kron_vector(es), kron_matvec([Q.T for Q in Qs], self.problem.w[:, j])
 
     def _llw(self, c: tuple, j: int, prm: dict) -> float:
         nug = 1.0 / (self.problem.lam_sim[j] * prm["lamWOs"][0]) + 1.0 / prm["lamWs"][j]
@@ -308,7 +308,7 @@ class KroneckerLikelihood:
         comps = {}
         if name == "betaU":
             k, j = idx
-            comps[j] = self._component(arr[:, j], self.comps[j], j, self.factor_of[k])
+            comps[j] = self._component(arr[:, j], j, self.comps[j], self.factor_of[k])
         llw = list(self.llw)
         js = range(len(self.comps)) if name == "lamWOs" else [idx[-1]]
         for j in js:
