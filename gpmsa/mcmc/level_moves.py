@@ -16,6 +16,7 @@ it mix.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -66,3 +67,20 @@ def shift_table(offsets: np.ndarray) -> list[list[tuple[float, ...]]]:
     n = offsets.shape[0]
     return [[tuple(float(v) for v in offsets[s] - offsets[r]) for s in range(n)]
             for r in range(n)]  # fmt: skip
+
+
+def shift(values: np.ndarray, cont: Sequence[int], steps: Sequence[float],
+          log_prior: Callable[[int, float], float]) -> float:  # fmt: skip
+    """Add ``steps`` (a row of `shift_table`) to ``values[cont]`` in place, one element after
+    another; the change of their log priors (``log_prior(k, x)``: element ``cont[k]``'s at
+    x), or -inf as soon as a shifted value lies outside its prior (``values`` then partly
+    shifted: the caller's candidate, discarded)."""
+    d_lp = 0.0
+    for k, (j, d) in enumerate(zip(cont, steps, strict=True)):
+        old = float(values[j])
+        lp_new = log_prior(k, old + d)
+        if lp_new == -math.inf:
+            return -math.inf
+        d_lp += lp_new - log_prior(k, old)
+        values[j] = old + d
+    return d_lp

@@ -243,14 +243,10 @@ class ChainState:
         lik = self.lik
         theta = lik.params["theta"].copy()
         theta[self.els[i][1][0]] = level
-        d_lp = 0.0
-        for k, d, prior in zip(cont, table[rows[x]][rows[level]], priors, strict=True):
-            old = float(theta[k])
-            lp_new = prior(old + d)
-            if lp_new == -math.inf:
-                return
-            d_lp += lp_new - prior(old)
-            theta[k] = old + d
+        d_lp = level_moves.shift(theta, cont, table[rows[x]][rows[level]],
+                                 lambda k, v: priors[k](v))  # fmt: skip
+        if d_lp == -math.inf:
+            return
         if self.constraint is not None and not self.constraint(theta):
             return
         ll_old = lik.loglik

@@ -304,13 +304,10 @@ class StudyState:
         d_lp = 0.0
         if e in self.shifts:
             rows, table, cont = self.shifts[e]
-            for j, d in zip(cont, table[rows[x]][rows[new]], strict=True):
-                old = float(cand[j])
-                lp_new = self._theta_lp(j, old + d)
-                if lp_new == -math.inf:
-                    return
-                d_lp += lp_new - self._theta_lp(j, old)
-                cand[j] = old + d
+            d_lp = level_moves.shift(cand, cont, table[rows[x]][rows[new]],
+                                     lambda k, v: self._theta_lp(cont[k], v))  # fmt: skip
+            if d_lp == -math.inf:
+                return
         touched = self.touched[e]
         dll = 0.0
         for i in touched:
