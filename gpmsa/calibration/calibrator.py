@@ -15,6 +15,13 @@ by a fraction of a percent on a grid that resolves the posterior) (``gpmsa.calib
 interpolation, constraint boundaries, draws, refinement).
 More parameters use the MCMC of ``gpmsa.calibrate``.
 
+A categorical calibration parameter (``theta_levels``): its grid axis is its levels, exactly
+(a continuous parameter beside it on ``n_grid`` nodes per level, default 129); its marginal a
+``LevelMarginal`` (a probability per level: the posterior integrated over the continuous
+nodes at that level), whose quantiles and draws are levels; such a grid is not refined (a
+warning where a level's continuous density is unresolved) and takes no constraint with a
+continuous parameter ("auto" chooses MCMC there: ``gpmsa.calibrate``'s joint level move).
+
 The fixed grid (``Calibrator.theta_grid``): ``n_grid`` equally spaced nodes per calibration
 parameter spanning the emulator's domain [t_min, t_max] of that parameter (the design's range,
 or the range given as ``SimData(t_range=)``), end points included (default 129 for one
@@ -69,14 +76,16 @@ from gpmsa.calibration.observations import (
     check_emulator,
     emulator_param_sets,
     emulator_record,
+    fit_at_levels,
     fit_of,
     fixed_gp,
     probe_layout,
     reduce,
+    theta_levels,
     theta_probe,
     warn_if_outside,
 )
-from gpmsa.calibration.posterior import Posterior, trapezoid_weights
+from gpmsa.calibration.posterior import LevelMarginal, Posterior, trapezoid_weights
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
@@ -92,6 +101,9 @@ narrows the spacing about 64-fold per pass, from 1/128 of the range to float64's
 MIN_STEP_ULPS = 8
 """One parameter: refined nodes are at least this many float64 spacings (ulps) apart, in the
 unit scale and in the parameter's native units (``Calibrator._min_step``)."""
+LEVEL_MASS = 0.01
+"""A categorical theta's grid: the levels whose conditional resolution is checked hold at least
+this share of the mass."""
 BISECT_STEPS = 64
 """Bisection steps locating a constraint's boundary between two nodes (to adjacent floats)."""
 PRIOR_BISECT_LEVELS = 4
@@ -146,8 +158,11 @@ class Calibrator:
 
     Args:
         emulator: a gpmsa.Emulator (no discrepancy model is used).
-        method: "grid" (exact, q <= 2), "mcmc" (``gpmsa.calibrate``), or "auto" (grid for q <= 2).
-        n_grid: nodes per calibration parameter of the fixed grid (default 129 for q = 1, 65 for 2).
+        method: "grid" (exact, q <= 2), "mcmc" (``gpmsa.calibrate``), or "auto" (grid for q <= 2;
+            MCMC for a categorical and a continuous parameter with a ``constraint``).
+        n_grid: nodes per calibration parameter of the fixed grid (default 129 for q = 1, 65 for
+            2; a categorical parameter's nodes are its levels, and the continuous one beside it
+            has n_grid per level, default 129).
         emulator_params: "point" (the emulator's point estimate) or "draws" (average the
             likelihood over up to ``n_emulator_draws`` of its retained draws, evenly spaced).
         extrapolate: allow x_obs outside the emulator's x domain (with a warning).
@@ -193,7 +208,8 @@ class Calibrator:
         backend: str | None = None,
         constraint=None,
     ) -> None:
-        check_emulator(emulator)
+        check_emulator(emulator, categorical_theta=True)
+        levels = theta_levels(emulator)  # unit scale per element, None: no categorical one
         std = emulator.standardizer
         self.constraint = constraints.make(constraint, std.t_min, std.t_max,
                                            tuple(emulator.t_names))  # fmt: skip
@@ -201,6 +217,8 @@ class Calibrator:
             raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
         backend = _mcmc_backend(backend, mcmc_options)
         backends.get(backend)  # unknown or not installed: a clear error now, not at update()
+        if levels is not None and backend not in ("numpy", "torch"):
+            check_emulator(emulator)  # as calibrate: their samplers have the joint level move
         if backend != "numpy" and method == "grid":
             raise GPMSAError(
                 "method='grid' runs on numpy; use method='mcmc' (or 'auto') with "
@@ -213,8 +231,18 @@ class Calibrator:
         q = emulator.t_unit.shape[1]
         if method == "grid" and q > 2:
             raise GPMSAError(f"method='grid' handles 1 or 2 calibration parameters, got q={q}")
+        # a categorical theta with a continuous one: the grid has no constraint cut along the
+        # continuous axis per level (it would ramp across the boundary's cell), so MCMC
+        mixed = levels is not None and None in levels
+        if method == "grid" and mixed and constraint is not None:
+            raise GPMSAError(
+                "method='grid' with a categorical and a continuous calibration parameter takes "
+                "no constraint (its boundary would not be located between nodes): use "
+                "method='mcmc' (or 'auto', which chooses it)"
+            )
         self.emulator = emulator
-        grid_ok = q <= 2 and backend == "numpy"
+        self._levels = levels
+        grid_ok = q <= 2 and backend == "numpy" and not (mixed and constraint is not None)
         self.method = ("grid" if grid_ok else "mcmc") if method == "auto" else method
         self.backend = backend
         self.q = q
@@ -239,15 +267,19 @@ class Calibrator:
                 "would ignore it: use Calibrator(emu, method='mcmc', mcmc_options={'fixed': "
                 "...}), or gpmsa.calibrate(..., fixed=...)"
             )
-        if n_grid is None:
-            n_grid = 129 if q == 1 else 65
+        if n_grid is None:  # a categorical parameter with a continuous one: 129 per level
+            n_grid = 129 if q == 1 or mixed else 65
         self.n_grid = check_count(n_grid, "n_grid", 3)
         if self.method == "mcmc":
             return
         m, p_u = emulator.x_unit.shape[0], emulator.K.shape[1]
         kept = emulator.n_draws if emulator.draws else 0  # at most these draws are used
         n_sets = 1 if emulator_params == "point" else min(self._n_emulator_draws, max(kept, 1))
-        G = self.n_grid**q
+        # the axes: a categorical parameter's nodes are its levels (exact: no interpolation
+        # between levels), a continuous one's n_grid equally spaced nodes
+        self._axes = [np.linspace(0.0, 1.0, self.n_grid) if lv is None else np.array(lv)
+                      for lv in (levels or [None] * q)]  # fmt: skip
+        G = int(np.prod([a.size for a in self._axes]))
         # per parameter set: R_t on the grid and its product with alpha (G x m per component)
         # and Sigma_W's factor; once the Chebyshev degrees are known, `_check_predictor_memory`
         # adds the predictors' products H and the prepared refinement
@@ -255,10 +287,16 @@ class Calibrator:
         what = (f"Calibrator(n_grid={self.n_grid}): {G} grid nodes x {m} runs x {p_u} "
                 f"components x {n_sets} emulator parameter set(s)")  # fmt: skip
         check_memory(n_sets * per_set + 8.0 * 8 * G, what)
-        self._axes = [np.linspace(0.0, 1.0, self.n_grid)] * q
         self._theta_unit = mesh(self._axes)
         std = emulator.standardizer
         self.theta_grid = std.t_from_unit(self._theta_unit)
+        if levels is not None:  # a categorical element's nodes: exactly its level codes
+            self._codes = _level_codes(emulator)
+            exact = mesh([a if c is None else c for a, c in zip(self._axes, self._codes,
+                                                                  strict=True)])  # fmt: skip
+            for k, c in enumerate(self._codes):
+                if c is not None:
+                    self.theta_grid[:, k] = exact[:, k]
         if q == 1:
             self.theta_grid = self.theta_grid[:, 0]
         with blas_controller().limit(limits=1, user_api="blas"):
@@ -274,19 +312,26 @@ class Calibrator:
         self._log_prior_theta = -0.5 * np.sum(
             ((self._theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1
         )
+        if levels is not None:  # a categorical element: uniform over its levels (calibrate's)
+            cont = [lv is None for lv in levels]
+            self._log_prior_theta = -0.5 * np.sum(
+                ((self._theta_unit[:, cont] - pri.theta_mean) / pri.theta_sd) ** 2, axis=1
+            )
         self._weights = trapezoid_weights(self.theta_grid) if q == 1 else None
         self._log_prior_norm = log_theta_norm(pri.theta_mean, pri.theta_sd)
         lo, hi = float(std.t_min[0]), float(std.t_max[0])  # one parameter: float64's resolution
         self._min_step = MIN_STEP_ULPS * max(np.spacing(1.0), np.spacing(max(abs(lo), abs(hi)))
                                              / (hi - lo))  # fmt: skip
         self._base_ok = None if self.constraint is None else self._allowed(self._theta_unit)
-        self._base_cut = None if self._base_ok is None else self._cut(self._axes, self._base_ok)
+        self._base_cut = None
+        if self._base_ok is not None and levels is None:  # all categorical: exact at the nodes
+            self._base_cut = self._cut(self._axes, self._base_ok)
 
     def _refined_axis(self, plans: list) -> np.ndarray | None:
         """One parameter whose predictors need no solves per update (a Chebyshev plan for every
         parameter set): the unit-scale axis of the usual refinement (`grid.whole_refined_axis`),
         for which `_refined_predictors` prepares predictors; None otherwise."""
-        if self.q != 1 or any(plan is None for plan in plans):
+        if self.q != 1 or self._levels is not None or any(plan is None for plan in plans):
             return None
         return whole_refined_axis(self._axes[0])
 
@@ -305,6 +350,7 @@ class Calibrator:
         """Unpickling: one pickled before the prepared refinement (session 65; a saved BCR
         holds one) prepares it now, as a Calibrator built now does."""
         self.__dict__.update(state)
+        self.__dict__.setdefault("_levels", None)  # pickled before categorical grids (s73)
         if "_refined" not in state and self.method == "grid":
             with blas_controller().limit(limits=1, user_api="blas"):
                 plans = [chebyshev_plan(gp) for gp in self._gps]
@@ -348,7 +394,9 @@ class Calibrator:
                 mean, cov = self._refined[1][k].predict(data.x)
             else:
                 mean, cov = gp.predict(data.x, theta_unit)
-            if fits is not None and theta_unit is None and self.n_grid < probe_layout(self.q)[0]:
+            if fits is not None and self._levels is not None:  # (fixed grid only)
+                fits.append(self._level_fit(gp, mean, cov, data))
+            elif fits is not None and theta_unit is None and self.n_grid < probe_layout(self.q)[0]:
                 probe = gp.predict(data.x, theta_probe(self.q))
                 fits.append(fit_of(*probe, data, probe_layout(self.q)))
             elif fits is not None:  # on the fixed grid (fits are kept only there)
@@ -365,6 +413,24 @@ class Calibrator:
                 )  # fmt: skip
             )
         return out
+
+    def _level_fit(self, gp, mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
+        """``Fit`` of the observation for a categorical theta from the fixed grid's predictive
+        ``mean``, ``cov`` (emulator parameter set ``gp``): the continuous nodes of each level
+        apart (a datum is met where its residual changes sign between neighbouring nodes of
+        one level, never between levels), the nearest over the levels; with fewer continuous
+        nodes than `theta_probe`'s, calibrate's probe (`fit_at_levels`)."""
+        cont = [k for k, lv in enumerate(self._levels) if lv is None]
+        if not cont:  # the nodes are the combinations of levels
+            return fit_of(mean, cov, data, None)
+        if self.n_grid < probe_layout(1)[0]:
+            fit = fit_at_levels(gp.predict, data, self._levels)
+            if fit is not None:
+                return fit
+        shape = tuple(a.size for a in self._axes)
+        rows = np.moveaxis(np.arange(mean.shape[0]).reshape(shape), cont[0], -1)
+        fits = [fit_of(mean[r], cov[r], data, (r.size,)) for r in rows]
+        return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
 
     @staticmethod
     def _combine(marginals: list[LamOsMarginal]) -> np.ndarray:
@@ -421,6 +487,8 @@ class Calibrator:
             vals = as_float(prior, "prior")
             G, n = self._theta_unit.shape[0], self.n_grid
             shapes = [(G,)] + ([(n, n)] if self.q == 2 else [])  # (n, n): [first, second]
+            if self._levels is not None and self.q == 2:  # rows: the first's nodes
+                shapes = [(G,), tuple(a.size for a in self._axes)]
             if vals.shape not in shapes:
                 raise GPMSAError(
                     f"prior must be log densities on the Calibrator's grid, of shape "
@@ -429,7 +497,8 @@ class Calibrator:
             vals = vals.reshape(-1)
             check_log_density(vals)
             if on_grid:
-                _warn_if_narrow_prior(vals, self.n_grid, self.q)
+                if self._levels is None:  # a categorical grid is never refined
+                    _warn_if_narrow_prior(vals, self.n_grid, self.q)
             else:
                 vals = interp_log(vals, self._axes[0], theta_unit, smooth=True)
         check_log_density(vals)
@@ -489,10 +558,12 @@ class Calibrator:
             if prior is not None:
                 user = self._prior_values(prior, theta, True)
                 free = free + user
-                if not callable(prior) and np.isneginf(user).any():
+                if not callable(prior) and self._levels is None and np.isneginf(user).any():
                     keep = zero_edges(self._axes, user)
             logp = constrained(free, ok)
             check_mass(logp)
+            if self._levels is not None:  # exact at the levels, never refined
+                return self._update_levels(data, free, ok, margs, outside, prior, seed, count)
             res = None  # two parameters: the resolution (grid.resolution) of the last grid
             why = "resolved"  # one parameter: why refinement ended (grid.refined_axis)
             for _ in range(MAX_REFINE if self.q == 2 else MAX_REFINE_ONE):
@@ -532,6 +603,113 @@ class Calibrator:
             _warn_if_ridge(sds, tuple(self.emulator.t_names), self.n_grid)
         self._count = count
         return post
+
+    def _update_levels(self, data, free, ok, margs, outside, prior, seed, count) -> Posterior:
+        """The rest of ``update`` for a categorical theta (`_level_posterior`): the
+        ``count``-th update's Posterior, its records and warnings."""
+        key = run_seed(seed) if seed is not None else (self._entropy, count)
+        post = self._level_posterior(free, ok, margs, key)
+        post.info["outside_sds"] = outside
+        if prior is None or callable(prior):  # an array: maybe other windows' log-likelihood
+            post.info.update(obs_values_sha256=data.values_sha256,
+                             obs_layout_sha256=data.layout_sha256)  # fmt: skip
+        if self.q == 2:
+            _warn_if_level_unresolved(post.info["resolution"], tuple(self.emulator.t_names),
+                                      self.n_grid)  # fmt: skip
+        self._count = count
+        return post
+
+    def _level_posterior(self, free: np.ndarray, ok, margs: list, key) -> Posterior:
+        """The posterior on the fixed grid of a categorical theta, whose nodes (in 'ij' order)
+        have the unconstrained log posterior ``free`` (G,), the constraint's verdicts ``ok``
+        (G,) (None: none; only where every element is categorical: exact at the levels) and the
+        lamOs marginals ``margs``; ``key`` seeds the lazy draws.
+
+        A categorical element's marginal is a `LevelMarginal`: per level, the posterior's
+        trapezoid integral over the continuous element's nodes at that level (1 where there is
+        none); a continuous element's a `GridMarginal`, the sum over levels of the density at
+        its nodes (piecewise linear between them). Draws: a level (or, all categorical, a node)
+        by its probability, then the continuous element from its density given that level."""
+        std = self.emulator.standardizer
+        names = tuple(self.emulator.t_names)
+        shape = tuple(a.size for a in self._axes)
+        logp = constrained(free, ok)
+        dens = np.exp(logp - logp.max()).reshape(shape)
+        codes = self._codes
+        native = [a * (std.t_max[k] - std.t_min[k]) + std.t_min[k] if c is None else c
+                  for k, (a, c) in enumerate(zip(self._axes, codes, strict=True))]  # fmt: skip
+        w = [trapezoid_weights(a) if c is None else np.ones(a.size)
+             for a, c in zip(native, codes, strict=True)]  # fmt: skip
+        cont = [k for k, c in enumerate(codes) if c is None]  # at most one (q <= 2)
+        mass = dens * (w[0] if self.q == 1 else np.outer(w[0], w[1]))
+        grids: dict = {}
+        resolved = []
+        for k, name in enumerate(names):
+            other = tuple(j for j in range(self.q) if j != k)
+            if self._codes[k] is not None:
+                grids[name] = LevelMarginal.from_probabilities(native[k], mass.sum(axis=other))
+                resolved.append(np.inf)
+                continue
+            with np.errstate(divide="ignore"):
+                grids[name] = trimmed_marginal(native[k], np.log(dens.sum(axis=other)), w[k])[0]
+            # the worst resolved conditional of a level holding LEVEL_MASS of the mass or more
+            rows = np.moveaxis(dens, k, -1)  # (levels, nodes)
+            p = rows @ w[k]
+            with np.errstate(divide="ignore"):
+                res = [resolution([native[k]], np.log(rows[r]))[0]
+                       for r in np.flatnonzero(p >= LEVEL_MASS * p.sum())]  # fmt: skip
+            resolved.append(min(res))
+        inv_lamos = _expected_inverse_lamos(margs) if self.q == 1 else None
+        log_evidence = None
+        if self.q == 1:  # the levels' prior: uniform (calibrate's)
+            top = float(logp.max())
+            log_evidence = top + float(np.log(np.mean(np.exp(logp - top))))
+        n_draws = self.n_draws
+
+        def draw() -> dict[str, np.ndarray]:
+            rng = np.random.default_rng(_seed_sequence(key))
+            if not cont:  # a node by its probability
+                cum = np.cumsum(mass.ravel())
+                node = np.minimum(np.searchsorted(cum, rng.random(n_draws) * cum[-1],
+                                                  side="right"), cum.size - 1)  # fmt: skip
+                idx = np.unravel_index(node, shape)
+                out = {name: native[k][idx[k]] for k, name in enumerate(names)}
+            else:  # a level, then the continuous element given it
+                c = cont[0]
+                lv = 1 - c
+                level = grids[names[lv]].sample(rng, n_draws)
+                li = np.searchsorted(native[lv], level)
+                rows = np.moveaxis(dens, c, -1)
+                vals = np.empty(n_draws)
+                for r in np.unique(li):
+                    sel = li == r
+                    with np.errstate(divide="ignore"):
+                        gm = trimmed_marginal(native[c], np.log(rows[r]), w[c])[0]
+                    vals[sel] = gm.sample(rng, int(sel.sum()))
+                ci = nearest(native[c], vals)
+                idx = (li, ci) if c == 1 else (ci, li)
+                node = np.ravel_multi_index(idx, shape)
+                out = {names[lv]: level, names[c]: vals}
+            out["lamOs"] = _draw_lamos(margs, node, rng)
+            return {name: out[name] for name in (*names, "lamOs")}
+
+        info = {
+            "method": "grid",
+            "expected_inv_lamOs": inv_lamos,
+            "names": names + ("lamOs",),
+            "n_nodes": int(free.size),
+            "refined": False,
+            "log_evidence": log_evidence,
+            "levels": {
+                n: list(map(float, c)) for n, c in zip(names, codes, strict=True) if c is not None
+            },  # fmt: skip
+            "emulator_params": self.emulator_params,
+            **emulator_record(self.emulator),
+            "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
+        }
+        if self.q == 2:
+            info["resolution"] = tuple(resolved)
+        return Posterior(grids=grids, draw=draw, info=info)
 
     def _on_grid(self, data, axes: list, prior) -> tuple:
         """The lamOs marginals, unconstrained log posterior (G,), constraint verdicts (G,) (None:
@@ -781,6 +959,29 @@ def _warn_if_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> No
             f"method='mcmc' or another n_grid (now {n_grid})",
             stacklevel=3,
         )
+
+
+def _warn_if_level_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> None:
+    """Warn where the continuous parameter's density given a level (one holding LEVEL_MASS of
+    the mass or more) spans fewer than UNRESOLVED_SD node spacings per width on the fixed grid
+    (a categorical theta's grid is not refined)."""
+    k = int(np.argmin(res))
+    if res[k] < UNRESOLVED_SD:
+        warnings.warn(
+            f"the grid does not resolve the posterior of {names[k]} given the level of "
+            f"{names[1 - k]}: its width spans {res[k]:.2g} node spacings (fewer than "
+            f"{UNRESOLVED_SD:g}), and a grid with a categorical calibration parameter is not "
+            f"refined, so its summaries, draws and the levels' probabilities may be off; use "
+            f"a larger n_grid (now {n_grid}) or method='mcmc'",
+            stacklevel=4,
+        )
+
+
+def _level_codes(emulator) -> list[np.ndarray | None]:
+    """Per calibration parameter, its training levels (native codes, float) or None."""
+    p = emulator.x_unit.shape[1]
+    return [None if lv is None else np.asarray(lv, dtype=np.float64)
+            for lv in emulator.levels[p:]]  # fmt: skip
 
 
 def _warn_if_ridge(sds: tuple[float, float], names: tuple, n_grid: int) -> None:

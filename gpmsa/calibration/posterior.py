@@ -145,6 +145,95 @@ class GridMarginal:
         return self.ppf(rng.random(size))
 
 
+@dataclass(frozen=True, eq=False)
+class LevelMarginal:
+    """The posterior of a categorical parameter: a probability per level (native codes), exact.
+
+    Its summaries are those of a discrete distribution on the level codes: ``mean`` and ``sd``
+    the probability-weighted moments of the codes (as the mean and sd of an MCMC's draws of
+    it); ``cdf`` P(X <= value); ``ppf`` (quantiles) the lower quantile, the smallest level
+    whose CDF reaches q (a level, never a value between levels); draws and ``hdi``'s ends are
+    levels too. ``nodes``, ``density`` and ``weights`` (ones) read as a `GridMarginal`'s
+    (``weights @ density`` = 1).
+
+    Attributes:
+        nodes: (k,) the levels, increasing.
+        density: (k,) their probabilities, sum 1.
+        weights: (k,) ones.
+    """
+
+    nodes: np.ndarray
+    density: np.ndarray
+    weights: np.ndarray
+
+    @classmethod
+    def from_probabilities(cls, levels, probabilities) -> LevelMarginal:
+        """Normalise ``probabilities`` (k,), non-negative, some positive, of the increasing
+        ``levels`` (k,); GPMSAError otherwise."""
+        levels = np.asarray(levels, dtype=float)
+        p = np.asarray(probabilities, dtype=float)
+        if levels.ndim != 1 or levels.size < 1 or p.shape != levels.shape:
+            raise GPMSAError(f"a level marginal needs one probability per level, got levels "
+                             f"{levels.shape} and probabilities {p.shape}")  # fmt: skip
+        if not (np.all(np.isfinite(levels)) and np.all(np.diff(levels) > 0)):
+            raise GPMSAError("a level marginal's levels must be finite and strictly increasing")
+        total = float(np.sum(p))
+        if not (np.all(np.isfinite(p)) and np.all(p >= 0.0) and total > 0.0):
+            raise GPMSAError("a level marginal's probabilities must be finite, non-negative "
+                             "and not all 0")  # fmt: skip
+        return cls(levels, p / total, np.ones(levels.size))
+
+    def probabilities(self) -> dict[float, float]:
+        """level -> its posterior probability."""
+        return {float(v): float(p) for v, p in zip(self.nodes, self.density, strict=True)}
+
+    def mean(self) -> float:
+        """Posterior mean of the level code (between levels where two carry mass)."""
+        return float(np.clip(self.density @ self.nodes, self.nodes[0], self.nodes[-1]))
+
+    def sd(self) -> float:
+        """Posterior standard deviation of the level code."""
+        d = self.nodes - self.mean()
+        return float(np.sqrt(self.density @ (d * d)))
+
+    def __repr__(self) -> str:
+        probs = ", ".join(f"{v:g}: {p:.3g}" for v, p in self.probabilities().items())
+        return f"LevelMarginal({{{probs}}})"
+
+    def cdf(self, value: np.ndarray | float) -> np.ndarray:
+        """P(X <= value)."""
+        cum = np.cumsum(self.density)
+        k = np.searchsorted(self.nodes, np.asarray(value, dtype=float), side="right")
+        return np.clip(np.where(k > 0, cum[np.maximum(k - 1, 0)], 0.0), 0.0, 1.0)
+
+    def ppf(self, q: np.ndarray | float) -> np.ndarray:
+        """The lower quantile: the smallest level with mass whose CDF reaches q (q = 0: the
+        smallest level with mass)."""
+        live = np.flatnonzero(self.density > 0.0)
+        cum = np.cumsum(self.density[live])
+        j = np.searchsorted(cum, np.asarray(q, dtype=float) * cum[-1], side="left")
+        return self.nodes[live][np.minimum(j, live.size - 1)]
+
+    def hdi(self, level: float) -> tuple[float, float]:
+        """The shortest interval [a, b] between levels holding probability ``level`` at least
+        (of two as short, the one holding more)."""
+        cum = np.concatenate([[0.0], np.cumsum(self.density)])
+        best = (np.inf, 0.0, 0, self.nodes.size - 1)
+        for i in range(self.nodes.size):
+            for j in range(i, self.nodes.size):
+                mass = cum[j + 1] - cum[i]
+                if mass >= level * (1.0 - 1e-12):
+                    width = self.nodes[j] - self.nodes[i]
+                    if (width, -mass) < (best[0], -best[1]):
+                        best = (width, mass, i, j)
+                    break
+        return float(self.nodes[best[2]]), float(self.nodes[best[3]])
+
+    def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
+        """Independent draws of the level."""
+        return self.ppf(rng.random(size))
+
+
 def _hdi_probabilities(level: float) -> np.ndarray:
     """The lower tail probabilities `GridMarginal.hdi` tries, then the same plus ``level``."""
     p = np.linspace(0.0, 1.0 - level, HDI_STEPS)
@@ -282,8 +371,10 @@ def _checked_grids(grids, names) -> dict[str, GridMarginal]:
     for name, grid in grids.items():
         if not isinstance(name, str):
             raise GPMSAError(f"grids: parameter names must be strings, got {name!r}")
-        if not isinstance(grid, GridMarginal):
-            raise GPMSAError(f"grids[{name!r}] must be a GridMarginal, got {type(grid).__name__}")
+        if not isinstance(grid, GridMarginal | LevelMarginal):
+            raise GPMSAError(f"grids[{name!r}] must be a GridMarginal, got "
+                             f"{type(grid).__name__} (a categorical parameter's: a "
+                             "LevelMarginal)")  # fmt: skip
         if names is not None and name not in names:
             raise GPMSAError(f"grids[{name!r}] is not a parameter of the posterior, which has "
                              f"{tuple(names)}")  # fmt: skip
@@ -304,7 +395,8 @@ class Posterior:
     Args:
         samples: name -> draws (n_draws,) for scalar parameters, or None when ``draw`` gives them.
         grids: name -> GridMarginal, the exact grid representation of a parameter's marginal (the
-            fast path); summaries of that name come from it, not from draws.
+            fast path; a LevelMarginal, a probability per level, for a categorical one);
+            summaries of that name come from it, not from draws.
         draw: a callable returning the samples dict, called once on first access of ``samples``
             (the fast path draws lazily so that an update costs nothing it does not need).
         chains: name -> (n_chains, n_draws) the MCMC draws per chain (for ``to_arviz`` and traces).
@@ -504,13 +596,21 @@ class Posterior:
         fig = Figure(figsize=(9.0, 3.5))
         ax_h, ax_t = fig.subplots(1, 2)
         draws = np.asarray(self.samples[name])
-        ax_h.hist(draws, bins=bins, density=True, color="0.75", label="draws")
-        if name in self.grids:
-            g = self.grids[name]
+        g = self.grids.get(name)
+        if isinstance(g, LevelMarginal):  # a categorical parameter: a probability per level
+            freq = np.array([np.mean(draws == v) for v in g.nodes])
+            ax_h.bar(g.nodes, freq, width=0.4, color="0.75", label="draws")
+            ax_h.plot(g.nodes, g.density, "o", color="C0", label="exact (levels)")
+        else:
+            ax_h.hist(draws, bins=bins, density=True, color="0.75", label="draws")
+        if isinstance(g, GridMarginal):
             ax_h.plot(g.nodes, g.density, color="C0", label="exact (grid)")
         ax_h.axvline(self.mean(name), color="C3", lw=1, label="mean")
         ax_h.set_xlabel(label)
-        ax_h.set_ylabel(f"density (1/{unit})" if unit else "density")
+        if isinstance(g, LevelMarginal):
+            ax_h.set_ylabel("probability")
+        else:
+            ax_h.set_ylabel(f"density (1/{unit})" if unit else "density")
         ax_h.legend(fontsize="small")
         chains = self.chains[name] if self.chains is not None else draws[None, :]
         for c, chain in enumerate(np.atleast_2d(chains)):

@@ -94,13 +94,12 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
 def _fixed(items: list[str], emu) -> dict[str, float]:
     """``--fixed``'s NAME -> value (native units; NAME one of the file's t_names or lamOs),
     each checked now, before any work, as ``calibrate(..., fixed=)`` checks it (`_check_held`);
-    GPMSAError naming the item otherwise (first, as the Calibrator would: a file it refuses,
-    such as one with a categorical calibration parameter)."""
+    GPMSAError naming the item otherwise (first, as the Calibrator would: a file it refuses)."""
     from gpmsa.calibration.observations import check_emulator
 
     if not items:
         return {}
-    check_emulator(emu)
+    check_emulator(emu, categorical_theta=True)
     t_names = tuple(str(n) for n in emu.t_names)
     allowed = (*t_names, "lamOs")
     given = _given(items, allowed, "fixed")

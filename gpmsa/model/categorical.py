@@ -121,6 +121,7 @@ def refuse_categorical_theta(levels: Levels, p: int, names: Sequence[str], what:
         if lv is not None:
             raise GPMSAError(
                 f"{what}: calibration parameter {names[p + k]} is categorical; a categorical "
-                "theta is calibrated by gpmsa.calibrate on the numpy (fast or not) or torch "
-                "backend only (with or without a discrepancy; docs/categorical-and-constraints.md)"
+                "theta is calibrated by gpmsa.calibrate (and gpmsa.Calibrator) on the numpy "
+                "(fast or not) or torch backend only (with or without a discrepancy; "
+                "docs/categorical-and-constraints.md)"
             )

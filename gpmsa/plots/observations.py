@@ -41,7 +41,7 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
         >>> [ax.get_title() for ax in fig.axes[:2]]
         ['PC 1: 1 of 2 outside the runs', 'PC 2: 1 of 2 outside the runs']
     """
-    check_emulator(emulator)
+    check_emulator(emulator, categorical_theta=True)  # theta plays no part here
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be a gpmsa.ObsData, got {type(obs).__name__}")
     max_pc = check_count(max_pc, "max_pc")
@@ -92,7 +92,7 @@ def weight_pairs(emulator, obs: ObsData | None = None, *, max_pc: int = 4, bins:
     """
     from matplotlib.lines import Line2D
 
-    check_emulator(emulator)
+    check_emulator(emulator, categorical_theta=True)  # theta plays no part here
     if obs is not None and not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be a gpmsa.ObsData or None, got {type(obs).__name__}")
     n_pc = min(check_count(max_pc, "max_pc"), emulator.p_u)

@@ -106,7 +106,7 @@ def test_a_categorical_parameter_must_be_held_at_a_level(tmp_path, capsys):
                                          r"levels \[0.0, 1.0, 2.0\]"):  # fmt: skip
         cli_calibrate._check_held(emu, ("t0",), "t0", 0.5)
     cli_calibrate._check_held(emu, ("t0",), "t0", 1.0)  # a level: held
-    # the command refuses such a file first, as Calibrator does (docs: categorical theta)
+    # the command takes such a file (session 73) and refuses a value off the levels by name
     path = str(emu.save(tmp_path / "cat.gpmsa"))
     code, _, err = _run(capsys, path, "--x", "x0=0.3", "--y", "y0=1", "--fixed", "t0=0.5")
-    assert code == 2 and "t0 is categorical" in err
+    assert code == 2 and "t0=0.5 cannot be held: give a value at one of its levels" in err
