@@ -1106,7 +1106,11 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
               "init": how, "warmup": int(warmup), "tune_stages": n_stages, "starts": start,
               "ridge_moves": state.ridge_moves, "chain_groups": where["groups"],
               "backend": "torch", "proportional_steps": prop_mh,
-              "device": str(dev), "dtype": str(dt).replace("torch.", "")},
+              "device": str(dev), "dtype": str(dt).replace("torch.", ""),
+              **({} if not state.level_shifts else {"level_offsets": {  # the joint level move
+                  "shifted": [int(j) for j in state.shift_elements],
+                  "offsets": {int(k): v.cpu().numpy().astype(np.float64)
+                              for k, v in state.level_shifts.items()}}})},
     )  # fmt: skip
 
 

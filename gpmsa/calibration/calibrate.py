@@ -23,7 +23,6 @@ from threadpoolctl import threadpool_limits
 from gpmsa import backends
 from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
-    EXTRAPOLATED,
     OUTSIDE_SDS,
     Fit,
     Observations,
@@ -52,7 +51,7 @@ from gpmsa.calibration.posterior import Posterior
 from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
 from gpmsa.errors import GPMSAError, ReductionWarning
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import tempering, tuning
+from gpmsa.mcmc import level_moves, tempering, tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
@@ -109,13 +108,11 @@ def calibration_problem(
             given = ObsData(x, y)
         else:
             checked_obs_data(emulator, given, extrapolate)
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", message=EXTRAPOLATED)  # check_x warned already
-            obs, corr = reduce_obs(
-                given, emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
-                getattr(emulator, "levels", None), getattr(emulator, "y_names", None),
-                discrepancy_groups,
-            )  # fmt: skip
+        obs, corr = reduce_obs(
+            given, emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
+            getattr(emulator, "levels", None), getattr(emulator, "y_names", None),
+            discrepancy_groups, x_checked=True,  # check_x checked and warned
+        )  # fmt: skip
     pri = emulator.priors
     lo = pri.lamOs
     priors = replace(pri, lamOs=replace(lo, a=lo.a + corr[0], b=lo.b + corr[1]))
@@ -271,7 +268,10 @@ def calibrate(
         discrepancy_groups: the precision group of each discrepancy basis vector, as
             ``gpmsa.fit``'s (GPM/SA's lamVzGroup; None: one group).
         n_chains: independent chains (their kept draws are pooled in ``samples``).
-        extrapolate: allow x_obs outside the emulator's x domain (with a warning).
+        extrapolate: allow x_obs outside the emulator's x domain by more than
+            ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width (with an ExtrapolationWarning).
+            Within the margin x_obs is taken with that warning as a joint ``gpmsa.fit``
+            takes it; beyond it, False: GPMSAError naming the column.
         fast: None (auto: the specialised sampler when it applies), True, or False (the backend).
         log_prior: optional extra log prior of theta, a vectorised callable of native theta as
             ``Calibrator.update`` takes it ((k,) values for one parameter, (k, q) for more ->
@@ -572,6 +572,9 @@ def _run_fast(
         "step_widths": widths.tolist(),
         "chebyshev": all(p.cheb is not None or p.cheb2 is not None for p in sampler.preds),
     }
+    moves = level_moves.chains_record([r.level_offsets for r in runs], runs[0].level_shifted)
+    if moves:  # a categorical theta's joint level move, per chain (native units)
+        info["level_offsets"] = _level_record(emulator, moves)
     if held_theta is not None or held_lamos is not None:
         values = {} if held_theta is None else {"theta": held_theta}
         if held_lamos is not None:
@@ -602,6 +605,14 @@ def _fast_held(emulator, held: dict) -> tuple[dict[int, float] | None, float | N
     if "lamOs" in held:
         lamos = float(checked_fixed("lamOs", held["lamOs"], (1,), emulator.priors)[0])
     return theta, lamos
+
+
+def _level_record(emulator, moves: dict) -> dict:
+    """The samplers' record of the joint level moves (``level_moves.chains_record``, unit
+    scale) in theta's native units, by name (``level_moves.native_record``)."""
+    std = emulator.standardizer
+    return level_moves.native_record(moves, emulator.t_names, std.t_min, std.t_max,
+                                     tuple(emulator.levels)[len(emulator.x_names):])  # fmt: skip
 
 
 def _wrong_fast_run(run, n_samples: int, q: int) -> str | None:
@@ -653,6 +664,8 @@ def _run_backend(
         "accept_rate": {k: np.asarray(v).tolist() for k, v in chains.accept_rate.items()},
         "step_widths": {k: np.asarray(v).tolist() for k, v in chains.step_widths.items()},
     }
+    if "level_offsets" in chains.info:  # a categorical theta's joint level move, per chain
+        info["level_offsets"] = _level_record(emulator, chains.info["level_offsets"])
     if "temperatures" in chains.info:  # parallel tempering: as fit's settings record it
         info.update(temperatures=list(chains.info["temperatures"]),
                     swap_every=int(chains.info["swap_every"]),

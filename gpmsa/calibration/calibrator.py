@@ -165,7 +165,10 @@ class Calibrator:
             has n_grid per level, default 129).
         emulator_params: "point" (the emulator's point estimate) or "draws" (average the
             likelihood over up to ``n_emulator_draws`` of its retained draws, evenly spaced).
-        extrapolate: allow x_obs outside the emulator's x domain (with a warning).
+        extrapolate: allow x_obs outside the emulator's x domain by more than
+            ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width (with an ExtrapolationWarning).
+            Within the margin x_obs is taken with that warning as a joint ``gpmsa.fit``
+            takes it; beyond it, False: GPMSAError naming the column.
         n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``.
         seed: seed of those draws (and of the MCMC), for reproducibility: an integer, a numpy
             Generator (an integer is drawn from it) or None (fresh entropy).

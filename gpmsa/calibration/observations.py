@@ -32,12 +32,11 @@ from gpmsa.model.data import (
     values_digest,
 )
 from gpmsa.model.problem import GLS_RIDGE, MAX_STD_OBS, SIGOBS_RIDGE, ObsProblem, reduce_obs
+from gpmsa.model.transforms import EXTRAPOLATION_MARGIN
 
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 EMULATOR_PARAM_MODES = ("point", "draws")
-EXTRAPOLATED = "x_obs lies outside the simulation design's range"
-"""The start of `gpmsa.model.problem.check_x_obs`'s warning, which ``check_x`` gives first."""
 OUTSIDE_SDS = 5.0
 """An observation farther than this many predictive sds from every emulator prediction at its
 x (over the whole theta domain) lies outside what the emulator has seen: a warning
@@ -201,8 +200,10 @@ def layout_digest(grids: list, precisions: list | None, grid: np.ndarray) -> str
 def check_x(
     emulator, x_obs, extrapolate: bool, what: str = "x_obs"
 ) -> tuple[np.ndarray, np.ndarray]:
-    """x_obs native (n, p) and unit scale; outside the emulator's x domain: GPMSAError, or with
-    ``extrapolate=True`` a warning. ``what``: the argument's name in messages. An emulator
+    """x_obs native (n, p) and unit scale, with a joint fit's rule (``check_x_obs``) and the
+    predictions': outside the emulator's x domain by up to ``EXTRAPOLATION_MARGIN`` (10 %) of
+    a column's width an ``ExtrapolationWarning``; further a GPMSAError naming the column, or
+    with ``extrapolate=True`` a warning. ``what``: the argument's name in messages. An emulator
     without known inputs (p = 0) takes None as one row of no columns (1, 0); a gpmsa.ObsData
     is refused (`refuse_obs_data`)."""
     refuse_obs_data(**{what: x_obs})
@@ -216,12 +217,14 @@ def check_x(
     xu = emulator.standardizer.x_to_unit(x)
     out = (xu < 0.0) | (xu > 1.0)
     if out.any():
-        j, k = (int(i) for i in np.argwhere(out)[0])
+        far = (xu < -EXTRAPOLATION_MARGIN) | (xu > 1.0 + EXTRAPOLATION_MARGIN)
+        j, k = (int(i) for i in np.argwhere(far if far.any() else out)[0])
         name = emulator.x_names[k]
         lo, hi = emulator.domain[name]
         msg = f"{what} {name}={x[j, k]:.6g} lies outside the emulator's domain [{lo:.6g}, {hi:.6g}]"
-        if not extrapolate:
-            raise GPMSAError(msg + "; pass extrapolate=True to allow it")
+        if far.any() and not extrapolate:
+            raise GPMSAError(f"{msg} by more than {EXTRAPOLATION_MARGIN:.0%} of its width; pass "
+                             "extrapolate=True to allow it")  # fmt: skip
         warnings.warn(
             msg + "; the emulator extrapolates", ExtrapolationWarning, stacklevel=user_stacklevel()
         )
@@ -323,9 +326,7 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
         obs = ObsProblem(xu, u, np.zeros((n, 0)), sig, True, (np.ones((1, 1)),) * n, None)
         corr = (0.0, 0.0)
     else:
-        with warnings.catch_warnings():
-            warnings.filterwarnings("ignore", message=EXTRAPOLATED)  # check_x warned already
-            obs, corr = reduce_obs(ObsData(x, y), std, K, None, emulator.x_names)
+        obs, corr = reduce_obs(ObsData(x, y), std, K, None, emulator.x_names, x_checked=True)
     digests = values_digest(x, list(y)), layout_digest([None] * n, None, std.grid)
     return _observations(emulator, obs, corr, digests, xu)
 
@@ -369,12 +370,10 @@ def _reduce_obs_data(emulator, obs: ObsData, extrapolate: bool) -> Observations:
     """``reduce`` for a ``gpmsa.ObsData``: GPM/SA's reduction of its experiments on their own
     grids (interpolated basis) and with their precisions (`gpmsa.model.problem.reduce_obs`)."""
     x, xu = checked_obs_data(emulator, obs, extrapolate)
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message=EXTRAPOLATED)  # check_x warned already
-        reduced, corr = reduce_obs(
-            obs, emulator.standardizer, emulator.K, None, emulator.x_names,
-            getattr(emulator, "levels", None), _y_names(emulator),
-        )  # fmt: skip
+    reduced, corr = reduce_obs(
+        obs, emulator.standardizer, emulator.K, None, emulator.x_names,
+        getattr(emulator, "levels", None), _y_names(emulator), x_checked=True,
+    )  # fmt: skip
     digests = (obs.values_digest(emulator.x_names, _y_names(emulator)),
                layout_digest(obs.grids, obs.output_precisions(_y_names(emulator)),
                              emulator.standardizer.grid))  # fmt: skip

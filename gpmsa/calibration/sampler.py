@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.polynomial import chebyshev as cheb
@@ -278,7 +278,10 @@ def _loglik(ey, lam: float) -> float:
 @dataclass(frozen=True)
 class ChainResult:
     """Draws of one chain: theta (n, q) unit scale, lamOs (n,), emulator-set index (n,),
-    log posterior (n,) up to a constant, acceptance rate and step width per element."""
+    log posterior (n,) up to a constant, acceptance rate and step width per element; the
+    joint level moves' offsets (categorical theta position -> ``level_moves.level_offsets``
+    (n_levels, n_shifted), unit scale) and the shifted elements' positions (none without a
+    categorical theta)."""
 
     theta: np.ndarray
     lamOs: np.ndarray
@@ -286,6 +289,8 @@ class ChainResult:
     log_post: np.ndarray
     accept_rate: np.ndarray
     widths: np.ndarray
+    level_offsets: dict = field(default_factory=dict)
+    level_shifted: tuple = ()
 
 
 class CalibrationSampler:
@@ -420,9 +425,11 @@ class CalibrationSampler:
                     out.append((*state.theta, state.lam, state.k, state.log_post()))
                 bar.update(len(u))
         arr = np.array(out)
+        shifted = next(iter(state.shifts.values()))[2] if state.shifts else ()
         return ChainResult(
             theta=arr[:, :q], lamOs=arr[:, q], index=arr[:, q + 1].astype(np.int64),
             log_post=arr[:, q + 2], accept_rate=accepted / max(n_iter, 1), widths=w,
+            level_offsets=dict(state.offsets), level_shifted=tuple(shifted),
         )  # fmt: skip
 
 
@@ -439,6 +446,7 @@ class _State:
         self.lp_theta = s._log_prior_theta(self.theta)
         self.lp_lam = s._log_prior_lamos(lam)
         self.shifts: dict[int, tuple] = {}  # categorical element -> its level move's shifts
+        self.offsets: dict[int, np.ndarray] = {}  # categorical element -> its level_offsets
 
     def learn_level_shifts(self) -> None:
         """The joint level moves' shifts of the continuous free theta elements
@@ -460,6 +468,7 @@ class _State:
             off = level_moves.level_offsets(log_post, np.array(self.theta), i, s.levels[i], cont)
             rows = {v: r for r, v in enumerate(s.levels[i])}
             self.shifts[i] = (rows, level_moves.shift_table(off), cont)
+            self.offsets[i] = off
 
     def log_post(self) -> float:
         """Log posterior up to a constant."""

@@ -36,7 +36,11 @@ def add_parser(sub) -> None:
                         "--fixed)")  # fmt: skip
     p.add_argument("--level", type=_level, default=0.9, help="central interval level (0.9)")
     p.add_argument("--seed", type=int, default=None, help="seed of the draws / MCMC")
-    p.add_argument("--extrapolate", action="store_true", help="allow x outside the domain")
+    p.add_argument(
+        "--extrapolate",
+        action="store_true",
+        help="allow x more than 10%% of its width outside the domain",
+    )
     p.add_argument("--json", action="store_true", help="print JSON for programs")
     p.set_defaults(func=run)
 

@@ -116,6 +116,31 @@ def _tempering_text(settings: dict) -> str:
                 f"swap rates {rate_text}", 600)  # fmt: skip
 
 
+def _level_moves_text(record: object) -> str:
+    """The joint level moves' record (settings "level_offsets", ``level_moves.native_record``;
+    not checked by the reader: anything else printed as it is), in words: per categorical
+    theta and chain, the shifted elements' conditional modes at each level (native units)."""
+    if not isinstance(record, dict):
+        return value(record)
+    parts = []
+    for name, rec in record.items():
+        try:
+            levels, shifted, modes = rec["levels"], rec["shifted"], rec["modes"]
+            chains = "; ".join(
+                f"chain {c + 1}: " + ", ".join(
+                    f"{number(lv, 'g')} -> "
+                    + (number(m[0], ".4g") if len(m) == 1
+                       else "(" + ", ".join(number(v, ".4g") for v in m) + ")")
+                    for lv, m in zip(levels, per, strict=True))
+                for c, per in enumerate(modes))  # fmt: skip
+            what = ", ".join(safe(n, 60) for n in shifted)
+            parts.append(f"{safe(name, 60)} shifts {what} between their modes at each level "
+                         f"({chains})")  # fmt: skip
+        except (KeyError, TypeError, ValueError):
+            parts.append(f"{safe(name, 60)}: {value(rec)}")
+    return safe("; ".join(parts) + " (native units)", 600)
+
+
 def _given_scale(std) -> str:
     """The output standardisation of a Standardizer with a given y_mean or y_sd, in words."""
     each = std.columnwise  # an sd per output element (given, or y_scale="columnwise")
@@ -186,6 +211,8 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     lines.append("settings:        " + ", ".join(flat))
     if "temperatures" in s:  # parallel tempering (fit(..., temperatures=)): lists, not above
         lines.append(f"tempering:       {_tempering_text(s)}")
+    if "level_offsets" in s:  # a categorical theta's joint level move: a dict, not above
+        lines.append(f"level moves:     {_level_moves_text(s['level_offsets'])}")
     if s.get("discrepancy") is not None:
         groups = s.get("discrepancy_groups")
         lines.append(f"discrepancy:     {plain(s['discrepancy'])}{_bases_text(manifest)}, "

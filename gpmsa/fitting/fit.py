@@ -27,7 +27,7 @@ from gpmsa.fitting.continuation import (
 )
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import tempering
+from gpmsa.mcmc import level_moves, tempering
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.mcmc.sampler import (
@@ -196,6 +196,11 @@ def fit(
     posterior needs T_max of tens). Refused on the torch and pyro backends and with ``init``
     an emulator (docs/internals.md, "Parallel tempering").
 
+    A categorical theta of a joint fit moves levels jointly with the continuous theta
+    (``gpmsa.mcmc.level_moves``): ``settings["level_offsets"]`` records, per categorical name,
+    its "levels", the "shifted" elements and per chain their conditional "modes" at each level
+    (native units; the move from level a to b shifts them by modes[b] - modes[a]).
+
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
     names each parameter with R-hat > 1.01 or ESS < 100. A chain that fails or produces
@@ -324,6 +329,10 @@ def fit(
             "temperatures": list(chains.info["temperatures"]),
             "swap_every": int(chains.info["swap_every"]),
             "swap_rate": np.asarray(chains.info["swap_rate"]).tolist()}),
+        **({} if "level_offsets" not in chains.info else {  # a categorical theta's level move
+            "level_offsets": level_moves.native_record(
+                chains.info["level_offsets"], data.t_names, prep.standardizer.t_min,
+                prep.standardizer.t_max, tuple(data.levels)[len(data.x_names):])}),
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "versions": library_versions(backend),
     }  # fmt: skip

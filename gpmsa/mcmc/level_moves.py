@@ -84,3 +84,31 @@ def shift(values: np.ndarray, cont: Sequence[int], steps: Sequence[float],
         d_lp += lp_new - log_prior(k, old)
         values[j] = old + d
     return d_lp
+
+
+def chains_record(per_chain: Sequence[dict[int, np.ndarray]], cont: Sequence[int]) -> dict:
+    """The samplers' record of the offsets (``Chains.info["level_offsets"]``, unit scale):
+    ``per_chain[c]``, categorical theta element -> its `level_offsets` (n_levels, len(cont)),
+    as {"shifted": the continuous elements' positions, "offsets": element -> (n_chains,
+    n_levels, len(cont))}; {} where no chain made the move."""
+    if not per_chain or not per_chain[0]:
+        return {}
+    return {"shifted": [int(j) for j in cont],
+            "offsets": {int(k): np.stack([np.asarray(c[k], dtype=np.float64) for c in per_chain])
+                        for k in per_chain[0]}}  # fmt: skip
+
+
+def native_record(record: dict, t_names: Sequence[str], t_min, t_max, levels) -> dict:
+    """``chains_record``'s record for a person and a file (JSON): per categorical theta name,
+    its "levels" (native codes, ``levels[k]``), the "shifted" continuous elements' names and
+    "modes" [chain][level][shifted element], their conditional modes at each level in theta's
+    native units (the move from level a to b shifts them by modes[c][b] - modes[c][a])."""
+    if not record:
+        return {}
+    cont = record["shifted"]
+    lo = np.asarray(t_min, dtype=np.float64)[cont]
+    width = np.asarray(t_max, dtype=np.float64)[cont] - lo
+    return {str(t_names[k]): {"levels": [int(v) for v in levels[k]],
+                              "shifted": [str(t_names[j]) for j in cont],
+                              "modes": (lo + np.asarray(off) * width).tolist()}
+            for k, off in record["offsets"].items()}  # fmt: skip

@@ -209,6 +209,7 @@ class ChainState:
         if self.constraint is not None:
             self.constraint.check_start(self.lik.params["theta"], "the chain's start")
         self.level_shifts: dict[int, tuple] = {}  # `learn_level_shifts`: element -> its shifts
+        self.level_offsets: dict[int, np.ndarray] = {}  # theta position -> its level_offsets
 
     def learn_level_shifts(self) -> None:
         """Each categorical theta element's joint level move (``gpmsa.mcmc.level_moves``): the
@@ -235,6 +236,13 @@ class ChainState:
             off = level_moves.level_offsets(log_post, theta, self.els[i][1][0], lv, cont)
             rows = {float(v): r for r, v in enumerate(lv)}
             self.level_shifts[i] = (rows, level_moves.shift_table(off), cont, priors)
+            self.level_offsets[self.els[i][1][0]] = off
+
+    def level_record(self) -> tuple[dict[int, np.ndarray], list[int]]:
+        """The offsets of the level moves (`learn_level_shifts`; theta position -> (n_levels,
+        n_shifted)) and the shifted elements' positions: the chain's record of the move."""
+        cont = next(iter(self.level_shifts.values()))[2] if self.level_shifts else []
+        return dict(self.level_offsets), list(cont)
 
     def _level_move(self, i: int, x: float, level: float, u1: float, accepted) -> None:
         """Element ``i`` (categorical theta, at level ``x``) to ``level`` with the continuous
@@ -488,12 +496,14 @@ def run_chain(
     start: dict[str, np.ndarray] | None = None,
     ridge_moves: int = 0,
     proportional_steps: bool | None = None,
+    record: dict | None = None,
 ) -> tuple[dict[str, np.ndarray], np.ndarray, dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Tune (optionally), then ``n_iter`` sweeps from ``start`` (default ``problem.init``), the
     precisions by GPM/SA's proportional step where ``proportional_steps`` (None: ``not tune``).
 
-    Returns draws, log_post, accept rates, widths. GPMSAError when the start's log posterior is
-    NaN (no proposal could ever be accepted).
+    Returns draws, log_post, accept rates, widths; ``record`` (a dict) gets "level" (the level
+    moves' offsets and shifted elements, ``ChainState.level_record``). GPMSAError when the
+    start's log posterior is NaN (no proposal could ever be accepted).
     """
     from tqdm.auto import tqdm
 
@@ -527,6 +537,8 @@ def run_chain(
                 bar.update(100)
         bar.update(n_iter % 100)
     bar.close()
+    if record is not None:
+        record["level"] = state.level_record()
     return draws, log_post, *state.element_records(accepted, w, n_iter)
 
 
@@ -539,31 +551,39 @@ def _chain_task(
 ):  # fmt: skip
     """One chain from plain data (run in a worker process): ``run_chain`` from ``start`` (drawn
     by ``sample`` in the parent), its generator from ``seed``; ``run_chain``'s result (with
-    ``temperatures``: ``tempering.run_tempered_chain``'s, the swap rates last)."""
+    ``temperatures``: ``tempering.run_tempered_chain``'s, the swap rates after it), then a dict
+    of the level moves' offsets (``ChainState.level_record``: "offsets", "shifted")."""
+    record: dict = {}
     with threadpool_limits(1):
         if temperatures is not None:
             rng = np.random.default_rng(seed)
             first = problem.init if start is None else start
-            return tempering.run_tempered_chain(
+            out = tempering.run_tempered_chain(
                 problem, n_iter, lambda: ChainState(problem, first, rng, ridge_moves=ridge_moves),
                 temperatures=temperatures, swap_every=swap_every, tune=tune, widths=widths,
                 rng=rng, tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress,
-                desc=desc, proportional_steps=proportional_steps,
+                desc=desc, proportional_steps=proportional_steps, record=record,
             )  # fmt: skip
-        return run_chain(
-            problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
-            tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress, desc=desc,
-            start=start, ridge_moves=ridge_moves, proportional_steps=proportional_steps,
-        )  # fmt: skip
+        else:
+            out = run_chain(
+                problem, n_iter, tune=tune, widths=widths, rng=np.random.default_rng(seed),
+                tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress, desc=desc,
+                start=start, ridge_moves=ridge_moves, proportional_steps=proportional_steps,
+                record=record,
+            )  # fmt: skip
+    offsets, shifted = record["level"]
+    return (*out, {"offsets": offsets, "shifted": shifted})
 
 
 def wrong_result(result, expected: tuple, what: str) -> str | None:
     """``run_chains``' check of a chain task's ``result``: None when it is a tuple of one item
     per ``expected`` entry, a shape tuple (an array of that shape) or a dict name -> shape (a
-    dict of such arrays); otherwise ``what``, the draws it should hold."""
+    dict of such arrays) or ``dict`` (any dict); otherwise ``what``, the draws it should hold."""
     ok = isinstance(result, tuple) and len(result) == len(expected)
     for got, want in zip(result if ok else (), expected, strict=False):
-        if isinstance(want, dict):
+        if want is dict:
+            ok = ok and isinstance(got, dict)
+        elif isinstance(want, dict):
             ok = ok and isinstance(got, dict) and set(got) == set(want)
             ok = ok and all(np.shape(got[k]) == shape for k, shape in want.items())
         else:
@@ -644,6 +664,7 @@ def sample(
                 shapes)  # fmt: skip
     if temps is not None:  # and each neighbour pair's swap rate
         expected += ((len(temps) - 1,),)
+    expected += (dict,)  # the level moves' offsets (a categorical theta; else empty)
     runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
                       desc="chain",
                       check=lambda _, r: wrong_result(r, expected, f"{n_iter} sweeps"))  # fmt: skip
@@ -661,5 +682,8 @@ def sample(
     if temps is not None:
         chains.info.update(temperatures=list(temps), swap_every=swap_every,
                            swap_rate=np.stack([r[4] for r in runs]))  # fmt: skip
+    moves = level_moves.chains_record([r[-1]["offsets"] for r in runs], runs[0][-1]["shifted"])
+    if moves:  # a categorical theta's joint level move: its offsets, per chain
+        chains.info["level_offsets"] = moves
     chains.check_finite()
     return chains

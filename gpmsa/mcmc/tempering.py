@@ -136,12 +136,14 @@ def run_tempered_chain(
     progress: bool = False,
     desc: str = "MCMC",
     proportional_steps: bool | None = None,
+    record: dict | None = None,
 ):
     """``sampler.run_chain`` with a ladder of tempered copies (module docstring), each a
     ``new_state()`` (a ``sampler.ChainState`` at the chain's start, drawing from ``rng``):
     ``n_iter`` sweeps of every copy after its tuning; the T = 1 copy's draws are kept. Returns
     ``run_chain``'s draws, log_post, accept rates and widths (of the T = 1 copy) and the swap
-    acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds."""
+    acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds; ``record``
+    as ``run_chain``'s (the T = 1 copy's level moves, shared by the ladder)."""
     from tqdm.auto import tqdm
 
     betas = tuple(1.0 / t for t in temperatures)
@@ -191,4 +193,6 @@ def run_tempered_chain(
         bar.update((n_iter % 100) * n_temps)
     bar.close()
     rate, wid = cold.element_records(accepted[0], w[0], n_iter)
+    if record is not None:
+        record["level"] = cold.level_record()
     return draws, log_post, rate, wid, swaps / max(n_iter // swap_every, 1)

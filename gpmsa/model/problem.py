@@ -384,6 +384,7 @@ def reduce_obs(
     levels: categorical.Levels | None = None,
     y_names=None,
     groups=None,
+    x_checked: bool = False,
 ) -> tuple[ObsProblem, tuple[float, float]]:
     """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db).
 
@@ -394,7 +395,9 @@ def reduce_obs(
 
     ``levels``: the x columns' training levels (``SimData.levels``); an unseen level is refused.
     ``y_names``: the simulation outputs' names, by which a y table with named columns and no
-    index is read (`ObsData.outputs`).
+    index is read (`ObsData.outputs`). ``x_checked``: the caller has checked x_obs against the
+    domain and warned (calibration's ``check_x``, whose ``extrapolate=True`` allows any
+    distance): no ``check_x_obs`` here.
     """
     x_native = obs.inputs(x_names)
     if x_native.ndim != 2 or x_native.shape[1] != std.x_min.size:  # before x_to_unit broadcasts
@@ -402,7 +405,8 @@ def reduce_obs(
     x = std.x_to_unit(x_native)
     if levels is not None:
         categorical.check_levels(x_native, levels[: x.shape[1]], x_names, "x_obs")
-    check_x_obs(x, x_names)
+    if not x_checked:
+        check_x_obs(x, x_names)
     n, p_u = obs.n, K.shape[1]
     scalar = K.shape[0] == 1
     experiments = obs.outputs(y_names)

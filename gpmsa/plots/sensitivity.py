@@ -76,7 +76,9 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
     return fig
 
 
-def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0):
+def main_effect_curves(
+    sens: Sensitivity, *, level: float = 0.9, output: int = 0, level_names: dict | None = None
+):
     """Main-effect functions E[y | z_k] of each varied input, with their band over draws.
 
     One panel per varied input (SEPIA's main-effect plot), on a shared output axis: the mean
@@ -88,10 +90,17 @@ def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0
     over draws (the mean GP variance plus the variance of the curves over draws), the GP's
     uncertainty about the function between the runs as well as the parameters'.
 
+    A categorical input (``sens.categorical``) has no values between its levels: its panel
+    shows points at the levels, the same intervals as error bars (the wider, lighter one with
+    the GP's variance), and the levels as the axis's ticks (their names from ``level_names``).
+
     Args:
         sens: a Sensitivity from ``gpmsa.sensitivity(..., main_effect_grid=G)``.
         level: probability of the bands.
         output: the output element (index on the simulation grid) of a functional output.
+        level_names: categorical input name -> the names of its levels for the tick labels:
+            a dict level code -> name, or a list of names, one per level varied over in
+            increasing order (default: the integer codes).
 
     Example:
         >>> import numpy as np, gpmsa
@@ -126,8 +135,16 @@ def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0
     z = float(norm.ppf((1 + level) / 2))
     y_name = sens.y_names[output] if output < len(sens.y_names) else "y"
     y_unit = sens.y_units[output] if output < len(sens.y_units) else ""
+    ticks = _level_ticks(sens, level_names)
     for k, name in enumerate(sens.names):
         ax, grid, cur = axes[k], sens.effect_grid[:, k], curves[:, :, k]
+        if name in ticks:
+            _level_points(ax, grid, cur, None if gp is None else gp[:, :, k], q, z, level, spread)
+            ax.set_xticks(*ticks[name])
+            ax.margins(x=0.15)
+            ax.axhline(float(np.mean(sens.mean[:, output])), color="0.5", ls=":", lw=1)
+            ax.set_xlabel(axis_label(name, sens.units.get(name, "")))
+            continue
         ax.plot(grid, cur.mean(axis=0), color="C0", label="mean over draws" if spread else None)
         if gp is not None:
             sd = np.sqrt(gp[:, :, k].mean(axis=0) + np.var(cur, axis=0))
@@ -149,3 +166,56 @@ def main_effect_curves(sens: Sensitivity, *, level: float = 0.9, output: int = 0
     drawn = f"over {curves.shape[0]} draws" if spread else "the point estimate"
     fig.suptitle(f"main effects{where} ({drawn})", fontsize="small")
     return fig
+
+
+def _level_ticks(sens: Sensitivity, level_names) -> dict[str, tuple[list[float], list[str]]]:
+    """Per categorical input of ``sens``: its levels and their tick labels (``level_names``'
+    names, or the integer codes); GPMSAError naming the input for a bad ``level_names``."""
+    if level_names is None:
+        level_names = {}
+    if not isinstance(level_names, dict):
+        raise GPMSAError(f"level_names must be None or a dict input name -> level names, got "
+                         f"{level_names!r}")  # fmt: skip
+    for name in level_names:
+        if name not in sens.categorical:
+            raise GPMSAError(f"level_names names {name!r}, not a varied categorical input; those "
+                             f"are {sens.categorical}")  # fmt: skip
+    out = {}
+    for name in sens.categorical:
+        levels = [int(v) for v in sens.bounds[name]]
+        given = level_names.get(name)
+        if given is None:
+            labels = [str(v) for v in levels]
+        elif isinstance(given, dict):
+            missing = [v for v in levels if v not in given]
+            if missing:
+                raise GPMSAError(f"level_names[{name!r}] has no name for levels {missing} (the "
+                                 f"levels varied over: {levels})")  # fmt: skip
+            labels = [str(given[v]) for v in levels]
+        elif isinstance(given, list | tuple) and len(given) == len(levels):
+            labels = [str(v) for v in given]
+        else:
+            raise GPMSAError(f"level_names[{name!r}] must be a dict level -> name or a list of "
+                             f"{len(levels)} names (one per level of {levels}), got "
+                             f"{given!r}")  # fmt: skip
+        out[name] = ([float(v) for v in levels], labels)
+    return out
+
+
+def _level_points(ax, grid, cur, gp, q, z: float, level: float, spread: bool) -> None:
+    """A categorical input's main effect on ``ax``: the mean over draws at each level (the
+    grid's finite rows) as points, the interval over draws and (``gp``: the GP's variance
+    per draw) the wider one with it as error bars; nothing drawn between the levels."""
+    at = np.isfinite(grid)
+    grid, cur = grid[at], cur[:, at]
+    mean = cur.mean(axis=0)
+    if gp is not None:
+        sd = np.sqrt(gp[:, at].mean(axis=0) + np.var(cur, axis=0))
+        ax.errorbar(grid, mean, yerr=z * sd, fmt="none", ecolor="C0", alpha=0.4, elinewidth=6,
+                    label=f"{100 * level:.0f} % with the GP's variance")  # fmt: skip
+    if spread:
+        lo, hi = np.quantile(cur, q, axis=0)
+        # the interval [lo, hi] itself: a skewed spread can leave the mean outside it
+        ax.errorbar(grid, (lo + hi) / 2, yerr=(hi - lo) / 2, fmt="none", ecolor="C0",
+                    capsize=4, label=f"{100 * level:.0f} % over draws")  # fmt: skip
+    ax.plot(grid, mean, "o", color="C0", label="mean over draws" if spread else None)

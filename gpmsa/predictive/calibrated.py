@@ -127,8 +127,9 @@ def calibrated_predict(
         resid: include the emulator's nugget and residual variance (see ``Emulator.predict``).
         n_theta: at most this many posterior draws when draws are used.
         extrapolate: allow x_new outside the emulator's x domain, however far (with a
-            warning naming x_new), as ``gpmsa.calibrate`` allows x_obs; False: GPMSAError for
-            x_new outside it.
+            warning naming x_new), as ``gpmsa.calibrate`` allows x_obs; False: within
+            ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width a warning, as
+            ``Emulator.predict``, beyond it a GPMSAError naming the column.
 
     Returns:
         CalibratedPrediction (native units).

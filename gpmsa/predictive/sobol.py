@@ -138,6 +138,8 @@ class Sensitivity:
             native output units^2; None unless ``effect_variance`` and ``main_effect_grid``.
         joint_effect_variance: (S, G2, G2, l_sim, P) the same of each joint-effect function
             (SEPIA's ``jef_v``); None unless ``effect_variance`` and ``joint_effect_grid``.
+        categorical: the varied inputs that are categorical (their ``bounds`` entry: the levels
+            varied over; their effect functions are given at those levels only).
     """
 
     names: tuple[str, ...]
@@ -173,6 +175,7 @@ class Sensitivity:
     group_joint_aggregated: np.ndarray | None = field(default=None, repr=False)
     main_effect_variance: np.ndarray | None = field(default=None, repr=False)
     joint_effect_variance: np.ndarray | None = field(default=None, repr=False)
+    categorical: tuple[str, ...] = field(default=(), repr=False)
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
         """Per input: the aggregated main and total indices, their mean, sd and central
@@ -1016,4 +1019,5 @@ def sensitivity(
         groups=tuple(tuple(k_names[n] for n in group) for group in group_pos),
         group_joint=out_group, group_joint_pc=out_group_pc, group_joint_aggregated=out_group_agg,
         main_effect_variance=main_var, joint_effect_variance=joint_var,
+        categorical=tuple(n for n, lev in zip(k_names, lev_n, strict=True) if lev is not None),
     )  # fmt: skip
