@@ -416,6 +416,9 @@ def calibrate(
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
         backend_options=backends.recorded_options(options),
     )  # fmt: skip
+    codes = theta_levels_native(emulator)
+    if codes:  # a categorical theta: its quantiles are levels (Posterior.quantile)
+        info["levels"] = codes
     if held is not None:
         info["fixed"] = info.pop("fixed", {})  # after the run's own keys
         info["held"] = list(held_names)  # the posterior names held (Posterior.summary's "held")
@@ -605,6 +608,18 @@ def _fast_held(emulator, held: dict) -> tuple[dict[int, float] | None, float | N
     if "lamOs" in held:
         lamos = float(checked_fixed("lamOs", held["lamOs"], (1,), emulator.priors)[0])
     return theta, lamos
+
+
+def theta_levels_native(emulator) -> dict[str, list[float]]:
+    """Each categorical calibration parameter's training levels (native codes) by name, as
+    ``Posterior.info["levels"]`` records them (the Calibrator's grid too); {} without one."""
+    levels = getattr(emulator, "levels", None)
+    if levels is None:
+        return {}
+    p = len(emulator.x_names)
+    return {str(name): [float(v) for v in lv]
+            for name, lv in zip(emulator.t_names, tuple(levels)[p:], strict=True)
+            if lv is not None}  # fmt: skip
 
 
 def _level_record(emulator, moves: dict) -> dict:

@@ -495,14 +495,17 @@ class Posterior:
 
     def quantile(self, name: str, q: float | np.ndarray) -> float | np.ndarray:
         """Posterior quantile(s) of ``name`` at probability q in [0, 1]: a number, or an array
-        of them (vectorised: an array of quantiles of the same shape)."""
+        of them (vectorised: an array of quantiles of the same shape). A categorical
+        parameter's (``info["levels"]``) is the lower quantile, a level: the smallest whose
+        CDF reaches q."""
         self._check(name)
         q_arr = check_probabilities(q, "q")
-        out = (
-            self.grids[name].ppf(q_arr)
-            if name in self.grids
-            else np.quantile(self.samples[name], q_arr)
-        )
+        if name in self.grids:
+            out = self.grids[name].ppf(q_arr)
+        else:  # a categorical parameter's (info["levels"]): the lower quantile, a level
+            discrete = name in (self.info.get("levels") or {})
+            out = np.quantile(self.samples[name], q_arr,
+                              method="inverted_cdf" if discrete else "linear")  # fmt: skip
         return float(out) if np.ndim(out) == 0 else out
 
     def interval(self, name: str, level: float = 0.9) -> tuple[float, float]:

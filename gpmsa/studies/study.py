@@ -236,9 +236,13 @@ class Study:
         self.metadata = dict(metadata or {})
         self.sha256: str | None = None
         chains = native_chains(layout, self.draws)
+        levels = {}  # a categorical element's codes: Posterior.info["levels"] (level quantiles)
         for el, lv in zip(layout.elements, element_levels(layout, self.members), strict=True):
             if lv is not None:  # a categorical element's draws: exactly the level codes
                 chains[el.name] = np.round(chains[el.name])
+                i, k = el.uses[0]
+                emu = self.members[i]
+                levels[el.name] = [float(v) for v in emu.levels[len(emu.x_names) + k]]
         for name, value in _held_theta(layout, self.draws, self.settings).items():
             chains[name][...] = value
         samples = {k: v.reshape(-1) for k, v in chains.items()}
@@ -246,6 +250,8 @@ class Study:
         n_chains, n_draws = self.draws["log_post"].shape
         info = {"method": f"study {kind}", "diagnostics": self.diagnostics, **self.settings,
                 "units": study_units(layout, self.members)}  # fmt: skip
+        if levels:
+            info["levels"] = levels
         self.convergence = None
         if n_chains > 1:
             shapes = {k: () for k in chains}
