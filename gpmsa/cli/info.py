@@ -9,7 +9,7 @@ import sys
 
 import numpy as np
 
-from gpmsa.cli.text import internal_error, number, plain, safe, value
+from gpmsa.cli.text import internal_error, number, plain, safe, tempering_text, value
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.validation import DISCREPANCY_ARRAY
 from gpmsa.mcmc.diagnostics import beyond
@@ -97,23 +97,6 @@ def _separable_text(emulator) -> str:
         for g, n in zip(sep.groups, sep.sizes, strict=True)
     )
     return f"{factors}, the first varying slowest (SimData(separable=); arrays/kron_factor)"
-
-
-def _tempering_text(settings: dict) -> str:
-    """Parallel tempering's records (settings "temperatures", "swap_every", "swap_rate"; not
-    checked by the reader: any JSON printed as it is), in words."""
-    temps, rates = settings.get("temperatures"), settings.get("swap_rate")
-    if isinstance(temps, list):
-        ladder = f"{len(temps)} temperatures [{', '.join(number(t, '.6g') for t in temps)}]"
-    else:
-        ladder = f"temperatures {value(temps)}"
-    if isinstance(rates, list) and all(isinstance(r, list) for r in rates):
-        rate_text = "; ".join(", ".join(number(v, ".3f") for v in r) for r in rates)
-        rate_text = f"[{rate_text}] (per chain; per neighbour pair, over the draws)"
-    else:
-        rate_text = value(rates)
-    return safe(f"{ladder}, a swap round every {plain(settings.get('swap_every'))} sweep(s); "
-                f"swap rates {rate_text}", 600)  # fmt: skip
 
 
 def _level_moves_text(record: object) -> str:
@@ -210,7 +193,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))
     if "temperatures" in s:  # parallel tempering (fit(..., temperatures=)): lists, not above
-        lines.append(f"tempering:       {_tempering_text(s)}")
+        lines.append(f"tempering:       {tempering_text(s)}")
     if "level_offsets" in s:  # a categorical theta's joint level move: a dict, not above
         lines.append(f"level moves:     {_level_moves_text(s['level_offsets'])}")
     if s.get("discrepancy") is not None:

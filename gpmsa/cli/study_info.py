@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from gpmsa.cli.text import number, plain, safe, value
+from gpmsa.cli.text import number, plain, safe, tempering_text, value
 
 
 def study_lines(file: str, manifest: dict, study) -> list[str]:
@@ -44,6 +44,8 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in manifest["settings"].items()
             if not isinstance(v, (list, dict))]  # fmt: skip
     lines.append("settings:        " + ", ".join(flat))
+    if "temperatures" in manifest["settings"]:  # calibrate_study(..., temperatures=): lists
+        lines.append(f"tempering:       {tempering_text(manifest['settings'])}")
     for k, v in manifest["metadata"].items():
         lines.append(f"metadata {safe(k, 60)}: {value(v)}")
     for name, row in study.summary(0.9).items():

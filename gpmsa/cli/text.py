@@ -68,3 +68,20 @@ def internal_error(exc: BaseException) -> str:
         f"unexpected {type(exc).__name__} ({safe(exc, MAX_VALUE_CHARS)}): the file or the input "
         "is outside what gpmsa checks; please report it"
     )
+
+
+def tempering_text(settings: dict) -> str:
+    """Parallel tempering's records (settings "temperatures", "swap_every", "swap_rate"; not
+    checked by the reader: any JSON printed as it is), in words."""
+    temps, rates = settings.get("temperatures"), settings.get("swap_rate")
+    if isinstance(temps, list):
+        ladder = f"{len(temps)} temperatures [{', '.join(number(t, '.6g') for t in temps)}]"
+    else:
+        ladder = f"temperatures {value(temps)}"
+    if isinstance(rates, list) and all(isinstance(r, list) for r in rates):
+        rate_text = "; ".join(", ".join(number(v, ".3f") for v in r) for r in rates)
+        rate_text = f"[{rate_text}] (per chain; per neighbour pair, over the draws)"
+    else:
+        rate_text = value(rates)
+    return safe(f"{ladder}, a swap round every {plain(settings.get('swap_every'))} sweep(s); "
+                f"swap rates {rate_text}", 600)  # fmt: skip

@@ -212,7 +212,8 @@ def warn_unconverged(
             "if longer chains do not bring them together, the posterior may have several "
             "modes that no chain crosses (compare the chains: to_arviz(), "
             "gpmsa.plots.traces; parallel tempering moves between modes: the numpy "
-            "sampler's temperatures= option of gpmsa.fit and calibrate(fast=False))."
+            "sampler's temperatures= option of gpmsa.fit, calibrate(fast=False), "
+            "calibrate_study and fit_study)."
         )
     warnings.warn(
         f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "

@@ -266,10 +266,26 @@ class ChainState:
             self.log_prior += d_lp
             accepted[i] += 1
 
+    def use_level_shifts(self, source: ChainState) -> None:
+        """``source``'s level shifts (`learn_level_shifts`; a tempered copy takes the T = 1
+        copy's: any shifts keep the move exact)."""
+        self.level_shifts = source.level_shifts
+
     @property
     def params(self) -> dict[str, np.ndarray]:
         """Current parameter values."""
         return self.lik.params
+
+    @property
+    def loglik(self) -> float:
+        """Current log-likelihood (untempered)."""
+        return self.lik.loglik
+
+    def exchange(self, other: ChainState) -> None:
+        """Swap states with ``other`` (a tempered copy: ``gpmsa.mcmc.tempering.swap``): the
+        likelihood states, the parameters with them, and the running log priors."""
+        self.lik, other.lik = other.lik, self.lik
+        self.log_prior, other.log_prior = other.log_prior, self.log_prior
 
     def log_post(self) -> float:
         """Current log posterior (likelihood + priors of the sampled parameters)."""

@@ -76,33 +76,35 @@ def ladder(temperatures) -> tuple[float, ...] | None:
     return tuple(float(v) for v in arr)
 
 
-def check_swap_every(swap_every, temperatures, n_iter: int | None = None) -> int:
+def check_swap_every(swap_every, temperatures, n_iter: int | None = None,
+                     what: str = "n_iter") -> int:  # fmt: skip
     """``swap_every`` as an int in [1, ``MAX_SWAP_EVERY``]; GPMSAError for another value, for
     a value other than 1 without ``temperatures`` (there is nothing to swap), or for one above
-    ``n_iter`` with them (no swap round among the draws: its swap rate would read 0)."""
+    ``n_iter`` (the caller's argument ``what``) with them (no swap round among the draws: its
+    swap rate would read 0)."""
     n = check_count(swap_every, "swap_every", 1, MAX_SWAP_EVERY)
     if temperatures is None and n != 1:
         raise GPMSAError(f"swap_every={n} needs temperatures= (parallel tempering)")
     if temperatures is not None and n_iter is not None and n > n_iter:
         raise GPMSAError(
-            f"swap_every={n} exceeds n_iter={n_iter}: no swap round would run among the draws "
+            f"swap_every={n} exceeds {what}={n_iter}: no swap round would run among the draws "
             "(the copies would never exchange states, and the swap rates would read 0); give "
-            "swap_every <= n_iter"
+            f"swap_every <= {what}"
         )
     return n
 
 
 def swap(states: list, betas: tuple[float, ...], u: np.ndarray, accepted: np.ndarray) -> None:
     """One round of neighbour swaps: for k = 0 .. K - 2, copies k and k + 1 (``states``,
-    ``ChainState``s at inverse temperatures ``betas``) exchange their likelihood states (the
-    parameters with them) and running log priors where log u[k] is below the log acceptance
-    ratio; adds 1 to ``accepted[k]`` per swap."""
+    ``ChainState``s or a study's ``StudyState``s at inverse temperatures ``betas``) exchange
+    their states (``exchange``: the likelihood states, the parameters with them, and the running
+    log priors) where log u[k] is below the log acceptance ratio, on each copy's ``loglik``;
+    adds 1 to ``accepted[k]`` per swap."""
     for k in range(len(states) - 1):
         a, b = states[k], states[k + 1]
-        log_r = (betas[k] - betas[k + 1]) * (b.lik.loglik - a.lik.loglik)
+        log_r = (betas[k] - betas[k + 1]) * (b.loglik - a.loglik)
         if math.log(u[k]) < log_r:
-            a.lik, b.lik = b.lik, a.lik
-            a.log_prior, b.log_prior = b.log_prior, a.log_prior
+            a.exchange(b)
             accepted[k] += 1
 
 
@@ -119,6 +121,50 @@ def tune_ladder(states: list, betas, rng, names, widths, n_rounds, n_levels, swa
             swap(states, betas, rng.random(len(states) - 1), swaps)
         on_round(n_levels * len(states))
     return [tuning.choose_widths(widths, cands, a, n_rounds) for a in acc]
+
+
+def run_ladder(states: list, rng: np.random.Generator, n_iter: int, widths: np.ndarray,
+               kinds: list[str], record: Callable[[int], None], *, swap_every: int, tune: bool,
+               tune_rounds: int, tune_levels: int, prop_mh: bool, bar, desc: str):  # fmt: skip
+    """The ladder's run (module docstring) over ``states``, its copies at the inverse
+    temperatures of their ``beta`` (each a ``sampler.ChainState``, or a study's
+    ``StudyState``, at the chain's start): the categorical level shifts learnt at T = 1 and
+    shared, every copy tuned at its temperature from ``widths`` (``tune``; GPM/SA's tuning
+    ``kinds``, per element), then ``n_iter`` sweeps of every copy, a swap round every
+    ``swap_every``, ``record(it)`` after each (the T = 1 copy, ``states[0]``, is the one to
+    keep). Returns the T = 1 copy's accepted counts and widths and the swap acceptance rate
+    (K - 1,) of each neighbour pair over the draws' swap rounds."""
+    betas = tuple(state.beta for state in states)
+    n_temps = len(states)
+    w = [widths] * n_temps
+    swaps = np.zeros(n_temps - 1)
+    if tune and widths.size:
+        _share_level_shifts(states)  # the widths tuned with the level moves (categorical)
+        bar.set_description(f"{desc}: tuning step widths ({n_temps} temperatures)")
+        w = tune_ladder(states, betas, rng, kinds, widths, tune_rounds, tune_levels, swaps,
+                        bar.update)  # fmt: skip
+    _share_level_shifts(states)  # anew at T = 1, shared: any shifts keep the move exact
+    bar.set_description(f"{desc}: sampling ({n_temps} temperatures)")
+    accepted = [np.zeros(widths.size) for _ in states]
+    swaps[:] = 0.0
+    for it in range(n_iter):
+        for k, state in enumerate(states):
+            state.sweep(w[k], prop_mh, accepted[k])
+        if it % swap_every == swap_every - 1:
+            swap(states, betas, rng.random(n_temps - 1), swaps)
+        record(it)
+        if it % 100 == 99:
+            bar.update(100 * n_temps)
+    bar.update((n_iter % 100) * n_temps)
+    return accepted[0], w[0], swaps / max(n_iter // swap_every, 1)
+
+
+def _share_level_shifts(states: list) -> None:
+    """The T = 1 copy's categorical level shifts learnt at its state, every copy given them."""
+    cold = states[0]
+    cold.learn_level_shifts()
+    for state in states[1:]:
+        state.use_level_shifts(cold)
 
 
 def run_tempered_chain(
@@ -138,61 +184,43 @@ def run_tempered_chain(
     proportional_steps: bool | None = None,
     record: dict | None = None,
 ):
-    """``sampler.run_chain`` with a ladder of tempered copies (module docstring), each a
-    ``new_state()`` (a ``sampler.ChainState`` at the chain's start, drawing from ``rng``):
-    ``n_iter`` sweeps of every copy after its tuning; the T = 1 copy's draws are kept. Returns
-    ``run_chain``'s draws, log_post, accept rates and widths (of the T = 1 copy) and the swap
-    acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds; ``record``
+    """``sampler.run_chain`` with a ladder of tempered copies (module docstring, `run_ladder`),
+    each a ``new_state()`` (a ``sampler.ChainState`` at the chain's start, drawing from
+    ``rng``): ``n_iter`` sweeps of every copy after its tuning; the T = 1 copy's draws are kept.
+    Returns ``run_chain``'s draws, log_post, accept rates and widths (of the T = 1 copy) and the
+    swap acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds; ``record``
     as ``run_chain``'s (the T = 1 copy's level moves, shared by the ladder)."""
     from tqdm.auto import tqdm
 
-    betas = tuple(1.0 / t for t in temperatures)
     states = []
-    for beta in betas:
+    for t in temperatures:
         state = new_state()
-        state.beta = beta
+        state.beta = 1.0 / t
         states.append(state)
     cold = states[0]
     cold.check_start()
-    els = cold.els
     n_temps = len(states)
-    w = [cold.flat_widths(widths)] * n_temps
-    swaps = np.zeros(n_temps - 1)
     total = n_temps * (n_iter + (tune_rounds * tune_levels if tune else 0))
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
+    log_post = np.empty(n_iter)
+    names = problem.names
+
+    def keep(it: int) -> None:
+        prm = cold.params
+        for n in names:
+            draws[n][it] = prm[n]
+        log_post[it] = cold.log_post()
+
+    prop_mh = (not tune) if proportional_steps is None else proportional_steps
     with threadpool_limits(1):
-        if tune and els:
-            cold.learn_level_shifts()  # the widths tuned with the level moves (categorical)
-            for state in states[1:]:
-                state.level_shifts = cold.level_shifts
-            bar.set_description(f"{desc}: tuning step widths ({n_temps} temperatures)")
-            names = [n for n, _ in els]
-            w = tune_ladder(states, betas, rng, names, w[0], tune_rounds, tune_levels, swaps,
-                            bar.update)  # fmt: skip
-        cold.learn_level_shifts()  # anew at T = 1, shared: any shifts keep the move exact
-        for state in states[1:]:
-            state.level_shifts = cold.level_shifts
-        bar.set_description(f"{desc}: sampling ({n_temps} temperatures)")
-        draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
-        log_post = np.empty(n_iter)
-        accepted = [np.zeros(len(els)) for _ in states]
-        swaps[:] = 0.0
-        prop_mh = (not tune) if proportional_steps is None else proportional_steps
-        names = problem.names
-        for it in range(n_iter):
-            for k, state in enumerate(states):
-                state.sweep(w[k], prop_mh, accepted[k])
-            if it % swap_every == swap_every - 1:
-                swap(states, betas, rng.random(n_temps - 1), swaps)
-            prm = cold.params
-            for n in names:
-                draws[n][it] = prm[n]
-            log_post[it] = cold.log_post()
-            if it % 100 == 99:
-                bar.update(100 * n_temps)
-        bar.update((n_iter % 100) * n_temps)
+        accepted, w, rates = run_ladder(
+            states, rng, n_iter, cold.flat_widths(widths), [n for n, _ in cold.els], keep,
+            swap_every=swap_every, tune=tune, tune_rounds=tune_rounds, tune_levels=tune_levels,
+            prop_mh=prop_mh, bar=bar, desc=desc,
+        )  # fmt: skip
     bar.close()
-    rate, wid = cold.element_records(accepted[0], w[0], n_iter)
+    rate, wid = cold.element_records(accepted, w, n_iter)
     if record is not None:
         record["level"] = cold.level_record()
-    return draws, log_post, rate, wid, swaps / max(n_iter // swap_every, 1)
+    return draws, log_post, rate, wid, rates

@@ -35,7 +35,7 @@ from gpmsa.fitting.fit import (
     thinning,
 )
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import tuning
+from gpmsa.mcmc import tempering, tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.mcmc.starts import check_init
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
@@ -124,9 +124,28 @@ def _check_memory(problems, n_iter: int, n_chains: int, what: str,
     check_memory(nbytes, what)
 
 
+def _check_tempering(temperatures, swap_every, n_iter, continuing: bool, what: str):
+    """The ladder (``tempering.ladder``; None: off) and ``swap_every`` (None: 1) of a study's
+    parallel tempering, checked (n_iter, ``what``, already is); GPMSAError naming
+    ``temperatures`` with ``init`` a study (its record holds the T = 1 chains alone)."""
+    temps = tempering.ladder(temperatures)
+    every = 1 if swap_every is None else swap_every
+    every = tempering.check_swap_every(every, temps, int(n_iter), what)
+    if temps is not None and continuing:
+        raise GPMSAError(
+            "temperatures= with init=study: a study's record holds its T = 1 chains alone, not "
+            "the tempered copies to continue; run the study afresh with temperatures=, or "
+            "continue it without temperatures="
+        )
+    return {} if temps is None else {"temperatures": temps, "swap_every": every}
+
+
 def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
     rate = chains.accept_rate.mean(axis=0)
-    return {**chains.info, "n_burn": int(n_burn), **extra,
+    info = chains.info
+    if "swap_rate" in info:  # parallel tempering: as fit's settings record it
+        info = {**info, "swap_rate": np.asarray(info["swap_rate"]).tolist()}
+    return {**info, "n_burn": int(n_burn), **extra,
             "accept_rate": {n: float(r) for n, r in zip(chains.names, rate, strict=True)},
             "step_widths": {n: float(w) for n, w in zip(chains.names, chains.widths[0],
                                                         strict=True)},
@@ -306,7 +325,7 @@ def calibrate_study(
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     extrapolate: bool = False, progress: bool = False, n_jobs: int | None = None,
     executor=None, metadata: dict | None = None, discrepancy=None, discrepancy_groups=None,
-    fixed=None, append: bool = False,
+    fixed=None, append: bool = False, temperatures=None, swap_every: int | None = None,
 ) -> Study:  # fmt: skip
     """Calibrate several fitted emulators at once, their emulator parameters fixed (as
     ``gpmsa.calibrate`` does for one), with shared and/or hierarchical calibration parameters.
@@ -359,6 +378,14 @@ def calibrate_study(
             every model that has it (one dict for all does so); a held hierarchical element
             stays in its group at its value. ``settings["fixed"]`` records each model's (as
             ``calibrate``'s ``info["fixed"]``).
+        temperatures, swap_every: parallel tempering, as ``gpmsa.fit``'s (off by default, and
+            then the draws are the plain sampler's, bit for bit): each chain runs a copy of the
+            whole study per temperature (the models' likelihoods raised to 1/T, every prior and
+            the hierarchy's untempered), each tuned at its temperature; neighbours propose to
+            swap their states every ``swap_every`` (1, at most n_samples) sweeps, and only the
+            T = 1 copy's draws are kept (about n times the time). ``settings`` record
+            "temperatures", "swap_every" and "swap_rate" (per chain, per neighbour pair).
+            Refused with ``init`` a study (continue without them).
 
     Returns a ``Study``; ``study.posterior`` names each shared parameter by its name, every
     other by "NAME[LABEL]", each model's "lamOs[LABEL]" (and with a discrepancy its
@@ -401,6 +428,7 @@ def calibrate_study(
     n_burn = (0 if continuing else 1000) if n_burn is None else n_burn
     given_hyper = hyper is not None
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
+    tempered = _check_tempering(temperatures, swap_every, n_samples, continuing, "n_samples")
     if not continuing:
         check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
@@ -469,6 +497,7 @@ def calibrate_study(
         problems, layout, hyper, n_iter=int(n_samples), n_chains=int(n_chains), tune=tune,
         seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
         tune_levels=tune_levels, progress=progress, n_jobs=n_jobs, executor=executor, **resumed,
+        **tempered,
     )  # fmt: skip
     chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples), **extra)
@@ -551,7 +580,8 @@ def fit_study(
     priors: Priors | None = None, n_pc: int | float | None = None, basis=None, discrepancy=None,
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
-    metadata: dict | None = None, fixed=None, append: bool = False,
+    metadata: dict | None = None, fixed=None, append: bool = False, temperatures=None,
+    swap_every: int | None = None,
 ) -> Study:  # fmt: skip
     """Fit several GPM/SA models jointly (each its emulator and observations, as ``gpmsa.fit``
     with ``obs``) whose calibration parameters are shared and/or hierarchical (SEPIA's shared
@@ -587,6 +617,9 @@ def fit_study(
             parameter held must be held at one value by every model that has it; each model's
             ``settings["fixed"]`` records its own (as ``fit``'s), ``study.settings["fixed"]``
             all of them.
+        temperatures, swap_every: parallel tempering, as ``calibrate_study``'s (each copy a
+            whole study, its emulators' parameters too; at most n_iter between swap rounds);
+            each member's settings record them too, with the study's swap rates.
 
     Returns a ``Study`` of kind "fit": ``study.members`` are the models' fitted emulators (their
     ``calibration`` holds the model's theta draws), ``study.posterior`` as ``calibrate_study``.
@@ -616,6 +649,7 @@ def fit_study(
         n_burn = 0 if continuing else n_iter // 5
     given_hyper = hyper is not None
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
+    tempered = _check_tempering(temperatures, swap_every, n_iter, continuing, "n_iter")
     if not continuing:
         check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
@@ -672,6 +706,7 @@ def fit_study(
         problems, layout, hyper, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         seed=seed, init="auto" if continuing else init, tune_rounds=tune_rounds,
         tune_levels=tune_levels, progress=progress, n_jobs=n_jobs, executor=executor, **resumed,
+        **tempered,
     )  # fmt: skip
     chains = _with_held(chains, problems, ORDER, fixes)
     if not append:
@@ -716,6 +751,9 @@ def fit_study(
             emu_settings.update(discrepancy_record(prep.problem.obs))
         if fixes[i] is not None:  # as gpmsa.fit records it (continuations compare it)
             emu_settings["fixed"] = fixed_record(problems[i])
+        if tempered:  # as gpmsa.fit(..., temperatures=) records it (the study's swaps)
+            emu_settings.update({k: settings[k] for k in ("temperatures", "swap_every",
+                                                          "swap_rate")})  # fmt: skip
         if continuing:  # as gpmsa.fit(..., init=the source member) records it
             emu_settings["continued_from"] = init.members[i].model_sha256
         if append:  # as gpmsa.fit(..., init=the source member, append=True) records it

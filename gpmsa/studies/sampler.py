@@ -13,6 +13,13 @@ start, so that the tuned widths suit every level the chain visits, and again aft
 frozen for the draws: `StudyState.learn_level_shifts`), accepted on the sum of the
 touched models' log-likelihood changes and the shifted elements' priors (its own prior is
 uniform over its levels).
+
+With ``temperatures`` (parallel tempering, ``gpmsa.mcmc.tempering``) a chain runs a ladder of
+whole study states, copy k at temperature T_k targeting prior x L^(1/T_k), L the product of the
+models' likelihoods (every likelihood change in the sweep's acceptances times 1/T_k; the priors,
+the groups' hyperpriors and truncated normals with them, untempered: the groups' moves are the
+same at every temperature); neighbours swap their whole states (study elements, groups, each
+model's likelihood state) as ``tempering.swap`` accepts; the T = 1 copy's draws are kept.
 """
 
 from __future__ import annotations
@@ -24,7 +31,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import level_moves, starts, tuning
+from gpmsa.mcmc import level_moves, starts, tempering, tuning
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.mcmc.sampler import DEFAULT_WIDTHS, ChainState, default_widths, require_finite
 from gpmsa.model.problem import Problem
@@ -143,7 +150,8 @@ def _holds(problem: Problem, k: int) -> bool:
 
 class StudyState:
     """The current state of one study chain: the models' ``ChainState``s (theta held), the study
-    elements g, and the groups' (mu, lam)."""
+    elements g, and the groups' (mu, lam). ``beta``: the power 1/T of the likelihoods in the
+    acceptances (a tempered copy; 1.0: the plain sweep bit for bit)."""
 
     def __init__(
         self, problems: list[Problem], layout: Layout, hyper: HyperPriors,
@@ -166,6 +174,37 @@ class StudyState:
         self.shifts: dict[int, tuple] = {}  # `learn_level_shifts`: element -> its shifts
         self.touched = {e: _models_of(layout, [e]) for e, lv in enumerate(self.levels)
                         if lv is not None}  # fmt: skip
+        self._beta = 1.0
+
+    # --- a tempered copy (gpmsa.mcmc.tempering) ------------------------------------------------
+    @property
+    def beta(self) -> float:
+        """The power 1/T of the likelihoods (every model's sweep takes it too)."""
+        return self._beta
+
+    @beta.setter
+    def beta(self, value: float) -> None:
+        self._beta = float(value)
+        for s in self.states:
+            s.beta = self._beta
+
+    @property
+    def loglik(self) -> float:
+        """The sum of the models' log-likelihoods (untempered)."""
+        return sum(s.lik.loglik for s in self.states)
+
+    def exchange(self, other: StudyState) -> None:
+        """Swap states with ``other`` (``tempering.swap``): the study elements, the groups'
+        (mu, lam) and each model's likelihood state and running log prior."""
+        self.g, other.g = other.g, self.g
+        self.mu, other.mu = other.mu, self.mu
+        self.lam, other.lam = other.lam, self.lam
+        for s, t in zip(self.states, other.states, strict=True):
+            s.exchange(t)
+
+    def use_level_shifts(self, source: StudyState) -> None:
+        """``source``'s level moves (`learn_level_shifts`; any shifts keep the move exact)."""
+        self.shifts, self.touched = source.shifts, source.touched
 
     # --- priors -------------------------------------------------------------------------------
     def _theta_lp(self, e: int, x: float) -> float:
@@ -212,6 +251,7 @@ class StudyState:
         """One sweep (theta elements, each model's own parameters, the groups' mu and lam);
         adds 1 to ``accepted[i]`` per accepted element (order as ``element_names``)."""
         G, H = self.layout.n_elements, len(self.group_els)
+        beta = self._beta
         u = self.rng.random((G + 2 * H, 2))
         for e, el in enumerate(self.layout.elements):
             if e in self.held:
@@ -234,7 +274,7 @@ class StudyState:
                 dll += ll - lik.loglik
             if dll == -math.inf:
                 continue
-            if math.log(u[e, 1]) < dll + lp_new - self._theta_lp(e, x):
+            if math.log(u[e, 1]) < dll * beta + lp_new - self._theta_lp(e, x):
                 for i, _ in el.uses:
                     self.states[i].lik.accept()
                 self.g[e] = cand
@@ -316,7 +356,7 @@ class StudyState:
             if ll == -math.inf:
                 return
             dll += ll - lik.loglik
-        if math.log(u1) < dll + d_lp:
+        if math.log(u1) < dll * self._beta + d_lp:
             for i in touched:
                 self.states[i].lik.accept()
             self.g = cand
@@ -375,68 +415,89 @@ def run_study_chain(
     seed: np.random.SeedSequence, init: str = "gpmsa", tune_rounds: int = tuning.N_BURN,
     tune_levels: int = tuning.N_LEVELS, progress: bool = False, desc: str = "study",
     start: tuple | None = None, widths: np.ndarray | None = None, prop_mh: bool | None = None,
+    temperatures: tuple[float, ...] | None = None, swap_every: int = 1,
 ) -> dict:  # fmt: skip
     """One chain: its start (``gpmsa.mcmc.starts`` rule ``init``; a continuation's ``start``:
     (models' starts, g, mu, lam)), tuning, ``n_iter`` sweeps; ``widths``: the initial step
     widths in sweep order (None: GPM/SA's); ``prop_mh``: GPM/SA's proportional precision steps
-    (None: when not tuned).
+    (None: when not tuned). ``temperatures``: a ladder from 1 (``tempering.ladder``), a copy of
+    the study state per temperature from the same start, each tuned at its temperature, a swap
+    round every ``swap_every`` sweeps (``tempering.run_ladder``); the T = 1 copy's draws kept.
 
     Returns plain arrays: theta (N, G), mu, lam (N, H), log_post (N,), members (per model,
-    name -> (N, *shape)), accept_rate and widths per element.
+    name -> (N, *shape)), accept_rate and widths per element; with ``temperatures`` also
+    swap_rate (K - 1,), each neighbour pair's swap acceptance over the draws.
     """
     from tqdm.auto import tqdm
 
     rng = np.random.default_rng(seed)
     if start is None:
         start = _start(problems, layout, hyper, init, starts.start_generator(seed))
-    state = StudyState(problems, layout, hyper, *start, rng)
+    copies = [StudyState(problems, layout, hyper, *start, rng) for _ in temperatures or (1.0,)]
+    state = copies[0]
     if math.isnan(state.log_post()):
         raise GPMSAError("the starting values give a log posterior of NaN; check the data")
     w = _default_widths(state, layout) if widths is None else np.array(widths, dtype=float)
     prop_mh = not tune if prop_mh is None else prop_mh
-    total = n_iter + (tune_rounds * tune_levels if tune else 0)
+    total = len(copies) * (n_iter + (tune_rounds * tune_levels if tune else 0))
     own = [s.problem.sampled for s in state.states]
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
+           "mu": np.empty((n_iter, len(layout.groups))),
+           "lam": np.empty((n_iter, len(layout.groups)))}  # fmt: skip
+    members = [{n: np.empty((n_iter, *s.params[n].shape)) for n in names}
+               for s, names in zip(state.states, own, strict=True)]  # fmt: skip
+
+    def record(it: int) -> None:  # the (T = 1) state's sweep it
+        out["theta"][it], out["mu"][it], out["lam"][it] = state.g, state.mu, state.lam
+        for s, names, rec in zip(state.states, own, members, strict=True):
+            for n in names:
+                rec[n][it] = s.params[n]
+        out["log_post"][it] = state.log_post()
+
+    kinds = _tuning_kinds(state.states, layout)
     with threadpool_limits(1):
-        if tune:
-            bar.set_description(f"{desc}: tuning step widths")
-            kinds = _tuning_kinds(state.states, layout)
-            state.learn_level_shifts()  # the widths tuned with the level moves: for both modes
-            w = tuning.tune_widths(state.sweep, kinds, w, tune_rounds, tune_levels, bar.update)
-        state.learn_level_shifts()  # found anew, frozen before the draws (a categorical theta)
-        bar.set_description(f"{desc}: sampling")
-        out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
-               "mu": np.empty((n_iter, len(layout.groups))),
-               "lam": np.empty((n_iter, len(layout.groups)))}  # fmt: skip
-        members = [{n: np.empty((n_iter, *s.params[n].shape)) for n in names}
-                   for s, names in zip(state.states, own, strict=True)]  # fmt: skip
-        accepted = np.zeros(w.size)
-        for it in range(n_iter):
-            state.sweep(w, prop_mh, accepted)
-            out["theta"][it], out["mu"][it], out["lam"][it] = state.g, state.mu, state.lam
-            for s, names, rec in zip(state.states, own, members, strict=True):
-                for n in names:
-                    rec[n][it] = s.params[n]
-            out["log_post"][it] = state.log_post()
-            if it % 100 == 99:
-                bar.update(100)
-        bar.update(n_iter % 100)
+        if temperatures is not None:
+            for copy, t in zip(copies, temperatures, strict=True):
+                copy.beta = 1.0 / t
+            accepted, w, out["swap_rate"] = tempering.run_ladder(
+                copies, rng, n_iter, w, kinds, record, swap_every=swap_every, tune=tune,
+                tune_rounds=tune_rounds, tune_levels=tune_levels, prop_mh=prop_mh, bar=bar,
+                desc=desc,
+            )  # fmt: skip
+        else:
+            if tune:
+                bar.set_description(f"{desc}: tuning step widths")
+                state.learn_level_shifts()  # the widths tuned with the level moves: both modes
+                w = tuning.tune_widths(state.sweep, kinds, w, tune_rounds, tune_levels,
+                                       bar.update)  # fmt: skip
+            state.learn_level_shifts()  # found anew, frozen before the draws (categorical)
+            bar.set_description(f"{desc}: sampling")
+            accepted = np.zeros(w.size)
+            for it in range(n_iter):
+                state.sweep(w, prop_mh, accepted)
+                record(it)
+                if it % 100 == 99:
+                    bar.update(100)
+            bar.update(n_iter % 100)
     bar.close()
     out.update(members=members, accept_rate=accepted / max(n_iter, 1), widths=w,
                names=element_names(state.states, layout))  # fmt: skip
     return out
 
 
-def _wrong_run(run, n_iter: int, n_elements: int) -> str | None:
+def _wrong_run(run, n_iter: int, n_elements: int, n_temps: int = 0) -> str | None:
     """``run_chains``' check of a study chain's result: None when it is the task's own, as
-    `run_study_chain` makes it, else the draws it should hold."""
+    `run_study_chain` makes it (``n_temps`` > 0: with the swap rates of that many copies),
+    else the draws it should hold."""
     keys = {"theta", "mu", "lam", "log_post", "members", "accept_rate", "widths", "names"}
     if isinstance(run, dict) and keys <= set(run):
         if np.shape(run["theta"]) == (n_iter, n_elements) and np.shape(run["log_post"]) == (
             n_iter,
         ):
-            return None
-    return f"{n_iter} sweeps"
+            if not n_temps or np.shape(run.get("swap_rate")) == (n_temps - 1,):
+                return None
+    return f"{n_iter} sweeps" + (f" at {n_temps} temperatures" if n_temps else "")
 
 
 def sample_study(
@@ -445,13 +506,16 @@ def sample_study(
     tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
     chain_starts: list | None = None, widths: list | None = None, prop_mh: bool | None = None,
+    temperatures: tuple[float, ...] | None = None, swap_every: int = 1,
 ) -> StudyChains:  # fmt: skip
     """``n_chains`` study chains, chain c on ``SeedSequence(seed).spawn(n_chains)[c]`` (its draws
     do not depend on where it runs: ``n_jobs`` processes or ``executor``, as
     ``gpmsa.mcmc.parallel.run_chains``). A continuation gives ``chain_starts`` (per chain:
     models' starts, g, mu, lam; init "continued"), ``widths`` (per chain, sweep order; None:
-    GPM/SA's) and ``prop_mh`` (``run_study_chain``'s). ChainError names a chain that failed or
-    whose draws are not finite."""
+    GPM/SA's) and ``prop_mh`` (``run_study_chain``'s). ``temperatures`` (a checked ladder,
+    ``tempering.ladder``) and ``swap_every``: parallel tempering (``run_study_chain``); info
+    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1). ChainError names a
+    chain that failed or whose draws are not finite."""
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     held_elements(problems, layout)  # a held element the models disagree on: before any work
     element_levels(problems, layout)  # a categorical element the study cannot sample: likewise
@@ -468,9 +532,13 @@ def sample_study(
             task.update(start=chain_starts[c], prop_mh=prop_mh)
         if widths is not None:
             task["widths"] = widths[c]
+        if temperatures is not None:
+            task.update(temperatures=tuple(temperatures), swap_every=int(swap_every))
+    n_temps = 0 if temperatures is None else len(temperatures)
     runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
                       progress=progress, desc="study chain",
-                      check=lambda _, r: _wrong_run(r, int(n_iter), layout.n_elements))  # fmt: skip
+                      check=lambda _, r: _wrong_run(r, int(n_iter), layout.n_elements,
+                                                    n_temps))  # fmt: skip
     members = tuple(
         {n: np.stack([r["members"][i][n] for r in runs]) for n in runs[0]["members"][i]}
         for i in range(len(problems))
@@ -484,5 +552,9 @@ def sample_study(
               "tune_rounds": tune_rounds, "tune_levels": tune_levels, "seed": seed,
               "seed_entropy": str(seq.entropy), "init": how},
     )  # fmt: skip
+    if temperatures is not None:  # the ladder and each neighbour pair's swap rate
+        out.info.update(temperatures=[float(t) for t in temperatures],
+                        swap_every=int(swap_every),
+                        swap_rate=np.stack([r["swap_rate"] for r in runs]))  # fmt: skip
     require_finite({"theta": out.theta, "mu": out.mu, "lam": out.lam}, out.log_post)
     return out

@@ -64,7 +64,7 @@ def test_a_plain_file_has_neither_line(tmp_path, capsys):
 
 
 def test_hostile_tempering_records_are_printed_escaped(tempered_file):
-    from gpmsa.cli.info import _tempering_text
+    from gpmsa.cli.text import tempering_text as _tempering_text
 
     text = _tempering_text({"temperatures": ["\x1b[2J", {"a": 1}], "swap_every": "\x1b",
                             "swap_rate": [[1e400, None], "x" * 2000]})  # fmt: skip
