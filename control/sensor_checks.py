@@ -69,6 +69,10 @@ MAX_NOISE_SD_MPS2 = 1e4
 its square must stay finite)."""
 FREE_FALL_MPS2 = -GRAVITY
 """What the vertical acceleration reads while a wheel is in the air (the simulator's -g), m/s^2."""
+NEAR_EQUAL = 1e-6
+"""Fraction of a block's largest |acceleration| within which the clip check takes samples as
+one value (free-fall samples read -g up to the solver's residual: two flights of one block
+can differ by ~1e-8)."""
 EPS = float(np.finfo(float).eps)
 """Machine epsilon of float64 (the rounding bounds of the level checks' shortcuts)."""
 
@@ -208,6 +212,8 @@ def longest_repeat(a: np.ndarray) -> int:
     if a.size == 0:
         return 0
     change = np.flatnonzero((a[1:] - a[:-1]) != 0)  # np.diff(a) != 0, without its wrapper
+    if change.size == a.size - 1:  # (the usual case: every sample differs from the one before)
+        return 1
     edges = np.concatenate([[-1], change, [a.size - 1]])
     return int((edges[1:] - edges[:-1]).max())
 
@@ -239,14 +245,19 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
         return f"quantised or clipped signal: {distinct} distinct values in {a.size} samples"
     if limits.range_mps2 is not None and np.any(np.abs(a) >= limits.range_mps2):
         return f"clipped signal: |a| reaches the sensor's range {limits.range_mps2:g} m/s^2"
-    values, counts = _near_equal_groups(ordered, gaps, peak)
-    if np.count_nonzero(counts > limits.max_same) >= 2:  # free flight piles up at one value
-        top = np.argsort(counts, kind="stable")[::-1][:2]
-        lo, hi = sorted(top, key=lambda i: values[i])
-        return (
-            f"clipped signal: {counts[lo]} samples at {values[lo]:.4g} m/s^2 and {counts[hi]} at "
-            f"{values[hi]:.4g} m/s^2 (allowed {limits.max_same} at two values)"
-        )
+    tol = NEAR_EQUAL * (peak or 1.0)
+    # two piles of more than max_same samples each hold max_same gaps within tol between their
+    # sorted samples (the usual case: fewer such gaps, no groups to form)
+    if np.count_nonzero(gaps <= tol) >= 2 * limits.max_same:
+        values, counts = _near_equal_groups(ordered, gaps, tol)
+        if np.count_nonzero(counts > limits.max_same) >= 2:  # free flight piles up at one value
+            top = np.argsort(counts, kind="stable")[::-1][:2]
+            lo, hi = sorted(top, key=lambda i: values[i])
+            return (
+                f"clipped signal: {counts[lo]} samples at {values[lo]:.4g} m/s^2 and "
+                f"{counts[hi]} at {values[hi]:.4g} m/s^2 (allowed {limits.max_same} at two "
+                f"values)"
+            )
     flight = flight_reading(limits)
     s1, s2, sd = _centred_sums(a)  # shared by the dead, noise-floor and level checks
     # every DEAD_STRETCH consecutive samples in order: their ranges (the dead check) and the
@@ -369,6 +380,8 @@ def _most_lattice_like(
 ) -> tuple[float, int, int, float]:  # fmt: skip
     """`most_lattice_like` with the block's `_resolution` known (and `_sorted_runs` of
     ``DEAD_STRETCH`` samples, where given: that stretch's)."""
+    if free_fall is not None and not _in_flight(a, free_fall).any():
+        free_fall = None  # (the usual case: no value of the block to exempt)
     found = [
         (*_lattice_stretch(a, n, free_fall, resolution,
                            sorted_runs if n == DEAD_STRETCH else None), n)
@@ -419,34 +432,46 @@ def _lattice_stretch(
         return 1.0, -1, float("nan")
     if ordered is None:
         ordered = _sorted_runs(a, stretch)  # (stretch, stretches)
+    if free_fall is not None:  # a wheel in the air's values as NaN: they neither count nor
+        # make a step (every comparison with NaN is False), in their places in value order
+        ordered = np.where(_in_flight(ordered, free_fall), np.nan, ordered)
     low = ordered[:-1]
     step = ordered[1:] - low  # (stretch - 1 steps, stretches): neighbours in value
     usable = step > resolution
-    if free_fall is not None:
-        flying = _in_flight(ordered, free_fall)
-        usable &= ~(flying[:-1] | flying[1:])
     if not usable.any():
         return 1.0, -1, float("nan")
     g = np.where(usable, step, 1.0)
-    # |x - rint(x)| g <= r / 2 with x = (value - low) / g for each of the stretch's values (in
-    # value order: the hits count them), in one buffer (in place): this (steps, stretch,
-    # stretches) array is the check's main cost
-    x = np.subtract(ordered[None], low[:, None])
-    x /= g[:, None]
+    # |x - rint(x)| g <= r / 2 with x = (value - low) / g for each of the stretch's other values
+    # than the two that make the step (they lie on it), in one buffer (in place): this (others,
+    # steps, stretches) array is the check's main cost; g, (steps, stretches), spans its inner
+    # axes (one pass of the ufunc loop over them)
+    x = ordered[_others(stretch)]
+    x -= low
+    x /= g
     x -= np.rint(x)
     np.abs(x, out=x)
-    x *= g[:, None]
+    x *= g
     on = x <= 0.5 * resolution
-    if free_fall is not None:
-        on &= ~flying[None]
-    hits = on.sum(axis=1) - 2  # the two values that make the step are on it
-    row, col = np.nonzero(usable & (hits > 0))
-    if row.size == 0:
+    # (counted in the smallest type that holds the stretch: a sum into int64 costs ~2x as much)
+    hits = on.sum(axis=0, dtype=np.min_scalar_type(stretch))
+    found = np.flatnonzero(usable & (hits > 0))  # (steps, stretches), in C order
+    if found.size == 0:
         return 1.0, -1, float("nan")
-    chance = np.minimum(1.0, 2.0 * resolution / g[row, col])
-    p = bdtrc(hits[row, col] - 1, stretch - 2, chance)  # P(hits or more)
+    chance = np.minimum(1.0, 2.0 * resolution / g.ravel()[found])
+    p = bdtrc(hits.ravel()[found] - 1, stretch - 2, chance)  # P(hits or more)
     k = int(np.argmin(p))
-    return float(p[k] * (stretch - 1)), int(col[k]), float(step[row[k], col[k]])
+    row, col = divmod(int(found[k]), g.shape[1])
+    return float(p[k] * (stretch - 1)), col, float(step[row, col])
+
+
+@functools.lru_cache(maxsize=8)
+def _others(stretch: int) -> np.ndarray:
+    """Indices (stretch - 2, stretch - 1) of a sorted stretch's values other than the two that
+    make each step: column i, those of the step from value i to value i + 1. Read-only."""
+    steps = [[j for j in range(stretch) if j not in (i, i + 1)] for i in range(stretch - 1)]
+    index = np.array(steps, dtype=np.intp).reshape(stretch - 1, stretch - 2).T.copy()
+    index.flags.writeable = False
+    return index
 
 
 def _sorted_runs(a: np.ndarray, stretch: int) -> np.ndarray | None:
@@ -503,12 +528,10 @@ def _stretch_spreads(s1: np.ndarray, s2: np.ndarray, stretch: int) -> np.ndarray
 
 
 def _near_equal_groups(
-    ordered: np.ndarray, gaps: np.ndarray, peak: float, rel: float = 1e-6
+    ordered: np.ndarray, gaps: np.ndarray, tol: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """(a value, the count) of each group of sorted values ``ordered`` (``gaps``: their
-    differences; ``peak``: their largest magnitude) equal within rel * peak (free-fall samples
-    read -g up to the solver's residual: two flights of one block can differ by ~1e-8)."""
-    tol = rel * (peak or 1.0)
+    differences) equal within ``tol`` (``NEAR_EQUAL`` of their largest magnitude)."""
     starts = np.concatenate([[0], np.flatnonzero(gaps > tol) + 1])
     return ordered[starts], np.diff(np.concatenate([starts, [ordered.size]]))
 
