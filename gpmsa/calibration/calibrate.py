@@ -44,6 +44,7 @@ from gpmsa.calibration.observations import (
     probe_layout,
     reduce,
     theta_levels,
+    theta_levels_native,
     theta_probe,
     warn_if_outside,
 )
@@ -608,18 +609,6 @@ def _fast_held(emulator, held: dict) -> tuple[dict[int, float] | None, float | N
     if "lamOs" in held:
         lamos = float(checked_fixed("lamOs", held["lamOs"], (1,), emulator.priors)[0])
     return theta, lamos
-
-
-def theta_levels_native(emulator) -> dict[str, list[float]]:
-    """Each categorical calibration parameter's training levels (native codes) by name, as
-    ``Posterior.info["levels"]`` records them (the Calibrator's grid too); {} without one."""
-    levels = getattr(emulator, "levels", None)
-    if levels is None:
-        return {}
-    p = len(emulator.x_names)
-    return {str(name): [float(v) for v in lv]
-            for name, lv in zip(emulator.t_names, tuple(levels)[p:], strict=True)
-            if lv is not None}  # fmt: skip
 
 
 def _level_record(emulator, moves: dict) -> dict:

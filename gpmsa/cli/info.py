@@ -9,7 +9,15 @@ import sys
 
 import numpy as np
 
-from gpmsa.cli.text import internal_error, number, plain, safe, tempering_text, value
+from gpmsa.cli.text import (
+    internal_error,
+    level_moves_text,
+    number,
+    plain,
+    safe,
+    tempering_text,
+    value,
+)
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.validation import DISCREPANCY_ARRAY
 from gpmsa.mcmc.diagnostics import beyond
@@ -99,31 +107,6 @@ def _separable_text(emulator) -> str:
     return f"{factors}, the first varying slowest (SimData(separable=); arrays/kron_factor)"
 
 
-def _level_moves_text(record: object) -> str:
-    """The joint level moves' record (settings "level_offsets", ``level_moves.native_record``;
-    not checked by the reader: anything else printed as it is), in words: per categorical
-    theta and chain, the shifted elements' conditional modes at each level (native units)."""
-    if not isinstance(record, dict):
-        return value(record)
-    parts = []
-    for name, rec in record.items():
-        try:
-            levels, shifted, modes = rec["levels"], rec["shifted"], rec["modes"]
-            chains = "; ".join(
-                f"chain {c + 1}: " + ", ".join(
-                    f"{number(lv, 'g')} -> "
-                    + (number(m[0], ".4g") if len(m) == 1
-                       else "(" + ", ".join(number(v, ".4g") for v in m) + ")")
-                    for lv, m in zip(levels, per, strict=True))
-                for c, per in enumerate(modes))  # fmt: skip
-            what = ", ".join(safe(n, 60) for n in shifted)
-            parts.append(f"{safe(name, 60)} shifts {what} between their modes at each level "
-                         f"({chains})")  # fmt: skip
-        except (KeyError, TypeError, ValueError):
-            parts.append(f"{safe(name, 60)}: {value(rec)}")
-    return safe("; ".join(parts) + " (native units)", 600)
-
-
 def _given_scale(std) -> str:
     """The output standardisation of a Standardizer with a given y_mean or y_sd, in words."""
     each = std.columnwise  # an sd per output element (given, or y_scale="columnwise")
@@ -195,7 +178,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     if "temperatures" in s:  # parallel tempering (fit(..., temperatures=)): lists, not above
         lines.append(f"tempering:       {tempering_text(s)}")
     if "level_offsets" in s:  # a categorical theta's joint level move: a dict, not above
-        lines.append(f"level moves:     {_level_moves_text(s['level_offsets'])}")
+        lines.append(f"level moves:     {level_moves_text(s['level_offsets'])}")
     if s.get("discrepancy") is not None:
         groups = s.get("discrepancy_groups")
         lines.append(f"discrepancy:     {plain(s['discrepancy'])}{_bases_text(manifest)}, "

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from gpmsa.cli.text import number, plain, safe, tempering_text, value
+from gpmsa.cli.text import level_moves_text, number, plain, safe, tempering_text, value
 
 
 def study_lines(file: str, manifest: dict, study) -> list[str]:
@@ -46,6 +46,8 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
     lines.append("settings:        " + ", ".join(flat))
     if "temperatures" in manifest["settings"]:  # calibrate_study(..., temperatures=): lists
         lines.append(f"tempering:       {tempering_text(manifest['settings'])}")
+    if "level_offsets" in manifest["settings"]:  # a categorical parameter's joint level move
+        lines.append(f"level moves:     {level_moves_text(manifest['settings']['level_offsets'])}")
     for k, v in manifest["metadata"].items():
         lines.append(f"metadata {safe(k, 60)}: {value(v)}")
     for name, row in study.summary(0.9).items():

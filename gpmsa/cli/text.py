@@ -85,3 +85,29 @@ def tempering_text(settings: dict) -> str:
         rate_text = value(rates)
     return safe(f"{ladder}, a swap round every {plain(settings.get('swap_every'))} sweep(s); "
                 f"swap rates {rate_text}", 600)  # fmt: skip
+
+
+def level_moves_text(record: object) -> str:
+    """The joint level moves' record (settings "level_offsets", ``level_moves.native_record``:
+    a joint fit's, or a study's by study element names; not checked by the reader: anything
+    else printed as it is), in words: per categorical theta and chain, the shifted elements'
+    conditional modes at each level (native units)."""
+    if not isinstance(record, dict):
+        return value(record)
+    parts = []
+    for name, rec in record.items():
+        try:
+            levels, shifted, modes = rec["levels"], rec["shifted"], rec["modes"]
+            chains = "; ".join(
+                f"chain {c + 1}: " + ", ".join(
+                    f"{number(lv, 'g')} -> "
+                    + (number(m[0], ".4g") if len(m) == 1
+                       else "(" + ", ".join(number(v, ".4g") for v in m) + ")")
+                    for lv, m in zip(levels, per, strict=True))
+                for c, per in enumerate(modes))  # fmt: skip
+            what = ", ".join(safe(n, 60) for n in shifted)
+            parts.append(f"{safe(name, 60)} shifts {what} between their modes at each level "
+                         f"({chains})")  # fmt: skip
+        except (KeyError, TypeError, ValueError):
+            parts.append(f"{safe(name, 60)}: {value(rec)}")
+    return safe("; ".join(parts) + " (native units)", 600)

@@ -693,14 +693,17 @@ class Emulator:
         return out
 
     def theta_summary(self) -> dict[str, dict[str, float]]:
-        """Posterior of the calibration parameters (native units) from a joint sim+obs fit."""
+        """Posterior of the calibration parameters (native units) from a joint sim+obs fit (a
+        categorical one's quantiles are levels, as ``Posterior.quantile`` gives them)."""
         if not self.calibration:
             raise GPMSAError("no calibration draws: fit was run without obs=")
         th = self.calibration["theta_native"]
         out = {}
         for k, name in enumerate(self.t_names):
             col = th[:, k]
-            q = np.quantile(col, [0.025, 0.5, 0.975])
+            levels = self.levels[self.p + k] is not None  # a categorical one's: levels
+            q = np.quantile(col, [0.025, 0.5, 0.975],
+                            method="inverted_cdf" if levels else "linear")  # fmt: skip
             out[name] = {"mean": float(col.mean()), "sd": float(col.std(ddof=1)),
                          "q2.5": float(q[0]), "q50": float(q[1]), "q97.5": float(q[2])}  # fmt: skip
         return out

@@ -62,14 +62,19 @@ def rng_of(seed) -> np.random.Generator:
     return seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
 
 
-def unit_inputs(values, names, lo, hi, what: str, levels=None) -> tuple[np.ndarray, np.ndarray]:
+def unit_inputs(
+    values, names, lo, hi, what: str, levels=None, extrapolate: bool | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Native rows (N, d) -> (native, unit scale), with the library's extrapolation rule.
 
     A 1-D array is one column when d = 1 and one row otherwise; a number one point when d = 1
     (as ``gpmsa.calibrate`` takes x_obs). Inside the design range: silent;
     up to ``EXTRAPOLATION_MARGIN`` of the range outside it: a warning; beyond: GPMSAError naming
-    the input, the values and the domain. With no inputs (d = 0, an emulator without known
-    inputs) None, or an (N, 0) array, is one row of no columns (broadcast against t's rows).
+    the input, the values and the domain (``extrapolate``: the caller's option of that name,
+    None where it has none; False: the message points at it; True: the warning at any
+    distance, as ``gpmsa.calibrate(extrapolate=True)`` takes x_obs). With no inputs (d = 0,
+    an emulator without known inputs) None, or an (N, 0) array, is one row of no columns
+    (broadcast against t's rows).
     ``levels``: per column the training levels of a categorical input, None for a continuous
     one (``gpmsa.model.categorical``): a level never seen in training is refused first, as
     ``Emulator.predict`` does.
@@ -89,12 +94,13 @@ def unit_inputs(values, names, lo, hi, what: str, levels=None) -> tuple[np.ndarr
     unit = snap_to_unit((native - lo) / (hi - lo))
     below, above = unit.min(axis=0), unit.max(axis=0)
     far = (below < -EXTRAPOLATION_MARGIN) | (above > 1 + EXTRAPOLATION_MARGIN)
-    if far.any():
+    if far.any() and not extrapolate:
         k = int(np.flatnonzero(far)[0])
         raise GPMSAError(
             f"{what}: {names[k]} reaches [{native[:, k].min():.6g}, {native[:, k].max():.6g}], "
             f"outside the emulator's domain [{lo[k]:.6g}, {hi[k]:.6g}] by more than "
             f"{EXTRAPOLATION_MARGIN:.0%} of its width"
+            + ("; pass extrapolate=True to allow it" if extrapolate is False else "")
         )
     outside = (below < 0) | (above > 1)
     if outside.any():

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
-from gpmsa.calibration.observations import blas_controller, layout_digest
+from gpmsa.calibration.observations import blas_controller, check_x, layout_digest
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
@@ -49,6 +49,7 @@ from gpmsa.model.data import (
     as_float,
     check_count,
     check_finite,
+    check_flag,
     check_level,
     evenly_spaced,
 )
@@ -448,6 +449,7 @@ def full_prediction(
     grid=None,
     seed=None,
     experiment: int | None = None,
+    extrapolate: bool = False,
 ) -> FullPrediction:
     """The calibrated prediction at new x: eta(x, theta), delta(x) and y(x), draw by draw.
 
@@ -456,7 +458,8 @@ def full_prediction(
             calibration draws are used, paired with its emulator-parameter draws.
         obs: the ObsData the calibration used (the prediction conditions on it).
         x: (N, p) new known inputs, native units. Outside the training range: a warning; more
-            than ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError.
+            than ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError naming the
+            column (``extrapolate=True``: the warning).
         posterior: instead of the joint fit's draws, a Posterior of gpmsa.calibrate (theta,
             lamOs, and betaV, lamVz with a discrepancy) with the emulator at its point estimate;
             ``obs`` must then hold the calibration's x_obs and y_obs (where the Posterior
@@ -480,6 +483,11 @@ def full_prediction(
         experiment: with per-experiment bases, the experiment (0-based) whose basis gives
             delta, on its index grid (SEPIA's ``obs_ref``): needed where experiments share a
             grid with different bases (``[D_0, zeros]`` on one grid); None: ``grid``'s.
+        extrapolate: as ``gpmsa.calibrate``'s: allow ``obs``'s x (which the calibration
+            warned of) and ``x`` outside the emulator's x domain by more than
+            ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width, ``x`` with an
+            ExtrapolationWarning; False: GPMSAError naming the column (a calibration made with
+            ``extrapolate=True`` is predicted from with it too).
 
     Returns:
         FullPrediction (native units; ``u``, ``v``, ``mu``, ``cov`` in the basis space).
@@ -504,6 +512,7 @@ def full_prediction(
     if posterior is not None and not isinstance(posterior, Posterior):
         raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
     n_rlz = check_count(n_rlz, "n_rlz")
+    extrapolate = check_flag(extrapolate, "extrapolate")
     rng = rng_of(seed)
     std, K = emulator.standardizer, emulator.K
     scalar = emulator.l_sim == 1
@@ -518,7 +527,8 @@ def full_prediction(
         _check_fitted_obs(getattr(posterior, "info", None) or {}, obs)  # a joint fit's draws
         _check_calibrated_obs(posterior, obs, emulator.x_names, emulator.y_names, std.grid)
     levels = tuple(emulator.levels)
-    x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x", levels[: emulator.p])
+    x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x", levels[: emulator.p],
+                            extrapolate)  # fmt: skip
     idx, sets = _posterior_sets(emulator, posterior, n_draws)
     record = (
         posterior.info if posterior is not None else getattr(emulator, "settings", None)
@@ -527,8 +537,9 @@ def full_prediction(
         discrepancy_groups = record.get("discrepancy_groups") if discrepancy is not None else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the calibration already warned about its x_obs
+        check_x(emulator, obs.inputs(emulator.x_names), extrapolate)  # its rule: far refused
         ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, levels, emulator.y_names,
-                           discrepancy_groups)  # fmt: skip
+                           discrepancy_groups, x_checked=True)  # fmt: skip
     p_v = ob.p_v
     if ("betaV" in sets[0]) != (p_v > 0):
         raise GPMSAError(

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gpmsa.calibration.observations import emulator_record
+from gpmsa.calibration.observations import emulator_record, theta_levels_native
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.model.discrepancy import to_samples
@@ -79,6 +79,9 @@ def calibration_posterior(emulator) -> Posterior:
     held = fixed_calibration_names(emulator.settings.get("fixed"), emulator.t_names, shapes)
     if held:  # fixed=: as calibrate records it (Posterior.summary's "held")
         info["held"] = held
+    codes = theta_levels_native(emulator)
+    if codes:  # a categorical theta: its quantiles are levels (as calibrate's)
+        info["levels"] = codes
     return Posterior(samples, chains=chains, info=info)
 
 

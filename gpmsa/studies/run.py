@@ -35,7 +35,7 @@ from gpmsa.fitting.fit import (
     thinning,
 )
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import tempering, tuning
+from gpmsa.mcmc import level_moves, tempering, tuning
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.mcmc.starts import check_init
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
@@ -142,7 +142,7 @@ def _check_tempering(temperatures, swap_every, n_iter, continuing: bool, what: s
 
 def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
     rate = chains.accept_rate.mean(axis=0)
-    info = chains.info
+    info = {k: v for k, v in chains.info.items() if k != "level_offsets"}  # `_level_offsets`
     if "swap_rate" in info:  # parallel tempering: as fit's settings record it
         info = {**info, "swap_rate": np.asarray(info["swap_rate"]).tolist()}
     return {**info, "n_burn": int(n_burn), **extra,
@@ -155,6 +155,25 @@ def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
             "seconds": time.perf_counter() - t0,
             "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
             "versions": library_versions("numpy")}  # fmt: skip
+
+
+def _level_offsets(chains: StudyChains, layout, models) -> dict:
+    """The joint level moves' record (``chains.info["level_offsets"]``, unit scale) in native
+    units, as ``gpmsa.calibrate``'s ``info["level_offsets"]`` (``level_moves.native_record``)
+    with study element names: per categorical study element, its "levels" (native codes, its
+    first model's: ``models``, the emulators or SimData), the "shifted" continuous elements (of
+    every model that uses it) and per chain their conditional "modes" at each level; {} where
+    no element made the move."""
+    record = chains.info.get("level_offsets") or {}
+    names = [el.name for el in layout.elements]
+    lo, hi = np.array(layout.bounds, dtype=np.float64).reshape(-1, 2).T
+    out = {}
+    for e, rec in record.items():
+        i, k = layout.elements[e].uses[0]
+        levels = {e: models[i].levels[len(models[i].x_names) + k]}
+        out.update(level_moves.native_record({"shifted": rec["shifted"], "offsets": {e: rec[
+            "offsets"]}}, names, lo, hi, levels))  # fmt: skip
+    return out
 
 
 def _tune_rule(tune, init) -> bool | None:
@@ -343,7 +362,9 @@ def calibrate_study(
             sd prior's sd_max below 1e-3, a GPMSAError). Every other parameter is its model's.
             A categorical parameter (``t_categorical``) may be shared (the same levels in
             every model) or a model's own, not hierarchical; its level moves with the
-            continuous parameters (``gpmsa.studies.sampler``, docs/models.md).
+            continuous parameters (``gpmsa.studies.sampler``, docs/models.md), and
+            ``settings["level_offsets"]`` records the move as ``gpmsa.calibrate``'s
+            ``info["level_offsets"]`` does, by study element names (`_level_offsets`).
         n_samples, n_burn, tune, seed, n_chains, init, tune_rounds, tune_levels, extrapolate,
             progress, n_jobs, executor: as ``gpmsa.calibrate`` (the generic numpy sweep);
             seed None (or a numpy Generator) draws one from fresh entropy (from the
@@ -502,6 +523,9 @@ def calibrate_study(
     chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples), **extra)
     settings.update(record)
+    moves = _level_offsets(chains, layout, emulators)
+    if moves:  # a categorical parameter's joint level move (other studies as before)
+        settings["level_offsets"] = moves
     keep = slice(thin - 1, None, thin) if append else slice(int(n_burn), None)
     draws = _study_draws(chains, keep, discrepancy=True)
     if append:  # the source's draws, then every sweep at its step (1)
@@ -621,6 +645,10 @@ def fit_study(
             whole study, its emulators' parameters too; at most n_iter between swap rounds);
             each member's settings record them too, with the study's swap rates.
 
+    A categorical parameter's joint level move is recorded as ``calibrate_study`` records it
+    (``settings["level_offsets"]``), and in each member's settings under its own t_name (as
+    ``gpmsa.fit``'s; the shifted elements named as the study names them).
+
     Returns a ``Study`` of kind "fit": ``study.members`` are the models' fitted emulators (their
     ``calibration`` holds the model's theta draws), ``study.posterior`` as ``calibrate_study``.
     With several chains each member's ``convergence`` judges every parameter its model sampled
@@ -714,6 +742,9 @@ def fit_study(
     keep = slice(thin - 1, None, thin) if append else slice(int(n_burn), None, thin)
     settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point, **extra)
     settings.update(record)
+    moves = _level_offsets(chains, layout, sims)
+    if moves:  # a categorical parameter's joint level move (other studies as before)
+        settings["level_offsets"] = moves
     draws = _study_draws(chains, keep)
     if append:  # the source's draws, then the continuation's at its step
         draws = cont.pool_study_draws(init, draws)
@@ -751,6 +782,11 @@ def fit_study(
             emu_settings.update(discrepancy_record(prep.problem.obs))
         if fixes[i] is not None:  # as gpmsa.fit records it (continuations compare it)
             emu_settings["fixed"] = fixed_record(problems[i])
+        own = {t: moves[layout.elements[layout.index[i][k]].name]
+               for k, t in enumerate(sim.t_names)
+               if layout.elements[layout.index[i][k]].name in moves}  # fmt: skip
+        if own:  # as gpmsa.fit records it, by its t_name (the shifted: study elements)
+            emu_settings["level_offsets"] = own
         if tempered:  # as gpmsa.fit(..., temperatures=) records it (the study's swaps)
             emu_settings.update({k: settings[k] for k in ("temperatures", "swap_every",
                                                           "swap_rate")})  # fmt: skip

@@ -172,6 +172,7 @@ class StudyState:
         self.sizes = [len(s.els) for s in self.states]
         self.levels = element_levels(problems, layout)  # a categorical element: its level moves
         self.shifts: dict[int, tuple] = {}  # `learn_level_shifts`: element -> its shifts
+        self.offsets: dict[int, np.ndarray] = {}  # and its level_offsets (the record's)
         self.touched = {e: _models_of(layout, [e]) for e, lv in enumerate(self.levels)
                         if lv is not None}  # fmt: skip
         self._beta = 1.0
@@ -327,7 +328,15 @@ class StudyState:
             off = level_moves.level_offsets(log_post, self.g, e, lv, cont)
             rows = {float(v): r for r, v in enumerate(lv)}
             self.shifts[e] = (rows, level_moves.shift_table(off), cont)
+            self.offsets[e] = off
             self.touched[e] = touched
+
+    def level_record(self) -> dict[int, dict]:
+        """The level moves' record (`learn_level_shifts`): categorical element -> {"shifted":
+        the continuous elements it shifts, "offsets": their ``level_moves.level_offsets``
+        (n_levels, len(shifted)), unit scale}; {} where no element makes the joint move."""
+        return {e: {"shifted": [int(j) for j in self.shifts[e][2]], "offsets": off}
+                for e, off in self.offsets.items()}  # fmt: skip
 
     def _level_move(self, e: int, u0: float, u1: float, accepted: np.ndarray) -> None:
         """Categorical element ``e`` to another of its levels (uniformly: a symmetric proposal,
@@ -425,8 +434,9 @@ def run_study_chain(
     round every ``swap_every`` sweeps (``tempering.run_ladder``); the T = 1 copy's draws kept.
 
     Returns plain arrays: theta (N, G), mu, lam (N, H), log_post (N,), members (per model,
-    name -> (N, *shape)), accept_rate and widths per element; with ``temperatures`` also
-    swap_rate (K - 1,), each neighbour pair's swap acceptance over the draws.
+    name -> (N, *shape)), accept_rate and widths per element, level_offsets (the (T = 1)
+    state's level moves, ``StudyState.level_record``); with ``temperatures`` also swap_rate
+    (K - 1,), each neighbour pair's swap acceptance over the draws.
     """
     from tqdm.auto import tqdm
 
@@ -482,7 +492,8 @@ def run_study_chain(
             bar.update(n_iter % 100)
     bar.close()
     out.update(members=members, accept_rate=accepted / max(n_iter, 1), widths=w,
-               names=element_names(state.states, layout))  # fmt: skip
+               names=element_names(state.states, layout),
+               level_offsets=state.level_record())  # fmt: skip
     return out
 
 
@@ -514,8 +525,11 @@ def sample_study(
     models' starts, g, mu, lam; init "continued"), ``widths`` (per chain, sweep order; None:
     GPM/SA's) and ``prop_mh`` (``run_study_chain``'s). ``temperatures`` (a checked ladder,
     ``tempering.ladder``) and ``swap_every``: parallel tempering (``run_study_chain``); info
-    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1). ChainError names a
-    chain that failed or whose draws are not finite."""
+    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1); with a categorical
+    element's joint level move, "level_offsets": element -> {"shifted": the continuous
+    elements it shifts, "offsets": (n_chains, n_levels, len(shifted)), unit scale} (as
+    ``level_moves.chains_record``, per element). ChainError names a chain that failed or whose
+    draws are not finite."""
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     held_elements(problems, layout)  # a held element the models disagree on: before any work
     element_levels(problems, layout)  # a categorical element the study cannot sample: likewise
@@ -556,5 +570,12 @@ def sample_study(
         out.info.update(temperatures=[float(t) for t in temperatures],
                         swap_every=int(swap_every),
                         swap_rate=np.stack([r["swap_rate"] for r in runs]))  # fmt: skip
+    moves = runs[0].get("level_offsets") or {}
+    if moves:  # a categorical element's joint level move: its offsets, per chain
+        out.info["level_offsets"] = {
+            e: {"shifted": rec["shifted"],
+                "offsets": np.stack([np.asarray(r["level_offsets"][e]["offsets"],
+                                                dtype=np.float64) for r in runs])}
+            for e, rec in moves.items()}  # fmt: skip
     require_finite({"theta": out.theta, "mu": out.mu, "lam": out.lam}, out.log_post)
     return out

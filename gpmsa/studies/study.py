@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from gpmsa.calibration.observations import emulator_record, theta_levels
+from gpmsa.calibration.observations import emulator_record, theta_levels, theta_levels_native
 from gpmsa.calibration.posterior import Posterior, held_names
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, load
@@ -318,6 +318,9 @@ class Study:
         own = [n for n in out if pooled.get(n, f"{n}[{self.labels[i]}]") in held]
         if own:
             info["held"] = own
+        codes = theta_levels_native(self.members[i])
+        if codes:  # a categorical theta: its quantiles are levels (as study.posterior's)
+            info["levels"] = codes
         return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out, info=info)
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:

@@ -15,8 +15,8 @@ import pytest
 from _level_cases import level_function
 
 import gpmsa
-from gpmsa.cli.info import _level_moves_text
 from gpmsa.cli.main import main
+from gpmsa.cli.text import level_moves_text as _level_moves_text
 
 
 @pytest.fixture(scope="module")
