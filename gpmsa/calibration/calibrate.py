@@ -191,10 +191,10 @@ def _theta_options(emulator, constraint, theta_init):
     included), as ``gpmsa.fit`` asks."""
     std = emulator.standardizer
     names = tuple(emulator.t_names)
-    con = constraints.make(constraint, std.t_min, std.t_max, names)
     levels = getattr(emulator, "levels", None)
     levels = None if levels is None else levels[emulator.x_unit.shape[1] :]
     closed = None if levels is None else [lv is not None for lv in levels]
+    con = constraints.make(constraint, std.t_min, std.t_max, names, closed or ())
     start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, names, closed)
     if start is not None and levels is not None:
         native = constraints.theta_native(theta_init, names)
@@ -533,8 +533,10 @@ def _run_fast(
             raise GPMSAError("log_prior must be a callable of native theta for MCMC")
         names = tuple(emulator.t_names)
 
+        categorical = [lv is not None for lv in theta_levels(emulator) or ()]
+
         def extra(theta_unit: np.ndarray) -> float:
-            native = std.t_from_unit(theta_unit[None, :])
+            native = constraints.round_levels(std.t_from_unit(theta_unit[None, :]), categorical)
             val = np.ravel(log_prior(native[:, 0] if native.shape[1] == 1 else native))
             return check_log_prior(val, names, native[0])
 
@@ -658,6 +660,8 @@ def _run_backend(
             chains_draws[k][:, :, mask] = problem.init[k][mask]
         chains = replace(chains, draws=chains_draws)
     theta = std.t_from_unit(np.asarray(chains.draws["theta"]))
+    # categorical draws: exactly the level codes (as the fast sampler's)
+    constraints.round_levels(theta, [lv is not None for lv in theta_levels(emulator) or ()])
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.asarray(chains.draws["lamOs"])[:, :, 0]
     if "lamVz" in chains.draws:

@@ -214,8 +214,9 @@ class Calibrator:
         check_emulator(emulator, categorical_theta=True)
         levels = theta_levels(emulator)  # unit scale per element, None: no categorical one
         std = emulator.standardizer
+        self._categorical = [lv is not None for lv in levels or ()]
         self.constraint = constraints.make(constraint, std.t_min, std.t_max,
-                                           tuple(emulator.t_names))  # fmt: skip
+                                           tuple(emulator.t_names), self._categorical)  # fmt: skip
         if method not in METHODS:
             raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
         backend = _mcmc_backend(backend, mcmc_options)
@@ -354,6 +355,7 @@ class Calibrator:
         holds one) prepares it now, as a Calibrator built now does."""
         self.__dict__.update(state)
         self.__dict__.setdefault("_levels", None)  # pickled before categorical grids (s73)
+        self.__dict__.setdefault("_categorical", [])
         if "_refined" not in state and self.method == "grid":
             with blas_controller().limit(limits=1, user_api="blas"):
                 plans = [chebyshev_plan(gp) for gp in self._gps]
@@ -479,6 +481,7 @@ class Calibrator:
             return np.zeros(theta_unit.shape[0])
         if callable(prior):
             native = self.emulator.standardizer.t_from_unit(theta_unit)
+            constraints.round_levels(native, self._categorical)
             vals = as_float(prior(native[:, 0] if self.q == 1 else native), "prior(theta)")
             vals = vals.reshape(-1)
             if vals.size != theta_unit.shape[0]:

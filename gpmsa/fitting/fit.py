@@ -449,8 +449,9 @@ def _model_options(prep, data: SimData, fixed, constraint, theta_init) -> Proble
     if (constraint is not None or theta_init is not None) and problem.obs is None:
         raise GPMSAError("constraint= and theta_init= apply to theta: they need obs= (a joint fit)")
     if constraint is not None:
+        categorical = [lv is not None for lv in problem.theta_levels or ()]
         problem = replace(problem, constraint=constraints.make(
-            constraint, std.t_min, std.t_max, data.t_names))  # fmt: skip
+            constraint, std.t_min, std.t_max, data.t_names, categorical))  # fmt: skip
     levels = problem.theta_levels
     closed = None if levels is None else [lv is not None for lv in levels]
     start = constraints.theta_init_unit(theta_init, std.t_min, std.t_max, data.t_names, closed)

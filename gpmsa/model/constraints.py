@@ -28,10 +28,14 @@ class ThetaConstraint:
     t_min: np.ndarray
     t_max: np.ndarray
     names: tuple[str, ...]
+    categorical: tuple[bool, ...] = ()
 
     def native(self, theta_unit: np.ndarray) -> np.ndarray:
-        """Unit-scale theta (q,) or (k, q) -> native, the same shape."""
-        return np.asarray(theta_unit, dtype=np.float64) * (self.t_max - self.t_min) + self.t_min
+        """Unit-scale theta (q,) or (k, q) -> native, the same shape; a categorical element
+        (``categorical``) exactly its integer level (the unit scale's round trip can miss it by
+        an ulp: 13 -> 12.999999999999998 with 24 levels)."""
+        native = np.asarray(theta_unit, dtype=np.float64) * (self.t_max - self.t_min) + self.t_min
+        return round_levels(native, self.categorical)
 
     def __call__(self, theta_unit: np.ndarray) -> bool:
         """Whether unit-scale theta (q,) is allowed; GPMSAError if ``fn`` fails or is not bool."""
@@ -86,8 +90,18 @@ class ThetaConstraint:
             )
 
 
-def make(constraint, t_min, t_max, names) -> ThetaConstraint | None:
-    """A ``ThetaConstraint`` from the user's ``constraint`` (None: no constraint)."""
+def round_levels(native: np.ndarray, categorical) -> np.ndarray:
+    """Native theta (..., q) with each categorical element (``categorical``, (q,) flags; empty:
+    none) rounded to its integer level, in place; the same array."""
+    for k, flag in enumerate(categorical):
+        if flag:
+            native[..., k] = np.round(native[..., k])
+    return native
+
+
+def make(constraint, t_min, t_max, names, categorical=()) -> ThetaConstraint | None:
+    """A ``ThetaConstraint`` from the user's ``constraint`` (None: no constraint);
+    ``categorical``: (q,) flags of the categorical elements (empty: none)."""
     if constraint is None:
         return None
     if not callable(constraint):
@@ -95,7 +109,8 @@ def make(constraint, t_min, t_max, names) -> ThetaConstraint | None:
             f"constraint must be a callable of native theta (q,) -> bool, got {constraint!r}"
         )
     return ThetaConstraint(constraint, np.asarray(t_min, dtype=np.float64),
-                           np.asarray(t_max, dtype=np.float64), tuple(names))  # fmt: skip
+                           np.asarray(t_max, dtype=np.float64), tuple(names),
+                           tuple(bool(c) for c in categorical))  # fmt: skip
 
 
 def theta_native(value, names, what: str = "theta_init") -> np.ndarray:
