@@ -35,7 +35,7 @@ from tqdm.auto import tqdm
 from gpmsa.backends import check_sample_args
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
-from gpmsa.mcmc import level_moves, ridge, starts, tuning
+from gpmsa.mcmc import level_moves, ridge, starts, tempering, tuning
 from gpmsa.mcmc.parallel import in_this_process, n_workers, run_chains
 from gpmsa.mcmc.sampler import (
     PRECISION_PARAMS,
@@ -505,7 +505,12 @@ class BatchState:
     the theta constraint refuses is rejected before its likelihood (the constraint called per
     chain); with a mean basis the coefficients are integrated out (`gls`) and the observations'
     mean adds the GLS trend h([x_obs, theta]) coef (`mean_rows`, cached per chain).
+    ``beta``: None (plain chains), or (C,) the power 1/T of each row's likelihood in its
+    acceptance (parallel tempering, `_tempered_sweeps`: the rows are the chains' copies; the
+    prior is not tempered).
     """
+
+    beta: Tensor | None = None
 
     def __init__(self, problem: Problem, n_chains: int, dtype: torch.dtype, device,
                  start: dict[str, np.ndarray] | None = None, ridge_moves: int = 0):  # fmt: skip
@@ -595,6 +600,17 @@ class BatchState:
         """Current log-likelihood (C,)."""
         return self.ll_w.sum(-1) + self.ll_obs
 
+    def exchange(self, a: Tensor, b: Tensor) -> None:
+        """Rows ``a`` and ``b`` (index tensors of equal length) exchange their states: the
+        parameters and every cached term (correlations, Sigma_W factors, likelihood terms,
+        mean rows); one Sigma_W shared by all rows (calibration) stays."""
+        cached = [self.ll_w, self.ll_obs, self.corr, self.h_obs]
+        if self.chol is not None and self.chol.shape[0] == self.n_chains:  # per row
+            cached += [self.chol, self.alpha, self.coef]
+        for t in (*self.params.values(), *cached):
+            if t is not None:
+                t[a], t[b] = t[b], t[a]  # both gathered (copies) before either is written
+
     def log_post(self) -> Tensor:
         """Current log posterior (C,): likelihood + priors of the sampled parameters."""
         lp = self.loglik
@@ -648,25 +664,28 @@ class BatchState:
         found = at.any(-1)
         return torch.where(found, at.to(torch.long).argmax(-1), lv.numel()), found
 
-    def learn_level_shifts(self) -> None:
+    def learn_level_shifts(self, copies: int = 1) -> None:
         """Each categorical theta element's joint level move (``gpmsa.mcmc.level_moves``, as the
         numpy sampler's ``ChainState.learn_level_shifts``): per chain, the conditional modes of
         the continuous sampled theta elements at each of its levels, the other parameters at
         the chain's current values (``level_offsets`` on the chain's log posterior); none
-        without observations, a categorical and a continuous sampled theta element."""
+        without observations, a categorical and a continuous sampled theta element.
+        ``copies`` > 1 (parallel tempering, rows c * copies + k): learnt at each chain's T = 1
+        row, every copy of the chain given them."""
         sampled = [idx[0] for n, idx in self.els if n == "theta"]
         cat = [k for k in sampled if k in self.levels and self.levels[k].numel() > 1]
         cont = [k for k in sampled if k not in self.levels]
         if not (cat and cont and self.data.has_obs):
             return
         self.shift_elements = cont
-        theta = self.params["theta"].cpu().numpy().astype(np.float64)
-        posts = [self._chain_log_post(c, cont) for c in range(self.n_chains)]
+        theta = self.params["theta"][::copies].cpu().numpy().astype(np.float64)
+        posts = [self._chain_log_post(c, cont) for c in range(0, self.n_chains, copies)]
         for k in cat:
             lv = self.levels[k].cpu().numpy().astype(np.float64)
             off = [level_moves.level_offsets(f, th, k, lv, cont)
                    for f, th in zip(posts, theta, strict=True)]  # fmt: skip
-            self.level_shifts[k] = torch.as_tensor(np.stack(off), dtype=self.ll_w.dtype,
+            self.level_shifts[k] = torch.as_tensor(np.repeat(np.stack(off), copies, axis=0),
+                                                   dtype=self.ll_w.dtype,
                                                    device=self.ll_w.device)  # fmt: skip
 
     def _chain_log_post(self, c: int, cont: list[int]):
@@ -710,9 +729,10 @@ class BatchState:
         lp_new = torch.where(found, lp_new, -torch.inf)
         return theta, lp_new, log_prior_elements(self.priors, "theta", cur[:, cont]).sum(-1)
 
-    def update(self, name: str, idx: tuple[int, ...], width: float, kind: int, prop_mh: bool,
-               u: Tensor) -> Tensor:  # fmt: skip
-        """One Metropolis step of element ``idx`` of ``name`` in every chain; u (2, C) uniforms.
+    def update(self, name: str, idx: tuple[int, ...], width: float | Tensor, kind: int,
+               prop_mh: bool, u: Tensor) -> Tensor:  # fmt: skip
+        """One Metropolis step of element ``idx`` of ``name`` in every chain; u (2, C) uniforms;
+        ``width``: the chains' step width, or each row's (C,).
 
         Returns the accepted mask (C,).
         """
@@ -790,7 +810,10 @@ class BatchState:
             lp_old = lp_new if joint is None else joint[2]
         else:
             lp_old = log_prior_elements(self.priors, name, x, idx[-1])
-        ratio = ll_new - self.loglik + lp_new - lp_old + corr
+        d_ll = ll_new - self.loglik
+        if self.beta is not None:  # tempered copies: each row's likelihood to its power 1/T
+            d_ll = d_ll * self.beta
+        ratio = d_ll + lp_new - lp_old + corr
         acc = (torch.log(u[1]) < ratio) & valid
         take = torch.nonzero(acc).squeeze(-1)
         accepted[take] = True
@@ -812,17 +835,21 @@ class BatchState:
             self.h_obs[take] = h_obs[take]
         return accepted
 
-    def sweep(self, widths: np.ndarray, prop_mh: bool, gen: torch.Generator) -> Tensor:
+    def sweep(self, widths: np.ndarray | Tensor, prop_mh: bool, gen: torch.Generator) -> Tensor:
         """One Metropolis-within-Gibbs sweep in GPM/SA's order, then ``ridge_moves`` moves along
-        the nugget ridge (``gpmsa.mcmc.ridge``); returns accepted (n_el, C) of the sweep."""
+        the nugget ridge (``gpmsa.mcmc.ridge``); returns accepted (n_el, C) of the sweep.
+        ``widths``: (n_el,) shared by every chain, or a tensor (n_el, C) of each row's
+        (tempered copies, each at its own widths)."""
         c = self.ll_w.shape[0]
         n_el = len(self.els)
         u = torch.rand((n_el + self.ridge_moves, 2, c), generator=gen, dtype=self.ll_w.dtype,
                        device=self.ll_w.device)  # fmt: skip
         out = torch.zeros((n_el, c), dtype=torch.bool, device=self.ll_w.device)
+        per_row = isinstance(widths, Tensor)
         for i, (name, idx) in enumerate(self.els):
             kind = 1 if name in RHO_PARAMS else 2 if name in PRECISION_PARAMS else 0
-            out[i] = self.update(name, idx, float(widths[i]), kind, prop_mh, u[i])
+            width = widths[i] if per_row else float(widths[i])
+            out[i] = self.update(name, idx, width, kind, prop_mh, u[i])
         if self.ridge_moves:
             self.ridge_sweep(u[n_el:])
         return out
@@ -932,6 +959,8 @@ def sample(
     n_jobs: int | None = None,
     executor=None,
     proportional_steps: bool | None = None,
+    temperatures=None,
+    swap_every: int = 1,
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
@@ -966,12 +995,34 @@ def sample(
     A theta constraint or a callable mean basis (callables of this process) keeps the groups
     in this process, one after another (an ``executor`` is refused), as the numpy backend's
     chains (``gpmsa.mcmc.parallel.in_this_process``).
+
+    ``temperatures``: parallel tempering (``gpmsa.mcmc.tempering``, as the numpy backend's; None:
+    off, the sampler above bit for bit): an integer n (the ladder 2**k) or a ladder from 1. The
+    batch then holds n_chains x K rows, chain c's copy k at row c K + k, whose likelihood
+    enters its acceptance to the power 1/T_k (priors untempered); each copy's widths are tuned
+    at its temperature (acceptance pooled over the chains' copy k), the categorical level
+    shifts learnt at T = 1 and shared by the chain's copies; after every warm-up sweep and
+    every tuning level, and every ``swap_every`` draw sweeps, neighbours k, k + 1 (k = 0 .. K -
+    2 in turn) exchange their rows' states with probability min(1, exp((1/T_k - 1/T_{k+1})
+    (log L_{k+1} - log L_k))) (`_swap_rows`). The T = 1 rows' draws, log posteriors,
+    acceptance and widths are kept; ``info`` records "temperatures", "swap_every" and
+    "swap_rate" (n_chains, K - 1) over the draws' swap rounds. In one batch (``chain_groups``
+    1, no ``executor``).
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
+    temps = tempering.ladder(temperatures)
+    swap_every = tempering.check_swap_every(swap_every, temps, int(n_iter))
+    if temps is not None and (chain_groups != 1 or executor is not None):
+        raise GPMSAError(
+            f"temperatures= runs every chain's copies in one batch: give chain_groups=1 and no "
+            f"executor (got chain_groups={chain_groups!r}"
+            f"{'' if executor is None else ', an executor'})"
+        )
+    copies = 1 if temps is None else len(temps)
     check_draws_memory(problem, int(n_iter), int(n_chains))
-    check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype))
+    check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype), copies)
     where = _check_groups(chain_groups, n_jobs, executor, int(n_chains), device, num_threads)
     where["n_jobs"], where["executor"] = in_this_process(
         callables(problem), where["n_jobs"], where["executor"], where["groups"]
@@ -979,7 +1030,8 @@ def sample(
     with torch_threads(num_threads):
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,
-                       tune_stages, check_ridge(ridge_moves, problem), where, prop_mh)  # fmt: skip
+                       tune_stages, check_ridge(ridge_moves, problem), where, prop_mh,
+                       temps, swap_every)  # fmt: skip
 
 
 def callables(problem: Problem) -> list[str]:
@@ -992,22 +1044,26 @@ def callables(problem: Problem) -> list[str]:
     ) if on]  # fmt: skip
 
 
-def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torch.dtype) -> None:
+def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torch.dtype,
+                       copies: int = 1) -> None:  # fmt: skip
     """ResourceLimitError (before any chain is set up) when the draws (`check_draws_memory`) and
     the batch's per-chain caches exceed ``gpmsa.limits.MAX_MEMORY_BYTES``: per chain and basis
     component the packed correlation matrix and its proposal buffer, and with observations the
-    Sigma_W factor and its buffer (m x m each); none where Sigma_W is fixed (one for all)."""
+    Sigma_W factor and its buffer (m x m each); none where Sigma_W is fixed (one for all).
+    ``copies``: rows per chain (parallel tempering: one per temperature)."""
     if all(k in problem.fixed for k in SIM_PARAMS):
         return
     m = problem.m
     packed = sum((b - a) * b for a, b in row_blocks(m))
     per_chain = problem.p_u * (2 * packed + (2 * m * m if problem.obs is not None else 0))
-    caches = float(dtype.itemsize) * n_chains * per_chain
+    caches = float(dtype.itemsize) * n_chains * copies * per_chain
     mats = "Sigma_W" if problem.p_u == 1 else "Sigma_W's"
     name = str(dtype).replace("torch.", "")
+    temps = f" at {copies} temperatures" if copies > 1 else ""
     check_memory(draws_nbytes(problem, n_iter, n_chains) + caches,
-                 f"torch sample(n_iter={n_iter}, n_chains={n_chains}), which caches "
-                 f"{problem.p_u} {mats} of {m} x {m} ({name}) per chain,")  # fmt: skip
+                 f"torch sample(n_iter={n_iter}, n_chains={n_chains}){temps}, which caches "
+                 f"{problem.p_u} {mats} of {m} x {m} ({name}) per chain"
+                 f"{' and temperature' if copies > 1 else ''},")  # fmt: skip
 
 
 def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_threads) -> dict:
@@ -1042,8 +1098,10 @@ def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_thr
 
 def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
             tune_levels, device, dtype, init, warmup, tune_stages, n_ridge,
-            where, prop_mh: bool) -> Chains:  # fmt: skip
-    """``sample`` without the thread setting (``prop_mh``: its ``proportional_steps``, decided)."""
+            where, prop_mh: bool, temps: tuple[float, ...] | None = None,
+            swap_every: int = 1) -> Chains:  # fmt: skip
+    """``sample`` without the thread setting (``prop_mh``: its ``proportional_steps``, decided;
+    ``temps``: the ladder, checked, or None)."""
     dev, dt = _device(device), _dtype(dtype)
     warmup = (WARMUP if tune else 0) if warmup is None else check_count(warmup, "warmup", 0)
     tune_stages = check_count(tune_stages, "tune_stages")
@@ -1056,7 +1114,9 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     seeds = np.random.SeedSequence(seed).spawn(n_chains)  # chain c starts as the numpy chain c
     how, firsts = starts.chain_starts(problem, init, seeds)
     start = {k: np.stack([f[k] for f in firsts]) for k in problem.init}
-    state = BatchState(problem, int(n_chains), dt, dev, start, n_ridge)
+    copies = 1 if temps is None else len(temps)
+    rows = start if temps is None else {k: np.repeat(v, copies, axis=0) for k, v in start.items()}
+    state = BatchState(problem, int(n_chains) * copies, dt, dev, rows, n_ridge)
     els = state.els
     w = np.array([float(widths[n][idx]) for n, idx in els])
     n_stages = tune_stages if tune else 1
@@ -1065,10 +1125,18 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     in_process = where["groups"] == 1 and where["executor"] is None
     if not in_process:
         total -= n_iter  # the groups' sweeps: counted by run_chains' bar over the groups
+    tempered = {}
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
-        if tune:  # the widths tuned with the level moves (a categorical theta; no draws used)
+        if temps is not None:
+            w, draws, log_post, accepted, rates = _tempered_sweeps(
+                state, w, temps, swap_every, n_iter, prop_mh, gen, bar, warmup=warmup,
+                n_stages=n_stages, tune=tune, tune_rounds=tune_rounds, tune_levels=tune_levels,
+            )  # fmt: skip
+            tempered = {"temperatures": list(temps), "swap_every": swap_every,
+                        "swap_rate": rates}  # fmt: skip
+        elif tune:  # the widths tuned with the level moves (a categorical theta; no draws used)
             state.learn_level_shifts()
-        for _stage in range(n_stages):
+        for _stage in range(n_stages if temps is None else 0):  # (tempered: done above)
             bar.set_description("torch MCMC: warm-up and tuning" if tune else "torch MCMC: warm-up")
             for _ in range(warmup):  # leave the starts (then the last widths' region) first
                 state.sweep(w, prop_mh, gen)
@@ -1082,8 +1150,9 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                     acc[lev] += state.sweep(cands[lev], False, gen).sum(-1)
                 bar.update(tune_levels)
             w = tuning.choose_widths(w, cands, acc.cpu().numpy(), tune_rounds * n_chains)
-        state.learn_level_shifts()  # found anew, frozen before the draws (a categorical theta)
-        if in_process:
+        if temps is None:
+            state.learn_level_shifts()  # found anew, frozen before the draws (categorical theta)
+        if in_process and temps is None:
             bar.set_description("torch MCMC: sampling")
             draws, log_post, accepted = _sweeps(state, w, n_iter, prop_mh, gen, bar)
     if not in_process:
@@ -1109,9 +1178,100 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
               "device": str(dev), "dtype": str(dt).replace("torch.", ""),
               **({} if not state.level_shifts else {"level_offsets": {  # the joint level move
                   "shifted": [int(j) for j in state.shift_elements],
-                  "offsets": {int(k): v.cpu().numpy().astype(np.float64)
-                              for k, v in state.level_shifts.items()}}})},
+                  "offsets": {int(k): v[::copies].cpu().numpy().astype(np.float64)
+                              for k, v in state.level_shifts.items()}}}),
+              **tempered},
     )  # fmt: skip
+
+
+def _swap_rows(state: BatchState, betas: tuple[float, ...], u: Tensor, accepted: Tensor) -> None:
+    """One round of neighbour swaps in every chain of a tempered batch (rows c K + k, K =
+    len(betas)): for k = 0 .. K - 2 in turn, copies k and k + 1 exchange their rows' states
+    (``BatchState.exchange``) where log u[k] (C,) is below (beta_k - beta_{k+1}) (log L_{k+1} -
+    log L_k), as ``gpmsa.mcmc.tempering.swap``; adds the accepted swaps to accepted (K - 1, C).
+    """
+    n_temps = len(betas)
+    for k in range(n_temps - 1):
+        ll = state.loglik.view(-1, n_temps)
+        acc = torch.log(u[k]) < (betas[k] - betas[k + 1]) * (ll[:, k + 1] - ll[:, k])
+        if acc.any():
+            rows = torch.nonzero(acc).squeeze(-1) * n_temps + k
+            state.exchange(rows, rows + 1)
+        accepted[k] += acc
+
+
+def _tempered_sweeps(state: BatchState, w: np.ndarray, temps: tuple[float, ...],
+                     swap_every: int, n_iter: int, prop_mh: bool, gen: torch.Generator, bar, *,
+                     warmup: int, n_stages: int, tune: bool, tune_rounds: int,
+                     tune_levels: int) -> tuple:  # fmt: skip
+    """``_sample``'s warm-up, tuning and draws with parallel tempering (``sample``'s
+    ``temperatures``): ``state`` holds C chains x K copies (row c K + k at temperature
+    ``temps[k]``), every copy from the widths ``w`` (n_el,). Each stage: ``warmup`` sweeps,
+    then GPM/SA's tuning of each copy's widths at its temperature (acceptance pooled over the
+    chains' copy k), a swap round (`_swap_rows`) after each sweep and each tuning level; then
+    ``n_iter`` sweeps, a swap round every ``swap_every``. Returns the T = 1 copy's widths
+    (n_el,), `_sweeps`' draws, log posterior and accepted counts of the T = 1 rows, and the swap
+    rate (C, K - 1) of each neighbour pair over the draws' swap rounds."""
+    n_temps, n_el = len(temps), len(state.els)
+    n_chains = state.n_chains // n_temps
+    dt, dev = state.ll_w.dtype, state.ll_w.device
+    betas = tuple(1.0 / t for t in temps)
+    state.beta = torch.tensor(betas, dtype=dt, device=dev).repeat(n_chains)
+    swaps = torch.zeros((n_temps - 1, n_chains), dtype=torch.long, device=dev)
+    names = [n for n, _ in state.els]
+
+    def rows(per_copy: np.ndarray) -> Tensor:  # (K, n_el) -> each row's widths (n_el, C K)
+        return torch.as_tensor(per_copy.T, dtype=dt, device=dev).repeat(1, n_chains)
+
+    def swap_round() -> None:
+        u = torch.rand((n_temps - 1, n_chains), generator=gen, dtype=dt, device=dev)
+        _swap_rows(state, betas, u, swaps)
+
+    ws = np.tile(w, (n_temps, 1))  # each copy's widths
+    if tune:  # the widths tuned with the level moves (a categorical theta), learnt at T = 1
+        state.learn_level_shifts(n_temps)
+    for _stage in range(n_stages):
+        bar.set_description(f"torch MCMC: warm-up{' and tuning' if tune else ''} ({n_temps} "
+                            "temperatures)")  # fmt: skip
+        per_row = rows(ws)
+        for _ in range(warmup):
+            state.sweep(per_row, prop_mh, gen)
+            swap_round()
+            bar.update(1)
+        if not (tune and n_el):
+            break
+        cands = [tuning.level_widths(names, ws[k], tune_levels) for k in range(n_temps)]
+        levels = [rows(np.stack([c[lev] for c in cands])) for lev in range(tune_levels)]
+        acc = torch.zeros((tune_levels, n_el, n_temps), dtype=torch.long, device=dev)
+        for _ in range(tune_rounds):
+            for lev in range(tune_levels):
+                took = state.sweep(levels[lev], False, gen)  # (n_el, C K)
+                acc[lev] += took.view(n_el, n_chains, n_temps).sum(1)
+                swap_round()
+            bar.update(tune_levels)
+        counts = acc.cpu().numpy()
+        ws = np.stack([tuning.choose_widths(ws[k], cands[k], counts[..., k],
+                                            tune_rounds * n_chains)
+                       for k in range(n_temps)])  # fmt: skip
+    state.learn_level_shifts(n_temps)  # anew at T = 1, shared by the copies, frozen
+    bar.set_description(f"torch MCMC: sampling ({n_temps} temperatures)")
+    problem, cold, per_row = state.problem, slice(None, None, n_temps), rows(ws)
+    draws = {n: torch.empty((n_iter, n_chains, *problem.init[n].shape), dtype=dt, device=dev)
+             for n in problem.names}  # fmt: skip
+    log_post = torch.empty((n_iter, n_chains), dtype=dt, device=dev)
+    accepted = torch.zeros((n_el, n_chains), dtype=torch.long, device=dev)
+    swaps.zero_()
+    for it in range(n_iter):
+        accepted += state.sweep(per_row, prop_mh, gen)[:, cold]
+        if it % swap_every == swap_every - 1:
+            swap_round()
+        for n in problem.names:
+            draws[n][it] = state.params[n][cold]
+        log_post[it] = state.log_post()[cold]
+        bar.update(1)
+    rate = swaps.cpu().numpy().T / max(n_iter // swap_every, 1)
+    return (ws[0], {n: np.moveaxis(v.cpu().numpy(), 0, 1) for n, v in draws.items()},
+            log_post.cpu().numpy().T, accepted.cpu().numpy(), rate)  # fmt: skip
 
 
 def _sweeps(

@@ -373,7 +373,9 @@ def calibrate(
             f"calibrate: options {sorted(options)} go to a backend's sampler, which the fast "
             "numpy sampler replaces; pass fast=False (or another backend) to use them"
         )
-    temps = tempering.ladder(options.get("temperatures")) if backend == "numpy" else None
+    temps = None  # parallel tempering (numpy, torch: their samplers' option)
+    if backend in ("numpy", "torch"):
+        temps = tempering.ladder(options.get("temperatures"))
     _check_calibrate_memory(emulator, n_samples, n_chains, fast, 1 if temps is None else len(temps))
     _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}
@@ -489,7 +491,7 @@ def _check_calibrate_memory(
     emulator, n_samples: int, n_chains: int, fast: bool, copies: int = 1
 ) -> None:
     """Refuse before sampling a run whose stored sweeps exceed gpmsa.limits.MAX_MEMORY_BYTES;
-    with parallel tempering (``copies`` > 1 temperatures, the numpy backend) its ``copies``
+    with parallel tempering (``copies`` > 1 temperatures, numpy or torch) its ``copies``
     likelihood states too, as ``gpmsa.fit`` counts them (``_check_fit_memory(copies=)``)."""
     p, q, p_u = emulator.x_unit.shape[1], emulator.t_unit.shape[1], emulator.K.shape[1]
     if fast:  # a tuple of q + 3 Python floats per sweep, then an array

@@ -182,19 +182,20 @@ def fit(
     there). theta_init: the chains' start of theta (native, (q,) or a dict by t_names; default
     the centre; a categorical element: one of its levels).
 
-    Parallel tempering (numpy options ``temperatures`` and ``swap_every``; off by default, and
-    then the draws are GPM/SA's sampler's, bit for bit): for a posterior with several modes
-    that the one-element steps do not cross (a ConvergenceWarning whose chains lie apart, log
-    posteriors tens apart). ``temperatures``: an integer n (the ladder T = 2**k, k = 0 .. n -
-    1) or a ladder (1, T_1, ...), strictly increasing from 1; each chain then runs a copy per
-    temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at its
-    temperature; neighbouring copies propose to swap states every ``swap_every`` (1) sweeps,
+    Parallel tempering (numpy and torch options ``temperatures`` and ``swap_every``; off by
+    default, and then the draws are the plain sampler's, bit for bit): for a posterior with
+    several modes that the one-element steps do not cross (a ConvergenceWarning whose chains lie
+    apart, log posteriors tens apart). ``temperatures``: an integer n (the ladder T = 2**k, k =
+    0 .. n - 1) or a ladder (1, T_1, ...), strictly increasing from 1; each chain then runs a
+    copy per temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at
+    its temperature; neighbouring copies propose to swap states every ``swap_every`` (1) sweeps,
     and only the T = 1 copy's draws are kept. It costs about one sweep per copy (n times the
-    time, memory for n likelihood states). ``settings`` record "temperatures", "swap_every"
-    and "swap_rate" (per chain, per neighbour pair): rates near 0 say the ladder is too
-    sparse, the hottest copy should cross between the modes (a barrier of 50 in log
-    posterior needs T_max of tens). Refused on the torch and pyro backends and with ``init``
-    an emulator (docs/internals.md, "Parallel tempering").
+    time, memory for n likelihood states). ``settings`` record "temperatures", "swap_every" and
+    "swap_rate" (per chain, per neighbour pair): rates near 0 say the ladder is too sparse, the
+    hottest copy should cross between the modes (a barrier of 50 in log posterior needs T_max of
+    tens). torch: the batch holds every chain's copies (n_chains x n rows), in one batch
+    (``chain_groups=1``). Refused on the pyro backend and with ``init`` an emulator
+    (docs/internals.md, "Parallel tempering").
 
     A categorical theta of a joint fit moves levels jointly with the continuous theta
     (``gpmsa.mcmc.level_moves``): ``settings["level_offsets"]`` records, per categorical name,
@@ -364,13 +365,14 @@ def fit(
 
 def _check_tempering(options: dict, backend: str, continuing: bool):
     """The ladder of ``fit``'s ``temperatures`` option (``tempering.ladder``; None: off).
-    GPMSAError naming ``temperatures``/``swap_every`` given to another backend than numpy, or
-    ``temperatures`` with ``init`` an emulator (its record holds the T = 1 copy alone)."""
+    GPMSAError naming ``temperatures``/``swap_every`` given to another backend than numpy or
+    torch, or ``temperatures`` with ``init`` an emulator (its record holds the T = 1 copy
+    alone)."""
     given = [k for k in ("temperatures", "swap_every") if options.get(k) is not None]
-    if given and backend != "numpy":
+    if given and backend not in ("numpy", "torch"):
         raise GPMSAError(
-            f"{' and '.join(given)}: parallel tempering runs on the numpy backend only, not "
-            f"backend={backend!r}"
+            f"{' and '.join(given)}: parallel tempering runs on the numpy and torch backends "
+            f"only, not backend={backend!r}"
         )
     temps = tempering.ladder(options.get("temperatures"))
     if temps is not None and continuing:

@@ -211,8 +211,8 @@ def warn_unconverged(
             f" R-hat {shown} ({el}) says the chains lie apart, not merely that they are short: "
             "if longer chains do not bring them together, the posterior may have several "
             "modes that no chain crosses (compare the chains: to_arviz(), "
-            "gpmsa.plots.traces; parallel tempering moves between modes: the numpy "
-            "sampler's temperatures= option of gpmsa.fit, calibrate(fast=False), "
+            "gpmsa.plots.traces; parallel tempering moves between modes: the numpy and "
+            "torch samplers' temperatures= option of gpmsa.fit, calibrate(fast=False), "
             "calibrate_study and fit_study)."
         )
     warnings.warn(

@@ -1,4 +1,4 @@
-"""Parallel tempering (opt-in, numpy backend): a move between the modes of a posterior.
+"""Parallel tempering (opt-in): a move between the modes of a posterior.
 
 GPM/SA's Metropolis-within-Gibbs sweep moves one element a short step at a time; a chain that
 ends tuning in a mode tens of log-posterior units below the main one stays there for thousands
@@ -21,6 +21,9 @@ T = 1 copy, whose draws alone are kept, samples the posterior. Swaps run through
 sweeps too (the cold copy can reach the main mode before any draw). A categorical theta's level
 move learns its shifts at T = 1 and every copy uses them (any shifts keep the move exact).
 Every uniform comes from the chain's own Generator: the draws depend on the seed alone.
+The torch backend runs the same definition with every chain's copies as rows of one batch
+(``gpmsa.backends.torch_backend``, ``sample``'s ``temperatures``; ``ladder`` and
+``check_swap_every`` check its arguments).
 """
 
 from __future__ import annotations

@@ -119,7 +119,7 @@ def test_ladder_and_swap_every():
 def test_refused_by_name_elsewhere():
     sim, obs = _case()
     with pytest.raises(GPMSAError, match="temperatures: parallel tempering runs on the numpy"):
-        gpmsa.fit(sim, obs, n_iter=10, backend="torch", temperatures=2)
+        gpmsa.fit(sim, obs, n_iter=10, backend="pyro", temperatures=2)  # (torch: s73)
     with pytest.raises(GPMSAError, match="swap_every: parallel tempering runs on the numpy"):
         gpmsa.fit(sim, obs, n_iter=10, backend="pyro", swap_every=2)
     emu = gpmsa.fit(sim, obs, n_iter=10, seed=0, tune=False)
