@@ -584,7 +584,8 @@ class Posterior:
 
     def plot(self, name: str, bins: int = 50, unit: str | None = None):
         """Histogram of ``bins`` bars (with the grid density when there is one) and trace of
-        ``name``: a Figure.
+        ``name``: a Figure. A categorical parameter (a `LevelMarginal`, or ``info["levels"]``
+        of draws) gets a bar per level, its draws' share: a probability, not a density.
 
         ``unit`` labels the axes (None: ``info["units"][name]`` where calibrate or Calibrator
         recorded the emulator's units)."""
@@ -600,17 +601,21 @@ class Posterior:
         ax_h, ax_t = fig.subplots(1, 2)
         draws = np.asarray(self.samples[name])
         g = self.grids.get(name)
+        codes = None if g is not None else self._level_codes(name)
         if isinstance(g, LevelMarginal):  # a categorical parameter: a probability per level
             freq = np.array([np.mean(draws == v) for v in g.nodes])
             ax_h.bar(g.nodes, freq, width=0.4, color="0.75", label="draws")
             ax_h.plot(g.nodes, g.density, "o", color="C0", label="exact (levels)")
+        elif codes is not None:  # its draws (calibrate, a study): their share per level
+            freq = np.array([np.mean(draws == v) for v in codes])
+            ax_h.bar(codes, freq, width=0.4, color="0.75", label="draws")
         else:
             ax_h.hist(draws, bins=bins, density=True, color="0.75", label="draws")
         if isinstance(g, GridMarginal):
             ax_h.plot(g.nodes, g.density, color="C0", label="exact (grid)")
         ax_h.axvline(self.mean(name), color="C3", lw=1, label="mean")
         ax_h.set_xlabel(label)
-        if isinstance(g, LevelMarginal):
+        if isinstance(g, LevelMarginal) or codes is not None:
             ax_h.set_ylabel("probability")
         else:
             ax_h.set_ylabel(f"density (1/{unit})" if unit else "density")
@@ -622,6 +627,17 @@ class Posterior:
         ax_t.set_ylabel(label)
         fig.tight_layout()
         return fig
+
+    def _level_codes(self, name: str) -> np.ndarray | None:
+        """A categorical parameter's level codes (``info["levels"][name]``: finite numbers),
+        increasing; None for another parameter or a record that holds no such list."""
+        levels = self.info.get("levels")
+        codes = levels.get(name) if isinstance(levels, dict) else None
+        try:
+            codes = np.unique(np.asarray(codes, dtype=float))
+        except (TypeError, ValueError):
+            return None
+        return codes if codes.size and np.all(np.isfinite(codes)) else None
 
     def __repr__(self) -> str:
         try:

@@ -292,10 +292,12 @@ def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str
 
 def _cells(vals: list, fmt: str, held: set[int]) -> str:
     """A diagnostic's values, one cell per element in its place: "held" at ``held``'s
-    positions, "nan" for a value stored as null (non-finite) among others; none where every
-    value is null (a diagnostic one chain cannot give)."""
-    if all(v is None for k, v in enumerate(vals) if k not in held):
-        return ", ".join("held" for k in range(len(vals)) if k in held)
+    positions, "nan" for a value stored as null (non-finite) among others (a free element
+    beside a held one too: a categorical theta element whose draws all sit at one level has
+    no ESS); none where every value is null and none held (a diagnostic one chain cannot
+    give)."""
+    if not held and all(v is None for v in vals):
+        return ""
     return ", ".join("held" if k in held else "nan" if v is None else number(v, fmt)
                      for k, v in enumerate(vals))  # fmt: skip
 

@@ -350,11 +350,30 @@ def default_init(p: int, q: int, p_u: int, priors: Priors, obs: ObsProblem | Non
     return init
 
 
-def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
+def check_x_obs(
+    x_unit: np.ndarray,
+    names: tuple[str, ...],
+    x_native: np.ndarray | None = None,
+    domain: tuple[np.ndarray, np.ndarray] | None = None,
+) -> None:
     """Warn when observations lie outside the design range; refuse beyond
-    ``EXTRAPOLATION_MARGIN``."""
+    ``EXTRAPOLATION_MARGIN``. ``x_native`` (n, p) and ``domain`` (the range's native ends,
+    each (p,)): the messages name the value given and the range in native units, as
+    calibration's ``check_x`` does (None: the unit scale)."""
     lo, hi = x_unit.min(axis=0), x_unit.max(axis=0)
     far = (lo < -EXTRAPOLATION_MARGIN) | (hi > 1 + EXTRAPOLATION_MARGIN)
+    where = "x_obs lies outside the simulation design's range"
+    if x_native is not None and domain is not None and ((lo < 0) | (hi > 1)).any():
+        beyond = -EXTRAPOLATION_MARGIN if far.any() else 0.0
+        j, k = (int(i) for i in np.argwhere((x_unit < beyond) | (x_unit > 1 - beyond))[0])
+        where = (f"x_obs {names[k]}={x_native[j, k]:.6g} lies outside the simulation design's "
+                 f"range [{domain[0][k]:.6g}, {domain[1][k]:.6g}]")  # fmt: skip
+        if far.any():
+            raise GPMSAError(
+                f"{where} by more than {EXTRAPOLATION_MARGIN:.0%} of its width: a joint fit "
+                "cannot extrapolate that far (gpmsa.calibrate of a fitted emulator takes "
+                "extrapolate=True)"
+            )
     if far.any():
         k = int(np.flatnonzero(far)[0])
         raise GPMSAError(
@@ -364,7 +383,7 @@ def check_x_obs(x_unit: np.ndarray, names: tuple[str, ...]) -> None:
         )
     if (lo < 0).any() or (hi > 1).any():
         warnings.warn(
-            "x_obs lies outside the simulation design's range; the emulator extrapolates there",
+            where + "; the emulator extrapolates there",
             ExtrapolationWarning,
             stacklevel=user_stacklevel(),
         )
@@ -406,7 +425,7 @@ def reduce_obs(
     if levels is not None:
         categorical.check_levels(x_native, levels[: x.shape[1]], x_names, "x_obs")
     if not x_checked:
-        check_x_obs(x, x_names)
+        check_x_obs(x, x_names, x_native, (std.x_min, std.x_max))
     n, p_u = obs.n, K.shape[1]
     scalar = K.shape[0] == 1
     experiments = obs.outputs(y_names)
