@@ -106,8 +106,12 @@ def check_options(
     unknown = [] if open_ended else sorted(set(options) - set(accepted))
     if unknown:
         offered = sorted(set(accepted) - set(reserved) - {"problem"})
+        hint = ("; x_obs outside the design: a joint fit warns within 10% of a column's width "
+                "and refuses beyond, gpmsa.calibrate of the fitted emulator takes extrapolate=True"
+                if "extrapolate" in unknown else "")  # fmt: skip
         raise GPMSAError(
-            f"{caller}: unknown option(s) {unknown} for the {backend!r} backend; it takes {offered}"
+            f"{caller}: unknown option(s) {unknown} for the {backend!r} backend; it takes "
+            f"{offered}{hint}"
         )
 
 

@@ -613,7 +613,8 @@ class Posterior:
             ax_h.hist(draws, bins=bins, density=True, color="0.75", label="draws")
         if isinstance(g, GridMarginal):
             ax_h.plot(g.nodes, g.density, color="C0", label="exact (grid)")
-        ax_h.axvline(self.mean(name), color="C3", lw=1, label="mean")
+        if not isinstance(g, LevelMarginal) and codes is None:  # (a categorical one's mean
+            ax_h.axvline(self.mean(name), color="C3", lw=1, label="mean")  # lies between levels)
         ax_h.set_xlabel(label)
         if isinstance(g, LevelMarginal) or codes is not None:
             ax_h.set_ylabel("probability")

@@ -188,9 +188,11 @@ def _level_ticks(sens: Sensitivity, level_names) -> dict[str, tuple[list[float],
             labels = [str(v) for v in levels]
         elif isinstance(given, dict):
             missing = [v for v in levels if v not in given]
+            extra = [v for v in given if v not in levels]
             if missing:
+                also = f"; {extra} are not among them" if extra else ""
                 raise GPMSAError(f"level_names[{name!r}] has no name for levels {missing} (the "
-                                 f"levels varied over: {levels})")  # fmt: skip
+                                 f"levels varied over: {levels}{also})")  # fmt: skip
             labels = [str(given[v]) for v in levels]
         elif isinstance(given, list | tuple) and len(given) == len(levels):
             labels = [str(v) for v in given]

@@ -82,6 +82,7 @@ def test_level_names_label_the_ticks_and_bad_ones_are_refused(sens):
     plt.close(fig)
     for bad, msg in (({"x": ["a", "b"]}, "'x', not a varied categorical input"),
                      ({"kind": {0: "a", 1: "b"}}, "no name for levels [3]"),
+                     ({"kind": {0: "a", 1: "b", 5: "c"}}, "[5] are not among them"),
                      ({"kind": ["a", "b"]}, "a list of 3 names"),
                      (["a"], "level_names must be None or a dict")):  # fmt: skip
         with pytest.raises(GPMSAError, match=msg.replace("[", r"\[").replace("]", r"\]")):

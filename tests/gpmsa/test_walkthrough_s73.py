@@ -70,3 +70,22 @@ def test_a_joint_fits_x_obs_outside_the_design_is_named_in_native_units():
     warned = rf"x_obs s=1.02 lies outside the simulation design's range \[{lo}"
     with pytest.warns(gpmsa.ExtrapolationWarning, match=warned):
         gpmsa.prepare(data, gpmsa.ObsData(x=[[0.5], [1.02]], y=[[1.3], [0.3]]))
+
+
+def test_a_categorical_plot_draws_no_mean_between_levels():
+    """The mean of the codes (0.27 here) lies between levels: no line for it (a continuous
+    parameter keeps its mean line)."""
+    draws = np.r_[np.zeros(73), np.ones(27)]
+    post = gpmsa.Posterior({"kind": draws, "k": np.linspace(0, 1, 100)},
+                           info={"levels": {"kind": [0.0, 1.0, 2.0]}})  # fmt: skip
+    assert "mean" not in post.plot("kind").axes[0].get_legend_handles_labels()[1]
+    assert "mean" in post.plot("k").axes[0].get_legend_handles_labels()[1]
+
+
+def test_fit_with_extrapolate_says_where_the_option_is():
+    rng = np.random.default_rng(0)
+    x, t = rng.random((12, 1)), rng.random((12, 1))
+    sim = gpmsa.SimData(x, t, x[:, 0] + t[:, 0])
+    with pytest.raises(gpmsa.GPMSAError, match="calibrate of the fitted emulator takes "
+                       "extrapolate=True"):  # fmt: skip
+        gpmsa.fit(sim, n_iter=10, extrapolate=True)
