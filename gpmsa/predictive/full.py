@@ -43,6 +43,7 @@ from gpmsa.model.basis import (
     interpolate_basis,
     is_basis_list,
 )
+from gpmsa.model.constraints import round_levels
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
     ObsData,
@@ -84,7 +85,8 @@ class FullPrediction:
     Attributes:
         x: (N, p) the inputs, native units; grid: (l,) the output grid of eta, delta, zeta, y.
         draw_index: (S,) the posterior draws used, in order.
-        theta: (S, q) their calibration parameters, native; lamOs: (S,) their noise precisions.
+        theta: (S, q) their calibration parameters, native (a categorical one its level
+            codes); lamOs: (S,) their noise precisions.
         mu: (S, N, p_v + p_u) per draw, the conditional mean of the basis weights (v then u,
             standardised scale); cov: (S, N, p_v + p_u, p_v + p_u) their covariance at each point.
         u: (S * n_rlz, N, p_u), v: (S * n_rlz, N, p_v) realizations of the weights (row
@@ -606,6 +608,8 @@ def full_prediction(
     noise = rng.standard_normal(eta.shape) / np.sqrt(np.repeat(lamOs, n_rlz))[:, None, None]
     y = eta + delta + noise * sd
     theta = std.t_from_unit(np.array([prm["theta"] for prm in sets]))
+    # categorical draws: exactly the level codes (as the posterior's and a joint fit's)
+    round_levels(theta, [lv is not None for lv in levels[emulator.p :]])
     return FullPrediction(
         x=x_nat, grid=g, draw_index=idx, theta=theta, lamOs=lamOs, mu=mu, cov=cov_pt,
         u=u, v=v, eta=eta, delta=delta, y=y, K=K_pred, D=D_pred, y_mean=std.mean_on(g),
