@@ -215,6 +215,13 @@ def warn_unconverged(
             "torch samplers' temperatures= option of gpmsa.fit, calibrate(fast=False), "
             "calibrate_study and fit_study)."
         )
+    if any(str(why).startswith("constant draws") for why in flagged.values()):
+        apart += (
+            " Constant draws in every chain: a categorical theta's chains that never leave the "
+            "levels they started at read so too, whether the posterior holds one level or the "
+            "chains are stuck (start chains at other levels, or let parallel tempering's "
+            "temperatures= move between them: docs/models.md)."
+        )
     warnings.warn(
         f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "
         f"chains x {record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
