@@ -680,6 +680,8 @@ def _run_backend(
         info.update(temperatures=list(chains.info["temperatures"]),
                     swap_every=int(chains.info["swap_every"]),
                     swap_rate=np.asarray(chains.info["swap_rate"]).tolist())  # fmt: skip
+    if "adapted_temperatures" in chains.info:  # adapt_ladder=True: each chain's, frozen
+        info["adapted_temperatures"] = np.asarray(chains.info["adapted_temperatures"]).tolist()
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
         info.update({"discrepancy": discrepancy_kind(discrepancy),
                      **discrepancy_record(problem.obs)})  # fmt: skip

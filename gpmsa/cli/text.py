@@ -71,8 +71,9 @@ def internal_error(exc: BaseException) -> str:
 
 
 def tempering_text(settings: dict) -> str:
-    """Parallel tempering's records (settings "temperatures", "swap_every", "swap_rate"; not
-    checked by the reader: any JSON printed as it is), in words."""
+    """Parallel tempering's records (settings "temperatures", "swap_every", "swap_rate", with
+    ``adapt_ladder`` "adapted_temperatures"; not checked by the reader: any JSON printed as it
+    is), in words."""
     temps, rates = settings.get("temperatures"), settings.get("swap_rate")
     if isinstance(temps, list):
         ladder = f"{len(temps)} temperatures [{', '.join(number(t, '.6g') for t in temps)}]"
@@ -83,6 +84,12 @@ def tempering_text(settings: dict) -> str:
         rate_text = f"[{rate_text}] (per chain; per neighbour pair, over the draws)"
     else:
         rate_text = value(rates)
+    adapted = settings.get("adapted_temperatures")  # adapt_ladder=True: per chain
+    if isinstance(adapted, list) and all(isinstance(r, list) for r in adapted):
+        ladder += (" adapted to [" + "; ".join(", ".join(number(t, ".4g") for t in r)
+                                                for r in adapted) + "] (per chain)")  # fmt: skip
+    elif adapted is not None:
+        ladder += f" adapted to {value(adapted)}"
     return safe(f"{ladder}, a swap round every {plain(settings.get('swap_every'))} sweep(s); "
                 f"swap rates {rate_text}", 600)  # fmt: skip
 

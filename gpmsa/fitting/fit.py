@@ -195,7 +195,12 @@ def fit(
     hottest copy should cross between the modes (a barrier of 50 in log posterior needs T_max of
     tens). torch: the batch holds every chain's copies (n_chains x n rows), in one batch
     (``chain_groups=1``). Refused on the pyro backend and with ``init`` an emulator
-    (docs/internals.md, "Parallel tempering").
+    (docs/internals.md, "Parallel tempering"). numpy option ``adapt_ladder=True`` (off by
+    default; with ``temperatures``, at least 3, and ``tune``): each chain adapts its ladder's
+    temperatures between 1 and the hottest during tuning towards equal swap rates, then freezes
+    it before the widths' tuning and the draws (an exact MCMC; about ``tune_rounds`` x
+    ``tune_levels`` more sweeps per copy); ``settings["adapted_temperatures"]`` (per chain)
+    records it, "temperatures" the ladder it started from.
 
     A categorical theta of a joint fit moves levels jointly with the continuous theta
     (``gpmsa.mcmc.level_moves``): ``settings["level_offsets"]`` records, per categorical name,
@@ -329,7 +334,10 @@ def fit(
         **({} if temps is None else {  # parallel tempering: the ladder and the swaps' success
             "temperatures": list(chains.info["temperatures"]),
             "swap_every": int(chains.info["swap_every"]),
-            "swap_rate": np.asarray(chains.info["swap_rate"]).tolist()}),
+            "swap_rate": np.asarray(chains.info["swap_rate"]).tolist(),
+            **({} if "adapted_temperatures" not in chains.info else {  # per chain, frozen
+                "adapted_temperatures": np.asarray(
+                    chains.info["adapted_temperatures"]).tolist()})}),
         **({} if "level_offsets" not in chains.info else {  # a categorical theta's level move
             "level_offsets": level_moves.native_record(
                 chains.info["level_offsets"], data.t_names, prep.standardizer.t_min,
@@ -373,6 +381,11 @@ def _check_tempering(options: dict, backend: str, continuing: bool):
         raise GPMSAError(
             f"{' and '.join(given)}: parallel tempering runs on the numpy and torch backends "
             f"only, not backend={backend!r}"
+        )
+    if "adapt_ladder" in options and backend != "numpy":
+        raise GPMSAError(
+            f"adapt_ladder: the adaptive ladder runs on the numpy backend only, not "
+            f"backend={backend!r} (give a fixed ladder, temperatures=)"
         )
     temps = tempering.ladder(options.get("temperatures"))
     if temps is not None and continuing:

@@ -563,11 +563,12 @@ def _chain_task(
     seed: np.random.SeedSequence, start: dict[str, np.ndarray], tune_rounds: int,
     tune_levels: int, ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
     proportional_steps: bool | None = None, temperatures: tuple[float, ...] | None = None,
-    swap_every: int = 1,
+    swap_every: int = 1, adapt_ladder: bool = False,
 ):  # fmt: skip
     """One chain from plain data (run in a worker process): ``run_chain`` from ``start`` (drawn
     by ``sample`` in the parent), its generator from ``seed``; ``run_chain``'s result (with
-    ``temperatures``: ``tempering.run_tempered_chain``'s, the swap rates after it), then a dict
+    ``temperatures``: ``tempering.run_tempered_chain``'s, the swap rates after it, and the
+    adapted ladder after them with ``adapt_ladder``), then a dict
     of the level moves' offsets (``ChainState.level_record``: "offsets", "shifted")."""
     record: dict = {}
     with threadpool_limits(1):
@@ -579,6 +580,7 @@ def _chain_task(
                 temperatures=temperatures, swap_every=swap_every, tune=tune, widths=widths,
                 rng=rng, tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress,
                 desc=desc, proportional_steps=proportional_steps, record=record,
+                adapt_ladder=adapt_ladder,
             )  # fmt: skip
         else:
             out = run_chain(
@@ -625,6 +627,7 @@ def sample(
     proportional_steps: bool | None = None,
     temperatures=None,
     swap_every: int = 1,
+    adapt_ladder: bool = False,
 ) -> Chains:
     """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
 
@@ -650,7 +653,12 @@ def sample(
     temperature (each tuned at its temperature), neighbours propose a swap every
     ``swap_every`` sweeps (at most ``n_iter``), and the T = 1 copy's draws are kept; ``info``
     records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1), each neighbour
-    pair's swap acceptance over the draws. Raises ChainError naming a chain that failed or whose
+    pair's swap acceptance over the draws. ``adapt_ladder`` (with ``temperatures``, at least 3,
+    and ``tune``): each chain adapts its ladder's temperatures between 1 and the hottest during
+    tuning towards equal swap rates, then freezes it before the tuning of the widths and the
+    draws, which are therefore an exact MCMC (``tempering.adapt_ladder``); ``info`` records
+    "adapt_ladder" and "adapted_temperatures" (n_chains, K) ("temperatures": the starting
+    ladder). Raises ChainError naming a chain that failed or whose
     draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
@@ -658,6 +666,7 @@ def sample(
     prop_mh = proportional_step_choice(proportional_steps, tune)
     temps = tempering.ladder(temperatures)
     swap_every = tempering.check_swap_every(swap_every, temps, int(n_iter))
+    adapt = tempering.check_adapt(adapt_ladder, temps, tune)
     check_draws_memory(problem, int(n_iter), int(n_chains))
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     seq = np.random.SeedSequence(seed)
@@ -671,7 +680,8 @@ def sample(
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": w, "seed": s,
          "start": first, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
          "ridge_moves": n_ridge, "proportional_steps": prop_mh,
-         **({} if temps is None else {"temperatures": temps, "swap_every": swap_every})}
+         **({} if temps is None else {"temperatures": temps, "swap_every": swap_every}),
+         **({"adapt_ladder": True} if adapt else {})}
         for s, first, w in zip(seeds, firsts, widths, strict=True)
     ]  # fmt: skip
     names = problem.names
@@ -679,7 +689,7 @@ def sample(
     expected = ({n: (int(n_iter), *v) for n, v in shapes.items()}, (int(n_iter),), shapes,
                 shapes)  # fmt: skip
     if temps is not None:  # and each neighbour pair's swap rate
-        expected += ((len(temps) - 1,),)
+        expected += ((len(temps) - 1,),) + (((len(temps),),) if adapt else ())
     expected += (dict,)  # the level moves' offsets (a categorical theta; else empty)
     runs = run_chains(_chain_task, tasks, n_jobs=n_jobs, executor=executor, progress=progress,
                       desc="chain",
@@ -698,6 +708,8 @@ def sample(
     if temps is not None:
         chains.info.update(temperatures=list(temps), swap_every=swap_every,
                            swap_rate=np.stack([r[4] for r in runs]))  # fmt: skip
+    if adapt:  # each chain's ladder, adapted in its tuning and frozen for its draws
+        chains.info.update(adapt_ladder=True, adapted_temperatures=np.stack([r[5] for r in runs]))
     moves = level_moves.chains_record([r[-1]["offsets"] for r in runs], runs[0][-1]["shifted"])
     if moves:  # a categorical theta's joint level move: its offsets, per chain
         chains.info["level_offsets"] = moves

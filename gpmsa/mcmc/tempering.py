@@ -24,6 +24,20 @@ Every uniform comes from the chain's own Generator: the draws depend on the seed
 The torch backend runs the same definition with every chain's copies as rows of one batch
 (``gpmsa.backends.torch_backend``, ``sample``'s ``temperatures``; ``ladder`` and
 ``check_swap_every`` check its arguments).
+
+An adaptive ladder (opt-in, numpy: ``adapt_ladder=True``, `adapt_ladder`): before GPM/SA's
+tuning, ``tune_rounds`` x ``tune_levels`` further sweeps of every copy (GPM/SA's candidate
+widths in turn), a swap round after each, move the temperatures between T_0 = 1 and the hottest
+(both fixed: the hottest must cross the barrier, which no swap rate measures) so that the
+neighbours' swap rates become equal: after swap round n, each gap's logarithm
+S_k = log(T_{k+1} - T_k) moves by kappa_n (a_k - mean(a)), a_k the pair's acceptance
+probability min(1, r_k) in that round (the swap rate's Rao-Blackwellised estimate), kappa_n =
+``ADAPT_RATE`` ``ADAPT_LAG`` / (n + ``ADAPT_LAG``) (Vousden, Farr & Mandel 2016, MNRAS 455,
+1919, their dynamics of log(T_k - T_{k-1}), with the gaps rescaled to keep the hottest
+temperature); the ladder kept is the mean of S over the second half of the rounds (Polyak
+averaging). The ladder is then FROZEN: the copies' widths are tuned at it and every kept draw
+comes from the fixed-ladder chain above, an exact MCMC (the adaptation only chooses the
+ladder, as the tuning chooses the widths).
 """
 
 from __future__ import annotations
@@ -36,7 +50,7 @@ from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
-from gpmsa.model.data import check_count
+from gpmsa.model.data import check_count, check_flag
 from gpmsa.model.problem import Problem
 
 RATIO = 2.0
@@ -45,6 +59,10 @@ MAX_TEMPERATURES = 32
 """Most copies per chain (each holds its own likelihood state and costs a sweep)."""
 MAX_SWAP_EVERY = 1_000_000
 """Largest ``swap_every`` (sweeps between swap rounds)."""
+ADAPT_RATE = 0.1
+"""The adaptive ladder's initial step kappa_0 on the log gaps (per swap round; `adapt_ladder`)."""
+ADAPT_LAG = 200.0
+"""Swap rounds over which the adaptive ladder's step halves (kappa_n = kappa_0 lag / (n + lag))."""
 
 
 def ladder(temperatures) -> tuple[float, ...] | None:
@@ -97,18 +115,84 @@ def check_swap_every(swap_every, temperatures, n_iter: int | None = None,
     return n
 
 
-def swap(states: list, betas: tuple[float, ...], u: np.ndarray, accepted: np.ndarray) -> None:
+def swap(states: list, betas: tuple[float, ...], u: np.ndarray, accepted: np.ndarray,
+         probs: np.ndarray | None = None) -> None:  # fmt: skip
     """One round of neighbour swaps: for k = 0 .. K - 2, copies k and k + 1 (``states``,
     ``ChainState``s or a study's ``StudyState``s at inverse temperatures ``betas``) exchange
     their states (``exchange``: the likelihood states, the parameters with them, and the running
     log priors) where log u[k] is below the log acceptance ratio, on each copy's ``loglik``;
-    adds 1 to ``accepted[k]`` per swap."""
+    adds 1 to ``accepted[k]`` per swap and, given ``probs`` (K - 1,), sets probs[k] to the
+    proposal's acceptance probability min(1, exp(log ratio))."""
     for k in range(len(states) - 1):
         a, b = states[k], states[k + 1]
         log_r = (betas[k] - betas[k + 1]) * (b.loglik - a.loglik)
+        if probs is not None:
+            probs[k] = math.exp(min(log_r, 0.0))
         if math.log(u[k]) < log_r:
             a.exchange(b)
             accepted[k] += 1
+
+
+def check_adapt(adapt_ladder, temperatures: tuple[float, ...] | None, tune: bool) -> bool:
+    """``adapt_ladder`` as a bool; GPMSAError for a non-bool, or for True without
+    ``temperatures`` (a checked ladder), with fewer than 3 of them (T_0 = 1 and the hottest
+    stay: nothing between them to move) or without tuning (the ladder adapts during it)."""
+    if not check_flag(adapt_ladder, "adapt_ladder"):
+        return False
+    if temperatures is None:
+        raise GPMSAError("adapt_ladder=True needs temperatures= (parallel tempering)")
+    if len(temperatures) < 3:
+        raise GPMSAError(
+            f"adapt_ladder=True needs at least 3 temperatures, got {list(temperatures)}: T_0 = "
+            "1 and the hottest stay fixed, the ones between them move"
+        )
+    if not tune:
+        raise GPMSAError(
+            "adapt_ladder=True with tune=False: the ladder adapts during tuning, before the "
+            "draws; give tune=True, or a fixed ladder"
+        )
+    return True
+
+
+def adapt_ladder(states: list, temperatures, rng, names, widths, n_rounds, n_levels, on_round):
+    """The adaptive ladder (module docstring) of the copies ``states`` at ``temperatures`` (the
+    starting ladder; their ``beta`` set to the adapted one): ``n_rounds`` rounds of a sweep of
+    every copy at each of GPM/SA's ``n_levels`` candidate widths (``tuning.level_widths`` of
+    ``widths``, as the tuning's; the acceptances not kept), a swap round after each, the log
+    gaps moved after each swap round. Returns the adapted ladder (K,): 1, strictly increasing,
+    the hottest unchanged."""
+    temps = np.asarray(temperatures, dtype=float)
+    top, n_temps = temps[-1], len(states)
+    log_gap = np.log(np.diff(temps))
+    mean_gap, n_mean = np.zeros_like(log_gap), 0
+    cands = tuning.level_widths(names, widths, n_levels)
+    acc, swaps, probs = np.zeros(widths.size), np.zeros(n_temps - 1), np.empty(n_temps - 1)
+    n_total = n_rounds * n_levels
+    for n in range(n_total):
+        lev = n % n_levels
+        for state in states:
+            state.sweep(cands[lev], False, acc)
+        betas = tuple(state.beta for state in states)
+        swap(states, betas, rng.random(n_temps - 1), swaps, probs)
+        log_gap += ADAPT_RATE * ADAPT_LAG / (n + ADAPT_LAG) * (probs - probs.mean())
+        log_gap += math.log(top - 1.0) - np.log(np.sum(np.exp(log_gap)))  # the hottest kept
+        _set_ladder(states, log_gap, top)
+        if 2 * n >= n_total:  # the second half's mean (Polyak averaging)
+            mean_gap += log_gap
+            n_mean += 1
+        if lev == n_levels - 1:
+            on_round(n_levels * n_temps)
+    return _set_ladder(states, mean_gap / max(n_mean, 1), top)
+
+
+def _set_ladder(states: list, log_gap: np.ndarray, top: float) -> tuple[float, ...]:
+    """The ladder 1, 1 + cumsum(exp(log_gap)) (its last entry ``top`` exactly) given to the
+    copies' ``beta``; returns it."""
+    temps = np.concatenate([[1.0], 1.0 + np.cumsum(np.exp(log_gap))])
+    temps[-1] = top
+    for state, t in zip(states[1:], temps[1:], strict=True):
+        state.beta = 1.0 / t
+    return tuple(float(t) for t in temps)
 
 
 def tune_ladder(states: list, betas, rng, names, widths, n_rounds, n_levels, swaps, on_round):
@@ -128,19 +212,29 @@ def tune_ladder(states: list, betas, rng, names, widths, n_rounds, n_levels, swa
 
 def run_ladder(states: list, rng: np.random.Generator, n_iter: int, widths: np.ndarray,
                kinds: list[str], record: Callable[[int], None], *, swap_every: int, tune: bool,
-               tune_rounds: int, tune_levels: int, prop_mh: bool, bar, desc: str):  # fmt: skip
+               tune_rounds: int, tune_levels: int, prop_mh: bool, bar, desc: str,
+               adapt: tuple[float, ...] | None = None):  # fmt: skip
     """The ladder's run (module docstring) over ``states``, its copies at the inverse
     temperatures of their ``beta`` (each a ``sampler.ChainState``, or a study's
     ``StudyState``, at the chain's start): the categorical level shifts learnt at T = 1 and
-    shared, every copy tuned at its temperature from ``widths`` (``tune``; GPM/SA's tuning
-    ``kinds``, per element), then ``n_iter`` sweeps of every copy, a swap round every
-    ``swap_every``, ``record(it)`` after each (the T = 1 copy, ``states[0]``, is the one to
-    keep). Returns the T = 1 copy's accepted counts and widths and the swap acceptance rate
-    (K - 1,) of each neighbour pair over the draws' swap rounds."""
-    betas = tuple(state.beta for state in states)
+    shared, the ladder adapted (``adapt``: the copies' temperatures, to adapt with ``tune``,
+    `adapt_ladder`, then frozen; None: the ladder stays), every
+    copy tuned at its temperature from ``widths`` (``tune``; GPM/SA's tuning ``kinds``, per
+    element), then ``n_iter`` sweeps of every copy, a swap round every ``swap_every``,
+    ``record(it)`` after each (the T = 1 copy, ``states[0]``, is the one to keep). Returns the
+    T = 1 copy's accepted counts and widths, the swap acceptance rate (K - 1,) of each
+    neighbour pair over the draws' swap rounds and the adapted ladder (K,; None without
+    ``adapt``)."""
     n_temps = len(states)
+    temps = None if adapt is None else tuple(adapt)
     w = [widths] * n_temps
     swaps = np.zeros(n_temps - 1)
+    if tune and adapt is not None and widths.size:
+        _share_level_shifts(states)  # the level moves as in the tuning (categorical)
+        bar.set_description(f"{desc}: adapting the ladder ({n_temps} temperatures)")
+        temps = adapt_ladder(states, adapt, rng, kinds, widths, tune_rounds, tune_levels,
+                             bar.update)  # fmt: skip
+    betas = tuple(state.beta for state in states)  # frozen from here: the draws' ladder
     if tune and widths.size:
         _share_level_shifts(states)  # the widths tuned with the level moves (categorical)
         bar.set_description(f"{desc}: tuning step widths ({n_temps} temperatures)")
@@ -159,7 +253,7 @@ def run_ladder(states: list, rng: np.random.Generator, n_iter: int, widths: np.n
         if it % 100 == 99:
             bar.update(100 * n_temps)
     bar.update((n_iter % 100) * n_temps)
-    return accepted[0], w[0], swaps / max(n_iter // swap_every, 1)
+    return accepted[0], w[0], swaps / max(n_iter // swap_every, 1), temps
 
 
 def _share_level_shifts(states: list) -> None:
@@ -186,13 +280,16 @@ def run_tempered_chain(
     desc: str = "MCMC",
     proportional_steps: bool | None = None,
     record: dict | None = None,
+    adapt_ladder: bool = False,
 ):
     """``sampler.run_chain`` with a ladder of tempered copies (module docstring, `run_ladder`),
     each a ``new_state()`` (a ``sampler.ChainState`` at the chain's start, drawing from
     ``rng``): ``n_iter`` sweeps of every copy after its tuning; the T = 1 copy's draws are kept.
     Returns ``run_chain``'s draws, log_post, accept rates and widths (of the T = 1 copy) and the
-    swap acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds; ``record``
-    as ``run_chain``'s (the T = 1 copy's level moves, shared by the ladder)."""
+    swap acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds, and with
+    ``adapt_ladder`` (and ``tune``) the adapted ladder (K,), frozen before the tuning of the
+    widths and the draws; ``record`` as ``run_chain``'s (the T = 1 copy's level moves, shared
+    by the ladder)."""
     from tqdm.auto import tqdm
 
     states = []
@@ -203,8 +300,9 @@ def run_tempered_chain(
     cold = states[0]
     cold.check_start()
     n_temps = len(states)
-    total = n_temps * (n_iter + (tune_rounds * tune_levels if tune else 0))
-    bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    n_tune = tune_rounds * tune_levels * (1 + adapt_ladder) if tune else 0
+    bar = tqdm(total=n_temps * (n_iter + n_tune), desc=desc, disable=not progress,
+               mininterval=0.5)  # fmt: skip
     draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
     log_post = np.empty(n_iter)
     names = problem.names
@@ -217,13 +315,15 @@ def run_tempered_chain(
 
     prop_mh = (not tune) if proportional_steps is None else proportional_steps
     with threadpool_limits(1):
-        accepted, w, rates = run_ladder(
+        accepted, w, rates, adapted = run_ladder(
             states, rng, n_iter, cold.flat_widths(widths), [n for n, _ in cold.els], keep,
             swap_every=swap_every, tune=tune, tune_rounds=tune_rounds, tune_levels=tune_levels,
-            prop_mh=prop_mh, bar=bar, desc=desc,
+            prop_mh=prop_mh, bar=bar, desc=desc, adapt=temperatures if adapt_ladder else None,
         )  # fmt: skip
     bar.close()
     rate, wid = cold.element_records(accepted, w, n_iter)
     if record is not None:
         record["level"] = cold.level_record()
+    if adapt_ladder:
+        return draws, log_post, rate, wid, rates, np.asarray(adapted)
     return draws, log_post, rate, wid, rates

@@ -124,27 +124,33 @@ def _check_memory(problems, n_iter: int, n_chains: int, what: str,
     check_memory(nbytes, what)
 
 
-def _check_tempering(temperatures, swap_every, n_iter, continuing: bool, what: str):
-    """The ladder (``tempering.ladder``; None: off) and ``swap_every`` (None: 1) of a study's
-    parallel tempering, checked (n_iter, ``what``, already is); GPMSAError naming
-    ``temperatures`` with ``init`` a study (its record holds the T = 1 chains alone)."""
+def _check_tempering(temperatures, swap_every, n_iter, continuing: bool, what: str,
+                     adapt_ladder=False, tune=True):  # fmt: skip
+    """The ladder (``tempering.ladder``; None: off), ``swap_every`` (None: 1) and
+    ``adapt_ladder`` (``tempering.check_adapt``, with ``tune`` the run's) of a study's parallel
+    tempering, checked (n_iter, ``what``, already is); GPMSAError naming ``temperatures`` with
+    ``init`` a study (its record holds the T = 1 chains alone)."""
     temps = tempering.ladder(temperatures)
     every = 1 if swap_every is None else swap_every
     every = tempering.check_swap_every(every, temps, int(n_iter), what)
+    adapt = tempering.check_adapt(adapt_ladder, temps, tune)
     if temps is not None and continuing:
         raise GPMSAError(
             "temperatures= with init=study: a study's record holds its T = 1 chains alone, not "
             "the tempered copies to continue; run the study afresh with temperatures=, or "
             "continue it without temperatures="
         )
-    return {} if temps is None else {"temperatures": temps, "swap_every": every}
+    if temps is None:
+        return {}
+    return {"temperatures": temps, "swap_every": every, **({"adapt_ladder": True} if adapt else {})}
 
 
 def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
     rate = chains.accept_rate.mean(axis=0)
     info = {k: v for k, v in chains.info.items() if k != "level_offsets"}  # `_level_offsets`
-    if "swap_rate" in info:  # parallel tempering: as fit's settings record it
-        info = {**info, "swap_rate": np.asarray(info["swap_rate"]).tolist()}
+    for key in ("swap_rate", "adapted_temperatures"):  # parallel tempering: as fit's settings
+        if key in info:
+            info = {**info, key: np.asarray(info[key]).tolist()}
     return {**info, "n_burn": int(n_burn), **extra,
             "accept_rate": {n: float(r) for n, r in zip(chains.names, rate, strict=True)},
             "step_widths": {n: float(w) for n, w in zip(chains.names, chains.widths[0],
@@ -345,6 +351,7 @@ def calibrate_study(
     extrapolate: bool = False, progress: bool = False, n_jobs: int | None = None,
     executor=None, metadata: dict | None = None, discrepancy=None, discrepancy_groups=None,
     fixed=None, append: bool = False, temperatures=None, swap_every: int | None = None,
+    adapt_ladder: bool = False,
 ) -> Study:  # fmt: skip
     """Calibrate several fitted emulators at once, their emulator parameters fixed (as
     ``gpmsa.calibrate`` does for one), with shared and/or hierarchical calibration parameters.
@@ -407,6 +414,11 @@ def calibrate_study(
             T = 1 copy's draws are kept (about n times the time). ``settings`` record
             "temperatures", "swap_every" and "swap_rate" (per chain, per neighbour pair).
             Refused with ``init`` a study (continue without them).
+        adapt_ladder: with ``temperatures`` (at least 3) and tuning, each chain adapts its
+            ladder's temperatures between 1 and the hottest during tuning towards equal swap
+            rates, then freezes it before the widths' tuning and the draws (an exact MCMC;
+            ``gpmsa.mcmc.tempering.adapt_ladder``); ``settings["adapted_temperatures"]``
+            (per chain) records it, "temperatures" the ladder it started from.
 
     Returns a ``Study``; ``study.posterior`` names each shared parameter by its name, every
     other by "NAME[LABEL]", each model's "lamOs[LABEL]" (and with a discrepancy its
@@ -449,7 +461,8 @@ def calibrate_study(
     n_burn = (0 if continuing else 1000) if n_burn is None else n_burn
     given_hyper = hyper is not None
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
-    tempered = _check_tempering(temperatures, swap_every, n_samples, continuing, "n_samples")
+    tempered = _check_tempering(temperatures, swap_every, n_samples, continuing, "n_samples",
+                                adapt_ladder, tune is not False)  # fmt: skip
     if not continuing:
         check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
@@ -605,7 +618,7 @@ def fit_study(
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
     metadata: dict | None = None, fixed=None, append: bool = False, temperatures=None,
-    swap_every: int | None = None,
+    swap_every: int | None = None, adapt_ladder: bool = False,
 ) -> Study:  # fmt: skip
     """Fit several GPM/SA models jointly (each its emulator and observations, as ``gpmsa.fit``
     with ``obs``) whose calibration parameters are shared and/or hierarchical (SEPIA's shared
@@ -644,6 +657,8 @@ def fit_study(
         temperatures, swap_every: parallel tempering, as ``calibrate_study``'s (each copy a
             whole study, its emulators' parameters too; at most n_iter between swap rounds);
             each member's settings record them too, with the study's swap rates.
+        adapt_ladder: the adaptive ladder, as ``calibrate_study``'s (each member's settings
+            record the study's "adapted_temperatures").
 
     A categorical parameter's joint level move is recorded as ``calibrate_study`` records it
     (``settings["level_offsets"]``), and in each member's settings under its own t_name (as
@@ -677,7 +692,8 @@ def fit_study(
         n_burn = 0 if continuing else n_iter // 5
     given_hyper = hyper is not None
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
-    tempered = _check_tempering(temperatures, swap_every, n_iter, continuing, "n_iter")
+    tempered = _check_tempering(temperatures, swap_every, n_iter, continuing, "n_iter",
+                                adapt_ladder, tune is not False)  # fmt: skip
     if not continuing:
         check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
@@ -789,7 +805,9 @@ def fit_study(
             emu_settings["level_offsets"] = own
         if tempered:  # as gpmsa.fit(..., temperatures=) records it (the study's swaps)
             emu_settings.update({k: settings[k] for k in ("temperatures", "swap_every",
-                                                          "swap_rate")})  # fmt: skip
+                                                          "swap_rate", "adapt_ladder",
+                                                          "adapted_temperatures")
+                                 if k in settings})  # fmt: skip
         if continuing:  # as gpmsa.fit(..., init=the source member) records it
             emu_settings["continued_from"] = init.members[i].model_sha256
         if append:  # as gpmsa.fit(..., init=the source member, append=True) records it

@@ -425,18 +425,21 @@ def run_study_chain(
     tune_levels: int = tuning.N_LEVELS, progress: bool = False, desc: str = "study",
     start: tuple | None = None, widths: np.ndarray | None = None, prop_mh: bool | None = None,
     temperatures: tuple[float, ...] | None = None, swap_every: int = 1,
+    adapt_ladder: bool = False,
 ) -> dict:  # fmt: skip
     """One chain: its start (``gpmsa.mcmc.starts`` rule ``init``; a continuation's ``start``:
     (models' starts, g, mu, lam)), tuning, ``n_iter`` sweeps; ``widths``: the initial step
     widths in sweep order (None: GPM/SA's); ``prop_mh``: GPM/SA's proportional precision steps
     (None: when not tuned). ``temperatures``: a ladder from 1 (``tempering.ladder``), a copy of
     the study state per temperature from the same start, each tuned at its temperature, a swap
-    round every ``swap_every`` sweeps (``tempering.run_ladder``); the T = 1 copy's draws kept.
+    round every ``swap_every`` sweeps (``tempering.run_ladder``); the T = 1 copy's draws kept;
+    ``adapt_ladder``: the ladder adapted during tuning, then frozen (``tempering.adapt_ladder``).
 
     Returns plain arrays: theta (N, G), mu, lam (N, H), log_post (N,), members (per model,
     name -> (N, *shape)), accept_rate and widths per element, level_offsets (the (T = 1)
     state's level moves, ``StudyState.level_record``); with ``temperatures`` also swap_rate
-    (K - 1,), each neighbour pair's swap acceptance over the draws.
+    (K - 1,), each neighbour pair's swap acceptance over the draws, and with ``adapt_ladder``
+    ladder (K,), the adapted one.
     """
     from tqdm.auto import tqdm
 
@@ -449,7 +452,8 @@ def run_study_chain(
         raise GPMSAError("the starting values give a log posterior of NaN; check the data")
     w = _default_widths(state, layout) if widths is None else np.array(widths, dtype=float)
     prop_mh = not tune if prop_mh is None else prop_mh
-    total = len(copies) * (n_iter + (tune_rounds * tune_levels if tune else 0))
+    n_tune = tune_rounds * tune_levels * (1 + adapt_ladder) if tune else 0
+    total = len(copies) * (n_iter + n_tune)
     own = [s.problem.sampled for s in state.states]
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
     out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
@@ -470,11 +474,13 @@ def run_study_chain(
         if temperatures is not None:
             for copy, t in zip(copies, temperatures, strict=True):
                 copy.beta = 1.0 / t
-            accepted, w, out["swap_rate"] = tempering.run_ladder(
+            accepted, w, out["swap_rate"], adapted = tempering.run_ladder(
                 copies, rng, n_iter, w, kinds, record, swap_every=swap_every, tune=tune,
                 tune_rounds=tune_rounds, tune_levels=tune_levels, prop_mh=prop_mh, bar=bar,
-                desc=desc,
+                desc=desc, adapt=temperatures if adapt_ladder else None,
             )  # fmt: skip
+            if adapt_ladder:
+                out["ladder"] = np.asarray(adapted)
         else:
             if tune:
                 bar.set_description(f"{desc}: tuning step widths")
@@ -497,17 +503,19 @@ def run_study_chain(
     return out
 
 
-def _wrong_run(run, n_iter: int, n_elements: int, n_temps: int = 0) -> str | None:
+def _wrong_run(run, n_iter: int, n_elements: int, n_temps: int = 0,
+               adapt: bool = False) -> str | None:  # fmt: skip
     """``run_chains``' check of a study chain's result: None when it is the task's own, as
-    `run_study_chain` makes it (``n_temps`` > 0: with the swap rates of that many copies),
-    else the draws it should hold."""
+    `run_study_chain` makes it (``n_temps`` > 0: with the swap rates of that many copies, and
+    their adapted ladder with ``adapt``), else the draws it should hold."""
     keys = {"theta", "mu", "lam", "log_post", "members", "accept_rate", "widths", "names"}
     if isinstance(run, dict) and keys <= set(run):
         if np.shape(run["theta"]) == (n_iter, n_elements) and np.shape(run["log_post"]) == (
             n_iter,
         ):
             if not n_temps or np.shape(run.get("swap_rate")) == (n_temps - 1,):
-                return None
+                if not adapt or np.shape(run.get("ladder")) == (n_temps,):
+                    return None
     return f"{n_iter} sweeps" + (f" at {n_temps} temperatures" if n_temps else "")
 
 
@@ -518,6 +526,7 @@ def sample_study(
     progress: bool = False, n_jobs: int | None = None, executor=None,
     chain_starts: list | None = None, widths: list | None = None, prop_mh: bool | None = None,
     temperatures: tuple[float, ...] | None = None, swap_every: int = 1,
+    adapt_ladder: bool = False,
 ) -> StudyChains:  # fmt: skip
     """``n_chains`` study chains, chain c on ``SeedSequence(seed).spawn(n_chains)[c]`` (its draws
     do not depend on where it runs: ``n_jobs`` processes or ``executor``, as
@@ -525,7 +534,9 @@ def sample_study(
     models' starts, g, mu, lam; init "continued"), ``widths`` (per chain, sweep order; None:
     GPM/SA's) and ``prop_mh`` (``run_study_chain``'s). ``temperatures`` (a checked ladder,
     ``tempering.ladder``) and ``swap_every``: parallel tempering (``run_study_chain``); info
-    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1); with a categorical
+    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1); ``adapt_ladder``
+    (a checked flag, ``tempering.check_adapt``): each chain's ladder adapted during tuning, then
+    frozen, info "adapt_ladder" and "adapted_temperatures" (n_chains, K); with a categorical
     element's joint level move, "level_offsets": element -> {"shifted": the continuous
     elements it shifts, "offsets": (n_chains, n_levels, len(shifted)), unit scale} (as
     ``level_moves.chains_record``, per element). ChainError names a chain that failed or whose
@@ -548,11 +559,13 @@ def sample_study(
             task["widths"] = widths[c]
         if temperatures is not None:
             task.update(temperatures=tuple(temperatures), swap_every=int(swap_every))
+        if adapt_ladder:
+            task["adapt_ladder"] = True
     n_temps = 0 if temperatures is None else len(temperatures)
     runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
                       progress=progress, desc="study chain",
                       check=lambda _, r: _wrong_run(r, int(n_iter), layout.n_elements,
-                                                    n_temps))  # fmt: skip
+                                                    n_temps, adapt_ladder))  # fmt: skip
     members = tuple(
         {n: np.stack([r["members"][i][n] for r in runs]) for n in runs[0]["members"][i]}
         for i in range(len(problems))
@@ -570,6 +583,9 @@ def sample_study(
         out.info.update(temperatures=[float(t) for t in temperatures],
                         swap_every=int(swap_every),
                         swap_rate=np.stack([r["swap_rate"] for r in runs]))  # fmt: skip
+    if adapt_ladder:  # each chain's ladder, adapted in its tuning and frozen for its draws
+        out.info.update(adapt_ladder=True,
+                        adapted_temperatures=np.stack([r["ladder"] for r in runs]))  # fmt: skip
     moves = runs[0].get("level_offsets") or {}
     if moves:  # a categorical element's joint level move: its offsets, per chain
         out.info["level_offsets"] = {
