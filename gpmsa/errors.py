@@ -27,8 +27,9 @@ class OutsideEmulatorWarning(UserWarning):
 class ExtrapolationWarning(UserWarning):
     """Inputs (x, theta or bounds given to a prediction or a calibration) lie outside the
     emulator's training domain: the emulator extrapolates there (predictions, a joint fit's and
-    calibration's x_obs within ``EXTRAPOLATION_MARGIN`` of it, further refused; calibration's
-    x_obs and ``calibrated_predict``'s x_new with ``extrapolate=True`` at any distance)."""
+    calibration's x_obs within ``EXTRAPOLATION_MARGIN`` of it, further refused; with
+    ``extrapolate=True`` at any distance: calibration's x_obs, the x of ``calibrated_predict``
+    and ``full_prediction``, the x and t of ``Emulator.predict`` and ``emulator_prediction``)."""
 
 
 def user_stacklevel() -> int:

@@ -11,7 +11,6 @@ import dataclasses
 import functools
 import json
 import sys
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,7 +20,7 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 from threadpoolctl import threadpool_limits
 
-from gpmsa.errors import EmulatorFileError, ExtrapolationWarning, GPMSAError
+from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.validation import (
     DISCREPANCY_ARRAY,
     EMULATOR_PARAMS,
@@ -62,7 +61,7 @@ from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import GammaPrior, Priors, as_group_priors
-from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
+from gpmsa.model.transforms import Standardizer, check_extrapolation
 
 __all__ = [
     "EMULATOR_PARAMS",
@@ -452,11 +451,12 @@ class Emulator:
             self._factors[-2] = kronecker.emulator_factors(self, self.params)
         return self._factors[-2]
 
-    def _inputs(self, x, t, *, far_ok: bool = False, stacklevel: int = 3) -> np.ndarray:
-        """Unit-scale z (N, p + q) of native x and t; beyond ``EXTRAPOLATION_MARGIN`` of the
-        domain a GPMSAError unless ``far_ok`` (a caller that allows it and has warned);
-        ``stacklevel``: of the extrapolation warning, counted from here (3: the caller's
-        caller), so that it names the user's line."""
+    def _inputs(self, x, t, *, extrapolate: bool = False, stacklevel: int = 3) -> np.ndarray:
+        """Unit-scale z (N, p + q) of native x and t, under the library's extrapolation rule
+        (``check_extrapolation``): outside the domain an ExtrapolationWarning, beyond
+        ``EXTRAPOLATION_MARGIN`` of a column's width a GPMSAError naming x or t, the column, its
+        values and the domain, unless ``extrapolate`` (then the warning); ``stacklevel``: of the
+        warning, counted from here (3: the caller's caller), so that it names the user's line."""
         check_same_rows({"x": x, "t": t}, {"x": self.x_names, "t": self.t_names})
         if x is None and self.p == 0:  # no known inputs: one row of none, broadcast against t
             x = np.empty((1, 0))
@@ -481,24 +481,16 @@ class Emulator:
                     f"x and t need the same number of rows, got {x.shape} and {t.shape}"
                 )
         names = self.x_names + self.t_names
-        categorical_mod.check_levels(np.hstack([x, t]), self.levels, names, "predict()")
-        z = np.hstack([self.standardizer.x_to_unit(x), self.standardizer.t_to_unit(t)])
-        lo, hi = z.min(axis=0), z.max(axis=0)
-        far = (lo < -EXTRAPOLATION_MARGIN) | (hi > 1 + EXTRAPOLATION_MARGIN)
-        if far.any() and not far_ok:
-            k = int(np.flatnonzero(far)[0])
-            col = np.hstack([x, t])[:, k]
-            a, b = self.domain[names[k]]
-            raise GPMSAError(
-                f"{names[k]} reaches [{col.min():.6g}, {col.max():.6g}], outside the emulator's "
-                f"domain [{a:.6g}, {b:.6g}] by more than {EXTRAPOLATION_MARGIN:.0%} of its width"
-            )
-        if (lo < 0).any() or (hi > 1).any():
-            warnings.warn(
-                "predict() extrapolates beyond the training domain",
-                ExtrapolationWarning,
-                stacklevel=stacklevel,
-            )
+        native = np.hstack([x, t])
+        categorical_mod.check_levels(native, self.levels, names, "predict()")
+        s = self.standardizer
+        z = np.hstack([s.x_to_unit(x), s.t_to_unit(t)])
+        if z.size and (z.min() < 0.0 or z.max() > 1.0):  # outside the domain: the rule
+            check_extrapolation(
+                native, z, names, np.concatenate([s.x_min, s.t_min]),
+                np.concatenate([s.x_max, s.t_max]), ("x",) * self.p + ("t",) * self.q,
+                extrapolate, stacklevel,
+            )  # fmt: skip
         return z
 
     def _predict_std(self, z: np.ndarray, params, factors, resid: bool, *, var: bool = True):
@@ -538,22 +530,23 @@ class Emulator:
             f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs)",
         )
 
-    def _predict_point(self, x, t, resid: bool, *, far_ok: bool = False, var: bool = True):
-        """``predict(x, t, resid=resid)`` at the point estimate (native mean and variance);
-        ``far_ok``: x or t beyond ``EXTRAPOLATION_MARGIN`` of the domain allowed (for a caller
-        that allows extrapolation and has warned, as ``calibrated_predict(extrapolate=True)``);
-        ``var=False``: the variance None (``predict_mean``)."""
+    def _predict_point(self, x, t, resid: bool, *, extrapolate: bool = False, var: bool = True):
+        """``predict(x, t, resid=resid, extrapolate=extrapolate)`` at the point estimate (native
+        mean and variance); ``var=False``: the variance None (``predict_mean``)."""
         self._check_predict_memory(x, t)
-        z = self._inputs(x, t, far_ok=far_ok, stacklevel=4)  # the caller of predict()
+        z = self._inputs(x, t, extrapolate=extrapolate, stacklevel=4)  # the caller of predict()
         m, v = self._predict_std(z, self.params, self._predict_factors(None, True), resid, var=var)
         s = self.standardizer
         return s.y_from_std(m), None if v is None else s.var_from_std(v)
 
-    def _predict_draws(self, x, t, n_draws: int | None, resid: bool, *, var: bool = True):
-        """``predict(x, t, draws=True, n_draws=n_draws, resid=resid)``; ``var=False``: the
-        variance None (``predict_mean``)."""
+    def _predict_draws(
+        self, x, t, n_draws: int | None, resid: bool, *, extrapolate: bool = False,
+        var: bool = True,
+    ):  # fmt: skip
+        """``predict(x, t, draws=True, n_draws=n_draws, resid=resid, extrapolate=extrapolate)``;
+        ``var=False``: the variance None (``predict_mean``)."""
         self._check_predict_memory(x, t)
-        z = self._inputs(x, t, stacklevel=4)  # the caller of predict()
+        z = self._inputs(x, t, extrapolate=extrapolate, stacklevel=4)  # the caller of predict()
         s = self.standardizer
         if not self.draws:
             raise GPMSAError(
@@ -576,8 +569,9 @@ class Emulator:
         return s.y_from_std(mean), s.var_from_std(var_)
 
     def predict(
-        self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True
-    ) -> tuple[np.ndarray, np.ndarray]:
+        self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True,
+        extrapolate: bool = False,
+    ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
         """Predictive mean and variance (N, l_sim) of the simulator output in native units.
 
         x (N, p) known inputs and t (N, q) parameters, native units (a single row broadcasts;
@@ -588,26 +582,34 @@ class Emulator:
         last: ``evenly_spaced``), combining the variances by the law of total variance.
         ``resid`` adds the nugget 1/lamWs and the residual variance 1/lamWOs (the spread of a new
         simulation run about the smooth emulator). The mean alone: `predict_mean`.
+        Inputs outside the emulator's ``domain``: an ExtrapolationWarning; beyond it by more
+        than ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width a GPMSAError naming x or t,
+        the column, its values and the domain, unless ``extrapolate=True`` (then the warning),
+        as ``gpmsa.calibrate`` takes x_obs.
         """
         draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
+        extrapolate = check_flag(extrapolate, "extrapolate")
         if n_draws is not None:  # also where draws=False leaves it unused
             check_count(n_draws, "n_draws")
         if not draws:
-            return self._predict_point(x, t, resid)
-        return self._predict_draws(x, t, n_draws, resid)
+            return self._predict_point(x, t, resid, extrapolate=extrapolate)
+        return self._predict_draws(x, t, n_draws, resid, extrapolate=extrapolate)
 
-    def predict_mean(self, x, t, *, draws: bool = False, n_draws: int | None = None) -> np.ndarray:
+    def predict_mean(
+        self, x, t, *, draws: bool = False, n_draws: int | None = None, extrapolate: bool = False
+    ) -> np.ndarray:
         """Predictive mean (N, l_sim) in native units: ``predict(x, t, draws=draws,
-        n_draws=n_draws)[0]`` to the last bit, without computing the variance (its triangular
-        solves, about half of ``predict``'s time at many points). The mean does not depend on
-        ``resid``; the arguments and their checks are ``predict``'s.
+        n_draws=n_draws, extrapolate=extrapolate)[0]`` to the last bit, without computing the
+        variance (its triangular solves, about half of ``predict``'s time at many points). The
+        mean does not depend on ``resid``; the arguments and their checks are ``predict``'s.
         """
         draws = check_flag(draws, "draws")
+        extrapolate = check_flag(extrapolate, "extrapolate")
         if n_draws is not None:  # also where draws=False leaves it unused
             check_count(n_draws, "n_draws")
         if not draws:
-            return self._predict_point(x, t, False, var=False)[0]
-        return self._predict_draws(x, t, n_draws, False, var=False)[0]
+            return self._predict_point(x, t, False, extrapolate=extrapolate, var=False)[0]
+        return self._predict_draws(x, t, n_draws, False, extrapolate=extrapolate, var=False)[0]
 
     # --- checks -------------------------------------------------------------------------------
     def loo(self) -> LooResult:

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from gpmsa.errors import ExtrapolationWarning, GPMSAError
 from gpmsa.model.data import SimData, check_increasing, column_scales, output_scale
 
 UNIT_TOL = 1e-9
@@ -22,6 +25,44 @@ order ``Standardizer.y_given`` and the file's ``model.y_given`` list it."""
 EXTRAPOLATION_MARGIN = 0.1
 """How far (unit scale) inputs may lie outside the design's range, for predictions and
 observations alike: outside the range a warning, beyond the margin a refusal."""
+
+
+def check_extrapolation(
+    native: np.ndarray,
+    unit: np.ndarray,
+    names: Sequence[str],
+    lo,
+    hi,
+    what: str | Sequence[str],
+    extrapolate: bool | None = None,
+    stacklevel: int = 2,
+) -> None:
+    """The library's rule for inputs (rows ``native`` (N, d), ``unit`` their unit scale) against
+    the emulator's domain [``lo``, ``hi``] (per column, native units): inside it silent; outside
+    it by up to ``EXTRAPOLATION_MARGIN`` of a column's width an ``ExtrapolationWarning``; beyond
+    a GPMSAError, unless ``extrapolate`` (then the warning). Both name the argument (``what``:
+    its name, or one per column where columns come from several arguments, as ``predict``'s x
+    and t), the column, the values it reaches and the domain; ``extrapolate``: the caller's
+    option of that name (False: the error points at it), None where it has none.
+    ``stacklevel``: of the warning, counted from the caller of this function."""
+    below, above = unit.min(axis=0), unit.max(axis=0)
+    far = (below < -EXTRAPOLATION_MARGIN) | (above > 1 + EXTRAPOLATION_MARGIN)
+    outside = far | (below < 0) | (above > 1)
+    if not outside.any():
+        return
+    k = int(np.flatnonzero(far if far.any() else outside)[0])
+    arg = what if isinstance(what, str) else what[k]
+    msg = (f"{arg}: {names[k]} reaches [{native[:, k].min():.6g}, {native[:, k].max():.6g}], "
+           f"outside the emulator's domain [{float(lo[k]):.6g}, {float(hi[k]):.6g}]")  # fmt: skip
+    if far[k]:
+        msg += f" by more than {EXTRAPOLATION_MARGIN:.0%} of its width"
+        if not extrapolate:
+            raise GPMSAError(
+                msg + ("; pass extrapolate=True to allow it" if extrapolate is False else "")
+            )
+    warnings.warn(
+        msg + "; the emulator extrapolates there", ExtrapolationWarning, stacklevel=stacklevel + 1
+    )
 
 
 def snap_to_unit(u: np.ndarray) -> np.ndarray:

@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
-from gpmsa.errors import ExtrapolationWarning, GPMSAError
+from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import NO_DRAWS, Emulator
 from gpmsa.model import kronecker
 from gpmsa.model.categorical import check_levels
@@ -27,7 +27,7 @@ from gpmsa.model.data import (
 )
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
-from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, snap_to_unit
+from gpmsa.model.transforms import check_extrapolation, snap_to_unit
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 
@@ -70,11 +70,11 @@ def unit_inputs(
     A 1-D array is one column when d = 1 and one row otherwise; a number one point when d = 1
     (as ``gpmsa.calibrate`` takes x_obs). Inside the design range: silent;
     up to ``EXTRAPOLATION_MARGIN`` of the range outside it: a warning; beyond: GPMSAError naming
-    the input, the values and the domain (``extrapolate``: the caller's option of that name,
-    None where it has none; False: the message points at it; True: the warning at any
-    distance, as ``gpmsa.calibrate(extrapolate=True)`` takes x_obs). With no inputs (d = 0,
-    an emulator without known inputs) None, or an (N, 0) array, is one row of no columns
-    (broadcast against t's rows).
+    ``what``, the input, the values and the domain (``check_extrapolation``; ``extrapolate``:
+    the caller's option of that name, None where it has none; False: the message points at it;
+    True: the warning at any distance, as ``gpmsa.calibrate(extrapolate=True)`` takes x_obs).
+    With no inputs (d = 0, an emulator without known inputs) None, or an (N, 0) array, is one
+    row of no columns (broadcast against t's rows).
     ``levels``: per column the training levels of a categorical input, None for a continuous
     one (``gpmsa.model.categorical``): a level never seen in training is refused first, as
     ``Emulator.predict`` does.
@@ -92,25 +92,7 @@ def unit_inputs(
         check_levels(native, levels, names, what)
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     unit = snap_to_unit((native - lo) / (hi - lo))
-    below, above = unit.min(axis=0), unit.max(axis=0)
-    far = (below < -EXTRAPOLATION_MARGIN) | (above > 1 + EXTRAPOLATION_MARGIN)
-    if far.any() and not extrapolate:
-        k = int(np.flatnonzero(far)[0])
-        raise GPMSAError(
-            f"{what}: {names[k]} reaches [{native[:, k].min():.6g}, {native[:, k].max():.6g}], "
-            f"outside the emulator's domain [{lo[k]:.6g}, {hi[k]:.6g}] by more than "
-            f"{EXTRAPOLATION_MARGIN:.0%} of its width"
-            + ("; pass extrapolate=True to allow it" if extrapolate is False else "")
-        )
-    outside = (below < 0) | (above > 1)
-    if outside.any():
-        k = int(np.flatnonzero(outside)[0])
-        warnings.warn(
-            f"{what}: {names[k]} lies outside the emulator's domain [{lo[k]:.6g}, {hi[k]:.6g}]; "
-            "the emulator extrapolates there",
-            ExtrapolationWarning,
-            stacklevel=3,
-        )
+    check_extrapolation(native, unit, names, lo, hi, what, extrapolate, stacklevel=3)
     return native, unit
 
 

@@ -179,7 +179,7 @@ def calibrated_predict(
     ts = np.repeat(theta, N, axis=0)
     with warnings.catch_warnings():  # x_new and theta were checked (and warned about) above
         warnings.simplefilter("ignore")
-        mean, var = emulator._predict_point(xs, ts, resid, far_ok=extrapolate)
+        mean, var = emulator._predict_point(xs, ts, resid, extrapolate=extrapolate)
     l_sim = mean.shape[1]
     mean = mean.reshape(K, N, l_sim)
     var = var.reshape(K, N, l_sim)

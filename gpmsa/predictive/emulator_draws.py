@@ -132,6 +132,7 @@ def emulator_prediction(
     resid: bool = True,
     joint: bool = False,
     seed=None,
+    extrapolate: bool = False,
 ) -> EmulatorPrediction:
     """Realizations of the simulator output at (x, t), one set per emulator posterior draw.
 
@@ -139,8 +140,10 @@ def emulator_prediction(
         emulator: a fitted gpmsa.Emulator.
         x: (N, p) known inputs; t: (N, q) calibration parameters; native units (a single row of
             either broadcasts). Outside the training range: a warning; more than
-            ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError. A categorical
-            input takes its training levels only (another: GPMSAError, as ``predict``).
+            ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError naming x or t, the
+            column, its values and the domain (``extrapolate=True``: the warning). A
+            categorical input takes its training levels only (another: GPMSAError, as
+            ``predict``).
         draws: use the retained posterior draws (True, the default) or only the point estimate.
         n_draws: at most this many draws, evenly spaced (None: all retained draws).
         n_rlz: realizations per draw.
@@ -149,6 +152,9 @@ def emulator_prediction(
             ``False`` draws each point independently from its marginal (cheaper; the same
             marginal distribution).
         seed: int, numpy Generator or None.
+        extrapolate: allow x and t outside the emulator's domain by more than
+            ``EXTRAPOLATION_MARGIN`` of a column's width (with an ExtrapolationWarning), as
+            ``Emulator.predict(extrapolate=True)``.
 
     Returns:
         EmulatorPrediction; its ``mean()`` and ``var()`` equal ``Emulator.predict(x, t,
@@ -169,14 +175,14 @@ def emulator_prediction(
     """
     gpmsa_model_only(emulator, "emulator_prediction")
     draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
-    joint = check_flag(joint, "joint")
+    joint, extrapolate = check_flag(joint, "joint"), check_flag(extrapolate, "extrapolate")
     n_rlz = check_count(n_rlz, "n_rlz")
     rng = rng_of(seed)
     s = emulator.standardizer
     check_same_rows({"x": x, "t": t}, {"x": emulator.x_names, "t": emulator.t_names})
     levels, p = tuple(emulator.levels), emulator.p
-    x_nat, xu = unit_inputs(x, emulator.x_names, s.x_min, s.x_max, "x", levels[:p])
-    t_nat, tu = unit_inputs(t, emulator.t_names, s.t_min, s.t_max, "t", levels[p:])
+    x_nat, xu = unit_inputs(x, emulator.x_names, s.x_min, s.x_max, "x", levels[:p], extrapolate)
+    t_nat, tu = unit_inputs(t, emulator.t_names, s.t_min, s.t_max, "t", levels[p:], extrapolate)
     if x_nat.shape[0] != t_nat.shape[0]:
         if x_nat.shape[0] == 1:
             x_nat, xu = (np.repeat(a, t_nat.shape[0], axis=0) for a in (x_nat, xu))

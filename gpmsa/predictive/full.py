@@ -539,7 +539,7 @@ def full_prediction(
         discrepancy_groups = record.get("discrepancy_groups") if discrepancy is not None else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the calibration already warned about its x_obs
-        check_x(emulator, obs.inputs(emulator.x_names), extrapolate)  # its rule: far refused
+        check_x(emulator, obs.inputs(emulator.x_names), extrapolate, "obs")  # far: refused
         ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, levels, emulator.y_names,
                            discrepancy_groups, x_checked=True)  # fmt: skip
     p_v = ob.p_v

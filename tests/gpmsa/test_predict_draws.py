@@ -90,7 +90,7 @@ def test_a_single_row_broadcasts_and_basis_space_is_consistent():
 def test_outside_the_domain_warns_within_the_margin_and_refuses_beyond():
     emu = vector_fit()
     lo, hi = emu.domain["x"]
-    with pytest.warns(UserWarning, match="x lies outside the emulator's domain"):
+    with pytest.warns(UserWarning, match=r"x: x reaches .*, outside the emulator's domain"):
         emulator_prediction(emu, [[hi + 0.05 * (hi - lo)]], [[0.0]], n_draws=2)
     with pytest.raises(GPMSAError, match=r"x reaches .* by more than 10% of its width"):
         emulator_prediction(emu, [[hi + 0.2 * (hi - lo)]], [[0.0]], n_draws=2)

@@ -220,7 +220,7 @@ def test_unseen_levels_are_refused_by_name():
     with pytest.raises(gpmsa.GPMSAError, match="x: categorical input x1 has level 5"):
         gpmsa.full_prediction(emu, obs, [[0.5, 5]], posterior=post, discrepancy=None)
     bad = gpmsa.ObsData([[0.3, 0], [0.6, 4]], [0.5, 1.8])
-    with pytest.raises(gpmsa.GPMSAError, match="x_obs: categorical input x1 has level 4"):
+    with pytest.raises(gpmsa.GPMSAError, match="obs: categorical input x1 has level 4"):
         gpmsa.full_prediction(emu, bad, [[0.5, 1]], posterior=post, discrepancy=None)
     off = gpmsa.Posterior({"t0": np.full(4, 0.5), "t1": np.full(4, 0.5),
                            "lamOs": np.full(4, 100.0)})  # fmt: skip
