@@ -160,7 +160,9 @@ def adapt_ladder(states: list, temperatures, rng, names, widths, n_rounds, n_lev
     every copy at each of GPM/SA's ``n_levels`` candidate widths (``tuning.level_widths`` of
     ``widths``, as the tuning's; the acceptances not kept), a swap round after each, the log
     gaps moved after each swap round. Returns the adapted ladder (K,): 1, strictly increasing,
-    the hottest unchanged."""
+    the hottest unchanged; the starting ladder where the averaged one is not that in float64
+    (swap rates stuck at 0 and 1 can shrink a gap below a rung's resolution: rungs merged or
+    past the hottest)."""
     temps = np.asarray(temperatures, dtype=float)
     top, n_temps = temps[-1], len(states)
     log_gap = np.log(np.diff(temps))
@@ -182,7 +184,12 @@ def adapt_ladder(states: list, temperatures, rng, names, widths, n_rounds, n_lev
             n_mean += 1
         if lev == n_levels - 1:
             on_round(n_levels * n_temps)
-    return _set_ladder(states, mean_gap / max(n_mean, 1), top)
+    out = _set_ladder(states, mean_gap / max(n_mean, 1), top)
+    if np.all(np.diff(out) > 0):  # (so every rung finite: between 1 and the hottest)
+        return out
+    for state, t in zip(states, temps, strict=True):  # not a ladder: the starting one stays
+        state.beta = 1.0 / t
+    return tuple(float(t) for t in temps)
 
 
 def _set_ladder(states: list, log_gap: np.ndarray, top: float) -> tuple[float, ...]:
