@@ -503,7 +503,8 @@ class Posterior:
         if name in self.grids:
             out = self.grids[name].ppf(q_arr)
         else:  # a categorical parameter's (info["levels"]): the lower quantile, a level
-            discrete = name in (self.info.get("levels") or {})
+            levels = self.info.get("levels")
+            discrete = isinstance(levels, dict) and name in levels
             out = np.quantile(self.samples[name], q_arr,
                               method="inverted_cdf" if discrete else "linear")  # fmt: skip
         return float(out) if np.ndim(out) == 0 else out

@@ -19,6 +19,9 @@ def test_a_draws_quantile_of_a_recorded_level_parameter_is_a_level():
     np.testing.assert_array_equal(post.quantile("kind", [0.25, 0.51, 1.0]), [0.0, 1.0, 1.0])
     assert post.interval("kind", 0.5) == (0.0, 1.0)
     assert post.quantile("k", 0.5) == pytest.approx(0.25)  # a continuous one: as before
+    for odd in ("kind", 3, ["kind"]):  # a record that is no dict of levels: linear, as before
+        odd_post = gpmsa.Posterior(draws, info={"levels": odd})
+        assert odd_post.quantile("kind", 0.5) == pytest.approx(0.5)
 
 
 def test_calibrate_records_the_levels_and_its_quantiles_are_levels():
