@@ -18,9 +18,10 @@ More parameters use the MCMC of ``gpmsa.calibrate``.
 A categorical calibration parameter (``theta_levels``): its grid axis is its levels, exactly
 (a continuous parameter beside it on ``n_grid`` nodes per level, default 129); its marginal a
 ``LevelMarginal`` (a probability per level: the posterior integrated over the continuous
-nodes at that level), whose quantiles and draws are levels; such a grid is not refined (a
-warning where a level's continuous density is unresolved) and takes no constraint with a
-continuous parameter ("auto" chooses MCMC there: ``gpmsa.calibrate``'s joint level move).
+nodes at that level), whose quantiles and draws are levels; the continuous axis of each level
+is refined as one parameter's is (a warning where a level's continuous density stays
+unresolved), and such a grid takes no constraint with a continuous parameter ("auto" chooses
+MCMC there: ``gpmsa.calibrate``'s joint level move).
 
 The fixed grid (``Calibrator.theta_grid``): ``n_grid`` equally spaced nodes per calibration
 parameter spanning the emulator's domain [t_min, t_max] of that parameter (the design's range,
@@ -39,6 +40,7 @@ from scipy.special import log_ndtr
 
 from gpmsa import backends
 from gpmsa.calibration.grid import (
+    MODE_MASS,
     RIDGE_SD,
     UNRESOLVED_SD,
     ConstraintCut,
@@ -323,9 +325,7 @@ class Calibrator:
             )
         self._weights = trapezoid_weights(self.theta_grid) if q == 1 else None
         self._log_prior_norm = log_theta_norm(pri.theta_mean, pri.theta_sd)
-        lo, hi = float(std.t_min[0]), float(std.t_max[0])  # one parameter: float64's resolution
-        self._min_step = MIN_STEP_ULPS * max(np.spacing(1.0), np.spacing(max(abs(lo), abs(hi)))
-                                             / (hi - lo))  # fmt: skip
+        self._min_step = _float_step(std, 0)  # one parameter: float64's resolution
         self._base_ok = None if self.constraint is None else self._allowed(self._theta_unit)
         self._base_cut = None
         if self._base_ok is not None and levels is None:  # all categorical: exact at the nodes
@@ -503,7 +503,7 @@ class Calibrator:
             vals = vals.reshape(-1)
             check_log_density(vals)
             if on_grid:
-                if self._levels is None:  # a categorical grid is never refined
+                if self._levels is None:  # not square with a categorical axis: not checked
                     _warn_if_narrow_prior(vals, self.n_grid, self.q)
             else:
                 vals = interp_log(vals, self._axes[0], theta_unit, smooth=True)
@@ -568,8 +568,10 @@ class Calibrator:
                     keep = zero_edges(self._axes, user)
             logp = constrained(free, ok)
             check_mass(logp)
-            if self._levels is not None:  # exact at the levels, never refined
-                return self._update_levels(data, free, ok, margs, outside, prior, seed, count)
+            if self._levels is not None:  # exact at the levels; the continuous axis per level
+                table = None if prior is None or callable(prior) else user
+                return self._update_levels(data, free, ok, margs, outside, prior, table, seed,
+                                           count)  # fmt: skip
             res = None  # two parameters: the resolution (grid.resolution) of the last grid
             why = "resolved"  # one parameter: why refinement ended (grid.refined_axis)
             for _ in range(MAX_REFINE if self.q == 2 else MAX_REFINE_ONE):
@@ -610,11 +612,15 @@ class Calibrator:
         self._count = count
         return post
 
-    def _update_levels(self, data, free, ok, margs, outside, prior, seed, count) -> Posterior:
-        """The rest of ``update`` for a categorical theta (`_level_posterior`): the
-        ``count``-th update's Posterior, its records and warnings."""
+    def _update_levels(
+        self, data, free, ok, margs, outside, prior, table, seed, count
+    ) -> Posterior:
+        """The rest of ``update`` for a categorical theta (`_refine_levels`,
+        `_level_posterior`; ``table``: a gridded prior's log values on the fixed grid (G,), or
+        None): the ``count``-th update's Posterior, its records and warnings."""
         key = run_seed(seed) if seed is not None else (self._entropy, count)
-        post = self._level_posterior(free, ok, margs, key)
+        refined = self._refine_levels(data, constrained(free, ok), prior, table)
+        post = self._level_posterior(free, ok, margs, key, refined)
         post.info["outside_sds"] = outside
         if prior is None or callable(prior):  # an array: maybe other windows' log-likelihood
             post.info.update(obs_values_sha256=data.values_sha256,
@@ -625,7 +631,67 @@ class Calibrator:
         self._count = count
         return post
 
-    def _level_posterior(self, free: np.ndarray, ok, margs: list, key) -> Posterior:
+    def _refine_levels(self, data, logp: np.ndarray, prior, table) -> dict:
+        """A categorical and a continuous parameter: per level holding MODE_MASS of the mass or
+        more on the fixed grid (log posterior ``logp`` (G,)), the continuous axis refined as one
+        parameter's is (`grid.refined_axis`, at most MAX_REFINE_ONE passes, each recomputing
+        the posterior at that level on the finer axis, `_level_row`), where the fixed grid does
+        not resolve its density given the level. ``table``: a gridded prior's log values on the
+        fixed grid (G,) (interpolated along the level's nodes; the lines where it turns zero
+        kept, `grid.zero_edges`), or None. Returns {level index: (unit-scale axis (k,), log
+        posterior (k,), lamOs marginals)} of the refined levels ({} where none is)."""
+        cont = [k for k, lv in enumerate(self._levels) if lv is None]
+        if self.q != 2 or not cont:
+            return {}
+        c = cont[0]
+        shape = tuple(a.size for a in self._axes)
+        rows = np.moveaxis(logp.reshape(shape), c, -1)  # (levels, nodes)
+        given = None if table is None else np.moveaxis(table.reshape(shape), c, -1)
+        axis0 = self._axes[c]
+        mass = np.exp(rows - rows.max()) @ trapezoid_weights(axis0)
+        step = _float_step(self.emulator.standardizer, c)
+        out = {}
+        for r in np.flatnonzero(mass >= MODE_MASS * mass.sum()):
+            keep = None
+            if given is not None and np.isneginf(given[r]).any():
+                keep = zero_edges([axis0], given[r])[0]
+            axis, row, margs = axis0, rows[r], None
+            for _ in range(MAX_REFINE_ONE):
+                finer, why = refined_axis(axis, row, keep, step)
+                if finer is None:
+                    break
+                axis = finer
+                user = None if given is None else given[r]
+                margs, row = self._level_row(data, c, r, axis, prior, user)
+                if why != "refine":
+                    break
+            if margs is not None:
+                out[int(r)] = (axis, row, margs)
+        return out
+
+    def _level_row(self, data, c: int, r: int, axis: np.ndarray, prior, table) -> tuple:
+        """The lamOs marginals and the log posterior (k,) at level ``r`` of the categorical
+        parameter on the unit-scale ``axis`` (k,) of the continuous one (element ``c``):
+        dense solves, the emulator's theta prior of the continuous element, the user's
+        ``prior`` (``table``: its log values along that level on the fixed grid, interpolated
+        as `_prior_values` interpolates a gridded prior; None: a callable, or none)."""
+        theta = np.empty((axis.size, 2))
+        theta[:, c], theta[:, 1 - c] = axis, self._axes[1 - c][r]
+        margs = self._marginals(data, theta)
+        pri = self.emulator.priors
+        logp = self._combine(margs) - 0.5 * ((axis - pri.theta_mean) / pri.theta_sd) ** 2
+        if table is not None:
+            vals = interp_log(table, self._axes[c], axis[:, None], smooth=True)
+            check_log_density(vals)
+            logp = logp + vals
+        elif prior is not None:
+            logp = logp + self._prior_values(prior, theta, False)
+        check_mass(logp)
+        return margs, logp
+
+    def _level_posterior(
+        self, free: np.ndarray, ok, margs: list, key, refined: dict | None = None
+    ) -> Posterior:
         """The posterior on the fixed grid of a categorical theta, whose nodes (in 'ij' order)
         have the unconstrained log posterior ``free`` (G,), the constraint's verdicts ``ok``
         (G,) (None: none; only where every element is categorical: exact at the levels) and the
@@ -635,12 +701,17 @@ class Calibrator:
         trapezoid integral over the continuous element's nodes at that level (1 where there is
         none); a continuous element's a `GridMarginal`, the sum over levels of the density at
         its nodes (piecewise linear between them). Draws: a level (or, all categorical, a node)
-        by its probability, then the continuous element from its density given that level."""
+        by its probability, then the continuous element from its density given that level.
+        ``refined`` (`_refine_levels`): the levels whose continuous axis was refined, with
+        their axis, log posterior and lamOs marginals there, which replace the fixed grid's at
+        those levels (the continuous marginal then on the union of the levels' nodes)."""
         std = self.emulator.standardizer
         names = tuple(self.emulator.t_names)
         shape = tuple(a.size for a in self._axes)
         logp = constrained(free, ok)
-        dens = np.exp(logp - logp.max()).reshape(shape)
+        refined = refined or {}
+        top = max([float(logp.max())] + [float(row.max()) for _, row, _ in refined.values()])
+        dens = np.exp(logp - top).reshape(shape)
         codes = self._codes
         native = [a * (std.t_max[k] - std.t_min[k]) + std.t_min[k] if c is None else c
                   for k, (a, c) in enumerate(zip(self._axes, codes, strict=True))]  # fmt: skip
@@ -648,21 +719,42 @@ class Calibrator:
              for a, c in zip(native, codes, strict=True)]  # fmt: skip
         cont = [k for k, c in enumerate(codes) if c is None]  # at most one (q <= 2)
         mass = dens * (w[0] if self.q == 1 else np.outer(w[0], w[1]))
+        per_level = []  # per level: the continuous element's native nodes, density, weights
+        if cont:
+            c = cont[0]
+            span = std.t_max[c] - std.t_min[c]
+            rows = np.moveaxis(dens, c, -1)  # (levels, nodes)
+            per_level = [(native[c], rows[r], w[c]) for r in range(rows.shape[0])]
+            for r, (axis, row, _) in refined.items():
+                x = axis * span + std.t_min[c]
+                per_level[r] = (x, np.exp(row - top), trapezoid_weights(x))
         grids: dict = {}
         resolved = []
         for k, name in enumerate(names):
             other = tuple(j for j in range(self.q) if j != k)
             if self._codes[k] is not None:
-                grids[name] = LevelMarginal.from_probabilities(native[k], mass.sum(axis=other))
+                p = mass.sum(axis=other)
+                for r in refined:
+                    p[r] = per_level[r][2] @ per_level[r][1]
+                grids[name] = LevelMarginal.from_probabilities(native[k], p)
                 resolved.append(np.inf)
                 continue
-            with np.errstate(divide="ignore"):
-                grids[name] = trimmed_marginal(native[k], np.log(dens.sum(axis=other)), w[k])[0]
+            if refined:  # the levels' densities, piecewise linear, summed on all their nodes
+                x = np.unique(np.concatenate([a for a, _, _ in per_level]))
+                x = x[np.concatenate(([True], np.diff(x) >= _float_step(std, k) * span))]
+                total = sum(np.interp(x, a, d, left=0.0, right=0.0) for a, d, _ in per_level)
+                with np.errstate(divide="ignore"):
+                    grids[name] = trimmed_marginal(x, np.log(total), trapezoid_weights(x))[0]
+            else:
+                with np.errstate(divide="ignore"):
+                    grids[name] = trimmed_marginal(native[k], np.log(dens.sum(axis=other)),
+                                                   w[k])[0]  # fmt: skip
             # the worst resolved conditional of a level holding LEVEL_MASS of the mass or more
-            rows = np.moveaxis(dens, k, -1)  # (levels, nodes)
-            p = rows @ w[k]
+            p = np.moveaxis(dens, k, -1) @ w[k]
+            for r in refined:
+                p[r] = per_level[r][2] @ per_level[r][1]
             with np.errstate(divide="ignore"):
-                res = [resolution([native[k]], np.log(rows[r]))[0]
+                res = [resolution([per_level[r][0]], np.log(per_level[r][1]))[0]
                        for r in np.flatnonzero(p >= LEVEL_MASS * p.sum())]  # fmt: skip
             resolved.append(min(res))
         inv_lamos = _expected_inverse_lamos(margs) if self.q == 1 else None
@@ -680,31 +772,39 @@ class Calibrator:
                                                   side="right"), cum.size - 1)  # fmt: skip
                 idx = np.unravel_index(node, shape)
                 out = {name: native[k][idx[k]] for k, name in enumerate(names)}
+                out["lamOs"] = _draw_lamos(margs, node, rng)
             else:  # a level, then the continuous element given it
                 c = cont[0]
                 lv = 1 - c
                 level = grids[names[lv]].sample(rng, n_draws)
                 li = np.searchsorted(native[lv], level)
-                rows = np.moveaxis(dens, c, -1)
                 vals = np.empty(n_draws)
                 for r in np.unique(li):
                     sel = li == r
+                    x, row, wr = per_level[r]
                     with np.errstate(divide="ignore"):
-                        gm = trimmed_marginal(native[c], np.log(rows[r]), w[c])[0]
+                        gm = trimmed_marginal(x, np.log(row), wr)[0]
                     vals[sel] = gm.sample(rng, int(sel.sum()))
-                ci = nearest(native[c], vals)
-                idx = (li, ci) if c == 1 else (ci, li)
-                node = np.ravel_multi_index(idx, shape)
-                out = {names[lv]: level, names[c]: vals}
-            out["lamOs"] = _draw_lamos(margs, node, rng)
+                lam = np.empty(n_draws)  # lamOs at each draw's nearest node of its level's grid
+                base = ~np.isin(li, list(refined))
+                if base.any():
+                    ci = nearest(native[c], vals[base])
+                    idx = (li[base], ci) if c == 1 else (ci, li[base])
+                    lam[base] = _draw_lamos(margs, np.ravel_multi_index(idx, shape), rng)
+                for r, (_, _, level_margs) in refined.items():
+                    sel = li == r
+                    if sel.any():
+                        node = nearest(per_level[r][0], vals[sel])
+                        lam[sel] = _draw_lamos(level_margs, node, rng)
+                out = {names[lv]: level, names[c]: vals, "lamOs": lam}
             return {name: out[name] for name in (*names, "lamOs")}
 
         info = {
             "method": "grid",
             "expected_inv_lamOs": inv_lamos,
             "names": names + ("lamOs",),
-            "n_nodes": int(free.size),
-            "refined": False,
+            "n_nodes": int(free.size) + sum(a.size - self.n_grid for a, _, _ in refined.values()),
+            "refined": bool(refined),
             "log_evidence": log_evidence,
             "levels": {
                 n: list(map(float, c)) for n, c in zip(names, codes, strict=True) if c is not None
@@ -969,18 +1069,25 @@ def _warn_if_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> No
 
 def _warn_if_level_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> None:
     """Warn where the continuous parameter's density given a level (one holding LEVEL_MASS of
-    the mass or more) spans fewer than UNRESOLVED_SD node spacings per width on the fixed grid
-    (a categorical theta's grid is not refined)."""
+    the mass or more) spans fewer than UNRESOLVED_SD node spacings per width on the grid its
+    refinement ended with (`Calibrator._refine_levels`)."""
     k = int(np.argmin(res))
     if res[k] < UNRESOLVED_SD:
         warnings.warn(
             f"the grid does not resolve the posterior of {names[k]} given the level of "
             f"{names[1 - k]}: its width spans {res[k]:.2g} node spacings (fewer than "
-            f"{UNRESOLVED_SD:g}), and a grid with a categorical calibration parameter is not "
-            f"refined, so its summaries, draws and the levels' probabilities may be off; use "
-            f"a larger n_grid (now {n_grid}) or method='mcmc'",
+            f"{UNRESOLVED_SD:g}) on the grid refinement ended with, so its summaries, draws "
+            f"and the levels' probabilities may be off; use a larger n_grid (now {n_grid}) or "
+            f"method='mcmc'",
             stacklevel=4,
         )
+
+
+def _float_step(std, k: int) -> float:
+    """The least spacing of refined nodes of calibration parameter ``k`` (unit scale): MIN_STEP_ULPS
+    float64 spacings, in the unit scale and in its native units (``std``: the standardizer)."""
+    lo, hi = float(std.t_min[k]), float(std.t_max[k])
+    return MIN_STEP_ULPS * max(np.spacing(1.0), np.spacing(max(abs(lo), abs(hi))) / (hi - lo))
 
 
 def _level_codes(emulator) -> list[np.ndarray | None]:
