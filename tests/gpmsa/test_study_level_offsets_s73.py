@@ -13,7 +13,7 @@ import warnings
 
 import numpy as np
 import pytest
-from _level_cases import level_function
+from _level_cases import level_function, level_sim
 
 import gpmsa
 from gpmsa.cli.main import main
@@ -24,10 +24,7 @@ def case():
     """kind 0 at k = 0.9 fits as kind 1 at k = 0.4 (_level_cases), 36 runs, fixed emulator
     parameters; two experiments, one per model."""
     rng = np.random.default_rng(2)
-    x = rng.random((36, 1))
-    t = np.column_stack([rng.random(36), np.arange(36) % 3])
-    sim = gpmsa.SimData(x, t, level_function(x, t), x_names=["s"], t_names=["k", "kind"],
-                        t_categorical=["kind"])  # fmt: skip
+    sim = level_sim(rng, 36)
     emu = gpmsa.Emulator.from_params(sim, {"betaU": [[4.0], [1.0], [0.5]], "lamUz": [1.0],
                                            "lamWs": [1e5], "lamWOs": [1e5]})  # fmt: skip
     xo = np.linspace(0.1, 0.9, 6)[:, None]

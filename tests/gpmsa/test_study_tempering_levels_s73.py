@@ -14,7 +14,7 @@ The emulator is the s72 fixture's 600-sweep fit, its parameters written out (no 
 import warnings
 
 import numpy as np
-from _level_cases import level_function
+from _level_cases import level_function, level_sim
 
 import gpmsa
 
@@ -24,11 +24,7 @@ PARAMS = {"betaU": [[0.854], [0.0655], [0.3338]], "lamUz": [0.3356], "lamWs": [3
 
 def _case():
     rng = np.random.default_rng(2)
-    m = 60
-    x = rng.random((m, 1))
-    t = np.column_stack([rng.random(m), np.arange(m) % 3])
-    sim = gpmsa.SimData(x, t, level_function(x, t), x_names=["s"], t_names=["k", "kind"],
-                        t_categorical=["kind"])  # fmt: skip
+    sim = level_sim(rng, 60)
     emu = gpmsa.Emulator.from_params(sim, PARAMS)
     obs = []
     for lo, hi, n in [(0.1, 0.9, 6), (0.15, 0.85, 5)]:

@@ -14,6 +14,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _level_cases import three_theta_case
 
 import gpmsa
 from gpmsa.errors import GPMSAError, ResourceLimitError
@@ -143,14 +144,7 @@ def test_swap_is_exact_and_keeps_each_row_consistent():
 
 
 def test_categorical_and_constraint_with_copies():
-    rng = np.random.default_rng(2)
-    m = 30
-    x = rng.random((m, 1))
-    t = np.column_stack([rng.random(m), rng.random(m), np.arange(m) % 2])
-    y = np.sin(3 * x[:, :1]) + t[:, :1] + 0.3 * t[:, 1:2] + 0.5 * t[:, 2:]
-    sim = gpmsa.SimData(x, t, y, t_names=["a", "b", "kind"], t_categorical=["kind"])
-    xo = np.linspace(0.1, 0.9, 5)[:, None]
-    obs = gpmsa.ObsData(x=xo, y=np.sin(3 * xo) + 0.4 + 0.5 + 0.02 * rng.standard_normal((5, 1)))
+    sim, obs = three_theta_case(np.random.default_rng(2))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         emu = gpmsa.fit(sim, obs, n_iter=30, n_chains=2, seed=0, backend="torch",
