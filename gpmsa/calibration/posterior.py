@@ -503,8 +503,7 @@ class Posterior:
         if name in self.grids:
             out = self.grids[name].ppf(q_arr)
         else:  # a categorical parameter's (info["levels"]): the lower quantile, a level
-            levels = self.info.get("levels")
-            discrete = isinstance(levels, dict) and name in levels
+            discrete = self._level_codes(name) is not None
             out = np.quantile(self.samples[name], q_arr,
                               method="inverted_cdf" if discrete else "linear")  # fmt: skip
         return float(out) if np.ndim(out) == 0 else out

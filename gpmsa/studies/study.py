@@ -241,8 +241,8 @@ class Study:
             if lv is not None:  # a categorical element's draws: exactly the level codes
                 chains[el.name] = np.round(chains[el.name])
                 i, k = el.uses[0]
-                emu = self.members[i]
-                levels[el.name] = [float(v) for v in emu.levels[len(emu.x_names) + k]]
+                member = self.members[i]
+                levels[el.name] = theta_levels_native(member)[member.t_names[k]]
         for name, value in _held_theta(layout, self.draws, self.settings).items():
             chains[name][...] = value
         samples = {k: v.reshape(-1) for k, v in chains.items()}
