@@ -17,7 +17,9 @@ whichever of the process's threads the kernel hands the signal to.
 
 from __future__ import annotations
 
+import gc
 import multiprocessing
+import multiprocessing.context
 import os
 import sys
 import warnings
@@ -99,10 +101,46 @@ def as_executor(executor) -> Executor | None:
     )
 
 
+_forking_worker = False
+"""True while this process forks one of gpmsa's own pool workers (read in the child)."""
+
+
+def _freeze_inherited() -> None:
+    """In a forked worker, put every object inherited from the parent beyond the garbage
+    collector's reach (`gc.freeze`). The parent's uncollected garbage may hold another pool's
+    executor whose weakref callback takes a lock that one of the parent's threads held at the
+    fork (CPython's ``concurrent.futures.process``): collected in the child, it would wait for
+    that lock forever. Runs before any Python code of the child; what the chain creates is
+    collected as usual."""
+    if _forking_worker:
+        gc.freeze()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_freeze_inherited)
+
+
+class _WorkerProcess(multiprocessing.context.ForkProcess):
+    """A fork-started pool worker whose child freezes what it inherits (`_freeze_inherited`)."""
+
+    @staticmethod
+    def _Popen(process_obj):
+        global _forking_worker
+        _forking_worker = True
+        try:
+            return multiprocessing.context.ForkProcess._Popen(process_obj)
+        finally:
+            _forking_worker = False
+
+
+class _WorkerContext(multiprocessing.context.ForkContext):
+    Process = _WorkerProcess
+
+
 def _own_pool(workers: int) -> ProcessPoolExecutor:
     # fork where it exists (Linux): a worker starts in ~0.05 s against ~2 s for forkserver or
     # spawn, which re-import numpy and scipy. The workers run numpy only, one BLAS thread.
-    ctx = multiprocessing.get_context("fork") if sys.platform == "linux" else None
+    ctx = _WorkerContext() if sys.platform == "linux" else None
     return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
 
 
@@ -120,12 +158,15 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     running one (``terminate_workers`` of Python 3.14), so that a failed or interrupted run
     leaves no process computing chains nobody will read."""
     processes = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)  # shutdown forgets it
     pool.shutdown(wait=False, cancel_futures=True)
     for proc in processes:
         if proc.is_alive():
             proc.terminate()
     for proc in processes:
         proc.join(timeout=_JOIN_S)
+    if manager is not None:  # it takes the pool's locks: a fork while it runs inherits them
+        manager.join(timeout=_JOIN_S)
 
 
 def _closed(exc: BaseException) -> bool:

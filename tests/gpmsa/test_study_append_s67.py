@@ -156,11 +156,12 @@ def test_the_memory_check_counts_an_appended_studys_pooled_draws(monkeypatch):
     appended fit's (session 67's review: the study's check left them out)."""
     import gpmsa.studies.run as run
 
+    cal_source, fit_source = _cal_source(), _fit_source()  # sampled before the check is watched
     seen = []
     monkeypatch.setattr(run, "check_memory", lambda nbytes, what: seen.append((nbytes, what)))
-    _calibrate(6, 2, init=_cal_source(), tune=False)
-    _calibrate(6, 2, init=_cal_source(), tune=False, append=True)
-    _fit(8, 2, init=_fit_source(), tune=False, append=True)
+    _calibrate(6, 2, init=cal_source, tune=False)
+    _calibrate(6, 2, init=cal_source, tune=False, append=True)
+    _fit(8, 2, init=fit_source, tune=False, append=True)
     (plain, _), (pooled, what), (fitted, fit_what) = seen
     assert pooled > plain and "appending to 26 draws a chain" in what  # 20 + 6 at step 1
     assert "appending to 10 draws a chain" in fit_what  # 8 + 8 // 4
