@@ -506,8 +506,8 @@ class BatchState:
     chain); with a mean basis the coefficients are integrated out (`gls`) and the observations'
     mean adds the GLS trend h([x_obs, theta]) coef (`mean_rows`, cached per chain).
     ``beta``: None (plain chains), or (C,) the power 1/T of each row's likelihood in its
-    acceptance (parallel tempering, `_tempered_sweeps`: the rows are the chains' copies; the
-    prior is not tempered).
+    acceptance (parallel tempering, `_tempered_tuning`, `_tempered_draws`: the rows are the
+    chains' copies; the prior is not tempered).
     """
 
     beta: Tensor | None = None
@@ -1006,20 +1006,16 @@ def sample(
     2 in turn) exchange their rows' states with probability min(1, exp((1/T_k - 1/T_{k+1})
     (log L_{k+1} - log L_k))) (`_swap_rows`). The T = 1 rows' draws, log posteriors,
     acceptance and widths are kept; ``info`` records "temperatures", "swap_every" and
-    "swap_rate" (n_chains, K - 1) over the draws' swap rounds. In one batch (``chain_groups``
-    1, no ``executor``).
+    "swap_rate" (n_chains, K - 1) over the draws' swap rounds. Tuning runs in one batch;
+    ``chain_groups`` > 1 (or an ``executor``) then samples groups of whole chains, each with
+    all its K copies (tempering within the group as in one batch), with the groups' streams
+    as above; draws, acceptance and swap rates are assembled in chain order.
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
     temps = tempering.ladder(temperatures)
     swap_every = tempering.check_swap_every(swap_every, temps, int(n_iter))
-    if temps is not None and (chain_groups != 1 or executor is not None):
-        raise GPMSAError(
-            f"temperatures= runs every chain's copies in one batch: give chain_groups=1 and no "
-            f"executor (got chain_groups={chain_groups!r}"
-            f"{'' if executor is None else ', an executor'})"
-        )
     copies = 1 if temps is None else len(temps)
     check_draws_memory(problem, int(n_iter), int(n_chains))
     check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype), copies)
@@ -1125,15 +1121,17 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     in_process = where["groups"] == 1 and where["executor"] is None
     if not in_process:
         total -= n_iter  # the groups' sweeps: counted by run_chains' bar over the groups
-    tempered = {}
+    ws = rates = None  # tempered: each copy's widths (K, n_el); the swap rates (C, K - 1)
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
         if temps is not None:
-            w, draws, log_post, accepted, rates = _tempered_sweeps(
-                state, w, temps, swap_every, n_iter, prop_mh, gen, bar, warmup=warmup,
-                n_stages=n_stages, tune=tune, tune_rounds=tune_rounds, tune_levels=tune_levels,
-            )  # fmt: skip
-            tempered = {"temperatures": list(temps), "swap_every": swap_every,
-                        "swap_rate": rates}  # fmt: skip
+            ws = _tempered_tuning(state, w, temps, prop_mh, gen, bar, warmup=warmup,
+                                  n_stages=n_stages, tune=tune, tune_rounds=tune_rounds,
+                                  tune_levels=tune_levels)  # fmt: skip
+            w = ws[0]
+            if in_process:
+                draws, log_post, accepted, rates = _tempered_draws(
+                    state, ws, temps, swap_every, n_iter, prop_mh, gen, bar
+                )
         elif tune:  # the widths tuned with the level moves (a categorical theta; no draws used)
             state.learn_level_shifts()
         for _stage in range(n_stages if temps is None else 0):  # (tempered: done above)
@@ -1156,9 +1154,13 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
             bar.set_description("torch MCMC: sampling")
             draws, log_post, accepted = _sweeps(state, w, n_iter, prop_mh, gen, bar)
     if not in_process:
-        draws, log_post, accepted = _grouped_sweeps(state, w, n_iter, prop_mh, seeds[0], where,
-                                                    dtype=str(dt).replace("torch.", ""),
-                                                    progress=progress)  # fmt: skip
+        draws, log_post, accepted, rates = _grouped_sweeps(
+            state, w if temps is None else ws, n_iter, prop_mh, seeds[0], where,
+            dtype=str(dt).replace("torch.", ""), progress=progress, temps=temps,
+            swap_every=swap_every,
+        )  # fmt: skip
+    tempered = {} if temps is None else {"temperatures": list(temps), "swap_every": swap_every,
+                                         "swap_rate": rates}  # fmt: skip
     rate = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
     wid = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
     acc_np = accepted / n_iter
@@ -1200,77 +1202,100 @@ def _swap_rows(state: BatchState, betas: tuple[float, ...], u: Tensor, accepted:
         accepted[k] += acc
 
 
-def _tempered_sweeps(state: BatchState, w: np.ndarray, temps: tuple[float, ...],
-                     swap_every: int, n_iter: int, prop_mh: bool, gen: torch.Generator, bar, *,
-                     warmup: int, n_stages: int, tune: bool, tune_rounds: int,
-                     tune_levels: int) -> tuple:  # fmt: skip
-    """``_sample``'s warm-up, tuning and draws with parallel tempering (``sample``'s
+def _temper(state: BatchState, temps: tuple[float, ...]) -> tuple[float, ...]:
+    """Set ``state.beta`` for rows c K + k at ``temps[k]`` (K = len(temps)); returns 1/T_k."""
+    betas = tuple(1.0 / t for t in temps)
+    state.beta = state.ll_w.new_tensor(betas).repeat(state.n_chains // len(temps))
+    return betas
+
+
+def _copy_widths(state: BatchState, per_copy: np.ndarray) -> Tensor:
+    """Each copy's widths (K, n_el) as each row's (n_el, C K) of a tempered batch."""
+    n_temps = per_copy.shape[0]
+    return state.ll_w.new_tensor(per_copy.T).repeat(1, state.n_chains // n_temps)
+
+
+def _swap_round(state: BatchState, betas: tuple[float, ...], gen: torch.Generator,
+                swaps: Tensor) -> None:  # fmt: skip
+    """`_swap_rows` with uniforms (K - 1, C) drawn from ``gen``; counts into swaps (K - 1, C)."""
+    u = torch.rand(swaps.shape, generator=gen, dtype=state.ll_w.dtype, device=state.ll_w.device)
+    _swap_rows(state, betas, u, swaps)
+
+
+def _tempered_tuning(state: BatchState, w: np.ndarray, temps: tuple[float, ...], prop_mh: bool,
+                     gen: torch.Generator, bar, *, warmup: int, n_stages: int, tune: bool,
+                     tune_rounds: int, tune_levels: int) -> np.ndarray:  # fmt: skip
+    """``_sample``'s warm-up and tuning with parallel tempering (``sample``'s
     ``temperatures``): ``state`` holds C chains x K copies (row c K + k at temperature
     ``temps[k]``), every copy from the widths ``w`` (n_el,). Each stage: ``warmup`` sweeps,
     then GPM/SA's tuning of each copy's widths at its temperature (acceptance pooled over the
     chains' copy k), a swap round (`_swap_rows`) after each sweep and each tuning level; then
-    ``n_iter`` sweeps, a swap round every ``swap_every``. Returns the T = 1 copy's widths
-    (n_el,), `_sweeps`' draws, log posterior and accepted counts of the T = 1 rows, and the swap
-    rate (C, K - 1) of each neighbour pair over the draws' swap rounds."""
+    the level shifts learnt at T = 1. Returns each copy's widths (K, n_el) for
+    `_tempered_draws`."""
     n_temps, n_el = len(temps), len(state.els)
     n_chains = state.n_chains // n_temps
-    dt, dev = state.ll_w.dtype, state.ll_w.device
-    betas = tuple(1.0 / t for t in temps)
-    state.beta = torch.tensor(betas, dtype=dt, device=dev).repeat(n_chains)
-    swaps = torch.zeros((n_temps - 1, n_chains), dtype=torch.long, device=dev)
+    betas = _temper(state, temps)
+    swaps = torch.zeros((n_temps - 1, n_chains), dtype=torch.long, device=state.ll_w.device)
     names = [n for n, _ in state.els]
-
-    def rows(per_copy: np.ndarray) -> Tensor:  # (K, n_el) -> each row's widths (n_el, C K)
-        return torch.as_tensor(per_copy.T, dtype=dt, device=dev).repeat(1, n_chains)
-
-    def swap_round() -> None:
-        u = torch.rand((n_temps - 1, n_chains), generator=gen, dtype=dt, device=dev)
-        _swap_rows(state, betas, u, swaps)
-
     ws = np.tile(w, (n_temps, 1))  # each copy's widths
     if tune:  # the widths tuned with the level moves (a categorical theta), learnt at T = 1
         state.learn_level_shifts(n_temps)
     for _stage in range(n_stages):
         bar.set_description(f"torch MCMC: warm-up{' and tuning' if tune else ''} ({n_temps} "
                             "temperatures)")  # fmt: skip
-        per_row = rows(ws)
+        per_row = _copy_widths(state, ws)
         for _ in range(warmup):
             state.sweep(per_row, prop_mh, gen)
-            swap_round()
+            _swap_round(state, betas, gen, swaps)
             bar.update(1)
         if not (tune and n_el):
             break
         cands = [tuning.level_widths(names, ws[k], tune_levels) for k in range(n_temps)]
-        levels = [rows(np.stack([c[lev] for c in cands])) for lev in range(tune_levels)]
-        acc = torch.zeros((tune_levels, n_el, n_temps), dtype=torch.long, device=dev)
+        levels = [_copy_widths(state, np.stack([c[lev] for c in cands]))
+                  for lev in range(tune_levels)]  # fmt: skip
+        acc = torch.zeros((tune_levels, n_el, n_temps), dtype=torch.long, device=swaps.device)
         for _ in range(tune_rounds):
             for lev in range(tune_levels):
                 took = state.sweep(levels[lev], False, gen)  # (n_el, C K)
                 acc[lev] += took.view(n_el, n_chains, n_temps).sum(1)
-                swap_round()
+                _swap_round(state, betas, gen, swaps)
             bar.update(tune_levels)
         counts = acc.cpu().numpy()
         ws = np.stack([tuning.choose_widths(ws[k], cands[k], counts[..., k],
                                             tune_rounds * n_chains)
                        for k in range(n_temps)])  # fmt: skip
     state.learn_level_shifts(n_temps)  # anew at T = 1, shared by the copies, frozen
+    return ws
+
+
+def _tempered_draws(state: BatchState, ws: np.ndarray, temps: tuple[float, ...],
+                    swap_every: int, n_iter: int, prop_mh: bool, gen: torch.Generator,
+                    bar) -> tuple:  # fmt: skip
+    """``n_iter`` sweeps of a tempered batch (rows c K + k at ``temps[k]``, each copy at its
+    widths ``ws`` (K, n_el)), a swap round every ``swap_every``: `_sweeps`' draws, log
+    posterior and accepted counts of the T = 1 rows, and the swap rate (C, K - 1) of each
+    neighbour pair over the swap rounds. One batch's, or a chain group's (`_group_task`)."""
+    n_temps = len(temps)
+    n_chains = state.n_chains // n_temps
+    betas = _temper(state, temps)
+    dt, dev = state.ll_w.dtype, state.ll_w.device
     bar.set_description(f"torch MCMC: sampling ({n_temps} temperatures)")
-    problem, cold, per_row = state.problem, slice(None, None, n_temps), rows(ws)
+    problem, cold, per_row = state.problem, slice(None, None, n_temps), _copy_widths(state, ws)
     draws = {n: torch.empty((n_iter, n_chains, *problem.init[n].shape), dtype=dt, device=dev)
              for n in problem.names}  # fmt: skip
     log_post = torch.empty((n_iter, n_chains), dtype=dt, device=dev)
-    accepted = torch.zeros((n_el, n_chains), dtype=torch.long, device=dev)
-    swaps.zero_()
+    accepted = torch.zeros((len(state.els), n_chains), dtype=torch.long, device=dev)
+    swaps = torch.zeros((n_temps - 1, n_chains), dtype=torch.long, device=dev)
     for it in range(n_iter):
         accepted += state.sweep(per_row, prop_mh, gen)[:, cold]
         if it % swap_every == swap_every - 1:
-            swap_round()
+            _swap_round(state, betas, gen, swaps)
         for n in problem.names:
             draws[n][it] = state.params[n][cold]
         log_post[it] = state.log_post()[cold]
         bar.update(1)
     rate = swaps.cpu().numpy().T / max(n_iter // swap_every, 1)
-    return (ws[0], {n: np.moveaxis(v.cpu().numpy(), 0, 1) for n, v in draws.items()},
+    return ({n: np.moveaxis(v.cpu().numpy(), 0, 1) for n, v in draws.items()},
             log_post.cpu().numpy().T, accepted.cpu().numpy(), rate)  # fmt: skip
 
 
@@ -1297,33 +1322,42 @@ def _sweeps(
 
 def _group_task(problem: Problem, start: dict[str, np.ndarray], widths: np.ndarray, n_iter: int,
                 prop_mh: bool, stream: int, dtype: str, ridge_moves: int, progress: bool = False,
-                desc: str = "torch chains",
-                level_shifts: tuple | None = None) -> tuple:  # fmt: skip
+                desc: str = "torch chains", level_shifts: tuple | None = None,
+                temps: tuple[float, ...] | None = None, swap_every: int = 1) -> tuple:  # fmt: skip
     """One chain group's sweeps from plain data (run in a worker process, one thread);
     ``level_shifts``: the group's (``BatchState.shift_elements``, element -> offsets (C', K,
-    n)) of the joint level move (None: none)."""
+    n)) of the joint level move (None: none). ``temps``: parallel tempering (None: off);
+    ``start`` then holds the group's chains' rows c K + k (every copy), ``widths`` each copy's
+    (K, n_el), and the result adds the swap rates (`_tempered_draws`)."""
     with torch_threads(1), torch.no_grad():
-        n_chains = len(next(iter(start.values())))
-        state = BatchState(problem, n_chains, _dtype(dtype), "cpu", start, ridge_moves)
+        n_rows = len(next(iter(start.values())))
+        state = BatchState(problem, n_rows, _dtype(dtype), "cpu", start, ridge_moves)
         if level_shifts is not None:
             state.shift_elements = list(level_shifts[0])
             state.level_shifts = {k: torch.as_tensor(v, dtype=state.ll_w.dtype)
                                   for k, v in level_shifts[1].items()}  # fmt: skip
         gen = torch.Generator().manual_seed(stream)
         with tqdm(total=n_iter, desc=desc, disable=not progress) as bar:
+            if temps is not None:
+                return _tempered_draws(state, widths, temps, swap_every, n_iter, prop_mh, gen,
+                                       bar)  # fmt: skip
             return _sweeps(state, widths, n_iter, prop_mh, gen, bar)
 
 
 def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh: bool,
-                    first: np.random.SeedSequence, where: dict, *, dtype: str,
-                    progress: bool) -> tuple:  # fmt: skip
+                    first: np.random.SeedSequence, where: dict, *, dtype: str, progress: bool,
+                    temps: tuple | None = None, swap_every: int = 1) -> tuple:  # fmt: skip
     """``_sweeps`` of consecutive chain groups in worker processes (``gpmsa.mcmc.parallel``);
-    group g's stream is child n_chains + g of the seed's SeedSequence (``first`` is child 0)."""
-    c, k = state.n_chains, where["groups"]
+    group g's stream is child n_chains + g of the seed's SeedSequence (``first`` is child 0).
+    ``temps``: parallel tempering (``widths`` each copy's (K, n_el)): each group holds whole
+    chains, rows c K + k of all K copies, and runs `_tempered_draws`. Returns draws, log
+    posterior, accepted counts and the swap rates (C, K - 1; None untempered)."""
+    copies = 1 if temps is None else len(temps)
+    c, k = state.n_chains // copies, where["groups"]
     bounds = np.linspace(0, c, k + 1).round().astype(int)
     tasks = []
     for g in range(k):
-        lo, hi = int(bounds[g]), int(bounds[g + 1])
+        lo, hi = int(bounds[g]) * copies, int(bounds[g + 1]) * copies  # the chains' rows
         seq = np.random.SeedSequence(first.entropy, spawn_key=(c + g,))
         tasks.append({
             "problem": state.problem, "widths": np.asarray(widths), "n_iter": int(n_iter),
@@ -1333,6 +1367,7 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
             "level_shifts": (tuple(state.shift_elements), {
                 k: v[lo:hi].cpu().numpy().copy() for k, v in state.level_shifts.items()
             }) if state.level_shifts else None,
+            **({} if temps is None else {"temps": tuple(temps), "swap_every": int(swap_every)}),
         })  # fmt: skip
     shapes = {n: v.shape[1:] for n, v in state.params.items()}
 
@@ -1340,6 +1375,8 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
         size = int(bounds[g + 1] - bounds[g])
         expected = ({n: (size, int(n_iter), *v) for n, v in shapes.items()},
                     (size, int(n_iter)), (len(state.els), size))  # fmt: skip
+        if temps is not None:
+            expected = (*expected, (size, copies - 1))
         return wrong_result(result, expected, f"{size} chains x {n_iter} sweeps")
 
     try:
@@ -1351,4 +1388,6 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
         chains = tuple(range(int(bounds[g]), int(bounds[g + 1])))
         raise ChainError(f"chains {chains[0]}-{chains[-1]}: {exc}", chains) from exc
     draws = {n: np.concatenate([r[0][n] for r in runs]) for n in runs[0][0]}
-    return draws, np.concatenate([r[1] for r in runs]), np.concatenate([r[2] for r in runs], 1)
+    rates = None if temps is None else np.concatenate([r[3] for r in runs])
+    return (draws, np.concatenate([r[1] for r in runs]), np.concatenate([r[2] for r in runs], 1),
+            rates)  # fmt: skip

@@ -193,8 +193,9 @@ def fit(
     time, memory for n likelihood states). ``settings`` record "temperatures", "swap_every" and
     "swap_rate" (per chain, per neighbour pair): rates near 0 say the ladder is too sparse, the
     hottest copy should cross between the modes (a barrier of 50 in log posterior needs T_max of
-    tens). torch: the batch holds every chain's copies (n_chains x n rows), in one batch
-    (``chain_groups=1``). Refused on the pyro backend and with ``init`` an emulator
+    tens). torch: the batch holds every chain's copies (n_chains x n rows); with
+    ``chain_groups`` > 1 each group holds whole chains with all their copies (tuning in one
+    batch). Refused on the pyro backend and with ``init`` an emulator
     (docs/internals.md, "Parallel tempering"). numpy option ``adapt_ladder=True`` (off by
     default; with ``temperatures``, at least 3, and ``tune``): each chain adapts its ladder's
     temperatures between 1 and the hottest during tuning towards equal swap rates, then freezes

@@ -22,8 +22,9 @@ sweeps too (the cold copy can reach the main mode before any draw). A categorica
 move learns its shifts at T = 1 and every copy uses them (any shifts keep the move exact).
 Every uniform comes from the chain's own Generator: the draws depend on the seed alone.
 The torch backend runs the same definition with every chain's copies as rows of one batch
-(``gpmsa.backends.torch_backend``, ``sample``'s ``temperatures``; ``ladder`` and
-``check_swap_every`` check its arguments).
+(``gpmsa.backends.torch_backend``, ``sample``'s ``temperatures``; with ``chain_groups`` > 1 a
+group holds whole chains with all their copies; ``ladder`` and ``check_swap_every`` check its
+arguments).
 
 An adaptive ladder (opt-in, numpy: ``adapt_ladder=True``, `adapt_ladder`): before GPM/SA's
 tuning, ``tune_rounds`` x ``tune_levels`` further sweeps of every copy (GPM/SA's candidate

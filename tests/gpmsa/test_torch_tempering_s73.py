@@ -1,6 +1,6 @@
 """Parallel tempering on the torch backend (session 73: ``fit``/``calibrate(..., backend="torch",
-temperatures=, swap_every=)``; ``torch_backend._tempered_sweeps``, ``_swap_rows``,
-``BatchState.exchange``).
+temperatures=, swap_every=)``; ``torch_backend._tempered_tuning`` and ``_tempered_draws``
+(one ``_tempered_sweeps`` before session 74), ``_swap_rows``, ``BatchState.exchange``).
 
 The batch holds n_chains x K rows (chain c's copy k at row c K + k), each row's likelihood
 tempered by its 1/T_k; neighbours swap rows' states with the exact acceptance; only the T = 1
@@ -160,9 +160,7 @@ def test_categorical_and_constraint_with_copies():
 
 def test_refused_by_name():
     sim, obs = _sym_case()
-    with pytest.raises(GPMSAError, match="temperatures= runs every chain's copies in one batch"):
-        gpmsa.fit(sim, obs, n_iter=10, n_chains=2, backend="torch", temperatures=2,
-                  chain_groups=2)  # fmt: skip
+    # (chain_groups > 1 with temperatures: taken since session 74, test_torch_tempering_groups_s74)
     with pytest.raises(GPMSAError, match="swap_every=20 exceeds n_iter=10"):
         gpmsa.fit(sim, obs, n_iter=10, backend="torch", temperatures=2, swap_every=20)
     with pytest.raises(GPMSAError, match="swap_every=3 needs temperatures"):
