@@ -84,6 +84,7 @@ from gpmsa.calibration.observations import (
     probe_layout,
     reduce,
     theta_levels,
+    theta_levels_native,
     theta_probe,
     warn_if_outside,
 )
@@ -170,7 +171,8 @@ class Calibrator:
         extrapolate: allow x_obs outside the emulator's x domain by more than
             ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width (with an ExtrapolationWarning).
             Within the margin x_obs is taken with that warning as a joint ``gpmsa.fit``
-            takes it; beyond it, False: GPMSAError naming the column.
+            takes it; beyond it, False: GPMSAError naming the column. The default of every
+            update; ``update(..., extrapolate=)`` sets it for one.
         n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``.
         seed: seed of those draws (and of the MCMC), for reproducibility: an integer, a numpy
             Generator (an integer is drawn from it) or None (fresh entropy).
@@ -452,7 +454,9 @@ class Calibrator:
                 "this Calibrator uses MCMC (q > 2 or method='mcmc'); no grid likelihood"
             )
 
-    def log_likelihood_grid(self, x_obs=None, y_obs=None) -> tuple[np.ndarray, np.ndarray]:
+    def log_likelihood_grid(
+        self, x_obs=None, y_obs=None, extrapolate: bool | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Exact log-likelihood of theta on the fixed grid, lamOs integrated out.
 
         Returns (theta_grid, loglik): theta_grid native units, (G,) for one calibration parameter
@@ -460,11 +464,11 @@ class Calibrator:
         all normalising constants (the density of the reduced observation data u, standardised
         units), lamOs integrated against its prior (each window has its own lamOs); with
         unobserved directions (``ObsProblem.n_null``) a likelihood of theta, not a density.
-        Successive independent windows multiply: add their logliks. x_obs, y_obs (or one ObsData) as
-        ``update``'s. Raises GPMSAError for invalid input.
+        Successive independent windows multiply: add their logliks. x_obs, y_obs (or one ObsData)
+        and ``extrapolate`` as ``update``'s. Raises GPMSAError for invalid input.
         """
         self._check_grid_method()
-        data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
+        data = reduce(self.emulator, x_obs, y_obs, self._extrapolate(extrapolate))
         fits: list[Fit] = []
         with blas_controller().limit(limits=1, user_api="blas"):
             ll = self._combine(self._marginals(data, None, fits))
@@ -510,7 +514,13 @@ class Calibrator:
         check_log_density(vals)
         return vals
 
-    def update(self, x_obs=None, y_obs=None, prior=None, seed=None) -> Posterior:
+    def _extrapolate(self, extrapolate: bool | None) -> bool:
+        """An update's ``extrapolate``: None the constructor's setting, else a flag."""
+        return self.extrapolate if extrapolate is None else check_flag(extrapolate, "extrapolate")
+
+    def update(
+        self, x_obs=None, y_obs=None, prior=None, seed=None, extrapolate: bool | None = None
+    ) -> Posterior:
         """Posterior of the calibration parameters (and lamOs) given one observation window.
 
         Args:
@@ -537,6 +547,12 @@ class Calibrator:
                 the MCMC (there it wins over
                 ``mcmc_options["seed"]``; default: derived from the Calibrator's seed and a
                 counter of its updates, an update that raises not counted).
+            extrapolate: this update's x_obs rule (``Calibrator(extrapolate=)``'s): None (the
+                default) the constructor's setting; True allows x_obs outside the emulator's x
+                domain by more than ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width (with
+                an ExtrapolationWarning), False refuses it (GPMSAError naming the column).
+                Within the margin x_obs is taken with the warning either way. The setting
+                of the Calibrator is left as it is.
 
         Returns:
             Posterior; for the grid method its summaries of theta are exact (grid),
@@ -548,11 +564,12 @@ class Calibrator:
             (as given, unnormalised), for one parameter.
         """
         count = self._count + 1  # counted once it succeeds
+        extrapolate = self._extrapolate(extrapolate)
         if self.method == "mcmc":
-            post = self._update_mcmc(x_obs, y_obs, prior, seed, count)
+            post = self._update_mcmc(x_obs, y_obs, prior, seed, count, extrapolate)
             self._count = count
             return post
-        data = reduce(self.emulator, x_obs, y_obs, self.extrapolate)
+        data = reduce(self.emulator, x_obs, y_obs, extrapolate)
         fits: list[Fit] = []
         with blas_controller().limit(limits=1, user_api="blas"):
             margs = self._marginals(data, None, fits)
@@ -806,9 +823,7 @@ class Calibrator:
             "n_nodes": int(free.size) + sum(a.size - self.n_grid for a, _, _ in refined.values()),
             "refined": bool(refined),
             "log_evidence": log_evidence,
-            "levels": {
-                n: list(map(float, c)) for n, c in zip(names, codes, strict=True) if c is not None
-            },  # fmt: skip
+            "levels": theta_levels_native(self.emulator),  # the codes as calibrate has them
             "emulator_params": self.emulator_params,
             **emulator_record(self.emulator),
             "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
@@ -828,7 +843,7 @@ class Calibrator:
         check_mass(logp)
         return margs, free, ok, logp
 
-    def _update_mcmc(self, x_obs, y_obs, prior, seed, count: int) -> Posterior:
+    def _update_mcmc(self, x_obs, y_obs, prior, seed, count: int, extrapolate: bool) -> Posterior:
         """``update`` on the MCMC path (``gpmsa.calibrate``), the ``count``-th update."""
         from gpmsa.calibration.calibrate import calibrate
 
@@ -847,7 +862,7 @@ class Calibrator:
         opts.setdefault("n_emulator_draws", self._n_emulator_draws)
         opts.setdefault("backend", self.backend)
         return calibrate(
-            self.emulator, x_obs, y_obs, extrapolate=self.extrapolate, log_prior=prior, **opts
+            self.emulator, x_obs, y_obs, extrapolate=extrapolate, log_prior=prior, **opts
         )
 
     def _allowed(self, theta_unit: np.ndarray) -> np.ndarray:

@@ -812,13 +812,15 @@ def theta_levels(emulator) -> list[tuple[float, ...] | None] | None:
     return out
 
 
-def theta_levels_native(emulator) -> dict[str, list[float]]:
-    """Each categorical calibration parameter's training levels (native codes) by name, as
-    ``Posterior.info["levels"]`` records them (the Calibrator's grid too); {} without one."""
+def theta_levels_native(emulator) -> dict[str, list[int]]:
+    """Each categorical calibration parameter's training levels (native integer codes, as
+    ``emulator.categorical`` and ``info["level_offsets"]`` hold them; floats before session 74)
+    by name, as ``Posterior.info["levels"]`` records them (the Calibrator's grid too); {}
+    without one."""
     levels = getattr(emulator, "levels", None)
     if levels is None:
         return {}
     p = len(emulator.x_names)
-    return {str(name): [float(v) for v in lv]
+    return {str(name): [int(v) for v in lv]
             for name, lv in zip(emulator.t_names, tuple(levels)[p:], strict=True)
             if lv is not None}  # fmt: skip

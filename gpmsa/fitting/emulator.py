@@ -54,8 +54,10 @@ from gpmsa.model.data import (
     by_column_names,
     check_count,
     check_flag,
+    check_level,
     check_same_rows,
     evenly_spaced,
+    quantile_keys,
 )
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
@@ -694,20 +696,35 @@ class Emulator:
         out.__setstate__(state)
         return out
 
-    def theta_summary(self) -> dict[str, dict[str, float]]:
+    def theta_summary(self, level: float = 0.95) -> dict[str, dict[str, float]]:
         """Posterior of the calibration parameters (native units) from a joint sim+obs fit (a
-        categorical one's quantiles are levels, as ``Posterior.quantile`` gives them)."""
+        categorical one's quantiles are levels, as ``Posterior.quantile`` gives them).
+
+        name -> {mean, sd, "q2.5", "q50", "q97.5"} (the draws' 2.5 %, 50 % and 97.5 %
+        quantiles, whatever ``level``: the keys it has always had) and, as
+        ``Posterior.summary(level)`` names them, "median" and the ends of the central interval
+        at ``level`` named by their percentages ("q5" and "q95" for 0.9; `quantile_keys`) and
+        "n_draws"; each equals ``calibration_posterior(emu).summary(level)``'s entry, which
+        adds the ESS and R-hat and "held". ``level``: as ``Posterior.summary``'s (a number in
+        (0, 1)), but 0.95 by default, so that its interval's keys are "q2.5" and "q97.5"."""
         if not self.calibration:
             raise GPMSAError("no calibration draws: fit was run without obs=")
+        level = check_level(level)
+        lo_key, hi_key = quantile_keys(level)
         th = self.calibration["theta_native"]
         out = {}
         for k, name in enumerate(self.t_names):
             col = th[:, k]
             levels = self.levels[self.p + k] is not None  # a categorical one's: levels
-            q = np.quantile(col, [0.025, 0.5, 0.975],
-                            method="inverted_cdf" if levels else "linear")  # fmt: skip
+            method = "inverted_cdf" if levels else "linear"
+            q = np.quantile(col, [0.025, 0.5, 0.975], method=method)
             out[name] = {"mean": float(col.mean()), "sd": float(col.std(ddof=1)),
                          "q2.5": float(q[0]), "q50": float(q[1]), "q97.5": float(q[2])}  # fmt: skip
+            lo, hi = np.quantile(col, [(1 - level) / 2, (1 + level) / 2], method=method)
+            added = {lo_key: float(lo), "median": float(q[1]), hi_key: float(hi),
+                     "n_draws": int(col.size)}  # fmt: skip
+            for key, value in added.items():  # the old keys as they were (level 0.95's ends)
+                out[name].setdefault(key, value)
         return out
 
     # --- the file record ----------------------------------------------------------------------

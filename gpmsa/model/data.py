@@ -270,6 +270,35 @@ def check_level(level) -> float:
     return float(level)
 
 
+def _percent_key(value: float, tolerance: float) -> str:
+    """``value`` in 6 significant digits, more until it prints within ``tolerance`` of itself."""
+    for digits in range(6, 18):
+        key = f"{value:.{digits}g}"
+        if abs(float(key) - value) <= tolerance:
+            break
+    return key
+
+
+def quantile_keys(level: float) -> tuple[str, str]:
+    """``Posterior.summary``'s (and ``Emulator.theta_summary``'s) keys of the ends of the
+    central interval of probability ``level``: "q" and the percentage, 100 (1 -+ level) / 2,
+    in 6 significant digits ("q5", "q95" for 0.9; "q2.5", "q97.5" for 0.95), with more digits
+    where an end needs them to print within 1e-5 of its distance to the nearest of 0, 50 and
+    100 (e.g. "q49.999995", "q50.000005" for 1e-7; "q5e-07", "q99.9999995" for 0.99999999),
+    so that no two levels' keys collide and no end prints as 0, 50 or 100. GPMSAError for a
+    level so small that its ends are the median in float64 (below about 1e-16).
+    (In gpmsa.calibration.posterior before session 74; still importable from there.)"""
+    lo, hi = 100 * (1 - level) / 2, 100 * (1 + level) / 2
+    tolerance = 1e-5 * min(lo, hi - 50.0)
+    keys = _percent_key(lo, tolerance), _percent_key(hi, tolerance)
+    if tolerance > 0 and keys[0] != keys[1]:
+        return f"q{keys[0]}", f"q{keys[1]}"
+    raise GPMSAError(
+        f"level={level!r} is too small: the ends of its interval, at probabilities "
+        "(1 -+ level) / 2, are both the median (0.5) in float64; give a larger level"
+    )
+
+
 def check_probabilities(q, name: str = "q") -> np.ndarray:
     """``q`` as a float64 array of probabilities in [0, 1] (a number: a 0-d array); GPMSAError
     naming ``name`` and the value given for none, a NaN or an infinity, or one outside [0, 1]
