@@ -11,8 +11,16 @@ ones for several); fixed parameters are constants. A parameter with held element
 bounds), scattered with the held values into the full array; the held elements' priors are left
 out, as the numpy backend leaves them out.
 Categorical inputs and a "constant" or "linear" mean basis (its coefficients integrated out, as
-the numpy likelihood's) are sampled; a categorical theta, a theta constraint and a callable mean
-basis with theta sampled are refused (`refuse_unsupported`).
+the numpy likelihood's) are sampled. A categorical theta (its prior uniform over its levels, as
+the numpy sampler's) is marginalised out of the density NUTS samples: the log-sum-exp over the
+combinations of the free categorical elements' levels of prior x likelihood
+(`PyroModel.with_levels`; at most `MAX_LEVEL_COMBINATIONS`, each costs one likelihood); each
+kept draw's levels are then drawn from their conditional given its continuous parameters
+(exact), so the draws carry the levels as the other backends' do; with a continuous theta
+beside it, the joint level move (`LevelJumps`, ``gpmsa.mcmc.level_moves``) after each draw
+carries a chain between the modes of a level and a continuous parameter that trade off. A
+theta constraint and a callable mean basis with theta sampled are refused
+(`refuse_unsupported`).
 """
 
 from __future__ import annotations
@@ -26,6 +34,7 @@ import torch
 from pyro.distributions import constraints
 from pyro.infer import MCMC, NUTS
 from pyro.infer.autoguide import init_to_value
+from pyro.infer.mcmc.mcmc_kernel import MCMCKernel
 
 from gpmsa.backends import check_sample_args
 from gpmsa.backends.torch_backend import (
@@ -39,13 +48,16 @@ from gpmsa.backends.torch_backend import (
     torch_threads,
 )
 from gpmsa.errors import GPMSAError
-from gpmsa.mcmc import parallel, starts
+from gpmsa.mcmc import level_moves, parallel, starts
 from gpmsa.mcmc.sampler import RHO_PARAMS, Chains, check_draws_memory
 from gpmsa.model.data import as_real, check_count, check_flag
 from gpmsa.model.problem import Problem
 
 N_WARMUP = 500
 """Default NUTS warm-up (step size and mass-matrix adaptation) iterations per chain."""
+MAX_LEVEL_COMBINATIONS = 64
+"""Most combinations of a categorical theta's levels (the product over its free categorical
+elements) the pyro backend marginalises: each costs one likelihood evaluation per gradient."""
 
 
 def _support(
@@ -97,6 +109,11 @@ class PyroModel:
         }
         self.free = tuple(k for k in problem.sampled if k not in self.const)
         masks = problem.held_masks(self.free)
+        self.cat, self.combos = _level_combinations(problem, masks, self.free, dtype)
+        self.cat_levels = [problem.theta_levels[k] for k in self.cat]  # unit scale, each
+        if self.cat.size:  # theta's site: its continuous free elements, the levels scattered in
+            masks["theta"] = masks.get("theta", np.zeros(problem.q, dtype=bool))
+            masks["theta"][self.cat] = True
         self.held = {k: _scatter(problem.init[k], mask, dtype) for k, mask in masks.items()}
         self.support = {
             name: _support(problem, name, dtype, self.held[name][0].numpy() if name in self.held
@@ -119,12 +136,18 @@ class PyroModel:
         model's sample sites."""
         start = self.problem.init if start is None else start
         out = {}
-        for name in self.free:
+        for name in self.sites:
             v = torch.as_tensor(start[name], dtype=self.dtype)
             if name in self.held:
                 v = v.reshape(-1)[self.held[name][0]]
             out[_site(name)] = torch.exp(-0.25 * v) if name in RHO_PARAMS else v
         return out
+
+    @property
+    def sites(self) -> tuple[str, ...]:
+        """The parameters NUTS samples (a theta of categorical and held elements only has no
+        site: its levels are marginalised)."""
+        return tuple(k for k in self.free if k not in self.held or self.held[k][0].numel())
 
     def params(self, sites: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
         """Model parameters (name -> (C, *shape)) from sample-site values (C, *shape)."""
@@ -132,7 +155,11 @@ class PyroModel:
         for name in self.problem.names:
             if name in self.const:
                 continue
-            v = sites[_site(name)]
+            if name not in self.sites:  # categorical and held elements only
+                c = next(iter(sites.values())).shape[0]
+                v = torch.zeros(c, 0, dtype=self.dtype)
+            else:
+                v = sites[_site(name)]
             v = -4.0 * torch.log(v) if name in RHO_PARAMS else v
             if name in self.held:  # free elements (C, n_free) and held values, in C order
                 _, order, values = self.held[name]
@@ -159,8 +186,36 @@ class PyroModel:
             ll_w = ll_w + obs_loglik(d, chol, alpha, prm, coef, h_obs)
         return ll_w
 
+    def with_levels(self, prm: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+        """``prm`` (name -> (C, *shape)) at every combination of the categorical theta's levels
+        (``self.combos`` (K, n_cat)): name -> (C K, *shape), draw c's combination j at row
+        c K + j."""
+        k = self.combos.shape[0]
+        out = {n: v.repeat_interleave(k, 0) for n, v in prm.items() if n != "theta"}
+        theta = prm["theta"].unsqueeze(1).repeat(1, k, 1)
+        theta[:, :, self.cat] = self.combos
+        out["theta"] = theta.reshape(-1, theta.shape[-1])
+        return out
+
+    def log_post_at(self, prm: dict[str, torch.Tensor], combo: torch.Tensor) -> torch.Tensor:
+        """GPM/SA log posterior (C,) of ``prm`` (name -> (C, *shape)) with the categorical
+        theta at ``combo`` (n_cat,) (its levels' prior uniform, 0)."""
+        theta = prm["theta"].clone()
+        theta[:, self.cat] = combo
+        each = {**prm, "theta": theta}
+        return self.log_likelihood(each) + self.log_prior(each)
+
+    def level_log_post(self, prm: dict[str, torch.Tensor]) -> torch.Tensor:
+        """GPM/SA log posterior (C, K) of each draw of ``prm`` at each combination of the
+        categorical theta's levels (`with_levels`; the levels' prior uniform, 0 as the numpy
+        sampler's)."""
+        each = self.with_levels(prm)
+        lp = self.log_likelihood(each) + self.log_prior(each)
+        return lp.reshape(-1, self.combos.shape[0])
+
     def log_prior(self, prm: dict[str, torch.Tensor]) -> torch.Tensor:
-        """Sum of the sampled elements' log priors (C,) (held elements left out)."""
+        """Sum of the sampled elements' log priors (C,) (held elements and a categorical theta,
+        uniform over its levels, left out)."""
         c = prm["betaU"].shape[0]
         lp = torch.zeros(c, dtype=self.dtype)
         for name in self.free:
@@ -172,15 +227,146 @@ class PyroModel:
 
     def __call__(self) -> None:
         sites = {}
-        for name in self.free:
+        for name in self.sites:
             shape = self.problem.init[name].shape
             if name in self.held:
                 shape = self.held[name][0].shape
             base = dist.ImproperUniform(self.support[name], (), shape)
             sites[_site(name)] = pyro.sample(_site(name), base).unsqueeze(0)
         prm = self.params(sites)
+        if self.cat.size:  # the levels marginalised: log sum over them of prior x likelihood
+            pyro.factor("log_post", torch.logsumexp(self.level_log_post(prm)[0], 0))
+            return
         pyro.factor("log_prior", self.log_prior(prm)[0])
         pyro.factor("log_likelihood", self.log_likelihood(prm)[0])
+
+    def draw_levels(self, prm: dict[str, torch.Tensor], rng: np.random.Generator,
+                    chunk: int = 256) -> tuple[dict[str, torch.Tensor], np.ndarray]:  # fmt: skip
+        """(``prm`` with each draw's categorical theta at levels drawn from their conditional
+        given its other parameters, the log posterior (n,) of each draw there); ``prm``: name
+        -> (n, *shape), ``rng`` the draws' generator (Gumbel-max, one (n, K) block)."""
+        n, k = prm["theta"].shape[0], self.combos.shape[0]
+        step = max(1, chunk // k)  # bounds the memory of Sigma_W as `_chunked_log_post`
+        lp = torch.cat([self.level_log_post({a: v[s : s + step] for a, v in prm.items()})
+                        for s in range(0, n, step)]).numpy()  # fmt: skip
+        pick = np.argmax(lp + rng.gumbel(size=lp.shape), axis=1)
+        theta = prm["theta"].clone()
+        theta[:, self.cat] = self.combos[torch.as_tensor(pick)]
+        return {**prm, "theta": theta}, lp[np.arange(n), pick]
+
+
+class LevelJumps(MCMCKernel):
+    """NUTS on the continuous parameters (the categorical theta marginalised, `PyroModel`) and,
+    after each of its draws past the warm-up, a categorical theta element's joint level move
+    (``gpmsa.mcmc.level_moves``, the numpy sampler's): the levels drawn from their conditional
+    given the draw (exact), then each element to another of its levels drawn uniformly with the
+    continuous theta shifted by o[l'] - o[l] (their conditional modes at the two levels, found
+    by `level_moves.level_offsets` at the first draw past the warm-up, frozen then), accepted on
+    the posterior ratio. Both leave the joint posterior of (levels, continuous) invariant, so the
+    continuous draws keep the marginal NUTS targets; the move carries a chain between the modes
+    of a level and a continuous parameter that trade off, which NUTS alone does not cross."""
+
+    def __init__(self, nuts: NUTS, model: PyroModel, rng: np.random.Generator):
+        self.nuts, self.model, self.rng = nuts, model, rng
+        self.warmup, self.t, self.moves, self.accepted = 0, 0, 0, 0
+        self.offsets: dict[int, np.ndarray] | None = None  # theta position -> (levels, cont)
+        self.cont = model.held["theta"][0].numpy()  # theta's continuous free elements
+        self.sizes = [len(lv) for lv in model.cat_levels]
+
+    def setup(self, warmup_steps, *args, **kwargs):
+        self.warmup = int(warmup_steps)
+        self.nuts.setup(warmup_steps, *args, **kwargs)
+
+    def __getattr__(self, name):  # NUTS's transforms, model, step_size, ...
+        if "nuts" not in self.__dict__:
+            raise AttributeError(name)
+        return getattr(self.__dict__["nuts"], name)
+
+    @property
+    def initial_params(self):
+        return self.nuts.initial_params
+
+    @initial_params.setter
+    def initial_params(self, params):
+        self.nuts.initial_params = params
+
+    def logging(self):
+        return self.nuts.logging()
+
+    def diagnostics(self):
+        return self.nuts.diagnostics()
+
+    def cleanup(self):
+        self.nuts.cleanup()
+
+    def _prm(self, params: dict[str, torch.Tensor]) -> dict[str, torch.Tensor]:
+        """Model parameters (batch 1) of unconstrained site values ``params``."""
+        sites = {k: self.nuts.transforms[k].inv(v).unsqueeze(0) for k, v in params.items()}
+        return self.model.params(sites)
+
+    def sample(self, params):
+        params = self.nuts.sample(params)
+        self.t += 1
+        if self.t <= self.warmup:
+            return params
+        with torch.no_grad():
+            prm = self._prm(params)
+            lp = self.model.level_log_post(prm)[0].numpy()
+            row = int(np.argmax(lp + self.rng.gumbel(size=lp.shape)))  # levels | the draw
+            if self.offsets is None:
+                self.offsets = self._learn(prm, row)
+            theta, row = self._moves(prm, row, float(lp[row]))
+        if theta is None:
+            return params
+        self.nuts.clear_cache()  # NUTS goes on from the moved point
+        site = self.nuts.transforms["theta"](theta[0, self.cont])
+        return {**params, "theta": site}
+
+    def _learn(self, prm: dict[str, torch.Tensor], row: int) -> dict[int, np.ndarray]:
+        """Each categorical element's conditional modes of the continuous theta at its levels,
+        the other parameters at ``prm``'s values and the other levels at combination ``row``."""
+        model, out = self.model, {}
+        theta0 = prm["theta"][0].clone()
+        theta0[model.cat] = model.combos[row]
+
+        def log_post(th: np.ndarray) -> float:
+            theta = torch.as_tensor(th, dtype=model.dtype).unsqueeze(0)
+            at = {**prm, "theta": theta}
+            return float(model.log_post_at(at, theta[0, model.cat])[0])
+
+        for i, k in enumerate(model.cat):
+            if self.sizes[i] > 1:
+                out[int(k)] = level_moves.level_offsets(
+                    log_post, theta0.numpy(), int(k), model.cat_levels[i], self.cont
+                )
+        return out
+
+    def _moves(self, prm, row: int, lp: float):
+        """Each categorical element's joint level move from combination ``row`` (log posterior
+        ``lp``): (the moved theta (1, q), or None where none was accepted; the final row)."""
+        model, theta, moved = self.model, prm["theta"], None
+        idx = list(np.unravel_index(row, self.sizes))
+        for i, k in enumerate(model.cat):
+            off = self.offsets.get(int(k))
+            if off is None:
+                continue
+            a = idx[i]
+            b = int(self.rng.integers(self.sizes[i] - 1))
+            b += b >= a  # another level, uniformly
+            new = theta.clone()
+            shifted = new[0, self.cont] + torch.as_tensor(off[b] - off[a], dtype=model.dtype)
+            new[0, self.cont] = shifted
+            cand = list(idx)
+            cand[i] = b
+            r = int(np.ravel_multi_index(cand, self.sizes))
+            self.moves += 1
+            if not bool(torch.all((shifted > 0.0) & (shifted < 1.0))):
+                continue  # outside theta's prior: rejected
+            lp_new = float(model.log_post_at({**prm, "theta": new}, model.combos[r])[0])
+            if np.log(self.rng.random()) < lp_new - lp:
+                theta, idx, row, lp, moved = new, cand, r, lp_new, True
+                self.accepted += 1
+        return (theta if moved else None), row
 
 
 def _scatter(init: np.ndarray, held: np.ndarray, dtype: torch.dtype):
@@ -196,22 +382,39 @@ def _scatter(init: np.ndarray, held: np.ndarray, dtype: torch.dtype):
     return torch.as_tensor(free), torch.as_tensor(order), values
 
 
+def _level_combinations(problem: Problem, masks: dict[str, np.ndarray], free: tuple[str, ...],
+                        dtype: torch.dtype) -> tuple[np.ndarray, torch.Tensor]:  # fmt: skip
+    """(positions (n_cat,) of theta's free categorical elements, every combination of their
+    unit-scale levels (K, n_cat), the first element slowest); (empty, (1, 0)) without one.
+    GPMSAError when K exceeds `MAX_LEVEL_COMBINATIONS`."""
+    levels = problem.theta_levels if "theta" in free else None
+    held = masks.get("theta", np.zeros(problem.q, dtype=bool))
+    cat = [k for k, lv in enumerate(levels or ()) if lv is not None and not held[k]]
+    if not cat:
+        return np.zeros(0, dtype=np.int64), torch.zeros(1, 0, dtype=dtype)
+    sizes = [len(levels[k]) for k in cat]
+    if int(np.prod(sizes)) > MAX_LEVEL_COMBINATIONS:
+        raise GPMSAError(
+            f"the pyro backend marginalises a categorical theta over the combinations of its "
+            f"levels: theta elements {cat} have {' x '.join(map(str, sizes))} = "
+            f"{int(np.prod(sizes))}, more than MAX_LEVEL_COMBINATIONS = "
+            f"{MAX_LEVEL_COMBINATIONS}; hold some with fixed=, or use backend='numpy' or 'torch'"
+        )
+    grid = np.meshgrid(*(levels[k] for k in cat), indexing="ij")
+    combos = np.stack([g.reshape(-1) for g in grid], axis=-1)
+    return np.asarray(cat, dtype=np.int64), torch.as_tensor(combos, dtype=dtype)
+
+
 def refuse_unsupported(problem: Problem) -> None:
-    """GPMSAError naming what of ``problem``'s extensions NUTS cannot sample (categorical inputs
-    and a named mean basis it can; a fixed or held theta lifts the theta-side refusals): a
-    categorical calibration parameter (discrete: no gradient), a theta constraint (a hard
-    boundary inside theta's support) and a callable mean basis at the observations' sampled
-    theta (a numpy callable: no gradient)."""
+    """GPMSAError naming what of ``problem``'s extensions NUTS cannot sample (categorical inputs,
+    a categorical theta (marginalised, `PyroModel`) and a named mean basis it can; a fixed or
+    held theta lifts the theta-side refusals): a theta constraint (a hard boundary inside
+    theta's support) and a callable mean basis at the observations' sampled theta (a numpy
+    callable: no gradient)."""
     masks = problem.held_masks(("theta",))
     held = masks.get("theta", np.zeros(problem.q, dtype=bool)) if "theta" in problem.init else None
     free = None if held is None else ~held  # theta's free elements (None: no theta)
     what = []
-    if free is not None and problem.theta_levels is not None:
-        what += [
-            f"categorical calibration parameters (theta element {k})"
-            for k, lv in enumerate(problem.theta_levels)
-            if lv is not None and free[k]
-        ]
     if free is not None and free.any() and problem.constraint is not None:
         what.append("theta constraints")
     mean = problem.mean_basis
@@ -281,7 +484,9 @@ def sample(
     seeded from ``seed`` inside ``torch.random.fork_rng`` (the global RNG is left as it was).
     ``accept_rate`` holds pyro's per-chain "acceptance rate" diagnostic and ``step_widths`` the
     adapted NUTS step size, each repeated over every sampled element (NaN for held elements,
-    ``problem.fixed_elements``, whose draws are their values exactly). ``jit``: compile the
+    ``problem.fixed_elements``, whose draws are their values exactly; a categorical theta
+    element, marginalised and drawn from its conditional per draw: rate 1, width NaN;
+    ``info["marginalised_levels"]`` its positions). ``jit``: compile the
     potential energy with the torch JIT (about 1.6x faster on the road case). ``num_threads``:
     torch CPU threads while sampling (see the torch backend; None: unchanged). ``n_jobs``: None,
     1 or -1 (the chains run one after another in this process; any other number is a
@@ -304,6 +509,12 @@ def sample(
     seqs = np.random.SeedSequence(seed).spawn(int(n_chains))
     how, firsts = starts.chain_starts(problem, init, seqs)
     model = PyroModel(problem)
+    if not model.sites:
+        raise GPMSAError(
+            "the pyro backend samples the continuous parameters by NUTS, with a categorical "
+            "theta's levels marginalised; every other parameter is held here: use "
+            "backend='numpy' or 'torch'"
+        )
     runs = []
     for seq, first in zip(seqs, firsts, strict=True):
         seed_c = int(seq.generate_state(1)[0])
@@ -314,9 +525,13 @@ def sample(
             ignore_jit_warnings=True,
             init_strategy=init_to_value(values=model.init_values(first)),
         )  # fmt: skip
+        rng = _level_generator(seq)  # a categorical theta's moves and draws
+        driver = kernel
+        if model.cat.size and model.held["theta"][0].numel():  # levels and continuous theta
+            driver = LevelJumps(kernel, model, rng)
         with torch.random.fork_rng(), torch_threads(num_threads):
             torch.manual_seed(seed_c)
-            mcmc = MCMC(kernel, num_samples=int(n_iter), warmup_steps=warmup,
+            mcmc = MCMC(driver, num_samples=int(n_iter), warmup_steps=warmup,
                         disable_progbar=not progress)  # fmt: skip
             with warnings.catch_warnings():  # pyro's JIT uses the deprecated torch.jit.trace
                 warnings.filterwarnings(
@@ -332,12 +547,19 @@ def sample(
                 f"NUTS never left its starting point in {int(n_iter)} draws (acceptance rate "
                 f"{float(accept):.2g}): the chain is no sample of the posterior; {why}"
             )
-        runs.append((sites, float(accept), float(kernel.step_size)))
+        jumps = (1.0, {})  # (the level moves' acceptance, their offsets)
+        if driver is not kernel:
+            jumps = (driver.accepted / max(driver.moves, 1), driver.offsets or {})
+        runs.append((sites, float(accept), float(kernel.step_size), rng, jumps))
     draws, log_post = {}, []
-    for sites, _, _ in runs:
+    for sites, _, _, rng, _ in runs:
         with torch.no_grad():
             prm = model.params(sites)
-            log_post.append(_chunked_log_post(model, prm))
+            if model.cat.size:  # each draw's levels from their conditional (exact)
+                prm, lp = model.draw_levels(prm, rng)
+                log_post.append(lp)
+            else:
+                log_post.append(_chunked_log_post(model, prm))
         for name in problem.names:
             draws.setdefault(name, []).append(prm[name].numpy())
     rate, wid = {}, {}
@@ -346,6 +568,11 @@ def sample(
         held = masks.get(name, np.zeros(problem.init[name].shape, dtype=bool))
         rate[name] = np.stack([np.where(held, np.nan, float(r[1])) for r in runs])
         wid[name] = np.stack([np.where(held, np.nan, float(r[2])) for r in runs])
+    if model.cat.size:  # the level moves' acceptance (1: no continuous theta, drawn), no step
+        rate["theta"][:, model.cat] = np.array([r[4][0] for r in runs])[:, None]
+        wid["theta"][:, model.cat] = np.nan
+    moves = level_moves.chains_record([r[4][1] for r in runs], model.held["theta"][0].tolist()
+                                      if model.cat.size else [])  # fmt: skip
     return Chains(
         draws={k: np.stack(v) for k, v in draws.items()},
         log_post=np.stack(log_post),
@@ -355,8 +582,17 @@ def sample(
               "n_warmup": warmup, "target_accept": target_accept, "full_mass": full_mass,
               "seed": seed, "init": how,
               "starts": {k: np.stack([f[k] for f in firsts]) for k in problem.init},
-              "backend": "pyro", "sampler": "NUTS"},
+              "backend": "pyro", "sampler": "NUTS",
+              **({"marginalised_levels": [int(k) for k in model.cat]} if model.cat.size else {}),
+              **({"level_offsets": moves} if moves else {})},
     )  # fmt: skip
+
+
+def _level_generator(seq: np.random.SeedSequence) -> np.random.Generator:
+    """The generator of a chain's categorical theta draws: a child of its SeedSequence (not its
+    NUTS stream nor its start's, ``gpmsa.mcmc.starts.start_generator``)."""
+    child = np.random.SeedSequence(seq.entropy, spawn_key=(*seq.spawn_key, 0x1E7E1))
+    return np.random.default_rng(child)
 
 
 def _chunked_log_post(model: PyroModel, prm: dict[str, torch.Tensor], chunk: int = 256):

@@ -85,7 +85,7 @@ def calibration_problem(
     ``fit``: ``observation_fit(emulator, reduced, [emulator.params])`` where the caller has it
     (with ``reduced``), for the lamOs start.
     """
-    check_emulator(emulator, categorical_theta=True)  # calibrate refuses it for pyro
+    check_emulator(emulator, categorical_theta=True)
     kronecker.check_dense(emulator, "calibration (gpmsa.calibrate)")
     if reduced is not None and discrepancy is not None:
         raise GPMSAError("calibration_problem: reduced= is the no-discrepancy reduction; with a "
@@ -357,8 +357,6 @@ def calibrate(
             f"not False; got backend={backend!r}, discrepancy={describe_discrepancy(discrepancy)}, "
             f"fast={fast}"
         )
-    if backend not in ("numpy", "torch"):  # a categorical theta: their samplers only (the
-        check_emulator(emulator)  # joint level move, gpmsa.mcmc.level_moves; NUTS has none)
     reserved = ("n_iter", "n_chains", "tune", "seed", "progress", "n_jobs", "executor",
                 "tune_rounds", "tune_levels")  # fmt: skip
     renamed = {"n_iter": "n_samples"}  # gpmsa.fit's name: no backend option (nor fast=False)

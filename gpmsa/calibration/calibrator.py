@@ -225,8 +225,6 @@ class Calibrator:
             raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
         backend = _mcmc_backend(backend, mcmc_options)
         backends.get(backend)  # unknown or not installed: a clear error now, not at update()
-        if levels is not None and backend not in ("numpy", "torch"):
-            check_emulator(emulator)  # as calibrate: their samplers have the joint level move
         if backend != "numpy" and method == "grid":
             raise GPMSAError(
                 "method='grid' runs on numpy; use method='mcmc' (or 'auto') with "

@@ -80,8 +80,8 @@ class Observations:
 
 def check_emulator(emulator, categorical_theta: bool = False) -> None:
     """Raise GPMSAError unless ``emulator`` has what calibration needs (a categorical
-    calibration parameter only where ``categorical_theta``: the numpy samplers, with their joint
-    level move, ``gpmsa.mcmc.level_moves``)."""
+    calibration parameter only where ``categorical_theta``: every backend samples one, numpy
+    and torch with their joint level move, ``gpmsa.mcmc.level_moves``, pyro marginalised)."""
     missing = [a for a in EMULATOR_ATTRS if not hasattr(emulator, a)]
     if missing:
         raise GPMSAError(f"emulator lacks {missing}: calibration needs a gpmsa.Emulator")
