@@ -5,6 +5,8 @@ Prints, single-threaded (BLAS limited to one thread; --pin also pins the process
   (v, f), after 50 warm-up calls: median, p90, p99, max,
   also with the posterior's mean and P(GD > 350) read (what a control loop does);
 - ``Calibrator.log_likelihood_grid`` latency (the sequential-filter hook);
+- ``Calibrator.update`` latency on a categorical and a continuous parameter (the trading-off
+  case of the tests: y = sin(3x) + k + 0.5 kind, three kinds; each level's axis refined);
 - ``gpmsa.calibrate`` with the paper's settings (tuning 50 x 20, 5,000 draws, 1,000 burned), the
   fast sampler and the generic numpy backend; the same on a two-parameter case with three
   observations (the fast sampler's dense path: no Chebyshev series), the two engines' runs
@@ -58,6 +60,22 @@ def two_parameter_case() -> tuple[Emulator, np.ndarray, np.ndarray]:
               "lamWOs": [5000.0]}  # fmt: skip
     x_obs = np.array([[0.2], [0.5], [0.8]])
     return Emulator.from_params(sim, params), x_obs, np.sin(2 * x_obs + 0.6) + 0.48 * x_obs
+
+
+def level_case() -> tuple[Emulator, np.ndarray, np.ndarray]:
+    """The trading-off case (tests/gpmsa/_level_cases.py: 60 runs, y = sin(3x) + k + 0.5 kind,
+    kind in {0, 1, 2}, categorical), its emulator parameters set to its 600-sweep fit's point
+    estimate, observed at 6 x values at k = 0.4, kind 1 (kind 0 at k = 0.9 fits alike)."""
+    rng = np.random.default_rng(2)
+    x = rng.random((60, 1))
+    t = np.column_stack([rng.random(60), np.arange(60) % 3])
+    sim = gpmsa.SimData(x, t, np.sin(3 * x[:, 0]) + t[:, 0] + 0.5 * t[:, 1], x_names=["s"],
+                        t_names=["k", "kind"], t_categorical=["kind"])  # fmt: skip
+    params = {"betaU": [[0.854], [0.0655], [0.334]], "lamUz": [0.336], "lamWs": [3919.0],
+              "lamWOs": [3171.0]}  # fmt: skip
+    x_obs = np.linspace(0.1, 0.9, 6)[:, None]
+    y_obs = np.sin(3 * x_obs[:, 0]) + 0.9 + rng.normal(0, 0.05, 6)
+    return Emulator.from_params(sim, params), x_obs, y_obs
 
 
 def observations(emu: Emulator, n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -128,6 +146,18 @@ def main() -> None:
         wall, cpu = latencies(fn, v, f)
         print(row(name + " (wall)", 1e3 * wall, f"~{1e3 * sepia:.0f}"))
         print(row(name + " (CPU)", 1e3 * cpu))
+    emu_l, x_l, y_l = level_case()
+    cal_l = gpmsa.Calibrator(emu_l, seed=0)
+    for _ in range(5):
+        post = cal_l.update(x_l, y_l)
+    wall, cpu = np.empty(50), np.empty(50)
+    for i in range(wall.size):
+        t0, c0 = time.perf_counter(), time.thread_time()
+        cal_l.update(x_l, y_l)
+        wall[i], cpu[i] = time.perf_counter() - t0, time.thread_time() - c0
+    name = f"Calibrator.update, categorical ({post.info['n_nodes']} nodes)"
+    print(row(name + " (wall)", 1e3 * wall))
+    print(row(name + " (CPU)", 1e3 * cpu))
     x_obs, y_obs = [[float(ref_v)] for ref_v in [1.25]], [[12.09696044]]
     runs = []
     for seed in range(args.runs):
