@@ -261,10 +261,11 @@ class LevelJumps(MCMCKernel):
     (``gpmsa.mcmc.level_moves``, the numpy sampler's): the levels drawn from their conditional
     given the draw (exact), then each element to another of its levels drawn uniformly with the
     continuous theta shifted by o[l'] - o[l] (their conditional modes at the two levels, found
-    by `level_moves.level_offsets` at the first draw past the warm-up, frozen then), accepted on
-    the posterior ratio. Both leave the joint posterior of (levels, continuous) invariant, so the
-    continuous draws keep the marginal NUTS targets; the move carries a chain between the modes
-    of a level and a continuous parameter that trade off, which NUTS alone does not cross."""
+    by `level_moves.level_offsets` at the last warm-up draw (without a warm-up: the first draw,
+    which has no move), frozen then), accepted on the posterior ratio. Both leave the joint
+    posterior of (levels, continuous) invariant, so the continuous draws keep the marginal NUTS
+    targets; the move carries a chain between the modes of a level and a continuous parameter
+    that trade off, which NUTS alone does not cross."""
 
     def __init__(self, nuts: NUTS, model: PyroModel, rng: np.random.Generator):
         self.nuts, self.model, self.rng = nuts, model, rng
@@ -307,14 +308,15 @@ class LevelJumps(MCMCKernel):
     def sample(self, params):
         params = self.nuts.sample(params)
         self.t += 1
-        if self.t <= self.warmup:
+        if self.t < max(self.warmup, 1):
             return params
         with torch.no_grad():
             prm = self._prm(params)
             lp = self.model.level_log_post(prm)[0].numpy()
             row = int(np.argmax(lp + self.rng.gumbel(size=lp.shape)))  # levels | the draw
-            if self.offsets is None:
+            if self.offsets is None:  # frozen before the moves: each kept draw's move exact
                 self.offsets = self._learn(prm, row)
+                return params
             theta, row = self._moves(prm, row, float(lp[row]))
         if theta is None:
             return params

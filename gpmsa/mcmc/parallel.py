@@ -22,6 +22,7 @@ import multiprocessing
 import multiprocessing.context
 import os
 import sys
+import threading
 import warnings
 from collections.abc import Callable, Sequence
 from concurrent.futures import (
@@ -101,8 +102,10 @@ def as_executor(executor) -> Executor | None:
     )
 
 
-_forking_worker = False
-"""True while this process forks one of gpmsa's own pool workers (read in the child)."""
+_forking_thread: int | None = None
+"""The thread of this process that forks one of gpmsa's own pool workers, while it does (read in
+the child, whose one thread is the one that forked: another thread's fork meanwhile is not
+ours)."""
 
 
 def _freeze_inherited() -> None:
@@ -111,30 +114,31 @@ def _freeze_inherited() -> None:
     executor whose weakref callback takes a lock that one of the parent's threads held at the
     fork (CPython's ``concurrent.futures.process``): collected in the child, it would wait for
     that lock forever. Runs before any Python code of the child; what the chain creates is
-    collected as usual."""
-    if _forking_worker:
+    collected as usual. Any child forgets the flag: its own forks are not gpmsa's workers."""
+    global _forking_thread
+    if _forking_thread is not None and _forking_thread == threading.get_ident():
         gc.freeze()
+    _forking_thread = None
 
 
-if hasattr(os, "register_at_fork"):
+if sys.platform == "linux":  # where `_own_pool` forks (Windows has no ForkProcess)
     os.register_at_fork(after_in_child=_freeze_inherited)
 
+    class _WorkerProcess(multiprocessing.context.ForkProcess):
+        """A fork-started pool worker whose child freezes what it inherits
+        (`_freeze_inherited`)."""
 
-class _WorkerProcess(multiprocessing.context.ForkProcess):
-    """A fork-started pool worker whose child freezes what it inherits (`_freeze_inherited`)."""
+        @staticmethod
+        def _Popen(process_obj):
+            global _forking_thread
+            _forking_thread = threading.get_ident()
+            try:
+                return multiprocessing.context.ForkProcess._Popen(process_obj)
+            finally:
+                _forking_thread = None
 
-    @staticmethod
-    def _Popen(process_obj):
-        global _forking_worker
-        _forking_worker = True
-        try:
-            return multiprocessing.context.ForkProcess._Popen(process_obj)
-        finally:
-            _forking_worker = False
-
-
-class _WorkerContext(multiprocessing.context.ForkContext):
-    Process = _WorkerProcess
+    class _WorkerContext(multiprocessing.context.ForkContext):
+        Process = _WorkerProcess
 
 
 def _own_pool(workers: int) -> ProcessPoolExecutor:
