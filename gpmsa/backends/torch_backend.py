@@ -961,6 +961,7 @@ def sample(
     proportional_steps: bool | None = None,
     temperatures=None,
     swap_every: int = 1,
+    adapt_ladder: bool = False,
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
@@ -1010,12 +1011,23 @@ def sample(
     ``chain_groups`` > 1 (or an ``executor``) then samples groups of whole chains, each with
     all its K copies (tempering within the group as in one batch), with the groups' streams
     as above; draws, acceptance and swap rates are assembled in chain order.
+
+    ``adapt_ladder`` (with ``temperatures``, at least 3, and ``tune``; as the numpy backend's,
+    ``gpmsa.mcmc.tempering.adapt_ladder``): after the first stage's warm-up, ``tune_rounds`` x
+    ``tune_levels`` further sweeps of every row (GPM/SA's candidate widths in turn), a swap
+    round after each, move each chain's interior temperatures towards equal swap rates
+    (`_adapt_ladders`: per chain, from its own swaps, rows c K + k at their chain's ladder);
+    each chain's ladder is then frozen for the widths' tuning and every draw (an exact MCMC),
+    its groups (``chain_groups`` > 1) given their chains' ladders. ``info`` records
+    "adapt_ladder" and "adapted_temperatures" (n_chains, K) ("temperatures": the starting
+    ladder).
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
     temps = tempering.ladder(temperatures)
     swap_every = tempering.check_swap_every(swap_every, temps, int(n_iter))
+    adapt = tempering.check_adapt(adapt_ladder, temps, tune)
     copies = 1 if temps is None else len(temps)
     check_draws_memory(problem, int(n_iter), int(n_chains))
     check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype), copies)
@@ -1027,7 +1039,7 @@ def sample(
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,
                        tune_stages, check_ridge(ridge_moves, problem), where, prop_mh,
-                       temps, swap_every)  # fmt: skip
+                       temps, swap_every, adapt)  # fmt: skip
 
 
 def callables(problem: Problem) -> list[str]:
@@ -1095,9 +1107,9 @@ def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_thr
 def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
             tune_levels, device, dtype, init, warmup, tune_stages, n_ridge,
             where, prop_mh: bool, temps: tuple[float, ...] | None = None,
-            swap_every: int = 1) -> Chains:  # fmt: skip
+            swap_every: int = 1, adapt: bool = False) -> Chains:  # fmt: skip
     """``sample`` without the thread setting (``prop_mh``: its ``proportional_steps``, decided;
-    ``temps``: the ladder, checked, or None)."""
+    ``temps``: the ladder, checked, or None; ``adapt``: its ``adapt_ladder``, checked)."""
     dev, dt = _device(device), _dtype(dtype)
     warmup = (WARMUP if tune else 0) if warmup is None else check_count(warmup, "warmup", 0)
     tune_stages = check_count(tune_stages, "tune_stages")
@@ -1117,20 +1129,23 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     w = np.array([float(widths[n][idx]) for n, idx in els])
     n_stages = tune_stages if tune else 1
     total = n_iter + n_stages * (warmup + (tune_rounds * tune_levels if tune else 0))
+    total += tune_rounds * tune_levels if adapt else 0  # the ladder's adaptation
     names = problem.names
     in_process = where["groups"] == 1 and where["executor"] is None
     if not in_process:
         total -= n_iter  # the groups' sweeps: counted by run_chains' bar over the groups
     ws = rates = None  # tempered: each copy's widths (K, n_el); the swap rates (C, K - 1)
+    ladders = temps  # tempered: the draws' ladder (K,), or with adapt each chain's (C, K)
     with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
         if temps is not None:
-            ws = _tempered_tuning(state, w, temps, prop_mh, gen, bar, warmup=warmup,
-                                  n_stages=n_stages, tune=tune, tune_rounds=tune_rounds,
-                                  tune_levels=tune_levels)  # fmt: skip
+            ws, ladders = _tempered_tuning(state, w, temps, prop_mh, gen, bar, warmup=warmup,
+                                           n_stages=n_stages, tune=tune,
+                                           tune_rounds=tune_rounds, tune_levels=tune_levels,
+                                           adapt=adapt)  # fmt: skip
             w = ws[0]
             if in_process:
                 draws, log_post, accepted, rates = _tempered_draws(
-                    state, ws, temps, swap_every, n_iter, prop_mh, gen, bar
+                    state, ws, ladders, swap_every, n_iter, prop_mh, gen, bar
                 )
         elif tune:  # the widths tuned with the level moves (a categorical theta; no draws used)
             state.learn_level_shifts()
@@ -1156,11 +1171,13 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     if not in_process:
         draws, log_post, accepted, rates = _grouped_sweeps(
             state, w if temps is None else ws, n_iter, prop_mh, seeds[0], where,
-            dtype=str(dt).replace("torch.", ""), progress=progress, temps=temps,
+            dtype=str(dt).replace("torch.", ""), progress=progress, temps=ladders,
             swap_every=swap_every,
         )  # fmt: skip
     tempered = {} if temps is None else {"temperatures": list(temps), "swap_every": swap_every,
                                          "swap_rate": rates}  # fmt: skip
+    if adapt:  # each chain's ladder, adapted in its tuning and frozen for its draws
+        tempered.update(adapt_ladder=True, adapted_temperatures=np.asarray(ladders))
     rate = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
     wid = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
     acc_np = accepted / n_iter
@@ -1186,24 +1203,37 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     )  # fmt: skip
 
 
-def _swap_rows(state: BatchState, betas: tuple[float, ...], u: Tensor, accepted: Tensor) -> None:
-    """One round of neighbour swaps in every chain of a tempered batch (rows c K + k, K =
-    len(betas)): for k = 0 .. K - 2 in turn, copies k and k + 1 exchange their rows' states
+def _swap_rows(state: BatchState, betas: tuple[float, ...] | Tensor, u: Tensor, accepted: Tensor,
+               probs: Tensor | None = None) -> None:  # fmt: skip
+    """One round of neighbour swaps in every chain of a tempered batch (rows c K + k, K copies):
+    for k = 0 .. K - 2 in turn, copies k and k + 1 exchange their rows' states
     (``BatchState.exchange``) where log u[k] (C,) is below (beta_k - beta_{k+1}) (log L_{k+1} -
-    log L_k), as ``gpmsa.mcmc.tempering.swap``; adds the accepted swaps to accepted (K - 1, C).
-    """
-    n_temps = len(betas)
+    log L_k), as ``gpmsa.mcmc.tempering.swap``; adds the accepted swaps to accepted (K - 1, C)
+    and, given ``probs`` (K - 1, C), sets probs[k] to the proposals' acceptance probabilities.
+    ``betas``: the ladder's 1/T_k (K,) shared by every chain, or each chain's (C, K) tensor
+    (an adapted ladder, `_adapt_ladders`)."""
+    per_chain = isinstance(betas, Tensor)
+    n_temps = betas.shape[1] if per_chain else len(betas)
     for k in range(n_temps - 1):
         ll = state.loglik.view(-1, n_temps)
-        acc = torch.log(u[k]) < (betas[k] - betas[k + 1]) * (ll[:, k + 1] - ll[:, k])
+        d_beta = betas[:, k] - betas[:, k + 1] if per_chain else betas[k] - betas[k + 1]
+        log_r = d_beta * (ll[:, k + 1] - ll[:, k])
+        if probs is not None:
+            probs[k] = torch.exp(torch.clamp(log_r, max=0.0))
+        acc = torch.log(u[k]) < log_r
         if acc.any():
             rows = torch.nonzero(acc).squeeze(-1) * n_temps + k
             state.exchange(rows, rows + 1)
         accepted[k] += acc
 
 
-def _temper(state: BatchState, temps: tuple[float, ...]) -> tuple[float, ...]:
-    """Set ``state.beta`` for rows c K + k at ``temps[k]`` (K = len(temps)); returns 1/T_k."""
+def _temper(state: BatchState, temps) -> tuple[float, ...] | Tensor:
+    """Set ``state.beta`` for rows c K + k at ``temps[k]`` (a ladder (K,) shared by every chain;
+    returns 1/T_k) or at ``temps[c, k]`` (an array (C, K), each chain's; returns 1/T (C, K))."""
+    if isinstance(temps, np.ndarray) and temps.ndim == 2:
+        betas = state.ll_w.new_tensor(1.0 / temps)
+        state.beta = betas.flatten()
+        return betas
     betas = tuple(1.0 / t for t in temps)
     state.beta = state.ll_w.new_tensor(betas).repeat(state.n_chains // len(temps))
     return betas
@@ -1215,23 +1245,25 @@ def _copy_widths(state: BatchState, per_copy: np.ndarray) -> Tensor:
     return state.ll_w.new_tensor(per_copy.T).repeat(1, state.n_chains // n_temps)
 
 
-def _swap_round(state: BatchState, betas: tuple[float, ...], gen: torch.Generator,
-                swaps: Tensor) -> None:  # fmt: skip
+def _swap_round(state: BatchState, betas: tuple[float, ...] | Tensor, gen: torch.Generator,
+                swaps: Tensor, probs: Tensor | None = None) -> None:  # fmt: skip
     """`_swap_rows` with uniforms (K - 1, C) drawn from ``gen``; counts into swaps (K - 1, C)."""
     u = torch.rand(swaps.shape, generator=gen, dtype=state.ll_w.dtype, device=state.ll_w.device)
-    _swap_rows(state, betas, u, swaps)
+    _swap_rows(state, betas, u, swaps, probs)
 
 
 def _tempered_tuning(state: BatchState, w: np.ndarray, temps: tuple[float, ...], prop_mh: bool,
                      gen: torch.Generator, bar, *, warmup: int, n_stages: int, tune: bool,
-                     tune_rounds: int, tune_levels: int) -> np.ndarray:  # fmt: skip
+                     tune_rounds: int, tune_levels: int, adapt: bool = False) -> tuple:  # fmt: skip
     """``_sample``'s warm-up and tuning with parallel tempering (``sample``'s
     ``temperatures``): ``state`` holds C chains x K copies (row c K + k at temperature
     ``temps[k]``), every copy from the widths ``w`` (n_el,). Each stage: ``warmup`` sweeps,
     then GPM/SA's tuning of each copy's widths at its temperature (acceptance pooled over the
     chains' copy k), a swap round (`_swap_rows`) after each sweep and each tuning level; then
-    the level shifts learnt at T = 1. Returns each copy's widths (K, n_el) for
-    `_tempered_draws`."""
+    the level shifts learnt at T = 1. ``adapt`` (``sample``'s ``adapt_ladder``): after the
+    first stage's warm-up, each chain's ladder adapted (`_adapt_ladders`) and frozen for the
+    tuning that follows. Returns each copy's widths (K, n_el) and the draws' ladder, ``temps``
+    or with ``adapt`` each chain's (C, K), for `_tempered_draws`."""
     n_temps, n_el = len(temps), len(state.els)
     n_chains = state.n_chains // n_temps
     betas = _temper(state, temps)
@@ -1250,6 +1282,10 @@ def _tempered_tuning(state: BatchState, w: np.ndarray, temps: tuple[float, ...],
             bar.update(1)
         if not (tune and n_el):
             break
+        if adapt and _stage == 0:
+            temps = _adapt_ladders(state, w, temps, gen, bar, tune_rounds, tune_levels)
+            betas = _temper(state, temps)  # frozen from here: the tuning's and draws' ladders
+            bar.set_description(f"torch MCMC: tuning ({n_temps} temperatures, adapted)")
         cands = [tuning.level_widths(names, ws[k], tune_levels) for k in range(n_temps)]
         levels = [_copy_widths(state, np.stack([c[lev] for c in cands]))
                   for lev in range(tune_levels)]  # fmt: skip
@@ -1265,17 +1301,57 @@ def _tempered_tuning(state: BatchState, w: np.ndarray, temps: tuple[float, ...],
                                             tune_rounds * n_chains)
                        for k in range(n_temps)])  # fmt: skip
     state.learn_level_shifts(n_temps)  # anew at T = 1, shared by the copies, frozen
-    return ws
+    if adapt and not isinstance(temps, np.ndarray):  # (no element to sweep: none adapted)
+        temps = np.tile(np.asarray(temps, dtype=float), (n_chains, 1))
+    return ws, temps
 
 
-def _tempered_draws(state: BatchState, ws: np.ndarray, temps: tuple[float, ...],
-                    swap_every: int, n_iter: int, prop_mh: bool, gen: torch.Generator,
-                    bar) -> tuple:  # fmt: skip
-    """``n_iter`` sweeps of a tempered batch (rows c K + k at ``temps[k]``, each copy at its
-    widths ``ws`` (K, n_el)), a swap round every ``swap_every``: `_sweeps`' draws, log
-    posterior and accepted counts of the T = 1 rows, and the swap rate (C, K - 1) of each
-    neighbour pair over the swap rounds. One batch's, or a chain group's (`_group_task`)."""
+def _adapt_ladders(state: BatchState, w: np.ndarray, temps: tuple[float, ...], gen: torch.Generator,
+                   bar, tune_rounds: int, tune_levels: int) -> np.ndarray:  # fmt: skip
+    """The adaptive ladder (``gpmsa.mcmc.tempering.adapt_ladder``, the numpy backend's) of
+    every chain of a tempered batch, its rows c K + k from the starting ladder ``temps`` (K,):
+    ``tune_rounds`` x ``tune_levels`` sweeps of every row at GPM/SA's candidate widths of ``w``
+    in turn (acceptances not kept), a swap round (`_swap_rows`) after each, after which each
+    chain's log gaps move by its own pairs' acceptance probabilities (``tempering.adapt_gaps``)
+    and its rows take its new ladder. Returns each chain's ladder kept (C, K; the mean of the
+    second half's log gaps, ``tempering.kept_ladder``), ``state.beta`` set to it."""
     n_temps = len(temps)
+    n_chains = state.n_chains // n_temps
+    start = np.asarray(temps, dtype=float)
+    top = float(start[-1])
+    log_gap = np.tile(np.log(np.diff(start)), (n_chains, 1))
+    mean_gap, n_mean = np.zeros_like(log_gap), 0
+    cands = tuning.level_widths([n for n, _ in state.els], w, tune_levels)
+    swaps = torch.zeros((n_temps - 1, n_chains), dtype=torch.long, device=state.ll_w.device)
+    probs = state.ll_w.new_empty((n_temps - 1, n_chains))
+    betas = _temper(state, np.tile(start, (n_chains, 1)))
+    bar.set_description(f"torch MCMC: adapting the ladder ({n_temps} temperatures)")
+    n_total = tune_rounds * tune_levels
+    for n in range(n_total):
+        lev = n % tune_levels
+        state.sweep(cands[lev], False, gen)
+        _swap_round(state, betas, gen, swaps, probs)
+        a = probs.T.cpu().numpy().astype(np.float64)  # (C, K - 1)
+        log_gap = tempering.adapt_gaps(log_gap, a, n, top)
+        betas = _temper(state, tempering.gap_ladder(log_gap, top))
+        if 2 * n >= n_total:  # the second half's mean (Polyak averaging)
+            mean_gap += log_gap
+            n_mean += 1
+        if lev == tune_levels - 1:
+            bar.update(tune_levels)
+    ladders = tempering.kept_ladder(mean_gap / max(n_mean, 1), start)
+    _temper(state, ladders)
+    return ladders
+
+
+def _tempered_draws(state: BatchState, ws: np.ndarray, temps, swap_every: int, n_iter: int,
+                    prop_mh: bool, gen: torch.Generator, bar) -> tuple:  # fmt: skip
+    """``n_iter`` sweeps of a tempered batch (rows c K + k at ``temps[k]``, or at ``temps[c,
+    k]`` with each chain's ladder (C, K), an adapted one; each copy at its widths ``ws`` (K,
+    n_el)), a swap round every ``swap_every``: `_sweeps`' draws, log posterior and accepted
+    counts of the T = 1 rows, and the swap rate (C, K - 1) of each neighbour pair over the swap
+    rounds. One batch's, or a chain group's (`_group_task`)."""
+    n_temps = np.shape(temps)[-1]
     n_chains = state.n_chains // n_temps
     betas = _temper(state, temps)
     dt, dev = state.ll_w.dtype, state.ll_w.device
@@ -1323,10 +1399,11 @@ def _sweeps(
 def _group_task(problem: Problem, start: dict[str, np.ndarray], widths: np.ndarray, n_iter: int,
                 prop_mh: bool, stream: int, dtype: str, ridge_moves: int, progress: bool = False,
                 desc: str = "torch chains", level_shifts: tuple | None = None,
-                temps: tuple[float, ...] | None = None, swap_every: int = 1) -> tuple:  # fmt: skip
+                temps=None, swap_every: int = 1) -> tuple:  # fmt: skip
     """One chain group's sweeps from plain data (run in a worker process, one thread);
     ``level_shifts``: the group's (``BatchState.shift_elements``, element -> offsets (C', K,
-    n)) of the joint level move (None: none). ``temps``: parallel tempering (None: off);
+    n)) of the joint level move (None: none). ``temps``: parallel tempering (None: off; the
+    ladder (K,), or its chains' adapted ladders (C', K));
     ``start`` then holds the group's chains' rows c K + k (every copy), ``widths`` each copy's
     (K, n_el), and the result adds the swap rates (`_tempered_draws`)."""
     with torch_threads(1), torch.no_grad():
@@ -1350,9 +1427,11 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
     """``_sweeps`` of consecutive chain groups in worker processes (``gpmsa.mcmc.parallel``);
     group g's stream is child n_chains + g of the seed's SeedSequence (``first`` is child 0).
     ``temps``: parallel tempering (``widths`` each copy's (K, n_el)): each group holds whole
-    chains, rows c K + k of all K copies, and runs `_tempered_draws`. Returns draws, log
-    posterior, accepted counts and the swap rates (C, K - 1; None untempered)."""
-    copies = 1 if temps is None else len(temps)
+    chains, rows c K + k of all K copies, and runs `_tempered_draws` (``temps`` (C, K), each
+    chain's adapted ladder: each group given its chains'). Returns draws, log posterior,
+    accepted counts and the swap rates (C, K - 1; None untempered)."""
+    copies = 1 if temps is None else np.shape(temps)[-1]
+    per_chain = isinstance(temps, np.ndarray) and temps.ndim == 2
     c, k = state.n_chains // copies, where["groups"]
     bounds = np.linspace(0, c, k + 1).round().astype(int)
     tasks = []
@@ -1367,7 +1446,9 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
             "level_shifts": (tuple(state.shift_elements), {
                 k: v[lo:hi].cpu().numpy().copy() for k, v in state.level_shifts.items()
             }) if state.level_shifts else None,
-            **({} if temps is None else {"temps": tuple(temps), "swap_every": int(swap_every)}),
+            **({} if temps is None else {
+                "temps": temps[bounds[g]:bounds[g + 1]].copy() if per_chain else tuple(temps),
+                "swap_every": int(swap_every)}),
         })  # fmt: skip
     shapes = {n: v.shape[1:] for n, v in state.params.items()}
 

@@ -196,12 +196,13 @@ def fit(
     tens). torch: the batch holds every chain's copies (n_chains x n rows); with
     ``chain_groups`` > 1 each group holds whole chains with all their copies (tuning in one
     batch). Refused on the pyro backend and with ``init`` an emulator
-    (docs/internals.md, "Parallel tempering"). numpy option ``adapt_ladder=True`` (off by
-    default; with ``temperatures``, at least 3, and ``tune``): each chain adapts its ladder's
-    temperatures between 1 and the hottest during tuning towards equal swap rates, then freezes
-    it before the widths' tuning and the draws (an exact MCMC; about ``tune_rounds`` x
-    ``tune_levels`` more sweeps per copy); ``settings["adapted_temperatures"]`` (per chain)
-    records it, "temperatures" the ladder it started from.
+    (docs/internals.md, "Parallel tempering"). numpy and torch option ``adapt_ladder=True``
+    (off by default; with ``temperatures``, at least 3, and ``tune``): each chain adapts its
+    ladder's temperatures between 1 and the hottest during tuning towards equal swap rates, then
+    freezes it before the widths' tuning and the draws (an exact MCMC; about ``tune_rounds`` x
+    ``tune_levels`` more sweeps per copy; torch: after the first stage's warm-up, each chain from
+    its own swaps); ``settings["adapted_temperatures"]`` (per chain) records it, "temperatures"
+    the ladder it started from.
 
     A categorical theta of a joint fit moves levels jointly with the continuous theta
     (``gpmsa.mcmc.level_moves``): ``settings["level_offsets"]`` records, per categorical name,
@@ -383,10 +384,10 @@ def _check_tempering(options: dict, backend: str, continuing: bool):
             f"{' and '.join(given)}: parallel tempering runs on the numpy and torch backends "
             f"only, not backend={backend!r}"
         )
-    if "adapt_ladder" in options and backend != "numpy":
+    if "adapt_ladder" in options and backend not in ("numpy", "torch"):
         raise GPMSAError(
-            f"adapt_ladder: the adaptive ladder runs on the numpy backend only, not "
-            f"backend={backend!r} (give a fixed ladder, temperatures=)"
+            f"adapt_ladder: the adaptive ladder runs on the numpy and torch backends only, not "
+            f"backend={backend!r}"
         )
     temps = tempering.ladder(options.get("temperatures"))
     if temps is not None and continuing:

@@ -26,11 +26,11 @@ The torch backend runs the same definition with every chain's copies as rows of 
 group holds whole chains with all their copies; ``ladder`` and ``check_swap_every`` check its
 arguments).
 
-An adaptive ladder (opt-in, numpy: ``adapt_ladder=True``, `adapt_ladder`): before GPM/SA's
-tuning, ``tune_rounds`` x ``tune_levels`` further sweeps of every copy (GPM/SA's candidate
-widths in turn), a swap round after each, move the temperatures between T_0 = 1 and the hottest
-(both fixed: the hottest must cross the barrier, which no swap rate measures) so that the
-neighbours' swap rates become equal: after swap round n, each gap's logarithm
+An adaptive ladder (opt-in, numpy and torch: ``adapt_ladder=True``, `adapt_ladder`): before
+GPM/SA's tuning, ``tune_rounds`` x ``tune_levels`` further sweeps of every copy (GPM/SA's
+candidate widths in turn), a swap round after each, move the temperatures between T_0 = 1 and
+the hottest (both fixed: the hottest must cross the barrier, which no swap rate measures) so
+that the neighbours' swap rates become equal: after swap round n, each gap's logarithm
 S_k = log(T_{k+1} - T_k) moves by kappa_n (a_k - mean(a)), a_k the pair's acceptance
 probability min(1, r_k) in that round (the swap rate's Rao-Blackwellised estimate), kappa_n =
 ``ADAPT_RATE`` ``ADAPT_LAG`` / (n + ``ADAPT_LAG``) (Vousden, Farr & Mandel 2016, MNRAS 455,
@@ -38,7 +38,9 @@ probability min(1, r_k) in that round (the swap rate's Rao-Blackwellised estimat
 temperature); the ladder kept is the mean of S over the second half of the rounds (Polyak
 averaging). The ladder is then FROZEN: the copies' widths are tuned at it and every kept draw
 comes from the fixed-ladder chain above, an exact MCMC (the adaptation only chooses the
-ladder, as the tuning chooses the widths).
+ladder, as the tuning chooses the widths). The torch backend adapts every chain's ladder in
+its batch by the same rule (`adapt_gaps`, `gap_ladder`, `kept_ladder`, on a leading chain
+axis), each chain's rows at its own ladder.
 """
 
 from __future__ import annotations
@@ -160,10 +162,9 @@ def adapt_ladder(states: list, temperatures, rng, names, widths, n_rounds, n_lev
     starting ladder; their ``beta`` set to the adapted one): ``n_rounds`` rounds of a sweep of
     every copy at each of GPM/SA's ``n_levels`` candidate widths (``tuning.level_widths`` of
     ``widths``, as the tuning's; the acceptances not kept), a swap round after each, the log
-    gaps moved after each swap round. Returns the adapted ladder (K,): 1, strictly increasing,
-    the hottest unchanged; the starting ladder where the averaged one is not that in float64
-    (swap rates stuck at 0 and 1 can shrink a gap below a rung's resolution: rungs merged or
-    past the hottest)."""
+    gaps moved after each swap round (`adapt_gaps`). Returns the adapted ladder (K,): 1,
+    strictly increasing, the hottest unchanged; the starting ladder where the averaged one is
+    not that in float64 (`kept_ladder`)."""
     temps = np.asarray(temperatures, dtype=float)
     top, n_temps = temps[-1], len(states)
     log_gap = np.log(np.diff(temps))
@@ -177,30 +178,53 @@ def adapt_ladder(states: list, temperatures, rng, names, widths, n_rounds, n_lev
             state.sweep(cands[lev], False, acc)
         betas = tuple(state.beta for state in states)
         swap(states, betas, rng.random(n_temps - 1), swaps, probs)
-        log_gap += ADAPT_RATE * ADAPT_LAG / (n + ADAPT_LAG) * (probs - probs.mean())
-        log_gap += math.log(top - 1.0) - np.log(np.sum(np.exp(log_gap)))  # the hottest kept
-        _set_ladder(states, log_gap, top)
+        log_gap = adapt_gaps(log_gap, probs, n, top)
+        _set_ladder(states, gap_ladder(log_gap, top))
         if 2 * n >= n_total:  # the second half's mean (Polyak averaging)
             mean_gap += log_gap
             n_mean += 1
         if lev == n_levels - 1:
             on_round(n_levels * n_temps)
-    out = _set_ladder(states, mean_gap / max(n_mean, 1), top)
-    if np.all(np.diff(out) > 0):  # (so every rung finite: between 1 and the hottest)
-        return out
-    for state, t in zip(states, temps, strict=True):  # not a ladder: the starting one stays
-        state.beta = 1.0 / t
-    return tuple(float(t) for t in temps)
+    out = kept_ladder(mean_gap / max(n_mean, 1), temps)
+    _set_ladder(states, out, first=0)
+    return tuple(float(t) for t in out)
 
 
-def _set_ladder(states: list, log_gap: np.ndarray, top: float) -> tuple[float, ...]:
-    """The ladder 1, 1 + cumsum(exp(log_gap)) (its last entry ``top`` exactly) given to the
-    copies' ``beta``; returns it."""
-    temps = np.concatenate([[1.0], 1.0 + np.cumsum(np.exp(log_gap))])
-    temps[-1] = top
-    for state, t in zip(states[1:], temps[1:], strict=True):
+def adapt_gaps(log_gap: np.ndarray, probs: np.ndarray, n: int, top: float) -> np.ndarray:
+    """The adaptive ladder's move after swap round ``n`` (from 0; module docstring): the log
+    gaps ``log_gap`` (..., K - 1), S_k = log(T_{k+1} - T_k), moved by kappa_n (a_k - mean(a)),
+    a = ``probs`` (..., K - 1) the round's swap acceptance probabilities, then shifted so that
+    the ladder's hottest stays ``top``; a leading axis holds one ladder per chain. Returns the
+    new log gaps (the arrays given unchanged)."""
+    mean = probs.mean(axis=-1, keepdims=True)
+    log_gap = log_gap + ADAPT_RATE * ADAPT_LAG / (n + ADAPT_LAG) * (probs - mean)
+    return log_gap + (math.log(top - 1.0) - np.log(np.sum(np.exp(log_gap), -1, keepdims=True)))
+
+
+def gap_ladder(log_gap: np.ndarray, top: float) -> np.ndarray:
+    """The ladder (..., K) 1, 1 + cumsum(exp(log_gap)) of the log gaps (..., K - 1), its last
+    entry ``top`` exactly."""
+    ones = np.ones((*log_gap.shape[:-1], 1))
+    temps = np.concatenate([ones, 1.0 + np.cumsum(np.exp(log_gap), -1)], -1)
+    temps[..., -1] = top
+    return temps
+
+
+def kept_ladder(mean_gap: np.ndarray, start) -> np.ndarray:
+    """The adapted ladder kept (..., K): `gap_ladder` of the averaged log gaps ``mean_gap``
+    (..., K - 1), or the starting ladder ``start`` (K,) in each where that is not strictly
+    increasing in float64 (swap rates stuck at 0 and 1 can shrink a gap below a rung's
+    resolution: rungs merged or past the hottest)."""
+    start = np.asarray(start, dtype=float)
+    out = gap_ladder(mean_gap, start[-1])
+    ok = np.all(np.diff(out, axis=-1) > 0, axis=-1)  # (so every rung finite: in [1, top])
+    return np.where(ok[..., None], out, start)
+
+
+def _set_ladder(states: list, temps: np.ndarray, first: int = 1) -> None:
+    """The copies' ``beta`` from the ladder ``temps`` (K,), from copy ``first`` on."""
+    for state, t in zip(states[first:], temps[first:], strict=True):
         state.beta = 1.0 / t
-    return tuple(float(t) for t in temps)
 
 
 def tune_ladder(states: list, betas, rng, names, widths, n_rounds, n_levels, swaps, on_round):

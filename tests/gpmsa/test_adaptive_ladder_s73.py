@@ -152,7 +152,7 @@ def test_calibrate_and_studies_record_the_adapted_ladder():
      ({"temperatures": 2}, "at least 3 temperatures"),
      ({"temperatures": 3, "tune": False}, "adapt_ladder=True with tune=False"),
      ({"temperatures": 3, "adapt_ladder": "yes"}, "adapt_ladder must be True or False"),
-     ({"backend": "torch"}, "adapt_ladder: the adaptive ladder runs on the numpy")],
+     ({"backend": "pyro"}, "adapt_ladder: the adaptive ladder runs on the numpy and torch")],
 )  # fmt: skip
 def test_refused_by_name(kw, words):
     sim, obs = _case()

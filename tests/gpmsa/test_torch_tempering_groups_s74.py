@@ -115,9 +115,7 @@ def test_bad_combinations_are_still_refused_by_name():
     for kw, msg in cases:
         with pytest.raises(GPMSAError, match=msg):
             _sample(problem, temperatures=2, **kw)
-    with pytest.raises(GPMSAError, match="adapt_ladder"):
-        gpmsa.fit(*_sym_case(), n_iter=10, backend="torch", temperatures=3, adapt_ladder=True,
-                  chain_groups=2)  # fmt: skip
+    # (adapt_ladder with chain_groups: taken since session 74, test_torch_adaptive_ladder_s74)
 
 
 def test_memory_check_counts_every_copy_with_groups(monkeypatch):
