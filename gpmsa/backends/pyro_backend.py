@@ -487,7 +487,8 @@ def sample(
     ``accept_rate`` holds pyro's per-chain "acceptance rate" diagnostic and ``step_widths`` the
     adapted NUTS step size, each repeated over every sampled element (NaN for held elements,
     ``problem.fixed_elements``, whose draws are their values exactly; a categorical theta
-    element, marginalised and drawn from its conditional per draw: rate 1, width NaN;
+    element, marginalised and drawn from its conditional per draw: width NaN, rate its joint
+    level moves' acceptance (1 where no continuous theta is sampled: no move);
     ``info["marginalised_levels"]`` its positions). ``jit``: compile the
     potential energy with the torch JIT (about 1.6x faster on the road case). ``num_threads``:
     torch CPU threads while sampling (see the torch backend; None: unchanged). ``n_jobs``: None,

@@ -249,7 +249,8 @@ def calibrate(
             takes it: each experiment then lies on its own ``index`` within the simulation
             grid (the basis is interpolated there, as SEPIA's y_ind_obs) and may carry its
             observation-error ``precision`` (native units; lamOs still scales it).
-        n_samples: sweeps per chain after tuning; n_burn: of these, burned (kept: the rest).
+        n_samples: sweeps per chain after tuning (pyro: NUTS draws after its ``n_warmup``
+            adaptation steps, 500 by default); n_burn: of these, burned (kept: the rest).
         tune: GPM/SA step-size tuning first (tune_rounds x tune_levels sweeps).
         tune_rounds, tune_levels: the tuning's rounds and candidate widths per element (None:
             the backend's default; numpy 50 x 20; torch ceil(50 / n_chains) x 20). The pyro

@@ -196,7 +196,9 @@ class Calibrator:
             a cell wide, may lie on the wrong side), and draws the constraint rejects are
             redrawn: none lies outside. A region of either verdict that touches no node (nor
             new node) is not seen by the density (draws are still checked). MCMC passes it to
-            ``gpmsa.calibrate``. It is evaluated on the fixed grid once, here (on a refined
+            ``gpmsa.calibrate`` (numpy or torch; pyro refuses it): where it rejects the start
+            (the design's centre) give one inside as ``mcmc_options={"theta_init": [...]}``
+            (native units). It is evaluated on the fixed grid once, here (on a refined
             grid, at the update).
     """
 
@@ -363,19 +365,19 @@ class Calibrator:
 
     def _check_mcmc_path(self, backend: str) -> None:
         """GPMSAError now, not at every update, for MCMC settings ``gpmsa.calibrate`` refuses:
-        a constraint or the emulator's draws on another backend than numpy, or the draws with
-        ``mcmc_options={"fast": False}`` (only the fast numpy sampler averages over them)."""
+        a constraint on pyro (numpy and torch take one), the emulator's draws on another backend
+        than numpy, or the draws with ``mcmc_options={"fast": False}`` (only the fast numpy
+        sampler averages over them)."""
         if self.method != "mcmc":
             return
         opts = self.mcmc_options
         backend = opts.get("backend", backend)
-        if backend != "numpy":
-            for what, given in (
-                ("constraint", opts.get("constraint") is not None),
-                ("emulator_params='draws'", self.emulator_params == "draws"),
-            ):
-                if given:
-                    raise GPMSAError(f"{what} needs backend='numpy', got backend={backend!r}")
+        if backend == "pyro" and opts.get("constraint") is not None:
+            raise GPMSAError("constraint needs backend='numpy' or 'torch', got backend='pyro'")
+        if backend != "numpy" and self.emulator_params == "draws":
+            raise GPMSAError(
+                f"emulator_params='draws' needs backend='numpy', got backend={backend!r}"
+            )
         if self.emulator_params == "draws" and opts.get("fast") is False:
             raise GPMSAError("emulator_params='draws' needs the fast numpy sampler: drop "
                              "mcmc_options['fast'] = False")  # fmt: skip
@@ -859,9 +861,16 @@ class Calibrator:
         opts.setdefault("emulator_params", self.emulator_params)
         opts.setdefault("n_emulator_draws", self._n_emulator_draws)
         opts.setdefault("backend", self.backend)
-        return calibrate(
-            self.emulator, x_obs, y_obs, extrapolate=extrapolate, log_prior=prior, **opts
-        )
+        try:
+            return calibrate(
+                self.emulator, x_obs, y_obs, extrapolate=extrapolate, log_prior=prior, **opts
+            )
+        except GPMSAError as exc:  # calibrate's advice names its argument, not the Calibrator's
+            if "pass theta_init=" not in str(exc) or "theta_init" in opts:
+                raise
+            raise GPMSAError(
+                f"{exc} (a Calibrator takes it as mcmc_options={{'theta_init': [...]}})"
+            ) from exc
 
     def _allowed(self, theta_unit: np.ndarray) -> np.ndarray:
         """(G,) bool: whether the constraint allows each unit-scale node (G, q)."""
