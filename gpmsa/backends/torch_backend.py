@@ -1025,10 +1025,18 @@ def sample(
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
-    temps = tempering.ladder(temperatures)
+    ladders = tempering.chain_ladders(temperatures, int(n_chains))  # each chain's
+    temps = None if ladders is None else ladders[0]
     swap_every = tempering.check_swap_every(swap_every, temps, int(n_iter))
     adapt = tempering.check_adapt(adapt_ladder, temps, tune)
     copies = 1 if temps is None else len(temps)
+    if temps is not None and ladders.count(temps) < len(ladders):  # a ladder per chain
+        if adapt:
+            raise GPMSAError(
+                "adapt_ladder=True with a ladder per chain (temperatures (n_chains, K)): the "
+                "torch backend adapts from one ladder; give temperatures= one ladder"
+            )
+        temps = np.array(ladders)
     check_draws_memory(problem, int(n_iter), int(n_chains))
     check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype), copies)
     where = _check_groups(chain_groups, n_jobs, executor, int(n_chains), device, num_threads)
@@ -1122,7 +1130,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     seeds = np.random.SeedSequence(seed).spawn(n_chains)  # chain c starts as the numpy chain c
     how, firsts = starts.chain_starts(problem, init, seeds)
     start = {k: np.stack([f[k] for f in firsts]) for k in problem.init}
-    copies = 1 if temps is None else len(temps)
+    copies = 1 if temps is None else np.shape(temps)[-1]
     rows = start if temps is None else {k: np.repeat(v, copies, axis=0) for k, v in start.items()}
     state = BatchState(problem, int(n_chains) * copies, dt, dev, rows, n_ridge)
     els = state.els
@@ -1174,7 +1182,8 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
             dtype=str(dt).replace("torch.", ""), progress=progress, temps=ladders,
             swap_every=swap_every,
         )  # fmt: skip
-    tempered = {} if temps is None else {"temperatures": list(temps), "swap_every": swap_every,
+    tempered = {} if temps is None else {"temperatures": np.asarray(temps).tolist(),
+                                         "swap_every": swap_every,
                                          "swap_rate": rates}  # fmt: skip
     if adapt:  # each chain's ladder, adapted in its tuning and frozen for its draws
         tempered.update(adapt_ladder=True, adapted_temperatures=np.asarray(ladders))
@@ -1264,7 +1273,7 @@ def _tempered_tuning(state: BatchState, w: np.ndarray, temps: tuple[float, ...],
     first stage's warm-up, each chain's ladder adapted (`_adapt_ladders`) and frozen for the
     tuning that follows. Returns each copy's widths (K, n_el) and the draws' ladder, ``temps``
     or with ``adapt`` each chain's (C, K), for `_tempered_draws`."""
-    n_temps, n_el = len(temps), len(state.els)
+    n_temps, n_el = np.shape(temps)[-1], len(state.els)
     n_chains = state.n_chains // n_temps
     betas = _temper(state, temps)
     swaps = torch.zeros((n_temps - 1, n_chains), dtype=torch.long, device=state.ll_w.device)

@@ -11,6 +11,7 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.mcmc import tempering
 from gpmsa.mcmc.sampler import check_step_widths
 from gpmsa.model.basis import reordered_basis
 from gpmsa.model.data import ObsData, check_flag
@@ -180,6 +181,52 @@ def continued_widths(emulator: Emulator, problem: Problem, n_chains: int,
             f"this fit ({exc}); pass step_widths= or tune=True"
         ) from None
     return record
+
+
+def continued_ladder(emulator: Emulator, options: dict, n_chains: int, given):
+    """The ladder of ``fit(..., init=emulator)`` (a continuation; ``options`` its backend's,
+    ``given`` their "temperatures" checked by ``tempering.ladder``): ``given`` where the option
+    is there (None given: a continuation without tempering), else the source's where it was
+    tempered (`source_ladders`), set in ``options`` with its "swap_every" unless given. Every
+    copy of a chain then starts at the chain's last kept state and is tuned at its temperature
+    before any draw (``fit``: the record holds the T = 1 copy alone; a hot copy is auxiliary,
+    any start is valid once warmed up). Returns chain 0's ladder (K,), or None."""
+    if "temperatures" in options:
+        return given
+    ladders, every = source_ladders(emulator.settings or {}, n_chains)
+    if ladders is None:
+        return None
+    if options.get("swap_every") is None:
+        options["swap_every"] = every
+    options["temperatures"] = ladders.tolist() if ladders.ndim == 1 else ladders
+    return tuple(float(t) for t in np.atleast_2d(ladders)[0])
+
+
+def source_ladders(settings: dict, n_chains: int, source: str = "init=emulator"):
+    """A tempered source's ladder and swap interval from its ``settings`` (a fit's or a
+    study's): (the ladder (K,) of settings "temperatures", or each chain's (n_chains, K) where
+    its chains adapted theirs, "adapted_temperatures"; its "swap_every", 1 where not recorded);
+    (None, None) where it was not tempered. GPMSAError naming a damaged record (``source``: the
+    argument that gave it)."""
+    if settings.get("temperatures") is None:
+        return None, None
+    try:
+        start = tempering.ladder(settings["temperatures"])
+        ladders = [start] * n_chains
+        if settings.get("adapted_temperatures") is not None:
+            adapted = np.asarray(settings["adapted_temperatures"], dtype=float)
+            if adapted.shape != (n_chains, len(start)):
+                raise GPMSAError(f"adapted_temperatures of shape {adapted.shape}, not "
+                                 f"({n_chains}, {len(start)})")  # fmt: skip
+            ladders = tempering.chain_ladders(adapted, n_chains)
+        every = tempering.check_swap_every(settings.get("swap_every", 1), start)
+    except (GPMSAError, TypeError, ValueError) as exc:
+        raise GPMSAError(
+            f"{source}: its tempering record (settings 'temperatures', 'adapted_temperatures', "
+            f"'swap_every') is damaged ({exc}); pass temperatures="
+        ) from None
+    same = ladders.count(ladders[0]) == n_chains
+    return np.array(ladders[0] if same else ladders), every
 
 
 def continued_steps(emulator: Emulator) -> bool | None:

@@ -19,6 +19,7 @@ from gpmsa.fitting.continuation import (
     check_append,
     check_same_scales,
     component_order,
+    continued_ladder,
     continued_starts,
     continued_steps,
     continued_widths,
@@ -141,7 +142,8 @@ def fit(
     "appended_to" (the source's ``model_sha256``), "appended_after" (its draws per chain),
     "pooled_sweeps" and "sweeps_run" (per chain, after burn-in and in all). It refuses (naming
     the argument) n_burn > 0, tuning (numpy, torch), an n_keep other than the draws the step
-    keeps, and ``init`` not an emulator. point: "mean" (posterior mean, default) or "map" (the
+    keeps, and ``init`` not an emulator (a tempered continuation tunes its copies: see
+    parallel tempering below). point: "mean" (posterior mean, default) or "map" (the
     draw of highest log posterior) for ``Emulator.params``. n_pc: basis size, or a variance
     fraction in (0, 1) (SEPIA's n_pc < 1; default 99.5%). basis: instead of the runs' PCA, a
     given basis (l_sim, p_u), columns the orthogonal basis vectors on the simulation grid in
@@ -195,8 +197,14 @@ def fit(
     hottest copy should cross between the modes (a barrier of 50 in log posterior needs T_max of
     tens). torch: the batch holds every chain's copies (n_chains x n rows); with
     ``chain_groups`` > 1 each group holds whole chains with all their copies (tuning in one
-    batch). Refused on the pyro backend and with ``init`` an emulator
-    (docs/internals.md, "Parallel tempering"). numpy and torch option ``adapt_ladder=True``
+    batch). Refused on the pyro backend (docs/internals.md, "Parallel tempering"). A
+    continuation (``init`` an emulator) of a tempered fit runs on tempered, at its ladder (each
+    chain's where they adapted theirs) and ``swap_every`` unless ``temperatures=`` is given
+    (``temperatures=None`` given: untempered); a plain fit's with ``temperatures=`` at that
+    ladder. Every copy of a chain starts at the chain's last kept state, from its recorded
+    widths, and is tuned at its temperature (the copies warming up, swapping) before any draw is
+    kept; ``tune=False`` is refused there, and ``append=True`` pools as a plain append (the
+    warm-up between the parts). numpy and torch option ``adapt_ladder=True``
     (off by default; with ``temperatures``, at least 3, and ``tune``): each chain adapts its
     ladder's temperatures between 1 and the hottest during tuning towards equal swap rates, then
     freezes it before the widths' tuning and the draws (an exact MCMC; about ``tune_rounds`` x
@@ -236,7 +244,17 @@ def fit(
             "field data, and a simulator-only fit has none"
         )
     seed = run_seed(seed)
-    temps = _check_tempering(options, backend, continuing)
+    temps = _check_tempering(options, backend)
+    if continuing and backend in MH_BACKENDS:  # the source's ladder unless temperatures= given
+        temps = continued_ladder(options["init"], options, int(n_chains), temps)
+    if continuing and temps is not None and tune is False:
+        raise GPMSAError(
+            "tune=False with a tempered continuation (temperatures=, or init=emulator a tempered "
+            "fit): the record holds the T = 1 copy's widths alone, so every copy is tuned at its "
+            "temperature (from those widths) while the copies warm up from the chain's last "
+            "state, before any draw is kept; leave tune out (or tune=True: from GPM/SA's "
+            "widths), or pass temperatures=None to continue without tempering"
+        )
     if isinstance(data, SimData) and data.separable is not None and backend != "numpy":
         kronecker.refuse(f"backend={backend!r}")
     module = backends.get(backend)
@@ -266,8 +284,8 @@ def fit(
         if step_widths is None and tune is not True and backend != "pyro":  # NUTS adapts
             step_widths = recorded = continued_widths(resumed, problem, int(n_chains), order)
     if tune is None:  # only the widths the chains were tuned to run on untuned
-        tune = recorded is None
-    if append and tune and backend in MH_BACKENDS:
+        tune = recorded is None or temps is not None  # tempered: every copy tuned, warmed up
+    if append and tune and backend in MH_BACKENDS and temps is None:
         raise GPMSAError(
             "append=True pools the chains' draws evenly spaced in sweeps; tuning (tune=True, "
             "or tune=None where init=emulator records no Metropolis step widths) would run "
@@ -333,13 +351,7 @@ def fit(
         "fixed": fixed_record(problem),
         "constraint": constraint is not None,
         "step_widths": {k: v.tolist() for k, v in chains.step_widths.items()},
-        **({} if temps is None else {  # parallel tempering: the ladder and the swaps' success
-            "temperatures": list(chains.info["temperatures"]),
-            "swap_every": int(chains.info["swap_every"]),
-            "swap_rate": np.asarray(chains.info["swap_rate"]).tolist(),
-            **({} if "adapted_temperatures" not in chains.info else {  # per chain, frozen
-                "adapted_temperatures": np.asarray(
-                    chains.info["adapted_temperatures"]).tolist()})}),
+        **({} if temps is None else tempering_record(chains.info, resumed)),
         **({} if "level_offsets" not in chains.info else {  # a categorical theta's level move
             "level_offsets": level_moves.native_record(
                 chains.info["level_offsets"], data.t_names, prep.standardizer.t_min,
@@ -360,9 +372,7 @@ def fit(
     record = None
     if n_chains > 1:
         record = sampled_convergence(problem, summary, n_chains, per)
-        how = "append more: gpmsa.fit(..., init=the returned emulator, append=True)"
-        if not append:
-            how = "continue these: gpmsa.fit(..., init=the returned emulator)"
+        how = more_advice(append, settings)
         warn_unconverged(record, f"gpmsa.fit (backend {backend!r})", more=f", or {how}")
     return Emulator._from_prepared(
         data, prep, params,
@@ -373,11 +383,47 @@ def fit(
     )  # fmt: skip
 
 
-def _check_tempering(options: dict, backend: str, continuing: bool):
+def tempering_record(info: dict, source: Emulator | None) -> dict:
+    """The settings of a tempered fit from its sampler's ``info``: "temperatures" (the ladder it
+    started from), "swap_every", "swap_rate" (per chain, per neighbour pair) and, where the
+    chains adapted their ladders (``adapt_ladder``) or continued ``source``'s adapted ones
+    (each chain at its own: "temperatures" then the source's), "adapted_temperatures" (per
+    chain, frozen for the draws)."""
+    out = {"temperatures": list(info["temperatures"]), "swap_every": int(info["swap_every"]),
+           "swap_rate": np.asarray(info["swap_rate"]).tolist()}  # fmt: skip
+    if np.ndim(info["temperatures"]) == 2:  # a continuation at the source's adapted ladders
+        out["temperatures"] = list(source.settings["temperatures"])
+        out["adapted_temperatures"] = np.asarray(info["temperatures"]).tolist()
+    if "adapted_temperatures" in info:  # per chain, frozen
+        out["adapted_temperatures"] = np.asarray(info["adapted_temperatures"]).tolist()
+    return out
+
+
+def more_advice(append: bool, settings: dict) -> str:
+    """The call a ConvergenceWarning of ``fit`` advises to run the chains on: a continuation
+    (``append``: appended), for a tempered fit (its ``settings``) at its ladder, which such a
+    continuation takes by default (each chain's adapted one where they adapted them)."""
+    how = "append more: gpmsa.fit(..., init=the returned emulator, append=True"
+    if not append:
+        how = "continue these: gpmsa.fit(..., init=the returned emulator"
+    temps = settings.get("temperatures")
+    if temps is None:
+        return how + ")"
+    every = settings.get("swap_every", 1)
+    every = f", swap_every={every}" if every != 1 else ""
+    if "adapted_temperatures" in settings:
+        return (
+            f"{how}{every}), tempered as these chains ran: by default at each chain's "
+            "adapted ladder (settings['adapted_temperatures']; temperatures= gives another)"
+        )
+    ladder = ", ".join(f"{t:g}" if float(f"{t:g}") == t else repr(t) for t in temps)
+    return f"{how}, temperatures=[{ladder}]{every}), tempered as these chains ran"
+
+
+def _check_tempering(options: dict, backend: str):
     """The ladder of ``fit``'s ``temperatures`` option (``tempering.ladder``; None: off).
     GPMSAError naming ``temperatures``/``swap_every`` given to another backend than numpy or
-    torch, or ``temperatures`` with ``init`` an emulator (its record holds the T = 1 copy
-    alone)."""
+    torch."""
     given = [k for k in ("temperatures", "swap_every") if options.get(k) is not None]
     if given and backend not in ("numpy", "torch"):
         raise GPMSAError(
@@ -389,14 +435,7 @@ def _check_tempering(options: dict, backend: str, continuing: bool):
             f"adapt_ladder: the adaptive ladder runs on the numpy and torch backends only, not "
             f"backend={backend!r}"
         )
-    temps = tempering.ladder(options.get("temperatures"))
-    if temps is not None and continuing:
-        raise GPMSAError(
-            "temperatures= with init=emulator: a fit's record holds its T = 1 chains alone, not "
-            "the tempered copies to continue; fit afresh with temperatures= (init= may give the "
-            "starts as a dict), or continue without temperatures="
-        )
-    return temps
+    return tempering.ladder(options.get("temperatures"))
 
 
 def check_keep(n_keep, n_chains: int) -> int:

@@ -652,19 +652,22 @@ def sample(
     n (the ladder 2**k, k = 0 .. n - 1) or a ladder from 1; each chain runs a copy per
     temperature (each tuned at its temperature), neighbours propose a swap every
     ``swap_every`` sweeps (at most ``n_iter``), and the T = 1 copy's draws are kept; ``info``
-    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1), each neighbour
-    pair's swap acceptance over the draws. ``adapt_ladder`` (with ``temperatures``, at least 3,
-    and ``tune``): each chain adapts its ladder's temperatures between 1 and the hottest during
-    tuning towards equal swap rates, then freezes it before the tuning of the widths and the
-    draws, which are therefore an exact MCMC (``tempering.adapt_ladder``); ``info`` records
-    "adapt_ladder" and "adapted_temperatures" (n_chains, K) ("temperatures": the starting
-    ladder). Raises ChainError naming a chain that failed or whose
-    draws are not finite.
+    records "temperatures" (a ladder per chain, (n_chains, K), where they differ), "swap_every"
+    and "swap_rate" (n_chains, K - 1), each neighbour pair's swap acceptance over the draws;
+    ``temperatures`` may also be an (n_chains, K) array, chain c at ladder c (a continuation of
+    chains that adapted their ladders, `tempering.chain_ladders`). ``adapt_ladder`` (with
+    ``temperatures``, at least 3, and ``tune``): each chain adapts its ladder's temperatures
+    between 1 and the hottest during tuning towards equal swap rates, then freezes it before
+    the tuning of the widths and the draws, which are therefore an exact MCMC
+    (``tempering.adapt_ladder``); ``info`` records "adapt_ladder" and "adapted_temperatures"
+    (n_chains, K) ("temperatures": the starting ladder). Raises ChainError naming a chain that
+    failed or whose draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
     prop_mh = proportional_step_choice(proportional_steps, tune)
-    temps = tempering.ladder(temperatures)
+    ladders = tempering.chain_ladders(temperatures, int(n_chains))  # each chain's
+    temps = None if ladders is None else ladders[0]
     swap_every = tempering.check_swap_every(swap_every, temps, int(n_iter))
     adapt = tempering.check_adapt(adapt_ladder, temps, tune)
     check_draws_memory(problem, int(n_iter), int(n_chains))
@@ -680,9 +683,9 @@ def sample(
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": w, "seed": s,
          "start": first, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
          "ridge_moves": n_ridge, "proportional_steps": prop_mh,
-         **({} if temps is None else {"temperatures": temps, "swap_every": swap_every}),
+         **({} if temps is None else {"temperatures": ladders[c], "swap_every": swap_every}),
          **({"adapt_ladder": True} if adapt else {})}
-        for s, first, w in zip(seeds, firsts, widths, strict=True)
+        for c, (s, first, w) in enumerate(zip(seeds, firsts, widths, strict=True))
     ]  # fmt: skip
     names = problem.names
     shapes = {n: problem.init[n].shape for n in names}
@@ -706,7 +709,8 @@ def sample(
               "backend": "numpy"},
     )  # fmt: skip
     if temps is not None:
-        chains.info.update(temperatures=list(temps), swap_every=swap_every,
+        ran = list(temps) if ladders.count(temps) == len(ladders) else [list(t) for t in ladders]
+        chains.info.update(temperatures=ran, swap_every=swap_every,
                            swap_rate=np.stack([r[4] for r in runs]))  # fmt: skip
     if adapt:  # each chain's ladder, adapted in its tuning and frozen for its draws
         chains.info.update(adapt_ladder=True, adapted_temperatures=np.stack([r[5] for r in runs]))

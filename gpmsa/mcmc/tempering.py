@@ -100,6 +100,22 @@ def ladder(temperatures) -> tuple[float, ...] | None:
     return tuple(float(v) for v in arr)
 
 
+def chain_ladders(temperatures, n_chains: int) -> list[tuple[float, ...]] | None:
+    """Each chain's ladder of a sampler's ``temperatures``: `ladder`'s, the same for every
+    chain, or a (n_chains, K) array (a continuation of a fit whose chains adapted their ladders,
+    ``settings["adapted_temperatures"]``), row c chain c's ladder (each checked by `ladder`);
+    None without tempering. GPMSAError naming the value otherwise."""
+    if isinstance(temperatures, np.ndarray) and temperatures.ndim == 2:
+        if temperatures.shape[0] != n_chains:
+            raise GPMSAError(
+                f"temperatures: one ladder per chain must have {n_chains} rows (n_chains), got "
+                f"shape {temperatures.shape}"
+            )
+        return [ladder(row) for row in temperatures]
+    one = ladder(temperatures)
+    return None if one is None else [one] * n_chains
+
+
 def check_swap_every(swap_every, temperatures, n_iter: int | None = None,
                      what: str = "n_iter") -> int:  # fmt: skip
     """``swap_every`` as an int in [1, ``MAX_SWAP_EVERY``]; GPMSAError for another value, for

@@ -22,7 +22,7 @@ from gpmsa.calibration.calibrate import (
 )
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
-from gpmsa.fitting.continuation import appended_record
+from gpmsa.fitting.continuation import appended_record, source_ladders
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.fitting.fit import (
     N_KEEP,
@@ -124,25 +124,46 @@ def _check_memory(problems, n_iter: int, n_chains: int, what: str,
     check_memory(nbytes, what)
 
 
-def _check_tempering(temperatures, swap_every, n_iter, continuing: bool, what: str,
-                     adapt_ladder=False, tune=True):  # fmt: skip
+def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_ladder=False,
+                     tune=True, n_chains: int = 1):  # fmt: skip
     """The ladder (``tempering.ladder``; None: off), ``swap_every`` (None: 1) and
     ``adapt_ladder`` (``tempering.check_adapt``, with ``tune`` the run's) of a study's parallel
-    tempering, checked (n_iter, ``what``, already is); GPMSAError naming ``temperatures`` with
-    ``init`` a study (its record holds the T = 1 chains alone)."""
-    temps = tempering.ladder(temperatures)
+    tempering, checked (n_iter, ``what``, already is). A continuation (``source`` the study
+    ``init``; else None) of a tempered study runs on at its ladder (each chain's, an
+    (n_chains, K) array, where its chains adapted theirs) and swap interval unless
+    ``temperatures=`` or ``swap_every=`` is given (``source_ladders``); GPMSAError naming
+    ``tune=False`` with a tempered continuation (every copy is tuned while it warms up)."""
+    temps, ladders = tempering.ladder(temperatures), None
+    if temps is None and source is not None:
+        ladders, every = source_ladders(source.settings or {}, n_chains, "init=study")
+        if ladders is not None:
+            temps = tuple(float(t) for t in np.atleast_2d(ladders)[0])
+            swap_every = every if swap_every is None else swap_every
     every = 1 if swap_every is None else swap_every
     every = tempering.check_swap_every(every, temps, int(n_iter), what)
     adapt = tempering.check_adapt(adapt_ladder, temps, tune)
-    if temps is not None and continuing:
+    if temps is not None and source is not None and not tune:
         raise GPMSAError(
-            "temperatures= with init=study: a study's record holds its T = 1 chains alone, not "
-            "the tempered copies to continue; run the study afresh with temperatures=, or "
-            "continue it without temperatures="
+            "tune=False with a tempered continuation (temperatures=, or init=study a tempered "
+            "study): the record holds the T = 1 copy's widths alone, so every copy is tuned at "
+            "its temperature (from those widths) while the copies warm up from the chain's "
+            "last state, before any draw is kept; leave tune out, or tune=True"
         )
     if temps is None:
         return {}
+    if ladders is not None and ladders.ndim == 2:  # each chain at its own (adapted) ladder
+        temps = ladders
     return {"temperatures": temps, "swap_every": every, **({"adapt_ladder": True} if adapt else {})}
+
+
+def _source_ladder_record(settings: dict, source) -> None:
+    """A study's ``settings`` where its chains ran at the adapted ladders of ``source`` (each
+    chain's, "temperatures" (n_chains, K) in its sampler's record) as a tempered study records
+    them: "temperatures" the source's (the ladder they started from), "adapted_temperatures"
+    each chain's (unless adapted again here)."""
+    if np.ndim(settings.get("temperatures")) == 2:
+        settings.setdefault("adapted_temperatures", np.asarray(settings["temperatures"]).tolist())
+        settings["temperatures"] = list(source.settings["temperatures"])
 
 
 def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
@@ -190,7 +211,7 @@ def _tune_rule(tune, init) -> bool | None:
 
 
 def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool | None,
-              models: list[list[dict]], append: bool, orders=None
+              models: list[list[dict]], append: bool, orders=None, tempered: bool = False
               ) -> tuple[bool, dict, dict, dict[str, str]]:  # fmt: skip
     """A continuation of ``source``'s chains from ``models`` (per chain, each model's start):
     (tune, ``sample_study``'s continuation arguments, the settings it adds, each sweep
@@ -198,16 +219,16 @@ def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool 
     its chains' widths, or False), each chain runs on with its recorded widths and precision
     steps (a per-component element's its source component's: ``orders``, per model,
     ``continuation.member_orders``); tuned, from GPM/SA's widths (refused where it
-    ``append``s: `continuation.refuse_tuning`)."""
+    ``append``s: `continuation.refuse_tuning`). ``tempered`` (parallel tempering): ``tune``
+    None tunes every copy at its temperature from the recorded widths (the copies warm up
+    before any draw; appending too)."""
     starts = cont.chain_starts(source, models)
     names, there = cont.sweep_names(problems, layout, hyper, starts[0], orders)
     widths = None if tune is True else cont.continued_widths(source, there, n_chains)
     if tune is None:
-        tune = widths is None
-    if tune and append:
+        tune = widths is None or tempered  # tempered: every copy tuned while it warms up
+    if tune and append and not tempered:
         cont.refuse_tuning()
-    if tune:
-        widths = None
     steps = None if tune else cont.continued_steps(source)
     extra = {"continued_from": cont.source_digest(source)}
     if steps is not None:
@@ -413,7 +434,10 @@ def calibrate_study(
             swap their states every ``swap_every`` (1, at most n_samples) sweeps, and only the
             T = 1 copy's draws are kept (about n times the time). ``settings`` record
             "temperatures", "swap_every" and "swap_rate" (per chain, per neighbour pair).
-            Refused with ``init`` a study (continue without them).
+            A continuation (``init`` a study) of a tempered study runs on at its ladder (each
+            chain's where they adapted theirs) and ``swap_every`` unless given, every copy from
+            its chain's last kept state, tuned at its temperature before any draw
+            (``tune=False`` refused; docs/models.md, "Parallel tempering").
         adapt_ladder: with ``temperatures`` (at least 3) and tuning, each chain adapts its
             ladder's temperatures between 1 and the hottest during tuning towards equal swap
             rates, then freezes it before the widths' tuning and the draws (an exact MCMC;
@@ -461,8 +485,9 @@ def calibrate_study(
     n_burn = (0 if continuing else 1000) if n_burn is None else n_burn
     given_hyper = hyper is not None
     hyper = _check_run(n_samples, n_burn, n_chains, hyper)
-    tempered = _check_tempering(temperatures, swap_every, n_samples, continuing, "n_samples",
-                                adapt_ladder, tune is not False)  # fmt: skip
+    source = init if continuing else None  # a tempered one's ladder: the default
+    tempered = _check_tempering(temperatures, swap_every, n_samples, source, "n_samples",
+                                adapt_ladder, tune is not False, int(n_chains))  # fmt: skip
     if not continuing:
         check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
@@ -524,7 +549,8 @@ def calibrate_study(
         thin = cont.appended_thin(init, int(n_samples), int(n_chains)) if append else 1
         starts = cont.calibration_starts(init, problems)
         tune, resumed, extra, renamed = _continue(init, problems, layout, hyper, int(n_chains),
-                                                  tune, starts, append)  # fmt: skip
+                                                  tune, starts, append,
+                                                  tempered=bool(tempered))  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})", init if append else None, thin)  # fmt: skip
     chains = sample_study(
@@ -535,6 +561,7 @@ def calibrate_study(
     )  # fmt: skip
     chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples), **extra)
+    _source_ladder_record(settings, init)
     settings.update(record)
     moves = _level_offsets(chains, layout, emulators)
     if moves:  # a categorical parameter's joint level move (other studies as before)
@@ -692,8 +719,9 @@ def fit_study(
         n_burn = 0 if continuing else n_iter // 5
     given_hyper = hyper is not None
     hyper = _check_run(n_iter, n_burn, n_chains, hyper, "n_iter")
-    tempered = _check_tempering(temperatures, swap_every, n_iter, continuing, "n_iter",
-                                adapt_ladder, tune is not False)  # fmt: skip
+    source = init if continuing else None  # a tempered one's ladder: the default
+    tempered = _check_tempering(temperatures, swap_every, n_iter, source, "n_iter", adapt_ladder,
+                                tune is not False, int(n_chains))  # fmt: skip
     if not continuing:
         check_init(init, int(n_chains), "gpmsa.load_study")
     seed = run_seed(seed)
@@ -743,7 +771,8 @@ def fit_study(
         models = cont.fit_starts(init, problems, preps, obs, int(n_chains))
         orders = cont.member_orders(init, problems)  # K's columns among each member's
         tune, resumed, extra, renamed = _continue(init, problems, layout, hyper, int(n_chains),
-                                                  tune, models, append, orders)  # fmt: skip
+                                                  tune, models, append, orders,
+                                                  tempered=bool(tempered))  # fmt: skip
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})",
                   init if append else None, thin if append else 1)  # fmt: skip
     chains = sample_study(
@@ -757,6 +786,7 @@ def fit_study(
         thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
     keep = slice(thin - 1, None, thin) if append else slice(int(n_burn), None, thin)
     settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point, **extra)
+    _source_ladder_record(settings, init)
     settings.update(record)
     moves = _level_offsets(chains, layout, sims)
     if moves:  # a categorical parameter's joint level move (other studies as before)

@@ -533,8 +533,10 @@ def sample_study(
     ``gpmsa.mcmc.parallel.run_chains``). A continuation gives ``chain_starts`` (per chain:
     models' starts, g, mu, lam; init "continued"), ``widths`` (per chain, sweep order; None:
     GPM/SA's) and ``prop_mh`` (``run_study_chain``'s). ``temperatures`` (a checked ladder,
-    ``tempering.ladder``) and ``swap_every``: parallel tempering (``run_study_chain``); info
-    records "temperatures", "swap_every" and "swap_rate" (n_chains, K - 1); ``adapt_ladder``
+    ``tempering.ladder``, or an (n_chains, K) array, chain c at row c: a continuation of chains
+    that adapted their ladders) and ``swap_every``: parallel tempering (``run_study_chain``);
+    info records "temperatures" (per chain where they differ), "swap_every" and "swap_rate"
+    (n_chains, K - 1); ``adapt_ladder``
     (a checked flag, ``tempering.check_adapt``): each chain's ladder adapted during tuning, then
     frozen, info "adapt_ladder" and "adapted_temperatures" (n_chains, K); with a categorical
     element's joint level move, "level_offsets": element -> {"shifted": the continuous
@@ -545,6 +547,7 @@ def sample_study(
     held_elements(problems, layout)  # a held element the models disagree on: before any work
     element_levels(problems, layout)  # a categorical element the study cannot sample: likewise
     how = "continued" if chain_starts else starts.check_init(init, int(n_chains))
+    ladders = tempering.chain_ladders(temperatures, int(n_chains))  # each chain's
     seq = np.random.SeedSequence(seed)
     tasks = [
         {"problems": problems, "layout": layout, "hyper": hyper, "n_iter": int(n_iter),
@@ -558,10 +561,10 @@ def sample_study(
         if widths is not None:
             task["widths"] = widths[c]
         if temperatures is not None:
-            task.update(temperatures=tuple(temperatures), swap_every=int(swap_every))
+            task.update(temperatures=ladders[c], swap_every=int(swap_every))
         if adapt_ladder:
             task["adapt_ladder"] = True
-    n_temps = 0 if temperatures is None else len(temperatures)
+    n_temps = 0 if temperatures is None else len(ladders[0])
     runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
                       progress=progress, desc="study chain",
                       check=lambda _, r: _wrong_run(r, int(n_iter), layout.n_elements,
@@ -580,7 +583,8 @@ def sample_study(
               "seed_entropy": str(seq.entropy), "init": how},
     )  # fmt: skip
     if temperatures is not None:  # the ladder and each neighbour pair's swap rate
-        out.info.update(temperatures=[float(t) for t in temperatures],
+        same = ladders.count(ladders[0]) == len(ladders)  # else a ladder per chain
+        out.info.update(temperatures=list(ladders[0]) if same else [list(t) for t in ladders],
                         swap_every=int(swap_every),
                         swap_rate=np.stack([r["swap_rate"] for r in runs]))  # fmt: skip
     if adapt_ladder:  # each chain's ladder, adapted in its tuning and frozen for its draws

@@ -89,8 +89,9 @@ def test_seeded_placement_free_recorded_and_plain_untouched(tmp_path, capsys):
     plain = _study(**kw)
     assert "temperatures" not in plain.settings and "swap_rate" not in plain.settings
     assert not np.array_equal(plain.draws["theta"], a.draws["theta"])
-    more = _study(n_samples=10, n_chains=2, seed=6, init=a)  # continued untempered
-    assert "temperatures" not in more.settings
+    more = _study(n_samples=10, n_chains=2, seed=6, init=a, tune_rounds=1, tune_levels=2)
+    assert more.settings["temperatures"] == [1.0, 2.0, 4.0]  # continued tempered (s74)
+    assert more.settings["swap_every"] == 2 and more.settings["continued_from"]
 
 
 def test_hierarchical_and_fit_study_tempered():
@@ -165,8 +166,8 @@ def test_refused_by_name(kw, words):
 
 def test_continuation_refused():
     src = _study(n_samples=10, n_burn=0, seed=1, tune=False)
-    with pytest.raises(GPMSAError, match="temperatures= with init=study"):
-        _study(n_samples=10, seed=2, init=src, temperatures=2)
+    with pytest.raises(GPMSAError, match="tune=False with a tempered continuation"):
+        _study(n_samples=10, seed=2, init=src, temperatures=2, tune=False)
     sims = [gpmsa.SimData(t=T, y=10 * (T - 0.5) ** 2, t_names=["t"])] * 2
     obs = [gpmsa.ObsData(y=Y_A)] * 2
     with pytest.raises(GPMSAError, match="swap_every=9 exceeds n_iter=5"):

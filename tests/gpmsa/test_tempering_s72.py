@@ -67,7 +67,9 @@ def test_seeded_and_placement_free():
         np.testing.assert_array_equal(b.draws[k], v)
     np.testing.assert_array_equal(b.calibration["theta"], a.calibration["theta"])
     assert a.settings["temperatures"] == [1.0, 2.0, 4.0] and a.settings["swap_every"] == 2
-    more = gpmsa.fit(sim, obs, n_iter=10, n_chains=2, seed=6, init=a, n_jobs=1)  # untempered
+    more = gpmsa.fit(
+        sim, obs, n_iter=10, n_chains=2, seed=6, init=a, n_jobs=1, temperatures=None
+    )  # untempered (by default tempered: s74)
     assert more.settings["continued_from"] == a.model_sha256 and "temperatures" not in more.settings
     plain = gpmsa.fit(sim, obs, n_jobs=1, **{**kw, "temperatures": None, "swap_every": 1})
     assert "temperatures" not in plain.settings
@@ -124,9 +126,7 @@ def test_refused_by_name_elsewhere():
     with pytest.raises(GPMSAError, match="swap_every: parallel tempering runs on the numpy"):
         gpmsa.fit(sim, obs, n_iter=10, backend="pyro", swap_every=2)
     emu = gpmsa.fit(sim, obs, n_iter=10, seed=0, tune=False)
-    with pytest.raises(GPMSAError, match="temperatures= with init=emulator"):
-        gpmsa.fit(sim, obs, n_iter=10, init=emu, temperatures=2)
-    with pytest.raises(GPMSAError, match="temperatures= with init=emulator"):
+    with pytest.raises(GPMSAError, match="tune=False with a tempered continuation"):
         gpmsa.fit(sim, obs, n_iter=10, init=emu, temperatures=2, append=True, tune=False)
 
 
