@@ -1323,7 +1323,8 @@ def _adapt_ladders(state: BatchState, w: np.ndarray, temps: tuple[float, ...], g
     in turn (acceptances not kept), a swap round (`_swap_rows`) after each, after which each
     chain's log gaps move by its own pairs' acceptance probabilities (``tempering.adapt_gaps``)
     and its rows take its new ladder. Returns each chain's ladder kept (C, K; the mean of the
-    second half's log gaps, ``tempering.kept_ladder``), ``state.beta`` set to it."""
+    second half's log gaps, ``tempering.kept_ladder``; the starting ladder where two of its rungs
+    share one 1/T in the batch's dtype), ``state.beta`` set to it."""
     n_temps = len(temps)
     n_chains = state.n_chains // n_temps
     start = np.asarray(temps, dtype=float)
@@ -1349,7 +1350,11 @@ def _adapt_ladders(state: BatchState, w: np.ndarray, temps: tuple[float, ...], g
         if lev == tune_levels - 1:
             bar.update(tune_levels)
     ladders = tempering.kept_ladder(mean_gap / max(n_mean, 1), start)
-    _temper(state, ladders)
+    betas = _temper(state, ladders)
+    merged = (betas[:, 1:] >= betas[:, :-1]).any(1).cpu().numpy()  # rungs one in the dtype
+    if merged.any():  # (float32's 1/T merges rungs float64 keeps apart): the start stays
+        ladders[merged] = start
+        _temper(state, ladders)
     return ladders
 
 

@@ -198,8 +198,9 @@ class Calibrator:
             new node) is not seen by the density (draws are still checked). MCMC passes it to
             ``gpmsa.calibrate`` (numpy or torch; pyro refuses it): where it rejects the start
             (the design's centre) give one inside as ``mcmc_options={"theta_init": [...]}``
-            (native units). It is evaluated on the fixed grid once, here (on a refined
-            grid, at the update).
+            (native units; with ``"fast": False`` or torch, whose chains start at random,
+            add ``"init": "gpmsa"`` where no random start lies inside). It is evaluated on
+            the fixed grid once, here (on a refined grid, at the update).
     """
 
     def __init__(
@@ -866,11 +867,15 @@ class Calibrator:
                 self.emulator, x_obs, y_obs, extrapolate=extrapolate, log_prior=prior, **opts
             )
         except GPMSAError as exc:  # calibrate's advice names its argument, not the Calibrator's
-            if "pass theta_init=" not in str(exc) or "theta_init" in opts:
+            if "pass init='gpmsa' with theta_init=" in str(exc):  # (no random start allowed)
+                if opts.get("init") == "gpmsa" and "theta_init" in opts:
+                    raise
+                advice = "them as mcmc_options={'init': 'gpmsa', 'theta_init': [...]}"
+            elif "pass theta_init=" in str(exc) and "theta_init" not in opts:
+                advice = "it as mcmc_options={'theta_init': [...]}"
+            else:
                 raise
-            raise GPMSAError(
-                f"{exc} (a Calibrator takes it as mcmc_options={{'theta_init': [...]}})"
-            ) from exc
+            raise GPMSAError(f"{exc} (a Calibrator takes {advice})") from exc
 
     def _allowed(self, theta_unit: np.ndarray) -> np.ndarray:
         """(G,) bool: whether the constraint allows each unit-scale node (G, q)."""
