@@ -96,3 +96,14 @@ def categorical_emulator() -> Emulator:
     sim = gpmsa.SimData(x, t, x + np.array([0.0, 1.0, -0.7])[t], t_categorical=[0])
     return Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e3],
                                       "lamWOs": [1e3]})  # fmt: skip
+
+
+def one_t_emulator() -> tuple[Emulator, list, list]:
+    """A 1-parameter emulator (y = x + t, t in [0, 1], centre 0.5) at fixed parameters, and one
+    observation near t = 0.8: (emulator, x_obs, y_obs)."""
+    rng = np.random.default_rng(0)
+    x, t = rng.random(16), rng.random(16)
+    sim = gpmsa.SimData(x[:, None], t[:, None], (x + t)[:, None], x_names=["x"], t_names=["t"])
+    emu = Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e3],
+                                     "lamWOs": [1e3]})  # fmt: skip
+    return emu, [[0.5]], [[1.3]]

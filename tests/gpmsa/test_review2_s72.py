@@ -7,17 +7,11 @@ states there, and ``settings["swap_rate"]`` read 0.0 for every pair (30 sweeps, 
 
 import numpy as np
 import pytest
+from _tempering_cases import two_mode_case as _case
 
 import gpmsa
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tempering
-
-
-def _case():
-    t = np.linspace(0.0, 1.0, 11)[:, None]
-    sim = gpmsa.SimData(t=t, y=10 * (t - 0.5) ** 2)
-    obs = gpmsa.ObsData(y=0.9 + 0.002 * np.array([[1], [-1], [0.5], [-0.5]] * 2))
-    return sim, obs
 
 
 def test_swap_every_above_n_iter_refused():

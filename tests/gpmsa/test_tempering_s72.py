@@ -13,6 +13,7 @@ import warnings
 import numpy as np
 import pytest
 from _level_cases import three_theta_case
+from _tempering_cases import two_mode_case as _case
 
 import gpmsa
 from gpmsa.errors import GPMSAError, ResourceLimitError
@@ -20,13 +21,6 @@ from gpmsa.mcmc import tempering
 from gpmsa.mcmc.sampler import ChainState
 
 LADDER = [1.0, 4.0, 16.0, 64.0]
-
-
-def _case():
-    t = np.linspace(0.0, 1.0, 11)[:, None]
-    sim = gpmsa.SimData(t=t, y=10 * (t - 0.5) ** 2)
-    obs = gpmsa.ObsData(y=0.9 + 0.002 * np.array([[1], [-1], [0.5], [-0.5]] * 2))
-    return sim, obs
 
 
 def _fit(n_iter=1500, **kw):

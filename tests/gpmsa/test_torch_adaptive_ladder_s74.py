@@ -14,6 +14,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _tempering_cases import two_mode_case as _sym_case
 
 import gpmsa
 from gpmsa import backends
@@ -26,13 +27,6 @@ tb = backends.get("torch")
 LADDER = [1.0, 4.0, 16.0, 64.0]
 KW = {"n_iter": 10, "n_chains": 4, "seed": 5, "warmup": 5, "tune_stages": 1, "tune_rounds": 8,
       "tune_levels": 5, "temperatures": LADDER}  # fmt: skip
-
-
-def _sym_case():
-    t = np.linspace(0.0, 1.0, 11)[:, None]
-    sim = gpmsa.SimData(t=t, y=10 * (t - 0.5) ** 2)
-    obs = gpmsa.ObsData(y=0.9 + 0.002 * np.array([[1], [-1], [0.5], [-0.5]] * 2))
-    return sim, obs
 
 
 def _problem():

@@ -14,6 +14,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 from _backend_cases import multi_data
+from _tempering_cases import two_mode_case as _sym_case
 
 import gpmsa
 from gpmsa import backends
@@ -75,13 +76,6 @@ def test_grouped_tempered_run_relates_to_one_batch_as_a_plain_one():
         assert ("swap_rate" in grouped.info) == (temps is not None)
         if temps is not None:
             assert np.shape(grouped.info["swap_rate"]) == np.shape(one.info["swap_rate"]) == (4, 1)
-
-
-def _sym_case():
-    t = np.linspace(0.0, 1.0, 11)[:, None]
-    sim = gpmsa.SimData(t=t, y=10 * (t - 0.5) ** 2)
-    obs = gpmsa.ObsData(y=0.9 + 0.002 * np.array([[1], [-1], [0.5], [-0.5]] * 2))
-    return sim, obs
 
 
 def test_fit_and_calibrate_take_groups_with_temperatures():

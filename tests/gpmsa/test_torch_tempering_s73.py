@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 import pytest
 from _level_cases import three_theta_case
+from _tempering_cases import two_mode_case as _sym_case
 
 import gpmsa
 from gpmsa.errors import GPMSAError, ResourceLimitError
@@ -51,13 +52,6 @@ def _grid_upper() -> float:
     lp = -0.5 * ((Y - _f(e)) ** 2).sum(0) / SD**2 - 0.5 * ((e - 0.5) / 10) ** 2
     w = np.exp(lp - lp.max())
     return float(w[e > 0.5].sum() / w.sum())
-
-
-def _sym_case():
-    t = np.linspace(0.0, 1.0, 11)[:, None]
-    sim = gpmsa.SimData(t=t, y=10 * (t - 0.5) ** 2)
-    obs = gpmsa.ObsData(y=0.9 + 0.002 * np.array([[1], [-1], [0.5], [-0.5]] * 2))
-    return sim, obs
 
 
 def _fit(**kw):

@@ -10,8 +10,8 @@ defects of a ``Calibrator`` with a theta constraint on its MCMC path.
   take: the error now names ``mcmc_options={"theta_init": ...}``.
 """
 
-import numpy as np
 import pytest
+from _calib_cases import one_t_emulator
 
 import gpmsa
 
@@ -20,12 +20,7 @@ import gpmsa
 def small():
     """A 1-parameter emulator (t in [0, 1], centre 0.5) at fixed parameters, and one
     observation near t = 0.8."""
-    rng = np.random.default_rng(0)
-    x, t = rng.random(16), rng.random(16)
-    sim = gpmsa.SimData(x[:, None], t[:, None], (x + t)[:, None], x_names=["x"], t_names=["t"])
-    emu = gpmsa.Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0],
-                                           "lamWs": [1e3], "lamWOs": [1e3]})  # fmt: skip
-    return emu, [[0.5]], [[1.3]]
+    return one_t_emulator()
 
 
 def test_a_torch_calibrator_takes_a_constraint(small):
