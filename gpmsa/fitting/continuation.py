@@ -207,11 +207,17 @@ def source_ladders(settings: dict, n_chains: int, source: str = "init=emulator")
     study's): (the ladder (K,) of settings "temperatures", or each chain's (n_chains, K) where
     its chains adapted theirs, "adapted_temperatures"; its "swap_every", 1 where not recorded);
     (None, None) where it was not tempered. GPMSAError naming a damaged record (``source``: the
-    argument that gave it)."""
+    argument that gave it; one naming n_chains where the source ran other chains)."""
     if settings.get("temperatures") is None:
         return None, None
+    n_prev = settings.get("n_chains")
+    if type(n_prev) is int and n_prev != n_chains:  # before its per-chain ladders' shape
+        raise GPMSAError(f"{source} continues its {n_prev} chain(s): pass n_chains={n_prev}")
     try:
-        start = tempering.ladder(settings["temperatures"])
+        recorded = settings["temperatures"]
+        if np.ndim(recorded) != 1:  # a fit records a list, never a count
+            raise GPMSAError(f"temperatures is a {type(recorded).__name__}, not a list")
+        start = tempering.ladder(recorded)
         ladders = [start] * n_chains
         if settings.get("adapted_temperatures") is not None:
             adapted = np.asarray(settings["adapted_temperatures"], dtype=float)

@@ -188,7 +188,7 @@ def fit(
     default, and then the draws are the plain sampler's, bit for bit): for a posterior with
     several modes that the one-element steps do not cross (a ConvergenceWarning whose chains lie
     apart, log posteriors tens apart). ``temperatures``: an integer n (the ladder T = 2**k, k =
-    0 .. n - 1) or a ladder (1, T_1, ...), strictly increasing from 1; each chain then runs a
+    0 .. n - 1; 1: no tempering) or a ladder (1, T_1, ...), strictly increasing from 1; each chain then runs a
     copy per temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at
     its temperature; neighbouring copies propose to swap states every ``swap_every`` (1) sweeps,
     and only the T = 1 copy's draws are kept. It costs about one sweep per copy (n times the
@@ -200,7 +200,7 @@ def fit(
     batch). Refused on the pyro backend (docs/internals.md, "Parallel tempering"). A
     continuation (``init`` an emulator) of a tempered fit runs on tempered, at its ladder (each
     chain's where they adapted theirs) and ``swap_every`` unless ``temperatures=`` is given
-    (``temperatures=None`` given: untempered); a plain fit's with ``temperatures=`` at that
+    (``temperatures=None`` given, or 1: untempered); a plain fit's with ``temperatures=`` at that
     ladder. Every copy of a chain starts at the chain's last kept state, from its recorded
     widths, and is tuned at its temperature (the copies warming up, swapping) before any draw is
     kept; ``tune=False`` is refused there, and ``append=True`` pools as a plain append (the

@@ -69,18 +69,23 @@ ADAPT_LAG = 200.0
 
 
 def ladder(temperatures) -> tuple[float, ...] | None:
-    """The temperatures of ``sample``'s ``temperatures``: None (no tempering), an integer n in
-    [2, ``MAX_TEMPERATURES``] (RATIO**k, k = 0 .. n - 1), or a sequence of 2 to
+    """The temperatures of ``sample``'s ``temperatures``: None (no tempering), 1 (one
+    temperature: no tempering either; how a continuation of a tempered study or fit asks for
+    plain chains), an integer n in [2, ``MAX_TEMPERATURES``] (RATIO**k, k = 0 .. n - 1), or a
+    sequence of 2 to
     ``MAX_TEMPERATURES`` finite temperatures, strictly increasing from exactly 1 (the copy
     whose draws are kept). GPMSAError naming the value otherwise."""
     if temperatures is None:
         return None
     if isinstance(temperatures, int | np.integer) and not isinstance(temperatures, bool):
-        n = check_count(temperatures, "temperatures", 2, MAX_TEMPERATURES)
+        if temperatures == 1:
+            return None
+        n = check_count(temperatures, "temperatures", 1, MAX_TEMPERATURES)
         return tuple(RATIO**k for k in range(n))
     if isinstance(temperatures, str | bytes | dict) or not hasattr(temperatures, "__len__"):
         raise GPMSAError(
-            f"temperatures must be None, an integer n in [2, {MAX_TEMPERATURES}] (the ladder "
+            f"temperatures must be None, 1 (no tempering), an integer n in [2, "
+            f"{MAX_TEMPERATURES}] (the ladder "
             f"{RATIO:g}**k) or a sequence of temperatures from 1, got {temperatures!r}"
         )
     try:

@@ -134,7 +134,7 @@ def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_
     ``temperatures=`` or ``swap_every=`` is given (``source_ladders``); GPMSAError naming
     ``tune=False`` with a tempered continuation (every copy is tuned while it warms up)."""
     temps, ladders = tempering.ladder(temperatures), None
-    if temps is None and source is not None:
+    if temperatures is None and source is not None:  # (temperatures=1: plain)
         ladders, every = source_ladders(source.settings or {}, n_chains, "init=study")
         if ladders is not None:
             temps = tuple(float(t) for t in np.atleast_2d(ladders)[0])
@@ -147,7 +147,8 @@ def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_
             "tune=False with a tempered continuation (temperatures=, or init=study a tempered "
             "study): the record holds the T = 1 copy's widths alone, so every copy is tuned at "
             "its temperature (from those widths) while the copies warm up from the chain's "
-            "last state, before any draw is kept; leave tune out, or tune=True"
+            "last state, before any draw is kept; leave tune out, or tune=True, or pass "
+            "temperatures=1 to continue without tempering"
         )
     if temps is None:
         return {}

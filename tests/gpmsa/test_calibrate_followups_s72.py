@@ -126,4 +126,4 @@ def test_memory_counts_a_likelihood_state_per_temperature(monkeypatch):
             emu, xo, yo, n_samples=100, n_burn=10, n_chains=2, fast=False, temperatures=4
         )
     with pytest.raises(gpmsa.GPMSAError, match="temperatures"):  # checked before any work
-        gpmsa.calibrate(emu, xo, yo, n_samples=100, n_burn=10, fast=False, temperatures=1)
+        gpmsa.calibrate(emu, xo, yo, n_samples=100, n_burn=10, fast=False, temperatures=0)

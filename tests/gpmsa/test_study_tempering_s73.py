@@ -155,7 +155,7 @@ def sampler_problem(study, i):
 
 @pytest.mark.parametrize(
     ("kw", "words"),
-    [({"temperatures": 1}, "temperatures"), ({"temperatures": [2.0, 4.0]}, "exactly 1"),
+    [({"temperatures": 0}, "temperatures"), ({"temperatures": [2.0, 4.0]}, "exactly 1"),
      ({"swap_every": 3}, "swap_every=3 needs temperatures"),
      ({"temperatures": 2, "swap_every": 50}, "swap_every=50 exceeds n_samples=20")],
 )  # fmt: skip

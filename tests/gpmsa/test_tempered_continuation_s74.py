@@ -185,3 +185,21 @@ def test_adapted_study_continues_per_chain():
     other = _study(n_samples=10, n_chains=2, seed=2, init=src, temperatures=[1, 3], **SMALL)
     assert other.settings["temperatures"] == [1.0, 3.0]
     assert "adapted_temperatures" not in other.settings
+
+
+def test_temperatures_one_continues_plain():
+    """temperatures=1 (one temperature) is the way out of a tempered source's ladder: a study
+    has no other (None is its default), and it appends untuned at the recorded widths as a
+    plain study's continuation does (refused before: tune=False with a tempered continuation)."""
+    from test_study_tempering_s73 import _study
+
+    src = _study(n_samples=20, n_burn=0, n_chains=2, seed=1, temperatures=3, **SMALL)
+    more = _study(n_samples=10, n_chains=2, seed=2, init=src, temperatures=1, tune=False,
+                  append=True)  # fmt: skip
+    assert "temperatures" not in more.settings and more.settings["tune"] is False
+    assert more.draws["theta"].shape[1] == 30
+    fit_src = _fit(n_iter=20, n_chains=2, seed=3, temperatures=3, **SMALL)
+    plain = _fit(n_iter=10, n_chains=2, init=fit_src, seed=4, temperatures=1)
+    assert "temperatures" not in plain.settings and plain.settings["tune"] is False
+    with pytest.raises(GPMSAError, match=r"temperatures must be an integer in \[1, 32\], got 0"):
+        _fit(n_iter=10, n_chains=2, seed=4, temperatures=0)

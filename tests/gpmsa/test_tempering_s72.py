@@ -94,7 +94,7 @@ def test_swap_is_exact_between_two_states():
 
 @pytest.mark.parametrize(
     ("value", "words"),
-    [(1, "temperatures"), (True, "temperatures"), ([2.0, 4.0], "start at exactly 1"),
+    [(0, "temperatures"), (True, "temperatures"), ([2.0, 4.0], "start at exactly 1"),
      ([1.0, 1.0], "increase strictly"), ([1.0, np.inf], "finite"), ("hot", "temperatures"),
      ([[1.0, 2.0]], "flat sequence"), (list(range(1, 40)), "2 to 32")],
 )  # fmt: skip
