@@ -188,8 +188,8 @@ def fit(
     default, and then the draws are the plain sampler's, bit for bit): for a posterior with
     several modes that the one-element steps do not cross (a ConvergenceWarning whose chains lie
     apart, log posteriors tens apart). ``temperatures``: an integer n (the ladder T = 2**k, k =
-    0 .. n - 1; 1: no tempering) or a ladder (1, T_1, ...), strictly increasing from 1; each chain then runs a
-    copy per temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at
+    0 .. n - 1; 1: no tempering) or a ladder (1, T_1, ...), strictly increasing from 1; each
+    chain then runs a copy per temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at
     its temperature; neighbouring copies propose to swap states every ``swap_every`` (1) sweeps,
     and only the T = 1 copy's draws are kept. It costs about one sweep per copy (n times the
     time, memory for n likelihood states). ``settings`` record "temperatures", "swap_every" and
