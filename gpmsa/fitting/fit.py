@@ -184,33 +184,32 @@ def fit(
     there). theta_init: the chains' start of theta (native, (q,) or a dict by t_names; default
     the centre; a categorical element: one of its levels).
 
-    Parallel tempering (numpy and torch options ``temperatures`` and ``swap_every``; off by
-    default, and then the draws are the plain sampler's, bit for bit): for a posterior with
-    several modes that the one-element steps do not cross (a ConvergenceWarning whose chains lie
-    apart, log posteriors tens apart). ``temperatures``: an integer n (the ladder T = 2**k, k =
-    0 .. n - 1; 1: no tempering) or a ladder (1, T_1, ...), strictly increasing from 1; each
-    chain then runs a copy per temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at
-    its temperature; neighbouring copies propose to swap states every ``swap_every`` (1) sweeps,
-    and only the T = 1 copy's draws are kept. It costs about one sweep per copy (n times the
-    time, memory for n likelihood states). ``settings`` record "temperatures", "swap_every" and
+    Parallel tempering (numpy and torch options ``temperatures`` and ``swap_every``; off by default,
+    and then the draws are the plain sampler's, bit for bit): for a posterior with several modes
+    that the one-element steps do not cross (a ConvergenceWarning whose chains lie apart, log
+    posteriors tens apart). ``temperatures``: an integer n (the ladder T = 2**k, k = 0 .. n - 1; 1:
+    no tempering) or a ladder (1, T_1, ...), strictly increasing from 1; each chain then runs a copy
+    per temperature, its likelihood raised to 1/T (priors untempered), each copy tuned at its
+    temperature; neighbouring copies propose to swap states every ``swap_every`` (1) sweeps, and
+    only the T = 1 copy's draws are kept. It costs about one sweep per copy (n times the time,
+    memory for n likelihood states). ``settings`` record "temperatures", "swap_every" and
     "swap_rate" (per chain, per neighbour pair): rates near 0 say the ladder is too sparse, the
     hottest copy should cross between the modes (a barrier of 50 in log posterior needs T_max of
-    tens). torch: the batch holds every chain's copies (n_chains x n rows); with
-    ``chain_groups`` > 1 each group holds whole chains with all their copies (tuning in one
-    batch). Refused on the pyro backend (docs/internals.md, "Parallel tempering"). A
-    continuation (``init`` an emulator) of a tempered fit runs on tempered, at its ladder (each
-    chain's where they adapted theirs) and ``swap_every`` unless ``temperatures=`` is given
-    (``temperatures=None`` given, or 1: untempered); a plain fit's with ``temperatures=`` at that
-    ladder. Every copy of a chain starts at the chain's last kept state, from its recorded
-    widths, and is tuned at its temperature (the copies warming up, swapping) before any draw is
-    kept; ``tune=False`` is refused there, and ``append=True`` pools as a plain append (the
-    warm-up between the parts). numpy and torch option ``adapt_ladder=True``
-    (off by default; with ``temperatures``, at least 3, and ``tune``): each chain adapts its
-    ladder's temperatures between 1 and the hottest during tuning towards equal swap rates, then
-    freezes it before the widths' tuning and the draws (an exact MCMC; about ``tune_rounds`` x
-    ``tune_levels`` more sweeps per copy; torch: after the first stage's warm-up, each chain from
-    its own swaps); ``settings["adapted_temperatures"]`` (per chain) records it, "temperatures"
-    the ladder it started from.
+    tens). torch: the batch holds every chain's copies (n_chains x n rows); with ``chain_groups`` >
+    1 each group holds whole chains with all their copies (tuning in one batch). Refused on the pyro
+    backend (docs/internals.md, "Parallel tempering"). A continuation (``init`` an emulator) of a
+    tempered fit runs on tempered, at its ladder (each chain's where they adapted theirs) and
+    ``swap_every`` unless ``temperatures=`` is given (``temperatures=None`` given, or 1:
+    untempered); a plain fit's with ``temperatures=`` at that ladder. Every copy of a chain starts
+    at the chain's last kept state, from its recorded widths, and is tuned at its temperature (the
+    copies warming up, swapping) before any draw is kept; ``tune=False`` is refused there, and
+    ``append=True`` pools as a plain append (the warm-up between the parts). numpy and torch option
+    ``adapt_ladder=True`` (off by default; with ``temperatures``, at least 3, and ``tune``): each
+    chain adapts its ladder's temperatures between 1 and the hottest during tuning towards equal
+    swap rates, then freezes it before the widths' tuning and the draws (an exact MCMC; about
+    ``tune_rounds`` x ``tune_levels`` more sweeps per copy; torch: after the first stage's warm-up,
+    each chain from its own swaps); ``settings["adapted_temperatures"]`` (per chain) records it,
+    "temperatures" the ladder it started from.
 
     A categorical theta of a joint fit moves levels jointly with the continuous theta
     (``gpmsa.mcmc.level_moves``): ``settings["level_offsets"]`` records, per categorical name,
