@@ -372,7 +372,9 @@ def fit(
     if n_chains > 1:
         record = sampled_convergence(problem, summary, n_chains, per)
         how = more_advice(append, settings)
-        warn_unconverged(record, f"gpmsa.fit (backend {backend!r})", more=f", or {how}")
+        warn_unconverged(record, f"gpmsa.fit (backend {backend!r})", more=f", or {how}",
+                         names=element_names(data.x_names, data.t_names,
+                                             problem.init["betaU"].shape[1]))  # fmt: skip
     return Emulator._from_prepared(
         data, prep, params,
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,
@@ -395,6 +397,16 @@ def tempering_record(info: dict, source: Emulator | None) -> dict:
         out["adapted_temperatures"] = np.asarray(info["temperatures"]).tolist()
     if "adapted_temperatures" in info:  # per chain, frozen
         out["adapted_temperatures"] = np.asarray(info["adapted_temperatures"]).tolist()
+    return out
+
+
+def element_names(x_names, t_names, n_pc: int) -> dict[str, str]:
+    """The inputs a fit's elements stand for, as a ConvergenceWarning shows them: "theta[i]"
+    the i-th calibration parameter, "betaU[i,j]" the i-th input of x then theta (of each of the
+    ``n_pc`` components j)."""
+    inputs = [str(n) for n in (*x_names, *t_names)]
+    out = {f"theta[{i}]": str(n) for i, n in enumerate(t_names)}
+    out.update({f"betaU[{i},{j}]": n for i, n in enumerate(inputs) for j in range(n_pc)})
     return out
 
 

@@ -190,27 +190,32 @@ def convergence(
     }
 
 
-def warn_unconverged(
-    record: dict, what: str, stacklevel: int = 3, length: str = "n_iter", more: str = ""
-) -> None:
+def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str = "n_iter",
+                     more: str = "", names: dict[str, str] | None = None) -> None:  # fmt: skip
     """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record
     and the caller's argument ``length`` that sets the chains' length (``more``: a further
     remedy, appended). Where the worst R-hat exceeds RHAT_APART (or is infinite) the warning
-    adds that the chains lie apart, which longer chains may not mend (several modes)."""
+    adds that the chains lie apart, which longer chains may not mend (several modes).
+    ``names``: element -> what it is for a person ("theta[0]" -> "k"), shown beside it."""
     from gpmsa.errors import ConvergenceWarning
 
     flagged = record.get("flagged") or {}
     if not flagged:
         return
-    items = "; ".join(f"{el}: {why}" for el, why in flagged.items())
+    names = names or {}
+
+    def shown_as(el: str) -> str:
+        return f"{el} ({names[el]})" if el in names else el
+
+    items = "; ".join(f"{shown_as(el)}: {why}" for el, why in flagged.items())
     apart = ""
     el, r = record.get("max_rhat") or ("", None)
     if el and (r is None or r > RHAT_APART):  # None with an element: an infinite R-hat
         shown = "inf" if r is None else beyond(r, RHAT_APART, 3)
         apart = (
-            f" R-hat {shown} ({el}) says the chains lie apart, not merely that they are short: "
-            "if longer chains do not bring them together, the posterior may have several "
-            "modes that no chain crosses (compare the chains: to_arviz(), "
+            f" R-hat {shown} ({shown_as(el)}) says the chains lie apart, not merely that they "
+            "are short: if longer chains do not bring them together, the posterior may have "
+            "several modes that no chain crosses (compare the chains: to_arviz(), "
             "gpmsa.plots.traces; parallel tempering moves between modes: the numpy and "
             "torch samplers' temperatures= option of gpmsa.fit, calibrate(fast=False), "
             "calibrate_study and fit_study)."

@@ -10,6 +10,7 @@ import pytest
 
 import gpmsa
 from gpmsa import backends
+from gpmsa.fitting.fit import element_names
 from gpmsa.mcmc import parallel, starts
 from gpmsa.mcmc.sampler import require_finite
 
@@ -91,7 +92,8 @@ def test_short_chains_warn_naming_parameters_and_the_record_is_kept(multi, tmp_p
     assert len(conv["rhat"]["betaU"]) == 4  # (p + q) x p_u = 2 x 2 elements
     message = str(rec[0].message)
     for element, why in conv["flagged"].items():  # every flagged element is named with its figure
-        assert f"{element}: {why}" in message
+        named = element_names(sim.x_names, sim.t_names, 2).get(element)  # betaU's input
+        assert f"{element}{'' if named is None else f' ({named})'}: {why}" in message
         r = conv["rhat"][element.split("[")[0]]
         assert max(r) > 1.01 or min(conv["ess"][element.split("[")[0]]) < 100
     # the record goes into the file and comes back; gpmsa info shows it
