@@ -17,6 +17,7 @@ import warnings
 import numpy as np
 import pytest
 from _calib_cases import one_t_emulator
+from tqdm.auto import tqdm
 
 import gpmsa
 
@@ -83,21 +84,13 @@ class _Stuck:
         self.loglik[a], self.loglik[b] = self.loglik[b], self.loglik[a]
 
 
-class _Bar:
-    def set_description(self, text):
-        pass
-
-    def update(self, n):
-        pass
-
-
 def test_float32_rows_keep_distinct_temperatures():
     torch = pytest.importorskip("torch")
     tb = gpmsa.backends.get("torch")
     start = (1.0, 2.0, 4.0)
     state = _Stuck(2 * 3, torch.float32)
     gen = torch.Generator().manual_seed(0)
-    ad = tb._adapt_ladders(state, np.array([0.1]), start, gen, _Bar(), 50, 20)
+    ad = tb._adapt_ladders(state, np.array([0.1]), start, gen, tqdm(disable=True), 50, 20)
     betas = state.beta.view(-1, 3)
     assert torch.all(betas[:, :-1] > betas[:, 1:]), (ad, betas)  # no rung merged in float32
     assert torch.equal(betas, torch.as_tensor(1.0 / ad, dtype=torch.float32))  # as recorded

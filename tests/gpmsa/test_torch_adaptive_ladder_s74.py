@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 import pytest
 from _tempering_cases import two_mode_case as _sym_case
+from tqdm.auto import tqdm
 
 import gpmsa
 from gpmsa import backends
@@ -62,14 +63,6 @@ class _GaussRows:
         self.x[a], self.x[b] = self.x[b], self.x[a]
 
 
-class _Bar:
-    def set_description(self, text):
-        pass
-
-    def update(self, n):
-        pass
-
-
 def _rates(state, temps, n_rounds=400):
     """Each pair's swap rate (K - 1,) over the chains at the ladders ``temps`` (K,) or (C, K)."""
     n_temps = np.shape(temps)[-1]
@@ -89,7 +82,7 @@ def test_bad_ladder_adapted_per_chain_towards_equal_swap_rates():
     start, n_chains = (1.0, 1.5, 2.0, 64.0), 6
     state = _GaussRows(4 * n_chains)
     gen = torch.Generator().manual_seed(0)
-    ad = tb._adapt_ladders(state, np.array([0.1]), start, gen, _Bar(), 50, 20)
+    ad = tb._adapt_ladders(state, np.array([0.1]), start, gen, tqdm(disable=True), 50, 20)
     _is_ladder(ad, n_chains, start)
     assert torch.equal(state.beta, torch.as_tensor(1.0 / ad).flatten())  # the rows' ladders
     assert len({tuple(row) for row in ad}) == n_chains  # each chain its own
