@@ -390,14 +390,12 @@ def tempering_record(info: dict, source: Emulator | None) -> dict:
     chains adapted their ladders (``adapt_ladder``) or continued ``source``'s adapted ones
     (each chain at its own: "temperatures" then the source's), "adapted_temperatures" (per
     chain, frozen for the draws)."""
-    out = {"temperatures": list(info["temperatures"]), "swap_every": int(info["swap_every"]),
+    out = {"temperatures": np.asarray(info["temperatures"]).tolist(),
+           "swap_every": int(info["swap_every"]),
            "swap_rate": np.asarray(info["swap_rate"]).tolist()}  # fmt: skip
-    if np.ndim(info["temperatures"]) == 2:  # a continuation at the source's adapted ladders
-        out["temperatures"] = list(source.settings["temperatures"])
-        out["adapted_temperatures"] = np.asarray(info["temperatures"]).tolist()
     if "adapted_temperatures" in info:  # per chain, frozen
         out["adapted_temperatures"] = np.asarray(info["adapted_temperatures"]).tolist()
-    return out
+    return tempering.recorded_ladders(out, source.settings if source is not None else {})
 
 
 def element_names(x_names, t_names, n_pc: int) -> dict[str, str]:

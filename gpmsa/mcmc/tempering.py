@@ -121,6 +121,19 @@ def chain_ladders(temperatures, n_chains: int) -> list[tuple[float, ...]] | None
     return None if one is None else [one] * n_chains
 
 
+def recorded_ladders(record: dict, source_settings: dict) -> dict:
+    """A tempered run's settings ``record`` as a fresh tempered run records its ladders: where
+    its chains ran at a ladder each ("temperatures" (n_chains, K): a continuation of chains
+    that adapted theirs), "temperatures" becomes the source's (``source_settings``', the ladder
+    they started from) and "adapted_temperatures" each chain's, unless the run adapted them
+    again (its own "adapted_temperatures" kept). Other records are returned as given."""
+    if np.ndim(record.get("temperatures")) != 2:
+        return record
+    per_chain = np.asarray(record["temperatures"]).tolist()
+    return {**record, "temperatures": list(source_settings["temperatures"]),
+            "adapted_temperatures": record.get("adapted_temperatures", per_chain)}  # fmt: skip
+
+
 def check_swap_every(swap_every, temperatures, n_iter: int | None = None,
                      what: str = "n_iter") -> int:  # fmt: skip
     """``swap_every`` as an int in [1, ``MAX_SWAP_EVERY``]; GPMSAError for another value, for

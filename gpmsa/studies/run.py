@@ -157,16 +157,6 @@ def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_
     return {"temperatures": temps, "swap_every": every, **({"adapt_ladder": True} if adapt else {})}
 
 
-def _source_ladder_record(settings: dict, source) -> None:
-    """A study's ``settings`` where its chains ran at the adapted ladders of ``source`` (each
-    chain's, "temperatures" (n_chains, K) in its sampler's record) as a tempered study records
-    them: "temperatures" the source's (the ladder they started from), "adapted_temperatures"
-    each chain's (unless adapted again here)."""
-    if np.ndim(settings.get("temperatures")) == 2:
-        settings.setdefault("adapted_temperatures", np.asarray(settings["temperatures"]).tolist())
-        settings["temperatures"] = list(source.settings["temperatures"])
-
-
 def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
     rate = chains.accept_rate.mean(axis=0)
     info = {k: v for k, v in chains.info.items() if k != "level_offsets"}  # `_level_offsets`
@@ -562,7 +552,7 @@ def calibrate_study(
     )  # fmt: skip
     chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
     settings = _settings(chains, n_burn, t0, n_samples=int(n_samples), **extra)
-    _source_ladder_record(settings, init)
+    settings = tempering.recorded_ladders(settings, init.settings if continuing else {})
     settings.update(record)
     moves = _level_offsets(chains, layout, emulators)
     if moves:  # a categorical parameter's joint level move (other studies as before)
@@ -787,7 +777,7 @@ def fit_study(
         thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
     keep = slice(thin - 1, None, thin) if append else slice(int(n_burn), None, thin)
     settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point, **extra)
-    _source_ladder_record(settings, init)
+    settings = tempering.recorded_ladders(settings, init.settings if continuing else {})
     settings.update(record)
     moves = _level_offsets(chains, layout, sims)
     if moves:  # a categorical parameter's joint level move (other studies as before)
