@@ -20,6 +20,7 @@ from gpmsa.errors import (
     OutsideEmulatorWarning,
     ReductionWarning,
     ResourceLimitError,
+    StartRejectedError,
 )
 from gpmsa.fitting.emulator import Emulator, LooResult, load
 from gpmsa.fitting.fit import fit
@@ -61,6 +62,7 @@ __all__ = [
     "Problem",
     "ReductionWarning",
     "ResourceLimitError",
+    "StartRejectedError",
     "SimData",
     "Study",
     "backends",

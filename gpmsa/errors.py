@@ -58,6 +58,20 @@ class ReductionWarning(UserWarning):
     simulation outputs' spread (a variance passed for a precision?)."""
 
 
+class StartRejectedError(GPMSAError):
+    """The theta constraint rejects the chains' start, or no random start inside it was found.
+
+    ``remedy`` maps the keyword arguments that give an allowed start to the value they need
+    (``...``: the user's own, e.g. ``{"theta_init": ...}`` or ``{"init": "gpmsa",
+    "theta_init": ...}``), so a caller that passes them under other names (the Calibrator's
+    ``mcmc_options``) can say so without reading the message.
+    """
+
+    def __init__(self, message: str, remedy: dict | None = None):
+        super().__init__(message)
+        self.remedy = dict(remedy or {})
+
+
 class ChainError(GPMSAError):
     """A chain failed (its task raised, its worker died, or its draws are not finite).
 

@@ -89,7 +89,7 @@ from gpmsa.calibration.observations import (
     warn_if_outside,
 )
 from gpmsa.calibration.posterior import LevelMarginal, Posterior, trapezoid_weights
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, StartRejectedError
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, run_seed
@@ -866,16 +866,16 @@ class Calibrator:
             return calibrate(
                 self.emulator, x_obs, y_obs, extrapolate=extrapolate, log_prior=prior, **opts
             )
-        except GPMSAError as exc:  # calibrate's advice names its argument, not the Calibrator's
-            if "pass init='gpmsa' with theta_init=" in str(exc):  # (no random start allowed)
-                if opts.get("init") == "gpmsa" and "theta_init" in opts:
-                    raise
-                advice = "them as mcmc_options={'init': 'gpmsa', 'theta_init': [...]}"
-            elif "pass theta_init=" in str(exc) and "theta_init" not in opts:
-                advice = "it as mcmc_options={'theta_init': [...]}"
-            else:
+        except StartRejectedError as exc:  # calibrate's advice names its arguments, not ours
+            given = all(k in opts and (v is ... or opts[k] == v) for k, v in exc.remedy.items())
+            if given or not exc.remedy:  # the user's own start was rejected: as it is
                 raise
-            raise GPMSAError(f"{exc} (a Calibrator takes {advice})") from exc
+            fields = ", ".join(f"{k!r}: {'[...]' if v is ... else repr(v)}"
+                               for k, v in exc.remedy.items())  # fmt: skip
+            which = "it" if len(exc.remedy) == 1 else "them"
+            raise StartRejectedError(
+                f"{exc} (a Calibrator takes {which} as mcmc_options={{{fields}}})", exc.remedy
+            ) from exc
 
     def _allowed(self, theta_unit: np.ndarray) -> np.ndarray:
         """(G,) bool: whether the constraint allows each unit-scale node (G, q)."""

@@ -39,7 +39,7 @@ import os
 import numpy as np
 from scipy.special import gammainc, gammaincc, gammainccinv, gammaincinv
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, StartRejectedError
 from gpmsa.model.data import as_float
 from gpmsa.model.priors import PRECISIONS, GammaPrior, Priors
 from gpmsa.model.problem import Problem
@@ -221,10 +221,13 @@ def check_start(problem: Problem, start: dict[str, np.ndarray], how: str) -> Non
 
 def draw_start(problem: Problem, how: str, rng: np.random.Generator) -> dict[str, np.ndarray]:
     """One chain's starting values (name -> array of the init's shape) under rule ``how``;
-    GPMSAError (``check_start``) for one where a prior has no density."""
+    GPMSAError (``check_start``) for one where a prior has no density, `StartRejectedError`
+    for one the theta constraint rejects."""
     if how == "gpmsa":
         start = default_start(problem)
         check_start(problem, start, how)
+        if problem.constraint is not None and "theta" in problem.sampled:
+            problem.constraint.check_start(start["theta"], "init='gpmsa': the chains' theta")
         return start
     pri = problem.priors
     out = default_start(problem)
@@ -291,7 +294,8 @@ def _theta_start(problem: Problem, how: str, size: int, rng: np.random.Generator
         val = hold(problem, "theta", val)
         if problem.constraint is None or problem.constraint(val):
             return val
-    raise GPMSAError(
+    raise StartRejectedError(
         f"no {how!r} start of theta inside the theta constraint in {MAX_REDRAWS} draws; pass "
-        "init='gpmsa' with theta_init= inside the allowed region"
+        "init='gpmsa' with theta_init= inside the allowed region",
+        {"init": "gpmsa", "theta_init": ...},
     )

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, StartRejectedError
 from gpmsa.model.data import as_float, by_column_names, check_finite
 
 
@@ -79,14 +79,16 @@ class ThetaConstraint:
                     "inside the allowed region, or drop the constraint"
                 )
             if what == "fixed theta (held elements)":  # the others' start may help, or not
-                raise GPMSAError(
+                raise StartRejectedError(
                     f"{what}: the theta constraint rejects the start {value} (the held "
                     "elements at their fixed values): hold them inside the allowed region, or "
-                    "pass theta_init= (native units) for the others inside it"
+                    "pass theta_init= (native units) for the others inside it",
+                    {"theta_init": ...},
                 )
-            raise GPMSAError(
+            raise StartRejectedError(
                 f"{what}: the theta constraint rejects the initial value {value}; pass "
-                "theta_init= (native units) inside the allowed region"
+                "theta_init= (native units) inside the allowed region",
+                {"theta_init": ...},
             )
 
 

@@ -51,7 +51,7 @@ PUBLIC = [
     "Posterior", "Priors", "Problem", "ResourceLimitError", "SimData", "backends", "calibrate",
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
     "limits", "load", "plots", "predictive", "prepare", "sensitivity",
-    "HyperPriors", "Study", "calibrate_study", "fit_study", "load_study",
+    "HyperPriors", "Study", "calibrate_study", "fit_study", "load_study", "StartRejectedError",
 ]  # fmt: skip
 
 

@@ -41,7 +41,7 @@ def test_no_random_start_names_the_calibrators_options(small, backend):
         cal.update(xo, yo)
     assert "no 'jitter' start of theta" in str(err.value)
     assert "mcmc_options={'init': 'gpmsa', 'theta_init': [...]}" in str(err.value)
-    assert type(err.value) is gpmsa.GPMSAError and err.value.__cause__ is not None
+    assert type(err.value) is gpmsa.StartRejectedError and err.value.__cause__ is not None
     cal = gpmsa.Calibrator(
         emu,
         method="mcmc",
