@@ -55,6 +55,28 @@ def path_argument(value, name: str, of: str = "") -> Path:
     return checks.home_path(value)
 
 
+def check_lookup(path: Path, name: str, error: type[ControlError] = ControlError) -> None:
+    """``error`` naming the argument ``name`` where the OS cannot look ``path`` up: a name too
+    long for the file system, a folder on the way that cannot be searched, a NUL byte or a
+    character the file system's encoding cannot write (a lone surrogate). A missing path (or one
+    below a file) passes, as does a link (not followed): the caller says what it needs there.
+    Python 3.11's ``Path.exists``/``is_dir`` raise such errors as a bare OSError or ValueError."""
+    try:
+        os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return
+    except UnicodeEncodeError as exc:
+        bad = exc.object[exc.start : exc.end]
+        raise error(
+            f"{name}={str(path)!r}: the path holds {bad!r}, which the file system's encoding "
+            f"({exc.encoding}) cannot write"
+        ) from None
+    except ValueError as exc:  # "embedded null byte"
+        raise error(f"{name}={str(path)!r} is not a usable path ({exc})") from None
+    except OSError as exc:  # e.g. ENAMETOOLONG, EACCES
+        raise error(f"{name}={str(path)!r}: cannot look it up ({exc.strerror or exc})") from None
+
+
 def check_not_masked(values, name: str) -> None:
     """ControlError naming ``name`` for a numpy masked array: converted, its mask would be read
     as data."""

@@ -23,6 +23,7 @@ import math
 import os
 import secrets
 import stat
+import sys
 import tokenize
 import zipfile
 import zlib
@@ -393,7 +394,8 @@ def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
 
 def _check_path(path: object, name: str = "path", what: str = "file") -> None:
     """Raise VehicleError unless ``path`` (the argument ``name``, a ``what`` path) is a str or
-    os.PathLike (an int would be taken for an open file descriptor) without a NUL byte."""
+    os.PathLike (an int would be taken for an open file descriptor) without a NUL byte that the
+    file system's encoding can write (a lone surrogate such as "\\ud800" it cannot)."""
     if not isinstance(path, (str, os.PathLike)):
         raise VehicleError(
             f"{name}={path!r} must be a {what} path, str or os.PathLike (got {type(path).__name__})"
@@ -404,6 +406,14 @@ def _check_path(path: object, name: str = "path", what: str = "file") -> None:
         raise VehicleError(f"{name}={path!r} must be a {what} path: {exc}") from exc
     if "\0" in text:
         raise VehicleError(f"{name}={text!r} must be a {what} path: it contains a NUL byte")
+    try:
+        os.fsencode(text)
+    except UnicodeEncodeError as exc:  # os.open would raise it, deep in the write or read
+        bad = exc.object[exc.start : exc.end]
+        raise VehicleError(
+            f"{name}={text!r} must be a {what} path: it holds {bad!r}, which the file system's "
+            f"encoding ({sys.getfilesystemencoding()}) cannot write"
+        ) from exc
     if what == "file" and text.endswith(("/", os.sep)):  # "out/" names a folder, not a file
         raise VehicleError(f"{name}={text!r} names a folder (it ends in a separator), not a file")
 

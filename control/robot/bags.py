@@ -44,7 +44,7 @@ from control.errors import BagError, ControlError
 from control.robot import messages as msgs
 from control.robot import storage as storage_mod
 from control.robot.extra import require
-from control.validation import float_array, path_argument
+from control.validation import check_lookup, float_array, path_argument
 from roadgen.checks import home_path
 
 STORAGES = ("mcap", "sqlite3")
@@ -201,6 +201,7 @@ def source_of(path: Path) -> Path:
 
 def _resolve(path: Path) -> tuple[Path, str]:
     """(what to open, its kind) for a path the user gave."""
+    check_lookup(path, "path", BagError)
     if not path.exists():
         raise BagError(f"no recording at {path}")
     if not (path.is_dir() or path.is_file()):  # a FIFO would block the reader for ever
@@ -956,6 +957,7 @@ def open_bag_writer(
     or `check_bag_path` refuses it."""
     _check_storage(storage)
     path = path_argument(path, "path", " of the new bag folder")
+    check_lookup(path, "path")
     rosbag2 = require("rosbags.rosbag2", "writing a ROS 2 bag")
     if os.path.lexists(path):  # a link to nowhere too: the bag could not be moved onto it
         raise ControlError(f"{path} exists already; a bag is written to a new folder")

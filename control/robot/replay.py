@@ -72,6 +72,7 @@ from control.shipped import shipped_emulator
 from control.simplex import Simplex
 from control.validation import (
     check_instance,
+    check_lookup,
     path_argument,
     replace_fields,
     require_instance,
@@ -394,6 +395,7 @@ def load_emulator(
             f"'B' (the shipped ones), got {emulator!r} ({type(emulator).__name__})"
         )
     path = Path(emulator)
+    check_lookup(path, name)
     if not path.exists():
         raise ControlError(f"{name} {str(path)!r}: no such file (or give A or B: the shipped ones)")
     if not path.is_file():
@@ -584,7 +586,9 @@ def check_csv_target(path: Path, name: str) -> None:
     """`ControlError` naming the argument ``name`` unless ``path`` is free for a CSV of
     estimates: missing, an empty file or a CSV of estimates (its first line `CSV_HEADER`, as
     `ReplayResult.to_csv` writes it), which is replaced. A folder, a link to nowhere, a FIFO
-    or device, and any other file (an emulator, a recording, someone's data) are refused."""
+    or device, and any other file (an emulator, a recording, someone's data) are refused, as is
+    a path the OS cannot look up (`check_lookup`: a name too long, say)."""
+    check_lookup(path, name)
     if path.is_dir():
         raise ControlError(f"{name}={str(path)!r} is a folder; give the CSV file's path")
     if not os.path.lexists(path):

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from control.errors import BagError, ControlError
 from control.robot.extra import require
+from control.validation import check_lookup
 
 _RECORD = struct.Struct("<BQ")  # opcode, length
 _MESSAGE = struct.Struct("<HIQ")  # channel id, sequence, log time (publish time follows)
@@ -259,7 +260,8 @@ def check_mcap_target(path: Path, name: str) -> None:
     not name `LIBRARY` as its writer: a robot's recording, a bag's file, Foxglove's; one of
     at least `MIN_MCAP_BYTES` whose header cannot be read too). An earlier recording of
     `control.record_run`, an empty file, a stub shorter than any MCAP file or a new path may
-    be written."""
+    be written; a path the OS cannot look up (`check_lookup`: a name too long, say) may not."""
+    check_lookup(path, name)
     if not path.exists():
         return
     if path.is_dir():

@@ -91,7 +91,7 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
         mode = os.stat(path).st_mode
     except FileNotFoundError:
         mode = None
-    except OSError as exc:
+    except (OSError, ValueError) as exc:  # ValueError: a name the file system cannot encode
         raise error(_cannot_write(path, exc)) from exc
     if mode is not None and not stat.S_ISREG(mode):
         raise error(f"{path} exists and is not a regular file: refusing to replace it")
@@ -112,10 +112,17 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
     return tmp, fd
 
 
-def _cannot_write(path: Path, exc: OSError) -> str:
+def _cannot_write(path: Path, exc: OSError | ValueError) -> str:
     """Why ``path`` cannot be written, from the OS error ``exc``; a name or path too long says
-    how long it is and what the file system allows."""
-    why = exc.strerror or str(exc)
+    how long it is and what the file system allows, a name the file system's encoding cannot
+    write (a lone surrogate such as "\\ud800": UnicodeEncodeError) which character."""
+    if isinstance(exc, UnicodeEncodeError):
+        bad = exc.object[exc.start : exc.end]
+        return (
+            f"{path}: cannot write (the path holds {bad!r}, which the file system's encoding, "
+            f"{exc.encoding}, cannot write)"
+        )
+    why = getattr(exc, "strerror", None) or str(exc)
     if exc.errno == errno.ENAMETOOLONG:
         name = len(os.fsencode(path.name))
         try:
