@@ -83,6 +83,7 @@ from control.tracker import GDTracker, TrackerSettings
 from control.validation import (
     check_instance,
     check_not_masked,
+    is_choice,
     is_integer,
     is_real,
     replace_fields,
@@ -206,7 +207,7 @@ class BCRSettings:
                 "release_p",
             ),
         )
-        if self.method not in METHODS:
+        if not is_choice(self.method, METHODS):
             raise ControlError(f"method must be one of {METHODS}, got {self.method!r}")
         block = self.feature.name == "log_band_power"
         if (self.method == "changepoint") != block:
@@ -241,7 +242,7 @@ class BCRSettings:
                 raise ControlError(f"{name} must be finite and > 0, got {value}")
         if not 0 < self.interval_level < 1:
             raise ControlError(f"interval_level must lie in (0, 1), got {self.interval_level}")
-        if self.interval_kind not in INTERVAL_KINDS:
+        if not is_choice(self.interval_kind, INTERVAL_KINDS):
             raise ControlError(
                 f"interval_kind must be one of {INTERVAL_KINDS}, got {self.interval_kind!r}"
             )

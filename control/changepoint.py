@@ -34,6 +34,7 @@ from control.validation import (
     check_n_draws,
     check_posterior_name,
     float_array,
+    is_choice,
     is_real,
     require_integers,
     require_reals,
@@ -80,7 +81,7 @@ class ChangePointSettings:
             raise ControlError(f"min_jump must be finite and >= 0, got {self.min_jump}")
         if self.jump_sd is not None and not (np.isfinite(self.jump_sd) and self.jump_sd > 0):
             raise ControlError(f"jump_sd must be None or finite and > 0, got {self.jump_sd}")
-        if not callable(self.prior) and self.prior not in PRIORS:
+        if not (callable(self.prior) or is_choice(self.prior, PRIORS)):
             raise ControlError(f"prior must be one of {PRIORS} or a function, got {self.prior!r}")
         if self.max_runs < 2:  # an integer: require_integers above
             raise ControlError(f"max_runs must be an integer >= 2, got {self.max_runs}")

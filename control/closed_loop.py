@@ -85,9 +85,12 @@ class LoopMetrics:
         """RMSE of the estimates on the parts with prescribed GD `gd` (NaN where those parts
         hold no estimate, e.g. shorter than the first block); the GD matches to a relative
         1e-6, so a GD that went through float32 (300.1 as 300.1000061) finds its parts.
-        ControlError for a `gd` that no part of the track has, or that is not a number."""
+        ControlError for a `gd` that no part of the track has, or that is not a finite number
+        (inf lay within the relative tolerance of every part: the first part's RMSE)."""
         if not is_real(gd):
             raise ControlError(f"gd must be a real number, got {gd!r} ({type(gd).__name__})")
+        if not np.isfinite(gd):
+            raise ControlError(f"gd must be finite, got {gd!r}")
         gd = float(gd)
         track = np.array([e.gd for e in self.gd_errors], dtype=float)
         if track.size:

@@ -8,7 +8,7 @@ from math import isnan
 import numpy as np
 
 from control.errors import ControlError
-from control.validation import is_real
+from control.validation import is_choice, is_real
 from gpmsa import Posterior
 
 #: Status values. Only "ok" carries numbers; every other status says why there is no estimate.
@@ -142,7 +142,7 @@ class Estimate:
     domain_edge: str = ""
 
     def __post_init__(self) -> None:
-        if self.status not in STATUSES:
+        if not is_choice(self.status, STATUSES):
             raise ControlError(f"status must be one of {STATUSES}, got {self.status!r}")
         for name in NUMBERS:  # NaN where there is none; never a string, a bool or an array
             value = getattr(self, name)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from control.errors import ControlError
-from control.validation import check_instance, float_array, require_reals
+from control.validation import check_instance, float_array, is_choice, require_reals
 
 FAULT_KINDS = (
     "nan",  # the accelerometer reads NaN
@@ -50,7 +50,7 @@ class SensorFault:
             raise ControlError(f"start_s must be >= 0, got {self.start_s}")
         if not (np.isfinite(self.duration_s) and self.duration_s > 0):
             raise ControlError(f"duration_s must be > 0, got {self.duration_s}")
-        if self.kind not in FAULT_KINDS:
+        if not is_choice(self.kind, FAULT_KINDS):
             raise ControlError(f"kind must be one of {FAULT_KINDS}, got {self.kind!r}")
         if not (np.isfinite(self.magnitude) and self.magnitude > 0):
             raise ControlError(f"magnitude must be finite and > 0, got {self.magnitude}")

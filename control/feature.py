@@ -25,7 +25,13 @@ from functools import lru_cache
 import numpy as np
 
 from control.errors import ControlError
-from control.validation import check_instance, float_array, require_integers, require_reals
+from control.validation import (
+    check_instance,
+    float_array,
+    is_choice,
+    require_integers,
+    require_reals,
+)
 
 FEATURES = ("log_band_power", "log_var", "var")
 SCALAR_FEATURES = ("log_var", "var")
@@ -75,7 +81,7 @@ class FeatureSpec:
     quantiles: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
-        if self.name not in FEATURES:
+        if not is_choice(self.name, FEATURES):
             raise ControlError(f"feature name must be one of {FEATURES}, got {self.name!r}")
         require_integers(self, ("block_samples", "n_tapers"))
         require_reals(self, ("rate_hz", "taper_nw"))
@@ -348,7 +354,7 @@ def feature_of_variance(f: np.ndarray | float, feature: str = "log_var") -> np.n
     The one map from f to y, shared by the BCR (``window_feature``) and emulator training, so
     that both see the same quantity. "log_var" of f <= 0 is NaN.
     """
-    if feature not in SCALAR_FEATURES:
+    if not is_choice(feature, SCALAR_FEATURES):
         raise ControlError(f"feature must be one of {SCALAR_FEATURES}, got {feature!r}")
     f = float_array(f, "f")  # (None or a string is no variance: not NaN)
     if feature == "var":

@@ -226,10 +226,16 @@ def fast_on_rough_m(
     Args:
         position, speed: (n,) the vehicle's samples (front axle), m (finite, non-decreasing)
             and m/s.
+        gd_max, v_safe: the Simplex's (> 0, as `Simplex` requires). tol: >= 0, m/s.
     """
-    for name, value in (("gd_max", gd_max), ("v_safe", v_safe), ("tol", tol)):
-        if not (is_real(value) and np.isfinite(value)):
-            raise ControlError(f"{name} must be a finite real number, got {value!r}")
+    for name, value, zero_ok in (
+        ("gd_max", gd_max, False),
+        ("v_safe", v_safe, False),
+        ("tol", tol, True),
+    ):
+        if not (is_real(value) and np.isfinite(value) and (value > 0 or (zero_ok and value == 0))):
+            bound = ">= 0" if zero_ok else "> 0"
+            raise ControlError(f"{name} must be a finite real number {bound}, got {value!r}")
     starts, seg_gd = _track_parts(track)
     position, speed = _traces(position, speed, "speed")
     if not (np.all(np.isfinite(position)) and np.all(np.diff(position) >= 0)):

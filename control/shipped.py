@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 
 from control.errors import ControlError, EmulatorMismatchError
+from control.validation import is_choice
 from roadgen.checks import home_path
 
 EMULATOR_DIR = Path(__file__).parent / "emulators"
@@ -18,9 +19,9 @@ KINDS = ("band", "window")
 
 def emulator_file_name(case: str, kind: str = "band") -> str:
     """File name of the emulator of a case and feature kind."""
-    if case not in CASES:
+    if not is_choice(case, CASES):
         raise ControlError(f"case must be one of {CASES}, got {case!r}")
-    if kind not in KINDS:
+    if not is_choice(kind, KINDS):
         raise ControlError(f"kind must be one of {KINDS}, got {kind!r}")
     return f"jackal_{case}.gpmsa" if kind == "band" else f"jackal_{case}_window.gpmsa"
 

@@ -57,7 +57,7 @@ import numpy as np
 
 from control.errors import ControlError
 from control.estimate import FAULT_STATUSES, Estimate
-from control.validation import check_instance, is_real, require_reals
+from control.validation import check_instance, is_choice, is_real, require_reals
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
@@ -133,7 +133,7 @@ class Simplex:
             raise ControlError(f"kp must be finite and > 0, got {self.kp}")
         if self.risk is not None and not 0 < self.risk < 1:
             raise ControlError(f"risk must be None or lie in (0, 1), got {self.risk}")
-        if self.law not in LAWS:
+        if not is_choice(self.law, LAWS):
             raise ControlError(f"law must be one of {LAWS}, got {self.law!r}")
         if self.law == "switch" and self.kp is not None:
             raise ControlError("kp has no effect with law='switch' (v_max or v_safe): leave it")
@@ -144,7 +144,7 @@ class Simplex:
             )
         if not 0 < self.latch_p <= 1:
             raise ControlError(f"latch_p must lie in (0, 1], got {self.latch_p}")
-        if self.after_fault not in AFTER_FAULT:
+        if not is_choice(self.after_fault, AFTER_FAULT):
             raise ControlError(
                 f"after_fault must be one of {AFTER_FAULT}, got {self.after_fault!r}"
             )

@@ -31,6 +31,7 @@ from control.validation import (
     check_n_draws,
     check_posterior_name,
     float_array,
+    is_choice,
     is_real,
     require_integers,
     require_reals,
@@ -72,7 +73,7 @@ class TrackerSettings:
             raise ControlError(
                 f"drift_per_sqrt_m must be finite and >= 0, got {self.drift_per_sqrt_m}"
             )
-        if self.prior not in PRIORS:
+        if not is_choice(self.prior, PRIORS):
             raise ControlError(f"prior must be one of {PRIORS}, got {self.prior!r}")
         if not 16 <= self.n_grid <= MAX_GRID:
             raise ControlError(f"n_grid must lie in [16, {MAX_GRID}], got {self.n_grid}")

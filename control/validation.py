@@ -35,6 +35,12 @@ def is_integer(value) -> bool:
     return isinstance(value, Integral) and not isinstance(value, (bool, np.bool_))
 
 
+def is_choice(value, allowed: tuple) -> bool:
+    """Whether ``value`` is one of the strings ``allowed`` (an array or another non-string is
+    not: ``array in allowed`` would raise numpy's "truth value ... is ambiguous")."""
+    return isinstance(value, str) and value in allowed
+
+
 def within(value: float, lo: float, hi: float) -> bool:
     """Whether ``value`` lies in [lo, hi], its ends widened by 1e-9 of the width (rounding of a
     speed at the emulator's domain edge is inside)."""

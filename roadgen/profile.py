@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,9 @@ class ProfileSettings:
     waviness: w in Gd(n) = Gd(n0) (n/n0)^-w, in (0, MAX_WAVINESS = 5] (ISO 8608: 2).
     seed: the integer seed, or None when a Generator or fresh entropy was used.
     lead_in_m: length of the raised-cosine taper from z = 0 at the start, m (0: none).
+
+    RoadgenError, naming the field, for a value outside these (a road bounds the band by its
+    Nyquist frequency and the lead-in by its length when it is made with the settings).
     """
 
     band: tuple[float, float]
@@ -31,6 +35,17 @@ class ProfileSettings:
     waviness: float
     seed: int | None
     lead_in_m: float
+
+    def __post_init__(self) -> None:
+        lo, hi = checks.pair("band", self.band, "(n_min, n_max) in cycles/m")
+        if not (math.isfinite(hi) and 0.0 < lo < hi):
+            raise RoadgenError(
+                f"band={self.band!r} is out of range: need 0 < n_min < n_max, finite, cycles/m"
+            )
+        checks.choice("amplitudes", self.amplitudes, AMPLITUDE_MODES)
+        check_waviness("waviness", self.waviness)
+        checks.seed("seed", self.seed, generator=False)
+        checks.non_negative("lead_in_m", self.lead_in_m, unit="m")
 
 
 @dataclass(frozen=True, eq=False)
@@ -170,12 +185,8 @@ def check_settings(settings: object, dx_m: float, length_m: float) -> None:
         raise RoadgenError(
             f"settings={type(settings).__name__} is not allowed: need a roadgen ProfileSettings"
         )
-    checks.band("settings.band", settings.band, 0.5 / dx_m)
-    checks.choice("settings.amplitudes", settings.amplitudes, AMPLITUDE_MODES)
-    check_waviness("settings.waviness", settings.waviness)
-    checks.seed("settings.seed", settings.seed, generator=False)
-    lead = checks.non_negative("settings.lead_in_m", settings.lead_in_m)
-    if lead > length_m:
+    checks.band("settings.band", settings.band, 0.5 / dx_m)  # its fields: __post_init__
+    if float(settings.lead_in_m) > length_m:
         raise RoadgenError(
             f"settings.lead_in_m={settings.lead_in_m!r} is out of range: allowed [0, "
             f"{length_m:.6g}] m (the road's length)"

@@ -468,7 +468,8 @@ def run_campaign(
         Campaign. A run that fails (diverges) is recorded with NaN f and its message.
 
     Raises VehicleError for bad input (checked before any run: each argument's type and range,
-    a road too short for the window, traces beyond ``vehicle.checks.MAX_MEMORY_BYTES``, a
+    a road too short for the window, traces or a drive's solver time grid (rate_hz x substeps
+    steps a second) beyond ``vehicle.checks.MAX_MEMORY_BYTES``, a
     ``keep_s`` that keeps no sample, a drive longer than ``simulate``'s limit
     ``vehicle.kinematics.MAX_DRIVE_S``, a ``cache_dir`` that cannot be a folder), and
     RoadgenError for road settings that no road can have (too long for
@@ -531,7 +532,7 @@ def run_campaign(
             f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
         )
 
-    _check_drives(points, lengths, model, dx_m)
+    _check_drives(points, lengths, model, dx_m, rate_hz * substeps)
     seeds = np.random.SeedSequence(seed).generate_state(points.shape[0]).astype(np.int64)
     specs = [
         RunSpec(model, float(v), float(gd), int(s), road_m, dx_m, lead_in_m, band, rate_hz,
@@ -593,11 +594,15 @@ def run_campaign(
     )
 
 
-def _check_drives(points: np.ndarray, lengths: list[float], model: Model, dx_m: float) -> None:
+def _check_drives(
+    points: np.ndarray, lengths: list[float], model: Model, dx_m: float, steps_per_s: float
+) -> None:
     """Raise, before any run, for what would make runs fail: a road (``lengths``, m, one per
     design point) beyond ``roadgen.checks.MAX_MEMORY_BYTES`` (RoadgenError), or a drive,
     from a wheelbase in to the road's end at the point's speed, longer than ``simulate``'s limit
-    ``kinematics.MAX_DRIVE_S`` (VehicleError naming the point)."""
+    ``kinematics.MAX_DRIVE_S`` or whose time grid of ``steps_per_s`` (rate_hz x substeps)
+    solver steps a second needs more than ``vehicle.checks.MAX_MEMORY_BYTES`` (VehicleError
+    naming the point)."""
     roadgen.profile.grid_points(max(lengths), dx_m)
     drives = np.round(np.asarray(lengths) / dx_m) * dx_m - model.wheelbase_m  # as grid_points
     seconds = drives / points[:, 0]
@@ -608,6 +613,12 @@ def _check_drives(points: np.ndarray, lengths: list[float], model: Model, dx_m: 
             f"{seconds[i]:.4g} s: simulate allows drives of <= {kinematics.MAX_DRIVE_S:g} s "
             "(vehicle.kinematics.MAX_DRIVE_S); use a shorter road_length_m or keep_s"
         )
+    steps = seconds[i] * steps_per_s + 1  # as simulate's own check (kinematics.schedule_grid)
+    checks.memory(
+        checks.BYTES_PER_STEP * steps,
+        f"design[{i}] (v={points[i, 0]:.4g} m/s): a drive of {steps:.4g} solver steps "
+        "(rate_hz x substeps a second)",
+    )
 
 
 def package_versions() -> dict[str, str]:

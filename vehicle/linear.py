@@ -205,8 +205,9 @@ def linear_response(
     Raises VehicleError for a speed outside (0, model.max_speed_mps], n_samples or oversample
     not an integer >= 1, a rate_hz not finite and > 0, a start_m not finite or off the road, a
     road no longer than the wheelbase, n_samples that take the front axle past the road's end,
-    an envelope not a bool, or a grid that would need more than
-    ``vehicle.checks.MAX_MEMORY_BYTES``.
+    an envelope not a bool, a grid that would need more than
+    ``vehicle.checks.MAX_MEMORY_BYTES``, or a model whose fields are so far out of range (a
+    mass of 1e-300 kg) that its response overflows.
     """
     check_model(model)
     speed = checks.real("speed", speed)
@@ -242,8 +243,15 @@ def linear_response(
     x0 = np.concatenate([q0, np.zeros_like(q0)])
     from scipy import signal  # (as in `state_space`)
 
-    _, y, _ = signal.lsim(state_space(lm), u, t, X0=x0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        _, y, _ = signal.lsim(state_space(lm), u, t, X0=x0)
     keep = slice(oversample, None, oversample)
+    if not np.all(np.isfinite(y[keep])):  # e.g. a mass of 1e-300 kg: finite gains, NaN response
+        raise VehicleError(
+            f"{model.name}: its linear response overflows (stiffest mode "
+            f"{highest_mode_rad_s(model):.3g} rad/s, time step {t[1]:.3g} s): the model's "
+            "fields are out of range (far too stiff, too damped or too light)"
+        )
     return LinearTrace(t=t[keep], accel_front=y[keep, 0], accel_rear=y[keep, 1], q=y[keep, 2:])
 
 

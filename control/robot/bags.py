@@ -44,7 +44,7 @@ from control.errors import BagError, ControlError
 from control.robot import messages as msgs
 from control.robot import storage as storage_mod
 from control.robot.extra import require
-from control.validation import check_lookup, float_array, path_argument
+from control.validation import check_lookup, float_array, is_choice, path_argument
 from roadgen.checks import home_path
 
 STORAGES = ("mcap", "sqlite3")
@@ -886,7 +886,7 @@ def _register(store, path: Path, topic: str, schema) -> None:
 
 
 def _check_storage(storage: str) -> None:
-    if storage not in STORAGES:
+    if not is_choice(storage, STORAGES):
         raise ControlError(f"storage must be one of {STORAGES}, got {storage!r}")
 
 

@@ -36,6 +36,7 @@ import numpy as np
 from scipy.stats import median_abs_deviation
 
 from control.errors import BagError, ControlError
+from control.validation import is_choice
 from vehicle.models import GRAVITY
 
 GAP_PERIODS = 1.5  # a step above this many periods is a gap (as control.sensor_checks)
@@ -230,7 +231,7 @@ def resampling_filter(
     Kaiser beta 5). ``topic``: the IMU's topic, named in a `BagError`."""
     from scipy.signal import firwin, kaiserord  # here, not at import (tests/test_import_cost.py)
 
-    if method not in METHODS:
+    if not is_choice(method, METHODS):
         raise ControlError(f"method must be one of {METHODS}, got {method!r}")
     up, down = _ratio(rate_in, rate_out)
     fs = rate_out * down  # = (rate_out * down / up) * up

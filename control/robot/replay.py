@@ -73,6 +73,7 @@ from control.simplex import Simplex
 from control.validation import (
     check_instance,
     check_lookup,
+    is_choice,
     path_argument,
     replace_fields,
     require_instance,
@@ -161,7 +162,7 @@ class ReplaySettings:
                              "reorder_periods"))  # fmt: skip
         if not isinstance(self.restamp, bool):
             raise ControlError(f"restamp must be True or False, got {self.restamp!r}")
-        if self.imu_axis not in ("x", "y", "z"):
+        if not is_choice(self.imu_axis, ("x", "y", "z")):
             raise ControlError(f"imu_axis must be 'x', 'y' or 'z', got {self.imu_axis!r}")
         if self.imu_sign not in (1, -1):
             raise ControlError(f"imu_sign must be +1 or -1, got {self.imu_sign!r}")
@@ -169,7 +170,7 @@ class ReplaySettings:
             ("time_base", TIME_BASES), ("position", POSITIONS), ("gravity", GRAVITY),
             ("storage", STORAGES), ("resample", condition.METHODS),
         ):  # fmt: skip
-            if getattr(self, name) not in allowed:
+            if not is_choice(getattr(self, name), allowed):
                 raise ControlError(f"{name} must be one of {allowed}, got {getattr(self, name)!r}")
         if not (np.isfinite(self.highpass_hz) and self.highpass_hz >= MIN_HIGHPASS_HZ):
             raise ControlError(

@@ -110,11 +110,11 @@ def test_a_track_of_many_segments_costs_o_n_and_matches_the_running_sum():
 def test_roads_built_by_hand_check_what_they_were_made_from(road):
     fields = {"x": road.x, "z": road.z, "dx_m": road.dx_m, "gd": 450.0}
     for change, match in (
-        ({"band": (np.nan, 1.0)}, r"settings.band"),
-        ({"amplitudes": "x"}, r"settings.amplitudes='x' is not allowed"),
-        ({"waviness": -3.0}, r"settings.waviness=-3.0 is out of range"),
-        ({"seed": "s"}, r"settings.seed='s' must be None or an integer"),
-        ({"lead_in_m": -1.0}, r"settings.lead_in_m=-1.0 is out of range"),
+        ({"band": (np.nan, 1.0)}, r"band=\(nan, 1.0\) is out of range"),  # ProfileSettings'
+        ({"amplitudes": "x"}, r"amplitudes='x' is not allowed"),  # own check (session 75)
+        ({"waviness": -3.0}, r"waviness=-3.0 is out of range"),
+        ({"seed": "s"}, r"seed='s' must be None or an integer"),
+        ({"lead_in_m": -1.0}, r"lead_in_m=-1.0 is out of range"),
         ({"lead_in_m": 1e9}, r"settings.lead_in_m=1000000000.0 is out of range"),
     ):
         with pytest.raises(roadgen.RoadgenError, match=match):
