@@ -18,9 +18,16 @@ combinations of the free categorical elements' levels of prior x likelihood
 kept draw's levels are then drawn from their conditional given its continuous parameters
 (exact), so the draws carry the levels as the other backends' do; with a continuous theta
 beside it, the joint level move (`LevelJumps`, ``gpmsa.mcmc.level_moves``) after each draw
-carries a chain between the modes of a level and a continuous parameter that trade off. A
-theta constraint and a callable mean basis with theta sampled are refused
-(`refuse_unsupported`).
+carries a chain between the modes of a level and a continuous parameter that trade off.
+A theta constraint (``problem.constraint``, a numpy callable of native theta) enters the prior:
+a theta it rejects (the full theta, held elements at their values; with a categorical theta,
+each combination of levels with the continuous values) has log density -inf, a constant of the
+detached verdict (no gradient), so NUTS sees an infinite energy there: a divergence, whose
+subtree gets zero weight and ends the trajectory's doubling (pyro's ``NUTS._build_basetree``;
+the chain stays exact, a hard wall as Stan's). The level draws and moves take the same -inf.
+The verdict is numpy, which a JIT trace would freeze at its first value, so with a constraint
+the potential energy is not JIT-compiled (``jit`` is ignored). A callable mean basis with
+theta sampled is refused (`refuse_unsupported`).
 """
 
 from __future__ import annotations
@@ -108,6 +115,7 @@ class PyroModel:
             if k in problem.fixed or np.size(v) == 0
         }
         self.free = tuple(k for k in problem.sampled if k not in self.const)
+        self.constraint = problem.constraint if "theta" in self.free else None
         masks = problem.held_masks(self.free)
         self.cat, self.combos = _level_combinations(problem, masks, self.free, dtype)
         self.cat_levels = [problem.theta_levels[k] for k in self.cat]  # unit scale, each
@@ -215,7 +223,7 @@ class PyroModel:
 
     def log_prior(self, prm: dict[str, torch.Tensor]) -> torch.Tensor:
         """Sum of the sampled elements' log priors (C,) (held elements and a categorical theta,
-        uniform over its levels, left out)."""
+        uniform over its levels, left out), -inf where the theta constraint rejects theta."""
         c = prm["betaU"].shape[0]
         lp = torch.zeros(c, dtype=self.dtype)
         for name in self.free:
@@ -223,7 +231,17 @@ class PyroModel:
             if name in self.held:
                 each = each[:, self.held[name][0]]
             lp = lp + each.sum(-1)
+        if self.constraint is not None:
+            lp = lp + self.constraint_term(prm["theta"])
         return lp
+
+    def constraint_term(self, theta: torch.Tensor) -> torch.Tensor:
+        """0 where the theta constraint allows unit-scale theta (C, q), -inf where it rejects
+        it: (C,), a constant (the verdict of the detached values, called once per row)."""
+        con = self.constraint
+        ok = con.allows(con.native(theta.detach().numpy()))
+        out = torch.zeros(theta.shape[0], dtype=self.dtype)
+        return out.masked_fill_(torch.as_tensor(~ok), -torch.inf)
 
     def __call__(self) -> None:
         sites = {}
@@ -235,7 +253,10 @@ class PyroModel:
             sites[_site(name)] = pyro.sample(_site(name), base).unsqueeze(0)
         prm = self.params(sites)
         if self.cat.size:  # the levels marginalised: log sum over them of prior x likelihood
-            pyro.factor("log_post", torch.logsumexp(self.level_log_post(prm)[0], 0))
+            lse = torch.logsumexp(self.level_log_post(prm)[0], 0)
+            if self.constraint is not None and lse == -torch.inf:  # every level rejected: no
+                lse = lse.detach()  # gradient (a NaN one through logsumexp), a divergence
+            pyro.factor("log_post", lse)
             return
         pyro.factor("log_prior", self.log_prior(prm)[0])
         pyro.factor("log_likelihood", self.log_likelihood(prm)[0])
@@ -409,23 +430,19 @@ def _level_combinations(problem: Problem, masks: dict[str, np.ndarray], free: tu
 
 def refuse_unsupported(problem: Problem) -> None:
     """GPMSAError naming what of ``problem``'s extensions NUTS cannot sample (categorical inputs,
-    a categorical theta (marginalised, `PyroModel`) and a named mean basis it can; a fixed or
-    held theta lifts the theta-side refusals): a theta constraint (a hard boundary inside
-    theta's support) and a callable mean basis at the observations' sampled theta (a numpy
-    callable: no gradient)."""
+    a categorical theta (marginalised, `PyroModel`), a named mean basis and a theta constraint
+    (-inf outside it, `PyroModel.log_prior`) it can; a fixed or held theta lifts the theta-side
+    refusal): a callable mean basis at the observations' sampled theta (a numpy callable: no
+    gradient)."""
     masks = problem.held_masks(("theta",))
     held = masks.get("theta", np.zeros(problem.q, dtype=bool)) if "theta" in problem.init else None
     free = None if held is None else ~held  # theta's free elements (None: no theta)
-    what = []
-    if free is not None and free.any() and problem.constraint is not None:
-        what.append("theta constraints")
     mean = problem.mean_basis
     if free is not None and free.any() and mean is not None and mean.kind == "callable":
-        what.append("a callable mean_basis with theta sampled ('constant' and 'linear' it takes)")
-    if what:
         raise GPMSAError(
-            f"the pyro backend does not support {'; '.join(what)} (NUTS moves continuously, on "
-            "gradients, inside theta's box); use backend='numpy' or 'torch'"
+            "the pyro backend does not support a callable mean_basis with theta sampled "
+            "('constant' and 'linear' it takes; NUTS moves on gradients, which a numpy "
+            "callable has none of); use backend='numpy' or 'torch'"
         )
 
 
@@ -490,7 +507,9 @@ def sample(
     element, marginalised and drawn from its conditional per draw: width NaN, rate its joint
     level moves' acceptance (1 where no continuous theta is sampled: no move);
     ``info["marginalised_levels"]`` its positions). ``jit``: compile the
-    potential energy with the torch JIT (about 1.6x faster on the road case). ``num_threads``:
+    potential energy with the torch JIT (about 1.6x faster on the road case; not with a theta
+    constraint, whose numpy verdict a trace would freeze: `PyroModel`). A start the constraint
+    rejects is the numpy sampler's StartRejectedError ("pass theta_init="). ``num_threads``:
     torch CPU threads while sampling (see the torch backend; None: unchanged). ``n_jobs``: None,
     1 or -1 (the chains run one after another in this process; any other number is a
     GPMSAError).
@@ -523,7 +542,8 @@ def sample(
         seed_c = int(seq.generate_state(1)[0])
         kernel = NUTS(
             model, adapt_step_size=tune, adapt_mass_matrix=tune, target_accept_prob=target_accept,
-            max_tree_depth=max_tree_depth, max_plate_nesting=0, jit_compile=jit,
+            max_tree_depth=max_tree_depth, max_plate_nesting=0,
+            jit_compile=jit and model.constraint is None,  # a trace would freeze the verdict
             full_mass=full_mass,
             ignore_jit_warnings=True,
             init_strategy=init_to_value(values=model.init_values(first)),

@@ -643,7 +643,7 @@ def _run_backend(
         reduced=data if discrepancy is None else None, discrepancy_groups=groups, **theta_opts,
     )  # fmt: skip
     module = backends.get(backend)
-    if backend == "numpy" and problem.constraint is not None:  # (torch: its sample; pyro refuses)
+    if backend == "numpy" and problem.constraint is not None:  # (torch: its sample; pyro: here)
         n_jobs, executor = in_this_process(
             ["constraint"], where["n_jobs"], where["executor"], n_chains
         )

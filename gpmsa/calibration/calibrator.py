@@ -196,7 +196,7 @@ class Calibrator:
             a cell wide, may lie on the wrong side), and draws the constraint rejects are
             redrawn: none lies outside. A region of either verdict that touches no node (nor
             new node) is not seen by the density (draws are still checked). MCMC passes it to
-            ``gpmsa.calibrate`` (numpy or torch; pyro refuses it): where it rejects the start
+            ``gpmsa.calibrate`` (every backend): where it rejects the start
             (the design's centre) give one inside as ``mcmc_options={"theta_init": [...]}``
             (native units; with ``"fast": False`` or torch, whose chains start at random,
             add ``"init": "gpmsa"`` where no random start lies inside). It is evaluated on
@@ -366,15 +366,12 @@ class Calibrator:
 
     def _check_mcmc_path(self, backend: str) -> None:
         """GPMSAError now, not at every update, for MCMC settings ``gpmsa.calibrate`` refuses:
-        a constraint on pyro (numpy and torch take one), the emulator's draws on another backend
-        than numpy, or the draws with ``mcmc_options={"fast": False}`` (only the fast numpy
-        sampler averages over them)."""
+        the emulator's draws on another backend than numpy, or the draws with
+        ``mcmc_options={"fast": False}`` (only the fast numpy sampler averages over them)."""
         if self.method != "mcmc":
             return
         opts = self.mcmc_options
         backend = opts.get("backend", backend)
-        if backend == "pyro" and opts.get("constraint") is not None:
-            raise GPMSAError("constraint needs backend='numpy' or 'torch', got backend='pyro'")
         if backend != "numpy" and self.emulator_params == "draws":
             raise GPMSAError(
                 f"emulator_params='draws' needs backend='numpy', got backend={backend!r}"

@@ -267,7 +267,7 @@ def fit(
     reserved = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress", "n_jobs",
                 "executor")  # fmt: skip
     backends.check_options(backend, options, reserved, "fit")
-    if backend == "numpy":  # (torch's sample keeps its callables here itself; pyro refuses them)
+    if backend == "numpy":  # (torch's sample keeps its callables here; pyro runs here)
         mean = problem.mean_basis
         callables = [name for name, on in (
             ("constraint", problem.constraint is not None),
