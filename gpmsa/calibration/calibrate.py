@@ -335,7 +335,7 @@ def calibrate(
     n_chains = check_count(n_chains, "n_chains")
     ok = not isinstance(n_burn, bool) and isinstance(n_burn, int | np.integer)
     if not (ok and 0 <= n_burn < n_samples - 1):
-        raise GPMSAError(f"n_burn must be an integer in [0, n_samples - 1), got {n_burn!r}")
+        raise GPMSAError(burn_message(n_burn, n_samples, "n_samples", 1000))
     tune, extrapolate = check_flag(tune, "tune"), check_flag(extrapolate, "extrapolate")
     progress = check_flag(progress, "progress")
     backends.get(backend)  # unknown or not installed: a clear error before any work
@@ -434,6 +434,17 @@ def calibrate(
             info["convergence"], f"gpmsa.calibrate (backend {backend!r})", length="n_samples"
         )
     return Posterior(samples, chains=chains, info=info)
+
+
+def burn_message(n_burn, n_samples, what: str = "n_samples", default: int | None = None) -> str:
+    """The refusal of an ``n_burn`` outside [0, ``what`` - 1): the run's length, and where
+    ``n_burn`` is an integer too large for it, a hint (naming the ``default`` burn-in where
+    ``n_burn`` is it: users meet it without passing ``n_burn`` when they shorten the run)."""
+    msg = f"n_burn must be an integer in [0, {what} - 1), got {n_burn!r} with {what}={n_samples}"
+    if isinstance(n_burn, int | np.integer) and not isinstance(n_burn, bool) and n_burn > 0:
+        told = f"n_burn defaults to {default} burned sweeps: " if n_burn == default else ""
+        msg += f" ({told}pass a smaller n_burn= or a larger {what})"
+    return msg
 
 
 def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:

@@ -413,8 +413,9 @@ def _recorded_discrepancy(emulator, posterior: Posterior | None):
     """The discrepancy basis kind the joint fit (``posterior`` None) or the calibration behind
     ``posterior`` recorded (None: none), or the per-experiment bases the joint fit kept
     (``Emulator.discrepancy_bases``); GPMSAError where it must be passed again: a basis given
-    as an array, a list of them for a Posterior, or a Posterior that recorded the basis's
-    digest but not its kind (made before the kind was kept)."""
+    as an array, a list of them for a Posterior, a Posterior that recorded the basis's
+    digest but not its kind (made before the kind was kept), or one with discrepancy draws
+    and no record at all (made by hand or read back from ArviZ)."""
     record = (emulator.settings if posterior is None else posterior.info) or {}
     kind = record.get("discrepancy")
     source = "the joint fit" if posterior is None else "the calibration"
@@ -422,6 +423,13 @@ def _recorded_discrepancy(emulator, posterior: Posterior | None):
         raise GPMSAError(
             "with this posterior= pass the discrepancy basis the calibration used (None, "
             "'constant', 'linear' or the array): it records the basis's digest, not its kind"
+        )
+    drawn = posterior is not None and any(n.split("[")[0] == "lamVz" for n in posterior.names)
+    if drawn and "discrepancy" not in record:
+        raise GPMSAError(
+            "posterior= has discrepancy draws (betaV, lamVz) but records no discrepancy basis "
+            "(a Posterior made by hand or read back from ArviZ keeps no info): pass the "
+            "calibration's discrepancy= ('constant', 'linear', the array or the list)"
         )
     if isinstance(kind, str) and kind == "given":
         raise GPMSAError(

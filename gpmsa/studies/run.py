@@ -14,6 +14,7 @@ import numpy as np
 from gpmsa._version import library_versions
 from gpmsa.calibration.calibrate import (
     CALIBRATION_FIXED,
+    burn_message,
     calibration_fixed,
     calibration_held_native,
     calibration_problem,
@@ -101,7 +102,7 @@ def _check_run(n_iter, n_burn, n_chains, hyper, what: str = "n_samples") -> Hype
             raise GPMSAError(f"{name} must be an integer >= {low}, got {val!r}")
     if isinstance(n_burn, bool) or not (isinstance(n_burn, (int, np.integer))
                                         and 0 <= n_burn < n_iter - 1):  # fmt: skip
-        raise GPMSAError(f"n_burn must be an integer in [0, {what} - 1), got {n_burn!r}")
+        raise GPMSAError(burn_message(n_burn, n_iter, what, 1000 if what == "n_samples" else None))
     if hyper is None:
         return HyperPriors()
     if not isinstance(hyper, HyperPriors):
