@@ -27,7 +27,8 @@ next one, as those overlap the fault's block or the block before or after it).
 Every update returns an `Estimate` whose status says why there is no number: ``filling`` (not
 enough contiguous samples yet, or the first block after a fault), ``sensor_fault`` (non-finite
 values, a speed beyond any vehicle's, dropped, repeated or backwards time stamps, a stuck,
-quantised, clipped or dead signal), ``implausible`` (no GD in the emulator's domain explains the
+quantised, clipped or dead signal, a static level off the one ``SensorLimits.static_mps2``
+states: a scale fault), ``implausible`` (no GD in the emulator's domain explains the
 observation; with the change-point method also where a phase's last ``quiet_blocks`` blocks
 together read quieter than any GD explains: the quiet-signal check, see below),
 ``out_of_domain`` (speed outside the emulator's range and no earlier estimate),
@@ -149,7 +150,7 @@ class BCRSettings:
             check (``quiet_blocks``) and of the frozen-odometry check (`BCR`). 0 switches them
             off.
         sensor: thresholds of the signal checks (stuck, quantised, clipped, dead, below the
-            noise floor, a level jump).
+            noise floor, a level jump; the static level of an axis that reports gravity).
         recent_change_m: the distance of ``Estimate.prob_change``, m.
         quiet_blocks: change-point method: the quiet-signal check's memory, blocks of a phase
             (~1 s each): an estimate is "implausible" where its phase's last ``quiet_blocks``

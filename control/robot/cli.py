@@ -185,6 +185,13 @@ def parser() -> argparse.ArgumentParser:
         "highpass an IMU that reads gravity with an emulator trained without noise (A)",
     )  # fmt: skip
     p.add_argument(
+        "--static-mps2", type=float, default=None, metavar="M_PER_S2",
+        help="the mean the up axis reads at rest, after --sign: 9.80665 for an IMU that reports "
+        "gravity (specific force, REP-145); a block whose raw mean lies more than "
+        "SensorLimits.static_tolerance (20%%) off it is a scale fault (sensor_fault), with "
+        "--gravity keep or highpass (checked before the filter); default: not checked",
+    )  # fmt: skip
+    p.add_argument(
         "--resample", default=DEFAULTS.resample, choices=["sample", "lowpass"],
         help="for an IMU faster than the emulator: sample (band-limited, the simulator's "
         "sensor model; default) or lowpass (anti-aliasing at the emulator's Nyquist frequency)",
@@ -240,6 +247,7 @@ def main(argv: list[str] | None = None) -> int:
             time_base=args.time_base,
             position=args.position,
             gravity=args.gravity,
+            static_mps2=args.static_mps2,
             resample=args.resample,
             restamp=not args.no_restamp,
             reorder_periods=args.reorder_periods,

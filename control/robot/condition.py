@@ -22,6 +22,7 @@
   than 1.5 output periods ends a run. At each end of a run the samples the filter's start-up
   touches are cut, and where a run ended on a bad sample a marker is put in the stream (the
   last sample again, or a NaN), so the BCR reports the fault as it would at its own rate.
+- `static_level_marks`: the static-level check (a scale fault) of the signal before a high-pass.
 - `path_length`, `integrated_speed`, `odometry_at`: position along the path and speed at the
   IMU's sample times.
 """
@@ -36,6 +37,7 @@ import numpy as np
 from scipy.stats import median_abs_deviation
 
 from control.errors import BagError, ControlError
+from control.sensor_checks import SensorLimits, static_level
 from control.validation import is_choice
 from vehicle.models import GRAVITY
 
@@ -453,6 +455,29 @@ def highpass(t: np.ndarray, a: np.ndarray, rate_hz: float, cutoff_hz: float) -> 
         seg = a[lo:hi]
         out[lo:hi] = sosfiltfilt(sos, seg) if hi - lo > pad else seg - seg.mean()
     return out
+
+
+def static_level_marks(
+    a: np.ndarray, limits: SensorLimits, every: int, block: int
+) -> dict[int, str]:
+    """The static-level check (`control.sensor_checks.static_level`) of the raw samples ``a``
+    (m/s^2, before a high-pass removes their static level) at each update of a BCR fed them
+    ``every`` samples at a time from the first: {the update's newest sample: the reason} for
+    each update whose block (its newest ``block`` samples, all finite: a non-finite one is a
+    fault the BCR reports itself) has a mean off ``limits.static_mps2``."""
+    a = np.asarray(a, dtype=float)
+    finite = np.isfinite(a)
+    total = np.concatenate([[0.0], np.cumsum(np.where(finite, a, 0.0))])
+    count = np.concatenate([[0], np.cumsum(finite)])
+    ends = np.arange(every, a.size + 1, every)
+    ends = ends[ends >= block]
+    full = count[ends] - count[ends - block] == block
+    marks = {}
+    for end in ends[full]:
+        why = static_level(float((total[end] - total[end - block]) / block), block, limits)
+        if why:
+            marks[int(end - 1)] = why + " (the signal before the high-pass)"
+    return marks
 
 
 def _norm(d: np.ndarray) -> np.ndarray:

@@ -13,7 +13,8 @@ The pipeline (`replay_bag`):
    removes each block's mean before its feature, so a constant offset leaves the estimate
    alone, but without a noise sd its sensor checks exempt flights only near -9.81 m/s^2, where
    a gravity-free signal puts them: a noise-free signal with +9.81 in it has its flights
-   flagged as dead or quantised, docs/robot.md);
+   flagged as dead or quantised, docs/robot.md); with ``static_mps2`` a block whose mean
+   before the high-pass is off that static level is a scale fault (`ReplaySettings`);
 3. the odometry's position along the path (``position="path"``: the length of the pose
    trajectory from the odometry frame's origin, `condition.path_length`; ``"speed"``: the
    integral of the speed) and speed (the planar norm of ``twist.twist.linear``), interpolated
@@ -33,6 +34,7 @@ slower than the emulator's rate raise `BagError` naming the topic.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import os
 import shutil
 import time
@@ -67,7 +69,7 @@ from control.robot.bags import (
     recording_path,
     source_of,
 )
-from control.sensor_checks import flight_reading
+from control.sensor_checks import SensorLimits, flight_reading
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
 from control.validation import (
@@ -135,6 +137,16 @@ class ReplaySettings:
             about one by less than 1/6 period (`clock.restamp`): jitter goes, a dropped
             message, a duplicate or a clock step stays a sensor fault. Exact stamps are kept
             bit for bit.
+        static_mps2: the mean the up axis reads at rest, m/s^2, after ``imu_sign``: +9.80665
+            for an IMU that reports gravity (a sensor_msgs/Imu's specific force, REP-145);
+            None (default): no static-level check. With it, a block whose raw mean lies
+            outside ``static_mps2 * (1 +- bcr.sensor.static_tolerance)`` is a scale (or tilt)
+            fault, ``sensor_fault`` (`control.SensorLimits.static_mps2`). With ``gravity=
+            "keep"`` the BCR checks it (its ``sensor.static_mps2`` set to this); with
+            ``"highpass"`` the conditioning checks each update's block of the signal before the
+            filter (`condition.static_level_marks`) and marks a failing block's newest sample
+            non-finite, which the BCR reports as a sensor fault; the estimate's reason names
+            the level. An IMU that removes gravity itself cannot be checked so.
         estimate_topic: the output bag's topic of the estimates.
         storage: the output bag's storage, "mcap" or "sqlite3".
     """
@@ -152,6 +164,7 @@ class ReplaySettings:
     max_odometry_gap_s: float = 0.25
     reorder_periods: float = clock.REORDER_PERIODS
     restamp: bool = True
+    static_mps2: float | None = None
     estimate_topic: str = "/bcr/estimate"
     storage: str = "mcap"
 
@@ -159,7 +172,10 @@ class ReplaySettings:
         for name in ("imu_topic", "odom_topic", "estimate_topic", "imu_axis"):
             require_instance(self, name, str)
         require_reals(self, ("imu_sign", "highpass_hz", "rate_tolerance", "max_odometry_gap_s",
-                             "reorder_periods"))  # fmt: skip
+                             "reorder_periods", "static_mps2"),
+                      optional=("static_mps2",))  # fmt: skip
+        if self.static_mps2 is not None:  # (SensorLimits' rule, naming this field)
+            SensorLimits(static_mps2=self.static_mps2)
         if not isinstance(self.restamp, bool):
             raise ControlError(f"restamp must be True or False, got {self.restamp!r}")
         if not is_choice(self.imu_axis, ("x", "y", "z")):
@@ -627,10 +643,11 @@ def replay_recording(
     simplex = Simplex() if simplex is None else simplex
     _check_fit(s, bcr, emulator, likelihood, simplex)
     unchecked = _check_vehicle(rec, emulator, check_vehicle)
+    bcr, raw_check = _static_check(s, bcr)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     tic = time.perf_counter()
-    t, a, pos, spd, reports, resampling, notes, t0, restamping = _condition(
-        rec, s, bcr.rate_hz, flight_reading(bcr.sensor)
+    t, a, pos, spd, reports, resampling, notes, t0, restamping, marks = _condition(
+        rec, s, bcr.rate_hz, flight_reading(bcr.sensor), raw_check
     )
     notes[:0] = unchecked
     condition_s = time.perf_counter() - tic
@@ -643,6 +660,9 @@ def replay_recording(
     for k in tqdm(range(n_full), disable=not progress, unit="update", leave=False):
         part = slice(k * every, (k + 1) * every)
         est = estimator.update(t[part], pos[part], a[part], spd[part], now=t[part.stop - 1])
+        marked = marks.get(part.stop - 1)
+        if marked and est.status == "sensor_fault":  # (the marker's fault: name the level)
+            est = dataclasses.replace(est, reason=f"{marked}; {est.reason}")
         ests.append(est)
         cmds.append(controller.command(est))
         ends.append(part.stop - 1)
@@ -720,8 +740,35 @@ def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simple
             f"highpass_hz = {s.highpass_hz:g} Hz must lie below {nyquist:g} Hz, the Nyquist "
             f"frequency of the emulator's rate ({bcr.rate_hz:g} Hz)"
         )
+    static = bcr.sensor.static_mps2
+    if static is not None and s.gravity == "highpass":
+        raise ControlError(
+            f"bcr.sensor.static_mps2 = {static:g} with gravity='highpass': the high-pass removes "
+            "the static level the BCR would check (every block would read a scale fault); give "
+            "ReplaySettings.static_mps2 instead, which checks the signal before the filter"
+        )
+    if static is not None and s.static_mps2 is not None and static != s.static_mps2:
+        raise ControlError(
+            f"static_mps2 = {s.static_mps2:g} and bcr.sensor.static_mps2 = {static:g} differ: "
+            "give the static level once"
+        )
     if likelihood is not None:
         check_likelihood(emulator, likelihood)
+
+
+def _static_check(
+    s: ReplaySettings, bcr: BCRSettings
+) -> tuple[BCRSettings, tuple[SensorLimits, int, int] | None]:
+    """Where ``s.static_mps2`` asks for the static-level check: with gravity kept, (the BCR
+    settings with it, None); with "highpass", (the settings as they are, (the sensor limits
+    with it, samples per update, samples per block)) for the conditioning to check the raw
+    signal (`condition.static_level_marks`). Without it, (bcr, None)."""
+    if s.static_mps2 is None:
+        return bcr, None
+    sensor = dataclasses.replace(bcr.sensor, static_mps2=s.static_mps2)
+    if s.gravity == "keep":
+        return dataclasses.replace(bcr, sensor=sensor), None
+    return bcr, (sensor, bcr.samples_per_update, bcr.feature.block_samples)
 
 
 def _check_span(rec: Recording, base: str, imu_ns, odom_ns, t0: int) -> None:
@@ -740,10 +787,15 @@ def _check_span(rec: Recording, base: str, imu_ns, odom_ns, t0: int) -> None:
                 )
 
 
-def _condition(rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=None):
-    """The BCR's samples (t s from t0, accel, position, speed), the reports and t0 (ns);
-    ``flight_mps2``: the BCR's `flight_reading`, for `condition.gravity_direction`, whose
-    finding is a note and a `ControlWarning`."""
+def _condition(
+    rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=None,
+    raw_check: tuple[SensorLimits, int, int] | None = None,
+):  # fmt: skip
+    """The BCR's samples (t s from t0, accel, position, speed), the reports, t0 (ns) and the
+    static-level marks ({sample index: reason}, `condition.static_level_marks`: with
+    ``raw_check``, (limits, samples per update, per block), of the signal before the
+    high-pass; those samples read NaN); ``flight_mps2``: the BCR's `flight_reading`, for
+    `condition.gravity_direction`, whose finding is a note and a `ControlWarning`."""
     notes: list[str] = []
     upright = condition.gravity_direction(
         rec.imu.accel, s.imu_axis, s.imu_sign, rec.imu.topic, flight_mps2, s.gravity
@@ -781,6 +833,7 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=No
             f"{resampling.dropped} of its {t_imu.size} messages (repeated or backwards stamps, "
             "non-finite values) cut it into shorter ones"
         )
+    raw = a
     if s.gravity == "highpass":
         a = condition.highpass(t, a, rate_hz, s.highpass_hz)
 
@@ -809,6 +862,16 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=No
             "odometry message left out"
         )
     t, a = t[first:last], a[first:last]
+    marks: dict[int, str] = {}
+    if raw_check is not None:
+        marks = condition.static_level_marks(raw[first:last], *raw_check)
+        a[list(marks)] = np.nan
+        if marks:
+            notes.append(
+                f"{len(marks)} update(s) whose block read a static level off "
+                f"{s.static_mps2:g} m/s^2 before the high-pass (a scale fault): their newest "
+                "sample marked non-finite (sensor_fault)"
+            )
     pos, spd = condition.odometry_at(t, to, along, speed, s.max_odometry_gap_s)
     in_gap = finite_t[first:last] & ~np.isfinite(pos)
     if in_gap.any():
@@ -821,7 +884,7 @@ def _condition(rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=No
             f"the IMU topic {rec.imu.topic!r} and the odometry topic {rec.odometry.topic!r} do "
             "not overlap in time"
         )
-    return t, a, pos, spd, reports, resampling, notes, t0, restamping
+    return t, a, pos, spd, reports, resampling, notes, t0, restamping, marks
 
 
 def _imu_clock(topic: str, t: np.ndarray, accel: np.ndarray, base: str, s: ReplaySettings):
