@@ -208,10 +208,16 @@ def _resolve(path: Path) -> tuple[Path, str]:
         raise BagError(f"{path} is not a regular file nor a folder (a FIFO, device or socket)")
     if path.is_dir():
         if not (path / "metadata.yaml").is_file():
+            data = sorted(p.name for p in path.glob("*") if p.suffix in (".mcap", ".db3"))
             raise BagError(
                 f"{path} is a folder without metadata.yaml: not a ROS 2 bag (give the bag's "
-                "folder, a *.mcap file or a ROS 1 *.bag file)"
-            )
+                "folder, a *.mcap file or a ROS 1 *.bag file)" + (
+                    f"; it holds {', '.join(data[:3])}{' ...' if len(data) > 3 else ''}: a "
+                    "recorder stopped before it wrote metadata.yaml leaves such a folder, "
+                    f"which `ros2 bag reindex {path} -s {_storage_id(data[0])}` mends"
+                    if data else ""
+                )
+            )  # fmt: skip
         return path, "rosbag2"
     if in_bag_folder(path):
         return path.parent, "rosbag2"
@@ -220,11 +226,20 @@ def _resolve(path: Path) -> tuple[Path, str]:
     if path.suffix == ".bag":
         return path, "ros1"
     if path.suffix == ".db3":
-        raise BagError(f"{path} is a sqlite3 bag file without its folder's metadata.yaml")
+        raise BagError(
+            f"{path} is a sqlite3 bag file without its folder's metadata.yaml (a recorder "
+            f"stopped before it wrote it: `ros2 bag reindex {path.parent} -s sqlite3` mends "
+            "the folder)"
+        )
     raise BagError(
         f"{path}: not a recording this reader knows (a ROS 2 bag folder, *.mcap, *.db3 in its "
         "bag folder, or a ROS 1 *.bag)"
     )
+
+
+def _storage_id(name: str) -> str:
+    """The ``ros2 bag`` storage id of a bag's data file."""
+    return "mcap" if name.endswith(".mcap") else "sqlite3"
 
 
 def _starts_with(path: Path, magic: bytes) -> bool:

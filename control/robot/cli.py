@@ -203,8 +203,8 @@ def parser() -> argparse.ArgumentParser:
     )  # fmt: skip
     p.add_argument(
         "--reorder-periods", type=float, default=DEFAULTS.reorder_periods, metavar="PERIODS",
-        help="put IMU messages received out of header-stamp order by at most this many periods "
-        "in stamp order (default 3; 0: the order received)",
+        help="put IMU (and odometry) messages received out of header-stamp order by at most "
+        "this many of their periods in stamp order (default 3; 0: the order received)",
     )  # fmt: skip
     p.add_argument(
         "--storage", default=DEFAULTS.storage, choices=["mcap", "sqlite3"],

@@ -6,7 +6,8 @@ repeated sample, a sensor fault. `restamp` fits the stream's clock and gives eac
 slot's time, so that jitter well below half a period goes while a dropped message still leaves
 an empty slot (a gap), a duplicate shares one and a clock step shows; `stamp_order` puts
 messages delivered late (stamped right) back in stamp order. The replay uses both
-(`control.robot.replay`, docs/robot.md "Time stamps").
+(`control.robot.replay`, docs/robot.md "Time stamps"), and `header_skew` to find an IMU whose
+header stamps run on another clock than the odometry's.
 """
 
 from __future__ import annotations
@@ -256,3 +257,36 @@ def restamp(t: np.ndarray, what: str = "the stamps") -> tuple[np.ndarray, Restam
             f"; {np.count_nonzero(~fitted)} message(s) in runs too short to fit kept as recorded"
         )
     return out, Restamping(True, **info, note=text)
+
+
+SKEW_BIN_S = 1.0
+"""`header_skew` takes the median over the messages received within each such span, s: a
+message delivered late by a loaded recorder moves no median."""
+
+
+def header_skew(
+    imu_stamp_ns: np.ndarray, imu_log_ns: np.ndarray, odom_stamp_ns: np.ndarray,
+    odom_log_ns: np.ndarray,
+) -> np.ndarray | None:  # fmt: skip
+    """How far each IMU message's header clock runs from the odometry's, s (> 0: the IMU's
+    ahead), against the receive times both share: (stamp - receive time) of the IMU less that
+    of the odometry (interpolated at the IMU's receive time), its median over each
+    `SKEW_BIN_S` of receive time. On one clock it is the difference of the two topics'
+    delivery latencies (ms); on two, their offset (an IMU stamped in GPS time, a driver's clock
+    step). Receive times in received (rising) order, as `read_recording` gives them. None where
+    either topic's are not usable: fewer than two distinct ones, or fewer distinct than half
+    its messages (a bag whose writer set them all alike)."""
+    logs = (np.asarray(imu_log_ns, dtype=np.int64), np.asarray(odom_log_ns, dtype=np.int64))
+    if any(np.count_nonzero(np.diff(x)) + 1 < max(2, x.size // 2) for x in logs):
+        return None
+    il, ol = logs
+    t0 = int(il[0])
+    imu = (np.asarray(imu_stamp_ns, dtype=np.int64) - il) / 1e9
+    odom = (np.asarray(odom_stamp_ns, dtype=np.int64) - ol) / 1e9
+    skew = imu - np.interp((il - t0) / 1e9, (ol - t0) / 1e9, odom)
+    key = np.floor((il - t0) / 1e9 / SKEW_BIN_S)
+    edges = np.r_[0, np.flatnonzero(np.diff(key)) + 1, key.size]  # received order: key rises
+    out = np.empty_like(skew)
+    for a, b in zip(edges[:-1], edges[1:], strict=True):
+        out[a:b] = np.median(skew[a:b])
+    return out

@@ -15,11 +15,14 @@ The pipeline (`replay_bag`):
    a gravity-free signal puts them: a noise-free signal with +9.81 in it has its flights
    flagged as dead or quantised, docs/robot.md); with ``static_mps2`` a block whose mean
    before the high-pass is off that static level is a scale fault (`ReplaySettings`);
-3. the odometry's position along the path (``position="path"``: the length of the pose
-   trajectory from the odometry frame's origin, `condition.path_length`; ``"speed"``: the
-   integral of the speed) and speed (the planar norm of ``twist.twist.linear``), interpolated
-   linearly at the IMU's sample times; IMU samples before the first or after the last odometry
-   message are left out, those inside an odometry gap get NaN (the BCR reports a sensor fault);
+   on header stamps, IMU messages whose header clock is not the odometry's (against their
+   receive times, `clock.header_skew`) are fed as faults, or the replay refused where all are;
+3. the odometry, in stamp order where delivered late (header stamps); its position along the
+   path (``position="path"``: the length of the pose trajectory from the odometry frame's
+   origin, `condition.path_length`; ``"speed"``: the integral of the speed) and speed (the
+   planar norm of ``twist.twist.linear``), interpolated linearly at the IMU's sample times;
+   IMU samples before the first or after the last odometry message are left out, those inside
+   an odometry gap get NaN (the BCR reports a sensor fault);
 4. the BCR fed in time order, one update's worth of samples (one block) at a time with the
    newest sample's time as its clock (``now=``), the call `control.run_closed_loop` makes, and
    the Simplex's command for each estimate.
@@ -27,8 +30,9 @@ The pipeline (`replay_bag`):
 Faults in the recording are reported, never raised: repeated or backwards stamps and gaps
 (those re-stamping keeps: not jitter) reach the BCR, which gives ``sensor_fault`` with the
 reason for the blocks they touch (status and reason columns of the CSV), and the per-topic
-`StreamReport` counts them. A missing topic, a topic of another type, no messages or an IMU
-slower than the emulator's rate raise `BagError` naming the topic.
+`StreamReport` counts them. A missing topic, a topic of another type, no messages, an IMU
+slower than the emulator's rate or an IMU stamped on another clock than the odometry throughout
+raise `BagError` naming the topic.
 """
 
 from __future__ import annotations
@@ -131,7 +135,8 @@ class ReplaySettings:
             (a sensor fault), s.
         reorder_periods: IMU messages whose stamps step back by at most this many nominal
             periods are put in stamp order (received late, stamped right); a longer step back
-            is a clock step and stays (a sensor fault). 0: the order received. Only on header
+            is a clock step and stays (a sensor fault). Odometry messages likewise, by their
+            own periods (a longer step back is left out). 0: the order received. Only on header
             stamps (receive times are in order).
         restamp: put the IMU's stamps on their own fitted regular clock where they jitter
             about one by less than 1/6 period (`clock.restamp`): jitter goes, a dropped
@@ -147,6 +152,13 @@ class ReplaySettings:
             filter (`condition.static_level_marks`) and marks a failing block's newest sample
             non-finite, which the BCR reports as a sensor fault; the estimate's reason names
             the level. An IMU that removes gravity itself cannot be checked so.
+        max_clock_skew_s: on header stamps, IMU messages whose header clock runs further
+            than this from the odometry's, s, against their receive times
+            (`clock.header_skew`: an IMU stamped in GPS time, a driver's clock step) would be
+            paired with the odometry of another time: they become sensor faults (non-finite
+            accel), with a note and a `ControlWarning`; where all of them do, the replay is
+            refused (`BagError`: replay on receive times, ``time_base="log"``). ``math.inf``:
+            no check.
         estimate_topic: the output bag's topic of the estimates.
         storage: the output bag's storage, "mcap" or "sqlite3".
     """
@@ -165,6 +177,7 @@ class ReplaySettings:
     reorder_periods: float = clock.REORDER_PERIODS
     restamp: bool = True
     static_mps2: float | None = None
+    max_clock_skew_s: float = 1.0
     estimate_topic: str = "/bcr/estimate"
     storage: str = "mcap"
 
@@ -172,7 +185,7 @@ class ReplaySettings:
         for name in ("imu_topic", "odom_topic", "estimate_topic", "imu_axis"):
             require_instance(self, name, str)
         require_reals(self, ("imu_sign", "highpass_hz", "rate_tolerance", "max_odometry_gap_s",
-                             "reorder_periods", "static_mps2"),
+                             "reorder_periods", "static_mps2", "max_clock_skew_s"),
                       optional=("static_mps2",))  # fmt: skip
         if self.static_mps2 is not None:  # (SensorLimits' rule, naming this field)
             SensorLimits(static_mps2=self.static_mps2)
@@ -200,6 +213,8 @@ class ReplaySettings:
             raise ControlError(
                 f"reorder_periods must be >= 0 (periods), got {self.reorder_periods}"
             )
+        if not self.max_clock_skew_s > 0:  # NaN too; inf: no check
+            raise ControlError(f"max_clock_skew_s must be > 0 (s), got {self.max_clock_skew_s}")
         if not (np.isfinite(self.max_odometry_gap_s) and self.max_odometry_gap_s > 0):
             raise ControlError(f"max_odometry_gap_s must be > 0, got {self.max_odometry_gap_s}")
         for name in ("imu_topic", "odom_topic", "estimate_topic"):
@@ -502,7 +517,8 @@ def replay_bag(
 
     Returns:
         `ReplayResult`. Raises `BagError` (a topic missing, mistyped or empty; an IMU slower
-        than the emulator's rate; a damaged file or simulation record),
+        than the emulator's rate; on header stamps, an IMU stamped on another clock than the
+        odometry throughout, ``max_clock_skew_s``; a damaged file or simulation record),
         `EmulatorMismatchError` (the recording's simulated vehicle is not the emulator's, see
         ``check_vehicle``), `ControlError` (``bag`` not a path; ``csv``
         or ``out_bag`` not a path, one in or on what is read (the recording, the whole bag
@@ -811,9 +827,19 @@ def _condition(
     t_imu = (imu_ns - t0) / 1e9
     t_odom = (odom_ns - t0) / 1e9
     imu_recorded, accel_recorded = t_imu, accel
+    if base == "header":
+        accel, skewed = _other_clock(rec, accel, s.max_clock_skew_s)
+        if skewed:
+            notes.append(skewed)
+            warnings.warn(skewed, ControlWarning, stacklevel=user_stacklevel())
     odom_finite = np.all(np.isfinite(rec.odometry.position), axis=1) & np.all(
         np.isfinite(rec.odometry.velocity), axis=1
     )
+    order = np.arange(t_odom.size)
+    if base == "header" and s.reorder_periods > 0 and t_odom.size > 1:
+        period = condition.nominal_period(t_odom)  # odometry delivered late: stamp order
+        if np.isfinite(period):
+            order = clock.stamp_order(t_odom, s.reorder_periods * period)
     t_imu, accel, said, restamping = _imu_clock(rec.imu.topic, t_imu, accel, base, s)
     imu_note = "; ".join(filter(None, [note, *said]))
     reports = (
@@ -822,6 +848,7 @@ def _condition(
         ),  # fmt: skip
         condition.check_stream(rec.odometry.topic, t_odom, odom_finite, base, note),
     )
+    t_odom, odom_finite = t_odom[order], odom_finite[order]
     t, a, resampling = condition.to_rate(
         t_imu, accel, rate_hz, s.rate_tolerance, s.resample, rec.imu.topic
     )
@@ -845,7 +872,8 @@ def _condition(
             f"{np.count_nonzero(~keep)} odometry messages left out (repeated or backwards "
             "stamps, non-finite values)"
         )
-    to, po, vo = t_odom[keep], rec.odometry.position[keep], rec.odometry.velocity[keep]
+    to = t_odom[keep]
+    po, vo = rec.odometry.position[order][keep], rec.odometry.velocity[order][keep]
     speed = np.hypot(vo[:, 0], vo[:, 1])
     if s.position == "path":
         along = condition.path_length(po)
@@ -885,6 +913,43 @@ def _condition(
             "not overlap in time"
         )
     return t, a, pos, spd, reports, resampling, notes, t0, restamping, marks
+
+
+def _other_clock(rec: Recording, accel: np.ndarray, limit_s: float) -> tuple[np.ndarray, str]:
+    """``accel`` with NaN at the IMU messages whose header clock runs more than ``limit_s``
+    from the odometry's (`clock.header_skew`), and a note saying so ("" where none);
+    `BagError` where every message does (the two topics were stamped on different clocks)."""
+    if not np.isfinite(limit_s):
+        return accel, ""
+    imu, odom = rec.imu, rec.odometry
+    skew = clock.header_skew(imu.stamp_ns, imu.log_ns, odom.stamp_ns, odom.log_ns)
+    if skew is None:
+        return accel, ""
+    off = np.abs(skew) > limit_s
+    if not off.any():
+        return accel, ""
+    worst = float(skew[np.argmax(np.abs(skew))])
+    how = f"{abs(worst):.3g} s {'ahead of' if worst > 0 else 'behind'}"
+    remedy = (
+        "paired on header stamps, an IMU sample would meet the odometry of another time; "
+        'replay on the receive times (--time-base log, time_base="log"), or stamp both '
+        "topics on one clock"
+    )
+    if off.all():
+        raise BagError(
+            f"the IMU topic {imu.topic!r} and the odometry topic {odom.topic!r} are stamped "
+            f"on different clocks: against their receive times the IMU's header stamps run "
+            f"{how} the odometry's (median {float(np.median(skew)):.3g} s, more than "
+            f"max_clock_skew_s = {limit_s:g} s): {remedy}"
+        )
+    t_off = (imu.log_ns[np.argmax(off)] - imu.log_ns[0]) / 1e9
+    return np.where(off, np.nan, accel), (
+        f"{np.count_nonzero(off)} of the IMU's {off.size} messages (from {t_off:.1f} s of "
+        f"receive time on) were stamped on another clock than the odometry's: their header "
+        f"stamps run up to {how} it against their receive times (more than max_clock_skew_s "
+        f"= {limit_s:g} s; a clock step of the IMU's driver?), fed as sensor faults "
+        f"(non-finite accel): {remedy}"
+    )
 
 
 def _imu_clock(topic: str, t: np.ndarray, accel: np.ndarray, base: str, s: ReplaySettings):
