@@ -280,7 +280,8 @@ def calibrate(
             (k,) log densities; called with k = 1); fast path only.
         progress: show a tqdm bar.
         n_jobs, executor: where several chains run (numpy backend): ``n_jobs`` worker processes
-            (None or -1: every CPU, never more than the chains) or any
+            (None or -1: every CPU, never more than the chains; this process where it is a
+            daemonic worker, e.g. dask's) or any
             ``concurrent.futures.Executor`` / dask ``Client``; each chain has its own seed, so
             the draws do not depend on it.
             With ``log_prior`` (a callable, not shipped to workers) the chains run here.

@@ -219,7 +219,8 @@ def fit(
     With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
     are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
     names each parameter with R-hat > 1.01 or ESS < 100. A chain that fails or produces
-    non-finite draws raises ``gpmsa.ChainError`` naming it.
+    non-finite draws raises ``gpmsa.ChainError`` naming it. In a daemonic worker (e.g. a dask
+    task's), which may not start processes, n_jobs None or -1 runs the chains in it.
     """
     n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
     continuing = isinstance(options.get("init"), Emulator)  # its chains start past burn-in

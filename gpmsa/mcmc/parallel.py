@@ -3,7 +3,10 @@
 Each chain is one task: a module-level function called with plain, picklable data (the Problem,
 settings and the chain's own ``numpy.random.SeedSequence``), so its draws depend on the chain's
 index and the seed only, never on the number of workers or on where it ran. With one worker and
-no executor the chains run one after another in this process (no pool).
+no executor the chains run one after another in this process (no pool), as they do in a daemonic
+process (a ``multiprocessing.Pool``'s or a dask worker's), which may not start one. A dask
+Client's workers are first asked to import the task's module (dask would wait forever for a
+task they cannot unpickle).
 
 Failures: a task that raises ``GPMSAError`` (bad input, the same on any machine) stops the run
 with ``ChainError`` naming the chain. Any other failure (a worker that died, a lost connection,
@@ -18,6 +21,7 @@ whichever of the process's threads the kernel hands the signal to.
 from __future__ import annotations
 
 import gc
+import importlib
 import multiprocessing
 import multiprocessing.context
 import os
@@ -51,18 +55,27 @@ def available_cpus() -> int:
 
 def n_workers(n_jobs: int | None, n_chains: int) -> int:
     """Worker processes for ``n_chains`` chains: ``n_jobs`` (None or -1, joblib's spelling: every
-    CPU), never more than the chains. GPMSAError for ``n_jobs`` 0 or below -1, not an integer,
-    or (counting only the workers that would run, min(n_jobs, n_chains)) above the CPUs
-    available."""
+    CPU), never more than the chains; in a daemonic process (a ``multiprocessing.Pool``'s or a
+    dask worker's), which may not start any, None or -1 gives 1 (the chains run in it).
+    GPMSAError for ``n_jobs`` 0 or below -1, not an integer, (counting only the workers that
+    would run, min(n_jobs, n_chains)) above the CPUs available, or above 1 in a daemonic
+    process."""
     cpus = available_cpus()
     integer = not isinstance(n_jobs, bool) and isinstance(n_jobs, int | np.integer)
+    daemon = multiprocessing.current_process().daemon
     if n_jobs is None or (integer and n_jobs == -1):
-        return max(1, min(cpus, n_chains))
+        return 1 if daemon else max(1, min(cpus, n_chains))
     if not integer or n_jobs < 1:
         raise GPMSAError(
             f"n_jobs must be None or -1 (every CPU) or an integer >= 1, got {n_jobs!r}"
         )
     n_jobs = int(n_jobs)
+    if daemon and min(n_jobs, n_chains) > 1:
+        raise GPMSAError(
+            f"n_jobs={n_jobs}: this process is a daemonic worker (a multiprocessing.Pool's or a "
+            "dask worker's), which may not start worker processes; give n_jobs=1 or None (the "
+            "chains run here, one after another, with the same draws)"
+        )
     if min(n_jobs, n_chains) > cpus:  # only the workers that would run count
         raise GPMSAError(
             f"n_jobs={n_jobs} is more than the {cpus} CPUs this process may use; give "
@@ -87,19 +100,50 @@ def in_this_process(callables: list[str], n_jobs, executor, n_chains: int):
     return 1, None
 
 
-def as_executor(executor) -> Executor | None:
-    """``executor`` as a ``concurrent.futures.Executor`` (a dask ``Client`` gives its own)."""
-    if executor is None or isinstance(executor, Executor):
+def as_executor(executor, fn: Callable | None = None) -> Executor | None:
+    """``executor`` as a ``concurrent.futures.Executor`` (a dask ``Client`` gives its own). With
+    ``fn`` (a task function) and a dask ``Client`` (or its ``get_executor()``), first checks
+    that every worker imports ``fn``'s module: dask waits forever for a task its workers cannot
+    unpickle (gpmsa, or torch for the torch backend, not installed there)."""
+    if executor is None:
         return executor
-    if callable(getattr(executor, "get_executor", None)):  # distributed.Client
-        if getattr(executor, "status", None) in ("closing", "closed"):
-            raise GPMSAError(  # its executor would hang: a task resubmitted there never ends
-                f"executor: the dask Client is {executor.status}; pass a running Client"
-            )
+    client = _dask_client(executor)
+    closed = getattr(client, "status", None) in ("closing", "closed")
+    if closed and client is executor:  # (its executor's submit refuses the task: run_chains)
+        raise GPMSAError(  # its executor would hang: a task resubmitted there never ends
+            f"executor: the dask Client is {client.status}; pass a running Client"
+        )
+    if client is not None and not closed and fn is not None:
+        module = fn.__module__
+        try:
+            client.run(_importable, module)
+        except Exception as exc:
+            raise GPMSAError(
+                f"executor: the dask Client's workers cannot import {module} ({_describe(exc)}); "
+                "install gpmsa (and, for the torch backend, torch) where they run, or pass "
+                "n_jobs= to run the chains on this machine"
+            ) from exc
+    if isinstance(executor, Executor):
+        return executor
+    if client is not None:
         return executor.get_executor()
     raise GPMSAError(
         f"executor must be a concurrent.futures.Executor or a dask Client, got {executor!r}"
     )
+
+
+def _dask_client(executor):
+    """The dask ``Client`` behind ``executor`` (a Client, or its ``get_executor()``), else None."""
+    if callable(getattr(executor, "get_executor", None)):
+        return executor
+    client = getattr(executor, "_client", None)  # distributed's ClientExecutor
+    return client if callable(getattr(client, "get_executor", None)) else None
+
+
+def _importable(module: str) -> bool:
+    """Import ``module`` (run on every dask worker by `as_executor`)."""
+    importlib.import_module(module)
+    return True
 
 
 _forking_thread: int | None = None
@@ -212,7 +256,7 @@ def run_chains(
     n = len(tasks)
     if executor is not None and n_jobs is not None:
         raise GPMSAError("give n_jobs or executor, not both (n_jobs sizes gpmsa's own pool)")
-    executor = as_executor(executor)
+    executor = as_executor(executor, fn)
     if not isinstance(retries, int) or retries < 0:
         raise GPMSAError(f"retries must be an integer >= 0, got {retries!r}")
     workers = 1 if executor is not None else n_workers(n_jobs, n)
