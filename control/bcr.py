@@ -28,13 +28,13 @@ Every update returns an `Estimate` whose status says why there is no number: ``f
 enough contiguous samples yet, or the first block after a fault), ``sensor_fault`` (non-finite
 values, a speed beyond any vehicle's, dropped, repeated or backwards time stamps, a stuck,
 quantised, clipped or dead signal, a static level off the one ``SensorLimits.static_mps2``
-states: a scale fault), ``implausible`` (no GD in the emulator's domain explains the
-observation; with the change-point method also where a phase's last ``quiet_blocks`` blocks
-together read quieter than any GD explains: the quiet-signal check, see below),
-``out_of_domain`` (speed outside the emulator's range and no earlier estimate),
-``calibration_failed``, ``stale`` (no new information for ``max_age_s``). While the speed is
-outside the emulator's range (e.g. standing) there is no new information: the change-point
-estimate is carried on (its reason says so) until it turns stale.
+states, over a block or the last ``static_span`` samples: a scale fault), ``implausible`` (no
+GD in the emulator's domain explains the observation; with the change-point method also where
+a phase's last ``quiet_blocks`` blocks together read quieter than any GD explains: the
+quiet-signal check, see below), ``out_of_domain`` (speed outside the emulator's range and no
+earlier estimate), ``calibration_failed``, ``stale`` (no new information for ``max_age_s``).
+While the speed is outside the emulator's range (e.g. standing) there is no new information:
+the change-point estimate is carried on (its reason says so) until it turns stale.
 
 The quiet-signal check: a sensor gain below 1 (or sensor noise below the emulator's) lowers
 every band power and quantile and reads as smoother ground, within each block's scatter. Each
@@ -79,7 +79,14 @@ from control.changepoint import ChangePointFilter, ChangePointSettings, _mixture
 from control.errors import ControlError
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, feature_of_variance, features_of_blocks
-from control.sensor_checks import SensorLimits, signal_fault, stream_breaks, timing_fault
+from control.sensor_checks import (
+    SensorLimits,
+    StaticSpan,
+    signal_fault,
+    static_span_fault,
+    stream_breaks,
+    timing_fault,
+)
 from control.tracker import GDTracker, TrackerSettings
 from control.validation import (
     check_instance,
@@ -431,6 +438,8 @@ class BCR:
         # (one pickled before it had a note, the quiet-signal hold or the standing time)
         self.__dict__.update({"_start_note": "", "_held_by": None, "_standing_from": np.nan,
                               "_breaks": None, **state})  # fmt: skip
+        if "_span" not in state:  # (pickled before the static-level check's long span)
+            self._span = self._new_span()
         self._warm_up()
 
     def _warm_up(self) -> None:
@@ -537,6 +546,15 @@ class BCR:
         self._held_by: Estimate | None = None  # the implausible estimate that started a hold
         self._standing_from = np.nan  # first sample time of the newest standing blocks in a row
         self._tracked_at: list[float | None] = [None] * len(getattr(self, "trackers", ()))
+        self._span = self._new_span()
+
+    def _new_span(self) -> StaticSpan | None:
+        """The static-level check's long span (`SensorLimits.static_span`), empty; None where
+        the check or its span is off."""
+        sensor = self.settings.sensor
+        if sensor.static_mps2 is None or not sensor.static_span:
+            return None
+        return StaticSpan(sensor.static_span)
 
     def update(self, t, position, accel, speed, *, now: float | None = None) -> Estimate:
         """Take new samples; return the newest estimate (or why there is none), or the gravest
@@ -628,7 +646,12 @@ class BCR:
             keep = slice(k + 1, None) if drop[k] else slice(k, None)
             self._acc, self._spd, self._t, self._pos = acc[keep], spd[keep], t[keep], pos[keep]
             self._fresh = self._acc.size
+            if self._span is not None:  # a break: the long span starts again, as the buffer
+                self._span.restart()
+                self._span.push(self._acc)
             return
+        if self._span is not None:
+            self._span.push(acc)
         self._acc = np.concatenate([self._acc, acc])[-self.buffer :]
         self._spd = np.concatenate([self._spd, spd])[-self.buffer :]
         self._t = np.concatenate([self._t, t])[-self.buffer :]
@@ -753,7 +776,12 @@ class BCR:
             reason = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
             if reason:
                 return reason
-        return signal_fault(accel, s.sensor, steady=steady)
+        return signal_fault(accel, s.sensor, steady=steady) or self._span_reason()
+
+    def _span_reason(self) -> str:
+        """The static-level check's long span (`static_span_fault`): "" while it is off or not
+        yet full."""
+        return "" if self._span is None else static_span_fault(self._span, self.settings.sensor)
 
     def _window_signal_reason(self) -> str:
         """The window methods' checks: the signal checks on the buffer's samples that came
@@ -836,9 +864,12 @@ class BCR:
         elif spd.min() < MAX_SPEED_CHANGE * spd.max():
             why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"
         if why:  # the emulator knows constant speeds in its range only
-            timing = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
-            if timing:  # odometry that disagrees with the speeds (a sign flip, a wild speed)
-                return self._skip_block(phase, ds, "sensor_fault", timing, speed=v)
+            # odometry that disagrees with the speeds (a sign flip, a wild speed); a long span off
+            # the static level (standing too: a healthy axis then reads the level itself)
+            fault = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
+            fault = fault or self._span_reason()
+            if fault:
+                return self._skip_block(phase, ds, "sensor_fault", fault, speed=v)
             status, frozen = self._frozen_odometry(phase, acc, spd, standing_from)
             if status == "sensor_fault":  # standing by the odometry, driving by the accelerometer
                 return self._skip_block(phase, ds, status, frozen, speed=v)

@@ -80,6 +80,8 @@ STATIC_BLOCK = 125
 ``SensorLimits.static_tolerance`` holds; a shorter block's mean is held to that tolerance times
 ``STATIC_BLOCK / n`` (its mean is the change of vertical velocity over a shorter time: the
 window methods' chunks of ``update_every`` samples)."""
+MAX_STATIC_SPAN = 1 << 20
+"""Longest ``SensorLimits.static_span``, samples (2.4 h at 120 Hz; its ring holds 8 MiB)."""
 
 
 @dataclass(frozen=True)
@@ -168,7 +170,29 @@ class SensorLimits:
             GD 550-600). 0.2 leaves 1.27x that on level ground, and allows a slope of 10 degrees
             (the level reads g cos 10 = 0.985 g: 1.18x margin); a gain of 0.7 or below is flagged in
             its first block, 0.8 in about every other block, 0.9 only in blocks that read 11% of g
-            low (fast, rough ground).
+            low (fast, rough ground): the long span below catches it.
+        static_span: the static-level check's long span, samples (1,000: 8.3 s at 120 Hz; 0
+            switches it off): with ``static_mps2``, the mean of the newest ``static_span``
+            contiguous samples outside ``static_mps2 * (1 +- static_span_tolerance)`` is a scale
+            (or tilt) fault too (`static_span_level`), checked at every update once the span is
+            full. The BCR keeps it (`StaticSpan`, a running sum: O(1) per update) across its
+            blocks, phases and window restarts; a break in the stream (a dropped, repeated or
+            backwards sample, a gap), ``reset`` and ``resume`` start it again (it then checks
+            nothing for ``static_span`` samples); a fault of the checks does not (a persistent
+            scale fault is a fault at every update, until the span reads healthy again); a
+            standstill fills it too (a healthy axis at rest reads the level itself). The mean of
+            the vertical acceleration over a span is its change of vertical velocity over the
+            span's time, which shrinks as 1 / span: over clean drives (GD 200-600, 0.5-2 m/s,
+            with and without N(0, 1) noise; campaign seeds 7 and 11, 258 drives of 120 s, a
+            span every 42 samples) it reached 0.157 g over 125 samples, 0.078 g over 250, 0.046
+            g over 500 and 0.021 g over 1,000 (0.011 g over 2,000).
+        static_span_tolerance: the long span's tolerance, a fraction of ``static_mps2`` (0.07):
+            the dynamics' 0.021 g over 1,000 samples plus a slope of 15 degrees held for the
+            whole span (g cos 15 = 0.966 g: 0.055 g off in all, 1.27x margin; up to 18 degrees
+            on smooth ground). A gain of 0.9 reads at most 0.92 of the level over a full span and
+            is flagged once most of the span reads it (5-8 s after it begins); 0.95 lies within
+            the tolerance (an 18-degree slope reads as much), and so does a gain of up to 1.07
+            (less on a slope: 1.1 cos 15 = 1.06).
     """
 
     max_repeats: int = 8
@@ -186,17 +210,19 @@ class SensorLimits:
     odometry_slack_m: float = 0.1
     static_mps2: float | None = None
     static_tolerance: float = 0.2
+    static_span: int = 1000
+    static_span_tolerance: float = 0.07
 
     def __post_init__(self) -> None:
         require_reals(
             self,
             ("range_mps2", "max_level_jump", "dead_fraction", "free_fall_mps2", "noise_sd_mps2",
              "noise_floor", "lattice_p", "rate_tolerance", "odometry_tolerance",
-             "odometry_slack_m", "static_mps2", "static_tolerance"),
+             "odometry_slack_m", "static_mps2", "static_tolerance", "static_span_tolerance"),
             optional=("range_mps2", "free_fall_mps2", "noise_sd_mps2", "static_mps2"),
         )  # fmt: skip
         counts = ("max_repeats", "min_distinct", "max_same")
-        require_integers(self, counts)
+        require_integers(self, (*counts, "static_span"))
         for name in counts:
             value = getattr(self, name)
             if value < 1:
@@ -239,6 +265,16 @@ class SensorLimits:
             raise ControlError(
                 f"static_tolerance must lie in (0, 1) (a fraction of static_mps2), got "
                 f"{self.static_tolerance}"
+            )
+        if not (self.static_span == 0 or 2 <= self.static_span <= MAX_STATIC_SPAN):
+            raise ControlError(
+                f"static_span must be 0 (off) or an integer in [2, {MAX_STATIC_SPAN}] (samples), "
+                f"got {self.static_span}"
+            )
+        if not 0 < self.static_span_tolerance < 1:
+            raise ControlError(
+                f"static_span_tolerance must lie in (0, 1) (a fraction of static_mps2), got "
+                f"{self.static_span_tolerance}"
             )
 
 
@@ -354,10 +390,30 @@ def static_level(mean: float, n: int, limits: SensorLimits) -> str:
     """The static-level check (``SensorLimits.static_mps2``): why a block of ``n`` samples
     whose mean acceleration is ``mean`` (m/s^2) cannot come from a healthy axis of that static
     level (a scale fault, or an axis tilted from the vertical), or "" (also without a level)."""
-    static = limits.static_mps2
-    if static is None or n < 1:
+    if limits.static_mps2 is None or n < 1:
         return ""
     tol = limits.static_tolerance * max(1.0, STATIC_BLOCK / n)
+    return _off_static(mean, limits.static_mps2, tol, "the block's mean acceleration", f"{n}")
+
+
+def static_span_level(mean: float, limits: SensorLimits) -> str:
+    """The static-level check's long span (``SensorLimits.static_span``): why the mean
+    acceleration ``mean`` (m/s^2) of the newest ``static_span`` contiguous samples cannot come
+    from a healthy axis of level ``static_mps2`` (beyond ``static_span_tolerance``), or "" (also
+    without a level or a span)."""
+    if limits.static_mps2 is None or not limits.static_span:
+        return ""
+    n = limits.static_span
+    return _off_static(
+        mean, limits.static_mps2, limits.static_span_tolerance,
+        f"the last {n} samples' mean acceleration", f"a span of {n} (static_span)",
+    )  # fmt: skip
+
+
+def _off_static(mean: float, static: float, tol: float, what: str, over: str) -> str:
+    """The reason of `static_level` and `static_span_level` for ``what`` reading ``mean``
+    (m/s^2) against the level ``static`` and the tolerance ``tol`` over ``over`` samples, or
+    "" within it."""
     ratio = mean / static
     if abs(ratio - 1.0) <= tol:
         return ""
@@ -369,10 +425,92 @@ def static_level(mean: float, n: int, limits: SensorLimits) -> str:
     else:
         why = f"a sensor gain of about {ratio:.2g}"
     return (
-        f"scale or tilt: the block's mean acceleration {mean:.4g} m/s^2 is {ratio:.3g} of the "
-        f"static level {static:g} m/s^2 a healthy axis reads (allowed {1 - tol:.3g}-"
-        f"{1 + tol:.3g} over {n} samples): {why}"
+        f"scale or tilt: {what} {mean:.4g} m/s^2 is {ratio:.3g} of the static level {static:g} "
+        f"m/s^2 a healthy axis reads (allowed {1 - tol:.3g}-{1 + tol:.3g} over {over} samples): "
+        f"{why}"
     )
+
+
+class StaticSpan:
+    """The mean of the newest ``size`` contiguous samples of a stream (the static-level check's
+    long span, `static_span_level`): a ring of the samples and their running sum, O(1) per
+    sample (each is added once and taken off once). The ring is summed afresh each time it
+    wraps (the running sum's rounding then stays within `rounding`), for as long as a value
+    beyond ``MAX_ACCEL_MPS2`` is in it, and where a mean lies near the limit or off it
+    (`static_span_fault`), so that a verdict and its reason do not depend on how the stream was
+    chunked."""
+
+    def __init__(self, size: int) -> None:
+        self._ring = np.zeros(size)
+        self.restart()
+
+    def restart(self) -> None:
+        """Forget every sample (a break in the stream: the span starts again)."""
+        self._ring.fill(0.0)
+        self._next, self._held, self._total = 0, 0, 0.0
+        self._exact = 0  # samples to take before the running sum may be used again
+
+    @property
+    def full(self) -> bool:
+        """Whether the span holds ``size`` samples."""
+        return self._held == self._ring.size
+
+    @property
+    def rounding(self) -> float:
+        """A bound on the running mean's rounding, m/s^2: between two fresh sums at most ``size``
+        pushes of values within ``MAX_ACCEL_MPS2``, each of at most three roundings of a total
+        of at most ``size * MAX_ACCEL_MPS2``, plus a chunk's own sum (9e-8 m/s^2 for 1,000
+        samples; the rounding itself is ~1e-13 for accelerations within 100 m/s^2)."""
+        return 4.0 * self._ring.size * EPS * MAX_ACCEL_MPS2
+
+    def push(self, a: np.ndarray) -> None:
+        """Append the samples ``a`` (finite, m/s^2), the oldest ones leaving."""
+        ring, k = self._ring, a.size
+        size = ring.size
+        start, stop = self._next, self._next + k
+        if k >= size:
+            ring[:] = a[k - size :]
+            start, stop = 0, size
+        elif stop <= size:
+            self._total += float(a.sum()) - float(ring[start:stop].sum())
+            ring[start:stop] = a
+        else:
+            wrap = stop - size
+            self._total += float(a.sum()) - float(ring[start:].sum()) - float(ring[:wrap].sum())
+            ring[start:] = a[: size - start]
+            ring[:wrap] = a[size - start :]
+        self._next = stop % size
+        self._held = min(self._held + k, size)
+        if k and not np.abs(a).max() <= MAX_ACCEL_MPS2:  # a wild value: the running sum may
+            self._exact = size  # lose the others' digits; summed afresh until it has left
+        elif self._exact:
+            self._exact = max(self._exact - k, 0)
+            if not self._exact:  # (it has left)
+                self._total = float(ring.sum())
+        if stop >= size:  # (wrapped: its rounding forgotten)
+            self._total = float(ring.sum())
+
+    def running_mean(self) -> float:
+        """The span's mean from the running sum (summed afresh while a wild value is in it)."""
+        if self._exact:
+            return self.exact_mean()
+        return self._total / self._ring.size
+
+    def exact_mean(self) -> float:
+        """The span's mean summed afresh (the ring's order: its place in the stream)."""
+        return float(self._ring.sum() / self._ring.size)
+
+
+def static_span_fault(span: StaticSpan, limits: SensorLimits) -> str:
+    """`static_span_level` of a full `StaticSpan` ("" before it is full): the running mean
+    where it lies clearly within the tolerance, else the mean summed afresh."""
+    static = limits.static_mps2
+    if static is None or not span.full:
+        return ""
+    limit = limits.static_span_tolerance * abs(static) - span.rounding
+    if abs(span.running_mean() - static) < limit:  # (the usual case: clearly within it)
+        return ""
+    return static_span_level(span.exact_mean(), limits)
 
 
 def _distinct_count(ordered: np.ndarray, positive_gaps: np.ndarray) -> int:

@@ -188,7 +188,8 @@ def parser() -> argparse.ArgumentParser:
         "--static-mps2", type=float, default=None, metavar="M_PER_S2",
         help="the mean the up axis reads at rest, after --sign: 9.80665 for an IMU that reports "
         "gravity (specific force, REP-145); a block whose raw mean lies more than "
-        "SensorLimits.static_tolerance (20%%) off it is a scale fault (sensor_fault), with "
+        "SensorLimits.static_tolerance (20%%) off it, or a span of static_span (1000) samples "
+        "more than static_span_tolerance (7%%), is a scale fault (sensor_fault), with "
         "--gravity keep or highpass (checked before the filter); default: not checked",
     )  # fmt: skip
     p.add_argument(

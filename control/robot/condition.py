@@ -37,7 +37,7 @@ import numpy as np
 from scipy.stats import median_abs_deviation
 
 from control.errors import BagError, ControlError
-from control.sensor_checks import SensorLimits, static_level
+from control.sensor_checks import SensorLimits, static_level, static_span_level
 from control.validation import is_choice
 from vehicle.models import GRAVITY
 
@@ -458,13 +458,16 @@ def highpass(t: np.ndarray, a: np.ndarray, rate_hz: float, cutoff_hz: float) -> 
 
 
 def static_level_marks(
-    a: np.ndarray, limits: SensorLimits, every: int, block: int
+    a: np.ndarray, limits: SensorLimits, every: int, block: int, t: np.ndarray, rate_hz: float
 ) -> dict[int, str]:
     """The static-level check (`control.sensor_checks.static_level`) of the raw samples ``a``
-    (m/s^2, before a high-pass removes their static level) at each update of a BCR fed them
-    ``every`` samples at a time from the first: {the update's newest sample: the reason} for
-    each update whose block (its newest ``block`` samples, all finite: a non-finite one is a
-    fault the BCR reports itself) has a mean off ``limits.static_mps2``."""
+    (m/s^2, before a high-pass removes their static level; times ``t``, s, at ``rate_hz``) at
+    each update of a BCR fed them ``every`` samples at a time from the first: {the update's
+    newest sample: the reason} for each update whose block (its newest ``block`` samples, all
+    finite: a non-finite one is a fault the BCR reports itself) has a mean off
+    ``limits.static_mps2``, or, with ``limits.static_span``, whose newest ``static_span``
+    samples, finite and contiguous (steps within [0.5, ``GAP_PERIODS``] periods, as the BCR's
+    long span: `static_span_level`), have one off it by more than ``static_span_tolerance``."""
     a = np.asarray(a, dtype=float)
     finite = np.isfinite(a)
     total = np.concatenate([[0.0], np.cumsum(np.where(finite, a, 0.0))])
@@ -477,6 +480,21 @@ def static_level_marks(
         why = static_level(float((total[end] - total[end - block]) / block), block, limits)
         if why:
             marks[int(end - 1)] = why + " (the signal before the high-pass)"
+    span = limits.static_span
+    if span and a.size >= span:
+        step = np.diff(t, prepend=np.nan) * rate_hz
+        start = ~finite | ~np.isfinite(t) | ~((step >= 0.5) & (step <= GAP_PERIODS))
+        run = np.cumsum(start)  # (a run's first sample may be its start: finite, after a gap)
+        ends = np.arange(every, a.size + 1, every)
+        ends = ends[ends >= span]
+        whole = run[ends - 1] == run[ends - span]
+        whole &= finite[ends - span] & np.isfinite(t[ends - span])
+        windows = np.lib.stride_tricks.sliding_window_view(a, span)
+        for end in ends[whole]:
+            # each span summed on its own (a running sum would carry a wild value's rounding on)
+            why = static_span_level(float(windows[end - span].sum() / span), limits)
+            if why and int(end - 1) not in marks:
+                marks[int(end - 1)] = why + " (the signal before the high-pass)"
     return marks
 
 

@@ -145,13 +145,15 @@ class ReplaySettings:
         static_mps2: the mean the up axis reads at rest, m/s^2, after ``imu_sign``: +9.80665
             for an IMU that reports gravity (a sensor_msgs/Imu's specific force, REP-145);
             None (default): no static-level check. With it, a block whose raw mean lies
-            outside ``static_mps2 * (1 +- bcr.sensor.static_tolerance)`` is a scale (or tilt)
-            fault, ``sensor_fault`` (`control.SensorLimits.static_mps2`). With ``gravity=
+            outside ``static_mps2 * (1 +- bcr.sensor.static_tolerance)``, or whose newest
+            ``bcr.sensor.static_span`` contiguous samples (1,000) have a mean outside
+            ``static_mps2 * (1 +- static_span_tolerance)`` (7%: a gain of 0.9), is a scale (or
+            tilt) fault, ``sensor_fault`` (`control.SensorLimits.static_mps2`). With ``gravity=
             "keep"`` the BCR checks it (its ``sensor.static_mps2`` set to this); with
-            ``"highpass"`` the conditioning checks each update's block of the signal before the
-            filter (`condition.static_level_marks`) and marks a failing block's newest sample
-            non-finite, which the BCR reports as a sensor fault; the estimate's reason names
-            the level. An IMU that removes gravity itself cannot be checked so.
+            ``"highpass"`` the conditioning checks each update's block and span of the signal
+            before the filter (`condition.static_level_marks`) and marks a failing update's
+            newest sample non-finite, which the BCR reports as a sensor fault; the estimate's
+            reason names the level. An IMU that removes gravity itself cannot be checked so.
         max_clock_skew_s: on header stamps, IMU messages whose header clock runs further
             than this from the odometry's, s, against their receive times
             (`clock.header_skew`: an IMU stamped in GPS time, a driver's clock step) would be
@@ -892,11 +894,11 @@ def _condition(
     t, a = t[first:last], a[first:last]
     marks: dict[int, str] = {}
     if raw_check is not None:
-        marks = condition.static_level_marks(raw[first:last], *raw_check)
+        marks = condition.static_level_marks(raw[first:last], *raw_check, t, rate_hz)
         a[list(marks)] = np.nan
         if marks:
             notes.append(
-                f"{len(marks)} update(s) whose block read a static level off "
+                f"{len(marks)} update(s) whose block or span read a static level off "
                 f"{s.static_mps2:g} m/s^2 before the high-pass (a scale fault): their newest "
                 "sample marked non-finite (sensor_fault)"
             )
