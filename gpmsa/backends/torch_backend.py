@@ -446,16 +446,23 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
     return ll
 
 
-def log_prior_elements(priors: Priors, name: str, x: Tensor, element: int | None = None) -> Tensor:
+def log_prior_elements(priors: Priors, name: str, x: Tensor, element=None) -> Tensor:
     """GPM/SA log prior of each element of ``x`` (any shape); -inf outside the bounds.
 
     ``element``: x holds that element (index in a 1-D parameter) of ``name`` in every chain;
     None: x holds whole parameters, along its last axis (lamVz or betaV with per-group priors:
-    group g's prior on x[..., g]).
+    group g's prior on x[..., g]; theta with per-element priors: element k's on x[..., k]);
+    for theta also an index list: x[..., i] holds theta element ``element[i]``.
     """
     inf = torch.full_like(x, -torch.inf)
     if name == "theta":
-        val = -0.5 * ((x - priors.theta_mean) / priors.theta_sd) ** 2
+        if isinstance(element, int | np.integer):
+            mean, sd = priors.theta_prior(int(element))
+        else:  # floats where one prior is shared; per-element: tensors along the last axis
+            mean, sd = priors.theta_moments(x.shape[-1] if element is None else None, element)
+            if isinstance(mean, np.ndarray):
+                mean, sd = x.new_tensor(mean), x.new_tensor(sd)
+        val = -0.5 * ((x - mean) / sd) ** 2
         ok = (x > 0.0) & (x < 1.0)
     elif name in RHO_PARAMS:
         if element is None:  # betaV with per-group priors: group g's on x[..., g]
@@ -703,7 +710,7 @@ class BatchState:
 
         def log_post(theta: np.ndarray) -> float:
             th = like(theta).unsqueeze(0)
-            lp = log_prior_elements(self.priors, "theta", th[0, cont]).sum()
+            lp = log_prior_elements(self.priors, "theta", th[0, cont], cont).sum()
             if not torch.isfinite(lp) or (self.constraint is not None
                                           and not self.constraint(theta)):  # fmt: skip
                 return -math.inf
@@ -725,9 +732,9 @@ class BatchState:
         theta = cur.clone()
         theta[:, k] = cand
         theta[:, cont] = cur[:, cont] + (off[chains, new_row] - off[chains, row])
-        lp_new = log_prior_elements(self.priors, "theta", theta[:, cont]).sum(-1)
+        lp_new = log_prior_elements(self.priors, "theta", theta[:, cont], cont).sum(-1)
         lp_new = torch.where(found, lp_new, -torch.inf)
-        return theta, lp_new, log_prior_elements(self.priors, "theta", cur[:, cont]).sum(-1)
+        return theta, lp_new, log_prior_elements(self.priors, "theta", cur[:, cont], cont).sum(-1)
 
     def update(self, name: str, idx: tuple[int, ...], width: float | Tensor, kind: int,
                prop_mh: bool, u: Tensor) -> Tensor:  # fmt: skip

@@ -317,17 +317,16 @@ class Calibrator:
             self._predictors = [GridPredictor(gp, self._theta_unit, plan)
                                 for gp, plan in zip(self._gps, plans, strict=True)]  # fmt: skip
             self._refined = self._refined_predictors(refined, plans)
-        pri = emulator.priors
-        self._log_prior_theta = -0.5 * np.sum(
-            ((self._theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1
-        )
+        mean, sd = emulator.priors.theta_moments(q)  # floats, or per element (q,)
+        self._log_prior_theta = -0.5 * np.sum(((self._theta_unit - mean) / sd) ** 2, axis=1)
         if levels is not None:  # a categorical element: uniform over its levels (calibrate's)
             cont = [lv is None for lv in levels]
+            mean, sd = emulator.priors.theta_moments(q, np.flatnonzero(cont))
             self._log_prior_theta = -0.5 * np.sum(
-                ((self._theta_unit[:, cont] - pri.theta_mean) / pri.theta_sd) ** 2, axis=1
+                ((self._theta_unit[:, cont] - mean) / sd) ** 2, axis=1
             )
         self._weights = trapezoid_weights(self.theta_grid) if q == 1 else None
-        self._log_prior_norm = log_theta_norm(pri.theta_mean, pri.theta_sd)
+        self._log_prior_norm = log_theta_norm(*emulator.priors.theta_prior(0))  # q = 1's
         self._min_step = _float_step(std, 0)  # one parameter: float64's resolution
         self._base_ok = None if self.constraint is None else self._allowed(self._theta_unit)
         self._base_cut = None
@@ -693,8 +692,8 @@ class Calibrator:
         theta = np.empty((axis.size, 2))
         theta[:, c], theta[:, 1 - c] = axis, self._axes[1 - c][r]
         margs = self._marginals(data, theta)
-        pri = self.emulator.priors
-        logp = self._combine(margs) - 0.5 * ((axis - pri.theta_mean) / pri.theta_sd) ** 2
+        mean, sd = self.emulator.priors.theta_prior(c)
+        logp = self._combine(margs) - 0.5 * ((axis - mean) / sd) ** 2
         if table is not None:
             vals = interp_log(table, self._axes[c], axis[:, None], smooth=True)
             check_log_density(vals)
@@ -941,8 +940,8 @@ class Calibrator:
 
     def _theta_prior_at(self, theta_unit: np.ndarray, prior) -> np.ndarray:
         """The emulator's theta prior plus the user's at refined unit-scale nodes."""
-        pri = self.emulator.priors
-        base = -0.5 * np.sum(((theta_unit - pri.theta_mean) / pri.theta_sd) ** 2, axis=1)
+        mean, sd = self.emulator.priors.theta_moments(self.q)
+        base = -0.5 * np.sum(((theta_unit - mean) / sd) ** 2, axis=1)
         return base if prior is None else base + self._prior_values(prior, theta_unit, False)
 
     def _posterior(self, axes: list, free: np.ndarray, ok, margs: list, key, prior) -> Posterior:

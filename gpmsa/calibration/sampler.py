@@ -334,6 +334,8 @@ class CalibrationSampler:
         smooth = all(lv is None for lv in self.levels)
         self.preds = [ThetaPredictive(gp, data, expand=smooth) for gp in gps]
         self.priors = priors
+        priors.theta_moments(self.q)  # per-element priors: one per calibration parameter
+        self.theta_priors = [priors.theta_prior(k) for k in range(self.q)]  # (mean, sd) each
         self.lamos = data.lamos
         self.lam_power = data.lamos.shape - 1.0 - 0.5 * data.obs.n_null
         self.extra = log_prior
@@ -355,17 +357,17 @@ class CalibrationSampler:
             constraint.check_start(np.array(self.init_theta), what)
 
     def _log_prior_theta(self, theta: list[float]) -> float:
-        """Truncated-normal prior of unit-scale theta (plus the extra prior), pure Python."""
-        pri = self.priors
+        """Truncated-normal prior of unit-scale theta, element k under its own (mean, sd) (a
+        categorical element: uniform over its levels), plus the extra prior; pure Python."""
         lp = 0.0
-        for t, lv in zip(theta, self.levels, strict=True):
+        for t, lv, (mean, sd) in zip(theta, self.levels, self.theta_priors, strict=True):
             if lv is not None:  # uniform over the levels
                 if t not in lv:
                     return -math.inf
                 continue
             if not 0.0 < t < 1.0:
                 return -math.inf
-            z = (t - pri.theta_mean) / pri.theta_sd
+            z = (t - mean) / sd
             lp -= 0.5 * z * z
         if self.constraint is not None and not self.constraint(np.array(theta)):
             return -math.inf

@@ -171,7 +171,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
         some = any(_held_elements(v) for v in fixed.values())
         lines.append("fixed:           " + ", ".join(cells)
                      + (" (single elements: the others sampled)" if some else ""))  # fmt: skip
-    lines.extend(_prior_lines(manifest["priors"]))
+    lines.extend(_prior_lines(manifest["priors"], manifest["names"]["t"]))
     s = manifest["settings"]
     flat = [f"{safe(k, 60)}={plain(v)}" for k, v in s.items() if not isinstance(v, (list, dict))]
     lines.append("settings:        " + ", ".join(flat))
@@ -254,16 +254,28 @@ def _beta_v(priors: dict) -> str:
     return f"rho = exp(-betaV / 4) {text}"
 
 
-def _prior_lines(priors: dict) -> list[str]:
-    """The priors (validated): those a calibration with this file uses (theta, lamOs, lamVz, one
-    per precision group where so set; ``Emulator.with_calibration_priors`` changes them), then
-    the emulator's own (data-corrected)."""
+def _theta_prior(priors: dict, t_names: list[str]) -> str:
+    """theta's prior of validated priors: one Normal(mean, sd) on (0, 1) shared by every
+    calibration parameter, or NAME Normal(mean, sd) for each (per-element priors)."""
+    m, s = priors["theta_mean"], priors["theta_sd"]
+    if not isinstance(m, list) and not isinstance(s, list):
+        return f"theta Normal({number(m, '.6g')}, {number(s, '.6g')}) on (0, 1) (unit scale)"
+    ms, ss = (v if isinstance(v, list) else [v] * len(t_names) for v in (m, s))
+    cells = [f"{safe(n, 60)} Normal({number(a, '.6g')}, {number(b, '.6g')})"
+             for n, a, b in zip(t_names, ms, ss, strict=True)]  # fmt: skip
+    return f"theta [{', '.join(cells)}] on (0, 1) (unit scale, one per parameter)"
+
+
+def _prior_lines(priors: dict, t_names: list[str]) -> list[str]:
+    """The priors (validated): those a calibration with this file uses (theta, one per
+    calibration parameter ``t_names`` where so set, lamOs, lamVz, one per precision group where
+    so set; ``Emulator.with_calibration_priors`` changes them), then the emulator's own
+    (data-corrected)."""
     vz = priors["lamVz"]
     lam_vz = ("[" + ", ".join(_gamma(g) for g in vz) + "] (one per group)"
               if isinstance(vz, list) else _gamma(vz))  # fmt: skip
     return [
-        f"calibration priors: theta Normal({number(priors['theta_mean'], '.6g')}, "
-        f"{number(priors['theta_sd'], '.6g')}) on (0, 1) (unit scale), lamOs "
+        f"calibration priors: {_theta_prior(priors, t_names)}, lamOs "
         f"{_gamma(priors['lamOs'])}, lamVz {lam_vz}, {_beta_v(priors)}",
         f"emulator priors: rho = exp(-betaU / 4) Beta({number(priors['rho_a'], '.6g')}, "
         f"{number(priors['rho_b'], '.6g')}), lamUz {_gamma(priors['lamUz'])}, lamWs "

@@ -453,7 +453,7 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
     k_moved = order is not None and order != sorted(order)
     d_moved = discrepancy_moved(old_disc, new_disc, problem.obs)
     fixed = (settings.get("fixed", {}), fixed_record(problem))
-    priors = (_prior_record(emulator.priors, n_grp), _prior_record(problem.priors, n_grp))
+    priors = tuple(_prior_record(p, n_grp, problem.q) for p in (emulator.priors, problem.priors))
     differs = {
         "priors": priors[0] != priors[1] and not ((k_moved or d_moved) and _close(*priors)),
         "mean_basis": settings.get("mean_basis") != (None if mb is None else mb.kind),
@@ -488,12 +488,16 @@ def _close(a, b) -> bool:
     return a == b
 
 
-def _prior_record(priors: Priors, n_grp: int) -> dict:
-    """``priors.to_dict()`` with lamVz as the list of the ``n_grp`` groups' priors and rhoV_a,
-    rhoV_b as the lists of the groups' betaV Beta parameters (a shared prior, equal per-group
-    ones and, for betaV, none (betaU's) are one model); as written without a discrepancy, or
-    where the per-group priors do not fit the groups."""
+def _prior_record(priors: Priors, n_grp: int, q: int) -> dict:
+    """``priors.to_dict()`` with theta_mean, theta_sd as the lists of the ``q`` calibration
+    parameters' theta priors, lamVz as the list of the ``n_grp`` groups' priors and rhoV_a,
+    rhoV_b as the lists of the groups' betaV Beta parameters (a shared prior, equal per-element
+    or per-group ones and, for betaV, none (betaU's) are one model); as written without a
+    discrepancy, or where the per-element or per-group priors do not fit the model."""
     out = priors.to_dict()
+    if priors.theta_count in (None, q):
+        pairs = [priors.theta_prior(k) for k in range(q)]
+        out["theta_mean"], out["theta_sd"] = [m for m, _ in pairs], [s for _, s in pairs]
     if n_grp and (not priors.per_group or len(priors.lamVz) == n_grp):
         one = replace(priors, lamVz=priors.lamvz_priors(n_grp)).to_dict()
         out["lamVz"] = one["lamVz"]

@@ -665,7 +665,9 @@ class Emulator:
         self, *, theta_mean=None, theta_sd=None, lamOs=None, lamVz=None, rhoV_a=None, rhoV_b=None
     ) -> Emulator:
         """A copy of this emulator whose calibrations use other priors: theta's truncated normal
-        (``theta_mean``, ``theta_sd``, unit scale), the observation precision ``lamOs`` and the
+        (``theta_mean``, ``theta_sd``, unit scale: numbers, shared by every calibration
+        parameter, or sequences of one per parameter in ``t_names``' order, as ``Priors``
+        takes them), the observation precision ``lamOs`` and the
         discrepancy precision ``lamVz`` (``gpmsa.GammaPrior``s, before any data correction;
         ``lamVz`` also a sequence of them, one per discrepancy precision group, as
         ``Priors.lamVz``) and the discrepancy's correlation prior Beta(``rhoV_a``, ``rhoV_b``) on
@@ -686,6 +688,7 @@ class Emulator:
         if "lamVz" in given:
             given["lamVz"] = as_group_priors(given["lamVz"], "lamVz")
         priors = dataclasses.replace(self.priors, **given)  # checked by Priors' own rules
+        priors.theta_moments(self.q)  # per-element theta priors: one per calibration parameter
         state = self.__getstate__()
         state["priors"] = priors
         if given and state["calibration"] is not None:  # a joint fit's draws, made under the old

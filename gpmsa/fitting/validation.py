@@ -206,8 +206,9 @@ def _strings(value, n: int, field: str) -> list[str]:
     return value
 
 
-def check_priors(priors) -> None:
-    """The priors as ``Priors.to_dict`` writes them, with valid values."""
+def check_priors(priors, q: int | None = None) -> None:
+    """The priors as ``Priors.to_dict`` writes them, with valid values; per-element theta
+    priors (lists) one per each of the ``q`` calibration parameters (None: not checked)."""
     if not isinstance(priors, dict):
         raise _fail("priors", f"must be an object, got {_short(priors)}")
     expected = {*PRIOR_SCALARS, *PRECISIONS, "corrected"}
@@ -219,21 +220,13 @@ def check_priors(priors) -> None:
         )
     if PRIOR_OPTIONAL[0] in priors:
         _check_rhov(priors)
-    for name in PRIOR_SCALARS:
+    _check_theta_priors(priors, q)
+    for name in ("rho_a", "rho_b", "rho_cap"):
         v = _number(priors[name], f"priors.{name}")
-        ok = {
-            "theta_mean": math.isfinite(v),
-            "theta_sd": math.isfinite(v) and v > 0,
-            "rho_a": math.isfinite(v) and v > 0,
-            "rho_b": math.isfinite(v) and v > 0,
-            "rho_cap": 0 < v < 1,
-        }[name]
+        ok = 0 < v < 1 if name == "rho_cap" else math.isfinite(v) and v > 0
         if not ok:
-            allowed = {"theta_mean": "finite", "rho_cap": "(0, 1)"}.get(name, "(0, inf), finite")
+            allowed = "(0, 1)" if name == "rho_cap" else "(0, inf), finite"
             raise _fail(f"priors.{name}", f"{v!r} is out of range: allowed {allowed}")
-    bad = theta_prior_overflow(float(priors["theta_mean"]), float(priors["theta_sd"]))
-    if bad is not None:
-        raise _fail(f"priors.{bad[0]}", bad[1])
     if not isinstance(priors["corrected"], bool):
         raise _fail("priors.corrected", f"must be true or false, got {_short(priors['corrected'])}")
     for name in PRECISIONS:
@@ -245,6 +238,40 @@ def check_priors(priors) -> None:
                 _check_gamma(e, f"priors.lamVz[{i}]")
         else:
             _check_gamma(g, f"priors.{name}")
+
+
+def _check_theta_priors(priors: dict, q: int | None) -> None:
+    """theta_mean (finite), theta_sd (finite, > 0) as ``Priors.to_dict`` writes them: each a
+    number, or a list of one number per calibration parameter (``q`` of them where given; two
+    lists of equal length), every (mean, sd) pair with a float64 density."""
+    values = {}
+    for name, rule in (("theta_mean", "finite"), ("theta_sd", "(0, inf), finite")):
+        v = priors[name]
+        items = v if isinstance(v, list) else [v]
+        if not items:
+            raise _fail(f"priors.{name}", "an empty list: per-element priors need one per "
+                                          "calibration parameter")  # fmt: skip
+        if isinstance(v, list) and q is not None and len(v) != q:
+            raise _fail(f"priors.{name}", f"{len(v)} per-element theta priors, but the model has "
+                                          f"q = {q} calibration parameter(s)")  # fmt: skip
+        out = []
+        for i, e in enumerate(items):
+            field = f"priors.{name}[{i}]" if isinstance(v, list) else f"priors.{name}"
+            x = _number(e, field)
+            if not (math.isfinite(x) and (name == "theta_mean" or x > 0)):
+                raise _fail(field, f"{x!r} is out of range: allowed {rule}")
+            out.append(x)
+        values[name] = out
+    means, sds = values["theta_mean"], values["theta_sd"]
+    if len(means) > 1 and len(sds) > 1 and len(means) != len(sds):
+        raise _fail("priors.theta_sd", f"{len(sds)} per-element values, but priors.theta_mean "
+                                       f"has {len(means)}")  # fmt: skip
+    n = max(len(means), len(sds))
+    listed = isinstance(priors["theta_mean"], list) or isinstance(priors["theta_sd"], list)
+    for k in range(n):
+        bad = theta_prior_overflow(means[k % len(means)], sds[k % len(sds)])
+        if bad is not None:
+            raise _fail(f"priors.{bad[0]}" + (f"[{k}]" if listed else ""), bad[1])
 
 
 def _check_rhov(priors: dict) -> None:
@@ -538,7 +565,7 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
         raise _fail("names", f"input names must be unique, got {_short(inputs)}")
     if len(set(names["y"])) != len(names["y"]):
         raise _fail("names.y", "output names must be unique")
-    check_priors(manifest.get("priors"))
+    check_priors(manifest.get("priors"), q)
     model = manifest.get("model")
     if not isinstance(model, dict):
         raise _fail("model", f"must be an object, got {_short(model)}")

@@ -182,13 +182,22 @@ def _gamma(pri: Priors, name: str, size: int, rng: np.random.Generator) -> np.nd
     return out
 
 
-def _truncnorm01(mean: float, sd: float, size: int, rng: np.random.Generator) -> np.ndarray:
+def _truncnorm01(mean, sd, size: int, rng: np.random.Generator) -> np.ndarray:
+    """``size`` draws of Normal(mean, sd) truncated to (0, 1) by redrawing those outside;
+    ``mean``, ``sd``: floats, or arrays (size,) (per-element priors, element k under the k-th);
+    after 1000 rounds, those still outside uniform on (0.01, 0.99)."""
     out = rng.normal(mean, sd, size)
+    each = np.ndim(mean) > 0 or np.ndim(sd) > 0
+    if each:
+        mean, sd = np.broadcast_arrays(np.asarray(mean, float), np.asarray(sd, float))
     for _ in range(1000):
         bad = (out <= 0.0) | (out >= 1.0)
         if not bad.any():
             return out
-        out[bad] = rng.normal(mean, sd, int(bad.sum()))
+        if each:
+            out[bad] = rng.normal(mean[bad], sd[bad])
+        else:
+            out[bad] = rng.normal(mean, sd, int(bad.sum()))
     out[bad] = rng.uniform(0.01, 0.99, int(bad.sum()))
     return out
 
@@ -288,7 +297,7 @@ def _theta_start(problem: Problem, how: str, size: int, rng: np.random.Generator
         if how == "jitter":
             val = rng.uniform(0.1, 0.9, size)
         else:
-            val = _truncnorm01(pri.theta_mean, pri.theta_sd, size, rng)
+            val = _truncnorm01(*pri.theta_moments(size), size, rng)
         if problem.theta_levels is not None:  # a categorical element starts at its nearest level
             val = problem.snap_theta(val)
         val = hold(problem, "theta", val)

@@ -94,7 +94,13 @@ class GammaPrior:
 class Priors:
     """GPM/SA priors (Gamma in shape/rate form); data corrections are added by ``with_data``.
 
-    theta (unit scale): Normal(theta_mean, theta_sd) truncated to (0, 1).
+    theta (unit scale): Normal(theta_mean, theta_sd) truncated to (0, 1). ``theta_mean``,
+    ``theta_sd``: numbers (one prior shared by every calibration parameter), or sequences of
+    one number per calibration parameter (stored as tuples; element k gets the k-th; SEPIA's
+    ``model.params.theta.prior.params``), which a model checks against its q; one of them a
+    number and the other a sequence: the number is shared. theta_mean finite, theta_sd finite
+    and > 0. A categorical theta element's prior is uniform over its levels whatever its entry
+    here; a hierarchical study element's is its group's.
     betaU: Beta(rho_a, rho_b) on rho = exp(-beta/4), rho capped at ``rho_cap`` in the density;
     beta in (0, inf). betaV: Beta(rhoV_a, rhoV_b) likewise (GPM/SA's priors.rhoV), under the same
     cap; None for both (the default): betaU's Beta(rho_a, rho_b). ``rhoV_a``, ``rhoV_b``: both
@@ -108,8 +114,8 @@ class Priors:
     group g's lamVz[g] gets the g-th; a model with a discrepancy of G groups needs G of them.
     """
 
-    theta_mean: float = 0.5
-    theta_sd: float = 10.0
+    theta_mean: float | tuple[float, ...] = 0.5
+    theta_sd: float | tuple[float, ...] = 10.0
     rho_a: float = 1.0
     rho_b: float = 0.1
     rho_cap: float = 0.999
@@ -125,22 +131,13 @@ class Priors:
     rhoV_b: float | tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
-        allowed = {
-            "theta_mean": "finite",
-            "theta_sd": "finite and > 0",
-            "rho_a": "finite and > 0",
-            "rho_b": "finite and > 0",
-            "rho_cap": "in (0, 1)",
-        }
+        self._check_theta()
+        allowed = {"rho_a": "finite and > 0", "rho_b": "finite and > 0", "rho_cap": "in (0, 1)"}
         for name, rule in allowed.items():
             v = _real(self, name)
-            ok = 0 < v < 1 if name == "rho_cap" else math.isfinite(v) and (
-                name == "theta_mean" or v > 0)  # fmt: skip
+            ok = 0 < v < 1 if name == "rho_cap" else math.isfinite(v) and v > 0
             if not ok:
                 raise GPMSAError(f"Priors.{name} must be {rule}, got {v}")
-        bad = theta_prior_overflow(self.theta_mean, self.theta_sd)
-        if bad is not None:
-            raise GPMSAError(f"Priors.{bad[0]} = {bad[1]}")
         object.__setattr__(self, "lamVz", as_group_priors(self.lamVz, "Priors.lamVz"))
         for name in PRECISIONS:
             if name != "lamVz" and not isinstance(getattr(self, name), GammaPrior):
@@ -149,6 +146,63 @@ class Priors:
         if not isinstance(self.corrected, bool):
             raise GPMSAError(f"Priors.corrected must be True or False, got {self.corrected!r}")
         self._check_rhov()
+
+    def _check_theta(self) -> None:
+        """theta_mean (finite), theta_sd (finite, > 0): each a float, or a tuple of floats (one
+        per calibration parameter), both tuples of equal length; every (mean, sd) pair with a
+        float64 density (``theta_prior_overflow``); GPMSAError naming the field otherwise."""
+        m = _theta_values(self.theta_mean, "Priors.theta_mean", "finite", math.isfinite)
+        s = _theta_values(self.theta_sd, "Priors.theta_sd", "finite and > 0",
+                          lambda v: math.isfinite(v) and v > 0)  # fmt: skip
+        if isinstance(m, tuple) and isinstance(s, tuple) and len(m) != len(s):
+            raise GPMSAError(
+                f"Priors.theta_mean gives {len(m)} per-element value(s) but Priors.theta_sd "
+                f"{len(s)}: give one of each per calibration parameter (or a number, shared)"
+            )
+        object.__setattr__(self, "theta_mean", m)
+        object.__setattr__(self, "theta_sd", s)
+        for k in range(self.theta_count or 1):
+            bad = theta_prior_overflow(*self.theta_prior(k))
+            if bad is not None:
+                where = f"[{k}]" if self.theta_count else ""
+                raise GPMSAError(f"Priors.{bad[0]}{where} = {bad[1]}")
+
+    @property
+    def theta_count(self) -> int | None:
+        """The number of calibration parameters per-element theta priors are for (the length of
+        theta_mean or theta_sd given as a sequence); None where one prior is shared by all."""
+        for v in (self.theta_mean, self.theta_sd):
+            if isinstance(v, tuple):
+                return len(v)
+        return None
+
+    def theta_prior(self, element: int) -> tuple[float, float]:
+        """(mean, sd) of the truncated normal prior of unit-scale theta element ``element``."""
+        m, s = self.theta_mean, self.theta_sd
+        return (m[element] if isinstance(m, tuple) else m,
+                s[element] if isinstance(s, tuple) else s)  # fmt: skip
+
+    def theta_moments(self, q: int | None = None, elements=None):
+        """(mean, sd) of theta's truncated normal priors: the two floats where one prior is
+        shared by every element (so that such priors compute as they always have), else two
+        float arrays (q,) (each element's), or their ``elements`` (an index or index list).
+        ``q``: the model's number of calibration parameters, checked against per-element priors
+        (GPMSAError naming the field and both counts); None: not checked."""
+        n = self.theta_count
+        if n is None:
+            return self.theta_mean, self.theta_sd
+        if q is not None and n != q:
+            field = "theta_mean" if isinstance(self.theta_mean, tuple) else "theta_sd"
+            raise GPMSAError(
+                f"Priors.{field} gives {n} per-element theta prior(s) but the model has q = {q} "
+                "calibration parameter(s): give one value per calibration parameter (in "
+                "t_names' order), or one number shared by all"
+            )
+        m, s = (np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+                for v in (self.theta_mean, self.theta_sd))  # fmt: skip
+        if elements is None:
+            return m.copy(), s.copy()
+        return m[elements], s[elements]
 
     def _check_rhov(self) -> None:
         """rhoV_a, rhoV_b: both None, both numbers or both sequences of equal length (stored as
@@ -271,8 +325,12 @@ class Priors:
     def to_dict(self) -> dict:
         """JSON-able dict (infinite bounds as the string "inf"); per-group lamVz priors as a
         list of such dicts, one per group; rhoV_a, rhoV_b only where set (a number, or a list
-        of one per group), so that priors without them have the dict they had before."""
+        of one per group), so that priors without them have the dict they had before; per-element
+        theta_mean, theta_sd as lists (a shared one as the number it always was)."""
         d = asdict(self)
+        for name in ("theta_mean", "theta_sd"):
+            if isinstance(d[name], tuple):
+                d[name] = list(d[name])
         for name in RHOV:
             if d[name] is None:
                 del d[name]
@@ -307,12 +365,16 @@ class Priors:
                 kw[name] = _gamma_from(g, name)
         return cls(**kw)
 
-    def log_theta(self, theta: np.ndarray) -> float:
-        """Log prior of theta (unit scale); -inf outside (0, 1)."""
+    def log_theta(self, theta: np.ndarray, elements=None) -> float:
+        """Log prior of theta (unit scale): the whole vector (q,), or with ``elements`` (index
+        list) those elements of it; -inf outside (0, 1)."""
         theta = np.asarray(theta)
         if np.any(theta <= 0.0) or np.any(theta >= 1.0):
             return -np.inf
-        return float(-0.5 * np.sum(((theta - self.theta_mean) / self.theta_sd) ** 2))
+        each = elements is None and self.theta_count is not None
+        q = (theta.shape[-1] if theta.ndim else 1) if each else None
+        mean, sd = self.theta_moments(q, elements)
+        return float(-0.5 * np.sum(((theta - mean) / sd) ** 2))
 
     def log_beta(self, beta: np.ndarray, name: str = "betaU") -> float:
         """Log prior of correlation parameters beta of ``name`` (betaU or betaV; betaV's
@@ -326,10 +388,10 @@ class Priors:
 
     def scalar_log_prior(self, name: str, element: int = 0):
         """A fast function float -> float: the log prior of element ``element`` (its index in a
-        1-D parameter, its column in a 2-D one: lamVz's or betaV's group, whose prior may be its
-        own) of ``name``."""
+        1-D parameter, its column in a 2-D one: theta's element, lamVz's or betaV's group, whose
+        prior may be its own) of ``name``."""
         if name == "theta":
-            mu, sd = self.theta_mean, self.theta_sd
+            mu, sd = self.theta_prior(element)
 
             def f(x: float) -> float:
                 return -0.5 * ((x - mu) / sd) ** 2 if 0.0 < x < 1.0 else -math.inf
@@ -372,6 +434,28 @@ class Priors:
         if name in PRECISIONS:
             return getattr(self, name).log_density(value)
         raise GPMSAError(f"unknown parameter name {name!r}")
+
+
+def _theta_values(value, name: str, rule: str, ok) -> float | tuple[float, ...]:
+    """``value`` as theta_mean or theta_sd: a float, or a tuple of floats (one per calibration
+    parameter), each passing ``ok`` (``rule`` says what it needs); GPMSAError naming ``name``
+    (and the element) otherwise."""
+    many = isinstance(value, list | tuple) or (isinstance(value, np.ndarray) and value.ndim == 1)
+    items = list(value) if many else [value]
+    if many and not items:
+        raise GPMSAError(
+            f"{name} must be a number or a non-empty sequence of numbers (one per calibration "
+            f"parameter), got {value!r:.80}"
+        )
+    out = []
+    for i, v in enumerate(items):
+        where = f"{name}[{i}]" if many else name
+        if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+            raise GPMSAError(f"{where} must be a real number, got {v!r:.60} ({type(v).__name__})")
+        if not ok(float(v)):
+            raise GPMSAError(f"{where} must be {rule}, got {float(v)}")
+        out.append(float(v))
+    return tuple(out) if many else out[0]
 
 
 def _rho_values(value, name: str) -> float | tuple[float, ...]:

@@ -137,8 +137,11 @@ class Problem:
     separable: kronecker.Separable | None = None
 
     def __post_init__(self) -> None:
-        """GPMSAError when per-group lamVz or betaV priors do not give one prior per discrepancy
-        precision group (``Priors.lamvz_priors``, ``Priors.rhov_priors``), before any sampling."""
+        """GPMSAError when per-element theta priors do not give one prior per calibration
+        parameter, or per-group lamVz or betaV priors one per discrepancy precision group
+        (``Priors.theta_moments``, ``Priors.lamvz_priors``, ``Priors.rhov_priors``), before any
+        sampling."""
+        self.priors.theta_moments(self.q)
         if self.obs is not None and self.obs.p_v:
             self.priors.lamvz_priors(self.obs.n_groups)
             self.priors.rhov_priors(self.obs.n_groups)
@@ -285,7 +288,7 @@ def theta_log_prior(priors: Priors, levels, theta) -> float:
     if any(lv is not None and not np.any(lv == v) for lv, v in zip(levels, theta, strict=True)):
         return -np.inf
     cont = [k for k, lv in enumerate(levels) if lv is None]
-    return priors.log_prior("theta", theta[cont]) if cont else 0.0
+    return priors.log_theta(theta[cont], cont) if cont else 0.0
 
 
 def fixed_record(problem: Problem, names=None) -> dict:

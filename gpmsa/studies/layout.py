@@ -122,7 +122,8 @@ start (every proposal rejected, lam drifting to 1e308, the group sd reported as 
 @dataclass(frozen=True)
 class Element:
     """One study element: its display name, the parameter's name, the (model, theta index) pairs
-    that use it, its hierarchical group (-1: none) and the theta prior (mean, sd) of its models."""
+    that use it, its hierarchical group (-1: none) and its models' theta prior (mean, sd) of
+    it (``Priors.theta_prior``; a hierarchical element's is its group's instead)."""
 
     name: str
     param: str
@@ -199,21 +200,36 @@ def check_labels(labels, n_models: int) -> tuple[str, ...]:
     return labels
 
 
+def model_theta_priors(priors, q: int) -> list[tuple[float, float]]:
+    """The theta prior (mean, sd) of each of a model's ``q`` calibration parameters under its
+    ``priors`` (a ``gpmsa.Priors``: one shared, or per element; GPMSAError where those are not
+    one per parameter)."""
+    priors.theta_moments(q)
+    return [priors.theta_prior(k) for k in range(q)]
+
+
+def _element_prior(priors, k: int) -> tuple[float, float]:
+    """Parameter k's (mean, sd) of one model's theta priors as ``build_layout`` takes them."""
+    shared = len(priors) == 2 and all(isinstance(v, int | float) for v in priors)
+    return tuple(priors) if shared else tuple(priors[k])
+
+
 def build_layout(
     labels: tuple[str, ...],
     t_names: list[tuple[str, ...]],
     t_bounds: list[tuple[np.ndarray, np.ndarray]],
-    theta_priors: list[tuple[float, float]],
+    theta_priors: list,
     shared=(),
     hierarchical=(),
 ) -> Layout:
     """The study's layout from each model's parameter names, native (t_min, t_max) and theta
-    prior (mean, sd).
+    priors: per model, one (mean, sd) shared by its parameters or a list of one (mean, sd) per
+    parameter (``model_theta_priors``).
 
     Raises GPMSAError naming the problem: a shared or hierarchical name no model has or only one
     model has, a name both shared and hierarchical, models whose ranges (t_min, t_max) of a
     shared or hierarchical parameter differ (the unit scale would mean different things), a
-    shared parameter whose models' theta priors differ.
+    shared parameter whose models' theta priors (of that parameter) differ.
     """
     shared = _names(shared, "shared")
     hier = _names(hierarchical, "hierarchical")
@@ -253,10 +269,11 @@ def build_layout(
             if n in by_shared:
                 e = by_shared[n]
                 el = elements[e]
-                if el.prior != tuple(theta_priors[i]):
+                prior = _element_prior(theta_priors[i], k)
+                if el.prior != prior:
                     raise GPMSAError(
-                        f"shared parameter {n!r}: the models' theta priors differ "
-                        f"({labels[el.uses[0][0]]}: {el.prior}, {labels[i]}: {theta_priors[i]})"
+                        f"shared parameter {n!r}: the models' theta priors (mean, sd) of it "
+                        f"differ ({labels[el.uses[0][0]]}: {el.prior}, {labels[i]}: {prior})"
                     )
                 elements[e] = Element(el.name, n, (*el.uses, (i, k)), -1, el.prior)
             else:
@@ -265,7 +282,8 @@ def build_layout(
                     by_shared[n] = e
                 name = n if n in shared else f"{n}[{labels[i]}]"
                 group = hier.index(n) if n in hier else -1
-                elements.append(Element(name, n, ((i, k),), group, tuple(theta_priors[i])))
+                elements.append(Element(name, n, ((i, k),), group,
+                                        _element_prior(theta_priors[i], k)))  # fmt: skip
                 bounds.append((float(lo[k]), float(hi[k])))
             row.append(e)
         index.append(row)

@@ -52,6 +52,7 @@ from gpmsa.studies.layout import (
     check_hyper,
     check_labels,
     check_study_names,
+    model_theta_priors,
 )
 from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
 from gpmsa.studies.sampler import StudyChains, held_elements, sample_study
@@ -738,7 +739,7 @@ def fit_study(
     layout = build_layout(
         labels, [tuple(s.t_names) for s in sims],
         [(p.standardizer.t_min, p.standardizer.t_max) for p in preps],
-        [(p.problem.priors.theta_mean, p.problem.priors.theta_sd) for p in preps],
+        [model_theta_priors(p.problem.priors, p.problem.q) for p in preps],
         shared, hierarchical,
     )  # fmt: skip
     check_study_names(layout)

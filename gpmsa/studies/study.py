@@ -35,7 +35,7 @@ from gpmsa.io.container import (
 from gpmsa.mcmc.diagnostics import convergence, summarize, to_inference_data
 from gpmsa.model.data import as_real, check_count
 from gpmsa.model.discrepancy import to_samples
-from gpmsa.studies.layout import HyperPriors, Layout, build_layout
+from gpmsa.studies.layout import HyperPriors, Layout, build_layout, model_theta_priors
 from gpmsa.studies.record import (
     DISCREPANCIES,
     FILE_RE,
@@ -63,11 +63,12 @@ can come back an ulp off."""
 
 
 def layout_of(emulators, labels, shared, hierarchical) -> Layout:
-    """The study layout of fitted emulators (their t names, t ranges and theta priors)."""
+    """The study layout of fitted emulators (their t names, t ranges and theta priors); a
+    GPMSAError where per-element theta priors do not give one per calibration parameter."""
     return build_layout(
         tuple(labels), [tuple(e.t_names) for e in emulators],
         [(e.standardizer.t_min, e.standardizer.t_max) for e in emulators],
-        [(e.priors.theta_mean, e.priors.theta_sd) for e in emulators], shared, hierarchical,
+        [model_theta_priors(e.priors, len(e.t_names)) for e in emulators], shared, hierarchical,
     )  # fmt: skip
 
 
