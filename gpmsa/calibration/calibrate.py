@@ -33,6 +33,7 @@ from gpmsa.calibration.observations import (
     check_y,
     checked_obs_data,
     closer_fit,
+    draw_positions,
     emulator_param_sets,
     emulator_record,
     fit_at_levels,
@@ -260,7 +261,9 @@ def calibrate(
             ``info["seed"]`` (``seed=`` that integer repeats it).
         backend: "numpy" (default), "torch" or "pyro" (``gpmsa.backends.available()``).
         emulator_params: "point" (the emulator's point estimate) or "draws" (the likelihood
-            averaged over ``n_emulator_draws`` of its retained draws; numpy fast path only).
+            averaged over ``n_emulator_draws`` of its retained draws; numpy fast path only;
+            ``info["emulator_draws"]`` then records, per sample, the retained draw it was drawn
+            with, which ``calibrated_predict(..., draws=True)`` pairs with its theta).
             ``n_emulator_draws`` must be an integer >= 1 in either mode (at most the retained
             draws are used).
         discrepancy: None (no discrepancy, the default) or a discrepancy basis (generic backends):
@@ -404,6 +407,7 @@ def calibrate(
                 {**theta_opts, "fixed": held, "fit": None if discrepancy is not None else fit},
             )  # fmt: skip
     held_names = info.pop("held_names", ())
+    set_index = info.pop("set_index", None)
     for k, value in calibration_held_native(emulator, fixed).items():  # the value given
         draws[emulator.t_names[k]][...] = value
     require_finite(draws)
@@ -419,6 +423,9 @@ def calibrate(
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
         backend_options=backends.recorded_options(options),
     )  # fmt: skip
+    if emulator_params == "draws":  # the retained draw each sample was drawn with
+        positions = draw_positions(emulator, n_emulator_draws)
+        info["emulator_draws"] = positions[set_index[:, n_burn:].reshape(-1)]
     codes = theta_levels_native(emulator)
     if codes:  # a categorical theta: its quantiles are levels (Posterior.quantile)
         info["levels"] = codes
@@ -581,6 +588,7 @@ def _run_fast(
             theta[:, :, k] = np.round(theta[:, :, k])
     draws = {name: theta[:, :, k] for k, name in enumerate(emulator.t_names)}
     draws["lamOs"] = np.stack([r.lamOs for r in runs])
+    set_index = np.stack([r.index for r in runs])  # (chains, n): the emulator set per draw
     rates, widths = np.stack([r.accept_rate for r in runs]), np.stack([r.widths for r in runs])
     held = [*(held_theta or ())] + ([sampler.q] if held_lamos is not None else [])
     rates[:, held] = widths[:, held] = np.nan  # held: no step, no acceptance (as the backends)
@@ -590,6 +598,7 @@ def _run_fast(
         "accept_rate": rates.tolist(),
         "step_widths": widths.tolist(),
         "chebyshev": all(p.cheb is not None or p.cheb2 is not None for p in sampler.preds),
+        "set_index": set_index,  # calibrate's info["emulator_draws"] (popped there)
     }
     moves = level_moves.chains_record([r.level_offsets for r in runs], runs[0].level_shifted)
     if moves:  # a categorical theta's joint level move, per chain (native units)

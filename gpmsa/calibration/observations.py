@@ -112,12 +112,19 @@ def emulator_param_sets(emulator, mode: str, n_sets: int) -> list[dict]:
         raise GPMSAError(f"emulator_params must be one of {EMULATOR_PARAM_MODES}, got {mode!r}")
     if mode == "point":
         return [emulator.params]
+    idx = draw_positions(emulator, n_sets)
+    return [{k: np.asarray(emulator.draws[k][i]) for k in EMULATOR_PARAMS} for i in idx]
+
+
+def draw_positions(emulator, n_sets: int) -> np.ndarray:
+    """The retained draws (their positions in ``emulator.draws``) that ``emulator_params="draws"``
+    conditions on, in the order of its sets: ``n_sets`` evenly spaced (``evenly_spaced``);
+    GPMSAError when the emulator kept none."""
     draws = getattr(emulator, "draws", None) or {}
     n = len(next(iter(draws.values()))) if draws else 0
     if n == 0:
         raise GPMSAError("emulator_params='draws' needs retained draws; this emulator has none")
-    idx = evenly_spaced(n, n_sets, "n_emulator_draws")
-    return [{k: np.asarray(draws[k][i]) for k in EMULATOR_PARAMS} for i in idx]
+    return evenly_spaced(n, n_sets, "n_emulator_draws")
 
 
 @cache

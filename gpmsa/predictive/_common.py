@@ -157,6 +157,46 @@ def check_posterior_emulator(emulator, posterior) -> None:
     )
 
 
+def paired_draws(emulator, posterior, what: str) -> np.ndarray:
+    """(n,) per posterior sample, the position in ``emulator.draws`` of the emulator parameters
+    drawn jointly with it: ``info["emulator_draws"]`` (``gpmsa.calibrate(...,
+    emulator_params="draws")``), or draw i for sample i where the posterior's theta draws are
+    the emulator's own joint-fit draws (``calibration_posterior``). GPMSAError where the
+    emulator kept no draws or the posterior holds none jointly with theta."""
+    kept = emulator.n_draws if getattr(emulator, "draws", None) else 0
+    if kept == 0:
+        raise GPMSAError(f"{what} with draws=True needs the emulator's retained draws, but this "
+                         f"emulator kept none {NO_DRAWS}; pass draws=False")  # fmt: skip
+    names = tuple(emulator.t_names)
+    n = np.size(posterior.samples[names[0]])
+    recorded = posterior.info.get("emulator_draws")
+    if recorded is not None:
+        pos = np.asarray(recorded)
+        if (pos.shape != (n,) or pos.dtype.kind not in "iu" or (n and not (
+                0 <= pos.min() and pos.max() < kept))):  # fmt: skip
+            raise GPMSAError(
+                f"posterior info['emulator_draws'] must hold one position in the emulator's "
+                f"{kept} retained draws per sample ({n}), got shape {pos.shape}, dtype {pos.dtype}"
+            )
+        return pos
+    cal = getattr(emulator, "calibration", None)
+    if cal and n == kept:
+        theta = np.asarray(cal["theta_native"], dtype=float)
+        own = all(np.array_equal(np.asarray(posterior.samples[k], dtype=float), theta[:, j])
+                  for j, k in enumerate(names))  # fmt: skip
+        if own:
+            return np.arange(n)
+    why = ("its theta draws are not this emulator's joint-fit draws" if cal else
+           "this emulator was fitted without observations, so it has no theta draws")  # fmt: skip
+    raise GPMSAError(
+        f"{what} with draws=True pairs each theta draw with the emulator-parameter draw drawn "
+        f"with it, but this posterior records none (info['emulator_draws']: gpmsa.calibrate at "
+        f"the point estimate, a grid Calibrator, a Posterior made by hand) and {why}: pass "
+        "gpmsa.calibration_posterior(emu) of a joint fit (gpmsa.fit(data, obs)), a posterior "
+        "of gpmsa.calibrate(..., emulator_params='draws'), or draws=False"
+    )
+
+
 def gpmsa_model_only(emulator, what: str, *, callable_basis: bool = True) -> None:
     """GPMSAError when ``emulator`` is not a gpmsa.Emulator, or, where ``what`` integrates the
     mean over the inputs (``callable_basis`` False: only the named mean bases,

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
-from gpmsa.calibration.observations import EMULATOR_ATTRS, check_x
+from gpmsa.calibration.observations import EMULATOR_ATTRS, blas_controller, check_x
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import (
@@ -22,8 +22,10 @@ from gpmsa.model.data import (
 )
 from gpmsa.model.discrepancy import has_draws
 from gpmsa.predictive._common import (
+    EMULATOR_PARAMS,
     check_posterior_emulator,
     lacks_text,
+    paired_draws,
     posterior_lamos,
     posterior_theta,
 )
@@ -102,6 +104,7 @@ def calibrated_predict(
     *,
     noise: bool = False,
     resid: bool = True,
+    draws: bool = False,
     n_theta: int = 200,
     extrapolate: bool = False,
 ) -> CalibratedPrediction:
@@ -110,7 +113,9 @@ def calibrated_predict(
     Each mixture component is the emulator's Gaussian predictive (``Emulator.predict``, point
     estimate) at (x_new, theta_k). For a grid posterior of one parameter the components are the
     grid nodes carrying mass, weighted by the exact posterior (trapezoid weights); otherwise up to
-    ``n_theta`` evenly spaced posterior draws, equally weighted.
+    ``n_theta`` evenly spaced posterior draws, equally weighted. ``draws=True``: each draw's
+    component at the emulator parameters drawn with that theta (GPM/SA's gPred 'wpred' after a
+    joint fit, SEPIA's predictions from ``samples``), so the spread includes theirs.
 
     Args:
         emulator: the gpmsa.Emulator the posterior was computed with.
@@ -125,6 +130,12 @@ def calibrated_predict(
             A posterior with discrepancy draws (lamVz) is refused (GPMSAError): a new
             observation then includes the discrepancy, which ``gpmsa.full_prediction`` adds.
         resid: include the emulator's nugget and residual variance (see ``Emulator.predict``).
+        draws: pair each theta draw with its own draw of the emulator parameters (betaU,
+            lamUz, lamWs, lamWOs) instead of the point estimate: where the posterior holds them
+            jointly, ``calibration_posterior`` of a joint fit (the fit's draw i with theta's
+            draw i) or ``gpmsa.calibrate(..., emulator_params="draws")`` (its
+            ``info["emulator_draws"]``); another posterior (calibrated at the point estimate,
+            a grid ``Calibrator``'s, one made by hand) is refused (GPMSAError).
         n_theta: at most this many posterior draws when draws are used.
         extrapolate: allow x_new outside the emulator's x domain, however far (with a
             warning naming x_new), as ``gpmsa.calibrate`` allows x_obs; False: within
@@ -139,6 +150,7 @@ def calibrated_predict(
         raise GPMSAError(f"emulator lacks {missing}: calibrated_predict needs a gpmsa.Emulator, "
                          f"got {type(emulator).__name__}")  # fmt: skip
     noise, resid = check_flag(noise, "noise"), check_flag(resid, "resid")
+    draws = check_flag(draws, "draws")
     extrapolate = check_flag(extrapolate, "extrapolate")
     x, _ = check_x(emulator, x_new, extrapolate, "x_new")
     if not isinstance(posterior, Posterior):
@@ -156,9 +168,11 @@ def calibrated_predict(
             "emulator, obs, x, posterior=posterior, discrepancy=...) and its 'y', or noise=False "
             "for the simulator output at the calibrated theta"
         )
+    paired = paired_draws(emulator, posterior, "calibrated_predict") if draws else None
     lam = None
     inv_lam = posterior.info.get("expected_inv_lamOs")
-    if len(names) == 1 and names[0] in posterior.grids and (inv_lam is not None or not noise):
+    on_grid = len(names) == 1 and names[0] in posterior.grids and paired is None
+    if on_grid and (inv_lam is not None or not noise):
         g = posterior.grids[names[0]]
         w = g.weights * g.density
         live = w > 1e-12 * w.max()
@@ -179,7 +193,11 @@ def calibrated_predict(
     ts = np.repeat(theta, N, axis=0)
     with warnings.catch_warnings():  # x_new and theta were checked (and warned about) above
         warnings.simplefilter("ignore")
-        mean, var = emulator._predict_point(xs, ts, resid, extrapolate=extrapolate)
+        if paired is None:
+            mean, var = emulator._predict_point(xs, ts, resid, extrapolate=extrapolate)
+        else:
+            mean, var = _paired_predict(emulator, xs, ts, np.repeat(paired[idx], N), resid,
+                                        extrapolate)  # fmt: skip
     l_sim = mean.shape[1]
     mean = mean.reshape(K, N, l_sim)
     var = var.reshape(K, N, l_sim)
@@ -188,3 +206,20 @@ def calibrated_predict(
     m = np.tensordot(weights, mean, axes=1)
     v = np.tensordot(weights, var + (mean - m[None]) ** 2, axes=1)
     return CalibratedPrediction(x, m, v, mean, var, weights)
+
+
+def _paired_predict(emulator, xs, ts, draw_of: np.ndarray, resid: bool, extrapolate: bool):
+    """Native predictive mean and variance (n, l_sim) at native (xs, ts) (n rows), row i at the
+    emulator's retained draw ``draw_of[i]`` (``Emulator.predict``'s single-draw predictive)."""
+    emulator._check_predict_memory(xs, ts)
+    z = emulator._inputs(xs, ts, extrapolate=extrapolate)
+    mean = np.empty((z.shape[0], emulator.l_sim))
+    var = np.empty_like(mean)
+    with blas_controller().limit(limits=1, user_api="blas"):  # many small solves: one thread
+        for d in np.unique(draw_of):
+            rows = draw_of == d
+            prm = {k: np.asarray(emulator.draws[k][d]) for k in EMULATOR_PARAMS}
+            fac = emulator._predict_factors(prm)
+            mean[rows], var[rows] = emulator._predict_std(z[rows], prm, fac, resid)
+    s = emulator.standardizer
+    return s.y_from_std(mean), s.var_from_std(var)

@@ -64,6 +64,7 @@ from gpmsa.predictive._common import (
     gpmsa_model_only,
     lacks_text,
     mvn_factor,
+    paired_draws,
     posterior_lamos,
     posterior_theta,
     realization_interval,
@@ -193,8 +194,11 @@ class FullPrediction:
                 f"p_v={self.p_v})")  # fmt: skip
 
 
-def _posterior_sets(emulator, posterior, n_draws):
-    """Indices and per-draw parameter dicts (unit theta) from a joint fit or a Posterior."""
+def _posterior_sets(emulator, posterior, n_draws, paired: bool | None = None):
+    """Indices and per-draw parameter dicts (unit theta) from a joint fit or a Posterior; the
+    emulator parameters paired draws or the point estimate (``paired``; None: the joint fit's
+    draws, a Posterior's point estimate)."""
+    paired = posterior is None if paired is None else paired
     if posterior is None:
         cal = getattr(emulator, "calibration", None)
         if not cal:
@@ -202,13 +206,14 @@ def _posterior_sets(emulator, posterior, n_draws):
                 "full_prediction needs calibration draws: fit jointly (gpmsa.fit(data, obs, "
                 "discrepancy=...)) or pass posterior= from gpmsa.calibrate"
             )
-        if not emulator.draws:
+        if paired and not emulator.draws:
             raise GPMSAError("the emulator kept no posterior draws of its own parameters")
         n = cal["theta"].shape[0]
         p = emulator.p
 
         def get(i):
-            prm = {k: np.asarray(emulator.draws[k][i]) for k in EMULATOR_PARAMS}
+            prm = {k: np.asarray(emulator.draws[k][i]) if paired else emulator.params[k]
+                   for k in EMULATOR_PARAMS}  # fmt: skip
             prm["theta"] = np.asarray(cal["theta"][i], dtype=float).reshape(-1)
             prm["lamOs"] = float(np.ravel(cal["lamOs"][i])[0])
             if "betaV" in cal:
@@ -228,6 +233,7 @@ def _posterior_sets(emulator, posterior, n_draws):
             emulator, np.column_stack([np.asarray(samples[k], dtype=float) for k in names])
         )
         lam_os = posterior_lamos(posterior)
+        pos = paired_draws(emulator, posterior, "full_prediction") if paired else None
         n = theta.shape[0]
         p = emulator.p
         n_grp = groups_of(samples, p)
@@ -237,7 +243,8 @@ def _posterior_sets(emulator, posterior, n_draws):
                 raise GPMSAError(f"the posterior's {k} draws must be > 0")
 
         def get(i):
-            prm = {k: emulator.params[k] for k in EMULATOR_PARAMS}
+            prm = {k: emulator.params[k] if pos is None else np.asarray(emulator.draws[k][pos[i]])
+                   for k in EMULATOR_PARAMS}  # fmt: skip
             prm["theta"] = theta[i]
             prm["lamOs"] = float(lam_os[i])
             if n_grp:
@@ -454,6 +461,7 @@ def full_prediction(
     posterior: Posterior | None = None,
     discrepancy=AS_FITTED,
     discrepancy_groups=AS_FITTED,
+    draws: bool | None = None,
     n_draws: int | None = None,
     n_rlz: int = 1,
     grid=None,
@@ -471,7 +479,8 @@ def full_prediction(
             than ``EXTRAPOLATION_MARGIN`` (10 %) of the range outside: GPMSAError naming the
             column (``extrapolate=True``: the warning).
         posterior: instead of the joint fit's draws, a Posterior of gpmsa.calibrate (theta,
-            lamOs, and betaV, lamVz with a discrepancy) with the emulator at its point estimate;
+            lamOs, and betaV, lamVz with a discrepancy) with the emulator at its point estimate
+            (``draws=True``: at the emulator draws recorded with each theta);
             ``obs`` must then hold the calibration's x_obs and y_obs (where the Posterior
             recorded them: info "obs_values_sha256"), and ``emulator`` be the one it was drawn
             with (where it recorded it: info "emulator_sha256", ``Emulator.model_sha256``).
@@ -483,6 +492,12 @@ def full_prediction(
         discrepancy_groups: the precision group of each discrepancy basis vector (as
             ``gpmsa.fit``'s); the default takes the one the joint fit or ``gpmsa.calibrate``
             recorded (none recorded: one group).
+        draws: the emulator parameters (betaU, lamUz, lamWs, lamWOs) of each draw: True, the
+            draw drawn jointly with its theta (a joint fit's own; with ``posterior``, as
+            ``calibrated_predict(..., draws=True)`` pairs them: ``calibration_posterior`` of
+            this joint fit or ``gpmsa.calibrate(..., emulator_params="draws")``, another
+            refused, GPMSAError); False, the point estimate; None (default): a joint fit's
+            paired draws without ``posterior``, the point estimate with it.
         n_draws: at most this many posterior draws, evenly spaced (None: all).
         n_rlz: realizations per draw.
         grid: output grid of the prediction within the simulation grid, in any order (default:
@@ -523,6 +538,7 @@ def full_prediction(
         raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
     n_rlz = check_count(n_rlz, "n_rlz")
     extrapolate = check_flag(extrapolate, "extrapolate")
+    draws = None if draws is None else check_flag(draws, "draws")
     rng = rng_of(seed)
     std, K = emulator.standardizer, emulator.K
     scalar = emulator.l_sim == 1
@@ -539,7 +555,8 @@ def full_prediction(
     levels = tuple(emulator.levels)
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x", levels[: emulator.p],
                             extrapolate)  # fmt: skip
-    idx, sets = _posterior_sets(emulator, posterior, n_draws)
+    paired = posterior is None if draws is None else draws
+    idx, sets = _posterior_sets(emulator, posterior, n_draws, paired)
     record = (
         posterior.info if posterior is not None else getattr(emulator, "settings", None)
     ) or {}
@@ -597,7 +614,7 @@ def full_prediction(
     cov_pt = np.empty((S, N, n_c, n_c))
     lat = np.empty((S, n_rlz, N, n_c))
     with blas_controller().limit(limits=1, user_api="blas"):
-        point = gp_factors(emulator, emulator.params) if posterior is not None else None
+        point = None if paired else gp_factors(emulator, emulator.params)
         for i, prm in enumerate(sets):
             fac = point if point is not None else gp_factors(emulator, prm)
             m_i, C_i = _conditional(emulator, ob, prm, fac, xu, p_v, scalar)
