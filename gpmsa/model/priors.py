@@ -437,15 +437,26 @@ class Priors:
 
 
 def _theta_values(value, name: str, rule: str, ok) -> float | tuple[float, ...]:
-    """``value`` as theta_mean or theta_sd: a float, or a tuple of floats (one per calibration
-    parameter), each passing ``ok`` (``rule`` says what it needs); GPMSAError naming ``name``
-    (and the element) otherwise."""
+    """``value`` as theta_mean or theta_sd (`_per_element`, one per calibration parameter)."""
+    return _per_element(value, name, "calibration parameter", rule, ok)
+
+
+def _rho_values(value, name: str) -> float | tuple[float, ...]:
+    """``value`` as a Beta parameter of betaV's prior (`_per_element`, one per discrepancy
+    precision group), each finite and > 0."""
+    return _per_element(value, name, "discrepancy precision group", "finite and > 0",
+                        lambda v: math.isfinite(v) and v > 0)  # fmt: skip
+
+
+def _per_element(value, name: str, per: str, rule: str, ok) -> float | tuple[float, ...]:
+    """``value`` as a float, or a tuple of floats (one per ``per``), each passing ``ok``
+    (``rule`` says what it needs); GPMSAError naming ``name`` (and the element) otherwise."""
     many = isinstance(value, list | tuple) or (isinstance(value, np.ndarray) and value.ndim == 1)
     items = list(value) if many else [value]
     if many and not items:
         raise GPMSAError(
-            f"{name} must be a number or a non-empty sequence of numbers (one per calibration "
-            f"parameter), got {value!r:.80}"
+            f"{name} must be a number or a non-empty sequence of numbers (one per {per}), got "
+            f"{value!r:.80}"
         )
     out = []
     for i, v in enumerate(items):
@@ -454,27 +465,6 @@ def _theta_values(value, name: str, rule: str, ok) -> float | tuple[float, ...]:
             raise GPMSAError(f"{where} must be a real number, got {v!r:.60} ({type(v).__name__})")
         if not ok(float(v)):
             raise GPMSAError(f"{where} must be {rule}, got {float(v)}")
-        out.append(float(v))
-    return tuple(out) if many else out[0]
-
-
-def _rho_values(value, name: str) -> float | tuple[float, ...]:
-    """``value`` as a Beta parameter of betaV's prior: a float, or a tuple of floats (one per
-    discrepancy precision group), each finite and > 0; GPMSAError naming ``name`` otherwise."""
-    many = isinstance(value, list | tuple) or (isinstance(value, np.ndarray) and value.ndim == 1)
-    items = list(value) if many else [value]
-    if many and not items:
-        raise GPMSAError(
-            f"{name} must be a number or a non-empty sequence of numbers (one per discrepancy "
-            f"precision group), got {value!r:.80}"
-        )
-    out = []
-    for i, v in enumerate(items):
-        where = f"{name}[{i}]" if many else name
-        if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
-            raise GPMSAError(f"{where} must be a real number, got {v!r:.60} ({type(v).__name__})")
-        if not (math.isfinite(v) and v > 0):
-            raise GPMSAError(f"{where} must be finite and > 0, got {float(v)}")
         out.append(float(v))
     return tuple(out) if many else out[0]
 
