@@ -465,12 +465,20 @@ class StaticSpan:
 
     def push(self, a: np.ndarray) -> None:
         """Append the samples ``a`` (finite, m/s^2), the oldest ones leaving."""
+        wild = bool(a.size) and not np.abs(a).max() <= MAX_ACCEL_MPS2
+        if wild or self._exact:  # sums of values beyond any accelerometer's may overflow
+            with np.errstate(over="ignore", invalid="ignore"):
+                self._push(a, wild)
+        else:
+            self._push(a, wild)
+
+    def _push(self, a: np.ndarray, wild: bool) -> None:
+        """`push`; ``wild``: a value of ``a`` lies beyond ``MAX_ACCEL_MPS2``."""
         ring, k = self._ring, a.size
         size = ring.size
         start, stop = self._next, self._next + k
-        if k >= size:
-            ring[:] = a[k - size :]
-            start, stop = 0, size
+        if k >= size:  # each sample in its slot of the stream, as in finer chunks
+            ring[:] = np.roll(a[k - size :], stop % size)
         elif stop <= size:
             self._total += float(a.sum()) - float(ring[start:stop].sum())
             ring[start:stop] = a
@@ -481,8 +489,8 @@ class StaticSpan:
             ring[:wrap] = a[size - start :]
         self._next = stop % size
         self._held = min(self._held + k, size)
-        if k and not np.abs(a).max() <= MAX_ACCEL_MPS2:  # a wild value: the running sum may
-            self._exact = size  # lose the others' digits; summed afresh until it has left
+        if wild:  # the running sum may lose the others' digits: summed afresh until it has left
+            self._exact = size
         elif self._exact:
             self._exact = max(self._exact - k, 0)
             if not self._exact:  # (it has left)
@@ -497,8 +505,10 @@ class StaticSpan:
         return self._total / self._ring.size
 
     def exact_mean(self) -> float:
-        """The span's mean summed afresh (the ring's order: its place in the stream)."""
-        return float(self._ring.sum() / self._ring.size)
+        """The span's mean summed afresh (the ring's order: its place in the stream; inf or NaN
+        where wild values overflow the sum)."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            return float(self._ring.sum() / self._ring.size)
 
 
 def static_span_fault(span: StaticSpan, limits: SensorLimits) -> str:

@@ -470,16 +470,19 @@ def static_level_marks(
     long span: `static_span_level`), have one off it by more than ``static_span_tolerance``."""
     a = np.asarray(a, dtype=float)
     finite = np.isfinite(a)
-    total = np.concatenate([[0.0], np.cumsum(np.where(finite, a, 0.0))])
     count = np.concatenate([[0], np.cumsum(finite)])
     ends = np.arange(every, a.size + 1, every)
     ends = ends[ends >= block]
     full = count[ends] - count[ends - block] == block
     marks = {}
-    for end in ends[full]:
-        why = static_level(float((total[end] - total[end - block]) / block), block, limits)
-        if why:
-            marks[int(end - 1)] = why + " (the signal before the high-pass)"
+    blocks = np.lib.stride_tricks.sliding_window_view(a, min(block, a.size))
+    with np.errstate(over="ignore", invalid="ignore"):  # (a wild value's sum: a fault anyway)
+        for end in ends[full]:
+            # each block summed on its own, as the BCR sums it (a running sum over the recording
+            # would carry one wild value's rounding into every later block)
+            why = static_level(float(blocks[end - block].sum() / block), block, limits)
+            if why:
+                marks[int(end - 1)] = why + " (the signal before the high-pass)"
     span = limits.static_span
     if span and a.size >= span:
         step = np.diff(t, prepend=np.nan) * rate_hz
@@ -490,11 +493,12 @@ def static_level_marks(
         whole = run[ends - 1] == run[ends - span]
         whole &= finite[ends - span] & np.isfinite(t[ends - span])
         windows = np.lib.stride_tricks.sliding_window_view(a, span)
-        for end in ends[whole]:
-            # each span summed on its own (a running sum would carry a wild value's rounding on)
-            why = static_span_level(float(windows[end - span].sum() / span), limits)
-            if why and int(end - 1) not in marks:
-                marks[int(end - 1)] = why + " (the signal before the high-pass)"
+        with np.errstate(over="ignore", invalid="ignore"):
+            for end in ends[whole]:
+                # each span summed on its own (a running sum would carry a wild value's rounding)
+                why = static_span_level(float(windows[end - span].sum() / span), limits)
+                if why and int(end - 1) not in marks:
+                    marks[int(end - 1)] = why + " (the signal before the high-pass)"
     return marks
 
 
