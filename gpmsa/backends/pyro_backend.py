@@ -22,12 +22,13 @@ carries a chain between the modes of a level and a continuous parameter that tra
 A theta constraint (``problem.constraint``, a numpy callable of native theta) enters the prior:
 a theta it rejects (the full theta, held elements at their values; with a categorical theta,
 each combination of levels with the continuous values) has log density -inf, a constant of the
-detached verdict (no gradient), so NUTS sees an infinite energy there: a divergence, whose
-subtree gets zero weight and ends the trajectory's doubling (pyro's ``NUTS._build_basetree``;
-the chain stays exact, a hard wall as Stan's). The level draws and moves take the same -inf.
-The verdict is numpy, which a JIT trace would freeze at its first value, so with a constraint
-the potential energy is not JIT-compiled (``jit`` is ignored). A callable mean basis with
-theta sampled is refused (`refuse_unsupported`).
+detached verdict (no gradient; asked only where theta's prior allows it, as the numpy and
+torch samplers ask it: never outside (0, 1)), so NUTS sees an infinite energy there: a
+divergence, whose subtree gets zero weight and ends the trajectory's doubling (pyro's
+``NUTS._build_basetree``; the chain stays exact, a hard wall as Stan's). The level draws and
+moves take the same -inf. The verdict is numpy, which a JIT trace would freeze at its first
+value, so with a constraint the potential energy is not JIT-compiled (``jit`` is ignored). A
+callable mean basis with theta sampled is refused (`refuse_unsupported`).
 """
 
 from __future__ import annotations
@@ -231,15 +232,21 @@ class PyroModel:
             if name in self.held:
                 each = each[:, self.held[name][0]]
             lp = lp + each.sum(-1)
-        if self.constraint is not None:
-            lp = lp + self.constraint_term(prm["theta"])
+        if self.constraint is not None:  # asked only where the priors allow (numpy's order)
+            lp = lp + self.constraint_term(prm["theta"], torch.isfinite(lp).numpy())
         return lp
 
-    def constraint_term(self, theta: torch.Tensor) -> torch.Tensor:
+    def constraint_term(self, theta: torch.Tensor, ask: np.ndarray) -> torch.Tensor:
         """0 where the theta constraint allows unit-scale theta (C, q), -inf where it rejects
-        it: (C,), a constant (the verdict of the detached values, called once per row)."""
-        con = self.constraint
-        ok = con.allows(con.native(theta.detach().numpy()))
+        it: (C,), a constant (the verdict of the detached values, called once per row asked).
+        ``ask`` (C,) bool: the rows to ask (the others 0: rows outside theta's prior, where the
+        numpy and torch samplers never call the constraint, which may fail there)."""
+        con, th = self.constraint, theta.detach().numpy()
+        if ask.all():
+            ok = con.allows(con.native(th))
+        else:
+            ok = np.ones(ask.size, dtype=bool)
+            ok[ask] = con.allows(con.native(th[ask]))
         out = torch.zeros(theta.shape[0], dtype=self.dtype)
         return out.masked_fill_(torch.as_tensor(~ok), -torch.inf)
 
