@@ -533,6 +533,7 @@ def replay_bag(
         `MissingExtraError` (the ``robot`` extra not installed).
     """
     bag = recording_path(bag, "bag")
+    check_lookup(bag, "bag", BagError)
     csv, out_bag = _check_outputs(bag, emulator, csv, out_bag)
     s = _settings(settings, overrides)
     if out_bag is not None:
@@ -560,8 +561,9 @@ def replay_bag(
 
 def _check_outputs(bag: Path, emulator, csv, out_bag) -> tuple[Path | None, Path | None]:
     """``csv`` and ``out_bag`` as Paths, checked before the replay: `ControlError` where one is
-    not a path, lies in or on an input (`replay_inputs`), both are the same, ``out_bag`` exists
-    (even as a dangling link) or ``csv`` is refused by `check_csv_target`."""
+    not a path, the OS cannot look it up (`check_lookup`: a name too long, say), lies in or on
+    an input (`replay_inputs`), both are the same, ``out_bag`` exists (even as a dangling link)
+    or ``csv`` is refused by `check_csv_target`."""
     inputs = replay_inputs(bag, emulator)
     paths = []
     for name, value in (("csv", csv), ("out_bag", out_bag)):
@@ -569,6 +571,7 @@ def _check_outputs(bag: Path, emulator, csv, out_bag) -> tuple[Path | None, Path
             paths.append(None)
             continue
         path = path_argument(value, name)
+        check_lookup(path, name)  # a name too long for the file system: before the replay
         what = overlapped_input(path, inputs)
         if what is not None:
             raise ControlError(f"{name}={str(path)!r} would overwrite {what}")
@@ -608,7 +611,11 @@ def overlapped_input(target: Path, inputs: list[tuple[str, Path]]) -> str | None
 def _overlaps(target: Path, source: Path) -> bool:
     """Whether writing ``target`` would replace ``source`` or a file inside it (links followed;
     a hard link to ``source`` counts)."""
-    target_r, source_r = target.resolve(), source.resolve()
+    target_r = target.resolve()
+    try:
+        source_r = source.resolve()
+    except ValueError:  # a name the OS cannot look up (a lone surrogate): no file to replace
+        return False
     if target_r == source_r or source_r in target_r.parents:
         return True
     try:

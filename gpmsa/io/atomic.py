@@ -123,7 +123,7 @@ def _cannot_write(path: Path, exc: OSError | ValueError) -> str:
             f"{exc.encoding}, cannot write)"
         )
     why = getattr(exc, "strerror", None) or str(exc)
-    if exc.errno == errno.ENAMETOOLONG:
+    if getattr(exc, "errno", None) == errno.ENAMETOOLONG:  # a ValueError has none
         name = len(os.fsencode(path.name))
         try:
             most = os.pathconf(path.parent, "PC_NAME_MAX")

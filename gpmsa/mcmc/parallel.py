@@ -107,22 +107,26 @@ def as_executor(executor, fn: Callable | None = None) -> Executor | None:
     unpickle (gpmsa, or torch for the torch backend, not installed there)."""
     if executor is None:
         return executor
+    if isinstance(executor, ProcessPoolExecutor) and multiprocessing.current_process().daemon:
+        raise GPMSAError(  # its submit fails, a retry too: "daemonic processes are not allowed..."
+            "executor: a ProcessPoolExecutor cannot start its processes in this daemonic worker "
+            "(a multiprocessing.Pool's or a dask worker's); leave executor=None and n_jobs=None "
+            "(the chains run here, one after another, with the same draws)"
+        )
     client = _dask_client(executor)
     closed = getattr(client, "status", None) in ("closing", "closed")
     if closed and client is executor:  # (its executor's submit refuses the task: run_chains)
         raise GPMSAError(  # its executor would hang: a task resubmitted there never ends
             f"executor: the dask Client is {client.status}; pass a running Client"
         )
+    if client is not None and not closed and getattr(client, "asynchronous", False):
+        raise GPMSAError(  # its run() gives a coroutine here; waiting for the chains, a hang
+            "executor: the dask Client is asynchronous and this thread runs its event loop, "
+            "which waiting for the chains here would block for ever; call gpmsa from another "
+            "thread (e.g. await asyncio.to_thread(...)) or pass a synchronous Client"
+        )
     if client is not None and not closed and fn is not None:
-        module = fn.__module__
-        try:
-            client.run(_importable, module)
-        except Exception as exc:
-            raise GPMSAError(
-                f"executor: the dask Client's workers cannot import {module} ({_describe(exc)}); "
-                "install gpmsa (and, for the torch backend, torch) where they run, or pass "
-                "n_jobs= to run the chains on this machine"
-            ) from exc
+        _check_imports(client, fn.__module__)
     if isinstance(executor, Executor):
         return executor
     if client is not None:
@@ -140,10 +144,37 @@ def _dask_client(executor):
     return client if callable(getattr(client, "get_executor", None)) else None
 
 
-def _importable(module: str) -> bool:
-    """Import ``module`` (run on every dask worker by `as_executor`)."""
-    importlib.import_module(module)
-    return True
+def _check_imports(client, module: str) -> None:
+    """GPMSAError unless every worker of the dask ``client`` imports ``module``. A worker that
+    cannot be reached (lost meanwhile: an OSError such as dask's CommClosedError) ends the check
+    unrefused: dask runs its tasks elsewhere, as it would without the check."""
+    try:
+        answers = client.run(_importable, module)
+    except OSError:
+        return
+    except Exception as exc:  # e.g. gpmsa itself missing there: `_importable` cannot be unpickled
+        raise _cannot_import(module, _describe(exc)) from exc
+    failed = next((f"{why}, on {who}" for who, why in answers.items() if why is not None), None)
+    if failed is not None:
+        raise _cannot_import(module, failed)
+
+
+def _cannot_import(module: str, why: str) -> GPMSAError:
+    return GPMSAError(
+        f"executor: the dask Client's workers cannot import {module} ({why}); install gpmsa "
+        "(and, for the torch backend, torch) where they run, or pass n_jobs= to run the chains "
+        "on this machine"
+    )
+
+
+def _importable(module: str) -> str | None:
+    """None where ``module`` imports here (run on every dask worker by `_check_imports`), else
+    why not (an import may fail with any error, an OSError for a missing shared library too)."""
+    try:
+        importlib.import_module(module)
+    except Exception as exc:
+        return _describe(exc)
+    return None
 
 
 _forking_thread: int | None = None
