@@ -428,7 +428,7 @@ def load_emulator(
             f"{name} must be a gpmsa.Emulator, the path of an emulator file (*.gpmsa) or 'A' / "
             f"'B' (the shipped ones), got {emulator!r} ({type(emulator).__name__})"
         )
-    path = Path(emulator)
+    path = path_argument(emulator, name)  # a leading ~ is the home folder, as for the bag
     check_lookup(path, name)
     if not path.exists():
         raise ControlError(f"{name} {str(path)!r}: no such file (or give A or B: the shipped ones)")
@@ -598,7 +598,7 @@ def replay_inputs(bag: Path, emulator) -> list[tuple[str, Path]]:
     inputs = [(what, source)]
     if (isinstance(emulator, str | os.PathLike) and str(emulator)
             and not (isinstance(emulator, str) and emulator in SHIPPED)):  # fmt: skip
-        inputs.append((f"the emulator file {str(emulator)!r}", Path(emulator)))
+        inputs.append((f"the emulator file {str(emulator)!r}", path_argument(emulator, "emulator")))
     return inputs
 
 

@@ -40,3 +40,16 @@ def test_an_emulator_path_the_os_cannot_encode_beside_a_csv_is_named(bag, tmp_pa
 def test_the_recording_is_named_bag(tmp_path):
     with pytest.raises(BagError, match=r"^bag=.*holds '\\ud800'"):
         replay_bag(tmp_path / "r\ud800.mcap", "A")
+
+
+def test_an_emulator_path_under_home_is_expanded(tmp_path, monkeypatch):
+    """load_emulator read "~/e.gpmsa" literally (no such file) where the bag and CSV paths
+    expand the home folder."""
+    import shutil
+
+    from control.robot.replay import load_emulator
+    from control.shipped import shipped_emulator_path
+
+    monkeypatch.setenv("HOME", str(tmp_path))
+    shutil.copyfile(shipped_emulator_path("A"), tmp_path / "e.gpmsa")
+    assert load_emulator("~/e.gpmsa").q == 1
