@@ -844,18 +844,20 @@ def _condition(
     odom_finite = np.all(np.isfinite(rec.odometry.position), axis=1) & np.all(
         np.isfinite(rec.odometry.velocity), axis=1
     )
-    order = np.arange(t_odom.size)
+    order, odom_said = np.arange(t_odom.size), ""
     if base == "header" and s.reorder_periods > 0 and t_odom.size > 1:
         period = condition.nominal_period(t_odom)  # odometry delivered late: stamp order
         if np.isfinite(period):
             order = clock.stamp_order(t_odom, s.reorder_periods * period)
+            odom_said = _reordered(t_odom, order, s.reorder_periods)
     t_imu, accel, said, restamping = _imu_clock(rec.imu.topic, t_imu, accel, base, s)
     imu_note = "; ".join(filter(None, [note, *said]))
+    odom_note = "; ".join(filter(None, [note, odom_said]))
     reports = (
         condition.check_stream(
             rec.imu.topic, imu_recorded, np.isfinite(accel_recorded), base, imu_note
         ),  # fmt: skip
-        condition.check_stream(rec.odometry.topic, t_odom, odom_finite, base, note),
+        condition.check_stream(rec.odometry.topic, t_odom, odom_finite, base, odom_note),
     )
     t_odom, odom_finite = t_odom[order], odom_finite[order]
     t, a, resampling = condition.to_rate(
@@ -961,6 +963,17 @@ def _other_clock(rec: Recording, accel: np.ndarray, limit_s: float) -> tuple[np.
     )
 
 
+def _reordered(t: np.ndarray, order: np.ndarray, periods: float) -> str:
+    """A topic's report note where ``order`` (`clock.stamp_order`) put some of its messages,
+    times ``t`` (s, as recorded), back in stamp order ("" where it moved none)."""
+    if np.count_nonzero(np.diff(t) < 0) > np.count_nonzero(np.diff(t[order]) < 0):
+        return (
+            f"messages received out of stamp order by at most {periods:g} periods put in "
+            "stamp order"
+        )
+    return ""
+
+
 def _imu_clock(topic: str, t: np.ndarray, accel: np.ndarray, base: str, s: ReplaySettings):
     """The IMU's (times s, accel) in stamp order within ``s.reorder_periods`` (header stamps
     only) and re-stamped on their clock (``s.restamp``, `clock.restamp`), what was done
@@ -969,13 +982,9 @@ def _imu_clock(topic: str, t: np.ndarray, accel: np.ndarray, base: str, s: Repla
     period = condition.nominal_period(t)
     if base == "header" and s.reorder_periods > 0 and np.isfinite(period):
         order = clock.stamp_order(t, s.reorder_periods * period)
-        late = int(np.count_nonzero(np.diff(t) < 0))
+        if reordered := _reordered(t, order, s.reorder_periods):
+            said.append(reordered)
         t, accel = t[order], accel[order]
-        if late > np.count_nonzero(np.diff(t) < 0):
-            said.append(
-                f"messages received out of stamp order by at most {s.reorder_periods:g} "
-                "periods put in stamp order"
-            )
     if not s.restamp:
         return t, accel, said, clock.Restamping(False)
     what = "header stamps" if base == "header" else "receive times"
