@@ -29,6 +29,7 @@ from gpmsa.model.data import ObsData, SimData
 from gpmsa.model.priors import GammaPrior, Priors
 from gpmsa.model.problem import ObsProblem, Problem, prepare
 from gpmsa.predictive import (
+    calibrated_predict,
     calibration_posterior,
     cross_validate,
     emulator_prediction,
@@ -74,6 +75,7 @@ __all__ = [
     "fit",
     "fit_study",
     "full_prediction",
+    "calibrated_predict",
     "limits",
     "load",
     "load_study",
