@@ -371,7 +371,7 @@ within a few per cent)."""
 
 def gravity_direction(
     accel: np.ndarray, axis: str, sign: float, topic: str, flight_mps2: float | None,
-    gravity: str,
+    gravity: str, static_mps2: float | None = None,
 ) -> str:  # fmt: skip
     """What the IMU's gravity says against the settings, for a warning ("" where nothing).
 
@@ -381,7 +381,9 @@ def gravity_direction(
     the replay's "keep" or "highpass". Where the mean acceleration's norm lies within
     `GRAVITY_BAND` g, it is gravity's reaction, pointing up: an axis pointing down, gravity
     along another axis, an axis more than `MAX_TILT_DEG` from it, or gravity kept where the
-    sensor checks expect flights at -g, are named with their remedy."""
+    sensor checks expect flights at -g, are named with their remedy; so is a ``static_mps2``
+    (the static-level check's level) given for a recording whose IMU reads no gravity (every
+    block would be a scale fault)."""
     rows = np.asarray(accel, dtype=float)
     rows = rows[np.all(np.isfinite(rows), axis=1)]
     if not rows.size:
@@ -389,7 +391,15 @@ def gravity_direction(
     mean = rows.mean(axis=0)
     norm = float(np.linalg.norm(mean))
     if not GRAVITY_BAND[0] * GRAVITY <= norm <= GRAVITY_BAND[1] * GRAVITY:
-        return ""
+        if static_mps2 is None:
+            return ""
+        return (
+            f"static_mps2 = {static_mps2:g} m/s^2, but the IMU topic {topic!r} reads no gravity "
+            f"(its mean acceleration's norm is {norm:.3g} m/s^2 over the recording): every "
+            "block will read as a scale fault (sensor_fault); the static-level check needs an "
+            "IMU that reports gravity: drop static_mps2 (--static-mps2) for one that removes "
+            "it, or for a recording simulated without it"
+        )
     i = "xyz".index(axis)
     up = sign * float(mean[i])
     angle = float(np.degrees(np.arccos(np.clip(up / norm, -1.0, 1.0))))

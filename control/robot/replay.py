@@ -672,8 +672,9 @@ def replay_recording(
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
     tic = time.perf_counter()
     t, a, pos, spd, reports, resampling, notes, t0, restamping, marks = _condition(
-        rec, s, bcr.rate_hz, flight_reading(bcr.sensor), raw_check
-    )
+        rec, s, bcr.rate_hz, flight_reading(bcr.sensor), raw_check,
+        bcr.sensor.static_mps2 if raw_check is None else raw_check[0].static_mps2,
+    )  # fmt: skip
     notes[:0] = unchecked
     condition_s = time.perf_counter() - tic
 
@@ -814,17 +815,19 @@ def _check_span(rec: Recording, base: str, imu_ns, odom_ns, t0: int) -> None:
 
 def _condition(
     rec: Recording, s: ReplaySettings, rate_hz: float, flight_mps2=None,
-    raw_check: tuple[SensorLimits, int, int] | None = None,
+    raw_check: tuple[SensorLimits, int, int] | None = None, static_mps2: float | None = None,
 ):  # fmt: skip
     """The BCR's samples (t s from t0, accel, position, speed), the reports, t0 (ns) and the
     static-level marks ({sample index: reason}, `condition.static_level_marks`: with
     ``raw_check``, (limits, samples per update, per block), of the signal before the
-    high-pass; those samples read NaN); ``flight_mps2``: the BCR's `flight_reading`, for
+    high-pass; those samples read NaN); ``flight_mps2``: the BCR's `flight_reading`, and
+    ``static_mps2``: the static-level check's level (None: off), for
     `condition.gravity_direction`, whose finding is a note and a `ControlWarning`."""
     notes: list[str] = []
     upright = condition.gravity_direction(
-        rec.imu.accel, s.imu_axis, s.imu_sign, rec.imu.topic, flight_mps2, s.gravity
-    )
+        rec.imu.accel, s.imu_axis, s.imu_sign, rec.imu.topic, flight_mps2, s.gravity,
+        static_mps2,
+    )  # fmt: skip
     if upright:
         notes.append(upright)
         warnings.warn(upright, ControlWarning, stacklevel=user_stacklevel())
