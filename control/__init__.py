@@ -28,7 +28,7 @@ from control.errors import (
     MissingExtraError,
 )
 from control.estimate import DOMAIN_EDGES, FAULT_STATUSES, STATUSES, Estimate, edge_counts
-from control.faults import FAULT_KINDS, SensorFault
+from control.faults import FAULT_KINDS, FaultInjector, SensorFault
 from control.feature import FeatureSpec, block_features, window_feature
 from control.metrics import (
     GDError,
@@ -73,6 +73,7 @@ __all__ = [
     "ObservationModel",
     "ReplayResult",
     "ReplaySettings",
+    "FaultInjector",
     "SensorFault",
     "SensorLimits",
     "Simplex",

@@ -357,10 +357,15 @@ def calibrate(
     if not fast and (emulator_params != "point" or log_prior is not None):
         what = ("emulator_params='draws'" if emulator_params != "point"
                 else "log_prior (a Calibrator update's prior=)")  # fmt: skip
+        if backend != "numpy":  # what stands in the way, as the user gave it
+            got = f"backend={backend!r}"
+        elif discrepancy is not None:
+            got = f"discrepancy={describe_discrepancy(discrepancy)}"
+        else:
+            got = "fast=False"
         raise GPMSAError(
             f"{what} needs the fast numpy sampler: backend='numpy', no discrepancy and fast "
-            f"not False; got backend={backend!r}, discrepancy={describe_discrepancy(discrepancy)}, "
-            f"fast={fast}"
+            f"not False; got {got}"
         )
     reserved = ("n_iter", "n_chains", "tune", "seed", "progress", "n_jobs", "executor",
                 "tune_rounds", "tune_levels")  # fmt: skip

@@ -463,7 +463,19 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
         != (problem.constraint is not None),
         "discrepancy": old_disc != new_disc and not d_moved,
     }
-    return [name for name, differ in differs.items() if differ]
+    names = [name for name, differ in differs.items() if differ]
+    return [_prior_fields(*priors) if name == "priors" else name for name in names]
+
+
+def _prior_fields(source: dict, this: dict) -> str:
+    """"priors" with the fields in which the records ``source`` and ``this`` (`_prior_record`)
+    differ and their values (the source's, then this fit's), and the remedy (an Emulator's
+    ``priors`` are data-corrected: ``fit`` takes the priors as set before fitting)."""
+    fields = [k for k in sorted(set(source) | set(this)) if source.get(k) != this.get(k)]
+    shown = "; ".join(f"{k}: {source.get(k)!r:.60} there, {this.get(k)!r:.60} here"
+                      for k in fields[:3])  # fmt: skip
+    more = f"; and {len(fields) - 3} more" if len(fields) > 3 else ""
+    return f"priors ({shown}{more}: give priors= as the source was fitted with)"
 
 
 def discrepancy_moved(old: dict, new: dict, obs) -> bool:
