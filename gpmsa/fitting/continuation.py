@@ -468,9 +468,10 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
 
 
 def _prior_fields(source: dict, this: dict) -> str:
-    """ "priors" with the fields in which the records ``source`` and ``this`` (`_prior_record`)
-    differ and their values (the source's, then this fit's), and the remedy (an Emulator's
-    ``priors`` are data-corrected: ``fit`` takes the priors as set before fitting)."""
+    """The word priors with the fields in which the records ``source`` and ``this``
+    (`_prior_record`) differ and their values (the source's, then this fit's), and the remedy
+    (an Emulator's ``priors`` are data-corrected: ``fit`` takes the priors as set before
+    fitting)."""
     fields = [k for k in sorted(set(source) | set(this)) if source.get(k) != this.get(k)]
     shown = "; ".join(f"{k}: {source.get(k)!r:.60} there, {this.get(k)!r:.60} here"
                       for k in fields[:3])  # fmt: skip
