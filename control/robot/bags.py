@@ -41,10 +41,12 @@ import numpy as np
 
 import vehicle
 from control.errors import BagError, ControlError
+from control.faults import FaultInjector, SensorFault
+from control.feature import STANDARD_GRAVITY
 from control.robot import messages as msgs
 from control.robot import storage as storage_mod
 from control.robot.extra import require
-from control.validation import check_lookup, float_array, is_choice, path_argument
+from control.validation import check_lookup, float_array, is_choice, is_integer, path_argument
 from roadgen.checks import home_path
 
 STORAGES = ("mcap", "sqlite3")
@@ -1010,19 +1012,29 @@ def merge_in_time(streams: Sequence[tuple[object, np.ndarray, Sequence[bytes]]])
         yield chans[i], int(times[i]), data[i]
 
 
+def check_gravity(gravity) -> None:
+    """`ControlError` unless ``gravity`` (the writers' option) is True or False."""
+    if not isinstance(gravity, bool | np.bool_):
+        raise ControlError(f"gravity must be True or False, got {gravity!r:.60}")
+
+
 def sensor_messages(
     imu_time, accel, odom_time, position, speed, *, axis: str = "z",
     imu_frame: str = "imu_link", odom_frame: str = "odom", base_frame: str = "base_link",
-    offset_ns: int = 0,
+    offset_ns: int = 0, gravity: bool = False,
 ) -> tuple[np.ndarray, list[bytes], np.ndarray, list[bytes]]:  # fmt: skip
     """(IMU stamps ns, CDR Imu messages, odometry stamps ns, CDR Odometry messages) of sampled
     signals (see `write_sensor_bag` for the arguments), every stamp ``offset_ns`` later;
     `ControlError` for a stamp outside a ROS 2 header's [0, 2**31) s."""
     if axis not in ("x", "y", "z"):
         raise ControlError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
+    check_gravity(gravity)
     t_imu = stamps_ns("imu_time", imu_time, offset_ns=offset_ns)
     t_odom = stamps_ns("odom_time", odom_time, offset_ns=offset_ns)
     acc = _vectors("accel", accel, t_imu.size, axis)
+    if gravity:  # REP-145: the specific force, +g on the axis that points up at rest
+        acc = acc.copy()
+        acc[:, "xyz".index(axis)] += STANDARD_GRAVITY
     pos = _vectors("position", position, t_odom.size)
     vel = _vectors("speed", speed, t_odom.size)
     imu = [msgs.encode_imu(s, a, imu_frame) for s, a in zip(t_imu.tolist(), acc.tolist(),
@@ -1049,6 +1061,7 @@ def write_sensor_bag(
     log_time=None,
     model=None,
     noise_std: float | None = None,
+    gravity: bool = False,
 ) -> Path:
     """Write sampled signals as a ROS 2 bag of standard messages (``sensor_msgs/msg/Imu``,
     ``nav_msgs/msg/Odometry``), e.g. a simulated drive to try the replay on.
@@ -1069,6 +1082,10 @@ def write_sensor_bag(
             `vehicle.HalfCar`) and the accelerometer noise sd (m/s^2) they were simulated
             with, recorded in the bag's metadata (`SIMULATION_KEYS`), each where given: the
             replay refuses an emulator made for another vehicle (`control.replay_bag`).
+        gravity: write the accelerations as an IMU that reports gravity does (a
+            sensor_msgs/Imu's specific force, REP-145): +9.80665 m/s^2 added to ``axis``, the
+            axis that points up at rest, for ``accel`` free of gravity (the simulator's). False
+            (default): as given. The replay's static-level check (``static_mps2``) needs it.
 
     Returns:
         the bag folder.
@@ -1080,7 +1097,7 @@ def write_sensor_bag(
     if record:
         custom[SIMULATION_SHA256] = simulation_checksum(record)
     t_imu, imu, t_odom, odom = sensor_messages(
-        imu_time, accel, odom_time, position, speed, axis=axis
+        imu_time, accel, odom_time, position, speed, axis=axis, gravity=gravity
     )
     if log_time is None:
         log = np.concatenate([t_imu, t_odom])
@@ -1098,15 +1115,33 @@ def write_sensor_bag(
     return home_path(path)
 
 
-def write_run_bag(result, path: str | os.PathLike, **kw) -> Path:
+def write_run_bag(
+    result, path: str | os.PathLike, *, gravity: bool = False,
+    faults: Sequence[SensorFault] = (), fault_seed: int = 0, **kw,
+) -> Path:  # fmt: skip
     """Write the samples of a `control.ClosedLoopResult` (front-axle acceleration on the IMU's
     z axis, position and speed as odometry along x, both at the loop's rate) as a ROS 2 bag;
     keyword arguments as `write_sensor_bag`; ``model`` and ``noise_std`` default to the run's
-    (its ``settings``), so that the bag records the vehicle simulated."""
+    (its ``settings``), so that the bag records the vehicle simulated.
+
+    ``gravity`` as `write_sensor_bag`'s. ``faults`` (`control.SensorFault`s, on the run's
+    sample times) are applied to what is written, after gravity is added, as a failing IMU
+    would record them (a "scale" fault scales gravity too, as a gain error does; a run's
+    ``sample_accel`` holds no fault `control.run_closed_loop` injected); ``fault_seed`` seeds
+    the "noise" faults. A "time_nan" fault is refused (a bag's stamps are numbers)."""
     t = result.sample_time
     settings = getattr(result, "settings", None) or {}
     for name in ("model", "noise_std"):
         kw.setdefault(name, settings.get(name))
-    return write_sensor_bag(
-        path, t, result.sample_accel, t, result.sample_position, result.sample_speed, **kw
-    )
+    accel, position, speed = result.sample_accel, result.sample_position, result.sample_speed
+    check_gravity(gravity)
+    if not (is_integer(fault_seed) and fault_seed >= 0):
+        raise ControlError(f"fault_seed must be an integer >= 0, got {fault_seed!r:.60}")
+    inject = FaultInjector(faults, np.random.default_rng(fault_seed))
+    if any(f.kind == "time_nan" for f in inject.faults):
+        raise ControlError("a time_nan fault cannot be written to a bag (its stamps are numbers)")
+    if inject.faults:
+        up = STANDARD_GRAVITY if gravity else 0.0
+        t, position, accel, speed = inject(t, position, np.asarray(accel) + up, speed)
+        gravity = False  # (added before the faults)
+    return write_sensor_bag(path, t, accel, t, position, speed, gravity=gravity, **kw)

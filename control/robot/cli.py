@@ -205,7 +205,8 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--reorder-periods", type=float, default=DEFAULTS.reorder_periods, metavar="PERIODS",
         help="put IMU (and odometry) messages received out of header-stamp order by at most "
-        "this many of their periods in stamp order (default 3; 0: the order received)",
+        "this many of their periods in stamp order (default 3; 0: the order received); "
+        "odometry later still where its stamp fills the gap it left",
     )  # fmt: skip
     p.add_argument(
         "--storage", default=DEFAULTS.storage, choices=["mcap", "sqlite3"],

@@ -5,7 +5,8 @@ it delivers every sample; at 120 Hz the BCR reads a step outside 0.5-1.5 periods
 repeated sample, a sensor fault. `restamp` fits the stream's clock and gives each message its
 slot's time, so that jitter well below half a period goes while a dropped message still leaves
 an empty slot (a gap), a duplicate shares one and a clock step shows; `stamp_order` puts
-messages delivered late (stamped right) back in stamp order. The replay uses both
+messages delivered late (stamped right) back in stamp order, and `into_gaps` (odometry) those
+later still whose stamps fill the gaps they left. The replay uses them
 (`control.robot.replay`, docs/robot.md "Time stamps"), and `header_skew` to find an IMU whose
 header stamps run on another clock than the odometry's.
 """
@@ -16,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from control.robot.condition import nominal_period, robust_sd
+from control.robot.condition import GAP_PERIODS, increasing, nominal_period, robust_sd
 
 REORDER_PERIODS = 3.0
 """Messages whose stamps step back by at most this many nominal periods are put in stamp order
@@ -79,6 +80,38 @@ def stamp_order(t: np.ndarray, window_s: float) -> np.ndarray:
         return np.arange(t.size)
     run = np.concatenate([[0], np.cumsum(np.diff(t) < -window_s)])
     return np.lexsort((t, run))
+
+
+def into_gaps(t: np.ndarray, order: np.ndarray, period: float) -> tuple[np.ndarray, int]:
+    """``order`` (`stamp_order`'s of times ``t``, s) with each message it leaves behind a later
+    one (more than its window late, a repeated stamp, a clock step back) moved into stamp
+    order where its time fills a gap the messages in order leave: it lies between two of them
+    more than `GAP_PERIODS` ``period`` apart, at least half a period from each, and the gap
+    takes as many as its missing slots hold (each half a period from the next). A message
+    received late, stamped right, fills the slot it left empty; a message after a clock step
+    back, a repeated or stale stamp, or a stamp of 0 lands on slots taken (or outside the
+    stream), and stays behind. Returns (the order, the messages moved)."""
+    ts = t[order]
+    kept = increasing(ts)
+    late = np.flatnonzero(~kept & np.isfinite(ts))
+    if not late.size or np.count_nonzero(kept) < 2 or not np.isfinite(period):
+        return order, 0
+    at = np.flatnonzero(kept)
+    k, tc = ts[at], ts[late]
+    j = np.clip(np.searchsorted(k, tc), 1, k.size - 1)  # the gap (k[j - 1], k[j])
+    lo, hi = k[j - 1], k[j]
+    fits = (hi - lo > GAP_PERIODS * period) & (tc - lo >= period / 2) & (hi - tc >= period / 2)
+    for gap in np.unique(j[fits]):
+        inside = fits & (j == gap)
+        times = np.sort(tc[inside])
+        slots = round((k[gap] - k[gap - 1]) / period) - 1
+        if times.size > slots or np.any(np.diff(times) < period / 2):
+            fits[inside] = False  # more than the gap holds: not (only) late messages
+    if not fits.any():
+        return order, 0
+    anchor = np.arange(ts.size, dtype=float)  # each moved message right after the gap's start
+    anchor[late[fits]] = at[j[fits] - 1] + 0.5
+    return order[np.lexsort((ts, anchor))], int(np.count_nonzero(fits))
 
 
 def _fit_line(k: np.ndarray, t: np.ndarray) -> tuple[float, float]:

@@ -87,7 +87,9 @@ def check_can_record() -> None:
     require("rosbags.typesys", "recording a run as MCAP")
 
 
-def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
+def record_run(
+    result, path: str | os.PathLike, *, start_ns: int = 0, gravity: bool = False
+) -> Path:
     """Write a `control.ClosedLoopResult` as an MCAP file for Foxglove (topics in the module
     docstring).
 
@@ -99,6 +101,9 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
         start_ns: the time stamp of the run's time 0, ns, in [0, 2**31 s) (0: the epoch;
             Foxglove shows seconds from the start either way); every header stamp and receive
             time is that much later.
+        gravity: write the IMU as one that reports gravity (+9.80665 m/s^2 on its z axis,
+            REP-145's specific force; `control.robot.write_sensor_bag`); False (default):
+            the simulator's gravity-free acceleration.
 
     The file records the vehicle model and noise sd the run's ``settings`` hold (``"model"``,
     ``"noise_std"``; `control.run_closed_loop` sets both), each where it is there.
@@ -123,7 +128,7 @@ def record_run(result, path: str | os.PathLike, *, start_ns: int = 0) -> Path:
     t = result.sample_time
     t_imu, imu, t_odom, odom = sensor_messages(
         t, result.sample_accel, t, result.sample_position, result.sample_speed,
-        offset_ns=start_ns,
+        offset_ns=start_ns, gravity=gravity,
     )  # fmt: skip
     stamps = stamps_ns("the run's update times", result.time, offset_ns=start_ns)
     rows = _estimate_rows(result)

@@ -17,7 +17,8 @@ The pipeline (`replay_bag`):
    before the high-pass is off that static level is a scale fault (`ReplaySettings`);
    on header stamps, IMU messages whose header clock is not the odometry's (against their
    receive times, `clock.header_skew`) are fed as faults, or the replay refused where all are;
-3. the odometry, in stamp order where delivered late (header stamps); its position along the
+3. the odometry, in stamp order where delivered late (header stamps; however late, where a
+   stamp fills the gap it left, `clock.into_gaps`); its position along the
    path (``position="path"``: the length of the pose trajectory from the odometry frame's
    origin, `condition.path_length`; ``"speed"``: the integral of the speed) and speed (the
    planar norm of ``twist.twist.linear``), interpolated linearly at the IMU's sample times;
@@ -136,8 +137,9 @@ class ReplaySettings:
         reorder_periods: IMU messages whose stamps step back by at most this many nominal
             periods are put in stamp order (received late, stamped right); a longer step back
             is a clock step and stays (a sensor fault). Odometry messages likewise, by their
-            own periods (a longer step back is left out). 0: the order received. Only on header
-            stamps (receive times are in order).
+            own periods, and one later still where its stamp fills the gap it left
+            (`clock.into_gaps`); others are left out (a clock step back, a stale stamp). 0: the
+            order received. Only on header stamps (receive times are in order).
         restamp: put the IMU's stamps on their own fitted regular clock where they jitter
             about one by less than 1/6 period (`clock.restamp`): jitter goes, a dropped
             message, a duplicate or a clock step stays a sensor fault. Exact stamps are kept
@@ -852,7 +854,8 @@ def _condition(
         period = condition.nominal_period(t_odom)  # odometry delivered late: stamp order
         if np.isfinite(period):
             order = clock.stamp_order(t_odom, s.reorder_periods * period)
-            odom_said = _reordered(t_odom, order, s.reorder_periods)
+            order, far = clock.into_gaps(t_odom, order, period)
+            odom_said = _odometry_reordered(t_odom, order, far, s.reorder_periods)
     t_imu, accel, said, restamping = _imu_clock(rec.imu.topic, t_imu, accel, base, s)
     imu_note = "; ".join(filter(None, [note, *said]))
     odom_note = "; ".join(filter(None, [note, odom_said]))
@@ -975,6 +978,23 @@ def _reordered(t: np.ndarray, order: np.ndarray, periods: float) -> str:
             "stamp order"
         )
     return ""
+
+
+def _odometry_reordered(t: np.ndarray, order: np.ndarray, far: int, periods: float) -> str:
+    """The odometry report's note where ``order`` put messages received behind a later one
+    (times ``t``, s, as recorded) in stamp order: how many, ``far`` of them more than
+    ``periods`` late (`clock.into_gaps`); "" where it put none."""
+    behind = np.zeros(t.size, dtype=bool)
+    behind[1:] = t[1:] < np.maximum.accumulate(t)[:-1]
+    used = np.zeros(t.size, dtype=bool)
+    used[order] = condition.increasing(t[order])
+    n = int(np.count_nonzero(behind & used))
+    if not n:
+        return ""
+    return f"{n} message(s) received out of stamp order put in stamp order" + (
+        f" ({far} of them more than {periods:g} periods late, each into the gap its stamp "
+        "left)" if far else f" (by at most {periods:g} periods)"
+    )  # fmt: skip
 
 
 def _imu_clock(topic: str, t: np.ndarray, accel: np.ndarray, base: str, s: ReplaySettings):
