@@ -1128,7 +1128,9 @@ def write_run_bag(
     sample times) are applied to what is written, after gravity is added, as a failing IMU
     would record them (a "scale" fault scales gravity too, as a gain error does; a run's
     ``sample_accel`` holds no fault `control.run_closed_loop` injected); ``fault_seed`` seeds
-    the "noise" faults. A "time_nan" fault is refused (a bag's stamps are numbers)."""
+    the "noise" faults. A "time_nan" fault is refused (a bag's stamps are numbers); a "drop"
+    fault leaves out the odometry messages of its samples too (a run's samples are one stream).
+    """
     t = result.sample_time
     settings = getattr(result, "settings", None) or {}
     for name in ("model", "noise_std"):

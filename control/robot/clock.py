@@ -90,7 +90,10 @@ def into_gaps(t: np.ndarray, order: np.ndarray, period: float) -> tuple[np.ndarr
     takes as many as its missing slots hold (each half a period from the next). A message
     received late, stamped right, fills the slot it left empty; a message after a clock step
     back, a repeated or stale stamp, or a stamp of 0 lands on slots taken (or outside the
-    stream), and stays behind. Returns (the order, the messages moved)."""
+    stream), and stays behind. Messages left behind one after another in ``order`` (a burst
+    delivered late, the stretch after a clock step back) move together or not at all: a
+    clock step's messages that land in a gap stay behind with the rest. Returns (the order,
+    the messages moved)."""
     ts = t[order]
     kept = increasing(ts)
     late = np.flatnonzero(~kept & np.isfinite(ts))
@@ -101,12 +104,15 @@ def into_gaps(t: np.ndarray, order: np.ndarray, period: float) -> tuple[np.ndarr
     j = np.clip(np.searchsorted(k, tc), 1, k.size - 1)  # the gap (k[j - 1], k[j])
     lo, hi = k[j - 1], k[j]
     fits = (hi - lo > GAP_PERIODS * period) & (tc - lo >= period / 2) & (hi - tc >= period / 2)
+    block = np.cumsum(kept)[late]  # messages left behind one after another: one block
+    fits &= ~np.isin(block, block[~fits])
     for gap in np.unique(j[fits]):
         inside = fits & (j == gap)
         times = np.sort(tc[inside])
         slots = round((k[gap] - k[gap - 1]) / period) - 1
         if times.size > slots or np.any(np.diff(times) < period / 2):
             fits[inside] = False  # more than the gap holds: not (only) late messages
+    fits &= ~np.isin(block, block[~fits])  # a block moves whole or not at all
     if not fits.any():
         return order, 0
     anchor = np.arange(ts.size, dtype=float)  # each moved message right after the gap's start

@@ -349,6 +349,7 @@ def calibrate(
     if discrepancy is None:
         check_groups(discrepancy_groups, 0)  # groups without a basis: refused
     can_fast = backend == "numpy" and discrepancy is None
+    fast_given = fast is not None
     if fast is None:
         fast = can_fast
     fast = check_flag(fast, "fast")
@@ -357,15 +358,14 @@ def calibrate(
     if not fast and (emulator_params != "point" or log_prior is not None):
         what = ("emulator_params='draws'" if emulator_params != "point"
                 else "log_prior (a Calibrator update's prior=)")  # fmt: skip
-        if backend != "numpy":  # what stands in the way, as the user gave it
-            got = f"backend={backend!r}"
-        elif discrepancy is not None:
-            got = f"discrepancy={describe_discrepancy(discrepancy)}"
-        else:
-            got = "fast=False"
+        got = [f"backend={backend!r}"] if backend != "numpy" else []  # each in the way, as given
+        if discrepancy is not None:
+            got.append(f"discrepancy={describe_discrepancy(discrepancy)}")
+        if fast_given:
+            got.append("fast=False")
         raise GPMSAError(
             f"{what} needs the fast numpy sampler: backend='numpy', no discrepancy and fast "
-            f"not False; got {got}"
+            f"not False; got {', '.join(got)}"
         )
     reserved = ("n_iter", "n_chains", "tune", "seed", "progress", "n_jobs", "executor",
                 "tune_rounds", "tune_levels")  # fmt: skip
