@@ -50,11 +50,11 @@ def continued_starts(
         )  # fmt: skip
     if obs is not None and settings.get("obs_sha256") not in (None, obs.digest()):
         raise GPMSAError("init=emulator was fitted jointly with other observations")
-    differs = _model_differences(emulator, problem, order)
+    differs, detail = _model_differences(emulator, problem, order)
     if differs:
         raise GPMSAError(
-            f"init=emulator was another model: its {', '.join(differs)} differ from this fit's; "
-            "continue it with the same settings, or start afresh"
+            f"init=emulator was another model: its {', '.join(differs)} differ from this "
+            f"fit's{detail}; continue it with the same settings, or start afresh"
         )
     per = emulator.log_post.size // n_chains
     last = np.arange(1, n_chains + 1) * per - 1  # kept draws are stored chain after chain
@@ -436,14 +436,15 @@ def pool_accept(summary: dict, source: Emulator, accept_rate: dict, n_iter: int,
 
 
 def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | None = None
-                       ) -> list[str]:  # fmt: skip
+                       ) -> tuple[list[str], str]:  # fmt: skip
     """What of the model ``emulator`` was fitted with differs from ``problem``'s: its priors,
     mean basis, fixed parameters, theta constraint and discrepancy basis and groups. A
     discrepancy basis whose columns are the source's up to their signs and order (each with
     its group: ``reordered_basis``) is the same; where it or K (``order``, from
     ``component_order``) is reordered, the data-corrected priors agree to 1e-12 (the
     correction's sums run in another order), and a per-component parameter held (fixed) with
-    K in another order is another model."""
+    K in another order is another model. Returns (the names of what differs, `_prior_fields`'
+    detail where the priors do, else "")."""
     settings = emulator.settings or {}
     mb = problem.mean_basis
     disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
@@ -464,19 +465,33 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
         "discrepancy": old_disc != new_disc and not d_moved,
     }
     names = [name for name, differ in differs.items() if differ]
-    return [_prior_fields(*priors) if name == "priors" else name for name in names]
+    return names, _prior_fields(*priors) if differs["priors"] else ""
+
+
+CORRECTED = frozenset({"lamWOs", "lamOs", "corrected"})
+"""Prior fields that fitting corrects for the data (GPM/SA's data corrections): they differ
+with the data or the discrepancy, not as the user set them, so `_prior_fields` leaves them out."""
 
 
 def _prior_fields(source: dict, this: dict) -> str:
-    """The word priors with the fields in which the records ``source`` and ``this``
-    (`_prior_record`) differ and their values (the source's, then this fit's), and the remedy
+    """ " (priors: ...)": the fields in which the prior records ``source`` and ``this``
+    (`_prior_record`) differ with their values (the source's, then this fit's), and the remedy
     (an Emulator's ``priors`` are data-corrected: ``fit`` takes the priors as set before
     fitting)."""
-    fields = [k for k in sorted(set(source) | set(this)) if source.get(k) != this.get(k)]
-    shown = "; ".join(f"{k}: {source.get(k)!r:.60} there, {this.get(k)!r:.60} here"
+    fields = [k for k in sorted((set(source) | set(this)) - CORRECTED)
+              if source.get(k) != this.get(k)]  # fmt: skip
+    if not fields:  # only the data's corrections differ (other data, another discrepancy)
+        return ""
+    shown = "; ".join(f"{k}: {_short(source.get(k))} there, {_short(this.get(k))} here"
                       for k in fields[:3])  # fmt: skip
     more = f"; and {len(fields) - 3} more" if len(fields) > 3 else ""
-    return f"priors ({shown}{more}: give priors= as the source was fitted with)"
+    return f" (priors: {shown}{more}: give priors= as the source was fitted with)"
+
+
+def _short(value, width: int = 60) -> str:
+    """``repr(value)``, cut to ``width`` characters with "..." where longer."""
+    text = repr(value)
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def discrepancy_moved(old: dict, new: dict, obs) -> bool:

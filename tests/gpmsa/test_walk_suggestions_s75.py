@@ -25,7 +25,10 @@ def case():
 
 def test_a_continuation_with_other_priors_names_the_field_and_values(case):
     sim, obs, emu = case
-    want = r"priors \(theta_sd: \[0\.3\] there, \[10\.0\] here: give priors= as the source"
+    want = (
+        r"its priors differ from this fit's \(priors: theta_sd: \[0\.3\] there, \[10\.0\] "
+        r"here: give priors= as the source"
+    )
     with pytest.raises(gpmsa.GPMSAError, match=want):
         gpmsa.fit(sim, obs, n_iter=30, seed=1, init=emu)
     with warnings.catch_warnings():
