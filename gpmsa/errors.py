@@ -1,5 +1,6 @@
-"""Exceptions raised by gpmsa."""
+"""Exceptions and warnings raised by gpmsa, and the text of the numbers in their messages."""
 
+import math
 import sys
 
 
@@ -39,6 +40,22 @@ def user_stacklevel() -> int:
     while frame is not None and frame.f_globals.get("__name__", "").split(".")[0] == "gpmsa":
         frame, level = frame.f_back, level + 1
     return level
+
+
+def numbers_text(*values: float, digits: int = 6) -> tuple[str, ...]:
+    """``values`` (a value and the range it is checked against, say) as text for a message:
+    ``digits`` significant digits, more (up to 17) where the values lie close together
+    relative to their size, so that 1e6 + 1.5 and the range [1e6 + 0.02, 1e6 + 0.99] do not all
+    read "1e+06": three significant digits of their smallest difference are kept."""
+    finite = sorted({float(v) for v in values if math.isfinite(v)})
+    gaps = [b - a for a, b in zip(finite, finite[1:], strict=False)]
+    if gaps:
+        scale = max(abs(finite[0]), abs(finite[-1]))
+        spread = scale / min(gaps)  # > 0: distinct values
+        if spread > 1e3:
+            need = math.ceil(math.log10(spread)) + 3 if math.isfinite(spread) else 17
+            digits = min(17, max(digits, need))
+    return tuple(f"{float(v):.{digits}g}" for v in values)
 
 
 class DomainWarning(UserWarning):

@@ -19,6 +19,7 @@ from gpmsa.errors import (
     GPMSAError,
     OutsideEmulatorWarning,
     ResourceLimitError,
+    numbers_text,
     user_stacklevel,
 )
 from gpmsa.model import categorical, kronecker
@@ -228,7 +229,8 @@ def check_x(
         j, k = (int(i) for i in np.argwhere(far if far.any() else out)[0])
         name = emulator.x_names[k]
         lo, hi = emulator.domain[name]
-        msg = f"{what} {name}={x[j, k]:.6g} lies outside the emulator's domain [{lo:.6g}, {hi:.6g}]"
+        v, lo, hi = numbers_text(x[j, k], lo, hi)
+        msg = f"{what} {name}={v} lies outside the emulator's domain [{lo}, {hi}]"
         if far.any() and not extrapolate:
             raise GPMSAError(f"{msg} by more than {EXTRAPOLATION_MARGIN:.0%} of its width; pass "
                              "extrapolate=True to allow it")  # fmt: skip

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.errors import GPMSAError, StartRejectedError
+from gpmsa.errors import GPMSAError, StartRejectedError, numbers_text
 from gpmsa.model.data import as_float, by_column_names, check_finite
 
 
@@ -147,8 +147,9 @@ def theta_init_unit(
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         kind = "closed range [" if closed[k] else "open range ("
+        v, lo, hi = numbers_text(arr[k], t_min[k], t_max[k])
         raise GPMSAError(
-            f"{what} {names[k]}={arr[k]:.6g} lies outside the {kind}{float(t_min[k]):.6g}, "
-            f"{float(t_max[k]):.6g}{']' if closed[k] else ')'} of the design"
+            f"{what} {names[k]}={v} lies outside the {kind}{lo}, {hi}"
+            f"{']' if closed[k] else ')'} of the design"
         )
     return unit

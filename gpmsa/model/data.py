@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from gpmsa.errors import DomainWarning, GPMSAError, user_stacklevel
+from gpmsa.errors import DomainWarning, GPMSAError, numbers_text, user_stacklevel
 from gpmsa.model import categorical, kronecker
 
 
@@ -636,15 +636,16 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
             raise GPMSAError(f"{label}: {names[j]} is categorical; its unit scale is its levels', "
                              "give no range for it")  # fmt: skip
         col_lo, col_hi = float(arr[:, j].min()), float(arr[:, j].max())
+        a, b, c, d = numbers_text(col_lo, col_hi, lo, hi)
         if col_lo < lo or col_hi > hi:
             raise GPMSAError(
-                f"design column {names[j]} spans [{col_lo:.6g}, {col_hi:.6g}], outside its "
-                f"{attr} [{lo:.6g}, {hi:.6g}]: the range must hold every run"
+                f"design column {names[j]} spans [{a}, {b}], outside its {attr} [{c}, {d}]: the "
+                "range must hold every run"
             )
         if (col_hi - col_lo) < RANGE_COVER_MIN * width:
             warnings.warn(
-                f"design column {names[j]} spans [{col_lo:.6g}, {col_hi:.6g}], "
-                f"{(col_hi - col_lo) / width:.3g} of its {attr} [{lo:.6g}, {hi:.6g}] (less than "
+                f"design column {names[j]} spans [{a}, {b}], "
+                f"{(col_hi - col_lo) / width:.3g} of its {attr} [{c}, {d}] (less than "
                 f"{RANGE_COVER_MIN:g}): the runs fill a sliver of the unit interval, where the "
                 "fit resolves the input poorly (below 0.05 it ignores it) and the emulator "
                 "extrapolates over the rest; check the range's units, or give the range the "

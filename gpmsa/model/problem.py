@@ -9,7 +9,13 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from gpmsa.errors import ExtrapolationWarning, GPMSAError, ReductionWarning, user_stacklevel
+from gpmsa.errors import (
+    ExtrapolationWarning,
+    GPMSAError,
+    ReductionWarning,
+    numbers_text,
+    user_stacklevel,
+)
 from gpmsa.model import categorical, kronecker
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model import mean_basis as mean_basis_mod
@@ -369,8 +375,8 @@ def check_x_obs(
     if x_native is not None and domain is not None and ((lo < 0) | (hi > 1)).any():
         beyond = -EXTRAPOLATION_MARGIN if far.any() else 0.0
         j, k = (int(i) for i in np.argwhere((x_unit < beyond) | (x_unit > 1 - beyond))[0])
-        where = (f"x_obs {names[k]}={x_native[j, k]:.6g} lies outside the simulation design's "
-                 f"range [{domain[0][k]:.6g}, {domain[1][k]:.6g}]")  # fmt: skip
+        v, lo_k, hi_k = numbers_text(x_native[j, k], domain[0][k], domain[1][k])
+        where = f"x_obs {names[k]}={v} lies outside the simulation design's range [{lo_k}, {hi_k}]"
         if far.any():
             raise GPMSAError(
                 f"{where} by more than {EXTRAPOLATION_MARGIN:.0%} of its width: a joint fit "
@@ -477,9 +483,10 @@ def reduce_obs(
     lo, hi = std.grid.min(), std.grid.max()
     for j, (e, g, lam) in enumerate(zip(ys, obs.grids, lamy, strict=True)):
         if g is not None and not (g.min() >= lo and g.max() <= hi):
+            a, b, c, d = numbers_text(g.min(), g.max(), lo, hi)
             raise GPMSAError(
-                f"the index of experiment {j} reaches [{g.min():.6g}, {g.max():.6g}], outside the "
-                f"simulation grid [{lo:.6g}, {hi:.6g}]; observations must lie within it"
+                f"the index of experiment {j} reaches [{a}, {b}], outside the simulation grid "
+                f"[{c}, {d}]; observations must lie within it"
             )
         Kj = interpolate_basis(K, std.grid, g)
         Dj = None if bases is None else bases[j]

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.errors import ExtrapolationWarning, GPMSAError
+from gpmsa.errors import ExtrapolationWarning, GPMSAError, numbers_text
 from gpmsa.model.data import SimData, check_increasing, column_scales, output_scale
 
 UNIT_TOL = 1e-9
@@ -52,8 +52,8 @@ def check_extrapolation(
         return
     k = int(np.flatnonzero(far if far.any() else outside)[0])
     arg = what if isinstance(what, str) else what[k]
-    msg = (f"{arg}: {names[k]} reaches [{native[:, k].min():.6g}, {native[:, k].max():.6g}], "
-           f"outside the emulator's domain [{float(lo[k]):.6g}, {float(hi[k]):.6g}]")  # fmt: skip
+    a, b, c, d = numbers_text(native[:, k].min(), native[:, k].max(), lo[k], hi[k])
+    msg = f"{arg}: {names[k]} reaches [{a}, {b}], outside the emulator's domain [{c}, {d}]"
     if far[k]:
         msg += f" by more than {EXTRAPOLATION_MARGIN:.0%} of its width"
         if not extrapolate:

@@ -33,7 +33,7 @@ from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa.calibration.observations import blas_controller, check_x, layout_digest
 from gpmsa.calibration.posterior import Posterior
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, numbers_text
 from gpmsa.limits import check_memory
 from gpmsa.model.basis import (
     basis_digest,
@@ -270,8 +270,10 @@ def _pred_grid(emulator, obs: ObsData, grid):
         check_finite(g, "grid")
         lo, hi = std.grid.min(), std.grid.max()
         if g.size == 0 or g.min() < lo or g.max() > hi:
-            raise GPMSAError(f"grid must be non-empty and lie within the simulation grid "
-                             f"[{lo:.6g}, {hi:.6g}]")  # fmt: skip
+            lo, hi = numbers_text(lo, hi, *((g.min(), g.max()) if g.size else ()))[:2]
+            raise GPMSAError(
+                f"grid must be non-empty and lie within the simulation grid [{lo}, {hi}]"
+            )
         return g
     grids = [std.grid if g is None else g for g in obs.grids]
     same = all(g.shape == grids[0].shape and np.array_equal(g, grids[0]) for g in grids)
