@@ -44,17 +44,17 @@ def user_stacklevel() -> int:
 
 def numbers_text(*values: float, digits: int = 6) -> tuple[str, ...]:
     """``values`` (a value and the range it is checked against, say) as text for a message:
-    ``digits`` significant digits, more (up to 17) where the values lie close together
-    relative to their size, so that 1e6 + 1.5 and the range [1e6 + 0.02, 1e6 + 0.99] do not all
-    read "1e+06": three significant digits of their smallest difference are kept."""
+    ``digits`` significant digits, more (up to 17) where two distinct values would read alike,
+    so that 1e6 + 1.5 and the range [1e6 + 0.02, 1e6 + 0.99] do not all read "1e+06": then
+    three significant digits of the values' smallest difference are kept."""
+    texts = tuple(f"{float(v):.{digits}g}" for v in values)
     finite = sorted({float(v) for v in values if math.isfinite(v)})
-    gaps = [b - a for a, b in zip(finite, finite[1:], strict=False)]
-    if gaps:
-        scale = max(abs(finite[0]), abs(finite[-1]))
-        spread = scale / min(gaps)  # > 0: distinct values
-        if spread > 1e3:
-            need = math.ceil(math.log10(spread)) + 3 if math.isfinite(spread) else 17
-            digits = min(17, max(digits, need))
+    if len({f"{v:.{digits}g}" for v in finite}) == len(finite):  # (the usual case)
+        return texts
+    gap = min(b - a for a, b in zip(finite, finite[1:], strict=False))
+    spread = max(abs(finite[0]), abs(finite[-1])) / gap
+    need = math.ceil(math.log10(spread)) + 3 if math.isfinite(spread) else 17
+    digits = min(17, max(digits, need))
     return tuple(f"{float(v):.{digits}g}" for v in values)
 
 
