@@ -175,7 +175,7 @@ class SensorLimits:
             switches it off): with ``static_mps2``, the mean of the newest ``static_span``
             contiguous samples outside ``static_mps2 * (1 +- static_span_tolerance)`` is a scale
             (or tilt) fault too (`static_span_level`), checked at every update once the span is
-            full. The BCR keeps it (`StaticSpan`, a running sum: O(1) per update) across its
+            full. The BCR keeps it (`StaticSpan`, a ring summed at each check) across its
             blocks, phases and window restarts; a break in the stream (a dropped, repeated or
             backwards sample, a gap), ``reset`` and ``resume`` start it again (it then checks
             nothing for ``static_span`` samples); a fault of the checks does not (a persistent
@@ -432,95 +432,52 @@ def _off_static(mean: float, static: float, tol: float, what: str, over: str) ->
 
 
 class StaticSpan:
-    """The mean of the newest ``size`` contiguous samples of a stream (the static-level check's
-    long span, `static_span_level`): a ring of the samples and their running sum, O(1) per
-    sample (each is added once and taken off once). The ring is summed afresh each time it
-    wraps (the running sum's rounding then stays within `rounding`), for as long as a value
-    beyond ``MAX_ACCEL_MPS2`` is in it, and where a mean lies near the limit or off it
-    (`static_span_fault`), so that a verdict and its reason do not depend on how the stream was
-    chunked."""
+    """The newest ``size`` contiguous samples of a stream (the static-level check's long span,
+    `static_span_level`): a ring in which each sample sits at its place in the stream modulo
+    ``size``, so that the span's mean, summed afresh at each check (one sum of ``size``
+    values: ~1 us for 1,000), does not depend on how the stream was chunked."""
 
     def __init__(self, size: int) -> None:
-        self._ring = np.zeros(size)
+        self._ring = np.empty(size)
         self.restart()
 
     def restart(self) -> None:
-        """Forget every sample (a break in the stream: the span starts again)."""
-        self._ring.fill(0.0)
-        self._next, self._held, self._total = 0, 0, 0.0
-        self._exact = 0  # samples to take before the running sum may be used again
+        """Forget every sample (a break in the stream: the span starts again; the ring's old
+        values are all overwritten before it is full again)."""
+        self._next, self._held = 0, 0
 
     @property
     def full(self) -> bool:
         """Whether the span holds ``size`` samples."""
         return self._held == self._ring.size
 
-    @property
-    def rounding(self) -> float:
-        """A bound on the running mean's rounding, m/s^2: between two fresh sums at most ``size``
-        pushes of values within ``MAX_ACCEL_MPS2``, each of at most three roundings of a total
-        of at most ``size * MAX_ACCEL_MPS2``, plus a chunk's own sum (9e-8 m/s^2 for 1,000
-        samples; the rounding itself is ~1e-13 for accelerations within 100 m/s^2)."""
-        return 4.0 * self._ring.size * EPS * MAX_ACCEL_MPS2
-
     def push(self, a: np.ndarray) -> None:
         """Append the samples ``a`` (finite, m/s^2), the oldest ones leaving."""
-        wild = bool(a.size) and not np.abs(a).max() <= MAX_ACCEL_MPS2
-        if wild or self._exact:  # sums of values beyond any accelerometer's may overflow
-            with np.errstate(over="ignore", invalid="ignore"):
-                self._push(a, wild)
-        else:
-            self._push(a, wild)
-
-    def _push(self, a: np.ndarray, wild: bool) -> None:
-        """`push`; ``wild``: a value of ``a`` lies beyond ``MAX_ACCEL_MPS2``."""
         ring, k = self._ring, a.size
         size = ring.size
         start, stop = self._next, self._next + k
         if k >= size:  # each sample in its slot of the stream, as in finer chunks
             ring[:] = np.roll(a[k - size :], stop % size)
         elif stop <= size:
-            self._total += float(a.sum()) - float(ring[start:stop].sum())
             ring[start:stop] = a
         else:
-            wrap = stop - size
-            self._total += float(a.sum()) - float(ring[start:].sum()) - float(ring[:wrap].sum())
             ring[start:] = a[: size - start]
-            ring[:wrap] = a[size - start :]
+            ring[: stop - size] = a[size - start :]
         self._next = stop % size
         self._held = min(self._held + k, size)
-        if wild:  # the running sum may lose the others' digits: summed afresh until it has left
-            self._exact = size
-        elif self._exact:
-            self._exact = max(self._exact - k, 0)
-            if not self._exact:  # (it has left)
-                self._total = float(ring.sum())
-        if stop >= size:  # (wrapped: its rounding forgotten)
-            self._total = float(ring.sum())
 
-    def running_mean(self) -> float:
-        """The span's mean from the running sum (summed afresh while a wild value is in it)."""
-        if self._exact:
-            return self.exact_mean()
-        return self._total / self._ring.size
-
-    def exact_mean(self) -> float:
-        """The span's mean summed afresh (the ring's order: its place in the stream; inf or NaN
-        where wild values overflow the sum)."""
+    def mean(self) -> float:
+        """The span's mean, m/s^2 (inf or NaN where values beyond any accelerometer's overflow
+        the sum: a fault then)."""
         with np.errstate(over="ignore", invalid="ignore"):
             return float(self._ring.sum() / self._ring.size)
 
 
 def static_span_fault(span: StaticSpan, limits: SensorLimits) -> str:
-    """`static_span_level` of a full `StaticSpan` ("" before it is full): the running mean
-    where it lies clearly within the tolerance, else the mean summed afresh."""
-    static = limits.static_mps2
-    if static is None or not span.full:
+    """`static_span_level` of a full `StaticSpan` ("" before it is full)."""
+    if limits.static_mps2 is None or not span.full:
         return ""
-    limit = limits.static_span_tolerance * abs(static) - span.rounding
-    if abs(span.running_mean() - static) < limit:  # (the usual case: clearly within it)
-        return ""
-    return static_span_level(span.exact_mean(), limits)
+    return static_span_level(span.mean(), limits)
 
 
 def _distinct_count(ordered: np.ndarray, positive_gaps: np.ndarray) -> int:

@@ -481,8 +481,8 @@ def static_level_marks(
     a = np.asarray(a, dtype=float)
     finite = np.isfinite(a)
     count = np.concatenate([[0], np.cumsum(finite)])
-    ends = np.arange(every, a.size + 1, every)
-    ends = ends[ends >= block]
+    updates = np.arange(every, a.size + 1, every)  # each update's end (exclusive)
+    ends = updates[updates >= block]
     full = count[ends] - count[ends - block] == block
     marks = {}
     blocks = np.lib.stride_tricks.sliding_window_view(a, min(block, a.size))
@@ -498,8 +498,7 @@ def static_level_marks(
         step = np.diff(t, prepend=np.nan) * rate_hz
         start = ~finite | ~np.isfinite(t) | ~((step >= 0.5) & (step <= GAP_PERIODS))
         run = np.cumsum(start)  # (a run's first sample may be its start: finite, after a gap)
-        ends = np.arange(every, a.size + 1, every)
-        ends = ends[ends >= span]
+        ends = updates[updates >= span]
         whole = run[ends - 1] == run[ends - span]
         whole &= finite[ends - span] & np.isfinite(t[ends - span])
         windows = np.lib.stride_tricks.sliding_window_view(a, span)

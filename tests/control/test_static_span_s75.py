@@ -52,7 +52,7 @@ def test_a_span_at_0_9_g_is_a_scale_fault_a_15_degree_slope_is_not():
     assert static_span_level(0.9 * G, SensorLimits(static_mps2=G, static_span=0)) == ""
 
 
-def test_the_running_mean_is_the_last_span_samples_in_any_chunking():
+def test_the_mean_is_the_last_span_samples_in_any_chunking():
     a = _drive(5000, seed=3) + G
     spans = []
     for seed in (0, 1):
@@ -63,9 +63,9 @@ def test_the_running_mean_is_the_last_span_samples_in_any_chunking():
             held = a[: cuts[k] if k < cuts.size else a.size][-1000:]
             assert span.full == (held.size == 1000)
             if span.full:
-                assert span.running_mean() == pytest.approx(held.mean(), abs=1e-12)
+                assert span.mean() == pytest.approx(held.mean(), abs=1e-12)
         spans.append(span)
-    assert spans[0].exact_mean() == spans[1].exact_mean()  # bit for bit
+    assert spans[0].mean() == spans[1].mean()  # bit for bit
     spans[0].restart()
     assert not spans[0].full
     spans[0].push(a[:999])
@@ -77,7 +77,7 @@ def test_the_running_mean_is_the_last_span_samples_in_any_chunking():
         span.push(part)
         held += part.size
         if held >= 252:
-            assert span.running_mean() == pytest.approx(wild[held - 100 : held].mean(), abs=1e-12)
+            assert span.mean() == pytest.approx(wild[held - 100 : held].mean(), abs=1e-12)
 
 
 def _feed(bcr: BCR, accel: np.ndarray, speed=1.5, t0: float = 0.0):
