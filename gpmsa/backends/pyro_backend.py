@@ -26,9 +26,10 @@ detached verdict (no gradient; asked only where theta's prior allows it, as the 
 torch samplers ask it: never outside (0, 1)), so NUTS sees an infinite energy there: a
 divergence, whose subtree gets zero weight and ends the trajectory's doubling (pyro's
 ``NUTS._build_basetree``; the chain stays exact, a hard wall as Stan's). The level draws and
-moves take the same -inf. The verdict is numpy, which a JIT trace would freeze at its first
-value, so with a constraint the potential energy is not JIT-compiled (``jit`` is ignored). A
-callable mean basis with theta sampled is refused (`refuse_unsupported`).
+moves take the same -inf (a move's candidate it rejects is refused without its likelihood). The
+verdict is numpy, which a JIT trace would freeze at its first value, so with a constraint the
+potential energy is not JIT-compiled (``jit`` is ignored). A callable mean basis with theta
+sampled is refused (`refuse_unsupported`).
 """
 
 from __future__ import annotations
@@ -392,11 +393,21 @@ class LevelJumps(MCMCKernel):
             self.moves += 1
             if not bool(torch.all((shifted > 0.0) & (shifted < 1.0))):
                 continue  # outside theta's prior: rejected
+            if model.constraint is not None and not self._allowed(new, r):
+                self.rng.random()  # rejected without the likelihood; the draws as if asked
+                continue
             lp_new = float(model.log_post_at({**prm, "theta": new}, model.combos[r])[0])
             if np.log(self.rng.random()) < lp_new - lp:
                 theta, idx, row, lp, moved = new, cand, r, lp_new, True
                 self.accepted += 1
         return (theta if moved else None), row
+
+    def _allowed(self, theta: torch.Tensor, row: int) -> bool:
+        """Whether the theta constraint allows ``theta`` (1, q) at level combination ``row``
+        (a candidate it rejects has log posterior -inf: no likelihood is needed)."""
+        at = theta.clone()
+        at[0, self.model.cat] = self.model.combos[row]
+        return bool(self.model.constraint_term(at, np.ones(1, dtype=bool))[0] == 0.0)
 
 
 def _scatter(init: np.ndarray, held: np.ndarray, dtype: torch.dtype):
