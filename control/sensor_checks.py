@@ -81,7 +81,7 @@ STATIC_BLOCK = 125
 ``STATIC_BLOCK / n`` (its mean is the change of vertical velocity over a shorter time: the
 window methods' chunks of ``update_every`` samples)."""
 MAX_STATIC_SPAN = 1 << 20
-"""Longest ``SensorLimits.static_span``, samples (2.4 h at 120 Hz; its ring holds 8 MiB)."""
+"""Longest ``SensorLimits.static_span``, samples (2.4 h at 120 Hz; its ring holds 16 MiB)."""
 
 
 @dataclass(frozen=True)
@@ -434,12 +434,23 @@ def _off_static(mean: float, static: float, tol: float, what: str, over: str) ->
 class StaticSpan:
     """The newest ``size`` contiguous samples of a stream (the static-level check's long span,
     `static_span_level`): a ring in which each sample sits at its place in the stream modulo
-    ``size``, so that the span's mean, summed afresh at each check (one sum of ``size``
-    values: ~1 us for 1,000), does not depend on how the stream was chunked."""
+    ``size``, and again ``size`` slots on, so that the span is one contiguous stretch of it in
+    the stream's order. Its mean, summed afresh at each check (one sum of ``size`` values: ~1 us
+    for 1,000), is then bit for bit the sum of those samples as a recording's (the replay's
+    `static_level_marks`), whatever the chunking and wherever the span started."""
 
     def __init__(self, size: int) -> None:
-        self._ring = np.empty(size)
+        self._size = size
+        self._ring = np.empty(2 * size)
         self.restart()
+
+    def __setstate__(self, state: dict) -> None:
+        # (pickled in session 75: each sample once, at its place modulo size; a running sum)
+        if "_size" not in state:
+            ring = state.pop("_ring")
+            state = {**state, "_size": ring.size, "_ring": np.concatenate([ring, ring])}
+            state.pop("_total", None), state.pop("_exact", None)
+        self.__dict__.update(state)
 
     def restart(self) -> None:
         """Forget every sample (a break in the stream: the span starts again; the ring's old
@@ -449,28 +460,30 @@ class StaticSpan:
     @property
     def full(self) -> bool:
         """Whether the span holds ``size`` samples."""
-        return self._held == self._ring.size
+        return self._held == self._size
 
     def push(self, a: np.ndarray) -> None:
         """Append the samples ``a`` (finite, m/s^2), the oldest ones leaving."""
-        ring, k = self._ring, a.size
-        size = ring.size
-        start, stop = self._next, self._next + k
-        if k >= size:  # each sample in its slot of the stream, as in finer chunks
-            ring[:] = np.roll(a[k - size :], stop % size)
-        elif stop <= size:
-            ring[start:stop] = a
+        ring, size, k = self._ring, self._size, a.size
+        self._held = min(self._held + k, size)
+        start = self._next
+        if k > size:  # only the newest size samples stay, each in its slot of the stream
+            start, a, k = (start + k - size) % size, a[k - size :], size
+        stop = start + k  # (at most 2 size: each sample in its slot, then its copy)
+        ring[start:stop] = a
+        if stop <= size:
+            ring[start + size : stop + size] = a
         else:
-            ring[start:] = a[: size - start]
+            ring[start + size :] = a[: size - start]
             ring[: stop - size] = a[size - start :]
         self._next = stop % size
-        self._held = min(self._held + k, size)
 
     def mean(self) -> float:
         """The span's mean, m/s^2 (inf or NaN where values beyond any accelerometer's overflow
         the sum: a fault then)."""
+        size = self._size
         with np.errstate(over="ignore", invalid="ignore"):
-            return float(self._ring.sum() / self._ring.size)
+            return float(self._ring[self._next : self._next + size].sum() / size)
 
 
 def static_span_fault(span: StaticSpan, limits: SensorLimits) -> str:

@@ -46,13 +46,14 @@ def numbers_text(*values: float, digits: int = 6) -> tuple[str, ...]:
     """``values`` (a value and the range it is checked against, say) as text for a message:
     ``digits`` significant digits, more (up to 17) where two distinct values would read alike,
     so that 1e6 + 1.5 and the range [1e6 + 0.02, 1e6 + 0.99] do not all read "1e+06": then
-    three significant digits of the values' smallest difference are kept."""
+    three significant digits of the difference of each two neighbouring values (relative to
+    their size, not to the largest value's: 0.1 and 0.1000001 beside 1e12 read so)."""
     texts = tuple(f"{float(v):.{digits}g}" for v in values)
     finite = sorted({float(v) for v in values if math.isfinite(v)})
     if len({f"{v:.{digits}g}" for v in finite}) == len(finite):  # (the usual case)
         return texts
-    gap = min(b - a for a, b in zip(finite, finite[1:], strict=False))
-    spread = max(abs(finite[0]), abs(finite[-1])) / gap
+    pairs = zip(finite, finite[1:], strict=False)
+    spread = max(max(abs(a), abs(b)) / (b - a) for a, b in pairs)  # (b - a > 0: distinct)
     need = math.ceil(math.log10(spread)) + 3 if math.isfinite(spread) else 17
     digits = min(17, max(digits, need))
     return tuple(f"{float(v):.{digits}g}" for v in values)

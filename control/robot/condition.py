@@ -476,8 +476,9 @@ def static_level_marks(
     newest sample: the reason} for each update whose block (its newest ``block`` samples, all
     finite: a non-finite one is a fault the BCR reports itself) has a mean off
     ``limits.static_mps2``, or, with ``limits.static_span``, whose newest ``static_span``
-    samples, finite and contiguous (steps within [0.5, ``GAP_PERIODS``] periods, as the BCR's
-    long span: `static_span_level`), have one off it by more than ``static_span_tolerance``."""
+    samples, finite and contiguous (steps within [0.5, ``GAP_PERIODS``] periods; one stamped
+    backwards is left out, as the BCR's long span leaves it: `static_span_level`), have one
+    off it by more than ``static_span_tolerance``."""
     a = np.asarray(a, dtype=float)
     finite = np.isfinite(a)
     count = np.concatenate([[0], np.cumsum(finite)])
@@ -496,11 +497,11 @@ def static_level_marks(
     span = limits.static_span
     if span and a.size >= span:
         step = np.diff(t, prepend=np.nan) * rate_hz
-        start = ~finite | ~np.isfinite(t) | ~((step >= 0.5) & (step <= GAP_PERIODS))
-        run = np.cumsum(start)  # (a run's first sample may be its start: finite, after a gap)
+        dropped = ~finite | ~np.isfinite(t) | (step < 0.5)  # (stamped backwards: the BCR drops it)
+        start = dropped | ~(step <= GAP_PERIODS)
+        run = np.cumsum(start)  # (a run's first sample may be its start: kept, after a gap)
         ends = updates[updates >= span]
-        whole = run[ends - 1] == run[ends - span]
-        whole &= finite[ends - span] & np.isfinite(t[ends - span])
+        whole = (run[ends - 1] == run[ends - span]) & ~dropped[ends - span]
         windows = np.lib.stride_tricks.sliding_window_view(a, span)
         with np.errstate(over="ignore", invalid="ignore"):
             for end in ends[whole]:

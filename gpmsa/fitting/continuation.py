@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, numbers_text
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
 from gpmsa.mcmc import tempering
 from gpmsa.mcmc.sampler import check_step_widths
@@ -83,20 +83,21 @@ def check_same_scales(emulator: Emulator, data, standardizer) -> None:
     ends = [np.concatenate([s.x_min, s.t_min, s.x_max, s.t_max]) for s in (old, new)]
     d = len(names)
     differs = [
-        f"{n}: [{ends[0][k]:.6g}, {ends[0][d + k]:.6g}] in init=emulator's fit, "
-        f"[{ends[1][k]:.6g}, {ends[1][d + k]:.6g}] here"
+        "{}: [{}, {}] in init=emulator's fit, [{}, {}] here".format(
+            n, *numbers_text(ends[0][k], ends[0][d + k], ends[1][k], ends[1][d + k])
+        )
         for k, n in enumerate(names)
         if ends[0][k] != ends[1][k] or ends[0][d + k] != ends[1][d + k]
     ]
     scale = {True: "'columnwise'", False: "'scalar'"}
     given = set(old.y_given) | set(new.y_given)  # else both the runs' own: the same
     if "y_mean" in given and not np.array_equal(old.y_mean, new.y_mean):
-        differs.append(f"y_mean: {_given(old, 'y_mean')} in init=emulator's fit, "
-                       f"{_given(new, 'y_mean')} here")  # fmt: skip
+        differs.append(f"y_mean: {_given(old, 'y_mean', new)} in init=emulator's fit, "
+                       f"{_given(new, 'y_mean', old)} here")  # fmt: skip
     if "y_sd" in given:
         if not np.array_equal(old.y_sd, new.y_sd):
-            differs.append(f"y_sd: {_given(old, 'y_sd')} in init=emulator's fit, "
-                           f"{_given(new, 'y_sd')} here")  # fmt: skip
+            differs.append(f"y_sd: {_given(old, 'y_sd', new)} in init=emulator's fit, "
+                           f"{_given(new, 'y_sd', old)} here")  # fmt: skip
     elif old.columnwise != new.columnwise:
         differs.append(f"y_scale: {scale[old.columnwise]} in init=emulator's fit, "
                        f"{scale[new.columnwise]} here")  # fmt: skip
@@ -108,11 +109,13 @@ def check_same_scales(emulator: Emulator, data, standardizer) -> None:
         )
 
 
-def _given(std, name: str) -> str:
-    """A Standardizer's ``name`` ("y_mean" or "y_sd") for a message: its value(s), and whether
-    the user gave it or it is the runs' own."""
-    v = np.ravel(getattr(std, name))
-    text = f"{v[0]:.6g}" if v.size == 1 else f"[{', '.join(f'{a:.6g}' for a in v[:3])}" + (
+def _given(std, name: str, other) -> str:
+    """A Standardizer's ``name`` ("y_mean" or "y_sd") for a message: its value(s), with the
+    digits that tell them from ``other``'s (`numbers_text`), and whether the user gave it or
+    it is the runs' own."""
+    v = np.ravel(getattr(std, name))[:4]
+    texts = numbers_text(*v[:3], *np.ravel(getattr(other, name))[:3])
+    text = texts[0] if v.size == 1 else f"[{', '.join(texts[: min(v.size, 3)])}" + (
         ", ...]" if v.size > 3 else "]")  # fmt: skip
     who = "given" if name in std.y_given else "the runs' own"
     return f"{text} ({who})"
