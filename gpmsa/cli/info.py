@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
@@ -13,6 +12,7 @@ from gpmsa.cli.text import (
     internal_error,
     level_moves_text,
     number,
+    numbers,
     plain,
     safe,
     tempering_text,
@@ -29,7 +29,8 @@ def add_parser(sub) -> None:
     p = sub.add_parser("info", help="print an emulator or study file's manifest (verifies it "
                        "first)")  # fmt: skip
     p.add_argument("file", help="path to a .gpmsa file (an emulator or a study)")
-    p.add_argument("--json", action="store_true", help="print the raw manifest as JSON")
+    p.add_argument("--json", action="store_true", help="print the same facts as one JSON object "
+                   "(keys: docs/emulator-file.md; the raw manifest under 'manifest')")  # fmt: skip
     p.set_defaults(func=run)
 
 
@@ -41,6 +42,7 @@ def run(args: argparse.Namespace) -> int:
     before anything is printed; every string from it is printed escaped (``gpmsa.cli.text``).
     A study file (``gpmsa.load_study``) is verified with every model file it lists.
     """
+    from gpmsa.cli.info_json import dumps, emulator_info, study_info
     from gpmsa.cli.study_info import study_lines
     from gpmsa.fitting.emulator import Emulator
     from gpmsa.fitting.validation import check_manifest
@@ -58,8 +60,10 @@ def run(args: argparse.Namespace) -> int:
             study = load_study(args.file)
         else:
             emulator = Emulator.from_record(manifest, arrays)
-        if args.json:  # ensure_ascii: control characters come out as \u001b escapes
-            text = json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True)
+        if args.json and manifest["format"] == STUDY_FORMAT:
+            text = dumps(study_info(args.file, manifest, study))
+        elif args.json:
+            text = dumps(emulator_info(args.file, manifest, _facts(manifest, arrays, emulator)))
         elif manifest["format"] == STUDY_FORMAT:
             lines = study_lines(args.file, manifest, study)
             lines.append(_convergence_line(study.convergence))  # from the draws, as load_study
@@ -86,13 +90,21 @@ def _bases_text(manifest: dict) -> str:
     return f" (one basis per experiment: {n_exp} experiments x {p_v} vectors, in the file)"
 
 
+def _variance_share(emulator) -> float | None:
+    """The share of the standardised runs' variance that the emulator basis holds; None for
+    runs without variance."""
+    total = float(np.sum(emulator.standardizer.y_to_std(emulator.y) ** 2))
+    if total <= 0:
+        return None
+    return float(np.sum(variance_shares(emulator.w, emulator.lam_sim, total)))
+
+
 def _basis_line(settings: dict, emulator) -> str:
     """Where the emulator basis came from, its size and the share of the standardised runs'
     variance it holds."""
     given = settings.get("basis") == "given"
-    total = float(np.sum(emulator.standardizer.y_to_std(emulator.y) ** 2))
-    held = np.sum(variance_shares(emulator.w, emulator.lam_sim, total))
-    share = f", {held:.2%} of the runs' variance" if total > 0 else ""
+    held = _variance_share(emulator)
+    share = f", {held:.2%} of the runs' variance" if held is not None else ""
     source = "given (fit(..., basis=))" if given else "PCA of the runs"
     return f"{source}, {emulator.K.shape[1]} vector(s){share}"
 
@@ -107,12 +119,57 @@ def _separable_text(emulator) -> str:
     return f"{factors}, the first varying slowest (SimData(separable=); arrays/kron_factor)"
 
 
+def _facts(manifest: dict, arrays: dict, emulator) -> dict:
+    """What ``_lines`` derives from the file beyond its manifest's fields, for ``--json``
+    (``gpmsa.cli.info_json.emulator_info``): the model's sha256, separable factors, output
+    scale, basis, the posterior's diagnostics (held positions marked, theta's means native)
+    and the number of array values."""
+    std, sep = emulator.standardizer, emulator.separable
+    names = emulator.x_names + emulator.t_names
+    separable = None
+    if sep is not None:
+        separable = {"groups": [[names[k] for k in g] for g in sep.groups],
+                     "sizes": list(sep.sizes)}  # fmt: skip
+    y_sd = [float(np.min(std.y_sd)), float(np.max(std.y_sd))] if "y_sd" in std.y_given else None
+    scale = {"y_mean_given": "y_mean" in std.y_given, "y_sd_given": "y_sd" in std.y_given,
+             "columnwise": bool(std.columnwise), "y_sd_range": y_sd}  # fmt: skip
+    given = manifest["settings"].get("basis") == "given"
+    basis = {"source": "given" if given else "pca", "vectors": int(emulator.K.shape[1]),
+             "variance_share": _variance_share(emulator)}  # fmt: skip
+    fixed = manifest["settings"].get("fixed")
+    fixed = fixed if isinstance(fixed, dict) else {}
+    shapes = _shapes(emulator)
+    posterior = {}
+    for name, d in manifest["diagnostics"].items():
+        if not (isinstance(d, dict) and isinstance(d.get("mean"), list)):
+            posterior[name] = d  # a record gpmsa does not write: as it is
+            continue
+        held = _held_positions(fixed.get(name), shapes.get(name), len(d["mean"]))
+        posterior[name] = {"mean": d["mean"], "ess": d.get("ess"), "rhat": d.get("rhat"),
+                           "held": sorted(held)}  # fmt: skip
+        native = _native_means(manifest, d["mean"], std) if name == "theta" else None
+        if native is not None:
+            posterior[name]["mean_native"] = dict(zip(emulator.t_names, native, strict=True))
+    return {"model_sha256": emulator.model_sha256, "separable": separable, "output_scale": scale,
+            "basis": basis, "posterior": posterior,
+            "array_values": sum(int(a.size) for a in arrays.values())}  # fmt: skip
+
+
+def _shapes(emulator) -> dict[str, tuple[int, ...]]:
+    """The element shapes of the 2-D parameters (betaU, a joint fit's betaV)."""
+    shapes = {"betaU": (emulator.p + emulator.q, emulator.p_u)}
+    if emulator.calibration and "betaV" in emulator.calibration:
+        shapes["betaV"] = emulator.calibration["betaV"].shape[1:]
+    return shapes
+
+
 def _given_scale(std) -> str:
     """The output standardisation of a Standardizer with a given y_mean or y_sd, in words."""
     each = std.columnwise  # an sd per output element (given, or y_scale="columnwise")
     mean = "centred by the given y_mean" if "y_mean" in std.y_given else "centred by the runs' mean"
     if "y_sd" in std.y_given:
-        values = f"{np.min(std.y_sd):.6g}" + (f" to {np.max(std.y_sd):.6g}" if each else "")
+        low, high = numbers(float(np.min(std.y_sd)), float(np.max(std.y_sd)))
+        values = low + (f" to {high}" if each else "")
         kind = "one per output element" if each else "one sd"
         sd = f"divided by the given y_sd ({kind}: {values})"
     else:
@@ -146,7 +203,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
         parts = []
         for n, u in zip(names, units[kind], strict=True):
             dom = manifest["domain"].get(n) if kind != "y" else None
-            rng = f" in [{dom[0]:.6g}, {dom[1]:.6g}]" if dom else ""
+            rng = " in [{}, {}]".format(*numbers(*dom)) if dom else ""
             if dom and n in (model.get("input_ranges") or ()):
                 rng += " (range given, design inside)"
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
@@ -198,9 +255,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     for k, v in manifest["metadata"].items():
         if k != "versions" or not isinstance(v, dict):
             lines.append(f"metadata {safe(k, 60)}: {value(v)}")
-    shapes = {"betaU": (emulator.p + emulator.q, emulator.p_u)}  # the 2-D parameters
-    if emulator.calibration and "betaV" in emulator.calibration:
-        shapes["betaV"] = emulator.calibration["betaV"].shape[1:]
+    shapes = _shapes(emulator)
     fixed = fixed if isinstance(fixed, dict) else {}
     for name, d in manifest["diagnostics"].items():
         if isinstance(d, dict) and isinstance(d.get("mean"), list):
@@ -235,10 +290,11 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
 
 def _gamma(g: dict) -> str:
     """A validated Gamma prior of the manifest as text: Gamma(a, b) on (lower, upper)."""
-    text = f"Gamma({number(g['a'], '.6g')}, {number(g['b'], '.6g')})"
+    upper = math.inf if g["upper"] == "inf" else g["upper"]
+    a, b, lower, high = numbers(g["a"], g["b"], g["lower"], upper)
+    text = f"Gamma({a}, {b})"
     if g["lower"] != 0 or g["upper"] != "inf":
-        upper = "inf" if g["upper"] == "inf" else number(g["upper"], ".6g")
-        text += f" on ({number(g['lower'], '.6g')}, {upper})"
+        text += f" on ({lower}, {high})"
     return text
 
 
@@ -249,7 +305,7 @@ def _beta_v(priors: dict) -> str:
     if a is None:
         return "betaV as betaU"
     pairs = zip(a, b, strict=True) if isinstance(a, list) else [(a, b)]
-    cells = [f"Beta({number(x, '.6g')}, {number(y, '.6g')})" for x, y in pairs]
+    cells = ["Beta({}, {})".format(*numbers(x, y)) for x, y in pairs]
     text = f"[{', '.join(cells)}] (one per group)" if isinstance(a, list) else cells[0]
     return f"rho = exp(-betaV / 4) {text}"
 
@@ -259,9 +315,9 @@ def _theta_prior(priors: dict, t_names: list[str]) -> str:
     calibration parameter, or NAME Normal(mean, sd) for each (per-element priors)."""
     m, s = priors["theta_mean"], priors["theta_sd"]
     if not isinstance(m, list) and not isinstance(s, list):
-        return f"theta Normal({number(m, '.6g')}, {number(s, '.6g')}) on (0, 1) (unit scale)"
+        return "theta Normal({}, {}) on (0, 1) (unit scale)".format(*numbers(m, s))
     ms, ss = (v if isinstance(v, list) else [v] * len(t_names) for v in (m, s))
-    cells = [f"{safe(n, 60)} Normal({number(a, '.6g')}, {number(b, '.6g')})"
+    cells = [f"{safe(n, 60)} Normal({', '.join(numbers(a, b))})"
              for n, a, b in zip(t_names, ms, ss, strict=True)]  # fmt: skip
     return f"theta [{', '.join(cells)}] on (0, 1) (unit scale, one per parameter)"
 
@@ -277,8 +333,10 @@ def _prior_lines(priors: dict, t_names: list[str]) -> list[str]:
     return [
         f"calibration priors: {_theta_prior(priors, t_names)}, lamOs "
         f"{_gamma(priors['lamOs'])}, lamVz {lam_vz}, {_beta_v(priors)}",
-        f"emulator priors: rho = exp(-betaU / 4) Beta({number(priors['rho_a'], '.6g')}, "
-        f"{number(priors['rho_b'], '.6g')}), lamUz {_gamma(priors['lamUz'])}, lamWs "
+        "emulator priors: rho = exp(-betaU / 4) Beta({}, {}), ".format(
+            *numbers(priors["rho_a"], priors["rho_b"])
+        )
+        + f"lamUz {_gamma(priors['lamUz'])}, lamWs "
         f"{_gamma(priors['lamWs'])}, lamWOs {_gamma(priors['lamWOs'])}"
         + (" (with GPM/SA's data corrections)" if priors["corrected"] is True else ""),
     ]
@@ -288,6 +346,18 @@ def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str
     """The label and the unit-scale theta ``means`` (a fixed theta, the diagnostics' means) as
     NAME=VALUE in native units (``standardizer.t_from_unit``); None for means that are not one
     number per parameter."""
+    native = _native_means(manifest, means, standardizer)
+    if native is None:
+        return None
+    names = manifest["names"]["t"]
+    cells = [f"{safe(n, 60)}={_in_domain(standardizer, k, v)}" for k, (n, v) in
+             enumerate(zip(names, native, strict=True))]  # fmt: skip
+    return "theta (native)", ", ".join(cells)
+
+
+def _native_means(manifest: dict, means: object, standardizer) -> list[float] | None:
+    """Unit-scale theta ``means`` in native units; None for means that are not one number per
+    parameter."""
     names = manifest["names"]["t"]
     if not isinstance(means, list) or len(means) != len(names):
         return None
@@ -297,9 +367,15 @@ def _native_theta(manifest: dict, means: object, standardizer) -> tuple[str, str
         unit = np.array([means], dtype=float)
     except OverflowError:  # an integer beyond float64 (10**400 in a file's diagnostics)
         return None
-    native = standardizer.t_from_unit(unit)[0]
-    cells = [f"{safe(n, 60)}={number(float(v), '.4g')}" for n, v in zip(names, native, strict=True)]
-    return "theta (native)", ", ".join(cells)
+    return [float(v) for v in standardizer.t_from_unit(unit)[0]]
+
+
+def _in_domain(standardizer, k: int, v: float) -> str:
+    """Calibration parameter ``k``'s native value ``v`` with 4 significant digits, or as many
+    more as tell it from its domain's ends (``numbers``: 1e6 + 0.5 in [1e6 + 0.003, 1e6 +
+    0.935] is not "1e+06")."""
+    ends = (float(standardizer.t_min[k]), float(standardizer.t_max[k]))
+    return numbers(float(v), *ends, digits=4)[0]
 
 
 def _cells(vals: list, fmt: str, held: set[int]) -> str:
@@ -353,7 +429,8 @@ def _fixed_cell(manifest: dict, name: str, record: object, standardizer) -> str:
             for (k,), u in held:
                 unit[0, k] = u
             native = standardizer.t_from_unit(unit)[0]
-            cells = [f"{safe(names[k], 60)}={number(float(native[k]), '.4g')}" for (k,), _ in held]
+            cells = [f"{safe(names[k], 60)}={_in_domain(standardizer, k, native[k])}"
+                     for (k,), _ in held]  # fmt: skip
             return f"theta (native)=[{', '.join(cells)}]"
     if held is not None:
         return ", ".join(f"{safe(name, 60)}[{','.join(map(str, i))}]={plain(v)}" for i, v in held)

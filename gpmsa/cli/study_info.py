@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from gpmsa.cli.text import level_moves_text, number, plain, safe, tempering_text, value
+from gpmsa.cli.text import level_moves_text, number, numbers, plain, safe, tempering_text, value
 
 
 def study_lines(file: str, manifest: dict, study) -> list[str]:
@@ -21,9 +21,9 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
     ]
     for i, (mod, emu) in enumerate(zip(st["models"], study.members, strict=True)):
         params = ", ".join(
-            f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''} in "
-            f"[{emu.domain[n][0]:.6g}, {emu.domain[n][1]:.6g}]"
+            f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''} in [{lo}, {hi}]"
             for n, u in zip(emu.t_names, emu.t_units, strict=True)
+            for lo, hi in [numbers(*emu.domain[n])]
         )
         lines.append(f"model {safe(mod['label'], 60)}: file {safe(mod['file'], 160)} sha256 "
                      f"{safe(mod['sha256'], 64)} (verified); m={emu.m}, p={emu.p}, "
@@ -54,7 +54,8 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
         if row["held"]:  # fixed=: no ESS or R-hat to give
             lines.append(f"posterior {safe(name, 80)}: held at {row['mean']:.6g} (fixed=)")
             continue
-        lines.append(f"posterior {safe(name, 80)}: mean {row['mean']:.6g} sd "
-                     f"{row['sd']:.4g} 90% [{row['q5']:.6g}, {row['q95']:.6g}] ESS "
+        mean, q5, q95 = numbers(row["mean"], row["q5"], row["q95"])
+        lines.append(f"posterior {safe(name, 80)}: mean {mean} sd "
+                     f"{row['sd']:.4g} 90% [{q5}, {q95}] ESS "
                      f"{number(row['ess'], '.0f')} R-hat {number(row['rhat'], '.3f')}")  # fmt: skip
     return lines

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import json
 
+from gpmsa.errors import numbers_text
+
 MAX_VALUE_CHARS = 300
 """Longest value printed whole; longer ones are cut and their length stated."""
 
@@ -59,6 +61,21 @@ def number(obj: object, fmt: str = ".4g") -> str:
         except OverflowError:
             pass
     return value(obj)
+
+
+def numbers(*objs: object, digits: int = 6) -> tuple[str, ...]:
+    """Numbers shown side by side (a range's ends, a value and its range) as
+    ``gpmsa.errors.numbers_text`` writes them: ``digits`` significant digits, more where two
+    distinct ones would read alike; a value that is no float (a string from a file, an integer
+    beyond float64) as ``number`` shows it, the others then with ``digits``."""
+    fmt = f".{digits}g"
+    try:
+        floats = [float(v) for v in objs if isinstance(v, (int, float)) and not isinstance(v, bool)]
+    except OverflowError:
+        floats = []
+    if len(floats) < len(objs):
+        return tuple(number(v, fmt) for v in objs)
+    return numbers_text(*floats, digits=digits)
 
 
 def internal_error(exc: BaseException) -> str:

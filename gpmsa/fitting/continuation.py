@@ -84,20 +84,19 @@ def check_same_scales(emulator: Emulator, data, standardizer) -> None:
     d = len(names)
     differs = [
         "{}: [{}, {}] in init=emulator's fit, [{}, {}] here".format(
-            n, *numbers_text(ends[0][k], ends[0][d + k], ends[1][k], ends[1][d + k])
-        )
+            n, *numbers_text(ends[0][k], ends[0][d + k], ends[1][k], ends[1][d + k]))
         for k, n in enumerate(names)
         if ends[0][k] != ends[1][k] or ends[0][d + k] != ends[1][d + k]
-    ]
+    ]  # fmt: skip
     scale = {True: "'columnwise'", False: "'scalar'"}
     given = set(old.y_given) | set(new.y_given)  # else both the runs' own: the same
     if "y_mean" in given and not np.array_equal(old.y_mean, new.y_mean):
-        differs.append(f"y_mean: {_given(old, 'y_mean', new)} in init=emulator's fit, "
-                       f"{_given(new, 'y_mean', old)} here")  # fmt: skip
+        was, now = _given(old, new, "y_mean")
+        differs.append(f"y_mean: {was} in init=emulator's fit, {now} here")
     if "y_sd" in given:
         if not np.array_equal(old.y_sd, new.y_sd):
-            differs.append(f"y_sd: {_given(old, 'y_sd', new)} in init=emulator's fit, "
-                           f"{_given(new, 'y_sd', old)} here")  # fmt: skip
+            was, now = _given(old, new, "y_sd")
+            differs.append(f"y_sd: {was} in init=emulator's fit, {now} here")
     elif old.columnwise != new.columnwise:
         differs.append(f"y_scale: {scale[old.columnwise]} in init=emulator's fit, "
                        f"{scale[new.columnwise]} here")  # fmt: skip
@@ -109,16 +108,19 @@ def check_same_scales(emulator: Emulator, data, standardizer) -> None:
         )
 
 
-def _given(std, name: str, other) -> str:
-    """A Standardizer's ``name`` ("y_mean" or "y_sd") for a message: its value(s), with the
-    digits that tell them from ``other``'s (`numbers_text`), and whether the user gave it or
-    it is the runs' own."""
-    v = np.ravel(getattr(std, name))[:4]
-    texts = numbers_text(*v[:3], *np.ravel(getattr(other, name))[:3])
-    text = texts[0] if v.size == 1 else f"[{', '.join(texts[: min(v.size, 3)])}" + (
-        ", ...]" if v.size > 3 else "]")  # fmt: skip
-    who = "given" if name in std.y_given else "the runs' own"
-    return f"{text} ({who})"
+def _given(old, new, name: str) -> tuple[str, str]:
+    """Two Standardizers' ``name`` ("y_mean" or "y_sd") for a message: each one's value(s)
+    (the first three; ``numbers_text``: as many digits as tell the two apart), and whether the
+    user gave it or it is the runs' own."""
+    values = [np.ravel(getattr(std, name)) for std in (old, new)]
+    texts = numbers_text(*values[0][:3], *values[1][:3])
+    cut = min(values[0].size, 3)
+    out = []
+    for std, v, cells in zip((old, new), values, (texts[:cut], texts[cut:]), strict=True):
+        text = cells[0] if v.size == 1 else f"[{', '.join(cells)}{', ...' if v.size > 3 else ''}]"
+        who = "given" if name in std.y_given else "the runs' own"
+        out.append(f"{text} ({who})")
+    return out[0], out[1]
 
 
 PER_COMPONENT = ("betaU", "lamUz", "lamWs")

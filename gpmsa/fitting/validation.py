@@ -23,7 +23,7 @@ import re
 
 import numpy as np
 
-from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.errors import EmulatorFileError, GPMSAError, numbers_text
 from gpmsa.model import kronecker
 from gpmsa.model.basis import ORTHOGONAL_TOL, basis_digest
 from gpmsa.model.data import as_float, column_scales, output_scale
@@ -826,15 +826,17 @@ def _in_unit(arrays: dict[str, np.ndarray], name: str, span) -> None:
     each column spanning [0, 1]."""
     a = _finite(arrays, name)
     if a.size and (a.min() < -UNIT_TOL or a.max() > 1 + UNIT_TOL):
-        raise _fail(f"arrays/{name}", f"must lie in [0, 1], spans [{a.min():.6g}, {a.max():.6g}]")
+        low, high = numbers_text(a.min(), a.max(), 0.0, 1.0)[:2]  # 1 + 2e-9 not read as 1
+        raise _fail(f"arrays/{name}", f"must lie in [0, 1], spans [{low}, {high}]")
     if a.size and np.any(span):
         lo, hi = a.min(axis=0), a.max(axis=0)
         k = np.flatnonzero(span & ((lo > UNIT_TOL) | (hi < 1 - UNIT_TOL)))
         if k.size:
             j = int(k[0])
+            low, high = numbers_text(lo[j], hi[j], 0.0, 1.0)[:2]  # 1 - 2e-9 not read as 1
             raise _fail(
                 f"arrays/{name}",
-                f"column {j} spans [{lo[j]:.6g}, {hi[j]:.6g}]: a design maps its own range "
+                f"column {j} spans [{low}, {high}]: a design maps its own range "
                 "onto [0, 1] exactly",
             )
 

@@ -409,6 +409,10 @@ def _check_members(zf: zipfile.ZipFile, path) -> dict[str, zipfile.ZipInfo]:
     infos = zf.infolist()
     if len(infos) > limits.MAX_MEMBERS:
         raise _fail(path, f"{len(infos)} members (limit {limits.MAX_MEMBERS})")
+    if all(info.filename != MANIFEST for info in infos):  # before its members' names are judged
+        first = f"; its first member {infos[0].filename[:60]!r}" if infos else ""
+        raise _fail(path, f"not a gpmsa emulator file (a zip without {MANIFEST}{first}: a numpy "
+                          ".npz such as a vehicle campaign file?)")  # fmt: skip
     members: dict[str, zipfile.ZipInfo] = {}
     total = 0
     for info in infos:
@@ -446,8 +450,6 @@ def _check_members(zf: zipfile.ZipFile, path) -> dict[str, zipfile.ZipInfo]:
     if total > limits.MAX_ARRAY_BYTES:
         raise _fail(path, f"arrays of {total} bytes once decompressed exceed "
                           f"gpmsa.limits.MAX_ARRAY_BYTES = {limits.MAX_ARRAY_BYTES}")  # fmt: skip
-    if MANIFEST not in members:
-        raise _fail(path, f"no {MANIFEST}: not a gpmsa emulator file")
     return members
 
 

@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 
-from gpmsa.errors import EmulatorFileError
+from gpmsa.errors import EmulatorFileError, numbers_text
 from gpmsa.fitting.validation import DISCREPANCY_KINDS, check_rate, check_sweeps, group_count
 from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout, finite
 
@@ -202,15 +202,15 @@ def check_study_arrays(
     for e, lv in enumerate(levels):  # a categorical element's draws: its levels (0 and 1 too)
         col = arrays["theta"][:, :, e]
         if lv is not None and not np.all(np.isin(col, lv)):
-            bad = col[~np.isin(col, lv)].flat[0]
+            bad = numbers_text(col[~np.isin(col, lv)].flat[0], *lv)[0]  # not read as a level
             raise _fail("arrays/theta", f"column {e} ({layout.elements[e].name}, categorical) "
                                         f"must hold its unit-scale levels {list(lv)}, got "
-                                        f"{bad:.6g}")  # fmt: skip
+                                        f"{bad}")  # fmt: skip
     cont = [e for e, lv in enumerate(levels) if lv is None]
     for name, a in (("theta", arrays["theta"][:, :, cont]), ("mu", arrays["mu"])):
-        if a.size and not (a.min() > 0.0 and a.max() < 1.0):
-            raise _fail(f"arrays/{name}", f"must lie in (0, 1) (unit scale), got "
-                                          f"{a.min():.6g}..{a.max():.6g}")  # fmt: skip
+        if a.size and not (a.min() > 0.0 and a.max() < 1.0):  # 1 + 1e-9 not read as 1
+            low, high = numbers_text(a.min(), a.max(), 0.0, 1.0)[:2]
+            raise _fail(f"arrays/{name}", f"must lie in (0, 1) (unit scale), got {low}..{high}")
     for name in ("lam", "lamOs", *(k for k in arrays if k not in ARRAYS)):
         a = arrays[name]
         if a.size and not a.min() > 0.0:
