@@ -5,8 +5,10 @@ settings and the chain's own ``numpy.random.SeedSequence``), so its draws depend
 index and the seed only, never on the number of workers or on where it ran. With one worker and
 no executor the chains run one after another in this process (no pool), as they do in a daemonic
 process (a ``multiprocessing.Pool``'s or a dask worker's), which may not start one. A dask
-Client's workers are first asked to import the task's module (dask would wait forever for a
-task they cannot unpickle).
+Client's workers that may run the tasks are first asked to import the task's module and to say
+their gpmsa version, which must be this process's: dask would wait forever for a task they cannot
+unpickle, and another version runs other code on other data. A worker that does not answer
+within ``WORKER_CHECK_S`` is named in a GPMSAError.
 
 Failures: a task that raises ``GPMSAError`` (bad input, the same on any machine) stops the run
 with ``ChainError`` naming the chain. Any other failure (a worker that died, a lost connection,
@@ -20,6 +22,7 @@ whichever of the process's threads the kernel hands the signal to.
 
 from __future__ import annotations
 
+import asyncio
 import gc
 import importlib
 import multiprocessing
@@ -40,10 +43,18 @@ from concurrent.futures import (
 
 import numpy as np
 
+from gpmsa import _version
 from gpmsa.errors import ChainError, GPMSAError
 
 RETRIES = 1
 """Default number of times a chain whose task failed for a reason other than its input is rerun."""
+
+WORKER_CHECK_S = 60.0
+"""Seconds a dask Client's workers have to answer the check before the chains (import the task's
+module, say their gpmsa version; 2-5 ms on two local worker processes): one that has not answered
+by then (hung, e.g. stopped) is named in a GPMSAError, where dask would give it tasks that never
+end. Read at each check: set ``gpmsa.mcmc.parallel.WORKER_CHECK_S`` for workers that import
+slowly."""
 
 
 def available_cpus() -> int:
@@ -102,9 +113,9 @@ def in_this_process(callables: list[str], n_jobs, executor, n_chains: int):
 
 def as_executor(executor, fn: Callable | None = None) -> Executor | None:
     """``executor`` as a ``concurrent.futures.Executor`` (a dask ``Client`` gives its own). With
-    ``fn`` (a task function) and a dask ``Client`` (or its ``get_executor()``), first checks
-    that every worker imports ``fn``'s module: dask waits forever for a task its workers cannot
-    unpickle (gpmsa, or torch for the torch backend, not installed there)."""
+    ``fn`` (a task function) and a dask ``Client`` (or its ``get_executor()``), first checks the
+    workers that may run the tasks (`_check_workers`): dask waits forever for a task its workers
+    cannot unpickle (gpmsa, or torch for the torch backend, not installed there)."""
     if executor is None:
         return executor
     if isinstance(executor, ProcessPoolExecutor) and multiprocessing.current_process().daemon:
@@ -126,7 +137,8 @@ def as_executor(executor, fn: Callable | None = None) -> Executor | None:
             "thread (e.g. await asyncio.to_thread(...)) or pass a synchronous Client"
         )
     if client is not None and not closed and fn is not None:
-        _check_imports(client, fn.__module__)
+        restrictions = {} if client is executor else getattr(executor, "_kwargs", {})
+        _check_workers(client, fn.__module__, restrictions, WORKER_CHECK_S)
     if isinstance(executor, Executor):
         return executor
     if client is not None:
@@ -144,32 +156,111 @@ def _dask_client(executor):
     return client if callable(getattr(client, "get_executor", None)) else None
 
 
-def _check_imports(client, module: str) -> None:
-    """GPMSAError unless every worker of the dask ``client`` imports ``module``. A worker that
-    cannot be reached (lost meanwhile: an OSError such as dask's CommClosedError) ends the check
-    unrefused: dask runs its tasks elsewhere, as it would without the check."""
-    try:
-        answers = client.run(_importable, module)
-    except OSError:
+def _check_workers(client, module: str, restrictions: dict, timeout_s: float) -> None:
+    """GPMSAError unless every worker of the dask ``client`` that may run a task submitted with
+    ``restrictions`` (a ``get_executor(...)``'s: `_task_workers`) imports ``module`` and runs
+    this process's gpmsa version, all answering within ``timeout_s`` seconds. The versions must
+    be equal, a development suffix included: the tasks' pickled functions and data, and the
+    draws they return, may differ between any two versions. A worker that cannot be reached
+    (lost meanwhile: an OSError such as dask's CommClosedError) is not refused: dask runs its
+    tasks elsewhere, as it would without the check."""
+    infos = client.scheduler_info(n_workers=-1)["workers"]  # every one (5 by default in 2025.4)
+    workers = _task_workers(infos, restrictions)
+    if not workers:  # none yet (dask waits for them, e.g. an adaptive cluster's)
         return
-    except Exception as exc:  # e.g. gpmsa itself missing there: `_importable` cannot be unpickled
-        raise _cannot_import(module, _describe(exc)) from exc
-    failed = next((f"{why}, on {who}" for who, why in answers.items() if why is not None), None)
-    if failed is not None:
-        raise _cannot_import(module, failed)
+    answers = client.sync(_ask_workers, client, workers, module, timeout_s)
+    failed, versions = [], {}
+    for who, answer in answers.items():
+        if isinstance(answer, OSError):
+            continue
+        if isinstance(answer, BaseException):  # e.g. gpmsa missing: `_worker_report` unpickled
+            failed.append(f"{_describe(answer)}, on {who}")
+        elif answer[0] is not None:
+            failed.append(f"{answer[0]}, on {who}")
+        elif answer[1] != _version.__version__:
+            versions.setdefault(answer[1], []).append(who)
+    ours = _version.__version__
+    if failed:
+        raise GPMSAError(
+            f"executor: the dask Client's workers cannot import {module} ({'; '.join(failed)}); "
+            f"install gpmsa {ours} (and, for the torch backend, torch) where they run, or pass "
+            "n_jobs= to run the chains on this machine"
+        )
+    if versions:
+        theirs = "; ".join(f"gpmsa {v} on {', '.join(sorted(w))}" for v, w in versions.items())
+        raise GPMSAError(
+            f"executor: the dask Client's workers run another gpmsa version than this process's "
+            f"{ours} ({theirs}): the chains would run other code on other data; install gpmsa "
+            f"{ours} where they run, or pass n_jobs= to run the chains on this machine"
+        )
+    silent = sorted(set(workers) - set(answers))
+    if silent:
+        raise GPMSAError(
+            f"executor: the dask Client's workers {', '.join(silent)} did not answer within "
+            f"{timeout_s:g} s (gpmsa.mcmc.parallel.WORKER_CHECK_S) whether they import {module}: "
+            "hung (stopped, or busy in a call that holds its event loop) or slow to import; dask "
+            "would give them chains that never end. Restart or retire them, raise WORKER_CHECK_S, "
+            "or restrict the tasks to other workers (Client.get_executor(workers=[...]))"
+        )
 
 
-def _cannot_import(module: str, why: str) -> GPMSAError:
-    return GPMSAError(
-        f"executor: the dask Client's workers cannot import {module} ({why}); install gpmsa "
-        "(and, for the torch backend, torch) where they run, or pass n_jobs= to run the chains "
-        "on this machine"
-    )
+def _task_workers(infos: dict[str, dict], restrictions: dict) -> list[str]:
+    """The addresses of the workers (``infos``: the scheduler's, by address) that may run a task
+    submitted with ``restrictions`` (``workers``, ``resources``, ``allow_other_workers``, as
+    ``Client.submit`` takes them), read as dask's scheduler reads them: an entry of ``workers``
+    is a worker's name or address, else a host; a worker has each resource asked, as much."""
+    if restrictions.get("allow_other_workers"):  # any worker, where none of those fits
+        return list(infos)
+    out = list(infos)
+    named = restrictions.get("workers")
+    if named is not None:
+        from distributed.comm.addressing import resolve_address
+
+        names = {info.get("name"): addr for addr, info in infos.items()}
+        addresses, hosts = set(), set()
+        for entry in [named] if isinstance(named, str | tuple) else named:
+            if isinstance(entry, tuple):
+                entry = f"{entry[0]}:{entry[1]}"
+            if entry in names:
+                addresses.add(names[entry])
+                continue
+            try:
+                addresses.add(resolve_address(entry))
+            except ValueError:  # no port: a host
+                hosts.add(entry)
+        out = [a for a in out if a in addresses or infos[a].get("host") in hosts]
+    needs = restrictions.get("resources") or {}
+    has = {a: infos[a].get("resources") or {} for a in out}
+    return [a for a in out if all(has[a].get(r, 0) >= amount for r, amount in needs.items())]
+
+
+async def _ask_workers(client, workers: list[str], module: str, timeout_s: float) -> dict:
+    """Each of ``workers``' `_worker_report` on ``module`` (or the exception that came instead),
+    by address, for those that answered within ``timeout_s`` seconds; run in the Client's
+    event loop (``Client.sync``), one call a worker so that a hung one delays no other."""
+
+    async def ask(who: str):
+        got = await client.run(
+            _worker_report, module, workers=[who], on_error="return", asynchronous=True
+        )
+        return got[who]
+
+    asked = {asyncio.ensure_future(ask(who)): who for who in workers}
+    done, late = await asyncio.wait(asked, timeout=timeout_s)
+    for fut in late:
+        fut.cancel()
+    return {asked[fut]: fut.exception() or fut.result() for fut in done}
+
+
+def _worker_report(module: str) -> tuple[str | None, str]:
+    """(None where ``module`` imports here, else why not; this process's gpmsa version): what
+    each dask worker answers `_check_workers`."""
+    return _importable(module), _version.__version__
 
 
 def _importable(module: str) -> str | None:
-    """None where ``module`` imports here (run on every dask worker by `_check_imports`), else
-    why not (an import may fail with any error, an OSError for a missing shared library too)."""
+    """None where ``module`` imports here, else why not (an import may fail with any error, an
+    OSError for a missing shared library too)."""
     try:
         importlib.import_module(module)
     except Exception as exc:

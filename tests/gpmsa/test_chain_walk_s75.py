@@ -2,6 +2,7 @@
 worker's), which may not start processes, and on a dask Client whose workers cannot import the
 chains' module (dask waits forever for such a task)."""
 
+import asyncio
 import multiprocessing
 import sys
 import warnings
@@ -55,18 +56,23 @@ def test_a_daemonic_worker_runs_its_chains_itself_or_says_why_not(problem):
 
 # --- a dask Client whose workers lack the package -------------------------------------------------
 class _FakeClient:
-    """A dask Client's face (``get_executor``, ``status``, ``run``) whose workers fail to import."""
+    """A dask Client's face (``get_executor``, ``status``, ``scheduler_info``, ``sync``, ``run``)
+    of one worker that fails to import."""
 
     status = "running"
 
     def __init__(self, error: BaseException | None):
         self.error, self.ran = error, []
 
-    def run(self, fn, *args):
+    def scheduler_info(self, n_workers=5):
+        return {"workers": {"tcp://worker:1": {}}}
+
+    def sync(self, fn, *args):
+        return asyncio.run(fn(*args))
+
+    async def run(self, fn, *args, workers, on_error, asynchronous):
         self.ran.append(args)
-        if self.error is not None:
-            raise self.error
-        return {"tcp://worker:1": fn(*args)}
+        return {w: self.error if self.error is not None else fn(*args) for w in workers}
 
     def get_executor(self) -> Executor:
         return ThreadPoolExecutor(1)
@@ -82,7 +88,7 @@ def test_a_dask_client_whose_workers_cannot_import_the_chains_is_refused():
     with pytest.raises(
         gpmsa.GPMSAError,
         match=r"workers cannot import .*test_chain_walk_s75 "
-        r"\(ModuleNotFoundError: No module named 'gpmsa'\); install gpmsa",
+        r"\(ModuleNotFoundError: No module named 'gpmsa', on tcp://worker:1\); install gpmsa",
     ):
         parallel.run_chains(_double, [{"x": 1}, {"x": 2}], executor=client)
     assert client.ran == [(_double.__module__,)]  # checked before any task was submitted

@@ -27,14 +27,21 @@ class CommClosedError(OSError):
 
 
 class _Client:
-    """A dask Client's face: ``run`` answers as ``answer`` says, ``get_executor`` runs tasks."""
+    """A dask Client's face of one worker: ``run`` answers as ``answer`` says, ``get_executor``
+    runs tasks."""
 
     status = "running"
 
     def __init__(self, answer):
         self.answer = answer
 
-    def run(self, fn, *args):
+    def scheduler_info(self, n_workers=5):
+        return {"workers": {"tcp://w:1": {}}}
+
+    def sync(self, fn, *args):
+        return asyncio.run(fn(*args))
+
+    async def run(self, fn, *args, workers, on_error, asynchronous):
         return self.answer(fn, args)
 
     def get_executor(self) -> Executor:
