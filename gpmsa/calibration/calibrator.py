@@ -76,6 +76,7 @@ from gpmsa.calibration.observations import (
     Observations,
     blas_controller,
     check_emulator,
+    draw_positions,
     emulator_param_sets,
     emulator_record,
     fit_at_levels,
@@ -167,7 +168,10 @@ class Calibrator:
             2; a categorical parameter's nodes are its levels, and the continuous one beside it
             has n_grid per level, default 129).
         emulator_params: "point" (the emulator's point estimate) or "draws" (average the
-            likelihood over up to ``n_emulator_draws`` of its retained draws, evenly spaced).
+            likelihood over up to ``n_emulator_draws`` of its retained draws, evenly spaced:
+            the posterior of theta, lamOs and the draw, whose draws record the draw drawn
+            with each in ``info["emulator_draws"]``, as ``gpmsa.calibrate``'s, for
+            ``calibrated_predict(..., draws=True)``).
         extrapolate: allow x_obs outside the emulator's x domain by more than
             ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width (with an ExtrapolationWarning).
             Within the margin x_obs is taken with that warning as a joint ``gpmsa.fit``
@@ -558,7 +562,10 @@ class Calibrator:
             unresolved core) on the final grid (two parameters; ``grid.resolution``; under
             ``grid.UNRESOLVED_SD`` a warning names it) and ``info["log_evidence"]`` holds
             log p(u_obs) under the emulator's (normalised) theta prior times the given prior
-            (as given, unnormalised), for one parameter.
+            (as given, unnormalised), for one parameter. With ``emulator_params="draws"``,
+            ``info["emulator_draws"]`` holds per draw of ``samples`` the position in
+            ``emulator.draws`` of the emulator parameters drawn with it (by their likelihood at
+            its node, as lamOs), set when the samples are drawn (lazily, on first access).
         """
         count = self._count + 1  # counted once it succeeds
         extrapolate = self._extrapolate(extrapolate)
@@ -786,7 +793,7 @@ class Calibrator:
                                                   side="right"), cum.size - 1)  # fmt: skip
                 idx = np.unravel_index(node, shape)
                 out = {name: native[k][idx[k]] for k, name in enumerate(names)}
-                out["lamOs"] = _draw_lamos(margs, node, rng)
+                out["lamOs"], sets = _draw_lamos(margs, node, rng)
             else:  # a level, then the continuous element given it
                 c = cont[0]
                 lv = 1 - c
@@ -800,17 +807,20 @@ class Calibrator:
                         gm = trimmed_marginal(x, np.log(row), wr)[0]
                     vals[sel] = gm.sample(rng, int(sel.sum()))
                 lam = np.empty(n_draws)  # lamOs at each draw's nearest node of its level's grid
+                sets = np.empty(n_draws, dtype=int)  # and the emulator parameter set with it
                 base = ~np.isin(li, list(refined))
                 if base.any():
                     ci = nearest(native[c], vals[base])
                     idx = (li[base], ci) if c == 1 else (ci, li[base])
-                    lam[base] = _draw_lamos(margs, np.ravel_multi_index(idx, shape), rng)
+                    lam[base], sets[base] = _draw_lamos(margs, np.ravel_multi_index(idx, shape),
+                                                        rng)  # fmt: skip
                 for r, (_, _, level_margs) in refined.items():
                     sel = li == r
                     if sel.any():
                         node = nearest(per_level[r][0], vals[sel])
-                        lam[sel] = _draw_lamos(level_margs, node, rng)
+                        lam[sel], sets[sel] = _draw_lamos(level_margs, node, rng)
                 out = {names[lv]: level, names[c]: vals, "lamOs": lam}
+            self._record_sets(into, sets)
             return {name: out[name] for name in (*names, "lamOs")}
 
         info = {
@@ -827,7 +837,9 @@ class Calibrator:
         }
         if self.q == 2:
             info["resolution"] = tuple(resolved)
-        return Posterior(grids=grids, draw=draw, info=info)
+        post = Posterior(grids=grids, draw=draw, info=info)
+        into = post.info  # where draw records (not post: a cycle would outlive the update)
+        return post
 
     def _on_grid(self, data, axes: list, prior) -> tuple:
         """The lamOs marginals, unconstrained log posterior (G,), constraint verdicts (G,) (None:
@@ -1008,7 +1020,8 @@ class Calibrator:
                 out = {name: vals[:, k] for k, name in enumerate(names)}
                 node = nearest(native[0], vals[:, 0]) * native[1].size
                 node += nearest(native[1], vals[:, 1])
-            out["lamOs"] = _draw_lamos(margs, node, rng)
+            out["lamOs"], sets = _draw_lamos(margs, node, rng)
+            self._record_sets(into, sets)
             return out
 
         info = {
@@ -1022,7 +1035,18 @@ class Calibrator:
             **emulator_record(self.emulator),  # its model_sha256, computed once per emulator
             "units": dict(zip(self.emulator.t_names, self.emulator.t_units, strict=True)),
         }
-        return Posterior(grids=grids, draw=draw, info=info)
+        post = Posterior(grids=grids, draw=draw, info=info)
+        into = post.info  # where draw records (not post: a cycle would outlive the update)
+        return post
+
+    def _record_sets(self, info: dict, sets: np.ndarray) -> None:
+        """With ``emulator_params="draws"``, ``info["emulator_draws"]`` of a grid posterior, set
+        as its draws are made: per draw, the position in ``emulator.draws`` of the emulator
+        parameter set drawn with it (``sets`` (n,): indices of the averaged sets), the record
+        ``gpmsa.calibrate(..., emulator_params="draws")`` keeps (``draws=True`` predictions pair
+        by it). The point estimate has none to record."""
+        if self.emulator_params == "draws":
+            info["emulator_draws"] = draw_positions(self.emulator, self._n_emulator_draws)[sets]
 
 
 def log_theta_norm(theta_mean: float, theta_sd: float) -> float:
@@ -1173,11 +1197,12 @@ def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
 
 def _draw_lamos(
     margs: list[LamOsMarginal], node: np.ndarray, rng: np.random.Generator
-) -> np.ndarray:
+) -> tuple[np.ndarray, np.ndarray]:
     """lamOs draws from its conditional at the given theta nodes (log-grid cell jitter: within
     half a step of the node, inwards only at the end nodes, whose trapezoid cells are half ones,
     so that no draw lies beyond a bound of the lamOs prior that ends the grid); with several
-    emulator parameter sets, each draw's set is chosen by its likelihood at the node."""
+    emulator parameter sets, each draw's set is chosen by its likelihood at the node (the
+    mixture's joint draw of theta, the set and lamOs). Returns (lamOs (n,), set index (n,))."""
     k = np.zeros(node.size, dtype=int)
     if len(margs) > 1:
         ll = np.stack([m.loglik[node] for m in margs], axis=1)  # (n, J)
@@ -1195,7 +1220,7 @@ def _draw_lamos(
         jitter = np.where(idx == 0, np.abs(jitter), jitter)
         jitter = np.where(idx == s.size - 1, -np.abs(jitter), jitter)
         out[sel] = np.exp(s[idx] + jitter)
-    return out
+    return out, k
 
 
 def _bisect(

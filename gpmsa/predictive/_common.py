@@ -160,9 +160,11 @@ def check_posterior_emulator(emulator, posterior) -> None:
 def paired_draws(emulator, posterior, what: str) -> np.ndarray:
     """(n,) per posterior sample, the position in ``emulator.draws`` of the emulator parameters
     drawn jointly with it: ``info["emulator_draws"]`` (``gpmsa.calibrate(...,
-    emulator_params="draws")``), or draw i for sample i where the posterior's theta draws are
-    the emulator's own joint-fit draws (``calibration_posterior``). GPMSAError where the
-    emulator kept no draws or the posterior holds none jointly with theta."""
+    emulator_params="draws")``, a ``Calibrator(..., emulator_params="draws")`` update's), or
+    draw i for sample i where the posterior's theta draws are the emulator's own joint-fit
+    draws (``calibration_posterior``, a ``fit_study`` member's). GPMSAError where the emulator
+    kept no draws or the posterior holds none jointly with theta (one calibrated at the point
+    estimate, ``calibrate_study``'s: the message says which)."""
     kept = emulator.n_draws if getattr(emulator, "draws", None) else 0
     if kept == 0:
         raise GPMSAError(f"{what} with draws=True needs the emulator's retained draws, but this "
@@ -188,12 +190,22 @@ def paired_draws(emulator, posterior, what: str) -> np.ndarray:
             return np.arange(n)
     why = ("its theta draws are not this emulator's joint-fit draws" if cal else
            "this emulator was fitted without observations, so it has no theta draws")  # fmt: skip
+    same = "every theta draw with the same emulator parameters, so there is no draw to pair"
+    use = ("gpmsa.calibration_posterior(emu) of a joint fit (gpmsa.fit(data, obs)), a posterior "
+           "of gpmsa.calibrate(..., emulator_params='draws') or of gpmsa.Calibrator(emu, "
+           "emulator_params='draws').update(...), or draws=False")  # fmt: skip
+    if posterior.info.get("method") == "study calibration":
+        source = f": gpmsa.calibrate_study calibrates at each model's point estimate, {same}"
+        use = "study.member_posterior(...) of gpmsa.fit_study (joint fits, paired), " + use
+    elif posterior.info.get("emulator_params") == "point":
+        source = ": it was calibrated at the emulator's point estimate (emulator_params='point'), "
+        source += same
+    else:
+        source = ""
     raise GPMSAError(
         f"{what} with draws=True pairs each theta draw with the emulator-parameter draw drawn "
-        f"with it, but this posterior records none (info['emulator_draws']: gpmsa.calibrate at "
-        f"the point estimate, a grid Calibrator, a Posterior made by hand) and {why}: pass "
-        "gpmsa.calibration_posterior(emu) of a joint fit (gpmsa.fit(data, obs)), a posterior "
-        "of gpmsa.calibrate(..., emulator_params='draws'), or draws=False"
+        f"with it, but this posterior records none (info['emulator_draws']){source}; and {why}: "
+        f"pass {use}"
     )
 
 

@@ -133,9 +133,10 @@ def calibrated_predict(
         draws: pair each theta draw with its own draw of the emulator parameters (betaU,
             lamUz, lamWs, lamWOs) instead of the point estimate: where the posterior holds them
             jointly, ``calibration_posterior`` of a joint fit (the fit's draw i with theta's
-            draw i) or ``gpmsa.calibrate(..., emulator_params="draws")`` (its
-            ``info["emulator_draws"]``); another posterior (calibrated at the point estimate,
-            a grid ``Calibrator``'s, one made by hand) is refused (GPMSAError).
+            draw i) or ``gpmsa.calibrate(..., emulator_params="draws")`` and
+            ``Calibrator(..., emulator_params="draws")`` (their ``info["emulator_draws"]``);
+            another posterior (calibrated at the point estimate, ``calibrate_study``'s, one
+            made by hand) is refused (GPMSAError saying why).
         n_theta: at most this many posterior draws when draws are used.
         extrapolate: allow x_new outside the emulator's x domain, however far (with a
             warning naming x_new), as ``gpmsa.calibrate`` allows x_obs; False: within

@@ -497,8 +497,9 @@ def full_prediction(
         draws: the emulator parameters (betaU, lamUz, lamWs, lamWOs) of each draw: True, the
             draw drawn jointly with its theta (a joint fit's own; with ``posterior``, as
             ``calibrated_predict(..., draws=True)`` pairs them: ``calibration_posterior`` of
-            this joint fit or ``gpmsa.calibrate(..., emulator_params="draws")``, another
-            refused, GPMSAError); False, the point estimate; None (default): a joint fit's
+            this joint fit, ``gpmsa.calibrate(..., emulator_params="draws")`` or a
+            ``Calibrator(..., emulator_params="draws")`` update, another refused, GPMSAError);
+            False, the point estimate; None (default): a joint fit's
             paired draws without ``posterior``, the point estimate with it.
         n_draws: at most this many posterior draws, evenly spaced (None: all).
         n_rlz: realizations per draw.
