@@ -34,7 +34,10 @@ Steps (docs/closed-loop.md):
 The files go to ``--emulator-dir`` (default ``OUT/emulators``); ``--ship`` writes them into the
 package (control/emulators/) instead, replacing the shipped ones; it refuses, before the
 campaign, speed or GD ranges that would not cover the default Simplex's speeds (1-2 m/s) and the
-paper's track (GD 300-500), which the README's main command needs. Each file's metadata records the
+paper's track (GD 300-500), which the README's main command needs. A fit may warn
+(``gpmsa.ConvergenceWarning``: one chain is judged by its split R-hat and bulk ESS, and the
+shipped band emulators' chains would be flagged for a few speed coefficients; docs/closed-loop.md);
+the file records the verdict, and ``--n-iter`` runs longer chains. Each file's metadata records the
 vehicle, the noise level, the feature, the road settings, the design, the fit settings and the
 versions of Python, numpy, scipy, exudyn and BLAS that made the training data (`gpmsa info`
 shows them, with those of the fit). OUT also gets ``campaign.npz`` (the drives' features and

@@ -234,6 +234,7 @@ def calibrate(
     constraint=None,
     theta_init=None,
     fixed: dict | None = None,
+    _online: bool = False,  # a Calibrator's update: one chain not judged (fast, silent)
     **options,
 ) -> Posterior:
     """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
@@ -314,9 +315,12 @@ def calibrate(
             numpy), e.g. ``device="cuda"``, ``dtype="float32"`` for torch; the fast sampler
             takes none.
 
-    With more than one chain, ``info["diagnostics"]`` holds each parameter's rank-normalised
-    R-hat and bulk ESS (and mean, sd), ``info["convergence"]`` the verdict, and a
-    ``gpmsa.ConvergenceWarning`` names each parameter with R-hat > 1.01 or ESS < 100. A chain
+    ``info["diagnostics"]`` holds each parameter's rank-normalised R-hat and bulk ESS (and
+    mean, sd), ``info["convergence"]`` the verdict, and a ``gpmsa.ConvergenceWarning`` names
+    each parameter with R-hat > 1.01 or ESS < 100; one chain (the default) is judged by its
+    split R-hat, which compares the chain's halves (the warning then advises a longer chain or
+    ``n_chains >= 2``). A ``gpmsa.Calibrator``'s update (its MCMC path, online) judges one
+    chain by none of them: its Posterior has no diagnostics, and no warning. A chain
     that fails or produces non-finite draws raises ``gpmsa.ChainError`` naming it.
 
     Returns:
@@ -437,7 +441,7 @@ def calibrate(
     if held is not None:
         info["fixed"] = info.pop("fixed", {})  # after the run's own keys
         info["held"] = list(held_names)  # the posterior names held (Posterior.summary's "held")
-    if n_chains > 1:
+    if n_chains > 1 or not _online:  # a Calibrator's one-chain update: fast and silent
         info["diagnostics"] = summarize(chains)
         shapes = {k: v.shape[2:] for k, v in chains.items()}
         info["convergence"] = convergence(

@@ -871,9 +871,8 @@ class Calibrator:
         opts.setdefault("n_emulator_draws", self._n_emulator_draws)
         opts.setdefault("backend", self.backend)
         try:
-            return calibrate(
-                self.emulator, x_obs, y_obs, extrapolate=extrapolate, log_prior=prior, **opts
-            )
+            return calibrate(self.emulator, x_obs, y_obs, extrapolate=extrapolate,
+                             log_prior=prior, _online=True, **opts)  # fmt: skip
         except StartRejectedError as exc:  # calibrate's advice names its arguments, not ours
             given = all(k in opts and (v is ... or opts[k] == v) for k, v in exc.remedy.items())
             if given or not exc.remedy:  # the user's own start was rejected: as it is

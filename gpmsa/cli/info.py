@@ -460,9 +460,10 @@ def _figure(val: object, limit: object, places: int, none: str, above: bool) -> 
 
 
 def _convergence_line(rec: object) -> str:
-    """One line on the chains' convergence (files of one chain or older ones have no record)."""
+    """One line on the chains' convergence (older files, and those of one chain from before
+    one chain was judged, have no record; one chain's R-hat is its split R-hat)."""
     if not rec:
-        return "convergence:     not checked (one chain, or a file from before the check)"
+        return "convergence:     not checked (a file from before the check)"
     if not isinstance(rec, dict):
         return f"convergence:     {value(rec)}"
     try:
@@ -476,8 +477,10 @@ def _convergence_line(rec: object) -> str:
         e_txt = _figure(e_val, rec.get("ess_min"), 0, "undefined", False)
         worst = (f"max R-hat {r_txt}{_element(r_el)}, min bulk ESS {e_txt}"
                  f"{_element(e_el)}")  # fmt: skip
-    head = (f"convergence:     {plain(rec.get('n_chains'))} chains x "
-            f"{plain(rec.get('n_draws'))} draws; {worst}; ")  # fmt: skip
+    chains = f"{plain(rec.get('n_chains'))} chains"
+    if type(rec.get("n_chains")) is int and rec["n_chains"] == 1:  # split R-hat: its halves
+        chains, worst = "1 chain", worst.replace("max R-hat", "max split R-hat")
+    head = f"convergence:     {chains} x {plain(rec.get('n_draws'))} draws; {worst}; "
     flagged = rec.get("flagged") or {}
     if not flagged:
         return head + (f"converged (R-hat <= {plain(rec.get('rhat_max'))}, ESS >= "

@@ -175,9 +175,10 @@ class Emulator:
     draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected), x_names,
     t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
     settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
-    lamOs draws of a joint sim+obs fit, else None), convergence (several chains: R-hat and bulk
-    ESS of every sampled parameter and the elements flagged, see
-    ``gpmsa.mcmc.diagnostics.convergence``; None for one chain and for older files), levels
+    lamOs draws of a joint sim+obs fit, else None), convergence (R-hat, one chain's split
+    R-hat, and bulk ESS of every sampled parameter and the elements flagged, see
+    ``gpmsa.mcmc.diagnostics.convergence``; None for ``from_params``, for older files and for
+    one-chain files from before one chain was judged), levels
     (per column of [x, t]: a categorical input's training levels, else None), mean_basis (the
     weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md;
     discrepancy_bases (a joint fit given a list of per-experiment discrepancy bases: the

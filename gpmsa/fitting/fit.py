@@ -216,11 +216,13 @@ def fit(
     its "levels", the "shifted" elements and per chain their conditional "modes" at each level
     (native units; the move from level a to b shifts them by modes[b] - modes[a]).
 
-    With more than one chain, the rank-normalised R-hat and bulk ESS of every sampled parameter
-    are stored in ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning``
-    names each parameter with R-hat > 1.01 or ESS < 100. A chain that fails or produces
-    non-finite draws raises ``gpmsa.ChainError`` naming it. In a daemonic worker (e.g. a dask
-    task's), which may not start processes, n_jobs None or -1 runs the chains in it.
+    The rank-normalised R-hat and bulk ESS of every sampled parameter are stored in
+    ``Emulator.convergence`` (and the file), and a ``gpmsa.ConvergenceWarning`` names each
+    parameter with R-hat > 1.01 or ESS < 100; one chain (the default) is judged by its split
+    R-hat, which compares the chain's halves (the warning then advises a longer chain or
+    ``n_chains >= 2``, which can show whether independent chains agree). A chain that fails or
+    produces non-finite draws raises ``gpmsa.ChainError`` naming it. In a daemonic worker (e.g.
+    a dask task's), which may not start processes, n_jobs None or -1 runs the chains in it.
     """
     n_iter, n_chains = check_count(n_iter, "n_iter", 2), check_count(n_chains, "n_chains")
     continuing = isinstance(options.get("init"), Emulator)  # its chains start past burn-in
@@ -369,13 +371,11 @@ def fit(
     else:
         per = kept
         summary = summarize(post, chains.accept_rate)
-    record = None
-    if n_chains > 1:
-        record = sampled_convergence(problem, summary, n_chains, per)
-        how = more_advice(append, settings)
-        warn_unconverged(record, f"gpmsa.fit (backend {backend!r})", more=f", or {how}",
-                         names=element_names(data.x_names, data.t_names,
-                                             problem.init["betaU"].shape[1]))  # fmt: skip
+    record = sampled_convergence(problem, summary, n_chains, per)  # one chain: split R-hat
+    how = more_advice(append, settings)
+    warn_unconverged(record, f"gpmsa.fit (backend {backend!r})", more=f", or {how}",
+                     names=element_names(data.x_names, data.t_names,
+                                         problem.init["betaU"].shape[1]))  # fmt: skip
     return Emulator._from_prepared(
         data, prep, params,
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,

@@ -195,7 +195,9 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str =
     """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record
     and the caller's argument ``length`` that sets the chains' length (``more``: a further
     remedy, appended). Where the worst R-hat exceeds RHAT_APART (or is infinite) the warning
-    adds that the chains lie apart, which longer chains may not mend (several modes).
+    adds that the chains lie apart, which longer chains may not mend (several modes). A record
+    of one chain is worded for it: its split R-hat compares the chain's halves and cannot show
+    whether independent chains agree, so it advises a longer chain or ``n_chains >= 2``.
     ``names``: element -> what it is for a person ("theta[0]" -> "k"), shown beside it."""
     from gpmsa.errors import ConvergenceWarning
 
@@ -208,12 +210,14 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str =
         return f"{el} ({names[el]})" if el in names else el
 
     items = "; ".join(f"{shown_as(el)}: {why}" for el, why in flagged.items())
+    one = record["n_chains"] == 1
     apart = ""
     el, r = record.get("max_rhat") or ("", None)
     if el and (r is None or r > RHAT_APART):  # None with an element: an infinite R-hat
         shown = "inf" if r is None else beyond(r, RHAT_APART, 3)
+        which = "the chain's halves lie" if one else "the chains lie"
         apart = (
-            f" R-hat {shown} ({shown_as(el)}) says the chains lie apart, not merely that they "
+            f" R-hat {shown} ({shown_as(el)}) says {which} apart, not merely that they "
             "are short: if longer chains do not bring them together, the posterior may have "
             "several modes that no chain crosses (compare the chains: to_arviz(), "
             "gpmsa.plots.traces; parallel tempering moves between modes: the numpy and "
@@ -227,10 +231,16 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str =
             "chains are stuck (start chains at other levels, or let parallel tempering's "
             "temperatures= move between them: docs/models.md)."
         )
+    chains, advice = f"{record['n_chains']} chains", f"Run longer chains ({length}) or more of them"
+    if one:  # split R-hat: the chain's halves, not independent chains (PyMC's, Stan's practice)
+        chains = "1 chain"
+        advice = (
+            "One chain's split R-hat compares the chain's halves and cannot show whether "
+            f"independent chains agree: run a longer chain ({length}) or n_chains >= 2"
+        )
     warnings.warn(
-        f"{what}: {len(flagged)} parameter element(s) not converged over {record['n_chains']} "
-        f"chains x {record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
-        f"{record['ess_min']:.0f}): {items}. Run longer chains ({length}) or more of them{more}."
-        f"{apart}",
+        f"{what}: {len(flagged)} parameter element(s) not converged over {chains} x "
+        f"{record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
+        f"{record['ess_min']:.0f}): {items}. {advice}{more}.{apart}",
         ConvergenceWarning, stacklevel=stacklevel,
     )  # fmt: skip

@@ -566,8 +566,7 @@ def calibrate_study(
         settings.update(cont.appended_settings(init, int(n_samples), settings["accept_rate"],
                                                renamed))  # fmt: skip
     study = Study("calibration", emulators, layout, hyper, draws, settings, metadata)
-    if study.convergence is not None:
-        warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
+    warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
     return study
 
 
@@ -621,10 +620,8 @@ def _per_model(label: str, make, *args, **kwargs):
 def _member_convergence(problem, summary: dict, counts: tuple[int, int]):
     """A ``fit_study`` model's convergence records over its kept draws (``counts``: chains,
     draws a chain): (every parameter it sampled, as ``gpmsa.fit`` records it; those but theta
-    and lamOs, which the study's own record judges under the study's names); (None, None) for
-    one chain."""
-    if counts[0] < 2:
-        return None, None
+    and lamOs, which the study's own record judges under the study's names); one chain by its
+    split R-hat, as ``gpmsa.fit``."""
     return (sampled_convergence(problem, summary, *counts),
             sampled_convergence(problem, summary, *counts, skip=("theta", "lamOs")))  # fmt: skip
 
@@ -842,9 +839,8 @@ def fit_study(
             settings=emu_settings, diagnostics=summary, calibration=cal,
             convergence=records[0],
         ))  # fmt: skip
-        if records[1] is not None:  # its emulator's (and discrepancy's) elements
-            warn_unconverged(records[1], f"gpmsa.fit_study (model {labels[i]!r})")
+        # its emulator's (and discrepancy's) elements
+        warn_unconverged(records[1], f"gpmsa.fit_study (model {labels[i]!r})")
     study = Study("fit", members, layout, hyper, draws, settings, metadata)
-    if study.convergence is not None:
-        warn_unconverged(study.convergence, "gpmsa.fit_study")
+    warn_unconverged(study.convergence, "gpmsa.fit_study")
     return study

@@ -253,12 +253,10 @@ class Study:
                 "units": study_units(layout, self.members)}  # fmt: skip
         if levels:
             info["levels"] = levels
-        self.convergence = None
-        if n_chains > 1:
-            shapes = {k: () for k in chains}
-            held = held_names(self.settings)  # fitted with fixed=: not judged
-            self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held)
-            info["convergence"] = self.convergence
+        shapes = {k: () for k in chains}  # one chain too: its split R-hat (as gpmsa.fit's)
+        held = held_names(self.settings)  # fitted with fixed=: not judged
+        self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held)
+        info["convergence"] = self.convergence
         self.posterior = Posterior(samples, chains=chains, info=info)
 
     @property
@@ -379,8 +377,7 @@ class Study:
             "study": {"kind": self.kind, "shared": list(self.layout.shared),
                       "hierarchical": list(self.layout.groups), "models": models},
         }  # fmt: skip
-        if self.convergence is not None:
-            manifest["convergence"] = self.convergence
+        manifest["convergence"] = self.convergence
         return jsonable(manifest), {k: np.ascontiguousarray(v) for k, v in self.draws.items()}
 
     def save(self, path: str | Path) -> Path:
