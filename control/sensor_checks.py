@@ -17,6 +17,7 @@ from scipy.stats import chi2
 
 from control.errors import ControlError
 from control.validation import is_integer, require_integers, require_reals
+from gpmsa.errors import numbers_text
 from vehicle.models import GRAVITY
 
 MIN_SEGMENT = 32
@@ -348,7 +349,8 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
         if p < limits.lattice_p:
             return (
                 f"quantised signal: samples {start}-{start + stretch - 1} sit on a lattice of "
-                f"step {step:.4g} m/s^2 (probability {p:.2g} for a healthy sensor, "
+                f"step {step:.4g} m/s^2 (probability "
+                f"{numbers_text(p, limits.lattice_p, digits=2)[0]} for a healthy sensor, "
                 f"allowed {limits.lattice_p:g})"
             )
     if limits.noise_sd_mps2 is not None:
@@ -366,9 +368,10 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
     else:  # (the usual case: no segment can reach the limit, `_level_within`)
         ratio, (start, stop) = 1.0, (0, 0)
     if ratio > limits.max_level_jump:
+        shown = numbers_text(ratio, limits.max_level_jump, digits=3)[0]
         return (
             f"signal level jumps within the block: the variance of samples {start}-{stop - 1} "
-            f"differs from the rest's by a factor {ratio:.3g} (allowed {limits.max_level_jump:g})"
+            f"differs from the rest's by a factor {shown} (allowed {limits.max_level_jump:g})"
         )
     if steady:  # (the usual case: no stretch to scan, `_short_levels_to_scan`)
         for stretch, limit in _short_levels_to_scan(s1, s2):
@@ -378,7 +381,8 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
             if ratio > limit:
                 return (
                     f"signal level drops within the block: the variance of samples {start}-"
-                    f"{start + stretch - 1} is 1/{ratio:.3g} of the rest's and of the samples' "
+                    f"{start + stretch - 1} is 1/{numbers_text(ratio, limit, digits=3)[0]} of "
+                    "the rest's and of the samples' "
                     f"before it (allowed 1/{limit:g} for {stretch} samples)"
                 )
     if limits.static_mps2 is not None:
@@ -424,10 +428,10 @@ def _off_static(mean: float, static: float, tol: float, what: str, over: str) ->
         why = f"a sensor gain of about {ratio:.2g}, or an axis tilted ~{tilt:.0f} deg"
     else:
         why = f"a sensor gain of about {ratio:.2g}"
+    shown, lo, hi = numbers_text(ratio, 1 - tol, 1 + tol, digits=3)
     return (
-        f"scale or tilt: {what} {mean:.4g} m/s^2 is {ratio:.3g} of the static level {static:g} "
-        f"m/s^2 a healthy axis reads (allowed {1 - tol:.3g}-{1 + tol:.3g} over {over} samples): "
-        f"{why}"
+        f"scale or tilt: {what} {mean:.4g} m/s^2 is {shown} of the static level {static:g} "
+        f"m/s^2 a healthy axis reads (allowed {lo}-{hi} over {over} samples): {why}"
     )
 
 
@@ -1000,7 +1004,8 @@ class StreamBreaks:
             what.append(f"{self.nonfinite} sample(s) with non-finite {'/'.join(self.names)}")
         if self.too_fast:
             what.append(
-                f"{self.too_fast} sample(s) with |speed| up to {self.fastest:.3g} m/s, beyond any "
+                f"{self.too_fast} sample(s) with |speed| up to "
+                f"{numbers_text(self.fastest, MAX_SPEED_MPS, digits=3)[0]} m/s, beyond any "
                 f"ground robot's (MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
             )
         if self.backwards:
@@ -1110,7 +1115,8 @@ def timing_fault(
     fastest = float(np.max(np.abs(speed)))
     if fastest > MAX_SPEED_MPS:  # before the odometry check integrates them (and overflows)
         return (
-            f"out of range: |speed| reaches {fastest:.3g} m/s, beyond any ground robot's "
+            f"out of range: |speed| reaches {numbers_text(fastest, MAX_SPEED_MPS, digits=3)[0]} "
+            "m/s, beyond any ground robot's "
             f"(MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
         )
     span, expected = float(t[-1] - t[0]), (t.size - 1) / rate_hz

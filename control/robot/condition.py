@@ -468,8 +468,9 @@ def highpass(t: np.ndarray, a: np.ndarray, rate_hz: float, cutoff_hz: float) -> 
 
 
 def static_level_marks(
-    a: np.ndarray, limits: SensorLimits, every: int, block: int, t: np.ndarray, rate_hz: float
-) -> dict[int, str]:
+    a: np.ndarray, limits: SensorLimits, every: int, block: int, t: np.ndarray, rate_hz: float,
+    kept: np.ndarray | None = None,
+) -> dict[int, str]:  # fmt: skip
     """The static-level check (`control.sensor_checks.static_level`) of the raw samples ``a``
     (m/s^2, before a high-pass removes their static level; times ``t``, s, at ``rate_hz``) at
     each update of a BCR fed them ``every`` samples at a time from the first: {the update's
@@ -478,9 +479,11 @@ def static_level_marks(
     ``limits.static_mps2``, or, with ``limits.static_span``, whose newest ``static_span``
     samples, finite and contiguous (steps within [0.5, ``GAP_PERIODS``] periods; one stamped
     backwards is left out, as the BCR's long span leaves it: `static_span_level`), have one
-    off it by more than ``static_span_tolerance``."""
+    off it by more than ``static_span_tolerance``. ``kept``: (n,) bool, False for a sample the
+    BCR drops for its other values (no position or speed: an odometry gap), which breaks the
+    block and the span as a non-finite ``a`` does (None: every sample has them)."""
     a = np.asarray(a, dtype=float)
-    finite = np.isfinite(a)
+    finite = np.isfinite(a) if kept is None else np.isfinite(a) & kept
     count = np.concatenate([[0], np.cumsum(finite)])
     updates = np.arange(every, a.size + 1, every)  # each update's end (exclusive)
     ends = updates[updates >= block]

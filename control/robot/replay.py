@@ -907,9 +907,11 @@ def _condition(
             "odometry message left out"
         )
     t, a = t[first:last], a[first:last]
+    pos, spd = condition.odometry_at(t, to, along, speed, s.max_odometry_gap_s)
     marks: dict[int, str] = {}
-    if raw_check is not None:
-        marks = condition.static_level_marks(raw[first:last], *raw_check, t, rate_hz)
+    if raw_check is not None:  # (samples in an odometry gap: the BCR drops them, as non-finite)
+        kept = np.isfinite(pos) & np.isfinite(spd)
+        marks = condition.static_level_marks(raw[first:last], *raw_check, t, rate_hz, kept)
         a[list(marks)] = np.nan
         if marks:
             notes.append(
@@ -917,7 +919,6 @@ def _condition(
                 f"{s.static_mps2:g} m/s^2 before the high-pass (a scale fault): their newest "
                 "sample marked non-finite (sensor_fault)"
             )
-    pos, spd = condition.odometry_at(t, to, along, speed, s.max_odometry_gap_s)
     in_gap = finite_t[first:last] & ~np.isfinite(pos)
     if in_gap.any():
         notes.append(

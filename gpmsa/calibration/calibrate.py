@@ -51,7 +51,7 @@ from gpmsa.calibration.observations import (
 )
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
-from gpmsa.errors import GPMSAError, ReductionWarning
+from gpmsa.errors import GPMSAError, ReductionWarning, numbers_text
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, tempering, tuning
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
@@ -203,7 +203,7 @@ def _theta_options(emulator, constraint, theta_init):
             if lv is not None and not np.any(np.isclose(lv, native[k], rtol=0, atol=1e-9)):
                 raise GPMSAError(
                     f"theta_init: categorical calibration parameter {names[k]} must be one of "
-                    f"its training levels {list(lv)}, got {native[k]:g}"
+                    f"its training levels {list(lv)}, got {numbers_text(native[k], *lv)[0]}"
                 )
     return con, start
 

@@ -90,7 +90,7 @@ from gpmsa.calibration.observations import (
     warn_if_outside,
 )
 from gpmsa.calibration.posterior import LevelMarginal, Posterior, trapezoid_weights
-from gpmsa.errors import GPMSAError, StartRejectedError
+from gpmsa.errors import GPMSAError, StartRejectedError, numbers_text
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, run_seed
@@ -1075,7 +1075,8 @@ def _warn_at_float(res: float, marginal, emulator) -> None:
         warnings.warn(
             f"the posterior of {name} is narrower than the grid can represent: refinement "
             f"reached float64's resolution of {name} with its width (the smaller of its sd and "
-            f"IQR / 1.349) spanning {res:.2g} node spacings (fewer than {UNRESOLVED_SD:g}); its "
+            f"IQR / 1.349) spanning {numbers_text(res, UNRESOLVED_SD, digits=2)[0]} node "
+            f"spacings (fewer than {UNRESOLVED_SD:g}); its "
             "sd, quantiles and draws are good "
             f"to about the node spacing there, {h:.3g}{f' {unit}' if unit else ''}",
             stacklevel=3,
@@ -1089,7 +1090,8 @@ def _warn_if_narrow_prior(table: np.ndarray, n_grid: int, q: int) -> None:
     if sd < least:
         warnings.warn(
             f"prior= given on the grid is narrower than the grid represents: its sd at its peak"
-            f"{' (given the other parameter)' if q == 2 else ''} spans {sd:.2g} node spacings "
+            f"{' (given the other parameter)' if q == 2 else ''} spans "
+            f"{numbers_text(sd, least, digits=2)[0]} node spacings "
             f"(fewer than {least:g}); "
             f"between the nodes it is interpolated, so the posterior may be a tenth of its sd "
             f"or more off and too wide; pass prior= as a callable of theta, or use a Calibrator "
@@ -1105,7 +1107,8 @@ def _warn_if_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> No
     if res[k] < UNRESOLVED_SD:
         warnings.warn(
             f"the grid does not resolve the posterior of {names[k]}: its width (the smaller of its "
-            f"sd and IQR / 1.349) spans {res[k]:.2g} node spacings (fewer than "
+            f"sd and IQR / 1.349) spans {numbers_text(res[k], UNRESOLVED_SD, digits=2)[0]} "
+            "node spacings (fewer than "
             f"{UNRESOLVED_SD:g}) on the grid refinement ended with, so "
             f"its quantiles, cdf and draws may be off by several per cent of an sd; use "
             f"method='mcmc' or another n_grid (now {n_grid})",
@@ -1121,7 +1124,8 @@ def _warn_if_level_unresolved(res: tuple[float, ...], names: tuple, n_grid: int)
     if res[k] < UNRESOLVED_SD:
         warnings.warn(
             f"the grid does not resolve the posterior of {names[k]} given the level of "
-            f"{names[1 - k]}: its width spans {res[k]:.2g} node spacings (fewer than "
+            f"{names[1 - k]}: its width spans {numbers_text(res[k], UNRESOLVED_SD, digits=2)[0]} "
+            "node spacings (fewer than "
             f"{UNRESOLVED_SD:g}) on the grid refinement ended with, so its summaries, draws "
             f"and the levels' probabilities may be off; use a larger n_grid (now {n_grid}) or "
             f"method='mcmc'",
@@ -1152,7 +1156,8 @@ def _warn_if_ridge(sds: tuple[float, float], names: tuple, n_grid: int) -> None:
         warnings.warn(
             f"the grid does not resolve the posterior (a ridge across both parameters, or a "
             f"peak narrower than refinement reaches): the sd of {names[k]} given "
-            f"{names[1 - k]} spans {sds[k]:.2g} node spacings (fewer than {RIDGE_SD:g}), so its "
+            f"{names[1 - k]} spans {numbers_text(sds[k], RIDGE_SD, digits=2)[0]} node spacings "
+            f"(fewer than {RIDGE_SD:g}), so its "
             f"summaries and draws may be off by a large fraction of an sd; use a larger n_grid "
             f"(now {n_grid}) or method='mcmc'",
             stacklevel=3,

@@ -397,7 +397,8 @@ def _observations(emulator, obs: ObsProblem, corr, digests: tuple[str, str], xu)
     far = ~(np.abs(z) <= MAX_STD_OBS)  # an overflow (inf, NaN) is far too
     if far.any():
         worst = np.max(np.abs(z))
-        shown = f"{worst:.3g}" if np.isfinite(worst) else "more than 1.8e308 (overflow)"
+        shown = (numbers_text(worst, MAX_STD_OBS, digits=3)[0] if np.isfinite(worst)
+                 else "more than 1.8e308 (overflow)")  # fmt: skip
         raise GPMSAError(
             f"y_obs lies {shown} standard deviations of the simulation outputs from their "
             f"mean; allowed at most {MAX_STD_OBS:g} (wrong units?)"
@@ -751,7 +752,8 @@ def warn_if_outside(
         )
         warnings.warn(
             f"{'' if model is None else f'model {model!r}: '}"
-            f"y_obs lies {fit.outside_sds:.3g} predictive sds from the nearest emulator "
+            f"y_obs lies {numbers_text(fit.outside_sds, OUTSIDE_SDS, digits=3)[0]} predictive "
+            "sds from the nearest emulator "
             f"prediction at x_obs over the whole theta domain (more than {OUTSIDE_SDS:g})"
             f"{' (the emulator alone)' if discrepancy else ''}: the observation is outside "
             f"what the emulator has seen. {then}check the units, the feature and the "

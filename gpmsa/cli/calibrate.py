@@ -12,7 +12,7 @@ import warnings
 import numpy as np
 
 from gpmsa.calibration.posterior import quantile_keys
-from gpmsa.cli.text import internal_error, safe
+from gpmsa.cli.text import internal_error, numbers, safe
 from gpmsa.errors import GPMSAError
 from gpmsa.io.container import jsonable
 
@@ -131,21 +131,26 @@ def _check_held(emu, t_names: tuple[str, ...], name: str, value: float) -> None:
             calibration_fixed(emu, {"theta": {name: value}})
         return
     except GPMSAError:
-        allowed = _holdable(emu, t_names, name)
-    raise GPMSAError(f"--fixed {name}={value:.12g} cannot be held: give a value {allowed}")
+        shown, allowed = _holdable(emu, t_names, name, value)
+    raise GPMSAError(f"--fixed {name}={shown} cannot be held: give a value {allowed}")
 
 
-def _holdable(emu, t_names: tuple[str, ...], name: str) -> str:
-    """The values ``--fixed`` may hold ``name`` at, in words (native units)."""
+def _holdable(emu, t_names: tuple[str, ...], name: str, value: float) -> tuple[str, str]:
+    """``value`` as text, and the values ``--fixed`` may hold ``name`` at, in words (native
+    units); a value and the bounds it misses with the digits that tell them apart (a level is
+    matched within 1e-9: 12 digits tell a value off it)."""
     if name == "lamOs":
         g = emu.priors.precision_prior("lamOs")
-        return f"inside its prior's bounds ({g.lower:g}, {g.upper:g})"
+        lo, hi = numbers(g.lower, g.upper, value)[:2]
+        shown = numbers(value, g.lower, g.upper, digits=12)[0]
+        return shown, f"inside its prior's bounds ({lo}, {hi})"
     k = t_names.index(name)
     levels = None if emu.levels is None else emu.levels[emu.x_unit.shape[1] + k]
     if levels is not None:
-        return f"at one of its levels {[float(v) for v in levels]}"
+        return f"{value:.12g}", f"at one of its levels {[float(v) for v in levels]}"
     lo, hi = emu.standardizer.t_min[k], emu.standardizer.t_max[k]
-    return f"inside the design's open range ({lo:.12g}, {hi:.12g})"
+    shown, lo, hi = numbers(value, lo, hi, digits=12)
+    return shown, f"inside the design's open range ({lo}, {hi})"
 
 
 def run(args: argparse.Namespace) -> int:

@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 from scipy import stats
 
-from gpmsa.errors import BasisWarning, GPMSAError, user_stacklevel
+from gpmsa.errors import BasisWarning, GPMSAError, numbers_text, user_stacklevel
 from gpmsa.model.data import as_float, check_count, check_increasing
 
 VARIANCE_FRACTION = 0.995
@@ -97,7 +97,8 @@ def given_basis(basis, l_sim: int) -> np.ndarray:
     if off > ORTHOGONAL_TOL * lam.max():
         raise GPMSAError(
             f"basis columns must be orthogonal (largest |K^T K| off the diagonal "
-            f"{off / lam.max():.2g} of the largest diagonal element, tolerance "
+            f"{numbers_text(off / lam.max(), ORTHOGONAL_TOL, digits=2)[0]} of the largest "
+            "diagonal element, tolerance "
             f"{ORTHOGONAL_TOL:g}): GPM/SA's likelihood of the runs is exact only then. "
             "numpy.linalg.qr(K) or an SVD gives an orthogonal basis of the same span (the "
             "weights' GP prior then applies to its columns)"

@@ -645,7 +645,8 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
         if (col_hi - col_lo) < RANGE_COVER_MIN * width:
             warnings.warn(
                 f"design column {names[j]} spans [{a}, {b}], "
-                f"{(col_hi - col_lo) / width:.3g} of its {attr} [{c}, {d}] (less than "
+                f"{numbers_text((col_hi - col_lo) / width, RANGE_COVER_MIN, digits=3)[0]} of its "
+                f"{attr} [{c}, {d}] (less than "
                 f"{RANGE_COVER_MIN:g}): the runs fill a sliver of the unit interval, where the "
                 "fit resolves the input poorly (below 0.05 it ignores it) and the emulator "
                 "extrapolates over the rest; check the range's units, or give the range the "

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, numbers_text
 from gpmsa.model import categorical, constraints
 from gpmsa.model.data import as_real
 
@@ -190,20 +190,26 @@ def check_values(name: str, elements: dict[Index, float], priors, levels=None) -
     for idx, x in elements.items():
         lv = None if levels is None else levels[idx[0]]
         if lv is not None:
-            ok, where = bool(np.any(lv == x)), f"its levels {np.asarray(lv).tolist()}"
+            if bool(np.any(lv == x)):
+                continue
+            x_text = numbers_text(x, *np.asarray(lv, dtype=float).ravel())[0]
+            where = f"its levels {np.asarray(lv).tolist()}"
+        elif priors.scalar_log_prior(name, idx[-1])(x) > -np.inf:
+            continue
         else:
-            ok = priors.scalar_log_prior(name, idx[-1])(x) > -np.inf
-            where = f"its prior's bounds {_bounds(name, idx[-1], priors)}"
-        if not ok:
-            raise GPMSAError(f"fixed[{name!r}]: element {label(name, idx)} = {x:g} lies outside "
-                             f"{where} (zero prior density)")  # fmt: skip
+            lower, upper, scale = _bounds(name, idx[-1], priors)
+            x_text, lo, hi = numbers_text(x, lower, upper)
+            where = f"its prior's bounds ({lo}, {hi}){scale}"
+        raise GPMSAError(f"fixed[{name!r}]: element {label(name, idx)} = {x_text} lies outside "
+                         f"{where} (zero prior density)")  # fmt: skip
 
 
-def _bounds(name: str, element: int, priors) -> str:
-    """The open support of element ``element`` of ``name``'s prior (model scale)."""
+def _bounds(name: str, element: int, priors) -> tuple[float, float, str]:
+    """The open support (lower, upper) of element ``element`` of ``name``'s prior (model
+    scale), and the scale's name where it is not the model's own ("": it is)."""
     if name == "theta":
-        return "(0, 1) (unit scale)"
+        return 0.0, 1.0, " (unit scale)"
     if name in ("betaU", "betaV"):
-        return "(0, inf)"
+        return 0.0, np.inf, ""
     g = priors.precision_prior(name, element)
-    return f"({g.lower:g}, {g.upper:g})"
+    return float(g.lower), float(g.upper), ""

@@ -385,8 +385,11 @@ def check_x_obs(
             )
     if far.any():
         k = int(np.flatnonzero(far)[0])
+        low, high = numbers_text(
+            lo[k], hi[k], -EXTRAPOLATION_MARGIN, 1 + EXTRAPOLATION_MARGIN, digits=3
+        )[:2]
         raise GPMSAError(
-            f"x_obs column {names[k]} reaches {lo[k]:.3g}..{hi[k]:.3g} on the unit scale of the "
+            f"x_obs column {names[k]} reaches {low}..{high} on the unit scale of the "
             f"design; allowed [{-EXTRAPOLATION_MARGIN}, {1 + EXTRAPOLATION_MARGIN}] (the emulator "
             "cannot extrapolate that far)"
         )
@@ -450,8 +453,9 @@ def reduce_obs(
         check_finite(e, f"y_obs[{j}] in standardised units")
     far = max(float(np.max(np.abs(e))) for e in ys)
     if far > MAX_STD_OBS:
+        shown = numbers_text(far, MAX_STD_OBS, digits=3)[0]
         raise GPMSAError(
-            f"y_obs lies {far:.3g} standard deviations of the simulation outputs from their "
+            f"y_obs lies {shown} standard deviations of the simulation outputs from their "
             f"mean; allowed at most {MAX_STD_OBS:g} (wrong units?)"
         )
     lamy = [np.eye(e.size) for e in ys]
@@ -538,10 +542,11 @@ def _check_discrepancy_scales(kind, grids: list[np.ndarray]) -> None:
     reach = [float(np.max(np.abs(g))) for g in grids]
     if not np.isclose(max(reach), min(reach), rtol=1e-12, atol=0.0):  # 0.1 + 0.2 is 0.3
         j, k = int(np.argmin(reach)), int(np.argmax(reach))
+        low, high = numbers_text(reach[j], reach[k])
         raise GPMSAError(
             "discrepancy='linear' is normalised on each experiment's grid by its largest "
-            f"|index|, which differs between them (experiment {j}: {reach[j]:.6g}, experiment "
-            f"{k}: {reach[k]:.6g}), so the same weights would mean a different discrepancy in "
+            f"|index|, which differs between them (experiment {j}: {low}, experiment "
+            f"{k}: {high}), so the same weights would mean a different discrepancy in "
             "each: give every experiment a grid that reaches the same largest |index|, use "
             "discrepancy='constant', or pass the linear basis per experiment, which is "
             "normalised by one scale for all (as SEPIA's create_D_basis('linear') on ragged "
