@@ -57,9 +57,7 @@ def check_source(source: Study, kind: str, layout: Layout, hyper: HyperPriors,
         "labels": (list(old.labels), list(layout.labels)),
         "shared": (list(old.shared), list(layout.shared)),
         "hierarchical": (list(old.groups), list(layout.groups)),
-        "calibration parameters (names, ranges, theta priors)": (
-            [(e.name, e.prior, b) for e, b in zip(old.elements, old.bounds, strict=True)],
-            [(e.name, e.prior, b) for e, b in zip(layout.elements, layout.bounds, strict=True)]),
+        "calibration parameters (names, ranges, theta priors)": _differing_elements(old, layout),
         # without a group the hyperpriors act on nothing (a study file before sd_prior
         # records SEPIA's, one since the default): they cannot make the studies differ
         **({"hyper": (source.hyper.to_dict(), hyper.to_dict())} if layout.groups else {}),
@@ -72,6 +70,18 @@ def check_source(source: Study, kind: str, layout: Layout, hyper: HyperPriors,
         raise GPMSAError(f"init=study was another study: its {', '.join(differs)} differ "
                          f"({detail}); continue it with the same models and settings, or start "
                          "afresh")  # fmt: skip
+
+
+def _differing_elements(old: Layout, new: Layout) -> tuple[list, list]:
+    """The study elements (name, theta prior, range) of the layouts ``old`` and ``new``: those
+    that differ where both have as many (a model's own element names its model: "m[b]"), else
+    all of them."""
+    pairs = [[(e.name, e.prior, b) for e, b in zip(lay.elements, lay.bounds, strict=True)]
+             for lay in (old, new)]  # fmt: skip
+    if len(pairs[0]) != len(pairs[1]):
+        return pairs[0], pairs[1]
+    diff = [k for k, (a, b) in enumerate(zip(*pairs, strict=True)) if a != b]
+    return [pairs[0][k] for k in diff], [pairs[1][k] for k in diff]
 
 
 def _brief(value) -> str:

@@ -273,7 +273,9 @@ def build_layout(
                 if el.prior != prior:
                     raise GPMSAError(
                         f"shared parameter {n!r}: the models' theta priors (mean, sd) of it "
-                        f"differ ({labels[el.uses[0][0]]}: {el.prior}, {labels[i]}: {prior})"
+                        f"differ ({labels[el.uses[0][0]]}: {el.prior}, {labels[i]}: {prior}); "
+                        "give each model the same prior of it, at its own position (fit_study's "
+                        "priors=, one per model; a fitted emulator's with_calibration_priors)"
                     )
                 elements[e] = Element(el.name, n, (*el.uses, (i, k)), -1, el.prior)
             else:

@@ -41,6 +41,7 @@ from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.mcmc.starts import check_init
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
+from gpmsa.model.discrepancy import kept_bases
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
@@ -315,45 +316,73 @@ def _per_model_basis(basis, n: int) -> list:
     return list(basis)
 
 
-def _per_model_discrepancy(discrepancy, groups, n: int) -> list[tuple]:
-    """Each model's (basis, groups) from ``calibrate_study``'s ``discrepancy`` and
-    ``discrepancy_groups``: one value for every model, or a list or tuple with one entry per
-    model. A basis given as a list is read as the per-model list (one matrix for every model:
-    a numpy array); groups as one list of integers are every model's."""
-    if discrepancy is None or isinstance(discrepancy, (str, np.ndarray)):
-        bases = [discrepancy] * n
-    elif isinstance(discrepancy, (list, tuple)):
-        bases = list(discrepancy)
-    else:
+def _per_model_value(value, labels: tuple[str, ...], what: str, single: bool) -> list:
+    """Each model's value of a study's argument ``what``: ``value`` for every model where
+    ``single``, else ``value`` a dict label -> entry naming every model once, or a list or
+    tuple with one entry per model (in the models' order); GPMSAError naming ``what`` and the
+    labels (an unknown or missing label, a wrong count)."""
+    n = len(labels)
+    if single:
+        return [value] * n
+    if isinstance(value, dict):
+        unknown = [k for k in value if k not in labels]
+        missing = [lab for lab in labels if lab not in value]
+        if unknown or missing:
+            wrong = f"names unknown model(s) {unknown}" if unknown else ""
+            wrong += (" and " if unknown and missing else "") + (
+                f"has no entry for model(s) {missing}" if missing else "")  # fmt: skip
+            raise GPMSAError(
+                f"{what} as a dict by label {wrong}: give one entry for each of the study's "
+                f"labels {list(labels)} (None where a model takes the default)"
+            )
+        return [value[lab] for lab in labels]
+    if len(value) != n:
         raise GPMSAError(
-            "discrepancy must be None, 'constant', 'linear', a numpy array (every model's basis) "
-            f"or a list with one of these per model, got {type(discrepancy).__name__}"
+            f"{what} has {len(value)} entries for {n} models {list(labels)}: give one value "
+            "for every model, a list with one entry per model (in the order of the models) "
+            "or a dict label -> entry"
         )
-    if len(bases) != n:
+    return list(value)
+
+
+def _per_model_discrepancy(discrepancy, groups, labels: tuple[str, ...]) -> list[tuple]:
+    """Each model's (basis, groups) from a study's ``discrepancy`` and ``discrepancy_groups``:
+    one value for every model, or a list or tuple with one entry per model, or a dict by label
+    (``_per_model_value``). A basis given as a list is read as the per-model list (one matrix
+    for every model: a numpy array); groups as one list of integers are every model's."""
+    n = len(labels)
+    if not (discrepancy is None or isinstance(discrepancy, (str, np.ndarray, list, tuple, dict))):
         raise GPMSAError(
-            f"discrepancy has {len(bases)} entries for {n} models: give one value for every "
-            "model, or a list with one entry (None, 'constant', 'linear' or an array) per model"
+            "discrepancy must be None, 'constant', 'linear', a numpy array (every model's basis), "
+            "a list with one of these per model or a dict of them by label, got "
+            f"{type(discrepancy).__name__}"
+        )
+    if isinstance(discrepancy, (list, tuple)) and len(discrepancy) != n:
+        raise GPMSAError(
+            f"discrepancy has {len(discrepancy)} entries for {n} models {list(labels)}: give one "
+            "value for every model, or a list with one entry (None, 'constant', 'linear' or an "
+            "array) per model, or a dict by label"
             + (
                 "; a model's per-experiment bases (a list) are its entry: [[D_0, D_1], ...]"
                 if is_basis_list(discrepancy)
                 else ""
             )  # fmt: skip
         )
+    bases = _per_model_value(discrepancy, labels, "discrepancy",
+                             not isinstance(discrepancy, (list, tuple, dict)))  # fmt: skip
     one = groups is None or isinstance(groups, np.ndarray) or (
         isinstance(groups, (list, tuple))
         and all(isinstance(g, int | np.integer) for g in groups)
     )  # fmt: skip
-    if one:
-        per = [groups] * n
-    elif isinstance(groups, (list, tuple)):
-        per = list(groups)
-        if len(per) != n:
-            raise GPMSAError(
-                f"discrepancy_groups has {len(per)} entries for {n} models: give one list of "
-                "groups for every model, or a list with one entry (None or a list) per model"
-            )
-    else:
-        per = [groups] * n  # check_groups names what is wrong with it
+    if isinstance(groups, (list, tuple)) and not one and len(groups) != n:
+        raise GPMSAError(
+            f"discrepancy_groups has {len(groups)} entries for {n} models {list(labels)}: give "
+            "one list of groups for every model, or a list with one entry (None or a list) per "
+            "model, or a dict by label"
+        )
+    # anything else is every model's: check_groups names what is wrong with it
+    per = _per_model_value(groups, labels, "discrepancy_groups",
+                           one or not isinstance(groups, (list, tuple, dict)))  # fmt: skip
     return list(zip(bases, per, strict=True))
 
 
@@ -410,9 +439,12 @@ def calibrate_study(
         discrepancy, discrepancy_groups: each model's discrepancy basis and its precision
             groups, as ``gpmsa.calibrate``'s (None, "constant", "linear" or an array; groups
             None or one integer per basis vector): one value for every model, or a list with
-            one entry per model (``["constant", None]``). A list is read as the per-model list:
+            one entry per model (``["constant", None]``), or a dict label -> entry naming every
+            model once. A list is read as the per-model list:
             give one matrix for every model as a numpy array, and a model's per-experiment
-            bases (``gpmsa.calibrate``'s list) as its entry (``[[D_0, D_1], None]``).
+            bases (``gpmsa.calibrate``'s list) as its entry (``[[D_0, D_1], None]``). The
+            priors are each emulator's own (theta, lamOs, lamVz, betaV's: set per model with
+            ``Emulator.with_calibration_priors``; the emulator's are its fit's, held).
         fixed: parameters held at known values, as ``gpmsa.calibrate``'s ``fixed=`` (theta
             elements by t_name or position, native units; lamOs; with a discrepancy betaV and
             lamVz, whole or by element): one dict for every model, or a list with one entry
@@ -487,7 +519,7 @@ def calibrate_study(
     metadata = check_metadata(metadata)
     tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
     extrapolate = check_flag(extrapolate, "extrapolate")
-    bases = _per_model_discrepancy(discrepancy, discrepancy_groups, n)
+    bases = _per_model_discrepancy(discrepancy, discrepancy_groups, labels)
     fixes = _per_model_fixed(fixed, n)
     held = [_per_model(lab, calibration_fixed, e, f, b)
             for lab, e, f, (b, _) in zip(labels, emulators, fixes, bases, strict=True)]  # fmt: skip
@@ -597,6 +629,19 @@ def _record_fixed(settings: dict, labels, problems, layout, fixes, natives,
         settings[HELD_THETA] = theta
 
 
+def _check_priors(priors, q: int) -> None:
+    """GPMSAError naming ``priors`` where a model's (with ``q`` calibration parameters) is not
+    a ``gpmsa.Priors`` (or None), or gives per-element theta priors for another q."""
+    if priors is None:
+        return
+    if not isinstance(priors, Priors):
+        raise GPMSAError(f"priors must be a gpmsa.Priors or None, got {priors!r:.80}")
+    try:
+        priors.theta_moments(q)
+    except GPMSAError as exc:
+        raise GPMSAError(f"priors: {exc}") from None
+
+
 def _per_model(label: str, make, *args, **kwargs):
     """``make(*args, **kwargs)`` for the model ``label``; its GPMSAError and its warnings name
     that model (so that two models' alike warnings both show, and say which)."""
@@ -631,7 +676,8 @@ def fit_study(
     n_iter: int = 30_000, n_burn: int | None = None, n_keep: int | None = None,
     point: str = "mean",
     tune: bool | None = None, seed=None, n_chains: int = 1, init: str | Study = "auto",
-    priors: Priors | None = None, n_pc: int | float | None = None, basis=None, discrepancy=None,
+    priors: Priors | Sequence | dict | None = None,
+    n_pc: int | float | Sequence | dict | None = None, basis=None, discrepancy=None,
     discrepancy_groups=None, tune_rounds: int = tuning.N_BURN, tune_levels: int = tuning.N_LEVELS,
     progress: bool = False, n_jobs: int | None = None, executor=None,
     metadata: dict | None = None, fixed=None, append: bool = False, temperatures=None,
@@ -645,10 +691,8 @@ def fit_study(
     Args:
         sims, obs: per model, its ``gpmsa.SimData`` and ``gpmsa.ObsData``.
         labels, shared, hierarchical, hyper: as ``calibrate_study``.
-        n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, priors, n_pc, discrepancy,
-            discrepancy_groups, tune_rounds, tune_levels, progress, n_jobs, executor: as
-            ``gpmsa.fit`` (priors, n_pc, discrepancy and its groups: the same for every model,
-            so not a list of per-experiment bases); the seed
+        n_iter, n_burn, n_keep, point, tune, seed, n_chains, init, tune_rounds, tune_levels,
+            progress, n_jobs, executor: as ``gpmsa.fit``; the seed
             the study ran with is ``study.settings["seed"]`` and each model's
             ``settings["seed"]``. n_burn None: n_iter // 5 (0 for a continuation); tune None:
             True (for a continuation: False where the study records its chains' widths);
@@ -662,6 +706,19 @@ def fit_study(
             ``settings["thin"]``, as ``gpmsa.fit``'s ``append``); each member's settings
             record its own source member (``gpmsa.fit``'s appended settings). Also refused: an
             n_keep other than the n_chains x (n_iter // thin) draws that step keeps.
+        priors, n_pc, discrepancy, discrepancy_groups: as ``gpmsa.fit``'s, each one value for
+            every model, or per model (SEPIA builds each model with its own): a list or tuple
+            with one entry per model (in the order of ``sims``) or a dict label -> entry naming
+            every model once. A per-model ``priors`` entry (None: ``gpmsa.Priors()``) may give
+            per-element theta priors for its own q (in its t_names' order); a shared parameter's
+            prior must agree between its models (by name, wherever it sits in each model's
+            theta). ``discrepancy`` and its groups are read as ``calibrate_study``'s (a list is
+            the per-model list; a model's per-experiment bases are its entry). One ``n_pc`` sizes
+            the PCA of the models without a ``basis``; a per-model one is each model's (None
+            with a basis). Each member records its own (its ``priors``, settings "n_pc",
+            "discrepancy"); a continuation (``init``) with other ones is refused naming the
+            model. GPMSAError names the argument (and the model): a wrong number of entries, an
+            unknown or missing label, an entry of another type or for another q.
         basis: as ``gpmsa.fit``'s, a numpy array for every model or a list with one entry
             (None: the model's PCA, as ``n_pc`` says) per model.
         metadata: a JSON-able dict saved with the study.
@@ -721,18 +778,20 @@ def fit_study(
     metadata = check_metadata(metadata)
     tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
     labels = check_labels(labels, n)
-    if is_basis_list(discrepancy):
-        raise GPMSAError(
-            "fit_study takes one discrepancy for every model (None, 'constant', 'linear' or an "
-            "array); per-experiment bases (a list) are taken by gpmsa.fit, gpmsa.calibrate and "
-            "gpmsa.calibrate_study (one list per model)"
-        )
     bases = _per_model_basis(basis, n)
     fixes = _per_model_fixed(fixed, n)
-    pcs = [n_pc if k is None or all(b is not None for b in bases) else None for k in bases]
-    preps = [_per_model(lab, prepare, s, o, priors=priors, n_pc=pc, discrepancy=discrepancy,
-                        discrepancy_groups=discrepancy_groups, basis=k)
-             for lab, s, o, k, pc in zip(labels, sims, obs, bases, pcs, strict=True)]  # fmt: skip
+    per_pc = isinstance(n_pc, (list, tuple, dict))
+    pcs = _per_model_value(n_pc, labels, "n_pc", not per_pc)
+    if not per_pc:  # one n_pc: the PCA's of the models without a basis
+        pcs = [n_pc if k is None or all(b is not None for b in bases) else None for k in bases]
+    pris = _per_model_value(priors, labels, "priors", not isinstance(priors, (list, tuple, dict)))
+    discs = _per_model_discrepancy(discrepancy, discrepancy_groups, labels)
+    for lab, pri, s in zip(labels, pris, sims, strict=True):  # before the models' PCA
+        _per_model(lab, _check_priors, pri, len(s.t_names))
+    preps = [_per_model(lab, prepare, s, o, priors=pri, n_pc=pc, discrepancy=d,
+                        discrepancy_groups=g, basis=k)
+             for lab, s, o, k, pc, pri, (d, g) in zip(labels, sims, obs, bases, pcs, pris, discs,
+                                                      strict=True)]  # fmt: skip
     layout = build_layout(
         labels, [tuple(s.t_names) for s in sims],
         [(p.standardizer.t_min, p.standardizer.t_max) for p in preps],
@@ -788,7 +847,6 @@ def fit_study(
                                                renamed))  # fmt: skip
     lp = draws["log_post"].reshape(-1)
     members = []
-    fitted_discrepancy = discrepancy_kind(discrepancy)
     for i, (sim, prep) in enumerate(zip(sims, preps, strict=True)):
         post = {k: v[:, keep] for k, v in chains.members[i].items()}
         if append:
@@ -808,13 +866,13 @@ def fit_study(
                         "n_chains": int(n_chains), "tune": bool(tune), "backend": "numpy",
                         "seed": seed, "point": point, "n_pc": int(prep.K.shape[1]),
                         "basis": "pca" if bases[i] is None else "given",
-                        "joint_obs": True, "discrepancy": fitted_discrepancy,
+                        "joint_obs": True, "discrepancy": discrepancy_kind(discs[i][0]),
                         "obs_lengths": [int(e.size) for e in obs[i].experiments],
                         "obs_sha256": obs[i].digest(),
                         "study": {"label": labels[i], "shared": list(layout.shared),
                                   "hierarchical": list(layout.groups)},  # as read, once
                         "versions": settings["versions"]}  # fmt: skip
-        if discrepancy is not None:  # full_prediction refuses another basis
+        if discs[i][0] is not None:  # full_prediction refuses another basis
             emu_settings.update(discrepancy_record(prep.problem.obs))
         if fixes[i] is not None:  # as gpmsa.fit records it (continuations compare it)
             emu_settings["fixed"] = fixed_record(problems[i])
@@ -837,7 +895,7 @@ def fit_study(
         members.append(Emulator._from_prepared(
             sim, prep, params, draws={k: flat[k] for k in EMULATOR_PARAMS}, log_post=lp,
             settings=emu_settings, diagnostics=summary, calibration=cal,
-            convergence=records[0],
+            convergence=records[0], discrepancy_bases=kept_bases(prep.problem.obs, discs[i][0]),
         ))  # fmt: skip
         # its emulator's (and discrepancy's) elements
         warn_unconverged(records[1], f"gpmsa.fit_study (model {labels[i]!r})")
