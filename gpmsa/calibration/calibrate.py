@@ -246,7 +246,8 @@ def calibrate(
             observation of the one experiment.
         y_obs: (n, l_sim) observed outputs, native units (a scalar output also takes (n,)).
             A pandas DataFrame (or Series) is read by name, the emulator's x_names / y_names
-            in any order, never by position; a numpy masked array is refused.
+            in any order, never by position (but a y_obs frame with the default labels 0, 1,
+            ...: no names, by position, as ObsData reads it); a numpy masked array is refused.
             Or pass one ``gpmsa.ObsData`` as x_obs (y_obs None), as ``gpmsa.fit(data, obs)``
             takes it: each experiment then lies on its own ``index`` within the simulation
             grid (the basis is interpolated there, as SEPIA's y_ind_obs) and may carry its

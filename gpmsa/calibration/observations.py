@@ -29,6 +29,8 @@ from gpmsa.model.data import (
     by_column_names,
     check_finite,
     check_parameter_names,
+    column_labels,
+    default_labels,
     evenly_spaced,
     values_digest,
 )
@@ -249,11 +251,13 @@ def _y_names(emulator) -> tuple[str, ...] | None:
 def check_y(emulator, y_obs) -> np.ndarray:
     """y_obs as a float array with its columns in the order of the emulator's ``y_names``: a
     table with named columns by name (`by_column_names`: other names are a GPMSAError), a pandas
-    Series by its labels (`series_by_names`), an array as it is (by position). A numpy masked
-    array is refused (`as_float`); so is a list of experiments of different lengths
-    (`refuse_ragged`)."""
+    Series by its labels (`series_by_names`), an array as it is (by position), as is a table
+    with a frame's default labels 0, 1, ... (`default_labels`, as `ObsData` reads its y). A
+    numpy masked array is refused (`as_float`); so is a list of experiments of different
+    lengths (`refuse_ragged`)."""
     refuse_ragged(y_obs)
-    return as_float(by_column_names(y_obs, _y_names(emulator), "y_obs"), "y_obs")
+    names = None if default_labels(column_labels(y_obs)) else _y_names(emulator)
+    return as_float(by_column_names(y_obs, names, "y_obs"), "y_obs")
 
 
 def refuse_ragged(y_obs) -> None:

@@ -112,6 +112,12 @@ def column_labels(value) -> tuple[str, ...] | None:
     return tuple(str(c) for c in columns)
 
 
+def default_labels(labels) -> bool:
+    """Whether table column ``labels`` (`column_labels`) are a frame's default labels '0', '1',
+    ... in order: no names, so the columns are read by position, as an array's."""
+    return labels is not None and tuple(labels) == tuple(str(k) for k in range(len(labels)))
+
+
 def column_order(labels, names, name: str) -> list[int]:
     """The positions of ``names`` among a table's column ``labels``; GPMSAError naming ``name``
     when the labels are not ``names`` (in some order)."""
@@ -586,6 +592,21 @@ def _range_table(value, names: tuple[str, ...], attr: str):
     return value
 
 
+def _sepia_layout(rows: list, arr: np.ndarray) -> bool:
+    """Whether ``rows``, a square (2, 2) range matrix's (min, max) rows (`_ranges`), fail for the
+    design ``arr`` (m, 2) while their transpose (SEPIA's layout: a row of mins, a row of maxs)
+    holds it, each column within finite min < max."""
+    if len(rows) != 2 or any(not isinstance(r, np.ndarray) or r.shape != (2,) for r in rows):
+        return False
+    mat = np.array(rows)
+    lo, hi = arr.min(axis=0), arr.max(axis=0)
+
+    def holds(m: np.ndarray) -> bool:
+        return bool(np.all(np.isfinite(m)) and np.all(m[:, 0] <= lo) and np.all(hi <= m[:, 1]))
+
+    return not holds(mat) and holds(mat.T) and bool(np.all(mat.T[:, 0] < mat.T[:, 1]))
+
+
 def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...], attr: str):
     """``SimData``'s ``x_range`` / ``t_range`` as one (min, max) or None per column of ``arr``
     (None where no column is given); GPMSAError naming the column for a range that is not two
@@ -595,6 +616,7 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
         return None
     d = arr.shape[1]
     value = _range_table(value, names, attr)
+    sepia = False  # a square (2, 2) matrix may be SEPIA's layout, which its shape cannot tell
     if isinstance(value, dict):
         rows = [None] * d
         for name, pair in value.items():
@@ -614,6 +636,8 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
                 f"(min, max); got shape {mat.shape}{hint.format(d=d)}"
             )
         rows = list(mat)
+        sepia = _sepia_layout(rows, arr)  # named where its transpose would hold the design
+    hint = " (SEPIA's (2, 2) layout, mins then maxs? transpose it)" if sepia else ""
     out = []
     for j, pair in enumerate(rows):
         if pair is None:
@@ -628,7 +652,9 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
             width = hi - lo
         tiny = np.finfo(float).tiny * max(1.0, abs(lo), abs(hi))
         if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
-            raise GPMSAError(f"{label} = ({lo!r}, {hi!r}) must be finite numbers with min < max")
+            raise GPMSAError(
+                f"{label} = ({lo!r}, {hi!r}) must be finite numbers with min < max{hint}"
+            )
         if not (np.isfinite(width) and width > tiny):
             raise GPMSAError(f"{label} = ({lo!r}, {hi!r}): the width {width!r} is not a finite, "
                              "normal number; rescale the column")  # fmt: skip
@@ -640,7 +666,7 @@ def _ranges(value, arr: np.ndarray, names: tuple[str, ...], cats: tuple[int, ...
         if col_lo < lo or col_hi > hi:
             raise GPMSAError(
                 f"design column {names[j]} spans [{a}, {b}], outside its {attr} [{c}, {d}]: the "
-                "range must hold every run"
+                f"range must hold every run{hint}"
             )
         if (col_hi - col_lo) < RANGE_COVER_MIN * width:
             warnings.warn(
@@ -986,7 +1012,7 @@ class ObsData:
         labels = self.y_columns
         if labels is None or y_names is None:
             return None
-        if labels == tuple(str(k) for k in range(len(labels))):  # a frame's default labels
+        if default_labels(labels):
             return None
         names = [str(n) for n in y_names]
         if any(g is not None for g in self.grids):
