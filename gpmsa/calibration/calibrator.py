@@ -120,15 +120,15 @@ cheap prior, and a prior's cost per point grows with the level)."""
 def _check_mcmc_options(options, backend: str) -> dict:
     """``options`` (None or a dict of ``gpmsa.calibrate`` keywords, backend ``backend``'s
     sampler options among them, as ``calibrate`` passes them on) as a dict; GPMSAError naming
-    what is not a keyword the Calibrator may pass on (it gives the data, ``extrapolate`` and
-    the prior itself)."""
+    what is not a keyword the Calibrator may pass on (it gives the data, ``extrapolate``, the
+    prior and calibrate's private ``_online`` itself)."""
     from gpmsa.calibration.calibrate import calibrate  # calibrate imports this module
 
     if options is None:
         return {}
     if not isinstance(options, dict):
         raise GPMSAError(f"mcmc_options must be None or a dict, got {type(options).__name__}")
-    own = {"emulator", "x_obs", "y_obs", "extrapolate", "log_prior"}
+    own = {"emulator", "x_obs", "y_obs", "extrapolate", "log_prior", "_online"}
     named = {k for k, v in inspect.signature(calibrate).parameters.items()
              if v.kind is not inspect.Parameter.VAR_KEYWORD}  # fmt: skip
     sampler = set(inspect.signature(backends.get(backend).sample).parameters) - {"problem"}

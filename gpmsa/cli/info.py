@@ -282,7 +282,7 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
             )
         else:
             lines.append(f"diagnostics {safe(name, 60)}: {value(d)}")
-    lines.append(_convergence_line(manifest.get("convergence")))
+    lines.append(_convergence_line(manifest.get("convergence"), s.get("source")))
     n_arr = sum(int(a.size) for a in arrays.values())
     lines.append(f"arrays:          {len(arrays)} ({n_arr} values)")
     return lines
@@ -459,10 +459,13 @@ def _figure(val: object, limit: object, places: int, none: str, above: bool) -> 
     return number(val, f".{places}f")
 
 
-def _convergence_line(rec: object) -> str:
+def _convergence_line(rec: object, source: object = None) -> str:
     """One line on the chains' convergence (older files, and those of one chain from before
-    one chain was judged, have no record; one chain's R-hat is its split R-hat)."""
+    one chain was judged, have no record, nor ``from_params``'s (``source``: the settings'),
+    which sampled nothing; one chain's R-hat is its split R-hat)."""
     if not rec:
+        if source == "from_params":
+            return "convergence:     not checked (from_params: no chains were run)"
         return "convergence:     not checked (a file from before the check)"
     if not isinstance(rec, dict):
         return f"convergence:     {value(rec)}"

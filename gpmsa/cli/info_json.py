@@ -32,7 +32,7 @@ def _head(file: str, manifest: dict, kind: str) -> dict:
 
 
 def _converged(record: object) -> bool | None:
-    """The convergence record's verdict; None where none was made (one chain, older files)."""
+    """The convergence record's verdict; None where none was made (from_params, older files)."""
     if not isinstance(record, dict) or not record:
         return None
     flagged = record.get("flagged")

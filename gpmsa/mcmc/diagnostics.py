@@ -226,11 +226,16 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str =
         )
     if any(str(why).startswith("constant draws") for why in flagged.values()):
         apart += (
+            " Constant draws in the chain: a categorical theta's chain that never leaves the "
+            "level it started at reads so too, whether the posterior holds one level or the "
+            "chain is stuck (run chains started at other levels, or let parallel tempering's "
+            "temperatures= move between them: docs/models.md)."
+            if one else
             " Constant draws in every chain: a categorical theta's chains that never leave the "
             "levels they started at read so too, whether the posterior holds one level or the "
             "chains are stuck (start chains at other levels, or let parallel tempering's "
             "temperatures= move between them: docs/models.md)."
-        )
+        )  # fmt: skip
     chains, advice = f"{record['n_chains']} chains", f"Run longer chains ({length}) or more of them"
     if one:  # split R-hat: the chain's halves, not independent chains (PyMC's, Stan's practice)
         chains = "1 chain"

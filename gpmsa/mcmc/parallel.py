@@ -40,6 +40,7 @@ from concurrent.futures import (
     ProcessPoolExecutor,
     wait,
 )
+from numbers import Number
 
 import numpy as np
 
@@ -207,26 +208,28 @@ def _check_workers(client, module: str, restrictions: dict, timeout_s: float) ->
 def _task_workers(infos: dict[str, dict], restrictions: dict) -> list[str]:
     """The addresses of the workers (``infos``: the scheduler's, by address) that may run a task
     submitted with ``restrictions`` (``workers``, ``resources``, ``allow_other_workers``, as
-    ``Client.submit`` takes them), read as dask's scheduler reads them: an entry of ``workers``
-    is a worker's name or address, else a host; a worker has each resource asked, as much."""
+    ``Client.submit`` takes them), read as dask's scheduler reads them: ``workers`` one name,
+    address or host (a string or a number), or a list, set or tuple of them, each a worker's
+    name or address (a (host, port) tuple too), else a host; a worker has each resource asked,
+    as much."""
     if restrictions.get("allow_other_workers"):  # any worker, where none of those fits
         return list(infos)
     out = list(infos)
     named = restrictions.get("workers")
     if named is not None:
-        from distributed.comm.addressing import resolve_address
+        from distributed.comm.addressing import resolve_address, unparse_host_port
 
         names = {info.get("name"): addr for addr, info in infos.items()}
         addresses, hosts = set(), set()
-        for entry in [named] if isinstance(named, str | tuple) else named:
+        for entry in [named] if isinstance(named, str | Number) else named:  # Client.submit's
             if isinstance(entry, tuple):
-                entry = f"{entry[0]}:{entry[1]}"
+                entry = unparse_host_port(*entry)
             if entry in names:
                 addresses.add(names[entry])
                 continue
             try:
                 addresses.add(resolve_address(entry))
-            except ValueError:  # no port: a host
+            except (ValueError, TypeError):  # no port: a host (a number: no worker)
                 hosts.add(entry)
         out = [a for a in out if a in addresses or infos[a].get("host") in hosts]
     needs = restrictions.get("resources") or {}
