@@ -446,7 +446,12 @@ def calibrate(
         info["diagnostics"] = summarize(chains)
         shapes = {k: v.shape[2:] for k, v in chains.items()}
         info["convergence"] = convergence(
-            info["diagnostics"], shapes, n_chains, n_samples - n_burn, held=set(held_names)
+            info["diagnostics"],
+            shapes,
+            n_chains,
+            n_samples - n_burn,
+            held=set(held_names),
+            levels=set(codes),
         )
         warn_unconverged(
             info["convergence"], f"gpmsa.calibrate (backend {backend!r})", length="n_samples"

@@ -466,7 +466,8 @@ def sampled_convergence(
     elements (``fixed=``) excepted, over ``n_chains`` chains of ``per`` draws each."""
     shapes = {k: problem.init[k].shape for k in problem.sampled if k not in skip}
     held = {per_element.label(k, i) for k, v in problem.fixed_elements.items() for i in v}
-    return convergence(summary, shapes, n_chains, per, held=held)
+    levels = {f"theta[{k}]" for k, lv in enumerate(problem.theta_levels or ()) if lv is not None}
+    return convergence(summary, shapes, n_chains, per, held=held, levels=levels)
 
 
 def thinning(n_chains: int, kept: int, n_keep: int) -> int:

@@ -136,11 +136,16 @@ def convergence(
     n_chains: int,
     n_draws: int,
     held: frozenset[str] | set[str] = frozenset(),
+    levels: frozenset[str] | set[str] = frozenset(),
 ) -> dict:
     """The convergence record of sampled parameters from ``summarize`` output (JSON-able).
 
     ``shapes``: name -> element shape of every sampled parameter to judge; ``held``: names of
-    elements held fixed within them ("lamVz[1]"), not judged. Returns n_chains,
+    elements held fixed within them ("lamVz[1]"), not judged; ``levels``: names of categorical
+    elements (a level each draw), whose constant draws in one chain are not flagged: the
+    posterior may hold one level, and one chain cannot tell that from a stuck chain (several
+    chains at one level are flagged, as chains that may not have left their starts). Returns
+    n_chains,
     n_draws (per chain), the limits, per parameter ``rhat`` and ``ess`` (bulk) lists (C order),
     the worst element of each kind (``max_rhat``, ``min_ess``: [element, value]; the value None
     where it is not finite, an infinite R-hat of chains stuck at different values; the element
@@ -163,7 +168,10 @@ def convergence(
                 flagged[el] = f"too few draws to judge ({n_draws} a chain)"
                 continue
             if not (np.isfinite(r) or np.isfinite(e)):
-                flagged[el] = "constant draws (no proposal accepted)"
+                if el not in levels:
+                    flagged[el] = "constant draws (no proposal accepted)"
+                elif n_chains > 1:
+                    flagged[el] = "constant draws (one level in every chain)"
                 continue
             why = []
             if r > RHAT_MAX:

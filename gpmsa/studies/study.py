@@ -255,7 +255,8 @@ class Study:
             info["levels"] = levels
         shapes = {k: () for k in chains}  # one chain too: its split R-hat (as gpmsa.fit's)
         held = held_names(self.settings)  # fitted with fixed=: not judged
-        self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held)
+        self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held,
+                                       levels=set(levels))  # fmt: skip
         info["convergence"] = self.convergence
         self.posterior = Posterior(samples, chains=chains, info=info)
 
