@@ -480,8 +480,9 @@ def static_level_marks(
     samples, finite and contiguous (steps within [0.5, ``GAP_PERIODS``] periods; one stamped
     backwards is left out, as the BCR's long span leaves it: `static_span_level`), have one
     off it by more than ``static_span_tolerance``. ``kept``: (n,) bool, False for a sample the
-    BCR drops for its other values (no position or speed: an odometry gap), which breaks the
-    block and the span as a non-finite ``a`` does (None: every sample has them)."""
+    BCR drops for its other values (no position or speed: an odometry gap; a speed beyond
+    ``MAX_SPEED_MPS``), which breaks the block and the span as a non-finite ``a`` does (None:
+    every sample has them)."""
     a = np.asarray(a, dtype=float)
     finite = np.isfinite(a) if kept is None else np.isfinite(a) & kept
     count = np.concatenate([[0], np.cumsum(finite)])

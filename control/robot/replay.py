@@ -74,7 +74,7 @@ from control.robot.bags import (
     recording_path,
     source_of,
 )
-from control.sensor_checks import SensorLimits, flight_reading
+from control.sensor_checks import MAX_SPEED_MPS, SensorLimits, flight_reading
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
 from control.validation import (
@@ -909,8 +909,8 @@ def _condition(
     t, a = t[first:last], a[first:last]
     pos, spd = condition.odometry_at(t, to, along, speed, s.max_odometry_gap_s)
     marks: dict[int, str] = {}
-    if raw_check is not None:  # (samples in an odometry gap: the BCR drops them, as non-finite)
-        kept = np.isfinite(pos) & np.isfinite(spd)
+    if raw_check is not None:  # (samples the BCR drops for their odometry: as non-finite)
+        kept = _bcr_kept(pos, spd)
         marks = condition.static_level_marks(raw[first:last], *raw_check, t, rate_hz, kept)
         a[list(marks)] = np.nan
         if marks:
@@ -931,6 +931,14 @@ def _condition(
             "not overlap in time"
         )
     return t, a, pos, spd, reports, resampling, notes, t0, restamping, marks
+
+
+def _bcr_kept(pos: np.ndarray, spd: np.ndarray) -> np.ndarray:
+    """(n,) bool: False for a sample that the BCR drops for its odometry (`stream_breaks`): no
+    position or speed (an odometry gap), or a speed beyond ``MAX_SPEED_MPS`` (a wild odometry
+    velocity, interpolated)."""
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(pos) & np.isfinite(spd) & (np.abs(spd) <= MAX_SPEED_MPS)
 
 
 def _other_clock(rec: Recording, accel: np.ndarray, limit_s: float) -> tuple[np.ndarray, str]:

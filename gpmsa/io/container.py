@@ -410,9 +410,12 @@ def _check_members(zf: zipfile.ZipFile, path) -> dict[str, zipfile.ZipInfo]:
     if len(infos) > limits.MAX_MEMBERS:
         raise _fail(path, f"{len(infos)} members (limit {limits.MAX_MEMBERS})")
     if all(info.filename != MANIFEST for info in infos):  # before its members' names are judged
-        first = f"; its first member {infos[0].filename[:60]!r}" if infos else ""
-        raise _fail(path, f"not a gpmsa emulator file (a zip without {MANIFEST}{first}: a numpy "
-                          ".npz such as a vehicle campaign file?)")  # fmt: skip
+        if not infos:
+            raise _fail(path, f"not a gpmsa emulator file (an empty zip: no {MANIFEST})")
+        first = infos[0].filename
+        npz = ": a numpy .npz such as a vehicle campaign file?" if first.endswith(".npy") else ""
+        raise _fail(path, f"not a gpmsa emulator file (a zip without {MANIFEST}; its first "
+                          f"member {first[:60]!r}{npz})")  # fmt: skip
     members: dict[str, zipfile.ZipInfo] = {}
     total = 0
     for info in infos:
