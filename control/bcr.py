@@ -100,6 +100,7 @@ from control.validation import (
     within,
 )
 from gpmsa import Posterior
+from gpmsa.errors import numbers_text
 
 METHODS = ("changepoint", "window", "filter", "tempered")
 INTERVAL_KINDS = ("hdi", "central")
@@ -730,11 +731,15 @@ class BCR:
             self._clock_back = 0.0  # the clocks agree (again)
             return est
         t_now, pos_now = self._now()
-        limit = f"max_silence_s = {self.settings.max_silence_s:g}"
-        reason = f"no samples for {silence:.2f} s ({limit})"
+        most = self.settings.max_silence_s
+        shown, most_text = f"{silence:.2f}", f"{most:g}"
+        if not float(shown) > most:  # reads as the limit: numbers_text's digits
+            shown, most_text = numbers_text(silence, most)
+        limit = f"max_silence_s = {most_text}"
+        reason = f"no samples for {shown} s ({limit})"
         if self._clock_back:  # samples come, on a clock that stepped back while now= did not
             reason = (
-                f"the newest sample is {silence:.2f} s behind the caller's clock (now=; {limit}): "
+                f"the newest sample is {shown} s behind the caller's clock (now=; {limit}): "
                 f"the sample clock stepped back {self._clock_back:.4g} s, now= did not (now= "
                 "must run on the samples' clock)"
             )
@@ -860,7 +865,8 @@ class BCR:
         lo, hi = self.speed_range
         why = ""
         if not within(v, lo, hi):
-            why = f"speed {v:.3g} m/s outside the emulator's [{lo:g}, {hi:g}]"
+            shown = numbers_text(v, lo, hi, digits=3)[0]  # (a speed just past hi: not as hi)
+            why = f"speed {shown} m/s outside the emulator's [{lo:g}, {hi:g}]"
         elif spd.min() < MAX_SPEED_CHANGE * spd.max():
             why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"
         if why:  # the emulator knows constant speeds in its range only
@@ -892,8 +898,8 @@ class BCR:
         if p < s.plausibility_p:
             why = (
                 f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the block at "
-                f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = {p:.2g} < "
-                f"{s.plausibility_p:g})"
+                f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = "
+                f"{numbers_text(p, s.plausibility_p, digits=2)[0]} < {s.plausibility_p:g})"
             )
             return self._hold(self._skip_block(
                 phase, ds, "implausible", why, speed=v, feature=y, plausibility_p=p))  # fmt: skip
@@ -941,10 +947,11 @@ class BCR:
         z = self._level_score(y, lo) / self._level_sd
         if not z >= limit:
             return "", ""
+        z_text, limit_text = numbers_text(z, limit, digits=3)
         why = (
             f"the speeds read standing (below {STANDING_MPS:g} m/s) but the accelerometer reads "
-            f"as driving at {lo:g} m/s or faster (level score {z:.3g} sd, a sensor at rest reads "
-            f"below {limit:.3g})"
+            f"as driving at {lo:g} m/s or faster (level score {z_text} sd, a sensor at rest reads "
+            f"below {limit_text})"
         )
         if self._t[0] - self._standing_from >= STANDING_SETTLE_S:
             return "sensor_fault", f"frozen odometry: {why}"
@@ -1001,8 +1008,9 @@ class BCR:
         lo, hi = self.gd_range
         return (
             f"the last {n} block(s) read quieter than any GD in [{lo:g}, {hi:g}] explains at "
-            f"{v:.3g} m/s: level score {z:.3g} sd (p = {p:.2g} < {self.settings.plausibility_p:g})"
-            f"; a sensor gain or noise below the emulator's, or ground smoother than it knows",
+            f"{v:.3g} m/s: level score {z:.3g} sd (p = {numbers_text(p, limit, digits=2)[0]} < "
+            f"{limit:g}); a sensor gain or noise below the emulator's, or ground smoother than it "
+            "knows",
             p,
         )
 
@@ -1043,9 +1051,10 @@ class BCR:
             if len(scores) == len(self._phases):
                 self._held_by = None
             return None
+        release = self.settings.release_p
         reason = (
             f"{since}: the blocks read since then still read quiet on a phase (level score "
-            f"{z:.3g} sd, p = {p:.2g} < release_p {self.settings.release_p:g})"
+            f"{z:.3g} sd, p = {numbers_text(p, release, digits=2)[0]} < release_p {release:g})"
         )
         return self._no_estimate("implausible", reason, speed=v, feature=y, plausibility_p=p)
 
@@ -1165,7 +1174,8 @@ class BCR:
         lo, hi = self.speed_range
         unit = float(self.model.emulator.standardizer.x_to_unit([[v]])[0, 0])
         if not 0.0 <= unit <= 1.0:  # the emulator's own rule (snaps rounding at the ends)
-            why = f"window speed {v:.3g} m/s outside the emulator's range [{lo:g}, {hi:g}] m/s"
+            shown = numbers_text(v, lo, hi, digits=3)[0]  # (a speed just past hi: not as hi)
+            why = f"window speed {shown} m/s outside the emulator's range [{lo:g}, {hi:g}] m/s"
             if self.last.ok:
                 note = self._edge_sentence(self.last.domain_edge)
                 reason = "; ".join(filter(None, ("no new information: " + why, note)))
@@ -1228,10 +1238,11 @@ class BCR:
         p = float(chi2.sf(z2, 1))
         if p >= self.settings.plausibility_p:
             return "", p
+        limit = self.settings.plausibility_p
         return (
             f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the window at "
             f"{v:.3g} m/s: y is {np.sqrt(z2):.3g} predictive sds from the nearest "
-            f"(p = {p:.2g} < {self.settings.plausibility_p:g})"
+            f"(p = {numbers_text(p, limit, digits=2)[0]} < {limit:g})"
         ), p
 
     def _check_age(self, est: Estimate) -> Estimate:
@@ -1239,11 +1250,15 @@ class BCR:
         t_now, pos_now = self._now()
         age = t_now - est.data_time
         if est.ok and age > self.settings.max_age_s:
+            limit = self.settings.max_age_s
+            shown, limit_text = f"{age:.2f}", f"{limit:g}"
+            if not float(shown) > limit:  # reads as the limit: numbers_text's digits
+                shown, limit_text = numbers_text(age, limit)
             return Estimate(
                 t_now,
                 pos_now,
                 "stale",
-                f"newest information is {age:.2f} s old (max_age_s = {self.settings.max_age_s:g})",
+                f"newest information is {shown} s old (max_age_s = {limit_text})",
                 data_time=est.data_time,
             )
         return est

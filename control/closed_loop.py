@@ -29,6 +29,7 @@ from control.robot.storage import check_mcap_target
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_instance, is_real, path_argument
+from gpmsa.errors import numbers_text
 
 EXACT_CLOCK_SILENCE = 0.5
 """The simulated sensor's clock is exact, so any sample missing at an update is silence: the
@@ -295,8 +296,9 @@ def run_closed_loop(
         check_emulator(emulator, model=model)
     top = float(model.max_speed_mps)
     if simplex.v_max > top * (1 + 1e-12):
+        v_max, top_text = numbers_text(simplex.v_max, top)
         raise ControlError(
-            f"Simplex v_max = {simplex.v_max:g} m/s exceeds the vehicle's top speed {top:g} m/s"
+            f"Simplex v_max = {v_max} m/s exceeds the vehicle's top speed {top_text} m/s"
         )
     bcr = simulated_sensor_settings(bcr_settings_for(emulator) if bcr is None else bcr, noise_std)
     if check:

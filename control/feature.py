@@ -32,6 +32,7 @@ from control.validation import (
     require_integers,
     require_reals,
 )
+from gpmsa.errors import numbers_text
 
 FEATURES = ("log_band_power", "log_var", "var")
 SCALAR_FEATURES = ("log_var", "var")
@@ -108,8 +109,9 @@ class FeatureSpec:
             if edges.size < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
                 raise ControlError(f"bands_hz must be >= 2 increasing edges >= 0, got {edges}")
             if edges[-1] > nyquist + 1e-9:
+                top, nyquist_text = numbers_text(edges[-1], nyquist)
                 raise ControlError(
-                    f"bands_hz reach {edges[-1]:g} Hz, above the Nyquist frequency {nyquist:g} Hz"
+                    f"bands_hz reach {top} Hz, above the Nyquist frequency {nyquist_text} Hz"
                 )
             counts = _band_matrix(self.block_samples, float(self.rate_hz), self.bands_hz).sum(0)
             for lo, hi, count in zip(edges[:-1], edges[1:], counts, strict=True):

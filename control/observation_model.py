@@ -29,6 +29,7 @@ from scipy.linalg.lapack import dpotrf
 from control.errors import ControlError, EmulatorMismatchError
 from control.feature import FeatureSpec
 from control.validation import float_array, is_integer, is_real, require_reals, within
+from gpmsa.errors import numbers_text
 
 MAX_TABLE_NODES = 1_000_000
 """Most (speed, GD) nodes of an ObservationModel's mean table (the default has 3,751)."""
@@ -175,7 +176,8 @@ class ObservationModel:
         """(mean (G, K), lower Cholesky factor of Sigma (K, K)) at speed v (linear in v)."""
         lo, hi = self.speed_range
         if not within(v, lo, hi):
-            raise ControlError(f"speed {v:.10g} m/s outside the emulator's range [{lo:g}, {hi:g}]")
+            shown = numbers_text(v, lo, hi, digits=10)[0]  # (a narrow range: 1e-9 of its width)
+            raise ControlError(f"speed {shown} m/s outside the emulator's range [{lo:g}, {hi:g}]")
         x = _clip((v - lo) / (hi - lo) * (self.speed.size - 1), 0.0, self.speed.size - 1.0)
         i = min(int(x), self.speed.size - 2)
         a = x - i

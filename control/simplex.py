@@ -58,6 +58,7 @@ import numpy as np
 from control.errors import ControlError
 from control.estimate import FAULT_STATUSES, Estimate
 from control.validation import check_instance, is_choice, is_real, require_reals
+from gpmsa.errors import numbers_text
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
@@ -196,7 +197,8 @@ class Simplex:
                 self.v_safe, "safety", gd, "the road reads at or above the emulator's roughest GD"
             )
         if gd > self.gd_max:
-            return Command(self.v_safe, "safety", gd, f"GD {gd:.4g} > GD_max {self.gd_max:g}")
+            shown = numbers_text(gd, self.gd_max, digits=4)[0]  # (just past: not as GD_max)
+            return Command(self.v_safe, "safety", gd, f"GD {shown} > GD_max {self.gd_max:g}")
         return Command(self.on_speed_grid(self.performance_speed(gd)), "performance", gd)
 
     def on_speed_grid(self, speed: float) -> float:

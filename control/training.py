@@ -25,6 +25,7 @@ from control.feature import FeatureSpec, block_features
 from control.observation_model import BlockScatter
 from control.sensor_checks import MAX_ACCEL_MPS2
 from control.validation import check_instance, float_array, is_integer, is_real
+from gpmsa.errors import numbers_text
 
 
 @dataclass(frozen=True, eq=False)
@@ -73,7 +74,8 @@ def block_statistics(accel: np.ndarray, spec: FeatureSpec, batch: int = 8) -> Bl
     peak = float(np.max(np.abs(accel)))
     if peak > MAX_ACCEL_MPS2:  # its squares would overflow the band powers
         raise ControlError(
-            f"accel reaches {peak:.3g} m/s^2, beyond any accelerometer's range "
+            f"accel reaches {numbers_text(peak, MAX_ACCEL_MPS2, digits=3)[0]} m/s^2, beyond any "
+            "accelerometer's range "
             f"(MAX_ACCEL_MPS2 = {MAX_ACCEL_MPS2:g}; the BCR refuses such blocks as faults)"
         )
     n_blocks = accel.shape[1] // B
