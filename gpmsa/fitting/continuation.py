@@ -11,8 +11,9 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError, numbers_text
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator
+from gpmsa.fitting.validation import HOT_RECORD
 from gpmsa.mcmc import tempering
-from gpmsa.mcmc.sampler import check_step_widths
+from gpmsa.mcmc.sampler import check_hot_copies, check_step_widths
 from gpmsa.model.basis import reordered_basis
 from gpmsa.model.data import ObsData, check_flag
 from gpmsa.model.discrepancy import record as discrepancy_record
@@ -192,10 +193,11 @@ def continued_ladder(emulator: Emulator, options: dict, n_chains: int, given):
     """The ladder of ``fit(..., init=emulator)`` (a continuation; ``options`` its backend's,
     ``given`` their "temperatures" checked by ``tempering.ladder``): ``given`` where the option
     is there (None given: a continuation without tempering), else the source's where it was
-    tempered (`source_ladders`), set in ``options`` with its "swap_every" unless given. Every
-    copy of a chain then starts at the chain's last kept state and is tuned at its temperature
-    before any draw (``fit``: the record holds the T = 1 copy alone; a hot copy is auxiliary,
-    any start is valid once warmed up). Returns chain 0's ladder (K,), or None."""
+    tempered (`source_ladders`), set in ``options`` with its "swap_every" unless given. Where
+    the source records its hot copies (`resumes_copies`) each resumes where it stopped; else
+    every copy of a chain starts at the chain's last kept state and is tuned at its temperature
+    before any draw (``fit``; a hot copy is auxiliary, any start is valid once warmed up).
+    Returns chain 0's ladder (K,), or None."""
     if "temperatures" in options:
         return given
     ladders, every = source_ladders(emulator.settings or {}, n_chains)
@@ -205,6 +207,48 @@ def continued_ladder(emulator: Emulator, options: dict, n_chains: int, given):
         options["swap_every"] = every
     options["temperatures"] = ladders.tolist() if ladders.ndim == 1 else ladders
     return tuple(float(t) for t in np.atleast_2d(ladders)[0])
+
+
+def resumes_copies(emulator: Emulator, options: dict, n_chains: int) -> bool:
+    """Whether ``fit(..., init=emulator)`` (``options`` its backend's, the ladder set by
+    `continued_ladder`) resumes every hot copy where the source's stopped: the source records
+    them (``HOT_RECORD``) and the continuation runs at its ladder (each chain's), without
+    adapting it again."""
+    settings = emulator.settings or {}
+    if any(settings.get(k) is None for k in HOT_RECORD) or options.get("adapt_ladder"):
+        return False
+    ladders, _ = source_ladders(settings, n_chains)
+    mine = tempering.chain_ladders(options.get("temperatures"), n_chains)
+    if ladders is None or mine is None:
+        return False
+    theirs = np.atleast_2d(ladders)
+    return theirs.shape[1] == len(mine[0]) and np.array_equal(
+        np.broadcast_to(theirs, (n_chains, theirs.shape[1])), np.array(mine)
+    )
+
+
+def continued_copies(emulator: Emulator, problem: Problem, n_chains: int, ladders,
+                     order: list[int] | None = None) -> dict:  # fmt: skip
+    """The numpy sampler's ``hot_copies`` of a continuation resuming ``emulator``'s hot copies
+    (its settings ``HOT_RECORD``) at ``ladders`` (``options["temperatures"]``), per-component
+    parameters in this fit's order (``order``: ``component_order``). GPMSAError naming the
+    record where it does not fit this fit's chains, copies and parameters (a damaged file)."""
+    settings = emulator.settings or {}
+    record = {}
+    for part, key in zip(("starts", "widths"), HOT_RECORD, strict=True):
+        value = settings[key]
+        if isinstance(value, dict):
+            value = {k: _reordered_list(k, v, order) for k, v in value.items()}
+        record[part] = value
+    try:
+        check_hot_copies(record, problem, tempering.chain_ladders(ladders, n_chains), n_chains)
+    except GPMSAError as exc:
+        raise GPMSAError(
+            f"init=emulator: its recorded hot copies (settings['hot_states'], "
+            f"settings['hot_step_widths']) do not fit this fit ({exc}); pass tune=True (every "
+            "copy tuned from the chain's last state) or temperatures="
+        ) from None
+    return record
 
 
 def source_ladders(settings: dict, n_chains: int, source: str = "init=emulator"):

@@ -13,18 +13,21 @@ from gpmsa import backends
 from gpmsa._version import library_versions
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.continuation import (
+    HOT_RECORD,
     MH_BACKENDS,
     appended_record,
     appended_thin,
     check_append,
     check_same_scales,
     component_order,
+    continued_copies,
     continued_ladder,
     continued_starts,
     continued_steps,
     continued_widths,
     pool_accept,
     pool_draws,
+    resumes_copies,
 )
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
@@ -142,7 +145,7 @@ def fit(
     "appended_to" (the source's ``model_sha256``), "appended_after" (its draws per chain),
     "pooled_sweeps" and "sweeps_run" (per chain, after burn-in and in all). It refuses (naming
     the argument) n_burn > 0, tuning (numpy, torch), an n_keep other than the draws the step
-    keeps, and ``init`` not an emulator (a tempered continuation tunes its copies: see
+    keeps, and ``init`` not an emulator (a tempered continuation may tune its copies: see
     parallel tempering below). point: "mean" (posterior mean, default) or "map" (the
     draw of highest log posterior) for ``Emulator.params``. n_pc: basis size, or a variance
     fraction in (0, 1) (SEPIA's n_pc < 1; default 99.5%). basis: instead of the runs' PCA, a
@@ -200,16 +203,21 @@ def fit(
     backend (docs/internals.md, "Parallel tempering"). A continuation (``init`` an emulator) of a
     tempered fit runs on tempered, at its ladder (each chain's where they adapted theirs) and
     ``swap_every`` unless ``temperatures=`` is given (``temperatures=None`` given, or 1:
-    untempered); a plain fit's with ``temperatures=`` at that ladder. Every copy of a chain starts
-    at the chain's last kept state, from its recorded widths, and is tuned at its temperature (the
-    copies warming up, swapping) before any draw is kept; ``tune=False`` is refused there, and
-    ``append=True`` pools as a plain append (the warm-up between the parts). numpy and torch option
-    ``adapt_ladder=True`` (off by default; with ``temperatures``, at least 3, and ``tune``): each
-    chain adapts its ladder's temperatures between 1 and the hottest during tuning towards equal
-    swap rates, then freezes it before the widths' tuning and the draws (an exact MCMC; about
-    ``tune_rounds`` x ``tune_levels`` more sweeps per copy; torch: after the first stage's warm-up,
-    each chain from its own swaps); ``settings["adapted_temperatures"]`` (per chain) records it,
-    "temperatures" the ladder it started from.
+    untempered); a plain fit's with ``temperatures=`` at that ladder. A numpy tempered fit records
+    each hot copy's last state and widths (settings "hot_states", "hot_step_widths"), and its
+    numpy continuation at that ladder resumes every copy where it stopped, untuned (``tune``
+    None or False), the T = 1 copy at the chain's last kept draw: no warm-up. Otherwise (no such
+    record, another ladder, torch, ``tune=True``, ``step_widths=`` or ``adapt_ladder=True``)
+    every copy of a chain starts at the chain's last kept state, from its recorded widths, and
+    is tuned at its temperature (the copies warming up, swapping: ``tune_rounds`` x
+    ``tune_levels`` sweeps per copy) before any draw is kept; ``tune=False`` is refused there,
+    and ``append=True`` pools as a plain append (the warm-up between the parts). numpy and
+    torch option ``adapt_ladder=True`` (off by default; with ``temperatures``, at least 3, and
+    ``tune``): each chain adapts its ladder's temperatures between 1 and the hottest during
+    tuning towards equal swap rates, then freezes it before the widths' tuning and the draws (an
+    exact MCMC; about ``tune_rounds`` x ``tune_levels`` more sweeps per copy; torch: after the
+    first stage's warm-up, each chain from its own swaps); ``settings["adapted_temperatures"]``
+    (per chain) records it, "temperatures" the ladder it started from.
 
     A categorical theta of a joint fit moves levels jointly with the continuous theta
     (``gpmsa.mcmc.level_moves``): ``settings["level_offsets"]`` records, per categorical name,
@@ -249,13 +257,17 @@ def fit(
     temps = _check_tempering(options, backend)
     if continuing and backend in MH_BACKENDS:  # the source's ladder unless temperatures= given
         temps = continued_ladder(options["init"], options, int(n_chains), temps)
-    if continuing and temps is not None and tune is False:
+    resume = (continuing and backend == "numpy" and temps is not None and tune is not True
+              and step_widths is None
+              and resumes_copies(options["init"], options, int(n_chains)))  # fmt: skip
+    if continuing and temps is not None and tune is False and not resume:
         raise GPMSAError(
             "tune=False with a tempered continuation (temperatures=, or init=emulator a tempered "
-            "fit): the record holds the T = 1 copy's widths alone, so every copy is tuned at its "
-            "temperature (from those widths) while the copies warm up from the chain's last "
-            "state, before any draw is kept; leave tune out (or tune=True: from GPM/SA's "
-            "widths), or pass temperatures=None to continue without tempering"
+            "fit) that does not resume its hot copies (a numpy fit at the source's ladder, "
+            "whose record holds them, settings 'hot_states'): every copy is tuned at its "
+            "temperature (from the T = 1 copy's widths) while the copies warm up from the "
+            "chain's last state, before any draw is kept; leave tune out (or tune=True: from "
+            "GPM/SA's widths), or pass temperatures=None to continue without tempering"
         )
     if isinstance(data, SimData) and data.separable is not None and backend != "numpy":
         kronecker.refuse(f"backend={backend!r}")
@@ -285,8 +297,12 @@ def fit(
         order = component_order(resumed, problem)
         if step_widths is None and tune is not True and backend != "pyro":  # NUTS adapts
             step_widths = recorded = continued_widths(resumed, problem, int(n_chains), order)
+        if resume:  # every hot copy where it stopped, with its widths
+            options["hot_copies"] = continued_copies(resumed, problem, int(n_chains),
+                                                     options["temperatures"], order)  # fmt: skip
     if tune is None:  # only the widths the chains were tuned to run on untuned
-        tune = recorded is None or temps is not None  # tempered: every copy tuned, warmed up
+        # tempered: every copy tuned, warmed up, unless each resumes where it stopped
+        tune = recorded is None or (temps is not None and not resume)
     if append and tune and backend in MH_BACKENDS and temps is None:
         raise GPMSAError(
             "append=True pools the chains' draws evenly spaced in sweeps; tuning (tune=True, "
@@ -396,6 +412,9 @@ def tempering_record(info: dict, source: Emulator | None) -> dict:
            "swap_rate": np.asarray(info["swap_rate"]).tolist()}  # fmt: skip
     if "adapted_temperatures" in info:  # per chain, frozen
         out["adapted_temperatures"] = np.asarray(info["adapted_temperatures"]).tolist()
+    for key in HOT_RECORD:  # numpy: each hot copy's last state and widths, for a continuation
+        if key in info:
+            out[key] = {k: np.asarray(v).tolist() for k, v in info[key].items()}
     return tempering.recorded_ladders(out, source.settings if source is not None else {})
 
 

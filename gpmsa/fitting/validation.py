@@ -24,6 +24,7 @@ import re
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError, numbers_text
+from gpmsa.mcmc.sampler import none_as_nan
 from gpmsa.model import kronecker
 from gpmsa.model.basis import ORTHOGONAL_TOL, basis_digest
 from gpmsa.model.data import as_float, column_scales, output_scale
@@ -550,6 +551,57 @@ def check_fixed_draws(held: dict, arrays: dict[str, np.ndarray]) -> None:
                     f"holds {what} at {at}, but its draws are not held there")  # fmt: skip
 
 
+HOT_RECORD = ("hot_states", "hot_step_widths")
+"""A numpy tempered fit's settings holding each hot copy's last state (the model's scale: theta
+on the unit scale) and its step widths, name -> (n_chains, K - 1, *shape), from which its
+continuation resumes every copy (``gpmsa.fitting.continuation.resumes_copies``); both or
+neither."""
+
+
+def check_hot_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None:
+    """A numpy tempered fit's hot copies (settings ``HOT_RECORD``, absent in other files and
+    those written before session 76), both or neither, each an object naming parameters with
+    draws (``draw_``/``cal_`` arrays), its value (n_chains, K - 1, *shape), K the length of
+    settings.temperatures (where that is a list of 2 or more; a continuation names a damaged
+    ladder): hot_states finite numbers, hot_step_widths numbers > 0 and finite, or null (an
+    element not sampled)."""
+    given = [k for k in HOT_RECORD if settings.get(k) is not None]
+    if not given:
+        return
+    if len(given) < len(HOT_RECORD):
+        lacking = next(k for k in HOT_RECORD if k not in given)
+        raise _fail(f"settings.{lacking}", f"a tempered fit records {list(HOT_RECORD)} together; "
+                                           f"the file has only {given}")  # fmt: skip
+    temps = settings.get("temperatures")  # a damaged ladder: the continuation names it
+    n_hot = len(temps) - 1 if isinstance(temps, list) and len(temps) >= 2 else None
+    n_chains = settings.get("n_chains", 1)
+    for key in HOT_RECORD:
+        record = settings[key]
+        if not isinstance(record, dict):
+            raise _fail(f"settings.{key}", f"must be an object name -> values, got "
+                                           f"{_short(record)}")  # fmt: skip
+        for name, value in record.items():
+            field = f"settings.{key}[{_short(name, 40)}]"
+            shape = shapes.get(f"draw_{name}", shapes.get(f"cal_{name}"))
+            if shape is None:
+                raise _fail(field, "names no parameter with draws in the file")
+            try:  # null: a NaN written (a state's is not finite, a width's not sampled)
+                arr = as_float(none_as_nan(value), field)
+            except GPMSAError as exc:
+                raise EmulatorFileError(str(exc)) from None
+            if key == "hot_states" and not np.all(np.isfinite(arr)):
+                raise _fail(field, f"must be finite numbers, got {_short(value)}")
+            bad = ~np.isnan(arr) & ~(np.isfinite(arr) & (arr > 0))
+            if key == "hot_step_widths" and bad.any():
+                raise _fail(field, f"must be numbers > 0 and finite, or null, got "
+                                   f"{_short(arr[bad].tolist())}")  # fmt: skip
+            hot = arr.shape[1] if n_hot is None and arr.ndim > 1 else n_hot
+            want = (n_chains, hot, *shape[1:])
+            if arr.shape != want and not (arr.size == 0 and 0 in want):  # JSON: no empty shape
+                raise _fail(field, f"has shape {list(arr.shape)}, expected {list(want)} "
+                                   "(chains, hot copies, *the parameter's shape)")  # fmt: skip
+
+
 def check_fields(manifest: dict, dims: dict[str, int]) -> None:
     """Names, units, priors, the model sizes and the settings the code reads."""
     p, q, l_sim = dims["p"], dims["q"], dims["l_sim"]
@@ -973,6 +1025,7 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     check_values(arrays, dims, ranged_columns(manifest, dims), given)
     check_discrepancy_bases(manifest["settings"], arrays)
     check_fixed_draws(held, arrays)
+    check_hot_record(manifest["settings"], shapes)
     check_categorical(manifest, arrays, dims)
     check_kron_design(manifest, arrays)
     return dims

@@ -466,7 +466,7 @@ def check_step_widths(
             raise GPMSAError(f"step_widths: unknown parameter {name!r}; this model has "
                              f"{problem.names}")  # fmt: skip
         shape = widths[name].shape
-        arr = as_float(_none_as_nan(val), f"step_widths[{name!r}]")
+        arr = as_float(none_as_nan(val), f"step_widths[{name!r}]")
         if arr.size == 0 == widths[name].size:  # betaV (0, G) when p = 0: nothing to set (its
             continue  # record holds [] per chain: JSON keeps no empty shape)
         if arr.size == 1:
@@ -489,12 +489,12 @@ def check_step_widths(
     return per_chain
 
 
-def _none_as_nan(value):
+def none_as_nan(value):
     """``value`` with None (JSON's NaN, in a file's recorded widths) as NaN, in nested lists."""
     if value is None:
         return float("nan")
     if isinstance(value, list | tuple):
-        return [_none_as_nan(v) for v in value]
+        return [none_as_nan(v) for v in value]
     return value
 
 
@@ -563,24 +563,30 @@ def _chain_task(
     seed: np.random.SeedSequence, start: dict[str, np.ndarray], tune_rounds: int,
     tune_levels: int, ridge_moves: int = 0, progress: bool = False, desc: str = "MCMC",
     proportional_steps: bool | None = None, temperatures: tuple[float, ...] | None = None,
-    swap_every: int = 1, adapt_ladder: bool = False,
+    swap_every: int = 1, adapt_ladder: bool = False, copies: list | None = None,
 ):  # fmt: skip
     """One chain from plain data (run in a worker process): ``run_chain`` from ``start`` (drawn
     by ``sample`` in the parent), its generator from ``seed``; ``run_chain``'s result (with
-    ``temperatures``: ``tempering.run_tempered_chain``'s, the swap rates after it, and the
-    adapted ladder after them with ``adapt_ladder``), then a dict
-    of the level moves' offsets (``ChainState.level_record``: "offsets", "shifted")."""
+    ``temperatures``: ``tempering.run_tempered_chain``'s, its hot copies resumed from
+    ``copies``, the swap rates after it, and the adapted ladder after them with
+    ``adapt_ladder``), then a dict of the level moves' offsets (``ChainState.level_record``:
+    "offsets", "shifted") and, tempered, "hot": the hot copies' last states and widths."""
     record: dict = {}
     with threadpool_limits(1):
         if temperatures is not None:
             rng = np.random.default_rng(seed)
             first = problem.init if start is None else start
+
+            def new_state(at: dict | None) -> ChainState:
+                return ChainState(problem, first if at is None else at, rng,
+                                  ridge_moves=ridge_moves)  # fmt: skip
+
             out = tempering.run_tempered_chain(
-                problem, n_iter, lambda: ChainState(problem, first, rng, ridge_moves=ridge_moves),
+                problem, n_iter, new_state,
                 temperatures=temperatures, swap_every=swap_every, tune=tune, widths=widths,
                 rng=rng, tune_rounds=tune_rounds, tune_levels=tune_levels, progress=progress,
                 desc=desc, proportional_steps=proportional_steps, record=record,
-                adapt_ladder=adapt_ladder,
+                adapt_ladder=adapt_ladder, copies=copies,
             )  # fmt: skip
         else:
             out = run_chain(
@@ -590,7 +596,54 @@ def _chain_task(
                 record=record,
             )  # fmt: skip
     offsets, shifted = record["level"]
-    return (*out, {"offsets": offsets, "shifted": shifted})
+    return (*out, {"offsets": offsets, "shifted": shifted,
+                   **({"hot": record["hot"]} if "hot" in record else {})})  # fmt: skip
+
+
+def check_hot_copies(hot_copies, problem: Problem, ladders, n_chains: int) -> list | None:
+    """``sample``'s ``hot_copies``: None, or {"starts": ..., "widths": ...}, each name ->
+    (n_chains, K - 1, *shape) (as ``info`` "hot_states" and "hot_step_widths" record them), at
+    ``ladders`` (each chain's, K rungs). Returns per chain the K - 1 hot copies' (start,
+    widths), checked as a chain's ``init`` and ``step_widths`` are (``starts.chain_starts``,
+    `check_step_widths`: inside the priors' support, finite widths > 0); GPMSAError naming
+    ``hot_copies`` and the problem otherwise."""
+    if hot_copies is None:
+        return None
+    if ladders is None:
+        raise GPMSAError("hot_copies needs temperatures= (the copies of a tempered chain)")
+    if not isinstance(hot_copies, dict) or set(hot_copies) != {"starts", "widths"}:
+        raise GPMSAError(
+            "hot_copies must be a dict with 'starts' and 'widths' (name -> (n_chains, K - 1, "
+            f"*shape)), got {hot_copies!r:.80}"
+        )
+    n_hot = len(ladders[0]) - 1
+    flat = {}
+    for part in ("starts", "widths"):
+        given = hot_copies[part]
+        if not isinstance(given, dict):
+            raise GPMSAError(f"hot_copies[{part!r}] must be a dict name -> (n_chains, K - 1, "
+                             f"*shape), got {type(given).__name__}")  # fmt: skip
+        flat[part] = {}
+        for name, val in given.items():
+            arr = as_float(none_as_nan(val), f"hot_copies[{part!r}][{name!r}]")
+            shape = problem.init[name].shape if name in problem.init else None
+            if shape is not None and 0 in shape and arr.size == 0:  # JSON keeps no empty shape
+                arr = np.zeros((n_chains, n_hot, *shape))
+            if shape is not None and arr.shape != (n_chains, n_hot, *shape):
+                raise GPMSAError(
+                    f"hot_copies[{part!r}][{name!r}] must have shape {(n_chains, n_hot, *shape)}"
+                    f" (chains, hot copies, *shape), got {arr.shape}"
+                )
+            flat[part][name] = arr if shape is None else arr.reshape(n_chains * n_hot, *shape)
+    n_copies = n_chains * n_hot
+    try:
+        _, firsts = starts.chain_starts(problem, flat["starts"], [None] * n_copies)
+        widths = check_step_widths(flat["widths"], problem, n_copies)
+    except GPMSAError as exc:
+        raise GPMSAError(f"hot_copies (its chain c below: chain c // {n_hot}'s hot copy "
+                         f"1 + c % {n_hot}): {exc}") from None  # fmt: skip
+    pairs = list(zip(firsts, widths, strict=True))
+    return [pairs[c * n_hot : (c + 1) * n_hot] for c in range(n_chains)]
 
 
 def wrong_result(result, expected: tuple, what: str) -> str | None:
@@ -628,6 +681,7 @@ def sample(
     temperatures=None,
     swap_every: int = 1,
     adapt_ladder: bool = False,
+    hot_copies: dict | None = None,
 ) -> Chains:
     """Draw ``n_iter`` sweeps per chain after GPM/SA step-size tuning (``tune=True``).
 
@@ -660,8 +714,13 @@ def sample(
     between 1 and the hottest during tuning towards equal swap rates, then freezes it before
     the tuning of the widths and the draws, which are therefore an exact MCMC
     (``tempering.adapt_ladder``); ``info`` records "adapt_ladder" and "adapted_temperatures"
-    (n_chains, K) ("temperatures": the starting ladder). Raises ChainError naming a chain that
-    failed or whose draws are not finite.
+    (n_chains, K) ("temperatures": the starting ladder). A tempered run's ``info`` records
+    "hot_states" and "hot_step_widths" (name -> (n_chains, K - 1, *shape)): each hot copy's
+    last state and its widths (NaN where not sampled); ``hot_copies`` ({"starts": ...,
+    "widths": ...} of that form; `check_hot_copies`) starts each hot copy there, with those
+    widths where ``tune`` is False (a continuation resuming every copy where it stopped; else
+    every copy starts at its chain's start). Raises ChainError naming a chain that failed or
+    whose draws are not finite.
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
@@ -679,12 +738,14 @@ def sample(
     how, firsts = starts.chain_starts(problem, init, seeds)
     n_ridge = check_ridge(ridge_moves, problem)
     widths = check_step_widths(step_widths, problem, int(n_chains))
+    copies = check_hot_copies(hot_copies, problem, ladders, int(n_chains))
     tasks = [
         {"problem": problem, "n_iter": int(n_iter), "tune": tune, "widths": w, "seed": s,
          "start": first, "tune_rounds": tune_rounds, "tune_levels": tune_levels,
          "ridge_moves": n_ridge, "proportional_steps": prop_mh,
          **({} if temps is None else {"temperatures": ladders[c], "swap_every": swap_every}),
-         **({"adapt_ladder": True} if adapt else {})}
+         **({"adapt_ladder": True} if adapt else {}),
+         **({} if copies is None else {"copies": copies[c]})}
         for c, (s, first, w) in enumerate(zip(seeds, firsts, widths, strict=True))
     ]  # fmt: skip
     names = problem.names
@@ -712,6 +773,9 @@ def sample(
         ran = list(temps) if ladders.count(temps) == len(ladders) else [list(t) for t in ladders]
         chains.info.update(temperatures=ran, swap_every=swap_every,
                            swap_rate=np.stack([r[4] for r in runs]))  # fmt: skip
+        for key, part in (("hot_states", 0), ("hot_step_widths", 1)):  # (n_chains, K - 1, ...)
+            chains.info[key] = {n: np.stack([np.stack([c[n] for c in r[-1]["hot"][part]])
+                                             for r in runs]) for n in names}  # fmt: skip
     if adapt:  # each chain's ladder, adapted in its tuning and frozen for its draws
         chains.info.update(adapt_ladder=True, adapted_temperatures=np.stack([r[5] for r in runs]))
     moves = level_moves.chains_record([r[-1]["offsets"] for r in runs], runs[0][-1]["shifted"])

@@ -279,7 +279,8 @@ def tune_ladder(states: list, betas, rng, names, widths, n_rounds, n_levels, swa
 def run_ladder(states: list, rng: np.random.Generator, n_iter: int, widths: np.ndarray,
                kinds: list[str], record: Callable[[int], None], *, swap_every: int, tune: bool,
                tune_rounds: int, tune_levels: int, prop_mh: bool, bar, desc: str,
-               adapt: tuple[float, ...] | None = None):  # fmt: skip
+               adapt: tuple[float, ...] | None = None, copy_widths: list | None = None,
+               out: dict | None = None):  # fmt: skip
     """The ladder's run (module docstring) over ``states``, its copies at the inverse
     temperatures of their ``beta`` (each a ``sampler.ChainState``, or a study's
     ``StudyState``, at the chain's start): the categorical level shifts learnt at T = 1 and
@@ -290,10 +291,12 @@ def run_ladder(states: list, rng: np.random.Generator, n_iter: int, widths: np.n
     ``record(it)`` after each (the T = 1 copy, ``states[0]``, is the one to keep). Returns the
     T = 1 copy's accepted counts and widths, the swap acceptance rate (K - 1,) of each
     neighbour pair over the draws' swap rounds and the adapted ladder (K,; None without
-    ``adapt``)."""
+    ``adapt``). ``copy_widths``: the hot copies' flat widths (K - 1), which they run with where
+    not tuned (a resumed continuation; else ``widths``, each copy's); ``out`` (a dict) gets
+    "widths", every copy's widths as run (K)."""
     n_temps = len(states)
     temps = None if adapt is None else tuple(adapt)
-    w = [widths] * n_temps
+    w = [widths] * n_temps if copy_widths is None else [widths, *copy_widths]
     swaps = np.zeros(n_temps - 1)
     if tune and adapt is not None and widths.size:
         _share_level_shifts(states)  # the level moves as in the tuning (categorical)
@@ -319,6 +322,8 @@ def run_ladder(states: list, rng: np.random.Generator, n_iter: int, widths: np.n
         if it % 100 == 99:
             bar.update(100 * n_temps)
     bar.update((n_iter % 100) * n_temps)
+    if out is not None:
+        out["widths"] = w
     return accepted[0], w[0], swaps / max(n_iter // swap_every, 1), temps
 
 
@@ -333,7 +338,7 @@ def _share_level_shifts(states: list) -> None:
 def run_tempered_chain(
     problem: Problem,
     n_iter: int,
-    new_state: Callable[[], object],
+    new_state: Callable[[dict | None], object],
     *,
     temperatures: tuple[float, ...],
     swap_every: int,
@@ -347,20 +352,25 @@ def run_tempered_chain(
     proportional_steps: bool | None = None,
     record: dict | None = None,
     adapt_ladder: bool = False,
+    copies: list[tuple[dict, dict]] | None = None,
 ):
     """``sampler.run_chain`` with a ladder of tempered copies (module docstring, `run_ladder`),
-    each a ``new_state()`` (a ``sampler.ChainState`` at the chain's start, drawing from
-    ``rng``): ``n_iter`` sweeps of every copy after its tuning; the T = 1 copy's draws are kept.
-    Returns ``run_chain``'s draws, log_post, accept rates and widths (of the T = 1 copy) and the
-    swap acceptance rate (K - 1,) of each neighbour pair over the draws' swap rounds, and with
-    ``adapt_ladder`` (and ``tune``) the adapted ladder (K,), frozen before the tuning of the
-    widths and the draws; ``record`` as ``run_chain``'s (the T = 1 copy's level moves, shared
-    by the ladder)."""
+    each a ``new_state(start)`` (a ``sampler.ChainState`` at ``start``, None: the chain's start,
+    drawing from ``rng``): ``n_iter`` sweeps of every copy after its tuning; the T = 1 copy's
+    draws are kept. ``copies``: each hot copy's (start, widths) (K - 1; a continuation resuming
+    the copies where they stopped, its widths run with where not ``tune``); None: every copy at
+    the chain's start. Returns ``run_chain``'s draws, log_post, accept rates and widths (of the
+    T = 1 copy) and the swap acceptance rate (K - 1,) of each neighbour pair over the draws'
+    swap rounds, and with ``adapt_ladder`` (and ``tune``) the adapted ladder (K,), frozen before
+    the tuning of the widths and the draws; ``record`` as ``run_chain``'s (the T = 1 copy's
+    level moves, shared by the ladder) with "hot": the hot copies' last states and widths (each
+    a list of K - 1 dicts name -> array, widths NaN where not sampled)."""
     from tqdm.auto import tqdm
 
+    starts = [None] + [start for start, _ in copies or [(None, None)] * (len(temperatures) - 1)]
     states = []
-    for t in temperatures:
-        state = new_state()
+    for t, start in zip(temperatures, starts, strict=True):
+        state = new_state(start)
         state.beta = 1.0 / t
         states.append(state)
     cold = states[0]
@@ -380,16 +390,23 @@ def run_tempered_chain(
         log_post[it] = cold.log_post()
 
     prop_mh = (not tune) if proportional_steps is None else proportional_steps
+    hot_widths = None if copies is None else [cold.flat_widths(w) for _, w in copies]
+    ran: dict = {}
     with threadpool_limits(1):
         accepted, w, rates, adapted = run_ladder(
             states, rng, n_iter, cold.flat_widths(widths), [n for n, _ in cold.els], keep,
             swap_every=swap_every, tune=tune, tune_rounds=tune_rounds, tune_levels=tune_levels,
             prop_mh=prop_mh, bar=bar, desc=desc, adapt=temperatures if adapt_ladder else None,
+            copy_widths=hot_widths, out=ran,
         )  # fmt: skip
     bar.close()
     rate, wid = cold.element_records(accepted, w, n_iter)
     if record is not None:
         record["level"] = cold.level_record()
+        record["hot"] = (
+            [{n: np.array(state.params[n]) for n in names} for state in states[1:]],
+            [cold.element_records(accepted, v, n_iter)[1] for v in ran["widths"][1:]],
+        )
     if adapt_ladder:
         return draws, log_post, rate, wid, rates, np.asarray(adapted)
     return draws, log_post, rate, wid, rates
