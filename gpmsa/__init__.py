@@ -9,6 +9,7 @@ from gpmsa.calibration.calibrate import calibrate
 from gpmsa.calibration.calibrator import Calibrator
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import (
+    AtBoundWarning,
     BackendUnavailableError,
     BasisWarning,
     ChainError,
@@ -41,6 +42,7 @@ from gpmsa.studies.run import calibrate_study, fit_study
 from gpmsa.studies.study import Study, load_study
 
 __all__ = [
+    "AtBoundWarning",
     "BackendUnavailableError",
     "BasisWarning",
     "Calibrator",

@@ -25,6 +25,13 @@ class OutsideEmulatorWarning(UserWarning):
     """An observation lies outside what the emulator has seen (far from all its predictions)."""
 
 
+class AtBoundWarning(OutsideEmulatorWarning):
+    """An offline calibration's posterior of a theta element piles up against a bound of the
+    emulator's domain (``gpmsa.mcmc.bounds``): the data may point outside the
+    simulation design, or the model misses something that theta absorbs. An
+    OutsideEmulatorWarning subclass: a filter on that one covers it."""
+
+
 class ExtrapolationWarning(UserWarning):
     """Inputs (x, theta or bounds given to a prediction or a calibration) lie outside the
     emulator's training domain: the emulator extrapolates there (predictions, a joint fit's and

@@ -54,6 +54,7 @@ from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
 from gpmsa.errors import GPMSAError, ReductionWarning, numbers_text
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, tempering, tuning
+from gpmsa.mcmc.bounds import at_bound, warn_at_bound
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
@@ -323,6 +324,11 @@ def calibrate(
     ``n_chains >= 2``). A ``gpmsa.Calibrator``'s update (its MCMC path, online) judges one
     chain by none of them: its Posterior has no diagnostics, and no warning. A chain
     that fails or produces non-finite draws raises ``gpmsa.ChainError`` naming it.
+    ``info["at_bound"]`` names each calibration parameter whose posterior piles up against a
+    bound of the emulator's domain ("lower" or "upper": half its draws within 1 % of the
+    domain's width of it, ``gpmsa.mcmc.bounds``; categorical and held ones are not
+    judged), and a ``gpmsa.AtBoundWarning`` says what it may mean (the truth outside the
+    design, a missing discrepancy) and what to do; a Calibrator's update neither.
 
     Returns:
         Posterior with draws of each calibration parameter (named as the emulator's t_names,
@@ -456,6 +462,13 @@ def calibrate(
         warn_unconverged(
             info["convergence"], f"gpmsa.calibrate (backend {backend!r})", length="n_samples"
         )
+    if not _online:  # (a Calibrator's update: silent, and no time spent on it)
+        skip = {*held_names, *codes}  # held and categorical elements: no such bound
+        std = emulator.standardizer
+        info["at_bound"] = at_bound(samples, emulator.t_names, std.t_min, std.t_max, skip)
+        warn_at_bound(info["at_bound"], samples, emulator.t_names, std.t_min, std.t_max,
+                      f"gpmsa.calibrate (backend {backend!r})",
+                      "Posterior.info['at_bound']")  # fmt: skip
     return Posterior(samples, chains=chains, info=info)
 
 

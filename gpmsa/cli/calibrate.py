@@ -1,5 +1,6 @@
 """``gpmsa calibrate FILE --x v=1.25 --y f=12.1``: print the posterior of one observation
-(``--fixed GD=400`` holds a calibration parameter, or lamOs, at a known value: MCMC)."""
+(``--y-csv PATH``: its outputs from a CSV file, a functional output's many values; ``--fixed
+GD=400`` holds a calibration parameter, or lamOs, at a known value: MCMC)."""
 
 from __future__ import annotations
 
@@ -28,6 +29,10 @@ def add_parser(sub) -> None:
                    help="a known input, native units (repeat for each x name)")  # fmt: skip
     p.add_argument("--y", action="append", default=[], metavar="NAME=VALUE",
                    help="an observed output, native units (repeat for each y name)")  # fmt: skip
+    p.add_argument("--y-csv", default=None, metavar="PATH",
+                   help="the observed outputs from a CSV file instead of --y: the "
+                        "observation's values in one row (or one column), in the order of "
+                        "the file's y names, or under a header row of those names")  # fmt: skip
     p.add_argument("--fixed", action="append", default=[], metavar="NAME=VALUE",
                    help="hold a calibration parameter (a t_name, or lamOs) at VALUE, native "
                         "units (repeat for each; MCMC)")  # fmt: skip
@@ -93,6 +98,108 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
             f"--{what} needs exactly the names {list(names)}; unknown {unknown}, missing {missing}"
         )
     return np.array([[given[n] for n in names]])
+
+
+def _observed(args: argparse.Namespace, names: tuple[str, ...]) -> np.ndarray:
+    """The observation's outputs (1, l_sim), ordered as ``names``: from ``--y`` pairs, or from
+    ``--y-csv`` (`_csv_row`); GPMSAError for both, or neither where outputs are missing (the
+    advice names --y-csv for a vector output)."""
+    if args.y_csv is not None:
+        if args.y:
+            raise GPMSAError("give the observed outputs by --y NAME=VALUE or by --y-csv PATH, "
+                             "not both")  # fmt: skip
+        return _csv_row(args.y_csv, names)[None, :]
+    try:
+        return _pairs(args.y, names, "y")
+    except GPMSAError as exc:
+        if len(names) > 1 and not args.y:
+            raise GPMSAError(f"{exc} (or --y-csv PATH: the {len(names)} values in one row or "
+                             "one column of a CSV file)") from None  # fmt: skip
+        raise
+
+
+def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
+    """The values (len(names),) of one observation from the CSV file ``path``: one row or one
+    column of numbers (fields split at commas, or at blanks in a line without one, as
+    ``numpy.savetxt`` writes them; blank lines and lines starting with "#" skipped), in the
+    order of ``names``, or under a first row that names the columns (exactly ``names``, any
+    order: read by name). GPMSAError naming the file, and the row and column, for a file that
+    cannot be read, a field that is not a finite number, rows of unequal length, or another
+    count of values."""
+    where = f"--y-csv {safe(path, 200)}"
+    try:
+        with open(path, encoding="utf-8-sig") as fh:
+            lines = fh.read().splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
+    rows = [(k, line.split(",") if "," in line else line.split())
+            for k, line in enumerate(lines, 1)
+            if line.strip() and not line.lstrip().startswith("#")]  # fmt: skip
+    if not rows:
+        raise GPMSAError(f"{where}: the file holds no values (give the {len(names)} observed "
+                         "outputs in one row or one column)")  # fmt: skip
+    rows = [(k, [f.strip() for f in fields]) for k, fields in rows]
+    header = None
+    if not any(_number(f) is not None for f in rows[0][1]):  # a row of names
+        header, rows = rows[0][1], rows[1:]
+    widths = {len(fields) for _, fields in rows}
+    if len(widths) > 1:
+        (k0, first), (k, other) = rows[0], next(r for r in rows if len(r[1]) != len(rows[0][1]))
+        raise GPMSAError(f"{where}: line {k} has {len(other)} fields, line {k0} {len(first)}: "
+                         "every row must have the same number of columns")  # fmt: skip
+    values = []
+    for k, fields in rows:
+        for c, field in enumerate(fields, 1):
+            v = _number(field)
+            if v is None or not np.isfinite(v):
+                what = ("is empty (a missing value?)" if not field else
+                        f"{safe(field, 40)!r} is not a finite number" if v is not None else
+                        f"{safe(field, 40)!r} is not a number")  # fmt: skip
+                raise GPMSAError(f"{where}: line {k}, column {c} {what}")
+            values.append(v)
+    n_rows, n_cols = len(rows), (widths.pop() if widths else 0)
+    if header is not None:
+        return _by_header(where, header, rows, names)
+    if len(values) != len(names) or (n_rows > 1 and n_cols > 1):
+        raise GPMSAError(
+            f"{where}: {n_rows} row(s) x {n_cols} column(s) of values; the file's outputs are "
+            f"{len(names)} ({_names_text(names)}): give the one observation's {len(names)} "
+            "values in one row or one column (this command calibrates on one observation; "
+            "for several, gpmsa.calibrate in Python)"
+        )
+    return np.array(values)
+
+
+def _by_header(where: str, header: list[str], rows: list, names: tuple[str, ...]) -> np.ndarray:
+    """The one row under ``header`` (the columns' names: exactly ``names``, any order) ordered
+    as ``names``; GPMSAError otherwise."""
+    unknown = [h for h in header if h not in names]
+    missing = [n for n in names if n not in header]
+    twice = sorted({h for h in header if header.count(h) > 1})
+    if unknown or missing or twice:
+        raise GPMSAError(f"{where}: the header row must name the file's outputs "
+                         f"({_names_text(names)}) once each; unknown {safe(unknown, 200)}, "
+                         f"missing {safe(missing, 200)}, twice {safe(twice, 200)}")  # fmt: skip
+    if len(rows) != 1:
+        raise GPMSAError(f"{where}: under a header row give one row of values (one "
+                         f"observation), got {len(rows)}")  # fmt: skip
+    row = [_number(f) for f in rows[0][1]]
+    return np.array([row[header.index(n)] for n in names])
+
+
+def _names_text(names: tuple[str, ...]) -> str:
+    """The names for a message: all of up to 4, else the first two ... the last."""
+    shown = list(names) if len(names) <= 4 else [names[0], names[1], "...", names[-1]]
+    return safe(", ".join(shown), 200)
+
+
+def _number(text: str) -> float | None:
+    """``text`` as a float (nan and inf too: the caller refuses them), or None for anything
+    else (an underscore too: float() reads "1_0" as 10)."""
+    try:
+        return None if "_" in text else float(text)
+    except ValueError:
+        return None
 
 
 def _fixed(items: list[str], emu) -> dict[str, float]:
@@ -175,7 +282,7 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
                              "(auto chooses MCMC with --fixed)")  # fmt: skip
         emu = load(args.file)
         x = _pairs(args.x, tuple(emu.x_names), "x")
-        y = _pairs(args.y, tuple(emu.y_names), "y")
+        y = _observed(args, tuple(emu.y_names))
         fixed = _fixed(args.fixed, emu)
         options = {"fixed": _fixed_option(fixed)} if fixed else None
         method = "mcmc" if fixed else args.method  # auto: MCMC with --fixed

@@ -32,6 +32,7 @@ from gpmsa.fitting.continuation import (
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, tempering
+from gpmsa.mcmc.bounds import at_bound, warn_at_bound
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process
 from gpmsa.mcmc.sampler import (
@@ -125,7 +126,9 @@ def fit(
     """Fit the emulator by GPM/SA's Metropolis-within-Gibbs; returns an ``Emulator``.
 
     data: the simulation runs. obs: field data for GPM/SA's classic joint calibration (theta and
-    lamOs are sampled together with the emulator; the draws land in ``Emulator.calibration``).
+    lamOs are sampled together with the emulator; the draws land in ``Emulator.calibration``;
+    a ``gpmsa.AtBoundWarning`` where theta's piles up against a bound of the domain, as
+    ``gpmsa.calibrate`` warns).
     n_iter: sweeps per chain after step-size tuning (``tune``: 50 rounds x 20 levels, 1,000
     sweeps whatever ``n_iter``: a sweep's cost grows as m^3, ~0.06 s at m = 1,000 runs and
     ~0.35 s at 2,000 on a 2-core machine, so tuning alone takes 1 and 6 minutes there;
@@ -392,6 +395,17 @@ def fit(
     warn_unconverged(record, f"gpmsa.fit (backend {backend!r})", more=f", or {how}",
                      names=element_names(data.x_names, data.t_names,
                                          problem.init["betaU"].shape[1]))  # fmt: skip
+    if calibration is not None:  # theta's posterior piled against its domain's bound
+        draws = dict(zip(data.t_names, np.moveaxis(calibration["theta_native"], -1, 0),
+                         strict=True))  # fmt: skip
+        levels = problem.theta_levels or [None] * len(data.t_names)  # None: none categorical
+        skip = {name for name, lv in zip(data.t_names, levels, strict=True) if lv is not None}
+        skip |= {data.t_names[k] for k in fit_held_native(problem, fixed, data.t_names)}
+        std = prep.standardizer
+        found = at_bound(draws, data.t_names, std.t_min, std.t_max, skip)
+        warn_at_bound(found, draws, data.t_names, std.t_min, std.t_max,
+                      f"gpmsa.fit (backend {backend!r}, joint calibration)",
+                      "gpmsa.calibration_posterior(emulator).info['at_bound']")  # fmt: skip
     return Emulator._from_prepared(
         data, prep, params,
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,

@@ -479,6 +479,29 @@ def _labels(value, what: str, kind: str):
     return tuple(value)
 
 
+REPR_COLUMNS = 6
+"""The columns a SimData's or ObsData's repr names with their ranges (the rest counted)."""
+
+
+def _span(values: np.ndarray) -> str:
+    """``[min, max]`` of ``values`` to 4 significant digits, for a repr."""
+    return f"[{np.min(values):.4g}, {np.max(values):.4g}]" if np.size(values) else "[]"
+
+
+def _count(n: int, what: str) -> str:
+    return f"{n} {what}{'' if n == 1 else 's'}"
+
+
+def _columns_text(arr: np.ndarray, names) -> str:
+    """Each column's name and range (the first `REPR_COLUMNS`, then how many more), for a repr;
+    "none" without columns."""
+    if arr.shape[1] == 0:
+        return "none"
+    parts = [f"{name} {_span(arr[:, k])}" for k, name in enumerate(names[:REPR_COLUMNS])]
+    more = arr.shape[1] - REPR_COLUMNS
+    return ", ".join(parts) + (f", ... ({more} more)" if more > 0 else "")
+
+
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
     if names is None:
         return tuple(f"{prefix}{i}" for i in range(n))
@@ -487,7 +510,12 @@ def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple
                          f"name pass [{names!r}])")  # fmt: skip
     names = tuple(str(s) for s in names)
     if len(names) != n:
-        raise GPMSAError(f"{what} must have {n} entries, got {len(names)}: {names}")
+        each = ""
+        if what == "y_names" and len(names) == 1:  # one name for a functional output
+            each = (f" (one name per output value, a functional output's too: they are the keys "
+                    f"by which y_obs tables and `gpmsa calibrate --y` read it; to name them after "
+                    f"one: [f\"{names[0]}{{k}}\" for k in range({n})])")  # fmt: skip
+        raise GPMSAError(f"{what} must have {n} entries, got {len(names)}: {names}{each}")
     if len(set(names)) != n:
         raise GPMSAError(f"{what} must be unique, got {names}")
     return names
@@ -881,6 +909,13 @@ class SimData:
             kronecker.structure(np.hstack([x, t]), groups, names)
         object.__setattr__(self, "separable", groups)
 
+    def __repr__(self) -> str:
+        """Concise: the runs, each input's name and range, the output's length and range."""
+        grid = "" if self.index is None else f" on index {_span(self.index)}"
+        return (f"SimData({self.m} runs; x: {_columns_text(self.x, self.x_names)}; "
+                f"t: {_columns_text(self.t, self.t_names)}; y: {_count(self.l_sim, 'output')} "
+                f"{_span(self.y)}{grid})")  # fmt: skip
+
     @property
     def m(self) -> int:
         """Number of simulation runs."""
@@ -1128,6 +1163,18 @@ class ObsData:
                 raise GPMSAError(f"precision[{j}] must be symmetric positive definite")
             out.append(lam)
         return out
+
+    def __repr__(self) -> str:
+        """Concise: the experiments, x's columns and ranges, y's lengths and range, and whether
+        an index and precisions are given."""
+        names = self.x_columns or tuple(f"x_obs[:, {k}]" for k in range(self.x.shape[1]))
+        lengths = sorted({e.size for e in self.experiments})
+        each = f"{lengths[0]}" if len(lengths) == 1 else f"{lengths[0]} to {lengths[-1]}"
+        values = np.concatenate([np.ravel(e) for e in self.experiments])
+        given = [k for k in ("index", "precision") if getattr(self, k) is not None]
+        return (f"ObsData({_count(self.n, 'experiment')}; x: {_columns_text(self.x, names)}; "
+                f"y: {each} value(s) each {_span(values)}"
+                f"{''.join(f'; {k} given' for k in given)})")  # fmt: skip
 
     @property
     def n(self) -> int:

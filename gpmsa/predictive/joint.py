@@ -7,6 +7,7 @@ import numpy as np
 from gpmsa.calibration.observations import emulator_record, theta_levels_native
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
+from gpmsa.mcmc.bounds import at_bound
 from gpmsa.model.discrepancy import to_samples
 
 
@@ -23,7 +24,9 @@ def calibration_posterior(emulator) -> Posterior:
     ("obs_lengths", "obs_sha256"), so that ``gpmsa.full_prediction(..., posterior=)`` refuses
     other ones, as it does without it, and the emulator's ``model_sha256`` ("emulator_sha256"),
     so that it refuses another emulator; a fit with ``fixed=`` of calibration parameters,
-    "held": the names held (``summary()``'s "held", as ``gpmsa.calibrate`` records them).
+    "held": the names held (``summary()``'s "held", as ``gpmsa.calibrate`` records them);
+    "at_bound": the calibration parameters piled against a bound of the emulator's domain,
+    as ``gpmsa.calibrate`` records them (``gpmsa.fit`` warned of them).
 
     Example:
         >>> import numpy as np, gpmsa
@@ -82,6 +85,8 @@ def calibration_posterior(emulator) -> Posterior:
     codes = theta_levels_native(emulator)
     if codes:  # a categorical theta: its quantiles are levels (as calibrate's)
         info["levels"] = codes
+    std = emulator.standardizer  # piled against a bound (gpmsa.fit warned of it)
+    info["at_bound"] = at_bound(samples, emulator.t_names, std.t_min, std.t_max, {*held, *codes})
     return Posterior(samples, chains=chains, info=info)
 
 

@@ -52,7 +52,7 @@ PUBLIC = [
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
     "limits", "load", "plots", "predictive", "prepare", "sensitivity",
     "HyperPriors", "Study", "calibrate_study", "fit_study", "load_study", "StartRejectedError",
-    "calibrated_predict",
+    "calibrated_predict", "AtBoundWarning",
 ]  # fmt: skip
 
 
