@@ -866,7 +866,8 @@ class BCR:
         why = ""
         if not within(v, lo, hi):
             shown = numbers_text(v, lo, hi, digits=3)[0]  # (a speed just past hi: not as hi)
-            why = f"speed {shown} m/s outside the emulator's [{lo:g}, {hi:g}]"
+            lo_text, hi_text = numbers_text(v, lo, hi)[1:]  # (:g, more where v reads as one)
+            why = f"speed {shown} m/s outside the emulator's [{lo_text}, {hi_text}]"
         elif spd.min() < MAX_SPEED_CHANGE * spd.max():
             why = f"speed changed within the block ({np.min(spd):.3g}-{np.max(spd):.3g} m/s)"
         if why:  # the emulator knows constant speeds in its range only
@@ -899,7 +900,8 @@ class BCR:
             why = (
                 f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the block at "
                 f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = "
-                f"{numbers_text(p, s.plausibility_p, digits=2)[0]} < {s.plausibility_p:g})"
+                f"{numbers_text(p, s.plausibility_p, digits=2)[0]} < "
+                f"{numbers_text(p, s.plausibility_p)[1]})"
             )
             return self._hold(self._skip_block(
                 phase, ds, "implausible", why, speed=v, feature=y, plausibility_p=p))  # fmt: skip
@@ -1009,8 +1011,8 @@ class BCR:
         return (
             f"the last {n} block(s) read quieter than any GD in [{lo:g}, {hi:g}] explains at "
             f"{v:.3g} m/s: level score {z:.3g} sd (p = {numbers_text(p, limit, digits=2)[0]} < "
-            f"{limit:g}); a sensor gain or noise below the emulator's, or ground smoother than it "
-            "knows",
+            f"{numbers_text(p, limit)[1]}); a sensor gain or noise below the emulator's, or ground "
+            "smoother than it knows",
             p,
         )
 
@@ -1054,7 +1056,8 @@ class BCR:
         release = self.settings.release_p
         reason = (
             f"{since}: the blocks read since then still read quiet on a phase (level score "
-            f"{z:.3g} sd, p = {numbers_text(p, release, digits=2)[0]} < release_p {release:g})"
+            f"{z:.3g} sd, p = {numbers_text(p, release, digits=2)[0]} < release_p "
+            f"{numbers_text(p, release)[1]})"
         )
         return self._no_estimate("implausible", reason, speed=v, feature=y, plausibility_p=p)
 
@@ -1175,7 +1178,10 @@ class BCR:
         unit = float(self.model.emulator.standardizer.x_to_unit([[v]])[0, 0])
         if not 0.0 <= unit <= 1.0:  # the emulator's own rule (snaps rounding at the ends)
             shown = numbers_text(v, lo, hi, digits=3)[0]  # (a speed just past hi: not as hi)
-            why = f"window speed {shown} m/s outside the emulator's range [{lo:g}, {hi:g}] m/s"
+            lo_text, hi_text = numbers_text(v, lo, hi)[1:]  # (:g, more where v reads as one)
+            why = (
+                f"window speed {shown} m/s outside the emulator's range [{lo_text}, {hi_text}] m/s"
+            )
             if self.last.ok:
                 note = self._edge_sentence(self.last.domain_edge)
                 reason = "; ".join(filter(None, ("no new information: " + why, note)))
@@ -1242,7 +1248,7 @@ class BCR:
         return (
             f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the window at "
             f"{v:.3g} m/s: y is {np.sqrt(z2):.3g} predictive sds from the nearest "
-            f"(p = {numbers_text(p, limit, digits=2)[0]} < {limit:g})"
+            f"(p = {numbers_text(p, limit, digits=2)[0]} < {numbers_text(p, limit)[1]})"
         ), p
 
     def _check_age(self, est: Estimate) -> Estimate:

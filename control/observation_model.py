@@ -177,7 +177,10 @@ class ObservationModel:
         lo, hi = self.speed_range
         if not within(v, lo, hi):
             shown = numbers_text(v, lo, hi, digits=10)[0]  # (a narrow range: 1e-9 of its width)
-            raise ControlError(f"speed {shown} m/s outside the emulator's range [{lo:g}, {hi:g}]")
+            lo_text, hi_text = numbers_text(v, lo, hi)[1:]  # (:g, more where v reads as one)
+            raise ControlError(
+                f"speed {shown} m/s outside the emulator's range [{lo_text}, {hi_text}]"
+            )
         x = _clip((v - lo) / (hi - lo) * (self.speed.size - 1), 0.0, self.speed.size - 1.0)
         i = min(int(x), self.speed.size - 2)
         a = x - i

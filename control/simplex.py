@@ -198,7 +198,8 @@ class Simplex:
             )
         if gd > self.gd_max:
             shown = numbers_text(gd, self.gd_max, digits=4)[0]  # (just past: not as GD_max)
-            return Command(self.v_safe, "safety", gd, f"GD {shown} > GD_max {self.gd_max:g}")
+            limit = numbers_text(gd, self.gd_max)[1]  # (:g, more where gd reads as it)
+            return Command(self.v_safe, "safety", gd, f"GD {shown} > GD_max {limit}")
         return Command(self.on_speed_grid(self.performance_speed(gd)), "performance", gd)
 
     def on_speed_grid(self, speed: float) -> float:

@@ -5,6 +5,7 @@ GD=400`` holds a calibration parameter, or lamOs, at a known value: MCMC)."""
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import sys
 import time
@@ -120,28 +121,32 @@ def _observed(args: argparse.Namespace, names: tuple[str, ...]) -> np.ndarray:
 
 def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     """The values (len(names),) of one observation from the CSV file ``path``: one row or one
-    column of numbers (fields split at commas, or at blanks in a line without one, as
-    ``numpy.savetxt`` writes them; blank lines and lines starting with "#" skipped), in the
+    column of numbers (`_fields`; blank lines and lines starting with "#" skipped), in the
     order of ``names``, or under a first row that names the columns (exactly ``names``, any
-    order: read by name). GPMSAError naming the file, and the row and column, for a file that
-    cannot be read, a field that is not a finite number, rows of unequal length, or another
-    count of values."""
+    order: read by name; a row of no numbers, or of those names above another row).
+    GPMSAError naming the file, and the row and column, for a file that cannot be read, a
+    field that is not a finite number, rows of unequal length, or another count of values."""
     where = f"--y-csv {safe(path, 200)}"
     try:
         with open(path, encoding="utf-8-sig") as fh:
             lines = fh.read().splitlines()
     except (OSError, UnicodeDecodeError) as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
-    rows = [(k, line.split(",") if "," in line else line.split())
-            for k, line in enumerate(lines, 1)
-            if line.strip() and not line.lstrip().startswith("#")]  # fmt: skip
+    try:
+        rows = [(k, _fields(line)) for k, line in enumerate(lines, 1)
+                if line.strip() and not line.lstrip().startswith("#")]  # fmt: skip
+    except csv.Error as exc:  # a field beyond csv's size limit
+        raise GPMSAError(f"{where}: cannot read it as CSV ({safe(exc, 200)})") from None
     if not rows:
         raise GPMSAError(f"{where}: the file holds no values (give the {len(names)} observed "
                          "outputs in one row or one column)")  # fmt: skip
     rows = [(k, [f.strip() for f in fields]) for k, fields in rows]
     header = None
-    if not any(_number(f) is not None for f in rows[0][1]):  # a row of names
-        header, rows = rows[0][1], rows[1:]
+    first = rows[0][1]  # a row of names (numbers too where they are the outputs' names)
+    if not any(_number(f) is not None for f in first) or (
+        len(rows) > 1 and sorted(first) == sorted(names)
+    ):
+        header, rows = first, rows[1:]
     widths = {len(fields) for _, fields in rows}
     if len(widths) > 1:
         (k0, first), (k, other) = rows[0], next(r for r in rows if len(r[1]) != len(rows[0][1]))
@@ -168,6 +173,16 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
             "for several, gpmsa.calibrate in Python)"
         )
     return np.array(values)
+
+
+def _fields(line: str) -> list[str]:
+    """One CSV line's fields: split at commas (a field in double quotes as CSV writers quote
+    names, its quotes dropped), else at semicolons (a spreadsheet's CSV in some locales), else
+    at blanks (as ``numpy.savetxt`` writes a row)."""
+    for sep in (",", ";"):
+        if sep in line:
+            return next(csv.reader([line], delimiter=sep, skipinitialspace=True))
+    return line.split()
 
 
 def _by_header(where: str, header: list[str], rows: list, names: tuple[str, ...]) -> np.ndarray:

@@ -492,12 +492,24 @@ def _count(n: int, what: str) -> str:
     return f"{n} {what}{'' if n == 1 else 's'}"
 
 
+REPR_NAME = 40
+"""The characters of a column's name a repr shows (a longer one cut, ending "...")."""
+
+
+def _repr_name(name: str) -> str:
+    """``name`` for a one-line repr: escaped where not printable (a newline as \\n), cut to
+    `REPR_NAME` characters."""
+    text = name if name.isprintable() else repr(name)[1:-1]
+    return text if len(text) <= REPR_NAME else text[: REPR_NAME - 3] + "..."
+
+
 def _columns_text(arr: np.ndarray, names) -> str:
     """Each column's name and range (the first `REPR_COLUMNS`, then how many more), for a repr;
     "none" without columns."""
     if arr.shape[1] == 0:
         return "none"
-    parts = [f"{name} {_span(arr[:, k])}" for k, name in enumerate(names[:REPR_COLUMNS])]
+    parts = [f"{_repr_name(name)} {_span(arr[:, k])}"
+             for k, name in enumerate(names[:REPR_COLUMNS])]  # fmt: skip
     more = arr.shape[1] - REPR_COLUMNS
     return ", ".join(parts) + (f", ... ({more} more)" if more > 0 else "")
 
