@@ -30,6 +30,7 @@ from gpmsa.fitting.continuation import (
     resumes_copies,
 )
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
+from gpmsa.fitting.validation import MAX_HOT_VALUES
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, tempering
 from gpmsa.mcmc.bounds import at_bound, warn_at_bound
@@ -420,15 +421,17 @@ def tempering_record(info: dict, source: Emulator | None) -> dict:
     started from), "swap_every", "swap_rate" (per chain, per neighbour pair) and, where the
     chains adapted their ladders (``adapt_ladder``) or continued ``source``'s adapted ones
     (each chain at its own: "temperatures" then the source's), "adapted_temperatures" (per
-    chain, frozen for the draws)."""
+    chain, frozen for the draws); on numpy, the hot copies' last states and widths
+    (``HOT_RECORD``) where they hold at most ``MAX_HOT_VALUES`` numbers."""
     out = {"temperatures": np.asarray(info["temperatures"]).tolist(),
            "swap_every": int(info["swap_every"]),
            "swap_rate": np.asarray(info["swap_rate"]).tolist()}  # fmt: skip
     if "adapted_temperatures" in info:  # per chain, frozen
         out["adapted_temperatures"] = np.asarray(info["adapted_temperatures"]).tolist()
-    for key in HOT_RECORD:  # numpy: each hot copy's last state and widths, for a continuation
-        if key in info:
-            out[key] = {k: np.asarray(v).tolist() for k, v in info[key].items()}
+    hot = [{k: np.asarray(v) for k, v in info[key].items()} for key in HOT_RECORD if key in info]
+    if hot and sum(v.size for h in hot for v in h.values()) <= MAX_HOT_VALUES:  # numpy
+        for key, record in zip(HOT_RECORD, hot, strict=True):  # each hot copy's last state and
+            out[key] = {k: v.tolist() for k, v in record.items()}  # widths, to resume from
     return tempering.recorded_ladders(out, source.settings if source is not None else {})
 
 

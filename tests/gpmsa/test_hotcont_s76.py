@@ -157,3 +157,17 @@ def test_a_damaged_record_in_memory_is_refused_by_the_continuation(tmp_path):
     del src.settings["hot_step_widths"]
     with pytest.raises(GPMSAError, match="settings.hot_step_widths"):
         src.save(tmp_path / "never-written.gpmsa")
+
+
+def test_a_record_above_max_hot_values_is_left_out_and_its_continuation_warms_up(monkeypatch):
+    """The record lives in the JSON manifest (limit 16 MiB): a fit whose hot copies hold more
+    than ``MAX_HOT_VALUES`` numbers records none (a review found that a large tempered fit could
+    pass the manifest's limit, which it could be saved within before), and its continuation
+    tunes its copies as one without the record does."""
+    import gpmsa.fitting.fit as fit_module
+
+    monkeypatch.setattr(fit_module, "MAX_HOT_VALUES", 10)
+    src = _source()
+    assert "hot_states" not in src.settings and "hot_step_widths" not in src.settings
+    more = _fit(n_iter=10, n_chains=2, init=src, seed=4, **SMALL)
+    assert more.settings["tune"] is True and "hot_states" not in more.settings
