@@ -192,7 +192,9 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
         if D.ndim == 1:
             D = D[:, None]
         if D.ndim != 2 or D.shape[0] != grid.size:
-            raise GPMSAError(f"discrepancy basis must be ({grid.size}, p_v), got {D.shape}")
+            hint = "; SEPIA stores D as (p_v, l_obs): pass its transpose" if (
+                D.ndim == 2 and D.shape[1] == grid.size) else ""  # fmt: skip
+            raise GPMSAError(f"discrepancy basis must be ({grid.size}, p_v), got {D.shape}{hint}")
         if not np.all(np.isfinite(D)):
             raise GPMSAError("discrepancy basis must be finite")
     return _normalised([D], "discrepancy basis is all zeros")[0]
@@ -201,15 +203,30 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
 def _normalised(bases: list[np.ndarray], zero: str) -> list[np.ndarray]:
     """``bases`` divided by one scale, so that the largest diag(D D^T) over all of them is 1
     (GPMSAError ``zero`` when they are all zero)."""
+    big, scale = _scale(bases)
+    if big is not None:
+        bases = [D / big for D in bases]
+    if not scale > 0:
+        raise GPMSAError(zero)
+    return [D / np.sqrt(scale) for D in bases]
+
+
+def _scale(bases: list[np.ndarray]) -> tuple[float | None, float]:
+    """`_normalised`'s divisors: the largest diag(D D^T) over ``bases``, after dividing them by
+    ``big`` (their largest |value|; None where the squares neither over- nor underflow)."""
     with np.errstate(over="ignore", under="ignore"):
         scale = max(np.max(np.sum(D**2, axis=1)) for D in bases)
     if not np.finfo(np.float64).tiny <= scale < np.inf and any(np.any(D) for D in bases):
         big = max(np.max(np.abs(D)) for D in bases)  # squares over/underflow: rescale first
-        bases = [D / big for D in bases]
-        scale = max(np.max(np.sum(D**2, axis=1)) for D in bases)
-    if not scale > 0:
-        raise GPMSAError(zero)
-    return [D / np.sqrt(scale) for D in bases]
+        return big, max(np.max(np.sum((D / big) ** 2, axis=1)) for D in bases)
+    return None, scale
+
+
+def scaled_as(bases: list[np.ndarray], D: np.ndarray) -> np.ndarray:
+    """``D`` divided as `_normalised` divides ``bases`` (the same basis functions on another
+    grid keep the fit's normalisation)."""
+    big, scale = _scale(bases)
+    return (D if big is None else D / big) / np.sqrt(scale)
 
 
 def is_basis_list(kind) -> bool:

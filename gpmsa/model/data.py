@@ -555,12 +555,26 @@ def _index(index, n: int, name: str) -> np.ndarray | None:
     interpolated along it)."""
     if index is None:
         return None
-    arr = as_float(index, name).reshape(-1)
+    arr = as_float(index, name)
+    if arr.ndim > 1 and sorted(arr.shape)[-2] > 1 and arr.size != n:
+        raise GPMSAError(multi_column_index(name, arr.shape))
+    arr = arr.reshape(-1)
     if arr.size != n:
         raise GPMSAError(f"{name} must have {n} entries (one per output column), got {arr.size}")
     check_finite(arr, name)
     check_increasing(arr, name)
     return arr
+
+
+def multi_column_index(name: str, shape: tuple) -> str:
+    """The message for an output index of several columns (SEPIA's (l, 2) y_ind of (time,
+    angle) pairs): the output grid here is one increasing coordinate."""
+    return (
+        f"{name} must be one output grid (l,), got shape {tuple(shape)}: an index of several "
+        "columns (SEPIA's y_ind of (time, angle) pairs, say) is not supported; the basis is "
+        "interpolated along one coordinate. Number the simulation's output points 0..l_sim-1 "
+        "and give each observation its point's number (docs/from-sepia.md)"
+    )
 
 
 def check_increasing(grid: np.ndarray, name: str) -> None:
@@ -1120,6 +1134,10 @@ class ObsData:
         if index is None:
             return [None] * len(ys)
         per_experiment = isinstance(index, (list, tuple)) and len(index) > 0
+        if per_experiment and len(index) == len(ys):
+            for j, g in enumerate(index):
+                if np.ndim(g) == 2 and min(np.shape(g)) > 1:
+                    raise GPMSAError(multi_column_index(f"index[{j}]", np.shape(g)))
         per_experiment = per_experiment and all(np.ndim(g) == 1 for g in index)
         if per_experiment and len(index) != len(ys) and all(np.size(g) == 1 for g in index):
             per_experiment = False  # one grid as a column of 1-point lists

@@ -42,6 +42,7 @@ from gpmsa.model.basis import (
     discrepancy_kind,
     interpolate_basis,
     is_basis_list,
+    scaled_as,
 )
 from gpmsa.model.constraints import round_levels
 from gpmsa.model.correlation import correlation
@@ -308,6 +309,31 @@ def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool, b
     return D * (scales.pop() / D[0, 0])
 
 
+def _given_on_grid(kind, given, grid: np.ndarray, scalar: bool) -> np.ndarray:
+    """``given`` (grid.size, p_v): the basis functions of the calibration's array or list
+    ``kind`` on the prediction grid, divided as the fit divided the observations' bases."""
+    if scalar or kind is None or isinstance(kind, str):
+        raise GPMSAError(
+            "grid_discrepancy= goes with a discrepancy basis given as an array or a list, on a "
+            "multivariate output ('constant' and 'linear' are known on any grid)"
+        )
+    raw = [as_float(d, "discrepancy") for d in (kind if is_basis_list(kind) else [kind])]
+    raw = [d[:, None] if d.ndim == 1 else d for d in raw]
+    p_v = raw[0].shape[1]
+    D = as_float(given, "grid_discrepancy")
+    if D.ndim == 1 and p_v == 1:
+        D = D[:, None]
+    if D.shape != (grid.size, p_v):
+        hint = "; SEPIA stores D as (p_v, l): pass its transpose" if (
+            D.shape == (p_v, grid.size)) else ""  # fmt: skip
+        raise GPMSAError(
+            f"grid_discrepancy must be ({grid.size}, {p_v}): one row per point of the "
+            f"prediction grid, one column per discrepancy basis vector; got {D.shape}{hint}"
+        )
+    check_finite(D, "grid_discrepancy")
+    return scaled_as(raw, D)
+
+
 def _experiment_basis(bases, obs_grids: list[np.ndarray], grid: np.ndarray) -> np.ndarray:
     """Per-experiment bases (a list, normalised jointly): the basis of the experiments whose
     index grid is ``grid`` (SEPIA's full prediction likewise takes one experiment's D_obs,
@@ -470,6 +496,7 @@ def full_prediction(
     seed=None,
     experiment: int | None = None,
     extrapolate: bool = False,
+    grid_discrepancy=None,
 ) -> FullPrediction:
     """The calibrated prediction at new x: eta(x, theta), delta(x) and y(x), draw by draw.
 
@@ -516,6 +543,10 @@ def full_prediction(
             ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width, ``x`` with an
             ExtrapolationWarning; False: GPMSAError naming the column (a calibration made with
             ``extrapolate=True`` is predicted from with it too).
+        grid_discrepancy: with a discrepancy basis given as an array or a list, the same basis
+            functions evaluated on the prediction grid (``grid``, or its default), (l, p_v)
+            as given to the fit, before normalisation (SEPIA's ``D_sim``): delta there, the
+            fit's normalisation applied. None: the basis on the observations' grid only.
 
     Returns:
         FullPrediction (native units; ``u``, ``v``, ``mu``, ``cov`` in the basis space).
@@ -600,7 +631,13 @@ def full_prediction(
             "grids): pass the calibration's discrepancy= (the same kind, array or list) and "
             "discrepancy_groups="
         )
-    if experiment is None:
+    if grid_discrepancy is not None:
+        if experiment is not None:
+            raise GPMSAError("grid_discrepancy= and experiment= both choose delta's basis: "
+                             "give one")  # fmt: skip
+        g = _pred_grid(emulator, obs, grid)
+        D_pred = _given_on_grid(discrepancy, grid_discrepancy, g, scalar)
+    elif experiment is None:
         g = _pred_grid(emulator, obs, grid)
         D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar, ob.D)
     else:
