@@ -1,6 +1,8 @@
 """``gpmsa calibrate FILE --x v=1.25 --y f=12.1``: print the posterior of one observation
 (``--y-csv PATH``: its outputs from a CSV file, a functional output's many values; ``--fixed
-GD=400`` holds a calibration parameter, or lamOs, at a known value: MCMC)."""
+GD=400`` holds a calibration parameter, or lamOs, at a known value: MCMC), and name each
+calibration parameter piled against a bound of the emulator's domain (``gpmsa.mcmc.bounds``:
+the command is a one-off, unlike the Calibrator's updates in a loop, which stay silent)."""
 
 from __future__ import annotations
 
@@ -307,6 +309,7 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
         post = cal.update(x, y)
         summary = post.summary(args.level)
         seconds = time.perf_counter() - t0
+        piled = _at_bound(emu, post)
     except GPMSAError as exc:  # the library's advice, in this command's words
         advice = str(exc).replace("pass extrapolate=True", "pass --extrapolate")
         print(f"gpmsa calibrate: {safe(advice)}", file=sys.stderr)
@@ -324,6 +327,7 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
             **({"fixed": fixed} if fixed else {}),
             "seconds": seconds,
             "posterior": summary,
+            "at_bound": {name: side for name, (side, _) in piled.items()},
         }
         print(json.dumps(jsonable(out), indent=1, allow_nan=False))  # RFC 8259: no NaN
         return 0
@@ -339,7 +343,33 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
             continue
         print(f"{safe(name, 60):>10s} {s['mean']:12.5g} {s['sd']:12.5g} {s[lo_key]:12.5g} "
               f"{s['median']:12.5g} {s[hi_key]:12.5g}")  # fmt: skip
+    for name, (_, text) in piled.items():
+        print(f"{safe(name, 60)}: piled against the emulator's domain at {text}: the truth may "
+              "lie outside the simulation design (widen it beyond that bound and refit), or "
+              "the model misses something theta absorbs (check the emulator and units, add a "
+              "discrepancy)")  # fmt: skip
     return 0
+
+
+def _at_bound(emu, post) -> dict[str, tuple[str, str]]:
+    """name -> (side, `bound_text`'s words) for each calibration parameter that the posterior
+    piles against a bound of the emulator's domain (``gpmsa.mcmc.bounds.at_bound``, the rule
+    of ``gpmsa.calibrate``: half its mass within 1 % of the width of the bound), judged on
+    the grid posterior's exact marginal (its CDF: no draws) where it has one, else on the
+    draws; held (--fixed) and categorical parameters are not judged."""
+    from gpmsa.calibration.observations import theta_levels_native
+    from gpmsa.calibration.posterior import held_names
+    from gpmsa.mcmc.bounds import at_bound, bound_text
+
+    names = list(emu.t_names)
+    skip = {*held_names(post.info), *theta_levels_native(emu)}
+    judged = [n for n in names if n not in skip]
+    values = {n: post.grids[n] if n in post.grids else post.samples[n] for n in judged}
+    lo, hi = emu.standardizer.t_min, emu.standardizer.t_max
+    found = at_bound(values, names, lo, hi, skip)
+    return {n: (side, bound_text(side, values[n], float(lo[names.index(n)]),
+                                 float(hi[names.index(n)])))
+            for n, side in found.items()}  # fmt: skip
 
 
 def _fixed_option(fixed: dict[str, float]) -> dict:

@@ -37,6 +37,7 @@ from gpmsa.fitting.fit import (
 )
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, tempering, tuning
+from gpmsa.mcmc.bounds import warn_at_bound
 from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.mcmc.starts import check_init
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
@@ -57,7 +58,14 @@ from gpmsa.studies.layout import (
 )
 from gpmsa.studies.record import DISCREPANCIES, discrepancy_arrays
 from gpmsa.studies.sampler import StudyChains, held_elements, sample_study
-from gpmsa.studies.study import HELD_THETA, OBS_DIGESTS, OBS_LAYOUTS, Study, layout_of
+from gpmsa.studies.study import (
+    HELD_THETA,
+    OBS_DIGESTS,
+    OBS_LAYOUTS,
+    Study,
+    layout_of,
+    theta_domains,
+)
 
 
 def _sequence(value, what: str) -> list:
@@ -473,7 +481,11 @@ def calibrate_study(
     other by "NAME[LABEL]", each model's "lamOs[LABEL]" (and with a discrepancy its
     "betaV[LABEL]" and "lamVz[LABEL]", NAME as ``gpmsa.calibrate`` names it: "betaV[0][LABEL]"
     for several inputs, "lamVz[1][LABEL]" for several groups) and each hierarchical group's
-    "NAME.mu", "NAME.sd" (native units) and "NAME.lam" (unit-scale precision). GPMSAError
+    "NAME.mu", "NAME.sd" (native units) and "NAME.lam" (unit-scale precision).
+    ``study.posterior.info["at_bound"]`` names each study element and group mean whose
+    posterior piles up against a bound of its domain (``gpmsa.calibrate``'s rule,
+    ``gpmsa.mcmc.bounds``; categorical and held ones not judged), and one
+    ``gpmsa.AtBoundWarning`` names them (``fit_study`` likewise). GPMSAError
     names a bad input: mismatched numbers of models (or discrepancy entries), an unknown
     shared name, a shared or hierarchical parameter whose range differs between the models.
 
@@ -599,7 +611,17 @@ def calibrate_study(
                                                renamed))  # fmt: skip
     study = Study("calibration", emulators, layout, hyper, draws, settings, metadata)
     warn_unconverged(study.convergence, "gpmsa.calibrate_study", length="n_samples")
+    _warn_at_bound(study, "gpmsa.calibrate_study")
     return study
+
+
+def _warn_at_bound(study: Study, where: str) -> None:
+    """One ``AtBoundWarning`` naming the study's parameters that its posterior's
+    ``info["at_bound"]`` flags (``Study``: each element, each hierarchical group's mean; held
+    and categorical ones not judged), as ``gpmsa.calibrate`` warns; none where none is."""
+    post = study.posterior
+    warn_at_bound(post.info["at_bound"], post.samples, *theta_domains(study.layout), where,
+                  "study.posterior.info['at_bound']")  # fmt: skip
 
 
 def _record_fixed(settings: dict, labels, problems, layout, fixes, natives,
@@ -901,4 +923,5 @@ def fit_study(
         warn_unconverged(records[1], f"gpmsa.fit_study (model {labels[i]!r})")
     study = Study("fit", members, layout, hyper, draws, settings, metadata)
     warn_unconverged(study.convergence, "gpmsa.fit_study")
+    _warn_at_bound(study, "gpmsa.fit_study")
     return study

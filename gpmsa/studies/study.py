@@ -32,6 +32,7 @@ from gpmsa.io.container import (
     verify_content,
     write_sealed,
 )
+from gpmsa.mcmc.bounds import at_bound
 from gpmsa.mcmc.diagnostics import convergence, summarize, to_inference_data
 from gpmsa.model.data import as_real, check_count
 from gpmsa.model.discrepancy import to_samples
@@ -145,6 +146,22 @@ def native_chains(layout: Layout, draws: dict[str, np.ndarray]) -> dict[str, np.
     return out
 
 
+def theta_domains(layout: Layout) -> tuple[list[str], np.ndarray, np.ndarray]:
+    """The posterior names that ``gpmsa.mcmc.bounds.at_bound`` judges, and each one's native
+    domain (lower, upper bounds): each study element's (its models' range: a shared or
+    hierarchical parameter's is one range in every model, ``build_layout``; a model's own, its
+    emulator's) and each hierarchical group's mean "NAME.mu", whose prior stops at that same
+    range (mu is truncated to it, as its elements are): piled there, the group's centre lies
+    beyond the design. The group's sd and precision, and lamOs, have no such bound."""
+    names = [el.name for el in layout.elements]
+    bounds = list(layout.bounds)
+    for h, name in enumerate(layout.groups):
+        names.append(f"{name}.mu")
+        bounds.append(layout.bounds[layout.members_of(h)[0]])
+    lo, hi = np.array(bounds, dtype=np.float64).reshape(-1, 2).T
+    return names, lo, hi
+
+
 def study_units(layout: Layout, members) -> dict[str, str]:
     """The unit of each study posterior name that has one (``Posterior.info["units"]``, as
     ``gpmsa.calibrate`` records it, so that plots label its axes): each study element's, its
@@ -255,6 +272,9 @@ class Study:
             info["levels"] = levels
         shapes = {k: () for k in chains}  # one chain too: its split R-hat (as gpmsa.fit's)
         held = held_names(self.settings)  # fitted with fixed=: not judged
+        # piled against a bound of the domain (calibrate_study and fit_study warn of it; a
+        # study read from a file is judged anew, silently, as calibration_posterior's)
+        info["at_bound"] = at_bound(samples, *theta_domains(layout), {*held, *levels})
         self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held,
                                        levels=set(levels))  # fmt: skip
         info["convergence"] = self.convergence
@@ -321,6 +341,9 @@ class Study:
         codes = theta_levels_native(self.members[i])
         if codes:  # a categorical theta: its quantiles are levels (as study.posterior's)
             info["levels"] = codes
+        flagged = self.posterior.info["at_bound"]  # its elements', as calibrate records it
+        info["at_bound"] = {n: flagged[pooled[n]] for n in self.members[i].t_names
+                            if pooled[n] in flagged}  # fmt: skip
         return Posterior({k: v.reshape(-1) for k, v in out.items()}, chains=out, info=info)
 
     def summary(self, level: float = 0.9) -> dict[str, dict[str, float]]:
@@ -451,8 +474,9 @@ def load_study(path: str | Path, *, sha256: str | None = None) -> Study:
     models, and what the manifest says of them (the models' names and units, the kind, the
     chain and draw counts) against the draws and models
     (``gpmsa.studies.record.check_study_claims``); the diagnostics and convergence record are
-    computed anew from the draws. A symbolic link ``path`` reads the model files beside the
-    link's target. Raises EmulatorFileError naming the file and the field.
+    computed anew from the draws, as is ``posterior.info["at_bound"]`` (without a warning). A
+    symbolic link ``path`` reads the model files beside the link's target. Raises
+    EmulatorFileError naming the file and the field.
 
     >>> import gpmsa
     >>> gpmsa.load_study("no-such-study.gpmsa")  # doctest: +ELLIPSIS
