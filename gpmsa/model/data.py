@@ -1142,6 +1142,8 @@ class ObsData:
         if per_experiment and len(index) != len(ys) and all(np.size(g) == 1 for g in index):
             per_experiment = False  # one grid as a column of 1-point lists
         rows = isinstance(index, np.ndarray) and index.ndim == 2 and min(index.shape) > 1
+        if rows and all(e.size == index.shape[0] != index.shape[1] for e in ys):
+            raise GPMSAError(multi_column_index("index", index.shape))  # (l, k): SEPIA's y_ind
         if per_experiment or rows:  # an (n, l) array: a grid per experiment; (l, 1): one
             if len(index) != len(ys):
                 raise GPMSAError(

@@ -546,7 +546,9 @@ def full_prediction(
         grid_discrepancy: with a discrepancy basis given as an array or a list, the same basis
             functions evaluated on the prediction grid (``grid``, or its default), (l, p_v)
             as given to the fit, before normalisation (SEPIA's ``D_sim``): delta there, the
-            fit's normalisation applied. None: the basis on the observations' grid only.
+            fit's normalisation applied (with the list given to the fit as ``discrepancy=``:
+            a joint fit's kept ``discrepancy_bases`` are normalised, their scale not kept,
+            GPMSAError). None: the basis on the observations' grid only.
 
     Returns:
         FullPrediction (native units; ``u``, ``v``, ``mu``, ``cov`` in the basis space).
@@ -635,6 +637,13 @@ def full_prediction(
         if experiment is not None:
             raise GPMSAError("grid_discrepancy= and experiment= both choose delta's basis: "
                              "give one")  # fmt: skip
+        kept = getattr(emulator, "discrepancy_bases", None)
+        if kept is not None and discrepancy is kept:  # normalised: the fit's scale is lost
+            raise GPMSAError(
+                "grid_discrepancy= is divided by the scale that normalised the fit's bases, "
+                "which the joint fit does not keep (Emulator.discrepancy_bases are normalised): "
+                "pass the list given to the fit again as discrepancy="
+            )
         g = _pred_grid(emulator, obs, grid)
         D_pred = _given_on_grid(discrepancy, grid_discrepancy, g, scalar)
     elif experiment is None:

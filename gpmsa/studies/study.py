@@ -162,6 +162,12 @@ def theta_domains(layout: Layout) -> tuple[list[str], np.ndarray, np.ndarray]:
     return names, lo, hi
 
 
+def _at_bound(layout: Layout, samples: dict, settings: dict, levels) -> dict[str, str]:
+    """``posterior.info["at_bound"]`` of a study: `at_bound` over `theta_domains`, its held
+    (``settings``) and categorical (``levels``: their names) elements not judged."""
+    return at_bound(samples, *theta_domains(layout), {*held_names(settings), *levels})
+
+
 def study_units(layout: Layout, members) -> dict[str, str]:
     """The unit of each study posterior name that has one (``Posterior.info["units"]``, as
     ``gpmsa.calibrate`` records it, so that plots label its axes): each study element's, its
@@ -274,11 +280,20 @@ class Study:
         held = held_names(self.settings)  # fitted with fixed=: not judged
         # piled against a bound of the domain (calibrate_study and fit_study warn of it; a
         # study read from a file is judged anew, silently, as calibration_posterior's)
-        info["at_bound"] = at_bound(samples, *theta_domains(layout), {*held, *levels})
+        info["at_bound"] = _at_bound(layout, samples, self.settings, levels)
         self.convergence = convergence(self.diagnostics, shapes, n_chains, n_draws, held,
                                        levels=set(levels))  # fmt: skip
         info["convergence"] = self.convergence
         self.posterior = Posterior(samples, chains=chains, info=info)
+
+    def __setstate__(self, state: dict) -> None:
+        """For pickle: a study pickled before ``posterior.info["at_bound"]`` was kept is judged
+        now (as one read from a file), so that ``member_posterior`` finds it."""
+        self.__dict__.update(state)
+        info = self.posterior.info
+        if "at_bound" not in info:
+            info["at_bound"] = _at_bound(self.layout, self.posterior.samples, self.settings,
+                                         info.get("levels") or {})  # fmt: skip
 
     @property
     def labels(self) -> tuple[str, ...]:
