@@ -139,3 +139,21 @@ def test_roadgen_speed_prints_the_load_average_with_its_timings() -> None:
     assert lines[0].startswith("median of 1 runs; load average ")
     assert lines[-1].startswith("load average ") and lines[-1].endswith(" cores")
     assert sum(line.endswith(" ms") for line in lines) == 7
+
+
+def test_tempered_continuation_prints_each_variant_with_its_ratios_and_the_load(capsys) -> None:
+    # in this interpreter (its main takes argv): a fresh one's start and imports cost ~1.5 s
+    load_benchmark("tempered_continuation").main(["--quick"])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("# two-mode case") and "load average " in lines[0]
+    assert lines[-1].startswith("load average ") and lines[-1].endswith(" cores")
+    rows = [line for line in lines if line.startswith(("(a)", "(b)", "(c)"))]
+    assert len(rows) == 3
+    assert all("(exact 0.5)" in row and " of 2 chains" in row for row in rows)
+    assert lines[-2].startswith("a/b ") and "; a/c " in lines[-2]
+
+
+def test_tempered_continuation_refuses_too_few_sweeps() -> None:
+    bench = load_benchmark("tempered_continuation")
+    with pytest.raises(SystemExit):
+        bench.main(["--sweeps", "5"])
