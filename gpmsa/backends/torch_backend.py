@@ -42,6 +42,7 @@ from gpmsa.mcmc.sampler import (
     RHO_PARAMS,
     Chains,
     check_draws_memory,
+    check_hot_copies,
     check_ridge,
     check_step_widths,
     draws_nbytes,
@@ -969,6 +970,7 @@ def sample(
     temperatures=None,
     swap_every: int = 1,
     adapt_ladder: bool = False,
+    hot_copies: dict | None = None,
 ) -> Chains:
     """Run ``n_chains`` chains batched in one tensor program: tuning, then ``n_iter`` sweeps.
 
@@ -1028,6 +1030,13 @@ def sample(
     its groups (``chain_groups`` > 1) given their chains' ladders. ``info`` records
     "adapt_ladder" and "adapted_temperatures" (n_chains, K) ("temperatures": the starting
     ladder).
+
+    A tempered run's ``info`` records "hot_states" and "hot_step_widths" (name -> (n_chains, K
+    - 1, *shape), as the numpy backend's): each hot copy's last state (float64) and its widths
+    (copy k's shared by the chains; NaN where not sampled). ``hot_copies`` ({"starts": ...,
+    "widths": ...} of that form; ``sampler.check_hot_copies``) starts row c K + k at chain c's
+    hot copy k, each copy's widths the median over the chains of its given ones (run as they
+    are where ``tune`` is False: a continuation resuming every copy where it stopped).
     """
     check_sample_args(n_iter, n_chains, seed)
     tune, progress = check_flag(tune, "tune"), check_flag(progress, "progress")
@@ -1044,6 +1053,7 @@ def sample(
                 "torch backend adapts from one ladder; give temperatures= one ladder"
             )
         temps = np.array(ladders)
+    hot = check_hot_copies(hot_copies, problem, ladders, int(n_chains))
     check_draws_memory(problem, int(n_iter), int(n_chains))
     check_batch_memory(problem, int(n_iter), int(n_chains), _dtype(dtype), copies)
     where = _check_groups(chain_groups, n_jobs, executor, int(n_chains), device, num_threads)
@@ -1054,7 +1064,7 @@ def sample(
         return _sample(problem, n_iter, int(n_chains), tune, step_widths, seed, progress,
                        tune_rounds, tune_levels, device, dtype, init, warmup,
                        tune_stages, check_ridge(ridge_moves, problem), where, prop_mh,
-                       temps, swap_every, adapt)  # fmt: skip
+                       temps, swap_every, adapt, hot)  # fmt: skip
 
 
 def callables(problem: Problem) -> list[str]:
@@ -1122,9 +1132,11 @@ def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_thr
 def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_rounds,
             tune_levels, device, dtype, init, warmup, tune_stages, n_ridge,
             where, prop_mh: bool, temps: tuple[float, ...] | None = None,
-            swap_every: int = 1, adapt: bool = False) -> Chains:  # fmt: skip
+            swap_every: int = 1, adapt: bool = False,
+            hot: list | None = None) -> Chains:  # fmt: skip
     """``sample`` without the thread setting (``prop_mh``: its ``proportional_steps``, decided;
-    ``temps``: the ladder, checked, or None; ``adapt``: its ``adapt_ladder``, checked)."""
+    ``temps``: the ladder, checked, or None; ``adapt``: its ``adapt_ladder``, checked; ``hot``:
+    its ``hot_copies``, checked: each chain's K - 1 hot copies' (start, widths), or None)."""
     dev, dt = _device(device), _dtype(dtype)
     warmup = (WARMUP if tune else 0) if warmup is None else check_count(warmup, "warmup", 0)
     tune_stages = check_count(tune_stages, "tune_stages")
@@ -1139,9 +1151,16 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
     start = {k: np.stack([f[k] for f in firsts]) for k in problem.init}
     copies = 1 if temps is None else np.shape(temps)[-1]
     rows = start if temps is None else {k: np.repeat(v, copies, axis=0) for k, v in start.items()}
+    for c, chain in enumerate(hot or []):  # row c K + k: chain c's hot copy k where it stopped
+        for k, (at, _) in enumerate(chain, start=1):
+            for n in rows:
+                rows[n][c * copies + k] = at[n]
     state = BatchState(problem, int(n_chains) * copies, dt, dev, rows, n_ridge)
     els = state.els
     w = np.array([float(widths[n][idx]) for n, idx in els])
+    ws0 = None if hot is None else np.stack([w, *(  # each hot copy's: its median over the chains
+        [float(np.median([chain[k][1][n][idx] for chain in hot])) for n, idx in els]
+        for k in range(copies - 1))])  # fmt: skip
     n_stages = tune_stages if tune else 1
     total = n_iter + n_stages * (warmup + (tune_rounds * tune_levels if tune else 0))
     total += tune_rounds * tune_levels if adapt else 0  # the ladder's adaptation
@@ -1156,10 +1175,10 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
             ws, ladders = _tempered_tuning(state, w, temps, prop_mh, gen, bar, warmup=warmup,
                                            n_stages=n_stages, tune=tune,
                                            tune_rounds=tune_rounds, tune_levels=tune_levels,
-                                           adapt=adapt)  # fmt: skip
+                                           adapt=adapt, ws=ws0)  # fmt: skip
             w = ws[0]
             if in_process:
-                draws, log_post, accepted, rates = _tempered_draws(
+                draws, log_post, accepted, rates, hot_states = _tempered_draws(
                     state, ws, ladders, swap_every, n_iter, prop_mh, gen, bar
                 )
         elif tune:  # the widths tuned with the level moves (a categorical theta; no draws used)
@@ -1184,7 +1203,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
             bar.set_description("torch MCMC: sampling")
             draws, log_post, accepted = _sweeps(state, w, n_iter, prop_mh, gen, bar)
     if not in_process:
-        draws, log_post, accepted, rates = _grouped_sweeps(
+        draws, log_post, accepted, rates, hot_states = _grouped_sweeps(
             state, w if temps is None else ws, n_iter, prop_mh, seeds[0], where,
             dtype=str(dt).replace("torch.", ""), progress=progress, temps=ladders,
             swap_every=swap_every,
@@ -1194,6 +1213,9 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                                          "swap_rate": rates}  # fmt: skip
     if adapt:  # each chain's ladder, adapted in its tuning and frozen for its draws
         tempered.update(adapt_ladder=True, adapted_temperatures=np.asarray(ladders))
+    if temps is not None:  # each hot copy's last state and widths (n_chains, K - 1, *shape)
+        tempered.update(hot_states=hot_states, hot_step_widths=_hot_widths(problem, els, ws,
+                                                                           n_chains))  # fmt: skip
     rate = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
     wid = {n: np.full((n_chains, *problem.init[n].shape), np.nan) for n in names}
     acc_np = accepted / n_iter
@@ -1217,6 +1239,16 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
                               for k, v in state.level_shifts.items()}}}),
               **tempered},
     )  # fmt: skip
+
+
+def _hot_widths(problem: Problem, els: list, ws: np.ndarray, n_chains: int) -> dict:
+    """Each hot copy's widths of ``ws`` (K, n_el; copy k's shared by the chains) as name ->
+    (n_chains, K - 1, *shape), NaN where not sampled (``info`` "hot_step_widths")."""
+    out = {n: np.full((n_chains, len(ws) - 1, *problem.init[n].shape), np.nan)
+           for n in problem.names}  # fmt: skip
+    for i, (n, idx) in enumerate(els):
+        out[n][(slice(None), slice(None), *idx)] = ws[1:, i]
+    return out
 
 
 def _swap_rows(state: BatchState, betas: tuple[float, ...] | Tensor, u: Tensor, accepted: Tensor,
@@ -1270,10 +1302,12 @@ def _swap_round(state: BatchState, betas: tuple[float, ...] | Tensor, gen: torch
 
 def _tempered_tuning(state: BatchState, w: np.ndarray, temps: tuple[float, ...], prop_mh: bool,
                      gen: torch.Generator, bar, *, warmup: int, n_stages: int, tune: bool,
-                     tune_rounds: int, tune_levels: int, adapt: bool = False) -> tuple:  # fmt: skip
+                     tune_rounds: int, tune_levels: int, adapt: bool = False,
+                     ws: np.ndarray | None = None) -> tuple:  # fmt: skip
     """``_sample``'s warm-up and tuning with parallel tempering (``sample``'s
     ``temperatures``): ``state`` holds C chains x K copies (row c K + k at temperature
-    ``temps[k]``), every copy from the widths ``w`` (n_el,). Each stage: ``warmup`` sweeps,
+    ``temps[k]``), every copy from the widths ``w`` (n_el,), or copy k from ``ws[k]`` (K, n_el;
+    resumed hot copies). Each stage: ``warmup`` sweeps,
     then GPM/SA's tuning of each copy's widths at its temperature (acceptance pooled over the
     chains' copy k), a swap round (`_swap_rows`) after each sweep and each tuning level; then
     the level shifts learnt at T = 1. ``adapt`` (``sample``'s ``adapt_ladder``): after the
@@ -1285,7 +1319,7 @@ def _tempered_tuning(state: BatchState, w: np.ndarray, temps: tuple[float, ...],
     betas = _temper(state, temps)
     swaps = torch.zeros((n_temps - 1, n_chains), dtype=torch.long, device=state.ll_w.device)
     names = [n for n, _ in state.els]
-    ws = np.tile(w, (n_temps, 1))  # each copy's widths
+    ws = np.tile(w, (n_temps, 1)) if ws is None else ws  # each copy's widths
     if tune:  # the widths tuned with the level moves (a categorical theta), learnt at T = 1
         state.learn_level_shifts(n_temps)
     for _stage in range(n_stages):
@@ -1370,8 +1404,9 @@ def _tempered_draws(state: BatchState, ws: np.ndarray, temps, swap_every: int, n
     """``n_iter`` sweeps of a tempered batch (rows c K + k at ``temps[k]``, or at ``temps[c,
     k]`` with each chain's ladder (C, K), an adapted one; each copy at its widths ``ws`` (K,
     n_el)), a swap round every ``swap_every``: `_sweeps`' draws, log posterior and accepted
-    counts of the T = 1 rows, and the swap rate (C, K - 1) of each neighbour pair over the swap
-    rounds. One batch's, or a chain group's (`_group_task`)."""
+    counts of the T = 1 rows, the swap rate (C, K - 1) of each neighbour pair over the swap
+    rounds and the hot copies' last states name -> (C, K - 1, *shape) (float64). One batch's,
+    or a chain group's (`_group_task`)."""
     n_temps = np.shape(temps)[-1]
     n_chains = state.n_chains // n_temps
     betas = _temper(state, temps)
@@ -1392,8 +1427,10 @@ def _tempered_draws(state: BatchState, ws: np.ndarray, temps, swap_every: int, n
         log_post[it] = state.log_post()[cold]
         bar.update(1)
     rate = swaps.cpu().numpy().T / max(n_iter // swap_every, 1)
+    hot = {n: v.cpu().numpy().astype(np.float64).reshape(n_chains, n_temps, *v.shape[1:])[:, 1:]
+           for n, v in state.params.items()}  # fmt: skip
     return ({n: np.moveaxis(v.cpu().numpy(), 0, 1) for n, v in draws.items()},
-            log_post.cpu().numpy().T, accepted.cpu().numpy(), rate)  # fmt: skip
+            log_post.cpu().numpy().T, accepted.cpu().numpy(), rate, hot)  # fmt: skip
 
 
 def _sweeps(
@@ -1426,7 +1463,7 @@ def _group_task(problem: Problem, start: dict[str, np.ndarray], widths: np.ndarr
     n)) of the joint level move (None: none). ``temps``: parallel tempering (None: off; the
     ladder (K,), or its chains' adapted ladders (C', K));
     ``start`` then holds the group's chains' rows c K + k (every copy), ``widths`` each copy's
-    (K, n_el), and the result adds the swap rates (`_tempered_draws`)."""
+    (K, n_el), and the result adds the swap rates and hot copies' states (`_tempered_draws`)."""
     with torch_threads(1), torch.no_grad():
         n_rows = len(next(iter(start.values())))
         state = BatchState(problem, n_rows, _dtype(dtype), "cpu", start, ridge_moves)
@@ -1450,7 +1487,8 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
     ``temps``: parallel tempering (``widths`` each copy's (K, n_el)): each group holds whole
     chains, rows c K + k of all K copies, and runs `_tempered_draws` (``temps`` (C, K), each
     chain's adapted ladder: each group given its chains'). Returns draws, log posterior,
-    accepted counts and the swap rates (C, K - 1; None untempered)."""
+    accepted counts, the swap rates (C, K - 1) and the hot copies' last states (name -> (C, K -
+    1, *shape)); the last two None untempered."""
     copies = 1 if temps is None else np.shape(temps)[-1]
     per_chain = isinstance(temps, np.ndarray) and temps.ndim == 2
     c, k = state.n_chains // copies, where["groups"]
@@ -1478,7 +1516,8 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
         expected = ({n: (size, int(n_iter), *v) for n, v in shapes.items()},
                     (size, int(n_iter)), (len(state.els), size))  # fmt: skip
         if temps is not None:
-            expected = (*expected, (size, copies - 1))
+            expected = (*expected, (size, copies - 1),
+                        {n: (size, copies - 1, *v) for n, v in shapes.items()})  # fmt: skip
         return wrong_result(result, expected, f"{size} chains x {n_iter} sweeps")
 
     try:
@@ -1491,5 +1530,6 @@ def _grouped_sweeps(state: BatchState, widths: np.ndarray, n_iter: int, prop_mh:
         raise ChainError(f"chains {chains[0]}-{chains[-1]}: {exc}", chains) from exc
     draws = {n: np.concatenate([r[0][n] for r in runs]) for n in runs[0][0]}
     rates = None if temps is None else np.concatenate([r[3] for r in runs])
+    hot = None if temps is None else {n: np.concatenate([r[4][n] for r in runs]) for n in shapes}
     return (draws, np.concatenate([r[1] for r in runs]), np.concatenate([r[2] for r in runs], 1),
-            rates)  # fmt: skip
+            rates, hot)  # fmt: skip

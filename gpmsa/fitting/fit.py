@@ -207,11 +207,12 @@ def fit(
     backend (docs/internals.md, "Parallel tempering"). A continuation (``init`` an emulator) of a
     tempered fit runs on tempered, at its ladder (each chain's where they adapted theirs) and
     ``swap_every`` unless ``temperatures=`` is given (``temperatures=None`` given, or 1:
-    untempered); a plain fit's with ``temperatures=`` at that ladder. A numpy tempered fit records
-    each hot copy's last state and widths (settings "hot_states", "hot_step_widths"), and its
-    numpy continuation at that ladder resumes every copy where it stopped, untuned (``tune``
-    None or False), the T = 1 copy at the chain's last kept draw: no warm-up. Otherwise (no such
-    record, another ladder, torch, ``tune=True``, ``step_widths=`` or ``adapt_ladder=True``)
+    untempered); a plain fit's with ``temperatures=`` at that ladder. A numpy or torch tempered fit
+    records each hot copy's last state and widths (settings "hot_states", "hot_step_widths"), and
+    its continuation at that ladder (either backend's) resumes every copy where it stopped,
+    untuned (``tune`` None or False; torch: each copy at the median of its chains' widths), the
+    T = 1 copy at the chain's last kept draw: no warm-up. Otherwise (no such record, another
+    ladder, ``tune=True``, ``step_widths=`` or ``adapt_ladder=True``)
     every copy of a chain starts at the chain's last kept state, from its recorded widths, and
     is tuned at its temperature (the copies warming up, swapping: ``tune_rounds`` x
     ``tune_levels`` sweeps per copy) before any draw is kept; ``tune=False`` is refused there,
@@ -261,14 +262,14 @@ def fit(
     temps = _check_tempering(options, backend)
     if continuing and backend in MH_BACKENDS:  # the source's ladder unless temperatures= given
         temps = continued_ladder(options["init"], options, int(n_chains), temps)
-    resume = (continuing and backend == "numpy" and temps is not None and tune is not True
+    resume = (continuing and backend in MH_BACKENDS and temps is not None and tune is not True
               and step_widths is None
               and resumes_copies(options["init"], options, int(n_chains)))  # fmt: skip
     if continuing and temps is not None and tune is False and not resume:
         raise GPMSAError(
             "tune=False with a tempered continuation (temperatures=, or init=emulator a tempered "
-            "fit) that does not resume its hot copies (a numpy fit at the source's ladder, "
-            "whose record holds them, settings 'hot_states'): every copy is tuned at its "
+            "fit) that does not resume its hot copies (a numpy or torch fit at the source's "
+            "ladder, whose record holds them, settings 'hot_states'): every copy is tuned at its "
             "temperature (from the T = 1 copy's widths) while the copies warm up from the "
             "chain's last state, before any draw is kept; leave tune out (or tune=True: from "
             "GPM/SA's widths), or pass temperatures=None to continue without tempering"
@@ -421,15 +422,15 @@ def tempering_record(info: dict, source: Emulator | None) -> dict:
     started from), "swap_every", "swap_rate" (per chain, per neighbour pair) and, where the
     chains adapted their ladders (``adapt_ladder``) or continued ``source``'s adapted ones
     (each chain at its own: "temperatures" then the source's), "adapted_temperatures" (per
-    chain, frozen for the draws); on numpy, the hot copies' last states and widths
-    (``HOT_RECORD``) where they hold at most ``MAX_HOT_VALUES`` numbers."""
+    chain, frozen for the draws); the hot copies' last states and widths (``HOT_RECORD``;
+    numpy, torch) where they hold at most ``MAX_HOT_VALUES`` numbers."""
     out = {"temperatures": np.asarray(info["temperatures"]).tolist(),
            "swap_every": int(info["swap_every"]),
            "swap_rate": np.asarray(info["swap_rate"]).tolist()}  # fmt: skip
     if "adapted_temperatures" in info:  # per chain, frozen
         out["adapted_temperatures"] = np.asarray(info["adapted_temperatures"]).tolist()
     hot = [{k: np.asarray(v) for k, v in info[key].items()} for key in HOT_RECORD if key in info]
-    if hot and sum(v.size for h in hot for v in h.values()) <= MAX_HOT_VALUES:  # numpy
+    if hot and sum(v.size for h in hot for v in h.values()) <= MAX_HOT_VALUES:  # numpy, torch
         for key, record in zip(HOT_RECORD, hot, strict=True):  # each hot copy's last state and
             out[key] = {k: v.tolist() for k, v in record.items()}  # widths, to resume from
     return tempering.recorded_ladders(out, source.settings if source is not None else {})

@@ -552,10 +552,10 @@ def check_fixed_draws(held: dict, arrays: dict[str, np.ndarray]) -> None:
 
 
 HOT_RECORD = ("hot_states", "hot_step_widths")
-"""A numpy tempered fit's settings holding each hot copy's last state (the model's scale: theta
-on the unit scale) and its step widths, name -> (n_chains, K - 1, *shape), from which its
-continuation resumes every copy (``gpmsa.fitting.continuation.resumes_copies``); both or
-neither."""
+"""A numpy or torch tempered fit's settings holding each hot copy's last state (the model's
+scale: theta on the unit scale) and its step widths, name -> (n_chains, K - 1, *shape), from
+which its continuation (either backend's) resumes every copy
+(``gpmsa.fitting.continuation.resumes_copies``); both or neither."""
 
 MAX_HOT_VALUES = 50_000
 """Most numbers the hot copies' record may hold (both fields; ~25-50 bytes each in the JSON
@@ -564,11 +564,11 @@ and its continuation warms its copies up as one without the record does."""
 
 
 def check_hot_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None:
-    """A numpy tempered fit's hot copies (settings ``HOT_RECORD``, absent in other files, in
-    those written before the record existed and in those above ``MAX_HOT_VALUES``), both or
-    neither, each an object naming parameters with draws (``draw_``/``cal_`` arrays), its value
-    (n_chains, K - 1, *shape), K the length of settings.temperatures (where that is a list of 2
-    or more; a continuation names a damaged ladder): hot_states finite numbers,
+    """A numpy or torch tempered fit's hot copies (settings ``HOT_RECORD``, absent in other
+    files, in those written before the record existed and in those above ``MAX_HOT_VALUES``),
+    both or neither, each an object naming parameters with draws (``draw_``/``cal_`` arrays),
+    its value (n_chains, K - 1, *shape), K the length of settings.temperatures (where that is a
+    list of 2 or more; a continuation names a damaged ladder): hot_states finite numbers,
     hot_step_widths numbers > 0 and finite, or null (an element not sampled)."""
     given = [k for k in HOT_RECORD if settings.get(k) is not None]
     if not given:
