@@ -68,7 +68,19 @@ def continued_starts(
                 "groups or model?)"
             )
         out[name] = np.array(reordered(name, source[name], order)[last], dtype=np.float64)
+    if "theta" in out:
+        _at_levels(problem, out["theta"])
     return out
+
+
+def _at_levels(problem: Problem, theta) -> None:
+    """Each categorical element of the unit ``theta`` (..., q) that a float32 fit (torch
+    ``dtype="float32"``) held at a level rounded to float32 put back on that level, in place
+    (the prior has mass at the levels alone); other values left for the checks to name."""
+    for k, lv in enumerate(problem.theta_levels or ()):
+        for level in () if lv is None else np.asarray(lv, dtype=np.float64):
+            col = theta[..., k]
+            col[np.float32(col) == np.float32(level)] = level
 
 
 def check_same_scales(emulator: Emulator, data, standardizer) -> None:
@@ -240,6 +252,15 @@ def continued_copies(emulator: Emulator, problem: Problem, n_chains: int, ladder
         if isinstance(value, dict):
             value = {k: _reordered_list(k, v, order) for k, v in value.items()}
         record[part] = value
+    theta = record["starts"].get("theta") if isinstance(record["starts"], dict) else None
+    if theta is not None and problem.theta_levels:  # a float32 fit's levels, as its draws'
+        try:
+            theta = np.array(theta, dtype=np.float64)
+        except (TypeError, ValueError):  # a damaged record: the check names it
+            theta = None
+        if theta is not None and theta.shape[-1:] == (len(problem.theta_levels),):
+            _at_levels(problem, theta)
+            record["starts"]["theta"] = theta
     try:
         check_hot_copies(record, problem, tempering.chain_ladders(ladders, n_chains), n_chains)
     except GPMSAError as exc:
