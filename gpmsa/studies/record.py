@@ -9,6 +9,7 @@ import numpy as np
 
 from gpmsa.errors import EmulatorFileError, numbers_text
 from gpmsa.fitting.validation import DISCREPANCY_KINDS, check_rate, check_sweeps, group_count
+from gpmsa.studies.hot import check_hot_record
 from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout, finite
 
 KINDS = ("calibration", "fit")
@@ -238,6 +239,7 @@ def check_study_claims(manifest: dict, study) -> None:
             raise _fail(field, f"{_short(saved, 200)} differ from the models' {expected}")
     _check_kind(study)
     _check_counts(manifest["settings"], study.draws["log_post"].shape)
+    check_hot_record(manifest["settings"], study)
 
 
 def _check_kind(study) -> None:

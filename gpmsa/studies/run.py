@@ -48,6 +48,7 @@ from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
 from gpmsa.studies import continuation as cont
 from gpmsa.studies.continuation import STEPS, WIDTHS_BY_CHAIN
+from gpmsa.studies.hot import continued_copies, hot_record, resumes_copies
 from gpmsa.studies.layout import (
     HyperPriors,
     build_layout,
@@ -143,7 +144,8 @@ def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_
     ``init``; else None) of a tempered study runs on at its ladder (each chain's, an
     (n_chains, K) array, where its chains adapted theirs) and swap interval unless
     ``temperatures=`` or ``swap_every=`` is given (``source_ladders``); GPMSAError naming
-    ``tune=False`` with a tempered continuation (every copy is tuned while it warms up)."""
+    ``tune=False`` with a tempered continuation that does not resume its hot copies (every copy
+    is tuned while it warms up; ``hot.resumes_copies``)."""
     temps, ladders = tempering.ladder(temperatures), None
     if temperatures is None and source is not None:  # (temperatures=1: plain)
         ladders, every = source_ladders(source.settings or {}, n_chains, "init=study")
@@ -153,24 +155,32 @@ def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_
     every = 1 if swap_every is None else swap_every
     every = tempering.check_swap_every(every, temps, int(n_iter), what)
     adapt = tempering.check_adapt(adapt_ladder, temps, tune)
-    if temps is not None and source is not None and not tune:
-        raise GPMSAError(
-            "tune=False with a tempered continuation (temperatures=, or init=study a tempered "
-            "study): the record holds the T = 1 copy's widths alone, so every copy is tuned at "
-            "its temperature (from those widths) while the copies warm up from the chain's "
-            "last state, before any draw is kept; leave tune out, or tune=True, or pass "
-            "temperatures=1 to continue without tempering"
-        )
-    if temps is None:
-        return {}
     if ladders is not None and ladders.ndim == 2:  # each chain at its own (adapted) ladder
         temps = ladders
-    return {"temperatures": temps, "swap_every": every, **({"adapt_ladder": True} if adapt else {})}
+    out = {} if temps is None else {"temperatures": temps, "swap_every": every,
+                                    **({"adapt_ladder": True} if adapt else {})}  # fmt: skip
+    if (
+        temps is not None
+        and source is not None
+        and not tune
+        and not resumes_copies(source.settings or {}, out, n_chains)
+    ):
+        raise GPMSAError(
+            "tune=False with a tempered continuation (temperatures=, or init=study a tempered "
+            "study) that does not resume its hot copies (at the source's ladder, which records "
+            "them, settings 'hot_states'): every copy is tuned at its temperature (from the "
+            "T = 1 copy's widths) while the copies warm up from the chain's last state, before "
+            "any draw is kept; leave tune out, or tune=True, or pass temperatures=1 to "
+            "continue without tempering"
+        )
+    return out
 
 
-def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
+def _settings(chains: StudyChains, n_burn: int, t0: float, labels, **extra) -> dict:
     rate = chains.accept_rate.mean(axis=0)
-    info = {k: v for k, v in chains.info.items() if k != "level_offsets"}  # `_level_offsets`
+    info = {
+        k: v for k, v in chains.info.items() if k not in ("level_offsets", "hot")
+    }  # `_level_offsets`, `hot_record`
     for key in ("swap_rate", "adapted_temperatures"):  # parallel tempering: as fit's settings
         if key in info:
             info = {**info, key: np.asarray(info[key]).tolist()}
@@ -181,6 +191,7 @@ def _settings(chains: StudyChains, n_burn: int, t0: float, **extra) -> dict:
             **({WIDTHS_BY_CHAIN: {n: [float(w) for w in col] for n, col in
                                   zip(chains.names, chains.widths.T, strict=True)}}
                if chains.widths.shape[0] > 1 else {}),
+            **hot_record(chains.info, chains.names, labels),
             "seconds": time.perf_counter() - t0,
             "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
             "versions": library_versions("numpy")}  # fmt: skip
@@ -213,7 +224,7 @@ def _tune_rule(tune, init) -> bool | None:
 
 
 def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool | None,
-              models: list[list[dict]], append: bool, orders=None, tempered: bool = False
+              models: list[list[dict]], append: bool, orders=None, tempered: dict | None = None
               ) -> tuple[bool, dict, dict, dict[str, str]]:  # fmt: skip
     """A continuation of ``source``'s chains from ``models`` (per chain, each model's start):
     (tune, ``sample_study``'s continuation arguments, the settings it adds, each sweep
@@ -221,14 +232,19 @@ def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool 
     its chains' widths, or False), each chain runs on with its recorded widths and precision
     steps (a per-component element's its source component's: ``orders``, per model,
     ``continuation.member_orders``); tuned, from GPM/SA's widths (refused where it
-    ``append``s: `continuation.refuse_tuning`). ``tempered`` (parallel tempering): ``tune``
-    None tunes every copy at its temperature from the recorded widths (the copies warm up
-    before any draw; appending too)."""
+    ``append``s: `continuation.refuse_tuning`). ``tempered`` (parallel tempering,
+    ``_check_tempering``'s): where ``source`` records its hot copies and this runs at its
+    ladder (``hot.resumes_copies``), ``tune`` None or False resumes every copy where it
+    stopped, untuned; else ``tune`` None tunes every copy at its temperature from the recorded
+    widths (the copies warm up before any draw; appending too)."""
+    tempered = tempered or {}
     starts = cont.chain_starts(source, models)
     names, there = cont.sweep_names(problems, layout, hyper, starts[0], orders)
     widths = None if tune is True else cont.continued_widths(source, there, n_chains)
-    if tune is None:
-        tune = widths is None or tempered  # tempered: every copy tuned while it warms up
+    resume = (tune is not True and widths is not None
+              and resumes_copies(source.settings, tempered, n_chains))  # fmt: skip
+    if tune is None:  # tempered: every copy tuned while it warms up, unless each resumes
+        tune = widths is None or (bool(tempered) and not resume)
     if tune and append and not tempered:
         cont.refuse_tuning()
     steps = None if tune else cont.continued_steps(source)
@@ -236,6 +252,11 @@ def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool 
     if steps is not None:
         extra[STEPS] = steps
     resumed = {"chain_starts": starts, "widths": widths, "prop_mh": steps}
+    if resume:  # every hot copy where it stopped, with its widths
+        resumed["hot_copies"] = continued_copies(
+            source.settings, starts, problems, layout, hyper, there,
+            orders or [None] * len(problems), len(tempering.chain_ladders(
+                tempered["temperatures"], n_chains)[0]))  # fmt: skip
     return tune, resumed, extra, dict(zip(names, there, strict=True))
 
 
@@ -466,10 +487,13 @@ def calibrate_study(
             the hierarchy's untempered), each tuned at its temperature; neighbours propose to
             swap their states every ``swap_every`` (1, at most n_samples) sweeps, and only the
             T = 1 copy's draws are kept (about n times the time). ``settings`` record
-            "temperatures", "swap_every" and "swap_rate" (per chain, per neighbour pair).
+            "temperatures", "swap_every", "swap_rate" (per chain, per neighbour pair) and
+            each hot copy's last state and widths ("hot_states", "hot_step_widths").
             A continuation (``init`` a study) of a tempered study runs on at its ladder (each
-            chain's where they adapted theirs) and ``swap_every`` unless given, every copy from
-            its chain's last kept state, tuned at its temperature before any draw
+            chain's where they adapted theirs) and ``swap_every`` unless given; at that
+            ladder, without ``tune=True`` or ``adapt_ladder``, every copy resumes where it
+            stopped, untuned; otherwise (no such record, another ladder) every copy starts
+            from its chain's last kept state, tuned at its temperature before any draw
             (``tune=False`` refused; docs/models.md, "Parallel tempering").
         adapt_ladder: with ``temperatures`` (at least 3) and tuning, each chain adapts its
             ladder's temperatures between 1 and the hottest during tuning towards equal swap
@@ -587,7 +611,7 @@ def calibrate_study(
         starts = cont.calibration_starts(init, problems)
         tune, resumed, extra, renamed = _continue(init, problems, layout, hyper, int(n_chains),
                                                   tune, starts, append,
-                                                  tempered=bool(tempered))  # fmt: skip
+                                                  tempered=tempered)  # fmt: skip
     _check_memory(problems, n_samples, n_chains, f"calibrate_study(n_samples={n_samples}, "
                   f"n_chains={n_chains})", init if append else None, thin)  # fmt: skip
     chains = sample_study(
@@ -597,7 +621,7 @@ def calibrate_study(
         **tempered,
     )  # fmt: skip
     chains = _with_held(chains, problems, ("lamOs", "betaV", "lamVz"), fixes)
-    settings = _settings(chains, n_burn, t0, n_samples=int(n_samples), **extra)
+    settings = _settings(chains, n_burn, t0, labels, n_samples=int(n_samples), **extra)
     settings = tempering.recorded_ladders(settings, init.settings if continuing else {})
     settings.update(record)
     moves = _level_offsets(chains, layout, emulators)
@@ -843,7 +867,7 @@ def fit_study(
         orders = cont.member_orders(init, problems)  # K's columns among each member's
         tune, resumed, extra, renamed = _continue(init, problems, layout, hyper, int(n_chains),
                                                   tune, models, append, orders,
-                                                  tempered=bool(tempered))  # fmt: skip
+                                                  tempered=tempered)  # fmt: skip
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})",
                   init if append else None, thin if append else 1)  # fmt: skip
     chains = sample_study(
@@ -856,7 +880,9 @@ def fit_study(
     if not append:
         thin = thinning(int(n_chains), int(n_iter - n_burn), n_keep)
     keep = slice(thin - 1, None, thin) if append else slice(int(n_burn), None, thin)
-    settings = _settings(chains, n_burn, t0, n_iter=int(n_iter), thin=thin, point=point, **extra)
+    settings = _settings(
+        chains, n_burn, t0, labels, n_iter=int(n_iter), thin=thin, point=point, **extra
+    )
     settings = tempering.recorded_ladders(settings, init.settings if continuing else {})
     settings.update(record)
     moves = _level_offsets(chains, layout, sims)

@@ -425,7 +425,7 @@ def run_study_chain(
     tune_levels: int = tuning.N_LEVELS, progress: bool = False, desc: str = "study",
     start: tuple | None = None, widths: np.ndarray | None = None, prop_mh: bool | None = None,
     temperatures: tuple[float, ...] | None = None, swap_every: int = 1,
-    adapt_ladder: bool = False,
+    adapt_ladder: bool = False, hot: list | None = None,
 ) -> dict:  # fmt: skip
     """One chain: its start (``gpmsa.mcmc.starts`` rule ``init``; a continuation's ``start``:
     (models' starts, g, mu, lam)), tuning, ``n_iter`` sweeps; ``widths``: the initial step
@@ -433,20 +433,23 @@ def run_study_chain(
     (None: when not tuned). ``temperatures``: a ladder from 1 (``tempering.ladder``), a copy of
     the study state per temperature from the same start, each tuned at its temperature, a swap
     round every ``swap_every`` sweeps (``tempering.run_ladder``); the T = 1 copy's draws kept;
-    ``adapt_ladder``: the ladder adapted during tuning, then frozen (``tempering.adapt_ladder``).
+    ``adapt_ladder``: the ladder adapted during tuning, then frozen (``tempering.adapt_ladder``);
+    ``hot``: each hot copy's (start, as ``start``; widths, sweep order), K - 1 of them (a
+    continuation resuming them where they stopped, run with those widths where not ``tune``).
 
     Returns plain arrays: theta (N, G), mu, lam (N, H), log_post (N,), members (per model,
     name -> (N, *shape)), accept_rate and widths per element, level_offsets (the (T = 1)
     state's level moves, ``StudyState.level_record``); with ``temperatures`` also swap_rate
-    (K - 1,), each neighbour pair's swap acceptance over the draws, and with ``adapt_ladder``
-    ladder (K,), the adapted one.
+    (K - 1,), each neighbour pair's swap acceptance over the draws, "hot" (the hot copies' last
+    states and widths, `hot_states`), and with ``adapt_ladder`` ladder (K,), the adapted one.
     """
     from tqdm.auto import tqdm
 
     rng = np.random.default_rng(seed)
     if start is None:
         start = _start(problems, layout, hyper, init, starts.start_generator(seed))
-    copies = [StudyState(problems, layout, hyper, *start, rng) for _ in temperatures or (1.0,)]
+    at = [start] + [h for h, _ in hot or [(start, None)] * (len(temperatures or (1.0,)) - 1)]
+    copies = [StudyState(problems, layout, hyper, *a, rng) for a in at]
     state = copies[0]
     if math.isnan(state.log_post()):
         raise GPMSAError("the starting values give a log posterior of NaN; check the data")
@@ -470,6 +473,7 @@ def run_study_chain(
         out["log_post"][it] = state.log_post()
 
     kinds = _tuning_kinds(state.states, layout)
+    ran: dict = {}
     with threadpool_limits(1):
         if temperatures is not None:
             for copy, t in zip(copies, temperatures, strict=True):
@@ -478,7 +482,10 @@ def run_study_chain(
                 copies, rng, n_iter, w, kinds, record, swap_every=swap_every, tune=tune,
                 tune_rounds=tune_rounds, tune_levels=tune_levels, prop_mh=prop_mh, bar=bar,
                 desc=desc, adapt=temperatures if adapt_ladder else None,
+                copy_widths=None if hot is None else [np.asarray(v, dtype=float) for _, v in hot],
+                out=ran,
             )  # fmt: skip
+            out["hot"] = hot_states(copies[1:], ran["widths"][1:])
             if adapt_ladder:
                 out["ladder"] = np.asarray(adapted)
         else:
@@ -501,6 +508,17 @@ def run_study_chain(
                names=element_names(state.states, layout),
                level_offsets=state.level_record())  # fmt: skip
     return out
+
+
+def hot_states(copies: list[StudyState], widths: list[np.ndarray]) -> dict:
+    """The hot copies' last states and widths: "theta" (K - 1, G), "mu", "lam" (K - 1, H),
+    "members" (per model, its sampled parameters name -> (K - 1, *shape)) and "widths"
+    (K - 1, n_el; sweep order)."""
+    models = [{n: np.stack([c.states[i].params[n] for c in copies]) for n in s.problem.sampled}
+              for i, s in enumerate(copies[0].states)] if copies else []  # fmt: skip
+    return {"theta": np.array([c.g for c in copies]), "mu": np.array([c.mu for c in copies]),
+            "lam": np.array([c.lam for c in copies]), "members": models,
+            "widths": np.array(widths)}  # fmt: skip
 
 
 def _wrong_run(run, n_iter: int, n_elements: int, n_temps: int = 0,
@@ -526,7 +544,7 @@ def sample_study(
     progress: bool = False, n_jobs: int | None = None, executor=None,
     chain_starts: list | None = None, widths: list | None = None, prop_mh: bool | None = None,
     temperatures: tuple[float, ...] | None = None, swap_every: int = 1,
-    adapt_ladder: bool = False,
+    adapt_ladder: bool = False, hot_copies: list | None = None,
 ) -> StudyChains:  # fmt: skip
     """``n_chains`` study chains, chain c on ``SeedSequence(seed).spawn(n_chains)[c]`` (its draws
     do not depend on where it runs: ``n_jobs`` processes or ``executor``, as
@@ -541,8 +559,10 @@ def sample_study(
     frozen, info "adapt_ladder" and "adapted_temperatures" (n_chains, K); with a categorical
     element's joint level move, "level_offsets": element -> {"shifted": the continuous
     elements it shifts, "offsets": (n_chains, n_levels, len(shifted)), unit scale} (as
-    ``level_moves.chains_record``, per element). ChainError names a chain that failed or whose
-    draws are not finite."""
+    ``level_moves.chains_record``, per element). Tempered, info "hot" holds the hot copies'
+    last states and widths (`hot_states`, each with a leading chain axis: (n_chains, K - 1,
+    ...)); ``hot_copies`` (per chain, ``run_study_chain``'s ``hot``) resumes them. ChainError
+    names a chain that failed or whose draws are not finite."""
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     held_elements(problems, layout)  # a held element the models disagree on: before any work
     element_levels(problems, layout)  # a categorical element the study cannot sample: likewise
@@ -564,6 +584,8 @@ def sample_study(
             task.update(temperatures=ladders[c], swap_every=int(swap_every))
         if adapt_ladder:
             task["adapt_ladder"] = True
+        if hot_copies is not None:
+            task["hot"] = hot_copies[c]
     n_temps = 0 if temperatures is None else len(ladders[0])
     runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
                       progress=progress, desc="study chain",
@@ -587,6 +609,11 @@ def sample_study(
         out.info.update(temperatures=list(ladders[0]) if same else [list(t) for t in ladders],
                         swap_every=int(swap_every),
                         swap_rate=np.stack([r["swap_rate"] for r in runs]))  # fmt: skip
+        hot = [r["hot"] for r in runs]  # (n_chains, K - 1, ...): a continuation resumes them
+        out.info["hot"] = {k: np.stack([h[k] for h in hot]) for k in ("theta", "mu", "lam",
+                                                                       "widths")}  # fmt: skip
+        out.info["hot"]["members"] = [{n: np.stack([h["members"][i][n] for h in hot]) for n in m}
+                                      for i, m in enumerate(hot[0]["members"])]  # fmt: skip
     if adapt_ladder:  # each chain's ladder, adapted in its tuning and frozen for its draws
         out.info.update(adapt_ladder=True,
                         adapted_temperatures=np.stack([r["ladder"] for r in runs]))  # fmt: skip

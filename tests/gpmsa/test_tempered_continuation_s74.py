@@ -159,7 +159,9 @@ def test_torch_continues_each_chains_ladder():
 def test_tempered_study_continuation_pools_to_the_grid():
     """calibrate_study's case of test_study_tempering_s73 (two models sharing t, P(t > 0.5)
     0.678 on an exact grid): a tempered study appended to by its (default) tempered
-    continuation; 8 seeds of this size: |z| <= 1.06."""
+    continuation; 8 seeds of this size: |z| <= 1.06 (re-tuned, before s76). Resumed (s76, its
+    hot copies where they stopped), seeds 0-21: |z| <= 1.49 but one 3.93 (mean share 0.677),
+    one chain's continued share outside (0.3, 0.95) (0.96)."""
     from test_study_tempering_s73 import LADDER as STUDY_LADDER
     from test_study_tempering_s73 import _grid_upper, _study
 
@@ -169,12 +171,15 @@ def test_tempered_study_continuation_pools_to_the_grid():
     up = out.draws["theta"][..., 0] > 0.5
     assert up.shape == (2, 900)
     new = up[:, 400:].mean(axis=1)
-    assert np.all((new > 0.3) & (new < 0.95)), new  # 0.66, 0.62: each chain in both modes
-    p, n_eff = up.mean(), sum(ess(u.astype(float)) for u in up)  # 0.651, 142
+    assert np.all((new > 0.3) & (new < 0.95)), new  # 0.63, 0.66 (s74, re-tuned: 0.66, 0.62)
+    p, n_eff = up.mean(), sum(ess(u.astype(float)) for u in up)  # 0.652, 116 (s74: 0.651, 142)
     assert abs(p - _grid_upper()) < 3 * np.sqrt(p * (1 - p) / n_eff), (p, n_eff)
     s = out.settings
-    assert s["temperatures"] == STUDY_LADDER and s["tune"] is True and s["swap_every"] == 1
+    assert s["temperatures"] == STUDY_LADDER and s["swap_every"] == 1
+    assert s["tune"] is False  # every copy resumed where it stopped (session 76): untuned
     assert np.array(s["swap_rate"]).shape == (2, 3) and s["appended_after"] == 400
+    for key in ("hot_states", "hot_step_widths"):  # as a file written before session 76
+        del src.settings[key]
     with pytest.raises(GPMSAError, match="tune=False with a tempered continuation"):
         _study(n_samples=10, n_chains=2, init=src, tune=False)
 

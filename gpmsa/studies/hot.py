@@ -1,0 +1,191 @@
+"""A tempered study's hot copies: their record in the study's settings (``HOT_RECORD``, as a
+tempered fit's, ``gpmsa.fitting.validation``), its check on loading, and a continuation at the
+same ladder resuming every copy where it stopped, untuned (docs/internals.md, "Tempered
+continuation").
+
+settings "hot_states": {"theta": (C, K - 1, G), "mu", "lam": (C, K - 1, H), "members": {label:
+{name: (C, K - 1, *shape)}}} (unit scale; each model's sampled parameters) and
+"hot_step_widths": {sweep element name: (C, K - 1)}; both or neither (absent in untempered
+studies, in files written before the record and where it would hold more than
+``MAX_HOT_VALUES`` numbers)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.fitting.continuation import reordered, source_ladders
+from gpmsa.fitting.validation import HOT_RECORD, MAX_HOT_VALUES
+from gpmsa.mcmc import tempering
+from gpmsa.studies.sampler import StudyState
+
+PARTS = ("theta", "mu", "lam", "members")
+"""The keys of settings "hot_states"."""
+
+
+def hot_record(info: dict, names, labels) -> dict:
+    """The settings of a tempered run's hot copies (``sample_study``'s info "hot"; ``names``:
+    the sweep's elements, ``labels``: the models'): ``HOT_RECORD``, or {} where they would hold
+    more than ``MAX_HOT_VALUES`` numbers (its continuation then tunes its copies)."""
+    hot = info.get("hot")
+    if hot is None:
+        return {}
+    arrays = [hot["theta"], hot["mu"], hot["lam"], hot["widths"],
+              *(v for m in hot["members"] for v in m.values())]  # fmt: skip
+    if sum(np.size(a) for a in arrays) > MAX_HOT_VALUES:
+        return {}
+    states = {k: np.asarray(hot[k]).tolist() for k in ("theta", "mu", "lam")}
+    states["members"] = {lab: {n: np.asarray(v).tolist() for n, v in m.items()}
+                         for lab, m in zip(labels, hot["members"], strict=True)}  # fmt: skip
+    widths = {n: hot["widths"][:, :, e].tolist() for e, n in enumerate(names)}
+    return dict(zip(HOT_RECORD, (states, widths), strict=True))
+
+
+def resumes_copies(settings: dict, tempered: dict, n_chains: int) -> bool:
+    """Whether a continuation of a study with ``settings``, run with ``tempered`` (its
+    ``temperatures`` and ``adapt_ladder``, as ``_check_tempering`` returns them), resumes every
+    hot copy: the source records them (``HOT_RECORD``) and the continuation runs at its ladder
+    (each chain's) without adapting it again. The caller also leaves ``tune`` out (or False)."""
+    if any(settings.get(k) is None for k in HOT_RECORD) or tempered.get("adapt_ladder"):
+        return False
+    temps = tempered.get("temperatures")
+    if temps is None:
+        return False
+    ladders, _ = source_ladders(settings, n_chains, "init=study")
+    mine = tempering.chain_ladders(temps, n_chains)
+    if ladders is None:
+        return False
+    theirs = np.atleast_2d(ladders)
+    return theirs.shape[1] == len(mine[0]) and np.array_equal(
+        np.broadcast_to(theirs, (n_chains, theirs.shape[1])), np.array(mine)
+    )
+
+
+def continued_copies(settings: dict, starts: list[tuple], problems, layout, hyper,
+                     there: list[str], orders: list, n_temps: int) -> list:  # fmt: skip
+    """Per chain, its K - 1 hot copies' (start, widths) from the source's ``settings``
+    (``HOT_RECORD``): each start (models' starts, g, mu, lam) the chain's (``starts``, as
+    ``continuation.chain_starts``) with the recorded values; widths in sweep order (``there``:
+    each element's name in the source; ``orders``: per model, its per-component parameters'
+    order among the source's). GPMSAError naming the record where it does not fit this study
+    or a copy's state has no finite log posterior here (a damaged file)."""
+    try:
+        return _copies(settings, starts, problems, layout, hyper, there, orders, n_temps - 1)
+    except (GPMSAError, KeyError, TypeError, ValueError, IndexError) as exc:
+        raise GPMSAError(
+            f"init=study: its recorded hot copies (settings['hot_states'], "
+            f"settings['hot_step_widths']) do not fit this study ({exc}); pass tune=True (every "
+            "copy tuned from the chain's last state) or temperatures="
+        ) from None
+
+
+def _copies(settings, starts, problems, layout, hyper, there, orders, n_hot):
+    states, widths = (settings[k] for k in HOT_RECORD)
+    n_chains = len(starts)
+
+    def arr(value, shape, what):
+        out = np.asarray(value, dtype=np.float64)
+        if 0 in shape and out.size == 0:  # JSON keeps no empty shape
+            out = np.zeros((n_chains, n_hot, *shape))
+        if out.shape != (n_chains, n_hot, *shape):
+            raise GPMSAError(f"{what} has shape {out.shape}, expected {(n_chains, n_hot, *shape)}")
+        return out
+
+    n_h = len(layout.groups)
+    g = arr(states["theta"], (layout.n_elements,), "theta")
+    mu, lam = arr(states["mu"], (n_h,), "mu"), arr(states["lam"], (n_h,), "lam")
+    members = []
+    for lab, prob, order in zip(layout.labels, problems, orders, strict=True):
+        rec = states["members"][lab]
+        if set(rec) != set(prob.sampled) - {"theta"}:
+            raise GPMSAError(f"model {lab!r}: parameters {sorted(rec)}, this study samples "
+                             f"{sorted(set(prob.sampled) - {'theta'})}")  # fmt: skip
+        members.append({n: reordered(n, arr(v, prob.init[n].shape, f"{lab}.{n}"), order)
+                        for n, v in rec.items()})  # fmt: skip
+    w = np.stack([arr(widths[n], (), f"widths of {n!r}") for n in there], axis=-1)
+    if not (np.all(np.isfinite(w)) and np.all(w > 0)):
+        raise GPMSAError("widths must be finite numbers > 0")
+    out = []
+    for c, (models, *_) in enumerate(starts):
+        chain = []
+        for k in range(n_hot):
+            start = ([{**m, **{n: v[c, k] for n, v in rec.items()}}
+                      for m, rec in zip(models, members, strict=True)],
+                     g[c, k].copy(), mu[c, k].copy(), lam[c, k].copy())  # fmt: skip
+            state = StudyState(problems, layout, hyper, *start, np.random.default_rng(0))
+            if not math.isfinite(state.log_post()):
+                raise GPMSAError(f"chain {c}'s hot copy {k + 1} has no finite log posterior")
+            chain.append((start, w[c, k]))
+        out.append(chain)
+    return out
+
+
+def check_hot_record(settings: dict, study) -> None:
+    """A study file's hot copies (settings ``HOT_RECORD``; absent: none), against ``study``
+    built from the file: both or neither, "hot_states" with theta (C, K - 1, G), mu and lam
+    (C, K - 1, H) and members {label: {name: (C, K - 1, ...)}} finite numbers (precisions > 0),
+    "hot_step_widths" {sweep element: (C, K - 1)} finite numbers > 0; C the draws' chains, K
+    the length of settings.temperatures. EmulatorFileError naming the field otherwise."""
+    given = [k for k in HOT_RECORD if settings.get(k) is not None]
+    if not given:
+        return
+    if len(given) < len(HOT_RECORD):
+        lacking = next(k for k in HOT_RECORD if k not in given)
+        raise _fail(f"settings.{lacking}", f"a tempered study records {list(HOT_RECORD)} "
+                                           f"together; the file has only {given}")  # fmt: skip
+    temps = settings.get("temperatures")
+    if not isinstance(temps, list) or len(temps) < 2:
+        raise _fail("settings.hot_states", f"needs settings.temperatures, a ladder of 2 or more "
+                                           f"(got {temps!r:.60})")  # fmt: skip
+    lead = (int(study.draws["log_post"].shape[0]), len(temps) - 1)
+    states, widths = (settings[k] for k in HOT_RECORD)
+    for key, value in ((HOT_RECORD[0], states), (HOT_RECORD[1], widths)):
+        if not isinstance(value, dict):
+            raise _fail(f"settings.{key}", f"must be an object, got {value!r:.60}")
+    if set(states) != set(PARTS):
+        raise _fail("settings.hot_states", f"must hold exactly {list(PARTS)}, got "
+                                           f"{sorted(states)!r:.120}")  # fmt: skip
+    n_h = len(study.layout.groups)
+    want = {"theta": (study.layout.n_elements,), "mu": (n_h,), "lam": (n_h,)}
+    for part, shape in want.items():
+        _values(states[part], (*lead, *shape), f"settings.hot_states.{part}", part == "lam")
+    members = states["members"]
+    if not isinstance(members, dict) or set(members) != set(study.labels):
+        raise _fail("settings.hot_states.members", f"must be an object naming the models "
+                                                   f"{list(study.labels)}")  # fmt: skip
+    for lab, rec in members.items():
+        if not isinstance(rec, dict):
+            raise _fail(f"settings.hot_states.members.{lab}", "must be an object name -> values")
+        for name, value in rec.items():
+            field = f"settings.hot_states.members.{lab}.{name}"
+            arr = _values(value, None, field, name.startswith("lam"))
+            if arr.shape[:2] != lead and not (arr.size == 0 and 0 in lead):
+                raise _fail(field, f"has shape {list(arr.shape)}, expected {list(lead)} + the "
+                                   "parameter's shape (chains, hot copies, ...)")  # fmt: skip
+    rates = settings.get("accept_rate")
+    if isinstance(rates, dict) and set(widths) != set(rates):
+        raise _fail("settings.hot_step_widths", "must name the sweep's elements (those of "
+                                                "settings.accept_rate)")  # fmt: skip
+    for name, value in widths.items():
+        _values(value, lead, f"settings.hot_step_widths[{name!r:.40}]", True)
+
+
+def _values(value, shape, field: str, positive: bool) -> np.ndarray:
+    """``value`` as finite float64 (> 0 where ``positive``) of ``shape`` (None: any)."""
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise _fail(field, f"must be an array of numbers, got {value!r:.60}") from None
+    if shape is not None and arr.shape != shape and not (arr.size == 0 and 0 in shape):
+        raise _fail(field, f"has shape {list(arr.shape)}, expected {list(shape)} (chains, hot "
+                           "copies, ...)")  # fmt: skip
+    if not np.all(np.isfinite(arr)) or (positive and arr.size and not arr.min() > 0):
+        need = "finite numbers > 0" if positive else "finite numbers"
+        raise _fail(field, f"must be {need}, got {arr.ravel()[:4].tolist()!r:.60}")
+    return arr
+
+
+def _fail(field: str, problem: str) -> EmulatorFileError:
+    return EmulatorFileError(f"{field}: {problem}")
