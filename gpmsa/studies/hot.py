@@ -181,9 +181,10 @@ def _values(value, shape, field: str, positive: bool) -> np.ndarray:
     if shape is not None and arr.shape != shape and not (arr.size == 0 and 0 in shape):
         raise _fail(field, f"has shape {list(arr.shape)}, expected {list(shape)} (chains, hot "
                            "copies, ...)")  # fmt: skip
-    if not np.all(np.isfinite(arr)) or (positive and arr.size and not arr.min() > 0):
+    bad = ~np.isfinite(arr) | ((arr <= 0) if positive else False)
+    if np.any(bad):  # the values refused, not the array's first
         need = "finite numbers > 0" if positive else "finite numbers"
-        raise _fail(field, f"must be {need}, got {arr.ravel()[:4].tolist()!r:.60}")
+        raise _fail(field, f"must be {need}, got {arr[bad][:4].tolist()!r:.60}")
     return arr
 
 
