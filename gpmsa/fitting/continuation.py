@@ -221,15 +221,16 @@ def continued_ladder(emulator: Emulator, options: dict, n_chains: int, given):
     return tuple(float(t) for t in np.atleast_2d(ladders)[0])
 
 
-def resumes_copies(emulator: Emulator, options: dict, n_chains: int) -> bool:
-    """Whether ``fit(..., init=emulator)`` (``options`` its backend's, the ladder set by
-    `continued_ladder`) resumes every hot copy where the source's stopped: the source records
-    them (``HOT_RECORD``) and the continuation runs at its ladder (each chain's), without
-    adapting it again."""
-    settings = emulator.settings or {}
+def resumes_copies(settings: dict, options: dict, n_chains: int,
+                   source: str = "init=emulator") -> bool:  # fmt: skip
+    """Whether a continuation of a fit's or a study's ``settings`` (``options``: its tempering,
+    "temperatures" set by `continued_ladder`, and "adapt_ladder") resumes every hot copy where
+    the source's stopped: the source records them (``HOT_RECORD``) and the continuation runs at
+    its ladder (each chain's), without adapting it again (``source``: the argument that gave
+    it, for `source_ladders`' errors). The caller also leaves ``tune`` out (or False)."""
     if any(settings.get(k) is None for k in HOT_RECORD) or options.get("adapt_ladder"):
         return False
-    ladders, _ = source_ladders(settings, n_chains)
+    ladders, _ = source_ladders(settings, n_chains, source)
     mine = tempering.chain_ladders(options.get("temperatures"), n_chains)
     if ladders is None or mine is None:
         return False

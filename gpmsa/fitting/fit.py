@@ -264,7 +264,8 @@ def fit(
         temps = continued_ladder(options["init"], options, int(n_chains), temps)
     resume = (continuing and backend in MH_BACKENDS and temps is not None and tune is not True
               and step_widths is None
-              and resumes_copies(options["init"], options, int(n_chains)))  # fmt: skip
+              and resumes_copies(options["init"].settings or {}, options,
+                                 int(n_chains)))  # fmt: skip
     if continuing and temps is not None and tune is False and not resume:
         raise GPMSAError(
             "tune=False with a tempered continuation (temperatures=, or init=emulator a tempered "

@@ -563,6 +563,18 @@ manifest, whose limit is ``limits.MAX_MANIFEST_BYTES``): a larger tempered fit r
 and its continuation warms its copies up as one without the record does."""
 
 
+def hot_record_given(settings: dict, what: str) -> bool:
+    """Whether a tempered ``what``'s (``"fit"``, ``"study"``) ``settings`` hold the hot copies'
+    record (``HOT_RECORD``): both fields (True) or neither (False); EmulatorFileError naming
+    the one missing where only one is."""
+    given = [k for k in HOT_RECORD if settings.get(k) is not None]
+    if given and len(given) < len(HOT_RECORD):
+        lacking = next(k for k in HOT_RECORD if k not in given)
+        raise _fail(f"settings.{lacking}", f"a tempered {what} records {list(HOT_RECORD)} "
+                                           f"together; the file has only {given}")  # fmt: skip
+    return bool(given)
+
+
 def check_hot_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None:
     """A numpy or torch tempered fit's hot copies (settings ``HOT_RECORD``, absent in other
     files, in those written before the record existed and in those above ``MAX_HOT_VALUES``),
@@ -570,13 +582,8 @@ def check_hot_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None
     its value (n_chains, K - 1, *shape), K the length of settings.temperatures (where that is a
     list of 2 or more; a continuation names a damaged ladder): hot_states finite numbers,
     hot_step_widths numbers > 0 and finite, or null (an element not sampled)."""
-    given = [k for k in HOT_RECORD if settings.get(k) is not None]
-    if not given:
+    if not hot_record_given(settings, "fit"):
         return
-    if len(given) < len(HOT_RECORD):
-        lacking = next(k for k in HOT_RECORD if k not in given)
-        raise _fail(f"settings.{lacking}", f"a tempered fit records {list(HOT_RECORD)} together; "
-                                           f"the file has only {given}")  # fmt: skip
     temps = settings.get("temperatures")  # a damaged ladder: the continuation names it
     n_hot = len(temps) - 1 if isinstance(temps, list) and len(temps) >= 2 else None
     n_chains = settings.get("n_chains", 1)

@@ -16,9 +16,8 @@ import math
 import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
-from gpmsa.fitting.continuation import reordered, source_ladders
-from gpmsa.fitting.validation import HOT_RECORD, MAX_HOT_VALUES
-from gpmsa.mcmc import tempering
+from gpmsa.fitting.continuation import reordered
+from gpmsa.fitting.validation import HOT_RECORD, MAX_HOT_VALUES, hot_record_given
 from gpmsa.studies.sampler import StudyState
 
 PARTS = ("theta", "mu", "lam", "members")
@@ -41,26 +40,6 @@ def hot_record(info: dict, names, labels) -> dict:
                          for lab, m in zip(labels, hot["members"], strict=True)}  # fmt: skip
     widths = {n: hot["widths"][:, :, e].tolist() for e, n in enumerate(names)}
     return dict(zip(HOT_RECORD, (states, widths), strict=True))
-
-
-def resumes_copies(settings: dict, tempered: dict, n_chains: int) -> bool:
-    """Whether a continuation of a study with ``settings``, run with ``tempered`` (its
-    ``temperatures`` and ``adapt_ladder``, as ``_check_tempering`` returns them), resumes every
-    hot copy: the source records them (``HOT_RECORD``) and the continuation runs at its ladder
-    (each chain's) without adapting it again. The caller also leaves ``tune`` out (or False)."""
-    if any(settings.get(k) is None for k in HOT_RECORD) or tempered.get("adapt_ladder"):
-        return False
-    temps = tempered.get("temperatures")
-    if temps is None:
-        return False
-    ladders, _ = source_ladders(settings, n_chains, "init=study")
-    mine = tempering.chain_ladders(temps, n_chains)
-    if ladders is None:
-        return False
-    theirs = np.atleast_2d(ladders)
-    return theirs.shape[1] == len(mine[0]) and np.array_equal(
-        np.broadcast_to(theirs, (n_chains, theirs.shape[1])), np.array(mine)
-    )
 
 
 def continued_copies(settings: dict, starts: list[tuple], problems, layout, hyper,
@@ -128,13 +107,8 @@ def check_hot_record(settings: dict, study) -> None:
     (C, K - 1, H) and members {label: {name: (C, K - 1, ...)}} finite numbers (precisions > 0),
     "hot_step_widths" {sweep element: (C, K - 1)} finite numbers > 0; C the draws' chains, K
     the length of settings.temperatures. EmulatorFileError naming the field otherwise."""
-    given = [k for k in HOT_RECORD if settings.get(k) is not None]
-    if not given:
+    if not hot_record_given(settings, "study"):
         return
-    if len(given) < len(HOT_RECORD):
-        lacking = next(k for k in HOT_RECORD if k not in given)
-        raise _fail(f"settings.{lacking}", f"a tempered study records {list(HOT_RECORD)} "
-                                           f"together; the file has only {given}")  # fmt: skip
     temps = settings.get("temperatures")
     if not isinstance(temps, list) or len(temps) < 2:
         raise _fail("settings.hot_states", f"needs settings.temperatures, a ladder of 2 or more "

@@ -23,7 +23,7 @@ from gpmsa.calibration.calibrate import (
 )
 from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
-from gpmsa.fitting.continuation import appended_record, source_ladders
+from gpmsa.fitting.continuation import appended_record, resumes_copies, source_ladders
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
 from gpmsa.fitting.fit import (
     N_KEEP,
@@ -48,7 +48,7 @@ from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
 from gpmsa.studies import continuation as cont
 from gpmsa.studies.continuation import STEPS, WIDTHS_BY_CHAIN
-from gpmsa.studies.hot import continued_copies, hot_record, resumes_copies
+from gpmsa.studies.hot import continued_copies, hot_record
 from gpmsa.studies.layout import (
     HyperPriors,
     build_layout,
@@ -145,7 +145,7 @@ def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_
     (n_chains, K) array, where its chains adapted theirs) and swap interval unless
     ``temperatures=`` or ``swap_every=`` is given (``source_ladders``); GPMSAError naming
     ``tune=False`` with a tempered continuation that does not resume its hot copies (every copy
-    is tuned while it warms up; ``hot.resumes_copies``)."""
+    is tuned while it warms up; ``gpmsa.fitting.continuation.resumes_copies``)."""
     temps, ladders = tempering.ladder(temperatures), None
     if temperatures is None and source is not None:  # (temperatures=1: plain)
         ladders, every = source_ladders(source.settings or {}, n_chains, "init=study")
@@ -163,7 +163,7 @@ def _check_tempering(temperatures, swap_every, n_iter, source, what: str, adapt_
         temps is not None
         and source is not None
         and not tune
-        and not resumes_copies(source.settings or {}, out, n_chains)
+        and not resumes_copies(source.settings or {}, out, n_chains, "init=study")
     ):
         raise GPMSAError(
             "tune=False with a tempered continuation (temperatures=, or init=study a tempered "
@@ -234,15 +234,16 @@ def _continue(source: Study, problems, layout, hyper, n_chains: int, tune: bool 
     ``continuation.member_orders``); tuned, from GPM/SA's widths (refused where it
     ``append``s: `continuation.refuse_tuning`). ``tempered`` (parallel tempering,
     ``_check_tempering``'s): where ``source`` records its hot copies and this runs at its
-    ladder (``hot.resumes_copies``), ``tune`` None or False resumes every copy where it
-    stopped, untuned; else ``tune`` None tunes every copy at its temperature from the recorded
-    widths (the copies warm up before any draw; appending too)."""
+    ladder (``gpmsa.fitting.continuation.resumes_copies``), ``tune`` None or False resumes
+    every copy where it stopped, untuned; else ``tune`` None tunes every copy at its
+    temperature from the recorded widths (the copies warm up before any draw; appending
+    too)."""
     tempered = tempered or {}
     starts = cont.chain_starts(source, models)
     names, there = cont.sweep_names(problems, layout, hyper, starts[0], orders)
     widths = None if tune is True else cont.continued_widths(source, there, n_chains)
     resume = (tune is not True and widths is not None
-              and resumes_copies(source.settings, tempered, n_chains))  # fmt: skip
+              and resumes_copies(source.settings, tempered, n_chains, "init=study"))  # fmt: skip
     if tune is None:  # tempered: every copy tuned while it warms up, unless each resumes
         tune = widths is None or (bool(tempered) and not resume)
     if tune and append and not tempered:
