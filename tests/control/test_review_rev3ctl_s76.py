@@ -9,18 +9,10 @@ import pytest
 import control
 from control.robot.condition import static_level_marks
 from control.sensor_checks import MAX_SPEED_MPS, SensorLimits
+from tests.control.test_msgdigits_control_s76 import _span_faults
 
 G = 9.80665
 ON = SensorLimits(static_mps2=G)
-
-
-def _span_faults(bcr, t, a, pos, spd) -> set[int]:
-    every, out = bcr.settings.samples_per_update, set()
-    for k in range(0, t.size - every + 1, every):
-        part = slice(k, k + every)
-        if "last 1000 samples" in bcr.update(t[part], pos[part], a[part], spd[part]).reason:
-            out.add(k + every - 1)
-    return out
 
 
 def test_samples_the_bcr_drops_for_a_speed_beyond_the_limit_restart_the_replays_span(new_bcr):
