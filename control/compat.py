@@ -20,6 +20,7 @@ from control.feature import FeatureSpec
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_instance, is_real, replace_fields, within
+from gpmsa.errors import numbers_text
 
 
 def _canon(obj) -> str:
@@ -163,8 +164,9 @@ def check_emulator(
         gds = [gd for _, gd in track.segments]
         outside = [gd for gd in gds if not lo <= gd <= hi]
         if outside:
+            low, high = numbers_text(*outside, lo, hi)[-2:]
             raise EmulatorMismatchError(
-                f"track GD {outside} outside the emulator's GD domain [{lo:g}, {hi:g}]"
+                f"track GD {outside} outside the emulator's GD domain [{low}, {high}]"
             )
         differ = _track_road_mismatch(meta, track)
         if differ:
@@ -238,16 +240,15 @@ def check_recorded_vehicle(emulator, model=None, noise_std: float | None = None,
 def _check_speeds(emulator, simplex: Simplex) -> None:
     """EmulatorMismatchError naming the Simplex's speeds outside the emulator's speed domain."""
     lo, hi = (float(b) for b in emulator.domain[emulator.x_names[0]])
-    outside = [
-        f"{name} = {speed:g} m/s"
-        for name, speed in (("v_safe", simplex.v_safe), ("v_max", simplex.v_max))
-        if not within(speed, lo, hi)
-    ]
-    if outside:
+    speeds = {"v_safe": simplex.v_safe, "v_max": simplex.v_max}
+    names = [name for name, speed in speeds.items() if not within(speed, lo, hi)]
+    if names:
+        *shown, low, high = numbers_text(*(speeds[name] for name in names), lo, hi)
+        outside = [f"{name} = {text} m/s" for name, text in zip(names, shown, strict=True)]
         raise EmulatorMismatchError(
             f"the Simplex's {' and '.join(outside)} {'lies' if len(outside) == 1 else 'lie'} "
             f"outside the emulator's speed domain "
-            f"[{lo:g}, {hi:g}] m/s: the BCR learns nothing at such a speed, so the robot would "
+            f"[{low}, {high}] m/s: the BCR learns nothing at such a speed, so the robot would "
             f"drive on an estimate that only ages; use a Simplex whose speeds lie in the domain "
             f"(control.Simplex(v_max=..., v_safe=...)) or an emulator trained over them "
             f"(examples/train_emulator.py --speed-range)"
@@ -337,7 +338,8 @@ def _track_road_mismatch(meta: dict, track) -> str:
     ):
         known = is_real(mine) and np.isfinite(trained) and trained > 0
         if known and not abs(float(mine) - trained) <= 1e-3 * trained:
-            differ.append(f"{name}{float(mine):.3g}{unit} against {trained:.3g}{unit}")
+            ours, theirs = numbers_text(mine, trained, digits=3)
+            differ.append(f"{name}{ours}{unit} against {theirs}{unit}")
     return "; ".join(differ)
 
 

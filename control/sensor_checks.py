@@ -1123,17 +1123,19 @@ def timing_fault(
     if abs(span / expected - 1.0) > limits.rate_tolerance:
         if not span > 0:  # (no rate to name)
             return f"time stamps that do not advance: the block's {t.size} stamps span {span:.4g} s"
+        spans = numbers_text(span, expected, digits=4)
         return (
-            f"samples at another rate: the block's {t.size} time stamps span {span:.4g} s "
-            f"({(t.size - 1) / span:.4g} Hz), not the {expected:.4g} s of {rate_hz:g} Hz"
+            f"samples at another rate: the block's {t.size} time stamps span {spans[0]} s "
+            f"({(t.size - 1) / span:.4g} Hz), not the {spans[1]} s of {rate_hz:g} Hz"
         )
     moved = float(position[-1] - position[0])
     # np.trapezoid(speed, t): its operations, without its wrapper
     by_speed = float(((t[1:] - t[:-1]) * (speed[1:] + speed[:-1]) / 2.0).sum())
     if abs(moved - by_speed) > limits.odometry_tolerance * abs(by_speed) + limits.odometry_slack_m:
+        moved_text, by_speed_text = numbers_text(moved, by_speed, digits=4)
         return (
-            f"odometry disagrees with the speeds: the position moved {moved:.4g} m over the "
-            f"block, its speeds give {by_speed:.4g} m"
+            f"odometry disagrees with the speeds: the position moved {moved_text} m over the "
+            f"block, its speeds give {by_speed_text} m"
         )
     return ""
 

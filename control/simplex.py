@@ -140,7 +140,8 @@ class Simplex:
             raise ControlError("kp has no effect with law='switch' (v_max or v_safe): leave it")
         if not (np.isfinite(self.speed_step_mps) and 0 <= self.speed_step_mps <= self.v_max):
             raise ControlError(
-                f"speed_step_mps must lie in [0, v_max] = [0, {self.v_max:g}], "
+                f"speed_step_mps must lie in [0, v_max] = "
+                f"[0, {numbers_text(self.speed_step_mps, self.v_max)[1]}], "
                 f"got {self.speed_step_mps}"
             )
         if not 0 < self.latch_p <= 1:

@@ -37,6 +37,7 @@ from control.validation import (
     require_reals,
 )
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
+from gpmsa.errors import numbers_text
 
 PRIORS = ("uniform", "log_uniform")
 
@@ -164,9 +165,10 @@ class GDTracker:
         lo, hi = self.log_grid[0], self.log_grid[-1]
         tol = 1e-9 * (hi - lo)
         if np.log(grid[0]) > lo + tol or np.log(grid[-1]) < hi - tol:
+            first, last, low, high = numbers_text(grid[0], grid[-1], self.grid[0], self.grid[-1])
             raise ControlError(
-                f"grid spans GD [{grid[0]:g}, {grid[-1]:g}] but the tracker's domain is "
-                f"[{self.grid[0]:g}, {self.grid[-1]:g}]: give the likelihood on a grid that "
+                f"grid spans GD [{first}, {last}] but the tracker's domain is "
+                f"[{low}, {high}]: give the likelihood on a grid that "
                 "covers the domain (outside its grid it would be read as flat)"
             )
 

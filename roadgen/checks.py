@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from roadgen.errors import RoadgenError
+from roadgen.errors import RoadgenError, distinct_texts
 
 MAX_MEMORY_BYTES = 4 * 1024**3
 """Largest memory (bytes) one call may need; change it by assignment."""
@@ -211,8 +211,9 @@ def band(
     pair of real numbers with 0 < n_min < n_max <= nyquist."""
     lo, hi = pair(name, value, "(n_min, n_max) in cycles/m", error)
     if not (math.isfinite(lo) and math.isfinite(hi) and 0.0 < lo < hi <= nyquist):
+        top = distinct_texts(hi, nyquist)[1]
         raise error(
-            f"{name}={value!r} is out of range: need 0 < n_min < n_max <= {nyquist:.6g} "
+            f"{name}={value!r} is out of range: need 0 < n_min < n_max <= {top} "
             "cycles/m (the Nyquist frequency 1/(2 dx_m) of the grid)"
         )
     return lo, hi
@@ -225,9 +226,8 @@ def positions(name: str, s: np.ndarray | float, length_m: float) -> np.ndarray:
     bad = ~np.isfinite(arr) | (arr < -tol) | (arr > length_m + tol)
     if np.any(bad):
         first = float(arr[bad].flat[0])
-        raise RoadgenError(
-            f"{name} contains {first!r}: allowed positions are [0, {length_m:.6g}] m"
-        )
+        end = distinct_texts(first, length_m)[1]
+        raise RoadgenError(f"{name} contains {first!r}: allowed positions are [0, {end}] m")
     return np.clip(arr, 0.0, length_m)
 
 

@@ -8,7 +8,7 @@ from typing import TypeVar
 import numpy as np
 
 from roadgen import checks
-from roadgen.errors import RoadgenError
+from roadgen.errors import RoadgenError, distinct_texts
 from roadgen.road import Road, check_road
 
 R = TypeVar("R", bound=Road)
@@ -35,7 +35,8 @@ def wheel_envelope(road: R, radius_m: float) -> R:
     r = checks.positive("radius_m", radius_m)
     if r > road.length_m:
         raise RoadgenError(
-            f"radius_m={radius_m!r} is out of range: allowed (0, {road.length_m:.6g}] m (the "
+            f"radius_m={radius_m!r} is out of range: allowed (0, "
+            f"{distinct_texts(r, road.length_m)[1]}] m (the "
             "road's length; a wheel in m, not mm?)"
         )
     z = road.z

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from roadgen.errors import RoadgenError
+from roadgen.errors import RoadgenError, distinct_texts
 from roadgen.iso8608 import N0, gd_spectrum
 from roadgen.psd import FIT_BAND, estimate_gd, profile_psd
 from roadgen.road import Road, check_road
@@ -70,10 +70,12 @@ def _fit_band(dx_m: float) -> tuple[float, float]:
     """FIT_BAND (cycles/m) with n_max lowered to the Nyquist frequency 0.5 / dx_m of the grid."""
     nyquist = 0.5 / dx_m
     if FIT_BAND[0] >= nyquist:
+        dx_text, most = distinct_texts(dx_m, 0.5 / FIT_BAND[0])
+        top = distinct_texts(nyquist, *FIT_BAND)[0]
         raise RoadgenError(
-            f"the grid dx_m={dx_m:.6g} m (Nyquist frequency {nyquist:.6g} cycles/m) is too coarse "
+            f"the grid dx_m={dx_text} m (Nyquist frequency {top} cycles/m) is too coarse "
             f"for the GD fit band FIT_BAND={FIT_BAND} cycles/m: pass a band inside "
-            f"(0, {nyquist:.6g}] cycles/m, or use dx_m < {0.5 / FIT_BAND[0]:g} m"
+            f"(0, {top}] cycles/m, or use dx_m < {most} m"
         )
     return FIT_BAND[0], min(FIT_BAND[1], nyquist)
 

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from roadgen import checks
-from roadgen.errors import RoadgenError
+from roadgen.errors import RoadgenError, distinct_texts
 from roadgen.iso8608 import check_waviness, gd_spectrum
 from roadgen.road import Road
 
@@ -115,9 +115,8 @@ def iso8608_profile(
     lead = checks.non_negative("lead_in_m", lead_in_m)
     n_points = grid_points(length, dx)
     if lead > (n_points - 1) * dx:
-        raise RoadgenError(
-            f"lead_in_m={lead_in_m!r} is out of range: allowed [0, {(n_points - 1) * dx:.6g}] m"
-        )
+        end = distinct_texts(lead, (n_points - 1) * dx)[1]
+        raise RoadgenError(f"lead_in_m={lead_in_m!r} is out of range: allowed [0, {end}] m")
     unit, settings = unit_road(n_points, dx, seed, band, amplitudes, waviness, lead)
     z = np.sqrt(gd_val) * unit * lead_in_taper(np.arange(n_points) * dx, lead)
     return Profile(x=np.arange(n_points) * dx, z=z, dx_m=dx, gd=gd_val, settings=settings)
@@ -143,10 +142,12 @@ def unit_road(
     else:
         lo, hi = checks.band("band", band, nyquist)
         if lo < dn * (1.0 - 1e-9):
+            length, need = distinct_texts((n_points - 1) * dx_m, 1.0 / lo - dx_m)
+            n_min, n_low = distinct_texts(lo, dn)
             raise RoadgenError(
-                f"length_m={(n_points - 1) * dx_m:.6g} is too short for band={band!r}: the band's "
-                f"n_min={lo:.6g} cycles/m needs length_m >= {1.0 / lo - dx_m:.6g} m "
-                f"(or use n_min >= {dn:.6g} cycles/m)"
+                f"length_m={length} is too short for band={band!r}: the band's "
+                f"n_min={n_min} cycles/m needs length_m >= {need} m "
+                f"(or use n_min >= {n_low} cycles/m)"
             )
     k = np.arange(n_points // 2 + 1)
     n = k * dn
@@ -187,9 +188,10 @@ def check_settings(settings: object, dx_m: float, length_m: float) -> None:
         )
     checks.band("settings.band", settings.band, 0.5 / dx_m)  # its fields: __post_init__
     if float(settings.lead_in_m) > length_m:
+        end = distinct_texts(settings.lead_in_m, length_m)[1]
         raise RoadgenError(
-            f"settings.lead_in_m={settings.lead_in_m!r} is out of range: allowed [0, "
-            f"{length_m:.6g}] m (the road's length)"
+            f"settings.lead_in_m={settings.lead_in_m!r} is out of range: allowed [0, {end}] m "
+            "(the road's length)"
         )
 
 

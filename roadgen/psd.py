@@ -8,7 +8,7 @@ from typing import Protocol
 import numpy as np
 
 from roadgen import checks
-from roadgen.errors import RoadgenError
+from roadgen.errors import RoadgenError, distinct_texts
 from roadgen.iso8608 import GD_SCALE, N0, check_waviness
 from roadgen.profile import band_edges
 
@@ -175,9 +175,10 @@ def estimate_gd(
         return _nonzero_gd(lambda h: _periodogram_gd(h, dx, w, content), z)
     lo, hi = _fit_band(band, dx)
     if method == "welch" and w > WELCH_MAX_WAVINESS:
+        most, w_text = distinct_texts(WELCH_MAX_WAVINESS, w)
         raise RoadgenError(
-            f"method='welch' fits waviness up to WELCH_MAX_WAVINESS={WELCH_MAX_WAVINESS:g}, got "
-            f"w={w:g}: beyond it the Hann window's leakage biases the estimate (x2 at w = 5); "
+            f"method='welch' fits waviness up to WELCH_MAX_WAVINESS={most}, got "
+            f"w={w_text}: beyond it the Hann window's leakage biases the estimate (x2 at w = 5); "
             "use method='fit'"
         )
     if method == "welch" and z.size < 32:  # profile_psd's default segment, N // 4, holds 8
@@ -237,20 +238,24 @@ def _periodogram_gd(
     n, gd = _fit_psd(z, dx, "periodogram", z.size, end_match=False)
     k = int(np.argmin(np.abs(np.log(n / N0))))
     if abs(np.log(n[k] / N0)) > np.log(PERIODOGRAM_REACH) + 1e-9:
+        length, shortest = distinct_texts(z.size * dx, 1.0 / (PERIODOGRAM_REACH * N0))
+        reach = (N0 / PERIODOGRAM_REACH, N0 * PERIODOGRAM_REACH)
+        nearest, spacing = distinct_texts(n[k], 1.0 / (z.size * dx), *reach)[:2]
         raise RoadgenError(
             f"method='periodogram' reads the harmonic nearest n0 = {N0} cycles/m, but the "
-            f"nearest of this road ({z.size * dx:.6g} m: harmonics every "
-            f"{1.0 / (z.size * dx):.6g} cycles/m) is {n[k]:.6g} cycles/m, more than a factor "
+            f"nearest of this road ({length} m: harmonics every "
+            f"{spacing} cycles/m) is {nearest} cycles/m, more than a factor "
             f"{PERIODOGRAM_REACH:g} from n0; scaling it to n0 along the slope would extrapolate. "
-            f"Use a road of at least {1.0 / (PERIODOGRAM_REACH * N0):g} m"
+            f"Use a road of at least {shortest} m"
         )
     if content is not None:
         edge_lo, edge_hi = band_edges(content, z.size)
         if not edge_lo <= n[k] <= edge_hi:
+            nearest, low, high = distinct_texts(n[k], *content)
             raise RoadgenError(
                 f"method='periodogram' reads the harmonic nearest n0 = {N0} cycles/m, "
-                f"{n[k]:.6g} cycles/m, but the road has no content there: its settings.band="
-                f"({content[0]:.6g}, {content[1]:.6g}) cycles/m; use method='fit' with a band "
+                f"{nearest} cycles/m, but the road has no content there: its settings.band="
+                f"({low}, {high}) cycles/m; use method='fit' with a band "
                 "inside settings.band, or make the road with a band that holds n0"
             )
     return float(_finite_psd(gd[k] * (n[k] / N0) ** w / GD_SCALE, z))
@@ -284,9 +289,10 @@ def _fit_bins(
     keep = in_band & (n >= edge_lo + margin) & (n <= edge_hi - margin)
     if not np.any(keep):
         clear = f" less 2 Welch bins ({margin:.6g} cycles/m) at each edge" if margin else ""
+        lo_text, hi_text, low, high = distinct_texts(lo, hi, *content)
         raise RoadgenError(
-            f"band=({lo:.6g}, {hi:.6g}) cycles/m holds no PSD bin of the road inside its content "
-            f"band settings.band=({content[0]:.6g}, {content[1]:.6g}) cycles/m{clear}"
+            f"band=({lo_text}, {hi_text}) cycles/m holds no PSD bin of the road inside its "
+            f"content band settings.band=({low}, {high}) cycles/m{clear}"
             f"{',' if how else ''}{how}: the road has no content there; pass a band inside "
             "settings.band"
         )
@@ -300,13 +306,14 @@ def _welch_too_short(
     WELCH_MIN_BIN."""
     seg = n_points // 4
     n_first = WELCH_MIN_BIN / (seg * dx)
+    lo, hi, top_text, first = distinct_texts(*band, top, n_first)
     return RoadgenError(
-        f"the road (length {n_points * dx:.6g} m) is too short for band=({band[0]:.6g}, "
-        f"{band[1]:.6g}) cycles/m with method='welch': it fits only Welch bins from index "
+        f"the road (length {n_points * dx:.6g} m) is too short for band=({lo}, {hi}) "
+        f"cycles/m with method='welch': it fits only Welch bins from index "
         f"WELCH_MIN_BIN={WELCH_MIN_BIN} of its segments of N // 4 = {seg} heights "
-        f"({seg * dx:.6g} m), n >= {n_first:.6g} cycles/m, and its bins in the band reach only "
-        f"{top:.6g} cycles/m; use a road longer than {4 * WELCH_MIN_BIN / top:.3g} m, a band "
-        f"reaching above {n_first:.6g} cycles/m, or method='fit'"
+        f"({seg * dx:.6g} m), n >= {first} cycles/m, and its bins in the band reach only "
+        f"{top_text} cycles/m; use a road longer than {4 * WELCH_MIN_BIN / top:.3g} m, a band "
+        f"reaching above {first} cycles/m, or method='fit'"
     )
 
 
@@ -348,10 +355,12 @@ def _fit_band(band: tuple[float, float] | None, dx: float) -> tuple[float, float
     if band is not None:
         return checks.band("band", band, nyquist)
     if FIT_BAND[1] > nyquist:
+        dx_text, most = distinct_texts(dx, 0.5 / FIT_BAND[1])
+        top = distinct_texts(nyquist, *FIT_BAND)[0]
         raise RoadgenError(
-            f"the grid dx_m={dx:.6g} m (Nyquist frequency {nyquist:.6g} cycles/m) is too coarse "
+            f"the grid dx_m={dx_text} m (Nyquist frequency {top} cycles/m) is too coarse "
             f"for the default fit band FIT_BAND={FIT_BAND} cycles/m: pass a band inside "
-            f"(0, {nyquist:.6g}] cycles/m, or use dx_m <= {0.5 / FIT_BAND[1]:g} m"
+            f"(0, {top}] cycles/m, or use dx_m <= {most} m"
         )
     return FIT_BAND
 

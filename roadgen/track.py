@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from roadgen import checks
-from roadgen.errors import RoadgenError
+from roadgen.errors import RoadgenError, distinct_texts
 from roadgen.profile import (
     ProfileSettings,
     check_settings,
@@ -100,8 +100,9 @@ def track(
     lengths = np.array([length for length, _ in segs])
     n_points = grid_points(float(lengths.sum()), dx)
     if lead > (n_points - 1) * dx:  # one segment, its length rounded down to whole steps
+        lead_text, end = distinct_texts(lead, (n_points - 1) * dx)
         raise RoadgenError(
-            f"lead_in_m={lead:g} is out of range: allowed [0, {(n_points - 1) * dx:.6g}] m (the "
+            f"lead_in_m={lead_text} is out of range: allowed [0, {end}] m (the "
             f"track's length, {lengths.sum():g} m rounded to whole dx_m = {dx:g} m steps); "
             "shorten lead_in_m"
         )
@@ -157,8 +158,9 @@ def _check_blend_and_lead(
     lead_max = lengths[0] - (0.5 * blend if len(segs) > 1 else 0.0)
     if lead > lead_max:
         reach = f", less half of blend_m={blend:g} m" if len(segs) > 1 else ""
+        lead_text, end = distinct_texts(lead, lead_max)
         raise RoadgenError(
-            f"lead_in_m={lead:g} is out of range: allowed [0, {lead_max:.6g}] m "
+            f"lead_in_m={lead_text} is out of range: allowed [0, {end}] m "
             f"(the first segment, {lengths[0]:g} m{reach}); lengthen the first segment or "
             "shorten lead_in_m"
         )
@@ -169,13 +171,15 @@ def _check_blend(lengths: np.ndarray, dx: float, blend: float) -> None:
     shortest of the segments' ``lengths`` (m)."""
     if lengths.min() < 2 * dx:  # no blend fits: name the segment, not an empty range
         k = int(np.argmin(lengths))
+        length, two_steps = distinct_texts(lengths[k], 2 * dx)
         raise RoadgenError(
-            f"segment {k} is {lengths[k]:g} m long, too short for any blend: shorter than two "
-            f"grid steps (2 dx_m = {2 * dx:.6g} m); lengthen it or merge it with a neighbour"
+            f"segment {k} is {length} m long, too short for any blend: shorter than two "
+            f"grid steps (2 dx_m = {two_steps} m); lengthen it or merge it with a neighbour"
         )
     if not 2 * dx <= blend <= lengths.min():
+        blend_text, low, high = distinct_texts(blend, 2 * dx, lengths.min())
         raise RoadgenError(
-            f"blend_m={blend:g} is out of range: allowed [{2 * dx:.6g}, {lengths.min():.6g}] m "
+            f"blend_m={blend_text} is out of range: allowed [{low}, {high}] m "
             "(two grid steps to the shortest segment)"
         )
 
@@ -210,8 +214,9 @@ def _check_total_length(
     track's length to whole grid steps)."""
     total = sum(length for length, _ in segs)
     if abs(total - length_m) > 0.5 * dx_m + 1e-9 * total:
+        span, length = distinct_texts(total, length_m)
         raise RoadgenError(
-            f"segments span {total:g} m but the road (x) is {length_m:.6g} m long: they must "
+            f"segments span {span} m but the road (x) is {length} m long: they must "
             f"agree within dx_m / 2 = {0.5 * dx_m:g} m"
         )
 

@@ -36,6 +36,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 import roadgen
+from roadgen.errors import distinct_texts
 from vehicle import checks, kinematics
 from vehicle.design import check_design, lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
@@ -526,10 +527,11 @@ def run_campaign(
     if short.any():
         v_short = float(np.max(speeds[short]))
         need_m = window * v_short / rate_hz
+        least = need_m + lead_in_m + 2 * model.wheelbase_m
         raise VehicleError(
             f"road_length_m={road_length_m!r} is too short: a {window}-sample window at "
             f"{v_short:.4g} m/s after the lead-in ({lead_in_m} m) needs "
-            f"road_length_m >= {need_m + lead_in_m + 2 * model.wheelbase_m:.4g} m"
+            f"road_length_m >= {distinct_texts(road_length_m, least, digits=4)[1]} m"
         )
 
     _check_drives(points, lengths, model, dx_m, rate_hz * substeps)
@@ -608,9 +610,11 @@ def _check_drives(
     seconds = drives / points[:, 0]
     i = int(np.argmax(seconds))
     if seconds[i] > kinematics.MAX_DRIVE_S:
+        took = distinct_texts(seconds[i], kinematics.MAX_DRIVE_S, digits=4)[0]
+        most = distinct_texts(seconds[i], kinematics.MAX_DRIVE_S)[1]
         raise VehicleError(
             f"design[{i}] (v={points[i, 0]:.4g} m/s) drives {drives[i]:.6g} m of road in "
-            f"{seconds[i]:.4g} s: simulate allows drives of <= {kinematics.MAX_DRIVE_S:g} s "
+            f"{took} s: simulate allows drives of <= {most} s "
             "(vehicle.kinematics.MAX_DRIVE_S); use a shorter road_length_m or keep_s"
         )
     steps = seconds[i] * steps_per_s + 1  # as simulate's own check (kinematics.schedule_grid)

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from roadgen import checks as roadgen_checks
+from roadgen.errors import distinct_texts
 from vehicle.errors import VehicleError
 
 MAX_MEMORY_BYTES = 4 * 1024**3
@@ -82,8 +83,9 @@ def grid_step(name: str, value: object, length_m: float, length_name: str) -> fl
         raise VehicleError(f"{name}={value!r} must be finite")
     low, high = roadgen_checks.MIN_DX_M, roadgen_checks.MAX_DX_M
     if not (low <= v <= high and round(length_m / v) >= 2):
+        most = distinct_texts(v, min(high, length_m / 1.5))[1]
         raise VehicleError(
-            f"{name}={value!r} is out of range: allowed [{low:g}, {min(high, length_m / 1.5):.6g}] "
+            f"{name}={value!r} is out of range: allowed [{low:g}, {most}] "
             f"m (a road's grid step, at most {length_name} / 1.5: each road holds at least 2 "
             "whole steps)"
         )

@@ -7,6 +7,7 @@ import math
 import numpy as np
 from scipy.stats import qmc
 
+from roadgen.errors import distinct_texts
 from vehicle import checks
 from vehicle.errors import VehicleError
 from vehicle.models import Model
@@ -52,9 +53,9 @@ def check_design(design: np.ndarray, model: Model) -> np.ndarray:
     bad_v = ~np.isfinite(v) | (v <= 0) | (v > model.max_speed_mps)
     if np.any(bad_v):
         i = int(np.argmax(bad_v))
+        most = distinct_texts(v[i], model.max_speed_mps)[1]
         raise VehicleError(
-            f"design[{i}] has v={float(v[i])!r} m/s: allowed (0, {model.max_speed_mps:g}] m/s for "
-            f"{model.name}"
+            f"design[{i}] has v={float(v[i])!r} m/s: allowed (0, {most}] m/s for {model.name}"
         )
     bad_g = ~np.isfinite(gd) | (gd <= 0)
     if np.any(bad_g):

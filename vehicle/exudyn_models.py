@@ -38,6 +38,7 @@ from exudyn.itemInterface import (
     SensorNode,
 )
 
+from roadgen.errors import distinct_texts
 from vehicle.errors import SimulationDivergedError
 from vehicle.kinematics import Drive
 from vehicle.models import HalfCar, Jackal, Model
@@ -369,10 +370,12 @@ def _check_range(st: States, model: Model, u_front: np.ndarray, u_rear: np.ndarr
     u_body = (model.b2_m * u_front + model.b1_m * u_rear) / model.wheelbase_m
     accel = np.concatenate([st.accel_front, st.accel_rear])
     disp = np.concatenate([st.heave - u_body, st.z_front - u_front, st.z_rear - u_rear])
-    if np.max(np.abs(accel)) > _MAX_ACCEL or np.max(np.abs(disp)) > _MAX_DISPLACEMENT:
+    peak_accel, peak_disp = np.max(np.abs(accel)), np.max(np.abs(disp))
+    if peak_accel > _MAX_ACCEL or peak_disp > _MAX_DISPLACEMENT:
         raise SimulationDivergedError(
             f"states out of range between t={st.t[0]:.4g} and {st.t[-1]:.4g} s: "
-            f"max |accel| {np.max(np.abs(accel)):.3g} m/s^2 (limit {_MAX_ACCEL:g}), "
-            f"max |displacement| from the road {np.max(np.abs(disp)):.3g} m "
+            f"max |accel| {distinct_texts(peak_accel, _MAX_ACCEL, digits=3)[0]} m/s^2 "
+            f"(limit {_MAX_ACCEL:g}), max |displacement| from the road "
+            f"{distinct_texts(peak_disp, _MAX_DISPLACEMENT, digits=3)[0]} m "
             f"(limit {_MAX_DISPLACEMENT:g})"
         )

@@ -13,6 +13,7 @@ from collections.abc import Callable
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
+from roadgen.errors import distinct_texts
 from vehicle import checks
 from vehicle.errors import VehicleError
 
@@ -51,6 +52,12 @@ class Drive:
         return np.interp(t, self.t0 + self.h * np.arange(self.v.size), self.v)
 
 
+def _too_long(seconds: float, max_duration_s: float) -> str:
+    """The message for a drive of ``seconds`` s, longer than ``max_duration_s`` s."""
+    took = distinct_texts(seconds, max_duration_s, digits=4)[0]
+    return f"the drive takes {took} s: allowed <= {distinct_texts(seconds, max_duration_s)[1]} s"
+
+
 def check_speed(
     name: str, v: np.ndarray | float, max_speed: float, allow_stop: bool = False
 ) -> np.ndarray:
@@ -61,9 +68,11 @@ def check_speed(
     bad = ~np.isfinite(arr) | low | (arr > max_speed * (1 + 1e-12))
     if np.any(bad):
         bracket = "[0" if allow_stop else "(0"
+        first = float(arr[bad].flat[0])
         raise VehicleError(
-            f"{name}={float(arr[bad].flat[0])!r} m/s is out of range: allowed "
-            f"{bracket}, {max_speed:g}] m/s (finite, at most the model's max_speed_mps)"
+            f"{name}={first!r} m/s is out of range: allowed "
+            f"{bracket}, {distinct_texts(first, max_speed)[1]}] m/s (finite, at most the model's "
+            "max_speed_mps)"
         )
     return arr
 
@@ -136,9 +145,7 @@ def schedule_grid(
         v_grid = check_speed("speed", fun(s_grid), max_speed)
         t_of_s = cumulative_trapezoid(1.0 / v_grid, s_grid, initial=0.0)
         if t_of_s[-1] > max_duration_s:
-            raise VehicleError(
-                f"the drive takes {t_of_s[-1]:.4g} s: allowed <= {max_duration_s:g} s"
-            )
+            raise VehicleError(_too_long(t_of_s[-1], max_duration_s))
         n = math.ceil(t_of_s[-1] / h)
         checks.memory(checks.BYTES_PER_STEP * (n + 1), f"a drive of {n + 1} solver steps")
         t = h * np.arange(n + 1)
@@ -147,9 +154,7 @@ def schedule_grid(
     if not (callable(speed) or isinstance(speed, tuple)):  # a constant: the length is known
         v0 = float(check_speed("speed", fun(0.0), max_speed))
         if (end_m - start_m) / v0 > max_duration_s:  # exact here, not up to a block beyond
-            raise VehicleError(
-                f"the drive takes {(end_m - start_m) / v0:.4g} s: allowed <= {max_duration_s:g} s"
-            )
+            raise VehicleError(_too_long((end_m - start_m) / v0, max_duration_s))
         n_est = (end_m - start_m) / (v0 * h) + 1
         checks.memory(checks.BYTES_PER_STEP * n_est, f"a drive of {n_est:.4g} solver steps")
     s_parts, v_parts, s_now, k0 = [], [], start_m, 0

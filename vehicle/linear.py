@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from roadgen.errors import distinct_texts
 from vehicle import checks
 from vehicle.errors import SolverStepWarning, VehicleError
 from vehicle.kinematics import check_speed
@@ -61,9 +62,11 @@ def warn_if_step_too_coarse(model: Model, rate_hz: float, substeps: int, stackle
         step = MAX_OMEGA_H * rate_hz
         need = omega / step if step > 0 else math.inf  # inf for an absurdly low rate_hz
         fix = f"substeps >= {math.ceil(need)}" if need < 1e15 else "a higher rate_hz"
+        shown = f"{omega_h:.2f}"  # exact where two decimals would read as the limit
+        shown = repr(omega_h) if shown == f"{MAX_OMEGA_H:.2f}" else shown
         warnings.warn(
             f"the model's stiffest mode ({omega / (2 * np.pi):.4g} Hz) is too fast for the solver "
-            f"step 1/({rate_hz:g} x {substeps}) s (omega h = {omega_h:.2f} > {MAX_OMEGA_H}): its "
+            f"step 1/({rate_hz:g} x {substeps}) s (omega h = {shown} > {MAX_OMEGA_H}): its "
             f"accelerations would be biased (half the variance at omega h = 0.8); use {fix}",
             SolverStepWarning,
             stacklevel=stacklevel,
@@ -267,8 +270,9 @@ def _check_drive(
     end = start_m + speed * n_samples / rate_hz
     if end > road.length_m + 1e-9:
         most = math.floor((road.length_m + 1e-9 - start_m) * rate_hz / speed)
+        reach, length = distinct_texts(end, road.length_m)
         raise VehicleError(
             f"n_samples={n_samples} at speed={speed:g} m/s and rate_hz={rate_hz:g} Hz from "
-            f"start_m={start_m:.6g} m take the front axle to {end:.6g} m, past the road's end at "
-            f"{road.length_m:.6g} m: allowed n_samples <= {most} (or a longer road)"
+            f"start_m={start_m:.6g} m take the front axle to {reach} m, past the road's end at "
+            f"{length} m: allowed n_samples <= {most} (or a longer road)"
         )

@@ -6,6 +6,7 @@ import numpy as np
 
 import roadgen
 from roadgen import checks as roadgen_checks
+from roadgen.errors import distinct_texts
 from vehicle.errors import VehicleError
 
 
@@ -31,8 +32,9 @@ class RoadInput:
                     "Track (or envelope=False)"
                 )
             if wheel_radius_m > road.length_m:  # roadgen's error would name its own radius_m
+                length = distinct_texts(wheel_radius_m, road.length_m)[1]
                 raise VehicleError(
-                    f"road length {road.length_m:.6g} m is shorter than the wheel radius "
+                    f"road length {length} m is shorter than the wheel radius "
                     f"wheel_radius_m={wheel_radius_m!r} m: it cannot be enveloped (use a longer "
                     "road, or envelope=False)"
                 )

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from roadgen.errors import distinct_texts
 from vehicle import checks
 from vehicle.errors import VehicleError
 from vehicle.exudyn_models import ExudynVehicle
@@ -56,18 +57,17 @@ def check_span(model: Model, road: RoadInput, start_m: float, end_m: float) -> N
     0 <= start_m < end_m <= road length."""
     wb = model.wheelbase_m
     if road.length_m <= wb:
+        length, wb_text = distinct_texts(road.length_m, wb)
         raise VehicleError(
-            f"road length {road.length_m:.6g} m is not longer than the wheelbase {wb:.6g} m: "
+            f"road length {length} m is not longer than the wheelbase {wb_text} m: "
             "allowed lengths > wheelbase"
         )
     if not (math.isfinite(start_m) and 0.0 <= start_m < road.length_m):
-        raise VehicleError(
-            f"start_m={start_m!r} is out of range: allowed [0, {road.length_m:.6g}) m"
-        )
+        end = distinct_texts(start_m, road.length_m)[1]
+        raise VehicleError(f"start_m={start_m!r} is out of range: allowed [0, {end}) m")
     if not (math.isfinite(end_m) and start_m < end_m <= road.length_m + 1e-9):
-        raise VehicleError(
-            f"end_m={end_m!r} is out of range: allowed ({start_m:.6g}, {road.length_m:.6g}] m"
-        )
+        start, end = distinct_texts(end_m, start_m, road.length_m)[1:]
+        raise VehicleError(f"end_m={end_m!r} is out of range: allowed ({start}, {end}] m")
 
 
 def simulate(

@@ -86,6 +86,7 @@ from control.validation import (
     require_instance,
     require_reals,
 )
+from gpmsa.errors import numbers_text
 from gpmsa.io.atomic import atomic_write
 from roadgen.checks import home_path
 
@@ -962,10 +963,11 @@ def _other_clock(rec: Recording, accel: np.ndarray, limit_s: float) -> tuple[np.
         "topics on one clock"
     )
     if off.all():
+        median = numbers_text(np.median(skew), limit_s, digits=3)[0]
         raise BagError(
             f"the IMU topic {imu.topic!r} and the odometry topic {odom.topic!r} are stamped "
             f"on different clocks: against their receive times the IMU's header stamps run "
-            f"{how} the odometry's (median {float(np.median(skew)):.3g} s, more than "
+            f"{how} the odometry's (median {median} s, more than "
             f"max_clock_skew_s = {limit_s:g} s): {remedy}"
         )
     t_off = (imu.log_ns[np.argmax(off)] - imu.log_ns[0]) / 1e9
