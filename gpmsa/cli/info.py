@@ -208,6 +208,12 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
                 rng += " (range given, design inside)"
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
         lines.append(f"{label + ':':17s}{', '.join(parts) or 'none'}")
+    grid = standardizer.grid
+    if grid.ndim == 2:  # an output index of several columns (SEPIA's (l, d) y_ind)
+        spans = " x ".join("[{}, {}]".format(*numbers(float(c.min()), float(c.max())))
+                           for c in grid.T)  # fmt: skip
+        lines.append(f"output index:    {grid.shape[0]} points in {grid.shape[1]} columns, "
+                     f"{spans} (interpolated on their triangulation)")  # fmt: skip
     if emulator.separable is not None:  # SimData(separable=): file array kron_factor
         lines.append(f"separable:       {_separable_text(emulator)}")
     cat = model.get("categorical") or {}

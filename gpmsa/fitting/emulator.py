@@ -170,10 +170,10 @@ class Emulator:
     """A GPM/SA emulator (unit-scale inputs, standardised outputs inside; native units outside).
 
     Attributes: standardizer, x_unit (m, p), t_unit (m, q), y (m, l_sim) native, K (l_sim, p_u),
-    w (m, p_u), lam_sim (p_u,), index (l_sim,) or None, params (point estimate: betaU (p+q, p_u),
-    lamUz, lamWs (p_u,), lamWOs (1,)), draws (name -> (n_draws, *shape), retained posterior
-    draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected), x_names,
-    t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
+    w (m, p_u), lam_sim (p_u,), index (l_sim,), (l_sim, d) or None, params (point estimate: betaU
+    (p+q, p_u), lamUz, lamWs (p_u,), lamWOs (1,)), draws (name -> (n_draws, *shape), retained
+    posterior draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected),
+    x_names, t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
     settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
     lamOs draws of a joint sim+obs fit, else None), convergence (R-hat, one chain's split
     R-hat, and bulk ESS of every sampled parameter and the elements flagged, see

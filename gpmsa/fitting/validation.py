@@ -29,6 +29,7 @@ from gpmsa.model import kronecker
 from gpmsa.model.basis import ORTHOGONAL_TOL, basis_digest
 from gpmsa.model.data import as_float, column_scales, output_scale
 from gpmsa.model.fixed_elements import label
+from gpmsa.model.index_points import check_points
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
 from gpmsa.model.priors import MAX_PRIOR_SHAPE, theta_prior_overflow
 from gpmsa.model.transforms import UNIT_TOL, Y_GIVEN
@@ -114,8 +115,11 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
         "y_sd": (l_sim,) if tuple(shapes["y_sd"]) == (l_sim,) else (1,),  # (l_sim,): columnwise
         **{f"param_{k}": v for k, v in pshape.items()},
     }  # fmt: skip
+    grid = tuple(shapes["grid"])
+    if len(grid) == 2 and grid[0] == l_sim and grid[1] >= 2:  # index points (l_sim, d)
+        want["grid"] = grid
     if "index" in shapes:
-        want["index"] = (l_sim,)
+        want["index"] = want["grid"]
     for name in shapes:
         if n == 0 and name.startswith(("draw_", "cal_")):  # would average nothing into NaN
             raise _fail(f"arrays/{name}", "needs >= 1 draw (log_post has none)")
@@ -946,7 +950,12 @@ def check_values(
         _finite(arrays, "index")
     for name in ("grid", "index"):  # the basis and the mean are interpolated along it
         g = arrays.get(name)
-        if g is not None and np.any(np.diff(g) <= 0):
+        if g is not None and g.ndim == 2:  # index points (l_sim, d): their own checks
+            try:
+                check_points(g, f"arrays/{name}")
+            except GPMSAError as exc:
+                raise EmulatorFileError(str(exc)) from None
+        elif g is not None and np.any(np.diff(g) <= 0):
             raise _fail(f"arrays/{name}", "must be strictly increasing (the output grid)")
     y_sd = _positive(arrays, "y_sd")
     y_sd = float(y_sd[0]) if y_sd.size == 1 else y_sd  # (l_sim,), l_sim > 1: columnwise

@@ -11,7 +11,9 @@ import numpy as np
 from scipy import stats
 
 from gpmsa.errors import BasisWarning, GPMSAError, numbers_text, user_stacklevel
+from gpmsa.model import index_points
 from gpmsa.model.data import as_float, check_count, check_increasing
+from gpmsa.model.index_points import is_points, n_points
 
 VARIANCE_FRACTION = 0.995
 ORTHOGONAL_TOL = 1e-8
@@ -149,11 +151,14 @@ def basis_weights(y_std: np.ndarray, K: np.ndarray) -> np.ndarray:
 
 def interpolate_basis(K: np.ndarray, grid: np.ndarray, new_grid: np.ndarray | None) -> np.ndarray:
     """Basis columns interpolated linearly from ``grid`` (strictly increasing) onto ``new_grid``
-    (any order; None: unchanged)."""
+    (any order; None: unchanged); from index points (l_sim, d) onto points (l, d), piecewise
+    linearly on their triangulation (`index_points.weights`; exact on a simulation point)."""
     if new_grid is None or (new_grid.shape == grid.shape and np.array_equal(new_grid, grid)):
         return K
     if K.shape[0] == 1:
         return np.repeat(K, new_grid.size, axis=0)
+    if is_points(grid) or is_points(new_grid):
+        return index_points.weights(grid, new_grid, "observation index") @ K
     check_increasing(grid, "the simulation grid")
     lo, hi = grid.min(), grid.max()
     if new_grid.min() < lo or new_grid.max() > hi:
@@ -174,7 +179,14 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
         return None
     if isinstance(kind, str):
         if kind == "constant":
-            D = np.ones((grid.size, 1))
+            D = np.ones((n_points(grid), 1))
+        elif kind == "linear" and is_points(grid):
+            raise GPMSAError(
+                f"discrepancy='linear' is [1, index] along one index grid; the output index "
+                f"here has {grid.shape[1]} columns: pass the basis per experiment, e.g. "
+                "discrepancy=[np.column_stack([np.ones(len(g)), g]) for g in obs.grids] "
+                "(1 and each index column), or discrepancy='constant'"
+            )
         elif kind == "linear":
             D = np.column_stack([np.ones(grid.size), grid])
         else:
@@ -191,10 +203,11 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
         D = as_float(kind, "discrepancy basis")
         if D.ndim == 1:
             D = D[:, None]
-        if D.ndim != 2 or D.shape[0] != grid.size:
+        n = n_points(grid)
+        if D.ndim != 2 or D.shape[0] != n:
             hint = "; SEPIA stores D as (p_v, l_obs): pass its transpose" if (
-                D.ndim == 2 and D.shape[1] == grid.size) else ""  # fmt: skip
-            raise GPMSAError(f"discrepancy basis must be ({grid.size}, p_v), got {D.shape}{hint}")
+                D.ndim == 2 and D.shape[1] == n) else ""  # fmt: skip
+            raise GPMSAError(f"discrepancy basis must be ({n}, p_v), got {D.shape}{hint}")
         if not np.all(np.isfinite(D)):
             raise GPMSAError("discrepancy basis must be finite")
     return _normalised([D], "discrepancy basis is all zeros")[0]
@@ -303,13 +316,13 @@ def discrepancy_bases(kind, grids: list[np.ndarray]) -> tuple[np.ndarray, ...] |
     bases = []
     for j, (d, g) in enumerate(zip(kind, grids, strict=True)):
         what = f"discrepancy[{j}] (experiment {j}'s basis)"
-        D = as_float(d, what)
-        if D.ndim != 2 or D.shape[0] != g.size:
+        D, n = as_float(d, what), n_points(g)
+        if D.ndim != 2 or D.shape[0] != n:
             hint = "; SEPIA stores D as (p_v, l_obs): pass its transpose" if (
-                D.ndim == 2 and D.shape[1] == g.size) else ""  # fmt: skip
+                D.ndim == 2 and D.shape[1] == n) else ""  # fmt: skip
             raise GPMSAError(
-                f"{what} must be ({g.size}, p_v): one row per value of experiment {j}'s index "
-                f"grid ({g.size}), columns the basis vectors; got shape {D.shape}{hint}"
+                f"{what} must be ({n}, p_v): one row per value of experiment {j}'s index "
+                f"grid ({n}), columns the basis vectors; got shape {D.shape}{hint}"
             )
         if D.shape[1] < 1:
             raise GPMSAError(f"{what} has no columns: give at least one basis vector")

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from gpmsa.errors import DomainWarning, GPMSAError, numbers_text, user_stacklevel
-from gpmsa.model import categorical, kronecker
+from gpmsa.model import categorical, index_points, kronecker
 
 
 def _first_non_number(value) -> str | None:
@@ -551,13 +551,18 @@ def _units(units: Sequence[str] | None, n: int, what: str) -> tuple[str, ...]:
 
 
 def _index(index, n: int, name: str) -> np.ndarray | None:
-    """The simulation output grid: finite and strictly increasing (the basis and the mean are
-    interpolated along it)."""
+    """The simulation output grid: finite and strictly increasing (l,) (the basis and the mean
+    are interpolated along it), or points of several columns (l, d), finite and distinct,
+    spanning d dimensions (interpolated on their triangulation: ``index_points``)."""
     if index is None:
         return None
     arr = as_float(index, name)
+    if arr.ndim == 2 and arr.shape[0] == n and arr.shape[1] > 1:
+        check_finite(arr, name)
+        index_points.check_points(arr, name)
+        return arr
     if arr.ndim > 1 and sorted(arr.shape)[-2] > 1 and arr.size != n:
-        raise GPMSAError(multi_column_index(name, arr.shape))
+        raise GPMSAError(multi_column_index(name, arr.shape, n))
     arr = arr.reshape(-1)
     if arr.size != n:
         raise GPMSAError(f"{name} must have {n} entries (one per output column), got {arr.size}")
@@ -566,15 +571,14 @@ def _index(index, n: int, name: str) -> np.ndarray | None:
     return arr
 
 
-def multi_column_index(name: str, shape: tuple) -> str:
-    """The message for an output index of several columns (SEPIA's (l, 2) y_ind of (time,
-    angle) pairs): the output grid here is one increasing coordinate."""
+def multi_column_index(name: str, shape: tuple, n: int) -> str:
+    """The message for an output index of a shape that is neither one grid (l,) nor one point
+    per output value (l, d) (SEPIA's y_ind of (time, angle) pairs)."""
     return (
-        f"{name} must be one output grid (l,), got shape {tuple(shape)}: an index of several "
-        "columns (SEPIA's y_ind of (time, angle) pairs, say) is not supported; the basis is "
-        "interpolated along one coordinate. Number the simulation's output points 0..l_sim-1 "
-        "and give each observation its point's number (docs/from-sepia.md)"
-    )
+        f"{name} must be one output grid ({n},) or one point per output value ({n}, d), got "
+        f"shape {tuple(shape)}" + ("; SEPIA's (d, l) layout: pass its transpose"
+                                   if len(shape) == 2 and shape[1] == n else "")
+    )  # fmt: skip
 
 
 def check_increasing(grid: np.ndarray, name: str) -> None:
@@ -794,7 +798,11 @@ class SimData:
 
     ``index`` (l_sim,) is the output grid of a multivariate output (None: 0..l_sim-1); it must
     be strictly increasing (a descending or unsorted grid is refused: sort the index and the
-    columns of ``y`` together). Names default to x0.., t0.., y0..; units to "". ``t_names`` may
+    columns of ``y`` together). An index of several columns (l_sim, d), d >= 2 (SEPIA's
+    ``y_ind_sim`` of (time, angle) pairs), gives each output value its point: finite, no point
+    twice, spanning d dimensions; the basis and the mean are interpolated piecewise-linearly on
+    the points' Delaunay triangulation (``gpmsa.model.index_points``).
+    Names default to x0.., t0.., y0..; units to "". ``t_names`` may
     not be a reserved name (lamOs, lamVz, betaV, betaV[k], betaV[k,g], lamVz[g]: the other
     parameters of a calibration posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every
     entry must be a real number (strings, bools and None are refused, never converted). A
@@ -938,6 +946,9 @@ class SimData:
     def __repr__(self) -> str:
         """Concise: the runs, each input's name and range, the output's length and range."""
         grid = "" if self.index is None else f" on index {_span(self.index)}"
+        if index_points.is_points(self.index):
+            spans = " x ".join(_span(c) for c in self.index.T)
+            grid = f" on index points {spans}"
         return (f"SimData({self.m} runs; x: {_columns_text(self.x, self.x_names)}; "
                 f"t: {_columns_text(self.t, self.t_names)}; y: {_count(self.l_sim, 'output')} "
                 f"{_span(self.y)}{grid})")  # fmt: skip
@@ -964,7 +975,7 @@ class SimData:
 
     @property
     def grid(self) -> np.ndarray:
-        """Output index grid (l_sim,): ``index`` or 0..l_sim-1."""
+        """Output index grid (l_sim,) or points (l_sim, d): ``index`` or 0..l_sim-1."""
         return self.index if self.index is not None else np.arange(self.l_sim, dtype=np.float64)
 
     @property
@@ -991,6 +1002,24 @@ def _arrays_digest(parts, tail: str = "") -> str:
     return h.hexdigest()
 
 
+def _index_points(index: list, ys: list[np.ndarray], names: list[str]) -> list[np.ndarray]:
+    """Each experiment's output index of several columns (l_j, d), d >= 2 the same for all
+    (SEPIA's y_ind_obs of (time, angle) pairs), finite, one point per value; in any order."""
+    grids = [as_float(g, name) for g, name in zip(index, names, strict=True)]
+    k = next(j for j, g in enumerate(grids) if g.ndim == 2 and g.shape[1] > 1)
+    d = grids[k].shape[1]
+    for j, (g, e, name) in enumerate(zip(grids, ys, names, strict=True)):
+        if g.ndim != 2 or g.shape[1] != d:
+            raise GPMSAError(
+                f"{name} has shape {g.shape}: every experiment's index must be points of the "
+                f"same columns, (l_j, {d}) as {names[k]}'s"
+            )
+        if g.shape[0] != e.size:
+            raise GPMSAError(f"{name} has {g.shape[0]} points, y[{j}] has {e.size}")
+        check_finite(g, name)
+    return grids
+
+
 @dataclass(frozen=True, eq=False)
 class ObsData:
     """Field observations: known inputs ``x`` (n, p) and outputs ``y`` in native units.
@@ -999,7 +1028,10 @@ class ObsData:
     ``index`` grid (a list of arrays; a single array applies to every experiment; None means the
     simulation grid). An observation grid may be in any order (each point is interpolated on the
     simulation grid, which is increasing), but must lie within the simulation grid; the columns
-    of ``y`` follow its order. ``precision`` is the observation-error precision in native units
+    of ``y`` follow its order. With a simulation index of several columns (l_sim, d), each
+    experiment's index is its points (l_j, d) (a list, ragged too; one (l, d) array applies to
+    every experiment), within the simulation points' convex hull.
+    ``precision`` is the observation-error precision in native units
     (1/unit^2): None (identity in standardised units, GPM/SA's default), a scalar (the same for
     every experiment), or per experiment a scalar, an (l_j,) vector (one precision per value:
     the diagonal of the matrix) or an (l_j, l_j) matrix (a list, or an array of shape (n,),
@@ -1135,15 +1167,14 @@ class ObsData:
             return [None] * len(ys)
         per_experiment = isinstance(index, (list, tuple)) and len(index) > 0
         if per_experiment and len(index) == len(ys):
-            for j, g in enumerate(index):
-                if np.ndim(g) == 2 and min(np.shape(g)) > 1:
-                    raise GPMSAError(multi_column_index(f"index[{j}]", np.shape(g)))
+            if any(np.ndim(g) == 2 and min(np.shape(g)) > 1 for g in index):
+                return _index_points(list(index), ys, [f"index[{j}]" for j in range(len(ys))])
         per_experiment = per_experiment and all(np.ndim(g) == 1 for g in index)
         if per_experiment and len(index) != len(ys) and all(np.size(g) == 1 for g in index):
             per_experiment = False  # one grid as a column of 1-point lists
         rows = isinstance(index, np.ndarray) and index.ndim == 2 and min(index.shape) > 1
         if rows and all(e.size == index.shape[0] != index.shape[1] for e in ys):
-            raise GPMSAError(multi_column_index("index", index.shape))  # (l, k): SEPIA's y_ind
+            return _index_points([index] * len(ys), ys, ["index"] * len(ys))  # SEPIA's y_ind
         if per_experiment or rows:  # an (n, l) array: a grid per experiment; (l, 1): one
             if len(index) != len(ys):
                 raise GPMSAError(

@@ -16,7 +16,7 @@ from gpmsa.errors import (
     numbers_text,
     user_stacklevel,
 )
-from gpmsa.model import categorical, kronecker
+from gpmsa.model import categorical, index_points, kronecker
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model import mean_basis as mean_basis_mod
 from gpmsa.model.basis import (
@@ -31,6 +31,7 @@ from gpmsa.model.basis import (
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.data import ObsData, SimData, as_float, check_finite
 from gpmsa.model.discrepancy import check_groups, n_groups
+from gpmsa.model.index_points import is_points
 from gpmsa.model.priors import Priors
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN, Standardizer
 
@@ -447,6 +448,10 @@ def reduce_obs(
                 f"experiment {j} has {e.size} values but the simulation output has {K.shape[0]}; "
                 "give ObsData an index grid"
             )
+    points = not scalar and (is_points(std.grid) or any(is_points(g) for g in obs.grids))
+    for j, g in enumerate(obs.grids):  # refused naming the experiment and the point
+        if points and g is not None:
+            index_points.weights(std.grid, g, f"the index of experiment {j}")
     with np.errstate(over="ignore"):  # an overflow gives inf: refused just below
         ys = [std.y_to_std(e, g) for e, g in zip(experiments, obs.grids, strict=True)]
     for j, e in enumerate(ys):
@@ -486,7 +491,7 @@ def reduce_obs(
     rank, total, ss = 0, 0, 0.0
     lo, hi = std.grid.min(), std.grid.max()
     for j, (e, g, lam) in enumerate(zip(ys, obs.grids, lamy, strict=True)):
-        if g is not None and not (g.min() >= lo and g.max() <= hi):
+        if not points and g is not None and not (g.min() >= lo and g.max() <= hi):
             a, b, c, d = numbers_text(g.min(), g.max(), lo, hi)
             raise GPMSAError(
                 f"the index of experiment {j} reaches [{a}, {b}], outside the simulation grid "
@@ -537,8 +542,8 @@ def _check_discrepancy_scales(kind, grids: list[np.ndarray]) -> None:
     """GPMSAError where a "linear" discrepancy basis, normalised on each experiment's grid
     (`discrepancy_basis`), takes different scales on the experiments' grids: the same weights
     would mean a different discrepancy in each (and ``gpmsa.full_prediction`` refuses it)."""
-    if not (isinstance(kind, str) and kind == "linear") or len(grids) < 2:
-        return
+    if not (isinstance(kind, str) and kind == "linear") or len(grids) < 2 or is_points(grids[0]):
+        return  # index points: "linear" is refused by discrepancy_basis
     reach = [float(np.max(np.abs(g))) for g in grids]
     if not np.isclose(max(reach), min(reach), rtol=1e-12, atol=0.0):  # 0.1 + 0.2 is 0.3
         j, k = int(np.argmin(reach)), int(np.argmax(reach))

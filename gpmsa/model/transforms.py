@@ -9,7 +9,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from gpmsa.errors import ExtrapolationWarning, GPMSAError, numbers_text
+from gpmsa.model import index_points
 from gpmsa.model.data import SimData, check_increasing, column_scales, output_scale
+from gpmsa.model.index_points import is_points, n_points
 
 UNIT_TOL = 1e-9
 """Unit-scale values within this distance outside [0, 1] are rounding of the design's edges (a
@@ -91,8 +93,9 @@ class Standardizer:
     Attributes (native units): ``x_min``, ``x_max`` (p,), ``t_min``, ``t_max`` (q,): the unit
     domain, per column the design's min/max or the range the user gave (``SimData(x_range=,
     t_range=)``), which ``x_ranged``, ``t_ranged`` flag (one bool per column; empty: none);
-    ``y_mean`` (l_sim,) on the simulation grid ``grid`` (l_sim,), ``y_sd``: a float (one sd,
-    ddof=1, over all outputs: GPM/SA's default) or, scaled columnwise, an array (l_sim,) of
+    ``y_mean`` (l_sim,) on the simulation grid ``grid`` (l_sim,) (or index points (l_sim, d)),
+    ``y_sd``: a float (one sd, ddof=1, over all outputs: GPM/SA's default) or, scaled
+    columnwise, an array (l_sim,) of
     each element's sd (``columnwise``); ``sd_on`` gives it on any grid. ``y_given``: which of
     "y_mean", "y_sd" the user gave (``SimData(y_mean=, y_sd=)``) instead of the runs' own
     (empty: neither); a given y_sd array (l_sim,) scales each element by its own.
@@ -166,11 +169,14 @@ class Standardizer:
         return self._on(self.y_mean, grid)
 
     def _on(self, values: np.ndarray, grid: np.ndarray | None) -> np.ndarray:
-        """``values`` (l_sim,) on the simulation grid, interpolated onto ``grid``."""
+        """``values`` (l_sim,) on the simulation grid, interpolated onto ``grid`` (index points
+        (l, d): piecewise linearly on the simulation points' triangulation)."""
         if grid is None or (grid.shape == self.grid.shape and np.array_equal(grid, self.grid)):
             return values
         if values.size == 1:
-            return np.full(grid.shape, values[0])
+            return np.full(n_points(grid), values[0])
+        if is_points(self.grid) or is_points(grid):
+            return index_points.weights(self.grid, grid, "observation index") @ values
         check_increasing(self.grid, "the simulation grid")
         return np.interp(grid, self.grid, values)
 

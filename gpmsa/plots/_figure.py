@@ -3,6 +3,9 @@ the axes' labels."""
 
 from __future__ import annotations
 
+import numpy as np
+
+from gpmsa.errors import GPMSAError
 from gpmsa.limits import BYTES_PER_HISTOGRAM_BIN, check_memory
 from gpmsa.model.data import check_count
 
@@ -27,3 +30,15 @@ def check_bins(bins, n_hist: int, what: str) -> int:
 def axis_label(name: str, unit: str) -> str:
     """``name (unit)``, every figure's label of a quantity, or the name alone without a unit."""
     return f"{name} ({unit})" if unit else name
+
+
+def check_line_index(grid, what: str) -> None:
+    """GPMSAError where the plot ``what`` would draw along an output index of several columns
+    (l, d) (SEPIA's (time, angle) y_ind): its curves are along one index column."""
+    if grid is not None and np.ndim(grid) == 2:
+        l, d = np.shape(grid)
+        raise GPMSAError(
+            f"{what} draws along a one-column output index; this one has {l} points in {d} "
+            "columns: plot the values against the points yourself (e.g. matplotlib's "
+            "tricontourf over emu.standardizer.grid)"
+        )

@@ -6,7 +6,7 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, SimData
-from gpmsa.plots._figure import axis_label, figure
+from gpmsa.plots._figure import axis_label, check_line_index, figure
 
 
 def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = None):
@@ -47,6 +47,7 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
         raise GPMSAError(f"obs has {x_obs.shape[1]} known inputs, the runs {sim.p}")
     if sim.l_sim == 1:
         return _scalar(sim, inputs, x_obs, ys)
+    check_line_index(sim.index, "plots.data")
     return _functional(sim, inputs, obs, ys, color_by)
 
 

@@ -9,7 +9,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.basis import variance_shares
 from gpmsa.model.data import SimData, check_count, check_flag, check_level, column_order
-from gpmsa.plots._figure import axis_label, figure
+from gpmsa.plots._figure import axis_label, check_line_index, figure
 from gpmsa.predictive.crossval import CrossValidation
 
 
@@ -34,6 +34,7 @@ def pc_basis(emulator, *, max_pc: int = 6):
     if not isinstance(emulator, Emulator):
         raise GPMSAError(f"emulator must be a gpmsa.Emulator, got {type(emulator).__name__}")
     std = emulator.standardizer
+    check_line_index(std.grid, "plots.pc_basis")
     p_u = min(emulator.p_u, check_count(max_pc, "max_pc"))
     scalar = emulator.l_sim == 1
     units = (*emulator.x_units, *emulator.t_units)
@@ -122,6 +123,7 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
     draws = check_flag(draws, "draws")
     if n_draws is not None:
         check_count(n_draws, "n_draws")
+    check_line_index(emulator.standardizer.grid, "plots.emulator_fit")
     if isinstance(held_out, CrossValidation):
         mean, var, actual = held_out.mean, held_out.var, held_out.y
         what = "cross-validation"

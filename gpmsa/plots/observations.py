@@ -8,7 +8,7 @@ import numpy as np
 from gpmsa.calibration.observations import check_emulator, reduce
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, check_count
-from gpmsa.plots._figure import check_bins, figure
+from gpmsa.plots._figure import check_bins, check_line_index, figure
 
 
 def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
@@ -45,6 +45,7 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be a gpmsa.ObsData, got {type(obs).__name__}")
     max_pc = check_count(max_pc, "max_pc")
+    check_line_index(emulator.standardizer.grid, "plots.obs_projection")
     reduced = reduce(emulator, obs, None, extrapolate=True).obs  # a plot shows them all
     n_pc = min(max_pc, emulator.p_u)
     functional = emulator.K.shape[0] > 1

@@ -6,7 +6,7 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, as_float, check_count, check_level
-from gpmsa.plots._figure import axis_label, figure
+from gpmsa.plots._figure import axis_label, check_line_index, figure
 from gpmsa.predictive.full import FullPrediction
 
 BANDS = (("y", "new observation y", "0.8"), ("zeta", "eta + delta", "C1"),
@@ -58,6 +58,7 @@ def prediction_bands(
         raise GPMSAError(f"pred must be a FullPrediction, got {type(pred).__name__}")
     level = check_level(level)
     max_panels = check_count(max_panels, "max_panels")
+    check_line_index(pred.grid, "plots.prediction_bands")
     N, l = pred.x.shape[0], pred.grid.size
     if pred.x.shape[1] == 0 and l == 1:
         raise GPMSAError(

@@ -10,7 +10,7 @@ from scipy.stats import norm
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import check_count, check_level
-from gpmsa.plots._figure import axis_label, figure
+from gpmsa.plots._figure import axis_label, check_line_index, figure
 from gpmsa.predictive.sobol import Sensitivity
 
 
@@ -37,6 +37,7 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
         raise GPMSAError(f"sens must be a Sensitivity, got {type(sens).__name__}")
     level = check_level(level)
     q = [(1 - level) / 2, (1 + level) / 2]
+    check_line_index(sens.grid, "plots.sensitivity_bars")
     functional = sens.grid.size > 1
     fig = figure(11.0 if functional else 5.5, 4.0)
     axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]

@@ -55,7 +55,8 @@ class EmulatorPrediction:
         resid: whether nugget and residual are included.
         K: (l_sim, p_u) the basis; y_mean (l_sim,), y_sd: the output standardisation (a
             float; scaled columnwise, (l_sim,) each element's sd);
-        lamWOs: (S,) the residual precision of each draw; grid: (l_sim,) the output grid.
+        lamWOs: (S,) the residual precision of each draw; grid: (l_sim,) the output grid
+            (or index points (l_sim, d)).
     """
 
     x: np.ndarray
@@ -116,7 +117,7 @@ class EmulatorPrediction:
     def __repr__(self) -> str:
         s = np.shape(self.mu_w)[0]
         rlz = np.shape(self.w)[0] // s if s else 0
-        return (f"EmulatorPrediction({np.shape(self.x)[0]} points x {np.size(self.grid)} "
+        return (f"EmulatorPrediction({np.shape(self.x)[0]} points x {np.shape(self.grid)[0]} "
                 f"outputs, {draws_text(self.draw_index)} x {rlz} realizations, "
                 f"resid={self.resid})")  # fmt: skip
 

@@ -35,6 +35,7 @@ from gpmsa.calibration.observations import blas_controller, check_x, layout_dige
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError, numbers_text
 from gpmsa.limits import check_memory
+from gpmsa.model import index_points
 from gpmsa.model.basis import (
     basis_digest,
     describe_discrepancy,
@@ -56,6 +57,7 @@ from gpmsa.model.data import (
     evenly_spaced,
 )
 from gpmsa.model.discrepancy import groups_of, params_at, sample_names
+from gpmsa.model.index_points import is_points, n_points
 from gpmsa.model.problem import reduce_obs
 from gpmsa.predictive._common import (
     EMULATOR_PARAMS,
@@ -138,7 +140,7 @@ class FullPrediction:
 
     def _moments_std(self, what: str) -> tuple[np.ndarray, np.ndarray]:
         """Per draw mean and variance (S, N, l), standardised scale, of one quantity."""
-        p_v, l = self.p_v, self.grid.size
+        p_v, l = self.p_v, n_points(self.grid)
         if what == "eta":
             B = np.hstack([np.zeros((l, p_v)), self.K])
         elif what == "delta":
@@ -190,7 +192,7 @@ class FullPrediction:
     def __repr__(self) -> str:
         s = np.shape(self.theta)[0]
         rlz = np.shape(self.eta)[0] // s if s else 0
-        return (f"FullPrediction({np.shape(self.x)[0]} points x {np.size(self.grid)} outputs, "
+        return (f"FullPrediction({np.shape(self.x)[0]} points x {n_points(self.grid)} outputs, "
                 f"{s} draws x {rlz} realizations, p_u={np.shape(self.K)[1]}, "
                 f"p_v={self.p_v})")  # fmt: skip
 
@@ -263,6 +265,15 @@ def _pred_grid(emulator, obs: ObsData, grid):
         if grid is not None:
             raise GPMSAError("a scalar output has no output grid; leave grid=None")
         return std.grid
+    if grid is not None and is_points(std.grid):
+        g = as_float(grid, "grid")
+        if g.ndim == 1 and g.size == std.grid.shape[1]:
+            g = g[None, :]  # one point
+        check_finite(g, "grid")
+        if g.shape[0] == 0:
+            raise GPMSAError("grid must hold at least one point")
+        index_points.weights(std.grid, g, "grid")  # columns checked; refused outside the hull
+        return g
     if grid is not None:
         g = as_float(grid, "grid")
         if g.ndim > 1 and sum(n > 1 for n in g.shape) > 1:
@@ -285,7 +296,7 @@ def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool, b
     """D (l, p_v) on the prediction grid with the normalisation the fit used for the data
     (``bases``: the reduction's per-experiment bases, ``ObsProblem.D``)."""
     if kind is None:
-        return np.zeros((grid.size, 0))
+        return np.zeros((n_points(grid), 0))
     if scalar:
         return np.ones((1, 1))
     obs_grids = [std.grid if g is None else g for g in obs.grids]
@@ -323,11 +334,12 @@ def _given_on_grid(kind, given, grid: np.ndarray, scalar: bool) -> np.ndarray:
     D = as_float(given, "grid_discrepancy")
     if D.ndim == 1 and p_v == 1:
         D = D[:, None]
-    if D.shape != (grid.size, p_v):
+    n = n_points(grid)
+    if D.shape != (n, p_v):
         hint = "; SEPIA stores D as (p_v, l): pass its transpose" if (
-            D.shape == (p_v, grid.size)) else ""  # fmt: skip
+            D.shape == (p_v, n)) else ""  # fmt: skip
         raise GPMSAError(
-            f"grid_discrepancy must be ({grid.size}, {p_v}): one row per point of the "
+            f"grid_discrepancy must be ({n}, {p_v}): one row per point of the "
             f"prediction grid, one column per discrepancy basis vector; got {D.shape}{hint}"
         )
     check_finite(D, "grid_discrepancy")
@@ -340,7 +352,7 @@ def _experiment_basis(bases, obs_grids: list[np.ndarray], grid: np.ndarray) -> n
     ``obs_ref``); GPMSAError where no experiment has that grid, or those that do differ."""
     on = [j for j, g in enumerate(obs_grids) if g.shape == grid.shape and np.array_equal(g, grid)]
     if not on:
-        sizes = ", ".join(f"{j}: {g.size} values" for j, g in enumerate(obs_grids[:6]))
+        sizes = ", ".join(f"{j}: {n_points(g)} values" for j, g in enumerate(obs_grids[:6]))
         raise GPMSAError(
             "per-experiment discrepancy bases (a list) are known on their experiments' index "
             "grids only: pass grid= one experiment's grid (obs.grids[j]; experiments "
@@ -369,10 +381,11 @@ def _experiment_prediction(kind, obs: ObsData, std, grid, experiment, bases):
     j = check_count(experiment, "experiment", 0, obs.n - 1)
     own = std.grid if obs.grids[j] is None else obs.grids[j]
     if grid is not None:
-        g = as_float(grid, "grid").reshape(-1)
+        g = as_float(grid, "grid")
+        g = g if is_points(own) else g.reshape(-1)
         if g.shape != own.shape or not np.array_equal(g, own):
             raise GPMSAError(
-                f"experiment={j} predicts on its grid (obs.grids[{j}], {own.size} values), "
+                f"experiment={j} predicts on its grid (obs.grids[{j}], {n_points(own)} values), "
                 "where its basis is known: leave grid= out"
             )
     return own, bases[j]
@@ -656,8 +669,8 @@ def full_prediction(
     n_c = p_v + p_u
     S = len(sets)
     check_memory(  # the draws (latents, eta, delta, y, noise) and per draw the joint covariance
-        8.0 * S * (n_rlz * N * (n_c + 4 * g.size) + N * n_c * n_c) + 8.0 * 4 * (n_c * N) ** 2,
-        f"full_prediction(n_rlz={n_rlz}) at {N} points x {S} draws x {g.size} outputs",
+        8.0 * S * (n_rlz * N * (n_c + 4 * n_points(g)) + N * n_c * n_c) + 8.0 * 4 * (n_c * N) ** 2,
+        f"full_prediction(n_rlz={n_rlz}) at {N} points x {S} draws x {n_points(g)} outputs",
     )
     mu = np.empty((S, N, n_c))
     cov_pt = np.empty((S, N, n_c, n_c))

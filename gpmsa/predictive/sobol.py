@@ -101,7 +101,7 @@ class Sensitivity:
             categorical input the tuple of its levels varied over (each equally likely).
         fixed: name -> native value of each input held fixed.
         draw_index: (S,) the emulator draws used (-1: the point estimate).
-        grid: (l_sim,) the output grid.
+        grid: (l_sim,) the output grid (or index points (l_sim, d)).
         main, total: (S, l_sim, d) indices of each output element.
         main_pc, total_pc: (S, p_u, d) indices of each basis component's weight.
         main_aggregated, total_aggregated: (S, d) indices of the output's variance summed over
@@ -234,7 +234,8 @@ class Sensitivity:
         total = np.mean(self.total_aggregated, axis=0) if d else ()
         effects = ", ".join(f"{n}={v:.2f}" for n, v in zip(self.names[:shown], total, strict=False))
         more = f", +{d - shown} more" if d > shown else ""
-        return (f"Sensitivity({d} inputs, {len(self.fixed)} fixed, {np.size(self.grid)} outputs, "
+        l = np.shape(self.grid)[0]
+        return (f"Sensitivity({d} inputs, {len(self.fixed)} fixed, {l} outputs, "
                 f"{draws_text(self.draw_index)}, total effect: {effects}{more})")  # fmt: skip
 
 

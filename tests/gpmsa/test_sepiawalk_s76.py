@@ -25,18 +25,20 @@ def _ball_drop():
     return sim, gpmsa.ObsData(x=r_obs[:, None], y=y_obs, index=H_OBS)
 
 
-def test_sim_index_of_several_columns_is_named():
+def test_sim_index_of_several_columns_is_points_its_transpose_named():
     t, phi = np.linspace(0, 1, 4), np.linspace(0, 6, 5)
     ind = np.column_stack([np.repeat(t, 5), np.tile(phi, 4)])  # SEPIA's (l, 2) y_ind_sim
-    with pytest.raises(gpmsa.GPMSAError, match=r"index must be one output grid.*\(20, 2\)"):
-        gpmsa.SimData(x=np.arange(5.0)[:, None], t=np.arange(5.0)[::-1, None] ** 2,
-                      y=np.arange(100.0).reshape(5, 20), index=ind)  # fmt: skip
+    run = {"x": np.arange(5.0)[:, None], "t": np.arange(5.0)[::-1, None] ** 2,
+           "y": np.arange(100.0).reshape(5, 20)}  # fmt: skip
+    assert gpmsa.SimData(**run, index=ind).grid.shape == (20, 2)
+    with pytest.raises(gpmsa.GPMSAError, match=r"\(20,\) or .*\(20, d\), got shape \(2, 20\)"):
+        gpmsa.SimData(**run, index=ind.T)
 
 
-def test_obs_index_of_several_columns_is_named():
+def test_obs_index_of_several_columns_is_points():
     ind = [np.column_stack([np.full(3, 0.5), [1.0, 2.0, 3.0]])] * 2
-    with pytest.raises(gpmsa.GPMSAError, match=r"index\[0\] must be one output grid.*\(3, 2\)"):
-        gpmsa.ObsData(x=[[0.1], [0.2]], y=[np.ones(3), np.ones(3)], index=ind)
+    obs = gpmsa.ObsData(x=[[0.1], [0.2]], y=[np.ones(3), np.ones(3)], index=ind)
+    assert [g.shape for g in obs.grids] == [(3, 2), (3, 2)]
 
 
 def test_discrepancy_array_in_sepia_layout_says_transpose():
