@@ -793,7 +793,10 @@ class BCR:
         since the previous update (those a restart kept), as the window fills too, so that
         every sample of a window has passed them once; the timing checks on a full window.
         New samples over which the speed changes by more than MAX_SPEED_CHANGE (starting,
-        stopping) skip the level-jump check: their level changes with the speed."""
+        stopping) skip the level-jump check (their level changes with the speed) and the
+        dead-stretch check (a robot getting under way on flat ground reads an all but constant
+        acceleration, as the change-point method's blocks over which the speed changes go
+        unchecked)."""
         every = self.settings.samples_per_update
         spd = np.abs(self._spd[-every:])
         steady = spd.size == 0 or np.min(spd) >= MAX_SPEED_CHANGE * np.max(spd)

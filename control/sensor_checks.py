@@ -295,7 +295,9 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
     or "" (stuck, quantised, clipped, a dead stretch, quieter than the sensor's noise, a level
     that drops within the block; with ``limits.static_mps2``, a mean off the static level:
     `static_level`). ``steady=False``: the vehicle started or stopped within the block, whose
-    level then changes with the speed: no level-jump check."""
+    level then changes with the speed: no level-jump check; and no dead-stretch check (a robot
+    getting under way on flat ground, or coming to rest, reads an all but constant
+    acceleration)."""
     a = np.asarray(accel, dtype=float)
     if a.ndim != 1:
         raise ControlError(f"accel must be a 1-D block of accelerations, got shape {a.shape}")
@@ -337,7 +339,7 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
     # lattice check's shortest stretches
     sorted_runs = _sorted_runs(a, DEAD_STRETCH)
     spread = None if sorted_runs is None else sorted_runs[-1] - sorted_runs[0]
-    start = _dead_stretch(a, limits.dead_fraction, flight, sd, spread)
+    start = _dead_stretch(a, limits.dead_fraction, flight, sd, spread) if steady else -1
     if start >= 0:
         return (
             f"dead sensor: samples {start}-{start + DEAD_STRETCH - 1} span less than "

@@ -148,13 +148,14 @@ def require_instance(obj, name: str, cls: type) -> None:
     check_instance(getattr(obj, name), f"{type(obj).__name__}.{name}", cls)
 
 
-def check_instance(value, name: str, cls: type) -> None:
+def check_instance(value, name: str, cls: type, hint: str = "") -> None:
     """ControlError naming the argument ``name`` when ``value`` is not a ``cls`` (named with
-    its package: ``control.Simplex``)."""
+    its package: ``control.Simplex``), and ``hint`` (how to make one) where given."""
     if not isinstance(value, cls):
         package = cls.__module__.split(".")[0]
         raise ControlError(
-            f"{name} must be a {package}.{cls.__name__}, got {value!r} ({type(value).__name__})"
+            f"{name} must be a {package}.{cls.__name__}, got {value!r:.60} "
+            f"({type(value).__name__})" + (f": {hint}" if hint else "")
         )
 
 

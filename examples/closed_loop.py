@@ -32,6 +32,7 @@ estimate on that part (shorter than the first block), or a change the estimate n
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 from pathlib import Path
 
@@ -56,6 +57,12 @@ PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 PAPER_RMSE = {"A": {"300": 42.58, "500": 94.42}, "B": {"300": 50.19, "500": 96.23}}
 
 
+TRACK_DEFAULTS = inspect.signature(roadgen.track).parameters
+LEAD_IN_M = TRACK_DEFAULTS["lead_in_m"].default
+"""roadgen.track's lead-in from flat ground at the start of the first segment, m."""
+BLEND_M = TRACK_DEFAULTS["blend_m"].default
+"""roadgen.track's cross-fade between neighbouring segments, m."""
+
 GD_MAX = 1e6
 """Largest GD (1e-6 m^3) the scripts take: beyond ISO 8608's roughest class (H, from 131072),
 far beyond what a small robot survives (its drive ends with `vehicle.SimulationDivergedError`)."""
@@ -65,8 +72,9 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
     """``"50:300,50:500,50:300"`` -> ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0)): length in m, GD.
 
     Raises ValueError naming the segment that is not ``LENGTH:GD`` with two finite positive
-    numbers, GD at most `GD_MAX`, and naming two GDs that differ but print alike (``f"{gd:g}"``,
-    six digits: the tables and metrics.json key each part by it, so one would hide the other).
+    numbers, GD at most `GD_MAX`, length at least roadgen.track's (`_check_lengths`), and
+    naming two GDs that differ but print alike (``f"{gd:g}"``, six digits: the tables and
+    metrics.json key each part by it, so one would hide the other).
     """
     segments = []
     labels: dict[str, float] = {}
@@ -87,7 +95,28 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
                 "six digits): give both parts one GD, or GDs that differ within six digits"
             )
         segments.append((length, gd))
+    _check_lengths(segments, [part.strip() for part in text.split(",")])
     return tuple(segments)
+
+
+def _check_lengths(segments: list[tuple[float, float]], parts: list[str]) -> None:
+    """ValueError naming the first segment shorter than roadgen.track allows with its default
+    lead-in (`LEAD_IN_M`) and blend (`BLEND_M`): the first segment holds the lead-in and half a
+    blend, every other segment a blend."""
+    several = len(segments) > 1
+    for k, ((length, _), part) in enumerate(zip(segments, parts, strict=True)):
+        shortest = BLEND_M if k else LEAD_IN_M + (0.5 * BLEND_M if several else 0.0)
+        if length < shortest:
+            if k:
+                why = f"the {BLEND_M:g} m blend between segments"
+            else:
+                why = f"the {LEAD_IN_M:g} m lead-in from flat ground" + (
+                    f" and half the {BLEND_M:g} m blend into the next segment" if several else ""
+                )
+            raise ValueError(
+                f"segment {part!r} is {length:g} m long: it must be at least {shortest:g} m "
+                f"({why}); lengthen it or merge it with a neighbour"
+            )
 
 
 def figure(value: float | None, spec: str) -> str:
