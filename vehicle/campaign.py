@@ -169,16 +169,18 @@ def load_campaign(path: str | os.PathLike) -> Campaign:
         )
     try:
         settings = json.loads(str(settings))
-    except (json.JSONDecodeError, RecursionError) as exc:
+    except (ValueError, RecursionError) as exc:  # also an integer beyond str/int's digit limit
         raise CampaignFileError(
-            f"campaign file {str(path)!r}: settings are not JSON (or nested too deep): {exc}"
+            f"campaign file {str(path)!r}: settings are not JSON that Python reads (or nested "
+            f"too deep): {exc}"
         ) from exc
     if not isinstance(settings, dict) or settings.pop("format", None) != FORMAT:
         raise CampaignFileError(f"campaign file {str(path)!r}: unknown format, need {FORMAT!r}")
     keep_s = settings.get("keep_s", 0.0)
     if isinstance(keep_s, int | float) and keep_s > 0 and "accel" not in arrays:
+        shown = f"{keep_s:g}" if keep_s <= sys.float_info.max else "more than 1.8e308"
         raise CampaignFileError(
-            f"campaign file {str(path)!r} is damaged: its settings keep {keep_s:g} s of traces "
+            f"campaign file {str(path)!r} is damaged: its settings keep {shown} s of traces "
             "per run, but it holds no traces"
         )
     try:

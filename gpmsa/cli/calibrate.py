@@ -20,6 +20,10 @@ from gpmsa.cli.text import internal_error, numbers, safe
 from gpmsa.errors import GPMSAError
 from gpmsa.io.container import jsonable
 
+Y_CSV_MAX_BYTES = 64 * 1024**2
+"""Most bytes of a ``--y-csv`` file read (one observation's values take far fewer); a longer
+file, or a device or pipe that never ends, is refused at this size."""
+
 
 def add_parser(sub) -> None:
     """Add the ``calibrate`` subcommand to an argparse subparsers object."""
@@ -126,14 +130,21 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     column of numbers (`_fields`; blank lines and lines starting with "#" skipped), in the
     order of ``names``, or under a first row that names the columns (exactly ``names``, any
     order: read by name; a row of no numbers, or of those names above another row).
-    GPMSAError naming the file, and the row and column, for a file that cannot be read, a
-    field that is not a finite number, rows of unequal length, or another count of values."""
+    GPMSAError naming the file, and the row and column, for a file that cannot be read or
+    holds more than ``Y_CSV_MAX_BYTES``, a field that is not a finite number, rows of unequal
+    length (the header row too), or another count of values."""
     where = f"--y-csv {safe(path, 200)}"
     try:
-        with open(path, encoding="utf-8-sig") as fh:
-            lines = fh.read().splitlines()
+        with open(path, "rb") as fh:  # a pipe or device may never end: read a bounded part
+            raw = fh.read(Y_CSV_MAX_BYTES + 1)
+        lines = raw.decode("utf-8-sig").splitlines()
     except (OSError, UnicodeDecodeError) as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
+    if len(raw) > Y_CSV_MAX_BYTES:
+        raise GPMSAError(
+            f"{where}: it holds more than {Y_CSV_MAX_BYTES} bytes, more than one observation's "
+            "values take (gpmsa.cli.calibrate.Y_CSV_MAX_BYTES)"
+        )
     try:
         rows = [(k, _fields(line)) for k, line in enumerate(lines, 1)
                 if line.strip() and not line.lstrip().startswith("#")]  # fmt: skip
@@ -148,7 +159,7 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     if not any(_number(f) is not None for f in first) or (
         len(rows) > 1 and sorted(first) == sorted(names)
     ):
-        header, rows = first, rows[1:]
+        (header_line, header), rows = rows[0], rows[1:]
     widths = {len(fields) for _, fields in rows}
     if len(widths) > 1:
         (k0, first), (k, other) = rows[0], next(r for r in rows if len(r[1]) != len(rows[0][1]))
@@ -166,7 +177,7 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
             values.append(v)
     n_rows, n_cols = len(rows), (widths.pop() if widths else 0)
     if header is not None:
-        return _by_header(where, header, rows, names)
+        return _by_header(where, (header_line, header), rows, names)
     if len(values) != len(names) or (n_rows > 1 and n_cols > 1):
         raise GPMSAError(
             f"{where}: {n_rows} row(s) x {n_cols} column(s) of values; the file's outputs are "
@@ -187,9 +198,13 @@ def _fields(line: str) -> list[str]:
     return line.split()
 
 
-def _by_header(where: str, header: list[str], rows: list, names: tuple[str, ...]) -> np.ndarray:
-    """The one row under ``header`` (the columns' names: exactly ``names``, any order) ordered
-    as ``names``; GPMSAError otherwise."""
+def _by_header(
+    where: str, head: tuple[int, list[str]], rows: list, names: tuple[str, ...]
+) -> np.ndarray:
+    """The one row under the header row ``head`` ((its line number, the columns' names: exactly
+    ``names``, any order)), with one value under each name, ordered as ``names``; GPMSAError
+    otherwise."""
+    header_line, header = head
     unknown = [h for h in header if h not in names]
     missing = [n for n in names if n not in header]
     twice = sorted({h for h in header if header.count(h) > 1})
@@ -200,7 +215,13 @@ def _by_header(where: str, header: list[str], rows: list, names: tuple[str, ...]
     if len(rows) != 1:
         raise GPMSAError(f"{where}: under a header row give one row of values (one "
                          f"observation), got {len(rows)}")  # fmt: skip
-    row = [_number(f) for f in rows[0][1]]
+    k, fields = rows[0]
+    if len(fields) != len(header):  # a value without a name, or a name without a value
+        raise GPMSAError(
+            f"{where}: line {k} has {len(fields)} fields, the header row (line {header_line}) "
+            f"{len(header)}: give one value under each name"
+        )
+    row = [_number(f) for f in fields]
     return np.array([row[header.index(n)] for n in names])
 
 
