@@ -46,7 +46,7 @@ from gpmsa.model import constraints, kronecker
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, run_seed
-from gpmsa.model.discrepancy import kept_bases
+from gpmsa.model.discrepancy import kept_bases, scale_record
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, fixed_record, prepare
@@ -160,7 +160,8 @@ def fit(
     experiment shares, or a list of one (l_j, p_v) array per experiment on its own index grid
     (SEPIA's ``create_D_basis(D_obs=[...])``, GPM/SA's per-experiment ``Dobs``; normalised
     jointly, ``gpmsa.model.basis.discrepancy_bases``; kept in ``Emulator.discrepancy_bases`` and
-    the file). discrepancy_groups: the
+    the file; an array's or list's normalising divisor in settings["discrepancy_scale"]).
+    discrepancy_groups: the
     precision group (0 .. G-1) of each discrepancy basis vector, GPM/SA's lamVzGroup (None: one
     group; each group has its own betaV column and lamVz). n_jobs, executor: where
     the chains run (numpy backend: ``n_jobs`` worker processes, None or -1 = every CPU but never
@@ -384,7 +385,8 @@ def fit(
         "versions": library_versions(backend),
     }  # fmt: skip
     if obs is not None and discrepancy is not None:  # full_prediction refuses another basis
-        settings.update(discrepancy_record(problem.obs))
+        source = (resumed.settings or {}) if continuing else None  # keeps its scale
+        settings.update(discrepancy_record(problem.obs), **scale_record(discrepancy, source))
     if append:  # the source's sweeps are gone: its retained draws and these, as pooled
         per = lp_kept.size // n_chains
         summary = summarize({k: v.reshape(n_chains, per, *v.shape[1:])

@@ -379,6 +379,22 @@ def check_discrepancy_record(settings: dict, shapes: dict[str, tuple[int, ...]])
                     f"{n_grp} group(s), but arrays/cal_lamVz holds draws of {lam[1]}")  # fmt: skip
 
 
+def check_discrepancy_scale(settings: dict) -> None:
+    """settings.discrepancy_scale (absent for the named kinds and in files written before it
+    was recorded): the divisor that normalised a discrepancy basis given as an array or a list
+    (settings.discrepancy "given" or "list"), a finite number > 0."""
+    if "discrepancy_scale" not in settings:
+        return
+    scale, kind = settings["discrepancy_scale"], settings.get("discrepancy")
+    if isinstance(scale, bool) or not isinstance(scale, int | float) or not 0 < scale < math.inf:
+        raise _fail("settings.discrepancy_scale", f"must be a finite number > 0, got "
+                                                  f"{_short(scale)}")  # fmt: skip
+    if kind not in ("given", "list"):
+        raise _fail("settings.discrepancy_scale", f"belongs to a discrepancy basis given as an "
+                    f"array or a list (settings.discrepancy 'given' or 'list'), not "
+                    f"{_short(kind)}")  # fmt: skip
+
+
 def _check_bases_shape(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None:
     """``DISCREPANCY_ARRAY`` exactly where settings.discrepancy is "list" (with calibration
     draws), one row per observed value (the sum of settings.obs_lengths) and, with several
@@ -859,6 +875,7 @@ def check_manifest(manifest: dict) -> None:
     check_fields(manifest, dims)
     check_prior_groups(manifest["priors"], shapes)
     check_discrepancy_record(manifest["settings"], shapes)
+    check_discrepancy_scale(manifest["settings"])
     check_fixed_record(manifest["settings"], shapes)
 
 
@@ -1041,6 +1058,7 @@ def check_record(manifest: dict, arrays: dict[str, np.ndarray]) -> dict[str, int
     check_fields(manifest, dims)
     check_prior_groups(manifest["priors"], shapes)
     check_discrepancy_record(manifest["settings"], shapes)
+    check_discrepancy_scale(manifest["settings"])
     held = check_fixed_record(manifest["settings"], shapes)
     given = tuple(manifest["model"].get("y_given", ()))  # check_fields checked it
     check_values(arrays, dims, ranged_columns(manifest, dims), given)

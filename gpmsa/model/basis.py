@@ -242,6 +242,28 @@ def scaled_as(bases: list[np.ndarray], D: np.ndarray) -> np.ndarray:
     return (D if big is None else D / big) / np.sqrt(scale)
 
 
+SCALE_TOL = 1e-9
+"""Relative tolerance within which two `basis_scale` values are one: a basis's and the one a
+fit recorded (settings "discrepancy_scale"), or 1 (a normalised basis)."""
+
+
+def basis_scale(bases: list[np.ndarray]) -> float:
+    """The one number `_normalised` divides ``bases`` by: the largest row norm over them
+    (their largest |value| times that of the bases divided by it, where the squares over- or
+    underflow); ``D / basis_scale(bases)`` is `scaled_as` (the same float division where they
+    do not, to an ulp where they do)."""
+    big, scale = _scale(bases)
+    root = float(np.sqrt(scale))
+    return root if big is None else float(big) * root
+
+
+def given_bases(kind) -> list[np.ndarray]:
+    """A discrepancy basis given as an array or a list (per-experiment bases) as float64
+    (l, p_v) arrays, a 1-D array as one column (unchecked: `discrepancy_bases` checks them)."""
+    raw = [as_float(d, "discrepancy") for d in (kind if is_basis_list(kind) else [kind])]
+    return [d[:, None] if d.ndim == 1 else d for d in raw]
+
+
 def is_basis_list(kind) -> bool:
     """Whether a ``discrepancy`` argument is a list (or tuple) of per-experiment bases: one of
     its entries is 2-D (an array, or a list of rows); a 2-D array given as a list of rows has

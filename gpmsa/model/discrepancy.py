@@ -10,12 +10,13 @@ Posterior names: with one group "betaV" (one known input) or "betaV[k]" (k = 0 .
 
 from __future__ import annotations
 
+import math
 import re
 
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.basis import basis_digest, is_basis_list
+from gpmsa.model.basis import SCALE_TOL, basis_digest, basis_scale, given_bases, is_basis_list
 
 NAME_PATTERN = re.compile(r"(betaV|lamVz)(\[\d+(,\d+)?\])?")
 """The discrepancy parameters' posterior names."""
@@ -126,6 +127,26 @@ def record(obs) -> dict:
     if obs.v_groups is not None:
         out["discrepancy_groups"] = list(obs.v_groups)
     return out
+
+
+def scale_record(kind, source: dict | None = None) -> dict:
+    """What a joint fit records of a discrepancy basis given as an array or a list (``kind``,
+    as given to the fit; the reduction checked it): "discrepancy_scale", the number its
+    normalisation divided it by (`gpmsa.model.basis.basis_scale`), with which
+    ``gpmsa.full_prediction(grid_discrepancy=)`` normalises the same basis functions on
+    another grid, the kept (normalised) bases given; {} for the other kinds. A continuation
+    (``source``: its source's settings, whose basis it has up to scale, signs and order) keeps
+    the source's where that records one (the kept bases, or a multiple, may be given to it);
+    where it records none (a file written before the record), a basis given normalised (its
+    scale 1), perhaps the source's kept bases, records none: the scale is not known."""
+    if kind is None or isinstance(kind, str):
+        return {}
+    if source is not None and source.get("discrepancy_scale") is not None:
+        return {"discrepancy_scale": source["discrepancy_scale"]}
+    scale = basis_scale(given_bases(kind))
+    if source is not None and math.isclose(scale, 1.0, rel_tol=SCALE_TOL):
+        return {}
+    return {"discrepancy_scale": scale}
 
 
 def kept_bases(obs, kind) -> tuple[np.ndarray, ...] | None:

@@ -25,6 +25,7 @@ docs/categorical-and-constraints.md).
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import dataclass
 
@@ -37,10 +38,13 @@ from gpmsa.errors import GPMSAError, numbers_text
 from gpmsa.limits import check_memory
 from gpmsa.model import index_points
 from gpmsa.model.basis import (
+    SCALE_TOL,
     basis_digest,
+    basis_scale,
     describe_discrepancy,
     discrepancy_basis,
     discrepancy_kind,
+    given_bases,
     interpolate_basis,
     is_basis_list,
     scaled_as,
@@ -320,16 +324,19 @@ def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool, b
     return D * (scales.pop() / D[0, 0])
 
 
-def _given_on_grid(kind, given, grid: np.ndarray, scalar: bool) -> np.ndarray:
+def _given_on_grid(kind, given, grid: np.ndarray, scalar: bool, kept: bool,
+                   fitted: float | None) -> np.ndarray:  # fmt: skip
     """``given`` (grid.size, p_v): the basis functions of the calibration's array or list
-    ``kind`` on the prediction grid, divided as the fit divided the observations' bases."""
+    ``kind`` on the prediction grid, divided as the fit divided the observations' bases
+    (``kept``: ``kind`` is the joint fit's kept, normalised list; ``fitted``: the divisor the
+    fit recorded, None where it recorded none)."""
     if scalar or kind is None or isinstance(kind, str):
         raise GPMSAError(
             "grid_discrepancy= goes with a discrepancy basis given as an array or a list, on a "
             "multivariate output ('constant' and 'linear' are known on any grid)"
         )
-    raw = [as_float(d, "discrepancy") for d in (kind if is_basis_list(kind) else [kind])]
-    raw = [d[:, None] if d.ndim == 1 else d for d in raw]
+    raw = given_bases(kind)
+    divisor = _grid_divisor(kind, raw, kept, fitted)
     p_v = raw[0].shape[1]
     D = as_float(given, "grid_discrepancy")
     if D.ndim == 1 and p_v == 1:
@@ -343,7 +350,41 @@ def _given_on_grid(kind, given, grid: np.ndarray, scalar: bool) -> np.ndarray:
             f"prediction grid, one column per discrepancy basis vector; got {D.shape}{hint}"
         )
     check_finite(D, "grid_discrepancy")
-    return scaled_as(raw, D)
+    return scaled_as(raw, D) if divisor is None else D / divisor
+
+
+def _grid_divisor(kind, raw: list[np.ndarray], kept: bool, fitted: float | None) -> float | None:
+    """The fit's divisor of ``grid_discrepancy=`` (`_given_on_grid`): None where ``kind`` is
+    the basis as given to the fit (its own normalisation, `scaled_as`, is the fit's), the
+    recorded one with the kept list; GPMSAError where neither is known to hold: the kept list
+    without a record, or a basis at another scale (a normalised copy, or a multiple)."""
+    if fitted is None:
+        if kept:
+            raise GPMSAError(
+                "grid_discrepancy= is divided by the scale that normalised the fit's bases, "
+                "which this emulator (or posterior=) does not record (settings['discrepancy_"
+                "scale'], absent from files written before it was recorded; Emulator."
+                "discrepancy_bases are normalised): pass the list given to the fit again as "
+                "discrepancy="
+            )
+        return None
+    fitted = float(fitted)
+    if kept:
+        return fitted
+    own = basis_scale(raw)
+    if math.isclose(own, fitted, rel_tol=SCALE_TOL):
+        return None
+    what = "list" if is_basis_list(kind) else "array"
+    remedy = ("leave discrepancy= at its default (the joint fit's kept bases, with its scale) or "
+              "pass the list given to the fit" if what == "list"
+              else "pass the array given to the fit")  # fmt: skip
+    raise GPMSAError(
+        f"grid_discrepancy= is divided by the scale that normalised the basis given to the fit "
+        f"({fitted:.6g}, settings['discrepancy_scale']), but discrepancy= ("
+        f"{describe_discrepancy(kind)}) normalises by {own:.6g}: it is that basis at another "
+        f"scale (a normalised copy, e.g. of Emulator.discrepancy_bases, or a multiple), so "
+        f"grid_discrepancy= could be meant at either scale: {remedy}"
+    )
 
 
 def _experiment_basis(bases, obs_grids: list[np.ndarray], grid: np.ndarray) -> np.ndarray:
@@ -559,9 +600,11 @@ def full_prediction(
         grid_discrepancy: with a discrepancy basis given as an array or a list, the same basis
             functions evaluated on the prediction grid (``grid``, or its default), (l, p_v)
             as given to the fit, before normalisation (SEPIA's ``D_sim``): delta there, the
-            fit's normalisation applied (with the list given to the fit as ``discrepancy=``:
-            a joint fit's kept ``discrepancy_bases`` are normalised, their scale not kept,
-            GPMSAError). None: the basis on the observations' grid only.
+            fit's normalisation applied (the divisor it recorded, settings
+            "discrepancy_scale", with its kept ``discrepancy_bases`` or the basis given to
+            it; the basis at another scale, a normalised copy or a multiple, GPMSAError; a
+            file without the record needs the basis given to the fit). None: the basis on the
+            observations' grid only.
 
     Returns:
         FullPrediction (native units; ``u``, ``v``, ``mu``, ``cov`` in the basis space).
@@ -651,14 +694,10 @@ def full_prediction(
             raise GPMSAError("grid_discrepancy= and experiment= both choose delta's basis: "
                              "give one")  # fmt: skip
         kept = getattr(emulator, "discrepancy_bases", None)
-        if kept is not None and discrepancy is kept:  # normalised: the fit's scale is lost
-            raise GPMSAError(
-                "grid_discrepancy= is divided by the scale that normalised the fit's bases, "
-                "which the joint fit does not keep (Emulator.discrepancy_bases are normalised): "
-                "pass the list given to the fit again as discrepancy="
-            )
         g = _pred_grid(emulator, obs, grid)
-        D_pred = _given_on_grid(discrepancy, grid_discrepancy, g, scalar)
+        D_pred = _given_on_grid(discrepancy, grid_discrepancy, g, scalar,
+                                kept is not None and discrepancy is kept,
+                                record.get("discrepancy_scale"))  # fmt: skip
     elif experiment is None:
         g = _pred_grid(emulator, obs, grid)
         D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar, ob.D)

@@ -20,7 +20,8 @@ def calibration_posterior(emulator) -> Posterior:
     `gpmsa.model.discrepancy`). ``chains`` splits the retained draws into the fit's chains, so
     ``to_arviz()``, ``summary()`` (with ESS) and ``plot()`` work as for ``gpmsa.calibrate``.
     ``info`` carries the fit's discrepancy record ("discrepancy", "discrepancy_sha256",
-    "discrepancy_groups" where there are several groups) and its record of its observations
+    "discrepancy_groups" where there are several groups, "discrepancy_scale" for an array or
+    a list) and its record of its observations
     ("obs_lengths", "obs_sha256"), so that ``gpmsa.full_prediction(..., posterior=)`` refuses
     other ones, as it does without it, and the emulator's ``model_sha256`` ("emulator_sha256"),
     so that it refuses another emulator; a fit with ``fixed=`` of calibration parameters,
@@ -73,7 +74,8 @@ def calibration_posterior(emulator) -> Posterior:
         **emulator_record(emulator),
         **{k: emulator.settings[k] for k in ("n_iter", "n_burn", "thin", "seed", "backend",
                                               "discrepancy", "discrepancy_sha256",
-                                              "discrepancy_groups", "obs_lengths", "obs_sha256")
+                                              "discrepancy_groups", "discrepancy_scale",
+                                              "obs_lengths", "obs_sha256")
            if k in emulator.settings},
     }  # fmt: skip
     shapes = {"theta": (len(emulator.t_names),), "lamOs": (1,)}

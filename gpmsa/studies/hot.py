@@ -18,6 +18,7 @@ import numpy as np
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.continuation import reordered
 from gpmsa.fitting.validation import HOT_RECORD, MAX_HOT_VALUES, hot_record_given
+from gpmsa.model.discrepancy import n_groups
 from gpmsa.studies.sampler import StudyState
 
 PARTS = ("theta", "mu", "lam", "members")
@@ -104,7 +105,8 @@ def _copies(settings, starts, problems, layout, hyper, there, orders, n_hot):
 def check_hot_record(settings: dict, study) -> None:
     """A study file's hot copies (settings ``HOT_RECORD``; absent: none), against ``study``
     built from the file: both or neither, "hot_states" with theta (C, K - 1, G), mu and lam
-    (C, K - 1, H) and members {label: {name: (C, K - 1, ...)}} finite numbers (precisions > 0),
+    (C, K - 1, H) and members {label: {name: (C, K - 1, *shape)}}, each name a parameter of
+    that model (``member_shapes``) of its shape, finite numbers (precisions > 0),
     "hot_step_widths" {sweep element: (C, K - 1)} finite numbers > 0; C the draws' chains, K
     the length of settings.temperatures. EmulatorFileError naming the field otherwise."""
     if not hot_record_given(settings, "study"):
@@ -132,18 +134,40 @@ def check_hot_record(settings: dict, study) -> None:
     for lab, rec in members.items():
         if not isinstance(rec, dict):
             raise _fail(f"settings.hot_states.members.{lab}", "must be an object name -> values")
+        own = member_shapes(study, study.labels.index(lab))
         for name, value in rec.items():
-            field = f"settings.hot_states.members.{lab}.{name}"
+            field = f"settings.hot_states.members.{lab}.{name:.40}"
+            if name not in own:
+                raise _fail(field, f"names no parameter of model {lab!r} (its own: "
+                                   f"{sorted(own)}; theta is the study's, settings.hot_states."
+                                   "theta)")  # fmt: skip
+            want = (*lead, *own[name])
             arr = _values(value, None, field, name.startswith("lam"))
-            if arr.shape[:2] != lead and not (arr.size == 0 and 0 in lead):
-                raise _fail(field, f"has shape {list(arr.shape)}, expected {list(lead)} + the "
-                                   "parameter's shape (chains, hot copies, ...)")  # fmt: skip
+            if arr.shape != want and not (arr.size == 0 and 0 in want):  # JSON: no empty shape
+                raise _fail(field, f"has shape {list(arr.shape)}, expected {list(want)}: "
+                                   f"(chains, hot copies) + {name}'s shape {list(own[name])} "
+                                   f"in model {lab!r}")  # fmt: skip
     rates = settings.get("accept_rate")
     if isinstance(rates, dict) and set(widths) != set(rates):
         raise _fail("settings.hot_step_widths", "must name the sweep's elements (those of "
                                                 "settings.accept_rate)")  # fmt: skip
     for name, value in widths.items():
         _values(value, lead, f"settings.hot_step_widths[{name!r:.40}]", True)
+
+
+def member_shapes(study, i: int) -> dict[str, tuple[int, ...]]:
+    """Model ``i``'s own parameters and their shapes, as its calibration problem or joint fit
+    has them (theta aside: the study's): the emulator's (``Emulator.params``; held in a
+    calibration), lamOs (1,) and, with a discrepancy of G precision groups, betaV (p, G) and
+    lamVz (G,)."""
+    emu = study.members[i]
+    own = {k: tuple(np.shape(v)) for k, v in emu.params.items()}
+    own["lamOs"] = (1,)
+    rec = study.discrepancy(i)
+    if rec is not None:
+        n_grp = n_groups(rec["discrepancy_groups"])
+        own.update(betaV=(emu.p, n_grp), lamVz=(n_grp,))
+    return own
 
 
 def _values(value, shape, field: str, positive: bool) -> np.ndarray:

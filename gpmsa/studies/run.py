@@ -42,7 +42,7 @@ from gpmsa.mcmc.diagnostics import summarize, warn_unconverged
 from gpmsa.mcmc.starts import check_init
 from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
-from gpmsa.model.discrepancy import kept_bases
+from gpmsa.model.discrepancy import kept_bases, scale_record
 from gpmsa.model.discrepancy import record as discrepancy_record
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
@@ -922,7 +922,9 @@ def fit_study(
                                   "hierarchical": list(layout.groups)},  # as read, once
                         "versions": settings["versions"]}  # fmt: skip
         if discs[i][0] is not None:  # full_prediction refuses another basis
-            emu_settings.update(discrepancy_record(prep.problem.obs))
+            source = (init.members[i].settings or {}) if continuing else None  # its scale
+            emu_settings.update(discrepancy_record(prep.problem.obs),
+                                **scale_record(discs[i][0], source))  # fmt: skip
         if fixes[i] is not None:  # as gpmsa.fit records it (continuations compare it)
             emu_settings["fixed"] = fixed_record(problems[i])
         own = {t: moves[layout.elements[layout.index[i][k]].name]

@@ -337,7 +337,8 @@ class Study:
         # gpmsa.calibrate; absent from study files written before it was kept)
         settings = self.members[i].settings if self.kind == "fit" else {}
         info.update({k: settings[k] for k in ("obs_lengths", "obs_sha256", "discrepancy",
-                                              "discrepancy_sha256", "discrepancy_groups")
+                                              "discrepancy_sha256", "discrepancy_groups",
+                                              "discrepancy_scale")
                      if settings.get(k) is not None})  # fmt: skip
         basis = self.settings.get(DISCREPANCIES, {}).get(self.labels[i])
         if basis is not None:  # a calibration's basis: full_prediction refuses another

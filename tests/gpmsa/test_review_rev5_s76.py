@@ -41,9 +41,12 @@ def _ragged_fit():
 
 
 def test_grid_discrepancy_with_a_joint_fits_kept_list_is_refused():
-    """The kept list is normalised (its scale lost): dividing grid_discrepancy by its scale
-    (1) left delta 3.3 times too large; the list given to the fit normalises it exactly."""
+    """The kept list is normalised: without the fit's recorded scale (a file written before
+    settings "discrepancy_scale"; with it: test_gridscale_s77), dividing grid_discrepancy by
+    the list's own (1) left delta 3.3 times too large; the list given to the fit normalises
+    it exactly."""
     emu, obs, D = _ragged_fit()
+    del emu.settings["discrepancy_scale"]
     kw = {"seed": 1, "n_draws": 5}
     for kept in ({}, {"discrepancy": emu.discrepancy_bases}):
         with pytest.raises(gpmsa.GPMSAError, match="pass the list given to the fit again"):
