@@ -26,15 +26,20 @@ def _source(**kw):
 
 
 def _digest(study) -> str:
-    data = b"".join(np.ascontiguousarray(study.draws[k]).tobytes() for k in sorted(study.draws))
+    """The sampled draws' digest, rounded to 12 decimals and without ``log_post``: the BLAS
+    kernel a host picks (OpenBLAS's Haswell, SkylakeX, Sandybridge) moves theta by an ulp and
+    the log posterior by ~1e-9 here, so raw bytes differ between hosts with equal draws."""
+    data = b"".join((np.round(study.draws[k], 12) + 0.0).tobytes()
+                    for k in sorted(study.draws) if k != "log_post")  # fmt: skip
     return hashlib.sha256(data).hexdigest()[:16]
 
 
 def test_fresh_seeded_studies_draw_as_before():
-    """Digests of the draws computed before the record existed (session 76, HEAD 7bb020d)."""
+    """Digests of the draws computed before the record existed (HEAD 7bb020d, equal under
+    the three OpenBLAS kernels above)."""
     kw = {"n_samples": 30, "n_burn": 0, "n_chains": 2, "seed": 4, "tune_rounds": 2}
-    assert _digest(_study(temperatures=LADDER, **kw)) == "da86b5c4fb7e60e7"
-    assert _digest(_study(**kw)) == "f96bba982c329ab4"
+    assert _digest(_study(temperatures=LADDER, **kw)) == "71b14961e5a6701d"
+    assert _digest(_study(**kw)) == "dbe2cd6ca35a04c5"
 
 
 def test_tempered_study_records_its_hot_copies_and_its_continuation_resumes_them(tmp_path):
