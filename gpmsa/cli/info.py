@@ -122,8 +122,8 @@ def _separable_text(emulator) -> str:
 def _facts(manifest: dict, arrays: dict, emulator) -> dict:
     """What ``_lines`` derives from the file beyond its manifest's fields, for ``--json``
     (``gpmsa.cli.info_json.emulator_info``): the model's sha256, separable factors, output
-    scale, basis, the posterior's diagnostics (held positions marked, theta's means native)
-    and the number of array values."""
+    scale, output index, basis, the posterior's diagnostics (held positions marked, theta's
+    means native) and the number of array values."""
     std, sep = emulator.standardizer, emulator.separable
     names = emulator.x_names + emulator.t_names
     separable = None
@@ -133,6 +133,11 @@ def _facts(manifest: dict, arrays: dict, emulator) -> dict:
     y_sd = [float(np.min(std.y_sd)), float(np.max(std.y_sd))] if "y_sd" in std.y_given else None
     scale = {"y_mean_given": "y_mean" in std.y_given, "y_sd_given": "y_sd" in std.y_given,
              "columnwise": bool(std.columnwise), "y_sd_range": y_sd}  # fmt: skip
+    index = None
+    if emulator.l_sim > 1:  # the "output index" line's facts, for one column too
+        columns = std.grid.reshape(std.grid.shape[0], -1)
+        index = {"points": int(columns.shape[0]), "columns": int(columns.shape[1]),
+                 "ranges": [[float(c.min()), float(c.max())] for c in columns.T]}  # fmt: skip
     given = manifest["settings"].get("basis") == "given"
     basis = {"source": "given" if given else "pca", "vectors": int(emulator.K.shape[1]),
              "variance_share": _variance_share(emulator)}  # fmt: skip
@@ -151,7 +156,7 @@ def _facts(manifest: dict, arrays: dict, emulator) -> dict:
         if native is not None:
             posterior[name]["mean_native"] = dict(zip(emulator.t_names, native, strict=True))
     return {"model_sha256": emulator.model_sha256, "separable": separable, "output_scale": scale,
-            "basis": basis, "posterior": posterior,
+            "output_index": index, "basis": basis, "posterior": posterior,
             "array_values": sum(int(a.size) for a in arrays.values())}  # fmt: skip
 
 

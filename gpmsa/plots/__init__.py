@@ -1,6 +1,8 @@
 """Figures users look at: the data before fitting, MCMC traces and autocorrelations, theta
 pairs, the PC basis and the observations' projection onto it (per component and in pairs), rho
-box plots, emulator fit, prediction bands, sensitivity bars and main-effect curves.
+box plots, emulator fit, prediction bands, sensitivity bars and main-effect curves. The figures
+that draw along the output index draw maps over an index of two columns (SEPIA's (time, angle)
+y_ind; ``gpmsa.plots._maps``).
 
 Each function returns a ``matplotlib.figure.Figure`` (matplotlib is imported only when one runs;
 nothing is shown): ``fig.savefig("trace.png")`` in a script, or display it in a notebook.

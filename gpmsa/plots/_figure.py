@@ -1,5 +1,5 @@
-"""A bare matplotlib Figure (no pyplot state, no GUI backend), the histograms' bin check, and
-the axes' labels."""
+"""A bare matplotlib Figure (no pyplot state, no GUI backend), the histograms' bin check, the
+axes' labels, and which output indices draw as maps."""
 
 from __future__ import annotations
 
@@ -32,13 +32,17 @@ def axis_label(name: str, unit: str) -> str:
     return f"{name} ({unit})" if unit else name
 
 
-def check_line_index(grid, what: str) -> None:
-    """GPMSAError where the plot ``what`` would draw along an output index of several columns
-    (l, d) (SEPIA's (time, angle) y_ind): its curves are along one index column."""
-    if grid is not None and np.ndim(grid) == 2:
-        l, d = np.shape(grid)
+def is_map(grid, what: str) -> bool:
+    """Whether the plot ``what`` draws maps over an output index of two columns (l, 2)
+    (SEPIA's (time, angle) y_ind) rather than curves along one (None or (l,)); GPMSAError for
+    three or more columns, which neither a curve nor a map shows."""
+    if grid is None or np.ndim(grid) != 2:
+        return False
+    l, d = np.shape(grid)
+    if d != 2:
         raise GPMSAError(
-            f"{what} draws along a one-column output index; this one has {l} points in {d} "
-            "columns: plot the values against the points yourself (e.g. matplotlib's "
-            "tricontourf over emu.standardizer.grid)"
+            f"{what} draws along a one-column output index or maps over a two-column one; this "
+            f"one has {l} points in {d} columns: plot slices of the values against two of its "
+            "columns yourself (e.g. matplotlib's tricontourf over emu.standardizer.grid)"
         )
+    return True

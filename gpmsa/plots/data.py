@@ -6,7 +6,11 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, SimData
-from gpmsa.plots._figure import axis_label, check_line_index, figure
+from gpmsa.plots import _maps
+from gpmsa.plots._figure import axis_label, figure, is_map
+
+MAP_PANELS = 4
+"""Runs, and experiments, drawn at most as maps over a two-column output index."""
 
 
 def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = None):
@@ -16,9 +20,13 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
     A functional output (l_sim > 1): every run over the output grid, coloured by the input
     ``color_by`` (a name of ``sim``'s x or t inputs, checked for a scalar output too; default
     its first calibration parameter) with a colour bar, and every experiment over its own grid
-    in black. A scalar output: the output against each input, one panel each; an experiment at
-    its known inputs in the x panels, and as a horizontal line in the t panels (where the runs
-    cross it, theta may lie).
+    in black. Over an output index of two columns (l_sim, 2) (SEPIA's (time, angle) y_ind),
+    maps on one colour scale: a row of 4 runs at evenly spaced ranks of ``color_by`` (the
+    lowest to the highest), each coloured linearly on the points' triangles with a dot at each
+    point, and a row of the first 4 experiments, their values as coloured markers at their own
+    points over the simulation points' grey dots. A scalar output: the output against each
+    input, one panel each; an experiment at its known inputs in the x panels, and as a
+    horizontal line in the t panels (where the runs cross it, theta may lie).
 
     Example:
         >>> import numpy as np, gpmsa
@@ -47,8 +55,21 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
         raise GPMSAError(f"obs has {x_obs.shape[1]} known inputs, the runs {sim.p}")
     if sim.l_sim == 1:
         return _scalar(sim, inputs, x_obs, ys)
-    check_line_index(sim.index, "plots.data")
+    if is_map(sim.index, "plots.data"):
+        return _maps_of(sim, inputs, obs, ys, color_by)
     return _functional(sim, inputs, obs, ys, color_by)
+
+
+def _experiment(sim: SimData, obs: ObsData, e: np.ndarray, j: int, grid) -> np.ndarray:
+    """Experiment ``j``'s index grid: its own, or the simulation's ``grid``; GPMSAError where it
+    has none and its values ``e`` do not match the simulation's."""
+    g = obs.grids[j]
+    if g is None and e.size != sim.l_sim:
+        raise GPMSAError(
+            f"obs experiment {j} has {e.size} values on the simulation grid of {sim.l_sim}: "
+            "give its own grid (ObsData(..., index=))"
+        )
+    return grid if g is None else g
 
 
 def _y_label(sim: SimData) -> str:
@@ -93,13 +114,7 @@ def _functional(sim: SimData, inputs, obs, ys, color_by):
     for row, v in zip(sim.y, values, strict=True):
         ax.plot(grid, row, color=cmap(norm(v)), lw=0.8, alpha=0.7)
     for j, e in enumerate(ys or ()):
-        g = obs.grids[j]
-        if g is None and e.size != sim.l_sim:
-            raise GPMSAError(
-                f"obs experiment {j} has {e.size} values on the simulation grid of {sim.l_sim}: "
-                "give its own grid (ObsData(..., index=))"
-            )
-        ax.plot(grid if g is None else g, e, "o-", ms=3, lw=1.2, color="k",
+        ax.plot(_experiment(sim, obs, e, j, grid), e, "o-", ms=3, lw=1.2, color="k",
                 label="observations" if j == 0 else None)  # fmt: skip
     bar = fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax)
     bar.set_label(axis_label(color_by, unit))
@@ -109,4 +124,36 @@ def _functional(sim: SimData, inputs, obs, ys, color_by):
                  fontsize="small")  # fmt: skip
     if ys:
         ax.legend(fontsize="x-small")
+    return fig
+
+
+def _maps_of(sim: SimData, inputs, obs, ys, color_by):
+    """Maps over a two-column index on one colour scale: runs at evenly spaced ranks of
+    ``color_by`` (top row), the first experiments at their points (bottom row)."""
+    names = [n for n, _, _ in inputs]
+    color_by = sim.t_names[0] if color_by is None else color_by
+    _, values, unit = inputs[names.index(color_by)]
+    ranks = np.unique(np.linspace(0, sim.m - 1, min(MAP_PANELS, sim.m)).round().astype(int))
+    runs = np.argsort(values, kind="stable")[ranks]
+    grids = [_experiment(sim, obs, e, j, sim.index) for j, e in enumerate(ys or ())]
+    shown, grids = list(ys or ())[:MAP_PANELS], grids[:MAP_PANELS]
+    norm = _maps.value_norm(sim.y[runs], *shown)
+    n_cols = max(runs.size, len(shown))
+    fig = figure(2.9 * n_cols + 1.0, 2.7 * (1 + bool(shown)) + 0.4)
+    panels = fig.add_gridspec(1 + bool(shown), n_cols)
+    axes = []
+    for c, i in enumerate(runs):
+        ax = fig.add_subplot(panels[0, c])
+        shade = _maps.surface(ax, sim.index, sim.y[i], norm, _maps.VALUES)
+        unit_text = f" {unit}" if unit else ""
+        ax.set_title(f"run {i}: {color_by} = {values[i]:.3g}{unit_text}", fontsize="small")
+        axes.append(ax)
+    for j, (e, g) in enumerate(zip(shown, grids, strict=True)):
+        ax = fig.add_subplot(panels[1, j])
+        _maps.markers(ax, g, e, norm, _maps.VALUES, background=sim.index)
+        ax.set_title(f"experiment {j}", fontsize="small")
+        axes.append(ax)
+    _maps.colour_bar(fig, shade, axes, _y_label(sim))
+    n_obs = "" if obs is None else f", {obs.n} experiment(s) ({len(shown)} shown)"
+    fig.suptitle(f"{sim.m} runs ({runs.size} shown, by {color_by}){n_obs}", fontsize="small")
     return fig

@@ -9,7 +9,8 @@ from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.basis import variance_shares
 from gpmsa.model.data import SimData, check_count, check_flag, check_level, column_order
-from gpmsa.plots._figure import axis_label, check_line_index, figure
+from gpmsa.plots import _maps
+from gpmsa.plots._figure import axis_label, figure, is_map
 from gpmsa.predictive.crossval import CrossValidation
 
 
@@ -18,7 +19,10 @@ def pc_basis(emulator, *, max_pc: int = 6):
     w_j against each input, one row per component (at most ``max_pc``): a Figure.
 
     The title of each basis panel gives the share of the standardised runs' variance the
-    component carries. A scalar output (K = [[1]]) shows the weights only.
+    component carries. A scalar output (K = [[1]]) shows the weights only. Over an output index
+    of two columns (l_sim, 2) (SEPIA's (time, angle) y_ind) each basis vector is a map over the
+    points (linear on their triangles, a dot at each point) with its own colour bar, symmetric
+    about zero.
 
     Example:
         >>> import numpy as np, gpmsa
@@ -34,7 +38,7 @@ def pc_basis(emulator, *, max_pc: int = 6):
     if not isinstance(emulator, Emulator):
         raise GPMSAError(f"emulator must be a gpmsa.Emulator, got {type(emulator).__name__}")
     std = emulator.standardizer
-    check_line_index(std.grid, "plots.pc_basis")
+    maps = is_map(std.grid, "plots.pc_basis")
     p_u = min(emulator.p_u, check_count(max_pc, "max_pc"))
     scalar = emulator.l_sim == 1
     units = (*emulator.x_units, *emulator.t_units)
@@ -47,17 +51,23 @@ def pc_basis(emulator, *, max_pc: int = 6):
     total = float(np.sum(y_std**2))
     share = variance_shares(emulator.w, emulator.lam_sim, total) if total > 0 else None
     n_col = len(inputs) + (0 if scalar else 1)
-    fig = figure(2.6 * n_col + 0.4, 2.2 * p_u + 0.4)
+    fig = figure(2.6 * n_col + (1.2 if maps else 0.4), 2.2 * p_u + 0.4)
     axes = fig.subplots(p_u, n_col, squeeze=False)
     for j in range(p_u):
         row = list(axes[j])
         if not scalar:
             ax = row.pop(0)
-            ax.plot(std.grid, std.y_sd * emulator.K[:, j], color=f"C{j}")
-            ax.axhline(0.0, color="0.7", lw=0.6)
+            vector = std.y_sd * emulator.K[:, j]
+            if maps:
+                norm = _maps.signed_norm(vector)
+                shade = _maps.surface(ax, std.grid, vector, norm, _maps.SIGNED)
+                _maps.colour_bar(fig, shade, ax, f"y_sd K{j + 1}")
+            else:
+                ax.plot(std.grid, vector, color=f"C{j}")
+                ax.axhline(0.0, color="0.7", lw=0.6)
+                ax.set_xlabel("output index")
             pct = f" ({100 * share[j]:.1f} % of variance)" if share is not None else ""
             ax.set_title(f"PC {j + 1}{pct}", fontsize="small")
-            ax.set_xlabel("output index")
         for ax, (name, values) in zip(row, inputs, strict=True):
             ax.plot(values, emulator.w[:, j], ".", ms=3, color=f"C{j}")
             ax.set_xlabel(name)
@@ -74,7 +84,11 @@ def _held_out_inputs(emulator, held_out: SimData) -> tuple[np.ndarray, np.ndarra
         raise GPMSAError(f"held-out runs have {held_out.l_sim} outputs, the emulator "
                          f"{emulator.l_sim}")  # fmt: skip
     grid, index = emulator.standardizer.grid, held_out.index  # either may be None (scalar)
-    if grid is not None and index is not None and not np.allclose(index, grid):
+    if (
+        grid is not None
+        and index is not None
+        and (np.shape(index) != np.shape(grid) or not np.allclose(index, grid))
+    ):
         raise GPMSAError("held-out runs lie on another output grid (index) than the emulator's")
     columns = []
     sides = ((held_out.x, held_out.x_names, emulator.x_names, "x"),
@@ -98,6 +112,10 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
     Left: predicted mean against the run's value for every output element, with central
     intervals of probability ``level``, and the share of values they cover. Right (a functional
     output): up to ``max_runs`` runs over the output grid, their value and the predicted band.
+    Over an output index of two columns (l_sim, 2) (SEPIA's (time, angle) y_ind), one row of
+    maps per run instead: the predicted mean (linear on the points' triangles, a dot at each
+    point), the width of its interval, and the run's value minus the mean as coloured markers
+    at the points; each column on one colour scale.
 
     Args:
         emulator: the gpmsa.Emulator.
@@ -123,7 +141,7 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
     draws = check_flag(draws, "draws")
     if n_draws is not None:
         check_count(n_draws, "n_draws")
-    check_line_index(emulator.standardizer.grid, "plots.emulator_fit")
+    maps = is_map(emulator.standardizer.grid, "plots.emulator_fit")
     if isinstance(held_out, CrossValidation):
         mean, var, actual = held_out.mean, held_out.var, held_out.y
         what = "cross-validation"
@@ -145,23 +163,19 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
         )
     half = ndtri(0.5 + level / 2) * np.sqrt(var)
     inside = float(np.mean(np.abs(actual - mean) <= half))
+    title = f"{what}: {100 * inside:.0f} % inside the {100 * level:.0f} % intervals"
     functional = actual.shape[1] > 1
-    fig = figure(10.0 if functional else 5.0, 4.2)
-    axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]
-    ax = axes[0]
-    ax.errorbar(actual.ravel(), mean.ravel(), yerr=half.ravel(), fmt=".", ms=3, lw=0.6,
-                color="C0", ecolor="0.6")  # fmt: skip
-    lims = [min(actual.min(), mean.min()), max(actual.max(), mean.max())]
-    ax.plot(lims, lims, color="C3", lw=1)
-    ax.set_xlabel("run value")
-    ax.set_ylabel("predicted")
-    ax.set_title(f"{what}: {100 * inside:.0f} % inside the {100 * level:.0f} % intervals",
-                 fontsize="small")  # fmt: skip
     if functional:
-        grid = emulator.standardizer.grid
         n_rows = min(check_count(max_runs, "max_runs"), actual.shape[0])
         rows = np.unique(np.linspace(0, actual.shape[0] - 1, n_rows)
                          .round().astype(int))  # fmt: skip
+    if functional and maps:
+        return _fit_maps(emulator.standardizer.grid, rows, actual, mean, half, level, title)
+    fig = figure(10.0 if functional else 5.0, 4.2)
+    axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]
+    _fit_scatter(axes[0], actual, mean, half, title)
+    if functional:
+        grid = emulator.standardizer.grid
         for c, i in enumerate(rows):
             col = f"C{c % 10}"
             axes[1].fill_between(grid, mean[i] - half[i], mean[i] + half[i], color=col, alpha=0.2)
@@ -170,4 +184,39 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
         axes[1].set_xlabel("output index")
         axes[1].set_ylabel("output")
         axes[1].set_title("runs (dots) and predicted bands", fontsize="small")
+    return fig
+
+
+def _fit_scatter(ax, actual: np.ndarray, mean: np.ndarray, half: np.ndarray, title: str) -> None:
+    """Predicted mean against the runs' values, every output element, with its interval."""
+    ax.errorbar(actual.ravel(), mean.ravel(), yerr=half.ravel(), fmt=".", ms=3, lw=0.6,
+                color="C0", ecolor="0.6")  # fmt: skip
+    lims = [min(actual.min(), mean.min()), max(actual.max(), mean.max())]
+    ax.plot(lims, lims, color="C3", lw=1)
+    ax.set_xlabel("run value")
+    ax.set_ylabel("predicted")
+    ax.set_title(title, fontsize="small")
+
+
+def _fit_maps(points, rows, actual, mean, half, level: float, title: str):
+    """The scatter of ``_fit_scatter`` (left) and per run in ``rows`` a row of maps over the
+    two-column index ``points``: predicted mean, interval width, run minus mean."""
+    fig = figure(12.5, max(4.2, 2.5 * rows.size + 0.6))
+    panels = fig.add_gridspec(rows.size, 4, width_ratios=[1.4, 1, 1, 1])
+    _fit_scatter(fig.add_subplot(panels[:, 0]), actual, mean, half, title)
+    surface, markers = _maps.surface, _maps.markers
+    columns = (
+        (mean, _maps.value_norm(mean[rows], actual[rows]), _maps.VALUES, "predicted mean",
+         surface),
+        (2 * half, _maps.value_norm(0.0, 2 * half[rows]), _maps.SPREAD,
+         f"width of the {100 * level:.0f} % interval", surface),
+        (actual - mean, _maps.signed_norm(actual[rows] - mean[rows]), _maps.SIGNED,
+         "run minus predicted mean", markers),
+    )  # fmt: skip
+    for c, (values, norm, cmap, label, draw) in enumerate(columns, start=1):
+        axes = [fig.add_subplot(panels[r, c]) for r in range(rows.size)]
+        for ax, i in zip(axes, rows, strict=True):
+            shade = draw(ax, points, values[i], norm, cmap)
+            ax.set_title(f"run {i}: {label}", fontsize="small")
+        _maps.colour_bar(fig, shade, axes, label)
     return fig

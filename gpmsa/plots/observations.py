@@ -8,7 +8,11 @@ import numpy as np
 from gpmsa.calibration.observations import check_emulator, reduce
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, check_count
-from gpmsa.plots._figure import check_bins, check_line_index, figure
+from gpmsa.plots import _maps
+from gpmsa.plots._figure import check_bins, figure, is_map
+
+MAP_EXPERIMENTS = 3
+"""Experiments whose residual a two-column index's last row maps, at most."""
 
 
 def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
@@ -19,7 +23,10 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     units over the output grid): the runs' residuals y - mean - sd K w in grey, each
     experiment's in colour. SEPIA's ``plot_K_weights``, ``plot_u_w_pairs`` (diagonal) and
     ``plot_K_residuals`` in one Figure. No discrepancy basis: the weights shown are those a
-    calibration without one fits.
+    calibration without one fits. Over an output index of two columns (l_sim, 2) (SEPIA's
+    (time, angle) y_ind) the last row holds maps: the runs' rms residual at each point (linear
+    on the points' triangles, a dot at each point), and the first 3 experiments' residuals as
+    coloured markers at their own points, on one colour scale symmetric about zero.
 
     Args:
         emulator: a gpmsa.Emulator.
@@ -45,14 +52,17 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     if not isinstance(obs, ObsData):
         raise GPMSAError(f"obs must be a gpmsa.ObsData, got {type(obs).__name__}")
     max_pc = check_count(max_pc, "max_pc")
-    check_line_index(emulator.standardizer.grid, "plots.obs_projection")
+    maps = is_map(emulator.standardizer.grid, "plots.obs_projection")
     reduced = reduce(emulator, obs, None, extrapolate=True).obs  # a plot shows them all
     n_pc = min(max_pc, emulator.p_u)
     functional = emulator.K.shape[0] > 1
     bins = check_bins(bins, n_pc, "plots.obs_projection")
     n_cols = min(3, n_pc)
     n_rows = -(-n_pc // n_cols)
-    fig = figure(3.2 * n_cols + 0.4, 2.4 * (n_rows + functional) + 0.4)
+    width = 3.2 * n_cols + 0.4
+    if maps:  # room for the runs' map, the experiments' and two colour bars
+        width = max(width, 3.0 * (1 + min(obs.n, MAP_EXPERIMENTS)) + 1.6)
+    fig = figure(width, 2.4 * (n_rows + functional) + 0.4)
     grid = fig.add_gridspec(n_rows + functional, n_cols)
     for j in range(n_pc):
         ax = fig.add_subplot(grid[j // n_cols, j % n_cols])
@@ -66,7 +76,9 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
         ax.set_title(f"PC {j + 1}: {outside} of {u.size} outside the runs", fontsize="medium")
         ax.set_xlabel(f"weight w{j + 1}")
     fig.axes[0].legend(fontsize="small", loc="upper right")
-    if functional:
+    if functional and maps:
+        _residual_maps(fig, grid[n_rows, :], emulator, obs, reduced)
+    elif functional:
         _residuals(fig.add_subplot(grid[n_rows, :]), emulator, obs, reduced)
     return fig
 
@@ -143,8 +155,8 @@ def _outside_hull(runs: np.ndarray, points: np.ndarray) -> int | None:
     return int(np.sum(hull.find_simplex(points) < 0))
 
 
-def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
-    """What the basis misses of the runs (grey) and of each experiment (colour), native units."""
+def _misses(emulator, obs: ObsData, reduced) -> tuple[np.ndarray, list[np.ndarray]]:
+    """What the basis misses, native units: of the runs (m, l_sim), of each experiment (l_j,)."""
     std = emulator.standardizer
     fitted = (
         emulator.w @ emulator.K.T * std.y_sd
@@ -152,12 +164,19 @@ def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
         else std.y_sd * emulator.w @ emulator.K.T
     )
     runs = (emulator.y - std.y_mean) - fitted
+    misses = [std.sd_on(obs.grids[e]) * (y_std - K @ u)
+              for e, (y_std, K, u) in enumerate(zip(reduced.y_std, reduced.K, reduced.u,
+                                                    strict=True))]  # fmt: skip
+    return runs, misses
+
+
+def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
+    """What the basis misses of the runs (grey) and of each experiment (colour), native units."""
+    std = emulator.standardizer
+    runs, misses = _misses(emulator, obs, reduced)
     ax.plot(std.grid, runs.T, color="0.75", lw=0.6)
-    misses = []
-    for e, (y_std, K, u) in enumerate(zip(reduced.y_std, reduced.K, reduced.u, strict=True)):
+    for e, miss in enumerate(misses):
         grid = std.grid if obs.grids[e] is None else obs.grids[e]
-        miss = std.sd_on(obs.grids[e]) * (y_std - K @ u)
-        misses.append(miss)
         ax.plot(grid, miss, color=f"C{e % 10}", lw=1.2)
     rms_runs = float(np.sqrt(np.mean(runs**2)))
     rms_obs = float(np.sqrt(np.mean(np.concatenate(misses) ** 2)))
@@ -168,3 +187,27 @@ def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
     )
     ax.set_xlabel("output index")
     ax.set_ylabel("residual")
+
+
+def _residual_maps(fig, cell, emulator, obs: ObsData, reduced) -> None:
+    """What the basis misses over a two-column index, in the gridspec ``cell``: the runs' rms
+    at each point, and the first experiments' residuals at their points."""
+    std = emulator.standardizer
+    runs, misses = _misses(emulator, obs, reduced)
+    shown = misses[:MAP_EXPERIMENTS]
+    panels = cell.subgridspec(1, 1 + len(shown))
+    ax = fig.add_subplot(panels[0, 0])
+    rms = np.sqrt(np.mean(runs**2, axis=0))
+    shade = _maps.surface(ax, std.grid, rms, _maps.value_norm(0.0, rms), _maps.SPREAD)
+    _maps.colour_bar(fig, shade, ax, "rms residual")
+    ax.set_title(f"runs beyond {emulator.p_u} components: rms {np.sqrt(np.mean(runs**2)):.3g}",
+                 fontsize="small")  # fmt: skip
+    norm = _maps.signed_norm(*shown)
+    axes = []
+    for e, miss in enumerate(shown):
+        ax = fig.add_subplot(panels[0, 1 + e])
+        grid = std.grid if obs.grids[e] is None else obs.grids[e]
+        dots = _maps.markers(ax, grid, miss, norm, _maps.SIGNED, background=std.grid)
+        ax.set_title(f"experiment {e}: rms {np.sqrt(np.mean(miss**2)):.3g}", fontsize="small")
+        axes.append(ax)
+    _maps.colour_bar(fig, dots, axes, "residual")

@@ -6,7 +6,8 @@ import numpy as np
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, as_float, check_count, check_level
-from gpmsa.plots._figure import axis_label, check_line_index, figure
+from gpmsa.plots import _maps
+from gpmsa.plots._figure import axis_label, figure, is_map
 from gpmsa.predictive.full import FullPrediction
 
 BANDS = (("y", "new observation y", "0.8"), ("zeta", "eta + delta", "C1"),
@@ -31,6 +32,14 @@ def prediction_bands(
     the discrepancy delta. A scalar output gets the same bands against the known input
     ``x_column``. With ``relative`` the top panels show everything minus the predicted mean of
     y, so that narrow bands on a large output (say 0.05 s on 4 s) can be seen.
+
+    Over an output index of two columns (SEPIA's (time, angle) y_ind; ``pred.grid`` of shape
+    (g, 2)) each column is a stack of maps over the points, each row on one colour scale: the
+    predicted mean of y (linear on the points' triangles, a dot at each point; coloured markers
+    where the points span no triangle), the width of its band of probability ``level``, the
+    discrepancy's mean, and with ``observed`` the observed value minus the mean of y as
+    coloured markers at the points. ``relative`` changes nothing there (the width and the
+    observed minus the mean are relative already).
 
     Args:
         pred: a FullPrediction from ``full_prediction``.
@@ -58,8 +67,8 @@ def prediction_bands(
         raise GPMSAError(f"pred must be a FullPrediction, got {type(pred).__name__}")
     level = check_level(level)
     max_panels = check_count(max_panels, "max_panels")
-    check_line_index(pred.grid, "plots.prediction_bands")
-    N, l = pred.x.shape[0], pred.grid.size
+    maps = is_map(pred.grid, "plots.prediction_bands")
+    N, l = pred.x.shape[0], pred.grid.shape[0]
     if pred.x.shape[1] == 0 and l == 1:
         raise GPMSAError(
             "prediction_bands draws a scalar output against a known input, and this prediction "
@@ -71,6 +80,9 @@ def prediction_bands(
         observed = _observed(observed, N, l)
     if not isinstance(relative, bool | np.bool_):
         raise GPMSAError(f"relative must be True or False, got {relative!r}")
+    cols = np.unique(np.linspace(0, N - 1, min(max_panels, N)).round().astype(int))
+    if maps:
+        return _band_maps(pred, observed, cols, level)
     bands = {w: pred.interval(w, level) for w in ("y", "zeta", "eta", "delta")}
     eta_mean = pred.mean("eta")
     if relative:
@@ -102,7 +114,6 @@ def prediction_bands(
         top.set_ylabel(ylabel)
         top.legend(fontsize="small")
         return fig
-    cols = np.unique(np.linspace(0, N - 1, min(max_panels, N)).round().astype(int))
     fig = figure(2.8 * cols.size + 0.6, 5.6)
     axes = fig.subplots(2, cols.size, squeeze=False, sharex=True, height_ratios=[2, 1])
     by_index = np.argsort(pred.grid, kind="stable")  # a grid may come in any order
@@ -121,13 +132,45 @@ def prediction_bands(
         bottom.plot(grid, delta_mean[i, by_index], color="C2", lw=1)
         bottom.axhline(0.0, color="0.6", lw=0.6)
         bottom.set_xlabel("output index")
-        named = [(*_input(pred, k), v) for k, v in enumerate(pred.x[i])]
-        xs = ", ".join(f"{n} = {v:.3g}{' ' + u if u else ''}" for n, u, v in named)
-        top.set_title(xs or "no known inputs", fontsize="small")
+        top.set_title(_inputs_text(pred, i), fontsize="small")
     axes[0, 0].set_ylabel(ylabel)
     axes[1, 0].set_ylabel("discrepancy delta")
     axes[0, 0].legend(fontsize="x-small")
     return fig
+
+
+def _band_maps(pred: FullPrediction, observed, cols: np.ndarray, level: float):
+    """One column of maps over the two-column ``pred.grid`` per new x in ``cols``: mean of y,
+    width of its band, mean of delta, observed minus the mean of y; each row one scale."""
+    lo, hi = pred.interval("y", level)
+    y_mean, delta_mean = pred.mean("y"), pred.mean("delta")
+    surface, markers = _maps.surface, _maps.markers
+    rows = [
+        (y_mean, _maps.value_norm(y_mean[cols], *([] if observed is None else [observed[cols]])),
+         _maps.VALUES, "mean of y", surface),
+        (hi - lo, _maps.value_norm(0.0, (hi - lo)[cols]), _maps.SPREAD,
+         f"width of the {100 * level:.0f} % band of y", surface),
+        (delta_mean, _maps.signed_norm(delta_mean[cols]), _maps.SIGNED, "mean of delta", surface),
+    ]  # fmt: skip
+    if observed is not None:
+        rows.append((observed - y_mean, _maps.signed_norm((observed - y_mean)[cols]),
+                     _maps.SIGNED, "observed minus mean of y", markers))  # fmt: skip
+    fig = figure(2.9 * cols.size + 1.4, 2.5 * len(rows) + 0.4)
+    axes = fig.subplots(len(rows), cols.size, squeeze=False, sharex=True, sharey=True)
+    for r, (values, norm, cmap, label, draw) in enumerate(rows):
+        for c, i in enumerate(cols):
+            shade = draw(axes[r, c], pred.grid, values[i], norm, cmap)
+            axes[r, c].set_title(label if r else f"{_inputs_text(pred, i)}\n{label}",
+                                 fontsize="small")  # fmt: skip
+        _maps.colour_bar(fig, shade, list(axes[r]), label)
+    return fig
+
+
+def _inputs_text(pred: FullPrediction, i: int) -> str:
+    """The known inputs of the new x ``i`` as "name = value unit, ..." (or none)."""
+    named = [(*_input(pred, k), v) for k, v in enumerate(pred.x[i])]
+    xs = ", ".join(f"{n} = {v:.3g}{' ' + u if u else ''}" for n, u, v in named)
+    return xs or "no known inputs"
 
 
 def _input(pred: FullPrediction, k: int) -> tuple[str, str]:

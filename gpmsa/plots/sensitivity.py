@@ -10,7 +10,8 @@ from scipy.stats import norm
 
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import check_count, check_level
-from gpmsa.plots._figure import axis_label, check_line_index, figure
+from gpmsa.plots import _maps
+from gpmsa.plots._figure import axis_label, figure, is_map
 from gpmsa.predictive.sobol import Sensitivity
 
 
@@ -20,7 +21,11 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
     Left: bars of the aggregated indices (mean over draws) with the central interval of
     probability ``level`` over draws as error bars (the interval itself: a skewed spread over
     draws can leave the mean outside it). Right (a functional output): main (solid)
-    and total (dashed) effect of each input along the output grid, with their bands.
+    and total (dashed) effect of each input along the output grid, with their bands. Over an
+    output index of two columns (l_sim, 2) (SEPIA's (time, angle) y_ind), maps of each input's
+    main (top row) and total (bottom row) effect over the points instead, the mean over draws
+    (linear on the points' triangles, a dot at each point; blank where the output does not
+    vary), all on one colour scale from 0 to 1.
 
     Example:
         >>> import numpy as np, gpmsa
@@ -37,11 +42,16 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
         raise GPMSAError(f"sens must be a Sensitivity, got {type(sens).__name__}")
     level = check_level(level)
     q = [(1 - level) / 2, (1 + level) / 2]
-    check_line_index(sens.grid, "plots.sensitivity_bars")
-    functional = sens.grid.size > 1
-    fig = figure(11.0 if functional else 5.5, 4.0)
-    axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]
+    maps = is_map(sens.grid, "plots.sensitivity_bars")
+    functional = sens.grid.shape[0] > 1
     d = len(sens.names)
+    if maps:
+        fig = figure(5.5 + 2.8 * d + 0.8, 5.6)
+        panels = fig.add_gridspec(2, 1 + d, width_ratios=[5.5 / 2.8] + [1] * d)
+        axes = [fig.add_subplot(panels[:, 0])]
+    else:
+        fig = figure(11.0 if functional else 5.5, 4.0)
+        axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]
     pos = np.arange(d)
     for off, kind, arr, color in ((-0.2, "main", sens.main_aggregated, "C0"),
                                   (0.2, "total", sens.total_aggregated, "C1")):  # fmt: skip
@@ -58,7 +68,9 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
               else f"; bars: {100 * level:.0f} % over {sens.main.shape[0]} draws")  # fmt: skip
     axes[0].set_title(title + spread, fontsize="small")
     axes[0].legend(fontsize="small")
-    if functional:
+    if maps:
+        _effect_maps(fig, panels, sens)
+    elif functional:
         ax = axes[1]
         with warnings.catch_warnings():  # all-NaN grid points (zero output variance)
             warnings.simplefilter("ignore", RuntimeWarning)
@@ -75,6 +87,23 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
         ax.set_ylabel("index (solid: main, dashed: total)")
         ax.legend(fontsize="small")
     return fig
+
+
+def _effect_maps(fig, panels, sens: Sensitivity) -> None:
+    """Each input's main (row 0) and total (row 1) effect over the two-column ``sens.grid``,
+    the mean over draws, in columns 1.. of the gridspec ``panels``; one scale, 0 to 1."""
+    norm = _maps.value_norm(0.0, 1.0)
+    axes = []
+    with warnings.catch_warnings():  # all-NaN grid points (zero output variance)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for r, (arr, kind) in enumerate(((sens.main, "main"), (sens.total, "total"))):
+            for k, name in enumerate(sens.names):
+                ax = fig.add_subplot(panels[r, 1 + k])
+                shade = _maps.surface(ax, sens.grid, np.nanmean(arr[:, :, k], axis=0), norm,
+                                      _maps.VALUES)  # fmt: skip
+                ax.set_title(f"{kind} effect of {name}", fontsize="small")
+                axes.append(ax)
+    _maps.colour_bar(fig, shade, axes, "Sobol index (mean over draws)")
 
 
 def main_effect_curves(

@@ -2,7 +2,7 @@
 shape (l, d)): observations on simulation points fit and calibrate as the numbered-points
 workaround to the bit, between points the basis and mean are piecewise linear on the points'
 triangulation, outside their hull refused; the emulator file keeps the points; bad shapes are
-refused naming the problem."""
+refused naming the problem (the figures' maps: test_plots_maps_s77.py)."""
 
 from __future__ import annotations
 
@@ -138,15 +138,10 @@ def test_bad_index_points_are_refused():
         _obs([POINTS[ROWS[0]], ROWS[1].astype(float)])
 
 
-def test_linear_discrepancy_and_line_plots_are_refused_naming_the_alternative():
+def test_linear_discrepancy_is_refused_naming_the_alternative():
     sim, obs = _sim(POINTS), _obs([POINTS[r] for r in ROWS])
     with pytest.raises(gpmsa.GPMSAError, match=r"2 columns: pass the basis per experiment"):
         gpmsa.fit(sim, obs, n_iter=5, tune=False, n_pc=2, discrepancy="linear")
-    emu = gpmsa.fit(sim, n_iter=10, tune=False, seed=0, n_pc=2)
-    with pytest.raises(gpmsa.GPMSAError, match="plots.pc_basis draws along a one-column"):
-        gpmsa.plots.pc_basis(emu)
-    with pytest.raises(gpmsa.GPMSAError, match="plots.data draws along a one-column"):
-        gpmsa.plots.data(sim, obs)
 
 
 def test_grid_discrepancy_on_other_points():
