@@ -157,6 +157,18 @@ def _dask_client(executor):
     return client if callable(getattr(client, "get_executor", None)) else None
 
 
+def _all_workers(client) -> dict:
+    """The scheduler's record of every worker of the dask ``client``: distributed 2025.4 and
+    later list 5 unless asked ``n_workers=-1``; earlier releases take no such argument and list
+    all."""
+    try:
+        return client.scheduler_info(n_workers=-1)["workers"]
+    except TypeError as error:
+        if "n_workers" not in str(error):
+            raise
+        return client.scheduler_info()["workers"]
+
+
 def _check_workers(client, module: str, restrictions: dict, timeout_s: float) -> None:
     """GPMSAError unless every worker of the dask ``client`` that may run a task submitted with
     ``restrictions`` (a ``get_executor(...)``'s: `_task_workers`) imports ``module`` and runs
@@ -165,7 +177,7 @@ def _check_workers(client, module: str, restrictions: dict, timeout_s: float) ->
     draws they return, may differ between any two versions. A worker that cannot be reached
     (lost meanwhile: an OSError such as dask's CommClosedError) is not refused: dask runs its
     tasks elsewhere, as it would without the check."""
-    infos = client.scheduler_info(n_workers=-1)["workers"]  # every one (5 by default in 2025.4)
+    infos = _all_workers(client)
     workers = _task_workers(infos, restrictions)
     if not workers:  # none yet (dask waits for them, e.g. an adaptive cluster's)
         return
