@@ -35,6 +35,12 @@ cost grows as d^3: one Calibrator update of a scalar output took 0.27 s for 64 r
 128 and 7.1 s for 256 here (the issue: 11.8 s for 400). Split long records into windows (their
 ``Calibrator.log_likelihood_grid`` values add) or raise this limit."""
 
+MAX_INDEX_SIMPLICES = 2_000_000
+"""Most simplices an output index of three or more columns may triangulate into at worst,
+l^ceil(d/2) (the upper bound theorem; two columns: at most 2 l, no limit): 3 or 4 columns up to
+1,414 points, 5 or 6 up to 125 (80 points in 10 columns: 1.2 million simplices, 50 s and 1 GB).
+A regular grid in three columns triangulates into ~6 l: raise this for one of more points."""
+
 # --- the emulator file (gpmsa.io.container) -----------------------------------------------------
 MAX_FILE_BYTES = 2 * GIB
 """Largest emulator file on disk."""

@@ -133,11 +133,7 @@ def _facts(manifest: dict, arrays: dict, emulator) -> dict:
     y_sd = [float(np.min(std.y_sd)), float(np.max(std.y_sd))] if "y_sd" in std.y_given else None
     scale = {"y_mean_given": "y_mean" in std.y_given, "y_sd_given": "y_sd" in std.y_given,
              "columnwise": bool(std.columnwise), "y_sd_range": y_sd}  # fmt: skip
-    index = None
-    if emulator.l_sim > 1:  # the "output index" line's facts, for one column too
-        columns = std.grid.reshape(std.grid.shape[0], -1)
-        index = {"points": int(columns.shape[0]), "columns": int(columns.shape[1]),
-                 "ranges": [[float(c.min()), float(c.max())] for c in columns.T]}  # fmt: skip
+    index = _index_points(std.grid) if emulator.l_sim > 1 else None  # one column too
     given = manifest["settings"].get("basis") == "given"
     basis = {"source": "given" if given else "pca", "vectors": int(emulator.K.shape[1]),
              "variance_share": _variance_share(emulator)}  # fmt: skip
@@ -158,6 +154,14 @@ def _facts(manifest: dict, arrays: dict, emulator) -> dict:
     return {"model_sha256": emulator.model_sha256, "separable": separable, "output_scale": scale,
             "output_index": index, "basis": basis, "posterior": posterior,
             "array_values": sum(int(a.size) for a in arrays.values())}  # fmt: skip
+
+
+def _index_points(grid: np.ndarray) -> dict:
+    """An output index (l_sim,) or (l_sim, d): its points, columns and each column's
+    [min, max]."""
+    columns = grid.reshape(grid.shape[0], -1)
+    ranges = [[float(c.min()), float(c.max())] for c in columns.T]
+    return {"points": int(columns.shape[0]), "columns": int(columns.shape[1]), "ranges": ranges}
 
 
 def _shapes(emulator) -> dict[str, tuple[int, ...]]:
@@ -213,12 +217,11 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
                 rng += " (range given, design inside)"
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
         lines.append(f"{label + ':':17s}{', '.join(parts) or 'none'}")
-    grid = standardizer.grid
-    if grid.ndim == 2:  # an output index of several columns (SEPIA's (l, d) y_ind)
-        spans = " x ".join("[{}, {}]".format(*numbers(float(c.min()), float(c.max())))
-                           for c in grid.T)  # fmt: skip
-        lines.append(f"output index:    {grid.shape[0]} points in {grid.shape[1]} columns, "
-                     f"{spans} (interpolated on their triangulation)")  # fmt: skip
+    if standardizer.grid.ndim == 2:  # an output index of several columns (SEPIA's (l, d) y_ind)
+        points = _index_points(standardizer.grid)
+        spans = " x ".join("[{}, {}]".format(*numbers(*r)) for r in points["ranges"])
+        lines.append(f"output index:    {points['points']} points in {points['columns']} "
+                     f"columns, {spans} (interpolated on their triangulation)")  # fmt: skip
     if emulator.separable is not None:  # SimData(separable=): file array kron_factor
         lines.append(f"separable:       {_separable_text(emulator)}")
     cat = model.get("categorical") or {}

@@ -65,7 +65,7 @@ def _priors(priors: object) -> object:
 def emulator_info(file: str, manifest: dict, facts: dict) -> dict:
     """An emulator file's record: ``manifest`` verified, ``facts`` what ``gpmsa.cli.info``
     derives from it and the emulator loaded from it (its ``_facts``: model_sha256, the
-    separable factors, output scale, basis, posterior, array_values)."""
+    separable factors, output scale, output index, basis, posterior, array_values)."""
     model = manifest.get("model", {})
     convergence = manifest.get("convergence")
     return {

@@ -161,7 +161,7 @@ def interpolate_basis(K: np.ndarray, grid: np.ndarray, new_grid: np.ndarray | No
         return index_points.weights(grid, new_grid, "observation index") @ K
     check_increasing(grid, "the simulation grid")
     lo, hi = grid.min(), grid.max()
-    if new_grid.min() < lo or new_grid.max() > hi:
+    if not index_points.within(new_grid, lo, hi):  # an end reached by rounding: the end
         raise GPMSAError(
             f"observation index must lie within the simulation grid [{lo}, {hi}], "
             f"got [{new_grid.min()}, {new_grid.max()}]"

@@ -3,14 +3,29 @@ d >= 2, e.g. (time, angle) pairs): its checks, and the piecewise-linear interpol
 Delaunay triangulation of the simulation's index points that maps the basis and the mean onto
 the observations' points (as ``scipy.interpolate.LinearNDInterpolator``; exact on a
 simulation point). A one-column index (l,) is interpolated along it by ``np.interp``
-elsewhere."""
+elsewhere; `within` is its range check, with the same rounding tolerance."""
 
 from __future__ import annotations
 
+import functools
+import math
+
 import numpy as np
+from scipy import sparse
 from scipy.spatial import Delaunay, QhullError
 
-from gpmsa.errors import GPMSAError, numbers_text
+from gpmsa import limits
+from gpmsa.errors import GPMSAError, ResourceLimitError, numbers_text
+
+HULL_TOL = 1e-9
+"""A point outside the simulation points' convex hull (or a one-column grid's ends) by at most
+this fraction of each index column's span (of its simplex, for a slanted edge) is rounding (0.1
++ 0.2 for 0.3): taken onto the edge, exactly the edge point's values there."""
+
+TIE_TOL = 1e-10
+"""A located point this close (barycentric) to a face of its simplex is on a face the neighbour
+shares: it is looked up by brute force, the lowest-numbered simplex holding it, so that its
+weights do not depend on where scipy's walk started (the batch's previous point)."""
 
 
 def is_points(grid: np.ndarray | None) -> bool:
@@ -42,18 +57,41 @@ def check_points(points: np.ndarray, name: str) -> None:
     _triangulation(points, name)
 
 
+def within(values: np.ndarray, lo: float, hi: float) -> bool:
+    """Whether the one-column index ``values`` lies in [lo, hi] up to rounding (`HULL_TOL` of
+    hi - lo; ``np.interp`` takes a value beyond an end as the end)."""
+    slack = HULL_TOL * (hi - lo)
+    return bool(values.min() >= lo - slack and values.max() <= hi + slack)
+
+
 def _triangulation(points: np.ndarray, name: str) -> Delaunay:
-    d = points.shape[1]
+    l, d = points.shape
+    if d > 2 and l ** math.ceil(d / 2) > limits.MAX_INDEX_SIMPLICES:
+        raise ResourceLimitError(
+            f"{name} of {l} points in {d} columns may triangulate into up to {l}^"
+            f"{math.ceil(d / 2)} simplices, over gpmsa.limits.MAX_INDEX_SIMPLICES = "
+            f"{limits.MAX_INDEX_SIMPLICES:,} (the basis is interpolated on the points' Delaunay "
+            "triangulation, whose size can grow as l^(d/2); a regular grid's stays ~6 l in 3 "
+            "columns): raise that limit for such a grid, or give fewer points or columns "
+            "(2 columns: any number of points)"
+        )
     try:
-        if points.shape[0] <= d:
+        if l <= d:
             raise QhullError("too few points")
-        return Delaunay(points)
+        return _delaunay(points.shape, np.ascontiguousarray(points).tobytes())
     except QhullError:
         raise GPMSAError(
             f"{name} of {points.shape[0]} points in {d} columns does not span {d} dimensions "
             f"(fewer than {d + 1} points, or all on a line or plane): the basis is interpolated "
             "on their triangulation"
         ) from None
+
+
+@functools.lru_cache(maxsize=4)
+def _delaunay(shape: tuple[int, int], data: bytes) -> Delaunay:
+    """The triangulation of the points (``shape``, float64 bytes), kept for the next call: a fit
+    or a prediction interpolates the basis, the mean and the sd on the same points."""
+    return Delaunay(np.frombuffer(data).reshape(shape))
 
 
 def check_columns(points: np.ndarray, new: np.ndarray, what: str) -> None:
@@ -68,29 +106,63 @@ def check_columns(points: np.ndarray, new: np.ndarray, what: str) -> None:
         )
 
 
-def weights(points: np.ndarray, new: np.ndarray, what: str) -> np.ndarray:
-    """W (l_new, l_sim): values on the simulation ``points`` (l_sim, d) times W are their
-    piecewise-linear interpolant (barycentric on the Delaunay triangulation) at ``new``
-    (l_new, d); a row of W is one-hot where its point is a simulation point (exact there).
-    GPMSAError naming ``what`` and the point where one lies outside the points' convex hull."""
+def weights(points: np.ndarray, new: np.ndarray, what: str) -> sparse.csr_array:
+    """W (l_new, l_sim), sparse: values on the simulation ``points`` (l_sim, d) times W are
+    their piecewise-linear interpolant (barycentric on the Delaunay triangulation) at ``new``
+    (l_new, d), at most d + 1 entries a row; a row is one-hot where its point is a simulation
+    point (exact there). A point outside the points' convex hull by rounding (`HULL_TOL`) is
+    taken onto it; one beyond: GPMSAError naming ``what`` and the point. A row depends on its
+    point alone (not on the other points of ``new``)."""
     check_columns(points, new, what)
-    W = np.zeros((new.shape[0], points.shape[0]))
-    at = {row.tobytes(): i for i, row in enumerate(points + 0.0)}  # + 0.0: -0.0 is 0.0
-    on = np.array([at.get(row.tobytes(), -1) for row in new + 0.0], dtype=np.intp)
-    hit = on >= 0
-    W[np.flatnonzero(hit), on[hit]] = 1.0
-    rest = np.flatnonzero(~hit)
+    new = _onto_box(points, new + 0.0)  # + 0.0: -0.0 is 0.0
+    at = {row.tobytes(): i for i, row in enumerate(points + 0.0)}
+    on = np.array([at.get(row.tobytes(), -1) for row in new], dtype=np.intp)
+    hit, rest = np.flatnonzero(on >= 0), np.flatnonzero(on < 0)
+    rows, cols, vals = [hit], [on[hit]], [np.ones(hit.size)]
     if rest.size:
         tri = _triangulation(points, "the simulation index")
-        s = tri.find_simplex(new[rest])
+        s = _locate(tri, new[rest])
         if np.any(s < 0):
             k = int(rest[np.flatnonzero(s < 0)[0]])
             raise GPMSAError(
                 f"{what} has the point {_point_text(new[k])} (row {k}) outside the convex hull "
                 "of the simulation index's points; observations must lie within it"
             )
-        d = points.shape[1]
-        T = tri.transform[s]
-        b = np.einsum("nij,nj->ni", T[:, :d], new[rest] - T[:, d])
-        W[rest[:, None], tri.simplices[s]] = np.column_stack([b, 1.0 - b.sum(axis=1)])
-    return W
+        b = _barycentric(tri, s, new[rest])
+        rows.append(np.repeat(rest, b.shape[1]))
+        cols.append(tri.simplices[s].reshape(-1))
+        vals.append(b.reshape(-1))
+    shape = (new.shape[0], points.shape[0])
+    coo = (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols)))
+    return sparse.csr_array(coo, shape=shape)
+
+
+def _onto_box(points: np.ndarray, new: np.ndarray) -> np.ndarray:
+    """``new`` with each coordinate beyond the points' range by rounding (`HULL_TOL` of the
+    column's span) set to the range's end."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    slack = HULL_TOL * (hi - lo)
+    low = (new < lo) & (new >= lo - slack)
+    high = (new > hi) & (new <= hi + slack)
+    return np.where(low, lo, np.where(high, hi, new))
+
+
+def _locate(tri: Delaunay, q: np.ndarray) -> np.ndarray:
+    """Each point's simplex (-1: outside the hull beyond rounding): scipy's walk, then by brute
+    force (the lowest-numbered simplex holding it, whatever the walk's start) for a point on a
+    face (`TIE_TOL`) and, within `HULL_TOL` of its simplex, for one outside a slanted edge."""
+    s = tri.find_simplex(q)
+    found = np.flatnonzero(s >= 0)
+    tie = found[_barycentric(tri, s[found], q[found]).min(axis=1) <= TIE_TOL]
+    s[tie] = tri.find_simplex(q[tie], bruteforce=True)
+    out = np.flatnonzero(s < 0)
+    s[out] = tri.find_simplex(q[out], bruteforce=True, tol=HULL_TOL)
+    return s
+
+
+def _barycentric(tri: Delaunay, s: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The barycentric coordinates (n, d + 1) of the points ``q`` in their simplices ``s``."""
+    d = q.shape[1]
+    T = tri.transform[s]
+    b = np.einsum("nij,nj->ni", T[:, :d], q - T[:, d])
+    return np.column_stack([b, 1.0 - b.sum(axis=1)])

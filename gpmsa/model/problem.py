@@ -491,7 +491,7 @@ def reduce_obs(
     rank, total, ss = 0, 0, 0.0
     lo, hi = std.grid.min(), std.grid.max()
     for j, (e, g, lam) in enumerate(zip(ys, obs.grids, lamy, strict=True)):
-        if not points and g is not None and not (g.min() >= lo and g.max() <= hi):
+        if not points and g is not None and not index_points.within(g, lo, hi):
             a, b, c, d = numbers_text(g.min(), g.max(), lo, hi)
             raise GPMSAError(
                 f"the index of experiment {j} reaches [{a}, {b}], outside the simulation grid "

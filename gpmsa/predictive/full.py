@@ -285,7 +285,7 @@ def _pred_grid(emulator, obs: ObsData, grid):
         g = g.reshape(-1)
         check_finite(g, "grid")
         lo, hi = std.grid.min(), std.grid.max()
-        if g.size == 0 or g.min() < lo or g.max() > hi:
+        if g.size == 0 or not index_points.within(g, lo, hi):
             lo, hi = numbers_text(lo, hi, *((g.min(), g.max()) if g.size else ()))[:2]
             raise GPMSAError(
                 f"grid must be non-empty and lie within the simulation grid [{lo}, {hi}]"
