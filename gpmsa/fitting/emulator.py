@@ -181,6 +181,8 @@ class Emulator:
     one-chain files from before one chain was judged), levels
     (per column of [x, t]: a categorical input's training levels, else None), mean_basis (the
     weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md;
+    index_names, index_units (``SimData(index_names=, index_units=)``: labels of the output
+    index's columns, or None);
     discrepancy_bases (a joint fit given a list of per-experiment discrepancy bases: the
     normalised (l_j, p_v) basis of each experiment, as the fit used them, ``gpmsa.model.basis.
     discrepancy_bases``; else None). The arrays are read-only copies, params, draws and
@@ -213,6 +215,8 @@ class Emulator:
         mean_basis: MeanBasis | None = None,
         discrepancy_bases: tuple[np.ndarray, ...] | None = None,
         separable: tuple[tuple[int, ...], ...] | None = None,
+        index_names: tuple[str, ...] | None = None,
+        index_units: tuple[str, ...] | None = None,
     ):
         self.standardizer = standardizer
         self.x_unit, self.t_unit, self.y, self.K, self.w = x_unit, t_unit, y, K, w
@@ -222,6 +226,7 @@ class Emulator:
         self.priors = priors
         self.x_names, self.t_names, self.y_names = names["x"], names["t"], names["y"]
         self.x_units, self.t_units, self.y_units = units["x"], units["t"], units["y"]
+        self.index_names, self.index_units = index_names, index_units
         self.draws = draws if draws is not None else {}
         self.log_post = log_post if log_post is not None else np.zeros(0)
         self.metadata = metadata  # a dict (copied) or None (``__setattr__`` checks it)
@@ -295,6 +300,8 @@ class Emulator:
         self.__dict__.update(state)
         self.__dict__.setdefault("discrepancy_bases", None)
         self.__dict__.setdefault("separable", None)
+        self.__dict__.setdefault("index_names", None)
+        self.__dict__.setdefault("index_units", None)
         self._freeze()
 
     # --- construction -------------------------------------------------------------------------
@@ -337,7 +344,8 @@ class Emulator:
             names={"x": sim.x_names, "t": sim.t_names, "y": sim.y_names},
             units={"x": sim.x_units, "t": sim.t_units, "y": sim.y_units},
             levels=sim.levels, mean_basis=prob.mean_basis,
-            separable=None if prob.separable is None else prob.separable.groups, **kw,
+            separable=None if prob.separable is None else prob.separable.groups,
+            index_names=sim.index_names, index_units=sim.index_units, **kw,
         )  # fmt: skip
 
     # --- shapes and domain --------------------------------------------------------------------
@@ -773,6 +781,9 @@ class Emulator:
             manifest["model"]["input_ranges"] = list(ranged)
         if self.standardizer.y_given:  # only then, as input_ranges: other files as before
             manifest["model"]["y_given"] = list(self.standardizer.y_given)
+        for key in ("index_names", "index_units"):  # only where given, as y_given
+            if getattr(self, key) is not None:
+                manifest["model"][key] = list(getattr(self, key))
         _check_metadata(self.metadata, "metadata")
         if self.convergence is not None:
             manifest["convergence"] = self.convergence
@@ -815,8 +826,9 @@ class Emulator:
         every array its file holds (training runs, basis, weights, standardisation, point
         estimate, retained draws, a joint fit's calibration draws; as float64), its input and
         output names, categorical levels, mean basis and priors. Not its metadata, settings,
-        diagnostics or units, nor (unlike a file's ``content_sha256``, which ``gpmsa.load``'s
-        ``sha256=`` checks) the time of writing or the library version: an emulator read back
+        diagnostics, units or output index labels (``index_names``, ``index_units``), nor
+        (unlike a file's ``content_sha256``, which ``gpmsa.load``'s ``sha256=`` checks) the
+        time of writing or the library version: an emulator read back
         by ``gpmsa.load`` has the ``model_sha256`` of the one saved. A calibration records it
         (Posterior info "emulator_sha256") so that predictions refuse another emulator with its
         draws. Computed once, on first use (0.4 ms for the shipped band emulator's 0.3 MB of
@@ -868,6 +880,8 @@ class Emulator:
                 levels=_levels(manifest, names), mean_basis=_mean_basis(manifest, names),
                 discrepancy_bases=split_bases(arrays, manifest["settings"]),
                 separable=kron_groups(arrays),
+                **{k: tuple(v) for k in ("index_names", "index_units")
+                   if (v := manifest["model"].get(k)) is not None},  # check_fields checked them
             )  # fmt: skip
             _check_consistent(emu)
             domain = {k: list(v) for k, v in emu.domain.items()}

@@ -85,7 +85,8 @@ def _short(value, n: int = 60) -> str:
 
 # --- shapes (from declarations or arrays) -------------------------------------------------------
 def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
-    """Sizes (m, p, q, l_sim, p_u, n_draws) of a record whose arrays have these shapes."""
+    """Sizes (m, p, q, l_sim, p_u, n_draws; d, the output index's columns) of a record whose
+    arrays have these shapes."""
     missing = [k for k in REQUIRED if k not in shapes]
     if missing:
         raise EmulatorFileError(f"arrays: required arrays missing: {missing}")
@@ -165,7 +166,8 @@ def check_shapes(shapes: dict[str, tuple[int, ...]]) -> dict[str, int]:
     for name, shape in want.items():
         if tuple(shapes[name]) != tuple(shape):
             raise _fail(f"arrays/{name}", f"has shape {list(shapes[name])}, expected {list(shape)}")
-    return {"m": m, "p": p, "q": q, "l_sim": l_sim, "p_u": p_u, "n_draws": n}
+    d = want["grid"][1] if len(want["grid"]) == 2 else 1
+    return {"m": m, "p": p, "q": q, "l_sim": l_sim, "p_u": p_u, "n_draws": n, "d": d}
 
 
 def _check_complete(shapes: dict[str, tuple[int, ...]], n: int) -> None:
@@ -691,6 +693,27 @@ def check_fields(manifest: dict, dims: dict[str, int]) -> None:
     if manifest.get("convergence") is not None and not isinstance(manifest["convergence"], dict):
         raise _fail("convergence", f"must be an object, got {_short(manifest['convergence'])}")
     _check_model_options(model, inputs)
+    check_index_labels(model, l_sim, dims.get("d", 1))
+
+
+def check_index_labels(model: dict, l_sim: int, d: int) -> None:
+    """model.index_names and model.index_units (``SimData(index_names=, index_units=)``), each
+    absent (files without them, every file before them) or a list of ``d`` strings, one per
+    column of the output index, of a functional output (``l_sim`` > 1); names non-empty and
+    unique."""
+    for key in ("index_names", "index_units"):
+        if key not in model:
+            continue
+        field = f"model.{key}"
+        if l_sim == 1:
+            raise _fail(field, "a scalar output (l_sim 1) has no output index to label")
+        value = _strings(model[key], d, field)
+        if key == "index_units":
+            continue
+        if not all(s.strip() for s in value):
+            raise _fail(field, f"names must be non-empty, got {_short(value)}")
+        if len(set(value)) != d:
+            raise _fail(field, f"names must be unique, got {_short(value)}")
 
 
 def _sweep_count(settings: dict, key: str, low: int) -> int | None:

@@ -550,6 +550,59 @@ def _units(units: Sequence[str] | None, n: int, what: str) -> tuple[str, ...]:
     return units
 
 
+def _index_labels(value, d: int, l_sim: int, what: str) -> tuple[str, ...] | None:
+    """``SimData``'s ``index_names`` or ``index_units`` (``what``): None, or one string per
+    column of the output index (``d`` columns; a single string for one column); names
+    non-empty (not only blanks) and unique. GPMSAError naming ``what`` otherwise, and for a
+    scalar output (``l_sim`` 1), which has no index to label."""
+    if value is None:
+        return None
+    kind = "names" if what == "index_names" else "units"
+    if l_sim == 1:
+        raise GPMSAError(
+            f"{what} labels the output index, but y has one column (a scalar output has no "
+            f"index); leave {what} out"
+        )
+    if isinstance(value, str):
+        if d != 1:
+            raise GPMSAError(
+                f"{what} must be a list of {d} {kind}, one per column of the output index "
+                f"({l_sim}, {d}), got the string {value!r}"
+            )
+        value = (value,)
+    value = _labels(value, what, kind)
+    if len(value) != d:
+        shape = f"({l_sim},)" if d == 1 else f"({l_sim}, {d})"
+        raise GPMSAError(
+            f"{what} must have {d} entries, one per column of the output index {shape}, got "
+            f"{len(value)}: {value!r:.200}"
+        )
+    for k, entry in enumerate(value):
+        if not isinstance(entry, str):
+            raise GPMSAError(f"{what}[{k}] must be a string, got {type(entry).__name__} "
+                             f"{entry!r:.80}")  # fmt: skip
+        if kind == "names" and not entry.strip():
+            raise GPMSAError(f"{what}[{k}] must be a non-empty name, got {entry!r}")
+    if kind == "names" and len(set(value)) != d:
+        raise GPMSAError(f"{what} must be unique, got {value}")
+    return tuple(str(entry) for entry in value)
+
+
+def _named_index(index, names):
+    """An output ``index`` given as a pandas table or Series, and ``index_names``: a table
+    with named columns (not a frame's default labels 0, 1, ...) names the index columns
+    where ``names`` is None, else is read by ``names`` (its columns in that order); a named
+    Series names its one column. Returns (index, names); anything else as it is."""
+    if names is None and is_series(index):
+        return index, None if index.name is None else (str(index.name),)
+    labels = column_labels(index)
+    if names is None:
+        return index, None if labels is None or default_labels(labels) else labels
+    if is_series(index) or not (labels is None or default_labels(labels)):
+        index = by_column_names(index, (names,) if isinstance(names, str) else names, "index")
+    return index, names
+
+
 def _index(index, n: int, name: str) -> np.ndarray | None:
     """The simulation output grid: finite and strictly increasing (l,) (the basis and the mean
     are interpolated along it), or points of several columns (l, d), finite and distinct,
@@ -840,6 +893,13 @@ class SimData:
     given y_mean goes with either. Stored as y_mean (l_sim,) and y_sd a float or (l_sim,)
     (l_sim > 1). The priors are on the standardised scale: give a scale of the order of the
     outputs' spread (docs/internals.md, "The output scale").
+    ``index_names``, ``index_units``: labels of the output index's columns for figures and
+    ``gpmsa info`` (SEPIA has none): one string per column, a single string for a one-column
+    index (``index`` (l_sim,), or None: 0..l_sim-1); names non-empty and unique. None (the
+    default): "output index" ("output index[:, k]" per column of (l_sim, d)), no unit. An
+    index given as a pandas table with named columns, or a named Series, names its columns
+    where ``index_names`` is None (else its columns are read by those names). Not for a
+    scalar output. Labels only: the fit, its draws and ``model_sha256`` are the same without.
     """
 
     x: np.ndarray | None = None
@@ -860,13 +920,18 @@ class SimData:
     separable: bool | Sequence | None = None
     y_mean: float | np.ndarray | None = None
     y_sd: float | np.ndarray | None = None
+    index_names: str | Sequence[str] | None = None
+    index_units: str | Sequence[str] | None = None
 
     def __post_init__(self) -> None:
         check_same_rows({"x": self.x, "t": self.t, "y": self.y})
-        for part in ("x", "t", "y"):
+        for part in ("x", "t", "y", "index"):
             for kind in ("names", "units"):
                 attr = f"{part}_{kind}"
                 object.__setattr__(self, attr, _labels(getattr(self, attr), attr, kind))
+        index, index_names = _named_index(self.index, self.index_names)
+        object.__setattr__(self, "index", index)
+        object.__setattr__(self, "index_names", index_names)
         for part in ("x", "t", "y"):  # a table: its columns by name, never by position
             value, names = getattr(self, part), getattr(self, f"{part}_names")
             labels = column_labels(value)
@@ -906,6 +971,10 @@ class SimData:
         object.__setattr__(self, "t", t)
         object.__setattr__(self, "y", y)
         object.__setattr__(self, "index", _index(self.index, y.shape[1], "index"))
+        d = 1 if self.index is None or self.index.ndim == 1 else self.index.shape[1]
+        for attr in ("index_names", "index_units"):
+            labels = _index_labels(getattr(self, attr), d, y.shape[1], attr)
+            object.__setattr__(self, attr, labels)
         object.__setattr__(self, "x_names", _names(self.x_names, p, "x", "x_names"))
         object.__setattr__(self, "t_names", _names(self.t_names, q, "t", "t_names"))
         check_parameter_names(self.t_names)

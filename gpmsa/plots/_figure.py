@@ -32,6 +32,17 @@ def axis_label(name: str, unit: str) -> str:
     return f"{name} ({unit})" if unit else name
 
 
+def index_labels(names, units, grid) -> tuple[str, ...]:
+    """The axis labels of an output index ``grid`` ((l,), (l, d) or None: one column):
+    ``name (unit)`` per column as ``SimData(index_names=, index_units=)`` gave them (None:
+    "output index" for one column, "output index[:, k]" for column k of several; no unit)."""
+    d = np.shape(grid)[1] if np.ndim(grid) == 2 else 1
+    default = ("output index",) if d == 1 else tuple(f"output index[:, {k}]" for k in range(d))
+    names = default if names is None else tuple(names)
+    units = ("",) * d if units is None else tuple(units)
+    return tuple(axis_label(n, u) for n, u in zip(names, units, strict=True))
+
+
 def is_map(grid, what: str) -> bool:
     """Whether the plot ``what`` draws maps over an output index of two columns (l, 2)
     (SEPIA's (time, angle) y_ind) rather than curves along one (None or (l,)); GPMSAError for

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 AXIS_LABELS = ("output index[:, 0]", "output index[:, 1]")
+"""The axes' labels of an index without names (``SimData(index_names=)`` None)."""
 VALUES, SIGNED, SPREAD = "viridis", "RdBu_r", "magma"  # colour maps: values, signed, widths
 
 
@@ -31,35 +32,37 @@ def signed_norm(*arrays: np.ndarray):
     return Normalize(-top, top) if top > 0 else Normalize(-1.0, 1.0)
 
 
-def surface(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str):
+def surface(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, labels=AXIS_LABELS):
     """``values`` (l,) at ``points`` (l, 2) on ``ax``: colour linear on each Delaunay triangle
     (``tripcolor`` with Gouraud shading; a triangle with a non-finite corner is left blank) and a
     small black marker at each point; points that span no triangle (fewer than 3, or on one
-    line) get coloured markers instead (``markers``). Returns the mappable for a colour bar."""
+    line) get coloured markers instead (``markers``). ``labels``: the axes' (the index
+    columns', ``_figure.index_labels``). Returns the mappable for a colour bar."""
     from matplotlib.tri import Triangulation
 
     try:
         tri = Triangulation(points[:, 0], points[:, 1])
     except (ValueError, RuntimeError):  # fewer than 3 points, or all on a line
-        return markers(ax, points, values, norm, cmap)
+        return markers(ax, points, values, norm, cmap, labels=labels)
     finite = np.isfinite(values)
     tri.set_mask(~np.all(finite[tri.triangles], axis=1))
     mesh = ax.tripcolor(tri, np.where(finite, values, 0.0), shading="gouraud", norm=norm,
                         cmap=cmap)  # fmt: skip
     ax.plot(points[:, 0], points[:, 1], ".", ms=2, color="k")
-    _labels(ax)
+    _labels(ax, labels)
     return mesh
 
 
-def markers(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, *, background=None):
+def markers(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, *, background=None,
+            labels=AXIS_LABELS):  # fmt: skip
     """``values`` (l,) at ``points`` (l, 2) as markers coloured by value (observations at their
-    own points), over the grey dots of ``background`` (l_sim, 2), e.g. the simulation points.
-    Returns the mappable for a colour bar."""
+    own points), over the grey dots of ``background`` (l_sim, 2), e.g. the simulation points;
+    ``labels``: the axes' (as ``surface``'s). Returns the mappable for a colour bar."""
     if background is not None:
         ax.plot(background[:, 0], background[:, 1], ".", ms=2, color="0.7")
     dots = ax.scatter(points[:, 0], points[:, 1], c=values, norm=norm, cmap=cmap, s=36,
                       edgecolors="k", linewidths=0.6)  # fmt: skip
-    _labels(ax)
+    _labels(ax, labels)
     return dots
 
 
@@ -68,6 +71,6 @@ def colour_bar(fig, mappable, axes, label: str) -> None:
     fig.colorbar(mappable, ax=axes, shrink=0.9).set_label(label)
 
 
-def _labels(ax) -> None:
-    ax.set_xlabel(AXIS_LABELS[0])
-    ax.set_ylabel(AXIS_LABELS[1])
+def _labels(ax, labels) -> None:
+    ax.set_xlabel(labels[0])
+    ax.set_ylabel(labels[1])

@@ -7,7 +7,7 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, SimData
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
 
 MAP_PANELS = 4
 """Runs, and experiments, drawn at most as maps over a two-column output index."""
@@ -118,7 +118,7 @@ def _functional(sim: SimData, inputs, obs, ys, color_by):
                 label="observations" if j == 0 else None)  # fmt: skip
     bar = fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax)
     bar.set_label(axis_label(color_by, unit))
-    ax.set_xlabel("output index")
+    ax.set_xlabel(index_labels(sim.index_names, sim.index_units, sim.index)[0])
     ax.set_ylabel(_y_label(sim))
     ax.set_title(f"{sim.m} runs" + ("" if obs is None else f", {obs.n} experiment(s)"),
                  fontsize="small")  # fmt: skip
@@ -138,19 +138,20 @@ def _maps_of(sim: SimData, inputs, obs, ys, color_by):
     grids = [_experiment(sim, obs, e, j, sim.index) for j, e in enumerate(ys or ())]
     shown, grids = list(ys or ())[:MAP_PANELS], grids[:MAP_PANELS]
     norm = _maps.value_norm(sim.y[runs], *shown)
+    labels = index_labels(sim.index_names, sim.index_units, sim.index)
     n_cols = max(runs.size, len(shown))
     fig = figure(2.9 * n_cols + 1.0, 2.7 * (1 + bool(shown)) + 0.4)
     panels = fig.add_gridspec(1 + bool(shown), n_cols)
     axes = []
     for c, i in enumerate(runs):
         ax = fig.add_subplot(panels[0, c])
-        shade = _maps.surface(ax, sim.index, sim.y[i], norm, _maps.VALUES)
+        shade = _maps.surface(ax, sim.index, sim.y[i], norm, _maps.VALUES, labels)
         unit_text = f" {unit}" if unit else ""
         ax.set_title(f"run {i}: {color_by} = {values[i]:.3g}{unit_text}", fontsize="small")
         axes.append(ax)
     for j, (e, g) in enumerate(zip(shown, grids, strict=True)):
         ax = fig.add_subplot(panels[1, j])
-        _maps.markers(ax, g, e, norm, _maps.VALUES, background=sim.index)
+        _maps.markers(ax, g, e, norm, _maps.VALUES, background=sim.index, labels=labels)
         ax.set_title(f"experiment {j}", fontsize="small")
         axes.append(ax)
     _maps.colour_bar(fig, shade, axes, _y_label(sim))

@@ -10,7 +10,7 @@ from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.basis import variance_shares
 from gpmsa.model.data import SimData, check_count, check_flag, check_level, column_order
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
 from gpmsa.predictive.crossval import CrossValidation
 
 
@@ -51,6 +51,7 @@ def pc_basis(emulator, *, max_pc: int = 6):
     total = float(np.sum(y_std**2))
     share = variance_shares(emulator.w, emulator.lam_sim, total) if total > 0 else None
     n_col = len(inputs) + (0 if scalar else 1)
+    labels = index_labels(emulator.index_names, emulator.index_units, std.grid)
     fig = figure(2.6 * n_col + (1.2 if maps else 0.4), 2.2 * p_u + 0.4)
     axes = fig.subplots(p_u, n_col, squeeze=False)
     for j in range(p_u):
@@ -60,12 +61,12 @@ def pc_basis(emulator, *, max_pc: int = 6):
             vector = std.y_sd * emulator.K[:, j]
             if maps:
                 norm = _maps.signed_norm(vector)
-                shade = _maps.surface(ax, std.grid, vector, norm, _maps.SIGNED)
+                shade = _maps.surface(ax, std.grid, vector, norm, _maps.SIGNED, labels)
                 _maps.colour_bar(fig, shade, ax, f"y_sd K{j + 1}")
             else:
                 ax.plot(std.grid, vector, color=f"C{j}")
                 ax.axhline(0.0, color="0.7", lw=0.6)
-                ax.set_xlabel("output index")
+                ax.set_xlabel(labels[0])
             pct = f" ({100 * share[j]:.1f} % of variance)" if share is not None else ""
             ax.set_title(f"PC {j + 1}{pct}", fontsize="small")
         for ax, (name, values) in zip(row, inputs, strict=True):
@@ -170,7 +171,7 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
         rows = np.unique(np.linspace(0, actual.shape[0] - 1, n_rows)
                          .round().astype(int))  # fmt: skip
     if functional and maps:
-        return _fit_maps(emulator.standardizer.grid, rows, actual, mean, half, level, title)
+        return _fit_maps(emulator, rows, actual, mean, half, level, title)
     fig = figure(10.0 if functional else 5.0, 4.2)
     axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]
     _fit_scatter(axes[0], actual, mean, half, title)
@@ -181,7 +182,7 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
             axes[1].fill_between(grid, mean[i] - half[i], mean[i] + half[i], color=col, alpha=0.2)
             axes[1].plot(grid, mean[i], color=col, lw=1)
             axes[1].plot(grid, actual[i], "o", color=col, ms=3)
-        axes[1].set_xlabel("output index")
+        axes[1].set_xlabel(index_labels(emulator.index_names, emulator.index_units, grid)[0])
         axes[1].set_ylabel("output")
         axes[1].set_title("runs (dots) and predicted bands", fontsize="small")
     return fig
@@ -198,9 +199,11 @@ def _fit_scatter(ax, actual: np.ndarray, mean: np.ndarray, half: np.ndarray, tit
     ax.set_title(title, fontsize="small")
 
 
-def _fit_maps(points, rows, actual, mean, half, level: float, title: str):
+def _fit_maps(emulator, rows, actual, mean, half, level: float, title: str):
     """The scatter of ``_fit_scatter`` (left) and per run in ``rows`` a row of maps over the
-    two-column index ``points``: predicted mean, interval width, run minus mean."""
+    emulator's two-column index: predicted mean, interval width, run minus mean."""
+    points = emulator.standardizer.grid
+    labels = index_labels(emulator.index_names, emulator.index_units, points)
     fig = figure(12.5, max(4.2, 2.5 * rows.size + 0.6))
     panels = fig.add_gridspec(rows.size, 4, width_ratios=[1.4, 1, 1, 1])
     _fit_scatter(fig.add_subplot(panels[:, 0]), actual, mean, half, title)
@@ -216,7 +219,7 @@ def _fit_maps(points, rows, actual, mean, half, level: float, title: str):
     for c, (values, norm, cmap, label, draw) in enumerate(columns, start=1):
         axes = [fig.add_subplot(panels[r, c]) for r in range(rows.size)]
         for ax, i in zip(axes, rows, strict=True):
-            shade = draw(ax, points, values[i], norm, cmap)
+            shade = draw(ax, points, values[i], norm, cmap, labels=labels)
             ax.set_title(f"run {i}: {label}", fontsize="small")
         _maps.colour_bar(fig, shade, axes, label)
     return fig

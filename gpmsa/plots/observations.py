@@ -9,7 +9,7 @@ from gpmsa.calibration.observations import check_emulator, reduce
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, check_count
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import check_bins, figure, is_map
+from gpmsa.plots._figure import check_bins, figure, index_labels, is_map
 
 MAP_EXPERIMENTS = 3
 """Experiments whose residual a two-column index's last row maps, at most."""
@@ -185,7 +185,7 @@ def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
         f"beyond {emulator.p_u} components: rms {rms_runs:.3g} (runs), {rms_obs:.3g} (experiments)",
         fontsize="medium",
     )
-    ax.set_xlabel("output index")
+    ax.set_xlabel(index_labels(emulator.index_names, emulator.index_units, std.grid)[0])
     ax.set_ylabel("residual")
 
 
@@ -193,12 +193,13 @@ def _residual_maps(fig, cell, emulator, obs: ObsData, reduced) -> None:
     """What the basis misses over a two-column index, in the gridspec ``cell``: the runs' rms
     at each point, and the first experiments' residuals at their points."""
     std = emulator.standardizer
+    labels = index_labels(emulator.index_names, emulator.index_units, std.grid)
     runs, misses = _misses(emulator, obs, reduced)
     shown = misses[:MAP_EXPERIMENTS]
     panels = cell.subgridspec(1, 1 + len(shown))
     ax = fig.add_subplot(panels[0, 0])
     rms = np.sqrt(np.mean(runs**2, axis=0))
-    shade = _maps.surface(ax, std.grid, rms, _maps.value_norm(0.0, rms), _maps.SPREAD)
+    shade = _maps.surface(ax, std.grid, rms, _maps.value_norm(0.0, rms), _maps.SPREAD, labels)
     _maps.colour_bar(fig, shade, ax, "rms residual")
     ax.set_title(f"runs beyond {emulator.p_u} components: rms {np.sqrt(np.mean(runs**2)):.3g}",
                  fontsize="small")  # fmt: skip
@@ -207,7 +208,8 @@ def _residual_maps(fig, cell, emulator, obs: ObsData, reduced) -> None:
     for e, miss in enumerate(shown):
         ax = fig.add_subplot(panels[0, 1 + e])
         grid = std.grid if obs.grids[e] is None else obs.grids[e]
-        dots = _maps.markers(ax, grid, miss, norm, _maps.SIGNED, background=std.grid)
+        dots = _maps.markers(ax, grid, miss, norm, _maps.SIGNED, background=std.grid,
+                             labels=labels)  # fmt: skip
         ax.set_title(f"experiment {e}: rms {np.sqrt(np.mean(miss**2)):.3g}", fontsize="small")
         axes.append(ax)
     _maps.colour_bar(fig, dots, axes, "residual")

@@ -7,7 +7,7 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, as_float, check_count, check_level
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
 from gpmsa.predictive.full import FullPrediction
 
 BANDS = (("y", "new observation y", "0.8"), ("zeta", "eta + delta", "C1"),
@@ -131,7 +131,7 @@ def prediction_bands(
         bottom.fill_between(grid, lo[i, by_index], hi[i, by_index], color="C2", alpha=0.4)
         bottom.plot(grid, delta_mean[i, by_index], color="C2", lw=1)
         bottom.axhline(0.0, color="0.6", lw=0.6)
-        bottom.set_xlabel("output index")
+        bottom.set_xlabel(index_labels(pred.index_names, pred.index_units, pred.grid)[0])
         top.set_title(_inputs_text(pred, i), fontsize="small")
     axes[0, 0].set_ylabel(ylabel)
     axes[1, 0].set_ylabel("discrepancy delta")
@@ -145,6 +145,7 @@ def _band_maps(pred: FullPrediction, observed, cols: np.ndarray, level: float):
     lo, hi = pred.interval("y", level)
     y_mean, delta_mean = pred.mean("y"), pred.mean("delta")
     surface, markers = _maps.surface, _maps.markers
+    labels = index_labels(pred.index_names, pred.index_units, pred.grid)
     rows = [
         (y_mean, _maps.value_norm(y_mean[cols], *([] if observed is None else [observed[cols]])),
          _maps.VALUES, "mean of y", surface),
@@ -159,7 +160,7 @@ def _band_maps(pred: FullPrediction, observed, cols: np.ndarray, level: float):
     axes = fig.subplots(len(rows), cols.size, squeeze=False, sharex=True, sharey=True)
     for r, (values, norm, cmap, label, draw) in enumerate(rows):
         for c, i in enumerate(cols):
-            shade = draw(axes[r, c], pred.grid, values[i], norm, cmap)
+            shade = draw(axes[r, c], pred.grid, values[i], norm, cmap, labels=labels)
             axes[r, c].set_title(label if r else f"{_inputs_text(pred, i)}\n{label}",
                                  fontsize="small")  # fmt: skip
         _maps.colour_bar(fig, shade, list(axes[r]), label)

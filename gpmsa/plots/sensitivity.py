@@ -11,7 +11,7 @@ from scipy.stats import norm
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import check_count, check_level
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
 from gpmsa.predictive.sobol import Sensitivity
 
 
@@ -83,7 +83,7 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
                         lo, hi = np.nanquantile(col, q, axis=0)
                         ax.fill_between(sens.grid, lo, hi, color=f"C{k}", alpha=0.15)
         ax.set_ylim(0.0, 1.05)
-        ax.set_xlabel("output index")
+        ax.set_xlabel(index_labels(sens.index_names, sens.index_units, sens.grid)[0])
         ax.set_ylabel("index (solid: main, dashed: total)")
         ax.legend(fontsize="small")
     return fig
@@ -93,6 +93,7 @@ def _effect_maps(fig, panels, sens: Sensitivity) -> None:
     """Each input's main (row 0) and total (row 1) effect over the two-column ``sens.grid``,
     the mean over draws, in columns 1.. of the gridspec ``panels``; one scale, 0 to 1."""
     norm = _maps.value_norm(0.0, 1.0)
+    labels = index_labels(sens.index_names, sens.index_units, sens.grid)
     axes = []
     with warnings.catch_warnings():  # all-NaN grid points (zero output variance)
         warnings.simplefilter("ignore", RuntimeWarning)
@@ -100,7 +101,7 @@ def _effect_maps(fig, panels, sens: Sensitivity) -> None:
             for k, name in enumerate(sens.names):
                 ax = fig.add_subplot(panels[r, 1 + k])
                 shade = _maps.surface(ax, sens.grid, np.nanmean(arr[:, :, k], axis=0), norm,
-                                      _maps.VALUES)  # fmt: skip
+                                      _maps.VALUES, labels)  # fmt: skip
                 ax.set_title(f"{kind} effect of {name}", fontsize="small")
                 axes.append(ax)
     _maps.colour_bar(fig, shade, axes, "Sobol index (mean over draws)")

@@ -104,6 +104,8 @@ class FullPrediction:
         K: (l, p_u) and D: (l, p_v) the bases on ``grid``; y_mean: (l,), y_sd: the
             standardisation (a float; scaled columnwise, (l,) each element's sd on ``grid``).
         x_names, x_units: (p,) the known inputs' names and units (for figures; empty: unknown).
+        index_names, index_units: the output index's labels (``SimData(index_names=,
+            index_units=)``; None: none given), for figures.
     """
 
     x: np.ndarray
@@ -124,6 +126,8 @@ class FullPrediction:
     y_sd: float | np.ndarray
     x_names: tuple[str, ...] = ()
     x_units: tuple[str, ...] = ()
+    index_names: tuple[str, ...] | None = None
+    index_units: tuple[str, ...] | None = None
 
     @property
     def zeta(self) -> np.ndarray:
@@ -740,6 +744,7 @@ def full_prediction(
         x=x_nat, grid=g, draw_index=idx, theta=theta, lamOs=lamOs, mu=mu, cov=cov_pt,
         u=u, v=v, eta=eta, delta=delta, y=y, K=K_pred, D=D_pred, y_mean=std.mean_on(g),
         y_sd=sd, x_names=tuple(emulator.x_names), x_units=tuple(emulator.x_units),
+        index_names=emulator.index_names, index_units=emulator.index_units,
     )  # fmt: skip
 
 

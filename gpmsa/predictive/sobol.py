@@ -108,7 +108,9 @@ class Sensitivity:
             its grid (one number per input for a functional output; = main/total for l_sim 1).
         variance: (S, l_sim) variance of the emulator mean over the box, native units^2.
         mean: (S, l_sim) its mean over the box, native units.
-        units: name -> unit of each varied input; y_names, y_units: (l_sim,) the outputs'.
+        units: name -> unit of each varied input; y_names, y_units: (l_sim,) the outputs';
+            index_names, index_units: the output index's labels (``SimData(index_names=,
+            index_units=)``; None: none given).
         pairs: (P,) the pairs of varied inputs asked for (``sensitivity(pairs=)``; () if none).
         joint, interaction: (S, l_sim, P) closed joint index V_{k,l} / V and interaction index
             (V_{k,l} - V_k - V_l) / V of each pair (SEPIA's ``sje``, ``sie``); None without
@@ -158,6 +160,8 @@ class Sensitivity:
     units: dict[str, str] = field(default_factory=dict, repr=False)
     y_names: tuple[str, ...] = field(default=(), repr=False)
     y_units: tuple[str, ...] = field(default=(), repr=False)
+    index_names: tuple[str, ...] | None = field(default=None, repr=False)
+    index_units: tuple[str, ...] | None = field(default=None, repr=False)
     pairs: tuple[tuple[str, str], ...] = ()
     joint: np.ndarray | None = field(default=None, repr=False)
     interaction: np.ndarray | None = field(default=None, repr=False)
@@ -1010,6 +1014,7 @@ def sensitivity(
         units={n: u for n, u in zip(names, (*emulator.x_units, *emulator.t_units), strict=True)
                if n in box},
         y_names=tuple(emulator.y_names), y_units=tuple(emulator.y_units),
+        index_names=emulator.index_names, index_units=emulator.index_units,
         pairs=tuple((k_names[a], k_names[b]) for a, b in pair_pos),
         joint=out_pair.get("joint"), interaction=out_pair.get("interaction"),
         joint_pc=out_pair_pc.get("joint"), interaction_pc=out_pair_pc.get("interaction"),

@@ -221,10 +221,12 @@ def test_one_column_figures_keep_their_lines():
 @pytest.mark.parametrize(
     ("index", "expected"),
     [
-        (POINTS, {"points": 20, "columns": 2, "ranges": [[0.0, 1.0], [0.0, 2.0]]}),
-        (np.linspace(2.0, 5.0, 20), {"points": 20, "columns": 1, "ranges": [[2.0, 5.0]]}),
+        (POINTS, {"points": 20, "columns": 2, "ranges": [[0.0, 1.0], [0.0, 2.0]],
+                  "names": None, "units": None}),
+        (np.linspace(2.0, 5.0, 20), {"points": 20, "columns": 1, "ranges": [[2.0, 5.0]],
+                                     "names": None, "units": None}),
     ],
-)
+)  # fmt: skip
 def test_info_json_describes_the_output_index(tmp_path, capsys, index, expected):
     gpmsa.Emulator.from_params(_sim(index), PARAMS).save(tmp_path / "e.gpmsa")
     assert main(["info", str(tmp_path / "e.gpmsa"), "--json"]) == 0
