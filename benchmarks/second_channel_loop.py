@@ -160,11 +160,13 @@ class TwoChannelBCR(control.BCR):
         second = control.block_features(self._second[-block.size :], self.settings.feature)[0]
         return np.concatenate([super()._block_feature(block), second])
 
-    def _signal_reason(self, accel: np.ndarray, timing: bool = True, steady: bool = True) -> str:
+    def _signal_reason(
+        self, accel: np.ndarray, timing: bool = True, slow: np.ndarray | None = None
+    ) -> str:
         """The shipped checks (time stamps, odometry, the first channel), then the signal
         checks on the second channel's samples alongside ``accel``."""
-        return super()._signal_reason(accel, timing, steady) or signal_fault(
-            self._second[-accel.size :], self.settings.sensor, steady=steady
+        return super()._signal_reason(accel, timing, slow) or signal_fault(
+            self._second[-accel.size :], self.settings.sensor, steady=slow is None, slow=slow
         )
 
 

@@ -772,16 +772,20 @@ class BCR:
         """The feature vector (K,) of the newest block of clean samples."""
         return features_of_blocks(block[None, :], self.settings.feature)[0]
 
-    def _signal_reason(self, accel: np.ndarray, timing: bool = True, steady: bool = True) -> str:
+    def _signal_reason(
+        self, accel: np.ndarray, timing: bool = True, slow: np.ndarray | None = None
+    ) -> str:
         """The checks of the buffer's time stamps and odometry (`timing_fault`; with
-        ``timing``), then the signal checks on ``accel`` (`signal_fault`, with ``steady``): a
-        whole block, or a window's new samples (`_window_signal_reason`)."""
+        ``timing``), then the signal checks on ``accel`` (`signal_fault`; ``slow``: its samples
+        below half their top speed, None for none): a whole block, or a window's new samples
+        (`_window_signal_reason`)."""
         s = self.settings
         if timing:
             reason = timing_fault(self._t, self._pos, self._spd, s.rate_hz, s.sensor)
             if reason:
                 return reason
-        return signal_fault(accel, s.sensor, steady=steady) or self._span_reason()
+        steady = slow is None
+        return signal_fault(accel, s.sensor, steady=steady, slow=slow) or self._span_reason()
 
     def _span_reason(self) -> str:
         """The static-level check's long span (`static_span_fault`): "" while it is off or not
@@ -793,15 +797,17 @@ class BCR:
         since the previous update (those a restart kept), as the window fills too, so that
         every sample of a window has passed them once; the timing checks on a full window.
         New samples over which the speed changes by more than MAX_SPEED_CHANGE (starting,
-        stopping) skip the level-jump check (their level changes with the speed) and the
-        dead-stretch check (a robot getting under way on flat ground reads an all but constant
-        acceleration, as the change-point method's blocks over which the speed changes go
-        unchecked)."""
+        stopping) skip the level-jump check (their level changes with the speed), and their
+        dead-stretch check passes over the stretches that take in a sample below
+        MAX_SPEED_CHANGE of their top speed (a robot getting under way on flat ground reads an
+        all but constant acceleration; a sensor that dies at speed is still caught)."""
         every = self.settings.samples_per_update
         spd = np.abs(self._spd[-every:])
-        steady = spd.size == 0 or np.min(spd) >= MAX_SPEED_CHANGE * np.max(spd)
+        slow = ~(spd >= MAX_SPEED_CHANGE * np.max(spd)) if spd.size else None  # (NaN: slow)
         return self._signal_reason(
-            self._acc[-every:], timing=self._acc.size >= self.buffer, steady=steady
+            self._acc[-every:],
+            timing=self._acc.size >= self.buffer,
+            slow=slow if slow is not None and slow.any() else None,
         )
 
     def _restart_window(self) -> None:

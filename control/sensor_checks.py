@@ -290,14 +290,18 @@ def longest_repeat(a: np.ndarray) -> int:
     return int((edges[1:] - edges[:-1]).max())
 
 
-def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True) -> str:
+def signal_fault(
+    accel: np.ndarray, limits: SensorLimits, *, steady: bool = True,
+    slow: np.ndarray | None = None,
+) -> str:  # fmt: skip
     """Why a block of accelerations (finite values, m/s^2) cannot come from a healthy sensor,
     or "" (stuck, quantised, clipped, a dead stretch, quieter than the sensor's noise, a level
     that drops within the block; with ``limits.static_mps2``, a mean off the static level:
     `static_level`). ``steady=False``: the vehicle started or stopped within the block, whose
-    level then changes with the speed: no level-jump check; and no dead-stretch check (a robot
-    getting under way on flat ground, or coming to rest, reads an all but constant
-    acceleration)."""
+    level then changes with the speed: no level-jump check. ``slow`` (bool, one per sample;
+    None: none): the samples at which the vehicle was slow (below half the block's top speed):
+    a dead stretch that takes one in is no fault (a robot getting under way on flat ground, or
+    coming to rest, reads an all but constant acceleration), one at speed still is."""
     a = np.asarray(accel, dtype=float)
     if a.ndim != 1:
         raise ControlError(f"accel must be a 1-D block of accelerations, got shape {a.shape}")
@@ -339,7 +343,7 @@ def signal_fault(accel: np.ndarray, limits: SensorLimits, *, steady: bool = True
     # lattice check's shortest stretches
     sorted_runs = _sorted_runs(a, DEAD_STRETCH)
     spread = None if sorted_runs is None else sorted_runs[-1] - sorted_runs[0]
-    start = _dead_stretch(a, limits.dead_fraction, flight, sd, spread) if steady else -1
+    start = _dead_stretch(a, limits.dead_fraction, flight, sd, spread, slow)
     if start >= 0:
         return (
             f"dead sensor: samples {start}-{start + DEAD_STRETCH - 1} span less than "
@@ -522,10 +526,11 @@ def dead_stretch(a: np.ndarray, fraction: float, free_fall: float | None) -> int
 
 def _dead_stretch(
     a: np.ndarray, fraction: float, free_fall: float | None, sd: float,
-    spread: np.ndarray | None = None,
+    spread: np.ndarray | None = None, slow: np.ndarray | None = None,
 ) -> int:  # fmt: skip
     """`dead_stretch` with the standard deviation ``sd`` of ``a`` known, and the range of each
-    stretch (``spread``, by start: from `_sorted_runs`) where given."""
+    stretch (``spread``, by start: from `_sorted_runs`) where given; a stretch that takes in a
+    ``slow`` sample (`signal_fault`) is none."""
     n = a.size - DEAD_STRETCH + 1
     if n < 1:
         return -1
@@ -538,6 +543,8 @@ def _dead_stretch(
     dead = spread < fraction * sd
     if not dead.any():  # the usual case: no flight exemption to work out
         return -1
+    if slow is not None and slow.any():
+        dead &= np.convolve(slow, np.ones(DEAD_STRETCH), mode="valid")[:n] == 0
     if free_fall is not None:
         total = a[:n].copy()
         for j in range(1, DEAD_STRETCH):  # running sum over the stretch

@@ -58,10 +58,10 @@ def memory_limit(
     """Raise ``error`` when ``nbytes`` (an estimate) exceeds ``limit``, naming the ``setting``
     that holds the limit and the ``advice`` (shared with ``vehicle.checks``)."""
     if nbytes > limit:
+        need, most = distinct_texts(nbytes / 1024**3, limit / 1024**3, digits=3)
         raise error(
-            f"{what} needs about {nbytes / 1024**3:.3g} GiB of memory, above the limit "
-            f"{setting} = {limit / 1024**3:.3g} GiB; {advice}, or raise the limit ({setting} "
-            "= ...) if the machine has the memory"
+            f"{what} needs about {need} GiB of memory, above the limit {setting} = {most} GiB; "
+            f"{advice}, or raise the limit ({setting} = ...) if the machine has the memory"
         )
 
 

@@ -43,10 +43,11 @@ def wheel_envelope(road: R, radius_m: float) -> R:
     n = z.size
     reach = min(int(np.floor(r / road.dx_m * (1.0 + 1e-12))), n - 1)
     if float(reach) * n > MAX_ENVELOPE_WORK:
+        work, most = distinct_texts(float(reach) * n, MAX_ENVELOPE_WORK, digits=3)
         raise RoadgenError(
             f"radius_m={radius_m!r} reaches {reach} grid steps on each side of {n} points: "
-            f"{float(reach) * n:.3g} comparisons, above MAX_ENVELOPE_WORK = "
-            f"{MAX_ENVELOPE_WORK:.3g}; use a shorter road or a coarser grid"
+            f"{work} comparisons, above MAX_ENVELOPE_WORK = {most}; use a shorter road or a "
+            "coarser grid"
         )
     env = z.copy()
     for m in range(1, reach + 1):

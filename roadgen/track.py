@@ -200,9 +200,10 @@ def _check_boundaries(
     lengths = np.array([length for length, _ in segs])
     expected = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
     if np.max(np.abs(starts - expected)) > 1e-9 * lengths.sum():
+        shown = distinct_texts(*expected, *starts)[: expected.size]  # (not as the given ones)
         raise RoadgenError(
             f"boundaries_m={boundaries!r} do not match segments: a segment starts where the "
-            f"previous one ends, at ({', '.join(f'{b:g}' for b in expected)}) m"
+            f"previous one ends, at ({', '.join(shown)}) m"
         )
     return starts
 

@@ -137,14 +137,17 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     try:
         with open(path, "rb") as fh:  # a pipe or device may never end: read a bounded part
             raw = fh.read(Y_CSV_MAX_BYTES + 1)
-        lines = raw.decode("utf-8-sig").splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
+    except OSError as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
-    if len(raw) > Y_CSV_MAX_BYTES:
+    if len(raw) > Y_CSV_MAX_BYTES:  # (before decoding: the limit may cut a character)
         raise GPMSAError(
             f"{where}: it holds more than {Y_CSV_MAX_BYTES} bytes, more than one observation's "
             "values take (gpmsa.cli.calibrate.Y_CSV_MAX_BYTES)"
         )
+    try:
+        lines = raw.decode("utf-8-sig").splitlines()
+    except UnicodeDecodeError as exc:
+        raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
     try:
         rows = [(k, _fields(line)) for k, line in enumerate(lines, 1)
                 if line.strip() and not line.lstrip().startswith("#")]  # fmt: skip

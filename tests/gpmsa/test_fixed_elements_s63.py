@@ -69,7 +69,8 @@ def test_whole_array_fixing_draws_as_before():
     cal = {"theta": 50.28310916769502, "betaV": 640.4126922110979, "lamOs": 153577.16242460115}
     for k, v in cal.items():
         np.testing.assert_allclose(emu.calibration[k].sum(), v, rtol=1e-12)
-    np.testing.assert_allclose(emu.log_post.sum(), 140180.97847410757, rtol=1e-12)
+    # the log posterior to 1e-10: OpenBLAS's kernel (Sandybridge here) moves it by ~2e-12
+    np.testing.assert_allclose(emu.log_post.sum(), 140180.97847410757, rtol=1e-10)
     assert emu.settings["fixed"] == {"lamVz": [20.0, 1e4]}
 
 

@@ -63,13 +63,14 @@ def test_fits_without_held_elements_draw_as_before():
               "lamWs": 18039.95231195273, "lamWOs": 18319.496438958944}  # fmt: skip
     for k, v in before.items():
         np.testing.assert_allclose(emu.draws[k].sum(), v, rtol=1e-12)
-    np.testing.assert_allclose(emu.log_post.sum(), 740.5016769750844, rtol=1e-12)
+    # the log posteriors to 1e-10: OpenBLAS's kernel (Sandybridge here) moves them by ~4e-12
+    np.testing.assert_allclose(emu.log_post.sum(), 740.5016769750844, rtol=1e-10)
     np.testing.assert_allclose(emu.settings["step_widths"]["lamWs"],
                                [[0.284700264365863], [0.2574671612237942]], rtol=1e-12)  # fmt: skip
     cal = _fit(sim, obs, fixed=EMU, **short)
     for k, v in {"theta": 13.375217259112802, "lamOs": 16910.59187843946}.items():
         np.testing.assert_allclose(cal.calibration[k].sum(), v, rtol=1e-12)
-    np.testing.assert_allclose(cal.log_post.sum(), 130.2119734725245, rtol=1e-12)
+    np.testing.assert_allclose(cal.log_post.sum(), 130.2119734725245, rtol=1e-10)
     assert np.all(np.isnan(cal.settings["step_widths"]["lamWs"]))
 
 
