@@ -21,6 +21,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from gpmsa import backends
+from gpmsa.calibration import continuation as cont
 from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
     OUTSIDE_SDS,
@@ -214,8 +215,8 @@ def calibrate(
     x_obs=None,
     y_obs=None,
     n_samples: int = 5000,
-    n_burn: int = 1000,
-    tune: bool = True,
+    n_burn: int | None = None,
+    tune: bool | None = None,
     seed=None,
     backend: str = "numpy",
     *,
@@ -235,6 +236,7 @@ def calibrate(
     constraint=None,
     theta_init=None,
     fixed: dict | None = None,
+    append: bool = False,
     _online: bool = False,  # a Calibrator's update: one chain not judged (fast, silent)
     **options,
 ) -> Posterior:
@@ -254,8 +256,10 @@ def calibrate(
             grid (the basis is interpolated there, as SEPIA's y_ind_obs) and may carry its
             observation-error ``precision`` (native units; lamOs still scales it).
         n_samples: sweeps per chain after tuning (pyro: NUTS draws after its ``n_warmup``
-            adaptation steps, 500 by default); n_burn: of these, burned (kept: the rest).
-        tune: GPM/SA step-size tuning first (tune_rounds x tune_levels sweeps).
+            adaptation steps, 500 by default); n_burn: of these, burned (kept: the rest;
+            None: 1000, 0 for a continuation).
+        tune: GPM/SA step-size tuning first (tune_rounds x tune_levels sweeps); None: True,
+            but a continuation (``init`` a Posterior) runs on the widths its chains ended with.
         tune_rounds, tune_levels: the tuning's rounds and candidate widths per element (None:
             the backend's default; numpy 50 x 20; torch ceil(50 / n_chains) x 20). The pyro
             backend (NUTS) has no such tuning: giving either to it is a GPMSAError.
@@ -313,17 +317,39 @@ def calibrate(
             torch and pyro backends hold any of them, whole or by element. The emulator's
             parameters (betaU, lamUz, lamWs, lamWOs) are not sampled here: naming one is a
             GPMSAError (fix them in ``gpmsa.fit(..., fixed=)``).
+        append: with ``init`` a Posterior, return its chains each followed by this
+            continuation's draws (below).
         options: passed to the backend's ``sample`` (``fast=False`` or another backend than
             numpy), e.g. ``device="cuda"``, ``dtype="float32"`` for torch; the fast sampler
-            takes none.
+            takes none. ``init``: a backend's start rule (``gpmsa.mcmc.starts``), or a
+            Posterior that ``calibrate`` returned, whose chains continue (below).
+
+    Continuing (``init=posterior``, as ``gpmsa.fit(..., init=emulator)``): each chain starts at
+    its last draw, on the engine it ran on (fast sampler or backend), with the step widths it
+    ended with and its precision steps (a tuned source's uniform steps; ``info
+    ["proportional_steps"]``), untuned unless ``tune=True`` (from GPM/SA's widths); the seed
+    gives a fresh stream, so n sweeps continued by m are not one run of n + m, but the same
+    seed repeats the continuation. A tempered source runs on at its ladder (``temperatures=``
+    gives another, None: untempered), every copy tuned at its temperature from the chain's
+    last state (calibrate records no hot copies; ``tune=False`` refused). Refused naming what
+    differs: another emulator (``model_sha256``: another fit or other calibration priors),
+    other observations, another number of chains, emulator_params or n_emulator_draws, held
+    values (``fixed=``), constraint or log_prior given or not, another discrepancy, the other
+    engine, and ``theta_init``. ``info["continued_from"]`` records the source's chains'
+    digest. ``append=True``: the chains pooled, diagnostics, convergence, the at-bound check
+    and ``emulator_draws`` over them; info "appended_to", "appended_after" (the source's draws
+    per chain), "pooled_sweeps", "sweeps_run" and "accept_rate" weighted by the parts' sweeps;
+    refused with n_burn > 0 or tuning (untempered). A Posterior kept by pickle continues; one
+    rebuilt from ``to_arviz()`` has no widths or settings, and is refused.
 
     ``info["diagnostics"]`` holds each parameter's rank-normalised R-hat and bulk ESS (and
     mean, sd), ``info["convergence"]`` the verdict, and a ``gpmsa.ConvergenceWarning`` names
     each parameter with R-hat > 1.01 or ESS < 100; one chain (the default) is judged by its
     split R-hat, which compares the chain's halves (the warning then advises a longer chain or
-    ``n_chains >= 2``). A ``gpmsa.Calibrator``'s update (its MCMC path, online) judges one
-    chain by none of them: its Posterior has no diagnostics, and no warning. A chain
-    that fails or produces non-finite draws raises ``gpmsa.ChainError`` naming it.
+    ``n_chains >= 2``); the warning advises a continuation too (``init=`` the Posterior, with
+    ``append=True`` where it was appended). A ``gpmsa.Calibrator``'s update (its MCMC path,
+    online) judges one chain by none of them: its Posterior has no diagnostics, and no
+    warning. A chain that fails or produces non-finite draws raises ``gpmsa.ChainError`` naming it.
     ``info["at_bound"]`` names each calibration parameter whose posterior piles up against a
     bound of the emulator's domain ("lower" or "upper": half its draws within 1 % of the
     domain's width of it, ``gpmsa.mcmc.bounds``; categorical and held ones are not
@@ -348,10 +374,17 @@ def calibrate(
     seed = run_seed(seed)
     n_samples = check_count(n_samples, "n_samples", 2)
     n_chains = check_count(n_chains, "n_chains")
+    source = None  # init= a Posterior of calibrate: its chains continue (a rule: the backend's)
+    if options.get("init") is not None and not isinstance(options["init"], str | dict):
+        source = cont.checked_source(options.pop("init"), n_chains)
+    append = cont.check_append(append, source, n_burn)
+    if n_burn is None:
+        n_burn = 1000 if source is None else 0
     ok = not isinstance(n_burn, bool) and isinstance(n_burn, int | np.integer)
     if not (ok and 0 <= n_burn < n_samples - 1):
         raise GPMSAError(burn_message(n_burn, n_samples, "n_samples", 1000))
-    tune, extrapolate = check_flag(tune, "tune"), check_flag(extrapolate, "extrapolate")
+    tune = None if tune is None else check_flag(tune, "tune")
+    extrapolate = check_flag(extrapolate, "extrapolate")
     progress = check_flag(progress, "progress")
     backends.get(backend)  # unknown or not installed: a clear error before any work
     tuning_opts = _tuning_options(backend, tune_rounds, tune_levels)
@@ -361,9 +394,12 @@ def calibrate(
         check_groups(discrepancy_groups, 0)  # groups without a basis: refused
     can_fast = backend == "numpy" and discrepancy is None
     fast_given = fast is not None
-    if fast is None:
-        fast = can_fast
+    if fast is None:  # a continuation: on its source's engine
+        fast = can_fast and (source is None or source.info["engine"] == "fast")
     fast = check_flag(fast, "fast")
+    if source is not None:
+        _check_source(source, emulator, fast, emulator_params, n_emulator_draws, constraint,
+                      log_prior, discrepancy, theta_init)  # fmt: skip
     if fast and not can_fast:
         raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
     if not fast and (emulator_params != "point" or log_prior is not None):
@@ -392,10 +428,22 @@ def calibrate(
             f"calibrate: options {sorted(options)} go to a backend's sampler, which the fast "
             "numpy sampler replaces; pass fast=False (or another backend) to use them"
         )
+    given_options = dict(options)  # recorded as given (a continuation adds its ladder)
     temps = None  # parallel tempering (numpy, torch: their samplers' option)
-    if backend in ("numpy", "torch"):
+    if backend in ("numpy", "torch") and source is not None and not fast:
+        temps = cont.continued_ladder(source, options, n_chains)  # the source's by default
+    elif backend in ("numpy", "torch"):
         temps = tempering.ladder(options.get("temperatures"))
-    _check_calibrate_memory(emulator, n_samples, n_chains, fast, 1 if temps is None else len(temps))
+    resume = None  # a continuation's source, recorded widths and precision steps
+    if source is None:
+        tune = True if tune is None else tune
+    else:
+        tune, resume = _continued_run(source, tune, fast, backend, temps, append, options)
+        if emulator_params == "draws":
+            resume["positions"] = draw_positions(emulator, n_emulator_draws)
+    pooled = 0 if not append else np.atleast_2d(next(iter(source.chains.values()))).shape[1]
+    _check_calibrate_memory(emulator, n_samples + pooled, n_chains, fast,
+                            1 if temps is None else len(temps))  # fmt: skip
     _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}
     held = calibration_fixed(emulator, fixed, discrepancy)
@@ -408,12 +456,16 @@ def calibrate(
             if discrepancy is not None:  # the reduction with its basis warns (_run_backend)
                 warnings.simplefilter("ignore", ReductionWarning)
             data = reduce(emulator, x_obs, y_obs, extrapolate)
+        if source is not None:
+            cont.check_same(source, observations=(
+                [source.info.get(k) for k in ("obs_values_sha256", "obs_layout_sha256")],
+                [data.values_sha256, data.layout_sha256]))  # fmt: skip
         fit = observation_fit(emulator, data, sets)
         warn_if_outside(fit, discrepancy=discrepancy is not None)
         if fast:
             draws, info = _run_fast(
                 emulator, data, fit, sets, n_samples, n_chains, tune, tuning_opts, seed,
-                log_prior, progress, where, theta_opts,
+                log_prior, progress, where, theta_opts, resume,
             )  # fmt: skip
         else:
             draws, info = _run_backend(
@@ -421,6 +473,7 @@ def calibrate(
                 n_samples, n_chains, tune, {**tuning_opts, **options}, seed, extrapolate,
                 progress, where,
                 {**theta_opts, "fixed": held, "fit": None if discrepancy is not None else fit},
+                resume,
             )  # fmt: skip
     held_names = info.pop("held_names", ())
     set_index = info.pop("set_index", None)
@@ -428,6 +481,8 @@ def calibrate(
         draws[emulator.t_names[k]][...] = value
     require_finite(draws)
     chains = {k: v[:, n_burn:] for k, v in draws.items()}
+    if append:  # the source's chains, each followed by its continuation's
+        chains = cont.pool(source, chains)
     samples = {k: v.reshape(-1) for k, v in chains.items()}
     info.update(
         method="mcmc", n_samples=n_samples, n_burn=n_burn, n_chains=n_chains, tune=tune,
@@ -437,11 +492,19 @@ def calibrate(
         obs_layout_sha256=data.layout_sha256,
         **emulator_record(emulator),
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
-        backend_options=backends.recorded_options(options),
+        backend_options=backends.recorded_options(given_options),
     )  # fmt: skip
+    info.update(_settings_record(constraint, log_prior, emulator_params, n_emulator_draws))
+    if source is not None:  # as gpmsa.fit's settings record a continuation
+        info["continued_from"] = cont.chains_sha256(source)
+        if append:
+            info.update(cont.appended_info(source, n_samples, info["accept_rate"]))
     if emulator_params == "draws":  # the retained draw each sample was drawn with
         positions = draw_positions(emulator, n_emulator_draws)
         info["emulator_draws"] = positions[set_index[:, n_burn:].reshape(-1)]
+        if append:
+            info["emulator_draws"] = cont.pool_flat(source.info["emulator_draws"],
+                                                    info["emulator_draws"], n_chains)  # fmt: skip
     codes = theta_levels_native(emulator)
     if codes:  # a categorical theta: its quantiles are levels (Posterior.quantile)
         info["levels"] = codes
@@ -455,12 +518,15 @@ def calibrate(
             info["diagnostics"],
             shapes,
             n_chains,
-            n_samples - n_burn,
+            next(iter(chains.values())).shape[1],
             held=set(held_names),
             levels=set(codes),
         )
         warn_unconverged(
-            info["convergence"], f"gpmsa.calibrate (backend {backend!r})", length="n_samples"
+            info["convergence"],
+            f"gpmsa.calibrate (backend {backend!r})",
+            length="n_samples",
+            more="" if _online else f", or {_more_advice(append)}",
         )
     if not _online:  # (a Calibrator's update: silent, and no time spent on it)
         skip = {*held_names, *codes}  # held and categorical elements: no such bound
@@ -470,6 +536,84 @@ def calibrate(
                       f"gpmsa.calibrate (backend {backend!r})",
                       "Posterior.info['at_bound']")  # fmt: skip
     return Posterior(samples, chains=chains, info=info)
+
+
+def _check_source(source, emulator, fast: bool, emulator_params: str, n_emulator_draws: int,
+                  constraint, log_prior, discrepancy, theta_init) -> None:  # fmt: skip
+    """GPMSAError where ``calibrate``'s ``init`` (a Posterior, ``source``) is a calibration of
+    another emulator (its ``model_sha256``: another fit, or other calibration priors), another
+    emulator_params, constraint, log_prior or discrepancy, or ran on the other engine; and
+    where ``theta_init`` is given (the chains start at their last draws)."""
+    info = source.info
+    same = {
+        "emulator": (info.get("emulator_sha256"),
+                     emulator_record(emulator).get("emulator_sha256")),
+        "emulator_params": (info.get("emulator_params"), emulator_params),
+        "theta constraint": (bool(info.get("constraint", False)), constraint is not None),
+        "log_prior": (bool(info.get("log_prior", False)), log_prior is not None),
+        "discrepancy": (info.get("discrepancy"), discrepancy_kind(discrepancy)),
+    }  # fmt: skip
+    if emulator_params == "draws":
+        same["n_emulator_draws"] = (info.get("n_emulator_draws"), n_emulator_draws)
+    cont.check_same(source, **same)
+    cont.check_engine(source, fast)
+    if theta_init is not None:
+        raise GPMSAError(f"theta_init= sets a fresh chain's start; {cont.SOURCE}'s chains "
+                         "continue from their last draws: leave theta_init out")  # fmt: skip
+
+
+def _continued_run(source, tune, fast: bool, backend: str, temps, append: bool,
+                   options: dict) -> tuple[bool, dict]:  # fmt: skip
+    """A continuation's tuning and what its run takes ({"source", "widths": run on the recorded
+    step widths (the fast sampler: True; a backend: name -> per chain; None: GPM/SA's),
+    "proportional": the precisions' steps (None: ``not tune``)}), by ``gpmsa.fit``'s rules:
+    ``tune`` None runs untuned on the recorded widths (tuned where none are recorded, and
+    every copy of a tempered one tuned at its temperature from them: ``tune=False`` refused
+    there); True tunes again from GPM/SA's widths; ``append`` refuses tuning (untempered)."""
+    widths = None
+    if tune is not True and "step_widths" not in options:
+        widths = True if fast else cont.backend_widths(source, backend)
+    if tune is None:
+        tune = widths is None or temps is not None
+    if temps is not None and not tune:
+        raise GPMSAError(
+            f"tune=False with a tempered continuation (temperatures=, or {cont.SOURCE} a "
+            "tempered calibration): calibrate records no hot copies' states, so every copy is "
+            "tuned at its temperature (from the T = 1 copy's widths) while the copies warm up "
+            "from the chain's last state, before any draw is kept; leave tune out (or "
+            "tune=True: from GPM/SA's widths), or pass temperatures=None to continue without "
+            "tempering"
+        )
+    if append and tune and (fast or backend in cont.MH_BACKENDS) and temps is None:
+        raise GPMSAError(
+            "append=True pools the chains' draws one sweep apart; tuning (tune=True, or "
+            f"tune=None where {cont.SOURCE} records no Metropolis step widths) would run its "
+            "sweeps between the source's and the continuation's: pass tune=False"
+        )
+    steps = None  # the precisions' steps as the chains it continues (SEPIA: once tuned, always)
+    metropolis = fast or (backend in cont.MH_BACKENDS
+                          and source.info.get("backend") in cont.MH_BACKENDS)  # fmt: skip
+    if not tune and metropolis and "proportional_steps" not in options:
+        steps = cont.proportional(source)
+    return tune, {"source": source, "widths": widths, "proportional": steps}
+
+
+def _settings_record(constraint, log_prior, emulator_params: str, n_emulator_draws: int) -> dict:
+    """What ``info`` records of the settings a continuation must share and the draws do not
+    show: "constraint" and "log_prior" (True where given), "n_emulator_draws" (its draws mode)."""
+    out = {k: True for k, v in (("constraint", constraint), ("log_prior", log_prior))
+           if v is not None}  # fmt: skip
+    if emulator_params == "draws":
+        out["n_emulator_draws"] = int(n_emulator_draws)
+    return out
+
+
+def _more_advice(append: bool) -> str:
+    """The call a ConvergenceWarning of ``calibrate`` advises to run the chains on (as
+    ``gpmsa.fit``'s): a continuation (``append``: appended)."""
+    if append:
+        return "append more: gpmsa.calibrate(..., init=the returned posterior, append=True)"
+    return "continue these: gpmsa.calibrate(..., init=the returned posterior)"
 
 
 def burn_message(n_burn, n_samples, what: str = "n_samples", default: int | None = None) -> str:
@@ -554,8 +698,11 @@ def _check_calibrate_memory(
 def _fast_chain(
     sampler: CalibrationSampler, n_samples: int, seed: np.random.SeedSequence, tune: bool,
     tune_rounds: int, tune_levels: int, progress: bool = False, desc: str = "calibrate",
+    start: tuple | None = None, widths: np.ndarray | None = None,
+    proportional: bool | None = None,
 ):  # fmt: skip
-    """One chain of the fast sampler (a worker process runs it from plain data)."""
+    """One chain of the fast sampler (a worker process runs it from plain data); ``start``,
+    ``widths``, ``proportional``: a continuation's (``CalibrationSampler.run``)."""
     with threadpool_limits(1):
         return sampler.run(
             n_samples,
@@ -564,12 +711,15 @@ def _fast_chain(
             tune_rounds=tune_rounds,
             tune_levels=tune_levels,
             progress=progress,
+            widths=widths,
+            start=start,
+            proportional=proportional,
         )
 
 
 def _run_fast(
     emulator, data, fit, sets, n_samples, n_chains, tune, tuning_opts, seed, log_prior,
-    progress, where, theta_opts,
+    progress, where, theta_opts, resume=None,
 ):  # fmt: skip
     std = emulator.standardizer
     theta_opts = dict(theta_opts)
@@ -597,9 +747,13 @@ def _run_fast(
                                        ("constraint", con is not None)) if on]  # fmt: skip
     n_jobs, executor = in_this_process(callables, where["n_jobs"], where["executor"], n_chains)
     where = {"n_jobs": n_jobs, "executor": executor}
+    fixed_info = _fast_fixed_info(emulator, held_theta, held_lamos, sampler.q)
+    resumed = {} if resume is None else _fast_resume(emulator, sampler, resume, n_chains,
+                                                     fixed_info.get("fixed"))  # fmt: skip
     tasks = [
-        {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune, **tuning_opts}
-        for s in np.random.SeedSequence(seed).spawn(n_chains)
+        {"sampler": sampler, "n_samples": n_samples, "seed": s, "tune": tune, **tuning_opts,
+         **{k: v[c] for k, v in resumed.items()}}
+        for c, s in enumerate(np.random.SeedSequence(seed).spawn(n_chains))
     ]  # fmt: skip
     runs = run_chains(
         _fast_chain, tasks, progress=progress, desc="calibrate chain",
@@ -631,19 +785,48 @@ def _run_fast(
     moves = level_moves.chains_record([r.level_offsets for r in runs], runs[0].level_shifted)
     if moves:  # a categorical theta's joint level move, per chain (native units)
         info["level_offsets"] = _level_record(emulator, moves)
-    if held_theta is not None or held_lamos is not None:
-        values = {} if held_theta is None else {"theta": held_theta}
-        if held_lamos is not None:
-            values["lamOs"] = [held_lamos]
-        if len(values.get("theta", ())) == sampler.q:
-            values["theta"] = [held_theta[k] for k in range(sampler.q)]
-        elif "theta" in values:
-            values["theta"] = {(k,): v for k, v in held_theta.items()}
-        names = list(emulator.t_names)
-        info["fixed"] = per_element.record(values)
-        info["held_names"] = [names[k] for k in held_theta or ()] + (
-            ["lamOs"] if held_lamos is not None else [])  # fmt: skip
+    info.update(fixed_info)
+    if resume is not None and resume["proportional"] is not None:
+        info["proportional_steps"] = resume["proportional"]
     return draws, info
+
+
+def _fast_fixed_info(emulator, held_theta, held_lamos, q: int) -> dict:
+    """The fast sampler's info "fixed" (``per_element.record`` of the held values, as the
+    backends' ``fixed_record``) and "held_names" (the posterior names held); {} with none."""
+    if held_theta is None and held_lamos is None:
+        return {}
+    values = {} if held_theta is None else {"theta": held_theta}
+    if held_lamos is not None:
+        values["lamOs"] = [held_lamos]
+    if len(values.get("theta", ())) == q:
+        values["theta"] = [held_theta[k] for k in range(q)]
+    elif "theta" in values:
+        values["theta"] = {(k,): v for k, v in held_theta.items()}
+    names = list(emulator.t_names)
+    return {"fixed": per_element.record(values),
+            "held_names": [names[k] for k in held_theta or ()]
+            + (["lamOs"] if held_lamos is not None else [])}  # fmt: skip
+
+
+def _fast_resume(emulator, sampler: CalibrationSampler, resume: dict, n_chains: int,
+                 fixed) -> dict[str, list]:  # fmt: skip
+    """A fast continuation's per-chain "start" (each chain's last draw), "widths" (recorded,
+    or None: GPM/SA's) and "proportional", for `_fast_chain`; GPMSAError where the source held
+    other values (``fixed``: this run's record) or a start has no posterior mass here."""
+    source = resume["source"]
+    cont.check_same(source, **{"fixed parameters": (source.info.get("fixed") or None,
+                                                    fixed or None)})  # fmt: skip
+    starts = cont.fast_starts(source, emulator, sampler.levels, resume.get("positions"))
+    for c, start in enumerate(starts):
+        if not np.isfinite(sampler.log_post_at(start)):
+            raise GPMSAError(f"{cont.SOURCE}: chain {c}'s last draw has no posterior mass in "
+                             "this calibration (another constraint or log_prior?); start "
+                             "afresh")  # fmt: skip
+    widths = [None] * n_chains
+    if resume["widths"]:
+        widths = cont.fast_widths(source, sampler.q, n_chains)
+    return {"start": starts, "widths": widths, "proportional": [resume["proportional"]] * n_chains}
 
 
 def _fast_held(emulator, held: dict) -> tuple[dict[int, float] | None, float | None]:
@@ -682,10 +865,10 @@ def _wrong_fast_run(run, n_samples: int, q: int) -> str | None:
 
 def _run_backend(
     emulator, data, x_obs, y_obs, backend, discrepancy, n_samples, n_chains, tune, tuning_opts,
-    seed, extrapolate, progress, where, theta_opts,
+    seed, extrapolate, progress, where, theta_opts, resume=None,
 ):  # fmt: skip
     """The generic backend's draws and info; ``discrepancy``: (basis, groups); ``theta_opts``
-    with ``calibration_problem``'s ``fixed``."""
+    with ``calibration_problem``'s ``fixed``; ``resume``: a continuation's (`_continued_run`)."""
     discrepancy, groups = discrepancy
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate,
@@ -698,12 +881,14 @@ def _run_backend(
         )
         where = {"n_jobs": n_jobs, "executor": executor}
     opts = {**tuning_opts, **backends.placement(backend, **where)}
+    masks = problem.held_masks(CALIBRATION_FIXED)
+    if resume is not None:
+        opts.update(_backend_resume(emulator, problem, masks, resume))
     chains = module.sample(
         problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed, progress=progress,
         **opts,
     )  # fmt: skip
     std = emulator.standardizer
-    masks = problem.held_masks(CALIBRATION_FIXED)
     if masks:  # float64 whatever the backend sampled in, a held parameter exactly its value
         chains_draws = {k: np.array(v, dtype=float) for k, v in chains.draws.items()}
         for k, mask in masks.items():
@@ -730,6 +915,8 @@ def _run_backend(
                     swap_rate=np.asarray(chains.info["swap_rate"]).tolist())  # fmt: skip
     if "adapted_temperatures" in chains.info:  # adapt_ladder=True: each chain's, frozen
         info["adapted_temperatures"] = np.asarray(chains.info["adapted_temperatures"]).tolist()
+    if resume is not None and chains.info.get("proportional_steps") is not None:
+        info["proportional_steps"] = bool(chains.info["proportional_steps"])
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis
         info.update({"discrepancy": discrepancy_kind(discrepancy),
                      **discrepancy_record(problem.obs)})  # fmt: skip
@@ -740,6 +927,25 @@ def _run_backend(
         info["held_names"] += ["lamOs"] if "lamOs" in masks else []
         info["held_names"] += held_discrepancy_names(problem, masks)
     return draws, info
+
+
+def _backend_resume(emulator, problem: Problem, masks: dict, resume: dict) -> dict:
+    """A backend continuation's sampler options: "init" (each chain's last draw), its recorded
+    "step_widths" and "proportional_steps" where it runs on them; GPMSAError where the source
+    held other values or had another discrepancy basis or groups (naming them)."""
+    source = resume["source"]
+    disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
+    cont.check_same(source, **{
+        "fixed parameters": (source.info.get("fixed") or None,
+                             (fixed_record(problem, masks) if masks else None) or None),
+        "discrepancy basis or groups": ({k: source.info.get(k) for k in disc}, disc),
+    })  # fmt: skip
+    out = {"init": cont.backend_starts(source, problem, emulator)}
+    if resume["widths"] is not None:
+        out["step_widths"] = resume["widths"]
+    if resume["proportional"] is not None:
+        out["proportional_steps"] = resume["proportional"]
+    return out
 
 
 def held_discrepancy_names(problem: Problem, masks: dict[str, np.ndarray]) -> list[str]:

@@ -356,6 +356,25 @@ class CalibrationSampler:
             what = "fixed theta" if len(held_theta) == self.q else what
             constraint.check_start(np.array(self.init_theta), what)
 
+    def _initial(self) -> tuple[list[float], float, int]:
+        """GPM/SA's initial (theta, lamOs, set index) of a chain."""
+        return self.init_theta, self.init_lamos, 0
+
+    def _held(self, start: tuple) -> tuple[list[float], float, int]:
+        """A given start (theta, lamOs, set index) with the held elements at their values."""
+        theta, lam, k = start
+        theta = [float(v) for v in theta]
+        for i in set(range(self.q)) - set(self.free):
+            theta[i] = self.init_theta[i]
+        return theta, self.init_lamos if self.held_lamos else float(lam), int(k)
+
+    def log_post_at(self, start: tuple[list[float], float, int]) -> float:
+        """The log posterior (up to a constant) at a chain's start (theta, lamOs, set index),
+        as ``run(start=)`` takes it: -inf where the priors or the constraint give it no mass."""
+        theta, lam, k = self._held(start)
+        lp = self._log_prior_theta(theta) + self._log_prior_lamos(lam)
+        return lp if lp == -math.inf else lp + _loglik(self.preds[k].at(theta), lam)
+
     def _log_prior_theta(self, theta: list[float]) -> float:
         """Truncated-normal prior of unit-scale theta, element k under its own (mean, sd) (a
         categorical element: uniform over its levels), plus the extra prior; pure Python."""
@@ -393,14 +412,22 @@ class CalibrationSampler:
         tune_levels: int = tuning.N_LEVELS,
         widths: np.ndarray | None = None,
         progress: bool = False,
+        start: tuple[list[float], float, int] | None = None,
+        proportional: bool | None = None,
     ) -> ChainResult:
-        """Tune (optionally, GPM/SA's stepsize), then ``n_iter`` sweeps from GPM/SA's initials."""
+        """Tune (optionally, GPM/SA's stepsize), then ``n_iter`` sweeps from GPM/SA's initials.
+
+        ``widths``: (q + 1,) the step widths to start from (None: GPM/SA's). ``start``: the
+        chain's (unit theta (q,), lamOs, emulator-set index) instead of the initials (a
+        continuation, ``calibrate(init=)``; held elements are set to their values).
+        ``proportional``: lamOs steps by GPM/SA's proportional step (None: ``not tune``)."""
         from tqdm import tqdm
 
         q = self.q
         names = ["theta"] * q + ["lamOs"]
         w = np.array([THETA_WIDTH] * q + [self.init_lamos / 2.0]) if widths is None else widths
-        state = _State(self, self.init_theta, self.init_lamos, 0)
+        state = _State(self, *(self._initial() if start is None else self._held(start)))
+        prop_mh = not tune if proportional is None else proportional
         n_tune = tune_rounds * tune_levels if tune else 0
         with tqdm(total=n_iter + n_tune, desc="calibrate", disable=not progress) as bar:
             if tune:
@@ -423,7 +450,7 @@ class CalibrationSampler:
             for start in range(0, n_iter, block):
                 u = rng.random((min(block, n_iter - start), 2 * (q + 2))).tolist()
                 for row in u:
-                    state.sweep(widths_l, not tune, accepted, row)
+                    state.sweep(widths_l, prop_mh, accepted, row)
                     out.append((*state.theta, state.lam, state.k, state.log_post()))
                 bar.update(len(u))
         arr = np.array(out)
