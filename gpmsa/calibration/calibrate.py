@@ -338,9 +338,10 @@ def calibrate(
     engine, and ``theta_init``. ``info["continued_from"]`` records the source's chains'
     digest. ``append=True``: the chains pooled, diagnostics, convergence, the at-bound check
     and ``emulator_draws`` over them; info "appended_to", "appended_after" (the source's draws
-    per chain), "pooled_sweeps", "sweeps_run" and "accept_rate" weighted by the parts' sweeps;
-    refused with n_burn > 0 or tuning (untempered). A Posterior kept by pickle continues; one
-    rebuilt from ``to_arviz()`` has no widths or settings, and is refused.
+    per chain), "pooled_sweeps", "sweeps_run" and "accept_rate" weighted by the parts' sweeps
+    (a NUTS part beside a Metropolis one: the continuation's own); refused with n_burn > 0 or
+    tuning (untempered). A Posterior kept by pickle continues; one rebuilt from ``to_arviz()``
+    has no widths or settings, and is refused.
 
     ``info["diagnostics"]`` holds each parameter's rank-normalised R-hat and bulk ESS (and
     mean, sd), ``info["convergence"]`` the verdict, and a ``gpmsa.ConvergenceWarning`` names
@@ -444,8 +445,10 @@ def calibrate(
     pooled = 0 if not append else np.atleast_2d(next(iter(source.chains.values()))).shape[1]
     _check_calibrate_memory(emulator, n_samples + pooled, n_chains, fast,
                             1 if temps is None else len(temps))  # fmt: skip
-    _theta_options(emulator, constraint, theta_init)  # refuse bad ones before any work
+    con, _ = _theta_options(emulator, constraint, theta_init)  # refuse bad ones before work
     theta_opts = {"constraint": constraint, "theta_init": theta_init}
+    if source is not None:  # the chains start at their last draws, not at GPM/SA's initial
+        theta_opts["theta_init"] = cont.theta_start(source, emulator, con)
     held = calibration_fixed(emulator, fixed, discrepancy)
     if held is not None and fast:
         theta_opts["held"] = _fast_held(emulator, held)  # checked before any work
@@ -498,7 +501,7 @@ def calibrate(
     if source is not None:  # as gpmsa.fit's settings record a continuation
         info["continued_from"] = cont.chains_sha256(source)
         if append:
-            info.update(cont.appended_info(source, n_samples, info["accept_rate"]))
+            info.update(cont.appended_info(source, n_samples, info["accept_rate"], backend))
     if emulator_params == "draws":  # the retained draw each sample was drawn with
         positions = draw_positions(emulator, n_emulator_draws)
         info["emulator_draws"] = positions[set_index[:, n_burn:].reshape(-1)]
@@ -821,7 +824,7 @@ def _fast_resume(emulator, sampler: CalibrationSampler, resume: dict, n_chains: 
     for c, start in enumerate(starts):
         if not np.isfinite(sampler.log_post_at(start)):
             raise GPMSAError(f"{cont.SOURCE}: chain {c}'s last draw has no posterior mass in "
-                             "this calibration (another constraint or log_prior?); start "
+                             "this calibration (another log_prior?); start "
                              "afresh")  # fmt: skip
     widths = [None] * n_chains
     if resume["widths"]:
@@ -915,6 +918,8 @@ def _run_backend(
                     swap_rate=np.asarray(chains.info["swap_rate"]).tolist())  # fmt: skip
     if "adapted_temperatures" in chains.info:  # adapt_ladder=True: each chain's, frozen
         info["adapted_temperatures"] = np.asarray(chains.info["adapted_temperatures"]).tolist()
+    if resume is not None:  # each chain at its own adapted ladder: recorded as they adapted
+        info = tempering.recorded_ladders(info, resume["source"].info)
     if resume is not None and chains.info.get("proportional_steps") is not None:
         info["proportional_steps"] = bool(chains.info["proportional_steps"])
     if discrepancy is not None:  # full_prediction(posterior=) refuses another basis

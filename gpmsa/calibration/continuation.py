@@ -74,8 +74,7 @@ def check_same(source: Posterior, **same) -> None:
             for n in differs
         )
         raise GPMSAError(
-            f"{SOURCE} was another calibration: its {', '.join(differs)} "
-            f"{'differ' if len(differs) > 1 else 'differs'} ({detail}); "
+            f"{SOURCE} was another calibration: other {', '.join(differs)} ({detail}); "
             "continue it with the same emulator, observations and settings, or start afresh"
         )
 
@@ -142,6 +141,20 @@ def theta_unit(source: Posterior, emulator) -> np.ndarray:
     its level (the draws hold the native codes)."""
     native = np.column_stack([_last(source, str(n)) for n in emulator.t_names])
     return emulator.standardizer.t_to_unit(native)
+
+
+def theta_start(source: Posterior, emulator, constraint) -> list[float]:
+    """Chain 0's last theta (native, (q,)): the run's ``theta_init``, so that the checks of a
+    fresh chain's start (the constraint at GPM/SA's initial, held elements beside it) see where
+    the chains start. GPMSAError naming each chain whose last draw ``constraint`` (a
+    ``ThetaConstraint``, or None) refuses."""
+    unit = theta_unit(source, emulator)
+    for c, t in enumerate(unit if constraint is not None else ()):
+        if not constraint(t):
+            raise GPMSAError(f"{SOURCE}: chain {c}'s last draw "
+                             f"({constraint.describe(constraint.native(t))}) lies outside this "
+                             "theta constraint (another constraint?): start afresh")  # fmt: skip
+    return [float(_last(source, str(n))[0]) for n in emulator.t_names]
 
 
 def fast_starts(source: Posterior, emulator, levels, positions) -> list[tuple]:
@@ -216,8 +229,7 @@ def continued_ladder(source: Posterior, options: dict, n_chains: int):
     if info.get("temperatures") is None:
         return None
     try:
-        temps = np.asarray(info["temperatures"], dtype=float)
-        first = tempering.ladder((temps if temps.ndim == 1 else temps[0]).tolist())
+        first = tempering.ladder(info["temperatures"])  # the ladder the chains started from
         ladders = first
         if info.get("adapted_temperatures") is not None:
             ladders = np.asarray(info["adapted_temperatures"], dtype=float)
@@ -266,12 +278,13 @@ def _sweeps(info: dict) -> tuple[int, int]:
     return int(info["n_samples"]) - int(info["n_burn"]), int(info["n_samples"])
 
 
-def appended_info(source: Posterior, n_samples: int, accept_rate):
+def appended_info(source: Posterior, n_samples: int, accept_rate, backend: str):
     """The info an appended calibration adds: appended_to (``chains_sha256`` of the source),
     appended_after (its draws per chain), pooled_sweeps and sweeps_run (per chain, tuning
     aside), and accept_rate: both parts' rates weighted by their sweeps (as ``accept_rate``,
     a list per chain or a dict name -> per chain; the continuation's own where they do not
-    match)."""
+    match, or where one part ran Metropolis (``MH_BACKENDS``) and the continuation on
+    ``backend`` NUTS or the reverse: pyro's rate is another figure)."""
     kept, run = _sweeps(source.info)
     out = {
         "appended_to": chains_sha256(source),
@@ -280,6 +293,9 @@ def appended_info(source: Posterior, n_samples: int, accept_rate):
         "sweeps_run": run + int(n_samples),
     }
     old = source.info.get("accept_rate")
+    mixed = (source.info.get("backend") in MH_BACKENDS) != (backend in MH_BACKENDS)
+    if mixed or isinstance(old, dict) != isinstance(accept_rate, dict):
+        return {**out, "accept_rate": accept_rate}  # not comparable: the continuation's own
 
     def weighted(a, b):
         a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
@@ -287,8 +303,8 @@ def appended_info(source: Posterior, n_samples: int, accept_rate):
             return np.asarray(b).tolist()
         return ((a * run + b * n_samples) / (run + n_samples)).tolist()
 
-    if isinstance(accept_rate, dict) and isinstance(old, dict):
+    if isinstance(accept_rate, dict):
         out["accept_rate"] = {k: weighted(old.get(k, v), v) for k, v in accept_rate.items()}
-    elif not isinstance(accept_rate, dict) and not isinstance(old, dict):
+    else:
         out["accept_rate"] = weighted(old, accept_rate)
     return out

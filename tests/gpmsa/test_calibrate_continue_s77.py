@@ -90,8 +90,8 @@ def test_two_chains_and_emulator_draws_append():
 def test_what_differs_is_refused_by_name(road):
     emu, x, y, src = road
     cases = [
-        ({"y_obs": [[y[0][0] + 1.0]]}, "its observations differs"),
-        ({"emulator": emu.with_calibration_priors(theta_sd=0.5)}, "its emulator differs"),
+        ({"y_obs": [[y[0][0] + 1.0]]}, "other observations \\(observations: "),
+        ({"emulator": emu.with_calibration_priors(theta_sd=0.5)}, "other emulator \\(emulator: "),
         ({"constraint": lambda t: True}, "theta constraint: False there, True here"),
         ({"fixed": {"lamOs": 100.0}}, "fixed parameters: None there"),
         ({"theta_init": [1.0]}, "leave theta_init out"),
