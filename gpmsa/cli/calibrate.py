@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import argparse
 import csv
+import itertools
 import json
+import re
 import sys
 import time
 import warnings
@@ -23,6 +25,20 @@ from gpmsa.io.container import jsonable
 Y_CSV_MAX_BYTES = 64 * 1024**2
 """Most bytes of a ``--y-csv`` file read (one observation's values take far fewer); a longer
 file, or a device or pipe that never ends, is refused at this size."""
+Y_CSV_FIELDS_PER_OUTPUT = 4
+"""Most fields a ``--y-csv`` file's rows hold together, per output of the emulator file: twice
+a header row and one row of values (n fields each); the line that takes the file past them
+is refused without reading on (a file of a few more values than the outputs is named as such)."""
+_LINE_BREAKS = "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
+"""The characters that end a line, as ``str.splitlines`` reads them (CR LF one break)."""
+_SKIPPED = re.compile(rf"(?:\s++|#[^{_LINE_BREAKS}]*+)*+")
+"""Blank lines and lines starting with "#" (the next line's leading blanks too), from a line's
+start (re's whitespace is ``str.isspace``'s, every line break among it)."""
+_LINE = re.compile(rf"[^{_LINE_BREAKS}]*")
+_WORD = re.compile(r"\S+")
+_FIELD = {sep: re.compile(rf' *(?:"(?:[^"]|"")*"?)?[^{sep}]*') for sep in ",;"}
+"""One CSV field as ``csv.reader(delimiter=sep, skipinitialspace=True)`` reads it: blanks, a
+quoted part (doubled quotes inside; to the line's end if never closed), then up to ``sep``."""
 
 
 def add_parser(sub) -> None:
@@ -131,12 +147,13 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     order of ``names``, or under a first row that names the columns (exactly ``names``, any
     order: read by name; a row of no numbers, or of those names above another row).
     GPMSAError naming the file, and the row and column, for a file that cannot be read or
-    holds more than ``Y_CSV_MAX_BYTES``, a field that is not a finite number, rows of unequal
-    length (the header row too), or another count of values."""
+    holds more than ``Y_CSV_MAX_BYTES``, rows of more than ``Y_CSV_FIELDS_PER_OUTPUT`` fields
+    per name together (refused at the line that passes them, `_rows`), a field that is not a
+    finite number, rows of unequal length (the header row too), or another count of values."""
     where = f"--y-csv {safe(path, 200)}"
     try:
         with open(path, "rb") as fh:  # a pipe or device may never end: read a bounded part
-            raw = fh.read(Y_CSV_MAX_BYTES + 1)
+            raw = _bounded_read(fh, Y_CSV_MAX_BYTES + 1)
     except OSError as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
     if len(raw) > Y_CSV_MAX_BYTES:  # (before decoding: the limit may cut a character)
@@ -145,12 +162,11 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
             "values take (gpmsa.cli.calibrate.Y_CSV_MAX_BYTES)"
         )
     try:
-        lines = raw.decode("utf-8-sig").splitlines()
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
     try:
-        rows = [(k, _fields(line)) for k, line in enumerate(lines, 1)
-                if line.strip() and not line.lstrip().startswith("#")]  # fmt: skip
+        rows = _rows(text, where, names)
     except csv.Error as exc:  # a field beyond csv's size limit
         raise GPMSAError(f"{where}: cannot read it as CSV ({safe(exc, 200)})") from None
     if not rows:
@@ -189,6 +205,72 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
             "for several, gpmsa.calibrate in Python)"
         )
     return np.array(values)
+
+
+def _bounded_read(fh, most: int, chunk: int = 1024**2) -> bytes:
+    """At most ``most`` bytes of the binary file ``fh``, read a ``chunk`` at a time (a single
+    ``read(most)`` sets aside ``most`` bytes, however short the file)."""
+    parts, size = [], 0
+    while size < most and (part := fh.read(min(chunk, most - size))):
+        parts.append(part)
+        size += len(part)
+    return b"".join(parts)
+
+
+def _rows(text: str, where: str, names: tuple[str, ...]) -> list[tuple[int, list[str]]]:
+    """The lines of ``text`` that hold values, as (line number, fields) (`_fields`; blank lines
+    and lines starting with "#" skipped); GPMSAError naming the line that takes the fields past
+    ``Y_CSV_FIELDS_PER_OUTPUT`` per name, before its fields or any later line are read."""
+    bound = Y_CSV_FIELDS_PER_OUTPUT * len(names)
+    rows, seen = [], 0
+    for k, line in _lines(text):
+        if seen + _field_count(line, bound - seen) > bound:
+            raise GPMSAError(
+                f"{where}: line {k} takes the file past {bound} fields "
+                f"({Y_CSV_FIELDS_PER_OUTPUT} per output: twice a header row and one row of "
+                f"values); the file's outputs are {len(names)} ({_names_text(names)}): give "
+                f"the one observation's {len(names)} values in one row or one column (this "
+                "command calibrates on one observation; for several, gpmsa.calibrate in Python)"
+            )
+        rows.append((k, _fields(line)))
+        seen += len(rows[-1][1])
+    return rows
+
+
+def _lines(text: str):
+    """(line number, line) of each line of ``text`` that holds values (not blank, not starting
+    with "#"), numbered as ``str.splitlines`` splits them; the lines between are passed over
+    in one step (a file of millions of them takes no step per line)."""
+    pos, k = 0, 1
+    while pos < len(text):
+        run = _SKIPPED.match(text, pos).end()
+        if run == len(text):
+            return
+        start = max(pos - 1, *(text.rfind(c, pos, run) for c in _LINE_BREAKS)) + 1
+        k += _breaks(text, pos, start)
+        end = _LINE.match(text, start).end()
+        yield k, text[start:end]
+        pos, k = end + (2 if text.startswith("\r\n", end) else 1), k + 1
+
+
+def _breaks(text: str, start: int, end: int) -> int:
+    """The line breaks in ``text[start:end]``, CR LF one."""
+    count = sum(text.count(c, start, end) for c in _LINE_BREAKS)
+    return count - text.count("\r\n", start, end)
+
+
+def _field_count(line: str, most: int) -> int:
+    """The number of fields `_fields` splits ``line`` into, counted up to ``most`` + 1 (a
+    longer line is not split: its count is all that is read)."""
+    sep = next((s for s in ",;" if s in line), None)
+    if sep is None:  # blanks: ``str.split``'s words (re's \S is str.isspace's complement)
+        return sum(1 for _ in itertools.islice(_WORD.finditer(line), most + 1))
+    pattern, pos, count = _FIELD[sep], 0, 0
+    while True:
+        pos = pattern.match(line, pos).end() + 1  # the field and its separator
+        count += 1
+        if pos > len(line) or count > most:
+            return count
 
 
 def _fields(line: str) -> list[str]:

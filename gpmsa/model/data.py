@@ -590,17 +590,36 @@ def _index_labels(value, d: int, l_sim: int, what: str) -> tuple[str, ...] | Non
 
 def _named_index(index, names):
     """An output ``index`` given as a pandas table or Series, and ``index_names``: a table
-    with named columns (not a frame's default labels 0, 1, ...) names the index columns
-    where ``names`` is None, else is read by ``names`` (its columns in that order); a named
-    Series names its one column. Returns (index, names); anything else as it is."""
-    if names is None and is_series(index):
-        return index, None if index.name is None else (str(index.name),)
-    labels = column_labels(index)
+    whose column labels are names (`_label_names`) names the index columns where ``names`` is
+    None, else is read by ``names`` (its columns in that order); so does a Series' name (a
+    Series of another name than the one in ``names``: GPMSAError). Labels that are no names
+    (a frame's default 0, 1, ..., blank or repeated ones) name nothing: the index is read by
+    position, as an array. Returns (index, names); anything else as it is."""
+    series = is_series(index)
+    if series:
+        labels = None if index.name is None else (str(index.name),)
+    else:
+        labels = column_labels(index)
     if names is None:
-        return index, None if labels is None or default_labels(labels) else labels
-    if is_series(index) or not (labels is None or default_labels(labels)):
-        index = by_column_names(index, (names,) if isinstance(names, str) else names, "index")
+        return index, labels if _label_names(labels) else None
+    given = (names,) if isinstance(names, str) else names
+    if series:
+        if _label_names(labels) and len(given) == 1 and labels != tuple(given):
+            raise GPMSAError(f"index is a pandas Series named {labels[0]!r:.80}, but index_names "
+                             f"gives {given!r:.80}: leave index_names out to take the Series' "
+                             "name, or give that name")  # fmt: skip
+        return index, names
+    if not (labels is None or default_labels(labels)):
+        index = by_column_names(index, given, "index")
     return index, names
+
+
+def _label_names(labels: tuple[str, ...] | None) -> bool:
+    """Whether a table's or Series' ``labels`` name an index's columns: not a frame's default
+    labels '0', '1', ..., none blank, none twice."""
+    if labels is None or default_labels(labels):
+        return False
+    return all(s.strip() for s in labels) and len(set(labels)) == len(labels)
 
 
 def _index(index, n: int, name: str) -> np.ndarray | None:
@@ -898,8 +917,10 @@ class SimData:
     index (``index`` (l_sim,), or None: 0..l_sim-1); names non-empty and unique. None (the
     default): "output index" ("output index[:, k]" per column of (l_sim, d)), no unit. An
     index given as a pandas table with named columns, or a named Series, names its columns
-    where ``index_names`` is None (else its columns are read by those names). Not for a
-    scalar output. Labels only: the fit, its draws and ``model_sha256`` are the same without.
+    where ``index_names`` is None (else its columns are read by those names; a Series of
+    another name is refused); labels that are no names (a frame's default 0, 1, ..., blank
+    or repeated ones) name nothing. Not for a scalar output. Labels only: the fit, its draws
+    and ``model_sha256`` are the same without.
     """
 
     x: np.ndarray | None = None
