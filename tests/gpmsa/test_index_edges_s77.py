@@ -7,7 +7,6 @@ in a file too."""
 from __future__ import annotations
 
 import json
-import time
 import warnings
 
 import numpy as np
@@ -85,7 +84,6 @@ def test_the_weights_are_sparse_and_the_points_triangulated_once():
 def test_an_index_whose_triangulation_could_be_huge_is_refused(tmp_path):
     rng = np.random.default_rng(0)
     many = rng.uniform(size=(80, 10))  # Delaunay: 1.2 million simplices, 50 s, 1 GB
-    start = time.perf_counter()
     with pytest.raises(gpmsa.GPMSAError, match=r"80 points in 10 columns"):
         gpmsa.SimData(rng.uniform(size=(5, 1)), rng.uniform(size=(5, 1)),
                       rng.uniform(size=(5, 80)), index=many)  # fmt: skip
@@ -101,8 +99,7 @@ def test_an_index_whose_triangulation_could_be_huge_is_refused(tmp_path):
     hostile = rng.uniform(size=(40, 10))  # 1.7 s and 0.2 GB; 80 such points: 50 s, 1 GB
     write_raw(path, manifest, dict(arrays, grid=hostile, index=hostile))
     with pytest.raises(gpmsa.EmulatorFileError, match=r"arrays/grid of 40 points in 10 columns"):
-        gpmsa.load(path)
-    assert time.perf_counter() - start < 5.0
+        gpmsa.load(path)  # (refused before triangulating: the message is the limit's)
 
 
 def test_info_json_names_the_output_index_points(tmp_path, capsys):
