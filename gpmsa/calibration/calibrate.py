@@ -116,6 +116,7 @@ def calibration_problem(
             given, emulator.standardizer, emulator.K, discrepancy, emulator.x_names,
             getattr(emulator, "levels", None), getattr(emulator, "y_names", None),
             discrepancy_groups, x_checked=True,  # check_x checked and warned
+            index_names=getattr(emulator, "index_names", None),
         )  # fmt: skip
     pri = emulator.priors
     lo = pri.lamOs

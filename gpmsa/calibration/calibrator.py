@@ -139,7 +139,29 @@ def _check_mcmc_options(options, backend: str) -> dict:
             f"mcmc_options: unknown keyword(s) {unknown}; gpmsa.calibrate takes {allowed} "
             f"(with the {backend!r} backend)"
         )
+    _refuse_continuation(options)
     return dict(options)
+
+
+def _refuse_continuation(options: dict) -> None:
+    """GPMSAError where ``options`` continue an offline calibration (``init`` other than a
+    start rule, ``append`` other than False): each update runs fresh chains on its own
+    observations, so there is no calibration to continue."""
+    fresh = ("a Calibrator's update runs fresh chains on each update's observations, so there "
+             "are no chains to continue")  # fmt: skip
+    init = options.get("init")
+    if init is not None and not isinstance(init, str | dict):
+        raise GPMSAError(
+            f"mcmc_options['init'] takes a start rule (a name such as 'gpmsa', or a dict), got "
+            f"{type(init).__name__}: {fresh} (a Posterior's chains continue in "
+            "gpmsa.calibrate(..., init=posterior))"
+        )
+    if options.get("append", False) is not False:
+        raise GPMSAError(
+            f"mcmc_options['append']={options['append']!r}: {fresh} (append=True pools a "
+            "continuation's draws with its source's in gpmsa.calibrate(..., init=posterior, "
+            "append=True)): leave it out"
+        )
 
 
 def _mcmc_backend(backend, options) -> str:
@@ -184,7 +206,8 @@ class Calibrator:
             (``"fixed"``, which holds parameters at known values, only there: with the grid
             method it is a GPMSAError), the backend's sampler options among them, as
             ``calibrate`` takes them (``{"dtype": "float32"}`` for torch, ``{"n_warmup": 200}``
-            for pyro).
+            for pyro). A continuation's ``"init"`` (a Posterior) and ``"append": True`` are a
+            GPMSAError: each update runs fresh chains.
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
             ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
             "auto" choose MCMC. None (the default): ``mcmc_options["backend"]`` where it names

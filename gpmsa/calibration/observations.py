@@ -386,6 +386,7 @@ def _reduce_obs_data(emulator, obs: ObsData, extrapolate: bool) -> Observations:
     reduced, corr = reduce_obs(
         obs, emulator.standardizer, emulator.K, None, emulator.x_names,
         getattr(emulator, "levels", None), _y_names(emulator), x_checked=True,
+        index_names=getattr(emulator, "index_names", None),
     )  # fmt: skip
     digests = (obs.values_digest(emulator.x_names, _y_names(emulator)),
                layout_digest(obs.grids, obs.output_precisions(_y_names(emulator)),

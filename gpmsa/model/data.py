@@ -514,6 +514,18 @@ def _columns_text(arr: np.ndarray, names) -> str:
     return ", ".join(parts) + (f", ... ({more} more)" if more > 0 else "")
 
 
+def _index_text(index: np.ndarray | None, names: tuple[str, ...] | None, l_sim: int) -> str:
+    """The output index for ``SimData``'s repr: " on index [0, 1]", " on index points [0, 1] x
+    [0, 2]", each column's range led by its name where ``names`` gives them (the default index
+    0..l_sim-1 too); "" without an index or names."""
+    if index is None and names is None:
+        return ""
+    cols = (np.arange(l_sim, dtype=np.float64) if index is None else index).reshape(l_sim, -1).T
+    labels = [""] * len(cols) if names is None else [f"{_repr_name(n)} " for n in names]
+    kind = "index points" if len(cols) > 1 else "index"
+    return f" on {kind} " + " x ".join(f"{a}{_span(c)}" for a, c in zip(labels, cols, strict=True))
+
+
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
     if names is None:
         return tuple(f"{prefix}{i}" for i in range(n))
@@ -1034,11 +1046,9 @@ class SimData:
         object.__setattr__(self, "separable", groups)
 
     def __repr__(self) -> str:
-        """Concise: the runs, each input's name and range, the output's length and range."""
-        grid = "" if self.index is None else f" on index {_span(self.index)}"
-        if index_points.is_points(self.index):
-            spans = " x ".join(_span(c) for c in self.index.T)
-            grid = f" on index points {spans}"
+        """Concise: the runs, each input's name and range, the output's length and range, and
+        its index's columns' ranges (named where ``index_names`` names them)."""
+        grid = _index_text(self.index, self.index_names, self.l_sim)
         return (f"SimData({self.m} runs; x: {_columns_text(self.x, self.x_names)}; "
                 f"t: {_columns_text(self.t, self.t_names)}; y: {_count(self.l_sim, 'output')} "
                 f"{_span(self.y)}{grid})")  # fmt: skip
@@ -1324,10 +1334,12 @@ class ObsData:
         lengths = sorted({e.size for e in self.experiments})
         each = f"{lengths[0]}" if len(lengths) == 1 else f"{lengths[0]} to {lengths[-1]}"
         values = np.concatenate([np.ravel(e) for e in self.experiments])
-        given = [k for k in ("index", "precision") if getattr(self, k) is not None]
+        d = max((g.shape[1] for g in self.grids if index_points.is_points(g)), default=1)
+        given = [f"{k} given" + (f" ({d} columns)" if k == "index" and d > 1 else "")
+                 for k in ("index", "precision") if getattr(self, k) is not None]  # fmt: skip
         return (f"ObsData({_count(self.n, 'experiment')}; x: {_columns_text(self.x, names)}; "
                 f"y: {each} value(s) each {_span(values)}"
-                f"{''.join(f'; {k} given' for k in given)})")  # fmt: skip
+                f"{''.join(f'; {k}' for k in given)})")  # fmt: skip
 
     @property
     def n(self) -> int:

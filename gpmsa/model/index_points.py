@@ -38,8 +38,18 @@ def n_points(grid: np.ndarray) -> int:
     return int(np.shape(grid)[0])
 
 
-def _point_text(row: np.ndarray) -> str:
-    return "(" + ", ".join(numbers_text(*row)) + ")"
+def _point_text(row: np.ndarray, names: tuple[str, ...] | None = None) -> str:
+    """``row`` as "(0.3, 1.2)", or with the index columns' ``names`` "(time 0.3, angle 1.2)"."""
+    values = numbers_text(*row)
+    if names is not None and len(names) == len(values):
+        values = [f"{n} {v}" for n, v in zip(names, values, strict=True)]
+    return "(" + ", ".join(values) + ")"
+
+
+def named(what: str, names: tuple[str, ...] | None) -> str:
+    """``what`` (a one-column index, e.g. "grid") followed by its column's name where given:
+    "grid (time)"."""
+    return what if names is None or len(names) != 1 else f"{what} ({names[0]})"
 
 
 def check_points(points: np.ndarray, name: str) -> None:
@@ -106,13 +116,16 @@ def check_columns(points: np.ndarray, new: np.ndarray, what: str) -> None:
         )
 
 
-def weights(points: np.ndarray, new: np.ndarray, what: str) -> sparse.csr_array:
+def weights(
+    points: np.ndarray, new: np.ndarray, what: str, names: tuple[str, ...] | None = None
+) -> sparse.csr_array:
     """W (l_new, l_sim), sparse: values on the simulation ``points`` (l_sim, d) times W are
     their piecewise-linear interpolant (barycentric on the Delaunay triangulation) at ``new``
     (l_new, d), at most d + 1 entries a row; a row is one-hot where its point is a simulation
     point (exact there). A point outside the points' convex hull by rounding (`HULL_TOL`) is
-    taken onto it; one beyond: GPMSAError naming ``what`` and the point. A row depends on its
-    point alone (not on the other points of ``new``)."""
+    taken onto it; one beyond: GPMSAError naming ``what`` and the point (by the index columns'
+    ``names`` where given). A row depends on its point alone (not on the other points of
+    ``new``)."""
     check_columns(points, new, what)
     new = _onto_box(points, new + 0.0)  # + 0.0: -0.0 is 0.0
     at = {row.tobytes(): i for i, row in enumerate(points + 0.0)}
@@ -125,8 +138,8 @@ def weights(points: np.ndarray, new: np.ndarray, what: str) -> sparse.csr_array:
         if np.any(s < 0):
             k = int(rest[np.flatnonzero(s < 0)[0]])
             raise GPMSAError(
-                f"{what} has the point {_point_text(new[k])} (row {k}) outside the convex hull "
-                "of the simulation index's points; observations must lie within it"
+                f"{what} has the point {_point_text(new[k], names)} (row {k}) outside the "
+                "convex hull of the simulation index's points; observations must lie within it"
             )
         b = _barycentric(tri, s, new[rest])
         rows.append(np.repeat(rest, b.shape[1]))

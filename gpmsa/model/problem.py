@@ -417,6 +417,7 @@ def reduce_obs(
     y_names=None,
     groups=None,
     x_checked: bool = False,
+    index_names: tuple[str, ...] | None = None,
 ) -> tuple[ObsProblem, tuple[float, float]]:
     """GPM/SA's reduction of the observations; also returns the lamOs prior correction (da, db).
 
@@ -429,7 +430,8 @@ def reduce_obs(
     ``y_names``: the simulation outputs' names, by which a y table with named columns and no
     index is read (`ObsData.outputs`). ``x_checked``: the caller has checked x_obs against the
     domain and warned (calibration's ``check_x``, whose ``extrapolate=True`` allows any
-    distance): no ``check_x_obs`` here.
+    distance): no ``check_x_obs`` here. ``index_names``: the output index's column names
+    (``SimData.index_names``), by which a point outside the simulation index is named.
     """
     x_native = obs.inputs(x_names)
     if x_native.ndim != 2 or x_native.shape[1] != std.x_min.size:  # before x_to_unit broadcasts
@@ -451,7 +453,7 @@ def reduce_obs(
     points = not scalar and (is_points(std.grid) or any(is_points(g) for g in obs.grids))
     for j, g in enumerate(obs.grids):  # refused naming the experiment and the point
         if points and g is not None:
-            index_points.weights(std.grid, g, f"the index of experiment {j}")
+            index_points.weights(std.grid, g, f"the index of experiment {j}", index_names)
     with np.errstate(over="ignore"):  # an overflow gives inf: refused just below
         ys = [std.y_to_std(e, g) for e, g in zip(experiments, obs.grids, strict=True)]
     for j, e in enumerate(ys):
@@ -494,8 +496,9 @@ def reduce_obs(
         if not points and g is not None and not index_points.within(g, lo, hi):
             a, b, c, d = numbers_text(g.min(), g.max(), lo, hi)
             raise GPMSAError(
-                f"the index of experiment {j} reaches [{a}, {b}], outside the simulation grid "
-                f"[{c}, {d}]; observations must lie within it"
+                f"{index_points.named(f'the index of experiment {j}', index_names)} reaches "
+                f"[{a}, {b}], outside the simulation grid [{c}, {d}]; observations must lie "
+                "within it"
             )
         Kj = interpolate_basis(K, std.grid, g)
         Dj = None if bases is None else bases[j]
@@ -655,9 +658,8 @@ def prepare(
     obs_p, os_corr = (None, (0.0, 0.0))
     levels = sim.levels
     if obs is not None:
-        obs_p, os_corr = reduce_obs(
-            obs, std, K, discrepancy, sim.x_names, levels, sim.y_names, discrepancy_groups
-        )
+        obs_p, os_corr = reduce_obs(obs, std, K, discrepancy, sim.x_names, levels, sim.y_names,
+                                    discrepancy_groups, index_names=sim.index_names)  # fmt: skip
     elif discrepancy_groups is not None:
         check_groups(discrepancy_groups, 0)  # refused: no discrepancy without observations
     priors = base.with_data(wos, os_corr)

@@ -280,7 +280,8 @@ def _pred_grid(emulator, obs: ObsData, grid):
         check_finite(g, "grid")
         if g.shape[0] == 0:
             raise GPMSAError("grid must hold at least one point")
-        index_points.weights(std.grid, g, "grid")  # columns checked; refused outside the hull
+        # its columns checked; a point outside the hull refused
+        index_points.weights(std.grid, g, "grid", emulator.index_names)
         return g
     if grid is not None:
         g = as_float(grid, "grid")
@@ -292,7 +293,8 @@ def _pred_grid(emulator, obs: ObsData, grid):
         if g.size == 0 or not index_points.within(g, lo, hi):
             lo, hi = numbers_text(lo, hi, *((g.min(), g.max()) if g.size else ()))[:2]
             raise GPMSAError(
-                f"grid must be non-empty and lie within the simulation grid [{lo}, {hi}]"
+                f"{index_points.named('grid', emulator.index_names)} must be non-empty and lie "
+                f"within the simulation grid [{lo}, {hi}]"
             )
         return g
     grids = [std.grid if g is None else g for g in obs.grids]
@@ -662,7 +664,8 @@ def full_prediction(
         warnings.simplefilter("ignore")  # the calibration already warned about its x_obs
         check_x(emulator, obs.inputs(emulator.x_names), extrapolate, "obs")  # far: refused
         ob, _ = reduce_obs(obs, std, K, discrepancy, emulator.x_names, levels, emulator.y_names,
-                           discrepancy_groups, x_checked=True)  # fmt: skip
+                           discrepancy_groups, x_checked=True,
+                           index_names=emulator.index_names)  # fmt: skip
     p_v = ob.p_v
     if ("betaV" in sets[0]) != (p_v > 0):
         raise GPMSAError(
