@@ -80,10 +80,12 @@ def check_same(source: Posterior, **same) -> None:
 
 
 def _brief(value) -> str:
-    """``value`` for a message: a digest (64 hex characters) by its first 12, a list of them
-    so, anything else its repr cut to 100 characters."""
+    """``value`` for a message: a digest (64 hex characters) by its first 12, a list or dict
+    of them so, anything else its repr cut to 100 characters."""
     if isinstance(value, list | tuple):
         return "[" + ", ".join(_brief(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k}: {_brief(v)}" for k, v in value.items()) + "}"
     if isinstance(value, str) and len(value) == 64:
         return value[:12]
     text = repr(value)

@@ -112,7 +112,7 @@ def check_columns(points: np.ndarray, new: np.ndarray, what: str) -> None:
     if d != e or new.ndim > 2:
         raise GPMSAError(
             f"{what} has shape {new.shape} but the simulation index has {d} column(s) "
-            f"(shape {points.shape}): give the observations' points in the same columns"
+            f"(shape {points.shape}): give its points in the same columns"
         )
 
 
@@ -139,7 +139,8 @@ def weights(
             k = int(rest[np.flatnonzero(s < 0)[0]])
             raise GPMSAError(
                 f"{what} has the point {_point_text(new[k], names)} (row {k}) outside the "
-                "convex hull of the simulation index's points; observations must lie within it"
+                "convex hull of the simulation index's points, on which the basis is "
+                "interpolated: give points within it"
             )
         b = _barycentric(tri, s, new[rest])
         rows.append(np.repeat(rest, b.shape[1]))

@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 
-AXIS_LABELS = ("output index[:, 0]", "output index[:, 1]")
-"""The axes' labels of an index without names (``SimData(index_names=)`` None)."""
 VALUES, SIGNED, SPREAD = "viridis", "RdBu_r", "magma"  # colour maps: values, signed, widths
 
 
@@ -32,7 +30,7 @@ def signed_norm(*arrays: np.ndarray):
     return Normalize(-top, top) if top > 0 else Normalize(-1.0, 1.0)
 
 
-def surface(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, labels=AXIS_LABELS):
+def surface(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, labels) -> object:
     """``values`` (l,) at ``points`` (l, 2) on ``ax``: colour linear on each Delaunay triangle
     (``tripcolor`` with Gouraud shading; a triangle with a non-finite corner is left blank) and a
     small black marker at each point; points that span no triangle (fewer than 3, or on one
@@ -53,8 +51,8 @@ def surface(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, labels=
     return mesh
 
 
-def markers(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, *, background=None,
-            labels=AXIS_LABELS):  # fmt: skip
+def markers(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, *, labels,
+            background=None) -> object:  # fmt: skip
     """``values`` (l,) at ``points`` (l, 2) as markers coloured by value (observations at their
     own points), over the grey dots of ``background`` (l_sim, 2), e.g. the simulation points;
     ``labels``: the axes' (as ``surface``'s). Returns the mappable for a colour bar."""

@@ -1,26 +1,12 @@
 """The closed loop on tracks the examples do not ship: a start from rest, short segments, GDs
 outside the emulator's domain, and what a refused request says about how to get it."""
 
-import numpy as np
 import pytest
+from _robot_cases import start_from_rest
 
 import control
 import roadgen
 from tests._examples import load_example
-
-RATE_HZ = 120.0
-
-
-def _start_from_rest(n: int, seed: int = 0) -> tuple[np.ndarray, ...]:
-    """(t, position, accel, speed) of ``n`` samples of a robot getting under way at 20 m/s^2 to
-    1 m/s over a road that starts flat (roadgen's lead-in): its first samples read an all but
-    constant acceleration (noise-free, case A), then ~4 m/s^2 of ground."""
-    t = np.arange(1, n + 1) / RATE_HZ
-    speed = np.minimum(20.0 * t, 1.0)
-    position = np.cumsum(speed) / RATE_HZ
-    accel = np.random.default_rng(seed).normal(0.0, 4.0, n)
-    accel[:6] = [1.6e-4, 5.1e-4, 1.07e-3, 2.85e-3, 3.9e-3, 2.63e-3]  # a closed-loop run's start
-    return t, position, accel, speed
 
 
 def test_a_start_from_rest_is_no_dead_sensor_for_the_window_method():
@@ -28,7 +14,7 @@ def test_a_start_from_rest_is_no_dead_sensor_for_the_window_method():
     # on the lead-in's flat ground, as a dead sensor and latched the Simplex in safety mode for
     # the whole run (examples/closed_loop.py --track 6:300 --first-seed 11, case A).
     bcr = control.BCR.from_emulator(control.shipped_emulator("A", "window"), method="window")
-    t, position, accel, speed = _start_from_rest(bcr.settings.samples_per_update)
+    t, position, accel, speed = start_from_rest(bcr.settings.samples_per_update)
     estimate = bcr.update(t, position, accel, speed)
     assert estimate.status == "filling", estimate.reason
 
@@ -36,7 +22,7 @@ def test_a_start_from_rest_is_no_dead_sensor_for_the_window_method():
 def test_a_dead_stretch_at_a_steady_speed_is_still_a_fault_for_the_window_method():
     bcr = control.BCR.from_emulator(control.shipped_emulator("A", "window"), method="window")
     n = bcr.settings.samples_per_update
-    t, position, accel, speed = _start_from_rest(2 * n)
+    t, position, accel, speed = start_from_rest(2 * n)
     bcr.update(t[:n], position[:n], accel[:n], speed[:n])
     accel[n + 10 : n + 16] = 0.5  # dead for 0.05 s at 1 m/s
     estimate = bcr.update(t[n:], position[n:], accel[n:], speed[n:])
