@@ -400,7 +400,7 @@ def calibrate(
         fast = can_fast and (source is None or source.info["engine"] == "fast")
     fast = check_flag(fast, "fast")
     if source is not None:
-        _check_source(source, emulator, fast, emulator_params, n_emulator_draws, constraint,
+        cont.check_source(source, emulator, fast, emulator_params, n_emulator_draws, constraint,
                       log_prior, discrepancy, theta_init)  # fmt: skip
     if fast and not can_fast:
         raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
@@ -440,7 +440,7 @@ def calibrate(
     if source is None:
         tune = True if tune is None else tune
     else:
-        tune, resume = _continued_run(source, tune, fast, backend, temps, append, options)
+        tune, resume = cont.continued_run(source, tune, fast, backend, temps, append, options)
         if emulator_params == "draws":
             resume["positions"] = draw_positions(emulator, n_emulator_draws)
     pooled = 0 if not append else np.atleast_2d(next(iter(source.chains.values()))).shape[1]
@@ -498,7 +498,7 @@ def calibrate(
         units=dict(zip(emulator.t_names, emulator.t_units, strict=True)),
         backend_options=backends.recorded_options(given_options),
     )  # fmt: skip
-    info.update(_settings_record(constraint, log_prior, emulator_params, n_emulator_draws))
+    info.update(cont.settings_record(constraint, log_prior, emulator_params, n_emulator_draws))
     if source is not None:  # as gpmsa.fit's settings record a continuation
         info["continued_from"] = cont.chains_sha256(source)
         if append:
@@ -540,76 +540,6 @@ def calibrate(
                       f"gpmsa.calibrate (backend {backend!r})",
                       "Posterior.info['at_bound']")  # fmt: skip
     return Posterior(samples, chains=chains, info=info)
-
-
-def _check_source(source, emulator, fast: bool, emulator_params: str, n_emulator_draws: int,
-                  constraint, log_prior, discrepancy, theta_init) -> None:  # fmt: skip
-    """GPMSAError where ``calibrate``'s ``init`` (a Posterior, ``source``) is a calibration of
-    another emulator (its ``model_sha256``: another fit, or other calibration priors), another
-    emulator_params, constraint, log_prior or discrepancy, or ran on the other engine; and
-    where ``theta_init`` is given (the chains start at their last draws)."""
-    info = source.info
-    same = {
-        "emulator": (info.get("emulator_sha256"),
-                     emulator_record(emulator).get("emulator_sha256")),
-        "emulator_params": (info.get("emulator_params"), emulator_params),
-        "theta constraint": (bool(info.get("constraint", False)), constraint is not None),
-        "log_prior": (bool(info.get("log_prior", False)), log_prior is not None),
-        "discrepancy": (info.get("discrepancy"), discrepancy_kind(discrepancy)),
-    }  # fmt: skip
-    if emulator_params == "draws":
-        same["n_emulator_draws"] = (info.get("n_emulator_draws"), n_emulator_draws)
-    cont.check_same(source, **same)
-    cont.check_engine(source, fast)
-    if theta_init is not None:
-        raise GPMSAError(f"theta_init= sets a fresh chain's start; {cont.SOURCE}'s chains "
-                         "continue from their last draws: leave theta_init out")  # fmt: skip
-
-
-def _continued_run(source, tune, fast: bool, backend: str, temps, append: bool,
-                   options: dict) -> tuple[bool, dict]:  # fmt: skip
-    """A continuation's tuning and what its run takes ({"source", "widths": run on the recorded
-    step widths (the fast sampler: True; a backend: name -> per chain; None: GPM/SA's),
-    "proportional": the precisions' steps (None: ``not tune``)}), by ``gpmsa.fit``'s rules:
-    ``tune`` None runs untuned on the recorded widths (tuned where none are recorded, and
-    every copy of a tempered one tuned at its temperature from them: ``tune=False`` refused
-    there); True tunes again from GPM/SA's widths; ``append`` refuses tuning (untempered)."""
-    widths = None
-    if tune is not True and "step_widths" not in options:
-        widths = True if fast else cont.backend_widths(source, backend)
-    if tune is None:
-        tune = widths is None or temps is not None
-    if temps is not None and not tune:
-        raise GPMSAError(
-            f"tune=False with a tempered continuation (temperatures=, or {cont.SOURCE} a "
-            "tempered calibration): calibrate records no hot copies' states, so every copy is "
-            "tuned at its temperature (from the T = 1 copy's widths) while the copies warm up "
-            "from the chain's last state, before any draw is kept; leave tune out (or "
-            "tune=True: from GPM/SA's widths), or pass temperatures=None to continue without "
-            "tempering"
-        )
-    if append and tune and (fast or backend in cont.MH_BACKENDS) and temps is None:
-        raise GPMSAError(
-            "append=True pools the chains' draws one sweep apart; tuning (tune=True, or "
-            f"tune=None where {cont.SOURCE} records no Metropolis step widths) would run its "
-            "sweeps between the source's and the continuation's: pass tune=False"
-        )
-    steps = None  # the precisions' steps as the chains it continues (SEPIA: once tuned, always)
-    metropolis = fast or (backend in cont.MH_BACKENDS
-                          and source.info.get("backend") in cont.MH_BACKENDS)  # fmt: skip
-    if not tune and metropolis and "proportional_steps" not in options:
-        steps = cont.proportional(source)
-    return tune, {"source": source, "widths": widths, "proportional": steps}
-
-
-def _settings_record(constraint, log_prior, emulator_params: str, n_emulator_draws: int) -> dict:
-    """What ``info`` records of the settings a continuation must share and the draws do not
-    show: "constraint" and "log_prior" (True where given), "n_emulator_draws" (its draws mode)."""
-    out = {k: True for k, v in (("constraint", constraint), ("log_prior", log_prior))
-           if v is not None}  # fmt: skip
-    if emulator_params == "draws":
-        out["n_emulator_draws"] = int(n_emulator_draws)
-    return out
 
 
 def _more_advice(append: bool) -> str:
@@ -872,7 +802,7 @@ def _run_backend(
     seed, extrapolate, progress, where, theta_opts, resume=None,
 ):  # fmt: skip
     """The generic backend's draws and info; ``discrepancy``: (basis, groups); ``theta_opts``
-    with ``calibration_problem``'s ``fixed``; ``resume``: a continuation's (`_continued_run`)."""
+    with ``calibration_problem``'s ``fixed``; ``resume``: a continuation's (`continuation.continued_run`)."""
     discrepancy, groups = discrepancy
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate,

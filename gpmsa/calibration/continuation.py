@@ -10,9 +10,11 @@ import hashlib
 
 import numpy as np
 
+from gpmsa.calibration.observations import emulator_record
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tempering
+from gpmsa.model.basis import discrepancy_kind
 from gpmsa.model.categorical import snap_to_levels
 from gpmsa.model.data import check_flag
 from gpmsa.model.discrepancy import sample_names
@@ -309,4 +311,74 @@ def appended_info(source: Posterior, n_samples: int, accept_rate, backend: str):
         out["accept_rate"] = {k: weighted(old.get(k, v), v) for k, v in accept_rate.items()}
     else:
         out["accept_rate"] = weighted(old, accept_rate)
+    return out
+
+
+def check_source(source, emulator, fast: bool, emulator_params: str, n_emulator_draws: int,
+                  constraint, log_prior, discrepancy, theta_init) -> None:  # fmt: skip
+    """GPMSAError where ``calibrate``'s ``init`` (a Posterior, ``source``) is a calibration of
+    another emulator (its ``model_sha256``: another fit, or other calibration priors), another
+    emulator_params, constraint, log_prior or discrepancy, or ran on the other engine; and
+    where ``theta_init`` is given (the chains start at their last draws)."""
+    info = source.info
+    same = {
+        "emulator": (info.get("emulator_sha256"),
+                     emulator_record(emulator).get("emulator_sha256")),
+        "emulator_params": (info.get("emulator_params"), emulator_params),
+        "theta constraint": (bool(info.get("constraint", False)), constraint is not None),
+        "log_prior": (bool(info.get("log_prior", False)), log_prior is not None),
+        "discrepancy": (info.get("discrepancy"), discrepancy_kind(discrepancy)),
+    }  # fmt: skip
+    if emulator_params == "draws":
+        same["n_emulator_draws"] = (info.get("n_emulator_draws"), n_emulator_draws)
+    check_same(source, **same)
+    check_engine(source, fast)
+    if theta_init is not None:
+        raise GPMSAError(f"theta_init= sets a fresh chain's start; {SOURCE}'s chains "
+                         "continue from their last draws: leave theta_init out")  # fmt: skip
+
+
+def continued_run(source, tune, fast: bool, backend: str, temps, append: bool,
+                   options: dict) -> tuple[bool, dict]:  # fmt: skip
+    """A continuation's tuning and what its run takes ({"source", "widths": run on the recorded
+    step widths (the fast sampler: True; a backend: name -> per chain; None: GPM/SA's),
+    "proportional": the precisions' steps (None: ``not tune``)}), by ``gpmsa.fit``'s rules:
+    ``tune`` None runs untuned on the recorded widths (tuned where none are recorded, and
+    every copy of a tempered one tuned at its temperature from them: ``tune=False`` refused
+    there); True tunes again from GPM/SA's widths; ``append`` refuses tuning (untempered)."""
+    widths = None
+    if tune is not True and "step_widths" not in options:
+        widths = True if fast else backend_widths(source, backend)
+    if tune is None:
+        tune = widths is None or temps is not None
+    if temps is not None and not tune:
+        raise GPMSAError(
+            f"tune=False with a tempered continuation (temperatures=, or {SOURCE} a "
+            "tempered calibration): calibrate records no hot copies' states, so every copy is "
+            "tuned at its temperature (from the T = 1 copy's widths) while the copies warm up "
+            "from the chain's last state, before any draw is kept; leave tune out (or "
+            "tune=True: from GPM/SA's widths), or pass temperatures=None to continue without "
+            "tempering"
+        )
+    if append and tune and (fast or backend in MH_BACKENDS) and temps is None:
+        raise GPMSAError(
+            "append=True pools the chains' draws one sweep apart; tuning (tune=True, or "
+            f"tune=None where {SOURCE} records no Metropolis step widths) would run its "
+            "sweeps between the source's and the continuation's: pass tune=False"
+        )
+    steps = None  # the precisions' steps as the chains it continues (SEPIA: once tuned, always)
+    metropolis = fast or (backend in MH_BACKENDS
+                          and source.info.get("backend") in MH_BACKENDS)  # fmt: skip
+    if not tune and metropolis and "proportional_steps" not in options:
+        steps = proportional(source)
+    return tune, {"source": source, "widths": widths, "proportional": steps}
+
+
+def settings_record(constraint, log_prior, emulator_params: str, n_emulator_draws: int) -> dict:
+    """What ``info`` records of the settings a continuation must share and the draws do not
+    show: "constraint" and "log_prior" (True where given), "n_emulator_draws" (its draws mode)."""
+    out = {k: True for k, v in (("constraint", constraint), ("log_prior", log_prior))
+           if v is not None}  # fmt: skip
+    if emulator_params == "draws":
+        out["n_emulator_draws"] = int(n_emulator_draws)
     return out
