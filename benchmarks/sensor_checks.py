@@ -23,8 +23,9 @@ case:
 
 With ``--chunks`` it prints instead, per case and ``update_every`` in ``EVERY``, what the BCR's
 signal checks see when a user feeds each drive from its start, one update at a time: the window
-methods check each update's new samples alone (`BCR._window_signal_reason`: 10-60 samples for
-a small ``update_every``, against limits calibrated on blocks of 125), the change-point method
+methods check each update's new samples with the ``CHECK_CONTEXT`` (32) before them, at
+least the newest ``CHECK_LEAST`` (125, the blocks the limits were calibrated on;
+`BCR._window_signal_reason`), the change-point method
 the newest 125 samples at each update (`BCR._estimate_changepoint`; ``update_every`` >= 16).
 Per method: the checks made, those `signal_fault` flags (the false alarms), the largest ratio of
 the short level check per stretch in the window methods' chunks ("-": no chunk holds one), and
@@ -42,7 +43,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 import vehicle
-from control.bcr import MAX_PHASES
+from control.bcr import CHECK_CONTEXT, CHECK_LEAST, MAX_PHASES
 from control.sensor_checks import (
     SHORT_LEVEL_BEFORE,
     SHORT_LEVEL_STRETCHES,
@@ -99,8 +100,10 @@ def scale_hits(blocks, gain, length, rng, limits) -> tuple[int, int]:
 
 def window_spans(n: int, every: int) -> list[tuple[int, int]]:
     """(start, stop) of the samples the window methods' signal checks see at each update of a
-    stream of ``n`` samples fed from its start: the update's ``every`` new samples."""
-    return [(s, s + every) for s in range(0, n - every + 1, every)]
+    stream of ``n`` samples fed from its start: the update's ``every`` new samples and the
+    ``CHECK_CONTEXT`` before them, at least the newest ``CHECK_LEAST``."""
+    checked = max(every + CHECK_CONTEXT, CHECK_LEAST)
+    return [(max(e - checked, 0), e) for e in range(every, n + 1, every)]
 
 
 def changepoint_spans(n: int, every: int) -> list[tuple[int, int]]:

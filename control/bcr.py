@@ -80,6 +80,7 @@ from control.errors import ControlError
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, feature_of_variance, features_of_blocks
 from control.sensor_checks import (
+    MIN_SEGMENT,
     SensorLimits,
     StaticSpan,
     signal_fault,
@@ -118,6 +119,18 @@ MAX_QUIET_BLOCKS = 1024
 MAX_SPEED_CHANGE = 0.5
 """A block whose lowest speed is below this fraction of its highest (starting, stopping) carries
 no information for the change-point method: the emulator knows constant speeds only."""
+CHECK_CONTEXT = MIN_SEGMENT
+"""Samples before a window update's new samples that its signal checks take in too (0.27 s at
+120 Hz; at most those a restart kept). A sensor that dies on an update's last samples, fewer than
+the checks' shortest stretch, leaves the next update all dead, with nothing healthy to read it
+against; the level check holds a quiet segment to the ``MIN_SEGMENT`` samples before it. Without
+them such a death gives ok estimates on dead data (GD falling) for 5-9 m, against 0.1-1.4 m for
+one earlier in an update (`tests/control/test_dead_update_end_s77.py`)."""
+CHECK_LEAST = 125
+"""Fewest samples a window update's signal checks read (the newest, at most those a restart
+kept; 1.04 s at 120 Hz): the blocks their limits were calibrated on. With a small
+``update_every`` the new samples and ``CHECK_CONTEXT`` alone leave the short level check little
+margin (a clean 42-sample block of 10 new samples read 364 against its limit of 400)."""
 STANDING_MPS = 0.05
 """A block whose every |speed| is below this, m/s, reads as a robot standing (5 cm in a 1 s
 block: the ground gives next to no vertical acceleration). Where its accelerometer reads at
@@ -794,18 +807,19 @@ class BCR:
 
     def _window_signal_reason(self) -> str:
         """The window methods' checks: the signal checks on the buffer's samples that came
-        since the previous update (those a restart kept), as the window fills too, so that
-        every sample of a window has passed them once; the timing checks on a full window.
-        New samples over which the speed changes by more than MAX_SPEED_CHANGE (starting,
+        since the previous update and the ``CHECK_CONTEXT`` before them, at least the newest
+        ``CHECK_LEAST`` (those a restart kept), as the window fills too, so that every sample
+        of a window has passed them with the samples before it; the timing checks on a full
+        window. Samples over which the speed changes by more than MAX_SPEED_CHANGE (starting,
         stopping) skip the level-jump check (their level changes with the speed), and their
         dead-stretch check passes over the stretches that take in a sample below
         MAX_SPEED_CHANGE of their top speed (a robot getting under way on flat ground reads an
         all but constant acceleration; a sensor that dies at speed is still caught)."""
-        every = self.settings.samples_per_update
-        spd = np.abs(self._spd[-every:])
+        checked = max(self.settings.samples_per_update + CHECK_CONTEXT, CHECK_LEAST)
+        spd = np.abs(self._spd[-checked:])
         slow = ~(spd >= MAX_SPEED_CHANGE * np.max(spd)) if spd.size else None  # (NaN: slow)
         return self._signal_reason(
-            self._acc[-every:],
+            self._acc[-checked:],
             timing=self._acc.size >= self.buffer,
             slow=slow if slow is not None and slow.any() else None,
         )

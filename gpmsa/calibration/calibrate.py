@@ -802,7 +802,8 @@ def _run_backend(
     seed, extrapolate, progress, where, theta_opts, resume=None,
 ):  # fmt: skip
     """The generic backend's draws and info; ``discrepancy``: (basis, groups); ``theta_opts``
-    with ``calibration_problem``'s ``fixed``; ``resume``: a continuation's (`continuation.continued_run`)."""
+    with ``calibration_problem``'s ``fixed``; ``resume``: a continuation's
+    (`continuation.continued_run`)."""
     discrepancy, groups = discrepancy
     problem = calibration_problem(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate,
