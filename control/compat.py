@@ -13,13 +13,16 @@ import warnings
 
 import numpy as np
 
+import gpmsa
 import vehicle
 from control.bcr import BCRSettings, emulator_domain
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.feature import FeatureSpec
+from control.observation_model import BlockScatter, top_block_loglik
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_instance, is_real, replace_fields, within
+from gpmsa.calibration.posterior import trapezoid_weights
 from gpmsa.errors import numbers_text
 
 
@@ -116,7 +119,9 @@ def check_emulator(
     data and the noisy one with noisy data; a mismatch biases GD, but a robustness study may
     want it); a track whose grid step or band top differs from the training roads' (metadata
     ``road``: the GD estimates are biased; on the paper's track a 2 cm grid read GD 500 as
-    358); vehicle or noise metadata missing.
+    358); vehicle or noise metadata missing; a Simplex with ``risk=None`` whose GD_max lies
+    above `top_reach` (the posterior mean, cut at the emulator's highest GD, seldom exceeds it
+    even on rougher ground).
     """
     _check_is_emulator(emulator)
     if model is not None and not callable(getattr(model, "describe", None)):
@@ -192,6 +197,70 @@ def check_emulator(
                 "mode; GD is in units of 1e-6 m^3 (Gd(n0) x 1e6: the paper's band is "
                 "Simplex(gd_min=250, gd_max=350))"
             )
+        _warn_if_out_of_reach(emulator, simplex)
+
+
+REACH_GRID = 121
+"""GD nodes (uniform in log GD, as `ObservationModel`'s default grid) of `top_reach` for an
+emulator of the block feature."""
+
+
+def top_reach(emulator, speeds) -> tuple[float, float]:
+    """(level, sd): the highest GD_max that the BCR's posterior mean reliably exceeds on ground
+    at or beyond the top b of the emulator's GD domain, ``level = b - sd``, with ``sd`` the
+    largest over ``speeds`` (m/s, clipped to the speed domain) of the posterior sd of GD given
+    one observation equal to the emulator's mean at (speed, b), under a uniform prior on the
+    domain: one block's feature (`top_block_loglik`) for an emulator with a ``block_scatter``,
+    else one window (`gpmsa.Calibrator`'s grid). The posterior is cut at b, so its mean stays
+    below it: for a likelihood rising steeply beyond b the mean sits at b - sd (docs/
+    closed-loop.md, The Simplex, has the measurements)."""
+    (v_lo, v_hi), (lo, hi) = emulator_domain(emulator)
+    sds = []
+    for gd, loglik in _top_logliks(emulator, np.unique(np.clip(speeds, v_lo, v_hi)), lo, hi):
+        mass = trapezoid_weights(gd) * np.exp(loglik - np.max(loglik))
+        mass /= mass.sum()
+        mean = mass @ gd
+        sds.append(float(np.sqrt(mass @ (gd - mean) ** 2)))
+    sd = max(sds)
+    return hi - sd, sd
+
+
+def _top_logliks(emulator, speeds: np.ndarray, lo: float, hi: float):
+    """(GD nodes, log-likelihood there) per speed (m/s) of one observation equal to the
+    emulator's mean at (speed, hi) (`top_reach`)."""
+    meta = dict(getattr(emulator, "metadata", None) or {})
+    if "block_scatter" in meta:
+        gd = np.geomspace(lo, hi, REACH_GRID)
+        scatter = BlockScatter.from_dict(meta["block_scatter"])
+        return [(gd, top_block_loglik(emulator, scatter, v, gd)) for v in speeds]
+    calibrator = gpmsa.Calibrator(emulator)
+    tops = np.asarray(emulator.predict_mean(speeds, np.full(speeds.size, hi)))
+    tops = tops.reshape(speeds.size, 1, -1)
+    return [calibrator.log_likelihood_grid([[v]], y) for v, y in zip(speeds, tops, strict=True)]
+
+
+def _warn_if_out_of_reach(emulator, simplex: Simplex) -> None:
+    """ControlWarning where the Simplex compares the posterior mean (``risk=None``) with a GD_max
+    above `top_reach` at its speeds (v_safe, their middle, v_max). A posterior sd is at most
+    half the domain's width, so a GD_max at or below the domain's middle is not computed."""
+    (_, _), (lo, hi) = emulator_domain(emulator)
+    if simplex.risk is not None or simplex.gd_max <= (lo + hi) / 2:
+        return
+    if not callable(getattr(emulator, "predict_mean", None)):
+        return  # not an emulator that predicts (a stand-in of its records)
+    speeds = (simplex.v_safe, (simplex.v_safe + simplex.v_max) / 2, simplex.v_max)
+    level, sd = top_reach(emulator, speeds)
+    if simplex.gd_max > level:
+        reach = f"{np.floor(level):.0f}"  # (rounded down: a gd_max at it is within reach)
+        warnings.warn(
+            f"Simplex gd_max = {simplex.gd_max:g} lies above {reach}, the highest GD_max the "
+            f"posterior mean reliably reaches with this emulator: on ground at its highest GD "
+            f"{hi:g} or rougher the mean sits about {sd:.0f} below it (the posterior sd of one "
+            f"observation there), so safety mode may seldom or never start; use gd_max <= "
+            f"{reach}, or risk=alpha (safety mode when P(GD > GD_max) > alpha)",
+            ControlWarning,
+            stacklevel=user_stacklevel(),
+        )
 
 
 def recorded_vehicle_mismatch(emulator, model, what: str = "the recording") -> str:

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import special, stats
-from scipy.linalg import cholesky
+from scipy.linalg import cholesky, solve_triangular
 from scipy.linalg.lapack import dpotrf
 
 from control.errors import ControlError, EmulatorMismatchError
@@ -273,6 +273,18 @@ class ObservationModel:
             )
         w = inverse @ d
         return float(w @ residual / np.sqrt(w @ w))
+
+
+def top_block_loglik(emulator, scatter: BlockScatter, v: float, gd: np.ndarray) -> np.ndarray:
+    """log p(y | GD) on the increasing GD nodes ``gd`` (G,), up to a constant, of one block at
+    speed ``v`` (m/s) whose feature y is the emulator's mean at (v, ``gd[-1]``): what one block
+    read at the top of the grid says (`control.compat.top_reach`)."""
+    mean = np.asarray(emulator.predict_mean(np.full(gd.size, float(v)), gd), dtype=float)
+    mean = mean.reshape(gd.size, -1)  # (G, K)
+    chol = _cholesky_lower(_interp_cov(scatter, v))
+    d2 = np.sum(solve_triangular(chol, (mean - mean[-1]).T, lower=True) ** 2, axis=0)
+    nu, K = scatter.dof, mean.shape[1]
+    return -0.5 * d2 if np.isinf(nu) else -0.5 * (nu + K) * np.log1p(d2 / nu)
 
 
 def _check_feature_length(emulator) -> None:
