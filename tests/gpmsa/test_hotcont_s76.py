@@ -12,10 +12,9 @@ its continuation at the same ladder runs on from them untuned: 0.38 s (a fresh f
 source's widths, 0 of 24 changes of mode across the join.
 """
 
-import warnings
-
 import numpy as np
 import pytest
+from _tempering_cases import check_resumed_hot_copies, fit_two_mode
 from _tempering_cases import two_mode_case as _case
 
 import gpmsa
@@ -31,10 +30,7 @@ SMALL = {"tune_rounds": 1, "tune_levels": 2}
 
 
 def _fit(**kw):
-    sim, obs = _case()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
-        return gpmsa.fit(sim, obs, **{"n_jobs": 1, **kw})
+    return fit_two_mode(**{"n_jobs": 1, **kw})
 
 
 def _source():
@@ -43,23 +39,9 @@ def _source():
 
 def test_tempered_fit_records_its_hot_copies_and_its_continuation_resumes_them(tmp_path):
     src = _source()
-    s = src.settings
-    assert np.shape(s["hot_states"]["theta"]) == (2, 2, 1)  # (chains, hot copies, *shape)
-    assert np.shape(s["hot_step_widths"]["betaU"]) == (2, 2, 1, 1)
-    assert np.all(np.isfinite(s["hot_states"]["lamWOs"]))
     more = _fit(n_iter=10, n_chains=2, init=src, seed=4)
-    m = more.settings
-    assert m["tune"] is False and m["temperatures"] == [1.0, 2.0, 4.0]
-    assert m["step_widths"] == s["step_widths"]  # the T = 1 copy's, untuned
-    assert m["hot_step_widths"] == s["hot_step_widths"]  # and every hot copy's
-    assert m["proportional_steps"] is False  # as the tuned source stepped
-    assert m["hot_states"] != s["hot_states"]  # where they stopped now
-    back = gpmsa.load(src.save(tmp_path / "t.gpmsa"))
-    assert back.settings["hot_states"] == s["hot_states"]
-    again = _fit(n_iter=10, n_chains=2, init=back, seed=4)  # the file's: the same draws
-    np.testing.assert_array_equal(again.log_post, more.log_post)
-    resumed = _fit(n_iter=10, n_chains=2, init=src, seed=4, tune=False)  # allowed now
-    np.testing.assert_array_equal(resumed.log_post, more.log_post)
+    check_resumed_hot_copies(src, more, _fit, tmp_path / "t.gpmsa")
+    assert more.settings["proportional_steps"] is False  # as the tuned source stepped
 
 
 def test_copies_start_at_the_states_and_widths_given():

@@ -9,10 +9,9 @@ P(t > 0.5) = 1/2. A plain fit started at t = 0.2 never leaves its mode; a temper
 tempered continuation, visit both.
 """
 
-import warnings
-
 import numpy as np
 import pytest
+from _tempering_cases import fit_two_mode as _fit
 from _tempering_cases import two_mode_case as _case
 
 import gpmsa
@@ -23,13 +22,6 @@ from gpmsa.model.problem import prepare
 
 LADDER = [1.0, 4.0, 16.0, 64.0]
 SMALL = {"tune_rounds": 1, "tune_levels": 2}
-
-
-def _fit(**kw):
-    sim, obs = _case()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
-        return gpmsa.fit(sim, obs, **kw)
 
 
 def _upper(emu, n_chains: int) -> np.ndarray:

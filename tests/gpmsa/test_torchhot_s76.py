@@ -13,13 +13,11 @@ pooled 0.515). The record has one layout on both backends, so either continues t
 file.
 """
 
-import warnings
-
 import numpy as np
 import pytest
+from _tempering_cases import check_resumed_hot_copies, fit_two_mode
 from _tempering_cases import two_mode_case as _case
 
-import gpmsa
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc.sampler import default_widths
 from gpmsa.model.problem import prepare
@@ -31,11 +29,8 @@ WARM = {"warmup": 2, "tune_stages": 1}  # torch's tuning, kept short
 
 
 def _fit(backend="torch", **kw):
-    sim, obs = _case()
     where = {"n_jobs": 1} if backend == "numpy" else {}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", gpmsa.ConvergenceWarning)
-        return gpmsa.fit(sim, obs, backend=backend, **where, **kw)
+    return fit_two_mode(backend=backend, **where, **kw)
 
 
 def _source(backend="torch", **kw):
@@ -59,26 +54,12 @@ def test_torch_tempered_fit_records_its_hot_copies_and_its_continuation_resumes_
     tmp_path, monkeypatch
 ):
     src = _source()
-    s = src.settings
-    assert np.shape(s["hot_states"]["theta"]) == (2, 2, 1)  # (chains, hot copies, *shape)
-    assert np.shape(s["hot_step_widths"]["betaU"]) == (2, 2, 1, 1)
-    assert np.all(np.isfinite(s["hot_states"]["lamWOs"]))
-    widths = np.array(s["hot_step_widths"]["theta"])
+    widths = np.array(src.settings["hot_step_widths"]["theta"])
     assert np.all(widths[0] == widths[1])  # torch: copy k's widths shared by the chains
     sweeps = _counted(monkeypatch)
     more = _fit(n_iter=10, n_chains=2, init=src, seed=4)
     assert len(sweeps) == 10  # no sweep before the first draw (re-tuned: 10 more here)
-    m = more.settings
-    assert m["tune"] is False and m["temperatures"] == [1.0, 2.0, 4.0]
-    assert m["step_widths"] == s["step_widths"]  # the T = 1 copy's, untuned
-    assert m["hot_step_widths"] == s["hot_step_widths"]  # and every hot copy's
-    assert m["hot_states"] != s["hot_states"]  # where they stopped now
-    back = gpmsa.load(src.save(tmp_path / "t.gpmsa"))
-    assert back.settings["hot_states"] == s["hot_states"]
-    again = _fit(n_iter=10, n_chains=2, init=back, seed=4)  # the file's: the same draws
-    np.testing.assert_array_equal(again.log_post, more.log_post)
-    resumed = _fit(n_iter=10, n_chains=2, init=src, seed=4, tune=False)  # allowed now
-    np.testing.assert_array_equal(resumed.log_post, more.log_post)
+    check_resumed_hot_copies(src, more, _fit, tmp_path / "t.gpmsa")
 
 
 def test_each_backend_resumes_the_others_hot_copies(monkeypatch):
