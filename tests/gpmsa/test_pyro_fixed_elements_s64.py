@@ -68,8 +68,9 @@ def test_fits_without_held_elements_draw_as_before():
     np.testing.assert_allclose(emu.settings["step_widths"]["lamWs"],
                                [[0.284700264365863], [0.2574671612237942]], rtol=1e-12)  # fmt: skip
     cal = _fit(sim, obs, fixed=EMU, **short)
+    # to 1e-10: torch's MKL kernel (AVX512, AVX2 or SSE4.2 by the host) moves them by up to 2e-12
     for k, v in {"theta": 13.375217259112802, "lamOs": 16910.59187843946}.items():
-        np.testing.assert_allclose(cal.calibration[k].sum(), v, rtol=1e-12)
+        np.testing.assert_allclose(cal.calibration[k].sum(), v, rtol=1e-10)
     np.testing.assert_allclose(cal.log_post.sum(), 130.2119734725245, rtol=1e-10)
     assert np.all(np.isnan(cal.settings["step_widths"]["lamWs"]))
 
