@@ -18,11 +18,11 @@ import vehicle
 from control.bcr import BCRSettings, emulator_domain
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.feature import FeatureSpec
-from control.observation_model import BlockScatter, top_block_loglik
+from control.observation_model import BlockScatter, one_block_logliks
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_instance, is_real, replace_fields, within
-from gpmsa.calibration.posterior import trapezoid_weights
+from gpmsa.calibration.posterior import GridMarginal
 from gpmsa.errors import numbers_text
 
 
@@ -121,7 +121,9 @@ def check_emulator(
     ``road``: the GD estimates are biased; on the paper's track a 2 cm grid read GD 500 as
     358); vehicle or noise metadata missing; a Simplex with ``risk=None`` whose GD_max lies
     above `top_reach` (the posterior mean, cut at the emulator's highest GD, seldom exceeds it
-    even on rougher ground).
+    even on rougher ground); one with ``risk`` = alpha whose GD_max lies above
+    `top_quantile_reach` (the (1 - alpha) quantile seldom exceeds it) or below `bottom_quantile`
+    at v_safe (that quantile exceeds it even on the emulator's smoothest ground).
     """
     _check_is_emulator(emulator)
     if model is not None and not callable(getattr(model, "describe", None)):
@@ -201,63 +203,165 @@ def check_emulator(
 
 
 REACH_GRID = 121
-"""GD nodes (uniform in log GD, as `ObservationModel`'s default grid) of `top_reach` for an
-emulator of the block feature."""
+"""GD nodes (uniform in log GD, as `ObservationModel`'s default grid) of
+`one_observation_posteriors` for an emulator of the block feature."""
+
+DOMAIN_ENDS = ("bottom", "top")
+"""The ends of the emulator's GD domain that `one_observation_posteriors` reads at."""
+
+
+def one_observation_posteriors(
+    emulator, speeds, ends: tuple[str, ...] = ("top",)
+) -> dict[str, list[GridMarginal]]:
+    """Per end of the emulator's GD domain in ``ends`` ("bottom": its lowest GD, "top": its
+    highest) and per speed in ``speeds`` (m/s, clipped to the speed domain; in their order): the
+    posterior of GD, under a uniform prior on the domain, given one observation equal to the
+    emulator's mean at (speed, that end): one block's feature (`one_block_logliks`) for an
+    emulator with a ``block_scatter``, else one window (`gpmsa.Calibrator`'s grid). The ends
+    share the work: one prediction of the block feature per speed, one Calibrator."""
+    (v_lo, v_hi), (lo, hi) = emulator_domain(emulator)
+    speeds = [float(v) for v in np.clip(speeds, v_lo, v_hi)]
+    unknown = [end for end in ends if end not in DOMAIN_ENDS]
+    if unknown or not ends:
+        raise ControlError(f"ends must be some of {DOMAIN_ENDS}, got {ends!r}")
+    meta = dict(getattr(emulator, "metadata", None) or {})
+    if "block_scatter" in meta:
+        gd = np.geomspace(lo, hi, REACH_GRID)
+        scatter = BlockScatter.from_dict(meta["block_scatter"])
+        at = tuple(0 if end == "bottom" else -1 for end in ends)
+        rows = {v: one_block_logliks(emulator, scatter, v, gd, at) for v in set(speeds)}
+        return {
+            end: [GridMarginal.from_log_density(gd, rows[v][i]) for v in speeds]
+            for i, end in enumerate(ends)
+        }
+    calibrator = gpmsa.Calibrator(emulator)
+    out = {}
+    for end in ends:
+        reads = np.full(len(speeds), lo if end == "bottom" else hi)
+        obs = np.asarray(emulator.predict_mean(np.asarray(speeds), reads))
+        obs = obs.reshape(len(speeds), 1, -1)
+        out[end] = [
+            GridMarginal.from_log_density(*calibrator.log_likelihood_grid([[v]], y))
+            for v, y in zip(speeds, obs, strict=True)
+        ]
+    return out
 
 
 def top_reach(emulator, speeds) -> tuple[float, float]:
     """(level, sd): the highest GD_max that the BCR's posterior mean reliably exceeds on ground
     at or beyond the top b of the emulator's GD domain, ``level = b - sd``, with ``sd`` the
     largest over ``speeds`` (m/s, clipped to the speed domain) of the posterior sd of GD given
-    one observation equal to the emulator's mean at (speed, b), under a uniform prior on the
-    domain: one block's feature (`top_block_loglik`) for an emulator with a ``block_scatter``,
-    else one window (`gpmsa.Calibrator`'s grid). The posterior is cut at b, so its mean stays
-    below it: for a likelihood rising steeply beyond b the mean sits at b - sd (docs/
-    closed-loop.md, The Simplex, has the measurements)."""
-    (v_lo, v_hi), (lo, hi) = emulator_domain(emulator)
-    sds = []
-    for gd, loglik in _top_logliks(emulator, np.unique(np.clip(speeds, v_lo, v_hi)), lo, hi):
-        mass = trapezoid_weights(gd) * np.exp(loglik - np.max(loglik))
-        mass /= mass.sum()
-        mean = mass @ gd
-        sds.append(float(np.sqrt(mass @ (gd - mean) ** 2)))
-    sd = max(sds)
+    one observation equal to the emulator's mean at (speed, b) (`one_observation_posteriors`).
+    The posterior is cut at b, so its mean stays below it: for a likelihood rising steeply
+    beyond b the mean sits at b - sd (docs/closed-loop.md, The Simplex, has the
+    measurements)."""
+    hi = emulator_domain(emulator)[1][1]
+    return _mean_reach(one_observation_posteriors(emulator, speeds)["top"], hi)
+
+
+def top_quantile_reach(emulator, speeds, risk: float) -> float:
+    """The highest GD_max that the (1 - ``risk``) posterior quantile (a Simplex with
+    ``risk``) reliably exceeds on ground at or beyond the top b of the emulator's GD domain:
+    the smallest over ``speeds`` (m/s, clipped to the speed domain) of that quantile of the
+    posterior given one observation equal to the emulator's mean at (speed, b)
+    (`one_observation_posteriors`; docs/closed-loop.md, The Simplex, has the measurements)."""
+    return _quantile(one_observation_posteriors(emulator, speeds)["top"], risk, min)
+
+
+def bottom_quantile(emulator, speed: float, risk: float) -> float:
+    """The (1 - ``risk``) quantile of the posterior of GD given one observation equal to the
+    emulator's mean at (``speed``, a), a the lowest GD of its domain
+    (`one_observation_posteriors`): what a Simplex with ``risk`` compares with GD_max on the
+    smoothest ground the emulator knows."""
+    return _quantile(one_observation_posteriors(emulator, [speed], ("bottom",))["bottom"], risk)
+
+
+def _mean_reach(top: list[GridMarginal], hi: float) -> tuple[float, float]:
+    """(b - sd, sd) of `top_reach` from the posteriors at the domain's top b = ``hi``."""
+    sd = max(post.sd() for post in top)
     return hi - sd, sd
 
 
-def _top_logliks(emulator, speeds: np.ndarray, lo: float, hi: float):
-    """(GD nodes, log-likelihood there) per speed (m/s) of one observation equal to the
-    emulator's mean at (speed, hi) (`top_reach`)."""
-    meta = dict(getattr(emulator, "metadata", None) or {})
-    if "block_scatter" in meta:
-        gd = np.geomspace(lo, hi, REACH_GRID)
-        scatter = BlockScatter.from_dict(meta["block_scatter"])
-        return [(gd, top_block_loglik(emulator, scatter, v, gd)) for v in speeds]
-    calibrator = gpmsa.Calibrator(emulator)
-    tops = np.asarray(emulator.predict_mean(speeds, np.full(speeds.size, hi)))
-    tops = tops.reshape(speeds.size, 1, -1)
-    return [calibrator.log_likelihood_grid([[v]], y) for v, y in zip(speeds, tops, strict=True)]
+def _quantile(posts: list[GridMarginal], risk: float, pick=max) -> float:
+    """``pick`` (min or max) over ``posts`` of their (1 - ``risk``) quantiles."""
+    return pick(float(post.ppf(1.0 - risk)) for post in posts)
+
+
+def _risk_above(posts: list[GridMarginal], gd_max: float) -> float:
+    """The smallest over ``posts`` of P(GD > ``gd_max``): a risk at or below it puts every
+    posterior's (1 - risk) quantile at or above ``gd_max``, one above it puts some below."""
+    return min(1.0 - float(post.cdf(gd_max)) for post in posts)
+
+
+def _risk_text(risk: float, up: bool) -> str:
+    """``risk`` to 2 significant digits, rounded up (``up``) or down: a risk that still holds."""
+    digits = 1 - int(np.floor(np.log10(risk)))
+    scaled = risk * 10.0**digits
+    return f"{(np.ceil(scaled) if up else np.floor(scaled)) / 10.0**digits:.{max(digits, 0)}f}"
 
 
 def _warn_if_out_of_reach(emulator, simplex: Simplex) -> None:
-    """ControlWarning where the Simplex compares the posterior mean (``risk=None``) with a GD_max
-    above `top_reach` at its speeds (v_safe, their middle, v_max). A posterior sd is at most
-    half the domain's width, so a GD_max at or below the domain's middle is not computed."""
+    """ControlWarning where the GD the Simplex compares with GD_max cannot serve it, from the
+    posteriors of one observation at the ends of the emulator's GD domain
+    (`one_observation_posteriors`) at its speeds (v_safe, their middle, v_max): with
+    ``risk=None`` a GD_max above `top_reach` (the posterior mean seldom exceeds it); with
+    ``risk`` = alpha a GD_max above `top_quantile_reach` (the (1 - alpha) quantile seldom
+    exceeds it), or below `bottom_quantile` at v_safe (that quantile exceeds it even on the
+    smoothest ground: safety mode seldom ends). Each names the risks that serve: those at
+    most P(GD > GD_max) at the top and at least that at the bottom; for a feature monotone in
+    GD one observation at the bottom makes GD > GD_max no likelier than the uniform prior does
+    and one at the top no less likely, so the two ranges meet. With ``risk=None`` a posterior
+    sd is at most half the domain's width, so a GD_max at or below the domain's middle is not
+    computed."""
     (_, _), (lo, hi) = emulator_domain(emulator)
-    if simplex.risk is not None or simplex.gd_max <= (lo + hi) / 2:
+    risk, gd_max = simplex.risk, simplex.gd_max
+    if risk is None and gd_max <= (lo + hi) / 2:
         return
     if not callable(getattr(emulator, "predict_mean", None)):
         return  # not an emulator that predicts (a stand-in of its records)
     speeds = (simplex.v_safe, (simplex.v_safe + simplex.v_max) / 2, simplex.v_max)
-    level, sd = top_reach(emulator, speeds)
-    if simplex.gd_max > level:
-        reach = f"{np.floor(level):.0f}"  # (rounded down: a gd_max at it is within reach)
+    ends = ("top",) if risk is None else DOMAIN_ENDS
+    posts = one_observation_posteriors(emulator, speeds, ends)
+    top = posts["top"]
+    if risk is None:
+        level, sd = _mean_reach(top, hi)
+        if gd_max > level:
+            reach = f"{np.floor(level):.0f}"  # (rounded down: a gd_max at it is within reach)
+            warnings.warn(
+                f"Simplex gd_max = {gd_max:g} lies above {reach}, the highest GD_max the "
+                f"posterior mean reliably reaches with this emulator: on ground at its highest "
+                f"GD {hi:g} or rougher the mean sits about {sd:.0f} below it (the posterior sd "
+                f"of one observation there), so safety mode may seldom or never start; use "
+                f"gd_max <= {reach}, or risk=alpha (safety mode when P(GD > GD_max) > alpha)",
+                ControlWarning,
+                stacklevel=user_stacklevel(),
+            )
+        return
+    q = f"{1 - risk:g}"
+    bottom = posts["bottom"][:1]  # at v_safe: the speed of a robot held in safety mode
+    level, floor = _quantile(top, risk, min), _quantile(bottom, risk)
+    if gd_max > level:
+        reach = f"{np.floor(level):.0f}"
         warnings.warn(
-            f"Simplex gd_max = {simplex.gd_max:g} lies above {reach}, the highest GD_max the "
-            f"posterior mean reliably reaches with this emulator: on ground at its highest GD "
-            f"{hi:g} or rougher the mean sits about {sd:.0f} below it (the posterior sd of one "
-            f"observation there), so safety mode may seldom or never start; use gd_max <= "
-            f"{reach}, or risk=alpha (safety mode when P(GD > GD_max) > alpha)",
+            f"Simplex gd_max = {gd_max:g} lies above {reach}, the highest GD_max the {q} "
+            f"posterior quantile (risk = {risk:g}) reliably reaches with this emulator: on "
+            f"ground at its highest GD {hi:g} that quantile of one observation's posterior "
+            f"reads {level:.1f}, so safety mode may seldom or never start; use gd_max <= "
+            f"{reach}, or risk <= {_risk_text(_risk_above(top, gd_max), up=False)}",
+            ControlWarning,
+            stacklevel=user_stacklevel(),
+        )
+    if floor > gd_max:
+        raise_to = [f"gd_max >= {np.ceil(floor):.0f}, or "] if np.ceil(floor) < hi else []
+        warnings.warn(
+            f"Simplex gd_max = {gd_max:g} lies below {floor:.1f}, the {q} posterior quantile "
+            f"(risk = {risk:g}) of one observation on ground at the emulator's lowest GD "
+            f"{lo:g} at v_safe = {simplex.v_safe:g} m/s: an estimate from one block or window "
+            f"calls for safety mode even on the smoothest ground the emulator knows, so the "
+            f"robot may seldom leave safety mode (the change-point method pools the blocks of "
+            f"steady ground and reads lower there, but not after a change); use "
+            f"{''.join(raise_to)}risk >= "
+            f"{_risk_text(_risk_above(bottom, gd_max), up=True)}",
             ControlWarning,
             stacklevel=user_stacklevel(),
         )

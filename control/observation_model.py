@@ -275,14 +275,18 @@ class ObservationModel:
         return float(w @ residual / np.sqrt(w @ w))
 
 
-def top_block_loglik(emulator, scatter: BlockScatter, v: float, gd: np.ndarray) -> np.ndarray:
-    """log p(y | GD) on the increasing GD nodes ``gd`` (G,), up to a constant, of one block at
-    speed ``v`` (m/s) whose feature y is the emulator's mean at (v, ``gd[-1]``): what one block
-    read at the top of the grid says (`control.compat.top_reach`)."""
+def one_block_logliks(
+    emulator, scatter: BlockScatter, v: float, gd: np.ndarray, at: tuple[int, ...] = (-1,)
+) -> np.ndarray:
+    """log p(y | GD) (len(at), G) on the increasing GD nodes ``gd`` (G,), up to a constant, of
+    one block at speed ``v`` (m/s) whose feature y is the emulator's mean at (v, ``gd[k]``), a
+    row for each node index k in ``at``: what one block read at a node says (at the grid's ends:
+    `control.compat.one_observation_posteriors`)."""
     mean = np.asarray(emulator.predict_mean(np.full(gd.size, float(v)), gd), dtype=float)
     mean = mean.reshape(gd.size, -1)  # (G, K)
     chol = _cholesky_lower(_interp_cov(scatter, v))
-    d2 = np.sum(solve_triangular(chol, (mean - mean[-1]).T, lower=True) ** 2, axis=0)
+    diff = (mean[None, :, :] - mean[list(at)][:, None, :]).reshape(-1, mean.shape[1])
+    d2 = np.sum(solve_triangular(chol, diff.T, lower=True) ** 2, axis=0).reshape(len(at), -1)
     nu, K = scatter.dof, mean.shape[1]
     return -0.5 * d2 if np.isinf(nu) else -0.5 * (nu + K) * np.log1p(d2 / nu)
 
