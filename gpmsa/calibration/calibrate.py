@@ -22,6 +22,7 @@ from threadpoolctl import threadpool_limits
 
 from gpmsa import backends
 from gpmsa.calibration import continuation as cont
+from gpmsa.calibration.judge import Run, judge_bounds, judge_convergence
 from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
     OUTSIDE_SDS,
@@ -52,11 +53,9 @@ from gpmsa.calibration.observations import (
 )
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
-from gpmsa.errors import GPMSAError, ReductionWarning, numbers_text
+from gpmsa.errors import GPMSAError, ReductionWarning, numbers_text, user_stacklevel
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, tempering, tuning
-from gpmsa.mcmc.bounds import at_bound, warn_at_bound
-from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import require_finite
 from gpmsa.model import constraints, kronecker
@@ -238,7 +237,6 @@ def calibrate(
     theta_init=None,
     fixed: dict | None = None,
     append: bool = False,
-    _online: bool = False,  # a Calibrator's update: one chain not judged (fast, silent)
     **options,
 ) -> Posterior:
     """Calibrate theta (and lamOs) by MCMC with the emulator fixed.
@@ -372,6 +370,37 @@ def calibrate(
         ``info["emulator_sha256"]`` the emulator (``Emulator.model_sha256``), so that the
         predictions taking an emulator and ``posterior=`` refuse another one.
     """
+    run = sample_calibration(
+        emulator, x_obs, y_obs, n_samples, n_burn, tune, seed, backend,
+        emulator_params=emulator_params, n_emulator_draws=n_emulator_draws,
+        discrepancy=discrepancy, discrepancy_groups=discrepancy_groups, n_chains=n_chains,
+        tune_rounds=tune_rounds, tune_levels=tune_levels, extrapolate=extrapolate, fast=fast,
+        log_prior=log_prior, progress=progress, n_jobs=n_jobs, executor=executor,
+        constraint=constraint, theta_init=theta_init, fixed=fixed, append=append, **options,
+    )  # fmt: skip
+    where = f"gpmsa.calibrate (backend {backend!r})"
+    judge_convergence(run, where, more=f", or {_more_advice(append)}")
+    std = emulator.standardizer
+    judge_bounds(run, emulator.t_names, std.t_min, std.t_max, where)
+    return run.posterior()
+
+
+def sample_calibration(
+    emulator, x_obs=None, y_obs=None, n_samples: int = 5000, n_burn: int | None = None,
+    tune: bool | None = None, seed=None, backend: str = "numpy", *,
+    emulator_params: str = "point", n_emulator_draws: int = 20, discrepancy=None,
+    discrepancy_groups=None, n_chains: int = 1, tune_rounds: int | None = None,
+    tune_levels: int | None = None, extrapolate: bool = False, fast: bool | None = None,
+    log_prior=None, progress: bool = False, n_jobs: int | None = None, executor=None,
+    constraint=None, theta_init=None, fixed: dict | None = None, append: bool = False,
+    **options,
+) -> Run:  # fmt: skip
+    """``calibrate``'s run, unjudged: its arguments (the same, with the same defaults) checked,
+    the chains run and their draws recorded as ``calibrate`` records them, without
+    ``info["diagnostics"]``, ``["convergence"]`` or ``["at_bound"]`` and their warnings
+    (``judge.judge_convergence``, ``judge.judge_bounds``). ``gpmsa.calibrate`` is this run
+    judged; a ``Calibrator``'s MCMC update runs it and judges several chains' convergence only
+    (its one chain: fast and silent). ``run.posterior()`` is the Posterior."""
     check_emulator(emulator, categorical_theta=True)
     seed = run_seed(seed)
     n_samples = check_count(n_samples, "n_samples", 2)
@@ -465,7 +494,8 @@ def calibrate(
                 [source.info.get(k) for k in ("obs_values_sha256", "obs_layout_sha256")],
                 [data.values_sha256, data.layout_sha256]))  # fmt: skip
         fit = observation_fit(emulator, data, sets)
-        warn_if_outside(fit, discrepancy=discrepancy is not None)
+        # attributed to the user's call (of calibrate, or of a Calibrator's update)
+        warn_if_outside(fit, user_stacklevel() + 1, discrepancy=discrepancy is not None)
         if fast:
             draws, info = _run_fast(
                 emulator, data, fit, sets, n_samples, n_chains, tune, tuning_opts, seed,
@@ -515,31 +545,7 @@ def calibrate(
     if held is not None:
         info["fixed"] = info.pop("fixed", {})  # after the run's own keys
         info["held"] = list(held_names)  # the posterior names held (Posterior.summary's "held")
-    if n_chains > 1 or not _online:  # a Calibrator's one-chain update: fast and silent
-        info["diagnostics"] = summarize(chains)
-        shapes = {k: v.shape[2:] for k, v in chains.items()}
-        info["convergence"] = convergence(
-            info["diagnostics"],
-            shapes,
-            n_chains,
-            next(iter(chains.values())).shape[1],
-            held=set(held_names),
-            levels=set(codes),
-        )
-        warn_unconverged(
-            info["convergence"],
-            f"gpmsa.calibrate (backend {backend!r})",
-            length="n_samples",
-            more="" if _online else f", or {_more_advice(append)}",
-        )
-    if not _online:  # (a Calibrator's update: silent, and no time spent on it)
-        skip = {*held_names, *codes}  # held and categorical elements: no such bound
-        std = emulator.standardizer
-        info["at_bound"] = at_bound(samples, emulator.t_names, std.t_min, std.t_max, skip)
-        warn_at_bound(info["at_bound"], samples, emulator.t_names, std.t_min, std.t_max,
-                      f"gpmsa.calibrate (backend {backend!r})",
-                      "Posterior.info['at_bound']")  # fmt: skip
-    return Posterior(samples, chains=chains, info=info)
+    return Run(samples, chains, info, tuple(held_names), tuple(codes))
 
 
 def _more_advice(append: bool) -> str:

@@ -62,6 +62,7 @@ from gpmsa.calibration.grid import (
     with_edges,
     zero_edges,
 )
+from gpmsa.calibration.judge import judge_convergence
 from gpmsa.calibration.local_cubic import NARROW_PRIOR_SD, narrowest_sd
 from gpmsa.calibration.model import (
     GridPredictor,
@@ -120,16 +121,16 @@ cheap prior, and a prior's cost per point grows with the level)."""
 def _check_mcmc_options(options, backend: str) -> dict:
     """``options`` (None or a dict of ``gpmsa.calibrate`` keywords, backend ``backend``'s
     sampler options among them, as ``calibrate`` passes them on) as a dict; GPMSAError naming
-    what is not a keyword the Calibrator may pass on (it gives the data, ``extrapolate``, the
-    prior and calibrate's private ``_online`` itself)."""
-    from gpmsa.calibration.calibrate import calibrate  # calibrate imports this module
+    what is not a keyword the Calibrator may pass on (it gives the data, ``extrapolate`` and the
+    prior itself)."""
+    from gpmsa.calibration.calibrate import sample_calibration  # calibrate imports this module
 
     if options is None:
         return {}
     if not isinstance(options, dict):
         raise GPMSAError(f"mcmc_options must be None or a dict, got {type(options).__name__}")
-    own = {"emulator", "x_obs", "y_obs", "extrapolate", "log_prior", "_online"}
-    named = {k for k, v in inspect.signature(calibrate).parameters.items()
+    own = {"emulator", "x_obs", "y_obs", "extrapolate", "log_prior"}
+    named = {k for k, v in inspect.signature(sample_calibration).parameters.items()
              if v.kind is not inspect.Parameter.VAR_KEYWORD}  # fmt: skip
     sampler = set(inspect.signature(backends.get(backend).sample).parameters) - {"problem"}
     allowed = sorted((named | sampler) - own - {"n_iter"})  # n_iter: calibrate's n_samples
@@ -876,8 +877,10 @@ class Calibrator:
         return margs, free, ok, logp
 
     def _update_mcmc(self, x_obs, y_obs, prior, seed, count: int, extrapolate: bool) -> Posterior:
-        """``update`` on the MCMC path (``gpmsa.calibrate``), the ``count``-th update."""
-        from gpmsa.calibration.calibrate import calibrate
+        """``update`` on the MCMC path, the ``count``-th update: ``gpmsa.calibrate``'s run
+        (``sample_calibration``), its convergence judged with several chains only (one online
+        chain: fast and silent), its draws never checked against the domain's bounds."""
+        from gpmsa.calibration.calibrate import sample_calibration
 
         if prior is not None and not callable(prior):
             raise GPMSAError(
@@ -894,8 +897,8 @@ class Calibrator:
         opts.setdefault("n_emulator_draws", self._n_emulator_draws)
         opts.setdefault("backend", self.backend)
         try:
-            return calibrate(self.emulator, x_obs, y_obs, extrapolate=extrapolate,
-                             log_prior=prior, _online=True, **opts)  # fmt: skip
+            run = sample_calibration(self.emulator, x_obs, y_obs, extrapolate=extrapolate,
+                                     log_prior=prior, **opts)  # fmt: skip
         except StartRejectedError as exc:  # calibrate's advice names its arguments, not ours
             given = all(k in opts and (v is ... or opts[k] == v) for k, v in exc.remedy.items())
             if given or not exc.remedy:  # the user's own start was rejected: as it is
@@ -906,6 +909,9 @@ class Calibrator:
             raise StartRejectedError(
                 f"{exc} (a Calibrator takes {which} as mcmc_options={{{fields}}})", exc.remedy
             ) from exc
+        if run.info["n_chains"] > 1:
+            judge_convergence(run, f"gpmsa.calibrate (backend {opts['backend']!r})")
+        return run.posterior()
 
     def _allowed(self, theta_unit: np.ndarray) -> np.ndarray:
         """(G,) bool: whether the constraint allows each unit-scale node (G, q)."""
