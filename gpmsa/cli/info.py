@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 
+from gpmsa.cli.index_text import index_record, index_text
 from gpmsa.cli.text import (
     internal_error,
     level_moves_text,
@@ -133,10 +134,6 @@ def _facts(manifest: dict, arrays: dict, emulator) -> dict:
     y_sd = [float(np.min(std.y_sd)), float(np.max(std.y_sd))] if "y_sd" in std.y_given else None
     scale = {"y_mean_given": "y_mean" in std.y_given, "y_sd_given": "y_sd" in std.y_given,
              "columnwise": bool(std.columnwise), "y_sd_range": y_sd}  # fmt: skip
-    index = None
-    if emulator.l_sim > 1:  # the "output index" line's facts, for one column too
-        index = {**_index_points(std.grid), "names": _listed(emulator.index_names),
-                 "units": _listed(emulator.index_units)}  # fmt: skip
     given = manifest["settings"].get("basis") == "given"
     basis = {"source": "given" if given else "pca", "vectors": int(emulator.K.shape[1]),
              "variance_share": _variance_share(emulator)}  # fmt: skip
@@ -155,33 +152,8 @@ def _facts(manifest: dict, arrays: dict, emulator) -> dict:
         if native is not None:
             posterior[name]["mean_native"] = dict(zip(emulator.t_names, native, strict=True))
     return {"model_sha256": emulator.model_sha256, "separable": separable, "output_scale": scale,
-            "output_index": index, "basis": basis, "posterior": posterior,
+            "output_index": index_record(emulator), "basis": basis, "posterior": posterior,
             "array_values": sum(int(a.size) for a in arrays.values())}  # fmt: skip
-
-
-def _index_points(grid: np.ndarray) -> dict:
-    """An output index (l_sim,) or (l_sim, d): its points, columns and each column's
-    [min, max]."""
-    columns = grid.reshape(grid.shape[0], -1)
-    ranges = [[float(c.min()), float(c.max())] for c in columns.T]
-    return {"points": int(columns.shape[0]), "columns": int(columns.shape[1]), "ranges": ranges}
-
-
-def _listed(labels) -> list[str] | None:
-    """``labels`` (a tuple or None) as ``--json`` gives them: a list, or null."""
-    return None if labels is None else list(labels)
-
-
-def _index_text(emulator) -> str:
-    """The output index's labels for its line, " (name [unit], ...)" (no names: "-" each);
-    "" where ``SimData(index_names=, index_units=)`` gave none."""
-    names, units = emulator.index_names, emulator.index_units
-    if names is None and units is None:
-        return ""
-    d = len(names if names is not None else units)
-    cells = [f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}"
-             for n, u in zip(names or ("-",) * d, units or ("",) * d, strict=True)]  # fmt: skip
-    return f" ({', '.join(cells)})"
 
 
 def _shapes(emulator) -> dict[str, tuple[int, ...]]:
@@ -237,16 +209,9 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
                 rng += " (range given, design inside)"
             parts.append(f"{safe(n, 60)}{' [' + safe(u, 60) + ']' if u else ''}{rng}")
         lines.append(f"{label + ':':17s}{', '.join(parts) or 'none'}")
-    grid = standardizer.grid
-    labels = _index_text(emulator)
-    if grid.ndim == 2:  # an output index of several columns (SEPIA's (l, d) y_ind)
-        spans = " x ".join("[{}, {}]".format(*numbers(float(c.min()), float(c.max())))
-                           for c in grid.T)  # fmt: skip
-        lines.append(f"output index:    {grid.shape[0]} points in {grid.shape[1]} columns"
-                     f"{labels}, {spans} (interpolated on their triangulation)")  # fmt: skip
-    elif labels:  # one column, named (SimData(index_names=, index_units=)): said only then
-        span = "[{}, {}]".format(*numbers(float(grid.min()), float(grid.max())))
-        lines.append(f"output index:    {grid.shape[0]} points{labels}, {span}")
+    index = index_text(emulator)
+    if index is not None:
+        lines.append(f"output index:    {index}")
     if emulator.separable is not None:  # SimData(separable=): file array kron_factor
         lines.append(f"separable:       {_separable_text(emulator)}")
     cat = model.get("categorical") or {}

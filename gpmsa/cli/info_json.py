@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 
+from gpmsa.cli.index_text import index_record
 from gpmsa.io.container import jsonable
 
 INFO_FORMAT = "gpmsa-info/1"
@@ -96,6 +97,7 @@ def study_info(file: str, manifest: dict, study) -> dict:
                   for n, u in zip(emu.t_names, emu.t_units, strict=True)]  # fmt: skip
         models.append({"label": mod["label"], "file": mod["file"], "sha256": mod["sha256"],
                        "m": emu.m, "p": emu.p, "l_sim": emu.l_sim, "parameters": params,
+                       "output_index": index_record(emu),
                        "discrepancy": study.discrepancy(i)})  # fmt: skip
     hyper = manifest["priors"].get("hyper") if st["hierarchical"] else None
     return {

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from gpmsa.cli.index_text import index_text
 from gpmsa.cli.text import level_moves_text, number, numbers, plain, safe, tempering_text, value
 
 
@@ -28,6 +29,9 @@ def study_lines(file: str, manifest: dict, study) -> list[str]:
         lines.append(f"model {safe(mod['label'], 60)}: file {safe(mod['file'], 160)} sha256 "
                      f"{safe(mod['sha256'], 64)} (verified); m={emu.m}, p={emu.p}, "
                      f"l_sim={emu.l_sim}; parameters {params}")  # fmt: skip
+        index = index_text(emu)
+        if index is not None:  # as an emulator file's "output index:" line
+            lines.append(f"  output index {index}")
         disc = study.discrepancy(i)
         if disc is not None:  # the model's discrepancy and its precision groups
             groups = disc["discrepancy_groups"]
