@@ -305,7 +305,7 @@ def run_closed_loop(
     if check:
         check_emulator(emulator, model=model, noise_std=noise_std, bcr=bcr)
         _check_track_domain(emulator, track)
-        check_emulator(emulator, simplex=simplex)
+        check_emulator(emulator, simplex=simplex, bcr=bcr)  # (its method: ends checked)
     if likelihood is not None:
         check_likelihood(emulator, likelihood)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)

@@ -122,8 +122,10 @@ def check_emulator(
     358); vehicle or noise metadata missing; a Simplex with ``risk=None`` whose GD_max lies
     above `top_reach` (the posterior mean, cut at the emulator's highest GD, seldom exceeds it
     even on rougher ground); one with ``risk`` = alpha whose GD_max lies above
-    `top_quantile_reach` (the (1 - alpha) quantile seldom exceeds it) or below `bottom_quantile`
-    at v_safe (that quantile exceeds it even on the emulator's smoothest ground).
+    `top_quantile_reach` (the (1 - alpha) quantile seldom exceeds it) or, with ``bcr`` of
+    method "window" (each window alone), below `bottom_quantile` at v_safe (that quantile
+    exceeds it even on the emulator's smoothest ground; the default methods pool and read
+    lower there).
     """
     _check_is_emulator(emulator)
     if model is not None and not callable(getattr(model, "describe", None)):
@@ -199,7 +201,7 @@ def check_emulator(
                 "mode; GD is in units of 1e-6 m^3 (Gd(n0) x 1e6: the paper's band is "
                 "Simplex(gd_min=250, gd_max=350))"
             )
-        _warn_if_out_of_reach(emulator, simplex)
+        _warn_if_out_of_reach(emulator, simplex, bcr is not None and bcr.method == "window")
 
 
 REACH_GRID = 121
@@ -293,26 +295,46 @@ def _risk_above(posts: list[GridMarginal], gd_max: float) -> float:
     return min(1.0 - float(post.cdf(gd_max)) for post in posts)
 
 
-def _risk_text(risk: float, up: bool) -> str:
-    """``risk`` to 2 significant digits, rounded up (``up``) or down: a risk that still holds."""
-    digits = 1 - int(np.floor(np.log10(risk)))
-    scaled = risk * 10.0**digits
-    return f"{(np.ceil(scaled) if up else np.floor(scaled)) / 10.0**digits:.{max(digits, 0)}f}"
+def _risk_text(low: float, high: float, up: bool) -> str | None:
+    """A risk in [``low``, ``high``] and in (0, 1) as text: ``low`` rounded up (``up``) or
+    ``high`` rounded down, to the fewest significant digits (2 to 6) that stay in that range
+    (a risk that serves both ends of the domain); None where none does."""
+    x = low if up else high
+    if not 0 < x < 1:
+        return None
+    for sig in range(2, 7):
+        digits = sig - 1 - int(np.floor(np.log10(x)))
+        scaled = x * 10.0**digits
+        value = (np.ceil(scaled) if up else np.floor(scaled)) / 10.0**digits
+        if low <= value <= high and 0 < value < 1:
+            return f"{value:.{max(digits, 0)}f}"
+    return None
 
 
-def _warn_if_out_of_reach(emulator, simplex: Simplex) -> None:
+def _remedies(gd_max_text: str | None, risk_text: str | None, op: str) -> str:
+    """The end of a reach warning: the GD_max and the risk (``op``: "<=" or ">=" it) that
+    serve, either None where none serves both ends of the domain."""
+    uses = [text for text in (gd_max_text, risk_text and f"risk {op} {risk_text}") if text]
+    if not uses:
+        return "no GD_max or risk serves both ends of this emulator's domain"
+    return "use " + ", or ".join(uses)
+
+
+def _warn_if_out_of_reach(emulator, simplex: Simplex, one_observation: bool = False) -> None:
     """ControlWarning where the GD the Simplex compares with GD_max cannot serve it, from the
     posteriors of one observation at the ends of the emulator's GD domain
     (`one_observation_posteriors`) at its speeds (v_safe, their middle, v_max): with
     ``risk=None`` a GD_max above `top_reach` (the posterior mean seldom exceeds it); with
     ``risk`` = alpha a GD_max above `top_quantile_reach` (the (1 - alpha) quantile seldom
-    exceeds it), or below `bottom_quantile` at v_safe (that quantile exceeds it even on the
-    smoothest ground: safety mode seldom ends). Each names the risks that serve: those at
-    most P(GD > GD_max) at the top and at least that at the bottom; for a feature monotone in
-    GD one observation at the bottom makes GD > GD_max no likelier than the uniform prior does
-    and one at the top no less likely, so the two ranges meet. With ``risk=None`` a posterior
-    sd is at most half the domain's width, so a GD_max at or below the domain's middle is not
-    computed."""
+    exceeds it), or, for a BCR that estimates from each window alone (``one_observation``:
+    method "window"), below `bottom_quantile` at v_safe (that quantile exceeds it even on the
+    smoothest ground: much of the drive in safety mode; the default methods pool the blocks or
+    windows of steady ground and read lower there). Each names a GD_max and a risk that serve
+    both ends: risks at most P(GD > GD_max) at the top and at least that at the bottom; for a
+    feature monotone in GD one observation at the bottom makes GD > GD_max no likelier than the
+    uniform prior does and one at the top no less likely, so the two ranges meet. With
+    ``risk=None`` a posterior sd is at most half the domain's width, so a GD_max at or below
+    the domain's middle is not computed."""
     (_, _), (lo, hi) = emulator_domain(emulator)
     risk, gd_max = simplex.risk, simplex.gd_max
     if risk is None and gd_max <= (lo + hi) / 2:
@@ -320,8 +342,8 @@ def _warn_if_out_of_reach(emulator, simplex: Simplex) -> None:
     if not callable(getattr(emulator, "predict_mean", None)):
         return  # not an emulator that predicts (a stand-in of its records)
     speeds = (simplex.v_safe, (simplex.v_safe + simplex.v_max) / 2, simplex.v_max)
-    ends = ("top",) if risk is None else DOMAIN_ENDS
-    posts = one_observation_posteriors(emulator, speeds, ends)
+    both = risk is not None and one_observation
+    posts = one_observation_posteriors(emulator, speeds, DOMAIN_ENDS if both else ("top",))
     top = posts["top"]
     if risk is None:
         level, sd = _mean_reach(top, hi)
@@ -337,31 +359,35 @@ def _warn_if_out_of_reach(emulator, simplex: Simplex) -> None:
                 stacklevel=user_stacklevel(),
             )
         return
-    q = f"{1 - risk:g}"
-    bottom = posts["bottom"][:1]  # at v_safe: the speed of a robot held in safety mode
-    level, floor = _quantile(top, risk, min), _quantile(bottom, risk)
+    q = numbers_text(1 - risk, 1.0)[0]  # (0.999999999 for risk 1e-9, not 1)
+    level, top_risk = _quantile(top, risk, min), _risk_above(top, gd_max)
+    floor, bottom_risk = -np.inf, 0.0  # (a pooling BCR: the bottom is not checked)
+    if both:
+        bottom = posts["bottom"][:1]  # at v_safe: the speed of a robot held in safety mode
+        floor, bottom_risk = _quantile(bottom, risk), _risk_above(bottom, gd_max)
     if gd_max > level:
-        reach = f"{np.floor(level):.0f}"
+        reach = np.floor(level)  # (rounded down: a gd_max at it is within reach)
+        lower = f"gd_max <= {reach:.0f}" if reach >= floor else None
         warnings.warn(
-            f"Simplex gd_max = {gd_max:g} lies above {reach}, the highest GD_max the {q} "
+            f"Simplex gd_max = {gd_max:g} lies above {reach:.0f}, the highest GD_max the {q} "
             f"posterior quantile (risk = {risk:g}) reliably reaches with this emulator: on "
             f"ground at its highest GD {hi:g} that quantile of one observation's posterior "
-            f"reads {level:.1f}, so safety mode may seldom or never start; use gd_max <= "
-            f"{reach}, or risk <= {_risk_text(_risk_above(top, gd_max), up=False)}",
+            f"reads {level:.1f}, so safety mode may seldom or never start; "
+            + _remedies(lower, _risk_text(bottom_risk, top_risk, up=False), "<="),
             ControlWarning,
             stacklevel=user_stacklevel(),
         )
     if floor > gd_max:
-        raise_to = [f"gd_max >= {np.ceil(floor):.0f}, or "] if np.ceil(floor) < hi else []
+        least = np.ceil(floor)
+        higher = f"gd_max >= {least:.0f}" if least < hi and least <= level else None
         warnings.warn(
             f"Simplex gd_max = {gd_max:g} lies below {floor:.1f}, the {q} posterior quantile "
             f"(risk = {risk:g}) of one observation on ground at the emulator's lowest GD "
-            f"{lo:g} at v_safe = {simplex.v_safe:g} m/s: an estimate from one block or window "
+            f"{lo:g} at v_safe = {simplex.v_safe:g} m/s: an estimate from one window there "
             f"calls for safety mode even on the smoothest ground the emulator knows, so the "
-            f"robot may seldom leave safety mode (the change-point method pools the blocks of "
-            f"steady ground and reads lower there, but not after a change); use "
-            f"{''.join(raise_to)}risk >= "
-            f"{_risk_text(_risk_above(bottom, gd_max), up=True)}",
+            f"robot may spend much of its drive in safety mode (the default methods pool the "
+            f"blocks or windows of steady ground and read lower there); "
+            + _remedies(higher, _risk_text(bottom_risk, top_risk, up=True), ">="),
             ControlWarning,
             stacklevel=user_stacklevel(),
         )

@@ -9,7 +9,7 @@ import pytest
 from scipy import stats
 
 import control
-from control.compat import bottom_quantile, top_quantile_reach
+from control.compat import _warn_if_out_of_reach, bottom_quantile, top_quantile_reach
 from control.observation_model import BlockScatter
 
 
@@ -66,20 +66,31 @@ def test_a_gd_max_out_of_the_quantiles_reach_warns_naming_the_level_and_the_risk
     assert check(block_emulator(), gd_max=599, risk=0.01) == []  # 599.4: a smaller risk reaches
 
 
+def one_window(emu, **simplex) -> list[str]:
+    """The reach check's ControlWarnings for a BCR that estimates from each window alone
+    (method "window": the bottom is checked too)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _warn_if_out_of_reach(emu, control.Simplex(**simplex), one_observation=True)
+    return [str(w.message) for w in caught if issubclass(w.category, control.ControlWarning)]
+
+
 def test_a_gd_max_below_the_quantile_on_the_smoothest_ground_warns():
     """Simplex(gd_max=300, risk=0.01) passed silently: on ground at the domain's lowest GD 200
     one observation's 0.99 quantile reads 328.8, so every estimate there calls for safety mode
     (the shipped window emulators' estimates on GD 200 at 1 m/s: 100% with gd_max 350)."""
-    (message,) = check(block_emulator(), gd_min=210, gd_max=300, risk=0.01)
+    (message,) = one_window(block_emulator(), gd_min=210, gd_max=300, risk=0.01)
     assert message.startswith(
         "Simplex gd_max = 300 lies below 328.8, the 0.99 posterior quantile (risk = 0.01) of "
         "one observation on ground at the emulator's lowest GD 200 at v_safe = 1 m/s"
     )
-    assert "the robot may seldom leave safety mode" in message
+    assert "the robot may spend much of its drive in safety mode" in message
     # P(GD > 300) = 2 (1 - Phi(2)) = 0.0455: a risk from 0.046 lets the robot go
     assert message.endswith("use gd_max >= 329, or risk >= 0.046")
-    assert check(block_emulator(), gd_min=210, gd_max=300, risk=0.05) == []
-    assert check(block_emulator(), gd_max=350, risk=0.01) == []  # the paper's band
+    assert one_window(block_emulator(), gd_min=210, gd_max=300, risk=0.05) == []
+    assert one_window(block_emulator(), gd_max=350, risk=0.01) == []  # the paper's band
+    # a BCR that pools (the default methods): the bottom is not checked
+    assert check(block_emulator(), gd_min=210, gd_max=300, risk=0.01) == []
 
 
 def test_both_ends_share_one_prediction_per_speed():
