@@ -81,8 +81,8 @@ from gpmsa.calibration.observations import (
     emulator_param_sets,
     emulator_record,
     fit_at_levels,
-    fit_of,
     fixed_gp,
+    outside_sds,
     probe_layout,
     reduce,
     theta_levels,
@@ -409,16 +409,18 @@ class Calibrator:
 
     # --- the exact likelihood on a grid ---------------------------------------------------------
     def _marginals(
-        self, data: Observations, theta_unit: np.ndarray | None, fits: list | None = None
+        self, data: Observations, theta_unit: np.ndarray | None, outside: list | None = None
     ) -> list[LamOsMarginal]:
         """lamOs-marginal likelihoods per emulator parameter set on the fixed grid (None) or on
-        the given unit-scale nodes (dense solves); ``fits`` collects each set's ``Fit``, on
-        `theta_probe`'s nodes where the fixed grid is coarser (its distance otherwise grew as
-        the grid coarsened: n_grid=3 read an observation at 0.3 of the range 34 sds outside)."""
+        the given unit-scale nodes (dense solves); ``outside`` collects each set's
+        ``Fit.outside_sds`` (`outside_sds`), on `theta_probe`'s nodes where the fixed grid is
+        coarser (its distance otherwise grew as the grid coarsened: n_grid=3 read an
+        observation at 0.3 of the range 34 sds outside)."""
         out = []
         d = data.z.size
         refined = self._refined is not None and theta_unit is not None and np.array_equal(
             theta_unit[:, 0], self._refined[0])  # fmt: skip
+        coarse = self.n_grid < probe_layout(self.q)[0]  # the fit is judged on the probe
         for k, (gp, pred) in enumerate(zip(self._gps, self._predictors, strict=True)):
             if theta_unit is None:
                 mean, cov = pred.predict(data.x)
@@ -426,13 +428,13 @@ class Calibrator:
                 mean, cov = self._refined[1][k].predict(data.x)
             else:
                 mean, cov = gp.predict(data.x, theta_unit)
-            if fits is not None and self._levels is not None:  # (fixed grid only)
-                fits.append(self._level_fit(gp, mean, cov, data))
-            elif fits is not None and theta_unit is None and self.n_grid < probe_layout(self.q)[0]:
+            if outside is not None and self._levels is not None:  # (fixed grid only)
+                outside.append(self._level_outside(gp, mean, cov, data))
+            elif outside is not None and theta_unit is None and coarse:
                 probe = gp.predict(data.x, theta_probe(self.q))
-                fits.append(fit_of(*probe, data, probe_layout(self.q)))
-            elif fits is not None:  # on the fixed grid (fits are kept only there)
-                fits.append(fit_of(mean, cov, data, (self.n_grid,) * self.q))
+                outside.append(outside_sds(*probe, data, probe_layout(self.q)))
+            elif outside is not None:  # on the fixed grid (kept only there)
+                outside.append(outside_sds(mean, cov, data, (self.n_grid,) * self.q))
             G = mean.shape[0]
             out.append(
                 lamos_marginal(
@@ -446,23 +448,22 @@ class Calibrator:
             )
         return out
 
-    def _level_fit(self, gp, mean: np.ndarray, cov: np.ndarray, data: Observations) -> Fit:
-        """``Fit`` of the observation for a categorical theta from the fixed grid's predictive
-        ``mean``, ``cov`` (emulator parameter set ``gp``): the continuous nodes of each level
-        apart (a datum is met where its residual changes sign between neighbouring nodes of
-        one level, never between levels), the nearest over the levels; with fewer continuous
-        nodes than `theta_probe`'s, calibrate's probe (`fit_at_levels`)."""
+    def _level_outside(self, gp, mean: np.ndarray, cov: np.ndarray, data: Observations) -> float:
+        """``Fit.outside_sds`` of the observation for a categorical theta from the fixed grid's
+        predictive ``mean``, ``cov`` (emulator parameter set ``gp``): the continuous nodes of each
+        level apart (a datum is met where its residual changes sign between neighbouring nodes of
+        one level, never between levels), the nearest over the levels; with fewer continuous nodes
+        than `theta_probe`'s, calibrate's probe (`fit_at_levels`)."""
         cont = [k for k, lv in enumerate(self._levels) if lv is None]
         if not cont:  # the nodes are the combinations of levels
-            return fit_of(mean, cov, data, None)
+            return outside_sds(mean, cov, data, None)
         if self.n_grid < probe_layout(1)[0]:
             fit = fit_at_levels(gp.predict, data, self._levels)
             if fit is not None:
-                return fit
+                return fit.outside_sds
         shape = tuple(a.size for a in self._axes)
         rows = np.moveaxis(np.arange(mean.shape[0]).reshape(shape), cont[0], -1)
-        fits = [fit_of(mean[r], cov[r], data, (r.size,)) for r in rows]
-        return Fit(min(f.outside_sds for f in fits), min(f.excess_var for f in fits))
+        return min(outside_sds(mean[r], cov[r], data, (r.size,)) for r in rows)
 
     @staticmethod
     def _combine(marginals: list[LamOsMarginal]) -> np.ndarray:
@@ -494,10 +495,10 @@ class Calibrator:
         """
         self._check_grid_method()
         data = reduce(self.emulator, x_obs, y_obs, self._extrapolate(extrapolate))
-        fits: list[Fit] = []
+        seen: list[float] = []
         with blas_controller().limit(limits=1, user_api="blas"):
-            ll = self._combine(self._marginals(data, None, fits))
-        warn_if_outside(Fit(min(f.outside_sds for f in fits), 0.0))
+            ll = self._combine(self._marginals(data, None, seen))
+        warn_if_outside(Fit(min(seen), 0.0))
         if np.any(np.isnan(ll)):
             raise GPMSAError("the likelihood could not be evaluated for this observation")
         return self.theta_grid, ll
@@ -598,10 +599,10 @@ class Calibrator:
             self._count = count
             return post
         data = reduce(self.emulator, x_obs, y_obs, extrapolate)
-        fits: list[Fit] = []
+        seen: list[float] = []
         with blas_controller().limit(limits=1, user_api="blas"):
-            margs = self._marginals(data, None, fits)
-            outside = min(f.outside_sds for f in fits)
+            margs = self._marginals(data, None, seen)
+            outside = min(seen)
             warn_if_outside(Fit(outside, 0.0))
             axes, theta, ok = self._axes, self._theta_unit, self._base_ok
             free = self._combine(margs) + self._log_prior_theta
