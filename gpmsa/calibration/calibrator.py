@@ -184,7 +184,8 @@ class Calibrator:
     """Calibration of ``emulator`` for a stream of observations, prepared once.
 
     Args:
-        emulator: a gpmsa.Emulator (no discrepancy model is used).
+        emulator: a gpmsa.Emulator (the grid uses no discrepancy model; the MCMC path takes
+            one as ``mcmc_options={"discrepancy": ...}``).
         method: "grid" (exact, q <= 2), "mcmc" (``gpmsa.calibrate``), or "auto" (grid for q <= 2;
             MCMC for a categorical and a continuous parameter with a ``constraint``).
         n_grid: nodes per calibration parameter of the fixed grid (default 129 for q = 1, 65 for
@@ -204,8 +205,9 @@ class Calibrator:
         seed: seed of those draws (and of the MCMC), for reproducibility: an integer, a numpy
             Generator (an integer is drawn from it) or None (fresh entropy).
         mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC
-            (``"fixed"``, which holds parameters at known values, only there: with the grid
-            method it is a GPMSAError), the backend's sampler options among them, as
+            (``"fixed"``, which holds parameters at known values, and ``"discrepancy"`` /
+            ``"discrepancy_groups"``, only there: with the grid method they are a GPMSAError),
+            the backend's sampler options among them, as
             ``calibrate`` takes them (``{"dtype": "float32"}`` for torch, ``{"n_warmup": 200}``
             for pyro). A continuation's ``"init"`` (a Posterior) and ``"append": True`` are a
             GPMSAError: each update runs fresh chains.
@@ -303,6 +305,16 @@ class Calibrator:
                 "uses the exact grid (method='auto' chooses it for 1 or 2 parameters), which "
                 "would ignore it: use Calibrator(emu, method='mcmc', mcmc_options={'fixed': "
                 "...}), or gpmsa.calibrate(..., fixed=...)"
+            )
+        model = [k for k in ("discrepancy", "discrepancy_groups")
+                 if self.mcmc_options.get(k) is not None]  # fmt: skip
+        if self.method == "grid" and model:
+            raise GPMSAError(
+                f"mcmc_options[{model[0]!r}] adds a discrepancy on the MCMC path, and this "
+                "Calibrator uses the exact grid (method='auto' chooses it for 1 or 2 "
+                "parameters), which has no discrepancy and would ignore it: use "
+                f"Calibrator(emu, method='mcmc', mcmc_options={{{model[0]!r}: ...}}), or "
+                f"gpmsa.calibrate(..., {model[0]}=...)"
             )
         if n_grid is None:  # a categorical parameter with a continuous one: 129 per level
             n_grid = 129 if q == 1 or mixed else 65

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 from threadpoolctl import threadpool_limits
 
-from gpmsa.errors import EmulatorFileError, GPMSAError
+from gpmsa.errors import EmulatorFileError, GPMSAError, user_stacklevel
 from gpmsa.fitting.validation import (
     DISCREPANCY_ARRAY,
     EMULATOR_PARAMS,
@@ -462,12 +462,13 @@ class Emulator:
             self._factors[-2] = kronecker.emulator_factors(self, self.params)
         return self._factors[-2]
 
-    def _inputs(self, x, t, *, extrapolate: bool = False, stacklevel: int = 3) -> np.ndarray:
+    def _inputs(self, x, t, *, extrapolate: bool = False) -> np.ndarray:
         """Unit-scale z (N, p + q) of native x and t, under the library's extrapolation rule
         (``check_extrapolation``): outside the domain an ExtrapolationWarning, beyond
         ``EXTRAPOLATION_MARGIN`` of a column's width a GPMSAError naming x or t, the column, its
-        values and the domain, unless ``extrapolate`` (then the warning); ``stacklevel``: of the
-        warning, counted from here (3: the caller's caller), so that it names the user's line."""
+        values and the domain, unless ``extrapolate`` (then the warning). The warning names the
+        user's line: the first frame outside gpmsa, however deep the library's own calls run
+        (``predict`` called by ``plots.emulator_fit`` too)."""
         check_same_rows({"x": x, "t": t}, {"x": self.x_names, "t": self.t_names})
         if x is None and self.p == 0:  # no known inputs: one row of none, broadcast against t
             x = np.empty((1, 0))
@@ -500,7 +501,7 @@ class Emulator:
             check_extrapolation(
                 native, z, names, np.concatenate([s.x_min, s.t_min]),
                 np.concatenate([s.x_max, s.t_max]), ("x",) * self.p + ("t",) * self.q,
-                extrapolate, stacklevel,
+                extrapolate, user_stacklevel(),
             )  # fmt: skip
         return z
 
@@ -545,7 +546,7 @@ class Emulator:
         """``predict(x, t, resid=resid, extrapolate=extrapolate)`` at the point estimate (native
         mean and variance); ``var=False``: the variance None (``predict_mean``)."""
         self._check_predict_memory(x, t)
-        z = self._inputs(x, t, extrapolate=extrapolate, stacklevel=4)  # the caller of predict()
+        z = self._inputs(x, t, extrapolate=extrapolate)
         m, v = self._predict_std(z, self.params, self._predict_factors(None, True), resid, var=var)
         s = self.standardizer
         return s.y_from_std(m), None if v is None else s.var_from_std(v)
@@ -557,7 +558,7 @@ class Emulator:
         """``predict(x, t, draws=True, n_draws=n_draws, resid=resid, extrapolate=extrapolate)``;
         ``var=False``: the variance None (``predict_mean``)."""
         self._check_predict_memory(x, t)
-        z = self._inputs(x, t, extrapolate=extrapolate, stacklevel=4)  # the caller of predict()
+        z = self._inputs(x, t, extrapolate=extrapolate)
         s = self.standardizer
         if not self.draws:
             raise GPMSAError(

@@ -193,10 +193,27 @@ def main_effect_curves(
         ax.set_visible(False)
     if spread or gp is not None:
         axes[0].legend(fontsize="small")
-    where = f" at output {output}" if l_sim > 1 else ""
+    where = f" at output {output}{_point_title(sens, output)}" if l_sim > 1 else ""
     drawn = f"over {curves.shape[0]} draws" if spread else "the point estimate"
     fig.suptitle(f"main effects{where} ({drawn})", fontsize="small")
     return fig
+
+
+def _point_title(sens: Sensitivity, output: int) -> str:
+    """Where output element ``output`` lies on the output index, for a title: ", time = 0.6 s,
+    angle = 0 rad" (the index's names and units; "output index" or "output index[:, k]" where
+    none were given); "" without an index."""
+    grid = getattr(sens, "grid", None)
+    if grid is None or np.shape(grid)[0] != sens.main_effect.shape[2]:
+        return ""
+    d = np.shape(grid)[1] if np.ndim(grid) == 2 else 1
+    default = ("output index",) if d == 1 else tuple(f"output index[:, {k}]" for k in range(d))
+    names = default if sens.index_names is None else tuple(sens.index_names)
+    units = ("",) * d if sens.index_units is None else tuple(sens.index_units)
+    row = np.reshape(grid[output], -1)
+    parts = [f"{n} = {float(v):.4g}" + (f" {u}" if u else "")
+             for n, v, u in zip(names, row, units, strict=True)]  # fmt: skip
+    return ", " + ", ".join(parts)
 
 
 def _level_ticks(sens: Sensitivity, level_names) -> dict[str, tuple[list[float], list[str]]]:

@@ -316,7 +316,9 @@ def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool, b
         if not all(g.shape == grid.shape and np.array_equal(g, grid) for g in obs_grids):
             raise GPMSAError(
                 "a discrepancy basis given as an array is known on the observations' grid only: "
-                "every experiment must share that grid, and grid= must be it (or None)"
+                "every experiment must share that grid, and grid= must be it (or None); on any "
+                "other grid pass the same basis functions evaluated at grid='s points as "
+                "grid_discrepancy= (one row per point)"
             )
         return discrepancy_basis(kind, grid)
     # "constant"/"linear": the first column is 1 before normalisation; keep the data's scale.
@@ -403,7 +405,9 @@ def _experiment_basis(bases, obs_grids: list[np.ndarray], grid: np.ndarray) -> n
         raise GPMSAError(
             "per-experiment discrepancy bases (a list) are known on their experiments' index "
             "grids only: pass grid= one experiment's grid (obs.grids[j]; experiments "
-            f"{sizes}{', ...' if len(obs_grids) > 6 else ''}); delta is then its basis's"
+            f"{sizes}{', ...' if len(obs_grids) > 6 else ''}), whose basis gives delta, or "
+            "experiment=j; on any other grid pass the basis functions evaluated at grid='s "
+            "points as grid_discrepancy= (one row per point, as given to the fit)"
         )
     D = bases[on[0]]
     if any(not np.array_equal(bases[j], D) for j in on[1:]):
@@ -531,7 +535,9 @@ def _recorded_discrepancy(emulator, posterior: Posterior | None):
             f"{source} used a discrepancy basis given as an array; pass it again as discrepancy="
         )
     if isinstance(kind, str) and kind == "list":
-        kept = getattr(emulator, "discrepancy_bases", None) if posterior is None else None
+        kept = getattr(emulator, "discrepancy_bases", None)
+        if posterior is not None and not _kept_for(emulator, record):
+            kept = None
         if kept is None:
             raise GPMSAError(
                 f"{source} used per-experiment discrepancy bases (a list); pass the list again "
@@ -539,6 +545,24 @@ def _recorded_discrepancy(emulator, posterior: Posterior | None):
             )
         return kept
     return kind
+
+
+def _kept_for(emulator, record: dict) -> bool:
+    """Whether the joint fit's kept per-experiment bases (``Emulator.discrepancy_bases``) are
+    the list a posterior's calibration used (``record``: its info): the same normalised basis
+    and groups (``discrepancy_sha256``) divided by the same number (``discrepancy_scale``), as
+    ``calibration_posterior(emu)`` records them (a ``calibrate`` run on the joint fit's
+    emulator with the list given to the fit too); the emulator itself is checked by the
+    caller (``emulator_sha256``)."""
+    settings = emulator.settings or {}
+    digest, scale = settings.get("discrepancy_sha256"), settings.get("discrepancy_scale")
+    return (
+        digest is not None
+        and scale is not None
+        and record.get("discrepancy_sha256") == digest
+        and record.get("discrepancy_scale") is not None
+        and float(record["discrepancy_scale"]) == float(scale)
+    )
 
 
 def full_prediction(
