@@ -187,21 +187,30 @@ def check_emulator(
                 stacklevel=user_stacklevel(),
             )
     if simplex is not None:
-        _check_speeds(emulator, simplex)
-        lo, hi = emulator_domain(emulator)[1]
-        if not simplex.gd_max < hi:
-            raise EmulatorMismatchError(
-                f"Simplex gd_max = {simplex.gd_max:g} is not below the emulator's highest GD "
-                f"{hi:g}: no GD estimate could exceed it, so safety mode would never start"
-            )
-        if not simplex.gd_max > lo:
-            raise EmulatorMismatchError(
-                f"Simplex gd_max = {simplex.gd_max:g} is not above the emulator's lowest GD "
-                f"{lo:g}: every GD estimate exceeds it, so the robot would never leave safety "
-                "mode; GD is in units of 1e-6 m^3 (Gd(n0) x 1e6: the paper's band is "
-                "Simplex(gd_min=250, gd_max=350))"
-            )
-        _warn_if_out_of_reach(emulator, simplex, bcr is not None and bcr.method == "window")
+        check_simplex(emulator, simplex, bcr)
+
+
+def check_simplex(emulator, simplex: Simplex, bcr: BCRSettings | None = None) -> None:
+    """`check_emulator`'s checks of a Simplex (speeds inside the speed domain, GD_max inside the
+    GD domain: `EmulatorMismatchError`; GD_max out of the estimate's reach: `ControlWarning`),
+    without its feature check: ``bcr`` only tells which estimator runs (method "window": the
+    bottom of the domain is checked too), so a replay of an emulator that records no feature
+    takes them."""
+    _check_speeds(emulator, simplex)
+    lo, hi = emulator_domain(emulator)[1]
+    if not simplex.gd_max < hi:
+        raise EmulatorMismatchError(
+            f"Simplex gd_max = {simplex.gd_max:g} is not below the emulator's highest GD "
+            f"{hi:g}: no GD estimate could exceed it, so safety mode would never start"
+        )
+    if not simplex.gd_max > lo:
+        raise EmulatorMismatchError(
+            f"Simplex gd_max = {simplex.gd_max:g} is not above the emulator's lowest GD "
+            f"{lo:g}: every GD estimate exceeds it, so the robot would never leave safety "
+            "mode; GD is in units of 1e-6 m^3 (Gd(n0) x 1e6: the paper's band is "
+            "Simplex(gd_min=250, gd_max=350))"
+        )
+    _warn_if_out_of_reach(emulator, simplex, bcr is not None and bcr.method == "window")
 
 
 REACH_GRID = 121

@@ -58,6 +58,7 @@ from control.compat import (
     check_likelihood,
     check_recorded_feature,
     check_recorded_vehicle,
+    check_simplex,
     recorded_vehicle_mismatch,
 )
 from control.errors import BagError, ControlError, ControlWarning, user_stacklevel
@@ -761,7 +762,8 @@ def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simple
     if not isinstance(simplex, Simplex):
         raise ControlError(f"simplex must be a control.Simplex, got {type(simplex).__name__}")
     check_instance(bcr, "bcr", BCRSettings)
-    check_emulator(emulator, simplex=simplex)
+    check_emulator(emulator)
+    check_simplex(emulator, simplex, bcr)  # (the BCR's method: the window's reach checked)
     check_recorded_feature(emulator, bcr)  # as the BCR would, once the recording was read
     nyquist = bcr.rate_hz / 2
     if s.gravity == "highpass" and s.highpass_hz >= nyquist:
