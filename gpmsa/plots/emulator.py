@@ -8,7 +8,14 @@ from scipy.special import ndtri
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.basis import variance_shares
-from gpmsa.model.data import SimData, check_count, check_flag, check_level, column_order
+from gpmsa.model.data import (
+    SimData,
+    as_matrix,
+    check_count,
+    check_flag,
+    check_level,
+    column_order,
+)
 from gpmsa.plots import _maps
 from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
 from gpmsa.predictive.crossval import CrossValidation
@@ -106,6 +113,26 @@ def _held_out_inputs(emulator, held_out: SimData) -> tuple[np.ndarray, np.ndarra
     return columns[0], columns[1]
 
 
+def _held_out_runs(emulator, held_out) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
+    """x, t (the emulator's column order) and y (n, l_sim) of held-out runs given as a SimData
+    (`_held_out_inputs`) or as a tuple (x, t, y) of native arrays in the emulator's columns (any
+    number of runs, one too: a SimData needs p + q + 2 of them); GPMSAError naming a bad part
+    (``Emulator.predict`` checks x and t)."""
+    if isinstance(held_out, SimData):
+        return (*_held_out_inputs(emulator, held_out), held_out.y)
+    if len(held_out) != 3:
+        raise GPMSAError(f"held_out as a tuple must be (x, t, y), got {len(held_out)} items")
+    x, t, y = held_out
+    y = as_matrix(y, "held_out y", ncols=emulator.l_sim)
+    rows = {"t": as_matrix(t, "held_out t", ncols=emulator.q).shape[0]}
+    if x is not None:
+        rows["x"] = as_matrix(x, "held_out x", ncols=emulator.p, no_columns=True).shape[0]
+    if any(n != y.shape[0] for n in rows.values()):
+        raise GPMSAError(f"held_out x, t and y must have one row per run: y has {y.shape[0]} "
+                         f"rows, {', '.join(f'{k} {v}' for k, v in rows.items())}")  # fmt: skip
+    return x, t, y
+
+
 def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
                  draws: bool = True, n_draws: int | None = 100):  # fmt: skip
     """Emulator predictions against held-out runs (or a cross-validation): a Figure.
@@ -121,7 +148,9 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
     Args:
         emulator: the gpmsa.Emulator.
         held_out: a SimData of runs not used in the fit (predicted by ``Emulator.predict``, over
-            the retained draws when ``draws``), or a CrossValidation from ``cross_validate``.
+            the retained draws when ``draws``), or their arrays ``(x, t, y)`` in native units
+            and the emulator's columns (x None without known inputs; any number of runs, where
+            a SimData needs p + q + 2), or a CrossValidation from ``cross_validate``.
         level: probability of the intervals.
         max_runs: runs drawn on the right.
         draws: average the prediction of held-out runs over the posterior draws (at most
@@ -151,16 +180,15 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
                 "held_out is the cross-validation of another emulator (its runs' outputs differ "
                 "from this emulator's)"
             )
-    elif isinstance(held_out, SimData):
-        x, t = _held_out_inputs(emulator, held_out)
+    elif isinstance(held_out, SimData | tuple):
+        x, t, actual = _held_out_runs(emulator, held_out)
         use = draws and emulator.n_draws > 0
         mean, var = emulator.predict(x, t, draws=use, n_draws=n_draws)
-        actual = held_out.y
-        what = f"{held_out.m} held-out runs"
+        what = f"{actual.shape[0]} held-out runs"
     else:
         raise GPMSAError(
-            f"held_out must be a SimData of held-out runs or a CrossValidation, got "
-            f"{type(held_out).__name__}"
+            f"held_out must be a SimData of held-out runs, their (x, t, y) arrays or a "
+            f"CrossValidation, got {type(held_out).__name__}"
         )
     half = ndtri(0.5 + level / 2) * np.sqrt(var)
     inside = float(np.mean(np.abs(actual - mean) <= half))
