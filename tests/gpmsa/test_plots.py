@@ -129,11 +129,13 @@ def test_emulator_fit_against_held_out_runs_and_cross_validation():
     test = gpmsa.SimData(x=x, t=t, y=y, index=s)
     fig = plots.emulator_fit(emu, test)
     assert len(fig.axes) == 2 and "8 held-out runs" in fig.axes[0].get_title()
+    fig_title = fig.axes[0].get_title()
     cv = gpmsa.cross_validate(emu, n_draws=5)
     fig = plots.emulator_fit(emu, cv, level=0.5)
     assert "cross-validation" in fig.axes[0].get_title()
+    assert plots.emulator_fit(emu, (x, t, y)).axes[0].get_title() == fig_title  # the arrays
     with pytest.raises(GPMSAError, match="held_out must be"):
-        plots.emulator_fit(emu, (x, t, y))
+        plots.emulator_fit(emu, {"x": x, "t": t, "y": y})
     for bad in (0, -1, 2.5):  # 0 and -1 drew nothing, silently
         with pytest.raises(GPMSAError, match="max_runs must be an integer >= 1"):
             plots.emulator_fit(emu, test, max_runs=bad)
