@@ -1,39 +1,20 @@
 """A Simplex GD_max above what the posterior mean reaches at the top of the emulator's domain."""
 
 import warnings
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _reach_cases import block_emulator
 
 import control
 from control.compat import top_reach
-from control.observation_model import BlockScatter
 
 FEATURE_SD = 0.5  # one block's feature GD / 100 has this sd: the likelihood's sd is 50 GD
 
 
-def block_emulator(calls: list | None = None):
-    """A stand-in block-feature emulator on GD [200, 600]: its feature is GD / 100."""
-
-    def predict_mean(v, gd):
-        if calls is not None:
-            calls.append(len(gd))
-        return np.asarray(gd, dtype=float)[:, None] / 100.0
-
-    scatter = BlockScatter(np.array([0.5, 2.0]), np.full((2, 1, 1), FEATURE_SD**2))
-    return SimpleNamespace(
-        domain={"v": (0.5, 2.0), "GD": (200.0, 600.0)},
-        x_names=["v"],
-        t_names=["GD"],
-        metadata={"block_scatter": scatter.to_dict()},
-        predict_mean=predict_mean,
-    )
-
-
 def test_top_reach_is_the_top_less_the_sd_of_the_posterior_cut_there():
     # a normal likelihood of sd 50 about 600, cut at 600: the half-normal's sd 50 (1 - 2/pi)^0.5
-    level, sd = top_reach(block_emulator(), [1.0, 2.0])
+    level, sd = top_reach(block_emulator(FEATURE_SD), [1.0, 2.0])
     assert sd == pytest.approx(50 * np.sqrt(1 - 2 / np.pi), rel=0.01)
     assert level == pytest.approx(600 - sd)
 
@@ -41,7 +22,7 @@ def test_top_reach_is_the_top_less_the_sd_of_the_posterior_cut_there():
 def test_a_gd_max_out_of_the_means_reach_warns_naming_the_margin_and_remedy():
     """Simplex(gd_max=599) passed silently: the mean of a posterior cut at 600 never exceeds it
     (on shipped emulator A, ground of GD 800 read 583 at the median, above 590 in 7%)."""
-    emu = block_emulator()  # reach: 600 - 30.2 = 569.8
+    emu = block_emulator(FEATURE_SD)  # reach: 600 - 30.2 = 569.8
     with pytest.warns(control.ControlWarning, match=r"gd_max = 599 lies above 569,.* about 30 "
                       r"below .* use gd_max <= 569, or risk=alpha"):  # fmt: skip
         control.check_emulator(emu, simplex=control.Simplex(gd_max=599))
@@ -57,6 +38,10 @@ def test_the_default_band_is_not_computed():
     calls: list = []
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        control.check_emulator(block_emulator(calls), simplex=control.Simplex())  # gd_max 350
-        control.check_emulator(block_emulator(calls), simplex=control.Simplex(gd_max=400))
+        control.check_emulator(
+            block_emulator(FEATURE_SD, calls), simplex=control.Simplex()
+        )  # gd_max 350
+        control.check_emulator(
+            block_emulator(FEATURE_SD, calls), simplex=control.Simplex(gd_max=400)
+        )
     assert calls == []  # at or below the domain's middle: no posterior sd can put it out of reach

@@ -2,34 +2,14 @@
 emulator's GD domain, or below that quantile at its bottom (safety mode for good)."""
 
 import warnings
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _reach_cases import block_emulator
 from scipy import stats
 
 import control
 from control.compat import _warn_if_out_of_reach, bottom_quantile, top_quantile_reach
-from control.observation_model import BlockScatter
-
-
-def block_emulator(feature_sd: float = 0.5, calls: list | None = None):
-    """A stand-in block-feature emulator on GD [200, 600], speeds [0.5, 2] m/s: its feature is
-    GD / 100 with sd ``feature_sd`` (the likelihood's sd in GD: 100 ``feature_sd``)."""
-
-    def predict_mean(v, gd):
-        if calls is not None:
-            calls.append(len(gd))
-        return np.asarray(gd, dtype=float)[:, None] / 100.0
-
-    scatter = BlockScatter(np.array([0.5, 2.0]), np.full((2, 1, 1), feature_sd**2))
-    return SimpleNamespace(
-        domain={"v": (0.5, 2.0), "GD": (200.0, 600.0)},
-        x_names=["v"],
-        t_names=["GD"],
-        metadata={"block_scatter": scatter.to_dict()},
-        predict_mean=predict_mean,
-    )
 
 
 def check(emu, **simplex) -> list[str]:

@@ -12,7 +12,7 @@ import warnings
 
 import numpy as np
 import pytest
-from test_gd_max_risk_reach_s78 import block_emulator
+from _reach_cases import block_emulator
 
 import control
 import roadgen
