@@ -309,10 +309,11 @@ class Calibrator:
         model = [k for k in ("discrepancy", "discrepancy_groups")
                  if self.mcmc_options.get(k) is not None]  # fmt: skip
         if self.method == "grid" and model:
+            chosen = " (method='auto' chooses it for 1 or 2 parameters)" if method == "auto" else ""
             raise GPMSAError(
-                f"mcmc_options[{model[0]!r}] adds a discrepancy on the MCMC path, and this "
-                "Calibrator uses the exact grid (method='auto' chooses it for 1 or 2 "
-                "parameters), which has no discrepancy and would ignore it: use "
+                f"mcmc_options[{model[0]!r}] is a discrepancy model's option, taken on the MCMC "
+                f"path, and this Calibrator uses the exact grid{chosen}, which has no "
+                "discrepancy and would ignore it: use "
                 f"Calibrator(emu, method='mcmc', mcmc_options={{{model[0]!r}: ...}}), or "
                 f"gpmsa.calibrate(..., {model[0]}=...)"
             )

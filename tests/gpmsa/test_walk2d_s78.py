@@ -146,6 +146,9 @@ def test_grid_calibrator_refuses_a_discrepancy():
     for opts in ({"discrepancy": "constant"}, {"discrepancy": D}, {"discrepancy_groups": [0]}):
         with pytest.raises(GPMSAError, match=r"exact grid.*method='mcmc'"):
             gpmsa.Calibrator(emu, mcmc_options=opts)
+    with pytest.raises(GPMSAError, match=r"exact grid, which") as told:  # asked for: no aside
+        gpmsa.Calibrator(emu, method="grid", mcmc_options={"discrepancy_groups": [0]})
+    assert "discrepancy model's option" in str(told.value)
     assert gpmsa.Calibrator(emu, mcmc_options={"discrepancy": None}).method == "grid"
     cal = gpmsa.Calibrator(emu, method="mcmc", seed=0,
                            mcmc_options={"discrepancy": D, "n_samples": 60, "n_burn": 20,
