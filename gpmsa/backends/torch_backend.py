@@ -920,7 +920,13 @@ def _device(device) -> torch.device:
     none, or fewer than ``cuda:N`` needs."""
     dev = _parsed_device(device)
     if dev.type == "cuda" and not torch.cuda.is_available():
-        raise GPMSAError(f"device={device!r} was asked for but torch sees no CUDA device")
+        why = (f"this torch {torch.__version__} is a CPU build" if torch.version.cuda is None
+               else f"torch {torch.__version__} is built for CUDA {torch.version.cuda} but finds "
+               "no GPU (driver, CUDA_VISIBLE_DEVICES)")  # fmt: skip
+        raise GPMSAError(
+            f"device={device!r} was asked for but torch sees no CUDA device ({why}); give "
+            "device='cpu' (the default), or run where torch sees a GPU"
+        )
     if dev.type == "cuda" and dev.index is not None and dev.index >= torch.cuda.device_count():
         raise GPMSAError(
             f"device={device!r} was asked for but torch sees {torch.cuda.device_count()} CUDA "

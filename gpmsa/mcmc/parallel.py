@@ -104,9 +104,14 @@ def in_this_process(callables: list[str], n_jobs, executor, n_chains: int):
     if not callables:
         return n_jobs, executor
     if executor is not None:
+        which = (
+            f"{callables[0]} is a callable of this process: it"
+            if len(callables) == 1
+            else f"{' and '.join(callables)} are callables of this process: they"
+        )
         raise GPMSAError(
-            f"{' and '.join(callables)} are callables of this process: they cannot go to "
-            "executor= (the chains run here)"
+            f"{which} cannot go to executor=; leave executor= out: the chains then run here, "
+            "one after another, with the draws the executor would give"
         )
     n_workers(n_jobs, n_chains)
     return 1, None

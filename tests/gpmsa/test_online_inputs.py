@@ -198,7 +198,8 @@ def test_callables_keep_several_chains_in_this_process():
             sim, obs, n_iter=20, n_chains=2, seed=0, constraint=lambda th: bool(th[0] + th[1] < 1.2)
         )  # a lambda: no pickle
     assert np.all(emu.calibration["theta_native"].sum(axis=1) < 1.2)
-    with pytest.raises(GPMSAError, match="callables of this process: they cannot go to executor"):
+    msg = "mean_basis is a callable of this process: it cannot go to executor"
+    with pytest.raises(GPMSAError, match=msg):
         from concurrent.futures import ThreadPoolExecutor
 
         with ThreadPoolExecutor(1) as ex:
