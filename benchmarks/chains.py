@@ -7,7 +7,10 @@ Prints, each with the load average (the machine is shared: compare rows of one r
    pooled tuning): max R-hat (target < 1.01), min bulk ESS, ESS/s and its ratio to the numpy
    single chain's of part 1 (target >= 1 on this CPU), as one batch (one core) and as
    ``chain_groups`` = the CPU count (one process per group after the tuning);
-3. the cost of one chain-sweep: torch x64 against a numpy sweep (CPU time, alternating).
+3. the cost of one chain-sweep: torch x64 against a numpy sweep (CPU time, alternating); with
+   ``--case functional`` the synthetic functional fit (``functional``: 160 runs, a 30-point
+   output, 5 basis components, 2 known inputs, 4 calibration parameters, 4 observations),
+   simulation-only and joint, ``--torch-chains`` chains (8 there).
 
 Fit: the simulation-only emulator (198 runs, scalar output; betaU, lamUz, lamWs, lamWOs), run
 through the backend's ``sample`` with its defaults (tuning, the nugget-ridge moves); ESS: arviz
@@ -17,6 +20,7 @@ included). The torch chains draw as many sweeps as the numpy chain (``--torch-it
 to ``--numpy-iter``): the ESS/s of chains of equal length (at 2,000 draws a chain 64 chains each
 pay the warm-up: docs/performance.md). Usage: python benchmarks/chains.py [--repeats 3]
 [--numpy-iter 6000] [--torch-iter N] [--torch-chains 64] [--only numpy|torch|sweep]
+[--case road|functional] (``functional``: part 3 only).
 """
 
 from __future__ import annotations
@@ -120,19 +124,53 @@ def _worst_rhat(chains, burn: int) -> str:
     return worst[1] or "no finite R-hat"  # (one chain, or too few draws)
 
 
-def sweep_cost(n_chains: int, rounds: int = 12) -> None:
-    """Part 3: CPU ms per chain-sweep, torch batched vs numpy, alternating (one thread each)."""
+def functional(seed: int = 0):
+    """The synthetic functional case: 160 runs of a smooth 30-point output over 2 known inputs
+    and 4 calibration parameters (5 basis components), and 4 noisy observations at theta =
+    (0.3, 0.5, 0.6, 0.4). Returns (SimData, ObsData)."""
+    import gpmsa
+
+    rng = np.random.default_rng(seed)
+    m, grid = 160, np.linspace(0.0, 1.0, 30)
+    design = (np.argsort(rng.random((m, 6)), axis=0) + rng.random((m, 6))) / m  # a Latin square
+
+    def model(x: np.ndarray, t: np.ndarray) -> np.ndarray:
+        g = grid[None, :]
+        return (np.sin(2.0 * g * (1.0 + t[:, :1] + x[:, :1])) * (1.0 + t[:, 1:2])
+                + t[:, 2:3] * np.cos(3.0 * g + x[:, 1:2]) + 0.5 * t[:, 3:4] * g**2)  # fmt: skip
+
+    x, t = design[:, :2], design[:, 2:]
+    x_obs = rng.random((4, 2))
+    theta = np.tile([0.3, 0.5, 0.6, 0.4], (4, 1))
+    y_obs = model(x_obs, theta) + 0.02 * rng.normal(size=(4, grid.size))
+    sim = gpmsa.SimData(x=x, t=t, y=model(x, t), index=grid)
+    return sim, gpmsa.ObsData(x=x_obs, y=y_obs)
+
+
+def sweep_cost(n_chains: int, rounds: int = 12, case: str = "road") -> None:
+    """Part 3: CPU ms per chain-sweep, torch batched vs numpy, alternating (one thread each);
+    ``case`` "functional": the synthetic functional fit, simulation-only then joint."""
+    if case == "road":
+        _sweep_cost(prepare(road()[0]).problem, "road case", n_chains, rounds, 128)
+        return
+    sim, obs = functional()
+    for what, data in (("simulation-only", None), ("joint", obs)):
+        problem = prepare(sim, data, n_pc=5).problem
+        _sweep_cost(problem, f"functional case, {what}", n_chains, max(rounds // 3, 2), 8)
+
+
+def _sweep_cost(problem, label: str, n_chains: int, rounds: int, np_sweeps: int) -> None:
     import torch
     from threadpoolctl import threadpool_limits
 
     from gpmsa.backends.torch_backend import BatchState
     from gpmsa.mcmc.sampler import ChainState, elements, sample
 
-    problem = prepare(road()[0]).problem
     tuned = sample(problem, n_iter=10, seed=0, tune_rounds=10)
     start = problem.with_init({k: v[0, -1] for k, v in tuned.draws.items()})
     w = np.array([tuned.step_widths[n][0][i] for n, i in elements(start)])
-    print(f"\n# one chain-sweep (CPU time, 1 thread, the ridge moves included); {load()}")
+    print(f"\n# one chain-sweep, {label} (CPU time, 1 thread, the ridge moves included); "
+          f"{load()}")  # fmt: skip
     torch.set_num_threads(1)
     with threadpool_limits(1), torch.no_grad():
         chain = ChainState(start, start.init, np.random.default_rng(1), ridge_moves=5)
@@ -142,9 +180,9 @@ def sweep_cost(n_chains: int, rounds: int = 12) -> None:
         np_ms, t_ms = [], []
         for _ in range(rounds):
             t0 = time.process_time()
-            for _ in range(128):
+            for _ in range(np_sweeps):
                 chain.sweep(w, False, acc)
-            np_ms.append((time.process_time() - t0) / 128 * 1e3)
+            np_ms.append((time.process_time() - t0) / np_sweeps * 1e3)
             t0 = time.process_time()
             for _ in range(2):
                 batch.sweep(w, False, gen)
@@ -162,6 +200,8 @@ def main(argv=None) -> None:
     ap.add_argument("--torch-iter", type=int, default=None, help="default: --numpy-iter")
     ap.add_argument("--torch-chains", type=int, default=64)
     ap.add_argument("--only", choices=("numpy", "torch", "sweep"), default=None)
+    ap.add_argument("--case", choices=("road", "functional"), default="road",
+                    help="part 3's fit (functional: part 3 only)")  # fmt: skip
     args = ap.parse_args(argv)
     if args.repeats < 1:
         ap.error(f"--repeats must be >= 1, got {args.repeats}")
@@ -173,6 +213,9 @@ def main(argv=None) -> None:
         ap.error(f"--torch-chains must be >= 1, got {args.torch_chains}")
     print(f"# {os.cpu_count()} CPUs; {load()}; one BLAS / torch thread per chain or batch")
     rate = None
+    if args.case == "functional":
+        sweep_cost(args.torch_chains, case="functional")
+        return
     if args.only in (None, "numpy"):
         rate = numpy_parallel(args.numpy_iter, args.repeats)
     if args.only in (None, "torch"):

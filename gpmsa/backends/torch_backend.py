@@ -301,7 +301,7 @@ def _factor_scaled(
     nugget = (1.0 / (lam_sim * lamWOs) + 1.0 / lamWs).numpy()
     c_n, j_n, _ = corr.shape
     m = data.d_sim.shape[-1]
-    cr, sc, wn = corr.contiguous().numpy(), scale.numpy(), w.numpy()
+    cr, sc, wn = corr.numpy(), scale.numpy(), w.numpy()  # a component's slice: not copied
     o = None if out is None else out.numpy()
     if o is None and (scratch is None or scratch.shape != (m, m) or scratch.dtype != cr.dtype):
         scratch = np.empty((m, m), dtype=cr.dtype)
@@ -404,9 +404,26 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
     lamOs (C, 1), and betaV (C, p, G), lamVz (C, G) when there is a discrepancy of G precision
     groups. With a mean basis: coef (C, p_u, k) from `gls` (alpha its chol^-1 (w - h coef))
     and h_obs (C, n, k) from `mean_rows`, the u blocks' mean adding h_obs coef.
-    Returns (C,).
+    Returns (C,): `obs_combine` of every component's `obs_parts`.
     """
-    p, n = data.p, data.d_obs.shape[-1]
+    mean_u, cond = obs_parts(data, chol, alpha, prm)
+    return obs_combine(data, mean_u, cond, prm, coef, h_obs)
+
+
+def obs_parts(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, Tensor],
+              comps: slice = slice(None)) -> tuple[Tensor, Tensor]:  # fmt: skip
+    """The observation terms of basis components ``comps`` (J of them): each one's u-block mean
+    S_UW_j S_W_j^-1 w_j (C, J, n) and conditional covariance S_U_j - S_UW_j S_W_j^-1 S_WU_j +
+    I / lamWs_j (C, J, n, n). chol (C, J, m, m), alpha (C, J, m): those components' Sigma_W
+    factors (`obs_loglik`; a leading 1: shared); prm: as `obs_loglik`'s, all components.
+
+    Component j's terms depend on theta and j's parameters and factor only: `BatchState` keeps
+    them, and a proposal that moves one component recomputes that component's. The correlations
+    (S_UW, S_U) are computed for every component and then cut to ``comps`` (they cost little next
+    to the solves): the same operations on the same shapes give the same bits whichever
+    components are asked for (a product or an exp over a slice may round differently).
+    """
+    p = data.p
     betaU, lamUz = prm["betaU"], prm["lamUz"]
     b_x, b_t = betaU[:, :p], betaU[:, p:]
     dt = (prm["theta"].unsqueeze(-1) - data.t_sim.T) ** 2  # (C, q, m)
@@ -415,20 +432,27 @@ def obs_loglik(data: ModelTensors, chol: Tensor, alpha: Tensor, prm: dict[str, T
         dt = torch.where(data.theta_cat[:, None], CATEGORICAL_DISTANCE * differ, dt)
     expo = torch.einsum("ckj,kab->cjab", b_x, data.d_cross)
     expo = expo + torch.einsum("ckj,ckm->cjm", b_t, dt).unsqueeze(-2)
-    s_uw = torch.exp(-expo) / lamUz[..., None, None]  # (C, p_u, n, m)
-    c, p_u, _, m = s_uw.shape
+    s_uw = (torch.exp(-expo) / lamUz[..., None, None])[:, comps]  # (C, J, n, m)
+    c, p_u, n, m = s_uw.shape
     if chol.shape[0] == 1 and c > 1:  # one Sigma_W for all chains: one solve, C n right sides
         rhs = s_uw.permute(1, 3, 0, 2).reshape(p_u, m, c * n)
         a = torch.linalg.solve_triangular(chol[0], rhs, upper=False)
         a = a.reshape(p_u, m, c, n).permute(2, 0, 1, 3)
     else:
         a = torch.linalg.solve_triangular(chol, s_uw.transpose(-1, -2), upper=False)
-    mean_u = (a * alpha.unsqueeze(-1)).sum(-2)  # (C, p_u, n)
+    mean_u = (a * alpha.unsqueeze(-1)).sum(-2)  # (C, J, n)
+    cond = scaled_correlation(b_x, data.d_obs, lamUz)[:, comps] - a.transpose(-1, -2) @ a
+    return mean_u, _add_diagonal(cond, (1.0 / prm["lamWs"][:, comps]).unsqueeze(-1))
+
+
+def obs_combine(data: ModelTensors, mean_u: Tensor, cond: Tensor, prm: dict[str, Tensor],
+                coef: Tensor | None = None, h_obs: Tensor | None = None) -> Tensor:  # fmt: skip
+    """`obs_loglik` (C,) from every component's `obs_parts` mean_u (C, p_u, n) and cond (C, p_u,
+    n, n): the u blocks, the discrepancy's blocks and S_obs / lamOs assembled and factored."""
+    n = data.d_obs.shape[-1]
     if coef is not None:  # the GLS mean at [x_obs, theta]
         coef = coef.expand(h_obs.shape[0], -1, -1)  # one shared Sigma_W: one coef
         mean_u = mean_u + torch.einsum("cnk,cjk->cjn", h_obs, coef)
-    cond = scaled_correlation(b_x, data.d_obs, lamUz) - a.transpose(-1, -2) @ a
-    cond = _add_diagonal(cond, (1.0 / prm["lamWs"]).unsqueeze(-1))
     full = data.sig_obs / prm["lamOs"][..., None]  # (C, N, N)
     mean = torch.zeros_like(full[..., 0])
     for j, blk in enumerate(data.u_blocks):
@@ -513,6 +537,10 @@ class BatchState:
     the theta constraint refuses is rejected before its likelihood (the constraint called per
     chain); with a mean basis the coefficients are integrated out (`gls`) and the observations'
     mean adds the GLS trend h([x_obs, theta]) coef (`mean_rows`, cached per chain).
+    As the numpy sampler's ``IncrementalLikelihood``, a proposal recomputes only what it moves:
+    each component's observation terms are cached per chain (``obs_mean``, ``obs_cond``:
+    `obs_parts`), so a betaU, lamUz or lamWs proposal factors and re-solves its component alone,
+    a lamOs, betaV or lamVz proposal only assembles the observations' covariance (`obs_combine`).
     ``beta``: None (plain chains), or (C,) the power 1/T of each row's likelihood in its
     acceptance (parallel tempering, `_tempered_tuning`, `_tempered_draws`: the rows are the
     chains' copies; the prior is not tempered).
@@ -601,7 +629,12 @@ class BatchState:
         self.h_obs = None
         if d.has_obs and self.coef is not None:
             self.h_obs = mean_rows(self.problem, d, params["theta"])
-        self.ll_obs = self._obs(params, self.chol, self.alpha, self.coef, self.h_obs)
+        # each component's observation terms (`obs_parts`), per row: a proposal that moves one
+        # component recomputes that component's only
+        self.obs_mean = self.obs_cond = None
+        if d.has_obs:
+            self.obs_mean, self.obs_cond = obs_parts(d, self.chol, self.alpha, params)
+        self.ll_obs = self._obs(params, slice(None), None, self.coef, self.h_obs)
 
     @property
     def loglik(self) -> Tensor:
@@ -611,8 +644,8 @@ class BatchState:
     def exchange(self, a: Tensor, b: Tensor) -> None:
         """Rows ``a`` and ``b`` (index tensors of equal length) exchange their states: the
         parameters and every cached term (correlations, Sigma_W factors, likelihood terms,
-        mean rows); one Sigma_W shared by all rows (calibration) stays."""
-        cached = [self.ll_w, self.ll_obs, self.corr, self.h_obs]
+        mean rows, observation terms); one Sigma_W shared by all rows (calibration) stays."""
+        cached = [self.ll_w, self.ll_obs, self.corr, self.h_obs, self.obs_mean, self.obs_cond]
         if self.chol is not None and self.chol.shape[0] == self.n_chains:  # per row
             cached += [self.chol, self.alpha, self.coef]
         for t in (*self.params.values(), *cached):
@@ -630,12 +663,20 @@ class BatchState:
             lp = lp + each.reshape(x.shape[0], -1).sum(-1)
         return lp - self._held_lp if self.problem.fixed_elements else lp
 
-    def _obs(self, prm: dict[str, Tensor], chol: Tensor | None, alpha: Tensor | None,
+    def _obs(self, prm: dict[str, Tensor], comps: slice, parts: tuple[Tensor, Tensor] | None,
              coef: Tensor | None = None, h_obs: Tensor | None = None) -> Tensor:  # fmt: skip
-        """Observation term (C',) at ``prm`` given the Sigma_W factors (zeros without obs)."""
+        """Observation term (C,) at ``prm`` (zeros without obs): the cached component terms
+        (``obs_mean``, ``obs_cond``), those of components ``comps`` replaced by ``parts`` (the
+        proposal's `obs_parts`; None: none changed)."""
         if not self.data.has_obs:
             return self.ll_w.new_zeros(prm["betaU"].shape[0])
-        return obs_loglik(self.data, chol, alpha, prm, coef, h_obs)
+        mean_u, cond = self.obs_mean, self.obs_cond
+        if parts is not None and comps == slice(None):
+            mean_u, cond = parts
+        elif parts is not None:
+            mean_u, cond = mean_u.clone(), cond.clone()
+            mean_u[:, comps], cond[:, comps] = parts
+        return obs_combine(self.data, mean_u, cond, prm, coef, h_obs)
 
     def _allowed(self, idx: tuple[int, ...], cand: Tensor, valid: Tensor,
                  theta: Tensor | None = None) -> Tensor:  # fmt: skip
@@ -785,9 +826,12 @@ class BatchState:
         if joint is not None:
             prm[name] = torch.where(valid.unsqueeze(-1), joint[0], cur)
         d = self.data
-        chol, alpha, ll_w, coef, h_obs = self.chol, self.alpha, self.ll_w, self.coef, self.h_obs
+        ll_w, coef, h_obs = self.ll_w, self.coef, self.h_obs
         if name == "theta" and h_obs is not None:
             h_obs = mean_rows(self.problem, d, prm["theta"])
+        comps, parts = slice(None), None  # components whose observation terms move, their new ones
+        if name == "theta" and d.has_obs:
+            parts = obs_parts(d, self.chol, self.alpha, prm)
         if name in SIM_PARAMS:
             whole = name == "lamWOs" or d.w.shape[0] == 1
             comps = slice(None) if whole else slice(idx[-1], idx[-1] + 1)
@@ -802,17 +846,16 @@ class BatchState:
                 prm["lamWOs"], out=self._buffer("chol", j_c) if d.has_obs else None,
                 scratch=self._scratch, only=valid,
             )  # fmt: skip
-            ll_w, chol, alpha, coef = ll_c, chol_c, alpha_c, coef_c
+            ll_w, coef = ll_c, coef_c
             if not whole:
                 ll_w = self.ll_w.clone()
                 ll_w[:, comps] = ll_c
-                if d.has_obs:
-                    chol, alpha = self.chol.clone(), self.alpha.clone()
-                    chol[:, comps], alpha[:, comps] = chol_c, alpha_c
-                    if coef_c is not None:
-                        coef = self.coef.clone()
-                        coef[:, comps] = coef_c
-        ll_obs = self._obs(prm, chol, alpha, coef, h_obs)
+                if d.has_obs and coef_c is not None:
+                    coef = self.coef.clone()
+                    coef[:, comps] = coef_c
+            if d.has_obs:  # the moved components' observation terms only
+                parts = obs_parts(d, chol_c, alpha_c, prm, comps)
+        ll_obs = self._obs(prm, comps, parts, coef, h_obs)
         ll_new = ll_w.sum(-1) + ll_obs
         if level:
             lp_old = lp_new if joint is None else joint[2]
@@ -830,6 +873,9 @@ class BatchState:
         else:
             cur[take] = prm[name][take]
         self.ll_obs[take] = ll_obs[take]
+        if parts is not None:
+            self.obs_mean[take, comps] = parts[0][take]
+            self.obs_cond[take, comps] = parts[1][take]
         if name in SIM_PARAMS:
             self.ll_w[take] = ll_w[take]
             if name == "betaU":
