@@ -195,7 +195,11 @@ def check_simplex(emulator, simplex: Simplex, bcr: BCRSettings | None = None) ->
     GD domain: `EmulatorMismatchError`; GD_max out of the estimate's reach: `ControlWarning`),
     without its feature check: ``bcr`` only tells which estimator runs (method "window": the
     bottom of the domain is checked too), so a replay of an emulator that records no feature
-    takes them."""
+    takes them. Each argument of the wrong kind is a `ControlError` naming it."""
+    _check_is_emulator(emulator)
+    check_instance(simplex, "simplex", Simplex)
+    if bcr is not None:
+        check_instance(bcr, "bcr", BCRSettings)
     _check_speeds(emulator, simplex)
     lo, hi = emulator_domain(emulator)[1]
     if not simplex.gd_max < hi:

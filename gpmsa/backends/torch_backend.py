@@ -966,9 +966,12 @@ def _device(device) -> torch.device:
     none, or fewer than ``cuda:N`` needs."""
     dev = _parsed_device(device)
     if dev.type == "cuda" and not torch.cuda.is_available():
-        why = (f"this torch {torch.__version__} is a CPU build" if torch.version.cuda is None
-               else f"torch {torch.__version__} is built for CUDA {torch.version.cuda} but finds "
-               "no GPU (driver, CUDA_VISIBLE_DEVICES)")  # fmt: skip
+        hip = getattr(torch.version, "hip", None)  # a ROCm build: its GPUs go by "cuda" too
+        why = (f"torch {torch.__version__} is built for CUDA {torch.version.cuda} but finds no "
+               "GPU (driver, CUDA_VISIBLE_DEVICES)" if torch.version.cuda is not None
+               else f"torch {torch.__version__} is built for ROCm (HIP {hip}) but finds no GPU "
+               "(driver, HIP_VISIBLE_DEVICES)" if hip
+               else f"this torch {torch.__version__} is a CPU build")  # fmt: skip
         raise GPMSAError(
             f"device={device!r} was asked for but torch sees no CUDA device ({why}); give "
             "device='cpu' (the default), or run where torch sees a GPU"
@@ -1132,23 +1135,46 @@ def callables(problem: Problem) -> list[str]:
 def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torch.dtype,
                        copies: int = 1) -> None:  # fmt: skip
     """ResourceLimitError (before any chain is set up) when the draws (`check_draws_memory`) and
-    the batch's per-chain caches exceed ``gpmsa.limits.MAX_MEMORY_BYTES``: per chain and basis
+    the batch's per-chain terms exceed ``gpmsa.limits.MAX_MEMORY_BYTES``: per chain and basis
     component the packed correlation matrix and its proposal buffer, and with observations the
-    Sigma_W factor and its buffer (m x m each); none where Sigma_W is fixed (one for all).
+    Sigma_W factor and its buffer (m x m each), none where Sigma_W is fixed (one for all); with
+    observations also (`obs_bytes`) each component's cached observation terms, a proposal's
+    cross-correlations and the observations' N x N covariance with its factor, one per chain.
     ``copies``: rows per chain (parallel tempering: one per temperature)."""
-    if all(k in problem.fixed for k in SIM_PARAMS):
+    shared = all(k in problem.fixed for k in SIM_PARAMS)
+    if shared and problem.obs is None:
         return
-    m = problem.m
+    m, size = problem.m, float(dtype.itemsize)
     packed = sum((b - a) * b for a, b in row_blocks(m))
-    per_chain = problem.p_u * (2 * packed + (2 * m * m if problem.obs is not None else 0))
-    caches = float(dtype.itemsize) * n_chains * copies * per_chain
+    per_chain = (
+        0 if shared else problem.p_u * (2 * packed + (2 * m * m if problem.obs is not None else 0))
+    )
+    per_obs = obs_bytes(problem, 1.0)
+    rows = n_chains * copies
     mats = "Sigma_W" if problem.p_u == 1 else "Sigma_W's"
     name = str(dtype).replace("torch.", "")
     temps = f" at {copies} temperatures" if copies > 1 else ""
-    check_memory(draws_nbytes(problem, n_iter, n_chains) + caches,
-                 f"torch sample(n_iter={n_iter}, n_chains={n_chains}){temps}, which caches "
-                 f"{problem.p_u} {mats} of {m} x {m} ({name}) per chain"
-                 f"{' and temperature' if copies > 1 else ''},")  # fmt: skip
+    what = [] if shared else [f"caches {problem.p_u} {mats} of {m} x {m} ({name})"]
+    if per_obs > per_chain:  # named where it is the larger part
+        big = problem.obs.sig_obs.shape[0]
+        what.append(f"factors the observations' {big} x {big} covariance ({name})")
+    check_memory(
+        draws_nbytes(problem, n_iter, n_chains) + size * rows * (per_chain + per_obs),
+        f"torch sample(n_iter={n_iter}, n_chains={n_chains}){temps}, which "
+        f"{' and '.join(what)} per chain{' and temperature' if copies > 1 else ''},",
+    )
+
+
+def obs_bytes(problem: Problem, itemsize: float) -> float:
+    """A batch row's observation terms in bytes of ``itemsize`` (0 without observations): the
+    cached terms of every component (`obs_parts`: p_u (n^2 + n)), a proposal's correlations and
+    solves against the runs (2 p_u n (m + n)) and the observations' covariance with its factor
+    (`obs_combine`: 2 N^2, N = n (p_u + p_v))."""
+    obs = problem.obs
+    if obs is None:
+        return 0.0
+    n, p_u, big = obs.x.shape[0], problem.p_u, obs.sig_obs.shape[0]
+    return itemsize * (p_u * (n * n + n) + 2 * p_u * n * (problem.m + n) + 2 * big * big)
 
 
 def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_threads) -> dict:

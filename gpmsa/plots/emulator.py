@@ -123,6 +123,12 @@ def _held_out_runs(emulator, held_out) -> tuple[np.ndarray | None, np.ndarray, n
     if len(held_out) != 3:
         raise GPMSAError(f"held_out as a tuple must be (x, t, y), got {len(held_out)} items")
     x, t, y = held_out
+    if x is None and emulator.p > 0:
+        raise GPMSAError(
+            f"held_out x is None, but the emulator has {emulator.p} known input(s) "
+            f"{list(emulator.x_names)}: give their values (runs x {emulator.p}) as the tuple's "
+            "first item (None only for an emulator without known inputs)"
+        )
     y = as_matrix(y, "held_out y", ncols=emulator.l_sim)
     rows = {"t": as_matrix(t, "held_out t", ncols=emulator.q).shape[0]}
     if x is not None:
