@@ -190,7 +190,7 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
         x, t, actual = _held_out_runs(emulator, held_out)
         use = draws and emulator.n_draws > 0
         mean, var = emulator.predict(x, t, draws=use, n_draws=n_draws)
-        what = f"{actual.shape[0]} held-out runs"
+        what = f"{actual.shape[0]} held-out run{'' if actual.shape[0] == 1 else 's'}"
     else:
         raise GPMSAError(
             f"held_out must be a SimData of held-out runs, their (x, t, y) arrays or a "

@@ -43,7 +43,7 @@ def test_held_out_arrays_give_the_simdata_figure_and_take_one_run():
         gpmsa.plots.emulator_fit(emu, sim)
     )
     one = gpmsa.plots.emulator_fit(emu, (x[0], t[0], y[0]))  # one run (a SimData needs 5)
-    assert _title(one).startswith("1 held-out runs: ")
+    assert _title(one).startswith("1 held-out run: ")
 
 
 @pytest.mark.parametrize(
