@@ -182,13 +182,6 @@ def test_seeded_torch_fit_keeps_its_draws(case):
             np.testing.assert_allclose(got[key], val, rtol=1e-10, atol=0, err_msg=f"{case} {key}")
 
 
-if __name__ == "__main__":
-    import pprint
-
-    digests = {case: digest(case) for case in sorted(CASES)}
-    pprint.pprint(digests, width=100, sort_dicts=False, compact=True)
-
-
 @pytest.mark.parametrize("case", ["joint", "discrepancy", "mean"])
 def test_cached_component_terms_are_those_of_a_fresh_solve(case):
     """After sweeps, the batch's cached observation terms equal obs_parts of its current state
