@@ -54,7 +54,6 @@ import gpmsa
 from control.bcr import BCR, BCRSettings
 from control.compat import (
     bcr_settings_for,
-    check_emulator,
     check_likelihood,
     check_recorded_feature,
     check_recorded_vehicle,
@@ -762,8 +761,7 @@ def _check_fit(s: ReplaySettings, bcr: BCRSettings, emulator, likelihood, simple
     if not isinstance(simplex, Simplex):
         raise ControlError(f"simplex must be a control.Simplex, got {type(simplex).__name__}")
     check_instance(bcr, "bcr", BCRSettings)
-    check_emulator(emulator)
-    check_simplex(emulator, simplex, bcr)  # (the BCR's method: the window's reach checked)
+    check_simplex(emulator, simplex, bcr)  # the emulator too; the BCR's method: the reach
     check_recorded_feature(emulator, bcr)  # as the BCR would, once the recording was read
     nyquist = bcr.rate_hz / 2
     if s.gravity == "highpass" and s.highpass_hz >= nyquist:

@@ -1138,7 +1138,7 @@ def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torc
     the batch's per-chain terms exceed ``gpmsa.limits.MAX_MEMORY_BYTES``: per chain and basis
     component the packed correlation matrix and its proposal buffer, and with observations the
     Sigma_W factor and its buffer (m x m each), none where Sigma_W is fixed (one for all); with
-    observations also (`obs_bytes`) each component's cached observation terms, a proposal's
+    observations also (`obs_values`) each component's cached observation terms, a proposal's
     cross-correlations and the observations' N x N covariance with its factor, one per chain.
     ``copies``: rows per chain (parallel tempering: one per temperature)."""
     shared = all(k in problem.fixed for k in SIM_PARAMS)
@@ -1149,7 +1149,7 @@ def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torc
     per_chain = (
         0 if shared else problem.p_u * (2 * packed + (2 * m * m if problem.obs is not None else 0))
     )
-    per_obs = obs_bytes(problem, 1.0)
+    per_obs = obs_values(problem)
     rows = n_chains * copies
     mats = "Sigma_W" if problem.p_u == 1 else "Sigma_W's"
     name = str(dtype).replace("torch.", "")
@@ -1165,16 +1165,16 @@ def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torc
     )
 
 
-def obs_bytes(problem: Problem, itemsize: float) -> float:
-    """A batch row's observation terms in bytes of ``itemsize`` (0 without observations): the
-    cached terms of every component (`obs_parts`: p_u (n^2 + n)), a proposal's correlations and
-    solves against the runs (2 p_u n (m + n)) and the observations' covariance with its factor
-    (`obs_combine`: 2 N^2, N = n (p_u + p_v))."""
+def obs_values(problem: Problem) -> int:
+    """A batch row's observation terms in values (0 without observations): the cached terms of
+    every component (`obs_parts`: p_u (n^2 + n)), a proposal's correlations and solves against
+    the runs (2 p_u n (m + n)) and the observations' covariance with its factor (`obs_combine`:
+    2 N^2, N = n (p_u + p_v))."""
     obs = problem.obs
     if obs is None:
-        return 0.0
+        return 0
     n, p_u, big = obs.x.shape[0], problem.p_u, obs.sig_obs.shape[0]
-    return itemsize * (p_u * (n * n + n) + 2 * p_u * n * (problem.m + n) + 2 * big * big)
+    return p_u * (n * n + n) + 2 * p_u * n * (problem.m + n) + 2 * big * big
 
 
 def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_threads) -> dict:
