@@ -32,15 +32,21 @@ def axis_label(name: str, unit: str) -> str:
     return f"{name} ({unit})" if unit else name
 
 
-def index_labels(names, units, grid) -> tuple[str, ...]:
-    """The axis labels of an output index ``grid`` ((l,), (l, d) or None: one column):
-    ``name (unit)`` per column as ``SimData(index_names=, index_units=)`` gave them (None:
-    "output index" for one column, "output index[:, k]" for column k of several; no unit)."""
+def index_columns(names, units, grid) -> tuple[tuple[str, str], ...]:
+    """(name, unit) of each column of an output index ``grid`` ((l,), (l, d) or None: one
+    column) as ``SimData(index_names=, index_units=)`` gave them (None: "output index" for one
+    column, "output index[:, k]" for column k of several; no unit)."""
     d = np.shape(grid)[1] if np.ndim(grid) == 2 else 1
     default = ("output index",) if d == 1 else tuple(f"output index[:, {k}]" for k in range(d))
     names = default if names is None else tuple(names)
     units = ("",) * d if units is None else tuple(units)
-    return tuple(axis_label(n, u) for n, u in zip(names, units, strict=True))
+    return tuple(zip(names, units, strict=True))
+
+
+def index_labels(names, units, grid) -> tuple[str, ...]:
+    """The axis labels of an output index ``grid``: ``name (unit)`` per column
+    (`index_columns`)."""
+    return tuple(axis_label(n, u) for n, u in index_columns(names, units, grid))
 
 
 def is_map(grid, what: str) -> bool:

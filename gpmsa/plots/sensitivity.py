@@ -11,7 +11,7 @@ from scipy.stats import norm
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import check_count, check_level
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
+from gpmsa.plots._figure import axis_label, figure, index_columns, index_labels, is_map
 from gpmsa.predictive.sobol import Sensitivity
 
 
@@ -206,13 +206,10 @@ def _point_title(sens: Sensitivity, output: int) -> str:
     grid = getattr(sens, "grid", None)
     if grid is None or np.shape(grid)[0] != sens.main_effect.shape[2]:
         return ""
-    d = np.shape(grid)[1] if np.ndim(grid) == 2 else 1
-    default = ("output index",) if d == 1 else tuple(f"output index[:, {k}]" for k in range(d))
-    names = default if sens.index_names is None else tuple(sens.index_names)
-    units = ("",) * d if sens.index_units is None else tuple(sens.index_units)
+    columns = index_columns(sens.index_names, sens.index_units, grid)
     row = np.reshape(grid[output], -1)
     parts = [f"{n} = {float(v):.4g}" + (f" {u}" if u else "")
-             for n, v, u in zip(names, row, units, strict=True)]  # fmt: skip
+             for (n, u), v in zip(columns, row, strict=True)]  # fmt: skip
     return ", " + ", ".join(parts)
 
 
