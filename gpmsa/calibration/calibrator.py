@@ -118,6 +118,15 @@ once (16 calls of 15 points an edge instead of 64 of one; 4-8 levels measured al
 cheap prior, and a prior's cost per point grows with the level)."""
 
 
+_MCMC_ONLY = {
+    "fixed": "holds parameters on the MCMC path",
+    "discrepancy": "is a discrepancy model's option, taken on the MCMC path",
+    "discrepancy_groups": "is a discrepancy model's option, taken on the MCMC path",
+}
+"""The Calibrator's ``mcmc_options`` that the exact grid has no use for (refused with it), and
+what each does on the MCMC path."""
+
+
 def _check_mcmc_options(options, backend: str) -> dict:
     """``options`` (None or a dict of ``gpmsa.calibrate`` keywords, backend ``backend``'s
     sampler options among them, as ``calibrate`` passes them on) as a dict; GPMSAError naming
@@ -299,23 +308,15 @@ class Calibrator:
         if constraint is not None:
             self.mcmc_options.setdefault("constraint", constraint)
         self._check_mcmc_path(backend)
-        if self.method == "grid" and self.mcmc_options.get("fixed") is not None:
-            raise GPMSAError(
-                "mcmc_options['fixed'] holds parameters on the MCMC path, and this Calibrator "
-                "uses the exact grid (method='auto' chooses it for 1 or 2 parameters), which "
-                "would ignore it: use Calibrator(emu, method='mcmc', mcmc_options={'fixed': "
-                "...}), or gpmsa.calibrate(..., fixed=...)"
-            )
-        model = [k for k in ("discrepancy", "discrepancy_groups")
-                 if self.mcmc_options.get(k) is not None]  # fmt: skip
-        if self.method == "grid" and model:
+        given = [k for k in _MCMC_ONLY if self.mcmc_options.get(k) is not None]
+        if self.method == "grid" and given:  # options the grid would ignore
+            k = given[0]
             chosen = " (method='auto' chooses it for 1 or 2 parameters)" if method == "auto" else ""
             raise GPMSAError(
-                f"mcmc_options[{model[0]!r}] is a discrepancy model's option, taken on the MCMC "
-                f"path, and this Calibrator uses the exact grid{chosen}, which has no "
-                "discrepancy and would ignore it: use "
-                f"Calibrator(emu, method='mcmc', mcmc_options={{{model[0]!r}: ...}}), or "
-                f"gpmsa.calibrate(..., {model[0]}=...)"
+                f"mcmc_options[{k!r}] {_MCMC_ONLY[k]}, and this Calibrator uses the exact "
+                f"grid{chosen}, which {'' if k == 'fixed' else 'has no discrepancy and '}would "
+                f"ignore it: use Calibrator(emu, method='mcmc', mcmc_options={{{k!r}: ...}}), or "
+                f"gpmsa.calibrate(..., {k}=...)"
             )
         if n_grid is None:  # a categorical parameter with a continuous one: 129 per level
             n_grid = 129 if q == 1 or mixed else 65
