@@ -32,6 +32,7 @@ parameter, 65 x 65 for two, in 'ij' order, first parameter slowest).
 from __future__ import annotations
 
 import inspect
+import math
 import warnings
 from collections.abc import Callable
 
@@ -327,10 +328,9 @@ class Calibrator:
         kept = emulator.n_draws if emulator.draws else 0  # at most these draws are used
         n_sets = 1 if emulator_params == "point" else min(self._n_emulator_draws, max(kept, 1))
         # the axes: a categorical parameter's nodes are its levels (exact: no interpolation
-        # between levels), a continuous one's n_grid equally spaced nodes
-        self._axes = [np.linspace(0.0, 1.0, self.n_grid) if lv is None else np.array(lv)
-                      for lv in (levels or [None] * q)]  # fmt: skip
-        G = int(np.prod([a.size for a in self._axes]))
+        # between levels), a continuous one's n_grid equally spaced nodes (counted first: a
+        # huge n_grid is refused by its memory below before an axis is made)
+        G = math.prod(self.n_grid if lv is None else len(lv) for lv in (levels or [None] * q))
         # per parameter set: R_t on the grid and its product with alpha (G x m per component)
         # and Sigma_W's factor; once the Chebyshev degrees are known, `_check_predictor_memory`
         # adds the predictors' products H and the prepared refinement
@@ -338,6 +338,8 @@ class Calibrator:
         what = (f"Calibrator(n_grid={self.n_grid}): {G} grid nodes x {m} runs x {p_u} "
                 f"components x {n_sets} emulator parameter set(s)")  # fmt: skip
         check_memory(n_sets * per_set + 8.0 * 8 * G, what)
+        self._axes = [np.linspace(0.0, 1.0, self.n_grid) if lv is None else np.array(lv)
+                      for lv in (levels or [None] * q)]  # fmt: skip
         self._theta_unit = mesh(self._axes)
         std = emulator.standardizer
         self.theta_grid = std.t_from_unit(self._theta_unit)

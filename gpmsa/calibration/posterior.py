@@ -560,13 +560,15 @@ class Posterior:
         ``name``: a Figure. A categorical parameter (a `LevelMarginal`, or ``info["levels"]``
         of draws) gets a bar per level, its draws' share: a probability, not a density.
 
-        ``unit`` labels the axes (None: ``info["units"][name]`` where calibrate or Calibrator
-        recorded the emulator's units)."""
+        ``unit`` (a str) labels the axes (None: ``info["units"][name]`` where calibrate or
+        Calibrator recorded the emulator's units)."""
         from matplotlib.figure import Figure
 
         self._check(name)
         bins = check_count(bins, "bins")
         check_memory(BYTES_PER_HISTOGRAM_BIN * bins, f"Posterior.plot: a histogram of {bins} bins")
+        if unit is not None and not isinstance(unit, str):
+            raise GPMSAError(f"unit must be a text label (str) or None, got {unit!r}")
         if unit is None:
             unit = (self.info.get("units") or {}).get(name, "")
         label = f"{name} ({unit})" if unit else name

@@ -78,10 +78,22 @@ def as_float(value, name: str) -> np.ndarray:
     except OverflowError as exc:  # a Python int beyond float64's range
         raise GPMSAError(f"{name} holds a number too large for float64: {exc}") from exc
     except (TypeError, ValueError) as exc:
-        raise GPMSAError(f"{name} must be a numeric array, got {type(value).__name__}") from exc
+        raise GPMSAError(f"{name} must be a numeric array, got {_kind_of(value)}") from exc
     if arr is None:
         raise GPMSAError(f"{name} must hold real numbers, got complex values")
     return arr
+
+
+def _kind_of(value) -> str:
+    """What ``value`` is, for the message of a value numpy cannot make a float array of: a
+    ragged list or tuple (entries of different lengths) says so, with the lengths."""
+    if isinstance(value, (list, tuple)):
+        lengths = [len(e) if isinstance(e, (list, tuple, np.ndarray)) else 1 for e in value]
+        if len(set(lengths)) > 1:
+            shown = ", ".join(map(str, lengths[:8])) + (", ..." if len(lengths) > 8 else "")
+            return (f"a ragged {type(value).__name__}: its entries have lengths [{shown}] (every "
+                    "row needs the same number of values)")  # fmt: skip
+    return type(value).__name__
 
 
 def as_real(value, name: str) -> float:

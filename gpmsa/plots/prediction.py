@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.errors import GPMSAError
-from gpmsa.model.data import ObsData, as_float, check_count, check_level
+from gpmsa.model.data import ObsData, as_float, check_count, check_finite, check_level
 from gpmsa.plots import _maps
 from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
 from gpmsa.predictive.full import FullPrediction
@@ -43,8 +43,8 @@ def prediction_bands(
 
     Args:
         pred: a FullPrediction from ``full_prediction``.
-        observed: (N, l) observed values at ``pred.x`` and ``pred.grid`` (e.g. held-out
-            observations), or None.
+        observed: (N, l) finite observed values at ``pred.x`` and ``pred.grid`` (e.g.
+            held-out observations), or None.
         level: probability of the bands.
         max_panels: columns at most (functional output).
         x_column: the known input on the horizontal axis (scalar output), labelled with its
@@ -198,4 +198,5 @@ def _observed(observed, N: int, l: int) -> np.ndarray:
         observed = observed[:, None]
     if observed.shape != (N, l):
         raise GPMSAError(f"{want}, got {observed.shape}")
+    check_finite(observed, "observed")  # NaN or inf would be drawn as nothing, silently
     return observed

@@ -83,9 +83,11 @@ def unit_inputs(
     if d == 0 and values is None:
         values = np.empty((1, 0))
     values = by_column_names(values, names, what)
-    if (d > 1 and np.ndim(values) == 1 and np.size(values) == d) or (
-        d == 1 and np.ndim(values) == 0
-    ):
+    try:
+        ndim = np.ndim(values)
+    except ValueError:  # a ragged list: as_matrix refuses it by name, with its lengths
+        ndim = -1
+    if (d > 1 and ndim == 1 and np.size(values) == d) or (d == 1 and ndim == 0):
         values = as_float(values, what).reshape(1, -1)  # a dict is refused by its own name
     native = as_matrix(values, what, ncols=d, no_columns=d == 0)
     if levels is not None and any(lv is not None for lv in levels):

@@ -804,6 +804,10 @@ def fit_study(
     """
     sims, obs = _sequence(sims, "sims"), _sequence(obs, "obs")
     n = _same_count(sims=sims, obs=obs)
+    for k, s in enumerate(sims):
+        if not isinstance(s, SimData):
+            raise GPMSAError(f"sims must hold one gpmsa.SimData per model, got "
+                             f"{type(s).__name__} (model {k})")  # fmt: skip
     for o in obs:
         if not isinstance(o, ObsData):
             raise GPMSAError(f"obs must hold one gpmsa.ObsData per model, got {type(o).__name__}")
