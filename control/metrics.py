@@ -62,6 +62,35 @@ def _track_parts(track) -> tuple[np.ndarray, np.ndarray]:
     return starts, seg_gd
 
 
+def _check_on_track(track, starts: np.ndarray, position: np.ndarray) -> None:
+    """ControlError for a finite position off ``track``: before its first segment's start or
+    past its end (the segments' total length or ``track.length_m``, whichever is longer, as
+    `roadgen.Track.gd_at` reads it), within 1e-9 of its span; the metrics would charge it to
+    the first or last segment (a position in mm, say, all to the last one)."""
+    end = float(starts[-1]) + _last_length(track)
+    length = getattr(track, "length_m", None)
+    if is_real(length) and np.isfinite(length):
+        end = max(end, float(length))
+    lo = float(starts[0])
+    tol = 1e-9 * max(end - lo, 1.0)
+    off = np.isfinite(position) & ((position < lo - tol) | (position > end + tol))
+    if off.any():
+        k = int(np.flatnonzero(off)[0])
+        raise ControlError(
+            f"position holds {position[k]:g} m at index {k}: off the track, which spans "
+            f"[{lo:g}, {end:g}] m: give positions on it, in metres (as the run's)"
+        )
+
+
+def _last_length(track) -> float:
+    """Length of ``track``'s last segment, m (0 where it is not a finite number >= 0)."""
+    try:
+        length = float(track.segments[-1][0])
+    except (TypeError, ValueError, IndexError):
+        return 0.0
+    return length if np.isfinite(length) and length >= 0 else 0.0
+
+
 def segment_index(track, position: np.ndarray) -> np.ndarray:
     """Index of the track segment holding each position (clipped to the first/last segment).
     `ControlError` for a position that is NaN (it lies in no segment: leave it out first) and
@@ -99,7 +128,8 @@ def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDE
 
     Args:
         track: a roadgen Track (segments, boundaries_m).
-        position: (n,) positions of the estimates (front axle when the estimate was made), m.
+        position: (n,) positions of the estimates (front axle when the estimate was made), m,
+            on the track (`ControlError` for a finite one off it).
         gd_estimate: (n,) posterior means; NaN entries (no estimate), and estimates without a
             finite position, are left out.
 
@@ -108,6 +138,7 @@ def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDE
     """
     position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
     starts, seg_gd = _track_parts(track)
+    _check_on_track(track, starts, position)
     ok = np.isfinite(gd_estimate) & np.isfinite(position)
     truth = np.full(position.shape, np.nan)  # no segment: left out
     truth[ok] = seg_gd[_segment_of(starts, position[ok])]
@@ -197,11 +228,13 @@ def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tu
 
     One value per boundary between segments of different GD; NaN if the estimate never crosses
     before the next change of GD (adjacent segments of one GD are one part; or the end of the
-    data). ``position`` and ``gd_estimate`` are (n,) in time order ("first" is first in time);
-    estimates that are not finite (NaN: none) detect nothing, as in `gd_errors`.
+    data). ``position`` and ``gd_estimate`` are (n,) in time order ("first" is first in time),
+    positions on the track (`ControlError` for a finite one off it); estimates that are not
+    finite (NaN: none) detect nothing, as in `gd_errors`.
     """
     position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
     starts, seg_gd = _track_parts(track)
+    _check_on_track(track, starts, position)
     seg_gd = seg_gd.tolist()
     finite = np.isfinite(gd_estimate)
     delays = []
@@ -224,8 +257,8 @@ def fast_on_rough_m(
     """Distance driven faster than v_safe + tol (m/s) where the prescribed GD exceeds gd_max, m.
 
     Args:
-        position, speed: (n,) the vehicle's samples (front axle), m (finite, non-decreasing)
-            and m/s.
+        position, speed: (n,) the vehicle's samples (front axle), m (finite, non-decreasing,
+            on the track) and m/s.
         gd_max, v_safe: the Simplex's (> 0, as `Simplex` requires). tol: >= 0, m/s.
     """
     for name, value, zero_ok in (
@@ -242,6 +275,7 @@ def fast_on_rough_m(
         raise ControlError("position must hold finite, non-decreasing samples, m")
     if not np.all(np.isfinite(speed)):
         raise ControlError("speed must hold finite samples, m/s")
+    _check_on_track(track, starts, position)
     if position.size < 2:
         return 0.0
     mid = 0.5 * (position[1:] + position[:-1])

@@ -221,11 +221,12 @@ class SimplexRun:
     ``simplex.after_fault == "latch"``.
 
     Attributes:
-        simplex: the controller.
+        simplex: the controller (`ControlError` for anything else).
         latched_by: the estimate that latched safety mode, or None.
     """
 
     def __init__(self, simplex: Simplex) -> None:
+        check_instance(simplex, "simplex", Simplex, "make one with control.Simplex(...)")
         self.simplex = simplex
         self.latched_by: Estimate | None = None
 

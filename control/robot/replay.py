@@ -525,7 +525,8 @@ def replay_bag(
         than the emulator's rate; on header stamps, an IMU stamped on another clock than the
         odometry throughout, ``max_clock_skew_s``; a damaged file or simulation record),
         `EmulatorMismatchError` (the recording's simulated vehicle is not the emulator's, see
-        ``check_vehicle``), `ControlError` (``bag`` not a path; ``csv``
+        ``check_vehicle``), `ControlError` (``bag`` not a path; ``progress`` or
+        ``check_vehicle`` not True or False; ``csv``
         or ``out_bag`` not a path, one in or on what is read (the recording, the whole bag
         folder of a file given inside one, or the emulator file) or an existing output
         refused as above; an
@@ -539,6 +540,7 @@ def replay_bag(
     check_lookup(bag, "bag", BagError)
     csv, out_bag = _check_outputs(bag, emulator, csv, out_bag)
     s = _settings(settings, overrides)
+    _check_flags(progress=progress, check_vehicle=check_vehicle)
     if out_bag is not None:
         check_bag_path(out_bag, s.storage, "out_bag")
     emulator = load_emulator(emulator)
@@ -665,6 +667,7 @@ def replay_recording(
     check_vehicle: bool = True,
 ) -> ReplayResult:
     """`replay_bag` on a recording already read (`control.robot.bags.read_recording`)."""
+    _check_flags(progress=progress, check_vehicle=check_vehicle)
     s = _settings(settings, {})
     emulator = load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
@@ -739,11 +742,18 @@ def replay_recording(
     )
 
 
+def _check_flags(**flags) -> None:
+    """ControlError naming the first of ``flags`` (name: value) that is not True or False (a
+    numpy bool too, as `control.run_closed_loop` takes them)."""
+    for name, flag in flags.items():
+        if not isinstance(flag, bool | np.bool_):
+            raise ControlError(f"{name} must be True or False, got {flag!r:.60}")
+
+
 def _check_vehicle(rec: Recording, emulator, check: bool) -> list[str]:
     """`check_recorded_vehicle` of the recording's simulation record (``check``); where not
     asked to check, a note for a vehicle that it would have refused."""
-    if not isinstance(check, bool):
-        raise ControlError(f"check_vehicle must be True or False, got {check!r}")
+    _check_flags(check_vehicle=check)
     what = f"the recording {str(rec.path)!r}"
     if check:
         check_recorded_vehicle(emulator, rec.vehicle, rec.noise_std, what)
