@@ -23,6 +23,7 @@ every proposal. See docs/performance.md for measured speeds.
 from __future__ import annotations
 
 import math
+import os
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -930,12 +931,26 @@ class BatchState:
         ws[:, 0], wos[:, 0] = s, t
 
 
+MAX_THREADS = 1024
+"""Most torch CPU threads (``num_threads``), or the machine's CPUs where it has more: torch's
+OpenMP pool allocates per thread up front (10**9 aborted the process out of memory, 10**5
+crashed it), and threads beyond the CPUs add nothing."""
+
+
 @contextmanager
 def torch_threads(num_threads: int | None):
     """Set torch's CPU thread count, and the BLAS libraries' (scipy's LAPACK factors on the CPU),
-    inside the block (None: unchanged); restored afterwards."""
+    inside the block (None: unchanged); restored afterwards. GPMSAError naming ``num_threads``
+    for a count outside [1, ``MAX_THREADS``] (or the machine's CPUs, where more)."""
     if num_threads is not None:
         check_count(num_threads, "num_threads")
+        most = max(MAX_THREADS, os.cpu_count() or 1)
+        if num_threads > most:
+            raise GPMSAError(
+                f"num_threads must be an integer in [1, {most}], got {num_threads!r}: torch "
+                f"would start that many CPU threads, and this machine has {os.cpu_count()} "
+                "CPUs (more threads than CPUs add nothing)"
+            )
     previous = torch.get_num_threads()
     if num_threads is None:
         yield
@@ -1047,7 +1062,7 @@ def sample(
     ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
     ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
-    torch's setting.
+    torch's setting; at most ``MAX_THREADS`` (or the machine's CPUs, where more).
 
     Several cores, or a cluster, on the CPU: ``chain_groups`` > 1 splits the chains, after the
     (pooled) tuning, into that many batches of consecutive chains, each sampled in a worker

@@ -317,8 +317,9 @@ def fit(
             "1,000 sweeps between the source's and the continuation's: pass tune=False (and "
             "step_widths= to choose the widths)"
         )
-    steps = None  # the precisions' steps as the chains it continues (SEPIA: once tuned, always)
-    if continuing and not tune and "proportional_steps" not in options:
+    steps = None  # the precisions' steps as the chains it continues (SEPIA: once tuned, always;
+    # pyro's NUTS has none)
+    if continuing and not tune and backend in MH_BACKENDS and "proportional_steps" not in options:
         steps = continued_steps(resumed)
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,

@@ -329,6 +329,16 @@ def discrepancy_bases(kind, grids: list[np.ndarray]) -> tuple[np.ndarray, ...] |
     string kinds' bases).
     """
     if not is_basis_list(kind):
+        lengths = [n_points(g) for g in grids]
+        if kind is not None and not isinstance(kind, str) and len(set(lengths)) > 1:
+            shape = (f"of shape {kind.shape}" if isinstance(kind, np.ndarray)
+                     else f"(a {type(kind).__name__})")  # fmt: skip
+            shown = ", ".join(map(str, lengths[:8])) + (", ..." if len(lengths) > 8 else "")
+            raise GPMSAError(
+                f"discrepancy: one basis {shape} is for the index grid every experiment "
+                f"shares, but the experiments' grids have [{shown}] values: give a list of one "
+                "(l_j, p_v) array per experiment, rows on its own index grid"
+            )
         return None if kind is None else tuple(discrepancy_basis(kind, g) for g in grids)
     if len(kind) != len(grids):
         raise GPMSAError(

@@ -538,13 +538,29 @@ def _index_text(index: np.ndarray | None, names: tuple[str, ...] | None, l_sim: 
     return f" on {kind} " + " x ".join(f"{a}{_span(c)}" for a, c in zip(labels, cols, strict=True))
 
 
+def _label_text(entry, k: int, what: str, kind: str) -> str:
+    """Entry ``k`` of the column labels ``what`` (x_names, t_units, ...) as text: a string, or
+    an integer (a table's column number) as its digits; GPMSAError naming ``what[k]`` for
+    anything else (None, a list, bytes, a float), which would otherwise be kept as its repr
+    ("None", "['a']"), and for a blank name (a posterior, a y_obs table and ``gpmsa
+    calibrate`` read the columns by their names)."""
+    if isinstance(entry, int | np.integer) and not isinstance(entry, bool | np.bool_):
+        return str(entry)
+    if not isinstance(entry, str):
+        raise GPMSAError(f"{what}[{k}] must be a {kind} (a string), got "
+                         f"{type(entry).__name__} {entry!r:.80}")  # fmt: skip
+    if kind == "name" and not entry.strip():
+        raise GPMSAError(f"{what}[{k}] must be a non-empty name, got {entry!r}")
+    return str(entry)
+
+
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
     if names is None:
         return tuple(f"{prefix}{i}" for i in range(n))
     if isinstance(names, str):
         raise GPMSAError(f"{what} must be a list of names, got the string {names!r} (for one "
                          f"name pass [{names!r}])")  # fmt: skip
-    names = tuple(str(s) for s in names)
+    names = tuple(_label_text(s, k, what, "name") for k, s in enumerate(names))
     if len(names) != n:
         each = ""
         if what == "y_names" and len(names) == 1:  # one name for a functional output
@@ -563,7 +579,7 @@ def _units(units: Sequence[str] | None, n: int, what: str) -> tuple[str, ...]:
     if isinstance(units, str):
         raise GPMSAError(f"{what} must be a list of units, got the string {units!r} (for one "
                          f"unit pass [{units!r}])")  # fmt: skip
-    units = tuple(str(s) for s in units)
+    units = tuple(_label_text(s, k, what, "unit") for k, s in enumerate(units))
     if len(units) != n:
         each = ""
         if what == "y_units" and len(units) == 1:
@@ -898,7 +914,8 @@ class SimData:
     ``y_ind_sim`` of (time, angle) pairs), gives each output value its point: finite, no point
     twice, spanning d dimensions; the basis and the mean are interpolated piecewise-linearly on
     the points' Delaunay triangulation (``gpmsa.model.index_points``).
-    Names default to x0.., t0.., y0..; units to "". ``t_names`` may
+    Names default to x0.., t0.., y0..; units to "". A name is a non-blank string (an integer,
+    a table's column number, is taken as its digits), a unit a string. ``t_names`` may
     not be a reserved name (lamOs, lamVz, betaV, betaV[k], betaV[k,g], lamVz[g]: the other
     parameters of a calibration posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every
     entry must be a real number (strings, bools and None are refused, never converted). A
@@ -1139,10 +1156,11 @@ class ObsData:
     ``y`` is (n, l_obs), or a list of n 1-D arrays of differing lengths ("ragged"), each with its
     ``index`` grid (a list of arrays; a single array applies to every experiment; None means the
     simulation grid). An observation grid may be in any order (each point is interpolated on the
-    simulation grid, which is increasing), but must lie within the simulation grid; the columns
-    of ``y`` follow its order. With a simulation index of several columns (l_sim, d), each
-    experiment's index is its points (l_j, d) (a list, ragged too; one (l, d) array applies to
-    every experiment), within the simulation points' convex hull.
+    simulation grid, which is increasing), but must lie within the simulation grid (a scalar
+    output's: None, or its one point); the columns of ``y`` follow its order. With a simulation
+    index of several columns (l_sim, d), each experiment's index is its points (l_j, d) (a list,
+    ragged too; one (l, d) array applies to every experiment), within the simulation points'
+    convex hull.
     ``precision`` is the observation-error precision in native units
     (1/unit^2): None (identity in standardised units, GPM/SA's default), a scalar (the same for
     every experiment), or per experiment a scalar, an (l_j,) vector (one precision per value:
