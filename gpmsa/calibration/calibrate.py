@@ -38,6 +38,7 @@ from gpmsa.calibration.observations import (
     draw_positions,
     emulator_param_sets,
     emulator_record,
+    far_value,
     fit_at_levels,
     fit_of,
     fixed_gp,
@@ -495,7 +496,8 @@ def sample_calibration(
                 [data.values_sha256, data.layout_sha256]))  # fmt: skip
         fit = observation_fit(emulator, data, sets)
         # attributed to the user's call (of calibrate, or of a Calibrator's update)
-        warn_if_outside(fit, user_stacklevel() + 1, discrepancy=discrepancy is not None)
+        warn_if_outside(fit, user_stacklevel() + 1, discrepancy=discrepancy is not None,
+                        far=far_value(emulator, data, fit))  # fmt: skip
         if fast:
             draws, info = _run_fast(
                 emulator, data, fit, sets, n_samples, n_chains, tune, tuning_opts, seed,

@@ -81,6 +81,7 @@ from gpmsa.calibration.observations import (
     draw_positions,
     emulator_param_sets,
     emulator_record,
+    far_value,
     fit_at_levels,
     fixed_gp,
     outside_sds,
@@ -514,7 +515,8 @@ class Calibrator:
         seen: list[float] = []
         with blas_controller().limit(limits=1, user_api="blas"):
             ll = self._combine(self._marginals(data, None, seen))
-        warn_if_outside(Fit(min(seen), 0.0))
+        fit = Fit(min(seen), 0.0)
+        warn_if_outside(fit, far=far_value(self.emulator, data, fit))
         if np.any(np.isnan(ll)):
             raise GPMSAError("the likelihood could not be evaluated for this observation")
         return self.theta_grid, ll
@@ -619,7 +621,8 @@ class Calibrator:
         with blas_controller().limit(limits=1, user_api="blas"):
             margs = self._marginals(data, None, seen)
             outside = min(seen)
-            warn_if_outside(Fit(outside, 0.0))
+            fit = Fit(outside, 0.0)
+            warn_if_outside(fit, far=far_value(self.emulator, data, fit))
             axes, theta, ok = self._axes, self._theta_unit, self._base_ok
             free = self._combine(margs) + self._log_prior_theta
             keep = None  # grid lines a refined grid keeps: where a gridded prior's zero ends

@@ -918,7 +918,9 @@ class SimData:
     a table's column number, is taken as its digits), a unit a string. ``t_names`` may
     not be a reserved name (lamOs, lamVz, betaV, betaV[k], betaV[k,g], lamVz[g]: the other
     parameters of a calibration posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every
-    entry must be a real number (strings, bools and None are refused, never converted). A
+    entry must be a real number (strings, bools and None are refused, never converted); every
+    input column must vary, and so must y over the runs (y the same in every run, varying only
+    along its index, is refused: the emulator learns how it changes with x and t). A
     pandas table names its columns (read by ``*_names`` where given), a named pandas Series
     (``df["a"]``) its one column; pandas inputs of several rows must carry the same row labels
     (rows pair by position).
@@ -1020,12 +1022,19 @@ class SimData:
         p, q = x.shape[1], t.shape[1]
         if m < p + q + 2:
             raise GPMSAError(
-                f"need at least p + q + 2 = {p + q + 2} simulation runs for {p + q} inputs, got {m}"
+                f"need at least p + q + 2 = {p + q + 2} simulation runs for "
+                f"{_count(p + q, 'input')}, got {m}"
             )
         _check_spans(x, "x", self.x_names)
         _check_spans(t, "t", self.t_names)
         if np.ptp(y) == 0.0:
             raise GPMSAError(f"y is constant ({y[0, 0]}); the simulation output must vary")
+        if not np.any(np.ptp(y, axis=0) > 0.0):  # varying along the index only
+            raise GPMSAError(
+                f"y is the same in every run ({m} runs of {y.shape[1]} output values, none of "
+                "which varies over the runs): the emulator learns how the output changes with "
+                "x and t; check that each run's own output was read (not one run's for all)"
+            )
         _check_resolution(y, output_scale(y))
         if not (isinstance(self.y_scale, str) and self.y_scale in Y_SCALES):
             raise GPMSAError(f"y_scale must be one of {Y_SCALES}, got {self.y_scale!r:.80}")

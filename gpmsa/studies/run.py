@@ -21,7 +21,12 @@ from gpmsa.calibration.calibrate import (
     held_discrepancy_names,
     observation_fit,
 )
-from gpmsa.calibration.observations import check_emulator, reduce, warn_if_outside
+from gpmsa.calibration.observations import (
+    check_emulator,
+    far_value,
+    reduce,
+    warn_if_outside,
+)
 from gpmsa.errors import GPMSAError, ReductionWarning, user_stacklevel
 from gpmsa.fitting.continuation import appended_record, resumes_copies, source_ladders
 from gpmsa.fitting.emulator import EMULATOR_PARAMS, Emulator, check_metadata
@@ -572,7 +577,8 @@ def calibrate_study(
                 warnings.simplefilter("ignore", ReductionWarning)
             reduced.append(_per_model(lab, reduce, e, x, y, extrapolate))
         fits.append(observation_fit(e, reduced[-1], [e.params]))  # as gpmsa.calibrate warns
-        warn_if_outside(fits[-1], stacklevel=3, discrepancy=basis is not None, model=lab)
+        warn_if_outside(fits[-1], stacklevel=3, discrepancy=basis is not None, model=lab,
+                        far=far_value(e, reduced[-1], fits[-1]))  # fmt: skip
     problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate,
                            reduced=None if basis is not None else r, discrepancy=basis,
                            discrepancy_groups=groups, fixed=h,
