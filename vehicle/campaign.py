@@ -22,8 +22,12 @@ import json
 import math
 import os
 import secrets
+import signal
 import stat
 import sys
+import tempfile
+import threading
+import time
 import tokenize
 import zipfile
 import zlib
@@ -454,7 +458,8 @@ def run_campaign(
             [0, ``vehicle.sensor.MAX_NOISE_STD``].
         window: samples in the ``f_window`` span.
         executor: any ``concurrent.futures.Executor`` (e.g. a dask ``Client.get_executor()``);
-            default a process pool over all cores, shut down at the end.
+            default a process pool over all cores, shut down at the end (its workers end
+            with this process, even one killed outright).
         cache_dir: finished runs are stored there, one ``.npz`` per run named by a hash of its
             settings and of the code that computes it (``code_fingerprint``: the roadgen and
             vehicle source, numpy, scipy and exudyn), and reused: an interrupted campaign loses
@@ -555,7 +560,13 @@ def run_campaign(
     bar = tqdm(total=len(specs), initial=len(specs) - len(todo), disable=not progress,
                desc=f"campaign {model.name}", unit="run")  # fmt: skip
     own = executor is None and len(todo) > 0
-    pool = ProcessPoolExecutor(max_workers=min(os.cpu_count() or 1, len(todo))) if own else executor
+    pool = (
+        ProcessPoolExecutor(
+            max_workers=min(os.cpu_count() or 1, len(todo)), initializer=_end_with_parent
+        )
+        if own
+        else executor
+    )
     futures: dict[Future, int] = {}
     try:
         for i in todo:
@@ -596,6 +607,36 @@ def run_campaign(
         settings=settings,
         **traces,
     )
+
+
+def _end_with_parent() -> None:
+    """The campaign pool's worker initializer: end this worker when its parent, the process that
+    started it, ends. A campaign killed (SIGTERM, SIGKILL, the OOM killer: its cleanup never runs)
+    would leave its workers waiting for runs for ever, each holding a copy of its memory. On Linux
+    the kernel kills the worker then (prctl PR_SET_PDEATHSIG); elsewhere a thread checks the parent
+    each second. (gpmsa's chain pools do the same; vehicle does not import gpmsa.) The kernel's
+    signal follows the thread that started the worker: the one that runs the campaign, which
+    outlives the pool."""
+    parent = os.getppid()
+    if sys.platform == "linux":
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            if libc.prctl(1, int(signal.SIGKILL), 0, 0, 0) == 0:  # 1: PR_SET_PDEATHSIG
+                if os.getppid() != parent:  # it ended before the call
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):  # no libc.prctl: watch as elsewhere
+            pass
+    threading.Thread(target=_watch_parent, args=(parent,), name="vehicle-end-with-parent",
+                     daemon=True).start()  # fmt: skip
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(1.0)
+    os._exit(1)
 
 
 def _check_drives(
@@ -765,9 +806,11 @@ def _cache_folder(cache_dir: str | os.PathLike) -> Path:
     cache = roadgen.checks.home_path(cache_dir)  # not a folder named "~"
     try:
         cache.mkdir(parents=True, exist_ok=True)
-        probe = cache / f".write-test-{os.getpid()}"  # an existing folder may not be writable
-        probe.write_bytes(b"")
-        probe.unlink()
+        # an existing folder may not be writable: a probe of a name of its own (campaigns on
+        # other machines sharing the folder may have this one's process id), without a name
+        # where the OS allows (O_TMPFILE: an interrupted probe leaves nothing behind)
+        with tempfile.TemporaryFile(dir=cache, prefix=".write-test-"):
+            pass
     except OSError as exc:
         raise VehicleError(
             f"cache_dir={str(cache_dir)!r} cannot be used as a folder: {exc}"

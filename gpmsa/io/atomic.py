@@ -7,8 +7,10 @@ import errno
 import os
 import secrets
 import stat
+import sys
+import time
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import IO
 
@@ -49,7 +51,12 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
     group's block ends without an exception the temporary files are moved over their paths in
     the order staged; on any exception (while writing any of them) every temporary file is
     removed and no path is touched. Only an OS failure during the final moves (each one step)
-    can leave some paths replaced and others not.
+    can leave some paths replaced and others not. Where it can (`_folder_lock`), a group of
+    several files holds a lock on each folder during its moves, so that two processes saving
+    the same files at once leave one's files, all of them, not a mix of both.
+
+    An OS error while a file is written (a full disk, a quota, an I/O error), flushed to disk or
+    moved (e.g. no permission) raises ``error`` naming the path, the OS error chained.
     """
     staged: list[tuple[Path, Path]] = []
 
@@ -67,14 +74,29 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
         staged.append((tmp, path))
         kw = {"encoding": "utf-8", "newline": ""} if text else {}
         with os.fdopen(fd, "w+" if text else "w+b", **kw) as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
+            try:
+                yield fh
+            except OSError as exc:  # the writer's writes: the disk full, say (an error of its
+                if exc.errno not in _WRITE_ERRNOS:  # own, e.g. a font it reads, stays as is)
+                    raise
+                raise error(_cannot_write(path, exc)) from exc
+            try:
+                fh.flush()
+                os.fsync(fh.fileno())
+            except OSError as exc:
+                raise error(_cannot_write(path, exc)) from exc
 
     try:
         yield stage
-        for tmp, path in staged:
-            os.replace(tmp, path)
+        folders = sorted({path.parent for _, path in staged}) if len(staged) > 1 else []
+        with ExitStack() as locks:
+            for folder in folders:
+                locks.enter_context(_folder_lock(folder, error))
+            for tmp, path in staged:
+                try:
+                    os.replace(tmp, path)
+                except OSError as exc:
+                    raise error(_cannot_write(path, exc)) from exc
     except BaseException:
         for tmp, _ in staged:
             try:
@@ -82,6 +104,53 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
             except OSError:
                 pass
         raise
+
+
+_WRITE_ERRNOS = frozenset(
+    getattr(errno, name) for name in ("ENOSPC", "EDQUOT", "EFBIG", "EIO") if hasattr(errno, name)
+)
+"""The OS errors a write to a file raises (no space, over the quota, too large, an I/O error)."""
+
+LOCK_WAIT_S = 60.0
+"""Seconds a group's moves wait for another process's moves into the same folder to end (they
+take milliseconds): past that (a writer stopped midway), ``error`` names the folder."""
+
+
+@contextmanager
+def _folder_lock(folder: Path, error: type[Exception]) -> Iterator[None]:
+    """An exclusive advisory lock (``flock``) on ``folder`` while the block runs, where the OS
+    and the file system give one (POSIX; not Windows, and on some network file systems not):
+    elsewhere none, and the moves run as they would without it. A lock held by another process
+    for ``LOCK_WAIT_S`` seconds raises ``error`` naming the folder."""
+    if sys.platform == "win32":
+        yield
+        return
+    import fcntl
+
+    try:
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:  # a folder that cannot be opened: the moves say why, if they fail
+        yield
+        return
+    try:
+        deadline = time.monotonic() + LOCK_WAIT_S
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:  # another process is moving its files into the folder
+                if time.monotonic() > deadline:
+                    raise error(
+                        f"{folder}: another process has held the folder's lock for "
+                        f"{LOCK_WAIT_S:g} s (gpmsa.io.atomic.LOCK_WAIT_S) while replacing files "
+                        "there; let it finish (or end it) and save again"
+                    ) from None
+                time.sleep(0.01)
+            except OSError:  # no locks on this file system: move without one
+                break
+        yield
+    finally:
+        os.close(fd)  # (releases the lock)
 
 
 def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:

@@ -17,7 +17,9 @@ in a fresh pool when the pool was ours; then ``ChainError`` names the chain and 
 chain is never dropped silently. When a run stops early (a chain failed, or KeyboardInterrupt),
 the chains not yet finished are cancelled: gpmsa's own worker processes are ended, an
 executor's futures cancelled. Ctrl-C stops a parallel run within a quarter of a second,
-whichever of the process's threads the kernel hands the signal to.
+whichever of the process's threads the kernel hands the signal to. A process killed outright
+(SIGTERM, SIGKILL), whose cleanup never runs, takes its own workers with it
+(`end_with_parent`).
 """
 
 from __future__ import annotations
@@ -28,8 +30,10 @@ import importlib
 import multiprocessing
 import multiprocessing.context
 import os
+import signal
 import sys
 import threading
+import time
 import warnings
 from collections.abc import Callable, Sequence
 from concurrent.futures import (
@@ -331,7 +335,40 @@ def _own_pool(workers: int) -> ProcessPoolExecutor:
     # fork where it exists (Linux): a worker starts in ~0.05 s against ~2 s for forkserver or
     # spawn, which re-import numpy and scipy. The workers run numpy only, one BLAS thread.
     ctx = _WorkerContext() if sys.platform == "linux" else None
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=end_with_parent)
+
+
+_PR_SET_PDEATHSIG = 1
+"""Linux's prctl option: the signal a process gets when its parent ends."""
+
+
+def end_with_parent() -> None:
+    """A pool worker's initializer: end this worker when its parent, the process that started it,
+    ends. A parent killed (SIGTERM, SIGKILL, the OOM killer: its cleanup never runs) would leave its
+    pool's workers waiting for tasks for ever, each holding a copy of its memory. On Linux the
+    kernel kills the worker then (prctl PR_SET_PDEATHSIG); elsewhere a thread checks the parent each
+    second. The kernel's signal follows the thread that started the worker: the one that calls and
+    waits for the pool, which outlives it."""
+    parent = os.getppid()
+    if sys.platform == "linux":
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            if libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0:
+                if os.getppid() != parent:  # it ended before the call
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):  # no libc.prctl: watch as elsewhere
+            pass
+    threading.Thread(target=_watch_parent, args=(parent,), name="gpmsa-end-with-parent",
+                     daemon=True).start()  # fmt: skip
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(1.0)
+    os._exit(1)
 
 
 _JOIN_S = 5.0

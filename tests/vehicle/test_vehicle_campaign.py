@@ -478,7 +478,9 @@ def test_an_error_cancels_the_queued_runs(monkeypatch, own_pool):
         return np.ones(4), np.zeros(0), np.zeros(0)
 
     monkeypatch.setattr(campaign, "_drive", drive)
-    monkeypatch.setattr(campaign, "ProcessPoolExecutor", lambda max_workers: ThreadPoolExecutor(1))
+    monkeypatch.setattr(
+        campaign, "ProcessPoolExecutor", lambda max_workers, **kw: ThreadPoolExecutor(1)
+    )
     design = np.column_stack([np.linspace(0.5, 1.5, 8), np.full(8, 300.0)])
     with ThreadPoolExecutor(1) as ex, pytest.raises(Boom):
         vehicle.run_campaign(design, executor=None if own_pool else ex, **SHORT)
