@@ -35,7 +35,14 @@ from gpmsa.model.data import (
     evenly_spaced,
     values_digest,
 )
-from gpmsa.model.problem import GLS_RIDGE, MAX_STD_OBS, SIGOBS_RIDGE, ObsProblem, reduce_obs
+from gpmsa.model.problem import (
+    GLS_RIDGE,
+    MAX_STD_OBS,
+    SIGOBS_RIDGE,
+    ObsProblem,
+    check_scalar_index,
+    reduce_obs,
+)
 from gpmsa.model.transforms import EXTRAPOLATION_MARGIN
 
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
@@ -71,8 +78,9 @@ class Observations:
     obs the ObsProblem for the samplers; values_sha256 the SHA-256 of the native x and y rows
     (`gpmsa.model.data.values_digest`: an ObsData of the same values has the same);
     layout_sha256 that of where they lie and how precise they are (`layout_digest`); values
-    each experiment's y (native, in the emulator's y order) and grids each one's index (None:
-    the simulation grid), which `far_value` reads."""
+    each experiment's y (native, in the emulator's y order), grids each one's index (None:
+    the simulation grid) and precisions each one's observation-error precision (native, in
+    that order; None: not given), which `far_value` reads."""
 
     x: np.ndarray
     z: np.ndarray
@@ -84,6 +92,7 @@ class Observations:
     layout_sha256: str
     values: tuple
     grids: tuple
+    precisions: tuple
 
 
 def check_emulator(emulator, categorical_theta: bool = False) -> None:
@@ -346,7 +355,7 @@ def reduce(emulator, x_obs, y_obs, extrapolate: bool = False) -> Observations:
     else:
         obs, corr = reduce_obs(ObsData(x, y), std, K, None, emulator.x_names, x_checked=True)
     digests = values_digest(x, list(y)), layout_digest([None] * n, None, std.grid)
-    return _observations(emulator, obs, corr, digests, xu, (tuple(y), (None,) * n))
+    return _observations(emulator, obs, corr, digests, xu, (tuple(y), (None,) * n, (None,) * n))
 
 
 def _check_obs_values(n: int, p_u: int) -> None:
@@ -367,14 +376,12 @@ def checked_obs_data(emulator, obs: ObsData, extrapolate: bool) -> tuple[np.ndar
     """Check a ``gpmsa.ObsData`` given to calibration against ``emulator``; returns its x
     native (n, p) in the order of the emulator's x_names (`ObsData.inputs`) and on the unit
     scale. Its x as ``check_x``'s; a scalar output takes one value per experiment and no
-    index; a functional output's experiments lie on the simulation grid or on their own index
-    within it (checked by the reduction)."""
+    index (or its one point); a functional output's experiments lie on the simulation grid or
+    on their own index within it (checked by the reduction)."""
     x, xu = check_x(emulator, obs.inputs(emulator.x_names), extrapolate, "the ObsData's input")
     _check_obs_values(x.shape[0], emulator.K.shape[1])
     if emulator.K.shape[0] == 1:
-        if any(g is not None for g in obs.grids):
-            raise GPMSAError("the emulator's output is a scalar: ObsData index (an output grid) "
-                             "is for a functional output")  # fmt: skip
+        check_scalar_index(obs.grids, emulator.standardizer.grid)  # None, or its one point
         sizes = sorted({e.size for e in obs.experiments} - {1})
         if sizes:
             raise GPMSAError(
@@ -396,16 +403,18 @@ def _reduce_obs_data(emulator, obs: ObsData, extrapolate: bool) -> Observations:
     digests = (obs.values_digest(emulator.x_names, _y_names(emulator)),
                layout_digest(obs.grids, obs.output_precisions(_y_names(emulator)),
                              emulator.standardizer.grid))  # fmt: skip
-    native = tuple(obs.outputs(_y_names(emulator))), tuple(obs.grids)
+    precisions = obs.output_precisions(_y_names(emulator)) or [None] * obs.n
+    native = tuple(obs.outputs(_y_names(emulator))), tuple(obs.grids), tuple(precisions)
     return _observations(emulator, reduced, corr, digests, xu, native)
 
 
 def _observations(
-    emulator, obs: ObsProblem, corr, digests: tuple[str, str], xu, native: tuple[tuple, tuple]
+    emulator, obs: ObsProblem, corr, digests: tuple[str, str], xu, native: tuple[tuple, ...]
 ) -> Observations:
     """The ``Observations`` of a reduction ``obs`` (lamOs prior correction ``corr``; the data's
-    values and layout ``digests``; ``native``: the experiments' y and grids); GPMSAError where
-    its reduced data lie more than ``MAX_STD_OBS`` simulation sds from the mean (wrong units)."""
+    values and layout ``digests``; ``native``: the experiments' y, grids and precisions);
+    GPMSAError where its reduced data lie more than ``MAX_STD_OBS`` simulation sds from the
+    mean (wrong units)."""
     z = obs.z
     far = ~(np.abs(z) <= MAX_STD_OBS)  # an overflow (inf, NaN) is far too
     if far.any():
@@ -787,8 +796,10 @@ class FarValue:
 def far_value(emulator, data: Observations, fit: Fit | None = None) -> FarValue | None:
     """The observed value (of ``data.values``, on ``data.grids``) farthest beyond the
     simulation runs' range at its output point, where it lies more than ``OUTSIDE_SDS`` of the
-    outputs' sds (the emulator's standardising scale there) beyond it; None where no value
-    does, or for an object without the runs' outputs ``y``. The runs' range is interpolated
+    outputs' sds (the emulator's standardising scale there) beyond it, and more than that many
+    of its own noise sds where the data give a precision (``data.precisions``: a value
+    within its stated noise is no outlier); None where no value does, or for an object
+    without the runs' outputs ``y``. The runs' range is interpolated
     onto an experiment's own index as the basis is. A scalar output whose ``fit`` reads the data
     inside is not looked at (None): each datum is then within reach of the emulator at its x,
     and a Calibrator's update on the road case is spared the pass (10-20 us of 0.5 ms).
@@ -802,35 +813,62 @@ def far_value(emulator, data: Observations, fit: Fit | None = None) -> FarValue 
     if y is None or (fit is not None and fit.outside_sds <= OUTSIDE_SDS and np.shape(y)[1] == 1):
         return None
     std = emulator.standardizer
-    experiments, grids = data.values, data.grids
+    experiments, grids, lams = data.values, data.grids, data.precisions
     low, high = np.min(y, axis=0), np.max(y, axis=0)  # the runs' range per output element
     if all(g is None for g in grids):  # on the simulation grid: at once
         values = np.asarray(experiments, dtype=np.float64).reshape(len(experiments), -1)
         with np.errstate(over="ignore", invalid="ignore"):
             sds = np.maximum(values - high, low - values) / std.y_sd
+        if not np.max(sds) > OUTSIDE_SDS:  # NaN: none (the common case, at once)
+            return None
+        for j, lam in enumerate(lams):
+            sds[j] = _beyond_noise(sds[j], std.y_sd, lam)
         at = int(np.argmax(sds))
         if not sds.flat[at] > OUTSIDE_SDS:
             return None
         j, k = divmod(at, values.shape[1])
         return _far(emulator, float(sds.flat[at]), j, values[j, k], low[k], high[k], None, k)
     worst = None
-    for j, (e, g) in enumerate(zip(experiments, grids, strict=True)):
+    for j, (e, g, lam) in enumerate(zip(experiments, grids, lams, strict=True)):
         e = np.asarray(e, dtype=np.float64).reshape(-1)
         lo, hi = (np.column_stack([low, high]) if g is None
                   else interpolate_basis(np.column_stack([low, high]), std.grid, g)).T  # fmt: skip
+        scale = std.sd_on(g)
         with np.errstate(over="ignore", invalid="ignore"):
-            sds = np.maximum(e - hi, lo - e) / std.sd_on(g)
+            sds = _beyond_noise(np.maximum(e - hi, lo - e) / scale, scale, lam)
         k = int(np.argmax(sds))
         if sds[k] > OUTSIDE_SDS and (worst is None or sds[k] > worst[1]):
             worst = (emulator, float(sds[k]), j, e[k], lo[k], hi[k], g, k)
     return None if worst is None else _far(*worst)
 
 
+def _beyond_noise(sds: np.ndarray, scale, lam: np.ndarray | None) -> np.ndarray:
+    """``sds`` (one experiment's distances beyond the runs, in the outputs' sds ``scale``) with
+    those within ``OUTSIDE_SDS`` of the value's own stated noise sd set to 0: with a given
+    observation-error precision ``lam`` (native; None: not given, the noise on the outputs'
+    scale) a value that far outside every run is within its noise, no outlier (an output
+    element the runs barely vary, scaled columnwise, observed with its real noise)."""
+    if lam is None or not np.max(sds) > OUTSIDE_SDS:
+        return sds
+    diagonal = np.diagonal(lam)
+    if np.count_nonzero(lam) == np.count_nonzero(diagonal):  # one precision per value
+        noise = 1.0 / np.sqrt(diagonal)
+    else:
+        noise = np.sqrt(np.diagonal(np.linalg.inv(lam)))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.where(sds * scale > OUTSIDE_SDS * noise, sds, 0.0)
+
+
 def _far(emulator, sds: float, j: int, value, low, high, grid, k: int) -> FarValue:
     """`far_value`'s record of experiment ``j``'s value ``k`` (on ``grid``; None: the
-    simulation grid)."""
-    point = None
-    if np.shape(emulator.y)[1] > 1:  # a functional output: where the value lies
+    simulation grid): where it lies by the index, or for outputs given without one (several
+    named outputs) by the output's name."""
+    if np.shape(emulator.y)[1] == 1:
+        return FarValue(sds, j, float(value), float(low), float(high), None)
+    names = getattr(emulator, "y_names", None)
+    if grid is None and names and getattr(emulator, "index", 0) is None:
+        point = f"output {names[k]!r}"  # several outputs, no index: by the output's name
+    else:  # a functional output: where the value lies
         point = _point_text(emulator, (emulator.standardizer.grid if grid is None else grid)[k])
     return FarValue(sds, j, float(value), float(low), float(high), point)
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import datetime
 import hashlib
+import numbers
 import re
 import sys
 import warnings
@@ -539,19 +541,35 @@ def _index_text(index: np.ndarray | None, names: tuple[str, ...] | None, l_sim: 
 
 
 def _label_text(entry, k: int, what: str, kind: str) -> str:
-    """Entry ``k`` of the column labels ``what`` (x_names, t_units, ...) as text: a string, or
-    an integer (a table's column number) as its digits; GPMSAError naming ``what[k]`` for
-    anything else (None, a list, bytes, a float), which would otherwise be kept as its repr
-    ("None", "['a']"), and for a blank name (a posterior, a y_obs table and ``gpmsa
-    calibrate`` read the columns by their names)."""
-    if isinstance(entry, int | np.integer) and not isinstance(entry, bool | np.bool_):
-        return str(entry)
-    if not isinstance(entry, str):
+    """Entry ``k`` of the column labels ``what`` (x_names, t_units, ...) as text: a string, or a
+    table's column label of another type as its text, as `column_labels` reads a table's (an
+    integer column number, a number such as a wavelength, a date, a MultiIndex's tuple: so
+    ``y_names=df.columns`` names what ``df`` alone does); GPMSAError naming ``what[k]`` for
+    anything else (None, a bool, bytes, a list or array, a non-finite number), which would
+    otherwise be kept as its repr ("None", "['a']"), and for a blank name (a posterior, a
+    y_obs table and ``gpmsa calibrate`` read the columns by their names)."""
+    if not isinstance(entry, str) and not _column_label(entry):
+        hint = ": decode it (.decode())" if isinstance(entry, bytes) else ""
         raise GPMSAError(f"{what}[{k}] must be a {kind} (a string), got "
-                         f"{type(entry).__name__} {entry!r:.80}")  # fmt: skip
-    if kind == "name" and not entry.strip():
+                         f"{type(entry).__name__} {entry!r:.80}{hint}")  # fmt: skip
+    text = str(entry)
+    if kind == "name" and not text.strip():
         raise GPMSAError(f"{what}[{k}] must be a non-empty name, got {entry!r}")
-    return str(entry)
+    return text
+
+
+def _column_label(entry) -> bool:
+    """Whether ``entry``, no string, is a table column label that reads as text: a real number
+    (not a bool, finite), a date or time, or a tuple of such labels or strings (a pandas
+    MultiIndex's)."""
+    if isinstance(entry, bool | np.bool_):
+        return False
+    if isinstance(entry, numbers.Real):  # int, float and their numpy kinds
+        return bool(np.isfinite(float(entry)))
+    if isinstance(entry, datetime.date | datetime.time | np.datetime64):
+        return True
+    return (isinstance(entry, tuple) and len(entry) > 0
+            and all(isinstance(e, str) or _column_label(e) for e in entry))  # fmt: skip
 
 
 def _names(names: Sequence[str] | None, n: int, prefix: str, what: str) -> tuple[str, ...]:
@@ -914,16 +932,17 @@ class SimData:
     ``y_ind_sim`` of (time, angle) pairs), gives each output value its point: finite, no point
     twice, spanning d dimensions; the basis and the mean are interpolated piecewise-linearly on
     the points' Delaunay triangulation (``gpmsa.model.index_points``).
-    Names default to x0.., t0.., y0..; units to "". A name is a non-blank string (an integer,
-    a table's column number, is taken as its digits), a unit a string. ``t_names`` may
-    not be a reserved name (lamOs, lamVz, betaV, betaV[k], betaV[k,g], lamVz[g]: the other
-    parameters of a calibration posterior). A 1-D ``x``, ``t`` or ``y`` is one column. Every
-    entry must be a real number (strings, bools and None are refused, never converted); every
-    input column must vary, and so must y over the runs (y the same in every run, varying only
-    along its index, is refused: the emulator learns how it changes with x and t). A
-    pandas table names its columns (read by ``*_names`` where given), a named pandas Series
-    (``df["a"]``) its one column; pandas inputs of several rows must carry the same row labels
-    (rows pair by position).
+    Names default to x0.., t0.., y0..; units to "". A name is a non-blank string, a unit a
+    string; a table's column label of another type (a column number, a number such as a
+    wavelength, a date, a MultiIndex's tuple) is taken as its text, as a table's own labels.
+    ``t_names`` may not be a reserved name (lamOs, lamVz, betaV, betaV[k], betaV[k,g],
+    lamVz[g]: the other parameters of a calibration posterior). A 1-D ``x``, ``t`` or ``y`` is
+    one column. Every entry must be a real number (strings, bools and None are refused, never
+    converted); every input column must vary, and so must y over the runs (y the same in every
+    run, varying only along its index, is refused: the emulator learns how it changes with x
+    and t). A pandas table names its columns (read by ``*_names`` where given), a named pandas
+    Series (``df["a"]``) its one column; pandas inputs of several rows must carry the same row
+    labels (rows pair by position).
     ``x_categorical``, ``t_categorical``: the categorical inputs (column indices or names; None:
     none), whose values are integer level codes; see docs/categorical-and-constraints.md.
     ``x_range``, ``t_range``: the native domain the unit scale maps onto [0, 1] (SEPIA's

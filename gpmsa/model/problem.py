@@ -407,6 +407,21 @@ MAX_STD_OBS = 1e6
 units, not data (the samplers' squares would overflow or the fit be meaningless)."""
 
 
+def check_scalar_index(grids, grid: np.ndarray) -> None:
+    """GPMSAError naming the experiment whose index ``grids[j]`` is not a scalar output's one
+    point ``grid``: an index there is None or that point (as ``ObsData`` documents), never
+    another, which would be ignored."""
+    for j, g in enumerate(grids):
+        if g is not None and not np.array_equal(np.reshape(g, -1), grid.reshape(-1)):
+            a, b = numbers_text(float(np.reshape(g, -1)[0]), float(grid.reshape(-1)[0]))
+            a = a if np.size(g) == 1 else f"{np.size(g)} values ({a}, ...)"
+            raise GPMSAError(
+                f"the index of experiment {j} is {a}, but the simulation output is scalar, "
+                f"one value at index {b}: a scalar output has no grid to observe it along; "
+                "leave ObsData's index out"
+            )
+
+
 def reduce_obs(
     obs: ObsData,
     std: Standardizer,
@@ -475,14 +490,7 @@ def reduce_obs(
     if scalar:
         if any(e.size != 1 for e in ys):
             raise GPMSAError("a scalar simulation output needs one value per experiment in y_obs")
-        for j, g in enumerate(obs.grids):  # its one point, or none: never another, ignored
-            if g is not None and not np.array_equal(np.reshape(g, -1), std.grid.reshape(-1)):
-                a, b = numbers_text(float(np.reshape(g, -1)[0]), float(std.grid.reshape(-1)[0]))
-                raise GPMSAError(
-                    f"the index of experiment {j} is {a}, but the simulation output is scalar, "
-                    f"one value at index {b}: a scalar output has no grid to observe it along; "
-                    "leave ObsData's index out"
-                )
+        check_scalar_index(obs.grids, std.grid)
         u = np.array([e[0] for e in ys])[:, None]
         p_v = 0 if discrepancy is None else 1
         if p_v and not (isinstance(discrepancy, str) and discrepancy == "constant"):

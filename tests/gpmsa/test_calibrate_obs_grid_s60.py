@@ -213,8 +213,9 @@ def test_full_prediction_conditions_on_the_calibrated_layout_and_refuses_another
 
 def test_a_scalar_output_takes_precisions_and_refuses_an_index():
     """A scalar output: per-experiment precisions weight the observations as the unreduced
-    likelihood does (a precision 4x another halves that value's noise sd); an index is
-    refused, as is more than one value per experiment."""
+    likelihood does (a precision 4x another halves that value's noise sd); an index other than
+    its one point is refused (as gpmsa.fit refuses it), as is more than one value per
+    experiment."""
     emu = road_emulator()
     x, y = road_obs()
     xs, ys = [x[0], [1.5]], [y[0], [y[0][0] * 1.1]]
@@ -223,8 +224,9 @@ def test_a_scalar_output_takes_precisions_and_refuses_an_index():
     post = gpmsa.Calibrator(emu).update(obs)
     assert abs(post.mean("GD") - ref["mean"]) < 0.02 * ref["sd"]
     assert abs(post.sd("GD") / ref["sd"] - 1.0) < 0.02
-    with pytest.raises(GPMSAError, match="output is a scalar: ObsData index"):
-        gpmsa.Calibrator(emu).update(gpmsa.ObsData(x, y, index=[0.0]))
+    with pytest.raises(GPMSAError, match="index of experiment 0 is 1, but the simulation output "
+                                         "is scalar, one value at index 0"):  # fmt: skip
+        gpmsa.Calibrator(emu).update(gpmsa.ObsData(x, y, index=[1.0]))
     with pytest.raises(GPMSAError, match="each ObsData experiment needs one value, got 2"):
         gpmsa.calibrate(emu, gpmsa.ObsData(x, [[1.0, 2.0]]), n_samples=10, n_burn=0)
 
