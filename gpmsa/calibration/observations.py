@@ -22,8 +22,7 @@ from gpmsa.errors import (
     numbers_text,
     user_stacklevel,
 )
-from gpmsa.model import categorical, kronecker
-from gpmsa.model.basis import interpolate_basis
+from gpmsa.model import categorical, far_values, kronecker
 from gpmsa.model.data import (
     ObsData,
     as_float,
@@ -35,6 +34,7 @@ from gpmsa.model.data import (
     evenly_spaced,
     values_digest,
 )
+from gpmsa.model.far_values import OUTSIDE_SDS, FarValue, warn_far
 from gpmsa.model.problem import (
     GLS_RIDGE,
     MAX_STD_OBS,
@@ -48,10 +48,6 @@ from gpmsa.model.transforms import EXTRAPOLATION_MARGIN
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 EMULATOR_PARAM_MODES = ("point", "draws")
-OUTSIDE_SDS = 5.0
-"""An observation farther than this many predictive sds from every emulator prediction at its
-x (over the whole theta domain) lies outside what the emulator has seen: a warning
-(``OutsideEmulatorWarning``), and ``Posterior.info["outside_sds"]`` holds the distance."""
 CLOSER_STARTS = 3
 """From how many of `theta_probe`'s best nodes `closer_fit` searches (three or more
 parameters), before it calls an observation outside."""
@@ -767,124 +763,22 @@ def _residual_noise(data: Observations) -> np.ndarray | float:
     return np.sum(data.obs_chol**2, axis=1) / lamos
 
 
-@dataclass(frozen=True)
-class FarValue:
-    """One observed value beyond every simulation run's value at its output point (`far_value`):
-    ``sds`` how far, in the outputs' sds there (the emulator's standardising scale); the
-    experiment's position, the value (native), the runs' range there (native, interpolated
-    onto an experiment's own index) and the point's text (None for a scalar output)."""
-
-    sds: float
-    experiment: int
-    value: float
-    low: float
-    high: float
-    point: str | None
-
-    def text(self) -> str:
-        """'y_obs[1] holds -999 at time 0.454545 s, 1.43e+03 sds ... there ([lo, hi])'."""
-        side = "above" if self.value > self.high else "below"
-        value, low, high = numbers_text(self.value, self.low, self.high)
-        sds = numbers_text(self.sds, digits=3)[0]
-        what = f"y_obs[{self.experiment}] = {value}, " if self.point is None else (
-            f"y_obs[{self.experiment}] holds {value} at {self.point}, ")  # fmt: skip
-        there = "" if self.point is None else " there"
-        return (f"{what}{sds} sds of the simulation outputs {side} every simulation run's "
-                f"value{there} ([{low}, {high}])")  # fmt: skip
-
-
 def far_value(emulator, data: Observations, fit: Fit | None = None) -> FarValue | None:
     """The observed value (of ``data.values``, on ``data.grids``) farthest beyond the
     simulation runs' range at its output point, where it lies more than ``OUTSIDE_SDS`` of the
-    outputs' sds (the emulator's standardising scale there) beyond it, and more than that many
-    of its own noise sds where the data give a precision (``data.precisions``: a value
-    within its stated noise is no outlier); None where no value does, or for an object
-    without the runs' outputs ``y``. The runs' range is interpolated
-    onto an experiment's own index as the basis is. A scalar output whose ``fit`` reads the data
-    inside is not looked at (None): each datum is then within reach of the emulator at its x,
-    and a Calibrator's update on the road case is spared the pass (10-20 us of 0.5 ms).
-
-    A value far outside every run (a missing-value code such as -999, a spike) among a
-    functional observation's values lies mostly beyond the emulator's basis, where GPM/SA's
-    reduction reads it as observation error (the lamOs prior's correction): it inflates that
-    error so much that the predictive check (`fit_of`) reads the data inside (1.5 sds for one
-    -999 among 36 values), while lamOs drops and theta's posterior falls back to its prior."""
+    outputs' sds (the emulator's standardising scale there) beyond it, and that many of its
+    own stated noise sds where the data give a precision (`gpmsa.model.far_values.far_value`);
+    None where no value does, or for an object without
+    the runs' outputs ``y``. A scalar output whose ``fit`` reads the data inside is not looked
+    at (None): each datum is then within reach of the emulator at its x, and a Calibrator's
+    update on the road case is spared the pass (10-20 us of 0.5 ms)."""
     y = getattr(emulator, "y", None)
     if y is None or (fit is not None and fit.outside_sds <= OUTSIDE_SDS and np.shape(y)[1] == 1):
         return None
-    std = emulator.standardizer
-    experiments, grids, lams = data.values, data.grids, data.precisions
-    low, high = np.min(y, axis=0), np.max(y, axis=0)  # the runs' range per output element
-    if all(g is None for g in grids):  # on the simulation grid: at once
-        values = np.asarray(experiments, dtype=np.float64).reshape(len(experiments), -1)
-        with np.errstate(over="ignore", invalid="ignore"):
-            sds = np.maximum(values - high, low - values) / std.y_sd
-        if not np.max(sds) > OUTSIDE_SDS:  # NaN: none (the common case, at once)
-            return None
-        for j, lam in enumerate(lams):
-            sds[j] = _beyond_noise(sds[j], std.y_sd, lam)
-        at = int(np.argmax(sds))
-        if not sds.flat[at] > OUTSIDE_SDS:
-            return None
-        j, k = divmod(at, values.shape[1])
-        return _far(emulator, float(sds.flat[at]), j, values[j, k], low[k], high[k], None, k)
-    worst = None
-    for j, (e, g, lam) in enumerate(zip(experiments, grids, lams, strict=True)):
-        e = np.asarray(e, dtype=np.float64).reshape(-1)
-        lo, hi = (np.column_stack([low, high]) if g is None
-                  else interpolate_basis(np.column_stack([low, high]), std.grid, g)).T  # fmt: skip
-        scale = std.sd_on(g)
-        with np.errstate(over="ignore", invalid="ignore"):
-            sds = _beyond_noise(np.maximum(e - hi, lo - e) / scale, scale, lam)
-        k = int(np.argmax(sds))
-        if sds[k] > OUTSIDE_SDS and (worst is None or sds[k] > worst[1]):
-            worst = (emulator, float(sds[k]), j, e[k], lo[k], hi[k], g, k)
-    return None if worst is None else _far(*worst)
-
-
-def _beyond_noise(sds: np.ndarray, scale, lam: np.ndarray | None) -> np.ndarray:
-    """``sds`` (one experiment's distances beyond the runs, in the outputs' sds ``scale``) with
-    those within ``OUTSIDE_SDS`` of the value's own stated noise sd set to 0: with a given
-    observation-error precision ``lam`` (native; None: not given, the noise on the outputs'
-    scale) a value that far outside every run is within its noise, no outlier (an output
-    element the runs barely vary, scaled columnwise, observed with its real noise)."""
-    if lam is None or not np.max(sds) > OUTSIDE_SDS:
-        return sds
-    diagonal = np.diagonal(lam)
-    if np.count_nonzero(lam) == np.count_nonzero(diagonal):  # one precision per value
-        noise = 1.0 / np.sqrt(diagonal)
-    else:
-        noise = np.sqrt(np.diagonal(np.linalg.inv(lam)))
-    with np.errstate(over="ignore", invalid="ignore"):
-        return np.where(sds * scale > OUTSIDE_SDS * noise, sds, 0.0)
-
-
-def _far(emulator, sds: float, j: int, value, low, high, grid, k: int) -> FarValue:
-    """`far_value`'s record of experiment ``j``'s value ``k`` (on ``grid``; None: the
-    simulation grid): where it lies by the index, or for outputs given without one (several
-    named outputs) by the output's name."""
-    if np.shape(emulator.y)[1] == 1:
-        return FarValue(sds, j, float(value), float(low), float(high), None)
-    names = getattr(emulator, "y_names", None)
-    if grid is None and names and getattr(emulator, "index", 0) is None:
-        point = f"output {names[k]!r}"  # several outputs, no index: by the output's name
-    else:  # a functional output: where the value lies
-        point = _point_text(emulator, (emulator.standardizer.grid if grid is None else grid)[k])
-    return FarValue(sds, j, float(value), float(low), float(high), point)
-
-
-def _point_text(emulator, point) -> str:
-    """An output index point as text: 'time 0.4545 s' by the emulator's index names and units,
-    'output index 0.4545' without names, '(a, b) (0.1, 0.2)' for points of several columns."""
-    values = np.atleast_1d(np.asarray(point, dtype=np.float64))
-    names = getattr(emulator, "index_names", None)
-    units = getattr(emulator, "index_units", None) or ("",) * values.size
-    names = names or ("output index",)
-    shown = [f"{v:.6g}" + (f" {u}" if u else "") for v, u in zip(values, units, strict=False)]
-    if values.size == 1:
-        return f"{names[0]} {shown[0]}"
-    label = names[0] if len(names) == 1 else f"({', '.join(names)})"
-    return f"{label} ({', '.join(shown)})"
+    named = getattr(emulator, "y_names", None) if getattr(emulator, "index", 0) is None else None
+    labels = (getattr(emulator, "index_names", None), getattr(emulator, "index_units", None), named)
+    return far_values.far_value(y, emulator.standardizer, data.values, data.grids,
+                                data.precisions, labels)  # fmt: skip
 
 
 def warn_if_outside(
@@ -901,14 +795,7 @@ def warn_if_outside(
     simulation run (`far_value`), which the warning names; where the predictive check reads the
     data inside, a warning of its own."""
     if fit.outside_sds <= OUTSIDE_SDS and far is not None:
-        warnings.warn(
-            f"{'' if model is None else f'model {model!r}: '}{far.text()}: a missing-value "
-            "code, an outlier or a units error? The posterior explains it by a large "
-            "observation error (small lamOs) and theta falls back towards its prior; drop or "
-            "correct the value",
-            OutsideEmulatorWarning,
-            stacklevel=stacklevel,
-        )
+        warn_far(far, stacklevel, model, discrepancy)
     if fit.outside_sds > OUTSIDE_SDS:
         then = (
             "The discrepancy term and the observation error must then explain the difference "

@@ -11,7 +11,7 @@ import numpy as np
 
 from gpmsa import backends
 from gpmsa._version import library_versions
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, user_stacklevel
 from gpmsa.fitting.continuation import (
     HOT_RECORD,
     MH_BACKENDS,
@@ -48,6 +48,7 @@ from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, run_seed
 from gpmsa.model.discrepancy import kept_bases, scale_record
 from gpmsa.model.discrepancy import record as discrepancy_record
+from gpmsa.model.far_values import joint_far_value, warn_far
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, fixed_record, prepare
 
@@ -321,6 +322,9 @@ def fit(
     # pyro's NUTS has none)
     if continuing and not tune and backend in MH_BACKENDS and "proportional_steps" not in options:
         steps = continued_steps(resumed)
+    far = None if obs is None else joint_far_value(data, obs, prep.standardizer)
+    if far is not None:  # before the long sampling, which the user may then stop
+        warn_far(far, user_stacklevel(), discrepancy=discrepancy is not None)
     chains = module.sample(
         problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,

@@ -1,0 +1,184 @@
+"""Observed values far beyond every simulation run's value at their output point: a missing-value
+code such as -999, a spike or a units error among the data, which GPM/SA's reduction reads as
+observation error (`far_value`; checked by ``gpmsa.calibrate``, the Calibrator and the studies
+with a fitted emulator, and by a joint ``gpmsa.fit`` / ``gpmsa.fit_study`` before sampling)."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from gpmsa.errors import OutsideEmulatorWarning, numbers_text
+from gpmsa.model.basis import interpolate_basis
+
+OUTSIDE_SDS = 5.0
+"""An observation farther than this many predictive sds from every emulator prediction at its
+x (over the whole theta domain) lies outside what the emulator has seen: a warning
+(``OutsideEmulatorWarning``), and ``Posterior.info["outside_sds"]`` holds the distance. So
+does an observed value this many of the outputs' sds beyond every simulation run's value at its
+output point (`far_value`)."""
+SCALAR_FAR_SDS = 100.0
+"""How many of the outputs' sds beyond every simulation run's value a scalar output's datum
+must lie for a joint fit (no fitted emulator, hence no predictive check) to name it
+(`joint_far_value`). A scalar's data are not reduced through a basis, and noisy data lie
+beyond the runs legitimately: 100 simulated experiments of stated noise sd 2 (5) output sds
+reached 4.3 (13.8) sds beyond, and still narrowed theta (sd 0.11, 0.18; prior 0.29). A datum
+100 sds beyond lies 4 of its stated sds away only where that sd is 25 output sds (data that
+hardly inform theta), while a -999 code or a units error lies thousands of sds away."""
+
+
+@dataclass(frozen=True)
+class FarValue:
+    """One observed value beyond every simulation run's value at its output point (`far_value`):
+    ``sds`` how far, in the outputs' sds there (the standardising scale); the experiment's
+    position, the value (native), the runs' range there (native, interpolated onto an
+    experiment's own index) and the point's text (None for a scalar output)."""
+
+    sds: float
+    experiment: int
+    value: float
+    low: float
+    high: float
+    point: str | None
+
+    def text(self) -> str:
+        """'y_obs[1] holds -999 at time 0.454545 s, 1.43e+03 sds ... there ([lo, hi])'."""
+        side = "above" if self.value > self.high else "below"
+        value, low, high = numbers_text(self.value, self.low, self.high)
+        sds = numbers_text(self.sds, digits=3)[0]
+        what = f"y_obs[{self.experiment}] = {value}, " if self.point is None else (
+            f"y_obs[{self.experiment}] holds {value} at {self.point}, ")  # fmt: skip
+        there = "" if self.point is None else " there"
+        return (f"{what}{sds} sds of the simulation outputs {side} every simulation run's "
+                f"value{there} ([{low}, {high}])")  # fmt: skip
+
+
+def warn_far(
+    far: FarValue, stacklevel: int, model: str | None = None, discrepancy: bool = False
+) -> None:
+    """Warn (``OutsideEmulatorWarning``) naming ``far`` (and the study ``model``'s label) as a
+    missing-value code, an outlier or a units error; ``stacklevel`` as ``warnings.warn``'s in
+    the function that calls this; ``discrepancy``: a discrepancy model is fitted too, which may
+    take up the difference (a linear one, in a joint fit of experiments each 5 above the runs'
+    outputs, up to 7 sds beyond every run: lamOs 3.5e3 and theta 0.58 +- 0.24 against
+    0.600 +- 0.014 without the offset; one -999 among the data instead: lamOs 1.6e-5)."""
+    by = "a large observation error (small lamOs)" + (" or the discrepancy" if discrepancy else "")
+    warnings.warn(
+        f"{'' if model is None else f'model {model!r}: '}{far.text()}: a missing-value "
+        f"code, an outlier or a units error? The posterior explains it by {by} and theta "
+        "falls back towards its prior; drop or correct the value",
+        OutsideEmulatorWarning,
+        stacklevel=stacklevel + 1,
+    )
+
+
+def far_value(
+    y: np.ndarray,
+    standardizer,
+    experiments,
+    grids,
+    precisions=None,
+    labels: tuple = (None, None, None),
+    margin: float = OUTSIDE_SDS,
+) -> FarValue | None:
+    """The observed value farthest beyond the simulation runs' range at its output point, where
+    it lies more than ``margin`` of the outputs' sds (``standardizer``'s scale there) beyond
+    it; None where no value does. ``y``: the runs' outputs (m, l_sim), native;
+    ``experiments``: each experiment's y (native, in the runs' y order) on its grid of
+    ``grids`` (None: the simulation grid); the runs' range is interpolated onto an
+    experiment's own index as the basis is. ``precisions``: each experiment's stated
+    observation-error precision (native; None, or a None entry: not given), where a value must
+    also lie more than ``margin`` of its own noise sds beyond the runs (a value within its
+    stated noise is no outlier). ``labels``: (index names, index units, output names) as
+    `SimData` gives them (None: not given); the output names are given where the outputs have
+    no index (several named outputs), and then name the value's output.
+
+    A value far outside every run (a missing-value code such as -999, a spike) among a
+    functional observation's values lies mostly beyond the emulator's basis, where GPM/SA's
+    reduction reads it as observation error (the lamOs prior's correction): it inflates that
+    error so much that the predictive check reads the data inside (1.5 sds for one -999 among
+    36 values), while lamOs drops and theta's posterior falls back to its prior."""
+    y = np.asarray(y)
+    std = standardizer
+    lams = [None] * len(grids) if precisions is None else precisions
+    low, high = np.min(y, axis=0), np.max(y, axis=0)  # the runs' range per output element
+    if all(g is None for g in grids):  # on the simulation grid: at once
+        values = np.asarray(experiments, dtype=np.float64).reshape(len(experiments), -1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            sds = np.maximum(values - high, low - values) / std.y_sd
+        if not np.max(sds) > margin:  # NaN: none (the common case, at once)
+            return None
+        for j, lam in enumerate(lams):
+            sds[j] = _beyond_noise(sds[j], std.y_sd, lam, margin)
+        at = int(np.argmax(sds))
+        if not sds.flat[at] > margin:
+            return None
+        j, k = divmod(at, values.shape[1])
+        worst = (float(sds.flat[at]), j, values[j, k], low[k], high[k], None, k)
+    else:
+        worst, ranges = None, np.column_stack([low, high])
+        for j, (e, g, lam) in enumerate(zip(experiments, grids, lams, strict=True)):
+            e = np.asarray(e, dtype=np.float64).reshape(-1)
+            lo, hi = (ranges if g is None else interpolate_basis(ranges, std.grid, g)).T
+            scale = std.sd_on(g)
+            with np.errstate(over="ignore", invalid="ignore"):
+                sds = _beyond_noise(np.maximum(e - hi, lo - e) / scale, scale, lam, margin)
+            k = int(np.argmax(sds))
+            if sds[k] > margin and (worst is None or sds[k] > worst[0]):
+                worst = (float(sds[k]), j, e[k], lo[k], hi[k], g, k)
+        if worst is None:
+            return None
+    sds, j, value, lo, hi, grid, k = worst
+    index_names, index_units, y_names = labels
+    point = None
+    if y.shape[1] > 1 and grid is None and y_names:
+        point = f"output {y_names[k]!r}"  # several outputs, no index: by the output's name
+    elif y.shape[1] > 1:  # a functional output: where the value lies
+        point = _point_text((std.grid if grid is None else grid)[k], index_names, index_units)
+    return FarValue(sds, j, float(value), float(lo), float(hi), point)
+
+
+def _beyond_noise(sds: np.ndarray, scale, lam: np.ndarray | None, margin: float) -> np.ndarray:
+    """``sds`` (one experiment's distances beyond the runs, in the outputs' sds ``scale``) with
+    those within ``margin`` of the value's own stated noise sd set to 0: with a given
+    observation-error precision ``lam`` (native; None: not given, the noise on the outputs'
+    scale) a value that far outside every run is within its noise, no outlier (an output
+    element the runs barely vary, scaled columnwise, observed with its real noise)."""
+    if lam is None or not np.max(sds) > margin:
+        return sds
+    lam = np.atleast_2d(np.asarray(lam, dtype=np.float64))
+    diagonal = np.diagonal(lam)
+    if np.count_nonzero(lam) == np.count_nonzero(diagonal):  # one precision per value
+        noise = 1.0 / np.sqrt(diagonal)
+    else:
+        noise = np.sqrt(np.diagonal(np.linalg.inv(lam)))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.where(sds * scale > margin * noise, sds, 0.0)
+
+
+def joint_far_value(sim, obs, standardizer) -> FarValue | None:
+    """`far_value` of a joint fit's observations ``obs`` (an ObsData) against the runs of
+    ``sim`` (a SimData; ``standardizer`` its scales), before any emulator is fitted: beyond
+    ``OUTSIDE_SDS`` for a functional output, ``SCALAR_FAR_SDS`` for a scalar one (with no
+    predictive check to tell a noisy datum within reach from one beyond it)."""
+    labels = (sim.index_names, sim.index_units, sim.y_names if sim.index is None else None)
+    return far_value(
+        sim.y, standardizer, obs.outputs(sim.y_names), obs.grids,
+        obs.output_precisions(sim.y_names), labels,
+        OUTSIDE_SDS if sim.y.shape[1] > 1 else SCALAR_FAR_SDS,
+    )  # fmt: skip
+
+
+def _point_text(point, names=None, units=None) -> str:
+    """An output index point as text: 'time 0.4545 s' by the index ``names`` and ``units``,
+    'output index 0.4545' without names, '(a, b) (0.1, 0.2)' for points of several columns."""
+    values = np.atleast_1d(np.asarray(point, dtype=np.float64))
+    units = units or ("",) * values.size
+    names = names or ("output index",)
+    shown = [f"{v:.6g}" + (f" {u}" if u else "") for v, u in zip(values, units, strict=False)]
+    if values.size == 1:
+        return f"{names[0]} {shown[0]}"
+    label = names[0] if len(names) == 1 else f"({', '.join(names)})"
+    return f"{label} ({', '.join(shown)})"
