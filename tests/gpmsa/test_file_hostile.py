@@ -438,7 +438,9 @@ def emulators(draw):
     y = scale * (y + 0.01 * rng.standard_normal((m, l_sim)))
     if l_sim > 1 and draw(st.booleans()):
         y[:, -1] = 0.0  # zero padding
-    names = draw(st.lists(NAMES, min_size=p + q + l_sim, max_size=p + q + l_sim, unique=True))
+    # (names are non-blank: SimData refuses a blank one; units may be anything)
+    names = draw(st.lists(NAMES.filter(str.strip), min_size=p + q + l_sim, max_size=p + q + l_sim,
+                          unique=True))  # fmt: skip
     # (no calibration parameter named as the posterior's others: SimData refuses those names)
     t_names = names[p : p + q]
     assume(not any(n in RESERVED_NAMES or re.fullmatch(r"betaV\[\d+\]", n) for n in t_names))

@@ -74,11 +74,11 @@ def test_x_obs_just_past_the_margin_reads_past_it():
 
 def test_y_obs_just_beyond_max_std_obs_reads_beyond_it():
     obs = SimpleNamespace(z=np.array([MAX_STD_OBS * (1 + 1e-6)]))
-    msg = _message(_observations, None, obs, None, ("", ""), None)
+    msg = _message(_observations, None, obs, None, ("", ""), None, ((), (), ()))
     assert re.search(r"y_obs lies 1000001 standard deviations .* allowed at most 1e\+06", msg)
     obs = SimpleNamespace(z=np.array([1.3e199]))
     assert "y_obs lies 1.3e+199 standard" in _message(
-        _observations, None, obs, None, ("", ""), None
+        _observations, None, obs, None, ("", ""), None, ((), (), ())
     )
 
 
