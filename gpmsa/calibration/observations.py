@@ -396,11 +396,12 @@ def _reduce_obs_data(emulator, obs: ObsData, extrapolate: bool) -> Observations:
         getattr(emulator, "levels", None), _y_names(emulator), x_checked=True,
         index_names=getattr(emulator, "index_names", None),
     )  # fmt: skip
+    grids = obs.output_grids(getattr(emulator, "index_names", None))
     digests = (obs.values_digest(emulator.x_names, _y_names(emulator)),
-               layout_digest(obs.grids, obs.output_precisions(_y_names(emulator)),
+               layout_digest(grids, obs.output_precisions(_y_names(emulator)),
                              emulator.standardizer.grid))  # fmt: skip
     precisions = obs.output_precisions(_y_names(emulator)) or [None] * obs.n
-    native = tuple(obs.outputs(_y_names(emulator))), tuple(obs.grids), tuple(precisions)
+    native = tuple(obs.outputs(_y_names(emulator))), tuple(grids), tuple(precisions)
     return _observations(emulator, reduced, corr, digests, xu, native)
 
 

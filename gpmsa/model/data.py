@@ -672,6 +672,39 @@ def _named_index(index, names):
     return index, names
 
 
+def by_index_names(value, names, what: str):
+    """An output-index table of several columns whose labels name them (`_label_names`; a
+    pandas table, as ``full_prediction``'s ``grid``) as its columns in the order of ``names``
+    (the simulation index's, ``SimData.index_names``): GPMSAError naming ``what`` where the
+    labels are other names. Anything else, or ``names`` None: as it is (by position)."""
+    labels = column_labels(value)
+    if names is None or labels is None or len(labels) < 2 or not _label_names(labels):
+        return value
+    return value.iloc[:, column_order(labels, [str(n) for n in names], what)]
+
+
+def _index_tables(index, n: int) -> tuple[object, tuple | None]:
+    """An ObsData ``index`` (one grid for every experiment, or a list of one per experiment)
+    with its pandas tables as arrays, and per experiment (``n``) the column labels of a table
+    of several columns that names them (`_label_names`), else None; None where no table does.
+    The labels order the columns by the simulation index's names (`ObsData.output_grids`)."""
+
+    def one(g):
+        labels = column_labels(g)
+        if labels is None:
+            return g, None
+        named = len(labels) > 1 and _label_names(labels)
+        return g.to_numpy(), (labels if named else None)
+
+    if isinstance(index, (list, tuple)):
+        pairs = [one(g) for g in index]
+        index, labels = [g for g, _ in pairs], tuple(lb for _, lb in pairs)
+    else:
+        index, label = one(index)
+        labels = (label,) * n
+    return index, (labels if any(lb is not None for lb in labels) else None)
+
+
 def _label_names(labels: tuple[str, ...] | None) -> bool:
     """Whether a table's or Series' ``labels`` name an index's columns: not a frame's default
     labels '0', '1', ..., none blank, none twice."""
@@ -1188,7 +1221,8 @@ class ObsData:
     output's: None, or its one point); the columns of ``y`` follow its order. With a simulation
     index of several columns (l_sim, d), each experiment's index is its points (l_j, d) (a list,
     ragged too; one (l, d) array applies to every experiment), within the simulation points'
-    convex hull.
+    convex hull; a pandas table whose column labels name them is read by the simulation
+    index's names in any column order (`output_grids`), as ``SimData`` reads its own.
     ``precision`` is the observation-error precision in native units
     (1/unit^2): None (identity in standardised units, GPM/SA's default), a scalar (the same for
     every experiment), or per experiment a scalar, an (l_j,) vector (one precision per value:
@@ -1212,6 +1246,7 @@ class ObsData:
     precisions: list[np.ndarray] | None = field(init=False, repr=False)
     x_columns: tuple[str, ...] | None = field(init=False, repr=False)
     y_columns: tuple[str, ...] | None = field(init=False, repr=False)
+    index_columns: tuple[tuple[str, ...] | None, ...] | None = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         check_same_rows({"x_obs": self.x, "y_obs": self.y})
@@ -1228,7 +1263,9 @@ class ObsData:
             ys = self._experiments(self.y, x.shape[0])
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "experiments", ys)
-        object.__setattr__(self, "grids", self._grids(self.index, ys))
+        index, labels = _index_tables(self.index, len(ys))
+        object.__setattr__(self, "index_columns", labels)
+        object.__setattr__(self, "grids", self._grids(index, ys))
         object.__setattr__(self, "precisions", self._precisions(self.precision, ys))
         ragged = len({len(e) for e in ys}) > 1
         object.__setattr__(self, "y", ys if ragged else np.stack(ys))
@@ -1250,6 +1287,24 @@ class ObsData:
         another order: ambiguous); ``y_names`` None: as given."""
         order = self._output_order(y_names)
         return self.experiments if order is None else [e[order] for e in self.experiments]
+
+    def output_grids(self, index_names=None) -> list[np.ndarray | None]:
+        """Every experiment's index (``grids``); where an experiment's index of several columns
+        was given as a table with named columns (``index_columns``), its columns in the order
+        of ``index_names`` (the simulation index's, ``SimData.index_names``): by name, as
+        ``SimData`` reads an index table (GPMSAError when those labels are other names). Arrays
+        and tables of a frame's default labels 0, 1, ...: by position; ``index_names`` None:
+        as given."""
+        if self.index_columns is None or index_names is None:
+            return self.grids
+        names = [str(n) for n in index_names]
+        out = []
+        for j, (g, labels) in enumerate(zip(self.grids, self.index_columns, strict=True)):
+            if labels is None or g is None or g.ndim != 2 or list(labels) == names:
+                out.append(g)
+            else:
+                out.append(g[:, column_order(labels, names, f"ObsData index[{j}]")])
+        return out
 
     def output_precisions(self, y_names=None) -> list[np.ndarray] | None:
         """``precisions`` with their rows and columns in the order `outputs` gives y's."""

@@ -165,7 +165,7 @@ def joint_far_value(sim, obs, standardizer) -> FarValue | None:
     predictive check to tell a noisy datum within reach from one beyond it)."""
     labels = (sim.index_names, sim.index_units, sim.y_names if sim.index is None else None)
     return far_value(
-        sim.y, standardizer, obs.outputs(sim.y_names), obs.grids,
+        sim.y, standardizer, obs.outputs(sim.y_names), obs.output_grids(sim.index_names),
         obs.output_precisions(sim.y_names), labels,
         OUTSIDE_SDS if sim.y.shape[1] > 1 else SCALAR_FAR_SDS,
     )  # fmt: skip

@@ -446,7 +446,8 @@ def reduce_obs(
     index is read (`ObsData.outputs`). ``x_checked``: the caller has checked x_obs against the
     domain and warned (calibration's ``check_x``, whose ``extrapolate=True`` allows any
     distance): no ``check_x_obs`` here. ``index_names``: the output index's column names
-    (``SimData.index_names``), by which a point outside the simulation index is named.
+    (``SimData.index_names``), by which a point outside the simulation index is named and an
+    index table's columns are read (`ObsData.output_grids`).
     """
     x_native = obs.inputs(x_names)
     if x_native.ndim != 2 or x_native.shape[1] != std.x_min.size:  # before x_to_unit broadcasts
@@ -459,18 +460,19 @@ def reduce_obs(
     n, p_u = obs.n, K.shape[1]
     scalar = K.shape[0] == 1
     experiments = obs.outputs(y_names)
-    for j, (e, g) in enumerate(zip(experiments, obs.grids, strict=True)):
+    obs_grids = obs.output_grids(index_names)  # a table's columns by the index's names
+    for j, (e, g) in enumerate(zip(experiments, obs_grids, strict=True)):
         if not scalar and g is None and e.size != K.shape[0]:
             raise GPMSAError(
                 f"experiment {j} has {e.size} values but the simulation output has {K.shape[0]}; "
                 "give ObsData an index grid"
             )
-    points = not scalar and (is_points(std.grid) or any(is_points(g) for g in obs.grids))
-    for j, g in enumerate(obs.grids):  # refused naming the experiment and the point
+    points = not scalar and (is_points(std.grid) or any(is_points(g) for g in obs_grids))
+    for j, g in enumerate(obs_grids):  # refused naming the experiment and the point
         if points and g is not None:
             index_points.weights(std.grid, g, f"the index of experiment {j}", index_names)
     with np.errstate(over="ignore"):  # an overflow gives inf: refused just below
-        ys = [std.y_to_std(e, g) for e, g in zip(experiments, obs.grids, strict=True)]
+        ys = [std.y_to_std(e, g) for e, g in zip(experiments, obs_grids, strict=True)]
     for j, e in enumerate(ys):
         check_finite(e, f"y_obs[{j}] in standardised units")
     far = max(float(np.max(np.abs(e))) for e in ys)
@@ -484,13 +486,13 @@ def reduce_obs(
     if obs.precisions is not None:
         lamy = [
             std.precision_to_std(lam, g)
-            for lam, g in zip(obs.output_precisions(y_names), obs.grids, strict=True)
+            for lam, g in zip(obs.output_precisions(y_names), obs_grids, strict=True)
         ]
         _warn_if_vague(lamy)
     if scalar:
         if any(e.size != 1 for e in ys):
             raise GPMSAError("a scalar simulation output needs one value per experiment in y_obs")
-        check_scalar_index(obs.grids, std.grid)
+        check_scalar_index(obs_grids, std.grid)
         u = np.array([e[0] for e in ys])[:, None]
         p_v = 0 if discrepancy is None else 1
         if p_v and not (isinstance(discrepancy, str) and discrepancy == "constant"):
@@ -502,13 +504,13 @@ def reduce_obs(
         v = np.zeros((n, 0))
         obs_p = ObsProblem(x, u, v, sig, True, Ks, Ds, p_v, tuple(ys))
         return obs_p, (0.0, 0.0)
-    grids = [std.grid if g is None else g for g in obs.grids]
+    grids = [std.grid if g is None else g for g in obs_grids]
     _check_discrepancy_scales(discrepancy, grids)
     bases = discrepancy_bases(discrepancy, grids)  # a list: one per experiment, scaled jointly
     Ks, Ds, vs, us, blocks = [], [], [], [], []
     rank, total, ss = 0, 0, 0.0
     lo, hi = std.grid.min(), std.grid.max()
-    for j, (e, g, lam) in enumerate(zip(ys, obs.grids, lamy, strict=True)):
+    for j, (e, g, lam) in enumerate(zip(ys, obs_grids, lamy, strict=True)):
         if not points and g is not None and not index_points.within(g, lo, hi):
             a, b, c, d = numbers_text(g.min(), g.max(), lo, hi)
             raise GPMSAError(

@@ -63,7 +63,7 @@ def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = Non
 def _experiment(sim: SimData, obs: ObsData, e: np.ndarray, j: int, grid) -> np.ndarray:
     """Experiment ``j``'s index grid: its own, or the simulation's ``grid``; GPMSAError where it
     has none and its values ``e`` do not match the simulation's."""
-    g = obs.grids[j]
+    g = obs.output_grids(sim.index_names)[j]
     if g is None and e.size != sim.l_sim:
         raise GPMSAError(
             f"obs experiment {j} has {e.size} values on the simulation grid of {sim.l_sim}: "

@@ -164,7 +164,8 @@ def _misses(emulator, obs: ObsData, reduced) -> tuple[np.ndarray, list[np.ndarra
         else std.y_sd * emulator.w @ emulator.K.T
     )
     runs = (emulator.y - std.y_mean) - fitted
-    misses = [std.sd_on(obs.grids[e]) * (y_std - K @ u)
+    grids = obs.output_grids(emulator.index_names)
+    misses = [std.sd_on(grids[e]) * (y_std - K @ u)
               for e, (y_std, K, u) in enumerate(zip(reduced.y_std, reduced.K, reduced.u,
                                                     strict=True))]  # fmt: skip
     return runs, misses
@@ -175,8 +176,9 @@ def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
     std = emulator.standardizer
     runs, misses = _misses(emulator, obs, reduced)
     ax.plot(std.grid, runs.T, color="0.75", lw=0.6)
+    grids = obs.output_grids(emulator.index_names)
     for e, miss in enumerate(misses):
-        grid = std.grid if obs.grids[e] is None else obs.grids[e]
+        grid = std.grid if grids[e] is None else grids[e]
         ax.plot(grid, miss, color=f"C{e % 10}", lw=1.2)
     rms_runs = float(np.sqrt(np.mean(runs**2)))
     rms_obs = float(np.sqrt(np.mean(np.concatenate(misses) ** 2)))
@@ -205,9 +207,10 @@ def _residual_maps(fig, cell, emulator, obs: ObsData, reduced) -> None:
                  fontsize="small")  # fmt: skip
     norm = _maps.signed_norm(*shown)
     axes = []
+    grids = obs.output_grids(emulator.index_names)
     for e, miss in enumerate(shown):
         ax = fig.add_subplot(panels[0, 1 + e])
-        grid = std.grid if obs.grids[e] is None else obs.grids[e]
+        grid = std.grid if grids[e] is None else grids[e]
         dots = _maps.markers(ax, grid, miss, norm, _maps.SIGNED, background=std.grid,
                              labels=labels)  # fmt: skip
         ax.set_title(f"experiment {e}: rms {np.sqrt(np.mean(miss**2)):.3g}", fontsize="small")

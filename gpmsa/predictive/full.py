@@ -54,6 +54,7 @@ from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
     ObsData,
     as_float,
+    by_index_names,
     check_count,
     check_finite,
     check_flag,
@@ -274,7 +275,7 @@ def _pred_grid(emulator, obs: ObsData, grid):
             raise GPMSAError("a scalar output has no output grid; leave grid=None")
         return std.grid
     if grid is not None and is_points(std.grid):
-        g = as_float(grid, "grid")
+        g = as_float(by_index_names(grid, emulator.index_names, "grid"), "grid")
         if g.ndim == 1 and g.size == std.grid.shape[1]:
             g = g[None, :]  # one point
         check_finite(g, "grid")
@@ -297,19 +298,20 @@ def _pred_grid(emulator, obs: ObsData, grid):
                 f"within the simulation grid [{lo}, {hi}]"
             )
         return g
-    grids = [std.grid if g is None else g for g in obs.grids]
+    grids = [std.grid if g is None else g for g in obs.output_grids(emulator.index_names)]
     same = all(g.shape == grids[0].shape and np.array_equal(g, grids[0]) for g in grids)
     return grids[0] if same else std.grid
 
 
-def _pred_discrepancy(kind, obs: ObsData, std, grid: np.ndarray, scalar: bool, bases=None):
+def _pred_discrepancy(kind, obs_grids: list, std, grid: np.ndarray, scalar: bool, bases=None):
     """D (l, p_v) on the prediction grid with the normalisation the fit used for the data
-    (``bases``: the reduction's per-experiment bases, ``ObsProblem.D``)."""
+    (``obs_grids``: the experiments' index grids, `ObsData.output_grids`; ``bases``: the
+    reduction's per-experiment bases, ``ObsProblem.D``)."""
     if kind is None:
         return np.zeros((n_points(grid), 0))
     if scalar:
         return np.ones((1, 1))
-    obs_grids = [std.grid if g is None else g for g in obs.grids]
+    obs_grids = [std.grid if g is None else g for g in obs_grids]
     if is_basis_list(kind):
         return _experiment_basis(bases, obs_grids, grid)
     if not isinstance(kind, str):
@@ -419,9 +421,10 @@ def _experiment_basis(bases, obs_grids: list[np.ndarray], grid: np.ndarray) -> n
     return D
 
 
-def _experiment_prediction(kind, obs: ObsData, std, grid, experiment, bases):
-    """(grid, D) of ``full_prediction(..., experiment=j)``: experiment j's index grid and its
-    per-experiment basis (``bases``: the reduction's, normalised as the fit's); GPMSAError for
+def _experiment_prediction(kind, obs_grids: list, std, grid, experiment, bases, index_names):
+    """(grid, D) of ``full_prediction(..., experiment=j)``: experiment j's index grid (of
+    ``obs_grids``, `ObsData.output_grids`) and its per-experiment basis (``bases``: the
+    reduction's, normalised as the fit's); GPMSAError for
     another kind of discrepancy, j outside the experiments, or a ``grid`` that is not j's."""
     if not is_basis_list(kind):
         raise GPMSAError(
@@ -429,10 +432,10 @@ def _experiment_prediction(kind, obs: ObsData, std, grid, experiment, bases):
             f"discrepancy={describe_discrepancy(kind)}: leave experiment out (grid= chooses "
             "the output grid)"
         )
-    j = check_count(experiment, "experiment", 0, obs.n - 1)
-    own = std.grid if obs.grids[j] is None else obs.grids[j]
+    j = check_count(experiment, "experiment", 0, len(obs_grids) - 1)
+    own = std.grid if obs_grids[j] is None else obs_grids[j]
     if grid is not None:
-        g = as_float(grid, "grid")
+        g = as_float(by_index_names(grid, index_names, "grid"), "grid")
         g = g if is_points(own) else g.reshape(-1)
         if g.shape != own.shape or not np.array_equal(g, own):
             raise GPMSAError(
@@ -481,7 +484,9 @@ def _check_fitted_obs(settings: dict, obs: ObsData) -> None:
         )
 
 
-def _check_calibrated_obs(posterior, obs: ObsData, x_names, y_names, grid: np.ndarray) -> None:
+def _check_calibrated_obs(
+    posterior, obs: ObsData, x_names, y_names, grid: np.ndarray, index_names=None
+) -> None:
     """GPMSAError when ``posterior`` recorded the values of its observations (``gpmsa.calibrate``:
     info "obs_values_sha256") and ``obs`` holds other ones. Its x is compared with its columns
     in the order of ``x_names`` and y with its columns in the order of ``y_names``
@@ -497,9 +502,8 @@ def _check_calibrated_obs(posterior, obs: ObsData, x_names, y_names, grid: np.nd
             "y_obs as ObsData(x=x_obs, y=y_obs))"
         )
     layout = info.get("obs_layout_sha256")
-    if layout is not None and (
-        layout_digest(obs.grids, obs.output_precisions(y_names), grid) != layout
-    ):
+    grids = obs.output_grids(index_names)  # an index table's columns by name
+    if layout is not None and layout_digest(grids, obs.output_precisions(y_names), grid) != layout:
         raise GPMSAError(
             "obs places its observations on other index grids or gives them other precisions "
             "than the calibration that drew posterior=: pass the ObsData given to "
@@ -673,8 +677,10 @@ def full_prediction(
     else:
         check_posterior_emulator(emulator, posterior)
         _check_fitted_obs(getattr(posterior, "info", None) or {}, obs)  # a joint fit's draws
-        _check_calibrated_obs(posterior, obs, emulator.x_names, emulator.y_names, std.grid)
+        _check_calibrated_obs(posterior, obs, emulator.x_names, emulator.y_names, std.grid,
+                              emulator.index_names)  # fmt: skip
     levels = tuple(emulator.levels)
+    obs_grids = obs.output_grids(emulator.index_names)  # a table's columns by name
     x_nat, xu = unit_inputs(x, emulator.x_names, std.x_min, std.x_max, "x", levels[: emulator.p],
                             extrapolate)  # fmt: skip
     paired = posterior is None if draws is None else draws
@@ -731,9 +737,10 @@ def full_prediction(
                                 record.get("discrepancy_scale"))  # fmt: skip
     elif experiment is None:
         g = _pred_grid(emulator, obs, grid)
-        D_pred = _pred_discrepancy(discrepancy, obs, std, g, scalar, ob.D)
+        D_pred = _pred_discrepancy(discrepancy, obs_grids, std, g, scalar, ob.D)
     else:
-        g, D_pred = _experiment_prediction(discrepancy, obs, std, grid, experiment, ob.D)
+        g, D_pred = _experiment_prediction(discrepancy, obs_grids, std, grid, experiment, ob.D,
+                                           emulator.index_names)  # fmt: skip
     K_pred = interpolate_basis(K, std.grid, g) if not scalar else K
     N, p_u = xu.shape[0], emulator.p_u
     n_c = p_v + p_u
