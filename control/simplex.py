@@ -62,6 +62,8 @@ from gpmsa.errors import numbers_text
 
 LAWS = ("linear", "paper", "switch")
 AFTER_FAULT = ("latch", "resume")
+LATCH_P = 1e-12
+"""Default ``Simplex.latch_p``."""
 
 
 @dataclass(frozen=True)
@@ -100,7 +102,8 @@ class Simplex:
             ~40,000 blocks of 400 fault-free closed-loop runs, 6 fell below it (the block law's
             tails are lighter than the road's), the smallest at 3.4e-10; a fault that no check
             of the signal sees and no GD explains lies far beyond (90% of such blocks of added
-            noise below 1e-15).
+            noise below 1e-15). Used with ``after_fault="latch"`` only (another value with
+            "resume" is a ControlError: it would have no effect).
         speed_step_mps: the performance-mode speed is rounded down to v_safe + k times this,
             m/s (0: the continuous law; see the module docstring).
     """
@@ -113,7 +116,7 @@ class Simplex:
     risk: float | None = None
     law: str = "linear"
     after_fault: str = "latch"
-    latch_p: float = 1e-12
+    latch_p: float = LATCH_P
     speed_step_mps: float = 0.1
 
     def __post_init__(self) -> None:
@@ -149,6 +152,12 @@ class Simplex:
         if not is_choice(self.after_fault, AFTER_FAULT):
             raise ControlError(
                 f"after_fault must be one of {AFTER_FAULT}, got {self.after_fault!r}"
+            )
+        if self.after_fault == "resume" and self.latch_p != LATCH_P:
+            raise ControlError(
+                f"latch_p = {self.latch_p:g} has no effect with after_fault='resume' (nothing "
+                "latches: the law takes over again at the next ok estimate); leave it, or use "
+                "after_fault='latch'"
             )
 
     @property

@@ -29,6 +29,7 @@ from gpmsa.calibration.observations import (
     Fit,
     Observations,
     blas_controller,
+    check_draws_mode,
     check_emulator,
     check_log_prior,
     check_x,
@@ -272,7 +273,8 @@ def calibrate(
             ``info["emulator_draws"]`` then records, per sample, the retained draw it was drawn
             with, which ``calibrated_predict(..., draws=True)`` pairs with its theta).
             ``n_emulator_draws`` must be an integer >= 1 in either mode (at most the retained
-            draws are used).
+            draws are used); another value than its default 20 with "point" is a GPMSAError
+            (it would have no effect).
         discrepancy: None (no discrepancy, the default) or a discrepancy basis (generic backends):
             "constant", "linear", an (l_obs, p_v) array, or a list of one (l_j, p_v) array per
             experiment of an ObsData on its own index grid (normalised jointly, as
@@ -422,6 +424,7 @@ def sample_calibration(
     tuning_opts = _tuning_options(backend, tune_rounds, tune_levels)
     n_emulator_draws = check_count(n_emulator_draws, "n_emulator_draws")  # as Calibrator's
     sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
+    check_draws_mode(emulator_params, n_emulator_draws, "calibrate")
     if discrepancy is None:
         check_groups(discrepancy_groups, 0)  # groups without a basis: refused
     can_fast = backend == "numpy" and discrepancy is None

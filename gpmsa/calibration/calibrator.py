@@ -77,6 +77,7 @@ from gpmsa.calibration.observations import (
     Fit,
     Observations,
     blas_controller,
+    check_draws_mode,
     check_emulator,
     draw_positions,
     emulator_param_sets,
@@ -99,6 +100,8 @@ from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, run_seed
 
 METHODS = ("auto", "grid", "mcmc")
+N_DRAWS = 4000
+"""Default ``n_draws`` of a Calibrator: the draws a grid posterior makes for its samples."""
 MAX_REFINE = 4
 """Refinement passes of one update, at most (each refines the peaks still unresolved)."""
 MAX_REFINE_ONE = 9
@@ -201,18 +204,20 @@ class Calibrator:
             MCMC for a categorical and a continuous parameter with a ``constraint``).
         n_grid: nodes per calibration parameter of the fixed grid (default 129 for q = 1, 65 for
             2; a categorical parameter's nodes are its levels, and the continuous one beside it
-            has n_grid per level, default 129).
+            has n_grid per level, default 129). Refused on the MCMC path (it has no grid).
         emulator_params: "point" (the emulator's point estimate) or "draws" (average the
             likelihood over up to ``n_emulator_draws`` of its retained draws, evenly spaced:
             the posterior of theta, lamOs and the draw, whose draws record the draw drawn
             with each in ``info["emulator_draws"]``, as ``gpmsa.calibrate``'s, for
-            ``calibrated_predict(..., draws=True)``).
+            ``calibrated_predict(..., draws=True)``; another ``n_emulator_draws`` than 20 with
+            "point" is a GPMSAError: it would have no effect).
         extrapolate: allow x_obs outside the emulator's x domain by more than
             ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width (with an ExtrapolationWarning).
             Within the margin x_obs is taken with that warning as a joint ``gpmsa.fit``
             takes it; beyond it, False: GPMSAError naming the column. The default of every
             update; ``update(..., extrapolate=)`` sets it for one.
-        n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``.
+        n_draws: draws a grid posterior makes (lazily) for ``Posterior.samples``; another
+            value than its default is refused on the MCMC path (whose draws are its chains').
         seed: seed of those draws (and of the MCMC), for reproducibility: an integer, a numpy
             Generator (an integer is drawn from it) or None (fresh entropy).
         mcmc_options: keyword arguments for ``gpmsa.calibrate`` when the method is MCMC
@@ -221,7 +226,9 @@ class Calibrator:
             the backend's sampler options among them, as
             ``calibrate`` takes them (``{"dtype": "float32"}`` for torch, ``{"n_warmup": 200}``
             for pyro). A continuation's ``"init"`` (a Posterior) and ``"append": True`` are a
-            GPMSAError: each update runs fresh chains.
+            GPMSAError: each update runs fresh chains. With ``method="grid"`` given, any but
+            ``"backend"`` is a GPMSAError (the grid would ignore them; "auto" keeps them for an
+            emulator that needs MCMC).
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
             ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
             "auto" choose MCMC. None (the default): ``mcmc_options["backend"]`` where it names
@@ -253,7 +260,7 @@ class Calibrator:
         emulator_params: str = "point",
         n_emulator_draws: int = 20,
         extrapolate: bool = False,
-        n_draws: int = 4000,
+        n_draws: int = N_DRAWS,
         seed=None,
         mcmc_options: dict | None = None,
         backend: str | None = None,
@@ -307,6 +314,7 @@ class Calibrator:
         self._entropy = np.random.SeedSequence(None if seed is None else run_seed(seed)).entropy
         self._count = 0
         self.mcmc_options = _check_mcmc_options(mcmc_options, backend)
+        user_options = sorted(self.mcmc_options)  # before the constraint joins them
         if constraint is not None:
             self.mcmc_options.setdefault("constraint", constraint)
         self._check_mcmc_path(backend)
@@ -320,9 +328,11 @@ class Calibrator:
                 f"ignore it: use Calibrator(emu, method='mcmc', mcmc_options={{{k!r}: ...}}), or "
                 f"gpmsa.calibrate(..., {k}=...)"
             )
+        grid_given = n_grid is not None
         if n_grid is None:  # a categorical parameter with a continuous one: 129 per level
             n_grid = 129 if q == 1 or mixed else 65
         self.n_grid = check_count(n_grid, "n_grid", 3)
+        self._check_path_options(method, grid_given, user_options)
         if self.method == "mcmc":
             return
         m, p_u = emulator.x_unit.shape[0], emulator.K.shape[1]
@@ -407,6 +417,38 @@ class Calibrator:
             with blas_controller().limit(limits=1, user_api="blas"):
                 plans = [chebyshev_plan(gp) for gp in self._gps]
                 self._refined = self._refined_predictors(self._refined_axis(plans), plans)
+
+    def _check_path_options(self, method: str, grid_given: bool, user_options: list) -> None:
+        """GPMSAError for an argument the chosen path (``self.method``; ``method`` as given)
+        would take without effect: ``n_grid`` (``grid_given``) or an ``n_draws`` other than
+        its default on the MCMC path (whose draws are ``gpmsa.calibrate``'s), the user's
+        ``mcmc_options`` (``user_options``, their keys) with ``method="grid"`` given (with
+        "auto" they wait for an emulator that needs MCMC), or an ``n_emulator_draws`` other
+        than its default with the point estimate."""
+        chosen = (" (method='auto' chooses MCMC here: more than 2 parameters, another backend "
+                  "than numpy, or a constraint beside a categorical parameter)"
+                  if method == "auto" else "")  # fmt: skip
+        if self.method == "mcmc" and grid_given:
+            raise GPMSAError(
+                f"n_grid={self.n_grid} sets the nodes of the exact grid, and this Calibrator runs "
+                f"MCMC{chosen}, which has no grid: leave n_grid out"
+            )
+        if self.method == "mcmc" and self.n_draws != N_DRAWS:
+            raise GPMSAError(
+                f"n_draws={self.n_draws} sets the draws a grid posterior makes, and this "
+                f"Calibrator runs MCMC{chosen}, whose draws are its chains' kept sweeps: leave "
+                "n_draws out and give mcmc_options={'n_samples': ..., 'n_burn': ...} (per chain)"
+            )
+        given = [k for k in user_options if k != "backend"]
+        if method == "grid" and given:
+            raise GPMSAError(
+                f"mcmc_options {given} apply on the MCMC path, and method='grid' computes the "
+                "posterior on its exact grid, which would ignore them: use method='mcmc' (or "
+                "'auto'), or leave mcmc_options out"
+            )
+        mode = self.mcmc_options.get("emulator_params", self.emulator_params)
+        mode = self.emulator_params if self.method == "grid" else mode
+        check_draws_mode(mode, self._n_emulator_draws, "Calibrator")
 
     def _check_mcmc_path(self, backend: str) -> None:
         """GPMSAError now, not at every update, for MCMC settings ``gpmsa.calibrate`` refuses:

@@ -48,6 +48,8 @@ from gpmsa.model.transforms import EXTRAPOLATION_MARGIN
 EMULATOR_ATTRS = ("standardizer", "x_unit", "t_unit", "K", "w", "lam_sim", "params", "priors")
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
 EMULATOR_PARAM_MODES = ("point", "draws")
+N_EMULATOR_DRAWS = 20
+"""Default ``n_emulator_draws`` of ``gpmsa.calibrate`` and the Calibrator (``"draws"`` mode)."""
 CLOSER_STARTS = 3
 """From how many of `theta_probe`'s best nodes `closer_fit` searches (three or more
 parameters), before it calls an observation outside."""
@@ -117,6 +119,19 @@ def emulator_record(emulator) -> dict[str, str]:
     for (``check_emulator``), not a gpmsa.Emulator: it has no fingerprint to record."""
     sha = getattr(emulator, "model_sha256", None)
     return {"emulator_sha256": sha} if isinstance(sha, str) else {}
+
+
+def check_draws_mode(mode: str, n_sets: int, where: str) -> None:
+    """GPMSAError for an ``n_emulator_draws`` other than ``N_EMULATOR_DRAWS`` with
+    ``emulator_params="point"`` (``mode``): the point estimate is one parameter set, so the
+    number would have no effect. ``where``: the call that takes them, as the message names it."""
+    if mode == "point" and n_sets != N_EMULATOR_DRAWS:
+        raise GPMSAError(
+            f"{where}: n_emulator_draws={n_sets} sets how many of the emulator's retained draws "
+            "emulator_params='draws' averages the likelihood over; with emulator_params='point' "
+            "(the default: its point estimate alone) it would have no effect: pass "
+            "emulator_params='draws' as well, or leave n_emulator_draws out"
+        )
 
 
 def emulator_param_sets(emulator, mode: str, n_sets: int) -> list[dict]:

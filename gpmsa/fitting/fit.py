@@ -191,7 +191,14 @@ def fit(
     naming every element equals fixing the whole array. constraint (joint fit only): a
     callable of native theta (q,) -> bool, False where theta is not allowed (zero prior mass
     there). theta_init: the chains' start of theta (native, (q,) or a dict by t_names; default
-    the centre; a categorical element: one of its levels).
+    the centre; a categorical element: one of its levels): the start of ``init="gpmsa"``, one
+    chain's default; the dispersed starts of several chains (``init`` "auto", "jitter") and
+    ``init="prior"`` draw theta instead (``init="gpmsa"`` starts every chain at theta_init);
+    refused with ``init`` an emulator, whose chains continue from their last kept draws.
+    Tuning options (``tune_rounds``, ``tune_levels``; torch ``tune_stages``; pyro
+    ``n_warmup``, ``target_accept``) act only where the chains tune: a run with ``tune`` False
+    (or None resolved to False, an untuned continuation) takes them without effect, so that
+    a continuation loop may pass the same options on every call.
 
     Parallel tempering (numpy and torch options ``temperatures`` and ``swap_every``; off by default,
     and then the draws are the plain sampler's, bit for bit): for a posterior with several modes
@@ -244,6 +251,12 @@ def fit(
     if isinstance(options.get("init"), str | os.PathLike):  # a rule (a file name: say how)
         check_init(options["init"], n_chains, "gpmsa.load")
     append = check_append(append, options.get("init"), n_burn)
+    if continuing and theta_init is not None:  # the chains start at their last kept draws
+        raise GPMSAError(
+            "theta_init= sets a fresh chain's start; init=emulator's chains continue from their "
+            "last kept draws, so it would have no effect: leave theta_init out (or start "
+            "afresh without init=emulator)"
+        )
     default_burn = 0 if continuing else n_iter // 5
     n_burn = default_burn if n_burn is None else check_count(n_burn, "n_burn", 0, n_iter - 1)
     check_point(point)

@@ -434,11 +434,26 @@ def proportional_step_choice(proportional_steps, tune: bool) -> bool:
 def check_ridge(ridge_moves, problem: Problem) -> int:
     """Moves along the nugget ridge per sweep: ``ridge_moves`` (None: the default where the move
     applies), 0 where it does not apply; GPMSAError for a value that is not an integer in
-    [0, ``ridge.MAX_MOVES``]."""
+    [0, ``ridge.MAX_MOVES``], or for one above 0 given where the move does not apply (it would
+    have no effect)."""
+    given = ridge_moves is not None
     if ridge_moves is None:
         ridge_moves = ridge.N_MOVES
     n = check_count(ridge_moves, "ridge_moves", 0, ridge.MAX_MOVES)
-    return n if ridge.applies(problem) else 0
+    if ridge.applies(problem):
+        return n
+    if given and n > 0:
+        why = ("the model has observations (a joint fit or a calibration)"
+               if problem.obs is not None else
+               f"the basis has {problem.p_u} components" if problem.p_u != 1 else
+               "lamWs or lamWOs is held (fixed=)")  # fmt: skip
+        raise GPMSAError(
+            f"ridge_moves={n}: the nugget-ridge move runs only where the likelihood depends on "
+            "lamWs and lamWOs through their nugget alone (a simulation-only fit with one basis "
+            f"component, both sampled), and here {why}, so it would have no effect: leave "
+            "ridge_moves out (or 0)"
+        )
+    return 0
 
 
 def check_step_widths(
@@ -698,7 +713,8 @@ def sample(
     dispersed ones for several; a dict name -> (n_chains, *shape) gives them).
     ``ridge_moves``: moves along the lamWs/lamWOs nugget ridge per sweep (``gpmsa.mcmc.ridge``;
     None: ``ridge.N_MOVES`` where the move applies, a simulation-only problem with one basis
-    component; 0: GPM/SA's sweep alone). ``proportional_steps``: the precisions (lamVz, lamUz,
+    component; 0: GPM/SA's sweep alone; a number above 0 where the move does not apply, a
+    GPMSAError: `check_ridge`). ``proportional_steps``: the precisions (lamVz, lamUz,
     lamWs, lamWOs, lamOs) step by GPM/SA's proportional step, width max(1, x/3) whatever their
     step widths (True), or uniformly with their widths (False); None: ``not tune``, as GPM/SA
     and SEPIA (``info["proportional_steps"]`` records it). ``temperatures``: parallel
