@@ -613,8 +613,9 @@ def _end_with_parent() -> None:
     """The campaign pool's worker initializer: end this worker when its parent, the process that
     started it, ends. A campaign killed (SIGTERM, SIGKILL, the OOM killer: its cleanup never runs)
     would leave its workers waiting for runs for ever, each holding a copy of its memory. On Linux
-    the kernel kills the worker then (prctl PR_SET_PDEATHSIG); elsewhere a thread checks the parent
-    each second. (gpmsa's chain pools do the same; vehicle does not import gpmsa.) The kernel's
+    the kernel kills the worker then (prctl PR_SET_PDEATHSIG); on other POSIX systems a thread
+    checks the parent each second (on Windows none: a process's parent id there is not updated when
+    the parent ends). (gpmsa's chain pools do the same; vehicle does not import gpmsa.) The kernel's
     signal follows the thread that started the worker: the one that runs the campaign, which
     outlives the pool."""
     parent = os.getppid()
@@ -629,6 +630,8 @@ def _end_with_parent() -> None:
                 return
         except (OSError, AttributeError):  # no libc.prctl: watch as elsewhere
             pass
+    if sys.platform == "win32":  # os.getppid() keeps the ended parent's id: nothing to watch
+        return
     threading.Thread(target=_watch_parent, args=(parent,), name="vehicle-end-with-parent",
                      daemon=True).start()  # fmt: skip
 

@@ -73,7 +73,8 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
         tmp, fd = _new_temporary(path, error)
         staged.append((tmp, path))
         kw = {"encoding": "utf-8", "newline": ""} if text else {}
-        with os.fdopen(fd, "w+" if text else "w+b", **kw) as fh:
+        fh = os.fdopen(fd, "w+" if text else "w+b", **kw)
+        try:
             try:
                 yield fh
             except OSError as exc:  # the writer's writes: the disk full, say (an error of its
@@ -85,6 +86,13 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
                 os.fsync(fh.fileno())
             except OSError as exc:
                 raise error(_cannot_write(path, exc)) from exc
+        except BaseException:
+            _close_quietly(fh)  # what it still buffers fails as the write did: the first error
+            raise
+        try:
+            fh.close()
+        except OSError as exc:
+            raise error(_cannot_write(path, exc)) from exc
 
     try:
         yield stage
@@ -104,6 +112,15 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
             except OSError:
                 pass
         raise
+
+
+def _close_quietly(fh: IO) -> None:
+    """Close ``fh`` (its descriptor always) after an error: the flush of what it still buffers
+    may fail again (a full disk), and that error would replace the one being raised."""
+    try:
+        fh.close()
+    except OSError:
+        pass
 
 
 _WRITE_ERRNOS = frozenset(

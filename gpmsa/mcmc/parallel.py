@@ -346,9 +346,10 @@ def end_with_parent() -> None:
     """A pool worker's initializer: end this worker when its parent, the process that started it,
     ends. A parent killed (SIGTERM, SIGKILL, the OOM killer: its cleanup never runs) would leave its
     pool's workers waiting for tasks for ever, each holding a copy of its memory. On Linux the
-    kernel kills the worker then (prctl PR_SET_PDEATHSIG); elsewhere a thread checks the parent each
-    second. The kernel's signal follows the thread that started the worker: the one that calls and
-    waits for the pool, which outlives it."""
+    kernel kills the worker then (prctl PR_SET_PDEATHSIG); on other POSIX systems a thread checks
+    the parent each second (on Windows none: a process's parent id there is not updated when the
+    parent ends). The kernel's signal follows the thread that started the worker: the one that calls
+    and waits for the pool, which outlives it."""
     parent = os.getppid()
     if sys.platform == "linux":
         try:
@@ -361,6 +362,8 @@ def end_with_parent() -> None:
                 return
         except (OSError, AttributeError):  # no libc.prctl: watch as elsewhere
             pass
+    if sys.platform == "win32":  # os.getppid() keeps the ended parent's id: nothing to watch
+        return
     threading.Thread(target=_watch_parent, args=(parent,), name="gpmsa-end-with-parent",
                      daemon=True).start()  # fmt: skip
 

@@ -26,7 +26,9 @@ must lie for a joint fit (no fitted emulator, hence no predictive check) to name
 beyond the runs legitimately: 100 simulated experiments of stated noise sd 2 (5) output sds
 reached 4.3 (13.8) sds beyond, and still narrowed theta (sd 0.11, 0.18; prior 0.29). A datum
 100 sds beyond lies 4 of its stated sds away only where that sd is 25 output sds (data that
-hardly inform theta), while a -999 code or a units error lies thousands of sds away."""
+hardly inform theta), while a -999 code or a units error lies thousands of sds away. Where the
+data state their noise (a precision), a datum must also lie beyond ``OUTSIDE_SDS`` of its own
+noise sds, as on every path."""
 
 
 @dataclass(frozen=True)
@@ -90,10 +92,11 @@ def far_value(
     ``grids`` (None: the simulation grid); the runs' range is interpolated onto an
     experiment's own index as the basis is. ``precisions``: each experiment's stated
     observation-error precision (native; None, or a None entry: not given), where a value must
-    also lie more than ``margin`` of its own noise sds beyond the runs (a value within its
-    stated noise is no outlier). ``labels``: (index names, index units, output names) as
-    `SimData` gives them (None: not given); the output names are given where the outputs have
-    no index (several named outputs), and then name the value's output.
+    also lie more than ``OUTSIDE_SDS`` of its own noise sds beyond the runs (a value within its
+    stated noise is no outlier; ``margin`` sets the outputs' sds only). ``labels``: (index
+    names, index units, output names) as `SimData` gives them (None: not given); the output
+    names are given where the outputs have no index (several named outputs), and then name the
+    value's output.
 
     A value far outside every run (a missing-value code such as -999, a spike) among a
     functional observation's values lies mostly beyond the emulator's basis, where GPM/SA's
@@ -142,7 +145,8 @@ def far_value(
 
 def _beyond_noise(sds: np.ndarray, scale, lam: np.ndarray | None, margin: float) -> np.ndarray:
     """``sds`` (one experiment's distances beyond the runs, in the outputs' sds ``scale``) with
-    those within ``margin`` of the value's own stated noise sd set to 0: with a given
+    those within ``OUTSIDE_SDS`` of the value's own stated noise sd set to 0 (none where no
+    distance exceeds ``margin``, the outputs' sds the caller asks for): with a given
     observation-error precision ``lam`` (native; None: not given, the noise on the outputs'
     scale) a value that far outside every run is within its noise, no outlier (an output
     element the runs barely vary, scaled columnwise, observed with its real noise)."""
@@ -155,7 +159,7 @@ def _beyond_noise(sds: np.ndarray, scale, lam: np.ndarray | None, margin: float)
     else:
         noise = np.sqrt(np.diagonal(np.linalg.inv(lam)))
     with np.errstate(over="ignore", invalid="ignore"):
-        return np.where(sds * scale > margin * noise, sds, 0.0)
+        return np.where(sds * scale > OUTSIDE_SDS * noise, sds, 0.0)
 
 
 def joint_far_value(sim, obs, standardizer) -> FarValue | None:
