@@ -25,6 +25,7 @@ from gpmsa.calibration import continuation as cont
 from gpmsa.calibration.judge import Run, judge_bounds, judge_convergence
 from gpmsa.calibration.observations import (
     EMULATOR_PARAMS,
+    N_EMULATOR_DRAWS,
     OUTSIDE_SDS,
     Fit,
     Observations,
@@ -223,7 +224,7 @@ def calibrate(
     backend: str = "numpy",
     *,
     emulator_params: str = "point",
-    n_emulator_draws: int = 20,
+    n_emulator_draws: int = N_EMULATOR_DRAWS,
     discrepancy=None,
     discrepancy_groups=None,
     n_chains: int = 1,
@@ -391,7 +392,7 @@ def calibrate(
 def sample_calibration(
     emulator, x_obs=None, y_obs=None, n_samples: int = 5000, n_burn: int | None = None,
     tune: bool | None = None, seed=None, backend: str = "numpy", *,
-    emulator_params: str = "point", n_emulator_draws: int = 20, discrepancy=None,
+    emulator_params: str = "point", n_emulator_draws: int = N_EMULATOR_DRAWS, discrepancy=None,
     discrepancy_groups=None, n_chains: int = 1, tune_rounds: int | None = None,
     tune_levels: int | None = None, extrapolate: bool = False, fast: bool | None = None,
     log_prior=None, progress: bool = False, n_jobs: int | None = None, executor=None,

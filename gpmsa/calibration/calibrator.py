@@ -74,6 +74,7 @@ from gpmsa.calibration.model import (
 )
 from gpmsa.calibration.observations import (
     EMULATOR_PARAM_MODES,
+    N_EMULATOR_DRAWS,
     Fit,
     Observations,
     blas_controller,
@@ -258,7 +259,7 @@ class Calibrator:
         method: str = "auto",
         n_grid: int | None = None,
         emulator_params: str = "point",
-        n_emulator_draws: int = 20,
+        n_emulator_draws: int = N_EMULATOR_DRAWS,
         extrapolate: bool = False,
         n_draws: int = N_DRAWS,
         seed=None,
