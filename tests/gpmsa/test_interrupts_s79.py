@@ -9,7 +9,6 @@ import signal
 import subprocess
 import sys
 import textwrap
-import time
 from pathlib import Path
 
 import pytest
@@ -17,6 +16,7 @@ import pytest
 import gpmsa
 from gpmsa.io import atomic
 from gpmsa.io.atomic import atomic_group, atomic_write
+from tests._processes import assert_workers_end
 
 fcntl = pytest.importorskip("fcntl")
 
@@ -152,20 +152,4 @@ def test_a_killed_parent_takes_its_pool_workers_with_it(tmp_path):
     worker = int(proc.stdout.readline())
     proc.stdout.close()
     assert proc.wait() == -signal.SIGKILL
-    try:
-        deadline = time.monotonic() + 30.0  # the kernel signals it as the parent ends
-        while _alive(worker) and time.monotonic() < deadline:
-            time.sleep(0.02)
-        assert not _alive(worker), f"worker {worker} outlived its killed parent"
-    finally:
-        if _alive(worker):
-            os.kill(worker, signal.SIGKILL)
-
-
-def _alive(pid: int) -> bool:
-    """Whether ``pid`` runs (not a zombie: reparented, init reaps it)."""
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except FileNotFoundError:
-        return False
+    assert_workers_end([worker])

@@ -18,68 +18,36 @@ import pytest
 
 import gpmsa
 from gpmsa import OutsideEmulatorWarning
-from gpmsa.backends import numpy_backend
 from gpmsa.fitting import fit as fit_module
 from gpmsa.fitting.emulator import Emulator
-from gpmsa.studies import run as study_run
+from tests.gpmsa._far_cases import (
+    GRID,
+    functional,
+    scalar_sim,
+    stop_sampling,
+)
+from tests.gpmsa._far_cases import (
+    functional_sim as _sim,
+)
+from tests.gpmsa._far_cases import (
+    texts_before_sampling as _outside,
+)
 
-GRID = np.linspace(0.0, 1.0, 12)
 NAMED = (r"y_obs\[1\] holds -999 at time 0\.4545\d* s, 1\.\d+e\+03 sds of the simulation "
          r"outputs below every simulation run's value there \(\[-?\d\.\d+, \d\.\d+\]\): a "
          r"missing-value code")  # fmt: skip
-
-
-class _Sampling(Exception):
-    """Raised by a stub in place of the MCMC: the sampling was reached."""
-
-
-def _design(m: int = 25) -> tuple[np.ndarray, np.ndarray]:
-    rng = np.random.default_rng(0)
-    x, t = rng.uniform(0, 1, m), rng.uniform(0, 1, m)
-    x[:2], t[:2] = (0.0, 1.0), (1.0, 0.0)
-    return x, t
-
-
-def _functional(x, t) -> np.ndarray:
-    return np.sin(3 * np.asarray(x)[:, None] + 2 * GRID) + np.asarray(t)[:, None] ** 2 * GRID
-
-
-def _sim() -> gpmsa.SimData:
-    x, t = _design()
-    return gpmsa.SimData(x=x, t=t, y=_functional(x, t), index=GRID, x_names=["v"],
-                         t_names=["k"], index_names="time", index_units="s")  # fmt: skip
-
-
-def _scalar_sim() -> gpmsa.SimData:
-    x, t = _design()
-    return gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t**2, x_names=["v"], t_names=["k"])
 
 
 def _observed() -> tuple[np.ndarray, np.ndarray]:
     """Three experiments at k = 0.5 with noise of sd 0.02 (the outputs' sd is about 0.7)."""
     x = np.array([[0.2], [0.4], [0.7]])
     noise = 0.02 * np.random.default_rng(0).standard_normal((3, GRID.size))
-    return x, _functional(x[:, 0], np.full(3, 0.5)) + noise
-
-
-def _outside(call) -> list[str]:
-    """The OutsideEmulatorWarnings' texts of ``call`` up to the sampling (stubbed: `_stopped`)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        with pytest.raises(_Sampling):
-            call()
-    return [str(w.message) for w in caught if issubclass(w.category, OutsideEmulatorWarning)]
+    return x, functional(x[:, 0], np.full(3, 0.5)) + noise
 
 
 @pytest.fixture
 def _stopped(monkeypatch):
-    """The MCMC of gpmsa.fit and gpmsa.fit_study replaced by a stop."""
-
-    def stop(*args, **kwargs):
-        raise _Sampling
-
-    monkeypatch.setattr(numpy_backend, "sample", stop)
-    monkeypatch.setattr(study_run, "sample_study", stop)
+    stop_sampling(monkeypatch)
 
 
 def test_joint_fit_names_a_missing_value_code_before_sampling(_stopped):
@@ -158,7 +126,7 @@ def test_ragged_and_interpolated_grids(_stopped):
 def test_scalar_output_named_only_far_beyond_the_runs(_stopped):
     """Noisy scalar data lie beyond the runs legitimately (stated noise of 5 output sds: 20
     sds beyond at 4 sds of noise); a -999 code lies thousands of sds away."""
-    sim = _scalar_sim()
+    sim = scalar_sim()
     sd = float(np.std(sim.y, ddof=1))
     x = np.linspace(0.05, 0.95, 10)[:, None]
     y = np.sin(3 * x) + 0.25

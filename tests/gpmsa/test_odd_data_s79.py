@@ -11,27 +11,17 @@ an ``OutsideEmulatorWarning``; so is the farthest value where the check already 
 from __future__ import annotations
 
 import re
-import warnings
 
 import numpy as np
 import pytest
 
 import gpmsa
-from gpmsa import GPMSAError, OutsideEmulatorWarning
+from gpmsa import GPMSAError
 from gpmsa.fitting.emulator import Emulator
-
-GRID = np.linspace(0.0, 1.0, 12)
-
-
-def _design(m: int = 25) -> tuple[np.ndarray, np.ndarray]:
-    rng = np.random.default_rng(0)
-    x, t = rng.uniform(0, 1, m), rng.uniform(0, 1, m)
-    x[:2], t[:2] = (0.0, 1.0), (1.0, 0.0)
-    return x, t
-
-
-def _functional(x, t) -> np.ndarray:
-    return np.sin(3 * np.asarray(x)[:, None] + 2 * GRID) + np.asarray(t)[:, None] ** 2 * GRID
+from tests.gpmsa._far_cases import GRID
+from tests.gpmsa._far_cases import design as _design
+from tests.gpmsa._far_cases import functional as _functional
+from tests.gpmsa._far_cases import outside_texts as _outside
 
 
 @pytest.fixture(scope="module")
@@ -57,14 +47,6 @@ def _observed() -> tuple[np.ndarray, np.ndarray]:
     x = np.array([[0.2], [0.4], [0.7]])
     noise = 0.02 * np.random.default_rng(0).standard_normal((3, GRID.size))
     return x, _functional(x[:, 0], np.full(3, 0.5)) + noise
-
-
-def _outside(call) -> tuple[list[str], object]:
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = call()
-    texts = [str(w.message) for w in caught if issubclass(w.category, OutsideEmulatorWarning)]
-    return texts, result
 
 
 # --- runs that are all the same output --------------------------------------------------------

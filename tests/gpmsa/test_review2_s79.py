@@ -7,15 +7,14 @@ stated precision."""
 from __future__ import annotations
 
 import os
-import warnings
 
 import numpy as np
 import pytest
 
 import gpmsa
-from gpmsa import OutsideEmulatorWarning
-from gpmsa.backends import numpy_backend
 from gpmsa.io.atomic import atomic_write
+from tests.gpmsa._far_cases import scalar_sim as _scalar_sim
+from tests.gpmsa._far_cases import stop_sampling, texts_before_sampling
 
 resource = pytest.importorskip("resource")
 signal = pytest.importorskip("signal")
@@ -89,27 +88,9 @@ def test_a_writers_own_error_is_kept_when_the_close_fails_too(tmp_path, file_siz
     assert os.listdir(tmp_path) == []
 
 
-class _Sampling(Exception):
-    """Raised by a stub in place of the MCMC: the sampling was reached."""
-
-
-def _scalar_sim() -> gpmsa.SimData:
-    rng = np.random.default_rng(0)
-    x, t = rng.uniform(0, 1, 25), rng.uniform(0, 1, 25)
-    x[:2], t[:2] = (0.0, 1.0), (1.0, 0.0)
-    return gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t**2, x_names=["v"], t_names=["k"])
-
-
 def _outside(monkeypatch, sim, obs) -> list[str]:
-    def stop(*args, **kwargs):
-        raise _Sampling
-
-    monkeypatch.setattr(numpy_backend, "sample", stop)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        with pytest.raises(_Sampling):
-            gpmsa.fit(sim, obs, seed=0)
-    return [str(w.message) for w in caught if issubclass(w.category, OutsideEmulatorWarning)]
+    stop_sampling(monkeypatch)
+    return texts_before_sampling(lambda: gpmsa.fit(sim, obs, seed=0))
 
 
 def test_a_scalar_joint_fit_names_a_datum_far_beyond_its_stated_noise(monkeypatch):

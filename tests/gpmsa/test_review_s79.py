@@ -15,34 +15,19 @@ far-value warning given for values within their own stated noise.
 
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import pytest
 
 import gpmsa
-from gpmsa import GPMSAError, OutsideEmulatorWarning
+from gpmsa import GPMSAError
 from gpmsa.fitting.emulator import Emulator
+from tests.gpmsa._far_cases import design as _design
+from tests.gpmsa._far_cases import outside_texts as _outside
 
 GRID = np.linspace(0.0, 1.0, 12)
 PARAMS_2 = {"betaU": [[1.0, 1.0], [1.5, 1.5]], "lamUz": [1.0, 1.0],
             "lamWs": [2000.0, 2000.0], "lamWOs": [2000.0]}  # fmt: skip
 X_OBS = np.array([[0.2], [0.4], [0.7]])
-
-
-def _design(m: int = 25) -> tuple[np.ndarray, np.ndarray]:
-    rng = np.random.default_rng(0)
-    x, t = rng.uniform(0, 1, m), rng.uniform(0, 1, m)
-    x[:2], t[:2] = (0.0, 1.0), (1.0, 0.0)
-    return x, t
-
-
-def _outside(call) -> tuple[list[str], object]:
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        result = call()
-    texts = [str(w.message) for w in caught if issubclass(w.category, OutsideEmulatorWarning)]
-    return texts, result
 
 
 # --- names: a table's own column labels -------------------------------------------------------

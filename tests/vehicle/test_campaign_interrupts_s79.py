@@ -6,11 +6,11 @@ import signal
 import subprocess
 import sys
 import textwrap
-import time
 
 import pytest
 
 import vehicle
+from tests._processes import assert_workers_end
 from vehicle import campaign
 
 
@@ -47,24 +47,7 @@ def test_a_killed_campaign_takes_its_pool_workers_with_it(tmp_path):
     workers = [int(pid) for pid in proc.stdout.readline().split()]
     proc.stdout.close()
     assert proc.wait() == -signal.SIGKILL and workers
-    try:
-        deadline = time.monotonic() + 30.0  # the kernel signals them as the parent ends
-        while any(map(_alive, workers)) and time.monotonic() < deadline:
-            time.sleep(0.02)
-        assert not [w for w in workers if _alive(w)], "workers outlived the killed campaign"
-    finally:
-        for w in workers:
-            if _alive(w):
-                os.kill(w, signal.SIGKILL)
-
-
-def _alive(pid: int) -> bool:
-    """Whether ``pid`` runs (not a zombie: reparented, init reaps it)."""
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
-    except FileNotFoundError:
-        return False
+    assert_workers_end(workers)
 
 
 def test_the_cache_folder_check_takes_no_name_another_process_may_hold(tmp_path, monkeypatch):
