@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import re
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,6 +112,9 @@ class HyperPriors:
 NUMBERS = ("mu_mean", "mu_sd", "sd_max", "lam_a", "lam_b", "lam_start")
 """HyperPriors' numeric fields."""
 
+SD_MAX_DEFAULT = HyperPriors.sd_max
+"""``HyperPriors.sd_max``'s default (1): a gamma sd prior takes no other."""
+
 SD_MAX_MIN = 1e-3
 """The smallest ``HyperPriors.sd_max`` (uniform sd prior) a study with a hierarchical group runs
 with. The sweep moves a group's elements and its mean one at a time, each within about sd_max
@@ -169,6 +173,20 @@ class Layout:
 def _names(arg, what: str) -> tuple[str, ...]:
     if isinstance(arg, str):
         arg = (arg,)
+    if isinstance(arg, Mapping):  # {"E": 2e11}: its values would act on nothing
+        raise GPMSAError(
+            f"{what} must be a list of parameter names, got a dict {arg!r:.80}: its values "
+            "would have no effect (fixed= holds a parameter at a value; hyper= sets every "
+            f"hierarchical group's hyperpriors); give {what}={list(arg)!r:.80}"
+        )
+    if isinstance(arg, (set, frozenset)):  # its order varies from process to process
+        raise GPMSAError(
+            f"{what} must be a list or tuple of parameter names, got a set {arg!r:.80}: a "
+            "set's order changes from one Python process to the next, and the study keeps it "
+            "(init=study compares it; the hierarchical groups' order sets their posterior "
+            "names' and the sweep's), so a seeded study would not rerun alike; give "
+            f"{what}={sorted(map(str, arg))!r:.80} (a list)"
+        )
     try:
         out = tuple(arg)
     except TypeError as exc:
@@ -187,6 +205,12 @@ def check_labels(labels, n_models: int) -> tuple[str, ...]:
         return tuple(f"model{i}" for i in range(n_models))
     if isinstance(labels, str):  # tuple("ab") would be ("a", "b")
         raise GPMSAError(f"labels must be a sequence of {n_models} strings, got {labels!r}")
+    if isinstance(labels, (set, frozenset)):  # its order is not the models'
+        raise GPMSAError(
+            f"labels must be a list or tuple of {n_models} strings in the models' order, got a "
+            f"set {labels!r:.80}: a set's order changes from one Python process to the next, so "
+            "a model could take another's label"
+        )
     labels = tuple(labels)
     if len(labels) != n_models:
         raise GPMSAError(f"got {len(labels)} labels for {n_models} models")
@@ -321,10 +345,12 @@ def check_study_names(layout: Layout) -> None:
         )
 
 
-def check_hyper(hyper: HyperPriors, given: bool, layout: Layout) -> None:
+def check_hyper(hyper: HyperPriors, given: bool, layout: Layout, fresh: bool = True) -> None:
     """GPMSAError where the study's hyperpriors cannot act as given: ``hyper=`` passed
-    (``given``) to a study with no hierarchical group, or a uniform sd prior's ``sd_max``
-    below ``SD_MAX_MIN`` in one with a group."""
+    (``given``) to a study with no hierarchical group, or with ``sd_prior="gamma"`` and an
+    ``sd_max`` of its own in a new study (``fresh``; only the uniform sd prior uses it; a
+    continuation takes its source's as they are), or a uniform sd prior's ``sd_max`` below
+    ``SD_MAX_MIN`` in one with a group."""
     if not layout.groups:
         if given:
             raise GPMSAError(
@@ -334,6 +360,13 @@ def check_hyper(hyper: HyperPriors, given: bool, layout: Layout) -> None:
                 "leave hyper out"
             )
         return
+    if given and fresh and hyper.sd_prior == "gamma" and hyper.sd_max != SD_MAX_DEFAULT:
+        raise GPMSAError(
+            f"HyperPriors.sd_max={hyper.sd_max!r:.60} with sd_prior='gamma': sd_max bounds the "
+            "uniform sd prior, and the gamma prior (lam ~ Gamma(lam_a, lam_b)) does not use it, "
+            "so it would have no effect; give sd_prior='uniform' to bound the group sd by "
+            "sd_max, or leave sd_max out (the gamma prior's spread is set by lam_a and lam_b)"
+        )
     if hyper.sd_prior == "uniform" and not hyper.sd_max >= SD_MAX_MIN:
         raise GPMSAError(
             f"HyperPriors.sd_max={hyper.sd_max!r:.60} is below {SD_MAX_MIN:g}: the study's "

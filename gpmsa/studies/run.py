@@ -311,9 +311,20 @@ def _held_names(problems, layout, fixes) -> list[str]:
     return names
 
 
-def _per_model_fixed(fixed, n: int) -> list:
+def _per_model_fixed(fixed, labels: tuple[str, ...]) -> list:
     """Each model's ``fixed=`` from a study's ``fixed``: None (none), one dict (every model's)
-    or a list or tuple with one entry (None or a dict) per model, as ``basis``."""
+    or a list or tuple with one entry (None or a dict) per model, as ``basis``; GPMSAError for
+    a dict keyed by the study's ``labels`` (a per-model value by label, as ``priors`` takes
+    one, would read as parameter names)."""
+    n = len(labels)
+    if isinstance(fixed, dict) and fixed and all(
+        k in labels and k not in ORDER for k in fixed
+    ):  # fmt: skip
+        raise GPMSAError(
+            f"fixed: a dict is every model's parameter -> value, and {list(fixed)} are the "
+            "study's labels, not parameters; give a list with one entry (None or a dict) per "
+            f"model, in the models' order {list(labels)}"
+        )
     if fixed is None or isinstance(fixed, dict):
         return [fixed] * n
     if not isinstance(fixed, (list, tuple)):
@@ -439,13 +450,17 @@ def calibrate_study(
         emulators: one ``gpmsa.Emulator`` per model; x_obs, y_obs: per model, its observations
             as ``gpmsa.calibrate`` takes them; or x_obs one ``gpmsa.ObsData`` per model and
             y_obs None (or a None entry for a model given an ObsData).
-        labels: the models' labels (default model0, model1, ...).
+        labels: the models' labels (default model0, model1, ...), a list or tuple in the
+            models' order.
         shared: parameter names (emulator t_names) that take one value in every model that has
-            them. hierarchical: names whose per-model values are draws of
+            them (a list or tuple, as ``hierarchical``: a set, whose order changes between
+            processes, or a dict, whose values would have no effect, is a GPMSAError).
+            hierarchical: names whose per-model values are draws of
             Normal(mu, 1/lam) truncated to the parameter's range, mu and lam sampled too
             (``hyper``: their priors, ``gpmsa.HyperPriors()``: a uniform group sd; SEPIA's:
-            ``HyperPriors.sepia()``; given without a hierarchical name, or with a uniform
-            sd prior's sd_max below 1e-3, a GPMSAError). Every other parameter is its model's.
+            ``HyperPriors.sepia()``; given without a hierarchical name, with a uniform sd
+            prior's sd_max below 1e-3, or with sd_prior="gamma" and an sd_max, which only the
+            uniform prior reads, a GPMSAError). Every other parameter is its model's.
             A categorical parameter (``t_categorical``) may be shared (the same levels in
             every model) or a model's own, not hierarchical; its level moves with the
             continuous parameters (``gpmsa.studies.sampler``, docs/models.md), and
@@ -484,7 +499,8 @@ def calibrate_study(
         fixed: parameters held at known values, as ``gpmsa.calibrate``'s ``fixed=`` (theta
             elements by t_name or position, native units; lamOs; with a discrepancy betaV and
             lamVz, whole or by element): one dict for every model, or a list with one entry
-            (None or a dict) per model. A shared parameter held must be held at one value by
+            (None or a dict) per model (a dict by label is a GPMSAError naming the list form).
+            A shared parameter held must be held at one value by
             every model that has it (one dict for all does so); a held hierarchical element
             stays in its group at its value. ``settings["fixed"]`` records each model's (as
             ``calibrate``'s ``info["fixed"]``).
@@ -563,12 +579,12 @@ def calibrate_study(
     tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
     extrapolate = check_flag(extrapolate, "extrapolate")
     bases = _per_model_discrepancy(discrepancy, discrepancy_groups, labels)
-    fixes = _per_model_fixed(fixed, n)
+    fixes = _per_model_fixed(fixed, labels)
     held = [_per_model(lab, calibration_fixed, e, f, b)
             for lab, e, f, (b, _) in zip(labels, emulators, fixes, bases, strict=True)]  # fmt: skip
     layout = layout_of(emulators, labels, shared, hierarchical)
     check_study_names(layout)
-    check_hyper(hyper, given_hyper, layout)
+    check_hyper(hyper, given_hyper, layout, fresh=not continuing)
     t0 = time.perf_counter()
     models = list(zip(labels, emulators, x_obs, y_obs, strict=True))
     reduced, fits = [], []
@@ -696,6 +712,27 @@ def _check_priors(priors, q: int) -> None:
         raise GPMSAError(f"priors: {exc}") from None
 
 
+def _refuse_group_priors(layout) -> None:
+    """GPMSAError where ``fit_study``'s ``priors`` give a hierarchical parameter of a model a
+    theta prior other than ``Priors``' default: its elements take their group's truncated
+    normal instead, so it would have no effect (the layout records each element's model
+    prior)."""
+    default = tuple(float(v) for v in Priors().theta_prior(0))
+    for el in layout.elements:
+        mean, sd = (float(v) for v in el.prior)
+        if el.group < 0 or (mean, sd) == default:
+            continue
+        raise GPMSAError(
+            f"model {layout.labels[el.uses[0][0]]!r}: priors gives hierarchical parameter "
+            f"{el.param!r} the theta prior (mean {mean:g}, sd {sd:g}), which would have no "
+            f"effect: each model's {el.param} takes its group's prior Normal(mu, 1/lam) instead "
+            "(mu's prior: hyper=gpmsa.HyperPriors(mu_mean=, mu_sd=)); leave it at the default "
+            f"({default[0]:g}, {default[1]:g}) (per element: Priors(theta_mean=[...], "
+            f"theta_sd=[...]) with {default[0]:g} and {default[1]:g} at {el.param}'s position), "
+            f"or make {el.param!r} shared or each model's own"
+        )
+
+
 def _per_model(label: str, make, *args, **kwargs):
     """``make(*args, **kwargs)`` for the model ``label``; its GPMSAError and its warnings name
     that model (so that two models' alike warnings both show, and say which)."""
@@ -766,8 +803,10 @@ def fit_study(
             every model once. A per-model ``priors`` entry (None: ``gpmsa.Priors()``) may give
             per-element theta priors for its own q (in its t_names' order); a shared parameter's
             prior must agree between its models (by name, wherever it sits in each model's
-            theta). ``discrepancy`` and its groups are read as ``calibrate_study``'s (a list is
-            the per-model list; a model's per-experiment bases are its entry). One ``n_pc`` sizes
+            theta), and a hierarchical one's is the default (its group's prior replaces it: any
+            other would have no effect, a GPMSAError). ``discrepancy`` and its groups are read
+            as ``calibrate_study``'s (a list is the per-model list; a model's per-experiment
+            bases are its entry). One ``n_pc`` sizes
             the PCA of the models without a ``basis``; a per-model one is each model's (None
             with a basis). Each member records its own (its ``priors``, settings "n_pc",
             "discrepancy"); a continuation (``init``) with other ones is refused naming the
@@ -837,7 +876,7 @@ def fit_study(
     tune, progress = _tune_rule(tune, init), check_flag(progress, "progress")
     labels = check_labels(labels, n)
     bases = _per_model_basis(basis, n)
-    fixes = _per_model_fixed(fixed, n)
+    fixes = _per_model_fixed(fixed, labels)
     per_pc = isinstance(n_pc, (list, tuple, dict))
     pcs = _per_model_value(n_pc, labels, "n_pc", not per_pc)
     if not per_pc:  # one n_pc: the PCA's of the models without a basis
@@ -857,7 +896,9 @@ def fit_study(
         shared, hierarchical,
     )  # fmt: skip
     check_study_names(layout)
-    check_hyper(hyper, given_hyper, layout)
+    check_hyper(hyper, given_hyper, layout, fresh=not continuing)
+    if not continuing:  # a continuation takes its source's priors as they are
+        _refuse_group_priors(layout)
     problems = [p.problem if f is None else _per_model(lab, hold_fixed, p.problem, f,
                                                        p.standardizer, s.t_names)
                 for lab, p, s, f in zip(labels, preps, sims, fixes, strict=True)]  # fmt: skip

@@ -80,10 +80,16 @@ def test_models_of_different_q_take_their_own_per_element_theta_priors(tmp_path)
     with pytest.raises(GPMSAError, match=r"shared parameter 'E'.*a: \(0.3, 0.2\), b: \(0.3, "
                                          r"0.25\).*priors="):  # fmt: skip
         _study(priors=[PA, other])
-    # a hierarchical parameter's elements take the group's prior: theirs need not agree
-    hier = _study(priors=[PA, other], shared=[], hierarchical=["E"])
-    spread = [el.prior for el in hier.layout.elements if el.param == "E"]
-    assert spread == [(0.3, 0.2), (0.3, 0.25)]
+    # a hierarchical parameter's elements take the group's prior: a model's own prior of it
+    # would have no effect (refused); the default at its position leaves the others' acting
+    with pytest.raises(GPMSAError, match=r"model 'a': priors gives hierarchical parameter 'E'"):
+        _study(priors=[PA, other], shared=[], hierarchical=["E"])
+    pa = dataclasses.replace(PA, theta_mean=[0.5, 0.6], theta_sd=[10.0, 0.5])
+    pb = dataclasses.replace(PB, theta_mean=[0.5, 0.5, 0.5], theta_sd=[1.0, 10.0, 3.0])
+    hier = _study(priors=[pa, pb], shared=[], hierarchical=["E"])
+    priors = {el.name: el.prior for el in hier.layout.elements}
+    assert priors == {"E[a]": (0.5, 10.0), "k[a]": (0.6, 0.5), "c[b]": (0.5, 1.0),
+                      "E[b]": (0.5, 10.0), "m[b]": (0.5, 3.0)}  # fmt: skip
 
 
 def test_one_value_is_every_models():
