@@ -31,9 +31,24 @@ a header row and one row of values (n fields each); the line that takes the file
 is refused without reading on (a file of a few more values than the outputs is named as such)."""
 _LINE_BREAKS = "\n\r\x0b\x0c\x1c\x1d\x1e\x85\u2028\u2029"
 """The characters that end a line, as ``str.splitlines`` reads them (CR LF one break)."""
-_SKIPPED = re.compile(rf"(?:\s++|#[^{_LINE_BREAKS}]*+)*+")
+SPREADSHEET_ERRORS = ("#N/A", "#VALUE!", "#REF!", "#DIV/0!", "#NUM!", "#NAME?", "#NULL!")
+"""A spreadsheet's error values (its missing value "#N/A" among them): a field that starts a
+line with one is a value to refuse, not a comment."""
+_ERROR_VALUE = "|".join(re.escape(e[1:]) for e in SPREADSHEET_ERRORS)
+_SKIPPED = re.compile(
+    rf"(?:\s++|#(?!(?:{_ERROR_VALUE}) *+(?:[,;\t{_LINE_BREAKS}]|$))[^{_LINE_BREAKS}]*+)*+"
+)
 """Blank lines and lines starting with "#" (the next line's leading blanks too), from a line's
-start (re's whitespace is ``str.isspace``'s, every line break among it)."""
+start (re's whitespace is ``str.isspace``'s, every line break among it); a line that starts
+with a spreadsheet's error value (`SPREADSHEET_ERRORS`) as its first field is no comment."""
+_MISSING_MARKS = frozenset({"na", "n/a", "null", "none", "-", "--", "?", "missing",
+                            *(e.lower() for e in SPREADSHEET_ERRORS)})  # fmt: skip
+"""Fields (lower case) that mark a missing value in files from spreadsheets, loggers and
+pandas (``to_csv``'s ``na_rep``)."""
+_GROUPED = re.compile(r"[+-]?[\d.,;'\"\s\u00a0\u202f]*\d[\d.,;'\"\s\u00a0\u202f]*")
+"""A field of digits with separators no float holds: a decimal comma ("1,5"), digit grouping
+("1,234.5", "1.234,5", "1 234", "1'234"), or a semicolon-separated line's values split at its
+decimal commas ("5;2")."""
 _LINE = re.compile(rf"[^{_LINE_BREAKS}]*")
 _WORD = re.compile(r"\S+")
 _FIELD = {sep: re.compile(rf' *(?:"(?:[^"]|"")*"?)?[^{sep}]*') for sep in ",;"}
@@ -112,8 +127,15 @@ def _given(items: list[str], names: tuple[str, ...], what: str) -> dict[str, flo
 
 
 def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
-    """Values ordered as ``names`` from NAME=VALUE strings (`_given`), one for every name."""
-    given = _given(items, names, what)
+    """Values ordered as ``names`` from NAME=VALUE strings (`_given`), one for every name (a
+    name with surrounding blanks, as a table's header may give it, also without them)."""
+    bare = dict(zip(_bare(names), names, strict=True))  # " v " (a CSV header's) given as v
+    given = {}
+    for key, value in _given(items, names, what).items():
+        name = key if key in names else bare.get(key, key)
+        if name in given:
+            raise GPMSAError(f"--{what} {name} is given twice; give each name once")
+        given[name] = value
     unknown = sorted(set(given) - set(names))
     missing = [n for n in names if n not in given]
     if unknown or missing:
@@ -145,11 +167,16 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     """The values (len(names),) of one observation from the CSV file ``path``: one row or one
     column of numbers (`_fields`; blank lines and lines starting with "#" skipped), in the
     order of ``names``, or under a first row that names the columns (exactly ``names``, any
-    order: read by name; a row of no numbers, or of those names above another row).
+    order: read by name; a row of no numbers, or of those names above another row). UTF-8 (a
+    byte order mark skipped) or UTF-16 with its byte order mark; an empty last field ending
+    every line (a spreadsheet's empty last column) dropped; header names matched without the
+    names' surrounding blanks (`_bare`).
     GPMSAError naming the file, and the row and column, for a file that cannot be read or
     holds more than ``Y_CSV_MAX_BYTES``, rows of more than ``Y_CSV_FIELDS_PER_OUTPUT`` fields
     per name together (refused at the line that passes them, `_rows`), a field that is not a
-    finite number, rows of unequal length (the header row too), or another count of values."""
+    finite number (`_not_a_value`: a missing-value mark, a decimal comma or digit grouping
+    named as such) or holds bytes that are not UTF-8 (`_check_utf8`), rows of unequal length
+    (the header row too), or another count of values."""
     where = f"--y-csv {safe(path, 200)}"
     try:
         with open(path, "rb") as fh:  # a pipe or device may never end: read a bounded part
@@ -161,8 +188,9 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
             f"{where}: it holds more than {Y_CSV_MAX_BYTES} bytes, more than one observation's "
             "values take (gpmsa.cli.calibrate.Y_CSV_MAX_BYTES)"
         )
-    try:
-        text = raw.decode("utf-8-sig")
+    try:  # UTF-16 with its byte order mark (a spreadsheet's "Unicode text"), else UTF-8
+        utf16 = raw.startswith((b"\xff\xfe", b"\xfe\xff"))
+        text = raw.decode("utf-16") if utf16 else raw.decode("utf-8-sig", "surrogateescape")
     except UnicodeDecodeError as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None
     try:
@@ -173,10 +201,14 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
         raise GPMSAError(f"{where}: the file holds no values (give the {len(names)} observed "
                          "outputs in one row or one column)")  # fmt: skip
     rows = [(k, [f.strip() for f in fields]) for k, fields in rows]
+    _check_utf8(where, rows)
+    trailing = all(len(f) > 1 and not f[-1] for _, f in rows)  # a separator ending every line
+    if trailing:
+        rows = [(k, fields[:-1]) for k, fields in rows]
     header = None
     first = rows[0][1]  # a row of names (numbers too where they are the outputs' names)
-    if not any(_number(f) is not None for f in first) or (
-        len(rows) > 1 and sorted(first) == sorted(names)
+    if not any(_value_like(f) for f in first) or (
+        len(rows) > 1 and sorted(first) == sorted(_bare(names))
     ):
         (header_line, header), rows = rows[0], rows[1:]
     widths = {len(fields) for _, fields in rows}
@@ -189,22 +221,62 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
         for c, field in enumerate(fields, 1):
             v = _number(field)
             if v is None or not np.isfinite(v):
-                what = ("is empty (a missing value?)" if not field else
-                        f"{safe(field, 40)!r} is not a finite number" if v is not None else
-                        f"{safe(field, 40)!r} is not a number")  # fmt: skip
-                raise GPMSAError(f"{where}: line {k}, column {c} {what}")
+                raise GPMSAError(f"{where}: line {k}, column {c} {_not_a_value(field, v)}")
             values.append(v)
     n_rows, n_cols = len(rows), (widths.pop() if widths else 0)
     if header is not None:
         return _by_header(where, (header_line, header), rows, names)
     if len(values) != len(names) or (n_rows > 1 and n_cols > 1):
+        dropped = " (the empty last column, a separator ending every line, dropped)"
         raise GPMSAError(
-            f"{where}: {n_rows} row(s) x {n_cols} column(s) of values; the file's outputs are "
+            f"{where}: {n_rows} row(s) x {n_cols} column(s) of values"
+            f"{dropped if trailing else ''}; the file's outputs are "
             f"{len(names)} ({_names_text(names)}): give the one observation's {len(names)} "
             "values in one row or one column (this command calibrates on one observation; "
             "for several, gpmsa.calibrate in Python)"
         )
     return np.array(values)
+
+
+def _value_like(field: str) -> bool:
+    """Whether ``field`` is a value, not a name: a number, a number written with a decimal
+    comma or digit grouping, or a missing-value mark (all refused later, naming the field)."""
+    return (_number(field) is not None or field.lower() in _MISSING_MARKS
+            or _GROUPED.fullmatch(field) is not None)  # fmt: skip
+
+
+def _not_a_value(field: str, value: float | None) -> str:
+    """Why the field ``field`` (`_number`: ``value``) is no value, for a message: empty, a
+    missing-value mark, a number written with a decimal comma or digit grouping, not finite,
+    or not a number."""
+    shown = repr(safe(field, 40))
+    missing = " (a missing value? give every output's value)"
+    if not field:
+        return "is empty (a missing value?)"
+    if value is not None:
+        beyond = np.isinf(value) and "inf" not in field.lower()  # 1e400
+        why = missing if np.isnan(value) else " (beyond float64's range)" if beyond else ""
+        return f"{shown} is not a finite number{why}"
+    if field.lower() in _MISSING_MARKS:
+        return f"{shown} is not a number{missing}"
+    if _GROUPED.fullmatch(field):
+        return (f"{shown} is not a number: a decimal comma or a thousands separator? The "
+                "file is read with '.' as the decimal mark and no digit grouping: save it "
+                "so (a spreadsheet's CSV in an English locale, or numpy.savetxt)")  # fmt: skip
+    return f"{shown} is not a number"
+
+
+def _check_utf8(where: str, rows: list[tuple[int, list[str]]]) -> None:
+    """GPMSAError naming the line and column of the first field that holds bytes that are not
+    UTF-8 (decoded as surrogates; such bytes in a skipped comment line do no harm)."""
+    for k, fields in rows:
+        for c, field in enumerate(fields, 1):
+            bad = re.search("[\udc80-\udcff]", field)
+            if bad:
+                byte = ord(bad.group()) - 0xDC00
+                raise GPMSAError(f"{where}: line {k}, column {c} holds the byte 0x{byte:02x}, "
+                                 "which is not UTF-8 (a latin-1 or Windows file?): save the "
+                                 "file as UTF-8 (a spreadsheet's \"CSV UTF-8\")")  # fmt: skip
 
 
 def _bounded_read(fh, most: int, chunk: int = 1024**2) -> bytes:
@@ -290,13 +362,18 @@ def _by_header(
     ``names``, any order)), with one value under each name, ordered as ``names``; GPMSAError
     otherwise."""
     header_line, header = head
-    unknown = [h for h in header if h not in names]
-    missing = [n for n in names if n not in header]
+    keys = _bare(names)  # a header's fields are read without their surrounding blanks
+    unknown = [h for h in header if h not in keys]
+    missing = [n for n, key in zip(names, keys, strict=True) if key not in header]
     twice = sorted({h for h in header if header.count(h) > 1})
     if unknown or missing or twice:
+        case = ""
+        if unknown and sorted(h.lower() for h in unknown) == sorted(n.lower() for n in missing):
+            case = " (names are case-sensitive: give them as the file's outputs spell them)"
         raise GPMSAError(f"{where}: the header row must name the file's outputs "
                          f"({_names_text(names)}) once each; unknown {safe(unknown, 200)}, "
-                         f"missing {safe(missing, 200)}, twice {safe(twice, 200)}")  # fmt: skip
+                         f"missing {safe(missing, 200)}, twice {safe(twice, 200)}"
+                         f"{case}")  # fmt: skip
     if len(rows) != 1:
         raise GPMSAError(f"{where}: under a header row give one row of values (one "
                          f"observation), got {len(rows)}")  # fmt: skip
@@ -307,7 +384,14 @@ def _by_header(
             f"{len(header)}: give one value under each name"
         )
     row = [_number(f) for f in fields]
-    return np.array([row[header.index(n)] for n in names])
+    return np.array([row[header.index(key)] for key in keys])
+
+
+def _bare(names: tuple[str, ...]) -> tuple[str, ...]:
+    """``names`` without their surrounding blanks (as a CSV row's fields are read), where that
+    leaves them apart; else ``names`` as they are."""
+    bare = tuple(n.strip() for n in names)
+    return bare if len(set(bare)) == len(bare) else tuple(names)
 
 
 def _names_text(names: tuple[str, ...]) -> str:

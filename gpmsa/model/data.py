@@ -72,7 +72,7 @@ def as_float(value, name: str) -> np.ndarray:
     if bad is not None:
         raise GPMSAError(
             f"{name} must be a numeric array, got {bad} (text, bools, dates and None are not "
-            "converted)"
+            f"converted){_text_hint(value) if bad.startswith('str ') else ''}"
         )
     try:
         is_complex = np.iscomplexobj(value)
@@ -84,6 +84,49 @@ def as_float(value, name: str) -> np.ndarray:
     if arr is None:
         raise GPMSAError(f"{name} must hold real numbers, got complex values")
     return arr
+
+
+_GROUPED = re.compile(r"[+-]?[\d.,'\s\u00a0\u202f]*\d[\d.,'\s\u00a0\u202f]*")
+"""Text of digits with separators no float holds: a decimal comma ("1,5") or digit grouping
+("1,234.5", "1.234,5", "1 234", "1'234")."""
+
+
+def _text_hint(value) -> str:
+    """For a value holding text (a table read from a CSV file whose column pandas kept as
+    text): where its first entry that does not read as a number lies (a table's row and column
+    labels, else the array index), and what it may be, for `as_float`'s message; "" where that
+    cannot be told. Every entry numeric text: that it is so."""
+    try:
+        arr = value.to_numpy(dtype=object) if hasattr(value, "to_numpy") else np.asarray(value)
+    except (TypeError, ValueError):
+        return ""
+    if arr.dtype.kind not in "OUS" or arr.ndim > 2:
+        return ""
+    for pos in np.ndindex(arr.shape):
+        entry = arr[pos]
+        if not isinstance(entry, str):
+            continue
+        try:
+            float(entry)
+        except ValueError:
+            break
+    else:
+        return ("; its text entries all read as numbers: convert them first (a pandas table: "
+                "df.apply(pd.to_numeric))")  # fmt: skip
+    rows, cols = getattr(value, "index", None), getattr(value, "columns", None)
+    if rows is not None and cols is not None and len(pos) == 2:
+        where = f"row {rows[pos[0]]!r:.40}, column {cols[pos[1]]!r:.40}"
+    elif rows is not None and len(pos) == 1:
+        where = f"row {rows[pos[0]]!r:.40}"
+    else:
+        where = f"index {pos}"
+    if _GROUPED.fullmatch(entry):
+        why = ("a decimal comma or a thousands separator? Read the file with "
+               "pd.read_csv(..., decimal=',') or thousands=',' as it is written")  # fmt: skip
+    else:
+        why = ("a missing-value mark or a unit? Read the file with pd.read_csv(..., "
+               f"na_values=[{entry!r:.40}]) and drop or fill those rows")  # fmt: skip
+    return f"; the first that is not a number: {entry!r:.40} at {where} ({why})"
 
 
 def _kind_of(value) -> str:
@@ -136,9 +179,50 @@ def column_order(labels, names, name: str) -> list[int]:
     """The positions of ``names`` among a table's column ``labels``; GPMSAError naming ``name``
     when the labels are not ``names`` (in some order)."""
     labels, names = list(labels), list(names)
-    if sorted(labels) != sorted(names):
-        raise GPMSAError(f"{name} has the columns {labels}; expected {names} (in any order)")
-    return [labels.index(n) for n in names]
+    if sorted(labels) == sorted(names):
+        return [labels.index(n) for n in names]
+    bare, keys = [str(c).strip() for c in labels], [str(n).strip() for n in names]
+    if sorted(bare) == sorted(keys) and len(set(bare)) == len(bare):  # a CSV header's blanks
+        return [bare.index(n) for n in keys]
+    raise GPMSAError(f"{name} has the columns {labels}; expected {names} (in any order)"
+                     f"{_columns_hint(labels, names)}")  # fmt: skip
+
+
+def _columns_hint(labels: list, names: list) -> str:
+    """What table column ``labels`` that are not ``names`` may be, for `column_order`'s
+    message: pandas' labels of a column without a header ("Unnamed: 3": a separator ending
+    every line of a CSV file) or of a repeated one ("f.1"), names of another case, numbers (a
+    file without a header row), or more columns than ``names``; "" otherwise."""
+    labels, names = [str(c) for c in labels], [str(n) for n in names]
+    unknown = [c for c in labels if c not in names]
+    hints = []
+    if unnamed := [c for c in unknown if c.startswith("Unnamed: ")]:
+        hints.append(f"{unnamed[0]!r:.40} is pandas' label of a column without a header: a "
+                     "separator ending every line of the CSV file? Drop it (e.g. "
+                     "df.dropna(axis=1, how='all'))")  # fmt: skip
+    twice = [c for c in unknown if re.fullmatch(r"(.+)\.\d+", c) and c.rsplit(".", 1)[0] in labels]
+    if twice:
+        hints.append(f"{twice[0]!r:.40} is pandas' label of a repeated header name: the file "
+                     "names a column twice")  # fmt: skip
+    if sorted(c.lower() for c in labels) == sorted(n.lower() for n in names):
+        hints.append("names are case-sensitive: give them as the data's names spell them")
+    elif all(_reads_as_number(c) for c in labels) and not all(_reads_as_number(n) for n in names):
+        hints.append(
+            "the labels are numbers: a file without a header row, its first row read "
+            "as names? Read it with pd.read_csv(..., header=None, names=[...])"
+        )
+    elif not hints and set(names) < set(labels):
+        hints.append(f"select the columns: table[{names!r:.200}]")
+    return f" ({'; '.join(hints)})" if hints else ""
+
+
+def _reads_as_number(text: str) -> bool:
+    """Whether ``text`` reads as a number (float())."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def by_column_names(value, names, name: str):
