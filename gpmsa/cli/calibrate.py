@@ -35,12 +35,17 @@ SPREADSHEET_ERRORS = ("#N/A", "#VALUE!", "#REF!", "#DIV/0!", "#NUM!", "#NAME?", 
 """A spreadsheet's error values (its missing value "#N/A" among them): a field that starts a
 line with one is a value to refuse, not a comment."""
 _ERROR_VALUE = "|".join(re.escape(e[1:]) for e in SPREADSHEET_ERRORS)
+_BLANK_NEXT = rf" ++(?:[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|#(?:{_ERROR_VALUE}))(?:\s|$)"
+"""Blanks and a number or another error value: the next field of a blank-separated line."""
 _SKIPPED = re.compile(
-    rf"(?:\s++|#(?!(?:{_ERROR_VALUE}) *+(?:[,;\t{_LINE_BREAKS}]|$))[^{_LINE_BREAKS}]*+)*+"
+    rf"(?:\s++|#(?!(?:{_ERROR_VALUE})(?: *+(?:[,;\t{_LINE_BREAKS}]|$)|{_BLANK_NEXT}))"
+    rf"[^{_LINE_BREAKS}]*+)*+"
 )
 """Blank lines and lines starting with "#" (the next line's leading blanks too), from a line's
 start (re's whitespace is ``str.isspace``'s, every line break among it); a line that starts
-with a spreadsheet's error value (`SPREADSHEET_ERRORS`) as its first field is no comment."""
+with a spreadsheet's error value (`SPREADSHEET_ERRORS`) as its first field is no comment: one
+ending the line or followed by a separator, or by blanks and a number or another error value
+(a blank-separated line; "#N/A means missing" is a comment)."""
 _MISSING_MARKS = frozenset({"na", "n/a", "null", "none", "-", "--", "?", "missing",
                             *(e.lower() for e in SPREADSHEET_ERRORS)})  # fmt: skip
 """Fields (lower case) that mark a missing value in files from spreadsheets, loggers and
@@ -167,7 +172,8 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     """The values (len(names),) of one observation from the CSV file ``path``: one row or one
     column of numbers (`_fields`; blank lines and lines starting with "#" skipped), in the
     order of ``names``, or under a first row that names the columns (exactly ``names``, any
-    order: read by name; a row of no numbers, or of those names above another row). UTF-8 (a
+    order: read by name; a row of no numbers, not all of them `_value_like`, or of those names
+    above another row). UTF-8 (a
     byte order mark skipped) or UTF-16 with its byte order mark; an empty last field ending
     every line (a spreadsheet's empty last column) dropped; header names matched without the
     names' surrounding blanks (`_bare`).
@@ -207,7 +213,8 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
         rows = [(k, fields[:-1]) for k, fields in rows]
     header = None
     first = rows[0][1]  # a row of names (numbers too where they are the outputs' names)
-    if not any(_value_like(f) for f in first) or (
+    no_number = not any(_number(f) is not None for f in first)
+    if (no_number and not all(map(_value_like, first))) or (  # not only marks or "1,5"s
         len(rows) > 1 and sorted(first) == sorted(_bare(names))
     ):
         (header_line, header), rows = rows[0], rows[1:]

@@ -96,8 +96,9 @@ def _text_hint(value) -> str:
     text): where its first entry that does not read as a number lies (a table's row and column
     labels, else the array index), and what it may be, for `as_float`'s message; "" where that
     cannot be told. Every entry numeric text: that it is so."""
+    table = hasattr(value, "to_numpy")  # a pandas object: its labels place the entry
     try:
-        arr = value.to_numpy(dtype=object) if hasattr(value, "to_numpy") else np.asarray(value)
+        arr = value.to_numpy(dtype=object) if table else np.asarray(value)
     except (TypeError, ValueError):
         return ""
     if arr.dtype.kind not in "OUS" or arr.ndim > 2:
@@ -113,20 +114,29 @@ def _text_hint(value) -> str:
     else:
         return ("; its text entries all read as numbers: convert them first (a pandas table: "
                 "df.apply(pd.to_numeric))")  # fmt: skip
-    rows, cols = getattr(value, "index", None), getattr(value, "columns", None)
+    rows = getattr(value, "index", None) if table else None  # a list's .index: a method
+    cols = getattr(value, "columns", None) if table else None
     if rows is not None and cols is not None and len(pos) == 2:
-        where = f"row {rows[pos[0]]!r:.40}, column {cols[pos[1]]!r:.40}"
+        where = f" at row {_label(rows[pos[0]])}, column {_label(cols[pos[1]])}"
     elif rows is not None and len(pos) == 1:
-        where = f"row {rows[pos[0]]!r:.40}"
+        where = f" at row {_label(rows[pos[0]])}"
     else:
-        where = f"index {pos}"
-    if _GROUPED.fullmatch(entry):
+        where = f" at index {pos}" if pos else ""  # one text value: no place to name
+    text, entry = str(entry), repr(str(entry)[:40])  # numpy's str_ shown as text
+    if _GROUPED.fullmatch(text):
         why = ("a decimal comma or a thousands separator? Read the file with "
                "pd.read_csv(..., decimal=',') or thousands=',' as it is written")  # fmt: skip
     else:
         why = ("a missing-value mark or a unit? Read the file with pd.read_csv(..., "
-               f"na_values=[{entry!r:.40}]) and drop or fill those rows")  # fmt: skip
-    return f"; the first that is not a number: {entry!r:.40} at {where} ({why})"
+               f"na_values=[{entry}]) and drop or fill those rows")  # fmt: skip
+    return f"; the first that is not a number: {entry}{where} ({why})"
+
+
+def _label(label) -> str:
+    """A table's row or column ``label`` for a message: numpy scalars as their Python value
+    (``20``, not ``np.int64(20)``), at most 40 characters."""
+    value = label.item() if isinstance(label, np.generic) else label
+    return f"{value!r:.40}"
 
 
 def _kind_of(value) -> str:
@@ -175,14 +185,25 @@ def default_labels(labels) -> bool:
     return labels is not None and tuple(labels) == tuple(str(k) for k in range(len(labels)))
 
 
+def same_names(labels, names) -> bool:
+    """Whether the labels ``labels`` (strings) are ``names`` in some order, as `column_order`
+    matches them: as they are, or without their surrounding blanks (a CSV header's) where
+    that leaves them apart."""
+    labels, names = list(labels), list(names)
+    if sorted(labels) == sorted(names):
+        return True
+    bare, keys = [str(c).strip() for c in labels], [str(n).strip() for n in names]
+    return sorted(bare) == sorted(keys) and len(set(bare)) == len(bare)
+
+
 def column_order(labels, names, name: str) -> list[int]:
-    """The positions of ``names`` among a table's column ``labels``; GPMSAError naming ``name``
-    when the labels are not ``names`` (in some order)."""
+    """The positions of ``names`` among a table's column ``labels`` (`same_names`); GPMSAError
+    naming ``name`` when the labels are not ``names`` (in some order)."""
     labels, names = list(labels), list(names)
     if sorted(labels) == sorted(names):
         return [labels.index(n) for n in names]
-    bare, keys = [str(c).strip() for c in labels], [str(n).strip() for n in names]
-    if sorted(bare) == sorted(keys) and len(set(bare)) == len(bare):  # a CSV header's blanks
+    if same_names(labels, names):  # a CSV header's blanks
+        bare, keys = [str(c).strip() for c in labels], [str(n).strip() for n in names]
         return [bare.index(n) for n in keys]
     raise GPMSAError(f"{name} has the columns {labels}; expected {names} (in any order)"
                      f"{_columns_hint(labels, names)}")  # fmt: skip
@@ -247,7 +268,7 @@ def pandas_rows(value, names=None):
     if pd is None or not isinstance(value, pd.DataFrame | pd.Series):
         return None
     if isinstance(value, pd.Series) and names is not None:
-        if sorted(str(i) for i in value.index) == sorted(str(n) for n in names):
+        if same_names([str(i) for i in value.index], [str(n) for n in names]):
             return None
     return value.index
 
@@ -295,7 +316,7 @@ def series_by_names(series, names, name: str) -> np.ndarray:
     against names it does not carry."""
     labels = tuple(str(i) for i in series.index)
     names = [str(n) for n in names]
-    if sorted(labels) == sorted(names):
+    if same_names(labels, names):
         return series.to_numpy()[column_order(labels, names, name)][None, :]
     title = None if series.name is None else str(series.name)
     if title is not None and [title] == names:
@@ -1406,7 +1427,8 @@ class ObsData:
             return None
         names = [str(n) for n in y_names]
         if any(g is not None for g in self.grids):
-            if sorted(labels) == sorted(names) and list(labels) != names:
+            in_order = list(range(len(names)))  # as the names, a CSV header's blanks aside too
+            if same_names(labels, names) and column_order(labels, names, "y") != in_order:
                 raise GPMSAError(
                     f"ObsData y has the columns {list(labels)}, the simulation outputs' names in "
                     "another order, and an index, whose order its columns follow: give the "
