@@ -194,8 +194,13 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
             f"{where}: it holds more than {Y_CSV_MAX_BYTES} bytes, more than one observation's "
             "values take (gpmsa.cli.calibrate.Y_CSV_MAX_BYTES)"
         )
+    utf16 = raw.startswith((b"\xff\xfe", b"\xfe\xff"))
+    if not utf16 and b"\0" in raw:  # no text file holds NUL bytes
+        raise GPMSAError(
+            f"{where}: it holds NUL bytes, which no UTF-8 text holds: UTF-16 without its byte "
+            "order mark (or not a text file)? Save it as UTF-8 (or as UTF-16 with its mark)"
+        )
     try:  # UTF-16 with its byte order mark (a spreadsheet's "Unicode text"), else UTF-8
-        utf16 = raw.startswith((b"\xff\xfe", b"\xfe\xff"))
         text = raw.decode("utf-16") if utf16 else raw.decode("utf-8-sig", "surrogateescape")
     except UnicodeDecodeError as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None

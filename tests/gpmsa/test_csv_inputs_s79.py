@@ -118,6 +118,13 @@ def test_bytes_that_are_not_utf8_are_named_by_line_and_column_and_harmless_in_a_
     np.testing.assert_array_equal(_row(tmp_path, utf16), [1, 2, 3])
 
 
+def test_utf16_without_its_byte_order_mark_is_named(tmp_path):
+    """Its NUL bytes read as fields of '\\x001\\x00' before."""
+    bare = "a\tb\tc\r\n1\t2\t3\r\n".encode("utf-16-le")  # no mark
+    with pytest.raises(GPMSAError, match=r"holds NUL bytes.*UTF-16 without its byte order mark"):
+        _row(tmp_path, bare)
+
+
 def test_header_names_match_without_blanks_and_case_is_named(tmp_path):
     np.testing.assert_array_equal(_row(tmp_path, b"b,a\n2,1\n", (" a ", "b")), [1, 2])
     with pytest.raises(GPMSAError, match=r"unknown \['A', 'B', 'C'\].*names are case-sensitive"):
