@@ -8,7 +8,7 @@ import numpy as np
 
 from roadgen.errors import RoadgenError, distinct_texts
 from roadgen.iso8608 import N0, gd_spectrum
-from roadgen.psd import FIT_BAND, estimate_gd, profile_psd
+from roadgen.psd import FIT_BAND, FIT_MIN_WAVINESS, estimate_gd, profile_psd
 from roadgen.road import Road, check_road
 
 if TYPE_CHECKING:
@@ -25,7 +25,8 @@ def plot_profile_psd(
 
     The PSD panel shows the prescribed line(s) Gd(n) = GD 1e-6 (n/n0)^-w for each distinct GD of the
     road (``gd`` of a Profile, the segments' GDs of a Track), n0 = 0.1 cycles/m, and the GD that
-    ``estimate_gd`` recovers. ``method`` is that of ``profile_psd``. The prescribed lines are
+    ``estimate_gd`` recovers (its "fit"; "welch" for a waviness below FIT_MIN_WAVINESS, where
+    the fit's end match leaks). ``method`` is that of ``profile_psd``. The prescribed lines are
     drawn wide and translucent underneath, the road's PSD as a thin line with a dot per ordinate
     on top: with deterministic amplitudes the periodogram lies exactly on its line and stays
     visible there. A plain Road (no GD of its own) shows no prescribed line and is fitted with
@@ -43,7 +44,9 @@ def plot_profile_psd(
             f"road is flat: its {method} is zero at every frequency, so there is no PSD to draw "
             "on log axes"
         )
-    recovered = estimate_gd(road, band=_fit_band(road.dx_m) if band is None else band)
+    waviness = getattr(getattr(road, "settings", None), "waviness", 2.0)
+    fit = "fit" if waviness >= FIT_MIN_WAVINESS else "welch"  # the fit's end match leaks below
+    recovered = estimate_gd(road, band=_fit_band(road.dx_m) if band is None else band, method=fit)
     from matplotlib.figure import Figure  # here, not at import (tests/test_import_cost.py)
 
     fig = Figure(figsize=(7.0, 6.5), layout="constrained")
@@ -51,7 +54,6 @@ def plot_profile_psd(
     ax_z.plot(road.x, 1e3 * road.z, lw=0.6)
     ax_z.set_xlabel("distance x (m)")
     ax_z.set_ylabel("height z (mm)")
-    waviness = getattr(getattr(road, "settings", None), "waviness", 2.0)
     for k, g in enumerate(_prescribed_gds(road)):
         ax_p.loglog(n, gd_spectrum(n, g, waviness), lw=5.0, alpha=0.35, color=f"C{k + 1}",
                     solid_capstyle="butt", zorder=1, label=f"prescribed GD {g:g}")  # fmt: skip
