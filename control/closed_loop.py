@@ -28,7 +28,7 @@ from control.metrics import (
 from control.robot.storage import check_mcap_target
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
-from control.validation import check_instance, is_real, path_argument
+from control.validation import check_flags, check_instance, is_real, path_argument
 from gpmsa.errors import numbers_text
 
 EXACT_CLOCK_SILENCE = 0.5
@@ -280,9 +280,7 @@ def run_closed_loop(
     if bcr is not None:
         check_instance(bcr, "bcr", BCRSettings)
     seed = _run_seed(seed)
-    for name, flag in (("check", check), ("progress", progress)):
-        if not isinstance(flag, bool | np.bool_):
-            raise ControlError(f"{name} must be True or False, got {flag!r:.60}")
+    check_flags(check=check, progress=progress)
     noise_std = vehicle.sensor.check_noise(noise_std)
     faults = _check_faults(faults)
     if max_time_s is not None and not (is_real(max_time_s) and max_time_s > 0):

@@ -159,6 +159,14 @@ def check_instance(value, name: str, cls: type, hint: str = "") -> None:
         )
 
 
+def check_flags(**flags) -> None:
+    """ControlError naming the first of ``flags`` (name: value) that is not True or False (a
+    numpy bool too)."""
+    for name, flag in flags.items():
+        if not isinstance(flag, bool | np.bool_):
+            raise ControlError(f"{name} must be True or False, got {flag!r:.60}")
+
+
 def replace_fields(settings, overrides: dict):
     """``settings`` (a settings dataclass) with ``overrides`` replacing its fields; `ControlError`
     naming the overrides that are no field of it, and for one that is a field of a nested

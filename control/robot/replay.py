@@ -78,6 +78,7 @@ from control.sensor_checks import MAX_SPEED_MPS, SensorLimits, flight_reading
 from control.shipped import shipped_emulator
 from control.simplex import Simplex
 from control.validation import (
+    check_flags,
     check_instance,
     check_lookup,
     is_choice,
@@ -540,7 +541,7 @@ def replay_bag(
     check_lookup(bag, "bag", BagError)
     csv, out_bag = _check_outputs(bag, emulator, csv, out_bag)
     s = _settings(settings, overrides)
-    _check_flags(progress=progress, check_vehicle=check_vehicle)
+    check_flags(progress=progress, check_vehicle=check_vehicle)
     if out_bag is not None:
         check_bag_path(out_bag, s.storage, "out_bag")
     emulator = load_emulator(emulator)
@@ -667,7 +668,7 @@ def replay_recording(
     check_vehicle: bool = True,
 ) -> ReplayResult:
     """`replay_bag` on a recording already read (`control.robot.bags.read_recording`)."""
-    _check_flags(progress=progress, check_vehicle=check_vehicle)
+    check_flags(progress=progress, check_vehicle=check_vehicle)
     s = _settings(settings, {})
     emulator = load_emulator(emulator)
     bcr = bcr_settings_for(emulator) if bcr is None else bcr
@@ -742,18 +743,10 @@ def replay_recording(
     )
 
 
-def _check_flags(**flags) -> None:
-    """ControlError naming the first of ``flags`` (name: value) that is not True or False (a
-    numpy bool too, as `control.run_closed_loop` takes them)."""
-    for name, flag in flags.items():
-        if not isinstance(flag, bool | np.bool_):
-            raise ControlError(f"{name} must be True or False, got {flag!r:.60}")
-
-
 def _check_vehicle(rec: Recording, emulator, check: bool) -> list[str]:
     """`check_recorded_vehicle` of the recording's simulation record (``check``); where not
     asked to check, a note for a vehicle that it would have refused."""
-    _check_flags(check_vehicle=check)
+    check_flags(check_vehicle=check)
     what = f"the recording {str(rec.path)!r}"
     if check:
         check_recorded_vehicle(emulator, rec.vehicle, rec.noise_std, what)
