@@ -480,7 +480,7 @@ def _check_fitted_obs(settings: dict, obs: ObsData) -> None:
     if digest is not None and obs.digest() != digest:
         raise GPMSAError(
             "obs holds other observations (x, y, grids or precisions) than the joint fit's: pass "
-            "the ObsData the fit used"
+            "the ObsData the fit used (its experiments in the same order)"
         )
 
 
@@ -498,8 +498,8 @@ def _check_calibrated_obs(
     if digest is not None and obs.values_digest(x_names, y_names) != digest:
         raise GPMSAError(
             "obs holds other observations (x or y) than the calibration that drew posterior=: "
-            "pass the ObsData given to gpmsa.calibrate or Calibrator.update (or its x_obs and "
-            "y_obs as ObsData(x=x_obs, y=y_obs))"
+            "pass the ObsData given to gpmsa.calibrate or Calibrator.update, its experiments in "
+            "the same order (or its x_obs and y_obs as ObsData(x=x_obs, y=y_obs))"
         )
     layout = info.get("obs_layout_sha256")
     grids = obs.output_grids(index_names)  # an index table's columns by name

@@ -180,6 +180,9 @@ def test_posterior_path_scalar_output_and_grid_option():
     for other in (gpmsa.ObsData(x=xo, y=obs.y + 0.5), gpmsa.ObsData(x=xo[:5], y=obs.y[:5])):
         with pytest.raises(GPMSAError, match="obs holds other observations .* than the calib"):
             full_prediction(emu, other, [[0.2]], posterior=post, discrepancy="constant")
+    reordered = gpmsa.ObsData(x=xo[::-1], y=obs.y[::-1])  # its rows are its experiments
+    with pytest.raises(GPMSAError, match="its experiments in the same order"):
+        full_prediction(emu, reordered, [[0.2]], posterior=post, discrepancy="constant")
     again = gpmsa.ObsData(x=xo.tolist(), y=obs.y[:, 0])  # other containers, the same values
     full_prediction(emu, again, [[0.2]], posterior=post, discrepancy="constant", n_draws=2)
 
@@ -244,6 +247,9 @@ def test_discrepancy_and_obs_must_be_the_joint_fits():
     for other in others:
         with pytest.raises(GPMSAError, match="obs holds other observations .* than the joint"):
             full_prediction(emu, other, [[0.5]])
+    reordered = gpmsa.ObsData(x=obs.x[::-1], y=obs.y[::-1], index=GRID)
+    with pytest.raises(GPMSAError, match=r"the fit used \(its experiments in the same order\)"):
+        full_prediction(emu, reordered, [[0.5]])
     again = gpmsa.ObsData(x=obs.x.copy(), y=np.array(obs.y), index=GRID.copy())
     assert again.digest() == obs.digest() == emu.settings["obs_sha256"]
     same = full_prediction(emu, obs, [[0.5]], discrepancy="linear", n_draws=2, seed=0)
