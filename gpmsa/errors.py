@@ -32,6 +32,13 @@ class AtBoundWarning(OutsideEmulatorWarning):
     OutsideEmulatorWarning subclass: a filter on that one covers it."""
 
 
+class OutlierRunWarning(UserWarning):
+    """A simulation run's output lies far beyond every other run's at an output point (a
+    missing-value code such as -999, a failed run, a units error, or an output with heavy
+    tails): ``gpmsa.fit`` and ``gpmsa.fit_study`` warn before sampling
+    (``gpmsa.model.far_values.far_run``)."""
+
+
 class ExtrapolationWarning(UserWarning):
     """Inputs (x, theta or bounds given to a prediction or a calibration) lie outside the
     emulator's training domain: the emulator extrapolates there (predictions, a joint fit's and

@@ -48,7 +48,7 @@ from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, run_seed
 from gpmsa.model.discrepancy import kept_bases, scale_record
 from gpmsa.model.discrepancy import record as discrepancy_record
-from gpmsa.model.far_values import joint_far_value, warn_far
+from gpmsa.model.far_values import far_run, joint_far_value, warn_far, warn_far_run
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import Problem, fixed_record, prepare
 
@@ -127,7 +127,9 @@ def fit(
 ) -> Emulator:
     """Fit the emulator by GPM/SA's Metropolis-within-Gibbs; returns an ``Emulator``.
 
-    data: the simulation runs. obs: field data for GPM/SA's classic joint calibration (theta and
+    data: the simulation runs (a run whose value lies far beyond every other run's at an output
+    point, such as a -999 missing-value code, draws a ``gpmsa.OutlierRunWarning`` before the
+    sampling: docs/internals.md). obs: field data for GPM/SA's classic joint calibration (theta and
     lamOs are sampled together with the emulator; the draws land in ``Emulator.calibration``;
     a ``gpmsa.AtBoundWarning`` where theta's piles up against a bound of the domain, as
     ``gpmsa.calibrate`` warns).
@@ -335,6 +337,9 @@ def fit(
     # pyro's NUTS has none)
     if continuing and not tune and backend in MH_BACKENDS and "proportional_steps" not in options:
         steps = continued_steps(resumed)
+    outlier = far_run(data, prep.standardizer.grid)
+    if outlier is not None:  # before the long sampling, which the user may then stop
+        warn_far_run(outlier, user_stacklevel())
     far = None if obs is None else joint_far_value(data, obs, prep.standardizer)
     if far is not None:  # before the long sampling, which the user may then stop
         warn_far(far, user_stacklevel(), discrepancy=discrepancy is not None)

@@ -49,7 +49,7 @@ from gpmsa.model.basis import discrepancy_kind, is_basis_list
 from gpmsa.model.data import ObsData, SimData, check_flag, run_seed
 from gpmsa.model.discrepancy import kept_bases, scale_record
 from gpmsa.model.discrepancy import record as discrepancy_record
-from gpmsa.model.far_values import joint_far_value, warn_far
+from gpmsa.model.far_values import far_run, joint_far_value, warn_far, warn_far_run
 from gpmsa.model.priors import Priors
 from gpmsa.model.problem import ORDER, fixed_record, prepare
 from gpmsa.studies import continuation as cont
@@ -924,7 +924,10 @@ def fit_study(
     _check_memory(problems, n_iter, n_chains, f"fit_study(n_iter={n_iter}, n_chains={n_chains})",
                   init if append else None, thin if append else 1)  # fmt: skip
     for lab, sim, ob, prep, (d, _) in zip(labels, sims, obs, preps, discs, strict=True):
-        far = joint_far_value(sim, ob, prep.standardizer)  # before the sampling
+        outlier = far_run(sim, prep.standardizer.grid)  # before the sampling
+        if outlier is not None:
+            warn_far_run(outlier, user_stacklevel(), model=lab)
+        far = joint_far_value(sim, ob, prep.standardizer)
         if far is not None:
             warn_far(far, user_stacklevel(), model=lab, discrepancy=d is not None)
     chains = sample_study(

@@ -47,7 +47,7 @@ PUBLIC = [
     "BackendUnavailableError", "BasisWarning", "Calibrator", "ChainError", "Chains",
     "ConvergenceWarning", "Emulator", "EmulatorFileError", "GPMSAError", "GammaPrior",
     "LooResult", "ObsData", "ExtrapolationWarning", "DomainWarning",
-    "ObsProblem", "OutsideEmulatorWarning", "ReductionWarning",
+    "ObsProblem", "OutlierRunWarning", "OutsideEmulatorWarning", "ReductionWarning",
     "Posterior", "Priors", "Problem", "ResourceLimitError", "SimData", "backends", "calibrate",
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
     "limits", "load", "plots", "predictive", "prepare", "sensitivity",
