@@ -95,6 +95,7 @@ from control.validation import (
     is_choice,
     is_integer,
     is_real,
+    python_number,
     replace_fields,
     require_instance,
     require_reals,
@@ -282,6 +283,8 @@ class BCRSettings:
                 f"quiet_blocks must be an integer in [0, {MAX_QUIET_BLOCKS}], got "
                 f"{self.quiet_blocks!r}"
             )
+        python_number(self, "quiet_blocks")
+        python_number(self, "update_every")
 
     @property
     def samples_per_update(self) -> int:
@@ -371,6 +374,12 @@ def _samples(name: str, values) -> np.ndarray:
                 f"({type(wrong[0]).__name__})"
             )
         return np.array([np.nan if v is None else float(v) for v in a])
+    if a.dtype.kind in "mM" and name == "t":  # numpy's or pandas' time stamps
+        raise ControlError(
+            f"{name} must hold real numbers, got dtype {a.dtype}: give the times as seconds as "
+            "float64 (for datetime64 stamps, (t - np.datetime64(0, 's')) / np.timedelta64(1, "
+            "'s'); for timedelta64, t / np.timedelta64(1, 's'))"
+        )
     if a.dtype.kind not in "iuf":
         raise ControlError(f"{name} must hold real numbers, got dtype {a.dtype}")
     return a.astype(float)

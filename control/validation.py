@@ -53,10 +53,16 @@ def path_argument(value, name: str, of: str = "") -> Path:
     separator) the home folder (``roadgen.checks.home_path``; a folder named "~" was made);
     ControlError naming the argument ``name`` for anything else (None, a number, ""); ``of``
     says what the path is of."""
-    if not isinstance(value, str | os.PathLike) or not str(value):
+    try:  # a path-like whose __fspath__ gives bytes, or neither str nor bytes: refused too
+        text = os.fspath(value) if isinstance(value, str | os.PathLike) else None
+    except TypeError:
+        text = None
+    if not isinstance(text, str) or not text:
         raise ControlError(
             f"{name} must be the path (a str or os.PathLike){of}, got {value!r:.60} "
-            f"({type(value).__name__})"
+            f"({type(value).__name__}"
+            + ("; decode bytes with os.fsdecode" if isinstance(text or value, bytes) else "")
+            + ")"
         )
     return checks.home_path(value)
 
@@ -117,7 +123,8 @@ def check_posterior_name(name) -> None:
 
 def require_reals(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:
     """ControlError naming the first of ``names`` whose value in ``obj`` is not a real number
-    (bools are not); the fields in ``optional`` may also be None."""
+    (bools are not); the fields in ``optional`` may also be None. A numpy scalar among them is
+    stored as the Python number of its value (`python_number`)."""
     for name in names:
         value = getattr(obj, name)
         if not (is_real(value) or (value is None and name in optional)):
@@ -128,11 +135,26 @@ def require_reals(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -
                 f"{type(obj).__name__}.{name} must be {allowed}, got {value!r:.60} "
                 f"({type(value).__name__})"
             )
+        python_number(obj, name)
+
+
+def python_number(obj, name: str) -> None:
+    """Store the field ``name`` of ``obj`` (a settings dataclass, frozen or not), where it is a
+    numpy scalar, as the Python float or int of its value: under NumPy's
+    promotion rules (NEP 50) a Python float meeting an np.float32 is computed in float32, so a
+    setting given as np.float32(25.0) would give other estimates and commands than 25.0 (and
+    an np.int64 is no count for Python's own APIs, e.g. a deque's maxlen)."""
+    value = getattr(obj, name)
+    if isinstance(value, np.floating):
+        object.__setattr__(obj, name, float(value))
+    elif isinstance(value, np.integer):
+        object.__setattr__(obj, name, int(value))
 
 
 def require_integers(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:
     """ControlError naming the first of ``names`` whose value in ``obj`` is not an integer
-    (bools are not; 3.0 is not); the fields in ``optional`` may also be None."""
+    (bools are not; 3.0 is not); the fields in ``optional`` may also be None. A numpy integer
+    among them is stored as the Python int (`python_number`)."""
     for name in names:
         value = getattr(obj, name)
         if not (is_integer(value) or (value is None and name in optional)):
@@ -141,6 +163,7 @@ def require_integers(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()
                 f"{type(obj).__name__}.{name} must be {allowed}, got {value!r:.60} "
                 f"({type(value).__name__})"
             )
+        python_number(obj, name)
 
 
 def require_instance(obj, name: str, cls: type) -> None:

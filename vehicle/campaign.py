@@ -21,8 +21,10 @@ import hashlib
 import json
 import math
 import os
+import re
 import secrets
 import signal
+import socket
 import stat
 import sys
 import tempfile
@@ -157,7 +159,10 @@ class Campaign:
         try:
             _save_npz(target, arrays)
         except OSError as exc:
-            raise CampaignFileError(f"cannot write campaign file {str(path)!r}: {exc}") from exc
+            why = str(exc)  # the temporary file's name in it says little: name the folder
+            if isinstance(exc, FileNotFoundError) and not os.path.isdir(target.parent):
+                why = f"the folder {str(target.parent)!r} does not exist; make it or save elsewhere"
+            raise CampaignFileError(f"cannot write campaign file {str(path)!r}: {why}") from exc
 
 
 def load_campaign(path: str | os.PathLike) -> Campaign:
@@ -377,14 +382,20 @@ def _refuse_to_replace(path: Path) -> None:
 def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
     """``np.savez`` to a new temporary file beside ``path``, moved over it in one step: a crash
     or an error never leaves a half-written file, and an existing one stays whole and keeps
-    its permissions."""
+    its permissions. The temporary file is named as gpmsa's ``atomic_write`` names its own
+    (the process id and host in it): one left by a save killed outright (SIGKILL) is removed
+    by the next save to ``path`` on that host once its process no longer runs
+    (`_remove_stale_temporaries`)."""
     try:
         mode = stat.S_IMODE(os.stat(path).st_mode)
     except (OSError, ValueError):
         mode = None
+    _remove_stale_temporaries(path)
     # the name's start (at most 32 characters) keeps the temporary name within the 255 bytes
     # a file name may have
-    tmp = path.with_name(f".{path.name[:32]}.{secrets.token_hex(6)}.part")
+    tmp = path.with_name(
+        f".{path.name[:32]}.{os.getpid()}@{_host_id()}.{secrets.token_hex(6)}.part"
+    )
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
     try:
         with os.fdopen(fd, "wb") as fh:
@@ -399,6 +410,60 @@ def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
         raise
 
 
+_STALE_PART = re.compile(r"(\d{1,10})@([0-9a-f]{8})\.[0-9a-f]{12}\.part")
+"""What follows a temporary file's prefix (``.NAME[:32].``): the writer's process id and host."""
+
+
+def _host_id() -> str:
+    """8 hexadecimal digits naming this host and its process-id space (the host name, the
+    machine id and, on Linux, the pid namespace), as gpmsa.io.atomic names them."""
+    try:
+        space = os.readlink("/proc/self/ns/pid")
+    except OSError:  # not Linux: the host name alone (and the machine id, where there is one)
+        space = ""
+    try:  # two machines of one host name ("localhost") have their own
+        with open("/etc/machine-id", "rb") as fh:
+            machine = fh.read(64).strip()
+    except OSError:
+        machine = b""
+    text = f"{socket.gethostname()}\0{space}\0".encode() + machine
+    return hashlib.sha256(text).hexdigest()[:8]
+
+
+def _remove_stale_temporaries(path: Path) -> None:
+    """Remove the temporary files of saves to ``path`` killed outright: those of a process of
+    this host that no longer runs. Never one of a running process (another save in progress,
+    another worker of a campaign sharing the cache), of another host, or on Windows."""
+    if sys.platform == "win32":
+        return
+    prefix, host = f".{path.name[:32]}.", _host_id()
+    try:
+        names = [e.name for e in os.scandir(path.parent) if e.name.startswith(prefix)]
+    except (OSError, ValueError):
+        return
+    for name in names:
+        found = _STALE_PART.fullmatch(name, len(prefix))
+        if found is None or found[2] != host or _runs(int(found[1])):
+            continue
+        try:
+            os.unlink(path.with_name(name))
+        except OSError:  # gone meanwhile (another save removed it), or a folder of that name
+            pass
+
+
+def _runs(pid: int) -> bool:
+    """Whether a process ``pid`` runs on this host (another user's or a zombie too)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (OSError, OverflowError):  # another user's (EPERM), or not a process id at all
+        return True
+    return True
+
+
 def _check_path(path: object, name: str = "path", what: str = "file") -> None:
     """Raise VehicleError unless ``path`` (the argument ``name``, a ``what`` path) is a str or
     os.PathLike (an int would be taken for an open file descriptor) without a NUL byte that the
@@ -408,9 +473,14 @@ def _check_path(path: object, name: str = "path", what: str = "file") -> None:
             f"{name}={path!r} must be a {what} path, str or os.PathLike (got {type(path).__name__})"
         )
     try:
-        text = os.fsdecode(path)
+        text = os.fspath(path)
     except TypeError as exc:  # a PathLike whose __fspath__ returns neither str nor bytes
         raise VehicleError(f"{name}={path!r} must be a {what} path: {exc}") from exc
+    if isinstance(text, bytes):  # Path() refuses it: a TypeError deep in the save
+        raise VehicleError(
+            f"{name}={path!r} must be a {what} path, str or os.PathLike giving a str (its "
+            f"__fspath__ gives bytes, {text!r}: decode them with os.fsdecode)"
+        )
     if "\0" in text:
         raise VehicleError(f"{name}={text!r} must be a {what} path: it contains a NUL byte")
     try:

@@ -87,12 +87,16 @@ class ImuMessages:
         log_ns: (n,) receive times, int ns.
         stamp_ns: (n,) header stamps, int ns.
         accel: (n, 3) ``linear_acceleration`` (x, y, z), m/s^2, in the IMU's frame.
+        accel_unknown: (n,) bool: the messages that mark their linear acceleration unknown
+            (``linear_acceleration_covariance[0] == -1``, the Imu message's "no estimate";
+            their ``accel`` is whatever the driver left there); None: none does.
     """
 
     topic: str
     log_ns: np.ndarray
     stamp_ns: np.ndarray
     accel: np.ndarray
+    accel_unknown: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -701,12 +705,16 @@ def _imu(path: Path, topic: str, log_ns, raws: list, decode, cdr: bool = True) -
     try:
         if not cdr:
             raise msgs.CdrLayoutError("not CDR")
-        stamp, accel = msgs.decode_imu(raws)
+        stamp, accel, unknown = msgs.decode_imu_fields(raws)
     except msgs.CdrLayoutError:
         fields = _decoded(path, topic, raws, decode)
-        stamp = np.array([_stamp(m) for m in fields], dtype=np.int64)
+        stamp = np.array([_stamp(m, ros1=not cdr) for m in fields], dtype=np.int64)
         accel = np.array([_xyz(m.linear_acceleration) for m in fields]).reshape(-1, 3)
-    return ImuMessages(topic, log, stamp, accel)
+        unknown = np.array(
+            [float(m.linear_acceleration_covariance[0]) == msgs.UNKNOWN_COVARIANCE
+             for m in fields], dtype=bool,
+        )  # fmt: skip
+    return ImuMessages(topic, log, stamp, accel, unknown if unknown.any() else None)
 
 
 def _odometry(
@@ -719,15 +727,18 @@ def _odometry(
         stamp, position, velocity = msgs.decode_odometry(raws)
     except msgs.CdrLayoutError:
         fields = _decoded(path, topic, raws, decode)
-        stamp = np.array([_stamp(m) for m in fields], dtype=np.int64)
+        stamp = np.array([_stamp(m, ros1=not cdr) for m in fields], dtype=np.int64)
         position = np.array([_xyz(m.pose.pose.position) for m in fields]).reshape(-1, 3)
         velocity = np.array([_xyz(m.twist.twist.linear) for m in fields]).reshape(-1, 3)
     return OdometryMessages(topic, log, stamp, position, velocity)
 
 
-def _stamp(msg) -> int:
+def _stamp(msg, ros1: bool = False) -> int:
+    """A message's header stamp, ns. A ROS 1 time's seconds are a uint32 (to 2106), which
+    rosbags decodes as ROS 2's int32: a stamp from 2038 on reads negative, and is mended."""
     stamp = msg.header.stamp
-    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+    sec = int(stamp.sec) % 2**32 if ros1 else int(stamp.sec)
+    return sec * 1_000_000_000 + int(stamp.nanosec)
 
 
 def _xyz(v) -> tuple[float, float, float]:

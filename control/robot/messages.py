@@ -54,7 +54,9 @@ bool safety              # mode == "safety" (a number for plots)
 _CDR_LE = b"\x00\x01\x00\x00"
 _IMU_TAIL = 8 * (4 + 9 + 3 + 9 + 3 + 9)  # orientation .. linear_acceleration_covariance
 _ODOM_TAIL = 8 * (3 + 4 + 36 + 3 + 3 + 36)  # pose with covariance, twist with covariance
-_UNKNOWN = (-1.0,) + (0.0,) * 8  # REP 145: element 0 = -1 marks "no estimate of this quantity"
+UNKNOWN_COVARIANCE = -1.0
+"""A covariance's element 0 that marks "no estimate of this quantity" (sensor_msgs/Imu, REP 145)."""
+_UNKNOWN = (UNKNOWN_COVARIANCE,) + (0.0,) * 8
 
 
 class CdrLayoutError(ValueError):
@@ -121,15 +123,25 @@ def _header(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def decode_imu(raws: Sequence[bytes]) -> tuple[np.ndarray, np.ndarray]:
     """(header stamps (n,) int ns, linear accelerations (n, 3) m/s^2) of CDR Imu messages.
     Raises `CdrLayoutError` where the data are not little-endian CDR Imu messages."""
+    stamp, accel, _ = decode_imu_fields(raws)
+    return stamp, accel
+
+
+def decode_imu_fields(raws: Sequence[bytes]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """`decode_imu`'s stamps and accelerations, and (n,) bool: whether each message marks its
+    linear acceleration unknown (``linear_acceleration_covariance[0] == -1``, the Imu
+    message's convention for "no estimate of this quantity", REP 145)."""
     stamp = np.empty(len(raws), dtype=np.int64)
     accel = np.empty((len(raws), 3))
+    unknown = np.empty(len(raws), dtype=bool)
     for idx, rows in _groups(raws):
         stamp[idx], end = _header(rows)
         base = 4 + _align(end, 8)
         if np.any(base + _IMU_TAIL != rows.shape[1]):
             raise CdrLayoutError("length does not match an Imu message")
         accel[idx] = _f64(rows, rows.shape[1] - 8 * 12, 3)
-    return stamp, accel
+        unknown[idx] = _f64(rows, rows.shape[1] - 8 * 9, 1)[:, 0] == UNKNOWN_COVARIANCE
+    return stamp, accel, unknown
 
 
 def decode_odometry(raws: Sequence[bytes]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -66,6 +66,7 @@ from control.robot import clock, condition
 from control.robot import messages as msgs
 from control.robot.bags import (
     STORAGES,
+    ImuMessages,
     Recording,
     check_bag_path,
     merge_in_time,
@@ -332,6 +333,7 @@ class ReplayResult:
         """Write the estimates as a ROS 2 bag (topic ``settings.estimate_topic``, type
         ``terrain_gpmsa_msgs/msg/GDEstimate``, stamped with ``stamp_ns``)."""
         storage = storage or self.settings.storage
+        self._check_header_stamps()
         store = msgs.typestore()
         level, gd_max = self.bcr.interval_level, self.simplex.gd_max
         datas = [estimate_message(store, row, level, gd_max) for row in self.rows()]
@@ -343,6 +345,20 @@ class ReplayResult:
             for c, stamp, data in merge_in_time([(conn, self.stamp_ns, datas)]):
                 writer.write(c, stamp, data)
         return home_path(path)
+
+    def _check_header_stamps(self) -> None:
+        """`ControlError` where an estimate's stamp lies outside a ROS 2 header stamp's range
+        (int32 s: 1970 to January 2038), as receive times or a ROS 1 bag's stamps may."""
+        bad = (self.stamp_ns < 0) | (self.stamp_ns > msgs.MAX_STAMP_NS)
+        if bad.any():
+            first = int(self.stamp_ns[bad][0])
+            raise ControlError(
+                f"an estimate's stamp is {first} ns ({first / 1e9:.6g} s since 1970), outside a "
+                f"ROS 2 header stamp's [0, {msgs.MAX_STAMP_NS}] ns (int32 s, to January 2038): "
+                "the estimates cannot be written as a ROS 2 bag; keep the CSV (replay_bag's csv=, "
+                "ReplayResult.to_csv), which holds any stamp, or replay on the other time base "
+                "(time_base, --time-base) where its times fit"
+            )
 
     def _count_line(self) -> str:
         """How many estimates of each status, or why there is none."""
@@ -830,16 +846,18 @@ def _condition(
     ``static_mps2``: the static-level check's level (None: off), for
     `condition.gravity_direction`, whose finding is a note and a `ControlWarning`."""
     notes: list[str] = []
+    imu_accel, unknown = _known_accel(rec)
+    if unknown:
+        notes.append(unknown)
     upright = condition.gravity_direction(
-        rec.imu.accel, s.imu_axis, s.imu_sign, rec.imu.topic, flight_mps2, s.gravity,
-        static_mps2,
-    )  # fmt: skip
+        imu_accel, s.imu_axis, s.imu_sign, rec.imu.topic, flight_mps2, s.gravity, static_mps2
+    )
     if upright:
         notes.append(upright)
         warnings.warn(upright, ControlWarning, stacklevel=user_stacklevel())
     base, note = _time_base(rec, s.time_base)
     imu_ns, odom_ns = _times(rec.imu, base), _times(rec.odometry, base)
-    accel = s.imu_sign * rec.imu.accel[:, "xyz".index(s.imu_axis)]
+    accel = s.imu_sign * imu_accel[:, "xyz".index(s.imu_axis)]
     t0 = int(imu_ns[0])
     _check_span(rec, base, imu_ns, odom_ns, t0)
     t_imu = (imu_ns - t0) / 1e9
@@ -850,6 +868,13 @@ def _condition(
         if skewed:
             notes.append(skewed)
             warnings.warn(skewed, ControlWarning, stacklevel=user_stacklevel())
+    copies = _exact_copies(rec.imu)
+    if copies.any():  # a recording's duplicate (merged or overlapping bags), not a sample
+        t_imu, accel = t_imu[~copies], accel[~copies]
+        notes.append(
+            f"{np.count_nonzero(copies)} IMU message(s) left out as exact copies of an earlier "
+            "one (the same header stamp and acceleration, bit for bit)"
+        )
     odom_finite = np.all(np.isfinite(rec.odometry.position), axis=1) & np.all(
         np.isfinite(rec.odometry.velocity), axis=1
     )
@@ -935,6 +960,48 @@ def _condition(
             "not overlap in time"
         )
     return t, a, pos, spd, reports, resampling, notes, t0, restamping, marks
+
+
+def _known_accel(rec: Recording) -> tuple[np.ndarray, str]:
+    """The IMU's (n, 3) accelerations with NaN (a sensor fault for the BCR) in the messages
+    that mark theirs unknown (`ImuMessages.accel_unknown`), and a note saying how many ("" for
+    none); `BagError` where every message does: the topic holds no acceleration."""
+    imu, unknown = rec.imu, rec.imu.accel_unknown
+    if unknown is None or not unknown.any():
+        return imu.accel, ""
+    how = "linear_acceleration_covariance[0] = -1, the Imu message's mark for no estimate"
+    if unknown.all():
+        imu_types = (msgs.IMU_TYPE, "sensor_msgs/Imu")  # (ROS 1 and some MCAP writers)
+        others = sorted(t for t, ty in rec.topics.items() if ty in imu_types and t != imu.topic)
+        raise BagError(
+            f"the IMU topic {imu.topic!r} marks its linear acceleration unknown in each of its "
+            f"{unknown.size} messages ({how}; an orientation-only output): it holds no "
+            "acceleration to replay; choose the IMU topic that reports it (imu_topic / "
+            "--imu-topic" + (f"; the recording's other IMU topics: {', '.join(others)})"
+                             if others else ")")
+        )  # fmt: skip
+    accel = imu.accel.copy()
+    accel[unknown] = np.nan
+    return accel, (
+        f"{np.count_nonzero(unknown)} of the IMU's {unknown.size} messages mark their linear "
+        f"acceleration unknown ({how}): fed as sensor faults (non-finite accel)"
+    )
+
+
+def _exact_copies(imu: ImuMessages) -> np.ndarray:
+    """(n,) bool: the IMU messages that repeat an earlier one of the topic exactly: the same
+    header stamp (and receive time, where every header stamp is zero) and the same
+    acceleration, bit for bit."""
+    n = imu.stamp_ns.size
+    zero = bool(np.all(imu.stamp_ns == 0))
+    key = np.empty(n, dtype=[("t", "<i8"), ("r", "<i8"), ("a", "V24")])
+    key["t"] = imu.stamp_ns
+    key["r"] = imu.log_ns if zero else 0
+    key["a"] = np.ascontiguousarray(imu.accel, dtype="<f8").view("V24")[:, 0]
+    _, first = np.unique(key, return_index=True)
+    copies = np.ones(n, dtype=bool)
+    copies[first] = False
+    return copies
 
 
 def _bcr_kept(pos: np.ndarray, spd: np.ndarray) -> np.ndarray:

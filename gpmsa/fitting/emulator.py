@@ -951,9 +951,22 @@ def load(path: str | Path, *, sha256: str | None = None) -> Emulator:
     Raises EmulatorFileError naming the problem (and the field) for a damaged, edited,
     inconsistent, foreign or newer file.
     """
+    return build(path, *read_checked(path, sha256=sha256))
+
+
+def read_checked(path: str | Path, *, sha256: str | None = None) -> tuple[dict, dict]:
+    """``load``'s first half: the emulator file's manifest and arrays, read and checked as
+    ``load`` checks them (the zip, the declared content, the content hash, ``sha256``), no
+    Emulator built; EmulatorFileError as ``load`` raises it."""
     expected = check_expected_sha256(sha256)
     manifest, arrays = read_raw(path, check_manifest)
     verify_content(manifest, expected, path)
+    return manifest, arrays
+
+
+def build(path: str | Path, manifest: dict, arrays: dict) -> Emulator:
+    """``load``'s second half: the Emulator of ``read_checked(path)``'s record;
+    EmulatorFileError naming ``path`` for inconsistent content."""
     try:
         return Emulator.from_record(manifest, arrays)
     except EmulatorFileError as exc:

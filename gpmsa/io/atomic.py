@@ -4,8 +4,11 @@ new one, never a part."""
 from __future__ import annotations
 
 import errno
+import hashlib
 import os
+import re
 import secrets
+import socket
 import stat
 import sys
 import time
@@ -35,7 +38,11 @@ def atomic_write(
         the open handle, positioned at 0 (opened "w+", so a writer may check what it wrote).
         A new file gets the permissions of a newly created file (0o666 less the umask); a file
         replaced keeps its permissions, and a symbolic link is written through (its target is
-        replaced, as ``open`` would write it).
+        replaced, as ``open`` would write it; the link stays a link).
+
+    The temporary file is named after ``path``, the process and its host (`_temporary_name`):
+    one left by a save killed outright (SIGKILL, a power cut) is removed by the next save to
+    ``path`` on that host once its process no longer runs (`remove_stale_temporaries`).
     """
     with atomic_group(error=error) as stage, stage(path, text=text) as fh:
         yield fh
@@ -51,9 +58,10 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
     group's block ends without an exception the temporary files are moved over their paths in
     the order staged; on any exception (while writing any of them) every temporary file is
     removed and no path is touched. Only an OS failure during the final moves (each one step)
-    can leave some paths replaced and others not. Where it can (`_folder_lock`), a group of
+    can leave some paths replaced and others not. Where it can (`folder_lock`), a group of
     several files holds a lock on each folder during its moves, so that two processes saving
-    the same files at once leave one's files, all of them, not a mix of both.
+    the same files at once leave one's files, all of them, not a mix of both, and a reader
+    holding the folder's shared lock reads them all before the moves or after.
 
     An OS error while a file is written (a full disk, a quota, an I/O error), flushed to disk or
     moved (e.g. no permission) raises ``error`` naming the path, the OS error chained.
@@ -99,7 +107,7 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
         folders = sorted({path.parent for _, path in staged}) if len(staged) > 1 else []
         with ExitStack() as locks:
             for folder in folders:
-                locks.enter_context(_folder_lock(folder, error))
+                locks.enter_context(folder_lock(folder, error))
             for tmp, path in staged:
                 try:
                     os.replace(tmp, path)
@@ -129,16 +137,24 @@ _WRITE_ERRNOS = frozenset(
 """The OS errors a write to a file raises (no space, over the quota, too large, an I/O error)."""
 
 LOCK_WAIT_S = 60.0
-"""Seconds a group's moves wait for another process's moves into the same folder to end (they
-take milliseconds): past that (a writer stopped midway), ``error`` names the folder."""
+"""Seconds a group's moves wait for another process's moves into the same folder, or a
+reader's read of a study there, to end (they take milliseconds): past that (a process stopped
+midway), ``error`` names the folder."""
 
 
 @contextmanager
-def _folder_lock(folder: Path, error: type[Exception]) -> Iterator[None]:
-    """An exclusive advisory lock (``flock``) on ``folder`` while the block runs, where the OS
-    and the file system give one (POSIX; not Windows, and on some network file systems not):
-    elsewhere none, and the moves run as they would without it. A lock held by another process
-    for ``LOCK_WAIT_S`` seconds raises ``error`` naming the folder."""
+def folder_lock(
+    folder: str | os.PathLike, error: type[Exception] = GPMSAError, *, shared: bool = False
+) -> Iterator[None]:
+    """An advisory lock (``flock``) on ``folder`` while the block runs, where the OS and the file
+    system give one (POSIX; not Windows, and on some network file systems not): elsewhere none,
+    and the block runs as it would without it. ``shared=False``: exclusive, held by a group's
+    moves (`atomic_group`); ``shared=True``: shared, held by a reader of several files that
+    must match (``gpmsa.load_study``), so that it waits for a save's moves in progress and a save
+    waits for its read. The lock is taken on the folder itself, opened for reading: a read-only
+    folder is locked as any other (no lock file is made), and a folder that cannot be opened is
+    not locked. A lock held by another process for ``LOCK_WAIT_S`` seconds raises ``error``
+    naming the folder."""
     if sys.platform == "win32":
         yield
         return
@@ -146,28 +162,101 @@ def _folder_lock(folder: Path, error: type[Exception]) -> Iterator[None]:
 
     try:
         fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
-    except OSError:  # a folder that cannot be opened: the moves say why, if they fail
+    except OSError:  # a folder that cannot be opened: the moves or reads say why, if they fail
         yield
         return
     try:
         deadline = time.monotonic() + LOCK_WAIT_S
         while True:
             try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                fcntl.flock(fd, (fcntl.LOCK_SH if shared else fcntl.LOCK_EX) | fcntl.LOCK_NB)
                 break
-            except BlockingIOError:  # another process is moving its files into the folder
+            except BlockingIOError:  # another process is replacing or reading files there
                 if time.monotonic() > deadline:
                     raise error(
                         f"{folder}: another process has held the folder's lock for "
-                        f"{LOCK_WAIT_S:g} s (gpmsa.io.atomic.LOCK_WAIT_S) while replacing files "
-                        "there; let it finish (or end it) and save again"
+                        f"{LOCK_WAIT_S:g} s (gpmsa.io.atomic.LOCK_WAIT_S) while "
+                        f"{'replacing' if shared else 'reading or replacing'} files there; let it "
+                        f"finish (or end it) and {'load' if shared else 'save'} again"
                     ) from None
                 time.sleep(0.01)
-            except OSError:  # no locks on this file system: move without one
+            except OSError:  # no locks on this file system: go on without one
                 break
         yield
     finally:
         os.close(fd)  # (releases the lock)
+
+
+_STALE_RE = re.compile(r"(\d{1,10})@([0-9a-f]{8})\.[0-9a-f]{12}\.part")
+"""What follows a temporary file's prefix (`_temporary_name`): the writer's process id and host."""
+
+
+def _host_id() -> str:
+    """8 hexadecimal digits naming this host and its process-id space: the host name, the
+    machine id (``/etc/machine-id``, where there is one: two machines may share a host name) and,
+    on Linux, the pid namespace (two containers that share a host name and a folder do not share
+    process ids, and each must never take the other's live process for a dead one). Stable
+    across a reboot, so that a temporary file left by a power cut is recognised as this host's."""
+    try:
+        space = os.readlink("/proc/self/ns/pid")
+    except OSError:  # not Linux: the host name alone (and the machine id, where there is one)
+        space = ""
+    try:  # two machines of one host name ("localhost") have their own
+        with open("/etc/machine-id", "rb") as fh:
+            machine = fh.read(64).strip()
+    except OSError:
+        machine = b""
+    text = f"{socket.gethostname()}\0{space}\0".encode() + machine
+    return hashlib.sha256(text).hexdigest()[:8]
+
+
+def _temporary_name(path: Path) -> str:
+    """The name of a new temporary file beside ``path``: hidden, the start of ``path``'s name (32
+    characters at most: a 255-byte name plus the suffix would exceed the file system's limit),
+    the writing process's id and host (`_host_id`), 12 random hexadecimal digits, ``.part``."""
+    return f".{path.name[:32]}.{os.getpid()}@{_host_id()}.{secrets.token_hex(6)}.part"
+
+
+def remove_stale_temporaries(path: str | os.PathLike) -> list[Path]:
+    """Remove the temporary files that saves to ``path`` left beside it when killed outright
+    (SIGKILL, a power cut: no ``finally`` ran): those named by `_temporary_name` for a process
+    of this host that no longer runs. A temporary of a running process (another save in
+    progress, in this process or another), of another host or of a process that cannot be told
+    (a reused process id: it runs) is never touched. Returns the paths removed; nothing on
+    Windows (whose ``os.kill`` cannot ask whether a process runs) or where the folder cannot
+    be listed."""
+    path = Path(path)
+    if sys.platform == "win32":
+        return []
+    prefix, host, removed = f".{path.name[:32]}.", _host_id(), []
+    try:
+        names = [e.name for e in os.scandir(path.parent) if e.name.startswith(prefix)]
+    except (OSError, ValueError):
+        return []
+    for name in names:
+        found = _STALE_RE.fullmatch(name, len(prefix))
+        if found is None or found[2] != host or _runs(int(found[1])):
+            continue
+        try:
+            os.unlink(path.with_name(name))
+            removed.append(path.with_name(name))
+        except OSError:  # gone meanwhile (another save removed it), or a folder of that name
+            pass
+    return removed
+
+
+def _runs(pid: int) -> bool:
+    """Whether a process ``pid`` runs on this host (one of another user's too; a zombie, not
+    yet waited for, counts as running)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (OSError, OverflowError):  # another user's (EPERM), or not a process id at all
+        return True
+    return True
 
 
 def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
@@ -181,13 +270,13 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
         raise error(_cannot_write(path, exc)) from exc
     if mode is not None and not stat.S_ISREG(mode):
         raise error(f"{path} exists and is not a regular file: refusing to replace it")
-    # the name's start only: a 255-byte name plus the suffix would exceed the file system's limit
-    tmp = path.with_name(f".{path.name[:32]}.{secrets.token_hex(6)}.part")
+    remove_stale_temporaries(path)
+    tmp = path.with_name(_temporary_name(path))
     flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
     try:
         fd = os.open(tmp, flags, 0o666)
     except OSError as exc:  # e.g. a missing folder or one without write permission
-        raise error(_cannot_write(path, exc)) from exc
+        raise error(_cannot_write(path, exc) + _folder_remedy(path, exc)) from exc
     if mode is not None:  # a file replaced keeps its permissions (a private one stays so)
         try:
             os.chmod(tmp, stat.S_IMODE(mode))
@@ -196,6 +285,17 @@ def _new_temporary(path: Path, error: type[Exception]) -> tuple[Path, int]:
             os.unlink(tmp)
             raise error(_cannot_write(path, exc)) from exc
     return tmp, fd
+
+
+def _folder_remedy(path: Path, exc: OSError) -> str:
+    """What to do where a new file cannot be made in ``path``'s folder (``exc``): make a
+    missing folder (a save makes none), or save to a folder that can be written."""
+    folder = path.parent
+    if exc.errno == errno.ENOENT and not os.path.isdir(folder):
+        return f": the folder {folder} does not exist; make it first or save elsewhere"
+    if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return f": the folder {folder} cannot be written; save elsewhere"
+    return ""
 
 
 def _cannot_write(path: Path, exc: OSError | ValueError) -> str:

@@ -182,8 +182,20 @@ def check_path(path) -> Path:
     (`home_path`; not a folder named "~"); GPMSAError unless it is a non-empty str or
     path-like (bytes, numbers and None are not file names here), or for a str that ends with a
     path separator (it names a folder; Path would drop the separator, and save("out/") write a
-    file named out)."""
-    if not isinstance(path, str | os.PathLike) or not str(path):
+    file named out). A bytes path (or a path-like whose ``__fspath__`` gives bytes) is refused,
+    naming the remedy: its name decoded, ``os.fsdecode(path)``."""
+    try:
+        text = os.fspath(path) if isinstance(path, str | os.PathLike) else None
+    except TypeError as exc:  # a path-like whose __fspath__ gives neither str nor bytes
+        raise GPMSAError(
+            f"path must be a file name (str or path-like), got {path!r}: {exc}"
+        ) from None
+    if isinstance(path, bytes) or isinstance(text, bytes):
+        raise GPMSAError(
+            f"path must be a file name (str or path-like), got {path!r}, which gives bytes: pass "
+            "its name as a str (os.fsdecode(path))"
+        )
+    if not text:
         raise GPMSAError(f"path must be a file name (str or path-like), got {path!r}")
     if isinstance(path, str) and path.endswith(tuple(filter(None, (os.sep, os.altsep)))):
         raise GPMSAError(f"path {path!r} ends with a separator: it names a folder, not a file")

@@ -17,8 +17,8 @@ import numpy as np
 from gpmsa.calibration.observations import emulator_record, theta_levels, theta_levels_native
 from gpmsa.calibration.posterior import Posterior, held_names
 from gpmsa.errors import EmulatorFileError, GPMSAError
-from gpmsa.fitting.emulator import _check_metadata, load
-from gpmsa.io.atomic import atomic_group
+from gpmsa.fitting.emulator import _check_metadata, build, read_checked
+from gpmsa.io.atomic import atomic_group, folder_lock
 from gpmsa.io.container import (
     FORMAT,
     STUDY_FORMAT,
@@ -502,13 +502,17 @@ def load_study(path: str | Path, *, sha256: str | None = None) -> Study:
     """
     expected = check_expected_sha256(sha256)
     path = _through_link(check_path(path))
-    manifest, arrays = read_raw(path, check_study_manifest, formats=(STUDY_FORMAT,))
-    verify_content(manifest, expected, path)
-    study = manifest["study"]
+    # the files are read under the folder's shared lock: a save's moves (under its exclusive
+    # lock) come before or after the reads, never between the study file's and its members'
+    with folder_lock(path.parent, EmulatorFileError, shared=True):
+        manifest, arrays = read_raw(path, check_study_manifest, formats=(STUDY_FORMAT,))
+        verify_content(manifest, expected, path)
+        study = manifest["study"]
+        records = [_read_member(path, j, mod) for j, mod in enumerate(study["models"])]
     members = []
-    for j, mod in enumerate(study["models"]):
+    for j, (mod, record) in enumerate(zip(study["models"], records, strict=True)):
         try:
-            members.append(load(path.with_name(mod["file"]), sha256=mod["sha256"]))
+            members.append(build(path.with_name(mod["file"]), *record))
         except EmulatorFileError as exc:
             raise EmulatorFileError(f"{path}: study.models[{j}] ({mod['label']}): {exc}") from exc
     labels = [mod["label"] for mod in study["models"]]
@@ -528,6 +532,15 @@ def load_study(path: str | Path, *, sha256: str | None = None) -> Study:
         raise EmulatorFileError(f"{path}: {exc}") from exc
     except GPMSAError as exc:
         raise EmulatorFileError(f"{path}: study: {exc}") from exc
+
+
+def _read_member(path: Path, j: int, mod: dict) -> tuple[dict, dict]:
+    """The record (manifest, arrays) of the study ``path``'s model ``j`` (``mod``: its entry of
+    ``study.models``), read and checked as ``gpmsa.load`` reads it, with the sha256 listed."""
+    try:
+        return read_checked(path.with_name(mod["file"]), sha256=mod["sha256"])
+    except EmulatorFileError as exc:
+        raise EmulatorFileError(f"{path}: study.models[{j}] ({mod['label']}): {exc}") from exc
 
 
 def _drawn_discrepancy(draws: dict[str, np.ndarray], j: int) -> dict[str, np.ndarray]:
