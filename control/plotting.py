@@ -11,6 +11,15 @@ from control.errors import ControlError
 from control.validation import is_real
 
 
+def _ink() -> str:
+    """The style's foreground colour (``rcParams["text.color"]``) for the prescribed GD: black
+    in matplotlib's default style, as "k" was; white in "dark_background", where black would
+    not show."""
+    from matplotlib import rcParams
+
+    return rcParams["text.color"]
+
+
 def _track_steps(track) -> tuple[np.ndarray, np.ndarray]:
     x = np.append(np.asarray(track.boundaries_m, dtype=float), float(track.length_m))
     gd = np.array([gd for _, gd in track.segments] + [track.segments[-1][1]], dtype=float)
@@ -106,7 +115,7 @@ def plot_gd_trace(
     ax = fig.add_subplot()
     _mark_track(ax, track, gd_max)
     x, gd = _track_steps(track)
-    ax.step(x, gd, where="post", color="k", lw=1.5, label="prescribed GD")
+    ax.step(x, gd, where="post", color=_ink(), lw=1.5, label="prescribed GD")
     for i, r in enumerate(results):
         line = ax.plot(r.position, r.gd_mean, lw=1.3, label=f"run {i + 1}: posterior mean")[0]
         label = f"run {i + 1}: {level:.0%} interval"
@@ -169,6 +178,10 @@ def plot_design(v: np.ndarray, gd: np.ndarray, title: str = "") -> Figure:
     return fig
 
 
+POSTERIOR_BINS = 40
+"""Bins of each histogram of `plot_posterior_grid`."""
+
+
 def plot_posterior_grid(
     cells: Sequence[tuple[float, float, np.ndarray]],
     title: str = "",
@@ -199,8 +212,8 @@ def plot_posterior_grid(
     axes = fig.subplots(len(gds), len(speeds), sharex=True, squeeze=False)
     for v, gd, draws in cells:
         ax = axes[gds.index(gd), speeds.index(v)]
-        ax.hist(draws, bins=40, range=hist_range, density=True, alpha=0.7)
-        ax.axvline(gd, color="k", lw=1)
+        ax.hist(draws, bins=POSTERIOR_BINS, range=hist_range, density=True, alpha=0.7)
+        ax.axvline(gd, color=_ink(), lw=1)
         ax.set_yticks([])
         if gd == gds[0]:
             ax.set_title(f"v = {v:g} m/s", fontsize=9)
@@ -246,8 +259,17 @@ def _cell_values(cells: Sequence[tuple[float, float, np.ndarray]]) -> np.ndarray
 
 def _gd_range(values: np.ndarray) -> tuple[float, float]:
     """The span (1e-6 m^3) of ``values``, rounded out to whole steps of the power of ten at or
-    below it (one step more either side where the span rounds to nothing)."""
+    below it (one step more either side where the span rounds to nothing). A span too narrow
+    for `POSTERIOR_BINS` bins of distinct float64 edges (draws a few ulps apart) counts as
+    none: the range about one value."""
     lo, hi = float(values.min()), float(values.max())
+    rounded = _rounded_range(lo, hi)
+    return rounded if _holds_bins(*rounded) else _rounded_range(lo, lo)
+
+
+def _rounded_range(lo: float, hi: float) -> tuple[float, float]:
+    """[lo, hi] rounded out to whole steps of the power of ten at or below its span (at or
+    below max(|lo|, 1) where lo = hi; one step more either side where it rounds to nothing)."""
     step = 10.0 ** np.floor(np.log10(hi - lo if hi > lo else max(abs(lo), 1.0)))
     lo_r, hi_r = float(np.floor(lo / step) * step), float(np.ceil(hi / step) * step)
     return (lo_r, hi_r) if hi_r > lo_r else (lo_r - step, hi_r + step)
@@ -261,4 +283,16 @@ def _checked_gd_range(gd_range: tuple[float, float]) -> tuple[float, float]:
         lo = hi = float("nan")
     if not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
         raise ControlError(f"gd_range={gd_range!r} must be two finite GD values lo < hi")
+    if not _holds_bins(lo, hi):
+        raise ControlError(
+            f"gd_range={gd_range!r} is too narrow for {POSTERIOR_BINS} bins at float64's "
+            f"resolution about {lo:g}: give a wider range, or None for the draws' own"
+        )
     return lo, hi
+
+
+def _holds_bins(lo: float, hi: float) -> bool:
+    """Whether [lo, hi] holds `POSTERIOR_BINS` equal bins of distinct float64 edges (numpy
+    refuses a histogram range that does not: "Too many bins for data range")."""
+    edges = np.linspace(lo, hi, POSTERIOR_BINS + 1)
+    return bool(np.all(edges[:-1] < edges[1:]))

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -12,6 +12,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.limits import BYTES_PER_HISTOGRAM_BIN, check_memory
 from gpmsa.mcmc import diagnostics
 from gpmsa.model.data import (
+    _label_text,
     as_float,
     as_real,
     check_count,
@@ -362,6 +363,29 @@ def held_names(info: dict) -> set[str]:
     return {h for h in held if isinstance(h, str)} if isinstance(held, list | tuple) else set()
 
 
+def recorded_units(info: dict) -> dict[str, str]:
+    """name -> unit that ``info["units"]`` records (calibrate, Calibrator and a study write a
+    dict name -> unit, so that figures label their axes "name (unit)"), read as ``SimData``
+    reads units: a string, or a number (a table's column label) as its text; an entry None or
+    "" is no unit, and so is a missing record. GPMSAError naming ``info['units']`` for a record
+    that is not such a dict, or an entry that is not such a label (a list, bytes, NaN), which a
+    label would show as its repr."""
+    units = info.get("units")
+    if units is None:
+        return {}
+    if not isinstance(units, Mapping):
+        raise GPMSAError(
+            f"info['units'] must be a dict parameter name -> unit (str), as calibrate records "
+            f"it, got {type(units).__name__} {units!r:.60}: record {{name: unit}}, or give the "
+            "unit to Posterior.plot(name, unit=...)"
+        )
+    out = {}
+    for name, unit in units.items():
+        if isinstance(name, str) and unit is not None and not (isinstance(unit, str) and not unit):
+            out[name] = _label_text(unit, repr(name), "info['units']", "unit")
+    return out
+
+
 class Posterior:
     """Posterior of a calibration, native units.
 
@@ -561,7 +585,7 @@ class Posterior:
         of draws) gets a bar per level, its draws' share: a probability, not a density.
 
         ``unit`` (a str) labels the axes (None: ``info["units"][name]`` where calibrate or
-        Calibrator recorded the emulator's units)."""
+        Calibrator recorded the emulator's units, read by `recorded_units`)."""
         from matplotlib.figure import Figure
 
         self._check(name)
@@ -570,7 +594,7 @@ class Posterior:
         if unit is not None and not isinstance(unit, str):
             raise GPMSAError(f"unit must be a text label (str) or None, got {unit!r}")
         if unit is None:
-            unit = (self.info.get("units") or {}).get(name, "")
+            unit = recorded_units(self.info).get(name, "")
         label = f"{name} ({unit})" if unit else name
         fig = Figure(figsize=(9.0, 3.5))
         ax_h, ax_t = fig.subplots(1, 2)
@@ -585,7 +609,8 @@ class Posterior:
             freq = np.array([np.mean(draws == v) for v in codes])
             ax_h.bar(codes, freq, width=0.4, color="0.75", label="draws")
         else:
-            ax_h.hist(draws, bins=bins, density=True, color="0.75", label="draws")
+            edges = diagnostics.histogram_bins(draws, bins)
+            ax_h.hist(draws, bins=edges, density=True, color="0.75", label="draws")
         if isinstance(g, GridMarginal):
             ax_h.plot(g.nodes, g.density, color="C0", label="exact (grid)")
         if not isinstance(g, LevelMarginal) and codes is None:  # (a categorical one's mean

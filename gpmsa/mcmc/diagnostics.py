@@ -25,6 +25,22 @@ def to_inference_data(draws: dict[str, np.ndarray], log_post: np.ndarray | None 
         return az.from_dict(posterior=dict(draws), sample_stats=sample_stats)
 
 
+def histogram_bins(draws: np.ndarray, bins: int) -> int | np.ndarray:
+    """``bins`` (an int) for a histogram of the finite ``draws``, or, where their spread is too
+    narrow for that many bins with distinct float64 edges (draws a few ulps apart, as rounding
+    leaves a stuck chain's; numpy refuses them: "Too many bins for data range"), the distinct
+    edges of those equal bins between the draws' extremes: fewer bins, still holding every draw.
+    Equal draws keep ``bins`` (numpy widens them to +-0.5)."""
+    arr = np.asarray(draws, dtype=float).ravel()
+    if arr.size == 0:
+        return bins
+    lo, hi = float(np.min(arr)), float(np.max(arr))
+    if not lo < hi:  # one value (or NaN): numpy's own handling
+        return bins
+    edges = np.linspace(lo, hi, bins + 1)  # numpy's equal-width edges
+    return bins if bool(np.all(edges[:-1] < edges[1:])) else np.unique(edges)
+
+
 MIN_DRAWS_ESS = 4
 """Fewest draws per chain for which ArviZ computes an ESS (it logs a shape error below)."""
 MIN_DRAWS_RHAT = 8

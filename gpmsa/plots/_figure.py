@@ -1,5 +1,5 @@
-"""A bare matplotlib Figure (no pyplot state, no GUI backend), the histograms' bin check, the
-axes' labels, and which output indices draw as maps."""
+"""A bare matplotlib Figure (no pyplot state, no GUI backend), the style's ink colour, the
+histograms' bin check, the axes' labels, and which output indices draw as maps."""
 
 from __future__ import annotations
 
@@ -15,6 +15,16 @@ def figure(width: float, height: float):
     from matplotlib.figure import Figure
 
     return Figure(figsize=(width, height), layout="constrained")
+
+
+def ink() -> str:
+    """The style's foreground colour (``rcParams["text.color"]``) for what is drawn as data
+    rather than as a band (observations, a prescribed value, error bars): black in matplotlib's
+    default style, as "k" was, and white in ``plt.style.use("dark_background")``, where black
+    would not show on the black axes."""
+    from matplotlib import rcParams
+
+    return rcParams["text.color"]
 
 
 def check_bins(bins, n_hist: int, what: str) -> int:

@@ -7,7 +7,7 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, SimData
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, ink, is_map
 
 MAP_PANELS = 4
 """Runs, and experiments, drawn at most as maps over a two-column output index."""
@@ -88,10 +88,10 @@ def _scalar(sim: SimData, inputs, x_obs, ys):
     for k, (ax, (name, values, unit)) in enumerate(zip(axes, inputs, strict=True)):
         ax.plot(values, sim.y[:, 0], ".", ms=4, color="C0", label="runs")
         if observed is not None and k < sim.p:
-            ax.plot(x_obs[:, k], observed, "o", mfc="none", color="k", label="observations")
+            ax.plot(x_obs[:, k], observed, "o", mfc="none", color=ink(), label="observations")
         elif observed is not None:
             for v in observed:
-                ax.axhline(v, color="k", lw=0.8)
+                ax.axhline(v, color=ink(), lw=0.8)
         ax.set_xlabel(axis_label(name, unit))
     axes[0].set_ylabel(_y_label(sim))
     if observed is not None:
@@ -114,7 +114,7 @@ def _functional(sim: SimData, inputs, obs, ys, color_by):
     for row, v in zip(sim.y, values, strict=True):
         ax.plot(grid, row, color=cmap(norm(v)), lw=0.8, alpha=0.7)
     for j, e in enumerate(ys or ()):
-        ax.plot(_experiment(sim, obs, e, j, grid), e, "o-", ms=3, lw=1.2, color="k",
+        ax.plot(_experiment(sim, obs, e, j, grid), e, "o-", ms=3, lw=1.2, color=ink(),
                 label="observations" if j == 0 else None)  # fmt: skip
     bar = fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax)
     bar.set_label(axis_label(color_by, unit))

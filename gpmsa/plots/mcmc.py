@@ -6,7 +6,7 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
-from gpmsa.calibration.posterior import Posterior
+from gpmsa.calibration.posterior import Posterior, recorded_units
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import diagnostics
 from gpmsa.mcmc.sampler import Chains
@@ -60,16 +60,13 @@ def _series(source) -> dict[str, np.ndarray]:
 
 def _units(source) -> dict[str, str]:
     """name -> unit of the calibration parameters where ``source`` records them (a Posterior's
-    ``info["units"]``, as calibrate and Calibrator write it; a joint fit's t_units)."""
+    ``info["units"]``, as calibrate and Calibrator write it, read by ``recorded_units``; a joint
+    fit's t_units)."""
     if isinstance(source, Posterior):
-        units = source.info.get("units")
-    elif getattr(source, "calibration", None) and hasattr(source, "t_units"):
-        units = dict(zip(source.t_names, source.t_units, strict=True))
-    else:
-        return {}
-    if not isinstance(units, Mapping):
-        return {}
-    return {k: v for k, v in units.items() if isinstance(k, str) and isinstance(v, str) and v}
+        return recorded_units(source.info)
+    if getattr(source, "calibration", None) and hasattr(source, "t_units"):
+        return {k: v for k, v in zip(source.t_names, source.t_units, strict=True) if v}
+    return {}
 
 
 def _name_list(names, available: list[str]) -> list[str]:
@@ -140,7 +137,9 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
             row[0].plot(ch, lw=0.6, color=f"C{c}", label=f"chain {c}" if len(chains) > 1 else None)
         row[0].set_ylabel(axis_label(name, units.get(name, "")))
         row[1].sharey(row[0])
-        row[1].hist(chains.reshape(-1), bins=bins, orientation="horizontal", color="0.6")
+        draws = chains.reshape(-1)
+        row[1].hist(draws, bins=diagnostics.histogram_bins(draws, bins), orientation="horizontal",
+                    color="0.6")  # fmt: skip
         row[1].tick_params(labelleft=False)
     axes[-1, 0].set_xlabel("retained draw")
     axes[-1, 1].set_xlabel("count")
@@ -297,7 +296,8 @@ def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30
                 ax.set_axis_off()
                 continue
             if i == j:
-                ax.hist(draws[ni], bins=bins, color="0.6", density=True)
+                ax.hist(draws[ni], bins=diagnostics.histogram_bins(draws[ni], bins), color="0.6",
+                        density=True)  # fmt: skip
                 if ni in truth:
                     ax.axvline(truth[ni], color="C3", lw=1.2)
                 ax.set_yticks([])

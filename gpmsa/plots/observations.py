@@ -7,6 +7,7 @@ import numpy as np
 
 from gpmsa.calibration.observations import check_emulator, reduce
 from gpmsa.errors import GPMSAError
+from gpmsa.mcmc.diagnostics import histogram_bins
 from gpmsa.model.data import ObsData, check_count
 from gpmsa.plots import _maps
 from gpmsa.plots._figure import check_bins, figure, index_labels, is_map
@@ -67,7 +68,7 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     for j in range(n_pc):
         ax = fig.add_subplot(grid[j // n_cols, j % n_cols])
         w, u = emulator.w[:, j], reduced.u[:, j]
-        ax.hist(w, bins=bins, color="0.7", label="runs")
+        ax.hist(w, bins=histogram_bins(w, bins), color="0.7", label="runs")
         for e, value in enumerate(u):
             ax.axvline(
                 value, color=f"C{e % 10}", lw=1.2, label=f"experiment {e}" if e < 10 else None
@@ -121,7 +122,7 @@ def weight_pairs(emulator, obs: ObsData | None = None, *, max_pc: int = 4, bins:
                 ax.set_axis_off()
                 continue
             if i == j:
-                ax.hist(w[:, i], bins=bins, color="0.7")
+                ax.hist(w[:, i], bins=histogram_bins(w[:, i], bins), color="0.7")
             else:
                 ax.plot(w[:, j], w[:, i], ".", ms=3, color="0.6")
                 if u is not None:

@@ -7,11 +7,13 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, as_float, check_count, check_finite, check_level
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, ink, is_map
 from gpmsa.predictive.full import FullPrediction
 
 BANDS = (("y", "new observation y", "0.8"), ("zeta", "eta + delta", "C1"),
          ("eta", "simulator eta", "C0"))  # fmt: skip
+BAR_WIDTHS = {"y": 18.0, "zeta": 11.0, "eta": 5.0, "delta": 11.0}
+"""Line widths (points) of the bands of a scalar output drawn at one value of x, as bars."""
 
 
 def prediction_bands(
@@ -30,8 +32,9 @@ def prediction_bands(
     eta + delta and of the simulator eta over the output grid (drawn in increasing order of the
     grid, whatever the order of ``pred.grid``), with the observed values; below,
     the discrepancy delta. A scalar output gets the same bands against the known input
-    ``x_column``. With ``relative`` the top panels show everything minus the predicted mean of
-    y, so that narrow bands on a large output (say 0.05 s on 4 s) can be seen.
+    ``x_column`` (at a single value of x, bars of decreasing width about the mean's tick).
+    With ``relative`` the top panels show everything minus the predicted mean of y, so that
+    narrow bands on a large output (say 0.05 s on 4 s) can be seen.
 
     Over an output index of two columns (SEPIA's (time, angle) y_ind; ``pred.grid`` of shape
     (g, 2)) each column is a stack of maps over the points, each row on one colour scale: the
@@ -97,16 +100,19 @@ def prediction_bands(
         xs = pred.x[order, x_column]
         fig = figure(6.0, 6.0)
         top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2, 1])
+        bars = xs[0] == xs[-1]  # one x (or one repeated): a band there would be a hairline
+        mean_style = {"marker": "_", "ms": BAR_WIDTHS["y"], "ls": "none"} if bars else {}
         for what, label, color in BANDS:
             lo, hi = bands[what]
-            top.fill_between(xs, lo[order, 0], hi[order, 0], color=color, alpha=0.35,
-                             label=f"{label} ({pct})")  # fmt: skip
-        top.plot(xs, eta_mean[order, 0], color="C0", lw=1)
+            _band(top, xs, lo[order, 0], hi[order, 0], bars and BAR_WIDTHS[what], color=color,
+                  alpha=0.35, label=f"{label} ({pct})")  # fmt: skip
+        top.plot(xs, eta_mean[order, 0], color="C0", lw=1, **mean_style)
         if observed is not None:
-            top.plot(xs, observed[order, 0], "o", color="k", ms=3, label="observed")
+            top.plot(xs, observed[order, 0], "o", color=ink(), ms=3, label="observed")
         lo, hi = bands["delta"]
-        bottom.fill_between(xs, lo[order, 0], hi[order, 0], color="C2", alpha=0.4)
-        bottom.plot(xs, pred.mean("delta")[order, 0], color="C2", lw=1)
+        _band(bottom, xs, lo[order, 0], hi[order, 0], bars and BAR_WIDTHS["delta"], color="C2",
+              alpha=0.4)  # fmt: skip
+        bottom.plot(xs, pred.mean("delta")[order, 0], color="C2", lw=1, **mean_style)
         bottom.axhline(0.0, color="0.6", lw=0.6)
         name, unit = _input(pred, x_column)
         bottom.set_xlabel(axis_label(name, unit))
@@ -126,7 +132,7 @@ def prediction_bands(
                              label=f"{label} ({pct})")  # fmt: skip
         top.plot(grid, eta_mean[i, by_index], color="C0", lw=1)
         if observed is not None:
-            top.plot(grid, observed[i, by_index], "o", color="k", ms=3, label="observed")
+            top.plot(grid, observed[i, by_index], "o", color=ink(), ms=3, label="observed")
         lo, hi = bands["delta"]
         bottom.fill_between(grid, lo[i, by_index], hi[i, by_index], color="C2", alpha=0.4)
         bottom.plot(grid, delta_mean[i, by_index], color="C2", lw=1)
@@ -137,6 +143,16 @@ def prediction_bands(
     axes[1, 0].set_ylabel("discrepancy delta")
     axes[0, 0].legend(fontsize="x-small")
     return fig
+
+
+def _band(ax, xs: np.ndarray, lo: np.ndarray, hi: np.ndarray, bar: float, **style) -> None:
+    """The band [lo, hi] along the increasing ``xs`` on ``ax``: filled between them, or, where
+    ``bar`` (a line width in points) is given for a band at one value of x, a vertical bar that
+    wide at it."""
+    if bar:
+        ax.vlines(xs, lo, hi, lw=bar, **style)
+    else:
+        ax.fill_between(xs, lo, hi, **style)
 
 
 def _band_maps(pred: FullPrediction, observed, cols: np.ndarray, level: float):

@@ -11,7 +11,7 @@ from scipy.stats import norm
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import check_count, check_level
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, index_columns, index_labels, is_map
+from gpmsa.plots._figure import axis_label, figure, index_columns, index_labels, ink, is_map
 from gpmsa.predictive.sobol import Sensitivity
 
 
@@ -58,7 +58,7 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
         lo, hi = np.quantile(arr, q, axis=0)
         axes[0].bar(pos + off, arr.mean(axis=0), width=0.4, color=color, label=f"{kind} effect")
         # the interval [lo, hi] itself: a skewed spread can leave the mean outside it
-        axes[0].errorbar(pos + off, (lo + hi) / 2, yerr=(hi - lo) / 2, fmt="none", ecolor="k",
+        axes[0].errorbar(pos + off, (lo + hi) / 2, yerr=(hi - lo) / 2, fmt="none", ecolor=ink(),
                          capsize=3)  # fmt: skip
     axes[0].set_xticks(pos, sens.names)
     axes[0].set_ylim(0.0, 1.05)
