@@ -384,13 +384,13 @@ def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
     or an error never leaves a half-written file, and an existing one stays whole and keeps
     its permissions. The temporary file is named as gpmsa's ``atomic_write`` names its own
     (the process id and host in it): one left by a save killed outright (SIGKILL) is removed
-    by the next save to ``path`` on that host once its process no longer runs
-    (`_remove_stale_temporaries`)."""
+    by a later process's first save into that folder on that host, once its process no longer
+    runs (`_remove_stale_temporaries`)."""
     try:
         mode = stat.S_IMODE(os.stat(path).st_mode)
     except (OSError, ValueError):
         mode = None
-    _remove_stale_temporaries(path)
+    _remove_stale_temporaries(path.parent)
     # the name's start (at most 32 characters) keeps the temporary name within the 255 bytes
     # a file name may have
     tmp = path.with_name(
@@ -410,8 +410,9 @@ def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
         raise
 
 
-_STALE_PART = re.compile(r"(\d{1,10})@([0-9a-f]{8})\.[0-9a-f]{12}\.part")
-"""What follows a temporary file's prefix (``.NAME[:32].``): the writer's process id and host."""
+_STALE_PART = re.compile(r"\..+\.(\d{1,10})@([0-9a-f]{8})\.[0-9a-f]{12}\.part", re.DOTALL)
+"""A temporary file's name (``.NAME[:32].PID@HOST.RANDOM.part``): the writer's process id and
+host."""
 
 
 def _host_id() -> str:
@@ -430,23 +431,31 @@ def _host_id() -> str:
     return hashlib.sha256(text).hexdigest()[:8]
 
 
-def _remove_stale_temporaries(path: Path) -> None:
-    """Remove the temporary files of saves to ``path`` killed outright: those of a process of
-    this host that no longer runs. Never one of a running process (another save in progress,
-    another worker of a campaign sharing the cache), of another host, or on Windows."""
-    if sys.platform == "win32":
+_SWEPT: set[str] = set()
+"""The folders (absolute) this process has swept of stale temporaries."""
+
+
+def _remove_stale_temporaries(folder: Path) -> None:
+    """At this process's first save into ``folder`` (one listing a folder and process: a cache
+    of one file a run must not be listed at every save), remove the temporary files there of
+    saves killed outright, whatever their target: those of a process of this host that no
+    longer runs. Never one of a running process (another save in progress, another worker of a
+    campaign sharing the cache), of another host, or on Windows."""
+    key = os.path.abspath(folder)
+    if sys.platform == "win32" or key in _SWEPT:
         return
-    prefix, host = f".{path.name[:32]}.", _host_id()
+    _SWEPT.add(key)
+    host = _host_id()
     try:
-        names = [e.name for e in os.scandir(path.parent) if e.name.startswith(prefix)]
+        names = [e.name for e in os.scandir(folder) if e.name.endswith(".part")]
     except (OSError, ValueError):
         return
     for name in names:
-        found = _STALE_PART.fullmatch(name, len(prefix))
+        found = _STALE_PART.fullmatch(name)
         if found is None or found[2] != host or _runs(int(found[1])):
             continue
         try:
-            os.unlink(path.with_name(name))
+            os.unlink(folder / name)
         except OSError:  # gone meanwhile (another save removed it), or a folder of that name
             pass
 

@@ -868,12 +868,13 @@ def _condition(
         if skewed:
             notes.append(skewed)
             warnings.warn(skewed, ControlWarning, stacklevel=user_stacklevel())
-    copies = _exact_copies(rec.imu)
+    copies = _exact_copies(rec.imu, base)
     if copies.any():  # a recording's duplicate (merged or overlapping bags), not a sample
         t_imu, accel = t_imu[~copies], accel[~copies]
+        same = "header stamp" if base == "header" else "header stamp, receive time"
         notes.append(
             f"{np.count_nonzero(copies)} IMU message(s) left out as exact copies of an earlier "
-            "one (the same header stamp and acceleration, bit for bit)"
+            f"one (the same {same} and acceleration, bit for bit)"
         )
     odom_finite = np.all(np.isfinite(rec.odometry.position), axis=1) & np.all(
         np.isfinite(rec.odometry.velocity), axis=1
@@ -988,15 +989,16 @@ def _known_accel(rec: Recording) -> tuple[np.ndarray, str]:
     )
 
 
-def _exact_copies(imu: ImuMessages) -> np.ndarray:
+def _exact_copies(imu: ImuMessages, base: str) -> np.ndarray:
     """(n,) bool: the IMU messages that repeat an earlier one of the topic exactly: the same
-    header stamp (and receive time, where every header stamp is zero) and the same
-    acceleration, bit for bit."""
+    header stamp, on receive times (``base`` "log": asked for, or where a topic's header stamps
+    are all zero) the same receive time too, and the same acceleration, bit for bit. On
+    receive times, messages of one header stamp received apart are samples (a driver that
+    stamps several at once, a stuck sensor's repeated reading): none is a copy."""
     n = imu.stamp_ns.size
-    zero = bool(np.all(imu.stamp_ns == 0))
     key = np.empty(n, dtype=[("t", "<i8"), ("r", "<i8"), ("a", "V24")])
     key["t"] = imu.stamp_ns
-    key["r"] = imu.log_ns if zero else 0
+    key["r"] = imu.log_ns if base == "log" else 0
     key["a"] = np.ascontiguousarray(imu.accel, dtype="<f8").view("V24")[:, 0]
     _, first = np.unique(key, return_index=True)
     copies = np.ones(n, dtype=bool)

@@ -34,21 +34,25 @@ noise sds, as on every path."""
 
 FAR_RUN_RANGES = 20.0
 """How far beyond every other run's value at an output point a run's value must lie, in those
-runs' range there, to be named (`far_run`). Measured on 300 designs of 12 independent outputs
-each: normal, exponential, Student-t(3) and lognormal (sigma 1) outputs of 10 or more runs
-reach it in at most 0.3 % of designs (their largest ratios 3.3, 11.4, 11.1, 38 at 10 runs;
-0.8, 3.3, 9.4, 10.3 at 40); a lognormal of sigma 2 (outputs over ~3,000x) in 9-41 % and a
-Cauchy in 28-36 %: heavy tails that one standardising sd and basis serve badly, where the
-warning's advice (emulate a transform) holds. A -999 code among outputs of order 1 lies
-hundreds of ranges beyond; among outputs of 250-350 (temperatures in K), 12.5 (not named)."""
+runs' range there, to be named (`far_run`). Measured on 1,000 designs of 12 independent outputs
+each (10, 40 and 200 runs): normal and exponential outputs never reach it, Student-t(3) ones in
+at most 0.1 % of designs and lognormal (sigma 1) ones in 0.2 % (10 runs; none at 40 or 200); a
+lognormal of sigma 2 (outputs over ~3,000x) in 8-38 % and a Cauchy in 30-35 %: heavy tails that
+one standardising sd and basis serve badly, where the warning's advice (emulate a transform)
+holds. A -999 code among outputs of order 1 lies hundreds of ranges beyond; among outputs of
+250-350 (temperatures in K), 12.5 (not named)."""
 FAR_RUN_MIN_RUNS = 10
-"""Fewer runs than this are not judged (`far_run`): with 5 runs, a lognormal (sigma 1) output
-lies 20 ranges beyond the other four in 8 % of designs."""
+"""Fewer runs than this are not judged (`far_run`): a lognormal (sigma 1) output lies 20 ranges
+beyond the others in 8 % of designs of 5 runs and 1.1 % of 9 runs."""
 FAR_RUN_FLOOR = 0.1
 """The others' range at an output point is taken as at least this fraction of the runs' typical
-range (the median over the output points of the range without each point's top and bottom
-value), so that a point where the other runs agree exactly (an output that starts at 0 in
-every run) does not make any difference there infinitely far."""
+range (`far_run`), so that a point where the other runs agree exactly or nearly (an output that
+starts at 0 in every run, the flat ends of a steep step, a pulse's quiet stretches) does not
+make a difference there of a millionth of the output's range look far. The typical range is
+that of the scale the fit divides y by: with one sd over all outputs (``y_scale="scalar"``),
+the largest over the output points of the range without each point's two top and two bottom
+values (so that neither one run far beyond the others nor two set it); with each element's own
+sd (``y_scale="columnwise"``, or a ``y_sd`` given per element), that element's own."""
 
 
 @dataclass(frozen=True)
@@ -212,9 +216,9 @@ def _point_text(point, names=None, units=None) -> str:
 class FarRun:
     """A simulation run's value beyond every other run's at an output point (`far_run`):
     ``ranges`` how far, in the other runs' range there (at least ``FAR_RUN_FLOOR`` of
-    ``typical``, the runs' typical range); the run's position, its value (native), the other
-    runs' range there, the point's text (None for a scalar output) and at how many output
-    points the run lies that far."""
+    ``typical``, the runs' typical range: `FAR_RUN_FLOOR`); the run's position, its value
+    (native), the other runs' range there, the point's text (None for a scalar output) and at
+    how many output points the run lies that far."""
 
     ranges: float
     run: int
@@ -240,16 +244,16 @@ class FarRun:
             gap = numbers_text(abs(self.value - (self.high if side == "above" else self.low)),
                                self.typical, digits=3)  # fmt: skip
             how = (f"{gap[0]} {side} every other run's value there ([{low}, {high}]), whose "
-                   f"range elsewhere is typically {gap[1]}")  # fmt: skip
+                   f"range reaches {gap[1]} elsewhere")  # fmt: skip
         return f"simulation run {self.run} (y[{self.run}]) holds {value}{where}, {how}{also}"
 
 
 def far_run(sim, grid) -> FarRun | None:
     """The simulation run whose value lies farthest beyond every other run's at an output point,
     where more than ``FAR_RUN_RANGES`` times the other runs' range there (at least
-    ``FAR_RUN_FLOOR`` of the typical range); None where none does, or with fewer than
-    ``FAR_RUN_MIN_RUNS`` runs. ``sim``: a SimData (its y native, its labels); ``grid``: its
-    output index points (the standardizer's grid).
+    ``FAR_RUN_FLOOR`` of the typical range of the scale the fit divides y by); None where none
+    does, or with fewer than ``FAR_RUN_MIN_RUNS`` runs. ``sim``: a SimData (its y native, its
+    labels); ``grid``: its output index points (the standardizer's grid).
 
     One such value (a missing-value code, a failed run) sets the outputs' scale and the
     emulator's basis: one -999 among 40 runs of 12 outputs of order 0.3 made the emulator's
@@ -259,7 +263,9 @@ def far_run(sim, grid) -> FarRun | None:
     if m < FAR_RUN_MIN_RUNS:
         return None
     s = np.sort(y, axis=0)
-    typical = float(np.median(s[-2] - s[1]))
+    spread = s[-3] - s[2]  # each point's range without its two top and two bottom values
+    own = sim.y_scale == "columnwise" or np.size(sim.y_sd) > 1  # each element's own sd
+    typical = spread if own else np.full(spread.shape, spread.max())
     floor = FAR_RUN_FLOOR * typical
     with np.errstate(divide="ignore", invalid="ignore"):
         above = (s[-1] - s[-2]) / np.maximum(s[-2] - s[0], floor)
@@ -279,7 +285,7 @@ def far_run(sim, grid) -> FarRun | None:
         point = _point_text(np.asarray(grid)[k], sim.index_names, sim.index_units)
     n_points = int(np.count_nonzero(np.any(far & (runs == run), axis=0)))
     return FarRun(float(ratios[side, k]), run, float(y[run, k]), float(low), float(high), point,
-                  n_points, typical)  # fmt: skip
+                  n_points, float(typical[k]))  # fmt: skip
 
 
 def warn_far_run(far: FarRun, stacklevel: int, model: str | None = None) -> None:

@@ -57,9 +57,13 @@ def _dead_pid() -> int:
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="no process check on Windows")
-def test_a_temporary_of_a_killed_save_is_removed_by_the_next_save_to_that_path(tmp_path):
+def test_a_temporary_of_a_killed_save_is_removed_by_the_next_save_to_that_folder(
+    tmp_path, monkeypatch
+):
     """A save killed outright (SIGKILL) left its hidden '.e.gpmsa.*.part' file for ever (50
-    kills of a saving process: 28 left, none removed by later saves)."""
+    kills of a saving process: 28 left, none removed by later saves). A process's first save
+    into a folder removes every dead process's temporary there, whatever its target; later
+    saves there list the folder no more (a cache of many files)."""
     host = atomic._host_id()
     dead = f".e.gpmsa.{_dead_pid()}@{host}.0123456789ab.part"
     alive = f".e.gpmsa.{os.getppid()}@{host}.0123456789ab.part"  # the parent runs
@@ -72,8 +76,14 @@ def test_a_temporary_of_a_killed_save_is_removed_by_the_next_save_to_that_path(t
         (tmp_path / name).write_bytes(b"half a file")
     _small().save(tmp_path / "e.gpmsa")
     left = sorted(os.listdir(tmp_path))
-    assert left == sorted(["e.gpmsa", alive, mine, elsewhere, old_style, other])
+    assert left == sorted(["e.gpmsa", alive, mine, elsewhere, old_style])
     assert gpmsa.load(tmp_path / "e.gpmsa").m == 8
+    listed = []
+    monkeypatch.setattr(atomic, "remove_stale_temporaries", listed.append)
+    later = f".g.gpmsa.{_dead_pid()}@{host}.0123456789ab.part"  # killed after the sweep
+    (tmp_path / later).write_bytes(b"half a file")
+    _small().save(tmp_path / "g.gpmsa")
+    assert listed == [] and later in os.listdir(tmp_path)  # (the next process's first save)
 
 
 def test_a_temporary_names_its_process_and_host_within_the_name_limit(tmp_path, monkeypatch):

@@ -21,7 +21,7 @@ def _dead_pid() -> int:
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="no process check on Windows")
-def test_a_temporary_of_a_killed_save_is_removed_by_the_next_save_to_that_path(tmp_path):
+def test_a_temporary_of_a_killed_save_is_removed_by_the_next_save_to_that_folder(tmp_path):
     """50 SIGKILLs of a process saving a campaign in a loop left 28 hidden '.c.npz.*.part'
     files, which no later save removed (a campaign cache shared by workers gathers them)."""
     host = campaign._host_id()
@@ -29,10 +29,15 @@ def test_a_temporary_of_a_killed_save_is_removed_by_the_next_save_to_that_path(t
     alive = f".c.npz.{os.getppid()}@{host}.0123456789ab.part"  # the parent runs
     other_host = "0" * 8 if host != "0" * 8 else "1" * 8
     elsewhere = f".c.npz.{_dead_pid()}@{other_host}.0123456789ab.part"
-    for name in (dead, alive, elsewhere):
+    other = f".d.npz.{_dead_pid()}@{host}.0123456789ab.part"  # another target's
+    for name in (dead, alive, elsewhere, other):
         (tmp_path / name).write_bytes(b"half a file")
     _campaign().save(tmp_path / "c.npz")
     assert sorted(os.listdir(tmp_path)) == sorted(["c.npz", alive, elsewhere])
+    later = f".e.npz.{_dead_pid()}@{host}.0123456789ab.part"  # killed after the sweep: kept
+    (tmp_path / later).write_bytes(b"half a file")  # until another process's first save
+    _campaign().save(tmp_path / "f.npz")
+    assert later in os.listdir(tmp_path)
     assert vehicle.load_campaign(tmp_path / "c.npz").v.size == 2
 
 
