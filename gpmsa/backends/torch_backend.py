@@ -1139,12 +1139,8 @@ def sample(
 
 def callables(problem: Problem) -> list[str]:
     """The callables of this process ``problem`` holds (names for `in_this_process`): a theta
-    constraint, a callable mean basis."""
-    mean = problem.mean_basis
-    return [name for name, on in (
-        ("constraint", problem.constraint is not None),
-        ("mean_basis", mean is not None and mean.kind == "callable"),
-    ) if on]  # fmt: skip
+    constraint, a callable mean basis (``Problem.callables``)."""
+    return problem.callables
 
 
 def check_batch_memory(problem: Problem, n_iter: int, n_chains: int, dtype: torch.dtype,

@@ -435,7 +435,7 @@ def sample_calibration(
     fast = check_flag(fast, "fast")
     if source is not None:
         cont.check_source(source, emulator, fast, emulator_params, n_emulator_draws, constraint,
-                      log_prior, discrepancy, theta_init)  # fmt: skip
+                      log_prior, discrepancy, theta_init, backend)  # fmt: skip
     if fast and not can_fast:
         raise GPMSAError("fast=True needs backend='numpy' and no discrepancy")
     if not fast and (emulator_params != "point" or log_prior is not None):
@@ -689,8 +689,11 @@ def _run_fast(
         init_lamos=lamos_start(fit, data.lamos), constraint=con, init_theta=theta0,
         theta_levels=theta_levels(emulator), held_theta=held_theta, held_lamos=held_lamos,
     )  # fmt: skip
+    mean = emulator.mean_basis  # a callable one goes with the emulator to every chain
     callables = [name for name, on in (("log_prior", extra is not None),
-                                       ("constraint", con is not None)) if on]  # fmt: skip
+                                       ("constraint", con is not None),
+                                       ("mean_basis", mean is not None and mean.kind == "callable"),
+                                       ) if on]  # fmt: skip
     n_jobs, executor = in_this_process(callables, where["n_jobs"], where["executor"], n_chains)
     where = {"n_jobs": n_jobs, "executor": executor}
     fixed_info = _fast_fixed_info(emulator, held_theta, held_lamos, sampler.q)
@@ -822,9 +825,9 @@ def _run_backend(
         reduced=data if discrepancy is None else None, discrepancy_groups=groups, **theta_opts,
     )  # fmt: skip
     module = backends.get(backend)
-    if backend == "numpy" and problem.constraint is not None:  # (torch: its sample; pyro: here)
+    if backend == "numpy":  # a constraint, a callable mean basis (torch: its sample; pyro: here)
         n_jobs, executor = in_this_process(
-            ["constraint"], where["n_jobs"], where["executor"], n_chains
+            problem.callables, where["n_jobs"], where["executor"], n_chains
         )
         where = {"n_jobs": n_jobs, "executor": executor}
     opts = {**tuning_opts, **backends.placement(backend, **where)}

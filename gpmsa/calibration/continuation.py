@@ -94,13 +94,18 @@ def _brief(value) -> str:
     return text if len(text) <= 100 else text[:97] + "..."
 
 
-def check_engine(source: Posterior, fast: bool) -> None:
+def check_engine(source: Posterior, fast: bool, backend: str = "numpy") -> None:
     """GPMSAError where ``source`` ran on the other engine (the fast numpy sampler or a
-    backend's): its states and widths are that engine's."""
+    backend's) than the continuation would, on ``backend``: its states and widths are that
+    engine's."""
     was = source.info["engine"] == "fast"
     if was != fast:
         how = "the fast numpy sampler" if was else f"backend {source.info.get('backend')!r}"
-        hint = "leave fast= out" if was else "pass fast=False (or its backend=)"
+        hint = "pass fast=False (or its backend=)"
+        if was:  # the fast sampler is numpy's: another backend is in the way, or fast=False
+            hint = ("leave fast= out" if backend == "numpy" else
+                    f"leave backend={backend!r} out (and fast=): the fast sampler is the numpy "
+                    "backend's")  # fmt: skip
         raise GPMSAError(
             f"{SOURCE} ran on {how} (info['engine'] {source.info['engine']!r}); its "
             f"continuation runs there too: {hint}"
@@ -315,11 +320,13 @@ def appended_info(source: Posterior, n_samples: int, accept_rate, backend: str):
 
 
 def check_source(source, emulator, fast: bool, emulator_params: str, n_emulator_draws: int,
-                  constraint, log_prior, discrepancy, theta_init) -> None:  # fmt: skip
+                  constraint, log_prior, discrepancy, theta_init,
+                  backend: str = "numpy") -> None:  # fmt: skip
     """GPMSAError where ``calibrate``'s ``init`` (a Posterior, ``source``) is a calibration of
     another emulator (its ``model_sha256``: another fit, or other calibration priors), another
-    emulator_params, constraint, log_prior or discrepancy, or ran on the other engine; and
-    where ``theta_init`` is given (the chains start at their last draws)."""
+    emulator_params, constraint, log_prior or discrepancy, or ran on another engine than
+    ``fast`` on ``backend`` runs (`check_engine`); and where ``theta_init`` is given (the
+    chains start at their last draws)."""
     info = source.info
     same = {
         "emulator": (info.get("emulator_sha256"),
@@ -332,7 +339,7 @@ def check_source(source, emulator, fast: bool, emulator_params: str, n_emulator_
     if emulator_params == "draws":
         same["n_emulator_draws"] = (info.get("n_emulator_draws"), n_emulator_draws)
     check_same(source, **same)
-    check_engine(source, fast)
+    check_engine(source, fast, backend)
     if theta_init is not None:
         raise GPMSAError(f"theta_init= sets a fresh chain's start; {SOURCE}'s chains "
                          "continue from their last draws: leave theta_init out")  # fmt: skip

@@ -306,12 +306,7 @@ def fit(
                 "executor")  # fmt: skip
     backends.check_options(backend, options, reserved, "fit")
     if backend == "numpy":  # (torch's sample keeps its callables here; pyro runs here)
-        mean = problem.mean_basis
-        callables = [name for name, on in (
-            ("constraint", problem.constraint is not None),
-            ("mean_basis", mean is not None and mean.kind == "callable"),
-        ) if on]  # fmt: skip
-        n_jobs, executor = in_this_process(callables, n_jobs, executor, int(n_chains))
+        n_jobs, executor = in_this_process(problem.callables, n_jobs, executor, int(n_chains))
     options.update(backends.placement(backend, n_jobs, executor))
     resumed, recorded, order = options.get("init"), None, None
     if continuing:  # order: K's columns among the source's (per-component parameters follow)

@@ -194,6 +194,17 @@ class Problem:
         return tuple(name for name, on in used if on)
 
     @property
+    def callables(self) -> list[str]:
+        """The callables of this process the problem holds, by the argument that gave them (a
+        theta constraint, a callable mean basis): its chains run in this process, one after
+        another (``gpmsa.mcmc.parallel.in_this_process``: a lambda cannot go to a worker)."""
+        mean = self.mean_basis
+        return [name for name, on in (
+            ("constraint", self.constraint is not None),
+            ("mean_basis", mean is not None and mean.kind == "callable"),
+        ) if on]  # fmt: skip
+
+    @property
     def theta_levels(self) -> list[np.ndarray | None] | None:
         """Per calibration parameter, its levels on the unit scale if categorical (the design's
         values), else None; None when no calibration parameter is categorical."""

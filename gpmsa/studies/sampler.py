@@ -32,7 +32,7 @@ from threadpoolctl import threadpool_limits
 
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import level_moves, starts, tempering, tuning
-from gpmsa.mcmc.parallel import run_chains
+from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import DEFAULT_WIDTHS, ChainState, default_widths, require_finite
 from gpmsa.model.problem import Problem
 from gpmsa.studies.layout import HyperPriors, Layout
@@ -561,8 +561,10 @@ def sample_study(
     elements it shifts, "offsets": (n_chains, n_levels, len(shifted)), unit scale} (as
     ``level_moves.chains_record``, per element). Tempered, info "hot" holds the hot copies'
     last states and widths (`hot_states`, each with a leading chain axis: (n_chains, K - 1,
-    ...)); ``hot_copies`` (per chain, ``run_study_chain``'s ``hot``) resumes them. ChainError
-    names a chain that failed or whose draws are not finite."""
+    ...)); ``hot_copies`` (per chain, ``run_study_chain``'s ``hot``) resumes them. A model's
+    callable mean basis (``Problem.callables``) keeps the chains in this process, one after
+    another (an ``executor`` is refused: ``parallel.in_this_process``). ChainError names a
+    chain that failed or whose draws are not finite."""
     tune_rounds, tune_levels = tuning.check_tuning(tune_rounds, tune_levels)
     held_elements(problems, layout)  # a held element the models disagree on: before any work
     element_levels(problems, layout)  # a categorical element the study cannot sample: likewise
@@ -587,6 +589,8 @@ def sample_study(
         if hot_copies is not None:
             task["hot"] = hot_copies[c]
     n_temps = 0 if temperatures is None else len(ladders[0])
+    held = sorted({name for p in problems for name in p.callables})  # a model's callable mean
+    n_jobs, executor = in_this_process(held, n_jobs, executor, int(n_chains))  # basis: run here
     runs = run_chains(run_study_chain, tasks, n_jobs=n_jobs, executor=executor,
                       progress=progress, desc="study chain",
                       check=lambda _, r: _wrong_run(r, int(n_iter), layout.n_elements,
