@@ -26,6 +26,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.correlation import correlation
 from gpmsa.model.mean_basis import GLS, MeanBasis
+from gpmsa.model.nugget import not_positive_definite
 
 _LOG_2PI = float(np.log(2.0 * np.pi))
 _LOG_2 = float(np.log(2.0))
@@ -96,9 +97,10 @@ class FixedGP:
             try:
                 chol[c] = cholesky(sigma, lower=True)
             except (np.linalg.LinAlgError, ValueError) as exc:
+                prm = {"betaU": self.betaU, "lamUz": self.lamUz, "lamWs": self.lamWs,
+                       "lamWOs": lamWOs}  # fmt: skip
                 raise GPMSAError(
-                    f"Sigma_W of component {c} is not positive definite at these emulator "
-                    f"parameters ({exc})"
+                    not_positive_definite(c, prm, lam_sim, self.m, "at these emulator parameters")
                 ) from exc
             if H is None:
                 alpha[c] = cho_solve((chol[c], True), w[:, c])

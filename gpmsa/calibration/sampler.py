@@ -188,14 +188,19 @@ class ThetaPredictive:
         m_ex, v_ex = self._dense(((s_test + 1.0) / 2.0)[:, None])
         d = self.d
         scale_m = max(1.0, float(np.max(np.abs(m_ex))))
-        scale_v = np.sqrt(np.einsum("gii,gjj->gij", v_ex, v_ex))  # |cov_ij| <= sqrt(v_ii v_jj)
+        # |cov_ij| <= sqrt(v_ii v_jj); a variance zero or negative by rounding (a nugget near
+        # float64's resolution) gives NaN or inf here, so no series passes: dense solves
+        with np.errstate(invalid="ignore", divide="ignore"):
+            scale_v = np.sqrt(np.einsum("gii,gjj->gij", v_ex, v_ex))
         for deg in CHEB_DEGREES:
             nodes = np.cos(np.pi * (np.arange(deg + 1) + 0.5) / (deg + 1))
             m, v = self._dense(((nodes + 1.0) / 2.0)[:, None])
             cm = cheb.chebfit(nodes, m, deg)
             cv = cheb.chebfit(nodes, v.reshape(-1, d * d), deg)
             err_m = np.max(np.abs(cheb.chebval(s_test, cm).T - m_ex)) / scale_m
-            err_v = np.max(np.abs(cheb.chebval(s_test, cv).T.reshape(-1, d, d) - v_ex) / scale_v)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                diff = np.abs(cheb.chebval(s_test, cv).T.reshape(-1, d, d) - v_ex)
+                err_v = np.max(diff / scale_v)
             if err_m <= tol and err_v <= 10 * tol:
                 return cm, cv.reshape(deg + 1, d, d)
         return None

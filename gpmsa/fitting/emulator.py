@@ -62,6 +62,7 @@ from gpmsa.model.data import (
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
+from gpmsa.model.nugget import not_positive_definite
 from gpmsa.model.priors import GammaPrior, Priors, as_group_priors
 from gpmsa.model.transforms import Standardizer, check_extrapolation
 
@@ -437,7 +438,11 @@ class Emulator:
             S[np.diag_indices(self.m)] += nug
             L = lower_cholesky(S) if np.all(np.isfinite(S)) else None
             if L is None:
-                raise GPMSAError("Sigma_W is not positive definite at these parameters")
+                raise GPMSAError(
+                    not_positive_definite(
+                        j, params, self.lam_sim, self.m, "at these emulator parameters"
+                    )
+                )
             L = np.tril(L)
             gls = None if H is None else GLS.of(L, self.w[:, j], H)
             alpha = cho_solve((L, True), self.w[:, j]) if gls is None else gls.alpha

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import replace
 from datetime import datetime, timezone
 
@@ -42,7 +43,7 @@ from gpmsa.mcmc.sampler import (
     sweeps_nbytes,
 )
 from gpmsa.mcmc.starts import check_init
-from gpmsa.model import constraints, kronecker
+from gpmsa.model import constraints, kronecker, nugget
 from gpmsa.model import fixed_elements as per_element
 from gpmsa.model.basis import describe_discrepancy, discrepancy_kind
 from gpmsa.model.data import ObsData, SimData, check_count, check_flag, run_seed
@@ -429,6 +430,16 @@ def fit(
         warn_at_bound(found, draws, data.t_names, std.t_min, std.t_max,
                       f"gpmsa.fit (backend {backend!r}, joint calibration)",
                       "gpmsa.calibration_posterior(emulator).info['at_bound']")  # fmt: skip
+    if problem.separable is None:  # a point estimate that cannot factor: said here, not later
+        bad = nugget.failing_component(problem.zt, params, problem.lam_sim, problem.categorical)
+        if bad is not None:
+            where = f"at the fit's point estimate (point={point!r})"
+            warnings.warn(
+                nugget.not_positive_definite(bad, params, problem.lam_sim, problem.m, where)
+                + ". predict, loo, calibrate, Calibrator, cross_validate and sensitivity refuse "
+                "this emulator",
+                UserWarning, stacklevel=user_stacklevel(),
+            )  # fmt: skip
     return Emulator._from_prepared(
         data, prep, params,
         draws={k: retained[k] for k in EMULATOR_PARAMS}, log_post=lp_kept,

@@ -27,6 +27,7 @@ from gpmsa.model.data import (
 )
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import KINDS as MEAN_BASIS_KINDS
+from gpmsa.model.nugget import not_positive_definite
 from gpmsa.model.transforms import check_extrapolation, snap_to_unit
 
 EMULATOR_PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
@@ -269,7 +270,11 @@ def factors(emulator, prm: dict) -> list[tuple[np.ndarray, np.ndarray]]:
         )
         L = lower_cholesky(S)
         if L is None:
-            raise GPMSAError("Sigma_W is not positive definite at these emulator parameters")
+            raise GPMSAError(
+                not_positive_definite(
+                    j, prm, emulator.lam_sim, emulator.m, "at these emulator parameters"
+                )
+            )
         L = np.tril(L)
         out.append((L, cho_solve((L, True), emulator.w[:, j])))
     return out
