@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import time as _time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
@@ -14,7 +15,7 @@ import roadgen
 import vehicle
 from control.bcr import BCR, BCRSettings
 from control.compat import bcr_settings_for, check_emulator, check_likelihood
-from control.errors import ControlError, EmulatorMismatchError
+from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.estimate import Estimate
 from control.faults import FaultInjector, SensorFault
 from control.metrics import (
@@ -274,7 +275,8 @@ def run_closed_loop(
     """
     make = "roadgen.track(segments, seed=...) makes one of (length_m, GD) segments"
     check_instance(track, "track", roadgen.Track, hint=make)
-    model = vehicle.Jackal() if model is None else vehicle.models.check_model(model)
+    defaulted = model is None
+    model = vehicle.Jackal() if defaulted else vehicle.models.check_model(model)
     simplex = Simplex() if simplex is None else simplex
     check_instance(simplex, "simplex", Simplex)
     if bcr is not None:
@@ -290,9 +292,26 @@ def run_closed_loop(
 
         check_can_record()
         _check_record_path(record)
-    if check and "vehicle" in (getattr(emulator, "metadata", None) or {}):
+    recorded = "vehicle" in (getattr(emulator, "metadata", None) or {})
+    if check and recorded:
         # first: a model left at its default says so, not that the Simplex is too fast for it
-        check_emulator(emulator, model=model)
+        try:
+            check_emulator(emulator, model=model)
+        except EmulatorMismatchError as exc:
+            if not defaulted:
+                raise
+            raise EmulatorMismatchError(
+                f"model= was not given, so the default vehicle.Jackal() would drive, but the "
+                f"{exc}: pass model=control.emulator_vehicle(emulator), the vehicle it records"
+            ) from None
+    elif check and defaulted:
+        warnings.warn(
+            "model= was not given, so the default vehicle.Jackal() drives, and the emulator's "
+            "metadata records no 'vehicle' to check it against: pass model=, the vehicle the "
+            "emulator was trained for",
+            ControlWarning,
+            stacklevel=user_stacklevel(),
+        )
     top = float(model.max_speed_mps)
     if simplex.v_max > top * (1 + 1e-12):
         v_max, top_text = numbers_text(simplex.v_max, top)
@@ -301,7 +320,9 @@ def run_closed_loop(
         )
     bcr = simulated_sensor_settings(bcr_settings_for(emulator) if bcr is None else bcr, noise_std)
     if check:
-        check_emulator(emulator, model=model, noise_std=noise_std, bcr=bcr)
+        # (a default model without a record to check is warned of above)
+        checked = None if defaulted and not recorded else model
+        check_emulator(emulator, model=checked, noise_std=noise_std, bcr=bcr)
         _check_track_domain(emulator, track)
         check_emulator(emulator, simplex=simplex, bcr=bcr)  # (its method: ends checked)
     if likelihood is not None:

@@ -1,6 +1,7 @@
 """Checks that an emulator suits the loop it is asked to serve (vehicle, noise, feature, domain).
 
-The training script (examples/train_emulator.py) records in ``emulator.metadata``: ``vehicle``
+The training script (examples/train_emulator.py) and `control.training.fit_band_emulator` /
+`fit_window_emulator` record in ``emulator.metadata``: ``vehicle``
 (``model.describe()``), ``noise_std`` (m/s^2), ``feature`` (`control.FeatureSpec.to_dict`),
 ``block_scatter`` for the block feature (`control.BlockScatter`) and the campaign's ``road``
 settings.
@@ -55,6 +56,17 @@ def _check_is_emulator(emulator) -> None:
         )
 
 
+_RECORDED_BY = {
+    "feature": "control.training.fit_band_emulator and fit_window_emulator, and "
+    "examples/train_emulator.py, record it; a gpmsa.fit of your own needs "
+    "metadata={'feature': control.FeatureSpec().to_dict(), ...} (docs/robot.md, section 4)",
+    "vehicle": "examples/train_emulator.py records it, as do control.training's "
+    "fit_band_emulator and fit_window_emulator given vehicle=, the model the runs were "
+    "simulated with; an emulator of a real robot's drives has no vehicle model to simulate",
+}
+"""What makes each record `_recorded` asks for (the remedy of its error)."""
+
+
 def _recorded(emulator, key: str, what: str):
     """The emulator's metadata ``key``; EmulatorMismatchError saying it does not say ``what``
     when the record is missing."""
@@ -62,8 +74,7 @@ def _recorded(emulator, key: str, what: str):
     meta = dict(getattr(emulator, "metadata", None) or {})
     if key not in meta:
         raise EmulatorMismatchError(
-            f"the emulator's metadata has no {key!r}: it does not say {what} "
-            "(examples/train_emulator.py records it)"
+            f"the emulator's metadata has no {key!r}: it does not say {what} ({_RECORDED_BY[key]})"
         )
     return meta[key]
 

@@ -129,8 +129,9 @@ class ObservationModel:
             if "block_scatter" not in meta:
                 raise EmulatorMismatchError(
                     "the emulator's metadata has no 'block_scatter' (the per-block observation "
-                    "covariance): it was not trained for the block feature "
-                    "(examples/train_emulator.py writes it)"
+                    "covariance): it was not trained for the block feature; train it with "
+                    "control.training.fit_band_emulator (your runs at known speed and GD) or "
+                    "examples/train_emulator.py, which write it"
                 )
             scatter = BlockScatter.from_dict(meta["block_scatter"])
         if scatter.cov.shape[1] != emulator.l_sim:

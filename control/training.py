@@ -11,6 +11,10 @@ Each campaign run drives one fresh road at one (v, GD) for ``keep_s`` seconds
   blocks is counted when the filter pools them. Pooled over runs and smoothed in speed, it is
   the known observation covariance Sigma(v) of one block (`BlockScatter`), with the Student-t
   degrees of freedom that fit the blocks' squared Mahalanobis distances.
+
+`fit_band_emulator` and `fit_window_emulator` make from such runs (a simulated campaign's, or a
+robot's own drives at known GD) the emulator files the BCR, the replay and the closed loop read,
+with the metadata they check (docs/robot.md, "From your robot's own drives").
 """
 
 from __future__ import annotations
@@ -243,3 +247,125 @@ def _fit_dof(speed, stats_: BlockStatistics, nodes, cov) -> float:
     res = optimize.minimize_scalar(nll, bounds=(np.log(2.5), np.log(1000.0)), method="bounded")
     gauss = -float(np.sum(stats.chi2.logpdf(x * K, K) + np.log(K)))
     return float(np.exp(res.x)) if res.fun < gauss - 1.0 else np.inf
+
+
+WINDOW_PRIORS_LAMWS = (1.0, 1e-3, 1.0, 1e5)
+"""The window emulators' lamWs prior (GPM/SA's Gamma(a, b) with bounds): relaxed from GPM/SA's
+lower bound of 60 to 1, so that the GP nugget describes the window-to-window scatter."""
+
+
+def _training_runs(speed, gd, accel, noise_std, vehicle) -> tuple:
+    """(speed, gd, accel) checked as m runs, and the metadata records every emulator gets:
+    ``noise_std`` (m/s^2) and, where given, ``vehicle`` (a model's ``describe()``)."""
+    speed, gd, accel = (
+        float_array(a, n) for a, n in ((speed, "speed"), (gd, "gd"), (accel, "accel"))
+    )
+    if accel.ndim != 2:
+        raise ControlError(
+            f"accel must be (runs, samples): one row per run, each cut to the same number of "
+            f"samples (e.g. the shortest run's), got shape {accel.shape}"
+        )
+    m = accel.shape[0]
+    for name, values in (("speed", speed), ("gd", gd)):
+        if values.shape != (m,) or not np.all(np.isfinite(values) & (values > 0)):
+            raise ControlError(
+                f"{name} must hold one finite value > 0 per run of accel ({m}; speed in m/s, GD "
+                f"in 1e-6 m^3), got {values.ravel()[:6]!r} (shape {values.shape})"
+            )
+    if not (is_real(noise_std) and 0 <= noise_std < np.inf):
+        raise ControlError(
+            f"noise_std must be the accelerometer's noise sd, a finite number >= 0, m/s^2 (the "
+            f"sd of its vertical axis standing still; 0: noise-free data), got {noise_std!r}"
+        )
+    meta: dict = {"noise_std": float(noise_std)}
+    if vehicle is not None:
+        if not callable(getattr(vehicle, "describe", None)):
+            raise ControlError(
+                f"vehicle must be None (a real robot: no model) or a vehicle model with "
+                f"describe() (vehicle.Jackal, vehicle.HalfCar), got {vehicle!r:.60}"
+            )
+        meta["vehicle"] = vehicle.describe()
+    return speed, gd, accel, meta
+
+
+def fit_band_emulator(
+    speed,
+    gd,
+    accel,
+    *,
+    noise_std: float,
+    feature: FeatureSpec | None = None,
+    vehicle=None,
+    n_pc: int = 8,
+    batch: int = 8,
+    nodes=None,
+    metadata: dict | None = None,
+    **fit_options,
+):
+    """The change-point BCR's emulator (the block feature) from m runs at known speed and GD.
+
+    As examples/train_emulator.py fits its band emulators: each run's mean block feature
+    (`block_statistics`) is the GP's output, through ``n_pc`` principal components; the block
+    scatter Sigma(v) (`block_scatter`) goes into the metadata with ``feature``, ``noise_std``
+    and, where given, ``vehicle``, the records the BCR and the loop's checks read.
+
+    Args:
+        speed: (m,) each run's speed, m/s (the robot drives it steadily).
+        gd: (m,) each run's ground roughness GD, 1e-6 m^3 (Gd(n0) x 1e6).
+        accel: (m, n) each run's vertical accelerations at the feature's rate (120 Hz by
+            default), gravity removed, m/s^2; at least 2 ``batch`` blocks a run.
+        noise_std: the accelerometer's noise sd, m/s^2 (the BCR's noise-floor check reads it).
+        feature: the block feature (default `FeatureSpec()`, the shipped emulators').
+        vehicle: the vehicle model the runs were simulated with, or None for a real robot's
+            drives (the loop then has no vehicle to check against).
+        n_pc: principal components (at most the feature's outputs).
+        batch, nodes: of `block_statistics` and `block_scatter`.
+        metadata: further records (the road, the design, ...).
+        fit_options: passed to `gpmsa.fit` (``n_iter``, ``seed``, ``n_chains``, ...).
+    """
+    import gpmsa
+
+    feature = FeatureSpec() if feature is None else feature
+    check_instance(feature, "feature", FeatureSpec)
+    speed, gd, accel, meta = _training_runs(speed, gd, accel, noise_std, vehicle)
+    stats_ = block_statistics(accel, feature, batch=batch)
+    scatter = block_scatter(speed, stats_, nodes=nodes)
+    data = gpmsa.SimData(
+        x=speed[:, None], t=gd[:, None], y=stats_.mean,
+        x_names=["v"], t_names=["GD"], y_names=feature.names(),
+        x_units=["m/s"], t_units=["1e-6 m^3"], y_units=feature.units(),
+    )  # fmt: skip
+    meta.update(feature=feature.to_dict(), block_scatter=scatter.to_dict())
+    return gpmsa.fit(data, n_pc=n_pc, metadata={**meta, **(metadata or {})}, **fit_options)
+
+
+def fit_window_emulator(
+    speed, gd, accel, *, noise_std: float, vehicle=None, metadata: dict | None = None,
+    **fit_options,
+):  # fmt: skip
+    """The paper's window emulator (y = log f, f the variance of a run's last 1,000 samples,
+    `control.PAPER_WINDOW`) from m runs at known speed and GD, as examples/train_emulator.py
+    fits it (the lamWs prior `WINDOW_PRIORS_LAMWS` unless ``fit_options`` gives ``priors``).
+
+    Args as `fit_band_emulator`'s; each run of ``accel`` holds at least 1,000 samples.
+    """
+    import gpmsa
+    from control.bcr import PAPER_WINDOW
+    from control.feature import feature_of_variance
+
+    speed, gd, accel, meta = _training_runs(speed, gd, accel, noise_std, vehicle)
+    n = PAPER_WINDOW.block_samples
+    if accel.shape[1] < n or not np.all(np.isfinite(accel[:, -n:])):
+        raise ControlError(
+            f"accel must hold >= {n} finite samples per run (the paper's window), got shape "
+            f"{accel.shape}"
+        )
+    f = np.var(accel[:, -n:], axis=1)
+    data = gpmsa.SimData(
+        x=speed[:, None], t=gd[:, None], y=feature_of_variance(f, "log_var")[:, None],
+        x_names=["v"], t_names=["GD"], y_names=["log_f"],
+        x_units=["m/s"], t_units=["1e-6 m^3"], y_units=["log((m/s^2)^2)"],
+    )  # fmt: skip
+    fit_options.setdefault("priors", gpmsa.Priors(lamWs=gpmsa.GammaPrior(*WINDOW_PRIORS_LAMWS)))
+    meta["feature"] = PAPER_WINDOW.to_dict()
+    return gpmsa.fit(data, metadata={**meta, **(metadata or {})}, **fit_options)

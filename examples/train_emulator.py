@@ -77,9 +77,9 @@ from control.plotting import plot_design  # noqa: E402
 from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
 from control.training import (  # noqa: E402
     SINGULAR_WEIGHT,
-    block_scatter,
-    block_statistics,
+    WINDOW_PRIORS_LAMWS,
     covariance_rank,
+    fit_band_emulator,
     weight_beyond_rank,
 )
 from gpmsa.fitting.fit import simulation_fit_nbytes  # noqa: E402
@@ -99,7 +99,7 @@ runs of 60 s, 8 blocks pooled, 1-2 m/s) the quantiles raise the information per 
 17% / 16% (A / B) with 6 components and 18% / 16% with 8. For the band vector alone 5 kept 99.9%
 (GPM/SA's default 99.5% kept 3-4 and dropped GD-dependent shape: held-out RMSE of log GD over
 8.3 s of driving 0.116 with 3, 0.110 with 5, 0.109 with all 8; docs/closed-loop.md)."""
-WINDOW_PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(1.0, 1e-3, 1.0, 1e5))
+WINDOW_PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(*WINDOW_PRIORS_LAMWS))
 GD_MIN_HI = 1.0
 """Smallest ``--gd-range`` HI (1e-6 m^3): 16 times smoother than the middle of ISO 8608's class A.
 Every ISO road's Gd(n0) in m^3 lies below it (class H's 0.13), so a range below it is a range
@@ -438,26 +438,21 @@ def check_finished_runs(parser: argparse.ArgumentParser, campaign, args) -> None
 
 
 def fit_band(case: str, campaign, model, args):
-    """The block-feature emulator of one case, with its block scatter in the metadata."""
+    """The block-feature emulator of one case, with its block scatter in the metadata
+    (`control.training.fit_band_emulator`, as a robot's own drives are fitted)."""
     feature = band_feature(args)
     accel = campaign.accel if case == "A" else campaign.accel_measured
     ok = fit_runs("band", case, campaign, args)
-    stats_ = block_statistics(accel[ok], feature, batch=BATCH)
-    nodes = np.linspace(*args.speed_range, SCATTER_NODES)
-    scatter = block_scatter(campaign.v[ok], stats_, nodes=nodes)
-    data = gpmsa.SimData(
-        x=campaign.v[ok, None], t=campaign.gd[ok, None], y=stats_.mean,
-        x_names=["v"], t_names=["GD"], y_names=feature.names(),
-        x_units=["m/s"], t_units=["1e-6 m^3"], y_units=feature.units(),
-    )  # fmt: skip
     extra = {
-        "block_scatter": scatter.to_dict(),
         "fit": {"n_iter": args.n_iter, "priors": "GPM/SA defaults", "n_pc": args.n_pc},
         "training_target": "mean feature of the run's blocks (expected feature)",
     }
-    return gpmsa.fit(
-        data, n_iter=args.n_iter, seed=args.seed, progress=True, n_pc=args.n_pc,
+    return fit_band_emulator(
+        campaign.v[ok], campaign.gd[ok], accel[ok], noise_std=noise_std(case, args),
+        feature=feature, vehicle=model, n_pc=args.n_pc, batch=BATCH,
+        nodes=np.linspace(*args.speed_range, SCATTER_NODES),
         metadata=metadata(case, feature, model, campaign, args, extra),
+        n_iter=args.n_iter, seed=args.seed, progress=True,
     )  # fmt: skip
 
 
@@ -472,7 +467,7 @@ def fit_window(case: str, campaign, model, args):
         x_names=["v"], t_names=["GD"], y_names=["log_f"],
         x_units=["m/s"], t_units=["1e-6 m^3"], y_units=["log((m/s^2)^2)"],
     )  # fmt: skip
-    extra = {"fit": {"n_iter": args.n_iter, "lamWs_prior": [1.0, 1e-3, 1.0, 1e5]}}
+    extra = {"fit": {"n_iter": args.n_iter, "lamWs_prior": list(WINDOW_PRIORS_LAMWS)}}
     return gpmsa.fit(
         data, n_iter=args.n_iter, seed=args.seed, progress=True, priors=WINDOW_PRIORS,
         metadata=metadata(case, PAPER_WINDOW, model, campaign, args, extra, anchored=False),
