@@ -212,7 +212,9 @@ def plot_posterior_grid(
     axes = fig.subplots(len(gds), len(speeds), sharex=True, squeeze=False)
     for v, gd, draws in cells:
         ax = axes[gds.index(gd), speeds.index(v)]
-        ax.hist(draws, bins=POSTERIOR_BINS, range=hist_range, density=True, alpha=0.7)
+        # float64, as the range was checked (numpy spaces the bins in the draws' own type)
+        ax.hist(np.asarray(draws, dtype=np.float64), bins=POSTERIOR_BINS, range=hist_range,
+                density=True, alpha=0.7)  # fmt: skip
         ax.axvline(gd, color=_ink(), lw=1)
         ax.set_yticks([])
         if gd == gds[0]:

@@ -432,7 +432,10 @@ def _host_id() -> str:
 
 
 _SWEPT: set[str] = set()
-"""The folders (absolute) this process has swept of stale temporaries."""
+"""The folders (absolute) this process has swept of stale temporaries; a forked child (a
+campaign's worker) starts with none, so that it sweeps again at its first save."""
+if hasattr(os, "register_at_fork"):  # POSIX
+    os.register_at_fork(after_in_child=_SWEPT.clear)
 
 
 def _remove_stale_temporaries(folder: Path) -> None:

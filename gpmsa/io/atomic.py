@@ -249,7 +249,11 @@ def remove_stale_temporaries(folder: str | os.PathLike) -> list[Path]:
 
 
 _SWEPT: set[str] = set()
-"""The folders (absolute) this process has swept of stale temporaries (`_sweep_once`)."""
+"""The folders (absolute) this process has swept of stale temporaries (`_sweep_once`); a forked
+child starts with none (a worker forked after its parent's sweep sweeps again: a temporary left
+by another worker killed since is removed by the next one's first save)."""
+if hasattr(os, "register_at_fork"):  # POSIX
+    os.register_at_fork(after_in_child=_SWEPT.clear)
 
 
 def _sweep_once(folder: Path) -> None:

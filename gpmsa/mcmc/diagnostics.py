@@ -30,15 +30,22 @@ def histogram_bins(draws: np.ndarray, bins: int) -> int | np.ndarray:
     narrow for that many bins with distinct float64 edges (draws a few ulps apart, as rounding
     leaves a stuck chain's; numpy refuses them: "Too many bins for data range"), the distinct
     edges of those equal bins between the draws' extremes: fewer bins, still holding every draw.
-    Equal draws keep ``bins`` (numpy widens them to +-0.5)."""
-    arr = np.asarray(draws, dtype=float).ravel()
+    Equal draws keep ``bins`` (numpy widens them to +-0.5). numpy spaces the edges in the draws'
+    own float type: float32 draws a few of their ulps apart are refused by it however far apart
+    float64 tells them, and get float64 edges."""
+    raw = np.asarray(draws)
+    arr = raw.astype(float).ravel()
     if arr.size == 0:
         return bins
     lo, hi = float(np.min(arr)), float(np.max(arr))
     if not lo < hi:  # one value (or NaN): numpy's own handling
         return bins
     edges = np.linspace(lo, hi, bins + 1)  # numpy's equal-width edges
-    return bins if bool(np.all(edges[:-1] < edges[1:])) else np.unique(edges)
+    own = edges
+    if np.issubdtype(raw.dtype, np.floating) and raw.dtype != np.float64:  # (float32: its own)
+        own = np.linspace(raw.min(), raw.max(), bins + 1, dtype=raw.dtype)
+    apart = bool(np.all(edges[:-1] < edges[1:]) and np.all(own[:-1] < own[1:]))
+    return bins if apart else np.unique(edges)
 
 
 MIN_DRAWS_ESS = 4

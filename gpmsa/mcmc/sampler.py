@@ -29,7 +29,7 @@ from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 from gpmsa.model.kronecker import KroneckerLikelihood
 from gpmsa.model.likelihood import IncrementalLikelihood, log_prior
-from gpmsa.model.nugget import not_positive_definite
+from gpmsa.model.nugget import failing_component, not_positive_definite
 from gpmsa.model.problem import Problem
 
 DEFAULT_WIDTHS = {"theta": 0.2, "betaU": 0.1, "betaV": 0.1, "lamVz": 10.0, "lamUz": 5.0,
@@ -295,7 +295,9 @@ class ChainState:
     def check_start(self) -> None:
         """GPMSAError where the state (a chain's start) gives a log posterior of NaN, or where
         a component's Sigma_W is not positive definite there (`nugget.not_positive_definite`:
-        a nugget too small for float64, as the torch backend refuses such a start)."""
+        a nugget too small for float64, as the torch backend refuses such a start). A start at
+        log-likelihood -inf for another reason (a mean basis whose GLS term does not factor
+        there, the observations' covariance) runs on: its first accepted proposal leaves it."""
         if math.isnan(self.log_post()):
             raise GPMSAError(
                 f"the starting values give a log posterior of NaN (log-likelihood "
@@ -304,10 +306,13 @@ class ChainState:
         if self.lik.loglik == -math.inf:
             comps = getattr(self.lik, "comps", ())
             bad = [j for j, c in enumerate(comps) if not getattr(c, "ok", True)]
-            if bad:
-                prm, problem = self.lik.params, self.problem
+            prm, problem = self.lik.params, self.problem
+            j = None if not bad else failing_component(
+                problem.zt, prm, problem.lam_sim, problem.categorical, bad
+            )  # fmt: skip
+            if j is not None:
                 raise GPMSAError(not_positive_definite(
-                    bad[0], prm, problem.lam_sim, problem.m, "at the chain's start"
+                    j, prm, problem.lam_sim, problem.m, "at the chain's start"
                 ))  # fmt: skip
 
     def flat_widths(self, widths: dict[str, np.ndarray]) -> np.ndarray:

@@ -45,12 +45,17 @@ def not_positive_definite(component: int, params: dict, lam_sim, m: int, where: 
     )
 
 
-def failing_component(zt: np.ndarray, params: dict, lam_sim, categorical=None) -> int | None:
-    """The first basis component whose Sigma_W at ``params`` (unit scale) over the runs ``zt``
-    (m, p + q) does not factor in float64 (as ``Emulator.predict`` factors it), or None."""
+def failing_component(
+    zt: np.ndarray, params: dict, lam_sim, categorical=None, components=None
+) -> int | None:
+    """The first basis component (of ``components``; None: all) whose Sigma_W at ``params``
+    (unit scale) over the runs ``zt`` (m, p + q) does not factor in float64 (as
+    ``Emulator.predict`` factors it), or None."""
     m = zt.shape[0]
     lam_wos = float(np.ravel(params["lamWOs"])[0])
-    for j in range(np.ravel(params["lamUz"]).size):
+    if components is None:
+        components = range(np.ravel(params["lamUz"]).size)
+    for j in components:
         S = correlation(zt, None, params["betaU"][:, j], categorical) / params["lamUz"][j]
         S[np.diag_indices(m)] += 1.0 / (lam_sim[j] * lam_wos) + 1.0 / params["lamWs"][j]
         if not np.all(np.isfinite(S)) or lower_cholesky(S) is None:
