@@ -43,8 +43,10 @@ _GD_RTOL = 1e-6
 below 6e-8)."""
 
 
-def _exact(x: float) -> str:
-    """``x`` as %g where that reads back as ``x``, else all its digits (300.1000061)."""
+def gd_key(x: float) -> str:
+    """``x`` as %g where that reads back as ``x``, else all its digits (300.1000061): the key
+    of a part of the track with prescribed GD ``x`` in `LoopMetrics.as_dict` (two GDs that
+    differ never share one)."""
     short = f"{x:g}"
     return short if float(short) == x else repr(float(x))
 
@@ -100,9 +102,9 @@ class LoopMetrics:
             i = int(np.argmin(off))  # the nearest, should two lie within the tolerance
             if off[i] <= _GD_RTOL * abs(gd):
                 return self.gd_errors[i].rmse
-        track_gds = ", ".join(_exact(e.gd) for e in self.gd_errors)
+        track_gds = ", ".join(gd_key(e.gd) for e in self.gd_errors)
         raise ControlError(
-            f"no part of the track has prescribed GD {_exact(gd)}; its GDs: {track_gds}"
+            f"no part of the track has prescribed GD {gd_key(gd)}; its GDs: {track_gds}"
         )
 
     def as_dict(self) -> dict:
@@ -111,8 +113,8 @@ class LoopMetrics:
         parts are keyed by their GD as ``%g`` ("300"), or all its digits where ``%g`` would
         not read back as it (two GDs that differ never share a key)."""
         summary = {
-            "rmse": {_exact(e.gd): e.rmse for e in self.gd_errors},  # (keys that differ)
-            "n_estimates": {_exact(e.gd): e.n for e in self.gd_errors},
+            "rmse": {gd_key(e.gd): e.rmse for e in self.gd_errors},  # (keys that differ)
+            "n_estimates": {gd_key(e.gd): e.n for e in self.gd_errors},
             "detection_delay_m": list(self.detection_delay_m),
             "fast_on_rough_m": self.fast_on_rough_m,
             "traversal_time_s": self.traversal_time_s,

@@ -48,6 +48,7 @@ import gpmsa  # noqa: E402
 import roadgen  # noqa: E402
 import vehicle  # noqa: E402
 from control.bcr import emulator_domain  # noqa: E402
+from control.closed_loop import gd_key  # noqa: E402
 from control.metrics import strict_json  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
 from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
@@ -73,8 +74,8 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
 
     Raises ValueError naming the segment that is not ``LENGTH:GD`` with two finite positive
     numbers, GD at most `GD_MAX`, length at least roadgen.track's (`_check_lengths`), and
-    naming two GDs that differ but print alike (``f"{gd:g}"``, six digits: the tables and
-    metrics.json key each part by it, so one would hide the other).
+    naming two GDs that differ but print alike to six digits (``f"{gd:g}"``), which a reader
+    of the tables would take for one.
     """
     segments = []
     labels: dict[str, float] = {}
@@ -91,8 +92,8 @@ def parse_segments(text: str) -> tuple[tuple[float, float], ...]:
         if labels.setdefault(f"{gd:g}", gd) != gd:
             raise ValueError(
                 f"segment {part.strip()!r}: GD {gd!r} differs from GD {labels[f'{gd:g}']!r} but "
-                f"both print as {gd:g} (the tables and metrics.json key each part by its GD to "
-                "six digits): give both parts one GD, or GDs that differ within six digits"
+                f"both print as {gd:g} to six digits, one GD to a reader of the tables: give "
+                "both parts one GD, or GDs that differ within six digits"
             )
         segments.append((length, gd))
     _check_lengths(segments, [part.strip() for part in text.split(",")])
@@ -187,7 +188,7 @@ def latched_by(result) -> str | None:
 
 
 def summarise(results, gds: list[float]) -> dict:
-    """Pooled RMSE per prescribed GD (keys ``f"{gd:g}"``, as the per-run metrics'), pooled
+    """Pooled RMSE per prescribed GD (keys `gd_key`'s, as the per-run metrics'), pooled
     interval coverage and the per-run metrics (with ``domain_edge``: how many estimates named
     each edge of the emulator's GD domain; ``latched_by``: the estimate that latched safety
     mode, `latched_by`); NaN where a part has no estimate."""
@@ -198,7 +199,7 @@ def summarise(results, gds: list[float]) -> dict:
     )
     covered = (lo[ok] <= true[ok]) & (true[ok] <= hi[ok])
     return {
-        "rmse": {f"{gd:g}": control.pooled_rmse(errors, gd) for gd in gds},
+        "rmse": {gd_key(gd): control.pooled_rmse(errors, gd) for gd in gds},
         "coverage": float(np.mean(covered)) if covered.size else float("nan"),
         "runs": [
             {

@@ -572,12 +572,20 @@ class Posterior:
         return bool(draws.size > 0 and draws.min() == draws.max())
 
     def to_arviz(self):
-        """ArviZ InferenceData of the draws (arviz imported lazily)."""
+        """ArviZ InferenceData of the draws (arviz imported lazily), per chain where they are
+        kept; each parameter's unit that ``info["units"]`` records (`recorded_units`) as its
+        variable's "units" attribute (none for a record that is not such a dict)."""
         from gpmsa.mcmc.diagnostics import to_inference_data
 
+        try:
+            units = recorded_units(self.info)
+        except GPMSAError:  # a record plot() refuses: the draws are kept all the same
+            units = {}
         if self.chains is not None:
-            return to_inference_data({k: np.asarray(v) for k, v in self.chains.items()})
-        return to_inference_data({k: np.asarray(v)[None, :] for k, v in self.samples.items()})
+            draws = {k: np.asarray(v) for k, v in self.chains.items()}
+        else:
+            draws = {k: np.asarray(v)[None, :] for k, v in self.samples.items()}
+        return to_inference_data(draws, units=units)
 
     def plot(self, name: str, bins: int = 50, unit: str | None = None):
         """Histogram of ``bins`` bars (with the grid density when there is one) and trace of

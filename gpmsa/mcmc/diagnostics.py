@@ -6,6 +6,8 @@ import warnings
 
 import numpy as np
 
+from gpmsa.errors import GPMSAError
+
 
 def _arviz():
     """Import arviz quietly (it emits a FutureWarning at import)."""
@@ -16,13 +18,36 @@ def _arviz():
     return arviz
 
 
-def to_inference_data(draws: dict[str, np.ndarray], log_post: np.ndarray | None = None):
-    """ArviZ InferenceData from draws name -> (n_chains, n_draws, *shape)."""
+def to_inference_data(
+    draws: dict[str, np.ndarray],
+    log_post: np.ndarray | None = None,
+    units: dict[str, str] | None = None,
+):
+    """ArviZ InferenceData from draws name -> (n_chains, n_draws, *shape); ``units`` name ->
+    unit, each kept as its variable's "units" attribute (a netCDF convention; none where
+    missing or ""). GPMSAError for a name that is one of ArviZ's dimension names ("chain",
+    "draw", "NAME_dim_K" of a draw with more axes): ArviZ would give that dimension's
+    coordinate in its place, and its draws would be lost without a word."""
+    dims = {"chain", "draw"}
+    for name, value in draws.items():
+        dims.update(f"{name}_dim_{k}" for k in range(np.ndim(value) - 2))
+    taken = [name for name in draws if name in dims]
+    if taken:
+        raise GPMSAError(
+            f"to_arviz: parameter {taken[0]!r} is named as one of ArviZ's dimensions (chain, "
+            "draw, NAME_dim_K), whose coordinate would replace its draws; rename the parameter "
+            "(SimData's t_names, or a study's shared or hierarchical names), or build the "
+            "InferenceData yourself under another name (arviz.from_dict)"
+        )
     az = _arviz()
     sample_stats = {"lp": log_post} if log_post is not None else None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return az.from_dict(posterior=dict(draws), sample_stats=sample_stats)
+        idata = az.from_dict(posterior=dict(draws), sample_stats=sample_stats)
+    for name, unit in (units or {}).items():
+        if unit and name in idata.posterior:
+            idata.posterior[name].attrs["units"] = str(unit)
+    return idata
 
 
 def histogram_bins(draws: np.ndarray, bins: int) -> int | np.ndarray:

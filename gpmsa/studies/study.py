@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from gpmsa.calibration.observations import emulator_record, theta_levels, theta_levels_native
-from gpmsa.calibration.posterior import Posterior, held_names
+from gpmsa.calibration.posterior import Posterior, held_names, recorded_units
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.emulator import _check_metadata, build, read_checked
 from gpmsa.io.atomic import atomic_group, folder_lock
@@ -379,9 +379,11 @@ class Study:
         """ArviZ InferenceData of the pooled posterior (arviz imported lazily): every name of
         ``study.posterior`` (native units) as (chain, draw), the study's chains kept apart, and
         the log posterior as sample_stats "lp", as ``Emulator.to_arviz`` gives it. A parameter
-        held with ``fixed=`` is its value in every draw (``summary``'s "held")."""
+        held with ``fixed=`` is its value in every draw (``summary``'s "held"). Each parameter's
+        unit (``study.posterior.info["units"]``) is its variable's "units" attribute."""
         chains = {k: np.asarray(v) for k, v in self.posterior.chains.items()}
-        return to_inference_data(chains, self.draws["log_post"])
+        units = recorded_units(self.posterior.info)
+        return to_inference_data(chains, self.draws["log_post"], units=units)
 
     def discrepancy(self, model: int | str) -> dict | None:
         """One model's discrepancy as its calibration or fit recorded it: {"discrepancy":
