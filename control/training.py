@@ -19,6 +19,7 @@ with the metadata they check (docs/robot.md, "From your robot's own drives").
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -254,9 +255,59 @@ WINDOW_PRIORS_LAMWS = (1.0, 1e-3, 1.0, 1e5)
 lower bound of 60 to 1, so that the GP nugget describes the window-to-window scatter."""
 
 
-def _training_runs(speed, gd, accel, noise_std, vehicle) -> tuple:
+GD_MIN_HI = 1.0
+"""Smallest highest GD (1e-6 m^3) of a training set: 16 times smoother than the middle of ISO
+8608's class A. Every ISO road's Gd(n0) in m^3 lies below it (class H's 0.13), so runs whose GDs
+all lie below it are GDs given in m^3, which would train on roads a million times too smooth."""
+_MIN_RUNS = 4
+"""Fewest runs of an emulator of speed and GD (gpmsa.SimData's p + q + 2)."""
+
+
+def _check_run_lengths(accel) -> None:
+    """ControlError naming the remedy where ``accel`` is a list of runs of different lengths
+    (as drives come; numpy would only say "inhomogeneous shape")."""
+    if isinstance(accel, list | tuple) and accel and all(np.ndim(a) == 1 for a in accel):
+        lengths = [len(a) for a in accel]
+        if min(lengths) != max(lengths):
+            raise ControlError(
+                f"accel holds runs of different lengths ({min(lengths)} to {max(lengths)} "
+                "samples): cut each to one length, e.g. n = min(map(len, accel)); "
+                "accel = np.stack([a[-n:] for a in accel])"
+            )
+
+
+def _check_metadata(meta: dict, metadata) -> None:
+    """ControlError unless ``metadata`` is None or a dict whose records the fit also writes
+    (``meta``: noise_std, vehicle, feature, block_scatter) agree with the fit's."""
+    if metadata is None:
+        return
+    if not isinstance(metadata, Mapping):
+        raise ControlError(
+            f"metadata must be a dict of further records (name -> JSON-able value), got "
+            f"{type(metadata).__name__} {metadata!r:.60}"
+        )
+    for key, value in meta.items():
+        if key in metadata and not _same_record(metadata[key], value):
+            raise ControlError(
+                f"metadata[{key!r}] = {metadata[key]!r:.60} differs from the {key} this fit "
+                f"records, {value!r:.60} (from its arguments and runs): leave {key!r} out of "
+                "metadata, or give the fit the value you mean"
+            )
+
+
+def _same_record(a, b) -> bool:
+    """Whether two metadata records are equal (False where they cannot be compared)."""
+    try:
+        return bool(a == b)
+    except (TypeError, ValueError):  # e.g. arrays of different shapes
+        return False
+
+
+def _training_runs(speed, gd, accel, noise_std, vehicle, metadata) -> tuple:
     """(speed, gd, accel) checked as m runs, and the metadata records every emulator gets:
-    ``noise_std`` (m/s^2) and, where given, ``vehicle`` (a model's ``describe()``)."""
+    ``noise_std`` (m/s^2) and, where given, ``vehicle`` (a model's ``describe()``);
+    ``metadata``, the further records, checked against them."""
+    _check_run_lengths(accel)
     speed, gd, accel = (
         float_array(a, n) for a, n in ((speed, "speed"), (gd, "gd"), (accel, "accel"))
     )
@@ -272,6 +323,25 @@ def _training_runs(speed, gd, accel, noise_std, vehicle) -> tuple:
                 f"{name} must hold one finite value > 0 per run of accel ({m}; speed in m/s, GD "
                 f"in 1e-6 m^3), got {values.ravel()[:6]!r} (shape {values.shape})"
             )
+    if m < _MIN_RUNS:
+        raise ControlError(
+            f"accel holds {m} run{'s' if m != 1 else ''}: an emulator of speed and GD needs "
+            f">= {_MIN_RUNS} runs (gpmsa.SimData's p + q + 2), at >= 2 speeds and >= 2 GDs"
+        )
+    for name, values, unit, what in (("speed", speed, " m/s", "speeds"), ("gd", gd, "", "GDs")):
+        if values.min() == values.max():
+            raise ControlError(
+                f"every run has {name} {values[0]:g}{unit}: the emulator learns how the "
+                f"feature changes with speed and GD, so its runs need >= 2 {what} (its domain "
+                "is their range)"
+            )
+    if gd.max() < GD_MIN_HI:  # every ISO 8608 road in m^3 lies below 1: a unit slip
+        lo, hi = numbers_text(gd.min() * 1e6, gd.max() * 1e6)
+        raise ControlError(
+            f"gd is Gd(n0) in units of 1e-6 m^3 (ISO 8608's smoothest class, A, spans 0-32), "
+            f"but every run's lies below {GD_MIN_HI:g} (largest {gd.max():g}): given in m^3? "
+            f"Then gd * 1e6, in [{lo}, {hi}]"
+        )
     if not (is_real(noise_std) and 0 <= noise_std < np.inf):
         raise ControlError(
             f"noise_std must be the accelerometer's noise sd, a finite number >= 0, m/s^2 (the "
@@ -285,6 +355,7 @@ def _training_runs(speed, gd, accel, noise_std, vehicle) -> tuple:
                 f"describe() (vehicle.Jackal, vehicle.HalfCar), got {vehicle!r:.60}"
             )
         meta["vehicle"] = vehicle.describe()
+    _check_metadata(meta, metadata)
     return speed, gd, accel, meta
 
 
@@ -311,7 +382,7 @@ def fit_band_emulator(
 
     Args:
         speed: (m,) each run's speed, m/s (the robot drives it steadily).
-        gd: (m,) each run's ground roughness GD, 1e-6 m^3 (Gd(n0) x 1e6).
+        gd: (m,) each run's ground roughness GD, 1e-6 m^3 (Gd(n0) x 1e6; `roadgen.estimate_gd`).
         accel: (m, n) each run's vertical accelerations at the feature's rate (120 Hz by
             default), gravity removed, m/s^2; at least 2 ``batch`` blocks a run.
         noise_std: the accelerometer's noise sd, m/s^2 (the BCR's noise-floor check reads it).
@@ -320,14 +391,21 @@ def fit_band_emulator(
             drives (the loop then has no vehicle to check against).
         n_pc: principal components (at most the feature's outputs).
         batch, nodes: of `block_statistics` and `block_scatter`.
-        metadata: further records (the road, the design, ...).
+        metadata: further records (the road, the design, ...); one of the records the fit
+            writes (``noise_std``, ``vehicle``, ``feature``, ``block_scatter``) only with the
+            fit's value.
         fit_options: passed to `gpmsa.fit` (``n_iter``, ``seed``, ``n_chains``, ...).
+
+    Raises ControlError, before the fit, naming the argument: runs of different lengths (cut
+    them to one), fewer than 4 runs, runs all at one speed or one GD, GDs all below `GD_MIN_HI`
+    (given in m^3), a ``noise_std`` that is not a finite number >= 0, a ``metadata`` record
+    that contradicts the fit's; and where `block_statistics` or `block_scatter` refuse the runs.
     """
     import gpmsa
 
     feature = FeatureSpec() if feature is None else feature
     check_instance(feature, "feature", FeatureSpec)
-    speed, gd, accel, meta = _training_runs(speed, gd, accel, noise_std, vehicle)
+    speed, gd, accel, meta = _training_runs(speed, gd, accel, noise_std, vehicle, metadata)
     stats_ = block_statistics(accel, feature, batch=batch)
     scatter = block_scatter(speed, stats_, nodes=nodes)
     data = gpmsa.SimData(
@@ -336,6 +414,7 @@ def fit_band_emulator(
         x_units=["m/s"], t_units=["1e-6 m^3"], y_units=feature.units(),
     )  # fmt: skip
     meta.update(feature=feature.to_dict(), block_scatter=scatter.to_dict())
+    _check_metadata(meta, metadata)
     return gpmsa.fit(data, n_pc=n_pc, metadata={**meta, **(metadata or {})}, **fit_options)
 
 
@@ -347,13 +426,14 @@ def fit_window_emulator(
     `control.PAPER_WINDOW`) from m runs at known speed and GD, as examples/train_emulator.py
     fits it (the lamWs prior `WINDOW_PRIORS_LAMWS` unless ``fit_options`` gives ``priors``).
 
-    Args as `fit_band_emulator`'s; each run of ``accel`` holds at least 1,000 samples.
+    Args and refusals as `fit_band_emulator`'s; each run of ``accel`` holds at least 1,000
+    samples, its last 1,000 finite.
     """
     import gpmsa
     from control.bcr import PAPER_WINDOW
     from control.feature import feature_of_variance
 
-    speed, gd, accel, meta = _training_runs(speed, gd, accel, noise_std, vehicle)
+    speed, gd, accel, meta = _training_runs(speed, gd, accel, noise_std, vehicle, metadata)
     n = PAPER_WINDOW.block_samples
     if accel.shape[1] < n or not np.all(np.isfinite(accel[:, -n:])):
         raise ControlError(
@@ -368,4 +448,5 @@ def fit_window_emulator(
     )  # fmt: skip
     fit_options.setdefault("priors", gpmsa.Priors(lamWs=gpmsa.GammaPrior(*WINDOW_PRIORS_LAMWS)))
     meta["feature"] = PAPER_WINDOW.to_dict()
+    _check_metadata(meta, metadata)
     return gpmsa.fit(data, metadata={**meta, **(metadata or {})}, **fit_options)

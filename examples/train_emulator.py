@@ -76,6 +76,7 @@ from control.feature import feature_of_variance  # noqa: E402
 from control.plotting import plot_design  # noqa: E402
 from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
 from control.training import (  # noqa: E402
+    GD_MIN_HI,  # the smallest --gd-range HI: a range below it is one given in m^3
     SINGULAR_WEIGHT,
     WINDOW_PRIORS_LAMWS,
     covariance_rank,
@@ -100,10 +101,6 @@ runs of 60 s, 8 blocks pooled, 1-2 m/s) the quantiles raise the information per 
 (GPM/SA's default 99.5% kept 3-4 and dropped GD-dependent shape: held-out RMSE of log GD over
 8.3 s of driving 0.116 with 3, 0.110 with 5, 0.109 with all 8; docs/closed-loop.md)."""
 WINDOW_PRIORS = gpmsa.Priors(lamWs=gpmsa.GammaPrior(*WINDOW_PRIORS_LAMWS))
-GD_MIN_HI = 1.0
-"""Smallest ``--gd-range`` HI (1e-6 m^3): 16 times smoother than the middle of ISO 8608's class A.
-Every ISO road's Gd(n0) in m^3 lies below it (class H's 0.13), so a range below it is a range
-given in m^3, which would train on roads a million times too smooth."""
 MIN_RUNS = 4
 """Fewest design points (``--n-runs``): gpmsa.SimData needs p + q + 2 = 4 runs for v and GD
 (and the band emulators at least ``--n-pc``)."""

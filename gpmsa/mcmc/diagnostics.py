@@ -18,6 +18,20 @@ def _arviz():
     return arviz
 
 
+CF_TIME_UNITS = frozenset(
+    ("days", "hours", "minutes", "seconds", "milliseconds", "microseconds", "nanoseconds")
+)
+"""Units that xarray's CF decoding reads as durations (timedelta64; by default in older xarray
+releases, 2025.09 among them), as it reads any "units" holding "since" as dates (and refuses to
+open a file whose reference date it cannot parse)."""
+
+
+def is_cf_time_unit(unit: str) -> bool:
+    """Whether xarray would decode a variable of this "units" attribute as times, not numbers
+    (`CF_TIME_UNITS`, or one holding "since": "days since 2000-01-01", "s since start")."""
+    return unit in CF_TIME_UNITS or "since" in unit
+
+
 def to_inference_data(
     draws: dict[str, np.ndarray],
     log_post: np.ndarray | None = None,
@@ -25,9 +39,11 @@ def to_inference_data(
 ):
     """ArviZ InferenceData from draws name -> (n_chains, n_draws, *shape); ``units`` name ->
     unit, each kept as its variable's "units" attribute (a netCDF convention; none where
-    missing or ""). GPMSAError for a name that is one of ArviZ's dimension names ("chain",
-    "draw", "NAME_dim_K" of a draw with more axes): ArviZ would give that dimension's
-    coordinate in its place, and its draws would be lost without a word."""
+    missing or "", nor where xarray would read the draws back as times, `is_cf_time_unit`:
+    dates or durations from ``to_netcdf``, or a file that does not open). GPMSAError for a
+    name that is one of ArviZ's dimension names ("chain", "draw", "NAME_dim_K" of a draw with
+    more axes): ArviZ would give that dimension's coordinate in its place, and its draws would
+    be lost without a word."""
     dims = {"chain", "draw"}
     for name, value in draws.items():
         dims.update(f"{name}_dim_{k}" for k in range(np.ndim(value) - 2))
@@ -45,7 +61,7 @@ def to_inference_data(
         warnings.simplefilter("ignore")
         idata = az.from_dict(posterior=dict(draws), sample_stats=sample_stats)
     for name, unit in (units or {}).items():
-        if unit and name in idata.posterior:
+        if unit and name in idata.posterior and not is_cf_time_unit(str(unit)):
             idata.posterior[name].attrs["units"] = str(unit)
     return idata
 
