@@ -25,3 +25,17 @@ def dask_client():
         distributed.Client(cluster) as client,
     ):
         yield client
+
+
+@pytest.fixture(autouse=True)
+def _working_folder_restored():
+    """Fail a test that leaves the working folder changed (use monkeypatch.chdir): later tests
+    read files by paths relative to the repository root."""
+    before = Path.cwd()
+    yield
+    after = Path.cwd()
+    if after != before:
+        import os
+
+        os.chdir(before)
+        pytest.fail(f"the test changed the working folder to {after} (use monkeypatch.chdir)")

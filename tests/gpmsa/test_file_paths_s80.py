@@ -25,9 +25,11 @@ class PathLike:
 
 
 @pytest.mark.parametrize("given", [b"e.gpmsa", PathLike(b"e.gpmsa"), PathLike(3)])
-def test_a_path_giving_bytes_or_no_path_is_a_gpmsa_error_on_save_and_load(tmp_path, given):
+def test_a_path_giving_bytes_or_no_path_is_a_gpmsa_error_on_save_and_load(
+    tmp_path, monkeypatch, given
+):
     """A path-like whose __fspath__ gives bytes raised a bare TypeError from pathlib."""
-    os.chdir(tmp_path)
+    monkeypatch.chdir(tmp_path)  # (restored after the test: later tests read relative paths)
     with pytest.raises(GPMSAError, match="path must be a file name"):
         _small().save(given)
     with pytest.raises(GPMSAError, match="path must be a file name"):
