@@ -18,9 +18,9 @@ import warnings
 from dataclasses import replace
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
 from gpmsa import backends
+from gpmsa._threads import one_thread
 from gpmsa.calibration import continuation as cont
 from gpmsa.calibration.judge import Run, judge_bounds, judge_convergence
 from gpmsa.calibration.observations import (
@@ -29,7 +29,6 @@ from gpmsa.calibration.observations import (
     OUTSIDE_SDS,
     Fit,
     Observations,
-    blas_controller,
     check_draws_mode,
     check_emulator,
     check_log_prior,
@@ -488,7 +487,7 @@ def sample_calibration(
     if held is not None and fast:
         theta_opts["held"] = _fast_held(emulator, held)  # checked before any work
     t0 = time.perf_counter()
-    with blas_controller().limit(limits=1, user_api="blas"):
+    with one_thread():
         where = {"n_jobs": n_jobs, "executor": executor}
         with warnings.catch_warnings():
             if discrepancy is not None:  # the reduction with its basis warns (_run_backend)
@@ -649,7 +648,7 @@ def _fast_chain(
 ):  # fmt: skip
     """One chain of the fast sampler (a worker process runs it from plain data); ``start``,
     ``widths``, ``proportional``: a continuation's (``CalibrationSampler.run``)."""
-    with threadpool_limits(1):
+    with one_thread(None):
         return sampler.run(
             n_samples,
             np.random.default_rng(seed),

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import inspect
 import math
+import threading
 import warnings
 from collections.abc import Callable
 
@@ -40,6 +41,7 @@ import numpy as np
 from scipy.special import log_ndtr
 
 from gpmsa import backends
+from gpmsa._threads import one_thread
 from gpmsa.calibration.grid import (
     MODE_MASS,
     RIDGE_SD,
@@ -77,7 +79,6 @@ from gpmsa.calibration.observations import (
     N_EMULATOR_DRAWS,
     Fit,
     Observations,
-    blas_controller,
     check_draws_mode,
     check_emulator,
     draw_positions,
@@ -314,6 +315,7 @@ class Calibrator:
         self.emulator_params = emulator_params
         self._entropy = np.random.SeedSequence(None if seed is None else run_seed(seed)).entropy
         self._count = 0
+        self._updating = threading.RLock()  # updates take turns: each has its own count
         self.mcmc_options = _check_mcmc_options(mcmc_options, backend)
         user_options = sorted(self.mcmc_options)  # before the constraint joins them
         if constraint is not None:
@@ -364,7 +366,7 @@ class Calibrator:
                     self.theta_grid[:, k] = exact[:, k]
         if q == 1:
             self.theta_grid = self.theta_grid[:, 0]
-        with blas_controller().limit(limits=1, user_api="blas"):
+        with one_thread():
             sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
             self._gps = [fixed_gp(emulator, prm) for prm in sets]
             plans = [chebyshev_plan(gp) for gp in self._gps]
@@ -408,14 +410,21 @@ class Calibrator:
         return axis, [GridPredictor(gp, axis[:, None], plan)
                       for gp, plan in zip(self._gps, plans, strict=True)]  # fmt: skip
 
+    def __getstate__(self) -> dict:
+        """For pickle and ``copy``: all but the update lock (a copy gets its own)."""
+        state = self.__dict__.copy()
+        state.pop("_updating", None)
+        return state
+
     def __setstate__(self, state: dict) -> None:
         """Unpickling: one pickled before the prepared refinement (session 65; a saved BCR
         holds one) prepares it now, as a Calibrator built now does."""
         self.__dict__.update(state)
+        self._updating = threading.RLock()
         self.__dict__.setdefault("_levels", None)  # pickled before categorical grids (s73)
         self.__dict__.setdefault("_categorical", [])
         if "_refined" not in state and self.method == "grid":
-            with blas_controller().limit(limits=1, user_api="blas"):
+            with one_thread():
                 plans = [chebyshev_plan(gp) for gp in self._gps]
                 self._refined = self._refined_predictors(self._refined_axis(plans), plans)
 
@@ -556,7 +565,7 @@ class Calibrator:
         self._check_grid_method()
         data = reduce(self.emulator, x_obs, y_obs, self._extrapolate(extrapolate))
         seen: list[float] = []
-        with blas_controller().limit(limits=1, user_api="blas"):
+        with one_thread():
             ll = self._combine(self._marginals(data, None, seen))
         fit = Fit(min(seen), 0.0)
         warn_if_outside(fit, far=far_value(self.emulator, data, fit))
@@ -652,7 +661,15 @@ class Calibrator:
             ``info["emulator_draws"]`` holds per draw of ``samples`` the position in
             ``emulator.draws`` of the emulator parameters drawn with it (by their likelihood at
             its node, as lamOs), set when the samples are drawn (lazily, on first access).
+
+        Updates called from several threads take turns (a lock), each counted as one of a
+        serial sequence; for the same draws whatever the order, pass each its ``seed``.
         """
+        with self._updating:
+            return self._update(x_obs, y_obs, prior, seed, extrapolate)
+
+    def _update(self, x_obs, y_obs, prior, seed, extrapolate) -> Posterior:
+        """`update`, under its lock."""
         count = self._count + 1  # counted once it succeeds
         extrapolate = self._extrapolate(extrapolate)
         if self.method == "mcmc":
@@ -661,7 +678,7 @@ class Calibrator:
             return post
         data = reduce(self.emulator, x_obs, y_obs, extrapolate)
         seen: list[float] = []
-        with blas_controller().limit(limits=1, user_api="blas"):
+        with one_thread():
             margs = self._marginals(data, None, seen)
             outside = min(seen)
             fit = Fit(outside, 0.0)

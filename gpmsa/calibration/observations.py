@@ -7,12 +7,11 @@ import itertools
 import math
 import warnings
 from dataclasses import dataclass
-from functools import cache
 
 import numpy as np
-from threadpoolctl import ThreadpoolController
 
 from gpmsa import limits
+from gpmsa._threads import blas_controller as blas_controller  # its home: gpmsa._threads
 from gpmsa.calibration.model import FixedGP, LamOsPrior
 from gpmsa.errors import (
     ExtrapolationWarning,
@@ -153,12 +152,6 @@ def draw_positions(emulator, n_sets: int) -> np.ndarray:
     if n == 0:
         raise GPMSAError("emulator_params='draws' needs retained draws; this emulator has none")
     return evenly_spaced(n, n_sets, "n_emulator_draws")
-
-
-@cache
-def blas_controller() -> ThreadpoolController:
-    """The process's BLAS libraries (scanned once: a scan costs about a millisecond)."""
-    return ThreadpoolController()
 
 
 def fixed_gp(emulator, params: dict | None = None) -> FixedGP:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
@@ -424,6 +425,8 @@ class Posterior:
                              f"{type(draw).__name__}")  # fmt: skip
         self._samples = None if samples is None else _checked_samples(samples)
         self._draw = draw
+        if draw is not None:  # one thread draws; others reading ``samples`` meanwhile wait
+            self._drawing = threading.Lock()
         self.info = _checked_info(info)
         known = tuple(self._samples) if self._samples is not None else self.info.get("names")
         self.grids = _checked_grids(grids, known)
@@ -435,23 +438,31 @@ class Posterior:
         state = self.__dict__.copy()
         if state.get("_draw") is not None:
             state["_samples"], state["_draw"] = self.samples, None
+        state.pop("_drawing", None)
         return state
 
     @property
     def samples(self) -> dict[str, np.ndarray]:
-        """Named draws, native units: name -> (n_draws,)."""
+        """Named draws, native units: name -> (n_draws,). Drawn lazily: once, by the first
+        thread that reads them (others reading them meanwhile wait, and get the same dict)."""
         if self._samples is None:
-            drawn = _checked_samples(self._draw())
-            missing = [n for n in (*(self.info.get("names") or ()), *self.grids)
-                       if n not in drawn]  # fmt: skip
-            if missing:
-                raise GPMSAError(
-                    f"the draw callable returned samples of {tuple(drawn)}, but the posterior "
-                    f"has {sorted(set(missing))} (info['names'] or grids) too: draw every "
-                    "parameter"
-                )
-            self._samples = drawn
+            with self._drawing:
+                if self._samples is None:
+                    self._samples = self._drawn()
         return self._samples
+
+    def _drawn(self) -> dict[str, np.ndarray]:
+        """The draw callable's samples, checked."""
+        drawn = _checked_samples(self._draw())
+        missing = [n for n in (*(self.info.get("names") or ()), *self.grids)
+                   if n not in drawn]  # fmt: skip
+        if missing:
+            raise GPMSAError(
+                f"the draw callable returned samples of {tuple(drawn)}, but the posterior "
+                f"has {sorted(set(missing))} (info['names'] or grids) too: draw every "
+                "parameter"
+            )
+        return drawn
 
     @property
     def names(self) -> tuple[str, ...]:

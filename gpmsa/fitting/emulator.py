@@ -18,8 +18,9 @@ from types import MappingProxyType
 
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
-from threadpoolctl import threadpool_limits
 
+from gpmsa import _threads
+from gpmsa._threads import one_thread
 from gpmsa.errors import EmulatorFileError, GPMSAError, user_stacklevel
 from gpmsa.fitting.validation import (
     DISCREPANCY_ARRAY,
@@ -451,10 +452,20 @@ class Emulator:
             out.append((L, alpha, gls))
         return out
 
+    def _cached(self, key: int, build):
+        """``self._factors[key]``, built by ``build()`` on first use: by one thread, while
+        others that need it wait (``_threads.LAZY``: an emulator shared read-only by threads
+        factors once); the cache holds only complete factors."""
+        out = self._factors.get(key)
+        if out is None:
+            with _threads.LAZY:
+                out = self._factors.get(key)
+                if out is None:
+                    out = self._factors[key] = build()
+        return out
+
     def _point_factor(self):
-        if -1 not in self._factors:
-            self._factors[-1] = self._factor(self.params)
-        return self._factors[-1]
+        return self._cached(-1, lambda: self._factor(self.params))
 
     def _predict_factors(self, params, point: bool = False) -> list:
         """The factors ``_predict_std`` takes: the dense ``_factor`` (``_point_factor`` at the
@@ -463,9 +474,7 @@ class Emulator:
             return self._point_factor() if point else self._factor(params)
         if not point:
             return kronecker.emulator_factors(self, params)
-        if -2 not in self._factors:
-            self._factors[-2] = kronecker.emulator_factors(self, self.params)
-        return self._factors[-2]
+        return self._cached(-2, lambda: kronecker.emulator_factors(self, self.params))
 
     def _inputs(self, x, t, *, extrapolate: bool = False) -> np.ndarray:
         """Unit-scale z (N, p + q) of native x and t, under the library's extrapolation rule
@@ -572,7 +581,7 @@ class Emulator:
             )
         idx = evenly_spaced(self.n_draws, n_draws)
         means, vars_ = [], []
-        with threadpool_limits(limits=1, user_api="blas"):  # many small solves: one thread
+        with one_thread():  # many small solves: one thread
             for i in idx:
                 prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
                 m, v = self._predict_std(z, prm, self._predict_factors(prm), resid, var=var)

@@ -20,8 +20,8 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from gpmsa._threads import one_thread
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, ridge, starts, tempering, tuning
@@ -561,7 +561,7 @@ def run_chain(
     w = state.flat_widths(widths)
     total = n_iter + (tune_rounds * tune_levels if tune else 0)
     bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
-    with threadpool_limits(1):
+    with one_thread(None):
         if tune and els:
             bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases
             names = [n for n, _ in els]
@@ -603,7 +603,7 @@ def _chain_task(
     ``adapt_ladder``), then a dict of the level moves' offsets (``ChainState.level_record``:
     "offsets", "shifted") and, tempered, "hot": the hot copies' last states and widths."""
     record: dict = {}
-    with threadpool_limits(1):
+    with one_thread(None):
         if temperatures is not None:
             rng = np.random.default_rng(seed)
             first = problem.init if start is None else start

@@ -49,8 +49,8 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
 from gpmsa.model.data import check_count, check_flag
@@ -392,7 +392,7 @@ def run_tempered_chain(
     prop_mh = (not tune) if proportional_steps is None else proportional_steps
     hot_widths = None if copies is None else [cold.flat_widths(w) for _, w in copies]
     ran: dict = {}
-    with threadpool_limits(1):
+    with one_thread(None):
         accepted, w, rates, adapted = run_ladder(
             states, rng, n_iter, cold.flat_widths(widths), [n for n, _ in cold.els], keep,
             swap_every=swap_every, tune=tune, tune_rounds=tune_rounds, tune_levels=tune_levels,

@@ -8,7 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
-from gpmsa.calibration.observations import EMULATOR_ATTRS, blas_controller, check_x
+from gpmsa._threads import one_thread
+from gpmsa.calibration.observations import EMULATOR_ATTRS, check_x
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import (
@@ -216,7 +217,7 @@ def _paired_predict(emulator, xs, ts, draw_of: np.ndarray, resid: bool, extrapol
     z = emulator._inputs(xs, ts, extrapolate=extrapolate)
     mean = np.empty((z.shape[0], emulator.l_sim))
     var = np.empty_like(mean)
-    with blas_controller().limit(limits=1, user_api="blas"):  # many small solves: one thread
+    with one_thread():  # many small solves: one thread
         for d in np.unique(draw_of):
             rows = draw_of == d
             prm = {k: np.asarray(emulator.draws[k][d]) for k in EMULATOR_PARAMS}

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.linalg import cho_solve
 from scipy.special import ndtr
 
-from gpmsa.calibration.observations import blas_controller
+from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import output_variance, span_text
 from gpmsa.limits import check_memory
@@ -190,7 +190,7 @@ def cross_validate(
     S = len(sets)
     acc = {k: np.zeros((m, l_sim)) for k in ("m", "m2", "v", "pit")}
     acc_w = {k: np.zeros((m, p_u)) for k in ("m", "m2", "v")}
-    with blas_controller().limit(limits=1, user_api="blas"):
+    with one_thread():
         for prm in sets:
             mw = np.empty((m, p_u))
             vw = np.empty((m, p_u))

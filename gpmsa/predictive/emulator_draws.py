@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.calibration.observations import blas_controller
+from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.data import check_count, check_flag, check_level, check_same_rows
@@ -205,7 +205,7 @@ def emulator_prediction(
     mu = np.empty((S, N, p_u))
     var = np.empty((S, N, p_u))
     w = np.empty((S, n_rlz, N, p_u))
-    with blas_controller().limit(limits=1, user_api="blas"):
+    with one_thread():
         for i, prm in enumerate(sets):
             m_i, spread = w_conditional(emulator, prm, gp_factors(emulator, prm), z, joint)
             nugget = 1.0 / prm["lamWs"] if resid else np.zeros(p_u)

@@ -32,7 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
-from gpmsa.calibration.observations import blas_controller, check_x, layout_digest
+from gpmsa._threads import one_thread
+from gpmsa.calibration.observations import check_x, layout_digest
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError, numbers_text
 from gpmsa.limits import check_memory
@@ -752,7 +753,7 @@ def full_prediction(
     mu = np.empty((S, N, n_c))
     cov_pt = np.empty((S, N, n_c, n_c))
     lat = np.empty((S, n_rlz, N, n_c))
-    with blas_controller().limit(limits=1, user_api="blas"):
+    with one_thread():
         point = None if paired else gp_factors(emulator, emulator.params)
         for i, prm in enumerate(sets):
             fac = point if point is not None else gp_factors(emulator, prm)

@@ -76,7 +76,7 @@ import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.special import erf, erfc
 
-from gpmsa.calibration.observations import blas_controller
+from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.correlation import CATEGORICAL_DISTANCE, correlation
@@ -902,7 +902,7 @@ def sensitivity(
         z_bar[varied] = centre
         for k, u in fix_u.items():
             z_bar[k] = u
-    with blas_controller().limit(limits=1, user_api="blas"):
+    with one_thread():
         for i, prm in enumerate(sets):
             beta = prm["betaU"]
             trend = None

@@ -28,8 +28,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
+from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import level_moves, starts, tempering, tuning
 from gpmsa.mcmc.parallel import in_this_process, run_chains
@@ -474,7 +474,7 @@ def run_study_chain(
 
     kinds = _tuning_kinds(state.states, layout)
     ran: dict = {}
-    with threadpool_limits(1):
+    with one_thread(None):
         if temperatures is not None:
             for copy, t in zip(copies, temperatures, strict=True):
                 copy.beta = 1.0 / t

@@ -23,7 +23,7 @@ REPO = Path(__file__).resolve().parents[2]
 PACKAGE = REPO / "gpmsa"
 
 LAYERS = (
-    ("errors", "_version"),
+    ("errors", "_version", "_threads"),
     ("limits",),
     ("model", "io"),
     ("mcmc",),
@@ -34,9 +34,9 @@ LAYERS = (
     ("__main__",),
 )
 """The parts of gpmsa from the bottom up. A part may import itself and the parts of LOWER layers
-only (never a part of its own layer, never one above): errors, _version <- model, io <- mcmc <-
-backends <- fitting, calibration <- predictive, studies <- cli, plots <- __main__ (``python -m
-gpmsa``, the cli's command) (studies: several models
+only (never a part of its own layer, never one above): errors, _version, _threads <- model, io <-
+mcmc <- backends <- fitting, calibration <- predictive, studies <- cli, plots <- __main__
+(``python -m gpmsa``, the cli's command) (studies: several models
 at once, built on fitting's Emulator and calibration's problem; cli describes study files); the
 file container (io) knows
 nothing of the Emulator, whose record lives in fitting and imports io. ``limits`` (resource
