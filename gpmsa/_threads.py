@@ -78,31 +78,50 @@ class _OneThread:
         self._shared, self._own = shared, own
 
     def __enter__(self) -> None:
-        with _lock:
-            for lc in self._shared:
-                held = _held.get(lc.filepath)
-                if held is None:
-                    n = lc.get_num_threads()
-                    if n != 1:
-                        _set(lc, 1)
-                    _held[lc.filepath] = held = [0, lc, n]
-                held[0] += 1
-        self._saved = [(lc, lc.get_num_threads()) for lc in self._own]
-        for lc, _ in self._saved:
-            lc.set_num_threads(1)
+        self._saved = []
+        entered = []  # the shared libraries counted so far: left again if a later step fails
+        try:
+            with _lock:
+                for lc in self._shared:
+                    held = _held.get(lc.filepath)
+                    if held is None:
+                        n = lc.get_num_threads()
+                        if n != 1:
+                            _set(lc, 1)
+                        _held[lc.filepath] = held = [0, lc, n]
+                    held[0] += 1
+                    entered.append(lc)
+            for lc in self._own:
+                n = lc.get_num_threads()
+                self._saved.append((lc, n))
+                lc.set_num_threads(1)
+        except BaseException:
+            self._leave(entered)
+            raise
 
     def __exit__(self, *exc) -> None:
-        for lc, n in self._saved:
-            if n is not None:
-                lc.set_num_threads(n)
-        with _lock:
-            for lc in self._shared:
-                held = _held[lc.filepath]
-                held[0] -= 1
-                if held[0] == 0:
-                    del _held[lc.filepath]
-                    if held[2] is not None and held[2] != 1:
-                        _set(held[1], held[2])
+        self._leave(self._shared)
+
+    def _leave(self, shared: list) -> None:
+        """Restore the per-thread libraries' counts and leave the ``shared`` ones (each left
+        even where a library's setter raises: a count left behind would hold one thread for
+        good)."""
+        try:
+            for lc, n in reversed(self._saved):
+                if n is not None:
+                    lc.set_num_threads(n)
+        finally:
+            with _lock:
+                restore = []
+                for lc in shared:
+                    held = _held[lc.filepath]
+                    held[0] -= 1
+                    if held[0] == 0:
+                        del _held[lc.filepath]
+                        if held[2] is not None and held[2] != 1:
+                            restore.append(held)
+                for _, lc, n in restore:
+                    _set(lc, n)
 
 
 def _set(lc, n: int) -> None:

@@ -426,7 +426,8 @@ class Posterior:
         self._samples = None if samples is None else _checked_samples(samples)
         self._draw = draw
         if draw is not None:  # one thread draws; others reading ``samples`` meanwhile wait
-            self._drawing = threading.Lock()
+            self._drawing = threading.RLock()  # re-entered by a draw that reads ``samples``
+            self._in_draw = False
         self.info = _checked_info(info)
         known = tuple(self._samples) if self._samples is not None else self.info.get("names")
         self.grids = _checked_grids(grids, known)
@@ -439,6 +440,7 @@ class Posterior:
         if state.get("_draw") is not None:
             state["_samples"], state["_draw"] = self.samples, None
         state.pop("_drawing", None)
+        state.pop("_in_draw", None)
         return state
 
     @property
@@ -448,7 +450,17 @@ class Posterior:
         if self._samples is None:
             with self._drawing:
                 if self._samples is None:
-                    self._samples = self._drawn()
+                    if self._in_draw:  # this thread's draw callable reads them
+                        raise GPMSAError(
+                            "the draw callable of this Posterior reads its samples (samples, "
+                            "mean, sd, ... of the posterior it draws): it must return the "
+                            "samples without reading the posterior"
+                        )
+                    self._in_draw = True
+                    try:
+                        self._samples = self._drawn()
+                    finally:
+                        self._in_draw = False
         return self._samples
 
     def _drawn(self) -> dict[str, np.ndarray]:
