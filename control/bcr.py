@@ -382,7 +382,34 @@ def _samples(name: str, values) -> np.ndarray:
         )
     if a.dtype.kind not in "iuf":
         raise ControlError(f"{name} must hold real numbers, got dtype {a.dtype}")
+    if name == "t" and a.dtype.kind == "f" and a.dtype.itemsize < 8:
+        _check_stamp_resolution(a)
     return a.astype(float)
+
+
+STAMP_RESOLUTION_S = 1e-3
+"""The coarsest resolution of time stamps given in a float type narrower than float64 (s): at a
+float32 stamp of 16,384 s its spacing is 2 ms, and rounded stamps step unevenly by a quarter of
+a 120 Hz period; since the epoch (1.7e9 s) by 128 s, every sample then repeats a stamp."""
+
+
+def _check_stamp_resolution(t: np.ndarray) -> None:
+    """ControlError where float32 (or float16) stamps ``t`` are coarser than
+    `STAMP_RESOLUTION_S` at their largest magnitude: every block would read as a timing fault
+    (repeated or uneven stamps), not as the type it is."""
+    finite = np.abs(t[np.isfinite(t)])
+    if finite.size == 0:
+        return
+    top = finite.max()
+    spacing = float(np.spacing(top))
+    if spacing > STAMP_RESOLUTION_S:
+        raise ControlError(
+            f"t is {t.dtype} and reaches {float(top):.6g} s, where its stamps are "
+            f"{spacing:.3g} s apart (coarser than {STAMP_RESOLUTION_S:g} s), so that blocks "
+            "would read as timing faults: give the stamps as float64 seconds, converted where "
+            "they are made (a header stamp's sec + 1e-9 * nanosec in float64; a float32 array "
+            "has already rounded them)"
+        )
 
 
 def emulator_domain(emulator) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -588,8 +615,9 @@ class BCR:
             t: (n,) sample times, s, increasing by 1 / rate_hz (a larger step means dropped
                 samples, a smaller or negative one repeated or misordered samples). Seconds,
                 not a ROS stamp's nanoseconds (every step would read as a gap), and float64
-                for stamps since the epoch (float32 holds them only to ~2 min: every step
-                would read as repeated).
+                for stamps since the epoch (float32 holds them only to ~2 min; float32 or
+                float16 stamps coarser than `STAMP_RESOLUTION_S` where they reach are a
+                ControlError).
             position: (n,) front-axle positions along the path driven, m: the distance
                 travelled (as the replay's odometry path length), not a map coordinate (one
                 that decreases while the speed is positive is broken odometry, a
