@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 
 from control.errors import ControlError
 from control.validation import is_real
+from gpmsa.mcmc.diagnostics import bins_apart
 
 
 def _ink() -> str:
@@ -296,5 +297,4 @@ def _checked_gd_range(gd_range: tuple[float, float]) -> tuple[float, float]:
 def _holds_bins(lo: float, hi: float) -> bool:
     """Whether [lo, hi] holds `POSTERIOR_BINS` equal bins of distinct float64 edges (numpy
     refuses a histogram range that does not: "Too many bins for data range")."""
-    edges = np.linspace(lo, hi, POSTERIOR_BINS + 1)
-    return bool(np.all(edges[:-1] < edges[1:]))
+    return bins_apart(lo, hi, POSTERIOR_BINS)

@@ -66,6 +66,14 @@ def to_inference_data(
     return idata
 
 
+def bins_apart(lo: float, hi: float, bins: int, dtype=np.float64) -> bool:
+    """Whether [lo, hi] holds ``bins`` equal bins whose edges, spaced in ``dtype`` as numpy
+    spaces a histogram's (its draws' own float type), are all distinct (numpy refuses a range
+    that does not: "Too many bins for data range")."""
+    edges = np.linspace(lo, hi, bins + 1, dtype=dtype)
+    return bool(np.all(edges[:-1] < edges[1:]))
+
+
 def histogram_bins(draws: np.ndarray, bins: int) -> int | np.ndarray:
     """``bins`` (an int) for a histogram of the finite ``draws``, or, where their spread is too
     narrow for that many bins with distinct float64 edges (draws a few ulps apart, as rounding
@@ -73,7 +81,7 @@ def histogram_bins(draws: np.ndarray, bins: int) -> int | np.ndarray:
     edges of those equal bins between the draws' extremes: fewer bins, still holding every draw.
     Equal draws keep ``bins`` (numpy widens them to +-0.5). numpy spaces the edges in the draws'
     own float type: float32 draws a few of their ulps apart are refused by it however far apart
-    float64 tells them, and get float64 edges."""
+    float64 tells them, and get float64 edges (`bins_apart`)."""
     raw = np.asarray(draws)
     arr = raw.astype(float).ravel()
     if arr.size == 0:
@@ -81,12 +89,10 @@ def histogram_bins(draws: np.ndarray, bins: int) -> int | np.ndarray:
     lo, hi = float(np.min(arr)), float(np.max(arr))
     if not lo < hi:  # one value (or NaN): numpy's own handling
         return bins
-    edges = np.linspace(lo, hi, bins + 1)  # numpy's equal-width edges
-    own = edges
-    if np.issubdtype(raw.dtype, np.floating) and raw.dtype != np.float64:  # (float32: its own)
-        own = np.linspace(raw.min(), raw.max(), bins + 1, dtype=raw.dtype)
-    apart = bool(np.all(edges[:-1] < edges[1:]) and np.all(own[:-1] < own[1:]))
-    return bins if apart else np.unique(edges)
+    apart = bins_apart(lo, hi, bins)
+    if apart and np.issubdtype(raw.dtype, np.floating) and raw.dtype != np.float64:
+        apart = bins_apart(raw.min(), raw.max(), bins, raw.dtype)  # (float32: its own spacing)
+    return bins if apart else np.unique(np.linspace(lo, hi, bins + 1))
 
 
 MIN_DRAWS_ESS = 4
