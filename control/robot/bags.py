@@ -705,7 +705,7 @@ def _imu(path: Path, topic: str, log_ns, raws: list, decode, cdr: bool = True) -
     try:
         if not cdr:
             raise msgs.CdrLayoutError("not CDR")
-        stamp, accel, unknown = msgs.decode_imu_fields(raws)
+        stamp, accel, unknown = msgs.decode_imu(raws)
     except msgs.CdrLayoutError:
         fields = _decoded(path, topic, raws, decode)
         stamp = np.array([_stamp(m, ros1=not cdr) for m in fields], dtype=np.int64)

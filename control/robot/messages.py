@@ -120,17 +120,11 @@ def _header(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return sec * 1_000_000_000 + nsec, 12 + _u32(rows, 12)
 
 
-def decode_imu(raws: Sequence[bytes]) -> tuple[np.ndarray, np.ndarray]:
-    """(header stamps (n,) int ns, linear accelerations (n, 3) m/s^2) of CDR Imu messages.
-    Raises `CdrLayoutError` where the data are not little-endian CDR Imu messages."""
-    stamp, accel, _ = decode_imu_fields(raws)
-    return stamp, accel
-
-
-def decode_imu_fields(raws: Sequence[bytes]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """`decode_imu`'s stamps and accelerations, and (n,) bool: whether each message marks its
-    linear acceleration unknown (``linear_acceleration_covariance[0] == -1``, the Imu
-    message's convention for "no estimate of this quantity", REP 145)."""
+def decode_imu(raws: Sequence[bytes]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(header stamps (n,) int ns, linear accelerations (n, 3) m/s^2, and (n,) bool: whether
+    each message marks its linear acceleration unknown (``linear_acceleration_covariance[0] ==
+    -1``, the Imu message's convention for "no estimate of this quantity", REP 145)) of CDR Imu
+    messages. Raises `CdrLayoutError` where the data are not little-endian CDR Imu messages."""
     stamp = np.empty(len(raws), dtype=np.int64)
     accel = np.empty((len(raws), 3))
     unknown = np.empty(len(raws), dtype=bool)

@@ -165,7 +165,7 @@ stamps = st.integers(0, msgs.MAX_STAMP_NS)
 @given(frames, stamps, st.lists(finite, min_size=3, max_size=3))
 def test_imu_codec_round_trips(frame, stamp, accel):
     raw = msgs.encode_imu(stamp, accel, frame)
-    got_stamp, got_accel = msgs.decode_imu([raw, msgs.encode_imu(1, [0, 0, 1], "imu")])
+    got_stamp, got_accel, _ = msgs.decode_imu([raw, msgs.encode_imu(1, [0, 0, 1], "imu")])
     assert got_stamp[0] == stamp and got_accel[0].tolist() == accel
     assert got_accel[1].tolist() == [0.0, 0.0, 1.0]
 
