@@ -11,7 +11,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from gpmsa import limits
-from gpmsa._threads import blas_controller as blas_controller  # its home: gpmsa._threads
 from gpmsa.calibration.model import FixedGP, LamOsPrior
 from gpmsa.errors import (
     ExtrapolationWarning,
