@@ -918,13 +918,13 @@ def _check_storage(storage: str) -> None:
         raise ControlError(f"storage must be one of {STORAGES}, got {storage!r}")
 
 
-MAX_STAMP_NS = 2**31 * 10**9
+STAMP_LIMIT_NS = msgs.MAX_STAMP_NS + 1
 """A ROS 2 header stamp's seconds are an int32: stamps lie in [0, 2**31) s."""
 MAX_LOG_NS = 2**63
 """A bag's receive times are int64 ns."""
 
 
-def stamps_ns(name: str, t, limit: int = MAX_STAMP_NS, offset_ns: int = 0) -> np.ndarray:
+def stamps_ns(name: str, t, limit: int = STAMP_LIMIT_NS, offset_ns: int = 0) -> np.ndarray:
     """Times ``t`` (s, 1-D) as int64 ns plus ``offset_ns``; `ControlError` naming ``name``
     unless every one is a finite number that lands in [0, ``limit``) ns."""
     arr = np.atleast_1d(float_array(t, name))

@@ -30,7 +30,6 @@ import numpy as np
 from control.errors import ControlError
 from control.robot import messages as msgs
 from control.robot.bags import (
-    MAX_STAMP_NS,
     SIMULATION_RECORD,
     SIMULATION_SHA256,
     merge_in_time,
@@ -119,7 +118,7 @@ def record_run(
     check_mcap_target(path, "path")
     writer_mod = require("mcap.writer", "recording a run as MCAP")
     if (isinstance(start_ns, bool) or not isinstance(start_ns, int | np.integer)
-            or not 0 <= start_ns < MAX_STAMP_NS):  # fmt: skip
+            or not 0 <= start_ns <= msgs.MAX_STAMP_NS):  # fmt: skip
         raise ControlError(
             f"start_ns must be an integer in [0, 2**31 s) (a ROS 2 stamp), got {start_ns!r}"
         )
