@@ -243,7 +243,8 @@ def run_closed_loop(
     """Drive `model` over `track` with the BCR estimating GD and the Simplex setting the speed.
 
     Args:
-        track: a roadgen Track (prescribed GD per segment).
+        track: a roadgen Track (prescribed GD per segment), longer than the vehicle's
+            wheelbase (and its wheel radius): a shorter one is a ControlError.
         emulator: a gpmsa Emulator mapping (v, GD) to the BCR's observation (see
             `control.shipped_emulator`).
         model: vehicle model (default `vehicle.Jackal()`); must match the emulator's metadata.
@@ -279,6 +280,7 @@ def run_closed_loop(
     check_instance(track, "track", roadgen.Track, hint=make)
     defaulted = model is None
     model = vehicle.Jackal() if defaulted else vehicle.models.check_model(model)
+    _check_track_fits(track, model)
     simplex = Simplex() if simplex is None else simplex
     check_instance(simplex, "simplex", Simplex)
     if bcr is not None:
@@ -425,6 +427,26 @@ def run_closed_loop(
     if record is not None:
         record_run(result, record)
     return result
+
+
+def _check_track_fits(track, model) -> None:
+    """ControlError before the drive for a track that the vehicle cannot drive: one shorter than
+    its wheel radius (the tyres follow the road enveloped by the wheel) or not longer than its
+    wheelbase (both axles stand on it)."""
+    length, radius, base = map(float, (track.length_m, model.wheel_radius_m, model.wheelbase_m))
+    if length < radius:
+        why = "shorter than the vehicle's wheel radius"
+    elif not length > base:
+        why = "not longer than the vehicle's wheelbase"
+    else:
+        return
+    length_text, need_text, base_text = numbers_text(
+        length, radius if length < radius else base, base
+    )
+    raise ControlError(
+        f"track is {length_text} m long, {why} {need_text} m: the vehicle cannot drive it; "
+        f"lengthen the track (to more than the wheelbase, {base_text} m)"
+    )
 
 
 def _check_track_domain(emulator, track) -> None:

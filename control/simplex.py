@@ -130,7 +130,12 @@ class Simplex:
             if not (np.isfinite(value) and value > 0):
                 raise ControlError(f"{name} must be finite and > 0, got {value}")
         if not self.gd_min < self.gd_max:
-            raise ControlError(f"gd_min must be < gd_max, got {self.gd_min} and {self.gd_max}")
+            raise ControlError(
+                f"gd_min must be < gd_max, got {self.gd_min} and {self.gd_max}: the band holds "
+                "the law's speeds between v_max and v_safe; for one threshold (v_max up to "
+                "gd_max, v_safe above it) use law='switch', which reads gd_max alone, with any "
+                "gd_min below it"
+            )
         if not self.v_safe <= self.v_max:
             raise ControlError(f"v_safe must be <= v_max, got {self.v_safe} and {self.v_max}")
         if self.kp is not None and not (np.isfinite(self.kp) and self.kp > 0):
