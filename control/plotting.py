@@ -188,7 +188,8 @@ def plot_posterior_grid(
     title: str = "",
     gd_range: tuple[float, float] | None = None,
 ) -> Figure:
-    """Histograms of posterior GD draws per (v, GD) cell (paper Appendix A).
+    """Histograms of posterior GD draws per (v, GD) cell (paper Appendix A): a row per true GD,
+    a column per speed; a (v, GD) pair without a cell is a blank panel reading "no data".
 
     Args:
         cells: (v, true GD, draws) triples; the true GD is drawn as a vertical line.
@@ -211,19 +212,29 @@ def plot_posterior_grid(
     gds = sorted({c[1] for c in cells})
     fig = Figure(figsize=(2.6 * len(speeds), 1.5 * len(gds)), constrained_layout=True)
     axes = fig.subplots(len(gds), len(speeds), sharex=True, squeeze=False)
+    drawn = np.zeros(axes.shape, dtype=bool)
     for v, gd, draws in cells:
-        ax = axes[gds.index(gd), speeds.index(v)]
+        row, col = gds.index(gd), speeds.index(v)
+        ax = axes[row, col]
+        drawn[row, col] = True
         # float64, as the range was checked (numpy spaces the bins in the draws' own type)
         ax.hist(np.asarray(draws, dtype=np.float64), bins=POSTERIOR_BINS, range=hist_range,
                 density=True, alpha=0.7)  # fmt: skip
         ax.axvline(gd, color=_ink(), lw=1)
         ax.set_yticks([])
-        if gd == gds[0]:
-            ax.set_title(f"v = {v:g} m/s", fontsize=9)
-        if v == speeds[0]:
-            ax.set_ylabel(f"GD {gd:g}", fontsize=9)
-    for ax in axes[-1]:
-        ax.set_xlabel("GD (1e-6 m$^3$)")
+    for row, gd in enumerate(gds):
+        axes[row, 0].set_ylabel(f"GD {gd:g}", fontsize=9)
+    for col, v in enumerate(speeds):
+        axes[0, col].set_title(f"v = {v:g} m/s", fontsize=9)  # (shown on an empty panel too)
+        lowest = axes[np.flatnonzero(drawn[:, col])[-1], col]  # each column has a cell
+        lowest.xaxis.set_tick_params(which="both", labelbottom=True)  # (sharex hid them)
+        lowest.xaxis.offsetText.set_visible(True)
+        lowest.set_xlabel("GD (1e-6 m$^3$)")
+    for row, col in zip(*np.nonzero(~drawn), strict=True):  # a (v, GD) with no cell
+        ax = axes[row, col]
+        ax.set_axis_off()
+        ax.text(0.5, 0.5, f"no data\nv = {speeds[col]:g} m/s, GD {gds[row]:g}", ha="center",
+                va="center", fontsize=8, color="0.5", transform=ax.transAxes)  # fmt: skip
     if title:
         fig.suptitle(title)
     return fig

@@ -32,6 +32,10 @@ from control.sensor_checks import MAX_ACCEL_MPS2
 from control.validation import check_instance, float_array, is_integer, is_real
 from gpmsa.errors import numbers_text
 
+__gpmsa_wrapper__ = True
+"""gpmsa's warnings in these fits (a ConvergenceWarning, an OutlierRunWarning) point at the
+line that calls `fit_band_emulator` / `fit_window_emulator` (``gpmsa.errors.WRAPPER_MARK``)."""
+
 
 @dataclass(frozen=True, eq=False)
 class BlockStatistics:
@@ -400,6 +404,7 @@ def fit_band_emulator(
     them to one), fewer than 4 runs, runs all at one speed or one GD, GDs all below `GD_MIN_HI`
     (given in m^3), a ``noise_std`` that is not a finite number >= 0, a ``metadata`` record
     that contradicts the fit's; and where `block_statistics` or `block_scatter` refuse the runs.
+    The fit's warnings (a ``gpmsa.ConvergenceWarning``, say) point at the line that calls this.
     """
     import gpmsa
 

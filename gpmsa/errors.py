@@ -47,13 +47,24 @@ class ExtrapolationWarning(UserWarning):
     and ``full_prediction``, the x and t of ``Emulator.predict`` and ``emulator_prediction``)."""
 
 
+WRAPPER_MARK = "__gpmsa_wrapper__"
+"""A module whose globals set this name to True (a library's thin layer over `gpmsa.fit`, say)
+is passed over by `user_stacklevel` as gpmsa's own modules are: gpmsa's warnings point past it,
+at the line of its caller."""
+
+
 def user_stacklevel() -> int:
     """``warnings.warn``'s stacklevel, in the function that calls this, of the first frame
-    outside gpmsa (the user's call, however deep the library's own calls run)."""
+    outside gpmsa (the user's call, however deep the library's own calls run) and outside any
+    module marked with `WRAPPER_MARK`."""
     frame, level = sys._getframe(1), 1
-    while frame is not None and frame.f_globals.get("__name__", "").split(".")[0] == "gpmsa":
+    while frame is not None and _library_frame(frame.f_globals):
         frame, level = frame.f_back, level + 1
     return level
+
+
+def _library_frame(names: dict) -> bool:
+    return names.get("__name__", "").split(".")[0] == "gpmsa" or names.get(WRAPPER_MARK) is True
 
 
 def numbers_text(*values: float, digits: int = 6) -> tuple[str, ...]:

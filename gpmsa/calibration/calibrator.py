@@ -181,6 +181,59 @@ def _refuse_continuation(options: dict) -> None:
         )
 
 
+_NUTS_UNUSED = ("tune_rounds", "tune_levels", "step_widths")
+"""``gpmsa.calibrate`` options of GPM/SA's step-size tuning, which pyro's NUTS does not take (it
+adapts its step size in its warm-up)."""
+
+
+def _refuse_unused_sampler_options(options: dict, backend: str) -> None:
+    """GPMSAError now, not at the first update, for ``mcmc_options`` (``options``, checked by
+    `_check_mcmc_options`) that ``gpmsa.calibrate`` on ``backend`` refuses as without effect
+    there: GPM/SA's tuning or step widths with pyro (NUTS), ``fast=True`` where the fast numpy
+    sampler cannot run (another backend, a discrepancy), and a backend sampler's own options
+    (``step_widths``, ``init``, ``temperatures``, ...) where it runs. Each names the options,
+    the backend and the remedy. Tuning counts are checked as ``calibrate`` checks them."""
+    from gpmsa.calibration.calibrate import _tuning_options, sample_calibration
+
+    if backend == "pyro":
+        given = [k for k in _NUTS_UNUSED if _given(options, k)]
+        if given:
+            them = "it" if len(given) == 1 else "them"
+            raise GPMSAError(
+                f"mcmc_options {given}: backend 'pyro' (NUTS) has no GPM/SA step-size tuning "
+                "or step widths (it adapts its step size in its warm-up, "
+                f"mcmc_options={{'n_warmup': ...}}): leave {them} out, or use backend='numpy' "
+                "or 'torch'"
+            )
+    _tuning_options(backend, options.get("tune_rounds"), options.get("tune_levels"))
+    fast = options.get("fast")
+    if fast is not None:
+        fast = check_flag(fast, "mcmc_options['fast']")
+    can_fast = backend == "numpy" and options.get("discrepancy") is None
+    if fast and not can_fast:
+        got = f"backend={backend!r}" if backend != "numpy" else "mcmc_options['discrepancy']"
+        raise GPMSAError(
+            f"mcmc_options['fast']=True needs backend='numpy' and no discrepancy (the fast numpy "
+            f"sampler), got {got}: leave mcmc_options['fast'] out"
+        )
+    named = {k for k, v in inspect.signature(sample_calibration).parameters.items()
+             if v.kind is not inspect.Parameter.VAR_KEYWORD}  # fmt: skip
+    sampler_only = sorted(k for k in options if k not in named)  # the backend sampler's
+    if sampler_only and can_fast and fast is not False:
+        raise GPMSAError(
+            f"mcmc_options {sampler_only} go to the numpy backend's sampler, which the fast "
+            "numpy sampler replaces (gpmsa.calibrate's default without a discrepancy): add "
+            "mcmc_options['fast'] = False (or choose backend='torch') to use them, or leave "
+            "them out"
+        )
+
+
+def _given(options: dict, key: str) -> bool:
+    """Whether ``options[key]`` is given as calibrate and pyro's ``sample`` read it: a tuning
+    count not None, step widths not empty."""
+    return bool(options.get(key)) if key == "step_widths" else options.get(key) is not None
+
+
 def _mcmc_backend(backend, options) -> str:
     """The Calibrator's backend: ``backend``, or where it is None (the default)
     ``options["backend"]`` (``mcmc_options``), else numpy; GPMSAError where both are given and
@@ -228,7 +281,10 @@ class Calibrator:
             the backend's sampler options among them, as
             ``calibrate`` takes them (``{"dtype": "float32"}`` for torch, ``{"n_warmup": 200}``
             for pyro). A continuation's ``"init"`` (a Posterior) and ``"append": True`` are a
-            GPMSAError: each update runs fresh chains. With ``method="grid"`` given, any but
+            GPMSAError: each update runs fresh chains. So are options that ``calibrate`` on
+            this backend refuses as without effect (`_refuse_unused_sampler_options`: pyro's
+            GPM/SA tuning and step widths, ``"fast": True`` where the fast sampler cannot run,
+            a backend sampler's options where it runs). With ``method="grid"`` given, any but
             ``"backend"`` is a GPMSAError (the grid would ignore them; "auto" keeps them for an
             emulator that needs MCMC).
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
@@ -475,6 +531,7 @@ class Calibrator:
         if self.emulator_params == "draws" and opts.get("fast") is False:
             raise GPMSAError("emulator_params='draws' needs the fast numpy sampler: drop "
                              "mcmc_options['fast'] = False")  # fmt: skip
+        _refuse_unused_sampler_options(opts, backend)
 
     # --- the exact likelihood on a grid ---------------------------------------------------------
     def _marginals(

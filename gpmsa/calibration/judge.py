@@ -14,7 +14,6 @@ from typing import NamedTuple
 import numpy as np
 
 from gpmsa.calibration.posterior import Posterior
-from gpmsa.errors import user_stacklevel
 from gpmsa.mcmc.bounds import at_bound, warn_at_bound
 from gpmsa.mcmc.diagnostics import convergence, summarize, warn_unconverged
 
@@ -51,8 +50,7 @@ def judge_convergence(run: Run, where: str, more: str = "") -> None:
     n_kept = next(iter(chains.values())).shape[1]
     info["convergence"] = convergence(info["diagnostics"], shapes, info["n_chains"], n_kept,
                                       held=set(run.held), levels=set(run.levels))  # fmt: skip
-    warn_unconverged(info["convergence"], where, length="n_samples", more=more,
-                     stacklevel=user_stacklevel() + 1)  # fmt: skip
+    warn_unconverged(info["convergence"], where, length="n_samples", more=more)
 
 
 def judge_bounds(run: Run, t_names, t_min, t_max, where: str) -> None:

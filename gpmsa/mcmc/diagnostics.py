@@ -277,7 +277,7 @@ def convergence(
     }
 
 
-def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str = "n_iter",
+def warn_unconverged(record: dict, what: str, length: str = "n_iter",
                      more: str = "", names: dict[str, str] | None = None) -> None:  # fmt: skip
     """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record
     and the caller's argument ``length`` that sets the chains' length (``more``: a further
@@ -285,8 +285,9 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str =
     adds that the chains lie apart, which longer chains may not mend (several modes). A record
     of one chain is worded for it: its split R-hat compares the chain's halves and cannot show
     whether independent chains agree, so it advises a longer chain or ``n_chains >= 2``.
-    ``names``: element -> what it is for a person ("theta[0]" -> "k"), shown beside it."""
-    from gpmsa.errors import ConvergenceWarning
+    ``names``: element -> what it is for a person ("theta[0]" -> "k"), shown beside it. The
+    warning points at the user's call (`user_stacklevel`)."""
+    from gpmsa.errors import ConvergenceWarning, user_stacklevel
 
     flagged = record.get("flagged") or {}
     if not flagged:
@@ -342,5 +343,5 @@ def warn_unconverged(record: dict, what: str, stacklevel: int = 3, length: str =
         f"{what}: {len(flagged)} parameter element(s) not converged over {chains} x "
         f"{record['n_draws']} draws (need R-hat <= {record['rhat_max']} and bulk ESS >= "
         f"{record['ess_min']:.0f}): {items}. {advice}{more}.{apart}",
-        ConvergenceWarning, stacklevel=stacklevel,
+        ConvergenceWarning, stacklevel=user_stacklevel(),
     )  # fmt: skip
