@@ -67,6 +67,7 @@ methods, a dead odometry reads as standing.
 from __future__ import annotations
 
 import time as _time
+import warnings
 from collections import deque
 from dataclasses import dataclass, field, replace
 from itertools import islice
@@ -76,7 +77,7 @@ import numpy as np
 from scipy.special import ndtr, ndtri
 
 from control.changepoint import ChangePointFilter, ChangePointSettings, _mixture_posterior
-from control.errors import ControlError
+from control.errors import ControlError, ControlWarning, user_stacklevel
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, feature_of_variance, features_of_blocks
 from control.sensor_checks import (
@@ -263,6 +264,17 @@ class BCRSettings:
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise ControlError(f"{name} must be finite and > 0, got {value}")
+        held_s = every / self.feature.rate_hz
+        if held_s > self.max_age_s:
+            held_text, age_text = numbers_text(held_s, self.max_age_s)
+            warnings.warn(
+                f"update_every ({every} samples, {held_text} s at {self.feature.rate_hz:g} Hz) "
+                f"is longer than max_age_s ({age_text} s): between two updates a controller "
+                "holds an estimate older than max_age_s that never turns stale (the closed "
+                "loop's Simplex keeps its speed); lower update_every to at most "
+                f"{int(self.max_age_s * self.feature.rate_hz)} samples or raise max_age_s",
+                ControlWarning, stacklevel=user_stacklevel(),
+            )  # fmt: skip
         if not 0 < self.interval_level < 1:
             raise ControlError(f"interval_level must lie in (0, 1), got {self.interval_level}")
         if not is_choice(self.interval_kind, INTERVAL_KINDS):

@@ -12,6 +12,7 @@ from control import (
     STATUSES,
     BCRSettings,
     ControlError,
+    ControlWarning,
     EmulatorMismatchError,
     Estimate,
     FeatureSpec,
@@ -629,7 +630,8 @@ def test_calibrator_errors_become_a_status():
 
 
 def test_an_old_window_estimate_turns_stale(fake_calibrator):
-    bcr = BCR(fake_calibrator, method="window", update_every=1000, max_age_s=1.0, **WINDOW)
+    with pytest.warns(ControlWarning, match="longer than max_age_s"):
+        bcr = BCR(fake_calibrator, method="window", update_every=1000, max_age_s=1.0, **WINDOW)
     t, p, a, v = stream(const(400), 1.5, 13, seed=1)
     assert bcr.update(t[:1000], p[:1000], a[:1000], v[:1000]).ok
     late = bcr.update(t[1000:1500], p[1000:1500], a[1000:1500], v[1000:1500])
