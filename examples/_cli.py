@@ -111,8 +111,10 @@ class _UntilTheReaderLeaves:
 def run(main: Callable[[], object]) -> None:
     """Run a script's ``main`` as a command: Ctrl-C ends it with one line on stderr and exit
     status 130 instead of a traceback (the files are written in one step each, so none is left
-    in part); a reader that stops reading its output does not stop it."""
-    sys.stdout = _UntilTheReaderLeaves(sys.stdout)
+    in part); a reader that stops reading its output does not stop it (nor does a closed
+    stdout: Python's sys.stdout is then None, and print writes nothing)."""
+    if sys.stdout is not None:
+        sys.stdout = _UntilTheReaderLeaves(sys.stdout)
     try:
         main()
     except KeyboardInterrupt:

@@ -20,6 +20,7 @@ Solver: generalised-alpha (spectral radius 0.9), modified Newton, fixed step
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import exudyn as exu
@@ -297,8 +298,9 @@ class ExudynVehicle:
         """Integrate from ``t_start`` over ``n_samples`` sample periods, continuing the state.
 
         Returns the states at t_start + j / rate_hz, j = 1..n_samples. Raises
-        SimulationDivergedError if the solver fails or the states leave their valid range.
-        """
+        SimulationDivergedError if the solver fails or the states leave their valid range, and
+        KeyboardInterrupt where Ctrl-C stopped the solver (inside a user function: Exudyn
+        reports it as a RuntimeError)."""
         self._input.update(self.drive, self.road, self.model.wheelbase_m)
         ti = self.settings.timeIntegration
         ti.startTime = t_start
@@ -309,6 +311,8 @@ class ExudynVehicle:
         try:
             ok = self.mbs.SolveDynamic(self.settings, updateInitialValues=True)
         except (RuntimeError, ValueError) as exc:
+            if _INTERRUPTED.search(str(exc)):  # Ctrl-C inside a user function: no divergence
+                raise KeyboardInterrupt(f"the solver, near t={t_start:.4g} s") from exc
             raise SimulationDivergedError(
                 f"Exudyn solver failed near t={t_start:.4g} s: {exc}"
             ) from exc
@@ -332,6 +336,12 @@ class ExudynVehicle:
         u = self.road.heights(np.stack([s, s - self.model.wheelbase_m]))
         _check_range(states, self.model, u[0], u[1])
         return states
+
+
+_INTERRUPTED = re.compile(r"^KeyboardInterrupt\b", re.MULTILINE)
+"""How Exudyn reports a KeyboardInterrupt raised in a Python user function (Ctrl-C lands there,
+the solver calling the road forces all the time): "Error in Python USER FUNCTION '...':" and
+the exception's type and message on the next line, in the RuntimeError it raises instead."""
 
 
 def _tyre_function(table: _TyreInput, axle: int, k: float, c: float, f_static: float):

@@ -43,8 +43,8 @@ class Samples:
 
 class Simulation:
     """A vehicle driving along a track, integrated on demand (the Exudyn model is built once).
-    After a `SimulationDivergedError` it refuses every further ``advance`` (its solver state is
-    no longer valid): make a new one.
+    After a `SimulationDivergedError`, or a KeyboardInterrupt (Ctrl-C) in ``advance``, it
+    refuses every further ``advance`` (its solver state is no longer valid): make a new one.
 
     The vehicle starts at rest on the road with its front axle at ``start_m`` (the rear axle,
     a wheelbase behind, reads a flat extension at the road's first height while it is before 0).
@@ -147,6 +147,9 @@ class Simulation:
             states = self._vehicle.integrate(self.time, n_fit)
         except SimulationDivergedError as exc:
             self._diverged = str(exc)
+            raise
+        except KeyboardInterrupt:  # Ctrl-C: the solver stopped part way, as in a divergence
+            self._diverged = "interrupted (KeyboardInterrupt)"
             raise
         k = np.arange(1, n_fit + 1) * sub
         position, spd = s[k], v[k]

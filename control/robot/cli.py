@@ -10,8 +10,11 @@ that is not finite, such as the rate of a topic with one message, is ``null``), 
 summary. DIR may not lie inside the recording (its bag folder, for a file given inside one),
 as ``replay_bag`` refuses its outputs there: replaying ``.`` from inside a bag folder needs an
 ``--out`` outside it. DIR is made only once the replay has run, and removed again (with the
-parents this made) if writing into it fails; a folder that was there before is never removed,
-none of the three outputs may be there already, and a failed write removes those it wrote.
+parents this made) if writing into it fails, where nothing else was written into it meanwhile;
+a folder that was there before is never removed, none of the three outputs may be there
+already (nor appear before each is written: another run given the same DIR), and a failed
+write removes those it wrote, and only those. A reader that has gone (``| head -1``) ends
+nothing: the outputs are written, exit status 0.
 Exit status 0 on success, also for a recording too short for one estimate (the summary then
 says "no estimate" and why); 2 with a one-line message on a usage error (``--out`` a file or
 inside the recording, a setting out of range), an emulator file that is missing or cannot be
@@ -117,31 +120,53 @@ def _report(bag: Path, source: str, settings: ReplaySettings, result: ReplayResu
 
 def _write(out: Path, result: ReplayResult, report: dict) -> None:
     """Write the estimates (CSV, ROS 2 bag) and the report (strict JSON) into ``out``, made
-    here where it is missing; on a failure the folders made here are removed again, and in a
-    folder that was there before, the outputs written here (`_check_out` saw none of them)."""
-    missing = [p for p in (out, *out.parents) if not p.exists()]  # the last made first
+    here where it is missing. Each output is refused (`ControlError`) where it has appeared
+    since `_check_out` (another run given the same ``--out``); on a failure only what this
+    call wrote is removed: its outputs, then the folders it made, where they are empty (another
+    run may have written into them)."""
+    made, written = [], []
     try:
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise ControlError(f"--out {str(out)!r}: cannot make it ({exc.strerror})") from exc
-        result.to_csv(out / "estimates.csv")
-        result.write_bag(out / "estimates")
+        for folder in reversed((out, *out.parents)):  # the outermost missing one first
+            if folder.exists():
+                continue
+            try:
+                folder.mkdir()
+                made.append(folder)
+            except FileExistsError:  # made meanwhile by another run: not this one's
+                pass
+            except OSError as exc:
+                raise ControlError(f"--out {str(out)!r}: cannot make it ({exc.strerror})") from exc
         text = json.dumps(strict_json(report), indent=2, allow_nan=False)
-        with atomic_write(out / "replay.json", text=True, error=ControlError) as fh:
-            fh.write(text)
+        for name, write in (
+            ("estimates.csv", lambda path: result.to_csv(path)),
+            ("estimates", lambda path: result.write_bag(path)),
+            ("replay.json", lambda path: _write_text(path, text)),
+        ):
+            path = out / name
+            if os.path.lexists(path):
+                raise ControlError(
+                    f"{path} exists already (written since the check of --out: another run "
+                    "given the same --out?); choose another --out"
+                )
+            write(path)
+            written.append(path)
     except BaseException:
-        if missing:
-            shutil.rmtree(missing[-1], ignore_errors=True)
-        else:
-            for name in OUTPUTS:
-                path = out / name
-                if path.is_dir():
-                    shutil.rmtree(path, ignore_errors=True)
-                else:  # a read-only file system refuses to unlink a missing file too (EROFS)
-                    with contextlib.suppress(OSError):
-                        path.unlink(missing_ok=True)
+        for path in written:
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path, ignore_errors=True)
+            else:  # a read-only file system refuses to unlink a missing file too (EROFS)
+                with contextlib.suppress(OSError):
+                    path.unlink(missing_ok=True)
+        for folder in reversed(made):  # the innermost first; one holding another's files stays
+            with contextlib.suppress(OSError):
+                folder.rmdir()
         raise
+
+
+def _write_text(path: Path, text: str) -> None:
+    """``text`` (UTF-8) written to ``path`` in one step."""
+    with atomic_write(path, text=True, error=ControlError) as fh:
+        fh.write(text)
 
 
 def parser() -> argparse.ArgumentParser:
@@ -261,7 +286,8 @@ def main(argv: list[str] | None = None) -> int:
         check_bag_path(out / "estimates", settings.storage, "--out")
         emulator = load_emulator(args.emulator, "--emulator")
         check_emulator(emulator, simplex=simplex)
-        result = replay_bag(bag, emulator, settings, simplex=simplex, progress=args.progress,
+        progress = args.progress and sys.stderr is not None  # no bar where stderr is closed
+        result = replay_bag(bag, emulator, settings, simplex=simplex, progress=progress,
                             check_vehicle=not args.ignore_vehicle)  # fmt: skip
         source = f"shipped emulator {args.emulator}" if args.emulator in SHIPPED else args.emulator
         _write(out, result, _report(bag, source, settings, result))
@@ -274,9 +300,14 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback (_write left no part)
         print("terrain-replay: interrupted (Ctrl-C)", file=sys.stderr)
         return 130
-    print(result.describe())
-    print(f"wrote {out / 'estimates.csv'}, {out / 'estimates'} (topic "
-          f"{settings.estimate_topic}) and {out / 'replay.json'}")  # fmt: skip
+    try:
+        print(result.describe())
+        print(f"wrote {out / 'estimates.csv'}, {out / 'estimates'} (topic "
+              f"{settings.estimate_topic}) and {out / 'replay.json'}")  # fmt: skip
+        if sys.stdout is not None:  # None: stdout closed (`>&-`), print wrote nothing
+            sys.stdout.flush()  # here, not at exit: a reader that has gone is no error
+    except BrokenPipeError:  # `terrain-replay ... | head -1`: the outputs are written
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 

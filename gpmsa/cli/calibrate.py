@@ -20,7 +20,7 @@ import numpy as np
 from gpmsa.calibration.posterior import quantile_keys
 from gpmsa.cli.text import internal_error, numbers, safe
 from gpmsa.errors import GPMSAError
-from gpmsa.io.container import jsonable
+from gpmsa.io.container import home_path, jsonable
 
 Y_CSV_MAX_BYTES = 64 * 1024**2
 """Most bytes of a ``--y-csv`` file read (one observation's values take far fewer); a longer
@@ -173,7 +173,7 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     column of numbers (`_fields`; blank lines and lines starting with "#" skipped), in the
     order of ``names``, or under a first row that names the columns (exactly ``names``, any
     order: read by name; a row of no numbers, not all of them `_value_like`, or of those names
-    above another row). UTF-8 (a
+    above another row); a leading ``~`` the home folder, as for FILE. UTF-8 (a
     byte order mark skipped) or UTF-16 with its byte order mark; an empty last field ending
     every line (a spreadsheet's empty last column) dropped; header names matched without the
     names' surrounding blanks (`_bare`).
@@ -185,7 +185,7 @@ def _csv_row(path: str, names: tuple[str, ...]) -> np.ndarray:
     (the header row too), or another count of values."""
     where = f"--y-csv {safe(path, 200)}"
     try:
-        with open(path, "rb") as fh:  # a pipe or device may never end: read a bounded part
+        with open(home_path(path), "rb") as fh:  # a pipe or device may never end: bounded
             raw = _bounded_read(fh, Y_CSV_MAX_BYTES + 1)
     except OSError as exc:
         raise GPMSAError(f"{where}: cannot read it ({type(exc).__name__}: {exc})") from None

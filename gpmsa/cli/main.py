@@ -34,3 +34,7 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback
         print("gpmsa: interrupted (Ctrl-C)", file=sys.stderr)
         return 130
+
+
+if __name__ == "__main__":  # python -m gpmsa.cli.main, as the console script runs it
+    sys.exit(main())
