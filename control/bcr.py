@@ -71,7 +71,7 @@ import warnings
 from collections import deque
 from dataclasses import dataclass, field, replace
 from itertools import islice
-from math import isfinite, sqrt
+from math import floor, isfinite, sqrt
 
 import numpy as np
 from scipy.special import ndtr, ndtri
@@ -266,15 +266,9 @@ class BCRSettings:
                 raise ControlError(f"{name} must be finite and > 0, got {value}")
         held_s = every / self.feature.rate_hz
         if held_s > self.max_age_s:
-            held_text, age_text = numbers_text(held_s, self.max_age_s)
-            warnings.warn(
-                f"update_every ({every} samples, {held_text} s at {self.feature.rate_hz:g} Hz) "
-                f"is longer than max_age_s ({age_text} s): between two updates a controller "
-                "holds an estimate older than max_age_s that never turns stale (the closed "
-                "loop's Simplex keeps its speed); lower update_every to at most "
-                f"{int(self.max_age_s * self.feature.rate_hz)} samples or raise max_age_s",
-                ControlWarning, stacklevel=user_stacklevel(),
-            )  # fmt: skip
+            least = -(-self.feature.block_samples // MAX_PHASES) if block else 1
+            warnings.warn(_hold_message(every, self.feature.rate_hz, self.max_age_s, least),
+                          ControlWarning, stacklevel=user_stacklevel())  # fmt: skip
         if not 0 < self.interval_level < 1:
             raise ControlError(f"interval_level must lie in (0, 1), got {self.interval_level}")
         if not is_choice(self.interval_kind, INTERVAL_KINDS):
@@ -317,6 +311,26 @@ class BCRSettings:
     def rate_hz(self) -> float:
         """Accelerometer rate, Hz."""
         return self.feature.rate_hz
+
+
+def _hold_message(every: int, rate_hz: float, max_age_s: float, least: int) -> str:
+    """`BCRSettings`' warning of ``every`` samples between updates, longer than ``max_age_s``,
+    with its remedies: the largest update_every held no longer than max_age_s where it is
+    one the method allows (at least ``least``), and the max_age_s that the interval needs."""
+    most = floor(max_age_s * rate_hz)  # (a float product may land either side of the count)
+    while (most + 1) / rate_hz <= max_age_s:
+        most += 1
+    while most > 0 and most / rate_hz > max_age_s:
+        most -= 1
+    held_text, age_text = numbers_text(every / rate_hz, max_age_s)
+    lower = f"lower update_every to at most {most} samples or " if most >= least else ""
+    bound = "" if most >= least else f" (update_every is at least {least} here)"
+    return (
+        f"update_every ({every} samples, {held_text} s at {rate_hz:g} Hz) is longer than "
+        f"max_age_s ({age_text} s): between two updates a controller holds an estimate older "
+        "than max_age_s that never turns stale (the closed loop's Simplex keeps its speed); "
+        f"{lower}raise max_age_s to at least {held_text} s{bound}"
+    )
 
 
 def _check_window_tracker(tracker: TrackerSettings) -> None:

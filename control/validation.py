@@ -208,4 +208,6 @@ def replace_fields(settings, overrides: dict):
             f"{', '.join(map(repr, unknown))}: no {type(settings).__name__} field{hint} (its "
             f"fields: {', '.join(names)})"
         )
+    if not overrides and type(settings).__dataclass_params__.frozen:
+        return settings  # the same settings (made anew, they would warn again)
     return replace(settings, **overrides)

@@ -121,7 +121,9 @@ def _report(bag: Path, source: str, settings: ReplaySettings, result: ReplayResu
 def _write(out: Path, result: ReplayResult, report: dict) -> None:
     """Write the estimates (CSV, ROS 2 bag) and the report (strict JSON) into ``out``, made
     here where it is missing. Each output is refused (`ControlError`) where it has appeared
-    since `_check_out` (another run given the same ``--out``); on a failure only what this
+    since `_check_out` (another run given the same ``--out``; an output file's name is taken
+    by `_reserve` before it is written, so that two such runs cannot write over each other's
+    at the same time); on a failure only what this
     call wrote is removed: its outputs, then the folders it made, where they are empty (another
     run may have written into them)."""
     made, written = [], []
@@ -143,13 +145,14 @@ def _write(out: Path, result: ReplayResult, report: dict) -> None:
             ("replay.json", lambda path: _write_text(path, text)),
         ):
             path = out / name
-            if os.path.lexists(path):
-                raise ControlError(
-                    f"{path} exists already (written since the check of --out: another run "
-                    "given the same --out?); choose another --out"
-                )
-            write(path)
+            if name == "estimates":  # a new folder, moved into place whole (open_bag_writer)
+                _refuse_existing(path)
+                write(path)
+                written.append(path)
+                continue
+            _reserve(path)  # a file: made empty here, so another run's cannot take its place
             written.append(path)
+            write(path)
     except BaseException:
         for path in written:
             if path.is_dir() and not path.is_symlink():
@@ -161,6 +164,31 @@ def _write(out: Path, result: ReplayResult, report: dict) -> None:
             with contextlib.suppress(OSError):
                 folder.rmdir()
         raise
+
+
+def _refuse_existing(path: Path) -> None:
+    """`ControlError` where ``path`` has appeared since `_check_out`."""
+    if os.path.lexists(path):
+        raise _appeared(path)
+
+
+def _appeared(path: Path) -> ControlError:
+    return ControlError(
+        f"{path} exists already (written since the check of --out: another run given the same "
+        "--out?); choose another --out"
+    )
+
+
+def _reserve(path: Path) -> None:
+    """Make ``path`` an empty file, where nothing is there (a link to nowhere too): an output
+    file's name taken in one step, so that two runs given one ``--out`` cannot both write it
+    (the writers replace an empty file); `ControlError` otherwise."""
+    try:
+        os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+    except FileExistsError:
+        raise _appeared(path) from None
+    except OSError as exc:
+        raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
 
 
 def _write_text(path: Path, text: str) -> None:

@@ -186,13 +186,14 @@ _NUTS_UNUSED = ("tune_rounds", "tune_levels", "step_widths")
 adapts its step size in its warm-up)."""
 
 
-def _refuse_unused_sampler_options(options: dict, backend: str) -> None:
+def _refuse_unused_sampler_options(options: dict, backend: str, draws: bool = False) -> None:
     """GPMSAError now, not at the first update, for ``mcmc_options`` (``options``, checked by
     `_check_mcmc_options`) that ``gpmsa.calibrate`` on ``backend`` refuses as without effect
     there: GPM/SA's tuning or step widths with pyro (NUTS), ``fast=True`` where the fast numpy
     sampler cannot run (another backend, a discrepancy), and a backend sampler's own options
     (``step_widths``, ``init``, ``temperatures``, ...) where it runs. Each names the options,
-    the backend and the remedy. Tuning counts are checked as ``calibrate`` checks them."""
+    the backend and the remedy (``draws``: emulator_params="draws", which only the fast
+    sampler takes). Tuning counts are checked as ``calibrate`` checks them."""
     from gpmsa.calibration.calibrate import _tuning_options, sample_calibration
 
     if backend == "pyro":
@@ -219,6 +220,12 @@ def _refuse_unused_sampler_options(options: dict, backend: str) -> None:
     named = {k for k, v in inspect.signature(sample_calibration).parameters.items()
              if v.kind is not inspect.Parameter.VAR_KEYWORD}  # fmt: skip
     sampler_only = sorted(k for k in options if k not in named)  # the backend sampler's
+    if sampler_only and can_fast and fast is not False and draws:
+        raise GPMSAError(
+            f"mcmc_options {sampler_only} go to the numpy backend's sampler, and "
+            "emulator_params='draws' needs the fast numpy sampler, which takes none of them: "
+            "leave them out"
+        )
     if sampler_only and can_fast and fast is not False:
         raise GPMSAError(
             f"mcmc_options {sampler_only} go to the numpy backend's sampler, which the fast "
@@ -531,7 +538,8 @@ class Calibrator:
         if self.emulator_params == "draws" and opts.get("fast") is False:
             raise GPMSAError("emulator_params='draws' needs the fast numpy sampler: drop "
                              "mcmc_options['fast'] = False")  # fmt: skip
-        _refuse_unused_sampler_options(opts, backend)
+        draws = opts.get("emulator_params", self.emulator_params) == "draws"
+        _refuse_unused_sampler_options(opts, backend, draws)
 
     # --- the exact likelihood on a grid ---------------------------------------------------------
     def _marginals(
