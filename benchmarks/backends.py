@@ -7,9 +7,15 @@ betaU, lamUz, lamWs, lamWOs sampled). Calibrate: ``gpmsa.calibrate`` at the SEPI
 posterior means (theta and lamOs sampled). Prints one line per configuration, medians over
 ``--repeats`` runs, and ``vs numpy``: the ESS/s over that of the task's first row in this run
 (numpy, one chain; for calibrate its fast sampler, ``gpmsa.calibrate``'s default), with the load
-average before and after. Usage: python benchmarks/backends.py [--repeats 3] [--quick]
-[--only fit:pyro]. The pyro fit (4 chains x 1,500 draws, one after another) takes ~10 min,
-the pyro calibrate (4 x 1,000) ~80 s a repeat.
+average before and after. R-hat needs two chains: a one-chain row prints "-". A short
+calibration runs first, untimed: a process's first ``gpmsa.calibrate`` imports ArviZ for its
+convergence check (~0.5 s), which would otherwise fall on the baseline's first repeat.
+``--only TASK:BACKEND`` runs that pair and the task's baseline row (numpy, one chain).
+
+Usage: python benchmarks/backends.py [--repeats 3] [--quick] [--only fit:pyro]. The pyro fit
+(4 chains x 1,500 draws, one after another) takes ~10 min, the pyro calibrate (4 x 1,000) ~80 s
+a repeat; ``--quick --only calibrate:numpy`` a few seconds. README.md's pyro R-hat: ``--only
+fit:pyro``.
 """
 
 from __future__ import annotations
@@ -57,6 +63,30 @@ def ess_rhat(draws: dict[str, np.ndarray], names) -> tuple[float, float]:
     return float(np.nanmin(e)), float(max(r)) if r else float("nan")
 
 
+def rhat_text(r_hat: float) -> str:
+    """R-hat for the table, 6 wide: "-" where it is undefined (one chain, too few draws)."""
+    return f"{r_hat:6.3f}" if np.isfinite(r_hat) else f"{'-':>6}"
+
+
+def selected(configs: list[tuple], task: str, only: str | None) -> list[tuple]:
+    """The task's configurations to run: all, or with ``--only TASK:BACKEND`` that backend's and
+    the first (the baseline of the ``vs numpy`` ratio), each once, in the table's order."""
+    if only is None:
+        return list(configs)
+    return [c for i, c in enumerate(configs) if only == f"{task}:{c[0]}" or (
+        i == 0 and only.startswith(f"{task}:"))]  # fmt: skip
+
+
+def warm_up() -> None:
+    """One short, untimed calibration: the process's first ``gpmsa.calibrate`` imports ArviZ
+    (~0.5 s), which would otherwise fall on the first timed row."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a short chain's convergence warning
+        bench_calibrate("numpy", 100, 1, True, seed=0)
+
+
 def bench_fit(backend: str, n_iter: int, n_chains: int, options: dict, seed: int) -> tuple:
     """(wall s, min ESS, max R-hat) of one simulation-only fit."""
     sim, _, _ = road()
@@ -88,13 +118,16 @@ def bench_calibrate(backend: str, n_samples: int, n_chains: int, fast: bool, see
 def main(argv=None) -> None:
     """Run every configuration and print wall time, min ESS and ESS/s (medians)."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument(
+        "--repeats", type=int, default=3, help="runs per configuration, medians printed (default 3)"
+    )
     ap.add_argument("--quick", action="store_true", help="shorter runs (noisier figures)")
     ap.add_argument(
         "--only",
         metavar="TASK:BACKEND",
         default=None,
-        help="run one task/backend pair only, e.g. fit:pyro or calibrate:torch",
+        help="run one task/backend pair (and the task's numpy baseline row), e.g. fit:pyro or "
+        "calibrate:torch",
     )
     args = ap.parse_args(argv)
     if args.repeats < 1:
@@ -119,13 +152,12 @@ def main(argv=None) -> None:
         ("pyro", 4, int(1000 * s), False),
     ]
     print(f"# {load()} at start; {os.cpu_count()} CPUs; torch threads 1")
+    warm_up()
     print(f"{'task':9} {'backend':14} {'chains':>6} {'draws':>6} {'wall s':>8} {'min ESS':>8} "
           f"{'ESS/s':>8} {'R-hat':>6} {'vs numpy':>8}")  # fmt: skip
     for task, configs in (("fit", fits), ("calibrate", cals)):
         baseline = None  # the ESS/s of the task's first row, numpy with one chain
-        for backend, chains, n, extra in configs:
-            if args.only and args.only != f"{task}:{backend}":
-                continue
+        for backend, chains, n, extra in selected(configs, task, args.only):
             runs = []
             for r in range(args.repeats):
                 if task == "fit":
@@ -141,7 +173,7 @@ def main(argv=None) -> None:
                 baseline = rate
             ratio = f"{rate / baseline:7.2f}x" if baseline else f"{'-':>8}"
             print(f"{task:9} {label:14} {chains:6d} {n:6d} {wall:8.2f} {n_eff:8.0f} {rate:8.1f} "
-                  f"{r_hat:6.3f} {ratio}", flush=True)  # fmt: skip
+                  f"{rhat_text(r_hat)} {ratio}", flush=True)  # fmt: skip
     print(f"# {load()} at the end")
 
 

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from backends import ess_rhat, road  # noqa: E402
+from backends import ess_rhat, rhat_text, road  # noqa: E402
 
 from gpmsa import backends  # noqa: E402
 from gpmsa.mcmc.parallel import available_cpus  # noqa: E402
@@ -78,7 +78,8 @@ def numpy_parallel(n_iter: int, repeats: int) -> float:
             sweeps[n_chains].append(n_chains * (n_iter + 1000) / wall)
             print(f"numpy {n_chains} chain(s), n_jobs={n_chains}, seed {r}: wall {wall:6.2f} s, "
                   f"CPU {cpu:6.2f} s, min ESS {n_eff:6.0f}, ESS/s {n_eff / wall:6.1f}, "
-                  f"ESS per CPU-s {n_eff / cpu:6.1f}, max R-hat {r_hat:.3f}; {load()}",
+                  f"ESS per CPU-s {n_eff / cpu:6.1f}, max R-hat {rhat_text(r_hat).strip()}; "
+                  f"{load()}",
                   flush=True)  # fmt: skip
     med = {k: statistics.median(v) for k, v in rates.items()}
     print(f"numpy ESS/s median: 1 chain {med[1]:.1f}, 2 chains in parallel {med[2]:.1f}: ratio "
@@ -195,11 +196,16 @@ def _sweep_cost(problem, label: str, n_chains: int, rounds: int, np_sweeps: int)
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--numpy-iter", type=int, default=6000)
+    ap.add_argument("--repeats", type=int, default=3,
+                    help="part 1's alternating runs, medians printed (default 3)")  # fmt: skip
+    ap.add_argument("--numpy-iter", type=int, default=6000,
+                    help="sweeps a numpy chain after its tuning (default 6000)")  # fmt: skip
     ap.add_argument("--torch-iter", type=int, default=None, help="default: --numpy-iter")
-    ap.add_argument("--torch-chains", type=int, default=64)
-    ap.add_argument("--only", choices=("numpy", "torch", "sweep"), default=None)
+    ap.add_argument("--torch-chains", type=int, default=64,
+                    help="batched torch chains of parts 2 and 3 (default 64)")  # fmt: skip
+    ap.add_argument("--only", choices=("numpy", "torch", "sweep"), default=None,
+                    help="one part: 1 numpy, 2 torch (no numpy ratio then), 3 sweep (default: "
+                    "all)")  # fmt: skip
     ap.add_argument("--case", choices=("road", "functional"), default="road",
                     help="part 3's fit (functional: part 3 only)")  # fmt: skip
     args = ap.parse_args(argv)

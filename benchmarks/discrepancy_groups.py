@@ -96,7 +96,8 @@ def run(seeds: int) -> dict:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--seeds", type=int, default=20)
+    parser.add_argument("--seeds", type=int, default=20,
+                        help="data sets (seeds 0 to N - 1) a truth (default 20)")  # fmt: skip
     parser.add_argument("--out", type=path_option, default=None, help="JSON file of the results")
     args = parser.parse_args(argv)
     if args.seeds < 1:

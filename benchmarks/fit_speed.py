@@ -1,9 +1,14 @@
 """Milliseconds per GPM/SA sweep on the road case (198 runs, scalar output), numpy backend.
 
 Prints the median over repeats for the sim-only and the sim+obs model and the extrapolated time
-of a 30,000-sweep fit (plus 1,000 tuning sweeps).
+of a 30,000-sweep fit (plus 1,000 tuning sweeps), each with its ratio to this run's baseline: the
+CPU time of one 198 x 198 Cholesky factorisation (LAPACK's dpotrf, as the sampler calls it, one
+thread; a sweep's floor is about five of them, docs/internals.md), and the load average before
+and after.
 
     PYTHONPATH=. python benchmarks/fit_speed.py [REPEATS]    # default 15 repeats of 200 sweeps
+
+About 9 s at the default (README.md's figures), 3 s with ``1``.
 """
 
 from __future__ import annotations
@@ -14,6 +19,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.linalg import lapack
 from threadpoolctl import threadpool_limits
 
 import gpmsa
@@ -46,18 +52,36 @@ def sweep_ms(problem, repeats: int, n_sweeps: int = 200) -> tuple[float, float, 
     return float(np.median(wall)), float(np.median(cpu)), float(np.min(cpu))
 
 
+def cholesky_ms(m: int, repeats: int, n_calls: int = 200) -> float:
+    """The baseline: median CPU ms of one m x m Cholesky (LAPACK's dpotrf, the sampler's, one
+    BLAS thread) over ``repeats`` batches of ``n_calls``, on a fixed SPD matrix (seed 0)."""
+    a = np.random.default_rng(0).standard_normal((m, m))
+    spd = a @ a.T + m * np.eye(m)
+    times = []
+    with threadpool_limits(1):
+        lapack.dpotrf(spd, lower=1, clean=0)
+        for _ in range(repeats):
+            c0 = time.process_time()
+            for _ in range(n_calls):
+                lapack.dpotrf(spd, lower=1, clean=0)
+            times.append((time.process_time() - c0) / n_calls * 1e3)
+    return float(np.median(times))
+
+
 def main(repeats: int = 15) -> None:
     d = np.load(CASE)
     sim = gpmsa.SimData(x=d["v"], t=d["GD"], y=d["f"])
     obs = gpmsa.ObsData(x=d["v_obs"][:, None], y=d["f_obs"][:, None])
     print(f"road case: m={sim.m}, scalar output; load average {os.getloadavg()[0]:.2f} "
           f"on {os.cpu_count()} cores; 1 BLAS thread")  # fmt: skip
+    chol = cholesky_ms(sim.m, repeats)
+    print(f"baseline: one {sim.m} x {sim.m} Cholesky {chol:.4f} ms CPU (median of {repeats})")
     for label, prob in (("sim-only", prepare(sim).problem), ("sim+obs", prepare(sim, obs).problem)):
         wall, cpu, best = sweep_ms(prob, repeats)
         print(
             f"{label:9s} {wall:6.3f} ms/sweep wall, {cpu:6.3f} ms CPU (medians of {repeats}), "
-            f"best {best:.3f} ms CPU; 30,000 sweeps + 1,000 tuning ~ {31 * wall:5.1f} s wall, "
-            f"{31 * cpu:5.1f} s CPU"
+            f"best {best:.3f} ms CPU; CPU / baseline {cpu / chol:5.2f}; 30,000 sweeps + 1,000 "
+            f"tuning ~ {31 * wall:5.1f} s wall, {31 * cpu:5.1f} s CPU"
         )
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 

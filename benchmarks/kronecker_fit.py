@@ -63,5 +63,6 @@ def main(n_sweeps: int = 3) -> None:
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("n_sweeps", nargs="?", type=int, default=3)
+    parser.add_argument("n_sweeps", nargs="?", type=int, default=3,
+                        help="timed sweeps per size and likelihood (default 3)")  # fmt: skip
     main(parser.parse_args().n_sweeps)

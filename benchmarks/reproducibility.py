@@ -66,7 +66,8 @@ def _report(label: str, a: np.ndarray, b: np.ndarray) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", type=int, default=198)
+    parser.add_argument("--runs", type=int, default=198,
+                        help="the default campaign's first N runs (default 198: all)")  # fmt: skip
     parser.add_argument("--env", action="store_true", help="also the machine settings (part 2)")
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)

@@ -175,7 +175,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=7, help="campaign seed")
     parser.add_argument("--keep-s", type=float, default=120.0, help="seconds kept per drive")
-    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--workers", type=int, default=2,
+                        help="worker processes of the campaign (default 2)")  # fmt: skip
     parser.add_argument("--cases", default="AB", choices=["A", "B", "AB"],
                         help="A: without sensor noise, B: with N(0, 1) noise")  # fmt: skip
     parser.add_argument("--drives", type=int, default=198, help="drives of the design")

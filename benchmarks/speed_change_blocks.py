@@ -31,6 +31,9 @@ first order the speed its spectrum saw. Two parts:
 
 Printed: the load average, the tables with each mean's standard error (over roads; in the loop
 part clustered by run).
+
+Run time: ~65 s for both parts on 2 workers at the defaults (docs/closed-loop.md's figures);
+``--part open --roads 2`` a few seconds.
 """
 
 from __future__ import annotations
@@ -229,15 +232,23 @@ def loop_part(case: str, runs: int, first_seed: int, workers: int) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--part", choices=("open", "loop", "both"), default="both")
-    ap.add_argument("--case", choices=("A", "B"), default="A")
-    ap.add_argument("--roads", type=int, default=160, help="open part: road seeds per GD")
-    ap.add_argument("--runs", type=int, default=16, help="loop part: closed-loop runs")
+    ap.add_argument("--part", choices=("open", "loop", "both"), default="both",
+                    help="open loop, closed loop or both (default both)")  # fmt: skip
+    ap.add_argument("--case", choices=("A", "B"), default="A",
+                    help="A: noise-free, B: N(0, 1) sensor noise (default A)")  # fmt: skip
+    ap.add_argument("--roads", type=int, default=160,
+                    help="open part: road seeds per GD, >= 2 (default 160)")  # fmt: skip
+    ap.add_argument("--runs", type=int, default=16,
+                    help="loop part: closed-loop runs, >= 2 (default 16)")  # fmt: skip
     ap.add_argument("--first-seed", type=int, default=101, help="first seed of either part")
-    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    ap.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                    help="worker processes (default: the CPU count)")  # fmt: skip
     args = ap.parse_args()
-    if args.roads < 2 or args.runs < 2 or args.workers < 1 or args.first_seed < 0:
-        ap.error("--roads and --runs must be >= 2, --workers >= 1, --first-seed >= 0")
+    for option, value, least in (("--roads", args.roads, 2), ("--runs", args.runs, 2),
+                                 ("--workers", args.workers, 1),
+                                 ("--first-seed", args.first_seed, 0)):  # fmt: skip
+        if value < least:
+            ap.error(f"{option} must be >= {least}, got {value}")
     last = args.first_seed + max(args.roads, args.runs) - 1 + OTHER_ROAD  # the other roads' too
     if last >= MAX_SEED:
         ap.error(f"--first-seed {args.first_seed}: its seeds run to {last}, beyond the seeds' "

@@ -20,6 +20,8 @@ the same source (same seed).
 
 Usage: python benchmarks/tempered_continuation.py [--repeats 5] [--sweeps 500] [--chains 4]
 [--quick]
+
+Run time: ~80 s at the defaults (docs/performance.md's figures), seconds with ``--quick``.
 """
 
 from __future__ import annotations
@@ -113,9 +115,10 @@ def mode_share(flags: list[np.ndarray]) -> tuple[float, float]:
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=5)
-    ap.add_argument("--sweeps", type=int, default=500, help="N, sweeps a part")
-    ap.add_argument("--chains", type=int, default=4)
+    ap.add_argument("--repeats", type=int, default=5,
+                    help="runs of each variant, medians printed (default 5)")  # fmt: skip
+    ap.add_argument("--sweeps", type=int, default=500, help="N, sweeps a part (default 500)")
+    ap.add_argument("--chains", type=int, default=4, help="chains a fit (default 4)")
     quick = "1 repeat, 20 sweeps, 2 chains, tuning 1 x 4 (seconds; noisy)"
     ap.add_argument("--quick", action="store_true", help=quick)
     args = ap.parse_args(argv)

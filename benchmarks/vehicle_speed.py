@@ -5,6 +5,9 @@ Real-time factor = simulated seconds per wall-clock second, and per CPU second o
 machine's load average, as timings on a shared machine vary.
 
     python benchmarks/vehicle_speed.py [--repeats 3] [--runs 198] [--skip-campaign]
+
+About 8 s at the defaults (the campaign 4-7 s); these are the settings of the figures in
+README.md and docs/vehicle-models.md.
 """
 
 from __future__ import annotations
@@ -34,16 +37,18 @@ def _median_rtf(fn, repeats: int) -> tuple[float, float, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--runs", type=int, default=198)
-    parser.add_argument("--skip-campaign", action="store_true")
+    parser.add_argument("--repeats", type=int, default=3,
+                        help="runs of each model, medians printed (default 3)")  # fmt: skip
+    parser.add_argument("--runs", type=int, default=198,
+                        help="runs of the timed campaign (default 198)")  # fmt: skip
+    parser.add_argument("--skip-campaign", action="store_true", help="time the models only")
     args = parser.parse_args()
     if args.repeats < 1:
         parser.error(f"--repeats must be >= 1, got {args.repeats}")
     if args.runs < 1:
         parser.error(f"--runs must be >= 1, got {args.runs}")
 
-    print(f"cores: {os.cpu_count()}, load average at start: {os.getloadavg()}")
+    print(f"cores: {os.cpu_count()}, load average at start: {load()}")
     road = roadgen.iso8608_profile(151.0, gd=400, seed=0, lead_in_m=1.0)
     track = roadgen.track([(50, 300), (50, 500), (50, 300)], seed=0)
 
@@ -78,8 +83,15 @@ def main() -> None:
         wall = time.perf_counter() - tic
         print(
             f"campaign: {args.runs} runs (Jackal, 21 m roads, process pool of {os.cpu_count()}) "
-            f"in {wall:.1f} s wall, {int(camp.ok.sum())} ok; load average after: {os.getloadavg()}"
+            f"in {wall:.1f} s wall, {int(camp.ok.sum())} ok; load average after: {load()}"
         )
+    else:
+        print(f"load average after: {load()}")
+
+
+def load() -> str:
+    """The load average (1, 5, 15 min), printed with the timings: the machine is shared."""
+    return "{:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
 
 
 if __name__ == "__main__":
