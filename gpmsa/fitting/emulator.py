@@ -80,6 +80,43 @@ __all__ = [
 NO_DRAWS = "(built by Emulator.from_params, or read from a file without draws)"
 """Why an emulator has no retained posterior draws, for the messages that need them."""
 
+PREDICT_BLOCK_VALUES = 2**21
+"""`Emulator.predict` and `predict_mean` take the points in blocks whose (points, m) work arrays
+hold about this many values (16 MiB each): at 100,000 points and 1,000 runs the peak is tens of
+MB, not GBs (`predict_block_rows`)."""
+
+
+def predict_block_rows(m: int) -> int:
+    """Points per block of a dense emulator's prediction with m runs: ``PREDICT_BLOCK_VALUES``
+    / m, rounded down to a multiple of 64 (at least 64)."""
+    return max(64, PREDICT_BLOCK_VALUES // max(m, 1) // 64 * 64)
+
+
+def _blocks(n: int, rows: int):
+    """Slices of ``rows`` consecutive of n points; a last block of one point joins the one
+    before it: numpy sums a lone column pairwise, several columns term by term, so a block of one
+    point would not give its values in the whole call."""
+    start = 0
+    while start < n:
+        stop = n if n - (start + rows) == 1 else start + rows
+        yield slice(start, stop)
+        start = stop
+
+
+def _spread_of_means(means: np.ndarray) -> np.ndarray:
+    """``means.var(axis=0)`` (the draws' means (draws, N, l_sim)), to the last bit, by blocks of
+    points: the squared deviations are never held for all points at once."""
+    if means.size <= PREDICT_BLOCK_VALUES:
+        return means.var(axis=0)
+    center = means.mean(axis=0)
+    out = np.empty(means.shape[1:])
+    step = max(2, PREDICT_BLOCK_VALUES // (means.shape[0] * means.shape[2]))
+    for part in _blocks(means.shape[1], step):
+        dev = means[:, part] - center[part]
+        np.multiply(dev, dev, out=dev)
+        out[part] = np.add.reduce(dev, axis=0) / means.shape[0]
+    return out
+
 
 @dataclass(frozen=True)
 class LooResult:
@@ -521,9 +558,26 @@ class Emulator:
 
     def _predict_std(self, z: np.ndarray, params, factors, resid: bool, *, var: bool = True):
         """Standardised predictive mean and variance (N, l_sim) at unit-scale z; ``var=False``:
-        the variance None, its triangular solves skipped (the mean's operations unchanged)."""
+        the variance None, its triangular solves skipped (the mean's operations unchanged).
+        The points go through in blocks of `predict_block_rows` (each point's values are those
+        of one call at all points: every operation is row by row, or column by column of the
+        solves), so that the (points, m) correlations and solves stay bounded at many points."""
         if self.separable is not None:  # through the factors: no m x m matrix
             return kronecker.predict_std(self, z, params, factors, resid, var=var)
+        rows = predict_block_rows(self.m)
+        if z.shape[0] <= rows:
+            return self._predict_block(z, params, factors, resid, var=var)
+        mean = np.empty((z.shape[0], self.l_sim))
+        out = np.empty((z.shape[0], self.l_sim)) if var else None
+        for part in _blocks(z.shape[0], rows):
+            m, v = self._predict_block(z[part], params, factors, resid, var=var)
+            mean[part] = m
+            if var:
+                out[part] = v
+        return mean, out
+
+    def _predict_block(self, z: np.ndarray, params, factors, resid: bool, *, var: bool = True):
+        """`_predict_std` of a dense emulator at the points z in one piece."""
         mean = np.zeros((z.shape[0], self.l_sim))
         out = np.zeros((z.shape[0], self.l_sim)) if var else None
         cat = self.categorical_mask
@@ -546,14 +600,20 @@ class Emulator:
             out += 1.0 / params["lamWOs"][0]
         return mean, out
 
-    def _check_predict_memory(self, x, t) -> None:
+    def _check_predict_memory(self, x, t, n_draws: int = 0) -> None:
+        """ResourceLimitError where a prediction at the points of x and t would need more than
+        the limit: a block of points' (points, m) work arrays, the inputs and outputs, and
+        with ``n_draws`` draws their means (n_draws, points, l_sim)."""
         try:  # the size before converting; a ragged input is named by _inputs
             n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
         except ValueError:
             n = 1
+        block = min(n, predict_block_rows(self.m)) if self.separable is None else n
         check_memory(
-            8.0 * n * (4.0 * self.m + 6.0 * self.l_sim + 4.0 * (self.p + self.q)),
-            f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs)",
+            8.0 * (4.0 * block * self.m + n * (6.0 * self.l_sim + 4.0 * (self.p + self.q)))
+            + 8.0 * n_draws * n * self.l_sim,
+            f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs"
+            + (f", {n_draws} draws)" if n_draws else ")"),
         )
 
     def _predict_point(self, x, t, resid: bool, *, extrapolate: bool = False, var: bool = True):
@@ -571,7 +631,8 @@ class Emulator:
     ):  # fmt: skip
         """``predict(x, t, draws=True, n_draws=n_draws, resid=resid, extrapolate=extrapolate)``;
         ``var=False``: the variance None (``predict_mean``)."""
-        self._check_predict_memory(x, t)
+        if self.draws:
+            self._check_predict_memory(x, t, len(evenly_spaced(self.n_draws, n_draws)))
         z = self._inputs(x, t, extrapolate=extrapolate)
         s = self.standardizer
         if not self.draws:
@@ -580,18 +641,22 @@ class Emulator:
                 "point estimate"
             )
         idx = evenly_spaced(self.n_draws, n_draws)
-        means, vars_ = [], []
+        # each draw's mean kept in one array (the law of total variance needs them all), its
+        # variance summed as it comes: the values of np.array(list).mean(axis=0) and .var(axis=0)
+        means = np.empty((len(idx), z.shape[0], self.l_sim))
+        var_sum = None
         with one_thread():  # many small solves: one thread
-            for i in idx:
-                prm = {k: self.draws[k][i] for k in EMULATOR_PARAMS}
-                m, v = self._predict_std(z, prm, self._predict_factors(prm), resid, var=var)
-                means.append(m)
-                vars_.append(v)
-        means = np.array(means)
+            for k, i in enumerate(idx):
+                prm = {name: self.draws[name][i] for name in EMULATOR_PARAMS}
+                means[k], v = self._predict_std(z, prm, self._predict_factors(prm), resid, var=var)
+                if var and var_sum is None:
+                    var_sum = v
+                elif var:
+                    var_sum += v
         mean = means.mean(axis=0)
         if not var:
             return s.y_from_std(mean), None
-        var_ = np.array(vars_).mean(axis=0) + means.var(axis=0)
+        var_ = var_sum / len(idx) + _spread_of_means(means)
         return s.y_from_std(mean), s.var_from_std(var_)
 
     def predict(
