@@ -16,7 +16,7 @@ import vehicle
 from control.bcr import BCR, BCRSettings
 from control.compat import bcr_settings_for, check_emulator, check_likelihood
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
-from control.estimate import Estimate
+from control.estimate import Estimate, run_text
 from control.faults import FaultInjector, SensorFault
 from control.metrics import (
     GDError,
@@ -164,6 +164,12 @@ class ClosedLoopResult:
     sample_accel: np.ndarray
     metrics: LoopMetrics
     settings: dict = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        """One line: the estimates, the span driven, the statuses and the samples (`run_text`);
+        not the arrays (a dataclass's repr printed them: 21,000 characters for a 50 m run)."""
+        text = run_text(self.status, self.sample_time, self.sample_position, "sensor")
+        return f"ClosedLoopResult({text})"
 
 
 def _run_seed(seed) -> int | None:

@@ -44,6 +44,22 @@ def graver_fault(first: Estimate | None, second: Estimate) -> Estimate | None:
 DOMAIN_EDGES = ("upper", "lower")
 
 
+def run_text(status, sample_time, sample_position, samples: str) -> str:
+    """A run's estimates for a one-line repr (`ClosedLoopResult`'s, `ReplayResult`'s): "125
+    estimates over 44.1 s, 49.7 m: filling 2, ok 122, out_of_domain 1; 5290 sensor samples"
+    (the span of the samples fed to the BCR; the statuses counted, by name), "no estimate; 40
+    sensor samples" without one; ``samples`` names the samples ("sensor", "IMU"). Never the
+    arrays: a repr of a long run's stays short and quick."""
+    status, t, s = (np.ravel(np.asarray(a)) for a in (status, sample_time, sample_position))
+    counted = f"{t.size} {samples} samples"
+    if not status.size:
+        return f"no estimate; {counted}"
+    names, counts = np.unique(status.astype(str), return_counts=True)
+    statuses = ", ".join(f"{k} {c}" for k, c in zip(names, counts, strict=True))
+    span = f" over {t[-1] - t[0]:.1f} s, {s[-1] - s[0]:.1f} m" if t.size and s.size else ""
+    return f"{status.size} estimates{span}: {statuses}; {counted}"
+
+
 def edge_counts(domain_edge) -> dict[str, int]:
     """How many estimates name each edge of the GD domain, from their ``domain_edge`` values
     (e.g. `ClosedLoopResult.domain_edge`), keyed by DOMAIN_EDGES; ControlError unless those

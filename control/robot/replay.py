@@ -61,7 +61,7 @@ from control.compat import (
     recorded_vehicle_mismatch,
 )
 from control.errors import BagError, ControlError, ControlWarning, user_stacklevel
-from control.estimate import Estimate, edge_counts
+from control.estimate import Estimate, edge_counts, run_text
 from control.robot import clock, condition
 from control.robot import messages as msgs
 from control.robot.bags import (
@@ -283,6 +283,14 @@ class ReplayResult:
     simplex: Simplex
     source: str = ""
     restamping: clock.Restamping = clock.Restamping(False)
+
+    def __repr__(self) -> str:
+        """One line: the estimates, the span replayed, the statuses, the IMU samples fed to the
+        BCR (`run_text`) and the recording's file name; not the arrays nor the estimates (a
+        dataclass's repr printed each with its posterior: 90,000 characters for 50 m)."""
+        text = run_text(self.status, self.sample_time, self.sample_position, "IMU")
+        name = Path(str(self.source)).name if self.source else ""
+        return f"ReplayResult({text}" + (f" from {name[:60]!r})" if name else ")")
 
     @property
     def duration_s(self) -> float:

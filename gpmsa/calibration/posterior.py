@@ -20,7 +20,9 @@ from gpmsa.model.data import (
     check_finite,
     check_level,
     check_probabilities,
+    numbers_text,
     quantile_keys,  # gpmsa.calibration.posterior.quantile_keys, as before session 74
+    repr_name,
 )
 
 #: Lower tail probabilities tried by `GridMarginal.hdi`.
@@ -96,7 +98,8 @@ class GridMarginal:
 
     def __repr__(self) -> str:
         k = np.size(self.nodes)
-        span = f" on [{self.nodes[0]:.4g}, {self.nodes[-1]:.4g}]" if k else ""
+        ends = numbers_text(self.nodes[0], self.nodes[-1], digits=4) if k else ()
+        span = f" on [{ends[0]}, {ends[1]}]" if k else ""
         return f"GridMarginal({k} nodes{span}, mean={self.mean():.4g}, sd={self.sd():.3g})"
 
     def cdf(self, value: np.ndarray | float) -> np.ndarray:
@@ -672,15 +675,20 @@ class Posterior:
         return codes if codes.size and np.all(np.isfinite(codes)) else None
 
     def __repr__(self) -> str:
+        """One line: the first 3 parameters' ``name=mean±sd`` (each name cut: `repr_name`),
+        how many more ("+17 more"), and the method."""
+        shown = 3
         try:
-            parts = [self._describe(n) for n in self.names[:3]]
+            parts = [self._describe(n) for n in self.names[:shown]]
         except Exception:  # a repr never raises (e.g. a failing draw callable)
             parts = ["?"]
+        if len(self.names) > shown:
+            parts.append(f"+{len(self.names) - shown} more")
         return f"Posterior({', '.join(parts)}, method={self.info.get('method', '?')})"
 
     def _describe(self, name: str) -> str:
         """``name=mean±sd`` (the mean alone where the sd is undefined: one draw)."""
-        text = f"{name}={self.mean(name):.4g}"
+        text = f"{repr_name(name)}={self.mean(name):.4g}"
         try:
             return f"{text}±{self.sd(name):.3g}"
         except GPMSAError:

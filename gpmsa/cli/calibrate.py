@@ -534,23 +534,36 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
         print(json.dumps(jsonable(out), indent=1, allow_nan=False))  # RFC 8259: no NaN
         return 0
     lo_key, hi_key = quantile_keys(args.level)
-    given = [", ".join(f"{safe(n, 60)}={v:g}" for n, v in zip(names, row, strict=True))
+    given = [", ".join(f"{safe(n, 60)}={_echo(v)}" for n, v in zip(names, row, strict=True))
              for names, row in ((emu.x_names, x[0]), (emu.y_names, y[0])) if names]  # fmt: skip
     print(f"posterior ({post.info.get('method')}, {1e3 * seconds:.2f} ms) given "
           + "; ".join(given))  # fmt: skip
-    print(f"{'name':>10s} {'mean':>12s} {'sd':>12s} {lo_key:>12s} {'median':>12s} {hi_key:>12s}")
+    units = dict(zip(emu.t_names, emu.t_units, strict=True))  # lamOs: a precision, no unit
+    print(f"{'name':>10s} {'mean':>12s} {'sd':>12s} {lo_key:>12s} {'median':>12s} {hi_key:>12s}"
+          + (" unit" if any(units.values()) else ""))  # fmt: skip
     for name, s in summary.items():
+        unit = f" {safe(units[name], 60)}" if units.get(name) else ""
         if s.get("held"):  # as `gpmsa info` prints a parameter held whole
-            print(f"{safe(name, 60):>10s} held at {s['mean']:.12g} (fixed=)")
+            print(f"{safe(name, 60):>10s} held at {s['mean']:.12g}{unit} (fixed=)")
             continue
-        print(f"{safe(name, 60):>10s} {s['mean']:12.5g} {s['sd']:12.5g} {s[lo_key]:12.5g} "
-              f"{s['median']:12.5g} {s[hi_key]:12.5g}")  # fmt: skip
+        # the location figures side by side as numbers_text gives them: distinct ones never
+        # read alike (a posterior near 1e6 printed "1e+06" for its mean, ends and median)
+        mean, lo, median, hi = numbers(s["mean"], s[lo_key], s["median"], s[hi_key], digits=5)
+        print(f"{safe(name, 60):>10s} {mean:>12s} {s['sd']:12.5g} {lo:>12s} {median:>12s} "
+              f"{hi:>12s}{unit}")  # fmt: skip
     for name, (_, text) in piled.items():
         print(f"{safe(name, 60)}: piled against the emulator's domain at {text}: the truth may "
               "lie outside the simulation design (widen it beyond that bound and refit), or "
               "the model misses something theta absorbs (check the emulator and units, add a "
               "discrepancy)")  # fmt: skip
     return 0
+
+
+def _echo(value: float) -> str:
+    """A given number for the summary's first line: as ``%g`` writes it where that reads back
+    as the value ("1.25", "3"), else its shortest exact text ("1000000.5", not "1e+06")."""
+    text = f"{value:g}"
+    return text if float(text) == value else repr(float(value))
 
 
 def _at_bound(emu, post) -> dict[str, tuple[str, str]]:

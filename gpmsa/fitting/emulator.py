@@ -59,6 +59,7 @@ from gpmsa.model.data import (
     check_same_rows,
     evenly_spaced,
     quantile_keys,
+    repr_names,
 )
 from gpmsa.model.likelihood import lower_cholesky
 from gpmsa.model.mean_basis import GLS, MeanBasis
@@ -1001,9 +1002,12 @@ class Emulator:
         return manifest, arrays
 
     def __repr__(self) -> str:
+        """One line: the runs, the first names of x and t (each cut, the rest counted: "+14
+        more"), the outputs, the components and the retained draws."""
+        outputs = f"{self.l_sim} output{'' if self.l_sim == 1 else 's'}"
         return (
-            f"Emulator(m={self.m}, x={list(self.x_names)}, t={list(self.t_names)}, "
-            f"y={self.l_sim} outputs, p_u={self.p_u}, draws={self.n_draws})"
+            f"Emulator(m={self.m}, x={repr_names(self.x_names)}, t={repr_names(self.t_names)}, "
+            f"y={outputs}, p_u={self.p_u}, draws={self.n_draws})"
         )
 
 

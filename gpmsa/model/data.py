@@ -603,8 +603,25 @@ REPR_COLUMNS = 6
 
 
 def _span(values: np.ndarray) -> str:
-    """``[min, max]`` of ``values`` to 4 significant digits, for a repr."""
-    return f"[{np.min(values):.4g}, {np.max(values):.4g}]" if np.size(values) else "[]"
+    """``[min, max]`` of ``values`` for a repr: 4 significant digits, more where the two would
+    read alike (`numbers_text`: [1e6 + 0.02, 1e6 + 0.99] as "[1000000.02, 1000000.99]", not
+    "[1e+06, 1e+06]"); a zero as "0", never "-0"."""
+    if not np.size(values):
+        return "[]"
+    lo, hi = numbers_text(float(np.min(values)) + 0.0, float(np.max(values)) + 0.0, digits=4)
+    return f"[{lo}, {hi}]"
+
+
+def repr_names(names, shown: int = REPR_COLUMNS) -> str:
+    """A list of names for a one-line repr: the first ``shown``, each cut to `REPR_NAME`
+    characters (ending "...") and quoted as Python quotes it (a newline as \\n), then how many
+    more ("['a', 'b', +14 more]")."""
+    names = [str(n) for n in names]
+    cut = [n if len(n) <= REPR_NAME else n[: REPR_NAME - 3] + "..." for n in names[:shown]]
+    parts = [repr(n) for n in cut]
+    if len(names) > shown:
+        parts.append(f"+{len(names) - shown} more")
+    return f"[{', '.join(parts)}]"
 
 
 def _count(n: int, what: str) -> str:
@@ -615,7 +632,7 @@ REPR_NAME = 40
 """The characters of a column's name a repr shows (a longer one cut, ending "...")."""
 
 
-def _repr_name(name: str) -> str:
+def repr_name(name: str) -> str:
     """``name`` for a one-line repr: escaped where not printable (a newline as \\n), cut to
     `REPR_NAME` characters."""
     text = name if name.isprintable() else repr(name)[1:-1]
@@ -627,7 +644,7 @@ def _columns_text(arr: np.ndarray, names) -> str:
     "none" without columns."""
     if arr.shape[1] == 0:
         return "none"
-    parts = [f"{_repr_name(name)} {_span(arr[:, k])}"
+    parts = [f"{repr_name(name)} {_span(arr[:, k])}"
              for k, name in enumerate(names[:REPR_COLUMNS])]  # fmt: skip
     more = arr.shape[1] - REPR_COLUMNS
     return ", ".join(parts) + (f", ... ({more} more)" if more > 0 else "")
@@ -640,7 +657,7 @@ def _index_text(index: np.ndarray | None, names: tuple[str, ...] | None, l_sim: 
     if index is None and names is None:
         return ""
     cols = (np.arange(l_sim, dtype=np.float64) if index is None else index).reshape(l_sim, -1).T
-    labels = [""] * len(cols) if names is None else [f"{_repr_name(n)} " for n in names]
+    labels = [""] * len(cols) if names is None else [f"{repr_name(n)} " for n in names]
     kind = "index points" if len(cols) > 1 else "index"
     return f" on {kind} " + " x ".join(f"{a}{_span(c)}" for a, c in zip(labels, cols, strict=True))
 

@@ -80,7 +80,7 @@ from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.correlation import CATEGORICAL_DISTANCE, correlation
-from gpmsa.model.data import as_real, check_count, check_flag, check_level
+from gpmsa.model.data import as_real, check_count, check_flag, check_level, repr_name
 from gpmsa.model.transforms import snap_to_unit
 from gpmsa.predictive._common import draws_text, factors, gpmsa_model_only, param_sets, unit_inputs
 
@@ -236,7 +236,8 @@ class Sensitivity:
     def __repr__(self) -> str:
         d, shown = len(self.names), 4
         total = np.mean(self.total_aggregated, axis=0) if d else ()
-        effects = ", ".join(f"{n}={v:.2f}" for n, v in zip(self.names[:shown], total, strict=False))
+        effects = ", ".join(f"{repr_name(n)}={v:.2f}"
+                            for n, v in zip(self.names[:shown], total, strict=False))  # fmt: skip
         more = f", +{d - shown} more" if d > shown else ""
         l = np.shape(self.grid)[0]
         return (f"Sensitivity({d} inputs, {len(self.fixed)} fixed, {l} outputs, "
