@@ -529,7 +529,9 @@ class BCR:
     @classmethod
     def from_emulator(cls, emulator, settings: BCRSettings | None = None, **overrides) -> BCR:
         """A BCR for ``emulator``: the settings default to its recorded feature
-        (`control.bcr_settings_for`), and the likelihood model is built from it."""
+        (`control.bcr_settings_for`), and the likelihood model is built from it. ``overrides``
+        replace `BCRSettings` fields (e.g. ``method="window"``) of ``settings`` or of that
+        default."""
         import gpmsa
         from control.compat import bcr_settings_for, check_feature
         from control.observation_model import ObservationModel

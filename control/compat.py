@@ -119,6 +119,10 @@ def check_emulator(
 ) -> None:
     """Raise `EmulatorMismatchError` or warn (`ControlWarning`) where the emulator does not fit.
 
+    Each check runs where its argument is given (None skips it): ``model`` (the vehicle
+    model), ``noise_std`` (the loop's accelerometer noise sd, m/s^2), ``bcr`` (the BCR's
+    settings: its feature and method), ``track`` and ``simplex``.
+
     Errors: another vehicle model; another feature (name, block or window length, rate, bands,
     tapers); a track whose prescribed GD lies outside the emulator's GD domain; a Simplex whose
     top or safe speed lies outside the emulator's speed domain (the BCR learns nothing at such

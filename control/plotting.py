@@ -104,6 +104,7 @@ def plot_gd_trace(
     Args:
         results: `ClosedLoopResult`s driven over `track` (or tracks with the same segments).
         track: the track whose prescribed GD is drawn as a black step line.
+        title: the axes' title ("": "BCR estimate of GD").
         gd_max: the Simplex's GD_max: the parts rougher than it are shaded (None: no shading).
         level: the level of the BCR's interval (for the legend), in (0, 1); None: the
             ``interval_level`` the runs' BCR recorded (``settings["bcr"]``; 0.9 where none is
@@ -146,6 +147,13 @@ def plot_speed(
     """Vehicle speed against position, one line per run, with the track's GD changes marked.
 
     The start (the vehicle ramps up from rest within a few centimetres) is left out.
+
+    Args:
+        results: `ClosedLoopResult`s driven over `track` (or tracks with the same segments).
+        track: the track whose segment changes are marked (dotted verticals).
+        title: the axes' title ("": "Speed set by the Simplex controller").
+        gd_max: the Simplex's GD_max: the parts rougher than it are shaded (None: no shading).
+        v_safe: the Simplex's safe speed, m/s, drawn as a dashed line (None: no line).
     """
     results = _runs(results)
     gd_max = _optional_real(gd_max, "gd_max", "GD (1e-6 m^3)")
@@ -169,7 +177,8 @@ def plot_speed(
 
 
 def plot_design(v: np.ndarray, gd: np.ndarray, title: str = "") -> Figure:
-    """The training design points (v, GD) (paper Fig. 5)."""
+    """The training design points (v, GD) (paper Fig. 5): speeds ``v`` (m/s) and GDs ``gd``
+    (1e-6 m^3) of the runs; ``title`` "" reads "Latin hypercube design, N runs"."""
     fig = Figure(figsize=(4.5, 4), constrained_layout=True)
     ax = fig.add_subplot()
     ax.scatter(v, gd, s=10)
@@ -193,6 +202,7 @@ def plot_posterior_grid(
 
     Args:
         cells: (v, true GD, draws) triples; the true GD is drawn as a vertical line.
+        title: the figure's title ("": none).
         gd_range: (lo, hi) of the histograms' common GD axis (1e-6 m^3), e.g. the emulator's GD
             domain; None: the span of every draw and true GD, rounded out to whole steps of the
             power of ten at or below it ((200, 600) for the paper's cells on its domain).

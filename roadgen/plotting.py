@@ -26,12 +26,13 @@ def plot_profile_psd(
     The PSD panel shows the prescribed line(s) Gd(n) = GD 1e-6 (n/n0)^-w for each distinct GD of the
     road (``gd`` of a Profile, the segments' GDs of a Track), n0 = 0.1 cycles/m, and the GD that
     ``estimate_gd`` recovers (its "fit"; "welch" for a waviness below FIT_MIN_WAVINESS, where
-    the fit's end match leaks). ``method`` is that of ``profile_psd``. The prescribed lines are
-    drawn wide and translucent underneath, the road's PSD as a thin line with a dot per ordinate
-    on top: with deterministic amplitudes the periodogram lies exactly on its line and stays
-    visible there. A plain Road (no GD of its own) shows no prescribed line and is fitted with
-    waviness 2. ``band`` (cycles/m) is that of the GD fit (``estimate_gd``); default FIT_BAND,
-    its n_max lowered to the grid's Nyquist frequency 0.5 / dx_m on grids coarser than 0.5 m.
+    the fit's end match leaks). ``method`` is that of ``profile_psd``; ``title`` the figure's
+    title (None: none). The prescribed lines are drawn wide and translucent underneath, the
+    road's PSD as a thin line with a dot per ordinate on top: with deterministic amplitudes the
+    periodogram lies exactly on its line and stays visible there. A plain Road (no GD of its
+    own) shows no prescribed line and is fitted with waviness 2. ``band`` (cycles/m) is that of
+    the GD fit (``estimate_gd``); default FIT_BAND, its n_max lowered to the grid's Nyquist
+    frequency 0.5 / dx_m on grids coarser than 0.5 m.
 
     Raises RoadgenError unless ``road`` is a roadgen Road, for a flat road (no PSD to draw), a grid
     too coarse for the default band (dx_m >= 10 m), and for the errors of ``profile_psd`` and

@@ -535,10 +535,15 @@ def run_campaign(
     Args:
         design: (n, 2) array [v (m/s), GD]; default ``lhs_design(198, seed=seed)``.
         model: default ``Jackal()``. band: road content band (cycles/m), default the full grid.
+        road_length_m: length of each road, m (lengthened where ``keep_s`` needs it).
         dx_m: the roads' grid step, m, in [``roadgen.checks.MIN_DX_M``, road_length_m / 1.5].
+        lead_in_m: the roads' raised-cosine lead-in, m (``roadgen.iso8608_profile``'s).
+        rate_hz: accelerometer sample rate, Hz. substeps: solver steps per sample period (as
+            ``simulate``'s).
         noise_std: accelerometer noise std for the ``*_noisy`` columns (paper: 1 m/s^2), in
             [0, ``vehicle.sensor.MAX_NOISE_STD``].
         window: samples in the ``f_window`` span.
+        progress: show a tqdm bar over the runs (on by default; False: none).
         executor: any ``concurrent.futures.Executor`` (e.g. a dask ``Client.get_executor()``);
             default a process pool over all cores, shut down at the end (its workers end
             with this process, even one killed outright).

@@ -339,7 +339,9 @@ class ReplayResult:
 
     def write_bag(self, path: str | os.PathLike, storage: str | None = None) -> Path:
         """Write the estimates as a ROS 2 bag (topic ``settings.estimate_topic``, type
-        ``terrain_gpmsa_msgs/msg/GDEstimate``, stamped with ``stamp_ns``)."""
+        ``terrain_gpmsa_msgs/msg/GDEstimate``, stamped with ``stamp_ns``) at ``path``, a new
+        folder (`control.robot.bags.open_bag_writer`); returns its path. ``storage``: "mcap" or
+        "sqlite3" (None: ``settings.storage``)."""
         storage = storage or self.settings.storage
         self._check_header_stamps()
         store = msgs.typestore()

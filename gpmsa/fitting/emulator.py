@@ -213,21 +213,21 @@ class Emulator:
     w (m, p_u), lam_sim (p_u,), index (l_sim,), (l_sim, d) or None, params (point estimate: betaU
     (p+q, p_u), lamUz, lamWs (p_u,), lamWOs (1,)), draws (name -> (n_draws, *shape), retained
     posterior draws; empty for ``from_params``), log_post (n_draws,), priors (data-corrected),
-    x_names, t_names, y_names, units, domain (name -> (lo, hi) native), metadata (user dict, saved),
-    settings (how it was fitted), diagnostics (acceptance, ESS, R-hat), calibration (theta and
-    lamOs draws of a joint sim+obs fit, else None), convergence (R-hat, one chain's split
-    R-hat, and bulk ESS of every sampled parameter and the elements flagged, see
-    ``gpmsa.mcmc.diagnostics.convergence``; None for ``from_params``, for older files and for
-    one-chain files from before one chain was judged), levels
-    (per column of [x, t]: a categorical input's training levels, else None), mean_basis (the
-    weights' GP mean basis, None: zero mean); docs/categorical-and-constraints.md;
-    index_names, index_units (``SimData(index_names=, index_units=)``: labels of the output
-    index's columns, or None);
+    x_names, t_names, y_names, x_units, t_units, y_units, domain (name -> (lo, hi) native),
+    metadata (user dict, saved), settings (how it was fitted), diagnostics (acceptance, ESS,
+    R-hat), calibration (theta and lamOs draws of a joint sim+obs fit, else None), convergence
+    (R-hat, one chain's split R-hat, and bulk ESS of every sampled parameter and the elements
+    flagged, see ``gpmsa.mcmc.diagnostics.convergence``; None for ``from_params``, for older
+    files and for one-chain files from before one chain was judged), levels (per column of
+    [x, t]: a categorical input's training levels, else None), mean_basis (the weights' GP mean
+    basis, None: zero mean); docs/categorical-and-constraints.md; index_names, index_units
+    (``SimData(index_names=, index_units=)``: labels of the output index's columns, or None);
     discrepancy_bases (a joint fit given a list of per-experiment discrepancy bases: the
     normalised (l_j, p_v) basis of each experiment, as the fit used them, ``gpmsa.model.basis.
-    discrepancy_bases``; else None). The arrays are read-only copies, params, draws and
-    calibration read-only mappings, and no attribute but ``metadata`` can be replaced
-    (``model_sha256`` holds).
+    discrepancy_bases``; else None); separable (a separable design's factor structure, a
+    ``gpmsa.model.kronecker.Separable``, from ``SimData(separable=)``; else None). The arrays
+    are read-only copies, params, draws and calibration read-only mappings, and no attribute
+    but ``metadata`` can be replaced (``model_sha256`` holds).
     """
 
     def __init__(

@@ -1087,7 +1087,8 @@ class SimData:
     ``y_ind_sim`` of (time, angle) pairs), gives each output value its point: finite, no point
     twice, spanning d dimensions; the basis and the mean are interpolated piecewise-linearly on
     the points' Delaunay triangulation (``gpmsa.model.index_points``).
-    Names default to x0.., t0.., y0..; units to "". A name is a non-blank string, a unit a
+    Names (``x_names``, ``t_names``, ``y_names``) default to x0.., t0.., y0..; units
+    (``x_units``, ``t_units``, ``y_units``) to "". A name is a non-blank string, a unit a
     string; a table's column label of another type (a column number, a number such as a
     wavelength, a date, a MultiIndex's tuple) is taken as its text, as a table's own labels.
     ``t_names`` may not be a reserved name (lamOs, lamVz, betaV, betaV[k], betaV[k,g],

@@ -106,9 +106,13 @@ class Priors:
     cap; None for both (the default): betaU's Beta(rho_a, rho_b). ``rhoV_a``, ``rhoV_b``: both
     numbers (shared by every discrepancy precision group) or both sequences of one number per
     group (stored as tuples; group g's column betaV[:, g] gets the g-th pair), each finite and
-    > 0. Precisions: Gamma priors below. ``lamWOs`` and ``lamOs`` here are
-    the base priors before the data corrections of GPM/SA (see ``with_data``); ``gpmsa.fit``
-    refuses corrected priors (``corrected=True``, e.g. an Emulator's ``priors``).
+    > 0. Precisions: a ``GammaPrior(a, b, lower, upper)`` each, by default GPM/SA's:
+    ``lamUz`` (the weights' GP precision) Gamma(5, 5) above 0.3, ``lamWs`` (their nugget's
+    precision) Gamma(3, 0.003) and ``lamWOs`` (the runs' residual precision) Gamma(5, 0.005),
+    both within (60, 1e5), ``lamOs`` (the observation precision's scale) and ``lamVz`` (the
+    discrepancy's precision) Gamma(1, 0.001). ``lamWOs`` and ``lamOs`` here are the base
+    priors before the data corrections of GPM/SA (see ``with_data``); ``gpmsa.fit`` refuses
+    corrected priors (``corrected=True``, e.g. an Emulator's ``priors``).
     ``lamVz``: one GammaPrior shared by every discrepancy precision group, or a sequence of them
     (stored as a tuple), one per group, as GPM/SA's per-group rows of priors.lamVz.params:
     group g's lamVz[g] gets the g-th; a model with a discrepancy of G groups needs G of them.

@@ -49,7 +49,9 @@ class ObsProblem:
     x (n, p) unit inputs; u (n, p_u) and v (n, p_v) the reduced data (GLS of y_obs on [D, K]);
     sig_obs (N, N) the covariance of the stacked reduced data per unit lamOs (N = n (p_v + p_u),
     or n for a scalar output, where u and v share one block). p_v: number of discrepancy basis
-    vectors (0: no discrepancy; a scalar output has v empty and p_v 0 or 1).
+    vectors (0: no discrepancy; a scalar output has v empty and p_v 0 or 1). scalar_out: a
+    scalar simulation output (one value per experiment). y_std: each experiment's observed y
+    on the standardised scale (for the figures; empty: not kept).
     The stacked order is GPM/SA's:
     v component 0 over all experiments, v component 1, ..., then u components likewise.
     K, D: per-experiment bases on the observation grids (D None without discrepancy).

@@ -242,6 +242,9 @@ class Study:
             lamVz (C, N, G) as "betaV_j", "lamVz_j".
         posterior: ``gpmsa.Posterior`` in native units (names: ``native_chains``); ``summary()``
             and ``to_arviz()`` give its summary (held parameters marked) and its chains.
+        diagnostics, convergence: the native chains' summary (ESS, R-hat per name) and its
+            verdict, as an Emulator's (``gpmsa.mcmc.diagnostics``; also in
+            ``posterior.info``).
         settings, metadata: how it was run; the user's JSON-able dict (saved).
         sha256: the ``content_sha256`` of the study file it was read from or last saved to
             (None before either); a continuation (``init=study``) records it as
