@@ -235,7 +235,7 @@ def run_closed_loop(
     emulator,
     model=None,
     noise_std: float = 0.0,
-    seed: int | np.random.Generator | None = None,
+    seed: int | np.integer | np.random.Generator | None = None,
     bcr: BCRSettings | None = None,
     simplex: Simplex | None = None,
     progress: bool = False,

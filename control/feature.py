@@ -18,9 +18,10 @@ Two features (the emulator records which one it was trained on; training and BCR
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
 from functools import lru_cache
+from typing import overload
 
 import numpy as np
 
@@ -350,7 +351,15 @@ def window_feature(accel: np.ndarray, feature: str = "log_var") -> float:
     return float(feature_of_variance(np.var(accel), feature))  # var: normalised by T (eq. 5)
 
 
-def feature_of_variance(f: np.ndarray | float, feature: str = "log_var") -> np.ndarray | float:
+@overload
+def feature_of_variance(f: float | np.floating, feature: str = "log_var") -> float: ...
+@overload
+def feature_of_variance(
+    f: np.ndarray | Sequence[float], feature: str = "log_var"
+) -> np.ndarray: ...
+def feature_of_variance(
+    f: float | np.floating | np.ndarray | Sequence[float], feature: str = "log_var"
+) -> float | np.ndarray:
     """The observation y of windows whose variance (normalised by T) is ``f``, (m/s^2)^2.
 
     The one map from f to y, shared by the BCR (``window_feature``) and emulator training, so

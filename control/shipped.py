@@ -7,6 +7,7 @@ from pathlib import Path
 
 from control.errors import ControlError, EmulatorMismatchError
 from control.validation import is_choice
+from gpmsa import Emulator
 from roadgen.checks import home_path
 
 EMULATOR_DIR = Path(__file__).parent / "emulators"
@@ -55,7 +56,7 @@ def shipped_emulator_path(case: str = "A", kind: str = "band", folder=None) -> P
     return path
 
 
-def shipped_emulator(case: str = "A", kind: str = "band", folder=None):
+def shipped_emulator(case: str = "A", kind: str = "band", folder=None) -> Emulator:
     """The shipped Jackal emulator of Test Case "A" or "B" as a `gpmsa.Emulator` (with
     ``folder``: the one of that name there, e.g. trained for your robot).
 

@@ -30,6 +30,7 @@ from control.feature import FeatureSpec, block_features
 from control.observation_model import BlockScatter
 from control.sensor_checks import MAX_ACCEL_MPS2
 from control.validation import check_instance, float_array, is_integer, is_real
+from gpmsa import Emulator
 from gpmsa.errors import numbers_text
 
 __gpmsa_wrapper__ = True
@@ -376,7 +377,7 @@ def fit_band_emulator(
     nodes=None,
     metadata: dict | None = None,
     **fit_options,
-):
+) -> Emulator:
     """The change-point BCR's emulator (the block feature) from m runs at known speed and GD.
 
     As examples/train_emulator.py fits its band emulators: each run's mean block feature
@@ -426,7 +427,7 @@ def fit_band_emulator(
 def fit_window_emulator(
     speed, gd, accel, *, noise_std: float, vehicle=None, metadata: dict | None = None,
     **fit_options,
-):  # fmt: skip
+) -> Emulator:  # fmt: skip
     """The paper's window emulator (y = log f, f the variance of a run's last 1,000 samples,
     `control.PAPER_WINDOW`) from m runs at known speed and GD, as examples/train_emulator.py
     fits it (the lamWs prior `WINDOW_PRIORS_LAMWS` unless ``fit_options`` gives ``priors``).

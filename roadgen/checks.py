@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -219,7 +220,9 @@ def band(
     return lo, hi
 
 
-def positions(name: str, s: np.ndarray | float, length_m: float) -> np.ndarray:
+def positions(
+    name: str, s: float | np.floating | np.ndarray | Sequence[float], length_m: float
+) -> np.ndarray:
     """Return ``s`` as a float array, or raise if any position is NaN or outside [0, length_m]."""
     arr = real_array(name, s)
     tol = 1e-9 * max(length_m, 1.0)

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -60,7 +62,11 @@ class Profile(Road):
         object.__setattr__(self, "gd", checks.gd("gd", self.gd))
         check_settings(self.settings, self.dx_m, self.length_m)
 
-    def gd_at(self, s: np.ndarray | float) -> np.ndarray | float:
+    @overload
+    def gd_at(self, s: float | np.floating) -> float: ...
+    @overload
+    def gd_at(self, s: np.ndarray | Sequence[float]) -> np.ndarray: ...
+    def gd_at(self, s: float | np.floating | np.ndarray | Sequence[float]) -> float | np.ndarray:
         """Prescribed GD at positions ``s`` (m): the constant ``gd``, shaped like ``s``."""
         arr = checks.positions("s", s, self.length_m)
         out = np.full(arr.shape, self.gd)
@@ -71,7 +77,7 @@ def iso8608_profile(
     length_m: float,
     gd: float,
     dx_m: float = 0.006,
-    seed: int | np.random.Generator | None = None,
+    seed: int | np.integer | np.random.Generator | None = None,
     band: tuple[float, float] | None = None,
     amplitudes: str = "deterministic",
     waviness: float = 2.0,
@@ -125,7 +131,7 @@ def iso8608_profile(
 def unit_road(
     n_points: int,
     dx_m: float,
-    seed: int | np.random.Generator | None,
+    seed: int | np.integer | np.random.Generator | None,
     band: tuple[float, float] | None,
     amplitudes: str,
     waviness: float,

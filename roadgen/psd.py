@@ -39,8 +39,10 @@ GD_METHODS = ("fit", "welch", "periodogram")
 class HasHeights(Protocol):
     """Anything with heights z (N,) m on a uniform grid of step dx_m (Profile, Track)."""
 
-    z: np.ndarray
-    dx_m: float
+    @property
+    def z(self) -> np.ndarray: ...
+    @property
+    def dx_m(self) -> float: ...
 
 
 def profile_psd(

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -46,7 +48,13 @@ class Road:
         """Length of the road, x[-1], m."""
         return float(self.x[-1])
 
-    def height_at(self, s: np.ndarray | float) -> np.ndarray | float:
+    @overload
+    def height_at(self, s: float | np.floating) -> float: ...
+    @overload
+    def height_at(self, s: np.ndarray | Sequence[float]) -> np.ndarray: ...
+    def height_at(
+        self, s: float | np.floating | np.ndarray | Sequence[float]
+    ) -> float | np.ndarray:
         """Height (m) at positions ``s`` (m, any shape, in [0, length_m]), linearly interpolated.
 
         Returns an array of the shape of ``s`` (a float for a scalar). Raises RoadgenError for a

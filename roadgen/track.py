@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 
@@ -50,7 +51,11 @@ class Track(Road):
         object.__setattr__(self, "lead_in_m", lead)
         object.__setattr__(self, "blend_m", blend)
 
-    def gd_at(self, s: np.ndarray | float) -> np.ndarray | float:
+    @overload
+    def gd_at(self, s: float | np.floating) -> float: ...
+    @overload
+    def gd_at(self, s: np.ndarray | Sequence[float]) -> np.ndarray: ...
+    def gd_at(self, s: float | np.floating | np.ndarray | Sequence[float]) -> float | np.ndarray:
         """Prescribed GD at positions ``s`` (m): that of the segment holding each position.
 
         This is the step function the paper scores against; the realised roughness changes over
@@ -69,7 +74,7 @@ class Track(Road):
 
 def track(
     segments: Sequence[tuple[float, float]],
-    seed: int | np.random.Generator | None = None,
+    seed: int | np.integer | np.random.Generator | None = None,
     dx_m: float = 0.006,
     band: tuple[float, float] | None = None,
     amplitudes: str = "deterministic",

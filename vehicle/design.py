@@ -24,7 +24,7 @@ def lhs_design(
     n: int = 198,
     v_range: tuple[float, float] = (0.5, 2.0),
     gd_range: tuple[float, float] = (200.0, 600.0),
-    seed: int | np.random.Generator | None = None,
+    seed: int | np.integer | np.random.Generator | None = None,
 ) -> np.ndarray:
     """A Latin-hypercube design (scipy.stats.qmc.LatinHypercube) of ``n`` points.
 

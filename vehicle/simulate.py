@@ -76,7 +76,7 @@ def simulate(
     speed: SpeedSchedule,
     rate_hz: float = 120.0,
     noise_std: float = 0.0,
-    seed: int | np.random.Generator | None = None,
+    seed: int | np.integer | np.random.Generator | None = None,
     *,
     speed_of: str = "time",
     start_m: float | None = None,

@@ -74,7 +74,7 @@ class Simulation:
         track,
         rate_hz: float = 120.0,
         noise_std: float = 0.0,
-        seed: int | np.random.Generator | None = None,
+        seed: int | np.integer | np.random.Generator | None = None,
         start_m: float = 0.0,
         *,
         substeps: int = SUBSTEPS,

@@ -48,6 +48,7 @@ from control.robot import storage as storage_mod
 from control.robot.extra import require
 from control.validation import check_lookup, float_array, is_choice, is_integer, path_argument
 from roadgen.checks import home_path
+from vehicle.models import Model
 
 STORAGES = ("mcap", "sqlite3")
 DIGEST_KEY = "terrain_gpmsa.messages_sha256"
@@ -141,7 +142,7 @@ class Recording:
     imu: ImuMessages
     odometry: OdometryMessages
     read_s: float
-    vehicle: vehicle.Model | None = None
+    vehicle: Model | None = None
     noise_std: float | None = None
 
 
@@ -466,7 +467,7 @@ def simulation_record(model=None, noise_std=None) -> dict[str, str]:
 
 def simulation_from_record(
     fields: dict[str, tuple[str, object]], checksum: tuple[str, object] | None = None
-) -> tuple[vehicle.Model | None, float | None]:
+) -> tuple[Model | None, float | None]:
     """(vehicle model, noise sd m/s^2) from a recording's simulation record ({field: (where it
     is, for a message; its text)}), None for each field absent. `BagError` naming the field
     where its text is not a str of at most `MAX_SIMULATION_CHARS` characters holding JSON of a

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import functools
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
@@ -24,6 +25,9 @@ from gpmsa.model.data import (
     quantile_keys,  # gpmsa.calibration.posterior.quantile_keys, as before session 74
     repr_name,
 )
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: Lower tail probabilities tried by `GridMarginal.hdi`.
 HDI_STEPS = 201
@@ -516,7 +520,13 @@ class Posterior:
             return 0.0
         return float(np.std(draws, ddof=1))
 
-    def quantile(self, name: str, q: float | np.ndarray) -> float | np.ndarray:
+    @overload
+    def quantile(self, name: str, q: float | np.floating) -> float: ...
+    @overload
+    def quantile(self, name: str, q: np.ndarray | Sequence[float]) -> np.ndarray: ...
+    def quantile(
+        self, name: str, q: float | np.floating | np.ndarray | Sequence[float]
+    ) -> float | np.ndarray:
         """Posterior quantile(s) of ``name`` at probability q in [0, 1]: a number, or an array
         of them (vectorised: an array of quantiles of the same shape). A categorical
         parameter's (``info["levels"]``) is the lower quantile, a level: the smallest whose
@@ -613,7 +623,7 @@ class Posterior:
             draws = {k: np.asarray(v)[None, :] for k, v in self.samples.items()}
         return to_inference_data(draws, units=units)
 
-    def plot(self, name: str, bins: int = 50, unit: str | None = None):
+    def plot(self, name: str, bins: int = 50, unit: str | None = None) -> Figure:
         """Histogram of ``bins`` bars (with the grid density when there is one) and trace of
         ``name``: a Figure. A categorical parameter (a `LevelMarginal`, or ``info["levels"]``
         of draws) gets a bar per level, its draws' share: a probability, not a density.

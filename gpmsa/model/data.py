@@ -10,11 +10,15 @@ import sys
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from gpmsa.errors import DomainWarning, GPMSAError, numbers_text, user_stacklevel
 from gpmsa.model import categorical, index_points, kronecker
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 
 def _first_non_number(value) -> str | None:
@@ -1162,6 +1166,32 @@ class SimData:
     index_names: str | Sequence[str] | None = None
     index_units: str | Sequence[str] | None = None
 
+    if TYPE_CHECKING:  # what the constructor takes (the fields above: what it stores)
+
+        def __init__(
+            self,
+            x: ArrayLike | None = None,
+            t: ArrayLike | None = None,
+            y: ArrayLike | None = None,
+            index: ArrayLike | None = None,
+            x_names: Sequence[str] | None = None,
+            t_names: Sequence[str] | None = None,
+            y_names: Sequence[str] | None = None,
+            x_units: Sequence[str] | None = None,
+            t_units: Sequence[str] | None = None,
+            y_units: Sequence[str] | None = None,
+            x_categorical: Sequence[int | str] | None = None,
+            t_categorical: Sequence[int | str] | None = None,
+            x_range: ArrayLike | Sequence | dict | None = None,
+            t_range: ArrayLike | Sequence | dict | None = None,
+            y_scale: str = "scalar",
+            separable: bool | Sequence | None = None,
+            y_mean: ArrayLike | None = None,
+            y_sd: ArrayLike | None = None,
+            index_names: str | Sequence[str] | None = None,
+            index_units: str | Sequence[str] | None = None,
+        ) -> None: ...
+
     def __post_init__(self) -> None:
         check_same_rows({"x": self.x, "t": self.t, "y": self.y})
         for part in ("x", "t", "y", "index"):
@@ -1370,6 +1400,16 @@ class ObsData:
     x_columns: tuple[str, ...] | None = field(init=False, repr=False)
     y_columns: tuple[str, ...] | None = field(init=False, repr=False)
     index_columns: tuple[tuple[str, ...] | None, ...] | None = field(init=False, repr=False)
+
+    if TYPE_CHECKING:  # what the constructor takes (the fields above: what it stores)
+
+        def __init__(
+            self,
+            x: ArrayLike | None = None,
+            y: ArrayLike | Sequence[ArrayLike] | None = None,
+            index: ArrayLike | Sequence[ArrayLike] | None = None,
+            precision: ArrayLike | Sequence[ArrayLike] | None = None,
+        ) -> None: ...
 
     def __post_init__(self) -> None:
         check_same_rows({"x_obs": self.x, "y_obs": self.y})

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -133,6 +135,25 @@ class Priors:
     corrected: bool = False
     rhoV_a: float | tuple[float, ...] | None = None
     rhoV_b: float | tuple[float, ...] | None = None
+
+    if TYPE_CHECKING:  # what the constructor takes (sequences, stored as tuples)
+
+        def __init__(
+            self,
+            theta_mean: float | Sequence[float] = 0.5,
+            theta_sd: float | Sequence[float] = 10.0,
+            rho_a: float = 1.0,
+            rho_b: float = 0.1,
+            rho_cap: float = 0.999,
+            lamVz: GammaPrior | Sequence[GammaPrior] = ...,
+            lamUz: GammaPrior = ...,
+            lamWs: GammaPrior = ...,
+            lamWOs: GammaPrior = ...,
+            lamOs: GammaPrior = ...,
+            corrected: bool = False,
+            rhoV_a: float | Sequence[float] | None = None,
+            rhoV_b: float | Sequence[float] | None = None,
+        ) -> None: ...
 
     def __post_init__(self) -> None:
         self._check_theta()

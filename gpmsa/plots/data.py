@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from gpmsa.errors import GPMSAError
@@ -9,11 +11,14 @@ from gpmsa.model.data import ObsData, SimData
 from gpmsa.plots import _maps
 from gpmsa.plots._figure import axis_label, figure, index_labels, ink, is_map
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 MAP_PANELS = 4
 """Runs, and experiments, drawn at most as maps over a two-column output index."""
 
 
-def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = None):
+def data(sim: SimData, obs: ObsData | None = None, *, color_by: str | None = None) -> Figure:
     """The runs' outputs and the observations in native units, a first look before fitting (as
     SEPIA's ``plot_data``): a Figure.
 

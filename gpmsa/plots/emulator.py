@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.special import ndtri
 
@@ -20,8 +22,11 @@ from gpmsa.plots import _maps
 from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
 from gpmsa.predictive.crossval import CrossValidation
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
-def pc_basis(emulator, *, max_pc: int = 6):
+
+def pc_basis(emulator, *, max_pc: int = 6) -> Figure:
     """The basis vectors (native units, sd K_j over the output grid) and the runs' weights
     w_j against each input, one row per component (at most ``max_pc``): a Figure.
 
@@ -140,7 +145,7 @@ def _held_out_runs(emulator, held_out) -> tuple[np.ndarray | None, np.ndarray, n
 
 
 def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
-                 draws: bool = True, n_draws: int | None = 100):  # fmt: skip
+                 draws: bool = True, n_draws: int | None = 100) -> Figure:  # fmt: skip
     """Emulator predictions against held-out runs (or a cross-validation): a Figure.
 
     Left: predicted mean against the run's value for every output element, with central

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,6 +14,9 @@ from gpmsa.mcmc.sampler import Chains
 from gpmsa.model.data import as_float, check_count
 from gpmsa.plots._figure import axis_label, check_bins, figure
 from gpmsa.predictive.joint import calibration_posterior
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 NUISANCE = ("lamOs", "lamVz")
 """Posterior names that are not calibration parameters (with ``betaV`` and ``betaV[k]``)."""
@@ -107,7 +111,7 @@ def _pick(series: dict, names, max_params: int) -> list[str]:
     return picked
 
 
-def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
+def traces(source, names=None, *, max_params: int = 12, bins: int = 40) -> Figure:
     """Trace (per chain) and histogram of each scalar parameter: a Figure.
 
     Args:
@@ -148,7 +152,7 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40):
     return fig
 
 
-def autocorrelation(source, names=None, *, max_params: int = 12, max_lag: int = 40):
+def autocorrelation(source, names=None, *, max_params: int = 12, max_lag: int = 40) -> Figure:
     """Autocorrelation of each scalar parameter's draws against the lag, a line per chain, the
     bulk ESS in each panel's title (SEPIA's ``plot_acf``): a Figure.
 
@@ -245,7 +249,7 @@ def _calibration_source(source):
     return source
 
 
-def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30):
+def theta_pairs(source, names=None, *, truth: dict | None = None, bins: int = 30) -> Figure:
     """Pair plot of the calibration parameters: histograms on the diagonal, draws below it.
 
     Args:

@@ -3,6 +3,8 @@ component (``obs_projection``) and in pairs of components (``weight_pairs``)."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from gpmsa.calibration.observations import check_emulator, reduce
@@ -12,11 +14,14 @@ from gpmsa.model.data import ObsData, check_count
 from gpmsa.plots import _maps
 from gpmsa.plots._figure import check_bins, figure, index_labels, is_map
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 MAP_EXPERIMENTS = 3
 """Experiments whose residual a two-column index's last row maps, at most."""
 
 
-def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
+def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30) -> Figure:
     """Can the emulator reach the observations? Per basis component (at most ``max_pc``): a
     histogram of the runs' weights w_j with each experiment's weight u_j (its GLS projection,
     as calibration reduces it) as a vertical line, the title counting the experiments outside
@@ -84,7 +89,9 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30):
     return fig
 
 
-def weight_pairs(emulator, obs: ObsData | None = None, *, max_pc: int = 4, bins: int = 20):
+def weight_pairs(
+    emulator, obs: ObsData | None = None, *, max_pc: int = 4, bins: int = 20
+) -> Figure:
     """The runs' weights in pairs of basis components (SEPIA's ``plot_u_w_pairs``): below the
     diagonal, w_j against w_i of every run (grey) with each experiment's u (its GLS
     projection, as calibration without a discrepancy reduces it) in colour, the title counting

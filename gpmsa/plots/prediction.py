@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from gpmsa.errors import GPMSAError
@@ -9,6 +11,9 @@ from gpmsa.model.data import ObsData, as_float, check_count, check_finite, check
 from gpmsa.plots import _maps
 from gpmsa.plots._figure import axis_label, figure, index_labels, ink, is_map
 from gpmsa.predictive.full import FullPrediction
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 BANDS = (("y", "new observation y", "0.8"), ("zeta", "eta + delta", "C1"),
          ("eta", "simulator eta", "C0"))  # fmt: skip
@@ -24,7 +29,7 @@ def prediction_bands(
     max_panels: int = 6,
     x_column: int = 0,
     relative: bool = False,
-):
+) -> Figure:
     """Bands of a full prediction and the observations at its x: a Figure.
 
     A functional output gets one column per new x (at most ``max_panels``, evenly chosen): on

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from gpmsa.errors import GPMSAError
@@ -10,6 +12,9 @@ from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.correlation import beta_to_rho
 from gpmsa.model.data import check_count
 from gpmsa.plots._figure import figure
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 def _rho_panels(emulator: Emulator, max_pc: int) -> np.ndarray:
@@ -28,7 +33,7 @@ def _rho_panels(emulator: Emulator, max_pc: int) -> np.ndarray:
     return np.moveaxis(beta_to_rho(beta), 2, 0)
 
 
-def rho_boxplots(emulator: Emulator, *, max_pc: int = 6):
+def rho_boxplots(emulator: Emulator, *, max_pc: int = 6) -> Figure:
     """Posterior box plots of rho = exp(-betaU/4) per input, one panel per basis component (at
     most ``max_pc``): a Figure.
 

@@ -4,6 +4,7 @@ main-effect functions with their band over draws."""
 from __future__ import annotations
 
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.stats import norm
@@ -14,8 +15,11 @@ from gpmsa.plots import _maps
 from gpmsa.plots._figure import axis_label, figure, index_columns, index_labels, ink, is_map
 from gpmsa.predictive.sobol import Sensitivity
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
-def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9):
+
+def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9) -> Figure:
     """Main- and total-effect indices per input with their spread over posterior draws.
 
     Left: bars of the aggregated indices (mean over draws) with the central interval of
@@ -109,7 +113,7 @@ def _effect_maps(fig, panels, sens: Sensitivity) -> None:
 
 def main_effect_curves(
     sens: Sensitivity, *, level: float = 0.9, output: int = 0, level_names: dict | None = None
-):
+) -> Figure:
     """Main-effect functions E[y | z_k] of each varied input, with their band over draws.
 
     One panel per varied input (SEPIA's main-effect plot), on a shared output axis: the mean

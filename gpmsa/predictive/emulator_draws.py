@@ -17,6 +17,7 @@ trend h(z)^T c_j and their covariance the coefficients' g^T (H^T Sigma_W_j^-1 H)
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -99,7 +100,7 @@ class EmulatorPrediction:
         """(N, l_sim) predictive variance, native units^2 (law of total variance over draws)."""
         return self._moments_std()[1] * self.y_sd**2
 
-    def quantile(self, q: float | np.ndarray) -> np.ndarray:
+    def quantile(self, q: float | np.ndarray | Sequence[float]) -> np.ndarray:
         """Predictive quantile(s) of the output, native units, at probability q in [0, 1] (a
         number, or an array of them): the empirical quantiles of the S * n_rlz realizations
         ``y`` (numpy's linear rule, so Monte-Carlo estimates), shape (N, l_sim) for a number and

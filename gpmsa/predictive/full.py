@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -176,7 +177,7 @@ class FullPrediction:
         m, v = self._moments_std(what)
         return (v.mean(axis=0) + m.var(axis=0)) * self.y_sd**2
 
-    def quantile(self, q: float | np.ndarray, what: str = "y") -> np.ndarray:
+    def quantile(self, q: float | np.ndarray | Sequence[float], what: str = "y") -> np.ndarray:
         """Predictive quantile(s) of ``what`` (as `mean`), native units, at probability q in
         [0, 1] (a number, or an array of them): the empirical quantiles of its S * n_rlz
         realizations (numpy's linear rule, so Monte-Carlo estimates), shape (N, l) for a number
