@@ -51,13 +51,18 @@ def run_text(status, sample_time, sample_position, samples: str) -> str:
     sensor samples" without one; ``samples`` names the samples ("sensor", "IMU"). Never the
     arrays: a repr of a long run's stays short and quick."""
     status, t, s = (np.ravel(np.asarray(a)) for a in (status, sample_time, sample_position))
-    counted = f"{t.size} {samples} samples"
+    counted = _count(t.size, f"{samples} sample")
     if not status.size:
         return f"no estimate; {counted}"
     names, counts = np.unique(status.astype(str), return_counts=True)
     statuses = ", ".join(f"{k} {c}" for k, c in zip(names, counts, strict=True))
     span = f" over {t[-1] - t[0]:.1f} s, {s[-1] - s[0]:.1f} m" if t.size and s.size else ""
-    return f"{status.size} estimates{span}: {statuses}; {counted}"
+    return f"{_count(status.size, 'estimate')}{span}: {statuses}; {counted}"
+
+
+def _count(n: int, what: str) -> str:
+    """``n`` and ``what``, plural unless one ("1 estimate", "2 estimates")."""
+    return f"{n} {what}{'' if n == 1 else 's'}"
 
 
 def edge_counts(domain_edge) -> dict[str, int]:

@@ -34,7 +34,10 @@ HEADER = re.compile(r"^(\s*)([A-Z][A-Za-z ]*):\s*(.*)$")
 ENTRY = re.compile(
     r"^(\s*)(\*{0,2}[A-Za-z_]\w*(?:\s*,\s*\*{0,2}[A-Za-z_]\w*)*)(?:\s*\([^)]*\))?:(?:\s|$)"
 )
-INLINE = re.compile(r"(?<=\. )([a-z_][a-z0-9_]*(?:, [a-z_][a-z0-9_]*)*): ")
+INLINE = re.compile(  # not after "e.g. "/"i.e. ", nor prose's "default: 5", "note: ..."
+    r"(?<=\. )(?<!e\.g\. )(?<!i\.e\. )(?!(?:defaults?|notes?)\b)"
+    r"([a-z_][a-z0-9_]*(?:, [a-z_][a-z0-9_]*)*): "
+)
 LITERAL = r"`{0,2}([-+]?\d[\d,_]*(?:\.\d+)?(?:e[-+]?\d+)?%?(?![\w.])|[\w.\"'+-]+?)`{0,2}"
 DEFAULT = re.compile(
     rf"\bdefaults?(?: is| to|:)?\s+{LITERAL}(?=[\s,;)]|\.?$)|{LITERAL}\s+\((?:the )?default\)",
@@ -365,7 +368,15 @@ def test_keywords_the_docs_pass_exist():
     [
         ("Args:\n    a: one. b_c: two.\n    d, e (int): three.\n", ["a", "b_c", "d", "e"]),
         ("Attributes:\n    x: the x\n        (more: text)\n    y: the y\n", ["x", "y"]),
+        # prose inside an entry is no entry (it read "default" and "m" as names taken)
+        ("Args:\n    n: nodes per axis. default: 129. m: runs.\n", ["n", "m"]),
+        ("Args:\n    u: the unit (e.g. m: metres; i.e. s: seconds). note: kept.\n", ["u"]),
     ],
 )
 def test_the_entry_parser(doc, names):
     assert list(entries(doc)) == names
+
+
+def test_a_default_written_after_a_sentence_is_read():
+    text = entries("Args:\n    n: nodes per axis. default: 129\n")["n"]
+    assert [m.group(1) for m in DEFAULT.finditer(text)] == ["129"], text

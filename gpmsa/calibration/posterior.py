@@ -102,7 +102,8 @@ class GridMarginal:
 
     def __repr__(self) -> str:
         k = np.size(self.nodes)
-        ends = numbers_text(self.nodes[0], self.nodes[-1], digits=4) if k else ()
+        first, last = (float(self.nodes[0]) + 0.0, float(self.nodes[-1]) + 0.0) if k else (0, 0)
+        ends = numbers_text(first, last, digits=4)  # (+ 0.0: a zero as "0", never "-0")
         span = f" on [{ends[0]}, {ends[1]}]" if k else ""
         return f"GridMarginal({k} nodes{span}, mean={self.mean():.4g}, sd={self.sd():.3g})"
 

@@ -542,7 +542,9 @@ def _run(args: argparse.Namespace, load, Calibrator) -> int:
     print(f"{'name':>10s} {'mean':>12s} {'sd':>12s} {lo_key:>12s} {'median':>12s} {hi_key:>12s}"
           + (" unit" if any(units.values()) else ""))  # fmt: skip
     for name, s in summary.items():
-        unit = f" {safe(units[name], 60)}" if units.get(name) else ""
+        # in brackets, as `gpmsa info` prints it: a unit that reads as a number ("1e-6 m^3",
+        # the shipped GD's) is not taken for one more figure of the row
+        unit = f" [{safe(units[name], 60)}]" if units.get(name) else ""
         if s.get("held"):  # as `gpmsa info` prints a parameter held whole
             print(f"{safe(name, 60):>10s} held at {s['mean']:.12g}{unit} (fixed=)")
             continue

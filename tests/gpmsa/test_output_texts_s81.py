@@ -129,6 +129,6 @@ def test_calibrate_prints_a_row_of_distinct_figures_distinctly_with_its_unit(tmp
     assert len(set(figures)) == 4 and "1e+06" not in figures, row
     for text, key in zip(figures, ("mean", "q5", "median", "q95"), strict=True):
         assert float(text) == pytest.approx(summary[key], abs=5e-4), (text, key)
-    assert row[-1] == "kg", row
+    assert row[-1] == "[kg]", row  # in brackets, as `gpmsa info` prints it
     lam = next(line for line in out if line.split()[0] == "lamOs").split()
     assert len(lam) == 6, lam  # a precision: no unit recorded, none printed

@@ -1,0 +1,20 @@
+"""A run's one-line repr counts as a person writes it: "1 estimate", "1 sensor sample" (it
+read "1 estimates over 0.3 s ...; 1 sensor samples"), as the Emulator's repr says "1 output"."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from control.estimate import run_text
+
+
+def test_one_estimate_and_one_sample_read_singular():
+    text = run_text(np.array(["ok"], dtype=object), [0.5], [2.0], "sensor")
+    assert text == "1 estimate over 0.0 s, 0.0 m: ok 1; 1 sensor sample", text
+    assert run_text([], [0.5], [2.0], "IMU") == "no estimate; 1 IMU sample"
+
+
+def test_many_read_plural_as_before():
+    text = run_text(np.array(["ok", "filling"]), [0.0, 0.25, 1.5], [0.0, 0.5, 3.0], "IMU")
+    assert text == "2 estimates over 1.5 s, 3.0 m: filling 1, ok 1; 3 IMU samples", text
+    assert run_text([], [], [], "sensor") == "no estimate; 0 sensor samples"
