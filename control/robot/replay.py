@@ -374,7 +374,8 @@ class ReplayResult:
         """How many estimates of each status, or why there is none."""
         if self.status.size:
             counts = ", ".join(f"{k} {v}" for k, v in sorted(self.status_counts().items()))
-            return f"{self.status.size} estimates over {self.duration_s:.1f} s: {counts}"
+            n = self.status.size
+            return f"{n} estimate{'s' if n != 1 else ''} over {self.duration_s:.1f} s: {counts}"
         every = self.bcr.samples_per_update
         return (
             f"no estimate: only {self.sample_time.size} IMU sample(s) lie within the "

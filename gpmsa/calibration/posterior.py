@@ -695,6 +695,7 @@ class Posterior:
             parts = ["?"]
         if len(self.names) > shown:
             parts.append(f"+{len(self.names) - shown} more")
+        parts = parts or ["no parameters"]
         return f"Posterior({', '.join(parts)}, method={self.info.get('method', '?')})"
 
     def _describe(self, name: str) -> str:

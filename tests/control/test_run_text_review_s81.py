@@ -18,3 +18,17 @@ def test_many_read_plural_as_before():
     text = run_text(np.array(["ok", "filling"]), [0.0, 0.25, 1.5], [0.0, 0.5, 3.0], "IMU")
     assert text == "2 estimates over 1.5 s, 3.0 m: filling 1, ok 1; 3 IMU samples", text
     assert run_text([], [], [], "sensor") == "no estimate; 0 sensor samples"
+
+
+def test_a_replay_of_one_estimate_counts_it_in_the_singular():
+    from control.robot.replay import ReplayResult
+
+    fake = type("R", (), {"status": np.array(["ok"]), "duration_s": 1.0,
+                          "status_counts": lambda self: {"ok": 1}})()  # fmt: skip
+    assert ReplayResult._count_line(fake).startswith("1 estimate over 1.0 s: ok 1")
+
+
+def test_a_posterior_of_no_parameters_says_so():
+    import gpmsa
+
+    assert repr(gpmsa.Posterior({})) == "Posterior(no parameters, method=?)"
