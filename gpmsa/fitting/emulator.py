@@ -95,8 +95,8 @@ def predict_block_rows(m: int) -> int:
 
 def _blocks(n: int, rows: int):
     """Slices of ``rows`` consecutive of n points; a last block of one point joins the one
-    before it: numpy sums a lone column pairwise, several columns term by term, so a block of one
-    point would not give its values in the whole call."""
+    before it: the product of a one-row block with the solve's weights goes through another BLAS
+    kernel than a row of a larger block (OpenBLAS: another summation order, other last bits)."""
     start = 0
     while start < n:
         stop = n if n - (start + rows) == 1 else start + rows
@@ -560,9 +560,13 @@ class Emulator:
     def _predict_std(self, z: np.ndarray, params, factors, resid: bool, *, var: bool = True):
         """Standardised predictive mean and variance (N, l_sim) at unit-scale z; ``var=False``:
         the variance None, its triangular solves skipped (the mean's operations unchanged).
-        The points go through in blocks of `predict_block_rows` (each point's values are those
-        of one call at all points: every operation is row by row, or column by column of the
-        solves), so that the (points, m) correlations and solves stay bounded at many points."""
+        The points go through in blocks of `predict_block_rows`, so that the (points, m)
+        correlations and solves stay bounded at many points. Every operation is row by row (a
+        point's correlations, its dot product with the weights, its column of the solves), so a
+        point's values are those of one call at all points up to the BLAS's summation order: a
+        BLAS may order a row's dot product by the row's place in the call (OpenBLAS: in groups
+        of rows, which blocks of a multiple of 64 rows keep; with several threads, at the
+        boundaries of its threads' shares), a last-bit difference at a few points."""
         if self.separable is not None:  # through the factors: no m x m matrix
             return kronecker.predict_std(self, z, params, factors, resid, var=var)
         rows = predict_block_rows(self.m)
@@ -603,18 +607,24 @@ class Emulator:
 
     def _check_predict_memory(self, x, t, n_draws: int = 0) -> None:
         """ResourceLimitError where a prediction at the points of x and t would need more than
-        the limit: a block of points' (points, m) work arrays, the inputs and outputs, and
-        with ``n_draws`` draws their means (n_draws, points, l_sim)."""
+        the limit: a block of points' (points, m) work arrays (a separable emulator: each
+        point's correlations to the factors' points and the contraction's (points, m / m_1)),
+        the inputs and outputs, and with ``n_draws`` draws their means (n_draws, points,
+        l_sim)."""
         try:  # the size before converting; a ragged input is named by _inputs
             n = max(np.shape(x)[0] if np.ndim(x) else 1, np.shape(t)[0] if np.ndim(t) else 1)
         except ValueError:
             n = 1
-        block = min(n, predict_block_rows(self.m)) if self.separable is None else n
+        if self.separable is None:
+            work = 4.0 * min(n, predict_block_rows(self.m)) * self.m
+        else:  # kronecker.predict_std: no (points, m) array
+            sizes = self.separable.sizes
+            work = n * (3.0 * sum(sizes) + 2.0 * self.m / sizes[0])
+        draws = f", {n_draws} draws, their means kept: n_draws= takes fewer" if n_draws else ""
         check_memory(
-            8.0 * (4.0 * block * self.m + n * (6.0 * self.l_sim + 4.0 * (self.p + self.q)))
+            8.0 * (work + n * (6.0 * self.l_sim + 4.0 * (self.p + self.q)))
             + 8.0 * n_draws * n * self.l_sim,
-            f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs"
-            + (f", {n_draws} draws)" if n_draws else ")"),
+            f"predict() at {n} points ({self.m} runs, {self.l_sim} outputs{draws})",
         )
 
     def _predict_point(self, x, t, resid: bool, *, extrapolate: bool = False, var: bool = True):
@@ -642,22 +652,28 @@ class Emulator:
                 "point estimate"
             )
         idx = evenly_spaced(self.n_draws, n_draws)
-        # each draw's mean kept in one array (the law of total variance needs them all), its
-        # variance summed as it comes: the values of np.array(list).mean(axis=0) and .var(axis=0)
+        # each draw's mean kept in one array (the law of total variance needs them all); their
+        # variances kept too where small or one value a draw (numpy's mean over the draws sums
+        # such a column pairwise), else summed as they come (numpy's order over an outer axis)
         means = np.empty((len(idx), z.shape[0], self.l_sim))
+        keep = means.size <= PREDICT_BLOCK_VALUES or z.shape[0] * self.l_sim == 1
+        vars_ = np.empty_like(means) if var and keep else None
         var_sum = None
         with one_thread():  # many small solves: one thread
             for k, i in enumerate(idx):
                 prm = {name: self.draws[name][i] for name in EMULATOR_PARAMS}
                 means[k], v = self._predict_std(z, prm, self._predict_factors(prm), resid, var=var)
-                if var and var_sum is None:
+                if vars_ is not None:
+                    vars_[k] = v
+                elif var and var_sum is None:
                     var_sum = v
                 elif var:
                     var_sum += v
         mean = means.mean(axis=0)
         if not var:
             return s.y_from_std(mean), None
-        var_ = var_sum / len(idx) + _spread_of_means(means)
+        var_mean = vars_.mean(axis=0) if vars_ is not None else var_sum / len(idx)
+        var_ = var_mean + _spread_of_means(means)
         return s.y_from_std(mean), s.var_from_std(var_)
 
     def predict(
