@@ -399,7 +399,8 @@ def fit_band_emulator(
         metadata: further records (the road, the design, ...); one of the records the fit
             writes (``noise_std``, ``vehicle``, ``feature``, ``block_scatter``) only with the
             fit's value.
-        fit_options: passed to `gpmsa.fit` (``n_iter``, ``seed``, ``n_chains``, ...).
+        fit_options: passed to `gpmsa.fit` (``n_iter``, ``seed``, ``n_chains``, ``progress``
+            for its tqdm bar, ...).
 
     Raises ControlError, before the fit, naming the argument: runs of different lengths (cut
     them to one), fewer than 4 runs, runs all at one speed or one GD, GDs all below `GD_MIN_HI`

@@ -20,6 +20,7 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa import _threads
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import EmulatorFileError, GPMSAError, user_stacklevel
 from gpmsa.fitting.validation import (
@@ -638,10 +639,11 @@ class Emulator:
 
     def _predict_draws(
         self, x, t, n_draws: int | None, resid: bool, *, extrapolate: bool = False,
-        var: bool = True,
+        var: bool = True, progress: bool = False, desc: str = "predict",
     ):  # fmt: skip
-        """``predict(x, t, draws=True, n_draws=n_draws, resid=resid, extrapolate=extrapolate)``;
-        ``var=False``: the variance None (``predict_mean``)."""
+        """``predict(x, t, draws=True, n_draws=n_draws, resid=resid, extrapolate=extrapolate,
+        progress=progress)``; ``var=False``: the variance None (``predict_mean``); ``desc``:
+        the bar's description."""
         if self.draws:
             self._check_predict_memory(x, t, len(evenly_spaced(self.n_draws, n_draws)))
         z = self._inputs(x, t, extrapolate=extrapolate)
@@ -659,7 +661,8 @@ class Emulator:
         keep = means.size <= PREDICT_BLOCK_VALUES or z.shape[0] * self.l_sim == 1
         vars_ = np.empty_like(means) if var and keep else None
         var_sum = None
-        with one_thread():  # many small solves: one thread
+        # many small solves: one thread
+        with one_thread(), progress_bar(progress, len(idx), desc) as bar:
             for k, i in enumerate(idx):
                 prm = {name: self.draws[name][i] for name in EMULATOR_PARAMS}
                 means[k], v = self._predict_std(z, prm, self._predict_factors(prm), resid, var=var)
@@ -669,6 +672,7 @@ class Emulator:
                     var_sum = v
                 elif var:
                     var_sum += v
+                bar.update(1)
         mean = means.mean(axis=0)
         if not var:
             return s.y_from_std(mean), None
@@ -678,7 +682,7 @@ class Emulator:
 
     def predict(
         self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True,
-        extrapolate: bool = False,
+        extrapolate: bool = False, progress: bool = False,
     ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
         """Predictive mean and variance (N, l_sim) of the simulator output in native units.
 
@@ -693,31 +697,38 @@ class Emulator:
         Inputs outside the emulator's ``domain``: an ExtrapolationWarning; beyond it by more
         than ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width a GPMSAError naming x or t,
         the column, its values and the domain, unless ``extrapolate=True`` (then the warning),
-        as ``gpmsa.calibrate`` takes x_obs.
+        as ``gpmsa.calibrate`` takes x_obs. ``progress=True`` shows a tqdm bar over the draws
+        on stderr ("predict"; ``draws=True`` only: the point estimate has no loop).
         """
         draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
         extrapolate = check_flag(extrapolate, "extrapolate")
+        progress = check_flag(progress, "progress")
         if n_draws is not None:  # also where draws=False leaves it unused
             check_count(n_draws, "n_draws")
         if not draws:
             return self._predict_point(x, t, resid, extrapolate=extrapolate)
-        return self._predict_draws(x, t, n_draws, resid, extrapolate=extrapolate)
+        return self._predict_draws(x, t, n_draws, resid, extrapolate=extrapolate,
+                                   progress=progress)  # fmt: skip
 
     def predict_mean(
-        self, x, t, *, draws: bool = False, n_draws: int | None = None, extrapolate: bool = False
-    ) -> np.ndarray:
+        self, x, t, *, draws: bool = False, n_draws: int | None = None, extrapolate: bool = False,
+        progress: bool = False,
+    ) -> np.ndarray:  # fmt: skip
         """Predictive mean (N, l_sim) in native units: ``predict(x, t, draws=draws,
         n_draws=n_draws, extrapolate=extrapolate)[0]`` to the last bit, without computing the
         variance (its triangular solves, about half of ``predict``'s time at many points). The
-        mean does not depend on ``resid``; the arguments and their checks are ``predict``'s.
+        mean does not depend on ``resid``; the arguments and their checks are ``predict``'s
+        (``progress``: its bar, described "predict_mean").
         """
         draws = check_flag(draws, "draws")
         extrapolate = check_flag(extrapolate, "extrapolate")
+        progress = check_flag(progress, "progress")
         if n_draws is not None:  # also where draws=False leaves it unused
             check_count(n_draws, "n_draws")
         if not draws:
             return self._predict_point(x, t, False, extrapolate=extrapolate, var=False)[0]
-        return self._predict_draws(x, t, n_draws, False, extrapolate=extrapolate, var=False)[0]
+        return self._predict_draws(x, t, n_draws, False, extrapolate=extrapolate, var=False,
+                                   progress=progress, desc="predict_mean")[0]  # fmt: skip
 
     # --- checks -------------------------------------------------------------------------------
     def loo(self) -> LooResult:

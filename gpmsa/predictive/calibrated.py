@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.calibration.observations import EMULATOR_ATTRS, check_x
 from gpmsa.calibration.posterior import Posterior
@@ -108,6 +109,7 @@ def calibrated_predict(
     draws: bool = False,
     n_theta: int = 200,
     extrapolate: bool = False,
+    progress: bool = False,
 ) -> CalibratedPrediction:
     """The output's predictive at ``x_new`` with theta (and lamOs) from ``posterior``.
 
@@ -143,6 +145,9 @@ def calibrated_predict(
             warning naming x_new), as ``gpmsa.calibrate`` allows x_obs; False: within
             ``EXTRAPOLATION_MARGIN`` (10 %) of a column's width a warning, as
             ``Emulator.predict``, beyond it a GPMSAError naming the column.
+        progress: with ``draws=True``, show a tqdm bar over the emulator draws on stderr
+            ("calibrated_predict"; each is factored once). The point estimate's one
+            vectorised prediction shows none.
 
     Returns:
         CalibratedPrediction (native units).
@@ -154,6 +159,7 @@ def calibrated_predict(
     noise, resid = check_flag(noise, "noise"), check_flag(resid, "resid")
     draws = check_flag(draws, "draws")
     extrapolate = check_flag(extrapolate, "extrapolate")
+    progress = check_flag(progress, "progress")
     x, _ = check_x(emulator, x_new, extrapolate, "x_new")
     if not isinstance(posterior, Posterior):
         raise GPMSAError(f"posterior must be a gpmsa.Posterior, got {type(posterior).__name__}")
@@ -199,7 +205,7 @@ def calibrated_predict(
             mean, var = emulator._predict_point(xs, ts, resid, extrapolate=extrapolate)
         else:
             mean, var = _paired_predict(emulator, xs, ts, np.repeat(paired[idx], N), resid,
-                                        extrapolate)  # fmt: skip
+                                        extrapolate, progress)  # fmt: skip
     l_sim = mean.shape[1]
     mean = mean.reshape(K, N, l_sim)
     var = var.reshape(K, N, l_sim)
@@ -210,18 +216,24 @@ def calibrated_predict(
     return CalibratedPrediction(x, m, v, mean, var, weights)
 
 
-def _paired_predict(emulator, xs, ts, draw_of: np.ndarray, resid: bool, extrapolate: bool):
+def _paired_predict(
+    emulator, xs, ts, draw_of: np.ndarray, resid: bool, extrapolate: bool, progress: bool = False
+):  # fmt: skip
     """Native predictive mean and variance (n, l_sim) at native (xs, ts) (n rows), row i at the
-    emulator's retained draw ``draw_of[i]`` (``Emulator.predict``'s single-draw predictive)."""
+    emulator's retained draw ``draw_of[i]`` (``Emulator.predict``'s single-draw predictive);
+    ``progress``: a bar over the distinct draws."""
     emulator._check_predict_memory(xs, ts)
     z = emulator._inputs(xs, ts, extrapolate=extrapolate)
     mean = np.empty((z.shape[0], emulator.l_sim))
     var = np.empty_like(mean)
-    with one_thread():  # many small solves: one thread
-        for d in np.unique(draw_of):
+    distinct = np.unique(draw_of)
+    # many small solves: one thread
+    with one_thread(), progress_bar(progress, distinct.size, "calibrated_predict") as bar:
+        for d in distinct:
             rows = draw_of == d
             prm = {k: np.asarray(emulator.draws[k][d]) for k in EMULATOR_PARAMS}
             fac = emulator._predict_factors(prm)
             mean[rows], var[rows] = emulator._predict_std(z[rows], prm, fac, resid)
+            bar.update(1)
     s = emulator.standardizer
     return s.y_from_std(mean), s.var_from_std(var)

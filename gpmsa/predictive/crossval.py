@@ -26,6 +26,7 @@ import numpy as np
 from scipy.linalg import cho_solve
 from scipy.special import ndtr
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import output_variance, span_text
@@ -145,6 +146,7 @@ def cross_validate(
     draws: bool = True,
     n_draws: int | None = None,
     seed=None,
+    progress: bool = False,
 ) -> CrossValidation:
     """Leave-one-out (default) or k-fold predictions of the runs, averaged over posterior draws.
 
@@ -157,6 +159,9 @@ def cross_validate(
             (then leave-one-out equals ``Emulator.loo()``).
         n_draws: at most this many draws, evenly spaced (None: all retained draws).
         seed: for the random folds.
+        progress: show a tqdm bar over the draws on stderr ("cross_validate"; each draw
+            factors the runs' covariance once per component: minutes for hundreds of runs
+            and draws).
 
     Returns:
         CrossValidation.
@@ -174,7 +179,7 @@ def cross_validate(
         True
     """
     gpmsa_model_only(emulator, "cross_validate")
-    draws = check_flag(draws, "draws")
+    draws, progress = check_flag(draws, "draws"), check_flag(progress, "progress")
     m, p_u, l_sim = emulator.m, emulator.p_u, emulator.l_sim
     labels = _fold_labels(folds, m, seed)
     groups = [np.flatnonzero(labels == g) for g in range(labels.max() + 1)]
@@ -190,7 +195,7 @@ def cross_validate(
     S = len(sets)
     acc = {k: np.zeros((m, l_sim)) for k in ("m", "m2", "v", "pit")}
     acc_w = {k: np.zeros((m, p_u)) for k in ("m", "m2", "v")}
-    with one_thread():
+    with one_thread(), progress_bar(progress, S, "cross_validate") as bar:
         for prm in sets:
             mw = np.empty((m, p_u))
             vw = np.empty((m, p_u))
@@ -217,6 +222,7 @@ def cross_validate(
             acc_w["m"] += mw
             acc_w["m2"] += mw**2
             acc_w["v"] += vw
+            bar.update(1)
 
     def moments(a):
         mean = a["m"] / S

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
@@ -135,6 +136,7 @@ def emulator_prediction(
     joint: bool = False,
     seed=None,
     extrapolate: bool = False,
+    progress: bool = False,
 ) -> EmulatorPrediction:
     """Realizations of the simulator output at (x, t), one set per emulator posterior draw.
 
@@ -157,6 +159,7 @@ def emulator_prediction(
         extrapolate: allow x and t outside the emulator's domain by more than
             ``EXTRAPOLATION_MARGIN`` of a column's width (with an ExtrapolationWarning), as
             ``Emulator.predict(extrapolate=True)``.
+        progress: show a tqdm bar over the draws on stderr ("emulator_prediction").
 
     Returns:
         EmulatorPrediction; its ``mean()`` and ``var()`` equal ``Emulator.predict(x, t,
@@ -178,6 +181,7 @@ def emulator_prediction(
     gpmsa_model_only(emulator, "emulator_prediction")
     draws, resid = check_flag(draws, "draws"), check_flag(resid, "resid")
     joint, extrapolate = check_flag(joint, "joint"), check_flag(extrapolate, "extrapolate")
+    progress = check_flag(progress, "progress")
     n_rlz = check_count(n_rlz, "n_rlz")
     rng = rng_of(seed)
     s = emulator.standardizer
@@ -206,7 +210,7 @@ def emulator_prediction(
     mu = np.empty((S, N, p_u))
     var = np.empty((S, N, p_u))
     w = np.empty((S, n_rlz, N, p_u))
-    with one_thread():
+    with one_thread(), progress_bar(progress, S, "emulator_prediction") as bar:
         for i, prm in enumerate(sets):
             m_i, spread = w_conditional(emulator, prm, gp_factors(emulator, prm), z, joint)
             nugget = 1.0 / prm["lamWs"] if resid else np.zeros(p_u)
@@ -219,6 +223,7 @@ def emulator_prediction(
             else:
                 var[i] = spread + nugget
                 w[i] = m_i + np.sqrt(var[i]) * rng.standard_normal((n_rlz, N, p_u))
+            bar.update(1)
     lamWOs = np.array([float(prm["lamWOs"][0]) for prm in sets])
     y_std = w @ emulator.K.T
     if resid:

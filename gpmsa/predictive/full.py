@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.calibration.observations import check_x, layout_digest
 from gpmsa.calibration.posterior import Posterior
@@ -587,6 +588,7 @@ def full_prediction(
     experiment: int | None = None,
     extrapolate: bool = False,
     grid_discrepancy=None,
+    progress: bool = False,
 ) -> FullPrediction:
     """The calibrated prediction at new x: eta(x, theta), delta(x) and y(x), draw by draw.
 
@@ -641,6 +643,7 @@ def full_prediction(
             it; the basis at another scale, a normalised copy or a multiple, GPMSAError; a
             file without the record needs the basis given to the fit). None: the basis on the
             observations' grid only.
+        progress: show a tqdm bar over the draws on stderr ("full_prediction").
 
     Returns:
         FullPrediction (native units; ``u``, ``v``, ``mu``, ``cov`` in the basis space).
@@ -667,6 +670,7 @@ def full_prediction(
     n_rlz = check_count(n_rlz, "n_rlz")
     extrapolate = check_flag(extrapolate, "extrapolate")
     draws = None if draws is None else check_flag(draws, "draws")
+    progress = check_flag(progress, "progress")
     rng = rng_of(seed)
     std, K = emulator.standardizer, emulator.K
     scalar = emulator.l_sim == 1
@@ -754,7 +758,7 @@ def full_prediction(
     mu = np.empty((S, N, n_c))
     cov_pt = np.empty((S, N, n_c, n_c))
     lat = np.empty((S, n_rlz, N, n_c))
-    with one_thread():
+    with one_thread(), progress_bar(progress, S, "full_prediction") as bar:
         point = None if paired else gp_factors(emulator, emulator.params)
         for i, prm in enumerate(sets):
             fac = point if point is not None else gp_factors(emulator, prm)
@@ -765,6 +769,7 @@ def full_prediction(
             A = mvn_factor(C_i)
             r = m_i + rng.standard_normal((n_rlz, n_c * N)) @ A.T
             lat[i] = r.reshape(n_rlz, n_c, N).transpose(0, 2, 1)
+            bar.update(1)
     lat = lat.reshape(S * n_rlz, N, n_c)
     v, u = lat[:, :, :p_v], lat[:, :, p_v:]
     lamOs = np.array([prm["lamOs"] for prm in sets])

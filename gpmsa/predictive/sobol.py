@@ -76,6 +76,7 @@ import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.special import erf, erfc
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
@@ -726,6 +727,7 @@ def sensitivity(
     joint_effect_grid: int | None = None,
     groups: list | None = None,
     effect_variance: bool = False,
+    progress: bool = False,
 ) -> Sensitivity:
     """Sobol main- and total-effect indices of the emulator's mean, over posterior draws.
 
@@ -758,6 +760,9 @@ def sensitivity(
             joint-effect function, per draw (``main_effect_variance``,
             ``joint_effect_variance``; SEPIA's ``mef_v``, ``jef_v``); needs
             ``main_effect_grid`` or ``joint_effect_grid``. False (default): not computed.
+        progress: show a tqdm bar over the draws on stderr ("sensitivity"; each draw
+            integrates the runs' kernels pairwise: about 40 s for 264 runs, 8 components and
+            100 draws).
 
     Returns:
         Sensitivity with indices per draw, per output element, per basis component and
@@ -787,7 +792,7 @@ def sensitivity(
     names = tuple(emulator.x_names) + tuple(emulator.t_names)
     lo_all = np.concatenate([std.x_min, std.t_min])
     hi_all = np.concatenate([std.x_max, std.t_max])
-    draws = check_flag(draws, "draws")
+    draws, progress = check_flag(draws, "draws"), check_flag(progress, "progress")
     bounds, fixed = _name_dict(bounds, "bounds"), _name_dict(fixed, "fixed")
     for what, given in (("bounds", bounds), ("fixed", fixed)):
         unknown = sorted(set(given) - set(names), key=str)
@@ -903,7 +908,7 @@ def sensitivity(
         z_bar[varied] = centre
         for k, u in fix_u.items():
             z_bar[k] = u
-    with one_thread():
+    with one_thread(), progress_bar(progress, S, "sensitivity") as bar:
         for i, prm in enumerate(sets):
             beta = prm["betaU"]
             trend = None
@@ -1006,6 +1011,7 @@ def sensitivity(
                     E = (E + trend.const[:, None, None, None] + lin[:, :, None, a_pos]
                          + lin[:, None, :, b_pos])  # fmt: skip
                 joint_effect[i] = y_mean[:, None] + sd_col * np.einsum("lj,jabp->ablp", K, E)
+            bar.update(1)
     return Sensitivity(
         names=tuple(k_names), bounds=box,
         fixed={k: float(v) for k, v in fixed.items()}, draw_index=idx, grid=std.grid,

@@ -23,7 +23,7 @@ REPO = Path(__file__).resolve().parents[2]
 PACKAGE = REPO / "gpmsa"
 
 LAYERS = (
-    ("errors", "_version", "_threads"),
+    ("errors", "_version", "_threads", "_progress"),
     ("limits",),
     ("model", "io"),
     ("mcmc",),
@@ -34,7 +34,8 @@ LAYERS = (
     ("__main__",),
 )
 """The parts of gpmsa from the bottom up. A part may import itself and the parts of LOWER layers
-only (never a part of its own layer, never one above): errors, _version, _threads <- model, io <-
+only (never a part of its own layer, never one above): errors, _version, _threads, _progress <-
+model, io <-
 mcmc <- backends <- fitting, calibration <- predictive, studies <- cli, plots <- __main__
 (``python -m gpmsa``, the cli's command) (studies: several models
 at once, built on fitting's Emulator and calibration's problem; cli describes study files); the
