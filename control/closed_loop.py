@@ -300,8 +300,8 @@ def run_closed_loop(
     if record is not None:  # without the robot extra, fail before the drive, not after it
         from control.robot.record import check_can_record, record_run
 
+        _check_record_path(record)  # a wrong path is named with or without the extra
         check_can_record()
-        _check_record_path(record)
     recorded = "vehicle" in (getattr(emulator, "metadata", None) or {})
     if check and recorded:
         # first: a model left at its default says so, not that the Simplex is too fast for it

@@ -360,8 +360,9 @@ def psd_slope(road: HasHeights, band: tuple[float, float] | None = None) -> floa
 
 
 def _end_match(z: np.ndarray) -> np.ndarray:
-    """z minus the straight line through its first and last values."""
-    return z - np.linspace(z[0], z[-1], z.size)
+    """z minus the straight line through its first and last values, along its last axis
+    (scipy < 1.16 passes ``periodogram``'s detrend the segments as rows of a 2-D array)."""
+    return z - np.linspace(z[..., 0], z[..., -1], z.shape[-1], axis=-1)
 
 
 def _fit_band(band: tuple[float, float] | None, dx: float) -> tuple[float, float]:

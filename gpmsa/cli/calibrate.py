@@ -35,17 +35,34 @@ SPREADSHEET_ERRORS = ("#N/A", "#VALUE!", "#REF!", "#DIV/0!", "#NUM!", "#NAME?", 
 """A spreadsheet's error values (its missing value "#N/A" among them): a field that starts a
 line with one is a value to refuse, not a comment."""
 _ERROR_VALUE = "|".join(re.escape(e[1:]) for e in SPREADSHEET_ERRORS)
-_BLANK_NEXT = rf" ++(?:[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|#(?:{_ERROR_VALUE}))(?:\s|$)"
-"""Blanks and a number or another error value: the next field of a blank-separated line."""
+
+
+def _skipped_pattern(possessive: bool = True, most: int | None = None) -> str:
+    """The pattern of `_SKIPPED`: possessive quantifiers (Python >= 3.11), or, for Python 3.10's
+    re, which has none, greedy ones (the same matches: nothing after them can fail, so they
+    never give back) and at most ``most`` lines a match (a greedy group repeat holds a few
+    hundred bytes a repeat until the match ends: 0.5 GB for a million comment lines)."""
+    p = "+" if possessive else ""
+    blank_next = (  # blanks and a number or another error value: a blank-separated line
+        rf" +{p}(?:[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|#(?:{_ERROR_VALUE}))(?:\s|$)"
+    )
+    repeat = f"*{p}" if most is None else f"{{0,{most}}}"
+    return (
+        rf"(?:\s+{p}|#(?!(?:{_ERROR_VALUE})(?: *{p}(?:[,;\t{_LINE_BREAKS}]|$)|{blank_next}))"
+        rf"[^{_LINE_BREAKS}]*{p}){repeat}"
+    )
+
+
+_SKIPPED_MOST = 1024
+"""Python 3.10: the most blank runs and comment lines `_SKIPPED` passes in one match."""
 _SKIPPED = re.compile(
-    rf"(?:\s++|#(?!(?:{_ERROR_VALUE})(?: *+(?:[,;\t{_LINE_BREAKS}]|$)|{_BLANK_NEXT}))"
-    rf"[^{_LINE_BREAKS}]*+)*+"
+    _skipped_pattern() if sys.version_info >= (3, 11) else _skipped_pattern(False, _SKIPPED_MOST)
 )
 """Blank lines and lines starting with "#" (the next line's leading blanks too), from a line's
 start (re's whitespace is ``str.isspace``'s, every line break among it); a line that starts
 with a spreadsheet's error value (`SPREADSHEET_ERRORS`) as its first field is no comment: one
 ending the line or followed by a separator, or by blanks and a number or another error value
-(a blank-separated line; "#N/A means missing" is a comment)."""
+(a blank-separated line; "#N/A means missing" is a comment). `_skipped_end` matches it."""
 _MISSING_MARKS = frozenset({"na", "n/a", "null", "none", "-", "--", "?", "missing",
                             *(e.lower() for e in SPREADSHEET_ERRORS)})  # fmt: skip
 """Fields (lower case) that mark a missing value in files from spreadsheets, loggers and
@@ -327,7 +344,7 @@ def _lines(text: str):
     in one step (a file of millions of them takes no step per line)."""
     pos, k = 0, 1
     while pos < len(text):
-        run = _SKIPPED.match(text, pos).end()
+        run = _skipped_end(text, pos)
         if run == len(text):
             return
         start = max(pos - 1, *(text.rfind(c, pos, run) for c in _LINE_BREAKS)) + 1
@@ -335,6 +352,14 @@ def _lines(text: str):
         end = _LINE.match(text, start).end()
         yield k, text[start:end]
         pos, k = end + (2 if text.startswith("\r\n", end) else 1), k + 1
+
+
+def _skipped_end(text: str, pos: int, pattern: re.Pattern[str] = _SKIPPED) -> int:
+    """Where the blank and comment lines that start at ``pos`` end (``pattern``: `_SKIPPED`);
+    a pattern of at most some lines a match (Python 3.10's) is matched again where it ended."""
+    while (end := pattern.match(text, pos).end()) > pos:
+        pos = end
+    return pos
 
 
 def _breaks(text: str, start: int, end: int) -> int:

@@ -9,10 +9,13 @@ import warnings
 import numpy as np
 import pytest
 
-import control
-import roadgen
-import vehicle
-from control.robot import replay_bag, write_sensor_bag
+pytest.importorskip("rosbags")  # the robot extra: the bags are written and replayed
+pytest.importorskip("mcap")
+
+import control  # noqa: E402
+import roadgen  # noqa: E402
+import vehicle  # noqa: E402
+from control.robot import replay_bag, write_sensor_bag  # noqa: E402
 
 G = 9.81
 
