@@ -110,3 +110,27 @@ def test_the_source_distribution_holds_what_the_readme_runs():
         assert f"graft {folder}" in lines
     assert "include .ci/run" in lines
     assert "global-exclude *.py[cod] __pycache__ .DS_Store" in lines
+
+
+def test_the_source_distribution_leaves_out_what_git_ignores(tmp_path, monkeypatch):
+    """MANIFEST.in as setuptools reads it, over a checkout where the examples, benchmarks and
+    tests have run from their own folders: their out/ folders (figures, campaign caches) and
+    the tools' caches stay out of the sdist, as .gitignore keeps them out of the repository."""
+    file_list = pytest.importorskip("setuptools.command.egg_info").FileList
+    kept = ["docs/a.md", "examples/a.py", "benchmarks/b.py", "tests/data/d.csv",
+            "tests/control/test_a.py", ".ci/run"]  # fmt: skip
+    ignored = ["examples/out/fig.png", "benchmarks/out/bench_campaigns/run.npz",
+               "tests/control/out/o.json", "tests/.hypothesis/examples/h",
+               "tests/.pytest_cache/v", "tests/.ruff_cache/r", "docs/.ruff_cache/r",
+               "tests/__pycache__/t.cpython-311.pyc", "benchmarks/a.campaign-cache/c.npz",
+               "out/metrics.json", "build/lib/x.py"]  # fmt: skip
+    for name in kept + ignored:
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text("x\n")
+    monkeypatch.chdir(tmp_path)
+    files = file_list()
+    files.findall()
+    for line in (REPO / "MANIFEST.in").read_text().splitlines():
+        if line.strip() and not line.startswith("#"):
+            files.process_template_line(line)
+    assert sorted(files.files) == sorted(kept)

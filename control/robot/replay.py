@@ -402,9 +402,10 @@ class ReplayResult:
         beyond = {"upper": "rougher", "lower": "smoother"}
         for edge, named in edge_counts(self.domain_edge).items():
             if named:
+                counted = "1 estimate favours" if named == 1 else f"{named} estimates favour"
                 lines.append(
-                    f"{named} estimates favour the {edge} edge of the emulator's GD domain: the "
-                    f"road may be {beyond[edge]} than any it was trained on"
+                    f"{counted} the {edge} edge of the emulator's GD domain: the road may be "
+                    f"{beyond[edge]} than any it was trained on"
                 )
         lines.append(
             f"replayed at {self.real_time_factor:.0f}x real time (read {self.read_s:.3f} s, "

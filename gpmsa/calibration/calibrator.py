@@ -315,10 +315,12 @@ class Calibrator:
             (native units; with ``"fast": False`` or torch, whose chains start at random,
             add ``"init": "gpmsa"`` where no random start lies inside). It is evaluated on
             the fixed grid once, here (on a refined grid, at the update).
-        progress: show a tqdm bar on stderr ("Calibrator") over the emulator parameter sets
-            the grid prepares here (one with "point"; with "draws" about 0.3 s each for the
-            shipped band emulators, a minute for 200). The MCMC path prepares nothing here;
-            its updates' chains show their bars with ``mcmc_options={"progress": True}``.
+        progress: show a tqdm bar on stderr ("Calibrator") over the grid's preparation
+            here, in steps: per emulator parameter set (one with "point"; with "draws" about
+            0.3 s each for the shipped band emulators, a minute for 200) its GP's Chebyshev
+            plan, its predictor on the grid and, one continuous parameter, on the refined
+            grid. The MCMC path prepares nothing here; its updates' chains show their bars
+            with ``mcmc_options={"progress": True}``.
     """
 
     def __init__(
@@ -438,17 +440,24 @@ class Calibrator:
             self.theta_grid = self.theta_grid[:, 0]
         with one_thread():
             sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
-            self._gps, plans = [], []
-            with progress_bar(progress, len(sets), "Calibrator", "set") as bar:
-                for prm in sets:  # the Chebyshev plans take most of the time
+            # the bar's steps, per set: its GP and Chebyshev plan, its predictor on the grid
+            # and, one continuous parameter, on the refined grid (a plan refused after its fit
+            # or a plan's products on many nodes: any of them can take most of the time)
+            steps = (3 if q == 1 and levels is None else 2) * len(sets)
+            with progress_bar(progress, steps, "Calibrator", "step") as bar:
+                self._gps, plans = [], []
+                for prm in sets:
                     self._gps.append(fixed_gp(emulator, prm))
                     plans.append(chebyshev_plan(self._gps[-1]))
                     bar.update(1)
-            refined = self._refined_axis(plans)
-            _check_predictor_memory(self._gps, plans, G, refined, 8.0 * 8 * G, what)
-            self._predictors = [GridPredictor(gp, self._theta_unit, plan)
-                                for gp, plan in zip(self._gps, plans, strict=True)]  # fmt: skip
-            self._refined = self._refined_predictors(refined, plans)
+                refined = self._refined_axis(plans)
+                _check_predictor_memory(self._gps, plans, G, refined, 8.0 * 8 * G, what)
+                self._predictors = []
+                for gp, plan in zip(self._gps, plans, strict=True):
+                    self._predictors.append(GridPredictor(gp, self._theta_unit, plan))
+                    bar.update(1)
+                self._refined = self._refined_predictors(refined, plans, bar.update)
+                bar.update(steps - bar.n)  # a set without a plan: no refined grid prepared
         mean, sd = emulator.priors.theta_moments(q)  # floats, or per element (q,)
         self._log_prior_theta = -0.5 * np.sum(((self._theta_unit - mean) / sd) ** 2, axis=1)
         if levels is not None:  # a categorical element: uniform over its levels (calibrate's)
@@ -474,15 +483,20 @@ class Calibrator:
         return whole_refined_axis(self._axes[0])
 
     def _refined_predictors(
-        self, axis: np.ndarray | None, plans: list
+        self, axis: np.ndarray | None, plans: list, done=None
     ) -> tuple[np.ndarray, list[GridPredictor]] | None:
         """Predictors on the refined ``axis`` (`_refined_axis`), so that an update that refines
         so costs no dense solves either (the road case: 2.4 -> 1.5 ms, 2.5% of its updates);
-        None without an axis (refined nodes get dense solves)."""
+        None without an axis (refined nodes get dense solves). ``done(1)`` is called after each
+        predictor (a progress bar's ``update``)."""
         if axis is None:
             return None
-        return axis, [GridPredictor(gp, axis[:, None], plan)
-                      for gp, plan in zip(self._gps, plans, strict=True)]  # fmt: skip
+        predictors = []
+        for gp, plan in zip(self._gps, plans, strict=True):
+            predictors.append(GridPredictor(gp, axis[:, None], plan))
+            if done is not None:
+                done(1)
+        return axis, predictors
 
     def __getstate__(self) -> dict:
         """For pickle and ``copy``: all but the update lock (a copy gets its own)."""

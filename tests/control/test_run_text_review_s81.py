@@ -32,3 +32,26 @@ def test_a_posterior_of_no_parameters_says_so():
     import gpmsa
 
     assert repr(gpmsa.Posterior({})) == "Posterior(no parameters, method=?)"
+
+
+def _replay_with_edges(edges):
+    """A ReplayResult's describe() over stand-ins of its parts, one estimate per edge given."""
+    from types import SimpleNamespace
+
+    from control.robot.replay import ReplayResult
+
+    topic = SimpleNamespace(describe=lambda: "a topic")
+    n = len(edges)
+    fake = SimpleNamespace(
+        imu=topic, odometry=topic, resampling=SimpleNamespace(filter="none"), notes=(),
+        status=np.array(["ok"] * n), gd_mean=np.full(n, 300.0), mode=np.array(["normal"] * n),
+        domain_edge=np.array(edges), real_time_factor=50.0, read_s=0.1, condition_s=0.1,
+        bcr_s=0.1, _count_line=lambda: f"{n} estimates",
+    )  # fmt: skip
+    return ReplayResult.describe(fake)
+
+
+def test_one_estimate_at_an_edge_is_counted_in_the_singular():
+    text = _replay_with_edges(["upper", "", "lower", "lower"])
+    assert "\n1 estimate favours the upper edge of the emulator's GD domain" in text, text
+    assert "\n2 estimates favour the lower edge of the emulator's GD domain" in text, text
