@@ -54,6 +54,7 @@ from control.robot.replay import (
     replay_inputs,
 )
 from control.simplex import Simplex
+from gpmsa._version import __version__
 from gpmsa.io.atomic import atomic_write
 from roadgen.checks import home_path
 
@@ -280,6 +281,7 @@ def parser() -> argparse.ArgumentParser:
         "(refused by default; a robot's recording records none)",
     )  # fmt: skip
     p.add_argument("--progress", action="store_true", help="show a progress bar")
+    p.add_argument("--version", action="version", version=f"terrain-replay {__version__}")
     return p
 
 

@@ -161,7 +161,7 @@ def cross_validate(
         seed: for the random folds.
         progress: show a tqdm bar over the draws on stderr ("cross_validate"; each draw
             factors the runs' covariance once per component: minutes for hundreds of runs
-            and draws).
+            and draws); none at the point estimate (``draws=False``).
 
     Returns:
         CrossValidation.
@@ -195,7 +195,7 @@ def cross_validate(
     S = len(sets)
     acc = {k: np.zeros((m, l_sim)) for k in ("m", "m2", "v", "pit")}
     acc_w = {k: np.zeros((m, p_u)) for k in ("m", "m2", "v")}
-    with one_thread(), progress_bar(progress, S, "cross_validate") as bar:
+    with one_thread(), progress_bar(progress and draws, S, "cross_validate") as bar:
         for prm in sets:
             mw = np.empty((m, p_u))
             vw = np.empty((m, p_u))

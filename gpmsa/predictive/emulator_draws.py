@@ -159,7 +159,8 @@ def emulator_prediction(
         extrapolate: allow x and t outside the emulator's domain by more than
             ``EXTRAPOLATION_MARGIN`` of a column's width (with an ExtrapolationWarning), as
             ``Emulator.predict(extrapolate=True)``.
-        progress: show a tqdm bar over the draws on stderr ("emulator_prediction").
+        progress: show a tqdm bar over the draws on stderr ("emulator_prediction"); none at
+            the point estimate (``draws=False``).
 
     Returns:
         EmulatorPrediction; its ``mean()`` and ``var()`` equal ``Emulator.predict(x, t,
@@ -210,7 +211,7 @@ def emulator_prediction(
     mu = np.empty((S, N, p_u))
     var = np.empty((S, N, p_u))
     w = np.empty((S, n_rlz, N, p_u))
-    with one_thread(), progress_bar(progress, S, "emulator_prediction") as bar:
+    with one_thread(), progress_bar(progress and draws, S, "emulator_prediction") as bar:
         for i, prm in enumerate(sets):
             m_i, spread = w_conditional(emulator, prm, gp_factors(emulator, prm), z, joint)
             nugget = 1.0 / prm["lamWs"] if resid else np.zeros(p_u)

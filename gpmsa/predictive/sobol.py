@@ -762,7 +762,7 @@ def sensitivity(
             ``main_effect_grid`` or ``joint_effect_grid``. False (default): not computed.
         progress: show a tqdm bar over the draws on stderr ("sensitivity"; each draw
             integrates the runs' kernels pairwise: about 40 s for 264 runs, 8 components and
-            100 draws).
+            100 draws); none at the point estimate (``draws=False``).
 
     Returns:
         Sensitivity with indices per draw, per output element, per basis component and
@@ -908,7 +908,7 @@ def sensitivity(
         z_bar[varied] = centre
         for k, u in fix_u.items():
             z_bar[k] = u
-    with one_thread(), progress_bar(progress, S, "sensitivity") as bar:
+    with one_thread(), progress_bar(progress and draws, S, "sensitivity") as bar:
         for i, prm in enumerate(sets):
             beta = prm["betaU"]
             trend = None
