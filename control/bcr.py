@@ -510,6 +510,21 @@ class BCR:
         self.reset()
         self._warm_up()
 
+    def __repr__(self) -> str:
+        """One line: the method, the feature, the update interval (samples and seconds), the
+        estimates made since the start (or the last reset or resume) and the newest estimate's
+        status. Reads attributes only: no computation, and never
+        raises (an odd BCR shows "?")."""
+        try:
+            s = self.settings
+            every = s.samples_per_update
+            parts = [f"method={s.method}", f"feature={s.feature.name}",
+                     f"every={every} samples ({every / s.feature.rate_hz:.3g} s)",
+                     f"estimates={self._n_updates}", f"last={self.last.status}"]  # fmt: skip
+        except Exception:  # a repr never raises
+            parts = ["?"]
+        return f"BCR({', '.join(parts)})"
+
     def __setstate__(self, state: dict) -> None:  # a restored BCR warms up as a new one
         # (one pickled before it had a note, the quiet-signal hold or the standing time)
         self.__dict__.update({"_start_note": "", "_held_by": None, "_standing_from": np.nan,

@@ -53,6 +53,7 @@ from control.metrics import strict_json  # noqa: E402
 from control.plotting import plot_gd_trace, plot_speed  # noqa: E402
 from control.shipped import EMULATOR_DIR, emulator_file_name  # noqa: E402
 from control.validation import within  # noqa: E402
+from gpmsa.model.data import repr_name  # noqa: E402
 
 PAPER_SEGMENTS = ((50.0, 300.0), (50.0, 500.0), (50.0, 300.0))
 PAPER_RMSE = {"A": {"300": 42.58, "500": 94.42}, "B": {"300": 50.19, "500": 96.23}}
@@ -392,7 +393,11 @@ def main(argv: list[str] | None = None) -> dict:
 
     source = "paper: Lewis et al. 2025" if paper_track else "no paper figures for this track"
     which = f"seed {seeds.start}" if len(seeds) == 1 else f"seeds {seeds.start}-{seeds[-1]} pooled"
-    print(f"RMSE of the GD estimate, {which} ({source})")
+    # GD's unit in brackets, as `gpmsa info` prints it, where the emulators record one alike
+    units = {str(emu.t_units[0]) if emu.t_units else "" for emu in emulators.values()}
+    named = units.pop() if len(units) == 1 else ""  # (two cases with different units: none)
+    unit = f" [{repr_name(named)}]" if named else ""
+    print(f"RMSE of the GD estimate{unit}, {which} ({source})")
     print(f"{'case':<6}{'part':<9}{'paper':>8}{'paper method':>14}{'ours':>8}   ours per run")
     for case in args.cases:
         ours = metrics["ours"][case]

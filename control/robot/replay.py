@@ -90,6 +90,7 @@ from control.validation import (
 )
 from gpmsa.errors import numbers_text
 from gpmsa.io.atomic import atomic_write
+from gpmsa.model.data import repr_name
 from roadgen.checks import home_path
 
 TIME_BASES = ("header", "log")
@@ -247,7 +248,8 @@ class ReplayResult:
     the IMU's stamps; ``resampling``: what was done to the IMU's rate; ``notes``: what else
     was left out. ``read_s``, ``condition_s``, ``bcr_s``: wall-clock times of the three
     stages, s; ``t0_ns``: stamp of time 0; ``settings``, ``bcr``,
-    ``simplex``: what ran; ``source``: the recording read.
+    ``simplex``: what ran; ``source``: the recording read; ``gd_unit``: the emulator's unit
+    of GD ("1e-6 m^3" for the shipped ones; "" where it records none).
     """
 
     stamp_ns: np.ndarray
@@ -283,6 +285,7 @@ class ReplayResult:
     simplex: Simplex
     source: str = ""
     restamping: clock.Restamping = clock.Restamping(False)
+    gd_unit: str = ""
 
     def __repr__(self) -> str:
         """One line: the estimates, the span replayed, the statuses, the IMU samples fed to the
@@ -394,9 +397,12 @@ class ReplayResult:
             self._count_line(),
         ]
         if ok.any():
+            # the unit in brackets, as `gpmsa info` prints it ("1e-6 m^3" reads as a number)
+            unit = getattr(self, "gd_unit", "")  # ("": a result pickled before it had one)
+            unit = f" [{repr_name(unit)}]" if unit else ""
             lines.append(
                 f"GD posterior mean {np.min(self.gd_mean[ok]):.0f} to "
-                f"{np.max(self.gd_mean[ok]):.0f}; safety mode "
+                f"{np.max(self.gd_mean[ok]):.0f}{unit}; safety mode "
                 f"{np.mean(self.mode == 'safety'):.0%} of the time"
             )
         beyond = {"upper": "rougher", "lower": "smoother"}
@@ -768,6 +774,7 @@ def replay_recording(
         simplex=simplex,
         source=str(rec.path),
         restamping=restamping,
+        gd_unit=str(emulator.t_units[0]) if emulator.t_units else "",
     )
 
 

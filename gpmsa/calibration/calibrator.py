@@ -100,7 +100,7 @@ from gpmsa.calibration.posterior import LevelMarginal, Posterior, trapezoid_weig
 from gpmsa.errors import GPMSAError, StartRejectedError, numbers_text, user_stacklevel
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
-from gpmsa.model.data import as_float, check_count, check_flag, run_seed
+from gpmsa.model.data import as_float, check_count, check_flag, repr_names, run_seed
 
 METHODS = ("auto", "grid", "mcmc")
 N_DRAWS = 4000
@@ -497,6 +497,24 @@ class Calibrator:
             if done is not None:
                 done(1)
         return axis, predictors
+
+    def __repr__(self) -> str:
+        """One line: the method, its backend, the calibration parameters (`repr_names`), the
+        grid's nodes per axis (grid method), the emulator's parameters where they are its
+        draws, and the updates made so far. Reads attributes only: no computation, and never
+        raises (a half-built or odd Calibrator shows "?")."""
+        try:
+            parts = [f"method={self.method}", f"backend={self.backend}",
+                     f"t={repr_names(self.emulator.t_names)}"]  # fmt: skip
+            axes = getattr(self, "_axes", None)
+            if self.method == "grid" and axes is not None:
+                parts.append(f"grid={'x'.join(str(len(a)) for a in axes)} nodes")
+            if self.emulator_params != "point":
+                parts.append(f"emulator_params={self.emulator_params}")
+            parts.append(f"updates={self._count}")
+        except Exception:  # a repr never raises
+            parts = ["?"]
+        return f"Calibrator({', '.join(parts)})"
 
     def __getstate__(self) -> dict:
         """For pickle and ``copy``: all but the update lock (a copy gets its own)."""

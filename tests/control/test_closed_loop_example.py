@@ -100,7 +100,10 @@ def test_a_part_too_short_for_an_estimate_prints_a_dash_and_writes_null(tmp_path
     written = json.loads((tmp_path / "metrics.json").read_text())  # strict JSON: no NaN token
     assert written["paper_method"]["A"]["rmse"]["300"] is None
     assert "NaN" not in (tmp_path / "metrics.json").read_text()
-    rows = [line.split() for line in capsys.readouterr().out.splitlines() if "GD 300" in line]
+    out = capsys.readouterr().out
+    # GD's unit in brackets in the table's title, as `gpmsa info` prints it (session 81)
+    assert out.startswith("RMSE of the GD estimate [1e-6 m^3], seed 1 (no paper figures"), out
+    rows = [line.split() for line in out.splitlines() if "GD 300" in line]
     assert len(rows) == 2 and all(row[3:5] == ["-", "-"] for row in rows)  # paper, paper method
 
 
