@@ -107,3 +107,18 @@ def one_t_emulator() -> tuple[Emulator, list, list]:
     emu = Emulator.from_params(sim, {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e3],
                                      "lamWOs": [1e3]})  # fmt: skip
     return emu, [[0.5]], [[1.3]]
+
+
+@cache
+def sine_sum_emulator(q: int, runs: int, n_iter: int, prefix: str = "t") -> Emulator:
+    """``runs`` runs of y = sin(3 x) + sum(t) (one scalar output, q calibration parameters named
+    prefix0, prefix1, ...), an untuned fit of ``n_iter`` sweeps (its retained draws)."""
+    import warnings
+
+    rng = np.random.default_rng(81)
+    x, t = rng.uniform(size=(runs, 1)), rng.uniform(size=(runs, q))
+    data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x[:, 0]) + t.sum(axis=1), x_names=["x"],
+                         t_names=[f"{prefix}{k}" for k in range(q)])  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return gpmsa.fit(data, n_iter=n_iter, tune=False, seed=0)

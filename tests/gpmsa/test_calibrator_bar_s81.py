@@ -2,25 +2,16 @@
 predictors on the grid and on the refined grid included (they took 87 % of a window
 emulator's preparation over 20 draws while the bar stood at 100 %), and ends full."""
 
-import warnings
-from functools import cache
-
 import numpy as np
+from _calib_cases import sine_sum_emulator
 
 import gpmsa
 from gpmsa.calibration import calibrator
 
 
-@cache
 def _emulator(q: int):
     """25 runs of one scalar output, q calibration parameters, 40 retained draws."""
-    rng = np.random.default_rng(81)
-    x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, q))
-    data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x[:, 0]) + t.sum(axis=1), x_names=["x"],
-                         t_names=[f"t{k}" for k in range(q)])  # fmt: skip
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return gpmsa.fit(data, n_iter=40, tune=False, seed=0)
+    return sine_sum_emulator(q, runs=25, n_iter=40)
 
 
 def _watch(monkeypatch):

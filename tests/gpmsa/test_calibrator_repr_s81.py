@@ -3,23 +3,16 @@ backend, parameter names, grid size, updates so far), never the default ``<... o
 0x...>``, and never raises."""
 
 import warnings
-from functools import cache
 
 import numpy as np
+from _calib_cases import sine_sum_emulator
 
 import gpmsa
 
 
-@cache
 def _emulator(q: int, name: str = "t"):
     """20 runs of one scalar output, q calibration parameters."""
-    rng = np.random.default_rng(81)
-    x, t = rng.uniform(size=(20, 1)), rng.uniform(size=(20, q))
-    data = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x[:, 0]) + t.sum(axis=1), x_names=["x"],
-                         t_names=[f"{name}{k}" for k in range(q)])  # fmt: skip
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return gpmsa.fit(data, n_iter=20, tune=False, seed=0)
+    return sine_sum_emulator(q, runs=20, n_iter=20, prefix=name)
 
 
 def test_a_grid_calibrator_names_its_method_parameters_grid_and_updates():
