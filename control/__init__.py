@@ -45,6 +45,13 @@ from control.shipped import shipped_emulator, shipped_emulator_path
 from control.simplex import Command, Simplex, SimplexRun
 from control.tracker import GDTracker, TrackerSettings
 
+__gpmsa_wrapper__ = True
+"""gpmsa's warnings under control's calls (a BCR's calibration) point at the user's line that
+made the call, not at a line of control (``gpmsa.errors.WRAPPER_MARK``)."""
+__vehicle_wrapper__ = True
+"""vehicle's warnings under control's calls (a `vehicle.SolverStepWarning` of the closed loop's
+simulation) point at the user's line (``vehicle.errors.WRAPPER_MARK``)."""
+
 __all__ = [
     "BCR",
     "BCRSettings",

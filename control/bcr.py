@@ -66,6 +66,7 @@ methods, a dead odometry reads as standing.
 
 from __future__ import annotations
 
+import copy
 import time as _time
 import warnings
 from collections import deque
@@ -458,7 +459,9 @@ class BCR:
 
     A BCR is a stream's state: feed it from one thread (it holds no lock; BCRs on several
     threads may share one `ObservationModel`, whose cache holds no lock either), and copy it with
-    ``copy.deepcopy`` (``copy.copy`` shares its filters). It pickles, and so do its estimates
+    ``copy.copy`` (a BCR on the same model with a copy of the stream's state: it continues as
+    this one would, and updating either leaves the other as it was) or ``copy.deepcopy`` (the
+    model copied too). It pickles, and so do its estimates
     (their posteriors' lazily drawn samples are drawn then). Its estimates do not depend on
     how the samples are chunked across calls; a call returns the newest estimate, or the
     gravest fault among those it made.
@@ -524,6 +527,12 @@ class BCR:
         except Exception:  # a repr never raises
             parts = ["?"]
         return f"BCR({', '.join(parts)})"
+
+    def __copy__(self) -> BCR:
+        """``copy.copy``: a BCR on the same model (read-only, as BCRs sharing one) with its own
+        copy of the stream's state (filters, trackers, buffers, the static span, the newest
+        estimate): a shallow copy shared them, and updating it moved this one's filters."""
+        return copy.deepcopy(self, {id(self.model): self.model, id(self.settings): self.settings})
 
     def __setstate__(self, state: dict) -> None:  # a restored BCR warms up as a new one
         # (one pickled before it had a note, the quiet-signal hold or the standing time)

@@ -1,20 +1,8 @@
 """Exceptions and warnings raised by control."""
 
-import sys
-
-_OWN = ("control", "dataclasses")
-
-
-def user_stacklevel() -> int:
-    """``warnings.warn``'s stacklevel, in the function that calls this, of the first frame
-    outside control (the user's call, however deep control's own calls run; as
-    ``gpmsa.errors.user_stacklevel`` for gpmsa) and outside ``dataclasses`` (whose ``replace``
-    makes a settings class anew: its ``__post_init__``'s warnings point at the line that
-    called ``replace``)."""
-    frame, level = sys._getframe(1), 1
-    while frame is not None and frame.f_globals.get("__name__", "").split(".")[0] in _OWN:
-        frame, level = frame.f_back, level + 1
-    return level
+# control's package sets gpmsa.errors.WRAPPER_MARK: ``warnings.warn``'s stacklevel of the first
+# frame outside control, gpmsa and ``dataclasses``, for control's modules
+from gpmsa.errors import user_stacklevel as user_stacklevel
 
 
 class ControlError(ValueError):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +66,10 @@ class FaultInjector:
     Args:
         faults: the `SensorFault`s.
         rng: the generator of the random faults ("noise").
+
+    ``copy.copy`` (as ``copy.deepcopy``) gives an injector with its own copy of the generator
+    and of what the stuck and spike faults hold: it continues as this one would, and applying
+    either leaves the other as it was.
     """
 
     def __init__(self, faults, rng: np.random.Generator) -> None:
@@ -85,6 +90,11 @@ class FaultInjector:
         self._last = np.nan  # the newest finite reading of the batches before
         self._held: dict[int, float] = {}  # per stuck fault, the value it holds
         self._spiked: dict[int, int] = {}  # per spike fault, the samples it has covered so far
+
+    def __copy__(self) -> FaultInjector:
+        """``copy.copy``: a deep copy (a shallow one shared the generator and the held values,
+        so that the copy's batches changed the original's next ones)."""
+        return copy.deepcopy(self)
 
     def __call__(self, t, position, accel, speed):
         """(t, position, accel, speed) of the next batch with the faults applied (copies)."""

@@ -21,7 +21,14 @@ class BackendUnavailableError(ImportError):
     """A backend's optional packages are not installed; the message names the extra to install."""
 
 
-class OutsideEmulatorWarning(UserWarning):
+class GPMSAWarning(Warning):
+    """The base of every warning gpmsa issues: ``warnings.filterwarnings("error",
+    category=gpmsa.GPMSAWarning)`` turns them all into errors (a strict pipeline's CI, say)
+    and leaves numpy's and other libraries' alone. Each subclass is also a ``UserWarning``
+    (`ChainRetryWarning` a ``RuntimeWarning``), so filters on those catch them as well."""
+
+
+class OutsideEmulatorWarning(GPMSAWarning, UserWarning):
     """An observation lies outside what the emulator has seen (far from all its predictions)."""
 
 
@@ -32,14 +39,14 @@ class AtBoundWarning(OutsideEmulatorWarning):
     OutsideEmulatorWarning subclass: a filter on that one covers it."""
 
 
-class OutlierRunWarning(UserWarning):
+class OutlierRunWarning(GPMSAWarning, UserWarning):
     """A simulation run's output lies far beyond every other run's at an output point (a
     missing-value code such as -999, a failed run, a units error, or an output with heavy
     tails): ``gpmsa.fit`` and ``gpmsa.fit_study`` warn before sampling
     (``gpmsa.model.far_values.far_run``)."""
 
 
-class ExtrapolationWarning(UserWarning):
+class ExtrapolationWarning(GPMSAWarning, UserWarning):
     """Inputs (x, theta or bounds given to a prediction or a calibration) lie outside the
     emulator's training domain: the emulator extrapolates there (predictions, a joint fit's and
     calibration's x_obs within ``EXTRAPOLATION_MARGIN`` of it, further refused; with
@@ -48,15 +55,18 @@ class ExtrapolationWarning(UserWarning):
 
 
 WRAPPER_MARK = "__gpmsa_wrapper__"
-"""A module whose globals set this name to True (a library's thin layer over `gpmsa.fit`, say)
-is passed over by `user_stacklevel` as gpmsa's own modules are: gpmsa's warnings point past it,
-at the line of its caller."""
+"""A module whose globals set this name to True (a library's thin layer over `gpmsa.fit`, say),
+or every module of a package whose top-level ``__init__`` sets it (control's), is passed over
+by `user_stacklevel` as gpmsa's own modules are: gpmsa's warnings point past it, at the line
+of its caller."""
 
 
 def user_stacklevel() -> int:
     """``warnings.warn``'s stacklevel, in the function that calls this, of the first frame
-    outside gpmsa (the user's call, however deep the library's own calls run) and outside any
-    module marked with `WRAPPER_MARK`."""
+    outside gpmsa (the user's call, however deep the library's own calls run), outside any
+    module or package marked with `WRAPPER_MARK` and outside ``dataclasses`` (whose
+    ``replace`` makes a settings class anew: its ``__post_init__``'s warnings point at the
+    line that called ``replace``)."""
     frame, level = sys._getframe(1), 1
     while frame is not None and _library_frame(frame.f_globals):
         frame, level = frame.f_back, level + 1
@@ -64,7 +74,11 @@ def user_stacklevel() -> int:
 
 
 def _library_frame(names: dict) -> bool:
-    return names.get("__name__", "").split(".")[0] == "gpmsa" or names.get(WRAPPER_MARK) is True
+    top = names.get("__name__", "").split(".")[0]
+    if top in ("gpmsa", "dataclasses") or names.get(WRAPPER_MARK) is True:
+        return True
+    package = sys.modules.get(top)
+    return package is not None and getattr(package, WRAPPER_MARK, False) is True
 
 
 def numbers_text(*values: float, digits: int = 6) -> tuple[str, ...]:
@@ -84,18 +98,18 @@ def numbers_text(*values: float, digits: int = 6) -> tuple[str, ...]:
     return tuple(f"{float(v):.{digits}g}" for v in values)
 
 
-class DomainWarning(UserWarning):
+class DomainWarning(GPMSAWarning, UserWarning):
     """A unit domain given to ``SimData(x_range=, t_range=)`` is far wider than its design
     column spans (below ``gpmsa.model.data.RANGE_COVER_MIN`` of it: a unit mistake?): the
     runs then fill a sliver of [0, 1], and the fit can no longer resolve that input."""
 
 
-class BasisWarning(UserWarning):
+class BasisWarning(GPMSAWarning, UserWarning):
     """A user-supplied emulator basis gives the runs weights on a scale that the priors do not
     expect (``gpmsa.fit(..., basis=)``)."""
 
 
-class ReductionWarning(UserWarning):
+class ReductionWarning(GPMSAWarning, UserWarning):
     """The observations as reduced may not say what the data say
     (``gpmsa.model.problem.reduce_obs``): their precisions declare an error larger than the
     simulation outputs' spread (a variance passed for a precision?)."""
@@ -126,5 +140,32 @@ class ChainError(GPMSAError):
         self.chains = tuple(chains)
 
 
-class ConvergenceWarning(UserWarning):
+class ConvergenceWarning(GPMSAWarning, UserWarning):
     """Several chains disagree (R-hat above its limit) or give too few effective draws."""
+
+
+class GridResolutionWarning(GPMSAWarning, UserWarning):
+    """A grid `Calibrator`'s grid does not resolve the posterior (or a ``prior=`` given on it):
+    its summaries and draws may be off; the message says by how much and what to change
+    (a larger ``n_grid``, ``method="mcmc"``, a prior as a callable)."""
+
+
+class FewDrawsWarning(GPMSAWarning, UserWarning):
+    """Too few realizations for a prediction's central interval to resolve its tails
+    (``interval``): it reads too narrow; the message names the option that draws more."""
+
+
+class NuggetWarning(GPMSAWarning, UserWarning):
+    """A fit's point estimate gives a covariance that does not factor in float64 (its nugget
+    below rounding): the predictive functions refuse the emulator; the message names the
+    component and the remedy."""
+
+
+class UnusedSettingWarning(GPMSAWarning, UserWarning):
+    """A setting given that the chosen option does not use (``HyperPriors(lam_a=)`` with
+    ``sd_prior="uniform"``): the message names the option that would use it."""
+
+
+class ChainRetryWarning(GPMSAWarning, RuntimeWarning):
+    """A chain's task failed for a reason other than its input (a lost worker, say) and runs
+    again with the same seed; a second failure is a `ChainError`."""

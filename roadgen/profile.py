@@ -21,7 +21,8 @@ AMPLITUDE_MODES = ("deterministic", "rayleigh")
 class ProfileSettings:
     """How a profile was made.
 
-    band: (n_min, n_max) cycles/m, the spatial frequencies that carry content (as resolved).
+    band: (n_min, n_max) cycles/m, the spatial frequencies that carry content (as resolved);
+        a pair given as a list or an array is stored as a tuple of two floats.
     amplitudes: "deterministic" (each harmonic carries exactly Gd(n_k) dn) or "rayleigh"
         (Rayleigh-distributed amplitudes, i.e. a Gaussian process with that mean PSD).
     waviness: w in Gd(n) = Gd(n0) (n/n0)^-w, in (0, MAX_WAVINESS = 5] (ISO 8608: 2).
@@ -44,6 +45,9 @@ class ProfileSettings:
             raise RoadgenError(
                 f"band={self.band!r} is out of range: need 0 < n_min < n_max, finite, cycles/m"
             )
+        # stored as a tuple of floats (a list or an array given made the settings unhashable,
+        # and == between two of them raise "truth value of an array is ambiguous")
+        object.__setattr__(self, "band", (lo, hi))
         checks.choice("amplitudes", self.amplitudes, AMPLITUDE_MODES)
         check_waviness("waviness", self.waviness)
         checks.seed("seed", self.seed, generator=False)

@@ -99,7 +99,7 @@ class RunSpec:
         return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Campaign:
     """The campaign's table; arrays (n,) in design order.
 

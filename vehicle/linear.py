@@ -23,7 +23,7 @@ import numpy as np
 
 from roadgen.errors import distinct_texts
 from vehicle import checks
-from vehicle.errors import SolverStepWarning, VehicleError
+from vehicle.errors import SolverStepWarning, VehicleError, user_stacklevel
 from vehicle.kinematics import check_speed
 from vehicle.models import HalfCar, Jackal, Model, check_model
 from vehicle.road_input import RoadInput
@@ -53,9 +53,11 @@ def highest_mode_rad_s(model: Model) -> float:
     return float(np.sqrt(max(float(eig.max()), 0.0)))
 
 
-def warn_if_step_too_coarse(model: Model, rate_hz: float, substeps: int, stacklevel: int = 3):
+def warn_if_step_too_coarse(model: Model, rate_hz: float, substeps: int) -> None:
     """Warn (`SolverStepWarning`) when the fixed step 1 / (rate_hz substeps) s resolves the
-    model's stiffest mode too coarsely (omega h > MAX_OMEGA_H), naming the substeps that would."""
+    model's stiffest mode too coarsely (omega h > MAX_OMEGA_H), naming the substeps that would;
+    the warning names the user's call (`user_stacklevel`: past vehicle's frames and those of a
+    package marked as its wrapper, control's closed loop)."""
     omega = highest_mode_rad_s(model)
     omega_h = omega / (rate_hz * substeps)
     if omega_h > MAX_OMEGA_H:
@@ -69,7 +71,7 @@ def warn_if_step_too_coarse(model: Model, rate_hz: float, substeps: int, stackle
             f"step 1/({rate_hz:g} x {substeps}) s (omega h = {shown} > {MAX_OMEGA_H}): its "
             f"accelerations would be biased (half the variance at omega h = 0.8); use {fix}",
             SolverStepWarning,
-            stacklevel=stacklevel,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -21,7 +21,7 @@ SUBSTEPS = 5
 """Default solver steps per sample: h = 1/600 s at 120 Hz (converged, docs/vehicle-models.md)."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Trace:
     """A sampled drive; arrays (n,) at t = k / rate_hz, k = 1..n (the drive starts at t = 0).
 

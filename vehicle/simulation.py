@@ -17,7 +17,7 @@ from vehicle.sensor import add_noise, check_noise, check_rate, contact_flags
 from vehicle.simulate import SUBSTEPS, check_span
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Samples:
     """The samples of one ``advance`` call, arrays (n,) (n = 0 once the road has ended).
 
@@ -66,7 +66,22 @@ class Simulation:
     Attributes: time (s), position (front axle, m), speed (m/s), finished (no further sample
     fits before the end of the track: at the current speed, or at the speed last commanded, whose
     ``advance`` returned no samples), end_m (the track's length, m).
+
+    It holds a running Exudyn solver and cannot be copied or pickled (``copy.copy``,
+    ``copy.deepcopy``, ``pickle`` and a process pool's arguments raise a TypeError that says
+    so): build another from the same arguments where it is needed (an integer seed gives the
+    same samples).
     """
+
+    def __reduce_ex__(self, protocol):
+        """Refused: a shallow copy drove one solver from two objects, and a deep copy or a
+        pickle raised Exudyn's "user function which cannot be copied"."""
+        raise TypeError(
+            "a vehicle.Simulation cannot be copied or pickled: it holds a running Exudyn "
+            "solver. Build another where it is needed, vehicle.Simulation(model, track, "
+            "rate_hz, noise_std, seed, start_m) with the same arguments (an integer seed gives "
+            "the same samples), or send those arguments to the other process"
+        )
 
     def __init__(
         self,

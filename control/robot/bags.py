@@ -79,7 +79,7 @@ URI_PARTS = re.compile(r"[?#]|%[0-9A-Fa-f]{2}")
 a fragment, a percent-encoded byte."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class ImuMessages:
     """The messages of an IMU topic, in the recording's order.
 
@@ -100,7 +100,7 @@ class ImuMessages:
     accel_unknown: np.ndarray | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class OdometryMessages:
     """The messages of an odometry topic, in the recording's order.
 
@@ -118,7 +118,7 @@ class OdometryMessages:
     velocity: np.ndarray
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Recording:
     """What `read_recording` found.
 

@@ -97,7 +97,13 @@ from gpmsa.calibration.observations import (
     warn_if_outside,
 )
 from gpmsa.calibration.posterior import LevelMarginal, Posterior, trapezoid_weights
-from gpmsa.errors import GPMSAError, StartRejectedError, numbers_text, user_stacklevel
+from gpmsa.errors import (
+    GPMSAError,
+    GridResolutionWarning,
+    StartRejectedError,
+    numbers_text,
+    user_stacklevel,
+)
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, repr_names, run_seed
@@ -1296,6 +1302,7 @@ def _warn_at_float(res: float, marginal, emulator) -> None:
             f"spacings (fewer than {UNRESOLVED_SD:g}); its "
             "sd, quantiles and draws are good "
             f"to about the node spacing there, {h:.3g}{f' {unit}' if unit else ''}",
+            GridResolutionWarning,
             stacklevel=user_stacklevel(),
         )
 
@@ -1313,6 +1320,7 @@ def _warn_if_narrow_prior(table: np.ndarray, n_grid: int, q: int) -> None:
             f"between the nodes it is interpolated, so the posterior may be a tenth of its sd "
             f"or more off and too wide; pass prior= as a callable of theta, or use a Calibrator "
             f"with a larger n_grid (now {n_grid})",
+            GridResolutionWarning,
             stacklevel=user_stacklevel(),
         )
 
@@ -1329,6 +1337,7 @@ def _warn_if_unresolved(res: tuple[float, ...], names: tuple, n_grid: int) -> No
             f"{UNRESOLVED_SD:g}) on the grid refinement ended with, so "
             f"its quantiles, cdf and draws may be off by several per cent of an sd; use "
             f"method='mcmc' or another n_grid (now {n_grid})",
+            GridResolutionWarning,
             stacklevel=user_stacklevel(),
         )
 
@@ -1346,6 +1355,7 @@ def _warn_if_level_unresolved(res: tuple[float, ...], names: tuple, n_grid: int)
             f"{UNRESOLVED_SD:g}) on the grid refinement ended with, so its summaries, draws "
             f"and the levels' probabilities may be off; use a larger n_grid (now {n_grid}) or "
             f"method='mcmc'",
+            GridResolutionWarning,
             stacklevel=user_stacklevel(),
         )
 
@@ -1377,6 +1387,7 @@ def _warn_if_ridge(sds: tuple[float, float], names: tuple, n_grid: int) -> None:
             f"(fewer than {RIDGE_SD:g}), so its "
             f"summaries and draws may be off by a large fraction of an sd; use a larger n_grid "
             f"(now {n_grid}) or method='mcmc'",
+            GridResolutionWarning,
             stacklevel=user_stacklevel(),
         )
 

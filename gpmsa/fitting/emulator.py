@@ -120,7 +120,7 @@ def _spread_of_means(means: np.ndarray) -> np.ndarray:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class LooResult:
     """Exact leave-one-out predictions of the simulation runs (native units).
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from gpmsa import backends
 from gpmsa._version import library_versions
-from gpmsa.errors import GPMSAError, user_stacklevel
+from gpmsa.errors import GPMSAError, NuggetWarning, user_stacklevel
 from gpmsa.fitting.continuation import (
     HOT_RECORD,
     MH_BACKENDS,
@@ -438,7 +438,7 @@ def fit(
                 nugget.not_positive_definite(bad, params, problem.lam_sim, problem.m, where)
                 + ". predict, loo, calibrate, Calibrator, cross_validate and sensitivity refuse "
                 "this emulator",
-                UserWarning, stacklevel=user_stacklevel(),
+                NuggetWarning, stacklevel=user_stacklevel(),
             )  # fmt: skip
     return Emulator._from_prepared(
         data, prep, params,

@@ -49,7 +49,7 @@ from numbers import Number
 import numpy as np
 
 from gpmsa import _version
-from gpmsa.errors import ChainError, GPMSAError
+from gpmsa.errors import ChainError, ChainRetryWarning, GPMSAError, user_stacklevel
 
 RETRIES = 1
 """Default number of times a chain whose task failed for a reason other than its input is rerun."""
@@ -487,7 +487,7 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
             raise ChainError(f"{what} {i} of {n} failed{tries}: {_describe(exc)}", (i,)) from exc
         warnings.warn(
             f"{what} {i} of {n} failed ({_describe(exc)}); running it again (same seed, same "
-            f"draws)", RuntimeWarning, stacklevel=2,
+            f"draws)", ChainRetryWarning, stacklevel=user_stacklevel(),
         )  # fmt: skip
         if own and isinstance(exc, BrokenExecutor):  # a dead worker breaks the whole pool
             _stop(pool)

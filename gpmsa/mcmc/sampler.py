@@ -40,7 +40,7 @@ RHO_PARAMS = ("betaU", "betaV")
 PRECISION_PARAMS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
 
 
-@dataclass
+@dataclass(eq=False)
 class Chains:
     """Posterior draws of several chains.
 

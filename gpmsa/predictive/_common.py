@@ -11,7 +11,7 @@ import warnings
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import FewDrawsWarning, GPMSAError, user_stacklevel
 from gpmsa.fitting.emulator import NO_DRAWS, Emulator
 from gpmsa.model import kronecker
 from gpmsa.model.categorical import check_levels
@@ -43,7 +43,8 @@ def realization_interval(samples: np.ndarray, level: float, fix: str) -> tuple[n
         warnings.warn(
             f"a central {level:g} interval from {n} realization(s) is too narrow: its tails need "
             f"at least {need}; draw more ({fix})",
-            stacklevel=3,
+            FewDrawsWarning,
+            stacklevel=user_stacklevel(),
         )
     lo, hi = realization_quantile(samples, [(1 - level) / 2, (1 + level) / 2])
     return lo, hi

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.errors import GPMSAError
+from gpmsa.errors import GPMSAError, UnusedSettingWarning, user_stacklevel
 
 LABEL_RE = re.compile(r"\A[A-Za-z0-9_-]{1,48}\Z")  # \Z: "$" also matches before a final "\n"
 """A model's label: letters, digits, _ and -, at most 48 (it names the model's file)."""
@@ -79,7 +79,8 @@ class HyperPriors:
             warnings.warn(
                 f"HyperPriors: lam_a={self.lam_a!r} and lam_b={self.lam_b!r} set the gamma "
                 "prior of the precision, which sd_prior='uniform' does not use; give "
-                "sd_prior='gamma' (SEPIA's: HyperPriors.sepia())", UserWarning, stacklevel=3,
+                "sd_prior='gamma' (SEPIA's: HyperPriors.sepia())", UnusedSettingWarning,
+                stacklevel=user_stacklevel(),
             )  # fmt: skip
         if self.sd_prior == "uniform" and self.lam_start * self.sd_max**2 <= 1.0:
             raise GPMSAError(f"HyperPriors.lam_start={self.lam_start!r} gives a start sd "

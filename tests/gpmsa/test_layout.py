@@ -53,7 +53,8 @@ PUBLIC = [
     "calibration_posterior", "cross_validate", "emulator_prediction", "fit", "full_prediction",
     "limits", "load", "plots", "predictive", "prepare", "sensitivity",
     "HyperPriors", "Study", "calibrate_study", "fit_study", "load_study", "StartRejectedError",
-    "calibrated_predict", "AtBoundWarning",
+    "calibrated_predict", "AtBoundWarning", "GridResolutionWarning", "FewDrawsWarning",
+    "NuggetWarning", "UnusedSettingWarning", "ChainRetryWarning", "GPMSAWarning",
 ]  # fmt: skip
 
 
