@@ -8,6 +8,7 @@ interpreter would (a traceback on stderr, exit status 1).
 """
 
 import contextlib
+import functools
 import io
 import json
 import os
@@ -35,6 +36,25 @@ def run_scripts(runs: list[tuple[str, list[str]]], timeout_s: float = 900.0) -> 
         if done.returncode != 0 or not report.exists():
             raise RuntimeError(f"the script runner failed:\n{done.stderr[-3000:]}")
         return json.loads(report.read_text())
+
+
+@functools.cache
+def _all_helps() -> dict[str, dict]:
+    """`script_helps` of every script, made once a session."""
+    scripts = [
+        path.relative_to(ROOT).as_posix()
+        for folder in ("benchmarks", "examples")
+        for path in sorted((ROOT / folder).glob("*.py"))
+        if not path.name.startswith("_")  # a helper the scripts import (examples/_cli.py)
+    ]
+    return dict(zip(scripts, run_scripts([(s, ["--help"]) for s in scripts]), strict=True))
+
+
+def script_helps() -> dict[str, dict]:
+    """Each benchmark and example script's run with ``--help`` (`run_scripts`' record, by its
+    path relative to the repository root, as benchmarks/backends.py), all in one interpreter
+    once a session for the tests that read them (a copy: none changes another's)."""
+    return {script: dict(done) for script, done in _all_helps().items()}
 
 
 def _run_one(script: str, args: list[str]) -> dict:

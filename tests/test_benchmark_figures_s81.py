@@ -3,6 +3,7 @@ what it sets, no figure prints as NaN, and a timed row does not carry a process'
 (the first ``gpmsa.calibrate`` imports ArviZ, ~0.5 s, which fell on a baseline's first run)."""
 
 import re
+import sys
 from collections import Counter
 from pathlib import Path
 
@@ -11,7 +12,7 @@ import pytest
 
 import roadgen
 from tests._examples import load_benchmark, load_example
-from tests._script_runs import run_scripts
+from tests._script_runs import script_helps
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = [
@@ -22,19 +23,11 @@ SCRIPTS = [
 ]
 
 
-ODD_RUNS = [("benchmarks/speed_change_blocks.py", ["--part", "loop", "--runs", "1"])]
-
-
 @pytest.fixture(scope="module")
-def runs() -> list[dict]:
-    """Each script's ``--help``, then `ODD_RUNS`, all in one interpreter."""
-    return run_scripts([*((script, ["--help"]) for script in SCRIPTS), *ODD_RUNS])
-
-
-@pytest.fixture(scope="module")
-def helps(runs) -> dict:
-    """Each script's ``--help`` output."""
-    return {s: d["stdout"] for s, d in zip(SCRIPTS, runs, strict=False)}
+def helps() -> dict:
+    """Each script's ``--help`` output (`script_helps`: all in one interpreter)."""
+    done = script_helps()
+    return {s: done[s]["stdout"] for s in SCRIPTS}
 
 
 def _undocumented(text: str) -> list[str]:
@@ -64,11 +57,15 @@ def test_every_option_of_a_script_has_its_help(helps, script: str) -> None:
     assert [e for e in _undocumented(helps[script]) if not e.startswith("-h, --help")] == []
 
 
-def test_speed_change_blocks_names_the_option_and_its_value(runs) -> None:
+def test_speed_change_blocks_names_the_option_and_its_value(monkeypatch, capsys) -> None:
     # "--roads and --runs must be >= 2, --workers >= 1, --first-seed >= 0" for --runs 1
-    done = runs[len(SCRIPTS)]
-    assert done["returncode"] == 2
-    assert "error: --runs must be >= 2, got 1" in done["stderr"]
+    bench = load_benchmark("speed_change_blocks")
+    argv = ["benchmarks/speed_change_blocks.py", "--part", "loop", "--runs", "1"]
+    monkeypatch.setattr(sys, "argv", argv)
+    with pytest.raises(SystemExit) as done:
+        bench.main()
+    assert done.value.code == 2
+    assert "error: --runs must be >= 2, got 1" in capsys.readouterr().err
 
 
 def test_backends_one_chain_r_hat_prints_a_dash_not_nan() -> None:

@@ -6,7 +6,7 @@ import re
 
 import pytest
 
-from tests._script_runs import run_scripts
+from tests._script_runs import script_helps
 
 # (script, option, what its help must say)
 EXPECTED = [
@@ -27,9 +27,8 @@ EXPECTED = [
 
 @pytest.fixture(scope="module")
 def helps() -> dict:
-    scripts = sorted({script for script, _, _ in EXPECTED})
-    done = run_scripts([(script, ["--help"]) for script in scripts])
-    return {s: d["stdout"] for s, d in zip(scripts, done, strict=True)}
+    done = script_helps()  # every script's, in one interpreter
+    return {s: done[s]["stdout"] for s in sorted({script for script, _, _ in EXPECTED})}
 
 
 def _option_help(text: str, option: str) -> str:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tests._examples import load_benchmark, load_example
-from tests._script_runs import run_scripts
+from tests._script_runs import run_scripts, script_helps
 
 ROOT = Path(__file__).resolve().parents[1]
 CUT_SHORT = [  # their docstring's first sentence runs over its first line
@@ -28,8 +28,8 @@ def _description(help_text: str) -> str:
 
 
 def test_help_describes_the_script_in_whole_sentences() -> None:
-    helps = run_scripts([(script, ["--help"]) for script in CUT_SHORT])
-    for script, done in zip(CUT_SHORT, helps, strict=True):
+    helps = script_helps()  # every script's, in one interpreter
+    for script, done in ((s, helps[s]) for s in CUT_SHORT):
         assert done["returncode"] == 0, done["stderr"][-2000:]
         assert _description(done["stdout"]).endswith((".", "?")), (script, done["stdout"][:400])
 

@@ -3,9 +3,6 @@
 from deep inside a library). Also: the accuracy benchmark drives the robot that its emulators
 record."""
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -297,24 +294,23 @@ def test_accuracy_benchmark_drives_the_robot_its_emulators_record(tmp_path) -> N
     assert window.metadata == control.shipped_emulator("A", "window").metadata
 
 
-def _accuracy_usage_error(argv: list[str]) -> str:
+def _accuracy_usage_errors(*argvs: list[str]) -> list[str]:
     """The one-line usage error of ``closed_loop_accuracy.py argv`` (exit status 2, no
-    traceback)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    done = subprocess.run(
-        [sys.executable, str(ROOT / "benchmarks/closed_loop_accuracy.py"), *argv],
-        capture_output=True, text=True, cwd=ROOT, env=env, timeout=120,
-    )  # fmt: skip
-    assert done.returncode == 2, done.stderr[-2000:]
-    assert "Traceback" not in done.stderr
-    (error,) = [line for line in done.stderr.splitlines() if ": error: " in line]
-    return error
+    traceback) for each argv, all in one interpreter (`run_scripts`)."""
+    errors = []
+    runs = [("benchmarks/closed_loop_accuracy.py", argv) for argv in argvs]
+    for done in run_scripts(runs, timeout_s=120 * len(runs)):
+        assert done["returncode"] == 2, done["stderr"][-2000:]
+        assert "Traceback" not in done["stderr"]
+        (error,) = [line for line in done["stderr"].splitlines() if ": error: " in line]
+        errors.append(error)
+    return errors
 
 
 def test_accuracy_benchmark_refuses_a_paper_method_for_another_robot(tmp_path) -> None:
     folder = _emulators_for_another_robot(tmp_path / "mine", noise_std=0.0)
     argv = ["--sets", "paper", "--cases", "A", "--emulator-dir", str(folder)]
-    error = _accuracy_usage_error(argv)
+    (error,) = _accuracy_usage_errors(argv)
     assert "the shipped window emulator of case A, which does not fit" in error
     assert "mass_kg: model 21.5 vs emulator" in error
     assert "--features band window" in error
@@ -330,13 +326,13 @@ def test_accuracy_benchmark_refuses_emulators_it_cannot_drive(tmp_path) -> None:
     damaged = tmp_path / "damaged"
     damaged.mkdir()
     (damaged / "jackal_A.gpmsa").write_bytes(b"not a zip")
-    for folder, message in (
+    cases = (
         (unrecorded, "the emulator's metadata has no 'vehicle'"),
         (damaged, "jackal_A.gpmsa: not a gpmsa emulator file"),
-    ):
-        error = _accuracy_usage_error(
-            ["--sets", "random", "--cases", "A", "--emulator-dir", str(folder)]
-        )
+    )
+    argv = ["--sets", "random", "--cases", "A", "--emulator-dir"]
+    errors = _accuracy_usage_errors(*([*argv, str(folder)] for folder, _ in cases))
+    for (_, message), error in zip(cases, errors, strict=True):
         assert "--emulator-dir: " in error and message in error
 
 

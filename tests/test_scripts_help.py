@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from tests._script_runs import run_scripts
+from tests._script_runs import script_helps
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPTS = [
@@ -17,9 +17,9 @@ SCRIPTS = [
 
 @pytest.fixture(scope="module")
 def helps() -> dict:
-    """Each script's run with ``--help``, all in one interpreter (`run_scripts`)."""
-    runs = [(str(path.relative_to(ROOT)), ["--help"]) for path in SCRIPTS]
-    return dict(zip(SCRIPTS, run_scripts(runs), strict=True))
+    """Each script's run with ``--help``, all in one interpreter (`script_helps`)."""
+    done = script_helps()
+    return {path: done[path.relative_to(ROOT).as_posix()] for path in SCRIPTS}
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: f"{p.parent.name}/{p.name}")
