@@ -78,7 +78,7 @@ import numpy as np
 from scipy.special import ndtr, ndtri
 
 from control.changepoint import ChangePointFilter, ChangePointSettings, _mixture_posterior
-from control.errors import ControlError, ControlWarning, user_stacklevel
+from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.estimate import EDGE_BAYES_FACTOR, EDGE_MARGIN, Estimate, favoured_edge, graver_fault
 from control.feature import FeatureSpec, feature_of_variance, features_of_blocks
 from control.sensor_checks import (
@@ -445,6 +445,48 @@ def emulator_domain(emulator) -> tuple[tuple[float, float], tuple[float, float]]
     return tuple(map(float, dom[emulator.x_names[0]])), tuple(map(float, dom[emulator.t_names[0]]))
 
 
+UNIT_HINT_GAIN = 3.0
+"""An implausible block whose band powers read as an acceleration more than this many times
+louder or quieter than the emulator's GD domain explains gets a clause naming that gain
+(`BCR`'s reason; a message only)."""
+ACCEL_UNIT_SLIPS = (
+    (
+        1.0 / 9.80665,
+        "acceleration in g? accel must be m/s^2 (g x 9.80665); or the wrong axis "
+        "(one that feels little of the ground)",
+    ),
+    (1e2, "acceleration in cm/s^2? accel must be m/s^2 (x 0.01)"),
+    (1e3, "acceleration in mm/s^2? accel must be m/s^2 (x 0.001)"),
+)
+"""(gain, what it suggests): the unit slips an implausible block's reason names where its band
+powers read as within a factor 2 of that gain (`BCR._gain_hint`)."""
+
+GD_MIN_HI = 1.0
+"""Smallest highest GD (1e-6 m^3) of a training set or an emulator's GD domain: 16 times
+smoother than the middle of ISO 8608's class A. Every ISO road's Gd(n0) in m^3 lies below it
+(class H's 0.13), so runs, or a domain, whose GDs all lie below it are GDs given in m^3, which
+would train on roads a million times too smooth (`control.training`), or give estimates that
+every Simplex band in 1e-6 m^3 reads as smooth ground (`check_gd_unit`)."""
+
+
+def check_gd_unit(gd_range: tuple[float, float], name: str = "GD") -> None:
+    """EmulatorMismatchError where a GD domain ``gd_range`` (lo, hi) lies wholly below
+    `GD_MIN_HI`: an emulator whose GD axis is in m^3, not 1e-6 m^3. Its estimates (~4e-4 on
+    ground of GD 400) lie below any Simplex band in 1e-6 m^3 (the default 250-350), which then
+    commands its top speed on any ground."""
+    lo, hi = gd_range
+    if hi < GD_MIN_HI:
+        lo_text, hi_text = numbers_text(lo, hi)
+        raise EmulatorMismatchError(
+            f"the emulator's {name} domain [{lo_text}, {hi_text}] lies below {GD_MIN_HI:g}: "
+            f"{name} is Gd(n0) in units of 1e-6 m^3 (ISO 8608's smoothest class, A, spans "
+            f"0-32; the Simplex's band, the tracks and the estimates use that unit), so this "
+            f"emulator was trained on GDs in m^3, and a Simplex band in 1e-6 m^3 would read "
+            f"every estimate as smooth ground (its top speed); train it on {name} x 1e6 "
+            f"(control.training.fit_band_emulator refuses GDs in m^3)"
+        )
+
+
 class BCR:
     """Streaming GD estimator (see the module docstring).
 
@@ -510,6 +552,7 @@ class BCR:
             elif s.method == "window":
                 tracker = replace(tracker, mean_segment_m=0.0)
             self.trackers = [GDTracker(self.gd_range, tracker) for _ in range(n)]
+        check_gd_unit(self.gd_range, self.gd_name)
         self.reset()
         self._warm_up()
 
@@ -1013,7 +1056,7 @@ class BCR:
                 f"no GD in [{self.gd_range[0]:g}, {self.gd_range[1]:g}] explains the block at "
                 f"{v:.3g} m/s: squared Mahalanobis distance {d2:.3g} (p = "
                 f"{numbers_text(p, s.plausibility_p, digits=2)[0]} < "
-                f"{numbers_text(p, s.plausibility_p)[1]})"
+                f"{numbers_text(p, s.plausibility_p)[1]})" + self._gain_hint(y, v)
             )
             return self._hold(self._skip_block(
                 phase, ds, "implausible", why, speed=v, feature=y, plausibility_p=p))  # fmt: skip
@@ -1073,6 +1116,24 @@ class BCR:
             f"{why}: a stop's ringing, or frozen odometry (a sensor_fault once it has read "
             f"standing for STANDING_SETTLE_S = {STANDING_SETTLE_S:g} s)"
         )
+
+    def _gain_hint(self, y: np.ndarray, v: float) -> str:
+        """For an implausible block: a clause naming the gain its band powers read as
+        (`ObservationModel.band_gain`) where that lies beyond `UNIT_HINT_GAIN` either way, and
+        the likely unit slip where it lies within a factor 2 of one (`ACCEL_UNIT_SLIPS`); ""
+        otherwise, or for a model without ``band_gain``."""
+        band_gain = getattr(self.model, "band_gain", None)
+        if band_gain is None or self.settings.feature.name != "log_band_power":
+            return ""
+        gain = band_gain(y, v, slice(0, len(self.settings.feature.bands_hz) - 1))
+        if not (np.isfinite(gain) and gain > 0) or 1 / UNIT_HINT_GAIN < gain < UNIT_HINT_GAIN:
+            return ""
+        side = "smoothest" if gain < 1 else "roughest"
+        text = f"; its band powers read as the {side} ground's acceleration times {gain:.2g}"
+        for factor, slip in ACCEL_UNIT_SLIPS:
+            if 0.5 < gain / factor < 2.0:
+                return f"{text}: if every block reads so, {slip}"
+        return text
 
     def _level_score(self, y: np.ndarray, v: float) -> float:
         """The block's level score (`ObservationModel.level_score`) along the direction of a

@@ -16,7 +16,7 @@ import numpy as np
 
 import gpmsa
 import vehicle
-from control.bcr import BCRSettings, emulator_domain
+from control.bcr import BCRSettings, check_gd_unit, emulator_domain
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.feature import FeatureSpec
 from control.observation_model import BlockScatter, one_block_logliks
@@ -123,10 +123,11 @@ def check_emulator(
     model), ``noise_std`` (the loop's accelerometer noise sd, m/s^2), ``bcr`` (the BCR's
     settings: its feature and method), ``track`` and ``simplex``.
 
-    Errors: another vehicle model; another feature (name, block or window length, rate, bands,
-    tapers); a track whose prescribed GD lies outside the emulator's GD domain; a Simplex whose
-    top or safe speed lies outside the emulator's speed domain (the BCR learns nothing at such
-    a speed: the robot would drive on an estimate that only ages), or whose GD_max is not below
+    Errors: a GD domain below `control.bcr.GD_MIN_HI` (GDs in m^3, `check_gd_unit`); another
+    vehicle model; another feature (name, block or window length, rate, bands, tapers); a track
+    whose prescribed GD lies outside the emulator's GD domain; a Simplex whose top or safe speed
+    lies outside the emulator's speed domain (the BCR learns nothing at such a speed: the robot
+    would drive on an estimate that only ages), or whose GD_max is not below
     the emulator's highest GD (the posterior never exceeds that, so the estimate could never
     call for safety mode) or not above its lowest (every estimate exceeds that: safety mode for
     good, e.g. a GD band given in m^3). Warnings: a
@@ -143,6 +144,8 @@ def check_emulator(
     lower there).
     """
     _check_is_emulator(emulator)
+    gd_name = emulator.t_names[0]
+    check_gd_unit(tuple(map(float, emulator.domain[gd_name])), gd_name)
     if model is not None and not callable(getattr(model, "describe", None)):
         raise ControlError(
             f"model must be a vehicle model (e.g. vehicle.Jackal()), got {model!r:.60}"

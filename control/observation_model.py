@@ -253,6 +253,18 @@ class ObservationModel:
         p = special.chdtrc(K, d2_min) if np.isinf(nu) else special.fdtrc(K, nu, d2_min / K)
         return d2_min, float(p)
 
+    def band_gain(self, y: np.ndarray, v: float, bands: slice) -> float:
+        """The acceleration gain that a block's feature y (K,) at speed v (m/s) reads as against
+        the GD domain: its log band powers (the channels ``bands``) less the emulator's mean
+        ones, averaged over those channels, at the GD node where that offset is smallest, as a
+        gain of the acceleration (exp(offset / 2)). 1 where some GD of the domain matches the
+        block's level; below 1 for a block quieter than the smoothest GD explains (0.1: the
+        acceleration of that smoothest ground read at a tenth), above for one louder than the
+        roughest. For messages (an implausible block's likely unit slip), not for estimates."""
+        mean = self._speed_terms(float(v))[1]
+        offset = np.mean(np.asarray(y, dtype=float)[bands] - mean[:, bands], axis=1)  # (G,)
+        return float(np.exp(offset[np.argmin(np.abs(offset))] / 2.0))
+
     def level_score(self, y: np.ndarray, v: float, direction: np.ndarray) -> float:
         """The residual of y from the mean at its best GD (the node of the smallest Mahalanobis
         distance) along ``direction`` (K,), in sds of that projection under Sigma(v) (the

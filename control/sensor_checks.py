@@ -1016,6 +1016,7 @@ class StreamBreaks:
                 f"{self.too_fast} sample(s) with |speed| up to "
                 f"{numbers_text(self.fastest, MAX_SPEED_MPS, digits=3)[0]} m/s, beyond any "
                 f"ground robot's (MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
+                + _speed_unit_hint(self.fastest)
             )
         if self.backwards:
             what.append(f"{self.backwards} repeated or backwards time stamp(s)")
@@ -1126,7 +1127,7 @@ def timing_fault(
         return (
             f"out of range: |speed| reaches {numbers_text(fastest, MAX_SPEED_MPS, digits=3)[0]} "
             "m/s, beyond any ground robot's "
-            f"(MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)"
+            f"(MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s)" + _speed_unit_hint(fastest)
         )
     span, expected = float(t[-1] - t[0]), (t.size - 1) / rate_hz
     if abs(span / expected - 1.0) > limits.rate_tolerance:
@@ -1144,8 +1145,54 @@ def timing_fault(
         moved_text, by_speed_text = numbers_text(moved, by_speed, digits=4)
         return (
             f"odometry disagrees with the speeds: the position moved {moved_text} m over the "
-            f"block, its speeds give {by_speed_text} m"
+            f"block, its speeds give {by_speed_text} m" + _odometry_unit_hint(moved, by_speed)
         )
+    return ""
+
+
+ODOMETRY_UNIT_SLIPS = (
+    (
+        -1.0,
+        "the position and the speeds advance in opposite directions: a distance remaining "
+        "(counting down), or signed speeds beside a path length? position must be the distance "
+        "travelled and speed its rate (both signed, or the speed's norm beside a path length)",
+    ),
+    (
+        1.0 / 3.6,
+        "the speeds read 3.6 times the position's rate: speed in km/h? speed must be "
+        "m/s (km/h / 3.6)",
+    ),
+    (1e3, "the position moves 1000 times the speeds' distance: position in mm? it must be m"),
+    (1e2, "the position moves 100 times the speeds' distance: position in cm? it must be m"),
+    (
+        1e-3,
+        "the position moves 1/1000 of the speeds' distance: position in km, or speed in "
+        "mm/s? they must be m and m/s",
+    ),
+    (1e-2, "the position moves 1/100 of the speeds' distance: speed in cm/s? it must be m/s"),
+)
+"""(ratio of the position's advance to the speeds' distance over a block, what it suggests):
+the unit slips that `timing_fault` names where a block's ratio lies within 10% of one."""
+
+
+def _speed_unit_hint(fastest: float) -> str:
+    """A clause asking whether speeds beyond ``MAX_SPEED_MPS`` are in mm/s (up to 1000 times
+    it: a ground robot's speed in mm/s), else ""."""
+    if MAX_SPEED_MPS < fastest <= 1e3 * MAX_SPEED_MPS:
+        return "; if every sample reads so, speed in mm/s? it must be m/s"
+    return ""
+
+
+def _odometry_unit_hint(moved: float, by_speed: float) -> str:
+    """A clause naming the likely unit slip (`ODOMETRY_UNIT_SLIPS`) where the position's
+    advance ``moved`` over a block is within 10% of one of those ratios to the speeds' distance
+    ``by_speed`` (m), else "" (computed only for a block that fails the odometry check)."""
+    if not by_speed:
+        return ""
+    ratio = moved / by_speed
+    for factor, text in ODOMETRY_UNIT_SLIPS:
+        if abs(ratio / factor - 1.0) < 0.1:
+            return f"; if every block reads so, {text}"
     return ""
 
 

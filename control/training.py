@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, stats
 
+from control.bcr import GD_MIN_HI
 from control.errors import ControlError
 from control.feature import FeatureSpec, block_features
 from control.observation_model import BlockScatter
@@ -260,10 +261,6 @@ WINDOW_PRIORS_LAMWS = (1.0, 1e-3, 1.0, 1e5)
 lower bound of 60 to 1, so that the GP nugget describes the window-to-window scatter."""
 
 
-GD_MIN_HI = 1.0
-"""Smallest highest GD (1e-6 m^3) of a training set: 16 times smoother than the middle of ISO
-8608's class A. Every ISO road's Gd(n0) in m^3 lies below it (class H's 0.13), so runs whose GDs
-all lie below it are GDs given in m^3, which would train on roads a million times too smooth."""
 _MIN_RUNS = 4
 """Fewest runs of an emulator of speed and GD (gpmsa.SimData's p + q + 2)."""
 
