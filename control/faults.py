@@ -67,9 +67,10 @@ class FaultInjector:
         faults: the `SensorFault`s.
         rng: the generator of the random faults ("noise").
 
-    ``copy.copy`` (as ``copy.deepcopy``) gives an injector with its own copy of the generator
-    and of what the stuck and spike faults hold: it continues as this one would, and applying
-    either leaves the other as it was.
+    A batch that raises part way (a KeyboardInterrupt) leaves the injector, its generator
+    included, as it was before it. ``copy.copy`` (as ``copy.deepcopy``) gives an injector with
+    its own copy of the generator and of what the stuck and spike faults hold: it continues as
+    this one would, and applying either leaves the other as it was.
     """
 
     def __init__(self, faults, rng: np.random.Generator) -> None:
@@ -107,6 +108,22 @@ class FaultInjector:
             )
         keep = np.ones(t.size, dtype=bool)
         clock = t.copy()
+        spiked, held = dict(self._spiked), dict(self._held)  # kept once the batch is done
+        drawn = self.rng.bit_generator.state if self.faults else None  # (~2 us)
+        try:
+            self._apply(t, pos, acc, clock, keep, spiked, held)
+        except BaseException:  # (a KeyboardInterrupt): the injector as before the batch
+            if drawn is not None:
+                self.rng.bit_generator.state = drawn
+            raise
+        good = np.isfinite(acc) & keep
+        last = float(acc[good][-1]) if good.any() else self._last
+        self._spiked, self._held, self._last = spiked, held, last
+        return t[keep], pos[keep], acc[keep], spd[keep]
+
+    def _apply(self, t, pos, acc, clock, keep, spiked: dict, held: dict) -> None:
+        """Apply the faults to a batch's arrays in place; ``spiked`` and ``held``: copies of the
+        spike counts and stuck values, updated (`__call__` keeps them once all went well)."""
         for i, fault in enumerate(self.faults):
             hit = (clock >= fault.start_s) & (clock < fault.start_s + fault.duration_s)
             if not hit.any():
@@ -118,11 +135,11 @@ class FaultInjector:
                 keep &= ~hit
             elif k == "spike":
                 # counted over the fault's whole span, not per batch: the nearest whole spacing
-                every, seen = max(1, round(min(m, MAX_SPIKE_SPACING))), self._spiked.get(i, 0)
+                every, seen = max(1, round(min(m, MAX_SPIKE_SPACING))), spiked.get(i, 0)
                 covered = seen + np.arange(int(hit.sum()))
                 on = covered % every == 0
                 acc[np.flatnonzero(hit)[on]] = 1e6 * np.where((covered[on] // every) % 2, 1.0, -1.0)
-                self._spiked[i] = seen + int(hit.sum())
+                spiked[i] = seen + int(hit.sum())
             elif k == "noise":
                 acc[hit] += self.rng.normal(0.0, m, int(hit.sum()))
             elif k == "scale":
@@ -132,17 +149,13 @@ class FaultInjector:
                     steps = np.round(acc[hit] / m) * m
                 acc[hit] = np.where(np.isfinite(steps), steps, acc[hit])  # ... leaves it
             elif k == "stuck":
-                acc[hit] = self._held.setdefault(i, self._before(acc, int(np.flatnonzero(hit)[0])))
+                acc[hit] = held.setdefault(i, self._before(acc, int(np.flatnonzero(hit)[0])))
             elif k == "clip":
                 acc[hit] = np.clip(acc[hit], -m, m)
             elif k == "time_nan":
                 t[hit] = np.nan
             elif k == "position_nan":
                 pos[hit] = np.nan
-        good = np.isfinite(acc) & keep
-        if good.any():
-            self._last = float(acc[good][-1])
-        return t[keep], pos[keep], acc[keep], spd[keep]
 
     def _before(self, acc: np.ndarray, first: int) -> float:
         """The last good (finite) reading before sample ``first`` of this batch, or of the

@@ -467,6 +467,15 @@ class StaticSpan:
         values are all overwritten before it is full again)."""
         self._next, self._held = 0, 0
 
+    def state(self) -> tuple:
+        """What `restore` takes back to (a copy of the ring: ~1 us for 1,000 samples)."""
+        return self._ring.copy(), self._next, self._held
+
+    def restore(self, state: tuple) -> None:
+        """Return to a `state` taken of this span (a call that failed part way: `BCR.update`)."""
+        ring, self._next, self._held = state
+        self._ring[:] = ring
+
     @property
     def full(self) -> bool:
         """Whether the span holds ``size`` samples."""

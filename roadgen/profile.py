@@ -53,6 +53,14 @@ class ProfileSettings:
         checks.seed("seed", self.seed, generator=False)
         checks.non_negative("lead_in_m", self.lead_in_m, unit="m")
 
+    def __setstate__(self, state: dict) -> None:
+        """Unpickling: a band pickled as given (a list or an array, before it was stored as a
+        tuple) is read as the tuple of two floats that ``__post_init__`` stores."""
+        self.__dict__.update(state)
+        band = state.get("band")
+        if isinstance(band, (list, np.ndarray)):
+            object.__setattr__(self, "band", checks.pair("band", band, "(n_min, n_max)"))
+
 
 @dataclass(frozen=True, eq=False)
 class Profile(Road):

@@ -43,8 +43,10 @@ class Samples:
 
 class Simulation:
     """A vehicle driving along a track, integrated on demand (the Exudyn model is built once).
-    After a `SimulationDivergedError`, or a KeyboardInterrupt (Ctrl-C) in ``advance``, it
-    refuses every further ``advance`` (its solver state is no longer valid): make a new one.
+    After a `SimulationDivergedError`, or a KeyboardInterrupt (Ctrl-C) or any other exception
+    raised inside an ``advance`` that took its arguments, it refuses every further ``advance``
+    (its solver state, or its noise streams, moved on with samples the caller never got): make
+    a new one. An ``advance`` refused for its arguments (`VehicleError`) changes nothing.
 
     The vehicle starts at rest on the road with its front axle at ``start_m`` (the rear axle,
     a wheelbase behind, reads a flat extension at the road's first height while it is before 0).
@@ -157,21 +159,24 @@ class Simulation:
         self._at_end = n_fit == 0
         if n_fit == 0:
             return _empty()
-        self._drive.set(self.time, self._h, s[: n_fit * sub + 1], v[: n_fit * sub + 1])
         try:
-            states = self._vehicle.integrate(self.time, n_fit)
+            return self._drive_on(s, v, n_fit)
         except SimulationDivergedError as exc:
             self._diverged = str(exc)
             raise
-        except KeyboardInterrupt:  # Ctrl-C: the solver stopped part way, as in a divergence
-            self._diverged = "interrupted (KeyboardInterrupt)"
+        except BaseException as exc:  # Ctrl-C: the solver stopped part way, as in a divergence
+            # (or the samples were lost after it moved on: the noise streams drew part of them)
+            self._diverged = f"interrupted ({type(exc).__name__})"
             raise
+
+    def _drive_on(self, s: np.ndarray, v: np.ndarray, n_fit: int) -> Samples:
+        """`advance`'s solve over the ramp ``s``, ``v`` (substeps) of ``n_fit`` samples."""
+        sub = self._substeps
+        self._drive.set(self.time, self._h, s[: n_fit * sub + 1], v[: n_fit * sub + 1])
+        states = self._vehicle.integrate(self.time, n_fit)
         k = np.arange(1, n_fit + 1) * sub
         position, spd = s[k], v[k]
-        self.time = float(states.t[-1])
-        self.position = float(position[-1])
-        self.speed = float(spd[-1])
-        return Samples(
+        samples = Samples(
             t=states.t,
             position=position,
             accel_front=add_noise(states.accel_front, self.noise_std, self._rng),
@@ -183,6 +188,9 @@ class Simulation:
             accel_rear=add_noise(states.accel_rear, self.noise_std, self._rear_rng),
             accel_rear_true=states.accel_rear,
         )
+        self.time, self.position, self.speed = (
+            float(states.t[-1]), float(position[-1]), float(spd[-1]))  # fmt: skip
+        return samples
 
 
 def _empty() -> Samples:

@@ -578,6 +578,22 @@ class _DigestingWriter:
         return self._writer.add_connection(topic, *args, **kwargs)
 
     def write(self, connection, timestamp: int, data: bytes) -> None:
+        """Write one message; `ControlError`, before anything is written, for a ``timestamp``
+        that is not an integer receive time in [0, 2**63) ns or ``data`` that is not bytes
+        (rosbags' MCAP writer took such a message into its chunk's records before it refused
+        it, and the bag then raised on closing: every message before it lost)."""
+        if not (is_integer(timestamp) and 0 <= timestamp < MAX_LOG_NS):
+            raise ControlError(
+                f"timestamp must be an integer receive time in [0, 2**63) ns, got "
+                f"{timestamp!r:.60}: the message is not written (the bag stays open)"
+            )
+        try:
+            memoryview(data)  # bytes, or an array of them (rosbags' serialize_cdr)
+        except TypeError:
+            raise ControlError(
+                f"data must be a message's serialized bytes (CDR), got {type(data).__name__}: "
+                "the message is not written (the bag stays open)"
+            ) from None
         self._writer.write(connection, timestamp, data)
         log, digests = self._messages[connection.topic]
         log.append(int(timestamp))

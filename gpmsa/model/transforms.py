@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gpmsa.errors import ExtrapolationWarning, GPMSAError, numbers_text
+from gpmsa.errors import ExtrapolationWarning, GPMSAError, numbers_text, user_stacklevel
 from gpmsa.model import index_points
 from gpmsa.model.data import SimData, check_increasing, column_scales, output_scale
 from gpmsa.model.index_points import is_points, n_points
@@ -37,7 +37,7 @@ def check_extrapolation(
     hi,
     what: str | Sequence[str],
     extrapolate: bool | None = None,
-    stacklevel: int = 2,
+    stacklevel: int | None = None,
 ) -> None:
     """The library's rule for inputs (rows ``native`` (N, d), ``unit`` their unit scale) against
     the emulator's domain [``lo``, ``hi``] (per column, native units): inside it silent; outside
@@ -46,7 +46,9 @@ def check_extrapolation(
     its name, or one per column where columns come from several arguments, as ``predict``'s x
     and t), the column, the values it reaches and the domain; ``extrapolate``: the caller's
     option of that name (False: the error points at it), None where it has none.
-    ``stacklevel``: of the warning, counted from the caller of this function."""
+    ``stacklevel``: of the warning, counted from the caller of this function; None (the
+    default): the user's call, however deep the caller (`user_stacklevel`, found only when
+    there is a warning to give)."""
     below, above = unit.min(axis=0), unit.max(axis=0)
     far = (below < -EXTRAPOLATION_MARGIN) | (above > 1 + EXTRAPOLATION_MARGIN)
     outside = far | (below < 0) | (above > 1)
@@ -62,9 +64,8 @@ def check_extrapolation(
             raise GPMSAError(
                 msg + ("; pass extrapolate=True to allow it" if extrapolate is False else "")
             )
-    warnings.warn(
-        msg + "; the emulator extrapolates there", ExtrapolationWarning, stacklevel=stacklevel + 1
-    )
+    level = user_stacklevel() if stacklevel is None else stacklevel + 1
+    warnings.warn(msg + "; the emulator extrapolates there", ExtrapolationWarning, stacklevel=level)
 
 
 def snap_to_unit(u: np.ndarray) -> np.ndarray:

@@ -96,7 +96,7 @@ def unit_inputs(
         check_levels(native, levels, names, what)
     lo, hi = np.asarray(lo, dtype=float), np.asarray(hi, dtype=float)
     unit = snap_to_unit((native - lo) / (hi - lo))
-    check_extrapolation(native, unit, names, lo, hi, what, extrapolate, stacklevel=3)
+    check_extrapolation(native, unit, names, lo, hi, what, extrapolate)  # the user's line
     return native, unit
 
 

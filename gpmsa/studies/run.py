@@ -594,7 +594,7 @@ def calibrate_study(
                 warnings.simplefilter("ignore", ReductionWarning)
             reduced.append(_per_model(lab, reduce, e, x, y, extrapolate))
         fits.append(observation_fit(e, reduced[-1], [e.params]))  # as gpmsa.calibrate warns
-        warn_if_outside(fits[-1], stacklevel=3, discrepancy=basis is not None, model=lab,
+        warn_if_outside(fits[-1], discrepancy=basis is not None, model=lab,
                         far=far_value(e, reduced[-1], fits[-1]))  # fmt: skip
     problems = [_per_model(lab, calibration_problem, e, x, y, extrapolate=extrapolate,
                            reduced=None if basis is not None else r, discrepancy=basis,
