@@ -470,12 +470,15 @@ every Simplex band in 1e-6 m^3 reads as smooth ground (`check_gd_unit`)."""
 
 
 def check_gd_unit(gd_range: tuple[float, float], name: str = "GD") -> None:
-    """EmulatorMismatchError where a GD domain ``gd_range`` (lo, hi) lies wholly below
-    `GD_MIN_HI`: an emulator whose GD axis is in m^3, not 1e-6 m^3. Its estimates (~4e-4 on
-    ground of GD 400) lie below any Simplex band in 1e-6 m^3 (the default 250-350), which then
-    commands its top speed on any ground."""
+    """EmulatorMismatchError where the domain ``gd_range`` (lo, hi) of a parameter named GD
+    (``name``, in any case: the name `control.training` and the shipped emulators give it)
+    lies wholly below `GD_MIN_HI`: an emulator whose GD axis is in m^3, not 1e-6 m^3. Its
+    estimates (~4e-4 on ground of GD 400) lie below any Simplex band in 1e-6 m^3 (the default
+    250-350), which then commands its top speed on any ground. A parameter named otherwise (an
+    emulator of your own roughness measure, e.g. "IRI" in m/km) is not checked: its unit is
+    not GD's."""
     lo, hi = gd_range
-    if hi < GD_MIN_HI:
+    if str(name).casefold() == "gd" and hi < GD_MIN_HI:
         lo_text, hi_text = numbers_text(lo, hi)
         raise EmulatorMismatchError(
             f"the emulator's {name} domain [{lo_text}, {hi_text}] lies below {GD_MIN_HI:g}: "
@@ -485,6 +488,16 @@ def check_gd_unit(gd_range: tuple[float, float], name: str = "GD") -> None:
             f"every estimate as smooth ground (its top speed); train it on {name} x 1e6 "
             f"(control.training.fit_band_emulator refuses GDs in m^3)"
         )
+
+
+def _put_back(held: dict, saved: dict) -> None:
+    """Make ``held`` (an object's ``__dict__``) equal to ``saved`` (a copy of it taken before):
+    its keys set first, those added since removed after, so that no moment leaves one of
+    ``saved``'s keys missing (`BCR._restore`: a clear() then update() leaves the object without
+    a single attribute where an interrupt lands between them)."""
+    held.update(saved)
+    for key in held.keys() - saved.keys():
+        del held[key]
 
 
 class BCR:
@@ -654,12 +667,7 @@ class BCR:
         if np.isinf(moved_m):
             self.reset()
             return
-        saved = self._state()
-        try:
-            self._resume(float(moved_m))
-        except BaseException:  # (a KeyboardInterrupt): as before the call
-            self._restore(saved)
-            raise
+        self._all_or_nothing(self._resume, float(moved_m))
 
     def _resume(self, moved_m: float) -> None:
         """`resume` over a checked, finite ``moved_m``."""
@@ -751,12 +759,7 @@ class BCR:
         for name, a in zip(names, arrays, strict=True):
             if a.size != n:
                 raise ControlError(f"{name} must have t's length {n}, got {a.size}")
-        saved = self._state()
-        try:
-            return self._update(arrays, now)
-        except BaseException:  # (an error of the model's, a KeyboardInterrupt): as before it
-            self._restore(saved)
-            raise
+        return self._all_or_nothing(self._update, arrays, now)
 
     def _update(self, arrays: list[np.ndarray], now: float | None) -> Estimate:
         """`update` of checked samples (``arrays``: t, position, accel, speed of one length)."""
@@ -791,6 +794,21 @@ class BCR:
 
     # --- internals -------------------------------------------------------------------------------
 
+    def _all_or_nothing(self, call, *args):
+        """``call(*args)``, or where it raises (the model's error, a KeyboardInterrupt) the BCR
+        put back as it was before it (`_state`, `_restore`; a second interrupt inside the
+        restore: restored again, whole, then that interrupt raised)."""
+        saved = self._state()
+        try:
+            return call(*args)
+        except BaseException:
+            try:
+                self._restore(saved)
+            except BaseException:
+                self._restore(saved)  # idempotent
+                raise
+            raise
+
     def _state(self) -> tuple:
         """The stream's state, for `_restore` (~2 us with three phases): the BCR's attributes,
         each phase's and its filter's, its quiet-check scores, the trackers' masses and the
@@ -805,11 +823,12 @@ class BCR:
         return self.__dict__.copy(), list(self._tracked_at), span, inner
 
     def _restore(self, saved: tuple) -> None:
-        """Back to a `_state` (a call that raised part way leaves the BCR as it was)."""
+        """Back to a `_state` (a call that raised part way leaves the BCR as it was).
+        Idempotent, and no step leaves an attribute missing: where an interrupt lands inside
+        it, `update` and `resume` run it again, whole."""
         attributes, tracked_at, span, inner = saved
-        self.__dict__.clear()
-        self.__dict__.update(attributes)
-        self._tracked_at = tracked_at
+        _put_back(self.__dict__, attributes)
+        self._tracked_at = list(tracked_at)
         if span is not None:
             self._span.restore(span)
         if self.settings.method == "changepoint":
@@ -817,8 +836,7 @@ class BCR:
                 phase.__dict__.update(fields)
                 phase.levels.clear()
                 phase.levels.extend(levels)
-                phase.filter.__dict__.clear()
-                phase.filter.__dict__.update(filtered)
+                _put_back(phase.filter.__dict__, filtered)
         else:
             for tracker, log_mass in zip(self.trackers, inner, strict=True):
                 tracker.log_mass = log_mass

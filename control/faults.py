@@ -112,14 +112,16 @@ class FaultInjector:
         drawn = self.rng.bit_generator.state if self.faults else None  # (~2 us)
         try:
             self._apply(t, pos, acc, clock, keep, spiked, held)
+            # (inside the try: an interrupt here, after the generator drew, undoes that too)
+            good = np.isfinite(acc) & keep
+            last = float(acc[good][-1]) if good.any() else self._last
+            batch = t[keep], pos[keep], acc[keep], spd[keep]
         except BaseException:  # (a KeyboardInterrupt): the injector as before the batch
             if drawn is not None:
                 self.rng.bit_generator.state = drawn
             raise
-        good = np.isfinite(acc) & keep
-        last = float(acc[good][-1]) if good.any() else self._last
-        self._spiked, self._held, self._last = spiked, held, last
-        return t[keep], pos[keep], acc[keep], spd[keep]
+        self._spiked, self._held, self._last = spiked, held, last  # (no call between them)
+        return batch
 
     def _apply(self, t, pos, acc, clock, keep, spiked: dict, held: dict) -> None:
         """Apply the faults to a batch's arrays in place; ``spiked`` and ``held``: copies of the
