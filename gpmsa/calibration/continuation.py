@@ -36,7 +36,7 @@ def checked_source(init, n_chains: int) -> Posterior:
         hint = ""
         if kind == "Emulator":
             hint = " (a fit's chains continue in gpmsa.fit(..., init=emulator))"
-        elif kind == "InferenceData":
+        elif kind in ("InferenceData", "DataTree"):  # ArviZ 0.x, 1.x
             hint = (" (Posterior.to_arviz() keeps the draws, not the step widths and settings "
                     "a continuation needs: keep the Posterior itself, e.g. pickled)")  # fmt: skip
         raise GPMSAError(f"init must be a start rule or a Posterior that gpmsa.calibrate "

@@ -10,12 +10,24 @@ from gpmsa.errors import GPMSAError
 
 
 def _arviz():
-    """Import arviz quietly (it emits a FutureWarning at import)."""
+    """Import arviz quietly (0.x emits a FutureWarning at import, 1.x warnings of its xarray
+    accessors)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         import arviz
 
     return arviz
+
+
+def arviz_major() -> int:
+    """The installed ArviZ's major release. This module is the one place gpmsa calls ArviZ, and
+    hides what 1.x (Python >= 3.12) changed: ``from_dict`` takes the groups as one dict and
+    returns an xarray DataTree (0.x: keywords, an InferenceData; both have the groups
+    ``posterior`` and ``sample_stats`` and ``to_netcdf``), ``hdi`` takes ``prob=`` (0.x:
+    ``hdi_prob=``), and the array ``autocorr`` is ``arviz_stats.base.array_stats.autocorr`` (0.x:
+    ``arviz.autocorr``); ``ess`` and ``rhat`` of an array are called alike and agree to the
+    last digit."""
+    return int(str(_arviz().__version__).split(".", 1)[0])
 
 
 CF_TIME_UNITS = frozenset(
@@ -37,8 +49,9 @@ def to_inference_data(
     log_post: np.ndarray | None = None,
     units: dict[str, str] | None = None,
 ):
-    """ArviZ InferenceData from draws name -> (n_chains, n_draws, *shape); ``units`` name ->
-    unit, each kept as its variable's "units" attribute (a netCDF convention; none where
+    """ArviZ InferenceData (with ArviZ 1.x an xarray DataTree of the same groups, `arviz_major`)
+    from draws name -> (n_chains, n_draws, *shape); ``units`` name -> unit, each kept as its
+    variable's "units" attribute (a netCDF convention; none where
     missing or "", nor where xarray would read the draws back as times, `is_cf_time_unit`:
     dates or durations from ``to_netcdf``, or a file that does not open). GPMSAError for a
     name that is one of ArviZ's dimension names ("chain", "draw", "NAME_dim_K" of a draw with
@@ -56,10 +69,12 @@ def to_inference_data(
             "InferenceData yourself under another name (arviz.from_dict)"
         )
     az = _arviz()
-    sample_stats = {"lp": log_post} if log_post is not None else None
+    groups = {"posterior": dict(draws)}
+    if log_post is not None:
+        groups["sample_stats"] = {"lp": log_post}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        idata = az.from_dict(posterior=dict(draws), sample_stats=sample_stats)
+        idata = az.from_dict(groups) if arviz_major() >= 1 else az.from_dict(**groups)
     for name, unit in (units or {}).items():
         if unit and name in idata.posterior and not is_cf_time_unit(str(unit)):
             idata.posterior[name].attrs["units"] = str(unit)
@@ -119,14 +134,20 @@ def autocorrelation(x: np.ndarray) -> np.ndarray:
     out = np.full(x.shape, np.nan)
     varied = np.ptp(x, axis=1) > 0
     if np.any(varied):
-        out[varied] = _arviz().autocorr(x[varied], axis=-1)
+        if arviz_major() >= 1:
+            from arviz_stats.base import array_stats
+
+            out[varied] = array_stats.autocorr(x[varied], axis=-1)
+        else:
+            out[varied] = _arviz().autocorr(x[varied], axis=-1)
     return out
 
 
 def hdi(x: np.ndarray, level: float) -> tuple[float, float]:
     """Highest-density interval (ArviZ's: the shortest one) of 1-D draws x with probability
     ``level``."""
-    lo, hi = _arviz().hdi(np.asarray(x, dtype=np.float64), hdi_prob=level)
+    prob = {"prob": level} if arviz_major() >= 1 else {"hdi_prob": level}
+    lo, hi = _arviz().hdi(np.asarray(x, dtype=np.float64), **prob)
     return float(lo), float(hi)
 
 

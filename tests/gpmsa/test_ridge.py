@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-import torch
 from threadpoolctl import threadpool_limits
 
 import gpmsa
@@ -85,6 +84,7 @@ def test_numpy_ridge_move_samples_the_conditional_and_keeps_the_likelihood(scala
 
 
 def test_torch_ridge_move_samples_the_same_conditional(scalar_problem):
+    torch = pytest.importorskip("torch")
     from gpmsa.backends.torch_backend import BatchState
 
     prob = scalar_problem

@@ -3,17 +3,16 @@ mean and an sd array): ``Priors(theta_mean=[...], theta_sd=[...])``, used by eve
 grid, the starts, held and categorical elements, studies, the file and ``gpmsa info``."""
 
 import functools
+import importlib.util
 import json
 import warnings
 import zipfile
 
 import numpy as np
 import pytest
-import torch
 
 import gpmsa
 from gpmsa import Priors
-from gpmsa.backends.torch_backend import log_prior_elements
 from gpmsa.cli.main import main as cli_main
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.io.container import ENVELOPE, read_raw, write_raw
@@ -21,6 +20,9 @@ from gpmsa.mcmc.starts import _truncnorm01
 from gpmsa.model.problem import theta_log_prior
 
 TIGHT = ([0.3, 0.5], [0.05, 10.0])  # a tight prior on a, a vague one on b
+needs_torch = pytest.mark.skipif(
+    importlib.util.find_spec("torch") is None, reason="torch not installed (the torch extra)"
+)
 
 
 def _data(n=24, seed=3, t_categorical=None, t=None):
@@ -116,7 +118,10 @@ def test_a_wrong_count_is_refused_where_the_model_is_built():
         {},
         {"fast": False, "n_samples": 100},
         {"fixed": {"theta": {"b": 0.7}}},
-        {"backend": "torch", "n_chains": 2, "n_samples": 60, "n_burn": 20, "tune": False},
+        pytest.param(
+            {"backend": "torch", "n_chains": 2, "n_samples": 60, "n_burn": 20, "tune": False},
+            marks=needs_torch,
+        ),
         "grid",
     ],  # fmt: skip
     ids=["fast", "numpy", "held", "torch", "grid"],
@@ -135,15 +140,22 @@ def test_equal_per_element_values_are_the_shared_prior_bit_for_bit_calibrating(k
     _same(a, b)
 
 
-def test_equal_per_element_values_are_the_shared_prior_bit_for_bit_fitting():
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"init": "prior", "n_chains": 2},
+        pytest.param({"backend": "torch", "n_chains": 2}, marks=needs_torch),
+    ],
+    ids=["numpy", "torch"],
+)
+def test_equal_per_element_values_are_the_shared_prior_bit_for_bit_fitting(kw):
     data, xo, yo = _data(n=14)
     obs = gpmsa.ObsData(x=xo, y=yo)
     one, each = Priors(theta_mean=0.4, theta_sd=0.3), Priors(theta_mean=[0.4] * 2, theta_sd=0.3)
-    for kw in ({"init": "prior", "n_chains": 2}, {"backend": "torch", "n_chains": 2}):
-        a = gpmsa.fit(data, obs, n_iter=40, seed=1, priors=one, tune=False, **kw)
-        b = gpmsa.fit(data, obs, n_iter=40, seed=1, priors=each, tune=False, **kw)
-        np.testing.assert_array_equal(a.log_post, b.log_post)
-        np.testing.assert_array_equal(a.calibration["theta"], b.calibration["theta"])
+    a = gpmsa.fit(data, obs, n_iter=40, seed=1, priors=one, tune=False, **kw)
+    b = gpmsa.fit(data, obs, n_iter=40, seed=1, priors=each, tune=False, **kw)
+    np.testing.assert_array_equal(a.log_post, b.log_post)
+    np.testing.assert_array_equal(a.calibration["theta"], b.calibration["theta"])
 
 
 # --- per-element priors: every path the same posterior --------------------------------------
@@ -181,7 +193,12 @@ def test_the_numpy_sampler_follows_the_per_element_prior():
         assert post.sd(k) == pytest.approx(grid.sd(k), rel=0.25)
 
 
+@needs_torch
 def test_the_torch_prior_is_the_numpy_prior_per_element():
+    import torch
+
+    from gpmsa.backends.torch_backend import log_prior_elements
+
     p = Priors(theta_mean=[0.3, 0.5, 0.8], theta_sd=[0.05, 10.0, 0.2])
     th = np.array([[0.25, 0.9, 0.7], [0.31, 0.1, 0.99]])
     t = torch.as_tensor(th)
@@ -193,6 +210,7 @@ def test_the_torch_prior_is_the_numpy_prior_per_element():
     np.testing.assert_allclose(one, [p.scalar_log_prior("theta", 2)(r[2]) for r in th])
 
 
+@needs_torch
 def test_torch_calibration_follows_the_per_element_prior():
     emu, xo, yo = _emulator()
     per = emu.with_calibration_priors(theta_mean=TIGHT[0], theta_sd=TIGHT[1])

@@ -2,14 +2,15 @@
 
 import numpy as np
 import pytest
-import torch
 from threadpoolctl import threadpool_limits
 
 import gpmsa
 from gpmsa import backends
-from gpmsa.backends import torch_backend as tb
 from gpmsa.mcmc.diagnostics import rhat
 from gpmsa.model.likelihood import log_posterior
+
+torch = pytest.importorskip("torch")
+tb = pytest.importorskip("gpmsa.backends.torch_backend")
 
 
 @pytest.fixture(autouse=True)
