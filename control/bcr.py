@@ -526,6 +526,7 @@ class BCR:
 
     def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
         from control.compat import check_recorded_feature
+        from control.observation_model import check_emulator_inputs
 
         settings = BCRSettings() if settings is None else settings
         check_instance(settings, "settings", BCRSettings)
@@ -559,6 +560,7 @@ class BCR:
                     f"method {s.method!r} needs a gpmsa.Calibrator, got {type(model).__name__}"
                     " (BCR.from_emulator(emulator) builds the model an emulator needs)"
                 )
+            check_emulator_inputs(model.emulator)  # (a window's x_obs is [[v]])
             self.speed_range, self.gd_range = emulator_domain(model.emulator)
             self.gd_name = model.emulator.t_names[0]
             tracker, n = s.tracker, 1

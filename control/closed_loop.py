@@ -303,6 +303,8 @@ def run_closed_loop(
         _check_record_path(record)  # a wrong path is named with or without the extra
         check_can_record()
     recorded = "vehicle" in (getattr(emulator, "metadata", None) or {})
+    if check:  # its inputs and GD unit first: the message below is of the vehicle alone
+        check_emulator(emulator)
     if check and recorded:
         # first: a model left at its default says so, not that the Simplex is too fast for it
         try:

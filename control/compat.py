@@ -19,7 +19,12 @@ import vehicle
 from control.bcr import BCRSettings, check_gd_unit, emulator_domain
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.feature import FeatureSpec
-from control.observation_model import BlockScatter, one_block_logliks
+from control.observation_model import (
+    BlockScatter,
+    check_emulator_inputs,
+    check_feature_outputs,
+    one_block_logliks,
+)
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_instance, is_real, replace_fields, within
@@ -92,6 +97,7 @@ def check_feature(emulator, bcr: BCRSettings) -> None:
     """Raise `EmulatorMismatchError` naming each field in which the BCR's feature differs from
     the one the emulator was trained on."""
     trained = emulator_feature(emulator)
+    check_feature_outputs(emulator, trained)
     diff = trained.same_as(bcr.feature)
     if diff:
         pairs = ", ".join(
@@ -144,6 +150,7 @@ def check_emulator(
     lower there).
     """
     _check_is_emulator(emulator)
+    check_emulator_inputs(emulator)
     gd_name = emulator.t_names[0]
     check_gd_unit(tuple(map(float, emulator.domain[gd_name])), gd_name)
     if model is not None and not callable(getattr(model, "describe", None)):
@@ -159,6 +166,13 @@ def check_emulator(
     if simplex is not None:
         check_instance(simplex, "simplex", Simplex)
     meta = dict(getattr(emulator, "metadata", None) or {})
+    if "feature" in meta:  # its outputs against its recorded feature (with bcr= or not)
+        try:
+            recorded = FeatureSpec.from_dict(meta["feature"])
+        except (AttributeError, TypeError, ValueError):
+            recorded = None  # (a malformed record: named where a BCR's feature is checked)
+        if recorded is not None:
+            check_feature_outputs(emulator, recorded)
     if model is not None:
         if "vehicle" not in meta:
             warnings.warn(
@@ -215,6 +229,7 @@ def check_simplex(emulator, simplex: Simplex, bcr: BCRSettings | None = None) ->
     bottom of the domain is checked too), so a replay of an emulator that records no feature
     takes them. Each argument of the wrong kind is a `ControlError` naming it."""
     _check_is_emulator(emulator)
+    check_emulator_inputs(emulator)
     check_instance(simplex, "simplex", Simplex)
     if bcr is not None:
         check_instance(bcr, "bcr", BCRSettings)

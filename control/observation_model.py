@@ -28,6 +28,7 @@ from scipy.linalg.lapack import dpotrf
 
 from control.errors import ControlError, EmulatorMismatchError
 from control.feature import FeatureSpec
+from control.sensor_checks import MAX_SPEED_MPS
 from control.validation import float_array, is_integer, is_real, require_reals, within
 from gpmsa.errors import numbers_text
 
@@ -119,11 +120,7 @@ class ObservationModel:
             raise ControlError(
                 f"scatter must be a control BlockScatter or None, got {scatter!r:.60}"
             )
-        if emulator.p != 1 or emulator.q != 1:
-            raise EmulatorMismatchError(
-                f"the block likelihood needs one known input (speed) and one calibration "
-                f"parameter (GD); the emulator has p = {emulator.p}, q = {emulator.q}"
-            )
+        check_emulator_inputs(emulator)
         if scatter is None:
             meta = getattr(emulator, "metadata", None) or {}
             if "block_scatter" not in meta:
@@ -315,10 +312,130 @@ def _check_feature_length(emulator) -> None:
         feature = FeatureSpec.from_dict(record)
     except (AttributeError, TypeError, ValueError) as exc:
         raise EmulatorMismatchError(f"the emulator's feature is malformed: {exc}") from exc
-    if feature.dim != emulator.l_sim:
+    check_feature_outputs(emulator, feature)
+
+
+def check_feature_outputs(emulator, feature: FeatureSpec) -> None:
+    """EmulatorMismatchError where the emulator's outputs cannot be ``feature`` (its recorded
+    feature, which the BCR computes from each block or window): another number of outputs
+    (``l_sim``), or an output unit label (``y_units``, where given) that names another
+    transform or unit (`output_unit_slip`). An object without those attributes (a stand-in of
+    an emulator's records) is not checked."""
+    l_sim = getattr(emulator, "l_sim", None)
+    if l_sim is not None and feature.dim != l_sim:
         raise EmulatorMismatchError(
             f"the emulator's metadata records the feature {feature.name!r} of {feature.dim} "
-            f"outputs ({', '.join(feature.names())}), but the emulator has {emulator.l_sim}"
+            f"output{'s' if feature.dim != 1 else ''} ({', '.join(feature.names())}), but the "
+            f"emulator has {l_sim}: record the feature its outputs were computed as "
+            "(metadata={'feature': control.FeatureSpec(...).to_dict(), ...}), or fit it on that "
+            "feature's outputs"
+        )
+    cov = ((getattr(emulator, "metadata", None) or {}).get("block_scatter") or {}).get("cov")
+    shape = np.shape(cov) if isinstance(cov, list | tuple | np.ndarray) else ()
+    if len(shape) == 3 and shape[1] != feature.dim:
+        raise EmulatorMismatchError(
+            f"the emulator's block_scatter is {shape[1]}-dimensional but its feature "
+            f"{feature.name!r} has {feature.dim} outputs: record the scatter of that feature's "
+            "blocks (control.training.block_scatter; control.training.fit_band_emulator "
+            "records both)"
+        )
+    labels = tuple(getattr(emulator, "y_units", None) or ())
+    for k, (label, unit) in enumerate(zip(labels, feature.units(), strict=False)):
+        why = output_unit_slip(str(label), unit)
+        if why:
+            raise EmulatorMismatchError(
+                f"the emulator's y_units[{k}] = {label!r} ({feature.names()[k]}): {why}; the "
+                f"BCR compares it with the feature {feature.name!r} of the IMU's samples in "
+                f"{unit}, so every estimate would be biased: fit the emulator on that feature "
+                f"(control.feature.block_features / window_feature of accelerations in m/s^2)"
+            )
+
+
+OTHER_SPEED_UNITS = frozenset(("km/h", "kmh", "kph", "km/hr", "kmph", "mph", "mi/h", "ft/s",
+                               "fps", "ft/sec", "mm/s", "cm/s", "in/s", "kn", "kt", "kts",
+                               "knot", "knots"))  # fmt: skip
+"""Speed unit labels (lower case, no spaces) that are not m/s (`check_emulator_inputs`)."""
+OTHER_ACCEL_UNITS = ("cm/s", "mm/s", "ft/s", "in/s", "g^2", "gal")
+"""Parts of an output unit label (lower case, no spaces) that name an acceleration in another
+unit than m/s^2 (`output_unit_slip`; "g^2": a band power in g^2)."""
+
+
+def _unit_key(label: str) -> str:
+    """A unit label compared by `check_emulator_inputs` and `output_unit_slip`: lower case,
+    without spaces, "**" as "^"."""
+    return "".join(str(label).split()).lower().replace("**", "^").replace("²", "^2")
+
+
+def output_unit_slip(label: str, unit: str) -> str:
+    """Why an emulator output whose ``y_units`` label is ``label`` cannot be a feature channel
+    of unit ``unit`` (`FeatureSpec.units`: "log((m/s^2)^2)", "(m/s^2)^2" or "g"), or "" (an
+    empty label, one that names no unit this recognises, or the channel's own). Only labels
+    that name another transform or unit are refused: a log power labelled as a power (f, not
+    log f), a power labelled as a log, a power or quantile in another acceleration unit."""
+    key = _unit_key(label)
+    if not key or key == _unit_key(unit):
+        return ""
+    logged = "log" in key or key.startswith("ln")
+    if unit == "g":
+        if "/s" in key:
+            return "a quantile in an acceleration unit, where the feature's are in g"
+        return ""
+    if any(other in key for other in OTHER_ACCEL_UNITS):
+        return "an acceleration in another unit than m/s^2"
+    if ("/s" in key or "s^-" in key) and unit.startswith("log") and not logged:
+        return "a power itself, where the feature is its log (log f, not f)"
+    if unit == "(m/s^2)^2" and logged:
+        return "a log power, where the feature is the power itself (f, not log f)"
+    return ""
+
+
+def check_emulator_inputs(emulator) -> None:
+    """EmulatorMismatchError where ``emulator``'s inputs are not what the BCR reads: one known
+    input x, the speed (m/s), and one calibration parameter t, GD (1e-6 m^3), both continuous;
+    a speed domain whose lowest speed lies beyond any ground robot's (`MAX_SPEED_MPS`: GD
+    fitted as x and the speed as t); an x unit label (``x_units``, where given) naming another
+    speed unit (`OTHER_SPEED_UNITS`). Attributes an object lacks (a stand-in of an emulator's
+    records) are not checked."""
+    x_names, t_names = getattr(emulator, "x_names", None), getattr(emulator, "t_names", None)
+    if x_names is None or t_names is None:
+        return
+    x_names, t_names = list(x_names), list(t_names)
+    if len(x_names) != 1 or len(t_names) != 1:
+        raise EmulatorMismatchError(
+            f"the BCR reads an emulator of one known input x, the speed (m/s), and one "
+            f"calibration parameter t, GD (1e-6 m^3); this one has x = {x_names} and t = "
+            f"{t_names}: fit gpmsa.SimData(x=speed[:, None], t=gd[:, None], ...) (as "
+            "control.training.fit_band_emulator does), one emulator for each value of a "
+            "further input (a payload, a second roughness parameter)"
+        )
+    categorical = sorted(getattr(emulator, "categorical", None) or {})
+    if categorical:
+        raise EmulatorMismatchError(
+            f"the emulator's {' and '.join(map(repr, categorical))} "
+            f"{'is' if len(categorical) == 1 else 'are'} categorical (SimData x_categorical / "
+            "t_categorical): the BCR reads speed and GD as continuous inputs (it interpolates "
+            "the speed and puts GD on a grid between the training values); fit them as "
+            "continuous inputs"
+        )
+    domain = getattr(emulator, "domain", None)
+    if domain is not None and x_names[0] in domain and t_names[0] in domain:
+        v_lo, v_hi = (float(b) for b in domain[x_names[0]])
+        if v_lo > MAX_SPEED_MPS:
+            lo_text, hi_text = numbers_text(v_lo, v_hi)
+            g_lo, g_hi = numbers_text(*(float(b) for b in domain[t_names[0]]))
+            raise EmulatorMismatchError(
+                f"the emulator's speed input x = {x_names[0]!r} spans [{lo_text}, {hi_text}], "
+                f"beyond any ground robot's speed (MAX_SPEED_MPS = {MAX_SPEED_MPS:g} m/s), and "
+                f"its GD t = {t_names[0]!r} spans [{g_lo}, {g_hi}]: GD fitted as x and the "
+                "speed as t? x must be the speed (m/s) and t GD: fit "
+                "gpmsa.SimData(x=speed[:, None], t=gd[:, None], ...)"
+            )
+    x_units = tuple(getattr(emulator, "x_units", None) or ())
+    if x_units and _unit_key(x_units[0]) in OTHER_SPEED_UNITS:
+        raise EmulatorMismatchError(
+            f"the emulator's x_units = {x_units[0]!r}: the BCR reads the speed (x = "
+            f"{x_names[0]!r}) in m/s, as odometry gives it, so a speed in another unit reads "
+            "every block at the wrong speed: fit the emulator on the speed in m/s"
         )
 
 
