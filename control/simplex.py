@@ -47,6 +47,18 @@ flag in its first block never makes the robot faster on rough ground (docs/close
 the laws whose performance speed is never below v_safe ("linear", "switch"; not "paper").
 The latch needs the run's history: `Simplex.command` is memoryless, `Simplex.start` gives the
 stateful `SimplexRun` that the closed loop and the replay use.
+
+Release dwell (``release_m``, opt-in; default 0: none): once the run has driven in
+performance mode, safety mode for whatever reason (a GD above GD_max, an estimate that is not
+"ok", the latch until `SimplexRun.reset`) returns to performance mode only once the law has
+read performance mode (the same test as without the dwell, with the ``risk`` posture) at every
+update over ``release_m`` metres of travel (the estimates' ``position``); any update that
+reads safety mode restarts the count. The start's safety mode (the BCR's buffer filling) has no
+dwell. A sensor whose gain drops
+reads as smoother ground until the BCR's checks find it; the dwell keeps such a reading in
+safety mode for ``release_m`` more metres, at the price of ``release_m`` metres at v_safe after
+each safety mode of a healthy run (docs/closed-loop.md, "Release dwell", measures both).
+Used by `start`'s `SimplexRun` only.
 """
 
 from __future__ import annotations
@@ -106,6 +118,9 @@ class Simplex:
             "resume" is a ControlError: it would have no effect).
         speed_step_mps: the performance-mode speed is rounded down to v_safe + k times this,
             m/s (0: the continuous law; see the module docstring).
+        release_m: release dwell, m (finite, >= 0; 0: none): after safety mode, performance
+            mode again only once the law has read it over this much travel (see the module
+            docstring); used by `start`'s `SimplexRun`.
     """
 
     gd_min: float = 250.0
@@ -118,13 +133,15 @@ class Simplex:
     after_fault: str = "latch"
     latch_p: float = LATCH_P
     speed_step_mps: float = 0.1
+    release_m: float = 0.0
 
     def __post_init__(self) -> None:
         require_reals(
             self,
-            ("gd_min", "gd_max", "v_max", "v_safe", "kp", "risk", "latch_p", "speed_step_mps"),
+            ("gd_min", "gd_max", "v_max", "v_safe", "kp", "risk", "latch_p", "speed_step_mps",
+             "release_m"),
             optional=("kp", "risk"),
-        )
+        )  # fmt: skip
         for name in ("gd_min", "gd_max", "v_max", "v_safe"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
@@ -151,6 +168,12 @@ class Simplex:
                 f"speed_step_mps must lie in [0, v_max] = "
                 f"[0, {numbers_text(self.speed_step_mps, self.v_max)[1]}], "
                 f"got {self.speed_step_mps}"
+            )
+        if not (np.isfinite(self.release_m) and self.release_m >= 0):
+            raise ControlError(
+                f"release_m must be a finite distance >= 0, m, got {self.release_m}: 0 for no "
+                "release dwell, or the metres of travel over which the law must read "
+                "performance mode before the run leaves safety mode"
             )
         if not 0 < self.latch_p <= 1:
             raise ControlError(f"latch_p must lie in (0, 1], got {self.latch_p}")
@@ -232,17 +255,30 @@ class Simplex:
 
 class SimplexRun:
     """A `Simplex` over one run: its commands, latched in safety mode after a fault when
-    ``simplex.after_fault == "latch"``.
+    ``simplex.after_fault == "latch"``, held in safety mode by the release dwell when
+    ``simplex.release_m > 0``.
 
     Attributes:
         simplex: the controller (`ControlError` for anything else).
         latched_by: the estimate that latched safety mode, or None.
+        clear_since_m: with the release dwell, the position (m) of the first of the updates
+            in a row whose law reads performance mode; None after one that reads safety mode.
+        in_safety: with the release dwell, whether the last command was in safety mode.
+        performed: with the release dwell, whether the run has commanded performance mode
+            (the dwell holds from the first safety mode after it: the start has none).
     """
+
+    clear_since_m: float | None = None  # (class values: a run pickled before the dwell)
+    in_safety: bool = True
+    performed: bool = False
 
     def __init__(self, simplex: Simplex) -> None:
         check_instance(simplex, "simplex", Simplex, "make one with control.Simplex(...)")
         self.simplex = simplex
         self.latched_by: Estimate | None = None
+        self.clear_since_m: float | None = None
+        self.in_safety = True
+        self.performed = False
 
     @property
     def latched(self) -> bool:
@@ -256,7 +292,13 @@ class SimplexRun:
         if s.after_fault == "latch" and not self.latched and self._latches(estimate):
             self.latched_by = estimate
         if self.latched_by is None:
-            return s.command(estimate)
+            command = s.command(estimate)
+            if s.release_m == 0:
+                return command
+            command = self._dwell(command, estimate)
+            self.in_safety = command.mode == "safety"
+            return command
+        self.clear_since_m, self.in_safety = None, True
         first = self.latched_by
         return Command(
             s.v_safe,
@@ -267,11 +309,36 @@ class SimplexRun:
             + "; reset() to resume",
         )
 
+    def _dwell(self, command: Command, estimate: Estimate) -> Command:
+        """``command``, the law's, held in safety mode after the run's first performance mode
+        until the law has read performance mode over ``release_m`` metres in a row (an update
+        without a finite position restarts the count)."""
+        if command.mode == "safety":
+            self.clear_since_m = None
+            return command
+        position = estimate.position
+        if not np.isfinite(position):
+            self.clear_since_m = None
+        elif self.clear_since_m is None:
+            self.clear_since_m = position
+        clear_m = 0.0 if self.clear_since_m is None else position - self.clear_since_m
+        if self.performed and self.in_safety and not clear_m >= self.simplex.release_m:
+            return Command(
+                self.simplex.v_safe,
+                "safety",
+                command.gd_used,
+                f"release dwell: the law has read performance mode over {max(clear_m, 0.0):.2f} "
+                f"of release_m = {self.simplex.release_m:g} m",
+            )
+        self.performed = True
+        return command
+
     def _latches(self, estimate: Estimate) -> bool:
         if estimate.status == "implausible":
             return not estimate.plausibility_p >= self.simplex.latch_p  # NaN latches
         return estimate.status in FAULT_STATUSES
 
     def reset(self) -> None:
-        """Clear the latch (the operator has checked the sensor); the law applies again."""
+        """Clear the latch (the operator has checked the sensor); the law applies again (with
+        the release dwell, after ``release_m`` metres of it reading performance mode)."""
         self.latched_by = None

@@ -258,6 +258,11 @@ def main(argv: list[str] | None = None) -> dict:
         "docs/closed-loop.md)",
     )  # fmt: skip
     parser.add_argument(
+        "--release-m", type=float, default=control.Simplex.release_m, metavar="M",
+        help="the Simplex's release dwell, m: after safety mode, performance mode again only "
+        "once the law has read it over this much travel (default 0: none; docs/closed-loop.md)",
+    )  # fmt: skip
+    parser.add_argument(
         "--v-max", type=float, default=control.Simplex.v_max, metavar="M_PER_S",
         help="the Simplex's top speed, m/s (default 2.0, the paper's; within the emulators' "
         "speed range and the vehicle's top speed)",
@@ -307,10 +312,15 @@ def main(argv: list[str] | None = None) -> dict:
         control.Simplex(gd_min=args.gd_min, gd_max=args.gd_max)
     except control.ControlError as err:
         parser.error(f"--gd-min / --gd-max: {err}")
+    try:
+        control.Simplex(release_m=args.release_m)
+    except control.ControlError as err:
+        parser.error(f"--release-m: {err}")
     try:  # the speeds are checked together (v_safe <= v_max, the step <= v_max); --law: choices
         simplex = control.Simplex(
             risk=args.risk, law=args.law, speed_step_mps=args.speed_step,
             v_max=args.v_max, v_safe=args.v_safe, gd_min=args.gd_min, gd_max=args.gd_max,
+            release_m=args.release_m,
         )  # fmt: skip
     except control.ControlError as err:
         parser.error(f"--v-safe, --v-max, --speed-step: {err}")
