@@ -351,41 +351,116 @@ def check_feature_outputs(emulator, feature: FeatureSpec) -> None:
             )
 
 
-OTHER_SPEED_UNITS = frozenset(("km/h", "kmh", "kph", "km/hr", "kmph", "mph", "mi/h", "ft/s",
-                               "fps", "ft/sec", "mm/s", "cm/s", "in/s", "kn", "kt", "kts",
-                               "knot", "knots"))  # fmt: skip
-"""Speed unit labels (lower case, no spaces) that are not m/s (`check_emulator_inputs`)."""
-OTHER_ACCEL_UNITS = ("cm/s", "mm/s", "ft/s", "in/s", "g^2", "gal")
-"""Parts of an output unit label (lower case, no spaces) that name an acceleration in another
-unit than m/s^2 (`output_unit_slip`; "g^2": a band power in g^2)."""
+OTHER_SPEED_UNITS = frozenset(("km/h", "kmh", "kph", "km/hr", "kmph", "kmh^-1", "km*h^-1",
+                               "km.h^-1", "km/hour", "mph", "mi/h", "ft/s", "fps", "ft/sec",
+                               "mm/s", "cm/s", "in/s", "kn", "kt", "kts", "knot",
+                               "knots"))  # fmt: skip
+"""Speed unit labels (as `_unit_key` writes them) that are not m/s (`check_emulator_inputs`)."""
+
+_PER_S2 = ("/s^2", "s^-2", "*s^-2", ".s^-2", "/s/s", "/sec^2")
+_PER_S4 = ("^2/s^4", "^2s^-4", "^2*s^-4", "^2.s^-4", "^2/sec^4", "2/s4", "2s^-4")
+
+
+def _spellings(length: str) -> tuple[set[str], set[str]]:
+    """The unit keys of an acceleration in ``length`` per s^2 and of its power (squared)."""
+    accel = {length + s for s in _PER_S2}
+    return accel, {f"({a})^2" for a in accel} | {length + s for s in _PER_S4}
+
+
+def _output_units() -> dict[str, tuple[str, str]]:
+    """Output unit keys (`_unit_key`, a log transform taken off) -> (quantity, unit): the
+    spellings of an acceleration ("accel") or its power ("power") in m/s^2, of the quantiles'
+    g, and in the other units this knows (cm, mm, ft or in per s^2, gal, milli-g, g^2)."""
+    accel, power = _spellings("m")
+    known = {**dict.fromkeys(accel, ("accel", "m/s^2")), **dict.fromkeys(power, ("power", "m/s^2"))}
+    known.update(dict.fromkeys(("g", "g0", "g_0", "gn", "g_n"), ("accel", "g")))
+    for other in ("cm", "mm", "ft", "in"):
+        accel, power = _spellings(other)
+        known.update(dict.fromkeys(accel, ("accel", other + "/s^2")))
+        known.update(dict.fromkeys(power, ("power", other + "/s^2")))
+    for other in ("gal", "mg", "g"):
+        if other != "g":
+            known[other] = ("accel", other)
+        known.update(dict.fromkeys((f"{other}^2", f"({other})^2"), ("power", other)))
+    return known
+
+
+_OUTPUT_UNITS = _output_units()
+_LOG_TRANSFORMS = (("10*log10", "log10"), ("10log10", "log10"), ("log10", "log10"),
+                   ("log_10", "log10"), ("db", "log10"), ("log_e", "log"), ("loge", "log"),
+                   ("log", "log"), ("ln", "log"))  # fmt: skip
+"""Prefixes of an output unit key that name a transform: "log" the natural log (the feature's
+log f), "log10" the log to base 10 or decibels (log f / ln 10, 10 log10 f)."""
+_UNICODE = (("**", "^"), ("⁻¹", "^-1"), ("⁻²", "^-2"), ("⁻⁴", "^-4"), ("²", "^2"), ("⁴", "^4"),
+            ("·", "*"), ("[", "("), ("]", ")"))  # fmt: skip
 
 
 def _unit_key(label: str) -> str:
-    """A unit label compared by `check_emulator_inputs` and `output_unit_slip`: lower case,
-    without spaces, "**" as "^"."""
-    return "".join(str(label).split()).lower().replace("**", "^").replace("²", "^2")
+    """A unit label as `check_emulator_inputs` and `output_unit_slip` compare it: lower case,
+    without spaces, "**" and superscripts as "^" ("m·s⁻²" as "m*s^-2"), brackets as
+    parentheses."""
+    key = "".join(str(label).split()).lower()
+    for old, new in _UNICODE:
+        key = key.replace(old, new)
+    return key
+
+
+def _unwrapped(key: str) -> str:
+    """``key`` without one pair of parentheses around all of it."""
+    if not (key.startswith("(") and key.endswith(")")):
+        return key
+    depth = 0
+    for c in key[:-1]:
+        depth += {"(": 1, ")": -1}.get(c, 0)
+        if depth == 0:
+            return key  # "(m/s^2)/(s)": the first pair closes before the end
+    return key[1:-1]
+
+
+def _output_kind(label: str) -> tuple[str, str | None, str | None] | None:
+    """(transform, quantity, unit) an output unit label names: transform "" (none), "log" or
+    "log10" (`_LOG_TRANSFORMS`); quantity and unit (`_output_units`) where the rest of it is a
+    spelling this knows, else None. None for a label that names neither ("" included)."""
+    key = _unit_key(label)
+    transform = ""
+    for prefix, name in _LOG_TRANSFORMS:
+        if key.startswith(prefix):
+            transform, key = name, _unwrapped(key[len(prefix) :])
+            break
+    quantity, unit = _OUTPUT_UNITS.get(key, (None, None))
+    if not transform and quantity is None:
+        return None
+    return transform, quantity, unit
 
 
 def output_unit_slip(label: str, unit: str) -> str:
     """Why an emulator output whose ``y_units`` label is ``label`` cannot be a feature channel
-    of unit ``unit`` (`FeatureSpec.units`: "log((m/s^2)^2)", "(m/s^2)^2" or "g"), or "" (an
-    empty label, one that names no unit this recognises, or the channel's own). Only labels
-    that name another transform or unit are refused: a log power labelled as a power (f, not
-    log f), a power labelled as a log, a power or quantile in another acceleration unit."""
-    key = _unit_key(label)
-    if not key or key == _unit_key(unit):
+    of unit ``unit`` (`FeatureSpec.units`: "log((m/s^2)^2)", "(m/s^2)^2" or "g"), or "". Only
+    a label that is a known spelling of another transform or unit (`_output_kind`) is refused:
+    a power where the feature is its log (f, not log f), a log where it is the power, a log10
+    or dB where it is the natural log, an acceleration where it is a power, a power or
+    quantile in another unit. A label naming neither a transform nor a unit this knows ("log
+    var", "g (9.81 m/s^2)", "") is taken."""
+    got, want = _output_kind(label), _output_kind(unit)
+    if got is None or want is None or got == want:
         return ""
-    logged = "log" in key or key.startswith("ln")
-    if unit == "g":
-        if "/s" in key:
-            return "a quantile in an acceleration unit, where the feature's are in g"
-        return ""
-    if any(other in key for other in OTHER_ACCEL_UNITS):
-        return "an acceleration in another unit than m/s^2"
-    if ("/s" in key or "s^-" in key) and unit.startswith("log") and not logged:
-        return "a power itself, where the feature is its log (log f, not f)"
-    if unit == "(m/s^2)^2" and logged:
-        return "a log power, where the feature is the power itself (f, not log f)"
+    (transform, quantity, of), (w_transform, _, w_of) = got, want
+    if w_of == "g":
+        return "a quantile in another unit or transform, where the feature's are in g"
+    if of not in (None, w_of):
+        return f"an acceleration in another unit than {w_of}"
+    if transform != w_transform:
+        if not w_transform:
+            return "a log power, where the feature is the power itself (f, not log f)"
+        if transform == "log10":
+            return (
+                "a log10 (or dB) power, where the feature is its natural log (log f, not log10 f)"
+            )
+        if quantity == "power":
+            return "a power itself, where the feature is its log (log f, not f)"
+    if quantity == "accel":
+        its = "its power" if not w_transform else "the log of its power"
+        return f"an acceleration, where the feature is {its}"
     return ""
 
 

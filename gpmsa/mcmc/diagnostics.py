@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import warnings
 
 import numpy as np
@@ -19,6 +20,7 @@ def _arviz():
     return arviz
 
 
+@functools.cache
 def arviz_major() -> int:
     """The installed ArviZ's major release. This module is the one place gpmsa calls ArviZ, and
     hides what 1.x (Python >= 3.12) changed: ``from_dict`` takes the groups as one dict and
@@ -26,7 +28,7 @@ def arviz_major() -> int:
     ``posterior`` and ``sample_stats`` and ``to_netcdf``), ``hdi`` takes ``prob=`` (0.x:
     ``hdi_prob=``), and the array ``autocorr`` is ``arviz_stats.base.array_stats.autocorr`` (0.x:
     ``arviz.autocorr``); ``ess`` and ``rhat`` of an array are called alike and agree to the
-    last digit."""
+    last digit. Read once (a process imports one ArviZ)."""
     return int(str(_arviz().__version__).split(".", 1)[0])
 
 
@@ -56,7 +58,8 @@ def to_inference_data(
     dates or durations from ``to_netcdf``, or a file that does not open). GPMSAError for a
     name that is one of ArviZ's dimension names ("chain", "draw", "NAME_dim_K" of a draw with
     more axes): ArviZ would give that dimension's coordinate in its place, and its draws would
-    be lost without a word."""
+    be lost without a word; with ArviZ 1.x also for a name holding "/", which a DataTree
+    refuses (0.x's InferenceData takes it; its ``to_netcdf`` refuses it)."""
     dims = {"chain", "draw"}
     for name, value in draws.items():
         dims.update(f"{name}_dim_{k}" for k in range(np.ndim(value) - 2))
@@ -67,6 +70,15 @@ def to_inference_data(
             "draw, NAME_dim_K), whose coordinate would replace its draws; rename the parameter "
             "(SimData's t_names, or a study's shared or hierarchical names), or build the "
             "InferenceData yourself under another name (arviz.from_dict)"
+        )
+    slashed = [name for name in draws if "/" in name]
+    if slashed and arviz_major() >= 1:
+        raise GPMSAError(
+            f"to_arviz: parameter {slashed[0]!r} holds '/', which the xarray DataTree "
+            "that ArviZ 1.x builds refuses in a variable's name (a path separator); rename the "
+            "parameter (SimData's t_names, or a study's shared or hierarchical names), or build "
+            "the DataTree yourself under another name (arviz.from_dict({'posterior': "
+            "{name.replace('/', '_'): draws}}))"
         )
     az = _arviz()
     groups = {"posterior": dict(draws)}
