@@ -55,7 +55,7 @@ from gpmsa.calibration.observations import (
 )
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.calibration.sampler import CalibrationSampler, ChainResult
-from gpmsa.errors import GPMSAError, ReductionWarning, numbers_text, user_stacklevel
+from gpmsa.errors import GPMSAError, ReductionWarning, numbers_text
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, tempering, tuning
 from gpmsa.mcmc.parallel import in_this_process, run_chains
@@ -499,7 +499,7 @@ def sample_calibration(
                 [data.values_sha256, data.layout_sha256]))  # fmt: skip
         fit = observation_fit(emulator, data, sets)
         # attributed to the user's call (of calibrate, or of a Calibrator's update)
-        warn_if_outside(fit, user_stacklevel() + 1, discrepancy=discrepancy is not None,
+        warn_if_outside(fit, discrepancy=discrepancy is not None,
                         far=far_value(emulator, data, fit))  # fmt: skip
         if fast:
             draws, info = _run_fast(

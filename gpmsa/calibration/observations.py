@@ -791,7 +791,6 @@ def far_value(emulator, data: Observations, fit: Fit | None = None) -> FarValue 
 
 def warn_if_outside(
     fit: Fit,
-    stacklevel: int | None = None,
     discrepancy: bool = False,
     model: str | None = None,
     far: FarValue | None = None,
@@ -801,11 +800,10 @@ def warn_if_outside(
     model is calibrated too (the warning says that it must explain the difference); ``model``:
     the study model's label the warning names. ``far``: the value farthest outside every
     simulation run (`far_value`), which the warning names; where the predictive check reads the
-    data inside, a warning of its own. ``stacklevel``: as ``warnings.warn``'s here; None (the
-    default): the user's call, however deep the caller (`user_stacklevel`, found only when
-    there is a warning to give)."""
+    data inside, a warning of its own. The warnings name the user's call, however deep the
+    caller (`user_stacklevel`, found only when there is a warning to give)."""
     if fit.outside_sds <= OUTSIDE_SDS and far is not None:
-        warn_far(far, user_stacklevel() if stacklevel is None else stacklevel, model, discrepancy)
+        warn_far(far, user_stacklevel(), model, discrepancy)
     if fit.outside_sds > OUTSIDE_SDS:
         then = (
             "The discrepancy term and the observation error must then explain the difference "
@@ -824,7 +822,7 @@ def warn_if_outside(
             f"what the emulator has seen. {then}check the units, the feature and the "
             "emulator's domain" + ("" if far is None else f". The farthest value: {far.text()}"),
             OutsideEmulatorWarning,
-            stacklevel=user_stacklevel() if stacklevel is None else stacklevel,
+            stacklevel=user_stacklevel(),
         )
 
 

@@ -22,7 +22,7 @@ from scipy.linalg import cho_solve, solve_triangular
 from gpmsa import _threads
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
-from gpmsa.errors import EmulatorFileError, GPMSAError, user_stacklevel
+from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.validation import (
     DISCREPANCY_ARRAY,
     EMULATOR_PARAMS,
@@ -554,7 +554,7 @@ class Emulator:
             check_extrapolation(
                 native, z, names, np.concatenate([s.x_min, s.t_min]),
                 np.concatenate([s.x_max, s.t_max]), ("x",) * self.p + ("t",) * self.q,
-                extrapolate, user_stacklevel(),
+                extrapolate,
             )  # fmt: skip
         return z
 

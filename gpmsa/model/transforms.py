@@ -37,7 +37,6 @@ def check_extrapolation(
     hi,
     what: str | Sequence[str],
     extrapolate: bool | None = None,
-    stacklevel: int | None = None,
 ) -> None:
     """The library's rule for inputs (rows ``native`` (N, d), ``unit`` their unit scale) against
     the emulator's domain [``lo``, ``hi``] (per column, native units): inside it silent; outside
@@ -45,10 +44,9 @@ def check_extrapolation(
     a GPMSAError, unless ``extrapolate`` (then the warning). Both name the argument (``what``:
     its name, or one per column where columns come from several arguments, as ``predict``'s x
     and t), the column, the values it reaches and the domain; ``extrapolate``: the caller's
-    option of that name (False: the error points at it), None where it has none.
-    ``stacklevel``: of the warning, counted from the caller of this function; None (the
-    default): the user's call, however deep the caller (`user_stacklevel`, found only when
-    there is a warning to give)."""
+    option of that name (False: the error points at it), None where it has none. The warning
+    names the user's call, however deep the caller (`user_stacklevel`, found only when there is
+    a warning to give)."""
     below, above = unit.min(axis=0), unit.max(axis=0)
     far = (below < -EXTRAPOLATION_MARGIN) | (above > 1 + EXTRAPOLATION_MARGIN)
     outside = far | (below < 0) | (above > 1)
@@ -64,8 +62,8 @@ def check_extrapolation(
             raise GPMSAError(
                 msg + ("; pass extrapolate=True to allow it" if extrapolate is False else "")
             )
-    level = user_stacklevel() if stacklevel is None else stacklevel + 1
-    warnings.warn(msg + "; the emulator extrapolates there", ExtrapolationWarning, stacklevel=level)
+    msg += "; the emulator extrapolates there"
+    warnings.warn(msg, ExtrapolationWarning, stacklevel=user_stacklevel())
 
 
 def snap_to_unit(u: np.ndarray) -> np.ndarray:
