@@ -17,7 +17,10 @@ def data_dir() -> Path:
 def dask_client():
     """A dask.distributed client of two single-thread workers in this process (threads: a
     cluster of worker processes takes seconds to start); skipped without distributed."""
-    distributed = pytest.importorskip("distributed")
+    distributed = pytest.importorskip(
+        "distributed",
+        reason='needs distributed: pip install "terrain-gpmsa[dask]" (the dask extra)',
+    )
     with (
         distributed.LocalCluster(
             n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None

@@ -8,7 +8,10 @@ test_theta_priors_s75.py and test_torch_chains.py imported torch at module level
 ``pytest tests/gpmsa`` stopped with 3 collection errors, running none of its tests."""
 
 import ast
+import re
 from pathlib import Path
+
+import pytest
 
 TESTS = Path(__file__).resolve().parent
 OPTIONAL = {"torch", "gpytorch", "pyro", "dask", "distributed", "rosbags", "mcap"}
@@ -88,3 +91,34 @@ def test_the_check_finds_a_plain_import_and_passes_importorskip(tmp_path):
                     "from mcap.reader import make_reader\n\n"
                     "def test_a():\n    import rosbags\n")  # fmt: skip
     assert _plain_optional_imports(good, tmp_path) == []
+
+
+def test_the_skip_marks_name_the_extra_that_installs_the_package(monkeypatch):
+    """tests/_extras.py's marks (``@TORCH``, ``backend_param("torch")``, ``needs(...)``) skip
+    with a reason that names the missing package and the extra of pyproject.toml that installs
+    it, and only where it is missing."""
+    tomllib = pytest.importorskip("tomllib")
+    from tests import _extras
+
+    extras = tomllib.loads((TESTS.parent / "pyproject.toml").read_text())["project"]
+    imports = {"pyro-ppl": ["pyro"], "dask[distributed]": ["dask", "distributed"]}
+    declared = {
+        module: extra
+        for extra, requirements in extras["optional-dependencies"].items()
+        if extra != "test"
+        for req in requirements
+        for module in imports.get(re.split(r"[<>=!~; ]", req)[0], [re.split(r"[<>=!~; ]", req)[0]])
+    }
+    assert declared == _extras.EXTRA and set(declared) == OPTIONAL
+    monkeypatch.setattr(_extras, "installed", lambda module: module != "pyro")
+    assert _extras.needs("torch", "mcap").args == (False,)
+    mark = _extras.backend_param("pyro").marks[0]
+    assert mark.args == (True,)
+    assert (
+        mark.kwargs["reason"] == 'needs pyro: pip install "terrain-gpmsa[torch]" (the torch extra)'
+    )
+    assert _extras.backend_param("numpy", 1).marks[0].args == (False,)
+    monkeypatch.setattr(_extras, "installed", lambda module: False)
+    for module, extra in declared.items():
+        reason = _extras.needs(module).kwargs["reason"]
+        assert reason == f'needs {module}: pip install "terrain-gpmsa[{extra}]" (the {extra} extra)'

@@ -39,7 +39,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
 
 import roadgen
 from roadgen.errors import distinct_texts
@@ -644,8 +643,7 @@ def run_campaign(
             todo.append(i)
         else:
             results[i] = cached
-    bar = tqdm(total=len(specs), initial=len(specs) - len(todo), disable=not progress,
-               desc=f"campaign {model.name}", unit="run")  # fmt: skip
+    bar = _progress_bar(progress, len(specs), len(specs) - len(todo), f"campaign {model.name}")
     own = executor is None and len(todo) > 0
     pool = (
         ProcessPoolExecutor(
@@ -694,6 +692,44 @@ def run_campaign(
         settings=settings,
         **traces,
     )
+
+
+class _NoBar:
+    """The campaign's bar without ``progress``: counts, shows nothing, starts no thread."""
+
+    def __init__(self, total: int, initial: int) -> None:
+        self.total, self.n = total, initial
+
+    def update(self, n: int = 1) -> None:
+        self.n += n
+
+    def close(self) -> None:
+        pass
+
+
+@functools.cache
+def _bar_class():
+    from tqdm.auto import tqdm
+
+    class Bar(tqdm):
+        """tqdm.auto's bar without tqdm's monitor thread (see `_progress_bar`)."""
+
+        monitor_interval = 0
+
+    return Bar
+
+
+def _progress_bar(progress: bool, total: int, initial: int, desc: str):
+    """The campaign's bar over its runs (tqdm on stderr) when ``progress``, else a `_NoBar`.
+    Neither starts a thread: tqdm starts its monitor thread with its first bar, a disabled one
+    too, and keeps it; the pool would fork its workers beside it (Python >= 3.12: "This process
+    is multi-threaded, use of fork() may lead to deadlocks", and a rare real deadlock). The bar
+    is a tqdm subclass whose ``monitor_interval`` is 0 (tqdm's own class is left as it is; the
+    monitor only refreshes a bar that has waited over ``maxinterval``, and this one updates
+    at each run). (gpmsa's bars do the same; vehicle does not import gpmsa.)"""
+    if not progress:
+        return _NoBar(total, initial)
+    return _bar_class()(total=total, initial=initial, desc=desc, unit="run")
 
 
 def _end_with_parent() -> None:

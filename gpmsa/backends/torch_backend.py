@@ -31,8 +31,8 @@ import numpy as np
 import torch
 from scipy.linalg import cho_solve, lapack
 from threadpoolctl import threadpool_limits
-from tqdm.auto import tqdm
 
+from gpmsa._progress import progress_bar
 from gpmsa.backends import check_sample_args
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
@@ -1259,7 +1259,7 @@ def _sample(problem, n_iter, n_chains, tune, step_widths, seed, progress, tune_r
         total -= n_iter  # the groups' sweeps: counted by run_chains' bar over the groups
     ws = rates = None  # tempered: each copy's widths (K, n_el); the swap rates (C, K - 1)
     ladders = temps  # tempered: the draws' ladder (K,), or with adapt each chain's (C, K)
-    with torch.no_grad(), tqdm(total=total, desc="torch MCMC", disable=not progress) as bar:
+    with torch.no_grad(), progress_bar(progress, total, "torch MCMC", "it", mininterval=0.1) as bar:
         if temps is not None:
             ws, ladders = _tempered_tuning(state, w, temps, prop_mh, gen, bar, warmup=warmup,
                                            n_stages=n_stages, tune=tune,
@@ -1561,7 +1561,7 @@ def _group_task(problem: Problem, start: dict[str, np.ndarray], widths: np.ndarr
             state.level_shifts = {k: torch.as_tensor(v, dtype=state.ll_w.dtype)
                                   for k, v in level_shifts[1].items()}  # fmt: skip
         gen = torch.Generator().manual_seed(stream)
-        with tqdm(total=n_iter, desc=desc, disable=not progress) as bar:
+        with progress_bar(progress, n_iter, desc, "it", mininterval=0.1) as bar:
             if temps is not None:
                 return _tempered_draws(state, widths, temps, swap_every, n_iter, prop_mh, gen,
                                        bar)  # fmt: skip

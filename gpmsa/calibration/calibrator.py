@@ -355,12 +355,12 @@ class Calibrator:
         if method not in METHODS:
             raise GPMSAError(f"method must be one of {METHODS}, got {method!r}")
         backend = _mcmc_backend(backend, mcmc_options)
-        backends.get(backend)  # unknown or not installed: a clear error now, not at update()
-        if backend != "numpy" and method == "grid":
-            raise GPMSAError(
+        if backend in backends.names() and backend != "numpy" and method == "grid":
+            raise GPMSAError(  # whether the backend's packages are installed or not
                 "method='grid' runs on numpy; use method='mcmc' (or 'auto') with "
                 f"backend={backend!r}"
             )
+        backends.get(backend)  # unknown or not installed: a clear error now, not at update()
         if emulator_params not in EMULATOR_PARAM_MODES:
             raise GPMSAError(
                 f"emulator_params must be one of {EMULATOR_PARAM_MODES}, got {emulator_params!r}"

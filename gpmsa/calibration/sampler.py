@@ -24,6 +24,7 @@ import numpy as np
 from numpy.polynomial import chebyshev as cheb
 from scipy.linalg import solve_triangular
 
+from gpmsa._progress import progress_bar
 from gpmsa.calibration.model import FixedGP, lower_solve
 from gpmsa.calibration.observations import Observations
 from gpmsa.errors import GPMSAError
@@ -426,15 +427,13 @@ class CalibrationSampler:
         chain's (unit theta (q,), lamOs, emulator-set index) instead of the initials (a
         continuation, ``calibrate(init=)``; held elements are set to their values).
         ``proportional``: lamOs steps by GPM/SA's proportional step (None: ``not tune``)."""
-        from tqdm import tqdm
-
         q = self.q
         names = ["theta"] * q + ["lamOs"]
         w = np.array([THETA_WIDTH] * q + [self.init_lamos / 2.0]) if widths is None else widths
         state = _State(self, *(self._initial() if start is None else self._held(start)))
         prop_mh = not tune if proportional is None else proportional
         n_tune = tune_rounds * tune_levels if tune else 0
-        with tqdm(total=n_iter + n_tune, desc="calibrate", disable=not progress) as bar:
+        with progress_bar(progress, n_iter + n_tune, "calibrate", "it", mininterval=0.1) as bar:
             if tune:
                 bar.set_description("calibrate: tuning step widths")
                 cands = tuning.level_widths(names, w, tune_levels)

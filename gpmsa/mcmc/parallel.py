@@ -49,6 +49,7 @@ from numbers import Number
 import numpy as np
 
 from gpmsa import _version
+from gpmsa._progress import progress_bar
 from gpmsa.errors import ChainError, ChainRetryWarning, GPMSAError, user_stacklevel
 
 RETRIES = 1
@@ -466,15 +467,13 @@ def _in_process(fn, task, i, n, progress, desc, what):
 
 
 def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
-    from tqdm.auto import tqdm
-
     n = len(tasks)
     own = executor is None
     pool = _own_pool(workers) if own else executor
     results: list = [None] * n
     attempts = [0] * n
     running: dict[Future, int] = {}
-    bar = tqdm(total=n, desc=desc, unit=what, disable=not progress)
+    bar = progress_bar(progress, n, desc, what, mininterval=0.1)  # no thread beside the forks
 
     def submit(i: int) -> None:
         attempts[i] += 1

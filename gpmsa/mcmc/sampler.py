@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
@@ -552,15 +553,13 @@ def run_chain(
     moves' offsets and shifted elements, ``ChainState.level_record``). GPMSAError when the
     start's log posterior is NaN (no proposal could ever be accepted).
     """
-    from tqdm.auto import tqdm
-
     state = ChainState(problem, problem.init if start is None else start, rng,
                        ridge_moves=ridge_moves)  # fmt: skip
     state.check_start()
     els = state.els
     w = state.flat_widths(widths)
     total = n_iter + (tune_rounds * tune_levels if tune else 0)
-    bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    bar = progress_bar(progress, total, desc, unit="it")
     with one_thread(None):
         if tune and els:
             bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases

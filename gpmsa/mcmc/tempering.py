@@ -50,6 +50,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
@@ -365,8 +366,6 @@ def run_tempered_chain(
     the tuning of the widths and the draws; ``record`` as ``run_chain``'s (the T = 1 copy's
     level moves, shared by the ladder) with "hot": the hot copies' last states and widths (each
     a list of K - 1 dicts name -> array, widths NaN where not sampled)."""
-    from tqdm.auto import tqdm
-
     starts = [None] + [start for start, _ in copies or [(None, None)] * (len(temperatures) - 1)]
     states = []
     for t, start in zip(temperatures, starts, strict=True):
@@ -377,8 +376,7 @@ def run_tempered_chain(
     cold.check_start()
     n_temps = len(states)
     n_tune = tune_rounds * tune_levels * (1 + adapt_ladder) if tune else 0
-    bar = tqdm(total=n_temps * (n_iter + n_tune), desc=desc, disable=not progress,
-               mininterval=0.5)  # fmt: skip
+    bar = progress_bar(progress, n_temps * (n_iter + n_tune), desc, unit="it")
     draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
     log_post = np.empty(n_iter)
     names = problem.names

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import level_moves, starts, tempering, tuning
@@ -443,8 +444,6 @@ def run_study_chain(
     (K - 1,), each neighbour pair's swap acceptance over the draws, "hot" (the hot copies' last
     states and widths, `hot_states`), and with ``adapt_ladder`` ladder (K,), the adapted one.
     """
-    from tqdm.auto import tqdm
-
     rng = np.random.default_rng(seed)
     if start is None:
         start = _start(problems, layout, hyper, init, starts.start_generator(seed))
@@ -458,7 +457,7 @@ def run_study_chain(
     n_tune = tune_rounds * tune_levels * (1 + adapt_ladder) if tune else 0
     total = len(copies) * (n_iter + n_tune)
     own = [s.problem.sampled for s in state.states]
-    bar = tqdm(total=total, desc=desc, disable=not progress, mininterval=0.5)
+    bar = progress_bar(progress, total, desc, unit="it")
     out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
            "mu": np.empty((n_iter, len(layout.groups))),
            "lam": np.empty((n_iter, len(layout.groups)))}  # fmt: skip

@@ -10,6 +10,7 @@ import gpmsa
 from gpmsa import backends
 from gpmsa.errors import BackendUnavailableError, GPMSAError
 from gpmsa.mcmc import diagnostics
+from tests._extras import PYRO, TORCH
 
 
 def _road_calibration_problem():
@@ -20,6 +21,7 @@ def _road_calibration_problem():
     return prob.with_init(fixed, fixed=frozenset(fixed))
 
 
+@PYRO
 def test_available_lists_all_three_backends():
     assert set(backends.available()) == {"numpy", "torch", "pyro"}
 
@@ -55,6 +57,7 @@ def test_importing_gpmsa_never_imports_torch():
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
+@TORCH
 def test_torch_bad_options_raise():
     tb = backends.get("torch")
     prob = _road_calibration_problem()
@@ -78,12 +81,14 @@ def test_torch_bad_options_raise():
             tb.sample(prob, n_iter=2, device="cuda")
 
 
+@PYRO
 def test_pyro_rejects_step_widths():
     pb = backends.get("pyro")
     with pytest.raises(GPMSAError, match="takes no step_widths"):
         pb.sample(_road_calibration_problem(), n_iter=2, step_widths={"theta": 0.1})
 
 
+@TORCH
 def test_torch_same_seed_same_numbers_and_fixed_params_stay():
     tb = backends.get("torch")
     prob = _road_calibration_problem()
@@ -99,6 +104,7 @@ def test_torch_same_seed_same_numbers_and_fixed_params_stay():
     assert not np.array_equal(a.draws["theta"][0], a.draws["theta"][1])
 
 
+@PYRO
 def test_pyro_same_seed_same_numbers():
     pb = backends.get("pyro")
     prob = _road_calibration_problem()
@@ -110,17 +116,29 @@ def test_pyro_same_seed_same_numbers():
     assert np.all(np.isfinite(a.log_post))
 
 
-@pytest.mark.filterwarnings("ignore::gpmsa.ConvergenceWarning")  # 8 x 500 kept draws: R-hat ~1.02
-def test_calibrator_takes_a_backend():
-    """Calibrator(backend=...) validates the name at construction and runs its MCMC path on that
-    backend; its posterior agrees with the exact numpy grid within Monte-Carlo error."""
-    from _calib_cases import road_emulator, road_obs
+def test_calibrator_checks_its_backend_at_construction():
+    """Calibrator(backend=...) validates the name, and the method it goes with, at construction,
+    whether the backend's packages are installed or not."""
+    from _calib_cases import road_emulator
 
     emu = road_emulator()
     with pytest.raises(GPMSAError, match="unknown backend 'jax'"):
         gpmsa.Calibrator(emu, backend="jax")
-    with pytest.raises(GPMSAError, match="method='grid' runs on numpy"):
-        gpmsa.Calibrator(emu, method="grid", backend="torch")
+    with pytest.raises(GPMSAError, match="unknown backend 'jax'"):
+        gpmsa.Calibrator(emu, method="grid", backend="jax")
+    for name in ("torch", "pyro"):  # before (without torch): BackendUnavailableError
+        with pytest.raises(GPMSAError, match="method='grid' runs on numpy"):
+            gpmsa.Calibrator(emu, method="grid", backend=name)
+
+
+@TORCH
+@pytest.mark.filterwarnings("ignore::gpmsa.ConvergenceWarning")  # 8 x 500 kept draws: R-hat ~1.02
+def test_calibrator_takes_a_backend():
+    """Calibrator(backend=...) runs its MCMC path on that backend; its posterior agrees with the
+    exact numpy grid within Monte-Carlo error."""
+    from _calib_cases import road_emulator, road_obs
+
+    emu = road_emulator()
     cal = gpmsa.Calibrator(
         emu, backend="torch", seed=5, mcmc_options={"n_chains": 8, "n_samples": 1500}
     )

@@ -4,6 +4,9 @@ import numpy as np
 import pytest
 
 import gpmsa
+from tests._extras import TORCH
+
+pytestmark = TORCH  # every test fits or calibrates with the torch backend
 
 
 @pytest.fixture(scope="module")

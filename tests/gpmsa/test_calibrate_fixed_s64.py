@@ -17,6 +17,7 @@ import gpmsa
 from gpmsa import GPMSAError
 from gpmsa.calibration.observations import fixed_gp, reduce
 from gpmsa.calibration.sampler import CalibrationSampler
+from tests._extras import PYRO, backend_param
 from tests.gpmsa._calib_cases import (
     categorical_emulator,
     road_emulator,
@@ -106,7 +107,8 @@ def _pinned_runs(**fx):
     }  # fmt: skip
 
 
-@pytest.mark.parametrize("case", sorted(PINNED))
+@pytest.mark.parametrize("case", [backend_param(case, backend="torch" if "torch" in case else None)
+                                  for case in sorted(PINNED)])  # fmt: skip
 def test_default_draws_are_those_before_fixed_existed(case):
     post = _pinned_runs()[case]()
     for name, (total, last) in PINNED[case].items():
@@ -127,7 +129,7 @@ def test_an_empty_fixed_dict_draws_as_none():
 
 
 # --- a held theta element: exactly its value, the others sampled ----------------------------------
-ENGINES = [{}, {"fast": False}, {"backend": "torch"}]
+ENGINES = [{}, {"fast": False}, backend_param({"backend": "torch"}, backend="torch")]
 
 
 @pytest.mark.parametrize("engine", ENGINES, ids=["fast", "numpy", "torch"])
@@ -146,7 +148,10 @@ def test_a_held_theta_element_is_its_value_in_every_draw(engine, given):
     assert "a" not in post.info["convergence"]["flagged"]
 
 
-@pytest.mark.parametrize("engine", ENGINES + [{"backend": "pyro"}],
+PYRO_ENGINE = backend_param({"backend": "pyro"}, backend="pyro")
+
+
+@pytest.mark.parametrize("engine", ENGINES + [PYRO_ENGINE],
                          ids=["fast", "numpy", "torch", "pyro"])  # fmt: skip
 def test_the_whole_theta_and_lamos_held(engine):
     run = {**RUN, **engine}
@@ -164,6 +169,7 @@ def test_the_whole_theta_and_lamos_held(engine):
     assert lam.info["fixed"] == {"lamOs": [50.0]}
 
 
+@PYRO
 def test_pyro_holds_a_single_theta_element():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -282,7 +288,7 @@ def test_a_held_lamos_gives_the_posterior_with_it_known(engine):
 
 
 # --- discrepancy parameters, by element -----------------------------------------------------------
-@pytest.mark.parametrize("backend", ["numpy", "torch"])
+@pytest.mark.parametrize("backend", ["numpy", backend_param("torch")])
 def test_one_discrepancy_group_switched_off(backend):
     data, obs = _data()
     warmup = {"warmup": 10} if backend == "torch" else {}  # 100 a tuning stage: 2/3 of the time

@@ -13,6 +13,7 @@ from gpmsa import backends
 from gpmsa.fitting.fit import element_names
 from gpmsa.mcmc import parallel, starts
 from gpmsa.mcmc.sampler import require_finite
+from tests._extras import PYRO
 
 
 @pytest.fixture(scope="module")
@@ -199,6 +200,13 @@ def test_bad_chain_arguments_raise_naming_them(multi, problem):
             gpmsa.fit(sim, n_iter=10, n_chains=2, n_jobs=1, executor=ex)
     with pytest.raises(gpmsa.GPMSAError, match="executor must be a concurrent.futures.Executor"):
         gpmsa.fit(sim, n_iter=10, n_chains=2, executor="cluster")
+    with pytest.raises(gpmsa.GPMSAError, match="init must be one of"):
+        backends.get("numpy").sample(problem, n_iter=5, init="random")
+
+
+@PYRO
+def test_the_torch_and_pyro_backends_refuse_a_placement_they_cannot_use(multi):
+    sim, _ = multi
     with pytest.raises(gpmsa.GPMSAError, match="n_jobs=2: the pyro backend runs its chains one"):
         gpmsa.fit(sim, n_iter=10, n_chains=2, backend="pyro", n_jobs=2)
     with ThreadPoolExecutor(1) as ex:
@@ -206,8 +214,6 @@ def test_bad_chain_arguments_raise_naming_them(multi, problem):
             gpmsa.fit(sim, n_iter=10, n_chains=2, backend="pyro", executor=ex)
     with pytest.raises(gpmsa.GPMSAError, match="n_jobs=2 with chain_groups=1: the torch backend"):
         gpmsa.fit(sim, n_iter=10, n_chains=2, backend="torch", n_jobs=2)
-    with pytest.raises(gpmsa.GPMSAError, match="init must be one of"):
-        backends.get("numpy").sample(problem, n_iter=5, init="random")
 
 
 def test_a_chain_that_produces_nan_is_named(problem):
@@ -387,13 +393,17 @@ def test_progress_with_parallel_chains_is_one_bar_over_the_chains(problem, capsy
     assert "chain: 100%" in err and "2/2" in err and chains.n_chains == 2
 
 
-def test_calibrate_refuses_bad_placement():
+def _road_emulator():
     from _backend_cases import road_data
 
-    emu = gpmsa.Emulator.from_params(
+    return gpmsa.Emulator.from_params(
         road_data()[0],
         {"betaU": [[0.924], [0.354]], "lamUz": [0.453], "lamWs": [164.6], "lamWOs": [837.1]},
     )
+
+
+def test_calibrate_refuses_bad_placement():
+    emu = _road_emulator()
     x, y = [[1.25]], [[12.1]]
     cpus = parallel.available_cpus()
     more = cpus + 1  # chains and workers beyond the CPUs
@@ -403,5 +413,9 @@ def test_calibrate_refuses_bad_placement():
         gpmsa.calibrate(emu, x, y, n_chains=more, n_jobs=more, log_prior=lambda t: 0.0 * t)
     with ThreadPoolExecutor(1) as ex, pytest.raises(gpmsa.GPMSAError, match="cannot go to exec"):
         gpmsa.calibrate(emu, x, y, n_chains=2, executor=ex, log_prior=lambda t: 0.0 * t)
+
+
+@PYRO
+def test_calibrate_on_pyro_refuses_n_jobs():
     with pytest.raises(gpmsa.GPMSAError, match="n_jobs=2: the pyro backend runs its chains one"):
-        gpmsa.calibrate(emu, x, y, n_chains=2, backend="pyro", n_jobs=2)
+        gpmsa.calibrate(_road_emulator(), [[1.25]], [[12.1]], n_chains=2, backend="pyro", n_jobs=2)

@@ -15,6 +15,7 @@ import pytest
 import gpmsa
 from gpmsa import backends
 from gpmsa.mcmc import parallel
+from tests._extras import DISTRIBUTED
 
 
 def _double(x, progress=False, desc=""):
@@ -82,6 +83,7 @@ def test_only_the_workers_a_restricted_executor_may_use_are_checked(dask_client,
             parallel.as_executor(dask_client.get_executor(**kwargs), _double)
 
 
+@DISTRIBUTED  # dask's own reading of an address
 def test_the_workers_a_task_may_run_on_are_read_as_dask_reads_them():
     infos = {
         "tcp://10.0.0.1:1": {"name": "a", "host": "10.0.0.1", "resources": {"GPU": 1}},

@@ -9,6 +9,7 @@ import pytest
 
 import gpmsa
 from gpmsa import GPMSAError
+from tests._extras import TORCH
 from tests.gpmsa._backend_cases import multi_data
 
 PARAMS = {"betaU": [[2.0], [1.0], [1.0]], "lamUz": [1.0], "lamWs": [1e4], "lamWOs": [1e4]}
@@ -70,13 +71,21 @@ def test_from_params_refuses_transposed_or_unknown_parameters():
     assert base.p_u == 1
 
 
-def test_calibrator_refuses_at_construction_what_every_update_would():
-    # a constraint off numpy: taken on torch, refused on pyro (test_walkthrough_s74.py)
+def _fitted():
     rng = np.random.default_rng(1)
     x, t = rng.uniform(size=(25, 1)), rng.uniform(size=(25, 1))
-    fitted = gpmsa.fit(gpmsa.SimData(x=x, t=t, y=x + t), n_iter=40, tune=False, seed=0)
+    return gpmsa.fit(gpmsa.SimData(x=x, t=t, y=x + t), n_iter=40, tune=False, seed=0)
+
+
+@TORCH
+def test_calibrator_refuses_the_emulators_draws_off_numpy():
+    # a constraint off numpy: taken on torch, refused on pyro (test_walkthrough_s74.py)
     with pytest.raises(GPMSAError, match="emulator_params='draws' needs backend='numpy'"):
-        gpmsa.Calibrator(fitted, method="mcmc", backend="torch", emulator_params="draws")
+        gpmsa.Calibrator(_fitted(), method="mcmc", backend="torch", emulator_params="draws")
+
+
+def test_calibrator_refuses_at_construction_what_every_update_would():
+    fitted = _fitted()
     with pytest.raises(GPMSAError, match=r"drop mcmc_options\['fast'\] = False"):
         gpmsa.Calibrator(fitted, method="mcmc", emulator_params="draws",
                          mcmc_options={"fast": False})  # fmt: skip
@@ -118,6 +127,7 @@ def test_a_collinear_mean_basis_and_a_non_finite_one_are_refused_by_fit():
         gpmsa.fit(sim, n_iter=20, mean_basis=lambda z: np.full((len(z), 1), np.nan))
 
 
+@TORCH
 def test_torch_devices_and_float32_fits():
     sim, obs = multi_data()
     for device in ("gpu", "mps", 5, None):

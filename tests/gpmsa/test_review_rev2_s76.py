@@ -13,6 +13,7 @@ from _calib_cases import one_t_emulator
 import gpmsa
 from gpmsa.mcmc import parallel
 from gpmsa.mcmc.diagnostics import convergence, warn_unconverged
+from tests._extras import DISTRIBUTED
 
 
 def test_calibrator_mcmc_options_neither_list_nor_take_calibrates_private_online():
@@ -32,6 +33,7 @@ INFOS = {
 }
 
 
+@DISTRIBUTED  # dask's own reading of an address
 def test_task_workers_read_a_tuple_of_workers_and_a_bare_number_as_dask_does():
     workers = parallel._task_workers
     # Client.submit passes a tuple on as a collection (the scheduler iterates it): before, it
