@@ -42,3 +42,29 @@ def _working_folder_restored():
 
         os.chdir(before)
         pytest.fail(f"the test changed the working folder to {after} (use monkeypatch.chdir)")
+
+
+@pytest.fixture
+def forks(monkeypatch):
+    """The names of the threads started since the test began that run at each fork of this
+    process (a bar made now starts a monitor of its own, even where an earlier test left one
+    running): a test of the library's forks checks that no thread of its own runs at them."""
+    import os
+    import threading
+
+    import tqdm.auto
+    import tqdm.std
+
+    for cls in {tqdm.std.tqdm, tqdm.auto.tqdm}:
+        if "monitor" in vars(cls):
+            monkeypatch.setattr(cls, "monitor", None)
+    before = set(threading.enumerate())
+    seen: list[list[str]] = []
+    real_fork = os.fork
+
+    def fork():
+        seen.append(sorted(t.name for t in set(threading.enumerate()) - before))
+        return real_fork()
+
+    monkeypatch.setattr(os, "fork", fork)
+    return seen

@@ -9,7 +9,6 @@ Before (session 82): ``gpmsa.fit(..., n_chains=2, n_jobs=2)`` forked each worker
 tqdm_monitor, progress on or off (2 DeprecationWarnings a fit on Python 3.13)."""
 
 import os
-import threading
 import warnings
 
 import numpy as np
@@ -19,26 +18,6 @@ import tqdm.std
 
 import gpmsa
 from gpmsa._progress import NoBar, progress_bar
-
-
-@pytest.fixture
-def forks(monkeypatch):
-    """The names of the threads started since the test began that run at each fork of this
-    process (a bar made now starts a monitor of its own, even where an earlier test left one
-    running)."""
-    for cls in {tqdm.std.tqdm, tqdm.auto.tqdm}:
-        if "monitor" in vars(cls):
-            monkeypatch.setattr(cls, "monitor", None)
-    before = set(threading.enumerate())
-    seen: list[list[str]] = []
-    real_fork = os.fork
-
-    def fork():
-        seen.append(sorted(t.name for t in set(threading.enumerate()) - before))
-        return real_fork()
-
-    monkeypatch.setattr(os, "fork", fork)
-    return seen
 
 
 def _data():

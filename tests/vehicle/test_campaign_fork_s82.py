@@ -9,7 +9,6 @@ DeprecationWarnings a two-run campaign on Python 3.13)."""
 
 import multiprocessing
 import os
-import threading
 
 import numpy as np
 import pytest
@@ -19,26 +18,6 @@ import tqdm.std
 import vehicle
 
 DESIGN = np.array([[0.5, 200.0], [0.8, 400.0]])
-
-
-@pytest.fixture
-def forks(monkeypatch):
-    """The names of the threads started since the test began that run at each fork of this
-    process (a bar made now starts a monitor of its own, even where an earlier test left one
-    running)."""
-    for cls in {tqdm.std.tqdm, tqdm.auto.tqdm}:
-        if "monitor" in vars(cls):
-            monkeypatch.setattr(cls, "monitor", None)
-    before = set(threading.enumerate())
-    seen: list[list[str]] = []
-    real_fork = os.fork
-
-    def fork():
-        seen.append(sorted(t.name for t in set(threading.enumerate()) - before))
-        return real_fork()
-
-    monkeypatch.setattr(os, "fork", fork)
-    return seen
 
 
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork on this platform")
