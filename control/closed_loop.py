@@ -9,7 +9,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from tqdm.auto import tqdm
 
 import roadgen
 import vehicle
@@ -30,6 +29,7 @@ from control.robot.storage import check_mcap_target
 from control.sensor_checks import SensorLimits
 from control.simplex import Simplex
 from control.validation import check_flags, check_instance, is_real, path_argument
+from gpmsa._progress import progress_bar
 from gpmsa.errors import numbers_text
 
 EXACT_CLOCK_SILENCE = 0.5
@@ -354,7 +354,9 @@ def run_closed_loop(
     tic = _time.perf_counter()
     controller = simplex.start()
     command = controller.command(estimator.last)
-    bar = tqdm(total=round(float(track.length_m)), unit="m", disable=not progress, leave=False)
+    bar = progress_bar(  # (none without progress: no tqdm monitor thread beside later forks)
+        progress, round(float(track.length_m)), None, "m", mininterval=0.1, leave=False
+    )
     while not sim.finished:
         if sim.time > limit:
             raise ControlError(_timeout_message(sim, track, simplex, limit))

@@ -53,8 +53,10 @@ performance mode, safety mode for whatever reason (a GD above GD_max, an estimat
 "ok", the latch until `SimplexRun.reset`) returns to performance mode only once the law has
 read performance mode (the same test as without the dwell, with the ``risk`` posture) at every
 update over ``release_m`` metres of travel (the estimates' ``position``); any update that
-reads safety mode restarts the count. The start's safety mode (the BCR's buffer filling) has no
-dwell. A sensor whose gain drops
+reads safety mode restarts the count. The start's safety mode (the BCR's buffer filling, and a
+GD above GD_max before the first performance mode) has no dwell; a fault (one that latches, with
+either ``after_fault``) ends the start. The held speed is v_safe, or the law's where that is
+lower ("paper"): the dwell never commands more than the law. A sensor whose gain drops
 reads as smoother ground until the BCR's checks find it; the dwell keeps such a reading in
 safety mode for ``release_m`` more metres, at the price of ``release_m`` metres at v_safe after
 each safety mode of a healthy run (docs/closed-loop.md, "Release dwell", measures both).
@@ -264,8 +266,10 @@ class SimplexRun:
         clear_since_m: with the release dwell, the position (m) of the first of the updates
             in a row whose law reads performance mode; None after one that reads safety mode.
         in_safety: with the release dwell, whether the last command was in safety mode.
-        performed: with the release dwell, whether the run has commanded performance mode
-            (the dwell holds from the first safety mode after it: the start has none).
+        performed: with the release dwell, whether the run has commanded performance mode or
+            met a fault (an estimate that latches, ``FAULT_STATUSES``, with either
+            ``after_fault``); the dwell holds from the first safety mode after either: the
+            start's has none.
     """
 
     clear_since_m: float | None = None  # (class values: a run pickled before the dwell)
@@ -289,8 +293,11 @@ class SimplexRun:
         """The speed command for the next estimate of the run."""
         check_instance(estimate, "estimate", Estimate)
         s = self.simplex
-        if s.after_fault == "latch" and not self.latched and self._latches(estimate):
+        fault = self._latches(estimate)
+        if s.after_fault == "latch" and not self.latched and fault:
             self.latched_by = estimate
+        if fault and s.release_m > 0:  # a fault is never the start's safety mode
+            self.performed = True
         if self.latched_by is None:
             command = s.command(estimate)
             if s.release_m == 0:
@@ -311,8 +318,9 @@ class SimplexRun:
 
     def _dwell(self, command: Command, estimate: Estimate) -> Command:
         """``command``, the law's, held in safety mode after the run's first performance mode
-        until the law has read performance mode over ``release_m`` metres in a row (an update
-        without a finite position restarts the count)."""
+        (or fault) until the law has read performance mode over ``release_m`` metres in a row
+        (an update without a finite position restarts the count). The held speed is v_safe, or
+        the law's where lower ("paper"): the dwell never commands more than the law."""
         if command.mode == "safety":
             self.clear_since_m = None
             return command
@@ -323,8 +331,8 @@ class SimplexRun:
             self.clear_since_m = position
         clear_m = 0.0 if self.clear_since_m is None else position - self.clear_since_m
         if self.performed and self.in_safety and not clear_m >= self.simplex.release_m:
-            return Command(
-                self.simplex.v_safe,
+            return Command(  # (min: "paper" reads performance mode below v_safe; never faster)
+                min(self.simplex.v_safe, command.speed),
                 "safety",
                 command.gd_used,
                 f"release dwell: the law has read performance mode over {max(clear_m, 0.0):.2f} "

@@ -57,16 +57,18 @@ def _bar_class():
 def progress_bar(
     progress: bool,
     total: int,
-    desc: str,
+    desc: str | None,
     unit: str = "draw",
     *,
     mininterval: float = 0.5,
     initial: int = 0,
+    leave: bool = True,
 ):
-    """A tqdm bar of ``total`` steps described by ``desc`` (the call's name) when ``progress``,
-    else a `NoBar`; use it as a context manager and ``update(1)`` per step. Neither starts a
-    thread (see the module docstring)."""
+    """A tqdm bar of ``total`` steps described by ``desc`` (the call's name; None: none) when
+    ``progress``, else a `NoBar`; use it as a context manager and ``update(1)`` per step.
+    Neither starts a thread (see the module docstring). ``leave``: tqdm's (False: the bar is
+    cleared when closed). Used by control's loops too (control may import gpmsa)."""
     if not progress:
         return NoBar(total, initial)
     return _bar_class()(total=total, desc=desc, unit=unit, mininterval=mininterval,
-                        initial=initial)  # fmt: skip
+                        initial=initial, leave=leave)  # fmt: skip

@@ -48,7 +48,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
 
 import gpmsa
 from control.bcr import BCR, BCRSettings
@@ -88,6 +87,7 @@ from control.validation import (
     require_instance,
     require_reals,
 )
+from gpmsa._progress import progress_bar
 from gpmsa.errors import numbers_text
 from gpmsa.io.atomic import atomic_write
 from gpmsa.model.data import repr_name
@@ -724,15 +724,18 @@ def replay_recording(
     n_full = t.size // every
     ests, cmds, ends = [], [], []
     controller = simplex.start()
-    for k in tqdm(range(n_full), disable=not progress, unit="update", leave=False):
-        part = slice(k * every, (k + 1) * every)
-        est = estimator.update(t[part], pos[part], a[part], spd[part], now=t[part.stop - 1])
-        marked = marks.get(part.stop - 1)
-        if marked and est.status == "sensor_fault":  # (the marker's fault: name the level)
-            est = dataclasses.replace(est, reason=f"{marked}; {est.reason}")
-        ests.append(est)
-        cmds.append(controller.command(est))
-        ends.append(part.stop - 1)
+    # (no tqdm bar without progress: its monitor thread would outlive the replay)
+    with progress_bar(progress, n_full, None, "update", mininterval=0.1, leave=False) as bar:
+        for k in range(n_full):
+            part = slice(k * every, (k + 1) * every)
+            est = estimator.update(t[part], pos[part], a[part], spd[part], now=t[part.stop - 1])
+            marked = marks.get(part.stop - 1)
+            if marked and est.status == "sensor_fault":  # (the marker's fault: name the level)
+                est = dataclasses.replace(est, reason=f"{marked}; {est.reason}")
+            ests.append(est)
+            cmds.append(controller.command(est))
+            ends.append(part.stop - 1)
+            bar.update(1)
     if t.size > n_full * every:
         tail = slice(n_full * every, None)
         estimator.update(t[tail], pos[tail], a[tail], spd[tail], now=t[-1])
