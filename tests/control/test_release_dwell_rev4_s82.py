@@ -5,15 +5,9 @@ first performance mode holds the dwell after reset())."""
 import copy
 
 import pytest
+from test_release_dwell_s82 import ok
 
 from control import Estimate, Simplex
-
-
-def ok(position: float, gd: float) -> Estimate:
-    return Estimate(
-        time=position, position=position, status="ok", gd_mean=gd, gd_sd=10.0,
-        interval=(gd - 20.0, gd + 20.0),
-    )  # fmt: skip
 
 
 def fault(position: float) -> Estimate:
