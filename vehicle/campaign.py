@@ -264,8 +264,8 @@ def _checked_table(c: Campaign) -> dict[str, np.ndarray | None]:
     for name in ("v", "gd", *_F_NAMES):
         out[name] = checks.real_array(f"Campaign.{name}", getattr(c, name))
     try:
-        seed = np.asarray(c.seed)
-        status = np.asarray(c.status)
+        seed = np.asarray(c.seed)  # (copied below, as int64)
+        status = np.array(c.status)  # a copy: the caller's array may change later
     except (TypeError, ValueError) as exc:
         raise VehicleError(f"Campaign.seed and .status must be arrays: {exc}") from exc
     if seed.size == 0 and status.size == 0:  # an empty table: any dtype will do

@@ -444,6 +444,7 @@ class Calibrator:
                     self.theta_grid[:, k] = exact[:, k]
         if q == 1:
             self.theta_grid = self.theta_grid[:, 0]
+        self.theta_grid.flags.writeable = False  # `log_likelihood_grid` hands it out
         with one_thread():
             sets = emulator_param_sets(emulator, emulator_params, n_emulator_draws)
             # the bar's steps, per set: its GP and Chebyshev plan, its predictor on the grid
@@ -668,7 +669,7 @@ class Calibrator:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Exact log-likelihood of theta on the fixed grid, lamOs integrated out.
 
-        Returns (theta_grid, loglik): theta_grid native units, (G,) for one calibration parameter
+        Returns (theta_grid, loglik): theta_grid native units (read-only), (G,) for one parameter
         or (G, 2) for two (``Calibrator.theta_grid``); loglik (G,) = log p(u_obs | theta) with
         all normalising constants (the density of the reduced observation data u, standardised
         units), lamOs integrated against its prior (each window has its own lamOs); with
@@ -685,7 +686,9 @@ class Calibrator:
         warn_if_outside(fit, far=far_value(self.emulator, data, fit))
         if np.any(np.isnan(ll)):
             raise GPMSAError("the likelihood could not be evaluated for this observation")
-        return self.theta_grid, ll
+        grid = self.theta_grid.view()  # read-only (a pickled Calibrator's grid is writable)
+        grid.flags.writeable = False
+        return grid, ll
 
     # --- posterior ------------------------------------------------------------------------------
     def _prior_values(self, prior, theta_unit: np.ndarray, on_grid: bool) -> np.ndarray:

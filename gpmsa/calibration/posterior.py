@@ -67,8 +67,10 @@ class GridMarginal:
         """Normalise exp(log_density) on ``nodes`` (any additive constant); ``weights``: the
         grid's trapezoid weights when already known. GPMSAError unless ``nodes`` are at least 2
         finite, strictly increasing values and ``log_density`` one value per node, none NaN or
-        +inf, some finite (-inf: zero density)."""
-        nodes = np.asarray(nodes, dtype=float)
+        +inf, some finite (-inf: zero density). The marginal holds read-only copies of
+        ``nodes`` and ``weights`` (often a Calibrator's or a filter's own grid, which a write into
+        a posterior's nodes changed for every later posterior) and a read-only density."""
+        nodes = np.array(nodes, dtype=float)
         log_density = np.asarray(log_density, dtype=float)
         if nodes.ndim != 1 or nodes.size < 2:
             raise GPMSAError(f"a grid marginal needs at least 2 finite nodes (k,), got "
@@ -84,9 +86,12 @@ class GridMarginal:
             raise GPMSAError("log_density must not be NaN or +inf")
         if top == -np.inf:
             raise GPMSAError("log_density is -inf at every node: the density has no mass")
-        w = trapezoid_weights(nodes) if weights is None else weights
+        w = trapezoid_weights(nodes) if weights is None else np.array(weights, dtype=float)
         f = np.exp(log_density - top)
-        return cls(nodes, f / float(w @ f), w)
+        density = f / float(w @ f)
+        for a in (nodes, density, w):
+            a.flags.writeable = False
+        return cls(nodes, density, w)
 
     def _cell_mass(self) -> np.ndarray:
         return 0.5 * np.diff(self.nodes) * (self.density[:-1] + self.density[1:])
