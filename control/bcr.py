@@ -519,9 +519,9 @@ class BCR:
     model copied too). It pickles, and so do its estimates
     (their posteriors' lazily drawn samples are drawn then). Its estimates do not depend on
     how the samples are chunked across calls; a call returns the newest estimate, or the
-    gravest fault among those it made. A call of ``update`` or ``resume`` that raises (a
-    refused argument; part way: an error of the model's, a KeyboardInterrupt) leaves the BCR as
-    it was before it: fed the same samples again, it continues as if the call never happened.
+    gravest fault among those it made. A call of ``update``, ``resume`` or ``reset`` that raises
+    (a refused argument; part way: an error of the model's, a KeyboardInterrupt) leaves the BCR
+    as it was before it: fed the same samples again, it continues as if the call never happened.
     """
 
     def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
@@ -570,7 +570,7 @@ class BCR:
                 tracker = replace(tracker, mean_segment_m=0.0)
             self.trackers = [GDTracker(self.gd_range, tracker) for _ in range(n)]
         check_gd_unit(self.gd_range, self.gd_name)
-        self.reset()
+        self._reset()
         self._warm_up()
 
     def __repr__(self) -> str:
@@ -644,7 +644,11 @@ class BCR:
         return self._phases[self._phase].filter
 
     def reset(self) -> None:
-        """Empty the buffers and forget the GD state."""
+        """Empty the buffers and forget the GD state (all or nothing, as `update`)."""
+        self._all_or_nothing(self._reset)
+
+    def _reset(self) -> None:
+        """`reset`, also of a BCR being made (which has no state to restore yet)."""
         self._forget_stream()
         if self.settings.method == "changepoint":
             for phase in self._phases:

@@ -13,7 +13,7 @@ import numpy as np
 import roadgen
 import vehicle
 from control.bcr import BCR, BCRSettings
-from control.compat import bcr_settings_for, check_emulator, check_likelihood
+from control.compat import bcr_settings_for, check_against, check_emulator, check_likelihood
 from control.errors import ControlError, ControlWarning, EmulatorMismatchError, user_stacklevel
 from control.estimate import Estimate, run_text
 from control.faults import FaultInjector, SensorFault
@@ -304,11 +304,11 @@ def run_closed_loop(
         check_can_record()
     recorded = "vehicle" in (getattr(emulator, "metadata", None) or {})
     if check:  # its inputs and GD unit first: the message below is of the vehicle alone
-        check_emulator(emulator)
+        check_emulator(emulator)  # (once: the checks below are `check_against`'s)
     if check and recorded:
         # first: a model left at its default says so, not that the Simplex is too fast for it
         try:
-            check_emulator(emulator, model=model)
+            check_against(emulator, model=model)
         except EmulatorMismatchError as exc:
             if not defaulted:
                 raise
@@ -334,9 +334,9 @@ def run_closed_loop(
     if check:
         # (a default model without a record to check is warned of above)
         checked = None if defaulted and not recorded else model
-        check_emulator(emulator, model=checked, noise_std=noise_std, bcr=bcr)
+        check_against(emulator, model=checked, noise_std=noise_std, bcr=bcr)
         _check_track_domain(emulator, track)
-        check_emulator(emulator, simplex=simplex, bcr=bcr)  # (its method: ends checked)
+        check_against(emulator, simplex=simplex, bcr=bcr)  # (its method: ends checked)
     if likelihood is not None:
         check_likelihood(emulator, likelihood)
     estimator = BCR.from_emulator(emulator, bcr) if likelihood is None else BCR(likelihood, bcr)
@@ -460,10 +460,10 @@ def _check_track_fits(track, model) -> None:
 
 
 def _check_track_domain(emulator, track) -> None:
-    """`check_emulator` of ``track``: a GD outside the emulator's domain is an
+    """`check_against` of ``track``: a GD outside the emulator's domain is an
     `EmulatorMismatchError` that says how to drive it anyway."""
     try:
-        check_emulator(emulator, track=track)
+        check_against(emulator, track=track)
     except EmulatorMismatchError as exc:
         raise EmulatorMismatchError(
             f"{exc}: check=False drives it anyway (it skips every check of the emulator; "

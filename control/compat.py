@@ -173,6 +173,24 @@ def check_emulator(
             recorded = None  # (a malformed record: named where a BCR's feature is checked)
         if recorded is not None:
             check_feature_outputs(emulator, recorded)
+    check_against(emulator, model=model, noise_std=noise_std, bcr=bcr, track=track,
+                  simplex=simplex)  # fmt: skip
+
+
+def check_against(
+    emulator,
+    *,
+    model=None,
+    noise_std: float | None = None,
+    bcr: BCRSettings | None = None,
+    track=None,
+    simplex: Simplex | None = None,
+) -> None:
+    """`check_emulator`'s checks of the arguments given, in its order, without its checks of
+    the emulator alone and of the arguments' kinds: for a caller that has run
+    ``check_emulator(emulator)`` and checked its arguments already (`run_closed_loop`, whose
+    own checks lie between these)."""
+    meta = dict(getattr(emulator, "metadata", None) or {})
     if model is not None:
         if "vehicle" not in meta:
             warnings.warn(

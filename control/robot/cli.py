@@ -276,6 +276,11 @@ def parser() -> argparse.ArgumentParser:
         help="the Simplex's safety-mode speed, m/s (default 1.0, the paper's)",
     )  # fmt: skip
     p.add_argument(
+        "--release-m", type=float, default=Simplex.release_m, metavar="M",
+        help="the Simplex's release dwell, m: after safety mode, performance mode again only "
+        "once the law has read it over this much travel (default 0: none; docs/closed-loop.md)",
+    )  # fmt: skip
+    p.add_argument(
         "--ignore-vehicle", action="store_true",
         help="replay a simulated recording that records another vehicle than the emulator's "
         "(refused by default; a robot's recording records none)",
@@ -286,7 +291,12 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = parser().parse_args(argv)
+    usage = parser()
+    args = usage.parse_args(argv)
+    try:
+        Simplex(release_m=args.release_m)
+    except ControlError as err:
+        usage.error(f"--release-m: {err}")
     for name, given in (("BAG", args.bag), ("--out", args.out), ("--emulator", args.emulator)):
         if given is not None and not given.strip():  # would mean the current folder
             print(f"terrain-replay: error: {name} is an empty path: give a file or folder name",
@@ -310,7 +320,7 @@ def main(argv: list[str] | None = None) -> int:
             reorder_periods=args.reorder_periods,
             storage=args.storage,
         )
-        simplex = Simplex(v_max=args.v_max, v_safe=args.v_safe)
+        simplex = Simplex(v_max=args.v_max, v_safe=args.v_safe, release_m=args.release_m)
         _check_out_apart(out, bag, args.out is None)
         _check_out(out)
         check_bag_path(out / "estimates", settings.storage, "--out")

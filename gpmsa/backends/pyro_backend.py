@@ -484,6 +484,17 @@ def _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full
     return check_count(n_warmup, "n_warmup") if tune else 0
 
 
+def check_n_jobs(n_jobs) -> None:
+    """GPMSAError for an ``n_jobs`` that `sample` refuses, whatever the problem: any but None,
+    1 or -1 (the chains run one after another in this process)."""
+    parallel.n_workers(n_jobs, 1)  # refuse a bad n_jobs
+    if n_jobs is not None and n_jobs > 1:
+        raise GPMSAError(
+            f"n_jobs={n_jobs}: the pyro backend runs its chains one after another in this "
+            "process; leave n_jobs=None (or 1)"
+        )
+
+
 def sample(
     problem: Problem,
     *,
@@ -537,12 +548,7 @@ def sample(
     check_sample_args(n_iter, n_chains, seed)
     progress = check_flag(progress, "progress")
     check_draws_memory(problem, int(n_iter), int(n_chains))
-    parallel.n_workers(n_jobs, 1)  # refuse a bad n_jobs
-    if n_jobs is not None and n_jobs > 1:
-        raise GPMSAError(
-            f"n_jobs={n_jobs}: the pyro backend runs its chains one after another in this "
-            "process; leave n_jobs=None (or 1)"
-        )
+    check_n_jobs(n_jobs)
     refuse_unsupported(problem)
     warmup = _check_nuts_args(n_iter, tune, n_warmup, target_accept, max_tree_depth, full_mass,
                               jit)  # fmt: skip

@@ -1188,6 +1188,17 @@ def obs_values(problem: Problem) -> int:
     return p_u * (n * n + n) + 2 * p_u * n * (problem.m + n) + 2 * big * big
 
 
+def check_n_jobs(n_jobs, chain_groups: int) -> None:
+    """GPMSAError for an ``n_jobs`` that `sample` refuses with ``chain_groups`` (an integer in
+    [1, n_chains]): a bad one (`n_workers`), or any above 1 with one group (one batch)."""
+    n_workers(n_jobs, chain_groups)  # refuse a bad n_jobs up front
+    if chain_groups == 1 and n_jobs is not None and n_jobs > 1:
+        raise GPMSAError(
+            f"n_jobs={n_jobs} with chain_groups=1: the torch backend samples its chains as one "
+            f"batch; give chain_groups={n_jobs} (or more) to sample in {n_jobs} processes"
+        )
+
+
 def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_threads) -> dict:
     """``sample``'s placement of the sampling phase: {"groups", "n_jobs", "executor"}."""
     if (
@@ -1209,12 +1220,7 @@ def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_thr
             f"with chain_groups > 1 or an executor each group's process runs one thread: give "
             f"num_threads=1 (got {num_threads!r}); use more groups for more cores"
         )
-    n_workers(n_jobs, int(chain_groups))  # refuse a bad n_jobs up front
-    if chain_groups == 1 and n_jobs is not None and n_jobs > 1:
-        raise GPMSAError(
-            f"n_jobs={n_jobs} with chain_groups=1: the torch backend samples its chains as one "
-            f"batch; give chain_groups={n_jobs} (or more) to sample in {n_jobs} processes"
-        )
+    check_n_jobs(n_jobs, int(chain_groups))
     return {"groups": int(chain_groups), "n_jobs": n_jobs, "executor": executor}
 
 

@@ -242,6 +242,24 @@ def _refuse_unused_sampler_options(options: dict, backend: str, draws: bool = Fa
         )
 
 
+def _refuse_placement(options: dict, backend: str) -> None:
+    """GPMSAError now, not at the first update, for an ``n_jobs`` or ``executor`` that backend
+    ``backend``'s sampler refuses whatever the data, with its message: pyro's (its chains run
+    one after another here: no executor, n_jobs None, 1 or -1), and torch's n_jobs with one
+    chain group (a given ``chain_groups`` other than the integer 1 is left to the update, whose
+    refusal depends on the chains and the CPUs)."""
+    if backend == "numpy":  # its chains may run elsewhere: checked where they run
+        return
+    backends.placement(backend, executor=options.get("executor"))
+    if "n_jobs" not in options:
+        return
+    groups = options.get("chain_groups", 1)
+    if backend == "pyro":
+        backends.get(backend).check_n_jobs(options["n_jobs"])
+    elif backend == "torch" and not isinstance(groups, bool) and groups == 1:
+        backends.get(backend).check_n_jobs(options["n_jobs"], 1)
+
+
 def _given(options: dict, key: str) -> bool:
     """Whether ``options[key]`` is given as calibrate and pyro's ``sample`` read it: a tuning
     count not None, step widths not empty."""
@@ -298,9 +316,11 @@ class Calibrator:
             GPMSAError: each update runs fresh chains. So are options that ``calibrate`` on
             this backend refuses as without effect (`_refuse_unused_sampler_options`: pyro's
             GPM/SA tuning and step widths, ``"fast": True`` where the fast sampler cannot run,
-            a backend sampler's options where it runs). With ``method="grid"`` given, any but
-            ``"backend"`` is a GPMSAError (the grid would ignore them; "auto" keeps them for an
-            emulator that needs MCMC).
+            a backend sampler's options where it runs), and an ``"n_jobs"`` or ``"executor"``
+            its sampler refuses whatever the data (`_refuse_placement`: pyro's ``n_jobs`` > 1
+            or executor, torch's ``n_jobs`` > 1 with one chain group). With ``method="grid"``
+            given, any but ``"backend"`` is a GPMSAError (the grid would ignore them; "auto"
+            keeps them for an emulator that needs MCMC).
         backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
             ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
             "auto" choose MCMC. None (the default): ``mcmc_options["backend"]`` where it names
@@ -590,6 +610,7 @@ class Calibrator:
                              "mcmc_options['fast'] = False")  # fmt: skip
         draws = opts.get("emulator_params", self.emulator_params) == "draws"
         _refuse_unused_sampler_options(opts, backend, draws)
+        _refuse_placement(opts, backend)
 
     # --- the exact likelihood on a grid ---------------------------------------------------------
     def _marginals(
