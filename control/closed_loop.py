@@ -354,25 +354,24 @@ def run_closed_loop(
     tic = _time.perf_counter()
     controller = simplex.start()
     command = controller.command(estimator.last)
-    bar = progress_bar(  # (none without progress: no tqdm monitor thread beside later forks)
+    with progress_bar(  # (none without progress: no tqdm monitor thread beside later forks)
         progress, round(float(track.length_m)), None, "m", mininterval=0.1, leave=False
-    )
-    while not sim.finished:
-        if sim.time > limit:
-            raise ControlError(_timeout_message(sim, track, simplex, limit))
-        samples = sim.advance(dt, command.speed)
-        if len(samples) == 0:
-            break
-        s_t.append(np.asarray(samples.t, dtype=float))
-        s_pos.append(np.asarray(samples.position, dtype=float))
-        s_spd.append(np.asarray(samples.speed, dtype=float))
-        s_acc.append(np.asarray(samples.accel_front, dtype=float))
-        observed = inject(samples.t, samples.position, samples.accel_front, samples.speed)
-        estimate = estimator.update(*observed, now=float(samples.t[-1]))
-        command = controller.command(estimate)
-        rows.append((estimate, command))
-        bar.update(max(0, round(float(s_pos[-1][-1])) - bar.n))
-    bar.close()
+    ) as bar:
+        while not sim.finished:
+            if sim.time > limit:
+                raise ControlError(_timeout_message(sim, track, simplex, limit))
+            samples = sim.advance(dt, command.speed)
+            if len(samples) == 0:
+                break
+            s_t.append(np.asarray(samples.t, dtype=float))
+            s_pos.append(np.asarray(samples.position, dtype=float))
+            s_spd.append(np.asarray(samples.speed, dtype=float))
+            s_acc.append(np.asarray(samples.accel_front, dtype=float))
+            observed = inject(samples.t, samples.position, samples.accel_front, samples.speed)
+            estimate = estimator.update(*observed, now=float(samples.t[-1]))
+            command = controller.command(estimate)
+            rows.append((estimate, command))
+            bar.update(max(0, round(float(s_pos[-1][-1])) - bar.n))
     wall = _time.perf_counter() - tic
 
     ests = [e for e, _ in rows]

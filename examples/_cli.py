@@ -95,7 +95,9 @@ class _UntilTheReaderLeaves:
                 return getattr(self._stream, name)(*args)
             except BrokenPipeError:
                 self._gone = True  # and no error when Python flushes it at exit:
-                os.dup2(os.open(os.devnull, os.O_WRONLY), self._stream.fileno())
+                devnull = os.open(os.devnull, os.O_WRONLY)  # closed once the stream holds it
+                os.dup2(devnull, self._stream.fileno())
+                os.close(devnull)
         return len(args[0]) if args else None
 
     def write(self, text: str) -> int:

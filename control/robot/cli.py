@@ -347,7 +347,9 @@ def main(argv: list[str] | None = None) -> int:
         if sys.stdout is not None:  # None: stdout closed (`>&-`), print wrote nothing
             sys.stdout.flush()  # here, not at exit: a reader that has gone is no error
     except BrokenPipeError:  # `terrain-replay ... | head -1`: the outputs are written
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        devnull = os.open(os.devnull, os.O_WRONLY)  # closed once stdout holds it
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
     return 0
 
 

@@ -29,7 +29,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return args.func(args)
     except BrokenPipeError:  # the reader went away (`gpmsa info FILE | head`): not an error
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        devnull = os.open(os.devnull, os.O_WRONLY)  # closed once stdout holds it
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
         return 0
     except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback
         print("gpmsa: interrupted (Ctrl-C)", file=sys.stderr)

@@ -559,8 +559,7 @@ def run_chain(
     els = state.els
     w = state.flat_widths(widths)
     total = n_iter + (tune_rounds * tune_levels if tune else 0)
-    bar = progress_bar(progress, total, desc, unit="it")
-    with one_thread(None):
+    with progress_bar(progress, total, desc, unit="it") as bar, one_thread(None):
         if tune and els:
             bar.set_description(f"{desc}: tuning step widths")  # the bar counts both phases
             names = [n for n, _ in els]
@@ -582,7 +581,6 @@ def run_chain(
             if it % 100 == 99:
                 bar.update(100)
         bar.update(n_iter % 100)
-    bar.close()
     if record is not None:
         record["level"] = state.level_record()
     return draws, log_post, *state.element_records(accepted, w, n_iter)

@@ -376,7 +376,6 @@ def run_tempered_chain(
     cold.check_start()
     n_temps = len(states)
     n_tune = tune_rounds * tune_levels * (1 + adapt_ladder) if tune else 0
-    bar = progress_bar(progress, n_temps * (n_iter + n_tune), desc, unit="it")
     draws = {n: np.empty((n_iter, *problem.init[n].shape)) for n in problem.names}
     log_post = np.empty(n_iter)
     names = problem.names
@@ -390,14 +389,14 @@ def run_tempered_chain(
     prop_mh = (not tune) if proportional_steps is None else proportional_steps
     hot_widths = None if copies is None else [cold.flat_widths(w) for _, w in copies]
     ran: dict = {}
-    with one_thread(None):
+    total = n_temps * (n_iter + n_tune)
+    with progress_bar(progress, total, desc, unit="it") as bar, one_thread(None):
         accepted, w, rates, adapted = run_ladder(
             states, rng, n_iter, cold.flat_widths(widths), [n for n, _ in cold.els], keep,
             swap_every=swap_every, tune=tune, tune_rounds=tune_rounds, tune_levels=tune_levels,
             prop_mh=prop_mh, bar=bar, desc=desc, adapt=temperatures if adapt_ladder else None,
             copy_widths=hot_widths, out=ran,
         )  # fmt: skip
-    bar.close()
     rate, wid = cold.element_records(accepted, w, n_iter)
     if record is not None:
         record["level"] = cold.level_record()

@@ -457,7 +457,6 @@ def run_study_chain(
     n_tune = tune_rounds * tune_levels * (1 + adapt_ladder) if tune else 0
     total = len(copies) * (n_iter + n_tune)
     own = [s.problem.sampled for s in state.states]
-    bar = progress_bar(progress, total, desc, unit="it")
     out = {"theta": np.empty((n_iter, layout.n_elements)), "log_post": np.empty(n_iter),
            "mu": np.empty((n_iter, len(layout.groups))),
            "lam": np.empty((n_iter, len(layout.groups)))}  # fmt: skip
@@ -473,7 +472,7 @@ def run_study_chain(
 
     kinds = _tuning_kinds(state.states, layout)
     ran: dict = {}
-    with one_thread(None):
+    with progress_bar(progress, total, desc, unit="it") as bar, one_thread(None):
         if temperatures is not None:
             for copy, t in zip(copies, temperatures, strict=True):
                 copy.beta = 1.0 / t
@@ -502,7 +501,6 @@ def run_study_chain(
                 if it % 100 == 99:
                     bar.update(100)
             bar.update(n_iter % 100)
-    bar.close()
     out.update(members=members, accept_rate=accepted / max(n_iter, 1), widths=w,
                names=element_names(state.states, layout),
                level_offsets=state.level_record())  # fmt: skip
