@@ -254,9 +254,10 @@ def _refuse_placement(options: dict, backend: str) -> None:
     if "n_jobs" not in options:
         return
     groups = options.get("chain_groups", 1)
+    one_group = isinstance(groups, int | np.integer) and groups is not True and groups == 1
     if backend == "pyro":
         backends.get(backend).check_n_jobs(options["n_jobs"])
-    elif backend == "torch" and not isinstance(groups, bool) and groups == 1:
+    elif backend == "torch" and one_group:  # (1.0 or True: refused by name at the update)
         backends.get(backend).check_n_jobs(options["n_jobs"], 1)
 
 
@@ -550,9 +551,13 @@ class Calibrator:
         return state
 
     def __setstate__(self, state: dict) -> None:
-        """Unpickling: one pickled before the prepared refinement (session 65; a saved BCR
-        holds one) prepares it now, as a Calibrator built now does."""
+        """Unpickling (and ``copy.deepcopy``): one pickled before the prepared refinement
+        (session 65; a saved BCR holds one) prepares it now, as a Calibrator built now does;
+        ``theta_grid`` read-only again (numpy restores an array writable)."""
         self.__dict__.update(state)
+        grid = self.__dict__.get("theta_grid")
+        if isinstance(grid, np.ndarray):
+            grid.flags.writeable = False
         self._updating = threading.RLock()
         self.__dict__.setdefault("_levels", None)  # pickled before categorical grids (s73)
         self.__dict__.setdefault("_categorical", [])
@@ -707,7 +712,7 @@ class Calibrator:
         warn_if_outside(fit, far=far_value(self.emulator, data, fit))
         if np.any(np.isnan(ll)):
             raise GPMSAError("the likelihood could not be evaluated for this observation")
-        grid = self.theta_grid.view()  # read-only (a pickled Calibrator's grid is writable)
+        grid = self.theta_grid.view()  # a read-only view of its own
         grid.flags.writeable = False
         return grid, ll
 

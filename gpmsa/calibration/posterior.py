@@ -185,8 +185,10 @@ class LevelMarginal:
     @classmethod
     def from_probabilities(cls, levels, probabilities) -> LevelMarginal:
         """Normalise ``probabilities`` (k,), non-negative, some positive, of the increasing
-        ``levels`` (k,); GPMSAError otherwise."""
-        levels = np.asarray(levels, dtype=float)
+        ``levels`` (k,); GPMSAError otherwise. The marginal holds a read-only copy of ``levels``
+        (often a Calibrator's own level codes) and read-only probabilities and weights, as a
+        `GridMarginal` does."""
+        levels = np.array(levels, dtype=float)
         p = np.asarray(probabilities, dtype=float)
         if levels.ndim != 1 or levels.size < 1 or p.shape != levels.shape:
             raise GPMSAError(f"a level marginal needs one probability per level, got levels "
@@ -197,7 +199,10 @@ class LevelMarginal:
         if not (np.all(np.isfinite(p)) and np.all(p >= 0.0) and total > 0.0):
             raise GPMSAError("a level marginal's probabilities must be finite, non-negative "
                              "and not all 0")  # fmt: skip
-        return cls(levels, p / total, np.ones(levels.size))
+        density, weights = p / total, np.ones(levels.size)
+        for a in (levels, density, weights):
+            a.flags.writeable = False
+        return cls(levels, density, weights)
 
     def probabilities(self) -> dict[float, float]:
         """level -> its posterior probability."""
