@@ -34,7 +34,13 @@ import tokenize
 import zipfile
 import zlib
 from collections import Counter
-from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import (
+    BrokenExecutor,
+    Executor,
+    Future,
+    ProcessPoolExecutor,
+    as_completed,
+)
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -647,7 +653,9 @@ def run_campaign(
     own = executor is None and len(todo) > 0
     pool = (
         ProcessPoolExecutor(
-            max_workers=min(os.cpu_count() or 1, len(todo)), initializer=_end_with_parent
+            max_workers=min(os.cpu_count() or 1, len(todo)),
+            initializer=_end_with_parent,
+            initargs=(os.getpid(),),
         )
         if own
         else executor
@@ -657,7 +665,13 @@ def run_campaign(
         for i in todo:
             futures[pool.submit(run_one, specs[i], None if cache is None else str(cache))] = i
         for fut in as_completed(futures):
-            results[futures[fut]] = fut.result()
+            try:
+                results[futures[fut]] = fut.result()
+            except BrokenExecutor as exc:
+                why = _start_failure(pool) if own else None
+                if why is None:
+                    raise
+                raise VehicleError(why) from exc
             bar.update()
     finally:  # after an error or Ctrl-C, the runs not yet started are cancelled, not waited for
         bar.close()
@@ -732,17 +746,20 @@ def _progress_bar(progress: bool, total: int, initial: int, desc: str):
     return _bar_class()(total=total, initial=initial, desc=desc, unit="run")
 
 
-def _end_with_parent() -> None:
-    """The campaign pool's worker initializer: end this worker when its parent, the process that
-    started it, ends. A campaign killed (SIGTERM, SIGKILL, the OOM killer: its cleanup never runs)
-    would leave its workers waiting for runs for ever, each holding a copy of its memory. On Linux
-    the kernel kills the worker then (prctl PR_SET_PDEATHSIG); on other POSIX systems a thread
-    checks the parent each second (on Windows none: a process's parent id there is not updated when
-    the parent ends). (gpmsa's chain pools do the same; vehicle does not import gpmsa.) The kernel's
-    signal follows the thread that started the worker: the one that runs the campaign, which
-    outlives the pool."""
+def _end_with_parent(owner: int | None = None) -> None:
+    """The campaign pool's worker initializer: end this worker when ``owner`` (the process that
+    runs the campaign; None: its parent) ends. A campaign killed (SIGTERM, SIGKILL, the OOM
+    killer: its cleanup never runs) would leave its workers waiting for runs for ever, each
+    holding a copy of its memory. On Linux, where the owner started the worker itself (fork,
+    spawn), the kernel kills the worker then (prctl PR_SET_PDEATHSIG); elsewhere on POSIX, and
+    where a forkserver started it (Python 3.14's default on Linux: its parent, which outlives the
+    owner while any worker holds its pipe), a thread checks the parent and the owner each second
+    (on Windows none: a process's parent id there is not updated when the parent ends). (gpmsa's
+    chain pools do the same; vehicle does not import gpmsa.) The kernel's signal follows the
+    thread that started the worker: the one that runs the campaign, which outlives the pool."""
     parent = os.getppid()
-    if sys.platform == "linux":
+    owner = parent if owner is None else owner
+    if sys.platform == "linux" and owner == parent:
         try:
             import ctypes
 
@@ -755,14 +772,57 @@ def _end_with_parent() -> None:
             pass
     if sys.platform == "win32":  # os.getppid() keeps the ended parent's id: nothing to watch
         return
-    threading.Thread(target=_watch_parent, args=(parent,), name="vehicle-end-with-parent",
+    threading.Thread(target=_watch_parent, args=(parent, owner), name="vehicle-end-with-parent",
                      daemon=True).start()  # fmt: skip
 
 
-def _watch_parent(parent: int) -> None:
-    while os.getppid() == parent:
+def _watch_parent(parent: int, owner: int) -> None:
+    while os.getppid() == parent and _alive(owner):
         time.sleep(1.0)
     os._exit(1)
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's
+        pass
+    return True
+
+
+def _start_failure(pool: ProcessPoolExecutor) -> str | None:
+    """Why the campaign's own ``pool`` broke, where a worker started by spawn or forkserver (not
+    fork) ended with an error (exit code > 0) while it started: it runs the main script again
+    (as ``"__mp_main__"``), which fails where the script runs the campaign outside an
+    ``if __name__ == "__main__":`` block or was read from standard input; else None. (gpmsa's
+    chain pools say the same; vehicle does not import gpmsa.)"""
+    context = getattr(pool, "_mp_context", None)
+    method = context.get_start_method() if context is not None else "fork"
+    if method == "fork":
+        return None
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if manager is not None:  # it joins the workers: a worker may not have ended quite yet
+        manager.join(timeout=5.0)
+    codes = [p.exitcode for p in (getattr(pool, "_processes", None) or {}).values()]
+    code = next((c for c in codes if c is not None and c > 0), None)
+    if code is None:
+        return None
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if getattr(main, "__spec__", None) is None and path is not None and not os.path.isfile(path):
+        fix = f"a script read from {path} cannot be read again: save it as a file and run that"
+    else:
+        where = f" of {path}" if path is not None else ""
+        fix = f'call run_campaign inside an `if __name__ == "__main__":` block{where}'
+    return (
+        f"a campaign worker process ended while starting (exit code {code}; its error is above, "
+        f"on stderr). The workers start by {method!r} (this platform's default, or "
+        f"multiprocessing.set_start_method's choice), which runs the main script again in each: "
+        f"{fix}"
+    )
 
 
 def _check_drives(

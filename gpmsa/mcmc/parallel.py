@@ -13,7 +13,9 @@ within ``WORKER_CHECK_S`` is named in a GPMSAError.
 Failures: a task that raises ``GPMSAError`` (bad input, the same on any machine) stops the run
 with ``ChainError`` naming the chain. Any other failure (a worker that died, a lost connection,
 an executor whose ``submit`` raises) is retried ``retries`` times, with a ``RuntimeWarning``,
-in a fresh pool when the pool was ours; then ``ChainError`` names the chain and the cause. A
+in a fresh pool when the pool was ours; then ``ChainError`` names the chain and the cause (at
+once where a worker of ours that spawn or forkserver started ended while starting: a script
+without an ``if __name__ == "__main__":`` block, or read from standard input). A
 chain is never dropped silently. When a run stops early (a chain failed, or KeyboardInterrupt),
 the chains not yet finished are cancelled: gpmsa's own worker processes are ended, an
 executor's futures cancelled. Ctrl-C stops a parallel run within a quarter of a second,
@@ -336,23 +338,27 @@ def _own_pool(workers: int) -> ProcessPoolExecutor:
     # fork where it exists (Linux): a worker starts in ~0.05 s against ~2 s for forkserver or
     # spawn, which re-import numpy and scipy. The workers run numpy only, one BLAS thread.
     ctx = _WorkerContext() if sys.platform == "linux" else None
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=end_with_parent)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=end_with_parent,
+                               initargs=(os.getpid(),))  # fmt: skip
 
 
 _PR_SET_PDEATHSIG = 1
 """Linux's prctl option: the signal a process gets when its parent ends."""
 
 
-def end_with_parent() -> None:
-    """A pool worker's initializer: end this worker when its parent, the process that started it,
-    ends. A parent killed (SIGTERM, SIGKILL, the OOM killer: its cleanup never runs) would leave its
-    pool's workers waiting for tasks for ever, each holding a copy of its memory. On Linux the
-    kernel kills the worker then (prctl PR_SET_PDEATHSIG); on other POSIX systems a thread checks
-    the parent each second (on Windows none: a process's parent id there is not updated when the
-    parent ends). The kernel's signal follows the thread that started the worker: the one that calls
-    and waits for the pool, which outlives it."""
+def end_with_parent(owner: int | None = None) -> None:
+    """A pool worker's initializer: end this worker when ``owner`` (the process whose pool it
+    serves; None: its parent) ends. A parent killed (SIGTERM, SIGKILL, the OOM killer: its cleanup
+    never runs) would leave its pool's workers waiting for tasks for ever, each holding a copy of
+    its memory. On Linux, where the owner started the worker itself, the kernel kills the worker
+    then (prctl PR_SET_PDEATHSIG); elsewhere on POSIX, and where a forkserver started it (its
+    parent, which outlives the owner while any worker holds its pipe), a thread checks the
+    parent and the owner each second (on Windows none: a process's parent id there is not
+    updated when the parent ends). The kernel's signal follows the thread that started the
+    worker: the one that calls and waits for the pool, which outlives it."""
     parent = os.getppid()
-    if sys.platform == "linux":
+    owner = parent if owner is None else owner
+    if sys.platform == "linux" and owner == parent:
         try:
             import ctypes
 
@@ -365,14 +371,25 @@ def end_with_parent() -> None:
             pass
     if sys.platform == "win32":  # os.getppid() keeps the ended parent's id: nothing to watch
         return
-    threading.Thread(target=_watch_parent, args=(parent,), name="gpmsa-end-with-parent",
+    threading.Thread(target=_watch_parent, args=(parent, owner), name="gpmsa-end-with-parent",
                      daemon=True).start()  # fmt: skip
 
 
-def _watch_parent(parent: int) -> None:
-    while os.getppid() == parent:
+def _watch_parent(parent: int, owner: int) -> None:
+    while os.getppid() == parent and _alive(owner):
         time.sleep(1.0)
     os._exit(1)
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's
+        pass
+    return True
 
 
 _JOIN_S = 5.0
@@ -398,6 +415,37 @@ def _stop(pool: ProcessPoolExecutor) -> None:
         proc.join(timeout=_JOIN_S)
     if manager is not None:  # it takes the pool's locks: a fork while it runs inherits them
         manager.join(timeout=_JOIN_S)
+
+
+def _start_failure(pool: ProcessPoolExecutor) -> str | None:
+    """Why our ``pool`` broke, where a worker started by spawn or forkserver (not fork) ended with
+    an error (exit code > 0) while it started: it runs the main script again (as
+    ``"__mp_main__"``), which fails where the script calls gpmsa outside an
+    ``if __name__ == "__main__":`` block or was read from standard input; else None."""
+    context = getattr(pool, "_mp_context", None)
+    method = context.get_start_method() if context is not None else "fork"
+    if method == "fork":
+        return None
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if manager is not None:  # it joins the workers: a worker may not have ended quite yet
+        manager.join(timeout=_JOIN_S)
+    codes = [p.exitcode for p in (getattr(pool, "_processes", None) or {}).values()]
+    code = next((c for c in codes if c is not None and c > 0), None)
+    if code is None:
+        return None
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if getattr(main, "__spec__", None) is None and path is not None and not os.path.isfile(path):
+        fix = f"a script read from {path} cannot be read again: save it as a file and run that"
+    else:
+        where = f" of {path}" if path is not None else ""
+        fix = f'call gpmsa inside an `if __name__ == "__main__":` block{where}'
+    return (
+        f"a worker process ended while starting (exit code {code}; its error is above, on "
+        f"stderr). The workers start by {method!r} (this platform's default, or "
+        f"multiprocessing.set_start_method's choice), which runs the main script again in each: "
+        f"{fix}; or give n_jobs=1 (the chains then run here, with the same draws)"
+    )
 
 
 def _closed(exc: BaseException) -> bool:
@@ -481,6 +529,10 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
 
     def retry_or_raise(i: int, exc: BaseException) -> None:
         nonlocal pool
+        broken = own and isinstance(exc, BrokenExecutor)  # a dead worker breaks the whole pool
+        why = _start_failure(pool) if broken else None
+        if why is not None:  # a fresh pool's workers would end the same way
+            raise ChainError(f"{what} {i} of {n} failed: {why}", (i,)) from exc
         if isinstance(exc, GPMSAError) or attempts[i] > retries:
             tries = f" after {attempts[i]} attempts" if attempts[i] > 1 else ""
             raise ChainError(f"{what} {i} of {n} failed{tries}: {_describe(exc)}", (i,)) from exc
@@ -488,7 +540,7 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
             f"{what} {i} of {n} failed ({_describe(exc)}); running it again (same seed, same "
             f"draws)", ChainRetryWarning, stacklevel=user_stacklevel(),
         )  # fmt: skip
-        if own and isinstance(exc, BrokenExecutor):  # a dead worker breaks the whole pool
+        if broken:
             _stop(pool)
             pool = _own_pool(workers)
             others = list(running.items())

@@ -1,0 +1,78 @@
+"""run_campaign's own pool where its workers start by spawn or forkserver (Python 3.14's default
+on Linux, macOS's, or multiprocessing.set_start_method's choice): each worker runs the main
+script again.
+
+Before (session 83): a script that ran the campaign outside an ``if __name__ == "__main__":``
+block, or read from standard input, gave a bare "BrokenProcessPool: A process in the process pool
+was terminated abruptly" from inside concurrent.futures; and a forkserver's workers watched the
+forkserver, which outlives a killed campaign while any worker holds its pipe: they outlived it."""
+
+import multiprocessing.context
+import os
+import subprocess
+import sys
+import types
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+import pytest
+
+import vehicle
+from vehicle import campaign
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
+
+
+class _ForkNamedForkserver(multiprocessing.context.ForkContext):
+    """Forks (fast) but says 'forkserver': the parent reads the start method from the context."""
+
+    _name = "forkserver"
+
+
+def _ends_while_starting(owner) -> None:
+    os._exit(1)  # as a worker whose import of the main script failed
+
+
+def test_a_worker_that_ends_while_starting_names_the_main_guard(monkeypatch):
+    def pool(max_workers, initializer, initargs):
+        return ProcessPoolExecutor(max_workers, mp_context=_ForkNamedForkserver(),
+                                   initializer=_ends_while_starting, initargs=initargs)  # fmt: skip
+
+    script = types.ModuleType("__main__")
+    script.__file__, script.__spec__ = __file__, None
+    monkeypatch.setitem(sys.modules, "__main__", script)
+    monkeypatch.setattr(campaign, "ProcessPoolExecutor", pool)
+    with pytest.raises(vehicle.VehicleError, match="ended while starting") as info:
+        vehicle.run_campaign(np.array([[0.5, 200.0]]), road_length_m=4.0, window=100,
+                             progress=False)  # fmt: skip
+    message = str(info.value)
+    assert "'forkserver'" in message and 'if __name__ == "__main__":' in message
+    assert __file__ in message
+
+
+def test_a_worker_of_another_parent_watches_the_campaign(monkeypatch):
+    started = []
+
+    class _Thread:
+        def __init__(self, target, args, name, daemon):
+            started.append((target, args))
+
+        def start(self):
+            pass
+
+    monkeypatch.setattr(campaign.threading, "Thread", _Thread)
+    owner = os.getppid() + 1  # a forkserver's worker: its parent is not the campaign's process
+    campaign._end_with_parent(owner)  # no prctl on this process: its parent is not the owner
+    assert started == [(campaign._watch_parent, (os.getppid(), owner))]
+
+
+def test_the_watcher_ends_the_worker_once_the_campaign_is_gone(monkeypatch):
+    gone = subprocess.Popen([sys.executable, "-c", "pass"])
+    gone.wait()
+
+    def exits(code):
+        raise SystemExit(code)
+
+    monkeypatch.setattr(campaign.os, "_exit", exits)
+    with pytest.raises(SystemExit):
+        campaign._watch_parent(os.getppid(), gone.pid)
