@@ -31,6 +31,7 @@ from control.simplex import Simplex
 from control.validation import check_flags, check_instance, is_real, path_argument
 from gpmsa._progress import progress_bar
 from gpmsa.errors import numbers_text
+from vehicle.simulate import SUBSTEPS
 
 EXACT_CLOCK_SILENCE = 0.5
 """The simulated sensor's clock is exact, so any sample missing at an update is silence: the
@@ -142,7 +143,7 @@ class ClosedLoopResult:
     Per sensor sample (length n): ``sample_time``, ``sample_position``, ``sample_speed``,
     ``sample_accel`` (the measured front-axle acceleration, m/s^2, before injected faults).
     ``settings``: what ran: ``model`` (the vehicle), ``noise_std``, ``seed``, ``bcr``,
-    ``simplex``, ``faults``.
+    ``simplex``, ``faults``, ``substeps``.
     """
 
     time: np.ndarray
@@ -245,6 +246,7 @@ def run_closed_loop(
     check: bool = True,
     max_time_s: float | None = None,
     record: str | os.PathLike | None = None,
+    substeps: int = SUBSTEPS,
 ) -> ClosedLoopResult:
     """Drive `model` over `track` with the BCR estimating GD and the Simplex setting the speed.
 
@@ -278,6 +280,8 @@ def run_closed_loop(
         record: write the run to this MCAP file for Foxglove (`control.record_run`: the
             accelerations, speed command and actual speed, the GD estimate with its interval,
             the mode and the true GD; needs the ``robot`` extra).
+        substeps: the vehicle solver's steps per sample period (`vehicle.Simulation`; its
+            `SolverStepWarning` names the number a stiff model needs).
 
     Returns:
         `ClosedLoopResult` with traces and `LoopMetrics`.
@@ -344,8 +348,9 @@ def run_closed_loop(
     noise_seed, fault_rng = rng.integers(2**63), np.random.default_rng(rng.integers(2**63))
     inject = FaultInjector(faults, fault_rng)
     sim = vehicle.Simulation(
-        model, track, rate_hz=bcr.rate_hz, noise_std=noise_std, seed=int(noise_seed)
-    )
+        model, track, rate_hz=bcr.rate_hz, noise_std=noise_std, seed=int(noise_seed),
+        substeps=substeps,
+    )  # fmt: skip
     dt = bcr.samples_per_update / bcr.rate_hz
     limit = 20.0 * float(track.length_m) / simplex.v_safe if max_time_s is None else max_time_s
 
@@ -431,6 +436,7 @@ def run_closed_loop(
             "bcr": bcr,
             "simplex": simplex,
             "faults": tuple(faults),
+            "substeps": substeps,
         },
     )
     if record is not None:

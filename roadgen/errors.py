@@ -1,6 +1,7 @@
 """Exceptions raised by roadgen, and the text of the numbers in their messages."""
 
 import math
+from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal
 
 
 class RoadgenError(ValueError):
@@ -17,3 +18,16 @@ def distinct_texts(*values: float, digits: int = 6) -> tuple[str, ...]:
     if len({f"{v:.{digits}g}" for v in finite}) == len(finite):  # (the usual case)
         return tuple(f"{v:.{digits}g}" for v in floats)
     return tuple(repr(v) for v in floats)
+
+
+def bound_text(value: float, up: bool, digits: int = 6) -> str:
+    """``value`` as text for a message's advice, ``digits`` significant digits rounded up
+    (``up``: a least value to give) or down (a most), so that the number a user copies from the
+    text still meets the bound (``length_m >= 66.6607`` for a need of 66.66066, not 66.6607
+    rounded from 66.66074)."""
+    exact = Decimal(float(value))
+    if not exact.is_finite() or exact == 0:
+        return f"{float(value):.{digits}g}"
+    step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
+    rounded = exact.quantize(step, rounding=ROUND_CEILING if up else ROUND_FLOOR)
+    return f"{float(rounded):.{digits}g}"

@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from roadgen.errors import RoadgenError, distinct_texts
+from roadgen.errors import RoadgenError, bound_text, distinct_texts
 from roadgen.iso8608 import N0, gd_spectrum
 from roadgen.psd import FIT_BAND, FIT_MIN_WAVINESS, estimate_gd, profile_psd
 from roadgen.road import Road, check_road
@@ -74,9 +74,9 @@ def _fit_band(dx_m: float) -> tuple[float, float]:
     nyquist = 0.5 / dx_m
     if FIT_BAND[0] >= nyquist:
         dx_text, most = distinct_texts(dx_m, 0.5 / FIT_BAND[0])
-        top = distinct_texts(nyquist, *FIT_BAND)[0]
+        nyq, top = distinct_texts(nyquist, *FIT_BAND)[0], bound_text(nyquist, up=False)
         raise RoadgenError(
-            f"the grid dx_m={dx_text} m (Nyquist frequency {top} cycles/m) is too coarse "
+            f"the grid dx_m={dx_text} m (Nyquist frequency {nyq} cycles/m) is too coarse "
             f"for the GD fit band FIT_BAND={FIT_BAND} cycles/m: pass a band inside "
             f"(0, {top}] cycles/m, or use dx_m < {most} m"
         )

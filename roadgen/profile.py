@@ -10,7 +10,7 @@ from typing import overload
 import numpy as np
 
 from roadgen import checks
-from roadgen.errors import RoadgenError, distinct_texts
+from roadgen.errors import RoadgenError, bound_text, distinct_texts
 from roadgen.iso8608 import check_waviness, gd_spectrum
 from roadgen.road import Road
 
@@ -160,13 +160,7 @@ def unit_road(
     else:
         lo, hi = checks.band("band", band, nyquist)
         if lo < dn * (1.0 - 1e-9):
-            length, need = distinct_texts((n_points - 1) * dx_m, 1.0 / lo - dx_m)
-            n_min, n_low = distinct_texts(lo, dn)
-            raise RoadgenError(
-                f"length_m={length} is too short for band={band!r}: the band's "
-                f"n_min={n_min} cycles/m needs length_m >= {need} m "
-                f"(or use n_min >= {n_low} cycles/m)"
-            )
+            raise _short_for_band(band, lo, n_points, dx_m)
     k = np.arange(n_points // 2 + 1)
     n = k * dn
     edge_lo, edge_hi = band_edges((lo, hi), n_points)
@@ -231,6 +225,29 @@ def lead_in_taper(x: np.ndarray, lead_in_m: float) -> np.ndarray:
         return np.ones_like(x)
     t = np.clip(x / lead_in_m, 0.0, 1.0)
     return 0.5 * (1.0 - np.cos(np.pi * t))
+
+
+def _short_for_band(
+    band: tuple[float, float], lo: float, n_points: int, dx_m: float
+) -> RoadgenError:
+    """The error for a grid of ``n_points`` whose fundamental lies above the band's n_min
+    ``lo``: the least length_m (whole steps, as `grid_points` rounds it) and n_min that pass,
+    their text rounded towards passing (`bound_text`), each read apart from the value given."""
+    need = max(n_points + 1, math.ceil((1.0 - 1e-9) / (lo * dx_m)))
+    while lo < 1.0 / (need * dx_m) * (1.0 - 1e-9):  # iso8608_profile's test, in float64
+        need += 1
+    length, least = f"{(n_points - 1) * dx_m:.6g}", f"{(need - 1) * dx_m:.6g}"
+    if round(float(least) / dx_m) + 1 < need:  # (66.666 passes as well as 66.6660001)
+        least = bound_text((need - 1) * dx_m, up=True)
+    if length == least:
+        length, least = repr((n_points - 1) * dx_m), repr((need - 1) * dx_m)
+    n_min, n_low = f"{lo:.6g}", bound_text(1.0 / (n_points * dx_m), up=True)
+    if n_min == n_low:
+        n_min, n_low = repr(lo), repr(1.0 / (n_points * dx_m))
+    return RoadgenError(
+        f"length_m={length} is too short for band={band!r}: the band's n_min={n_min} "
+        f"cycles/m needs length_m >= {least} m (or use n_min >= {n_low} cycles/m)"
+    )
 
 
 def grid_points(length_m: float, dx_m: float) -> int:

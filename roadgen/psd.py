@@ -8,7 +8,7 @@ from typing import Protocol
 import numpy as np
 
 from roadgen import checks
-from roadgen.errors import RoadgenError, distinct_texts
+from roadgen.errors import RoadgenError, bound_text, distinct_texts
 from roadgen.iso8608 import GD_SCALE, N0, check_waviness
 from roadgen.profile import band_edges
 
@@ -309,10 +309,25 @@ def _fit_bins(
         raise RoadgenError(
             f"band=({lo_text}, {hi_text}) cycles/m holds no PSD bin of the road inside its "
             f"content band settings.band=({low}, {high}) cycles/m{clear}"
-            f"{',' if how else ''}{how}: the road has no content there; pass a band inside "
-            "settings.band"
-        )
+            f"{',' if how else ''}{how}: the road has no content there; "
+            + (_welch_bins_text(n, edge_lo + margin, edge_hi - margin) if margin else
+               "pass a band inside settings.band")
+        )  # fmt: skip
     return keep
+
+
+def _welch_bins_text(n: np.ndarray, lo: float, hi: float) -> str:
+    """The remedy for a Welch fit whose band holds no bin of n (M,) cycles/m in [lo, hi] (the
+    content band less its 2-bin margins): the bins it would fit (from WELCH_MIN_BIN up), a
+    longer road, or method='fit' (no margins)."""
+    usable = n[(n >= lo) & (n <= hi) & (n / n[0] >= WELCH_MIN_BIN)]  # as _fitted_gd
+    if usable.size == 0:
+        return "use a longer road, or method='fit'"
+    first, last = bound_text(usable[0], up=True), bound_text(usable[-1], up=False)
+    return (
+        f"pass a band that holds one of the Welch bins it fits, {first} to {last} cycles/m "
+        f"(every {n[0]:.6g} cycles/m), use a longer road, or method='fit'"
+    )
 
 
 def _welch_too_short(
@@ -373,9 +388,9 @@ def _fit_band(band: tuple[float, float] | None, dx: float) -> tuple[float, float
         return checks.band("band", band, nyquist)
     if FIT_BAND[1] > nyquist:
         dx_text, most = distinct_texts(dx, 0.5 / FIT_BAND[1])
-        top = distinct_texts(nyquist, *FIT_BAND)[0]
+        nyq, top = distinct_texts(nyquist, *FIT_BAND)[0], bound_text(nyquist, up=False)
         raise RoadgenError(
-            f"the grid dx_m={dx_text} m (Nyquist frequency {top} cycles/m) is too coarse "
+            f"the grid dx_m={dx_text} m (Nyquist frequency {nyq} cycles/m) is too coarse "
             f"for the default fit band FIT_BAND={FIT_BAND} cycles/m: pass a band inside "
             f"(0, {top}] cycles/m, or use dx_m <= {most} m"
         )

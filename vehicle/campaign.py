@@ -47,7 +47,7 @@ from pathlib import Path
 import numpy as np
 
 import roadgen
-from roadgen.errors import distinct_texts
+from roadgen.errors import bound_text, distinct_texts
 from vehicle import checks, kinematics
 from vehicle.design import check_design, lhs_design
 from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleError
@@ -630,7 +630,7 @@ def run_campaign(
         raise VehicleError(
             f"road_length_m={road_length_m!r} is too short: a {window}-sample window at "
             f"{v_short:.4g} m/s after the lead-in ({lead_in_m} m) needs "
-            f"road_length_m >= {distinct_texts(road_length_m, least, digits=4)[1]} m"
+            f"road_length_m >= {bound_text(least, up=True, digits=4)} m"
         )
 
     _check_drives(points, lengths, model, dx_m, rate_hz * substeps)

@@ -1188,14 +1188,31 @@ def obs_values(problem: Problem) -> int:
     return p_u * (n * n + n) + 2 * p_u * n * (problem.m + n) + 2 * big * big
 
 
-def check_n_jobs(n_jobs, chain_groups: int) -> None:
+def check_n_jobs(n_jobs, chain_groups: int, n_chains: int | None = None) -> None:
     """GPMSAError for an ``n_jobs`` that `sample` refuses with ``chain_groups`` (an integer in
-    [1, n_chains]): a bad one (`n_workers`), or any above 1 with one group (one batch)."""
+    [1, n_chains]): a bad one (`n_workers`), or any above 1 with one group (one batch); its
+    advice fits ``n_chains`` where given (chain_groups is at most n_chains)."""
     n_workers(n_jobs, chain_groups)  # refuse a bad n_jobs up front
     if chain_groups == 1 and n_jobs is not None and n_jobs > 1:
+        if isinstance(n_chains, bool) or not isinstance(n_chains, int | np.integer):
+            n_chains = None  # (not given, or a bad one, refused by name where it is read)
+        groups = n_jobs if n_chains is None else max(1, min(n_jobs, int(n_chains)))
+        if groups == 1:
+            fix = (
+                f"n_chains={n_chains} is one chain, which runs in one process: leave n_jobs "
+                f"out, or give n_chains >= {n_jobs} and chain_groups={n_jobs} for {n_jobs} "
+                "processes"
+            )
+        elif n_chains is None or n_chains > groups:
+            fix = f"give chain_groups={groups} (or more) to sample in {groups} processes"
+        else:
+            fix = (
+                f"give chain_groups={groups} to sample in {groups} processes (one per chain "
+                f"of n_chains={n_chains})"
+            )
         raise GPMSAError(
             f"n_jobs={n_jobs} with chain_groups=1: the torch backend samples its chains as one "
-            f"batch; give chain_groups={n_jobs} (or more) to sample in {n_jobs} processes"
+            f"batch; {fix}"
         )
 
 
@@ -1220,7 +1237,7 @@ def _check_groups(chain_groups, n_jobs, executor, n_chains: int, device, num_thr
             f"with chain_groups > 1 or an executor each group's process runs one thread: give "
             f"num_threads=1 (got {num_threads!r}); use more groups for more cores"
         )
-    check_n_jobs(n_jobs, int(chain_groups))
+    check_n_jobs(n_jobs, int(chain_groups), n_chains)
     return {"groups": int(chain_groups), "n_jobs": n_jobs, "executor": executor}
 
 

@@ -258,7 +258,7 @@ def _refuse_placement(options: dict, backend: str) -> None:
     if backend == "pyro":
         backends.get(backend).check_n_jobs(options["n_jobs"])
     elif backend == "torch" and one_group:  # (1.0 or True: refused by name at the update)
-        backends.get(backend).check_n_jobs(options["n_jobs"], 1)
+        backends.get(backend).check_n_jobs(options["n_jobs"], 1, options.get("n_chains", 1))
 
 
 def _given(options: dict, key: str) -> bool:

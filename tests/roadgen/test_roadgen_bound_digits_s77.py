@@ -45,7 +45,7 @@ CASES = {
     ),
     "profile length for band": (
         _short_band,
-        "needs length_m >= 20.000000041 m (or use n_min >= 0.04878048780487805 cycles/m)",
+        "needs length_m >= 20.5 m (or use n_min >= 0.04878048780487805 cycles/m)",
     ),
     "track lead_in_m, one segment": (
         lambda: roadgen.track([(20.0, 10.0)], seed=0, dx_m=0.5, lead_in_m=PAST),
