@@ -649,7 +649,6 @@ def run_campaign(
             todo.append(i)
         else:
             results[i] = cached
-    bar = _progress_bar(progress, len(specs), len(specs) - len(todo), f"campaign {model.name}")
     own = executor is None and len(todo) > 0
     pool = (
         ProcessPoolExecutor(
@@ -659,7 +658,8 @@ def run_campaign(
         )
         if own
         else executor
-    )
+    )  # (before the bar: a pool that cannot be made leaves no bar open; it starts no process yet)
+    bar = _progress_bar(progress, len(specs), len(specs) - len(todo), f"campaign {model.name}")
     futures: dict[Future, int] = {}
     try:
         for i in todo:
