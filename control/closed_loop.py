@@ -298,6 +298,7 @@ def run_closed_loop(
     seed = _run_seed(seed)
     check_flags(check=check, progress=progress)
     noise_std = vehicle.sensor.check_noise(noise_std)
+    substeps = vehicle.checks.integer("substeps", substeps, 1)  # before the emulator's checks
     faults = _check_faults(faults)
     if max_time_s is not None and not (is_real(max_time_s) and max_time_s > 0):
         raise ControlError(f"max_time_s must be None or a number > 0, s, got {max_time_s!r}")

@@ -24,10 +24,13 @@ def bound_text(value: float, up: bool, digits: int = 6) -> str:
     """``value`` as text for a message's advice, ``digits`` significant digits rounded up
     (``up``: a least value to give) or down (a most), so that the number a user copies from the
     text still meets the bound (``length_m >= 66.6607`` for a need of 66.66066, not 66.6607
-    rounded from 66.66074)."""
-    exact = Decimal(float(value))
-    if not exact.is_finite() or exact == 0:
-        return f"{float(value):.{digits}g}"
+    rounded from 66.66074); rounded to nearest where that number meets it too (``n_min >= 0.1``
+    for the float 0.1, not 0.100001)."""
+    v = float(value)
+    text = f"{v:.{digits}g}"
+    if not math.isfinite(v) or (float(text) >= v if up else float(text) <= v):
+        return text
+    exact = Decimal(v)
     step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
     rounded = exact.quantize(step, rounding=ROUND_CEILING if up else ROUND_FLOOR)
     return f"{float(rounded):.{digits}g}"

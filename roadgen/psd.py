@@ -319,11 +319,15 @@ def _fit_bins(
 def _welch_bins_text(n: np.ndarray, lo: float, hi: float) -> str:
     """The remedy for a Welch fit whose band holds no bin of n (M,) cycles/m in [lo, hi] (the
     content band less its 2-bin margins): the bins it would fit (from WELCH_MIN_BIN up), a
-    longer road, or method='fit' (no margins)."""
+    longer road, or method='fit' (no margins). The first and last are rounded inwards (a band
+    that reaches either holds it), where a bin lies between them (a band from the first to the
+    last then holds that one), else outwards (that band holds them: one bin reads as a range
+    around it, not 1.33334 to 1.33333)."""
     usable = n[(n >= lo) & (n <= hi) & (n / n[0] >= WELCH_MIN_BIN)]  # as _fitted_gd
     if usable.size == 0:
         return "use a longer road, or method='fit'"
-    first, last = bound_text(usable[0], up=True), bound_text(usable[-1], up=False)
+    inwards = usable.size > 2
+    first, last = bound_text(usable[0], up=inwards), bound_text(usable[-1], up=not inwards)
     return (
         f"pass a band that holds one of the Welch bins it fits, {first} to {last} cycles/m "
         f"(every {n[0]:.6g} cycles/m), use a longer road, or method='fit'"

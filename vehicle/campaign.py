@@ -20,9 +20,11 @@ import functools
 import hashlib
 import json
 import math
+import multiprocessing
 import os
 import re
 import secrets
+import select
 import signal
 import socket
 import stat
@@ -34,6 +36,7 @@ import tokenize
 import zipfile
 import zlib
 from collections import Counter
+from collections.abc import Callable
 from concurrent.futures import (
     BrokenExecutor,
     Executor,
@@ -626,11 +629,13 @@ def run_campaign(
     if short.any():
         v_short = float(np.max(speeds[short]))
         need_m = window * v_short / rate_hz
-        least = need_m + lead_in_m + 2 * model.wheelbase_m
+        least = bound_text(need_m + lead_in_m + 2 * model.wheelbase_m, up=True, digits=4)
+        while not float(least) - lead_in_m - 2 * model.wheelbase_m >= need_m:  # as above, in
+            least = bound_text(np.nextafter(float(least), np.inf), up=True, digits=4)  # float64
         raise VehicleError(
             f"road_length_m={road_length_m!r} is too short: a {window}-sample window at "
             f"{v_short:.4g} m/s after the lead-in ({lead_in_m} m) needs "
-            f"road_length_m >= {bound_text(least, up=True, digits=4)} m"
+            f"road_length_m >= {least} m"
         )
 
     _check_drives(points, lengths, model, dx_m, rate_hz * substeps)
@@ -650,11 +655,13 @@ def run_campaign(
         else:
             results[i] = cached
     own = executor is None and len(todo) > 0
+    ctx = multiprocessing.get_context()  # the pool's: its workers set `started` once started
+    started = None if not own or ctx.get_start_method() == "fork" else ctx.Value("b", 0, lock=False)
     pool = (
         ProcessPoolExecutor(
             max_workers=min(os.cpu_count() or 1, len(todo)),
             initializer=_end_with_parent,
-            initargs=(os.getpid(),),
+            initargs=(os.getpid(), started),
         )
         if own
         else executor
@@ -668,7 +675,7 @@ def run_campaign(
             try:
                 results[futures[fut]] = fut.result()
             except BrokenExecutor as exc:
-                why = _start_failure(pool) if own else None
+                why = _start_failure(pool, started) if own else None
                 if why is None:
                     raise
                 raise VehicleError(why) from exc
@@ -746,9 +753,11 @@ def _progress_bar(progress: bool, total: int, initial: int, desc: str):
     return _bar_class()(total=total, initial=initial, desc=desc, unit="run")
 
 
-def _end_with_parent(owner: int | None = None) -> None:
-    """The campaign pool's worker initializer: end this worker when ``owner`` (the process that
-    runs the campaign; None: its parent) ends. A campaign killed (SIGTERM, SIGKILL, the OOM
+def _end_with_parent(owner: int | None = None, started=None) -> None:
+    """The campaign pool's worker initializer: set the shared flag ``started`` (a ``Value``;
+    None: none) to 1, and end this worker when ``owner`` (the process that runs the campaign;
+    None: its parent) ends. (Spawn and forkserver run the main script before the initializer:
+    a worker that set the flag got past it.) A campaign killed (SIGTERM, SIGKILL, the OOM
     killer: its cleanup never runs) would leave its workers waiting for runs for ever, each
     holding a copy of its memory. On Linux, where the owner started the worker itself (fork,
     spawn), the kernel kills the worker then (prctl PR_SET_PDEATHSIG); elsewhere on POSIX, and
@@ -757,6 +766,8 @@ def _end_with_parent(owner: int | None = None) -> None:
     (on Windows none: a process's parent id there is not updated when the parent ends). (gpmsa's
     chain pools do the same; vehicle does not import gpmsa.) The kernel's signal follows the
     thread that started the worker: the one that runs the campaign, which outlives the pool."""
+    if started is not None:
+        started.value = 1
     parent = os.getppid()
     owner = parent if owner is None else owner
     if sys.platform == "linux" and owner == parent:
@@ -777,9 +788,25 @@ def _end_with_parent(owner: int | None = None) -> None:
 
 
 def _watch_parent(parent: int, owner: int) -> None:
-    while os.getppid() == parent and _alive(owner):
+    ended = _ended(owner)
+    while os.getppid() == parent and not ended():
         time.sleep(1.0)
     os._exit(1)
+
+
+def _ended(pid: int) -> Callable[[], bool]:
+    """A test whether process ``pid`` has ended: on Linux by a pidfd, readable once it ended,
+    before its parent reaps it (a killed campaign whose parent does not wait for it stays a
+    zombie), and never by another process that reuses the id; elsewhere by `_alive`."""
+    try:
+        fd = os.pidfd_open(pid)
+    except ProcessLookupError:
+        return lambda: True
+    except (AttributeError, OSError):  # not Linux, or a kernel before 5.3
+        return lambda: not _alive(pid)
+    poller = select.poll()
+    poller.register(fd, select.POLLIN)
+    return lambda: bool(poller.poll(0))
 
 
 def _alive(pid: int) -> bool:
@@ -793,15 +820,17 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def _start_failure(pool: ProcessPoolExecutor) -> str | None:
+def _start_failure(pool: ProcessPoolExecutor, started=None) -> str | None:
     """Why the campaign's own ``pool`` broke, where a worker started by spawn or forkserver (not
     fork) ended with an error (exit code > 0) while it started: it runs the main script again
     (as ``"__mp_main__"``), which fails where the script runs the campaign outside an
-    ``if __name__ == "__main__":`` block or was read from standard input; else None. (gpmsa's
-    chain pools say the same; vehicle does not import gpmsa.)"""
+    ``if __name__ == "__main__":`` block or was read from standard input; else None (also where
+    a worker got past the main script, its flag ``started`` set: one that ended in a run, by
+    ``exit(1)`` in a library, was no start failure). (gpmsa's chain pools say the same; vehicle
+    does not import gpmsa.)"""
     context = getattr(pool, "_mp_context", None)
     method = context.get_start_method() if context is not None else "fork"
-    if method == "fork":
+    if method == "fork" or (started is not None and started.value):
         return None
     manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None:  # it joins the workers: a worker may not have ended quite yet

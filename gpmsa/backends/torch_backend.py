@@ -1194,7 +1194,7 @@ def check_n_jobs(n_jobs, chain_groups: int, n_chains: int | None = None) -> None
     advice fits ``n_chains`` where given (chain_groups is at most n_chains)."""
     n_workers(n_jobs, chain_groups)  # refuse a bad n_jobs up front
     if chain_groups == 1 and n_jobs is not None and n_jobs > 1:
-        if isinstance(n_chains, bool) or not isinstance(n_chains, int | np.integer):
+        if isinstance(n_chains, bool) or not isinstance(n_chains, int | np.integer) or n_chains < 1:
             n_chains = None  # (not given, or a bad one, refused by name where it is read)
         groups = n_jobs if n_chains is None else max(1, min(n_jobs, int(n_chains)))
         if groups == 1:

@@ -32,6 +32,7 @@ import importlib
 import multiprocessing
 import multiprocessing.context
 import os
+import select
 import signal
 import sys
 import threading
@@ -337,18 +338,23 @@ if sys.platform == "linux":  # where `_own_pool` forks (Windows has no ForkProce
 def _own_pool(workers: int) -> ProcessPoolExecutor:
     # fork where it exists (Linux): a worker starts in ~0.05 s against ~2 s for forkserver or
     # spawn, which re-import numpy and scipy. The workers run numpy only, one BLAS thread.
-    ctx = _WorkerContext() if sys.platform == "linux" else None
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=end_with_parent,
-                               initargs=(os.getpid(),))  # fmt: skip
+    ctx = _WorkerContext() if sys.platform == "linux" else multiprocessing.get_context()
+    started = None if ctx.get_start_method() == "fork" else ctx.Value("b", 0, lock=False)
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=end_with_parent,
+                               initargs=(os.getpid(), started))  # fmt: skip
+    pool.gpmsa_started = started  # read by `_start_failure`
+    return pool
 
 
 _PR_SET_PDEATHSIG = 1
 """Linux's prctl option: the signal a process gets when its parent ends."""
 
 
-def end_with_parent(owner: int | None = None) -> None:
-    """A pool worker's initializer: end this worker when ``owner`` (the process whose pool it
-    serves; None: its parent) ends. A parent killed (SIGTERM, SIGKILL, the OOM killer: its cleanup
+def end_with_parent(owner: int | None = None, started=None) -> None:
+    """A pool worker's initializer: set the shared flag ``started`` (a ``Value``; None: none) to
+    1, and end this worker when ``owner`` (the process whose pool it serves; None: its parent)
+    ends. (Spawn and forkserver run the main script before the initializer: a worker that set
+    the flag got past it.) A parent killed (SIGTERM, SIGKILL, the OOM killer: its cleanup
     never runs) would leave its pool's workers waiting for tasks for ever, each holding a copy of
     its memory. On Linux, where the owner started the worker itself, the kernel kills the worker
     then (prctl PR_SET_PDEATHSIG); elsewhere on POSIX, and where a forkserver started it (its
@@ -356,6 +362,8 @@ def end_with_parent(owner: int | None = None) -> None:
     parent and the owner each second (on Windows none: a process's parent id there is not
     updated when the parent ends). The kernel's signal follows the thread that started the
     worker: the one that calls and waits for the pool, which outlives it."""
+    if started is not None:
+        started.value = 1
     parent = os.getppid()
     owner = parent if owner is None else owner
     if sys.platform == "linux" and owner == parent:
@@ -376,9 +384,25 @@ def end_with_parent(owner: int | None = None) -> None:
 
 
 def _watch_parent(parent: int, owner: int) -> None:
-    while os.getppid() == parent and _alive(owner):
+    ended = _ended(owner)
+    while os.getppid() == parent and not ended():
         time.sleep(1.0)
     os._exit(1)
+
+
+def _ended(pid: int) -> Callable[[], bool]:
+    """A test whether process ``pid`` has ended: on Linux by a pidfd, readable once it ended,
+    before its parent reaps it (a killed owner whose parent does not wait for it stays a
+    zombie), and never by another process that reuses the id; elsewhere by `_alive`."""
+    try:
+        fd = os.pidfd_open(pid)
+    except ProcessLookupError:
+        return lambda: True
+    except (AttributeError, OSError):  # not Linux, or a kernel before 5.3
+        return lambda: not _alive(pid)
+    poller = select.poll()
+    poller.register(fd, select.POLLIN)
+    return lambda: bool(poller.poll(0))
 
 
 def _alive(pid: int) -> bool:
@@ -421,10 +445,13 @@ def _start_failure(pool: ProcessPoolExecutor) -> str | None:
     """Why our ``pool`` broke, where a worker started by spawn or forkserver (not fork) ended with
     an error (exit code > 0) while it started: it runs the main script again (as
     ``"__mp_main__"``), which fails where the script calls gpmsa outside an
-    ``if __name__ == "__main__":`` block or was read from standard input; else None."""
+    ``if __name__ == "__main__":`` block or was read from standard input; else None (also where
+    a worker got past the main script, its flag ``pool.gpmsa_started`` set: one that ended in a
+    chain, by ``exit(1)`` in a library, is retried)."""
     context = getattr(pool, "_mp_context", None)
     method = context.get_start_method() if context is not None else "fork"
-    if method == "fork":
+    started = getattr(pool, "gpmsa_started", None)
+    if method == "fork" or (started is not None and started.value):
         return None
     manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None:  # it joins the workers: a worker may not have ended quite yet

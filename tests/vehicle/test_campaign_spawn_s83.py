@@ -29,7 +29,7 @@ class _ForkNamedForkserver(multiprocessing.context.ForkContext):
     _name = "forkserver"
 
 
-def _ends_while_starting(owner) -> None:
+def _ends_while_starting(owner, started=None) -> None:
     os._exit(1)  # as a worker whose import of the main script failed
 
 

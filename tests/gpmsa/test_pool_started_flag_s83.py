@@ -1,0 +1,63 @@
+"""gpmsa's own pool under spawn or forkserver tells a worker that ended while starting from one
+that ended in a chain, and its workers end with an owner killed and left unreaped (session 83
+review).
+
+Before: a worker that got past the main script and then ended with exit code 1 in a chain (a
+library's ``exit(1)``, as OpenBLAS's on too many threads) was named "a worker process ended
+while starting ... call gpmsa inside an ``if __name__ == "__main__":`` block" and not retried
+(under fork the same death is retried); and a forkserver's worker whose owner was killed but
+not yet reaped by its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie."""
+
+import multiprocessing.context
+import os
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from gpmsa.mcmc import parallel
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
+
+
+class _ForkNamedSpawn(multiprocessing.context.ForkContext):
+    """Forks (fast) but says 'spawn': the parent reads the start method from the context."""
+
+    _name = "spawn"
+
+
+def _ends_once(x, marker, progress=False, desc=""):
+    if x == 1 and not os.path.exists(marker):
+        open(marker, "w").close()
+        os._exit(1)  # a started worker that ends in the chain
+    return x
+
+
+def test_a_started_worker_that_ends_in_a_chain_is_retried(monkeypatch, tmp_path):
+    monkeypatch.setattr(parallel, "_WorkerContext", _ForkNamedSpawn)
+    marker = str(tmp_path / "ended")
+    tasks = [{"x": i, "marker": marker} for i in range(2)]
+    with pytest.warns(parallel.ChainRetryWarning, match="BrokenProcessPool"):
+        assert parallel.run_chains(_ends_once, tasks, n_jobs=2) == [0, 1]
+
+
+@pytest.mark.skipif(not hasattr(os, "pidfd_open"), reason="a zombie reads as alive without pidfd")
+def test_the_watcher_ends_the_worker_of_an_owner_left_a_zombie(monkeypatch):
+    owner = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    try:
+        owner.send_signal(signal.SIGKILL)
+        os.waitid(os.P_PID, owner.pid, os.WEXITED | os.WNOWAIT)  # ended, not reaped
+
+        def exits(code):
+            raise SystemExit(code)
+
+        def sleeps(seconds):
+            raise AssertionError("still watching an owner that ended")
+
+        monkeypatch.setattr(parallel.os, "_exit", exits)
+        monkeypatch.setattr(parallel.time, "sleep", sleeps)
+        with pytest.raises(SystemExit):
+            parallel._watch_parent(os.getppid(), owner.pid)
+    finally:
+        owner.wait()

@@ -1,0 +1,71 @@
+"""run_campaign's own pool under spawn or forkserver tells a worker that ended while starting
+from one that ended in a run, and its workers end with a campaign killed and left unreaped
+(session 83 review).
+
+Before: a worker that got past the main script and then ended with exit code 1 in a run (a
+library's ``exit(1)``) was named "a campaign worker process ended while starting ... call
+run_campaign inside an ``if __name__ == "__main__":`` block" (under fork: the
+BrokenProcessPool); and a forkserver's worker whose campaign was killed but not yet reaped by
+its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie."""
+
+import multiprocessing.context
+import os
+import signal
+import subprocess
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+
+import numpy as np
+import pytest
+
+import vehicle
+from vehicle import campaign
+
+pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
+
+
+class _ForkNamedSpawn(multiprocessing.context.ForkContext):
+    """Forks (fast) but says 'spawn': the parent reads the start method from the context."""
+
+    _name = "spawn"
+
+
+def _ends_in_the_run(spec, cache):
+    os._exit(1)  # a started worker that ends in its run
+
+
+def test_a_started_worker_that_ends_in_a_run_is_not_named_a_start_failure(monkeypatch):
+    context = _ForkNamedSpawn()
+
+    def pool(max_workers, initializer, initargs):
+        return ProcessPoolExecutor(max_workers, mp_context=context, initializer=initializer,
+                                   initargs=initargs)  # fmt: skip
+
+    monkeypatch.setattr(campaign.multiprocessing, "get_context", lambda: context)
+    monkeypatch.setattr(campaign, "ProcessPoolExecutor", pool)
+    monkeypatch.setattr(campaign, "run_one", _ends_in_the_run)
+    with pytest.raises(BrokenProcessPool):
+        vehicle.run_campaign(np.array([[0.5, 200.0]]), road_length_m=4.0, window=100,
+                             progress=False)  # fmt: skip
+
+
+@pytest.mark.skipif(not hasattr(os, "pidfd_open"), reason="a zombie reads as alive without pidfd")
+def test_the_watcher_ends_the_worker_of_a_campaign_left_a_zombie(monkeypatch):
+    owner = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    try:
+        owner.send_signal(signal.SIGKILL)
+        os.waitid(os.P_PID, owner.pid, os.WEXITED | os.WNOWAIT)  # ended, not reaped
+
+        def exits(code):
+            raise SystemExit(code)
+
+        def sleeps(seconds):
+            raise AssertionError("still watching a campaign that ended")
+
+        monkeypatch.setattr(campaign.os, "_exit", exits)
+        monkeypatch.setattr(campaign.time, "sleep", sleeps)
+        with pytest.raises(SystemExit):
+            campaign._watch_parent(os.getppid(), owner.pid)
+    finally:
+        owner.wait()
