@@ -87,7 +87,7 @@ def test_the_speed_figures_mark_the_simplex_settings_given(tmp_path, monkeypatch
         return real(*args, **kwargs)
 
     monkeypatch.setattr(script, "plot_speed", spy)
-    argv = ["--out", str(tmp_path), "--runs", "1", "--track", "10:250,10:450", "--v-safe", "0.8"]
+    argv = ["--out", str(tmp_path), "--runs", "1", "--track", "3:250,3:450", "--v-safe", "0.8"]
     script.main(argv)
     assert len(seen) == 4  # two cases x (ours, the paper's method)
     assert all(kw.get("v_safe") == 0.8 and kw.get("gd_max") == 350.0 for kw in seen)

@@ -7,9 +7,9 @@ import warnings
 
 import numpy as np
 import pytest
+from _level_cases import level_case
 
 import gpmsa
-from tests.gpmsa._level_cases import level_case
 
 
 def test_a_draws_quantile_of_a_recorded_level_parameter_is_a_level():
