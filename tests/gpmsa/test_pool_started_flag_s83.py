@@ -6,13 +6,11 @@ Before: a worker that got past the main script and then ended with exit code 1 i
 library's ``exit(1)``, as OpenBLAS's on too many threads) was named "a worker process ended
 while starting ... call gpmsa inside an ``if __name__ == "__main__":`` block" and not retried
 (under fork the same death is retried); and a forkserver's worker whose owner was killed but
-not yet reaped by its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie."""
+not yet reaped by its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie.
+(The watchers' tests: tests/test_pool_watchers_s83.py.)"""
 
 import multiprocessing.context
 import os
-import signal
-import subprocess
-import sys
 
 import pytest
 
@@ -40,24 +38,3 @@ def test_a_started_worker_that_ends_in_a_chain_is_retried(monkeypatch, tmp_path)
     tasks = [{"x": i, "marker": marker} for i in range(2)]
     with pytest.warns(parallel.ChainRetryWarning, match="BrokenProcessPool"):
         assert parallel.run_chains(_ends_once, tasks, n_jobs=2) == [0, 1]
-
-
-@pytest.mark.skipif(not hasattr(os, "pidfd_open"), reason="a zombie reads as alive without pidfd")
-def test_the_watcher_ends_the_worker_of_an_owner_left_a_zombie(monkeypatch):
-    owner = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
-    try:
-        owner.send_signal(signal.SIGKILL)
-        os.waitid(os.P_PID, owner.pid, os.WEXITED | os.WNOWAIT)  # ended, not reaped
-
-        def exits(code):
-            raise SystemExit(code)
-
-        def sleeps(seconds):
-            raise AssertionError("still watching an owner that ended")
-
-        monkeypatch.setattr(parallel.os, "_exit", exits)
-        monkeypatch.setattr(parallel.time, "sleep", sleeps)
-        with pytest.raises(SystemExit):
-            parallel._watch_parent(os.getppid(), owner.pid)
-    finally:
-        owner.wait()

@@ -6,11 +6,11 @@ or one read from standard input, broke every pool: a ChainRetryWarning, a fresh 
 the same way, then "ChainError: chain 1 of 2 failed after 2 attempts: BrokenProcessPool: A process
 in the process pool was terminated abruptly" (650 lines of the workers' tracebacks). A worker
 that a forkserver started watched its parent, the forkserver, which outlives a killed owner while
-any worker holds its pipe: the workers outlived it."""
+any worker holds its pipe: the workers outlived it.
+(The watchers' tests: tests/test_pool_watchers_s83.py.)"""
 
 import multiprocessing.context
 import os
-import subprocess
 import sys
 import types
 import warnings
@@ -76,31 +76,3 @@ def test_a_forked_worker_that_dies_is_still_retried(monkeypatch):
     monkeypatch.setattr(parallel, "_own_pool", pool)
     with pytest.warns(parallel.ChainRetryWarning), pytest.raises(ChainError, match="attempts"):
         parallel.run_chains(_task, [{"x": 0}, {"x": 1}], n_jobs=2)
-
-
-def test_a_worker_of_another_parent_watches_its_owner(monkeypatch):
-    started = []
-
-    class _Thread:
-        def __init__(self, target, args, name, daemon):
-            started.append((target, args))
-
-        def start(self):
-            pass
-
-    monkeypatch.setattr(parallel.threading, "Thread", _Thread)
-    owner = os.getppid() + 1  # a forkserver's worker: its parent is not the pool's owner
-    parallel.end_with_parent(owner)  # no prctl on this process: its parent is not the owner
-    assert started == [(parallel._watch_parent, (os.getppid(), owner))]
-
-
-def test_the_watcher_ends_the_worker_once_the_owner_is_gone(monkeypatch):
-    gone = subprocess.Popen([sys.executable, "-c", "pass"])
-    gone.wait()
-
-    def exits(code):
-        raise SystemExit(code)
-
-    monkeypatch.setattr(parallel.os, "_exit", exits)
-    with pytest.raises(SystemExit):
-        parallel._watch_parent(os.getppid(), gone.pid)

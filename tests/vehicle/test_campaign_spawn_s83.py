@@ -5,11 +5,11 @@ script again.
 Before (session 83): a script that ran the campaign outside an ``if __name__ == "__main__":``
 block, or read from standard input, gave a bare "BrokenProcessPool: A process in the process pool
 was terminated abruptly" from inside concurrent.futures; and a forkserver's workers watched the
-forkserver, which outlives a killed campaign while any worker holds its pipe: they outlived it."""
+forkserver, which outlives a killed campaign while any worker holds its pipe: they outlived it.
+(The watchers' tests: tests/test_pool_watchers_s83.py.)"""
 
 import multiprocessing.context
 import os
-import subprocess
 import sys
 import types
 from concurrent.futures import ProcessPoolExecutor
@@ -48,31 +48,3 @@ def test_a_worker_that_ends_while_starting_names_the_main_guard(monkeypatch):
     message = str(info.value)
     assert "'forkserver'" in message and 'if __name__ == "__main__":' in message
     assert __file__ in message
-
-
-def test_a_worker_of_another_parent_watches_the_campaign(monkeypatch):
-    started = []
-
-    class _Thread:
-        def __init__(self, target, args, name, daemon):
-            started.append((target, args))
-
-        def start(self):
-            pass
-
-    monkeypatch.setattr(campaign.threading, "Thread", _Thread)
-    owner = os.getppid() + 1  # a forkserver's worker: its parent is not the campaign's process
-    campaign._end_with_parent(owner)  # no prctl on this process: its parent is not the owner
-    assert started == [(campaign._watch_parent, (os.getppid(), owner))]
-
-
-def test_the_watcher_ends_the_worker_once_the_campaign_is_gone(monkeypatch):
-    gone = subprocess.Popen([sys.executable, "-c", "pass"])
-    gone.wait()
-
-    def exits(code):
-        raise SystemExit(code)
-
-    monkeypatch.setattr(campaign.os, "_exit", exits)
-    with pytest.raises(SystemExit):
-        campaign._watch_parent(os.getppid(), gone.pid)

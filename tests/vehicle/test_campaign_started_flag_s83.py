@@ -6,13 +6,11 @@ Before: a worker that got past the main script and then ended with exit code 1 i
 library's ``exit(1)``) was named "a campaign worker process ended while starting ... call
 run_campaign inside an ``if __name__ == "__main__":`` block" (under fork: the
 BrokenProcessPool); and a forkserver's worker whose campaign was killed but not yet reaped by
-its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie."""
+its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie.
+(The watchers' tests: tests/test_pool_watchers_s83.py.)"""
 
 import multiprocessing.context
 import os
-import signal
-import subprocess
-import sys
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
@@ -48,24 +46,3 @@ def test_a_started_worker_that_ends_in_a_run_is_not_named_a_start_failure(monkey
     with pytest.raises(BrokenProcessPool):
         vehicle.run_campaign(np.array([[0.5, 200.0]]), road_length_m=4.0, window=100,
                              progress=False)  # fmt: skip
-
-
-@pytest.mark.skipif(not hasattr(os, "pidfd_open"), reason="a zombie reads as alive without pidfd")
-def test_the_watcher_ends_the_worker_of_a_campaign_left_a_zombie(monkeypatch):
-    owner = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
-    try:
-        owner.send_signal(signal.SIGKILL)
-        os.waitid(os.P_PID, owner.pid, os.WEXITED | os.WNOWAIT)  # ended, not reaped
-
-        def exits(code):
-            raise SystemExit(code)
-
-        def sleeps(seconds):
-            raise AssertionError("still watching a campaign that ended")
-
-        monkeypatch.setattr(campaign.os, "_exit", exits)
-        monkeypatch.setattr(campaign.time, "sleep", sleeps)
-        with pytest.raises(SystemExit):
-            campaign._watch_parent(os.getppid(), owner.pid)
-    finally:
-        owner.wait()
