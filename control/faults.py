@@ -61,7 +61,9 @@ class SensorFault:
 
 class FaultInjector:
     """The faults applied to a stream of sample batches, one batch after another (a stuck sensor
-    holds the value it read before the fault through every batch the fault spans).
+    holds the value it read before the fault through every batch the fault spans). The samples
+    do not depend on how the stream is split into batches (but where two noise faults overlap:
+    each batch draws their noise in turn).
 
     Args:
         faults: the `SensorFault`s.
@@ -88,7 +90,9 @@ class FaultInjector:
             check_instance(fault, f"faults[{k}]", SensorFault)
         check_instance(rng, "rng", np.random.Generator)
         self.rng = rng
-        self._last = np.nan  # the newest finite reading of the batches before
+        # per stuck fault, the newest finite reading of the batches before, with the faults
+        # listed before it applied (as it reads the samples before it in its own batch)
+        self._read: dict[int, float] = {}
         self._held: dict[int, float] = {}  # per stuck fault, the value it holds
         self._spiked: dict[int, int] = {}  # per spike fault, the samples it has covered so far
 
@@ -96,6 +100,14 @@ class FaultInjector:
         """``copy.copy``: a deep copy (a shallow one shared the generator and the held values,
         so that the copy's batches changed the original's next ones)."""
         return copy.deepcopy(self)
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickling: one pickled before session 83 kept one newest reading, with every fault
+        applied, for all its stuck faults."""
+        last = state.pop("_last", np.nan)
+        stuck = [i for i, f in enumerate(state["faults"]) if f.kind == "stuck"]
+        state.setdefault("_read", {i: last for i in stuck if np.isfinite(last)})
+        self.__dict__.update(state)
 
     def __call__(self, t, position, accel, speed):
         """(t, position, accel, speed) of the next batch with the faults applied (copies)."""
@@ -108,26 +120,28 @@ class FaultInjector:
             )
         keep = np.ones(t.size, dtype=bool)
         clock = t.copy()
-        spiked, held = dict(self._spiked), dict(self._held)  # kept once the batch is done
+        # kept once the batch is done
+        spiked, held, read = dict(self._spiked), dict(self._held), dict(self._read)
         drawn = self.rng.bit_generator.state if self.faults else None  # (~2 us)
         try:
-            self._apply(t, pos, acc, clock, keep, spiked, held)
+            self._apply(t, pos, acc, clock, keep, spiked, held, read)
             # (inside the try: an interrupt here, after the generator drew, undoes that too)
-            good = np.isfinite(acc) & keep
-            last = float(acc[good][-1]) if good.any() else self._last
             batch = t[keep], pos[keep], acc[keep], spd[keep]
         except BaseException:  # (a KeyboardInterrupt): the injector as before the batch
             if drawn is not None:
                 self.rng.bit_generator.state = drawn
             raise
-        self._spiked, self._held, self._last = spiked, held, last  # (no call between them)
+        self._spiked, self._held, self._read = spiked, held, read  # (no call between them)
         return batch
 
-    def _apply(self, t, pos, acc, clock, keep, spiked: dict, held: dict) -> None:
-        """Apply the faults to a batch's arrays in place; ``spiked`` and ``held``: copies of the
-        spike counts and stuck values, updated (`__call__` keeps them once all went well)."""
+    def _apply(self, t, pos, acc, clock, keep, spiked: dict, held: dict, read: dict) -> None:
+        """Apply the faults to a batch's arrays in place; ``spiked``, ``held`` and ``read``:
+        copies of the spike counts, stuck values and stuck faults' newest readings, updated
+        (`__call__` keeps them once all went well)."""
         for i, fault in enumerate(self.faults):
             hit = (clock >= fault.start_s) & (clock < fault.start_s + fault.duration_s)
+            if fault.kind == "stuck" and i not in held:
+                self._before(acc, hit, i, read)
             if not hit.any():
                 continue
             k, m = fault.kind, fault.magnitude
@@ -150,8 +164,8 @@ class FaultInjector:
                 with np.errstate(over="ignore"):  # a step far below a reading's resolution
                     steps = np.round(acc[hit] / m) * m
                 acc[hit] = np.where(np.isfinite(steps), steps, acc[hit])  # ... leaves it
-            elif k == "stuck":
-                acc[hit] = held.setdefault(i, self._before(acc, int(np.flatnonzero(hit)[0])))
+            elif k == "stuck":  # the reading before it (the first one if none came)
+                acc[hit] = held.setdefault(i, read.get(i, float(acc[np.argmax(hit)])))
             elif k == "clip":
                 acc[hit] = np.clip(acc[hit], -m, m)
             elif k == "time_nan":
@@ -159,14 +173,15 @@ class FaultInjector:
             elif k == "position_nan":
                 pos[hit] = np.nan
 
-    def _before(self, acc: np.ndarray, first: int) -> float:
-        """The last good (finite) reading before sample ``first`` of this batch, or of the
-        batches before; the first one if none came (a stuck fault after a NaN fault holds the
-        value before the NaNs)."""
-        finite = np.flatnonzero(np.isfinite(acc[:first]))
+    @staticmethod
+    def _before(acc: np.ndarray, hit: np.ndarray, i: int, read: dict) -> None:
+        """Keep in ``read[i]`` the newest finite reading of ``acc`` before the first sample of
+        ``hit`` (all of them where none is hit), the value stuck fault ``i`` holds once it
+        begins: ``acc`` as the faults listed before it left it, in this batch or the ones
+        before (a stuck fault after a NaN fault holds the value before the NaNs)."""
+        finite = np.flatnonzero(np.isfinite(acc[: np.argmax(hit) if hit.any() else None]))
         if finite.size:
-            return float(acc[finite[-1]])
-        return self._last if np.isfinite(self._last) else float(acc[0])
+            read[i] = float(acc[finite[-1]])
 
 
 def _batch(name: str, value) -> np.ndarray:

@@ -99,8 +99,9 @@ def test_a_second_interrupt_inside_the_roll_back_leaves_the_bcr_as_it_was(monkey
 
 
 class _Numpy:
-    """numpy, whose ``isfinite`` raises `_Stop` at its first call (the interrupt landing just
-    after the batch's faults were applied)."""
+    """numpy, whose ``clip`` raises `_Stop` at its first call (the interrupt landing in the
+    batch's last fault, after the noise was drawn; session 83: the injector no longer calls
+    numpy once the faults are applied)."""
 
     def __init__(self):
         self.calls = 0
@@ -108,18 +109,19 @@ class _Numpy:
     def __getattr__(self, name):
         return getattr(np, name)
 
-    def isfinite(self, a):
+    def clip(self, *args):
         self.calls += 1
         if self.calls == 1:
             raise _Stop
-        return np.isfinite(a)
+        return np.clip(*args)
 
 
 def test_an_interrupt_after_the_faults_were_applied_leaves_the_injector_as_it_was(monkeypatch):
     """Before: the noise had been drawn (the generator moved on) but the spike counts not kept,
     so that the batch fed again drew other noise than the twin's."""
     kinds = [control.SensorFault(0.0, 10.0, "spike", 7.0),
-             control.SensorFault(0.0, 10.0, "noise", 0.5)]  # fmt: skip
+             control.SensorFault(0.0, 10.0, "noise", 0.5),
+             control.SensorFault(0.0, 10.0, "clip", 100.0)]  # fmt: skip
     t = np.arange(1, 241) / 120.0
     batches = [(t[k : k + 40], 0.5 * t[k : k + 40], np.sin(t[k : k + 40]), np.full(40, 0.5))
                for k in range(0, 240, 40)]  # fmt: skip
