@@ -100,12 +100,16 @@ def _check_out_apart(out: Path, bag: Path, default: bool) -> None:
         )
 
 
-def _report(bag: Path, source: str, settings: ReplaySettings, result: ReplayResult) -> dict:
-    """The content of ``replay.json``."""
+def _report(
+    bag: Path, source: str, settings: ReplaySettings, simplex: Simplex, result: ReplayResult
+) -> dict:
+    """The content of ``replay.json`` (``simplex``: the settings whose commands the outputs
+    hold)."""
     return {
         "bag": str(bag),
         "emulator": source,
         "settings": asdict(settings),
+        "simplex": asdict(simplex),
         "imu": asdict(result.imu),
         "odometry": asdict(result.odometry),
         "restamping": asdict(result.restamping),
@@ -330,7 +334,7 @@ def main(argv: list[str] | None = None) -> int:
         result = replay_bag(bag, emulator, settings, simplex=simplex, progress=progress,
                             check_vehicle=not args.ignore_vehicle)  # fmt: skip
         source = f"shipped emulator {args.emulator}" if args.emulator in SHIPPED else args.emulator
-        _write(out, result, _report(bag, source, settings, result))
+        _write(out, result, _report(bag, source, settings, simplex, result))
     except MissingExtraError as exc:
         print(f"terrain-replay: {_one_line(exc)}", file=sys.stderr)
         return 2

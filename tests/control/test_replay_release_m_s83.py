@@ -5,6 +5,9 @@ naming the option), given to the replay's Simplex.
 Before: the command had no such option (``unrecognized arguments: --release-m``), so a replay
 could not show the commands of a Simplex with the dwell that the closed loop runs."""
 
+import dataclasses
+import json
+
 import numpy as np
 import pytest
 
@@ -49,3 +52,6 @@ def test_the_replay_runs_the_simplex_with_the_release_dwell(tmp_path, monkeypatc
     argv = [str(bag), "--emulator", "A", "--out", str(tmp_path / "o"), "--release-m", "7.5"]
     assert cli.main(argv) == 0
     assert ran == [control.Simplex(release_m=7.5)]
+    # replay.json says which Simplex made the commands (before: no Simplex setting at all)
+    report = json.loads((tmp_path / "o" / "replay.json").read_text())
+    assert report["simplex"] == dataclasses.asdict(control.Simplex(release_m=7.5))
