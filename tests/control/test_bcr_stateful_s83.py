@@ -9,27 +9,24 @@ estimate); every estimate's fields are consistent."""
 
 from __future__ import annotations
 
-import copy
 import functools
 import math
-import pickle
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import (
     RuleBasedStateMachine,
     initialize,
     invariant,
     rule,
-    run_state_machine_as_test,
 )
 
 import control
 import gpmsa
 import roadgen
 from control.estimate import graver_fault
+from tests._stateful import COPIES, run_machine
 
 METHODS = ("changepoint", "window", "filter")
 
@@ -106,11 +103,6 @@ BAD_KINDS = ("nan_accel", "nan_t", "nan_pos", "nan_speed", "gap", "repeat", "bac
              "saturate", "spike", "dead", "fast")  # fmt: skip
 REFUSED_KINDS = ("2d", "length", "string", "none", "ragged", "now_nan", "resume_neg",
                  "resume_str", "bool_now")  # fmt: skip
-COPIES = {
-    "copy": copy.copy,
-    "deepcopy": copy.deepcopy,
-    "pickle": lambda b: pickle.loads(pickle.dumps(b)),
-}
 
 
 class BCRMachine(RuleBasedStateMachine):
@@ -290,16 +282,7 @@ class BCRMachine(RuleBasedStateMachine):
 
 
 def run(max_examples: int, steps: int = 30, derandomize: bool = True) -> None:
-    run_state_machine_as_test(
-        BCRMachine,
-        settings=settings(
-            max_examples=max_examples,
-            stateful_step_count=steps,
-            deadline=None,
-            derandomize=derandomize,
-            suppress_health_check=list(HealthCheck),
-        ),
-    )
+    run_machine(BCRMachine, max_examples, steps, derandomize)
 
 
 def test_bcr_random_interleavings():

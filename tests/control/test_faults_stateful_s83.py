@@ -7,30 +7,22 @@ same samples (the faults follow the sample time, not the batches)."""
 
 from __future__ import annotations
 
-import copy
 import functools
 import itertools
-import pickle
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import (
     RuleBasedStateMachine,
     initialize,
     rule,
-    run_state_machine_as_test,
 )
 
 import control
 import roadgen
+from tests._stateful import COPIES, run_machine
 
-COPIES = {
-    "copy": copy.copy,
-    "deepcopy": copy.deepcopy,
-    "pickle": lambda f: pickle.loads(pickle.dumps(f)),
-}
 MAGNITUDE = {"spike": (1.0, 50.0), "noise": (0.01, 3.0), "scale": (0.1, 3.0),
              "quantize": (0.01, 1.0), "clip": (0.1, 5.0)}  # fmt: skip
 
@@ -129,16 +121,7 @@ class InjectorMachine(RuleBasedStateMachine):
 
 
 def run(max_examples: int, steps: int = 30, derandomize: bool = True) -> None:
-    run_state_machine_as_test(
-        InjectorMachine,
-        settings=settings(
-            max_examples=max_examples,
-            stateful_step_count=steps,
-            deadline=None,
-            derandomize=derandomize,
-            suppress_health_check=list(HealthCheck),
-        ),
-    )
+    run_machine(InjectorMachine, max_examples, steps, derandomize)
 
 
 def test_fault_injector_random_interleavings():

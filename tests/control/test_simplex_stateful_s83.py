@@ -8,15 +8,12 @@ gives the same command, and so does a copy."""
 
 from __future__ import annotations
 
-import copy
 import functools
 import math
-import pickle
 from dataclasses import replace
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import (
     RuleBasedStateMachine,
@@ -24,18 +21,13 @@ from hypothesis.stateful import (
     invariant,
     precondition,
     rule,
-    run_state_machine_as_test,
 )
 
 import control
 import roadgen
+from tests._stateful import COPIES, run_machine
 
 NOT_OK = tuple(s for s in control.STATUSES if s != "ok")
-COPIES = {
-    "copy": copy.copy,
-    "deepcopy": copy.deepcopy,
-    "pickle": lambda r: pickle.loads(pickle.dumps(r)),
-}
 
 
 @functools.cache
@@ -203,16 +195,7 @@ class SimplexMachine(RuleBasedStateMachine):
 
 
 def run(max_examples: int, steps: int = 40, derandomize: bool = True) -> None:
-    run_state_machine_as_test(
-        SimplexMachine,
-        settings=settings(
-            max_examples=max_examples,
-            stateful_step_count=steps,
-            deadline=None,
-            derandomize=derandomize,
-            suppress_health_check=list(HealthCheck),
-        ),
-    )
+    run_machine(SimplexMachine, max_examples, steps, derandomize)
 
 
 def test_simplex_run_random_interleavings():

@@ -8,28 +8,21 @@ counted); a twin fed only the accepted updates, and a copy, give the same draws 
 from __future__ import annotations
 
 import copy
-import pickle
 
 import numpy as np
 import pytest
 from _calib_cases import road_emulator
-from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import (
     RuleBasedStateMachine,
     initialize,
     invariant,
     rule,
-    run_state_machine_as_test,
 )
 
 import gpmsa
+from tests._stateful import COPIES, run_machine
 
-COPIES = {
-    "copy": copy.copy,
-    "deepcopy": copy.deepcopy,
-    "pickle": lambda c: pickle.loads(pickle.dumps(c)),
-}
 SPEEDS = (0.6, 1.0, 1.25, 1.9)
 FEATURES = (9.0, 12.1, 15.0, 20.0)
 
@@ -118,16 +111,7 @@ class CalibratorMachine(RuleBasedStateMachine):
 
 
 def run(max_examples: int, steps: int = 20, derandomize: bool = True) -> None:
-    run_state_machine_as_test(
-        CalibratorMachine,
-        settings=settings(
-            max_examples=max_examples,
-            stateful_step_count=steps,
-            deadline=None,
-            derandomize=derandomize,
-            suppress_health_check=list(HealthCheck),
-        ),
-    )
+    run_machine(CalibratorMachine, max_examples, steps, derandomize)
 
 
 @pytest.mark.filterwarnings("ignore::gpmsa.OutsideEmulatorWarning")  # (far windows: wanted)
