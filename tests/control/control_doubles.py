@@ -139,3 +139,18 @@ def plotted_run_and_track():
         sample_speed=np.full(50, 1.5),
     )
     return run, track
+
+
+def bcr_of(kind: str):
+    """A BCR on the doubles: "changepoint" (on `FakeBlockModel`), "static span" (the same with
+    the static-level check's ring of 300 samples at standard gravity), or a window method's name
+    (on `FakeCalibrator`, the paper's window)."""
+    import control
+    from control.feature import STANDARD_GRAVITY
+
+    if kind == "changepoint":
+        return control.BCR(FakeBlockModel())
+    if kind == "static span":  # the static-level check's ring too
+        limits = control.SensorLimits(static_mps2=STANDARD_GRAVITY, static_span=300)
+        return control.BCR(FakeBlockModel(), sensor=limits)
+    return control.BCR(FakeCalibrator(), method=kind, feature=control.PAPER_WINDOW)

@@ -5,7 +5,7 @@ writer refuses a bad message before rosbags takes it in (the bag then stays clos
 
 import numpy as np
 import pytest
-from control_doubles import FakeBlockModel, FakeCalibrator, stream
+from control_doubles import bcr_of, stream
 
 import control
 from control.feature import STANDARD_GRAVITY
@@ -39,15 +39,6 @@ def _numbers(e: control.Estimate) -> tuple:
             e.position, e.data_time)  # fmt: skip
 
 
-def _bcr(kind: str) -> control.BCR:
-    if kind == "changepoint":
-        return control.BCR(FakeBlockModel())
-    if kind == "static span":  # the static-level check's ring too
-        limits = control.SensorLimits(static_mps2=STANDARD_GRAVITY, static_span=300)
-        return control.BCR(FakeBlockModel(), sensor=limits)
-    return control.BCR(FakeCalibrator(), method=kind, feature=control.PAPER_WINDOW)
-
-
 def _chunks(kind: str):
     t, p, a, v = PARTS
     a = a + STANDARD_GRAVITY if kind == "static span" else a
@@ -72,7 +63,7 @@ def test_an_update_that_raises_part_way_leaves_the_bcr_as_it_was(monkeypatch, ki
     same chunk fed again read as repeated stamps ("sensor_fault") and the estimates after it
     differed from the twin's (changepoint: GD 293.39 -> a fault at the window's first estimate;
     filter: its tracker predicted twice)."""
-    bcr, twin = _bcr(kind), _bcr(kind)
+    bcr, twin = bcr_of(kind), bcr_of(kind)
     chunks = _chunks(kind)
     for part in chunks[:at]:
         assert _numbers(bcr.update(*part)) == _numbers(twin.update(*part))
@@ -97,7 +88,7 @@ def test_an_update_that_raises_part_way_leaves_the_bcr_as_it_was(monkeypatch, ki
 
 
 def test_an_interrupted_resume_leaves_the_bcr_as_it_was(monkeypatch):
-    bcr, twin = _bcr("changepoint"), _bcr("changepoint")
+    bcr, twin = bcr_of("changepoint"), bcr_of("changepoint")
     chunks = _chunks("changepoint")
     for part in chunks[:12]:
         bcr.update(*part), twin.update(*part)
@@ -122,7 +113,7 @@ REFUSED = {
 @pytest.mark.parametrize("bad", REFUSED)
 @pytest.mark.parametrize("kind", ["changepoint", "window"])
 def test_a_refused_update_changes_nothing(kind, bad):
-    bcr, twin = _bcr(kind), _bcr(kind)
+    bcr, twin = bcr_of(kind), bcr_of(kind)
     chunks = _chunks(kind)
     for part in chunks[:21]:
         bcr.update(*part), twin.update(*part)

@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 import pytest
-from control_doubles import FakeBlockModel, FakeCalibrator, stream
+from control_doubles import bcr_of, stream
 
 import control
 from control.feature import STANDARD_GRAVITY
@@ -29,15 +29,6 @@ def _numbers(e: control.Estimate) -> str:
     """The estimate's fields, exactly (a repr: NaN reads as itself)."""
     return repr((e.status, e.reason, e.gd_mean, e.gd_sd, e.interval, e.prob_change, e.time,
                  e.position, e.data_time))  # fmt: skip
-
-
-def _bcr(kind: str) -> control.BCR:
-    if kind == "changepoint":
-        return control.BCR(FakeBlockModel())
-    if kind == "static span":  # the static-level check's ring too
-        limits = control.SensorLimits(static_mps2=STANDARD_GRAVITY, static_span=300)
-        return control.BCR(FakeBlockModel(), sensor=limits)
-    return control.BCR(FakeCalibrator(), method=kind, feature=control.PAPER_WINDOW)
 
 
 def _chunks(kind: str) -> list:
@@ -82,7 +73,7 @@ def test_an_interrupted_reset_leaves_the_bcr_as_it_was(kind, at):
     """Each place inside reset (and what it calls) is tried, the twin a copy of the BCR (each
     estimate of its next 3 updates, over its 3 phases or trackers, compared)."""
     chunks = _chunks(kind)
-    bcr = _bcr(kind)
+    bcr = bcr_of(kind)
     for part in chunks[:at]:
         bcr.update(*part)
     twin = copy.copy(bcr)
@@ -106,7 +97,7 @@ def test_an_interrupted_reset_leaves_the_bcr_as_it_was(kind, at):
 def test_a_model_error_inside_reset_leaves_the_bcr_as_it_was(monkeypatch):
     """An error raised by what reset calls (the last phase's filter) rolls it back too."""
     chunks = _chunks("changepoint")
-    bcr, twin = _bcr("changepoint"), _bcr("changepoint")
+    bcr, twin = bcr_of("changepoint"), bcr_of("changepoint")
     for part in chunks[:12]:
         bcr.update(*part), twin.update(*part)
 
