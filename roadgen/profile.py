@@ -148,8 +148,11 @@ def unit_road(
     amplitudes: str,
     waviness: float,
     lead_in_m: float,
+    *,
+    length_name: str = "length_m",
 ) -> tuple[np.ndarray, ProfileSettings]:
-    """Heights (n_points,) m of a GD = 1 profile on the grid, and the resolved settings."""
+    """Heights (n_points,) m of a GD = 1 profile on the grid, and the resolved settings;
+    ``length_name``: the caller's name for the road's length in a band-too-long error."""
     checks.choice("amplitudes", amplitudes, AMPLITUDE_MODES)
     w = check_waviness("waviness", waviness)
     period = n_points * dx_m
@@ -160,7 +163,7 @@ def unit_road(
     else:
         lo, hi = checks.band("band", band, nyquist)
         if lo < dn * (1.0 - 1e-9):
-            raise _short_for_band(band, lo, n_points, dx_m)
+            raise _short_for_band(band, lo, n_points, dx_m, length_name)
     k = np.arange(n_points // 2 + 1)
     n = k * dn
     edge_lo, edge_hi = band_edges((lo, hi), n_points)
@@ -228,11 +231,12 @@ def lead_in_taper(x: np.ndarray, lead_in_m: float) -> np.ndarray:
 
 
 def _short_for_band(
-    band: tuple[float, float], lo: float, n_points: int, dx_m: float
+    band: tuple[float, float], lo: float, n_points: int, dx_m: float, length_name: str
 ) -> RoadgenError:
     """The error for a grid of ``n_points`` whose fundamental lies above the band's n_min
-    ``lo``: the least length_m (whole steps, as `grid_points` rounds it) and n_min that pass,
-    their text rounded towards passing (`bound_text`), each read apart from the value given."""
+    ``lo``: the least length (``length_name``; whole steps, as `grid_points` rounds it) and
+    n_min that pass, their text rounded towards passing (`bound_text`), each read apart from the
+    value given."""
     need = max(n_points + 1, math.ceil((1.0 - 1e-9) / (lo * dx_m)))
     while lo < 1.0 / (need * dx_m) * (1.0 - 1e-9):  # iso8608_profile's test, in float64
         need += 1
@@ -245,8 +249,8 @@ def _short_for_band(
     if n_min == n_low:
         n_min, n_low = repr(lo), repr(1.0 / (n_points * dx_m))
     return RoadgenError(
-        f"length_m={length} is too short for band={band!r}: the band's n_min={n_min} "
-        f"cycles/m needs length_m >= {least} m (or use n_min >= {n_low} cycles/m)"
+        f"{length_name}={length} is too short for band={band!r}: the band's n_min={n_min} "
+        f"cycles/m needs {length_name} >= {least} m (or use n_min >= {n_low} cycles/m)"
     )
 
 

@@ -604,8 +604,11 @@ def run_campaign(
         _check_path(cache_dir, "cache_dir", "folder")
         if not os.fsdecode(cache_dir):  # Path("") is the working directory: never by accident
             raise VehicleError("cache_dir='' must be a folder path, got the empty string")
-    roadgen.profile.grid_points(road_length_m, dx_m)  # one road fits in memory
-    if band is not None:  # and holds the band: roadgen's check, on the shortest road
+    n_points = roadgen.profile.grid_points(road_length_m, dx_m)  # one road fits in memory
+    if band is not None:  # and holds the band: roadgen's checks, on the shortest road
+        roadgen.profile.unit_road(
+            n_points, dx_m, 0, band, "deterministic", 2.0, 0.0, length_name="road_length_m"
+        )
         roadgen.iso8608_profile(road_length_m, 1.0, dx_m, seed=0, band=band, lead_in_m=lead_in_m)
     keep = int(round(keep_s * rate_hz))
     if keep_s > 0 and keep == 0:
@@ -669,17 +672,17 @@ def run_campaign(
     bar = _progress_bar(progress, len(specs), len(specs) - len(todo), f"campaign {model.name}")
     futures: dict[Future, int] = {}
     try:
-        for i in todo:
-            futures[pool.submit(run_one, specs[i], None if cache is None else str(cache))] = i
-        for fut in as_completed(futures):
-            try:
+        try:  # (a pool broken while runs are still submitted refuses the next submit)
+            for i in todo:
+                futures[pool.submit(run_one, specs[i], None if cache is None else str(cache))] = i
+            for fut in as_completed(futures):
                 results[futures[fut]] = fut.result()
-            except BrokenExecutor as exc:
-                why = _start_failure(pool, started) if own else None
-                if why is None:
-                    raise
-                raise VehicleError(why) from exc
-            bar.update()
+                bar.update()
+        except BrokenExecutor as exc:
+            why = _start_failure(pool, started) if own else None
+            if why is None:
+                raise
+            raise VehicleError(why) from exc
     finally:  # after an error or Ctrl-C, the runs not yet started are cancelled, not waited for
         bar.close()
         for fut in futures:

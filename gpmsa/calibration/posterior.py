@@ -42,6 +42,16 @@ def trapezoid_weights(nodes: np.ndarray) -> np.ndarray:
     return w
 
 
+def _set_read_only_state(marginal: object, state: dict) -> None:
+    """A marginal's unpickled ``state``, its arrays as read-only views (a ``copy.copy``'s state
+    holds the original's arrays: a view leaves them as they are)."""
+    for name, value in state.items():
+        if isinstance(value, np.ndarray):
+            value = value.view()
+            value.flags.writeable = False
+        object.__setattr__(marginal, name, value)
+
+
 @dataclass(frozen=True, eq=False)
 class GridMarginal:
     """A 1-D posterior density known at the nodes of a sorted grid (native units).
@@ -59,6 +69,11 @@ class GridMarginal:
     nodes: np.ndarray
     density: np.ndarray
     weights: np.ndarray
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickling (and ``copy.deepcopy``): the arrays read-only again, as made (numpy
+        restores an array writable)."""
+        _set_read_only_state(self, state)
 
     @classmethod
     def from_log_density(
@@ -181,6 +196,11 @@ class LevelMarginal:
     nodes: np.ndarray
     density: np.ndarray
     weights: np.ndarray
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickling (and ``copy.deepcopy``): the arrays read-only again, as made (numpy
+        restores an array writable)."""
+        _set_read_only_state(self, state)
 
     @classmethod
     def from_probabilities(cls, levels, probabilities) -> LevelMarginal:

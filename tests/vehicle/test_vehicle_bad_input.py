@@ -244,7 +244,11 @@ def test_design_sizes_and_ranges_take_numpy_numbers():
         ({"band": ("1", "2")}, vehicle.VehicleError, r"^band\[0\]='1' must be a real number"),
         ({"band": (0.0, 2.0)}, vehicle.VehicleError, r"^band=\(0.0, 2.0\) is out of range"),
         ({"band": 5}, vehicle.VehicleError, r"^band=5 must be a pair"),
-        ({"band": (0.01, 1.0)}, roadgen.RoadgenError, r"^length_m=21 is too short for band"),
+        (  # the caller's name for the length (it named roadgen's length_m before session 84)
+            {"band": (0.01, 1.0)},
+            roadgen.RoadgenError,
+            r"^road_length_m=21 is too short for band=.* needs road_length_m >= 99.996 m",
+        ),
         ({"rate_hz": "120"}, vehicle.VehicleError, r"^rate_hz='120' must be a real number"),
         ({"rate_hz": np.inf}, vehicle.VehicleError, r"^rate_hz=inf must be finite"),
         ({"noise_std": "1"}, vehicle.VehicleError, r"^noise_std='1' must be a real number"),
