@@ -104,6 +104,11 @@ CSV_COLUMNS = (
 )  # fmt: skip
 CSV_HEADER = ",".join(CSV_COLUMNS).encode()
 """The first line of a CSV of estimates (`ReplayResult.to_csv`), without its line end."""
+OLDER_CSV_HEADERS = (
+    CSV_HEADER.replace(b"domain_edge,", b""),  # before the domain_edge column (07aa72a)
+)
+"""The first lines of the CSVs of estimates that earlier versions wrote (`check_csv_target`
+replaces those too)."""
 
 
 MIN_HIGHPASS_HZ = 1e-4
@@ -667,9 +672,10 @@ def _overlaps(target: Path, source: Path) -> bool:
 def check_csv_target(path: Path, name: str) -> None:
     """`ControlError` naming the argument ``name`` unless ``path`` is free for a CSV of
     estimates: missing, an empty file or a CSV of estimates (its first line `CSV_HEADER`, as
-    `ReplayResult.to_csv` writes it), which is replaced. A folder, a link to nowhere, a FIFO
-    or device, and any other file (an emulator, a recording, someone's data) are refused, as is
-    a path the OS cannot look up (`check_lookup`: a name too long, say)."""
+    `ReplayResult.to_csv` writes it, or one of `OLDER_CSV_HEADERS`), which is replaced. A
+    folder, a link to nowhere, a FIFO or device, and any other file (an emulator, a recording,
+    someone's data) are refused, as is a path the OS cannot look up (`check_lookup`: a name too
+    long, say)."""
     check_lookup(path, name)
     if path.is_dir():
         raise ControlError(f"{name}={str(path)!r} is a folder; give the CSV file's path")
@@ -682,7 +688,7 @@ def check_csv_target(path: Path, name: str) -> None:
             head = f.read(len(CSV_HEADER) + 2)
     except OSError as exc:
         raise ControlError(f"{name}={str(path)!r}: cannot read it ({exc.strerror})") from exc
-    if head and head.split(b"\n", 1)[0].rstrip(b"\r") != CSV_HEADER:
+    if head and head.split(b"\n", 1)[0].rstrip(b"\r") not in (CSV_HEADER, *OLDER_CSV_HEADERS):
         raise ControlError(
             f"{name}={str(path)!r} exists and is not a CSV of estimates (its first line is not "
             f"the columns' header {CSV_HEADER.decode()[:30]}...); refusing to replace it: "

@@ -511,11 +511,11 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
     """What of the model ``emulator`` was fitted with differs from ``problem``'s: its priors,
     mean basis, fixed parameters, theta constraint and discrepancy basis and groups. A
     discrepancy basis whose columns are the source's up to their signs and order (each with
-    its group: ``reordered_basis``) is the same; where it or K (``order``, from
-    ``component_order``) is reordered, the data-corrected priors agree to 1e-12 (the
-    correction's sums run in another order), and a per-component parameter held (fixed) with
-    K in another order is another model. Returns (the names of what differs, `_prior_fields`'
-    detail where the priors do, else "")."""
+    its group: ``reordered_basis``) is the same; priors that agree to 1e-12 are the same (the
+    data correction's sums run in another order where K or that basis is reordered, or in a
+    file of an older version), and a per-component parameter held (fixed) with K in another
+    order (``order``, from ``component_order``) is another model. Returns (the names of what
+    differs, `_prior_fields`' detail where the priors do, else "")."""
     settings = emulator.settings or {}
     mb = problem.mean_basis
     disc = {} if problem.obs is None or problem.obs.D is None else discrepancy_record(problem.obs)
@@ -527,7 +527,7 @@ def _model_differences(emulator: Emulator, problem: Problem, order: list[int] | 
     fixed = (settings.get("fixed", {}), fixed_record(problem))
     priors = tuple(_prior_record(p, n_grp, problem.q) for p in (emulator.priors, problem.priors))
     differs = {
-        "priors": priors[0] != priors[1] and not ((k_moved or d_moved) and _close(*priors)),
+        "priors": not _close(*priors),
         "mean_basis": settings.get("mean_basis") != (None if mb is None else mb.kind),
         "fixed parameters": fixed[0] != fixed[1]
         or (k_moved and any(k in f for f in fixed for k in PER_COMPONENT)),

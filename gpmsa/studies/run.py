@@ -624,7 +624,9 @@ def calibrate_study(
             init, "calibration", layout, hyper, int(n_chains),
             emulators=([e.model_sha256 for e in init.members],
                        [e.model_sha256 for e in emulators]),
-            observations=([old.get(OBS_DIGESTS), old.get(OBS_LAYOUTS)],
+            # a file from before these records (6947c74) says nothing of its observations:
+            # not compared, as fit(init=emulator) takes a file without obs_sha256
+            observations=([old.get(k, record[k]) for k in (OBS_DIGESTS, OBS_LAYOUTS)],
                           [record[OBS_DIGESTS], record[OBS_LAYOUTS]]),
             **{"fixed values": ([old.get(k) for k in ("fixed", HELD_THETA)],
                                 [record.get(k) for k in ("fixed", HELD_THETA)]),
