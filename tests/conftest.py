@@ -1,5 +1,6 @@
 """Shared pytest configuration."""
 
+import sys
 from pathlib import Path
 
 import pytest
@@ -42,6 +43,18 @@ def _working_folder_restored():
 
         os.chdir(before)
         pytest.fail(f"the test changed the working folder to {after} (use monkeypatch.chdir)")
+
+
+@pytest.fixture(autouse=True)
+def _trace_function_restored():
+    """Fail a test that leaves another trace function (restore ``sys.gettrace()``'s, never
+    None): coverage and debuggers trace through it, and a run under coverage lost every later
+    test's lines to two tests that set None (session 84)."""
+    before = sys.gettrace()
+    yield
+    if sys.gettrace() is not before:
+        sys.settrace(before)
+        pytest.fail("the test left another trace function (restore sys.gettrace()'s after)")
 
 
 @pytest.fixture

@@ -57,13 +57,14 @@ def _interrupt_at(nth: int):
 def _interrupted_reset(bcr: control.BCR, nth: int) -> bool:
     """``bcr.reset()`` interrupted at its ``nth`` event; whether it was (False: it completed)."""
     tracer, fired = _interrupt_at(nth)
+    previous = sys.gettrace()  # a coverage or debugger tracer, restored after
     sys.settrace(tracer)
     try:
         bcr.reset()
     except _Stop:
         pass
     finally:
-        sys.settrace(None)
+        sys.settrace(previous)
     return bool(fired)
 
 

@@ -68,6 +68,7 @@ def test_a_second_interrupt_inside_the_roll_back_leaves_the_bcr_as_it_was(monkey
         with monkeypatch.context() as patch:
             if call == "update":  # an error of the model's, then Ctrl-C inside the roll-back
                 patch.setattr(bcr.model, "loglik", _model_error)
+                previous = sys.gettrace()  # a coverage or debugger tracer, restored after
                 sys.settrace(tracer)
                 try:
                     with pytest.raises((_Stop, control.ControlError)) as raised:
@@ -75,15 +76,16 @@ def test_a_second_interrupt_inside_the_roll_back_leaves_the_bcr_as_it_was(monkey
                             bcr.update(*CHUNKS[at])
                             twin.update(*CHUNKS[at])
                 finally:
-                    sys.settrace(None)
+                    sys.settrace(previous)
             else:
                 patch.setattr(bcr._phases[2].filter, "relocate", _model_error)
+                previous = sys.gettrace()
                 sys.settrace(tracer)
                 try:
                     with pytest.raises((_Stop, control.ControlError)) as raised:
                         bcr.resume(3.0)
                 finally:
-                    sys.settrace(None)
+                    sys.settrace(previous)
                 at = 9
         if call == "resume":
             bcr.resume(3.0), twin.resume(3.0)
