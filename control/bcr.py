@@ -281,7 +281,9 @@ class BCRSettings:
         if not 0 <= self.release_p < 1:
             raise ControlError(f"release_p must lie in [0, 1), got {self.release_p}")
         if not (np.isfinite(self.recent_change_m) and self.recent_change_m >= 0):
-            raise ControlError(f"recent_change_m must be >= 0, got {self.recent_change_m}")
+            raise ControlError(
+                f"recent_change_m must be >= 0 and finite, m, got {self.recent_change_m}"
+            )
         if not isinstance(self.quiet_scan, bool | np.bool_):
             raise ControlError(f"quiet_scan must be True or False, got {self.quiet_scan!r:.60}")
         object.__setattr__(self, "quiet_scan", bool(self.quiet_scan))

@@ -48,9 +48,9 @@ class SensorFault:
     def __post_init__(self) -> None:
         require_reals(self, ("start_s", "duration_s", "magnitude"))
         if not (np.isfinite(self.start_s) and self.start_s >= 0):
-            raise ControlError(f"start_s must be >= 0, got {self.start_s}")
+            raise ControlError(f"start_s must be >= 0 and finite, got {self.start_s}")
         if not (np.isfinite(self.duration_s) and self.duration_s > 0):
-            raise ControlError(f"duration_s must be > 0, got {self.duration_s}")
+            raise ControlError(f"duration_s must be > 0 and finite, got {self.duration_s}")
         if not is_choice(self.kind, FAULT_KINDS):
             raise ControlError(f"kind must be one of {FAULT_KINDS}, got {self.kind!r}")
         if not (np.isfinite(self.magnitude) and self.magnitude > 0):

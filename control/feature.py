@@ -96,7 +96,7 @@ class FeatureSpec:
                 f"block_samples must lie in [16, {MAX_BLOCK_SAMPLES}], got {self.block_samples}"
             )
         if not (np.isfinite(self.rate_hz) and self.rate_hz > 0):
-            raise ControlError(f"rate_hz must be > 0, got {self.rate_hz}")
+            raise ControlError(f"rate_hz must be > 0 and finite, got {self.rate_hz}")
         edges = float_array(self.bands_hz, "bands_hz")
         if edges.ndim != 1 or not np.all(np.isfinite(edges)):
             raise ControlError(

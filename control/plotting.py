@@ -267,7 +267,9 @@ def _cell_values(cells: Sequence[tuple[float, float, np.ndarray]]) -> np.ndarray
         try:
             arr = np.asarray(draws, dtype=float).ravel()
         except (TypeError, ValueError):
-            arr = np.full(1, np.nan)  # refused below
+            raise ControlError(
+                f"cells[{i}]: the draws must be an array of GD values (numbers), got {draws!r:.60}"
+            ) from None
         true_gd = float(gd) if is_real(gd) else float("nan")
         if arr.size == 0 or not np.all(np.isfinite(arr)) or not np.isfinite(true_gd):
             raise ControlError(

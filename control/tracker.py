@@ -89,7 +89,7 @@ class GDTracker:
             raise ControlError(f"domain must be a pair (lo, hi) of real numbers, got {domain!r}")
         lo, hi = (float(d) for d in pair)
         if not (np.isfinite(lo) and np.isfinite(hi) and 0 < lo < hi):
-            raise ControlError(f"domain must satisfy 0 < lo < hi, got {domain}")
+            raise ControlError(f"domain must satisfy 0 < lo < hi, both finite, got {domain}")
         self.settings = TrackerSettings() if settings is None else settings
         check_instance(self.settings, "settings", TrackerSettings)
         self.log_grid = np.linspace(np.log(lo), np.log(hi), self.settings.n_grid)

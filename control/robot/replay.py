@@ -224,12 +224,14 @@ class ReplaySettings:
             raise ControlError(f"rate_tolerance must lie in [0, 0.5), got {self.rate_tolerance}")
         if not (np.isfinite(self.reorder_periods) and self.reorder_periods >= 0):
             raise ControlError(
-                f"reorder_periods must be >= 0 (periods), got {self.reorder_periods}"
+                f"reorder_periods must be >= 0 and finite (periods), got {self.reorder_periods}"
             )
         if not self.max_clock_skew_s > 0:  # NaN too; inf: no check
             raise ControlError(f"max_clock_skew_s must be > 0 (s), got {self.max_clock_skew_s}")
         if not (np.isfinite(self.max_odometry_gap_s) and self.max_odometry_gap_s > 0):
-            raise ControlError(f"max_odometry_gap_s must be > 0, got {self.max_odometry_gap_s}")
+            raise ControlError(
+                f"max_odometry_gap_s must be > 0 and finite, s, got {self.max_odometry_gap_s}"
+            )
         for name in ("imu_topic", "odom_topic", "estimate_topic"):
             if not getattr(self, name).startswith("/"):
                 raise ControlError(f"{name} must start with '/', got {getattr(self, name)!r}")

@@ -27,7 +27,6 @@ from control.robot.extra import require
 from control.validation import check_lookup
 
 _RECORD = struct.Struct("<BQ")  # opcode, length
-_MESSAGE = struct.Struct("<HIQ")  # channel id, sequence, log time (publish time follows)
 _RECORD_MESSAGE = struct.Struct("<BQHIQ")  # a record's opcode and length, a message's fields
 _MESSAGE_DATA = 9 + 2 + 4 + 8 + 8  # offset of a Message record's data from the record's start
 _CHUNK = struct.Struct("<QQQI")  # start and end time, uncompressed size, crc
@@ -153,7 +152,7 @@ def _text(data: bytes, what: str) -> str:
 def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
     """Append the Message records of the wanted channels (id -> topic)."""
     pos, end = 0, len(records)
-    full, head, message = _RECORD_MESSAGE.unpack_from, _RECORD.unpack_from, _MESSAGE.unpack_from
+    full, head = _RECORD_MESSAGE.unpack_from, _RECORD.unpack_from
     logs = {channel: out.log_ns[topic] for channel, topic in wanted.items()}
     datas = {channel: out.data[topic] for channel, topic in wanted.items()}
     last = end - _RECORD_MESSAGE.size  # from here on a record may end before a message's fields
@@ -167,16 +166,12 @@ def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
                 times.append(log)
                 datas[channel].append(records[pos + _MESSAGE_DATA : pos + 9 + length])
         pos += 9 + length
+    # the records left start within a message's fields of the end: none is a whole message (a
+    # message record holds >= _MESSAGE_DATA bytes), so one of opcode Message is damaged
     while pos < end:
         op, length = head(records, pos)
-        if op == OP_MESSAGE:
-            if length < _MESSAGE_DATA - 9:
-                raise _Damaged(f"a message record at byte {pos} of its records is too short")
-            channel, _seq, log = message(records, pos + 9)
-            topic = wanted.get(channel)
-            if topic is not None:
-                out.log_ns[topic].append(log)
-                out.data[topic].append(records[pos + _MESSAGE_DATA : pos + 9 + length])
+        if op == OP_MESSAGE and length < _MESSAGE_DATA - 9:
+            raise _Damaged(f"a message record at byte {pos} of its records is too short")
         pos += 9 + length
     if pos != end:
         raise _Damaged("its last record runs past its end")
