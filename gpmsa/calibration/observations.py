@@ -176,20 +176,6 @@ def _as_rows(value, name: str, ncols: int) -> np.ndarray:
     return arr
 
 
-def refuse_obs_data(**given) -> None:
-    """GPMSAError naming what to pass instead when an argument (``x_new``, or ``x_obs`` /
-    ``y_obs`` where arrays are needed, by keyword) is a ``gpmsa.ObsData``."""
-    for what, value in given.items():
-        if not isinstance(value, ObsData):
-            continue
-        if what == "x_new":
-            raise GPMSAError("x_new is a gpmsa.ObsData: pass its inputs, x_new=obs.x")
-        raise GPMSAError(
-            f"{what} is a gpmsa.ObsData: pass it alone, as the observations (x_obs=obs, "
-            "y_obs=None), or its arrays, x_obs=obs.x, y_obs=obs.y"
-        )
-
-
 def given_obs_data(x_obs, y_obs) -> ObsData | None:
     """The ``gpmsa.ObsData`` given in place of (x_obs, y_obs): as x_obs (positionally, as
     ``gpmsa.fit(data, obs)`` takes it) or as y_obs, the other None; None where neither is one.
@@ -232,8 +218,10 @@ def check_x(
     a column's width an ``ExtrapolationWarning``; further a GPMSAError naming the column, or
     with ``extrapolate=True`` a warning. ``what``: the argument's name in messages. An emulator
     without known inputs (p = 0) takes None as one row of no columns (1, 0); a gpmsa.ObsData
-    is refused (`refuse_obs_data`)."""
-    refuse_obs_data(**{what: x_obs})
+    is refused (an x_new given as one; one given as x_obs or y_obs is the observations, which
+    `given_obs_data` takes before this)."""
+    if isinstance(x_obs, ObsData):
+        raise GPMSAError(f"{what} is a gpmsa.ObsData: pass its inputs, {what}=obs.x")
     p = emulator.x_unit.shape[1]
     if x_obs is None and p == 0:
         x_obs = np.empty((1, 0))
@@ -300,9 +288,8 @@ def obs_inputs(emulator, x_obs, y_obs, what: str = "x_obs"):
     """``x_obs`` as given, or, where it is None and the emulator has no known inputs (p = 0), an
     (n, 0) array: one row per observation of ``y_obs`` (each a replicate of the one experiment,
     as SEPIA's dummy x; a scalar output reads every value of ``y_obs`` as one observation).
-    GPMSAError when ``y_obs`` is None, or ``x_obs`` is None and the emulator has known inputs,
-    or either is a gpmsa.ObsData (`refuse_obs_data`)."""
-    refuse_obs_data(x_obs=x_obs, y_obs=y_obs)
+    GPMSAError when ``y_obs`` is None, or ``x_obs`` is None and the emulator has known inputs.
+    Its callers take a gpmsa.ObsData given as either first (`given_obs_data`)."""
     if y_obs is None:
         hint = ""
         if x_obs is not None and emulator.x_unit.shape[1] == 0:

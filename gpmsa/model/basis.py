@@ -208,6 +208,8 @@ def discrepancy_basis(kind, grid: np.ndarray) -> np.ndarray | None:
             hint = "; SEPIA stores D as (p_v, l_obs): pass its transpose" if (
                 D.ndim == 2 and D.shape[1] == n) else ""  # fmt: skip
             raise GPMSAError(f"discrepancy basis must be ({n}, p_v), got {D.shape}{hint}")
+        if D.shape[1] < 1:
+            raise GPMSAError("discrepancy basis has no columns: give at least one basis vector")
         if not np.all(np.isfinite(D)):
             raise GPMSAError("discrepancy basis must be finite")
     return _normalised([D], "discrepancy basis is all zeros")[0]

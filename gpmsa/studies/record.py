@@ -278,8 +278,9 @@ def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
     got = {k: settings.get(k, 1 if k == "thin" else None)
            for k in ("n_chains", "n_iter", "n_burn", "thin")}  # fmt: skip
     for k, v in got.items():
-        if isinstance(v, bool) or not isinstance(v, int) or v < (0 if k == "n_burn" else 1):
-            raise _fail(f"settings.{k}", f"must be an integer, got {_short(v)}")
+        low = 0 if k == "n_burn" else 1
+        if isinstance(v, bool) or not isinstance(v, int) or v < low:
+            raise _fail(f"settings.{k}", f"must be an integer >= {low}, got {_short(v)}")
     if settings.get("n_samples", got["n_iter"]) != got["n_iter"]:  # calibrate_study's name
         raise _fail("settings.n_samples", f"{_short(settings['n_samples'])} differs from n_iter "
                                           f"{got['n_iter']}")  # fmt: skip
