@@ -608,13 +608,15 @@ class _DigestingWriter:
 def _from_raw(path: Path, raw, imu_topic: str, odom_topic: str):
     """(topics, IMU, odometry) from raw messages read by `control.robot.storage`."""
     _check_topics(path, raw.types, imu_topic, odom_topic)
-    store = None
 
     def decoder(topic: str):
+        store = None
+
         def decode(data: bytes):
             nonlocal store
             if store is None:
-                store = _typestore_for(raw.types, raw.definitions)
+                encoding, text = raw.definitions.get(topic, ("", ""))
+                store = _decoding_store(path, topic, raw.types[topic], encoding, text)
             return store.deserialize_cdr(data, _normalise(raw.types[topic]))
 
         return decode
@@ -635,19 +637,35 @@ def _from_raw(path: Path, raw, imu_topic: str, odom_topic: str):
     return raw.types, out[0], out[1]
 
 
-def _typestore_for(types: dict[str, str], definitions: dict[str, tuple[str, str]]):
-    """A typestore knowing ROS 2's standard messages and the definitions a file carries."""
+def _decoding_store(path: Path, topic: str, msgtype: str, encoding: str, data: bytes | str):
+    """The typestore that decodes ``topic``'s ``msgtype``: the definition its file carries
+    (schema ``encoding`` ros2msg or ros2idl, text ``data``), as rosbags reads a bag, else (none,
+    or an empty one) ROS 2's standard one (Humble). `BagError` for a definition that does not
+    parse."""
     stores = require("rosbags.typesys", "reading a ROS bag")
-    store = stores.get_typestore(stores.Stores.ROS2_HUMBLE)
-    for topic, (encoding, text) in definitions.items():
-        try:
-            if encoding == "ros2idl":
-                store.register(stores.get_types_from_idl(text))
-            elif encoding == "ros2msg":
-                store.register(stores.get_types_from_msg(text, _normalise(types[topic])))
-        except Exception:  # a definition that clashes with the standard one: that one serves
-            continue
+    try:
+        text = data.decode() if isinstance(data, bytes) else data
+        if encoding not in ("ros2msg", "ros2idl") or not text.strip():
+            return stores.get_typestore(stores.Stores.ROS2_HUMBLE)
+        store = stores.get_typestore(stores.Stores.EMPTY)
+        if encoding == "ros2msg":
+            store.register(stores.get_types_from_msg(text, _normalise(msgtype)))
+        elif text.startswith(_IDL_BLOCK):  # MCAP's form: one "IDL: <type>" block a type
+            types = {}
+            for block in text.split(_SEPARATOR)[1:]:
+                types.update(stores.get_types_from_idl(block.partition("\n")[2]))
+            store.register(types)
+        else:
+            store.register(stores.get_types_from_idl(text))
+    except (UnicodeDecodeError, stores.TypesysError) as exc:
+        raise BagError(
+            f"{path} is damaged: the schema of the topic {topic!r} does not parse ({_why(exc)})"
+        ) from exc
     return store
+
+
+_SEPARATOR = "=" * 80 + "\n"
+_IDL_BLOCK = _SEPARATOR + "IDL: "
 
 
 def _damage_errors() -> tuple[type[BaseException], ...]:
@@ -809,7 +827,6 @@ def _messages(reader, conns: list, path: Path, topic: str) -> tuple[list[int], l
 
 def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
     reader_mod = require("mcap.reader", "reading an MCAP file")
-    stores = require("rosbags.typesys", "reading an MCAP file")
     with open(path, "rb") as f:
         try:
             reader = reader_mod.make_reader(f, validate_crcs=True)
@@ -854,14 +871,14 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
         _check_topics(path, topics, imu_topic, odom_topic)
     elif summary.statistics is not None:
         _check_counts(path, summary, {t: len(log) for t, (log, _) in collected.items()})
-    store = stores.get_typestore(stores.Stores.EMPTY)
+    by_topic = {}
     for topic, schema in schemas.items():
         if schema is None:
             raise BagError(f"the topic {topic!r} in {path} has no schema")
-        _register(store, path, topic, schema)
+        by_topic[topic] = _decoding_store(path, topic, schema.name, schema.encoding, schema.data)
 
     def decoder(topic: str):
-        name = _normalise(topics[topic])
+        name, store = _normalise(topics[topic]), by_topic.get(topic)
         return lambda raw: store.deserialize_cdr(raw, name)
 
     imu = _imu(path, imu_topic, *collected[imu_topic], decoder(imu_topic))
@@ -910,21 +927,6 @@ def _check_counts(path: Path, summary, found: dict[str, int]) -> None:
                 f"{topic!r}, its indexed chunks hold {n} (a damaged chunk index, or messages "
                 "outside chunks, which the mcap package does not read)"
             )
-
-
-def _register(store, path: Path, topic: str, schema) -> None:
-    """Register the message definition an MCAP schema carries (ros2idl or ros2msg text)."""
-    stores = require("rosbags.typesys", "reading an MCAP file")
-    try:
-        text = schema.data.decode()
-        if schema.encoding == "ros2idl":
-            store.register(stores.get_types_from_idl(text))
-        else:
-            store.register(stores.get_types_from_msg(text, _normalise(schema.name)))
-    except (UnicodeDecodeError, stores.TypesysError) as exc:
-        raise BagError(
-            f"{path} is damaged: the schema of the topic {topic!r} does not parse ({_why(exc)})"
-        ) from exc
 
 
 # --- writing ------------------------------------------------------------------------------------

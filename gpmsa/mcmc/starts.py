@@ -94,8 +94,12 @@ def chain_starts(
                     f"init[{name!r}] must have shape {want} (chains, *shape){one}, got {val.shape}"
                 )
             start[name] = hold(problem, name, val[c].copy())
-        if not all(np.all(np.isfinite(v)) for v in start.values()):
-            raise GPMSAError(f"init: chain {c}'s start is not finite")
+        bad = [k for k, v in start.items() if not np.all(np.isfinite(v))]
+        if bad:
+            got = np.ravel(start[bad[0]]).tolist()
+            raise GPMSAError(
+                f"init[{bad[0]!r}] must be finite numbers, got {got!r:.80} (chain {c})"
+            )
         check_start(problem, start, "given")
         if problem.constraint is not None and "theta" in start:
             problem.constraint.check_start(start["theta"], f"init: chain {c}'s theta")
