@@ -391,7 +391,8 @@ def write_chunk_crcs(path: Path) -> None:
 
 
 def sqlite_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics:
-    """The messages of ``topics`` in rosbag2 sqlite3 files, by receive time. Raises `BagError`
+    """The messages of ``topics`` in rosbag2 sqlite3 files, by receive time, and their message
+    definitions where a file holds them (`_sqlite_definitions`). Raises `BagError`
     for a file sqlite3 cannot read, a truncated one, or one whose topics are not UTF-8 text
     (or NULL) or whose messages are not (int, bytes)."""
     out = RawTopics()
@@ -425,6 +426,7 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
             if name in out.log_ns:
                 ids[tid] = name
                 out.encodings[name] = encoding
+        _sqlite_definitions(con, path, {name: out.types[name] for name in ids.values()}, out)
         for tid, name in ids.items():
             rows = con.execute(
                 "SELECT timestamp, data FROM messages WHERE topic_id = ? ORDER BY timestamp, id",
@@ -440,6 +442,38 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
             out.data[name].extend(data)
     finally:
         con.close()
+
+
+def _sqlite_definitions(
+    con: sqlite3.Connection, path: Path, types: dict[str, str | None], out: RawTopics
+) -> None:
+    """Record the definitions of the topics ``types`` (topic -> message type) that a bag of
+    rosbag2's schema 4 on (Iron) holds in its message_definitions table, the first of a type
+    (as rosbags reads them); a bag without that table has none."""
+    tables = "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'message_definitions'"
+    if con.execute(tables).fetchone() is None:
+        return
+    rows = con.execute(
+        "SELECT topic_type, encoding, CAST(encoded_message_definition AS BLOB) "
+        "FROM message_definitions ORDER BY id"
+    ).fetchall()
+    found: dict[str, tuple[str, bytes]] = {}
+    for msgtype, encoding, text in rows:
+        if type(msgtype) is not str or type(encoding) is not str or type(text) is not bytes:
+            raise BagError(
+                f"{path} is damaged: a message definition lacks its type, encoding or text"
+            )
+        found.setdefault(msgtype, (encoding, text))
+    for topic, msgtype in types.items():
+        if msgtype in found and topic not in out.definitions:
+            encoding, text = found[msgtype]
+            try:
+                out.definitions[topic] = (encoding, text.decode())
+            except UnicodeDecodeError as exc:
+                raise BagError(
+                    f"{path} is damaged: the message definition of the topic {topic!r} is not "
+                    "UTF-8 text"
+                ) from exc
 
 
 def _check_complete(con: sqlite3.Connection, path: Path) -> None:
