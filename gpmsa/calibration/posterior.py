@@ -43,11 +43,12 @@ def trapezoid_weights(nodes: np.ndarray) -> np.ndarray:
 
 
 def _set_read_only_state(marginal: object, state: dict) -> None:
-    """A marginal's unpickled ``state``, its arrays as read-only views (a ``copy.copy``'s state
-    holds the original's arrays: a view leaves them as they are)."""
+    """A marginal's unpickled ``state``, its arrays as read-only copies (a ``copy.copy``'s state
+    holds the original's arrays, and a ``copy.deepcopy`` of a list holding the marginal and its
+    nodes shares them with the list: a copy leaves those as they are and shares nothing)."""
     for name, value in state.items():
         if isinstance(value, np.ndarray):
-            value = value.view()
+            value = value.copy()
             value.flags.writeable = False
         object.__setattr__(marginal, name, value)
 

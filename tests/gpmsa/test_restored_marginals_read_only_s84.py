@@ -43,3 +43,13 @@ def test_a_shallow_copy_leaves_the_originals_arrays_as_they_are():
     twin = copy.copy(made_by_hand)
     assert nodes.flags.writeable and density.flags.writeable and weights.flags.writeable
     assert not twin.nodes.flags.writeable and twin.mean() == made_by_hand.mean()
+
+
+def test_a_deepcopy_beside_its_own_nodes_shares_nothing_with_them():
+    """Review: ``copy.deepcopy([m, m.nodes])`` restored the marginal's nodes as a read-only view
+    of the list's writable copy, so a write through the list moved the marginal."""
+    grid, _ = _marginals()
+    twin, nodes = copy.deepcopy([grid, grid.nodes])
+    nodes *= 1e-6
+    np.testing.assert_array_equal(twin.nodes, grid.nodes)
+    assert twin.mean() == grid.mean()
