@@ -227,12 +227,22 @@ def resumes_copies(settings: dict, options: dict, n_chains: int,
     "temperatures" set by `continued_ladder`, and "adapt_ladder") resumes every hot copy where
     the source's stopped: the source records them (``HOT_RECORD``) and the continuation runs at
     its ladder (each chain's), without adapting it again (``source``: the argument that gave
-    it, for `source_ladders`' errors). The caller also leaves ``tune`` out (or False)."""
+    it, for `source_ladders`' errors). The caller also leaves ``tune`` out (or False). A
+    damaged ladder record resumes none (the continuation's ladder is given: its copies are
+    tuned); a source of other chains is named."""
     if any(settings.get(k) is None for k in HOT_RECORD) or options.get("adapt_ladder"):
         return False
-    ladders, _ = source_ladders(settings, n_chains, source)
     mine = tempering.chain_ladders(options.get("temperatures"), n_chains)
-    if ladders is None or mine is None:
+    if mine is None:
+        return False
+    try:
+        ladders, _ = source_ladders(settings, n_chains, source)
+    except GPMSAError:
+        n_prev = settings.get("n_chains")
+        if type(n_prev) is int and n_prev != n_chains:
+            raise
+        return False
+    if ladders is None:
         return False
     theirs = np.atleast_2d(ladders)
     return theirs.shape[1] == len(mine[0]) and np.array_equal(
@@ -268,7 +278,7 @@ def continued_copies(emulator: Emulator, problem: Problem, n_chains: int, ladder
         raise GPMSAError(
             f"init=emulator: its recorded hot copies (settings['hot_states'], "
             f"settings['hot_step_widths']) do not fit this fit ({exc}); pass tune=True (every "
-            "copy tuned from the chain's last state) or temperatures="
+            "copy tuned from the chain's last state) or temperatures= another ladder (1: none)"
         ) from None
     return record
 

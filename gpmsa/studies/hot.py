@@ -57,7 +57,7 @@ def continued_copies(settings: dict, starts: list[tuple], problems, layout, hype
         raise GPMSAError(
             f"init=study: its recorded hot copies (settings['hot_states'], "
             f"settings['hot_step_widths']) do not fit this study ({exc}); pass tune=True (every "
-            "copy tuned from the chain's last state) or temperatures="
+            "copy tuned from the chain's last state) or temperatures= another ladder (1: none)"
         ) from None
 
 
