@@ -2,9 +2,27 @@
 
 from __future__ import annotations
 
+import multiprocessing.context
 import os
 import signal
 import time
+
+
+class ForkNamedSpawn(multiprocessing.context.ForkContext):
+    """Forks (fast) but says 'spawn': the parent reads the start method from the context."""
+
+    _name = "spawn"
+
+
+class ForkNamedForkserver(multiprocessing.context.ForkContext):
+    """Forks (fast) but says 'forkserver': the parent reads the start method from the context."""
+
+    _name = "forkserver"
+
+
+def ends_while_starting(*_initargs) -> None:
+    """A worker initializer that ends as one whose import of the main script failed."""
+    os._exit(1)
 
 
 def alive(pid: int) -> bool:

@@ -9,20 +9,14 @@ while starting ... call gpmsa inside an ``if __name__ == "__main__":`` block" an
 not yet reaped by its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie.
 (The watchers' tests: tests/test_pool_watchers_s83.py.)"""
 
-import multiprocessing.context
 import os
 
 import pytest
 
 from gpmsa.mcmc import parallel
+from tests._processes import ForkNamedSpawn
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
-
-
-class _ForkNamedSpawn(multiprocessing.context.ForkContext):
-    """Forks (fast) but says 'spawn': the parent reads the start method from the context."""
-
-    _name = "spawn"
 
 
 def _ends_once(x, marker, progress=False, desc=""):
@@ -33,7 +27,7 @@ def _ends_once(x, marker, progress=False, desc=""):
 
 
 def test_a_started_worker_that_ends_in_a_chain_is_retried(monkeypatch, tmp_path):
-    monkeypatch.setattr(parallel, "_WorkerContext", _ForkNamedSpawn)
+    monkeypatch.setattr(parallel, "_WorkerContext", ForkNamedSpawn)
     marker = str(tmp_path / "ended")
     tasks = [{"x": i, "marker": marker} for i in range(2)]
     with pytest.warns(parallel.ChainRetryWarning, match="BrokenProcessPool"):

@@ -20,18 +20,9 @@ import pytest
 
 from gpmsa.errors import ChainError
 from gpmsa.mcmc import parallel
+from tests._processes import ForkNamedSpawn, ends_while_starting
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
-
-
-class _ForkNamedSpawn(multiprocessing.context.ForkContext):
-    """Forks (fast) but says 'spawn': the parent reads the start method from the context."""
-
-    _name = "spawn"
-
-
-def _ends_while_starting() -> None:
-    os._exit(1)  # as a spawned worker whose import of the main script failed
 
 
 def _task(x, progress=False, desc=""):
@@ -41,8 +32,8 @@ def _task(x, progress=False, desc=""):
 @pytest.fixture
 def failing_spawn_pool(monkeypatch):
     def pool(workers):
-        return ProcessPoolExecutor(workers, mp_context=_ForkNamedSpawn(),
-                                   initializer=_ends_while_starting)  # fmt: skip
+        return ProcessPoolExecutor(workers, mp_context=ForkNamedSpawn(),
+                                   initializer=ends_while_starting)  # fmt: skip
 
     monkeypatch.setattr(parallel, "_own_pool", pool)
 
@@ -71,7 +62,7 @@ def test_a_script_read_from_stdin_is_named(failing_spawn_pool, monkeypatch):
 def test_a_forked_worker_that_dies_is_still_retried(monkeypatch):
     def pool(workers):  # a fork pool: the start-up diagnosis does not apply
         return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
-                                   initializer=_ends_while_starting)  # fmt: skip
+                                   initializer=ends_while_starting)  # fmt: skip
 
     monkeypatch.setattr(parallel, "_own_pool", pool)
     with pytest.warns(parallel.ChainRetryWarning), pytest.raises(ChainError, match="attempts"):

@@ -8,7 +8,6 @@ was terminated abruptly" from inside concurrent.futures; and a forkserver's work
 forkserver, which outlives a killed campaign while any worker holds its pipe: they outlived it.
 (The watchers' tests: tests/test_pool_watchers_s83.py.)"""
 
-import multiprocessing.context
 import os
 import sys
 import types
@@ -18,25 +17,16 @@ import numpy as np
 import pytest
 
 import vehicle
+from tests._processes import ForkNamedForkserver, ends_while_starting
 from vehicle import campaign
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
 
 
-class _ForkNamedForkserver(multiprocessing.context.ForkContext):
-    """Forks (fast) but says 'forkserver': the parent reads the start method from the context."""
-
-    _name = "forkserver"
-
-
-def _ends_while_starting(owner, started=None) -> None:
-    os._exit(1)  # as a worker whose import of the main script failed
-
-
 def test_a_worker_that_ends_while_starting_names_the_main_guard(monkeypatch):
     def pool(max_workers, initializer, initargs):
-        return ProcessPoolExecutor(max_workers, mp_context=_ForkNamedForkserver(),
-                                   initializer=_ends_while_starting, initargs=initargs)  # fmt: skip
+        return ProcessPoolExecutor(max_workers, mp_context=ForkNamedForkserver(),
+                                   initializer=ends_while_starting, initargs=initargs)  # fmt: skip
 
     script = types.ModuleType("__main__")
     script.__file__, script.__spec__ = __file__, None

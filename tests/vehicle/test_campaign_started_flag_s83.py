@@ -9,7 +9,6 @@ BrokenProcessPool); and a forkserver's worker whose campaign was killed but not 
 its parent (a zombie) kept running: ``os.kill(pid, 0)`` finds a zombie.
 (The watchers' tests: tests/test_pool_watchers_s83.py.)"""
 
-import multiprocessing.context
 import os
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
@@ -18,15 +17,10 @@ import numpy as np
 import pytest
 
 import vehicle
+from tests._processes import ForkNamedSpawn
 from vehicle import campaign
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
-
-
-class _ForkNamedSpawn(multiprocessing.context.ForkContext):
-    """Forks (fast) but says 'spawn': the parent reads the start method from the context."""
-
-    _name = "spawn"
 
 
 def _ends_in_the_run(spec, cache):
@@ -34,7 +28,7 @@ def _ends_in_the_run(spec, cache):
 
 
 def test_a_started_worker_that_ends_in_a_run_is_not_named_a_start_failure(monkeypatch):
-    context = _ForkNamedSpawn()
+    context = ForkNamedSpawn()
 
     def pool(max_workers, initializer, initargs):
         return ProcessPoolExecutor(max_workers, mp_context=context, initializer=initializer,

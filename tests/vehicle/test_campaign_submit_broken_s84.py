@@ -7,7 +7,6 @@ runs whose spawn or forkserver workers failed to start (a script without the mai
 still end in a bare "BrokenProcessPool: A child process terminated abruptly" from inside
 concurrent.futures (a race with the pool's manager thread; made certain here)."""
 
-import multiprocessing.context
 import os
 import sys
 import time
@@ -18,19 +17,10 @@ import numpy as np
 import pytest
 
 import vehicle
+from tests._processes import ForkNamedSpawn, ends_while_starting
 from vehicle import campaign
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "fork"), reason="the stand-in pool forks")
-
-
-class _ForkNamedSpawn(multiprocessing.context.ForkContext):
-    """Forks (fast) but says 'spawn': the parent reads the start method from the context."""
-
-    _name = "spawn"
-
-
-def _ends_while_starting(owner, started=None) -> None:
-    os._exit(1)  # as a worker whose import of the main script failed
 
 
 class _BreaksBeforeTheSecondSubmit(ProcessPoolExecutor):
@@ -47,8 +37,8 @@ class _BreaksBeforeTheSecondSubmit(ProcessPoolExecutor):
 
 def test_a_pool_broken_while_runs_are_submitted_names_the_main_guard(monkeypatch):
     def pool(max_workers, initializer, initargs):
-        return _BreaksBeforeTheSecondSubmit(max_workers, mp_context=_ForkNamedSpawn(),
-                                            initializer=_ends_while_starting,
+        return _BreaksBeforeTheSecondSubmit(max_workers, mp_context=ForkNamedSpawn(),
+                                            initializer=ends_while_starting,
                                             initargs=initargs)  # fmt: skip
 
     script = types.ModuleType("__main__")
