@@ -920,6 +920,15 @@ def _finite(arrays: dict[str, np.ndarray], name: str) -> np.ndarray:
     return a
 
 
+def _resolvable_precision(a: np.ndarray, name: str, param: str) -> None:
+    """A precision whose variance 1 / value overflows float64 (a subnormal one) is refused as
+    the Emulator refuses it in params, naming the array."""
+    if a.size and not np.all(a > 1.0 / np.finfo(float).max):
+        pos = tuple(int(i) for i in np.argwhere(~(a > 1.0 / np.finfo(float).max))[0])
+        raise _fail(f"arrays/{name}", f"holds {a[pos]} at index {list(pos)}: a precision whose "
+                                      f"variance 1 / {param} overflows float64")  # fmt: skip
+
+
 def _positive(arrays: dict[str, np.ndarray], name: str) -> np.ndarray:
     a = _finite(arrays, name)
     if a.size and not np.all(a > 0):
@@ -1036,8 +1045,12 @@ def check_values(
         raise _fail("arrays/w", "differs from the projection of the training outputs on arrays/K")
     for k in EMULATOR_PARAMS:
         prm = _positive(arrays, f"param_{k}")
+        if k.startswith("lam"):
+            _resolvable_precision(prm, f"param_{k}", k)
         if f"draw_{k}" in arrays:
             draws = _positive(arrays, f"draw_{k}")
+            if k.startswith("lam"):
+                _resolvable_precision(draws, f"draw_{k}", k)
             if draws.shape[0]:
                 lo, hi = draws.min(axis=0), draws.max(axis=0)
                 slack = 1e-9 * np.maximum(np.abs(lo), np.abs(hi))

@@ -87,6 +87,8 @@ def to_inference_data(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         idata = az.from_dict(groups) if arviz_major() >= 1 else az.from_dict(**groups)
+    if tuple(idata.posterior.data_vars) != tuple(draws):  # 0.x with dm-tree sorts the names
+        idata.posterior = idata.posterior[list(draws)]
     for name, unit in (units or {}).items():
         if unit and name in idata.posterior and not is_cf_time_unit(str(unit)):
             idata.posterior[name].attrs["units"] = str(unit)

@@ -93,11 +93,12 @@ def test_the_pin_allows_arviz_1_from_python_3_12_only():
     arviz = [requirements.Requirement(d) for d in deps if d.startswith("arviz")]
 
     def allowed(python: str) -> set[str]:
-        versions = ("0.18.0", "0.19.0", "0.23.4", "1.0.0", "1.1.0", "1.2.0", "1.3.0", "2.0.0")
+        versions = ("0.19.0", "0.23.0", "0.23.1", "0.23.4", "1.0.0", "1.1.0", "1.2.0", "1.3.0",
+                    "2.0.0")  # fmt: skip
         env = {"python_version": python, "python_full_version": python + ".0"}
         live = [r for r in arviz if r.marker is None or r.marker.evaluate(env)]
         assert len(live) == 1, (python, live)
         return {v for v in versions if live[0].specifier.contains(v)}
 
-    assert allowed("3.10") == allowed("3.11") == {"0.19.0", "0.23.4"}
-    assert allowed("3.12") == allowed("3.13") == {"0.19.0", "0.23.4", "1.2.0", "1.3.0"}
+    assert allowed("3.10") == allowed("3.11") == {"0.23.1", "0.23.4"}
+    assert allowed("3.12") == allowed("3.13") == {"0.23.1", "0.23.4", "1.2.0", "1.3.0"}
