@@ -28,6 +28,7 @@ from gpmsa.fitting.validation import (
     EMULATOR_PARAMS,
     KRON_ARRAY,
     REQUIRED,
+    SMALLEST_PRECISION,
     STD_FIELDS,
     check_manifest,
     check_record,
@@ -197,7 +198,7 @@ def _check_params(params: Mapping, shapes: dict) -> dict[str, np.ndarray]:
         val = val.reshape(shape)
         if not np.all(np.isfinite(val)) or np.any(val <= 0):
             raise GPMSAError(f"params[{name!r}] must be finite and > 0, got {val.ravel()}")
-        if name.startswith("lam") and not np.all(val > 1.0 / np.finfo(float).max):
+        if name.startswith("lam") and not np.all(val > SMALLEST_PRECISION):
             raise GPMSAError(  # (1 / lam, a variance, would overflow at the first prediction)
                 f"params[{name!r}] = {val.ravel()}: a precision whose variance 1 / {name} "
                 "overflows float64; GPM/SA's precisions lie far above this"

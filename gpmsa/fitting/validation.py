@@ -45,6 +45,9 @@ PRECISIONS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
 PRIOR_SCALARS = ("theta_mean", "theta_sd", "rho_a", "rho_b", "rho_cap")
 PRIOR_OPTIONAL = ("rhoV_a", "rhoV_b")
 """betaV's own Beta prior: in a file both or neither (a file without them: betaU's)."""
+SMALLEST_PRECISION = 1.0 / np.finfo(float).max
+"""1 / the largest float64: a precision lam at or below it (a subnormal one) has a variance
+1 / lam that overflows, and is refused in a file and in ``Emulator`` params alike."""
 REL_TOL = 1e-9
 """Relative tolerance of the recomputed redundancies (y_mean, y_sd)."""
 W_TOL = 1e-7
@@ -923,8 +926,9 @@ def _finite(arrays: dict[str, np.ndarray], name: str) -> np.ndarray:
 def _resolvable_precision(a: np.ndarray, name: str, param: str) -> None:
     """A precision whose variance 1 / value overflows float64 (a subnormal one) is refused as
     the Emulator refuses it in params, naming the array."""
-    if a.size and not np.all(a > 1.0 / np.finfo(float).max):
-        pos = tuple(int(i) for i in np.argwhere(~(a > 1.0 / np.finfo(float).max))[0])
+    resolvable = a > SMALLEST_PRECISION
+    if not np.all(resolvable):
+        pos = tuple(int(i) for i in np.argwhere(~resolvable)[0])
         raise _fail(f"arrays/{name}", f"holds {a[pos]} at index {list(pos)}: a precision whose "
                                       f"variance 1 / {param} overflows float64")  # fmt: skip
 
