@@ -102,3 +102,19 @@ def test_the_pin_allows_arviz_1_from_python_3_12_only():
 
     assert allowed("3.10") == allowed("3.11") == {"0.23.1", "0.23.4"}
     assert allowed("3.12") == allowed("3.13") == {"0.23.1", "0.23.4", "1.2.0", "1.3.0"}
+
+
+def test_where_arviz_1_may_install_the_netcdf_writer_is_required():
+    """ArviZ 1.x leaves h5netcdf and h5py to an extra: a fresh Python 3.13 install wrote no
+    netCDF (`to_arviz().to_netcdf` raised ValueError, "none of the suitable backend libraries"),
+    while 0.x requires them itself."""
+    tomllib = pytest.importorskip("tomllib")
+    requirements = pytest.importorskip("packaging.requirements")
+    deps = tomllib.loads((REPO / "pyproject.toml").read_text())["project"]["dependencies"]
+    for python in ("3.12", "3.13", "3.14"):
+        env = {"python_version": python, "python_full_version": python + ".0"}
+        live = [requirements.Requirement(d) for d in deps]
+        live = [r for r in live if r.marker is None or r.marker.evaluate(env)]
+        writer = [r for r in live if r.name == "h5netcdf"]
+        assert len(writer) == 1 and "h5py" in writer[0].extras, python
+        assert writer[0].specifier.contains("1.8.0") and not writer[0].specifier.contains("1.7.0")
