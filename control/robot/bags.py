@@ -608,60 +608,100 @@ class _DigestingWriter:
 def _from_raw(path: Path, raw, imu_topic: str, odom_topic: str):
     """(topics, IMU, odometry) from raw messages read by `control.robot.storage`."""
     _check_topics(path, raw.types, imu_topic, odom_topic)
-
-    def decoder(topic: str):
-        store = None
-
-        def decode(data: bytes):
-            nonlocal store
-            if store is None:
-                encoding, text = raw.definitions.get(topic, ("", ""))
-                store = _decoding_store(path, topic, raw.types[topic], encoding, text)
-            return store.deserialize_cdr(data, _normalise(raw.types[topic]))
-
-        return decode
-
     out = []
     for topic, make in ((imu_topic, _imu), (odom_topic, _odometry)):
-        if raw.encodings.get(topic, "cdr") != "cdr":
-            raise BagError(
-                f"the topic {topic!r} in {path} is encoded as {raw.encodings[topic]!r}; the "
-                "replay reads ROS 2 (cdr) messages"
-            )
+        _check_encoding(path, topic, raw.encodings.get(topic, "cdr"))
         log = _receive_times(path, topic, raw.log_ns[topic])
         order = np.argsort(log, kind="stable")
-        data = raw.data[topic]
+        data, which = raw.data[topic], raw.schema_index.get(topic)
         if np.any(np.diff(order) != 1):
             data = [data[i] for i in order]
-        out.append(make(path, topic, log[order], data, decoder(topic)))
+            if which is not None:
+                which = [which[i] for i in order]
+        decode = _schema_decoder(path, topic, raw.types[topic], raw.definitions.get(topic), which)
+        out.append(make(path, topic, log[order], data, decode))
     return raw.types, out[0], out[1]
+
+
+def _schema_decoder(
+    path: Path,
+    topic: str,
+    msgtype: str,
+    definitions: Sequence[tuple[str, bytes | str]] | None,
+    which: Sequence[int] | None,
+):
+    """``decode(k, data)``: message k of ``topic`` (``msgtype``) deserialised with the
+    typestore of its own channel's schema, ``definitions[which[k]]`` (``which`` None: the
+    first; no definitions: ROS 2's standard types); each typestore made when first needed
+    (`_decoding_store`), so that messages the fast decoder reads never need one."""
+    made: dict[int, object] = {}
+    name = _normalise(msgtype)
+
+    def decode(k: int, data: bytes):
+        i = which[k] if which else 0
+        if i not in made:
+            encoding, text = definitions[i] if definitions else ("", "")
+            made[i] = _decoding_store(path, topic, msgtype, encoding, text)
+        return made[i].deserialize_cdr(data, name)
+
+    return decode
 
 
 def _decoding_store(path: Path, topic: str, msgtype: str, encoding: str, data: bytes | str):
     """The typestore that decodes ``topic``'s ``msgtype``: the definition its file carries
     (schema ``encoding`` ros2msg or ros2idl, text ``data``), as rosbags reads a bag, else (none,
-    or an empty one) ROS 2's standard one (Humble). `BagError` for a definition that does not
-    parse."""
+    or an empty one) ROS 2's standard one (Humble). A sub-message type the definition uses
+    but does not define (a schema without its "MSG: <type>" blocks) is taken from ROS 2's
+    standard types where it is one of them. `BagError` for a definition that does not parse,
+    or that lacks a sub-message type that is not a standard one (naming it)."""
     stores = require("rosbags.typesys", "reading a ROS bag")
+    standard = stores.get_typestore(stores.Stores.ROS2_HUMBLE)
     try:
         text = data.decode() if isinstance(data, bytes) else data
         if encoding not in ("ros2msg", "ros2idl") or not text.strip():
-            return stores.get_typestore(stores.Stores.ROS2_HUMBLE)
-        store = stores.get_typestore(stores.Stores.EMPTY)
+            return standard
         if encoding == "ros2msg":
-            store.register(stores.get_types_from_msg(text, _normalise(msgtype)))
+            types = stores.get_types_from_msg(text, _normalise(msgtype))
         elif text.startswith(_IDL_BLOCK):  # MCAP's form: one "IDL: <type>" block a type
             types = {}
             for block in text.split(_SEPARATOR)[1:]:
                 types.update(stores.get_types_from_idl(block.partition("\n")[2]))
-            store.register(types)
         else:
-            store.register(stores.get_types_from_idl(text))
+            types = stores.get_types_from_idl(text)
+        missing = _complete(types, standard.fielddefs)
+        if missing:
+            raise BagError(
+                f"{path}: the schema {msgtype!r} ({encoding}) of the topic {topic!r} uses the "
+                f"type {missing!r} without its definition, which is not a standard ROS 2 "
+                "type either (a schema carries the definition of each type its fields use)"
+            )
+        store = stores.get_typestore(stores.Stores.EMPTY)
+        store.register(types)
     except (UnicodeDecodeError, stores.TypesysError) as exc:
         raise BagError(
             f"{path} is damaged: the schema of the topic {topic!r} does not parse ({_why(exc)})"
         ) from exc
     return store
+
+
+def _complete(types: dict, standard: dict) -> str | None:
+    """Add to ``types`` (a rosbags Typesdict: name -> (constants, fields)) each type its fields
+    use, at any depth, that it lacks and ``standard`` holds; the first type used that neither
+    holds, None where none."""
+    nodes = require("rosbags.interfaces", "reading a ROS bag").Nodetype
+    pending = list(types)
+    while pending:
+        for _, desc in types[pending.pop()][1]:
+            while desc[0] in (nodes.ARRAY, nodes.SEQUENCE):  # (kind, (element, size))
+                desc = desc[1][0]
+            kind, used = desc
+            if kind != nodes.NAME or used in types:
+                continue
+            if used not in standard:
+                return used
+            types[used] = standard[used]
+            pending.append(used)
+    return None
 
 
 _SEPARATOR = "=" * 80 + "\n"
@@ -720,19 +760,34 @@ def _receive_times(path: Path, topic: str, log_ns) -> np.ndarray:
         ) from exc
 
 
-def _decoded(path: Path, topic: str, raws: list, decode) -> list:
-    """The messages deserialised one by one by ``decode`` (a generic deserialiser)."""
+def _decoded(path: Path, topic: str, raws: list, decode, read, what: str) -> list:
+    """``read(message)`` of each message deserialised by ``decode(k, raw)`` (a generic
+    deserialiser; k: the message's index); `BagError` naming the message where it does not
+    deserialise, or where its type, as its schema defines it, lacks ``what`` ``read`` reads."""
     errors = _damage_errors()
     out = []
     for k, raw in enumerate(raws):
         try:
-            out.append(decode(raw))
+            message = decode(k, raw)
+        except BagError:  # the schema's own (`_decoding_store`), a ValueError too
+            raise
         except errors as exc:
             raise BagError(
                 f"{path} is damaged: message {k} of the topic {topic!r} does not deserialise "
                 f"({_why(exc)})"
             ) from exc
+        try:
+            out.append(read(message))
+        except (AttributeError, TypeError, ValueError, IndexError) as exc:
+            raise BagError(
+                f"message {k} of the topic {topic!r} in {path} lacks the fields the replay "
+                f"reads ({what}): its schema defines its type otherwise ({_why(exc)})"
+            ) from exc
     return out
+
+
+_IMU_FIELDS = "header.stamp, linear_acceleration, linear_acceleration_covariance"
+_ODOMETRY_FIELDS = "header.stamp, pose.pose.position, twist.twist.linear"
 
 
 def _imu(path: Path, topic: str, log_ns, raws: list, decode, cdr: bool = True) -> ImuMessages:
@@ -742,13 +797,15 @@ def _imu(path: Path, topic: str, log_ns, raws: list, decode, cdr: bool = True) -
             raise msgs.CdrLayoutError("not CDR")
         stamp, accel, unknown = msgs.decode_imu(raws)
     except msgs.CdrLayoutError:
-        fields = _decoded(path, topic, raws, decode)
-        stamp = np.array([_stamp(m, ros1=not cdr) for m in fields], dtype=np.int64)
-        accel = np.array([_xyz(m.linear_acceleration) for m in fields]).reshape(-1, 3)
-        unknown = np.array(
-            [float(m.linear_acceleration_covariance[0]) == msgs.UNKNOWN_COVARIANCE
-             for m in fields], dtype=bool,
-        )  # fmt: skip
+
+        def read(m) -> tuple:
+            covariance = float(m.linear_acceleration_covariance[0])
+            return _stamp(m, ros1=not cdr), _xyz(m.linear_acceleration), covariance
+
+        fields = _decoded(path, topic, raws, decode, read, _IMU_FIELDS)
+        stamp = np.array([f[0] for f in fields], dtype=np.int64)
+        accel = np.array([f[1] for f in fields]).reshape(-1, 3)
+        unknown = np.array([f[2] == msgs.UNKNOWN_COVARIANCE for f in fields], dtype=bool)
     return ImuMessages(topic, log, stamp, accel, unknown if unknown.any() else None)
 
 
@@ -761,10 +818,14 @@ def _odometry(
             raise msgs.CdrLayoutError("not CDR")
         stamp, position, velocity = msgs.decode_odometry(raws)
     except msgs.CdrLayoutError:
-        fields = _decoded(path, topic, raws, decode)
-        stamp = np.array([_stamp(m, ros1=not cdr) for m in fields], dtype=np.int64)
-        position = np.array([_xyz(m.pose.pose.position) for m in fields]).reshape(-1, 3)
-        velocity = np.array([_xyz(m.twist.twist.linear) for m in fields]).reshape(-1, 3)
+
+        def read(m) -> tuple:
+            return _stamp(m, ros1=not cdr), _xyz(m.pose.pose.position), _xyz(m.twist.twist.linear)
+
+        fields = _decoded(path, topic, raws, decode, read, _ODOMETRY_FIELDS)
+        stamp = np.array([f[0] for f in fields], dtype=np.int64)
+        position = np.array([f[1] for f in fields]).reshape(-1, 3)
+        velocity = np.array([f[2] for f in fields]).reshape(-1, 3)
     return OdometryMessages(topic, log, stamp, position, velocity)
 
 
@@ -802,7 +863,7 @@ def _read_rosbags(path: Path, kind: str, imu_topic: str, odom_topic: str, digest
             _check_digest(path, digests or {}, topic, log, raws)
             msgtype = conns[0].msgtype
 
-            def decode(raw, msgtype=msgtype):
+            def decode(_k: int, raw: bytes, msgtype=msgtype):
                 return reader.deserialize(raw, msgtype)
 
             out.append(make(path, topic, log, raws, decode, cdr=reader.is2))
@@ -826,7 +887,11 @@ def _messages(reader, conns: list, path: Path, topic: str) -> tuple[list[int], l
 
 
 def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
+    """(topics, IMU, odometry, metadata) of an MCAP file the fast reader does not take, read
+    with the mcap package (or, for a file without a summary, its stream reader): each message
+    decoded, where the fast decoder does not read it, with its own channel's schema."""
     reader_mod = require("mcap.reader", "reading an MCAP file")
+    wanted = (imu_topic, odom_topic)
     with open(path, "rb") as f:
         try:
             reader = reader_mod.make_reader(f, validate_crcs=True)
@@ -836,78 +901,107 @@ def _read_mcap(path: Path, imu_topic: str, odom_topic: str):
                 raise BagError(f"{path} {cut}") from exc
             raise BagError(f"cannot read {path} as an MCAP file: {_why(exc)}") from exc
         if summary is not None:
-            topics = {  # "": no schema (id 0), or one the summary lacks (a damaged file)
-                ch.topic: getattr(summary.schemas.get(ch.schema_id), "name", "")
-                for ch in summary.channels.values()
+            channels = {  # None: no schema (id 0), or one the summary lacks (a damaged file)
+                cid: (ch, summary.schemas.get(ch.schema_id)) for cid, ch in summary.channels.items()
             }
-            _check_topics(path, topics, imu_topic, odom_topic)
+            topics = _channel_topics(path, channels.values(), wanted)
             metadata = storage_mod.indexed_metadata(
                 path, f, summary, SIMULATION_NAMES, _METADATA_BYTES
             )
-            messages = reader.iter_messages(topics=[imu_topic, odom_topic])
+            messages = reader.iter_messages(topics=list(wanted))
         else:  # an unindexed (e.g. truncated) file: find the topics by reading it all
-            topics, metadata = {}, {name: [] for name in SIMULATION_NAMES}
-            messages = _unindexed_messages(f, metadata)
-        collected: dict[str, tuple[list, list]] = {imu_topic: ([], []), odom_topic: ([], [])}
-        schemas: dict[str, object] = {}
+            channels, metadata = {}, {name: [] for name in SIMULATION_NAMES}
+            messages = _unindexed_messages(f, metadata, channels)
+        collected: dict[str, tuple[list, list, list]] = {t: ([], [], []) for t in wanted}
+        definitions: dict[str, list[tuple[str, bytes]]] = {t: [] for t in wanted}
         try:
             for schema, channel, message in messages:
-                topics.setdefault(channel.topic, schema.name if schema else "")
                 if channel.topic not in collected:
                     continue
-                if channel.message_encoding != "cdr":
-                    raise BagError(
-                        f"the topic {channel.topic!r} in {path} is encoded as "
-                        f"{channel.message_encoding!r}; the replay reads ROS 2 (cdr) messages"
-                    )
-                schemas[channel.topic] = schema
-                collected[channel.topic][0].append(message.log_time)
-                collected[channel.topic][1].append(message.data)
+                log, data, which = collected[channel.topic]
+                known = definitions[channel.topic]
+                key = (schema.encoding, schema.data) if schema is not None else ("", b"")
+                if key not in known:
+                    known.append(key)
+                log.append(message.log_time)
+                data.append(message.data)
+                which.append(known.index(key))
         except BagError:
             raise
         except Exception as exc:
             raise BagError(f"cannot read the messages of {path}: {_why(exc)}") from exc
     if summary is None:
-        _check_topics(path, topics, imu_topic, odom_topic)
+        topics = _channel_topics(path, channels.values(), wanted)
     elif summary.statistics is not None:
-        _check_counts(path, summary, {t: len(log) for t, (log, _) in collected.items()})
-    by_topic = {}
-    for topic, schema in schemas.items():
-        if schema is None:
-            raise BagError(f"the topic {topic!r} in {path} has no schema")
-        by_topic[topic] = _decoding_store(path, topic, schema.name, schema.encoding, schema.data)
-
-    def decoder(topic: str):
-        name, store = _normalise(topics[topic]), by_topic.get(topic)
-        return lambda raw: store.deserialize_cdr(raw, name)
-
-    imu = _imu(path, imu_topic, *collected[imu_topic], decoder(imu_topic))
-    odom = _odometry(path, odom_topic, *collected[odom_topic], decoder(odom_topic))
-    return topics, imu, odom, metadata
+        _check_counts(path, summary, {t: len(log) for t, (log, _, _) in collected.items()})
+    out = []
+    for topic, make in ((imu_topic, _imu), (odom_topic, _odometry)):
+        log, data, which = collected[topic]
+        decode = _schema_decoder(path, topic, topics[topic], definitions[topic], which)
+        out.append(make(path, topic, log, data, decode))
+    return topics, out[0], out[1], metadata
 
 
-def _unindexed_messages(f, metadata: dict[str, list[dict[str, str]]]) -> Iterator[tuple]:
+def _channel_topics(path: Path, channels, wanted: Sequence[str]) -> dict[str, str | None]:
+    """{topic: its message type (None: several)} of an MCAP file's (channel, schema or None)
+    pairs, the topics ``wanted`` (IMU, odometry) checked (`_check_topics`, `_check_encoding`)
+    as the fast reader checks them."""
+    topics: dict[str, str | None] = {}
+    encodings: dict[str, str] = {}
+    for channel, schema in channels:
+        storage_mod.note_type(topics, channel.topic, schema.name if schema is not None else "")
+        if channel.topic in wanted:
+            storage_mod.note_encoding(encodings, channel.topic, channel.message_encoding)
+            if schema is not None:
+                _check_schema_text(path, channel.topic, schema.data)
+    _check_topics(path, topics, *wanted)
+    for topic in wanted:
+        _check_encoding(path, topic, encodings[topic])
+    return topics
+
+
+def _check_schema_text(path: Path, topic: str, data: bytes) -> None:
+    """`BagError` where a schema's text is not UTF-8 (as the fast reader words it)."""
+    try:
+        data.decode()
+    except UnicodeDecodeError as exc:
+        raise BagError(f"{path} is damaged: the schema of {topic!r} is not UTF-8 text") from exc
+
+
+def _check_encoding(path: Path, topic: str, encoding: str) -> None:
+    """`BagError` unless the messages of ``topic`` are encoded as cdr (ROS 2's)."""
+    if encoding != "cdr":
+        raise BagError(
+            f"the topic {topic!r} in {path} is encoded as {encoding!r}; the replay reads ROS 2 "
+            "(cdr) messages"
+        )
+
+
+def _unindexed_messages(
+    f, metadata: dict[str, list[dict[str, str]]], channels: dict[int, tuple]
+) -> Iterator[tuple]:
     """(schema, channel, message) of each message of the MCAP file ``f`` (without a summary) in
     log-time order, as the mcap package's reader gives them, appending to ``metadata``
-    ({name: []}) the metadata of each Metadata record of those names met on the way: one
-    pass over the file for both."""
+    ({name: []}) the metadata of each Metadata record of those names met on the way, and
+    to ``channels`` (channel id -> (channel, its schema or None)) each Channel record: one
+    pass over the file for all."""
     records = require("mcap.records", "reading an MCAP file")
     error = require("mcap.exceptions", "reading an MCAP file").McapError
     f.seek(0)
     stream = require("mcap.stream_reader", "reading an MCAP file").StreamReader(f)
-    schemas, channels, found = {}, {}, []
+    schemas, found = {}, []
     for record in stream.records:
         if isinstance(record, records.Message):
-            channel = channels.get(record.channel_id)
-            if channel is None:
+            if record.channel_id not in channels:
                 raise error(f"no channel record found with id {record.channel_id}")
-            found.append((schemas.get(channel.schema_id), channel, record))
+            channel, schema = channels[record.channel_id]
+            found.append((schema, channel, record))
         elif isinstance(record, records.Schema):
             schemas[record.id] = record
         elif isinstance(record, records.Channel):
             if record.schema_id != 0 and record.schema_id not in schemas:
                 raise error(f"no schema record found with id {record.schema_id}")
-            channels[record.id] = record
+            channels[record.id] = (record, schemas.get(record.schema_id))
         elif isinstance(record, records.Metadata) and record.name in metadata:
             metadata[record.name].append(dict(record.metadata))
     found.sort(key=lambda item: item[2].log_time)  # stable, as the mcap package's reader

@@ -20,6 +20,7 @@ import struct
 import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 from control.errors import BagError, ControlError
@@ -54,8 +55,13 @@ class RawTopics:
         types: every topic of the files and its message type (None: several types).
         log_ns: topic -> receive times (int ns).
         data: topic -> serialised messages (bytes).
-        definitions: topic -> (schema encoding, schema text) where the file has one.
-        encodings: topic -> message encoding ("cdr" for ROS 2).
+        definitions: topic -> the (schema encoding, schema text) of each distinct schema its
+            channels carry, in the order met (("", "") for a channel without one).
+        schema_index: topic -> per message, the index in ``definitions[topic]`` of its
+            channel's schema (an MCAP file's; absent: the topic's one definition, if any, is
+            every message's).
+        encodings: topic -> message encoding ("cdr" for ROS 2; where its channels differ,
+            the first other than "cdr").
         metadata: name -> the metadata (a dict) of each Metadata record of that name, for
             the names asked for (an MCAP file's, found through its summary).
     """
@@ -63,7 +69,8 @@ class RawTopics:
     types: dict[str, str | None] = field(default_factory=dict)
     log_ns: dict[str, list[int]] = field(default_factory=dict)
     data: dict[str, list[bytes]] = field(default_factory=dict)
-    definitions: dict[str, tuple[str, str]] = field(default_factory=dict)
+    definitions: dict[str, list[tuple[str, str]]] = field(default_factory=dict)
+    schema_index: dict[str, list[int]] = field(default_factory=dict)
     encodings: dict[str, str] = field(default_factory=dict)
     metadata: dict[str, list[dict[str, str]]] = field(default_factory=dict)
 
@@ -149,12 +156,15 @@ def _text(data: bytes, what: str) -> str:
         raise _Damaged(f"{what} is not UTF-8 text") from exc
 
 
-def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
-    """Append the Message records of the wanted channels (id -> topic)."""
+def _walk(records: bytes, wanted: dict[int, tuple[str, int]], out: RawTopics) -> None:
+    """Append the Message records of the wanted channels (id -> (topic, the index of its
+    schema in ``out.definitions[topic]``))."""
     pos, end = 0, len(records)
     full, head = _RECORD_MESSAGE.unpack_from, _RECORD.unpack_from
-    logs = {channel: out.log_ns[topic] for channel, topic in wanted.items()}
-    datas = {channel: out.data[topic] for channel, topic in wanted.items()}
+    logs = {channel: out.log_ns[topic] for channel, (topic, _) in wanted.items()}
+    datas = {channel: out.data[topic] for channel, (topic, _) in wanted.items()}
+    marks = {channel: partial(out.schema_index[topic].append, i)
+             for channel, (topic, i) in wanted.items()}  # fmt: skip
     last = end - _RECORD_MESSAGE.size  # from here on a record may end before a message's fields
     while pos <= last:  # one unpack a record: its opcode and length, a message's fields
         op, length, channel, _seq, log = full(records, pos)
@@ -165,6 +175,7 @@ def _walk(records: bytes, wanted: dict[int, str], out: RawTopics) -> None:
             if times is not None:
                 times.append(log)
                 datas[channel].append(records[pos + _MESSAGE_DATA : pos + 9 + length])
+                marks[channel]()
         pos += 9 + length
     # the records left start within a message's fields of the end: none is a whole message (a
     # message record holds >= _MESSAGE_DATA bytes), so one of opcode Message is damaged
@@ -189,7 +200,7 @@ def mcap_messages(
     are damaged."""
     out = RawTopics(metadata={name: [] for name in metadata})
     for topic in topics:
-        out.log_ns[topic], out.data[topic] = [], []
+        out.log_ns[topic], out.data[topic], out.schema_index[topic] = [], [], []
     for path in paths:
         with open(path, "rb") as f:
             try:
@@ -314,6 +325,13 @@ def note_type(types: dict[str, str | None], topic: str, msgtype: str) -> None:
         types[topic] = None
 
 
+def note_encoding(encodings: dict[str, str], topic: str, encoding: str) -> None:
+    """Record that a channel of ``topic`` holds messages of ``encoding``: the first other than
+    "cdr" once its channels differ (the replay reads cdr only and names it)."""
+    if encodings.setdefault(topic, encoding) == "cdr":
+        encodings[topic] = encoding
+
+
 def _mcap_file(f, out: RawTopics):
     """Append the messages of ``out``'s topics in one MCAP file; its summary, None where it
     is not the simple case."""
@@ -330,11 +348,15 @@ def _mcap_file(f, out: RawTopics):
         name = schema.name if schema is not None else ""
         note_type(out.types, channel.topic, name)
         if channel.topic in out.log_ns:
-            wanted[cid] = channel.topic
-            out.encodings[channel.topic] = channel.message_encoding
+            note_encoding(out.encodings, channel.topic, channel.message_encoding)
+            definition = ("", "")
             if schema is not None:
                 text = _text(schema.data, f"the schema of {channel.topic!r}")
-                out.definitions[channel.topic] = (schema.encoding, text)
+                definition = (schema.encoding, text)
+            known = out.definitions.setdefault(channel.topic, [])
+            if definition not in known:
+                known.append(definition)
+            wanted[cid] = (channel.topic, known.index(definition))
     before = {t: len(v) for t, v in out.log_ns.items()}
     size = os.fstat(f.fileno()).st_size
     for index in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
@@ -351,10 +373,11 @@ def _mcap_file(f, out: RawTopics):
         except _Damaged as exc:
             raise _Damaged(f"the chunk at byte {start}: {exc}") from exc
     counts = summary.statistics.channel_message_counts
-    for cid, topic in wanted.items():
+    for topic in before:
+        channels = [cid for cid, (t, _) in wanted.items() if t == topic]
         found = len(out.log_ns[topic]) - before[topic]
-        if counts.get(cid, found) != found:  # messages outside chunks
-            return None
+        if all(c in counts for c in channels) and sum(counts[c] for c in channels) != found:
+            return None  # messages outside chunks
     return summary
 
 
@@ -468,7 +491,7 @@ def _sqlite_definitions(
         if msgtype in found and topic not in out.definitions:
             encoding, text = found[msgtype]
             try:
-                out.definitions[topic] = (encoding, text.decode())
+                out.definitions[topic] = [(encoding, text.decode())]
             except UnicodeDecodeError as exc:
                 raise BagError(
                     f"{path} is damaged: the message definition of the topic {topic!r} is not "

@@ -103,8 +103,8 @@ def _message(channel: int, log_ns: int, data: bytes) -> bytes:
 
 
 def _walk(records: bytes) -> storage.RawTopics:
-    out = storage.RawTopics(log_ns={"/a": []}, data={"/a": []})
-    storage._walk(records, {1: "/a"}, out)
+    out = storage.RawTopics(log_ns={"/a": []}, data={"/a": []}, schema_index={"/a": []})
+    storage._walk(records, {1: ("/a", 0)}, out)
     return out
 
 
