@@ -698,7 +698,7 @@ def prepare(
     x_unit, t_unit = std.x_to_unit(sim.x), std.t_to_unit(sim.t)
     basis = mean_basis_mod.make(mean_basis, sim.p + sim.q, sim.m)
     if basis is not None:  # refused before sampling, not at the first prediction
-        mean_basis_mod.check_rank(basis, np.hstack([x_unit, t_unit]))
+        mean_basis_mod.check_rank(basis, np.hstack([x_unit, t_unit]), sim.x_names + sim.t_names)
     sep = None
     if sim.separable is not None:  # the unit design keeps the native one's product
         if obs is not None or basis is not None:
