@@ -21,7 +21,7 @@ from gpmsa.cli.text import (
 )
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.validation import DISCREPANCY_ARRAY
-from gpmsa.mcmc.diagnostics import beyond
+from gpmsa.mcmc.diagnostics import beyond, element_names
 from gpmsa.model.basis import variance_shares
 
 
@@ -123,8 +123,8 @@ def _separable_text(emulator) -> str:
 def _facts(manifest: dict, arrays: dict, emulator) -> dict:
     """What ``_lines`` derives from the file beyond its manifest's fields, for ``--json``
     (``gpmsa.cli.info_json.emulator_info``): the model's sha256, separable factors, output
-    scale, output index, basis, the posterior's diagnostics (held positions marked, theta's
-    means native) and the number of array values."""
+    scale, output index, basis, the posterior's diagnostics (held positions and those of an
+    infinite R-hat marked, theta's means native) and the number of array values."""
     std, sep = emulator.standardizer, emulator.separable
     names = emulator.x_names + emulator.t_names
     separable = None
@@ -146,8 +146,9 @@ def _facts(manifest: dict, arrays: dict, emulator) -> dict:
             posterior[name] = d  # a record gpmsa does not write: as it is
             continue
         held = _held_positions(fixed.get(name), shapes.get(name), len(d["mean"]))
+        apart = _infinite_rhat(manifest.get("convergence"), name, shapes.get(name), len(d["mean"]))
         posterior[name] = {"mean": d["mean"], "ess": d.get("ess"), "rhat": d.get("rhat"),
-                           "held": sorted(held)}  # fmt: skip
+                           "held": sorted(held), "rhat_inf": sorted(apart - held)}  # fmt: skip
         native = _native_means(manifest, d["mean"], std) if name == "theta" else None
         if native is not None:
             posterior[name]["mean_native"] = dict(zip(emulator.t_names, native, strict=True))
@@ -264,11 +265,14 @@ def _lines(file: str, manifest: dict, arrays: dict, emulator) -> list[str]:
     for name, d in manifest["diagnostics"].items():
         if isinstance(d, dict) and isinstance(d.get("mean"), list):
             held = _held_positions(fixed.get(name), shapes.get(name), len(d["mean"]))
+            apart = _infinite_rhat(manifest.get("convergence"), name, shapes.get(name),
+                                   len(d["mean"]))  # fmt: skip
             cells = {}
             for key, fmt in (("mean", ".4g"), ("ess", ".0f"), ("rhat", ".3f")):
                 vals = d.get(key, [])
                 cells[key] = (
-                    _cells(vals, fmt, held if key != "mean" else set())
+                    _cells(vals, fmt, held if key != "mean" else set(),
+                           apart if key == "rhat" else set())
                     if isinstance(vals, list) else value(vals)
                 )  # fmt: skip
             label = safe(name, 60)
@@ -382,16 +386,38 @@ def _in_domain(standardizer, k: int, v: float) -> str:
     return numbers(float(v), *ends, digits=4)[0]
 
 
-def _cells(vals: list, fmt: str, held: set[int]) -> str:
+def _cells(vals: list, fmt: str, held: set[int], infinite: set[int]) -> str:
     """A diagnostic's values, one cell per element in its place: "held" at ``held``'s
-    positions, "nan" for a value stored as null (non-finite) among others (a free element
-    beside a held one too: a categorical theta element whose draws all sit at one level has
-    no ESS); none where every value is null and none held (a diagnostic one chain cannot
-    give)."""
-    if not held and all(v is None for v in vals):
+    positions, "inf" for a value stored as null at ``infinite``'s (an R-hat of chains stuck
+    apart, `_infinite_rhat`), "nan" for another value stored as null (not computable) among
+    others (a free element beside a held one too: a categorical theta element whose draws all
+    sit at one level has no ESS); none where every value is null and none held or infinite (a
+    diagnostic one chain cannot give)."""
+    if not (held or infinite) and all(v is None for v in vals):
         return ""
-    return ", ".join("held" if k in held else "nan" if v is None else number(v, fmt)
+    return ", ".join("held" if k in held else number(v, fmt) if v is not None
+                     else "inf" if k in infinite else "nan"
                      for k, v in enumerate(vals))  # fmt: skip
+
+
+INFINITE_RHAT = "R-hat inf"
+"""The convergence record's reason (``diagnostics.convergence``'s "flagged") for an element
+whose R-hat is infinite, before any ", ESS ..." it adds."""
+
+
+def _infinite_rhat(record: object, name: str, shape, size: int) -> set[int]:
+    """The positions (C order) of the ``size`` elements of parameter ``name`` whose R-hat is
+    infinite (each chain constant, the chains apart): those the convergence ``record`` flags
+    so (``INFINITE_RHAT``). The diagnostics store such an R-hat as null, as they store one
+    that cannot be computed (every draw one value). ``shape``: a 2-D parameter's; None: 1-D."""
+    flagged = record.get("flagged") if isinstance(record, dict) else None
+    if not isinstance(flagged, dict):
+        return set()
+    two_d = shape is not None and len(shape) == 2 and shape[0] * shape[1] == size
+    names = element_names(name, tuple(shape) if two_d else (size,))
+    reasons = [flagged.get(el) for el in names]
+    return {k for k, why in enumerate(reasons)
+            if isinstance(why, str) and why.split(",")[0] == INFINITE_RHAT}  # fmt: skip
 
 
 def _held_positions(record: object, shape, size: int) -> set[int]:

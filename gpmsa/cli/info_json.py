@@ -3,13 +3,15 @@
 Its keys are documented in docs/emulator-file.md ("gpmsa info --json"); ``INFO_FORMAT`` names
 their version. Numbers are JSON numbers; a value that is not finite (an R-hat of stuck chains,
 the ESS of a held parameter) is null, and so is a prior's infinite upper bound, so a strict
-parser (RFC 8259: no NaN or Infinity tokens) reads the output. The verified manifest is kept
+parser (RFC 8259: no NaN or Infinity tokens) reads the output; the posterior's "rhat_inf" tells
+an infinite R-hat (chains stuck apart) from one not computable. The verified manifest is kept
 whole under "manifest".
 """
 
 from __future__ import annotations
 
 import json
+import math
 
 from gpmsa.cli.index_text import index_record
 from gpmsa.io.container import jsonable
@@ -87,6 +89,12 @@ def emulator_info(file: str, manifest: dict, facts: dict) -> dict:
     }
 
 
+def _infinite(value: object) -> bool:
+    """Whether ``value`` is an infinite number (an R-hat of chains stuck apart), which the
+    record writes as null, as it writes NaN (an R-hat not computable)."""
+    return isinstance(value, float) and math.isinf(value)
+
+
 def study_info(file: str, manifest: dict, study) -> dict:
     """A study file's record: ``manifest`` verified, ``study`` loaded from it
     (``gpmsa.load_study``: its posterior summary and convergence computed from the draws)."""
@@ -107,7 +115,10 @@ def study_info(file: str, manifest: dict, study) -> dict:
         "hyperpriors": hyper,
         "settings": manifest["settings"],
         "metadata": manifest["metadata"],
-        "posterior": study.summary(0.9),
+        "posterior": {
+            name: {**row, "rhat_inf": _infinite(row.get("rhat"))}
+            for name, row in study.summary(0.9).items()
+        },
         "convergence": study.convergence or None,
         "converged": _converged(study.convergence),
     }

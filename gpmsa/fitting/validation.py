@@ -544,13 +544,21 @@ def _held_elements(rec: dict, shape: tuple[int, ...], field: str) -> tuple[list,
     return seen, values
 
 
+def file_floats(value, field: str) -> np.ndarray:
+    """``value``, a file's record of numbers in nested lists, as a float array;
+    EmulatorFileError naming ``field`` as a damaged record for anything else (text, bools,
+    null, objects, ragged lists, an integer beyond float64): ``as_float``'s message without
+    its advice on a user's own data (a CSV table's text)."""
+    try:
+        return as_float(value, field, advice=False)
+    except GPMSAError as exc:
+        raise EmulatorFileError(f"{exc} (a damaged record: gpmsa writes numbers there)") from None
+
+
 def _finite_values(value, field: str) -> np.ndarray:
     """``value`` (numbers in nested lists) as a float array; EmulatorFileError naming ``field``
     for anything else (text, bools, null, ragged lists) or a value that is not finite."""
-    try:
-        arr = as_float(value, field)
-    except GPMSAError as exc:
-        raise EmulatorFileError(str(exc)) from None
+    arr = file_floats(value, field)
     if not np.all(np.isfinite(arr)):
         raise _fail(field, f"must be finite numbers, got {_short(value)}")
     return arr
@@ -622,10 +630,8 @@ def check_hot_record(settings: dict, shapes: dict[str, tuple[int, ...]]) -> None
             shape = shapes.get(f"draw_{name}", shapes.get(f"cal_{name}"))
             if shape is None:
                 raise _fail(field, "names no parameter with draws in the file")
-            try:  # null: a NaN written (a state's is not finite, a width's not sampled)
-                arr = as_float(none_as_nan(value), field)
-            except GPMSAError as exc:
-                raise EmulatorFileError(str(exc)) from None
+            # null: a NaN written (a state's is not finite, a width's not sampled)
+            arr = file_floats(none_as_nan(value), field)
             if key == "hot_states" and not np.all(np.isfinite(arr)):
                 raise _fail(field, f"must be finite numbers, got {_short(value)}")
             bad = ~np.isnan(arr) & ~(np.isfinite(arr) & (arr > 0))

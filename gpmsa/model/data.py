@@ -66,13 +66,18 @@ def check_not_masked(value, name: str) -> None:
         )
 
 
-def as_float(value, name: str) -> np.ndarray:
+def as_float(value, name: str, *, advice: bool = True) -> np.ndarray:
     """Return ``value`` as a float64 array (a copy); GPMSAError naming ``name`` when it is not
     real numbers (strings, even numeric ones, bools, None, objects, ragged lists; complex
     values, which are never cast to their real part). numpy integer and float scalars are
-    numbers. A numpy masked array is refused (`check_not_masked`)."""
+    numbers. A numpy masked array is refused (`check_not_masked`). ``advice``: the message
+    says what is not converted and, for text, where it lies and what it may be (a CSV table's
+    decimal comma, a missing-value mark); False for a value read from a file's record, whose
+    caller says the record is damaged."""
     check_not_masked(value, name)
     bad = _first_non_number(value)
+    if bad is not None and not advice:
+        raise GPMSAError(f"{name} must be a numeric array, got {bad}")
     if bad is not None:
         raise GPMSAError(
             f"{name} must be a numeric array, got {bad} (text, bools, dates and None are not "

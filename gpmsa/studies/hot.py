@@ -17,7 +17,9 @@ import numpy as np
 
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.fitting.continuation import reordered
-from gpmsa.fitting.validation import HOT_RECORD, MAX_HOT_VALUES, hot_record_given
+from gpmsa.fitting.validation import HOT_RECORD, MAX_HOT_VALUES, file_floats, hot_record_given
+from gpmsa.mcmc.sampler import none_as_nan
+from gpmsa.model.data import as_float
 from gpmsa.model.discrepancy import n_groups
 from gpmsa.studies.sampler import StudyState
 
@@ -66,7 +68,7 @@ def _copies(settings, starts, problems, layout, hyper, there, orders, n_hot):
     n_chains = len(starts)
 
     def arr(value, shape, what):
-        out = np.asarray(value, dtype=np.float64)
+        out = as_float(value, what, advice=False)
         if 0 in shape and out.size == 0:  # JSON keeps no empty shape
             out = np.zeros((n_chains, n_hot, *shape))
         if out.shape != (n_chains, n_hot, *shape):
@@ -84,6 +86,8 @@ def _copies(settings, starts, problems, layout, hyper, there, orders, n_hot):
                              f"{sorted(set(prob.sampled) - {'theta'})}")  # fmt: skip
         members.append({n: reordered(n, arr(v, prob.init[n].shape, f"{lab}.{n}"), order)
                         for n, v in rec.items()})  # fmt: skip
+    if set(widths) != set(there):
+        raise GPMSAError(f"widths name {sorted(widths)}, this study sweeps {sorted(there)}")
     w = np.stack([arr(widths[n], (), f"widths of {n!r}") for n in there], axis=-1)
     if not (np.all(np.isfinite(w)) and np.all(w > 0)):
         raise GPMSAError("widths must be finite numbers > 0")
@@ -171,14 +175,13 @@ def member_shapes(study, i: int) -> dict[str, tuple[int, ...]]:
 
 
 def _values(value, shape, field: str, positive: bool) -> np.ndarray:
-    """``value`` as finite float64 (> 0 where ``positive``) of ``shape`` (None: any)."""
-    try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise _fail(field, f"must be an array of numbers, got {value!r:.60}") from None
+    """``value`` as finite float64 (> 0 where ``positive``) of ``shape`` (None: any): numbers
+    in nested lists, null among them read as NaN (refused as not finite)."""
+    arr = file_floats(none_as_nan(value) if isinstance(value, list) else value, field)
     if shape is not None and arr.shape != shape and not (arr.size == 0 and 0 in shape):
         raise _fail(field, f"has shape {list(arr.shape)}, expected {list(shape)} (chains, hot "
-                           "copies, ...)")  # fmt: skip
+                           "copies: one per rung of settings.temperatures above T = 1, "
+                           "...)")  # fmt: skip
     bad = ~np.isfinite(arr) | ((arr <= 0) if positive else False)
     if np.any(bad):  # the values refused, not the array's first
         need = "finite numbers > 0" if positive else "finite numbers"

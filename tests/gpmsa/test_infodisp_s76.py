@@ -119,7 +119,8 @@ def test_info_json_of_non_finite_diagnostics_is_strict_json(tmp_path, capsys):
     path = str(emu.save(tmp_path / "stuck.gpmsa"))
     assert main(["info", "--json", path]) == 0
     out = _strict(capsys.readouterr().out)
-    assert out["posterior"]["lamUz"] == {"mean": [1.0], "ess": [None], "rhat": [None], "held": []}
+    assert out["posterior"]["lamUz"] == {"mean": [1.0], "ess": [None], "rhat": [None], "held": [],
+                                         "rhat_inf": [0]}  # fmt: skip
     assert out["convergence"]["max_rhat"] == ["lamUz[0]", None] and out["converged"] is False
     assert out["posterior"]["lamWs"]["held"] == [] and out["settings"]["n_chains"] == 2
 
