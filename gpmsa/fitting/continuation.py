@@ -267,7 +267,7 @@ def continued_copies(emulator: Emulator, problem: Problem, n_chains: int, ladder
     if theta is not None and problem.theta_levels:  # a float32 fit's levels, as its draws'
         try:
             theta = np.array(theta, dtype=np.float64)
-        except (TypeError, ValueError):  # a damaged record: the check names it
+        except (TypeError, ValueError, OverflowError):  # a damaged record: the check names it
             theta = None
         if theta is not None and theta.shape[-1:] == (len(problem.theta_levels),):
             _at_levels(problem, theta)

@@ -25,6 +25,7 @@ from gpmsa.fitting.continuation import (
 )
 from gpmsa.fitting.continuation import check_append as check_fit_append
 from gpmsa.fitting.emulator import EMULATOR_PARAMS
+from gpmsa.model.data import as_float
 from gpmsa.model.problem import Problem
 from gpmsa.studies.layout import HyperPriors, Layout
 from gpmsa.studies.record import discrepancy_arrays
@@ -215,9 +216,9 @@ def continued_widths(source: Study, names: list[str], n_chains: int) -> list[np.
     if not isinstance(record, dict) or sorted(record) != sorted(names):
         raise GPMSAError("init=study: its recorded step widths do not name this study's sweep "
                          "elements (another model?); pass tune=True")  # fmt: skip
-    try:
-        w = np.array([record[n] for n in names], dtype=np.float64).T
-    except (TypeError, ValueError):
+    try:  # text, bools, null or a number beyond float64: a damaged record
+        w = as_float([record[n] for n in names], "the step widths", advice=False).T
+    except GPMSAError:
         w = np.empty(0)
     if w.shape != (n_chains, len(names)) or not (np.all(np.isfinite(w)) and np.all(w > 0)):
         raise GPMSAError(f"init=study: its recorded step widths are not finite positive widths "
