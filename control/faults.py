@@ -95,6 +95,7 @@ class FaultInjector:
         self._read: dict[int, float] = {}
         self._held: dict[int, float] = {}  # per stuck fault, the value it holds
         self._spiked: dict[int, int] = {}  # per spike fault, the samples it has covered so far
+        self._spans = _spans(self.faults)
 
     def __copy__(self) -> FaultInjector:
         """``copy.copy``: a deep copy (a shallow one shared the generator and the held values,
@@ -107,6 +108,7 @@ class FaultInjector:
         last = state.pop("_last", np.nan)
         stuck = [i for i, f in enumerate(state["faults"]) if f.kind == "stuck"]
         state.setdefault("_read", {i: last for i in stuck if np.isfinite(last)})
+        state.setdefault("_spans", _spans(state["faults"]))  # (one pickled before session 85)
         self.__dict__.update(state)
 
     def __call__(self, t, position, accel, speed):
@@ -137,8 +139,11 @@ class FaultInjector:
     def _apply(self, t, pos, acc, clock, keep, spiked: dict, held: dict, read: dict) -> None:
         """Apply the faults to a batch's arrays in place; ``spiked``, ``held`` and ``read``:
         copies of the spike counts, stuck values and stuck faults' newest readings, updated
-        (`__call__` keeps them once all went well)."""
-        for i, fault in enumerate(self.faults):
+        (`__call__` keeps them once all went well). Only the faults whose span may reach the
+        batch's times (and the stuck ones, which read every batch before theirs) are visited:
+        a long stream with a fault every few seconds costs per batch what its own faults do."""
+        for i in self._visited(clock).tolist():
+            fault = self.faults[i]
             hit = (clock >= fault.start_s) & (clock < fault.start_s + fault.duration_s)
             if fault.kind == "stuck" and i not in held:
                 self._before(acc, hit, i, read)
@@ -173,6 +178,16 @@ class FaultInjector:
             elif k == "position_nan":
                 pos[hit] = np.nan
 
+    def _visited(self, clock: np.ndarray) -> np.ndarray:
+        """Indices, in list order, of the faults `_apply` visits for a batch at times
+        ``clock``: every fault but those whose [start_s, start_s + duration_s) lies wholly
+        before or after the batch's finite times (such a fault hits none of its samples)."""
+        start, end, stuck = self._spans
+        times = clock[~np.isnan(clock)]
+        if not times.size:
+            return np.flatnonzero(stuck)
+        return np.flatnonzero(((start <= times.max()) & (end > times.min())) | stuck)
+
     @staticmethod
     def _before(acc: np.ndarray, hit: np.ndarray, i: int, read: dict) -> None:
         """Keep in ``read[i]`` the newest finite reading of ``acc`` before the first sample of
@@ -182,6 +197,17 @@ class FaultInjector:
         finite = np.flatnonzero(np.isfinite(acc[: np.argmax(hit) if hit.any() else None]))
         if finite.size:
             read[i] = float(acc[finite[-1]])
+
+
+def _spans(faults: tuple[SensorFault, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(start, end, stuck) per fault: its start_s and start_s + duration_s as floats, each
+    widened by one ulp (a start or duration given as an int or a numpy scalar rounds to the
+    nearest float: the span stays one that holds every time its fault hits), and whether it is
+    a stuck fault."""
+    start = np.array([float(f.start_s) for f in faults], dtype=float)
+    end = np.array([float(f.start_s + f.duration_s) for f in faults], dtype=float)
+    stuck = np.array([f.kind == "stuck" for f in faults], dtype=bool)
+    return np.nextafter(start, -np.inf), np.nextafter(end, np.inf), stuck
 
 
 def _batch(name: str, value) -> np.ndarray:

@@ -140,12 +140,18 @@ def gd_errors(track, position: np.ndarray, gd_estimate: np.ndarray) -> tuple[GDE
     starts, seg_gd = _track_parts(track)
     _check_on_track(track, starts, position)
     ok = np.isfinite(gd_estimate) & np.isfinite(position)
-    truth = np.full(position.shape, np.nan)  # no segment: left out
-    truth[ok] = seg_gd[_segment_of(starts, position[ok])]
+    gds, part = np.unique(seg_gd, return_inverse=True)
+    part = part[_segment_of(starts, position[ok])]  # the distinct GD of each kept estimate
+    part[np.isnan(gds[part])] = gds.size  # a GD that is NaN matches no estimate
+    # each GD's estimates in one slice, in their order (stable): the sums of a mask per GD,
+    # bit for bit, in one pass rather than one per distinct GD
+    order = np.argsort(part, kind="stable")
+    values = gd_estimate[ok][order]
+    edges = np.searchsorted(part[order], np.arange(gds.size + 1))
     out = []
-    for gd in np.unique(seg_gd):
-        sel = ok & (truth == gd)
-        out.append(GDError(float(gd), float(np.sum((gd_estimate[sel] - gd) ** 2)), int(sel.sum())))
+    for k, gd in enumerate(gds):
+        sel = values[edges[k] : edges[k + 1]]
+        out.append(GDError(float(gd), float(np.sum((sel - gd) ** 2)), int(sel.size)))
     return tuple(out)
 
 
@@ -235,20 +241,20 @@ def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tu
     position, gd_estimate = _traces(position, gd_estimate, "gd_estimate")
     starts, seg_gd = _track_parts(track)
     _check_on_track(track, starts, position)
-    seg_gd = seg_gd.tolist()
-    finite = np.isfinite(gd_estimate)
-    delays = []
-    for k in range(1, len(seg_gd)):
-        before, after = seg_gd[k - 1], seg_gd[k]
-        if before == after:
-            continue
-        nxt = next((j for j in range(k + 1, len(seg_gd)) if seg_gd[j] != after), None)
-        end = np.inf if nxt is None else starts[nxt]
-        mid = (before + after) / 2
-        crossed = (gd_estimate > mid) if after > before else (gd_estimate < mid)
-        sel = np.flatnonzero((position >= starts[k]) & (position < end) & crossed & finite)
-        delays.append(float(position[sel[0]] - starts[k]) if sel.size else np.nan)
-    return tuple(delays)
+    # each change of GD k watches from its start to the next change: [starts[k], starts[next])
+    change = np.flatnonzero(seg_gd[1:] != seg_gd[:-1]) + 1  # (a NaN GD differs from all)
+    before, after = seg_gd[change - 1], seg_gd[change]
+    mid = (before + after) / 2
+    delays = np.full(change.size, np.nan)
+    seen = np.flatnonzero(np.isfinite(position) & np.isfinite(gd_estimate))
+    w = np.searchsorted(starts[change], position[seen], side="right") - 1  # the change watching
+    seen, w = seen[w >= 0], w[w >= 0]
+    est, m = gd_estimate[seen], mid[w]
+    crossed = np.where(after[w] > before[w], est > m, est < m)
+    first, at = np.unique(w[crossed], return_index=True)  # the first in time of each change
+    hit = seen[crossed][at]
+    delays[first] = position[hit] - starts[change[first]]
+    return tuple(float(d) for d in delays)
 
 
 def fast_on_rough_m(

@@ -106,18 +106,36 @@ def into_gaps(t: np.ndarray, order: np.ndarray, period: float) -> tuple[np.ndarr
     fits = (hi - lo > GAP_PERIODS * period) & (tc - lo >= period / 2) & (hi - tc >= period / 2)
     block = np.cumsum(kept)[late]  # messages left behind one after another: one block
     fits &= ~np.isin(block, block[~fits])
-    for gap in np.unique(j[fits]):
-        inside = fits & (j == gap)
-        times = np.sort(tc[inside])
-        slots = round((k[gap] - k[gap - 1]) / period) - 1
-        if times.size > slots or np.any(np.diff(times) < period / 2):
-            fits[inside] = False  # more than the gap holds: not (only) late messages
+    fits[_overfilled(j, tc, fits, k, period)] = False  # not (only) late messages
     fits &= ~np.isin(block, block[~fits])  # a block moves whole or not at all
     if not fits.any():
         return order, 0
     anchor = np.arange(ts.size, dtype=float)  # each moved message right after the gap's start
     anchor[late[fits]] = at[j[fits] - 1] + 0.5
     return order[np.lexsort((ts, anchor))], int(np.count_nonzero(fits))
+
+
+def _overfilled(
+    j: np.ndarray, tc: np.ndarray, fits: np.ndarray, k: np.ndarray, period: float
+) -> np.ndarray:
+    """Mask of the late messages that fit (``fits``; time ``tc``, in gap ``j`` between the
+    times ``k[j - 1]`` and ``k[j]`` in order) whose gap gets more than its missing slots hold,
+    or two of them less than half a period apart. One sort for all gaps (a loop over the gaps
+    cost a pass over every late message per gap: quadratic in a long stream's gaps)."""
+    out = np.zeros(fits.shape, dtype=bool)
+    idx = np.flatnonzero(fits)
+    if not idx.size:
+        return out
+    idx = idx[np.lexsort((tc[idx], j[idx]))]  # by gap, then by time
+    gap, times = j[idx], tc[idx]
+    new = np.r_[True, gap[1:] != gap[:-1]]  # a gap's first message
+    first = np.flatnonzero(new)
+    gaps, count = gap[first], np.diff(np.r_[first, gap.size])
+    slots = np.rint((k[gaps] - k[gaps - 1]) / period) - 1
+    close = np.r_[False, (np.diff(times) < period / 2) & ~new[1:]]  # within one gap
+    bad = (count > slots) | np.logical_or.reduceat(close, first)
+    out[idx[np.repeat(bad, count)]] = True
+    return out
 
 
 def _fit_line(k: np.ndarray, t: np.ndarray) -> tuple[float, float]:
