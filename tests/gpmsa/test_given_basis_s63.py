@@ -1,14 +1,13 @@
 """A user-supplied emulator basis (``fit(..., basis=)``, GPM/SA's ``Ksim``): checks, the
 weight-scale warning, agreement with the PCA path, files, continuation and studies."""
 
-import subprocess
-import sys
 import warnings
 
 import numpy as np
 import pytest
 
 import gpmsa
+from gpmsa.cli.main import main
 
 GRID = np.linspace(0.0, 1.0, 25)
 
@@ -137,7 +136,7 @@ def test_the_weight_scale_is_judged_by_the_lamuz_prior_given():
     _no_warnings(gpmsa.prepare, sim, basis=K * 10.0, priors=tight)  # weights / 10
 
 
-def test_a_given_basis_round_trips_and_info_names_it(tmp_path):
+def test_a_given_basis_round_trips_and_info_names_it(tmp_path, capsys):
     sim = _sim()
     K = _cosine_basis(sim, 6)
     emu = gpmsa.fit(sim, n_iter=200, seed=1, basis=K)
@@ -145,20 +144,22 @@ def test_a_given_basis_round_trips_and_info_names_it(tmp_path):
     emu.save(path)
     back = gpmsa.load(path)
     assert np.array_equal(back.K, K) and back.settings["basis"] == "given"
-    out = subprocess.run([sys.executable, "-m", "gpmsa", "info", str(path)],
-                         capture_output=True, text=True, check=True).stdout  # fmt: skip
+    capsys.readouterr()
+    assert main(["info", str(path)]) == 0  # in process; python -m gpmsa: test_cli_module_and_info
+    out = capsys.readouterr().out
     line = next(s for s in out.splitlines() if s.startswith("basis:"))
     y_std = emu.standardizer.y_to_std(sim.y)
     share = 1 - np.sum((y_std - emu.w @ K.T) ** 2) / np.sum(y_std**2)
     assert "given" in line and "6 vector(s)" in line and f"{share:.2%}" in line
 
 
-def test_a_pca_file_shows_its_basis_share(tmp_path):
+def test_a_pca_file_shows_its_basis_share(tmp_path, capsys):
     sim = _sim()
     path = tmp_path / "pca.gpmsa"
     gpmsa.fit(sim, n_iter=100, seed=1, n_pc=2).save(path)
-    out = subprocess.run([sys.executable, "-m", "gpmsa", "info", str(path)],
-                         capture_output=True, text=True, check=True).stdout  # fmt: skip
+    capsys.readouterr()
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
     assert "basis:           PCA of the runs, 2 vector(s)" in out
 
 

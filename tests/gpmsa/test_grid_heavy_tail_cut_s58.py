@@ -23,7 +23,7 @@ def test_a_heavy_tail_cut_past_its_peak_is_refined_over_its_core(n, cut, n_grid)
     x, y = observations(n)
     cal = Calibrator(vague_lamos_emulator(), n_grid=n_grid, constraint=lambda t: t[0] >= cut)
     post = cal.update(x, y)
-    sd, quantiles = dense_reference(cal, x, y, around=0.4, cut=cut)
+    sd, quantiles = dense_reference(n, around=0.4, cut=cut)
     assert np.max(np.abs(post.quantile("t", LEVELS) - quantiles)) < 0.04 * sd
     assert np.max(np.abs(post.grids["t"].cdf(quantiles) - LEVELS)) < 0.0015
 

@@ -6,6 +6,7 @@ silently wrong), down to float64's resolution of the parameter."""
 
 import warnings
 from dataclasses import replace
+from functools import cache
 
 import numpy as np
 import pytest
@@ -40,17 +41,30 @@ def observations(n: int):
     return x, 0.3 * x + 0.4 + 1e-4 * np.random.default_rng(0).standard_normal(x.shape)
 
 
-def dense_reference(cal, x, y, around: float, cut: float | None = None):
-    """(sd, quantiles at LEVELS) of the exact posterior (the Calibrator's per-node likelihood,
-    lamOs integrated) on the whole axis at 1/20000 plus nodes 1/400000 apart within 0.05 of
-    ``around`` (unit scale; tens of nodes per sd); ``cut``: cut below this (native), a node
-    inserted there."""
+@cache
+def dense_log_posterior(n: int, around: float) -> tuple[np.ndarray, np.ndarray]:
+    """(unit-scale nodes, log posterior) of `observations` (n) on `vague_lamos_emulator` (the
+    Calibrator's per-node likelihood, lamOs integrated): the whole axis at 1/20000 plus nodes
+    1/400000 apart within 0.05 of ``around`` (tens of nodes per sd). It depends on neither the
+    Calibrator's n_grid nor its constraint (the same to the bit), so the tests of one ``n``
+    share it (1.2 s each); read-only."""
     u = np.unique(np.concatenate([np.linspace(0, 1, 20001),
                                   np.linspace(around - 0.05, around + 0.05, 40001)]))  # fmt: skip
-    data = reduce(cal.emulator, x, y, False)
+    cal = Calibrator(vague_lamos_emulator())
+    data = reduce(cal.emulator, *observations(n), False)
     logp = np.concatenate([cal._combine(cal._marginals(data, t)) + cal._theta_prior_at(t, None)
                            for t in np.array_split(u[:, None], 15)])  # fmt: skip
-    std = cal.emulator.standardizer
+    u.setflags(write=False)
+    logp.setflags(write=False)
+    return u, logp
+
+
+def dense_reference(n: int, around: float, cut: float | None = None):
+    """(sd, quantiles at LEVELS) of the exact posterior of `observations` (n) on
+    `vague_lamos_emulator` (`dense_log_posterior`); ``cut``: cut below this (native), a node
+    inserted there."""
+    u, logp = dense_log_posterior(n, around)
+    std = vague_lamos_emulator().standardizer
     nodes = u * (std.t_max[0] - std.t_min[0]) + std.t_min[0]
     if cut is not None:
         native, nodes = nodes, np.unique(np.concatenate([nodes[nodes >= cut], [cut]]))
@@ -75,7 +89,7 @@ def test_heavy_tails_beyond_the_node_budget_are_refined_over_their_core(n, n_gri
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         post = cal.update(x, y)
-    sd, quantiles = dense_reference(cal, x, y, around=0.4)
+    sd, quantiles = dense_reference(n, around=0.4)
     gm = post.grids["t"]
     assert np.max(np.abs(post.quantile("t", LEVELS) - quantiles)) < 0.015 * sd
     assert np.max(np.abs(gm.cdf(quantiles) - LEVELS)) < 0.001
@@ -144,7 +158,7 @@ def test_a_fine_gridded_prior_with_zeros_no_longer_holds_refinement_at_its_nodes
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         post = cal.update(x, y, prior=np.where(unit > 0.6, -np.inf, 0.0))
-    sd, quantiles = dense_reference(cal, x, y, around=0.4)
+    sd, quantiles = dense_reference(2, around=0.4)
     inner = slice(1, -1)  # 0.01-0.99: the prior's zero beyond 0.6 cuts the far tail only
     assert np.max(np.abs(post.quantile("t", LEVELS[inner]) - quantiles[inner])) < 0.015 * sd
     assert post.prob_above("t", post.grids["t"].nodes[-1]) == 0.0

@@ -7,6 +7,7 @@ package's face, which imports every part and which no module may import.
 """
 
 import ast
+import functools
 import importlib
 import inspect
 import os
@@ -99,7 +100,10 @@ def gpmsa_imports(source: str, name: str, is_package: bool, known) -> list[tuple
     return found
 
 
+@functools.cache
 def import_graph(root: Path = PACKAGE) -> dict[str, list[tuple[str, int]]]:
+    """Each module under ``root`` -> its `gpmsa_imports`; parsed once a session per root (the
+    checks only read it)."""
     files = module_files(root)
     return {
         name: gpmsa_imports(path.read_text(), name, path.name == "__init__.py", files)

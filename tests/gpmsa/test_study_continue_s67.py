@@ -1,6 +1,7 @@
 """Continuing a study's chains (``init=study``, session 67): SEPIA's second ``do_mcmc`` of its
 shared and hierarchical models."""
 
+import functools
 import warnings
 
 import numpy as np
@@ -124,6 +125,12 @@ def _preps(sim, obs):
     return [prepare(sim, o) for o in obs]
 
 
+@functools.cache
+def _refused_source():
+    """The study each refusal below is asked to continue, made once (the refusals only read it)."""
+    return _calibrate(60, 1, n_burn=10)
+
+
 @pytest.mark.parametrize(
     ("change", "match"),
     [
@@ -137,7 +144,7 @@ def _preps(sim, obs):
     ],
 )
 def test_a_continuation_refuses_another_study(change, match):
-    src = _calibrate(60, 1, n_burn=10)
+    src = _refused_source()
     xs, ys = _data()
     if change.pop("ys", False):
         ys = [y + 0.01 for y in ys]
