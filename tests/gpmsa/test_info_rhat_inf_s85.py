@@ -9,13 +9,13 @@ there, and ``--json`` keeps the null (strict JSON) and lists those positions und
 "rhat_inf" (a study's rows: true or false).
 """
 
-import json
 import re
 import warnings
 
 import numpy as np
 import pytest
 from _study_cases import emulator, observations
+from test_infodisp_s76 import _strict
 
 import gpmsa
 from gpmsa.cli.main import main
@@ -24,15 +24,6 @@ from gpmsa.mcmc import diagnostics
 from tests.gpmsa._emulator_edit import replaced
 
 SHAPES = {"betaU": (2, 1), "lamUz": (1,), "lamWs": (1,), "lamWOs": (1,)}
-
-
-def _strict(text: str):
-    """``text`` parsed as RFC 8259 JSON: a NaN, Infinity or -Infinity token raises."""
-
-    def refuse(token):
-        raise ValueError(f"not JSON: {token}")
-
-    return json.loads(text, parse_constant=refuse)
 
 
 @pytest.fixture(scope="module")
