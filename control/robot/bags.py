@@ -323,7 +323,8 @@ def _bag_information(folder: Path):
     for one nested too deep to parse (rosbags' parser would take seconds more to fail too)."""
     yaml = require("ruamel.yaml", "reading a ROS 2 bag")
     try:
-        return yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_text())[
+        # bytes: YAML's own encodings (UTF-8 as ROS 2 writes it, or a BOM's), not the locale's
+        return yaml.YAML(typ="safe").load((folder / "metadata.yaml").read_bytes())[
             "rosbag2_bagfile_information"
         ]
     except RecursionError as exc:
