@@ -21,7 +21,7 @@ from gpmsa.cli.text import (
 )
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.validation import DISCREPANCY_ARRAY
-from gpmsa.mcmc.diagnostics import beyond, element_names
+from gpmsa.mcmc.diagnostics import INFINITE_RHAT, beyond, element_names
 from gpmsa.model.basis import variance_shares
 
 
@@ -398,11 +398,6 @@ def _cells(vals: list, fmt: str, held: set[int], infinite: set[int]) -> str:
     return ", ".join("held" if k in held else number(v, fmt) if v is not None
                      else "inf" if k in infinite else "nan"
                      for k, v in enumerate(vals))  # fmt: skip
-
-
-INFINITE_RHAT = "R-hat inf"
-"""The convergence record's reason (``diagnostics.convergence``'s "flagged") for an element
-whose R-hat is infinite, before any ", ESS ..." it adds."""
 
 
 def _infinite_rhat(record: object, name: str, shape, size: int) -> set[int]:

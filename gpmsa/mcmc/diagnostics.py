@@ -208,6 +208,10 @@ RHAT_MAX = 1.01
 """Largest R-hat (rank-normalised, split) of a converged parameter (Vehtari et al. 2021)."""
 ESS_MIN = 100.0
 """Smallest bulk effective sample size of a converged parameter (all chains together)."""
+INFINITE_RHAT = "R-hat inf"
+"""`convergence`'s reason (before any ", ESS ..." it adds) for an element whose R-hat is
+infinite (each chain constant, the chains apart); a file's record stores that R-hat as null, as
+it stores one not computable, and `gpmsa info` tells them apart by this reason."""
 RHAT_NOISE = 7.0
 """(R-hat - 1) x bulk ESS that one converged chain's split R-hat exceeds in about 1% of chains,
 whatever its autocorrelation (measured on AR(1) chains, ESS 100-1,300: 99th percentiles 5.4-7.1,
@@ -287,7 +291,7 @@ def convergence(
                 continue
             why = []
             if r > RHAT_MAX:
-                why.append(f"R-hat {beyond(r, RHAT_MAX, 3)}")
+                why.append(INFINITE_RHAT if np.isinf(r) else f"R-hat {beyond(r, RHAT_MAX, 3)}")
                 if n_chains == 1 and e >= ESS_MIN and r <= 1.0 + RHAT_NOISE / e:
                     why[-1] += f" (within one converged chain's noise at ESS {e:.0f})"
             if e < ESS_MIN:
