@@ -653,7 +653,7 @@ def check_hot_copies(hot_copies, problem: Problem, ladders, n_chains: int) -> li
                              f"*shape), got {type(given).__name__}")  # fmt: skip
         flat[part] = {}
         for name, val in given.items():
-            arr = as_float(none_as_nan(val), f"hot_copies[{part!r}][{name!r}]")
+            arr = as_float(none_as_nan(val), f"hot_copies[{part!r}][{name!r}]", advice=False)
             shape = problem.init[name].shape if name in problem.init else None
             if shape is not None and 0 in shape and arr.size == 0:  # JSON keeps no empty shape
                 arr = np.zeros((n_chains, n_hot, *shape))
