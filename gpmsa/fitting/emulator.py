@@ -52,6 +52,7 @@ from gpmsa.model import kronecker
 from gpmsa.model.correlation import correlation
 from gpmsa.model.data import (
     SimData,
+    array_text,
     as_float,
     as_matrix,
     by_column_names,
@@ -197,17 +198,19 @@ def _check_params(params: Mapping, shapes: dict) -> dict[str, np.ndarray]:
             raise GPMSAError(f"params[{name!r}] must have shape {shape}, got {val.shape}")
         val = val.reshape(shape)
         if not np.all(np.isfinite(val)) or np.any(val <= 0):
-            raise GPMSAError(f"params[{name!r}] must be finite and > 0, got {val.ravel()}")
+            raise GPMSAError(
+                f"params[{name!r}] must be finite and > 0, got {array_text(val.ravel())}"
+            )
         if name.startswith("lam") and not np.all(val > SMALLEST_PRECISION):
             raise GPMSAError(  # (1 / lam, a variance, would overflow at the first prediction)
-                f"params[{name!r}] = {val.ravel()}: a precision whose variance 1 / {name} "
-                "overflows float64; GPM/SA's precisions lie far above this"
+                f"params[{name!r}] = {array_text(val.ravel())}: a precision whose variance "
+                f"1 / {name} overflows float64; GPM/SA's precisions lie far above this"
             )
         if name == "lamUz" and np.any(val < MIN_LAMUZ):
             raise GPMSAError(
-                f"params['lamUz'] = {val.ravel()}: below {MIN_LAMUZ:g} the GP's prior variance "
-                "1 / lamUz (in units of the outputs' variance) is too large for float64 to "
-                "resolve the predictive variance near the runs (GPM/SA bounds lamUz at 0.3)"
+                f"params['lamUz'] = {array_text(val.ravel())}: below {MIN_LAMUZ:g} the GP's prior "
+                "variance 1 / lamUz (in units of the outputs' variance) is too large for float64 "
+                "to resolve the predictive variance near the runs (GPM/SA bounds lamUz at 0.3)"
             )
         out[name] = val
     return out

@@ -365,6 +365,23 @@ def as_matrix(
     return arr
 
 
+NUMPY_PRINT_DEFAULTS = {
+    "precision": 8, "threshold": 1000, "edgeitems": 3, "linewidth": 75, "suppress": False,
+    "nanstr": "nan", "infstr": "inf", "sign": "-", "floatmode": "maxprec", "legacy": False,
+    "formatter": None, "override_repr": None,
+}  # fmt: skip
+"""numpy's own print options (``np.get_printoptions()`` of a fresh session)."""
+
+
+def array_text(arr) -> str:
+    """``str(arr)`` as numpy's default print options write it, whatever the user has set with
+    ``np.set_printoptions`` (precision=2 or suppress=True showed 1.004 as 1.00 and 1e-9 as 0.00
+    in a message about that very value; threshold=5 hid a NaN behind "...")."""
+    given = np.get_printoptions()  # override_repr: numpy >= 2.1
+    with np.printoptions(**{k: v for k, v in NUMPY_PRINT_DEFAULTS.items() if k in given}):
+        return str(np.asarray(arr))
+
+
 def check_finite(arr: np.ndarray, name: str) -> None:
     """Raise GPMSAError if ``arr`` holds NaN or inf, naming the first bad position."""
     bad = ~np.isfinite(arr)

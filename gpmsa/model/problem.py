@@ -29,7 +29,7 @@ from gpmsa.model.basis import (
     warn_weight_scale,
 )
 from gpmsa.model.constraints import ThetaConstraint
-from gpmsa.model.data import ObsData, SimData, as_float, check_finite
+from gpmsa.model.data import ObsData, SimData, array_text, as_float, check_finite
 from gpmsa.model.discrepancy import check_groups, n_groups
 from gpmsa.model.index_points import is_points
 from gpmsa.model.priors import Priors
@@ -344,12 +344,13 @@ def checked_fixed(name: str, val, shape: tuple[int, ...], priors: Priors, theta_
         raise GPMSAError(f"fixed[{name!r}] must be a scalar or have shape {shape}, got {arr.shape}")
     arr = arr.reshape(shape)
     if not np.all(np.isfinite(arr)):
-        raise GPMSAError(f"fixed[{name!r}] must be finite, got {arr.ravel()}")
+        raise GPMSAError(f"fixed[{name!r}] must be finite, got {array_text(arr.ravel())}")
     is_theta = name == "theta"
     lp = theta_log_prior(priors, theta_levels, arr) if is_theta else priors.log_prior(name, arr)
     if lp == -np.inf:
         raise GPMSAError(
-            f"fixed[{name!r}] = {arr.ravel()} lies outside its prior's bounds (zero prior density)"
+            f"fixed[{name!r}] = {array_text(arr.ravel())} lies outside its prior's bounds "
+            "(zero prior density)"
         )
     return arr
 

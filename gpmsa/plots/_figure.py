@@ -1,5 +1,6 @@
 """A bare matplotlib Figure (no pyplot state, no GUI backend), the style's ink colour, the
-histograms' bin check, the axes' labels, and which output indices draw as maps."""
+colours of series told apart by colour, the histograms' bin check, the axes' labels, and which
+output indices draw as maps."""
 
 from __future__ import annotations
 
@@ -25,6 +26,22 @@ def ink() -> str:
     from matplotlib import rcParams
 
     return rcParams["text.color"]
+
+
+def series_colours(n: int) -> list[str]:
+    """The colours of ``n`` series that a legend tells apart by colour alone (chains,
+    experiments): the style's colour cycle, ``"C0"``, ``"C1"``, ..., where it holds at least
+    ``min(n, 10)`` distinct colours, else matplotlib's default ten ("tab:blue", ...; a style or an
+    ``rcParams["axes.prop_cycle"]`` of one colour drew every series, and its legend entry, in
+    that one colour)."""
+    from matplotlib import rcParams
+    from matplotlib.colors import TABLEAU_COLORS, to_rgba
+
+    cycle = rcParams["axes.prop_cycle"].by_key().get("color", [])
+    if len({to_rgba(c) for c in cycle}) >= min(n, 10):
+        return [f"C{k}" for k in range(n)]
+    tab10 = list(TABLEAU_COLORS)
+    return [tab10[k % 10] for k in range(n)]
 
 
 def check_bins(bins, n_hist: int, what: str) -> int:

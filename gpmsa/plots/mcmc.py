@@ -12,7 +12,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import diagnostics
 from gpmsa.mcmc.sampler import Chains
 from gpmsa.model.data import as_float, check_count
-from gpmsa.plots._figure import axis_label, check_bins, figure
+from gpmsa.plots._figure import axis_label, check_bins, figure, series_colours
 from gpmsa.predictive.joint import calibration_posterior
 
 if TYPE_CHECKING:
@@ -137,8 +137,10 @@ def traces(source, names=None, *, max_params: int = 12, bins: int = 40) -> Figur
     axes = np.atleast_2d(fig.subplots(len(picked), 2, width_ratios=[3, 1], squeeze=False))
     for row, name in zip(axes, picked, strict=True):
         chains = series[name]
+        colours = series_colours(len(chains))
         for c, ch in enumerate(chains):
-            row[0].plot(ch, lw=0.6, color=f"C{c}", label=f"chain {c}" if len(chains) > 1 else None)
+            row[0].plot(ch, lw=0.6, color=colours[c],
+                        label=f"chain {c}" if len(chains) > 1 else None)  # fmt: skip
         row[0].set_ylabel(axis_label(name, units.get(name, "")))
         row[1].sharey(row[0])
         draws = chains.reshape(-1)
@@ -189,8 +191,9 @@ def autocorrelation(source, names=None, *, max_params: int = 12, max_lag: int = 
     band = 1.96 / np.sqrt(n_draws)
     for ax, name in zip(axes, picked, strict=False):
         chains = series[name]
+        colours = series_colours(len(chains))
         for c, acf in enumerate(diagnostics.autocorrelation(chains)):
-            ax.plot(lags, acf[: lags.size], lw=1.0, color=f"C{c}",
+            ax.plot(lags, acf[: lags.size], lw=1.0, color=colours[c],
                     label=f"chain {c}" if len(chains) > 1 else None)  # fmt: skip
         ax.axhline(0.0, color="0.3", lw=0.6)
         ax.axhspan(-band, band, color="0.85", zorder=0)

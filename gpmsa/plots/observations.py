@@ -12,7 +12,7 @@ from gpmsa.errors import GPMSAError
 from gpmsa.mcmc.diagnostics import histogram_bins
 from gpmsa.model.data import ObsData, check_count
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import check_bins, figure, index_labels, is_map
+from gpmsa.plots._figure import check_bins, figure, index_labels, is_map, series_colours
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -74,9 +74,10 @@ def obs_projection(emulator, obs: ObsData, *, max_pc: int = 6, bins: int = 30) -
         ax = fig.add_subplot(grid[j // n_cols, j % n_cols])
         w, u = emulator.w[:, j], reduced.u[:, j]
         ax.hist(w, bins=histogram_bins(w, bins), color="0.7", label="runs")
+        colours = series_colours(min(u.size, 10))
         for e, value in enumerate(u):
             ax.axvline(
-                value, color=f"C{e % 10}", lw=1.2, label=f"experiment {e}" if e < 10 else None
+                value, color=colours[e % 10], lw=1.2, label=f"experiment {e}" if e < 10 else None
             )
         outside = int(np.sum((u < w.min()) | (u > w.max())))
         ax.set_title(f"PC {j + 1}: {outside} of {u.size} outside the runs", fontsize="medium")
@@ -119,6 +120,7 @@ def weight_pairs(
     n_pc = min(check_count(max_pc, "max_pc"), emulator.p_u)
     bins = check_bins(bins, n_pc, "plots.weight_pairs")
     u = None if obs is None else reduce(emulator, obs, None, extrapolate=True).obs.u
+    colours = series_colours(0 if u is None else min(u.shape[0], 10))
     w = emulator.w
     fig = figure(2.2 * n_pc + 0.6, 2.2 * n_pc + 0.4)
     axes = fig.subplots(n_pc, n_pc, squeeze=False)
@@ -134,7 +136,7 @@ def weight_pairs(
                 ax.plot(w[:, j], w[:, i], ".", ms=3, color="0.6")
                 if u is not None:
                     for e in range(u.shape[0]):
-                        ax.plot(u[e, j], u[e, i], "o", ms=5, color=f"C{e % 10}")
+                        ax.plot(u[e, j], u[e, i], "o", ms=5, color=colours[e % 10])
                     outside = _outside_hull(w[:, [j, i]], u[:, [j, i]])
                     if outside is not None:
                         ax.set_title(f"{outside} of {u.shape[0]} outside the runs",
@@ -145,7 +147,7 @@ def weight_pairs(
                 ax.set_ylabel(f"w{i + 1}")
     if u is not None and n_pc > 1:  # the experiments' colours, in the empty upper corner
         handles = [Line2D([], [], ls="", marker=".", color="0.6", label="runs")]
-        handles += [Line2D([], [], ls="", marker="o", color=f"C{e % 10}", label=f"experiment {e}")
+        handles += [Line2D([], [], ls="", marker="o", color=colours[e], label=f"experiment {e}")
                     for e in range(min(u.shape[0], 10))]  # fmt: skip
         axes[0, n_pc - 1].legend(handles=handles, fontsize="small", loc="upper right")
     return fig
@@ -185,9 +187,10 @@ def _residuals(ax, emulator, obs: ObsData, reduced) -> None:
     runs, misses = _misses(emulator, obs, reduced)
     ax.plot(std.grid, runs.T, color="0.75", lw=0.6)
     grids = obs.output_grids(emulator.index_names)
+    colours = series_colours(min(len(misses), 10))
     for e, miss in enumerate(misses):
         grid = std.grid if grids[e] is None else grids[e]
-        ax.plot(grid, miss, color=f"C{e % 10}", lw=1.2)
+        ax.plot(grid, miss, color=colours[e % 10], lw=1.2)
     rms_runs = float(np.sqrt(np.mean(runs**2)))
     rms_obs = float(np.sqrt(np.mean(np.concatenate(misses) ** 2)))
     ax.axhline(0.0, color="0.3", lw=0.6)

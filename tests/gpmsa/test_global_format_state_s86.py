@@ -1,0 +1,89 @@
+"""The user's global display state (numpy print options, matplotlib's colour cycle) changes
+neither what a message says about a value nor which series a legend tells apart."""
+
+import re
+
+import matplotlib as mpl
+import numpy as np
+import pytest
+from cycler import cycler
+from matplotlib.colors import to_rgba
+
+import gpmsa
+from gpmsa import plots
+
+USER_PRINT = dict(precision=2, threshold=5, edgeitems=1, floatmode="fixed", suppress=True,
+                  sign="+")  # fmt: skip
+
+
+def _emulator(params=None):
+    rng = np.random.default_rng(0)
+    x, t, s = rng.uniform(size=(20, 1)), rng.uniform(size=(20, 1)), np.linspace(0, 1, 8)
+    data = gpmsa.SimData(x=x, t=t, y=np.outer(x, s) + np.outer(t, s**2), index=s)
+    given = {"betaU": [[1, 1], [1, 1]], "lamUz": [1, 1], "lamWs": [1e3, 1e3], "lamWOs": [1e3]}
+    return gpmsa.Emulator.from_params(data, {**given, **(params or {})}), s
+
+
+def _message(call) -> str:
+    with pytest.raises(gpmsa.GPMSAError) as info:
+        call()
+    return str(info.value)
+
+
+@pytest.mark.parametrize("legacy", [False, "1.13", "1.25"])
+def test_a_message_about_a_given_array_keeps_its_digits_under_the_users_print_options(legacy):
+    """precision=2 / suppress=True wrote lamUz = 1.23456e-9 (below 1e-8) as [+0.00 +1.00] and
+    lamWs = -0.123456 as [-0.12 +1.00]."""
+    cases = [{"lamUz": [1.23456e-9, 1.0]}, {"lamWs": [-0.123456, 1.0]}, {"lamWs": [1.0, np.nan]}]
+    for params in cases:
+        default = _message(lambda p=params: _emulator(p))
+        with np.printoptions(**USER_PRINT, legacy=legacy):
+            assert _message(lambda p=params: _emulator(p)) == default
+    assert "[1.23456e-09 1.00000e+00]" in _message(lambda: _emulator(cases[0]))
+    assert "[-0.123456  1.      ]" in _message(lambda: _emulator(cases[1]))
+
+
+def test_a_fixed_value_outside_its_bounds_is_shown_in_full_under_the_users_print_options():
+    emu, s = _emulator()
+
+    def calibrate():
+        gpmsa.calibrate(emu, [[0.5]], [s], fixed={"lamOs": -0.123456})
+
+    default = _message(calibrate)
+    assert re.search(r"fixed\['lamOs'\] = \[-0\.123456\] lies outside", default)
+    with np.printoptions(**USER_PRINT):
+        assert _message(calibrate) == default  # was [-0.12]
+
+
+def _legend_colours(fig) -> list[tuple]:
+    legend = next(ax.get_legend() for ax in fig.axes if ax.get_legend() is not None)
+    return [to_rgba(h.get_color()) for h in legend.legend_handles if h.get_label() != "runs"]
+
+
+def _figures():
+    emu, s = _emulator()
+    obs = gpmsa.ObsData(x=[[0.5], [0.5], [0.4]], y=[0.5 * s + 0.5 * s**2, 0.5 * s + 3 * s**2, s])
+    draws = {"theta": np.random.default_rng(0).normal(size=(3, 40, 1))}
+    chains = gpmsa.Chains(draws=draws, log_post=np.zeros((3, 40)), accept_rate={},
+                          step_widths={}, info={})  # fmt: skip
+    return {
+        "traces": lambda: plots.traces(chains),
+        "autocorrelation": lambda: plots.autocorrelation(chains),
+        "obs_projection": lambda: plots.obs_projection(emu, obs),
+        "weight_pairs": lambda: plots.weight_pairs(emu, obs),
+    }
+
+
+@pytest.mark.parametrize("name", ["traces", "autocorrelation", "obs_projection", "weight_pairs"])
+def test_series_a_legend_names_differ_in_colour_under_a_one_colour_cycle(name):
+    """With rcParams["axes.prop_cycle"] of one colour, chains 0-2 (experiments 0-2) were drawn,
+    and listed in the legend, in that one colour."""
+    draw = _figures()[name]
+    with mpl.rc_context({"axes.prop_cycle": cycler(color=["#1f77b4"])}):
+        before = dict(mpl.rcParams)
+        colours = _legend_colours(draw())
+        assert dict(mpl.rcParams) == before
+    assert len(colours) == 3 and len(set(colours)) == 3
+    with mpl.rc_context({"axes.prop_cycle": cycler(color=["r", "g", "b", "k"])}):
+        assert _legend_colours(draw()) == [to_rgba(c) for c in "rgb"]  # the style's, as before
+    assert _legend_colours(draw()) == [to_rgba(f"C{k}") for k in range(3)]
