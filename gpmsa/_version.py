@@ -29,10 +29,12 @@ def library_versions(backend: str | None = None) -> dict[str, str]:
         from threadpoolctl import threadpool_info
 
         blas = [i for i in threadpool_info() if i.get("user_api") == "blas"]
-        out["blas"] = "; ".join(
-            f"{i.get('internal_api')} {i.get('version')} ({i.get('architecture')}, "
-            f"{i.get('num_threads')} threads)"
-            for i in blas
+        out["blas"] = "; ".join(  # sorted: the order threadpoolctl finds them varies by run
+            sorted(
+                f"{i.get('internal_api')} {i.get('version')} ({i.get('architecture')}, "
+                f"{i.get('num_threads')} threads)"
+                for i in blas
+            )
         )
     except Exception:  # threadpoolctl is optional here; versions are informative only
         out["blas"] = "unknown"
