@@ -19,7 +19,7 @@ from gpmsa.model.data import (
     column_order,
 )
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, index_labels, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, is_map, series_colours
 from gpmsa.predictive.crossval import CrossValidation
 
 if TYPE_CHECKING:
@@ -216,8 +216,9 @@ def emulator_fit(emulator, held_out, *, level: float = 0.9, max_runs: int = 6,
     _fit_scatter(axes[0], actual, mean, half, title)
     if functional:
         grid = emulator.standardizer.grid
+        colours = series_colours(min(rows.size, 10))
         for c, i in enumerate(rows):
-            col = f"C{c % 10}"
+            col = colours[c % 10]
             axes[1].fill_between(grid, mean[i] - half[i], mean[i] + half[i], color=col, alpha=0.2)
             axes[1].plot(grid, mean[i], color=col, lw=1)
             axes[1].plot(grid, actual[i], "o", color=col, ms=3)

@@ -9,7 +9,7 @@ import numpy as np
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import ObsData, as_float, check_count, check_finite, check_level
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, index_labels, ink, is_map
+from gpmsa.plots._figure import axis_label, figure, index_labels, ink, is_map, series_colours
 from gpmsa.predictive.full import FullPrediction
 
 if TYPE_CHECKING:
@@ -93,6 +93,7 @@ def prediction_bands(
         return _band_maps(pred, observed, cols, level)
     bands = {w: pred.interval(w, level) for w in ("y", "zeta", "eta", "delta")}
     eta_mean = pred.mean("eta")
+    colour = dict(zip(("C0", "C1", "C2"), series_colours(3), strict=True))
     if relative:
         ref = pred.mean("y")
         bands.update({w: (bands[w][0] - ref, bands[w][1] - ref) for w in ("y", "zeta", "eta")})
@@ -109,15 +110,15 @@ def prediction_bands(
         mean_style = {"marker": "_", "ms": BAR_WIDTHS["y"], "ls": "none"} if bars else {}
         for what, label, color in BANDS:
             lo, hi = bands[what]
-            _band(top, xs, lo[order, 0], hi[order, 0], bars and BAR_WIDTHS[what], color=color,
-                  alpha=0.35, label=f"{label} ({pct})")  # fmt: skip
-        top.plot(xs, eta_mean[order, 0], color="C0", lw=1, **mean_style)
+            _band(top, xs, lo[order, 0], hi[order, 0], bars and BAR_WIDTHS[what],
+                  color=colour.get(color, color), alpha=0.35, label=f"{label} ({pct})")  # fmt: skip
+        top.plot(xs, eta_mean[order, 0], color=colour["C0"], lw=1, **mean_style)
         if observed is not None:
             top.plot(xs, observed[order, 0], "o", color=ink(), ms=3, label="observed")
         lo, hi = bands["delta"]
-        _band(bottom, xs, lo[order, 0], hi[order, 0], bars and BAR_WIDTHS["delta"], color="C2",
-              alpha=0.4)  # fmt: skip
-        bottom.plot(xs, pred.mean("delta")[order, 0], color="C2", lw=1, **mean_style)
+        _band(bottom, xs, lo[order, 0], hi[order, 0], bars and BAR_WIDTHS["delta"],
+              color=colour["C2"], alpha=0.4)  # fmt: skip
+        bottom.plot(xs, pred.mean("delta")[order, 0], color=colour["C2"], lw=1, **mean_style)
         bottom.axhline(0.0, color="0.6", lw=0.6)
         name, unit = _input(pred, x_column)
         bottom.set_xlabel(axis_label(name, unit))
@@ -133,14 +134,14 @@ def prediction_bands(
         top, bottom = axes[0, c], axes[1, c]
         for what, label, color in BANDS:
             lo, hi = bands[what]
-            top.fill_between(grid, lo[i, by_index], hi[i, by_index], color=color, alpha=0.35,
-                             label=f"{label} ({pct})")  # fmt: skip
-        top.plot(grid, eta_mean[i, by_index], color="C0", lw=1)
+            top.fill_between(grid, lo[i, by_index], hi[i, by_index], color=colour.get(color, color),
+                             alpha=0.35, label=f"{label} ({pct})")  # fmt: skip
+        top.plot(grid, eta_mean[i, by_index], color=colour["C0"], lw=1)
         if observed is not None:
             top.plot(grid, observed[i, by_index], "o", color=ink(), ms=3, label="observed")
         lo, hi = bands["delta"]
-        bottom.fill_between(grid, lo[i, by_index], hi[i, by_index], color="C2", alpha=0.4)
-        bottom.plot(grid, delta_mean[i, by_index], color="C2", lw=1)
+        bottom.fill_between(grid, lo[i, by_index], hi[i, by_index], color=colour["C2"], alpha=0.4)
+        bottom.plot(grid, delta_mean[i, by_index], color=colour["C2"], lw=1)
         bottom.axhline(0.0, color="0.6", lw=0.6)
         bottom.set_xlabel(index_labels(pred.index_names, pred.index_units, pred.grid)[0])
         top.set_title(_inputs_text(pred, i), fontsize="small")

@@ -12,7 +12,15 @@ from scipy.stats import norm
 from gpmsa.errors import GPMSAError
 from gpmsa.model.data import check_count, check_level
 from gpmsa.plots import _maps
-from gpmsa.plots._figure import axis_label, figure, index_columns, index_labels, ink, is_map
+from gpmsa.plots._figure import (
+    axis_label,
+    figure,
+    index_columns,
+    index_labels,
+    ink,
+    is_map,
+    series_colours,
+)
 from gpmsa.predictive.sobol import Sensitivity
 
 if TYPE_CHECKING:
@@ -57,8 +65,9 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9) -> Figure:
         fig = figure(11.0 if functional else 5.5, 4.0)
         axes = fig.subplots(1, 2 if functional else 1, squeeze=False)[0]
     pos = np.arange(d)
-    for off, kind, arr, color in ((-0.2, "main", sens.main_aggregated, "C0"),
-                                  (0.2, "total", sens.total_aggregated, "C1")):  # fmt: skip
+    main_colour, total_colour = series_colours(2)
+    for off, kind, arr, color in ((-0.2, "main", sens.main_aggregated, main_colour),
+                                  (0.2, "total", sens.total_aggregated, total_colour)):  # fmt: skip
         lo, hi = np.quantile(arr, q, axis=0)
         axes[0].bar(pos + off, arr.mean(axis=0), width=0.4, color=color, label=f"{kind} effect")
         # the interval [lo, hi] itself: a skewed spread can leave the mean outside it
@@ -78,14 +87,15 @@ def sensitivity_bars(sens: Sensitivity, *, level: float = 0.9) -> Figure:
         ax = axes[1]
         with warnings.catch_warnings():  # all-NaN grid points (zero output variance)
             warnings.simplefilter("ignore", RuntimeWarning)
+            colours = series_colours(len(sens.names))
             for k, name in enumerate(sens.names):
                 for arr, style in ((sens.main, "-"), (sens.total, "--")):
                     col = arr[:, :, k]
-                    ax.plot(sens.grid, np.nanmean(col, axis=0), style, color=f"C{k}",
+                    ax.plot(sens.grid, np.nanmean(col, axis=0), style, color=colours[k],
                             label=name if style == "-" else None)  # fmt: skip
                     if col.shape[0] > 1:
                         lo, hi = np.nanquantile(col, q, axis=0)
-                        ax.fill_between(sens.grid, lo, hi, color=f"C{k}", alpha=0.15)
+                        ax.fill_between(sens.grid, lo, hi, color=colours[k], alpha=0.15)
         ax.set_ylim(0.0, 1.05)
         ax.set_xlabel(index_labels(sens.index_names, sens.index_units, sens.grid)[0])
         ax.set_ylabel("index (solid: main, dashed: total)")

@@ -7,7 +7,7 @@ import matplotlib as mpl
 import numpy as np
 import pytest
 from cycler import cycler
-from matplotlib.colors import to_rgba
+from matplotlib.colors import to_rgba, to_rgba_array
 
 import gpmsa
 from gpmsa import plots
@@ -87,3 +87,51 @@ def test_series_a_legend_names_differ_in_colour_under_a_one_colour_cycle(name):
     with mpl.rc_context({"axes.prop_cycle": cycler(color=["r", "g", "b", "k"])}):
         assert _legend_colours(draw()) == [to_rgba(c) for c in "rgb"]  # the style's, as before
     assert _legend_colours(draw()) == [to_rgba(f"C{k}") for k in range(3)]
+
+
+def _colours_of(axes, kinds=("lines", "collections", "patches")) -> set[tuple]:
+    """The face or line colours (alpha dropped) of every artist of ``axes``."""
+    out = set()
+    for ax in axes:
+        for kind in kinds:
+            for artist in getattr(ax, kind):
+                get = getattr(artist, "get_facecolor", None) if kind != "lines" else None
+                colour = get() if get is not None else artist.get_color()
+                colour = np.atleast_2d(to_rgba_array(colour))
+                out.update(tuple(np.round(c[:3], 6)) for c in colour)
+    return out
+
+
+def _other_plots():
+    """prediction_bands (eta + delta, eta, delta), sensitivity_bars (main and total effects,
+    one curve per input), emulator_fit (one held-out run's band, mean and values per colour, in
+    its right-hand axes), each as (draw, the axes drawn by colour, series)."""
+    emu, s = _emulator()
+    rng = np.random.default_rng(1)
+    x, t = rng.uniform(size=(12, 1)), rng.uniform(size=(12, 1))
+    scalar = gpmsa.SimData(x=x, t=t, y=x + t)
+    obs = gpmsa.ObsData(x=[[0.2], [0.5], [0.8]], y=[[0.7], [1.1], [1.3]])
+    joint = gpmsa.fit(scalar, obs, n_iter=20, tune=False, seed=0, discrepancy="constant")
+    pred = gpmsa.full_prediction(joint, obs, np.linspace(0.1, 0.9, 4)[:, None], seed=1)
+    sens = gpmsa.sensitivity(emu, draws=False)
+    held = gpmsa.cross_validate(emu, folds=4, draws=False)
+    return {
+        "prediction_bands": (lambda: plots.prediction_bands(pred).axes, 3),
+        "sensitivity_bars": (lambda: plots.sensitivity_bars(sens).axes, 2),
+        "emulator_fit": (
+            lambda: plots.emulator_fit(emu, held, draws=False, max_runs=3).axes[1:],
+            3,
+        ),
+    }
+
+
+def test_other_plots_tell_their_series_apart_under_a_one_colour_cycle():
+    """prediction_bands drew "eta + delta" and "simulator eta" (and delta), sensitivity_bars the
+    main and total effects, emulator_fit each held-out run, all in a one-colour cycle's colour."""
+    greys = {(0.8, 0.8, 0.8), (0.7, 0.7, 0.7), (0.6, 0.6, 0.6), (0.0, 0.0, 0.0), (1.0, 1.0, 1.0)}
+    for name, (draw, series) in _other_plots().items():
+        with mpl.rc_context({"axes.prop_cycle": cycler(color=["#1f77b4"])}):
+            one = _colours_of(draw()) - greys
+        default = _colours_of(draw()) - greys
+        assert len(one) >= series, (name, one)
+        assert one == default, name  # the default cycle's own colours, as drawn before
