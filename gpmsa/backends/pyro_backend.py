@@ -35,6 +35,8 @@ sampled is refused (`refuse_unsupported`).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
+from contextlib import ExitStack, contextmanager
 
 import numpy as np
 import pyro
@@ -529,7 +531,9 @@ def sample(
     shorter steps along the curved lamWs/lamWOs ridge of a scalar-output emulator. With these
     defaults the road case's fit reaches R-hat 1.005 in 4 x 1,500 draws (docs/performance.md).
     ``step_widths`` do not apply to NUTS (an error if given). Each chain's torch randomness is
-    seeded from ``seed`` inside ``torch.random.fork_rng`` (the global RNG is left as it was).
+    seeded from ``seed`` inside ``torch.random.fork_rng`` (the global RNG is left as it was);
+    NUTS runs on the CPU with gradients whatever torch's grad or inference mode and default
+    device as the caller set them (`_autograd_on_cpu`).
     ``accept_rate`` holds pyro's per-chain "acceptance rate" diagnostic and ``step_widths`` the
     adapted NUTS step size, each repeated over every sampled element (NaN for held elements,
     ``problem.fixed_elements``, whose draws are their values exactly; a categorical theta
@@ -554,85 +558,102 @@ def sample(
                               jit)  # fmt: skip
     seqs = np.random.SeedSequence(seed).spawn(int(n_chains))
     how, firsts = starts.chain_starts(problem, init, seqs)
-    model = PyroModel(problem)
-    if not model.sites:
-        raise GPMSAError(
-            "the pyro backend samples the continuous parameters by NUTS, with a categorical "
-            "theta's levels marginalised; every other parameter is held here: use "
-            "backend='numpy' or 'torch'"
-        )
-    runs = []
-    for seq, first in zip(seqs, firsts, strict=True):
-        seed_c = int(seq.generate_state(1)[0])
-        kernel = NUTS(
-            model, adapt_step_size=tune, adapt_mass_matrix=tune, target_accept_prob=target_accept,
-            max_tree_depth=max_tree_depth, max_plate_nesting=0,
-            jit_compile=jit and model.constraint is None,  # a trace would freeze the verdict
-            full_mass=full_mass,
-            ignore_jit_warnings=True,
-            init_strategy=init_to_value(values=model.init_values(first)),
-        )  # fmt: skip
-        rng = _level_generator(seq)  # a categorical theta's moves and draws
-        driver = kernel
-        if model.cat.size and model.held["theta"][0].numel():  # levels and continuous theta
-            driver = LevelJumps(kernel, model, rng)
-        with torch.random.fork_rng(), torch_threads(num_threads):
-            torch.manual_seed(seed_c)
-            mcmc = MCMC(driver, num_samples=int(n_iter), warmup_steps=warmup,
-                        disable_progbar=not progress)  # fmt: skip
-            with warnings.catch_warnings():  # pyro's JIT uses the deprecated torch.jit.trace
-                warnings.filterwarnings(
-                    "ignore", message=".*jit.trace", category=DeprecationWarning
-                )
-                mcmc.run()
-        sites = {k: v.detach() for k, v in mcmc.get_samples().items()}
-        accept = mcmc.diagnostics()["acceptance rate"]["chain 0"]
-        if all(bool(torch.all(v == v[:1])) for v in sites.values()):
-            why = ("with tune=False NUTS keeps a unit step size; use tune=True" if not tune
-                   else "raise n_warmup, or lower target_accept")  # fmt: skip
+    with _autograd_on_cpu():  # whatever the caller's grad mode and default device
+        model = PyroModel(problem)
+        if not model.sites:
             raise GPMSAError(
-                f"NUTS never left its starting point in {int(n_iter)} draws (acceptance rate "
-                f"{float(accept):.2g}): the chain is no sample of the posterior; {why}"
+                "the pyro backend samples the continuous parameters by NUTS, with a categorical "
+                "theta's levels marginalised; every other parameter is held here: use "
+                "backend='numpy' or 'torch'"
             )
-        jumps = (1.0, {})  # (the level moves' acceptance, their offsets)
-        if driver is not kernel:
-            jumps = (driver.accepted / max(driver.moves, 1), driver.offsets or {})
-        runs.append((sites, float(accept), float(kernel.step_size), rng, jumps))
-    draws, log_post = {}, []
-    for sites, _, _, rng, _ in runs:
-        with torch.no_grad():
-            prm = model.params(sites)
-            if model.cat.size:  # each draw's levels from their conditional (exact)
-                prm, lp = model.draw_levels(prm, rng)
-                log_post.append(lp)
-            else:
-                log_post.append(_chunked_log_post(model, prm))
-        for name in problem.names:
-            draws.setdefault(name, []).append(prm[name].numpy())
-    rate, wid = {}, {}
-    masks = problem.held_masks()
-    for name in problem.names:  # held: no step, no acceptance
-        held = masks.get(name, np.zeros(problem.init[name].shape, dtype=bool))
-        rate[name] = np.stack([np.where(held, np.nan, float(r[1])) for r in runs])
-        wid[name] = np.stack([np.where(held, np.nan, float(r[2])) for r in runs])
-    if model.cat.size:  # the level moves' acceptance (1: no continuous theta, drawn), no step
-        rate["theta"][:, model.cat] = np.array([r[4][0] for r in runs])[:, None]
-        wid["theta"][:, model.cat] = np.nan
-    moves = level_moves.chains_record([r[4][1] for r in runs], model.held["theta"][0].tolist()
-                                      if model.cat.size else [])  # fmt: skip
-    return Chains(
-        draws={k: np.stack(v) for k, v in draws.items()},
-        log_post=np.stack(log_post),
-        accept_rate=rate,
-        step_widths=wid,
-        info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": tune,
-              "n_warmup": warmup, "target_accept": target_accept, "full_mass": full_mass,
-              "seed": seed, "init": how,
-              "starts": {k: np.stack([f[k] for f in firsts]) for k in problem.init},
-              "backend": "pyro", "sampler": "NUTS",
-              **({"marginalised_levels": [int(k) for k in model.cat]} if model.cat.size else {}),
-              **({"level_offsets": moves} if moves else {})},
-    )  # fmt: skip
+        runs = []
+        for seq, first in zip(seqs, firsts, strict=True):
+            seed_c = int(seq.generate_state(1)[0])
+            kernel = NUTS(
+                model, adapt_step_size=tune, adapt_mass_matrix=tune,
+                target_accept_prob=target_accept, max_tree_depth=max_tree_depth,
+                max_plate_nesting=0,
+                jit_compile=jit and model.constraint is None,  # a trace would freeze the verdict
+                full_mass=full_mass,
+                ignore_jit_warnings=True,
+                init_strategy=init_to_value(values=model.init_values(first)),
+            )  # fmt: skip
+            rng = _level_generator(seq)  # a categorical theta's moves and draws
+            driver = kernel
+            if model.cat.size and model.held["theta"][0].numel():  # levels and continuous theta
+                driver = LevelJumps(kernel, model, rng)
+            with torch.random.fork_rng(), torch_threads(num_threads):
+                torch.manual_seed(seed_c)
+                mcmc = MCMC(driver, num_samples=int(n_iter), warmup_steps=warmup,
+                            disable_progbar=not progress)  # fmt: skip
+                with warnings.catch_warnings():  # pyro's JIT uses the deprecated torch.jit.trace
+                    warnings.filterwarnings(
+                        "ignore", message=".*jit.trace", category=DeprecationWarning
+                    )
+                    mcmc.run()
+            sites = {k: v.detach() for k, v in mcmc.get_samples().items()}
+            accept = mcmc.diagnostics()["acceptance rate"]["chain 0"]
+            if all(bool(torch.all(v == v[:1])) for v in sites.values()):
+                why = ("with tune=False NUTS keeps a unit step size; use tune=True" if not tune
+                       else "raise n_warmup, or lower target_accept")  # fmt: skip
+                raise GPMSAError(
+                    f"NUTS never left its starting point in {int(n_iter)} draws (acceptance rate "
+                    f"{float(accept):.2g}): the chain is no sample of the posterior; {why}"
+                )
+            jumps = (1.0, {})  # (the level moves' acceptance, their offsets)
+            if driver is not kernel:
+                jumps = (driver.accepted / max(driver.moves, 1), driver.offsets or {})
+            runs.append((sites, float(accept), float(kernel.step_size), rng, jumps))
+        draws, log_post = {}, []
+        for sites, _, _, rng, _ in runs:
+            with torch.no_grad():
+                prm = model.params(sites)
+                if model.cat.size:  # each draw's levels from their conditional (exact)
+                    prm, lp = model.draw_levels(prm, rng)
+                    log_post.append(lp)
+                else:
+                    log_post.append(_chunked_log_post(model, prm))
+            for name in problem.names:
+                draws.setdefault(name, []).append(prm[name].numpy())
+        rate, wid = {}, {}
+        masks = problem.held_masks()
+        for name in problem.names:  # held: no step, no acceptance
+            held = masks.get(name, np.zeros(problem.init[name].shape, dtype=bool))
+            rate[name] = np.stack([np.where(held, np.nan, float(r[1])) for r in runs])
+            wid[name] = np.stack([np.where(held, np.nan, float(r[2])) for r in runs])
+        if model.cat.size:  # the level moves' acceptance (1: no continuous theta, drawn), no step
+            rate["theta"][:, model.cat] = np.array([r[4][0] for r in runs])[:, None]
+            wid["theta"][:, model.cat] = np.nan
+        moves = level_moves.chains_record([r[4][1] for r in runs], model.held["theta"][0].tolist()
+                                          if model.cat.size else [])  # fmt: skip
+        return Chains(
+            draws={k: np.stack(v) for k, v in draws.items()},
+            log_post=np.stack(log_post),
+            accept_rate=rate,
+            step_widths=wid,
+            info={"n_iter": int(n_iter), "n_chains": int(n_chains), "tune": tune,
+                  "n_warmup": warmup, "target_accept": target_accept, "full_mass": full_mass,
+                  "seed": seed, "init": how,
+                  "starts": {k: np.stack([f[k] for f in firsts]) for k in problem.init},
+                  "backend": "pyro", "sampler": "NUTS",
+                  **({"marginalised_levels": [int(k) for k in model.cat]}
+                     if model.cat.size else {}),
+                  **({"level_offsets": moves} if moves else {})},
+        )  # fmt: skip
+
+
+@contextmanager
+def _autograd_on_cpu() -> Iterator[None]:
+    """Gradients recorded (NUTS differentiates the potential) and new tensors on the CPU inside
+    the block, whatever the caller set: ``torch.no_grad()``, ``set_grad_enabled(False)``,
+    ``inference_mode()``, a default device (``set_default_device``, ``with torch.device``);
+    restored afterwards. (The device mode costs every torch call: entered only where needed.)"""
+    with ExitStack() as stack:
+        stack.enter_context(torch.inference_mode(False))
+        stack.enter_context(torch.enable_grad())
+        if torch.empty(0).device.type != "cpu":  # (torch.get_default_device: torch >= 2.3)
+            stack.enter_context(torch.device("cpu"))
+        yield
 
 
 def _level_generator(seq: np.random.SeedSequence) -> np.random.Generator:

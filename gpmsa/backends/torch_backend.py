@@ -557,7 +557,7 @@ class BatchState:
         self.ridge_moves = int(ridge_moves) if ridge.applies(problem) else 0
         self._buffers: dict[tuple[str, int], Tensor] = {}
         m = problem.m
-        self._scratch = torch.empty((m, m), dtype=dtype).numpy()  # factors not kept (CPU)
+        self._scratch = torch.empty((m, m), dtype=dtype, device="cpu").numpy()  # factors not kept
         self.data = ModelTensors.from_problem(problem, dtype, device)
         self.priors = problem.priors
         self.els = elements(problem)
@@ -1059,7 +1059,8 @@ def sample(
     precisions' steps in the warm-up and sampling sweeps, GPM/SA's proportional one (True) or
     uniform with their widths (False); None: ``not tune``, as the numpy backend's ``sample``.
     Draws hold every sweep after the warm-up (no burn-in removed).
-    ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32".
+    ``device``: "cpu" or "cuda"; ``dtype``: "float64" (default) or "float32" (torch's default
+    dtype and device, as the caller set them, are not used).
     ``num_threads``: torch's CPU threads while sampling (default 1, as the numpy backend; on a
     busy machine more threads made every small tensor op wait for the thread pool); None keeps
     torch's setting; at most ``MAX_THREADS`` (or the machine's CPUs, where more).
@@ -1581,7 +1582,7 @@ def _group_task(problem: Problem, start: dict[str, np.ndarray], widths: np.ndarr
         state = BatchState(problem, n_rows, _dtype(dtype), "cpu", start, ridge_moves)
         if level_shifts is not None:
             state.shift_elements = list(level_shifts[0])
-            state.level_shifts = {k: torch.as_tensor(v, dtype=state.ll_w.dtype)
+            state.level_shifts = {k: torch.as_tensor(v, dtype=state.ll_w.dtype, device="cpu")
                                   for k, v in level_shifts[1].items()}  # fmt: skip
         gen = torch.Generator().manual_seed(stream)
         with progress_bar(progress, n_iter, desc, "it", mininterval=0.1) as bar:
