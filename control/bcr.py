@@ -767,7 +767,10 @@ class BCR:
         for name, a in zip(names, arrays, strict=True):
             if a.size != n:
                 raise ControlError(f"{name} must have t's length {n}, got {a.size}")
-        return self._all_or_nothing(self._update, arrays, now)
+        # a grid posterior's far tails underflow to 0 as intended, whatever the caller's
+        # np.seterr (one errstate here, ~1 us, not one per step inside)
+        with np.errstate(under="ignore"):
+            return self._all_or_nothing(self._update, arrays, now)
 
     def _update(self, arrays: list[np.ndarray], now: float | None) -> Estimate:
         """`update` of checked samples (``arrays``: t, position, accel, speed of one length)."""

@@ -62,7 +62,8 @@ def gd_spectrum(n: np.ndarray, gd: float, waviness: float = 2.0) -> np.ndarray:
             "allowed frequencies where Gd(n) > 2.2e-308 m^3"
         )
     if not np.all(np.isfinite(out)):
-        n_min = N0 * (g * GD_SCALE / np.finfo(float).max) ** (1.0 / w)
+        # (Python floats: a subnormal quotient, no FloatingPointError under np.seterr)
+        n_min = N0 * (g * GD_SCALE / float(np.finfo(float).max)) ** (1.0 / w)
         raise RoadgenError(
             f"n contains {float(np.min(arr))!r}: Gd(n) overflows for gd={g:g}, waviness={w:g}; "
             f"allowed frequencies above about {n_min:.3g} cycles/m"

@@ -93,7 +93,8 @@ def _psd(
     """``profile_psd`` of checked heights z (N,) m on a step dx m (n = 0 dropped)."""
     import scipy.signal  # here, not at import (tests/test_import_cost.py)
 
-    with np.errstate(over="ignore", invalid="ignore"):  # overflow: _finite_psd names it
+    # an overflow (inf, NaN) and an underflow (0): _finite_psd and _nonzero_gd name them
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
         if method == "periodogram":
             detrend = _end_match if end_match else "constant"
             n, gd = scipy.signal.periodogram(z, fs=1.0 / dx, window="boxcar", detrend=detrend)

@@ -59,7 +59,8 @@ class GridMarginal:
 
     Moments are trapezoid sums over the nodes (geometrically accurate for a smooth density that
     is resolved by the grid); the CDF, quantiles and draws use the piecewise-linear interpolant of
-    the density, normalised by the same trapezoid sum.
+    the density, normalised by the same trapezoid sum. Far tails underflow to 0 (subnormal) as
+    in numpy's default state, whatever the caller's ``np.seterr(under=...)``.
 
     Attributes:
         nodes: (k,) strictly increasing parameter values.
@@ -77,6 +78,7 @@ class GridMarginal:
         _set_read_only_state(self, state)
 
     @classmethod
+    @np.errstate(under="ignore")
     def from_log_density(
         cls, nodes: np.ndarray, log_density: np.ndarray, weights: np.ndarray | None = None
     ) -> GridMarginal:
@@ -112,10 +114,12 @@ class GridMarginal:
     def _cell_mass(self) -> np.ndarray:
         return 0.5 * np.diff(self.nodes) * (self.density[:-1] + self.density[1:])
 
+    @np.errstate(under="ignore")
     def mean(self) -> float:
         """Posterior mean."""
         return float((self.weights * self.density) @ self.nodes)
 
+    @np.errstate(under="ignore")
     def sd(self) -> float:
         """Posterior standard deviation."""
         d = self.nodes - self.mean()
@@ -128,6 +132,7 @@ class GridMarginal:
         span = f" on [{ends[0]}, {ends[1]}]" if k else ""
         return f"GridMarginal({k} nodes{span}, mean={self.mean():.4g}, sd={self.sd():.3g})"
 
+    @np.errstate(under="ignore")
     def cdf(self, value: np.ndarray | float) -> np.ndarray:
         """P(X <= value) under the piecewise-linear density."""
         x = np.asarray(value, dtype=float)
@@ -141,6 +146,7 @@ class GridMarginal:
         out = np.where(t < h, cum[k] + f0 * t + 0.5 * (f1 - f0) * t * t / h, cum[k + 1])
         return np.clip(out / cum[-1], 0.0, 1.0)
 
+    @np.errstate(under="ignore")
     def ppf(self, q: np.ndarray | float) -> np.ndarray:
         """Quantile function: the inverse of ``cdf`` (exact for the piecewise-linear density)."""
         q = np.asarray(q, dtype=float)

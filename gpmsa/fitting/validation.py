@@ -45,9 +45,11 @@ PRECISIONS = ("lamVz", "lamUz", "lamWs", "lamWOs", "lamOs")
 PRIOR_SCALARS = ("theta_mean", "theta_sd", "rho_a", "rho_b", "rho_cap")
 PRIOR_OPTIONAL = ("rhoV_a", "rhoV_b")
 """betaV's own Beta prior: in a file both or neither (a file without them: betaU's)."""
-SMALLEST_PRECISION = 1.0 / np.finfo(float).max
+SMALLEST_PRECISION = 1.0 / float(np.finfo(float).max)
 """1 / the largest float64: a precision lam at or below it (a subnormal one) has a variance
-1 / lam that overflows, and is refused in a file and in ``Emulator`` params alike."""
+1 / lam that overflows, and is refused in a file and in ``Emulator`` params alike. (Divided as
+Python floats: numpy's scalar division of this subnormal raised at import under a caller's
+``np.seterr(under="raise")``.)"""
 REL_TOL = 1e-9
 """Relative tolerance of the recomputed redundancies (y_mean, y_sd)."""
 W_TOL = 1e-7

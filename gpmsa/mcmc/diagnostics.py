@@ -136,7 +136,9 @@ def ess(x: np.ndarray) -> float:
     x = np.atleast_2d(np.asarray(x, dtype=np.float64))
     if np.ptp(x) == 0 or x.shape[1] < MIN_DRAWS_ESS:
         return float("nan")
-    with warnings.catch_warnings():
+    # ArviZ's own numerics (a 0 / 0 of chains stuck apart gives R-hat inf): quiet whatever the
+    # caller's np.seterr, as its warnings are
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
         return float(_arviz().ess(np.atleast_2d(x)))
 
@@ -173,7 +175,9 @@ def rhat(x: np.ndarray) -> float:
     if x.shape[0] == 1:
         half = x.shape[1] // 2
         x = np.vstack([x[0, :half], x[0, half : 2 * half]])
-    with warnings.catch_warnings():
+    # ArviZ's own numerics (a 0 / 0 of chains stuck apart gives R-hat inf): quiet whatever the
+    # caller's np.seterr, as its warnings are
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
         return float(_arviz().rhat(np.atleast_2d(x)))
 
