@@ -105,6 +105,7 @@ from control.validation import (
 )
 from gpmsa import Posterior
 from gpmsa.errors import numbers_text
+from roadgen.checks import tensor_values
 
 METHODS = ("changepoint", "window", "filter", "tempered")
 INTERVAL_KINDS = ("hdi", "central")
@@ -390,7 +391,7 @@ def _samples(name: str, values) -> np.ndarray:
         raise ControlError(f"{name} must be a 1-D sequence of numbers, got None")
     check_not_masked(values, name)
     try:
-        a = np.atleast_1d(np.asarray(values))
+        a = np.atleast_1d(np.asarray(tensor_values(values)))
     except ValueError as exc:  # a ragged list
         raise ControlError(f"{name} must be a 1-D sequence of numbers: {exc}") from None
     if a.ndim != 1:

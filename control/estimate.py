@@ -8,7 +8,7 @@ from math import isnan
 import numpy as np
 
 from control.errors import ControlError
-from control.validation import is_choice, is_real
+from control.validation import is_choice, is_real, python_number, python_value
 from gpmsa import Posterior
 
 #: Status values. Only "ok" carries numbers; every other status says why there is no estimate.
@@ -169,6 +169,7 @@ class Estimate:
             value = getattr(self, name)
             if not is_real(value):
                 raise ControlError(f"{name} must be a real number (NaN: none), got {value!r}")
+            python_number(self, name)  # np.float32 would make the Simplex's law float32
         self._check_interval()
         if self.domain_edge not in ("", *DOMAIN_EDGES):
             raise ControlError(
@@ -207,6 +208,8 @@ class Estimate:
         lo, hi = float(pair[0]), float(pair[1])
         if isnan(lo) != isnan(hi) or lo > hi:  # (math's isnan: two floats)
             raise ControlError(f"interval must have lo <= hi (or be two NaNs), got {pair!r}")
+        if any(isinstance(v, np.generic) for v in pair):  # as the numbers: Python's
+            object.__setattr__(self, "interval", tuple(map(python_value, pair)))
 
     @property
     def ok(self) -> bool:

@@ -145,10 +145,18 @@ def python_number(obj, name: str) -> None:
     setting given as np.float32(25.0) would give other estimates and commands than 25.0 (and
     an np.int64 is no count for Python's own APIs, e.g. a deque's maxlen)."""
     value = getattr(obj, name)
+    if isinstance(value, np.floating | np.integer):
+        object.__setattr__(obj, name, python_value(value))
+
+
+def python_value(value):
+    """``value`` as the Python float or int of its value where it is a numpy float or integer
+    scalar (a longdouble's ``item()`` stays a longdouble); anything else as it is."""
     if isinstance(value, np.floating):
-        object.__setattr__(obj, name, float(value))
-    elif isinstance(value, np.integer):
-        object.__setattr__(obj, name, int(value))
+        return float(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    return value
 
 
 def require_integers(obj, names: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:

@@ -121,10 +121,21 @@ def flag(name: str, value: object, error: type[Exception] = RoadgenError) -> boo
     return bool(value)
 
 
+def tensor_values(value: object) -> object:
+    """``value``, or for a torch tensor (an object with a bool ``requires_grad`` and a
+    ``detach`` method) the tensor without its gradient record: numpy refuses one that records
+    gradients ("Can't call numpy() on Tensor that requires grad"); only the values are read."""
+    if getattr(value, "requires_grad", None) is True and callable(getattr(value, "detach", None)):
+        return value.detach()
+    return value
+
+
 def real_array(name: str, value: object, error: type[Exception] = RoadgenError) -> np.ndarray:
     """Return ``value`` as a new float array if it holds real numbers (ints or floats, not
     bools, strings, complex numbers or objects); else raise ``error``. NaN and inf pass. A bool
-    inside a list is refused too (numpy would read ``[[True, 300]]`` as integers)."""
+    inside a list is refused too (numpy would read ``[[True, 300]]`` as integers). A torch
+    tensor's values are read (`tensor_values`)."""
+    value = tensor_values(value)
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError) as exc:  # e.g. ragged nested lists

@@ -30,6 +30,7 @@ from gpmsa.model.data import (
     column_labels,
     default_labels,
     evenly_spaced,
+    size_of,
     values_digest,
 )
 from gpmsa.model.far_values import OUTSIDE_SDS, FarValue, warn_far
@@ -275,7 +276,7 @@ def refuse_ragged(y_obs) -> None:
             return
     except ValueError:  # an experiment ragged itself: as_float refuses it
         return
-    lengths = [int(np.size(e)) for e in y_obs]
+    lengths = [size_of(e) for e in y_obs]
     if len(set(lengths)) > 1:
         raise GPMSAError(
             f"y_obs holds experiments of different lengths {lengths}: give observations on "

@@ -27,7 +27,7 @@ def _first_non_number(value) -> str | None:
     every entry is a number (numpy's integer and float scalars are)."""
     stack, seen = [value], set()
     while stack:
-        v = stack.pop()
+        v = tensor_values(stack.pop())
         if v is None:
             return "None"
         if isinstance(v, (str, bytes, bool, np.bool_)):
@@ -42,7 +42,7 @@ def _first_non_number(value) -> str | None:
             continue
         try:
             arr = v if isinstance(v, np.ndarray) else np.asarray(v)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, RuntimeError):
             continue  # the conversion fails later with its own message
         if arr.dtype.kind in "bUS":
             if not arr.size:
@@ -54,6 +54,26 @@ def _first_non_number(value) -> str | None:
         if arr.dtype.kind == "O":
             stack.extend(x for x in reversed(arr.reshape(-1).tolist()) if x is not v)
     return None
+
+
+def tensor_values(value):
+    """``value``, or for a torch tensor (an object with a bool ``requires_grad`` and a
+    ``detach`` method) its values as a numpy array: numpy refuses a tensor that records
+    gradients ("Can't call numpy() on Tensor that requires grad") and warns that a tensor's
+    ``__array__`` takes no ``copy`` when it copies one. A tensor numpy cannot hold (on a GPU)
+    is returned as it is, for the caller's conversion to refuse."""
+    if not isinstance(getattr(value, "requires_grad", None), bool):
+        return value
+    try:
+        return np.asarray(value.detach())
+    except (AttributeError, TypeError, RuntimeError):
+        return value
+
+
+def size_of(value) -> int:
+    """The number of entries of ``value``, from its shape (``np.size`` of a torch tensor is
+    the tensor's ``size`` method, not a count); ValueError for a ragged list, as numpy's."""
+    return int(np.prod(np.shape(value)))
 
 
 def check_not_masked(value, name: str) -> None:
@@ -75,6 +95,7 @@ def as_float(value, name: str, *, advice: bool = True) -> np.ndarray:
     decimal comma, a missing-value mark); False for a value read from a file's record, whose
     caller says the record is damaged."""
     check_not_masked(value, name)
+    value = tensor_values(value)
     bad = _first_non_number(value)
     if bad is not None and not advice:
         raise GPMSAError(f"{name} must be a numeric array, got {bad}")
@@ -90,6 +111,8 @@ def as_float(value, name: str, *, advice: bool = True) -> np.ndarray:
         raise GPMSAError(f"{name} holds a number too large for float64: {exc}") from exc
     except (TypeError, ValueError) as exc:
         raise GPMSAError(f"{name} must be a numeric array, got {_kind_of(value)}") from exc
+    except RuntimeError as exc:  # e.g. a list of torch tensors that record gradients
+        raise GPMSAError(f"{name} cannot be converted to numbers: {exc}") from exc
     if arr is None:
         raise GPMSAError(f"{name} must hold real numbers, got complex values")
     return arr
@@ -1536,7 +1559,7 @@ class ObsData:
     def _experiments(y, n: int | None) -> list[np.ndarray]:
         """y as one 1-D array per experiment; ``n``: the experiments x_obs gives (None: no x,
         a 1-D y is one experiment)."""
-        if isinstance(y, (list, tuple)) and any(np.ndim(e) == 1 and np.size(e) > 1 for e in y):
+        if isinstance(y, (list, tuple)) and any(np.ndim(e) == 1 and size_of(e) > 1 for e in y):
             ys = [as_float(e, f"y_obs[{j}]").reshape(-1) for j, e in enumerate(y)]
         else:
             arr = as_float(y, "y_obs")
@@ -1569,7 +1592,7 @@ class ObsData:
             if any(np.ndim(g) == 2 and min(np.shape(g)) > 1 for g in index):
                 return _index_points(list(index), ys, [f"index[{j}]" for j in range(len(ys))])
         per_experiment = per_experiment and all(np.ndim(g) == 1 for g in index)
-        if per_experiment and len(index) != len(ys) and all(np.size(g) == 1 for g in index):
+        if per_experiment and len(index) != len(ys) and all(size_of(g) == 1 for g in index):
             per_experiment = False  # one grid as a column of 1-point lists
         rows = isinstance(index, np.ndarray) and index.ndim == 2 and min(index.shape) > 1
         if rows and all(e.size == index.shape[0] != index.shape[1] for e in ys):
