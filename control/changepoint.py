@@ -392,10 +392,19 @@ def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:
     """Prior mass per grid node: the density (1/GD for log-uniform, 1 for uniform, or exp of
     the user's log density) times the node's trapezoid weight, normalised."""
     if callable(prior):
+        given = prior(gd.copy())  # its own errors propagate as raised
         try:
-            log_density = np.asarray(prior(gd.copy()), dtype=float)
+            raw = np.asarray(given)
+            real = given is not None and raw.dtype.kind not in "bc"  # a mask is no log density
+            log_density = raw.astype(float) if real else None
         except (TypeError, ValueError) as exc:
             raise ControlError(f"prior(gd) must return real log densities: {exc}") from None
+        if log_density is None:
+            got = "None" if given is None else f"{raw.dtype.name} values"
+            hint = (
+                " (a mask? return 0.0 where allowed, -inf elsewhere)" if raw.dtype == bool else ""
+            )
+            raise ControlError(f"prior(gd) must return real log densities, got {got}{hint}")
         if log_density.shape != gd.shape or np.any(np.isnan(log_density)):
             raise ControlError(
                 f"prior(gd) must return {gd.size} log densities (no NaN), got shape "

@@ -81,8 +81,8 @@ def _as_function(speed: SpeedSchedule) -> Callable[[np.ndarray], np.ndarray]:
     if callable(speed):
 
         def evaluate(x: np.ndarray) -> np.ndarray:
-            try:
-                out = checks.real_array("speed(...)", speed(x))
+            try:  # a copy: a callable that edits its input cannot edit the schedule's grid
+                out = checks.real_array("speed(...)", speed(x.copy()))
             except (TypeError, ValueError):  # a scalar function (VehicleError is a ValueError)
                 out = None
             if out is None or out.shape != x.shape:

@@ -680,7 +680,7 @@ def _run_fast(
 
         def extra(theta_unit: np.ndarray) -> float:
             native = constraints.round_levels(std.t_from_unit(theta_unit[None, :]), categorical)
-            val = np.ravel(log_prior(native[:, 0] if native.shape[1] == 1 else native))
+            val = log_prior(native[:, 0] if native.shape[1] == 1 else native)
             return check_log_prior(val, names, native[0])
 
     sampler = CalibrationSampler(

@@ -415,6 +415,7 @@ class Calibrator:
         self._entropy = np.random.SeedSequence(None if seed is None else run_seed(seed)).entropy
         self._count = 0
         self._updating = threading.RLock()  # updates take turns: each has its own count
+        self._in_update = False  # an update runs (`update` refuses one from inside it)
         self.mcmc_options = _check_mcmc_options(mcmc_options, backend)
         user_options = sorted(self.mcmc_options)  # before the constraint joins them
         if constraint is not None:
@@ -548,6 +549,7 @@ class Calibrator:
         """For pickle and ``copy``: all but the update lock (a copy gets its own)."""
         state = self.__dict__.copy()
         state.pop("_updating", None)
+        state.pop("_in_update", None)  # a copy made inside an update is not in it
         return state
 
     def __setstate__(self, state: dict) -> None:
@@ -559,6 +561,7 @@ class Calibrator:
         if isinstance(grid, np.ndarray):
             grid.flags.writeable = False
         self._updating = threading.RLock()
+        self._in_update = False
         self.__dict__.setdefault("_levels", None)  # pickled before categorical grids (s73)
         self.__dict__.setdefault("_categorical", [])
         if "_refined" not in state and self.method == "grid":
@@ -809,7 +812,18 @@ class Calibrator:
         serial sequence; for the same draws whatever the order, pass each its ``seed``.
         """
         with self._updating:
-            return self._update(x_obs, y_obs, prior, seed, extrapolate)
+            if self._in_update:  # this thread, from the prior or constraint of its update
+                raise GPMSAError(
+                    "Calibrator.update was called from inside an update of the same Calibrator "
+                    "(by its prior= or constraint): the two would be counted as one and draw "
+                    "with one seed; call update before, or use another Calibrator there (of "
+                    "its own seed)"
+                )
+            self._in_update = True
+            try:
+                return self._update(x_obs, y_obs, prior, seed, extrapolate)
+            finally:
+                self._in_update = False
 
     def _update(self, x_obs, y_obs, prior, seed, extrapolate) -> Posterior:
         """`update`, under its lock."""

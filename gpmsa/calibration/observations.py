@@ -835,17 +835,25 @@ def lamos_start(fit: Fit, prior: LamOsPrior) -> float:
     return start
 
 
-def check_log_prior(values: np.ndarray, names: tuple[str, ...], theta) -> float:
-    """One log prior density from a user's ``log_prior`` (a 1-element array): a float, or
-    -inf; NaN, +inf or a wrong size raise GPMSAError (a NaN is an error, not a zero density)."""
-    if np.size(values) != 1:
-        raise GPMSAError(
-            f"log_prior must return one log density per theta row, got {np.size(values)} values"
-        )
+def check_log_prior(value, names: tuple[str, ...], theta) -> float:
+    """One log prior density from what a user's ``log_prior`` returned at one theta row (one
+    number, in any shape or array type numpy reads): a float, or -inf; no real number (bools,
+    complex values, text, None), NaN, +inf or a wrong size raise GPMSAError (a NaN is an error,
+    not a zero density; a mask is not a log density)."""
     try:
-        val = float(np.asarray(values, dtype=float).reshape(-1)[0])
-    except (TypeError, ValueError) as exc:
-        raise GPMSAError(f"log_prior must return numbers, got {values!r}") from exc
+        values = np.asarray(value)
+    except (TypeError, ValueError) as exc:  # e.g. a ragged list
+        raise GPMSAError(f"log_prior must return numbers, got {value!r}") from exc
+    kind = values.dtype.kind
+    if kind not in "iuf":
+        got = "None" if value is None else f"{value!r} (dtype {values.dtype})"
+        hint = " (a mask? return 0.0 where allowed, -inf elsewhere)" if kind == "b" else ""
+        raise GPMSAError(f"log_prior must return real log densities, got {got}{hint}")
+    if values.size != 1:
+        raise GPMSAError(
+            f"log_prior must return one log density per theta row, got {values.size} values"
+        )
+    val = float(values.reshape(-1)[0])
     if np.isnan(val) or val == np.inf:
         at = ", ".join(f"{n}={float(v):.6g}" for n, v in zip(names, np.ravel(theta), strict=False))
         raise GPMSAError(

@@ -182,7 +182,9 @@ def fit(
     Beyond GPM/SA's model (numpy backend; docs/categorical-and-constraints.md): categorical
     inputs are declared in ``SimData`` (a categorical theta of a joint fit is sampled over its
     levels, uniform prior). mean_basis: None (zero mean, GPM/SA), "constant",
-    "linear" or a callable of unit-scale [x, t] (n, p + q) -> (n, k); its coefficients are
+    "linear" or a callable of unit-scale [x, t] (n, p + q) -> (n, k), called on a copy and
+    again at every prediction, so a deterministic function of each row (one using random
+    numbers or state gives predictions that change from call to call); its coefficients are
     integrated out (flat prior). fixed: name -> value held fixed (model scales as
     ``Emulator.params``; theta in native units), e.g. ``{"lamWOs": 1e5 - 1}``: a scalar or an
     array of the parameter's shape holds the whole array; a dict element index -> value holds
