@@ -104,7 +104,9 @@ def bench_fit(backend: str, n_iter: int, n_chains: int, options: dict, seed: int
 def bench_calibrate(backend: str, n_samples: int, n_chains: int, fast: bool, seed: int) -> tuple:
     """(wall s, min ESS, max R-hat over GD and lamOs) of one gpmsa.calibrate."""
     sim, x_obs, y_obs = road()
-    ref = json.loads(REF.read_text())["sepia_calibration_only"]["fixed_emulator_params_unit_scale"]
+    ref = json.loads(REF.read_text(encoding="utf-8"))["sepia_calibration_only"][
+        "fixed_emulator_params_unit_scale"
+    ]
     emu = gpmsa.Emulator.from_params(sim, {k: np.asarray(v) for k, v in ref.items()})
     t0 = time.perf_counter()
     post = gpmsa.calibrate(

@@ -43,7 +43,7 @@ WARM_UP = 50
 
 def road_emulator() -> tuple[Emulator, dict]:
     case = dict(np.load(DATA / "case.npz", allow_pickle=False))
-    ref = json.loads((DATA / "reference_posteriors.json").read_text())
+    ref = json.loads((DATA / "reference_posteriors.json").read_text(encoding="utf-8"))
     sim = gpmsa.SimData(
         x=case["v"][:, None], t=case["GD"][:, None], y=case["f"][:, None],
         x_names=["v"], t_names=["GD"], y_names=["f"],

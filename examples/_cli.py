@@ -114,8 +114,11 @@ def run(main: Callable[[], object]) -> None:
     """Run a script's ``main`` as a command: Ctrl-C ends it with one line on stderr and exit
     status 130 instead of a traceback (the files are written in one step each, so none is left
     in part); a reader that stops reading its output does not stop it (nor does a closed
-    stdout: Python's sys.stdout is then None, and print writes nothing)."""
+    stdout: Python's sys.stdout is then None, and print writes nothing); a character that
+    stdout's encoding lacks (a folder named in cp1252 output) is escaped, not an error."""
     if sys.stdout is not None:
+        if hasattr(sys.stdout, "reconfigure"):  # a path that the output's encoding (cp1252 in
+            sys.stdout.reconfigure(errors="backslashreplace")  # a file on Windows) lacks
         sys.stdout = _UntilTheReaderLeaves(sys.stdout)
     try:
         main()

@@ -976,7 +976,8 @@ def _drive(spec: RunSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def code_fingerprint() -> str:
     """SHA-256 of what computes a run: the source of ``roadgen`` and ``vehicle`` and the versions
     of numpy, scipy and exudyn. Part of every cache key, so that a cache written by other code
-    (a road drawn differently, another solver) is never taken for this code's runs."""
+    (a road drawn differently, another solver) is never taken for this code's runs. Line ends
+    are read as LF: a checkout with CRLF ones (git's autocrlf on Windows) is the same code."""
     from importlib import metadata
 
     import scipy
@@ -985,7 +986,7 @@ def code_fingerprint() -> str:
     for folder in (Path(roadgen.__file__).parent, Path(__file__).parent):
         for source in sorted(folder.glob("*.py")):
             digest.update(f"{folder.name}/{source.name}\0".encode())
-            digest.update(source.read_bytes())
+            digest.update(source.read_bytes().replace(b"\r\n", b"\n"))
     try:
         exudyn_version = metadata.version("exudyn")
     except metadata.PackageNotFoundError:

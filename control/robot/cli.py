@@ -297,6 +297,8 @@ def parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     usage = parser()
     args = usage.parse_args(argv)
+    if hasattr(sys.stdout, "reconfigure"):  # a path that the output's encoding (cp1252 in a
+        sys.stdout.reconfigure(errors="backslashreplace")  # file on Windows) lacks: \u0141
     try:
         Simplex(release_m=args.release_m)
     except ControlError as err:
