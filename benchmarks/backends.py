@@ -28,6 +28,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _host import load_average
 
 import gpmsa
 from gpmsa import backends
@@ -181,7 +182,7 @@ def main(argv=None) -> None:
 
 def load() -> str:
     """The load average (1, 5, 15 min), printed with the figures: the machine is shared."""
-    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+    return "load average {:.2f} {:.2f} {:.2f}".format(*load_average())
 
 
 if __name__ == "__main__":

@@ -32,6 +32,7 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
+from _host import load_average
 
 import gpmsa
 from gpmsa.fitting.emulator import Emulator
@@ -227,7 +228,7 @@ def main() -> None:
 
 def load() -> str:
     """The load average with the cores, printed with the timings (the machine is shared)."""
-    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*os.getloadavg(), os.cpu_count())
+    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
 
 
 if __name__ == "__main__":

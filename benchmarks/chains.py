@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _host import load_average
 from backends import ess_rhat, rhat_text, road  # noqa: E402
 
 from gpmsa import backends  # noqa: E402
@@ -48,7 +49,7 @@ the burn-in of n_iter // 5."""
 
 def load() -> str:
     """The 1-minute load average, printed with every figure."""
-    return f"load {os.getloadavg()[0]:.2f}"
+    return f"load {load_average()[0]:.2f}"
 
 
 def run_fit(backend: str, n_iter: int, n_chains: int, seed: int, **options) -> tuple:

@@ -54,12 +54,12 @@ figures); ``--sets paper --cases A`` ~15 s.
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import fields, replace
 
 import numpy as np
+from _host import load_average
 
 import control
 import gpmsa
@@ -494,7 +494,7 @@ def main() -> None:
         last = args.steady_first_seed + args.steady_roads - 1
         print(f"steady set: seeds {args.steady_first_seed}-{last}")
     print("\n".join(out))
-    load = os.getloadavg()
+    load = load_average()
     print(f"\n{time.perf_counter() - tic:.0f} s on {args.workers} worker(s), load average "
           f"{load[0]:.2f} {load[1]:.2f} {load[2]:.2f}")  # fmt: skip
 

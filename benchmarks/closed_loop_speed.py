@@ -24,10 +24,10 @@ from __future__ import annotations
 import argparse
 import copy
 import dataclasses
-import os
 import time
 
 import numpy as np
+from _host import load_average
 
 import control
 import roadgen
@@ -111,7 +111,7 @@ def main() -> None:
         bcr_share.append(replay_wall / max(float(c[0][-1]) for c in chunks if len(c[0])))
 
     lat = np.array(latencies) * 1e3
-    load = os.getloadavg()
+    load = load_average()
     print(
         f"closed loop, case {args.case}, {args.method}, paper track, {args.repeats} runs "
         f"(medians), lattice_p {settings.sensor.lattice_p:g}; "

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 import warnings
@@ -39,6 +38,7 @@ from roadgen.checks import home_path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "examples"))
 from _cli import path_option, write_text  # noqa: E402
+from _host import load_average
 
 TRUE_T = 0.4
 GRID = np.linspace(0.0, 1.0, 15)
@@ -108,9 +108,9 @@ def main(argv: list[str] | None = None) -> None:
     if out is not None and not out.parent.is_dir():
         parser.error(f"--out {args.out!r}: its folder does not exist")
     warnings.simplefilter("ignore")  # small fits: convergence and outside-emulator warnings
-    load0, t0 = os.getloadavg()[0], time.perf_counter()
+    load0, t0 = load_average()[0], time.perf_counter()
     res = run(args.seeds)
-    print(f"{args.seeds} seeds, true t = {TRUE_T}; load {load0:.2f} -> {os.getloadavg()[0]:.2f}, "
+    print(f"{args.seeds} seeds, true t = {TRUE_T}; load {load0:.2f} -> {load_average()[0]:.2f}, "
           f"{time.perf_counter() - t0:.0f} s")  # fmt: skip
     print(f"{'truth':8s} {'grouping':18s} {'bias':>8s} {'RMSE':>8s} {'mean sd':>8s} "
           f"{'90% cov':>8s}  median lamVz per group (over seeds)")  # fmt: skip

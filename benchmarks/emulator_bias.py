@@ -59,7 +59,6 @@ Campaign runs are cached under ``--cache-dir``.
 from __future__ import annotations
 
 import argparse
-import os
 import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
@@ -67,6 +66,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from _host import load_average
 from scipy import stats
 
 import control
@@ -85,7 +85,7 @@ N_BOOT = 400
 
 
 def load() -> str:
-    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+    return "load average {:.2f} {:.2f} {:.2f}".format(*load_average())
 
 
 def training_seeds(emu) -> np.ndarray:

@@ -51,7 +51,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
 import sys
 import time
 import traceback
@@ -60,6 +59,7 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
+from _host import load_average
 from scipy import stats
 
 import control
@@ -348,7 +348,7 @@ def excerpt(clean, faulted, fault, before_s: float = 3.0, after_s: float = 12.0)
 
 
 def load() -> str:
-    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+    return "load average {:.2f} {:.2f} {:.2f}".format(*load_average())
 
 
 def print_excerpt(o: Outcome) -> None:

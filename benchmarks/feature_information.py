@@ -49,13 +49,13 @@ recomputes the features (a few seconds).
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from _host import load_average
 from scipy.linalg import cho_factor, cho_solve
 from scipy.signal.windows import hann
 
@@ -393,7 +393,7 @@ def paired_j_ratio(
 
 
 def load() -> str:
-    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+    return "load average {:.2f} {:.2f} {:.2f}".format(*load_average())
 
 
 def main(argv: list[str] | None = None) -> None:

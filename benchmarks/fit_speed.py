@@ -19,6 +19,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _host import load_average
 from scipy.linalg import lapack
 from threadpoolctl import threadpool_limits
 
@@ -72,7 +73,7 @@ def main(repeats: int = 15) -> None:
     d = np.load(CASE)
     sim = gpmsa.SimData(x=d["v"], t=d["GD"], y=d["f"])
     obs = gpmsa.ObsData(x=d["v_obs"][:, None], y=d["f_obs"][:, None])
-    print(f"road case: m={sim.m}, scalar output; load average {os.getloadavg()[0]:.2f} "
+    print(f"road case: m={sim.m}, scalar output; load average {load_average()[0]:.2f} "
           f"on {os.cpu_count()} cores; 1 BLAS thread")  # fmt: skip
     chol = cholesky_ms(sim.m, repeats)
     print(f"baseline: one {sim.m} x {sim.m} Cholesky {chol:.4f} ms CPU (median of {repeats})")
@@ -83,7 +84,7 @@ def main(repeats: int = 15) -> None:
             f"best {best:.3f} ms CPU; CPU / baseline {cpu / chol:5.2f}; 30,000 sweeps + 1,000 "
             f"tuning ~ {31 * wall:5.1f} s wall, {31 * cpu:5.1f} s CPU"
         )
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
+    print(f"load average after: {load_average()[0]:.2f}")
 
 
 if __name__ == "__main__":

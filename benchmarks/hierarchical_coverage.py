@@ -12,13 +12,14 @@ cover theta_i, mu and the group sd. Usage: python benchmarks/hierarchical_covera
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the tests' study case
+from _host import load_average
+
 import gpmsa  # noqa: E402
 from tests.gpmsa.test_study_hierarchical import coverage  # noqa: E402
 
@@ -33,7 +34,7 @@ def main(argv=None) -> None:
     if args.sets < 1:
         ap.error(f"--sets must be >= 1, got {args.sets}")
     print(f"# 90% interval coverage, {args.sets} data sets a row; load "
-          f"{os.getloadavg()[0]:.2f}")  # fmt: skip
+          f"{load_average()[0]:.2f}")  # fmt: skip
     print("groups  sd    prior     theta_i (n)    mu     group sd")
     for n_groups, sd in CONFIGS:
         for name, hyper in (("uniform", gpmsa.HyperPriors()), ("sepia", gpmsa.HyperPriors.sepia())):

@@ -17,6 +17,7 @@ import os
 import time
 
 import numpy as np
+from _host import load_average
 from threadpoolctl import threadpool_limits
 
 import gpmsa
@@ -49,7 +50,7 @@ def sweep_cpu(problem, n_sweeps: int) -> float:
 
 
 def main(n_sweeps: int = 3) -> None:
-    print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; 1 BLAS thread; "
+    print(f"load average {load_average()[0]:.2f} on {os.cpu_count()} cores; 1 BLAS thread; "
           f"{n_sweeps} sweeps each; CPU seconds per sweep")  # fmt: skip
     for nx, nt in SIZES:
         kron = separable_problem(nx, nt)
@@ -58,7 +59,7 @@ def main(n_sweeps: int = 3) -> None:
         t_dense = sweep_cpu(dense, n_sweeps)
         print(f"m = {nx * nt:5d} ({nx} x {nt}): dense {t_dense:8.4f} s, Kronecker "
               f"{t_kron:8.5f} s, ratio {t_dense / t_kron:7.0f}; load average "
-              f"{os.getloadavg()[0]:.2f}")  # fmt: skip
+              f"{load_average()[0]:.2f}")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -33,12 +33,12 @@ estimator can. Targets (issue 12): <= 35 on the GD-300 parts, <= 60 on the GD-50
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 
 import numpy as np
+from _host import load_average
 
 import control
 import roadgen
@@ -172,7 +172,7 @@ def main() -> None:
     tic = time.perf_counter()
     with ProcessPoolExecutor(max_workers=args.workers) as pool:
         results = {r["job"]: r for r in pool.map(_run, jobs)}
-    load = os.getloadavg()
+    load = load_average()
     print(
         "paper track, RMSE of GD on the GD-300 / GD-500 parts (targets 35 / 60), the shipped "
         "estimator's drives"

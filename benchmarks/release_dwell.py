@@ -36,6 +36,7 @@ import os
 import time
 
 import numpy as np
+from _host import load_average
 
 import control
 import roadgen
@@ -192,7 +193,7 @@ def main(argv=None) -> None:
             ):
                 print(f"{c:<5} {rel:>9g}  {secs:6.1f}  {safety:>18.1f}  {fast:>16.1f}  "
                       f"{r300:8.2f}  {r500:8.2f}")  # fmt: skip
-    load = "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*os.getloadavg(), os.cpu_count())
+    load = "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
     print(f"{time.perf_counter() - tic:.1f} s; {load}")
 
 

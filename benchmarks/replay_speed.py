@@ -21,6 +21,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from _host import load_average
 
 import control
 import roadgen
@@ -86,7 +87,7 @@ def main() -> None:
         print("target: >= 200x real time (ratio: read, resample and BCR; 'with outputs': the "
               "whole call, CSV and output bag written)")  # fmt: skip
         print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f} on {} cores".format(
-            *os.getloadavg(), os.cpu_count()))  # fmt: skip
+            *load_average(), os.cpu_count()))  # fmt: skip
     finally:
         shutil.rmtree(work, ignore_errors=True)
 

@@ -13,6 +13,8 @@ import statistics
 import time
 from collections.abc import Callable
 
+from _host import load_average
+
 import roadgen
 
 
@@ -55,7 +57,7 @@ def main(argv: list[str] | None = None) -> None:
 
 def load() -> str:
     """The load average with the cores, printed with the timings (the machine is shared)."""
-    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*os.getloadavg(), os.cpu_count())
+    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
 
 
 if __name__ == "__main__":

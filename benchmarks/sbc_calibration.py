@@ -22,7 +22,6 @@ Usage: python benchmarks/sbc_calibration.py [--replicates 500] [--mcmc-replicate
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 import warnings
@@ -34,6 +33,8 @@ from scipy.linalg import cho_factor, cho_solve
 from scipy.stats import chisquare, truncnorm
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from _host import load_average
+
 import gpmsa  # noqa: E402
 
 REPORT_SEED = 2018
@@ -243,7 +244,7 @@ def main(argv=None) -> None:
     seed = DEV_SEED if args.dev else args.seed
     print(
         f"# SBC of the online calibration; seed {seed} ({'development' if args.dev else 'root'}"
-        f"; reported: {REPORT_SEED}, development: {DEV_SEED}); load {os.getloadavg()[0]:.2f}"
+        f"; reported: {REPORT_SEED}, development: {DEV_SEED}); load {load_average()[0]:.2f}"
     )
     print(
         f"# grid: PIT of the truth (exact CDF); MCMC: rank among {N_RANK_DRAWS} draws of "
@@ -270,7 +271,7 @@ def main(argv=None) -> None:
             tag = "mcmc, lamOs known" if known else "mcmc"
             for name, (rank, cover) in ranks.items():
                 print(row(f"{tag} {label}", name, rank, float(N_RANK_DRAWS), cover), flush=True)
-    print(f"# {time.perf_counter() - start:.0f} s; load {os.getloadavg()[0]:.2f}")
+    print(f"# {time.perf_counter() - start:.0f} s; load {load_average()[0]:.2f}")
 
 
 if __name__ == "__main__":

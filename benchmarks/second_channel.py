@@ -42,11 +42,11 @@ Run time: ~50 s at the defaults (docs/closed-loop.md's figures); ``--roads 4 --d
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+from _host import load_average
 from scipy.signal.windows import dpss
 
 import roadgen
@@ -247,7 +247,7 @@ def main() -> None:
             j = float(np.mean(folds))
             ref = base.setdefault("noisy" if "noise" in label else "clean", j)
             print(f"  {label:52s} J {j:6.2f}  x{j / ref:4.2f}  ({folds[0]:.2f} / {folds[1]:.2f})")
-    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    load = " ".join(f"{x:.2f}" for x in load_average())
     print(f"\n{time.perf_counter() - tic:.0f} s; load average {load}")
 
 

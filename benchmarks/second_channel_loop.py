@@ -37,7 +37,6 @@ ones have 30,000, which moved no closed-loop figure beyond its scatter, docs/clo
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -59,6 +58,7 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "examples"))
 import closed_loop_accuracy as cla  # noqa: E402
 from _cli import check_option_memory, output_folder, path_option  # noqa: E402
+from _host import load_average  # noqa: E402
 from second_channel import GYRO_NOISE_RAD_S, spectral_derivative  # noqa: E402
 from train_emulator import BATCH, LEAD_IN_M, fit_memory, stretched_design  # noqa: E402
 
@@ -346,7 +346,7 @@ def main() -> None:
                     print(cla.report_random(results, case))
                 if name.startswith("steady"):
                     print("\n".join(cla.report_steady(results, case)))
-    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    load = " ".join(f"{x:.2f}" for x in load_average())
     print(f"\n{time.perf_counter() - tic:.0f} s on {args.workers} worker(s), load average {load}")
 
 

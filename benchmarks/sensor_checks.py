@@ -36,11 +36,11 @@ after the first block) flagged by an update whose samples hold part of the drop.
 from __future__ import annotations
 
 import argparse
-import os
 import time
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+from _host import load_average
 
 import vehicle
 from control.bcr import CHECK_CONTEXT, CHECK_LEAST, MAX_PHASES
@@ -258,7 +258,7 @@ def main() -> None:
                 found.append(f"{gain:g}: {100 * hits / tried:5.1f}%")
             fewer = f" ({tried:,} blocks each)" if tried < PICKS else ""
             print(f"   {length} samples scaled by " + ", ".join(found) + fewer)
-    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
+    load = " ".join(f"{x:.2f}" for x in load_average())
     print(f"{time.perf_counter() - tic:.0f} s; load average {load}")
 
 

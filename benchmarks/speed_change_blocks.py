@@ -45,6 +45,7 @@ from concurrent.futures import ProcessPoolExecutor
 from functools import cache
 
 import numpy as np
+from _host import load_average
 from scipy.signal.windows import dpss
 
 import control
@@ -66,7 +67,7 @@ NOISE_STD = {"A": 0.0, "B": 1.0}
 
 
 def load() -> str:
-    return "load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+    return "load average {:.2f} {:.2f} {:.2f}".format(*load_average())
 
 
 class _BlockReader:

@@ -33,6 +33,7 @@ import time
 import warnings
 
 import numpy as np
+from _host import load_average
 
 import gpmsa
 
@@ -57,7 +58,7 @@ def two_mode_case() -> tuple[gpmsa.SimData, gpmsa.ObsData]:
 
 def load() -> str:
     """The load average with the cores, printed with the timings (the machine is shared)."""
-    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*os.getloadavg(), os.cpu_count())
+    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
 
 
 def upper(emu: gpmsa.Emulator, n_chains: int) -> np.ndarray:

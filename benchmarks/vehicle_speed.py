@@ -17,6 +17,7 @@ import os
 import time
 
 import numpy as np
+from _host import load_average
 
 import roadgen
 import vehicle
@@ -91,7 +92,7 @@ def main() -> None:
 
 def load() -> str:
     """The load average (1, 5, 15 min), printed with the timings: the machine is shared."""
-    return "{:.2f} {:.2f} {:.2f}".format(*os.getloadavg())
+    return "{:.2f} {:.2f} {:.2f}".format(*load_average())
 
 
 if __name__ == "__main__":
