@@ -106,16 +106,16 @@ class ChangePointFilter:
         lg = np.log(gd)
         jump = lg[None, :] - lg[:, None]
         T = self.prior[None, :] * (np.abs(jump) >= s.min_jump)
-        if s.jump_sd is not None:
-            with np.errstate(over="ignore", under="ignore"):
+        with np.errstate(over="ignore", under="ignore"):  # far jumps underflow to 0 as intended
+            if s.jump_sd is not None:
                 T = T * np.exp(-0.5 * (jump / s.jump_sd) ** 2)
-        rows = T.sum(axis=1, keepdims=True)
-        if np.any(rows <= 0):
-            raise ControlError(
-                f"min_jump = {s.min_jump} with jump_sd = {s.jump_sd} leaves no GD to jump to "
-                f"from some node of the domain [{gd[0]:g}, {gd[-1]:g}]"
-            )
-        self._jump = T / rows
+            rows = T.sum(axis=1, keepdims=True)
+            if np.any(rows <= 0):
+                raise ControlError(
+                    f"min_jump = {s.min_jump} with jump_sd = {s.jump_sd} leaves no GD to jump "
+                    f"to from some node of the domain [{gd[0]:g}, {gd[-1]:g}]"
+                )
+            self._jump = T / rows
         self._scale = s.mean_segment_m / s.segment_shape
         self.reset()
 
@@ -171,10 +171,14 @@ class ChangePointFilter:
         survival.flags.writeable = False
         self._survival = (dist, survival)
 
+    # predict, relocate and update: masses far from the data underflow to 0 as intended,
+    # whatever the caller's np.seterr (one errstate per call, ~1 us; none per run length)
+    @np.errstate(under="ignore")
     def predict(self, ds_m: float) -> None:
         """Propagate over ds_m metres (change points; GD unchanged within a run)."""
         self._set(*self._predicted(ds_m))
 
+    @np.errstate(under="ignore")
     def relocate(self, ds_m: float) -> None:
         """Propagate over ds_m metres moved without data (a robot moved while down): as
         ``predict``, but a run that ended there is followed by GD from the prior, not by a
@@ -222,6 +226,7 @@ class ChangePointFilter:
         self._survival_of(dist, merged)
         return mass, dist
 
+    @np.errstate(under="ignore")
     def update(self, loglik: np.ndarray, ds_m: float) -> None:
         """One block ds_m metres long with log-likelihood ``loglik`` on the grid (G,). All or
         nothing: a refused block leaves the filter as it was."""
@@ -317,7 +322,8 @@ class ChangePointFilter:
 
     def expected_run_m(self) -> float:
         """Posterior mean of the distance since the last change, m."""
-        return float(self._mass.sum(axis=1) @ self._dist)
+        with np.errstate(under="ignore"):  # runs of (near) no mass
+            return float(self._mass.sum(axis=1) @ self._dist)
 
     def posterior(self, name: str = "GD", n_draws: int = 4000) -> Posterior:
         """The GD posterior as a gpmsa Posterior holding the grid marginal under ``name``;
@@ -346,7 +352,8 @@ def mixture_posterior(
         )
     if any(not np.array_equal(f.gd, filters[0].gd) for f in filters[1:]):
         raise ControlError("mixture_posterior needs filters on one GD grid")
-    return _mixture_posterior(filters, w, name, n_draws)
+    with np.errstate(under="ignore"):  # (the BCR's own call is inside BCR.update's)
+        return _mixture_posterior(filters, w, name, n_draws)
 
 
 def _mixture_posterior(
@@ -412,15 +419,17 @@ def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:
             )
         if np.any(log_density == np.inf) or not np.any(np.isfinite(log_density)):
             raise ControlError("prior(gd) must be finite somewhere and never +inf")
-        density = np.exp(log_density - np.max(log_density[np.isfinite(log_density)]))
+        with np.errstate(under="ignore"):  # far below its peak the density is 0
+            density = np.exp(log_density - np.max(log_density[np.isfinite(log_density)]))
     else:
         density = 1.0 / gd if prior == "log_uniform" else np.ones_like(gd)
-    mass = density * weights
-    if np.count_nonzero(mass > 0) < 2:  # e.g. -inf but at one node, or a density that underflows
-        node = float(gd[int(np.argmax(mass))])
-        raise ControlError(
-            f"prior(gd) puts all its mass on one grid node (GD {node:g}): a change would have "
-            "nowhere to go; give a log density that is finite on more of the grid and varies "
-            "by far less than 700 across it"
-        )
-    return mass / mass.sum()
+    with np.errstate(under="ignore"):  # (and so is the mass)
+        mass = density * weights
+        if np.count_nonzero(mass > 0) < 2:  # e.g. -inf but at one node, or an underflow
+            node = float(gd[int(np.argmax(mass))])
+            raise ControlError(
+                f"prior(gd) puts all its mass on one grid node (GD {node:g}): a change would "
+                "have nowhere to go; give a log density that is finite on more of the grid and "
+                "varies by far less than 700 across it"
+            )
+        return mass / mass.sum()

@@ -1064,7 +1064,8 @@ def stream_breaks(
     with np.errstate(invalid="ignore"):
         too_fast = np.abs(speed) > MAX_SPEED_MPS
     bad_value = ~finite | too_fast
-    step = t - _previous_finite(t, t_prev)
+    with np.errstate(invalid="ignore"):  # inf - inf (an inf stamp after an inf t_prev): NaN
+        step = t - _previous_finite(t, t_prev)
     finite_step = np.isfinite(step)  # a non-finite time stamp is a bad value, not a step
     with np.errstate(invalid="ignore"):
         backwards = finite_step & (step < 0.5 * dt)

@@ -111,6 +111,7 @@ class GDTracker:
         """Forget everything: back to the prior."""
         self.log_mass = self.log_prior.copy()
 
+    @np.errstate(under="ignore")
     def predict(self, ds_m: float) -> None:
         """Propagate the state over ds_m metres travelled (random walk, then change point)."""
         if not (is_real(ds_m) and ds_m >= 0):
@@ -133,6 +134,7 @@ class GDTracker:
         mass = (1 - hazard) * mass + hazard * np.exp(self.log_prior)
         self.log_mass = np.log(np.maximum(mass, 1e-300))
 
+    @np.errstate(under="ignore")
     def update(self, grid: np.ndarray, loglik: np.ndarray, power: float = 1.0) -> None:
         """Multiply in a likelihood given on any sorted grid of native GD (interpolated in log GD).
 

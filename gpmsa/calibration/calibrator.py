@@ -685,7 +685,8 @@ class Calibrator:
             return marginals[0].loglik
         ll = np.stack([m.loglik for m in marginals])
         peak = ll.max(axis=0)
-        return peak + np.log(np.mean(np.exp(ll - peak), axis=0))
+        with np.errstate(under="ignore"):  # sets far below the best: 0
+            return peak + np.log(np.mean(np.exp(ll - peak), axis=0))
 
     def _check_grid_method(self) -> None:
         if self.method != "grid":
@@ -930,7 +931,8 @@ class Calibrator:
         rows = np.moveaxis(logp.reshape(shape), c, -1)  # (levels, nodes)
         given = None if table is None else np.moveaxis(table.reshape(shape), c, -1)
         axis0 = self._axes[c]
-        mass = np.exp(rows - rows.max()) @ trapezoid_weights(axis0)
+        with np.errstate(under="ignore"):  # levels far below the best: 0
+            mass = np.exp(rows - rows.max()) @ trapezoid_weights(axis0)
         step = _float_step(self.emulator.standardizer, c)
         out = {}
         for r in np.flatnonzero(mass >= MODE_MASS * mass.sum()):
@@ -971,6 +973,7 @@ class Calibrator:
         check_mass(logp)
         return margs, logp
 
+    @np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
     def _level_posterior(
         self, free: np.ndarray, ok, margs: list, key, refined: dict | None = None
     ) -> Posterior:
@@ -1244,7 +1247,8 @@ class Calibrator:
             gm, kept = trimmed_marginal(x, logd, w)
             grids = {names[0]: gm}
             peak = float(logd.max())
-            log_evidence = float(np.log(w @ np.exp(logd - peak))) + peak
+            with np.errstate(under="ignore"):  # far tails: 0
+                log_evidence = float(np.log(w @ np.exp(logd - peak))) + peak
             log_evidence -= float(np.log(std.t_max[0] - std.t_min[0])) + self._log_prior_norm
             inv_lamos = _expected_inverse_lamos(margs)
             if lik is not None or kept.stop - kept.start < x.size:
@@ -1252,17 +1256,18 @@ class Calibrator:
                 inv_lamos = inv_lamos[lik][kept]
         else:
             shape = (axes[0].size, axes[1].size)
-            if ok is None:
-                dens = np.exp(free - free.max()).reshape(shape)
-                split = native
-            else:  # the free density, cut by the constraint on the split grid
-                cut = self._base_cut if base else self._cut(axes, ok)
-                logd = np.where(cut.live.ravel(), free, -np.inf)
-                dens = cut.density(np.exp(logd - logd.max()).reshape(shape))
-                split = [a * (std.t_max[k] - std.t_min[k]) + std.t_min[k]
-                         for k, a in enumerate(cut.axes)]  # fmt: skip
+            cut = None if ok is None else self._base_cut if base else self._cut(axes, ok)
+            with np.errstate(under="ignore"):  # a density's far tails underflow to 0
+                if cut is None:
+                    dens = np.exp(free - free.max()).reshape(shape)
+                    split = native
+                else:  # the free density, cut by the constraint on the split grid
+                    logd = np.where(cut.live.ravel(), free, -np.inf)
+                    dens = cut.density(np.exp(logd - logd.max()).reshape(shape))
+                    split = [a * (std.t_max[k] - std.t_min[k]) + std.t_min[k]
+                             for k, a in enumerate(cut.axes)]  # fmt: skip
             w = [trapezoid_weights(a) for a in split]
-            with np.errstate(divide="ignore"):
+            with np.errstate(divide="ignore", under="ignore"):
                 grids = {
                     names[0]: trimmed_marginal(split[0], np.log(dens @ w[1]))[0],
                     names[1]: trimmed_marginal(split[1], np.log(w[0] @ dens))[0],
@@ -1327,7 +1332,8 @@ def log_theta_norm(theta_mean: float, theta_sd: float) -> float:
     if c > 0.0:  # by symmetry, where log_ndtr keeps its precision
         a, b = -b, -a
     lb, la = float(log_ndtr(b)), float(log_ndtr(a))
-    return float(np.log(theta_sd * np.sqrt(2.0 * np.pi)) + lb + np.log1p(-np.exp(la - lb)))
+    with np.errstate(under="ignore"):  # a lower tail far below the upper one: 0
+        return float(np.log(theta_sd * np.sqrt(2.0 * np.pi)) + lb + np.log1p(-np.exp(la - lb)))
 
 
 def _warn_at_float(res: float, marginal, emulator) -> None:
@@ -1453,6 +1459,7 @@ def _block_diag(cov: np.ndarray) -> np.ndarray:
     return out
 
 
+@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
 def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
     """(G,) E[1/lamOs | data, theta node]: the observation-error variance (standardised units)
     expected at each theta node; several emulator parameter sets are weighted by their
@@ -1470,6 +1477,7 @@ def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
     return (p * per_set).sum(axis=0) / p.sum(axis=0)
 
 
+@np.errstate(under="ignore")
 def _draw_lamos(
     margs: list[LamOsMarginal], node: np.ndarray, rng: np.random.Generator
 ) -> tuple[np.ndarray, np.ndarray]:

@@ -127,7 +127,7 @@ def interp_log(
     if finite.all():
         return by_log
     near_zero = at((~finite).astype(float)) > 0.0
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", under="ignore"):
         by_density = np.log(at(np.exp(table - peak))) + peak
     return np.where(near_zero, by_density, by_log)
 
@@ -202,6 +202,7 @@ def _cell_inverse(g0: np.ndarray, g1: np.ndarray, r: np.ndarray) -> np.ndarray:
     return np.clip(2.0 * target / np.where(denom > 0.0, denom, 1.0), 0.0, 1.0)
 
 
+@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
 def draw_bilinear(
     axes: list, dens: np.ndarray, rng: np.random.Generator, size: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -447,6 +448,7 @@ def zero_edges(axes: list, log_prior: np.ndarray) -> list:
     return out
 
 
+@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
 def conditional_sds(axes: list, logp: np.ndarray) -> tuple[float, float]:
     """Two parameters: per parameter, the root of the mean (over the posterior, log density
     ``logp`` (G,) on the grid of ``axes``) of its variance given the other parameter's node, in
@@ -511,6 +513,7 @@ def _resolution(axis: np.ndarray, density: np.ndarray) -> float:
     return float(np.sqrt(total / inverse2))
 
 
+@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
 def resolution(axes: list, logp: np.ndarray) -> tuple[float, ...]:
     """Per parameter, the node spacings per sd of its marginal on the grid of ``axes``
     (`_resolution`; the posterior's log density ``logp`` (G,))."""
@@ -528,6 +531,7 @@ def _core(axis: np.ndarray, density: np.ndarray) -> tuple[int, int]:
     return max(i0 - 1, 0), min(i1 + 1, axis.size - 1)
 
 
+@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
 def tail_refined_axes(
     axes: list,
     logp: np.ndarray,
@@ -593,6 +597,7 @@ def _with_core(
     return np.unique(np.concatenate(pieces))
 
 
+@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
 def refined_axes(axes: list, logp: np.ndarray, keep: list | None) -> list | None:
     """Two parameters: the unit-scale axes of a finer grid where a mode of the posterior (log
     density ``logp`` (G,) on the grid of ``axes``) is not resolved along some parameter
@@ -621,6 +626,7 @@ def whole_refined_axis(axis: np.ndarray) -> np.ndarray:
                        REFINE_FACTORS[0])  # fmt: skip
 
 
+@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
 def refined_axis(
     axis: np.ndarray, logp: np.ndarray, keep: np.ndarray | None, min_step: float
 ) -> tuple[np.ndarray | None, str]:

@@ -219,11 +219,10 @@ def _normalised(bases: list[np.ndarray], zero: str) -> list[np.ndarray]:
     """``bases`` divided by one scale, so that the largest diag(D D^T) over all of them is 1
     (GPMSAError ``zero`` when they are all zero)."""
     big, scale = _scale(bases)
-    if big is not None:
-        bases = [D / big for D in bases]
     if not scale > 0:
         raise GPMSAError(zero)
-    return [D / np.sqrt(scale) for D in bases]
+    with np.errstate(under="ignore"):  # entries far below the largest one: subnormal or 0
+        return [(D if big is None else D / big) / np.sqrt(scale) for D in bases]
 
 
 def _scale(bases: list[np.ndarray]) -> tuple[float | None, float]:
@@ -233,7 +232,8 @@ def _scale(bases: list[np.ndarray]) -> tuple[float | None, float]:
         scale = max(np.max(np.sum(D**2, axis=1)) for D in bases)
     if not np.finfo(np.float64).tiny <= scale < np.inf and any(np.any(D) for D in bases):
         big = max(np.max(np.abs(D)) for D in bases)  # squares over/underflow: rescale first
-        return big, max(np.max(np.sum((D / big) ** 2, axis=1)) for D in bases)
+        with np.errstate(under="ignore"):  # (entries far below ``big``: to 0)
+            return big, max(np.max(np.sum((D / big) ** 2, axis=1)) for D in bases)
     return None, scale
 
 
@@ -241,7 +241,8 @@ def scaled_as(bases: list[np.ndarray], D: np.ndarray) -> np.ndarray:
     """``D`` divided as `_normalised` divides ``bases`` (the same basis functions on another
     grid keep the fit's normalisation)."""
     big, scale = _scale(bases)
-    return (D if big is None else D / big) / np.sqrt(scale)
+    with np.errstate(under="ignore"):
+        return (D if big is None else D / big) / np.sqrt(scale)
 
 
 SCALE_TOL = 1e-9

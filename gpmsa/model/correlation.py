@@ -60,7 +60,8 @@ def correlation(
         diff = _col_diff(a[:, k], b[:, k], bool(mask[k]))
         diff *= beta[k]
         exponent -= diff
-    return np.exp(exponent, out=exponent)
+    with np.errstate(under="ignore"):  # far apart: 0, whatever the caller's np.seterr
+        return np.exp(exponent, out=exponent)
 
 
 def correlation_row(
@@ -78,7 +79,8 @@ def correlation_row(
             diff *= diff
         diff *= beta_k
         exponent -= diff
-    return np.exp(exponent, out=exponent)
+    with np.errstate(under="ignore"):
+        return np.exp(exponent, out=exponent)
 
 
 def beta_to_rho(beta: np.ndarray) -> np.ndarray:

@@ -267,7 +267,7 @@ def far_run(sim, grid) -> FarRun | None:
     own = sim.y_scale == "columnwise" or np.size(sim.y_sd) > 1  # each element's own sd
     typical = spread if own else np.full(spread.shape, spread.max())
     floor = FAR_RUN_FLOOR * typical
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", under="ignore"):  # (under: ratio ~0)
         above = (s[-1] - s[-2]) / np.maximum(s[-2] - s[0], floor)
         below = (s[1] - s[0]) / np.maximum(s[-1] - s[1], floor)
     ratios = np.nan_to_num(np.vstack([above, below]), nan=0.0, posinf=0.0)  # 0/0, x/0: unjudged
