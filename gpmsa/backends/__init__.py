@@ -2,7 +2,8 @@
 
 A backend module exposes ``sample(problem, *, n_iter, n_chains=1, tune=True, step_widths=None,
 seed=None, progress=False, **options) -> gpmsa.mcmc.sampler.Chains``. Modules are imported
-lazily, so importing gpmsa never imports torch.
+lazily, so importing gpmsa never imports torch. ``register`` adds a backend of one's own
+(docs/internals.md, "A backend of your own").
 """
 
 from __future__ import annotations
@@ -14,24 +15,59 @@ from types import ModuleType
 import numpy as np
 
 from gpmsa.errors import BackendUnavailableError, GPMSAError
-from gpmsa.mcmc.sampler import check_sample_args
+from gpmsa.mcmc.sampler import Chains, check_sample_args
 
 __all__ = [
     "available",
     "check_options",
     "check_sample_args",
+    "check_tempering",
     "get",
     "names",
     "placement",
     "recorded_options",
+    "register",
+    "sample",
+    "takes",
 ]
 
-_REGISTRY: dict[str, tuple[str, str]] = {
-    # name: (module path, pip extra that provides its packages)
+_REGISTRY: dict[str, tuple[str | ModuleType, str]] = {
+    # name: (module path, or a registered module, and the pip argument that installs its packages)
     "numpy": ("gpmsa.backends.numpy_backend", ""),
-    "torch": ("gpmsa.backends.torch_backend", "torch"),
-    "pyro": ("gpmsa.backends.pyro_backend", "torch"),
+    "torch": ("gpmsa.backends.torch_backend", "terrain-gpmsa[torch]"),
+    "pyro": ("gpmsa.backends.pyro_backend", "terrain-gpmsa[torch]"),
 }
+BUILTIN = ("numpy", "torch", "pyro")
+"""The backends gpmsa ships; any other registered name is a plug-in (`register`)."""
+
+INTERFACE = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress")
+"""The keywords every backend's ``sample`` takes (after the problem)."""
+
+
+def register(name: str, module: str | ModuleType, *, extra: str = "") -> None:
+    """Register a backend of one's own as ``name`` (a plug-in; re-registering it replaces it).
+
+    ``module``: an import path (imported at first use, as the built-in backends are) or a
+    module (any object) with ``sample(problem, *, n_iter, n_chains=1, tune=True,
+    step_widths=None, seed=None, progress=False, ...) -> gpmsa.mcmc.sampler.Chains``; its other
+    keyword options are passed through from ``fit``/``calibrate`` as given (every one where it
+    takes ``**options``), ``n_jobs``/``executor`` only where its signature names them. It may
+    declare ``SUPPORTS``: the ``Problem.extensions`` its ``sample`` handles; a problem using
+    another is refused before sampling, as is parallel tempering (numpy and torch only).
+    ``extra``: the pip argument that installs its packages, named when its import fails.
+    GPMSAError for a name that is not a non-empty string or is a built-in backend's."""
+    if not isinstance(name, str) or not name.strip():
+        raise GPMSAError(f"register: name must be a non-empty string, got {name!r}")
+    if name in BUILTIN:
+        raise GPMSAError(f"register: {name!r} is a built-in backend's name; choose another")
+    if not isinstance(extra, str):
+        raise GPMSAError(f"register: extra must be a string (a pip argument), got {extra!r}")
+    if isinstance(module, str):
+        if not module.strip():
+            raise GPMSAError("register: module must be an import path or a module, got ''")
+    else:
+        _check_module(name, module)  # refused now, not at the fit
+    _REGISTRY[name] = (module, extra)
 
 
 def names() -> tuple[str, ...]:
@@ -60,24 +96,102 @@ def get(name: str) -> ModuleType:
     if not isinstance(name, str) or name not in _REGISTRY:
         raise GPMSAError(f"unknown backend {name!r}; registered: {names()}")
     path, extra = _REGISTRY[name]
+    if not isinstance(path, str):
+        return path
     try:
-        return importlib.import_module(path)
+        module = importlib.import_module(path)
     except ModuleNotFoundError as exc:
         if exc.name == path:
             raise GPMSAError(f"backend {name!r} is registered but {path} does not exist") from exc
         if _own(exc):
             raise
-        raise BackendUnavailableError(
-            f'backend {name!r} needs {exc.name}: pip install "terrain-gpmsa[{extra}]"'
-        ) from exc
+        how = f': pip install "{extra}"' if extra else ""
+        raise BackendUnavailableError(f"backend {name!r} needs {exc.name}{how}") from exc
     except (ImportError, OSError) as exc:  # installed but broken: incompatible versions, libraries
         if isinstance(exc, ImportError) and _own(exc):
             raise
+        how = f': pip install --upgrade "{extra}"' if extra else ""
         raise BackendUnavailableError(
             f"backend {name!r}: its packages are installed but fail to import "
-            f"({type(exc).__name__}: {exc}); install compatible versions: "
-            f'pip install --upgrade "terrain-gpmsa[{extra}]"'
+            f"({type(exc).__name__}: {exc}); install compatible versions{how}"
         ) from exc
+    if name not in BUILTIN:
+        _check_module(name, module)
+    return module
+
+
+def _check_module(name: str, module) -> None:
+    """GPMSAError where plug-in ``module`` has no callable ``sample`` taking `INTERFACE`."""
+    sample = getattr(module, "sample", None)
+    if not callable(sample):
+        raise GPMSAError(f"backend {name!r}: {module!r} has no callable sample(problem, *, ...)")
+    params = inspect.signature(sample).parameters
+    if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
+        missing = [k for k in INTERFACE if k not in params]
+        if missing:
+            raise GPMSAError(
+                f"backend {name!r}: its sample takes no {missing}; a backend's sample takes "
+                f"(problem, *, {', '.join(INTERFACE)}, ...)"
+            )
+
+
+def takes(backend: str, key: str) -> bool:
+    """Whether backend ``backend``'s ``sample`` takes keyword ``key`` (by name, or a plug-in's
+    through ``**options``)."""
+    params = inspect.signature(get(backend).sample).parameters
+    return key in params or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+
+
+def sample(backend: str, problem, *, n_iter: int, n_chains: int, **kwargs) -> Chains:
+    """The chains of backend ``backend``'s ``sample(problem, n_iter=, n_chains=, **kwargs)``,
+    checked: a plug-in's ``problem`` without an extension it does not declare (its
+    ``SUPPORTS``), its result a `Chains` of ``n_chains`` x ``n_iter`` draws of every parameter
+    of ``problem`` (GPMSAError naming what is wrong)."""
+    module = get(backend)
+    if backend not in BUILTIN:
+        declared = getattr(module, "SUPPORTS", ())
+        missing = [e for e in problem.extensions if e not in declared]
+        if missing:
+            raise GPMSAError(
+                f"backend {backend!r} does not declare support for {missing} (its module's "
+                f"SUPPORTS: {tuple(declared)}); use backend='numpy', or declare them where "
+                "its sample handles them"
+            )
+    chains = module.sample(problem, n_iter=n_iter, n_chains=n_chains, **kwargs)
+    if not isinstance(chains, Chains):
+        raise GPMSAError(f"backend {backend!r}: its sample returned a {type(chains).__name__}, "
+                         "not a gpmsa.mcmc.sampler.Chains")  # fmt: skip
+    lead = (n_chains, n_iter)
+    if chains.log_post.shape != lead:  # (Chains' own check: each draw's first axes log_post's)
+        wrong = [f"log_post has shape {chains.log_post.shape}"]
+    else:
+        missing = [k for k in problem.names if k not in chains.draws]
+        wrong = [f"no draws of {missing}"] if missing else []
+        shapes = {k: (np.shape(chains.draws[k]), (*lead, *v.shape))
+                  for k, v in problem.init.items() if k in chains.draws}  # fmt: skip
+        wrong += [f"draws[{k!r}] has shape {got}, not {want}"
+                  for k, (got, want) in shapes.items() if got != want]  # fmt: skip
+    if wrong:
+        raise GPMSAError(f"backend {backend!r}: its sample returned Chains of other draws than "
+                         f"n_chains x n_iter = {n_chains} x {n_iter} sweeps of the problem's "
+                         f"parameters: {'; '.join(wrong)}")  # fmt: skip
+    return chains
+
+
+def check_tempering(backend: str, options: dict) -> None:
+    """GPMSAError naming ``temperatures``/``swap_every``/``adapt_ladder`` in ``options`` for
+    another backend than numpy or torch, which alone run tempered chains."""
+    given = [k for k in ("temperatures", "swap_every") if options.get(k) is not None]
+    if given and backend not in ("numpy", "torch"):
+        raise GPMSAError(
+            f"{' and '.join(given)}: parallel tempering runs on the numpy and torch backends "
+            f"only, not backend={backend!r}"
+        )
+    if "adapt_ladder" in options and backend not in ("numpy", "torch"):
+        raise GPMSAError(
+            f"adapt_ladder: the adaptive ladder runs on the numpy and torch backends only, not "
+            f"backend={backend!r}"
+        )
 
 
 def _own(exc: ImportError) -> bool:
@@ -146,7 +260,7 @@ def placement(backend: str, n_jobs=None, executor=None) -> dict:
     out = {}
     for key, val in (("n_jobs", n_jobs), ("executor", executor)):
         if val is not None:
-            if key not in inspect.signature(sample).parameters:
+            if key not in inspect.signature(sample).parameters:  # named: **options is not enough
                 raise GPMSAError(
                     f"backend {backend!r} runs its chains in one process: it takes no {key}="
                 )

@@ -267,7 +267,8 @@ def calibrate(
         seed: an integer, a numpy Generator or None (fresh entropy): the same seed gives the
             same draws, with any number of chains' workers; the integer the run used is
             ``info["seed"]`` (``seed=`` that integer repeats it).
-        backend: "numpy" (default), "torch" or "pyro" (``gpmsa.backends.available()``).
+        backend: "numpy" (default), "torch", "pyro" or a plug-in's name
+            (``gpmsa.backends.register``; ``gpmsa.backends.available()``).
         emulator_params: "point" (the emulator's point estimate) or "draws" (the likelihood
             averaged over ``n_emulator_draws`` of its retained draws; numpy fast path only;
             ``info["emulator_draws"]`` then records, per sample, the retained draw it was drawn
@@ -458,6 +459,7 @@ def sample_calibration(
             "gpmsa.ObsData(x, y, index=..., precision=...) in place of x_obs (y_obs left out)"
         )
     backends.check_options(backend, options, reserved, "calibrate", renamed)
+    backends.check_tempering(backend, options)  # a plug-in's (pyro's: not its options)
     if options and fast:
         raise GPMSAError(
             f"calibrate: options {sorted(options)} go to a backend's sampler, which the fast "
@@ -584,6 +586,8 @@ def _tuning_options(backend: str, tune_rounds, tune_levels) -> dict[str, int]:
         return {}
     if backend == "numpy":
         given = {"tune_rounds": tuning.N_BURN, "tune_levels": tuning.N_LEVELS, **given}
+    if untaken := [k for k in given if not backends.takes(backend, k)]:  # a plug-in's sample
+        raise GPMSAError(f"backend {backend!r} takes no {' or '.join(untaken)}=")
     # torch's default rounds, ceil(50 / n_chains), are at most numpy's
     rounds, levels = tuning.check_tuning(given.get("tune_rounds", tuning.N_BURN),
                                          given.get("tune_levels", tuning.N_LEVELS))  # fmt: skip
@@ -823,7 +827,6 @@ def _run_backend(
         emulator, x_obs, y_obs, discrepancy=discrepancy, extrapolate=extrapolate,
         reduced=data if discrepancy is None else None, discrepancy_groups=groups, **theta_opts,
     )  # fmt: skip
-    module = backends.get(backend)
     if backend == "numpy":  # a constraint, a callable mean basis (torch: its sample; pyro: here)
         n_jobs, executor = in_this_process(
             problem.callables, where["n_jobs"], where["executor"], n_chains
@@ -833,9 +836,9 @@ def _run_backend(
     masks = problem.held_masks(CALIBRATION_FIXED)
     if resume is not None:
         opts.update(_backend_resume(emulator, problem, masks, resume))
-    chains = module.sample(
-        problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed, progress=progress,
-        **opts,
+    chains = backends.sample(
+        backend, problem, n_iter=n_samples, n_chains=n_chains, tune=tune, seed=seed,
+        progress=progress, **opts,
     )  # fmt: skip
     std = emulator.standardizer
     if masks:  # float64 whatever the backend sampled in, a held parameter exactly its value

@@ -155,9 +155,12 @@ def _check_mcmc_options(options, backend: str) -> dict:
     own = {"emulator", "x_obs", "y_obs", "extrapolate", "log_prior"}
     named = {k for k, v in inspect.signature(sample_calibration).parameters.items()
              if v.kind is not inspect.Parameter.VAR_KEYWORD}  # fmt: skip
-    sampler = set(inspect.signature(backends.get(backend).sample).parameters) - {"problem"}
+    params = inspect.signature(backends.get(backend).sample).parameters.values()
+    sampler = {p.name for p in params if p.kind not in (p.VAR_KEYWORD, p.VAR_POSITIONAL)}
+    sampler -= {"problem"}
     allowed = sorted((named | sampler) - own - {"n_iter"})  # n_iter: calibrate's n_samples
-    unknown = sorted(set(options) - set(allowed), key=str)
+    open_ended = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params)  # a plug-in's
+    unknown = [] if open_ended else sorted(set(options) - set(allowed), key=str)
     if unknown:
         raise GPMSAError(
             f"mcmc_options: unknown keyword(s) {unknown}; gpmsa.calibrate takes {allowed} "

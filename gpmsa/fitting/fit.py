@@ -174,10 +174,11 @@ def fit(
     entropy); the integer the fit ran with is ``settings["seed"]``, and ``fit(..., seed=that)``
     repeats it. priors: a ``gpmsa.Priors`` (None: GPM/SA's, ``Priors()``; the data
     corrections are added here). metadata: a JSON-able dict kept in ``Emulator.metadata``
-    and the file. options: passed to the backend's ``sample`` (e.g. ``init``: a rule of
-    ``gpmsa.mcmc.starts``, or an Emulator of this fit, whose chains then continue from their
-    last kept draws: ``fit(data, n_iter=..., n_chains=emu's, init=emu)``, see
-    ``continued_starts``).
+    and the file. backend: "numpy" (default), "torch", "pyro" or a plug-in's name
+    (``gpmsa.backends.register``). options: passed to the backend's ``sample`` (e.g.
+    ``init``: a rule of ``gpmsa.mcmc.starts``, or an Emulator of this fit, whose chains then
+    continue from their last kept draws: ``fit(data, n_iter=..., n_chains=emu's, init=emu)``,
+    see ``continued_starts``).
 
     Beyond GPM/SA's model (numpy backend; docs/categorical-and-constraints.md): categorical
     inputs are declared in ``SimData`` (a categorical theta of a joint fit is sampled over its
@@ -297,7 +298,7 @@ def fit(
         )
     if isinstance(data, SimData) and data.separable is not None and backend != "numpy":
         kronecker.refuse(f"backend={backend!r}")
-    module = backends.get(backend)
+    backends.get(backend)  # unknown or not installed: a clear error before any work
     prep = prepare(data, obs, priors=priors, n_pc=n_pc, discrepancy=discrepancy,
                    mean_basis=mean_basis, discrepancy_groups=discrepancy_groups,
                    basis=basis)  # fmt: skip
@@ -341,8 +342,8 @@ def fit(
     far = None if obs is None else joint_far_value(data, obs, prep.standardizer)
     if far is not None:  # before the long sampling, which the user may then stop
         warn_far(far, user_stacklevel(), discrepancy=discrepancy is not None)
-    chains = module.sample(
-        problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
+    chains = backends.sample(
+        backend, problem, n_iter=int(n_iter), n_chains=int(n_chains), tune=tune,
         step_widths=step_widths, seed=seed, progress=progress, **options,
         **({} if steps is None else {"proportional_steps": steps}),
     )  # fmt: skip
@@ -503,19 +504,9 @@ def more_advice(append: bool, settings: dict) -> str:
 
 def _check_tempering(options: dict, backend: str):
     """The ladder of ``fit``'s ``temperatures`` option (``tempering.ladder``; None: off).
-    GPMSAError naming ``temperatures``/``swap_every`` given to another backend than numpy or
-    torch."""
-    given = [k for k in ("temperatures", "swap_every") if options.get(k) is not None]
-    if given and backend not in ("numpy", "torch"):
-        raise GPMSAError(
-            f"{' and '.join(given)}: parallel tempering runs on the numpy and torch backends "
-            f"only, not backend={backend!r}"
-        )
-    if "adapt_ladder" in options and backend not in ("numpy", "torch"):
-        raise GPMSAError(
-            f"adapt_ladder: the adaptive ladder runs on the numpy and torch backends only, not "
-            f"backend={backend!r}"
-        )
+    GPMSAError naming ``temperatures``/``swap_every``/``adapt_ladder`` given to another backend
+    than numpy or torch (``backends.check_tempering``)."""
+    backends.check_tempering(backend, options)
     return tempering.ladder(options.get("temperatures"))
 
 

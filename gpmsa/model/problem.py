@@ -188,11 +188,13 @@ class Problem:
     @property
     def extensions(self) -> tuple[str, ...]:
         """The features beyond GPM/SA's model this problem uses (categorical inputs, a mean
-        basis, a theta constraint): the numpy and torch backends sample them, pyro some
-        (``gpmsa.backends.pyro_backend.refuse_unsupported``)."""
+        basis, a theta constraint, held elements of a sampled parameter): the numpy and torch
+        backends sample them, pyro some (``gpmsa.backends.pyro_backend.refuse_unsupported``),
+        a plug-in those it declares (``gpmsa.backends.register``)."""
         used = (("categorical inputs", self.categorical is not None),
                 ("mean_basis", self.mean_basis is not None),
-                ("theta constraint", self.constraint is not None))  # fmt: skip
+                ("theta constraint", self.constraint is not None),
+                ("held elements", any(self.fixed_elements.values())))  # fmt: skip
         return tuple(name for name, on in used if on)
 
     @property
