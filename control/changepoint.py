@@ -39,6 +39,7 @@ from control.validation import (
     require_integers,
     require_reals,
 )
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 
 PRIORS = ("log_uniform", "uniform")
@@ -173,12 +174,12 @@ class ChangePointFilter:
 
     # predict, relocate and update: masses far from the data underflow to 0 as intended,
     # whatever the caller's np.seterr (one errstate per call, ~1 us; none per run length)
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def predict(self, ds_m: float) -> None:
         """Propagate over ds_m metres (change points; GD unchanged within a run)."""
         self._set(*self._predicted(ds_m))
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def relocate(self, ds_m: float) -> None:
         """Propagate over ds_m metres moved without data (a robot moved while down): as
         ``predict``, but a run that ended there is followed by GD from the prior, not by a
@@ -226,7 +227,7 @@ class ChangePointFilter:
         self._survival_of(dist, merged)
         return mass, dist
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def update(self, loglik: np.ndarray, ds_m: float) -> None:
         """One block ds_m metres long with log-likelihood ``loglik`` on the grid (G,). All or
         nothing: a refused block leaves the filter as it was."""

@@ -36,6 +36,7 @@ from control.validation import (
     require_integers,
     require_reals,
 )
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.calibration.posterior import GridMarginal, Posterior, trapezoid_weights
 from gpmsa.errors import numbers_text
 
@@ -111,7 +112,7 @@ class GDTracker:
         """Forget everything: back to the prior."""
         self.log_mass = self.log_prior.copy()
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def predict(self, ds_m: float) -> None:
         """Propagate the state over ds_m metres travelled (random walk, then change point)."""
         if not (is_real(ds_m) and ds_m >= 0):
@@ -134,7 +135,7 @@ class GDTracker:
         mass = (1 - hazard) * mass + hazard * np.exp(self.log_prior)
         self.log_mass = np.log(np.maximum(mass, 1e-300))
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def update(self, grid: np.ndarray, loglik: np.ndarray, power: float = 1.0) -> None:
         """Multiply in a likelihood given on any sorted grid of native GD (interpolated in log GD).
 

@@ -20,6 +20,7 @@ from dataclasses import replace
 import numpy as np
 
 from gpmsa import backends
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._threads import one_thread
 from gpmsa.calibration import continuation as cont
 from gpmsa.calibration.judge import Run, judge_bounds, judge_convergence
@@ -212,6 +213,7 @@ def _theta_options(emulator, constraint, theta_init):
     return con, start
 
 
+@underflow_as_zero
 def calibrate(
     emulator,
     x_obs=None,

@@ -41,6 +41,7 @@ import numpy as np
 from scipy.special import log_ndtr
 
 from gpmsa import backends
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.calibration.grid import (
@@ -353,6 +354,7 @@ class Calibrator:
             with ``mcmc_options={"progress": True}``.
     """
 
+    @underflow_as_zero
     def __init__(
         self,
         emulator,
@@ -697,6 +699,7 @@ class Calibrator:
                 "this Calibrator uses MCMC (q > 2 or method='mcmc'); no grid likelihood"
             )
 
+    @underflow_as_zero
     def log_likelihood_grid(
         self, x_obs=None, y_obs=None, extrapolate: bool | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
@@ -764,6 +767,7 @@ class Calibrator:
         """An update's ``extrapolate``: None the constructor's setting, else a flag."""
         return self.extrapolate if extrapolate is None else check_flag(extrapolate, "extrapolate")
 
+    @underflow_as_zero
     def update(
         self, x_obs=None, y_obs=None, prior=None, seed=None, extrapolate: bool | None = None
     ) -> Posterior:
@@ -976,7 +980,7 @@ class Calibrator:
         check_mass(logp)
         return margs, logp
 
-    @np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+    @underflow_as_zero  # a density's far tails underflow to 0 as intended
     def _level_posterior(
         self, free: np.ndarray, ok, margs: list, key, refined: dict | None = None
     ) -> Posterior:
@@ -1462,7 +1466,7 @@ def _block_diag(cov: np.ndarray) -> np.ndarray:
     return out
 
 
-@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+@underflow_as_zero  # a density's far tails underflow to 0 as intended
 def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
     """(G,) E[1/lamOs | data, theta node]: the observation-error variance (standardised units)
     expected at each theta node; several emulator parameter sets are weighted by their
@@ -1480,7 +1484,7 @@ def _expected_inverse_lamos(margs: list[LamOsMarginal]) -> np.ndarray:
     return (p * per_set).sum(axis=0) / p.sum(axis=0)
 
 
-@np.errstate(under="ignore")
+@underflow_as_zero
 def _draw_lamos(
     margs: list[LamOsMarginal], node: np.ndarray, rng: np.random.Generator
 ) -> tuple[np.ndarray, np.ndarray]:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.calibration.local_cubic import STENCIL, local_cubic
 from gpmsa.calibration.posterior import GridMarginal, trapezoid_weights
 from gpmsa.errors import GPMSAError
@@ -202,7 +203,7 @@ def _cell_inverse(g0: np.ndarray, g1: np.ndarray, r: np.ndarray) -> np.ndarray:
     return np.clip(2.0 * target / np.where(denom > 0.0, denom, 1.0), 0.0, 1.0)
 
 
-@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+@underflow_as_zero  # a density's far tails underflow to 0 as intended
 def draw_bilinear(
     axes: list, dens: np.ndarray, rng: np.random.Generator, size: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -448,7 +449,7 @@ def zero_edges(axes: list, log_prior: np.ndarray) -> list:
     return out
 
 
-@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+@underflow_as_zero  # a density's far tails underflow to 0 as intended
 def conditional_sds(axes: list, logp: np.ndarray) -> tuple[float, float]:
     """Two parameters: per parameter, the root of the mean (over the posterior, log density
     ``logp`` (G,) on the grid of ``axes``) of its variance given the other parameter's node, in
@@ -513,7 +514,7 @@ def _resolution(axis: np.ndarray, density: np.ndarray) -> float:
     return float(np.sqrt(total / inverse2))
 
 
-@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+@underflow_as_zero  # a density's far tails underflow to 0 as intended
 def resolution(axes: list, logp: np.ndarray) -> tuple[float, ...]:
     """Per parameter, the node spacings per sd of its marginal on the grid of ``axes``
     (`_resolution`; the posterior's log density ``logp`` (G,))."""
@@ -531,7 +532,7 @@ def _core(axis: np.ndarray, density: np.ndarray) -> tuple[int, int]:
     return max(i0 - 1, 0), min(i1 + 1, axis.size - 1)
 
 
-@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+@underflow_as_zero  # a density's far tails underflow to 0 as intended
 def tail_refined_axes(
     axes: list,
     logp: np.ndarray,
@@ -597,7 +598,7 @@ def _with_core(
     return np.unique(np.concatenate(pieces))
 
 
-@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+@underflow_as_zero  # a density's far tails underflow to 0 as intended
 def refined_axes(axes: list, logp: np.ndarray, keep: list | None) -> list | None:
     """Two parameters: the unit-scale axes of a finer grid where a mode of the posterior (log
     density ``logp`` (G,) on the grid of ``axes``) is not resolved along some parameter
@@ -626,7 +627,7 @@ def whole_refined_axis(axis: np.ndarray) -> np.ndarray:
                        REFINE_FACTORS[0])  # fmt: skip
 
 
-@np.errstate(under="ignore")  # a density's far tails underflow to 0 as intended
+@underflow_as_zero  # a density's far tails underflow to 0 as intended
 def refined_axis(
     axis: np.ndarray, logp: np.ndarray, keep: np.ndarray | None, min_step: float
 ) -> tuple[np.ndarray | None, str]:

@@ -22,6 +22,7 @@ from numpy.polynomial import chebyshev as cheb
 from scipy.linalg import cho_solve, cholesky, lapack, solve_triangular
 from scipy.special import gammainc, gammainccinv, gammaln
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.model.correlation import correlation
@@ -355,7 +356,7 @@ def _log_integrand(
     return out
 
 
-@np.errstate(under="ignore")  # the integrand's far tails underflow to 0 as intended
+@underflow_as_zero  # the integrand's far tails underflow to 0 as intended
 def lamos_marginal(
     mean: np.ndarray,
     cov: np.ndarray,

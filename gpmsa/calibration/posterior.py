@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.errors import GPMSAError
 from gpmsa.limits import BYTES_PER_HISTOGRAM_BIN, check_memory
 from gpmsa.mcmc import diagnostics
@@ -78,7 +79,7 @@ class GridMarginal:
         _set_read_only_state(self, state)
 
     @classmethod
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def from_log_density(
         cls, nodes: np.ndarray, log_density: np.ndarray, weights: np.ndarray | None = None
     ) -> GridMarginal:
@@ -114,12 +115,12 @@ class GridMarginal:
     def _cell_mass(self) -> np.ndarray:
         return 0.5 * np.diff(self.nodes) * (self.density[:-1] + self.density[1:])
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def mean(self) -> float:
         """Posterior mean."""
         return float((self.weights * self.density) @ self.nodes)
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def sd(self) -> float:
         """Posterior standard deviation."""
         d = self.nodes - self.mean()
@@ -132,7 +133,7 @@ class GridMarginal:
         span = f" on [{ends[0]}, {ends[1]}]" if k else ""
         return f"GridMarginal({k} nodes{span}, mean={self.mean():.4g}, sd={self.sd():.3g})"
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def cdf(self, value: np.ndarray | float) -> np.ndarray:
         """P(X <= value) under the piecewise-linear density."""
         x = np.asarray(value, dtype=float)
@@ -146,7 +147,7 @@ class GridMarginal:
         out = np.where(t < h, cum[k] + f0 * t + 0.5 * (f1 - f0) * t * t / h, cum[k + 1])
         return np.clip(out / cum[-1], 0.0, 1.0)
 
-    @np.errstate(under="ignore")
+    @underflow_as_zero
     def ppf(self, q: np.ndarray | float) -> np.ndarray:
         """Quantile function: the inverse of ``cdf`` (exact for the piecewise-linear density)."""
         q = np.asarray(q, dtype=float)

@@ -20,6 +20,7 @@ import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
 from gpmsa import _threads
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import EmulatorFileError, GPMSAError
@@ -689,6 +690,7 @@ class Emulator:
         var_ = var_mean + _spread_of_means(means)
         return s.y_from_std(mean), s.var_from_std(var_)
 
+    @underflow_as_zero
     def predict(
         self, x, t, *, draws: bool = False, n_draws: int | None = None, resid: bool = True,
         extrapolate: bool = False, progress: bool = False,
@@ -719,6 +721,7 @@ class Emulator:
         return self._predict_draws(x, t, n_draws, resid, extrapolate=extrapolate,
                                    progress=progress)  # fmt: skip
 
+    @underflow_as_zero
     def predict_mean(
         self, x, t, *, draws: bool = False, n_draws: int | None = None, extrapolate: bool = False,
         progress: bool = False,
@@ -740,6 +743,7 @@ class Emulator:
                                    progress=progress, desc="predict_mean")[0]  # fmt: skip
 
     # --- checks -------------------------------------------------------------------------------
+    @underflow_as_zero
     def loo(self) -> LooResult:
         """Exact leave-one-out cross-validation at the point estimate (Cholesky of Sigma_W).
 

@@ -11,6 +11,7 @@ from datetime import datetime, timezone
 import numpy as np
 
 from gpmsa import backends
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._version import library_versions
 from gpmsa.errors import GPMSAError, NuggetWarning, user_stacklevel
 from gpmsa.fitting.continuation import (
@@ -97,6 +98,7 @@ def simulation_fit_nbytes(
     return sweeps_nbytes(elements, n_iter, n_chains) + _factor_nbytes(m, p, q, p_u)
 
 
+@underflow_as_zero
 def fit(
     data: SimData,
     obs: ObsData | None = None,

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import ndtr
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.calibration.observations import EMULATOR_ATTRS, check_x
@@ -99,6 +100,7 @@ class CalibratedPrediction:
                 f"{np.size(self.weights)} mixture components)")  # fmt: skip
 
 
+@underflow_as_zero
 def calibrated_predict(
     emulator,
     posterior: Posterior,

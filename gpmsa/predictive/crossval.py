@@ -26,6 +26,7 @@ import numpy as np
 from scipy.linalg import cho_solve
 from scipy.special import ndtr
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
@@ -139,6 +140,7 @@ def _check_identified(H: np.ndarray, labels: np.ndarray, groups: list[np.ndarray
             )
 
 
+@underflow_as_zero
 def cross_validate(
     emulator,
     *,

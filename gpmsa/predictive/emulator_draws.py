@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
@@ -124,6 +125,7 @@ class EmulatorPrediction:
                 f"resid={self.resid})")  # fmt: skip
 
 
+@underflow_as_zero
 def emulator_prediction(
     emulator,
     x,

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import cho_solve, solve_triangular
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.calibration.observations import check_x, layout_digest
@@ -572,6 +573,7 @@ def _kept_for(emulator, record: dict) -> bool:
     )
 
 
+@underflow_as_zero
 def full_prediction(
     emulator,
     obs: ObsData,

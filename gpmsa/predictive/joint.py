@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.calibration.observations import emulator_record, theta_levels_native
 from gpmsa.calibration.posterior import Posterior
 from gpmsa.errors import GPMSAError
@@ -11,6 +12,7 @@ from gpmsa.mcmc.bounds import at_bound
 from gpmsa.model.discrepancy import to_samples
 
 
+@underflow_as_zero
 def calibration_posterior(emulator) -> Posterior:
     """The calibration draws of a joint fit (``gpmsa.fit(data, obs, ...)``) as a Posterior.
 

@@ -76,6 +76,7 @@ import numpy as np
 from scipy.linalg import solve_triangular
 from scipy.special import erf, erfc
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
@@ -715,6 +716,7 @@ def _group_positions(groups, names: list[str], fixed: dict) -> list[tuple[int, .
     return out
 
 
+@underflow_as_zero
 def sensitivity(
     emulator,
     *,

@@ -11,6 +11,7 @@ from datetime import datetime, timezone
 
 import numpy as np
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa._version import library_versions
 from gpmsa.calibration.calibrate import (
     CALIBRATION_FIXED,
@@ -433,6 +434,7 @@ def _per_model_discrepancy(discrepancy, groups, labels: tuple[str, ...]) -> list
     return list(zip(bases, per, strict=True))
 
 
+@underflow_as_zero
 def calibrate_study(
     emulators, x_obs, y_obs=None, *, labels=None, shared=(), hierarchical=(),
     hyper: HyperPriors | None = None, n_samples: int = 5000, n_burn: int | None = None,
@@ -764,6 +766,7 @@ def _member_convergence(problem, summary: dict, counts: tuple[int, int]):
             sampled_convergence(problem, summary, *counts, skip=("theta", "lamOs")))  # fmt: skip
 
 
+@underflow_as_zero
 def fit_study(
     sims, obs, *, labels=None, shared=(), hierarchical=(), hyper: HyperPriors | None = None,
     n_iter: int = 30_000, n_burn: int | None = None, n_keep: int | None = None,
