@@ -10,6 +10,7 @@ from matplotlib.figure import Figure
 from control.errors import ControlError
 from control.validation import is_real
 from gpmsa.mcmc.diagnostics import bins_apart
+from gpmsa.plots._figure import series_colours
 
 
 def _ink() -> str:
@@ -118,8 +119,10 @@ def plot_gd_trace(
     _mark_track(ax, track, gd_max)
     x, gd = _track_steps(track)
     ax.step(x, gd, where="post", color=_ink(), lw=1.5, label="prescribed GD")
+    colours = series_colours(len(results))
     for i, r in enumerate(results):
-        line = ax.plot(r.position, r.gd_mean, lw=1.3, label=f"run {i + 1}: posterior mean")[0]
+        line = ax.plot(r.position, r.gd_mean, lw=1.3, color=colours[i],
+                       label=f"run {i + 1}: posterior mean")[0]  # fmt: skip
         label = f"run {i + 1}: {level:.0%} interval"
         for edge in (r.gd_lo, r.gd_hi):
             ax.plot(r.position, edge, lw=0.6, alpha=0.7, color=line.get_color(), ls="--",
@@ -161,10 +164,12 @@ def plot_speed(
     fig = Figure(figsize=(7.5, 3.0), constrained_layout=True)
     ax = fig.add_subplot()
     _mark_track(ax, track, gd_max)
+    colours = series_colours(len(results))
     for i, r in enumerate(results):
         start = r.sample_position[0] if len(r.sample_position) else 0.0  # a run without samples
         moving = r.sample_position > start + 0.1
-        ax.plot(r.sample_position[moving], r.sample_speed[moving], lw=1.0, label=f"run {i + 1}")
+        ax.plot(r.sample_position[moving], r.sample_speed[moving], lw=1.0, color=colours[i],
+                label=f"run {i + 1}")  # fmt: skip
     if v_safe is not None:
         ax.axhline(v_safe, color="0.3", lw=0.8, ls="--", label=f"safe speed {v_safe:g} m/s")
     ax.set_xlabel("position of the front axle (m)")
