@@ -1,6 +1,8 @@
 """Exceptions and warnings raised by gpmsa, and the text of the numbers in their messages."""
 
+import functools
 import math
+import os
 import sys
 
 
@@ -66,11 +68,20 @@ def user_stacklevel() -> int:
     outside gpmsa (the user's call, however deep the library's own calls run), outside any
     module or package marked with `WRAPPER_MARK` and outside ``dataclasses`` (whose
     ``replace`` makes a settings class anew: its ``__post_init__``'s warnings point at the
-    line that called ``replace``)."""
-    frame, level = sys._getframe(1), 1
-    while frame is not None and _library_frame(frame.f_globals):
-        frame, level = frame.f_back, level + 1
-    return level
+    line that called ``replace``). A frame of the standard library or of an installed package
+    with a library frame further out (scipy's optimizer calling a marked wrapper's objective,
+    which calls gpmsa) is passed over too; a user's own function there (a callback that calls
+    gpmsa) is not: the warning points at its line."""
+    frames = []  # (a library frame?, its code's file), the caller's first
+    frame = sys._getframe(1)
+    while frame is not None:
+        frames.append((_library_frame(frame.f_globals), frame.f_code.co_filename))
+        frame = frame.f_back
+    outermost = max((i for i, (own, _) in enumerate(frames) if own), default=-1)
+    for i, (own, filename) in enumerate(frames):
+        if not (own or (i < outermost and _installed_frame(filename))):
+            return i + 1
+    return len(frames) + 1
 
 
 def _library_frame(names: dict) -> bool:
@@ -79,6 +90,27 @@ def _library_frame(names: dict) -> bool:
         return True
     package = sys.modules.get(top)
     return package is not None and getattr(package, WRAPPER_MARK, False) is True
+
+
+def _installed_frame(filename: str) -> bool:
+    """Whether ``filename`` (a frame's code's) is the standard library's or an installed
+    package's (frozen modules' ``<frozen ...>`` included): never the user's script."""
+    if filename.startswith("<"):  # <frozen runpy>; <string>, <stdin>, a notebook's <ipython-...>
+        return filename.startswith("<frozen ")
+    return os.path.normcase(os.path.abspath(filename)).startswith(_installed_roots())
+
+
+@functools.cache
+def _installed_roots() -> tuple[str, ...]:
+    import site
+    import sysconfig
+
+    paths = sysconfig.get_paths()
+    roots = {paths[k] for k in ("stdlib", "platstdlib", "purelib", "platlib")}
+    roots.update(site.getsitepackages() if hasattr(site, "getsitepackages") else ())
+    roots.add(site.getusersitepackages())
+    both = roots | {os.path.realpath(r) for r in roots}
+    return tuple(os.path.join(os.path.normcase(os.path.abspath(r)), "") for r in both)
 
 
 def numbers_text(*values: float, digits: int = 6) -> tuple[str, ...]:

@@ -57,7 +57,7 @@ from vehicle.errors import CampaignFileError, SimulationDivergedError, VehicleEr
 from vehicle.linear import warn_if_step_too_coarse
 from vehicle.models import Jackal, Model, check_model
 from vehicle.sensor import check_noise, check_rate
-from vehicle.simulate import SUBSTEPS, simulate
+from vehicle.simulate import SUBSTEPS, _simulate
 
 FORMAT = "vehicle.campaign/1"
 _F_NAMES = ("f_full", "f_window", "f_full_noisy", "f_window_noisy")
@@ -592,7 +592,7 @@ def run_campaign(
     noise_std = check_noise(noise_std)
     window = checks.integer("window", window, 2)
     substeps = checks.integer("substeps", substeps, 1)
-    warn_if_step_too_coarse(model, rate_hz, substeps)  # here: a worker process's warning is lost
+    warn_if_step_too_coarse(model, rate_hz, substeps)  # here, not in each run (`_drive`)
     progress = checks.flag("progress", progress)
     keep_s = checks.non_negative("keep_s", keep_s, unit="s")
     if executor is not None and not callable(getattr(executor, "submit", None)):
@@ -948,9 +948,11 @@ def _drive(spec: RunSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         spec.road_length_m, spec.gd, dx_m=spec.dx_m, seed=spec.seed, band=spec.band,
         lead_in_m=spec.lead_in_m,
     )  # fmt: skip
-    trace = simulate(
-        spec.model, profile, spec.v, rate_hz=spec.rate_hz, noise_std=spec.noise_std,
-        seed=np.random.default_rng([spec.seed, 1]), substeps=spec.substeps,
+    # run_campaign warned of a coarse step, once, at the user's call
+    trace = _simulate(
+        spec.model, profile, spec.v, spec.rate_hz, spec.noise_std,
+        np.random.default_rng([spec.seed, 1]), speed_of="time", start_m=None, end_m=None,
+        substeps=spec.substeps, envelope=True, step_warning=False,
     )  # fmt: skip
     full = trace.position >= spec.lead_in_m + spec.model.wheelbase_m
     need = max(spec.window, spec.keep_samples)

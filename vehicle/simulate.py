@@ -109,6 +109,29 @@ def simulate(
         Trace. Raises VehicleError on bad input (also a drive longer than
         ``vehicle.kinematics.MAX_DRIVE_S``, 3600 s), SimulationDivergedError if the run diverges.
     """
+    return _simulate(
+        model, road, speed, rate_hz, noise_std, seed, speed_of=speed_of, start_m=start_m,
+        end_m=end_m, substeps=substeps, envelope=envelope,
+    )  # fmt: skip
+
+
+def _simulate(
+    model: Model,
+    road,
+    speed: SpeedSchedule,
+    rate_hz: float,
+    noise_std: float,
+    seed: int | np.integer | np.random.Generator | None,
+    *,
+    speed_of: str,
+    start_m: float | None,
+    end_m: float | None,
+    substeps: int,
+    envelope: bool,
+    step_warning: bool = True,
+) -> Trace:
+    """`simulate`; ``step_warning=False``: no `SolverStepWarning` (a campaign's run: the
+    campaign warned once, at the user's call, and a worker's would name concurrent.futures)."""
     check_model(model)
     rate = check_rate(rate_hz)
     noise = check_noise(noise_std)
@@ -130,7 +153,8 @@ def simulate(
             f"the drive from {start:.6g} m to {end:.6g} m is shorter than one sample period "
             f"(1/{rate:g} s): use a longer road or a lower speed"
         )
-    warn_if_step_too_coarse(model, rate, substeps)
+    if step_warning:
+        warn_if_step_too_coarse(model, rate, substeps)
     drive = Drive(0.0, h, s, v)
     states = ExudynVehicle(model, road_in, drive, rate, substeps).integrate(0.0, n_samples)
     position, spd = drive.positions(states.t), drive.speeds(states.t)
