@@ -403,10 +403,10 @@ def _prior_mass(gd: np.ndarray, weights: np.ndarray, prior) -> np.ndarray:
         given = prior(gd.copy())  # its own errors propagate as raised
         try:
             raw = np.asarray(given)
-            real = given is not None and raw.dtype.kind not in "bc"  # a mask is no log density
-            log_density = raw.astype(float) if real else None
-        except (TypeError, ValueError) as exc:
+        except (TypeError, ValueError) as exc:  # e.g. a ragged list
             raise ControlError(f"prior(gd) must return real log densities: {exc}") from None
+        # numbers only (as gpmsa's log_prior): a mask is no log density, nor is text
+        log_density = raw.astype(float) if raw.dtype.kind in "iuf" else None
         if log_density is None:
             got = "None" if given is None else f"{raw.dtype.name} values"
             hint = (

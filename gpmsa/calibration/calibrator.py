@@ -161,7 +161,8 @@ def _check_mcmc_options(options, backend: str) -> dict:
     sampler -= {"problem"}
     allowed = sorted((named | sampler) - own - {"n_iter"})  # n_iter: calibrate's n_samples
     open_ended = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params)  # a plug-in's
-    unknown = [] if open_ended else sorted(set(options) - set(allowed), key=str)
+    taken = own | {"n_iter"}  # the Calibrator's own, or calibrate's n_samples: never passed on
+    unknown = sorted((set(options) & taken) if open_ended else set(options) - set(allowed), key=str)
     if unknown:
         raise GPMSAError(
             f"mcmc_options: unknown keyword(s) {unknown}; gpmsa.calibrate takes {allowed} "

@@ -31,6 +31,7 @@ from gpmsa.model.data import (
     default_labels,
     evenly_spaced,
     size_of,
+    tensor_values,
     values_digest,
 )
 from gpmsa.model.far_values import OUTSIDE_SDS, FarValue, warn_far
@@ -271,6 +272,7 @@ def refuse_ragged(y_obs) -> None:
     different lengths (SEPIA's ragged y_obs, each on its own grid)."""
     if not isinstance(y_obs, (list, tuple)):
         return
+    y_obs = tensor_values(y_obs)  # (np.ndim reads a list of tensors that record gradients)
     try:
         if not all(np.ndim(e) == 1 for e in y_obs):
             return

@@ -56,18 +56,27 @@ def _first_non_number(value) -> str | None:
     return None
 
 
-def tensor_values(value):
+def tensor_values(value, _depth: int = 0):
     """``value``, or for a torch tensor (an object with a bool ``requires_grad`` and a
     ``detach`` method) its values as a numpy array: numpy refuses a tensor that records
     gradients ("Can't call numpy() on Tensor that requires grad") and warns that a tensor's
-    ``__array__`` takes no ``copy`` when it copies one. A tensor numpy cannot hold (on a GPU)
-    is returned as it is, for the caller's conversion to refuse."""
+    ``__array__`` takes no ``copy`` when it copies one. A list or tuple holding such tensors
+    (numpy's depth of nesting at most) comes back as a list of their values; one without them
+    as it is. A tensor numpy cannot hold (on a GPU) is returned as it is, for the caller's
+    conversion to refuse."""
+    if isinstance(value, (list, tuple)) and _depth < MAX_NESTING:
+        items = [tensor_values(v, _depth + 1) for v in value]
+        return items if any(a is not b for a, b in zip(items, value, strict=True)) else value
     if not isinstance(getattr(value, "requires_grad", None), bool):
         return value
     try:
         return np.asarray(value.detach())
     except (AttributeError, TypeError, RuntimeError):
         return value
+
+
+MAX_NESTING = 64
+"""The deepest nesting of lists `tensor_values` reads (numpy's largest number of dimensions)."""
 
 
 def size_of(value) -> int:
@@ -1559,6 +1568,7 @@ class ObsData:
     def _experiments(y, n: int | None) -> list[np.ndarray]:
         """y as one 1-D array per experiment; ``n``: the experiments x_obs gives (None: no x,
         a 1-D y is one experiment)."""
+        y = tensor_values(y)  # (np.ndim reads a list of tensors that record gradients)
         if isinstance(y, (list, tuple)) and any(np.ndim(e) == 1 and size_of(e) > 1 for e in y):
             ys = [as_float(e, f"y_obs[{j}]").reshape(-1) for j, e in enumerate(y)]
         else:

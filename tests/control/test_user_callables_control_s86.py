@@ -31,6 +31,9 @@ def _filter(prior) -> ChangePointFilter:
         (lambda gd: _normal(gd) + 1j, "complex"),
         (lambda gd: _normal(gd) + 0j, "complex"),
         (lambda gd: None, "None"),
+        (lambda gd: np.full(gd.shape, "0.0"), "str"),  # before: read as numbers
+        (lambda gd: ["0"] * gd.size, "str"),
+        (lambda gd: np.zeros(gd.shape, dtype=object), "object"),
     ],
 )
 def test_a_prior_returning_no_real_log_densities_is_named(prior, named):

@@ -216,3 +216,11 @@ def test_a_plugin_without_options_refuses_them_by_name(registry):
         gpmsa.fit(road_data()[0], n_iter=12, backend="plain", note=3)
     post = gpmsa.calibrate(emu, *road_obs(), n_samples=20, n_burn=2, seed=1, backend="plain")
     assert post.info["backend"] == "plain"
+
+
+@pytest.mark.parametrize("key", ["log_prior", "x_obs", "extrapolate", "emulator", "n_iter"])
+def test_a_plugins_calibrator_refuses_its_own_keywords_in_mcmc_options(plugin, key):
+    """Before: built, then its first update raised "TypeError: sample_calibration() got
+    multiple values for keyword argument ...": a ``**options`` sampler let them through."""
+    with pytest.raises(GPMSAError, match=rf"mcmc_options: unknown keyword\(s\) \['{key}'\]"):
+        gpmsa.Calibrator(road_emulator(), backend="mine", mcmc_options={key: 1})
