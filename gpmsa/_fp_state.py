@@ -8,7 +8,9 @@ ignored (`underflow_as_zero`): their results are those of numpy's default state,
 caller's state is as it was after the call (numpy >= 2 keeps it per thread and context, so
 nested and concurrent calls each restore their own). Overflow, division by zero and invalid
 operations keep the caller's handling: the library says where it expects them (``np.errstate``
-at the site). The wrapper is gpmsa's own, not numpy's ``errstate`` used as a decorator, whose
+at the site). A user's function that gpmsa calls (a constraint, ``log_prior``, a mean basis,
+a Calibrator's ``prior``) runs in that state too: its own underflow is not raised there. The
+wrapper is gpmsa's own, not numpy's ``errstate`` used as a decorator, whose
 frame (numpy's) would end `gpmsa.errors.user_stacklevel`'s walk and point the library's
 warnings at numpy instead of the caller's line."""
 

@@ -23,12 +23,18 @@ def load_example(name: str) -> ModuleType:
 
 def load_benchmark(name: str) -> ModuleType:
     """benchmarks/<name>.py imported as module ``name``, registered in sys.modules (a dataclass
-    of the script looks its module up there), with benchmarks/ on sys.path as when the script
-    runs (its helpers: ``from _host import ...``)."""
-    if str(BENCHMARKS) not in sys.path:
+    of the script looks its module up there), with benchmarks/ on sys.path while it is
+    imported, as when the script runs (its helpers: ``from _host import ...``); not after, where
+    a bare ``import backends`` would find a benchmark."""
+    added = str(BENCHMARKS) not in sys.path
+    if added:
         sys.path.append(str(BENCHMARKS))
-    spec = importlib.util.spec_from_file_location(name, BENCHMARKS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
+    try:
+        spec = importlib.util.spec_from_file_location(name, BENCHMARKS / f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    finally:
+        if added:
+            sys.path.remove(str(BENCHMARKS))
     return module

@@ -327,11 +327,11 @@ class Calibrator:
             or executor, torch's ``n_jobs`` > 1 with one chain group). With ``method="grid"``
             given, any but ``"backend"`` is a GPMSAError (the grid would ignore them; "auto"
             keeps them for an emulator that needs MCMC).
-        backend: engine of the MCMC path ("numpy", "torch", "pyro"; see
-            ``gpmsa.backends.available()``). The grid path is numpy's; another backend makes
-            "auto" choose MCMC. None (the default): ``mcmc_options["backend"]`` where it names
-            one, else "numpy"; a GPMSAError where both are given and differ (an explicit
-            "numpy" too).
+        backend: engine of the MCMC path ("numpy", "torch", "pyro" or a plug-in's name,
+            ``gpmsa.backends.register``; see ``gpmsa.backends.available()``). The grid path
+            is numpy's; another backend makes "auto" choose MCMC. None (the default):
+            ``mcmc_options["backend"]`` where it names one, else "numpy"; a GPMSAError where
+            both are given and differ (an explicit "numpy" too).
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there. On the grid, for one parameter the density is cut at
             the boundary (located by bisection between nodes, to float precision), so that no

@@ -30,15 +30,15 @@ def ink() -> str:
 
 def series_colours(n: int) -> list[str]:
     """The colours of ``n`` series that a legend tells apart by colour alone (chains,
-    experiments): the style's colour cycle, ``"C0"``, ``"C1"``, ..., where it holds at least
-    ``min(n, 10)`` distinct colours, else matplotlib's default ten ("tab:blue", ...; a style or an
-    ``rcParams["axes.prop_cycle"]`` of one colour drew every series, and its legend entry, in
-    that one colour)."""
+    experiments): the style's colour cycle, ``"C0"``, ``"C1"``, ..., where its first
+    ``min(n, 10)`` colours differ from each other, else matplotlib's default ten ("tab:blue",
+    ...; a style or an ``rcParams["axes.prop_cycle"]`` of one colour drew every series, and its
+    legend entry, in that one colour). Beyond ten series colours repeat, as matplotlib's do."""
     from matplotlib import rcParams
     from matplotlib.colors import TABLEAU_COLORS, to_rgba
 
-    cycle = rcParams["axes.prop_cycle"].by_key().get("color", [])
-    if len({to_rgba(c) for c in cycle}) >= min(n, 10):
+    first = rcParams["axes.prop_cycle"].by_key().get("color", [])[: min(n, 10)]
+    if len({to_rgba(c) for c in first}) == min(n, 10):
         return [f"C{k}" for k in range(n)]
     tab10 = list(TABLEAU_COLORS)
     return [tab10[k % 10] for k in range(n)]

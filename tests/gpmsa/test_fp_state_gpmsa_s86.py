@@ -50,6 +50,7 @@ def test_a_grid_marginal_with_far_tails_reads_alike_under_raise() -> None:
 
 def test_rhat_of_chains_stuck_apart_is_inf_under_raise() -> None:
     stuck_apart = np.repeat([[1.0], [2.0]], 20, axis=1)
+    default = ess(stuck_apart)
     with np.errstate(all="raise"):
         assert rhat(stuck_apart) == np.inf
-        assert ess(stuck_apart) == ess(stuck_apart.copy())
+        assert ess(stuck_apart) == default > 0  # the default state's number

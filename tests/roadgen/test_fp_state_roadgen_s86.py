@@ -12,9 +12,12 @@ import roadgen
 def fp_raise():
     """numpy's global error state set to raise on everything, as a cautious caller sets it."""
     old = np.seterr(all="raise")
-    yield
-    assert np.geterr() == dict.fromkeys(("divide", "over", "under", "invalid"), "raise")
-    np.seterr(**old)
+    try:
+        yield
+        left = np.geterr()
+    finally:
+        np.seterr(**old)  # restored even where the test failed
+    assert left == dict.fromkeys(("divide", "over", "under", "invalid"), "raise")
 
 
 @pytest.mark.parametrize("method", ["fit", "welch", "periodogram"])
