@@ -100,11 +100,12 @@ def _default_dtype(dtype):
 
 @contextmanager
 def _default_device(device):
+    old = torch.empty(0).device  # (torch.get_default_device: torch >= 2.3)
     torch.set_default_device(device)
     try:
         yield
     finally:
-        torch.set_default_device(None)
+        torch.set_default_device(None if old.type == "cpu" else old)
 
 
 @contextmanager
@@ -117,11 +118,20 @@ def _flag(setter, getter, value):
         setter(old)
 
 
+@contextmanager
 def _seeded():
+    """The global torch, numpy and Python generators seeded, as users seed them; their states
+    restored after."""
+    states = torch.get_rng_state(), np.random.get_state(), random.getstate()  # noqa: NPY002
     torch.manual_seed(12345)
-    np.random.seed(5)  # noqa: NPY002 (as users seed it)
+    np.random.seed(5)  # noqa: NPY002
     random.seed(7)
-    return _default_dtype(torch.get_default_dtype())  # (no setting to restore)
+    try:
+        yield
+    finally:
+        torch.set_rng_state(states[0])
+        np.random.set_state(states[1])  # noqa: NPY002
+        random.setstate(states[2])
 
 
 SETTINGS = {
