@@ -14,6 +14,7 @@ from types import ModuleType
 
 import numpy as np
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.errors import BackendUnavailableError, GPMSAError
 from gpmsa.mcmc.sampler import Chains, check_sample_args
 
@@ -142,6 +143,7 @@ def takes(backend: str, key: str) -> bool:
     return key in params or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
 
 
+@underflow_as_zero
 def sample(backend: str, problem, *, n_iter: int, n_chains: int, **kwargs) -> Chains:
     """The chains of backend ``backend``'s ``sample(problem, n_iter=, n_chains=, **kwargs)``,
     checked: a plug-in's ``problem`` without an extension it does not declare (its

@@ -193,7 +193,8 @@ class LevelMarginal:
     it); ``cdf`` P(X <= value); ``ppf`` (quantiles) the lower quantile, the smallest level
     whose CDF reaches q (a level, never a value between levels); draws and ``hdi``'s ends are
     levels too. ``nodes``, ``density`` and ``weights`` (ones) read as a `GridMarginal`'s
-    (``weights @ density`` = 1).
+    (``weights @ density`` = 1). A far level's probability underflows to 0 (subnormal) as in
+    numpy's default state, whatever the caller's ``np.seterr(under=...)``.
 
     Attributes:
         nodes: (k,) the levels, increasing.
@@ -211,6 +212,7 @@ class LevelMarginal:
         _set_read_only_state(self, state)
 
     @classmethod
+    @underflow_as_zero
     def from_probabilities(cls, levels, probabilities) -> LevelMarginal:
         """Normalise ``probabilities`` (k,), non-negative, some positive, of the increasing
         ``levels`` (k,); GPMSAError otherwise. The marginal holds a read-only copy of ``levels``
@@ -236,10 +238,12 @@ class LevelMarginal:
         """level -> its posterior probability."""
         return {float(v): float(p) for v, p in zip(self.nodes, self.density, strict=True)}
 
+    @underflow_as_zero
     def mean(self) -> float:
         """Posterior mean of the level code (between levels where two carry mass)."""
         return float(np.clip(self.density @ self.nodes, self.nodes[0], self.nodes[-1]))
 
+    @underflow_as_zero
     def sd(self) -> float:
         """Posterior standard deviation of the level code."""
         d = self.nodes - self.mean()

@@ -109,7 +109,8 @@ def choose_widths(
         b = fit_logistic(np.log(cand), accepted[:, i], n_burn)
         if b is None or not b[1] < 0:
             continue
-        with np.errstate(over="ignore"):  # a tiny slope gives inf: clipped to the widest
+        # a tiny slope gives inf or 0 (overflow, underflow): clipped to the widest or narrowest
+        with np.errstate(over="ignore", under="ignore"):
             w = np.exp((logit - b[0]) / b[1])
         out[i] = np.clip(w, cand.min(), cand.max())
     return out

@@ -408,8 +408,11 @@ class Priors:
         if np.any(beta <= 0.0) or np.any(~np.isfinite(beta)):
             return -np.inf
         a, b = self.rho_arrays(name, beta.shape[-1] if beta.ndim else 1)
-        rho = np.minimum(np.exp(-0.25 * beta), self.rho_cap)
-        return float(np.sum((a - 1.0) * np.log(rho) + (b - 1.0) * np.log1p(-rho)))
+        with np.errstate(under="ignore"):  # a large beta's rho underflows (subnormal, or 0)
+            rho = np.minimum(np.exp(-0.25 * beta), self.rho_cap)
+            # log(rho) is -beta/4 where rho underflowed to 0 (log(0) = -inf gave 0 * -inf = NaN)
+            log_rho = np.where(rho > 0.0, np.log(np.where(rho > 0.0, rho, 1.0)), -0.25 * beta)
+            return float(np.sum((a - 1.0) * log_rho + (b - 1.0) * np.log1p(-rho)))
 
     def scalar_log_prior(self, name: str, element: int = 0):
         """A fast function float -> float: the log prior of element ``element`` (its index in a
@@ -428,8 +431,8 @@ class Priors:
             def f(x: float) -> float:
                 if not 0.0 < x < math.inf:
                     return -math.inf
-                rho = min(math.exp(-0.25 * x), cap)
-                return a1 * math.log(rho) + b1 * math.log1p(-rho)
+                rho = min(math.exp(-0.25 * x), cap)  # 0 for a large x: log(rho) is -x/4
+                return a1 * (math.log(rho) if rho > 0.0 else -0.25 * x) + b1 * math.log1p(-rho)
 
         elif name in PRECISIONS:
             g = self.precision_prior(name, element)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from gpmsa._fp_state import underflow_as_zero
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 from gpmsa.model.correlation import beta_to_rho
@@ -33,6 +34,7 @@ def _rho_panels(emulator: Emulator, max_pc: int) -> np.ndarray:
     return np.moveaxis(beta_to_rho(beta), 2, 0)
 
 
+@underflow_as_zero  # rho of a rough input's large beta underflows to 0
 def rho_boxplots(emulator: Emulator, *, max_pc: int = 6) -> Figure:
     """Posterior box plots of rho = exp(-betaU/4) per input, one panel per basis component (at
     most ``max_pc``): a Figure.

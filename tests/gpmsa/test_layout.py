@@ -24,7 +24,7 @@ REPO = Path(__file__).resolve().parents[2]
 PACKAGE = REPO / "gpmsa"
 
 LAYERS = (
-    ("errors", "_version", "_threads", "_progress"),
+    ("errors", "_version", "_threads", "_progress", "_fp_state"),
     ("limits",),
     ("model", "io"),
     ("mcmc",),
@@ -35,7 +35,8 @@ LAYERS = (
     ("__main__",),
 )
 """The parts of gpmsa from the bottom up. A part may import itself and the parts of LOWER layers
-only (never a part of its own layer, never one above): errors, _version, _threads, _progress <-
+only (never a part of its own layer, never one above): errors, _version, _threads, _progress,
+_fp_state <-
 model, io <-
 mcmc <- backends <- fitting, calibration <- predictive, studies <- cli, plots <- __main__
 (``python -m gpmsa``, the cli's command) (studies: several models

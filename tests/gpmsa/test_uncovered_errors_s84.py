@@ -118,7 +118,7 @@ def test_obsdata_refuses_a_3d_y_and_an_empty_experiment():
     ("kw", "kind", "match"),
     [
         ({"log_prior": 5}, gpmsa.GPMSAError, "log_prior must be a callable of native theta"),
-        ({"log_prior": lambda th: "abc"}, gpmsa.ChainError, "log_prior must return numbers"),
+        ({"log_prior": lambda th: "abc"}, gpmsa.ChainError, "log_prior must return real log"),
         ({"emulator_params": "bad"}, gpmsa.GPMSAError, r"one of \('point', 'draws'\), got 'bad'"),
         ({"constraint": 5}, gpmsa.GPMSAError, "constraint must be a callable of native theta"),
         ({"constraint": lambda th: 1.0}, gpmsa.GPMSAError, "must return True or False, got 1.0"),
