@@ -154,23 +154,24 @@ SETTINGS = {
 }
 
 
-@pytest.mark.parametrize("setting", list(SETTINGS))
-def test_torch_backend_draws_and_the_callers_state(problem, torch_ref, setting):
-    with SETTINGS[setting]():
-        before = _globals()
-        got = _torch(problem)
-        _assert_kept(before)
-    _assert_same(got, torch_ref)
+CASES = [("torch", k) for k in SETTINGS] + [
+    ("pyro", k)
+    for k in SETTINGS
+    if k != "detect_anomaly"  # anomaly mode: NUTS ~5x slower
+]
 
 
-@pytest.mark.parametrize("setting", [k for k in SETTINGS if k != "detect_anomaly"])
-def test_pyro_backend_draws_and_the_callers_state(small, pyro_ref, setting):
-    """(Not under anomaly mode, which makes NUTS ~5x slower: the torch case above keeps it.)"""
+@pytest.mark.parametrize(("backend", "setting"), CASES)
+def test_draws_and_the_callers_state(request, backend, setting):
+    """Each backend's draws under the caller's setting equal its draws in the default state,
+    and the call leaves the setting (and the global generators) as the caller had them."""
+    run, data = (_torch, "problem") if backend == "torch" else (_pyro, "small")
+    problem, ref = request.getfixturevalue(data), request.getfixturevalue(f"{backend}_ref")
     with SETTINGS[setting]():
         before = _globals()
-        got = _pyro(small)
+        got = run(problem)
         _assert_kept(before)
-    _assert_same(got, pyro_ref)
+    _assert_same(got, ref)
 
 
 def test_float32_option_whatever_the_default_dtype(problem, torch_ref):
