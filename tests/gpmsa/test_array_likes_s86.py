@@ -12,6 +12,7 @@ float64 array's model to the bit; they are kept so.
 from __future__ import annotations
 
 import array
+import importlib.util
 from decimal import Decimal
 from fractions import Fraction
 
@@ -22,11 +23,12 @@ import gpmsa
 from gpmsa import GPMSAError
 from gpmsa.fitting.emulator import Emulator
 
-try:
-    import torch
-except ImportError:  # without the torch extra the tensor cases skip and the others run
-    torch = None
-needs_torch = pytest.mark.skipif(torch is None, reason="needs torch (the torch extra)")
+
+@pytest.fixture
+def torch():
+    """torch, imported by the tests that use it: without the torch extra they skip alone."""
+    return pytest.importorskip("torch")
+
 
 PARAMS = {"betaU": [[1.0], [1.5]], "lamUz": [1.0], "lamWs": [2000.0], "lamWOs": [2000.0]}
 _rng = np.random.default_rng(86)
@@ -45,12 +47,14 @@ def emulator() -> Emulator:
     return _model()
 
 
-def _grad(values) -> torch.Tensor:
+def _grad(values):
+    """A float64 tensor of ``values`` that records gradients (called by tests that have torch)."""
+    import torch
+
     return torch.tensor(np.asarray(values, dtype=float), requires_grad=True)
 
 
-@needs_torch
-def test_a_tensor_that_requires_grad_gives_the_plain_arrays_results(emulator):
+def test_a_tensor_that_requires_grad_gives_the_plain_arrays_results(emulator, torch):
     assert _model(_grad(X), _grad(T), _grad(Y)).model_sha256 == emulator.model_sha256
     xs, ts = np.array([[2.0], [7.0]]), np.array([[2.0], [4.0]])
     for got, want in zip(emulator.predict(_grad(xs), _grad(ts)), emulator.predict(xs, ts),
@@ -67,8 +71,7 @@ def test_a_tensor_that_requires_grad_gives_the_plain_arrays_results(emulator):
     np.testing.assert_array_equal(got.total, want.total)
 
 
-@needs_torch
-def test_functional_experiments_as_a_list_of_tensors_make_the_observations():
+def test_functional_experiments_as_a_list_of_tensors_make_the_observations(torch):
     y = [np.array([1.0, 2.0, 3.0]), np.array([1.5, 2.5, 3.5])]
     want = gpmsa.ObsData(x=X_OBS, y=y).digest()
     assert gpmsa.ObsData(x=X_OBS, y=[torch.tensor(e) for e in y]).digest() == want
@@ -80,11 +83,16 @@ def test_functional_experiments_as_a_list_of_tensors_make_the_observations():
     )
 
 
-@needs_torch
-def test_experiments_of_different_lengths_as_tensors_are_named(emulator):
+def test_experiments_of_different_lengths_as_tensors_are_named(emulator, torch):
     ragged = [torch.tensor([1.0, 2.0]), torch.tensor([1.0, 2.0, 3.0])]
     with pytest.raises(GPMSAError, match=r"y_obs holds experiments of different lengths \[2, 3\]"):
         gpmsa.calibrate(emulator, x_obs=X_OBS, y_obs=ragged, n_samples=10, n_burn=5)
+
+
+def _tensor(values):
+    import torch
+
+    return torch.tensor(values)
 
 
 def _same_forms():
@@ -93,7 +101,7 @@ def _same_forms():
     ro = X.copy()
     ro.flags.writeable = False
     return {
-        **({} if torch is None else {"torch float64": torch.tensor(X)}),
+        **({"torch float64": _tensor(X)} if importlib.util.find_spec("torch") else {}),
         "xarray": xr.DataArray(X, dims="run", coords={"run": np.arange(12) + 5}),
         "np.matrix": np.matrix(X).T,
         "longdouble": X.astype(np.longdouble),
@@ -114,8 +122,7 @@ def test_the_same_values_in_other_forms_make_the_same_emulator(emulator):
         assert _model(x=x).model_sha256 == emulator.model_sha256, name
 
 
-@needs_torch
-def test_nested_lists_of_scalar_tensors_that_require_grad_are_read_as_values(emulator):
+def test_nested_lists_of_scalar_tensors_that_require_grad_are_read_as_values(emulator, torch):
     """Before: "RuntimeError: Can't call numpy() on Tensor that requires grad" from np.ndim in
     ObsData and in calibrate's ragged check, and a GPMSAError for a flat list of them."""
     y = [[1.0, 2.0], [1.0, 3.0]]
