@@ -27,7 +27,7 @@ def _first_non_number(value) -> str | None:
     every entry is a number (numpy's integer and float scalars are)."""
     stack, seen = [value], set()
     while stack:
-        v = tensor_values(stack.pop())
+        v = _tensor_array(stack.pop())  # (it walks lists itself: one tensor at a time)
         if v is None:
             return "None"
         if isinstance(v, (str, bytes, bool, np.bool_)):
@@ -57,16 +57,21 @@ def _first_non_number(value) -> str | None:
 
 
 def tensor_values(value, _depth: int = 0):
-    """``value``, or for a torch tensor (an object with a bool ``requires_grad`` and a
-    ``detach`` method) its values as a numpy array: numpy refuses a tensor that records
-    gradients ("Can't call numpy() on Tensor that requires grad") and warns that a tensor's
-    ``__array__`` takes no ``copy`` when it copies one. A list or tuple holding such tensors
-    (numpy's depth of nesting at most) comes back as a list of their values; one without them
-    as it is. A tensor numpy cannot hold (on a GPU) is returned as it is, for the caller's
-    conversion to refuse."""
+    """``value`` with its torch tensors as their values (`_tensor_array`): a tensor itself, or
+    a list or tuple holding tensors (numpy's depth of nesting at most), which comes back as a
+    list of their values; anything else, and a list without tensors, as it is."""
     if isinstance(value, (list, tuple)) and _depth < MAX_NESTING:
         items = [tensor_values(v, _depth + 1) for v in value]
         return items if any(a is not b for a, b in zip(items, value, strict=True)) else value
+    return _tensor_array(value)
+
+
+def _tensor_array(value):
+    """``value``, or for a torch tensor (an object with a bool ``requires_grad`` and a
+    ``detach`` method) its values as a numpy array: numpy refuses a tensor that records
+    gradients ("Can't call numpy() on Tensor that requires grad") and warns that a tensor's
+    ``__array__`` takes no ``copy`` when it copies one. A tensor numpy cannot hold (on a GPU)
+    is returned as it is, for the caller's conversion to refuse."""
     if not isinstance(getattr(value, "requires_grad", None), bool):
         return value
     try:
