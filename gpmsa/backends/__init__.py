@@ -25,6 +25,7 @@ __all__ = [
     "check_tempering",
     "get",
     "names",
+    "open_ended",
     "placement",
     "recorded_options",
     "register",
@@ -126,8 +127,8 @@ def _check_module(name: str, module) -> None:
     sample = getattr(module, "sample", None)
     if not callable(sample):
         raise GPMSAError(f"backend {name!r}: {module!r} has no callable sample(problem, *, ...)")
-    params = inspect.signature(sample).parameters
-    if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
+    if not _any_keyword(sample):
+        params = inspect.signature(sample).parameters
         missing = [k for k in INTERFACE if k not in params]
         if missing:
             raise GPMSAError(
@@ -139,8 +140,19 @@ def _check_module(name: str, module) -> None:
 def takes(backend: str, key: str) -> bool:
     """Whether backend ``backend``'s ``sample`` takes keyword ``key`` (by name, or a plug-in's
     through ``**options``)."""
-    params = inspect.signature(get(backend).sample).parameters
-    return key in params or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
+    sample = get(backend).sample
+    return key in inspect.signature(sample).parameters or _any_keyword(sample)
+
+
+def open_ended(backend: str) -> bool:
+    """Whether backend ``backend``'s ``sample`` takes any keyword (``**options``: a plug-in's
+    options pass through unchecked)."""
+    return _any_keyword(get(backend).sample)
+
+
+def _any_keyword(sample) -> bool:
+    return any(p.kind is inspect.Parameter.VAR_KEYWORD
+               for p in inspect.signature(sample).parameters.values())  # fmt: skip
 
 
 @underflow_as_zero
@@ -208,7 +220,6 @@ def check_options(
     take, or that ``caller`` sets itself (``reserved``: its own arguments; ``renamed``: a
     reserved name -> the caller's argument that sets it, where their names differ)."""
     accepted = inspect.signature(get(backend).sample).parameters
-    open_ended = any(a.kind is inspect.Parameter.VAR_KEYWORD for a in accepted.values())
     taken = sorted(set(options) & set(reserved))
     if taken:
         hints = "".join(
@@ -219,7 +230,7 @@ def check_options(
         raise GPMSAError(
             f"{caller}: {taken} are {caller}'s own arguments, not backend options{hints}"
         )
-    unknown = [] if open_ended else sorted(set(options) - set(accepted))
+    unknown = [] if open_ended(backend) else sorted(set(options) - set(accepted))
     if unknown:
         offered = sorted(set(accepted) - set(reserved) - {"problem"})
         hint = ("; x_obs outside the design: a joint fit warns within 10% of a column's width "

@@ -160,9 +160,9 @@ def _check_mcmc_options(options, backend: str) -> dict:
     sampler = {p.name for p in params if p.kind not in (p.VAR_KEYWORD, p.VAR_POSITIONAL)}
     sampler -= {"problem"}
     allowed = sorted((named | sampler) - own - {"n_iter"})  # n_iter: calibrate's n_samples
-    open_ended = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params)  # a plug-in's
     taken = own | {"n_iter"}  # the Calibrator's own, or calibrate's n_samples: never passed on
-    unknown = sorted((set(options) & taken) if open_ended else set(options) - set(allowed), key=str)
+    unknown = sorted((set(options) & taken) if backends.open_ended(backend)  # a plug-in's
+                     else set(options) - set(allowed), key=str)  # fmt: skip
     if unknown:
         raise GPMSAError(
             f"mcmc_options: unknown keyword(s) {unknown}; gpmsa.calibrate takes {allowed} "
