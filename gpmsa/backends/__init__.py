@@ -195,13 +195,15 @@ def sample(backend: str, problem, *, n_iter: int, n_chains: int, **kwargs) -> Ch
 def check_tempering(backend: str, options: dict) -> None:
     """GPMSAError naming ``temperatures``/``swap_every``/``adapt_ladder`` in ``options`` for
     another backend than numpy or torch, which alone run tempered chains."""
+    if backend in ("numpy", "torch"):
+        return
     given = [k for k in ("temperatures", "swap_every") if options.get(k) is not None]
-    if given and backend not in ("numpy", "torch"):
+    if given:
         raise GPMSAError(
             f"{' and '.join(given)}: parallel tempering runs on the numpy and torch backends "
             f"only, not backend={backend!r}"
         )
-    if "adapt_ladder" in options and backend not in ("numpy", "torch"):
+    if "adapt_ladder" in options:
         raise GPMSAError(
             f"adapt_ladder: the adaptive ladder runs on the numpy and torch backends only, not "
             f"backend={backend!r}"
