@@ -1174,7 +1174,12 @@ class Calibrator:
         return ConstraintCut.make(axes, ok, self._allowed)
 
     def _constraint_edges(
-        self, nodes: np.ndarray, ok: np.ndarray, allows: Callable | None = None, levels: int = 1
+        self,
+        nodes: np.ndarray,
+        ok: np.ndarray,
+        allows: Callable | None = None,
+        levels: int = 1,
+        what: str = "constraint (allowed and forbidden)",
     ) -> tuple[np.ndarray, ...]:
         """Where the constraint's status changes between the unit-scale nodes (k,) (one
         parameter; ``ok`` (k,) their status): (cells i (e,), first (e,), second (e,)), the
@@ -1182,12 +1187,21 @@ class Calibrator:
         steps per call of ``allows``): ``first`` has the status of node i, ``second`` that of
         node i + 1. ``allows`` (unit-scale points (m,) -> status (m,) bool) gives the status
         between nodes (default: the constraint's). A point whose native value is its node's (an
-        edge on a node, e.g. ``th[0] > t_min``) is that node."""
+        edge on a node, e.g. ``th[0] > t_min``) is that node. GPMSAError where a bracket ends
+        in adjacent floats of one native value: ``what`` (named in it) answered both there."""
         allows = allows or (lambda points: self._allowed(points[:, None]))
         std = self.emulator.standardizer
         span, low = std.t_max[0] - std.t_min[0], std.t_min[0]  # native as `_posterior` has it
         cells = np.flatnonzero(ok[:-1] != ok[1:])
         first, second = _bisect(nodes[cells], nodes[cells + 1], ok[cells], allows, levels)
+        same = np.flatnonzero(first * span + low == second * span + low)
+        if same.size:  # both verdicts at one native theta: not a function of theta
+            value = float(first[same[0]] * span + low)
+            raise GPMSAError(
+                f"Calibrator: the {what} gave both answers at "
+                f"{self.emulator.t_names[0]} = {value!r}: it must be a function of theta alone, "
+                "the same answer for the same theta (no random numbers or state)"
+            )
         first = np.where(first * span + low == nodes[cells] * span + low, nodes[cells], first)
         second = np.where(
             second * span + low == nodes[cells + 1] * span + low, nodes[cells + 1], second
@@ -1223,7 +1237,10 @@ class Calibrator:
         nonzero = np.isfinite(total)  # free is finite: the prior's zeros
         allowed = nonzero if ok is None else ok & nonzero
         levels = PRIOR_BISECT_LEVELS if self.constraint is None else 1  # its fn: point by point
-        edges = self._constraint_edges(axis, allowed, allows, levels)
+        what = "prior (zero and not)"
+        if self.constraint is not None:
+            what = "constraint or the prior (allowed and forbidden, or zero and not)"
+        edges = self._constraint_edges(axis, allowed, allows, levels, what)
         return with_edges(axis, free, allowed, edges, user, total)
 
     def _theta_prior_at(self, theta_unit: np.ndarray, prior) -> np.ndarray:
