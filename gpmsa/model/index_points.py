@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
+from typing import NamedTuple
 
 import numpy as np
 from scipy import sparse
@@ -74,7 +75,7 @@ def within(values: np.ndarray, lo: float, hi: float) -> bool:
     return bool(values.min() >= lo - slack and values.max() <= hi + slack)
 
 
-def _triangulation(points: np.ndarray, name: str) -> Delaunay:
+def _triangulation(points: np.ndarray, name: str) -> Triangulation:
     l, d = points.shape
     if d > 2 and l ** math.ceil(d / 2) > limits.MAX_INDEX_SIMPLICES:
         raise ResourceLimitError(
@@ -88,20 +89,60 @@ def _triangulation(points: np.ndarray, name: str) -> Delaunay:
     try:
         if l <= d:
             raise QhullError("too few points")
-        return _delaunay(points.shape, np.ascontiguousarray(points).tobytes())
+        found = _delaunay(points.shape, np.ascontiguousarray(points).tobytes())
     except QhullError:
         raise GPMSAError(
             f"{name} of {points.shape[0]} points in {d} columns does not span {d} dimensions "
             f"(fewer than {d + 1} points, or all on a line or plane): the basis is interpolated "
             "on their triangulation"
         ) from None
+    lost = found.tri.coplanar.shape[0]
+    if lost:
+        spans = numbers_text(*np.ptp(points, axis=0), digits=3)
+        raise GPMSAError(
+            f"{name}: {lost} of its {l} points fall out of their triangulation in float64 "
+            f"(within rounding of others: the index columns span {', '.join(spans)}, and spans "
+            "that differ by a factor of about 1e6 or more put a narrow column's points that "
+            "close; so do points nearly repeated); rescale the index columns to comparable "
+            "spans, or merge the nearly repeated points"
+        )
+    return found
+
+
+class Triangulation(NamedTuple):
+    """The Delaunay triangulation ``tri`` of the simulation's index points, made in their own
+    units or, where float64 cannot hold it there, in the ``frame`` (origin (d,), width) that
+    maps them onto [0, 1] by one width (a shift and a scale: the same triangles): points
+    located in it are first mapped by `local`."""
+
+    tri: Delaunay
+    frame: tuple[np.ndarray, float] | None
+
+    def local(self, q: np.ndarray) -> np.ndarray:
+        """Points ``q`` (n, d) in the triangulation's coordinates."""
+        return q if self.frame is None else (q - self.frame[0]) / self.frame[1]
 
 
 @functools.lru_cache(maxsize=4)
-def _delaunay(shape: tuple[int, int], data: bytes) -> Delaunay:
+def _delaunay(shape: tuple[int, int], data: bytes) -> Triangulation:
     """The triangulation of the points (``shape``, float64 bytes), kept for the next call: a fit
-    or a prediction interpolates the basis, the mean and the sd on the same points."""
-    return Delaunay(np.frombuffer(data).reshape(shape))
+    or a prediction interpolates the basis, the mean and the sd on the same points. Made in the
+    points' own units; where Qhull fails there or leaves points out (``coplanar``: an offset
+    far beyond the points' span, e.g. 1e7 + [0, 1], or a span near float64's ends), again on
+    the points shifted to the origin and divided by their widest column's span (Delaunay's
+    triangles do not change under a shift and one scale; a column far narrower than another
+    still leaves points out: `_triangulation` refuses it)."""
+    points = np.frombuffer(data).reshape(shape)
+    try:
+        tri = Delaunay(points)
+        if not tri.coplanar.shape[0]:
+            return Triangulation(tri, None)
+    except QhullError:
+        pass
+    origin = points.min(axis=0)
+    width = float(np.max(points.max(axis=0) - origin))
+    origin.flags.writeable = False
+    return Triangulation(Delaunay((points - origin) / width), (origin, width))
 
 
 def check_columns(points: np.ndarray, new: np.ndarray, what: str) -> None:
@@ -133,8 +174,9 @@ def weights(
     hit, rest = np.flatnonzero(on >= 0), np.flatnonzero(on < 0)
     rows, cols, vals = [hit], [on[hit]], [np.ones(hit.size)]
     if rest.size:
-        tri = _triangulation(points, "the simulation index")
-        s = _locate(tri, new[rest])
+        found = _triangulation(points, "the simulation index")
+        tri, q = found.tri, found.local(new[rest])
+        s = _locate(tri, q)
         if np.any(s < 0):
             k = int(rest[np.flatnonzero(s < 0)[0]])
             raise GPMSAError(
@@ -142,7 +184,7 @@ def weights(
                 "convex hull of the simulation index's points, on which the basis is "
                 "interpolated: give points within it"
             )
-        b = _barycentric(tri, s, new[rest])
+        b = _barycentric(tri, s, q)
         rows.append(np.repeat(rest, b.shape[1]))
         cols.append(tri.simplices[s].reshape(-1))
         vals.append(b.reshape(-1))
