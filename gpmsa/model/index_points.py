@@ -109,6 +109,12 @@ def _triangulation(points: np.ndarray, name: str) -> Triangulation:
     return found
 
 
+def triangles(points: np.ndarray, name: str) -> np.ndarray:
+    """The triangles (k, d + 1) of row indices on which the index ``points`` (l, d) are
+    interpolated (the figures draw maps on them); GPMSAError where they span no triangle."""
+    return _triangulation(points, name).tri.simplices
+
+
 class Triangulation(NamedTuple):
     """The Delaunay triangulation ``tri`` of the simulation's index points, made in their own
     units or, where float64 cannot hold it there, in the ``frame`` (origin (d,), width) that

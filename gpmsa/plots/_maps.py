@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from gpmsa.errors import GPMSAError
+from gpmsa.model.index_points import triangles
+
 VALUES, SIGNED, SPREAD = "viridis", "RdBu_r", "magma"  # colour maps: values, signed, widths
 
 
@@ -31,17 +34,19 @@ def signed_norm(*arrays: np.ndarray):
 
 
 def surface(ax, points: np.ndarray, values: np.ndarray, norm, cmap: str, labels) -> object:
-    """``values`` (l,) at ``points`` (l, 2) on ``ax``: colour linear on each Delaunay triangle
-    (``tripcolor`` with Gouraud shading; a triangle with a non-finite corner is left blank) and a
-    small black marker at each point; points that span no triangle (fewer than 3, or on one
-    line) get coloured markers instead (``markers``). ``labels``: the axes' (the index
+    """``values`` (l,) at ``points`` (l, 2) on ``ax``: colour linear on each of the triangles
+    gpmsa interpolates on (`gpmsa.model.index_points.triangles`; ``tripcolor`` with Gouraud
+    shading; a triangle with a non-finite corner is left blank) and a small black marker at
+    each point; points that span no triangle (fewer than 3, on one line, or within rounding of
+    each other) get coloured markers instead (``markers``). ``labels``: the axes' (the index
     columns', ``_figure.index_labels``). Returns the mappable for a colour bar."""
     from matplotlib.tri import Triangulation
 
-    try:
-        tri = Triangulation(points[:, 0], points[:, 1])
-    except (ValueError, RuntimeError):  # fewer than 3 points, or all on a line
+    try:  # gpmsa's own triangles: matplotlib's split a regular grid's cells otherwise
+        simplices = triangles(np.asarray(points, dtype=np.float64), "the map's points")
+    except GPMSAError:  # fewer than 3 points, on one line, or points within rounding
         return markers(ax, points, values, norm, cmap, labels=labels)
+    tri = Triangulation(points[:, 0], points[:, 1], triangles=simplices)
     finite = np.isfinite(values)
     tri.set_mask(~np.all(finite[tri.triangles], axis=1))
     mesh = ax.tripcolor(tri, np.where(finite, values, 0.0), shading="gouraud", norm=norm,
