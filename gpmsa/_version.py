@@ -7,11 +7,16 @@ __version__ = "0.1.0"
 
 _BACKEND_PACKAGES = {"torch": ("torch", "gpytorch"), "pyro": ("torch", "pyro-ppl")}
 
+MAX_VERSION_CHARS = 200
+"""A plug-in's record is cut to this many characters (its ``__version__`` is anything it says)."""
 
-def library_versions(backend: str | None = None) -> dict[str, str]:
+
+def library_versions(backend: str | None = None, plugin=None) -> dict[str, str]:
     """Versions of Python, gpmsa, numpy, scipy and the BLAS in use (name, version, CPU kernel,
-    threads), plus the backend's packages: the numbers that can change a seeded result between
-    machines (docs/vehicle-models.md, "Reproducibility")."""
+    threads), plus the backend's packages, or for a plug-in backend (``plugin``: its module,
+    ``gpmsa.backends.get(backend)``) its module's name and version (`plugin_version`): the
+    numbers that can change a seeded result between machines (docs/vehicle-models.md,
+    "Reproducibility")."""
     import platform
     from importlib import metadata
 
@@ -43,4 +48,43 @@ def library_versions(backend: str | None = None) -> dict[str, str]:
             out[pkg] = metadata.version(pkg)
         except metadata.PackageNotFoundError:
             out[pkg] = "not installed"
-    return out
+    return out if plugin is None else out | plugin_version(str(backend), plugin)
+
+
+def plugin_version(backend: str, module) -> dict[str, str]:
+    """The record of plug-in backend ``backend`` (``gpmsa.backends.register``) whose module is
+    ``module``: ``{"backend <backend>": "<its module's name> <version>"}``, the version its
+    ``__version__``, else that of the distribution providing its top-level package, else
+    "unknown". Never raises ({} at worst): versions are informative, a broken plug-in's
+    metadata must not fail a fit."""
+    try:
+        name = getattr(module, "__name__", None)
+        name = name if isinstance(name, str) and name else None
+        version = _module_version(module, name)
+        record = version if name is None else f"{name} {version}"
+        return {f"backend {backend}": record[:MAX_VERSION_CHARS]}
+    except Exception:  # anything a broken plug-in raises
+        return {}
+
+
+def _module_version(module, name: str | None) -> str:
+    """``module.__version__`` as a string, else `_distribution_version`; "unknown" where
+    either raises."""
+    try:
+        version = getattr(module, "__version__", None)
+        return _distribution_version(name) if version is None else str(version)
+    except Exception:  # a broken plug-in's metadata
+        return "unknown"
+
+
+def _distribution_version(module_name: str | None) -> str:
+    """The version of the installed distribution providing ``module_name``'s top-level
+    package ("<version> (<distribution>)" where their names differ), else "unknown"."""
+    from importlib import metadata
+
+    top = (module_name or "").split(".")[0]
+    dists = metadata.packages_distributions().get(top) if top else None
+    if not dists:
+        return "unknown"
+    version = metadata.version(dists[0])
+    return version if dists[0] == top else f"{version} ({dists[0]})"

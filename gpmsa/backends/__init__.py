@@ -3,7 +3,7 @@
 A backend module exposes ``sample(problem, *, n_iter, n_chains=1, tune=True, step_widths=None,
 seed=None, progress=False, **options) -> gpmsa.mcmc.sampler.Chains``. Modules are imported
 lazily, so importing gpmsa never imports torch. ``register`` adds a backend of one's own
-(docs/internals.md, "A backend of your own").
+(docs/internals.md, "A backend of your own"), ``unregister`` removes it.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from gpmsa.mcmc.sampler import Chains, check_sample_args
 
 __all__ = [
     "available",
+    "check_extensions",
     "check_options",
     "check_sample_args",
     "check_tempering",
@@ -31,6 +32,7 @@ __all__ = [
     "register",
     "sample",
     "takes",
+    "unregister",
 ]
 
 _REGISTRY: dict[str, tuple[str | ModuleType, str]] = {
@@ -47,7 +49,8 @@ INTERFACE = ("n_iter", "n_chains", "tune", "step_widths", "seed", "progress")
 
 
 def register(name: str, module: str | ModuleType, *, extra: str = "") -> None:
-    """Register a backend of one's own as ``name`` (a plug-in; re-registering it replaces it).
+    """Register a backend of one's own as ``name`` (a plug-in; re-registering it replaces it,
+    `unregister` removes it).
 
     ``module``: an import path (imported at first use, as the built-in backends are) or a
     module (any object) with ``sample(problem, *, n_iter, n_chains=1, tune=True,
@@ -70,6 +73,17 @@ def register(name: str, module: str | ModuleType, *, extra: str = "") -> None:
     else:
         _check_module(name, module)  # refused now, not at the fit
     _REGISTRY[name] = (module, extra)
+
+
+def unregister(name: str) -> None:
+    """Remove the plug-in registered as ``name`` (`register`); GPMSAError for a built-in
+    backend's name or a name not registered."""
+    if isinstance(name, str) and name in BUILTIN:
+        raise GPMSAError(f"unregister: {name!r} is a built-in backend, which cannot be removed")
+    if not isinstance(name, str) or name not in _REGISTRY:
+        plugins = tuple(n for n in _REGISTRY if n not in BUILTIN)
+        raise GPMSAError(f"unregister: no plug-in {name!r} is registered; registered: {plugins}")
+    del _REGISTRY[name]
 
 
 def names() -> tuple[str, ...]:
@@ -161,17 +175,8 @@ def sample(backend: str, problem, *, n_iter: int, n_chains: int, **kwargs) -> Ch
     checked: a plug-in's ``problem`` without an extension it does not declare (its
     ``SUPPORTS``), its result a `Chains` of ``n_chains`` x ``n_iter`` draws of every parameter
     of ``problem`` (GPMSAError naming what is wrong)."""
-    module = get(backend)
-    if backend not in BUILTIN:
-        declared = getattr(module, "SUPPORTS", ())
-        missing = [e for e in problem.extensions if e not in declared]
-        if missing:
-            raise GPMSAError(
-                f"backend {backend!r} does not declare support for {missing} (its module's "
-                f"SUPPORTS: {tuple(declared)}); use backend='numpy', or declare them where "
-                "its sample handles them"
-            )
-    chains = module.sample(problem, n_iter=n_iter, n_chains=n_chains, **kwargs)
+    check_extensions(backend, problem.extensions)
+    chains = get(backend).sample(problem, n_iter=n_iter, n_chains=n_chains, **kwargs)
     if not isinstance(chains, Chains):
         raise GPMSAError(f"backend {backend!r}: its sample returned a {type(chains).__name__}, "
                          "not a gpmsa.mcmc.sampler.Chains")  # fmt: skip
@@ -190,6 +195,22 @@ def sample(backend: str, problem, *, n_iter: int, n_chains: int, **kwargs) -> Ch
                          f"n_chains x n_iter = {n_chains} x {n_iter} sweeps of the problem's "
                          f"parameters: {'; '.join(wrong)}")  # fmt: skip
     return chains
+
+
+def check_extensions(backend: str, extensions: tuple[str, ...]) -> None:
+    """GPMSAError naming the ``extensions`` (names of ``Problem.extensions``) that plug-in
+    ``backend``'s module does not declare in its ``SUPPORTS``; a built-in backend's pass (they
+    check their own)."""
+    if backend in BUILTIN:
+        return
+    declared = getattr(get(backend), "SUPPORTS", ())
+    missing = [e for e in extensions if e not in declared]
+    if missing:
+        raise GPMSAError(
+            f"backend {backend!r} does not declare support for {missing} (its module's "
+            f"SUPPORTS: {tuple(declared)}); use backend='numpy', or declare them where "
+            "its sample handles them"
+        )
 
 
 def check_tempering(backend: str, options: dict) -> None:

@@ -108,6 +108,7 @@ from gpmsa.errors import (
 from gpmsa.limits import check_memory
 from gpmsa.model import constraints
 from gpmsa.model.data import as_float, check_count, check_flag, repr_names, run_seed
+from gpmsa.model.problem import extensions_used
 
 METHODS = ("auto", "grid", "mcmc")
 N_DRAWS = 4000
@@ -331,7 +332,9 @@ class Calibrator:
             ``gpmsa.backends.register``; see ``gpmsa.backends.available()``). The grid path
             is numpy's; another backend makes "auto" choose MCMC. None (the default):
             ``mcmc_options["backend"]`` where it names one, else "numpy"; a GPMSAError where
-            both are given and differ (an explicit "numpy" too).
+            both are given and differ (an explicit "numpy" too), and, here, where a plug-in's
+            module does not declare an extension the emulator or options already give
+            (`_extensions`; ``gpmsa.backends.check_extensions``).
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there. On the grid, for one parameter the density is cut at
             the boundary (located by bisection between nodes, to float precision), so that no
@@ -625,6 +628,22 @@ class Calibrator:
         draws = opts.get("emulator_params", self.emulator_params) == "draws"
         _refuse_unused_sampler_options(opts, backend, draws)
         _refuse_placement(opts, backend)
+        if backend not in backends.BUILTIN:  # a plug-in: the extensions it does not declare
+            backends.check_extensions(backend, self._extensions())
+
+    def _extensions(self) -> tuple[str, ...]:
+        """The ``Problem.extensions`` that every MCMC update's problem will use, as far as the
+        emulator and ``mcmc_options`` tell before observations come: categorical inputs, a
+        mean basis, a theta constraint, and theta elements held (``fixed``, checked as
+        ``gpmsa.calibrate`` checks it); discrepancy elements held are left to the update."""
+        from gpmsa.calibration.calibrate import calibration_fixed
+
+        opts = self.mcmc_options
+        fixed = calibration_fixed(self.emulator, opts.get("fixed"), opts.get("discrepancy"))
+        held = isinstance((fixed or {}).get("theta"), dict)  # some elements (all: the vector)
+        return extensions_used(getattr(self.emulator, "categorical_mask", None),
+                               getattr(self.emulator, "mean_basis", None),
+                               opts.get("constraint"), held)  # fmt: skip
 
     # --- the exact likelihood on a grid ---------------------------------------------------------
     def _marginals(

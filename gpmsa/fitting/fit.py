@@ -406,7 +406,9 @@ def fit(
                 chains.info["level_offsets"], data.t_names, prep.standardizer.t_min,
                 prep.standardizer.t_max, tuple(data.levels)[len(data.x_names):])}),
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "versions": library_versions(backend),
+        "versions": library_versions(
+            backend, None if backend in backends.BUILTIN else backends.get(backend)
+        ),
     }  # fmt: skip
     if obs is not None and discrepancy is not None:  # full_prediction refuses another basis
         source = (resumed.settings or {}) if continuing else None  # keeps its scale

@@ -191,11 +191,8 @@ class Problem:
         basis, a theta constraint, held elements of a sampled parameter): the numpy and torch
         backends sample them, pyro some (``gpmsa.backends.pyro_backend.refuse_unsupported``),
         a plug-in those it declares (``gpmsa.backends.register``)."""
-        used = (("categorical inputs", self.categorical is not None),
-                ("mean_basis", self.mean_basis is not None),
-                ("theta constraint", self.constraint is not None),
-                ("held elements", any(self.fixed_elements.values())))  # fmt: skip
-        return tuple(name for name, on in used if on)
+        return extensions_used(self.categorical, self.mean_basis, self.constraint,
+                               any(self.fixed_elements.values()))  # fmt: skip
 
     @property
     def callables(self) -> list[str]:
@@ -297,6 +294,17 @@ class Problem:
         full = {k for k, v in merged.items() if len(v) == self.init[k].size}
         merged = {k: v for k, v in merged.items() if k not in full}
         return replace(prob, fixed=prob.fixed | full, fixed_elements=merged)
+
+
+def extensions_used(categorical, mean_basis, constraint, held: bool) -> tuple[str, ...]:
+    """The names of ``Problem.extensions`` that a problem with these ``categorical`` (mask or
+    None), ``mean_basis``, ``constraint`` (None: without it) and ``held`` elements uses; a
+    ``Calibrator`` names those its emulator and options give before any problem is built."""
+    used = (("categorical inputs", categorical is not None),
+            ("mean_basis", mean_basis is not None),
+            ("theta constraint", constraint is not None),
+            ("held elements", held))  # fmt: skip
+    return tuple(name for name, on in used if on)
 
 
 def theta_log_prior(priors: Priors, levels, theta) -> float:
