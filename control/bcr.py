@@ -521,10 +521,12 @@ class BCR:
     this one would, and updating either leaves the other as it was) or ``copy.deepcopy`` (the
     model copied too). It pickles, and so do its estimates
     (their posteriors' lazily drawn samples are drawn then). Its estimates do not depend on
-    how the samples are chunked across calls; a call returns the newest estimate, or the
-    gravest fault among those it made. A call of ``update``, ``resume`` or ``reset`` that raises
-    (a refused argument; part way: an error of the model's, a KeyboardInterrupt) leaves the BCR
-    as it was before it: fed the same samples again, it continues as if the call never happened.
+    how the samples are chunked across calls (but for their times: with ``now=``, the
+    estimates that one call makes are stamped at its clock); a call returns the newest
+    estimate, or the gravest fault among those it made. A call of ``update``, ``resume`` or
+    ``reset`` that raises (a refused argument; part way: an error of the model's, a
+    KeyboardInterrupt) leaves the BCR as it was before it: fed the same samples again, it
+    continues as if the call never happened.
     """
 
     def __init__(self, model, settings: BCRSettings | None = None, **overrides) -> None:
@@ -800,7 +802,8 @@ class BCR:
                 self._n_updates += 1
         if self._n_updates == 0 and self._received:  # samples in, the first update to come
             reason = f"{self._start_note}{self._received} of the first update's {every} samples"
-            self.last = replace(self.last, reason=reason)
+            t_now, pos_now = self._now()  # (the newest sample's, not the placeholder's 0)
+            self.last = replace(self.last, time=t_now, position=pos_now, reason=reason)
         est = self._check_age(fault or self.last)
         return self._check_silence(est, fresh=self._n_updates > updates, pending=True)
 
