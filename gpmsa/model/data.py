@@ -410,12 +410,14 @@ NUMPY_PRINT_DEFAULTS = {
 """numpy's own print options (``np.get_printoptions()`` of a fresh session)."""
 
 
-def array_text(arr) -> str:
+def array_text(arr, **options) -> str:
     """``str(arr)`` as numpy's default print options write it, whatever the user has set with
     ``np.set_printoptions`` (precision=2 or suppress=True showed 1.004 as 1.00 and 1e-9 as 0.00
-    in a message about that very value; threshold=5 hid a NaN behind "...")."""
+    in a message about that very value; threshold=5 hid a NaN behind "..."); ``options``: the
+    message's own (e.g. ``precision=3``), in place of those defaults."""
     given = np.get_printoptions()  # override_repr: numpy >= 2.1
-    with np.printoptions(**{k: v for k, v in NUMPY_PRINT_DEFAULTS.items() if k in given}):
+    chosen = {k: v for k, v in NUMPY_PRINT_DEFAULTS.items() if k in given} | options
+    with np.printoptions(**chosen):
         return str(np.asarray(arr))
 
 

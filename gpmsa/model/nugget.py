@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from gpmsa.model.correlation import correlation
+from gpmsa.model.data import array_text
 from gpmsa.model.likelihood import lower_cholesky
 
 
@@ -37,7 +38,7 @@ def not_positive_definite(component: int, params: dict, lam_sim, m: int, where: 
         f"nugget 1/lamWs + 1/(lam_sim lamWOs) = {nug:.3g} (lamWs {lam_ws:.3g}, lamWOs "
         f"{lam_wos:.3g}) is {nug / var:.2g} of the GP variance 1/lamUz = {var:.3g}, too little "
         f"to keep the correlation matrix of the {m} runs (betaU[:, {j}] = "
-        f"{np.array2string(beta, precision=3, max_line_width=200, threshold=8)}) positive "
+        f"{array_text(beta, precision=3, linewidth=200, threshold=8)}) positive "
         "definite to rounding (long correlation lengths against the runs' spacing, or runs "
         "that nearly coincide, make it near-singular). Keep lamWs and lamWOs within GPM/SA's "
         "bounds (their priors' upper bound 1e5, a nugget of at least 1e-5), or hold them at "
