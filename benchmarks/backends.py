@@ -115,6 +115,7 @@ def bench_calibrate(backend: str, n_samples: int, n_chains: int, fast: bool, see
         backend=backend, n_chains=n_chains, fast=fast,
     )  # fmt: skip
     wall = time.perf_counter() - t0
+    assert post.chains is not None, "an MCMC posterior has chains"
     return (wall, *ess_rhat(post.chains, ("GD", "lamOs")))
 
 

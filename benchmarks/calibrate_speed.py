@@ -196,18 +196,19 @@ def main() -> None:
         row("calibrate, paper settings (numpy backend)", 1e3 * np.array(runs), f"{1e3 * sepia:.0f}")
     )
     emu2, x2, y2 = two_parameter_case()
-    wall, cpu = {True: [], False: []}, {True: [], False: []}
+    walls: dict[bool, list[float]] = {True: [], False: []}
+    cpus: dict[bool, list[float]] = {True: [], False: []}
     for seed in range(max(2, args.runs // 5)):
         for fast in (True, False):  # alternated: a change in the machine's load hits both
             t0, c0 = time.perf_counter(), time.process_time()
             gpmsa.calibrate(emu2, x2, y2, seed=seed, fast=fast)
-            wall[fast].append(time.perf_counter() - t0)
-            cpu[fast].append(time.process_time() - c0)
+            walls[fast].append(time.perf_counter() - t0)
+            cpus[fast].append(time.process_time() - c0)
     for fast in (True, False):
         engine = "fast sampler" if fast else "numpy backend"
-        print(row(f"calibrate, 2 parameters, 3 obs ({engine})", 1e3 * np.array(wall[fast])))
-    ratio = np.median(wall[True]) / np.median(wall[False])
-    ratio_cpu = np.median(cpu[True]) / np.median(cpu[False])
+        print(row(f"calibrate, 2 parameters, 3 obs ({engine})", 1e3 * np.array(walls[fast])))
+    ratio = np.median(walls[True]) / np.median(walls[False])
+    ratio_cpu = np.median(cpus[True]) / np.median(cpus[False])
     print(f"  fast / numpy backend, 2 parameters: {ratio:.2f} (wall), {ratio_cpu:.2f} (CPU)")
     predictors = [*cal._predictors, *(cal._refined[1] if cal._refined else [])]
     cached = sum(a.nbytes for p in predictors for a in [p.rt_alpha, *(p.H or [])])
@@ -228,7 +229,8 @@ def main() -> None:
 
 def load() -> str:
     """The load average with the cores, printed with the timings (the machine is shared)."""
-    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
+    averages = "{:.2f} {:.2f} {:.2f}".format(*load_average())
+    return f"load average {averages} on {os.cpu_count()} cores"
 
 
 if __name__ == "__main__":

@@ -70,7 +70,9 @@ def run_fit(backend: str, n_iter: int, n_chains: int, seed: int, **options) -> t
 def numpy_parallel(n_iter: int, repeats: int) -> float:
     """Part 1; returns the single chain's median ESS/s."""
     print(f"\n# numpy, road case fit, {n_iter} sweeps a chain after 1,000 tuning sweeps; {load()}")
-    rates, per_cpu, sweeps = {1: [], 2: []}, {1: [], 2: []}, {1: [], 2: []}
+    rates: dict[int, list[float]] = {1: [], 2: []}
+    per_cpu: dict[int, list[float]] = {1: [], 2: []}
+    sweeps: dict[int, list[float]] = {1: [], 2: []}
     for r in range(repeats):
         for n_chains in (1, 2):
             wall, cpu, n_eff, r_hat, _ = run_fit("numpy", n_iter, n_chains, seed=r, n_jobs=n_chains)

@@ -147,6 +147,7 @@ def _run(job: tuple) -> dict:
     if method == "changepoint":
         bcr = replace(bcr, changepoint=cp, update_every=update_every)
     simplex = control.Simplex(speed_step_mps=speed_step)
+    segments: tuple[tuple[float, float], ...]
     if kind == "steady":
         gd, speed = extra
         segments = ((STEADY_ROAD_M, gd),)
@@ -195,7 +196,7 @@ def jobs_for(
     steady_first_seed: int = SETS["steady"].start,
     interval: str = control.BCRSettings.interval_kind,
 ) -> list[tuple]:
-    out = []
+    out: list[tuple] = []
     for case in cases:
         seeds = SETS[name]
         if name in ("paper", "heldout"):

@@ -73,6 +73,7 @@ def main() -> None:
         except roadgen.RoadgenError as exc:
             parser.error(f"--long-m {args.long_m:g} (three segments of a third): {exc}")
     emu = control.shipped_emulator(args.case, "band" if args.method == "changepoint" else "window")
+    assert emu.metadata is not None, "a shipped emulator records how it was trained"
     noise = float(emu.metadata["noise_std"])
     try:
         settings = control.bcr_settings_for(

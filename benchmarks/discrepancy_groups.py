@@ -72,7 +72,9 @@ def case(seed: int, truth: str) -> tuple[gpmsa.SimData, gpmsa.ObsData]:
 
 def run(seeds: int) -> dict:
     """Per truth and grouping, the per-seed posterior summaries."""
-    out = {truth: {name: [] for name in GROUPINGS} for truth in ("offset", "shape")}
+    out: dict[str, dict[str, list[dict]]] = {
+        truth: {name: [] for name in GROUPINGS} for truth in ("offset", "shape")
+    }
     for truth, by_grouping in out.items():
         for seed in range(seeds):
             data, obs = case(seed, truth)

@@ -233,7 +233,9 @@ def mean_cov(emu, v: float, gd: float) -> np.ndarray:
     return basis @ np.diag(pred.var_w[0, 0]) @ basis.T
 
 
-def linearised(d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray, width: float):
+def linearised(
+    d: np.ndarray, g: np.ndarray, w: np.ndarray, cov_d: np.ndarray, width: float
+) -> tuple[float, float]:
     """(relative GD bias, its se) of the weighted least-squares step g' W d / (g' W g) in
     log GD, W = the likelihood's inverse covariance, cov_d the covariance of d; (NaN, NaN)
     where the emulator is too flat in GD to linearise: a step or se beyond ``width``, the

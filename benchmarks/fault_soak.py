@@ -353,6 +353,7 @@ def load() -> str:
 
 def print_excerpt(o: Outcome) -> None:
     sc, f = o.scenario, o.fault
+    assert f is not None, "an excerpt is of a faulted run"
     print(
         f"\n{sc.name} case {sc.case} {f.kind} magnitude {f.magnitude:.4g} at {f.start_s:.2f} s "
         f"for {f.duration_s:.3g} s; track {list(sc.segments)}; fast on rough: clean "

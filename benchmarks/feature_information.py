@@ -80,7 +80,8 @@ SPEED_BANDS = ((0.0, 1.0, "v<1"), (1.0, 1.5, "1-1.5"), (1.5, 9.9, "v>1.5"))
 N_GRID = 401
 NARROW_BANDS_HZ = (1.5, 3, 4.5, 6, 7, 8.5, 10, 12, 14, 17, 20, 25, 30, 37, 45, 52, 60)
 BANDS_ONLY = {"quantiles": ()}
-BAND_VARIANTS = {  # name: (block samples, FeatureSpec fields, extra moment or None)
+BAND_VARIANTS: dict[str, tuple[int, dict, str | None]] = {  # name: (block samples, FeatureSpec
+    # fields, extra moment or None)
     "8 bands": (125, BANDS_ONLY, None),
     "+ quantiles 0.9, 0.98 (shipped)": (125, {}, None),
     "+ quantiles 0.02, 0.1, 0.9, 0.98": (125, {"quantiles": (0.02, 0.1, 0.9, 0.98)}, None),
@@ -129,6 +130,7 @@ def campaign(n: int, keep_s: float, seed: int, workers: int, cache_dir: str | No
             lhs(n, seed), seed=seed, keep_s=keep_s, executor=pool, progress=False,
             cache_dir=cache_dir,
         )  # fmt: skip
+    assert c.accel is not None and c.accel_measured is not None, "keep_s > 0 keeps them"
     ok = c.ok & np.all(np.isfinite(c.accel_measured), axis=1)
     return c.v[ok], c.gd[ok], {"A": c.accel[ok], "B": c.accel_measured[ok]}
 
@@ -357,14 +359,14 @@ def info_per_s(s: Scores, t_s: float, rng: np.random.Generator, n_boot: int = 30
     for _ in range(n_boot):
         pick = np.concatenate([idx[i] for i in rng.integers(0, runs.size, runs.size)])
         boot.append((j_of(s.err[pick]), jlin_of(s.err_lin[pick])))
-    boot = np.array(boot)
+    boot_j = np.array(boot)
     return {
         "J": j_of(s.err),
-        "se": float(np.std(boot[:, 0])),
+        "se": float(np.std(boot_j[:, 0])),
         "rmse": float(np.sqrt(np.mean(s.err**2))),
         "cov": float(np.mean(s.covered)),
         "Jlin": jlin_of(s.err_lin),
-        "se_lin": float(np.std(boot[:, 1])),
+        "se_lin": float(np.std(boot_j[:, 1])),
     }
 
 
@@ -602,13 +604,13 @@ def main(argv: list[str] | None = None) -> None:
             for B in BLOCKS:
                 row = f"{name:<10}{B:5d} "
                 for *_, lab in SPEED_BANDS:
-                    t, key, ref = (
+                    t, band_key, ref = (
                         band_j[case, name, B, lab],
                         (case, name, B, lab),
                         (case, *PAPER, lab),
                     )
-                    row += f"{t['J']:10.2f} ({ratio(band_j, key, ref, 'J'):4.2f})"
-                    row += f"{t['Jlin']:9.2f} ({ratio(band_j, key, ref, 'Jlin'):4.2f})"
+                    row += f"{t['J']:10.2f} ({ratio(band_j, band_key, ref, 'J'):4.2f})"
+                    row += f"{t['Jlin']:9.2f} ({ratio(band_j, band_key, ref, 'Jlin'):4.2f})"
                 print(row)
 
     print(f"\n4. Variants of the band vector at T ~ 8.3 s (1,000 samples; {load()})")

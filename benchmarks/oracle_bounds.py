@@ -103,7 +103,7 @@ def replay(
             and np.min(spd[block]) >= MAX_SPEED_CHANGE * np.max(spd[block])
         )  # fmt: skip
         y = control.block_features(result.sample_accel[block], s.feature)[0] if usable else None
-        if usable and model.plausibility(y, v)[1] >= s.plausibility_p:
+        if y is not None and model.plausibility(y, v)[1] >= s.plausibility_p:
             ph.filter.update(model.loglik(y, v), ds)
             ph.data_time = float(result.sample_time[end - 1])
         else:

@@ -34,6 +34,7 @@ import argparse
 import dataclasses
 import os
 import time
+from collections.abc import Sequence
 
 import numpy as np
 from _host import load_average
@@ -161,7 +162,9 @@ def main(argv=None) -> None:
                     help="one seed, one fault start, gain 0.7, release 10, case B, no "
                     "paper track (~1 s)")  # fmt: skip
     args = ap.parse_args(argv)
-    seeds, starts, gains = range(1, 6), range(1, 6), GAINS
+    seeds: Sequence[int] = range(1, 6)
+    starts: Sequence[int] = range(1, 6)
+    gains: Sequence[float] = GAINS
     releases, cases = args.release, args.cases
     if args.quick:
         seeds, starts, gains, releases, cases = [1], [3], [0.7], [10.0], ["B"]
@@ -193,7 +196,8 @@ def main(argv=None) -> None:
             ):
                 print(f"{c:<5} {rel:>9g}  {secs:6.1f}  {safety:>18.1f}  {fast:>16.1f}  "
                       f"{r300:8.2f}  {r500:8.2f}")  # fmt: skip
-    load = "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
+    averages = "{:.2f} {:.2f} {:.2f}".format(*load_average())
+    load = f"load average {averages} on {os.cpu_count()} cores"
     print(f"{time.perf_counter() - tic:.1f} s; {load}")
 
 

@@ -51,6 +51,7 @@ def main() -> None:
     if args.repeats < 1:
         parser.error(f"--repeats must be >= 1, got {args.repeats}")
     emu = control.shipped_emulator(args.case)
+    assert emu.metadata is not None, "a shipped emulator records how it was trained"
     noise = float(emu.metadata["noise_std"])
     likelihood = control.ObservationModel(emu)
     work = Path(tempfile.mkdtemp(prefix="replay_speed_"))
@@ -86,8 +87,8 @@ def main() -> None:
                       f"({r.read_s:.3f} / {r.condition_s:.3f} / {r.bcr_s:.3f})")  # fmt: skip
         print("target: >= 200x real time (ratio: read, resample and BCR; 'with outputs': the "
               "whole call, CSV and output bag written)")  # fmt: skip
-        print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f} on {} cores".format(
-            *load_average(), os.cpu_count()))  # fmt: skip
+        print("load average (1, 5, 15 min): {:.2f} {:.2f} {:.2f}".format(*load_average())
+              + f" on {os.cpu_count()} cores")  # fmt: skip
     finally:
         shutil.rmtree(work, ignore_errors=True)
 

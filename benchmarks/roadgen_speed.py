@@ -57,7 +57,8 @@ def main(argv: list[str] | None = None) -> None:
 
 def load() -> str:
     """The load average with the cores, printed with the timings (the machine is shared)."""
-    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
+    averages = "{:.2f} {:.2f} {:.2f}".format(*load_average())
+    return f"load average {averages} on {os.cpu_count()} cores"
 
 
 if __name__ == "__main__":

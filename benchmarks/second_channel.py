@@ -44,6 +44,7 @@ from __future__ import annotations
 import argparse
 import time
 from concurrent.futures import ProcessPoolExecutor
+from typing import Any
 
 import numpy as np
 from _host import load_average
@@ -231,7 +232,7 @@ def main() -> None:
             for name, keys in channels.items()
         ]
         lines.append(("enveloped road, sensor's band (ideal road sensor)", ["road"]))
-        base = {}
+        base: dict[str, Any] = {}
         for label, keys in lines:
             folds = []
             for parity in (0, 1):

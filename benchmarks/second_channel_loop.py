@@ -223,6 +223,7 @@ def drive(job: tuple) -> dict:
     emu, likelihood = _MODELS[path]
     bcr = loop_settings()
     simplex = control.Simplex()
+    segments: tuple[tuple[float, float], ...]
     if kind == "steady":
         gd, speed = extra
         segments = ((100.0, gd),)
@@ -261,7 +262,7 @@ def emulator_path(folder: Path, channels: str, case: str, pcs: int | None) -> Pa
 
 
 def jobs_for(name: str, channels: str, cases, emulator_dir: str, random_tracks: int, pcs) -> list:
-    out = []
+    out: list[tuple] = []
     for case in cases:
         if name == "dev":
             out += [(channels, case, "paper", s, None) for s in cla.SETS["dev"]]

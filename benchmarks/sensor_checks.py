@@ -218,6 +218,7 @@ def main() -> None:
                 design, seed=args.seed, keep_s=args.keep_s, noise_std=noise, executor=pool,
                 progress=False,
             )  # fmt: skip
+        assert camp.accel_measured is not None, "keep_s > 0 keeps the accelerations"
         acc = camp.accel_measured[camp.ok]
         per_drive = acc.shape[1] // BLOCK
         blocks = acc[:, : per_drive * BLOCK].reshape(-1, BLOCK)
@@ -245,12 +246,12 @@ def main() -> None:
             fewer = f" ({tried:,} blocks each)" if tried < PICKS else ""
             print(f"   rounded to {step:g} m/s^2 steps for " + ", ".join(found) + fewer)
         anchored = limits.noise_sd_mps2 is None  # (as `signal_fault` exempts flights)
-        worst = [
+        ratios = [
             f"{n} samples {max(short_level_drop(b, n, anchored=anchored)[0] for b in blocks):.4g} "
             f"(limit {most:g})"
             for n, most in SHORT_LEVEL_STRETCHES
         ]
-        print("   short level check, largest ratio: " + ", ".join(worst))
+        print("   short level check, largest ratio: " + ", ".join(ratios))
         for length in GAIN_LENGTHS:
             found = []
             for gain in GAINS:

@@ -224,8 +224,8 @@ def loop_part(case: str, runs: int, first_seed: int, workers: int) -> None:
                 continue
             cells = []
             for side in (0, 1):
-                runs = [np.array(run[side]).reshape(-1, 3) for run in results]
-                picked = [r[(r[:, 0] >= lo) & (r[:, 0] < hi) & (r[:, 1] == up), 2] for r in runs]
+                rows = [np.array(run[side]).reshape(-1, 3) for run in results]
+                picked = [r[(r[:, 0] >= lo) & (r[:, 0] < hi) & (r[:, 1] == up), 2] for r in rows]
                 cells.append(f"{_clustered(picked):>16s} n {sum(x.size for x in picked):5d}")
             way = "" if lo == 1.0 else ("up" if up else "down")
             print(f"  [{lo:.3f}, {hi:.3f}) {way:4s}  {cells[0]:>26s}  {cells[1]:>26s}")

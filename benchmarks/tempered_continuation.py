@@ -58,11 +58,13 @@ def two_mode_case() -> tuple[gpmsa.SimData, gpmsa.ObsData]:
 
 def load() -> str:
     """The load average with the cores, printed with the timings (the machine is shared)."""
-    return "load average {:.2f} {:.2f} {:.2f} on {} cores".format(*load_average(), os.cpu_count())
+    averages = "{:.2f} {:.2f} {:.2f}".format(*load_average())
+    return f"load average {averages} on {os.cpu_count()} cores"
 
 
 def upper(emu: gpmsa.Emulator, n_chains: int) -> np.ndarray:
     """(chains, kept draws) booleans: the draw lies in the upper mode (t > 0.5)."""
+    assert emu.calibration is not None, "a joint fit's emulator has calibration draws"
     return emu.calibration["theta_native"][:, 0].reshape(n_chains, -1) > 0.5
 
 

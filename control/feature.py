@@ -21,7 +21,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass
 from functools import lru_cache
-from typing import overload
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 
@@ -72,6 +72,9 @@ class FeatureSpec:
             as the band powers are. None (default): `BAND_QUANTILES` for ``log_band_power``,
             none for the window features; ``()``: the band vector alone (the feature of
             emulator files written before this field existed).
+
+    ``bands_hz`` and ``quantiles`` are taken as any sequence of numbers (a list, an array) and
+    stored as tuples of floats, ``quantiles`` always one (None given: its default).
     """
 
     name: str = "log_band_power"
@@ -80,7 +83,20 @@ class FeatureSpec:
     bands_hz: tuple[float, ...] = BAND_EDGES_HZ
     taper_nw: float = 2.0
     n_tapers: int = 3
-    quantiles: tuple[float, ...] | None = None
+    quantiles: tuple[float, ...] = None  # type: ignore[assignment]  # None: made the default
+
+    if TYPE_CHECKING:  # what the constructor takes (the fields above: what it stores)
+
+        def __init__(
+            self,
+            name: str = "log_band_power",
+            block_samples: int = 125,
+            rate_hz: float = 120.0,
+            bands_hz: Sequence[float] | np.ndarray = BAND_EDGES_HZ,
+            taper_nw: float = 2.0,
+            n_tapers: int = 3,
+            quantiles: Sequence[float] | np.ndarray | None = None,
+        ) -> None: ...
 
     def __post_init__(self) -> None:
         if not is_choice(self.name, FEATURES):

@@ -29,6 +29,7 @@ import argparse
 import json
 import math
 import time
+from typing import Any
 
 import matplotlib
 
@@ -208,7 +209,7 @@ def main(argv: list[str] | None = None) -> dict:
     for name, fig in figs.items():
         _label_heights(fig)
         save_figure(fig, out / f"{name}.png")
-    summary = {
+    summary: dict[str, Any] = {
         "posterior": post.summary(0.9),
         "world": WORLD,
         "emulator": {"p_u": emu.p_u, "held_out_rmse_s": float(np.sqrt(np.mean(

@@ -441,15 +441,15 @@ def main(argv: list[str] | None = None) -> dict:
     if latched:
         print("\nruns latched in safety mode by a fault (v_safe for the rest of the run):")
         print("\n".join(f"  {line}" for line in latched))
-    named = [
+    edges = [
         f"{case} seed {k}: " + ", ".join(f"{n} {e}" for e, n in r["domain_edge"].items() if n)
         for case in args.cases
         for k, r in zip(seeds, metrics["ours"][case]["runs"], strict=True)
         if any(r["domain_edge"].values())
     ]
-    if named:
+    if edges:
         print("\nestimates naming an edge of the emulator's GD domain (the road may lie beyond):")
-        print("\n".join(f"  {line}" for line in named))
+        print("\n".join(f"  {line}" for line in edges))
     print(f"\nwrote {out / 'metrics.json'} and the figures gd_trace_*.png, speed_*.png")
     if args.record:
         print(f"wrote one MCAP per run in {args.record} (open in Foxglove with "

@@ -178,7 +178,7 @@ def main(argv: list[str] | None = None) -> dict:
         "shared (joint fit)": {"E": joint.posterior.samples["E"],
                                "rho": joint.posterior.samples["rho[modal]"]},
     }  # fmt: skip
-    summary = {"truth": TRUTH, "posterior": {}}
+    summary: dict[str, dict] = {"truth": TRUTH, "posterior": {}}
     lines = [f"{'':26s} {'E [GPa] mean  90% interval':32s} {'rho [kg/m^3] mean  90% interval'}"]
     for label, draws in rows.items():
         cells, rec = [], {}
@@ -219,8 +219,10 @@ def main(argv: list[str] | None = None) -> dict:
     save_figure(fig, out / "pairs_E_rho.png")
     fig = Figure(figsize=(8, 3))
     ax = fig.subplots()
+    chains = back.posterior.chains
+    assert chains is not None, "a study's posterior has its MCMC chains"
     for name in ("E", "rho[modal]"):
-        ch = back.posterior.chains[name][0]
+        ch = chains[name][0]
         # a short chain may not move at all (sd 0): drawn flat at 0, not as NaN
         ax.plot((ch - ch.mean()) / (ch.std() or 1.0), lw=0.5, label=name)
     ax.set_xlabel("sweep (after burn-in)")

@@ -52,6 +52,7 @@ import argparse
 import dataclasses
 import json
 import time
+from typing import Any
 
 import matplotlib
 
@@ -190,7 +191,7 @@ def vehicle_model(overrides: list[str]) -> vehicle.Jackal:
     refuses (`vehicle.VehicleError`: out of its range).
     """
     fields = {f.name for f in dataclasses.fields(vehicle.Jackal)}
-    kw: dict[str, object] = {}
+    kw: dict[str, Any] = {}
     for item in overrides:
         name, sep, value = item.partition("=")
         if not sep or name not in fields:

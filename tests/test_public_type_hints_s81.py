@@ -5,7 +5,8 @@ Without a type checker at test time: every public callable's hints resolve at ru
 name the module never binds is a NameError there), and the hints that correct user code needs
 say what the functions take and give: a constructor that takes lists, where the docs pass lists
 (``SimData(x_names=["v"])``, ``ObsData(x=[[0.3]], precision=[1e4])``,
-``Priors(theta_mean=[0.3, 0.5])``); a number for a number and an array for an array
+``Priors(theta_mean=[0.3, 0.5])``, ``FeatureSpec(quantiles=[0.9])``, whose stored fields read
+as the tuples they always are); a number for a number and an array for an array
 (``Posterior.quantile``, ``Track.gd_at``); a numpy integer as a seed.
 """
 
@@ -114,7 +115,16 @@ def _typed_init(cls) -> ast.FunctionDef:
     raise AssertionError(f"{cls.__name__} declares no typed __init__ for type checkers")
 
 
-@pytest.mark.parametrize("cls", [gpmsa.SimData, gpmsa.ObsData, gpmsa.Priors])
+def _default(cls, node: ast.expr) -> object:
+    """The value of a default written in the typed ``__init__``: a literal, or a module constant."""
+    if isinstance(node, ast.Constant):
+        return node.value
+    if isinstance(node, ast.Name):
+        return getattr(sys.modules[cls.__module__], node.id)
+    return ast.literal_eval(node)
+
+
+@pytest.mark.parametrize("cls", [gpmsa.SimData, gpmsa.ObsData, gpmsa.Priors, control.FeatureSpec])
 def test_the_typed_constructor_matches_the_dataclass(cls) -> None:
     """Its parameters are the dataclass's init fields, in order, with the same defaults (a
     default factory's: ``...``), so that it cannot drift from what the class takes."""
@@ -125,9 +135,7 @@ def test_the_typed_constructor_matches_the_dataclass(cls) -> None:
     assert not init.args.kwonlyargs and init.args.vararg is None and init.args.kwarg is None
     assert len(init.args.defaults) == len(params)
     for f, default in zip(fields, init.args.defaults, strict=True):
-        value = (
-            ast.literal_eval(default) if not isinstance(default, ast.Constant) else default.value
-        )
+        value = _default(cls, default)
         if f.default is dataclasses.MISSING:
             assert value is Ellipsis, f.name
         else:
@@ -159,6 +167,21 @@ def test_simdata_and_obsdata_take_array_likes_and_lists_of_names() -> None:
     obs_data = gpmsa.ObsData(x=[[0.3], [0.7]], y=[[1.0], [2.0]], precision=[1e4, 2.5e3])
     assert isinstance(obs_data.x, np.ndarray) and len(obs_data.precisions) == 2
     assert gpmsa.Priors(theta_mean=[0.3, 0.5]).theta_mean == (0.3, 0.5)
+
+
+def test_a_feature_spec_takes_sequences_and_stores_tuples() -> None:
+    """``FeatureSpec(bands_hz=[...], quantiles=[...])`` type-checks (the constructor takes any
+    sequence, or None for the default levels), and ``spec.quantiles`` reads as the tuple it
+    always is once made (``len(spec.quantiles)`` type-checks: never None)."""
+    init = _annotations(control.FeatureSpec)
+    assert init["bands_hz"] == "Sequence[float] | np.ndarray"
+    assert init["quantiles"] == "Sequence[float] | np.ndarray | None"
+    stored = typing.get_type_hints(control.FeatureSpec)
+    assert stored["bands_hz"] == stored["quantiles"] == tuple[float, ...]
+    for name in ("log_band_power", "log_var"):  # None given: the default levels, or none
+        assert type(control.FeatureSpec(name=name).quantiles) is tuple
+    spec = control.FeatureSpec(bands_hz=np.array([1.5, 4.5, 7.0]), quantiles=[0.9])
+    assert spec.bands_hz == (1.5, 4.5, 7.0) and spec.quantiles == (0.9,)
 
 
 # -- a number for a number, an array for an array ---------------------------------------------
