@@ -441,9 +441,15 @@ def _host_id() -> str:
 
 _SWEPT: set[str] = set()
 """The folders (absolute) this process has swept of stale temporaries; a forked child (a
-campaign's worker) starts with none, so that it sweeps again at its first save."""
+campaign's worker) starts with none, so that it sweeps again at its first save. At most
+`_SWEPT_FOLDERS` of them."""
 if hasattr(os, "register_at_fork"):  # POSIX
     os.register_at_fork(after_in_child=_SWEPT.clear)
+
+_SWEPT_FOLDERS = 1024
+"""The folders `_SWEPT` holds at most (as gpmsa.io.atomic's): a process that saves campaigns
+into ever new folders would otherwise keep a name for each for good. Past it the record starts
+afresh, and a folder saved into again is swept once more."""
 
 
 def _remove_stale_temporaries(folder: Path) -> None:
@@ -455,6 +461,8 @@ def _remove_stale_temporaries(folder: Path) -> None:
     key = os.path.abspath(folder)
     if sys.platform == "win32" or key in _SWEPT:
         return
+    if len(_SWEPT) >= _SWEPT_FOLDERS:
+        _SWEPT.clear()
     _SWEPT.add(key)
     host = _host_id()
     try:

@@ -251,17 +251,27 @@ def remove_stale_temporaries(folder: str | os.PathLike) -> list[Path]:
 _SWEPT: set[str] = set()
 """The folders (absolute) this process has swept of stale temporaries (`_sweep_once`); a forked
 child starts with none (a worker forked after its parent's sweep sweeps again: a temporary left
-by another worker killed since is removed by the next one's first save)."""
+by another worker killed since is removed by the next one's first save). At most
+`_SWEPT_FOLDERS` of them."""
 if hasattr(os, "register_at_fork"):  # POSIX
     os.register_at_fork(after_in_child=_SWEPT.clear)
+
+_SWEPT_FOLDERS = 1024
+"""The folders `_SWEPT` holds at most: a process that saves into ever new folders (a service's
+folder per job) would otherwise keep a name for each for good (~90 B a save). Past it the
+record starts afresh (one step, safe beside another thread's save), and a folder saved into
+again is swept once more: one more listing of it per ``_SWEPT_FOLDERS`` new folders."""
 
 
 def _sweep_once(folder: Path) -> None:
     """`remove_stale_temporaries` of ``folder`` at this process's first save there: one listing a
     folder and process, not one a save (a campaign cache of 10,000 files took 5.5 ms a save to
-    list), and a killed save's temporary is removed whatever target the next save has."""
+    list), and a killed save's temporary is removed whatever target the next save has (again
+    once `_SWEPT` has started afresh, `_SWEPT_FOLDERS`)."""
     key = os.path.abspath(folder)
     if key not in _SWEPT:
+        if len(_SWEPT) >= _SWEPT_FOLDERS:
+            _SWEPT.clear()
         _SWEPT.add(key)
         remove_stale_temporaries(folder)
 
