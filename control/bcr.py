@@ -392,7 +392,7 @@ def _samples(name: str, values) -> np.ndarray:
     check_not_masked(values, name)
     try:
         a = np.atleast_1d(np.asarray(tensor_values(values)))
-    except ValueError as exc:  # a ragged list
+    except (TypeError, ValueError) as exc:  # a ragged list; a tensor on a GPU (torch says how)
         raise ControlError(f"{name} must be a 1-D sequence of numbers: {exc}") from None
     if a.ndim != 1:
         raise ControlError(f"{name} must be 1-D, got shape {a.shape}")

@@ -124,12 +124,30 @@ def as_float(value, name: str, *, advice: bool = True) -> np.ndarray:
     except OverflowError as exc:  # a Python int beyond float64's range
         raise GPMSAError(f"{name} holds a number too large for float64: {exc}") from exc
     except (TypeError, ValueError) as exc:
-        raise GPMSAError(f"{name} must be a numeric array, got {_kind_of(value)}") from exc
+        raise GPMSAError(
+            f"{name} must be a numeric array, got {_kind_of(value)}{_device_hint(value)}"
+        ) from exc
     except RuntimeError as exc:  # e.g. a list of torch tensors that record gradients
         raise GPMSAError(f"{name} cannot be converted to numbers: {exc}") from exc
     if arr is None:
         raise GPMSAError(f"{name} must hold real numbers, got complex values")
     return arr
+
+
+def _device_hint(value) -> str:
+    """For a torch tensor (or a list or tuple whose first entry is one) on another device than
+    the CPU, which numpy cannot read: where it is and how to bring it; "" otherwise."""
+    first = value
+    for _ in range(MAX_NESTING):
+        if not isinstance(first, (list, tuple)) or not first:
+            break
+        first = first[0]
+    device = getattr(first, "device", None)
+    kind = getattr(device, "type", None)
+    if not isinstance(getattr(first, "requires_grad", None), bool) or kind in (None, "cpu"):
+        return ""
+    return (f" (a torch tensor on device {str(device)!r}: numpy reads tensors on the CPU only; "
+            "pass tensor.cpu(), or tensor.detach().cpu() where it records gradients)")  # fmt: skip
 
 
 _GROUPED = re.compile(r"[+-]?[\d.,'\s\u00a0\u202f]*\d[\d.,'\s\u00a0\u202f]*")
