@@ -3,6 +3,8 @@ what computed a result (recorded with a fitted emulator, shown by ``gpmsa info``
 
 from __future__ import annotations
 
+import functools
+
 __version__ = "0.1.0"
 
 _BACKEND_PACKAGES = {"torch": ("torch", "gpytorch"), "pyro": ("torch", "pyro-ppl")}
@@ -11,7 +13,7 @@ MAX_VERSION_CHARS = 200
 """A plug-in's record is cut to this many characters (its ``__version__`` is anything it says)."""
 
 
-def library_versions(backend: str | None = None, plugin=None) -> dict[str, str]:
+def library_versions(backend: str | None = None, plugin: object = None) -> dict[str, str]:
     """Versions of Python, gpmsa, numpy, scipy and the BLAS in use (name, version, CPU kernel,
     threads), plus the backend's packages, or for a plug-in backend (``plugin``: its module,
     ``gpmsa.backends.get(backend)``) its module's name and version (`plugin_version`): the
@@ -83,8 +85,22 @@ def _distribution_version(module_name: str | None) -> str:
     from importlib import metadata
 
     top = (module_name or "").split(".")[0]
-    dists = metadata.packages_distributions().get(top) if top else None
+    if not top:
+        return "unknown"
+    dists = _distributions().get(top)
+    if not dists:  # installed since the map was built? (a pip install in a notebook)
+        _distributions.cache_clear()
+        dists = _distributions().get(top)
     if not dists:
         return "unknown"
     version = metadata.version(dists[0])
     return version if dists[0] == top else f"{version} ({dists[0]})"
+
+
+@functools.cache
+def _distributions() -> dict:
+    """importlib.metadata's top-level package -> distributions map (~0.1-0.3 s to build: kept;
+    `_distribution_version` builds it again for a package it does not hold)."""
+    from importlib import metadata
+
+    return metadata.packages_distributions()

@@ -449,7 +449,7 @@ if hasattr(os, "register_at_fork"):  # POSIX
 _SWEPT_FOLDERS = 1024
 """The folders `_SWEPT` holds at most (as gpmsa.io.atomic's): a process that saves campaigns
 into ever new folders would otherwise keep a name for each for good. Past it the record starts
-afresh, and a folder saved into again is swept once more."""
+afresh, and a folder saved into again is swept once more (each time it starts afresh)."""
 
 
 def _remove_stale_temporaries(folder: Path) -> None:

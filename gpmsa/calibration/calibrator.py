@@ -333,8 +333,9 @@ class Calibrator:
             is numpy's; another backend makes "auto" choose MCMC. None (the default):
             ``mcmc_options["backend"]`` where it names one, else "numpy"; a GPMSAError where
             both are given and differ (an explicit "numpy" too), and, here, where a plug-in's
-            module does not declare an extension the emulator or options already give
-            (`_extensions`; ``gpmsa.backends.check_extensions``).
+            module does not declare an extension that the emulator (categorical inputs, a mean
+            basis), ``constraint`` or ``mcmc_options["fixed"]`` already give
+            (``gpmsa.backends.check_extensions``).
         constraint: optional callable of native theta (q,) -> bool, False where theta is not
             allowed: zero prior mass there. On the grid, for one parameter the density is cut at
             the boundary (located by bisection between nodes, to float precision), so that no

@@ -260,7 +260,9 @@ _SWEPT_FOLDERS = 1024
 """The folders `_SWEPT` holds at most: a process that saves into ever new folders (a service's
 folder per job) would otherwise keep a name for each for good (~90 B a save). Past it the
 record starts afresh (one step, safe beside another thread's save), and a folder saved into
-again is swept once more: one more listing of it per ``_SWEPT_FOLDERS`` new folders."""
+again is swept once more: one more listing of it each time the record starts afresh (a process
+that cycles over more than ``_SWEPT_FOLDERS`` folders lists about every folder it saves into,
+as before the record was kept)."""
 
 
 def _sweep_once(folder: Path) -> None:

@@ -147,7 +147,8 @@ def _device_hint(value) -> str:
     if not isinstance(getattr(first, "requires_grad", None), bool) or kind in (None, "cpu"):
         return ""
     return (f" (a torch tensor on device {str(device)!r}: numpy reads tensors on the CPU only; "
-            "pass tensor.cpu(), or tensor.detach().cpu() where it records gradients)")  # fmt: skip
+            "bring its values there, e.g. a GPU's by tensor.cpu(), or tensor.detach().cpu() "
+            "where it records gradients)")  # fmt: skip
 
 
 _GROUPED = re.compile(r"[+-]?[\d.,'\s\u00a0\u202f]*\d[\d.,'\s\u00a0\u202f]*")

@@ -65,7 +65,7 @@ def check_points(points: np.ndarray, name: str) -> None:
             f"{name} holds the point {_point_text(points[k])} twice (rows {j} and {k}): every "
             "simulation output point must be distinct"
         )
-    _triangulation(points, name)
+    _triangulation(points, name, complete=False)
 
 
 def within(values: np.ndarray, lo: float, hi: float) -> bool:
@@ -75,7 +75,12 @@ def within(values: np.ndarray, lo: float, hi: float) -> bool:
     return bool(values.min() >= lo - slack and values.max() <= hi + slack)
 
 
-def _triangulation(points: np.ndarray, name: str) -> Triangulation:
+def _triangulation(points: np.ndarray, name: str, complete: bool = True) -> Triangulation:
+    """The triangulation of the simulation index ``points`` (l, d) (`_delaunay`); GPMSAError
+    where they span no simplex and, with ``complete``, where Qhull leaves some of them out
+    (within rounding of others: interpolation between points would not see their values;
+    without it, as `check_points` asks, such an index is taken: values on its points need no
+    triangles)."""
     l, d = points.shape
     if d > 2 and l ** math.ceil(d / 2) > limits.MAX_INDEX_SIMPLICES:
         raise ResourceLimitError(
@@ -96,37 +101,45 @@ def _triangulation(points: np.ndarray, name: str) -> Triangulation:
             f"(fewer than {d + 1} points, or all on a line or plane): the basis is interpolated "
             "on their triangulation"
         ) from None
-    lost = found.tri.coplanar.shape[0]
-    if lost:
+    lost = found.tri.coplanar
+    if complete and lost.shape[0]:
+        row, near = int(lost[0, 0]), int(lost[0, 2])
         spans = numbers_text(*np.ptp(points, axis=0), digits=3)
         raise GPMSAError(
-            f"{name}: {lost} of its {l} points fall out of their triangulation in float64 "
-            f"(within rounding of others: the index columns span {', '.join(spans)}, and spans "
-            "that differ by a factor of about 1e6 or more put a narrow column's points that "
-            "close; so do points nearly repeated); rescale the index columns to comparable "
-            "spans, or merge the nearly repeated points"
+            f"{name}: {lost.shape[0]} of its {l} points fall out of their triangulation in "
+            f"float64, the first {_point_text(points[row])} (row {row}) within rounding of "
+            f"{_point_text(points[near])} (row {near}), so values between points cannot be "
+            f"interpolated there (the index columns span {', '.join(spans)}: a column about "
+            "1e6 times narrower than another, or points nearly repeated, do that); rescale "
+            "the index columns to comparable spans, or merge the nearly repeated points"
         )
     return found
 
 
 def triangles(points: np.ndarray, name: str) -> np.ndarray:
     """The triangles (k, d + 1) of row indices on which the index ``points`` (l, d) are
-    interpolated (the figures draw maps on them); GPMSAError where they span no triangle."""
-    return _triangulation(points, name).tri.simplices
+    interpolated (the figures draw maps on them; a copy); GPMSAError where they span no
+    triangle or leave points out."""
+    return _triangulation(points, name).tri.simplices.copy()
 
 
 class Triangulation(NamedTuple):
     """The Delaunay triangulation ``tri`` of the simulation's index points, made in their own
-    units or, where float64 cannot hold it there, in the ``frame`` (origin (d,), width) that
-    maps them onto [0, 1] by one width (a shift and a scale: the same triangles): points
-    located in it are first mapped by `local`."""
+    units or, where float64 cannot hold it there, in the ``frame`` (scale, origin (d,), width)
+    that maps them onto [0, 1] by one width (`local`: divided by a power of two, exactly,
+    shifted and divided by the width): points located in it are first mapped by `local`.
+    Where the points are in general position the triangles are the same in both; a regular
+    grid's cells (four points on a circle) may be split either way."""
 
     tri: Delaunay
-    frame: tuple[np.ndarray, float] | None
+    frame: tuple[float, np.ndarray, float] | None
 
     def local(self, q: np.ndarray) -> np.ndarray:
         """Points ``q`` (n, d) in the triangulation's coordinates."""
-        return q if self.frame is None else (q - self.frame[0]) / self.frame[1]
+        if self.frame is None:
+            return q
+        scale, origin, width = self.frame
+        return (q / scale - origin) / width
 
 
 @functools.lru_cache(maxsize=4)
@@ -134,10 +147,9 @@ def _delaunay(shape: tuple[int, int], data: bytes) -> Triangulation:
     """The triangulation of the points (``shape``, float64 bytes), kept for the next call: a fit
     or a prediction interpolates the basis, the mean and the sd on the same points. Made in the
     points' own units; where Qhull fails there or leaves points out (``coplanar``: an offset
-    far beyond the points' span, e.g. 1e7 + [0, 1], or a span near float64's ends), again on
-    the points shifted to the origin and divided by their widest column's span (Delaunay's
-    triangles do not change under a shift and one scale; a column far narrower than another
-    still leaves points out: `_triangulation` refuses it)."""
+    far beyond the points' span, e.g. 1e7 + [0, 1], or a span near float64's ends), again in
+    `Triangulation`'s frame (a column far narrower than another still leaves points out:
+    `_triangulation` refuses it). QhullError where they span no simplex in either."""
     points = np.frombuffer(data).reshape(shape)
     try:
         tri = Delaunay(points)
@@ -145,10 +157,14 @@ def _delaunay(shape: tuple[int, int], data: bytes) -> Triangulation:
             return Triangulation(tri, None)
     except QhullError:
         pass
-    origin = points.min(axis=0)
-    width = float(np.max(points.max(axis=0) - origin))
+    scale = math.ldexp(1.0, math.frexp(float(np.max(np.abs(points))))[1] - 1)  # |unit| < 2
+    unit = points / scale
+    origin = unit.min(axis=0)
+    width = float(np.max(unit.max(axis=0) - origin))
+    if not width > 0.0:  # one point repeated
+        raise QhullError("the points coincide")
     origin.flags.writeable = False
-    return Triangulation(Delaunay((points - origin) / width), (origin, width))
+    return Triangulation(Delaunay((unit - origin) / width), (scale, origin, width))
 
 
 def check_columns(points: np.ndarray, new: np.ndarray, what: str) -> None:

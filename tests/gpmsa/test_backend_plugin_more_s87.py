@@ -161,14 +161,19 @@ def test_a_fit_on_a_plugin_records_its_version_in_the_file(plugin, tmp_path, cap
     assert "backend mine mybackend_s87 2.5.1" in capsys.readouterr().out
 
 
-def test_a_plugins_version_falls_back_to_its_distribution_then_unknown(monkeypatch):
+def test_a_plugins_version_falls_back_to_its_distribution_then_unknown(monkeypatch, request):
     from importlib import metadata
+
+    from gpmsa._version import _distributions
+
+    request.addfinalizer(_distributions.cache_clear)  # (the map is kept a process)
 
     np_module = types.ModuleType("numpy.fake_backend_s87")  # numpy's distribution provides it
     assert library_versions("dist", np_module)["backend dist"] == (
         f"numpy.fake_backend_s87 {metadata.version('numpy')}")  # fmt: skip
     monkeypatch.setattr(metadata, "packages_distributions", lambda: {"numpy": ["numpy-x"]})
     monkeypatch.setattr(metadata, "version", lambda dist: {"numpy-x": "9.1"}[dist])
+    _distributions.cache_clear()
     assert library_versions("dist", np_module)["backend dist"] == (
         "numpy.fake_backend_s87 9.1 (numpy-x)")  # fmt: skip
     bare = types.SimpleNamespace(sample=_toy().sample)  # no name, no version

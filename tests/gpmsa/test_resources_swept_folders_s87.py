@@ -7,7 +7,6 @@ saves, 2,003 names held), never flattening. It now holds `_SWEPT_FOLDERS` names 
 starts afresh past that; a folder forgotten so is swept again at its next save.
 """
 
-import gc
 import subprocess
 import sys
 
@@ -35,7 +34,6 @@ def test_saves_into_many_new_folders_keep_a_bounded_record(tmp_path, monkeypatch
         folder.mkdir()
         _save(folder / "e.gpmsa")
         sizes.append(len(atomic._SWEPT))
-    gc.collect()
     assert max(sizes) <= 16  # before: 200 names, one a folder
     assert all((tmp_path / f"job-{k}" / "e.gpmsa").read_text() == "whole" for k in range(200))
 

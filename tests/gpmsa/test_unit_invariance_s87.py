@@ -54,8 +54,10 @@ def test_index_columns_of_very_different_spans_are_refused_not_interpolated_wron
     points = np.column_stack([a.ravel(), b.ravel()])  # Qhull left 12 of 20 out: say so
     with pytest.raises(gpmsa.GPMSAError, match="fall out of their triangulation.*comparable"):
         index_points.weights(points, NEW * [1.0, 1e8], "o")
-    with pytest.raises(gpmsa.GPMSAError, match="fall out of their triangulation"):
-        gpmsa.SimData(t=np.arange(3.0), y=np.ones((3, 20)) * [[0], [1], [3]], index=points)
+    # taken where no value between points is asked for: the runs, and observations on them
+    gpmsa.SimData(t=np.arange(3.0), y=np.ones((3, 20)) * [[0], [1], [3]], index=points)
+    on = index_points.weights(points, points[[3, 7]], "o").toarray()
+    assert np.array_equal(on, np.eye(20)[[3, 7]])
 
 
 def _two_column_case(shift: float, scale: float):
@@ -137,3 +139,27 @@ def test_a_linear_discrepancy_on_the_unit_index_does_not_depend_on_its_units():
     for scale, shift in ((1e3, 273.15), (1e-6, 0.0)):
         got = _linear_unit_discrepancy(scale, shift)
         assert np.abs(got - ref).max() <= 1e-9
+
+
+def test_an_index_spanning_float64s_range_is_refused_by_gpmsa_not_numpy():
+    """The rescaled frame divides by a power of two before shifting: a span of 2e308 (which
+    overflows as a difference) gave scipy's "Points cannot contain NaN"."""
+    points = np.array([[1e308, 0.0], [-1e308, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    with pytest.raises(gpmsa.GPMSAError, match="does not span 2 dimensions"):
+        gpmsa.SimData(t=np.arange(4.0), y=np.arange(16.0).reshape(4, 4) ** 2, index=points)
+    wide = np.array([[1e308, 0.0], [-1e308, 0.0], [0.0, 1e308], [0.0, -1e308]])
+    assert index_points.triangles(wide, "index").shape == (2, 3)
+
+
+def test_nearly_repeated_points_are_taken_until_a_value_between_them_is_asked_for():
+    """Observations on the simulation points (SEPIA's y_ind_obs = y_ind_sim) need no
+    triangles; interpolating between points names the points Qhull left out."""
+    grid = np.column_stack([np.repeat(np.linspace(0, 1, 4), 5), np.tile(np.linspace(0, 1, 5), 4)])
+    points = np.vstack([grid, [[0.1 + 0.2, 0.5], [0.3, 0.5]]])
+    gpmsa.SimData(t=np.arange(3.0), y=np.ones((3, 22)) * [[0], [1], [3]], index=points)
+    on = index_points.weights(points, points[[20, 21]], "o").toarray()
+    assert np.array_equal(on, np.eye(22)[[20, 21]])
+    with pytest.raises(
+        gpmsa.GPMSAError, match=r"\(row 2[01]\) within rounding of .* \(row 2[01]\)"
+    ):
+        index_points.weights(points, np.array([[0.5, 0.55]]), "o")
