@@ -143,8 +143,11 @@ def theta_unit(value, std, names, levels=None):
         if keep is not None and k not in keep:
             continue
         if lv is not None and not np.any(np.isclose(lv, unit[k], rtol=0, atol=1e-12)):
+            lo, span = float(std.t_min[k]), float(std.t_max[k] - std.t_min[k])
+            got, *codes = numbers_text(lo + span * unit[k], *(lo + span * np.asarray(lv)))
             raise GPMSAError("fixed theta: categorical calibration parameter "
-                             f"{names[k]} must be one of its training levels")  # fmt: skip
+                             f"{names[k]} must be one of its training levels "
+                             f"[{', '.join(codes)}], got {got}")  # fmt: skip
     unit = categorical.snap_to_levels(unit, levels or ())  # a categorical one: its level
     return unit if keep is None else {k: float(unit[k]) for k in keep}
 
