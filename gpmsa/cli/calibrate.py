@@ -130,7 +130,8 @@ def _given(items: list[str], names: tuple[str, ...], what: str) -> dict[str, flo
     """NAME -> value from NAME=VALUE strings (split at the last "=": a name may hold "=", a
     number never does). A NAME that is not one of ``names`` is read without its surrounding
     spaces (``" v=1"`` gives v); one that is, whole (a name may end in a space). GPMSAError for
-    an item without "=", a name given twice or a value that is not a number."""
+    an item without "=", a name given twice or a value that is not a finite number (named here,
+    as a --y-csv file's: the library would name x_obs or y_obs)."""
     given = {}
     for item in items:
         name, sep, value = item.rpartition("=")
@@ -145,6 +146,9 @@ def _given(items: list[str], names: tuple[str, ...], what: str) -> dict[str, flo
             given[key] = float(value)
         except ValueError as exc:
             raise GPMSAError(f"--{what} {name}: {value!r} is not a number") from exc
+        if not np.isfinite(given[key]):
+            beyond = " (beyond float64's range)" if "inf" not in value.lower() else ""
+            raise GPMSAError(f"--{what} {key}: {value.strip()} is not a finite number{beyond}")
     return given
 
 
@@ -160,6 +164,9 @@ def _pairs(items: list[str], names: tuple[str, ...], what: str) -> np.ndarray:
         given[name] = value
     unknown = sorted(set(given) - set(names))
     missing = [n for n in names if n not in given]
+    if unknown and not names:  # x of a file with p = 0
+        raise GPMSAError(f"--{what} {', '.join(unknown)}: the file has no known inputs "
+                         f"({what}); leave --{what} out")  # fmt: skip
     if unknown or missing:
         raise GPMSAError(
             f"--{what} needs exactly the names {list(names)}; unknown {unknown}, missing {missing}"
@@ -462,8 +469,6 @@ def _fixed(items: list[str], emu) -> dict[str, float]:
         if name not in allowed:
             raise GPMSAError(f"--fixed {name}: not a calibration parameter of the file; give "
                              f"one of {list(allowed)}")  # fmt: skip
-        if not np.isfinite(value):
-            raise GPMSAError(f"--fixed {name}: {value} is not a finite number")
         _check_held(emu, t_names, name, value)
     return given
 
