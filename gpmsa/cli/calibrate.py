@@ -147,7 +147,8 @@ def _given(items: list[str], names: tuple[str, ...], what: str) -> dict[str, flo
         except ValueError as exc:
             raise GPMSAError(f"--{what} {name}: {value!r} is not a number") from exc
         if not np.isfinite(given[key]):
-            beyond = " (beyond float64's range)" if "inf" not in value.lower() else ""
+            overflow = np.isinf(given[key]) and "inf" not in value.lower()  # e.g. 1e400
+            beyond = " (beyond float64's range)" if overflow else ""
             raise GPMSAError(f"--{what} {key}: {value.strip()} is not a finite number{beyond}")
     return given
 

@@ -44,6 +44,7 @@ def test_a_value_that_is_no_finite_number_names_the_option(files, capsys, given,
     out, err = capsys.readouterr()
     assert code == 2 and out == ""
     assert message in err and "x_obs" not in err and "y_obs" not in err
+    assert ("beyond float64" in err) == ("1e400" in message)  # only an overflow says so
 
 
 def test_x_for_a_file_without_known_inputs_says_so(files, capsys):

@@ -6,7 +6,6 @@ good: saving a campaign into a new folder per job grew it by ~90 B a save (2,000
 names held). It now holds `_SWEPT_FOLDERS` names at most and starts afresh past that.
 """
 
-
 import numpy as np
 
 from vehicle import campaign
