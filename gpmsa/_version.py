@@ -88,19 +88,24 @@ def _distribution_version(module_name: str | None) -> str:
     if not top:
         return "unknown"
     dists = _distributions().get(top)
-    if not dists:  # installed since the map was built? (a pip install in a notebook)
+    if not dists and top not in _NO_DISTRIBUTION:  # installed since the map was built?
         _distributions.cache_clear()
         dists = _distributions().get(top)
-    if not dists:
+    if not dists:  # a module of no installed package (a local file): looked up once
+        _NO_DISTRIBUTION.add(top)
         return "unknown"
     version = metadata.version(dists[0])
     return version if dists[0] == top else f"{version} ({dists[0]})"
 
 
+_NO_DISTRIBUTION: set[str] = set()
+"""Top-level module names no installed distribution provided when the map was last built."""
+
+
 @functools.cache
 def _distributions() -> dict:
     """importlib.metadata's top-level package -> distributions map (~0.1-0.3 s to build: kept;
-    `_distribution_version` builds it again for a package it does not hold)."""
+    `_distribution_version` builds it again once for a package it does not hold)."""
     from importlib import metadata
 
     return metadata.packages_distributions()

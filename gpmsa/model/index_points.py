@@ -71,7 +71,7 @@ def check_points(points: np.ndarray, name: str) -> None:
 def within(values: np.ndarray, lo: float, hi: float) -> bool:
     """Whether the one-column index ``values`` lies in [lo, hi] up to rounding (`HULL_TOL` of
     hi - lo; ``np.interp`` takes a value beyond an end as the end)."""
-    slack = HULL_TOL * (hi - lo)
+    slack = HULL_TOL * hi - HULL_TOL * lo  # (hi - lo may overflow)
     return bool(values.min() >= lo - slack and values.max() <= hi + slack)
 
 
@@ -96,24 +96,36 @@ def _triangulation(points: np.ndarray, name: str, complete: bool = True) -> Tria
             raise QhullError("too few points")
         found = _delaunay(points.shape, np.ascontiguousarray(points).tobytes())
     except QhullError:
+        spans = _spans(points)
+        apart = (f", or columns whose spans are too far apart for float64: "
+                 f"{', '.join(numbers_text(*spans, digits=3))}"
+                 if np.all(spans > 0) and np.max(spans) > 1e6 * np.min(spans) else "")  # fmt: skip
         raise GPMSAError(
             f"{name} of {points.shape[0]} points in {d} columns does not span {d} dimensions "
-            f"(fewer than {d + 1} points, or all on a line or plane): the basis is interpolated "
-            "on their triangulation"
+            f"(fewer than {d + 1} points, or all on a line or plane{apart}): the basis is "
+            "interpolated on their triangulation"
         ) from None
     lost = found.tri.coplanar
     if complete and lost.shape[0]:
         row, near = int(lost[0, 0]), int(lost[0, 2])
-        spans = numbers_text(*np.ptp(points, axis=0), digits=3)
+        spans = numbers_text(*_spans(points), digits=3)
+        both = numbers_text(*points[row], *points[near])  # distinct where they differ
+        first, second = (f"({', '.join(both[k * d : k * d + d])})" for k in (0, 1))
         raise GPMSAError(
             f"{name}: {lost.shape[0]} of its {l} points fall out of their triangulation in "
-            f"float64, the first {_point_text(points[row])} (row {row}) within rounding of "
-            f"{_point_text(points[near])} (row {near}), so values between points cannot be "
+            f"float64, the first {first} (row {row}) within rounding of {second} (row {near}), "
+            "so values between points cannot be "
             f"interpolated there (the index columns span {', '.join(spans)}: a column about "
             "1e6 times narrower than another, or points nearly repeated, do that); rescale "
             "the index columns to comparable spans, or merge the nearly repeated points"
         )
     return found
+
+
+def _spans(points: np.ndarray) -> np.ndarray:
+    """Each column's span (d,), inf where it overflows float64 (beyond ~1.8e308)."""
+    with np.errstate(over="ignore"):
+        return np.max(points, axis=0) - np.min(points, axis=0)
 
 
 def triangles(points: np.ndarray, name: str) -> np.ndarray:
@@ -196,7 +208,7 @@ def weights(
     hit, rest = np.flatnonzero(on >= 0), np.flatnonzero(on < 0)
     rows, cols, vals = [hit], [on[hit]], [np.ones(hit.size)]
     if rest.size:
-        found = _triangulation(points, "the simulation index")
+        found = _triangulation(points, f"the simulation index (interpolated onto {what})")
         tri, q = found.tri, found.local(new[rest])
         s = _locate(tri, q)
         if np.any(s < 0):
@@ -219,7 +231,7 @@ def _onto_box(points: np.ndarray, new: np.ndarray) -> np.ndarray:
     """``new`` with each coordinate beyond the points' range by rounding (`HULL_TOL` of the
     column's span) set to the range's end."""
     lo, hi = points.min(axis=0), points.max(axis=0)
-    slack = HULL_TOL * (hi - lo)
+    slack = HULL_TOL * hi - HULL_TOL * lo  # (hi - lo may overflow)
     low = (new < lo) & (new >= lo - slack)
     high = (new > hi) & (new <= hi + slack)
     return np.where(low, lo, np.where(high, hi, new))

@@ -208,3 +208,22 @@ def test_a_plugins_broken_metadata_never_fails_a_fit(registry, tmp_path, capsys,
     assert gpmsa.load(path).settings["versions"] == emu.settings["versions"]
     assert main(["info", str(path)]) == 0
     capsys.readouterr()
+
+
+def test_a_plugin_of_no_installed_package_rebuilds_the_distribution_map_once(monkeypatch):
+    from importlib import metadata
+
+    from gpmsa import _version
+
+    builds = []
+    monkeypatch.setattr(metadata, "packages_distributions", lambda: builds.append(1) or {})
+    monkeypatch.setattr(_version, "_NO_DISTRIBUTION", set())
+    _version._distributions.cache_clear()
+    try:
+        local = types.ModuleType("my_local_backend_s87")  # a file beside the user's script
+        for _ in range(3):
+            assert library_versions("local", local)["backend local"] == (
+                "my_local_backend_s87 unknown")  # fmt: skip
+        assert len(builds) == 2  # the first build, and one more in case it was installed since
+    finally:
+        _version._distributions.cache_clear()

@@ -42,3 +42,11 @@ def test_the_data_maps_are_drawn_on_the_interpolations_triangles(offset):
     assert _drawn(fig, points) == want
     if offset == 0.0:  # scipy's Delaunay: the fit's interpolation (index_points.weights)
         assert want == _as_set(Delaunay(POINTS).simplices)
+
+
+def test_the_triangles_given_out_are_a_copy_of_the_cached_ones():
+    """A caller writing into the triangles it got must not change later interpolations."""
+    points = POINTS + 0.0
+    first = triangles(points, "index")
+    first[:] = 0
+    assert _as_set(triangles(points, "index")) == _as_set(Delaunay(POINTS).simplices)

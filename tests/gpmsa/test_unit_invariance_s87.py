@@ -8,6 +8,7 @@ units by design (docs/calibration.md): [1, unit index] given as an array is inva
 
 from __future__ import annotations
 
+import re
 import warnings
 
 import numpy as np
@@ -145,7 +146,7 @@ def test_an_index_spanning_float64s_range_is_refused_by_gpmsa_not_numpy():
     """The rescaled frame divides by a power of two before shifting: a span of 2e308 (which
     overflows as a difference) gave scipy's "Points cannot contain NaN"."""
     points = np.array([[1e308, 0.0], [-1e308, 0.0], [0.0, 1.0], [0.0, -1.0]])
-    with pytest.raises(gpmsa.GPMSAError, match="does not span 2 dimensions"):
+    with pytest.raises(gpmsa.GPMSAError, match="does not span 2 dimensions.*spans are too far"):
         gpmsa.SimData(t=np.arange(4.0), y=np.arange(16.0).reshape(4, 4) ** 2, index=points)
     wide = np.array([[1e308, 0.0], [-1e308, 0.0], [0.0, 1e308], [0.0, -1e308]])
     assert index_points.triangles(wide, "index").shape == (2, 3)
@@ -163,3 +164,22 @@ def test_nearly_repeated_points_are_taken_until_a_value_between_them_is_asked_fo
         gpmsa.GPMSAError, match=r"\(row 2[01]\) within rounding of .* \(row 2[01]\)"
     ):
         index_points.weights(points, np.array([[0.5, 0.55]]), "o")
+
+
+def test_a_point_far_outside_an_index_spanning_float64s_range_is_refused():
+    """The hull's rounding slack, HULL_TOL x (hi - lo), overflowed to inf for a column spanning
+    more than float64 holds: a point 0.7e308 beyond it was snapped onto its end, one-hot."""
+    wide = np.array([[1e308, 0], [-1e308, 0], [0, 1e308], [0, -1e308], [0.2e308, 0.1e308]])
+    with pytest.raises(gpmsa.GPMSAError, match="outside the convex hull"):
+        index_points.weights(wide, np.array([[-1.7e308, 0.0]]), "q")
+    inside = index_points.weights(wide, np.array([[0.0, 0.0]]), "q").toarray()
+    assert inside.sum() == pytest.approx(1.0) and np.all(inside >= 0)
+
+
+def test_the_points_left_out_are_shown_apart():
+    grid = np.column_stack([np.repeat(np.linspace(0, 1, 4), 5), np.tile(np.linspace(0, 1, 5), 4)])
+    points = np.vstack([grid, [[0.1 + 0.2, 0.5], [0.3, 0.5]]])
+    with pytest.raises(gpmsa.GPMSAError) as err:
+        index_points.weights(points, np.array([[0.5, 0.55]]), "o")
+    first, second = re.findall(r"\(([^()]*)\) \(row 2[01]\)", str(err.value))
+    assert first != second
