@@ -210,23 +210,12 @@ class FullPrediction:
                 f"p_v={self.p_v})")  # fmt: skip
 
 
-def _check_has_draws(emulator) -> None:
-    """GPMSAError when ``emulator`` holds no calibration draws (a simulation-only fit) and no
-    posterior= is given: before any check against a joint fit's record, which it has none of."""
-    if not getattr(emulator, "calibration", None):
-        raise GPMSAError(
-            "full_prediction needs calibration draws: fit jointly (gpmsa.fit(data, obs, "
-            "discrepancy=...)) or pass posterior= from gpmsa.calibrate"
-        )
-
-
 def _posterior_sets(emulator, posterior, n_draws, paired: bool | None = None):
     """Indices and per-draw parameter dicts (unit theta) from a joint fit or a Posterior; the
     emulator parameters paired draws or the point estimate (``paired``; None: the joint fit's
     draws, a Posterior's point estimate)."""
     paired = posterior is None if paired is None else paired
-    if posterior is None:
-        _check_has_draws(emulator)
+    if posterior is None:  # (full_prediction checked that the emulator holds the draws)
         cal = emulator.calibration
         if paired and not emulator.draws:
             raise GPMSAError("the emulator kept no posterior draws of its own parameters")
@@ -682,8 +671,11 @@ def full_prediction(
     rng = rng_of(seed)
     std, K = emulator.standardizer, emulator.K
     scalar = emulator.l_sim == 1
-    if posterior is None:
-        _check_has_draws(emulator)
+    if posterior is None and not getattr(emulator, "calibration", None):  # before any check
+        raise GPMSAError(  # against a joint fit's record, which a simulation-only fit lacks
+            "full_prediction needs calibration draws: fit jointly (gpmsa.fit(data, obs, "
+            "discrepancy=...)) or pass posterior= from gpmsa.calibrate"
+        )
     if isinstance(discrepancy, str) and discrepancy == AS_FITTED:
         discrepancy = _recorded_discrepancy(emulator, posterior)
     elif posterior is None:
