@@ -1,10 +1,14 @@
 """Problems shared by the backend tests: the road case and a small multivariate case."""
 
+import sys
+import textwrap
 from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
 import gpmsa
+from gpmsa import backends
 from gpmsa.model.problem import Prepared, prepare
 
 DATA = Path(__file__).parents[1] / "data" / "case.npz"
@@ -46,3 +50,14 @@ def multi_problem(discrepancy=None) -> Prepared:
     """Prepared multivariate problem (joint sim + obs)."""
     sim, obs = multi_data()
     return prepare(sim, obs, discrepancy=discrepancy)
+
+
+def installed_plugin(monkeypatch, folder: Path, module: str, source: str) -> ModuleType:
+    """A plug-in backend in the user's project: ``source`` written as ``folder/module.py``,
+    importable from there and registered by its import path as "mine" (the caller restores the
+    registry, and drops the module from ``sys.modules`` afterwards)."""
+    (folder / f"{module}.py").write_text(textwrap.dedent(source), encoding="utf-8")
+    monkeypatch.syspath_prepend(str(folder))
+    monkeypatch.delitem(sys.modules, module, raising=False)
+    backends.register("mine", module)
+    return backends.get("mine")

@@ -5,12 +5,11 @@ records its module's identity and version beside the built-ins' packages, and a 
 metadata is broken still fits, saves, loads and is described."""
 
 import sys
-import textwrap
 import types
 
 import numpy as np
 import pytest
-from _backend_cases import road_data
+from _backend_cases import installed_plugin, road_data
 from _calib_cases import categorical_emulator, road_emulator, road_obs, two_param_emulator
 
 import gpmsa
@@ -142,11 +141,7 @@ def sample(problem, *, n_iter, n_chains=1, tune=True, step_widths=None, seed=Non
 @pytest.fixture
 def plugin(registry, monkeypatch, tmp_path):
     """``mybackend_s87.py`` (``__version__`` 2.5.1) in the user's project, registered as "mine"."""
-    (tmp_path / "mybackend_s87.py").write_text(textwrap.dedent(PLUGIN), encoding="utf-8")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    monkeypatch.delitem(sys.modules, "mybackend_s87", raising=False)
-    backends.register("mine", "mybackend_s87")
-    yield backends.get("mine")
+    yield installed_plugin(monkeypatch, tmp_path, "mybackend_s87", PLUGIN)
     sys.modules.pop("mybackend_s87", None)
 
 

@@ -8,13 +8,12 @@ KeyError or was recorded as it came, a constraint went to a sampler that may ign
 Calibrator refused the options a ``**options`` sampler takes)."""
 
 import sys
-import textwrap
 import types
 import warnings
 
 import numpy as np
 import pytest
-from _backend_cases import road_data
+from _backend_cases import installed_plugin, road_data
 from _calib_cases import road_emulator, road_obs
 
 import gpmsa
@@ -51,11 +50,7 @@ def registry(monkeypatch):
 @pytest.fixture
 def plugin(registry, monkeypatch, tmp_path):
     """``mybackend_s86.py`` in the user's project, registered by its import path as "mine"."""
-    (tmp_path / "mybackend_s86.py").write_text(textwrap.dedent(PLUGIN), encoding="utf-8")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    monkeypatch.delitem(sys.modules, "mybackend_s86", raising=False)
-    backends.register("mine", "mybackend_s86")
-    yield backends.get("mine")
+    yield installed_plugin(monkeypatch, tmp_path, "mybackend_s86", PLUGIN)
     sys.modules.pop("mybackend_s86", None)
 
 
