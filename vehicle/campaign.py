@@ -38,11 +38,12 @@ import zlib
 from collections import Counter
 from collections.abc import Callable
 from concurrent.futures import (
+    FIRST_COMPLETED,
     BrokenExecutor,
     Executor,
     Future,
     ProcessPoolExecutor,
-    as_completed,
+    wait,
 )
 from dataclasses import dataclass
 from pathlib import Path
@@ -683,7 +684,7 @@ def run_campaign(
         try:  # (a pool broken while runs are still submitted refuses the next submit)
             for i in todo:
                 futures[pool.submit(run_one, specs[i], None if cache is None else str(cache))] = i
-            for fut in as_completed(futures):
+            for fut in _completed(futures):
                 results[futures[fut]] = fut.result()
                 bar.update()
         except BrokenExecutor as exc:
@@ -691,7 +692,11 @@ def run_campaign(
             if why is None:
                 raise
             raise VehicleError(why) from exc
-    finally:  # after an error or Ctrl-C, the runs not yet started are cancelled, not waited for
+    except BaseException:  # an error or Ctrl-C: our own pool's running runs end at once
+        if own:
+            _stop(pool)
+        raise
+    finally:  # the runs not yet started are cancelled, not waited for
         bar.close()
         for fut in futures:
             fut.cancel()
@@ -762,6 +767,43 @@ def _progress_bar(progress: bool, total: int, initial: int, desc: str):
     if not progress:
         return _NoBar(total, initial)
     return _bar_class()(total=total, initial=initial, desc=desc, unit="run")
+
+
+_POLL_S = 0.25
+"""Seconds between the campaign's checks for an interrupt while runs are simulated. The kernel
+may hand a process's SIGINT to any of its threads (the pool's, BLAS's); Python acts on it in the
+main thread only, and a wait without a timeout would hold it until a run ends."""
+
+_JOIN_S = 5.0
+"""Seconds to wait for a terminated worker process to exit."""
+
+
+def _completed(futures: dict[Future, int]):
+    """``as_completed(futures)``, waking every `_POLL_S` seconds so that an interrupt taken by
+    another thread is acted on within that time."""
+    pending = set(futures)
+    while pending:
+        done, pending = wait(pending, timeout=_POLL_S, return_when=FIRST_COMPLETED)
+        yield from done
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """End our own ``pool`` at once after an error or an interrupt (Ctrl-C, a notebook's
+    interrupt, which signals this process alone): cancel the runs not started and terminate the
+    workers still simulating one (``terminate_workers`` of Python 3.14), so that the interrupt
+    does not wait for their runs and no process goes on simulating runs nobody will read. A run
+    cut off leaves no cache entry (each is written whole or not at all). (gpmsa's chain pools do
+    the same; vehicle does not import gpmsa.)"""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)  # shutdown forgets it
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        if proc.is_alive():
+            proc.terminate()
+    for proc in processes:
+        proc.join(timeout=_JOIN_S)
+    if manager is not None:  # it takes the pool's locks: a fork while it runs inherits them
+        manager.join(timeout=_JOIN_S)
 
 
 def _end_with_parent(owner: int | None = None, started=None) -> None:

@@ -25,7 +25,7 @@ def test_a_killed_campaign_takes_its_pool_workers_with_it(tmp_path):
         import vehicle
         from vehicle import campaign
 
-        real = campaign.as_completed
+        real = campaign._completed
 
         def first_then_killed(futures):
             for fut in real(futures):  # a run has finished: the workers are up
@@ -33,7 +33,7 @@ def test_a_killed_campaign_takes_its_pool_workers_with_it(tmp_path):
                 os.kill(os.getpid(), signal.SIGKILL)
                 yield fut
 
-        campaign.as_completed = first_then_killed
+        campaign._completed = first_then_killed
         design = np.array([[0.7, 250.0], [1.6, 550.0], [1.1, 400.0]])
         vehicle.run_campaign(design, road_length_m=6.0, window=300, lead_in_m=0.5,
                              progress=False, seed=1)

@@ -1,0 +1,63 @@
+"""An interrupt that reaches the campaign's process alone (a notebook's interrupt button, `kill
+-INT`: a terminal's Ctrl-C signals the workers too) ended the campaign only once every running
+simulation had finished: with 1,700 m runs at 0.5 m/s, 24 s after the signal. The running runs
+are now cut off and the workers ended (0.6 s); a run cut off leaves no cache entry."""
+
+import _thread
+import multiprocessing
+import os
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import vehicle
+from vehicle import campaign
+
+RUN_S = 1.0
+"""How long a stand-in run simulates, s: one that was waited out writes its marker file."""
+
+
+def slow_run(spec, cache_dir=None):
+    """A stand-in for `campaign.run_one` (forked workers inherit it): marks its start, sleeps,
+    then marks its end."""
+    folder = os.environ["CAMPAIGN_INTERRUPT_TEST_DIR"]
+    with open(f"{folder}/started-{spec.seed}", "w"):
+        pass
+    time.sleep(RUN_S)
+    with open(f"{folder}/finished-{spec.seed}", "w"):
+        pass
+    raise AssertionError("a run the interrupt should have cut off has finished")
+
+
+def interrupt_once_started(folder, done):
+    """Interrupt the main thread (as SIGINT to this process would) once a run has started."""
+    while not any(p.name.startswith("started-") for p in folder.iterdir()):
+        if done.wait(0.02):
+            return
+    _thread.interrupt_main()
+
+
+@pytest.mark.skipif(
+    multiprocessing.get_start_method() != "fork", reason="the stand-in reaches forked workers"
+)
+def test_an_interrupt_cuts_off_the_running_runs_instead_of_waiting_for_them(tmp_path, monkeypatch):
+    monkeypatch.setenv("CAMPAIGN_INTERRUPT_TEST_DIR", str(tmp_path))  # (workers inherit it)
+    monkeypatch.setattr(campaign, "run_one", slow_run)
+    done = threading.Event()
+    watcher = threading.Thread(target=interrupt_once_started, args=(tmp_path, done))
+    watcher.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            vehicle.run_campaign(
+                np.array([[0.7, 250.0], [1.6, 550.0]]), road_length_m=6.0, window=300,
+                lead_in_m=0.5, progress=False, seed=1,
+            )  # fmt: skip
+    finally:
+        done.set()
+        watcher.join()
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith("started-")]
+    time.sleep(RUN_S + 0.5)  # a worker still simulating would have finished its run by now
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith("finished-")]
+    assert not [p for p in multiprocessing.active_children() if p.is_alive()]
