@@ -22,6 +22,7 @@ import numpy as np
 from gpmsa import backends
 from gpmsa._fp_state import underflow_as_zero
 from gpmsa._threads import one_thread
+from gpmsa._version import library_versions
 from gpmsa.calibration import continuation as cont
 from gpmsa.calibration.judge import Run, judge_bounds, judge_convergence
 from gpmsa.calibration.observations import (
@@ -374,7 +375,10 @@ def calibrate(
         ``gpmsa.full_prediction`` refuses other ones with these draws, and
         ``info["obs_layout_sha256"]`` their index grids and precisions (`layout_digest`);
         ``info["emulator_sha256"]`` the emulator (``Emulator.model_sha256``), so that the
-        predictions taking an emulator and ``posterior=`` refuse another one.
+        predictions taking an emulator and ``posterior=`` refuse another one;
+        ``info["versions"]`` the versions of what ran the chains (as ``fit``'s
+        ``settings["versions"]``: Python, gpmsa, numpy, scipy, the BLAS, the backend's
+        packages or a plug-in's module).
     """
     run = sample_calibration(
         emulator, x_obs, y_obs, n_samples, n_burn, tune, seed, backend,
@@ -384,6 +388,9 @@ def calibrate(
         log_prior=log_prior, progress=progress, n_jobs=n_jobs, executor=executor,
         constraint=constraint, theta_init=theta_init, fixed=fixed, append=append, **options,
     )  # fmt: skip
+    ran = run.info["backend"]  # (the fast engine runs on numpy whichever backend was named)
+    plugin = None if ran in backends.BUILTIN else backends.get(ran)
+    run.info["versions"] = library_versions(ran, plugin)  # (here: a Calibrator's updates skip it)
     where = f"gpmsa.calibrate (backend {backend!r})"
     judge_convergence(run, where, more=f", or {_more_advice(append)}")
     std = emulator.standardizer

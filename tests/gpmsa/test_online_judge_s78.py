@@ -71,7 +71,7 @@ def fingerprint(post: gpmsa.Posterior, caught: list) -> tuple[str, float, float,
             return "float" if np.isfinite(v) else repr(v)
         return "sha256" if isinstance(v, str) and HEX.fullmatch(v) else v
 
-    record = {k: v for k, v in post.info.items() if k != "seconds"}
+    record = {k: v for k, v in post.info.items() if k not in ("seconds", "versions")}  # (host's)
     kinds = [w.category.__name__ for w in caught]
     text = json.dumps([shape(record), kinds])
     draws = np.stack(list(post.samples.values()))
