@@ -21,6 +21,7 @@ from gpmsa.calibration.posterior import quantile_keys
 from gpmsa.cli.text import internal_error, numbers, safe
 from gpmsa.errors import GPMSAError
 from gpmsa.io.container import home_path, jsonable
+from gpmsa.model.data import check_seed
 
 Y_CSV_MAX_BYTES = 64 * 1024**2
 """Most bytes of a ``--y-csv`` file read (one observation's values take far fewer); a longer
@@ -100,7 +101,8 @@ def add_parser(sub) -> None:
                    help="exact grid (1-2 parameters) or MCMC (default: auto, MCMC with "
                         "--fixed)")  # fmt: skip
     p.add_argument("--level", type=_level, default=0.9, help="central interval level (0.9)")
-    p.add_argument("--seed", type=int, default=None, help="seed of the draws / MCMC")
+    p.add_argument("--seed", type=_seed, default=None,
+                   help="seed of the draws / MCMC, an integer in [0, 2**128)")  # fmt: skip
     p.add_argument(
         "--extrapolate",
         action="store_true",
@@ -108,6 +110,20 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--json", action="store_true", help="print JSON for programs")
     p.set_defaults(func=run)
+
+
+def _seed(text: str) -> int:
+    """argparse type of --seed: an integer in [0, 2**128) (`check_seed`), checked before the
+    file is read."""
+    try:
+        seed = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    try:
+        return check_seed(seed)
+    except GPMSAError:
+        raise argparse.ArgumentTypeError(f"{text!r} is out of range: allowed integers in "
+                                         "[0, 2**128)") from None  # fmt: skip
 
 
 def _level(text: str) -> float:

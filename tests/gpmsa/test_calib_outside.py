@@ -254,9 +254,29 @@ def test_invalid_seed_in_fit_and_the_cli(tmp_path, capsys):
     with pytest.raises(GPMSAError, match=r"seed=-1 is out of range: allowed integers in \[0"):
         gpmsa.fit(sim, n_iter=10, seed=-1, tune=False)
     path = road_emulator().save(tmp_path / "road.gpmsa")
-    code = main(["calibrate", str(path), "--x", "v=1.25", "--y", "f=12.1", "--seed", "-1"])
-    assert code == 2
-    assert "seed=-1 is out of range" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_:
+        main(["calibrate", str(path), "--x", "v=1.25", "--y", "f=12.1", "--seed", "-1"])
+    assert exit_.value.code == 2
+    assert "argument --seed: '-1' is out of range: allowed integers in [0, 2**128)" in (
+        capsys.readouterr().err
+    )  # fmt: skip (session 88: named as the option, before the read)
+
+
+@pytest.mark.parametrize(
+    ("seed", "why"),
+    [("-1", "'-1' is out of range"), ("2.5", "'2.5' is not an integer"),
+     (str(2**128), f"'{2**128}' is out of range"), ("x", "'x' is not an integer")],
+)  # fmt: skip
+def test_the_cli_refuses_a_bad_seed_as_its_option_before_reading_the_file(tmp_path, capsys,
+                                                                          seed, why):  # fmt: skip
+    """Before: `gpmsa calibrate --seed -1` read the file, then said "seed=-1" (the library's
+    argument), not the option the user typed."""
+    with pytest.raises(SystemExit) as exit_:
+        main(["calibrate", str(tmp_path / "absent.gpmsa"), "--x", "v=1", "--y", "f=1",
+              "--seed", seed])  # fmt: skip
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument --seed: {why}" in err and "absent.gpmsa" not in err
 
 
 def test_oversized_requests_are_refused_before_allocating(monkeypatch):
