@@ -226,8 +226,8 @@ def parser() -> argparse.ArgumentParser:
         help="IMU axis that points up when the robot stands level",
     )  # fmt: skip
     p.add_argument(
-        "--sign", type=int, default=1, choices=[1, -1],
-        help="-1 if that axis points down (an IMU mounted upside down)",
+        "--sign", type=float, default=1, choices=[1, -1],
+        help="-1 if that axis points down (an IMU mounted upside down); 1.0 and -1.0 too",
     )  # fmt: skip
     p.add_argument(
         "--time-base", default=DEFAULTS.time_base, choices=list(TIME_BASES),
@@ -308,7 +308,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"terrain-replay: error: {name} is an empty path: give a file or folder name",
                   file=sys.stderr)  # fmt: skip
             return 2
-    bag = Path(args.bag)
+    bag = home_path(args.bag)  # a leading ~ is the home folder, as replay_bag reads it
     default_out = Path(f"{bag.name.removesuffix(bag.suffix)}_bcr")
     out = default_out if args.out is None else home_path(args.out)
     try:
@@ -335,7 +335,11 @@ def main(argv: list[str] | None = None) -> int:
         progress = args.progress and sys.stderr is not None  # no bar where stderr is closed
         result = replay_bag(bag, emulator, settings, simplex=simplex, progress=progress,
                             check_vehicle=not args.ignore_vehicle)  # fmt: skip
-        source = f"shipped emulator {args.emulator}" if args.emulator in SHIPPED else args.emulator
+        source = (
+            f"shipped emulator {args.emulator}" if args.emulator in SHIPPED
+            else str(home_path(args.emulator)) if args.emulator.startswith("~")  # as the shell
+            else args.emulator
+        )  # fmt: skip
         _write(out, result, _report(bag, source, settings, simplex, result))
     except MissingExtraError as exc:
         print(f"terrain-replay: {_one_line(exc)}", file=sys.stderr)

@@ -232,9 +232,15 @@ class ReplaySettings:
             raise ControlError(
                 f"max_odometry_gap_s must be > 0 and finite, s, got {self.max_odometry_gap_s}"
             )
-        for name in ("imu_topic", "odom_topic", "estimate_topic"):
-            if not getattr(self, name).startswith("/"):
-                raise ControlError(f"{name} must start with '/', got {getattr(self, name)!r}")
+        for name, option in (("imu_topic", " / --imu-topic"), ("odom_topic", " / --odom-topic"),
+                             ("estimate_topic", "")):  # fmt: skip
+            topic = getattr(self, name)
+            if not topic.startswith("/"):  # a bag records absolute names (ros2 resolves them)
+                hint = f": give {'/' + topic!r}" if topic else ""
+                raise ControlError(
+                    f"{name}{option} must start with '/' (a bag records a topic by its absolute "
+                    f"name), got {topic!r}{hint}"
+                )
 
 
 @dataclass(frozen=True, eq=False)

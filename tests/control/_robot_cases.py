@@ -1,5 +1,5 @@
-"""Small inputs shared by the robot I/O tests: a short drive's messages, a start from rest and a
-closed-loop result that needs no simulation."""
+"""Small inputs shared by the robot I/O tests: a short drive's messages, a start from rest, a
+closed-loop result that needs no simulation and a ROS 1 bag writer."""
 
 import numpy as np
 
@@ -38,3 +38,48 @@ def small_result(n: int = 240, settings: dict | None = None) -> ClosedLoopResult
         sample_accel=np.random.default_rng(0).normal(size=n), metrics={},
         settings={} if settings is None else settings,
     )  # fmt: skip
+
+
+def ros1_bag(path, t_ns, accel, position, speed):
+    """A ROS 1 bag (rosbags' serialiser, Noetic's messages) stamped at ``t_ns``; a header's
+    seconds are a uint32, written as the int32 of the same bits (rosbags' Time is int32)."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    T = store.types
+    vec, zeros9, zeros36 = T["geometry_msgs/msg/Vector3"], np.zeros(9), np.zeros(36)
+    quat = T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)
+
+    def header(ns, frame):
+        sec = ns // 10**9
+        sec -= 2**32 if sec >= 2**31 else 0  # uint32 bits as int32
+        stamp = T["builtin_interfaces/msg/Time"](sec=sec, nanosec=ns % 10**9)
+        return T["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id=frame)
+
+    with Writer(path) as writer:
+        c_imu = writer.add_connection("/imu/data", "sensor_msgs/msg/Imu", typestore=store)
+        c_odom = writer.add_connection("/odometry/filtered", "nav_msgs/msg/Odometry",
+                                       typestore=store)  # fmt: skip
+        for k, ns in enumerate(t_ns.tolist()):
+            imu = T["sensor_msgs/msg/Imu"](
+                header=header(ns, "imu_link"), orientation=quat, orientation_covariance=zeros9,
+                angular_velocity=vec(x=0.0, y=0.0, z=0.0), angular_velocity_covariance=zeros9,
+                linear_acceleration=vec(x=0.0, y=0.0, z=float(accel[k])),
+                linear_acceleration_covariance=zeros9,
+            )  # fmt: skip
+            writer.write(c_imu, ns, store.serialize_ros1(imu, "sensor_msgs/msg/Imu"))
+            pose = T["geometry_msgs/msg/Pose"](
+                position=T["geometry_msgs/msg/Point"](x=float(position[k]), y=0.0, z=0.0),
+                orientation=quat,
+            )
+            twist = T["geometry_msgs/msg/Twist"](
+                linear=vec(x=float(speed[k]), y=0.0, z=0.0), angular=vec(x=0.0, y=0.0, z=0.0)
+            )
+            odom = T["nav_msgs/msg/Odometry"](
+                header=header(ns, "odom"), child_frame_id="base_link",
+                pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros36),
+                twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros36),
+            )  # fmt: skip
+            writer.write(c_odom, ns, store.serialize_ros1(odom, "nav_msgs/msg/Odometry"))
+    return path

@@ -9,6 +9,7 @@ import struct
 
 import numpy as np
 import pytest
+from _robot_cases import ros1_bag
 
 pytest.importorskip("rosbags")
 pytest.importorskip("mcap")
@@ -117,64 +118,19 @@ def test_exact_copies_of_imu_messages_are_left_out_not_faults(emulator_b, likeli
     assert not any("exact copies" in n for n in r.notes)
 
 
-def _ros1_bag(path, t_ns, accel, position, speed):
-    """A ROS 1 bag (rosbags' serialiser, Noetic's messages) stamped at ``t_ns``; a header's
-    seconds are a uint32, written as the int32 of the same bits (rosbags' Time is int32)."""
-    from rosbags.rosbag1 import Writer
-    from rosbags.typesys import Stores, get_typestore
-
-    store = get_typestore(Stores.ROS1_NOETIC)
-    T = store.types
-    vec, zeros9, zeros36 = T["geometry_msgs/msg/Vector3"], np.zeros(9), np.zeros(36)
-    quat = T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)
-
-    def header(ns, frame):
-        sec = ns // 10**9
-        sec -= 2**32 if sec >= 2**31 else 0  # uint32 bits as int32
-        stamp = T["builtin_interfaces/msg/Time"](sec=sec, nanosec=ns % 10**9)
-        return T["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id=frame)
-
-    with Writer(path) as writer:
-        c_imu = writer.add_connection("/imu/data", "sensor_msgs/msg/Imu", typestore=store)
-        c_odom = writer.add_connection("/odometry/filtered", "nav_msgs/msg/Odometry",
-                                       typestore=store)  # fmt: skip
-        for k, ns in enumerate(t_ns.tolist()):
-            imu = T["sensor_msgs/msg/Imu"](
-                header=header(ns, "imu_link"), orientation=quat, orientation_covariance=zeros9,
-                angular_velocity=vec(x=0.0, y=0.0, z=0.0), angular_velocity_covariance=zeros9,
-                linear_acceleration=vec(x=0.0, y=0.0, z=float(accel[k])),
-                linear_acceleration_covariance=zeros9,
-            )  # fmt: skip
-            writer.write(c_imu, ns, store.serialize_ros1(imu, "sensor_msgs/msg/Imu"))
-            pose = T["geometry_msgs/msg/Pose"](
-                position=T["geometry_msgs/msg/Point"](x=float(position[k]), y=0.0, z=0.0),
-                orientation=quat,
-            )
-            twist = T["geometry_msgs/msg/Twist"](
-                linear=vec(x=float(speed[k]), y=0.0, z=0.0), angular=vec(x=0.0, y=0.0, z=0.0)
-            )
-            odom = T["nav_msgs/msg/Odometry"](
-                header=header(ns, "odom"), child_frame_id="base_link",
-                pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros36),
-                twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros36),
-            )  # fmt: skip
-            writer.write(c_odom, ns, store.serialize_ros1(odom, "nav_msgs/msg/Odometry"))
-    return path
-
-
 def test_a_ros1_bag_stamped_after_2038_reads_its_stamps_and_estimates(
     emulator_b, likelihood_b, tmp_path
 ):
     # a ROS 1 time's seconds run to 2106 (uint32); read as int32 they came out in 1902
     t, accel, position, speed = _drive()
     t_ns = np.rint(t * 1e9).astype(np.int64)
-    bag = _ros1_bag(
+    bag = ros1_bag(
         tmp_path / "run.bag", t_ns + 2_200_000_000 * 10**9, accel, position, speed
     )  # 2039
     rec = read_recording(bag)
     assert np.array_equal(rec.imu.stamp_ns, rec.imu.log_ns)
     assert rec.imu.stamp_ns[0] == 2_200_000_002_000_000_000
-    early = _ros1_bag(tmp_path / "early.bag", t_ns, accel, position, speed)
+    early = ros1_bag(tmp_path / "early.bag", t_ns, accel, position, speed)
     r, base = (replay_bag(b, emulator_b, likelihood=likelihood_b) for b in (bag, early))
     assert np.array_equal(r.gd_mean, base.gd_mean, equal_nan=True)
     assert np.array_equal(r.stamp_ns - 2_200_000_000_000_000_000, base.stamp_ns)
