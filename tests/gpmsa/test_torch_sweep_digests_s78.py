@@ -188,15 +188,15 @@ def test_cached_component_terms_are_those_of_a_fresh_solve(case):
     bit for bit, one component at a time or all at once, and its ll_obs is obs_loglik's."""
     state = tb.BatchState(_problem(case), 3, torch.float64, "cpu")
     gen = torch.Generator().manual_seed(3)
-    with tb.torch_threads(1):  # as sample's (one BLAS thread)
-        for _ in range(3):
+    with tb.torch_threads(1):  # as sample's (one BLAS thread), the fresh solves too: with two
+        for _ in range(3):  # threads a product's blocking may differ in its last bits (seen)
             state.sweep(np.full(len(state.els), 0.3), True, gen)
-    d, prm = state.data, state.params
-    mean_u, cond = tb.obs_parts(d, state.chol, state.alpha, prm)
-    assert torch.equal(mean_u, state.obs_mean) and torch.equal(cond, state.obs_cond)
-    for j in range(d.w.shape[0]):
-        s = slice(j, j + 1)
-        m_j, c_j = tb.obs_parts(d, state.chol[:, s].clone(), state.alpha[:, s].clone(), prm, s)
-        assert torch.equal(m_j, mean_u[:, s]) and torch.equal(c_j, cond[:, s]), j
-    want = tb.obs_loglik(d, state.chol, state.alpha, prm, state.coef, state.h_obs)
-    assert torch.equal(state.ll_obs, want)
+        d, prm = state.data, state.params
+        mean_u, cond = tb.obs_parts(d, state.chol, state.alpha, prm)
+        assert torch.equal(mean_u, state.obs_mean) and torch.equal(cond, state.obs_cond)
+        for j in range(d.w.shape[0]):
+            s = slice(j, j + 1)
+            m_j, c_j = tb.obs_parts(d, state.chol[:, s].clone(), state.alpha[:, s].clone(), prm, s)
+            assert torch.equal(m_j, mean_u[:, s]) and torch.equal(c_j, cond[:, s]), j
+        want = tb.obs_loglik(d, state.chol, state.alpha, prm, state.coef, state.h_obs)
+        assert torch.equal(state.ll_obs, want)
