@@ -202,6 +202,7 @@ def weights(
     ``names`` where given). A row depends on its point alone (not on the other points of
     ``new``)."""
     check_columns(points, new, what)
+    given = new
     new = _onto_box(points, new + 0.0)  # + 0.0: -0.0 is 0.0
     at = {row.tobytes(): i for i, row in enumerate(points + 0.0)}
     on = np.array([at.get(row.tobytes(), -1) for row in new], dtype=np.intp)
@@ -214,7 +215,7 @@ def weights(
         if np.any(s < 0):
             k = int(rest[np.flatnonzero(s < 0)[0]])
             raise GPMSAError(
-                f"{what} has the point {_point_text(new[k], names)} (row {k}) outside the "
+                f"{what} has the point {_point_text(given[k], names)} (row {k}) outside the "
                 "convex hull of the simulation index's points, on which the basis is "
                 "interpolated: give points within it"
             )
@@ -229,8 +230,9 @@ def weights(
 
 def _onto_box(points: np.ndarray, new: np.ndarray) -> np.ndarray:
     """``new`` with each coordinate beyond the points' range by rounding (`HULL_TOL` of the
-    column's span) set to the range's end."""
-    lo, hi = points.min(axis=0), points.max(axis=0)
+    column's span) set to the range's end (+0.0 for an end -0.0: the simulation point there is
+    found as one, `weights`)."""
+    lo, hi = points.min(axis=0) + 0.0, points.max(axis=0) + 0.0
     slack = HULL_TOL * hi - HULL_TOL * lo  # (hi - lo may overflow)
     low = (new < lo) & (new >= lo - slack)
     high = (new > hi) & (new <= hi + slack)
