@@ -14,6 +14,8 @@ import pytest
 pytest.importorskip("rosbags")
 pytest.importorskip("mcap")
 
+from _robot_cases import ros1_bag  # noqa: E402
+
 import control  # noqa: E402
 import roadgen  # noqa: E402
 import vehicle  # noqa: E402
@@ -438,44 +440,8 @@ def test_every_path_of_the_foxglove_layout_is_in_the_recorded_file(loop_run):
 
 def _write_ros1_bag(result, path):
     """The run's samples as a ROS 1 bag (rosbags' generic serialiser, Noetic's messages)."""
-    from rosbags.rosbag1 import Writer
-    from rosbags.typesys import Stores, get_typestore
-
-    store = get_typestore(Stores.ROS1_NOETIC)
-    T = store.types
-    vec, zeros9, zeros36 = T["geometry_msgs/msg/Vector3"], np.zeros(9), np.zeros(36)
-    quat = T["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0)
-    still = vec(x=0.0, y=0.0, z=0.0)
-
-    def header(ns, frame):
-        stamp = T["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
-        return T["std_msgs/msg/Header"](seq=0, stamp=stamp, frame_id=frame)
-
-    stamps = np.rint(result.sample_time * 1e9).astype(np.int64).tolist()
-    with Writer(path) as writer:
-        c_imu = writer.add_connection("/imu/data", "sensor_msgs/msg/Imu", typestore=store)
-        c_odom = writer.add_connection("/odometry/filtered", "nav_msgs/msg/Odometry",
-                                       typestore=store)  # fmt: skip
-        for k, ns in enumerate(stamps):
-            imu = T["sensor_msgs/msg/Imu"](
-                header=header(ns, "imu_link"), orientation=quat, orientation_covariance=zeros9,
-                angular_velocity=still, angular_velocity_covariance=zeros9,
-                linear_acceleration=vec(x=0.0, y=0.0, z=float(result.sample_accel[k])),
-                linear_acceleration_covariance=zeros9,
-            )  # fmt: skip
-            writer.write(c_imu, ns, store.serialize_ros1(imu, "sensor_msgs/msg/Imu"))
-            point = T["geometry_msgs/msg/Point"](x=float(result.sample_position[k]), y=0.0, z=0.0)
-            pose = T["geometry_msgs/msg/Pose"](position=point, orientation=quat)
-            twist = T["geometry_msgs/msg/Twist"](
-                linear=vec(x=float(result.sample_speed[k]), y=0.0, z=0.0), angular=still
-            )
-            odom = T["nav_msgs/msg/Odometry"](
-                header=header(ns, "odom"), child_frame_id="base_link",
-                pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=zeros36),
-                twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros36),
-            )  # fmt: skip
-            writer.write(c_odom, ns, store.serialize_ros1(odom, "nav_msgs/msg/Odometry"))
-    return path
+    stamps = np.rint(result.sample_time * 1e9).astype(np.int64)
+    return ros1_bag(path, stamps, result.sample_accel, result.sample_position, result.sample_speed)
 
 
 def test_a_ros1_bag_replays_to_the_last_bit(loop_run, emulator_a, likelihood_a, tmp_path):

@@ -21,6 +21,11 @@ def one_blas_thread():
 @pytest.fixture(scope="module")
 def scalar_problem():
     """A small simulation-only scalar-output problem (p_u = 1) at a plausible state."""
+    return small_scalar_problem()
+
+
+def small_scalar_problem():
+    """`scalar_problem`, made anew (also for test_sampler_mutation_s88)."""
     rng = np.random.default_rng(2)
     m = 20
     x, t = (rng.permutation(m) + rng.random(m)) / m, (rng.permutation(m) + rng.random(m)) / m

@@ -18,6 +18,7 @@ from gpmsa.mcmc import ridge, tuning
 from gpmsa.mcmc.sampler import ChainState, default_widths, run_chain
 from gpmsa.model.likelihood import log_likelihood, log_prior
 from tests.gpmsa.test_core_mcmc import smooth_problem
+from tests.gpmsa.test_ridge import small_scalar_problem
 
 MARGIN = 1e-5
 """Relative margin of the acceptance draw about exp(ratio): the decision flips across it."""
@@ -218,18 +219,8 @@ def test_the_joint_level_move_is_taken_exactly_below_its_ratio_with_the_shifts_p
     assert done >= 1
 
 
-def _scalar_problem():
-    rng = np.random.default_rng(2)
-    m = 20
-    x, t = (rng.permutation(m) + rng.random(m)) / m, (rng.permutation(m) + rng.random(m)) / m
-    sim = gpmsa.SimData(x=x, t=t, y=np.sin(3 * x) + t**2 + 0.05 * rng.standard_normal(m))
-    prob = gpmsa.prepare(sim).problem
-    state = {"betaU": [[2.0], [1.0]], "lamUz": [1.5], "lamWs": [400.0], "lamWOs": [900.0]}
-    return prob.with_init(state)
-
-
 def test_ridge_moves_are_taken_by_their_ratio_and_counted_one_each():
-    prob = _scalar_problem()
+    prob = small_scalar_problem()
     assert ridge.applies(prob)
     state = ChainState(prob, prob.init, np.random.default_rng(0), ridge_moves=3)
     u = np.random.default_rng(5).random((60, 2))
@@ -260,7 +251,7 @@ def test_ridge_moves_are_taken_by_their_ratio_and_counted_one_each():
 
 
 def test_a_chain_state_makes_no_ridge_moves_unless_asked():
-    prob = _scalar_problem()
+    prob = small_scalar_problem()
     a = ChainState(prob, prob.init, np.random.default_rng(4))
     b = ChainState(prob, prob.init, np.random.default_rng(4), ridge_moves=0)
     w = a.flat_widths(default_widths(prob))
