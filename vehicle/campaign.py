@@ -22,6 +22,7 @@ import json
 import math
 import multiprocessing
 import os
+import queue
 import re
 import secrets
 import select
@@ -37,14 +38,7 @@ import zipfile
 import zlib
 from collections import Counter
 from collections.abc import Callable
-from concurrent.futures import (
-    FIRST_COMPLETED,
-    BrokenExecutor,
-    Executor,
-    Future,
-    ProcessPoolExecutor,
-    wait,
-)
+from concurrent.futures import BrokenExecutor, Executor, Future, ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -780,11 +774,19 @@ _JOIN_S = 5.0
 
 def _completed(futures: dict[Future, int]):
     """``as_completed(futures)``, waking every `_POLL_S` seconds so that an interrupt taken by
-    another thread is acted on within that time."""
-    pending = set(futures)
-    while pending:
-        done, pending = wait(pending, timeout=_POLL_S, return_when=FIRST_COMPLETED)
-        yield from done
+    another thread is acted on within that time (each future reports itself done to a queue:
+    O(1) a wake, where re-waiting on the pending futures would cost O(runs))."""
+    done: queue.SimpleQueue[Future] = queue.SimpleQueue()
+    for fut in futures:
+        fut.add_done_callback(done.put)
+    for _ in range(len(futures)):
+        while True:
+            try:
+                fut = done.get(timeout=_POLL_S)
+            except queue.Empty:
+                continue
+            break
+        yield fut
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:

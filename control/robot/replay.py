@@ -236,7 +236,7 @@ class ReplaySettings:
                              ("estimate_topic", "")):  # fmt: skip
             topic = getattr(self, name)
             if not topic.startswith("/"):  # a bag records absolute names (ros2 resolves them)
-                hint = f": give {'/' + topic!r}" if topic else ""
+                hint = f": give {'/' + topic!r}" if topic[:1].isalpha() or topic[:1] == "_" else ""
                 raise ControlError(
                     f"{name}{option} must start with '/' (a bag records a topic by its absolute "
                     f"name), got {topic!r}{hint}"

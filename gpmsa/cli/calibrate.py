@@ -115,15 +115,20 @@ def add_parser(sub) -> None:
 def _seed(text: str) -> int:
     """argparse type of --seed: an integer in [0, 2**128) (`check_seed`), checked before the
     file is read."""
+    shown = repr(text) if len(text) <= 60 else f"{text[:40]!r}... ({len(text)} characters)"
+    out_of_range = argparse.ArgumentTypeError(
+        f"{shown} is out of range: allowed integers in [0, 2**128)"
+    )
     try:
         seed = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    except ValueError:  # int() refuses over 4,300 digits (sys.get_int_max_str_digits): no seed
+        if re.fullmatch(r"\s*[+-]?\d+(_\d+)*\s*", text):
+            raise out_of_range from None
+        raise argparse.ArgumentTypeError(f"{shown} is not an integer") from None
     try:
         return check_seed(seed)
     except GPMSAError:
-        raise argparse.ArgumentTypeError(f"{text!r} is out of range: allowed integers in "
-                                         "[0, 2**128)") from None  # fmt: skip
+        raise out_of_range from None
 
 
 def _level(text: str) -> float:
