@@ -36,6 +36,7 @@ from control.metrics import (
     detection_delays,
     fast_on_rough_m,
     gd_errors,
+    interval_coverage,
     pooled_rmse,
 )
 from control.observation_model import BlockScatter, ObservationModel
@@ -98,6 +99,7 @@ __all__ = [
     "emulator_vehicle",
     "fast_on_rough_m",
     "gd_errors",
+    "interval_coverage",
     "pooled_rmse",
     "record_run",
     "replay_bag",

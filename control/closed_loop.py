@@ -22,6 +22,7 @@ from control.metrics import (
     detection_delays,
     fast_on_rough_m,
     gd_errors,
+    interval_coverage,
     segment_index,
     strict_json,
 )
@@ -64,7 +65,8 @@ class LoopMetrics:
         wall_time_s: wall-clock time of the whole loop, s.
         latency_median_s, latency_max_s: BCR compute latency over its estimates, s.
         ok_fraction: fraction of BCR updates that produced an estimate.
-        coverage: fraction of the estimates whose credible interval holds the prescribed GD.
+        coverage: fraction of the estimates whose credible interval holds the prescribed GD,
+            both ends included (`metrics.interval_coverage`).
         latched_at_s: time of the estimate whose fault latched safety mode (the Simplex's
             ``after_fault="latch"``), s; NaN if none did.
     """
@@ -406,9 +408,7 @@ def run_closed_loop(
         latency_median_s=float(np.median(latencies)) if latencies.size else np.nan,
         latency_max_s=float(np.max(latencies)) if latencies.size else np.nan,
         ok_fraction=float(np.mean(ok)) if ests else 0.0,
-        coverage=float(np.mean((gd_lo[ok] <= gd_true[ok]) & (gd_true[ok] <= gd_hi[ok])))
-        if ok.any()
-        else np.nan,
+        coverage=interval_coverage(gd_mean, gd_lo, gd_hi, gd_true),
         latched_at_s=controller.latched_by.time if controller.latched else np.nan,
     )
     result = ClosedLoopResult(

@@ -257,6 +257,31 @@ def detection_delays(track, position: np.ndarray, gd_estimate: np.ndarray) -> tu
     return tuple(float(d) for d in delays)
 
 
+def interval_coverage(
+    gd_mean: np.ndarray, gd_lo: np.ndarray, gd_hi: np.ndarray, gd_true: np.ndarray
+) -> float:
+    """Fraction of the estimates (those with a finite posterior mean ``gd_mean``) whose credible
+    interval [gd_lo, gd_hi] holds the prescribed GD ``gd_true``, both ends included: an interval
+    may end exactly at a domain bound that is the truth (a part at GD 200 or 600); one with a
+    NaN end holds nothing. NaN where no estimate has a finite mean.
+
+    Args:
+        gd_mean, gd_lo, gd_hi, gd_true: (n,) each, 1e-6 m^3.
+    """
+    arrays = [float_array(a, n) for a, n in ((gd_mean, "gd_mean"), (gd_lo, "gd_lo"),
+                                            (gd_hi, "gd_hi"), (gd_true, "gd_true"))]  # fmt: skip
+    gd_mean, gd_lo, gd_hi, gd_true = arrays
+    if gd_mean.ndim != 1 or any(a.shape != gd_mean.shape for a in arrays):
+        shapes = ", ".join(str(a.shape) for a in arrays)
+        raise ControlError(
+            f"gd_mean, gd_lo, gd_hi and gd_true must be 1-D of one length, got shapes {shapes}"
+        )
+    ok = np.isfinite(gd_mean)
+    if not ok.any():
+        return float("nan")
+    return float(np.mean((gd_lo[ok] <= gd_true[ok]) & (gd_true[ok] <= gd_hi[ok])))
+
+
 def fast_on_rough_m(
     track, position: np.ndarray, speed: np.ndarray, gd_max: float, v_safe: float, tol: float = 0.02
 ) -> float:
