@@ -15,6 +15,7 @@ from types import ModuleType
 import numpy as np
 
 from gpmsa._fp_state import underflow_as_zero
+from gpmsa._version import library_versions
 from gpmsa.errors import BackendUnavailableError, GPMSAError
 from gpmsa.mcmc.sampler import Chains, check_sample_args
 
@@ -287,6 +288,12 @@ def recorded_options(options: dict) -> dict:
     name; other values left out."""
     recorded = {k: _recorded_option(v) for k, v in sorted(options.items())}
     return {k: v for k, v in recorded.items() if v is not _UNRECORDED}
+
+
+def recorded_versions(backend: str) -> dict[str, str]:
+    """The versions of what runs on ``backend`` as ``fit``'s settings and ``calibrate``'s info
+    record them (`gpmsa._version.library_versions`: a plug-in's module too)."""
+    return library_versions(backend, None if backend in BUILTIN else get(backend))
 
 
 def placement(backend: str, n_jobs=None, executor=None) -> dict:

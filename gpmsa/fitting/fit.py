@@ -12,7 +12,6 @@ import numpy as np
 
 from gpmsa import backends
 from gpmsa._fp_state import underflow_as_zero
-from gpmsa._version import library_versions
 from gpmsa.errors import GPMSAError, NuggetWarning, user_stacklevel
 from gpmsa.fitting.continuation import (
     HOT_RECORD,
@@ -406,9 +405,7 @@ def fit(
                 chains.info["level_offsets"], data.t_names, prep.standardizer.t_min,
                 prep.standardizer.t_max, tuple(data.levels)[len(data.x_names):])}),
         "fitted_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
-        "versions": library_versions(
-            backend, None if backend in backends.BUILTIN else backends.get(backend)
-        ),
+        "versions": backends.recorded_versions(backend),
     }  # fmt: skip
     if obs is not None and discrepancy is not None:  # full_prediction refuses another basis
         source = (resumed.settings or {}) if continuing else None  # keeps its scale
