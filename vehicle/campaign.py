@@ -798,14 +798,28 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     the same; vehicle does not import gpmsa.)"""
     processes = list((getattr(pool, "_processes", None) or {}).values())
     manager = getattr(pool, "_executor_manager_thread", None)  # shutdown forgets it
+    results = getattr(pool, "_result_queue", None)  # this too
     pool.shutdown(wait=False, cancel_futures=True)
     for proc in processes:
         if proc.is_alive():
             proc.terminate()
     for proc in processes:
         proc.join(timeout=_JOIN_S)
+    if all(not proc.is_alive() for proc in processes):
+        _close_writer(results)
     if manager is not None:  # it takes the pool's locks: a fork while it runs inherits them
         manager.join(timeout=_JOIN_S)
+
+
+def _close_writer(results: object) -> None:
+    """Close this process's end of a pool's result pipe (its workers all ended): a worker ended
+    while it sent a result leaves the rest of that message unwritten, and the pool's manager
+    thread would wait for it for ever (the interpreter joins that thread at exit: it would never
+    end); with no writer left it reads an end of file, and winds down as after any broken
+    worker. Nothing in this process writes there."""
+    writer = getattr(results, "_writer", None)
+    if writer is not None:
+        writer.close()
 
 
 def _end_with_parent(owner: int | None = None, started=None) -> None:
