@@ -48,6 +48,7 @@ from gpmsa.io.container import (
     write_raw,
 )
 from gpmsa.limits import check_memory
+from gpmsa.mcmc.diagnostics import read_back, read_back_convergence
 from gpmsa.model import categorical as categorical_mod
 from gpmsa.model import kronecker
 from gpmsa.model.correlation import correlation
@@ -990,14 +991,18 @@ class Emulator:
             units = {k: tuple(manifest["units"][k]) for k in ("x", "t", "y")}
             draws = {k[5:]: v for k, v in arrays.items() if k.startswith("draw_")}
             cal = {k[4:]: v for k, v in arrays.items() if k.startswith("cal_")} or None
+            shapes = {k: v.shape[1:] for k, v in {**(cal or {}), **draws}.items()}
+            convergence = read_back_convergence(manifest.get("convergence"), shapes)
+            flagged = convergence.get("flagged") if isinstance(convergence, dict) else None
             emu = cls(
                 standardizer=std, x_unit=arrays["x_unit"], t_unit=arrays["t_unit"],
                 y=arrays["y"], K=arrays["K"], w=arrays["w"], index=arrays.get("index"),
                 params={k: arrays[f"param_{k}"] for k in EMULATOR_PARAMS},
                 priors=Priors.from_dict(manifest["priors"]), names=names, units=units,
                 draws=draws, log_post=arrays["log_post"], metadata=manifest["metadata"],
-                settings=manifest["settings"], diagnostics=manifest["diagnostics"],
-                calibration=cal, convergence=manifest.get("convergence"),  # check_fields checked it
+                settings=manifest["settings"],
+                diagnostics=read_back(manifest["diagnostics"], shapes, flagged),  # NaN, inf
+                calibration=cal, convergence=convergence,  # check_fields checked it
                 levels=_levels(manifest, names), mean_basis=_mean_basis(manifest, names),
                 discrepancy_bases=split_bases(arrays, manifest["settings"]),
                 separable=kron_groups(arrays),

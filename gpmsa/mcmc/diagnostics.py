@@ -320,6 +320,56 @@ def convergence(
     }
 
 
+def read_back(summary: dict, shapes: dict[str, tuple[int, ...]], flagged: dict | None = None
+              ) -> dict:  # fmt: skip
+    """``summarize``'s output as a file's JSON stores it (non-finite numbers as null) read
+    back: a null inside a list as NaN (constant chains, one draw's sd, a rate not computed), or
+    as inf for an R-hat whose element the convergence record's ``flagged`` calls infinite
+    (`INFINITE_RHAT`: chains stuck apart). ``shapes``: name -> element shape (for the element
+    names). A field stored whole as null (no rates) stays None; anything else is kept as it
+    is (the file's checks judged it). ``summary`` is not changed."""
+    flagged = flagged or {}
+    return {
+        name: {key: _nulls_read(v, name, shapes, flagged, rhat=key == "rhat")
+               for key, v in entry.items()} if isinstance(entry, dict) else entry
+        for name, entry in summary.items()
+    }  # fmt: skip
+
+
+def read_back_convergence(record, shapes: dict[str, tuple[int, ...]]):
+    """A `convergence` record as a file stores it read back as `read_back` reads a summary:
+    its "rhat" and "ess" lists' nulls as NaN, or inf where its "flagged" calls the R-hat
+    infinite ("max_rhat" and "min_ess" keep None: `convergence` writes None there). ``record``
+    is not changed; one that is no dict (None: none recorded) comes back as it is."""
+    if not isinstance(record, dict):
+        return record
+    flagged = record.get("flagged")
+    flagged = flagged if isinstance(flagged, dict) else {}
+    out = dict(record)
+    for key in ("rhat", "ess"):
+        if isinstance(record.get(key), dict):
+            out[key] = {name: _nulls_read(v, name, shapes, flagged, rhat=key == "rhat")
+                        for name, v in record[key].items()}  # fmt: skip
+    return out
+
+
+def _nulls_read(values, name: str, shapes: dict, flagged: dict, rhat: bool):
+    """``values`` with each None item as NaN (inf for a flagged infinite R-hat); ``values`` as
+    it is where it is no list."""
+    if not isinstance(values, list):
+        return values
+    names = None
+    if rhat and name in shapes and int(np.prod(shapes[name])) == len(values):
+        names = element_names(name, tuple(shapes[name]))
+    out = []
+    for i, v in enumerate(values):
+        if v is None:
+            why = flagged.get(names[i], "") if names is not None else ""
+            v = np.inf if isinstance(why, str) and why.startswith(INFINITE_RHAT) else np.nan
+        out.append(v)
+    return out
+
+
 def warn_unconverged(record: dict, what: str, length: str = "n_iter",
                      more: str = "", names: dict[str, str] | None = None) -> None:  # fmt: skip
     """Warn (``gpmsa.ConvergenceWarning``) naming every flagged element of a convergence record

@@ -1,5 +1,6 @@
 """Round-trip fidelity of emulator files: ``load(save(emu))`` holds every field a user reaches
-(the JSON records as ``jsonable`` writes them: tuples as lists, non-finite floats as None), a
+(the JSON records as ``jsonable`` writes them: tuples as lists, non-finite floats as None; the
+diagnostics and convergence record with their NaN and inf, since session 89), a
 re-save keeps every member of the file (only ``created_utc`` and the hash that covers it
 change), and the loaded emulator predicts and continues its chains bit for bit as the one in
 memory. A sweep of session 86 (fit varieties x these checks) found no loss; this keeps it so."""
@@ -13,7 +14,8 @@ import gpmsa
 from gpmsa.io.container import jsonable, read_raw
 
 ARRAYS = ("x_unit", "t_unit", "y", "K", "w", "lam_sim", "index", "log_post")
-RECORDS = ("settings", "diagnostics", "convergence", "metadata")
+RECORDS = ("settings", "metadata")
+NUMERIC_RECORDS = ("diagnostics", "convergence")  # read back with their NaN and inf
 PLAIN = ("x_names", "t_names", "y_names", "x_units", "t_units", "y_units", "index_names",
          "index_units", "levels", "priors", "domain", "given_ranges", "model_sha256")  # fmt: skip
 
@@ -48,6 +50,21 @@ def _same_array(a, b) -> bool:
     return a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b, equal_nan=True)
 
 
+def _same_numbers(a, b) -> bool:
+    """Equal records, NaN equal to NaN (a float's type kept: no None for NaN)."""
+    if isinstance(a, dict):
+        return (
+            isinstance(b, dict)
+            and a.keys() == b.keys()
+            and all(_same_numbers(a[k], b[k]) for k in a)
+        )
+    if isinstance(a, (list, tuple)):
+        return isinstance(b, list) and len(a) == len(b) and all(map(_same_numbers, a, b))
+    if isinstance(a, float):
+        return isinstance(b, float) and (a == b or (np.isnan(a) and np.isnan(b)))
+    return a == b
+
+
 def _assert_same(a: gpmsa.Emulator, b: gpmsa.Emulator) -> None:
     for name in ARRAYS:
         assert _same_array(getattr(a, name), getattr(b, name)), name
@@ -56,6 +73,8 @@ def _assert_same(a: gpmsa.Emulator, b: gpmsa.Emulator) -> None:
         assert set(x) == set(y) and all(_same_array(x[k], y[k]) for k in x), name
     for name in RECORDS:
         assert jsonable(getattr(a, name)) == getattr(b, name), name
+    for name in NUMERIC_RECORDS:
+        assert _same_numbers(getattr(a, name), getattr(b, name)), name
     for name in PLAIN:
         assert getattr(a, name) == getattr(b, name), name
     std_a, std_b = a.standardizer, b.standardizer
