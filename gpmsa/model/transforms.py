@@ -81,7 +81,8 @@ def _domain(arr: np.ndarray, ranges) -> tuple[np.ndarray, np.ndarray, tuple[bool
     for j, r in enumerate(ranges):
         if r is not None:
             lo[j], hi[j] = r
-    return lo, hi, tuple(r is not None for r in ranges)
+    flags = tuple(r is not None for r in ranges)
+    return lo, hi, flags if any(flags) else ()  # none given reads () (as a file's none does)
 
 
 @dataclass(frozen=True, eq=False)
