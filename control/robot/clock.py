@@ -43,8 +43,14 @@ RESTAMP_SPLIT_PERIODS = 16.0
 afresh: after a pause or a clock step the phase is another."""
 RESTAMP_MOVE_PERIODS = 0.75
 """Two messages rounded onto one slot next to an empty one: the one nearer the empty slot moves
-there when that puts it within this many periods of the clock (a late or early sample, not a
-duplicate: a duplicate stays a repeated stamp)."""
+there when that puts it within this many periods of that slot's centre on the rounding phase
+(`_cut_phase`: the clock itself for jitter symmetric about it; for receive times, late only, the
+middle of where a slot's messages arrive, so that a message late by most of a period still goes
+back to its slot) (a late or early sample, not a duplicate: a duplicate stays a repeated
+stamp). Measured from the fitted clock instead, all 10 such pairs of 20,000 receive times with
+exponential latency (mean 0.12 period) stayed (20 stamp faults, against 0); a lone message off
+exact stamps by 0.625 period, which leaves the rounding phase 0.17 period off the clock, stays
+a repeated stamp (a fault: one odd message cannot tell where its slot's messages arrive)."""
 
 
 @dataclass(frozen=True)
