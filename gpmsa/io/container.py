@@ -164,7 +164,7 @@ def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
         )
     try:
         raw = json.dumps(manifest, indent=1, sort_keys=True, allow_nan=False).encode()
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, RecursionError) as exc:  # NaN, a set, nested too deep
         raise GPMSAError(f"the manifest is not JSON-able ({exc})") from exc
     if len(raw) > limits.MAX_MANIFEST_BYTES:
         sizes = {k: len(json.dumps(v, allow_nan=False)) for k, v in manifest.items()}
@@ -249,6 +249,10 @@ def seal(manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT) ->
         "created_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "arrays": {k: {"shape": list(v.shape), "dtype": v.dtype.str} for k, v in arrays.items()},
     }
+    try:  # the hash encodes the manifest first: a NaN or a set would raise from json
+        _canonical(manifest)
+    except (TypeError, ValueError, RecursionError) as exc:
+        raise GPMSAError(f"the manifest is not JSON-able ({exc})") from exc
     manifest["content_sha256"] = content_hash(arrays, manifest)
     return manifest, check_writable(manifest, arrays)
 
