@@ -163,7 +163,7 @@ def check_writable(manifest: dict, arrays: dict[str, np.ndarray]) -> bytes:
             "the limit (on every reader's machine too)"
         )
     try:
-        raw = json.dumps(manifest, indent=1, sort_keys=True, allow_nan=False).encode()
+        raw = json.dumps(manifest, indent=1, allow_nan=False).encode()  # the record's order
     except (TypeError, ValueError, RecursionError) as exc:  # NaN, a set, nested too deep
         raise GPMSAError(f"the manifest is not JSON-able ({exc})") from exc
     if len(raw) > limits.MAX_MANIFEST_BYTES:
