@@ -21,6 +21,7 @@ import hashlib
 import json
 import math
 import multiprocessing
+import multiprocessing.connection
 import os
 import queue
 import re
@@ -39,6 +40,7 @@ import zlib
 from collections import Counter
 from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -678,7 +680,7 @@ def run_campaign(
         try:  # (a pool broken while runs are still submitted refuses the next submit)
             for i in todo:
                 futures[pool.submit(run_one, specs[i], None if cache is None else str(cache))] = i
-            for fut in _completed(futures):
+            for fut in _completed(futures, pool if own else None):
                 results[futures[fut]] = fut.result()
                 bar.update()
         except BrokenExecutor as exc:
@@ -772,21 +774,54 @@ _JOIN_S = 5.0
 """Seconds to wait for a terminated worker process to exit."""
 
 
-def _completed(futures: dict[Future, int]):
+_STUCK_S = 2.0
+"""Seconds a worker of the campaign's own pool may have ended while the pool is not marked
+broken before the wait gives up (`_check_stuck`); the pool marks itself broken within
+milliseconds of a worker's end unless its manager thread is reading a result that worker was
+sending."""
+
+
+def _completed(futures: dict[Future, int], pool: ProcessPoolExecutor | None = None):
     """``as_completed(futures)``, waking every `_POLL_S` seconds so that an interrupt taken by
     another thread is acted on within that time (each future reports itself done to a queue:
-    O(1) a wake, where re-waiting on the pending futures would cost O(runs))."""
+    O(1) a wake, where re-waiting on the pending futures would cost O(runs)), and checking our
+    own ``pool`` (None: a user's executor) for a worker killed mid-send (`_check_stuck`)."""
     done: queue.SimpleQueue[Future] = queue.SimpleQueue()
     for fut in futures:
         fut.add_done_callback(done.put)
+    ended_since = None
     for _ in range(len(futures)):
         while True:
             try:
                 fut = done.get(timeout=_POLL_S)
             except queue.Empty:
+                ended_since = _check_stuck(pool, ended_since)
                 continue
             break
         yield fut
+
+
+def _check_stuck(pool: ProcessPoolExecutor | None, since: float | None) -> float | None:
+    """When (``time.monotonic``) a worker of our own ``pool`` was first seen ended while the
+    pool is not marked broken, None while none is; BrokenProcessPool once that has lasted
+    `_STUCK_S`. A worker killed while it sent a result (the OOM killer, ``kill -9``) leaves the
+    pool's manager thread reading the rest of that message for ever: it never marks the pool
+    broken, and the run's future never finishes (`_stop`, called then, ends the manager)."""
+    if pool is None or getattr(pool, "_broken", False):
+        return None
+    sentinels = [p.sentinel for p in (getattr(pool, "_processes", None) or {}).values()]
+    if not sentinels or not multiprocessing.connection.wait(sentinels, timeout=0):
+        return None
+    now = time.monotonic()
+    if since is None:
+        return now
+    if now - since < _STUCK_S:
+        return since
+    raise BrokenProcessPool(
+        "a campaign worker process ended while it sent its run's result (killed: out of "
+        "memory?); the pool cannot go on: run the campaign again (finished runs are cached "
+        "with cache_dir)"
+    )
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:

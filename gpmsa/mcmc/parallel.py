@@ -30,6 +30,7 @@ import asyncio
 import gc
 import importlib
 import multiprocessing
+import multiprocessing.connection
 import multiprocessing.context
 import os
 import select
@@ -47,6 +48,7 @@ from concurrent.futures import (
     ProcessPoolExecutor,
     wait,
 )
+from concurrent.futures.process import BrokenProcessPool
 from numbers import Number
 
 import numpy as np
@@ -425,6 +427,31 @@ hand a process's SIGINT (Ctrl-C) to any of its threads, BLAS's or the pool's; Py
 in the main thread only, and a wait without a timeout would hold it until a chain ends."""
 
 
+_STUCK_S = 2.0
+"""Seconds a worker of our own pool may have ended while the pool is not marked broken before
+the wait takes the pool as broken (`_ended_mid_send`); the pool marks itself broken within
+milliseconds of a worker's end unless its manager thread is reading a result that worker was
+sending."""
+
+
+def _ended_mid_send(pool: ProcessPoolExecutor, first_seen: list[float]) -> bool:
+    """Whether a worker of our own ``pool`` has been seen ended for `_STUCK_S` while the pool is
+    not marked broken (``first_seen``: [] or [when it was first seen, ``time.monotonic``],
+    updated). A worker killed while it sent a chain's draws (the OOM killer, ``kill -9``) leaves
+    the pool's manager thread reading the rest of that message for ever: it never marks the pool
+    broken, and the chain's future never finishes (`_stop`, called then, ends the manager)."""
+    sentinels = [p.sentinel for p in (getattr(pool, "_processes", None) or {}).values()]
+    if getattr(pool, "_broken", False) or not sentinels:
+        first_seen.clear()
+        return False
+    if not multiprocessing.connection.wait(sentinels, timeout=0):
+        first_seen.clear()
+        return False
+    if not first_seen:
+        first_seen.append(time.monotonic())
+    return time.monotonic() - first_seen[0] >= _STUCK_S
+
+
 def _stop(pool: ProcessPoolExecutor) -> None:
     """Shut our pool down at once: cancel the chains not started and end the workers still
     running one (``terminate_workers`` of Python 3.14), so that a failed or interrupted run
@@ -609,8 +636,17 @@ def _parallel(fn, tasks, executor, workers, progress, desc, retries, what):
     try:
         for i in range(n):
             _submit_checked(i)
+        first_seen: list[float] = []
         while running:
             done, _ = wait(list(running), timeout=_POLL_S, return_when=FIRST_COMPLETED)
+            if not done and own and _ended_mid_send(pool, first_seen):
+                first_seen.clear()
+                fut, i = next(iter(running.items()))  # the pool is broken: as after any death
+                del running[fut]
+                retry_or_raise(i, BrokenProcessPool(
+                    "a worker process ended while it sent a result (killed: out of memory?)"
+                ))  # fmt: skip
+                continue
             for fut in done:
                 i = running.pop(fut, None)
                 if i is None:  # resubmitted after its pool broke

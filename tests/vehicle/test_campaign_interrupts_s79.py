@@ -27,8 +27,8 @@ def test_a_killed_campaign_takes_its_pool_workers_with_it(tmp_path):
 
         real = campaign._completed
 
-        def first_then_killed(futures):
-            for fut in real(futures):  # a run has finished: the workers are up
+        def first_then_killed(futures, pool=None):
+            for fut in real(futures, pool):  # a run has finished: the workers are up
                 print(*[p.pid for p in multiprocessing.active_children()], flush=True)
                 os.kill(os.getpid(), signal.SIGKILL)
                 yield fut
