@@ -10,19 +10,18 @@ their gpmsa version, which must be this process's: dask would wait forever for a
 unpickle, and another version runs other code on other data. A worker that does not answer
 within ``WORKER_CHECK_S`` is named in a GPMSAError.
 
-Failures: a task that raises ``GPMSAError`` (bad input, the same on any machine) stops the run
-with ``ChainError`` naming the chain. Any other failure (a worker that died, a lost connection,
-an executor whose ``submit`` raises) is retried ``retries`` times, with a ``RuntimeWarning``,
-in a fresh pool when the pool was ours; then ``ChainError`` names the chain and the cause (at
-once where a worker of ours that spawn or forkserver started ended while starting: a script
-without an ``if __name__ == "__main__":`` block, or read from standard input). A
-chain is never dropped silently. When a run stops early (a chain failed, or KeyboardInterrupt),
-the chains not yet finished are cancelled: gpmsa's own worker processes are ended, an
-executor's futures cancelled. Ctrl-C stops a parallel run within a quarter of a second,
-whichever of the process's threads the kernel hands the signal to. A process killed outright
-(SIGTERM, SIGKILL), whose cleanup never runs, takes its own workers with it
-(`end_with_parent`).
-"""
+Failures: a task that raises ``GPMSAError`` (bad input, the same on any machine) stops the run with
+``ChainError`` naming the chain. Any other failure (a worker that died, also one killed while it
+sent its draws, which the pool itself would wait on for ever: `_ended_mid_send`; a lost connection,
+an executor whose ``submit`` raises) is retried ``retries`` times, with a ``RuntimeWarning``, in a
+fresh pool when the pool was ours; then ``ChainError`` names the chain and the cause (at once where
+a worker of ours that spawn or forkserver started ended while starting: a script without an ``if
+__name__ == "__main__":`` block, or read from standard input). A chain is never dropped silently.
+When a run stops early (a chain failed, or KeyboardInterrupt), the chains not yet finished are
+cancelled: gpmsa's own worker processes are ended, an executor's futures cancelled. Ctrl-C stops a
+parallel run within a quarter of a second, whichever of the process's threads the kernel hands the
+signal to. A process killed outright (SIGTERM, SIGKILL), whose cleanup never runs, takes its own
+workers with it (`end_with_parent`)."""
 
 from __future__ import annotations
 
