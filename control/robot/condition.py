@@ -311,7 +311,7 @@ def to_rate(
         bad_nan[j] = not finite[lo : kept[j]].all()
     step = np.diff(t[kept], prepend=-np.inf)
     start = dropped_before | (step > GAP_PERIODS / rate_hz)
-    start[0] = True
+    start[:1] = True  # (no sample kept: no run)
     bounds = np.concatenate([np.flatnonzero(start), [kept.size]])
     out_t, out_a, runs = [], [], 0
     for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
