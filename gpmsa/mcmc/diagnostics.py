@@ -320,15 +320,16 @@ def convergence(
     }
 
 
-def read_back(summary: dict, shapes: dict[str, tuple[int, ...]], flagged: dict | None = None
+def read_back(summary: dict, shapes: dict[str, tuple[int, ...]], flagged: object = None
               ) -> dict:  # fmt: skip
     """``summarize``'s output as a file's JSON stores it (non-finite numbers as null) read
     back: a null inside a list as NaN (constant chains, one draw's sd, a rate not computed), or
     as inf for an R-hat whose element the convergence record's ``flagged`` calls infinite
     (`INFINITE_RHAT`: chains stuck apart). ``shapes``: name -> element shape (for the element
-    names). A field stored whole as null (no rates) stays None; anything else is kept as it
-    is (the file's checks judged it). ``summary`` is not changed."""
-    flagged = flagged or {}
+    names; a ``flagged`` that is no dict, which a file's checks let pass, names none). A field
+    stored whole as null (no rates) stays None; anything else is kept as it is (the file's
+    checks judged it). ``summary`` is not changed."""
+    flagged = flagged if isinstance(flagged, dict) else {}
     return {
         name: {key: _nulls_read(v, name, shapes, flagged, rhat=key == "rhat")
                for key, v in entry.items()} if isinstance(entry, dict) else entry
