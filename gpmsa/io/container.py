@@ -76,6 +76,24 @@ def jsonable(obj):
     return obj
 
 
+def _key_not_str(obj, where: str) -> str | None:
+    """Where the first dict key of ``obj`` (dicts and lists within) that is not a str lies
+    ("manifest['metadata']: key 2 (int)"), or None."""
+    if isinstance(obj, dict):
+        for key, value in obj.items():
+            if not isinstance(key, str):
+                return f"{where}: key {key!r:.40} ({type(key).__name__})"
+            found = _key_not_str(value, f"{where}[{key!r:.40}]")
+            if found is not None:
+                return found
+    elif isinstance(obj, (list, tuple)):
+        for i, value in enumerate(obj):
+            found = _key_not_str(value, f"{where}[{i}]")
+            if found is not None:
+                return found
+    return None
+
+
 def _canonical(manifest: dict) -> bytes:
     body = {k: v for k, v in manifest.items() if k != "content_sha256"}
     return json.dumps(body, sort_keys=True, separators=(",", ":"), allow_nan=False).encode()
@@ -251,8 +269,14 @@ def seal(manifest: dict, arrays: dict[str, np.ndarray], *, fmt: str = FORMAT) ->
     }
     try:  # the hash encodes the manifest first: a NaN or a set would raise from json
         _canonical(manifest)
+        where = _key_not_str(manifest, "manifest")
     except (TypeError, ValueError, RecursionError) as exc:
         raise GPMSAError(f"the manifest is not JSON-able ({exc})") from exc
+    if where is not None:  # JSON writes 2 as "2": the reader's hash would sort it otherwise
+        raise GPMSAError(
+            f"{where}: the manifest's keys must be strings (JSON writes them as strings, so "
+            "the file would not read back as written)"
+        )
     manifest["content_sha256"] = content_hash(arrays, manifest)
     return manifest, check_writable(manifest, arrays)
 

@@ -375,3 +375,21 @@ def test_the_content_hash_is_the_documented_sha256_so_saved_files_stay_readable(
     ).hexdigest()
     assert want == "2e9b0daa76c27d39cf8d09b3fc51d9386de0a8f57f8cbfff5b68096e0bcfb061"
     assert container.content_hash(arrays, manifest) == want
+
+
+@pytest.mark.parametrize(
+    ("metadata", "where"),
+    [
+        ({2: 1, 10: 2}, r"manifest\['metadata'\]: key 2 \(int\)"),
+        ({"runs": [{"a": 1}, {1.5: 2}]}, r"manifest\['metadata'\]\['runs'\]\[1\]: key 1.5"),
+        ({"ok": {True: 1}}, r"key True \(bool\)"),
+    ],
+)
+def test_a_manifest_with_keys_that_are_not_strings_is_refused_by_the_writer(
+    tmp_path, metadata, where
+):
+    # JSON writes 2 as "2": the writer hashed the keys sorted as numbers, the reader as strings,
+    # and the file it wrote failed its own content hash ("edited or damaged")
+    with pytest.raises(GPMSAError, match=where + ".*keys must be strings"):
+        write_raw(tmp_path / "k.gpmsa", dict(CONTENT, metadata=metadata), {"x": np.ones(3)})
+    assert not (tmp_path / "k.gpmsa").exists()
