@@ -5,6 +5,8 @@ from __future__ import annotations
 import multiprocessing.context
 import os
 import signal
+import struct
+import sys
 import time
 
 
@@ -46,3 +48,36 @@ def assert_workers_end(workers: list[int], wait_s: float = 30.0) -> None:
         for w in workers:
             if alive(w):
                 os.kill(w, signal.SIGKILL)
+
+
+def send_half_a_result() -> None:
+    """In a worker of a ``concurrent.futures`` process pool: write the header of a 1 MiB result
+    and 10 of its bytes to the pool's result pipe, as a worker cut off while it sends a result
+    leaves it (the pool's manager thread then waits for the rest)."""
+    frame = sys._getframe()
+    while frame.f_code.co_name != "_process_worker":
+        frame = frame.f_back
+    writer = frame.f_locals["result_queue"]._writer
+    os.write(writer.fileno(), struct.pack("!i", 1 << 20) + b"x" * 10)
+
+
+def half_result_then_wait(marker: str) -> None:
+    """`send_half_a_result`, create the file ``marker``, then wait to be ended (60 s)."""
+    send_half_a_result()
+    with open(marker, "w"):
+        pass
+    time.sleep(60.0)
+
+
+def half_result_then_die(*_args, **_kwargs) -> None:
+    """`send_half_a_result`, then die as the OOM killer ends a process (SIGKILL)."""
+    send_half_a_result()
+    os.kill(os.getpid(), signal.SIGKILL)
+
+
+def wait_for(path: str, seconds: float = 60.0) -> None:
+    """Wait until the file ``path`` exists (AssertionError after ``seconds``)."""
+    deadline = time.monotonic() + seconds
+    while not os.path.exists(path):
+        assert time.monotonic() < deadline, f"{path} never appeared"
+        time.sleep(0.01)

@@ -6,40 +6,19 @@ once the workers are gone, so the manager thread reads an end of file and winds 
 
 import multiprocessing
 import os
-import struct
-import time
 from concurrent.futures import ProcessPoolExecutor
 
 import pytest
+from _processes import half_result_then_wait, wait_for
 
 from vehicle import campaign
-
-_writer_fd: list[int] = []
-"""The result pipe's write end, inherited by the forked worker."""
-
-
-def send_half_a_result(marker: str) -> None:
-    """Write the header of a 1 MiB message and 10 of its bytes to the result pipe, as a worker
-    cut off mid-send leaves it, then wait to be ended."""
-    os.write(_writer_fd[0], struct.pack("!i", 1 << 20) + b"x" * 10)
-    with open(marker, "w"):
-        pass
-    time.sleep(60.0)
-
-
-def wait_for(path: str, seconds: float = 60.0) -> None:
-    deadline = time.monotonic() + seconds
-    while not os.path.exists(path):
-        assert time.monotonic() < deadline, "the worker never wrote its part of a result"
-        time.sleep(0.01)
 
 
 @pytest.mark.skipif(os.name != "posix", reason="a forked worker")
 def test_a_worker_ended_mid_send_leaves_no_manager_thread(tmp_path):
     pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork"))
-    _writer_fd[:] = [pool._result_queue._writer.fileno()]
     marker = str(tmp_path / "sent")
-    future = pool.submit(send_half_a_result, marker)
+    future = pool.submit(half_result_then_wait, marker)
     wait_for(marker)
     manager = pool._executor_manager_thread
     campaign._stop(pool)

@@ -5,27 +5,14 @@ now sees a worker of its own pool ended while the pool is not marked broken, and
 pool is then stopped: no process and no thread left)."""
 
 import multiprocessing
-import os
-import signal
-import struct
 import sys
 import threading
 from concurrent.futures import BrokenExecutor, ProcessPoolExecutor
 
 import pytest
+from _processes import half_result_then_die
 
 from vehicle import campaign
-
-
-def half_send_then_die(*_args, **_kwargs) -> None:
-    """Write the header of a 1 MiB result and 10 of its bytes to the pool's result pipe, as a
-    worker killed mid-send leaves it, then die as the OOM killer ends a process."""
-    frame = sys._getframe()
-    while frame.f_code.co_name != "_process_worker":
-        frame = frame.f_back
-    writer = frame.f_locals["result_queue"]._writer
-    os.write(writer.fileno(), struct.pack("!i", 1 << 20) + b"x" * 10)
-    os.kill(os.getpid(), signal.SIGKILL)
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="a forked worker")
@@ -36,7 +23,7 @@ def test_the_wait_gives_up_on_a_worker_killed_mid_send(monkeypatch):
     rescue = threading.Timer(60.0, lambda: pool._result_queue._writer.close())  # no hang
     rescue.start()
     try:
-        futures = {pool.submit(half_send_then_die): 0}
+        futures = {pool.submit(half_result_then_die): 0}
         manager = pool._executor_manager_thread
         with pytest.raises(BrokenExecutor, match="ended while it sent"):
             for _ in campaign._completed(futures, pool):
@@ -57,7 +44,7 @@ def test_a_campaign_whose_worker_is_killed_mid_send_raises_instead_of_waiting(mo
     import vehicle
 
     monkeypatch.setattr(campaign, "_STUCK_S", 0.5)
-    monkeypatch.setattr(campaign, "run_one", half_send_then_die)
+    monkeypatch.setattr(campaign, "run_one", half_result_then_die)
     with pytest.raises(BrokenExecutor, match="ended while it sent"):
         vehicle.run_campaign(
             np.array([[0.7, 250.0], [1.6, 550.0]]), road_length_m=6.0, window=300,
