@@ -105,7 +105,7 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
 
     try:
         yield stage
-        folders = sorted({path.parent for _, path in staged}) if len(staged) > 1 else []
+        folders = _distinct_folders([path for _, path in staged]) if len(staged) > 1 else []
         with ExitStack() as locks:
             for folder in folders:
                 locks.enter_context(folder_lock(folder, error))
@@ -121,6 +121,21 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
             except OSError:
                 pass
         raise
+
+
+def _distinct_folders(paths: list[Path]) -> list[Path]:
+    """The folders of ``paths``, each once however it is named ("out" and "/home/me/out", or
+    through a link: two locks on one folder from one process wait for each other), ordered by
+    device and inode, the same for every process, so that two groups lock in one order. A
+    folder that cannot be found is left out (`folder_lock` could not open it either)."""
+    found: dict[tuple[int, int], Path] = {}
+    for path in paths:
+        try:
+            st = os.stat(path.parent)
+        except (OSError, ValueError):  # gone since it was staged: its move says so
+            continue
+        found.setdefault((st.st_dev, st.st_ino), path.parent)
+    return [found[key] for key in sorted(found)]
 
 
 def _close_quietly(fh: IO) -> None:
