@@ -158,15 +158,16 @@ def swap(states: list, betas: tuple[float, ...], u: np.ndarray, accepted: np.nda
     """One round of neighbour swaps: for k = 0 .. K - 2, copies k and k + 1 (``states``,
     ``ChainState``s or a study's ``StudyState``s at inverse temperatures ``betas``) exchange
     their states (``exchange``: the likelihood states, the parameters with them, and the running
-    log priors) where log u[k] is below the log acceptance ratio, on each copy's ``loglik``;
-    adds 1 to ``accepted[k]`` per swap and, given ``probs`` (K - 1,), sets probs[k] to the
-    proposal's acceptance probability min(1, exp(log ratio))."""
+    log priors) where log u[k] is below the log acceptance ratio (u[k] = 0: log u = -inf), on
+    each copy's ``loglik``; adds 1 to ``accepted[k]`` per swap and, given ``probs`` (K - 1,),
+    sets probs[k] to the proposal's acceptance probability min(1, exp(log ratio))."""
     for k in range(len(states) - 1):
         a, b = states[k], states[k + 1]
         log_r = (betas[k] - betas[k + 1]) * (b.loglik - a.loglik)
         if probs is not None:
             probs[k] = math.exp(min(log_r, 0.0))
-        if math.log(u[k]) < log_r:
+        log_u = math.log(u[k]) if u[k] > 0.0 else -math.inf  # random() may give 0.0
+        if log_u < log_r:
             a.exchange(b)
             accepted[k] += 1
 
