@@ -29,6 +29,7 @@ from gpmsa.calibration.model import FixedGP, lower_solve
 from gpmsa.calibration.observations import Observations
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import level_moves, tuning
+from gpmsa.mcmc.acceptance import log_uniform
 from gpmsa.model.categorical import snap_to_levels
 from gpmsa.model.constraints import ThetaConstraint
 from gpmsa.model.correlation import correlation_row
@@ -536,7 +537,7 @@ class _State:
                 continue
             ey = pred.at(cand)
             ll = _loglik(ey, self.lam)
-            if math.log(u[2 * i + 1]) < ll - self.ll + lp_new - self.lp_theta:
+            if log_uniform(u[2 * i + 1]) < ll - self.ll + lp_new - self.lp_theta:
                 self.theta, self.ey, self.ll, self.lp_theta = cand, ey, ll, lp_new
                 accepted[i] += 1
         if not s.held_lamos:
@@ -556,12 +557,12 @@ class _State:
             lp_new = s._log_prior_lamos(cand_l) if cand_l > 0.0 else -math.inf
             if lp_new != -math.inf:
                 ll = _loglik(self.ey, cand_l)
-                if math.log(u[2 * q + 1]) < ll - self.ll + lp_new - self.lp_lam + corr:
+                if log_uniform(u[2 * q + 1]) < ll - self.ll + lp_new - self.lp_lam + corr:
                     self.lam, self.ll, self.lp_lam = cand_l, ll, lp_new
                     accepted[q] += 1
         if len(s.preds) > 1:
             k = int(u[2 * q + 2] * len(s.preds))
             ey = s.preds[k].at(self.theta)
             ll = _loglik(ey, self.lam)
-            if math.log(u[2 * q + 3]) < ll - self.ll:
+            if log_uniform(u[2 * q + 3]) < ll - self.ll:
                 self.k, self.ey, self.ll = k, ey, ll

@@ -26,6 +26,7 @@ from gpmsa._threads import one_thread
 from gpmsa.errors import ChainError, GPMSAError
 from gpmsa.limits import check_memory
 from gpmsa.mcmc import level_moves, ridge, starts, tempering, tuning
+from gpmsa.mcmc.acceptance import log_uniform
 from gpmsa.mcmc.parallel import run_chains
 from gpmsa.model.data import as_float, check_count, check_flag, check_seed
 from gpmsa.model.kronecker import KroneckerLikelihood
@@ -263,7 +264,7 @@ class ChainState:
         ll_new = lik.propose_theta(theta)
         if ll_new == -math.inf:
             return
-        if math.log(u1) < (ll_new - ll_old) * self.beta + d_lp:
+        if log_uniform(u1) < (ll_new - ll_old) * self.beta + d_lp:
             lik.accept()
             self.log_prior += d_lp
             accepted[i] += 1
@@ -376,7 +377,7 @@ class ChainState:
             if ll_new == -math.inf:
                 continue
             lp_old = prior(x)
-            if math.log(u[i, 1]) < (ll_new - ll_old) * beta + lp_new - lp_old + corr:
+            if log_uniform(u[i, 1]) < (ll_new - ll_old) * beta + lp_new - lp_old + corr:
                 lik.accept()
                 self.log_prior += lp_new - lp_old
                 accepted[i] += 1
@@ -398,7 +399,7 @@ class ChainState:
             if lp_new == -math.inf:
                 continue
             lp_old = g_s(s) + g_t(t)
-            if math.log(u1) < lp_new - lp_old + ridge.log_jacobian_ratio(s, t, s2, t2):
+            if log_uniform(u1) < lp_new - lp_old + ridge.log_jacobian_ratio(s, t, s2, t2):
                 lik.params = {**lik.params, "lamWs": np.array([s2]), "lamWOs": np.array([t2])}
                 self.log_prior += lp_new - lp_old
                 self.ridge_accepted += 1

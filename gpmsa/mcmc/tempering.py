@@ -54,6 +54,7 @@ from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import tuning
+from gpmsa.mcmc.acceptance import log_uniform
 from gpmsa.model.data import check_count, check_flag
 from gpmsa.model.problem import Problem
 
@@ -166,8 +167,7 @@ def swap(states: list, betas: tuple[float, ...], u: np.ndarray, accepted: np.nda
         log_r = (betas[k] - betas[k + 1]) * (b.loglik - a.loglik)
         if probs is not None:
             probs[k] = math.exp(min(log_r, 0.0))
-        log_u = math.log(u[k]) if u[k] > 0.0 else -math.inf  # random() may give 0.0
-        if log_u < log_r:
+        if log_uniform(u[k]) < log_r:  # (u = 0: -inf)
             a.exchange(b)
             accepted[k] += 1
 

@@ -33,6 +33,7 @@ from gpmsa._progress import progress_bar
 from gpmsa._threads import one_thread
 from gpmsa.errors import GPMSAError
 from gpmsa.mcmc import level_moves, starts, tempering, tuning
+from gpmsa.mcmc.acceptance import log_uniform
 from gpmsa.mcmc.parallel import in_this_process, run_chains
 from gpmsa.mcmc.sampler import DEFAULT_WIDTHS, ChainState, default_widths, require_finite
 from gpmsa.model.problem import Problem
@@ -276,7 +277,7 @@ class StudyState:
                 dll += ll - lik.loglik
             if dll == -math.inf:
                 continue
-            if math.log(u[e, 1]) < dll * beta + lp_new - self._theta_lp(e, x):
+            if log_uniform(u[e, 1]) < dll * beta + lp_new - self._theta_lp(e, x):
                 for i, _ in el.uses:
                     self.states[i].lik.accept()
                 self.g[e] = cand
@@ -290,13 +291,14 @@ class StudyState:
             cur = self._group_lp(h, mu, lam)
             cand = mu + widths[o] * (u[G + 2 * h, 0] - 0.5)
             new = self._group_lp(h, cand, lam)
-            if math.log(u[G + 2 * h, 1]) < new - cur:
+            if log_uniform(u[G + 2 * h, 1]) < new - cur:
                 self.mu[h], mu, cur = cand, cand, new
                 accepted[o] += 1
             step = widths[o + 1] * (u[G + 2 * h + 1, 0] - 0.5)
             cand = lam * math.exp(step)
             new = self._group_lp(h, mu, cand)
-            if math.log(u[G + 2 * h + 1, 1]) < new - cur + step:  # step = log(lam'/lam): Hastings
+            # step = log(lam'/lam): the Hastings factor
+            if log_uniform(u[G + 2 * h + 1, 1]) < new - cur + step:
                 self.lam[h] = cand
                 accepted[o + 1] += 1
             o += 2
@@ -366,7 +368,7 @@ class StudyState:
             if ll == -math.inf:
                 return
             dll += ll - lik.loglik
-        if math.log(u1) < dll * self._beta + d_lp:
+        if log_uniform(u1) < dll * self._beta + d_lp:
             for i in touched:
                 self.states[i].lik.accept()
             self.g = cand
