@@ -56,3 +56,28 @@ def test_a_fast_calibration_step_at_a_zero_uniform_is_taken(element):
     acc = [0] * (s.q + 1)
     state.sweep([0.05, 0.05, 5.0], False, acc, _uniforms(s.q, element, 0.6, 0.0))
     assert acc[element] == 1
+
+
+def test_a_study_sweep_at_zero_uniforms_takes_its_theta_and_group_moves():
+    from test_study_basis_s68 import _data, _fit_source
+
+    from gpmsa.model.problem import prepare
+    from gpmsa.studies import continuation as cont
+    from gpmsa.studies.sampler import StudyState
+
+    src = _fit_source()
+    sim, obs = _data()
+    preps = [prepare(sim, o) for o in obs]
+    problems = [p.problem for p in preps]
+    start = cont.chain_starts(src, cont.fit_starts(src, problems, preps, obs, 2))[0]
+    state = StudyState(problems, src.layout, src.hyper, *start, np.random.default_rng(0))
+    G, H = state.layout.n_elements, len(state.group_els)
+    rows = np.tile([0.5, 0.0], (G + 2 * H, 1))  # no step, u = 0: every ratio 0 is taken
+    state.rng = FixedUniforms(rows)
+    sizes = sum(state.sizes)
+    acc = np.zeros(G + sizes + 2 * H)
+    widths = np.full(acc.size, 0.1)
+    state.sweep(widths, False, acc)  # ValueError: math domain error before
+    free = [e for e in range(G) if e not in state.held and state.levels[e] is None]
+    assert free and all(acc[e] == 1 for e in free)
+    assert all(acc[G + sizes + k] == 1 for k in range(2 * H))
