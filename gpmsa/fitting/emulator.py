@@ -984,8 +984,8 @@ class Emulator:
             ranged = manifest["model"].get("input_ranges", [])  # check_fields checked it
             std = Standardizer(
                 **{k: arrays[k] for k in STD_FIELDS}, y_sd=_y_sd(arrays["y_sd"]),
-                x_ranged=_ranged_flags(names["x"], ranged),
-                t_ranged=_ranged_flags(names["t"], ranged),
+                x_ranged=tuple(n in ranged for n in names["x"]),
+                t_ranged=tuple(n in ranged for n in names["t"]),
                 y_given=tuple(manifest["model"].get("y_given", ())),  # check_fields checked it
             )  # fmt: skip
             units = {k: tuple(manifest["units"][k]) for k in ("x", "t", "y")}
@@ -1161,13 +1161,6 @@ METADATA_INT_DIGITS = sys.int_info.default_max_str_digits
 (4300), which a reader's json.loads applies (a raised limit on the writer's machine is not the
 reader's)."""
 _INT_BOUND = 10**METADATA_INT_DIGITS
-
-
-def _ranged_flags(names: tuple[str, ...], ranged: list[str]) -> tuple[bool, ...]:
-    """`Standardizer`'s flags of which of ``names`` a file's ``input_ranges`` list; () where
-    none is (as in memory: empty, none given)."""
-    flags = tuple(n in ranged for n in names)
-    return flags if any(flags) else ()
 
 
 def _check_metadata(value, where: str, depth: int = 0) -> None:

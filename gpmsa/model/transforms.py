@@ -81,8 +81,7 @@ def _domain(arr: np.ndarray, ranges) -> tuple[np.ndarray, np.ndarray, tuple[bool
     for j, r in enumerate(ranges):
         if r is not None:
             lo[j], hi[j] = r
-    flags = tuple(r is not None for r in ranges)
-    return lo, hi, flags if any(flags) else ()  # none given reads () (as a file's none does)
+    return lo, hi, tuple(r is not None for r in ranges)
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,6 +110,11 @@ class Standardizer:
     x_ranged: tuple[bool, ...] = ()
     t_ranged: tuple[bool, ...] = ()
     y_given: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        for name in ("x_ranged", "t_ranged"):  # no column given reads (), however built
+            flags = tuple(getattr(self, name))
+            object.__setattr__(self, name, flags if any(flags) else ())
 
     @classmethod
     def from_sim(cls, sim: SimData) -> Standardizer:
