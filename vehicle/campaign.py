@@ -776,7 +776,7 @@ _JOIN_S = 5.0
 
 _STUCK_S = 2.0
 """Seconds a worker of the campaign's own pool may have ended while the pool is not marked
-broken before the wait gives up (`_check_stuck`); the pool marks itself broken within
+broken before the wait gives up (`_ended_mid_send`); the pool marks itself broken within
 milliseconds of a worker's end unless its manager thread is reading a result that worker was
 sending."""
 
@@ -785,43 +785,45 @@ def _completed(futures: dict[Future, int], pool: ProcessPoolExecutor | None = No
     """``as_completed(futures)``, waking every `_POLL_S` seconds so that an interrupt taken by
     another thread is acted on within that time (each future reports itself done to a queue:
     O(1) a wake, where re-waiting on the pending futures would cost O(runs)), and checking our
-    own ``pool`` (None: a user's executor) for a worker killed mid-send (`_check_stuck`)."""
+    own ``pool`` (None: a user's executor) for a worker killed mid-send (`_ended_mid_send`:
+    BrokenProcessPool)."""
     done: queue.SimpleQueue[Future] = queue.SimpleQueue()
     for fut in futures:
         fut.add_done_callback(done.put)
-    ended_since = None
+    first_seen: list[float] = []
     for _ in range(len(futures)):
         while True:
             try:
                 fut = done.get(timeout=_POLL_S)
             except queue.Empty:
-                ended_since = _check_stuck(pool, ended_since)
+                if pool is not None and _ended_mid_send(pool, first_seen):
+                    raise BrokenProcessPool(
+                        "a campaign worker process ended while it sent its run's result "
+                        "(killed: out of memory?); the pool cannot go on: run the campaign "
+                        "again (finished runs are cached with cache_dir)"
+                    ) from None
                 continue
             break
         yield fut
 
 
-def _check_stuck(pool: ProcessPoolExecutor | None, since: float | None) -> float | None:
-    """When (``time.monotonic``) a worker of our own ``pool`` was first seen ended while the
-    pool is not marked broken, None while none is; BrokenProcessPool once that has lasted
-    `_STUCK_S`. A worker killed while it sent a result (the OOM killer, ``kill -9``) leaves the
+def _ended_mid_send(pool: ProcessPoolExecutor, first_seen: list[float]) -> bool:
+    """Whether a worker of our own ``pool`` has been seen ended for `_STUCK_S` while the pool is
+    not marked broken (``first_seen``: [] or [when it was first seen, ``time.monotonic``],
+    updated). A worker killed while it sent a result (the OOM killer, ``kill -9``) leaves the
     pool's manager thread reading the rest of that message for ever: it never marks the pool
-    broken, and the run's future never finishes (`_stop`, called then, ends the manager)."""
-    if pool is None or getattr(pool, "_broken", False):
-        return None
+    broken, and the run's future never finishes (`_stop`, called then, ends the manager).
+    (gpmsa's chain pools do the same; vehicle does not import gpmsa.)"""
     sentinels = [p.sentinel for p in (getattr(pool, "_processes", None) or {}).values()]
-    if not sentinels or not multiprocessing.connection.wait(sentinels, timeout=0):
-        return None
-    now = time.monotonic()
-    if since is None:
-        return now
-    if now - since < _STUCK_S:
-        return since
-    raise BrokenProcessPool(
-        "a campaign worker process ended while it sent its run's result (killed: out of "
-        "memory?); the pool cannot go on: run the campaign again (finished runs are cached "
-        "with cache_dir)"
-    )
+    if getattr(pool, "_broken", False) or not sentinels:
+        first_seen.clear()
+        return False
+    if not multiprocessing.connection.wait(sentinels, timeout=0):
+        first_seen.clear()
+        return False
+    if not first_seen:
+        first_seen.append(time.monotonic())
+    return time.monotonic() - first_seen[0] >= _STUCK_S
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:
