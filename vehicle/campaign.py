@@ -16,6 +16,7 @@ for features of many short blocks per run.
 
 from __future__ import annotations
 
+import errno
 import functools
 import hashlib
 import json
@@ -413,6 +414,41 @@ def _save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+    _flush_folder(path.parent)
+
+
+def _flush_folder(folder: Path) -> None:
+    """Flush ``folder``'s entries to disk (``fsync`` of the folder, POSIX; as gpmsa.io.atomic's
+    twin), so that a power cut just after a save keeps the new file: its bytes were flushed
+    before the move, its new name only by this. Nothing where the OS or file system cannot
+    (Windows, a folder this process cannot open for reading, no ``fsync`` of a folder); an I/O
+    error raises OSError naming the folder."""
+    if sys.platform == "win32":
+        return
+    try:
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError as exc:
+        if exc.errno not in _NO_FOLDER_FSYNC:
+            raise OSError(
+                exc.errno,
+                f"{folder}: the file was moved into place, but the folder could not be flushed "
+                f"to disk ({exc.strerror or exc}): a power cut could still undo the save; check "
+                "the disk and save again",
+            ) from exc
+    finally:
+        os.close(fd)
+
+
+_NO_FOLDER_FSYNC = frozenset(
+    getattr(errno, name)
+    for name in ("EINVAL", "ENOTSUP", "EOPNOTSUPP", "EBADF")
+    if hasattr(errno, name)
+)
+"""The errors of an ``fsync`` of a folder that mean the file system does not take one."""
 
 
 _STALE_PART = re.compile(r"\..+\.(\d{1,10})@([0-9a-f]{8})\.[0-9a-f]{12}\.part", re.DOTALL)

@@ -47,6 +47,7 @@ from control.robot import messages as msgs
 from control.robot import storage as storage_mod
 from control.robot.extra import require
 from control.validation import check_lookup, float_array, is_choice, is_integer, path_argument
+from gpmsa.io.atomic import flush_folder
 from roadgen.checks import home_path
 from vehicle.models import Model
 
@@ -1119,12 +1120,30 @@ def open_bag_writer(
             writer.set_custom_data(DIGEST_KEY, digesting.record())
         for file in (work / path.name).glob("*.mcap"):  # rosbags writes chunks without CRCs
             storage_mod.write_chunk_crcs(file)
+        _flush_bag(work / path.name, path)
         try:
             os.rename(work / path.name, path)  # the bag's files are named after its folder
         except OSError as exc:  # e.g. path made meanwhile by another writer
             raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
+        flush_folder(path.parent, ControlError)
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def _flush_bag(bag: Path, path: Path) -> None:
+    """Flush a finished bag's files and folder (``bag``, before its move to ``path``) to disk,
+    so that a power cut after the move leaves the whole bag at ``path``, not empty files
+    (rosbags' writer flushes none). `ControlError` naming ``path`` for an OS error."""
+    try:
+        for file in bag.iterdir():
+            fd = os.open(file, os.O_RDONLY)
+            try:
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+    except OSError as exc:
+        raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
+    flush_folder(bag, ControlError)
 
 
 def merge_in_time(streams: Sequence[tuple[object, np.ndarray, Sequence[bytes]]]) -> Iterator:

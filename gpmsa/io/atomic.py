@@ -25,8 +25,8 @@ def atomic_write(
     path: str | os.PathLike, *, text: bool = False, error: type[Exception] = GPMSAError
 ) -> Iterator[IO]:
     """Open a new temporary file beside ``path`` for writing (and reading back); on a clean exit
-    flush it to disk and move it over ``path``; on any exception remove it, leaving an existing
-    ``path`` untouched.
+    flush it to disk, move it over ``path`` and flush the folder (`flush_folder`); on any
+    exception remove it, leaving an existing ``path`` untouched.
 
     Args:
         path: the file to write (its folder must exist); an existing ``path`` that is not a
@@ -57,15 +57,18 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
     Yields ``stage``: ``with stage(path, text=False) as fh:`` gives the handle of a new temporary
     file beside ``path`` (as ``atomic_write``'s), flushed to disk when its block ends. When the
     group's block ends without an exception the temporary files are moved over their paths in
-    the order staged; on any exception (while writing any of them) every temporary file is
-    removed and no path is touched. Only an OS failure during the final moves (each one step)
-    can leave some paths replaced and others not. Where it can (`folder_lock`), a group of
-    several files holds a lock on each folder during its moves, so that two processes saving
-    the same files at once leave one's files, all of them, not a mix of both, and a reader
-    holding the folder's shared lock reads them all before the moves or after.
+    the order staged, then each folder is flushed to disk (`flush_folder`: a power cut after
+    the save keeps the new files); on any exception (while writing any of them) every
+    temporary file is removed and no path is touched. Only an OS failure during the final
+    moves (each one step) can leave some paths replaced and others not. Where it can
+    (`folder_lock`), a group of several files holds a lock on each folder during its moves, so
+    that two processes saving the same files at once leave one's files, all of them, not a mix
+    of both, and a reader holding the folder's shared lock reads them all before the moves or
+    after.
 
     An OS error while a file is written (a full disk, a quota, an I/O error), flushed to disk or
-    moved (e.g. no permission) raises ``error`` naming the path, the OS error chained.
+    moved (e.g. no permission) raises ``error`` naming the path (an I/O error flushing a
+    folder after the moves: naming the folder), the OS error chained.
     """
     staged: list[tuple[Path, Path]] = []
 
@@ -105,15 +108,17 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
 
     try:
         yield stage
-        folders = _distinct_folders([path for _, path in staged]) if len(staged) > 1 else []
+        folders = _distinct_folders([path for _, path in staged])
         with ExitStack() as locks:
-            for folder in folders:
+            for folder in folders if len(staged) > 1 else []:
                 locks.enter_context(folder_lock(folder, error))
             for tmp, path in staged:
                 try:
                     os.replace(tmp, path)
                 except OSError as exc:
                     raise error(_cannot_write(path, exc)) from exc
+            for folder in folders:
+                flush_folder(folder, error)
     except BaseException:
         for tmp, _ in staged:
             try:
@@ -136,6 +141,41 @@ def _distinct_folders(paths: list[Path]) -> list[Path]:
             continue
         found.setdefault((st.st_dev, st.st_ino), path.parent)
     return [found[key] for key in sorted(found)]
+
+
+def flush_folder(folder: str | os.PathLike, error: type[Exception]) -> None:
+    """Flush ``folder``'s entries to disk (``fsync`` of the folder, POSIX): a file's bytes are
+    flushed before its move, its new name in the folder only by this, so that a power cut just
+    after a save keeps the new file rather than the old one (or, for a new path, none). Where the
+    OS or file system cannot (Windows, a folder this process cannot open for reading, a file
+    system that takes no ``fsync`` of a folder) nothing is done; an I/O error raises ``error``
+    naming the folder (the files are in place, but the disk failed to store the move)."""
+    if sys.platform == "win32":
+        return
+    try:
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:  # e.g. a folder with write but not read permission
+        return
+    try:
+        os.fsync(fd)
+    except OSError as exc:
+        if exc.errno not in _NO_FOLDER_FSYNC:
+            raise error(
+                f"{folder}: the files were moved into place, but the folder could not be "
+                f"flushed to disk ({exc.strerror or exc}): a power cut could still undo the "
+                "save; check the disk and save again"
+            ) from exc
+    finally:
+        os.close(fd)
+
+
+_NO_FOLDER_FSYNC = frozenset(
+    getattr(errno, name)
+    for name in ("EINVAL", "ENOTSUP", "EOPNOTSUPP", "EBADF")
+    if hasattr(errno, name)
+)
+"""The errors of an ``fsync`` of a folder that mean the file system does not take one (not a
+failure to store the move)."""
 
 
 def _close_quietly(fh: IO) -> None:

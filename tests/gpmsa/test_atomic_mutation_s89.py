@@ -207,9 +207,14 @@ def test_a_folder_that_refuses_a_new_file_is_named_with_its_remedy(tmp_path, mon
 def test_the_data_is_flushed_before_the_file_is_synced(tmp_path, monkeypatch):
     sizes = []
     real_fsync = os.fsync
-    monkeypatch.setattr(
-        atomic.os, "fsync", lambda fd: (sizes.append(os.fstat(fd).st_size), real_fsync(fd))
-    )
+
+    def fsync(fd):
+        st = os.fstat(fd)
+        if stat.S_ISREG(st.st_mode):  # (the folder is synced after the move: s90's tests)
+            sizes.append(st.st_size)
+        real_fsync(fd)
+
+    monkeypatch.setattr(atomic.os, "fsync", fsync)
     with atomic_write(tmp_path / "f") as fh:
         fh.write(b"0123456789")
     assert sizes == [10]
