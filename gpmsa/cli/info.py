@@ -21,7 +21,7 @@ from gpmsa.cli.text import (
 )
 from gpmsa.errors import GPMSAError
 from gpmsa.fitting.validation import DISCREPANCY_ARRAY
-from gpmsa.mcmc.diagnostics import INFINITE_RHAT, beyond, element_names
+from gpmsa.mcmc.diagnostics import beyond, element_names, says_infinite_rhat
 from gpmsa.model.basis import variance_shares
 
 
@@ -411,8 +411,7 @@ def _infinite_rhat(record: object, name: str, shape, size: int) -> set[int]:
     two_d = shape is not None and len(shape) == 2 and shape[0] * shape[1] == size
     names = element_names(name, tuple(shape) if two_d else (size,))
     reasons = [flagged.get(el) for el in names]
-    return {k for k, why in enumerate(reasons)
-            if isinstance(why, str) and why.split(",")[0] == INFINITE_RHAT}  # fmt: skip
+    return {k for k, why in enumerate(reasons) if says_infinite_rhat(why)}
 
 
 def _held_positions(record: object, shape, size: int) -> set[int]:

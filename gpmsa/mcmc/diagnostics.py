@@ -216,6 +216,15 @@ INFINITE_RHAT = "R-hat inf"
 """`convergence`'s reason (before any ", ESS ..." it adds) for an element whose R-hat is
 infinite (each chain constant, the chains apart); a file's record stores that R-hat as null, as
 it stores one not computable, and `gpmsa info` tells them apart by this reason."""
+
+
+def says_infinite_rhat(why: object) -> bool:
+    """Whether a convergence record's reason ``why`` (a flagged element's) calls its R-hat
+    infinite: `INFINITE_RHAT` before any ", ..." the reason adds (`gpmsa info` and
+    `read_back` read a file's record alike by this)."""
+    return isinstance(why, str) and why.split(",")[0] == INFINITE_RHAT
+
+
 RHAT_NOISE = 7.0
 """(R-hat - 1) x bulk ESS that one converged chain's split R-hat exceeds in about 1% of chains,
 whatever its autocorrelation (measured on AR(1) chains, ESS 100-1,300: 99th percentiles 5.4-7.1,
@@ -366,7 +375,7 @@ def _nulls_read(values, name: str, shapes: dict, flagged: dict, rhat: bool):
     for i, v in enumerate(values):
         if v is None:
             why = flagged.get(names[i], "") if names is not None else ""
-            v = np.inf if isinstance(why, str) and why.startswith(INFINITE_RHAT) else np.nan
+            v = np.inf if says_infinite_rhat(why) else np.nan
         out.append(v)
     return out
 
