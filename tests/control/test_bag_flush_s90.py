@@ -14,6 +14,7 @@ pytest.importorskip("rosbags")
 import control  # noqa: E402
 from control.robot import bags, read_recording, write_sensor_bag  # noqa: E402
 from gpmsa.io import atomic  # noqa: E402
+from tests._fsync import fail_fsync  # noqa: E402
 
 N = 40
 
@@ -49,14 +50,7 @@ def test_every_file_then_the_bag_then_its_parent_are_flushed(tmp_path, monkeypat
 
 
 def test_an_io_error_flushing_a_file_leaves_no_bag_and_names_it(tmp_path, monkeypatch):
-    real_fsync = os.fsync
-
-    def fsync(fd):
-        if stat.S_ISREG(os.fstat(fd).st_mode):
-            raise OSError(errno.EIO, os.strerror(errno.EIO))
-        real_fsync(fd)
-
-    monkeypatch.setattr(bags.os, "fsync", fsync)
+    fail_fsync(monkeypatch, bags, of="file")
     target = tmp_path / "bag"
     with pytest.raises(control.ControlError) as info:
         _write(target, "mcap")

@@ -12,6 +12,7 @@ import pytest
 import gpmsa
 from gpmsa.io import atomic
 from gpmsa.io.atomic import atomic_group, atomic_write
+from tests._fsync import fail_fsync
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="no fsync of a folder there")
 
@@ -62,14 +63,7 @@ def test_a_group_flushes_each_folder_once_after_every_move(tmp_path, monkeypatch
 
 
 def test_an_io_error_flushing_the_folder_names_it_and_leaves_the_file(tmp_path, monkeypatch):
-    real_fsync = os.fsync
-
-    def fsync(fd):
-        if stat.S_ISDIR(os.fstat(fd).st_mode):
-            raise OSError(errno.EIO, os.strerror(errno.EIO))
-        real_fsync(fd)
-
-    monkeypatch.setattr(atomic.os, "fsync", fsync)
+    fail_fsync(monkeypatch, atomic)
     with pytest.raises(gpmsa.GPMSAError) as info:
         with atomic_write(tmp_path / "f") as fh:
             fh.write(b"data")
@@ -85,14 +79,7 @@ def test_an_io_error_flushing_the_folder_names_it_and_leaves_the_file(tmp_path, 
 
 @pytest.mark.parametrize("code", ["EINVAL", "EBADF", "ENOTSUP"])
 def test_a_file_system_without_folder_fsync_saves_as_before(tmp_path, monkeypatch, code):
-    real_fsync = os.fsync
-
-    def fsync(fd):
-        if stat.S_ISDIR(os.fstat(fd).st_mode):
-            raise OSError(getattr(errno, code), "not supported")
-        real_fsync(fd)
-
-    monkeypatch.setattr(atomic.os, "fsync", fsync)
+    fail_fsync(monkeypatch, atomic, code=getattr(errno, code))
     with atomic_write(tmp_path / "f", error=ValueError) as fh:
         fh.write(b"data")
     assert (tmp_path / "f").read_bytes() == b"data"
@@ -118,15 +105,7 @@ def test_a_folder_that_cannot_be_opened_for_reading_saves_as_before(tmp_path, mo
 def test_the_folder_descriptor_is_closed(tmp_path, monkeypatch):
     closed, real_close = [], os.close
     monkeypatch.setattr(atomic.os, "close", lambda fd: (closed.append(fd), real_close(fd)))
-    monkeypatch.setattr(
-        atomic.os,
-        "fsync",
-        lambda fd: (
-            (_ for _ in ()).throw(OSError(errno.EIO, "I/O error"))
-            if stat.S_ISDIR(os.fstat(fd).st_mode)
-            else None
-        ),
-    )
+    fail_fsync(monkeypatch, atomic)
     with pytest.raises(gpmsa.GPMSAError):
         with atomic_write(tmp_path / "f") as fh:
             fh.write(b"data")

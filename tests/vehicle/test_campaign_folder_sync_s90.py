@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import vehicle
+from tests._fsync import fail_fsync
 from vehicle import campaign
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="no fsync of a folder there")
@@ -40,14 +41,7 @@ def test_a_save_flushes_its_folder_after_the_move(tmp_path, monkeypatch):
 
 
 def test_an_io_error_flushing_the_folder_is_named(tmp_path, monkeypatch):
-    real_fsync = os.fsync
-
-    def fsync(fd):
-        if stat.S_ISDIR(os.fstat(fd).st_mode):
-            raise OSError(errno.EIO, os.strerror(errno.EIO))
-        real_fsync(fd)
-
-    monkeypatch.setattr(campaign.os, "fsync", fsync)
+    fail_fsync(monkeypatch, campaign)
     path = tmp_path / "c.npz"
     with pytest.raises(vehicle.CampaignFileError) as info:
         _campaign().save(path)
@@ -61,13 +55,6 @@ def test_an_io_error_flushing_the_folder_is_named(tmp_path, monkeypatch):
 
 
 def test_a_file_system_without_folder_fsync_saves_as_before(tmp_path, monkeypatch):
-    real_fsync = os.fsync
-
-    def fsync(fd):
-        if stat.S_ISDIR(os.fstat(fd).st_mode):
-            raise OSError(errno.EINVAL, "not supported")
-        real_fsync(fd)
-
-    monkeypatch.setattr(campaign.os, "fsync", fsync)
+    fail_fsync(monkeypatch, campaign, code=errno.EINVAL)
     _campaign().save(tmp_path / "c.npz")
     assert vehicle.load_campaign(tmp_path / "c.npz").f_full.tolist() == [40.0, 80.0]
