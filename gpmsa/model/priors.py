@@ -85,9 +85,10 @@ class GammaPrior:
             raise GPMSAError(f"Gamma bounds need 0 <= lower < upper, got {lower}, {upper}")
 
     def log_density(self, x: np.ndarray) -> float:
-        """Unnormalised log density summed over elements; -inf outside the open bounds."""
+        """Unnormalised log density summed over elements; -inf outside the open bounds (a NaN
+        is outside them)."""
         x = np.asarray(x)
-        if np.any(x <= self.lower) or np.any(x >= self.upper):
+        if not np.all((x > self.lower) & (x < self.upper)):
             return -np.inf
         return float(np.sum((self.a - 1.0) * np.log(x) - self.b * x))
 
@@ -392,9 +393,9 @@ class Priors:
 
     def log_theta(self, theta: np.ndarray, elements=None) -> float:
         """Log prior of theta (unit scale): the whole vector (q,), or with ``elements`` (index
-        list) those elements of it; -inf outside (0, 1)."""
+        list) those elements of it; -inf outside (0, 1) (a NaN is outside it)."""
         theta = np.asarray(theta)
-        if np.any(theta <= 0.0) or np.any(theta >= 1.0):
+        if not np.all((theta > 0.0) & (theta < 1.0)):
             return -np.inf
         each = elements is None and self.theta_count is not None
         q = (theta.shape[-1] if theta.ndim else 1) if each else None
@@ -456,7 +457,7 @@ class Priors:
         if name == "lamVz" and self.per_group:
             x = np.asarray(value, dtype=np.float64).reshape(-1)
             a, b, lo, hi = self.gamma_arrays("lamVz", x.size)
-            if np.any(x <= lo) or np.any(x >= hi):
+            if not np.all((x > lo) & (x < hi)):
                 return -np.inf
             return float(np.sum((a - 1.0) * np.log(x) - b * x))
         if name in PRECISIONS:
