@@ -514,7 +514,7 @@ class Posterior:
         return self._samples
 
     def _drawn(self) -> dict[str, np.ndarray]:
-        """The draw callable's samples, checked."""
+        """The draw callable's samples, checked (and the chains, where given, against them)."""
         drawn = _checked_samples(self._draw())
         missing = [n for n in (*(self.info.get("names") or ()), *self.grids)
                    if n not in drawn]  # fmt: skip
@@ -524,6 +524,8 @@ class Posterior:
                 f"has {sorted(set(missing))} (info['names'] or grids) too: draw every "
                 "parameter"
             )
+        if self.chains is not None:  # chains given with the draw callable: checked against it
+            _checked_chains(self.chains, drawn)
         return drawn
 
     @property
