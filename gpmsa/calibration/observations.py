@@ -520,21 +520,21 @@ class _Settled(Exception):
 class _Nearest:
     """`fit_of` over every theta predicted at so far, kept up to date one theta at a time: a
     datum judged on its own is as near as the nearest theta to it (``layout``: `fit_of`'s, of
-    the first thetas only)."""
+    the first thetas only); a theta whose prediction is NaN is no nearer (np.fmin)."""
 
     def __init__(self, data: Observations, mean: np.ndarray, cov: np.ndarray,
                  layout: tuple[int, ...] | None = None, excess: bool = True):  # fmt: skip
         self.data, self.Linv = data, _chol_inverse(data) if excess else None
         resid, var, dist, self.alone = _distances(mean, cov, data)
-        if self.alone:  # no error estimate: each datum on its own
-            self.nearest = np.min(dist, axis=0)
+        if self.alone:  # no error estimate: each datum on its own; a NaN prediction is no nearer
+            self.nearest = np.fmin.reduce(dist, axis=0)
             if layout is not None:
                 self.nearest[_crossed(resid, layout)] = 0.0
         else:
-            self.nearest = np.min(np.max(dist, axis=1))
+            self.nearest = np.fmin.reduce(np.max(dist, axis=1))
         self.excess = np.nan  # ``excess=False``: not computed (`outside_sds`)
         if excess:
-            self.excess = float(np.min(_excess(resid, var, cov, self.data, self.Linv)))
+            self.excess = float(np.fmin.reduce(_excess(resid, var, cov, self.data, self.Linv)))
 
     def add(self, mean: np.ndarray, cov: np.ndarray) -> np.ndarray:
         """Take the predictive at one more theta ((1, p_u, n), (1, p_u, n, n)); its distances
@@ -703,17 +703,17 @@ def fit_at_levels(predict, data: Observations, levels: list) -> Fit | None:
         looked = True
         mean, cov = predict(data.x, theta)
         resid, var, dist, alone = _distances(mean, cov, data)
-        excess = min(excess, float(np.min(_excess(resid, var, cov, data, Linv))))
+        excess = min(excess, float(np.fmin.reduce(_excess(resid, var, cov, data, Linv))))
         if not alone:
-            best = min(best, float(np.min(np.max(dist, axis=1))))
+            best = min(best, float(np.fmin.reduce(np.max(dist, axis=1))))
             continue
         k = theta.shape[0] // b
-        near = np.min(dist.reshape(b, k, -1), axis=1)  # (b, d): per combination of levels
+        near = np.fmin.reduce(dist.reshape(b, k, -1), axis=1)  # (b, d): per combination
         if layout is not None:
             for i in range(b):
                 near[i, _crossed(resid[i * k : (i + 1) * k], layout)] = 0.0
-        near = np.min(near, axis=0)
-        nearest = near if nearest is None else np.minimum(nearest, near)
+        near = np.fmin.reduce(near, axis=0)
+        nearest = near if nearest is None else np.fmin(nearest, near)
     if not looked:
         return None
     return Fit(best if nearest is None else float(np.max(nearest)), excess)
@@ -817,19 +817,18 @@ def warn_if_outside(
 
 
 def lamos_start(fit: Fit, prior: LamOsPrior) -> float:
-    """A start of lamOs for the samplers: GPM/SA's max(20, a/b), lowered to 1/excess_var when
-    the observation needs a larger observation error than that (else an additive random walk
-    started there never reaches the posterior, decades below, and theta sticks at a bound),
-    and to the prior's mean a/b where that is lower still (the prior as the data's values
-    beyond the basis corrected it: with precisions declared 1e12 times too large its mean was
-    3.4e-9 and the chains, started at 1/excess_var = 6e-6, never came down: theta 0.3993 +-
-    0.0023 against the exact 0.4038 +- 0.0034), and kept inside the prior's bounds (the middle
-    of (lower, upper) where it would reach the upper bound: a chain started outside has no
-    posterior mass)."""
-    start = max(20.0, prior.shape / prior.rate)
+    """A start of lamOs for the samplers: the prior's mean a/b (GPM/SA starts at max(20, a/b);
+    here never above the mean: the prior as the data's values beyond the basis corrected it,
+    with precisions declared 1e12 times too large, had mean 3.4e-9, and chains started at
+    1/excess_var = 6e-6 never came down: theta 0.3993 +- 0.0023 against the exact 0.4038 +-
+    0.0034), lowered to 1/excess_var when the observation needs a larger observation error
+    than that (else an additive random walk started there never reaches the posterior,
+    decades below, and theta sticks at a bound), and kept inside the prior's bounds (the
+    middle of (lower, upper) where it would reach the upper bound: a chain started outside
+    has no posterior mass)."""
+    start = prior.shape / prior.rate
     if fit.excess_var > 0.0:
         start = min(start, 1.0 / fit.excess_var)
-    start = min(start, prior.shape / prior.rate)
     if prior.lower > 0.0:
         start = max(start, 1.01 * prior.lower)
     if start >= prior.upper:
