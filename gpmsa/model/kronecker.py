@@ -32,8 +32,6 @@ about 200 MB and an O(m^3) Cholesky per component at this size. ``predict``, ``p
 and ``loo`` never build it. Raise it (``gpmsa.model.kronecker.MAX_DENSE_RUNS = ...``) where the
 machine has the memory and the time."""
 
-UNSUPPORTED = "observations (obs=), a mean_basis, or a backend other than 'numpy'"
-
 
 @dataclass(frozen=True)
 class Separable:
@@ -83,7 +81,8 @@ def parse_groups(separable, names: tuple[str, ...]) -> tuple[tuple[int, ...], ..
             )
         groups = []
         for g in separable:
-            items = [g] if isinstance(g, str | int | np.integer) else list(g)
+            one = isinstance(g, str | bytes | int | np.integer) or not hasattr(g, "__iter__")
+            items = [g] if one else list(g)  # one input, named by _column if it is none
             groups.append(tuple(_column(v, names) for v in items))
         groups = tuple(groups)
     flat = [k for g in groups for k in g]
