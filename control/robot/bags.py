@@ -1090,14 +1090,15 @@ def open_bag_writer(
     """A rosbags ROS 2 bag writer (format version 9), open, for a new folder ``path``.
 
     The bag is written in a hidden folder beside ``path`` and moved to ``path`` once closed, so
-    an interrupted write (an exception, a killed process) never leaves a bag without its
-    metadata at ``path``; on an exception the hidden folder is removed. Each chunk of an MCAP
-    bag is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves
-    it 0), so that a reader refuses a chunk whose bytes changed, and the bag's metadata records
-    the SHA-256 of each topic's messages (``DIGEST_KEY``), which `read_recording` checks in any
-    storage (sqlite3 has no checksums of its own); ``custom_data`` ({str: str}) is added to
-    that metadata's custom_data. `ControlError` where ``path`` exists (a link to nowhere too)
-    or `check_bag_path` refuses it."""
+    an interrupted write (an exception, a killed process) never leaves a bag without its metadata at
+    ``path``; on an exception the hidden folder is removed (the moved bag too where an I/O error
+    keeps its parent folder from being flushed to disk: `_flush_parent`). Each chunk of an MCAP bag
+    is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves it 0), so
+    that a reader refuses a chunk whose bytes changed, and the bag's metadata records the SHA-256 of
+    each topic's messages (``DIGEST_KEY``), which `read_recording` checks in any storage (sqlite3
+    has no checksums of its own); ``custom_data`` ({str: str}) is added to that metadata's
+    custom_data. `ControlError` where ``path`` exists (a link to nowhere too) or `check_bag_path`
+    refuses it."""
     _check_storage(storage)
     path = path_argument(path, "path", " of the new bag folder")
     check_lookup(path, "path")
@@ -1125,9 +1126,29 @@ def open_bag_writer(
             os.rename(work / path.name, path)  # the bag's files are named after its folder
         except OSError as exc:  # e.g. path made meanwhile by another writer
             raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
-        flush_folder(path.parent, ControlError)
+        _flush_parent(path, work)
     finally:
         shutil.rmtree(work, ignore_errors=True)
+
+
+def _flush_parent(path: Path, work: Path) -> None:
+    """Flush the folder of the bag just moved to ``path`` (`flush_folder`); where an I/O error
+    fails it, the bag is moved back into ``work`` (removed with it) and `ControlError` names
+    ``path``: a bag written with an error is not kept, so that a caller's cleanup and a second
+    try (which a bag's existing folder refuses) hold. Where even that move fails, the error
+    of `flush_folder` (the bag in place)."""
+    try:
+        flush_folder(path.parent, ControlError)
+    except ControlError as exc:
+        why = getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
+        try:
+            os.rename(path, work / path.name)
+        except OSError:
+            raise exc from exc.__cause__  # the bag stays: flush_folder says so
+        raise ControlError(
+            f"{path}: cannot write (its folder {path.parent} could not be flushed to disk after "
+            f"the move: {why}; the bag was not kept: check the disk and write it again)"
+        ) from exc.__cause__
 
 
 def _flush_bag(bag: Path, path: Path) -> None:

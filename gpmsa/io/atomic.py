@@ -57,14 +57,13 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
     Yields ``stage``: ``with stage(path, text=False) as fh:`` gives the handle of a new temporary
     file beside ``path`` (as ``atomic_write``'s), flushed to disk when its block ends. When the
     group's block ends without an exception the temporary files are moved over their paths in
-    the order staged, then each folder is flushed to disk (`flush_folder`: a power cut after
-    the save keeps the new files); on any exception (while writing any of them) every
-    temporary file is removed and no path is touched. Only an OS failure during the final
-    moves (each one step) can leave some paths replaced and others not. Where it can
-    (`folder_lock`), a group of several files holds a lock on each folder during its moves, so
-    that two processes saving the same files at once leave one's files, all of them, not a mix
-    of both, and a reader holding the folder's shared lock reads them all before the moves or
-    after.
+    the order staged, then each folder is flushed to disk (`flush_folder`: a power cut after the
+    save keeps the new files); on any exception (while writing any of them) every temporary file is
+    removed and no path is touched. Only an OS failure during the final moves (each one step) can
+    leave some paths replaced and others not. Where it can (`folder_lock`), a group of several files
+    holds a lock on each folder during its moves (not their flush), so that two processes saving the
+    same files at once leave one's files, all of them, not a mix of both, and a reader holding the
+    folder's shared lock reads them all before the moves or after.
 
     An OS error while a file is written (a full disk, a quota, an I/O error), flushed to disk or
     moved (e.g. no permission) raises ``error`` naming the path (an I/O error flushing a
@@ -117,8 +116,8 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
                     os.replace(tmp, path)
                 except OSError as exc:
                     raise error(_cannot_write(path, exc)) from exc
-            for folder in folders:
-                flush_folder(folder, error)
+        for folder in folders:  # after the locks: a reader need not wait for the disk
+            flush_folder(folder, error)
     except BaseException:
         for tmp, _ in staged:
             try:

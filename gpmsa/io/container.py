@@ -305,8 +305,9 @@ def write_sealed(
 
     The zip is written to a new temporary file beside ``path``, checked as the reader checks a
     zip's structure and size (above ``limits.MAX_FILE_BYTES``: GPMSAError), flushed to disk and
-    then moved over ``path`` in one step: a failure at any point leaves an existing ``path``
-    untouched and no temporary file behind. ``stage``: an
+    then moved over ``path`` in one step: a failure before the move leaves an existing ``path``
+    untouched and no temporary file behind (an I/O error flushing the folder after it, a
+    GPMSAError naming the folder, leaves the new file in place). ``stage``: an
     ``atomic_group``'s stage, to defer the move to the end of that group (several files replaced
     together); None: moved at once. A member that deflates beyond ``limits.MAX_RATIO`` (e.g.
     zero padding) is stored uncompressed. An existing ``path`` that is not a regular file (a

@@ -74,14 +74,14 @@ def parse_groups(separable, names: tuple[str, ...]) -> tuple[tuple[int, ...], ..
     if separable is True:
         groups = tuple((k,) for k in range(d))
     else:
-        if isinstance(separable, str | bytes) or not hasattr(separable, "__iter__"):
+        if isinstance(separable, str | bytes) or not _iterable(separable):
             raise GPMSAError(
                 f"separable must be None, True or a sequence of factors (each an input name or "
                 f"index, or a sequence of them), got {separable!r:.80}"
             )
         groups = []
         for g in separable:
-            one = isinstance(g, str | bytes | int | np.integer) or not hasattr(g, "__iter__")
+            one = isinstance(g, str | bytes | int | np.integer) or not _iterable(g)
             items = [g] if one else list(g)  # one input, named by _column if it is none
             groups.append(tuple(_column(v, names) for v in items))
         groups = tuple(groups)
@@ -92,6 +92,11 @@ def parse_groups(separable, names: tuple[str, ...]) -> tuple[tuple[int, ...], ..
             f"factors, each input in exactly one; got {[[names[k] for k in g] for g in groups]}"
         )
     return groups
+
+
+def _iterable(value) -> bool:
+    """Whether ``value`` iterates (a 0-d array has ``__iter__`` but refuses iteration)."""
+    return hasattr(value, "__iter__") and not (isinstance(value, np.ndarray) and value.ndim == 0)
 
 
 def _column(value, names: tuple[str, ...]) -> int:

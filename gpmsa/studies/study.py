@@ -433,7 +433,8 @@ class Study:
         checks it before anything is written: a refused save (GPMSAError) writes nothing. The
         files are then written whole to temporary files and moved over their paths together
         (``gpmsa.io.atomic.atomic_group``), so a save that fails leaves an existing study at
-        ``path`` as it was (only an OS failure during the final moves could mix the two). A study
+        ``path`` as it was (only an OS failure during the final moves could mix the two; an I/O
+        error flushing the folder after them names it, the new files in place). A study
         is not written over an emulator file, nor a model file over a study file (GPMSAError):
         such a file belongs to another study, which would no longer load; nor are the model
         files of another study beside ``path`` with the same stem (``run`` or ``run.bak`` beside

@@ -59,7 +59,9 @@ def test_an_io_error_flushing_a_file_leaves_no_bag_and_names_it(tmp_path, monkey
 
 
 def test_an_io_error_flushing_the_parent_names_it_with_the_bag_in_place(tmp_path, monkeypatch):
-    real_fsync = os.fsync
+    """Where the bag cannot be moved back out of the way either (review s90: otherwise it is
+    not kept, tests/control/test_review_s90.py), flush_folder's error says it is in place."""
+    real_fsync, real_rename = os.fsync, os.rename
     target = tmp_path / "bag"
 
     def fsync(fd):
@@ -67,7 +69,13 @@ def test_an_io_error_flushing_the_parent_names_it_with_the_bag_in_place(tmp_path
             raise OSError(errno.EIO, os.strerror(errno.EIO))
         real_fsync(fd)
 
+    def rename(src, dst):
+        if os.fspath(src) == os.fspath(target):
+            raise OSError(errno.EIO, os.strerror(errno.EIO))
+        real_rename(src, dst)
+
     monkeypatch.setattr(atomic.os, "fsync", fsync)
+    monkeypatch.setattr(bags.os, "rename", rename)
     with pytest.raises(control.ControlError, match=f"^{tmp_path}: the files were moved into"):
         _write(target, "mcap")
     assert os.listdir(tmp_path) == ["bag"]
