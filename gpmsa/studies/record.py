@@ -24,7 +24,8 @@ digest (``gpmsa.model.discrepancy.record``), and with several precision groups
 "discrepancy_groups"}; absent for a study without one (and in files written before it)."""
 FILE_RE = re.compile(r"\A[A-Za-z0-9_-][A-Za-z0-9_.-]{0,150}\.gpmsa\Z")
 """A model's file name: beside the study file, no folder, no leading dot."""
-SHA_RE = re.compile(r"^[0-9a-f]{64}$")
+SHA_RE = re.compile(r"\A[0-9a-f]{64}\Z")
+"""A sha256 digest: 64 lowercase hex digits, nothing after (``$`` would take a final newline)."""
 
 
 def discrepancy_arrays(j: int) -> tuple[str, str]:
@@ -281,7 +282,8 @@ def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
         low = 0 if k == "n_burn" else 1
         if isinstance(v, bool) or not isinstance(v, int) or v < low:
             raise _fail(f"settings.{k}", f"must be an integer >= {low}, got {_short(v)}")
-    if settings.get("n_samples", got["n_iter"]) != got["n_iter"]:  # calibrate_study's name
+    n_samples = settings.get("n_samples", got["n_iter"])  # calibrate_study's name of n_iter
+    if isinstance(n_samples, bool) or not isinstance(n_samples, int) or n_samples != got["n_iter"]:
         raise _fail("settings.n_samples", f"{_short(settings['n_samples'])} differs from n_iter "
                                           f"{got['n_iter']}")  # fmt: skip
     if got["n_chains"] != shape[0]:
