@@ -435,6 +435,9 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
     """Append the messages of ``out``'s topics in one rosbag2 sqlite3 file."""
     # as_uri: a '#', '?' or '%' in the path is percent-encoded, not read as the URI's parts
     con = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
+    # sqlite3's own decoding turns TEXT that is not UTF-8 into an OperationalError ("Could not
+    # decode ...", as if the file could not be read): decoded here, it raises UnicodeDecodeError
+    con.text_factory = _utf8
     try:
         _check_complete(con, path)
         rows = con.execute("SELECT id, name, type, serialization_format FROM topics")
@@ -465,6 +468,11 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
             out.data[name].extend(data)
     finally:
         con.close()
+
+
+def _utf8(data: bytes) -> str:
+    """A TEXT value of a sqlite3 file as text; UnicodeDecodeError where it is not UTF-8."""
+    return data.decode()
 
 
 def _sqlite_definitions(
@@ -501,14 +509,20 @@ def _sqlite_definitions(
 
 def _check_complete(con: sqlite3.Connection, path: Path) -> None:
     """`BagError` for a database file shorter than its header says (sqlite3 reads the missing
-    pages as zeros: a truncated bag would lose the end of its last messages unnoticed). A file
-    with a write-ahead log beside it is not checked (the log holds pages the file lacks)."""
+    part of its last page as zeros: a truncated bag would lose the end of its last messages
+    unnoticed), or one whose size is not a whole number of pages (bytes appended). A file with
+    a write-ahead log beside it is not checked (the log holds pages the file lacks)."""
     if Path(f"{path}-wal").exists():
         return
     ((page,),) = con.execute("PRAGMA page_size").fetchall()
     ((pages,),) = con.execute("PRAGMA page_count").fetchall()
     size = path.stat().st_size
-    if size % page or size < page * pages:
+    if size < page * pages:
         raise BagError(
             f"{path} is truncated: {size} bytes, its header declares {pages} pages of {page}"
+        )
+    if size % page:
+        raise BagError(
+            f"{path} is damaged: {size} bytes, not a whole number of its {page}-byte pages "
+            f"({pages} declared)"
         )
