@@ -416,8 +416,8 @@ def write_chunk_crcs(path: Path) -> None:
 def sqlite_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics:
     """The messages of ``topics`` in rosbag2 sqlite3 files, by receive time, and their message
     definitions where a file holds them (`_sqlite_definitions`). Raises `BagError`
-    for a file sqlite3 cannot read, a truncated one, or one whose topics are not UTF-8 text
-    (or NULL) or whose messages are not (int, bytes)."""
+    for a file sqlite3 cannot read, a truncated one, or one whose topics or definitions are not
+    UTF-8 text (or NULL) or whose messages are not (int, bytes)."""
     out = RawTopics()
     for topic in topics:
         out.log_ns[topic], out.data[topic] = [], []
@@ -426,8 +426,6 @@ def sqlite_messages(paths: Sequence[Path], topics: Sequence[str]) -> RawTopics:
             _sqlite_file(Path(path), out)
         except sqlite3.Error as exc:
             raise BagError(f"{path} is not a readable rosbag2 sqlite3 file: {exc}") from exc
-        except UnicodeDecodeError as exc:  # sqlite3's for a TEXT value that is not UTF-8
-            raise BagError(f"{path} is damaged: a topic's name or type is not text") from exc
     return out
 
 
@@ -436,13 +434,17 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
     # as_uri: a '#', '?' or '%' in the path is percent-encoded, not read as the URI's parts
     con = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
     # sqlite3's own decoding turns TEXT that is not UTF-8 into an OperationalError ("Could not
-    # decode ...", as if the file could not be read): decoded here, it raises UnicodeDecodeError
+    # decode ...", as if the file could not be read): decoded here, it raises UnicodeDecodeError,
+    # named by the query that met it (`_fetch`)
     con.text_factory = _utf8
     try:
         _check_complete(con, path)
-        rows = con.execute("SELECT id, name, type, serialization_format FROM topics")
+        rows = _fetch(
+            con, path, "SELECT id, name, type, serialization_format FROM topics", (),
+            "a topic's name, type or serialisation format is not UTF-8 text",
+        )  # fmt: skip
         ids = {}
-        for tid, name, msgtype, encoding in rows.fetchall():
+        for tid, name, msgtype, encoding in rows:
             if not all(type(v) is str for v in (name, msgtype, encoding)):
                 raise BagError(
                     f"{path} is damaged: the topic of id {tid!r} lacks its name, type or "
@@ -454,16 +456,15 @@ def _sqlite_file(path: Path, out: RawTopics) -> None:
                 out.encodings[name] = encoding
         _sqlite_definitions(con, path, {name: out.types[name] for name in ids.values()}, out)
         for tid, name in ids.items():
-            rows = con.execute(
+            lacks = f"a message of the topic {name!r} lacks an integer time stamp or its data"
+            rows = _fetch(
+                con, path,
                 "SELECT timestamp, data FROM messages WHERE topic_id = ? ORDER BY timestamp, id",
-                (tid,),
-            ).fetchall()
+                (tid,), lacks,  # TEXT there, UTF-8 or not, is neither
+            )  # fmt: skip
             stamps, data = zip(*rows, strict=True) if rows else ((), ())
             if set(map(type, stamps)) - {int} or set(map(type, data)) - {bytes}:
-                raise BagError(
-                    f"{path} is damaged: a message of the topic {name!r} lacks an integer "
-                    "time stamp or its data"
-                )
+                raise BagError(f"{path} is damaged: {lacks}")
             out.log_ns[name].extend(stamps)
             out.data[name].extend(data)
     finally:
@@ -475,6 +476,15 @@ def _utf8(data: bytes) -> str:
     return data.decode()
 
 
+def _fetch(con: sqlite3.Connection, path: Path, query: str, args: tuple, why: str) -> list:
+    """The rows of ``query``; `BagError` "``path`` is damaged: ``why``" where a TEXT value
+    among them is not UTF-8 (`_utf8`)."""
+    try:
+        return con.execute(query, args).fetchall()
+    except UnicodeDecodeError as exc:
+        raise BagError(f"{path} is damaged: {why}") from exc
+
+
 def _sqlite_definitions(
     con: sqlite3.Connection, path: Path, types: dict[str, str | None], out: RawTopics
 ) -> None:
@@ -484,10 +494,12 @@ def _sqlite_definitions(
     tables = "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = 'message_definitions'"
     if con.execute(tables).fetchone() is None:
         return
-    rows = con.execute(
+    rows = _fetch(
+        con, path,
         "SELECT topic_type, encoding, CAST(encoded_message_definition AS BLOB) "
-        "FROM message_definitions ORDER BY id"
-    ).fetchall()
+        "FROM message_definitions ORDER BY id", (),
+        "a message definition's type or encoding is not UTF-8 text",
+    )  # fmt: skip
     found: dict[str, tuple[str, bytes]] = {}
     for msgtype, encoding, text in rows:
         if type(msgtype) is not str or type(encoding) is not str or type(text) is not bytes:

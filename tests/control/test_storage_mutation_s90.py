@@ -806,7 +806,9 @@ def test_a_topic_name_that_is_not_utf8_and_a_file_that_is_not_sqlite_are_named(t
     path.write_bytes(data.replace("/\u00e9".encode(), b"/\xff\xfe"))  # as many bytes
     with pytest.raises(BagError) as info:
         st.sqlite_messages([path], ["/a"])
-    assert str(info.value) == f"{path} is damaged: a topic's name or type is not text"
+    assert str(info.value) == (
+        f"{path} is damaged: a topic's name, type or serialisation format is not UTF-8 text"
+    )
     other = tmp_path / "other.db3"
     other.write_bytes(b"not a database" * 100)
     with pytest.raises(BagError) as info:
