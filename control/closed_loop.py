@@ -278,7 +278,7 @@ def run_closed_loop(
         check: check the emulator against model, noise, feature, track and the Simplex's
             speeds (`check_emulator`).
         max_time_s: simulated time after which a vehicle that has not reached the end is an
-            error (default: 20 times the track length at the safe speed).
+            error, finite (default: 20 times the track length at the safe speed).
         record: write the run to this MCAP file for Foxglove (`control.record_run`: the
             accelerations, speed command and actual speed, the GD estimate with its interval,
             the mode and the true GD; needs the ``robot`` extra).
@@ -302,8 +302,10 @@ def run_closed_loop(
     noise_std = vehicle.sensor.check_noise(noise_std)
     substeps = vehicle.checks.integer("substeps", substeps, 1)  # before the emulator's checks
     faults = _check_faults(faults)
-    if max_time_s is not None and not (is_real(max_time_s) and max_time_s > 0):
-        raise ControlError(f"max_time_s must be None or a number > 0, s, got {max_time_s!r}")
+    if max_time_s is not None and not (is_real(max_time_s) and 0 < max_time_s < np.inf):
+        raise ControlError(  # (inf: a vehicle that stands would never end the run)
+            f"max_time_s must be None or a finite number > 0, s, got {max_time_s!r}"
+        )
     if record is not None:  # without the robot extra, fail before the drive, not after it
         from control.robot.record import check_can_record, record_run
 

@@ -230,8 +230,8 @@ def test_arguments_are_checked_before_the_drive(emulator_a, likelihood_a, tmp_pa
             r"faults must be a sequence of SensorFault: pass \[fault\]",
         ),
         ({"faults": [("nan", 1, 2)]}, "faults must hold SensorFault objects"),
-        ({"max_time_s": float("nan")}, "max_time_s must be None or a number > 0"),
-        ({"max_time_s": 0.0}, "max_time_s must be None or a number > 0"),
+        ({"max_time_s": float("nan")}, "max_time_s must be None or a finite number > 0"),
+        ({"max_time_s": 0.0}, "max_time_s must be None or a finite number > 0"),
         ({"simplex": "fast"}, "simplex must be a control.Simplex"),
         ({"record": tmp_path}, "is a folder; name the .mcap file"),
     ):
