@@ -560,13 +560,9 @@ def check_point(point) -> None:
         raise GPMSAError(f"point must be 'mean' or 'map', got {point!r}")
 
 
-def _check_levels(problem: Problem, theta_unit: np.ndarray, names, what: str,
-                  only=None) -> None:  # fmt: skip
-    """GPMSAError when a categorical element of ``theta_unit`` (those at positions ``only``;
-    None: all) is not one of its levels."""
+def _check_levels(problem: Problem, theta_unit: np.ndarray, names, what: str) -> None:
+    """GPMSAError when a categorical element of ``theta_unit`` is not one of its levels."""
     for k, lv in enumerate(problem.theta_levels or ()):
-        if only is not None and k not in only:
-            continue
         if lv is not None and not np.any(np.isclose(lv, theta_unit[k], rtol=0, atol=1e-12)):
             raise GPMSAError(f"{what}: categorical calibration parameter {names[k]} must be one "
                              "of its training levels")  # fmt: skip
