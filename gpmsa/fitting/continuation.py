@@ -391,7 +391,7 @@ def append_step(thin, n_iter: int, n_chains: int, n_keep, source: str = "init=em
     new = n_chains * (n_iter // thin)
     if not new:
         raise GPMSAError(
-            f"append=True keeps every {thin}th sweep ({source}'s step, settings['thin']): "
+            f"append=True keeps one sweep in {thin} ({source}'s step, settings['thin']): "
             f"n_iter={n_iter} keeps none; pass n_iter >= {thin}"
         )
     if n_keep is not None and n_keep != new:
