@@ -50,14 +50,17 @@ def _vehicle_diff(trained, model, label: str = "model") -> str:
     )
 
 
-def _check_is_emulator(emulator) -> None:
+def _check_is_emulator(emulator, needs: tuple[str, ...] = ()) -> None:
     """ControlError for an argument that is not an emulator at all (a case name, a path, None),
-    before any message about its records could send the user to retrain it."""
-    if not hasattr(emulator, "metadata"):
+    before any message about its records could send the user to retrain it; with ``needs``,
+    also for one that lacks any of those attributes (an emulator's stand-in)."""
+    lacks = [name for name in ("metadata", *needs) if not hasattr(emulator, name)]
+    if lacks:
         raise ControlError(
             f"emulator must be a gpmsa.Emulator (gpmsa.load(path), or "
             f"control.shipped_emulator(case) for the shipped ones), got {emulator!r:.80} "
-            f"({type(emulator).__name__})"
+            f"({type(emulator).__name__}"
+            + (")" if "metadata" in lacks else f", without {', '.join(lacks)})")
         )
 
 
@@ -149,7 +152,8 @@ def check_emulator(
     exceeds it even on the emulator's smoothest ground; the default methods pool and read
     lower there).
     """
-    _check_is_emulator(emulator)
+    speeds = ("x_names",) if simplex is not None else ()  # (the Simplex's against its domain)
+    _check_is_emulator(emulator, needs=(*speeds, "t_names", "domain"))
     check_emulator_inputs(emulator)
     gd_name = emulator.t_names[0]
     check_gd_unit(tuple(map(float, emulator.domain[gd_name])), gd_name)

@@ -1107,6 +1107,7 @@ def open_bag_writer(
         raise ControlError(f"{path} exists already; a bag is written to a new folder")
     check_bag_path(path, storage)
     plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
+    made = _missing_folders(path.parent)  # their names are flushed into their parents too
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         work = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent))
@@ -1126,29 +1127,41 @@ def open_bag_writer(
             os.rename(work / path.name, path)  # the bag's files are named after its folder
         except OSError as exc:  # e.g. path made meanwhile by another writer
             raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
-        _flush_parent(path, work)
+        _flush_parent(path, work, made)
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
 
-def _flush_parent(path: Path, work: Path) -> None:
-    """Flush the folder of the bag just moved to ``path`` (`flush_folder`); where an I/O error
-    fails it, the bag is moved back into ``work`` (removed with it) and `ControlError` names
-    ``path``: a bag written with an error is not kept, so that a caller's cleanup and a second
-    try (which a bag's existing folder refuses) hold. Where even that move fails, the error
-    of `flush_folder` (the bag in place)."""
-    try:
-        flush_folder(path.parent, ControlError)
-    except ControlError as exc:
-        why = getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
+def _missing_folders(folder: Path) -> list[Path]:
+    """``folder`` and its ancestors that do not exist yet, the deepest first: the folders a
+    ``mkdir(parents=True)`` of it makes."""
+    missing = []
+    while not os.path.lexists(folder) and folder.parent != folder:
+        missing.append(folder)
+        folder = folder.parent
+    return missing
+
+
+def _flush_parent(path: Path, work: Path, made: Sequence[Path] = ()) -> None:
+    """Flush the folder of the bag just moved to ``path`` (`flush_folder`), then the parent of
+    each folder in ``made`` (those made for the bag, the deepest first: their names are entries
+    of their parents); where an I/O error fails one, the bag is moved back into ``work``
+    (removed with it) and `ControlError` names ``path``: a bag written with an error is not
+    kept, so that a caller's cleanup and a second try (which a bag's existing folder refuses)
+    hold. Where even that move fails, the error of `flush_folder` (the bag in place)."""
+    for folder in (path.parent, *(m.parent for m in made)):
         try:
-            os.rename(path, work / path.name)
-        except OSError:
-            raise exc from exc.__cause__  # the bag stays: flush_folder says so
-        raise ControlError(
-            f"{path}: cannot write (its folder {path.parent} could not be flushed to disk after "
-            f"the move: {why}; the bag was not kept: check the disk and write it again)"
-        ) from exc.__cause__
+            flush_folder(folder, ControlError)
+        except ControlError as exc:
+            why = getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
+            try:
+                os.rename(path, work / path.name)
+            except OSError:
+                raise exc from exc.__cause__  # the bag stays: flush_folder says so
+            raise ControlError(
+                f"{path}: cannot write (its folder {folder} could not be flushed to disk after "
+                f"the move: {why}; the bag was not kept: check the disk and write it again)"
+            ) from exc.__cause__
 
 
 def _flush_bag(bag: Path, path: Path) -> None:

@@ -721,14 +721,26 @@ def fit_at_levels(predict, data: Observations, levels: list) -> Fit | None:
 
 def _crossed(resid: np.ndarray, layout: tuple[int, ...]) -> np.ndarray:
     """Per datum (resid (G, d) on a grid of shape ``layout``), whether its residual is zero
-    at a node or changes sign between two neighbouring nodes along an axis."""
+    at a node or changes sign between two nodes along an axis with only NaN predictions (no
+    sign known) between them."""
     r = np.sign(resid).reshape(*layout, -1)
     hit = np.any(r == 0, axis=tuple(range(len(layout))))
     for axis in range(len(layout)):
-        lo = np.take(r, range(layout[axis] - 1), axis=axis)
+        known = _last_known(r, axis)
+        lo = np.take(known, range(layout[axis] - 1), axis=axis)
         hi = np.take(r, range(1, layout[axis]), axis=axis)
         hit |= np.any(lo * hi < 0, axis=tuple(range(len(layout))))
     return hit
+
+
+def _last_known(r: np.ndarray, axis: int) -> np.ndarray:
+    """``r`` with each NaN replaced by the last value before it along ``axis`` that is not NaN
+    (NaN where there is none)."""
+    shape = [1] * r.ndim
+    shape[axis] = r.shape[axis]
+    index = np.where(np.isnan(r), 0, np.arange(r.shape[axis]).reshape(shape))
+    index = np.maximum.accumulate(index, axis=axis)
+    return np.take_along_axis(r, index, axis=axis)
 
 
 def _observed_projector(obs: ObsProblem) -> np.ndarray | None:

@@ -50,7 +50,9 @@ def atomic_write(
 
 
 @contextmanager
-def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
+def atomic_group(
+    *, error: type[Exception] = GPMSAError, on_moved: Callable[[], None] | None = None
+) -> Iterator[Callable]:
     """Replace several files together: each is written whole to a temporary file first, and
     none is moved over its path until every one is written.
 
@@ -67,7 +69,10 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
 
     An OS error while a file is written (a full disk, a quota, an I/O error), flushed to disk or
     moved (e.g. no permission) raises ``error`` naming the path (an I/O error flushing a
-    folder after the moves: naming the folder), the OS error chained.
+    folder after the moves: naming the folder), the OS error chained. ``on_moved`` (None:
+    none) is called once every file is moved into place, before the folders are flushed: a
+    caller that records what it saved (`Study.save`'s digest) does so even where the flush then
+    fails, the new files being in place.
     """
     staged: list[tuple[Path, Path]] = []
 
@@ -116,8 +121,9 @@ def atomic_group(*, error: type[Exception] = GPMSAError) -> Iterator[Callable]:
                     os.replace(tmp, path)
                 except OSError as exc:
                     raise error(_cannot_write(path, exc)) from exc
-        for folder in folders:  # after the locks: a reader need not wait for the disk
-            flush_folder(folder, error)
+        if on_moved is not None:
+            on_moved()
+        _flush_folders(folders, error)  # after the locks: a reader need not wait for the disk
     except BaseException:
         for tmp, _ in staged:
             try:
@@ -166,6 +172,19 @@ def flush_folder(folder: str | os.PathLike, error: type[Exception]) -> None:
             ) from exc
     finally:
         os.close(fd)
+
+
+def _flush_folders(folders: list[Path], error: type[Exception]) -> None:
+    """`flush_folder` each of ``folders``, every one even after one fails (its files are in
+    place as the others' are); the first failure is raised then."""
+    failure: Exception | None = None
+    for folder in folders:
+        try:
+            flush_folder(folder, error)
+        except error as exc:
+            failure = failure or exc
+    if failure is not None:
+        raise failure
 
 
 _NO_FOLDER_FSYNC = frozenset(

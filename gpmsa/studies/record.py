@@ -283,8 +283,10 @@ def _check_counts(settings: dict, shape: tuple[int, int]) -> None:
         if isinstance(v, bool) or not isinstance(v, int) or v < low:
             raise _fail(f"settings.{k}", f"must be an integer >= {low}, got {_short(v)}")
     n_samples = settings.get("n_samples", got["n_iter"])  # calibrate_study's name of n_iter
-    if isinstance(n_samples, bool) or not isinstance(n_samples, int) or n_samples != got["n_iter"]:
-        raise _fail("settings.n_samples", f"{_short(settings['n_samples'])} differs from n_iter "
+    if isinstance(n_samples, bool) or not isinstance(n_samples, int):
+        raise _fail("settings.n_samples", f"must be an integer, got {_short(n_samples)}")
+    if n_samples != got["n_iter"]:
+        raise _fail("settings.n_samples", f"{_short(n_samples)} differs from n_iter "
                                           f"{got['n_iter']}")  # fmt: skip
     if got["n_chains"] != shape[0]:
         raise _fail("settings.n_chains", f"{got['n_chains']}, but the draws have {shape[0]} "

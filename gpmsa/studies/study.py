@@ -429,21 +429,21 @@ class Study:
         """Write the study file ``path`` and beside it each model's emulator file
         ``<stem>.<label>.gpmsa``; returns ``path``.
 
-        Every record (each model's and the study's) is built and checked as ``load_study``
-        checks it before anything is written: a refused save (GPMSAError) writes nothing. The
-        files are then written whole to temporary files and moved over their paths together
+        Every record (each model's and the study's) is built and checked as ``load_study`` checks it
+        before anything is written: a refused save (GPMSAError) writes nothing. The files are then
+        written whole to temporary files and moved over their paths together
         (``gpmsa.io.atomic.atomic_group``), so a save that fails leaves an existing study at
         ``path`` as it was (only an OS failure during the final moves could mix the two; an I/O
-        error flushing the folder after them names it, the new files in place). A study
-        is not written over an emulator file, nor a model file over a study file (GPMSAError):
-        such a file belongs to another study, which would no longer load; nor are the model
-        files of another study beside ``path`` with the same stem (``run`` or ``run.bak`` beside
-        ``run.gpmsa``) replaced. Nor is any file written over a non-empty file that is not a
-        gpmsa file (a user's CSV or notes). ``path``'s name names the model files, so it may
-        use only ASCII letters, digits, '_', '-' and '.', not start with '.', and its stem be at
-        most 150 - len(longest label) characters (GPMSAError up front otherwise). A symbolic
-        link ``path`` is written through: the study file and its model files go beside the
-        link's target, named after it (as ``load_study`` reads them).
+        error flushing the folder after them names it, the new files in place and ``sha256``
+        theirs). A study is not written over an emulator file, nor a model file over a study file
+        (GPMSAError): such a file belongs to another study, which would no longer load; nor are the
+        model files of another study beside ``path`` with the same stem (``run`` or ``run.bak``
+        beside ``run.gpmsa``) replaced. Nor is any file written over a non-empty file that is not a
+        gpmsa file (a user's CSV or notes). ``path``'s name names the model files, so it may use
+        only ASCII letters, digits, '_', '-' and '.', not start with '.', and its stem be at most
+        150 - len(longest label) characters (GPMSAError up front otherwise). A symbolic link
+        ``path`` is written through: the study file and its model files go beside the link's target,
+        named after it (as ``load_study`` reads them).
         """
         given = check_path(path)
         path = _through_link(given)
@@ -474,10 +474,13 @@ class Study:
         except EmulatorFileError as exc:
             raise GPMSAError(f"refusing to write {path}, it could not be read back: {exc}") from exc
         sealed.append((path, raw, arrays))
-        with atomic_group() as stage:
+
+        def moved() -> None:  # (a failed folder flush after the moves leaves the new files)
+            self.sha256 = head["content_sha256"]
+
+        with atomic_group(on_moved=moved) as stage:
             for target, raw_manifest, member_arrays in sealed:
                 write_sealed(target, raw_manifest, member_arrays, stage)
-        self.sha256 = head["content_sha256"]
         return given
 
     def __repr__(self) -> str:

@@ -3,6 +3,7 @@ the wrong kind: a sensor fault for what a robot can send, a ControlError for wha
 pass, never a silent estimate or a numpy traceback."""
 
 import shutil
+import types
 from fractions import Fraction
 
 import numpy as np
@@ -287,3 +288,22 @@ def test_a_clock_or_samples_numpy_cannot_hold_are_control_errors():
     with pytest.raises(ControlError, match=r"accel must hold real numbers .*, got 1000+ \(int\)"):
         bcr.update(t, t, [0.0, 10**400, 1.0], np.ones(3))  # OverflowError in float()
     assert bcr.update(t, t, [0.0, 2**63, 1.0], np.ones(3)).status == "filling"
+
+
+@pytest.mark.parametrize(
+    ("kept", "simplex", "lacks"),
+    [
+        (("metadata", "x_names", "domain"), None, "t_names"),
+        (("metadata",), None, "t_names, domain"),
+        (("metadata", "t_names", "domain"), Simplex(), "x_names"),
+    ],
+)
+def test_check_emulator_names_the_records_a_stand_in_lacks(kept, simplex, lacks):
+    # session 91: an object with metadata but no t_names raised a bare AttributeError (a
+    # stand-in without x_names is checked where no Simplex asks for its speed domain)
+    emulator = control.shipped_emulator("B")
+    stand_in = types.SimpleNamespace(**{name: getattr(emulator, name) for name in kept})
+    with pytest.raises(ControlError) as info:
+        control.check_emulator(stand_in, simplex=simplex)
+    assert str(info.value).endswith(f"(SimpleNamespace, without {lacks})")
+    assert str(info.value).startswith("emulator must be a gpmsa.Emulator (gpmsa.load(path)")

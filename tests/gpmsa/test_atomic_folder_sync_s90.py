@@ -112,3 +112,63 @@ def test_the_folder_descriptor_is_closed(tmp_path, monkeypatch):
     assert len(closed) == 1
     with pytest.raises(OSError):
         os.fstat(closed[0])
+
+
+def test_a_group_flushes_every_folder_though_one_fails_and_raises_the_first(tmp_path, monkeypatch):
+    # session 91: the first folder whose flush failed stopped the others' flushes
+    folders = [tmp_path / "a", tmp_path / "b", tmp_path / "c"]
+    for folder in folders:
+        folder.mkdir()
+    flushed, real_fsync = [], os.fsync
+
+    def fsync(fd):
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            flushed.append(st.st_ino)
+            if len(flushed) < 3:
+                raise OSError(errno.EIO, f"flush {len(flushed)} failed")
+        real_fsync(fd)
+
+    monkeypatch.setattr(atomic.os, "fsync", fsync)
+    with pytest.raises(gpmsa.GPMSAError, match=r"\(flush 1 failed\)") as info:
+        with atomic_group() as stage:
+            for folder in folders:
+                with stage(folder / "f") as fh:
+                    fh.write(b"new")
+    assert sorted(flushed) == sorted(os.stat(f).st_ino for f in folders)
+    assert str(info.value).startswith(f"{atomic._distinct_folders([f / 'f' for f in folders])[0]}:")
+    assert [(f / "f").read_bytes() for f in folders] == [b"new"] * 3
+
+
+def test_on_moved_runs_after_the_moves_before_the_flush_and_not_on_a_failed_write(
+    tmp_path, monkeypatch
+):
+    events = _record_syncs(monkeypatch, [tmp_path / "x"])
+    seen = []
+    with atomic_group(on_moved=lambda: seen.append((tmp_path / "x").read_bytes())) as stage:
+        with stage(tmp_path / "x") as fh:
+            fh.write(b"1")
+    assert seen == [b"1"] and [e[0] for e in events] == ["file", "folder"]
+    seen.clear()
+    with pytest.raises(RuntimeError):
+        with atomic_group(on_moved=lambda: seen.append("moved")) as stage:
+            with stage(tmp_path / "y") as fh:
+                raise RuntimeError("writer failed")
+    assert seen == [] and not (tmp_path / "y").exists()
+
+
+def test_a_study_whose_folder_flush_fails_records_the_digest_of_its_new_files(
+    tmp_path, monkeypatch
+):
+    # session 91: Study.save kept the old sha256 (None for a new study) while the new files
+    # were in place
+    from tests.gpmsa._study_cases import two_model_study
+
+    with pytest.warns(gpmsa.ConvergenceWarning):  # (a short chain)
+        study = two_model_study(n_samples=20, n_burn=10, tune_rounds=2)
+    fail_fsync(monkeypatch, atomic)
+    with pytest.raises(gpmsa.GPMSAError, match="could not be flushed to disk"):
+        study.save(tmp_path / "run.gpmsa")
+    monkeypatch.undo()
+    assert study.sha256 is not None
+    assert study.sha256 == gpmsa.load_study(tmp_path / "run.gpmsa").sha256

@@ -762,6 +762,41 @@ def test_a_nan_prediction_at_a_level_probe_node_is_no_nearer():
         assert fit.excess_var == pytest.approx(5.078125**2 - 0.01, rel=1e-12)
 
 
+def test_a_sign_change_across_nan_predictions_is_a_crossing():
+    # session 91: +, NaN, - along the grid hid the crossing (NaN * -1 is not < 0), so with the
+    # NaN no nearer the datum read as outside, at 40 sds, though the nodes bracket it
+    mean = np.array([[[9.0]], [[np.nan]], [[1.0]]])  # z = 5: residuals +4, NaN, -4
+    cov = np.full((3, 1, 1, 1), 0.01)
+    assert obsmod.fit_of(mean, cov, _one_datum(), layout=(3,)).outside_sds == 0.0
+    assert obsmod.outside_sds(mean, cov, _one_datum(), layout=(3,)) == 0.0
+    same_side = np.array([[[9.0]], [[np.nan]], [[10.0]]])
+    assert obsmod.fit_of(same_side, cov, _one_datum(), layout=(3,)).outside_sds == pytest.approx(
+        40.0
+    )
+
+
+def test_crossed_carries_the_last_known_sign_over_nan_nodes_along_each_axis():
+    nan = np.nan
+    line = np.array([nan, 1.0, nan, nan, -1.0, nan])[:, None]
+    assert obsmod._crossed(line, (6,)).tolist() == [True]
+    assert obsmod._crossed(np.array([nan, 1.0, nan, 2.0, nan])[:, None], (5,)).tolist() == [False]
+    assert obsmod._crossed(np.full((4, 1), nan), (4,)).tolist() == [False]
+    # 2 x 2 grid ('ij'): the sign changes across the NaN only along axis 1 (rows)
+    grid = np.array([1.0, nan, 2.0, 3.0])[:, None]  # [[1, nan], [2, 3]]: no change
+    assert obsmod._crossed(grid, (2, 2)).tolist() == [False]
+    grid = np.array([1.0, nan, 2.0, -3.0])[:, None]  # [[1, nan], [2, -3]]: row 2 changes
+    assert obsmod._crossed(grid, (2, 2)).tolist() == [True]
+    # a row with a NaN between + and -, three nodes long, in a 2 x 3 grid
+    grid = np.array([1.0, nan, -1.0, 1.0, 1.0, 1.0])[:, None]
+    assert obsmod._crossed(grid, (2, 3)).tolist() == [True]
+    # columns are independent: the last known sign never crosses from one line to the next
+    grid = np.array([1.0, nan, nan, -1.0])[:, None]  # [[1, nan], [nan, -1]]
+    assert obsmod._crossed(grid, (2, 2)).tolist() == [False]
+    # per datum: two data, the second crosses
+    two = np.array([[1.0, 1.0], [nan, nan], [1.0, -1.0]])
+    assert obsmod._crossed(two, (3,)).tolist() == [False, True]
+
+
 def test_fit_is_a_frozen_value():
     fit = obsmod.Fit(1.5, 0.25)
     assert fit == obsmod.Fit(1.5, 0.25) and hash(fit) == hash(obsmod.Fit(1.5, 0.25))

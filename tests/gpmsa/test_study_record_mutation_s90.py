@@ -1066,7 +1066,7 @@ APPENDED = {"appended_to": SHA, "pooled_sweeps": 9, "sweeps_run": 9}
         (
             {"n_chains": 1, "n_iter": 4, "n_burn": 1, "n_samples": None},
             (1, 3),
-            "settings.n_samples: None differs from n_iter 4",
+            "settings.n_samples: must be an integer, got None",
         ),
         (
             {"n_chains": 2, "n_iter": 4, "n_burn": 1},
@@ -1177,11 +1177,11 @@ def test_an_appended_study_keeps_the_source_draws_then_whole_thin_periods():
 @pytest.mark.parametrize("n_samples", [True, 1.0, "1"])
 def test_n_samples_other_than_the_integer_n_iter_is_refused(n_samples):
     """calibrate_study records n_samples, the integer n_iter: True and 1.0 equal 1 but are not
-    it (a damaged record)."""
+    it (a damaged record), and the refusal says so rather than "differs" (session 91)."""
     settings = {"n_chains": 1, "n_iter": 1, "n_burn": 0, "n_samples": n_samples}
     _refused(
         lambda: _check_counts(settings, (1, 1)),
-        f"settings.n_samples: {n_samples!r} differs from n_iter 1",
+        f"settings.n_samples: must be an integer, got {n_samples!r}",
     )
 
 
