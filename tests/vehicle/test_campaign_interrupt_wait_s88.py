@@ -33,11 +33,13 @@ def slow_run(spec, cache_dir=None):
     raise AssertionError("a run the interrupt should have cut off has finished")
 
 
-def interrupt_once_started(folder, done):
-    """Interrupt the main thread (as SIGINT to this process would) once a run has started."""
+def interrupt_once_started(folder, done, sent):
+    """Interrupt the main thread (as SIGINT to this process would) once a run has started;
+    ``sent`` gets the time of the interrupt (``time.monotonic``)."""
     while not any(p.name.startswith("started-") for p in folder.iterdir()):
         if done.wait(0.02):
             return
+    sent.append(time.monotonic())
     _thread.interrupt_main()
 
 
@@ -47,15 +49,25 @@ def interrupt_once_started(folder, done):
 def test_an_interrupt_cuts_off_the_running_runs_instead_of_waiting_for_them(tmp_path, monkeypatch):
     monkeypatch.setenv("CAMPAIGN_INTERRUPT_TEST_DIR", str(tmp_path))  # (workers inherit it)
     monkeypatch.setattr(campaign, "run_one", slow_run)
-    done = threading.Event()
-    watcher = threading.Thread(target=interrupt_once_started, args=(tmp_path, done))
+    done, sent = threading.Event(), []
+    watcher = threading.Thread(target=interrupt_once_started, args=(tmp_path, done, sent))
     watcher.start()
+    start = time.monotonic()
     try:
         with pytest.raises(KeyboardInterrupt):
-            vehicle.run_campaign(
-                np.array([[0.7, 250.0], [1.6, 550.0]]), road_length_m=6.0, window=300,
-                lead_in_m=0.5, progress=False, seed=1,
-            )  # fmt: skip
+            try:
+                vehicle.run_campaign(
+                    np.array([[0.7, 250.0], [1.6, 550.0]]), road_length_m=6.0, window=300,
+                    lead_in_m=0.5, progress=False, seed=1,
+                )  # fmt: skip
+            except Exception as exc:  # (says when the interrupt went, should it be lost again)
+                when = (
+                    f"interrupt_main called {sent[0] - start:.3f} s after the campaign started"
+                    if sent
+                    else "interrupt_main not called (no run seen started)"
+                )
+                ended = f"the campaign ended {time.monotonic() - start:.3f} s after its start"
+                raise AssertionError(f"{exc!r}: {when}; {ended}") from exc
     finally:
         done.set()
         watcher.join()
