@@ -1092,13 +1092,14 @@ def open_bag_writer(
     The bag is written in a hidden folder beside ``path`` and moved to ``path`` once closed, so
     an interrupted write (an exception, a killed process) never leaves a bag without its metadata at
     ``path``; on an exception the hidden folder is removed (the moved bag too where an I/O error
-    keeps its parent folder from being flushed to disk: `_flush_parent`). Each chunk of an MCAP bag
-    is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer leaves it 0), so
-    that a reader refuses a chunk whose bytes changed, and the bag's metadata records the SHA-256 of
-    each topic's messages (``DIGEST_KEY``), which `read_recording` checks in any storage (sqlite3
-    has no checksums of its own); ``custom_data`` ({str: str}) is added to that metadata's
-    custom_data. `ControlError` where ``path`` exists (a link to nowhere too) or `check_bag_path`
-    refuses it."""
+    keeps its parent folder from being flushed to disk: `_flush_parent`; the folders made for it
+    have their names flushed into their parents as they are made: `_flush_made`). Each chunk of
+    an MCAP bag is given the CRC32 of its records (`storage.write_chunk_crcs`; rosbags' writer
+    leaves it 0), so that a reader refuses a chunk whose bytes changed, and the bag's metadata
+    records the SHA-256 of each topic's messages (``DIGEST_KEY``), which `read_recording` checks
+    in any storage (sqlite3 has no checksums of its own); ``custom_data`` ({str: str}) is added
+    to that metadata's custom_data. `ControlError` where ``path`` exists (a link to nowhere too)
+    or `check_bag_path` refuses it."""
     _check_storage(storage)
     path = path_argument(path, "path", " of the new bag folder")
     check_lookup(path, "path")
@@ -1107,9 +1108,14 @@ def open_bag_writer(
         raise ControlError(f"{path} exists already; a bag is written to a new folder")
     check_bag_path(path, storage)
     plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
-    made = _missing_folders(path.parent)  # their names are flushed into their parents too
+    made = _missing_folders(path.parent)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        _remove_made(made)
+        raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
+    _flush_made(path, made)
+    try:
         work = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent))
     except OSError as exc:
         raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
@@ -1127,7 +1133,7 @@ def open_bag_writer(
             os.rename(work / path.name, path)  # the bag's files are named after its folder
         except OSError as exc:  # e.g. path made meanwhile by another writer
             raise ControlError(f"{path}: cannot write ({exc.strerror})") from exc
-        _flush_parent(path, work, made)
+        _flush_parent(path, work)
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -1142,26 +1148,53 @@ def _missing_folders(folder: Path) -> list[Path]:
     return missing
 
 
-def _flush_parent(path: Path, work: Path, made: Sequence[Path] = ()) -> None:
-    """Flush the folder of the bag just moved to ``path`` (`flush_folder`), then the parent of
-    each folder in ``made`` (those made for the bag, the deepest first: their names are entries
-    of their parents); where an I/O error fails one, the bag is moved back into ``work``
-    (removed with it) and `ControlError` names ``path``: a bag written with an error is not
-    kept, so that a caller's cleanup and a second try (which a bag's existing folder refuses)
-    hold. Where even that move fails, the error of `flush_folder` (the bag in place)."""
-    for folder in (path.parent, *(m.parent for m in made)):
+def _flush_made(path: Path, made: Sequence[Path]) -> None:
+    """Flush the parent of each folder in ``made`` (`_missing_folders`: those just made for the
+    bag at ``path``, the deepest first) to disk, their names being entries of their parents:
+    at once, before the bag is written, so that a second try after a failed write, which finds
+    them made, does not leave them unflushed. Where an I/O error fails one, the folders are
+    removed again (those still empty, so that a second try makes and flushes them) and
+    `ControlError` names ``path`` and that parent."""
+    for folder in made:
         try:
-            flush_folder(folder, ControlError)
+            flush_folder(folder.parent, ControlError)
         except ControlError as exc:
+            _remove_made(made)
             why = getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
-            try:
-                os.rename(path, work / path.name)
-            except OSError:
-                raise exc from exc.__cause__  # the bag stays: flush_folder says so
             raise ControlError(
-                f"{path}: cannot write (its folder {folder} could not be flushed to disk after "
-                f"the move: {why}; the bag was not kept: check the disk and write it again)"
+                f"{path}: cannot write (the folder {folder.parent} could not be flushed to disk "
+                f"after {folder.name!r} was made in it: {why}; nothing was kept: check the disk "
+                "and write it again)"
             ) from exc.__cause__
+
+
+def _remove_made(made: Sequence[Path]) -> None:
+    """Remove the folders in ``made`` (the deepest first) that exist and are empty."""
+    for folder in made:
+        try:
+            os.rmdir(folder)
+        except OSError:  # not made, or not empty (another writer's, meanwhile)
+            pass
+
+
+def _flush_parent(path: Path, work: Path) -> None:
+    """Flush the folder of the bag just moved to ``path`` (`flush_folder`); where an I/O error
+    fails it, the bag is moved back into ``work`` (removed with it) and `ControlError` names
+    ``path``: a bag written with an error is not kept, so that a caller's cleanup and a second
+    try (which a bag's existing folder refuses) hold. Where even that move fails, the error
+    of `flush_folder` (the bag in place)."""
+    try:
+        flush_folder(path.parent, ControlError)
+    except ControlError as exc:
+        why = getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
+        try:
+            os.rename(path, work / path.name)
+        except OSError:
+            raise exc from exc.__cause__  # the bag stays: flush_folder says so
+        raise ControlError(
+            f"{path}: cannot write (its folder {path.parent} could not be flushed to disk after "
+            f"the move: {why}; the bag was not kept: check the disk and write it again)"
+        ) from exc.__cause__
 
 
 def _flush_bag(bag: Path, path: Path) -> None:

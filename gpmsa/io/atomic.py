@@ -72,7 +72,8 @@ def atomic_group(
     folder after the moves: naming the folder), the OS error chained. ``on_moved`` (None:
     none) is called once every file is moved into place, before the folders are flushed: a
     caller that records what it saved (`Study.save`'s digest) does so even where the flush then
-    fails, the new files being in place.
+    fails, the new files being in place; the folders are flushed though ``on_moved`` raises
+    (its error raised then, unless a flush fails: that error, ``on_moved``'s its context).
     """
     staged: list[tuple[Path, Path]] = []
 
@@ -121,9 +122,11 @@ def atomic_group(
                     os.replace(tmp, path)
                 except OSError as exc:
                     raise error(_cannot_write(path, exc)) from exc
-        if on_moved is not None:
-            on_moved()
-        _flush_folders(folders, error)  # after the locks: a reader need not wait for the disk
+        try:  # (the files are in place: their folders are flushed though on_moved raises)
+            if on_moved is not None:
+                on_moved()
+        finally:
+            _flush_folders(folders, error)  # after the locks: a reader need not wait for the disk
     except BaseException:
         for tmp, _ in staged:
             try:

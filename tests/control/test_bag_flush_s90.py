@@ -98,8 +98,8 @@ def test_folders_made_for_the_bag_are_flushed_into_their_parents(tmp_path, monke
     target = tmp_path / "new" / "deeper" / "bag"
     _write(target, "mcap")
     inode = {p: os.stat(p).st_ino for p in (target, target.parent, target.parent.parent)}
-    assert events == [inode[target], inode[target.parent], inode[target.parent.parent],
-                      os.stat(tmp_path).st_ino]  # fmt: skip
+    assert events == [inode[target.parent.parent], os.stat(tmp_path).st_ino,  # as made
+                      inode[target], inode[target.parent]]  # fmt: skip
     assert bags._missing_folders(target) == []  # (written)
     assert bags._missing_folders(tmp_path / "a" / "b") == [tmp_path / "a" / "b", tmp_path / "a"]
 
@@ -117,7 +117,8 @@ def test_an_io_error_flushing_a_made_folder_s_parent_keeps_no_bag(tmp_path, monk
     with pytest.raises(control.ControlError) as info:
         _write(target, "mcap")
     assert str(info.value) == (
-        f"{target}: cannot write (its folder {tmp_path} could not be flushed to disk after the "
-        f"move: {os.strerror(errno.EIO)}; the bag was not kept: check the disk and write it again)"
+        f"{target}: cannot write (the folder {tmp_path} could not be flushed to disk after 'new' "
+        f"was made in it: {os.strerror(errno.EIO)}; nothing was kept: check the disk and write it "
+        "again)"
     )
-    assert os.listdir(tmp_path / "new") == []
+    assert os.listdir(tmp_path) == []  # (review s91: nor the folder made for it)
