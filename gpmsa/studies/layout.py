@@ -65,10 +65,12 @@ class HyperPriors:
                              "sds of (0, 1)")  # fmt: skip
         with np.errstate(over="ignore", under="ignore"):
             sd2 = float(np.float64(self.sd_max) ** 2)
-        if not (finite(sd2) and sd2 > 0 and finite(1.0 / sd2)):  # the prior works with sd^2
-            raise GPMSAError(f"HyperPriors.sd_max={self.sd_max!r:.60}: its square must be a "
-                             "finite, non-zero float64 (an sd on the unit scale: 0.01 to 10 "
-                             "is the useful range)")  # fmt: skip
+        # the prior works with sd^2, lam_min 1/sd^2 and the default start lam 4/sd^2
+        if not (finite(sd2) and sd2 > 0 and finite(4.0 / sd2)):
+            raise GPMSAError(f"HyperPriors.sd_max={self.sd_max!r:.60}: its square and "
+                             "4/sd_max^2 (the default start precision) must be finite, non-zero "
+                             "float64s (sd_max within about 1.5e-154 to 1.3e154; an sd on the "
+                             "unit scale: 0.01 to 10 is the useful range)")  # fmt: skip
         if self.lam_start is None:
             inside = self.sd_prior != "uniform" or 5.0 * sd2 > 1.0
             object.__setattr__(self, "lam_start", 5.0 if inside else 4.0 / sd2)
@@ -262,7 +264,8 @@ def build_layout(
     if both:
         raise GPMSAError(f"parameters {both} are both shared and hierarchical; choose one")
     if len(t_names) != len(labels) or len(t_bounds) != len(labels):
-        raise GPMSAError(f"got {len(t_names)} models' parameter names for {len(labels)} labels")
+        raise GPMSAError(f"got {len(t_names)} models' parameter names and {len(t_bounds)} "
+                         f"models' ranges for {len(labels)} labels")  # fmt: skip
     for what, names in (("shared", shared), ("hierarchical", hier)):
         for n in names:
             have = [labels[i] for i, ts in enumerate(t_names) if n in ts]
