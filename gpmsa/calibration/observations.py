@@ -566,8 +566,9 @@ def fit_of(
     """``Fit`` of the observation from the emulator's predictive on some theta values:
     mean (G, p_u, n), cov (G, p_u, n, n) (``FixedGP.predict`` / ``GridPredictor.predict``).
     ``layout``: the theta values' grid shape ('ij' order, G nodes), where they form one: a
-    datum judged on its own whose residual changes sign between neighbouring nodes is met
-    between them (the predictive mean is continuous in theta), however far the nodes' means
+    datum judged on its own whose residual changes sign between neighbouring nodes (or between
+    two nodes with only NaN predictions between them) is met between them (the predictive mean
+    is continuous in theta), however far the nodes' means
     lie from it in predictive sds (an emulator with a negligible nugget read a datum exactly
     on the simulator 11 sds outside, between probe nodes)."""
     return _Nearest(data, mean, cov, layout).fit()
