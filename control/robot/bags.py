@@ -1040,21 +1040,25 @@ MAX_LOG_NS = 2**63
 
 
 def stamps_ns(name: str, t, limit: int = STAMP_LIMIT_NS, offset_ns: int = 0) -> np.ndarray:
-    """Times ``t`` (s, 1-D) as int64 ns plus ``offset_ns``; `ControlError` naming ``name``
-    unless every one is a finite number that lands in [0, ``limit``) ns."""
+    """Times ``t`` (s, 1-D) as int64 ns plus ``offset_ns`` (an integer); `ControlError` naming
+    ``name`` unless every one is a finite number that lands in [0, ``limit``) ns, ``limit`` at
+    most 2**63 (checked in integers: near 2**31 s a float64 sum is off by up to 256 ns)."""
     arr = np.atleast_1d(float_array(t, name))
     if arr.ndim != 1:
         raise ControlError(f"{name} must be 1-D (times in s), got shape {arr.shape}")
     with np.errstate(invalid="ignore", over="ignore"):
         ns = np.rint(arr * 1e9)
-    bad = ~np.isfinite(ns) | (ns + offset_ns < 0) | (ns + offset_ns >= limit)
+    bad = ~(np.abs(ns) < 2.0**63)  # NaN, inf, beyond int64
+    whole = np.where(bad, 0.0, ns).astype(np.int64)
+    low, high = max(-offset_ns, -(2**63)), min(limit - offset_ns, 2**63) - 1  # whole's bounds
+    bad |= (whole < low) | (whole > high) if low <= high else True
     if np.any(bad):
         first = float(arr[bad][0])
         raise ControlError(
             f"{name} holds {first!r} s: allowed finite times that, with an offset of "
             f"{offset_ns} ns, lie in [0, {limit / 1e9:.6g}) s"
         )
-    return ns.astype(np.int64) + np.int64(offset_ns)
+    return whole + np.int64(offset_ns)
 
 
 def _vectors(name: str, a, n: int, axis: str = "x") -> np.ndarray:
