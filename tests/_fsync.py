@@ -20,3 +20,20 @@ def fail_fsync(monkeypatch, module, *, of: str = "folder", code: int = errno.EIO
         _REAL_FSYNC(fd)
 
     monkeypatch.setattr(module.os, "fsync", fsync)
+
+
+def record_folder_fsyncs(monkeypatch, module, *, fail_inode: int | None = None) -> list[int]:
+    """The inodes of the folders ``module.os.fsync`` flushes from now on, in order; the fsync
+    of folder ``fail_inode`` (None: none) raises OSError EIO after it is recorded."""
+    flushed: list[int] = []
+
+    def fsync(fd):
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            flushed.append(st.st_ino)
+            if st.st_ino == fail_inode:
+                raise OSError(errno.EIO, os.strerror(errno.EIO))
+        _REAL_FSYNC(fd)
+
+    monkeypatch.setattr(module.os, "fsync", fsync)
+    return flushed

@@ -1164,12 +1164,16 @@ def _flush_made(path: Path, made: Sequence[Path]) -> None:
             flush_folder(folder.parent, ControlError)
         except ControlError as exc:
             _remove_made(made)
-            why = getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
             raise ControlError(
                 f"{path}: cannot write (the folder {folder.parent} could not be flushed to disk "
-                f"after {folder.name!r} was made in it: {why}; nothing was kept: check the disk "
-                "and write it again)"
+                f"after {folder.name!r} was made in it: {_flush_reason(exc)}; nothing was kept: "
+                "check the disk and write it again)"
             ) from exc.__cause__
+
+
+def _flush_reason(exc: ControlError) -> str:
+    """What a failed `flush_folder` (``exc``) says went wrong: the OS error's text."""
+    return getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
 
 
 def _remove_made(made: Sequence[Path]) -> None:
@@ -1190,14 +1194,14 @@ def _flush_parent(path: Path, work: Path) -> None:
     try:
         flush_folder(path.parent, ControlError)
     except ControlError as exc:
-        why = getattr(exc.__cause__, "strerror", None) or str(exc.__cause__ or exc)
         try:
             os.rename(path, work / path.name)
         except OSError:
             raise exc from exc.__cause__  # the bag stays: flush_folder says so
         raise ControlError(
             f"{path}: cannot write (its folder {path.parent} could not be flushed to disk after "
-            f"the move: {why}; the bag was not kept: check the disk and write it again)"
+            f"the move: {_flush_reason(exc)}; the bag was not kept: check the disk and write it "
+            "again)"
         ) from exc.__cause__
 
 

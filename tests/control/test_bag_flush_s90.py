@@ -14,7 +14,7 @@ pytest.importorskip("rosbags")
 import control  # noqa: E402
 from control.robot import bags, read_recording, write_sensor_bag  # noqa: E402
 from gpmsa.io import atomic  # noqa: E402
-from tests._fsync import fail_fsync  # noqa: E402
+from tests._fsync import fail_fsync, record_folder_fsyncs  # noqa: E402
 
 N = 40
 
@@ -85,16 +85,7 @@ def test_an_io_error_flushing_the_parent_names_it_with_the_bag_in_place(tmp_path
 def test_folders_made_for_the_bag_are_flushed_into_their_parents(tmp_path, monkeypatch):
     # session 91: a bag written to new/deeper/bag made new/ and new/deeper/, but their names in
     # tmp_path and new/ were never flushed: a power cut could lose the whole bag
-    events, real_fsync = [], os.fsync
-
-    def fsync(fd):
-        st = os.fstat(fd)
-        if stat.S_ISDIR(st.st_mode):
-            events.append(st.st_ino)
-        real_fsync(fd)
-
-    monkeypatch.setattr(bags.os, "fsync", fsync)
-    monkeypatch.setattr(atomic.os, "fsync", fsync)
+    events = record_folder_fsyncs(monkeypatch, bags)
     target = tmp_path / "new" / "deeper" / "bag"
     _write(target, "mcap")
     inode = {p: os.stat(p).st_ino for p in (target, target.parent, target.parent.parent)}
@@ -105,14 +96,7 @@ def test_folders_made_for_the_bag_are_flushed_into_their_parents(tmp_path, monke
 
 
 def test_an_io_error_flushing_a_made_folder_s_parent_keeps_no_bag(tmp_path, monkeypatch):
-    real_fsync = os.fsync
-
-    def fsync(fd):
-        if os.fstat(fd).st_ino == os.stat(tmp_path).st_ino:
-            raise OSError(errno.EIO, os.strerror(errno.EIO))
-        real_fsync(fd)
-
-    monkeypatch.setattr(atomic.os, "fsync", fsync)
+    record_folder_fsyncs(monkeypatch, atomic, fail_inode=os.stat(tmp_path).st_ino)
     target = tmp_path / "new" / "bag"
     with pytest.raises(control.ControlError) as info:
         _write(target, "mcap")

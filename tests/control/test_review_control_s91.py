@@ -2,9 +2,7 @@
 into their parents as soon as they are made, so that a second try, which finds them made, does
 not leave them unflushed; relative, '..' and symlinked parents flush the real folders."""
 
-import errno
 import os
-import stat
 
 import numpy as np
 import pytest
@@ -13,7 +11,7 @@ pytest.importorskip("rosbags")
 
 import control  # noqa: E402
 from control.robot import bags, read_recording, write_sensor_bag  # noqa: E402
-from gpmsa.io import atomic  # noqa: E402
+from tests._fsync import record_folder_fsyncs  # noqa: E402
 
 N = 40
 
@@ -24,29 +22,12 @@ def _write(path):
     return write_sensor_bag(path, t, accel, t, 0.5 * (t - 1.0), np.full(N, 0.5), storage="mcap")
 
 
-def _record_folder_syncs(monkeypatch, fail_inode=None):
-    """The inodes of the folders fsync'd from now on; ``fail_inode``'s fsync raises EIO."""
-    flushed, real_fsync = [], os.fsync
-
-    def fsync(fd):
-        st = os.fstat(fd)
-        if stat.S_ISDIR(st.st_mode):
-            flushed.append(st.st_ino)
-            if st.st_ino == fail_inode:
-                raise OSError(errno.EIO, os.strerror(errno.EIO))
-        real_fsync(fd)
-
-    monkeypatch.setattr(bags.os, "fsync", fsync)
-    monkeypatch.setattr(atomic.os, "fsync", fsync)
-    return flushed
-
-
 def test_a_second_try_after_a_write_that_failed_still_flushes_the_made_folder(
     tmp_path, monkeypatch
 ):
     # review s91: a first write that failed in its block left new/ made but its name in
     # tmp_path unflushed, and the second, finding new/ there, flushed only new/
-    flushed = _record_folder_syncs(monkeypatch)
+    flushed = record_folder_fsyncs(monkeypatch, bags)
     target = tmp_path / "new" / "bag"
     with pytest.raises(RuntimeError, match="the recording failed"):
         with bags.open_bag_writer(target):
@@ -61,13 +42,13 @@ def test_a_retry_after_an_io_error_flushing_a_made_folder_s_parent_flushes_it(
 ):
     # review s91: "check the disk and write it again" wrote the bag into the folder left
     # behind without flushing its name into tmp_path
-    _record_folder_syncs(monkeypatch, fail_inode=os.stat(tmp_path).st_ino)
+    record_folder_fsyncs(monkeypatch, bags, fail_inode=os.stat(tmp_path).st_ino)
     target = tmp_path / "new" / "bag"
     with pytest.raises(control.ControlError, match="check the disk and write it again"):
         _write(target)
     assert os.listdir(tmp_path) == []  # nor the folder made for it
     monkeypatch.undo()
-    flushed = _record_folder_syncs(monkeypatch)
+    flushed = record_folder_fsyncs(monkeypatch, bags)
     _write(target)
     assert os.stat(tmp_path).st_ino in flushed
     assert read_recording(target).imu.stamp_ns.size == N
@@ -77,7 +58,7 @@ def test_relative_dotdot_and_symlinked_parents_flush_the_real_folders(tmp_path, 
     (tmp_path / "real").mkdir()
     (tmp_path / "link").symlink_to("real")
     monkeypatch.chdir(tmp_path)
-    flushed = _record_folder_syncs(monkeypatch)
+    flushed = record_folder_fsyncs(monkeypatch, bags)
     _write(os.path.join("a", "..", "b", "bag"))  # makes a/ and b/, both in tmp_path
     assert os.stat(tmp_path).st_ino in flushed and os.stat("b").st_ino in flushed
     flushed.clear()

@@ -2,30 +2,23 @@
 files in place, so the folders are still flushed to disk, and its error is raised."""
 
 import os
-import stat
 import sys
 
 import pytest
 
 from gpmsa.io import atomic
 from gpmsa.io.atomic import atomic_group
+from tests._fsync import record_folder_fsyncs
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="no fsync of a folder there")
 
 
 def test_an_on_moved_that_raises_still_has_the_folders_flushed(tmp_path, monkeypatch):
-    flushed, real_fsync = [], os.fsync
-
-    def fsync(fd):
-        st = os.fstat(fd)
-        if stat.S_ISDIR(st.st_mode):
-            flushed.append(st.st_ino)
-        real_fsync(fd)
+    flushed = record_folder_fsyncs(monkeypatch, atomic)
 
     def on_moved():
         raise RuntimeError("the caller's record failed")
 
-    monkeypatch.setattr(atomic.os, "fsync", fsync)
     (tmp_path / "a").mkdir()
     with pytest.raises(RuntimeError, match="the caller's record failed"):
         with atomic_group(on_moved=on_moved) as stage:
