@@ -135,8 +135,9 @@ class GridMarginal:
 
     @underflow_as_zero
     def cdf(self, value: np.ndarray | float) -> np.ndarray:
-        """P(X <= value) under the piecewise-linear density."""
-        x = np.asarray(value, dtype=float)
+        """P(X <= value) under the piecewise-linear density (0 below the first node, 1 from the
+        last; GPMSAError for a NaN value)."""
+        x = _values_without_nan(value)
         cum = np.concatenate([[0.0], np.cumsum(self._cell_mass())])
         k = np.clip(np.searchsorted(self.nodes, x, side="right") - 1, 0, self.nodes.size - 2)
         a, h = self.nodes[k], np.diff(self.nodes)[k]
@@ -147,10 +148,14 @@ class GridMarginal:
         out = np.where(t < h, cum[k] + f0 * t + 0.5 * (f1 - f0) * t * t / h, cum[k + 1])
         return np.clip(out / cum[-1], 0.0, 1.0)
 
-    @underflow_as_zero
     def ppf(self, q: np.ndarray | float) -> np.ndarray:
-        """Quantile function: the inverse of ``cdf`` (exact for the piecewise-linear density)."""
-        q = np.asarray(q, dtype=float)
+        """Quantile function: the inverse of ``cdf`` (exact for the piecewise-linear density);
+        ``q`` in [0, 1] (GPMSAError otherwise)."""
+        return self._ppf(check_probabilities(q, "q"))
+
+    @underflow_as_zero
+    def _ppf(self, q: np.ndarray) -> np.ndarray:
+        """`ppf` of probabilities already checked to lie in [0, 1]."""
         width = self.nodes[1:] - self.nodes[:-1]
         mass = 0.5 * width * (self.density[:-1] + self.density[1:])  # (`_cell_mass`)
         cells = np.flatnonzero(mass > 0.0)  # cells without mass hold no quantile
@@ -172,16 +177,16 @@ class GridMarginal:
     def hdi(self, level: float) -> tuple[float, float]:
         """The shortest interval holding probability ``level`` (the highest-density interval of a
         unimodal density; it reaches a grid end where the density piles up there), its lower
-        tail probability resolved to (1 - level) / (HDI_STEPS - 1)."""
-        tails = _float_hdi_probabilities if isinstance(level, float) else _hdi_probabilities
-        ends = self.ppf(tails(level))
+        tail probability resolved to (1 - level) / (HDI_STEPS - 1). ``level`` in (0, 1)
+        (GPMSAError otherwise)."""
+        ends = self._ppf(_float_hdi_probabilities(check_level(level)))
         lo, hi = ends[:HDI_STEPS], ends[HDI_STEPS:]
         k = int(np.argmin(hi - lo))
         return float(lo[k]), float(hi[k])
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """Independent draws from the piecewise-linear density."""
-        return self.ppf(rng.random(size))
+        return self._ppf(rng.random(size))
 
 
 @dataclass(frozen=True, eq=False)
@@ -254,22 +259,27 @@ class LevelMarginal:
         return f"LevelMarginal({{{probs}}})"
 
     def cdf(self, value: np.ndarray | float) -> np.ndarray:
-        """P(X <= value)."""
+        """P(X <= value) (GPMSAError for a NaN value)."""
         cum = np.cumsum(self.density)
-        k = np.searchsorted(self.nodes, np.asarray(value, dtype=float), side="right")
+        k = np.searchsorted(self.nodes, _values_without_nan(value), side="right")
         return np.clip(np.where(k > 0, cum[np.maximum(k - 1, 0)], 0.0), 0.0, 1.0)
 
     def ppf(self, q: np.ndarray | float) -> np.ndarray:
         """The lower quantile: the smallest level with mass whose CDF reaches q (q = 0: the
-        smallest level with mass)."""
+        smallest level with mass); ``q`` in [0, 1] (GPMSAError otherwise)."""
+        return self._ppf(check_probabilities(q, "q"))
+
+    def _ppf(self, q: np.ndarray) -> np.ndarray:
+        """`ppf` of probabilities already checked to lie in [0, 1]."""
         live = np.flatnonzero(self.density > 0.0)
         cum = np.cumsum(self.density[live])
-        j = np.searchsorted(cum, np.asarray(q, dtype=float) * cum[-1], side="left")
+        j = np.searchsorted(cum, q * cum[-1], side="left")
         return self.nodes[live][np.minimum(j, live.size - 1)]
 
     def hdi(self, level: float) -> tuple[float, float]:
         """The shortest interval [a, b] between levels holding probability ``level`` at least
-        (of two as short, the one holding more)."""
+        (of two as short, the one holding more); ``level`` in (0, 1) (GPMSAError otherwise)."""
+        level = check_level(level)
         cum = np.concatenate([[0.0], np.cumsum(self.density)])
         best = (np.inf, 0.0, 0, self.nodes.size - 1)
         for i in range(self.nodes.size):
@@ -284,21 +294,26 @@ class LevelMarginal:
 
     def sample(self, rng: np.random.Generator, size: int) -> np.ndarray:
         """Independent draws of the level."""
-        return self.ppf(rng.random(size))
-
-
-def _hdi_probabilities(level: float) -> np.ndarray:
-    """The lower tail probabilities `GridMarginal.hdi` tries, then the same plus ``level``."""
-    p = np.linspace(0.0, 1.0 - level, HDI_STEPS)
-    return np.concatenate([p, p + level])
+        return self._ppf(rng.random(size))
 
 
 @functools.lru_cache(maxsize=16)
 def _float_hdi_probabilities(level: float) -> np.ndarray:
-    """`_hdi_probabilities` of a float level, kept (read-only: every call shares them)."""
-    out = _hdi_probabilities(level)
+    """The lower tail probabilities `GridMarginal.hdi` tries at a float ``level``, then the
+    same plus ``level``; kept (read-only: every call shares them)."""
+    p = np.linspace(0.0, 1.0 - level, HDI_STEPS)
+    out = np.concatenate([p, p + level])
     out.flags.writeable = False
     return out
+
+
+def _values_without_nan(value) -> np.ndarray:
+    """``value`` as a float array for a marginal's ``cdf``; GPMSAError for a NaN (whose CDF
+    would read as 1)."""
+    x = np.asarray(value, dtype=float)
+    if np.isnan(x).any():
+        raise GPMSAError(f"value must not be NaN, got {value!r}")
+    return x
 
 
 def _named_arrays(value, what: str, kind: str, ndim: int, wrong_shape: str) -> dict:
@@ -579,7 +594,7 @@ class Posterior:
         self._check(name)
         q_arr = check_probabilities(q, "q")
         if name in self.grids:
-            out = self.grids[name].ppf(q_arr)
+            out = self.grids[name]._ppf(q_arr)
         else:  # a categorical parameter's (info["levels"]): the lower quantile, a level
             discrete = self._level_codes(name) is not None
             out = np.quantile(self.samples[name], q_arr,
