@@ -63,14 +63,12 @@ class HyperPriors:
                              f"{self.mu_sd!r:.60}: the unit range (0, 1) of mu lies {far:.3g} "
                              "sds from the mean, beyond float range; give a mean within 1e150 "
                              "sds of (0, 1)")  # fmt: skip
-        with np.errstate(over="ignore", under="ignore"):
-            sd2 = float(np.float64(self.sd_max) ** 2)
-        # the prior works with sd^2, lam_min 1/sd^2 and the default start lam 4/sd^2
-        if not (finite(sd2) and sd2 > 0 and finite(4.0 / sd2)):
+        if not sd_max_usable(self.sd_max):
             raise GPMSAError(f"HyperPriors.sd_max={self.sd_max!r:.60}: its square and "
                              "4/sd_max^2 (the default start precision) must be finite, non-zero "
                              "float64s (sd_max within about 1.5e-154 to 1.3e154; an sd on the "
                              "unit scale: 0.01 to 10 is the useful range)")  # fmt: skip
+        sd2 = float(np.float64(self.sd_max) ** 2)
         if self.lam_start is None:
             inside = self.sd_prior != "uniform" or 5.0 * sd2 > 1.0
             object.__setattr__(self, "lam_start", 5.0 if inside else 4.0 / sd2)
@@ -378,6 +376,15 @@ def check_hyper(hyper: HyperPriors, given: bool, layout: Layout, fresh: bool = T
             "stay near their start); 0.01 to 10 is the useful range (unit scale), and for a "
             f"parameter that takes one value in every model use shared={list(layout.groups)}"
         )
+
+
+def sd_max_usable(sd_max) -> bool:
+    """Whether the finite ``sd_max`` > 0 has a square and a 4/sd_max^2 (the default start
+    precision) that are finite, non-zero float64s: the prior works with sd^2, lam_min 1/sd^2
+    and the default start lam 4/sd^2 (sd_max within about 1.5e-154 to 1.3e154)."""
+    with np.errstate(over="ignore", under="ignore", divide="ignore"):
+        sd2 = float(np.float64(sd_max) ** 2)
+    return finite(sd2) and sd2 > 0 and finite(4.0 / sd2)
 
 
 def finite(val) -> bool:

@@ -10,7 +10,7 @@ import numpy as np
 from gpmsa.errors import EmulatorFileError, numbers_text
 from gpmsa.fitting.validation import DISCREPANCY_KINDS, check_rate, check_sweeps, group_count
 from gpmsa.studies.hot import check_hot_record
-from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout, finite
+from gpmsa.studies.layout import LABEL_RE, NUMBERS, SD_PRIORS, Layout, finite, sd_max_usable
 
 KINDS = ("calibration", "fit")
 """How a study's draws were made: calibration with the emulators fixed, or a joint fit."""
@@ -97,9 +97,9 @@ def check_study_manifest(manifest: dict) -> None:
         if not ok or (key != "mu_mean" and not val > 0):
             need = "a finite number" if key == "mu_mean" else "a finite number > 0"
             raise _fail(f"priors.hyper.{key}", f"must be {need}, got {_short(val)}")
-        if key == "sd_max" and not (finite(val * val) and val * val > 0):  # HyperPriors squares it
-            raise _fail(f"priors.hyper.{key}", f"{_short(val)}: its square is not a finite, "
-                                               "non-zero float64")  # fmt: skip
+        if key == "sd_max" and not sd_max_usable(val):  # as HyperPriors checks it
+            raise _fail(f"priors.hyper.{key}", f"{_short(val)}: its square and 4/sd_max^2 are "
+                                               "not finite, non-zero float64s")  # fmt: skip
     n_groups = _check_discrepancies(manifest, study["kind"], labels)
     specs = manifest["arrays"]
     want = [*ARRAYS, *(a for j in n_groups for a in discrepancy_arrays(j))]

@@ -315,16 +315,23 @@ def test_a_one_model_record_passes():
         ),
         (
             _set("priors.hyper.sd_max", 1e-170),
-            "priors.hyper.sd_max: 1e-170: its square is not a finite, non-zero float64",
+            "priors.hyper.sd_max: 1e-170: its square and 4/sd_max^2 are not finite, non-zero "
+            "float64s",
         ),
         (
             _set("priors.hyper.sd_max", 1e160),
-            "priors.hyper.sd_max: 1e+160: its square is not a finite, non-zero float64",
+            "priors.hyper.sd_max: 1e+160: its square and 4/sd_max^2 are not finite, non-zero "
+            "float64s",
+        ),
+        (  # its square 1e-308 is finite and non-zero, but 4/sd_max^2 overflows (session 92)
+            _set("priors.hyper.sd_max", 1e-154),
+            "priors.hyper.sd_max: 1e-154: its square and 4/sd_max^2 are not finite, non-zero "
+            "float64s",
         ),
         (
             _set("priors.hyper.sd_max", 10**200),
-            f"priors.hyper.sd_max: {str(10**200)[:57]}...: its square is not a finite, non-zero "
-            "float64",
+            f"priors.hyper.sd_max: {str(10**200)[:57]}...: its square and 4/sd_max^2 are not "
+            "finite, non-zero float64s",
         ),
     ],
 )
