@@ -6,7 +6,7 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import ndtr
+from scipy.special import ndtr, ndtri
 
 from gpmsa._fp_state import underflow_as_zero
 from gpmsa._progress import progress_bar
@@ -74,14 +74,14 @@ class CalibratedPrediction:
         return np.tensordot(self.weights, ndtr(z), axes=1)
 
     def quantile(self, q: float) -> np.ndarray:
-        """Predictive quantile (N, l_sim) at one probability q in (0, 1) (bisection on the CDF;
-        a list or an array of several q is refused: call once per q)."""
+        """Predictive quantile (N, l_sim) at one probability q in (0, 1) (bisection on the CDF
+        between the components' own q-quantiles, which bracket the mixture's at any q; a list
+        or an array of several q is refused: call once per q)."""
         q = as_real(q, "q")
         if not 0.0 < q < 1.0:
             raise GPMSAError(f"q must lie in (0, 1), got {q}")
-        sd = np.sqrt(self.comp_var)
-        lo = np.min(self.comp_mean - 9.0 * sd, axis=0)
-        hi = np.max(self.comp_mean + 9.0 * sd, axis=0)
+        own = self.comp_mean + np.sqrt(self.comp_var) * ndtri(q)  # below all: F < q; above: F >= q
+        lo, hi = np.min(own, axis=0), np.max(own, axis=0)
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             below = self.cdf(mid) < q

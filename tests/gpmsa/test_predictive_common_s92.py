@@ -564,3 +564,22 @@ def test_calibrated_predict_warns_once_for_x_new_in_the_margin():
         warnings.simplefilter("always")
         gpmsa.calibrated_predict(emu, post, [[1.05]])
     assert len(seen) == 1, [str(w.message) for w in seen]
+
+
+@pytest.mark.parametrize("q", [1e-25, 1e-300, 1.0 - 1e-16])
+def test_a_quantile_beyond_nine_sds_is_found(q):
+    """(Before session 92 the bisection started within 9 sds of the components and gave that
+    bracket's end for q below ~1e-19 or as near 1.) The components' own q-quantiles bracket a
+    mixture's: one component is inverted exactly, two far apart split the mass."""
+    from gpmsa.predictive.calibrated import CalibratedPrediction
+
+    one = CalibratedPrediction(x=np.zeros((1, 1)), mean=np.full((1, 1), 2.0),
+                               var=np.full((1, 1), 4.0), comp_mean=np.full((1, 1, 1), 2.0),
+                               comp_var=np.full((1, 1, 1), 4.0), weights=np.ones(1))  # fmt: skip
+    np.testing.assert_allclose(one.quantile(q), [[2.0 + 2.0 * ndtri(q)]], rtol=1e-14)
+    two = CalibratedPrediction(x=np.zeros((1, 1)), mean=np.full((1, 1), 5.0),
+                               var=np.full((1, 1), 26.0), comp_mean=np.array([[[0.0]], [[10.0]]]),
+                               comp_var=np.ones((2, 1, 1)), weights=np.full(2, 0.5))  # fmt: skip
+    if q < 0.5:  # (near 1 the CDF itself is resolved to ~1e-16 only)
+        # the far lower tail is the nearer component's alone, at probability q / 0.5
+        np.testing.assert_allclose(two.quantile(q), [[ndtri(2 * q)]], rtol=1e-12)
