@@ -510,10 +510,12 @@ def quantile_keys(level: float) -> tuple[str, str]:
 
 def check_probabilities(q, name: str = "q") -> np.ndarray:
     """``q`` as a float64 array of probabilities in [0, 1] (a number: a 0-d array); GPMSAError
-    naming ``name`` and the value given for none, a NaN or an infinity, or one outside [0, 1]
-    (the quantile functions' ``q``)."""
+    naming ``name`` and the value given for none (an empty q), a NaN or an infinity, or one
+    outside [0, 1] (the quantile functions' ``q``)."""
     arr = as_float(q, name)
-    if arr.size == 0 or np.any(~np.isfinite(arr)) or np.any((arr < 0) | (arr > 1)):
+    if arr.size == 0:
+        raise GPMSAError(f"{name} must hold at least one probability, got {q!r}")
+    if np.any(~np.isfinite(arr)) or np.any((arr < 0) | (arr > 1)):
         raise GPMSAError(f"{name} must lie in [0, 1], got {q!r}")
     return arr
 

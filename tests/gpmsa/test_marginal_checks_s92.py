@@ -55,3 +55,9 @@ def test_a_float32_level_is_read_as_its_float64_value():
     """(Before, a numpy float32 level went uncached through float32 tail arithmetic.)"""
     grid = _grid()
     assert grid.hdi(np.float32(0.5)) == grid.hdi(float(np.float32(0.5)))
+
+
+@pytest.mark.parametrize("make", MARGINALS)
+def test_an_empty_q_is_named_as_empty(make):
+    with pytest.raises(GPMSAError, match=r"^q must hold at least one probability, got \[\]$"):
+        make().ppf([])

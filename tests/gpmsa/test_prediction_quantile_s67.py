@@ -81,7 +81,7 @@ BAD_Q = [
     (float("nan"), r"q must lie in \[0, 1\], got nan"),
     (float("inf"), r"q must lie in \[0, 1\], got inf"),
     ([0.2, 1.01], r"q must lie in \[0, 1\], got \[0.2, 1.01\]"),
-    ([], r"q must lie in \[0, 1\], got \[\]"),
+    ([], r"q must hold at least one probability, got \[\]"),
     ("0.5", "q must be a numeric array, got str '0.5'"),
     (True, "q must be a numeric array, got bool"),
     (None, "q must be a numeric array, got None"),

@@ -155,7 +155,7 @@ def test_quantile_inverts_the_cdf(q):
 
 
 def test_quantile_of_a_far_tail_and_the_interval():
-    """q = 1e-15: the lower end, 7.9 sd below the mean, still inside the bracket of 9 sd."""
+    """q = 1e-15: the lower end, 7.9 sd below the mean (one component: its own q-quantile)."""
     p = _prediction()
     one = CalibratedPrediction(p.x, p.comp_mean[0], p.comp_var[0], p.comp_mean[:1],
                                      p.comp_var[:1], np.array([1.0]))  # fmt: skip
@@ -528,7 +528,7 @@ def test_grid_nodes_below_1e_12_of_the_largest_mass_are_dropped():
 
 @pytest.mark.parametrize("q", [1e-6, 1.0 - 1e-6])
 def test_quantile_of_a_wide_component_in_both_tails(q):
-    """sd 2: the 1e-6 quantiles lie 4.75 sd = 9.5 from the mean, inside the bracket of 9 sd."""
+    """sd 2: the 1e-6 quantiles lie 4.75 sd = 9.5 from the mean (in sds, not output units)."""
     one = CalibratedPrediction(np.zeros((1, 1)), np.ones((1, 1)), np.full((1, 1), 4.0),
                                np.ones((1, 1, 1)), np.full((1, 1, 1), 4.0), np.ones(1))  # fmt: skip
     np.testing.assert_allclose(one.quantile(q), 1.0 + 2.0 * ndtri(q), rtol=1e-9)
