@@ -101,3 +101,17 @@ def three_input_emulator() -> gpmsa.Emulator:
                          x_names=["x"], t_names=["a", "b"])  # fmt: skip
     prm = {"betaU": [[1.0], [2.0], [0.5]], "lamUz": [1.0], "lamWs": [1e3], "lamWOs": [1e3]}
     return gpmsa.Emulator.from_params(data, prm)
+
+
+def four_run_data() -> gpmsa.SimData:
+    """Four runs of one output, one x and one t: the exact prediction tests' tiny design."""
+    x = np.array([[0.0], [0.5], [1.0], [0.25]])
+    t = np.array([[0.0], [1.0], [0.5], [0.75]])
+    y = np.array([[1.0], [3.0], [2.0], [2.5]])
+    return gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["t"])
+
+
+def four_run_emulator() -> gpmsa.Emulator:
+    """`four_run_data`'s emulator (K = [[1]], lam_sim = 1) at fixed parameters."""
+    prm = {"betaU": [[1.0], [2.0]], "lamUz": [2.0], "lamWs": [10.0], "lamWOs": [50.0]}
+    return gpmsa.Emulator.from_params(four_run_data(), prm)

@@ -9,6 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _fit_cases import five_run_data
 
 import gpmsa
 from gpmsa import backends
@@ -19,11 +20,7 @@ from gpmsa.fitting import fit as fit_module
 
 @pytest.fixture(scope="module")
 def data() -> gpmsa.SimData:
-    """5 runs of one known input and one parameter, a 4-point output."""
-    rng = np.random.default_rng(0)
-    x, t = rng.uniform(size=(5, 1)), rng.uniform(size=(5, 1))
-    grid = np.arange(1, 5)
-    return gpmsa.SimData(x=x, t=t, y=np.sin(grid * (3 * x + t)))
+    return five_run_data()
 
 
 @pytest.fixture

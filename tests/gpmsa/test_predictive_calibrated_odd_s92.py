@@ -4,22 +4,13 @@ posterior's weights sum to 1 after the nodes below 1e-12 of the largest mass are
 
 import numpy as np
 import pytest
+from _predict_cases import four_run_emulator
 
 import gpmsa
 from gpmsa import GPMSAError
 from gpmsa.calibration.posterior import GridMarginal
 
 X2 = [[0.2], [0.8]]
-
-
-def _emulator() -> gpmsa.Emulator:
-    """Four runs of one output, one x and one t (K = [[1]]) at fixed parameters."""
-    x = np.array([[0.0], [0.5], [1.0], [0.25]])
-    t = np.array([[0.0], [1.0], [0.5], [0.75]])
-    y = np.array([[1.0], [3.0], [2.0], [2.5]])
-    data = gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["t"])
-    prm = {"betaU": [[1.0], [2.0]], "lamUz": [2.0], "lamWs": [10.0], "lamWOs": [50.0]}
-    return gpmsa.Emulator.from_params(data, prm)
 
 
 @pytest.mark.parametrize(
@@ -31,14 +22,14 @@ def test_flags_are_refused_by_name_unless_true_or_false(option, value, x_new):
     or let x_new = 2 lie 100 % beyond the x range)."""
     post = gpmsa.Posterior({"t": np.array([0.2, 0.4]), "lamOs": np.array([1.0, 2.0])})
     with pytest.raises(GPMSAError, match=f"{option} must be True or False"):
-        gpmsa.calibrated_predict(_emulator(), post, x_new, **{option: value})
+        gpmsa.calibrated_predict(four_run_emulator(), post, x_new, **{option: value})
 
 
 def test_grid_weights_sum_to_one_after_the_cut():
     """2001 nodes, one of density 1 and 2000 of 5e-13 (mass 5e-13 of the largest: cut): the cut
     mass is ~1e-9 of the total, so the one live node's weight is exactly 1 only if the kept
     masses are renormalised (multiplying by their sum instead gives 1 - 2e-9)."""
-    emu = _emulator()
+    emu = four_run_emulator()
     nodes = np.linspace(0.0, 1.0, 2001)
     log_f = np.full(2001, np.log(5e-13))
     log_f[1000] = 0.0

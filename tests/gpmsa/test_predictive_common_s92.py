@@ -10,6 +10,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _predict_cases import four_run_data, four_run_emulator
 from scipy.special import ndtr, ndtri
 
 import gpmsa
@@ -18,20 +19,6 @@ from gpmsa.calibration.posterior import GridMarginal
 from gpmsa.predictive import CalibratedPrediction
 
 X2 = [[0.2], [0.8]]
-
-
-def _data() -> gpmsa.SimData:
-    """Four runs of one output, one x and one t."""
-    x = np.array([[0.0], [0.5], [1.0], [0.25]])
-    t = np.array([[0.0], [1.0], [0.5], [0.75]])
-    y = np.array([[1.0], [3.0], [2.0], [2.5]])
-    return gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["t"])
-
-
-def _emulator() -> gpmsa.Emulator:
-    """`_data`'s emulator (K = [[1]]) at fixed parameters."""
-    prm = {"betaU": [[1.0], [2.0]], "lamUz": [2.0], "lamWs": [10.0], "lamWOs": [50.0]}
-    return gpmsa.Emulator.from_params(_data(), prm)
 
 
 def _components(emu, thetas, resid=True):
@@ -45,7 +32,7 @@ def _components(emu, thetas, resid=True):
 def test_draws_mixture_is_the_evenly_spaced_draws_components_with_their_lamos(noise):
     """Five draws, n_theta=3: draws 0, 2, 4, weights 1/3; noise adds y_sd^2 / lamOs_k (that
     draw's own lamOs); mean and variance by the law of total variance."""
-    emu = _emulator()
+    emu = four_run_emulator()
     t = np.array([0.1, 0.3, 0.5, 0.7, 0.9])
     lam = np.array([1.0, 2.0, 4.0, 8.0, 16.0])
     post = gpmsa.Posterior({"t": t, "lamOs": lam})
@@ -65,7 +52,7 @@ def test_draws_mixture_is_the_evenly_spaced_draws_components_with_their_lamos(no
 
 def test_noise_takes_only_the_used_draws_lamos():
     """A bad lamOs on a draw that n_theta skips is not read: only the used draws' lamOs are."""
-    emu = _emulator()
+    emu = four_run_emulator()
     post = gpmsa.Posterior({"t": np.array([0.1, 0.3, 0.5]), "lamOs": np.array([2.0, -1.0, 4.0])})
     p = gpmsa.calibrated_predict(emu, post, X2, n_theta=2, noise=True)
     _, var = _components(emu, [0.1, 0.5])
@@ -85,7 +72,7 @@ def _grid_posterior(info=None):
 def test_grid_mixture_is_the_live_nodes_with_the_trapezoid_mass(noise):
     """A one-parameter grid: the nodes carrying mass, weights w_i f_i normalised; noise adds
     y_sd^2 E[1/lamOs | theta_i] from info["expected_inv_lamOs"] at those nodes."""
-    emu = _emulator()
+    emu = four_run_emulator()
     inv = [0.5, 0.25, 1.0, 2.0]
     p = gpmsa.calibrated_predict(emu, _grid_posterior({"expected_inv_lamOs": inv}), X2,
                                  noise=noise)  # fmt: skip
@@ -104,7 +91,7 @@ def test_grid_mixture_is_the_live_nodes_with_the_trapezoid_mass(noise):
 def test_grid_without_expected_inv_lamos_and_noise_uses_the_draws():
     """noise=True on a grid posterior without info["expected_inv_lamOs"]: the draws (and their
     lamOs), equally weighted, not the grid."""
-    emu = _emulator()
+    emu = four_run_emulator()
     g = _grid_posterior().grids["t"]
     post = gpmsa.Posterior({"t": np.array([0.9, 0.7]), "lamOs": np.array([2.0, 4.0])},
                            grids={"t": g})  # fmt: skip
@@ -188,7 +175,7 @@ def test_repr_counts_points_outputs_and_components():
 
 
 def test_n_theta_defaults_to_200_evenly_spaced_draws():
-    emu = _emulator()
+    emu = four_run_emulator()
     t = np.linspace(0.0, 1.0, 401)
     p = gpmsa.calibrated_predict(emu, gpmsa.Posterior({"t": t}), X2)
     assert p.weights.shape == (200,)
@@ -281,7 +268,7 @@ def test_lacks_text_and_posterior_lamos():
 def test_check_posterior_emulator():
     from gpmsa.predictive._common import check_posterior_emulator
 
-    emu = _emulator()
+    emu = four_run_emulator()
     check_posterior_emulator(emu, gpmsa.Posterior({"t": np.zeros(2)}))
     own = gpmsa.Posterior({"t": np.zeros(2)}, info={"emulator_sha256": emu.model_sha256})
     check_posterior_emulator(emu, own)
@@ -300,7 +287,7 @@ def test_paired_draws_positions_and_their_bounds():
 
     from gpmsa.predictive._common import paired_draws
 
-    emu = with_draws(_emulator(), n=3)
+    emu = with_draws(four_run_emulator(), n=3)
     t = np.array([0.1, 0.2])
     for pos in ([0, 2], [2, 0]):
         got = paired_draws(emu, gpmsa.Posterior({"t": t}, info={"emulator_draws": pos}), "f")
@@ -312,7 +299,7 @@ def test_paired_draws_positions_and_their_bounds():
     empty = SimpleNamespace(samples={"t": np.zeros(0)}, info={"emulator_draws": np.zeros(0, int)})
     assert paired_draws(emu, empty, "f").shape == (0,)
     with pytest.raises(GPMSAError, match="kept none"):
-        paired_draws(_emulator(), gpmsa.Posterior({"t": t}), "f")
+        paired_draws(four_run_emulator(), gpmsa.Posterior({"t": t}), "f")
     point = gpmsa.Posterior({"t": t}, info={"emulator_params": "point"})
     with pytest.raises(GPMSAError, match=r"point estimate \(emulator_params='point'\), every "
                        r"theta draw.*fitted without observations"):  # fmt: skip
@@ -329,7 +316,7 @@ def test_param_sets_and_draws_text():
 
     from gpmsa.predictive._common import draws_text, param_sets
 
-    emu = with_draws(_emulator(), n=5)
+    emu = with_draws(four_run_emulator(), n=5)
     idx, sets = param_sets(emu, False, 2, "f")
     np.testing.assert_array_equal(idx, [-1])
     assert sets == [emu.params] and draws_text(idx) == "point estimate"
@@ -343,7 +330,7 @@ def test_param_sets_and_draws_text():
     with pytest.raises(GPMSAError, match="n_draws"):
         param_sets(emu, False, 0, "f")
     with pytest.raises(GPMSAError, match="f with draws=True needs the emulator's retained"):
-        param_sets(_emulator(), True, None, "f")
+        param_sets(four_run_emulator(), True, None, "f")
 
 
 def test_factors_and_w_conditional_by_dense_solves():
@@ -353,7 +340,7 @@ def test_factors_and_w_conditional_by_dense_solves():
     from gpmsa.model.correlation import correlation
     from gpmsa.predictive._common import factors, gp_factors, w_conditional
 
-    emu = _emulator()
+    emu = four_run_emulator()
     prm = {k: np.asarray(v, dtype=float) for k, v in emu.params.items()}
     S = correlation(emu.zt, None, prm["betaU"][:, 0]) / 2.0 + (1 / 50.0 + 1 / 10.0) * np.eye(4)
     [(L, alpha)] = factors(emu, prm)
@@ -396,7 +383,7 @@ def test_paired_draws_components_are_each_draws_own_predictive(resid, capsys):
     samples evenly spaced; repeated draws give the same component."""
     from _calib_cases import with_draws
 
-    base = _emulator()
+    base = four_run_emulator()
     emu = with_draws(base, n=4)
     t = np.array([0.1, 0.3, 0.5, 0.7, 0.9])
     pos = np.array([3, 0, 1, 0, 2])
@@ -406,7 +393,7 @@ def test_paired_draws_components_are_each_draws_own_predictive(resid, capsys):
     want_m, want_v = [], []
     for i in used:
         prm = {k: np.asarray(emu.draws[k][pos[i]]) for k in ("betaU", "lamUz", "lamWs", "lamWOs")}
-        one = gpmsa.Emulator.from_params(_data(), prm)
+        one = gpmsa.Emulator.from_params(four_run_data(), prm)
         m, v = one.predict(X2, np.full((2, 1), t[i]), resid=resid)
         want_m.append(m)
         want_v.append(v)
@@ -423,14 +410,16 @@ def test_paired_draws_without_a_record_and_as_many_samples_as_draws():
 
     from gpmsa.predictive._common import paired_draws
 
-    emu = with_draws(_emulator(), n=3)
+    emu = with_draws(four_run_emulator(), n=3)
     with pytest.raises(GPMSAError, match="fitted without observations, so it has no theta"):
         paired_draws(emu, gpmsa.Posterior({"t": np.array([0.1, 0.2, 0.3])}), "f")
 
 
 def _callable_basis_emulator() -> gpmsa.Emulator:
     prm = {"betaU": [[1.0], [2.0]], "lamUz": [2.0], "lamWs": [10.0], "lamWOs": [50.0]}
-    return gpmsa.Emulator.from_params(_data(), prm, mean_basis=lambda z: np.ones((len(z), 1)))
+    return gpmsa.Emulator.from_params(
+        four_run_data(), prm, mean_basis=lambda z: np.ones((len(z), 1))
+    )
 
 
 def test_extended_and_gpmsa_model_only():
@@ -440,7 +429,7 @@ def test_extended_and_gpmsa_model_only():
 
     from gpmsa.predictive._common import extended, gpmsa_model_only
 
-    assert not extended(_emulator())
+    assert not extended(four_run_emulator())
     assert extended(categorical_emulator())
     emu = _callable_basis_emulator()
     assert extended(emu)
@@ -484,7 +473,7 @@ def test_posterior_theta_is_on_the_unit_scale():
     """t in [0, 2] natively: theta 0.5 and 1.5 are 0.25 and 0.75 on the unit scale."""
     from gpmsa.predictive._common import posterior_theta
 
-    d = _data()
+    d = four_run_data()
     data = gpmsa.SimData(x=d.x, t=2.0 * d.t, y=d.y, x_names=["x"], t_names=["t"])
     prm = {"betaU": [[1.0], [2.0]], "lamUz": [2.0], "lamWs": [10.0], "lamWOs": [50.0]}
     emu = gpmsa.Emulator.from_params(data, prm)
@@ -513,7 +502,7 @@ def test_unit_inputs_refuses_a_ragged_table_by_name():
 def test_grid_nodes_below_1e_12_of_the_largest_mass_are_dropped():
     """201 nodes of mass ~1/200: a node of relative density 1e-11 is kept (mass 5e-14 > 1e-12 x
     5e-3), one of 1e-13 is dropped; the weights are the kept trapezoid masses, normalised."""
-    emu = _emulator()
+    emu = four_run_emulator()
     nodes = np.linspace(0.0, 1.0, 201)
     log_f = np.zeros(201)
     log_f[50], log_f[150] = np.log(1e-11), np.log(1e-13)
@@ -539,7 +528,7 @@ def test_calibrated_predict_checks_its_posterior_options_and_memory(monkeypatch)
     extrapolate default False) and a prediction above the memory limit are refused."""
     from _calib_cases import with_draws
 
-    emu = _emulator()
+    emu = four_run_emulator()
     post = gpmsa.Posterior({"t": np.array([0.2, 0.4])}, info={"emulator_sha256": "0" * 64})
     with pytest.raises(GPMSAError, match="drawn with another emulator"):
         gpmsa.calibrated_predict(emu, post, X2)
@@ -558,7 +547,7 @@ def test_calibrated_predict_checks_its_posterior_options_and_memory(monkeypatch)
 def test_calibrated_predict_warns_once_for_x_new_in_the_margin():
     """x_new 5 % outside the x range: one ExtrapolationWarning (check_x's), not another from
     the prediction inside."""
-    emu = _emulator()
+    emu = four_run_emulator()
     post = gpmsa.Posterior({"t": np.array([0.2, 0.4])})
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")

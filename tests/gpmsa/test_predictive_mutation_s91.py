@@ -8,6 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 from _calib_cases import with_draws
+from _predict_cases import four_run_emulator
 
 import gpmsa
 from gpmsa import GPMSAError
@@ -15,16 +16,6 @@ from gpmsa.model.correlation import correlation
 from gpmsa.predictive import CrossValidation, EmulatorPrediction
 
 PARAMS = ("betaU", "lamUz", "lamWs", "lamWOs")
-
-
-def _scalar_emulator() -> gpmsa.Emulator:
-    """Four runs of one output (K = [[1]], lam_sim = 1), one x and one t, fixed parameters."""
-    x = np.array([[0.0], [0.5], [1.0], [0.25]])
-    t = np.array([[0.0], [1.0], [0.5], [0.75]])
-    y = np.array([[1.0], [3.0], [2.0], [2.5]])
-    data = gpmsa.SimData(x=x, t=t, y=y, x_names=["x"], t_names=["t"])
-    prm = {"betaU": [[1.0], [2.0]], "lamUz": [2.0], "lamWs": [10.0], "lamWOs": [50.0]}
-    return gpmsa.Emulator.from_params(data, prm)
 
 
 def _vector_emulator() -> gpmsa.Emulator:
@@ -154,7 +145,7 @@ def test_a_single_row_of_t_broadcasts_against_the_rows_of_x():
 
 
 def test_interval_defaults_to_0_9_and_checks_its_level():
-    pred = gpmsa.emulator_prediction(_scalar_emulator(), X2, T2, draws=False, n_rlz=40, seed=2)
+    pred = gpmsa.emulator_prediction(four_run_emulator(), X2, T2, draws=False, n_rlz=40, seed=2)
     lo, hi = pred.interval()
     np.testing.assert_array_equal(lo, pred.quantile(0.05))
     np.testing.assert_array_equal(hi, pred.quantile(0.95))
@@ -163,11 +154,11 @@ def test_interval_defaults_to_0_9_and_checks_its_level():
 
 
 def _pred_case():
-    return gpmsa.emulator_prediction(_scalar_emulator(), X2, T2, draws=False, n_rlz=2, seed=0)
+    return gpmsa.emulator_prediction(four_run_emulator(), X2, T2, draws=False, n_rlz=2, seed=0)
 
 
 @pytest.mark.parametrize(
-    "make", [_pred_case, lambda: gpmsa.cross_validate(_scalar_emulator(), draws=False)]
+    "make", [_pred_case, lambda: gpmsa.cross_validate(four_run_emulator(), draws=False)]
 )
 def test_the_results_are_frozen_and_hash_by_identity(make):
     """Frozen dataclasses of arrays with eq=False: no field can be reassigned, and the object
@@ -233,7 +224,7 @@ def test_loo_of_a_tiny_emulator_by_dense_solves_and_its_pit():
     output the weight (one output: its projection noise is the residual), PIT = Phi(z)."""
     from scipy.special import ndtr
 
-    emu = _scalar_emulator()
+    emu = four_run_emulator()
     cv = gpmsa.cross_validate(emu, draws=False)
     S = _sigma_w(emu, emu.params, 0)
     w = emu.w[:, 0]
@@ -293,7 +284,7 @@ def test_group_folds_over_draws_are_the_mixture_of_dense_conditionals():
 
 
 def test_two_folds_is_the_smallest_k_and_holds_out_each_half():
-    emu = _scalar_emulator()
+    emu = four_run_emulator()
     cv = gpmsa.cross_validate(emu, folds=2, draws=False, seed=1)
     assert sorted(np.bincount(cv.folds)) == [2, 2]
     labelled = gpmsa.cross_validate(emu, folds=cv.folds, draws=False)
@@ -324,7 +315,7 @@ def test_an_empty_cross_validation_prints_zero_runs():
 
 
 def test_cross_validate_defaults_use_the_draws_without_a_bar(capfd):
-    emu = with_draws(_scalar_emulator(), n=3)
+    emu = with_draws(four_run_emulator(), n=3)
     cv = gpmsa.cross_validate(emu)
     np.testing.assert_array_equal(cv.draw_index, [0, 1, 2])
     assert capfd.readouterr().err == ""
