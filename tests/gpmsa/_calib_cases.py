@@ -122,3 +122,15 @@ def sine_sum_emulator(q: int, runs: int, n_iter: int, prefix: str = "t") -> Emul
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return gpmsa.fit(data, n_iter=n_iter, tune=False, seed=0)
+
+
+def one_component_functional() -> tuple[Emulator, np.ndarray]:
+    """(emulator, output grid): 10 runs of a 4-value output linear in x and t, one principal
+    component, at fixed parameters (the observation-reduction tests' functional case)."""
+    x = np.linspace(0.0, 1.0, 10)
+    t = np.random.default_rng(1).permutation(np.linspace(0.0, 1.0, 10))
+    grid = np.linspace(0.0, 1.0, 4)
+    y = (1.0 + x[:, None] + t[:, None]) * (1.0 + grid[None, :])
+    sim = gpmsa.SimData(x=x[:, None], t=t[:, None], y=y, index=grid, x_names=["x"], t_names=["t"])
+    params = {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [5000.0], "lamWOs": [5000.0]}
+    return Emulator.from_params(sim, params, n_pc=1), grid

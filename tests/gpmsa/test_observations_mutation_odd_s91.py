@@ -7,13 +7,10 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _calib_cases import one_component_functional
 
-import gpmsa
 from gpmsa.calibration import observations as obsmod
 from gpmsa.errors import ExtrapolationWarning, GPMSAError
-from gpmsa.fitting.emulator import Emulator
-
-PARAMS = {"betaU": [[1.0], [1.0]], "lamUz": [1.0], "lamWs": [5000.0], "lamWOs": [5000.0]}
 
 
 def test_fixed_gp_refuses_a_separable_emulator_above_the_dense_limit(monkeypatch):
@@ -38,12 +35,7 @@ def test_fit_is_a_frozen_hashable_value():
 def test_reduce_of_a_functional_output_extrapolates_x_where_allowed():
     # x beyond the design's range by more than the margin: refused, or (extrapolate=True)
     # reduced with a warning; the multi-output reduction must not check x again and refuse it
-    x = np.linspace(0.0, 1.0, 10)
-    t = np.random.default_rng(1).permutation(np.linspace(0.0, 1.0, 10))
-    grid = np.linspace(0.0, 1.0, 4)
-    y = (1.0 + x[:, None] + t[:, None]) * (1.0 + grid[None, :])
-    sim = gpmsa.SimData(x=x[:, None], t=t[:, None], y=y, index=grid, x_names=["x"], t_names=["t"])
-    emu = Emulator.from_params(sim, PARAMS, n_pc=1)
+    emu, grid = one_component_functional()
     y_obs = [3.0 * (1.0 + grid)]
     with pytest.raises(GPMSAError, match="extrapolate=True"):
         obsmod.reduce(emu, [[2.0]], y_obs)

@@ -14,6 +14,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from _calib_cases import one_component_functional
 
 import gpmsa
 from gpmsa.calibration import observations as obsmod
@@ -979,12 +980,7 @@ def test_fit_at_levels_with_more_combinations_a_block_than_nodes():
 
 
 def test_functional_output_of_one_component_takes_whole_experiments():
-    x = np.linspace(0.0, 1.0, 10)
-    t = np.random.default_rng(1).permutation(np.linspace(0.0, 1.0, 10))
-    grid = np.linspace(0.0, 1.0, 4)
-    y = (1.0 + x[:, None] + t[:, None]) * (1.0 + grid[None, :])
-    sim = gpmsa.SimData(x=x[:, None], t=t[:, None], y=y, index=grid, x_names=["x"], t_names=["t"])
-    emu = Emulator.from_params(sim, PARAMS, n_pc=1)
+    emu, grid = one_component_functional()
     assert emu.K.shape == (4, 1)
     data = obsmod.reduce(emu, gpmsa.ObsData(x=[[0.5]], y=[2.0 * (1.0 + grid)]), None)
     assert data.z.shape == (1,) and data.values[0].tolist() == (2.0 * (1.0 + grid)).tolist()
