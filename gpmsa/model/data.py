@@ -508,16 +508,30 @@ def quantile_keys(level: float) -> tuple[str, str]:
     )
 
 
+SHOWN_PROBABILITIES = 10
+"""A refused ``q`` of up to this many values is shown whole in ``check_probabilities``'s
+message; a longer one by its first bad entry."""
+
+
 def check_probabilities(q, name: str = "q") -> np.ndarray:
     """``q`` as a float64 array of probabilities in [0, 1] (a number: a 0-d array); GPMSAError
-    naming ``name`` and the value given for none (an empty q), a NaN or an infinity, or one
-    outside [0, 1] (the quantile functions' ``q``)."""
+    naming ``name`` for none (an empty q), a NaN or an infinity, or one outside [0, 1] (the
+    quantile functions' ``q``), with the value given where it holds up to
+    ``SHOWN_PROBABILITIES`` values, else with its first bad entry, that entry's index and the
+    count of bad ones (so that a message never prints a long array whole)."""
     arr = as_float(q, name)
     if arr.size == 0:
         raise GPMSAError(f"{name} must hold at least one probability, got {q!r}")
-    if np.any(~np.isfinite(arr)) or np.any((arr < 0) | (arr > 1)):
+    bad = ~((arr >= 0) & (arr <= 1))  # NaN compares False
+    if not bad.any():
+        return arr
+    if arr.size <= SHOWN_PROBABILITIES:
         raise GPMSAError(f"{name} must lie in [0, 1], got {q!r}")
-    return arr
+    pos = tuple(int(i) for i in np.argwhere(bad)[0])
+    raise GPMSAError(
+        f"{name} must lie in [0, 1], got {arr[pos]} at index {pos} (the first of "
+        f"{int(bad.sum())} of {arr.size} values outside it)"
+    )
 
 
 MAX_SEED = 2**128
