@@ -449,7 +449,7 @@ def emulator_domain(emulator) -> tuple[tuple[float, float], tuple[float, float]]
 
 
 UNIT_HINT_GAIN = 3.0
-"""An implausible block whose band powers read as an acceleration more than this many times
+"""An implausible block whose band powers read as an acceleration this many times (or more)
 louder or quieter than the emulator's GD domain explains gets a clause naming that gain
 (`BCR`'s reason; a message only)."""
 ACCEL_UNIT_SLIPS = (
@@ -1205,7 +1205,7 @@ class BCR:
 
     def _gain_hint(self, y: np.ndarray, v: float) -> str:
         """For an implausible block: a clause naming the gain its band powers read as
-        (`ObservationModel.band_gain`) where that lies beyond `UNIT_HINT_GAIN` either way, and
+        (`ObservationModel.band_gain`) where that reaches `UNIT_HINT_GAIN` either way, and
         the likely unit slip where it lies within a factor 2 of one (`ACCEL_UNIT_SLIPS`); ""
         otherwise, or for a model without ``band_gain``."""
         band_gain = getattr(self.model, "band_gain", None)
