@@ -323,14 +323,15 @@ def _pred_discrepancy(kind, obs_grids: list, std, grid: np.ndarray, scalar: bool
             )
         return discrepancy_basis(kind, grid)
     # "constant"/"linear": the first column is 1 before normalisation; keep the data's scale.
-    scales = {round(float(discrepancy_basis(kind, g)[0, 0]), 12) for g in obs_grids}
-    if len(scales) > 1:
+    # (the scale as computed, not rounded: an index of ~1e12 gives a 'linear' scale ~5e-13)
+    scales = np.array([float(discrepancy_basis(kind, g)[0, 0]) for g in obs_grids])
+    if not np.allclose(scales, scales[0], rtol=1e-12, atol=0.0):
         raise GPMSAError(
             f"the experiments' grids give the {kind!r} discrepancy basis different scales; "
             "full_prediction needs them to share one"
         )
     D = discrepancy_basis(kind, grid)
-    return D * (scales.pop() / D[0, 0])
+    return D * (scales[0] / D[0, 0])
 
 
 def _given_on_grid(kind, given, grid: np.ndarray, scalar: bool, kept: bool,
