@@ -61,10 +61,10 @@ def test_the_quantile_reach_is_the_lowest_over_the_speeds():
     }
     low = 600 - 100 * stats.norm.ppf(0.55)
     assert top_quantile_reach(emu, [0.5], 0.1) == pytest.approx(
-        600 - 50 * stats.norm.ppf(0.55), abs=0.2
+        600 - 50 * stats.norm.ppf(0.55), abs=0.02
     )
-    assert top_quantile_reach(emu, [0.5, 2.0], 0.1) == pytest.approx(low, abs=0.2)
-    assert top_quantile_reach(emu, [2.0, 0.5], 0.1) == pytest.approx(low, abs=0.2)
+    assert top_quantile_reach(emu, [0.5, 2.0], 0.1) == pytest.approx(low, abs=0.02)
+    assert top_quantile_reach(emu, [2.0, 0.5], 0.1) == pytest.approx(low, abs=0.02)
 
 
 def test_a_risk_is_written_with_at_most_six_significant_digits():
