@@ -31,7 +31,7 @@ def _row(what: str) -> list[str]:
 
 def test_the_two_commands_say_how_long_they_take_and_what_they_print():
     two = _section(README, "## The two commands")
-    assert "11-20 s" in two and "~8-12 min" in two and "~8,200 tests" in two
+    assert "11-20 s" in two and "~8-12 min" in two and "~8,400 tests" in two
     assert "python -m pytest -m slow" in two
     # the printed RMSEs are those of the results table
     for case in ("A", "B"):
