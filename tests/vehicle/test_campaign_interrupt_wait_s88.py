@@ -1,7 +1,14 @@
 """An interrupt that reaches the campaign's process alone (a notebook's interrupt button, `kill
 -INT`: a terminal's Ctrl-C signals the workers too) ended the campaign only once every running
 simulation had finished: with 1,700 m runs at 0.5 m/s, 24 s after the signal. The running runs
-are now cut off and the workers ended (0.6 s); a run cut off leaves no cache entry."""
+are now cut off and the workers ended (0.6 s); a run cut off leaves no cache entry.
+
+In 3 of about 14 full-suite runs (sessions 90 and 93) the simulated interrupt was lost: called
+0.1 s after the campaign started, no KeyboardInterrupt reached the main thread for the runs'
+20 s (cause not found; the campaign re-raises whatever it catches, and the test passes alone
+and in 60 runs under load). The watcher therefore sends one more interrupt `RESEND_S` after the
+first where the campaign is still running: a campaign that waits for its runs (the defect)
+ignores both until a run ends, so the test still fails on it."""
 
 import _thread
 import multiprocessing
@@ -21,6 +28,11 @@ so that no run finishes before the interrupt on a loaded machine (the runs are c
 test takes well under a second)."""
 
 
+RESEND_S = 2.0
+"""Seconds after the first interrupt at which the watcher sends a second one, should the
+campaign still be running (see the module docstring)."""
+
+
 def slow_run(spec, cache_dir=None):
     """A stand-in for `campaign.run_one` (forked workers inherit it): marks its start, sleeps,
     then marks its end."""
@@ -34,13 +46,17 @@ def slow_run(spec, cache_dir=None):
 
 
 def interrupt_once_started(folder, done, sent):
-    """Interrupt the main thread (as SIGINT to this process would) once a run has started;
-    ``sent`` gets the time of the interrupt (``time.monotonic``)."""
+    """Interrupt the main thread (as SIGINT to this process would) once a run has started, and
+    once more `RESEND_S` later unless ``done`` is set by then; ``sent`` gets the time of each
+    interrupt (``time.monotonic``)."""
     while not any(p.name.startswith("started-") for p in folder.iterdir()):
         if done.wait(0.02):
             return
     sent.append(time.monotonic())
     _thread.interrupt_main()
+    if not done.wait(RESEND_S):
+        sent.append(time.monotonic())
+        _thread.interrupt_main()
 
 
 @pytest.mark.skipif(
@@ -62,7 +78,8 @@ def test_an_interrupt_cuts_off_the_running_runs_instead_of_waiting_for_them(tmp_
                 )  # fmt: skip
             except Exception as exc:  # (says when the interrupt went, should it be lost again)
                 when = (
-                    f"interrupt_main called {sent[0] - start:.3f} s after the campaign started"
+                    f"interrupt_main called {len(sent)} time(s), first "
+                    f"{sent[0] - start:.3f} s after the campaign started"
                     if sent
                     else "interrupt_main not called (no run seen started)"
                 )
