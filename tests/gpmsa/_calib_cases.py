@@ -109,6 +109,17 @@ def one_t_emulator() -> tuple[Emulator, list, list]:
     return emu, [[0.5]], [[1.3]]
 
 
+def recorded_edge_prior(edge: float, shapes: list):
+    """A callable log prior on one parameter, zero (-inf) below ``edge`` and flat above, that
+    appends the shape of every array it is called with to ``shapes``."""
+
+    def prior(t):
+        shapes.append(np.shape(t))
+        return np.where(np.asarray(t) < edge, -np.inf, 0.0)
+
+    return prior
+
+
 @cache
 def sine_sum_emulator(q: int, runs: int, n_iter: int, prefix: str = "t") -> Emulator:
     """``runs`` runs of y = sin(3 x) + sum(t) (one scalar output, q calibration parameters named

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from _calib_cases import one_t_emulator
+from _calib_cases import one_t_emulator, recorded_edge_prior
 
 import gpmsa
 from gpmsa import Calibrator
@@ -415,10 +415,7 @@ def test_a_callable_priors_zero_edge_beside_a_constraint_is_bisected_point_by_po
 
     emu, x, y = one_t_emulator()
     sizes = []
-
-    def prior(t):
-        sizes.append(np.shape(t))
-        return np.where(np.asarray(t) < 0.6137, -np.inf, 0.0)
+    prior = recorded_edge_prior(0.6137, sizes)
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 import pytest
-from _calib_cases import one_t_emulator, road_emulator
+from _calib_cases import one_t_emulator, recorded_edge_prior, road_emulator
 
 import gpmsa
 from gpmsa import Calibrator, limits
@@ -59,10 +59,7 @@ def test_a_callable_priors_zero_edge_is_bisected_four_steps_a_call():
     129 nodes, after them the edge's one inserted point."""
     emu, x, y = one_t_emulator()
     sizes = []
-
-    def prior(t):
-        sizes.append(np.shape(t))
-        return np.where(np.asarray(t) < 0.6137, -np.inf, 0.0)
+    prior = recorded_edge_prior(0.6137, sizes)
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

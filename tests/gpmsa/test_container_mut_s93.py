@@ -14,20 +14,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_container_mutants_s89 import CONTENT, _npy
 
 from gpmsa import limits
 from gpmsa.errors import EmulatorFileError, GPMSAError
 from gpmsa.io import container
 from gpmsa.io.container import _check_directory, _check_members, jsonable, read_raw, seal
-
-CONTENT = {"names": {}, "units": {}, "priors": {}, "settings": {}, "metadata": {},
-           "diagnostics": {}}  # fmt: skip
-
-
-def _npy(arr: np.ndarray) -> bytes:
-    buf = io.BytesIO()
-    np.save(buf, arr, allow_pickle=False)
-    return buf.getvalue()
 
 
 def _end_record(entries: int, cd_size: int) -> bytes:
